@@ -1,0 +1,14 @@
+"""sim: Monte-Carlo reproduction of classic comparator and plotter calibration papers.
+
+The public surface: load and run studies, the Brown multilateration kernels, and the claims
+and storage helpers every study uses. Everything else is internal.
+"""
+from .claims import claim
+from .config import ConfigError, load_study
+from .multilateration import adjust, covariance, design_theta, ranges, simulate_ranges
+from .runner import run_chunks
+from .storage import read_provenance, write_table
+
+__all__ = ["ConfigError", "load_study", "run_chunks", "adjust", "covariance", "design_theta",
+           "ranges", "simulate_ranges", "claim", "write_table", "read_provenance"]
+__version__ = "0.1.0"

@@ -1,0 +1,153 @@
+"""Benchmark of the batched multilateration solver (``make bench``).
+
+Two questions, one Parquet row per cell (``results/bench/bench.parquet``) and a figure:
+
+1. Trials per second of the 25-point ``pivot`` adjustment, batched, against a per-trial loop
+   of ``scipy.optimize.least_squares`` given the analytic Jacobian, on the same simulated
+   observations and tolerance (both stop on corrections below ~1e-10 mm).
+2. Cost per trial against the number of points (25 to 10,000): linear if the point blocks are
+   eliminated (reduced normals), cubic for a dense solve.
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from . import multilateration as ml
+from .plate import grid_points, random_points
+from .storage import provenance, write_table
+
+__all__ = ["main"]
+
+
+def _obs(n_pts: int, trials: int, seed: int, h: float = 167.5):
+    rng = np.random.default_rng(seed)
+    k = int(round(np.sqrt(n_pts)))
+    pts = grid_points(k, 220.0 / (k - 1)) if k * k == n_pts else random_points(n_pts, 110.0, rng)
+    theta = ml.design_theta(h, 0.5, 1.0)
+    P = np.broadcast_to(pts, (trials,) + pts.shape)
+    obs = ml.simulate_ranges(P, np.broadcast_to(theta, (trials, 7)), rng, setting_sigma_um=1.0,
+                             settings=1)
+    t0 = theta.copy()
+    t0[5:] = 0.0
+    return pts, theta, obs, t0
+
+
+def _scipy_one(obs1: np.ndarray, t0: np.ndarray, p0: np.ndarray):
+    """One trial with scipy: unknowns [points (2n), globals (7)], analytic Jacobian."""
+    n = obs1.shape[0]
+
+    def unpack(z):
+        return z[:2 * n].reshape(1, n, 2), z[2 * n:][None]
+
+    def fun(z):
+        P, th = unpack(z)
+        return (ml.ranges(P, th) - obs1[None]).ravel()
+
+    def jac(z):
+        P, th = unpack(z)
+        Jp, Jg, _ = ml._jacobians(P, th, 7)
+        J = np.zeros((n * 4, 2 * n + 7))
+        rows = np.arange(4 * n)
+        pt = rows // 4
+        J[rows, 2 * pt] = Jp[0].reshape(-1, 2)[:, 0]
+        J[rows, 2 * pt + 1] = Jp[0].reshape(-1, 2)[:, 1]
+        J[:, 2 * n:] = Jg[0].reshape(-1, 7)
+        return J
+
+    z0 = np.concatenate([p0.ravel(), t0])
+    return least_squares(fun, z0, jac=jac, method="lm", xtol=1e-13, ftol=1e-15, gtol=1e-15)
+
+
+def _time(f, repeat: int = 3) -> float:
+    best = np.inf
+    for _ in range(repeat):
+        t = time.perf_counter()
+        f()
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def run(out: Path, quick: bool = False) -> dict:
+    rows: dict[str, list] = {k: [] for k in ("case", "n_points", "trials", "seconds",
+                                             "trials_per_s", "us_per_trial_per_point")}
+
+    def add(case, n, T, sec):
+        rows["case"].append(case)
+        rows["n_points"].append(n)
+        rows["trials"].append(T)
+        rows["seconds"].append(sec)
+        rows["trials_per_s"].append(T / sec)
+        rows["us_per_trial_per_point"].append(sec / T / n * 1e6)
+        print(f"{case:>16} n={n:>6} trials={T:>6} {T / sec:12.1f} trials/s")
+
+    # 1. batched vs scipy loop, 25 points, pivot model
+    T = 500 if quick else 4000
+    Ts = 20 if quick else 100
+    pts, theta, obs, t0 = _obs(25, T, 1)
+    add("batched", 25, T, _time(lambda: ml.adjust(obs, "pivot", t0)))
+    p0 = ml.initial_points(obs[:Ts], np.broadcast_to(t0, (Ts, 7)))
+    res = ml.adjust(obs[:Ts], "pivot", t0)
+
+    def loop():
+        for t in range(Ts):
+            _scipy_one(obs[t], t0, p0[t])
+
+    add("scipy_loop", 25, Ts, _time(loop, 1))
+    z = np.concatenate([res.points[0].ravel(), res.theta[0]])
+    zs = _scipy_one(obs[0], t0, p0[0]).x
+    agree = float(np.abs(z - zs).max())
+    # 2. cost against the number of points
+    for n in ([25, 100, 400, 1600] if quick else [25, 100, 400, 1600, 4900, 10000]):
+        Tn = max(4, 40000 // n)
+        _, _, o, tt = _obs(n, Tn, 2)
+        add("batched_points", n, Tn, _time(lambda: ml.adjust(o, "pivot", tt), 2))
+    prov = provenance({"study": "bench", "seed": 1, "quick": quick},
+                      solutions_agree_mm=agree)
+    write_table(out / "bench.parquet", rows, prov)
+    _figure(rows, out / "bench.png", agree)
+    return rows
+
+
+def _figure(rows, path, agree):
+    from .plotting import plt, save
+
+    case = np.array(rows["case"])
+    tps = np.array(rows["trials_per_s"])
+    n = np.array(rows["n_points"])
+    fig, axs = plt.subplots(1, 2, figsize=(10, 4))
+    b, s = tps[case == "batched"][0], tps[case == "scipy_loop"][0]
+    axs[0].bar(["batched (this)", "scipy loop"], [b, s], color=["tab:blue", "tab:gray"])
+    axs[0].set_yscale("log")
+    axs[0].set_ylabel("trials per second (25 points, pivot)")
+    axs[0].set_title(f"speed-up {b / s:.0f}x; solutions agree to {agree:.1e} mm")
+    sel = case == "batched_points"
+    cost = 1.0 / tps[sel]
+    axs[1].loglog(n[sel], cost * 1e3, "o-", label="measured")
+    axs[1].loglog(n[sel], cost[0] * 1e3 * n[sel] / n[sel][0], "--", color="0.5", label="linear")
+    slope = np.polyfit(np.log(n[sel]), np.log(cost), 1)[0]
+    axs[1].set_title(f"cost per trial vs points (log-log slope {slope:.2f})")
+    axs[1].set_xlabel("points per plate")
+    axs[1].set_ylabel("ms per trial")
+    axs[1].legend()
+    save(fig, path)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m sim.bench", description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default="results/bench")
+    ap.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
+    a = ap.parse_args(argv)
+    rows = run(Path(a.out), a.quick)
+    case = np.array(rows["case"])
+    tps = np.array(rows["trials_per_s"])
+    print(f"speed-up over the scipy loop: {tps[case == 'batched'][0] / tps[case == 'scipy_loop'][0]:.0f}x")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

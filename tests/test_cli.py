@@ -1,0 +1,138 @@
+"""The study-file contract: validation, one-line errors, outputs, provenance, determinism."""
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from sim.cli import main
+from sim.config import ConfigError, load_study, parse_override
+from sim.storage import read_provenance
+
+ROOT = Path(__file__).resolve().parent.parent
+BROWN = ROOT / "studies" / "brown_table1.toml"
+
+
+def write(tmp_path, text, name="study.toml"):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+BASE = 'study = "brown_table1"\ntrials = 20\n'
+
+
+@pytest.mark.parametrize("body, key", [
+    ("[plate]\ngird = 5\n", "plate.gird"),                       # unknown key
+    ("bogus = 1\n", "bogus"),
+    ("[errors]\nsetting_sigma_um = -1.0\n", "errors.setting_sigma_um"),  # negative sigma
+    ("[errors]\nsetting_sigma_um = 0.0\n", "errors.setting_sigma_um"),   # zero sigma
+    ("[errors]\ncomparator_sigma_um = nan\n", "errors.comparator_sigma_um"),
+    ("[errors]\nsettings = 0\n", "errors.settings"),
+    ("[errors]\nsettings = 1.5\n", "errors.settings"),             # wrong type
+    ("[plate]\ngrid = \"five\"\n", "plate.grid"),
+    ("[plate]\ngrid = 1\n", "plate.grid"),                         # fewer than 3 points
+    ("[plate]\npattern = \"list\"\npoints = [[0.0, 0.0], [10.0, 0.0]]\n", "plate.points"),
+    ("[plate]\npattern = \"list\"\npoints = [[0.0, 0.0], [10.0, 0.0], [20.0, 0.0], [30.0, 0.0]]\n",
+     "plate.points"),                                              # collinear
+    ("[plate]\npattern = \"list\"\npoints = [[0.0, 0.0], [10.0, 5.0], [10.0, 5.0], [3.0, 30.0]]\n",
+     "plate.points"),                                              # duplicate
+    ("[plate]\npattern = \"list\"\npoints = [[0.0, 0.0], [10.0, 5.0], [200.0, 5.0], [3.0, 30.0]]\n",
+     "plate.points"),                                              # outside the format
+    ("[plate]\nspacing_mm = 80.0\n", "plate.spacing_mm"),          # grid outside the format
+    ("[plate]\npattern = \"hexagon\"\n", "plate.pattern"),
+    ("[comparator]\nstation_offset_mm = 0.0\n", "comparator.station_offset_mm"),  # inside
+    ("[comparator]\nbeta_mm = inf\n", "comparator.beta_mm"),
+])
+def test_bad_config_names_the_key(tmp_path, body, key):
+    p = write(tmp_path, BASE + body)
+    with pytest.raises(ConfigError) as e:
+        load_study(p)
+    assert e.value.key == key
+    assert "\n" not in str(e.value)
+
+
+def test_cli_bad_input_one_line_exit_2_no_output(tmp_path, capsys):
+    p = write(tmp_path, BASE + "[plate]\ngird = 5\n")
+    out = tmp_path / "res"
+    assert main(["run", str(p), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "plate.gird" in err[0]
+    assert not out.exists() and not list(tmp_path.glob(".res*"))
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["run", "nonexistent.toml"], "no such study file"),
+    (["run", "{bad}"], "malformed TOML"),
+    (["run", "{ok}", "--set", "plate.grid=1"], "plate.grid"),
+    (["run", "{ok}", "--set", "nokey"], "key=value"),
+    (["run", "{ok}", "--trials", "1"], "trials"),
+    (["run", "{unknown_study}"], "unknown study"),
+])
+def test_cli_errors(tmp_path, capsys, args, needle):
+    files = {"bad": write(tmp_path, "study = \n", "bad.toml"), "ok": write(tmp_path, BASE, "ok.toml"),
+             "unknown_study": write(tmp_path, 'study = "nope"\n', "u.toml")}
+    args = [a.format(**files) for a in args]
+    assert main(args + ["--out", str(tmp_path / "o"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0]
+
+
+def test_unwritable_output_directory(tmp_path, capsys):
+    """The output's parent is a regular file: cannot be created (fails for root too)."""
+    blocker = tmp_path / "file"
+    blocker.write_text("not a directory")
+    p = write(tmp_path, BASE)
+    assert main(["run", str(p), "--out", str(blocker / "res"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--out" in err[0]
+
+
+def test_overrides_parse_toml_values():
+    assert parse_override("plate.grid=6") == ("plate.grid", 6)
+    assert parse_override("plate.pattern=random") == ("plate.pattern", "random")
+    assert parse_override("dilution.grids=[3, 4]") == ("dilution.grids", [3, 4])
+
+
+def test_run_writes_contract_files_with_provenance(tmp_path):
+    out = tmp_path / "t1"
+    assert main(["run", str(BROWN), "--out", str(out), "--trials", "60", "--quiet",
+                 "--set", "chunk=25"]) == 0
+    pts = pq.read_table(out / "points.parquet").to_pydict()
+    for col in ("model", "point", "x_mm", "y_mm", "sigma_x_um", "sigma_y_um", "mc_sigma_x_um",
+                "mc_sigma_y_um", "mc_trials"):
+        assert col in pts
+    assert set(pts["model"]) == {"known", "stations", "pivot"}
+    claims = pq.read_table(out / "claims.parquet").to_pydict()
+    for col in ("claim", "source", "paper", "value", "ci_low", "ci_high", "holds", "kind", "note"):
+        assert col in claims
+    assert set(claims["kind"]) <= {"predicted", "input"}
+    trials = pq.read_table(out / "trials.parquet").to_pydict()
+    assert {"converged", "iterations", "sigma0_um", "alpha_mm", "beta2_mm2"} <= set(trials)
+    prov = read_provenance(out / "points.parquet")
+    assert prov["config"]["trials"] == 60 and prov["seed"] == 1967
+    assert {"numpy", "pyarrow"} <= set(prov["versions"]) and prov["git_commit"]
+    assert (out / "table1.png").stat().st_size > 1000
+
+
+def test_same_seed_same_files_and_chunking_by_stream(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    for o in (a, b):
+        assert main(["run", str(BROWN), "--out", str(o), "--trials", "40", "--quiet",
+                     "--set", "chunk=16"]) == 0
+    for f in ("points.parquet", "claims.parquet", "trials.parquet", "table1.png"):
+        assert (a / f).read_bytes() == (b / f).read_bytes(), f
+    c = tmp_path / "c"
+    assert main(["run", str(BROWN), "--out", str(c), "--trials", "40", "--seed", "5",
+                 "--quiet", "--set", "chunk=16"]) == 0
+    ta = pq.read_table(a / "trials.parquet").column("sigma0_um").to_numpy()
+    tc = pq.read_table(c / "trials.parquet").column("sigma0_um").to_numpy()
+    assert not np.allclose(ta, tc)
+
+
+def test_python_dash_m_entry_point(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "sim", "check", str(BROWN)], capture_output=True,
+                       text=True, cwd=ROOT)
+    assert r.returncode == 0 and "plate.spacing_mm = 45.0" in r.stdout
