@@ -29,7 +29,7 @@ test: $(STAMP) ## run the test suite (sets up the environment first)
 	$(PY) -m pytest
 
 results/%/claims.parquet: studies/%.toml $(SIM_SRC) | $(STAMP)
-	$(PY) -m sim run $< --out results/$*
+	$(PY) -m sim run $< --out results/$* --overwrite
 
 results/REPORT.md: $(CLAIMS) | $(STAMP)
 	$(PY) -m sim report --results results

@@ -30,7 +30,8 @@ from scipy import stats
 
 from .storage import write_table
 
-__all__ = ["claim", "write_claims", "mean_ci", "std_ci", "bootstrap_ci", "spread", "CLAIM_COLUMNS"]
+__all__ = ["claim", "write_claims", "mean_ci", "std_ci", "bootstrap_ci", "spread", "sd_interval",
+           "CLAIM_COLUMNS"]
 
 CLAIM_COLUMNS = ["claim", "source", "paper", "value", "ci_low", "ci_high", "interval", "ref_low",
                  "ref_high", "holds", "kind", "note"]
@@ -89,6 +90,13 @@ def std_ci(x: np.ndarray, level: float = 0.95, axis: int = 0):
     lo = s * np.sqrt((n - 1) / stats.chi2.ppf(1 - a, n - 1))
     hi = s * np.sqrt((n - 1) / stats.chi2.ppf(a, n - 1))
     return s, lo, hi
+
+
+def sd_interval(s: float, n: int, level: float = 0.95) -> tuple[float, float]:
+    """Chi-square confidence interval of a standard deviation ``s`` from ``n`` Gaussian draws."""
+    a = (1 - level) / 2
+    return (float(s * np.sqrt((n - 1) / stats.chi2.ppf(1 - a, n - 1))),
+            float(s * np.sqrt((n - 1) / stats.chi2.ppf(a, n - 1))))
 
 
 def std_rel_se(n: int) -> float:

@@ -6,6 +6,7 @@ line on standard error naming the problem and exit code 2, with no partial resul
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import shutil
 import sys
@@ -27,6 +28,13 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override any config key with its dotted name (repeatable)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument("--executor", choices=("local", "dask"), default="local",
+                   help="local (in-process, or a process pool with --workers) or dask")
+    r.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    r.add_argument("--scheduler", help="dask scheduler address tcp://HOST:PORT (default: a "
+                   "LocalCluster started for the run)")
+    r.add_argument("--overwrite", action="store_true",
+                   help="replace results of a different config or code version")
     c = sub.add_parser("check", help="validate a study file and print the resolved config")
     c.add_argument("study")
     c.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
@@ -35,30 +43,62 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _run_record(cfg: dict) -> dict:
+    from .storage import code_hash
+
+    return {"config": cfg, "code_hash": code_hash()}
+
+
+def _read_record(d: Path) -> dict | None:
+    try:
+        return json.loads((d / "run.json").read_text())
+    except (OSError, ValueError):
+        return None
+
+
 def _run(args) -> int:
+    from .runner import ChunkStore, make_executor
     from .studies import RunContext
 
     study, cfg = load_study(args.study, args.set, args.trials, args.seed)
+    if args.workers < 1:
+        raise ConfigError("--workers", f"must be >= 1 (got {args.workers})")
     out = Path(args.out) if args.out else Path("results") / cfg["study"]
     stage = out.parent / f".{out.name}.partial"
+    record = _run_record(cfg)
+    for d, what in ((out, "results"), (stage, "an unfinished run")):
+        old = _read_record(d) if d.exists() else None
+        if d.exists() and old != record and not args.overwrite:
+            why = ("no run record" if old is None else "a different config" if
+                   old.get("config") != cfg else "a different code version")
+            raise ConfigError("--out", f"{d} holds {what} of {why}; use --overwrite to replace it")
     try:
-        if stage.exists():
+        if stage.exists() and _read_record(stage) != record:
             shutil.rmtree(stage)
-        stage.mkdir(parents=True)
+        stage.mkdir(parents=True, exist_ok=True)
+        (stage / "run.json").write_text(json.dumps(record, sort_keys=True, indent=1))
     except OSError as e:
         raise ConfigError("--out", f"cannot write to {out.parent}: {e.strerror}") from None
+    resumed = len(list((stage / "trials").rglob("chunk-*.parquet"))) if (stage / "trials").exists() else 0
+    if resumed:
+        print(f"sim: resuming {cfg['study']}: {resumed} finished chunks found", file=sys.stderr)
     try:
-        study.run(cfg, stage, RunContext(quiet=args.quiet))
-        old = out.parent / f".{out.name}.old"
-        if old.exists():
-            shutil.rmtree(old)
-        if out.exists():
-            os.replace(out, old)
-        os.replace(stage, out)
-        shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
-        raise
+        executor = make_executor(args.executor, args.workers, args.scheduler)
+    except RuntimeError as e:
+        raise ConfigError("--executor", str(e)) from None
+    try:
+        ctx = RunContext(quiet=args.quiet, executor=executor, store=ChunkStore(stage / "trials"))
+        study.run(cfg, stage, ctx)
+    finally:
+        executor.close()
+    # only a complete run replaces the output directory
+    old = out.parent / f".{out.name}.old"
+    if old.exists():
+        shutil.rmtree(old)
+    if out.exists():
+        os.replace(out, old)
+    os.replace(stage, out)
+    shutil.rmtree(old, ignore_errors=True)
     print(f"{cfg['study']}: results in {out}/")
     return 0
 
@@ -82,8 +122,13 @@ def main(argv: list[str] | None = None) -> int:
         print(f"sim: error: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("sim: interrupted", file=sys.stderr)
+        print("sim: interrupted; run the same command again to finish the missing chunks",
+              file=sys.stderr)
         return 130
+    except OSError as e:  # a failing write (full disk, vanished directory): one line, no traceback
+        print(f"sim: error: {e.strerror or e}: {getattr(e, 'filename', '') or ''}".rstrip(": "),
+              file=sys.stderr)
+        return 2
     return 1
 
 

@@ -41,6 +41,19 @@ def git_commit() -> str:
         return "unknown"
 
 
+@lru_cache(maxsize=1)
+def code_hash() -> str:
+    """sha256 of the library's source (every ``sim/**/*.py``), independent of git."""
+    import hashlib
+
+    root = Path(__file__).resolve().parent
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
 def versions() -> dict[str, str]:
     import matplotlib
     import scipy
@@ -52,7 +65,7 @@ def versions() -> dict[str, str]:
 def provenance(cfg: Mapping[str, Any], **extra: Any) -> dict[str, Any]:
     """Provenance record for a run: resolved config, seed, versions, git commit."""
     return {"study": cfg.get("study"), "config": dict(cfg), "seed": cfg.get("seed"),
-            "versions": versions(), "git_commit": git_commit(), **extra}
+            "versions": versions(), "git_commit": git_commit(), "code_hash": code_hash(), **extra}
 
 
 def _jsonable(o: Any) -> Any:

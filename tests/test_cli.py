@@ -109,8 +109,11 @@ def test_run_writes_contract_files_with_provenance(tmp_path):
     for col in ("claim", "source", "paper", "value", "ci_low", "ci_high", "holds", "kind", "note"):
         assert col in claims
     assert set(claims["kind"]) <= {"predicted", "input"}
-    trials = pq.read_table(out / "trials.parquet").to_pydict()
-    assert {"converged", "iterations", "sigma0_um", "alpha_mm", "beta2_mm2"} <= set(trials)
+    trials = pq.read_table(out / "trials").to_pydict()   # partitioned dataset, one file a chunk
+    assert len(trials["chunk"]) == 60 and sorted(set(trials["chunk"])) == [0, 1, 2]
+    for m in ("known", "stations", "pivot"):
+        assert {f"{m}_converged", f"{m}_iterations", f"{m}_sigma0_um", f"{m}_status"} <= set(trials)
+    assert {"pivot_alpha_mm", "pivot_beta2_mm2", "stations_y1_mm"} <= set(trials)
     prov = read_provenance(out / "points.parquet")
     assert prov["config"]["trials"] == 60 and prov["seed"] == 1967
     assert {"numpy", "pyarrow"} <= set(prov["versions"]) and prov["git_commit"]
@@ -122,13 +125,13 @@ def test_same_seed_same_files_and_chunking_by_stream(tmp_path):
     for o in (a, b):
         assert main(["run", str(BROWN), "--out", str(o), "--trials", "40", "--quiet",
                      "--set", "chunk=16"]) == 0
-    for f in ("points.parquet", "claims.parquet", "trials.parquet", "table1.png"):
+    for f in ("points.parquet", "claims.parquet", "trials/part-0/chunk-000001.parquet", "table1.png"):
         assert (a / f).read_bytes() == (b / f).read_bytes(), f
     c = tmp_path / "c"
     assert main(["run", str(BROWN), "--out", str(c), "--trials", "40", "--seed", "5",
                  "--quiet", "--set", "chunk=16"]) == 0
-    ta = pq.read_table(a / "trials.parquet").column("sigma0_um").to_numpy()
-    tc = pq.read_table(c / "trials.parquet").column("sigma0_um").to_numpy()
+    ta = pq.read_table(a / "trials").column("pivot_sigma0_um").to_numpy()
+    tc = pq.read_table(c / "trials").column("pivot_sigma0_um").to_numpy()
     assert not np.allclose(ta, tc)
 
 

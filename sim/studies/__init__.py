@@ -28,9 +28,13 @@ MODULES = {
 
 @dataclass(frozen=True)
 class RunContext:
-    """What a study's ``run`` gets besides its config."""
+    """What a study's ``run`` gets besides its config: pass it to
+    :func:`sim.runner.run_chunks` (``ctx=ctx``) so chunks use the chosen executor and are
+    stored for resumption."""
 
     quiet: bool = False
+    executor: object = None   # from sim.runner.make_executor; None = in-process
+    store: object = None      # sim.runner.ChunkStore of the run's staging directory
 
 
 @dataclass(frozen=True)
