@@ -58,6 +58,7 @@ def _read_record(d: Path) -> dict | None:
 
 def _run(args) -> int:
     from .runner import ChunkStore, make_executor
+    from .storage import provenance
     from .studies import RunContext
 
     study, cfg = load_study(args.study, args.set, args.trials, args.seed)
@@ -65,7 +66,9 @@ def _run(args) -> int:
         raise ConfigError("--workers", f"must be >= 1 (got {args.workers})")
     out = Path(args.out) if args.out else Path("results") / cfg["study"]
     stage = out.parent / f".{out.name}.partial"
-    record = _run_record(cfg)
+    from .sweep import read_sweep, run_sweep
+    sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
+    record = _run_record({**cfg, "sweep": sweep} if sweep else cfg)
     for d, what in ((out, "results"), (stage, "an unfinished run")):
         old = _read_record(d) if d.exists() else None
         if d.exists() and old != record and not args.overwrite:
@@ -87,8 +90,8 @@ def _run(args) -> int:
     except RuntimeError as e:
         raise ConfigError("--executor", str(e)) from None
     try:
-        ctx = RunContext(quiet=args.quiet, executor=executor, store=ChunkStore(stage / "trials"))
-        study.run(cfg, stage, ctx)
+        ctx = RunContext(quiet=args.quiet, executor=executor, store=ChunkStore(stage / "trials", provenance(cfg)))
+        run_sweep(study, cfg, sweep, stage, ctx) if sweep else study.run(cfg, stage, ctx)
     finally:
         executor.close()
     # only a complete run replaces the output directory

@@ -186,7 +186,7 @@ def load_study(path: str | Path, overrides: list[str] | tuple = (),
     from .studies import get_study  # local: the registry imports the study modules
 
     doc = read_toml(path)
-    flat = _flatten(doc)
+    flat = _flatten({k: v for k, v in doc.items() if k != "sweep"})  # [sweep]: sim.sweep
     name = flat.pop("study", None)
     if name is None:
         raise ConfigError("study", "missing: the file must say which study it is (study = \"...\")")

@@ -24,6 +24,7 @@ Executors (:func:`make_executor`): in-process (default), a local process pool
 from __future__ import annotations
 
 import io
+import json
 import os
 import pickle
 import sys
@@ -57,9 +58,13 @@ def _call_chunk(fn, seed: int, part: int, k: int, n: int) -> dict:
 
 @dataclass(frozen=True)
 class ChunkStore:
-    """A directory of finished chunks: ``<root>/part-<p>/chunk-<k>.parquet``."""
+    """A directory of finished chunks: ``<root>/part-<p>/chunk-<k>.parquet``.
+
+    ``prov``: provenance written into every chunk file's metadata (``sim.provenance``).
+    """
 
     root: Path
+    prov: dict | None = None
 
     def path(self, part: int, k: int) -> Path:
         return Path(self.root) / f"part-{part}" / f"chunk-{k:06d}.parquet"
@@ -71,7 +76,11 @@ class ChunkStore:
         np.savez(buf, **kept)
         table = pa.table({"chunk": np.full(n, k, np.int32), "trial_in_chunk": np.arange(n, dtype=np.int32),
                           **rows})
-        table = table.replace_schema_metadata({_ARRAYS: buf.getvalue(), b"n": str(n).encode()})
+        meta = {_ARRAYS: buf.getvalue(), b"n": str(n).encode()}
+        if self.prov is not None:
+            meta[b"sim.provenance"] = json.dumps({**self.prov, "chunk": k, "part": part,
+                                                  "spawn_key": [part, k]}, sort_keys=True).encode()
+        table = table.replace_schema_metadata(meta)
         with atomic_path(self.path(part, k)) as tmp:
             pq.write_table(table, tmp)
 

@@ -53,6 +53,11 @@ BASE = {
                                  lo=-50.0, hi=50.0, unit="mm"),
     "comparator.beta_mm": Field(1.0, "float", "tangential pivot offset beta (true value)",
                                 lo=0.0, hi=50.0, unit="mm"),
+    "comparator.scale_length_mm": Field(
+        0.0, "float", "graduated length of the scale (paper: 261 mm); every range must fit on "
+        "it plus the micrometer travel. 0 = not enforced", lo=0.0, unit="mm"),
+    "comparator.micrometer_mm": Field(1.0, "float", "micrometer travel added to the scale "
+                                      "(paper: at most 1 mm)", lo=0.0, unit="mm"),
     "errors.setting_sigma_um": Field(1.0, "float", "standard deviation of one setting", lo=0.0,
                                      lo_open=True, unit="um"),
     "errors.settings": Field(1, "int", "settings per point and position, averaged", lo=1, hi=100),
@@ -135,6 +140,14 @@ def check(cfg: dict) -> None:
     sv = np.linalg.svd(c, compute_uv=False)
     if sv[-1] <= 1e-9 * max(sv[0], 1e-300):
         raise ConfigError(key, "all points are collinear: the station coordinates cannot be recovered")
+    if cfg["comparator.scale_length_mm"] > 0:
+        _, theta = setup(cfg)
+        r = ml.ranges(pts[None], theta[None])
+        reach = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
+        if r.max() > reach or r.min() < 0:
+            raise ConfigError("comparator.scale_length_mm",
+                              f"ranges run from {r.min():.1f} to {r.max():.1f} mm but the scale "
+                              f"reads 0 to {reach:g} mm (move the stations in, or use alpha)")
 
 
 # ----------------------------------------------------------------------------- simulation core
