@@ -72,6 +72,77 @@ def _time(f, repeat: int = 3) -> float:
     return best
 
 
+def pivot_chunk(rng: np.random.Generator, n: int, *, pts: np.ndarray, theta: np.ndarray) -> dict:
+    """The 25-point ``pivot`` case as a streaming chunk: per-trial rows, per-chunk sums."""
+    P = np.broadcast_to(pts, (n,) + pts.shape)
+    obs = ml.simulate_ranges(P, np.broadcast_to(theta, (n, 7)), rng, setting_sigma_um=1.0,
+                             settings=1)
+    t0 = theta.copy()
+    t0[5:] = 0.0
+    res = ml.adjust(obs, "pivot", t0)
+    e = (res.points - pts)[res.converged] * 1e3
+    return {"rows.sigma0_um": res.sigma0 * 1e3, "rows.converged": res.converged,
+            "rows.iterations": res.iterations, "sum.n": np.array([len(e)], float),
+            "sum.e2": (e * e).sum(0)[None]}
+
+
+def _pivot_fn():
+    from functools import partial
+
+    k = 5
+    return partial(pivot_chunk, pts=grid_points(k, 220.0 / (k - 1)), theta=ml.design_theta(167.5, 0.5, 1.0))
+
+
+def executors(trials: int, chunk: int) -> list[tuple[str, int, float]]:
+    """Trials per second of the streaming pivot case for each executor."""
+    from .runner import make_executor, run_chunks
+    from .studies import RunContext
+
+    rows = []
+    for kind, workers in (("local", 1), ("local", 2), ("dask", 2)):
+        try:
+            ex = make_executor(kind, workers)
+        except RuntimeError as e:
+            print(f"{kind}: skipped ({e})")
+            continue
+        try:
+            run_chunks(_pivot_fn(), 2 * chunk, 1, chunk, ctx=RunContext(quiet=True, executor=ex))  # warm
+            t = time.perf_counter()
+            run_chunks(_pivot_fn(), trials, 1, chunk, ctx=RunContext(quiet=True, executor=ex))
+            rows.append((kind, workers, trials / (time.perf_counter() - t)))
+        finally:
+            ex.close()
+        print(f"{kind:>6} workers={workers} {rows[-1][2]:10.0f} trials/s")
+    return rows
+
+
+def million(out: Path, trials: int, chunk: int) -> None:
+    """Child process: stream ``trials`` pivot trials through the chunk store."""
+    import shutil
+
+    from .runner import ChunkStore, run_chunks
+    from .studies import RunContext
+
+    store_dir = out / "million_trials.tmp"
+    shutil.rmtree(store_dir, ignore_errors=True)
+    res = run_chunks(_pivot_fn(), trials, 1, chunk, ctx=RunContext(quiet=True, store=ChunkStore(store_dir)))
+    assert int(res["sum.n"].sum()) <= trials
+    shutil.rmtree(store_dir, ignore_errors=True)
+
+
+def peak_memory(out: Path, trials: int, chunk: int) -> tuple[float, float]:
+    """Run :func:`million` in a child process; its peak RSS (MiB) and wall time (s)."""
+    import resource
+    import subprocess
+    import sys
+
+    t = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "sim.bench", "--million-child", str(trials),
+                    "--chunk", str(chunk), "--out", str(out)], check=True)
+    wall = time.perf_counter() - t
+    return resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0, wall
+
+
 def run(out: Path, quick: bool = False) -> dict:
     rows: dict[str, list] = {k: [] for k in ("case", "n_points", "trials", "seconds",
                                              "trials_per_s", "us_per_trial_per_point")}
@@ -106,8 +177,16 @@ def run(out: Path, quick: bool = False) -> dict:
         Tn = max(4, 40000 // n)
         _, _, o, tt = _obs(n, Tn, 2)
         add("batched_points", n, Tn, _time(lambda: ml.adjust(o, "pivot", tt), 2))
+    # 3. executors, and the memory of a million-trial streamed run
+    n_ex = 20000 if quick else 100000
+    for kind, workers, tps in executors(n_ex, 5000):
+        add(f"{kind}_{workers}w", 25, n_ex, n_ex / tps)
+    n_mil = 50000 if quick else 1_000_000
+    rss, wall = peak_memory(out, n_mil, 10000)
+    print(f"{n_mil} trials streamed: peak memory {rss:.0f} MiB, {wall:.0f} s")
     prov = provenance({"study": "bench", "seed": 1, "quick": quick},
-                      solutions_agree_mm=agree)
+                      solutions_agree_mm=agree, million_trials=n_mil, peak_memory_mib=rss,
+                      million_wall_s=wall)
     write_table(out / "bench.parquet", rows, prov)
     _figure(rows, out / "bench.png", agree)
     return rows
@@ -119,7 +198,7 @@ def _figure(rows, path, agree):
     case = np.array(rows["case"])
     tps = np.array(rows["trials_per_s"])
     n = np.array(rows["n_points"])
-    fig, axs = plt.subplots(1, 2, figsize=(10, 4))
+    fig, axs = plt.subplots(1, 3, figsize=(15, 4))
     b, s = tps[case == "batched"][0], tps[case == "scipy_loop"][0]
     axs[0].bar(["batched (this)", "scipy loop"], [b, s], color=["tab:blue", "tab:gray"])
     axs[0].set_yscale("log")
@@ -134,6 +213,10 @@ def _figure(rows, path, agree):
     axs[1].set_xlabel("points per plate")
     axs[1].set_ylabel("ms per trial")
     axs[1].legend()
+    ex = [c for c in case if c.startswith(("local_", "dask_"))]
+    axs[2].bar(ex, [tps[case == c][0] for c in ex], color="tab:green")
+    axs[2].set_ylabel("trials per second (25 points, pivot, streamed)")
+    axs[2].set_title("executors on this machine")
     save(fig, path)
 
 
@@ -141,7 +224,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m sim.bench", description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="results/bench")
     ap.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
+    ap.add_argument("--million-child", type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--chunk", type=int, default=10000, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    if a.million_child:
+        million(Path(a.out), a.million_child, a.chunk)
+        return 0
     rows = run(Path(a.out), a.quick)
     case = np.array(rows["case"])
     tps = np.array(rows["trials_per_s"])

@@ -148,10 +148,9 @@ class _Dask:
             self.client = Client(self.cluster)
 
     def run(self, fn, seed, part, jobs):
-        fn_f = self.client.scatter(fn, broadcast=True)
-        futs = {}
+        futs = {}  # the chunk function is small: send it with each task (no scatter)
         for k, n in jobs:
-            futs[self.client.submit(_call_chunk, fn_f, seed, part, k, n, pure=False)] = (k, n)
+            futs[self.client.submit(_call_chunk, fn, seed, part, k, n, pure=False)] = (k, n)
         for f in self._completed(list(futs)):
             k, n = futs[f]
             yield k, n, f.result()
