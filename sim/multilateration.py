@@ -128,28 +128,46 @@ def _jg(ux: np.ndarray, uy: np.ndarray, q: np.ndarray, p: int) -> np.ndarray:
     return Jg
 
 
-#: nonzero Jacobian columns of each station's readings: (global index, sign, component);
-#: alpha (-1) and b (-1/(2q)) touch every station and are added in :func:`_station_blocks`
-STATION_COLS = (((0, -1.0, 1),),                 # station 1 (0, y1): y1
-                ((1, -1.0, 0), (2, -1.0, 1)),    # station 2 (x2, y2): x2, y2
-                ((3, -1.0, 1),),                 # station 3 (0, y3): y3
-                ((2, 1.0, 1), (4, -1.0, 0)))     # station 4 (x4, -y2): y2, x4
+def _global_blocks(ux, uy, q, e, products, p):
+    """Npg (T, 2, n, p), Ngg (T, p, p) and ug (T, p) in closed form.
 
-
-def _station_blocks(u: tuple, q: np.ndarray, p: int):
-    """Per station ``k``: the global indices it touches and their Jacobian columns (T, n, m)."""
-    out = []
-    for k, spec in enumerate(STATION_COLS):
-        idx = [g for g, _, _ in spec if g < p]
-        vec = [sgn * u[c][k] for g, sgn, c in spec if g < p]
-        if p > 5:
-            idx.append(5)
-            vec.append(np.full_like(q[k], -1.0))
-        if p > 6:
-            idx.append(6)
-            vec.append(-0.5 / q[k])
-        out.append((np.array(idx), np.stack(vec, -1)))
-    return out
+    The Jacobian of station ``k``'s readings with respect to the globals is sparse (the same
+    columns as :func:`_jg`): y1 -> -uy0; x2 -> -ux1; y2 -> -uy1 and +uy3; y3 -> -uy2;
+    x4 -> -ux3; alpha -> -1; b -> -h_k with h = 1/(2q). Every entry is written out with
+    the products ux*ux, ux*uy, uy*uy, ux*e, uy*e shared; arrays are (4, T, n), station first.
+    """
+    T, n = ux.shape[1:]
+    h = 0.5 / q
+    xx, xy, yy, xe, ye = products
+    uxh, uyh = ux * h, uy * h
+    # Npg: per point, component c (x, y) against each global
+    Npg = np.empty((T, 2, n, 7))
+    for c, (Jc, cc, cx) in enumerate(((ux, xx, xy), (uy, xy, yy))):
+        # cc = Jc*ux, cx = Jc*uy for each station
+        Npg[:, c, :, 0] = -cx[0]
+        Npg[:, c, :, 1] = -cc[1]
+        Npg[:, c, :, 2] = cx[3] - cx[1]
+        Npg[:, c, :, 3] = -cx[2]
+        Npg[:, c, :, 4] = -cc[3]
+        Npg[:, c, :, 5] = -Jc.sum(0)
+        Npg[:, c, :, 6] = -(uxh if c == 0 else uyh).sum(0)
+    S = lambda a: a.sum(-1)  # noqa: E731  sum over points -> (4, T) or (T,)
+    sxx, sxy, syy, sx, sy = S(xx), S(xy), S(yy), S(ux), S(uy)
+    sxh, syh, sh, shh = S(uxh), S(uyh), S(h), S(h * h)
+    sxe, sye = S(xe), S(ye)
+    N = np.zeros((T, 7, 7))
+    N[:, 0, 0], N[:, 0, 5], N[:, 0, 6] = syy[0], sy[0], syh[0]
+    N[:, 1, 1], N[:, 1, 2], N[:, 1, 5], N[:, 1, 6] = sxx[1], sxy[1], sx[1], sxh[1]
+    N[:, 2, 2], N[:, 2, 4] = syy[1] + syy[3], -sxy[3]
+    N[:, 2, 5], N[:, 2, 6] = sy[1] - sy[3], syh[1] - syh[3]
+    N[:, 3, 3], N[:, 3, 5], N[:, 3, 6] = syy[2], sy[2], syh[2]
+    N[:, 4, 4], N[:, 4, 5], N[:, 4, 6] = sxx[3], sx[3], sxh[3]
+    N[:, 5, 5], N[:, 5, 6], N[:, 6, 6] = 4.0 * n, sh.sum(0), shh.sum(0)
+    iu = np.triu_indices(7, 1)
+    N[:, iu[1], iu[0]] = N[:, iu[0], iu[1]]
+    ug = np.stack([-sye[0], -sxe[1], sye[3] - sye[1], -sye[2], -sxe[3], -e.sum((0, 2)),
+                   -(h * e).sum((0, 2))], -1)
+    return Npg[..., :p], N[:, :p, :p], ug[:, :p]
 
 
 @dataclass
@@ -188,31 +206,23 @@ def _reduce(points, theta, p, r_obs=None, check=True, rcond: float = 1e-13, S=No
     q = np.sqrt(np.maximum(dx * dx + dy * dy - theta[None, :, 6, None], 1e-300))
     ux, uy = dx / q, dy / q
     T, n = ux.shape[1:]
-    a, b, c = (ux * ux).sum(0), (ux * uy).sum(0), (uy * uy).sum(0)
+    xx, xy, yy = ux * ux, ux * uy, uy * uy
+    a, b, c = xx.sum(0), xy.sum(0), yy.sum(0)
     det = a * c - b * b
     ok = np.all(det > rcond * (a + c) ** 2, axis=1)
     inv = 1.0 / np.where(det > 0, det, 1.0)
     i00, i01, i11 = c * inv, -b * inv, a * inv             # symmetric inverse of the blocks
     if r_obs is None:
         e = np.zeros_like(q)
-        up = np.zeros((T, 2, n))
+        xe = ye = e
     else:
         e = r_obs.transpose(2, 0, 1) - (q - theta[None, :, 5, None])
-        up = np.stack([(ux * e).sum(0), (uy * e).sum(0)], 1)
+        xe, ye = ux * e, uy * e
+    up = np.stack([xe.sum(0), ye.sum(0)], 1)
     if p == 0:
         return Reduced(i00, i01, i11, np.zeros((T, 2, n, 0)), np.zeros((T, 0, 0)),
                        np.zeros((T, 0)), up, ok)
-    Ngg = np.zeros((T, p, p))
-    ug = np.zeros((T, p))
-    cols: list[list] = [[0.0] * p, [0.0] * p]              # Npg columns, summed per global
-    for k, (idx, V) in enumerate(_station_blocks((ux, uy), q, p)):
-        Vt = V.transpose(0, 2, 1)                          # (T, m, n)
-        Ngg[:, idx[:, None], idx[None, :]] += Vt @ V
-        ug[:, idx] += (Vt @ e[k][:, :, None])[..., 0]
-        for i, g in enumerate(idx):
-            cols[0][g] = cols[0][g] + ux[k] * V[..., i]
-            cols[1][g] = cols[1][g] + uy[k] * V[..., i]
-    Npg = np.stack([np.stack(cols[0], -1), np.stack(cols[1], -1)], 1)  # (T, 2, n, p)
+    Npg, Ngg, ug = _global_blocks(ux, uy, q, e, (xx, xy, yy, xe, ye), p)
     K = np.stack([i00[..., None] * Npg[:, 0] + i01[..., None] * Npg[:, 1],
                   i01[..., None] * Npg[:, 0] + i11[..., None] * Npg[:, 1]], 1)
     Kf = K.reshape(T, 2 * n, p)
