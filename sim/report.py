@@ -52,11 +52,13 @@ def claims_markdown(path: Path) -> str:
     for r in t:
         ref = ""
         if r["ref_low"] is not None and math.isfinite(r["ref_low"]):
-            ref = (fmt(r["ref_low"]) if r["ref_low"] == r["ref_high"]
-                   else f"{fmt(r['ref_low'])}–{fmt(r['ref_high'])}")
+            f = (lambda x: f"{x:.10g}") if r["interval"] == "exact" else fmt  # noqa: E731
+            ref = (f(r["ref_low"]) if r["ref_low"] == r["ref_high"]
+                   else f"{f(r['ref_low'])}–{f(r['ref_high'])}")
         ci = ("exact" if r["interval"] == "exact" else
               f"[{fmt(r['ci_low'])}, {fmt(r['ci_high'])}]" + (" range" if r["interval"] == "spread" else ""))
-        rows.append([f"`{r['claim']}`", r["paper"], ref, fmt(r["value"]), ci, _verdict(r["holds"]),
+        val = f"{r['value']:.10g}" if r["interval"] == "exact" else fmt(r["value"])
+        rows.append([f"`{r['claim']}`", r["paper"], ref, val, ci, _verdict(r["holds"]),
                      r["kind"], r["note"]])
     return md_table(["claim", "paper says", "paper ref.", "simulated", "95% interval", "verdict",
                      "kind", "note"], rows)

@@ -1,0 +1,128 @@
+"""Seed 002 (Salsig): encoder pieces, the calibration chain, the study's claims."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sim import encoders as enc
+from sim.config import ConfigError, load_study, validate
+from sim.studies import salsig
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _cfg(**over):
+    raw = {k: v for k, v in over.items()}
+    return validate(raw, salsig.SCHEMA, salsig.check)
+
+
+def test_published_decompositions_claims():
+    d = salsig.decompositions()
+    got = {(f, q): (v, p) for f, q, v, p in zip(d["figure"], d["quantity"], d["value"],
+                                                d["printed"])}
+    for q, tol in (("SX", 1e-9), ("SY", 1e-9), ("E_arcsec", 0.05)):
+        v, p = got[("FIG. 3", q)]
+        assert abs(v - p) <= tol, q
+    assert abs(got[("FIG. 2", "SX")][0] - 0.999993007) <= 1e-9
+    assert abs(got[("FIG. 2", "E_arcsec")][0] + 14.0) <= 0.05
+
+
+def test_line_fit_noise_free_and_standard_error():
+    z = np.linspace(10, 25, 9)
+    H = 12.5 * z - 37.0
+    f = enc.line_fit(z, H[None])
+    assert abs(f["S"][0] - 12.5) < 1e-12 and abs(f["z0"][0] + 37.0) < 1e-10
+    rng = np.random.default_rng(1)
+    T = 4000
+    f = enc.line_fit(z, H + rng.normal(0, 0.02, (T, 9)))
+    tol = 4 / np.sqrt(2 * (T - 1))
+    assert abs(np.std(f["S"], ddof=1) / np.sqrt(np.mean(f["se_S"] ** 2)) - 1) < tol
+    assert abs(np.std(f["z0"], ddof=1) / np.sqrt(np.mean(f["se_z0"] ** 2)) - 1) < tol
+
+
+def test_conformal3d_noise_free_recovery():
+    rng = np.random.default_rng(2)
+    T = 20
+    X = rng.uniform(-100, 100, (T, 6, 3))
+    R = enc.rotation_matrix(rng.normal(0, 0.1, T), rng.normal(0, 0.1, T), rng.uniform(-3, 3, T))
+    lam, t = rng.uniform(5, 15, T), rng.uniform(-1e3, 1e3, (T, 3))
+    Y = enc.apply_conformal3d(lam, R, t, X)
+    f = enc.conformal3d_fit(X, Y)
+    np.testing.assert_allclose(f["scale"], lam, rtol=1e-12)
+    np.testing.assert_allclose(f["R"], R, atol=1e-12)
+    assert np.max(np.abs(f["residuals"])) < 1e-9
+
+
+def test_conformal3d_is_least_squares():
+    """Perturbing the closed-form solution never lowers the residual sum of squares."""
+    rng = np.random.default_rng(3)
+    X = rng.uniform(-100, 100, (1, 8, 3))
+    Y = 10 * X + rng.normal(0, 0.5, X.shape)
+    f = enc.conformal3d_fit(X, Y)
+    base = np.sum(f["residuals"] ** 2)
+    for _ in range(50):
+        dR = enc.rotation_matrix(*rng.normal(0, 1e-4, 3))
+        Y2 = enc.apply_conformal3d(f["scale"] * (1 + rng.normal(0, 1e-5, 1)), (dR @ f["R"][0])[None],
+                                   f["t"] + rng.normal(0, 1e-2, (1, 3)), X)
+        assert np.sum((Y - Y2) ** 2) >= base - 1e-9
+
+
+def test_z_scale_correction_removes_vertical_residuals_without_noise():
+    cfg = _cfg(**{"vertical.sigma_xy_um": 0.0, "vertical.sigma_z_um": 1e-9,
+                  "b8.sy_mm_per_digit": 12.700082809, "b8.e_arcsec": 0.0})
+    r = salsig.simulate_vertical(cfg, np.random.default_rng(4), 50)
+    assert np.all(r["rms_z_after_um"] < 1e-6)
+    assert np.all(r["rms_z_before_um"] > 1.0)
+
+
+def test_chain_noise_free_recovers_truth():
+    cfg = _cfg(**{"b8.sigma_um": 1e-9, "comparator.sigma_um": 1e-9})
+    r = salsig.simulate_chain(cfg, np.random.default_rng(5), 30)
+    np.testing.assert_allclose(r["SX"], 12.700082809, rtol=1e-12)
+    np.testing.assert_allclose(r["SY"], 12.702028129, rtol=1e-12)
+    np.testing.assert_allclose(r["E_arcsec"], -59.2, atol=1e-6)
+
+
+def test_chain_spread_matches_stated_sd():
+    """With a near-perfect comparator the B8 fit's own covariance is the whole story."""
+    cfg = _cfg(**{"comparator.sigma_um": 1e-6})
+    T = 3000
+    r = salsig.simulate_chain(cfg, np.random.default_rng(6), T)
+    tol = 4 / np.sqrt(2 * (T - 1))
+    for k in ("E_arcsec", "scale_diff_ppm"):
+        ratio = np.std(r[k], ddof=1) / np.sqrt(np.mean(r["sd_" + k] ** 2))
+        assert abs(ratio - 1) < tol + 0.01, k
+
+
+def test_bad_config_names_the_key(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text('study = "salsig_encoders"\n[marks]\ngrid = 1\n')
+    with pytest.raises(ConfigError, match="marks.grid"):
+        load_study(f)
+    f.write_text('study = "salsig_encoders"\n[zscale]\nsigma_um = -1.0\n')
+    with pytest.raises(ConfigError, match="zscale.sigma_um"):
+        load_study(f)
+    f.write_text('study = "salsig_encoders"\n[power]\nmarks = []\n')
+    with pytest.raises(ConfigError, match="power.marks"):
+        load_study(f)
+
+
+def test_study_runs_small(tmp_path):
+    from sim.cli import main
+    from sim.storage import read_table
+
+    out = tmp_path / "ss"
+    rc = main(["run", str(ROOT / "studies/salsig_encoders.toml"), "--trials", "60", "--quiet",
+               "--set", "power.trials=20", "--set", "power.marks=[3, 5]",
+               "--set", "power.sigma_um=[5.0, 25.0]", "--set", "vertical.relief_sweep_mm=[2.0]",
+               "--out", str(out)])
+    assert rc == 0
+    t = read_table(out / "claims.parquet").to_pydict()
+    verdict = dict(zip(t["claim"], t["holds"]))
+    assert verdict["salsig.decompose_b8.SX_dev_last_digit"] is True
+    assert verdict["salsig.decompose_b8.E_dev_last_digit"] is True
+    assert verdict["salsig.decompose_grid.SY_dev_last_digit"] is False
+    for fig in ("residuals", "recovery", "power", "vertical"):
+        assert (out / f"{fig}.png").is_file()
+    text = salsig.report(out)
+    assert "power" in text and "![" in text
