@@ -1,0 +1,268 @@
+"""Polynomial error models and plane transformations, batched over trials.
+
+Seed: ``000_668e60e68f004f98.txt`` (Wolf & Pearsall 1976, *The Kern PG-2 as a
+Monocomparator*). The paper corrects measured model coordinates ``X, Y`` (mm, already
+reduced to the grid system) with a third-degree, ten-term polynomial per axis::
+
+    x = X + A1 + A2 X + A3 X^2 + A4 Y + A5 Y^2 + A6 X Y + A7 X^2 Y + A8 X Y^2 + A9 X^3 + A10 Y^3
+    y = Y + B1 + B2 X + B3 X^2 + B4 Y + B5 Y^2 + B6 X Y + B7 X^2 Y + B8 X Y^2 + B9 X^3 + B10 Y^3
+
+fitted by least squares to the grid intersections of several independent sets. The ten
+terms are the complete set of monomials of total degree <= 3, so the general degree-``d``
+polynomial of :func:`poly_terms` (``(d+1)(d+2)/2`` terms) contains it as ``d = 3``
+(with another ordering; :data:`WOLF_TERMS` keeps the paper's A1...A10 order).
+
+The raw readings are reduced first with the paper's *non-redundant* two-point
+transformation (:func:`two_point_transform`): scale from the length of line ``ab``,
+translation to ``a``, rotation by ``alpha = atan(Y''_b / X''_b)``. It uses no redundancy
+on purpose, so that the discrepancies of the measuring system are preserved. For
+comparison, least-squares similarity (4 parameters) and affine (6) fits are here too.
+
+Shapes: every function takes a leading *trial* axis ``T``: points ``(T, n, 2)`` (a plain
+``(n, 2)`` broadcasts). Coordinates in mm; the polynomial works internally in
+``coordinate / norm_mm`` (default 100 mm) so that the normal equations stay well
+conditioned up to degree 5 or more.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["WOLF_TERMS", "poly_terms", "design", "PolyFit", "fit_poly", "fit_wolf", "apply_poly",
+           "two_point_transform", "TwoPoint", "apply_two_point", "fit_similarity", "fit_affine",
+           "apply_linear", "discrepancy_stats", "lstsq_batched"]
+
+#: exponents (i, j) of X^i Y^j for the paper's A1 ... A10 (and B1 ... B10), in its order
+WOLF_TERMS = ((0, 0), (1, 0), (2, 0), (0, 1), (0, 2), (1, 1), (2, 1), (1, 2), (3, 0), (0, 3))
+
+
+def poly_terms(degree: int) -> tuple[tuple[int, int], ...]:
+    """Exponents ``(i, j)`` of all monomials ``X^i Y^j`` with ``i + j <= degree``.
+
+    Ordered by total degree, then by decreasing power of X: ``(d+1)(d+2)/2`` terms.
+    """
+    if degree < 0:
+        raise ValueError(f"degree must be >= 0 (got {degree})")
+    return tuple((t - j, j) for t in range(degree + 1) for j in range(t + 1))
+
+
+def design(pts: np.ndarray, terms, norm_mm: float = 100.0) -> np.ndarray:
+    """Design matrix ``(..., n, p)`` of the monomials ``terms`` at ``pts`` ``(..., n, 2)`` mm.
+
+    Columns are ``(X / norm)^i (Y / norm)^j``.
+    """
+    u = np.asarray(pts, float) / norm_mm
+    x, y = u[..., 0], u[..., 1]
+    mx = max(i for i, _ in terms)
+    my = max(j for _, j in terms)
+    px = [np.ones_like(x)]
+    py = [np.ones_like(y)]
+    for _ in range(mx):
+        px.append(px[-1] * x)
+    for _ in range(my):
+        py.append(py[-1] * y)
+    return np.stack([px[i] * py[j] for i, j in terms], axis=-1)
+
+
+def lstsq_batched(A: np.ndarray, b: np.ndarray, rcond: float = 1e-12):
+    """Least squares ``min |A c - b|`` for a batch: ``A (T, m, p)``, ``b (T, m, k)``.
+
+    Solved through a thin QR of each ``A`` (no normal equations). Returns ``c (T, p, k)`` and
+    ``ok (T,)``, False where ``A`` is rank deficient (relative diagonal of R below ``rcond``);
+    such solutions are NaN.
+    """
+    A = np.asarray(A, float)
+    b = np.asarray(b, float)
+    T, m, p = A.shape
+    if m < p:
+        return np.full((T, p, b.shape[-1]), np.nan), np.zeros(T, bool)
+    q, r = np.linalg.qr(A)
+    d = np.abs(np.diagonal(r, axis1=-2, axis2=-1))
+    ok = d.min(axis=-1) > rcond * np.maximum(d.max(axis=-1), 1e-300)
+    rhs = np.matmul(q.transpose(0, 2, 1), b)
+    c = np.full((T, p, b.shape[-1]), np.nan)
+    if ok.any():
+        c[ok] = np.linalg.solve(r[ok], rhs[ok])
+    return c, ok
+
+
+@dataclass(frozen=True)
+class PolyFit:
+    """A fitted correction polynomial per axis.
+
+    coef : ``(T, p, 2)`` coefficients of the correction in mm (column 0: x, 1: y) on the
+        normalised monomials; NaN where the fit was not estimable.
+    terms : the exponents of the ``p`` monomials.
+    norm_mm : coordinate normalisation.
+    ok : ``(T,)`` the fit was estimable (enough distinct points).
+    rms_mm : ``(T, 2)`` rms residual per axis on the fitting data.
+    """
+
+    coef: np.ndarray
+    terms: tuple
+    norm_mm: float
+    ok: np.ndarray
+    rms_mm: np.ndarray
+
+    @property
+    def degree(self) -> int:
+        return max(i + j for i, j in self.terms)
+
+    def coefficients_mm(self) -> np.ndarray:
+        """Coefficients for unnormalised ``X, Y`` in mm (``A_k = c_k / norm^(i+j)``), ``(T, p, 2)``."""
+        s = np.array([self.norm_mm ** -(i + j) for i, j in self.terms])
+        return self.coef * s[None, :, None]
+
+
+def fit_poly(measured: np.ndarray, true: np.ndarray, degree: int | None = 3, terms=None,
+             norm_mm: float = 100.0) -> PolyFit:
+    """Fit the correction ``true - measured = P(measured)`` by least squares, per trial.
+
+    Parameters
+    ----------
+    measured, true : ``(T, n, 2)`` mm (or ``(n, 2)`` for ``true``). Pool several sets by
+        concatenating them along the point axis.
+    degree : total degree of the complete polynomial (ignored when ``terms`` is given).
+    terms : explicit exponents, e.g. :data:`WOLF_TERMS`.
+
+    A degree-1 polynomial is the general affine transformation ``x = X + A1 + A2 X + A4 Y``.
+    """
+    measured = np.asarray(measured, float)
+    true = np.broadcast_to(np.asarray(true, float), measured.shape)
+    terms = tuple(terms) if terms is not None else poly_terms(degree)
+    A = design(measured, terms, norm_mm)
+    c, ok = lstsq_batched(A, true - measured)
+    res = true - measured - np.matmul(A, c)
+    rms = np.sqrt(np.mean(res ** 2, axis=1))
+    return PolyFit(c, terms, float(norm_mm), ok, rms)
+
+
+def fit_wolf(measured: np.ndarray, true: np.ndarray, norm_mm: float = 100.0) -> PolyFit:
+    """The paper's ten-term third-degree polynomial (A1...A10, B1...B10 in its order)."""
+    return fit_poly(measured, true, terms=WOLF_TERMS, norm_mm=norm_mm)
+
+
+def apply_poly(fit: PolyFit, measured: np.ndarray) -> np.ndarray:
+    """Refined coordinates ``X + P(X, Y)`` ``(T, n, 2)`` mm for new measured points."""
+    measured = np.asarray(measured, float)
+    A = design(measured, fit.terms, fit.norm_mm)
+    return measured + np.matmul(A, fit.coef)
+
+
+# ----------------------------------------------------------------------------- two-point reduction
+
+
+@dataclass(frozen=True)
+class TwoPoint:
+    """The paper's non-redundant reduction: ``x = R(-alpha) (s C - s C_a) + g_a``.
+
+    scale : ``(T,)`` mm per reading unit (``|ab| grid / |ab| measured``).
+    origin : ``(T, 2)`` the reading of ``a`` (reading units).
+    alpha : ``(T,)`` rotation (rad) from the scaled, translated system to the grid system.
+    a_grid : ``(2,)`` grid coordinates of ``a`` (mm).
+    """
+
+    scale: np.ndarray
+    origin: np.ndarray
+    alpha: np.ndarray
+    a_grid: np.ndarray
+
+
+def two_point_transform(read_a: np.ndarray, read_b: np.ndarray, grid_a, grid_b) -> TwoPoint:
+    """The non-redundant two-point transformation of Wolf & Pearsall.
+
+    ``read_a, read_b`` ``(T, 2)`` readings (any unit, e.g. counts) of points ``a`` and ``b``;
+    ``grid_a, grid_b`` ``(2,)`` their grid coordinates (mm). Scale from line ``ab``, translate
+    to ``a``, rotate by ``alpha = atan2(Y''_b, X''_b)`` less the grid direction of ``ab`` (zero
+    in the paper, where ``b`` lies on the grid x axis). ``a`` and ``b`` are reproduced exactly.
+    """
+    read_a = np.asarray(read_a, float)
+    read_b = np.asarray(read_b, float)
+    ga = np.asarray(grid_a, float)
+    gb = np.asarray(grid_b, float)
+    d = read_b - read_a
+    L = np.hypot(d[..., 0], d[..., 1])
+    scale = np.hypot(*(gb - ga)) / L
+    alpha = np.arctan2(d[..., 1], d[..., 0]) - np.arctan2(gb[1] - ga[1], gb[0] - ga[0])
+    return TwoPoint(scale, read_a, alpha, ga)
+
+
+def apply_two_point(tp: TwoPoint, readings: np.ndarray) -> np.ndarray:
+    """Reduce readings ``(T, n, 2)`` to the grid system (mm) with a :class:`TwoPoint`."""
+    r = (np.asarray(readings, float) - tp.origin[:, None, :]) * tp.scale[:, None, None]
+    c, s = np.cos(tp.alpha)[:, None], np.sin(tp.alpha)[:, None]
+    x = c * r[..., 0] + s * r[..., 1]
+    y = -s * r[..., 0] + c * r[..., 1]
+    return np.stack([x, y], axis=-1) + tp.a_grid
+
+
+# ----------------------------------------------------------------------------- LS similarity, affine
+
+
+def _linear_design(src: np.ndarray, kind: str) -> np.ndarray:
+    """Design ``(T, 2n, p)`` for x' = A src + t, rows interleaved (x0, y0, x1, y1, ...)."""
+    x, y = src[..., 0], src[..., 1]
+    o, z = np.ones_like(x), np.zeros_like(x)
+    if kind == "similarity":  # x' = a x - b y + tx ; y' = b x + a y + ty
+        rx = np.stack([x, -y, o, z], -1)
+        ry = np.stack([y, x, z, o], -1)
+    elif kind == "affine":    # x' = a1 x + a2 y + tx ; y' = b1 x + b2 y + ty
+        rx = np.stack([x, y, z, z, o, z], -1)
+        ry = np.stack([z, z, x, y, z, o], -1)
+    else:
+        raise ValueError(f"unknown transformation {kind!r}")
+    T, n, p = rx.shape
+    return np.stack([rx, ry], axis=2).reshape(T, 2 * n, p)
+
+
+def _fit_linear(src, dst, kind: str):
+    src = np.asarray(src, float)
+    dst = np.broadcast_to(np.asarray(dst, float), src.shape)
+    c0 = src.mean(axis=1, keepdims=True)  # centre for conditioning
+    A = _linear_design(src - c0, kind)
+    b = dst.reshape(dst.shape[0], -1, 1)
+    p, ok = lstsq_batched(A, b)
+    p = p[..., 0]
+    if kind == "similarity":
+        a, bb, tx, ty = p.T
+        M = np.stack([np.stack([a, -bb], -1), np.stack([bb, a], -1)], -2)
+        t = np.stack([tx, ty], -1)
+    else:
+        M = p[:, :4].reshape(-1, 2, 2)
+        t = p[:, 4:6]
+    t = t - np.einsum("tij,tj->ti", M, c0[:, 0, :])
+    return M, t
+
+
+def fit_similarity(src: np.ndarray, dst: np.ndarray):
+    """Least-squares similarity (scale, rotation, shift) mapping ``src`` onto ``dst``.
+
+    ``src`` ``(T, n, 2)``, ``dst`` ``(T, n, 2)`` or ``(n, 2)``. Returns ``M (T, 2, 2)``,
+    ``t (T, 2)`` with ``dst ~ src @ M.T + t``.
+    """
+    return _fit_linear(src, dst, "similarity")
+
+
+def fit_affine(src: np.ndarray, dst: np.ndarray):
+    """Least-squares affine (6 parameters) mapping ``src`` onto ``dst``; see :func:`fit_similarity`."""
+    return _fit_linear(src, dst, "affine")
+
+
+def apply_linear(M: np.ndarray, t: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """``pts @ M.T + t`` for ``pts (T, n, 2)``."""
+    return np.einsum("tij,tnj->tni", M, np.asarray(pts, float)) + t[:, None, :]
+
+
+# ----------------------------------------------------------------------------- statistics
+
+
+def discrepancy_stats(d: np.ndarray, axis: int = -2) -> dict[str, np.ndarray]:
+    """The paper's summary statistics of discrepancies: ``max``, ``rms``, ``mean``.
+
+    All of absolute values along ``axis`` (the point axis): ``max |d|``,
+    ``sqrt(mean d^2)``, ``mean |d|``. For ``d (T, n, 2)`` each is ``(T, 2)`` (x, y).
+    """
+    a = np.abs(np.asarray(d, float))
+    return {"max": a.max(axis=axis), "rms": np.sqrt(np.mean(a ** 2, axis=axis)),
+            "mean": a.mean(axis=axis)}

@@ -1,0 +1,262 @@
+"""Wolf & Pearsall (seed 000): polynomial correction, two-point reduction, error fields, study."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sim import errorfields as ef
+from sim import polynomial as pl
+from sim.config import ConfigError, validate
+from sim.studies import wolf
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _grid():
+    return wolf.grid_nodes([-100.0, 100.0, -40.0, 60.0], 20.0)
+
+
+def _cubic(P, rng, T, amp_mm=0.05):
+    """A random complete cubic correction field (mm) at P (T, n, 2)."""
+    c = rng.normal(0.0, amp_mm, (T, 10, 2))
+    return np.matmul(pl.design(P, pl.WOLF_TERMS), c)
+
+
+def test_grid_is_the_papers():
+    g = _grid()
+    assert len(g) == 66
+    assert g[:, 0].max() - g[:, 0].min() == 200 and g[:, 1].max() - g[:, 1].min() == 100
+    assert wolf._index(g, (0, 0)) >= 0 and wolf._index(g, (100, 0)) >= 0
+
+
+def test_cubic_field_removed_exactly_without_noise():
+    rng = np.random.default_rng(1)
+    T = 50
+    X = np.broadcast_to(_grid(), (T, 66, 2)) + rng.normal(0, 0.01, (T, 66, 2))
+    c = rng.normal(0.0, 0.05, (T, 10, 2))
+    field = lambda P: np.matmul(pl.design(P, pl.WOLF_TERMS), c)  # noqa: E731
+    fit = pl.fit_wolf(X, X + field(X))
+    assert fit.ok.all()
+    assert np.abs(fit.coef - c).max() < 1e-10
+    # and at new, independent points (the model is exact everywhere)
+    Y = rng.uniform(-100, 100, (T, 30, 2))
+    assert np.abs(pl.apply_poly(fit, Y) - (Y + field(Y))).max() < 1e-10
+
+
+def test_cubic_field_removed_to_the_noise_level():
+    """A third-degree error field plus white noise: residual variance = sigma^2 (n - p) / n."""
+    rng = np.random.default_rng(2)
+    T, sigma_mm = 400, 0.002
+    G = _grid()
+    X = np.broadcast_to(G, (T, 66, 2)) + rng.normal(0, 0.001, (T, 66, 2))
+    true = X + _cubic(X, rng, T) + rng.normal(0, sigma_mm, X.shape)
+    fit = pl.fit_wolf(X, true)
+    res = pl.apply_poly(fit, X) - true
+    dof = T * 2 * (66 - 10)
+    ratio = np.sum(res ** 2) / dof / sigma_mm ** 2
+    assert abs(ratio - 1) < 4 * math.sqrt(2 / dof)
+    # the field itself (tens of um) is gone: residual rms ~ sigma, not the field's size
+    assert np.sqrt(np.mean((true - X) ** 2)) > 20 * sigma_mm
+
+
+def test_degree_one_equals_affine_fit():
+    rng = np.random.default_rng(3)
+    T = 20
+    X = rng.uniform(-100, 100, (T, 40, 2))
+    true = X + _cubic(X, rng, T, 0.3) + rng.normal(0, 0.003, X.shape)
+    fit = pl.fit_poly(X, true, degree=1)
+    M, t = pl.fit_affine(X, true)
+    Y = rng.uniform(-100, 100, (T, 15, 2))
+    assert np.allclose(pl.apply_poly(fit, Y), pl.apply_linear(M, t, Y), atol=1e-9, rtol=0)
+
+
+def test_wolf_terms_span_the_complete_cubic():
+    rng = np.random.default_rng(4)
+    X = rng.uniform(-100, 100, (5, 66, 2))
+    true = X + rng.normal(0, 0.02, X.shape)
+    a = pl.fit_wolf(X, true)
+    b = pl.fit_poly(X, true, degree=3)
+    assert len(pl.poly_terms(3)) == 10 and set(pl.poly_terms(3)) == set(pl.WOLF_TERMS)
+    assert np.allclose(pl.apply_poly(a, X), pl.apply_poly(b, X), atol=1e-10)
+
+
+def test_two_point_reproduces_a_and_b_exactly():
+    rng = np.random.default_rng(5)
+    T = 100
+    ga, gb = np.array([0.0, 0.0]), np.array([100.0, 0.0])
+    ra = rng.uniform(-5000, 5000, (T, 2))
+    rb = ra + rng.uniform(20000, 30000, (T, 1)) * np.stack(
+        [np.cos(th := rng.uniform(-0.5, 0.5, T)), np.sin(th)], -1)
+    tp = pl.two_point_transform(ra, rb, ga, gb)
+    out = pl.apply_two_point(tp, np.stack([ra, rb], 1))
+    assert np.abs(out[:, 0] - ga).max() < 1e-12
+    assert np.abs(out[:, 1] - gb).max() < 1e-10
+    # b off the x axis too
+    gb2 = np.array([60.0, 80.0])
+    out2 = pl.apply_two_point(pl.two_point_transform(ra, rb, ga + 3, gb2), np.stack([ra, rb], 1))
+    assert np.abs(out2[:, 0] - (ga + 3)).max() < 1e-10 and np.abs(out2[:, 1] - gb2).max() < 1e-10
+
+
+def test_two_point_undoes_a_similarity():
+    """Readings that are an exact similarity of the grid come back as the grid."""
+    rng = np.random.default_rng(6)
+    G = _grid()
+    T = 10
+    s = rng.uniform(200, 300, T)
+    th = rng.uniform(-0.2, 0.2, T)
+    R = np.stack([np.stack([np.cos(th), -np.sin(th)], -1), np.stack([np.sin(th), np.cos(th)], -1)], -2)
+    C = s[:, None, None] * np.einsum("tij,nj->tni", R, G) + rng.uniform(-1e4, 1e4, (T, 1, 2))
+    ia, ib = wolf._index(G, (0, 0)), wolf._index(G, (100, 0))
+    out = pl.apply_two_point(pl.two_point_transform(C[:, ia], C[:, ib], G[ia], G[ib]), C)
+    assert np.abs(out - G).max() < 1e-9
+
+
+def test_discrepancy_stats_hand_computed():
+    d = np.array([[[3.0, -4.0], [-1.0, 0.0], [0.0, 2.0], [2.0, 2.0]]])
+    st = pl.discrepancy_stats(d, axis=1)
+    assert np.allclose(st["max"], [[3.0, 4.0]])
+    assert np.allclose(st["rms"], [[math.sqrt(3.5), math.sqrt(6.0)]])
+    assert np.allclose(st["mean"], [[1.5, 2.0]])
+
+
+def test_similarity_fit_recovers_parameters():
+    rng = np.random.default_rng(7)
+    X = rng.uniform(-50, 50, (4, 12, 2))
+    a, b = 1.001, 0.02
+    M0 = np.array([[a, -b], [b, a]])
+    Y = X @ M0.T + np.array([3.0, -2.0])
+    M, t = pl.fit_similarity(X, Y)
+    assert np.allclose(M, M0, atol=1e-12) and np.allclose(t, [3.0, -2.0], atol=1e-10)
+
+
+def test_underdetermined_fit_is_flagged():
+    X = np.random.default_rng(8).uniform(-1, 1, (3, 8, 2))
+    fit = pl.fit_poly(X, X, degree=3)  # 8 points, 10 terms
+    assert not fit.ok.any() and np.isnan(fit.coef).all()
+
+
+def test_stress_field_rms_and_smoothness():
+    spec = ef.FieldSpec(stress_um=5.0, stress_length_mm=60.0, stress_waves=32)
+    T = 4000
+    p = ef.draw(spec, np.random.default_rng(9), T)
+    pts = np.array([[0.0, 0.0], [3.0, 0.0], [150.0, 0.0]])
+    d = ef.evaluate(spec, p, pts)
+    s = d[:, 0, 0].std()
+    assert abs(s / 5.0 - 1) < 4 / math.sqrt(2 * (T - 1)) + 0.02
+    # neighbours 3 mm apart are nearly equal; points 150 mm apart nearly independent
+    c_near = np.corrcoef(d[:, 0, 0], d[:, 1, 0])[0, 1]
+    c_far = np.corrcoef(d[:, 0, 0], d[:, 2, 0])[0, 1]
+    assert c_near > 0.98 and abs(c_far) < 0.15
+
+
+def test_components_are_switched_off_by_zero_amplitude():
+    spec = ef.FieldSpec(plane_tilt_um=10.0)
+    p = ef.draw(spec, np.random.default_rng(10), 5)
+    comp = ef.evaluate_components(spec, p, _grid())
+    assert np.abs(comp["plane_tilt"]).max() > 1
+    for k in ef.COMPONENTS:
+        if k != "plane_tilt":
+            assert np.abs(comp[k]).max() == 0
+    assert np.allclose(ef.evaluate(spec, p, _grid()), comp["plane_tilt"])
+
+
+def test_ar1_weights_give_exponential_correlation():
+    t = np.array([0.0, 1.0, 4.0, 10.0])
+    W = ef.ar1_weights(t, 5.0)
+    C = W @ W.T
+    assert np.allclose(np.diag(C), 1.0)
+    assert np.allclose(C, np.exp(-np.abs(t[:, None] - t[None, :]) / 5.0))
+
+
+def test_reading_quantisation_error():
+    rng = np.random.default_rng(11)
+    q = 4.0
+    # no pointing noise: the rounding error of one reading is uniform, rms q / sqrt(12)
+    e0 = wolf.reading_error_rms(rng, q, 3, 0.0, 0.0, "one_side", size=100_000)
+    assert abs(e0 / (q / math.sqrt(12)) - 1) < 0.02
+    # large noise dithers the rounding: rms = sqrt((sigma^2 + q^2/12) / n)
+    e = wolf.reading_error_rms(rng, q, 3, 7.0, 0.0, "one_side", size=100_000)
+    assert abs(e / math.sqrt((49 + q * q / 12) / 3) - 1) < 4 / math.sqrt(2 * 100_000)
+
+
+def test_table1_transcription_reproduces_table2_and_table1():
+    t = wolf.load_table1(ROOT / "studies/data/wolf_table1.csv")
+    d = wolf.table1_discrepancies(t)
+    assert len(d["point"]) == 20
+    for (plate, ax, st), paper in wolf.PAPER_T2.items():
+        v = d[f"d{ax}_set{st}_foster_um"][d["plate"] == plate]
+        mx, rm, mn = wolf._st(v)
+        assert (round(mx), round(rm, 1), round(mn, 1)) == tuple(float(x) for x in paper)
+    x003 = wolf._st(d["dx_sets_um"][d["plate"] == "003"])
+    assert (round(x003[0]), round(x003[1], 1), round(x003[2], 1)) == (10, 5.8, 5.1)
+
+
+def _cfg(**over):
+    raw = {"trials": 20, "trade.trials": 10, **over}
+    return validate(raw, wolf.SCHEMA, wolf.check)
+
+
+def test_bad_config_is_rejected_by_key():
+    with pytest.raises(ConfigError) as e:
+        _cfg(**{"plate.spacing_mm": 30.0})
+    assert e.value.key == "plate.spacing_mm"
+    with pytest.raises(ConfigError) as e:
+        _cfg(**{"calib.degree": 6})
+    assert e.value.key == "calib.degree"
+    with pytest.raises(ConfigError) as e:
+        _cfg(**{"repeat.format_mm": [150.0, 120.0]})
+    assert e.value.key == "repeat.format_mm"
+    with pytest.raises(ConfigError) as e:
+        _cfg(**{"trade.spacings_mm": [20.0, 30.0]})
+    assert e.value.key == "trade.spacings_mm"
+    with pytest.raises(ConfigError) as e:
+        _cfg(**{"reading.approach": "both"})
+    assert e.value.key == "reading.approach"
+
+
+def test_main_chunk_before_after_and_noise_free_limit():
+    """The correction shrinks the discrepancies; with no noise, drift or restitution and a field
+    of polynomial components of degree <= 2 (no stress/periodic/gimbal), the cubic leaves only
+    the second-order effect of fitting in measured rather than true coordinates
+    (field gradient ~1e-3 x field ~100 um, i.e. a few tenths of a um)."""
+    cfg = _cfg()
+    out = wolf.main_chunk(cfg)(np.random.default_rng(12), 40)
+    assert np.median(out["after.rms_x_um"]) < 0.5 * np.median(out["before.rms_x_um"])
+    clean = _cfg(**{"reading.pointing_sigma_um": 0.0, "field.drift_fraction": 0.0,
+                    "field.restitution_um": 0.0, "field.stress_um": 0.0,
+                    "field.encoder_periodic_um": 0.0, "field.gimbal_eccentricity_um": 0.0,
+                    "plate.grid_sigma_um": 0.0, "reading.count_um": 0.01})
+    o = wolf.main_chunk(clean)(np.random.default_rng(13), 20)
+    assert np.max(o["after.rms_x_um"]) < 0.5 and np.max(o["after.rms_y_um"]) < 0.5
+    assert np.median(o["after.rms_x_um"]) < 0.02 * np.median(o["before.rms_x_um"])
+
+
+def test_study_runs_and_reports(tmp_path):
+    from sim.studies import RunContext
+
+    cfg = {"study": "wolf_polynomial", **_cfg(**{
+        "trade.degrees": [1, 3], "trade.spacings_mm": [20.0, 50.0], "trade.n_sets": [1, 3],
+        "trade.readings": [1, 3], "trade.pointing_sigmas_um": [7.0],
+        "trade.ages_weeks": [0.0, 52.0], "trade.drift_fractions": [0.5]})}
+    wolf.run(cfg, tmp_path, RunContext(quiet=True))
+    from sim.storage import read_table
+
+    claims = read_table(tmp_path / "claims.parquet").to_pydict()
+    names = set(claims["claim"])
+    for n in ("wolf.before.max_x_um", "wolf.after.rms_y_um", "wolf.repeatability.p003.rms_x_um",
+              "wolf.table1_real.p005.mean_y_um", "wolf.plate_after.rms_x_um",
+              "wolf.degree.cubic_excess_pct"):
+        assert n in names
+    i = claims["claim"].index("wolf.table1_real.p003.rms_y_um")
+    assert claims["holds"][i] is False and abs(claims["value"][i] - math.sqrt(53.0)) < 1e-9
+    d = read_table(tmp_path / "degree.parquet").to_pydict()
+    k = [j for j, (s, g) in enumerate(zip(d["spacing_mm"], d["degree"])) if s == 50.0 and g == 3]
+    assert all(d["estimable_share"][j] == 0 for j in k)  # 2 rows cannot carry a cubic
+    md = wolf.report(tmp_path)
+    assert "wolf.after.rms_x_um" in md and f"{tmp_path.name}/vectors.png" in md
+    for f in ("vectors.png", "components.png", "degree.png", "readings.png", "stability.png",
+              "table1_real.png", "trials.parquet"):
+        assert (tmp_path / f).is_file()
