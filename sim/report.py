@@ -92,6 +92,16 @@ def build_report(results: Path) -> str:
         sections.append((study.order, d.name,
                          f'<a id="{d.name}"></a>\n\n## {study.title}\n\nStudy `{d.name}` '
                          f"(seed paper `{study.seed_file}`), results in `{d.name}/`.\n\n{body}\n"))
+    for d in sorted(p for p in results.iterdir()
+                    if (p / "sweep.parquet").is_file() and not (p / "claims.parquet").is_file()):
+        from .sweep import sweep_markdown
+
+        prov = read_provenance(d / "sweep.parquet")
+        study = get_study(prov["study"])
+        sections.append((study.order + 1, d.name,
+                         f'<a id="{d.name}"></a>\n\n## Sweep: {study.title}\n\nSweep `{d.name}` over '
+                         f"study `{prov['study']}`, results in `{d.name}/`.\n\n"
+                         f"{sweep_markdown(d, d.name)}\n"))
     summary.sort()
     sections.sort()
     head = ("# Reproducibility report\n\n"

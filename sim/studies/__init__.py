@@ -23,6 +23,7 @@ MODULES = {
     "salsig_encoders": "sim.studies.salsig",
     "wolf_polynomial": "sim.studies.wolf",
     "agnard_block": "sim.studies.agnard",
+    "brown_design": "sim.studies.design",
 }
 
 

@@ -232,10 +232,11 @@ def chunk(rng: np.random.Generator, n: int, *, sim: dict, pts: np.ndarray, theta
         out["t1.share_1p1_1p3"] = ((ap >= 1.05) & (ap < 1.35)).mean(axis=(1, 2)) * nan
         out["t1.max_sigma_um"] = ap.max(axis=(1, 2)) * nan
         out["t1.points_ge_1p45"] = (ap.max(axis=2) >= 1.45).sum(axis=1) * nan
-        out["t1.setting_sigma_um"] = np.sqrt(sett.var(axis=-1, ddof=1).mean(axis=(1, 2))) * nan
-        for k in ("sigma0_um", "share_1p1_1p3", "max_sigma_um", "points_ge_1p45"):
-            out[f"rows.pivot_{k}" if k != "sigma0_um" else "rows.pivot_apost_ok"] = (
-                out[f"t1.{k}"] if k != "sigma0_um" else r.converged)
+        L = sett.shape[-1]  # the setting sigma needs repeated settings
+        out["t1.setting_sigma_um"] = (np.sqrt(sett.var(axis=-1, ddof=1).mean(axis=(1, 2))) * nan
+                                      if L > 1 else np.full(n, np.nan))
+        for k in ("share_1p1_1p3", "max_sigma_um", "points_ge_1p45"):
+            out[f"rows.pivot_{k}"] = out[f"t1.{k}"]
     return out
 
 
