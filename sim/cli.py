@@ -12,7 +12,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from .config import ConfigError, load_study
+from .config import ConfigError, StudyError, load_study
 
 __all__ = ["main"]
 
@@ -121,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
 
             print(write_report(Path(args.results)))
             return 0
-    except ConfigError as e:
+    except (ConfigError, StudyError) as e:
         print(f"sim: error: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-__all__ = ["ConfigError", "Field", "load_study", "parse_override", "validate"]
+__all__ = ["ConfigError", "StudyError", "Field", "load_study", "parse_override", "validate"]
 
 
 class ConfigError(ValueError):
@@ -28,6 +28,11 @@ class ConfigError(ValueError):
     def __init__(self, key: str | None, message: str):
         self.key = key
         super().__init__(f"{key}: {message}" if key else message)
+
+
+class StudyError(RuntimeError):
+    """The input passed validation but the study cannot produce results from it (e.g. a
+    singular reduced normal matrix in every trial). One line, like :class:`ConfigError`."""
 
 
 @dataclass(frozen=True)

@@ -162,7 +162,14 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
             cctx = ctx
             if getattr(ctx, "store", None) is not None:  # each cell its own chunk store
                 cctx = dataclasses.replace(ctx, store=type(ctx.store)(d / "trials"))
-            study.run(ccfg, d, cctx)
+            try:
+                study.run(ccfg, d, cctx)
+            except (KeyboardInterrupt, SystemExit):
+                raise
+            except Exception as e:  # noqa: BLE001 - a failed cell is recorded, the sweep goes on
+                row.update(feasible=False, reason=f"failed: {e}".splitlines()[0])
+                rows.append(row)
+                continue
             if (d / "claims.parquet").is_file():
                 for c in read_table(d / "claims.parquet").to_pylist():
                     row[c["claim"]] = c["value"]

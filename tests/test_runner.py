@@ -165,3 +165,22 @@ def test_jackknife_of_a_mean_matches_the_standard_error():
     assert (hi - lo) / 2 / stats.t.ppf(0.975, 39) == pytest.approx(
         x.mean(1).std(ddof=1) / np.sqrt(40), rel=1e-9)
     assert 0.6 < (hi - lo) / 2 / 1.96 / se < 1.4
+
+
+def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, capsys):
+    """A 2 x 2 grid passes validation but makes the pivot model's reduced normals singular."""
+    f = tmp_path / "s.toml"
+    f.write_text('study = "brown_table1"\ntrials = 20\nchunk = 10\n'
+                 '[sweep]\n"plate.grid" = [2, 5]\n')
+    out = tmp_path / "sw"
+    assert main(["run", str(f), "--out", str(out), "--quiet"]) == 0
+    t = pq.read_table(out / "sweep.parquet").to_pydict()
+    assert t["plate.grid"] == [2, 5]
+    assert t["feasible"] == [False, True]
+    assert "singular" in t["reason"][0]
+    # a plain run of the degenerate cell is a one-line error, exit 2
+    g = tmp_path / "g.toml"
+    g.write_text('study = "brown_table1"\ntrials = 20\nchunk = 10\n[plate]\ngrid = 2\n')
+    assert main(["run", str(g), "--out", str(tmp_path / "g"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "singular" in err[0]

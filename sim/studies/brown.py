@@ -22,7 +22,7 @@ from scipy import optimize
 
 from .. import multilateration as ml
 from ..claims import claim, rounding, sd_interval, spread, std_rel_se, write_claims
-from ..config import COMMON, ConfigError, Field
+from ..config import COMMON, ConfigError, Field, StudyError
 from ..plate import pattern_points
 from ..plotting import plt, save
 from ..report import claims_markdown, fmt, inputs_markdown, md_table
@@ -262,6 +262,10 @@ class MC:
         self.shape = self.sums.shape[1:]
         self.N = int(self.cnt.sum())
         self.nfail = sim["sum.nfail"].sum(0)
+        if self.N < 2:
+            raise StudyError(f"only {self.N} trials converged in all models (non-converged: "
+                             + ", ".join(f"{m} {int(f)}" for m, f in zip(MODEL_NAMES, self.nfail))
+                             + "): singular reduced normal matrix, the geometry is degenerate")
 
     def sd_from(self, total: np.ndarray) -> np.ndarray:
         """(3, n, 2) standard deviations from a packed total [N, sums...]."""
