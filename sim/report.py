@@ -52,7 +52,7 @@ def claims_markdown(path: Path) -> str:
     for r in t:
         ref = ""
         if r["ref_low"] is not None and math.isfinite(r["ref_low"]):
-            f = (lambda x: f"{x:.10g}") if r["interval"] == "exact" else fmt  # noqa: E731
+            f = (lambda x: f"{x:.10g}") if r["interval"] == "exact" else (lambda x: fmt(x, 4))  # noqa: E731
             ref = (f(r["ref_low"]) if r["ref_low"] == r["ref_high"]
                    else f"{f(r['ref_low'])}–{f(r['ref_high'])}")
         ci = ("exact" if r["interval"] == "exact" else

@@ -674,6 +674,14 @@ def report_dilution(out: Path) -> str:
         "",
         inputs_markdown(cfg, DILUTION),
         "",
+        "**Two caveats, from the `brown_design` study.** The dilution above is stated in "
+        "Brown's datum, which the station estimates define; in datums that do not lean on the "
+        "stations (inner constraints over the points, a similarity onto the corners) most of it "
+        "disappears -- see the `brown.datum_invariant_dilution` rows there. And this geometry "
+        "(points to the edges, stations well outside the midsides) is the idealised four-station "
+        "system of the paper's Figure 1: the built comparator reads ranges on a 261 mm scale, "
+        "which `brown_design` shows cannot reach such a layout.",
+        "",
         "**Where 0.71-0.85 holds.** The centre ratio is 1/sqrt(2) = 0.7071 for any station "
         "offset. The largest ratio depends on how far the points reach and how far out the "
         "stations are; the station offset giving 0.85 for a 5 x 5 grid:",

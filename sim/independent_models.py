@@ -1,0 +1,586 @@
+"""Block adjustment of independent stereomodels in 3-D, batched over Monte-Carlo trials.
+
+Seed: ``003_5ce730a990a7ebc5.txt`` (Agnard, Nolette & Gagnon): a block of two strips of
+eight models adjusted by independent models (the program SPACE-M of J. A. R. Blais), a
+7-parameter similarity per model, pass points tying models and strips, control weighted
+3 (planimetry) and 2 (height) against 0.1 on pass points; a first pass with 0.1 on control
+and 1.0 on pass points; digital pugging (the pass point keeps the very same image
+coordinates on the photo two models share) against mechanical pugging (re-centred).
+
+**Stereomodel formation** (:func:`form_models`). Normal-case photography and a known
+relative orientation: the model follows from the measured image coordinates by the
+parallax equations ``X = x' B / p``, ``Y = (y' + y'') B / (2 p)``, ``Z = -f B / p`` with
+``p = x' - x''``. The relative orientation is not re-estimated: the point errors reach the
+model through the exact intersection, including the height amplification ``H / B`` and
+the correlation of pass points shared by two models; the part of an image error a relative
+orientation would absorb (y-parallax) is not removed, which makes the model slightly
+pessimistic. Each model is then expressed in its own arbitrary frame by a random
+similarity (:func:`random_similarities`), which the block adjustment has to recover.
+
+**Adjustment** (:func:`adjust_block`). Unknowns: per model ``m`` a similarity
+``G = s_m R_m (x - c_m) + t_m`` (``c_m`` the centroid of the model's points, for
+conditioning) and per point its ground coordinates ``X_j``. Observation equations
+
+    v_mj = s_m R_m (x_mj - c_m) + t_m - X_j        (model points, weights w_obs)
+    v_j  = X_j - X_j^control                        (control, weights w_ctrl)
+
+linearised with the multiplicative corrections ``s <- s (1 + dl)``, ``R <- R(dtheta) R``.
+Gauss-Newton over a leading trial axis. The point blocks (3 x 3, diagonal here) are
+eliminated: the reduced normals of the model parameters have one 7 x 7 block per pair of
+models that share a point, assembled from the list of such pairs with sparse scatter
+matrices, so the work grows with the number of pairs, not with the square of the block.
+Small blocks solve them by a Cholesky factorisation batched over trials; from
+``SPARSE_FROM_MODELS`` models up as sparse matrices, one block at a time, so a block of
+hundreds of models costs little more than its number of model pairs.
+
+**Data snooping** (:func:`snoop`): Baarda's w-test on each residual component with the
+a-priori variance of unit weight (weights ``1 / sigma^2``), ``w = v / sqrt(q_vv)``, or
+Pope's tau-test with the a-posteriori one; the pass point with the largest ``|w|`` above
+the critical value is removed and the block re-adjusted until none exceeds it.
+
+Units: metres for ground and model coordinates; image coordinates in mm, errors in um.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import sparse
+
+__all__ = ["rotation", "rodrigues", "similarity_fit", "form_models", "random_similarities",
+           "to_model_frame", "BlockStructure", "AdjustResult", "adjust_block", "snoop",
+           "residual_cofactors", "normal_step", "chol_solve", "pointing_errors",
+           "initial_values", "point_cofactors", "SPARSE_FROM_MODELS"]
+
+
+# --------------------------------------------------------------------------- similarity
+def rotation(omega: np.ndarray, phi: np.ndarray, kappa: np.ndarray) -> np.ndarray:
+    """Rotation ``R = R_x(omega) R_y(phi) R_z(kappa)`` (radians), shape ``(..., 3, 3)``."""
+    co, so = np.cos(omega), np.sin(omega)
+    cp, sp = np.cos(phi), np.sin(phi)
+    ck, sk = np.cos(kappa), np.sin(kappa)
+    one, zero = np.ones_like(co), np.zeros_like(co)
+    Rx = np.stack([np.stack([one, zero, zero], -1), np.stack([zero, co, -so], -1),
+                   np.stack([zero, so, co], -1)], -2)
+    Ry = np.stack([np.stack([cp, zero, sp], -1), np.stack([zero, one, zero], -1),
+                   np.stack([-sp, zero, cp], -1)], -2)
+    Rz = np.stack([np.stack([ck, -sk, zero], -1), np.stack([sk, ck, zero], -1),
+                   np.stack([zero, zero, one], -1)], -2)
+    return Rx @ Ry @ Rz
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    z = np.zeros_like(v[..., 0])
+    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1),
+                     np.stack([v[..., 2], z, -v[..., 0]], -1),
+                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
+
+
+def rodrigues(theta: np.ndarray) -> np.ndarray:
+    """Rotation matrix ``(..., 3, 3)`` of the rotation vector ``theta`` ``(..., 3)``."""
+    a = np.linalg.norm(theta, axis=-1)[..., None, None]
+    K = _skew(theta)
+    small = a < 1e-12
+    a_ = np.where(small, 1.0, a)
+    s = np.where(small, 1.0, np.sin(a_) / a_)
+    c = np.where(small, 0.5, (1 - np.cos(a_)) / a_ ** 2)
+    return np.eye(3) + s * K + c * (K @ K)
+
+
+def similarity_fit(src: np.ndarray, dst: np.ndarray, w: np.ndarray | None = None):
+    """Least-squares 3-D similarity ``dst ~ s R src + t`` (Umeyama / Horn), batched.
+
+    src, dst : (..., n, 3); w : (..., n) non-negative point weights (isotropic).
+    Returns ``s (...), R (..., 3, 3), t (..., 3)``. This closed form is the least-squares
+    solution when every point has the same weight in X, Y and Z.
+    """
+    if w is None:
+        w = np.ones(src.shape[:-1])
+    w = w / w.sum(axis=-1, keepdims=True)
+    ms = np.einsum("...n,...nc->...c", w, src)
+    md = np.einsum("...n,...nc->...c", w, dst)
+    a = src - ms[..., None, :]
+    b = dst - md[..., None, :]
+    C = np.einsum("...n,...ni,...nj->...ij", w, b, a)
+    U, S, Vt = np.linalg.svd(C)
+    d = np.sign(np.linalg.det(U @ Vt))
+    D = np.ones(S.shape)
+    D[..., 2] = d
+    R = U @ (D[..., :, None] * Vt)
+    var = np.einsum("...n,...nc,...nc->...", w, a, a)
+    s = np.einsum("...i,...i->...", S, D) / var
+    t = md - s[..., None] * np.einsum("...ij,...j->...i", R, ms)
+    return s, R, t
+
+
+# ------------------------------------------------------------------ model simulation
+def form_models(xl_mm: np.ndarray, xr_mm: np.ndarray, focal_mm: float, base_m: float) -> np.ndarray:
+    """Model coordinates (m, origin at the left projection centre, ground-parallel axes)
+    from measured image coordinates of the left and right photo, ``(..., 2)`` each, by the
+    parallax equations of normal-case photography. Returns ``(..., 3)``."""
+    p = xl_mm[..., 0] - xr_mm[..., 0]
+    k = base_m / p
+    return np.stack([xl_mm[..., 0] * k, 0.5 * (xl_mm[..., 1] + xr_mm[..., 1]) * k,
+                     -focal_mm * k], -1)
+
+
+def random_similarities(rng: np.random.Generator, shape: tuple, *, tilt_rad: float = 0.02,
+                        scale_range: tuple[float, float] = (0.5, 2.0), shift_m: float = 1000.0):
+    """Arbitrary model frames: ``(s, R, t)`` with any heading, small tilts, a scale and a
+    shift, shapes ``shape``, ``shape + (3, 3)``, ``shape + (3,)``."""
+    om = rng.normal(0.0, tilt_rad, shape)
+    ph = rng.normal(0.0, tilt_rad, shape)
+    ka = rng.uniform(-np.pi, np.pi, shape)
+    s = np.exp(rng.uniform(np.log(scale_range[0]), np.log(scale_range[1]), shape))
+    t = rng.normal(0.0, shift_m, shape + (3,))
+    return s, rotation(om, ph, ka), t
+
+
+def to_model_frame(ground_xyz: np.ndarray, obs_model: np.ndarray, s, R, t) -> np.ndarray:
+    """Express ground-frame model points ``(T, K, 3)`` in the frames of their models:
+    ``x = R^T (X - t) / s`` with ``s (T, M)``, ``R (T, M, 3, 3)``, ``t (T, M, 3)``."""
+    d = ground_xyz - t[:, obs_model]
+    return np.einsum("tkji,tkj->tki", R[:, obs_model], d) / s[:, obs_model, None]
+
+
+def pointing_errors(rng: np.random.Generator, trials: int, obs_left: np.ndarray,
+                    obs_right: np.ndarray, obs_point: np.ndarray, photos_per_strip: int,
+                    n_strips: int, n_points: int, *, mark_um: float, parallax_um: float,
+                    digital: np.ndarray | None = None, mechanical: np.ndarray | None = None,
+                    transfer_um: float = 0.0, recentre_um: float = 0.0, gross_rate: float = 0.0,
+                    gross_um: tuple[float, float] = (0.0, 0.0)):
+    """Image-measurement errors (um) on the left and right photo of every model point.
+
+    Observation ``k`` (a point in a model) is measured on the flat photo indices
+    ``obs_left[k]`` and ``obs_right[k]`` (``strip * photos_per_strip + i``). Errors are image
+    shifts; in normal-case photography a shift of the pointed ground detail moves its image
+    by the same vector on every photo.
+
+    * Signalised points (default): re-pointed in every model. A setting error common to both
+      photos, N(0, ``mark_um``) per coordinate, plus a stereo (parallax) setting error:
+      N(0, ``parallax_um / sqrt(2)``) on each photo, so the x-parallax error has sigma
+      ``parallax_um``.
+    * Digital pugging (``digital`` (P,) True): the pixel marked on a photo is stored and
+      reused, so a photo shared by two models has the very same image coordinates in both;
+      the next photo of the strip is pointed stereoscopically to the stored pixel with a
+      parallax error N(0, ``parallax_um``). Along a strip the errors are a random walk over
+      the photos that see the point, starting from a setting error N(0, ``mark_um``); across
+      strips the point is marked afresh.
+    * Mechanical pugging (``mechanical`` (P,) True): a hole drilled on each photo (transfer
+      error N(0, ``transfer_um``) per photo, shared by the models using the photo),
+      re-centred in every model (N(0, ``recentre_um``) per photo and measurement); with
+      probability ``gross_rate`` per model point the hole is missed on one of the two photos
+      (white area, poor contrast of the scan) by a distance uniform in ``gross_um``.
+
+    Returns ``(e_left, e_right, gross)``: (T, K, 2), (T, K, 2) and (T, K) bool.
+    """
+    K = obs_point.size
+    T = trials
+    mu = rng.normal(0.0, mark_um, (T, K, 1, 2))
+    e = mu + rng.normal(0.0, parallax_um / np.sqrt(2.0), (T, K, 2, 2))
+    gross = np.zeros((T, K), bool)
+    S, F, P = n_strips, photos_per_strip, n_points
+    strip = obs_left // F
+    if digital is not None and np.any(digital):
+        dk = np.asarray(digital, bool)[obs_point]
+        first = np.full((S, P), F, np.intp)
+        np.minimum.at(first, (strip[dk], obs_point[dk]), obs_left[dk] % F)
+        walk = np.cumsum(rng.normal(0.0, parallax_um, (T, S, F, P, 2)), axis=2)
+        mark = rng.normal(0.0, mark_um, (T, S, P, 2))
+        sk, pk = strip[dk], obs_point[dk]
+        start = mark[:, sk, pk] - walk[:, sk, first[sk, pk], pk]
+        e[:, dk, 0] = start + walk[:, sk, obs_left[dk] % F, pk]
+        e[:, dk, 1] = start + walk[:, sk, obs_right[dk] % F, pk]
+    if mechanical is not None and np.any(mechanical):
+        mk = np.asarray(mechanical, bool)[obs_point]
+        n = int(mk.sum())
+        hole = rng.normal(0.0, transfer_um, (T, S * F, P, 2))
+        rec = rng.normal(0.0, recentre_um, (T, n, 2, 2))
+        hit = rng.random((T, n)) < gross_rate
+        side = rng.integers(0, 2, (T, n))
+        ang = rng.uniform(0, 2 * np.pi, (T, n))
+        mag = rng.uniform(gross_um[0], gross_um[1], (T, n)) * hit
+        g = np.stack([mag * np.cos(ang), mag * np.sin(ang)], -1)        # (T, n, 2)
+        for c, hole_photo in ((0, obs_left[mk]), (1, obs_right[mk])):
+            e[:, mk, c] = (hole[:, hole_photo, obs_point[mk]] + rec[:, :, c]
+                           + np.where((side == c)[..., None], g, 0.0))
+        gross[:, mk] = hit
+    return e[:, :, 0], e[:, :, 1], gross
+
+
+def initial_values(st: "BlockStructure", xm: np.ndarray, X_approx: np.ndarray):
+    """Starting similarities ``(s, R, t)`` per model by a closed-form fit of its model points
+    to approximate ground coordinates ``X_approx`` (T, P, 3) (one fit per model)."""
+    T = xm.shape[0]
+    M = st.n_models
+    s = np.empty((T, M))
+    R = np.empty((T, M, 3, 3))
+    t = np.empty((T, M, 3))
+    for m in range(M):  # a handful of models, each fit batched over trials
+        k = st.obs_model == m
+        s[:, m], R[:, m], t[:, m] = similarity_fit(xm[:, k], X_approx[:, st.obs_point[k]])
+    return s, R, t
+
+
+# ------------------------------------------------------------------- linear algebra
+def chol_solve(N: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Solve ``N x = b`` for a stack of symmetric positive-definite ``N`` ``(T, n, n)``,
+    ``b`` ``(T, n, r)``, by Cholesky factorisation and batched substitution.
+
+    (Batched LAPACK ``gesv`` through numpy is slow here when OpenBLAS threads compete for the
+    cores; the factorisation itself is fast and the substitutions vectorise over trials.)
+    A non-positive-definite ``N`` raises ``numpy.linalg.LinAlgError``.
+    """
+    L = np.linalg.cholesky(N)
+    n = N.shape[-1]
+    y = np.empty(b.shape)
+    for i in range(n):  # loop over the unknowns, vectorised over trials
+        y[:, i] = (b[:, i] - np.einsum("tj,tjr->tr", L[:, i, :i], y[:, :i])) / L[:, i, i, None]
+    x = np.empty(b.shape)
+    for i in range(n - 1, -1, -1):
+        x[:, i] = (y[:, i] - np.einsum("tj,tjr->tr", L[:, i + 1:, i], x[:, i + 1:])) / L[:, i, i, None]
+    return x
+
+
+# ------------------------------------------------------------------- block structure
+def _indicator(rows: np.ndarray, n_rows: int) -> sparse.csr_matrix:
+    """Sparse ``(n_rows, len(rows))`` matrix summing items into their rows."""
+    k = rows.size
+    return sparse.csr_matrix((np.ones(k), (rows, np.arange(k))), shape=(n_rows, k))
+
+
+def _scatter(S: sparse.csr_matrix, data: np.ndarray) -> np.ndarray:
+    """Sum ``data`` ``(T, k, ...)`` over its second axis into ``S.shape[0]`` bins."""
+    T, k = data.shape[:2]
+    rest = data.shape[2:]
+    d = np.moveaxis(data, 1, 0).reshape(k, -1)
+    out = np.asarray(S @ d).reshape((S.shape[0], T) + rest)
+    return np.moveaxis(out, 0, 1)
+
+
+@dataclass(frozen=True)
+class BlockStructure:
+    """Which model observes which point, and the derived scatter operators.
+
+    obs_model, obs_point : (K,) ; ctrl_point : (C,) ; n_models, n_points.
+    Pairs ``(k1, k2)`` are all ordered pairs of observations of the same point.
+    """
+
+    obs_model: np.ndarray
+    obs_point: np.ndarray
+    ctrl_point: np.ndarray
+    n_models: int
+    n_points: int
+    pk1: np.ndarray = field(init=False)
+    pk2: np.ndarray = field(init=False)
+    S_model: sparse.csr_matrix = field(init=False)
+    S_point: sparse.csr_matrix = field(init=False)
+    S_ctrl: sparse.csr_matrix = field(init=False)
+    S_pair: sparse.csr_matrix = field(init=False)
+    pair_m1: np.ndarray = field(init=False)
+    pair_m2: np.ndarray = field(init=False)
+    S_pair_obs: sparse.csr_matrix = field(init=False)
+    S_pair_point: sparse.csr_matrix = field(init=False)
+
+    def __post_init__(self):
+        om = np.asarray(self.obs_model)
+        op = np.asarray(self.obs_point)
+        order = np.argsort(op, kind="stable")
+        starts = np.searchsorted(op[order], np.arange(self.n_points))
+        ends = np.searchsorted(op[order], np.arange(self.n_points), side="right")
+        k1, k2 = [], []
+        for a, b in zip(starts, ends):  # structure only, once per block
+            idx = order[a:b]
+            k1.append(np.repeat(idx, idx.size))
+            k2.append(np.tile(idx, idx.size))
+        pk1 = np.concatenate(k1).astype(np.intp)
+        pk2 = np.concatenate(k2).astype(np.intp)
+        M = self.n_models
+        set_ = object.__setattr__
+        set_(self, "pk1", pk1)
+        set_(self, "pk2", pk2)
+        set_(self, "S_model", _indicator(om, M))
+        set_(self, "S_point", _indicator(op, self.n_points))
+        set_(self, "S_ctrl", _indicator(np.asarray(self.ctrl_point, np.intp), self.n_points))
+        mp, inv = np.unique(om[pk1] * M + om[pk2], return_inverse=True)
+        set_(self, "S_pair", _indicator(inv.ravel(), mp.size))      # observation pair -> model pair
+        set_(self, "pair_m1", mp // M)
+        set_(self, "pair_m2", mp % M)
+        set_(self, "S_pair_obs", _indicator(pk1, om.size))
+        set_(self, "S_pair_point", _indicator(op[pk1], self.n_points))
+
+
+@dataclass
+class AdjustResult:
+    """Result of :func:`adjust_block` (leading axis: trials).
+
+    s (T, M), R (T, M, 3, 3), t (T, M, 3): ground = s R x + t for each model;
+    X (T, P, 3) adjusted points; v_obs (T, K, 3) model-point residuals (ground units);
+    v_ctrl (T, C, 3) control residuals (adjusted minus given); sigma0 (T,) a-posteriori
+    standard error of unit weight; dof (T,); iterations; converged (T,) bool.
+    """
+
+    s: np.ndarray
+    R: np.ndarray
+    t: np.ndarray
+    X: np.ndarray
+    v_obs: np.ndarray
+    v_ctrl: np.ndarray
+    sigma0: np.ndarray
+    dof: np.ndarray
+    iterations: int
+    converged: np.ndarray
+    Nbar: np.ndarray | None = None
+    Dinv: np.ndarray | None = None
+    B: np.ndarray | None = None
+    J: np.ndarray | None = None
+
+
+def _linearise(st: BlockStructure, xm, c, s, R, t, X):
+    y = s[:, st.obs_model, None] * np.einsum("tkij,tkj->tki", R[:, st.obs_model],
+                                              xm - c[:, st.obs_model])
+    e = y + t[:, st.obs_model] - X[:, st.obs_point]
+    T, K = y.shape[:2]
+    J = np.empty((T, K, 3, 7))
+    J[..., 0] = y
+    J[..., 1:4] = -_skew(y)
+    J[..., 4:7] = np.eye(3)
+    return e, J
+
+
+def _reduced(st: BlockStructure, J, w_obs, w_ctrl_full):
+    """Reduced normals as 7 x 7 blocks of the model pairs ``(st.pair_m1, st.pair_m2)`` that
+    share a point, ``(T, n_pairs, 7, 7)``; ``B`` (T, K, 7, 3) and ``Dinv`` (T, P, 3)."""
+    B = -np.swapaxes(J * w_obs[..., None], -1, -2)              # (T, K, 7, 3)
+    Ngg = _scatter(st.S_model, -(B @ J))                         # (T, M, 7, 7)
+    D = _scatter(st.S_point, w_obs) + w_ctrl_full
+    Dinv = np.where(D > 0, 1.0 / np.where(D > 0, D, 1.0), 0.0)
+    BD = B * Dinv[:, st.obs_point, None, :]                      # (T, K, 7, 3)
+    C = BD[:, st.pk1] @ np.swapaxes(B, -1, -2)[:, st.pk2]        # (T, obs pairs, 7, 7)
+    blocks = -_scatter(st.S_pair, C)
+    diag = st.pair_m1 == st.pair_m2
+    blocks[:, diag] += Ngg[:, st.pair_m1[diag]]
+    return blocks, B, Dinv
+
+
+def _dense(st: BlockStructure, blocks: np.ndarray) -> np.ndarray:
+    """The reduced normal matrix ``(T, 7M, 7M)`` from its pair blocks."""
+    T, M = blocks.shape[0], st.n_models
+    N = np.zeros((T, M, M, 7, 7))
+    N[:, st.pair_m1, st.pair_m2] = blocks
+    return N.transpose(0, 1, 3, 2, 4).reshape(T, 7 * M, 7 * M)
+
+
+def _sparse_solve(st: BlockStructure, blocks: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Solve the reduced normals trial by trial as a sparse matrix (large blocks).
+
+    The matrix of a block of ``M`` models has about ``9 M`` non-zero 7 x 7 blocks (each model
+    shares points with its neighbours only), so a sparse LU costs far less than the dense
+    ``(7M)^3`` once ``M`` reaches a few hundred models. The loop runs over the trials, each
+    one a whole block.
+    """
+    from scipy.sparse.linalg import spsolve
+
+    M = st.n_models
+    i = np.arange(7)
+    shape = (st.pair_m1.size, 7, 7)
+    rows = np.broadcast_to(7 * st.pair_m1[:, None, None] + i[None, :, None], shape)
+    cols = np.broadcast_to(7 * st.pair_m2[:, None, None] + i[None, None, :], shape)
+    out = np.empty(rhs.shape)
+    for t in range(blocks.shape[0]):  # one sparse factorisation per simulated block
+        N = sparse.csc_matrix((blocks[t].ravel(), (rows.ravel(), cols.ravel())),
+                              shape=(7 * M, 7 * M))
+        out[t] = spsolve(N, rhs[t])
+    return out
+
+
+#: above this many models the reduced normals are solved as sparse matrices
+SPARSE_FROM_MODELS = 60
+
+
+def normal_step(st: BlockStructure, xm, c, s, R, t, X, w_obs, ctrl_xyz, w_ctrl, dense=False,
+                solver: str = "auto"):
+    """One Gauss-Newton correction ``(dg (T, M, 7), dX (T, P, 3))``.
+
+    The reduced normals are solved densely (batched Cholesky) or, for blocks of
+    ``SPARSE_FROM_MODELS`` models or more (``solver="auto"``), as sparse matrices;
+    ``solver`` may force ``"dense"`` or ``"sparse"``. ``dense=True`` instead builds and
+    solves the full normal matrix of all ``7M + 3P`` unknowns (for checking the reduced
+    solution on small blocks).
+    """
+    T = xm.shape[0]
+    M, P = st.n_models, st.n_points
+    e, J = _linearise(st, xm, c, s, R, t, X)
+    wc_full = _scatter(st.S_ctrl, np.broadcast_to(w_ctrl, (T,) + np.shape(w_ctrl)[-2:]))
+    ec = X[:, st.ctrl_point] - ctrl_xyz
+    ug = _scatter(st.S_model, -np.einsum("tkci,tkc->tki", J, w_obs * e))
+    up = _scatter(st.S_point, w_obs * e) - _scatter(st.S_ctrl, w_ctrl * ec)
+    if dense:
+        K = st.obs_model.size
+        C = st.ctrl_point.size
+        A = np.zeros((T, 3 * K + 3 * C, 7 * M + 3 * P))
+        rows = 3 * np.arange(K)[:, None] + np.arange(3)
+        for k in range(K):  # test-only dense assembly
+            A[:, rows[k], 7 * st.obs_model[k]:7 * st.obs_model[k] + 7] = J[:, k]
+            A[:, rows[k], 7 * M + 3 * st.obs_point[k] + np.arange(3)] = -1.0
+        for i, j in enumerate(st.ctrl_point):
+            A[:, 3 * K + 3 * i + np.arange(3), 7 * M + 3 * j + np.arange(3)] = 1.0
+        w = np.concatenate([w_obs.reshape(T, -1),
+                            np.broadcast_to(w_ctrl, ec.shape).reshape(T, -1)], 1)
+        r = np.concatenate([e.reshape(T, -1), ec.reshape(T, -1)], 1)
+        N = np.einsum("toi,to,toj->tij", A, w, A)
+        u = -np.einsum("toi,to->ti", A, w * r)
+        d = chol_solve(N, u[..., None])[..., 0]
+        return d[:, :7 * M].reshape(T, M, 7), d[:, 7 * M:].reshape(T, P, 3)
+    blocks, B, Dinv = _reduced(st, J, w_obs, wc_full)
+    ubar = ug - _scatter(st.S_model, np.einsum("tkic,tkc,tkc->tki", B, Dinv[:, st.obs_point],
+                                               up[:, st.obs_point]))
+    if solver == "auto":
+        solver = "sparse" if M >= SPARSE_FROM_MODELS else "dense"
+    if solver == "sparse":
+        dg = _sparse_solve(st, blocks, ubar.reshape(T, 7 * M)).reshape(T, M, 7)
+    else:
+        dg = chol_solve(_dense(st, blocks), ubar.reshape(T, 7 * M, 1)).reshape(T, M, 7)
+    dX = Dinv * (up - _scatter(st.S_point, np.einsum("tkic,tki->tkc", B, dg[:, st.obs_model])))
+    return dg, dX
+
+
+def adjust_block(st: BlockStructure, xm: np.ndarray, w_obs: np.ndarray, ctrl_xyz: np.ndarray,
+                 w_ctrl: np.ndarray, s0, R0, t0, X0, *, tol_m: float = 1e-5, max_iter: int = 20,
+                 keep_normals: bool = False, solver: str = "auto") -> AdjustResult:
+    """Batched least-squares block adjustment of independent models.
+
+    xm : (T, K, 3) model coordinates of observation ``k`` (model ``st.obs_model[k]``, point
+    ``st.obs_point[k]``); w_obs : (T, K, 3) or (K, 3) weights (0 removes an observation);
+    ctrl_xyz : (T, C, 3) given control coordinates; w_ctrl : (C, 3) weights.
+    s0, R0, t0 : initial similarities (ground = s R x + t), X0 : (T, P, 3) initial points.
+    Iterates until the largest point correction is below ``tol_m``. ``solver``: see
+    :func:`normal_step`.
+    """
+    T, K = xm.shape[:2]
+    w_obs = np.broadcast_to(w_obs, (T, K, 3)).astype(float)
+    w_ctrl = np.broadcast_to(w_ctrl, (T,) + np.shape(w_ctrl)[-2:]).astype(float)
+    wsum = _scatter(st.S_model, (w_obs.sum(-1) > 0).astype(float)[..., None])
+    c = _scatter(st.S_model, xm * (w_obs.sum(-1, keepdims=True) > 0)) / np.maximum(wsum, 1)
+    s = np.array(s0, float)
+    R = np.array(R0, float)
+    # work with t' = t + s R c (the ground position of the model centroid)
+    t = np.array(t0, float) + s[..., None] * np.einsum("tmij,tmj->tmi", R, c)
+    X = np.array(X0, float)
+    conv = np.zeros(T, bool)
+    it = 0
+    for it in range(1, max_iter + 1):
+        dg, dX = normal_step(st, xm, c, s, R, t, X, w_obs, ctrl_xyz, w_ctrl, solver=solver)
+        s = s * (1.0 + dg[..., 0])
+        R = rodrigues(dg[..., 1:4]) @ R
+        t = t + dg[..., 4:7]
+        X = X + dX
+        step = np.maximum(np.abs(dX).max(axis=(1, 2)),
+                          np.abs(dg[..., 4:7]).max(axis=(1, 2)))
+        conv = step < tol_m
+        if conv.all():
+            break
+    e, J = _linearise(st, xm, c, s, R, t, X)
+    vc = X[:, st.ctrl_point] - ctrl_xyz
+    used = (w_obs > 0).sum(axis=(1, 2))
+    n_unk = 7 * st.n_models + 3 * (_scatter(st.S_point, w_obs) + _scatter(
+        st.S_ctrl, w_ctrl) > 0).any(-1).sum(-1)
+    dof = used + (w_ctrl > 0).sum(axis=(1, 2)) - n_unk
+    ss = np.einsum("tkc,tkc->t", w_obs * e, e) + np.einsum("tkc,tkc->t", w_ctrl * vc, vc)
+    sigma0 = np.sqrt(ss / np.maximum(dof, 1))
+    t_out = t - s[..., None] * np.einsum("tmij,tmj->tmi", R, c)
+    res = AdjustResult(s, R, t_out, X, e, vc, sigma0, dof, it, conv)
+    if keep_normals:
+        wc_full = _scatter(st.S_ctrl, w_ctrl)
+        blocks, res.B, res.Dinv = _reduced(st, J, w_obs, wc_full)
+        res.Nbar = _dense(st, blocks)
+        res.J = J
+    return res
+
+
+def _cofactors(st: BlockStructure, res: AdjustResult):
+    """``(Qmm (T, K, 7, 7), Qmj (T, K, 7, 3), Qjj_diag (T, P, 3))`` from the reduced normals
+    kept in ``res``: the cofactors of observation k's model parameters, their cross terms
+    with its point, and the diagonal of every point's cofactor block (see
+    :func:`residual_cofactors`)."""
+    T = res.X.shape[0]
+    M = st.n_models
+    Q = chol_solve(res.Nbar, np.broadcast_to(np.eye(7 * M), res.Nbar.shape))
+    Q = Q.reshape(T, M, 7, M, 7).transpose(0, 1, 3, 2, 4)
+    om, op = st.obs_model, st.obs_point
+    Qp = Q[:, om[st.pk1], om[st.pk2]]                          # (T, npair, 7, 7)
+    B, Dinv = res.B, res.Dinv
+    QB = np.einsum("tpab,tpbc->tpac", Qp, B[:, st.pk2])        # (T, npair, 7, 3)
+    Qmj = -_scatter(st.S_pair_obs, QB) * Dinv[:, op][:, :, None, :]
+    inner = np.einsum("tpac,tpac->tpc", B[:, st.pk1], QB)      # diag of B1^T Q B2
+    Qjj = Dinv + Dinv ** 2 * _scatter(st.S_pair_point, inner)
+    return Q[:, om, om], Qmj, Qjj
+
+
+def point_cofactors(st: BlockStructure, res: AdjustResult) -> np.ndarray:
+    """Diagonal cofactors of the adjusted points ``(T, P, 3)`` (``keep_normals=True``);
+    times the variance of unit weight they are the variances of the ground coordinates."""
+    return _cofactors(st, res)[2]
+
+
+def residual_cofactors(st: BlockStructure, res: AdjustResult, w_obs: np.ndarray) -> np.ndarray:
+    """Diagonal of the residual cofactor matrix ``Q_vv = W^-1 - A Q_xx A^T`` of the model
+    points, ``(T, K, 3)``, from the reduced normals kept in ``res`` (``keep_normals=True``).
+
+    With ``A_k = [J_k, -I]`` for observation ``k`` of model ``m`` and point ``j``:
+    ``diag(A Q A^T) = diag(J Q_mm J^T) - 2 diag(J Q_mj) + diag(Q_jj)`` where
+    ``Q_gg = Nbar^-1``, ``Q_mj = -sum_k' Q_g[m, m_k'] B_k' D_j^-1`` and
+    ``Q_jj = D_j^-1 + D_j^-1 (sum_k'k'' B_k'^T Q_g[m_k', m_k''] B_k'') D_j^-1``.
+    Removed observations (weight 0) get NaN.
+    """
+    Qmm, Qmj, Qjj = _cofactors(st, res)
+    J = res.J
+    aqa = (np.einsum("tkca,tkab,tkcb->tkc", J, Qmm, J)
+           - 2 * np.einsum("tkca,tkac->tkc", J, Qmj) + Qjj[:, st.obs_point])
+    w = np.broadcast_to(w_obs, aqa.shape)
+    return np.where(w > 0, 1.0 / np.where(w > 0, w, 1.0) - aqa, np.nan)
+
+
+def snoop(st: BlockStructure, xm, w_obs, ctrl_xyz, w_ctrl, s0, R0, t0, X0, candidates: np.ndarray,
+          crit: float, max_reject: int = 30, a_posteriori: bool = False):
+    """Iterative data snooping (Baarda's w-test) on the points flagged in ``candidates``.
+
+    Weights must be ``1 / sigma^2`` (a-priori variance of unit weight 1). At each round
+    the candidate point with the largest ``|w| = |v| / (sigma0 sqrt(q_vv))`` over its
+    observation components is removed (all its model observations) when ``|w| > crit``; the
+    block is re-adjusted and tested again. ``sigma0`` is 1 (Baarda's w-test) or, with
+    ``a_posteriori``, the block's own estimate (Pope's tau-test). Only trials that still
+    reject are re-adjusted. Returns ``(rejected (T, P) bool, sigma0 (T,), w_max (T,),
+    rounds (T,))`` with ``w_max`` the largest remaining ``|w|`` of a candidate.
+    """
+    T, K = xm.shape[:2]
+    w = np.array(np.broadcast_to(w_obs, (T, K, 3)), float)
+    ctrl_xyz = np.broadcast_to(ctrl_xyz, (T,) + np.shape(ctrl_xyz)[-2:])
+    rejected = np.zeros((T, st.n_points), bool)
+    cand_obs = np.asarray(candidates)[st.obs_point]
+    s, R, t, X = (np.array(a, float) for a in (s0, R0, t0, X0))
+    sigma0 = np.ones(T)
+    wmax = np.zeros(T)
+    rounds = np.zeros(T, np.int32)
+    act = np.arange(T)
+    for _ in range(max_reject + 1):
+        res = adjust_block(st, xm[act], w[act], ctrl_xyz[act], w_ctrl, s[act], R[act], t[act],
+                           X[act], keep_normals=True)
+        s[act], R[act], t[act], X[act] = res.s, res.R, res.t, res.X
+        sigma0[act] = res.sigma0
+        q = residual_cofactors(st, res, w[act])
+        s0 = res.sigma0[:, None, None] if a_posteriori else 1.0
+        ok = (w[act] > 0) & (q > 1e-9 / np.maximum(w[act], 1e-300)) & cand_obs[None, :, None]
+        wt = np.where(ok, np.abs(res.v_obs) / (s0 * np.sqrt(np.where(ok, q, 1.0))), 0.0)
+        wk = wt.max(-1)                                        # (n_act, K)
+        kbest = wk.argmax(1)
+        wmax[act] = wk[np.arange(act.size), kbest]
+        flag = wmax[act] > crit
+        if not flag.any() or rounds.max() >= max_reject:
+            break
+        hit = act[flag]
+        rejected[hit, st.obs_point[kbest[flag]]] = True
+        rounds[hit] += 1
+        w[hit] = np.where(rejected[hit][:, st.obs_point, None], 0.0, w[hit])
+        act = hit
+    return rejected, sigma0, wmax, rounds

@@ -1,0 +1,347 @@
+"""Tests of the Agnard, Nolette & Gagnon study: block geometry, scanner model, independent-
+model block adjustment (reduced normals), data snooping, study config and a tiny run."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sim import independent_models as im
+from sim import scanner as sc
+from sim.block_layout import CONTROL_PATTERNS, make_block, select_control
+from sim.config import ConfigError, load_study
+
+STUDY = "studies/agnard_block.toml"
+
+
+@pytest.fixture(scope="module")
+def small():
+    """A 2 x 3 block with 40 signalised points."""
+    return make_block(2, 3, n_ground=40, pass_rows=3)
+
+
+def _models(block, T, rng, noise_m=0.0):
+    """Model coordinates of every observation in random model frames, and the frames."""
+    xl = block.image_coords(block.obs_left, block.obs_point)
+    xr = block.image_coords(block.obs_right, block.obs_point)
+    G = im.form_models(xl, xr, block.focal_mm, block.base_m) + block.photos.reshape(-1, 3)[
+        block.obs_left]
+    G = np.broadcast_to(G, (T,) + G.shape) + rng.normal(0, noise_m, (T,) + G.shape)
+    s, R, t = im.random_similarities(rng, (T, block.n_models))
+    return im.to_model_frame(G, block.obs_model, s, R, t), (s, R, t)
+
+
+def _start(block, st, xm, rng, T):
+    X0 = block.points + rng.normal(0, 2.0, (T,) + block.points.shape)
+    return im.initial_values(st, xm, X0) + (X0,)
+
+
+# ----------------------------------------------------------------------------- geometry
+
+
+def test_block_counts_and_incidence(small):
+    b = make_block()
+    assert b.n_ground == 178
+    assert b.strips * b.models == 16
+    # every pass point is seen by at least two models, every ground point by at least one
+    seen = np.bincount(b.obs_point, minlength=b.n_points)
+    assert seen[b.is_pass].min() >= 2 and seen[~b.is_pass].min() >= 1
+    assert np.all(np.diff(b.obs_model) >= 0)
+    assert select_control(b, "five").size == 5 and select_control(b, "full").size == 21
+    for p in CONTROL_PATTERNS:
+        c = select_control(b, p)
+        assert np.unique(c).size == c.size and c.max() < b.n_ground
+
+
+def test_parallax_intersection_is_exact(small):
+    b = small
+    xl = b.image_coords(b.obs_left, b.obs_point)
+    xr = b.image_coords(b.obs_right, b.obs_point)
+    G = im.form_models(xl, xr, b.focal_mm, b.base_m) + b.photos.reshape(-1, 3)[b.obs_left]
+    assert np.allclose(G, b.points[b.obs_point], atol=1e-9)
+
+
+def test_height_error_matches_parallax_propagation(small):
+    """MC std of the model Z error equals (H - Z)^2 / (f B) * sigma_p (std within sampling)."""
+    b = small
+    rng = np.random.default_rng(3)
+    k = 0
+    xl = b.image_coords(b.obs_left[[k]], b.obs_point[[k]])[0]
+    xr = b.image_coords(b.obs_right[[k]], b.obs_point[[k]])[0]
+    N, sp = 20000, 0.02  # mm of x-parallax
+    d = rng.normal(0, sp, N)
+    Z = im.form_models(np.column_stack([xl[0] + d, np.full(N, xl[1])]),
+                       np.broadcast_to(xr, (N, 2)), b.focal_mm, b.base_m)[:, 2]
+    hz = b.H_m - b.points[b.obs_point[k], 2]
+    expect = hz ** 2 / (b.focal_mm * b.base_m) * sp
+    assert abs(Z.std(ddof=1) / expect - 1) < 4 / math.sqrt(2 * (N - 1))
+
+
+# ----------------------------------------------------------------------------- scanner
+
+
+def test_scanner_field_peaks_and_calibration():
+    rng = np.random.default_rng(1)
+    f = sc.random_field(rng, 20, max_x_um=20.0, max_y_um=40.0, n_eval=47)
+    g = np.linspace(-115, 115, 47)
+    d = sc.evaluate(f, np.stack(np.meshgrid(g, g), -1).reshape(-1, 2))
+    assert np.allclose(np.abs(d[..., 0]).max(1), 20.0) and np.allclose(np.abs(d[..., 1]).max(1), 40.0)
+    nodes, disp = sc.scan_grid(f, rng, 5.0, 0.0)
+    xy = rng.uniform(-115, 115, (500, 2))
+    r = sc.evaluate(f, xy) - sc.interpolate(nodes, disp, xy)
+    # a noise-free 5 mm grid removes the smooth field to a few per cent
+    assert np.sqrt((r ** 2).mean()) < 0.03 * np.sqrt((sc.evaluate(f, xy) ** 2).mean())
+    # nodes are reproduced exactly
+    nn = np.stack(np.meshgrid(nodes, nodes), -1).reshape(-1, 2)
+    assert np.allclose(sc.interpolate(nodes, disp, nn), disp.reshape(20, -1, 2))
+
+
+def test_fiducial_affine_removes_affine_errors():
+    fid = sc.corner_fiducials(110.0)
+    A = np.array([[3.0, 2e-3, -1e-3], [-2.0, 5e-4, 4e-3]])           # um, um/mm
+    xy = np.random.default_rng(0).uniform(-110, 110, (30, 2))
+    lin = lambda p: np.column_stack([np.ones(len(p)), p]) @ A.T  # noqa: E731
+    beta = sc.fiducial_affine(lin(fid)[None], fid)[0]
+    fitted = np.column_stack([np.ones(30), xy]) @ beta
+    assert np.allclose(fitted, lin(xy), atol=1e-12)
+
+
+# ----------------------------------------------------------------------------- adjustment
+
+
+def test_noise_free_gives_zero_residuals_and_true_parameters(small):
+    rng = np.random.default_rng(7)
+    T = 3
+    xm, (s, R, t) = _models(small, T, rng)
+    ctrl = select_control(small, "five")
+    st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
+    s0, R0, t0, X0 = _start(small, st, xm, rng, T)
+    res = im.adjust_block(st, xm, np.ones(3), np.broadcast_to(small.points[ctrl], (T, 5, 3)),
+                          np.full((5, 3), 10.0), s0, R0, t0, X0, tol_m=1e-9)
+    assert res.converged.all()
+    assert np.abs(res.v_obs).max() < 1e-7 and np.abs(res.v_ctrl).max() < 1e-7
+    assert np.allclose(res.X, small.points, atol=1e-7)
+    assert np.allclose(res.s, s, rtol=1e-10) and np.allclose(res.R, R, atol=1e-10)
+    assert np.allclose(res.t, t, atol=1e-6)
+
+
+def test_all_control_reproduces_each_model_similarity(small):
+    """With every point a (near-fixed) control point the block splits into one independent
+    7-parameter fit per model: the closed-form (Horn/Umeyama) similarity."""
+    rng = np.random.default_rng(11)
+    T = 2
+    xm, _ = _models(small, T, rng, noise_m=0.3)
+    ctrl = np.arange(small.n_points)
+    ctrl_xyz = small.points + rng.normal(0, 0.1, (T,) + small.points.shape)
+    st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
+    s0, R0, t0, X0 = _start(small, st, xm, rng, T)
+    res = im.adjust_block(st, xm, np.ones(3), ctrl_xyz, np.full((ctrl.size, 3), 1e9), s0, R0,
+                          t0, X0, tol_m=1e-10)
+    for m in range(small.n_models):
+        k = small.obs_model == m
+        s, R, t = im.similarity_fit(xm[:, k], ctrl_xyz[:, small.obs_point[k]])
+        assert np.allclose(res.s[:, m], s, rtol=1e-6)
+        assert np.allclose(res.R[:, m], R, atol=1e-6)
+        assert np.allclose(res.t[:, m], t, atol=1e-3)
+
+
+def test_reduced_normals_equal_dense_solve(small):
+    rng = np.random.default_rng(5)
+    T = 2
+    xm, _ = _models(small, T, rng, noise_m=0.2)
+    ctrl = select_control(small, "full")
+    st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
+    s0, R0, t0, X0 = _start(small, st, xm, rng, T)
+    K = small.obs_model.size
+    w = rng.uniform(0.5, 2.0, (T, K, 3))
+    wc = np.broadcast_to([30.0, 30.0, 20.0], (ctrl.size, 3))
+    cx = np.broadcast_to(small.points[ctrl], (T, ctrl.size, 3))
+    c = np.zeros((T, small.n_models, 3))
+    args = (st, xm, c, s0, R0, t0, X0, w, cx, np.broadcast_to(wc, (T,) + wc.shape))
+    dg, dX = im.normal_step(*args)
+    dg2, dX2 = im.normal_step(*args, dense=True)
+    assert np.allclose(dg, dg2, rtol=1e-7, atol=1e-9 * np.abs(dg2).max())
+    assert np.allclose(dX, dX2, rtol=1e-7, atol=1e-9 * np.abs(dX2).max())
+
+
+def test_residual_cofactors_equal_dense(small):
+    rng = np.random.default_rng(9)
+    T = 2
+    xm, _ = _models(small, T, rng, noise_m=0.1)
+    ctrl = select_control(small, "full")
+    P, M, K, C = small.n_points, small.n_models, small.obs_model.size, ctrl.size
+    st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, M, P)
+    s0, R0, t0, X0 = _start(small, st, xm, rng, T)
+    w = rng.uniform(0.5, 2.0, (T, K, 3))
+    wc = np.full((C, 3), 25.0)
+    res = im.adjust_block(st, xm, w, np.broadcast_to(small.points[ctrl], (T, C, 3)), wc, s0, R0,
+                          t0, X0, keep_normals=True)
+    q = im.residual_cofactors(st, res, w)
+    J = res.J
+    A = np.zeros((T, 3 * K + 3 * C, 7 * M + 3 * P))
+    for k in range(K):
+        A[:, 3 * k:3 * k + 3, 7 * st.obs_model[k]:7 * st.obs_model[k] + 7] = J[:, k]
+        A[:, 3 * k:3 * k + 3, 7 * M + 3 * st.obs_point[k] + np.arange(3)] = -np.eye(3)
+    for i, j in enumerate(ctrl):
+        A[:, 3 * K + 3 * i:3 * K + 3 * i + 3, 7 * M + 3 * j + np.arange(3)] = np.eye(3)
+    W = np.concatenate([w.reshape(T, -1), np.broadcast_to(wc, (T, C, 3)).reshape(T, -1)], 1)
+    Qx = np.linalg.inv(np.einsum("toi,to,toj->tij", A, W, A))
+    Qv = 1 / W - np.einsum("toi,tij,toj->to", A, Qx, A)
+    assert np.allclose(q, Qv[:, :3 * K].reshape(T, K, 3), atol=1e-9)
+
+
+def test_chol_solve_matches_numpy():
+    rng = np.random.default_rng(2)
+    a = rng.normal(size=(4, 30, 30))
+    N = a @ a.transpose(0, 2, 1) + 30 * np.eye(30)
+    b = rng.normal(size=(4, 30, 2))
+    assert np.allclose(im.chol_solve(N, b), np.linalg.solve(N, b))
+
+
+def test_similarity_fit_recovers_transform():
+    rng = np.random.default_rng(4)
+    src = rng.normal(0, 100, (3, 12, 3))
+    s, R, t = im.random_similarities(rng, (3,))
+    dst = s[:, None, None] * np.einsum("tij,tnj->tni", R, src) + t[:, None]
+    s2, R2, t2 = im.similarity_fit(src, dst)
+    assert np.allclose(s2, s) and np.allclose(R2, R) and np.allclose(t2, t)
+
+
+# ----------------------------------------------------------------------------- pugging, snooping
+
+
+def test_digital_pugging_shares_image_coordinates(small):
+    b = small
+    rng = np.random.default_rng(6)
+    F = b.models + 1
+    el, er, _ = im.pointing_errors(rng, 4, b.obs_left, b.obs_right, b.obs_point, F, b.strips,
+                                   b.n_points, mark_um=21.0, parallax_um=21.0, digital=b.is_pass)
+    ml, mr, _ = im.pointing_errors(rng, 4, b.obs_left, b.obs_right, b.obs_point, F, b.strips,
+                                   b.n_points, mark_um=21.0, parallax_um=21.0,
+                                   mechanical=b.is_pass, transfer_um=10.0, recentre_um=21.0)
+    # a pass point on the photo that is the right of model m and the left of model m + 1
+    found = 0
+    for k1 in np.flatnonzero(b.is_pass[b.obs_point]):
+        k2 = np.flatnonzero((b.obs_point == b.obs_point[k1]) & (b.obs_left == b.obs_right[k1]))
+        for k in k2:
+            found += 1
+            assert np.array_equal(er[:, k1], el[:, k])          # digital: the very same pixel
+            assert not np.allclose(mr[:, k1], ml[:, k])         # mechanical: re-centred
+    assert found > 0
+
+
+def test_parallax_error_statistics(small):
+    """Signalised points: x-parallax error std = parallax_um (within the sampling error)."""
+    b = small
+    rng = np.random.default_rng(8)
+    el, er, _ = im.pointing_errors(rng, 400, b.obs_left, b.obs_right, b.obs_point, b.models + 1,
+                                   b.strips, b.n_points, mark_um=21.0, parallax_um=15.0)
+    p = (el[..., 0] - er[..., 0]).ravel()
+    assert abs(p.std(ddof=1) / 15.0 - 1) < 4 / math.sqrt(2 * (p.size - 1))
+
+
+def test_snooping_finds_a_planted_blunder(small):
+    b = small
+    rng = np.random.default_rng(12)
+    T = 4
+    sxy, sz = 0.13, 0.22
+    xl = b.image_coords(b.obs_left, b.obs_point)
+    xr = b.image_coords(b.obs_right, b.obs_point)
+    G = im.form_models(xl, xr, b.focal_mm, b.base_m) + b.photos.reshape(-1, 3)[b.obs_left]
+    G = G + rng.normal(0, 1, (T,) + G.shape) * [sxy, sxy, sz]
+    k_bad = int(np.flatnonzero(b.is_pass[b.obs_point] & (np.bincount(b.obs_point)[b.obs_point] >= 3))[0])
+    G[:, k_bad, 2] += 20 * sz                                    # a 20-sigma height blunder
+    s, R, t = im.random_similarities(rng, (T, b.n_models))
+    xm = im.to_model_frame(G, b.obs_model, s, R, t)
+    ctrl = select_control(b, "full")
+    st = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points)
+    s0, R0, t0, X0 = _start(b, st, xm, rng, T)
+    w = np.array([1 / sxy ** 2, 1 / sxy ** 2, 1 / sz ** 2])
+    rej, _, wmax, rounds = im.snoop(st, xm, w, np.broadcast_to(b.points[ctrl], (T, ctrl.size, 3)),
+                                      np.full((ctrl.size, 3), 1e4), s0, R0, t0, X0, b.is_pass,
+                                      crit=3.29, max_reject=10)
+    assert rej[:, b.obs_point[k_bad]].all() and (rounds >= 1).all()
+    assert (wmax <= 3.29).all()
+
+
+# ----------------------------------------------------------------------------- study
+
+
+def test_bad_config_names_the_key():
+    with pytest.raises(ConfigError, match="pugging.gross_px"):
+        load_study(STUDY, ["pugging.gross_px=[5.0, 1.0]"])
+    with pytest.raises(ConfigError, match="tradeoff.block_models"):
+        load_study(STUDY, ["tradeoff.block_models=[8]"])
+    with pytest.raises(ConfigError, match="block.base_mm"):
+        load_study(STUDY, ["block.base_mm=120.0"])
+    with pytest.raises(ConfigError, match="control.few"):
+        load_study(STUDY, ["control.few=everywhere"])
+    with pytest.raises(ConfigError, match="block.ground_points"):
+        load_study(STUDY, ["block.ground_points=12"])
+
+
+def test_tiny_run_writes_claims_and_report(tmp_path):
+    from sim.storage import read_table
+    from sim.studies import RunContext
+
+    study, cfg = load_study(STUDY, ["tradeoff.trials=2", "tradeoff.block_trials=2",
+                                    "tradeoff.block_strips=[1]", "tradeoff.block_models=[3]",
+                                    "tradeoff.dpis=[600.0]", "chunk=3"], trials=3)
+    study.run(cfg, tmp_path, RunContext(quiet=True))
+    rows = read_table(tmp_path / "claims.parquet").to_pylist()
+    names = {r["claim"] for r in rows}
+    for prefix in ("agnard.scanner_correction.", "agnard.control_5.", "agnard.control_21.",
+                   "agnard.pass_rejections.", "agnard.geometry_strength."):
+        assert any(n.startswith(prefix) for n in names)
+    assert all(r["kind"] in ("predicted", "input") for r in rows)
+    text = study.report(tmp_path)
+    assert f"{tmp_path.name}/block_layout.png" in text and "w-test" in text
+    for f in ("scanner_field.png", "block_layout.png", "check_residuals.png", "tradeoffs.png",
+              "trials.parquet"):
+        assert (tmp_path / f).is_file()
+
+
+def test_sparse_and_dense_reduced_solutions_agree(small):
+    rng = np.random.default_rng(13)
+    T = 2
+    xm, _ = _models(small, T, rng, noise_m=0.2)
+    ctrl = select_control(small, "perimeter")
+    st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
+    s0, R0, t0, X0 = _start(small, st, xm, rng, T)
+    cx = np.broadcast_to(small.points[ctrl], (T, ctrl.size, 3))
+    wc = np.full((ctrl.size, 3), 30.0)
+    a = im.adjust_block(st, xm, np.ones(3), cx, wc, s0, R0, t0, X0, solver="dense")
+    b = im.adjust_block(st, xm, np.ones(3), cx, wc, s0, R0, t0, X0, solver="sparse")
+    assert np.allclose(a.X, b.X, atol=1e-8) and np.allclose(a.s, b.s, rtol=1e-12)
+
+
+def test_monte_carlo_point_errors_match_adjustment_covariance(small):
+    """Model coordinates with Gaussian errors of known sigma, weights 1/sigma^2: the MC std of
+    the adjusted ground coordinates equals sqrt of the point cofactors (within sampling)."""
+    b = small
+    rng = np.random.default_rng(21)
+    T = 600
+    sig = np.array([0.13, 0.13, 0.22])
+    xl = b.image_coords(b.obs_left, b.obs_point)
+    xr = b.image_coords(b.obs_right, b.obs_point)
+    G = im.form_models(xl, xr, b.focal_mm, b.base_m) + b.photos.reshape(-1, 3)[b.obs_left]
+    G = G + rng.normal(0, 1, (T,) + G.shape) * sig
+    s, R, t = im.random_similarities(rng, (T, b.n_models))
+    xm = im.to_model_frame(G, b.obs_model, s, R, t)
+    ctrl = select_control(b, "full")
+    st = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points)
+    sc_ = 0.05
+    cx = b.points[ctrl] + rng.normal(0, sc_, (T, ctrl.size, 3))
+    X0 = np.broadcast_to(b.points, (T,) + b.points.shape)
+    res = im.adjust_block(st, xm, 1 / sig ** 2, cx, np.full((ctrl.size, 3), 1 / sc_ ** 2), s, R, t,
+                          X0, keep_normals=True)
+    q = im.point_cofactors(st, res)
+    err = (res.X - b.points)[:, ~np.isin(np.arange(b.n_points), ctrl)]
+    expect = np.sqrt(q[0])[~np.isin(np.arange(b.n_points), ctrl)]
+    ratio = np.sqrt((err ** 2).mean(0)) / expect          # true errors: mean is zero
+    tol = 4 / math.sqrt(2 * T)
+    # every coordinate within 4 standard errors of the std; the mean ratio within the bound
+    # that holds even for fully correlated coordinates
+    assert np.all(np.abs(ratio - 1) < tol)
+    assert abs(ratio.mean() - 1) < tol
