@@ -32,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import multilateration_jit as jit
+
 __all__ = ["MODELS", "PARAM_NAMES", "design_theta", "stations", "ranges", "simulate_ranges",
            "initial_points", "adjust", "covariance", "AdjustResult"]
 
@@ -232,7 +234,7 @@ def _reduce(points, theta, p, r_obs=None, check=True, rcond: float = 1e-13, S=No
     if check:  # scale-aware singularity test of the reduced normals
         dscale = np.sqrt(np.abs(np.einsum("tii->ti", Nbar))) + 1e-300
         C = Nbar / dscale[:, :, None] / dscale[:, None, :]
-        ok &= np.linalg.cond(C) < 1.0 / rcond
+        ok &= np.linalg.cond(C) < 1e10  # ten digits lost: numerically singular (as the kernel)
     return Reduced(i00, i01, i11, K, Nbar, ubar, up, ok)
 
 
@@ -273,14 +275,16 @@ class AdjustResult:
 
 
 def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, points0: np.ndarray | None = None,
-           tol_mm: float = 1e-10, max_iter: int = 30) -> AdjustResult:
+           tol_mm: float = 1e-10, max_iter: int = 30, engine: str = "auto") -> AdjustResult:
     """Batched Gauss-Newton adjustment of Brown's multilateration.
 
     r_obs : (T, n, 4) observed ranges, mm. model : ``known``, ``stations`` or ``pivot``.
     theta0 : (T, 7) or (7,): the fixed parameters (for ``known``, the true stations, alpha,
     beta^2) and the initial values of the free ones. points0 : initial points (default:
     linear trilateration from ``theta0``). Convergence: the largest correction of any unknown
-    (mm; mm^2 for ``b``) falls below ``tol_mm``.
+    (mm; mm^2 for ``b``) falls below ``tol_mm``. engine : ``numpy`` (vectorised over
+    trials), ``numba`` (the compiled kernel of :mod:`sim.multilateration_jit`, same math) or
+    ``auto`` (numba when installed).
     """
     if model not in MODELS:
         raise ValueError(f"model must be one of {', '.join(MODELS)}, not {model!r}")
@@ -293,6 +297,13 @@ def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, points0: np.ndarra
     if dof < 0 or n < 3:
         raise ValueError(f"{n} points give {4 * n} observations for {2 * n + p} unknowns")
     theta = np.broadcast_to(np.asarray(theta0, float), (T, 7)).copy()
+    if engine not in ("auto", "numpy", "numba"):
+        raise ValueError(f"engine must be auto, numpy or numba, not {engine!r}")
+    if engine == "numba" or (engine == "auto" and jit.AVAILABLE):
+        p0 = None if points0 is None else np.array(points0, float)
+        pts, status, iters, res, ssq = jit.gauss_newton(r_obs, theta, p0, p, tol_mm, max_iter)
+        s0 = np.sqrt(ssq / dof) if dof > 0 else np.full(T, np.nan)
+        return AdjustResult(pts, theta, res, s0, dof, iters, status == 0, status)
     pts = initial_points(r_obs, theta) if points0 is None else np.array(points0, float)
     active = np.ones(T, bool)
     status = np.ones(T, np.int8)
@@ -316,8 +327,13 @@ def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, points0: np.ndarra
         active &= ~done
         if not active.any():
             break
+    return _finish(r_obs, pts, theta, dof, iters, status)
+
+
+def _finish(r_obs, pts, theta, dof, iters, status) -> AdjustResult:
     res = r_obs - ranges(pts, theta)
-    s0 = np.sqrt(np.einsum("tnk,tnk->t", res, res) / dof) if dof > 0 else np.full(T, np.nan)
+    s0 = (np.sqrt(np.einsum("tnk,tnk->t", res, res) / dof) if dof > 0
+          else np.full(len(res), np.nan))
     return AdjustResult(pts, theta, res, s0, dof, iters, status == 0, status)
 
 

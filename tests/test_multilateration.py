@@ -172,3 +172,29 @@ def test_bad_arguments_rejected():
         ml.adjust(np.zeros((1, 5, 3)), "known", THETA)
     with pytest.raises(ValueError, match="unknowns"):
         ml.adjust(np.ones((1, 3, 4)) * 150, "pivot", THETA)
+
+
+@pytest.mark.skipif(not ml.jit.AVAILABLE, reason="numba not installed")
+@pytest.mark.parametrize("model", list(ml.MODELS))
+def test_compiled_engine_equals_numpy_engine(model):
+    T = 200
+    rng = np.random.default_rng(5)
+    P = batch(PTS, T)
+    r = ml.simulate_ranges(P, batch(THETA, T), rng, setting_sigma_um=2.0, settings=1)
+    t0 = THETA.copy()
+    t0[5:ml.MODELS[model]] = 0.0
+    a = ml.adjust(r, model, t0, engine="numpy")
+    b = ml.adjust(r, model, t0, engine="numba")
+    assert np.array_equal(a.status, b.status) and a.converged.all()
+    assert np.abs(a.points - b.points).max() < 1e-9
+    assert np.abs(a.theta - b.theta).max() < 1e-9
+    assert np.allclose(a.sigma0, b.sigma0, rtol=1e-9)
+    assert np.abs(a.iterations - b.iterations).max() <= 1
+
+
+@pytest.mark.skipif(not ml.jit.AVAILABLE, reason="numba not installed")
+def test_compiled_engine_flags_singular_geometry():
+    pts = np.stack([np.linspace(-50, 50, 6), np.zeros(6)], 1)
+    r = ml.ranges(batch(pts, 3), batch(THETA, 3))
+    res = ml.adjust(r, "pivot", THETA, engine="numba")
+    assert not res.converged.any() and set(res.status.tolist()) <= {2, 3}
