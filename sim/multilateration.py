@@ -282,7 +282,9 @@ def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, points0: np.ndarra
     theta0 : (T, 7) or (7,): the fixed parameters (for ``known``, the true stations, alpha,
     beta^2) and the initial values of the free ones. points0 : initial points (default:
     linear trilateration from ``theta0``). Convergence: the largest correction of any unknown
-    (mm; mm^2 for ``b``) falls below ``tol_mm``. engine : ``numpy`` (vectorised over
+    (mm; mm^2 for ``b``), or the remaining error estimated from the observed contraction
+    (rho / (1 - rho) times the correction, rho the ratio of the last two corrections), falls
+    below ``tol_mm``. engine : ``numpy`` (vectorised over
     trials), ``numba`` (the compiled kernel of :mod:`sim.multilateration_jit`, same math) or
     ``auto`` (numba when installed).
     """
@@ -308,6 +310,7 @@ def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, points0: np.ndarra
     active = np.ones(T, bool)
     status = np.ones(T, np.int8)
     iters = np.zeros(T, np.int32)
+    prev = np.full(T, np.nan)  # no contraction estimate before two corrections
     for it in range(1, max_iter + 1):
         red = _reduce(pts, theta, p, r_obs, check=(it == 1))
         dp, dg = _solve_reduced(red)
@@ -322,9 +325,13 @@ def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, points0: np.ndarra
         pts = pts + np.where(upd[:, :, None], dp, 0.0)
         theta[:, :p] += np.where(upd, dg, 0.0)
         iters[active] = it
-        done = active & (step < tol_mm)
+        rho = step / prev  # observed contraction: remaining error ~ rho / (1 - rho) * step
+        with np.errstate(invalid="ignore", divide="ignore"):
+            est = np.where(rho < 0.5, rho / (1.0 - rho) * step, np.inf)
+        done = active & ((step < tol_mm) | (est < tol_mm))
         status[done] = 0
         active &= ~done
+        prev = step
         if not active.any():
             break
     return _finish(r_obs, pts, theta, dof, iters, status)

@@ -4,8 +4,9 @@ The same model, parameterisation and reduction as the NumPy engine in
 :mod:`sim.multilateration` (seed ``004_f5bd9e86c308241f.txt``): ranges
 ``r = sqrt(d^2 - b) - alpha`` with ``b = beta^2``, Brown's datum, the 2x2 point blocks
 eliminated per point (reduced normal equations, Brown's EMBET), a scaled Cholesky solve of
-the p x p reduced normals (p <= 7), convergence when the largest correction is below the
-tolerance. The loop over trials is compiled, so no Python runs per trial; the NumPy engine
+the p x p reduced normals (p <= 7), convergence when the largest correction -- or the
+remaining error estimated from the observed contraction, rho / (1 - rho) x correction with
+rho the ratio of the last two corrections -- is below the tolerance. The loop over trials is compiled, so no Python runs per trial; the NumPy engine
 stays the reference implementation and the tests require both to agree.
 
 Status codes as in :class:`sim.multilateration.AdjustResult`: 0 converged, 1 iteration limit,
@@ -43,6 +44,7 @@ def _kernel(r_obs, theta, pts, p, tol, max_iter, rcond, rcond_g, status, iters, 
     dsc = np.empty(7)
     for t in range(T):
         st = 1
+        prev = np.nan  # no contraction estimate before two corrections
         for it in range(1, max_iter + 1):
             Sx[0] = 0.0
             Sy[0] = theta[t, 0]
@@ -177,9 +179,11 @@ def _kernel(r_obs, theta, pts, p, tol, max_iter, rcond, rcond_g, status, iters, 
             for r in range(p):
                 theta[t, r] += dg[r]
             iters[t] = it
-            if step < tol:
+            rho = step / prev  # observed contraction: remaining error ~ rho / (1 - rho) * step
+            if step < tol or (rho < 0.5 and rho / (1.0 - rho) * step < tol):
                 st = 0
                 break
+            prev = step
         status[t] = st
         # residuals and the sum of their squares at the final values
         Sx[1] = theta[t, 1]
