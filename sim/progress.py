@@ -15,8 +15,10 @@ class Progress:
     """``with Progress(total, label) as p: p.update(n)``."""
 
     def __init__(self, total: int, label: str = "", quiet: bool = False, stream=None,
-                 min_interval: float = 0.2):
+                 min_interval: float = 0.2, chunks: int = 0):
         self.total = int(total)
+        self.chunks = int(chunks)
+        self.chunks_done = 0
         self.label = label
         self.stream = stream if stream is not None else sys.stderr
         self.enabled = not quiet and hasattr(self.stream, "isatty") and self.stream.isatty()
@@ -34,8 +36,9 @@ class Progress:
             self.stream.write("\n")
             self.stream.flush()
 
-    def update(self, n: int) -> None:
+    def update(self, n: int, chunks: int = 0) -> None:
         self.done += int(n)
+        self.chunks_done += int(chunks)
         if self.enabled:
             self._draw()
 
@@ -49,6 +52,7 @@ class Progress:
         left = (self.total - self.done) / rate if rate > 0 else float("nan")
         frac = self.done / self.total if self.total else 1.0
         bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
-        self.stream.write(f"\r{self.label} [{bar}] {self.done}/{self.total} trials "
+        ch = f"chunk {self.chunks_done}/{self.chunks}, " if self.chunks else ""
+        self.stream.write(f"\r{self.label} [{bar}] {ch}{self.done}/{self.total} trials, "
                           f"{rate:,.0f}/s, {left:,.0f} s left ")
         self.stream.flush()

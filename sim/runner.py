@@ -207,15 +207,15 @@ def run_chunks(fn: Callable[[np.random.Generator, int], Mapping[str, np.ndarray]
                   "cannot be sent to workers)", file=sys.stderr)
         executor = _InProcess()
     done_trials = sum(sizes[k] for k in results)
-    with Progress(trials, label, quiet=quiet) as bar:
-        bar.update(done_trials)
+    with Progress(trials, label, quiet=quiet, chunks=len(sizes)) as bar:
+        bar.update(done_trials, len(results))
         for k, n, out in executor.run(fn, seed, part, todo):
             if store is not None:
                 store.save(part, k, n, out)
             if not keep_rows:
                 out = {key: v for key, v in out.items() if not key.startswith(ROWS)}
             results[k] = out
-            bar.update(n)
+            bar.update(n, 1)
     keys = results[0].keys() if results else []
     return {key: np.concatenate([results[k][key] for k in range(len(sizes))], axis=0)
             for key in keys}

@@ -1,0 +1,28 @@
+"""The progress bar draws on a terminal only."""
+import io
+
+from sim.progress import Progress
+
+
+class Tty(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_draws_chunks_trials_rate_and_time_left_on_a_terminal():
+    s = Tty()
+    with Progress(100, "study", stream=s, min_interval=0.0, chunks=4) as p:
+        p.update(25, 1)
+    out = s.getvalue()
+    assert "chunk 1/4" in out and "25/100 trials" in out and "/s" in out and "s left" in out
+
+
+def test_silent_when_not_a_terminal_or_quiet():
+    s = io.StringIO()
+    with Progress(100, "study", stream=s, min_interval=0.0) as p:
+        p.update(50)
+    assert s.getvalue() == ""
+    t = Tty()
+    with Progress(100, "study", stream=t, quiet=True, min_interval=0.0) as p:
+        p.update(50)
+    assert t.getvalue() == ""
