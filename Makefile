@@ -11,7 +11,7 @@ STUDIES := $(basename $(notdir $(STUDY_FILES)))
 CLAIMS := $(foreach s,$(STUDIES),results/$(s)/claims.parquet)
 
 .DEFAULT_GOAL := help
-.PHONY: help venv test reproduce report bench clean
+.PHONY: help venv test reproduce rerun report bench clean
 
 help: ## list the targets
 	@grep -E '^[a-zA-Z_%/.-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/:.*## /\t/' | sort | \
@@ -35,6 +35,10 @@ results/REPORT.md: $(CLAIMS) | $(STAMP)
 	$(PY) -m sim report --results results
 
 reproduce: results/REPORT.md ## run every study at full trial counts and rebuild results/REPORT.md
+
+rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report
+	@for s in $(STUDIES); do $(PY) -m sim run studies/$$s.toml --out results/$$s --overwrite || exit 1; done
+	$(PY) -m sim report --results results
 
 report: $(STAMP) ## rebuild results/REPORT.md from the Parquet files alone
 	$(PY) -m sim report --results results
