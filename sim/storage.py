@@ -27,14 +27,18 @@ _KEY = b"sim.provenance"
 
 @lru_cache(maxsize=1)
 def git_commit() -> str:
-    """The commit of the working tree (``-dirty`` if sim/ or studies/ have changes)."""
+    """The last commit that changed the code or the study definitions (``sim/``,
+    ``studies/``, ``pyproject.toml``), ``-dirty`` if they have uncommitted changes. A commit
+    of results alone does not change it, so re-running gives byte-identical files."""
     root = Path(__file__).resolve().parent.parent
     try:
-        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True,
-                              text=True, timeout=10)
-        if head.returncode != 0:
+        head = subprocess.run(["git", "log", "-1", "--format=%H", "--", "sim", "studies",
+                               "pyproject.toml"], cwd=root, capture_output=True, text=True,
+                              timeout=10)
+        if head.returncode != 0 or not head.stdout.strip():
             return "unknown"
-        dirty = subprocess.run(["git", "status", "--porcelain", "--", "sim", "studies"], cwd=root,
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", "sim", "studies",
+                                "pyproject.toml"], cwd=root,
                                capture_output=True, text=True, timeout=10).stdout.strip()
         return head.stdout.strip() + ("-dirty" if dirty else "")
     except (OSError, subprocess.SubprocessError):
