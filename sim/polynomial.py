@@ -16,7 +16,7 @@ The raw readings are reduced first with the paper's *non-redundant* two-point
 transformation (:func:`two_point_transform`): scale from the length of line ``ab``,
 translation to ``a``, rotation by ``alpha = atan(Y''_b / X''_b)``. It uses no redundancy
 on purpose, so that the discrepancies of the measuring system are preserved. For
-comparison, least-squares similarity (4 parameters) and affine (6) fits are here too.
+comparison, least-squares similarity and affine fits come from :mod:`sim.transforms2d`.
 
 Shapes: every function takes a leading *trial* axis ``T``: points ``(T, n, 2)`` (a plain
 ``(n, 2)`` broadcasts). Coordinates in mm; the polynomial works internally in
@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["WOLF_TERMS", "poly_terms", "design", "PolyFit", "fit_poly", "fit_wolf", "apply_poly",
-           "two_point_transform", "TwoPoint", "apply_two_point", "fit_similarity", "fit_affine",
-           "apply_linear", "discrepancy_stats", "lstsq_batched"]
+           "two_point_transform", "TwoPoint", "apply_two_point",
+           "discrepancy_stats", "lstsq_batched"]
 
 #: exponents (i, j) of X^i Y^j for the paper's A1 ... A10 (and B1 ... B10), in its order
 WOLF_TERMS = ((0, 0), (1, 0), (2, 0), (0, 1), (0, 2), (1, 1), (2, 1), (1, 2), (3, 0), (0, 3))
@@ -195,63 +195,6 @@ def apply_two_point(tp: TwoPoint, readings: np.ndarray) -> np.ndarray:
     x = c * r[..., 0] + s * r[..., 1]
     y = -s * r[..., 0] + c * r[..., 1]
     return np.stack([x, y], axis=-1) + tp.a_grid
-
-
-# ----------------------------------------------------------------------------- LS similarity, affine
-
-
-def _linear_design(src: np.ndarray, kind: str) -> np.ndarray:
-    """Design ``(T, 2n, p)`` for x' = A src + t, rows interleaved (x0, y0, x1, y1, ...)."""
-    x, y = src[..., 0], src[..., 1]
-    o, z = np.ones_like(x), np.zeros_like(x)
-    if kind == "similarity":  # x' = a x - b y + tx ; y' = b x + a y + ty
-        rx = np.stack([x, -y, o, z], -1)
-        ry = np.stack([y, x, z, o], -1)
-    elif kind == "affine":    # x' = a1 x + a2 y + tx ; y' = b1 x + b2 y + ty
-        rx = np.stack([x, y, z, z, o, z], -1)
-        ry = np.stack([z, z, x, y, z, o], -1)
-    else:
-        raise ValueError(f"unknown transformation {kind!r}")
-    T, n, p = rx.shape
-    return np.stack([rx, ry], axis=2).reshape(T, 2 * n, p)
-
-
-def _fit_linear(src, dst, kind: str):
-    src = np.asarray(src, float)
-    dst = np.broadcast_to(np.asarray(dst, float), src.shape)
-    c0 = src.mean(axis=1, keepdims=True)  # centre for conditioning
-    A = _linear_design(src - c0, kind)
-    b = dst.reshape(dst.shape[0], -1, 1)
-    p, ok = lstsq_batched(A, b)
-    p = p[..., 0]
-    if kind == "similarity":
-        a, bb, tx, ty = p.T
-        M = np.stack([np.stack([a, -bb], -1), np.stack([bb, a], -1)], -2)
-        t = np.stack([tx, ty], -1)
-    else:
-        M = p[:, :4].reshape(-1, 2, 2)
-        t = p[:, 4:6]
-    t = t - np.einsum("tij,tj->ti", M, c0[:, 0, :])
-    return M, t
-
-
-def fit_similarity(src: np.ndarray, dst: np.ndarray):
-    """Least-squares similarity (scale, rotation, shift) mapping ``src`` onto ``dst``.
-
-    ``src`` ``(T, n, 2)``, ``dst`` ``(T, n, 2)`` or ``(n, 2)``. Returns ``M (T, 2, 2)``,
-    ``t (T, 2)`` with ``dst ~ src @ M.T + t``.
-    """
-    return _fit_linear(src, dst, "similarity")
-
-
-def fit_affine(src: np.ndarray, dst: np.ndarray):
-    """Least-squares affine (6 parameters) mapping ``src`` onto ``dst``; see :func:`fit_similarity`."""
-    return _fit_linear(src, dst, "affine")
-
-
-def apply_linear(M: np.ndarray, t: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    """``pts @ M.T + t`` for ``pts (T, n, 2)``."""
-    return np.einsum("tij,tnj->tni", M, np.asarray(pts, float)) + t[:, None, :]
 
 
 # ----------------------------------------------------------------------------- statistics

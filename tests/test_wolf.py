@@ -9,6 +9,7 @@ import pytest
 
 from sim import errorfields as ef
 from sim import polynomial as pl
+from sim import transforms2d as tf
 from sim.config import ConfigError, validate
 from sim.studies import wolf
 
@@ -68,9 +69,9 @@ def test_degree_one_equals_affine_fit():
     X = rng.uniform(-100, 100, (T, 40, 2))
     true = X + _cubic(X, rng, T, 0.3) + rng.normal(0, 0.003, X.shape)
     fit = pl.fit_poly(X, true, degree=1)
-    M, t = pl.fit_affine(X, true)
+    aff = tf.fit_affine(X, true)
     Y = rng.uniform(-100, 100, (T, 15, 2))
-    assert np.allclose(pl.apply_poly(fit, Y), pl.apply_linear(M, t, Y), atol=1e-9, rtol=0)
+    assert np.allclose(pl.apply_poly(fit, Y), tf.apply_affine(aff.params, Y), atol=1e-9, rtol=0)
 
 
 def test_wolf_terms_span_the_complete_cubic():
@@ -120,16 +121,6 @@ def test_discrepancy_stats_hand_computed():
     assert np.allclose(st["max"], [[3.0, 4.0]])
     assert np.allclose(st["rms"], [[math.sqrt(3.5), math.sqrt(6.0)]])
     assert np.allclose(st["mean"], [[1.5, 2.0]])
-
-
-def test_similarity_fit_recovers_parameters():
-    rng = np.random.default_rng(7)
-    X = rng.uniform(-50, 50, (4, 12, 2))
-    a, b = 1.001, 0.02
-    M0 = np.array([[a, -b], [b, a]])
-    Y = X @ M0.T + np.array([3.0, -2.0])
-    M, t = pl.fit_similarity(X, Y)
-    assert np.allclose(M, M0, atol=1e-12) and np.allclose(t, [3.0, -2.0], atol=1e-10)
 
 
 def test_underdetermined_fit_is_flagged():

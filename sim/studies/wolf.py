@@ -28,6 +28,7 @@ import numpy as np
 
 from .. import errorfields as ef
 from .. import polynomial as pl
+from .. import transforms2d as tf
 from ..claims import bootstrap_ci, claim, rounding, spread, write_claims
 from ..config import COMMON, ConfigError, Field
 from ..plotting import plt, save
@@ -339,8 +340,8 @@ def correct_plate(fit, mean_tp, counts, known, use_poly=True, fiducials=None):
     if use_poly:
         X = pl.apply_poly(fit, X)
     sel = slice(None) if fiducials is None else fiducials
-    M, t = pl.fit_similarity(X[:, sel], known[sel] if known.ndim == 2 else known[:, sel])
-    return (pl.apply_linear(M, t, X) - known) * 1000.0
+    return (_ls_map("similarity", X[:, sel], known[sel] if known.ndim == 2 else known[:, sel], X)
+            - known) * 1000.0
 
 
 def _stats_cols(prefix: str, d_um: np.ndarray, out: dict):
@@ -399,11 +400,10 @@ def _main_chunk_impl(cfg, keep_vectors, rng: np.random.Generator, T: int) -> dic
     _stats_cols("check_after", (pl.apply_poly(fit, chk) - kc) * 1000.0, out)
     # least-squares similarity / affine reductions of the same sets (before correction)
     raw = [c[:, :nG] for c in counts]
-    for kind, f_ in (("similarity", pl.fit_similarity), ("affine", pl.fit_affine)):
+    for kind in ("similarity", "affine"):
         d = []
         for c in raw:
-            M, t = f_(c, G)
-            d.append((pl.apply_linear(M, t, c) - G) * 1000.0)
+            d.append((_ls_map(kind, c, G, c) - G) * 1000.0)
         _stats_cols(f"before_{kind}", np.concatenate(d, 1), out)
     # an independent plate at random points, read later
     m5 = 5.0  # margin so that the placed points stay (nearly) inside the calibrated area
@@ -918,8 +918,8 @@ def figures(cfg: dict, out: Path) -> None:
     P = np.column_stack([c["x_mm"][sel], c["y_mm"][sel]])
     tot = np.column_stack([sum(c[k][c["component"] == nm] for nm in names)
                            for k in ("dx_um", "dy_um")])
-    M, t = pl.fit_similarity(P[None] + tot[None] * 1e-3, P)          # what a similarity removes
-    rest = (pl.apply_linear(M, t, P[None] + tot[None] * 1e-3)[0] - P) * 1000.0
+    moved = P[None] + tot[None] * 1e-3                               # what a similarity removes
+    rest = (_ls_map("similarity", moved, P, moved)[0] - P) * 1000.0
     auto(axs.ravel()[-1], P[:, 0], P[:, 1], rest[:, 0], rest[:, 1],
          "sum, less its best similarity\n(scale, rotation, shift are absorbed)")
     fig.suptitle("Error-field components of one random draw at the default amplitudes (inputs); "
@@ -1229,3 +1229,13 @@ def _median_max_abs_normal(n: int) -> float:
     from scipy.stats import norm
 
     return float(norm.ppf((1.0 + 0.5 ** (1.0 / n)) / 2.0))
+
+
+def _ls_map(kind: str, src: np.ndarray, dst: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """Fit a least-squares ``similarity`` or ``affine`` mapping ``src`` (T, n, 2) onto ``dst``
+    ((T, n, 2) or (n, 2)) with :mod:`sim.transforms2d` and apply it to ``pts`` (T, m, 2)."""
+    src = np.asarray(src, float)
+    dst = np.broadcast_to(np.asarray(dst, float), src.shape)
+    if kind == "similarity":
+        return tf.apply_similarity(tf.fit_similarity(src, dst).params, pts)
+    return tf.apply_affine(tf.fit_affine(src, dst).params, pts)
