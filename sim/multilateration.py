@@ -307,34 +307,55 @@ def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, points0: np.ndarra
         s0 = np.sqrt(ssq / dof) if dof > 0 else np.full(T, np.nan)
         return AdjustResult(pts, theta, res, s0, dof, iters, status == 0, status)
     pts = initial_points(r_obs, theta) if points0 is None else np.array(points0, float)
-    active = np.ones(T, bool)
-    status = np.ones(T, np.int8)
-    iters = np.zeros(T, np.int32)
-    prev = np.full(T, np.nan)  # no contraction estimate before two corrections
+    gn = GNState(T)
     for it in range(1, max_iter + 1):
         red = _reduce(pts, theta, p, r_obs, check=(it == 1))
         dp, dg = _solve_reduced(red)
-        bad = ~red.ok & active
-        status[bad] = 2
-        active &= red.ok
+        pts = gn.advance(it, red.ok, dp, dg, pts, theta, tol_mm)
+        if gn.finished:
+            break
+    return _finish(r_obs, pts, theta, dof, gn.iters, gn.status)
+
+
+class GNState:
+    """Per-trial bookkeeping of a batched Gauss-Newton run (shared with
+    :mod:`sim.positions`). Status codes as in :class:`AdjustResult`; a trial stops when its
+    largest correction, or the remaining error estimated from the observed contraction
+    (rho / (1 - rho) x correction, rho the ratio of the last two corrections), is below the
+    tolerance."""
+
+    def __init__(self, T: int):
+        self.active = np.ones(T, bool)
+        self.status = np.ones(T, np.int8)
+        self.iters = np.zeros(T, np.int32)
+        self.prev = np.full(T, np.nan)  # no contraction estimate before two corrections
+
+    @property
+    def finished(self) -> bool:
+        return not self.active.any()
+
+    def advance(self, it: int, ok, dp, dg, pts, theta, tol: float):
+        """Flag singular (``~ok``) and non-finite trials, apply the corrections ``dp`` (T, n, 2)
+        and ``dg`` (T, p) to the active ones (``theta`` in place), test convergence; returns
+        the updated points."""
+        self.status[~ok & self.active] = 2
+        self.active &= ok
         step = np.maximum(np.abs(dp).max(axis=(1, 2)), np.abs(dg).max(axis=1, initial=0.0))
         finite = np.isfinite(step)
-        status[active & ~finite] = 3
-        active &= finite
-        upd = active[:, None]
-        pts = pts + np.where(upd[:, :, None], dp, 0.0)
-        theta[:, :p] += np.where(upd, dg, 0.0)
-        iters[active] = it
-        rho = step / prev  # observed contraction: remaining error ~ rho / (1 - rho) * step
+        self.status[self.active & ~finite] = 3
+        self.active &= finite
+        upd = self.active
+        pts = pts + np.where(upd[:, None, None], dp, 0.0)
+        theta[:, :dg.shape[1]] += np.where(upd[:, None], dg, 0.0)
+        self.iters[upd] = it
         with np.errstate(invalid="ignore", divide="ignore"):
+            rho = step / self.prev
             est = np.where(rho < 0.5, rho / (1.0 - rho) * step, np.inf)
-        done = active & ((step < tol_mm) | (est < tol_mm))
-        status[done] = 0
-        active &= ~done
-        prev = step
-        if not active.any():
-            break
-    return _finish(r_obs, pts, theta, dof, iters, status)
+        done = upd & ((step < tol) | (est < tol))
+        self.status[done] = 0
+        self.active &= ~done
+        self.prev = step
+        return pts
 
 
 def _finish(r_obs, pts, theta, dof, iters, status) -> AdjustResult:

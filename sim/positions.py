@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .multilateration import AdjustResult
+from .multilateration import AdjustResult, GNState
 
 __all__ = ["MODELS", "DATUMS", "circle_stations", "design_theta", "stations", "ranges",
            "n_free", "initial_points", "adjust", "covariance", "full_point_covariance",
@@ -226,9 +226,7 @@ def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, datum: str = "inne
         raise ValueError(f"{n} points in {P} positions give {P * n} ranges for too many unknowns")
     theta = np.broadcast_to(np.asarray(theta0, float), (T, 2 * P + 2)).copy()
     pts = initial_points(r_obs, theta)
-    active = np.ones(T, bool)
-    status = np.ones(T, np.int8)
-    iters = np.zeros(T, np.int32)
+    gn = GNState(T)
     C = None
     for it in range(1, max_iter + 1):
         red = _reduce(pts, theta, p, r_obs)
@@ -250,24 +248,12 @@ def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, datum: str = "inne
         else:
             dg = np.zeros((T, 0))
             dp = red.dp0
-        bad = ~red.ok & active
-        status[bad] = 2
-        active &= red.ok
-        step = np.maximum(np.abs(dp).max(axis=(1, 2)), np.abs(dg).max(axis=1, initial=0.0))
-        finite = np.isfinite(step)
-        status[active & ~finite] = 3
-        active &= finite
-        pts = pts + np.where(active[:, None, None], dp, 0.0)
-        theta[:, :p] += np.where(active[:, None], dg, 0.0)
-        iters[active] = it
-        done = active & (step < tol_mm)
-        status[done] = 0
-        active &= ~done
-        if not active.any():
+        pts = gn.advance(it, red.ok, dp, dg, pts, theta, tol_mm)
+        if gn.finished:
             break
     res = r_obs - ranges(pts, theta)
     s0 = np.sqrt(np.einsum("tnk,tnk->t", res, res) / dof) if dof > 0 else np.full(T, np.nan)
-    return AdjustResult(pts, theta, res, s0, dof, iters, status == 0, status)
+    return AdjustResult(pts, theta, res, s0, dof, gn.iters, gn.status == 0, gn.status)
 
 
 def covariance(points: np.ndarray, theta: np.ndarray, model: str, datum: str = "inner"):
