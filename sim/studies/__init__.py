@@ -7,7 +7,7 @@ of ``results/REPORT.md`` built from those files alone.
 from __future__ import annotations
 
 import importlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Mapping
 

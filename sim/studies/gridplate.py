@@ -333,7 +333,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     res = run_chunks(chunk_fn(cfg), cfg["trials"], cfg["seed"], cfg["chunk"], part=0,
                      label="gridplate", quiet=ctx.quiet, ctx=ctx)
     prov = provenance(cfg)
-    T, P = res["sim_sigma_um"].shape[0], cfg["plate.count"]
+    T = res["sim_sigma_um"].shape[0]
     N = cfg["plate.grid"] ** 2
     dof = N - 3
     ratios = list(cfg["analysis.ratios"])

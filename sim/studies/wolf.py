@@ -454,7 +454,6 @@ def _degree_chunk_impl(cfg, spacing, rng: np.random.Generator, T: int) -> dict:
     """
     area = cfg["plate.area_mm"]
     G = grid_nodes(area, spacing)
-    n = len(G)
     nx, ny = len(np.unique(G[:, 0])), len(np.unique(G[:, 1]))
     ia, ib = _index(G, (0, 0)), _index(G, (cfg["reduce.ab_mm"], 0))
     nmax = max(cfg["trade.n_sets"])
