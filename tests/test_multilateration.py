@@ -198,3 +198,29 @@ def test_compiled_engine_flags_singular_geometry():
     r = ml.ranges(batch(pts, 3), batch(THETA, 3))
     res = ml.adjust(r, "pivot", THETA, engine="numba")
     assert not res.converged.any() and set(res.status.tolist()) <= {2, 3}
+
+
+@pytest.mark.skipif(not ml.jit.AVAILABLE, reason="numba not installed")
+def test_simd_lanes_are_bit_identical_to_one_trial_at_a_time():
+    """The SIMD kernel adjusts blocks of LANES trials in lock-step: every trial's result must
+    be bit-identical to adjusting it alone, wherever it sits in a block (full blocks, a
+    padded last block), and a trial that fails (NaN, absurd range) must not disturb the
+    other lanes of its block."""
+    T = 2 * ml.jit.LANES + 7
+    assert ml.jit.use_lanes(T, len(PTS)) and not ml.jit.use_lanes(1, len(PTS))
+    rng = np.random.default_rng(9)
+    r = ml.simulate_ranges(batch(PTS, T), batch(THETA, T), rng, setting_sigma_um=2.0,
+                           settings=1)
+    r[3, 2, 1] = np.nan
+    r[T - 2, 0, 0] = 1e300
+    t0 = THETA.copy()
+    t0[5:] = 0.0
+    block = ml.adjust(r, "pivot", t0, engine="numba")
+    assert block.status[3] != 0 and block.status[T - 2] != 0
+    ok = np.ones(T, bool)
+    ok[[3, T - 2]] = False
+    assert block.converged[ok].all()
+    for t in (0, 3, ml.jit.LANES - 1, ml.jit.LANES, T - 2, T - 1):
+        one = ml.adjust(r[t:t + 1], "pivot", t0, engine="numba")
+        for f in ("points", "theta", "residuals", "sigma0", "iterations", "status"):
+            assert np.array_equal(getattr(one, f)[0], getattr(block, f)[t], equal_nan=True), (t, f)
