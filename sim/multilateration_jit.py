@@ -36,6 +36,20 @@ _MAX_LANE_MEMORY = 256 * 2**20
 W = 1  # the lane width the kernel is compiled with; bound per variant in _compile
 
 
+def _lane_stations(TH, Sx, Sy):  # pragma: no cover
+    """Station coordinates (4, lanes) from the globals (7, lanes) in Brown's datum
+    (x1 = x3 = 0, y4 = -y2)."""
+    for w in range(TH.shape[1]):
+        Sx[0, w] = 0.0
+        Sy[0, w] = TH[0, w]
+        Sx[1, w] = TH[1, w]
+        Sy[1, w] = TH[2, w]
+        Sx[2, w] = 0.0
+        Sy[2, w] = TH[3, w]
+        Sx[3, w] = TH[4, w]
+        Sy[3, w] = -TH[2, w]
+
+
 def _kernel(r_obs, theta, pts, p, tol, max_iter, rcond, rcond_g, status, iters, idx, cnt, res,
             ssq):  # pragma: no cover
     """Gauss-Newton on blocks of ``W`` trials (``W`` a compile-time constant, see
@@ -102,15 +116,8 @@ def _kernel(r_obs, theta, pts, p, tol, max_iter, rcond, rcond_g, status, iters, 
         for it in range(1, max_iter + 1):
             if nact == 0:
                 break
+            _lane_stations(TH, Sx, Sy)
             for w in range(W):
-                Sx[0, w] = 0.0
-                Sy[0, w] = TH[0, w]
-                Sx[1, w] = TH[1, w]
-                Sy[1, w] = TH[2, w]
-                Sx[2, w] = 0.0
-                Sy[2, w] = TH[3, w]
-                Sx[3, w] = TH[4, w]
-                Sy[3, w] = -TH[2, w]
                 sing[w] = False
             for r in range(p):
                 for w in range(W):
@@ -287,15 +294,8 @@ def _kernel(r_obs, theta, pts, p, tol, max_iter, rcond, rcond_g, status, iters, 
                         nact += 1
                     PREV[w] = step
         # residuals at the final values; write the lanes back
+        _lane_stations(TH, Sx, Sy)
         for w in range(W):
-            Sx[0, w] = 0.0
-            Sy[0, w] = TH[0, w]
-            Sx[1, w] = TH[1, w]
-            Sy[1, w] = TH[2, w]
-            Sx[2, w] = 0.0
-            Sy[2, w] = TH[3, w]
-            Sx[3, w] = TH[4, w]
-            Sy[3, w] = -TH[2, w]
             V[w] = 0.0
         for j in range(n):
             for k in range(4):
@@ -368,6 +368,7 @@ def _compile(fn, name: str, width: int):
 
 
 if AVAILABLE:
+    _lane_stations = njit(cache=True)(_lane_stations)
     _kernel_lanes = _compile(_kernel, "_kernel_lanes", LANES)
     _kernel_one = _compile(_kernel, "_kernel_one", 1)
     _start = njit(cache=True)(_start)
