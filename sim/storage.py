@@ -27,18 +27,18 @@ _KEY = b"sim.provenance"
 
 @lru_cache(maxsize=1)
 def git_commit() -> str:
-    """The last commit that changed the code or the study definitions (``sim/``,
-    ``studies/``, ``pyproject.toml``), ``-dirty`` if they have uncommitted changes. A commit
-    of results alone does not change it, so re-running gives byte-identical files."""
+    """The last commit that changed the code or the study definitions (``sim/`` but its
+    benchmark, ``studies/``, ``pyproject.toml``), ``-dirty`` if they have uncommitted changes.
+    A commit of results (or of the benchmark) alone does not change it, so re-running gives
+    byte-identical files."""
     root = Path(__file__).resolve().parent.parent
+    paths = ["sim", "studies", "pyproject.toml", ":(exclude)sim/bench.py"]
     try:
-        head = subprocess.run(["git", "log", "-1", "--format=%H", "--", "sim", "studies",
-                               "pyproject.toml"], cwd=root, capture_output=True, text=True,
-                              timeout=10)
+        head = subprocess.run(["git", "log", "-1", "--format=%H", "--", *paths], cwd=root,
+                              capture_output=True, text=True, timeout=10)
         if head.returncode != 0 or not head.stdout.strip():
             return "unknown"
-        dirty = subprocess.run(["git", "status", "--porcelain", "--", "sim", "studies",
-                                "pyproject.toml"], cwd=root,
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", *paths], cwd=root,
                                capture_output=True, text=True, timeout=10).stdout.strip()
         return head.stdout.strip() + ("-dirty" if dirty else "")
     except (OSError, subprocess.SubprocessError):
@@ -47,12 +47,15 @@ def git_commit() -> str:
 
 @lru_cache(maxsize=1)
 def code_hash() -> str:
-    """sha256 of the library's source (every ``sim/**/*.py``), independent of git."""
+    """sha256 of the library's source (every ``sim/**/*.py`` but the benchmark), independent
+    of git."""
     import hashlib
 
     root = Path(__file__).resolve().parent
     h = hashlib.sha256()
     for f in sorted(root.rglob("*.py")):
+        if f == root / "bench.py":
+            continue
         h.update(str(f.relative_to(root)).encode())
         h.update(f.read_bytes())
     return h.hexdigest()[:16]
