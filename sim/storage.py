@@ -62,11 +62,17 @@ def code_hash() -> str:
 
 
 def versions() -> dict[str, str]:
-    import matplotlib
-    import scipy
+    """Versions of Python and of every package a result can depend on (``not installed`` for
+    the optional ones: without numba the NumPy engine runs)."""
+    from importlib.metadata import PackageNotFoundError, version
 
-    return {"python": sys.version.split()[0], "numpy": np.__version__, "scipy": scipy.__version__,
-            "pyarrow": pa.__version__, "matplotlib": matplotlib.__version__}
+    out = {"python": sys.version.split()[0]}
+    for pkg in ("numpy", "scipy", "pyarrow", "matplotlib", "emcee", "numba"):
+        try:
+            out[pkg] = version(pkg)
+        except PackageNotFoundError:
+            out[pkg] = "not installed"
+    return out
 
 
 def provenance(cfg: Mapping[str, Any], **extra: Any) -> dict[str, Any]:

@@ -116,7 +116,7 @@ def test_run_writes_contract_files_with_provenance(tmp_path):
     assert {"pivot_alpha_mm", "pivot_beta2_mm2", "stations_y1_mm"} <= set(trials)
     prov = read_provenance(out / "points.parquet")
     assert prov["config"]["trials"] == 60 and prov["seed"] == 1967
-    assert {"numpy", "pyarrow"} <= set(prov["versions"]) and prov["git_commit"]
+    assert {"numpy", "pyarrow", "numba", "emcee"} <= set(prov["versions"]) and prov["git_commit"]
     assert (out / "table1.png").stat().st_size > 1000
 
 
