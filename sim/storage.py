@@ -23,6 +23,9 @@ import pyarrow.parquet as pq
 __all__ = ["provenance", "write_table", "read_table", "read_provenance", "atomic_path"]
 
 _KEY = b"sim.provenance"
+#: library files that no study result depends on: left out of the commit and the code hash
+#: (and of the Makefile's SIM_SRC, which filters the same files)
+NOT_STUDY_CODE = ("bench.py",)
 
 
 @lru_cache(maxsize=1)
@@ -32,7 +35,7 @@ def git_commit() -> str:
     A commit of results (or of the benchmark) alone does not change it, so re-running gives
     byte-identical files."""
     root = Path(__file__).resolve().parent.parent
-    paths = ["sim", "studies", "pyproject.toml", ":(exclude)sim/bench.py"]
+    paths = ["sim", "studies", "pyproject.toml", *(f":(exclude)sim/{f}" for f in NOT_STUDY_CODE)]
     try:
         head = subprocess.run(["git", "log", "-1", "--format=%H", "--", *paths], cwd=root,
                               capture_output=True, text=True, timeout=10)
@@ -54,7 +57,7 @@ def code_hash() -> str:
     root = Path(__file__).resolve().parent
     h = hashlib.sha256()
     for f in sorted(root.rglob("*.py")):
-        if f == root / "bench.py":
+        if f.relative_to(root).as_posix() in NOT_STUDY_CODE:
             continue
         h.update(str(f.relative_to(root)).encode())
         h.update(f.read_bytes())

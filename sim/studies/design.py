@@ -569,7 +569,8 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
                 "sigma0 of the pivot adjustment with the production budget and no other "
                 "comparator error", ref=rounding(PAPER_CLOSURE_UM, 1), interval="spread")
     worse = 100 * np.mean(s0p > PAPER_CLOSURE_UM)
-    row["note"] += f"; {worse:.0f} % of the simulated plates close worse than Table 1's {PAPER_CLOSURE_UM:g} um"
+    row["note"] += (f"; {worse:.0f} % of the simulated plates close worse than Table 1's "
+                    f"{PAPER_CLOSURE_UM:g} um")
     rows.append(row)
 
     # 3. datum -------------------------------------------------------------------------
@@ -1089,8 +1090,7 @@ def report(out: Path) -> str:
         f"coordinates). Production total {bud.get('production', np.nan):.2f} um against the paper's "
         f"1.3 um from the Zeiss grid; with Table 1's 1.1 um random comparator error "
         f"{bud.get('table1_model', np.nan):.2f} um. The named elements give a closure sigma0 of "
-        f"{g('brown.budget.closure_um'):.2f} um (median) against Table 1's {PAPER_CLOSURE_UM:g} um "
-        f"({N.get('brown.budget.closure_um', '').rpartition('; ')[2]}): "
+        f"{g('brown.budget.closure_um'):.2f} um (median) against Table 1's {PAPER_CLOSURE_UM:g} um: "
         + ("they leave part of the 1.1 um comparator contribution unexplained."
            if g("brown.budget.closure_um") < PAPER_CLOSURE_UM else
            "they account for the whole 1.1 um comparator contribution."),
