@@ -294,7 +294,7 @@ def test_tiny_run_writes_claims_and_report(tmp_path):
     for prefix in ("agnard.scanner_correction.", "agnard.control_5.", "agnard.control_21.",
                    "agnard.pass_rejections.", "agnard.geometry_strength."):
         assert any(n.startswith(prefix) for n in names)
-    assert all(r["kind"] in ("predicted", "input") for r in rows)
+    assert all(r["kind"] in ("prediction", "input", "finding", "self-check") for r in rows)
     text = study.report(tmp_path)
     assert f"{tmp_path.name}/block_layout.png" in text and "w-test" in text
     for f in ("scanner_field.png", "block_layout.png", "check_residuals.png", "tradeoffs.png",

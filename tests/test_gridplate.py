@@ -137,6 +137,6 @@ def test_study_runs_small(tmp_path):
     assert rc == 0
     t = read_table(out / "claims.parquet").to_pydict()
     assert "twoplate.weight_ratio.grid_sigma_1to3_um" in t["claim"]
-    assert set(t["kind"]) <= {"predicted", "input"}
+    assert set(t["kind"]) <= {"prediction", "input", "finding", "self-check"}
     for fig in ("residuals", "parameters", "coverage", "chi2_power", "implied_grid"):
         assert (out / f"{fig}.png").is_file()
