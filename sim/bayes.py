@@ -82,7 +82,7 @@ def brown_log_posterior(r_obs: np.ndarray, sigma_mm: float, tol_mm: float = 1e-1
         R = np.broadcast_to(r_obs, (W,) + r_obs.shape)
         res = ml.adjust(R, "known", theta, tol_mm=tol_mm, max_iter=20)
         rss = np.einsum("tnk,tnk->t", res.residuals, res.residuals)
-        Qpp = ml.covariance(res.points, theta, "known")[0]
+        Qpp = res.point_cofactors()
         logdetQ = np.log(np.maximum(Qpp[..., 0, 0] * Qpp[..., 1, 1] - Qpp[..., 0, 1] ** 2,
                                     1e-300)).sum(1)
         out = -0.5 * rss / sigma_mm ** 2 + 0.5 * logdetQ

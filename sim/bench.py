@@ -50,7 +50,8 @@ def _scipy_one(obs1: np.ndarray, t0: np.ndarray, p0: np.ndarray):
 
     def jac(z):
         P, th = unpack(z)
-        Jp, Jg, _ = ml._jacobians(P, th, 7)
+        lin = ml._model(None).linearize(P, th, True)
+        Jp, Jg = lin.Jp, lin.Jg
         J = np.zeros((n * 4, 2 * n + 7))
         rows = np.arange(4 * n)
         pt = rows // 4

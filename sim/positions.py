@@ -27,15 +27,13 @@ Any other datum, in particular one over the measured points, follows from
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from .multilateration import AdjustResult, GNState
+from . import lsq
 
 __all__ = ["MODELS", "DATUMS", "circle_stations", "design_theta", "stations", "ranges",
            "n_free", "initial_points", "adjust", "covariance", "full_point_covariance",
-           "from_brown_theta"]
+           "from_brown_theta", "RangeModel", "arm_angles", "datum_constraints"]
 
 MODELS = ("known", "stations", "pivot")
 DATUMS = ("brown", "inner")
@@ -126,93 +124,72 @@ def datum_constraints(theta: np.ndarray, p: int, datum: str) -> np.ndarray:
     return C
 
 
-@dataclass
-class Reduced:
-    """Reduced normal equations (unit weights); shapes as in :mod:`sim.multilateration`,
-    with ``K`` ``(T, n, 2, p)``."""
+class RangeModel:
+    """Observation model of the ranges for :mod:`sim.lsq`: one point block ``(x_j, y_j)`` per
+    point, ``P`` readings per point (one per station), misclosure ``r_obs - (q - alpha)``
+    with ``q = sqrt(d^2 - b)``.
 
-    Ninv: np.ndarray
-    K: np.ndarray
-    Nbar: np.ndarray
-    ubar: np.ndarray
-    dp0: np.ndarray
-    ok: np.ndarray
+    r_obs : (T, n, P) mm (None: zero misclosures, for cofactors only); layout : None (the
+    globals are ``X_1, Y_1, ..., X_P, Y_P, alpha, b``) or a constant matrix ``B``
+    ``(2P + 2, q)`` mapping the model's own ``q`` globals to that vector (Brown's datum in
+    :mod:`sim.multilateration`). ``P`` is taken from ``r_obs`` or from ``stations``.
+    """
 
+    point_dim = 2
 
-def _reduce(points, theta, p, r_obs=None, rcond=1e-13) -> Reduced:
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # diverged trials
-        return _reduce_impl(points, theta, p, r_obs, rcond)
+    def __init__(self, r_obs: np.ndarray | None, layout: np.ndarray | None = None,
+                 P: int | None = None):
+        self.r_obs = None if r_obs is None else np.asarray(r_obs, float)
+        self.layout = layout
+        self.P = self.r_obs.shape[2] if P is None else P
+        self.n_global = 2 * self.P + 2 if layout is None else layout.shape[1]
 
+    def full(self, theta: np.ndarray) -> np.ndarray:
+        """The station/alpha/b vector ``(T, 2P + 2)`` of the globals."""
+        return theta if self.layout is None else theta @ self.layout.T
 
-def _reduce_impl(points, theta, p, r_obs, rcond) -> Reduced:
-    S = stations(theta)                                    # (T, P, 2)
-    P = S.shape[1]
-    dx = points[None, :, :, 0] - S[:, :, 0].T[:, :, None]  # (P, T, n)
-    dy = points[None, :, :, 1] - S[:, :, 1].T[:, :, None]
-    q = np.sqrt(np.maximum(dx * dx + dy * dy - theta[None, :, -1, None], 1e-300))
-    ux, uy = dx / q, dy / q
-    T, n = ux.shape[1:]
-    a, b, c = (ux * ux).sum(0), (ux * uy).sum(0), (uy * uy).sum(0)
-    det = a * c - b * b
-    ok = np.all(det > rcond * (a + c) ** 2, axis=1)
-    inv = 1.0 / np.where(det > 0, det, 1.0)
-    i00, i01, i11 = c * inv, -b * inv, a * inv
-    Ninv = np.stack([np.stack([i00, i01], -1), np.stack([i01, i11], -1)], -2)  # (T, n, 2, 2)
-    if r_obs is None:
-        e = np.zeros_like(q)
-    else:
-        e = r_obs.transpose(2, 0, 1) - (q - theta[None, :, -2, None])
-    up = np.stack([(ux * e).sum(0), (uy * e).sum(0)], -1)  # (T, n, 2)
-    dp0 = (Ninv @ up[..., None])[..., 0]
-    if p == 0:
-        return Reduced(Ninv, np.zeros((T, n, 2, 0)), np.zeros((T, 0, 0)), np.zeros((T, 0)), dp0, ok)
-    # Jacobian of the ranges w.r.t. the globals, station axis first: (P, T, n, p)
-    J = np.zeros((P, T, n, p))
-    k = np.arange(P)
-    J[k, :, :, 2 * k] = -ux
-    J[k, :, :, 2 * k + 1] = -uy
-    if p > 2 * P:
+    def initial_points(self, theta: np.ndarray) -> np.ndarray:
+        return initial_points(self.r_obs, self.full(theta))
+
+    def linearize(self, points, theta, globals_needed=True) -> lsq.Linearization:
+        th = self.full(theta)
+        S = stations(th)                                   # (T, P, 2)
+        dx = points[:, :, None, 0] - S[:, None, :, 0]      # (T, n, P)
+        dy = points[:, :, None, 1] - S[:, None, :, 1]
+        q = np.sqrt(np.maximum(dx * dx + dy * dy - th[:, None, None, -1], 1e-300))
+        ux, uy = dx / q, dy / q
+        r = (np.zeros_like(q) if self.r_obs is None
+             else self.r_obs - (q - th[:, None, None, -2]))
+        Jp = np.stack([ux, uy], -1)
+        if not globals_needed:
+            return lsq.Linearization(r, Jp, None)
+        T, n, P = q.shape
+        J = np.zeros((T, n, P, 2 * P + 2))
+        k = np.arange(P)
+        J[:, :, k, 2 * k] = -ux
+        J[:, :, k, 2 * k + 1] = -uy
         J[..., 2 * P] = -1.0
         J[..., 2 * P + 1] = -0.5 / q
-    Jt = J.transpose(1, 0, 2, 3).reshape(T, P * n, p)      # batched matrix products (BLAS)
-    JtT = Jt.transpose(0, 2, 1)
-    Ngg = JtT @ Jt
-    ug = (JtT @ e.transpose(1, 0, 2).reshape(T, P * n, 1))[..., 0]
-    Npg = np.stack([(ux[..., None] * J).sum(0), (uy[..., None] * J).sum(0)], 2)  # (T, n, 2, p)
-    K = Ninv @ Npg                                         # (T, n, 2, p)
-    Kf = K.reshape(T, 2 * n, p)
-    KfT = Kf.transpose(0, 2, 1)
-    Nbar = Ngg - KfT @ Npg.reshape(T, 2 * n, p)
-    ubar = ug - (KfT @ up.reshape(T, 2 * n, 1))[..., 0]
-    return Reduced(Ninv, K, Nbar, ubar, dp0, ok)
+        return lsq.Linearization(r, Jp, J if self.layout is None else J @ self.layout)
 
 
-def _bordered(Nbar: np.ndarray, C: np.ndarray) -> np.ndarray:
-    T, p, d = C.shape
-    M = np.zeros((T, p + d, p + d))
-    M[:, :p, :p] = Nbar
-    M[:, :p, p:] = C
-    M[:, p:, :p] = C.transpose(0, 2, 1)
-    return M
-
-
-def _scaled_ok(M: np.ndarray, rcond: float) -> np.ndarray:
-    ds = np.sqrt(np.abs(np.einsum("tii->ti", M))) + 1e-300
-    ds = np.where(ds > 1e-150, ds, 1.0)
-    Mn = M / ds[:, :, None] / ds[:, None, :]
-    fin = np.all(np.isfinite(Mn), axis=(1, 2))
-    Mn = np.where(fin[:, None, None], Mn, np.eye(M.shape[-1]))
-    return fin & (np.linalg.cond(Mn) < 1.0 / rcond)
+def _datum(theta: np.ndarray, P: int, model: str, datum: str) -> lsq.Datum:
+    p = n_free(P, model)
+    if datum not in DATUMS:
+        raise ValueError(f"datum must be one of {', '.join(DATUMS)}, not {datum!r}")
+    return lsq.Datum(np.arange(p), datum_constraints(theta, p, datum) if p else None)
 
 
 def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, datum: str = "inner",
-           tol_mm: float = 1e-10, max_iter: int = 30, rcond: float = 1e-12) -> AdjustResult:
+           tol_mm: float = 1e-10, max_iter: int = 30,
+           rcond: float | None = None) -> lsq.Result:
     """Batched Gauss-Newton adjustment with ``P`` stations.
 
     r_obs : (T, n, P) mm. theta0 : (T, 2P+2) or (2P+2,) -- fixed values and starting values;
-    for ``brown`` the start must satisfy Brown's datum (it is kept exactly). Returns
-    :class:`sim.multilateration.AdjustResult` (status 0 converged, 1 not converged,
-    2 singular, 3 non-finite).
+    for ``brown`` the start must satisfy Brown's datum (it is kept exactly). Solved by the
+    engine :func:`sim.lsq.gauss_newton` (``rcond``: its scaled singularity threshold, default
+    :data:`sim.lsq.RCOND`); returns :class:`sim.lsq.Result` (status 0 converged,
+    1 not converged, 2 singular, 3 non-finite).
     """
     if model not in MODELS:
         raise ValueError(f"model must be one of {', '.join(MODELS)}, not {model!r}")
@@ -225,35 +202,9 @@ def adjust(r_obs: np.ndarray, model: str, theta0: np.ndarray, datum: str = "inne
     if dof < 0 or n < 3:
         raise ValueError(f"{n} points in {P} positions give {P * n} ranges for too many unknowns")
     theta = np.broadcast_to(np.asarray(theta0, float), (T, 2 * P + 2)).copy()
-    pts = initial_points(r_obs, theta)
-    gn = GNState(T)
-    C = None
-    for it in range(1, max_iter + 1):
-        red = _reduce(pts, theta, p, r_obs)
-        if p:
-            if C is None:
-                C = datum_constraints(theta, p, datum)
-            M = _bordered(red.Nbar, C)
-            if it == 1:
-                red.ok &= _scaled_ok(M, rcond)
-            M = np.where(red.ok[:, None, None], M, np.eye(p + 3))
-            rhs = np.concatenate([red.ubar, np.zeros((T, 3))], 1)[..., None]
-            try:
-                sol = np.linalg.solve(M, rhs)
-            except np.linalg.LinAlgError:  # a diverging trial went singular: flag it
-                red.ok &= _scaled_ok(M, rcond)
-                sol = np.linalg.solve(np.where(red.ok[:, None, None], M, np.eye(p + 3)), rhs)
-            dg = sol[:, :p, 0]
-            dp = red.dp0 - (red.K.reshape(T, 2 * n, p) @ dg[..., None]).reshape(T, n, 2)
-        else:
-            dg = np.zeros((T, 0))
-            dp = red.dp0
-        pts = gn.advance(it, red.ok, dp, dg, pts, theta, tol_mm)
-        if gn.finished:
-            break
-    res = r_obs - ranges(pts, theta)
-    s0 = np.sqrt(np.einsum("tnk,tnk->t", res, res) / dof) if dof > 0 else np.full(T, np.nan)
-    return AdjustResult(pts, theta, res, s0, dof, gn.iters, gn.status == 0, gn.status)
+    rc = lsq.RCOND if rcond is None else rcond
+    return lsq.gauss_newton(RangeModel(r_obs), theta, None, _datum(theta, P, model, datum),
+                            tol_mm, max_iter, rc, engine="numpy")
 
 
 def covariance(points: np.ndarray, theta: np.ndarray, model: str, datum: str = "inner"):
@@ -264,32 +215,13 @@ def covariance(points: np.ndarray, theta: np.ndarray, model: str, datum: str = "
     station coordinates in the chosen ``datum`` (bordered inverse of the reduced normals).
     """
     P = (theta.shape[-1] - 2) // 2
-    p = n_free(P, model)
-    red = _reduce(points, theta, p)
-    T = points.shape[0]
-    if p:
-        C = datum_constraints(theta, p, datum)
-        M = _bordered(red.Nbar, C)
-        ok = red.ok & _scaled_ok(M, 1e-13)
-        M = np.where(ok[:, None, None], M, np.eye(p + 3))
-        Qgg = np.linalg.inv(M)[:, :p, :p]
-        Qgg[~ok] = np.nan
-        KQ = (red.K.reshape(T, -1, p) @ Qgg).reshape(red.K.shape)
-        Qpp = red.Ninv + KQ @ red.K.transpose(0, 1, 3, 2)
-    else:
-        Qgg = np.zeros((T, 0, 0))
-        Qpp = red.Ninv
-    return Qpp, Qgg, red.K, red.Ninv
+    cof = lsq.cofactors(RangeModel(None, P=P), points, theta, _datum(theta, P, model, datum))
+    return cof.points, cof.Qgg, cof.K, cof.Ninv
 
 
 def full_point_covariance(points: np.ndarray, theta: np.ndarray, model: str,
                           datum: str = "inner") -> np.ndarray:
     """The full ``(T, 2n, 2n)`` cofactor of all point coordinates (x1, y1, x2, ...)."""
-    _, Qgg, K, Ninv = covariance(points, theta, model, datum)
-    T, n = points.shape[:2]
-    Kf = K.reshape(T, 2 * n, -1)
-    Q = Kf @ Qgg @ Kf.transpose(0, 2, 1) if Qgg.shape[-1] else np.zeros((T, 2 * n, 2 * n))
-    idx = np.arange(n)
-    Qb = Q.reshape(T, n, 2, n, 2)
-    Qb[:, idx, :, idx, :] += Ninv.transpose(1, 0, 2, 3)
-    return Qb.reshape(T, 2 * n, 2 * n)
+    P = (theta.shape[-1] - 2) // 2
+    return lsq.cofactors(RangeModel(None, P=P), points, theta,
+                         _datum(theta, P, model, datum)).full_points

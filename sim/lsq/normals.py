@@ -1,0 +1,189 @@
+"""Shared numerics of the engine: the scaled singularity rule, small symmetric inverses, the
+Schur-complement reduction of the normal equations and the bordered (datum) solve.
+
+Seed of the method: Brown 1968 (``004_f5bd9e86c308241f.txt``), whose EMBET eliminates every
+point's 2 x 2 block before the globals are solved ("reduced normal equations"). Everything is
+batched over a leading trial axis ``T``; no Python loop runs per trial.
+
+Normal equations, per trial, of observations ``r`` (observed minus computed) with diagonal
+weights ``w`` and Jacobians ``Jp`` (point blocks, ``d`` unknowns each) and ``Jg`` (the ``p``
+free globals)::
+
+    [Npp  Npg] [dp]   [up]        Npp = Jp^T W Jp (block diagonal, one d x d block per point)
+    [Npg' Ngg] [dg] = [ug]        Nbar = Ngg - Npg' Npp^-1 Npg,  ubar = ug - Npg' Npp^-1 up
+
+so the largest solve per trial is ``p x p`` (bordered by the ``c`` datum constraints
+``C' dg = 0``: ``(p + c) x (p + c)``) and the cost is linear in the number of points.
+
+**The singularity rule** (:func:`scaled_rcond`): a symmetric matrix is scaled to unit
+diagonal (rows with a zero diagonal, the constraint rows of a bordered matrix, are left
+unscaled; the constraint columns are normalised), and it is singular when the ratio of its
+smallest to its largest eigenvalue modulus is not above ``rcond`` (default :data:`RCOND`,
+ten digits lost) or any entry is not finite. The same rule is applied to every point block
+and to the (bordered) reduced normals; a singular trial is flagged, never raised.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["RCOND", "scaled_rcond", "inv_blocks", "Reduced", "reduce", "bordered_solve",
+           "bordered_inverse"]
+
+#: default reciprocal condition number below which a scaled matrix counts as singular
+RCOND = 1e-10
+
+
+def scaled_rcond(M: np.ndarray) -> np.ndarray:
+    """Ratio of the smallest to the largest |eigenvalue| of the symmetric ``M`` ``(..., m, m)``
+    scaled to unit diagonal; 0 where an entry is not finite. Shape ``(...)``."""
+    m = M.shape[-1]
+    d = np.abs(np.einsum("...ii->...i", M))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        s = np.where(d > 0, 1.0 / np.sqrt(d), 1.0)
+        C = M * s[..., :, None] * s[..., None, :]
+    fin = np.isfinite(C).all(axis=(-1, -2))
+    C = np.where(fin[..., None, None], C, np.eye(m))
+    if m == 1:
+        rc = (np.abs(C[..., 0, 0]) > 0).astype(float)
+    elif m == 2:  # closed form: eigenvalues t/2 +- sqrt(((a - c)/2)^2 + b^2)
+        a, b, c = C[..., 0, 0], C[..., 0, 1], C[..., 1, 1]
+        h, g = 0.5 * (a + c), np.sqrt((0.5 * (a - c)) ** 2 + b * b)
+        l1, l2 = np.abs(h + g), np.abs(h - g)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rc = np.minimum(l1, l2) / np.maximum(l1, l2)
+    else:
+        ev = np.abs(np.linalg.eigvalsh(C))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rc = ev.min(-1) / ev.max(-1)
+    return np.where(fin & np.isfinite(rc), rc, 0.0)
+
+
+def inv_blocks(N: np.ndarray, rcond: float = RCOND):
+    """Inverse of symmetric blocks ``N`` ``(T, n, d, d)`` and ``ok`` ``(T,)`` (every block of
+    the trial regular by the scaled rule). Singular blocks are replaced by the identity."""
+    d = N.shape[-1]
+    good = scaled_rcond(N) > rcond                         # (T, n)
+    ok = good.all(axis=1)
+    Ns = np.where(good[..., None, None], N, np.eye(d))
+    if d == 1:
+        return 1.0 / Ns, ok
+    if d == 2:
+        a, b, c = Ns[..., 0, 0], Ns[..., 0, 1], Ns[..., 1, 1]
+        inv = 1.0 / (a * c - b * b)
+        return np.stack([np.stack([c * inv, -b * inv], -1),
+                         np.stack([-b * inv, a * inv], -1)], -2), ok
+    return np.linalg.inv(Ns), ok
+
+
+@dataclass
+class Reduced:
+    """Normal equations after eliminating the point blocks (one linearisation point).
+
+    Ninv : (T, n, d, d) inverse point blocks; K : (T, n, d, p) = Npp^-1 Npg; Nbar : (T, p, p);
+    ubar : (T, p); dp0 : (T, n, d) the point corrections for ``dg = 0``; ok : (T,) all point
+    blocks regular.
+    """
+
+    Ninv: np.ndarray
+    K: np.ndarray
+    Nbar: np.ndarray
+    ubar: np.ndarray
+    dp0: np.ndarray
+    ok: np.ndarray
+
+    def points_step(self, dg: np.ndarray) -> np.ndarray:
+        """Point corrections ``dp0 - K dg`` ``(T, n, d)`` for the global corrections ``dg``."""
+        if dg.shape[-1] == 0:
+            return self.dp0
+        return self.dp0 - np.einsum("tnip,tp->tni", self.K, dg)
+
+
+def reduce(r, Jp, Jg, w=None, rcond: float = RCOND) -> Reduced:
+    """Form the normal equations and eliminate the point blocks (Schur complement).
+
+    r : (T, n, k) misclosures; Jp : (T, n, k, d) or None (no point unknowns); Jg :
+    (T, n, k, p) Jacobian of the free globals or None; w : weights broadcastable to
+    (T, n, k) or None (unit weights).
+    """
+    T, n, k = r.shape
+    wr = r if w is None else w * r
+    p = 0 if Jg is None else Jg.shape[-1]
+    if Jp is None or Jp.shape[-1] == 0:
+        d = 0
+        Ninv = np.zeros((T, n, 0, 0))
+        dp0 = np.zeros((T, n, 0))
+        ok = np.ones(T, bool)
+    else:
+        d = Jp.shape[-1]
+        WJp = Jp if w is None else w[..., None] * Jp
+        Npp = np.swapaxes(WJp, -1, -2) @ Jp                 # (T, n, d, d)
+        Ninv, ok = inv_blocks(Npp, rcond)
+        up = np.einsum("tnki,tnk->tni", Jp, wr)
+        dp0 = (Ninv @ up[..., None])[..., 0]
+    if p == 0:
+        return Reduced(Ninv, np.zeros((T, n, d, 0)), np.zeros((T, 0, 0)), np.zeros((T, 0)),
+                       dp0, ok)
+    Jf = Jg.reshape(T, n * k, p)
+    WJf = Jf if w is None else (np.broadcast_to(w, r.shape).reshape(T, n * k, 1) * Jf)
+    Nbar = np.swapaxes(WJf, -1, -2) @ Jf
+    ubar = (np.swapaxes(Jf, -1, -2) @ wr.reshape(T, n * k, 1))[..., 0]
+    if d == 0:
+        return Reduced(Ninv, np.zeros((T, n, 0, p)), Nbar, ubar, dp0, ok)
+    Npg = np.swapaxes(WJp, -1, -2) @ Jg                     # (T, n, d, p)
+    K = Ninv @ Npg
+    Kt = K.reshape(T, n * d, p).transpose(0, 2, 1)
+    Nbar = Nbar - Kt @ Npg.reshape(T, n * d, p)
+    ubar = ubar - (Kt @ up.reshape(T, n * d, 1))[..., 0]
+    return Reduced(Ninv, K, Nbar, ubar, dp0, ok)
+
+
+def _scaled_system(N: np.ndarray, C: np.ndarray | None):
+    """The bordered matrix scaled to unit diagonal, and the scale ``s`` (T, p)."""
+    T, p, _ = N.shape
+    dg = np.abs(np.einsum("tii->ti", N))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        s = np.where(dg > 0, 1.0 / np.sqrt(dg), 1.0)
+        Ns = N * s[:, :, None] * s[:, None, :]
+    if C is None or C.shape[-1] == 0:
+        return Ns, s
+    Cs = C * s[:, :, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Cs = Cs / np.linalg.norm(Cs, axis=1, keepdims=True)
+    c = C.shape[-1]
+    M = np.zeros((T, p + c, p + c))
+    M[:, :p, :p] = Ns
+    M[:, :p, p:] = Cs
+    M[:, p:, :p] = Cs.transpose(0, 2, 1)
+    return M, s
+
+
+def _safe(M: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    return np.where(ok[:, None, None], M, np.eye(M.shape[-1]))
+
+
+def bordered_solve(Nbar, ubar, C=None, rcond: float = RCOND):
+    """Solve ``Nbar dg = ubar`` subject to ``C' dg = 0`` (``C`` (T, p, c) or None) on the
+    scaled system. Returns ``(dg (T, p), ok (T,))``; singular trials get ``dg = 0``."""
+    T, p = ubar.shape
+    M, s = _scaled_system(Nbar, C)
+    ok = scaled_rcond(M) > rcond
+    rhs = np.zeros((T, M.shape[-1]))
+    rhs[:, :p] = np.where(np.isfinite(ubar), ubar, 0.0) * s
+    try:
+        y = np.linalg.solve(_safe(M, ok), rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # exactly singular although above rcond: never raise
+        y = (np.linalg.pinv(_safe(M, ok)) @ rhs[..., None])[..., 0]
+    return np.where(ok[:, None], y[:, :p] * s, 0.0), ok
+
+
+def bordered_inverse(Nbar, C=None, rcond: float = RCOND):
+    """Cofactor ``Qgg`` (T, p, p) of the globals in the datum ``C' dg = 0`` (the top-left block
+    of the bordered inverse) and ``ok`` (T,); NaN for singular trials."""
+    p = Nbar.shape[-1]
+    M, s = _scaled_system(Nbar, C)
+    ok = scaled_rcond(M) > rcond
+    Q = np.linalg.inv(_safe(M, ok))[:, :p, :p] * s[:, :, None] * s[:, None, :]
+    Q[~ok] = np.nan
+    return Q, ok
