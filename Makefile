@@ -5,13 +5,12 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
-SIM_SRC := $(filter-out sim/bench.py,$(shell find sim -name '*.py' 2>/dev/null))
+RUN_FLAGS ?= --workers 2
 STUDY_FILES := $(wildcard studies/*.toml)
 STUDIES := $(basename $(notdir $(STUDY_FILES)))
-CLAIMS := $(foreach s,$(STUDIES),results/$(s)/claims.parquet)
 
 .DEFAULT_GOAL := help
-.PHONY: help venv test reproduce rerun report bench clean
+.PHONY: help venv test reproduce rerun verify report bench clean
 
 help: ## list the targets
 	@grep -E '^[a-zA-Z_%/.-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/:.*## /\t/' | sort | \
@@ -28,16 +27,21 @@ venv: $(STAMP) ## create the virtual environment and install the project
 test: $(STAMP) ## run the test suite (sets up the environment first)
 	$(PY) -m pytest
 
-results/%/claims.parquet: studies/%.toml $(SIM_SRC) | $(STAMP)
-	$(PY) -m sim run $< --out results/$* --overwrite
-
-results/REPORT.md: $(CLAIMS) | $(STAMP)
+# A study is re-run when its results are not current: run.json must record the study file's
+# config and the hash of the code that study imports (sim/codehash.py). Decided by content,
+# not by file times, so a fresh clone re-runs nothing that is current.
+reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md
+	@for s in $(STUDIES); do \
+	  if $(PY) -m sim.codehash studies/$$s.toml results/$$s; then echo "$$s: up to date"; \
+	  else $(PY) -m sim run studies/$$s.toml --out results/$$s --overwrite $(RUN_FLAGS) || exit 1; fi; done
 	$(PY) -m sim report --results results
 
-reproduce: results/REPORT.md ## run every study at full trial counts and rebuild results/REPORT.md
-
 rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report
-	@for s in $(STUDIES); do $(PY) -m sim run studies/$$s.toml --out results/$$s --overwrite || exit 1; done
+	@for s in $(STUDIES); do $(PY) -m sim run studies/$$s.toml --out results/$$s --overwrite $(RUN_FLAGS) || exit 1; done
+	$(PY) -m sim report --results results
+
+verify: $(STAMP) ## re-run every study into a scratch directory and compare with results/ (tolerances per column)
+	$(PY) -m sim.verify --results results --workers 2
 	$(PY) -m sim report --results results
 
 report: $(STAMP) ## rebuild results/REPORT.md from the Parquet files alone

@@ -46,7 +46,7 @@ def _parser() -> argparse.ArgumentParser:
 def _run_record(cfg: dict) -> dict:
     from .storage import code_hash
 
-    return {"config": cfg, "code_hash": code_hash()}
+    return {"config": cfg, "code_hash": code_hash(cfg["study"])}
 
 
 def _read_record(d: Path) -> dict | None:

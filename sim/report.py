@@ -229,10 +229,10 @@ def build_report(results: Path) -> str:
                                                                        "code commit"],
                      [e[4] for e in entries])
     summary = referee_summary(entries)
-    repro = ""
-    rp = results / "reproducibility.md"
-    if rp.is_file():
-        repro = "\n" + rp.read_text()
+    from .verify import markdown as reproducibility_markdown
+
+    repro = reproducibility_markdown(results)
+    repro = "\n" + repro if repro else ""
     return (head + summary + "\n### Counts per study\n\n" + table + "\n\n" + rules + repro
             + "\n" + "\n".join(s[2] for s in sections))
 

@@ -23,19 +23,25 @@ import pyarrow.parquet as pq
 __all__ = ["provenance", "write_table", "read_table", "read_provenance", "atomic_path"]
 
 _KEY = b"sim.provenance"
-#: library files that no study result depends on: left out of the commit and the code hash
-#: (and of the Makefile's SIM_SRC, which filters the same files)
-NOT_STUDY_CODE = ("bench.py",)
+from .codehash import NOT_STUDY_CODE  # library files no study result depends on
 
 
-@lru_cache(maxsize=1)
-def git_commit() -> str:
-    """The last commit that changed the code or the study definitions (``sim/`` but its
-    benchmark, ``studies/``, ``pyproject.toml``), ``-dirty`` if they have uncommitted changes.
-    A commit of results (or of the benchmark) alone does not change it, so re-running gives
+@lru_cache(maxsize=None)
+def git_commit(study: str | None = None) -> str:
+    """The last commit that changed the code or definition of ``study`` (its modules, see
+    :mod:`sim.codehash`, its study file and ``pyproject.toml``; without a study: all of
+    ``sim/`` but the benchmark, and ``studies/``), ``-dirty`` if they have uncommitted changes.
+    A commit of results, or of another study's code, does not change it, so re-running gives
     byte-identical files."""
     root = Path(__file__).resolve().parent.parent
-    paths = ["sim", "studies", "pyproject.toml", *(f":(exclude)sim/{f}" for f in NOT_STUDY_CODE)]
+    if study is None:
+        paths = ["sim", "studies", "pyproject.toml",
+                 *(f":(exclude)sim/{f}" for f in NOT_STUDY_CODE)]
+    else:
+        from .codehash import study_files
+
+        paths = [p.relative_to(root).as_posix() for p in study_files(study)]
+        paths += [f"studies/{study}.toml", "pyproject.toml"]
     try:
         head = subprocess.run(["git", "log", "-1", "--format=%H", "--", *paths], cwd=root,
                               capture_output=True, text=True, timeout=10)
@@ -48,12 +54,15 @@ def git_commit() -> str:
         return "unknown"
 
 
-@lru_cache(maxsize=1)
-def code_hash() -> str:
-    """sha256 of the library's source (every ``sim/**/*.py`` but the benchmark), independent
-    of git."""
+def code_hash(study: str | None = None) -> str:
+    """sha256 of the code ``study`` depends on (:func:`sim.codehash.study_code_hash`), or,
+    without a study, of the library's source (every ``sim/**/*.py`` but the benchmark)."""
     import hashlib
 
+    if study is not None:
+        from .codehash import study_code_hash
+
+        return study_code_hash(study)
     root = Path(__file__).resolve().parent
     h = hashlib.sha256()
     for f in sorted(root.rglob("*.py")):
@@ -81,7 +90,8 @@ def versions() -> dict[str, str]:
 def provenance(cfg: Mapping[str, Any], **extra: Any) -> dict[str, Any]:
     """Provenance record for a run: resolved config, seed, versions, git commit."""
     return {"study": cfg.get("study"), "config": dict(cfg), "seed": cfg.get("seed"),
-            "versions": versions(), "git_commit": git_commit(), "code_hash": code_hash(), **extra}
+            "versions": versions(), "git_commit": git_commit(cfg.get("study")),
+            "code_hash": code_hash(cfg.get("study")), **extra}
 
 
 def _jsonable(o: Any) -> Any:
