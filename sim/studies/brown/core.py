@@ -1,0 +1,198 @@
+"""Simulation core of the Brown studies: analytic cofactor sigmas, the Monte-Carlo chunk
+(all three adjustment models on the same simulated ranges) and streamed statistics.
+
+Coordinates in mm, standard deviations in um. Seed paper 004 (Brown 1968).
+"""
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+
+from ... import multilateration as ml
+from ...config import StudyError
+from ...plate import pattern_points
+from ...runner import jackknife, run_chunks
+from .. import RunContext
+from .schema import MODEL_NAMES
+
+def analytic_sigma(pts: np.ndarray, theta: np.ndarray, model: str, sigma_um: float = 1.0):
+    """Per-point sigma_x, sigma_y (um) at the true values, shape (n, 2)."""
+    Q = ml.covariance(pts[None], theta[None], model)[0][0]
+    return sigma_um * np.sqrt(np.stack([Q[:, 0, 0], Q[:, 1, 1]], axis=1))
+
+
+def start_theta(theta: np.ndarray, model: str) -> np.ndarray:
+    """Initial globals: the design (true) stations; alpha and beta^2 start at 0 when free."""
+    t0 = theta.copy()
+    t0[5 + (model == "alpha"):ml.MODELS[model]] = 0.0
+    return t0
+
+
+SIM_KEYS = ("errors.setting_sigma_um", "errors.settings", "errors.comparator_sigma_um",
+            "errors.bias_um", "solver.tol_mm", "solver.max_iter")
+
+
+def chunk(rng: np.random.Generator, n: int, *, sim: dict, pts: np.ndarray, theta: np.ndarray,
+          shift_um: float | None = None, table1: bool = False) -> dict[str, np.ndarray]:
+    """One chunk of ``n`` simulated plates, adjusted with all three models.
+
+    Returns per-trial rows (``rows.*``: sigma0, iterations, status and globals per model),
+    per-chunk sums of the coordinate errors over the trials where all models converged
+    (``sum.n`` (1,), ``sum.e1``/``sum.e2`` (1, 3, n_pts, 2) in um and um^2) from which the
+    Monte-Carlo sigmas and their jackknife intervals follow, and, for the production test,
+    per-plate statistics of the a-posteriori sigmas. Module level, so it can be sent to
+    worker processes (bind the keywords with functools.partial).
+    """
+    P = np.broadcast_to(pts, (n,) + pts.shape)
+    TH = np.broadcast_to(theta, (n, 7))
+    obs, sett = ml.simulate_ranges(P, TH, rng, setting_sigma_um=sim["errors.setting_sigma_um"],
+                                   settings=sim["errors.settings"],
+                                   comparator_sigma_um=sim["errors.comparator_sigma_um"],
+                                   bias_um=sim["errors.bias_um"], return_settings=True)
+    out: dict[str, np.ndarray] = {}
+    errs, ok_all = [], np.ones(n, bool)
+    res_by = {}
+    for m in MODEL_NAMES:
+        res = ml.adjust(obs, m, start_theta(theta, m), tol_mm=sim["solver.tol_mm"],
+                        max_iter=sim["solver.max_iter"])
+        res_by[m] = res
+        out[f"rows.{m}_converged"] = res.converged
+        out[f"rows.{m}_status"] = res.status
+        out[f"rows.{m}_iterations"] = res.iterations
+        out[f"rows.{m}_sigma0_um"] = res.sigma0 * 1e3
+        for i, name in enumerate(ml.PARAM_NAMES[:ml.MODELS[m]]):
+            out[f"rows.{m}_{name}"] = res.theta[:, i]
+        errs.append((res.points - pts) * 1e3)                        # um
+        ok_all &= res.converged
+    e = np.stack(errs, 1)[ok_all]                                     # (n_ok, 3, n_pts, 2)
+    out["sum.n"] = np.array([ok_all.sum()], float)
+    out["sum.e1"] = e.sum(0)[None]
+    out["sum.e2"] = (e * e).sum(0)[None]
+    out["sum.nfail"] = np.array([[(~res_by[m].converged).sum() for m in MODEL_NAMES]], float)
+    if shift_um is not None:
+        r0 = res_by["pivot"]
+        r2 = ml.adjust(obs + shift_um * 1e-3, "pivot", start_theta(theta, "pivot"),
+                       tol_mm=sim["solver.tol_mm"], max_iter=sim["solver.max_iter"])
+        both = r0.converged & r2.converged
+        out["bias.max_point_shift_mm"] = np.array([np.abs(r2.points - r0.points)[both].max(initial=0.0)])
+        out["bias.alpha_err_mm"] = np.array(
+            [np.abs(r2.theta[both, 5] - r0.theta[both, 5] + shift_um * 1e-3).max(initial=0.0)])
+        out["bias.n"] = np.array([both.sum()])
+    if table1:
+        r = res_by["pivot"]
+        Qpp = ml.covariance(r.points, r.theta, "pivot")[0]
+        ap = r.sigma0[:, None, None] * 1e3 * np.sqrt(np.stack([Qpp[..., 0, 0], Qpp[..., 1, 1]], -1))
+        nan = np.where(r.converged, 1.0, np.nan)
+        out["t1.sigma0_um"] = r.sigma0 * 1e3 * nan
+        out["t1.share_1p1_1p3"] = ((ap >= 1.05) & (ap < 1.35)).mean(axis=(1, 2)) * nan
+        out["t1.max_sigma_um"] = ap.max(axis=(1, 2)) * nan
+        out["t1.points_ge_1p45"] = (ap.max(axis=2) >= 1.45).sum(axis=1) * nan
+        L = sett.shape[-1]  # the setting sigma needs repeated settings
+        out["t1.setting_sigma_um"] = (np.sqrt(sett.var(axis=-1, ddof=1).mean(axis=(1, 2))) * nan
+                                      if L > 1 else np.full(n, np.nan))
+        for k in ("share_1p1_1p3", "max_sigma_um", "points_ge_1p45"):
+            out[f"rows.pivot_{k}"] = out[f"t1.{k}"]
+    return out
+
+
+def run_mc(cfg: dict, pts, theta, ctx: RunContext, shift_um=None, table1=False) -> dict:
+    fn = partial(chunk, sim={k: cfg[k] for k in SIM_KEYS}, pts=pts, theta=theta,
+                 shift_um=shift_um, table1=table1)
+    return run_chunks(fn, cfg["trials"], cfg["seed"], cfg["chunk"], part=0, label=cfg["study"],
+                      ctx=ctx)
+
+
+class MC:
+    """Monte-Carlo statistics from per-chunk sums (streamed; memory independent of trials).
+
+    ``sums`` (C, 3, n, 2, 2) holds per chunk the first and second moments of the errors of
+    each model; ``cnt`` (C,) the trials they cover. Intervals are delete-one-chunk jackknife
+    intervals (:func:`sim.runner.jackknife`) or chi-square intervals for single sigmas.
+    """
+
+    def __init__(self, sim: dict):
+        self.cnt = sim["sum.n"]
+        self.sums = np.stack([sim["sum.e1"], sim["sum.e2"]], -1)
+        self.packed = np.concatenate([self.cnt[:, None], self.sums.reshape(len(self.cnt), -1)], 1)
+        self.shape = self.sums.shape[1:]
+        self.N = int(self.cnt.sum())
+        self.nfail = sim["sum.nfail"].sum(0)
+        if self.N < 2:
+            raise StudyError(f"only {self.N} trials converged in all models (non-converged: "
+                             + ", ".join(f"{m} {int(f)}" for m, f in zip(MODEL_NAMES, self.nfail))
+                             + "): singular reduced normal matrix, the geometry is degenerate")
+
+    def sd_from(self, total: np.ndarray) -> np.ndarray:
+        """(3, n, 2) standard deviations from a packed total [N, sums...]."""
+        N = total[0]
+        s = total[1:].reshape(self.shape)
+        return np.sqrt(np.maximum(s[..., 1] - s[..., 0] ** 2 / N, 0) / (N - 1))
+
+    @property
+    def sd(self) -> np.ndarray:
+        return self.sd_from(self.packed.sum(0))
+
+    def jack(self, f):
+        """Estimate and 95 % jackknife interval of ``f(sd (3, n, 2))``."""
+        return jackknife(lambda t: f(self.sd_from(t)), self.packed)
+
+
+def points_table(pts, an: dict, mc: MC, sr: float) -> dict:
+    """Rows of points.parquet: one per model and point (sigmas in um)."""
+    n = len(pts)
+    k_pt = pooled_sigma(an["known"])
+    cols: dict[str, list] = {k: [] for k in ("model", "point", "x_mm", "y_mm", "sigma_x_um",
+                                             "sigma_y_um", "mc_sigma_x_um", "mc_sigma_y_um",
+                                             "mc_trials", "ratio_x", "ratio_y", "dilution_pct")}
+    sd = mc.sd
+    for i, m in enumerate(MODEL_NAMES):
+        a = an[m]
+        cols["model"] += [m] * n
+        cols["point"] += list(range(1, n + 1))
+        cols["x_mm"] += list(pts[:, 0])
+        cols["y_mm"] += list(pts[:, 1])
+        cols["sigma_x_um"] += list(a[:, 0])
+        cols["sigma_y_um"] += list(a[:, 1])
+        cols["mc_sigma_x_um"] += list(sd[i, :, 0])
+        cols["mc_sigma_y_um"] += list(sd[i, :, 1])
+        cols["mc_trials"] += [mc.N] * n
+        cols["ratio_x"] += list(a[:, 0] / sr)
+        cols["ratio_y"] += list(a[:, 1] / sr)
+        cols["dilution_pct"] += list((pooled_sigma(a) / k_pt - 1) * 100)
+    return cols
+
+
+def pooled_sigma(a: np.ndarray) -> np.ndarray:
+    """sigma of a point: rms of its sigma_x and sigma_y, (n,)."""
+    return np.sqrt((a ** 2).mean(axis=-1))
+
+
+def max_ratio_known(pts, h):
+    return analytic_sigma(pts, ml.design_theta(h), "known").max()
+
+
+def geometry_grid(format_mm: float, k: int, extents, offsets) -> dict:
+    """Analytic edge ratio and dilution range for k x k grids over extents x station offsets.
+
+    All geometries are evaluated in one batched call (the geometries play the trial axis).
+    """
+    E, O = np.meshgrid(np.asarray(extents, float), np.asarray(offsets, float), indexing="ij")
+    E, O = E.ravel(), O.ravel()
+    P = np.stack([pattern_points("grid", grid=k, spacing_mm=2 * e / (k - 1)) for e in E])
+    TH = np.stack([ml.design_theta(format_mm / 2 + o) for o in O])
+    sig = {}
+    for m in ("known", "stations"):
+        Q = ml.covariance(P, TH, m)[0]
+        sig[m] = np.sqrt(np.stack([Q[..., 0, 0], Q[..., 1, 1]], -1))
+    d = (pooled_sigma(sig["stations"]) / pooled_sigma(sig["known"]) - 1) * 100
+    return {"half_extent_mm": E, "offset_mm": O, "known_max_ratio": sig["known"].max(axis=(1, 2)),
+            "dil_min_pct": d.min(1), "dil_max_pct": d.max(1)}
+
+
+def alpha_only_extra(pts, theta) -> float:
+    """Largest extra dilution (%) from freeing alpha alone (beta^2 known)."""
+    a = pooled_sigma(analytic_sigma(pts, theta, "alpha"))
+    s = pooled_sigma(analytic_sigma(pts, theta, "stations"))
+    return float(((a / s - 1) * 100).max())
+
