@@ -21,7 +21,7 @@ import numpy as np
 from scipy import special, stats
 
 __all__ = ["mahalanobis2", "ellipse_inside", "chi2_reject", "c4", "affine_trials",
-           "binomial_se"]
+           "binomial_se", "result_inside"]
 
 
 def mahalanobis2(e: np.ndarray, Q: np.ndarray) -> np.ndarray:
@@ -43,6 +43,19 @@ def ellipse_inside(e: np.ndarray, Q: np.ndarray, sigma: float | np.ndarray | Non
     if s0 is not None:
         return m2 / (2 * s0[:, None] ** 2) <= stats.f.ppf(level, 2, dof)
     return m2 / np.asarray(sigma) ** 2 <= stats.chi2.ppf(level, 2)
+
+
+def result_inside(result, truth: np.ndarray, sigma: float | None = None,
+                  level: float = 0.95) -> np.ndarray:
+    """Ellipse coverage of an engine result (:class:`sim.lsq.Result`): whether each adjusted
+    point's error ``result.points - truth`` ``(T, n, 2)`` lies inside its ``level`` ellipse
+    from the result's point cofactors; known ``sigma`` (the units of the points) or, if None,
+    the result's ``sigma0`` and ``dof``."""
+    e = result.points - truth
+    Q = result.point_cofactors()
+    if sigma is None:
+        return ellipse_inside(e, Q, s0=result.sigma0, dof=result.dof, level=level)
+    return ellipse_inside(e, Q, sigma=sigma, level=level)
 
 
 def chi2_reject(s0: np.ndarray, sigma: float, dof: int, alpha: float = 0.05) -> np.ndarray:

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["null_basis", "s_matrix", "s_transform", "inner", "similarity_onto", "corner_indices",
-           "point_sigmas"]
+           "point_sigmas", "result_in_datum"]
 
 
 def null_basis(points: np.ndarray, scale: bool = False) -> np.ndarray:
@@ -84,3 +84,9 @@ def point_sigmas(Q: np.ndarray) -> np.ndarray:
     """Per-point ``(sigma_x, sigma_y)`` from a full ``(..., 2n, 2n)`` cofactor: ``(..., n, 2)``."""
     d = np.sqrt(np.maximum(np.einsum("...ii->...i", Q), 0.0))
     return d.reshape(d.shape[:-1] + (-1, 2))
+
+
+def result_in_datum(result, S: np.ndarray) -> np.ndarray:
+    """Full point cofactor ``(T, 2n, 2n)`` of an engine result (:class:`sim.lsq.Result`,
+    e.g. from :func:`sim.positions.adjust`) moved into the datum of ``S``."""
+    return s_transform(result.full_point_cofactor(), S)

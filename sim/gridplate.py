@@ -19,9 +19,10 @@ Pieces, each batched over a leading trial axis ``T``:
       y_i  - y_a,i                   = v_y,i     weight P_cx
 
   with unknowns ``(A, B, C)`` and the adjusted grid coordinates ``(x_a, y_a)`` of every point
-  (``2N + 3`` unknowns, ``3N`` observations, redundancy ``N - 3``). Gauss-Newton from the
-  observed grid coordinates; each point's 2 x 2 block is eliminated (reduced normal
-  equations), so the largest solve is 3 x 3. ``P_cx = inf`` gives the ordinary affine row.
+  (``2N + 3`` unknowns, ``3N`` observations, redundancy ``N - 3``): the observation model
+  :class:`AffineRowModel` solved by the engine :mod:`sim.lsq` from the observed grid
+  coordinates; each point's 2 x 2 block is eliminated (reduced normal equations), so the
+  largest solve is 3 x 3. ``P_cx = inf`` gives the ordinary affine row.
 
 * :func:`chi2_test` -- the test of the a-posteriori variance of unit weight against its
   a-priori value (two-sided, ``dof * s0^2 / sigma0^2 ~ chi2(dof)``). The paper tests the
@@ -49,7 +50,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-__all__ = ["repeat_precision", "CombinedResult", "combined_adjustment", "chi2_test", "reweight"]
+from . import lsq
+
+__all__ = ["repeat_precision", "CombinedResult", "AffineRowModel", "combined_adjustment",
+           "chi2_test", "reweight"]
 
 
 def repeat_precision(readings: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -94,9 +98,60 @@ class CombinedResult:
     iterations: int
 
 
+class AffineRowModel:
+    """Observation model of the combined adjustment for :mod:`sim.lsq` (seed 001).
+
+    Point blocks: the adjusted grid coordinates ``(x_a, y_a)`` of each point (``d = 2``; none
+    when the grid is fixed). Globals: ``(A, B, C)``. Rows per point: the comparator reading
+    ``x' - (A x_a + B y_a + C)`` (weight ``P_x``) and, for a weighted grid, the grid
+    coordinates ``x - x_a``, ``y - y_a`` (weight ``P_cx``). comp : (T, N); grid : (T, N, 2);
+    p_comp, p_grid : (T,).
+    """
+
+    n_global = 3
+
+    def __init__(self, comp, grid, p_comp, p_grid, fixed_grid: bool):
+        self.comp, self.grid, self.fixed = comp, grid, fixed_grid
+        self.point_dim = 0 if fixed_grid else 2
+        w = [p_comp] if fixed_grid else [p_comp, p_grid, p_grid]
+        self.w = np.stack(w, -1)[:, None, :]               # (T, 1, k)
+
+    def initial_points(self, theta):
+        return self.grid.copy() if not self.fixed else self.grid[..., :0]
+
+    def linearize(self, points, theta, globals_needed=True):
+        u = self.grid if self.fixed else points
+        T, N = self.comp.shape
+        G = np.concatenate([u, np.ones((T, N, 1))], -1)      # d comp / d (A, B, C)
+        r0 = self.comp - np.einsum("tni,ti->tn", G, theta)
+        if self.fixed:
+            return lsq.Linearization(r0[..., None], None, G[:, :, None, :], self.w)
+        r = np.concatenate([r0[..., None], self.grid - u], -1)           # (T, N, 3)
+        Jp = np.zeros((T, N, 3, 2))
+        Jp[:, :, 0, :] = theta[:, None, :2]
+        Jp[:, :, 1, 0] = Jp[:, :, 2, 1] = 1.0
+        Jg = np.zeros((T, N, 3, 3))
+        Jg[:, :, 0, :] = G
+        return lsq.Linearization(r, Jp, Jg, self.w)
+
+
+def _adjust(comp, g, Px, Pc, fixed: bool, max_iter: int, tol: float):
+    """One engine run: the affine row starts at zero, whose first Gauss-Newton step is the
+    ordinary least-squares row on the given grid (the grid enters linearly at A = B = 0)."""
+    m = AffineRowModel(comp, g, Px, Pc, fixed)
+    T = comp.shape[0]
+    res = lsq.gauss_newton(m, np.zeros((T, 3)), m.initial_points(None), tol=tol,
+                           max_iter=max_iter + 1)
+    u = g if fixed else res.points
+    v_comp = res.residuals[..., 0]
+    v_grid = g - u
+    return res, u, v_comp, v_grid
+
+
 def combined_adjustment(comp: np.ndarray, grid: np.ndarray, p_comp=1.0, p_grid=np.inf,
                         max_iter: int = 10, tol: float = 1e-13) -> CombinedResult:
-    """Seed 001's simultaneous adjustment of one comparator coordinate.
+    """Seed 001's simultaneous adjustment of one comparator coordinate, by the engine
+    :func:`sim.lsq.gauss_newton` (each point's 2 x 2 block eliminated; largest solve 3 x 3).
 
     Parameters
     ----------
@@ -104,64 +159,31 @@ def combined_adjustment(comp: np.ndarray, grid: np.ndarray, p_comp=1.0, p_grid=n
     grid : (T, N, 2) or (N, 2) grid-plate coordinates as given (observations).
     p_comp, p_grid : weights ``P_x`` and ``P_cx`` (scalars or (T,)); ``p_grid = inf`` keeps
         the grid fixed (ordinary least squares of one affine row).
-    max_iter, tol : Gauss-Newton stops when the largest parameter change (relative to the
-        parameter scale) is below ``tol``.
+    max_iter, tol : Gauss-Newton stops when the largest correction, relative to the
+        coordinate scale ``max(1, max |grid|)``, is below ``tol``. ``iterations`` counts the
+        steps after the ordinary least-squares start.
     """
     comp = np.asarray(comp, float)
     T, N = comp.shape
     g = np.broadcast_to(np.asarray(grid, float), (T, N, 2)).copy()
-    Px = np.broadcast_to(np.asarray(p_comp, float), (T,))
-    Pc = np.broadcast_to(np.asarray(p_grid, float), (T,))
+    Px = np.broadcast_to(np.asarray(p_comp, float), (T,)).copy()
+    Pc = np.broadcast_to(np.asarray(p_grid, float), (T,)).copy()
     fixed = ~np.isfinite(Pc)
-    Pc_f = np.where(fixed, 0.0, Pc)
-    u = g.copy()                                                    # adjusted grid coords
-    # start: ordinary LS of the affine row
-    G = np.concatenate([g, np.ones((T, N, 1))], -1)
-    p = np.linalg.solve(np.einsum("tni,tnj->tij", G, G),
-                        np.einsum("tni,tn->ti", G, comp)[..., None])[..., 0]
-    it = 0
-    for it in range(1, max_iter + 1):
-        Jp = np.concatenate([u, np.ones((T, N, 1))], -1)            # (T, N, 3)
-        Ju = np.broadcast_to(p[:, None, :2], (T, N, 2))             # (T, N, 2)
-        w1 = comp - np.einsum("tni,ti->tn", Jp, p)                  # comparator misclosure
-        w2 = g - u                                                  # grid misclosure
-        Npp = Px[:, None, None] * np.einsum("tni,tnj->tij", Jp, Jp)
-        Npu = Px[:, None, None, None] * np.einsum("tni,tnj->tnij", Jp, Ju)       # (T,N,3,2)
-        Nuu = (Px[:, None, None, None] * np.einsum("tni,tnj->tnij", Ju, Ju)
-               + Pc_f[:, None, None, None] * np.eye(2))
-        npv = Px[:, None] * np.einsum("tni,tn->ti", Jp, w1)
-        nu = Px[:, None, None] * Ju * w1[..., None] + Pc_f[:, None, None] * w2   # (T,N,2)
-        # grid fixed: no update of u (Nuu would be singular); use a pseudo block
-        Nuu_s = np.where(fixed[:, None, None, None], np.eye(2), Nuu)
-        Nuu_inv = np.linalg.inv(Nuu_s)
-        K = np.einsum("tnij,tnjk->tnik", Npu, Nuu_inv)                           # (T,N,3,2)
-        red = np.where(fixed[:, None, None], 0.0, 1.0)
-        Nbar = Npp - red * np.einsum("tnik,tnjk->tij", K, Npu)
-        nbar = npv - red[..., 0] * np.einsum("tnik,tnk->ti", K, nu)
-        dp = np.linalg.solve(Nbar, nbar[..., None])[..., 0]
-        du = np.einsum("tnij,tnj->tni", Nuu_inv, nu - np.einsum("tnij,ti->tnj", Npu, dp))
-        du = np.where(fixed[:, None, None], 0.0, du)
-        p = p + dp
-        u = u + du
-        scale = np.maximum(np.abs(p), 1.0)
-        if np.max(np.abs(dp) / scale) < tol and np.max(np.abs(du)) < tol * max(1.0, np.abs(u).max()):
-            break
-    Jp = np.concatenate([u, np.ones((T, N, 1))], -1)
-    v_comp = comp - np.einsum("tni,ti->tn", Jp, p)
-    v_grid = g - u
-    Ju = np.broadcast_to(p[:, None, :2], (T, N, 2))
-    Npp = Px[:, None, None] * np.einsum("tni,tnj->tij", Jp, Jp)
-    Npu = Px[:, None, None, None] * np.einsum("tni,tnj->tnij", Jp, Ju)
-    Nuu = (Px[:, None, None, None] * np.einsum("tni,tnj->tnij", Ju, Ju)
-           + Pc_f[:, None, None, None] * np.eye(2))
-    Nuu_inv = np.linalg.inv(np.where(fixed[:, None, None, None], np.eye(2), Nuu))
-    red = np.where(fixed[:, None, None], 0.0, 1.0)
-    Nbar = Npp - red * np.einsum("tnik,tnjk->tij", np.einsum("tnij,tnjk->tnik", Npu, Nuu_inv), Npu)
-    Q = np.linalg.inv(Nbar)
-    dof = N - 3
-    vpv = Px * np.einsum("tn,tn->t", v_comp, v_comp) + Pc_f * np.einsum("tnk,tnk->t", v_grid, v_grid)
-    s0 = np.sqrt(vpv / dof)
-    return CombinedResult(p, u, Q, s0, v_comp, v_grid, dof, it)
+    tol_abs = tol * max(1.0, float(np.abs(g).max()))
+    params, u = np.zeros((T, 3)), g.copy()
+    Q, s0 = np.zeros((T, 3, 3)), np.zeros(T)
+    v_comp, v_grid = np.zeros((T, N)), np.zeros((T, N, 2))
+    iters = 0
+    for is_fixed in (True, False):
+        sel = fixed if is_fixed else ~fixed
+        if not sel.any():
+            continue
+        res, uu, vc, vg = _adjust(comp[sel], g[sel], Px[sel], Pc[sel], is_fixed, max_iter,
+                                  tol_abs)
+        params[sel], u[sel], v_comp[sel], v_grid[sel] = res.theta, uu, vc, vg
+        Q[sel], s0[sel] = res.global_cofactor(), res.sigma0
+        iters = max(iters, int(res.iterations.max()) - 1)
+    return CombinedResult(params, u, Q, s0, v_comp, v_grid, N - 3, iters)
 
 
 def chi2_test(s0: np.ndarray, dof: int, sigma0: float | np.ndarray = 1.0, alpha: float = 0.05):

@@ -116,3 +116,20 @@ def test_p_positions_monte_carlo_matches_analytic(P):
 def test_brown_datum_needs_four_stations():
     with pytest.raises(ValueError, match="4 stations"):
         po.covariance(PTS[None], po.design_theta(6, H)[None], "stations", "brown")
+
+
+def test_result_in_datum_and_coverage_use_the_engine_result():
+    from sim import coverage as cv
+    T = 400
+    rng = np.random.default_rng(21)
+    pts = grid_points(4, 60.0)
+    th = po.design_theta(4, 167.5, 0.5, 1.0)
+    P = np.broadcast_to(pts, (T,) + pts.shape)
+    r = po.ranges(P, np.broadcast_to(th, (T, len(th)))) + rng.normal(0, 1e-3, (T, len(pts), 4))
+    res = po.adjust(r, "known", np.broadcast_to(th, (T, len(th))))
+    S = dm.inner(pts)
+    F = dm.result_in_datum(res, S)
+    ref = dm.s_transform(po.full_point_covariance(res.points, res.theta, "known"), S)
+    assert np.allclose(F, ref, rtol=1e-12, atol=1e-15)
+    inside = cv.result_inside(res, pts, sigma=1e-3).mean()
+    assert abs(inside - 0.95) < 4 * np.sqrt(0.95 * 0.05 / (T * len(pts)))  # points independent
