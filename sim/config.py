@@ -19,7 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-__all__ = ["ConfigError", "StudyError", "Field", "load_study", "parse_override", "validate"]
+__all__ = ["ConfigError", "StudyError", "Field", "load_study", "parse_override", "validate",
+           "check_chunks"]
 
 
 class ConfigError(ValueError):
@@ -209,9 +210,19 @@ def load_study(path: str | Path, overrides: list[str] | tuple = (),
     return study, {"study": name, **cfg}
 
 
+def check_chunks(cfg: Mapping[str, Any]) -> None:
+    """A run needs at least 2 chunks: the Monte-Carlo intervals are delete-one-chunk jackknife
+    intervals, undefined for one chunk. Checked by ``sim run`` (and its sweep cells and the
+    Python API) for every study that has ``trials`` and ``chunk``."""
+    if "trials" in cfg and "chunk" in cfg and cfg["chunk"] >= cfg["trials"]:
+        raise ConfigError("chunk", f"{cfg['chunk']} >= trials ({cfg['trials']}) gives one chunk; "
+                          "the jackknife intervals need at least 2 chunks (make chunk smaller "
+                          "than trials)")
+
+
 COMMON = {
     "trials": Field(1000, "int", "Monte-Carlo trials", lo=2, hi=100_000_000),
-    "seed": Field(20261122, "int", "root seed of numpy.random.SeedSequence", lo=0),
+    "seed": Field(20261122, "int", "root seed of numpy.random.SeedSequence", lo=0, hi=2**63 - 1),
     "chunk": Field(1000, "int", "trials per chunk (each chunk has its own spawned stream)", lo=1,
                    hi=1_000_000),
 }

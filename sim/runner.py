@@ -25,8 +25,11 @@ from __future__ import annotations
 
 import io
 import json
+import os
 import pickle
+import signal
 import sys
+import threading
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,7 +42,7 @@ import pyarrow.parquet as pq
 from .progress import Progress
 from .storage import atomic_path
 
-__all__ = ["chunk_rng", "run_chunks", "ChunkStore", "make_executor", "jackknife"]
+__all__ = ["chunk_rng", "run_chunks", "ChunkStore", "make_executor", "jackknife", "require_finite"]
 
 ROWS = "rows."
 _ARRAYS = b"sim.arrays"
@@ -48,6 +51,22 @@ _ARRAYS = b"sim.arrays"
 def chunk_rng(seed: int, part: int, k: int) -> np.random.Generator:
     """The generator of chunk ``k`` of stream ``part``."""
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(part, k)))
+
+
+def require_finite(name: str, array, part: str, key: str | None = None) -> np.ndarray:
+    """``array`` as a float array, or :class:`sim.config.StudyError` (one line naming the study
+    ``part``, the quantity ``name`` and, when given, the config ``key`` to change) if any entry
+    is NaN or infinite. Study code calls it where a number is required (NaN that stands for
+    "missing" must not go through it)."""
+    from .config import StudyError
+
+    a = np.asarray(array, float)
+    bad = ~np.isfinite(a)
+    if bad.any():
+        hint = f"; change {key}" if key else ""
+        raise StudyError(f"{part}: {name} is not finite ({int(bad.sum())} of {a.size} values "
+                         f"NaN or infinite){hint}")
+    return a
 
 
 def _call_chunk(fn, seed: int, part: int, k: int, n: int) -> dict:
@@ -108,15 +127,43 @@ class _InProcess:
         for k, n in jobs:
             yield k, n, _call_chunk(fn, seed, part, k, n)
 
-    def close(self):
+    def close(self, kill: bool = False):
         pass
 
 
+def _watch_parent(ppid: int) -> None:
+    import time
+
+    while True:
+        if os.getppid() != ppid:
+            os._exit(1)
+        time.sleep(0.5)
+
+
+def _worker_init(ppid: int) -> None:
+    """In each pool worker: ignore SIGINT (the parent handles Ctrl-C and stops the pool) and
+    die with the parent, even after ``kill -9`` (PR_SET_PDEATHSIG on Linux; a thread that
+    watches the parent everywhere)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != ppid:  # the parent died before we got here
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(ppid,), daemon=True).start()
+
+
 class _Pool:
-    """A local process pool (``concurrent.futures``)."""
+    """A local process pool (``concurrent.futures``); its workers die with the parent."""
 
     def __init__(self, workers: int):
-        self.pool = ProcessPoolExecutor(max_workers=workers)
+        self.pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_init,
+                                        initargs=(os.getpid(),))
 
     def run(self, fn, seed, part, jobs):
         futs = {self.pool.submit(_call_chunk, fn, seed, part, k, n): (k, n) for k, n in jobs}
@@ -124,8 +171,18 @@ class _Pool:
             k, n = futs[f]
             yield k, n, f.result()
 
-    def close(self):
-        self.pool.shutdown(cancel_futures=True)
+    def close(self, kill: bool = False):
+        """Stop the pool; ``kill``: terminate running workers at once (interrupt, failure)."""
+        if kill:
+            procs = list((getattr(self.pool, "_processes", None) or {}).values())
+            for p in procs:
+                try:
+                    p.kill()
+                except (OSError, AttributeError):
+                    pass
+            for p in procs:
+                p.join(5)
+        self.pool.shutdown(wait=True, cancel_futures=True)
 
 
 class _Dask:
@@ -140,7 +197,7 @@ class _Dask:
         self._completed = dask_completed
         self.cluster = None
         if scheduler:
-            self.client = Client(scheduler)
+            self.client = Client(scheduler, timeout="10s")
         else:
             self.cluster = LocalCluster(n_workers=max(workers, 1), threads_per_worker=1,
                                         processes=True, dashboard_address=None)
@@ -154,7 +211,7 @@ class _Dask:
             k, n = futs[f]
             yield k, n, f.result()
 
-    def close(self):
+    def close(self, kill: bool = False):
         self.client.close()
         if self.cluster is not None:
             self.cluster.close()
@@ -175,6 +232,19 @@ def _picklable(fn) -> bool:
         return True
     except Exception:  # noqa: BLE001 - any pickling failure means: run in-process
         return False
+
+
+class _Shared:
+    """The run's shared bar, used by one :func:`run_chunks` call (it is not closed here)."""
+
+    def __init__(self, bar):
+        self.bar = bar
+
+    def __enter__(self):
+        return self.bar
+
+    def __exit__(self, *exc):
+        return None
 
 
 def run_chunks(fn: Callable[[np.random.Generator, int], Mapping[str, np.ndarray]], trials: int,
@@ -206,7 +276,9 @@ def run_chunks(fn: Callable[[np.random.Generator, int], Mapping[str, np.ndarray]
                   "cannot be sent to workers)", file=sys.stderr)
         executor = _InProcess()
     done_trials = sum(sizes[k] for k in results)
-    with Progress(trials, label, quiet=quiet, chunks=len(sizes)) as bar:
+    shared = getattr(ctx, "bar", None)
+    with (_Shared(shared) if shared is not None else
+          Progress(trials, label, quiet=quiet, chunks=len(sizes))) as bar:
         bar.update(done_trials, len(results))
         for k, n, out in executor.run(fn, seed, part, todo):
             if store is not None:
@@ -223,7 +295,7 @@ def run_chunks(fn: Callable[[np.random.Generator, int], Mapping[str, np.ndarray]
 def jackknife(stat: Callable[[np.ndarray], np.ndarray], sums: np.ndarray, level: float = 0.95):
     """Delete-one-chunk jackknife for a smooth function of per-chunk sums.
 
-    sums : (C, ...) per-chunk sufficient statistics (C >= 2); ``stat`` maps the total
+    sums : (C, ...) per-chunk sufficient statistics (C >= 2, else StudyError); ``stat`` maps the total
     (shape ``sums.shape[1:]``) to an estimate (scalar or array). Returns
     ``(estimate, lo, hi)`` with a Student-t interval (C - 1 degrees of freedom) from the
     jackknife standard error.
@@ -236,8 +308,10 @@ def jackknife(stat: Callable[[np.ndarray], np.ndarray], sums: np.ndarray, level:
     total = sums.sum(axis=0)
     est = np.asarray(stat(total), float)
     if C < 2:
-        nan = np.full_like(est, np.nan)
-        return est, nan, nan
+        from .config import StudyError
+
+        raise StudyError("the jackknife interval needs at least 2 chunks (make chunk smaller "
+                         "than trials)")
     loo = np.stack([np.asarray(stat(total - sums[c]), float) for c in range(C)])
     se = np.sqrt((C - 1) / C * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
     z = st.t.ppf(0.5 + level / 2, C - 1)

@@ -20,7 +20,8 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-__all__ = ["provenance", "write_table", "read_table", "read_provenance", "atomic_path"]
+__all__ = ["provenance", "write_table", "read_table", "read_provenance", "atomic_path",
+           "read_record", "StageLock", "NonFiniteError"]
 
 _KEY = b"sim.provenance"
 from .codehash import NOT_STUDY_CODE  # library files no study result depends on
@@ -79,7 +80,7 @@ def versions() -> dict[str, str]:
     from importlib.metadata import PackageNotFoundError, version
 
     out = {"python": sys.version.split()[0]}
-    for pkg in ("numpy", "scipy", "pyarrow", "matplotlib", "emcee", "numba"):
+    for pkg in ("numpy", "scipy", "pyarrow", "matplotlib", "emcee", "numba", "tqdm"):
         try:
             out[pkg] = version(pkg)
         except PackageNotFoundError:
@@ -122,11 +123,40 @@ class atomic_path:
             self.tmp.unlink(missing_ok=True)
 
 
+class NonFiniteError(ValueError):
+    """A statistic that must be a number is NaN or infinite (one line naming the table and
+    column)."""
+
+
+#: columns of a claims table that must hold finite numbers (a NaN reference is "no number")
+CLAIM_NUMBERS = ("value", "ci_low", "ci_high")
+
+
+def check_finite_table(name: str, table: pa.Table) -> None:
+    """No float column may hold +-inf (NaN may mean "missing"), and a claims table's value and
+    interval must be finite: a non-finite verdict is an error, never a result."""
+    is_claims = {"claim", *CLAIM_NUMBERS} <= set(table.column_names)
+    for col, arr in zip(table.column_names, table.columns):
+        if not pa.types.is_floating(arr.type):
+            continue
+        v = arr.to_numpy(zero_copy_only=False).astype(float)
+        bad = np.isinf(v) | (np.isnan(v) if is_claims and col in CLAIM_NUMBERS else False)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            what = f" (claim {table.column('claim')[i].as_py()})" if is_claims else f" (row {i})"
+            raise NonFiniteError(f"{name}: column {col} is {v[i]}{what}: a statistic that must "
+                                 "be a number is not finite")
+
+
 def write_table(path: str | Path, columns: Mapping[str, Any] | pa.Table,
                 prov: Mapping[str, Any]) -> Path:
-    """Write ``columns`` (name -> 1-D array/list, or a pyarrow Table) to Parquet."""
+    """Write ``columns`` (name -> 1-D array/list, or a pyarrow Table) to Parquet.
+
+    Raises :class:`NonFiniteError` (nothing written) for an infinite value in a float column
+    or a non-finite claim value or interval (see :func:`check_finite_table`)."""
     table = columns if isinstance(columns, pa.Table) else pa.table(
         {k: (np.asarray(v) if not isinstance(v, list) else v) for k, v in columns.items()})
+    check_finite_table(Path(path).name, table)
     meta = dict(table.schema.metadata or {})
     meta[_KEY] = json.dumps(prov, sort_keys=True, default=_jsonable).encode()
     table = table.replace_schema_metadata(meta)
@@ -142,3 +172,77 @@ def read_table(path: str | Path) -> pa.Table:
 def read_provenance(path: str | Path) -> dict[str, Any]:
     meta = pq.read_schema(path).metadata or {}
     return json.loads(meta.get(_KEY, b"{}"))
+
+
+# --- the output directory: what the suite wrote, and who is writing it -----------------------
+
+RECORD = "run.json"
+LOCK = ".lock"
+
+
+def read_record(d: str | Path) -> dict | None:
+    """The run record (``run.json``) of a directory the suite wrote, or None (none, or not one
+    of ours)."""
+    try:
+        rec = json.loads((Path(d) / RECORD).read_text())
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+    return rec if isinstance(rec, dict) and "config" in rec and "code_hash" in rec else None
+
+
+def write_record(d: str | Path, record: Mapping[str, Any]) -> None:
+    """Write ``run.json`` atomically."""
+    with atomic_path(Path(d) / RECORD) as tmp:
+        tmp.write_text(json.dumps(record, sort_keys=True, indent=1, default=_jsonable))
+
+
+class Locked(RuntimeError):
+    """Another live process holds the lock; ``pid`` is its process id (or None)."""
+
+    def __init__(self, pid: int | None):
+        self.pid = pid
+        super().__init__(f"locked by pid {pid}")
+
+
+class StageLock:
+    """An exclusive ``flock`` on ``<stage>/.lock`` for the life of a run.
+
+    The kernel drops the lock when the process dies (even ``kill -9``), so a stale lock file
+    never blocks a later run. The holder's pid is written into the file for the message a
+    second run prints.
+    """
+
+    def __init__(self, stage: str | Path):
+        self.stage = Path(stage)
+        self.fd: int | None = None
+        self.created = False
+
+    def acquire(self) -> "StageLock":
+        import fcntl
+
+        self.created = not self.stage.exists()
+        self.stage.mkdir(parents=True, exist_ok=True)
+        fd = os.open(self.stage / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            try:
+                pid = int(os.read(fd, 32).decode().strip() or 0) or None
+            except (OSError, ValueError):
+                pid = None
+            os.close(fd)
+            raise Locked(pid) from None
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+        self.fd = fd
+        return self
+
+    def release(self, unlink: Path | None = None) -> None:
+        """Drop the lock; ``unlink``: the lock file's current path, removed first (a finished
+        run's lock file must not stay in its results)."""
+        if self.fd is None:
+            return
+        if unlink is not None:
+            (Path(unlink) / LOCK).unlink(missing_ok=True)
+        os.close(self.fd)  # closing the descriptor releases the flock
+        self.fd = None

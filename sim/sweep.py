@@ -39,7 +39,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from .config import ConfigError, _flatten, read_toml, validate
+from .config import ConfigError, StudyError, check_chunks, read_toml, validate
 from .progress import Progress
 from .runner import chunk_rng
 
@@ -48,6 +48,20 @@ __all__ = ["SWEEP_KEY", "read_sweep", "expand", "cell_seed", "cell_label", "run_
 
 SWEEP_KEY = 0x5EE9  # spawn-key tag of the sweep's seed streams
 RESERVED = ("replicates", "seed_mode")
+MAX_CELLS = 10_000  # cells x replicates of one sweep (sim.estimate uses the same bound)
+
+
+def _flatten_sweep(d: Mapping, prefix: str = "") -> dict[str, Any]:
+    """Flatten nested tables to dotted keys, keeping range tables ``{start, stop, ...}`` whole
+    (``errors.settings = {start = 1, stop = 2, num = 2}`` is the range of one key)."""
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, dict) and not _is_range(v):
+            out.update(_flatten_sweep(v, key + "."))
+        else:
+            out[key] = v
+    return out
 
 
 def read_sweep(path: str | Path, schema: Mapping | None = None) -> dict[str, Any]:
@@ -57,13 +71,9 @@ def read_sweep(path: str | Path, schema: Mapping | None = None) -> dict[str, Any
     sw = doc.get("sweep", {})
     if not isinstance(sw, dict):
         raise ConfigError("sweep", "must be a table")
-    flat: dict[str, Any] = {}
-    for k, v in sw.items():
-        if isinstance(v, dict) and not _is_range(v):
-            for kk, vv in _flatten(v, k + ".").items():
-                flat[kk] = vv
-        else:
-            flat[k] = v
+    flat = _flatten_sweep(sw)
+    if "sweep" in doc and not flat:
+        raise ConfigError("sweep", "is empty: give at least one key to sweep")
     if flat and schema is not None:
         expand(flat, schema)
     return flat
@@ -73,29 +83,48 @@ def _is_range(v: Any) -> bool:
     return isinstance(v, dict) and "start" in v and "stop" in v
 
 
+def _finite(key: str, name: str, x: Any) -> float:
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+        raise ConfigError(f"sweep.{key}", f"{name} must be a finite number (got {x!r})")
+    return x
+
+
 def _values(key: str, v: Any) -> list:
     if isinstance(v, list):
         if not v:
             raise ConfigError(f"sweep.{key}", "needs at least one value")
+        if len(v) > MAX_CELLS:
+            raise ConfigError(f"sweep.{key}", f"has {len(v)} values (at most {MAX_CELLS})")
         return v
+    if isinstance(v, dict) and not _is_range(v):
+        raise ConfigError(f"sweep.{key}", "a range needs start and stop")
     if _is_range(v):
         extra = set(v) - {"start", "stop", "num", "step"}
         if extra:
             raise ConfigError(f"sweep.{key}", f"unknown range entries {sorted(extra)}")
-        a, b = v["start"], v["stop"]
+        a, b = _finite(key, "start", v["start"]), _finite(key, "stop", v["stop"])
+        if "num" in v and "step" in v:
+            raise ConfigError(f"sweep.{key}", "give num or step, not both")
         if "num" in v:
             n = v["num"]
-            if not isinstance(n, int) or n < 1:
-                raise ConfigError(f"sweep.{key}", "num must be a positive integer")
+            if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_CELLS:
+                raise ConfigError(f"sweep.{key}", f"num must be an integer from 1 to {MAX_CELLS} "
+                                  f"(got {n!r})")
             out = np.linspace(a, b, n)
         elif "step" in v:
-            s = v["step"]
-            if not isinstance(s, (int, float)) or s == 0 or (b - a) / s < 0:
+            s = _finite(key, "step", v["step"])
+            if s == 0 or (b - a) / s < 0:
                 raise ConfigError(f"sweep.{key}", "step must be non-zero and point from start to stop")
-            k = int(math.floor((b - a) / s + 1e-9))
+            count = (b - a) / s
+            if not count < MAX_CELLS:
+                raise ConfigError(f"sweep.{key}", f"step {s!r} gives more than {MAX_CELLS} values "
+                                  f"from {a!r} to {b!r}")
+            k = int(math.floor(count + 1e-9))
             out = a + s * np.arange(k + 1)
         else:
             raise ConfigError(f"sweep.{key}", "a range needs num or step")
+        if not np.isfinite(out).all():
+            raise ConfigError(f"sweep.{key}", "the range's values are not finite")
         if all(isinstance(x, int) for x in (a, b, v.get("step", 0))) and "num" not in v:
             return [int(x) for x in out]
         return [float(x) for x in out]
@@ -104,10 +133,12 @@ def _values(key: str, v: Any) -> list:
 
 def expand(table: Mapping[str, Any], schema: Mapping | None = None):
     """Cells of a sweep table: ``(keys, cells, replicates, seed_mode)``, ``cells`` a list of
-    ``{key: value}`` dicts in Cartesian-product order."""
+    ``{key: value}`` dicts in Cartesian-product order. At most :data:`MAX_CELLS` cells times
+    replicates."""
     reps = table.get("replicates", 1)
-    if not isinstance(reps, int) or isinstance(reps, bool) or reps < 1:
-        raise ConfigError("sweep.replicates", f"must be a positive integer (got {reps!r})")
+    if not isinstance(reps, int) or isinstance(reps, bool) or not 1 <= reps <= MAX_CELLS:
+        raise ConfigError("sweep.replicates", f"must be an integer from 1 to {MAX_CELLS} "
+                          f"(got {reps!r})")
     mode = table.get("seed_mode", "spawn")
     if mode not in ("spawn", "common"):
         raise ConfigError("sweep.seed_mode", f"must be spawn or common (got {mode!r})")
@@ -118,6 +149,9 @@ def expand(table: Mapping[str, Any], schema: Mapping | None = None):
         if schema is not None and k not in schema:
             raise ConfigError(f"sweep.{k}", "unknown key")
     vals = [_values(k, table[k]) for k in keys]
+    total = math.prod(len(v) for v in vals) * reps
+    if total > MAX_CELLS:
+        raise ConfigError("sweep", f"{total:,} cells x replicates (at most {MAX_CELLS:,})")
     cells = [dict(zip(keys, combo)) for combo in itertools.product(*vals)]
     return keys, cells, reps, mode
 
@@ -153,6 +187,7 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
             try:
                 ccfg = {"study": cfg["study"], **validate({**base, **cell, "seed": seed},
                                                           study.schema, study.check)}
+                check_chunks(ccfg)
             except ConfigError as e:
                 row.update(feasible=False, reason=str(e))
                 rows.append(row)
@@ -161,7 +196,8 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
             d.mkdir(parents=True, exist_ok=True)
             cctx = ctx
             if getattr(ctx, "store", None) is not None:  # each cell its own chunk store
-                cctx = dataclasses.replace(ctx, store=type(ctx.store)(d / "trials"))
+                cctx = dataclasses.replace(ctx, store=type(ctx.store)(
+                    d / "trials", provenance(ccfg, sweep_cell=row["label"], sweep=dict(table))))
             try:
                 study.run(ccfg, d, cctx)
             except (KeyboardInterrupt, SystemExit):
@@ -176,6 +212,10 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
                     row[c["claim"] + ":lo"] = c["ci_low"]
                     row[c["claim"] + ":hi"] = c["ci_high"]
             rows.append(row)
+    if rows and not any(r["feasible"] for r in rows):
+        reasons = list(dict.fromkeys(r["reason"] for r in rows))
+        raise StudyError(f"sweep: every cell failed ({len(rows)} of {len(rows)}): "
+                         + "; ".join(reasons[:3])[:500] + (" ..." if len(reasons) > 3 else ""))
     cols: dict[str, list] = {}
     names = list(dict.fromkeys(k for row in rows for k in row))
     for k in names:

@@ -21,7 +21,7 @@ def write(tmp_path, text, name="study.toml"):
     return p
 
 
-BASE = 'study = "brown_table1"\ntrials = 20\n'
+BASE = 'study = "brown_table1"\ntrials = 20\nchunk = 10\n'
 
 
 @pytest.mark.parametrize("body, key", [
@@ -139,3 +139,124 @@ def test_python_dash_m_entry_point(tmp_path):
     r = subprocess.run([sys.executable, "-m", "sim", "check", str(BROWN)], capture_output=True,
                        text=True, cwd=ROOT)
     assert r.returncode == 0 and "plate.spacing_mm = 45.0" in r.stdout
+
+
+# --- nothing the suite did not write is replaced; one-line option errors -------------------
+
+def _run(tmp_path, out, *extra):
+    p = write(tmp_path, BASE, "ok.toml")
+    return main(["run", str(p), "--out", str(out), "--quiet", *extra])
+
+
+@pytest.mark.parametrize("overwrite", [[], ["--overwrite"]])
+def test_a_file_or_a_foreign_directory_is_never_replaced(tmp_path, capsys, overwrite):
+    f = tmp_path / "notes.txt"
+    f.write_text("mine")
+    d = tmp_path / "mine"
+    d.mkdir()
+    (d / "a.txt").write_text("mine too")
+    for out, needle in ((f, "is a file"), (d, "no sim run record")):
+        assert _run(tmp_path, out, *overwrite) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and needle in err[0]
+    assert f.read_text() == "mine" and (d / "a.txt").read_text() == "mine too"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine", "notes.txt", "ok.toml"]
+
+
+def test_a_symlink_and_a_foreign_staging_directory_are_never_replaced(tmp_path, capsys):
+    target = tmp_path / "target"
+    target.mkdir()
+    (target / "keep").write_text("x")
+    (tmp_path / "link").symlink_to(target)
+    assert _run(tmp_path, tmp_path / "link", "--overwrite") == 2
+    stage = tmp_path / ".res.partial"
+    stage.mkdir()
+    (stage / "keep").write_text("y")
+    assert _run(tmp_path, tmp_path / "res", "--overwrite") == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and "symbolic link" in err[0] and "no sim run record" in err[1]
+    assert (target / "keep").read_text() == "x" and (stage / "keep").read_text() == "y"
+
+
+def test_an_empty_directory_and_our_own_results_are_replaced(tmp_path):
+    out = tmp_path / "res"
+    out.mkdir()
+    assert _run(tmp_path, out) == 0
+    assert (out / "run.json").is_file() and not (out / ".lock").exists()
+    assert _run(tmp_path, out, "--seed", "3", "--overwrite") == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.toml", "res"]
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["--out", ""], "--out: is empty"),
+    (["--trials", "2.5"], "invalid int value: '2.5'"),
+    (["--workers", "0"], "--workers"),
+    (["--scheduler", "not an address", "--executor", "dask"], "--scheduler"),
+    (["--scheduler", "tcp://127.0.0.1:8786"], "needs --executor dask"),
+    (["--trials", "20", "--set", "chunk=20"], "at least 2 chunks"),
+    (["--max-memory-gb", "nan"], "--max-memory-gb"),
+    (["--bogus"], "unrecognized arguments"),
+])
+def test_option_errors_are_one_line(tmp_path, capsys, args, needle):
+    p = write(tmp_path, BASE, "ok.toml")
+    argv = ["run", str(p), "--quiet", *args]
+    if "--out" not in args:
+        argv += ["--out", str(tmp_path / "o")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.toml"]
+
+
+def test_a_live_lock_stops_a_second_run_and_overwrite(tmp_path, capsys):
+    """A run holding the staging directory's lock: a second run into the same --out, with or
+    without --overwrite, stops at once naming the holder, and removes nothing."""
+    import os
+
+    from sim.storage import StageLock
+
+    out = tmp_path / "res"
+    stage = tmp_path / ".res.partial"
+    lock = StageLock(stage).acquire()
+    (stage / "trials").mkdir()
+    (stage / "trials" / "half-written").write_text("x")
+    try:
+        for extra in ([], ["--overwrite"]):
+            assert _run(tmp_path, out, *extra) == 2
+            err = capsys.readouterr().err.strip().splitlines()
+            assert len(err) == 1 and f"pid {os.getpid()}" in err[0] and "running sim" in err[0]
+        assert (stage / "trials" / "half-written").is_file() and not out.exists()
+    finally:
+        lock.release()
+    assert _run(tmp_path, out) == 0 and (out / "claims.parquet").is_file()
+
+
+def test_a_failed_run_says_where_and_does_not_block_the_corrected_command(tmp_path, capsys,
+                                                                          monkeypatch):
+    import dataclasses
+
+    import sim.studies as studies
+
+    real = studies.get_study
+
+    def failing(name):
+        st = real(name)
+
+        def run(cfg, out, ctx):
+            from sim.runner import ChunkStore
+
+            ChunkStore(out / "trials").save(0, 0, 2, {"x": np.zeros(2)})  # one finished chunk
+            if cfg["errors.settings"] == 2:
+                raise np.linalg.LinAlgError("SVD did not converge")
+            return st.run(cfg, out, ctx)
+        return dataclasses.replace(st, run=run)
+
+    monkeypatch.setattr(studies, "get_study", failing)
+    out = tmp_path / "res"
+    assert _run(tmp_path, out, "--set", "errors.settings=2") == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "LinAlgError: SVD did not converge" in err[0], err
+    assert (tmp_path / ".res.partial" / "run.json").is_file()    # kept: it holds a chunk
+    monkeypatch.setattr(studies, "get_study", real)
+    assert _run(tmp_path, out, "--set", "errors.settings=3") == 0   # corrected: replaces it
+    assert not (tmp_path / ".res.partial").exists()

@@ -14,7 +14,7 @@ from sim.sweep import cell_seed, expand, run_adaptive
 TABLE1 = """study = "brown_table1"
 trials = {trials}
 seed = 77
-chunk = 20
+chunk = 10
 """
 
 

@@ -147,7 +147,8 @@ def test_full_disk_is_one_line_and_no_result(tmp_path, capsys, monkeypatch):
 
     monkeypatch.setattr(runner.pq, "write_table", full)
     out = tmp_path / "o"
-    assert main(["run", str(STUDY), "--out", str(out), "--trials", "20", "--quiet"]) == 2
+    assert main(["run", str(STUDY), "--out", str(out), "--trials", "20", "--quiet",
+                 "--set", "chunk=10"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "No space left" in err[0]
     assert not out.exists()

@@ -112,7 +112,7 @@ def test_study_runs_small(tmp_path):
     from sim.storage import read_table
 
     out = tmp_path / "ss"
-    rc = main(["run", str(ROOT / "studies/salsig_encoders.toml"), "--trials", "60", "--quiet",
+    rc = main(["run", str(ROOT / "studies/salsig_encoders.toml"), "--trials", "60", "--quiet", "--set", "chunk=30",
                "--set", "power.trials=20", "--set", "power.marks=[3, 5]",
                "--set", "power.sigma_um=[5.0, 25.0]", "--set", "vertical.relief_sweep_mm=[2.0]",
                "--out", str(out)])

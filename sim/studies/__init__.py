@@ -7,7 +7,8 @@ of ``results/REPORT.md`` built from those files alone.
 from __future__ import annotations
 
 import importlib
-from dataclasses import dataclass
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Mapping
 
@@ -31,11 +32,31 @@ MODULES = {
 class RunContext:
     """What a study's ``run`` gets besides its config: pass it to
     :func:`sim.runner.run_chunks` (``ctx=ctx``) so chunks use the chosen executor and are
-    stored for resumption."""
+    stored for resumption, and share the run's one progress bar."""
 
     quiet: bool = False
     executor: object = None   # from sim.runner.make_executor; None = in-process
     store: object = None      # sim.runner.ChunkStore of the run's staging directory
+    estimate: object = None   # sim.estimate.Estimate of the run (the progress bar's total)
+    bars: list = field(default_factory=list, compare=False)  # the open shared bar, if any
+
+    @property
+    def bar(self):
+        """The run's shared progress bar while :meth:`progress_bar` is open, else None."""
+        return self.bars[-1] if self.bars else None
+
+    @contextmanager
+    def progress_bar(self, label: str):
+        """One bar for the whole run; its total is the estimate's trial count."""
+        from ..progress import Progress
+
+        total = getattr(self.estimate, "trials", 0) or 0
+        with Progress(total, label, quiet=self.quiet) as p:
+            self.bars.append(p)
+            try:
+                yield p
+            finally:
+                self.bars.remove(p)
 
 
 @dataclass(frozen=True)
