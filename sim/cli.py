@@ -249,8 +249,8 @@ def _run(args) -> int:
     check_limits(est, args.max_memory_gb, args.max_adjustments, args.workers)
     from .storage import code_hash
 
-    record = {"config": {**cfg, "sweep": sweep} if sweep else cfg, "code_hash": code_hash(cfg["study"]),
-              "versions": versions()}
+    record = {"config": {**cfg, "sweep": sweep} if sweep else cfg,
+              "code_hash": code_hash(cfg["study"]), "versions": versions()}
     _check_out(out, shown, record, args.overwrite)
     stage = out.parent / f".{out.name}.partial"
     try:
