@@ -20,6 +20,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import special, stats
 
+from .lsq.linear import lstsq
+
 __all__ = ["mahalanobis2", "ellipse_inside", "chi2_reject", "c4", "affine_trials",
            "binomial_se", "result_inside"]
 
@@ -87,12 +89,11 @@ def affine_trials(rng: np.random.Generator, T: int, grid: np.ndarray, sigma_um: 
     truth = G @ M.T                                         # (n, 2) mm
     noise = rng.normal(0.0, sigma_um, size=(T, n, 2))       # um
     obs = truth[None] + noise * 1e-3
-    Ginv = np.linalg.pinv(G)                                # (3, n)
-    p = np.einsum("kn,tnc->tkc", Ginv, obs)                 # (T, 3, 2)
+    f = lstsq(G, obs)                                       # shared design: factorised once
+    p = f.x                                                 # (T, 3, 2)
     fit = np.einsum("nk,tkc->tnc", G, p)
-    res = (obs - fit) * 1e3
     dof = 2 * n - 6
-    s0 = np.sqrt(np.einsum("tnc,tnc->t", res, res) / dof)
-    lev = np.einsum("nk,kn->n", G, Ginv)                    # diag of the hat matrix
+    s0 = f.s0 * 1e3
+    lev = np.einsum("nk,kl,nl->n", G, f.cofactor()[0], G)  # diag of the hat matrix
     return {"err_um": (fit - truth[None]) * 1e3, "leverage": lev, "s0_um": s0, "dof": dof,
             "param_err": p - M.T[None]}

@@ -47,28 +47,15 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import sparse
 
-__all__ = ["rotation", "rodrigues", "similarity_fit", "form_models", "random_similarities",
+from .geometry import rotation, similarity_fit
+
+__all__ = ["rodrigues", "form_models", "random_similarities",
            "to_model_frame", "BlockStructure", "AdjustResult", "adjust_block", "snoop",
            "residual_cofactors", "normal_step", "chol_solve", "pointing_errors",
            "initial_values", "point_cofactors", "SPARSE_FROM_MODELS"]
 
 
 # --------------------------------------------------------------------------- similarity
-def rotation(omega: np.ndarray, phi: np.ndarray, kappa: np.ndarray) -> np.ndarray:
-    """Rotation ``R = R_x(omega) R_y(phi) R_z(kappa)`` (radians), shape ``(..., 3, 3)``."""
-    co, so = np.cos(omega), np.sin(omega)
-    cp, sp = np.cos(phi), np.sin(phi)
-    ck, sk = np.cos(kappa), np.sin(kappa)
-    one, zero = np.ones_like(co), np.zeros_like(co)
-    Rx = np.stack([np.stack([one, zero, zero], -1), np.stack([zero, co, -so], -1),
-                   np.stack([zero, so, co], -1)], -2)
-    Ry = np.stack([np.stack([cp, zero, sp], -1), np.stack([zero, one, zero], -1),
-                   np.stack([-sp, zero, cp], -1)], -2)
-    Rz = np.stack([np.stack([ck, -sk, zero], -1), np.stack([sk, ck, zero], -1),
-                   np.stack([zero, zero, one], -1)], -2)
-    return Rx @ Ry @ Rz
-
-
 def _skew(v: np.ndarray) -> np.ndarray:
     z = np.zeros_like(v[..., 0])
     return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1),
@@ -85,32 +72,6 @@ def rodrigues(theta: np.ndarray) -> np.ndarray:
     s = np.where(small, 1.0, np.sin(a_) / a_)
     c = np.where(small, 0.5, (1 - np.cos(a_)) / a_ ** 2)
     return np.eye(3) + s * K + c * (K @ K)
-
-
-def similarity_fit(src: np.ndarray, dst: np.ndarray, w: np.ndarray | None = None):
-    """Least-squares 3-D similarity ``dst ~ s R src + t`` (Umeyama / Horn), batched.
-
-    src, dst : (..., n, 3); w : (..., n) non-negative point weights (isotropic).
-    Returns ``s (...), R (..., 3, 3), t (..., 3)``. This closed form is the least-squares
-    solution when every point has the same weight in X, Y and Z.
-    """
-    if w is None:
-        w = np.ones(src.shape[:-1])
-    w = w / w.sum(axis=-1, keepdims=True)
-    ms = np.einsum("...n,...nc->...c", w, src)
-    md = np.einsum("...n,...nc->...c", w, dst)
-    a = src - ms[..., None, :]
-    b = dst - md[..., None, :]
-    C = np.einsum("...n,...ni,...nj->...ij", w, b, a)
-    U, S, Vt = np.linalg.svd(C)
-    d = np.sign(np.linalg.det(U @ Vt))
-    D = np.ones(S.shape)
-    D[..., 2] = d
-    R = U @ (D[..., :, None] * Vt)
-    var = np.einsum("...n,...nc,...nc->...", w, a, a)
-    s = np.einsum("...i,...i->...", S, D) / var
-    t = md - s[..., None] * np.einsum("...ij,...j->...i", R, ms)
-    return s, R, t
 
 
 # ------------------------------------------------------------------ model simulation
@@ -218,7 +179,8 @@ def initial_values(st: "BlockStructure", xm: np.ndarray, X_approx: np.ndarray):
     t = np.empty((T, M, 3))
     for m in range(M):  # a handful of models, each fit batched over trials
         k = st.obs_model == m
-        s[:, m], R[:, m], t[:, m] = similarity_fit(xm[:, k], X_approx[:, st.obs_point[k]])
+        f = similarity_fit(xm[:, k], X_approx[:, st.obs_point[k]])
+        s[:, m], R[:, m], t[:, m] = f.scale, f.R, f.t
     return s, R, t
 
 

@@ -29,9 +29,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .lsq.linear import lstsq
+
 __all__ = ["WOLF_TERMS", "poly_terms", "design", "PolyFit", "fit_poly", "fit_wolf", "apply_poly",
            "two_point_transform", "TwoPoint", "apply_two_point",
-           "discrepancy_stats", "lstsq_batched"]
+           "discrepancy_stats"]
 
 #: exponents (i, j) of X^i Y^j for the paper's A1 ... A10 (and B1 ... B10), in its order
 WOLF_TERMS = ((0, 0), (1, 0), (2, 0), (0, 1), (0, 2), (1, 1), (2, 1), (1, 2), (3, 0), (0, 3))
@@ -65,28 +67,6 @@ def design(pts: np.ndarray, terms, norm_mm: float = 100.0) -> np.ndarray:
     return np.stack([px[i] * py[j] for i, j in terms], axis=-1)
 
 
-def lstsq_batched(A: np.ndarray, b: np.ndarray, rcond: float = 1e-12):
-    """Least squares ``min |A c - b|`` for a batch: ``A (T, m, p)``, ``b (T, m, k)``.
-
-    Solved through a thin QR of each ``A`` (no normal equations). Returns ``c (T, p, k)`` and
-    ``ok (T,)``, False where ``A`` is rank deficient (relative diagonal of R below ``rcond``);
-    such solutions are NaN.
-    """
-    A = np.asarray(A, float)
-    b = np.asarray(b, float)
-    T, m, p = A.shape
-    if m < p:
-        return np.full((T, p, b.shape[-1]), np.nan), np.zeros(T, bool)
-    q, r = np.linalg.qr(A)
-    d = np.abs(np.diagonal(r, axis1=-2, axis2=-1))
-    ok = d.min(axis=-1) > rcond * np.maximum(d.max(axis=-1), 1e-300)
-    rhs = np.matmul(q.transpose(0, 2, 1), b)
-    c = np.full((T, p, b.shape[-1]), np.nan)
-    if ok.any():
-        c[ok] = np.linalg.solve(r[ok], rhs[ok])
-    return c, ok
-
-
 @dataclass(frozen=True)
 class PolyFit:
     """A fitted correction polynomial per axis.
@@ -95,7 +75,7 @@ class PolyFit:
         normalised monomials; NaN where the fit was not estimable.
     terms : the exponents of the ``p`` monomials.
     norm_mm : coordinate normalisation.
-    ok : ``(T,)`` the fit was estimable (enough distinct points).
+    ok : ``(T,)`` the fit was estimable (the scaled singularity rule of :mod:`sim.lsq.linear`).
     rms_mm : ``(T, 2)`` rms residual per axis on the fitting data.
     """
 
@@ -131,11 +111,10 @@ def fit_poly(measured: np.ndarray, true: np.ndarray, degree: int | None = 3, ter
     measured = np.asarray(measured, float)
     true = np.broadcast_to(np.asarray(true, float), measured.shape)
     terms = tuple(terms) if terms is not None else poly_terms(degree)
-    A = design(measured, terms, norm_mm)
-    c, ok = lstsq_batched(A, true - measured)
-    res = true - measured - np.matmul(A, c)
-    rms = np.sqrt(np.mean(res ** 2, axis=1))
-    return PolyFit(c, terms, float(norm_mm), ok, rms)
+    A = design(measured, terms, norm_mm)                  # (T, n, p): one R0 for all trials
+    f = lstsq(A, true - measured)
+    rms = np.sqrt(np.mean(f.residuals ** 2, axis=1))
+    return PolyFit(f.x, terms, float(norm_mm), f.ok, rms)
 
 
 def fit_wolf(measured: np.ndarray, true: np.ndarray, norm_mm: float = 100.0) -> PolyFit:

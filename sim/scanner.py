@@ -31,6 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.polynomial import legendre
 
+from .lsq.linear import lstsq
+
 __all__ = ["ScannerField", "random_field", "evaluate", "scan_grid", "interpolate",
            "fiducial_affine", "corner_fiducials", "image_errors", "pixel_um", "DEGREES"]
 
@@ -137,10 +139,13 @@ def fiducial_affine(err_fid: np.ndarray, fid_mm: np.ndarray) -> np.ndarray:
     part of the fiducials' errors. To first order in the errors (um against mm) the error
     left at a point ``x`` is ``e(x) - [1, x, y] beta`` with ``beta`` the least-squares affine
     fit to the fiducial errors. err_fid : (..., F, 2) errors at the F fiducials (um);
-    fid_mm : (F, 2). Returns ``beta`` (..., 3, 2) (um, um/mm).
+    fid_mm : (F, 2). Returns ``beta`` (..., 3, 2) (um, um/mm): the library's one linear
+    routine, the fiducial design factorised once for every trial and photo.
     """
-    A = np.column_stack([np.ones(len(fid_mm)), fid_mm])              # (F, 3)
-    return np.einsum("kf,...fc->...kc", np.linalg.pinv(A), err_fid)
+    A = np.column_stack([np.ones(len(fid_mm)), fid_mm])              # (F, 3), shared
+    e = np.asarray(err_fid, float)
+    f = lstsq(A, e.reshape((-1,) + e.shape[-2:]))
+    return f.x.reshape(e.shape[:-2] + (3, 2))
 
 
 def corner_fiducials(offset_mm: float) -> np.ndarray:

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from sim import independent_models as im
+from sim.geometry import similarity_fit
 from sim import scanner as sc
 from sim.block_layout import CONTROL_PATTERNS, make_block, select_control
 from sim.config import ConfigError, load_study
@@ -140,7 +141,8 @@ def test_all_control_reproduces_each_model_similarity(small):
                           t0, X0, tol_m=1e-10)
     for m in range(small.n_models):
         k = small.obs_model == m
-        s, R, t = im.similarity_fit(xm[:, k], ctrl_xyz[:, small.obs_point[k]])
+        f = similarity_fit(xm[:, k], ctrl_xyz[:, small.obs_point[k]])
+        s, R, t = f.scale, f.R, f.t
         assert np.allclose(res.s[:, m], s, rtol=1e-6)
         assert np.allclose(res.R[:, m], R, atol=1e-6)
         assert np.allclose(res.t[:, m], t, atol=1e-3)
@@ -204,7 +206,8 @@ def test_similarity_fit_recovers_transform():
     src = rng.normal(0, 100, (3, 12, 3))
     s, R, t = im.random_similarities(rng, (3,))
     dst = s[:, None, None] * np.einsum("tij,tnj->tni", R, src) + t[:, None]
-    s2, R2, t2 = im.similarity_fit(src, dst)
+    f = similarity_fit(src, dst)
+    s2, R2, t2 = f.scale, f.R, f.t
     assert np.allclose(s2, s) and np.allclose(R2, R) and np.allclose(t2, t)
 
 
