@@ -5,16 +5,18 @@
 * :mod:`sim.lsq.normals` -- the shared numerics: the one scaled singularity rule, the
   Schur-complement elimination of the point blocks, the bordered (datum) solve;
 * :mod:`sim.lsq.gauss_newton` -- the one Gauss-Newton loop, per-trial status and message;
-* :mod:`sim.lsq.result` -- the one result object and its cofactor accessors.
-
-The linear one-step case (affine, similarity, polynomial fits; one factorisation when the
-design matrix is shared by all trials) is reserved as :mod:`sim.lsq.linear`.
+* :mod:`sim.lsq.result` -- the one result object and its cofactor accessors;
+* :mod:`sim.lsq.linear` -- the linear one-step case (affine, similarity, polynomial and line
+  fits): the one linear least-squares routine, one factorisation when the design matrix is
+  shared by all trials, the same scaled singularity rule and per-trial status.
 Seed of the method: Brown 1968 (``004_f5bd9e86c308241f.txt``).
 """
 from .gauss_newton import degrees_of_freedom, gauss_newton
+from .linear import LINEAR_STATUS, LinearFit, lstsq
 from .normals import RCOND, scaled_rcond
 from .problem import Datum, Linearization, register_fast_path
 from .result import STATUS, Cofactors, Result, cofactors
 
 __all__ = ["gauss_newton", "degrees_of_freedom", "RCOND", "scaled_rcond", "Datum",
-           "Linearization", "register_fast_path", "STATUS", "Cofactors", "Result", "cofactors"]
+           "Linearization", "register_fast_path", "STATUS", "Cofactors", "Result", "cofactors",
+           "lstsq", "LinearFit", "LINEAR_STATUS"]
