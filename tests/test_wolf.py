@@ -177,19 +177,77 @@ def test_reading_quantisation_error():
 
 
 def test_table1_transcription_reproduces_table2_and_table1():
+    """The transcribed coordinates reproduce every Table 2 summary line of the claim book and
+    plate 003's X line of Table 1 (the paper's own numbers, as printed)."""
+    from sim.studies.wolf.claims import load_book
+
+    book = load_book()
     t = wolf.load_table1(ROOT / "studies/data/wolf_table1.csv")
     d = wolf.table1_discrepancies(t)
     assert len(d["point"]) == 20
-    for (plate, ax, st), paper in wolf.PAPER_T2.items():
-        v = d[f"d{ax}_set{st}_foster_um"][d["plate"] == plate]
-        mx, rm, mn = wolf._st(v)
-        assert (round(mx), round(rm, 1), round(mn, 1)) == tuple(float(x) for x in paper)
-    x003 = wolf._st(d["dx_sets_um"][d["plate"] == "003"])
-    assert (round(x003[0]), round(x003[1], 1), round(x003[2], 1)) == (10, 5.8, 5.1)
+    n = 0
+    for cid, spec in book.specs.items():
+        if cid.startswith("wolf.table2_check.p"):
+            _, _, plate, st, stat = cid.split(".")
+            ax = stat.split("_")[1]
+            v = d[f"d{ax}_{st.replace('set', 'set')}_foster_um"][d["plate"] == plate[1:]]
+            got = wolf.summary(v)[stat.split("_")[0]]
+            assert round(got, spec["decimals"]) == spec["ref"], cid
+            n += 1
+    assert n == 24
+    x003 = wolf.summary(d["dx_sets_um"][d["plate"] == "003"])
+    assert (x003["max"], round(x003["rms"], 1), round(x003["mean"], 1)) == (10, 5.8, 5.1)
+
+
+def test_table3_recomputation_and_its_erratum():
+    t = wolf.load_table3(ROOT / "studies/data/wolf_table3.csv")
+    from sim.studies.wolf.tables import table3_discrepancies
+
+    d = table3_discrepancies(t)
+    y505 = wolf.summary(d["dy_printed_um"][d["photo"] == "505"])
+    assert y505["max"] == 17 and round(y505["mean"], 1) == 9.1
+    assert abs(y505["rms"] - math.sqrt(1108 / 11)) < 1e-12      # printed 9.7: an erratum
+    x501 = wolf.summary(d["dx_printed_um"][d["photo"] == "501"])
+    assert (x501["max"], round(x501["rms"], 1), round(x501["mean"], 1)) == (16, 8.2, 6.2)
+    # the coordinates agree with the printed differences except where the note says so
+    bad = d["dx_coord_um"] != np.where(d["dx_coord_um"] < 0, -1, 1) * d["dx_printed_um"]
+    assert set(d["point"][bad & (d["photo"] == "501")]) <= {74}
+
+
+def test_table_files_that_are_not_the_table_are_rejected_by_key(tmp_path):
+    binary = tmp_path / "t.bin"
+    binary.write_bytes(bytes(range(256)) * 4)
+    text = tmp_path / "t.csv"
+    text.write_text("a,b,c\n1,2,3\n")
+    notnum = tmp_path / "n.csv"
+    notnum.write_text((ROOT / "studies/data/wolf_table1.csv").read_text().replace("59.080", "x"))
+    for key in ("table1.file", "table3.file"):
+        for f in (binary, text, tmp_path / "missing.csv"):
+            with pytest.raises(ConfigError) as e:
+                _cfg(**{key: str(f)})
+            assert e.value.key == key and "\n" not in str(e.value)
+    with pytest.raises(ConfigError) as e:
+        _cfg(**{"table1.file": str(notnum)})
+    assert e.value.key == "table1.file" and "row 1" in str(e.value)
+
+
+@pytest.mark.parametrize("content", [bytes(range(256)) * 8, b"plate;point\n003;1\n"])
+def test_cli_bad_table_file_is_one_line_exit_2(tmp_path, content):
+    import subprocess
+    import sys
+
+    f = tmp_path / "table.csv"
+    f.write_bytes(content)
+    p = subprocess.run([sys.executable, "-m", "sim", "check", str(ROOT / "studies/wolf_polynomial.toml"),
+                        "--set", f"table1.file={str(f)!r}"], capture_output=True, text=True,
+                       cwd=ROOT)
+    assert p.returncode == 2
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and "table1.file" in lines[0] and "Traceback" not in p.stderr
 
 
 def _cfg(**over):
-    raw = {"trials": 20, "trade.trials": 10, **over}
+    raw = {"trials": 20, "trade.trials": 10, "unprinted.trials": 10, **over}
     return validate(raw, wolf.SCHEMA, wolf.check)
 
 
@@ -228,29 +286,83 @@ def test_main_chunk_before_after_and_noise_free_limit():
     assert np.median(o["after.rms_x_um"]) < 0.02 * np.median(o["before.rms_x_um"])
 
 
+def test_chunk_functions_pickle():
+    import pickle
+
+    cfg = _cfg()
+    for fn in (wolf.main_chunk(cfg, (("a.", {"reading.n": 2}),), full=False),
+               wolf.degree_chunk(cfg, 20.0), wolf.stability_chunk(cfg, [0.5], [0.0])):
+        g = pickle.loads(pickle.dumps(fn))
+        assert g.func is fn.func
+
+
+def test_field_scale_cell_equals_scaled_amplitudes():
+    """The field_scale of a sweep cell is the same as multiplying every field amplitude."""
+    from sim.studies.wolf.chunks import draw_main
+
+    cfg = _cfg()
+    k = 1.7
+    cfg2 = dict(cfg, **{f"field.{c}_um": k * cfg[f"field.{c}_um"] for c in ef.COMPONENTS})
+    a = draw_main(cfg, np.random.default_rng(21), 5, 3)
+    b = draw_main(cfg2, np.random.default_rng(21), 5, 3)
+    for pa, pb in zip(a["cal"] + a["rep"], b["cal"] + b["rep"]):
+        assert np.allclose(pb.field, k * pa.field, rtol=1e-12, atol=1e-9)
+        assert np.array_equal(pa.rest, pb.rest) and np.array_equal(pa.z, pb.z)
+
+
+def test_cells_share_instruments_and_default_cell_equals_main():
+    cfg = _cfg()
+    main = wolf.main_chunk(cfg, full=False)(np.random.default_rng(5), 6)
+    cells = wolf.main_chunk(cfg, (("d.", {}), ("s.", {"reading.pointing_sigma_um": 0.5})),
+                            full=False)(np.random.default_rng(5), 6)
+    for k, v in main.items():
+        assert np.array_equal(cells["d." + k], v)
+    # less pointing noise: the date-to-date repeatability shrinks on the same instruments
+    assert np.mean(cells["s.repeat.rms_x_um"]) < 0.7 * np.mean(cells["d.repeat.rms_x_um"])
+
+
 def test_study_runs_and_reports(tmp_path):
     from sim.studies import RunContext
+    from sim.storage import read_table
 
     cfg = {"study": "wolf_polynomial", **_cfg(**{
         "trade.degrees": [1, 3], "trade.spacings_mm": [20.0, 50.0], "trade.n_sets": [1, 3],
         "trade.readings": [1, 3], "trade.pointing_sigmas_um": [7.0],
-        "trade.ages_weeks": [0.0, 52.0], "trade.drift_fractions": [0.5]})}
+        "trade.ages_weeks": [0.0, 52.0], "trade.drift_fractions": [0.5],
+        "unprinted.pointing_sigmas_um": [3.0, 7.0], "unprinted.field_scales": [1.0],
+        "unprinted.mono_sigmas_um": [0.0, 3.0]})}
     wolf.run(cfg, tmp_path, RunContext(quiet=True))
-    from sim.storage import read_table
-
     claims = read_table(tmp_path / "claims.parquet").to_pydict()
-    names = set(claims["claim"])
-    for n in ("wolf.before.max_x_um", "wolf.after.rms_y_um", "wolf.repeatability.p003.rms_x_um",
-              "wolf.table1_real.p005.mean_y_um", "wolf.plate_after.rms_x_um",
-              "wolf.degree.cubic_excess_pct"):
-        assert n in names
-    i = claims["claim"].index("wolf.table1_real.p003.rms_y_um")
-    assert claims["holds"][i] is False and abs(claims["value"][i] - math.sqrt(53.0)) < 1e-9
+    by = {c: i for i, c in enumerate(claims["claim"])}
+    from sim.studies.wolf.claims import load_book
+
+    assert set(by) == set(load_book().specs)               # every declared claim, once
+    # the paper's errata: its own coordinates contradict its summary lines
+    for cid, v in (("wolf.table1.p003.rms_y_um", math.sqrt(53.0)),
+                   ("wolf.table1.p003.mean_y_um", 5.8), ("wolf.table1.p005.mean_x_um", 4.7),
+                   ("wolf.table3_check.p505.rms_y_um", math.sqrt(1108 / 11))):
+        i = by[cid]
+        assert claims["verdict"][i] == "erratum" and claims["kind"][i] == "paper-check"
+        assert abs(claims["value"][i] - v) < 1e-9 and claims["holds"][i] is False
+    assert claims["verdict"][by["wolf.table1.p003.rms_x_um"]] == "holds"
+    assert claims["headline"][by["wolf.headline.mean_vs_mono_um"]] is True
+    nr = read_table(tmp_path / "not_reproduced.parquet").to_pydict()
+    assert len(nr["printed"]) >= 10
+    cs = read_table(tmp_path / "consistent_set.parquet").to_pylist()
+    for name in ("reading.pointing_sigma_um", "field_scale", "mono.sigma_um"):
+        allr = [r for r in cs if r["input"] == name and r["claim"] == "ALL"]
+        assert len(allr) == 1
+        if allr[0]["n_consistent"]:                        # inside every dependent claim's set
+            for r in cs:
+                if r["input"] == name and r["depends"] and r["claim"] != "ALL":
+                    assert r["holds_low"] <= allr[0]["holds_low"] <= allr[0]["holds_high"] \
+                        <= r["holds_high"]
     d = read_table(tmp_path / "degree.parquet").to_pydict()
     k = [j for j, (s, g) in enumerate(zip(d["spacing_mm"], d["degree"])) if s == 50.0 and g == 3]
     assert all(d["estimable_share"][j] == 0 for j in k)  # 2 rows cannot carry a cubic
     md = wolf.report(tmp_path)
     assert "wolf.after.rms_x_um" in md and f"{tmp_path.name}/vectors.png" in md
+    assert "Consistent set of `reading.pointing_sigma_um`" in md
     for f in ("vectors.png", "components.png", "degree.png", "readings.png", "stability.png",
-              "table1_real.png", "trials.parquet"):
+              "table1_real.png", "consistent_set.png", "trials.parquet"):
         assert (tmp_path / f).is_file()

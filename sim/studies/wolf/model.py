@@ -1,0 +1,230 @@
+"""The simulated PG-2: error field over dates, placements, quantised readings, reductions.
+
+Wolf & Pearsall 1976 (seed ``000_668e60e68f004f98.txt``). A plotter whose measuring system
+carries a smooth systematic error field (:mod:`sim.errorfields`: the six sources the paper
+lists), read in *counts* of about 4 um, ``n`` readings per point averaged, approached from one
+side (backlash ``+b/2``). Dates and drift: the field of date ``t`` is
+``sqrt(1 - f) F + sqrt(f) D(t)`` with ``D`` an AR(1) sequence of independent draws
+(:func:`sim.errorfields.ar1_weights`, time constant ``tau``), plus a fresh small
+*restitution* field at every placement of a plate. Each calibration set is reduced with the
+paper's non-redundant two-point transformation and the polynomial is fitted to the pooled sets
+(:mod:`sim.polynomial`). Coordinates in mm, displacements and discrepancies in um.
+
+:func:`place` draws everything random about one reading of a plate once (placement, field
+and restitution displacements, standard-normal pointing noise for up to ``nmax`` readings,
+approach signs); :func:`read_placed` turns it into averaged counts for a given pointing sigma,
+number of readings, approach and common factor on the field amplitudes (the field is linear
+in its amplitudes). So sweeps over these inputs use common random numbers.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ... import errorfields as ef
+from ... import polynomial as pl
+from ... import transforms2d as tf
+
+AXES = ("x", "y")
+STATS = ("max", "rms", "mean")
+
+def field_spec(cfg: dict, **over) -> ef.FieldSpec:
+    kw = {name + "_um": cfg[f"field.{name}_um"] for name in ef.COMPONENTS}
+    kw.update(encoder_period_mm=cfg["field.encoder_period_mm"],
+              gimbal_height_mm=cfg["field.gimbal_height_mm"],
+              stress_length_mm=cfg["field.stress_length_mm"], spread_lo=cfg["field.spread"][0],
+              spread_hi=cfg["field.spread"][1])
+    kw.update(over)
+    return ef.FieldSpec(**kw)
+
+
+def restitution_spec(cfg: dict) -> ef.FieldSpec:
+    return ef.FieldSpec(stress_um=cfg["field.restitution_um"],
+                        stress_length_mm=cfg["field.restitution_length_mm"])
+
+
+# ----------------------------------------------------------------------------- simulation core
+
+
+class Instrument:
+    """``T`` simulated plotters: a static field, a drifting field over given dates, and the
+    reading process. ``disp(k, P)`` is the systematic displacement (um) on date ``k``."""
+
+    def __init__(self, cfg: dict, rng: np.random.Generator, T: int, dates_weeks,
+                 drift_fraction: float | None = None):
+        self.cfg, self.T = cfg, T
+        self.spec = field_spec(cfg)
+        self.rspec = restitution_spec(cfg)
+        self.static = ef.draw(self.spec, rng, T)
+        self.dates = np.asarray(dates_weeks, float)
+        self.drift = [ef.draw(self.spec, rng, T) for _ in self.dates]
+        self.W = ef.ar1_weights(self.dates, cfg["field.drift_tau_weeks"])
+        self.f = cfg["field.drift_fraction"] if drift_fraction is None else drift_fraction
+
+    def disp(self, k: int, P: np.ndarray, f: float | None = None) -> np.ndarray:
+        f = self.f if f is None else f
+        d = math.sqrt(1 - f) * ef.evaluate(self.spec, self.static, P)
+        if f > 0:
+            for j in range(k + 1):  # over dates, not trials
+                if self.W[k, j] != 0:
+                    d = d + math.sqrt(f) * self.W[k, j] * ef.evaluate(self.spec, self.drift[j], P)
+        return d
+
+    def restitution(self, rng, P):
+        return ef.evaluate(self.rspec, ef.draw(self.rspec, rng, self.T), P)
+
+
+def rotate(P: np.ndarray, th: np.ndarray) -> np.ndarray:
+    c, s = np.cos(th)[:, None], np.sin(th)[:, None]
+    return np.stack([c * P[..., 0] - s * P[..., 1], s * P[..., 0] + c * P[..., 1]], -1)
+
+
+def read_counts(rng, P_mm: np.ndarray, d_um: np.ndarray, count_um: float, n: int, sigma_um: float,
+                backlash_um: float, approach: str) -> np.ndarray:
+    """Mean of ``n`` quantised readings (counts) of carrier positions ``P_mm (T, m, 2)`` with
+    systematic displacement ``d_um``: each reading adds pointing noise and backlash and is
+    rounded to whole counts."""
+    T, m, _ = P_mm.shape
+    true_um = (P_mm * 1000.0 + d_um)[..., None]
+    noise = rng.normal(0.0, sigma_um, (T, m, 2, n)) if sigma_um > 0 else 0.0
+    if approach == "one_side":
+        bl = backlash_um / 2
+    else:
+        bl = backlash_um / 2 * rng.choice(np.array([-1.0, 1.0]), (T, m, 2, n))
+    return np.round((true_um + noise + bl) / count_um).mean(axis=-1)
+
+
+def measure(rng, inst: Instrument, k: int, plate_true: np.ndarray, rot_sigma_deg: float,
+            shift_sigma_mm: float, n: int | None = None, sigma_um: float | None = None,
+            approach: str | None = None, f: float | None = None):
+    """Place a plate (true coordinates ``(T, m, 2)`` mm in its own system) on date ``k`` and read
+    every point: averaged counts ``(T, m, 2)``."""
+    cfg, T = inst.cfg, inst.T
+    th = np.deg2rad(rot_sigma_deg) * rng.normal(size=T)
+    sh = rng.normal(0.0, shift_sigma_mm, (T, 2))
+    P = rotate(plate_true, th) + sh[:, None, :]
+    d = inst.disp(k, P, f) + inst.restitution(rng, P)
+    return read_counts(rng, P, d, cfg["reading.count_um"], cfg["reading.n"] if n is None else n,
+                       cfg["reading.pointing_sigma_um"] if sigma_um is None else sigma_um,
+                       cfg["reading.backlash_um"], cfg["reading.approach"] if approach is None
+                       else approach)
+
+
+def true_plate(rng, known: np.ndarray, T: int, sigma_um: float) -> np.ndarray:
+    """True coordinates of a plate whose known values are ``known (m, 2)``: known + N(0, sigma)."""
+    return known + rng.normal(0.0, sigma_um * 1e-3, (T,) + known.shape)
+
+
+def calib_dates(cfg: dict, n_sets: int) -> np.ndarray:
+    return np.linspace(0.0, cfg["calib.span_weeks"], n_sets) if n_sets > 1 else np.zeros(1)
+
+
+def calibrate(cfg, G, counts_sets, ia, ib, degree, terms=None):
+    """Reduce each set two-point, fit the polynomial to the pooled sets.
+
+    Returns the reduced sets ``(S, T, n, 2)``, the two-point transforms, the fit, and the mean
+    reduction (scale, centre-cross reading, alpha) used for later plates.
+    """
+    tps = [pl.two_point_transform(c[:, ia], c[:, ib], G[ia], G[ib]) for c in counts_sets]
+    red = np.stack([pl.apply_two_point(tp, c) for tp, c in zip(tps, counts_sets)])
+    S, T, n, _ = red.shape
+    meas = red.transpose(1, 0, 2, 3).reshape(T, S * n, 2)
+    fit = pl.fit_poly(meas, np.tile(G, (S, 1)), degree=degree, terms=terms)
+    mean_tp = pl.TwoPoint(np.mean([tp.scale for tp in tps], 0), np.mean([tp.origin for tp in tps], 0),
+                          np.mean([tp.alpha for tp in tps], 0), np.asarray(G[ia], float))
+    return red, tps, fit, mean_tp
+
+
+def correct_plate(fit, mean_tp, counts, known, use_poly=True, fiducials=None):
+    """Reduce a later plate: counts to mm and to the centre cross with the calibration's
+    reduction, the polynomial, then a least-squares similarity onto the plate's own system
+    (on ``fiducials`` indices, default all points). Returns discrepancies (um) ``(T, m, 2)``."""
+    X = pl.apply_two_point(mean_tp, counts)
+    if use_poly:
+        X = pl.apply_poly(fit, X)
+    sel = slice(None) if fiducials is None else fiducials
+    return (ls_map("similarity", X[:, sel], known[sel] if known.ndim == 2 else known[:, sel], X)
+            - known) * 1000.0
+
+
+def stats_cols(prefix: str, d_um: np.ndarray, out: dict):
+    st = pl.discrepancy_stats(d_um, axis=1)
+    for s in STATS:
+        for i, ax in enumerate(AXES):
+            out[f"{prefix}.{s}_{ax}_um"] = st[s][:, i]
+
+
+def photo_points(rng, cfg, T):
+    """``(T, 4 + n, 2)``: four midside fiducials then ``n`` random PUG marks in the format."""
+    w, h = cfg["repeat.format_mm"]
+    cx, cy = cfg["repeat.centre_mm"]
+    fid = np.array([[-w / 2, 0.0], [w / 2, 0.0], [0.0, -h / 2], [0.0, h / 2]])
+    pts = rng.uniform([-w / 2 * 0.95, -h / 2 * 0.95], [w / 2 * 0.95, h / 2 * 0.95],
+                      (T, cfg["repeat.n_points"], 2))
+    allp = np.concatenate([np.broadcast_to(fid, (T, 4, 2)), pts], axis=1)
+    return allp + np.array([cx, cy])
+
+
+@dataclass(frozen=True)
+class Placed:
+    """One plate placed on the carrier and everything random about reading it (see module doc).
+
+    P : (T, m, 2) mm carrier positions; field, rest : (T, m, 2) um field (at unit amplitude
+    factor) and restitution displacements; z : (T, m, 2, nmax) standard-normal pointing noise;
+    sign : (T, m, 2, nmax) approach signs for the ``random`` approach.
+    """
+
+    P: np.ndarray
+    field: np.ndarray
+    rest: np.ndarray
+    z: np.ndarray
+    sign: np.ndarray
+
+
+def place(rng, inst: "Instrument", k: int, plate_true: np.ndarray, rot_sigma_deg: float,
+          shift_sigma_mm: float, nmax: int) -> Placed:
+    """Place a plate (true coordinates ``(T, m, 2)`` mm in its own system) on date ``k``."""
+    T = inst.T
+    th = np.deg2rad(rot_sigma_deg) * rng.normal(size=T)
+    sh = rng.normal(0.0, shift_sigma_mm, (T, 2))
+    P = rotate(plate_true, th) + sh[:, None, :]
+    field = inst.disp(k, P)
+    rest = inst.restitution(rng, P)
+    z = rng.normal(size=P.shape + (nmax,))
+    sign = rng.choice(np.array([-1.0, 1.0]), P.shape + (nmax,))
+    return Placed(P, field, rest, z, sign)
+
+
+def read_placed(pl_: Placed, count_um: float, n: int, sigma_um: float, backlash_um: float,
+                approach: str, field_scale: float = 1.0) -> np.ndarray:
+    """Mean of ``n`` quantised readings (counts) of a :class:`Placed` plate ``(T, m, 2)``."""
+    true_um = (pl_.P * 1000.0 + field_scale * pl_.field + pl_.rest)[..., None]
+    bl = backlash_um / 2 if approach == "one_side" else backlash_um / 2 * pl_.sign[..., :n]
+    return np.round((true_um + sigma_um * pl_.z[..., :n] + bl) / count_um).mean(axis=-1)
+
+
+
+def reading_error_rms(rng, count_um, n, sigma_um, backlash_um, approach, size=200_000):
+    """rms error (um, per coordinate) of the mean of ``n`` quantised readings, true positions
+    uniform within a count, after removing the constant one-sided backlash offset."""
+    x = rng.uniform(0.0, count_um, (size, 1))
+    noise = rng.normal(0.0, sigma_um, (size, n))
+    bl = backlash_um / 2 if approach == "one_side" else backlash_um / 2 * rng.choice(
+        np.array([-1.0, 1.0]), (size, n))
+    e = np.round((x + noise + bl) / count_um).mean(1) * count_um - x[:, 0]
+    e = e - (backlash_um / 2 if approach == "one_side" else 0.0)
+    return float(np.sqrt(np.mean(e ** 2)))
+
+
+
+def ls_map(kind: str, src: np.ndarray, dst: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """Fit a least-squares ``similarity`` or ``affine`` mapping ``src`` (T, n, 2) onto ``dst``
+    ((T, n, 2) or (n, 2)) with :mod:`sim.transforms2d` and apply it to ``pts`` (T, m, 2)."""
+    src = np.asarray(src, float)
+    dst = np.broadcast_to(np.asarray(dst, float), src.shape)
+    if kind == "similarity":
+        return tf.apply_similarity(tf.fit_similarity(src, dst).params, pts)
+    return tf.apply_affine(tf.fit_affine(src, dst).params, pts)
+

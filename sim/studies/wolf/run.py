@@ -1,0 +1,161 @@
+"""Run of ``wolf_polynomial`` through the runner (every part chunked, every chunk function
+picklable, so ``--workers``, Dask and resume work). Wolf & Pearsall 1976, seed
+``000_668e60e68f004f98.txt``.
+
+Parts (spawn keys): 0 the main experiment (``trials``); 1 the cells run (``unprinted.trials``):
+the readings trade-off and the sweeps of the unprinted inputs, all on the same instruments;
+10+i the degree trade-off at spacing i; 40 the stability trade-off; 30, 90, 91, 98 single
+streams (reading-error table, the vector figure's instrument, one field draw, the bootstrap).
+Writes ``trials.parquet``, ``vectors.parquet``, ``components.parquet``, ``degree.parquet``,
+``trials_degree.parquet``, ``readings.parquet``, ``stability.parquet``,
+``table1_real.parquet``, ``table3_real.parquet``, ``sweep_values.parquet``,
+``consistent_set.parquet``, ``claims.parquet``, ``not_reproduced.parquet`` and the figures.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ... import errorfields as ef
+from ...claims import write_claims
+from ...runner import chunk_rng, run_chunks
+from ...storage import provenance, write_table
+from .. import RunContext
+from . import claims as cl
+from . import consistent, figures, tables
+from .chunks import degree_chunk, main_chunk, stability_chunk
+from .model import field_spec, reading_error_rms
+from .schema import grid_nodes, table_path
+
+APPROACHES = ("one_side", "random")
+
+
+def _summ(x):
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    if x.size == 0:
+        return np.nan, np.nan, np.nan
+    lo, med, hi = np.percentile(x, [2.5, 50, 97.5])
+    return float(med), float(lo), float(hi)
+
+
+def reading_cells(cfg: dict) -> list[tuple[str, str, float, int, dict]]:
+    """``(tag, approach, sigma, readings, override)`` of the readings trade-off."""
+    out = []
+    for a in APPROACHES:
+        for sg in cfg["trade.pointing_sigmas_um"]:
+            for n in cfg["trade.readings"]:
+                out.append((f"r.{a}.{sg:g}.{n}.", a, float(sg), int(n),
+                            {"reading.approach": a, "reading.pointing_sigma_um": float(sg),
+                             "reading.n": int(n)}))
+    return out
+
+
+def run(cfg: dict, out: Path, ctx: RunContext) -> None:
+    q = ctx.quiet
+    prov = provenance(cfg)
+    T, seed, ch = cfg["trials"], cfg["seed"], cfg["chunk"]
+    main = run_chunks(main_chunk(cfg), T, seed, ch, part=0, label="wolf main", quiet=q, ctx=ctx)
+    write_table(out / "trials.parquet", {"trial": np.arange(T), **main}, prov)
+    _vectors_and_components(cfg, out, prov)
+
+    # the readings trade-off and the sweeps of the unprinted inputs: one cells run
+    rc, sc = reading_cells(cfg), consistent.sweep_cells(cfg)
+    cells = [(t, o) for t, *_, o in rc] + [(t, o) for t, _, _, o in sc]
+    Ts = cfg["unprinted.trials"]
+    res = run_chunks(main_chunk(cfg, cells, full=False), Ts, seed, min(ch, Ts), part=1, ctx=ctx,
+                     label="wolf cells", quiet=q)
+    er = chunk_rng(seed, 30, 0)
+    rd = {k: [] for k in ("approach", "pointing_sigma_um", "readings", "reading_error_um",
+                          "after_check_rms_um", "after_check_lo_um", "after_check_hi_um",
+                          "after_plate_rms_um", "after_plate_lo_um", "after_plate_hi_um")}
+    for tag, a, sg, n, _ in rc:
+        ca = np.sqrt((res[tag + "check_after.rms_x_um"] ** 2 + res[tag + "check_after.rms_y_um"] ** 2) / 2)
+        pa = np.sqrt((res[tag + "plate_after.rms_x_um"] ** 2 + res[tag + "plate_after.rms_y_um"] ** 2) / 2)
+        vals = (a, sg, n, reading_error_rms(er, cfg["reading.count_um"], n, sg,
+                                            cfg["reading.backlash_um"], a),
+                *_summ(ca), *_summ(pa))
+        for k, v in zip(rd, vals):
+            rd[k].append(v)
+    write_table(out / "readings.parquet", rd, prov)
+    book = cl.load_book()
+    vals, cons = consistent.evaluate(cfg, res, book)
+    write_table(out / "sweep_values.parquet", vals, prov)
+    write_table(out / "consistent_set.parquet", cons, prov)
+
+    degt = _degree(cfg, out, prov, ctx)
+    _stability(cfg, out, prov, ctx)
+
+    t1 = tables.table1_discrepancies(tables.load_table1(table_path(cfg, "table1.file")))
+    t3 = tables.table3_discrepancies(tables.load_table3(table_path(cfg, "table3.file")))
+    write_table(out / "table1_real.parquet", t1, prov)
+    write_table(out / "table3_real.parquet", t3, prov)
+    write_claims(out / "claims.parquet", cl.rows(cfg, main, t1, t3, degt, book), prov, book)
+    figures.figures(cfg, out)
+
+
+def _vectors_and_components(cfg, out, prov):
+    seed = cfg["seed"]
+    rep = main_chunk(cfg, keep_vectors=True)(chunk_rng(seed, 90, 0), 1)
+    G = grid_nodes(cfg["plate.area_mm"], cfg["plate.spacing_mm"])
+    S = cfg["calib.n_sets"]
+    vb, va = rep["vec.before"][0], rep["vec.after"][0]
+    write_table(out / "vectors.parquet", {
+        "set": np.repeat(np.arange(1, S + 1), len(G)), "x_mm": np.tile(G[:, 0], S),
+        "y_mm": np.tile(G[:, 1], S), "dx_before_um": vb[..., 0].ravel(),
+        "dy_before_um": vb[..., 1].ravel(), "dx_after_um": va[..., 0].ravel(),
+        "dy_after_um": va[..., 1].ravel()}, prov)
+    spec = field_spec(cfg)
+    comp = ef.evaluate_components(spec, ef.draw(spec, chunk_rng(seed, 91, 0), 1), G)
+    names = list(ef.COMPONENTS)
+    write_table(out / "components.parquet", {
+        "component": np.repeat(names, len(G)), "x_mm": np.tile(G[:, 0], len(names)),
+        "y_mm": np.tile(G[:, 1], len(names)),
+        "dx_um": np.concatenate([comp[k][0, :, 0] for k in names]),
+        "dy_um": np.concatenate([comp[k][0, :, 1] for k in names]),
+        "amplitude_um": np.repeat([spec.amplitude(k) for k in names], len(G))}, prov)
+
+
+def _degree(cfg, out, prov, ctx) -> dict:
+    seed, q = cfg["seed"], ctx.quiet
+    Tt, cht = cfg["trade.trials"], min(cfg["trade.trials"], cfg["chunk"])
+    rows = {k: [] for k in ("spacing_mm", "n_points", "n_sets", "degree", "terms", "fit_rms_um",
+                            "fit_lo_um", "fit_hi_um", "check_rms_um", "check_lo_um",
+                            "check_hi_um", "estimable_share")}
+    trials = {k: [] for k in ("spacing_mm", "n_sets", "degree", "trial", "fit_rms_um",
+                              "check_rms_um")}
+    for i, sp in enumerate(cfg["trade.spacings_mm"]):
+        r = run_chunks(degree_chunk(cfg, sp), Tt, seed, cht, part=10 + i, ctx=ctx,
+                       label=f"degree, {sp:g} mm", quiet=q)
+        npts = len(grid_nodes(cfg["plate.area_mm"], sp))
+        for ns in cfg["trade.n_sets"]:
+            for d in cfg["trade.degrees"]:
+                fr, cr = r[f"fit.{ns}.{d}"], r[f"check.{ns}.{d}"]
+                vals = (sp, npts, ns, d, (d + 1) * (d + 2) // 2, *_summ(fr), *_summ(cr),
+                        float(np.isfinite(fr).mean()))
+                for k, v in zip(rows, vals):
+                    rows[k].append(v)
+                for k, v in zip(trials, (np.full(Tt, sp), np.full(Tt, ns), np.full(Tt, d),
+                                         np.arange(Tt), fr, cr)):
+                    trials[k].append(v)
+    write_table(out / "degree.parquet", rows, prov)
+    degt = {k: np.concatenate(v) for k, v in trials.items()}
+    write_table(out / "trials_degree.parquet", degt, prov)
+    return degt
+
+
+def _stability(cfg, out, prov, ctx) -> None:
+    Tt, cht = cfg["trade.trials"], min(cfg["trade.trials"], cfg["chunk"])
+    fr_, ages = cfg["trade.drift_fractions"], cfg["trade.ages_weeks"]
+    r = run_chunks(stability_chunk(cfg, fr_, ages), Tt, cfg["seed"], cht, part=40, ctx=ctx,
+                   label="stability", quiet=ctx.quiet)
+    stb = {k: [] for k in ("drift_fraction", "age_weeks", "before_rms_um", "before_lo_um",
+                           "before_hi_um", "after_rms_um", "after_lo_um", "after_hi_um",
+                           "share_after_better")}
+    for f in fr_:
+        for i, age in enumerate(ages):
+            b, a = r[f"before.{f}.{i}"], r[f"after.{f}.{i}"]
+            for k, v in zip(stb, (f, age, *_summ(b), *_summ(a), float(np.mean(a < b)))):
+                stb[k].append(v)
+    write_table(out / "stability.parquet", stb, prov)
