@@ -85,7 +85,6 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
             note = next((v for k, v in notes.items() if cid.startswith(k)), "")
             out.append(score_simulated(book, cid, main, T, note))
     out += _table_checks(book, t1, t3)
-    out.append(book.not_comparable("wolf.table3.natural_images"))
     for pre in ("check_after", "plate_after", "plate_before"):
         for s in ("max", "rms"):
             for ax in AXES:
