@@ -41,7 +41,8 @@ class Field:
     """One configuration key.
 
     kind : "int", "float", "str", "bool", "list[float]", "list[int]",
-        "list[str]" or "points" (a list of [x, y] pairs in mm).
+        "list[str]", "points" (a list of [x, y] pairs in mm) or "records" (a list of tables,
+        e.g. a network's observations; their fields are checked by the study's ``check``).
     lo, hi : inclusive bounds for numbers (and for every element of a list).
     lo_open : if True, ``lo`` itself is excluded (``> lo``).
     choices : allowed values for strings (and elements of string lists).
@@ -100,6 +101,12 @@ def check_value(key: str, f: Field, v: Any) -> Any:
             raise ConfigError(key, f"must be a string (got {v!r})")
         if f.choices and v not in f.choices:
             raise ConfigError(key, f"must be one of {', '.join(map(str, f.choices))} (got {v!r})")
+        return v
+    if k == "records":
+        if not isinstance(v, list) or not all(isinstance(e, dict) for e in v):
+            raise ConfigError(key, f"must be a list of tables {{key = value, ...}} (got {v!r:.60})")
+        if len(v) < f.min_len:
+            raise ConfigError(key, f"needs at least {f.min_len} entries (got {len(v)})")
         return v
     if k.startswith("list[") or k == "points":
         if not isinstance(v, list):

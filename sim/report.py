@@ -148,6 +148,8 @@ def referee_summary(entries: list[tuple]) -> str:
     """Per paper: the headline claims with their verdicts, then counts per verdict class."""
     by_seed: dict[str, list] = {}
     for _, name, study, claims, _ in entries:
+        if not study.seed_file:          # a user's network: no paper to referee
+            continue
         by_seed.setdefault(study.seed_file, []).append((name, study, claims))
     parts = ["## Referee's summary\n",
              "Each claim is decided by its stated rule (see *How verdicts are decided* below). "
@@ -186,7 +188,7 @@ def build_report(results: Path) -> str:
         c = verdict_counts(claims)
         nr = d / "not_reproduced.parquet"
         n_nr = read_table(nr).num_rows if nr.is_file() else 0
-        row = [f"[{study.title}](#{d.name})", f"`{study.seed_file}`"]
+        row = [f"[{study.title}](#{d.name})", f"`{study.seed_file}`" if study.seed_file else "—"]
         row += [c[k] for k, _ in _COUNT_COLS]
         if c["self-check failed"]:
             row[2 + [k for k, _ in _COUNT_COLS].index("self-check")] = (
@@ -196,7 +198,9 @@ def build_report(results: Path) -> str:
         body = study.report(d)
         sections.append((study.order, d.name,
                          f'<a id="{d.name}"></a>\n\n## {study.title}\n\nStudy `{d.name}` '
-                         f"(seed paper `{study.seed_file}`), results in `{d.name}/`.\n\n{body}\n"))
+                         + (f"(seed paper `{study.seed_file}`)" if study.seed_file else
+                            "(a declared network, no seed paper)")
+                         + f", results in `{d.name}/`.\n\n{body}\n"))
     for d in sorted(p for p in results.iterdir()
                     if (p / "sweep.parquet").is_file() and not (p / "claims.parquet").is_file()):
         from .sweep import sweep_markdown

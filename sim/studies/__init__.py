@@ -25,6 +25,7 @@ MODULES = {
     "wolf_polynomial": "sim.studies.wolf",
     "agnard_block": "sim.studies.agnard",
     "brown_design": "sim.studies.design",
+    "network": "sim.studies.network",
 }
 
 

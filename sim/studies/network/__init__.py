@@ -1,0 +1,22 @@
+"""The ``network`` study kind: a user's plane measuring set-up declared as data.
+
+Points, stations, observations (distances with Brown's additive constant and offset,
+directions, angles, coordinate differences, weighted coordinates), the datum and the outputs
+are all in the study file (:mod:`.schema`, :mod:`.definition`); the adjustment runs on the one
+engine (:mod:`sim.lsq`). Outputs: per point analytic and Monte-Carlo precision and 95 %
+ellipses with their coverage, per observation redundancy numbers, minimal detectable biases
+and their effect on the coordinates, the false-alarm rate of the global test, the dilution
+against a second parameterisation, other datums by S-transformation, and the network in
+GNU Gama's ``gama-local`` XML (:mod:`.gama`). Examples: ``studies/network_*.toml``.
+"""
+from __future__ import annotations
+
+from .. import Study
+from .report import report
+from .run import run
+from .schema import SCHEMA, check
+
+STUDIES = {
+    "network": Study("network", "Network design study (your own instrument as data)", "",
+                     SCHEMA, run, report, check, order=90),
+}

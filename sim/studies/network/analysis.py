@@ -1,0 +1,134 @@
+"""Pre-analysis and Monte Carlo of a declared network.
+
+Analytic (at the true coordinates, one linearisation): the covariance of the unknowns in the
+datum, per point standard deviations and 95 % error ellipses, the same in other datums by
+S-transformation (:mod:`sim.datum`), per observation the redundancy number
+``r_i = 1 - (A Q A' P)_ii`` (they sum to the degrees of freedom), Baarda's minimal detectable
+bias ``MDB_i = delta0 sigma_i / sqrt(r_i)`` (internal reliability; ``delta0`` from the test's
+``alpha0`` and power), its effect on the coordinates (external reliability: the largest point
+displacement it causes) and the bias-to-noise ratio ``delta0 sqrt((1 - r_i) / r_i)``.
+
+Monte Carlo (:func:`mc_chunk`, one chunk of trials, picklable): simulated readings, the
+adjustment on the engine, and per-chunk sums of the coordinate errors, the count inside the
+analytic 95 % ellipses and the count of global-test rejections (``v'Pv`` against the
+chi-square quantile with the a-priori unit variance). Units: mm and rad; sigmas in the
+tables in mm. Seeds: Baarda's reliability theory as used for comparator networks (``004``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+from ... import lsq
+from ...datum import null_basis, s_matrix, s_transform
+from .definition import Network
+from .model import NetworkModel, simulate
+
+__all__ = ["Analytic", "analyse", "delta0", "mc_chunk", "point_cov_in"]
+
+CHI2_2_95 = float(stats.chi2.ppf(0.95, 2))
+
+
+def delta0(alpha0: float, power: float) -> float:
+    """Baarda's non-centrality (as a normal shift) of the one-dimensional w-test."""
+    return float(stats.norm.ppf(1 - alpha0 / 2) + stats.norm.ppf(power))
+
+
+@dataclass
+class Analytic:
+    """Analytic pre-analysis. ``free`` (p,) indices of the estimated globals; ``Q`` (p, p)
+    their covariance (mm^2, rad^2); ``cov`` (n, 2, 2) point covariances (zero for points held
+    fixed); ``redundancy``, ``mdb``, ``ext_max_mm``, ``bnr`` (m,); ``dof``; ``ok``."""
+
+    free: np.ndarray
+    Q: np.ndarray
+    cov: np.ndarray
+    redundancy: np.ndarray
+    mdb: np.ndarray
+    ext_max_mm: np.ndarray
+    bnr: np.ndarray
+    dof: int
+    ok: bool
+
+
+def point_cov_in(net: Network, free: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """The full ``(2n, 2n)`` coordinate covariance (zeros for fixed coordinates)."""
+    full = np.zeros((net.q, net.q))
+    full[np.ix_(free, free)] = Q
+    return full[:2 * net.n, :2 * net.n]
+
+
+def analyse(net: Network, datum: lsq.Datum, a0: float, power: float) -> Analytic:
+    """The analytic pre-analysis of ``net`` in ``datum``."""
+    theta = net.theta_true()[None]
+    model = NetworkModel(net, None)
+    free = datum.free_index(net.q)
+    cof = lsq.cofactors(model, np.zeros((1, net.m, 0)), theta, datum)
+    Q = cof.Qgg[0]
+    ok = bool(cof.ok[0])
+    lin = model.linearize(np.zeros((1, net.m, 0)), theta, True)
+    Aw = lin.Jg[0, :, 0][:, free] / net.sigma[:, None]          # weighted design (m, p)
+    if not ok:
+        nan = np.full(net.m, np.nan)
+        return Analytic(free, Q, np.full((net.n, 2, 2), np.nan), nan, nan, nan, nan, 0, False)
+    H = Aw @ Q @ Aw.T
+    r = np.clip(1.0 - np.diag(H), 0.0, 1.0)
+    c = 0 if datum.constraint_matrix(theta) is None else datum.constraint_matrix(theta).shape[-1]
+    dof = net.m - len(free) + c
+    d0 = delta0(a0, power)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        controlled = r > 1e-9
+        mdb = np.where(controlled, d0 * net.sigma / np.sqrt(r), np.inf)
+        bnr = np.where(controlled, d0 * np.sqrt((1 - r) / r), np.inf)
+        # shift of the unknowns by an undetected MDB on observation i: Q Aw_i' (mdb_i / sigma_i)
+        shift = (Q @ Aw.T) * np.where(controlled, mdb / net.sigma, 0.0)   # (p, m)
+    full = np.zeros((net.q, net.m))
+    full[free] = shift
+    disp = np.hypot(full[0:2 * net.n:2], full[1:2 * net.n:2])          # (n, m)
+    ext = np.where(controlled, disp.max(axis=0), np.inf)
+    cov2 = point_cov_in(net, free, Q).reshape(net.n, 2, net.n, 2)
+    cov = cov2[np.arange(net.n), :, np.arange(net.n), :]
+    return Analytic(free, Q, cov, r, mdb, ext, bnr, int(dof), True)
+
+
+def in_datum(net: Network, an: Analytic, points: list[int]) -> np.ndarray:
+    """Point covariances ``(n, 2, 2)`` stated in the inner-constraint datum over ``points``
+    (S-transformation; translation and rotation, as :func:`sim.datum.inner`)."""
+    w = np.zeros(2 * net.n)
+    w[np.repeat(points, 2) * 2 + np.tile([0, 1], len(points))] = 1.0
+    S = s_matrix(null_basis(net.xy), w)
+    Qs = s_transform(point_cov_in(net, an.free, an.Q), S).reshape(net.n, 2, net.n, 2)
+    return Qs[np.arange(net.n), :, np.arange(net.n), :]
+
+
+def ellipse(cov: np.ndarray):
+    """1-sigma semi-axes ``a >= b`` and the bearing of ``a`` (rad from +x) of ``(n, 2, 2)``."""
+    sxx, syy, sxy = cov[:, 0, 0], cov[:, 1, 1], cov[:, 0, 1]
+    h, g = (sxx + syy) / 2, np.sqrt(((sxx - syy) / 2) ** 2 + sxy ** 2)
+    return np.sqrt(np.maximum(h + g, 0)), np.sqrt(np.maximum(h - g, 0)), \
+        0.5 * np.arctan2(2 * sxy, sxx - syy)
+
+
+def mc_chunk(rng: np.random.Generator, n: int, net: Network, free: np.ndarray,
+             C: np.ndarray | None, cov_inv: np.ndarray, pts: np.ndarray, crit: float,
+             tol: float, max_iter: int) -> dict:
+    """One chunk of ``n`` simulated adjustments (see the module doc). ``pts`` are the point
+    indices whose coordinates are estimated; ``cov_inv`` (len(pts), 2, 2) their inverse
+    analytic covariances; ``crit`` the global test's chi-square critical value."""
+    obs = simulate(net, rng, n)
+    theta = np.repeat(net.theta_true()[None], n, 0)
+    res = lsq.gauss_newton(NetworkModel(net, obs), theta, datum=lsq.Datum(free, C), tol=tol,
+                           max_iter=max_iter)
+    ok = res.converged
+    e = (res.theta - theta)[:, :2 * net.n].reshape(n, net.n, 2)[:, pts][ok]     # (N, k, 2)
+    inside = np.einsum("tki,kij,tkj->tk", e, cov_inv, e) <= CHI2_2_95
+    vpv = res.sigma0 ** 2 * res.dof if res.dof > 0 else np.zeros(n)
+    return {"sum.n": np.array([[ok.sum()]], float),
+            "sum.e": e.sum(0)[None], "sum.ee": np.einsum("tki,tkj->kij", e, e)[None],
+            "sum.inside": inside.sum(0)[None].astype(float),
+            "sum.reject": np.array([[(vpv[ok] > crit).sum()]], float),
+            "rows.converged": ok, "rows.status": res.status.astype(np.int8),
+            "rows.sigma0": np.where(np.isfinite(res.sigma0), res.sigma0, -1.0),
+            "rows.iterations": res.iterations}

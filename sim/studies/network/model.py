@@ -1,0 +1,174 @@
+"""The observation model of a declared network, on the one engine (:mod:`sim.lsq`).
+
+All unknowns are globals (``point_dim = 0``): the coordinates of every point (x, y in mm), one
+orientation per direction set (rad) and the additive constant of distances (mm); a network's
+observations tie two or three points together, so there is no per-point block to eliminate.
+Each observation is one row; weights are ``1 / sigma^2`` (sigma in mm or rad), so cofactors are
+covariances. The datum (:func:`datum`) frees the estimated globals and adds fixed points,
+inner constraints over chosen points, or a user's minimal constraints. Seed papers: Brown 1968
+(``004``: ranges with the pivot offsets) and the grid plates of ``001`` (weighted coordinates).
+"""
+from __future__ import annotations
+
+import fnmatch
+
+import numpy as np
+
+from ... import lsq
+from ...config import ConfigError
+from .definition import Network
+
+__all__ = ["NetworkModel", "computed", "simulate", "datum", "null_space"]
+
+_TWO_PI = 2 * np.pi
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    return (a + np.pi) % _TWO_PI - np.pi
+
+
+def computed(net: Network, theta: np.ndarray, jac: bool = False):
+    """Computed observations ``(T, m)`` at globals ``theta`` ``(T, q)`` and, with ``jac``,
+    their Jacobian ``(T, m, q)`` (dense)."""
+    T = theta.shape[0]
+    xy = theta[:, :2 * net.n].reshape(T, net.n, 2)
+    kind, i, j, k = net.kind, net.i, net.j, net.k
+    pi, pj = xy[:, i], xy[:, np.where(j >= 0, j, 0)]
+    dx, dy = pj[..., 0] - pi[..., 0], pj[..., 1] - pi[..., 1]
+    d2 = dx * dx + dy * dy
+    beta2 = net.offset_mm ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.sqrt(np.maximum(d2 - beta2, 0.0))
+        bear = np.arctan2(dy, dx)
+    ori = theta[:, 2 * net.n + np.where(net.oset >= 0, net.oset, 0)] if len(net.stations) else 0.0
+    alpha = theta[:, -1:]
+    pk = xy[:, np.where(k >= 0, k, 0)]
+    ex, ey = pk[..., 0] - pi[..., 0], pk[..., 1] - pi[..., 1]
+    bear_k = np.arctan2(ey, ex)
+    val = np.select([kind == 0, kind == 1, kind == 2, kind == 3, kind == 4, kind == 5],
+                    [s - alpha, bear - ori, (bear_k - bear) % _TWO_PI, dx, dy, pi[..., 0]],
+                    pi[..., 1])
+    if not jac:
+        return val
+    J = np.zeros((T, net.m, net.q + 1))           # the last column collects padding
+    rows = np.arange(net.m)
+    cx_i, cy_i = 2 * i, 2 * i + 1
+    cx_j = np.where(j >= 0, 2 * j, net.q)
+    cy_j = np.where(j >= 0, 2 * j + 1, net.q)
+    cx_k = np.where(k >= 0, 2 * k, net.q)
+    cy_k = np.where(k >= 0, 2 * k + 1, net.q)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        gx = np.select([kind == 0, kind == 1, kind == 2], [dx / s, -dy / d2, dy / d2], 0.0)
+        gy = np.select([kind == 0, kind == 1, kind == 2], [dy / s, dx / d2, -dx / d2], 0.0)
+        e2 = ex * ex + ey * ey
+        hx, hy = np.where(kind == 2, -ey / e2, 0.0), np.where(kind == 2, ex / e2, 0.0)
+    lin = kind <= 2
+    # d/d(point j) = (gx, gy); d/d(point i) = -(gx + hx, gy + hy); d/d(point k) = (hx, hy)
+    J[:, rows, cx_j] = np.where(lin, gx, np.where(kind == 3, 1.0, 0.0))
+    J[:, rows, cy_j] = np.where(lin, gy, np.where(kind == 4, 1.0, 0.0))
+    J[:, rows, cx_k] = hx
+    J[:, rows, cy_k] = hy
+    J[:, rows, cx_i] = np.where(lin, -(gx + hx), np.select([kind == 3, kind == 5], [-1.0, 1.0], 0.0))
+    J[:, rows, cy_i] = np.where(lin, -(gy + hy), np.select([kind == 4, kind == 6], [-1.0, 1.0], 0.0))
+    if len(net.stations):
+        d = kind == 1
+        J[:, rows[d], 2 * net.n + net.oset[d]] = -1.0
+    J[:, rows[kind == 0], net.q - 1] = -1.0
+    return val, J[..., :net.q]
+
+
+def simulate(net: Network, rng: np.random.Generator, T: int) -> np.ndarray:
+    """``T`` sets of readings ``(T, m)``: true values plus bias plus Gaussian noise."""
+    true = computed(net, net.theta_true()[None])
+    return true + net.bias + net.sigma * rng.standard_normal((T, net.m))
+
+
+class NetworkModel:
+    """Engine model (:mod:`sim.lsq.problem`) of ``net`` with observations ``obs`` ``(T, m)``."""
+
+    point_dim = 0
+
+    def __init__(self, net: Network, obs: np.ndarray | None):
+        self.net = net
+        self.obs = obs
+        self.n_global = net.q
+        self.n_obs = net.m
+        self.w = (1.0 / net.sigma ** 2)[None, :, None]
+
+    def linearize(self, points, theta, globals_needed):
+        val, J = computed(self.net, theta, jac=True)
+        obs = val if self.obs is None else self.obs
+        r = obs - val
+        ang = (self.net.kind == 1) | (self.net.kind == 2)
+        r = np.where(ang, _wrap(r), r)
+        return lsq.Linearization(r[..., None], None, J[:, :, None, :] if globals_needed else None,
+                                 self.w)
+
+    def initial_points(self, theta):
+        return np.zeros((theta.shape[0], self.net.m, 0))
+
+
+def null_space(net: Network, free: np.ndarray) -> np.ndarray:
+    """Candidate datum defects restricted to the free globals ``(p, 4)``: translation x, y,
+    rotation and scale of every point (orientations turn with a rotation)."""
+    c = net.xy - net.xy.mean(axis=0)
+    G = np.zeros((net.q, 4))
+    G[0:2 * net.n:2, 0] = 1
+    G[1:2 * net.n:2, 1] = 1
+    G[0:2 * net.n:2, 2], G[1:2 * net.n:2, 2] = -c[:, 1], c[:, 0]
+    G[2 * net.n:2 * net.n + len(net.stations), 2] = 1.0
+    G[0:2 * net.n:2, 3], G[1:2 * net.n:2, 3] = c[:, 0], c[:, 1]
+    return G[free]
+
+
+def _param_index(net: Network, key: str, name: str) -> int:
+    try:
+        pt, ax = name.rsplit(".", 1)
+        return 2 * net.index(pt) + "xy".index(ax)
+    except ValueError:
+        raise ConfigError(key, f"{name!r} is not <point>.x or <point>.y of a network point") from None
+
+
+def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
+    """The datum of the config: ``datum.kind`` ``fixed`` (the fixed points), ``inner``
+    (inner constraints over ``datum.points``, the defects the network has) or ``constraints``
+    (``datum.constraints``: records ``{"P1.x" = 1.0, ...}``, each ``sum c_k dx_k = 0``)."""
+    free = net.free_index(extra_fixed)
+    kind = cfg["datum.kind"]
+    if kind == "fixed":
+        return lsq.Datum(free)
+    if kind == "constraints":
+        recs = cfg["datum.constraints"]
+        if not recs:
+            raise ConfigError("datum.constraints", "datum.kind = constraints needs constraints")
+        C = np.zeros((len(free), len(recs)))
+        pos = {g: a for a, g in enumerate(free)}
+        for b, rec in enumerate(recs):
+            for name, coef in rec.items():
+                g = _param_index(net, f"datum.constraints[{b}]", name)
+                if g not in pos:
+                    if g // 2 in extra_fixed:
+                        continue            # held fixed in this parameterisation
+                    raise ConfigError(f"datum.constraints[{b}]", f"{name} is not a free unknown")
+                if isinstance(coef, bool) or not isinstance(coef, (int, float)):
+                    raise ConfigError(f"datum.constraints[{b}]", f"{name}: coefficient must be a number")
+                C[pos[g], b] = coef
+        keep = np.abs(C).sum(0) > 0
+        return lsq.Datum(free, C[:, keep] if keep.any() else None)
+    # inner constraints over the chosen points, for the defects the network really has
+    pats = cfg["datum.points"] or ["*"]
+    sel = np.zeros(net.n, bool)
+    for p in pats:
+        sel |= np.array([fnmatch.fnmatchcase(nm, p) for nm in net.names])
+    if not sel.any():
+        raise ConfigError("datum.points", f"no point matches {pats}")
+    G = null_space(net, free)
+    _, J = computed(net, net.theta_true()[None], jac=True)
+    A = J[0][:, free] / net.sigma[:, None]
+    defect = np.linalg.norm(A @ G, axis=0) <= 1e-9 * np.linalg.norm(A) * np.linalg.norm(G, axis=0)
+    if not defect.any():
+        return lsq.Datum(free)
+    mask = np.zeros(net.q)
+    mask[:2 * net.n] = np.repeat(sel, 2)
+    C = G[:, defect] * mask[free][:, None]
+    return lsq.Datum(free, C)

@@ -1,0 +1,187 @@
+"""Run a network study: pre-analysis, Monte Carlo through the runner, tables, figures.
+
+Writes ``summary.parquet`` (one row), ``points.parquet`` (per point: analytic sigma and 95 %
+ellipse, Monte-Carlo sigma with its interval, ellipse coverage, dilution against the compared
+parameterisation), ``datums.parquet`` (point sigmas in other datums), ``observations.parquet``
+(redundancy, MDB, external reliability), ``claims.parquet`` (self-checks: Monte Carlo against
+analytic, coverage, false-alarm rate of the global test, redundancy sum), ``network.xml`` (the
+network in ``gama-local`` XML when it has that form) and the figures.
+"""
+from __future__ import annotations
+
+import fnmatch
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+from ...claims import ClaimBook, write_claims
+from ...config import ConfigError, StudyError
+from ...runner import jackknife, run_chunks
+from ...storage import provenance, write_table
+from .analysis import CHI2_2_95, analyse, ellipse, in_datum, mc_chunk
+from .definition import KINDS, Network, build
+from .figures import network_figure, reliability_figure
+from .gama import merge_gama, write_gama
+from .model import datum
+
+__all__ = ["run", "compare_points"]
+
+K95 = float(np.sqrt(CHI2_2_95))
+
+
+def compare_points(net: Network, cfg: dict) -> list[int]:
+    out: list[int] = []
+    for p in cfg["compare.fix"]:
+        hit = [a for a, nm in enumerate(net.names) if fnmatch.fnmatchcase(nm, p)]
+        if not hit:
+            raise ConfigError("compare.fix", f"no point named {p!r}")
+        out += [h for h in hit if h not in out]
+    return out
+
+
+def _rms_sigma(cov: np.ndarray) -> np.ndarray:
+    return np.sqrt((cov[:, 0, 0] + cov[:, 1, 1]) / 2)
+
+
+def _mc(net, an, dt, pts, cfg, ctx):
+    C = dt.constraint_matrix(net.theta_true()[None])
+    crit = float(stats.chi2.ppf(1 - cfg["test.alpha"], an.dof))
+    cov_inv = np.linalg.inv(an.cov[pts])
+    fn = partial(mc_chunk, net=net, free=an.free, C=None if C is None else C[0], cov_inv=cov_inv,
+                 pts=np.asarray(pts), crit=crit, tol=cfg["solver.tol_mm"],
+                 max_iter=cfg["solver.max_iter"])
+    return run_chunks(fn, cfg["trials"], cfg["seed"], cfg["chunk"], part=0,
+                      label=cfg["study"], ctx=ctx)
+
+
+def run(cfg: dict, out: Path, ctx) -> None:
+    out = Path(out)
+    full = merge_gama(cfg)
+    net = build(full)
+    dt = datum(net, full)
+    an = analyse(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
+    if not an.ok:
+        raise StudyError("datum.kind: the normal equations are singular in this datum")
+    prov = provenance(cfg)
+    # estimated points whose 2 x 2 covariance is regular (a point held by a datum constraint,
+    # such as Brown's x1 = 0, has a singular block and no ellipse)
+    det = an.cov[:, 0, 0] * an.cov[:, 1, 1] - an.cov[:, 0, 1] ** 2
+    pts = [a for a in range(net.n) if net.role[a] != 1
+           and det[a] > 1e-12 * ((an.cov[a, 0, 0] + an.cov[a, 1, 1]) / 2) ** 2]
+    held = [net.names[a] for a in range(net.n) if net.role[a] != 1 and a not in pts]
+    sim = _mc(net, an, dt, pts, cfg, ctx)
+    n_ok = sim["sum.n"][:, 0]
+    if n_ok.sum() < 2 or np.count_nonzero(n_ok) < 2:
+        raise StudyError("solver.max_iter: fewer than two chunks have converged trials; the "
+                         "network does not converge from its true coordinates")
+    sums = np.concatenate([sim["sum.n"], sim["sum.e"].reshape(len(n_ok), -1),
+                           np.einsum("ckii->cki", sim["sum.ee"]).reshape(len(n_ok), -1),
+                           sim["sum.inside"], sim["sum.reject"]], axis=1)
+    k = len(pts)
+
+    def sig(t):
+        n, e, ee = t[0], t[1:1 + 2 * k], t[1 + 2 * k:1 + 4 * k]
+        return np.sqrt(np.maximum(ee / n - (e / n) ** 2, 0) * n / (n - 1))
+
+    an_sig = np.sqrt(np.stack([an.cov[pts, 0, 0], an.cov[pts, 1, 1]], 1)).reshape(-1)
+    s_mc, s_lo, s_hi = jackknife(sig, sums)
+    ratio = jackknife(lambda t: np.atleast_1d(np.mean(sig(t) / an_sig)), sums)
+    cover = jackknife(lambda t: t[1 + 4 * k:1 + 5 * k] / t[0], sums)
+    cover_mean = jackknife(lambda t: np.atleast_1d(np.mean(t[1 + 4 * k:1 + 5 * k] / t[0])), sums)
+    alarm = jackknife(lambda t: np.atleast_1d(t[-1] / t[0]), sums)
+
+    a95, b95, th = ellipse(an.cov[pts])
+    extra = compare_points(net, cfg)
+    dil = np.full(k, np.nan)
+    if extra:
+        an2 = analyse(net, datum(net, full, tuple(extra)), 0.001, 0.8)
+        if not an2.ok:
+            raise StudyError("compare.fix: the compared parameterisation is singular")
+        s1, s2 = _rms_sigma(an.cov[pts]), _rms_sigma(an2.cov[pts])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dil = np.where(s2 > 0, 100 * (s1 / s2 - 1), np.nan)
+    write_table(out / "points.parquet", {
+        "point": [net.names[a] for a in pts], "x_mm": net.xy[pts, 0], "y_mm": net.xy[pts, 1],
+        "role": [("free", "fixed", "observed")[net.role[a]] for a in pts],
+        "sigma_x_mm": an_sig[0::2], "sigma_y_mm": an_sig[1::2],
+        "ellipse95_a_mm": K95 * a95, "ellipse95_b_mm": K95 * b95,
+        "ellipse_bearing_deg": np.degrees(th),
+        "mc_sigma_x_mm": s_mc[0::2], "mc_sigma_x_lo_mm": s_lo[0::2], "mc_sigma_x_hi_mm": s_hi[0::2],
+        "mc_sigma_y_mm": s_mc[1::2], "mc_sigma_y_lo_mm": s_lo[1::2], "mc_sigma_y_hi_mm": s_hi[1::2],
+        "coverage95": cover[0], "coverage95_lo": cover[1], "coverage95_hi": cover[2],
+        "dilution_pct": dil}, prov)
+    drows = {"datum": [], "point": [], "sigma_x_mm": [], "sigma_y_mm": []}
+    for pat in cfg["output.inner_over"]:
+        sel = [a for a in range(net.n) if fnmatch.fnmatchcase(net.names[a], pat)]
+        if not sel:
+            raise ConfigError("output.inner_over", f"no point matches {pat!r}")
+        cov = in_datum(net, an, sel)
+        for a in range(net.n):
+            drows["datum"].append(f"inner over {pat}")
+            drows["point"].append(net.names[a])
+            drows["sigma_x_mm"].append(float(np.sqrt(max(cov[a, 0, 0], 0))))
+            drows["sigma_y_mm"].append(float(np.sqrt(max(cov[a, 1, 1], 0))))
+    write_table(out / "datums.parquet", drows, prov)
+    ang = np.isin(net.kind, (1, 2))
+    to = np.where(net.kind == 2, net.k, net.j)
+    write_table(out / "observations.parquet", {
+        "kind": [KINDS[c] for c in net.kind],
+        "from": [net.names[net.j[r]] if net.kind[r] == 2 else net.names[net.i[r]]
+                 for r in range(net.m)],
+        "to": [net.names[t] if t >= 0 else "" for t in to],
+        "at": [net.names[net.i[r]] if net.kind[r] == 2 else "" for r in range(net.m)],
+        "sigma_mm": np.where(ang, np.nan, net.sigma),
+        "sigma_arcsec": np.where(ang, net.sigma / (np.pi / 648000), np.nan),
+        "redundancy": an.redundancy,
+        "mdb_mm": np.where(ang | ~np.isfinite(an.mdb), np.nan, an.mdb),
+        "mdb_arcsec": np.where(ang & np.isfinite(an.mdb), an.mdb / (np.pi / 648000), np.nan),
+        "external_max_mm": np.where(np.isfinite(an.ext_max_mm), an.ext_max_mm, np.nan),
+        "bias_noise_ratio": np.where(np.isfinite(an.bnr), an.bnr, np.nan),
+        "controlled": np.isfinite(an.mdb)}, prov)
+    try:
+        write_gama(net, out / "network.xml")
+        gama = "network.xml"
+    except ConfigError as e:
+        gama = f"not exported: {e}"
+    C = dt.constraint_matrix(net.theta_true()[None])
+    n_tot = float(n_ok.sum())
+    write_table(out / "summary.parquet", {
+        "network": [net.name], "points": [net.n], "observations": [net.m],
+        "unknowns": [len(an.free)], "datum": [cfg["datum.kind"]],
+        "datum_constraints": [0 if C is None else C.shape[-1]], "dof": [an.dof],
+        "redundancy_sum": [float(an.redundancy.sum())], "trials": [cfg["trials"]],
+        "converged": [int(n_tot)], "false_alarm": [float(alarm[0][0])],
+        "test_alpha": [cfg["test.alpha"]], "coverage95_mean": [float(cover_mean[0][0])],
+        "mc_over_analytic": [float(ratio[0][0])], "compare_fix": [", ".join(cfg["compare.fix"])],
+        "held_by_datum": [", ".join(held)],
+        "gama_xml": [gama]}, prov)
+    _claims(out, prov, an, ratio, cover_mean, alarm, cfg, n_tot)
+    network_figure(net, an, pts, out / "network.png")
+    reliability_figure(net, an, out / "reliability.png")
+
+
+def _claims(out, prov, an, ratio, cover, alarm, cfg, n_tot) -> None:
+    """Self-checks, with decision zones stated a priori: Monte Carlo within 5 % of analytic,
+    coverage and false-alarm rate within 2 points of their nominal values, redundancy numbers
+    summing to the degrees of freedom to 1e-6."""
+    a = cfg["test.alpha"]
+    spec = [("network.mc_agreement.mean_ratio", "Monte-Carlo sigma / analytic sigma (mean over "
+             "coordinates)", 1.0, 0.05),
+            ("network.coverage95.mean", "share of adjusted points inside their analytic 95 % "
+             "ellipse", 0.95, 0.02),
+            ("network.global_test.false_alarm", f"rejection rate of the global test at alpha "
+             f"{a:g} (no blunders)", a, 0.02),
+            ("network.redundancy.sum", "redundancy numbers sum to the degrees of freedom",
+             float(an.dof), 1e-6)]
+    book = ClaimBook([{"id": i, "source": "this project (analytic pre-analysis)", "paper": p,
+                       "kind": "self-check", "form": "value", "ref": r, "tol": t}
+                      for i, p, r, t in spec], [], "<network self-checks>")
+    note = f"{int(n_tot)} converged of {cfg['trials']} trials; jackknife CI over chunks"
+    rows = [book.score(spec[0][0], ratio[0][0], (ratio[1][0], ratio[2][0]), note=note),
+            book.score(spec[1][0], cover[0][0], (cover[1][0], cover[2][0]), note=note),
+            book.score(spec[2][0], alarm[0][0], (alarm[1][0], alarm[2][0]), note=note),
+            book.score(spec[3][0], float(an.redundancy.sum()), interval="exact",
+                       note=f"{len(an.redundancy)} observations, dof {an.dof}")]
+    write_claims(out / "claims.parquet", rows, prov, book)
