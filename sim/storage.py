@@ -140,7 +140,8 @@ def check_finite_table(name: str, table: pa.Table) -> None:
         if not pa.types.is_floating(arr.type):
             continue
         v = arr.to_numpy(zero_copy_only=False).astype(float)
-        bad = np.isinf(v) | (np.isnan(v) if is_claims and col in CLAIM_NUMBERS else False)
+        valid = np.asarray(arr.is_valid())   # a null is "no number" (a not-comparable claim)
+        bad = np.isinf(v) | (np.isnan(v) & valid if is_claims and col in CLAIM_NUMBERS else False)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             what = f" (claim {table.column('claim')[i].as_py()})" if is_claims else f" (row {i})"

@@ -118,3 +118,19 @@ def test_older_interface_maps_rounding_to_the_zone():
     assert r["kind"] == "prediction" and r["verdict"] == "inconclusive"
     assert math.isclose(r["zone_low"], 0.705) and math.isclose(r["zone_high"], 0.715)
     assert decide("value", (0.706, 0.714), (0.705, 0.715)) == "holds"
+
+
+def test_not_comparable_rows_are_written_with_no_number(tmp_path):
+    import pyarrow.parquet as pq
+
+    from sim.claims import write_claims
+
+    b = ClaimBook([{"id": "t.nc", "source": "s", "paper": "p", "kind": "not comparable",
+                    "why": "the setup is not printed"},
+                   {"id": "t.v", "source": "s", "paper": "p", "kind": "prediction",
+                    "form": "value", "ref": 1.0, "tol": 0.1}], [], "<test>")
+    rows = [b.not_comparable("t.nc"), b.score("t.v", 1.0, (0.95, 1.05))]
+    write_claims(tmp_path / "claims.parquet", rows, {"study": "t"}, b)
+    t = pq.read_table(tmp_path / "claims.parquet").to_pydict()
+    assert t["value"][0] is None and t["verdict"] == ["not comparable", "holds"]
+    assert t["note"][0] == "the setup is not printed"
