@@ -282,27 +282,138 @@ def test_bad_config_names_the_key():
         load_study(STUDY, ["control.few=everywhere"])
     with pytest.raises(ConfigError, match="block.ground_points"):
         load_study(STUDY, ["block.ground_points=12"])
+    with pytest.raises(ConfigError, match="sweep.five_inset"):
+        load_study(STUDY, ["sweep.five_inset=[0.1, 0.1]"])
+    with pytest.raises(ConfigError, match="sweep.five_inset"):
+        load_study(STUDY, ["sweep.five_inset=[0.1, 0.9]"])
+    with pytest.raises(ConfigError, match="chunk"):
+        load_study(STUDY, ["chunk=1000000"])
 
 
-def test_tiny_run_writes_claims_and_report(tmp_path):
+def _tiny_overrides():
+    from pathlib import Path
+    lines = (Path(__file__).parent / "data" / "tiny" / "agnard_block.txt").read_text().split()
+    return [ln for ln in lines if not ln.startswith("trials=")]
+
+
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory):
+    from sim.studies import RunContext
+
+    out = tmp_path_factory.mktemp("agnard_tiny")
+    study, cfg = load_study(STUDY, _tiny_overrides(), trials=4)
+    study.run(cfg, out, RunContext(quiet=True))
+    return study, cfg, out
+
+
+def test_tiny_run_writes_claims_and_report(tiny_run):
+    from sim.claims import KINDS
+    from sim.storage import read_table
+    from sim.studies.agnard.claims import load_book
+
+    study, cfg, out = tiny_run
+    rows = read_table(out / "claims.parquet").to_pylist()
+    names = [r["claim"] for r in rows]
+    assert len(names) == len(set(names)) == len(load_book().specs)   # each claim scored once
+    assert all(r["kind"] in KINDS for r in rows)
+    nr = read_table(out / "not_reproduced.parquet").to_pylist()
+    assert nr and all(r["why"] for r in nr)
+    text = study.report(out)
+    assert f"{out.name}/block_layout.png" in text and "w-test" in text
+    assert f"{out.name}/consistent_set.png" in text
+    for f in ("scanner_field.png", "block_layout.png", "check_residuals.png", "tradeoffs.png",
+              "consistent_set.png", "trials.parquet", "consistent_set.parquet"):
+        assert (out / f).is_file()
+
+
+def test_consistent_set_table(tiny_run):
+    from sim.storage import read_table
+
+    _, cfg, out = tiny_run
+    cs = read_table(out / "consistent_set.parquet").to_pydict()
+    for c in ("input", "claim", "holds_low", "holds_high"):
+        assert c in cs
+    assert set(cs["input"]) == {"control.five_inset", "pugging.recentre_px"}
+    assert cs["claim"].count("ALL") == 2
+    lo, hi = np.array(cs["ok_low"], float), np.array(cs["ok_high"], float)
+    fin = np.isfinite(lo)
+    assert np.all(lo[fin] <= hi[fin])
+    # the consistent set lies inside every claim's non-failing range of the same input
+    for inp in set(cs["input"]):
+        k = [i for i, (a, c) in enumerate(zip(cs["input"], cs["claim"])) if a == inp]
+        allk = [i for i in k if cs["claim"][i] == "ALL"][0]
+        if np.isfinite(lo[allk]):
+            assert all(lo[i] <= lo[allk] and hi[allk] <= hi[i] for i in k)
+
+
+def test_table1_with_rows_are_paper_checks_recomputed_from_tables_2_3(tiny_run):
+    """The contradiction is a paper-check whose value is the nearer of the paper's own
+    Tables 2-3 numbers; the simulation is not scored against Table 1's 'with' rows."""
+    from sim.storage import read_table
+    from sim.studies.agnard.claims import load_book
+
+    book = load_book()
+    rows = {r["claim"]: r for r in read_table(tiny_run[2] / "claims.parquet").to_pylist()}
+    for w in ("ctrl", "check"):
+        for c in ("x", "y"):
+            r = rows[f"agnard.table1.with_{w}_{c}_m"]
+            assert r["kind"] == "paper-check" and r["interval"] == "exact"
+            t23 = [book.spec(f"agnard.{n}.{w}_{c}_cm")["ref"] / 100
+                   for n in ("control_5", "control_21")]
+            assert r["value"] == min(t23, key=lambda v: abs(v - book.spec(r["claim"])["ref"]))
+            assert rows[f"agnard.table1.without_{w}_{c}_m"]["verdict"] == "not comparable"
+    # the paper's control rms in Table 1 is 2-3 x its Tables 2-3: an erratum
+    assert rows["agnard.table1.with_ctrl_x_m"]["verdict"] == "erratum"
+    assert rows["agnard.table1.with_ctrl_y_m"]["verdict"] == "erratum"
+
+
+def test_budget_recomputation_and_pointing_model():
+    from sim.studies.agnard.schema import model_sigmas
+
+    _, cfg = load_study(STUDY)
+    pix_cm = 25.4e-3 / cfg["scan.dpi"] * cfg["block.scale"] * 100
+    sxy, sz = model_sigmas(cfg)
+    assert math.isclose(100 * sxy, pix_cm * math.hypot(0.5, 0.25))          # 14.7 cm
+    assert math.isclose(100 * sz, 0.5 * pix_cm * 152 / 90)                   # 22.2 cm
+
+
+def test_chunk_functions_pickle():
+    import pickle
+    from functools import partial
+
+    from sim.studies.agnard import chunks as ch
+    from sim.studies.agnard.schema import block_of
+
+    _, cfg = load_study(STUDY)
+    b = block_of(cfg)
+    for fn in (partial(ch.main_chunk, cfg, b), partial(ch.sweep_chunk, cfg, b),
+               partial(ch.pugging_chunk, cfg, b, 0.5), partial(ch.scanner_chunk, cfg, b, 300.0)):
+        assert pickle.loads(pickle.dumps(fn)).func is fn.func
+
+
+def test_workers_give_identical_tables(tmp_path):
+    """One and two workers, and a resumed run, give the same trial table."""
+    from sim.runner import ChunkStore, make_executor
     from sim.storage import read_table
     from sim.studies import RunContext
 
-    study, cfg = load_study(STUDY, ["tradeoff.trials=2", "tradeoff.block_trials=2",
-                                    "tradeoff.block_strips=[1]", "tradeoff.block_models=[3]",
-                                    "tradeoff.dpis=[600.0]", "chunk=3"], trials=3)
-    study.run(cfg, tmp_path, RunContext(quiet=True))
-    rows = read_table(tmp_path / "claims.parquet").to_pylist()
-    names = {r["claim"] for r in rows}
-    for prefix in ("agnard.scanner_correction.", "agnard.control_5.", "agnard.control_21.",
-                   "agnard.pass_rejections.", "agnard.geometry_strength."):
-        assert any(n.startswith(prefix) for n in names)
-    assert all(r["kind"] in ("prediction", "input", "finding", "self-check") for r in rows)
-    text = study.report(tmp_path)
-    assert f"{tmp_path.name}/block_layout.png" in text and "w-test" in text
-    for f in ("scanner_field.png", "block_layout.png", "check_residuals.png", "tradeoffs.png",
-              "trials.parquet"):
-        assert (tmp_path / f).is_file()
+    study, cfg = load_study(STUDY, _tiny_overrides(), trials=4)
+    tabs = []
+    for w in (1, 2):
+        out = tmp_path / f"w{w}"
+        out.mkdir()
+        ex = make_executor("local", w)
+        try:
+            study.run(cfg, out, RunContext(quiet=True, executor=ex,
+                                           store=ChunkStore(out / "trials")))
+        finally:
+            ex.close()
+        tabs.append(read_table(out / "trials.parquet"))
+    assert tabs[0].equals(tabs[1])
+    # resume: a second run over the same chunk store loads every chunk and agrees
+    out = tmp_path / "w1"
+    study.run(cfg, out, RunContext(quiet=True, store=ChunkStore(out / "trials")))
+    assert read_table(out / "trials.parquet").equals(tabs[0])
 
 
 def test_sparse_and_dense_reduced_solutions_agree(small):
