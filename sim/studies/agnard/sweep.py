@@ -50,7 +50,8 @@ def evaluate(book: ClaimBook, sweeps: dict[str, dict[float, dict[str, np.ndarray
                 outs.append(r["outcome"])
                 for k, x in (("input", inp), ("value", float(v)), ("claim", cid),
                              ("median", r["value"]), ("lo", r["ci_low"]), ("hi", r["ci_high"]),
-                             ("zone_low", r["zone_low"]), ("zone_high", r["zone_high"]),
+                             ("zone_low", _nan_inf(r["zone_low"])),
+                             ("zone_high", _nan_inf(r["zone_high"])),
                              ("outcome", r["outcome"]), ("unit", cid.rsplit("_", 1)[-1])):
                     long[k].append(x)
             outs = np.asarray(outs)
@@ -59,6 +60,11 @@ def evaluate(book: ClaimBook, sweeps: dict[str, dict[float, dict[str, np.ndarray
             _cs_row(cs, inp, cid, values, outs == "holds", outs != "fails")
         _cs_row(cs, inp, "ALL", values, hold_all, ok_all)
     return long, cs
+
+
+def _nan_inf(x: float) -> float:
+    """An unbounded side of a decision zone is stored as NaN (no bound), not infinity."""
+    return float(x) if np.isfinite(x) else np.nan
 
 
 def _cs_row(cs: dict, inp: str, cid: str, values, holds: np.ndarray, ok: np.ndarray) -> None:
