@@ -238,7 +238,8 @@ def test_cli_bad_table_file_is_one_line_exit_2(tmp_path, content):
 
     f = tmp_path / "table.csv"
     f.write_bytes(content)
-    p = subprocess.run([sys.executable, "-m", "sim", "check", str(ROOT / "studies/wolf_polynomial.toml"),
+    p = subprocess.run([sys.executable, "-m", "sim", "check",
+                        str(ROOT / "studies/wolf_polynomial.toml"),
                         "--set", f"table1.file={str(f)!r}"], capture_output=True, text=True,
                        cwd=ROOT)
     assert p.returncode == 2
@@ -352,11 +353,15 @@ def test_study_runs_and_reports(tmp_path):
     for name in ("reading.pointing_sigma_um", "field_scale", "mono.sigma_um"):
         allr = [r for r in cs if r["input"] == name and r["claim"] == "ALL"]
         assert len(allr) == 1
+        feas = [r for r in cs if r["input"] == name and r["claim"] == "ALL-feasible"]
+        assert len(feas) == 1 and feas[0]["n_consistent"] >= allr[0]["n_consistent"]
         if allr[0]["n_consistent"]:                        # inside every dependent claim's set
             for r in cs:
-                if r["input"] == name and r["depends"] and r["claim"] != "ALL":
+                if r["input"] == name and r["depends"] and not r["claim"].startswith("ALL"):
                     assert r["holds_low"] <= allr[0]["holds_low"] <= allr[0]["holds_high"] \
                         <= r["holds_high"]
+    mono = {r["claim"]: r["depends"] for r in cs if r["input"] == "mono.sigma_um"}
+    assert not mono["wolf.after.rms_x_um"] and mono["wolf.table2.p003.set1.rms_x_um"]
     d = read_table(tmp_path / "degree.parquet").to_pydict()
     k = [j for j, (s, g) in enumerate(zip(d["spacing_mm"], d["degree"])) if s == 50.0 and g == 3]
     assert all(d["estimable_share"][j] == 0 for j in k)  # 2 rows cannot carry a cubic

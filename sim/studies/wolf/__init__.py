@@ -29,6 +29,7 @@ __all__ = ["STUDIES", "SCHEMA", "check", "run", "report", "grid_nodes", "mid_cel
            "table1_discrepancies", "summary", "_index"]
 
 STUDIES = {
-    "wolf_polynomial": Study("wolf_polynomial", "Wolf & Pearsall: the Kern PG-2 as a monocomparator",
-                             SEED, SCHEMA, run, report, check, order=40),
+    "wolf_polynomial": Study("wolf_polynomial",
+                             "Wolf & Pearsall: the Kern PG-2 as a monocomparator", SEED,
+                             SCHEMA, run, report, check, order=40),
 }

@@ -45,7 +45,7 @@ def _spread(x) -> tuple[np.ndarray, np.ndarray]:
 
 
 def score_simulated(book: ClaimBook, cid: str, stats: dict, n_inst: int, note: str = "") -> dict:
-    """Score one simulated claim on the per-trial statistics ``stats`` (one value per instrument)."""
+    """Score one simulated claim on the per-trial statistics ``stats`` (one per instrument)."""
     if cid == HEADLINE:
         el = [_spread(stats[f"mono.mean_{ax}_um"]) for ax in AXES]
         return book.score(cid, interval="spread",
@@ -73,8 +73,8 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
         "wolf.repeatability.": f"{cfg['repeat.n_points']} points of a simulated P-30 photograph "
                                f"read {cfg['repeat.gap_weeks']:g} week(s) apart, each set "
                                "corrected and fitted to its four fiducials; the default pointing "
-                               "sigma was chosen from these (unprinted.pointing_sigmas_um gives the "
-                               "values they allow)",
+                               "sigma was chosen from these (unprinted.pointing_sigmas_um "
+                               "gives the values they allow)",
         "wolf.table2.": "Set 1 of the simulated photograph against a monocomparator reading "
                         f"(sigma {cfg['mono.sigma_um']:g} um per coordinate, not printed), both "
                         "fitted to the fiducials; every plate and set has the same simulated "

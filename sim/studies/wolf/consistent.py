@@ -10,19 +10,25 @@ that depend on the swept inputs are scored by the claim book's own rule. A claim
 is one instrument's or plate's; it never "holds" sharply with ten points), when a plate at
 least as extreme is not rarer than 5 % (the outcome is not ``fails``). The *consistent set*
 (claim ``ALL``) is the set of values where every claim that depends on the input is
-consistent together.
+consistent together; ``ALL-feasible`` the same without the claims that are consistent at no
+value tried (named in the ``ALL`` row's note), which would otherwise empty it.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ...claims import ClaimBook
-from .claims import score_simulated, swept_claims
+from .claims import HEADLINE, score_simulated, swept_claims
 
 #: swept input -> (config key of its values, the cell key it overrides)
-INPUTS = {"reading.pointing_sigma_um": ("unprinted.pointing_sigmas_um", "reading.pointing_sigma_um"),
+INPUTS = {"reading.pointing_sigma_um": ("unprinted.pointing_sigmas_um",
+                                        "reading.pointing_sigma_um"),
           "field_scale": ("unprinted.field_scales", "field_scale"),
           "mono.sigma_um": ("unprinted.mono_sigmas_um", "mono.sigma_um")}
+
+
+#: the consistent set of the claims that are consistent somewhere in the sweep
+ALL_FEASIBLE = "ALL-feasible"
 
 
 def sweep_cells(cfg: dict) -> list[tuple[str, str, float, dict]]:
@@ -71,38 +77,47 @@ def evaluate(cfg: dict, res: dict, book: ClaimBook) -> tuple[dict, dict]:
     for name in INPUTS:
         m = V["input"] == name
         xs = np.unique(V["value"][m])
-        together = np.ones(xs.size, bool)
-        empty, ranges = [], {}
+        oks = {}
         for cid in cids:
             mc = m & (V["claim"] == cid)
             order = np.argsort(V["value"][mc])
             x, ok = V["value"][mc][order], V["consistent"][mc][order]
-            med = V["median"][mc]
-            depends = bool(np.ptp(med) > 0) if med.size > 1 else True
+            depends = _depends(name, cid)
             if depends:
-                together &= ok
+                oks[cid] = ok
             lo, hi = (float(x[ok].min()), float(x[ok].max())) if ok.any() else (np.nan, np.nan)
-            if depends and not ok.any():
-                empty.append(cid)
-            if depends and ok.any():
-                ranges[cid] = (lo, hi)
             _add(cons, name, cid, _criterion(book.specs[cid]), depends, lo, hi, xs.size,
                  int(ok.sum()), "" if ok.all() or not ok.any() or
                  np.all(np.diff(np.flatnonzero(ok)) == 1) else "not contiguous")
-        note = ""
-        if not together.any():
-            if empty:
-                note = "no value: consistent nowhere: " + ", ".join(empty)
-            elif ranges:
-                a = max(ranges, key=lambda c: ranges[c][0])
-                b = min(ranges, key=lambda c: ranges[c][1])
-                note = (f"no value: {a} needs >= {ranges[a][0]:g}, {b} needs <= "
-                        f"{ranges[b][1]:g}")
-        lo, hi = ((float(xs[together].min()), float(xs[together].max())) if together.any()
-                  else (np.nan, np.nan))
-        _add(cons, name, "ALL", "every dependent claim consistent", True, lo, hi, xs.size,
-             int(together.sum()), note)
+        empty = [c for c, ok in oks.items() if not ok.any()]
+        for label, use in (("ALL", list(oks)), (ALL_FEASIBLE, [c for c in oks if c not in empty])):
+            together = np.ones(xs.size, bool)
+            for c in use:
+                together &= oks[c]
+            note = ""
+            if label == "ALL" and empty:
+                note = "consistent nowhere: " + ", ".join(empty)
+            elif not together.any() and use:
+                rng = {c: (xs[oks[c]].min(), xs[oks[c]].max()) for c in use}
+                a = max(rng, key=lambda c: rng[c][0])
+                b = min(rng, key=lambda c: rng[c][1])
+                note = f"conflict: {a} needs >= {rng[a][0]:g}, {b} needs <= {rng[b][1]:g}"
+            if label != "ALL" and empty:
+                note = ((note + "; " if note else "")
+                        + f"without the {len(empty)} consistent nowhere")
+            lo, hi = ((float(xs[together].min()), float(xs[together].max())) if together.any()
+                      else (np.nan, np.nan))
+            _add(cons, name, label, "every dependent claim consistent", True, lo, hi, xs.size,
+                 int(together.sum()), note)
     return vals, cons
+
+
+def _depends(name: str, cid: str) -> bool:
+    """Whether claim ``cid`` depends on the swept input ``name`` (by the model: the
+    monocomparator enters only the comparisons with it)."""
+    if name == "mono.sigma_um":
+        return cid.startswith("wolf.table2.") or cid == HEADLINE
+    return True
 
 
 def _add(t, *row):

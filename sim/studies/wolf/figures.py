@@ -196,7 +196,8 @@ def consistent_figure(out: Path) -> None:
                      fontsize=9)
         ax.legend(fontsize=7)
         ax = axs[row, 1]
-        rows = [r for r in c if r["input"] == name and r["depends"] and r["claim"] != "ALL"]
+        rows = [r for r in c if r["input"] == name and r["depends"]
+                and not r["claim"].startswith("ALL")]
         xs = np.unique(v["value"][v["input"] == name])
         mat = np.zeros((len(rows), xs.size))
         for i, r in enumerate(rows):
@@ -207,11 +208,15 @@ def consistent_figure(out: Path) -> None:
         edges = np.concatenate([[xs[0] - w / 2], mid, [xs[-1] + w / 2]])
         ax.pcolormesh(edges, np.arange(len(rows) + 1) - 0.5, mat, cmap=_CMAP, vmin=0, vmax=1)
         allr = next(r for r in c if r["input"] == name and r["claim"] == "ALL")
-        if allr["n_consistent"]:
-            lo = edges[np.searchsorted(xs, allr["holds_low"])]
-            hi = edges[np.searchsorted(xs, allr["holds_high"]) + 1]
-            ax.axvspan(lo, hi, fill=False, hatch="//", ec="k", lw=1.5, label="consistent set")
-            ax.legend(fontsize=7, loc="upper right")
+        feas = next(r for r in c if r["input"] == name and r["claim"] != "ALL"
+                    and r["claim"].startswith("ALL"))
+        for r, hatch, lab in ((allr, "//", "consistent set"),
+                              (feas, "..", "consistent set of the claims consistent somewhere")):
+            if r["n_consistent"] and (r is allr or not allr["n_consistent"]):
+                lo = edges[np.searchsorted(xs, r["holds_low"])]
+                hi = edges[np.searchsorted(xs, r["holds_high"]) + 1]
+                ax.axvspan(lo, hi, fill=False, hatch=hatch, ec="k", lw=1.5, label=lab)
+                ax.legend(fontsize=7, loc="upper right")
         ax.set_yticks(range(len(rows)))
         ax.set_yticklabels([r["claim"].replace("wolf.", "") for r in rows], fontsize=5)
         ax.set_ylim(-0.5, len(rows) - 0.5)

@@ -48,12 +48,15 @@ def findings(out: Path) -> list[str]:
                          f"`{r['claim']}` printed {_printed(r)}, recomputed {r['value']:.2f}"
                          for r in err) + ".")
     for r in cs:
-        if r["claim"] != "ALL":
+        if not r["claim"].startswith("ALL"):
             continue
         what = (f"{r['holds_low']:g} to {r['holds_high']:g} ({r['n_consistent']} of "
                 f"{r['n_values']} values tried)" if r["n_consistent"] else
-                f"none of the {r['n_values']} values tried ({r['note']})")
-        lines.append(f"- Consistent set of `{r['input']}`: {what}.")
+                f"none of the {r['n_values']} values tried")
+        label = ("Consistent set" if r["claim"] == "ALL" else
+                 "Consistent set of the claims consistent somewhere")
+        lines.append(f"- {label} of `{r['input']}`: {what}" + (f" ({r['note']})" if r["note"]
+                                                              else "") + ".")
     return lines
 
 

@@ -40,6 +40,12 @@ def _summ(x):
     return float(med), float(lo), float(hi)
 
 
+def sub_chunk(trials: int, chunk: int) -> int:
+    """Chunk size of the smaller parts: at most ``chunk``, and at least four chunks, so the
+    trade-offs and the sweeps spread over the workers too."""
+    return max(1, min(chunk, -(-trials // 4)))
+
+
 def reading_cells(cfg: dict) -> list[tuple[str, str, float, int, dict]]:
     """``(tag, approach, sigma, readings, override)`` of the readings trade-off."""
     out = []
@@ -64,15 +70,15 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     rc, sc = reading_cells(cfg), consistent.sweep_cells(cfg)
     cells = [(t, o) for t, *_, o in rc] + [(t, o) for t, _, _, o in sc]
     Ts = cfg["unprinted.trials"]
-    res = run_chunks(main_chunk(cfg, cells, full=False), Ts, seed, min(ch, Ts), part=1, ctx=ctx,
-                     label="wolf cells", quiet=q)
+    res = run_chunks(main_chunk(cfg, cells, full=False), Ts, seed, sub_chunk(Ts, ch), part=1,
+                     ctx=ctx, label="wolf cells", quiet=q)
     er = chunk_rng(seed, 30, 0)
     rd = {k: [] for k in ("approach", "pointing_sigma_um", "readings", "reading_error_um",
                           "after_check_rms_um", "after_check_lo_um", "after_check_hi_um",
                           "after_plate_rms_um", "after_plate_lo_um", "after_plate_hi_um")}
     for tag, a, sg, n, _ in rc:
-        ca = np.sqrt((res[tag + "check_after.rms_x_um"] ** 2 + res[tag + "check_after.rms_y_um"] ** 2) / 2)
-        pa = np.sqrt((res[tag + "plate_after.rms_x_um"] ** 2 + res[tag + "plate_after.rms_y_um"] ** 2) / 2)
+        ca, pa = (np.sqrt((res[f"{tag}{e}.rms_x_um"] ** 2 + res[f"{tag}{e}.rms_y_um"] ** 2) / 2)
+                  for e in ("check_after", "plate_after"))
         vals = (a, sg, n, reading_error_rms(er, cfg["reading.count_um"], n, sg,
                                             cfg["reading.backlash_um"], a),
                 *_summ(ca), *_summ(pa))
@@ -119,7 +125,8 @@ def _vectors_and_components(cfg, out, prov):
 
 def _degree(cfg, out, prov, ctx) -> dict:
     seed, q = cfg["seed"], ctx.quiet
-    Tt, cht = cfg["trade.trials"], min(cfg["trade.trials"], cfg["chunk"])
+    Tt = cfg["trade.trials"]
+    cht = sub_chunk(Tt, cfg["chunk"])
     rows = {k: [] for k in ("spacing_mm", "n_points", "n_sets", "degree", "terms", "fit_rms_um",
                             "fit_lo_um", "fit_hi_um", "check_rms_um", "check_lo_um",
                             "check_hi_um", "estimable_share")}
@@ -146,7 +153,8 @@ def _degree(cfg, out, prov, ctx) -> dict:
 
 
 def _stability(cfg, out, prov, ctx) -> None:
-    Tt, cht = cfg["trade.trials"], min(cfg["trade.trials"], cfg["chunk"])
+    Tt = cfg["trade.trials"]
+    cht = sub_chunk(Tt, cfg["chunk"])
     fr_, ages = cfg["trade.drift_fractions"], cfg["trade.ages_weeks"]
     r = run_chunks(stability_chunk(cfg, fr_, ages), Tt, cfg["seed"], cht, part=40, ctx=ctx,
                    label="stability", quiet=ctx.quiet)

@@ -229,7 +229,7 @@ def check(cfg: dict) -> None:
     if cx - w / 2 < a[0] or cx + w / 2 > a[1] or cy - h / 2 < a[2] or cy + h / 2 > a[3]:
         raise ConfigError("repeat.format_mm", "the photograph must lie inside the calibrated area "
                           "(the polynomial is not meant to extrapolate)")
-    m = len(g) * cfg["calib.n_sets"] + len(mid_cells(a, cfg["plate.spacing_mm"])) * cfg["calib.n_sets"]
+    m = (len(g) + len(mid_cells(a, cfg["plate.spacing_mm"]))) * cfg["calib.n_sets"]
     m += cfg["check.n_points"] + 2 * (cfg["repeat.n_points"] + 4)
     nmax = max([cfg["reading.n"], *cfg["trade.readings"]])
     for key in ("chunk", "trade.trials", "unprinted.trials"):
