@@ -1,0 +1,21 @@
+"""Study ``gridplate_two_plates``: comparator calibration with two grid plates (seed
+``001_7e3a2951e7fed426.txt``, *Calibration of a Comparator*).
+
+Modules: :mod:`.schema` (config and checks), :mod:`.model` (simulation and per-chunk
+reduction), :mod:`.run` (the run), :mod:`.sweep` (unprinted inputs, consistent set),
+``claims.toml`` + :mod:`.claims` (scoring), :mod:`.figures`, :mod:`.report`.
+"""
+from __future__ import annotations
+
+from .. import Study
+from .report import report
+from .run import run
+from .schema import SCHEMA, check
+
+SEED = "001_7e3a2951e7fed426.txt"
+
+STUDIES = {
+    "gridplate_two_plates": Study("gridplate_two_plates",
+                                  "Calibration of a comparator with two grid plates", SEED,
+                                  SCHEMA, run, report, check, order=20),
+}
