@@ -1,0 +1,21 @@
+"""Study ``salsig_encoders``: Salsig 1985, *Calibrating Stereo Plotter Encoders* (seed
+``002_fb81c7b0481438c4.txt``).
+
+Modules: :mod:`.schema` (config and checks), :mod:`.printed` (the paper's printed data),
+:mod:`.model` (simulation, chunk functions), :mod:`.run`, :mod:`.sweep` (unprinted inputs,
+consistent set), ``claims.toml`` + :mod:`.claims` (scoring), :mod:`.figures`, :mod:`.report`.
+"""
+from __future__ import annotations
+
+from .. import Study
+from .model import decompositions, simulate_chain, simulate_vertical, simulate_zscale  # noqa: F401
+from .report import report
+from .run import run
+from .schema import SCHEMA, check
+
+SEED = "002_fb81c7b0481438c4.txt"
+
+STUDIES = {
+    "salsig_encoders": Study("salsig_encoders", "Salsig: calibrating stereo plotter encoders", SEED,
+                             SCHEMA, run, report, check, order=30),
+}
