@@ -347,8 +347,9 @@ def write_claims(path, rows: Iterable[Mapping[str, Any]], prov: Mapping[str, Any
 
 
 def _null(x):
-    """NaN marks 'no number' in a row; Parquet stores it as null (missing), not as NaN."""
-    return None if isinstance(x, float) and math.isnan(x) else x
+    """NaN marks 'no number' in a row and an infinite zone side 'unbounded' (a bound's open
+    side); Parquet stores both as null (missing), never as NaN or infinity."""
+    return None if isinstance(x, float) and not math.isfinite(x) else x
 
 
 # --------------------------------------------------------------------------- statistics

@@ -50,13 +50,14 @@ _VERDICT_TEXT = {"holds": "holds", "fails": "**fails**", "inconclusive": "inconc
 def _ref_text(r) -> str:
     """The paper's reference as the decision zone it stands for."""
     lo, hi = r.get("zone_low"), r.get("zone_high")
-    if lo is None or (isinstance(lo, float) and math.isnan(lo)):
+    none = lambda x: x is None or (isinstance(x, float) and not math.isfinite(x))  # noqa: E731
+    if none(lo) and none(hi):
         return ""
     f = (lambda x: f"{x:.10g}") if r["interval"] == "exact" else (lambda x: fmt(x, 4))  # noqa: E731
     form = r.get("form") or ""
-    if form == "upper" or (math.isinf(lo) and lo < 0):
+    if form == "upper" or none(lo):
         return f"≤ {f(hi)}"
-    if form == "lower" or math.isinf(hi):
+    if form == "lower" or none(hi):
         return f"≥ {f(lo)}"
     return f(lo) if lo == hi else f"{f(lo)}–{f(hi)}"
 

@@ -134,3 +134,16 @@ def test_not_comparable_rows_are_written_with_no_number(tmp_path):
     t = pq.read_table(tmp_path / "claims.parquet").to_pydict()
     assert t["value"][0] is None and t["verdict"] == ["not comparable", "holds"]
     assert t["note"][0] == "the setup is not printed"
+
+
+def test_a_bound_is_written_with_its_open_side_null(tmp_path):
+    import pyarrow.parquet as pq
+
+    from sim.claims import write_claims
+    from sim.report import claims_markdown
+
+    b = book(form="upper", ref=2.0, tol=0)
+    write_claims(tmp_path / "claims.parquet", [b.score("t.c", 1.0, (0.5, 1.5))], {"study": "t"}, b)
+    t = pq.read_table(tmp_path / "claims.parquet").to_pydict()
+    assert t["zone_low"] == [None] and t["zone_high"] == [2.0] and t["verdict"] == ["holds"]
+    assert "≤ 2" in claims_markdown(tmp_path / "claims.parquet")
