@@ -459,3 +459,42 @@ def test_monte_carlo_point_errors_match_adjustment_covariance(small):
     # that holds even for fully correlated coordinates
     assert np.all(np.abs(ratio - 1) < tol)
     assert abs(ratio.mean() - 1) < tol
+
+
+def test_consistent_set_from_constructed_samples():
+    """Claim by claim, the swept values where the book's rule gives holds / not fails, and
+    the consistent set as their intersection."""
+    from sim.claims import ClaimBook
+    from sim.studies.agnard.sweep import evaluate
+
+    base = {"source": "s", "paper": "p", "kind": "prediction", "form": "one-plate",
+            "decimals": 0}
+    book = ClaimBook([{**base, "id": "a", "ref": 10, "tol": 2.0},
+                      {**base, "id": "b", "ref": 20, "tol": 4.0}], [], "<test>")
+    rng = np.random.default_rng(0)
+    centres = {0.0: (5, 20), 0.1: (10, 20.1), 0.2: (10.2, 30), 0.3: (20, 20)}
+    sweeps = {"u": {u: {"a": a + rng.normal(0, 0.3, 400), "b": b + rng.normal(0, 0.3, 400)}
+                    for u, (a, b) in centres.items()}}
+    long, cs = evaluate(book, sweeps)
+    rows = {c: (lo, hi, ol, oh) for c, lo, hi, ol, oh in zip(cs["claim"], cs["holds_low"],
+                                                             cs["holds_high"], cs["ok_low"],
+                                                             cs["ok_high"])}
+    assert rows["a"] == (0.1, 0.2, 0.1, 0.2)
+    assert rows["b"][:2] == (0.0, 0.3)
+    assert rows["ALL"] == (0.1, 0.1, 0.1, 0.1)
+    assert len(long["claim"]) == 8 and set(long["outcome"]) <= {"holds", "fails", "inconclusive"}
+
+
+def test_input_rows_follow_the_config():
+    """An input row reports the run's value (here changed by an override), never a typed one."""
+    from sim.studies.agnard.claims import input_rows, load_book
+    from sim.studies.agnard.schema import block_of
+
+    _, cfg = load_study(STUDY, ["scan.max_y_um=30.0"])
+    b = block_of(cfg)
+    book = load_book()
+    rows = {r["claim"]: r for r in input_rows(book, cfg, b, select_control(b, "five"),
+                                              select_control(b, "full"))}
+    assert rows["agnard.input.scan.max_y_um"]["value"] == 30.0
+    assert rows["agnard.input.scan.max_y_um"]["verdict"] == "input"
+    assert rows["agnard.scanner.pixel_um"]["verdict"] == "holds"          # 25.4 mm / 600

@@ -49,10 +49,11 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
         e = done[lay].X[:, :ng] - block.points[:ng]
         out[f"{CHUNK}{tag}_first_e_m"] = e[:1]
         out[f"{CHUNK}{tag}_sum_e_m"] = e.sum(0, keepdims=True)
-    # first pass: weak control
+    # first pass: weak control (started from the 21-control solution of the same blocks)
+    res21 = done[cfg["control.many"]]
     wo1, wc1 = paper_weights(cfg, first_pass=True)
     _, _, res = adj.adjust(sim, ("digital", "corrected"), cfg["control.many"], wo1, wc1,
-                           start=res0)
+                           start=res21)
     pas = block.is_pass[block.obs_point]
     v = res.v_obs[:, pas]
     out["first.pass_xy_m"] = np.sqrt(np.mean(v[..., 0] ** 2 + v[..., 1] ** 2, 1))
@@ -66,8 +67,8 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
     n_pass = int(block.is_pass.sum())
     for mode in ("digital", "mechanical"):
         rej, s0, _, _ = im.snoop(st, sim.xm[(mode, "corrected")], ws, sim.ctrl_obs[:, ctrl],
-                                 np.broadcast_to(wsc, (ctrl.size, 3)), res0.s, res0.R,
-                                 res0.t, res0.X, block.is_pass, crit,
+                                 np.broadcast_to(wsc, (ctrl.size, 3)), res21.s, res21.R,
+                                 res21.t, res21.X, block.is_pass, crit,
                                  cfg["snoop.max_reject"], cfg["snoop.test"] == "tau")
         out[f"snoop_{mode}.rejected"] = rej[:, block.is_pass].sum(1)
         out[f"snoop_{mode}.share_pct"] = 100.0 * out[f"snoop_{mode}.rejected"] / n_pass

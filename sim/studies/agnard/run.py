@@ -57,17 +57,25 @@ def _check_vectors(cfg, block, sim, c5, c21, T, prov, out):
     return vec
 
 
-def _scanner_table(cfg, block, ctx, prov, out):
+def _scanner_table(cfg, block, sim, ctx, prov, out):
+    """Scan resolution x calibration; the run's own resolution reuses the main blocks when
+    their 'without' adjustment has the 21-control layout."""
     t = {k: [] for k in ("dpi", "calibration", "trials", "check_xy_m", "check_xy_m_se",
                          "check_z_m", "check_z_m_se", "ctrl_xy_m", "ctrl_z_m", "gain_xy_pct",
                          "gain_xy_pct_se")}
     for i, dpi in enumerate(cfg["tradeoff.dpis"]):
-        r = _run(partial(ch.scanner_chunk, cfg, block, dpi), cfg["tradeoff.trials"], cfg, 1 + i,
-                 f"{dpi:g} DPI", ctx)
+        if dpi == cfg["scan.dpi"] and cfg["control.table1"] == cfg["control.many"]:
+            r = {f"{cal}.{q}": sim[f"{pre}.{q}"] for cal, pre in
+                 (("raw", "without"), ("corrected", f"layout_{cfg['control.many']}"))
+                 for q in ("check_xy_m", "check_z_m", "ctrl_xy_m", "ctrl_z_m")}
+            r["gain_xy_pct"] = 100 * (1 - r["corrected.check_xy_m"] / r["raw.check_xy_m"])
+        else:
+            r = _run(partial(ch.scanner_chunk, cfg, block, dpi), cfg["tradeoff.trials"], cfg,
+                     1 + i, f"{dpi:g} DPI", ctx)
         for cal in ("raw", "corrected"):
             t["dpi"].append(dpi)
             t["calibration"].append(cal)
-            t["trials"].append(cfg["tradeoff.trials"])
+            t["trials"].append(len(r["gain_xy_pct"]))
             for q in ("check_xy_m", "check_z_m"):
                 m, se = _mean_se(r[f"{cal}.{q}"])
                 t[q].append(m)
@@ -126,16 +134,20 @@ def _size_table(cfg, block, ctx, base, prov, out):
     return t
 
 
-def _pugging(cfg, block, ctx, base, prov, out):
+def _pugging(cfg, block, sim, ctx, base, prov, out):
+    """Rejections against the re-centring error; the run's own value is the main blocks'."""
     t = {k: [] for k in ("recentre_px", "trials", "mean_share_pct", "mean_share_pct_se")}
     per = {}
     for i, rc in enumerate(cfg["tradeoff.recentre_px"]):
-        r = _run(partial(ch.pugging_chunk, cfg, block, rc), cfg["tradeoff.trials"], cfg, base + i,
-                 f"re-centring {rc:g} px", ctx)
+        if rc == cfg["pugging.recentre_px"]:
+            r = {"share_pct": sim["snoop_mechanical.share_pct"]}
+        else:
+            r = _run(partial(ch.pugging_chunk, cfg, block, rc), cfg["tradeoff.trials"], cfg,
+                     base + i, f"re-centring {rc:g} px", ctx)
         per[float(rc)] = r["share_pct"]
         m, se = _mean_se(r["share_pct"])
         t["recentre_px"].append(rc)
-        t["trials"].append(cfg["tradeoff.trials"])
+        t["trials"].append(len(r["share_pct"]))
         t["mean_share_pct"].append(m)
         t["mean_share_pct_se"].append(se)
     write_table(out / "tradeoff_pugging.parquet", t, prov)
@@ -162,12 +174,12 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
                                          "z_m": block.points[:, 2], "kind": kind.astype(str),
                                          "models": nmod}, prov)
     vec = _check_vectors(cfg, block, sim, c5, c21, T, prov, out)
-    scan_t = _scanner_table(cfg, block, ctx, prov, out)
+    scan_t = _scanner_table(cfg, block, per_trial, ctx, prov, out)
     lay_t = _control_table(cfg, block, sim, prov, out)
     base = 1 + len(cfg["tradeoff.dpis"])
     size_t = _size_table(cfg, block, ctx, base, prov, out)
     base += len(cfg["tradeoff.block_strips"])
-    pug = _pugging(cfg, block, ctx, base, prov, out)
+    pug = _pugging(cfg, block, per_trial, ctx, base, prov, out)
     base += len(cfg["tradeoff.recentre_px"])
 
     # --- the unprinted five-point layout, swept
