@@ -146,46 +146,39 @@ def fig_tradeoffs(scan_t: dict, lay_t: dict, size_t: dict, path: Path) -> None:
 
 
 def fig_consistent(sweep: dict, cs: dict, path: Path) -> None:
-    """Per swept input: each claim's simulated median and 95 % plate range against the input,
-    the paper's value band (decision zone), the consistent set shaded."""
-    inputs = list(dict.fromkeys(sweep["input"]))
-    claims = {i: list(dict.fromkeys(c for j, c in zip(sweep["input"], sweep["claim"]) if j == i))
-              for i in inputs}
-    ncol = max(len(c) for c in claims.values())
-    fig, axs = plt.subplots(len(inputs), ncol, figsize=(2.9 * ncol, 3.1 * len(inputs)),
-                            squeeze=False)
-    fig.subplots_adjust(wspace=0.55, hspace=0.75)
+    """Per swept input and claim: the simulated median and 95 % plate range against the
+    input, the paper's value band (decision zone), the consistent set shaded."""
+    panels = list(dict.fromkeys(zip(sweep["input"], sweep["claim"])))
+    ncol = min(4, len(panels))
+    nrow = -(-len(panels) // ncol)
+    fig, axs = plt.subplots(nrow, ncol, figsize=(3.6 * ncol, 3.0 * nrow), squeeze=False)
+    fig.subplots_adjust(wspace=0.45, hspace=0.8)
     col = {"holds": "tab:green", "inconclusive": "tab:orange", "fails": "tab:red"}
-    for r, inp in enumerate(inputs):
+    for ax, (inp, cl) in zip(axs.flat, panels):
+        sel = [k for k, (i, c) in enumerate(zip(sweep["input"], sweep["claim"]))
+               if i == inp and c == cl]
+        x = np.asarray(sweep["value"])[sel]
+        med, lo, hi = (np.asarray(sweep[q])[sel] for q in ("median", "lo", "hi"))
+        zl, zh = sweep["zone_low"][sel[0]], sweep["zone_high"][sel[0]]
+        ax.axhspan(zl if np.isfinite(zl) else min(0.0, lo.min()),
+                   zh if np.isfinite(zh) else hi.max(), color="0.85")
+        ax.errorbar(x, med, yerr=[med - lo, hi - med], fmt="none", ecolor="0.4", capsize=2)
+        for k in sel:
+            ax.plot(sweep["value"][k], sweep["median"][k], "o",
+                    color=col.get(sweep["outcome"][k], "k"), ms=5)
         allrow = [k for k, (i, c) in enumerate(zip(cs["input"], cs["claim"]))
                   if i == inp and c == "ALL"]
-        lo = cs["ok_low"][allrow[0]] if allrow else np.nan
-        hi = cs["ok_high"][allrow[0]] if allrow else np.nan
-        for c_i, cl in enumerate(claims[inp]):
-            ax = axs[r, c_i]
-            sel = [k for k, (i, c) in enumerate(zip(sweep["input"], sweep["claim"]))
-                   if i == inp and c == cl]
-            x = np.asarray(sweep["value"])[sel]
-            zl, zh = sweep["zone_low"][sel[0]], sweep["zone_high"][sel[0]]
-            ax.axhspan(zl if np.isfinite(zl) else min(0.0, min(sweep["lo"][k] for k in sel)),
-                       zh if np.isfinite(zh) else max(sweep["hi"][k] for k in sel), color="0.85",
-                       label="paper (zone)")
-            ax.errorbar(x, np.asarray(sweep["median"])[sel],
-                        yerr=[np.asarray(sweep["median"])[sel] - np.asarray(sweep["lo"])[sel],
-                              np.asarray(sweep["hi"])[sel] - np.asarray(sweep["median"])[sel]],
-                        fmt="none", ecolor="0.4", capsize=2)
-            for k in sel:
-                ax.plot(sweep["value"][k], sweep["median"][k], "o",
-                        color=col.get(sweep["outcome"][k], "k"), ms=5)
-            if np.isfinite(lo):
-                ax.axvspan(lo, hi, color="tab:green", alpha=0.12)
-            ax.set_title(cl.replace("agnard.", ""), fontsize=7)
-            ax.set_xlabel(inp, fontsize=7)
-            ax.set_ylabel(sweep["unit"][sel[0]], fontsize=7)
-            ax.tick_params(labelsize=7)
-        for c_i in range(len(claims[inp]), ncol):
-            axs[r, c_i].axis("off")
-    fig.suptitle("claims against the unprinted inputs (dot: median plate; bar: 95 % of plates; "
-                 "grey: paper's zone; green dot holds, orange inconclusive, red fails; green "
-                 "band: consistent set, no claim fails)", fontsize=8)
+        a_lo, a_hi = cs["ok_low"][allrow[0]], cs["ok_high"][allrow[0]]
+        if np.isfinite(a_lo):
+            pad = 0.02 * (x.max() - x.min() or 1.0)
+            ax.axvspan(a_lo - pad, a_hi + pad, color="tab:green", alpha=0.15)
+        ax.set_title(cl.replace("agnard.", ""), fontsize=8)
+        ax.set_xlabel(inp, fontsize=8)
+        ax.set_ylabel(sweep["unit"][sel[0]], fontsize=8)
+        ax.tick_params(labelsize=7)
+    for ax in list(axs.flat)[len(panels):]:
+        ax.axis("off")
+    fig.suptitle("claims against the unprinted inputs: dot = median block, bar = 95 % of blocks, "
+                 "grey = paper's decision zone;\ndot green: holds, orange: inconclusive, red: "
+                 "fails; green band: consistent set (no claim of that input fails)", fontsize=9)
     save(fig, path)

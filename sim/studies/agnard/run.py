@@ -36,8 +36,11 @@ def _mean_se(x: np.ndarray) -> tuple[float, float]:
 
 
 def _run(fn, trials, cfg, part, label, ctx, chunk=None):
-    return run_chunks(fn, trials, cfg["seed"], chunk or cfg["chunk"], part=part,
-                      label=f"{NAME} {label}", quiet=ctx.quiet, ctx=ctx)
+    """One part through the runner, in at least four chunks (when it has the trials) so that
+    the parts, run one after the other, keep every worker busy."""
+    chunk = chunk or min(cfg["chunk"], max(1, -(-trials // 4)))
+    return run_chunks(fn, trials, cfg["seed"], chunk, part=part, label=f"{NAME} {label}",
+                      quiet=ctx.quiet, ctx=ctx)
 
 
 def _check_vectors(cfg, block, sim, c5, c21, T, prov, out):
@@ -118,7 +121,7 @@ def _size_table(cfg, block, ctx, base, prov, out):
         # bound the memory of the pair blocks (trials x observation pairs x 7 x 7)
         npair = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points).pk1.size
         chunk = max(1, min(cfg["chunk"], 4_000_000 // (49 * npair),
-                           -(-cfg["tradeoff.block_trials"] // 2)))  # >= 2 chunks: parallel
+                           -(-cfg["tradeoff.block_trials"] // 4)))  # >= 4 chunks: parallel
         r = _run(partial(ch.size_chunk, cfg, b, cen), cfg["tradeoff.block_trials"], cfg, base + i,
                  f"{S}x{M}", ctx, chunk)
         t["strips"].append(S)
