@@ -58,13 +58,16 @@ def design(pts: np.ndarray, terms, norm_mm: float = 100.0) -> np.ndarray:
     x, y = u[..., 0], u[..., 1]
     mx = max(i for i, _ in terms)
     my = max(j for _, j in terms)
-    px = [np.ones_like(x)]
-    py = [np.ones_like(y)]
-    for _ in range(mx):
-        px.append(px[-1] * x)
-    for _ in range(my):
-        py.append(py[-1] * y)
-    return np.stack([px[i] * py[j] for i, j in terms], axis=-1)
+    px = np.empty(x.shape + (mx + 1,))
+    py = np.empty(y.shape + (my + 1,))
+    px[..., 0], py[..., 0] = 1.0, 1.0
+    for i in range(mx):                   # successive products: the same numbers as x**i
+        np.multiply(px[..., i], x, out=px[..., i + 1])
+    for j in range(my):
+        np.multiply(py[..., j], y, out=py[..., j + 1])
+    ix = np.array([i for i, _ in terms])
+    iy = np.array([j for _, j in terms])
+    return np.take(px, ix, axis=-1) * np.take(py, iy, axis=-1)
 
 
 @dataclass(frozen=True)

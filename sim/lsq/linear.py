@@ -206,13 +206,15 @@ def _per_trial(A, b, w, fin_b, rcond) -> LinearFit:
         # Gershgorin: the eigenvalues of B'B lie within [1 - g, 1 + g]; keep R0 where g < 1/2
         near = np.abs(NB - np.eye(p)).sum(axis=-1).max(axis=-1) < 0.5
         P = np.broadcast_to(R0inv, (T, p, p))
+        N = np.matmul(np.matmul(R0.T, NB), R0)                      # A'WA for the rule
         if not near.all():
             far = ~near
             B[far], D = _equilibrated(Aw[far])
             NB[far] = np.matmul(np.swapaxes(B[far], 1, 2), B[far])
+            d = 1.0 / np.einsum("tii->ti", D)
+            N[far] = NB[far] * d[:, :, None] * d[:, None, :]
             P = P.copy()
             P[far] = D
-        N = np.matmul(np.matmul(np.linalg.inv(np.swapaxes(P, 1, 2)), NB), np.linalg.inv(P))
     else:
         B, P = _equilibrated(Aw)
         NB = np.matmul(np.swapaxes(B, 1, 2), B)
