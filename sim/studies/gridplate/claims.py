@@ -132,7 +132,9 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
                    "pooled; the printed 1.5 is an erratum (paper_check.affine_from_comparator_and_"
                    "grid), so the reference is the value the paper's other numbers support."))
     sup = math.hypot(r1p2, r0p7)
-    corner = (math.hypot(r1p2 - 0.05, r0p7 - 0.05), math.hypot(r1p2 + 0.05, r0p7 + 0.05))
+    h1 = 0.5 * 10.0 ** -book.spec("twoplate.comparator_sigma.sigma_um")["decimals"]
+    h2 = 0.5 * 10.0 ** -book.spec("twoplate.grid.stated_sigma_um")["decimals"]
+    corner = (math.hypot(r1p2 - h1, r0p7 - h2), math.hypot(r1p2 + h1, r0p7 + h2))
     r12, r13 = ref["twoplate.weight_ratio.grid_sigma_1to2_um"], ref["twoplate.weight_ratio.grid_sigma_1to3_um"]
     add(book.score("twoplate.paper_check.affine_from_comparator_and_grid", sup, interval="exact",
                    note=f"recomputed: sqrt({r1p2:g}^2 + {r0p7:g}^2) = {sup:.3f} um (independent "
