@@ -19,20 +19,6 @@ from .model import PARAM_LABEL, PARAMS
 BOOK = Path(__file__).with_name("claims.toml")
 
 
-#: stand-in for an open end of an ``upper``/``lower`` decision zone: storage refuses +-inf
-#: in float columns (a claims-API issue reported to the lead); NaN would hide the bound
-OPEN = float(np.finfo(float).max)
-
-
-def open_zones(rows: list[dict]) -> list[dict]:
-    """Replace the infinite end of half-open decision zones by +-``OPEN``."""
-    for r in rows:
-        for k in ("zone_low", "zone_high"):
-            if isinstance(r[k], float) and math.isinf(r[k]):
-                r[k] = math.copysign(OPEN, r[k])
-    return rows
-
-
 def load_book() -> ClaimBook:
     return ClaimBook.load(BOOK)
 
@@ -209,7 +195,7 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
                            f"contains the truth; {lab}"
                            + (f" (1:{cfg['analysis.ratios'][j_true]:g})" if tag.startswith("w") else "")
                            + "."))
-    return open_zones(rows), book
+    return rows, book
 
 
 def beyond_table(res: dict, ratios: list, j_true: int) -> dict:

@@ -15,20 +15,8 @@ from ...claims import ClaimBook, mean_ci, std_ci
 from . import printed as pr
 
 BOOK = Path(__file__).with_name("claims.toml")
-#: stand-in for the open end of an upper/lower zone (storage refuses +-inf in float columns)
-OPEN = float(np.finfo(float).max)
-
-
 def load_book() -> ClaimBook:
     return ClaimBook.load(BOOK)
-
-
-def open_zones(rows: list[dict]) -> list[dict]:
-    for r in rows:
-        for k in ("zone_low", "zone_high"):
-            if isinstance(r[k], float) and math.isinf(r[k]):
-                r[k] = math.copysign(OPEN, r[k])
-    return rows
 
 
 def s0_from_residuals(res, n_points: int = pr.N_POINTS) -> tuple[float, float, float]:
@@ -156,4 +144,4 @@ def score(cfg: dict, dec: dict, rec: dict, zs: dict, vt: dict) -> tuple[list[dic
         add(book.score(f"salsig.vertical_halved.rms_z_{tag}_um", float(med), (float(lo), float(hi)),
                        "spread", note=f"rms vertical control residual {tag} the correction, "
                        "model um, median and 95 % range over models."))
-    return open_zones(rows), book
+    return rows, book
