@@ -2,7 +2,15 @@
 
 The public surface: load and run studies, the Brown multilateration kernels, and the claims
 and storage helpers every study uses. Everything else is internal.
+
+The suite parallelises over chunks of trials (processes, ``--workers``); a multi-threaded
+BLAS inside each process would oversubscribe the cores and make the small batched solves
+several times slower, so BLAS runs single-threaded unless the environment says otherwise.
 """
+import os as _os
+
+for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    _os.environ.setdefault(_v, "1")
 from .claims import claim
 from .config import ConfigError, load_study
 from .multilateration import adjust, covariance, design_theta, ranges, simulate_ranges
