@@ -333,7 +333,7 @@ def test_consistent_set_table(tiny_run):
     cs = read_table(out / "consistent_set.parquet").to_pydict()
     for c in ("input", "claim", "holds_low", "holds_high"):
         assert c in cs
-    assert set(cs["input"]) == {"control.five_inset", "pugging.recentre_px"}
+    assert set(cs["input"]) == {"sweep.five_inset", "pugging.recentre_px"}
     assert cs["claim"].count("ALL") == 2
     lo, hi = np.array(cs["ok_low"], float), np.array(cs["ok_high"], float)
     fin = np.isfinite(lo)

@@ -195,7 +195,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         sweep_t[k] = np.concatenate([sw[f"inset{i}.{k}"] for i in range(len(insets))])
     ctrl_idx = [five_control(block, u) for u in insets]
     write_table(out / "sweep_five.parquet", sweep_t, prov)
-    sweeps = {"control.five_inset": {float(u): five_samples(sw, i) for i, u in enumerate(insets)},
+    sweeps = {"sweep.five_inset": {float(u): five_samples(sw, i) for i, u in enumerate(insets)},
               "pugging.recentre_px": {rc: {RECENTRE_CLAIMS[0]: s} for rc, s in pug.items()}}
     long, cs = evaluate(book, sweeps)
     write_table(out / "sweep_claims.parquet", long, prov)
