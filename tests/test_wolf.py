@@ -307,8 +307,28 @@ def test_field_scale_cell_equals_scaled_amplitudes():
     a = draw_main(cfg, np.random.default_rng(21), 5, 3)
     b = draw_main(cfg2, np.random.default_rng(21), 5, 3)
     for pa, pb in zip(a["cal"] + a["rep"], b["cal"] + b["rep"]):
-        assert np.allclose(pb.field, k * pa.field, rtol=1e-12, atol=1e-9)
+        assert np.allclose(pb.static, k * pa.static, rtol=1e-12, atol=1e-9)
+        assert np.allclose(pb.drift, k * pa.drift, rtol=1e-12, atol=1e-9)
         assert np.array_equal(pa.rest, pb.rest) and np.array_equal(pa.z, pb.z)
+
+
+def test_restitution_and_drift_cells_equal_the_configured_model():
+    """A cell's restitution amplitude and drifting share give the displacements of an instrument
+    configured with them (the restitution field is linear in its amplitude; the drift is
+    sqrt(1 - f) static + sqrt(f) drift)."""
+    from sim.studies.wolf.chunks import draw_main
+    from sim.studies.wolf.model import Instrument
+
+    cfg = _cfg(**{"field.restitution_um": 3.0, "field.drift_fraction": 0.4})
+    D = draw_main(cfg, np.random.default_rng(22), 4, 3)
+    rng = np.random.default_rng(22)
+    inst = Instrument(cfg, rng, 4, np.linspace(0.0, 4.0, 3).tolist() + [5.0, 5.0, 6.0])
+    P = D["cal"][1].P
+    st, dr = inst.parts(1, P)
+    assert np.allclose(inst.disp(1, P), math.sqrt(0.6) * st + math.sqrt(0.4) * dr, atol=1e-9)
+    r_unit = inst.restitution(np.random.default_rng(3), P, unit=True)
+    r_cfg = inst.restitution(np.random.default_rng(3), P)
+    assert np.allclose(r_cfg, 3.0 * r_unit, rtol=1e-12, atol=1e-12)
 
 
 def test_cells_share_instruments_and_default_cell_equals_main():

@@ -6,7 +6,8 @@ coordinates mm, discrepancies um.
 The main experiment draws one set of instruments, placements and noise per chunk
 (:func:`draw_main`) and reduces it for one or more *cells* (:func:`reduce_main`): a cell
 overrides the pointing sigma, the readings per point, the approach, the monocomparator sigma
-or a common factor on the field amplitudes. Cells of one chunk share their random numbers, so
+the restitution amplitude, the drifting share of the field or a common factor on the field
+amplitudes. Cells of one chunk share their random numbers, so
 the sweeps of the unprinted inputs and the readings trade-off compare like with like.
 """
 from __future__ import annotations
@@ -24,7 +25,7 @@ from .schema import _index, grid_nodes, mid_cells
 
 #: the config keys a cell may override, and the field-amplitude factor
 CELL_KEYS = ("reading.n", "reading.pointing_sigma_um", "reading.approach", "mono.sigma_um",
-             "field_scale")
+             "field.restitution_um", "field.drift_fraction", "field_scale")
 
 
 def _dates(cfg: dict, later) -> tuple[np.ndarray, np.ndarray]:
@@ -76,7 +77,9 @@ def reduce_main(cfg: dict, D: dict, cell: dict, full: bool = True, keep_vectors:
     n, sg = cell["reading.n"], cell["reading.pointing_sigma_um"]
     appr, fs = cell["reading.approach"], cell["field_scale"]
     rd = functools.partial(read_placed, count_um=cfg["reading.count_um"], n=n, sigma_um=sg,
-                           backlash_um=cfg["reading.backlash_um"], approach=appr, field_scale=fs)
+                           backlash_um=cfg["reading.backlash_um"], approach=appr, field_scale=fs,
+                           drift_fraction=cell["field.drift_fraction"],
+                           restitution_um=cell["field.restitution_um"])
     counts = [rd(p) for p in D["cal"]]
     red, tps, fit, mtp = calibrate(cfg, G, [c[:, :nG] for c in counts], ia, ib,
                                    cfg["calib.degree"], terms)

@@ -4,7 +4,8 @@ Wolf & Pearsall 1976 (seed ``000_668e60e68f004f98.txt``) print neither the point
 one reading, nor the sizes of the systematic error sources, nor the monocomparator's error.
 Each is swept (common random numbers: the same instruments for every value, see
 :mod:`.chunks`): ``reading.pointing_sigma_um``, a common factor ``field_scale`` on the seven
-``field.*_um`` amplitudes (their mix fixed), and ``mono.sigma_um``. For every value the claims
+``field.*_um`` amplitudes (their mix fixed), ``field.restitution_um``,
+``field.drift_fraction`` and ``mono.sigma_um``. For every value the claims
 that depend on the swept inputs are scored by the claim book's own rule. A claim is
 *consistent* with a value when it holds there or, for a one-plate statistic (the paper's number
 is one instrument's or plate's; it never "holds" sharply with ten points), when a plate at
@@ -24,6 +25,8 @@ from .claims import HEADLINE, score_simulated, swept_claims
 INPUTS = {"reading.pointing_sigma_um": ("unprinted.pointing_sigmas_um",
                                         "reading.pointing_sigma_um"),
           "field_scale": ("unprinted.field_scales", "field_scale"),
+          "field.restitution_um": ("unprinted.restitutions_um", "field.restitution_um"),
+          "field.drift_fraction": ("unprinted.drift_fractions", "field.drift_fraction"),
           "mono.sigma_um": ("unprinted.mono_sigmas_um", "mono.sigma_um")}
 
 

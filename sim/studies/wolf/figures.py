@@ -158,7 +158,9 @@ _GROUPS = (("before", "wolf.before.rms_", "before correction"),
 _CMAP = matplotlib.colors.ListedColormap(["#e8a0a0", "#9fd49f"])
 _LABEL = {"reading.pointing_sigma_um": "pointing sigma of one reading (um)",
           "field_scale": "common factor on the field amplitudes",
-          "mono.sigma_um": "monocomparator sigma (um)"}
+          "mono.sigma_um": "monocomparator sigma (um)",
+          "field.restitution_um": "restitution field, rms per axis (um)",
+          "field.drift_fraction": "drifting share of the field's variance"}
 
 
 def consistent_figure(out: Path) -> None:

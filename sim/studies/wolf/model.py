@@ -72,8 +72,22 @@ class Instrument:
                     d = d + math.sqrt(f) * self.W[k, j] * ef.evaluate(self.spec, self.drift[j], P)
         return d
 
-    def restitution(self, rng, P):
-        return ef.evaluate(self.rspec, ef.draw(self.rspec, rng, self.T), P)
+    def parts(self, k: int, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The static field and the drifting field of date ``k`` at ``P``, each at full size:
+        the displacement is ``sqrt(1 - f) static + sqrt(f) drift``."""
+        st = ef.evaluate(self.spec, self.static, P)
+        dr = np.zeros_like(st)
+        for j in range(k + 1):  # over dates, not trials
+            if self.W[k, j] != 0:
+                dr = dr + self.W[k, j] * ef.evaluate(self.spec, self.drift[j], P)
+        return st, dr
+
+    def restitution(self, rng, P, unit: bool = False):
+        """A fresh restitution field at ``P`` (rms ``field.restitution_um``, or 1 um with
+        ``unit``: the field is linear in its amplitude and draws the same numbers)."""
+        spec = ef.FieldSpec(stress_um=1.0, stress_length_mm=self.rspec.stress_length_mm) \
+            if unit else self.rspec
+        return ef.evaluate(spec, ef.draw(spec, rng, self.T), P)
 
 
 def rotate(P: np.ndarray, th: np.ndarray) -> np.ndarray:
@@ -171,13 +185,15 @@ def photo_points(rng, cfg, T):
 class Placed:
     """One plate placed on the carrier and everything random about reading it (see module doc).
 
-    P : (T, m, 2) mm carrier positions; field, rest : (T, m, 2) um field (at unit amplitude
-    factor) and restitution displacements; z : (T, m, 2, nmax) standard-normal pointing noise;
+    P : (T, m, 2) mm carrier positions; static, drift : (T, m, 2) um the static and the
+    drifting field (:meth:`Instrument.parts`, at unit amplitude factor); rest : (T, m, 2) um
+    restitution field of rms 1 um; z : (T, m, 2, nmax) standard-normal pointing noise;
     sign : (T, m, 2, nmax) approach signs for the ``random`` approach.
     """
 
     P: np.ndarray
-    field: np.ndarray
+    static: np.ndarray
+    drift: np.ndarray
     rest: np.ndarray
     z: np.ndarray
     sign: np.ndarray
@@ -190,17 +206,20 @@ def place(rng, inst: "Instrument", k: int, plate_true: np.ndarray, rot_sigma_deg
     th = np.deg2rad(rot_sigma_deg) * rng.normal(size=T)
     sh = rng.normal(0.0, shift_sigma_mm, (T, 2))
     P = rotate(plate_true, th) + sh[:, None, :]
-    field = inst.disp(k, P)
-    rest = inst.restitution(rng, P)
+    static, drift = inst.parts(k, P)
+    rest = inst.restitution(rng, P, unit=True)
     z = rng.normal(size=P.shape + (nmax,))
     sign = rng.choice(np.array([-1.0, 1.0]), P.shape + (nmax,))
-    return Placed(P, field, rest, z, sign)
+    return Placed(P, static, drift, rest, z, sign)
 
 
 def read_placed(pl_: Placed, count_um: float, n: int, sigma_um: float, backlash_um: float,
-                approach: str, field_scale: float = 1.0) -> np.ndarray:
+                approach: str, field_scale: float = 1.0, drift_fraction: float = 0.0,
+                restitution_um: float = 0.0) -> np.ndarray:
     """Mean of ``n`` quantised readings (counts) of a :class:`Placed` plate ``(T, m, 2)``."""
-    true_um = (pl_.P * 1000.0 + field_scale * pl_.field + pl_.rest)[..., None]
+    f = drift_fraction
+    field = math.sqrt(1 - f) * pl_.static + (math.sqrt(f) * pl_.drift if f > 0 else 0.0)
+    true_um = (pl_.P * 1000.0 + field_scale * field + restitution_um * pl_.rest)[..., None]
     bl = backlash_um / 2 if approach == "one_side" else backlash_um / 2 * pl_.sign[..., :n]
     return np.round((true_um + sigma_um * pl_.z[..., :n] + bl) / count_um).mean(axis=-1)
 

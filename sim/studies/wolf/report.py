@@ -126,9 +126,12 @@ def report(out: Path) -> str:
         "",
         claims_markdown(out / "claims.parquet"),
         "",
-        "**Unprinted inputs swept.** The paper prints neither the pointing error, nor the sizes "
-        "of the error sources, nor the monocomparator's error. Each is swept with the others at "
-        "their configured values, on the same simulated instruments; per claim, the swept values "
+        "**Unprinted inputs swept.** The paper does not print these inputs: "
+        + ", ".join(f"`{i}`" for i in dict.fromkeys(
+            read_table(out / "consistent_set.parquet").column("input").to_pylist()))
+        + " (`field_scale` is a common factor on the seven field amplitudes). Each is swept with "
+        "the others at their configured values, on the same simulated instruments; per claim, "
+        "the swept values "
         "for which it is consistent (criterion: holds, or for a one-plate claim, not "
         "contradicted, p >= 0.05), and the consistent set `ALL` of the values where every claim "
         "that depends on the input is consistent together:",

@@ -123,6 +123,12 @@ SCHEMA = {
                                 "list[float]", "common factors on the seven field.*_um amplitudes "
                                 "swept (their mix fixed; 1 = the configured amplitudes)", lo=0.0,
                                 hi=100.0, min_len=1),
+    "unprinted.restitutions_um": Field([0.0, 1.0, 2.0, 3.0, 4.0, 6.0], "list[float]",
+                                       "restitution amplitudes swept (field.restitution_um)",
+                                       lo=0.0, hi=100.0, min_len=1, unit="um"),
+    "unprinted.drift_fractions": Field([0.0, 0.1, 0.25, 0.5, 0.75], "list[float]",
+                                       "drifting shares of the field swept "
+                                       "(field.drift_fraction)", lo=0.0, hi=1.0, min_len=1),
     "unprinted.mono_sigmas_um": Field([0.0, 1.0, 2.0, 3.0, 4.0, 6.0], "list[float]",
                                   "monocomparator sigmas swept (mono.sigma_um)", lo=0.0, hi=100.0,
                                   min_len=1, unit="um"),
