@@ -1,7 +1,7 @@
 """sim: Monte-Carlo reproduction of classic comparator and plotter calibration papers.
 
-The public surface: load and run studies, the Brown multilateration kernels, and the claims
-and storage helpers every study uses. Everything else is internal.
+The public surface: ``sim.load(study_file, **overrides).run()`` (:mod:`sim.api`), the Brown
+multilateration kernels, and the claims and storage helpers every study uses. Everything else is internal.
 
 The suite parallelises over chunks of trials (processes, ``--workers``); a multi-threaded
 BLAS inside each process would oversubscribe the cores and make the small batched solves
@@ -11,12 +11,13 @@ import os as _os
 
 for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     _os.environ.setdefault(_v, "1")
+from .api import Results, StudyHandle, load  # noqa: E402
 from .claims import claim
-from .config import ConfigError, load_study
+from .config import ConfigError, StudyError, load_study
 from .multilateration import adjust, covariance, design_theta, ranges, simulate_ranges
 from .runner import run_chunks
 from .storage import read_provenance, write_table
 
-__all__ = ["ConfigError", "load_study", "run_chunks", "adjust", "covariance", "design_theta",
+__all__ = ["load", "StudyHandle", "Results", "ConfigError", "StudyError", "load_study", "run_chunks", "adjust", "covariance", "design_theta",
            "ranges", "simulate_ranges", "claim", "write_table", "read_provenance"]
 __version__ = "0.1.0"

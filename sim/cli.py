@@ -19,7 +19,7 @@ from pathlib import Path
 
 from .config import ConfigError, StudyError, check_chunks, load_study
 
-__all__ = ["main"]
+__all__ = ["main", "execute"]
 
 #: exit code of an internal error (a bug, not bad input): one line, traceback with SIM_DEBUG=1
 INTERNAL = 3
@@ -233,38 +233,54 @@ def _hint(msg: str, kind: str, schema) -> str:
 
 
 def _run(args) -> int:
-    from .estimate import check_limits, estimate
-    from .runner import ChunkStore, make_executor
-    from .storage import provenance, versions
-    from .studies import RunContext
-    from .sweep import read_sweep, run_sweep
+    from .sweep import read_sweep
 
     out = _check_args(args)
     study, cfg = load_study(args.study, args.set, args.trials, args.seed)
-    check_chunks(cfg)
     shown = args.out if args.out else str(Path("results") / cfg["study"])
-    out = out or Path(os.path.abspath(shown))
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
-    est = estimate(cfg, sweep)
-    check_limits(est, args.max_memory_gb, args.max_adjustments, args.workers)
-    from .storage import code_hash
+    execute(study, cfg, sweep, out or Path(os.path.abspath(shown)), shown,
+            executor=args.executor, workers=args.workers, scheduler=args.scheduler,
+            overwrite=args.overwrite, quiet=args.quiet, max_memory_gb=args.max_memory_gb,
+            max_adjustments=args.max_adjustments)
+    print(f"{cfg['study']}: results in {shown}/")
+    return 0
 
+
+def execute(study, cfg: dict, sweep: dict, out: Path, shown: str | None = None, *,
+            executor: str = "local", workers: int = 1, scheduler: str | None = None,
+            overwrite: bool = False, quiet: bool = False, max_memory_gb: float | None = None,
+            max_adjustments: float | None = None):
+    """Run a validated study config (and its sweep) into ``out`` (absolute): estimate and
+    limits, output checks, executor, locked staging directory, the run, and the final
+    replacement of ``out``. Raises ConfigError/StudyError (one line) on any failure.
+    Returns the run's :class:`sim.estimate.Estimate`."""
+    from .estimate import check_limits, estimate
+    from .runner import ChunkStore, make_executor
+    from .storage import code_hash, provenance, versions
+    from .studies import RunContext
+    from .sweep import run_sweep
+
+    shown = shown or str(out)
+    check_chunks(cfg)
+    est = estimate(cfg, sweep)
+    check_limits(est, max_memory_gb, max_adjustments, workers)
     record = {"config": {**cfg, "sweep": sweep} if sweep else cfg,
               "code_hash": code_hash(cfg["study"]), "versions": versions()}
-    _check_out(out, shown, record, args.overwrite)
+    _check_out(out, shown, record, overwrite)
     stage = out.parent / f".{out.name}.partial"
     try:
-        executor = make_executor(args.executor, args.workers, args.scheduler)
+        ex = make_executor(executor, workers, scheduler)
     except (RuntimeError, OSError, TimeoutError, ValueError, TypeError) as e:
-        key = "--scheduler" if args.scheduler else "--executor"
+        key = "--scheduler" if scheduler else "--executor"
         msg = (str(e).strip().splitlines() or [type(e).__name__])[0]
-        raise ConfigError(key, f"cannot start the {args.executor} executor: {msg}") from None
+        raise ConfigError(key, f"cannot start the {executor} executor: {msg}") from None
     lock = None
     try:
-        lock, resumed = _prepare_stage(stage, out, shown, record, args.overwrite)
+        lock, resumed = _prepare_stage(stage, out, shown, record, overwrite)
         if resumed:
             print(f"sim: resuming {cfg['study']}: {resumed} finished chunks found", file=sys.stderr)
-        ctx = RunContext(quiet=args.quiet, executor=executor,
+        ctx = RunContext(quiet=quiet, executor=ex,
                          store=ChunkStore(stage / "trials", provenance(cfg)), estimate=est)
         try:
             with ctx.progress_bar(cfg["study"]):
@@ -282,12 +298,12 @@ def _run(args) -> int:
             err.internal = True
             raise err from None
     except BaseException as e:
-        executor.close(kill=True)
+        ex.close(kill=True)
         if lock is not None:  # a failure of the run (not an interrupt) is marked replaceable
             failed = isinstance(e, (ConfigError, StudyError))
             _drop_stage(stage, lock, reason=str(e) if failed else None)
         raise
-    executor.close()
+    ex.close()
     try:
         _check_out(out, shown, record, True)  # again, under the lock: still ours or absent
         _publish(stage, out)
@@ -295,8 +311,7 @@ def _run(args) -> int:
         _drop_stage(stage, lock)
         raise
     lock.release()
-    print(f"{cfg['study']}: results in {shown}/")
-    return 0
+    return est
 
 
 def _publish(stage: Path, out: Path) -> None:

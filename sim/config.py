@@ -190,8 +190,12 @@ def read_toml(path: str | Path) -> dict[str, Any]:
 
 
 def load_study(path: str | Path, overrides: list[str] | tuple = (),
-               trials: int | None = None, seed: int | None = None):
+               trials: int | None = None, seed: int | None = None,
+               values: Mapping[str, Any] | None = None):
     """Load, override and validate a study file.
+
+    ``overrides``: ``"key=value"`` strings (values read as TOML, as ``--set``); ``values``:
+    ``{dotted.key: value}`` with Python values (the Python API).
 
     Returns ``(study, cfg)`` where ``study`` is the registered :class:`sim.studies.Study`
     and ``cfg`` the resolved flat configuration (including ``study``).
@@ -209,6 +213,10 @@ def load_study(path: str | Path, overrides: list[str] | tuple = (),
         if key == "study":
             raise ConfigError("study", "cannot be overridden")
         flat[key] = value
+    for key, value in (values or {}).items():
+        if key == "study":
+            raise ConfigError("study", "cannot be overridden")
+        flat[key] = list(value) if isinstance(value, tuple) else value
     if trials is not None:
         flat["trials"] = trials
     if seed is not None:

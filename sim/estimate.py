@@ -183,9 +183,12 @@ def _agnard(c: Mapping) -> tuple:
     trials = T + tT * (dp + rc) + bT * len(sizes)
     snoop = 1 + c.get("snoop.max_reject", 0)
     adj = T * (3 + layouts) * snoop + tT * (2 * dp + rc) * snoop + bT * len(sizes) * 2
-    # normal equations of the models (7 x 7 blocks coupled through the points)
-    b = max(ch * (7 * M) ** 2 * F8, 4e6 * F8, ch * scan_nodes * 2 * F8,
-            min(ch, bT or 1) * (7 * Mt) ** 2 * F8, ch * pts * M * 6 * F8) * COPIES
+    # reduced normal equations of the models (7 x 7 blocks coupled through the points); the
+    # block-size trade-off bounds its chunk by the pair blocks (4e6 floats)
+    npair = Mt * 40.0
+    ch_t = max(1.0, min(ch, bT or 1, 4e6 // (49 * npair)))
+    b = max(COPIES * max(ch * (7 * M) ** 2 * F8, ch * scan_nodes * 2 * F8, ch * pts * M * 6 * F8),
+            2 * (ch_t * (7 * Mt) ** 2 * F8 + 4e6 * F8))
     return trials, adj, int(max(U, Ut)), b
 
 

@@ -107,32 +107,60 @@ def test_refuses_to_mix_a_different_config(tmp_path, capsys):
     assert pq.read_table(o / "claims.parquet").schema.metadata  # replaced, complete
 
 
-def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path):
+def _children(pid: int) -> list[int]:
+    try:
+        return [int(c) for c in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
+    except OSError:
+        return []
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0] not in ("Z", "X")
+    except OSError:
+        return False
+
+
+def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path, capsys):
+    """A ``--workers 2`` run killed with ``kill -9``: a second run into the same --out while it
+    lives stops at once (exit 2, naming its pid), the workers die with it, no partial ``.tmp``
+    stays, and the same command finishes the missing chunks."""
     out = tmp_path / "res"
     cmd = [sys.executable, "-m", "sim", "run", str(STUDY), "--out", str(out), "--trials", "20000",
-           "--quiet", "--set", "chunk=100"]
+           "--quiet", "--set", "chunk=50"]
     stage = tmp_path / ".res.partial" / "trials" / "part-0"
-    p = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    p = subprocess.Popen(cmd + ["--workers", "2"], cwd=ROOT, stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL)
     t0 = time.time()
     while time.time() - t0 < 120:
         if stage.exists() and len(list(stage.glob("chunk-*.parquet"))) >= 3:
             break
         time.sleep(0.05)
+    second = main(cmd[3:] + ["--overwrite"])   # the same --out while the first one lives
+    err = capsys.readouterr().err.strip().splitlines()
+    workers = _children(p.pid)
     os.kill(p.pid, signal.SIGKILL)
     p.wait()
+    assert second == 2 and len(err) == 1 and f"running sim (pid {p.pid})" in err[0], err
     done = len(list(stage.glob("chunk-*.parquet")))
-    assert 3 <= done < 200, "the run finished before it could be killed; make it longer"
+    assert 3 <= done < 400, "the run finished before it could be killed; make it longer"
     assert not out.exists()                      # nothing that looks complete
+    assert workers, "the pool had no workers"
+    t0 = time.time()
+    while any(_alive(w) for w in workers) and time.time() - t0 < 20:
+        time.sleep(0.1)
+    assert not any(_alive(w) for w in workers), "pool workers outlived the killed run"
     r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert "resuming" in r.stderr
     rows = pq.read_table(out / "trials").to_pydict()
+    assert not list(out.rglob("*.tmp")) and not (out / ".lock").exists()
     assert len(rows["chunk"]) == 20000
     assert len(set(zip(rows["chunk"], rows["trial_in_chunk"]))) == 20000
     # identical to an uninterrupted run
     ref = tmp_path / "ref"
     assert main(["run", str(STUDY), "--out", str(ref), "--trials", "20000", "--quiet",
-                 "--set", "chunk=100"]) == 0
+                 "--set", "chunk=50"]) == 0
     for f in ("claims.parquet", "points.parquet", "table1_trials.parquet"):
         assert same_result(out / f, ref / f), f
 
@@ -185,3 +213,86 @@ def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, 
     assert main(["run", str(g), "--out", str(tmp_path / "g"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "singular" in err[0]
+
+
+# --- sweeps are bounded, estimates stop oversized runs, statistics are numbers -------------
+
+@pytest.mark.parametrize("sweep, needle", [
+    ('"errors.setting_sigma_um" = {start = 1.0, stop = nan, num = 2}', "stop must be a finite"),
+    ('"errors.setting_sigma_um" = {start = "a", stop = 2.0, num = 2}', "start must be a finite"),
+    ('"errors.setting_sigma_um" = {start = 1.0, stop = 2.0, step = 1e-12}', "more than 10000"),
+    ('"errors.setting_sigma_um" = {start = 1.0, stop = 2.0, num = 5000000}', "num must be"),
+    ('replicates = 3000000\n"errors.settings" = [2]', "sweep.replicates"),
+    ('"errors.settings" = [2, 3]\n"plate.grid" = {start = 3, stop = 9000, step = 1}', "cells"),
+])
+def test_sweep_cell_count_is_finite_and_bounded(tmp_path, capsys, sweep, needle):
+    f = tmp_path / "s.toml"
+    f.write_text(f'study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n{sweep}\n')
+    assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_dotted_range_syntax_and_sweep_chunks_carry_provenance(tmp_path):
+    from sim.storage import read_provenance
+
+    f = tmp_path / "s.toml"
+    f.write_text('study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n'
+                 'errors.settings = {start = 2, stop = 3, num = 2}\n')
+    assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    t = pq.read_table(tmp_path / "o" / "sweep.parquet").to_pydict()
+    assert t["errors.settings"] == [2.0, 3.0] and t["feasible"] == [True, True]
+    prov = read_provenance(tmp_path / "o" / "cells" / "cell0001_r0" / "trials" / "part-0" /
+                           "chunk-000001.parquet")
+    assert prov["config"]["errors.settings"] == 3 and prov["sweep_cell"] == "cell0001_r0"
+    assert prov["spawn_key"] == [0, 1] and "numpy" in prov["versions"]
+    import json
+    assert "tqdm" in json.loads((tmp_path / "o" / "run.json").read_text())["versions"]
+
+
+def test_a_sweep_whose_every_cell_fails_exits_2_with_the_reasons(tmp_path, capsys):
+    f = tmp_path / "s.toml"
+    f.write_text('study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n'
+                 '"plate.spacing_mm" = [80.0, 90.0]\n')
+    assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "every cell failed (2 of 2)" in err[0] and "plate" in err[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_the_estimate_stops_an_oversized_run_at_once(tmp_path, capsys, monkeypatch):
+    from sim.config import load_study
+    from sim.estimate import estimate
+
+    _, cfg = load_study(STUDY)
+    small = estimate(cfg)
+    _, cfg = load_study(STUDY, ["plate.grid=200", "plate.spacing_mm=1.0"])
+    big = estimate(cfg)
+    assert big.unknowns == 2 * 200 ** 2 + 7 and big.bytes > 1000 * small.bytes
+    args = ["run", str(STUDY), "--out", str(tmp_path / "o"), "--quiet", "--set", "chunk=100"]
+    assert main(args + ["--max-memory-gb", "0.001"]) == 2
+    monkeypatch.setenv("SIM_MAX_ADJUSTMENTS", "1000")
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and "GiB limit" in err[0] and "adjustments" in err[1]
+    assert "4,000 trials" in err[0] and not (tmp_path / "o").exists()
+
+
+def test_require_finite_and_write_table_refuse_non_finite_statistics(tmp_path):
+    from sim.config import StudyError
+    from sim.runner import require_finite
+    from sim.storage import NonFiniteError, write_table
+
+    assert require_finite("x", [1.0, 2.0], "part").tolist() == [1.0, 2.0]
+    with pytest.raises(StudyError, match="dilution: sigma_um is not finite .*change errors.x"):
+        require_finite("sigma_um", [1.0, np.inf, np.nan], "dilution", key="errors.x")
+    write_table(tmp_path / "ok.parquet", {"a": [1.0, np.nan]}, {})      # NaN may mean missing
+    with pytest.raises(NonFiniteError, match="column a is inf"):
+        write_table(tmp_path / "bad.parquet", {"a": [1.0, np.inf]}, {})
+    with pytest.raises(NonFiniteError, match="claim c2"):
+        write_table(tmp_path / "claims.parquet", {"claim": ["c1", "c2"], "value": [1.0, 2.0],
+                                                  "ci_low": [0.5, np.nan], "ci_high": [2.0, 3.0]}, {})
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.parquet"]
+    with pytest.raises(StudyError, match="at least 2 chunks"):
+        jackknife(lambda t: t[0], np.ones((1, 2)))

@@ -1,0 +1,113 @@
+"""The Python API: load a study, override keys, run it, read its tables.
+
+>>> import sim
+>>> st = sim.load("studies/brown_table1.toml", trials=400, chunk=100, **{"errors.settings": 3})
+>>> res = st.run(workers=2)                     # a fresh temporary directory unless out=...
+>>> res.claims().to_pylist()[0]["claim"]        # pyarrow tables
+>>> res.table("points").column("sigma_x_um")
+
+Overrides are config keys by their dotted names, with ``__`` standing for a dot in keyword
+form (``plate__grid=7`` is ``plate.grid = 7``); they are validated exactly like a study file
+(:class:`sim.config.ConfigError`, one line naming the key). A run goes through the same
+machinery as ``sim run``: the estimate and its limits, the locked staging directory, the
+executors, and the rule that nothing the suite did not write is ever replaced.
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+
+from .config import ConfigError, load_study
+
+__all__ = ["load", "StudyHandle", "Results"]
+
+
+def _key(k: str) -> str:
+    return k.replace("__", ".")
+
+
+@dataclass(frozen=True)
+class Results:
+    """A finished run's directory; tables are read from its Parquet files."""
+
+    path: Path
+    study: str
+
+    def names(self) -> list[str]:
+        """The tables of the run (``trials`` is the per-trial dataset, if any)."""
+        names = sorted(p.stem for p in self.path.glob("*.parquet"))
+        return names + (["trials"] if (self.path / "trials").is_dir() else [])
+
+    def table(self, name: str) -> pa.Table:
+        """The table ``name`` (``claims``, ``points``, ..., or ``trials``) as a pyarrow Table."""
+        import pyarrow.parquet as pq
+
+        p = self.path / (name if name == "trials" else f"{name}.parquet")
+        if not p.exists():
+            raise ConfigError("table", f"{self.study} has no table {name!r}; it has "
+                              f"{', '.join(self.names())}")
+        return pq.read_table(p)
+
+    def claims(self) -> pa.Table:
+        """The claims table: each paper claim beside the simulated value and its verdict."""
+        return self.table("claims")
+
+
+@dataclass(frozen=True)
+class StudyHandle:
+    """A validated study configuration, ready to run."""
+
+    path: Path
+    study: Any = field(repr=False)
+    config: dict = field(repr=False)
+    overrides: dict = field(default_factory=dict, repr=False)
+    sweep: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def name(self) -> str:
+        return self.config["study"]
+
+    def estimate(self):
+        """Work and memory of a run (:class:`sim.estimate.Estimate`)."""
+        from .estimate import estimate
+
+        return estimate(self.config, self.sweep)
+
+    def replace(self, **overrides) -> "StudyHandle":
+        """A new handle with more overrides."""
+        return load(self.path, **{**self.overrides, **{_key(k): v for k, v in overrides.items()}})
+
+    def run(self, out: str | os.PathLike | None = None, executor: str = "local",
+            workers: int = 1, trials: int | None = None, seed: int | None = None, *,
+            scheduler: str | None = None, overwrite: bool = False, quiet: bool = True) -> Results:
+        """Run the study into ``out`` (default: a new temporary directory) and return its
+        :class:`Results`. ``executor``: ``local`` (a process pool when ``workers > 1``) or
+        ``dask``. Output is identical for every executor and worker count."""
+        from .cli import execute
+
+        h = self if trials is None and seed is None else load(
+            self.path, **{**self.overrides, **({"trials": trials} if trials is not None else {}),
+                          **({"seed": seed} if seed is not None else {})})
+        if out is None:
+            base = Path(tempfile.mkdtemp(prefix=f"sim-{h.name}-"))
+            out = base / h.name
+        elif not str(out).strip():
+            raise ConfigError("out", "is empty: name an output directory")
+        out = Path(os.path.abspath(out))
+        execute(h.study, h.config, h.sweep, out, str(out), executor=executor, workers=workers,
+                scheduler=scheduler, overwrite=overwrite, quiet=quiet)
+        return Results(out, h.name)
+
+
+def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
+    """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
+    from .sweep import read_sweep
+
+    vals = {_key(k): v for k, v in overrides.items()}
+    study, cfg = load_study(study_file, values=vals)
+    return StudyHandle(Path(study_file), study, cfg, vals, read_sweep(study_file, study.schema))
