@@ -10,7 +10,7 @@ STUDY_FILES := $(wildcard studies/*.toml)
 STUDIES := $(basename $(notdir $(STUDY_FILES)))
 
 .DEFAULT_GOAL := help
-.PHONY: help venv test reproduce rerun verify report bench clean
+.PHONY: help venv test reproduce rerun verify report bench clean fuzz
 
 help: ## list the targets
 	@grep -E '^[a-zA-Z_%/.-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/:.*## /\t/' | sort | \
@@ -26,6 +26,9 @@ venv: $(STAMP) ## create the virtual environment and install the project
 
 test: $(STAMP) ## run the test suite (sets up the environment first)
 	$(PY) -m pytest
+
+fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=300, FUZZ_SEED, FUZZ_SAVE)
+	FUZZ_CASES=$${FUZZ_CASES:-300} $(PY) -m pytest tests/test_fuzz.py -p no:cacheprovider
 
 # A study is re-run when its results are not current: run.json must record the study file's
 # config and the hash of the code that study imports (sim/codehash.py). Decided by content,

@@ -292,7 +292,10 @@ def test_require_finite_and_write_table_refuse_non_finite_statistics(tmp_path):
         write_table(tmp_path / "bad.parquet", {"a": [1.0, np.inf]}, {})
     with pytest.raises(NonFiniteError, match="claim c2"):
         write_table(tmp_path / "claims.parquet", {"claim": ["c1", "c2"], "value": [1.0, 2.0],
-                                                  "ci_low": [0.5, np.nan], "ci_high": [2.0, 3.0]}, {})
+                                                  "ci_low": [0.5, np.nan], "ci_high": [2.0, 3.0],
+                                                  "verdict": ["holds", "fails"]}, {})
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.parquet"]
+    write_table(tmp_path / "claims.parquet", {"claim": ["c1"], "value": [np.nan], "ci_low": [np.nan],
+                                              "ci_high": [np.nan], "verdict": ["not comparable"]}, {})
     with pytest.raises(StudyError, match="at least 2 chunks"):
         jackknife(lambda t: t[0], np.ones((1, 2)))
