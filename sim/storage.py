@@ -134,22 +134,15 @@ CLAIM_NUMBERS = ("value", "ci_low", "ci_high")
 
 def check_finite_table(name: str, table: pa.Table) -> None:
     """No float column may hold +-inf (NaN may mean "missing"), and a claims table's value and
-    interval must be finite in every row with a verdict: a verdict on a non-finite number is
-    an error, never a result (rows without a verdict, e.g. ``not comparable``, may be NaN)."""
+    interval must be finite: a non-finite verdict is an error, never a result (a null, e.g. in
+    a ``not comparable`` row, is "no number" and allowed)."""
     is_claims = {"claim", *CLAIM_NUMBERS} <= set(table.column_names)
-    judged = np.ones(table.num_rows, bool)  # claims rows with a verdict need numbers
-    for c in ("verdict", "holds"):
-        if is_claims and c in table.column_names:
-            judged = np.array([x is not None and x != "not comparable"
-                               for x in table.column(c).to_pylist()], bool)
-            break
     for col, arr in zip(table.column_names, table.columns):
         if not pa.types.is_floating(arr.type):
             continue
         v = arr.to_numpy(zero_copy_only=False).astype(float)
         valid = np.asarray(arr.is_valid())   # a null is "no number" (a not-comparable claim)
-        bad = np.isinf(v) | (np.isnan(v) & valid & judged if is_claims and col in CLAIM_NUMBERS
-                             else False)
+        bad = np.isinf(v) | (np.isnan(v) & valid if is_claims and col in CLAIM_NUMBERS else False)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             what = f" (claim {table.column('claim')[i].as_py()})" if is_claims else f" (row {i})"

@@ -295,7 +295,7 @@ def test_require_finite_and_write_table_refuse_non_finite_statistics(tmp_path):
                                                   "ci_low": [0.5, np.nan], "ci_high": [2.0, 3.0],
                                                   "verdict": ["holds", "fails"]}, {})
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.parquet"]
-    write_table(tmp_path / "claims.parquet", {"claim": ["c1"], "value": [np.nan], "ci_low": [np.nan],
-                                              "ci_high": [np.nan], "verdict": ["not comparable"]}, {})
+    write_table(tmp_path / "claims.parquet", {"claim": ["c1"], "value": [None], "ci_low": [None],
+                                              "ci_high": [None], "verdict": ["not comparable"]}, {})
     with pytest.raises(StudyError, match="at least 2 chunks"):
         jackknife(lambda t: t[0], np.ones((1, 2)))
