@@ -128,7 +128,9 @@ def _salsig(c: Mapping) -> tuple:
     pm = _max(c.get("power.marks"), 5) ** 2
     cells = _n(c.get("power.marks", [])) * _n(c.get("power.sigma_um", []))
     pT = c.get("power.trials", 0)
-    relief = _n(c.get("vertical.relief_sweep_mm", [])) * min(T, 5000)
+    relief = _n(c.get("vertical.relief_sweep_mm", [])) * min(T, 5000) + c.get(
+        "consistency.trials", 0) * sum(_n(v) for k, v in c.items() if k.startswith("consistency.")
+                                       and isinstance(v, list))
     trials = 3 * T + cells * pT + relief
     adj = 6 * T + 3 * cells * pT + 2 * relief
     n = max(marks, grid, pm, c.get("zscale.points", 9), c.get("vertical.control", 6) ** 2)
