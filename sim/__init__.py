@@ -1,7 +1,8 @@
 """sim: Monte-Carlo reproduction of classic comparator and plotter calibration papers.
 
 The public surface: ``sim.load(study_file, **overrides).run()`` (:mod:`sim.api`), the Brown
-multilateration kernels, and the claims and storage helpers every study uses. Everything else is internal.
+multilateration kernels, and the claims and storage helpers every study uses. Everything
+else is internal.
 
 The suite parallelises over chunks of trials (processes, ``--workers``); a multi-threaded
 BLAS inside each process would oversubscribe the cores and make the small batched solves
@@ -18,6 +19,6 @@ from .multilateration import adjust, covariance, design_theta, ranges, simulate_
 from .runner import run_chunks
 from .storage import read_provenance, write_table
 
-__all__ = ["load", "StudyHandle", "Results", "ConfigError", "StudyError", "load_study", "run_chunks", "adjust", "covariance", "design_theta",
-           "ranges", "simulate_ranges", "claim", "write_table", "read_provenance"]
+__all__ = ["load", "StudyHandle", "Results", "ConfigError", "StudyError", "load_study",
+           "run_chunks", "adjust", "covariance", "design_theta", "ranges", "simulate_ranges", "claim", "write_table", "read_provenance"]
 __version__ = "0.1.0"
