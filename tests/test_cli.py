@@ -108,7 +108,8 @@ def test_run_writes_contract_files_with_provenance(tmp_path):
     claims = pq.read_table(out / "claims.parquet").to_pydict()
     for col in ("claim", "source", "paper", "value", "ci_low", "ci_high", "holds", "kind", "note"):
         assert col in claims
-    assert set(claims["kind"]) <= {"prediction", "input", "finding", "self-check"}
+    from sim.claims import KINDS
+    assert set(claims["kind"]) <= set(KINDS)
     trials = pq.read_table(out / "trials").to_pydict()   # partitioned dataset, one file a chunk
     assert len(trials["chunk"]) == 60 and sorted(set(trials["chunk"])) == [0, 1, 2]
     for m in ("known", "stations", "pivot"):

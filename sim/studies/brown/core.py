@@ -11,10 +11,10 @@ import numpy as np
 
 from ... import multilateration as ml
 from ...config import StudyError
-from ...plate import pattern_points
 from ...runner import jackknife, run_chunks
 from .. import RunContext
 from .schema import MODEL_NAMES
+
 
 def analytic_sigma(pts: np.ndarray, theta: np.ndarray, model: str, sigma_um: float = 1.0):
     """Per-point sigma_x, sigma_y (um) at the true values, shape (n, 2)."""
@@ -166,33 +166,3 @@ def points_table(pts, an: dict, mc: MC, sr: float) -> dict:
 def pooled_sigma(a: np.ndarray) -> np.ndarray:
     """sigma of a point: rms of its sigma_x and sigma_y, (n,)."""
     return np.sqrt((a ** 2).mean(axis=-1))
-
-
-def max_ratio_known(pts, h):
-    return analytic_sigma(pts, ml.design_theta(h), "known").max()
-
-
-def geometry_grid(format_mm: float, k: int, extents, offsets) -> dict:
-    """Analytic edge ratio and dilution range for k x k grids over extents x station offsets.
-
-    All geometries are evaluated in one batched call (the geometries play the trial axis).
-    """
-    E, O = np.meshgrid(np.asarray(extents, float), np.asarray(offsets, float), indexing="ij")
-    E, O = E.ravel(), O.ravel()
-    P = np.stack([pattern_points("grid", grid=k, spacing_mm=2 * e / (k - 1)) for e in E])
-    TH = np.stack([ml.design_theta(format_mm / 2 + o) for o in O])
-    sig = {}
-    for m in ("known", "stations"):
-        Q = ml.covariance(P, TH, m)[0]
-        sig[m] = np.sqrt(np.stack([Q[..., 0, 0], Q[..., 1, 1]], -1))
-    d = (pooled_sigma(sig["stations"]) / pooled_sigma(sig["known"]) - 1) * 100
-    return {"half_extent_mm": E, "offset_mm": O, "known_max_ratio": sig["known"].max(axis=(1, 2)),
-            "dil_min_pct": d.min(1), "dil_max_pct": d.max(1)}
-
-
-def alpha_only_extra(pts, theta) -> float:
-    """Largest extra dilution (%) from freeing alpha alone (beta^2 known)."""
-    a = pooled_sigma(analytic_sigma(pts, theta, "alpha"))
-    s = pooled_sigma(analytic_sigma(pts, theta, "stations"))
-    return float(((a / s - 1) * 100).max())
-

@@ -21,22 +21,26 @@ BASE = {
     "plate.format_mm": Field(245.0, "float", "side of the square plate format", lo=1.0, unit="mm"),
     "plate.pattern": Field("grid", "str", "point pattern", choices=("grid", "random", "list")),
     "plate.grid": Field(5, "int", "points per side of the grid pattern", lo=2, hi=200),
-    "plate.spacing_mm": Field(55.0, "float", "grid spacing", lo=0.0, lo_open=True, unit="mm"),
+    "plate.spacing_mm": Field(45.0, "float", "grid spacing (Table 1: 45 mm; the Concept section "
+                              "prints no layout, its extent is swept)", lo=0.0, lo_open=True,
+                              unit="mm"),
     "plate.n_random": Field(25, "int", "number of points of the random pattern", lo=3, hi=100000),
     "plate.random_half_extent_mm": Field(110.0, "float", "random points lie in |x|,|y| <= this",
                                          lo=0.0, lo_open=True, unit="mm"),
     "plate.points": Field([], "points", "explicit point list [[x, y], ...] for pattern 'list'"),
     "comparator.station_offset_mm": Field(
-        45.0, "float", "distance of the stations outside the midsides of the format "
-        "(the paper says only 'a short distance'; set so the known-station edge ratio is 0.85)",
-        lo=0.0, lo_open=True, input=True, unit="mm"),
+        17.0, "float", "distance of the stations outside the midsides of the format; the paper "
+        "says only 'a short distance' (nominal value: the middle of the 0-34 mm that fit the "
+        "261 mm scale for a +-90 mm grid; swept in consistency.*)", lo=0.0, lo_open=True,
+        unit="mm"),
     "comparator.alpha_mm": Field(0.5, "float", "radial pivot offset alpha (true value)",
                                  lo=-50.0, hi=50.0, unit="mm"),
     "comparator.beta_mm": Field(1.0, "float", "tangential pivot offset beta (true value)",
                                 lo=0.0, hi=50.0, unit="mm"),
     "comparator.scale_length_mm": Field(
-        0.0, "float", "graduated length of the scale (paper: 261 mm); every range must fit on "
-        "it plus the micrometer travel. 0 = not enforced", lo=0.0, unit="mm"),
+        261.0, "float", "graduated length of the scale (paper: 261 mm); every range must fit on "
+        "it plus the micrometer travel. 0 = not enforced (an idealised comparator)", lo=0.0,
+        unit="mm"),
     "comparator.micrometer_mm": Field(1.0, "float", "micrometer travel added to the scale "
                                       "(paper: at most 1 mm)", lo=0.0, unit="mm"),
     "errors.setting_sigma_um": Field(1.0, "float", "standard deviation of one setting", lo=0.0,
@@ -49,6 +53,14 @@ BASE = {
     "solver.tol_mm": Field(1e-10, "float", "convergence: largest correction below this", lo=0.0,
                            lo_open=True, hi=1e-3, unit="mm"),
     "solver.max_iter": Field(30, "int", "Gauss-Newton iteration limit", lo=1, hi=1000),
+    "consistency.offset_min_mm": Field(0.5, "float", "smallest station offset of the sweep",
+                                       lo=0.0, lo_open=True, unit="mm"),
+    "consistency.offset_max_mm": Field(60.0, "float", "largest station offset of the sweep "
+                                       "(offsets whose ranges do not fit the scale are shown as "
+                                       "idealised, never scored)", lo=0.0, lo_open=True,
+                                       unit="mm"),
+    "consistency.offset_step_mm": Field(0.5, "float", "step of the station-offset sweep", lo=0.0,
+                                        lo_open=True, unit="mm"),
 }
 
 DILUTION = {
@@ -57,12 +69,13 @@ DILUTION = {
     "dilution.grids": Field([3, 4, 5, 7, 10, 14, 20], "list[int]",
                             "grid sizes (points per side, same extent) for dilution vs point count",
                             lo=2, hi=200, min_len=2),
-    "dilution.offsets_mm": Field([2.0, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 80.0, 120.0, 160.0],
-                                 "list[float]", "station offsets for the sigma-range curve",
-                                 lo=0.0, lo_open=True, min_len=2, unit="mm"),
-    "dilution.extents_mm": Field([80.0, 90.0, 100.0, 110.0, 120.0], "list[float]",
-                                 "half extents of the point grid for the 0.85 search", lo=0.0,
-                                 lo_open=True, min_len=1, unit="mm"),
+    "consistency.extents_mm": Field([60.0, 70.0, 80.0, 90.0, 100.0, 110.0], "list[float]",
+                                    "half extents of the k x k grid swept with the station "
+                                    "offset (the Concept section prints no layout)", lo=0.0,
+                                    lo_open=True, min_len=1, unit="mm"),
+    "idealised.half_extent_mm": Field(110.0, "float", "half extent of the idealised four-station "
+                                      "layout (no scale): the offset giving 0.85 at the edges",
+                                      lo=0.0, lo_open=True, unit="mm"),
     "checks.bias_shift_um": Field(100.0, "float", "constant added to all ranges in the bias "
                                   "invariance check", lo=-1e5, hi=1e5, unit="um"),
 }
@@ -94,8 +107,50 @@ def points_of(cfg: dict) -> np.ndarray:
                           points=cfg["plate.points"], rng=chunk_rng(cfg["seed"], 99, 0))
 
 
+#: the most geometries one sweep may evaluate (memory: about 1 kB per geometry and point)
+MAX_SWEEP = 20000
+
+
+def sweep_offsets(cfg: dict) -> np.ndarray:
+    """The station offsets of the consistency sweep (mm)."""
+    lo, hi, st = (cfg[f"consistency.offset_{k}_mm"] for k in ("min", "max", "step"))
+    return lo + st * np.arange(int(np.floor((hi - lo) / st + 1e-9)) + 1)
+
+
+def max_offset_mm(cfg: dict, half_extent_mm: float) -> float:
+    """Largest station offset at which every range of a grid reaching +-half_extent_mm fits
+    the scale plus the micrometer (inf when the scale is not enforced). The farthest point
+    from station 1 (0, h) is (+-e, -e): r = sqrt(e^2 + (h + e)^2 - beta^2) - alpha."""
+    if cfg["comparator.scale_length_mm"] <= 0:
+        return float("inf")
+    reach = (cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
+             + cfg["comparator.alpha_mm"])
+    e = half_extent_mm
+    d2 = reach ** 2 + cfg["comparator.beta_mm"] ** 2 - e ** 2
+    return float(np.sqrt(d2) - e - cfg["plate.format_mm"] / 2) if d2 > 0 else -float("inf")
+
+
+def check_sweep(cfg: dict) -> None:
+    """The sweep keys: an ordered, non-empty, bounded grid of offsets (and extents)."""
+    if cfg["consistency.offset_max_mm"] < cfg["consistency.offset_min_mm"]:
+        raise ConfigError("consistency.offset_max_mm", "must be >= consistency.offset_min_mm")
+    n = (cfg["consistency.offset_max_mm"] - cfg["consistency.offset_min_mm"]) / cfg[
+        "consistency.offset_step_mm"] + 1
+    n_ext = len(cfg.get("consistency.extents_mm", [0]))
+    if n * n_ext > MAX_SWEEP:
+        raise ConfigError("consistency.offset_step_mm", f"the sweep would evaluate {n * n_ext:.3g} "
+                          f"geometries (limit {MAX_SWEEP}); use a larger step")
+    half = cfg["plate.format_mm"] / 2
+    for key in ("consistency.extents_mm", "idealised.half_extent_mm"):
+        v = cfg.get(key)
+        if v is not None and max(np.atleast_1d(v)) > half:
+            raise ConfigError(key, f"half extents must lie inside the format (<= {half:g} mm)")
+
+
 def check(cfg: dict) -> None:
-    """Cross-key rules: points inside the format, enough points, no duplicates/collinearity."""
+    """Cross-key rules: points inside the format, enough points, no duplicates/collinearity,
+    every range on the scale, a bounded sweep."""
+    check_sweep(cfg)
     key = {"grid": "plate.grid", "random": "plate.n_random", "list": "plate.points"}[cfg["plate.pattern"]]
     half = cfg["plate.format_mm"] / 2
     if cfg["plate.pattern"] == "grid":
