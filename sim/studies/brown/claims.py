@@ -99,10 +99,10 @@ def score_dilution(book, cfg, pts, theta, an, mc, sim, curve, extra, mono) -> li
         "brown.dilution_falls_with_points.monotone": "analytic: 1 when the mean and the largest "
                                                      "per-point dilution fall at every step of "
                                                      f"k x k grids k = {list(curve)} (same extent)",
-        "brown.pivot_extra_dilution.max_pct": f"analytic extra dilution of 'pivot' over 'stations'"
+        "brown.pivot_extra_dilution.range_pct": f"analytic per-point extra dilution of 'pivot' over 'stations'"
                                               f", largest at {_pt(pts, int(np.argmax(ex)))} "
                                               f"(median over points {np.median(ex):.1f} %). "
-                                              "'Essentially none' is taken as at most 2 %; beta^2 "
+                                              "'Essentially none' is taken as 0-2 % at every point; beta^2 "
                                               "shifts each range by about beta^2/(2d), most at "
                                               "short ranges",
     }
@@ -165,9 +165,14 @@ def score_table1(book, cfg, pts, an_pivot, sr, mc, t1) -> list[dict]:
         f"'typically': the middle half (25-75 %) of simulated plates' sigma0 ({q25:.2f}-"
         f"{q75:.2f} um) must lie in 1.5-2.0 um; {inside:.0%} of plates print inside. One "
         "comparator calibrated on Table 1; other production models may differ")))
-    rows.append(book.score("brown.table1_setting.sigma_um", samples=t1["setting_sigma_um"],
-                           note="recovered per plate from the differences of the double "
-                           "settings; the simulated setting sigma is the paper's value"))
+    if cfg["errors.settings"] > 1:
+        rows.append(book.score("brown.table1_setting.sigma_um", samples=t1["setting_sigma_um"],
+                               note="recovered per plate from the differences of the repeated "
+                               "settings; the simulated setting sigma is the paper's value"))
+    else:
+        rows.append(book.score("brown.table1_setting.sigma_um", cfg["errors.setting_sigma_um"],
+                               interval="exact", note="single settings: the setting sigma cannot "
+                               "be recovered from the plate; the value is the input"))
     rows.append(book.score("brown.table1_setting.pair_mean_um", 1.7 / np.sqrt(2), interval="exact",
                            note="recomputed: 1.7 / sqrt(2)"))
     rows.append(book.score("brown.table1_closure.comparator_um", float(np.sqrt(1.6 ** 2 - 1.2 ** 2)),
@@ -201,8 +206,8 @@ def score_table1(book, cfg, pts, an_pivot, sr, mc, t1) -> list[dict]:
         rows.append(book.score(f"brown.table1_point_sigma.{cid}", note=f"{what}; {at}",
                                **args[f"brown.table1_point_sigma.{cid}"]))
     rows.append(book.score("brown.table1_point_sigma.below_closure",
-                           note="largest sigma / sigma0 = sqrt of the largest cofactor (pivot "
-                           "model); " + geo, **args["brown.table1_point_sigma.below_closure"]))
+                           note="every sigma / sigma0 = sqrt(cofactor) (pivot model) must be "
+                           "below 1; " + geo, **args["brown.table1_point_sigma.below_closure"]))
     rows.append(mc_agreement(book, "brown.table1_mc_agreement.pivot.mean_ratio", mc, 2, an_pivot,
                              cfg["trials"]))
     return rows

@@ -82,7 +82,7 @@ def dilution_values(pts: np.ndarray, sig: dict, mono: np.ndarray) -> list[dict]:
     centre = pooled(kn[:, c])
     edge = kn.max(axis=(1, 2))
     dil = (pooled(st) / pooled(kn) - 1) * 100
-    extra = ((pooled(pv) / pooled(st) - 1) * 100).max(1)
+    extra = (pooled(pv) / pooled(st) - 1) * 100
     out = []
     for g in range(len(kn)):
         out.append({
@@ -91,7 +91,8 @@ def dilution_values(pts: np.ndarray, sig: dict, mono: np.ndarray) -> list[dict]:
             "brown.dilution.range_pct": dict(elems=(dil[g], dil[g]), interval="exact"),
             "brown.dilution_falls_with_points.monotone": dict(value=float(mono[g]),
                                                               interval="exact"),
-            "brown.pivot_extra_dilution.max_pct": dict(value=float(extra[g]), interval="exact"),
+            "brown.pivot_extra_dilution.range_pct": dict(elems=(extra[g], extra[g]),
+                                                         interval="exact"),
         })
     return out
 
@@ -124,8 +125,8 @@ def table1_values(cof: np.ndarray, s0_plates_um: np.ndarray) -> list[dict]:
     out = []
     for g in range(len(cof)):
         pl = point_sigma_stats(s0_plates_um[:, None, None] * cof[g][None])       # (Q,)
-        row = {"brown.table1_point_sigma.below_closure":
-               dict(value=float(cof[g].max()), interval="exact"),
+        c = cof[g].ravel()
+        row = {"brown.table1_point_sigma.below_closure": dict(elems=(c, c), interval="exact"),
                "brown.table1_point_sigma.share_1p1_1p3": dict(samples=pl["share"]),
                "brown.table1_point_sigma.points_ge_1p45": dict(samples=pl["count"]),
                "brown.table1_point_sigma.max_um": dict(samples=pl["max"])}
