@@ -41,7 +41,7 @@ TIMEOUT = float(os.environ.get("FUZZ_TIMEOUT", "300"))
 #: each study shrunk to a run of a few seconds (keys that the mutations then perturb)
 SMALL = {
     "brown_dilution": {"trials": 8, "chunk": 4, "dilution.grids": [3, 5],
-                       "dilution.offsets_mm": [20.0, 45.0], "dilution.extents_mm": [90.0, 110.0]},
+                       "consistency.offset_step_mm": 10.0, "consistency.extents_mm": [90.0]},
     "brown_table1": {"trials": 8, "chunk": 4},
     "brown_design": {"trials": 8, "chunk": 4, "design.positions": [4], "design.offsets_mm": [30.0],
                      "design.grids": [5], "design.extents_mm": [90.0], "design.settings": [2],
