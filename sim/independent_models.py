@@ -42,10 +42,12 @@ Units: metres for ground and model coordinates; image coordinates in mm, errors 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
+
+from . import lsq
+from .lsq.groups import chol_solve
 
 from .geometry import rotation, similarity_fit
 
@@ -184,92 +186,102 @@ def initial_values(st: "BlockStructure", xm: np.ndarray, X_approx: np.ndarray):
     return s, R, t
 
 
-# ------------------------------------------------------------------- linear algebra
-def chol_solve(N: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Solve ``N x = b`` for a stack of symmetric positive-definite ``N`` ``(T, n, n)``,
-    ``b`` ``(T, n, r)``, by Cholesky factorisation and batched substitution.
-
-    (Batched LAPACK ``gesv`` through numpy is slow here when OpenBLAS threads compete for the
-    cores; the factorisation itself is fast and the substitutions vectorise over trials.)
-    A non-positive-definite ``N`` raises ``numpy.linalg.LinAlgError``.
-    """
-    L = np.linalg.cholesky(N)
-    n = N.shape[-1]
-    y = np.empty(b.shape)
-    for i in range(n):  # loop over the unknowns, vectorised over trials
-        y[:, i] = (b[:, i] - np.einsum("tj,tjr->tr", L[:, i, :i], y[:, :i])) / L[:, i, i, None]
-    x = np.empty(b.shape)
-    for i in range(n - 1, -1, -1):
-        x[:, i] = (y[:, i] - np.einsum("tj,tjr->tr", L[:, i + 1:, i], x[:, i + 1:])) / L[:, i, i, None]
-    return x
+# ------------------------------------------------------------------- the adjustment
+#: above this many models the reduced normals are solved as sparse matrices
+SPARSE_FROM_MODELS = 60
 
 
-# ------------------------------------------------------------------- block structure
-def _indicator(rows: np.ndarray, n_rows: int) -> sparse.csr_matrix:
-    """Sparse ``(n_rows, len(rows))`` matrix summing items into their rows."""
-    k = rows.size
-    return sparse.csr_matrix((np.ones(k), (rows, np.arange(k))), shape=(n_rows, k))
+class BlockStructure(lsq.GroupStructure):
+    """Which model observes which point (:class:`sim.lsq.groups.GroupStructure` with the
+    models as groups): obs_model, obs_point : (K,); ctrl_point : (C,); n_models, n_points."""
+
+    def __init__(self, obs_model, obs_point, ctrl_point, n_models: int, n_points: int):
+        super().__init__(obs_model, obs_point, ctrl_point, n_models, n_points,
+                         sparse_from=SPARSE_FROM_MODELS)
+
+    obs_model = property(lambda self: self.obs_group)
+    ctrl_point = property(lambda self: self.point_rows)
+    n_models = property(lambda self: self.n_groups)
+    S_model = property(lambda self: self.S_group)
 
 
-def _scatter(S: sparse.csr_matrix, data: np.ndarray) -> np.ndarray:
-    """Sum ``data`` ``(T, k, ...)`` over its second axis into ``S.shape[0]`` bins."""
-    T, k = data.shape[:2]
-    rest = data.shape[2:]
-    d = np.moveaxis(data, 1, 0).reshape(k, -1)
-    out = np.asarray(S @ d).reshape((S.shape[0], T) + rest)
-    return np.moveaxis(out, 0, 1)
+class SimilarityModel:
+    """Observation model of the independent-model block for :mod:`sim.lsq` (group blocks).
 
-
-@dataclass(frozen=True)
-class BlockStructure:
-    """Which model observes which point, and the derived scatter operators.
-
-    obs_model, obs_point : (K,) ; ctrl_point : (C,) ; n_models, n_points.
-    Pairs ``(k1, k2)`` are all ordered pairs of observations of the same point.
+    Points: ground ``X_j`` (d = 3). Groups: per model the corrections ``(dl, dtheta, dt)``
+    of ``s <- s (1 + dl)``, ``R <- R(dtheta) R``, ``t' <- t' + dt`` (b = 7); the state
+    ``theta`` (T, M, 13) holds ``s``, ``R`` (9) and ``t' = t + s R c``. Rows: model points
+    ``x_mj - [s R (x_mj - c_m) + t'_m - X_j]`` (weights w_obs) and control
+    ``X_j^control - X_j`` (weights w_ctrl); metres.
     """
 
-    obs_model: np.ndarray
-    obs_point: np.ndarray
-    ctrl_point: np.ndarray
-    n_models: int
-    n_points: int
-    pk1: np.ndarray = field(init=False)
-    pk2: np.ndarray = field(init=False)
-    S_model: sparse.csr_matrix = field(init=False)
-    S_point: sparse.csr_matrix = field(init=False)
-    S_ctrl: sparse.csr_matrix = field(init=False)
-    S_pair: sparse.csr_matrix = field(init=False)
-    pair_m1: np.ndarray = field(init=False)
-    pair_m2: np.ndarray = field(init=False)
-    S_pair_obs: sparse.csr_matrix = field(init=False)
-    S_pair_point: sparse.csr_matrix = field(init=False)
+    point_dim = 3
 
-    def __post_init__(self):
-        om = np.asarray(self.obs_model)
-        op = np.asarray(self.obs_point)
-        order = np.argsort(op, kind="stable")
-        starts = np.searchsorted(op[order], np.arange(self.n_points))
-        ends = np.searchsorted(op[order], np.arange(self.n_points), side="right")
-        k1, k2 = [], []
-        for a, b in zip(starts, ends):  # structure only, once per block
-            idx = order[a:b]
-            k1.append(np.repeat(idx, idx.size))
-            k2.append(np.tile(idx, idx.size))
-        pk1 = np.concatenate(k1).astype(np.intp)
-        pk2 = np.concatenate(k2).astype(np.intp)
-        M = self.n_models
-        set_ = object.__setattr__
-        set_(self, "pk1", pk1)
-        set_(self, "pk2", pk2)
-        set_(self, "S_model", _indicator(om, M))
-        set_(self, "S_point", _indicator(op, self.n_points))
-        set_(self, "S_ctrl", _indicator(np.asarray(self.ctrl_point, np.intp), self.n_points))
-        mp, inv = np.unique(om[pk1] * M + om[pk2], return_inverse=True)
-        set_(self, "S_pair", _indicator(inv.ravel(), mp.size))      # observation pair -> model pair
-        set_(self, "pair_m1", mp // M)
-        set_(self, "pair_m2", mp % M)
-        set_(self, "S_pair_obs", _indicator(pk1, om.size))
-        set_(self, "S_pair_point", _indicator(op[pk1], self.n_points))
+    def __init__(self, st: BlockStructure, xm, c, w_obs, ctrl_xyz, w_ctrl, solver="auto"):
+        self.structure, self.xm, self.c, self.solver = st, xm, c, solver
+        T, K = xm.shape[:2]
+        self.w = np.broadcast_to(w_obs, (T, K, 3))
+        self.ctrl = np.broadcast_to(ctrl_xyz, (T,) + np.shape(ctrl_xyz)[-2:])
+        self.wc = np.broadcast_to(w_ctrl, self.ctrl.shape)
+        self.n_global = 7 * st.n_models
+
+    def linearize(self, X, theta, globals_needed=True) -> lsq.GroupLinearization:
+        st = self.structure
+        om, op = st.obs_model, st.obs_point
+        s, R, t = theta[..., 0], theta[..., 1:10].reshape(theta.shape[:2] + (3, 3)), theta[..., 10:]
+        y = s[:, om, None] * np.einsum("tkij,tkj->tki", R[:, om], self.xm - self.c[:, om])
+        e = y + t[:, om] - X[:, op]
+        T, K = y.shape[:2]
+        J = np.empty((T, K, 3, 7))
+        J[..., 0] = y
+        J[..., 1:4] = -_skew(y)
+        J[..., 4:7] = np.eye(3)
+        C = st.ctrl_point.size
+        return lsq.GroupLinearization(-e, np.broadcast_to(-np.eye(3), (T, K, 3, 3)), J, self.w,
+                                      self.ctrl - X[:, st.ctrl_point],
+                                      np.broadcast_to(np.eye(3), (T, C, 3, 3)), self.wc)
+
+    def retract(self, X, theta, dX, dg):
+        T, M = theta.shape[:2]
+        dg = dg.reshape(T, M, 7)
+        R = rodrigues(dg[..., 1:4]) @ theta[..., 1:10].reshape(T, M, 3, 3)
+        return X + dX, np.concatenate([theta[..., :1] * (1.0 + dg[..., :1]),
+                                       R.reshape(T, M, 9), theta[..., 10:] + dg[..., 4:7]], -1)
+
+
+def _state(s, R, t):
+    return np.concatenate([np.asarray(s, float)[..., None],
+                           np.asarray(R, float).reshape(np.shape(s) + (9,)), t], -1)
+
+
+def normal_step(st: BlockStructure, xm, c, s, R, t, X, w_obs, ctrl_xyz, w_ctrl, dense=False,
+                solver: str = "auto"):
+    """One Gauss-Newton correction ``(dg (T, M, 7), dX (T, P, 3))`` at ``(s, R, t' = t)``.
+
+    The engine's group-block step (:func:`sim.lsq.groups.step`: dense below
+    ``SPARSE_FROM_MODELS`` models, sparse above, or as ``solver`` says). ``dense=True``
+    instead builds and solves the full normal matrix of all ``7M + 3P`` unknowns (for
+    checking the reduced solution on small blocks).
+    """
+    T = xm.shape[0]
+    M, P = st.n_models, st.n_points
+    model = SimilarityModel(st, xm, c, w_obs, ctrl_xyz, w_ctrl, solver)
+    lin = model.linearize(np.asarray(X, float), _state(s, R, t))
+    if dense:
+        K, C = st.obs_model.size, st.ctrl_point.size
+        A = np.zeros((T, 3 * K + 3 * C, 7 * M + 3 * P))
+        for k in range(K):  # test-only dense assembly
+            A[:, 3 * k:3 * k + 3, 7 * st.obs_model[k]:7 * st.obs_model[k] + 7] = lin.Jg[:, k]
+            A[:, 3 * k:3 * k + 3, 7 * M + 3 * st.obs_point[k] + np.arange(3)] = -np.eye(3)
+        for i, j in enumerate(st.ctrl_point):
+            A[:, 3 * K + 3 * i + np.arange(3), 7 * M + 3 * j + np.arange(3)] = 1.0
+        w = np.concatenate([lin.w.reshape(T, -1), lin.wc.reshape(T, -1)], 1)
+        r = np.concatenate([lin.r.reshape(T, -1), lin.rc.reshape(T, -1)], 1)
+        N = np.einsum("toi,to,toj->tij", A, w, A)
+        d = chol_solve(N, np.einsum("toi,to->ti", A, w * r)[..., None])[..., 0]
+        return d[:, :7 * M].reshape(T, M, 7), d[:, 7 * M:].reshape(T, P, 3)
+    dX, dg, _ = lsq.groups.step(st, lin, solver)
+    return dg.reshape(T, M, 7), dX
 
 
 @dataclass
@@ -277,9 +289,12 @@ class AdjustResult:
     """Result of :func:`adjust_block` (leading axis: trials).
 
     s (T, M), R (T, M, 3, 3), t (T, M, 3): ground = s R x + t for each model;
-    X (T, P, 3) adjusted points; v_obs (T, K, 3) model-point residuals (ground units);
-    v_ctrl (T, C, 3) control residuals (adjusted minus given); sigma0 (T,) a-posteriori
-    standard error of unit weight; dof (T,); iterations; converged (T,) bool.
+    X (T, P, 3) adjusted points; v_obs (T, K, 3) model-point residuals (ground units,
+    adjusted minus observed); v_ctrl (T, C, 3) control residuals (adjusted minus given);
+    sigma0 (T,) a-posteriori standard error of unit weight; dof (T,); iterations (the most
+    any trial used); converged (T,) bool; status (T,) the engine's status codes; engine: the
+    :class:`sim.lsq.Result` (its cofactors serve :func:`residual_cofactors`); J (T, K, 3, 7)
+    the Jacobian of the model points w.r.t. the corrections (``keep_normals``).
     """
 
     s: np.ndarray
@@ -292,215 +307,59 @@ class AdjustResult:
     dof: np.ndarray
     iterations: int
     converged: np.ndarray
-    Nbar: np.ndarray | None = None
-    Dinv: np.ndarray | None = None
-    B: np.ndarray | None = None
+    status: np.ndarray | None = None
+    engine: lsq.Result | None = None
     J: np.ndarray | None = None
-
-
-def _linearise(st: BlockStructure, xm, c, s, R, t, X):
-    y = s[:, st.obs_model, None] * np.einsum("tkij,tkj->tki", R[:, st.obs_model],
-                                              xm - c[:, st.obs_model])
-    e = y + t[:, st.obs_model] - X[:, st.obs_point]
-    T, K = y.shape[:2]
-    J = np.empty((T, K, 3, 7))
-    J[..., 0] = y
-    J[..., 1:4] = -_skew(y)
-    J[..., 4:7] = np.eye(3)
-    return e, J
-
-
-def _reduced(st: BlockStructure, J, w_obs, w_ctrl_full):
-    """Reduced normals as 7 x 7 blocks of the model pairs ``(st.pair_m1, st.pair_m2)`` that
-    share a point, ``(T, n_pairs, 7, 7)``; ``B`` (T, K, 7, 3) and ``Dinv`` (T, P, 3)."""
-    B = -np.swapaxes(J * w_obs[..., None], -1, -2)              # (T, K, 7, 3)
-    Ngg = _scatter(st.S_model, -(B @ J))                         # (T, M, 7, 7)
-    D = _scatter(st.S_point, w_obs) + w_ctrl_full
-    Dinv = np.where(D > 0, 1.0 / np.where(D > 0, D, 1.0), 0.0)
-    BD = B * Dinv[:, st.obs_point, None, :]                      # (T, K, 7, 3)
-    C = BD[:, st.pk1] @ np.swapaxes(B, -1, -2)[:, st.pk2]        # (T, obs pairs, 7, 7)
-    blocks = -_scatter(st.S_pair, C)
-    diag = st.pair_m1 == st.pair_m2
-    blocks[:, diag] += Ngg[:, st.pair_m1[diag]]
-    return blocks, B, Dinv
-
-
-def _dense(st: BlockStructure, blocks: np.ndarray) -> np.ndarray:
-    """The reduced normal matrix ``(T, 7M, 7M)`` from its pair blocks."""
-    T, M = blocks.shape[0], st.n_models
-    N = np.zeros((T, M, M, 7, 7))
-    N[:, st.pair_m1, st.pair_m2] = blocks
-    return N.transpose(0, 1, 3, 2, 4).reshape(T, 7 * M, 7 * M)
-
-
-def _sparse_solve(st: BlockStructure, blocks: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Solve the reduced normals trial by trial as a sparse matrix (large blocks).
-
-    The matrix of a block of ``M`` models has about ``9 M`` non-zero 7 x 7 blocks (each model
-    shares points with its neighbours only), so a sparse LU costs far less than the dense
-    ``(7M)^3`` once ``M`` reaches a few hundred models. The loop runs over the trials, each
-    one a whole block.
-    """
-    from scipy.sparse.linalg import spsolve
-
-    M = st.n_models
-    i = np.arange(7)
-    shape = (st.pair_m1.size, 7, 7)
-    rows = np.broadcast_to(7 * st.pair_m1[:, None, None] + i[None, :, None], shape)
-    cols = np.broadcast_to(7 * st.pair_m2[:, None, None] + i[None, None, :], shape)
-    out = np.empty(rhs.shape)
-    for t in range(blocks.shape[0]):  # one sparse factorisation per simulated block
-        N = sparse.csc_matrix((blocks[t].ravel(), (rows.ravel(), cols.ravel())),
-                              shape=(7 * M, 7 * M))
-        out[t] = spsolve(N, rhs[t])
-    return out
-
-
-#: above this many models the reduced normals are solved as sparse matrices
-SPARSE_FROM_MODELS = 60
-
-
-def normal_step(st: BlockStructure, xm, c, s, R, t, X, w_obs, ctrl_xyz, w_ctrl, dense=False,
-                solver: str = "auto"):
-    """One Gauss-Newton correction ``(dg (T, M, 7), dX (T, P, 3))``.
-
-    The reduced normals are solved densely (batched Cholesky) or, for blocks of
-    ``SPARSE_FROM_MODELS`` models or more (``solver="auto"``), as sparse matrices;
-    ``solver`` may force ``"dense"`` or ``"sparse"``. ``dense=True`` instead builds and
-    solves the full normal matrix of all ``7M + 3P`` unknowns (for checking the reduced
-    solution on small blocks).
-    """
-    T = xm.shape[0]
-    M, P = st.n_models, st.n_points
-    e, J = _linearise(st, xm, c, s, R, t, X)
-    wc_full = _scatter(st.S_ctrl, np.broadcast_to(w_ctrl, (T,) + np.shape(w_ctrl)[-2:]))
-    ec = X[:, st.ctrl_point] - ctrl_xyz
-    ug = _scatter(st.S_model, -np.einsum("tkci,tkc->tki", J, w_obs * e))
-    up = _scatter(st.S_point, w_obs * e) - _scatter(st.S_ctrl, w_ctrl * ec)
-    if dense:
-        K = st.obs_model.size
-        C = st.ctrl_point.size
-        A = np.zeros((T, 3 * K + 3 * C, 7 * M + 3 * P))
-        rows = 3 * np.arange(K)[:, None] + np.arange(3)
-        for k in range(K):  # test-only dense assembly
-            A[:, rows[k], 7 * st.obs_model[k]:7 * st.obs_model[k] + 7] = J[:, k]
-            A[:, rows[k], 7 * M + 3 * st.obs_point[k] + np.arange(3)] = -1.0
-        for i, j in enumerate(st.ctrl_point):
-            A[:, 3 * K + 3 * i + np.arange(3), 7 * M + 3 * j + np.arange(3)] = 1.0
-        w = np.concatenate([w_obs.reshape(T, -1),
-                            np.broadcast_to(w_ctrl, ec.shape).reshape(T, -1)], 1)
-        r = np.concatenate([e.reshape(T, -1), ec.reshape(T, -1)], 1)
-        N = np.einsum("toi,to,toj->tij", A, w, A)
-        u = -np.einsum("toi,to->ti", A, w * r)
-        d = chol_solve(N, u[..., None])[..., 0]
-        return d[:, :7 * M].reshape(T, M, 7), d[:, 7 * M:].reshape(T, P, 3)
-    blocks, B, Dinv = _reduced(st, J, w_obs, wc_full)
-    ubar = ug - _scatter(st.S_model, np.einsum("tkic,tkc,tkc->tki", B, Dinv[:, st.obs_point],
-                                               up[:, st.obs_point]))
-    if solver == "auto":
-        solver = "sparse" if M >= SPARSE_FROM_MODELS else "dense"
-    if solver == "sparse":
-        dg = _sparse_solve(st, blocks, ubar.reshape(T, 7 * M)).reshape(T, M, 7)
-    else:
-        dg = chol_solve(_dense(st, blocks), ubar.reshape(T, 7 * M, 1)).reshape(T, M, 7)
-    dX = Dinv * (up - _scatter(st.S_point, np.einsum("tkic,tki->tkc", B, dg[:, st.obs_model])))
-    return dg, dX
 
 
 def adjust_block(st: BlockStructure, xm: np.ndarray, w_obs: np.ndarray, ctrl_xyz: np.ndarray,
                  w_ctrl: np.ndarray, s0, R0, t0, X0, *, tol_m: float = 1e-5, max_iter: int = 20,
                  keep_normals: bool = False, solver: str = "auto") -> AdjustResult:
-    """Batched least-squares block adjustment of independent models.
+    """Batched least-squares block adjustment of independent models, by the engine's
+    Gauss-Newton loop (:func:`sim.lsq.gauss_newton`, group blocks).
 
     xm : (T, K, 3) model coordinates of observation ``k`` (model ``st.obs_model[k]``, point
     ``st.obs_point[k]``); w_obs : (T, K, 3) or (K, 3) weights (0 removes an observation);
     ctrl_xyz : (T, C, 3) given control coordinates; w_ctrl : (C, 3) weights.
     s0, R0, t0 : initial similarities (ground = s R x + t), X0 : (T, P, 3) initial points.
-    Iterates until the largest point correction is below ``tol_m``. ``solver``: see
-    :func:`normal_step`.
+    A trial stops when its largest point or translation correction (m) is below ``tol_m``
+    (or the engine's contraction estimate of the remaining error is). ``solver``: see
+    :func:`normal_step`. ``keep_normals`` also keeps the Jacobian ``J``.
     """
     T, K = xm.shape[:2]
     w_obs = np.broadcast_to(w_obs, (T, K, 3)).astype(float)
     w_ctrl = np.broadcast_to(w_ctrl, (T,) + np.shape(w_ctrl)[-2:]).astype(float)
-    wsum = _scatter(st.S_model, (w_obs.sum(-1) > 0).astype(float)[..., None])
-    c = _scatter(st.S_model, xm * (w_obs.sum(-1, keepdims=True) > 0)) / np.maximum(wsum, 1)
+    wsum = lsq.groups.scatter(st.S_model, (w_obs.sum(-1) > 0).astype(float)[..., None])
+    c = lsq.groups.scatter(st.S_model, xm * (w_obs.sum(-1, keepdims=True) > 0)) / np.maximum(wsum, 1)
     s = np.array(s0, float)
     R = np.array(R0, float)
     # work with t' = t + s R c (the ground position of the model centroid)
     t = np.array(t0, float) + s[..., None] * np.einsum("tmij,tmj->tmi", R, c)
-    X = np.array(X0, float)
-    conv = np.zeros(T, bool)
-    it = 0
-    for it in range(1, max_iter + 1):
-        dg, dX = normal_step(st, xm, c, s, R, t, X, w_obs, ctrl_xyz, w_ctrl, solver=solver)
-        s = s * (1.0 + dg[..., 0])
-        R = rodrigues(dg[..., 1:4]) @ R
-        t = t + dg[..., 4:7]
-        X = X + dX
-        step = np.maximum(np.abs(dX).max(axis=(1, 2)),
-                          np.abs(dg[..., 4:7]).max(axis=(1, 2)))
-        conv = step < tol_m
-        if conv.all():
-            break
-    e, J = _linearise(st, xm, c, s, R, t, X)
-    vc = X[:, st.ctrl_point] - ctrl_xyz
-    used = (w_obs > 0).sum(axis=(1, 2))
-    n_unk = 7 * st.n_models + 3 * (_scatter(st.S_point, w_obs) + _scatter(
-        st.S_ctrl, w_ctrl) > 0).any(-1).sum(-1)
-    dof = used + (w_ctrl > 0).sum(axis=(1, 2)) - n_unk
-    ss = np.einsum("tkc,tkc->t", w_obs * e, e) + np.einsum("tkc,tkc->t", w_ctrl * vc, vc)
-    sigma0 = np.sqrt(ss / np.maximum(dof, 1))
-    t_out = t - s[..., None] * np.einsum("tmij,tmj->tmi", R, c)
-    res = AdjustResult(s, R, t_out, X, e, vc, sigma0, dof, it, conv)
-    if keep_normals:
-        wc_full = _scatter(st.S_ctrl, w_ctrl)
-        blocks, res.B, res.Dinv = _reduced(st, J, w_obs, wc_full)
-        res.Nbar = _dense(st, blocks)
-        res.J = J
-    return res
-
-
-def _cofactors(st: BlockStructure, res: AdjustResult):
-    """``(Qmm (T, K, 7, 7), Qmj (T, K, 7, 3), Qjj_diag (T, P, 3))`` from the reduced normals
-    kept in ``res``: the cofactors of observation k's model parameters, their cross terms
-    with its point, and the diagonal of every point's cofactor block (see
-    :func:`residual_cofactors`)."""
-    T = res.X.shape[0]
-    M = st.n_models
-    Q = chol_solve(res.Nbar, np.broadcast_to(np.eye(7 * M), res.Nbar.shape))
-    Q = Q.reshape(T, M, 7, M, 7).transpose(0, 1, 3, 2, 4)
-    om, op = st.obs_model, st.obs_point
-    Qp = Q[:, om[st.pk1], om[st.pk2]]                          # (T, npair, 7, 7)
-    B, Dinv = res.B, res.Dinv
-    QB = np.einsum("tpab,tpbc->tpac", Qp, B[:, st.pk2])        # (T, npair, 7, 3)
-    Qmj = -_scatter(st.S_pair_obs, QB) * Dinv[:, op][:, :, None, :]
-    inner = np.einsum("tpac,tpac->tpc", B[:, st.pk1], QB)      # diag of B1^T Q B2
-    Qjj = Dinv + Dinv ** 2 * _scatter(st.S_pair_point, inner)
-    return Q[:, om, om], Qmj, Qjj
+    model = SimilarityModel(st, xm, c, w_obs, ctrl_xyz, w_ctrl, solver)
+    scale = np.tile([np.inf] * 4 + [1.0] * 3, st.n_models)  # the test: points, translations
+    res = lsq.gauss_newton(model, _state(s, R, t), np.array(X0, float), tol=tol_m,
+                           max_iter=max_iter, step_scale=scale)
+    th = res.theta
+    s, R = th[..., 0], th[..., 1:10].reshape(T, -1, 3, 3)
+    t_out = th[..., 10:] - s[..., None] * np.einsum("tmij,tmj->tmi", R, c)
+    J = model.linearize(res.points, th).Jg if keep_normals else None
+    return AdjustResult(s, R, t_out, res.points, -res.residuals, -res.point_residuals,
+                        res.sigma0, res.dof, int(res.iterations.max()), res.converged,
+                        res.status, res, J)
 
 
 def point_cofactors(st: BlockStructure, res: AdjustResult) -> np.ndarray:
-    """Diagonal cofactors of the adjusted points ``(T, P, 3)`` (``keep_normals=True``);
-    times the variance of unit weight they are the variances of the ground coordinates."""
-    return _cofactors(st, res)[2]
+    """Diagonal cofactors of the adjusted points ``(T, P, 3)``; times the variance of unit
+    weight they are the variances of the ground coordinates."""
+    return np.einsum("tpii->tpi", res.engine.point_cofactors())
 
 
 def residual_cofactors(st: BlockStructure, res: AdjustResult, w_obs: np.ndarray) -> np.ndarray:
     """Diagonal of the residual cofactor matrix ``Q_vv = W^-1 - A Q_xx A^T`` of the model
-    points, ``(T, K, 3)``, from the reduced normals kept in ``res`` (``keep_normals=True``).
-
-    With ``A_k = [J_k, -I]`` for observation ``k`` of model ``m`` and point ``j``:
-    ``diag(A Q A^T) = diag(J Q_mm J^T) - 2 diag(J Q_mj) + diag(Q_jj)`` where
-    ``Q_gg = Nbar^-1``, ``Q_mj = -sum_k' Q_g[m, m_k'] B_k' D_j^-1`` and
-    ``Q_jj = D_j^-1 + D_j^-1 (sum_k'k'' B_k'^T Q_g[m_k', m_k''] B_k'') D_j^-1``.
-    Removed observations (weight 0) get NaN.
-    """
-    Qmm, Qmj, Qjj = _cofactors(st, res)
-    J = res.J
-    aqa = (np.einsum("tkca,tkab,tkcb->tkc", J, Qmm, J)
-           - 2 * np.einsum("tkca,tkac->tkc", J, Qmj) + Qjj[:, st.obs_point])
-    w = np.broadcast_to(w_obs, aqa.shape)
-    return np.where(w > 0, 1.0 / np.where(w > 0, w, 1.0) - aqa, np.nan)
+    points, ``(T, K, 3)`` (:meth:`sim.lsq.groups.GroupCofactors.residuals`, with the weights
+    of the adjustment; ``w_obs`` must be those). Removed observations (weight 0) get NaN."""
+    eng = res.engine
+    return eng.cofactors().residuals(eng.model.linearize(eng.points, eng.theta))
 
 
 def snoop(st: BlockStructure, xm, w_obs, ctrl_xyz, w_ctrl, s0, R0, t0, X0, candidates: np.ndarray,

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import groups
 from .normals import RCOND, bordered_solve, reduce
 from .problem import Datum, fast_path
 from .result import Result
@@ -90,6 +91,8 @@ def gauss_newton(model, theta0: np.ndarray, points0: np.ndarray | None = None,
             return res
     if engine == "fast":
         raise ValueError(f"no fast path applies to {type(model).__name__} with this datum")
+    if getattr(model, "structure", None) is not None:
+        return _grouped(model, theta, points0, datum, tol, max_iter, rcond, step_scale)
     free = datum.free_index(model.n_global)
     p = len(free)
     C = datum.constraint_matrix(theta) if p else None
@@ -129,3 +132,47 @@ def gauss_newton(model, theta0: np.ndarray, points0: np.ndarray | None = None,
     dof = degrees_of_freedom(model, pts.shape[1], datum, theta, lin.r[0].size)
     s0 = np.sqrt(vpv / dof) if dof > 0 else np.full(T, np.nan)
     return Result(pts, theta, lin.r, s0, dof, prog.iters, prog.status, model, datum)
+
+
+def _bcast(mask: np.ndarray, a: np.ndarray) -> np.ndarray:
+    return mask.reshape(mask.shape + (1,) * (a.ndim - 1))
+
+
+def _grouped(model, theta, points0, datum, tol, max_iter, rcond, step_scale) -> Result:
+    """The same loop for models whose globals are group blocks (:mod:`sim.lsq.groups`):
+    ``model.structure`` a :class:`~sim.lsq.groups.GroupStructure`, ``model.linearize``
+    returning a :class:`~sim.lsq.groups.GroupLinearization`, ``theta`` any per-trial state
+    that ``model.retract`` updates with the tangent corrections (T, G b)."""
+    if datum.free is not None or datum.constraints is not None:
+        raise ValueError("group-block models take their datum from weighted point rows")
+    st = model.structure
+    T = theta.shape[0]
+    scale = None if step_scale is None else np.asarray(step_scale, float)
+    solver = getattr(model, "solver", "auto")
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        pts = (model.initial_points(theta) if points0 is None
+               else np.array(points0, float, copy=True))
+        prog = _Progress(T)
+        for it in range(1, max_iter + 1):
+            dp, dg, ok = groups.step(st, model.linearize(pts, theta), solver, rcond, it == 1)
+            g = np.abs(dg) if scale is None else np.abs(dg) / scale
+            step = np.maximum(np.abs(dp).max(axis=(1, 2)), g.max(axis=1))
+            step = np.where(np.isfinite(dp).all(axis=(1, 2)) & np.isfinite(dg).all(axis=1),
+                            step, np.nan)
+            upd = prog.update(it, ok, step, tol)
+            new_pts, new_theta = model.retract(pts, theta, np.where(upd[:, None, None], dp, 0.0),
+                                               np.where(upd[:, None], dg, 0.0))
+            pts = np.where(upd[:, None, None], new_pts, pts)
+            theta = np.where(_bcast(upd, theta), new_theta, theta)
+            if not prog.active.any():
+                break
+        lin = model.linearize(pts, theta)
+        vpv = (np.einsum("tkm,tkm->t", lin.w * lin.r, lin.r)
+               + np.einsum("tcm,tcm->t", lin.wc * lin.rc, lin.rc))
+    present = (groups.scatter(st.S_point, lin.w) + groups.scatter(st.S_rows, lin.wc) > 0)
+    dof = ((lin.w > 0).sum(axis=(1, 2)) + (lin.wc > 0).sum(axis=(1, 2))
+           - st.n_groups * lin.Jg.shape[-1] - model.point_dim * present.any(-1).sum(-1))
+    s0 = np.sqrt(vpv / np.maximum(dof, 1))
+    res = Result(pts, theta, lin.r, s0, dof, prog.iters, prog.status, model, datum)
+    res.point_residuals = lin.rc
+    return res

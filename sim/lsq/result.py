@@ -67,7 +67,12 @@ class Cofactors:
 
 def cofactors(model, points: np.ndarray, theta: np.ndarray, datum: Datum | None = None,
               rcond: float = RCOND) -> Cofactors:
-    """Cofactors of ``model`` at ``points`` (T, n, d), ``theta`` (T, q) in ``datum``."""
+    """Cofactors of ``model`` at ``points`` (T, n, d), ``theta`` (T, q) in ``datum`` (a
+    :class:`sim.lsq.groups.GroupCofactors` for group-block models)."""
+    if getattr(model, "structure", None) is not None:  # group blocks
+        from .groups import cofactors as group_cofactors
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            return group_cofactors(model.structure, model.linearize(points, theta), rcond)
     datum = Datum() if datum is None else datum
     free = datum.free_index(model.n_global)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
@@ -89,7 +94,8 @@ class Result:
 
     points : (T, n, d); theta : (T, q) (fixed entries unchanged); residuals : (T, n, k)
     observed minus adjusted; sigma0 : (T,) a-posteriori standard error of unit weight
-    (``sqrt(v'Pv / dof)``, NaN for ``dof = 0``); dof : int; iterations : (T,) int;
+    (``sqrt(v'Pv / dof)``, NaN for ``dof = 0``); dof : int (per trial (T,) for group-block
+    models, whose zero weights remove observations); iterations : (T,) int;
     status : (T,) int8 (:data:`STATUS`); converged : (T,) bool. ``model`` and ``datum`` are
     kept for the cofactor accessors.
     """
@@ -104,6 +110,8 @@ class Result:
     model: object = field(default=None, repr=False)
     datum: Datum | None = field(default=None, repr=False)
     _cof: Cofactors | None = field(default=None, repr=False)
+    #: residuals of point-only rows (group-block models), else None
+    point_residuals: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def converged(self) -> np.ndarray:
