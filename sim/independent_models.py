@@ -47,9 +47,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import lsq
-from .lsq.groups import chol_solve
-
 from .geometry import rotation, similarity_fit
+from .lsq.groups import chol_solve
 
 __all__ = ["rodrigues", "form_models", "random_similarities",
            "to_model_frame", "BlockStructure", "AdjustResult", "adjust_block", "snoop",
