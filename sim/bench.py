@@ -7,6 +7,10 @@ Two questions, one Parquet row per cell (``results/bench/bench.parquet``) and a 
    observations and tolerance (both stop on corrections below ~1e-10 mm).
 2. Cost per trial against the number of points (25 to 10,000): linear if the point blocks are
    eliminated (reduced normals), cubic for a dense solve.
+3. Each engine of :mod:`sim.lsq` (P-position design cell, two-grid-plate combined
+   adjustment, independent-model block) against a per-trial ``scipy.optimize.least_squares``
+   loop of the same adjustment on the same observations (rows ``engine_*``, ``scipy_*``;
+   the SciPy time is measured on a few trials and scaled to the engine's count).
 """
 from __future__ import annotations
 
@@ -157,6 +161,145 @@ def peak_memory(out: Path, trials: int, chunk: int) -> tuple[float, float]:
     return float(done.stdout.split()[-1]), time.perf_counter() - t
 
 
+# ---------------------------------------------------------------- engine rows (issue 12)
+def _lsq_scipy(fun, z0, jac=None, sparsity=None):
+    return least_squares(fun, z0, jac=jac if jac is not None else "2-point",
+                         jac_sparsity=sparsity, method="trf", x_scale="jac",
+                         xtol=1e-12, ftol=1e-14, gtol=1e-14)
+
+
+def _pposition(T: int, seed: int = 3):
+    """P-position design cell: 6 positions, 5 x 5 points over 220 mm, pivot model."""
+    from . import positions as po
+
+    rng = np.random.default_rng(seed)
+    pts = grid_points(5, 55.0)
+    th = po.design_theta(6, 155.0, 0.5, 1.0)
+    TH = np.broadcast_to(th, (T, th.size))
+    r = po.ranges(np.broadcast_to(pts, (T,) + pts.shape), TH) + rng.normal(0, 1e-3, (T, 25, 6))
+    t0 = th.copy()
+    t0[-2:] = 0.0
+
+    def engine():
+        return po.adjust(r, "pivot", t0, "inner").sigma0
+
+    def one(t):  # minimal datum X_1, Y_1, X_2 held; sigma0 is datum-invariant
+        n, q = 25, th.size
+        keep = np.r_[3:q]
+        z0 = np.concatenate([po.initial_points(r[t:t + 1], t0[None])[0].ravel(), t0[keep]])
+        model = po.RangeModel(r[t:t + 1])
+
+        def unpack(z):
+            full = t0.copy()
+            full[keep] = z[2 * n:]
+            return z[:2 * n].reshape(1, n, 2), full[None]
+
+        def fun(z):
+            return model.linearize(*unpack(z), False).r.ravel()
+
+        def jac(z):
+            lin = model.linearize(*unpack(z), True)
+            J = np.zeros((n * 6, 2 * n + keep.size))
+            rows = np.arange(6 * n)
+            J[rows, 2 * (rows // 6)] = -lin.Jp[0].reshape(-1, 2)[:, 0]
+            J[rows, 2 * (rows // 6) + 1] = -lin.Jp[0].reshape(-1, 2)[:, 1]
+            J[:, 2 * n:] = -lin.Jg[0].reshape(-1, q)[:, keep]
+            return J
+
+        f = _lsq_scipy(fun, z0, jac)
+        return np.sqrt(2 * f.cost / (6 * n - 2 * n - q + 3))
+
+    return 25, engine, one
+
+
+def _gridplate(T: int, seed: int = 4):
+    """Two-grid-plate combined adjustment of one coordinate, 7 x 7 points, P_cx = 4."""
+    from . import gridplate as gp
+
+    rng = np.random.default_rng(seed)
+    g = grid_points(7, 36.0)
+    N = len(g)
+    true = g + rng.normal(0, 1e-3, (T, N, 2))
+    comp = 1.00002 * true[..., 0] + 3e-5 * true[..., 1] + 2.0 + rng.normal(0, 1e-3, (T, N))
+
+    def engine():
+        return gp.combined_adjustment(comp, g, 1.0, 4.0).params
+
+    def one(t):
+        def fun(z):
+            u = z[3:].reshape(N, 2)
+            return np.concatenate([comp[t] - (z[0] * u[:, 0] + z[1] * u[:, 1] + z[2]),
+                                   2.0 * (g - u).ravel()])
+        return _lsq_scipy(fun, np.r_[1.0, 0.0, 0.0, g.ravel()]).x[:3]
+
+    return N, engine, one
+
+
+def _block(T: int, seed: int = 5):
+    """Independent-model block of 2 strips x 3 models, 40 ground points, control on the
+    pattern "full" (the SciPy loop differentiates numerically on the sparsity pattern)."""
+    from . import independent_models as im
+    from .block_layout import make_block, select_control
+
+    rng = np.random.default_rng(seed)
+    b = make_block(2, 3, n_ground=40, pass_rows=3)
+    xl, xr = b.image_coords(b.obs_left, b.obs_point), b.image_coords(b.obs_right, b.obs_point)
+    G = im.form_models(xl, xr, b.focal_mm, b.base_m) + b.photos.reshape(-1, 3)[b.obs_left]
+    G = G[None] + rng.normal(0, 0.05, (T,) + G.shape)
+    s, R, t = im.random_similarities(rng, (T, b.n_models))
+    xm = im.to_model_frame(G, b.obs_model, s, R, t)
+    ctrl = select_control(b, "full")
+    st = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points)
+    X0 = b.points + rng.normal(0, 2.0, (T,) + b.points.shape)
+    s0, R0, t0 = im.initial_values(st, xm, X0)
+    cx = np.broadcast_to(b.points[ctrl], (T, ctrl.size, 3))
+    wc = np.full((ctrl.size, 3), 25.0)
+
+    def engine():
+        return im.adjust_block(st, xm, np.ones(3), cx, wc, s0, R0, t0, X0).X
+
+    def one(i):
+        M, P, K, C = b.n_models, b.n_points, b.obs_model.size, ctrl.size
+        om, op = b.obs_model, b.obs_point
+
+        def fun(z):
+            g = z[:7 * M].reshape(M, 7)
+            X = z[7 * M:].reshape(P, 3)
+            Rm = im.rodrigues(g[:, 1:4]) @ R0[i]
+            y = (s0[i] * (1 + g[:, 0]))[om, None] * np.einsum("kij,kj->ki", Rm[om], xm[i])
+            return np.concatenate([(y + t0[i][om] + g[om, 4:7] - X[op]).ravel(),
+                                   (5.0 * (X[ctrl] - cx[i])).ravel()])
+
+        sp = np.zeros((3 * K + 3 * C, 7 * M + 3 * P), bool)
+        for k in range(K):
+            sp[3 * k:3 * k + 3, 7 * om[k]:7 * om[k] + 7] = True
+            sp[3 * k:3 * k + 3, 7 * M + 3 * op[k]:7 * M + 3 * op[k] + 3] = True
+        for c, j in enumerate(ctrl):
+            sp[3 * K + 3 * c:3 * K + 3 * c + 3, 7 * M + 3 * j:7 * M + 3 * j + 3] = True
+        return _lsq_scipy(fun, np.r_[np.zeros(7 * M), X0[i].ravel()],
+                          sparsity=sp).x[7 * M:].reshape(P, 3)
+
+    return b.n_points, engine, one
+
+
+def engine_rows(quick: bool) -> list[tuple[str, int, int, float, float]]:
+    """Per engine: (name, points, trials, engine seconds, scipy seconds per the same number
+    of trials) and the largest difference of the solutions (printed)."""
+    out = []
+    for name, make, T, Ts in (("pposition", _pposition, 400, 10), ("gridplate", _gridplate, 400, 10),
+                              ("block", _block, 40, 2)):
+        T, Ts = (max(T // 10, 4), max(Ts // 2, 1)) if quick else (T, Ts)
+        n, engine, one = make(T)
+        eng = engine()
+        te = _time(engine, 1 if quick else 3)
+        ts = _time(lambda: [one(t) for t in range(Ts)], 1) * T / Ts
+        diff = max(float(np.abs(np.asarray(one(t)) - eng[t]).max()) for t in range(min(Ts, 2)))
+        print(f"{name:>10}: engine {T / te:10.1f} trials/s, scipy loop {T / ts:8.2f} trials/s, "
+              f"x{ts / te:.0f}; solutions differ by {diff:.1e}")
+        out.append((name, n, T, te, ts))
+    return out
+
+
 def run(out: Path, quick: bool = False) -> dict:
     rows: dict[str, list] = {k: [] for k in ("case", "n_points", "trials", "seconds",
                                              "trials_per_s", "us_per_trial_per_point")}
@@ -202,7 +345,11 @@ def run(out: Path, quick: bool = False) -> dict:
         Tn = max(2 * ml.jit.LANES, 40000 // n)  # whole SIMD blocks at every size
         _, _, o, tt = _obs(n, Tn, 2)
         add("batched_points", n, Tn, _time(lambda: ml.adjust(o, "pivot", tt), 2))
-    # 3. executors, and the memory of a million-trial streamed run
+    # 3. the engines of sim.lsq against per-trial SciPy loops of the same adjustments
+    for name, n, Te, te, ts in engine_rows(quick):
+        add(f"engine_{name}", n, Te, te)
+        add(f"scipy_{name}", n, Te, ts)
+    # 4. executors, and the memory of a million-trial streamed run
     n_ex = 20000 if quick else 100000
     for kind, workers, tps in executors(n_ex, 5000):
         add(f"{kind}_{workers}w", 25, n_ex, n_ex / tps)
