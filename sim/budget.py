@@ -14,6 +14,9 @@ the simulated scale readings (all amplitudes in um, readings in mm):
   ``sigma_screw`` (paper: 0.3 um), a Fourier series of ``harmonics`` terms over the 1 mm
   range. Uncorrected periodic error from drum eccentricity: ``A sin(2 pi f / pitch + phi)``
   (paper: up to 0.5 um; the pitch is not printed).
+* **uncalibrated scale** (``scale_spec``) -- the same model with the specification's 1 um.
+* **ball sphericity** -- the ball's out-of-roundness (paper: 0.25 um) as a second-harmonic
+  radial error over the arm's direction, like the wobble.
 * **pivot wobble** -- a radial error depending on the direction ``psi`` of the measuring arm
   in the comparator frame, ``W cos(m (psi - psi0))`` (paper: up to 2 um at 3 kg thrust, none
   at 6 kg). The first harmonic ``m = 1`` is a fixed displacement of the pivot and is absorbed
@@ -70,15 +73,19 @@ def wobble_error(psi: np.ndarray, rng: np.random.Generator, amp_um: float,
     return amp_um * np.cos(harmonic * (psi - psi0))
 
 
-SOURCES = ("scale", "screw", "drum_periodic", "wobble", "wobble_h1")
+SOURCES = ("scale", "scale_spec", "screw", "drum_periodic", "wobble", "wobble_h1", "sphericity")
 
 
 def source_error(name: str, r_mm: np.ndarray, psi: np.ndarray, rng: np.random.Generator,
                  cfg: dict) -> np.ndarray:
     """Error (um) of source ``name`` with the amplitudes of the flat config ``cfg``
-    (keys ``budget.*``)."""
+    (keys ``budget.*``); every source of :data:`SOURCES`."""
     if name == "scale":
         return graduation_error(r_mm, rng, cfg["budget.graduation_um"])
+    if name == "scale_spec":
+        return graduation_error(r_mm, rng, cfg["budget.scale_spec_um"])
+    if name == "sphericity":
+        return wobble_error(psi, rng, cfg["budget.sphericity_um"], 2)
     if name == "screw":
         return screw_error(r_mm, rng, cfg["budget.screw_um"], cfg["budget.screw_harmonics"])
     if name == "drum_periodic":

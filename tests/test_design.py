@@ -1,4 +1,9 @@
-"""brown_design: sweeps, adaptive trial counts, error budget, design constraints, coverage."""
+"""brown_design: sweeps, adaptive trial counts, error budget, design constraints, coverage,
+claim book, consistent set."""
+import pickle
+from functools import partial
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -139,11 +144,131 @@ def test_scale_length_makes_browns_dilution_geometry_infeasible():
     assert "pivot over the plate" in g8["reason"][0]
 
 
-def test_paper_design_must_be_in_the_grid():
+def test_paper_design_must_be_in_the_grid_and_fit_its_hardware():
     with pytest.raises(ConfigError, match="paper.offset_mm"):
         validate({"paper.offset_mm": 33.0}, design.SCHEMA, design.check)
     with pytest.raises(ConfigError, match="time.double_min"):
         validate({"time.double_min": 50.0}, design.SCHEMA, design.check)
+    # 45 mm is a cell of the grid, but a +-90 mm grid's ranges do not fit on 261 + 1 mm there
+    with pytest.raises(ConfigError, match="paper.offset_mm: the paper's design must fit"):
+        validate({"paper.offset_mm": 45.0}, design.SCHEMA, design.check)
+    with pytest.raises(ConfigError, match="sweep.offsets_mm"):
+        validate({"sweep.offsets_mm": [40.0, 60.0]}, design.SCHEMA, design.check)
+    with pytest.raises(ConfigError, match="sweep.zeiss_extents_mm"):
+        validate({"sweep.zeiss_extents_mm": [20.0, 90.0]}, design.SCHEMA, design.check)
+    with pytest.raises(ConfigError, match="design.offsets_mm"):
+        validate({"design.offsets_mm": list(np.arange(1.0, 2001.0) / 2)}, design.SCHEMA,
+                 design.check)
+
+
+def test_chunk_functions_pickle_and_give_the_same_chunks():
+    from sim.studies.design import chunks
+    cfg = validate({}, design.SCHEMA, design.check)
+    pts = grid_points(4, 60.0)
+    th = po.design_theta(4, 152.5, 0.5, 1.0)
+    bcfg = {k: v for k, v in cfg.items() if k.startswith("budget.")}
+    bcfg["comparator.sigma_um"] = 1.1
+    for fn in (partial(chunks.design_chunk, pts, th, 1.4),
+               partial(chunks.budget_chunk, bcfg, pts, th, ("scale", "screw"), 1.7, 2)):
+        back = pickle.loads(pickle.dumps(fn))
+        a = run_chunks(fn, 30, 3, 10, quiet=True)
+        b = run_chunks(back, 30, 3, 10, quiet=True)
+        assert all(np.array_equal(a[k], b[k], equal_nan=True) for k in a)
+
+
+def test_adaptive_loop_runs_through_the_runner_and_reuses_chunks(tmp_path):
+    from sim.runner import ChunkStore
+    from sim.studies import RunContext
+    from sim.studies.design.adaptive import run_adaptive as adaptive
+
+    def stat(res):
+        x = res["x"]
+        return {"mean": (float(x.mean()), float(x.std(ddof=1) / np.sqrt(len(x))))}
+
+    fn = partial(_normal_chunk, 1.0)
+    ctx = RunContext(quiet=True, store=ChunkStore(tmp_path / "trials"))
+    res, st = adaptive(fn, stat, 0.02, seed=5, chunk=500, part=3, min_trials=1000,
+                       max_trials=50_000, ctx=ctx)
+    n = len(res["x"])
+    assert st["mean"][1] < 0.02 and n % 500 == 0 and n < 5000
+    assert len(list((tmp_path / "trials" / "part-3").glob("chunk-*.parquet"))) == n // 500
+    assert np.array_equal(run_chunks(fn, n, 5, 500, part=3, quiet=True)["x"], res["x"])
+    res2, _ = adaptive(fn, stat, 0.02, seed=5, chunk=500, part=3, min_trials=1000,
+                       max_trials=50_000)          # no store: a temporary one
+    assert np.array_equal(res2["x"], res["x"])
+    capped, st = adaptive(fn, stat, 1e-6, seed=5, chunk=500, part=3, min_trials=500,
+                          max_trials=1700)
+    assert len(capped["x"]) == 1500 and st["mean"][1] > 1e-6   # stops at whole chunks
+
+
+def _normal_chunk(scale, rng, n):
+    return {"x": rng.normal(0.0, scale, n)}
+
+
+def test_tolerances_of_the_calibration_section_are_analytic():
+    from sim.studies.design import external as ex
+    cfg = validate({}, design.SCHEMA, design.check)
+    t = ex.tolerances(cfg, 50.0, 0.5)
+    assert t["lateral_error_um"] == pytest.approx(0.1 ** 2 / (2 * 50.0) * 1e3)   # 0.1 um
+    assert t["linearity_tol_um"] == pytest.approx(np.sqrt(2 * 50.0 * 1e-3) * 1e3)
+    assert t["axis_tilt_deg"] == pytest.approx(np.degrees(np.arctan(0.01)))
+    assert t["drum_graduation_um"] == pytest.approx(15 / 1296000 * 500)
+    z = ex.zeiss_points(cfg, 90.0)
+    assert z.shape == (33, 2) and len({tuple(p) for p in z}) == 33
+    assert np.all(np.abs(z) <= 90.0) and np.all(z % 10 == 0)
+
+
+def test_linearised_plate_rms_matches_its_covariance():
+    from sim.studies.design import external as ex
+    cfg = validate({"sweep.plates": 20000}, design.SCHEMA, design.check)
+    pts = ex.paper_points(cfg)
+    a, b = ex.plate_rms(cfg, pts, 30.0, 1.0, 1.0, 0.8, 91)
+    F = po.full_point_covariance(pts[None], ex._theta(cfg, 30.0, 1.0)[None], "pivot", "inner")[0]
+    S = dm.s_matrix(dm.null_basis(pts))
+    ms = np.trace(S @ F @ S.T) / (2 * len(pts))
+    se = (a ** 2).std() / np.sqrt(len(a))
+    assert abs((a ** 2).mean() - ms) < 4 * se
+    extra = 0.8 ** 2 * (2 * len(pts) - 3) / (2 * len(pts))      # the fit removes 3 of 2n
+    assert abs((b ** 2).mean() - ms - extra) < 4 * (b ** 2).std() / np.sqrt(len(b))
+
+
+def test_claim_book_classes_the_datum_and_emcee_rows():
+    from sim.studies.design.claims import load_book
+    book = load_book()
+    for cid, s in book.specs.items():
+        if cid.startswith("brown.datum."):
+            assert s["kind"] == "finding" and "ref" not in s
+        if cid.startswith("bayes.brown_agreement."):
+            assert s["kind"] == "self-check" and (s["tol"] > 0 or s["form"] == "upper")
+    assert len(book.not_reproduced) >= 10
+
+
+def test_tiny_run_end_to_end(tmp_path):
+    tiny = Path(__file__).parent / "data" / "tiny" / "brown_design.txt"
+    sets = [a for line in tiny.read_text().split() for a in ("--set", line)]
+    out = tmp_path / "o"
+    assert main(["run", "studies/brown_design.toml", *sets, "--out", str(out), "--quiet"]) == 0
+    cl = read_table(out / "claims.parquet").to_pydict()
+    V = dict(zip(cl["claim"], cl["verdict"]))
+    assert all(V[c] == "finding" for c in V if c.startswith("brown.datum."))
+    assert all(V[c] == "self-check" for c in V if c.startswith("bayes.brown_agreement."))
+    assert V["brown.calibration.scale_combined_um"] == "holds"     # a paper-check
+    assert not any(v is None for v in cl["verdict"])
+    tol = read_provenance(out / "claims.parquet")["tolerances"]
+    assert 0 < tol["bayes.parquet"]["ratio"] < 0.5 and "value" in tol["claims.parquet"]
+    cs = read_table(out / "consistent_set.parquet").to_pydict()
+    assert {"input", "claim", "holds_low", "holds_high"} <= set(cs)
+    assert set(cs["input"]) >= {"paper.offset_mm", "paper.beta_mm", "time.pass_min",
+                                "zeiss.half_extent_mm", "budget.pitch_mm"}
+    assert cs["claim"].count("ALL") == len(set(cs["input"]))
+    sv = read_table(out / "sweep_values.parquet").to_pydict()
+    hmax = dict(zip(cl["claim"], cl["value"]))["brown.design.max_offset_paper_grid_mm"]
+    for i, x, v in zip(sv["input"], sv["value"], sv["verdict"]):   # hardware decides
+        if i == "paper.offset_mm" and x > hmax:
+            assert v == "infeasible"
+    for f in ("pareto.png", "consistent_set.png", "corner.png"):
+        assert (out / f).is_file()
+    assert "consistent set" in design.report(out)
 
 
 def test_coverage_of_a_linear_models_ellipses_is_95_percent():

@@ -1,0 +1,26 @@
+"""Brown's comparator as a design problem (seed ``004_f5bd9e86c308241f.txt``, Brown 1968):
+study ``brown_design``.
+
+Modules: :mod:`.schema` (config and checks), :mod:`.cells` (the analytic design trade-off),
+:mod:`.chunks` (picklable chunk functions), :mod:`.adaptive` (adaptive trial counts through the
+runner), :mod:`.errbudget` (error budget), :mod:`.dilution` (datum), :mod:`.formal` (coverage),
+:mod:`.posterior` (emcee), :mod:`.external` (tolerances and external comparisons, linearised),
+:mod:`.consistent` (the unprinted inputs swept), :mod:`.claims` with ``claims.toml`` (the claim
+book), :mod:`.run`, :mod:`.figures`, :mod:`.report`.
+"""
+from __future__ import annotations
+
+from .. import Study
+from .cells import geometry_eval, measuring_time, pareto_front, time_model
+from .report import report
+from .run import run
+from .schema import SCHEMA, SEED, check
+
+__all__ = ["STUDIES", "SCHEMA", "check", "geometry_eval", "measuring_time", "pareto_front",
+           "time_model"]
+
+STUDIES = {
+    "brown_design": Study("brown_design", "Brown: design trade-offs, calibration tolerances, error "
+                          "budget, datum, coverage, Bayesian check", SEED, SCHEMA, run, report,
+                          check, order=12),
+}

@@ -1,0 +1,116 @@
+"""The paper's tolerances and external comparisons as functions of its unprinted inputs
+(seed ``004``, *Operation*, *Calibration*, *Results*).
+
+Linearised and cheap, so each can be evaluated at every swept value of an input the paper
+does not print (the station offset, beta, the screw pitch, the layout of the Zeiss grid's 33
+calibrated points):
+
+* tolerances: a lateral offset ``d`` of the image from the scale's radial line costs
+  ``d^2 / (2 r)`` of range at range ``r`` (worst case: the shortest range of the plate); so a
+  1 um accuracy tolerates ``d = sqrt(2 r_min x 1 um)`` of microscope non-linearity; a tilt of
+  the microscope axis by ``t`` across the gap ``g`` between scale and plate shifts the reading
+  by ``g tan t``; a drum graduation error of ``a`` arc seconds is ``a / 1296000`` of the pitch.
+* one plate's rms coordinate error after a translation and rotation (the paper's external
+  comparisons): Gaussian plates ``N(0, S F S^T sigma^2)`` with ``F`` the pivot model's
+  cofactor (:func:`sim.positions.full_point_covariance`), ``S`` the rigid-fit projector and
+  ``sigma`` the range sigma (Table 1's model: double settings of 1.7 um and 1.1 um of random
+  comparator error); the Zeiss comparison adds the grid's 0.8 um per coordinate.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ... import datum as dm, positions as po
+from ...plate import grid_points
+from ...runner import chunk_rng
+
+__all__ = ["shortest_range_mm", "tolerances", "plate_rms", "zeiss_points", "external_at",
+           "paper_points"]
+
+
+def paper_points(cfg: dict) -> np.ndarray:
+    return grid_points(cfg["paper.grid"], 2 * cfg["paper.extent_mm"] / (cfg["paper.grid"] - 1))
+
+
+def _theta(cfg, offset, beta, P=None):
+    return po.design_theta(P or cfg["paper.positions"], cfg["plate.format_mm"] / 2 + offset,
+                           cfg["comparator.alpha_mm"], beta)
+
+
+def shortest_range_mm(cfg: dict, pts: np.ndarray, offset: float, beta: float) -> float:
+    return float(po.ranges(pts[None], _theta(cfg, offset, beta)[None]).min())
+
+
+def longest_range_mm(cfg: dict, pts: np.ndarray, offset: float, beta: float) -> float:
+    return float(po.ranges(pts[None], _theta(cfg, offset, beta)[None]).max())
+
+
+def tolerances(cfg: dict, r_min_mm: float, pitch_mm: float) -> dict:
+    """Analytic tolerances (see the module doc): lateral-offset error (um), linearity
+    tolerance (um), axis tilt tolerance (degrees), drum graduation error (um)."""
+    d = cfg["operation.lateral_offset_um"] * 1e-3
+    acc = cfg["calibration.accuracy_um"] * 1e-3
+    return {"lateral_error_um": d ** 2 / (2 * r_min_mm) * 1e3,
+            "linearity_tol_um": np.sqrt(2 * r_min_mm * acc) * 1e3,
+            "axis_tilt_deg": float(np.degrees(np.arctan(cfg["calibration.accuracy_um"]
+                                                        / cfg["operation.gap_um"]))),
+            "drum_graduation_um": cfg["calibration.drum_dividing_arcsec"] / 1296000.0
+            * pitch_mm * 1e3}
+
+
+def zeiss_points(cfg: dict, half_extent_mm: float) -> np.ndarray:
+    """Stand-in for the Zeiss grid's 33 calibrated intersections (layout not printed):
+    ``zeiss.points`` distinct 1 cm lattice intersections within +-``half_extent_mm``, drawn
+    once from the run's seed (the same permutation stream for every extent)."""
+    m = int(half_extent_mm // 10)
+    ax = np.arange(-m, m + 1) * 10.0
+    lat = np.stack(np.meshgrid(ax, ax, indexing="ij"), -1).reshape(-1, 2)
+    order = chunk_rng(cfg["seed"], 90, 0).permutation(len(lat))
+    return lat[np.sort(order[:cfg["zeiss.points"]])]
+
+
+def range_sigma_um(cfg: dict) -> float:
+    """Table 1's model: the mean of the paper's settings plus the random comparator error."""
+    return float(np.sqrt(cfg["paper.setting_sigma_um"] ** 2 / cfg["paper.settings"]
+                         + cfg["comparator.sigma_um"] ** 2))
+
+
+def plate_rms(cfg: dict, pts: np.ndarray, offset: float, beta: float, sr_um: float,
+              extra_um: float, part: int) -> tuple[np.ndarray, np.ndarray]:
+    """rms coordinate error (um) of ``sweep.plates`` Gaussian plates after a rigid fit over
+    all points: without and with ``extra_um`` of independent per-coordinate error (a reference
+    grid's) added before the fit."""
+    th = _theta(cfg, offset, beta)
+    with np.errstate(invalid="ignore"):
+        F = po.full_point_covariance(pts[None], th[None], "pivot", "inner")[0]
+    S = dm.s_matrix(dm.null_basis(pts))
+    C = S @ F @ S.T * sr_um ** 2
+    w, V = np.linalg.eigh((C + C.T) / 2)
+    w = np.clip(w, 0.0, None)
+    rng = chunk_rng(cfg["seed"], part, 0)
+    z = rng.standard_normal((cfg["sweep.plates"], len(w)))
+    e = (z * np.sqrt(w)) @ V.T
+    g = e + rng.normal(0.0, extra_um, e.shape) @ S.T
+    return np.sqrt((e ** 2).mean(1)), np.sqrt((g ** 2).mean(1))
+
+
+def external_at(cfg: dict, offset: float, beta: float, zeiss_extent: float, pitch: float,
+                plates: bool = True) -> dict:
+    """Every linearised claim value at one setting of the unprinted inputs (``plates=False``:
+    the tolerances only). Plates use fixed streams (parts 91, 92), so a sweep compares like
+    with like."""
+    pts = paper_points(cfg)
+    sr = range_sigma_um(cfg)
+    r_min = shortest_range_mm(cfg, pts, offset, beta)
+    out = {"r_min_mm": r_min, "r_max_mm": longest_range_mm(cfg, pts, offset, beta),
+           **tolerances(cfg, r_min, pitch)}
+    out["feasible"] = out["r_max_mm"] <= cfg["scale.graduated_mm"] + cfg["scale.micrometer_mm"]
+    zp = zeiss_points(cfg, zeiss_extent)
+    zr = longest_range_mm(cfg, zp, offset, beta)
+    out["zeiss_feasible"] = zr <= cfg["scale.graduated_mm"] + cfg["scale.micrometer_mm"]
+    if plates:
+        out["table1_rms"] = plate_rms(cfg, pts, offset, beta, sr, 0.0, 91)[0]
+        out["zeiss_comparator_rms"], out["zeiss_rms"] = plate_rms(
+            cfg, zp, offset, beta, sr, cfg["zeiss.grid_sigma_um"], 92)
+        out["two_screw_rms"] = np.sqrt(2) * out["table1_rms"]
+    return out

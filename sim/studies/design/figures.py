@@ -1,0 +1,266 @@
+"""Figures of study ``brown_design`` (seed ``004``): Pareto front, error budget, datum,
+coverage, the emcee corner plot, the two-plate ratio and the consistent set of the unprinted
+inputs. Log axes carry a few labelled ticks only (plain numbers), so labels never overlap.
+"""
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator, ScalarFormatter
+from scipy import stats
+
+from ...plotting import plt, save
+from .cells import pareto_front
+from .claims import load_book
+
+__all__ = ["all_figures"]
+
+
+def _log_ticks(ax, axis: str, lo: float, hi: float, per_decade=(1, 2, 5)) -> None:
+    """Plain-number major ticks at 1-2-5 steps between ``lo`` and ``hi`` (at most ~8), no minor
+    labels."""
+    e0, e1 = int(np.floor(np.log10(lo))), int(np.ceil(np.log10(hi)))
+    ticks = [m * 10.0 ** e for e in range(e0, e1 + 1) for m in per_decade]
+    ticks = [t for t in ticks if lo <= t <= hi]
+    while len(ticks) > 8:
+        ticks = ticks[::2]
+    a = ax.xaxis if axis == "x" else ax.yaxis
+    a.set_major_locator(FixedLocator(ticks))
+    fmt = ScalarFormatter()
+    fmt.set_scientific(False)
+    a.set_major_formatter(fmt)
+    a.set_minor_locator(NullLocator())
+    a.set_minor_formatter(NullFormatter())
+
+
+def fig_pareto(cols, path, same_n):
+    t = np.array(cols["time_min"])
+    a = np.array(cols["worst_sigma_um"])
+    ok = np.array(cols["feasible"])
+    P = np.array(cols["positions"])
+    pf = np.array(cols["pareto"])
+    j = int(np.flatnonzero(cols["paper_design"])[0])
+    fig, axs = plt.subplots(1, 2, figsize=(15, 6))
+    ax = axs[0]
+    ax.scatter(t[~ok], a[~ok], s=6, c="0.85", label="infeasible (scale, format or pivot)")
+    for p, mk in zip(sorted(set(P.tolist())), "osD^v<>"):
+        sel = ok & (P == p)
+        ax.scatter(t[sel], a[sel], s=10, marker=mk, alpha=0.6, label=f"{p} positions")
+    o = np.argsort(t[pf])
+    ax.plot(t[pf][o], a[pf][o], "k-", lw=1.5, label="Pareto front (all cells)")
+    ss = np.array(cols["setting_sigma_um"])
+    for s_, ls in zip(sorted(set(ss.tolist())), ("--", ":", "-.")):
+        f = pareto_front(t, a, ok & (ss == s_))
+        o = np.argsort(t[f])
+        ax.step(t[f][o], a[f][o], where="post", color="0.3", ls=ls, lw=1,
+                label=f"front, setting sigma {s_:g} um")
+    ax.set_title("all designs (any number of points)")
+    ax = axs[1]
+    L = np.array(cols["settings"])
+    for p, mk in zip(sorted(set(P.tolist())), "osD^v<>"):
+        for l_, c in zip(sorted(set(L.tolist())), ("tab:blue", "tab:orange", "tab:green", "tab:red")):
+            sel = same_n & (P == p) & (L == l_)
+            if sel.any():
+                ax.scatter(t[sel], a[sel], s=18, marker=mk, color=c, alpha=0.7,
+                           label=f"P = {p}, {l_} setting(s)")
+    f = pareto_front(t, a, same_n)
+    o = np.argsort(t[f])
+    ax.step(t[f][o], a[f][o], where="post", color="k", lw=1.2, label="Pareto front")
+    ax.set_title(f"the paper's plate: {cols['n_points'][j]} points at +-{cols['extent_mm'][j]:g} mm,\n"
+                 f"setting sigma {cols['setting_sigma_um'][j]:g} um (feasible only)")
+    fin = np.isfinite(a) & (a > 0)
+    for ax in axs:
+        ax.plot(t[j], a[j], "r*", ms=16, label="paper's design (Table 1)")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        _log_ticks(ax, "x", t[fin].min() * 0.9, t[fin].max() * 1.1)
+        _log_ticks(ax, "y", a[fin].min() * 0.9, a[fin].max() * 1.1)
+        ax.set_xlabel("measuring time of one plate (min)")
+        ax.set_ylabel("worst-point sigma (um, datum-free)")
+        ax.legend(fontsize=7, loc="upper right")
+    fig.tight_layout()
+    save(fig, path)
+
+
+def fig_budget(b, path, ref):
+    fig, ax = plt.subplots(figsize=(9, 5))
+    y = np.arange(len(b["source"]))
+    ax.barh(y, b["rms_um"], xerr=1.96 * np.array(b["se_um"]), color=["tab:gray" if s else "tab:blue"
+                                                                     for s in b["settings"]])
+    ax.set_yticks(y, [f"{s} ({d})" for s, d in zip(b["source"], b["description"])], fontsize=7)
+    ax.axvline(ref, color="tab:red", ls="--", lw=1, label=f"paper: {ref:g} um (Zeiss grid)")
+    ax.set_xlabel("rms coordinate error after a rigid fit (um)")
+    ax.invert_yaxis()
+    ax.legend(fontsize=8)
+    save(fig, path)
+
+
+def fig_datum(cfg, d, path):
+    model = np.array(d["model"])
+    dn = np.array(d["datum"])
+    fig, axs = plt.subplots(1, 2, figsize=(12, 4.5))
+    for ax, m in zip(axs, ("stations", "pivot")):
+        for name, mk in (("brown", "o"), ("inner", "s"), ("corners", "^")):
+            sel = (model == m) & (dn == name) & ~np.array(d["corner"])
+            ax.plot(np.array(d["point"])[sel], np.array(d["dilution_pct"])[sel], mk, label=name)
+        ax.axhspan(5, 15, color="tab:orange", alpha=0.15, label="Brown's 5-15 % (his datum)")
+        ax.set_xlabel("point number (row by row from the top left)")
+        ax.set_ylabel(f"dilution of '{m}' over 'known' (%)")
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    save(fig, path)
+
+
+def fig_coverage(c, path):
+    model = np.array(c["model"])
+    scen = np.array(c["scenario"])
+    fig, axs = plt.subplots(1, 3, figsize=(15, 4.5))
+    for ax, (s, xkey, xl) in zip(axs, (("noise", "sigma_um", "range sigma (um)"),
+                                      ("points", "grid", "points per side"),
+                                      ("beta", "beta_mm", "beta (mm)"))):
+        sel = (scen == s) & (model == "pivot")
+        x = np.array(c[xkey], float)[sel]
+        N = np.array(c["trials"])[sel]
+        for key, lab in (("coverage_known", "ellipses, known sigma"),
+                         ("coverage_f", "ellipses, s0 and F"), ("b_coverage", "b = beta^2 interval"),
+                         ("beta_coverage", "beta interval (delta method)")):
+            ax.plot(np.where(x > 0, x, x[x > 0].min() / 3 if (x > 0).any() else 1), np.array(c[key])[sel],
+                    "o-", label=lab)
+        se = np.sqrt(0.95 * 0.05 / max(int(N[N > 0].min()) if (N > 0).any() else 1, 1))
+        ax.axhspan(0.95 - 1.96 * se, 0.95 + 1.96 * se, color="0.8", label="nominal 95 % +- MC error")
+        ax.set_xscale("log" if s != "points" else "linear")
+        ax.set_xlabel(xl + (" (0 drawn at left edge)" if s == "beta" else ""))
+        ax.set_ylabel("empirical coverage")
+        ax.set_ylim(0.0, 1.02)
+        ax.set_title(f"pivot model: {s}")
+        ax.legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    save(fig, path)
+
+
+def fig_corner(samples, mean, Q, names, path):
+    d = samples.shape[1]
+    fig, axs = plt.subplots(d, d, figsize=(12, 12))
+    sd = np.sqrt(np.diag(Q))
+    z = (samples - mean) / sd
+    t = np.linspace(0, 2 * np.pi, 100)
+    for i in range(d):
+        for j in range(d):
+            ax = axs[i, j]
+            if j > i:
+                ax.axis("off")
+                continue
+            if i == j:
+                ax.hist(z[:, i], bins=40, density=True, color="tab:blue", alpha=0.7)
+                xx = np.linspace(-4, 4, 100)
+                ax.plot(xx, stats.norm.pdf(xx), "r-", lw=1)
+            else:
+                ax.plot(z[::5, j], z[::5, i], ",", color="tab:blue", alpha=0.3)
+                C = Q[np.ix_([j, i], [j, i])] / np.outer(sd[[j, i]], sd[[j, i]])
+                w, v = np.linalg.eigh(C)
+                e = v @ (np.sqrt(w)[:, None] * np.vstack([np.cos(t), np.sin(t)])) * 2.45
+                ax.plot(e[0], e[1], "r-", lw=1)
+            ax.set_xlim(-4, 4)
+            if i < d - 1:
+                ax.set_xticklabels([])
+            else:
+                ax.set_xlabel(names[j], fontsize=7)
+            if j > 0 or i == 0:
+                ax.set_yticklabels([])
+            else:
+                ax.set_ylabel(names[i], fontsize=7)
+    fig.suptitle("posterior samples (blue) in units of the least-squares sigma about the LS "
+                 "estimate; red: LS Gaussian / 95 % ellipses", y=0.92)
+    save(fig, path)
+
+
+
+
+def fig_twoplate(cols, samples, path):
+    fig, ax = plt.subplots(figsize=(7, 4))
+    bins = np.logspace(-6, 6, 121)
+    for name, rho in samples.items():
+        ax.hist(rho, bins=bins, histtype="step", lw=1.5, label=f"posterior, {name} prior")
+    ax.axvline(cols["rw_ratio_mean"][0], color="tab:red", ls="--", label="chi-square re-weighting")
+    ax.set_xscale("log")
+    ax.set_xlabel("sigma_comparator^2 / sigma_grid^2  (= P_cx / P_x)")
+    ax.set_ylabel("samples")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    save(fig, path)
+
+
+_SHORT = {"brown.operation.lateral_offset_error_um": "reticle offset error (um)",
+          "brown.calibration.linearity_tolerance_um": "linearity tolerance (um)",
+          "brown.calibration.drum_graduation_um": "drum graduation error (um)",
+          "brown.results.two_screw_agreement_um": "two-screw agreement (um)",
+          "brown.results.accuracy_range_um": "rms accuracy (um)",
+          "brown.results.zeiss_discrepancy_um": "Zeiss discrepancy (um)",
+          "brown.results.zeiss_comparator_um": "Zeiss, comparator part (um)",
+          "brown.design.paper_on_front_same_points": "paper's design on front (finding)"}
+_COLOR = {"holds": "tab:green", "fails": "tab:red", "inconclusive": "tab:orange",
+          "infeasible": "0.6", "finding": "tab:blue"}
+
+
+def fig_consistent(sv, cs, path):
+    """One panel per (unprinted input, claim): the simulated value and its interval against the
+    swept input, coloured by verdict; the paper's decision zone as a band; the consistent set
+    (no claim fails) shaded."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    inp, cl = np.array(sv["input"]), np.array(sv["claim"])
+    pairs = list(dict.fromkeys(zip(sv["input"], sv["claim"])))
+    ncol = 4
+    nrow = int(np.ceil(len(pairs) / ncol))
+    fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.0 * nrow), squeeze=False)
+    comp = {i: (lo, hi) for i, c, lo, hi in zip(cs["input"], cs["claim"], cs["compatible_low"],
+                                                 cs["compatible_high"]) if c == "ALL"}
+    for ax, (i, c) in zip(axs.ravel(), pairs):
+        sel = (inp == i) & (cl == c)
+        x = np.array(sv["value"], float)[sel]
+        y = np.array(sv["sim_value"], float)[sel]
+        lo = np.array(sv["sim_low"], float)[sel]
+        hi = np.array(sv["sim_high"], float)[sel]
+        v = np.array(sv["verdict"])[sel]
+        zl, zh = np.array(sv["zone_low"], float)[sel][0], np.array(sv["zone_high"], float)[sel][0]
+        if np.isfinite(zl) or np.isfinite(zh):
+            ax.axhspan(zl if np.isfinite(zl) else min(np.nanmin(lo), zh),
+                       zh if np.isfinite(zh) else max(np.nanmax(hi), zl),
+                       color="tab:orange", alpha=0.2, lw=0)
+        a, b = comp.get(i, (np.nan, np.nan))
+        if a is not None and np.isfinite(a):
+            d = 0.02 * (x.max() - x.min())
+            ax.axvspan(a - d, b + d, color="tab:green", alpha=0.12, lw=0)
+        ax.plot(x, y, "-", color="0.6", lw=0.8)
+        colors = [_COLOR.get(vv, "k") for vv in v]
+        ax.vlines(x, lo, hi, colors=colors, lw=2)
+        ax.scatter(x, y, c=colors, s=14, zorder=3)
+        ax.set_xlabel(i, fontsize=8)
+        ax.set_title(_SHORT.get(c, c), fontsize=8)
+        ax.tick_params(labelsize=7)
+    for ax in axs.ravel()[len(pairs):]:
+        ax.axis("off")
+    handles = ([Line2D([], [], marker="o", ls="", color=col, label=k) for k, col in _COLOR.items()]
+               + [Patch(color="tab:orange", alpha=0.2, label="paper's decision zone"),
+                  Patch(color="tab:green", alpha=0.12, label="consistent set (no claim fails)")])
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8,
+               bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
+    save(fig, path)
+
+
+def all_figures(cfg, out, cols, bcols, dcols, ccols, samples, bay, tcols, tsamples, sv, cs):
+    from ... import multilateration as ml
+    jp = int(np.flatnonzero(cols["paper_design"])[0])
+    same_n = (np.array(cols["feasible"])
+              & np.isclose(np.array(cols["setting_sigma_um"]), cols["setting_sigma_um"][jp])
+              & (np.array(cols["n_points"]) == cols["n_points"][jp])
+              & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp]))
+    fig_pareto(cols, out / "pareto.png", same_n)
+    fig_budget(bcols, out / "budget.png",
+               float(load_book().spec("brown.results.zeiss_comparator_um")["ref"]))
+    fig_datum(cfg, dcols, out / "datum.png")
+    fig_coverage(ccols, out / "coverage.png")
+    fig_corner(samples, bay["theta_ls"], bay["Q"], ml.PARAM_NAMES, out / "corner.png")
+    if tcols is not None:
+        fig_twoplate(tcols, tsamples, out / "twoplate_ratio.png")
+    fig_consistent(sv, cs, out / "consistent_set.png")
