@@ -78,7 +78,8 @@ def sweep_unprinted(cfg: dict, book, design_cols: dict) -> tuple[dict, dict]:
                 ok = e["feasible"] and (e["zeiss_feasible"] if cid in _ZEISS else True)
                 row = verdict_of(book, cid, e)
                 for c, v in zip(vals, (inp, x, cid, row["value"], row["ci_low"], row["ci_high"],
-                                       row["zone_low"], row["zone_high"],
+                                       _finite_or_nan(row["zone_low"]),
+                                       _finite_or_nan(row["zone_high"]),
                                        row["verdict"] if ok else "infeasible", bool(ok))):
                     vals[c].append(v)
                 holds[cid].append(ok and row["verdict"] == "holds")
@@ -98,6 +99,10 @@ def sweep_unprinted(cfg: dict, book, design_cols: dict) -> tuple[dict, dict]:
             note = "no swept value where no claim fails; failing somewhere: " + ", ".join(fail)
         _append(cs, inp, "ALL", xs, allh, allc, note)
     return cs, vals
+
+
+def _finite_or_nan(x):
+    return float(x) if np.isfinite(x) else float("nan")
 
 
 def _append(cs, inp, cid, xs, h, cp, note):

@@ -5,7 +5,7 @@ inputs. Log axes carry a few labelled ticks only (plain numbers), so labels neve
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator, ScalarFormatter
+from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 from scipy import stats
 
 from ...plotting import plt, save
@@ -15,19 +15,22 @@ from .claims import load_book
 __all__ = ["all_figures"]
 
 
-def _log_ticks(ax, axis: str, lo: float, hi: float, per_decade=(1, 2, 5)) -> None:
-    """Plain-number major ticks at 1-2-5 steps between ``lo`` and ``hi`` (at most ~8), no minor
-    labels."""
+def _log_ticks(ax, axis: str, lo: float, hi: float) -> None:
+    """Plain-number major ticks on a log axis: the coarsest of 1-2-5, 1-2-3-5-7 or finer
+    mantissas that gives at least three ticks between ``lo`` and ``hi``, at most eight; no
+    minor labels (so labels never overlap)."""
     e0, e1 = int(np.floor(np.log10(lo))), int(np.ceil(np.log10(hi)))
-    ticks = [m * 10.0 ** e for e in range(e0, e1 + 1) for m in per_decade]
-    ticks = [t for t in ticks if lo <= t <= hi]
+    for mant in ((1, 2, 5), (1, 2, 3, 5, 7), (1, 1.2, 1.4, 1.6, 1.8, 2, 2.5, 3, 4, 5, 6, 7, 8, 9),
+                 tuple(np.round(np.arange(1.0, 10.0, 0.05), 2))):
+        ticks = [m * 10.0 ** e for e in range(e0, e1 + 1) for m in mant]
+        ticks = [t for t in ticks if lo <= t <= hi]
+        if len(ticks) >= 3:
+            break
     while len(ticks) > 8:
         ticks = ticks[::2]
     a = ax.xaxis if axis == "x" else ax.yaxis
     a.set_major_locator(FixedLocator(ticks))
-    fmt = ScalarFormatter()
-    fmt.set_scientific(False)
-    a.set_major_formatter(fmt)
+    a.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     a.set_minor_locator(NullLocator())
     a.set_minor_formatter(NullFormatter())
 
@@ -68,12 +71,12 @@ def fig_pareto(cols, path, same_n):
     ax.set_title(f"the paper's plate: {cols['n_points'][j]} points at +-{cols['extent_mm'][j]:g} mm,\n"
                  f"setting sigma {cols['setting_sigma_um'][j]:g} um (feasible only)")
     fin = np.isfinite(a) & (a > 0)
-    for ax in axs:
+    for ax, sel in zip(axs, (fin, fin & same_n)):
         ax.plot(t[j], a[j], "r*", ms=16, label="paper's design (Table 1)")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        _log_ticks(ax, "x", t[fin].min() * 0.9, t[fin].max() * 1.1)
-        _log_ticks(ax, "y", a[fin].min() * 0.9, a[fin].max() * 1.1)
+        _log_ticks(ax, "x", t[sel].min() * 0.9, t[sel].max() * 1.1)
+        _log_ticks(ax, "y", a[sel].min() * 0.95, a[sel].max() * 1.05)
         ax.set_xlabel("measuring time of one plate (min)")
         ax.set_ylabel("worst-point sigma (um, datum-free)")
         ax.legend(fontsize=7, loc="upper right")

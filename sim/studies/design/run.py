@@ -113,6 +113,15 @@ def _tolerances(R: dict) -> dict:
     return tol
 
 
+def _unbounded_as_null(row: dict) -> dict:
+    """An open side of a bound's decision zone (+-inf) is stored as null: tables refuse
+    infinities (:func:`sim.storage.check_finite_table`)."""
+    for k in ("zone_low", "zone_high"):
+        if isinstance(row[k], float) and np.isinf(row[k]):
+            row[k] = float("nan")
+    return row
+
+
 def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     prov = provenance(cfg)
     book = load_book()
@@ -150,7 +159,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     R["external"] = external_at(cfg, cfg["paper.offset_mm"], cfg["paper.beta_mm"],
                                 cfg["zeiss.half_extent_mm"], cfg["budget.pitch_mm"])
     cs, sv = sweep_unprinted(cfg, book, cols)
-    rows = score_all(book, cfg, R)
+    rows = [_unbounded_as_null(r) for r in score_all(book, cfg, R)]
     prov_t = provenance(cfg, tolerances=_tolerances(R))
     write_table(out / "bayes.parquet", bycols, prov_t)
     if tcols is not None:
