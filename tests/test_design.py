@@ -152,10 +152,10 @@ def test_paper_design_must_be_in_the_grid_and_fit_its_hardware():
     # 45 mm is a cell of the grid, but a +-90 mm grid's ranges do not fit on 261 + 1 mm there
     with pytest.raises(ConfigError, match="paper.offset_mm: the paper's design must fit"):
         validate({"paper.offset_mm": 45.0}, design.SCHEMA, design.check)
-    with pytest.raises(ConfigError, match="sweep.offsets_mm"):
-        validate({"sweep.offsets_mm": [40.0, 60.0]}, design.SCHEMA, design.check)
-    with pytest.raises(ConfigError, match="sweep.zeiss_extents_mm"):
-        validate({"sweep.zeiss_extents_mm": [20.0, 90.0]}, design.SCHEMA, design.check)
+    with pytest.raises(ConfigError, match="unprinted.offsets_mm"):
+        validate({"unprinted.offsets_mm": [40.0, 60.0]}, design.SCHEMA, design.check)
+    with pytest.raises(ConfigError, match="unprinted.zeiss_extents_mm"):
+        validate({"unprinted.zeiss_extents_mm": [20.0, 90.0]}, design.SCHEMA, design.check)
     with pytest.raises(ConfigError, match="design.offsets_mm"):
         validate({"design.offsets_mm": list(np.arange(1.0, 2001.0) / 2)}, design.SCHEMA,
                  design.check)
@@ -220,7 +220,7 @@ def test_tolerances_of_the_calibration_section_are_analytic():
 
 def test_linearised_plate_rms_matches_its_covariance():
     from sim.studies.design import external as ex
-    cfg = validate({"sweep.plates": 20000}, design.SCHEMA, design.check)
+    cfg = validate({"unprinted.plates": 20000}, design.SCHEMA, design.check)
     pts = ex.paper_points(cfg)
     a, b = ex.plate_rms(cfg, pts, 30.0, 1.0, 1.0, 0.8, 91)
     F = po.full_point_covariance(pts[None], ex._theta(cfg, 30.0, 1.0)[None], "pivot", "inner")[0]

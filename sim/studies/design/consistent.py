@@ -25,12 +25,12 @@ _OFFSET_CLAIMS = ("brown.operation.lateral_offset_error_um",
                   "brown.results.two_screw_agreement_um", "brown.results.accuracy_range_um",
                   "brown.results.zeiss_discrepancy_um", "brown.results.zeiss_comparator_um")
 INPUTS = {
-    "paper.offset_mm": ("sweep.offsets_mm", _OFFSET_CLAIMS),
-    "paper.beta_mm": ("sweep.betas_mm", _OFFSET_CLAIMS),
-    "zeiss.half_extent_mm": ("sweep.zeiss_extents_mm", ("brown.results.zeiss_discrepancy_um",
+    "paper.offset_mm": ("unprinted.offsets_mm", _OFFSET_CLAIMS),
+    "paper.beta_mm": ("unprinted.betas_mm", _OFFSET_CLAIMS),
+    "zeiss.half_extent_mm": ("unprinted.zeiss_extents_mm", ("brown.results.zeiss_discrepancy_um",
                                                         "brown.results.zeiss_comparator_um")),
-    "budget.pitch_mm": ("sweep.pitches_mm", ("brown.calibration.drum_graduation_um",)),
-    "time.pass_min": ("sweep.pass_min", ("brown.design.paper_on_front_same_points",)),
+    "budget.pitch_mm": ("unprinted.pitches_mm", ("brown.calibration.drum_graduation_um",)),
+    "time.pass_min": ("unprinted.pass_min", ("brown.design.paper_on_front_same_points",)),
 }
 _ZEISS = ("brown.results.zeiss_discrepancy_um", "brown.results.zeiss_comparator_um")
 

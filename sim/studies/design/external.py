@@ -77,7 +77,7 @@ def range_sigma_um(cfg: dict) -> float:
 
 def plate_rms(cfg: dict, pts: np.ndarray, offset: float, beta: float, sr_um: float,
               extra_um: float, part: int) -> tuple[np.ndarray, np.ndarray]:
-    """rms coordinate error (um) of ``sweep.plates`` Gaussian plates after a rigid fit over
+    """rms coordinate error (um) of ``unprinted.plates`` Gaussian plates after a rigid fit over
     all points: without and with ``extra_um`` of independent per-coordinate error (a reference
     grid's) added before the fit."""
     th = _theta(cfg, offset, beta)
@@ -88,7 +88,7 @@ def plate_rms(cfg: dict, pts: np.ndarray, offset: float, beta: float, sr_um: flo
     w, V = np.linalg.eigh((C + C.T) / 2)
     w = np.clip(w, 0.0, None)
     rng = chunk_rng(cfg["seed"], part, 0)
-    z = rng.standard_normal((cfg["sweep.plates"], len(w)))
+    z = rng.standard_normal((cfg["unprinted.plates"], len(w)))
     e = (z * np.sqrt(w)) @ V.T
     g = e + rng.normal(0.0, extra_um, e.shape) @ S.T
     return np.sqrt((e ** 2).mean(1)), np.sqrt((g ** 2).mean(1))

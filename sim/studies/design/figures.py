@@ -142,7 +142,7 @@ def fig_coverage(c, path):
 
 def fig_corner(samples, mean, Q, names, path):
     d = samples.shape[1]
-    fig, axs = plt.subplots(d, d, figsize=(12, 12))
+    fig, axs = plt.subplots(d, d, figsize=(10, 10))
     sd = np.sqrt(np.diag(Q))
     z = (samples - mean) / sd
     t = np.linspace(0, 2 * np.pi, 100)
@@ -157,7 +157,8 @@ def fig_corner(samples, mean, Q, names, path):
                 xx = np.linspace(-4, 4, 100)
                 ax.plot(xx, stats.norm.pdf(xx), "r-", lw=1)
             else:
-                ax.plot(z[::5, j], z[::5, i], ",", color="tab:blue", alpha=0.3)
+                ax.plot(z[::max(1, len(z) // 4000), j], z[::max(1, len(z) // 4000), i], ",",
+                        color="tab:blue", alpha=0.5)
                 C = Q[np.ix_([j, i], [j, i])] / np.outer(sd[[j, i]], sd[[j, i]])
                 w, v = np.linalg.eigh(C)
                 e = v @ (np.sqrt(w)[:, None] * np.vstack([np.cos(t), np.sin(t)])) * 2.45
@@ -214,7 +215,7 @@ def fig_consistent(sv, cs, path):
     pairs = list(dict.fromkeys(zip(sv["input"], sv["claim"])))
     ncol = 4
     nrow = int(np.ceil(len(pairs) / ncol))
-    fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.0 * nrow), squeeze=False)
+    fig, axs = plt.subplots(nrow, ncol, figsize=(3.6 * ncol, 2.7 * nrow), squeeze=False)
     comp = {i: (lo, hi) for i, c, lo, hi in zip(cs["input"], cs["claim"], cs["compatible_low"],
                                                  cs["compatible_high"]) if c == "ALL"}
     for ax, (i, c) in zip(axs.ravel(), pairs):

@@ -3,7 +3,7 @@
 
 Keys marked ``input`` were set to match a number the paper prints. Keys the paper does not
 print (station offset, beta, the pass time, the screw pitch, the layout of the Zeiss grid's
-33 calibrated points) carry a *sweep* range under ``sweep.*``: the study reports the values
+33 calibrated points) carry a swept range under ``unprinted.*``: the study reports the values
 for which each claim holds and the consistent set (``consistent_set.parquet``).
 """
 from __future__ import annotations
@@ -61,7 +61,7 @@ SCHEMA = {
     "time.double_min": F(90.0, "float", "the same with double settings (paper: about 90 min)",
                          lo=0.0, lo_open=True, hi=1e5, input=True, unit="min"),
     "time.pass_min": F(2.0, "float", "fixed cost of one plate position (turn the holder, swing "
-                       "the arm; not printed: swept under sweep.pass_min)", lo=0.0, hi=1e4,
+                       "the arm; not printed: swept under unprinted.pass_min)", lo=0.0, hi=1e4,
                        unit="min"),
     # the paper's design
     "paper.positions": F(4, "int", "plate positions of the paper's comparator", lo=3, hi=24,
@@ -73,10 +73,10 @@ SCHEMA = {
     "paper.setting_sigma_um": F(1.7, "float", "Table 1: one setting 1.7 um", lo=0.0,
                                 lo_open=True, hi=1000.0, input=True, unit="um"),
     "paper.offset_mm": F(30.0, "float", "station offset of the paper's design (not printed: "
-                         "swept under sweep.offsets_mm; must fit on the scale)", lo=0.0,
+                         "swept under unprinted.offsets_mm; must fit on the scale)", lo=0.0,
                          lo_open=True, hi=1000.0, unit="mm"),
     "paper.beta_mm": F(1.0, "float", "beta of the paper's design (not printed: swept under "
-                       "sweep.betas_mm)", lo=0.0, hi=50.0, unit="mm"),
+                       "unprinted.betas_mm)", lo=0.0, hi=50.0, unit="mm"),
     # datum (brown_dilution's geometry; an idealised one when it does not fit the scale)
     "datum.grid": F(5, "int", "points per side (brown_dilution geometry)", lo=3, hi=30),
     "datum.spacing_mm": F(55.0, "float", "grid spacing (brown_dilution geometry)", lo=0.01,
@@ -97,7 +97,7 @@ SCHEMA = {
                                 lo=1, hi=50),
     "budget.drum_periodic_um": F(0.5, "float", "uncorrected periodic error of the drum "
                                  "(paper: up to 0.5 um)", lo=0.0, hi=100.0, input=True, unit="um"),
-    "budget.pitch_mm": F(0.5, "float", "screw pitch (not printed: swept under sweep.pitches_mm)",
+    "budget.pitch_mm": F(0.5, "float", "screw pitch (not printed: swept under unprinted.pitches_mm)",
                          lo=0.01, hi=1.0, unit="mm"),
     "budget.wobble_um": F(2.0, "float", "radial pivot wobble at 3 kg thrust (paper: up to 2 um)",
                           lo=0.0, hi=100.0, input=True, unit="um"),
@@ -116,7 +116,7 @@ SCHEMA = {
     "zeiss.grid_sigma_um": F(0.8, "float", "stated accuracy of the Zeiss grid (paper: 0.8 um "
                              "rms)", lo=0.0, hi=100.0, input=True, unit="um"),
     "zeiss.half_extent_mm": F(90.0, "float", "half extent of the 33-point sample (layout not "
-                              "printed: swept under sweep.zeiss_extents_mm)", lo=1.0, hi=1000.0,
+                              "printed: swept under unprinted.zeiss_extents_mm)", lo=1.0, hi=1000.0,
                               unit="mm"),
     "operation.lateral_offset_um": F(100.0, "float", "lateral offset of the image in the reticle "
                                      "(paper: as much as 100 um)", lo=0.0, hi=1e4, input=True,
@@ -129,19 +129,19 @@ SCHEMA = {
                                           "(paper: 15 seconds of arc)", lo=0.0, hi=3600.0,
                                           input=True),
     # unprinted inputs swept (analytic / linearised per value)
-    "sweep.offsets_mm": F([5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 33.0, 40.0, 45.0, 60.0],
+    "unprinted.offsets_mm": F([5.0, 10.0, 15.0, 20.0, 22.5, 25.0, 27.5, 30.0, 33.0, 40.0, 45.0, 60.0],
                           "list[float]", "station offsets swept", lo=0.0, lo_open=True, hi=1000.0,
                           min_len=2, unit="mm"),
-    "sweep.betas_mm": F([0.0, 0.5, 1.0, 2.0, 5.0, 10.0], "list[float]", "betas swept", lo=0.0,
+    "unprinted.betas_mm": F([0.0, 0.5, 1.0, 2.0, 5.0, 10.0], "list[float]", "betas swept", lo=0.0,
                         hi=50.0, min_len=2, unit="mm"),
-    "sweep.pass_min": F([0.0, 1.0, 2.0, 4.0, 8.0, 12.0], "list[float]", "pass times swept",
+    "unprinted.pass_min": F([0.0, 1.0, 2.0, 4.0, 8.0, 12.0], "list[float]", "pass times swept",
                         lo=0.0, hi=1e4, min_len=2, unit="min"),
-    "sweep.pitches_mm": F([0.1, 0.25, 0.5, 1.0], "list[float]", "screw pitches swept", lo=0.01,
+    "unprinted.pitches_mm": F([0.1, 0.25, 0.5, 1.0], "list[float]", "screw pitches swept", lo=0.01,
                           hi=1.0, min_len=2, unit="mm"),
-    "sweep.zeiss_extents_mm": F([40.0, 60.0, 80.0, 90.0, 100.0, 115.0], "list[float]",
+    "unprinted.zeiss_extents_mm": F([40.0, 60.0, 80.0, 90.0, 100.0, 115.0], "list[float]",
                                 "half extents of the Zeiss 33-point sample swept", lo=1.0,
                                 hi=1000.0, min_len=2, unit="mm"),
-    "sweep.plates": F(4000, "int", "Gaussian plates drawn per sweep value (linearised)", lo=100,
+    "unprinted.plates": F(4000, "int", "Gaussian plates drawn per sweep value (linearised)", lo=100,
                       hi=1_000_000),
     # coverage
     "coverage.trials": F(10000, "int", "trials of the nominal coverage runs", lo=10,
@@ -160,7 +160,7 @@ SCHEMA = {
                         hi=0.5),
     # bayes
     "bayes.walkers": F(32, "int", "emcee walkers", lo=16, hi=1000),
-    "bayes.steps": F(1000, "int", "emcee steps per walker and chain", lo=100, hi=1_000_000),
+    "bayes.steps": F(500, "int", "emcee steps per walker and chain", lo=100, hi=1_000_000),
     "bayes.chains": F(4, "int", "independent emcee ensembles (run in parallel, one per chunk)",
                       lo=2, hi=64),
     "bayes.grid_prior_log_sd": F(0.1, "float", "sd of log sigma_g in the certificate prior of "
@@ -189,7 +189,7 @@ def check(cfg: dict) -> None:
                               f"{cfg[key]!r} is not in {lst} {cfg[lst]}")
     if cfg["time.double_min"] <= cfg["time.single_min"]:
         raise ConfigError("time.double_min", "must exceed time.single_min")
-    for key in ("time.pass_min", "sweep.pass_min"):
+    for key in ("time.pass_min", "unprinted.pass_min"):
         v = cfg[key] if key == "time.pass_min" else max(cfg[key])
         if 4 * v >= cfg["time.single_min"]:
             raise ConfigError(key, "four passes would take the whole single-setting time "
@@ -197,8 +197,8 @@ def check(cfg: dict) -> None:
     half = cfg["plate.format_mm"] / 2
     if cfg["paper.extent_mm"] > half:
         raise ConfigError("paper.extent_mm", "outside the format")
-    if cfg["zeiss.half_extent_mm"] > half or max(cfg["sweep.zeiss_extents_mm"]) > half:
-        raise ConfigError("sweep.zeiss_extents_mm", "the Zeiss sample must lie on the format "
+    if cfg["zeiss.half_extent_mm"] > half or max(cfg["unprinted.zeiss_extents_mm"]) > half:
+        raise ConfigError("unprinted.zeiss_extents_mm", "the Zeiss sample must lie on the format "
                           f"(half side {half:g} mm)")
     if (cfg["datum.grid"] - 1) * cfg["datum.spacing_mm"] / 2 > half:
         raise ConfigError("datum.spacing_mm", "the datum grid leaves the format")
@@ -208,12 +208,12 @@ def check(cfg: dict) -> None:
                           f"{cfg['paper.offset_mm']:g} mm the longest range exceeds the scale "
                           f"plus micrometer (at most {hmax:.1f} mm fits a +-"
                           f"{cfg['paper.extent_mm']:g} mm grid)")
-    if not any(v <= hmax for v in cfg["sweep.offsets_mm"]):
-        raise ConfigError("sweep.offsets_mm", f"no swept offset fits the scale (at most "
+    if not any(v <= hmax for v in cfg["unprinted.offsets_mm"]):
+        raise ConfigError("unprinted.offsets_mm", f"no swept offset fits the scale (at most "
                           f"{hmax:.1f} mm)")
-    for e in [cfg["zeiss.half_extent_mm"], *cfg["sweep.zeiss_extents_mm"]]:
+    for e in [cfg["zeiss.half_extent_mm"], *cfg["unprinted.zeiss_extents_mm"]]:
         if (2 * int(e // 10) + 1) ** 2 < cfg["zeiss.points"]:
-            raise ConfigError("sweep.zeiss_extents_mm", f"+-{e:g} mm holds fewer 1 cm grid "
+            raise ConfigError("unprinted.zeiss_extents_mm", f"+-{e:g} mm holds fewer 1 cm grid "
                               f"intersections than zeiss.points = {cfg['zeiss.points']}")
     n_cells = 1
     for lst in ("design.positions", "design.grids", "design.extents_mm", "design.offsets_mm",
