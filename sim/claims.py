@@ -260,8 +260,10 @@ class ClaimBook:
             tol = float(s["tol"])
             zlo, zhi = _zone(form, (rlo, rhi), half, tol)
             rlo, rhi = rlo - half, rhi + half
-            outcome = decide(form, (float(ci[0]), float(ci[1])), (zlo, zhi),
-                             elems=elems, p_plate=p_plate if form == "one-plate" else None)
+            # a one-plate claim given no plates (e.g. an exact input) is decided as a value
+            rule = "value" if form == "one-plate" and samples is None else form
+            outcome = decide(rule, (float(ci[0]), float(ci[1])), (zlo, zhi),
+                             elems=elems, p_plate=p_plate if rule == "one-plate" else None)
         verdict = _verdict(s["kind"], outcome)
         if s["kind"] == "not comparable":
             note = s.get("why", "") + (f" {note}" if note else "")

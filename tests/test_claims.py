@@ -147,3 +147,9 @@ def test_a_bound_is_written_with_its_open_side_null(tmp_path):
     t = pq.read_table(tmp_path / "claims.parquet").to_pydict()
     assert t["zone_low"] == [None] and t["zone_high"] == [2.0] and t["verdict"] == ["holds"]
     assert "≤ 2" in claims_markdown(tmp_path / "claims.parquet")
+
+
+def test_one_plate_claim_given_an_exact_value_is_decided_as_a_value():
+    b = book(kind="input", form="one-plate", ref=1.7, decimals=1, tol=0)
+    r = b.score("t.c", 1.7, interval="exact")
+    assert r["verdict"] == "input" and r["outcome"] == "holds" and r["p_plate"] != r["p_plate"]
