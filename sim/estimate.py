@@ -161,8 +161,14 @@ def _wolf(c: Mapping) -> tuple:
         _n(c.get("trade.degrees", []))
     rd_cells = 2 * _n(c.get("trade.pointing_sigmas_um", [])) * _n(c.get("trade.readings", []))
     ages = _n(c.get("trade.ages_weeks", [])) * _n(c.get("trade.drift_fractions", []))
-    trials = T + Tt * (_n(c.get("trade.spacings_mm", [])) + rd_cells + 1)
-    adj = T * (sets + 2) + Tt * (deg_cells + rd_cells * (sets + 2) + ages)
+    # the unprinted inputs: every swept value re-reduces the same simulated instruments
+    Tu = c.get("unprinted.trials", 0)
+    u_cells = sum(_n(c.get(f"unprinted.{k}", [])) for k in (
+        "pointing_sigmas_um", "field_scales", "restitutions_um", "drift_fractions",
+        "mono_sigmas_um"))
+    trials = T + Tt * (_n(c.get("trade.spacings_mm", [])) + rd_cells + 1) + Tu
+    adj = T * (sets + 2) + Tt * (deg_cells + rd_cells * (sets + 2) + ages) + \
+        Tu * u_cells * (sets + 2)
     b = max(ch * (n * sets * rd * 2 + n * U) * F8, cht * nt * nsets * (2 + Ut) * F8,
             ch * chk * U * F8, cht * (n * _max(c.get("trade.readings"), rd) * 2) * F8) * COPIES
     return trials, adj, max(U, Ut), b
@@ -182,9 +188,11 @@ def _agnard(c: Mapping) -> tuple:
     layouts = _n(c.get("tradeoff.layouts", []))
     tT, bT = c.get("tradeoff.trials", 0), c.get("tradeoff.block_trials", 0)
     dp, rc = _n(c.get("tradeoff.dpis", [])), _n(c.get("tradeoff.recentre_px", []))
-    trials = T + tT * (dp + rc) + bT * len(sizes)
+    sT, s_cells = c.get("sweep.trials", 0), _n(c.get("sweep.five_inset", []))  # swept layout
+    trials = T + tT * (dp + rc) + bT * len(sizes) + sT * s_cells
     snoop = 1 + c.get("snoop.max_reject", 0)
-    adj = T * (3 + layouts) * snoop + tT * (2 * dp + rc) * snoop + bT * len(sizes) * 2
+    adj = T * (3 + layouts) * snoop + tT * (2 * dp + rc) * snoop + bT * len(sizes) * 2 + \
+        sT * s_cells * 3 * snoop
     # reduced normal equations of the models (7 x 7 blocks coupled through the points); the
     # block-size trade-off bounds its chunk by the pair blocks (4e6 floats)
     npair = Mt * 40.0
