@@ -303,3 +303,11 @@ def test_sweep_rows_draw_and_tabulate(tmp_path):
     assert (tmp_path / "o" / "sweep.png").is_file()
     md = sweep_markdown(tmp_path / "o")
     assert md.count("\n") >= 5 and "no: plate.spacing_mm" in md and "sweep.png" in md
+
+
+def test_the_two_plate_posterior_finds_the_grid_plate_study():
+    # the cross-check must not be skipped silently when the grid-plate study moves
+    from sim.studies.design.posterior import _twoplate_data
+
+    gcfg, comp, g, sg, rw, fa = _twoplate_data({"seed": 1})
+    assert comp.shape == g.shape[:2] and comp.shape[0] == 2 * gcfg["plate.count"]

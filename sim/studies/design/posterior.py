@@ -83,9 +83,9 @@ def _twoplate_data(cfg: dict):
     """One simulated two-plate calibration of ``gridplate_two_plates`` (its defaults)."""
     from ... import gridplate as gp, transforms2d as t2
     from ...config import validate
-    from .. import gridplate as gs
+    from ..gridplate import model as gm, schema as gs
     gcfg = validate({}, gs.SCHEMA, gs.check)
-    sim = gs.simulate(gcfg, chunk_rng(cfg["seed"], 70, 0), 1)
+    sim = gm.simulate(gcfg, chunk_rng(cfg["seed"], 70, 0), 1)
     mean = sim["readings"].mean(axis=3)[0]                  # (plates, N, 2)
     cert = sim["cert"][0]
     comp = np.concatenate([mean[..., 0], mean[..., 1]], 0)  # rows x' (plates), y' (plates)
