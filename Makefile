@@ -35,7 +35,8 @@ fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=30
 # not by file times, so a fresh clone re-runs nothing that is current.
 reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md
 	@for s in $(STUDIES); do \
-	  if $(PY) -m sim.codehash studies/$$s.toml results/$$s; then echo "$$s: up to date"; \
+	  if $(PY) -c "import sys; from sim.codehash import is_current; sys.exit(not is_current(*sys.argv[1:]))" \
+	       studies/$$s.toml results/$$s; then echo "$$s: up to date"; \
 	  else $(PY) -m sim run studies/$$s.toml --out results/$$s --overwrite $(RUN_FLAGS) || exit 1; fi; done
 	$(PY) -m sim report --results results
 

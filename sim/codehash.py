@@ -6,16 +6,15 @@ from the sources, so nothing is imported or run), plus the data files inside its
 that study only, and a fresh clone (whose file times are the checkout's) does not re-run
 anything that is current.
 
-``python -m sim.codehash STUDY_FILE RESULTS_DIR`` exits 0 when ``RESULTS_DIR/run.json``
-records the study file's configuration and this code hash (the results are current), 1
-otherwise; the Makefile uses it.
+:func:`is_current` (``STUDY_FILE``, ``RESULTS_DIR``) is true when ``RESULTS_DIR/run.json``
+records the study file's configuration and this code hash (the results are current); the
+Makefile's ``reproduce`` uses it.
 """
 from __future__ import annotations
 
 import ast
 import hashlib
 import json
-import sys
 from functools import lru_cache
 from pathlib import Path
 
@@ -124,6 +123,3 @@ def is_current(study_file: str | Path, results: str | Path) -> bool:
     want = study_code_hash(cfg["study"])
     return record.get("config") == json.loads(json.dumps(cfg)) and record.get("code_hash") == want
 
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(0 if len(sys.argv) == 3 and is_current(sys.argv[1], sys.argv[2]) else 1)

@@ -1,0 +1,101 @@
+"""Every study through the runner: 1 and 2 workers, and a run killed with SIGKILL then started
+again, give the same files (issue 12).
+
+Each study provides ``tests/data/tiny/<study>.txt``: one ``KEY=VALUE`` override per line for a
+run of a few seconds with at least two chunks.
+"""
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+from sim.storage import read_provenance
+from sim.studies import MODULES
+
+ROOT = Path(__file__).resolve().parent.parent
+TINY = ROOT / "tests" / "data" / "tiny"
+
+
+def overrides(study: str) -> list[str]:
+    f = TINY / f"{study}.txt"
+    assert f.is_file(), f"{f} is missing: every study needs a tiny configuration"
+    lines = [ln.strip() for ln in f.read_text().splitlines()]
+    return [a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln)]
+
+
+#: the study file that stands for a study kind with several example files
+FILES = {"network": "network_testfield"}
+
+
+def command(study: str, out: Path, workers: int) -> list[str]:
+    return [sys.executable, "-m", "sim", "run", str(ROOT / "studies" / f"{FILES.get(study, study)}.toml"),
+            "--out", str(out), "--quiet", "--workers", str(workers), *overrides(study)]
+
+
+def same_table(a: Path, b: Path) -> bool:
+    """Equal schema and values, NaN equal to NaN (missing numbers)."""
+    import numpy as np
+    import pyarrow as pa
+
+    ta, tb = pq.read_table(a), pq.read_table(b)
+    if ta.schema.remove_metadata() != tb.schema.remove_metadata() or ta.num_rows != tb.num_rows:
+        return False
+    for ca, cb in zip(ta.columns, tb.columns):
+        if pa.types.is_floating(ca.type):
+            x = ca.to_numpy(zero_copy_only=False)
+            y = cb.to_numpy(zero_copy_only=False)
+            if not np.array_equal(x, y, equal_nan=True):
+                return False
+        elif ca.to_pylist() != cb.to_pylist():
+            return False
+    return True
+
+
+def same_files(a: Path, b: Path) -> None:
+    fa = sorted(p.relative_to(a).as_posix() for p in a.rglob("*") if p.is_file()
+                and p.suffix in (".parquet", ".png") and "trials" not in p.parts)
+    fb = sorted(p.relative_to(b).as_posix() for p in b.rglob("*") if p.is_file()
+                and p.suffix in (".parquet", ".png") and "trials" not in p.parts)
+    assert fa == fb and fa
+    for f in fa:
+        if f.endswith(".png"):
+            assert (a / f).read_bytes() == (b / f).read_bytes(), f
+            continue
+        assert same_table(a / f, b / f), f
+        pa_, pb_ = read_provenance(a / f), read_provenance(b / f)
+        assert pa_.get("config") == pb_.get("config") and pa_.get("seed") == pb_.get("seed"), f
+    ta = sorted(p.relative_to(a).as_posix() for p in (a / "trials").rglob("*.parquet")) \
+        if (a / "trials").is_dir() else []
+    tb = sorted(p.relative_to(b).as_posix() for p in (b / "trials").rglob("*.parquet")) \
+        if (b / "trials").is_dir() else []
+    assert ta == tb
+    for f in ta:
+        assert same_table(a / f, b / f), f
+
+
+@pytest.mark.parametrize("study", sorted(MODULES))
+def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path):
+    one = tmp_path / "one"
+    r = subprocess.run(command(study, one, 1), cwd=ROOT, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    two = tmp_path / "two"
+    stage = tmp_path / ".two.partial"
+    p = subprocess.Popen(command(study, two, 2), cwd=ROOT, stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL, start_new_session=True)
+    t0 = time.monotonic()
+    while p.poll() is None and time.monotonic() - t0 < 120:
+        if list(stage.rglob("chunk-*.parquet")):
+            os.killpg(p.pid, signal.SIGKILL)  # the run and its workers, as kill -9 would
+            break
+        time.sleep(0.05)
+    p.wait(timeout=60)
+    r = subprocess.run(command(study, two, 2), cwd=ROOT, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    same_files(one, two)
