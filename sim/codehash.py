@@ -21,8 +21,9 @@ from pathlib import Path
 __all__ = ["study_modules", "study_files", "study_code_hash", "is_current"]
 
 ROOT = Path(__file__).resolve().parent           # .../sim
-#: library files that no study result depends on
-NOT_STUDY_CODE = ("bench.py",)
+#: library files that no study result depends on (the benchmark; the verification, which the
+#: report imports for its reproducibility section only)
+NOT_STUDY_CODE = ("bench.py", "verify.py")
 
 
 def _module_file(name: str) -> Path | None:

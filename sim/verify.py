@@ -157,7 +157,9 @@ def verify(results: Path, scratch: Path, studies_dir: Path = Path("studies"), wo
             continue
         target = scratch / d.name
         if rerun:
-            sf = studies_dir / f"{study}.toml"
+            # a study kind with several example files (network_*) is named by its directory
+            sf = studies_dir / f"{d.name}.toml"
+            sf = sf if sf.is_file() else studies_dir / f"{study}.toml"
             cmd = [sys.executable, "-m", "sim", "run", str(sf), "--out", str(target), "--quiet",
                    "--workers", str(workers)]
             if target.exists():
