@@ -167,11 +167,11 @@ def verify(results: Path, scratch: Path, studies_dir: Path = Path("studies"), wo
             print(f"sim verify: re-running {study}", file=sys.stderr, flush=True)
             r = subprocess.run(cmd)
             if r.returncode != 0:
-                c = Comparison(study)
+                c = Comparison(d.name)
                 c.failures.append(f"the re-run exited with {r.returncode}")
                 out.append(c)
                 continue
-        out.append(compare_dirs(d, target, study))
+        out.append(compare_dirs(d, target, d.name))
     return out
 
 
