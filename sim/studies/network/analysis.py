@@ -113,10 +113,11 @@ def ellipse(cov: np.ndarray):
 
 def mc_chunk(rng: np.random.Generator, n: int, net: Network, free: np.ndarray,
              C: np.ndarray | None, cov_inv: np.ndarray, pts: np.ndarray, crit: float,
-             tol: float, max_iter: int) -> dict:
+             tol: float, max_iter: int, par: np.ndarray | None = None) -> dict:
     """One chunk of ``n`` simulated adjustments (see the module doc). ``pts`` are the point
     indices whose coordinates are estimated; ``cov_inv`` (len(pts), 2, 2) their inverse
-    analytic covariances; ``crit`` the global test's chi-square critical value."""
+    analytic covariances; ``crit`` the global test's chi-square critical value; ``par`` the
+    indices of the estimated globals that are not coordinates (their errors are summed)."""
     obs = simulate(net, rng, n)
     theta = np.repeat(net.theta_true()[None], n, 0)
     res = lsq.gauss_newton(NetworkModel(net, obs), theta, datum=lsq.Datum(free, C), tol=tol,
@@ -125,7 +126,10 @@ def mc_chunk(rng: np.random.Generator, n: int, net: Network, free: np.ndarray,
     e = (res.theta - theta)[:, :2 * net.n].reshape(n, net.n, 2)[:, pts][ok]     # (N, k, 2)
     inside = np.einsum("tki,kij,tkj->tk", e, cov_inv, e) <= CHI2_2_95
     vpv = res.sigma0 ** 2 * res.dof if res.dof > 0 else np.zeros(n)
+    par = np.zeros(0, int) if par is None else np.asarray(par, int)
+    g = (res.theta - theta)[:, par][ok]                                        # (N, k_par)
     return {"sum.n": np.array([[ok.sum()]], float),
+            "sum.pe": g.sum(0)[None], "sum.pee": (g * g).sum(0)[None],
             "sum.e": e.sum(0)[None], "sum.ee": np.einsum("tki,tkj->kij", e, e)[None],
             "sum.inside": inside.sum(0)[None].astype(float),
             "sum.reject": np.array([[(vpv[ok] > crit).sum()]], float),

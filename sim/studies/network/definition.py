@@ -16,8 +16,10 @@ plane system; bearings are measured from +x towards +y, as ``gama-local``'s ``ax
   (sigma / sqrt(settings)); ``bias`` is added to every simulated reading and unknown to the
   adjustment;
 * distance parameters (Brown's comparator, seed 004): every distance reads
-  ``sqrt(d^2 - beta^2) - alpha`` with the additive constant ``constant_mm`` (alpha; estimated
-  when ``estimate_constant``) and the known offset ``offset_mm`` (beta).
+  ``(1 + s) sqrt(d^2 - beta^2) - alpha`` with the additive constant ``constant_mm`` (alpha;
+  estimated when ``estimate_constant``), the known offset ``offset_mm`` (beta) and the scale
+  error ``scale_ppm`` (s, in parts per million; estimated when ``estimate_scale``: a distance
+  meter's or a scale's unknown scale).
 
 :func:`build` turns the validated config into a :class:`Network` of arrays, or raises
 :class:`~sim.config.ConfigError` naming the bad entry.
@@ -51,7 +53,7 @@ class Network:
     ``j`` (to / back-sight), ``k`` (angle fore-sight; else -1), ``sigma`` (effective: mm or
     rad), ``bias`` (mm or rad), ``oset`` (orientation set of a direction, else -1);
     ``stations`` names the orientation sets. Distance parameters ``constant_mm`` (alpha),
-    ``estimate_constant``, ``offset_mm`` (beta)."""
+    ``estimate_constant``, ``offset_mm`` (beta), ``scale_ppm`` (s), ``estimate_scale``."""
 
     name: str
     names: tuple
@@ -68,6 +70,8 @@ class Network:
     constant_mm: float = 0.0
     estimate_constant: bool = False
     offset_mm: float = 0.0
+    scale_ppm: float = 0.0
+    estimate_scale: bool = False
 
     @property
     def n(self) -> int:
@@ -79,16 +83,30 @@ class Network:
 
     @property
     def q(self) -> int:
-        """Globals: 2 coordinates per point, one orientation per set, the constant."""
+        """Globals: 2 coordinates per point, one orientation per set, the constant, the scale."""
+        return 2 * self.n + len(self.stations) + 2
+
+    @property
+    def i_constant(self) -> int:
+        """Index of the additive constant (mm) among the globals."""
+        return 2 * self.n + len(self.stations)
+
+    @property
+    def i_scale(self) -> int:
+        """Index of the scale error (ppm) among the globals."""
         return 2 * self.n + len(self.stations) + 1
+
+    def parameter_names(self) -> list[str]:
+        """Names of the globals that are not coordinates (orientations, constant, scale)."""
+        return [f"orientation {s}" for s in self.stations] + ["constant", "scale"]
 
     def index(self, name: str) -> int:
         return self.names.index(name)
 
     def theta_true(self) -> np.ndarray:
-        """(q,) true globals: coordinates, orientations (0), constant."""
+        """(q,) true globals: coordinates, orientations (0), constant, scale."""
         return np.concatenate([self.xy.reshape(-1), np.zeros(len(self.stations)),
-                               [self.constant_mm]])
+                               [self.constant_mm, self.scale_ppm]])
 
     def free_index(self, extra_fixed: tuple = ()) -> np.ndarray:
         """Indices of the estimated globals (``extra_fixed``: point indices held fixed too)."""
@@ -96,8 +114,9 @@ class Network:
         fixed[list(extra_fixed)] = True
         coords = np.flatnonzero(np.repeat(~fixed, 2))
         orient = 2 * self.n + np.arange(len(self.stations))
-        const = [self.q - 1] if self.estimate_constant else []
-        return np.concatenate([coords, orient, const]).astype(int)
+        const = [self.i_constant] if self.estimate_constant else []
+        scale = [self.i_scale] if self.estimate_scale else []
+        return np.concatenate([coords, orient, const, scale]).astype(int)
 
 
 def _num(key: str, v, lo: float | None = None, lo_open: bool = False, integer: bool = False):
@@ -309,4 +328,5 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
                               f"the shortest distance ({d.min():.3g} mm)")
     return Network(cfg["network.name"], tuple(names), xy, role, kind.astype(int), i.astype(int),
                    j.astype(int), kk.astype(int), sig.astype(float), bias.astype(float), oset,
-                   stations, cfg["network.constant_mm"], cfg["network.estimate_constant"], beta)
+                   stations, cfg["network.constant_mm"], cfg["network.estimate_constant"], beta,
+                   cfg["network.scale_ppm"], cfg["network.estimate_scale"])

@@ -19,7 +19,8 @@ vectors, height differences, correlated covariance blocks, other axes orientatio
 the observed values (``val``) are not used: the simulation draws readings from the points'
 coordinates, which every point must therefore have. On export, ``val`` is the error-free value,
 and settings are folded into the standard deviation; biases, the additive constant, the
-offset and coordinate differences have no ``gama-local`` form and are refused.
+offset, the scale of distances and coordinate differences have no ``gama-local`` form and
+are refused.
 """
 from __future__ import annotations
 
@@ -184,6 +185,8 @@ def write_gama(net: Network, path: str | Path) -> Path:
     if net.constant_mm or net.estimate_constant or net.offset_mm:
         raise ConfigError("network.constant_mm", "gama-local has no additive constant or "
                           "offset of distances")
+    if net.scale_ppm or net.estimate_scale:
+        raise ConfigError("network.scale_ppm", "gama-local has no scale parameter of distances")
     if np.any((net.kind == 3) | (net.kind == 4)):
         raise ConfigError("network.observations", "gama-local has no 2-D coordinate "
                           "differences (dx, dy)")

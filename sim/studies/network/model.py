@@ -1,7 +1,8 @@
 """The observation model of a declared network, on the one engine (:mod:`sim.lsq`).
 
 All unknowns are globals (``point_dim = 0``): the coordinates of every point (x, y in mm), one
-orientation per direction set (rad) and the additive constant of distances (mm); a network's
+orientation per direction set (rad), the additive constant of distances (mm) and their scale
+error (ppm); a distance reads ``(1 + s) sqrt(d^2 - beta^2) - alpha``; a network's
 observations tie two or three points together, so there is no per-point block to eliminate.
 Each observation is one row; weights are ``1 / sigma^2`` (sigma in mm or rad), so cofactors are
 covariances. The datum (:func:`datum`) frees the estimated globals and adds fixed points,
@@ -41,12 +42,13 @@ def computed(net: Network, theta: np.ndarray, jac: bool = False):
         s = np.sqrt(np.maximum(d2 - beta2, 0.0))
         bear = np.arctan2(dy, dx)
     ori = theta[:, 2 * net.n + np.where(net.oset >= 0, net.oset, 0)] if len(net.stations) else 0.0
-    alpha = theta[:, -1:]
+    alpha = theta[:, net.i_constant, None]
+    f = 1.0 + 1e-6 * theta[:, net.i_scale, None]
     pk = xy[:, np.where(k >= 0, k, 0)]
     ex, ey = pk[..., 0] - pi[..., 0], pk[..., 1] - pi[..., 1]
     bear_k = np.arctan2(ey, ex)
     val = np.select([kind == 0, kind == 1, kind == 2, kind == 3, kind == 4, kind == 5],
-                    [s - alpha, bear - ori, (bear_k - bear) % _TWO_PI, dx, dy, pi[..., 0]],
+                    [f * s - alpha, bear - ori, (bear_k - bear) % _TWO_PI, dx, dy, pi[..., 0]],
                     pi[..., 1])
     if not jac:
         return val
@@ -58,8 +60,8 @@ def computed(net: Network, theta: np.ndarray, jac: bool = False):
     cx_k = np.where(k >= 0, 2 * k, net.q)
     cy_k = np.where(k >= 0, 2 * k + 1, net.q)
     with np.errstate(invalid="ignore", divide="ignore"):
-        gx = np.select([kind == 0, kind == 1, kind == 2], [dx / s, -dy / d2, dy / d2], 0.0)
-        gy = np.select([kind == 0, kind == 1, kind == 2], [dy / s, dx / d2, -dx / d2], 0.0)
+        gx = np.select([kind == 0, kind == 1, kind == 2], [f * dx / s, -dy / d2, dy / d2], 0.0)
+        gy = np.select([kind == 0, kind == 1, kind == 2], [f * dy / s, dx / d2, -dx / d2], 0.0)
         e2 = ex * ex + ey * ey
         hx, hy = np.where(kind == 2, -ey / e2, 0.0), np.where(kind == 2, ex / e2, 0.0)
     lin = kind <= 2
@@ -73,7 +75,9 @@ def computed(net: Network, theta: np.ndarray, jac: bool = False):
     if len(net.stations):
         d = kind == 1
         J[:, rows[d], 2 * net.n + net.oset[d]] = -1.0
-    J[:, rows[kind == 0], net.q - 1] = -1.0
+    dist = rows[kind == 0]
+    J[:, dist, net.i_constant] = -1.0
+    J[:, dist, net.i_scale] = 1e-6 * s[:, kind == 0]
     return val, J[..., :net.q]
 
 
@@ -110,7 +114,8 @@ class NetworkModel:
 
 def null_space(net: Network, free: np.ndarray) -> np.ndarray:
     """Candidate datum defects restricted to the free globals ``(p, 4)``: translation x, y,
-    rotation and scale of every point (orientations turn with a rotation)."""
+    rotation and scale of every point (orientations turn with a rotation; an estimated scale
+    error of the distances shrinks as the coordinates grow)."""
     c = net.xy - net.xy.mean(axis=0)
     G = np.zeros((net.q, 4))
     G[0:2 * net.n:2, 0] = 1
@@ -118,6 +123,7 @@ def null_space(net: Network, free: np.ndarray) -> np.ndarray:
     G[0:2 * net.n:2, 2], G[1:2 * net.n:2, 2] = -c[:, 1], c[:, 0]
     G[2 * net.n:2 * net.n + len(net.stations), 2] = 1.0
     G[0:2 * net.n:2, 3], G[1:2 * net.n:2, 3] = c[:, 0], c[:, 1]
+    G[net.i_scale, 3] = -(1e6 + net.scale_ppm)
     return G[free]
 
 

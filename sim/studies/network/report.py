@@ -58,6 +58,20 @@ def report(out: Path) -> str:
                            [[o["kind"][a], o["at"][a], o["from"][a], o["to"][a],
                              fmt(o["redundancy"][a]), unit(a), fmt(o["external_max_mm"][a])]
                             for a in order]), ""]
+    g = read_table(out / "parameters.parquet").to_pydict() \
+        if (out / "parameters.parquet").is_file() else {"parameter": []}
+    if g["parameter"]:
+        parts += ["Other estimated parameters (analytic and Monte-Carlo sigma; "
+                  "`parameters.parquet`):", "",
+                  md_table(["parameter", "unit", "true", "sigma", "MC sigma [95 %]",
+                            "MC mean error [95 %]"],
+                           [[g["parameter"][a], g["unit"][a], fmt(g["true"][a]),
+                             fmt(g["sigma"][a]),
+                             f"{fmt(g['mc_sigma'][a])} [{fmt(g['mc_sigma_lo'][a])}, "
+                             f"{fmt(g['mc_sigma_hi'][a])}]",
+                             f"{fmt(g['mc_mean_error'][a])} [{fmt(g['mc_mean_error_lo'][a])}, "
+                             f"{fmt(g['mc_mean_error_hi'][a])}]"]
+                            for a in range(len(g["parameter"]))]), ""]
     d = read_table(out / "datums.parquet").to_pydict()
     if d["datum"]:
         for name in dict.fromkeys(d["datum"]):

@@ -2,7 +2,8 @@
 
 Writes ``summary.parquet`` (one row), ``points.parquet`` (per point: analytic sigma and 95 %
 ellipse, Monte-Carlo sigma with its interval, ellipse coverage, dilution against the compared
-parameterisation), ``datums.parquet`` (point sigmas in other datums), ``observations.parquet``
+parameterisation), ``parameters.parquet`` (orientations, additive constant and scale: analytic
+and Monte-Carlo sigma), ``datums.parquet`` (point sigmas in other datums), ``observations.parquet``
 (redundancy, MDB, external reliability), ``claims.parquet`` (self-checks: Monte Carlo against
 analytic, coverage, false-alarm rate of the global test, redundancy sum), ``network.xml`` (the
 network in ``gama-local`` XML when it has that form) and the figures.
@@ -45,13 +46,19 @@ def _rms_sigma(cov: np.ndarray) -> np.ndarray:
     return np.sqrt((cov[:, 0, 0] + cov[:, 1, 1]) / 2)
 
 
+def _params(net: Network, an) -> np.ndarray:
+    """Indices of the estimated globals that are not coordinates (orientations, constant,
+    scale)."""
+    return np.array([g for g in an.free if g >= 2 * net.n], int)
+
+
 def _mc(net, an, dt, pts, cfg, ctx):
     C = dt.constraint_matrix(net.theta_true()[None])
     crit = float(stats.chi2.ppf(1 - cfg["test.alpha"], an.dof))
     cov_inv = np.linalg.inv(an.cov[pts])
     fn = partial(mc_chunk, net=net, free=an.free, C=None if C is None else C[0], cov_inv=cov_inv,
                  pts=np.asarray(pts), crit=crit, tol=cfg["solver.tol_mm"],
-                 max_iter=cfg["solver.max_iter"])
+                 max_iter=cfg["solver.max_iter"], par=_params(net, an))
     return run_chunks(fn, cfg["trials"], cfg["seed"], cfg["chunk"], part=0,
                       label=cfg["study"], ctx=ctx)
 
@@ -112,6 +119,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
         "mc_sigma_y_mm": s_mc[1::2], "mc_sigma_y_lo_mm": s_lo[1::2], "mc_sigma_y_hi_mm": s_hi[1::2],
         "coverage95": cover[0], "coverage95_lo": cover[1], "coverage95_hi": cover[2],
         "dilution_pct": dil}, prov)
+    _parameters(net, an, sim, n_ok, out, prov)
     drows = {"datum": [], "point": [], "sigma_x_mm": [], "sigma_y_mm": []}
     for pat in cfg["output.inner_over"]:
         sel = [a for a in range(net.n) if fnmatch.fnmatchcase(net.names[a], pat)]
@@ -160,6 +168,42 @@ def run(cfg: dict, out: Path, ctx) -> None:
     _claims(out, prov, an, ratio, cover_mean, alarm, cfg, n_tot)
     network_figure(net, an, pts, out / "network.png")
     reliability_figure(net, an, out / "reliability.png")
+
+
+def _parameters(net: Network, an, sim: dict, n_ok: np.ndarray, out: Path, prov: dict) -> None:
+    """``parameters.parquet``: the estimated globals that are not coordinates (orientation of
+    each direction set in arcsec, additive constant in mm, scale in ppm) with their true value,
+    analytic sigma and Monte-Carlo mean error and sigma with intervals."""
+    par = _params(net, an)
+    names = net.parameter_names()
+    units = ["arcsec"] * len(net.stations) + ["mm", "ppm"]
+    f = np.array([1 / (np.pi / 648000)] * len(net.stations) + [1.0, 1.0])
+    rel = par - 2 * net.n
+    pos = {g: a for a, g in enumerate(an.free)}
+    an_sig = np.sqrt(np.maximum([an.Q[pos[g], pos[g]] for g in par], 0.0)) if len(par) else \
+        np.zeros(0)
+    cols = {"parameter": [names[r] for r in rel], "unit": [units[r] for r in rel],
+            "true": net.theta_true()[par] * f[rel], "sigma": an_sig * f[rel]}
+    if len(par):
+        kp = len(par)
+        sums = np.concatenate([n_ok[:, None], sim["sum.pe"], sim["sum.pee"]], axis=1)
+
+        def mean(t):
+            return t[1:1 + kp] / t[0]
+
+        def sd(t):
+            n, e, ee = t[0], t[1:1 + kp], t[1 + kp:]
+            return np.sqrt(np.maximum(ee / n - (e / n) ** 2, 0) * n / (n - 1))
+
+        (m, m_lo, m_hi), (s_, s_lo, s_hi) = jackknife(mean, sums), jackknife(sd, sums)
+        cols.update({"mc_mean_error": m * f[rel], "mc_mean_error_lo": m_lo * f[rel],
+                     "mc_mean_error_hi": m_hi * f[rel], "mc_sigma": s_ * f[rel],
+                     "mc_sigma_lo": s_lo * f[rel], "mc_sigma_hi": s_hi * f[rel]})
+    else:
+        cols.update({k: np.zeros(0) for k in ("mc_mean_error", "mc_mean_error_lo",
+                                             "mc_mean_error_hi", "mc_sigma", "mc_sigma_lo",
+                                             "mc_sigma_hi")})
+    write_table(out / "parameters.parquet", cols, prov)
 
 
 def _claims(out, prov, an, ratio, cover, alarm, cfg, n_tot) -> None:

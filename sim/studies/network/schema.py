@@ -38,6 +38,9 @@ SCHEMA = {
     "network.offset_mm": Field(0.0, "float", "known perpendicular offset of every distance "
                                "(Brown's beta): reads sqrt(d^2 - beta^2)", lo=0.0, hi=1e6,
                                unit="mm"),
+    "network.scale_ppm": Field(0.0, "float", "true scale error of every distance: reads "
+                               "(1 + s) times the distance", lo=-1e5, hi=1e5, unit="ppm"),
+    "network.estimate_scale": Field(False, "bool", "estimate the scale error of the distances"),
     "datum.kind": Field("fixed", "str", "fixed points, inner constraints over datum.points, or "
                         "explicit minimal constraints", choices=("fixed", "inner", "constraints")),
     "datum.points": Field([], "list[str]", "name patterns of the inner-constraint points "
