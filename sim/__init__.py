@@ -15,10 +15,21 @@ for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 from .api import Results, StudyHandle, load  # noqa: E402
 from .claims import claim
 from .config import ConfigError, StudyError, load_study
-from .multilateration import adjust, covariance, design_theta, ranges, simulate_ranges
 from .runner import run_chunks
 from .storage import read_provenance, write_table
 
 __all__ = ["load", "StudyHandle", "Results", "ConfigError", "StudyError", "load_study",
            "run_chunks", "adjust", "covariance", "design_theta", "ranges", "simulate_ranges", "claim", "write_table", "read_provenance"]
 __version__ = "0.1.0"
+
+_LAZY = {"adjust", "covariance", "design_theta", "ranges", "simulate_ranges"}
+
+
+def __getattr__(name: str):
+    """The Brown kernels load on first use: they pull in numba, which a study that does not
+    range has no need to import."""
+    if name in _LAZY:
+        from . import multilateration
+
+        return getattr(multilateration, name)
+    raise AttributeError(f"module 'sim' has no attribute {name!r}")

@@ -18,9 +18,10 @@ for a linear model; ``s0`` itself is biased low by the factor ``c4(dof + 1)``.
 from __future__ import annotations
 
 import numpy as np
-from scipy import special, stats
+from scipy import special
 
 from .lsq.linear import lstsq
+from . import distributions as D
 
 __all__ = ["mahalanobis2", "ellipse_inside", "chi2_reject", "c4", "affine_trials",
            "binomial_se", "result_inside"]
@@ -43,8 +44,8 @@ def ellipse_inside(e: np.ndarray, Q: np.ndarray, sigma: float | np.ndarray | Non
     """
     m2 = mahalanobis2(e, Q)
     if s0 is not None:
-        return m2 / (2 * s0[:, None] ** 2) <= stats.f.ppf(level, 2, dof)
-    return m2 / np.asarray(sigma) ** 2 <= stats.chi2.ppf(level, 2)
+        return m2 / (2 * s0[:, None] ** 2) <= D.f_ppf(level, 2, dof)
+    return m2 / np.asarray(sigma) ** 2 <= D.chi2_ppf(level, 2)
 
 
 def result_inside(result, truth: np.ndarray, sigma: float | None = None,
@@ -62,7 +63,7 @@ def result_inside(result, truth: np.ndarray, sigma: float | None = None,
 
 def chi2_reject(s0: np.ndarray, sigma: float, dof: int, alpha: float = 0.05) -> np.ndarray:
     """Global chi-square test of the a-posteriori variance: True where rejected."""
-    return dof * (s0 / sigma) ** 2 > stats.chi2.ppf(1 - alpha, dof)
+    return dof * (s0 / sigma) ** 2 > D.chi2_ppf(1 - alpha, dof)
 
 
 def c4(n: int) -> float:

@@ -48,7 +48,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
+from . import distributions as D
 
 from . import lsq
 
@@ -192,7 +192,7 @@ def chi2_test(s0: np.ndarray, dof: int, sigma0: float | np.ndarray = 1.0, alpha:
     Returns ``(statistic, p_value, reject)`` with ``statistic = dof s0^2 / sigma0^2``.
     """
     x = dof * np.asarray(s0, float) ** 2 / np.asarray(sigma0, float) ** 2
-    cdf = stats.chi2.cdf(x, dof)
+    cdf = D.chi2_cdf(x, dof)
     p = 2 * np.minimum(cdf, 1 - cdf)
     return x, p, p < alpha
 

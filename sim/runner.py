@@ -41,6 +41,7 @@ import pyarrow.parquet as pq
 
 from .progress import Progress
 from .storage import atomic_path
+from . import distributions as D
 
 __all__ = ["chunk_rng", "run_chunks", "ChunkStore", "make_executor", "jackknife", "require_finite"]
 
@@ -301,8 +302,6 @@ def jackknife(stat: Callable[[np.ndarray], np.ndarray], sums: np.ndarray, level:
     jackknife standard error.
     Streaming-friendly: memory grows with the number of chunks, not of trials.
     """
-    from scipy import stats as st
-
     sums = np.asarray(sums, float)
     C = sums.shape[0]
     total = sums.sum(axis=0)
@@ -314,5 +313,5 @@ def jackknife(stat: Callable[[np.ndarray], np.ndarray], sums: np.ndarray, level:
                          "than trials)")
     loo = np.stack([np.asarray(stat(total - sums[c]), float) for c in range(C)])
     se = np.sqrt((C - 1) / C * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
-    z = st.t.ppf(0.5 + level / 2, C - 1)
+    z = D.t_ppf(0.5 + level / 2, C - 1)
     return est, est - z * se, est + z * se

@@ -5,7 +5,7 @@ import pytest
 from sim import datum as dm
 from sim import multilateration as ml
 from sim import positions as po
-from sim.claims import std_rel_se
+from sim.intervals import std_rel_se
 from sim.plate import grid_points
 
 H = 122.5 + 45.0

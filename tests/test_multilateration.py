@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from sim import multilateration as ml
-from sim.claims import std_rel_se
+from sim.intervals import std_rel_se
 from sim.plate import grid_points
 
 H = 122.5 + 45.0

@@ -9,10 +9,10 @@ sums or examples (leading axis 1, keys ``chunk.*``). Lengths in metres.
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
 
 from ... import independent_models as im
 from ...block_layout import Block
+from ... import distributions as D
 from .schema import five_control, paper_weights, snoop_weights
 from .simulate import Adjuster, Simulated, _rms, accuracy
 
@@ -31,7 +31,7 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
     chunk, trial 0's and the summed check-point errors of the 5- and 21-control passes (for
     the figures)."""
     adj = Adjuster(block)
-    crit = float(stats.norm.ppf(1 - cfg["snoop.alpha"] / 2))
+    crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
     sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], mechanical=True)
     out: dict[str, np.ndarray] = {}
     wo, wc = paper_weights(cfg)
@@ -100,7 +100,7 @@ def pugging_chunk(cfg: dict, block: Block, recentre_px: float, rng: np.random.Ge
     """Data snooping under mechanical pugging with another re-centring error (px)."""
     c2 = {**cfg, "pugging.recentre_px": recentre_px}
     adj = Adjuster(block)
-    crit = float(stats.norm.ppf(1 - cfg["snoop.alpha"] / 2))
+    crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
     ws, wsc = snoop_weights(cfg)
     sim = Simulated(c2, block, rng, n, cfg["scan.dpi"], mechanical=True, uncorrected=False)
     ctrl, st, res0 = adj.adjust(sim, ("mechanical", "corrected"), cfg["control.many"],

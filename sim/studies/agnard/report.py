@@ -6,10 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
 
 from ...report import claims_markdown, fmt, inputs_markdown, md_table
 from ...storage import read_provenance, read_table
+from ... import distributions as D
 from .schema import SCHEMA
 
 
@@ -148,7 +148,7 @@ def report(out: Path) -> str:
     kinds = np.asarray(lay["kind"])
     n_pass = int((kinds == "pass").sum())
     n_ground = int((kinds != "pass").sum())
-    crit = float(stats.norm.ppf(1 - cfg["snoop.alpha"] / 2))
+    crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
     c = _claims(out)
     sxy, sz = c["agnard.budget.model_xy_cm"]["value"] / 100, c["agnard.budget.model_z_cm"]["value"] / 100
     pix_um = 25.4e3 / cfg["scan.dpi"]

@@ -13,7 +13,8 @@ import numpy as np
 from scipy import optimize
 
 from ... import multilateration as ml
-from ...claims import ClaimBook, std_rel_se
+from ...claims import ClaimBook
+from ...intervals import std_rel_se
 from ...runner import chunk_rng
 from . import values as V
 from .schema import MODEL_NAMES

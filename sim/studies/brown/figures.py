@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ... import multilateration as ml
-from ...claims import std_rel_se
+from ...intervals import std_rel_se
 from ...plotting import plt, save
 from ...storage import read_table
 from .schema import MODEL_NAMES

@@ -13,10 +13,10 @@ Seed paper 004 (Brown 1968).
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
 
 from ... import multilateration as ml
 from ...plate import pattern_points
+from ... import distributions as D
 
 #: sigma0 values spanning the paper's printed closure 1.6 um (1.55-1.65 um)
 S0_PAPER_UM = np.linspace(1.55, 1.65, 21)
@@ -101,7 +101,7 @@ def closure_quantiles(range_sigma_um: float, dof: int, n: int = N_QUANT) -> np.n
     """sigma0 of one plate at ``n`` evenly spaced quantile levels: sigma0^2 dof / sigma^2 is
     chi-square with ``dof`` degrees of freedom (a deterministic sample of the plates)."""
     q = (np.arange(n) + 0.5) / n
-    return range_sigma_um * np.sqrt(stats.chi2.ppf(q, dof) / dof)
+    return range_sigma_um * np.sqrt(D.chi2_ppf(q, dof) / dof)
 
 
 def point_sigma_stats(sig_um: np.ndarray) -> dict[str, np.ndarray]:

@@ -9,9 +9,9 @@ coordinates in mm inside the solvers, errors in um in the outputs.
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
 
 from ... import bayes, budget, coverage as cv, datum as dm, multilateration as ml, positions as po
+from ... import distributions as D
 
 __all__ = ["design_chunk", "budget_chunk", "coverage_chunk", "affine_chunk", "brown_chain_chunk",
            "twoplate_chain_chunk"]
@@ -64,7 +64,7 @@ def coverage_chunk(pts, th, sigma_um, alpha_test, rng, T):
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # flagged trials
         n = len(pts)
         dof = 4 * n - (2 * n + 7)
-        zq = stats.norm.ppf(0.975)
+        zq = D.norm_ppf(0.975)
         thp = po.from_brown_theta(th)
         Pt = np.broadcast_to(pts, (T,) + pts.shape)
         TH = np.broadcast_to(thp, (T, 10))

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ...claims import ClaimBook, spread
+from ...claims import ClaimBook
+from ...intervals import spread
 from .errbudget import BUDGET_ROWS
 
 __all__ = ["BOOK", "load_book", "EXTERNAL", "score_external", "score_all"]

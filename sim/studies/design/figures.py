@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
-from scipy import stats
 
 from ...plotting import plt, save
+from ... import distributions as D
 from .cells import pareto_front
 from .claims import load_book
 
@@ -155,7 +155,7 @@ def fig_corner(samples, mean, Q, names, path):
             if i == j:
                 ax.hist(z[:, i], bins=40, density=True, color="tab:blue", alpha=0.7)
                 xx = np.linspace(-4, 4, 100)
-                ax.plot(xx, stats.norm.pdf(xx), "r-", lw=1)
+                ax.plot(xx, D.norm_pdf(xx), "r-", lw=1)
             else:
                 ax.plot(z[::max(1, len(z) // 4000), j], z[::max(1, len(z) // 4000), i], ",",
                         color="tab:blue", alpha=0.5)

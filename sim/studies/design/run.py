@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from ... import datum as dm, positions as po
-from ...claims import bootstrap_ci, write_claims
+from ...claims import write_claims
+from ...intervals import bootstrap_ci
 from ...runner import chunk_rng, run_chunks
 from ...storage import provenance, write_table
 from .. import RunContext

@@ -10,11 +10,12 @@ import math
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
 
-from ...claims import ClaimBook, mean_ci, std_ci
+from ...claims import ClaimBook
+from ...intervals import mean_ci, std_ci
 from ...config import StudyError
 from .model import PARAM_LABEL, PARAMS
+from ... import distributions as D
 
 BOOK = Path(__file__).with_name("claims.toml")
 
@@ -28,8 +29,8 @@ def quantile_ci(x: np.ndarray, q: float, level: float = 0.95) -> tuple[float, tu
     x = np.sort(np.asarray(x, float).ravel())
     n = x.size
     a = (1 - level) / 2
-    lo = int(np.clip(stats.binom.ppf(a, n, q), 0, n - 1))
-    hi = int(np.clip(stats.binom.ppf(1 - a, n, q), 0, n - 1))
+    lo = int(np.clip(D.binom_ppf(a, n, q), 0, n - 1))
+    hi = int(np.clip(D.binom_ppf(1 - a, n, q), 0, n - 1))
     return float(np.quantile(x, q)), (float(x[lo]), float(x[hi]))
 
 
@@ -163,7 +164,7 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
                    "s_w^2/sg^2 - (A^2 + B^2) used for all trials."))
     nu = P * (2 * N - 6)
     sw = math.sqrt(sx ** 2 + sgt ** 2)
-    a_med = sw * math.sqrt(stats.chi2.ppf(0.5, nu) / nu)
+    a_med = sw * math.sqrt(D.chi2_ppf(0.5, nu) / nu)
     med, (lo, hi) = quantile_ci(aff, 0.5)
     add(book.score("twoplate.self_check.affine_sigma_analytic", med / a_med - 1,
                    (lo / a_med - 1, hi / a_med - 1),

@@ -20,12 +20,12 @@ iterations are counted on ``analysis.iter_sample`` adjustments per chunk.
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
 
 from ... import gridplate as gp
 from ... import transforms2d as t2
 from ...plate import grid_points
 from .schema import UM
+from ... import distributions as D
 
 PARAMS = ("S", "S2", "eps")
 PARAM_LABEL = {"S": "S", "S2": "S'", "eps": "eps"}
@@ -73,7 +73,7 @@ def reweight_trials(sw2: np.ndarray, k: np.ndarray, stated: float, dof: int, sta
     set ``P_cx <- s0^2 / stated^2`` and adjust again. Returns the number of re-weightings
     (0: the first adjustment passed; ``MAX_TRIALS``: never passed). Closed form per
     adjustment: ``s0^2 = s_w^2 / (1 + k / P_cx)``."""
-    lo, hi = stats.chi2.ppf(alpha / 2, dof), stats.chi2.ppf(1 - alpha / 2, dof)
+    lo, hi = D.chi2_ppf(alpha / 2, dof), D.chi2_ppf(1 - alpha / 2, dof)
     r = np.full(sw2.shape, float(start))
     count = np.zeros(sw2.shape, int)
     done = np.zeros(sw2.shape, bool)
@@ -117,7 +117,7 @@ def reduce_chunk(cfg: dict, sim: dict) -> dict[str, np.ndarray]:
     sx = cfg["comparator.coord_sigma_um"] * UM          # a-priori comparator sigma
     sg = cfg["grid.sigma_stated_um"] * UM
     alpha, dof = cfg["analysis.alpha"], N - 3
-    z = stats.norm.ppf(0.975)
+    z = D.norm_ppf(0.975)
     _, sigma_obs = gp.repeat_precision(readings)
     mean = readings.mean(axis=3).reshape(n * P, N, 2)
     g = cert.reshape(n * P, N, 2)
@@ -154,7 +154,7 @@ def reduce_chunk(cfg: dict, sim: dict) -> dict[str, np.ndarray]:
                 if tag == "pri":
                     out[f"{k}_sd_w_r{j}"] = sd[:, i].reshape(n, P)
     # chi-square test with a-priori weights P_x = 1/sx^2, P_cx = 1/stated^2 (closed form)
-    lo, hi = stats.chi2.ppf(alpha / 2, dof), stats.chi2.ppf(1 - alpha / 2, dof)
+    lo, hi = D.chi2_ppf(alpha / 2, dof), D.chi2_ppf(1 - alpha / 2, dof)
     for j, st in enumerate(cfg["analysis.stated_sigmas_um"]):
         s02 = sw2 / (sx ** 2 + kk * (st * UM) ** 2)
         x = dof * s02

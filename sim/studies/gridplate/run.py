@@ -6,9 +6,9 @@ from functools import partial
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
 
-from ...claims import spread, write_claims
+from ...claims import write_claims
+from ...intervals import spread
 from ...runner import chunk_rng, run_chunks
 from ...storage import provenance, write_table
 from .. import RunContext
@@ -16,6 +16,7 @@ from . import figures as F
 from .claims import beyond_table, score
 from .model import PARAMS, chunk, simulate
 from .sweep import run_sweep
+from ... import distributions as D
 
 
 def analytic_reject(cfg: dict, stated_um: float, dof: int) -> float:
@@ -24,8 +25,8 @@ def analytic_reject(cfg: dict, stated_um: float, dof: int) -> float:
     sx, st = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
     c = (sx ** 2 + st ** 2) / (sx ** 2 + stated_um ** 2)
     a = cfg["analysis.alpha"]
-    lo, hi = stats.chi2.ppf(a / 2, dof), stats.chi2.ppf(1 - a / 2, dof)
-    return float(stats.chi2.cdf(lo / c, dof) + stats.chi2.sf(hi / c, dof))
+    lo, hi = D.chi2_ppf(a / 2, dof), D.chi2_ppf(1 - a / 2, dof)
+    return float(D.chi2_cdf(lo / c, dof) + D.chi2_sf(hi / c, dof))
 
 
 def run(cfg: dict, out: Path, ctx: RunContext) -> None:
@@ -69,7 +70,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
           "hi": [], "analytic": [], "tests": []}
     for j, st in enumerate(cfg["analysis.stated_sigmas_um"]):
         x = res[f"reject_s{j}"].ravel()
-        lo, hi = stats.binomtest(int(x.sum()), x.size).proportion_ci(0.95, method="wilson")
+        lo, hi = D.wilson_ci(int(x.sum()), x.size, 0.95)
         for col, v in (("reject", x.mean()), ("lo", lo), ("hi", hi),
                        ("analytic", analytic_reject(cfg, st, dof)), ("tests", x.size)):
             ch[col].append(v)

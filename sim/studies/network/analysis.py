@@ -19,21 +19,21 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 from ... import lsq
 from ...datum import null_basis, s_matrix, s_transform
 from .definition import Network
 from .model import NetworkModel, simulate
+from ... import distributions as D
 
 __all__ = ["Analytic", "analyse", "delta0", "mc_chunk", "point_cov_in"]
 
-CHI2_2_95 = float(stats.chi2.ppf(0.95, 2))
+CHI2_2_95 = float(D.chi2_ppf(0.95, 2))
 
 
 def delta0(alpha0: float, power: float) -> float:
     """Baarda's non-centrality (as a normal shift) of the one-dimensional w-test."""
-    return float(stats.norm.ppf(1 - alpha0 / 2) + stats.norm.ppf(power))
+    return float(D.norm_ppf(1 - alpha0 / 2) + D.norm_ppf(power))
 
 
 @dataclass

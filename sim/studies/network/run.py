@@ -15,7 +15,6 @@ from functools import partial
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
 
 from ...claims import ClaimBook, write_claims
 from ...config import ConfigError, StudyError
@@ -26,6 +25,7 @@ from .definition import KINDS, Network, build
 from .figures import network_figure, reliability_figure
 from .gama import merge_gama, write_gama
 from .model import datum
+from ... import distributions as D
 
 __all__ = ["run", "compare_points"]
 
@@ -54,7 +54,7 @@ def _params(net: Network, an) -> np.ndarray:
 
 def _mc(net, an, dt, pts, cfg, ctx):
     C = dt.constraint_matrix(net.theta_true()[None])
-    crit = float(stats.chi2.ppf(1 - cfg["test.alpha"], an.dof))
+    crit = float(D.chi2_ppf(1 - cfg["test.alpha"], an.dof))
     cov_inv = np.linalg.inv(an.cov[pts])
     fn = partial(mc_chunk, net=net, free=an.free, C=None if C is None else C[0], cov_inv=cov_inv,
                  pts=np.asarray(pts), crit=crit, tol=cfg["solver.tol_mm"],

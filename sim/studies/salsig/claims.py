@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from ... import transforms2d as t2
-from ...claims import ClaimBook, mean_ci, std_ci
+from ...claims import ClaimBook
+from ...intervals import mean_ci, std_ci
 from . import printed as pr
 
 BOOK = Path(__file__).with_name("claims.toml")

@@ -16,13 +16,13 @@ Model/grid coordinates in mm, B8 readings in digits, errors in um.
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
 
 from ... import encoders as enc
 from ... import transforms2d as t2
 from ...plate import grid_points
 from .printed import FIG2, FIG2_PRINTED, FIG3, FIG3_PRINTED
 from .schema import UM
+from ... import distributions as D
 
 
 def b8_truth(cfg: dict) -> np.ndarray:
@@ -78,7 +78,7 @@ def simulate_chain(cfg: dict, rng: np.random.Generator, n: int, k_marks: int | N
     sd = np.sqrt(np.einsum("tii->ti", d3["cov"]))
     diff = d3["SX"] - d3["SY"]
     sd_diff = np.sqrt(d3["cov"][:, 0, 0] + d3["cov"][:, 1, 1] - 2 * d3["cov"][:, 0, 1])
-    zc = stats.norm.ppf(1 - cfg["analysis.alpha"] / 2)
+    zc = D.norm_ppf(1 - cfg["analysis.alpha"] / 2)
     out = {"SX": d3["SX"], "SY": d3["SY"], "E_arcsec": d3["E"] / t2.ARCSEC,
            "sd_SX": sd[:, 0], "sd_SY": sd[:, 1], "sd_E_arcsec": sd[:, 2] / t2.ARCSEC,
            "scale_diff_ppm": diff / d3["SX"] * 1e6, "sd_scale_diff_ppm": sd_diff / d3["SX"] * 1e6,

@@ -5,7 +5,6 @@ from functools import partial
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
 
 from ...claims import write_claims
 from ...runner import chunk_rng, run_chunks
@@ -15,6 +14,7 @@ from . import figures as F
 from .claims import score
 from .model import chain_chunk, decompositions, simulate_chain, simulate_zscale, vertical_chunk
 from .sweep import run_sweep
+from ... import distributions as D
 
 
 def run(cfg: dict, out: Path, ctx: RunContext) -> None:
@@ -38,7 +38,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
             sw["sigma_um"].append(s)
             for key, col in (("detect_E", "power_E"), ("detect_scale", "power_scale")):
                 x = r[key]
-                lo, hi = stats.binomtest(int(x.sum()), x.size).proportion_ci(0.95, "wilson")
+                lo, hi = D.wilson_ci(int(x.sum()), x.size, 0.95)
                 sw[col].append(float(x.mean()))
                 sw[col + "_lo"].append(lo)
                 sw[col + "_hi"].append(hi)

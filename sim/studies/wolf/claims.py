@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ...claims import ClaimBook, bootstrap_ci
+from ...claims import ClaimBook
+from ...intervals import bootstrap_ci
 from ...runner import chunk_rng
 from .tables import STATS, recomputation, summary
 
