@@ -13,8 +13,8 @@ import numpy as np
 
 from .storage import atomic_path, read_provenance, read_table
 
-__all__ = ["build_report", "claims_markdown", "fmt", "md_table", "inputs_markdown",
-           "verdict_counts", "referee_summary"]
+__all__ = ["build_report", "claims_markdown", "fmt", "md_table", "inputs_markdown", "number",
+           "consistent_rows", "verdict_counts", "referee_summary"]
 
 
 def fmt(x, digits: int = 3) -> str:
@@ -78,6 +78,25 @@ def _interval_text(r) -> str:
     if p is not None and math.isfinite(p):
         out += f", p = {fmt(p, 2)}"
     return out
+
+
+def number(x):
+    """A table cell as a number, or None where it is missing or NaN."""
+    return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
+
+
+def consistent_rows(cons: dict) -> list[list]:
+    """Rows ``[input, claim, kind, where it holds]`` of a ``consistent_set.parquet`` table
+    (one-input sweeps: the range of values where each claim, and all together, hold)."""
+    rows = []
+    for i, c in enumerate(cons["claim"]):
+        lo, hi = number(cons["holds_low"][i]), number(cons["holds_high"][i])
+        where = "nowhere" if lo is None else f"{fmt(lo)} - {fmt(hi)}"
+        if lo is not None and cons["n_holds"][i] != cons["n_values"][i]:
+            where += f" ({cons['n_holds'][i]} of {cons['n_values'][i]} values)"
+        rows.append([cons["input"][i], "**all claims**" if c == "ALL" else f"`{c}`",
+                     cons["kind"][i], where])
+    return rows
 
 
 def claims_markdown(path: Path) -> str:

@@ -2,30 +2,13 @@
 claim book only (no model code)."""
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
-from ...report import claims_markdown, fmt, inputs_markdown, md_table
+from ...report import claims_markdown, consistent_rows, fmt, inputs_markdown, md_table, number
 from ...storage import read_provenance, read_table
 from .schema import SCHEMA
 
 PARAM_LABEL = {"S": "S", "S2": "S'", "eps": "eps"}
-
-
-def _num(x):
-    return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
-
-
-def _consistent_text(cons: dict) -> list[list]:
-    rows = []
-    for i, c in enumerate(cons["claim"]):
-        lo, hi = _num(cons["holds_low"][i]), _num(cons["holds_high"][i])
-        where = ("nowhere" if lo is None else f"{fmt(lo)} - {fmt(hi)}"
-                 + ("" if cons["n_holds"][i] == cons["n_values"][i] or lo is None else
-                    f" ({cons['n_holds'][i]} of {cons['n_values'][i]} values)"))
-        rows.append([cons["input"][i],
-                     "**all claims**" if c == "ALL" else f"`{c}`", cons["kind"][i], where])
-    return rows
 
 
 def report(out: Path) -> str:
@@ -45,7 +28,7 @@ def report(out: Path) -> str:
     cons = read_table(out / "consistent_set.parquet").to_pydict()
     k = cfg["plate.grid"]
     errata = [r for r in c.values() if r["verdict"] == "erratum"]
-    alls = {cons["input"][i]: (_num(cons["holds_low"][i]), _num(cons["holds_high"][i]))
+    alls = {cons["input"][i]: (number(cons["holds_low"][i]), number(cons["holds_high"][i]))
             for i in range(len(cons["claim"])) if cons["claim"][i] == "ALL"}
     txt = [
         f"Simulated calibrations of a comparator with {cfg['plate.count']} grid plates of "
@@ -85,7 +68,7 @@ def report(out: Path) -> str:
         "is not contradicted there (holds or inconclusive). Paper-checks do not depend on the "
         "simulation and are left out of the consistent set (*all claims*).",
         "",
-        md_table(["input", "claim", "kind", "not contradicted for"], _consistent_text(cons)),
+        md_table(["input", "claim", "kind", "not contradicted for"], consistent_rows(cons)),
         "",
         "Consistent sets: " + "; ".join(
             f"`{kk}` " + ("none: the claims conflict" if lo is None else f"{fmt(lo)} - {fmt(hi)}")

@@ -1,28 +1,11 @@
 """Report section of ``salsig_encoders``: from the study's Parquet files and claim book only."""
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
-from ...report import claims_markdown, fmt, inputs_markdown, md_table
+from ...report import claims_markdown, consistent_rows, fmt, inputs_markdown, md_table, number
 from ...storage import read_provenance, read_table
 from .schema import SCHEMA
-
-
-def _num(x):
-    return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
-
-
-def consistent_rows(cons: dict) -> list[list]:
-    rows = []
-    for i, c in enumerate(cons["claim"]):
-        lo, hi = _num(cons["holds_low"][i]), _num(cons["holds_high"][i])
-        where = "nowhere" if lo is None else f"{fmt(lo)} - {fmt(hi)}"
-        if lo is not None and cons["n_holds"][i] != cons["n_values"][i]:
-            where += f" ({cons['n_holds'][i]} of {cons['n_values'][i]} values)"
-        rows.append([cons["input"][i], "**all claims**" if c == "ALL" else f"`{c}`",
-                     cons["kind"][i], where])
-    return rows
 
 
 def report(out: Path) -> str:
@@ -33,7 +16,7 @@ def report(out: Path) -> str:
     sw = read_table(out / "power.parquet").to_pydict()
     cons = read_table(out / "consistent_set.parquet").to_pydict()
     errata = [r for r in c.values() if r["verdict"] == "erratum"]
-    alls = [(cons["input"][i], _num(cons["holds_low"][i]), _num(cons["holds_high"][i]))
+    alls = [(cons["input"][i], number(cons["holds_low"][i]), number(cons["holds_high"][i]))
             for i in range(len(cons["claim"])) if cons["claim"][i] == "ALL"]
     txt = [
         "**Conventions.** Salsig's program prints the affine `X1 = A X2 + B Y2 + C`, "
