@@ -1,5 +1,5 @@
-"""Every study through the runner: 1 and 2 workers, and a run killed with SIGKILL then started
-again, give the same files (issue 12).
+"""Every study through the runner: 1 worker, 2 workers on a Dask LocalCluster, and a run on 2
+local workers killed with SIGKILL then started again, give the same files (issue 12).
 
 Each study provides ``tests/data/tiny/<study>.txt``: one ``KEY=VALUE`` override per line for a
 run of a few seconds with at least two chunks.
@@ -32,9 +32,9 @@ def overrides(study: str) -> list[str]:
 FILES = {"network": "network_testfield"}
 
 
-def command(study: str, out: Path, workers: int) -> list[str]:
+def command(study: str, out: Path, workers: int, *extra: str) -> list[str]:
     return [sys.executable, "-m", "sim", "run", str(ROOT / "studies" / f"{FILES.get(study, study)}.toml"),
-            "--out", str(out), "--quiet", "--workers", str(workers), *overrides(study)]
+            "--out", str(out), "--quiet", "--workers", str(workers), *extra, *overrides(study)]
 
 
 def same_table(a: Path, b: Path) -> bool:
@@ -95,7 +95,14 @@ def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path):
             break
         time.sleep(0.05)
     p.wait(timeout=60)
+    assert p.returncode == -signal.SIGKILL, "the run finished before it could be killed"
+    assert not two.exists() and list(stage.rglob("chunk-*.parquet"))   # killed mid-run
     r = subprocess.run(command(study, two, 2), cwd=ROOT, capture_output=True, text=True,
                        timeout=300)
     assert r.returncode == 0, r.stderr
     same_files(one, two)
+    dsk = tmp_path / "dask"
+    r = subprocess.run(command(study, dsk, 2, "--executor", "dask"), cwd=ROOT,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    same_files(one, dsk)
