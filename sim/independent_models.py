@@ -30,13 +30,11 @@ eliminated: the reduced normals of the model parameters have one 7 x 7 block per
 models that share a point, assembled from the list of such pairs with sparse scatter
 matrices, so the work grows with the number of pairs, not with the square of the block.
 Small blocks solve them by a Cholesky factorisation batched over trials; from
-``SPARSE_FROM_MODELS`` models up as sparse matrices, one block at a time, so a block of
+``SPARSE_FROM_MODELS`` models up the models are reordered to a narrow band and eliminated
+block by block, still batched over trials (:mod:`sim.lsq.group_solve`), so a block of
 hundreds of models costs little more than its number of model pairs.
 
-**Data snooping** (:func:`snoop`): Baarda's w-test on each residual component with the
-a-priori variance of unit weight (weights ``1 / sigma^2``), ``w = v / sqrt(q_vv)``, or
-Pope's tau-test with the a-posteriori one; the pass point with the largest ``|w|`` above
-the critical value is removed and the block re-adjusted until none exceeds it.
+**Data snooping**: :mod:`sim.data_snooping`.
 
 Units: metres for ground and model coordinates; image coordinates in mm, errors in um.
 """
@@ -51,8 +49,8 @@ from .geometry import rotation, similarity_fit
 from .lsq.groups import chol_solve
 
 __all__ = ["rodrigues", "form_models", "random_similarities",
-           "to_model_frame", "BlockStructure", "AdjustResult", "adjust_block", "snoop",
-           "residual_cofactors", "normal_step", "chol_solve", "pointing_errors",
+           "to_model_frame", "BlockStructure", "AdjustResult", "adjust_block",
+           "normal_step", "chol_solve", "pointing_errors",
            "initial_values", "point_cofactors", "SPARSE_FROM_MODELS"]
 
 
@@ -186,7 +184,7 @@ def initial_values(st: "BlockStructure", xm: np.ndarray, X_approx: np.ndarray):
 
 
 # ------------------------------------------------------------------- the adjustment
-#: above this many models the reduced normals are solved as sparse matrices
+#: from this many models up the reduced normals are solved by the banded elimination
 SPARSE_FROM_MODELS = 60
 
 
@@ -231,10 +229,12 @@ class SimilarityModel:
         y = s[:, om, None] * np.einsum("tkij,tkj->tki", R[:, om], self.xm - self.c[:, om])
         e = y + t[:, om] - X[:, op]
         T, K = y.shape[:2]
-        J = np.empty((T, K, 3, 7))
+        J = np.zeros((T, K, 3, 7))
         J[..., 0] = y
-        J[..., 1:4] = -_skew(y)
-        J[..., 4:7] = np.eye(3)
+        J[..., 0, 2], J[..., 0, 3] = y[..., 2], -y[..., 1]    # -skew(y): d(R y) / dtheta
+        J[..., 1, 1], J[..., 1, 3] = -y[..., 2], y[..., 0]
+        J[..., 2, 1], J[..., 2, 2] = y[..., 1], -y[..., 0]
+        J[..., [0, 1, 2], [4, 5, 6]] = 1.0
         C = st.ctrl_point.size
         return lsq.GroupLinearization(-e, np.broadcast_to(-np.eye(3), (T, K, 3, 3)), J, self.w,
                                       self.ctrl - X[:, st.ctrl_point],
@@ -292,7 +292,8 @@ class AdjustResult:
     adjusted minus observed); v_ctrl (T, C, 3) control residuals (adjusted minus given);
     sigma0 (T,) a-posteriori standard error of unit weight; dof (T,); iterations (the most
     any trial used); converged (T,) bool; status (T,) the engine's status codes; engine: the
-    :class:`sim.lsq.Result` (its cofactors serve :func:`residual_cofactors`); J (T, K, 3, 7)
+    :class:`sim.lsq.Result` (its cofactors serve
+    :func:`sim.data_snooping.residual_cofactors`); J (T, K, 3, 7)
     the Jacobian of the model points w.r.t. the corrections (``keep_normals``).
     """
 
@@ -351,56 +352,3 @@ def point_cofactors(st: BlockStructure, res: AdjustResult) -> np.ndarray:
     """Diagonal cofactors of the adjusted points ``(T, P, 3)``; times the variance of unit
     weight they are the variances of the ground coordinates."""
     return np.einsum("tpii->tpi", res.engine.point_cofactors())
-
-
-def residual_cofactors(st: BlockStructure, res: AdjustResult, w_obs: np.ndarray) -> np.ndarray:
-    """Diagonal of the residual cofactor matrix ``Q_vv = W^-1 - A Q_xx A^T`` of the model
-    points, ``(T, K, 3)`` (:meth:`sim.lsq.groups.GroupCofactors.residuals`, with the weights
-    of the adjustment; ``w_obs`` must be those). Removed observations (weight 0) get NaN."""
-    eng = res.engine
-    return eng.cofactors().residuals(eng.model.linearize(eng.points, eng.theta))
-
-
-def snoop(st: BlockStructure, xm, w_obs, ctrl_xyz, w_ctrl, s0, R0, t0, X0, candidates: np.ndarray,
-          crit: float, max_reject: int = 30, a_posteriori: bool = False):
-    """Iterative data snooping (Baarda's w-test) on the points flagged in ``candidates``.
-
-    Weights must be ``1 / sigma^2`` (a-priori variance of unit weight 1). At each round
-    the candidate point with the largest ``|w| = |v| / (sigma0 sqrt(q_vv))`` over its
-    observation components is removed (all its model observations) when ``|w| > crit``; the
-    block is re-adjusted and tested again. ``sigma0`` is 1 (Baarda's w-test) or, with
-    ``a_posteriori``, the block's own estimate (Pope's tau-test). Only trials that still
-    reject are re-adjusted. Returns ``(rejected (T, P) bool, sigma0 (T,), w_max (T,),
-    rounds (T,))`` with ``w_max`` the largest remaining ``|w|`` of a candidate.
-    """
-    T, K = xm.shape[:2]
-    w = np.array(np.broadcast_to(w_obs, (T, K, 3)), float)
-    ctrl_xyz = np.broadcast_to(ctrl_xyz, (T,) + np.shape(ctrl_xyz)[-2:])
-    rejected = np.zeros((T, st.n_points), bool)
-    cand_obs = np.asarray(candidates)[st.obs_point]
-    s, R, t, X = (np.array(a, float) for a in (s0, R0, t0, X0))
-    sigma0 = np.ones(T)
-    wmax = np.zeros(T)
-    rounds = np.zeros(T, np.int32)
-    act = np.arange(T)
-    for _ in range(max_reject + 1):
-        res = adjust_block(st, xm[act], w[act], ctrl_xyz[act], w_ctrl, s[act], R[act], t[act],
-                           X[act], keep_normals=True)
-        s[act], R[act], t[act], X[act] = res.s, res.R, res.t, res.X
-        sigma0[act] = res.sigma0
-        q = residual_cofactors(st, res, w[act])
-        s0 = res.sigma0[:, None, None] if a_posteriori else 1.0
-        ok = (w[act] > 0) & (q > 1e-9 / np.maximum(w[act], 1e-300)) & cand_obs[None, :, None]
-        wt = np.where(ok, np.abs(res.v_obs) / (s0 * np.sqrt(np.where(ok, q, 1.0))), 0.0)
-        wk = wt.max(-1)                                        # (n_act, K)
-        kbest = wk.argmax(1)
-        wmax[act] = wk[np.arange(act.size), kbest]
-        flag = wmax[act] > crit
-        if not flag.any() or rounds.max() >= max_reject:
-            break
-        hit = act[flag]
-        rejected[hit, st.obs_point[kbest[flag]]] = True
-        rounds[hit] += 1
-        w[hit] = np.where(rejected[hit][:, st.obs_point, None], 0.0, w[hit])
-        act = hit
-    return rejected, sigma0, wmax, rounds

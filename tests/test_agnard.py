@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from sim import data_snooping as ds
 from sim import independent_models as im
 from sim.geometry import similarity_fit
 from sim import scanner as sc
@@ -179,7 +180,7 @@ def test_residual_cofactors_equal_dense(small):
     wc = np.full((C, 3), 25.0)
     res = im.adjust_block(st, xm, w, np.broadcast_to(small.points[ctrl], (T, C, 3)), wc, s0, R0,
                           t0, X0, keep_normals=True)
-    q = im.residual_cofactors(st, res, w)
+    q = ds.residual_cofactors(st, res, w)
     J = res.J
     A = np.zeros((T, 3 * K + 3 * C, 7 * M + 3 * P))
     for k in range(K):
@@ -261,7 +262,7 @@ def test_snooping_finds_a_planted_blunder(small):
     st = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points)
     s0, R0, t0, X0 = _start(b, st, xm, rng, T)
     w = np.array([1 / sxy ** 2, 1 / sxy ** 2, 1 / sz ** 2])
-    rej, _, wmax, rounds = im.snoop(st, xm, w, np.broadcast_to(b.points[ctrl], (T, ctrl.size, 3)),
+    rej, _, wmax, rounds = ds.snoop(st, xm, w, np.broadcast_to(b.points[ctrl], (T, ctrl.size, 3)),
                                       np.full((ctrl.size, 3), 1e4), s0, R0, t0, X0, b.is_pass,
                                       crit=3.29, max_reject=10)
     assert rej[:, b.obs_point[k_bad]].all() and (rounds >= 1).all()

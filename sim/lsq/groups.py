@@ -11,13 +11,19 @@ Normal equations per trial, point blocks eliminated (Schur complement)::
 
     Nbar[g1, g2] = delta Ngg[g1] - sum_{k1, k2 on one point j} Npg_k1' Npp_j^-1 Npg_k2
 
-so the reduced normals have one ``b x b`` block per pair of groups sharing a point; they are
-assembled from the list of such pairs with sparse scatter matrices (work grows with the
-pairs, not with the square of the block). Small blocks are solved densely, batched over
-trials (Cholesky of the matrix scaled to unit diagonal, after the one scaled singularity rule
-of :mod:`sim.lsq.normals`); from ``sparse_from`` groups up each trial's matrix is factorised
-as a sparse matrix (one factorisation per trial: there the rule is replaced by a finite
-solution check, an eigenvalue bound being dearer than the solve). A point block whose
+so the reduced normals have one ``b x b`` block per pair of groups sharing a point. Each
+block is one matrix product over the stacked observation pairs it sums (pairs bucketed by
+their number, so one batched product per bucket; work grows with the pairs, not with the
+square of the block). Point Jacobians that are one constant diagonal matrix (coordinates
+observed directly) make the point blocks diagonal and their elimination elementwise. Small
+blocks are solved densely, batched over trials (Cholesky of the matrix scaled to unit
+diagonal, after the one scaled singularity rule of :mod:`sim.lsq.normals`); from
+``sparse_from`` groups up the groups are reordered to a narrow band and eliminated block by
+block, still batched (:mod:`sim.lsq.group_solve`; there the rule is replaced by a finite
+solution check, an eigenvalue bound being dearer than the solve). Cofactors need only the
+group-pair blocks of the inverse: per observation ``H_k`` (see :class:`GroupCofactors`),
+one batched product per bucket of points with the same number of observations, and
+optionally only for the points asked for. A point block whose
 normal matrix is exactly zero (every observation of the point removed) is absent: its
 unknowns are not corrected and do not count. Units: those of the model.
 """
@@ -28,7 +34,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from .normals import RCOND, scaled_rcond
+from .group_solve import (band_order, band_solve, chol_solve, chol_subst, dense, factor,
+                          inv_points, regular, regular_points, scaled)
+from .normals import RCOND
 
 __all__ = ["GroupStructure", "GroupLinearization", "chol_solve", "step", "cofactors"]
 
@@ -48,12 +56,25 @@ def scatter(S: sparse.csr_matrix, data: np.ndarray) -> np.ndarray:
     return np.moveaxis(out, 0, 1)
 
 
+def _buckets(keys: np.ndarray, n: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Items grouped by ``keys`` (in ``range(n)``) and bucketed by how many share a key:
+    ``[(ids (n_c,), items (n_c, c)), ...]`` -- one batched product per bucket (structure
+    only, built once)."""
+    order = np.argsort(keys, kind="stable")
+    counts = np.bincount(keys, minlength=n)
+    starts = np.cumsum(counts) - counts
+    return [(ids, order[starts[ids][:, None] + np.arange(c)])
+            for c in np.unique(counts[counts > 0]) for ids in [np.flatnonzero(counts == c)]]
+
+
 class GroupStructure:
     """Which group observes which point, and the scatter operators derived from it once.
 
     obs_group, obs_point : (K,); point_rows : (C,) points of the point-only rows; n_groups,
-    n_points; sparse_from : groups from which the reduced normals are solved sparsely.
-    ``pk1, pk2`` are all ordered pairs of observations of the same point.
+    n_points; sparse_from : groups from which the reduced normals are solved by the banded
+    elimination. ``pk1, pk2`` are all ordered pairs of observations of the same point;
+    ``gp_buckets`` the observation pairs summed into each group pair, ``group_buckets`` the
+    observations of each group and ``point_buckets`` those of each point, bucketed by count.
     """
 
     def __init__(self, obs_group, obs_point, point_rows, n_groups: int, n_points: int,
@@ -63,14 +84,12 @@ class GroupStructure:
         self.obs_group, self.obs_point = og, op
         self.point_rows = np.asarray(point_rows, np.intp)
         self.n_groups, self.n_points, self.sparse_from = n_groups, n_points, sparse_from
-        order = np.argsort(op, kind="stable")
-        starts = np.searchsorted(op[order], np.arange(n_points))
-        ends = np.searchsorted(op[order], np.arange(n_points), side="right")
+        self.point_buckets = _buckets(op, n_points)
         k1, k2 = [], []
-        for a, b in zip(starts, ends):  # structure only, once per block
-            idx = order[a:b]
-            k1.append(np.repeat(idx, idx.size))
-            k2.append(np.tile(idx, idx.size))
+        for _, items in self.point_buckets:  # structure only, once per block
+            c = items.shape[1]
+            k1.append(np.repeat(items, c, axis=1).ravel())
+            k2.append(np.tile(items, (1, c)).ravel())
         self.pk1 = np.concatenate(k1).astype(np.intp)
         self.pk2 = np.concatenate(k2).astype(np.intp)
         G = n_groups
@@ -78,10 +97,13 @@ class GroupStructure:
         self.S_point = _indicator(op, n_points)
         self.S_rows = _indicator(self.point_rows, n_points)
         gp, inv = np.unique(og[self.pk1] * G + og[self.pk2], return_inverse=True)
-        self.S_pair = _indicator(inv.ravel(), gp.size)          # observation pair -> group pair
         self.pair_g1, self.pair_g2 = gp // G, gp % G
-        self.S_pair_obs = _indicator(self.pk1, og.size)
-        self.S_pair_point = _indicator(op[self.pk1], n_points)
+        self.gp_buckets = _buckets(inv.ravel(), gp.size)
+        self.group_buckets = _buckets(og, G)
+        diag = np.flatnonzero(self.pair_g1 == self.pair_g2)
+        self.diag_of_group = np.full(G, -1, np.intp)
+        self.diag_of_group[self.pair_g1[diag]] = diag
+        self.band = band_order(self.pair_g1, self.pair_g2, G)
 
 
 @dataclass
@@ -99,38 +121,6 @@ class GroupLinearization:
     wc: np.ndarray
 
 
-def chol_solve(N: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Solve ``N x = b`` for symmetric positive-definite ``N`` ``(T, n, n)``, ``b``
-    ``(T, n, r)``, by Cholesky factorisation and substitutions vectorised over trials
-    (batched LAPACK ``gesv`` is slow here when OpenBLAS threads compete for the cores).
-    A non-positive-definite ``N`` raises ``numpy.linalg.LinAlgError``."""
-    L = np.linalg.cholesky(N)
-    n = N.shape[-1]
-    y = np.empty(b.shape)
-    for i in range(n):  # loop over the unknowns, vectorised over trials
-        y[:, i] = (b[:, i] - np.einsum("tj,tjr->tr", L[:, i, :i], y[:, :i])) / L[:, i, i, None]
-    x = np.empty(b.shape)
-    for i in range(n - 1, -1, -1):
-        x[:, i] = (y[:, i] - np.einsum("tj,tjr->tr", L[:, i + 1:, i], x[:, i + 1:])) / L[:, i, i, None]
-    return x
-
-
-def regular(Ns: np.ndarray, ok: np.ndarray, rcond: float = RCOND) -> np.ndarray:
-    """The scaled singularity rule on the unit-diagonal ``Ns`` (T, n, n), screened by a
-    Cholesky factorisation: every pivot is an upper bound of the smallest eigenvalue, so the
-    (dear) eigenvalue ratio is evaluated only for trials with a squared pivot below
-    ``sqrt(rcond)`` (or all, if the factorisation fails)."""
-    ok = ok.copy()
-    try:
-        L = np.linalg.cholesky(np.where(ok[:, None, None], Ns, np.eye(Ns.shape[-1])))
-    except np.linalg.LinAlgError:
-        return ok & (scaled_rcond(Ns) > rcond)
-    cand = ok & ((np.einsum("tii->ti", L) ** 2).min(axis=1) < np.sqrt(rcond))
-    if cand.any():
-        ok[cand] = scaled_rcond(Ns[cand]) > rcond
-    return ok
-
-
 @dataclass
 class GroupReduced:
     blocks: np.ndarray   # (T, n_pairs, b, b)
@@ -138,92 +128,95 @@ class GroupReduced:
     Ninv: np.ndarray     # (T, P, d, d), zero for absent points
     up: np.ndarray       # (T, P, d)
     Npg: np.ndarray      # (T, K, d, b)
+    NinvK: np.ndarray    # (T, K, d, b) = Ninv_j Npg_k
     ok: np.ndarray       # (T,)
 
 
-def reduce(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND) -> GroupReduced:
-    """Normal equations with the point blocks eliminated (pair blocks of the groups)."""
+def _tn(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """``A' B`` over the last two axes of stacks of small matrices."""
+    return np.swapaxes(A, -1, -2) @ B
+
+
+def _const_diag(J: np.ndarray) -> np.ndarray | None:
+    """The diagonal ``(d,)`` when ``J`` (T, n, d, d) is one constant diagonal matrix
+    broadcast over trials and rows (coordinates observed directly), else None."""
+    if J.ndim != 4 or J.shape[-1] != J.shape[-2] or J.strides[:2] != (0, 0):
+        return None
+    J0 = J[0, 0]
+    dg = np.diag(J0).copy()
+    return dg if np.array_equal(J0, np.diag(dg)) else None
+
+
+def _point_blocks(st: GroupStructure, lin: GroupLinearization, rcond: float):
+    """``(Ninv, up, Npg, NinvK, ok)`` of the point blocks; with constant diagonal point
+    Jacobians (:func:`_const_diag`) the blocks are diagonal and everything is elementwise."""
+    jp, jc = _const_diag(lin.Jp), _const_diag(lin.Jc)
+    if jp is not None and jc is not None and (jp != 0).all():
+        wp, wc = lin.w * jp, lin.wc * jc
+        npp = scatter(st.S_point, wp * jp) + scatter(st.S_rows, wc * jc)   # (T, P, d)
+        up = scatter(st.S_point, wp * lin.r) + scatter(st.S_rows, wc * lin.rc)
+        absent = ~np.any(npp != 0, axis=-1)
+        use = (npp > 0).all(-1) & np.isfinite(npp).all(-1)    # scaled: the identity
+        ok = (use | absent).all(axis=1)
+        ninv = np.where(use[..., None], 1.0 / np.where(use[..., None], npp, 1.0), 0.0)
+        Ninv = ninv[..., :, None] * np.eye(npp.shape[-1])
+        Npg = wp[..., None] * lin.Jg                                      # (T, K, d, b)
+        return Ninv, up, Npg, ninv[:, st.obs_point, :, None] * Npg, ok
     WJp = lin.w[..., None] * lin.Jp
     WJc = lin.wc[..., None] * lin.Jc
-    Npp = (scatter(st.S_point, np.swapaxes(WJp, -1, -2) @ lin.Jp)
-           + scatter(st.S_rows, np.swapaxes(WJc, -1, -2) @ lin.Jc))       # (T, P, d, d)
+    Npp = scatter(st.S_point, _tn(WJp, lin.Jp)) + scatter(st.S_rows, _tn(WJc, lin.Jc))
     up = (scatter(st.S_point, np.einsum("tkmi,tkm->tki", WJp, lin.r))
           + scatter(st.S_rows, np.einsum("tkmi,tkm->tki", WJc, lin.rc)))
-    d = Npp.shape[-1]
     absent = ~np.any(Npp != 0, axis=(-1, -2))
-    good = (scaled_rcond(Npp) > rcond) | absent
-    ok = good.all(axis=1)
-    Ninv = np.linalg.inv(np.where((good & ~absent)[..., None, None], Npp, np.eye(d)))
-    Ninv = np.where((good & ~absent)[..., None, None], Ninv, 0.0)
-    Npg = np.swapaxes(WJp, -1, -2) @ lin.Jg                             # (T, K, d, b)
-    Ngg = scatter(st.S_group, np.swapaxes(lin.w[..., None] * lin.Jg, -1, -2) @ lin.Jg)
+    good = regular_points(Npp, rcond) | absent
+    Ninv = inv_points(Npp, good & ~absent)
+    Npg = _tn(WJp, lin.Jg)                                              # (T, K, d, b)
+    return Ninv, up, Npg, Ninv[:, st.obs_point] @ Npg, good.all(axis=1)
+
+
+def reduce(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND) -> GroupReduced:
+    """Normal equations with the point blocks eliminated (pair blocks of the groups): one
+    batched product per bucket of group pairs with the same number of shared points."""
+    Ninv, up, Npg, NinvK, ok = _point_blocks(st, lin, rcond)
+    T, K, m, b = lin.Jg.shape
+    d = Npg.shape[2]
+    blocks = np.empty((T, st.pair_g1.size, b, b))
+    for ids, items in st.gp_buckets:
+        n, c = items.shape
+        X = Npg[:, st.pk1[items]].reshape(T, n, c * d, b)
+        Y = NinvK[:, st.pk2[items]].reshape(T, n, c * d, b)
+        blocks[:, ids] = -_tn(X, Y)
+    WJg = lin.w[..., None] * lin.Jg
+    for ids, items in st.group_buckets:
+        n, c = items.shape
+        X = WJg[:, items].reshape(T, n, c * m, b)
+        Y = lin.Jg[:, items].reshape(T, n, c * m, b)
+        blocks[:, st.diag_of_group[ids]] += _tn(X, Y)
     ug = scatter(st.S_group, np.einsum("tkmi,tkm->tki", lin.Jg, lin.w * lin.r))
-    NinvK = Ninv[:, st.obs_point] @ Npg                                  # (T, K, d, b)
-    C = np.swapaxes(Npg[:, st.pk1], -1, -2) @ NinvK[:, st.pk2]          # (T, pairs, b, b)
-    blocks = -scatter(st.S_pair, C)
-    diag = st.pair_g1 == st.pair_g2
-    blocks[:, diag] += Ngg[:, st.pair_g1[diag]]
     ubar = ug - scatter(st.S_group, np.einsum("tkib,tki->tkb", NinvK, up[:, st.obs_point]))
-    return GroupReduced(blocks, ubar, Ninv, up, Npg, ok)
-
-
-def dense(st: GroupStructure, blocks: np.ndarray) -> np.ndarray:
-    """The reduced normal matrix ``(T, G b, G b)`` from its pair blocks."""
-    T, G, b = blocks.shape[0], st.n_groups, blocks.shape[-1]
-    N = np.zeros((T, G, G, b, b))
-    N[:, st.pair_g1, st.pair_g2] = blocks
-    return N.transpose(0, 1, 3, 2, 4).reshape(T, G * b, G * b)
-
-
-def _sparse_solve(st: GroupStructure, blocks: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """One sparse LU per trial (each trial a whole block of about 9 non-zero blocks per
-    group): far less than the dense ``(G b)^3`` once ``G`` reaches a few hundred."""
-    from scipy.sparse.linalg import spsolve
-
-    b = blocks.shape[-1]
-    n = st.n_groups * b
-    i = np.arange(b)
-    shape = (st.pair_g1.size, b, b)
-    rows = np.broadcast_to(b * st.pair_g1[:, None, None] + i[None, :, None], shape).ravel()
-    cols = np.broadcast_to(b * st.pair_g2[:, None, None] + i[None, None, :], shape).ravel()
-    out = np.empty(rhs.shape)
-    for t in range(blocks.shape[0]):  # one sparse factorisation per simulated block
-        out[t] = spsolve(sparse.csc_matrix((blocks[t].ravel(), (rows, cols)), shape=(n, n)),
-                         rhs[t])
-    return out
+    return GroupReduced(blocks, ubar, Ninv, up, Npg, NinvK, ok)
 
 
 def solve(st: GroupStructure, red: GroupReduced, solver: str = "auto",
           rcond: float = RCOND, check: bool = True):
     """Group corrections ``dg`` (T, G, b) and ``ok`` (T,); singular trials get zeros.
 
-    ``check``: apply the scaled singularity rule (:func:`regular`; the loop applies it at the
+    ``check``: apply the scaled singularity rule (:func:`~sim.lsq.group_solve.regular`; the loop applies it at the
     first linearisation, where rank defects of the geometry show, and again whenever a
-    factorisation fails)."""
+    factorisation fails). ``sparse`` (from ``sparse_from`` groups up): the banded
+    elimination of :func:`~sim.lsq.group_solve.band_solve`, where a failed factorisation or a non-finite
+    solution flags the trial."""
     T, G, b = red.ubar.shape
     rhs = red.ubar.reshape(T, G * b)
     if solver == "auto":
         solver = "sparse" if G >= st.sparse_from else "dense"
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         if solver == "sparse":
-            dg = _sparse_solve(st, red.blocks, rhs)
-            ok = np.isfinite(dg).all(axis=1)
+            dg, ok = band_solve(st, red.blocks, rhs)
         else:
-            N = dense(st, red.blocks)
-            dgn = np.abs(np.einsum("tii->ti", N))
-            s = np.where(dgn > 0, 1.0 / np.sqrt(dgn), 1.0)
-            Ns = N * s[:, :, None] * s[:, None, :]
-            ok = np.isfinite(Ns).all(axis=(1, 2))
-            if check:
-                ok = regular(Ns, ok, rcond)
-            try:
-                y = chol_solve(np.where(ok[:, None, None], Ns, np.eye(G * b)),
-                               (rhs * s)[..., None])
-            except np.linalg.LinAlgError:  # a diverging trial: find it by the rule
-                ok &= scaled_rcond(Ns) > rcond
-                y = chol_solve(np.where(ok[:, None, None], Ns, np.eye(G * b)),
-                               (rhs * s)[..., None])
-            dg = y[..., 0] * s
+            Ns, s = scaled(dense(st, red.blocks))
+            L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)), rcond, check)
+            dg = chol_subst(L, (rhs * s)[..., None])[..., 0] * s
     ok &= red.ok
     return np.where(ok[:, None], dg, 0.0).reshape(T, G, b), ok
 
@@ -245,36 +238,72 @@ def step(st: GroupStructure, lin: GroupLinearization, solver: str = "auto",
 @dataclass
 class GroupCofactors:
     """Cofactors at one linearisation point: ``Q`` (T, G, G, b, b) of the groups, the reduced
-    pieces, and accessors for the point blocks and the observation residuals."""
+    pieces, and accessors for the point blocks and the observation residuals.
+
+    With ``F_k = Npp_j^-1 Npg_k`` and ``H_k = sum_{k2 on point j} Q[g_k, g_k2] F_k2'``
+    (b x d): ``Q(g_k, p_j) = -H_k`` and ``Q(p_j) = Npp_j^-1 + sum_{k on j} F_k H_k``."""
 
     Q: np.ndarray
     red: GroupReduced
     st: GroupStructure
+    _H: np.ndarray | None = None
 
-    def _cross(self):
-        st, Q, Npg = self.st, self.Q, self.red.Npg
+    def _h(self, points: np.ndarray | None = None) -> np.ndarray:
+        """``H_k`` (T, K, b, d) for the observations of ``points`` (bool (P,); None: all;
+        NaN elsewhere): one batched product per bucket of points with the same number of
+        observations."""
+        st, Q, F = self.st, self.Q, self.red.NinvK
+        T, K, d, b = F.shape
+        H = np.empty((T, K, b, d)) if points is None else np.full((T, K, b, d), np.nan)
         og = st.obs_group
-        return np.einsum("tpab,tpcb->tpac", Q[:, og[st.pk1], og[st.pk2]], Npg[:, st.pk2])
+        for ids, items in st.point_buckets:
+            if points is not None:
+                items = items[points[ids]]
+            n, c = items.shape
+            if n == 0:
+                continue
+            g = og[items]
+            Qj = Q[:, g[:, :, None], g[:, None, :]]                     # (T, n, c, c, b, b)
+            Qj = Qj.transpose(0, 1, 2, 4, 3, 5).reshape(T, n, c * b, c * b)
+            Fj = np.swapaxes(F[:, items], -1, -2).reshape(T, n, c * b, d)
+            H[:, items] = (Qj @ Fj).reshape(T, n, c, b, d)
+        return H
+
+    @property
+    def H(self) -> np.ndarray:
+        """``H_k`` (T, K, b, d) of every observation (computed once)."""
+        if self._H is None:
+            self._H = self._h()
+        return self._H
 
     @property
     def points(self) -> np.ndarray:
         """Point cofactor blocks ``Ninv + Ninv (sum Npg_k1 Q Npg_k2') Ninv`` (T, P, d, d)."""
-        st, Ninv = self.st, self.red.Ninv
-        inner = np.einsum("tpib,tpbc->tpic", self.red.Npg[:, st.pk1], self._cross())
-        return Ninv + Ninv @ scatter(st.S_pair_point, inner) @ Ninv
+        return self.red.Ninv + scatter(self.st.S_point, self.red.NinvK @ self.H)
 
-    def residuals(self, lin: GroupLinearization) -> np.ndarray:
+    def residuals(self, lin: GroupLinearization, points: np.ndarray | None = None) -> np.ndarray:
         """Diagonal of ``Q_vv = W^-1 - A Q_xx A'`` of the observation rows (T, K, m); NaN
-        where the weight is zero."""
-        st, Ninv = self.st, self.red.Ninv
+        where the weight is zero, and, with ``points`` (bool (P,)), for the observations of
+        the other points (not computed)."""
+        st = self.st
         og, op = st.obs_group, st.obs_point
-        Qgp = -scatter(st.S_pair_obs, self._cross()) @ Ninv[:, op]      # (T, K, b, d)
-        Qgg = self.Q[:, og, og]                                         # (T, K, b, b)
-        aqa = (np.einsum("tkmb,tkbc,tkmc->tkm", lin.Jg, Qgg, lin.Jg)
-               + 2 * np.einsum("tkmb,tkbd,tkmd->tkm", lin.Jg, Qgp, lin.Jp)
-               + np.einsum("tkmd,tkde,tkme->tkm", lin.Jp, self.points[:, op], lin.Jp))
-        w = lin.w
-        return np.where(w > 0, 1.0 / np.where(w > 0, w, 1.0) - aqa, np.nan)
+        if points is None:
+            ks, H, Qpp = slice(None), self.H, self.points
+        else:
+            points = np.asarray(points, bool)
+            ks = np.flatnonzero(points[op])
+            H = self._h(points)
+            X = np.zeros(self.red.Ninv.shape[:1] + H.shape[1:2] + self.red.Ninv.shape[2:])
+            X[:, ks] = self.red.NinvK[:, ks] @ H[:, ks]
+            Qpp = self.red.Ninv + scatter(st.S_point, X)
+        Jg, Jp, w = lin.Jg[:, ks], lin.Jp[:, ks], lin.w[:, ks]
+        Qgg = self.Q[:, og[ks], og[ks]]                                 # (T, k, b, b)
+        aqa = ((Jg @ Qgg) * Jg).sum(-1)
+        aqa -= 2 * ((Jg @ H[:, ks]) * Jp).sum(-1)
+        aqa += ((Jp @ Qpp[:, op[ks]]) * Jp).sum(-1)
+        out = np.full(lin.w.shape, np.nan)
+        out[:, ks] = np.where(w > 0, 1.0 / np.where(w > 0, w, 1.0) - aqa, np.nan)
+        return out
 
 
 def cofactors(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND) -> GroupCofactors:
@@ -282,12 +311,9 @@ def cofactors(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND)
     red = reduce(st, lin, rcond)
     N = dense(st, red.blocks)
     T, n = N.shape[:2]
-    dgn = np.abs(np.einsum("tii->ti", N))
-    s = np.where(dgn > 0, 1.0 / np.sqrt(dgn), 1.0)
-    Ns = N * s[:, :, None] * s[:, None, :]
-    ok = regular(Ns, np.isfinite(Ns).all(axis=(1, 2)) & red.ok, rcond)
-    Q = chol_solve(np.where(ok[:, None, None], Ns, np.eye(n)),
-                   np.broadcast_to(np.eye(n), (T, n, n)).copy())
+    Ns, s = scaled(N)
+    L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)) & red.ok, rcond, True)
+    Q = chol_subst(L, np.broadcast_to(np.eye(n), (T, n, n)).copy())
     Q = Q * s[:, :, None] * s[:, None, :]
     Q[~ok] = np.nan
     G = st.n_groups

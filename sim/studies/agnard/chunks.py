@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import independent_models as im
+from ...data_snooping import snoop
 from ...block_layout import Block
 from ... import distributions as D
 from .schema import five_control, paper_weights, snoop_weights
@@ -66,7 +66,7 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
     ctrl, st = adj.structure(cfg["control.many"])
     n_pass = int(block.is_pass.sum())
     for mode in ("digital", "mechanical"):
-        rej, s0, _, _ = im.snoop(st, sim.xm[(mode, "corrected")], ws, sim.ctrl_obs[:, ctrl],
+        rej, s0, _, _ = snoop(st, sim.xm[(mode, "corrected")], ws, sim.ctrl_obs[:, ctrl],
                                  np.broadcast_to(wsc, (ctrl.size, 3)), res21.s, res21.R,
                                  res21.t, res21.X, block.is_pass, crit,
                                  cfg["snoop.max_reject"], cfg["snoop.test"] == "tau")
@@ -105,7 +105,7 @@ def pugging_chunk(cfg: dict, block: Block, recentre_px: float, rng: np.random.Ge
     sim = Simulated(c2, block, rng, n, cfg["scan.dpi"], mechanical=True, uncorrected=False)
     ctrl, st, res0 = adj.adjust(sim, ("mechanical", "corrected"), cfg["control.many"],
                                 *paper_weights(cfg))
-    rej = im.snoop(st, sim.xm[("mechanical", "corrected")], ws, sim.ctrl_obs[:, ctrl],
+    rej = snoop(st, sim.xm[("mechanical", "corrected")], ws, sim.ctrl_obs[:, ctrl],
                    np.broadcast_to(wsc, (ctrl.size, 3)), res0.s, res0.R, res0.t, res0.X,
                    block.is_pass, crit, cfg["snoop.max_reject"], cfg["snoop.test"] == "tau")[0]
     return {"share_pct": 100.0 * rej[:, block.is_pass].sum(1) / block.is_pass.sum()}

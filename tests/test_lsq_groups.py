@@ -1,0 +1,79 @@
+"""The group-block engine (sim.lsq.groups, sim.lsq.group_solve) on a small block of
+independent models: the banded elimination equals the dense solve, cofactors restricted to
+some points equal the full ones, a non-positive-definite trial is flagged, not raised."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sim import independent_models as im
+from sim.block_layout import make_block, select_control
+from sim.lsq import group_solve as gs
+from sim.lsq import groups
+
+
+@pytest.fixture(scope="module")
+def setup():
+    b = make_block(2, 4, n_ground=50, pass_rows=3)
+    rng = np.random.default_rng(3)
+    T = 3
+    xl = b.image_coords(b.obs_left, b.obs_point)
+    xr = b.image_coords(b.obs_right, b.obs_point)
+    G = im.form_models(xl, xr, b.focal_mm, b.base_m) + b.photos.reshape(-1, 3)[b.obs_left]
+    G = G + rng.normal(0, 0.1, (T,) + G.shape)
+    s, R, t = im.random_similarities(rng, (T, b.n_models))
+    xm = im.to_model_frame(G, b.obs_model, s, R, t)
+    ctrl = select_control(b, "perimeter")
+    st = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points)
+    X0 = b.points + rng.normal(0, 2.0, (T,) + b.points.shape)
+    s0, R0, t0 = im.initial_values(st, xm, X0)
+    w = rng.uniform(0.5, 2.0, (T, b.obs_model.size, 3))
+    wc = np.full((ctrl.size, 3), 25.0)
+    cx = np.broadcast_to(b.points[ctrl], (T, ctrl.size, 3))
+    return b, st, xm, w, cx, wc, (s0, R0, t0, X0)
+
+
+def test_banded_solve_equals_dense(setup):
+    b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
+    c = np.zeros((xm.shape[0], st.n_models, 3))
+    args = (st, xm, c, s0, R0, t0, X0, w, cx, np.broadcast_to(wc, (xm.shape[0],) + wc.shape))
+    dg, dX = im.normal_step(*args, solver="dense")
+    dg2, dX2 = im.normal_step(*args, solver="sparse")
+    assert st.band[1] < st.n_groups          # the reordering gives a band narrower than G
+    assert np.allclose(dg2, dg, rtol=1e-8, atol=1e-10 * np.abs(dg).max())
+    assert np.allclose(dX2, dX, rtol=1e-8, atol=1e-10 * np.abs(dX).max())
+
+
+def test_band_solve_flags_an_indefinite_trial(setup):
+    b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
+    model = im.SimilarityModel(st, xm, np.zeros((xm.shape[0], st.n_models, 3)), w, cx, wc)
+    lin = model.linearize(X0, im._state(s0, R0, t0))
+    red = groups.reduce(st, lin)
+    blocks = red.blocks.copy()
+    blocks[1, st.diag_of_group[2]] *= -1.0   # trial 1 no longer positive definite
+    x, ok = gs.band_solve(st, blocks, red.ubar.reshape(xm.shape[0], -1))
+    assert ok.tolist() == [True, False, True]
+    x0, _ = gs.band_solve(st, red.blocks, red.ubar.reshape(xm.shape[0], -1))
+    assert np.allclose(x[[0, 2]], x0[[0, 2]])
+
+
+def test_residual_cofactors_of_some_points_equal_all(setup):
+    b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
+    model = im.SimilarityModel(st, xm, np.zeros((xm.shape[0], st.n_models, 3)), w, cx, wc)
+    lin = model.linearize(X0, im._state(s0, R0, t0))
+    cof = groups.cofactors(st, lin)
+    q = cof.residuals(lin)
+    sub = cof.residuals(lin, b.is_pass)
+    k = b.is_pass[b.obs_point]
+    assert np.allclose(sub[:, k], q[:, k], rtol=1e-12)
+    assert np.isnan(sub[:, ~k]).all()
+
+
+def test_chol_subst_blocks_match_numpy():
+    rng = np.random.default_rng(2)
+    a = rng.normal(size=(3, 45, 45))
+    N = a @ a.transpose(0, 2, 1) + 45 * np.eye(45)
+    rhs = rng.normal(size=(3, 45, 4))
+    for block in (1, 7, 32, 64):
+        x = gs.chol_subst(np.linalg.cholesky(N), rhs, block)
+        assert np.allclose(x, np.linalg.solve(N, rhs), rtol=1e-10, atol=1e-12)
