@@ -39,7 +39,7 @@ def test_banded_solve_equals_dense(setup):
     args = (st, xm, c, s0, R0, t0, X0, w, cx, np.broadcast_to(wc, (xm.shape[0],) + wc.shape))
     dg, dX = im.normal_step(*args, solver="dense")
     dg2, dX2 = im.normal_step(*args, solver="sparse")
-    assert st.band[1] < st.n_groups          # the reordering gives a band narrower than G
+    assert st.band.width < st.n_groups          # the reordering gives a band narrower than G
     assert np.allclose(dg2, dg, rtol=1e-8, atol=1e-10 * np.abs(dg).max())
     assert np.allclose(dX2, dX, rtol=1e-8, atol=1e-10 * np.abs(dX).max())
 

@@ -11,27 +11,49 @@ reduced normals of the models); Brown 1968 (``004_f5bd9e86c308241f.txt``) for th
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy import sparse
 
 from .normals import RCOND, scaled_rcond
 
-__all__ = ["band_order", "chol_factor", "chol_subst", "chol_solve", "regular", "factor",
+__all__ = ["Band", "band_order", "chol_factor", "chol_subst", "chol_solve", "regular", "factor",
            "inv_points", "regular_points", "dense", "scaled", "band_solve"]
 
 
-def band_order(pair_g1: np.ndarray, pair_g2: np.ndarray, G: int):
+@dataclass
+class Band:
+    """Block-tridiagonal layout of the reduced normals (structure only, built once): groups
+    at positions ``pos`` (reverse Cuthill-McKee), ``nblk`` blocks of ``width`` groups (the
+    last padded with ``pad`` identity groups); ``diag`` and ``sub`` the pair blocks that fall
+    in the diagonal and sub-diagonal blocks, as ``(pairs, block, row, col)``."""
+
+    perm: np.ndarray
+    pos: np.ndarray
+    width: int
+    nblk: int
+    pad: int
+    diag: tuple
+    sub: tuple
+
+
+def band_order(pair_g1: np.ndarray, pair_g2: np.ndarray, G: int) -> Band:
     """Groups reordered (reverse Cuthill-McKee on the groups sharing a point) and the block
-    size, in groups, at which the reordered reduced normals are block tridiagonal (structure
-    only, built once). ``(perm, width)``."""
+    size, in groups, at which the reordered reduced normals are block tridiagonal."""
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
     A = sparse.csr_matrix((np.ones(pair_g1.size), (pair_g1, pair_g2)), shape=(G, G))
     perm = np.asarray(reverse_cuthill_mckee(A, symmetric_mode=True), np.intp)
     pos = np.empty(G, np.intp)
     pos[perm] = np.arange(G)
-    width = int(np.abs(pos[pair_g1] - pos[pair_g2]).max(initial=0))
-    return perm, max(width, 1)
+    p1, p2 = pos[pair_g1], pos[pair_g2]
+    w = max(int(np.abs(p1 - p2).max(initial=0)), 1)
+    nblk = -(-G // w)
+    b1, b2 = p1 // w, p2 // w
+    d, s = np.flatnonzero(b1 == b2), np.flatnonzero(b1 == b2 + 1)
+    return Band(perm, pos, w, nblk, nblk * w - G, (d, b1[d], p1[d] % w, p2[d] % w),
+                (s, b2[s], p1[s] % w, p2[s] % w))
 
 
 def chol_factor(N: np.ndarray) -> np.ndarray:
@@ -40,10 +62,11 @@ def chol_factor(N: np.ndarray) -> np.ndarray:
     return np.linalg.cholesky(N)
 
 
-def chol_subst(L: np.ndarray, b: np.ndarray, block: int = 32) -> np.ndarray:
+def chol_subst(L: np.ndarray, b: np.ndarray, block: int | None = None) -> np.ndarray:
     """Solve ``L L' x = b`` (``b`` (T, n, r)) by blocked forward and back substitution,
     batched over trials (one matrix product per block of ``block`` unknowns)."""
     n = L.shape[-1]
+    block = block or (8 if b.shape[-1] < 8 else 16)
     cuts = list(range(0, n, block)) + [n]
     inv = [np.linalg.inv(L[:, a:e, a:e]) for a, e in zip(cuts[:-1], cuts[1:])]
     y = np.empty(b.shape)
@@ -139,68 +162,80 @@ def regular_points(Npp: np.ndarray, rcond: float) -> np.ndarray:
     return good
 
 
-def dense(st, blocks: np.ndarray, perm: np.ndarray | None = None) -> np.ndarray:
-    """The reduced normal matrix ``(T, G b, G b)`` from its pair blocks (groups in the order
-    ``perm``, if given)."""
+def dense(st, blocks: np.ndarray) -> np.ndarray:
+    """The reduced normal matrix ``(T, G b, G b)`` from its pair blocks."""
     T, G, b = blocks.shape[0], st.n_groups, blocks.shape[-1]
-    N = np.zeros((T, G, G, b, b))
-    if perm is None:
-        N[:, st.pair_g1, st.pair_g2] = blocks
-    else:
-        pos = np.empty(G, np.intp)
-        pos[perm] = np.arange(G)
-        N[:, pos[st.pair_g1], pos[st.pair_g2]] = blocks
-    return N.transpose(0, 1, 3, 2, 4).reshape(T, G * b, G * b)
+    N = np.zeros((T, G, b, G, b))
+    N[:, st.pair_g1, :, st.pair_g2, :] = np.moveaxis(blocks, 0, 1)
+    return N.reshape(T, G * b, G * b)
 
 
 def scaled(N: np.ndarray):
+    """``N`` scaled to unit diagonal (in place) and the scale ``s`` (T, n)."""
     dgn = np.abs(np.einsum("tii->ti", N))
     s = np.where(dgn > 0, 1.0 / np.sqrt(dgn), 1.0)
-    return N * s[:, :, None] * s[:, None, :], s
+    N *= s[:, :, None]
+    N *= s[:, None, :]
+    return N, s
 
 
 def band_solve(st, blocks: np.ndarray, rhs: np.ndarray):
-    """Solve the reduced normals of a large block batched over trials: groups reordered by
-    :func:`band_order`, the matrix scaled to unit diagonal is block tridiagonal in blocks of
-    ``width`` groups and is factorised block by block (Cholesky), with block substitutions.
-    Returns ``(x (T, G b), ok (T,))``; a trial whose factorisation fails is flagged."""
-    perm, width = st.band
-    T, G, b = rhs.shape[0], st.n_groups, blocks.shape[-1]
-    Ns, s = scaled(dense(st, blocks, perm))
-    y = (rhs.reshape(T, G, b)[:, perm].reshape(T, G * b) * s)[..., None]
-    ok = np.isfinite(Ns).all(axis=(1, 2)) & np.isfinite(y).all(axis=(1, 2))
-    Ns = np.where(ok[:, None, None], Ns, np.eye(G * b))
-    y = np.where(ok[:, None, None], y, 0.0)
-    B = width * b
-    cuts = list(range(0, G * b, B)) + [G * b]
-    Ls, Ms = [], []    # diagonal factors, sub-diagonal blocks L_{i+1,i}
-    prev = None
-    for i, (a, e) in enumerate(zip(cuts[:-1], cuts[1:])):
-        A = Ns[:, a:e, a:e]
-        if prev is not None:
-            A = A - prev @ np.swapaxes(prev, -1, -2)
+    """Solve the reduced normals of a large block batched over trials: the matrix, in the
+    group order of :func:`band_order` and scaled to unit diagonal, is assembled as its
+    diagonal and sub-diagonal blocks of ``width`` groups only and factorised block by block
+    (Cholesky), with block substitutions. Returns ``(x (T, G b), ok (T,))``; a trial whose
+    factorisation fails or whose solution is not finite is flagged."""
+    bd = st.band
+    T, b = rhs.shape[0], blocks.shape[-1]
+    w, nb = bd.width, bd.nblk
+    B = w * b
+    D = np.zeros((T, nb, w, w, b, b))
+    pr, k, r, c = bd.diag
+    D[:, k, r, c] = blocks[:, pr]
+    for o in range(w - bd.pad, w):
+        D[:, -1, o, o] = np.eye(b)
+    E = np.zeros((T, nb - 1, w, w, b, b))
+    pr, k, r, c = bd.sub
+    E[:, k, r, c] = blocks[:, pr]
+    D = D.transpose(0, 1, 2, 4, 3, 5).reshape(T, nb, B, B)
+    E = E.transpose(0, 1, 2, 4, 3, 5).reshape(T, nb - 1, B, B)
+    y = np.zeros((T, nb * w, b))
+    y[:, bd.pos] = rhs.reshape(T, -1, b)
+    y = y.reshape(T, nb, B)
+    dgn = np.abs(np.einsum("tkii->tki", D))
+    s = np.where(dgn > 0, 1.0 / np.sqrt(dgn), 1.0)
+    D = D * s[..., :, None] * s[..., None, :]
+    E = E * s[:, 1:, :, None] * s[:, :-1, None, :]
+    y = y * s
+    ok = (np.isfinite(D).all(axis=(1, 2, 3)) & np.isfinite(E).all(axis=(1, 2, 3))
+          & np.isfinite(y).all(axis=(1, 2)))
+    D = np.where(ok[:, None, None, None], D, np.eye(B))
+    E = np.where(ok[:, None, None, None], E, 0.0)
+    y = np.where(ok[:, None, None], y, 0.0)[..., None]
+    Ls, Ms = [], []    # inverse diagonal factors, sub-diagonal blocks L_{i+1,i}
+    for i in range(nb):
+        A = D[:, i] - Ms[-1] @ np.swapaxes(Ms[-1], -1, -2) if i else D[:, i]
         try:
             L = np.linalg.cholesky(A)
         except np.linalg.LinAlgError:  # a diverging trial: flag it, go on with the others
-            bad = np.array([np.linalg.eigvalsh(A[t]).min() <= 0 for t in range(T)])
+            bad = np.zeros(T, bool)
+            for t in range(T):  # the rare failure only: locate the trial
+                try:
+                    np.linalg.cholesky(A[t])
+                except np.linalg.LinAlgError:
+                    bad[t] = True
             ok &= ~bad
-            L = np.linalg.cholesky(np.where(bad[:, None, None], np.eye(e - a), A))
-        Li = np.linalg.inv(L)
-        Ls.append(Li)
-        if e < G * b:
-            e2 = cuts[i + 2]
-            prev = Ns[:, e:e2, a:e] @ np.swapaxes(Li, -1, -2)
-            Ms.append(prev)
+            L = np.linalg.cholesky(np.where(bad[:, None, None], np.eye(B), A))
+        Ls.append(np.linalg.inv(L))
+        if i < nb - 1:
+            Ms.append(E[:, i] @ np.swapaxes(Ls[-1], -1, -2))
     z = []
-    for i, Li in enumerate(Ls):
-        a, e = cuts[i], cuts[i + 1]
-        r = y[:, a:e] - Ms[i - 1] @ z[-1] if i else y[:, a:e]
-        z.append(Li @ r)
-    x = [None] * len(Ls)
-    for i in range(len(Ls) - 1, -1, -1):
-        r = z[i] - np.swapaxes(Ms[i], -1, -2) @ x[i + 1] if i < len(Ls) - 1 else z[i]
+    for i in range(nb):
+        z.append(Ls[i] @ (y[:, i] - Ms[i - 1] @ z[-1] if i else y[:, i]))
+    x = [None] * nb
+    for i in range(nb - 1, -1, -1):
+        r = z[i] - np.swapaxes(Ms[i], -1, -2) @ x[i + 1] if i < nb - 1 else z[i]
         x[i] = np.swapaxes(Ls[i], -1, -2) @ r
-    xs = np.concatenate(x, axis=1)[..., 0] * s
-    out = np.empty_like(xs)
-    out.reshape(T, G, b)[:, perm] = xs.reshape(T, G, b)
+    xs = (np.stack(x, 1)[..., 0] * s).reshape(T, nb * w, b)
+    out = xs[:, bd.pos].reshape(T, -1)
     return out, ok & np.isfinite(out).all(axis=1)

@@ -192,8 +192,8 @@ def reduce(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND) ->
         X = WJg[:, items].reshape(T, n, c * m, b)
         Y = lin.Jg[:, items].reshape(T, n, c * m, b)
         blocks[:, st.diag_of_group[ids]] += _tn(X, Y)
-    ug = scatter(st.S_group, np.einsum("tkmi,tkm->tki", lin.Jg, lin.w * lin.r))
-    ubar = ug - scatter(st.S_group, np.einsum("tkib,tki->tkb", NinvK, up[:, st.obs_point]))
+    v = (lin.Jg * (lin.w * lin.r)[..., None]).sum(2) - (NinvK * up[:, st.obs_point, :, None]).sum(2)
+    ubar = scatter(st.S_group, v)
     return GroupReduced(blocks, ubar, Ninv, up, Npg, NinvK, ok)
 
 
@@ -223,7 +223,7 @@ def solve(st: GroupStructure, red: GroupReduced, solver: str = "auto",
 
 def points_step(st: GroupStructure, red: GroupReduced, dg: np.ndarray) -> np.ndarray:
     """Point corrections ``Npp^-1 (up - sum_k Npg_k dg_k)`` (T, P, d)."""
-    u = red.up - scatter(st.S_point, np.einsum("tkib,tkb->tki", red.Npg, dg[:, st.obs_group]))
+    u = red.up - scatter(st.S_point, (red.Npg * dg[:, st.obs_group, None, :]).sum(-1))
     return (red.Ninv @ u[..., None])[..., 0]
 
 
