@@ -51,11 +51,13 @@ verify: $(STAMP) ## re-run every study into a scratch directory and compare with
 report: $(STAMP) ## rebuild results/REPORT.md from the Parquet files alone
 	$(PY) -m sim report --results results
 
-results/bench/bench.parquet: sim/bench.py sim/multilateration.py | $(STAMP)
-	$(PY) -m sim.bench --out results/bench
+# BENCH_FLAGS: e.g. "--quick" (a smoke run: small sizes, tiny study configurations),
+# "--no-rerun" (leave out the make rerun rows), "--only engines"; see python -m sim.bench -h
+BENCH_FLAGS ?=
+BENCH_OUT ?= results/bench
 
-bench: $(STAMP) ## time the batched solver against a scipy loop (results/bench/)
-	$(PY) -m sim.bench --out results/bench
+bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/; BENCH_FLAGS=--quick: smoke)
+	$(PY) -m sim.bench --out $(BENCH_OUT) $(BENCH_FLAGS)
 
 clean: ## remove the virtual environment and caches (results/ is kept)
 	rm -rf $(VENV) .pytest_cache sim.egg-info

@@ -18,12 +18,19 @@ import json
 from functools import lru_cache
 from pathlib import Path
 
-__all__ = ["study_modules", "study_files", "study_code_hash", "is_current"]
+__all__ = ["study_modules", "study_files", "study_code_hash", "is_current", "not_study_code"]
 
 ROOT = Path(__file__).resolve().parent           # .../sim
-#: library files that no study result depends on (the benchmark; the verification, which the
-#: report imports for its reproducibility section only)
-NOT_STUDY_CODE = ("bench.py", "verify.py")
+#: library files and packages (paths relative to ``sim/``) that no study result depends on (the
+#: benchmark package; the verification, which the report imports for its reproducibility
+#: section only)
+NOT_STUDY_CODE = ("bench", "verify.py")
+
+
+def not_study_code(rel: str) -> bool:
+    """True for a path relative to ``sim/`` (``bench/cli.py``) that :data:`NOT_STUDY_CODE`
+    names or lies inside."""
+    return any(rel == x or rel.startswith(x + "/") for x in NOT_STUDY_CODE)
 
 
 def _module_file(name: str) -> Path | None:
@@ -75,7 +82,7 @@ def study_modules(module: str) -> tuple[Path, ...]:
         parts = name.split(".")
         for k in range(1, len(parts) + 1):  # a module imports its parent packages
             f = _module_file(".".join(parts[:k]))
-            if f is None or f in seen or f.name in NOT_STUDY_CODE:
+            if f is None or f in seen or not_study_code(f.relative_to(ROOT).as_posix()):
                 continue
             seen[f] = None
             todo.extend(_imports(f))

@@ -24,7 +24,7 @@ __all__ = ["provenance", "write_table", "read_table", "read_provenance", "atomic
            "read_record", "StageLock", "NonFiniteError"]
 
 _KEY = b"sim.provenance"
-from .codehash import NOT_STUDY_CODE  # library files no study result depends on
+from .codehash import NOT_STUDY_CODE, not_study_code  # code no study result depends on
 
 
 @lru_cache(maxsize=None)
@@ -67,7 +67,7 @@ def code_hash(study: str | None = None) -> str:
     root = Path(__file__).resolve().parent
     h = hashlib.sha256()
     for f in sorted(root.rglob("*.py")):
-        if f.relative_to(root).as_posix() in NOT_STUDY_CODE:
+        if not_study_code(f.relative_to(root).as_posix()):
             continue
         h.update(str(f.relative_to(root)).encode())
         h.update(f.read_bytes())

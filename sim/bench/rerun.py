@@ -1,0 +1,77 @@
+"""Rerun rows of the benchmark (``rerun.parquet``): the wall time of ``make rerun``.
+
+Every study file is run the way ``make rerun`` runs it, one after the other, each in a fresh
+process: ``python -m sim run <file> --out <dir>/<name> --overwrite --workers N --quiet``,
+then ``python -m sim report`` over the results (``make rerun``'s last step), for ``N`` = 1 and
+2 workers. The results go to a scratch directory (``results/`` is never touched) that is
+removed afterwards. One row per study and worker count (``study`` = the file's name, or
+``report``), and a ``total`` row per worker count with the 90 s target of issue 12
+(``target_s``; NaN on the other rows). Wall clock, so the machine must be quiet.
+"""
+from __future__ import annotations
+
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["TARGET_S", "rerun_rows", "study_files"]
+
+#: issue 12: ``make rerun`` under 90 s on a 2-core machine with ``--workers 2``
+TARGET_S = 90.0
+
+
+def study_files(pattern: str = "studies/*.toml") -> list[Path]:
+    """The study files ``make rerun`` runs (its ``$(wildcard studies/*.toml)``), sorted."""
+    p = Path(pattern)
+    files = sorted(Path(p.parent).glob(p.name)) if p.parent.is_dir() else []
+    if not files:
+        raise FileNotFoundError(f"bench --rerun-files: no study file matches {pattern}")
+    return files
+
+
+def _wall(cmd: list[str], what: str) -> float:
+    t = time.perf_counter()
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - t
+    if done.returncode != 0:
+        last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+        raise RuntimeError(f"bench: {what} failed (exit {done.returncode}): {last}")
+    return wall
+
+
+def rerun_rows(files: list[Path], workers=(1, 2), extra=None) -> dict[str, list]:
+    """The columns of ``rerun.parquet``: ``study``, ``workers``, ``wall_s``, ``target_s``,
+    ``within_target`` (true/false on the total rows, false elsewhere). ``extra`` maps a study
+    file's name (stem) to more arguments of its ``sim run`` (e.g. ``--set trials=...`` for a
+    smoke run)."""
+    extra = extra or {}
+    rows: dict[str, list] = {c: [] for c in ("study", "workers", "wall_s", "target_s",
+                                             "within_target")}
+
+    def add(study, n, wall, target=np.nan):
+        rows["study"].append(study)
+        rows["workers"].append(n)
+        rows["wall_s"].append(wall)
+        rows["target_s"].append(target)
+        rows["within_target"].append(bool(wall < target))
+
+    py = [sys.executable, "-m", "sim"]
+    with tempfile.TemporaryDirectory(prefix="sim-bench-rerun-") as tmp:
+        for n in workers:
+            res = Path(tmp) / f"workers{n}"
+            walls = []
+            for f in files:
+                walls.append(_wall([*py, "run", str(f), "--out", str(res / f.stem), "--overwrite",
+                                    "--workers", str(n), "--quiet", *extra.get(f.stem, ())],
+                                   f"sim run {f}"))
+                add(f.stem, n, walls[-1])
+                print(f"{f.stem:>22} workers={n} {walls[-1]:7.1f} s")
+            walls.append(_wall([*py, "report", "--results", str(res)], "sim report"))
+            add("report", n, walls[-1])
+            add("total", n, float(sum(walls)), TARGET_S)
+            print(f"{'make rerun':>22} workers={n} {sum(walls):7.1f} s (target {TARGET_S:.0f} s)")
+    return rows
