@@ -88,8 +88,8 @@ def _pivot_fn():
 
 def executors(trials: int, chunk: int) -> list[tuple[str, int, float]]:
     """Trials per second of the streaming pivot case for each executor."""
-    from .runner import make_executor, run_chunks
-    from .studies import RunContext
+    from ..runner import make_executor, run_chunks
+    from ..studies import RunContext
 
     rows = []
     for kind, workers in (("local", 1), ("local", 2), ("dask", 2)):
@@ -113,8 +113,8 @@ def million(out: Path, trials: int, chunk: int) -> None:
     """Child process: stream ``trials`` pivot trials through the chunk store."""
     import shutil
 
-    from .runner import ChunkStore, run_chunks
-    from .studies import RunContext
+    from ..runner import ChunkStore, run_chunks
+    from ..studies import RunContext
 
     store_dir = out / "million_trials.tmp"
     shutil.rmtree(store_dir, ignore_errors=True)

@@ -13,8 +13,8 @@ The Gauss-Newton cases are here (the linear ones in :mod:`sim.bench.engines_line
   2 strips x 3 models, 40 ground points, full control; compared on the ground points (m).
 
 The SciPy side is ``scipy.optimize.least_squares`` (``trf``, tolerances near machine
-precision), with the analytic Jacobian where the module exposes one and finite differences on
-the Jacobian's sparsity pattern otherwise. It is timed on a few trials and scaled to the
+precision), with the analytic Jacobian where the module exposes one (``pposition``) and finite
+differences otherwise (on the Jacobian's sparsity pattern for the block). It is timed on a few trials and scaled to the
 engine's count. Before anything is timed both sides solve the same trials and must agree to
 the case's tolerance (:class:`Case`); a disagreement stops the benchmark.
 """
@@ -111,8 +111,8 @@ def _pposition(T: int, seed: int = 3):
         return np.sqrt(2 * f.cost / (6 * n - 2 * n - q + 3))
 
     return Case(25, engine, one, TOL_PPOSITION, "mm (sigma0)", _LSQ + ", analytic Jacobian",
-                "every trial is a small sparse problem (75 unknowns) that least_squares "
-                "solves with few iterations of compiled LAPACK")
+                "every trial is a small problem that least_squares solves in few iterations of "
+                "compiled LAPACK")
 
 
 def _gridplate(T: int, seed: int = 4):
