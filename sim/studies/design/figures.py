@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
+from ...figure_jobs import draw_figures
 from ...plotting import plt, save
 from ... import distributions as D
 from .cells import pareto_front
@@ -252,19 +253,24 @@ def fig_consistent(sv, cs, path):
     save(fig, path)
 
 
-def all_figures(cfg, out, cols, bcols, dcols, ccols, samples, bay, tcols, tsamples, sv, cs):
+def all_figures(cfg, out, cols, bcols, dcols, ccols, samples, bay, tcols, tsamples, sv, cs,
+                executor=None):
+    """Every figure of the study, on the run's idle workers when there are some
+    (:func:`sim.figure_jobs.draw_figures`), the dearest first."""
     from ... import multilateration as ml
     jp = int(np.flatnonzero(cols["paper_design"])[0])
     same_n = (np.array(cols["feasible"])
               & np.isclose(np.array(cols["setting_sigma_um"]), cols["setting_sigma_um"][jp])
               & (np.array(cols["n_points"]) == cols["n_points"][jp])
               & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp]))
-    fig_pareto(cols, out / "pareto.png", same_n)
-    fig_budget(bcols, out / "budget.png",
-               float(load_book().spec("brown.results.zeiss_comparator_um")["ref"]))
-    fig_datum(cfg, dcols, out / "datum.png")
-    fig_coverage(ccols, out / "coverage.png")
-    fig_corner(samples, bay["theta_ls"], bay["Q"], ml.PARAM_NAMES, out / "corner.png")
+    jobs = [(fig_consistent, (sv, cs, out / "consistent_set.png")),
+            (fig_corner, (samples, bay["theta_ls"], bay["Q"], ml.PARAM_NAMES,
+                          out / "corner.png")),
+            (fig_coverage, (ccols, out / "coverage.png"))]
     if tcols is not None:
-        fig_twoplate(tcols, tsamples, out / "twoplate_ratio.png")
-    fig_consistent(sv, cs, out / "consistent_set.png")
+        jobs.append((fig_twoplate, (tcols, tsamples, out / "twoplate_ratio.png")))
+    jobs += [(fig_pareto, (cols, out / "pareto.png", same_n)),
+             (fig_datum, (cfg, dcols, out / "datum.png")),
+             (fig_budget, (bcols, out / "budget.png",
+                           float(load_book().spec("brown.results.zeiss_comparator_um")["ref"])))]
+    draw_figures(jobs, executor)

@@ -171,4 +171,4 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_table(out / "sweep_values.parquet", sv, prov)
     write_claims(out / "claims.parquet", rows, prov_t, book)
     figures.all_figures(cfg, out, cols, bcols, dcols, ccols, samples, R["bayes"], tcols,
-                        tsamples, sv, cs)
+                        tsamples, sv, cs, ctx.executor)

@@ -9,6 +9,7 @@ import matplotlib.colors
 import matplotlib.ticker
 import numpy as np
 
+from ...figure_jobs import draw_figures
 from ...plotting import plt, save
 from ...storage import read_table
 from .model import ls_map
@@ -32,7 +33,16 @@ def _quiver(ax, x, y, dx, dy, title, key_um=20.0, um_per_mm=_UM_PER_MM):
     ax.set_ylabel("y (mm)")
 
 
-def figures(cfg: dict, out: Path) -> None:
+def figures(cfg: dict, out: Path, executor=None) -> None:
+    """Every figure of the study from its Parquet files, on the run's idle workers when
+    there are some (:func:`sim.figure_jobs.draw_figures`), the dearest first."""
+    draw_figures([(consistent_figure, (out,)), (components_figure, (out,)),
+                  (vectors_figure, (out,)), (stability_figure, (cfg, out)),
+                  (degree_figure, (out,)), (readings_figure, (out,)),
+                  (table1_figure, (out,))], executor)
+
+
+def vectors_figure(out: Path) -> None:
     v = read_table(out / "vectors.parquet").to_pydict()
     v = {k: np.asarray(a) for k, a in v.items()}
     sets = np.unique(v["set"])
@@ -50,6 +60,8 @@ def figures(cfg: dict, out: Path) -> None:
                  "Figure 2)", fontsize=10)
     save(fig, out / "vectors.png")
 
+
+def components_figure(out: Path) -> None:
     c = read_table(out / "components.parquet").to_pydict()
     c = {k: np.asarray(a) for k, a in c.items()}
     names = list(dict.fromkeys(c["component"]))
@@ -78,6 +90,8 @@ def figures(cfg: dict, out: Path) -> None:
                  "each panel has its own arrow scale", fontsize=10)
     save(fig, out / "components.png")
 
+
+def degree_figure(out: Path) -> None:
     d = read_table(out / "degree.parquet").to_pydict()
     d = {k: np.asarray(a) for k, a in d.items()}
     sps = list(dict.fromkeys(d["spacing_mm"]))
@@ -100,6 +114,8 @@ def figures(cfg: dict, out: Path) -> None:
     axs[0, 0].legend(fontsize=8)
     save(fig, out / "degree.png")
 
+
+def readings_figure(out: Path) -> None:
     r = read_table(out / "readings.parquet").to_pydict()
     r = {k: np.asarray(a) for k, a in r.items()}
     fig, axs = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
@@ -120,6 +136,8 @@ def figures(cfg: dict, out: Path) -> None:
     axs[0].legend(fontsize=7)
     save(fig, out / "readings.png")
 
+
+def stability_figure(cfg: dict, out: Path) -> None:
     s = read_table(out / "stability.parquet").to_pydict()
     s = {k: np.asarray(a) for k, a in s.items()}
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
@@ -136,6 +154,8 @@ def figures(cfg: dict, out: Path) -> None:
     ax.legend(fontsize=7)
     save(fig, out / "stability.png")
 
+
+def table1_figure(out: Path) -> None:
     t = read_table(out / "table1_real.parquet").to_pydict()
     t = {k: np.asarray(a) for k, a in t.items()}
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -146,7 +166,6 @@ def figures(cfg: dict, out: Path) -> None:
         for x, y, p in zip(t["x_set1_mm"][m], t["y_set1_mm"][m], t["point"][m]):
             ax.annotate(str(p), (x, y), textcoords="offset points", xytext=(3, -8), fontsize=7)
     save(fig, out / "table1_real.png")
-    consistent_figure(out)
 
 
 #: the per-trial statistics drawn against each swept input, with the claim prefix of their

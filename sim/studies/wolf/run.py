@@ -98,7 +98,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_table(out / "table1_real.parquet", t1, prov)
     write_table(out / "table3_real.parquet", t3, prov)
     write_claims(out / "claims.parquet", cl.rows(cfg, main, t1, t3, degt, book), prov, book)
-    figures.figures(cfg, out)
+    figures.figures(cfg, out, ctx.executor)
 
 
 def _vectors_and_components(cfg, out, prov):

@@ -1,0 +1,39 @@
+"""Draw a study's figures side by side on the run's workers.
+
+A study's figures are independent of each other and are drawn after its chunks are done, when
+the workers of a local process pool (``--workers N``) or of a local Dask cluster sit idle.
+:func:`draw_figures` sends each figure job there; without a pool (``--workers 1``, a remote
+Dask scheduler that may not see the output directory) it draws them in this process, in the
+given order. A job is ``(fn, args)`` with ``fn`` a module-level function (picklable) that
+draws one figure and saves it (:func:`sim.plotting.save`); the files are the same either way.
+"""
+from __future__ import annotations
+
+from concurrent.futures import Executor
+from typing import Callable, Sequence
+
+__all__ = ["draw_figures"]
+
+
+def _submitter(executor) -> Callable | None:
+    pool = getattr(executor, "pool", None)
+    if isinstance(pool, Executor):
+        return pool.submit
+    client = getattr(executor, "client", None)
+    if client is not None and getattr(executor, "cluster", None) is not None:  # local cluster
+        return lambda fn, *args: client.submit(fn, *args, pure=False)
+    return None
+
+
+def draw_figures(jobs: Sequence[tuple[Callable, tuple]], executor=None) -> None:
+    """Run every ``fn(*args)`` of ``jobs``: on the executor's local workers when it has some,
+    else here. Put the dearest figures first (the pool takes them in order). An exception in
+    a job is raised here."""
+    submit = _submitter(executor) if len(jobs) > 1 else None
+    if submit is None:
+        for fn, args in jobs:
+            fn(*args)
+        return
+    futures = [submit(fn, *args) for fn, args in jobs]
+    for f in futures:
+        f.result()
