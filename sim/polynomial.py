@@ -58,16 +58,17 @@ def design(pts: np.ndarray, terms, norm_mm: float = 100.0) -> np.ndarray:
     x, y = u[..., 0], u[..., 1]
     mx = max(i for i, _ in terms)
     my = max(j for _, j in terms)
-    px = np.empty(x.shape + (mx + 1,))
-    py = np.empty(y.shape + (my + 1,))
-    px[..., 0], py[..., 0] = 1.0, 1.0
+    px = np.empty((mx + 1,) + x.shape)    # powers first: each power a contiguous array
+    py = np.empty((my + 1,) + y.shape)
+    px[0], py[0] = 1.0, 1.0
     for i in range(mx):                   # successive products: the same numbers as x**i
-        np.multiply(px[..., i], x, out=px[..., i + 1])
+        np.multiply(px[i], x, out=px[i + 1])
     for j in range(my):
-        np.multiply(py[..., j], y, out=py[..., j + 1])
-    ix = np.array([i for i, _ in terms])
-    iy = np.array([j for _, j in terms])
-    return np.take(px, ix, axis=-1) * np.take(py, iy, axis=-1)
+        np.multiply(py[j], y, out=py[j + 1])
+    A = np.empty(x.shape + (len(terms),))
+    for c, (i, j) in enumerate(terms):    # over the p terms, not trials
+        np.multiply(px[i], py[j], out=A[..., c])
+    return A
 
 
 @dataclass(frozen=True)

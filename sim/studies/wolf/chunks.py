@@ -19,8 +19,8 @@ import numpy as np
 
 from ... import errorfields as ef
 from ... import polynomial as pl
-from .model import (Instrument, calib_dates, calibrate, correct_plate, ls_map, measure, place,
-                    photo_points, read_placed, stats_cols, true_plate)
+from .model import (Instrument, calib_dates, calibrate, correct_plate, ls_map, measure,
+                    measure_parts, place, photo_points, read_placed, stats_cols, true_plate)
 from .schema import _index, grid_nodes, mid_cells
 
 #: the config keys a cell may override, and the field-amplitude factor
@@ -68,8 +68,9 @@ def draw_main(cfg: dict, rng: np.random.Generator, T: int, nmax: int) -> dict:
             "mono_z": mono_z, "comp_rms": comp_rms}
 
 
-def reduce_main(cfg: dict, D: dict, cell: dict, full: bool = True, keep_vectors: bool = False):
-    """Read and reduce the drawn experiment ``D`` for one cell; per-trial statistics (um)."""
+def _reduce_readings(cfg: dict, D: dict, cell: dict, full: bool, keep_vectors: bool):
+    """Everything of :func:`reduce_main` but the monocomparator comparison: the statistics up
+    to the repeatability, set 1 of the photograph (um) and the fit's status (and vectors)."""
     G, Cm = D["G"], D["Cm"]
     nG, S = len(G), cfg["calib.n_sets"]
     ia, ib = _index(G, (0, 0)), _index(G, (cfg["reduce.ab_mm"], 0))
@@ -107,14 +108,31 @@ def reduce_main(cfg: dict, D: dict, cell: dict, full: bool = True, keep_vectors:
     ph = D["ph"]
     rep = [correct_plate(fit, mtp, rd(p), ph, fiducials=slice(0, 4)) for p in D["rep"]]
     stats_cols("repeat", (rep[0] - rep[1])[:, 4:], out)
-    # Table 2 analogue: set 1 against a monocomparator reading, also fitted to the fiducials
-    M = ph + cell["mono.sigma_um"] * 1e-3 * D["mono_z"]
-    mono = (ls_map("similarity", M[:, :4], ph[:, :4], M) - ph) * 1000.0
-    stats_cols("mono", (rep[0] - mono)[:, 4:], out)
-    out["fit.ok"] = fit.ok
+    tail = {"fit.ok": fit.ok}
     if keep_vectors:
-        out["vec.before"] = before.reshape(T, S, nG, 2)
-        out["vec.after"] = after.reshape(T, S, nG, 2)
+        tail["vec.before"] = before.reshape(T, S, nG, 2)
+        tail["vec.after"] = after.reshape(T, S, nG, 2)
+    return out, rep[0], tail
+
+
+def _mono(D: dict, rep0: np.ndarray, mono_sigma_um: float, out: dict) -> None:
+    """Table 2 analogue: set 1 (``rep0``, um) against a monocomparator reading, also fitted to
+    the fiducials."""
+    ph = D["ph"]
+    M = ph + mono_sigma_um * 1e-3 * D["mono_z"]
+    mono = (ls_map("similarity", M[:, :4], ph[:, :4], M) - ph) * 1000.0
+    stats_cols("mono", (rep0 - mono)[:, 4:], out)
+
+
+def reduce_main(cfg: dict, D: dict, cell: dict, full: bool = True, keep_vectors: bool = False,
+                _reduced=None):
+    """Read and reduce the drawn experiment ``D`` for one cell; per-trial statistics (um).
+    ``_reduced``: the result of :func:`_reduce_readings` for this cell, when known."""
+    out, rep0, tail = (_reduce_readings(cfg, D, cell, full, keep_vectors) if _reduced is None
+                       else _reduced)
+    out = dict(out)
+    _mono(D, rep0, cell["mono.sigma_um"], out)
+    out.update(tail)
     return out
 
 
@@ -129,9 +147,15 @@ def _main_chunk_impl(cfg, cells, full, keep_vectors, rng: np.random.Generator, T
     """Chunk function of the main experiment; ``cells`` = ((tag, ((key, value), ...)), ...)."""
     cl = [(tag, _cell(cfg, over)) for tag, over in cells]
     D = draw_main(cfg, rng, T, max(c["reading.n"] for _, c in cl))
-    out = {}
+    out, done = {}, {}
     for tag, c in cl:
-        out.update({tag + k: v for k, v in reduce_main(cfg, D, c, full, keep_vectors).items()})
+        # cells that differ only in the monocomparator sigma (or not at all) read and reduce
+        # the same numbers: once
+        key = tuple(sorted((k, v) for k, v in c.items() if k != "mono.sigma_um"))
+        if key not in done:
+            done[key] = _reduce_readings(cfg, D, c, full, keep_vectors)
+        r = reduce_main(cfg, D, c, full, keep_vectors, _reduced=done[key])
+        out.update({tag + k: v for k, v in r.items()})
     if full:
         for name, v in D["comp_rms"].items():
             out[f"component.{name}_rms_um"] = v
@@ -209,23 +233,28 @@ def _stability_chunk_impl(cfg, fractions, ages, rng_: np.random.Generator, T: in
     ia, ib = _index(G, (0, 0)), _index(G, (cfg["reduce.ab_mm"], 0))
     terms = pl.WOLF_TERMS if cfg["calib.degree"] == 3 else None
 
+    gs, m5 = cfg["plate.grid_sigma_um"], 5.0
+    # common random numbers: the same instruments, plates and readings for every drifting
+    # share f (the draws do not depend on f), read once; only their mixture depends on f
+    rng = rng_
+    inst = Instrument(cfg, rng, T, dates[order])
+    plate = true_plate(rng, G, T, gs)
+    cal = [measure_parts(rng, inst, int(rank[j]), plate, cfg["plate.rotation_sigma_deg"],
+                         cfg["plate.shift_sigma_mm"]) for j in range(S)]
+    checks = []
+    for i in range(len(ages)):
+        pk = rng.uniform([area[0] + m5, area[2] + m5], [area[1] - m5, area[3] - m5],
+                         (T, cfg["check.n_points"], 2))
+        pt = pk + rng.normal(0.0, gs * 1e-3, pk.shape)
+        checks.append((pk, measure_parts(rng, inst, int(rank[S + i]), pt,
+                                         cfg["check.rotation_sigma_deg"],
+                                         cfg["check.shift_sigma_mm"])))
     out = {}
-    state = rng_.bit_generator.state
-    for f in fractions:  # common random numbers: the same instruments for every f
-        rng = np.random.Generator(type(rng_.bit_generator)())
-        rng.bit_generator.state = state
-        inst = Instrument(cfg, rng, T, dates[order], drift_fraction=f)
-        plate = true_plate(rng, G, T, cfg["plate.grid_sigma_um"])
-        counts = [measure(rng, inst, int(rank[j]), plate, cfg["plate.rotation_sigma_deg"],
-                          cfg["plate.shift_sigma_mm"]) for j in range(S)]
-        _, _, fit, mtp = calibrate(cfg, G, counts, ia, ib, cfg["calib.degree"], terms)
-        m5 = 5.0
-        for i, age in enumerate(ages):
-            pk = rng.uniform([area[0] + m5, area[2] + m5], [area[1] - m5, area[3] - m5],
-                             (T, cfg["check.n_points"], 2))
-            pt = pk + rng.normal(0.0, cfg["plate.grid_sigma_um"] * 1e-3, pk.shape)
-            c = measure(rng, inst, int(rank[S + i]), pt, cfg["check.rotation_sigma_deg"],
-                        cfg["check.shift_sigma_mm"])
+    for f in fractions:
+        _, _, fit, mtp = calibrate(cfg, G, [r.counts(f) for r in cal], ia, ib,
+                                   cfg["calib.degree"], terms)
+        for i, (pk, r) in enumerate(checks):
+            c = r.counts(f)
             for tag, use in (("before", False), ("after", True)):
                 d = correct_plate(fit, mtp, c, pk, use_poly=use)
                 out[f"{tag}.{f}.{i}"] = np.sqrt((d ** 2).mean((1, 2)))

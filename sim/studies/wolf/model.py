@@ -95,19 +95,82 @@ def rotate(P: np.ndarray, th: np.ndarray) -> np.ndarray:
     return np.stack([c * P[..., 0] - s * P[..., 1], s * P[..., 0] + c * P[..., 1]], -1)
 
 
+def reading_noise(rng, shape: tuple, n: int, sigma_um: float, backlash_um: float,
+                  approach: str):
+    """The random part of ``n`` readings of coordinates of shape ``shape``: pointing noise and
+    backlash (um), each ``shape + (n,)`` (or a scalar)."""
+    noise = rng.normal(0.0, sigma_um, tuple(shape) + (n,)) if sigma_um > 0 else 0.0
+    if approach == "one_side":
+        bl = backlash_um / 2
+    else:
+        bl = backlash_um / 2 * rng.choice(np.array([-1.0, 1.0]), tuple(shape) + (n,))
+    return noise, bl
+
+
+def quantise(P_mm: np.ndarray, d_um: np.ndarray, noise, bl, count_um: float) -> np.ndarray:
+    """Mean of the readings (counts) rounded to whole counts: true position ``P_mm`` plus the
+    systematic displacement ``d_um``, the pointing noise and the backlash of
+    :func:`reading_noise`."""
+    true_um = (P_mm * 1000.0 + d_um)[..., None]
+    return np.round((true_um + noise + bl) / count_um).mean(axis=-1)
+
+
 def read_counts(rng, P_mm: np.ndarray, d_um: np.ndarray, count_um: float, n: int, sigma_um: float,
                 backlash_um: float, approach: str) -> np.ndarray:
     """Mean of ``n`` quantised readings (counts) of carrier positions ``P_mm (T, m, 2)`` with
     systematic displacement ``d_um``: each reading adds pointing noise and backlash and is
     rounded to whole counts."""
-    T, m, _ = P_mm.shape
-    true_um = (P_mm * 1000.0 + d_um)[..., None]
-    noise = rng.normal(0.0, sigma_um, (T, m, 2, n)) if sigma_um > 0 else 0.0
-    if approach == "one_side":
-        bl = backlash_um / 2
-    else:
-        bl = backlash_um / 2 * rng.choice(np.array([-1.0, 1.0]), (T, m, 2, n))
-    return np.round((true_um + noise + bl) / count_um).mean(axis=-1)
+    noise, bl = reading_noise(rng, P_mm.shape, n, sigma_um, backlash_um, approach)
+    return quantise(P_mm, d_um, noise, bl, count_um)
+
+
+@dataclass(frozen=True)
+class Reading:
+    """Everything random about one reading of a placed plate (see :func:`measure_parts`),
+    kept so that the same reading can be turned into counts for several drifting shares.
+
+    P : (T, m, 2) mm; static : (T, m, 2) um the static field; drift : ((weight, field), ...)
+    the weighted independent drift draws of the date (empty when not evaluated); rest :
+    (T, m, 2) um restitution field; noise, bl : pointing noise and backlash (um).
+    """
+
+    P: np.ndarray
+    static: np.ndarray
+    drift: tuple
+    rest: np.ndarray
+    noise: object
+    bl: object
+    count_um: float
+
+    def counts(self, f: float) -> np.ndarray:
+        """Averaged counts ``(T, m, 2)`` with drifting share ``f`` (the same numbers as
+        :func:`measure`)."""
+        d = math.sqrt(1 - f) * self.static
+        if f > 0:
+            for w, D in self.drift:
+                d = d + math.sqrt(f) * w * D
+        return quantise(self.P, d + self.rest, self.noise, self.bl, self.count_um)
+
+
+def measure_parts(rng, inst: Instrument, k: int, plate_true: np.ndarray, rot_sigma_deg: float,
+                  shift_sigma_mm: float, n: int | None = None, sigma_um: float | None = None,
+                  approach: str | None = None, drift: bool = True) -> Reading:
+    """Place a plate (true coordinates ``(T, m, 2)`` mm in its own system) on date ``k``, draw
+    everything random about reading it (the draws of :func:`measure`) and evaluate the
+    fields (the drifting ones only with ``drift``)."""
+    cfg, T = inst.cfg, inst.T
+    th = np.deg2rad(rot_sigma_deg) * rng.normal(size=T)
+    sh = rng.normal(0.0, shift_sigma_mm, (T, 2))
+    P = rotate(plate_true, th) + sh[:, None, :]
+    static = ef.evaluate(inst.spec, inst.static, P)
+    dr = tuple((inst.W[k, j], ef.evaluate(inst.spec, inst.drift[j], P))
+               for j in range(k + 1) if inst.W[k, j] != 0) if drift else ()
+    rest = inst.restitution(rng, P)
+    noise, bl = reading_noise(rng, P.shape, cfg["reading.n"] if n is None else n,
+                              cfg["reading.pointing_sigma_um"] if sigma_um is None else sigma_um,
+                              cfg["reading.backlash_um"],
+                              cfg["reading.approach"] if approach is None else approach)
+    return Reading(P, static, dr, rest, noise, bl, cfg["reading.count_um"])
 
 
 def measure(rng, inst: Instrument, k: int, plate_true: np.ndarray, rot_sigma_deg: float,
@@ -115,15 +178,9 @@ def measure(rng, inst: Instrument, k: int, plate_true: np.ndarray, rot_sigma_deg
             approach: str | None = None, f: float | None = None):
     """Place a plate (true coordinates ``(T, m, 2)`` mm in its own system) on date ``k`` and read
     every point: averaged counts ``(T, m, 2)``."""
-    cfg, T = inst.cfg, inst.T
-    th = np.deg2rad(rot_sigma_deg) * rng.normal(size=T)
-    sh = rng.normal(0.0, shift_sigma_mm, (T, 2))
-    P = rotate(plate_true, th) + sh[:, None, :]
-    d = inst.disp(k, P, f) + inst.restitution(rng, P)
-    return read_counts(rng, P, d, cfg["reading.count_um"], cfg["reading.n"] if n is None else n,
-                       cfg["reading.pointing_sigma_um"] if sigma_um is None else sigma_um,
-                       cfg["reading.backlash_um"], cfg["reading.approach"] if approach is None
-                       else approach)
+    f = inst.f if f is None else f
+    return measure_parts(rng, inst, k, plate_true, rot_sigma_deg, shift_sigma_mm, n, sigma_um,
+                         approach, drift=f > 0).counts(f)
 
 
 def true_plate(rng, known: np.ndarray, T: int, sigma_um: float) -> np.ndarray:
