@@ -118,3 +118,23 @@ def test_result_accessors_match_module_covariance():
     assert np.allclose(res.global_cofactor(), Qgg, rtol=1e-12)
     full = res.full_point_cofactor()
     assert np.allclose(full[:, 2:4, 2:4], Qpp[:, 1], rtol=1e-12)
+
+
+def test_screened_rule_decides_like_the_eigenvalue_ratio():
+    """The bordered solve screens the scaled rule with a norm bound: its decisions equal
+    ``scaled_rcond > rcond`` on matrices from well conditioned to singular, and its inverse
+    is the plain inverse."""
+    from sim.lsq import normals
+
+    rng = np.random.default_rng(5)
+    T, m = 400, 6
+    Q, _ = np.linalg.qr(rng.normal(size=(T, m, m)))
+    ev = np.ones((T, m))
+    ev[:, 0] = 10.0 ** rng.uniform(-14, 0, T) * rng.choice([-1.0, 1.0], T)  # indefinite too
+    M = np.einsum("tij,tj,tkj->tik", Q, ev, Q)
+    M[0, 0, 0] = np.nan
+    for rc in (1e-10, 1e-6):
+        Minv, ok = normals._screened_inverse(M, rc)
+        ref = normals.scaled_rcond(M) > rc
+        assert np.array_equal(ok, ref) and 0 < ref.sum() < T
+        np.testing.assert_array_equal(Minv[ok], np.linalg.inv(M[ok]))

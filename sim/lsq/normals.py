@@ -163,12 +163,42 @@ def _safe(M: np.ndarray, ok: np.ndarray) -> np.ndarray:
     return np.where(ok[:, None, None], M, np.eye(M.shape[-1]))
 
 
+def _screened_inverse(M: np.ndarray, rcond: float):
+    """Inverse of the symmetric ``M`` (T, m, m) and the scaled rule on it, ``ok`` (T,): the
+    same decisions as ``scaled_rcond(M) > rcond``, with the eigenvalues computed only where a
+    cheap bound cannot decide. With ``C = S M S`` the unit-diagonal matrix of the rule
+    (:func:`scaled_rcond`), ``|lambda|max(C) <= ||C||_F`` and ``1 / |lambda|min(C) <=
+    ||C^-1||_F <= ||M^-1||_F / min(s)^2``, so ``min(s)^2 / (||C||_F ||M^-1||_F)`` is a lower
+    bound of the ratio; trials whose bound is above ``4 rcond`` (a margin for the rounding of
+    the inverse) are regular. Returns ``(Minv, ok)``, ``Minv`` None when the factorisation of a
+    trial failed outright (then every trial gets the full rule). Non-finite trials are
+    singular."""
+    m = M.shape[-1]
+    fin = np.isfinite(M).all(axis=(1, 2))
+    Ms = np.where(fin[:, None, None], M, np.eye(m))
+    try:
+        Minv = np.linalg.inv(Ms)
+    except np.linalg.LinAlgError:
+        return None, scaled_rcond(M) > rcond
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        d = np.abs(np.einsum("tii->ti", Ms))
+        sc = np.where(d > 0, 1.0 / np.sqrt(d), 1.0)
+        Cs = Ms * sc[:, :, None] * sc[:, None, :]
+        lb = sc.min(axis=1) ** 2 / (np.sqrt(np.einsum("tij,tij->t", Cs, Cs))
+                                    * np.sqrt(np.einsum("tij,tij->t", Minv, Minv)))
+    ok = fin & (lb > 4.0 * rcond)
+    rest = fin & ~ok
+    if rest.any():
+        ok[rest] = scaled_rcond(M[rest]) > rcond
+    return Minv, ok
+
+
 def bordered_solve(Nbar, ubar, C=None, rcond: float = RCOND):
     """Solve ``Nbar dg = ubar`` subject to ``C' dg = 0`` (``C`` (T, p, c) or None) on the
     scaled system. Returns ``(dg (T, p), ok (T,))``; singular trials get ``dg = 0``."""
     T, p = ubar.shape
     M, s = _scaled_system(Nbar, C)
-    ok = scaled_rcond(M) > rcond
+    Minv, ok = _screened_inverse(M, rcond)
     rhs = np.zeros((T, M.shape[-1]))
     rhs[:, :p] = np.where(np.isfinite(ubar), ubar, 0.0) * s
     try:
@@ -183,7 +213,9 @@ def bordered_inverse(Nbar, C=None, rcond: float = RCOND):
     of the bordered inverse) and ``ok`` (T,); NaN for singular trials."""
     p = Nbar.shape[-1]
     M, s = _scaled_system(Nbar, C)
-    ok = scaled_rcond(M) > rcond
-    Q = np.linalg.inv(_safe(M, ok))[:, :p, :p] * s[:, :, None] * s[:, None, :]
+    Minv, ok = _screened_inverse(M, rcond)
+    if Minv is None:
+        Minv = np.linalg.inv(_safe(M, ok))
+    Q = Minv[:, :p, :p] * s[:, :, None] * s[:, None, :]
     Q[~ok] = np.nan
     return Q, ok
