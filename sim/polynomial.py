@@ -190,5 +190,8 @@ def discrepancy_stats(d: np.ndarray, axis: int = -2) -> dict[str, np.ndarray]:
     ``sqrt(mean d^2)``, ``mean |d|``. For ``d (T, n, 2)`` each is ``(T, 2)`` (x, y).
     """
     a = np.abs(np.asarray(d, float))
-    return {"max": a.max(axis=axis), "rms": np.sqrt(np.mean(a ** 2, axis=axis)),
+    if a.ndim == 3 and axis in (1, -2):   # points contiguous: reductions along the last axis
+        a = np.ascontiguousarray(a.transpose(0, 2, 1))
+        axis = -1
+    return {"max": a.max(axis=axis), "rms": np.sqrt(np.mean(a * a, axis=axis)),
             "mean": a.mean(axis=axis)}

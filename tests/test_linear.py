@@ -107,3 +107,23 @@ def test_bad_shapes_raise_value_error():
         lstsq(np.ones((4, 3)), np.ones((2, 5)))
     with pytest.raises(ValueError):
         lstsq(np.ones((4, 2)), np.ones((2, 4)), w=np.ones(3))
+
+
+def test_screened_rule_decides_like_the_eigenvalue_ratio():
+    """Per-trial designs from well conditioned to rank deficient: the screened rule of the
+    per-trial path decides like ``scaled_rcond(A'A) > rcond`` and solves like a plain inverse."""
+    from sim.lsq.normals import scaled_rcond
+
+    rng = np.random.default_rng(11)
+    T, m = 300, 12
+    x = rng.uniform(-1, 1, (T, m))
+    eps = 10.0 ** rng.uniform(-13, 0, T)                     # near-collinear third column
+    A = np.stack([np.ones((T, m)), x, x + eps[:, None] * rng.normal(size=(T, m))], -1)
+    b = rng.normal(size=(T, m))
+    for rc in (1e-10, 1e-6):
+        f = lstsq(A, b, rcond=rc)
+        ref = scaled_rcond(np.swapaxes(A, 1, 2) @ A) > rc
+        assert np.array_equal(f.ok, ref) and 0 < ref.sum() < T
+        good = ref & (eps > 1e-3)
+        xr = np.linalg.lstsq(A[good][0], b[good][0], rcond=None)[0]
+        np.testing.assert_allclose(f.x[good][0, :, 0], xr, rtol=1e-9, atol=1e-12)

@@ -184,6 +184,33 @@ def _equilibrated(Aw):
     return Aw * dinv[:, None, :], dinv[:, :, None] * np.eye(Aw.shape[2])
 
 
+def _screened_rule(N, NB, Q, cand, rcond):
+    """The scaled rule ``scaled_rcond(N) > rcond`` for the trials ``cand`` (the same
+    decisions), and ``inv(NB)`` (identity where not regular), or ``(ok, None)`` when an
+    inverse failed outright. ``N = Q^-T NB Q^-1`` (``Q`` None: ``N = NB``), so
+    ``N^-1 = Q NB^-1 Q'``; with ``C = S N S`` the unit-diagonal matrix of the rule,
+    ``1 / (||C||_F ||C^-1||_F)`` is a lower bound of its eigenvalue ratio: the eigenvalues are
+    computed only for trials whose bound is not above ``4 rcond``."""
+    p = NB.shape[-1]
+    try:
+        NBinv = np.linalg.inv(np.where(cand[:, None, None], NB, np.eye(p)))
+    except np.linalg.LinAlgError:
+        return cand & (scaled_rcond(N) > rcond), None
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        Ninv = NBinv if Q is None else np.matmul(np.matmul(Q, NBinv), np.swapaxes(Q, -1, -2))
+        d = np.abs(np.einsum("tii->ti", N))
+        sc = np.where(d > 0, 1.0 / np.sqrt(d), 1.0)
+        ss = sc[:, :, None] * sc[:, None, :]
+        C, Cinv = N * ss, Ninv / ss
+        lb = 1.0 / (np.sqrt(np.einsum("tij,tij->t", C, C))
+                    * np.sqrt(np.einsum("tij,tij->t", Cinv, Cinv)))
+    ok = cand & (lb > 4.0 * rcond)
+    rest = cand & ~ok
+    if rest.any():
+        ok[rest] = scaled_rcond(N[rest]) > rcond
+    return ok, np.where(ok[:, None, None], NBinv, np.eye(p))
+
+
 def _per_trial(A, b, w, fin_b, rcond) -> LinearFit:
     T, m, k = b.shape
     p = A.shape[2]
@@ -219,13 +246,14 @@ def _per_trial(A, b, w, fin_b, rcond) -> LinearFit:
         B, P = _equilibrated(Aw)
         NB = np.matmul(np.swapaxes(B, 1, 2), B)
         N = NB                             # the rule is invariant to the diagonal scaling
-    ok = fin & (scaled_rcond(N) > rcond) & (m >= p)
+    ok, NBinv = _screened_rule(N, NB, P if R0 is not None else None, fin & (m >= p), rcond)
     status = np.where(fin, np.where(ok, 0, 2), 3).astype(np.int8)
-    NB = np.where(ok[:, None, None], NB, np.eye(p))
-    try:
-        NBinv = np.linalg.inv(NB)
-    except np.linalg.LinAlgError:                  # exactly singular although above rcond
-        NBinv = np.linalg.pinv(NB, hermitian=True)
+    if NBinv is None:
+        NB = np.where(ok[:, None, None], NB, np.eye(p))
+        try:
+            NBinv = np.linalg.inv(NB)
+        except np.linalg.LinAlgError:              # exactly singular although above rcond
+            NBinv = np.linalg.pinv(NB, hermitian=True)
     y = np.matmul(NBinv, np.matmul(np.swapaxes(B, 1, 2), bw))
     x = np.matmul(P, y)
     return _finish(A, b, w, x, status, False, P, NBinv)

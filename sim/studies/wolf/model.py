@@ -112,7 +112,17 @@ def quantise(P_mm: np.ndarray, d_um: np.ndarray, noise, bl, count_um: float) -> 
     systematic displacement ``d_um``, the pointing noise and the backlash of
     :func:`reading_noise`."""
     true_um = (P_mm * 1000.0 + d_um)[..., None]
-    return np.round((true_um + noise + bl) / count_um).mean(axis=-1)
+    return _mean_counts(np.round((true_um + noise + bl) / count_um))
+
+
+def _mean_counts(r: np.ndarray) -> np.ndarray:
+    """Mean over the last axis (the readings) of whole counts: summed slice by slice (sums of
+    whole numbers are exact, so this is ``r.mean(-1)`` to the bit, without a reduction along
+    a short axis)."""
+    s = r[..., 0].copy()
+    for i in range(1, r.shape[-1]):  # over the readings, not trials
+        s += r[..., i]
+    return s / r.shape[-1]
 
 
 def read_counts(rng, P_mm: np.ndarray, d_um: np.ndarray, count_um: float, n: int, sigma_um: float,
@@ -278,7 +288,7 @@ def read_placed(pl_: Placed, count_um: float, n: int, sigma_um: float, backlash_
     field = math.sqrt(1 - f) * pl_.static + (math.sqrt(f) * pl_.drift if f > 0 else 0.0)
     true_um = (pl_.P * 1000.0 + field_scale * field + restitution_um * pl_.rest)[..., None]
     bl = backlash_um / 2 if approach == "one_side" else backlash_um / 2 * pl_.sign[..., :n]
-    return np.round((true_um + sigma_um * pl_.z[..., :n] + bl) / count_um).mean(axis=-1)
+    return _mean_counts(np.round((true_um + sigma_um * pl_.z[..., :n] + bl) / count_um))
 
 
 
