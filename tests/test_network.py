@@ -113,7 +113,8 @@ def test_monte_carlo_agrees_with_analytic_within_sampling_error(tmp_path):
     cov = np.array(p["coverage95"])
     assert np.all(np.abs(cov - 0.95) < 4.5 * math.sqrt(0.95 * 0.05 / n)), cov
     claims = pq.read_table(out / "claims.parquet").to_pydict()
-    assert set(claims["kind"]) == {"self-check"} and "fails" not in claims["outcome"]
+    assert set(claims["kind"]) == {"self-check", "finding"} and "fails" not in claims["outcome"]
+    assert sum(k == "self-check" for k in claims["kind"]) == 4
     assert (out / "network.png").stat().st_size > 1000 and (out / "network.xml").is_file()
 
 
@@ -239,3 +240,23 @@ def test_an_estimated_scale_adds_the_scale_defect_to_a_free_distance_network():
     with pytest.raises(ConfigError, match=r"rank defect of 4 .* \(3 constraints\)"):
         check({**free, "datum.kind": "constraints",
                "datum.constraints": [{"A.x": 1.0}, {"A.y": 1.0}, {"B.y": 1.0}]})
+
+
+def test_a_sweep_tabulates_the_design_figures_per_cell(tmp_path):
+    """A [sweep] over a network key gives, per cell, the analytic design figures; an estimated
+    scale is one more unknown, so no point sigma may shrink."""
+    study = tmp_path / "sweep.toml"
+    study.write_text((ROOT / "studies/network_testfield.toml").read_text()
+                     + '\n[sweep]\n"network.estimate_scale" = [false, true]\n')
+    r = subprocess.run([sys.executable, "-m", "sim", "run", str(study), "--out", str(tmp_path / "s"),
+                        "--quiet", "--set", "trials=200", "--set", "chunk=50"], cwd=ROOT,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    t = pq.read_table(tmp_path / "s/sweep.parquet").to_pydict()
+    assert t["network.estimate_scale"] == [False, True] and all(t["feasible"])
+    rms = t["network.design.sigma_rms_mm"]
+    assert rms[1] > rms[0] > 0
+    assert t["network.design.redundancy_min"][1] <= t["network.design.redundancy_min"][0] + 1e-12
+    _, fixed = pre(load("network_testfield"))
+    sig = np.sqrt(np.einsum("nii->ni", fixed.cov)[fixed.cov[:, 0, 0] > 0])
+    assert abs(rms[0] - np.sqrt(np.mean(sig ** 2))) < 1e-12 * rms[0]

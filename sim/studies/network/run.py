@@ -165,7 +165,12 @@ def run(cfg: dict, out: Path, ctx) -> None:
         "mc_over_analytic": [float(ratio[0][0])], "compare_fix": [", ".join(cfg["compare.fix"])],
         "held_by_datum": [", ".join(held)],
         "gama_xml": [gama]}, prov)
-    _claims(out, prov, an, ratio, cover_mean, alarm, cfg, n_tot)
+    design = {"sigma_max": (float(np.max(np.maximum(an_sig[0::2], an_sig[1::2]))),
+                            float(np.max(np.maximum(s_mc[0::2], s_mc[1::2])))),
+              "a95_max": float(np.max(K95 * a95)), "dilution_max": dil,
+              "r_min": float(an.redundancy.min()), "mdb_mm": an.mdb[~np.isin(net.kind, (1, 2))],
+              "sigma_rms": float(np.sqrt(np.mean(an_sig ** 2)))}
+    _claims(out, prov, an, ratio, cover_mean, alarm, cfg, n_tot, design)
     network_figure(net, an, pts, out / "network.png")
     reliability_figure(net, an, out / "reliability.png")
 
@@ -206,10 +211,13 @@ def _parameters(net: Network, an, sim: dict, n_ok: np.ndarray, out: Path, prov: 
     write_table(out / "parameters.parquet", cols, prov)
 
 
-def _claims(out, prov, an, ratio, cover, alarm, cfg, n_tot) -> None:
+def _claims(out, prov, an, ratio, cover, alarm, cfg, n_tot, design) -> None:
     """Self-checks, with decision zones stated a priori: Monte Carlo within 5 % of analytic,
     coverage and false-alarm rate within 2 points of their nominal values, redundancy numbers
-    summing to the degrees of freedom to 1e-6."""
+    summing to the degrees of freedom to 1e-6. Then the design figures as findings (exact,
+    analytic), so that a ``[sweep]`` over any key tabulates them per cell: the largest and
+    the rms point sigma, the largest 95 % semi-axis, the smallest redundancy number, the
+    largest MDB of a length observation and the largest dilution against ``compare.fix``."""
     a = cfg["test.alpha"]
     spec = [("network.mc_agreement.mean_ratio", "Monte-Carlo sigma / analytic sigma (mean over "
              "coordinates)", 1.0, 0.05),
@@ -219,13 +227,31 @@ def _claims(out, prov, an, ratio, cover, alarm, cfg, n_tot) -> None:
              f"{a:g} (no blunders)", a, 0.02),
             ("network.redundancy.sum", "redundancy numbers sum to the degrees of freedom",
              float(an.dof), 1e-6)]
-    book = ClaimBook([{"id": i, "source": "this project (analytic pre-analysis)", "paper": p,
-                       "kind": "self-check", "form": "value", "ref": r, "tol": t}
-                      for i, p, r, t in spec], [], "<network self-checks>")
+    src = "this project (analytic pre-analysis)"
+    finds = [("network.design.sigma_max_mm", "largest point sigma (x or y), mm"),
+             ("network.design.sigma_rms_mm", "rms of the point sigmas (x and y), mm"),
+             ("network.design.ellipse95_max_mm", "largest semi-axis of a 95 % ellipse, mm"),
+             ("network.design.redundancy_min", "smallest redundancy number"),
+             ("network.design.mdb_max_mm", "largest minimal detectable bias of a distance or "
+              "coordinate observation (controlled ones), mm"),
+             ("network.design.dilution_max_pct", "largest dilution against compare.fix known, %")]
+    book = ClaimBook([{"id": i, "source": src, "paper": p, "kind": "self-check", "form": "value",
+                       "ref": r, "tol": t} for i, p, r, t in spec]
+                     + [{"id": i, "source": src, "paper": p, "kind": "finding"} for i, p in finds],
+                     [], "<network self-checks>")
     note = f"{int(n_tot)} converged of {cfg['trials']} trials; jackknife CI over chunks"
     rows = [book.score(spec[0][0], ratio[0][0], (ratio[1][0], ratio[2][0]), note=note),
             book.score(spec[1][0], cover[0][0], (cover[1][0], cover[2][0]), note=note),
             book.score(spec[2][0], alarm[0][0], (alarm[1][0], alarm[2][0]), note=note),
             book.score(spec[3][0], float(an.redundancy.sum()), interval="exact",
                        note=f"{len(an.redundancy)} observations, dof {an.dof}")]
+    mdb = design["mdb_mm"][np.isfinite(design["mdb_mm"])]
+    dil = design["dilution_max"][np.isfinite(design["dilution_max"])]
+    vals = [design["sigma_max"][0], design["sigma_rms"], design["a95_max"], design["r_min"],
+            float(mdb.max()) if mdb.size else None, float(dil.max()) if dil.size else None]
+    notes = [f"analytic; Monte Carlo {design['sigma_max'][1]:.4g} mm", "analytic", "analytic",
+             "analytic", "analytic" if mdb.size else "no controlled length observation",
+             "analytic" if dil.size else "no compare.fix"]
+    rows += [book.score(i, v, interval="exact", note=nt)
+             for (i, _), v, nt in zip(finds, vals, notes)]
     write_claims(out / "claims.parquet", rows, prov, book)
