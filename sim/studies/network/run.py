@@ -228,30 +228,32 @@ def _claims(out, prov, an, ratio, cover, alarm, cfg, n_tot, design) -> None:
             ("network.redundancy.sum", "redundancy numbers sum to the degrees of freedom",
              float(an.dof), 1e-6)]
     src = "this project (analytic pre-analysis)"
-    finds = [("network.design.sigma_max_mm", "largest point sigma (x or y), mm"),
-             ("network.design.sigma_rms_mm", "rms of the point sigmas (x and y), mm"),
-             ("network.design.ellipse95_max_mm", "largest semi-axis of a 95 % ellipse, mm"),
-             ("network.design.redundancy_min", "smallest redundancy number"),
-             ("network.design.mdb_max_mm", "largest minimal detectable bias of a distance or "
-              "coordinate observation (controlled ones), mm"),
-             ("network.design.dilution_max_pct", "largest dilution against compare.fix known, %")]
+    mdb = design["mdb_mm"][np.isfinite(design["mdb_mm"])]
+    dil = design["dilution_max"][np.isfinite(design["dilution_max"])]
+    finds = [("network.design.sigma_max_mm", "largest point sigma (x or y), mm",
+              design["sigma_max"][0], f"analytic; Monte Carlo {design['sigma_max'][1]:.4g} mm"),
+             ("network.design.sigma_rms_mm", "rms of the point sigmas (x and y), mm",
+              design["sigma_rms"], "analytic"),
+             ("network.design.ellipse95_max_mm", "largest semi-axis of a 95 % ellipse, mm",
+              design["a95_max"], "analytic"),
+             ("network.design.redundancy_min", "smallest redundancy number", design["r_min"],
+              "analytic")]
+    if mdb.size:       # a network of directions and angles only has no length MDB
+        finds.append(("network.design.mdb_max_mm", "largest minimal detectable bias of a "
+                      "distance or coordinate observation (controlled ones), mm",
+                      float(mdb.max()), "analytic"))
+    if dil.size:       # only with compare.fix
+        finds.append(("network.design.dilution_max_pct", "largest dilution against "
+                      "compare.fix known, %", float(dil.max()), "analytic"))
     book = ClaimBook([{"id": i, "source": src, "paper": p, "kind": "self-check", "form": "value",
                        "ref": r, "tol": t} for i, p, r, t in spec]
-                     + [{"id": i, "source": src, "paper": p, "kind": "finding"} for i, p in finds],
-                     [], "<network self-checks>")
+                     + [{"id": f[0], "source": src, "paper": f[1], "kind": "finding"}
+                        for f in finds], [], "<network self-checks>")
     note = f"{int(n_tot)} converged of {cfg['trials']} trials; jackknife CI over chunks"
     rows = [book.score(spec[0][0], ratio[0][0], (ratio[1][0], ratio[2][0]), note=note),
             book.score(spec[1][0], cover[0][0], (cover[1][0], cover[2][0]), note=note),
             book.score(spec[2][0], alarm[0][0], (alarm[1][0], alarm[2][0]), note=note),
             book.score(spec[3][0], float(an.redundancy.sum()), interval="exact",
                        note=f"{len(an.redundancy)} observations, dof {an.dof}")]
-    mdb = design["mdb_mm"][np.isfinite(design["mdb_mm"])]
-    dil = design["dilution_max"][np.isfinite(design["dilution_max"])]
-    vals = [design["sigma_max"][0], design["sigma_rms"], design["a95_max"], design["r_min"],
-            float(mdb.max()) if mdb.size else None, float(dil.max()) if dil.size else None]
-    notes = [f"analytic; Monte Carlo {design['sigma_max'][1]:.4g} mm", "analytic", "analytic",
-             "analytic", "analytic" if mdb.size else "no controlled length observation",
-             "analytic" if dil.size else "no compare.fix"]
-    rows += [book.score(i, v, interval="exact", note=nt)
-             for (i, _), v, nt in zip(finds, vals, notes)]
+    rows += [book.score(i, v, interval="exact", note=nt) for i, _, v, nt in finds]
     write_claims(out / "claims.parquet", rows, prov, book)
