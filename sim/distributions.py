@@ -66,7 +66,7 @@ def binom_ppf(q: float, n: int, p: float) -> int:
     """Binomial quantile: the smallest ``k`` with ``P(X <= k) >= q`` (scalar arguments)."""
     k = np.arange(int(n) + 1)
     cdf = special.bdtr(k, int(n), p)
-    hit = np.flatnonzero(cdf >= q * (1 - 1e-12))
+    hit = np.flatnonzero(cdf >= q * (1 - 1e-12))  # a cdf within rounding of q reaches it
     return int(hit[0]) if hit.size else int(n)
 
 

@@ -14,7 +14,7 @@ import numpy as np
 from .storage import atomic_path, read_provenance, read_table
 
 __all__ = ["build_report", "claims_markdown", "fmt", "md_table", "inputs_markdown", "number",
-           "consistent_rows", "verdict_counts", "referee_summary"]
+           "consistent_rows", "consistent_sets_sentence", "verdict_counts", "referee_summary"]
 
 
 def fmt(x, digits: int = 3) -> str:
@@ -97,6 +97,19 @@ def consistent_rows(cons: dict) -> list[list]:
         rows.append([cons["input"][i], "**all claims**" if c == "ALL" else f"`{c}`",
                      cons["kind"][i], where])
     return rows
+
+
+def consistent_sets_sentence(cons: dict) -> str:
+    """'Consistent sets: ...' -- per swept input, the values where all claims hold together
+    (the ``ALL`` rows of a ``consistent_set.parquet`` table), or that they conflict."""
+    parts = []
+    for i, c in enumerate(cons["claim"]):
+        if c != "ALL":
+            continue
+        lo, hi = number(cons["holds_low"][i]), number(cons["holds_high"][i])
+        parts.append(f"`{cons['input'][i]}` "
+                     + ("none: the claims conflict" if lo is None else f"{fmt(lo)} - {fmt(hi)}"))
+    return "Consistent sets: " + "; ".join(parts) + "."
 
 
 def claims_markdown(path: Path) -> str:

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...report import claims_markdown, consistent_rows, fmt, inputs_markdown, md_table, number
+from ...report import (claims_markdown, consistent_rows, consistent_sets_sentence,
+                        fmt, inputs_markdown, md_table)
 from ...storage import read_provenance, read_table
 from .schema import SCHEMA
 
@@ -28,8 +29,6 @@ def report(out: Path) -> str:
     cons = read_table(out / "consistent_set.parquet").to_pydict()
     k = cfg["plate.grid"]
     errata = [r for r in c.values() if r["verdict"] == "erratum"]
-    alls = {cons["input"][i]: (number(cons["holds_low"][i]), number(cons["holds_high"][i]))
-            for i in range(len(cons["claim"])) if cons["claim"][i] == "ALL"}
     txt = [
         f"Simulated calibrations of a comparator with {cfg['plate.count']} grid plates of "
         f"{k} x {k} points at {cfg['plate.spacing_mm']:g} mm, each on its carrier with "
@@ -70,9 +69,7 @@ def report(out: Path) -> str:
         "",
         md_table(["input", "claim", "kind", "not contradicted for"], consistent_rows(cons)),
         "",
-        "Consistent sets: " + "; ".join(
-            f"`{kk}` " + ("none: the claims conflict" if lo is None else f"{fmt(lo)} - {fmt(hi)}")
-            for kk, (lo, hi) in alls.items()) + ".",
+        consistent_sets_sentence(cons),
         "",
         f"![consistent set]({name}/consistent_set.png)",
         "",

@@ -52,8 +52,7 @@ def _params(net: Network, an) -> np.ndarray:
     return np.array([g for g in an.free if g >= 2 * net.n], int)
 
 
-def _mc(net, an, dt, pts, cfg, ctx):
-    C = dt.constraint_matrix(net.theta_true()[None])
+def _mc(net, an, C, pts, cfg, ctx):
     crit = float(D.chi2_ppf(1 - cfg["test.alpha"], an.dof))
     cov_inv = np.linalg.inv(an.cov[pts])
     fn = partial(mc_chunk, net=net, free=an.free, C=None if C is None else C[0], cov_inv=cov_inv,
@@ -78,7 +77,8 @@ def run(cfg: dict, out: Path, ctx) -> None:
     pts = [a for a in range(net.n) if net.role[a] != 1
            and det[a] > 1e-12 * ((an.cov[a, 0, 0] + an.cov[a, 1, 1]) / 2) ** 2]
     held = [net.names[a] for a in range(net.n) if net.role[a] != 1 and a not in pts]
-    sim = _mc(net, an, dt, pts, cfg, ctx)
+    C = dt.constraint_matrix(net.theta_true()[None])
+    sim = _mc(net, an, C, pts, cfg, ctx)
     n_ok = sim["sum.n"][:, 0]
     if n_ok.sum() < 2 or np.count_nonzero(n_ok) < 2:
         raise StudyError("solver.max_iter: fewer than two chunks have converged trials; the "
@@ -153,7 +153,6 @@ def run(cfg: dict, out: Path, ctx) -> None:
         gama = "network.xml"
     except ConfigError as e:
         gama = f"not exported: {e}"
-    C = dt.constraint_matrix(net.theta_true()[None])
     n_tot = float(n_ok.sum())
     write_table(out / "summary.parquet", {
         "network": [net.name], "points": [net.n], "observations": [net.m],

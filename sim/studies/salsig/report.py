@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...report import claims_markdown, consistent_rows, fmt, inputs_markdown, md_table, number
+from ...report import (claims_markdown, consistent_rows, consistent_sets_sentence,
+                        fmt, inputs_markdown, md_table)
 from ...storage import read_provenance, read_table
 from .schema import SCHEMA
 
@@ -16,8 +17,6 @@ def report(out: Path) -> str:
     sw = read_table(out / "power.parquet").to_pydict()
     cons = read_table(out / "consistent_set.parquet").to_pydict()
     errata = [r for r in c.values() if r["verdict"] == "erratum"]
-    alls = [(cons["input"][i], number(cons["holds_low"][i]), number(cons["holds_high"][i]))
-            for i in range(len(cons["claim"])) if cons["claim"][i] == "ALL"]
     txt = [
         "**Conventions.** Salsig's program prints the affine `X1 = A X2 + B Y2 + C`, "
         "`Y1 = D X2 + E Y2 + F` from the observed system X2 (comparator, or B8 digits) to the "
@@ -53,9 +52,7 @@ def report(out: Path) -> str:
         "",
         md_table(["input", "claim", "kind", "not contradicted for"], consistent_rows(cons)),
         "",
-        "Consistent sets: " + "; ".join(
-            f"`{k}` " + ("none: the claims conflict" if lo is None else f"{fmt(lo)} - {fmt(hi)}")
-            for k, lo, hi in alls) + ".",
+        consistent_sets_sentence(cons),
         "",
         f"![consistent set]({name}/consistent_set.png)",
         f"![vertical]({name}/vertical.png)",
