@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
+from . import group_kernel
 from .group_solve import (band_order, band_solve, chol_solve, chol_subst, dense, factor,
                           inv_points, regular, regular_points, scaled)
 from .normals import RCOND
@@ -98,12 +99,23 @@ class GroupStructure:
         self.S_rows = _indicator(self.point_rows, n_points)
         gp, inv = np.unique(og[self.pk1] * G + og[self.pk2], return_inverse=True)
         self.pair_g1, self.pair_g2 = gp // G, gp % G
+        self.pair_of = inv.ravel()
         self.gp_buckets = _buckets(inv.ravel(), gp.size)
         self.group_buckets = _buckets(og, G)
         diag = np.flatnonzero(self.pair_g1 == self.pair_g2)
         self.diag_of_group = np.full(G, -1, np.intp)
         self.diag_of_group[self.pair_g1[diag]] = diag
         self.band = band_order(self.pair_g1, self.pair_g2, G)
+        self._kernel_index = None
+
+    @property
+    def kernel_index(self) -> dict:
+        """Index arrays of the compiled kernels (:func:`sim.lsq.group_kernel.index`)."""
+        if self._kernel_index is None:
+            self._kernel_index = group_kernel.index(
+                self.obs_group, self.obs_point, self.pk1, self.pk2, self.pair_of,
+                self.pair_g1, self.pair_g2, self.diag_of_group, self.n_points)
+        return self._kernel_index
 
 
 @dataclass
@@ -174,10 +186,16 @@ def _point_blocks(st: GroupStructure, lin: GroupLinearization, rcond: float):
     return Ninv, up, Npg, Ninv[:, st.obs_point] @ Npg, good.all(axis=1)
 
 
-def reduce(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND) -> GroupReduced:
-    """Normal equations with the point blocks eliminated (pair blocks of the groups): one
-    batched product per bucket of group pairs with the same number of shared points."""
+def reduce(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND,
+           jit: bool | None = None) -> GroupReduced:
+    """Normal equations with the point blocks eliminated (pair blocks of the groups): the
+    compiled kernel :func:`sim.lsq.group_kernel.pair_blocks` (``jit`` None: when numba is
+    there), else one batched product per bucket of group pairs with the same number of
+    shared points."""
     Ninv, up, Npg, NinvK, ok = _point_blocks(st, lin, rcond)
+    if group_kernel.available() if jit is None else jit:
+        blocks, ubar = group_kernel.pair_blocks(st, Npg, NinvK, lin.Jg, lin.w, lin.r, up)
+        return GroupReduced(blocks, ubar, Ninv, up, Npg, NinvK, ok)
     T, K, m, b = lin.Jg.shape
     d = Npg.shape[2]
     blocks = np.empty((T, st.pair_g1.size, b, b))
@@ -281,12 +299,21 @@ class GroupCofactors:
         """Point cofactor blocks ``Ninv + Ninv (sum Npg_k1 Q Npg_k2') Ninv`` (T, P, d, d)."""
         return self.red.Ninv + scatter(self.st.S_point, self.red.NinvK @ self.H)
 
-    def residuals(self, lin: GroupLinearization, points: np.ndarray | None = None) -> np.ndarray:
+    def residuals(self, lin: GroupLinearization, points: np.ndarray | None = None,
+                  jit: bool | None = None) -> np.ndarray:
         """Diagonal of ``Q_vv = W^-1 - A Q_xx A'`` of the observation rows (T, K, m); NaN
         where the weight is zero, and, with ``points`` (bool (P,)), for the observations of
-        the other points (not computed)."""
+        the other points (not computed). ``jit`` (None: when numba is there): by the
+        compiled kernel :func:`sim.lsq.group_kernel.residual_cofactors`."""
         st = self.st
         og, op = st.obs_group, st.obs_point
+        if group_kernel.available() if jit is None else jit:
+            T, G, _, b, _ = self.Q.shape
+            Q = self.Q.transpose(0, 1, 3, 2, 4).reshape(T, G * b, G * b)
+            pts = (np.arange(st.n_points) if points is None
+                   else np.flatnonzero(np.asarray(points, bool)))
+            return group_kernel.residual_cofactors(st, Q, self.red.NinvK, self.red.Ninv,
+                                                   lin.Jg, lin.Jp, lin.w, pts)
         if points is None:
             ks, H, Qpp = slice(None), self.H, self.points
         else:
