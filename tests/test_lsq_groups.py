@@ -91,8 +91,18 @@ def test_compiled_kernels_equal_numpy(setup):
     model = im.SimilarityModel(st, xm, np.zeros((xm.shape[0], st.n_models, 3)), w, cx, wc)
     lin = model.linearize(X0, im._state(s0, R0, t0))
     r0, r1 = groups.reduce(st, lin, jit=False), groups.reduce(st, lin, jit=True)
-    for a, c in ((r0.blocks, r1.blocks), (r0.ubar, r1.ubar)):
+    blocks, ubar = group_kernel.pair_blocks(st, r0.Npg, r0.NinvK, lin.Jg, lin.w, lin.r, r0.up)
+    dg = np.random.default_rng(5).normal(size=r0.ubar.shape)
+    L = np.linalg.cholesky(gs.dense(st, r0.blocks))
+    y = r0.ubar.reshape(len(L), -1)
+    for a, c in ((r0.blocks, r1.blocks), (r0.ubar, r1.ubar), (r0.Ninv, r1.Ninv),
+                 (r0.NinvK, r1.NinvK), (r0.up, r1.up), (r0.blocks, blocks), (r0.ubar, ubar),
+                 (groups.points_step(st, r0, dg),
+                  np.einsum("tpij,tpj->tpi", r0.Ninv, r0.up - groups.scatter(
+                      st.S_point, (r0.Npg * dg[:, st.obs_group, None, :]).sum(-1)))),
+                 (gs.chol_subst(L, y[..., None])[..., 0], group_kernel.chol_vec(L, y))):
         assert np.abs(c - a).max() <= 1e-12 * np.abs(a).max()
+    assert r1.ok.tolist() == r0.ok.tolist()
     cof = groups.cofactors(st, lin)
     for pts in (None, b.is_pass):
         q0, q1 = cof.residuals(lin, pts, jit=False), cof.residuals(lin, pts, jit=True)

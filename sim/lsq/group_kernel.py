@@ -24,7 +24,8 @@ import os
 
 import numpy as np
 
-__all__ = ["available", "pair_blocks", "residual_cofactors"]
+__all__ = ["available", "pair_blocks", "diag_reduce", "points_step", "chol_vec",
+           "residual_cofactors"]
 
 _compiled: dict | None = None
 
@@ -145,6 +146,113 @@ def _residual_cofactors(Q, F, Ninv, Jg, Jp, w, og, op, pts, pstart, pobs, out):
                     out[t, k, c] = 1.0 / wc - aqa if wc > 0 else np.nan
 
 
+def _diag_reduce(Jg, w, r, wc, rc, jp, jc, og, op, rows, diag_obs, xk1, xk2, xq, mir_dst,
+                 mir_src, npp, up, Npg, F, ok, blocks, ubar):  # pragma: no cover - compiled
+    T, K, m, b = Jg.shape
+    P = npp.shape[1]
+    C = rows.shape[0]
+    for t in range(T):
+        npp[t] = 0.0
+        up[t] = 0.0
+        for k in range(K):
+            j = op[k]
+            for a in range(m):
+                wp = w[t, k, a] * jp[a]
+                npp[t, j, a] += wp * jp[a]
+                up[t, j, a] += wp * r[t, k, a]
+        for c in range(C):
+            j = rows[c]
+            for a in range(m):
+                wq = wc[t, c, a] * jc[a]
+                npp[t, j, a] += wq * jc[a]
+                up[t, j, a] += wq * rc[t, c, a]
+        good = True
+        for j in range(P):
+            absent = True
+            use = True
+            for a in range(m):
+                x = npp[t, j, a]
+                if x != 0.0:
+                    absent = False
+                if not (x > 0.0 and np.isfinite(x)):
+                    use = False
+            if not (use or absent):
+                good = False
+            for a in range(m):
+                npp[t, j, a] = 1.0 / npp[t, j, a] if use else 0.0   # now Npp^-1
+        ok[t] = good
+        blocks[t] = 0.0
+        ubar[t] = 0.0
+        for k in range(K):
+            j, g, p = op[k], og[k], diag_obs[k]
+            for a in range(m):
+                wa = w[t, k, a]
+                wp = wa * jp[a]
+                ni = npp[t, j, a]
+                for i in range(b):
+                    x = wp * Jg[t, k, a, i]
+                    Npg[t, k, a, i] = x
+                    F[t, k, a, i] = ni * x
+                coef = wa - wp * wp * ni     # Ngg_k minus the pair (k, k)
+                for i in range(b):
+                    x = coef * Jg[t, k, a, i]
+                    for jj in range(b):
+                        blocks[t, p, i, jj] += x * Jg[t, k, a, jj]
+            for i in range(b):
+                v = 0.0
+                for a in range(m):
+                    v += Jg[t, k, a, i] * (w[t, k, a] * r[t, k, a]) - F[t, k, a, i] * up[t, j, a]
+                ubar[t, g, i] += v
+        for q in range(xk1.shape[0]):
+            k1, k2, p = xk1[q], xk2[q], xq[q]
+            for a in range(m):
+                for i in range(b):
+                    x = Npg[t, k1, a, i]
+                    for jj in range(b):
+                        blocks[t, p, i, jj] -= x * F[t, k2, a, jj]
+        for e in range(mir_dst.shape[0]):
+            for i in range(b):
+                for jj in range(b):
+                    blocks[t, mir_dst[e], i, jj] = blocks[t, mir_src[e], jj, i]
+
+
+def _points_step(Npg, Ninv, up, dg, og, op, out):  # pragma: no cover - compiled
+    T, K, d, b = Npg.shape
+    P = up.shape[1]
+    u = np.empty((P, d))
+    for t in range(T):
+        u[:, :] = up[t]
+        for k in range(K):
+            j, g = op[k], og[k]
+            for a in range(d):
+                v = 0.0
+                for i in range(b):
+                    v += Npg[t, k, a, i] * dg[t, g, i]
+                u[j, a] -= v
+        for j in range(P):
+            for a in range(d):
+                v = 0.0
+                for c in range(d):
+                    v += Ninv[t, j, a, c] * u[j, c]
+                out[t, j, a] = v
+
+
+def _chol_vec(L, y, x):  # pragma: no cover - compiled
+    T, n = y.shape
+    z = np.empty(n)
+    for t in range(T):
+        for i in range(n):
+            v = y[t, i]
+            for k in range(i):
+                v -= L[t, i, k] * z[k]
+            z[i] = v / L[t, i, i]
+        for i in range(n - 1, -1, -1):
+            v = z[i]
+            for k in range(i + 1, n):
+                v -= L[t, k, i] * x[t, k]
+            x[t, i] = v / L[t, i, i]
+
+
 def _kernels() -> dict | None:
     """The compiled kernels (compiled or loaded from the disk cache once per process), or
     None without numba."""
@@ -159,7 +267,9 @@ def _kernels() -> dict | None:
                 _compiled = {}
             else:
                 jit = njit(cache=True, error_model="numpy")
-                _compiled = {"pairs": jit(_pair_blocks), "resid": jit(_residual_cofactors)}
+                _compiled = {"pairs": jit(_pair_blocks), "resid": jit(_residual_cofactors),
+                             "diag": jit(_diag_reduce), "points": jit(_points_step),
+                             "chol": jit(_chol_vec)}
     return _compiled or None
 
 
@@ -185,6 +295,41 @@ def pair_blocks(st, Npg, F, Jg, w, r, up):
     return blocks, ubar
 
 
+def diag_reduce(st, lin, jp: np.ndarray, jc: np.ndarray):
+    """The whole reduction for constant diagonal point Jacobians ``jp``, ``jc`` (d,) (point
+    coordinates observed directly): diagonal point blocks, their elimination and the pair
+    blocks. Returns ``(blocks, ubar, Ninv (T, P, d, d), up, Npg, F, ok)`` as
+    :func:`sim.lsq.groups.reduce`."""
+    T, K, m, b = lin.Jg.shape
+    P = st.n_points
+    ix = st.kernel_index
+    ninv, up = np.empty((T, P, m)), np.empty((T, P, m))
+    Npg, F = np.empty((T, K, m, b)), np.empty((T, K, m, b))
+    ok = np.empty(T, np.bool_)
+    blocks = np.empty((T, st.pair_g1.size, b, b))
+    ubar = np.empty((T, st.n_groups, b))
+    _kernels()["diag"](_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc),
+                       ix["og"], ix["op"], ix["rows"], ix["diag_obs"], ix["xk1"], ix["xk2"],
+                       ix["xq"], ix["mir_dst"], ix["mir_src"], ninv, up, Npg, F, ok, blocks,
+                       ubar)
+    return blocks, ubar, ninv[..., :, None] * np.eye(m), up, Npg, F, ok
+
+
+def points_step(st, Npg, Ninv, up, dg) -> np.ndarray:
+    """Point corrections ``Npp^-1 (up - sum_k Npg_k dg_k)`` (T, P, d)."""
+    ix = st.kernel_index
+    out = np.empty(up.shape)
+    _kernels()["points"](_c(Npg), _c(Ninv), _c(up), _c(dg), ix["og"], ix["op"], out)
+    return out
+
+
+def chol_vec(L: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Solve ``L L' x = y`` for ``L`` (T, n, n) lower triangular, ``y`` (T, n)."""
+    x = np.empty(y.shape)
+    _kernels()["chol"](_c(L), _c(y), x)
+    return x
+
+
 def residual_cofactors(st, Q, F, Ninv, Jg, Jp, w, points: np.ndarray) -> np.ndarray:
     """Diagonal of ``Q_vv`` (T, K, m) for the observations of ``points`` (indices), NaN
     elsewhere and where the weight is zero; ``Q`` (T, G b, G b) the group cofactors."""
@@ -197,12 +342,14 @@ def residual_cofactors(st, Q, F, Ninv, Jg, Jp, w, points: np.ndarray) -> np.ndar
 
 def index(og: np.ndarray, op: np.ndarray, pk1: np.ndarray, pk2: np.ndarray,
           pair_of: np.ndarray, pair_g1: np.ndarray, pair_g2: np.ndarray,
-          diag_of_group: np.ndarray, n_points: int) -> dict:
+          diag_of_group: np.ndarray, n_points: int, rows: np.ndarray) -> dict:
     """Integer arrays the kernels read (structure only, built once): the observation pairs
     with ``g1 <= g2`` and their pair block ``pq``, the mirrored pair blocks, each
-    observation's diagonal block, and the observations of each point (CSR)."""
+    observation's diagonal block, the pairs of distinct observations (``xk1, xk2, xq``)
+    likewise, the point rows, and the observations of each point (CSR)."""
     G = int(max(pair_g1.max(initial=0), pair_g2.max(initial=0))) + 1
     lower = pair_g1[pair_of] <= pair_g2[pair_of]
+    cross = lower & (pk1 != pk2)
     key = pair_g1 * G + pair_g2
     lookup = {int(v): i for i, v in enumerate(key)}
     mir = np.flatnonzero(pair_g1 > pair_g2)
@@ -212,5 +359,6 @@ def index(og: np.ndarray, op: np.ndarray, pk1: np.ndarray, pk2: np.ndarray,
     i64 = lambda a: np.ascontiguousarray(a, np.int64)  # noqa: E731
     return {"og": i64(og), "op": i64(op), "pk1": i64(pk1[lower]), "pk2": i64(pk2[lower]),
             "pq": i64(pair_of[lower]), "mir_dst": i64(mir), "mir_src": i64(src),
-            "diag_obs": i64(diag_of_group[og]),
+            "diag_obs": i64(diag_of_group[og]), "xk1": i64(pk1[cross]),
+            "xk2": i64(pk2[cross]), "xq": i64(pair_of[cross]), "rows": i64(rows),
             "pstart": i64(np.concatenate([[0], np.cumsum(counts)])), "pobs": i64(order)}

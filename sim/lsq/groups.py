@@ -114,7 +114,7 @@ class GroupStructure:
         if self._kernel_index is None:
             self._kernel_index = group_kernel.index(
                 self.obs_group, self.obs_point, self.pk1, self.pk2, self.pair_of,
-                self.pair_g1, self.pair_g2, self.diag_of_group, self.n_points)
+                self.pair_g1, self.pair_g2, self.diag_of_group, self.n_points, self.point_rows)
         return self._kernel_index
 
 
@@ -192,8 +192,13 @@ def reduce(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND,
     compiled kernel :func:`sim.lsq.group_kernel.pair_blocks` (``jit`` None: when numba is
     there), else one batched product per bucket of group pairs with the same number of
     shared points."""
+    jit = group_kernel.available() if jit is None else jit
+    if jit:
+        jp, jc = _const_diag(lin.Jp), _const_diag(lin.Jc)
+        if jp is not None and jc is not None and (jp != 0).all():
+            return GroupReduced(*group_kernel.diag_reduce(st, lin, jp, jc))
     Ninv, up, Npg, NinvK, ok = _point_blocks(st, lin, rcond)
-    if group_kernel.available() if jit is None else jit:
+    if jit:
         blocks, ubar = group_kernel.pair_blocks(st, Npg, NinvK, lin.Jg, lin.w, lin.r, up)
         return GroupReduced(blocks, ubar, Ninv, up, Npg, NinvK, ok)
     T, K, m, b = lin.Jg.shape
@@ -234,13 +239,18 @@ def solve(st: GroupStructure, red: GroupReduced, solver: str = "auto",
         else:
             Ns, s = scaled(dense(st, red.blocks))
             L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)), rcond, check)
-            dg = chol_subst(L, (rhs * s)[..., None])[..., 0] * s
+            if group_kernel.available():
+                dg = group_kernel.chol_vec(L, rhs * s) * s
+            else:
+                dg = chol_subst(L, (rhs * s)[..., None])[..., 0] * s
     ok &= red.ok
     return np.where(ok[:, None], dg, 0.0).reshape(T, G, b), ok
 
 
 def points_step(st: GroupStructure, red: GroupReduced, dg: np.ndarray) -> np.ndarray:
     """Point corrections ``Npp^-1 (up - sum_k Npg_k dg_k)`` (T, P, d)."""
+    if group_kernel.available():
+        return group_kernel.points_step(st, red.Npg, red.Ninv, red.up, dg)
     u = red.up - scatter(st.S_point, (red.Npg * dg[:, st.obs_group, None, :]).sum(-1))
     return (red.Ninv @ u[..., None])[..., 0]
 
