@@ -1,5 +1,11 @@
-"""Every study through the runner: 1 worker, 2 workers on a Dask LocalCluster, and a run on 2
-local workers killed with SIGKILL then started again, give the same files (issue 12).
+"""Every study through the runner: a run on 1 worker and a run on 2 local workers that is killed
+with SIGKILL after its first chunks and then resumed on a Dask cluster with 2 workers give the
+same files (issue 12). So every study shows that the chunks of 2 local pool workers, those of
+Dask workers and those of the in-process run are the same, and that a killed run resumes (even
+on another executor) to the files of an uninterrupted one.
+
+The Dask cluster is one for the module (a scheduler address given with ``--scheduler``); the
+path where ``--executor dask`` starts its own LocalCluster is tested in ``test_runner.py``.
 
 Each study provides ``tests/data/tiny/<study>.txt``: one ``KEY=VALUE`` override per line for a
 run of a few seconds with at least two chunks.
@@ -78,8 +84,17 @@ def same_files(a: Path, b: Path) -> None:
         assert same_table(a / f, b / f), f
 
 
+@pytest.fixture(scope="module")
+def scheduler():
+    """A Dask LocalCluster with 2 single-threaded worker processes, shared by the studies."""
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        yield cluster.scheduler_address
+
+
 @pytest.mark.parametrize("study", sorted(MODULES))
-def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path):
+def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path, scheduler):
     one = tmp_path / "one"
     r = subprocess.run(command(study, one, 1), cwd=ROOT, capture_output=True, text=True,
                        timeout=300)
@@ -97,12 +112,8 @@ def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path):
     p.wait(timeout=60)
     assert p.returncode == -signal.SIGKILL, "the run finished before it could be killed"
     assert not two.exists() and list(stage.rglob("chunk-*.parquet"))   # killed mid-run
-    r = subprocess.run(command(study, two, 2), cwd=ROOT, capture_output=True, text=True,
-                       timeout=300)
+    r = subprocess.run(command(study, two, 2, "--executor", "dask", "--scheduler", scheduler),
+                       cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
+    assert "resuming" in r.stderr
     same_files(one, two)
-    dsk = tmp_path / "dask"
-    r = subprocess.run(command(study, dsk, 2, "--executor", "dask"), cwd=ROOT,
-                       capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0, r.stderr
-    same_files(one, dsk)
