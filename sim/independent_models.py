@@ -226,19 +226,30 @@ class SimilarityModel:
         st = self.structure
         om, op = st.obs_model, st.obs_point
         s, R, t = theta[..., 0], theta[..., 1:10].reshape(theta.shape[:2] + (3, 3)), theta[..., 10:]
-        y = s[:, om, None] * np.einsum("tkij,tkj->tki", R[:, om], self.xm - self.c[:, om])
+        d = self.xm - self.c[:, om]
+        Rk = R[:, om]                                         # y = s R (x - c), unrolled
+        y = s[:, om, None] * (Rk[..., 0] * d[..., 0, None] + Rk[..., 1] * d[..., 1, None]
+                              + Rk[..., 2] * d[..., 2, None])
         e = y + t[:, om] - X[:, op]
         T, K = y.shape[:2]
         J = np.zeros((T, K, 3, 7))
         J[..., 0] = y
-        J[..., 0, 2], J[..., 0, 3] = y[..., 2], -y[..., 1]    # -skew(y): d(R y) / dtheta
-        J[..., 1, 1], J[..., 1, 3] = -y[..., 2], y[..., 0]
-        J[..., 2, 1], J[..., 2, 2] = y[..., 1], -y[..., 0]
-        J[..., [0, 1, 2], [4, 5, 6]] = 1.0
+        J[..., 0, 2] = y[..., 2]                              # -skew(y): d(R y) / dtheta
+        J[..., 0, 3] = -y[..., 1]
+        J[..., 1, 1] = -y[..., 2]
+        J[..., 1, 3] = y[..., 0]
+        J[..., 2, 1] = y[..., 1]
+        J[..., 2, 2] = -y[..., 0]
+        J[..., 0, 4] = J[..., 1, 5] = J[..., 2, 6] = 1.0
         C = st.ctrl_point.size
         return lsq.GroupLinearization(-e, np.broadcast_to(-np.eye(3), (T, K, 3, 3)), J, self.w,
                                       self.ctrl - X[:, st.ctrl_point],
                                       np.broadcast_to(np.eye(3), (T, C, 3, 3)), self.wc)
+
+    def take(self, idx: np.ndarray) -> "SimilarityModel":
+        """The same model on the trials ``idx`` only (the loop's active trials)."""
+        return SimilarityModel(self.structure, self.xm[idx], self.c[idx], self.w[idx],
+                               self.ctrl[idx], self.wc[idx], self.solver)
 
     def retract(self, X, theta, dX, dg):
         T, M = theta.shape[:2]

@@ -142,7 +142,9 @@ def _grouped(model, theta, points0, datum, tol, max_iter, rcond, step_scale) -> 
     """The same loop for models whose globals are group blocks (:mod:`sim.lsq.groups`):
     ``model.structure`` a :class:`~sim.lsq.groups.GroupStructure`, ``model.linearize``
     returning a :class:`~sim.lsq.groups.GroupLinearization`, ``theta`` any per-trial state
-    that ``model.retract`` updates with the tangent corrections (T, G b)."""
+    that ``model.retract`` updates with the tangent corrections (T, G b). A model with a
+    ``take(trials)`` method (the same model on some trials) is linearised, once some trials
+    have stopped, on the active trials only."""
     if datum.free is not None or datum.constraints is not None:
         raise ValueError("group-block models take their datum from weighted point rows")
     st = model.structure
@@ -154,7 +156,15 @@ def _grouped(model, theta, points0, datum, tol, max_iter, rcond, step_scale) -> 
                else np.array(points0, float, copy=True))
         prog = _Progress(T)
         for it in range(1, max_iter + 1):
-            dp, dg, ok = groups.step(st, model.linearize(pts, theta), solver, rcond, it == 1)
+            act = np.flatnonzero(prog.active)
+            if act.size < T and hasattr(model, "take"):   # only the trials still iterating
+                dp_a, dg_a, ok_a = groups.step(st, model.take(act).linearize(pts[act], theta[act]),
+                                               solver, rcond, it == 1)
+                dp, dg = np.zeros_like(pts), np.zeros((T,) + dg_a.shape[1:])
+                ok = np.ones(T, bool)
+                dp[act], dg[act], ok[act] = dp_a, dg_a, ok_a
+            else:
+                dp, dg, ok = groups.step(st, model.linearize(pts, theta), solver, rcond, it == 1)
             g = np.abs(dg) if scale is None else np.abs(dg) / scale
             step = np.maximum(np.abs(dp).max(axis=(1, 2)), g.max(axis=1))
             step = np.where(np.isfinite(dp).all(axis=(1, 2)) & np.isfinite(dg).all(axis=1),

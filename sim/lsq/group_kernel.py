@@ -148,7 +148,8 @@ def _residual_cofactors(Q, F, Ninv, Jg, Jp, w, og, op, pts, pstart, pobs, out):
 
 def _diag_reduce(Jg, w, r, wc, rc, jp, jc, og, op, rows, diag_obs, xk1, xk2, xq, mir_dst,
                  mir_src, npp, up, Npg, F, ok, blocks, ubar):  # pragma: no cover - compiled
-    T, K, m, b = Jg.shape
+    T, K = Jg.shape[0], Jg.shape[1]
+    m, b = M_ROWS, B_GROUP    # compile-time constants (see _specialised)
     P = npp.shape[1]
     C = rows.shape[0]
     for t in range(T):
@@ -268,9 +269,28 @@ def _kernels() -> dict | None:
             else:
                 jit = njit(cache=True, error_model="numpy")
                 _compiled = {"pairs": jit(_pair_blocks), "resid": jit(_residual_cofactors),
-                             "diag": jit(_diag_reduce), "points": jit(_points_step),
+                             "points": jit(_points_step),
                              "chol": jit(_chol_vec)}
     return _compiled or None
+
+
+def _specialised(m: int, b: int):
+    """:func:`_diag_reduce` compiled with the block sizes ``m`` (rows = point dimension) and
+    ``b`` (group unknowns) frozen to constants (numba treats globals as such), which lets the
+    compiler unroll and vectorise the small loops; cached on disk under its own name."""
+    import types
+
+    from numba import njit
+
+    key = ("diag", m, b)
+    if key not in _compiled:
+        fn = _diag_reduce
+        name = f"_diag_reduce_{m}_{b}"
+        f = types.FunctionType(fn.__code__, dict(fn.__globals__, M_ROWS=m, B_GROUP=b), name,
+                               fn.__defaults__, fn.__closure__)
+        f.__qualname__ = name
+        _compiled[key] = njit(cache=True, error_model="numpy")(f)
+    return _compiled[key]
 
 
 def available() -> bool:
@@ -308,7 +328,8 @@ def diag_reduce(st, lin, jp: np.ndarray, jc: np.ndarray):
     ok = np.empty(T, np.bool_)
     blocks = np.empty((T, st.pair_g1.size, b, b))
     ubar = np.empty((T, st.n_groups, b))
-    _kernels()["diag"](_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc),
+    _kernels()
+    _specialised(m, b)(_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc),
                        ix["og"], ix["op"], ix["rows"], ix["diag_obs"], ix["xk1"], ix["xk2"],
                        ix["xq"], ix["mir_dst"], ix["mir_src"], ninv, up, Npg, F, ok, blocks,
                        ubar)

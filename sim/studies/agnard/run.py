@@ -7,7 +7,8 @@ the run context (executor, chunk store), with picklable chunk functions
 (:mod:`.chunks`), so ``--workers``, Dask and resumption after a kill apply.
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
 tables, ``sweep_five.parquet``, ``sweep_claims.parquet``, ``consistent_set.parquet``,
-``claims.parquet`` + ``not_reproduced.parquet`` and the figures.
+``claims.parquet`` + ``not_reproduced.parquet`` and the figures (drawn on the run's idle
+workers when it has some, :func:`sim.figure_jobs.draw_figures`).
 """
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ import numpy as np
 from ... import independent_models as im
 from ...block_layout import select_control
 from ...claims import write_claims
+from ...figure_jobs import draw_figures
 from ...runner import run_chunks
 from ...storage import provenance, write_table
 from .. import RunContext
@@ -207,8 +209,9 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
 
     write_claims(out / "claims.parquet", claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug,
                                                     book), prov, book)
-    fg.fig_scanner(cfg, out / "scanner_field.png")
-    fg.fig_layout(block, c5, c21, out / "block_layout.png", ctrl_idx, insets)
-    fg.fig_residuals(vec, out / "check_residuals.png")
-    fg.fig_tradeoffs(scan_t, lay_t, size_t, out / "tradeoffs.png")
-    fg.fig_consistent(long, cs, out / "consistent_set.png")
+    draw_figures([(fg.fig_consistent, (long, cs, out / "consistent_set.png")),   # dearest first
+                  (fg.fig_tradeoffs, (scan_t, lay_t, size_t, out / "tradeoffs.png")),
+                  (fg.fig_scanner, (cfg, out / "scanner_field.png")),
+                  (fg.fig_residuals, (vec, out / "check_residuals.png")),
+                  (fg.fig_layout, (block, c5, c21, out / "block_layout.png", ctrl_idx, insets))],
+                 ctx.executor)
