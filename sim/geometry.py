@@ -15,8 +15,9 @@ transpose is the photogrammetric orientation matrix ``M = M_kappa M_phi M_omega`
 weight per point (the same for every coordinate), batched over trials:
 
 * 2-D: linear in ``(a, b, c, c')`` with ``x' = a x + b y + c``, ``y' = -b x + a y + c'``
-  (seed 001's "isogonal affine"), so ``s R = [[a, b], [-b, a]]``; solved by the library's one
-  linear routine :func:`sim.lsq.linear.lstsq` (cofactors of ``(a, b, c, c')`` included);
+  (seed 001's "isogonal affine"), so ``s R = [[a, b], [-b, a]]``; the normal equations of
+  that linear fit solved in closed form (centroids, then ``a, b``; the cofactors of
+  ``(a, b, c, c')`` and the scaled singularity rule of :mod:`sim.lsq.normals` too);
   ``s0^2 = v'Pv / (2n - 4)``.
 * 3-D (the 7-parameter conformal transformation): the closed form of Umeyama (1991) / Horn
   (1987) from the SVD of the weighted cross-covariance, the least-squares solution the
@@ -65,7 +66,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .lsq.linear import LinearFit, lstsq
+from .lsq.linear import LinearFit
+from .lsq.normals import RCOND
 
 __all__ = ["ARCSEC", "rotation", "rotation_angles", "Similarity", "similarity_fit",
            "similarity_apply", "apply_affine", "apply_similarity", "affine_from_columns",
@@ -156,18 +158,67 @@ def similarity_fit(src, dst, w=None) -> Similarity:
 
 
 def _similarity_2d(src, dst, w) -> Similarity:
+    """Closed form of the 2-D least-squares similarity (the linear fit of ``(a, b, c, c')``
+    solved analytically): with weighted centroids and centred coordinates ``x, y`` (src) and
+    ``X, Y`` (dst), ``D = sum w (x^2 + y^2)``, ``a = sum w (x X + y Y) / D``,
+    ``b = sum w (y X - x Y) / D``, ``c = X0 - a x0 - b y0``, ``c' = Y0 + b x0 - a y0``.
+
+    The normal matrix ``N`` of ``(a, b, c, c')`` scaled to unit diagonal has the eigenvalues
+    ``1 +- rho`` (each twice), ``rho^2 = (sx^2 + sy^2) / (S W)`` with ``S = sum w |p|^2``,
+    ``sx, sy = sum w p``, ``W = sum w``; so the scaled singularity rule's eigenvalue ratio is
+    ``(1 - rho) / (1 + rho) = (D / S) / (1 + rho)^2`` (``1 - rho^2 = D / S``). The cofactor
+    ``Q = N^-1`` is closed form too: ``Q_aa = Q_bb = 1 / D``, ``Q_ac = -x0 / D``,
+    ``Q_ac' = -y0 / D``, ``Q_bc = -y0 / D``, ``Q_bc' = x0 / D``,
+    ``Q_cc = Q_c'c' = 1 / W + (x0^2 + y0^2) / D``, the rest zero."""
     T, n, _ = dst.shape
+    shared = src.ndim == 2
+    src = np.broadcast_to(src, dst.shape)
+    w = np.ones((T, n)) if w is None else np.clip(
+        np.broadcast_to(np.asarray(w, float), (T, n)), 0.0, None)
+    fin = (np.isfinite(src).all(axis=(1, 2)) & np.isfinite(dst).all(axis=(1, 2))
+           & np.isfinite(w).all(axis=1))
+    if not fin.all():
+        src, dst = (np.where(fin[:, None, None], v, 0.0) for v in (src, dst))
+        w = np.where(fin[:, None], w, 1.0)
+    W = w.sum(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ms = np.einsum("tn,tnc->tc", w, src) / W[:, None]          # weighted centroids
+        md = np.einsum("tn,tnc->tc", w, dst) / W[:, None]
+        a_ = src - ms[:, None, :]
+        b_ = dst - md[:, None, :]
+        wa = w[..., None] * a_
+        D = np.einsum("tnc,tnc->t", wa, a_)
+        S = np.einsum("tn,tnc,tnc->t", w, src, src)
+        rho = np.sqrt(np.einsum("tc,tc->t", ms, ms) * W / S)        # |sum w p| / sqrt(S W)
+        rc = (D / S) / (1.0 + rho) ** 2
+        ok = fin & (W > 0) & np.isfinite(rc) & (rc > RCOND) & (2 * n >= 4)
+        Dg = np.where(ok, D, 1.0)
+        a = np.einsum("tnc,tnc->t", wa, b_) / Dg
+        b = (np.einsum("tn,tn->t", wa[..., 1], b_[..., 0])
+             - np.einsum("tn,tn->t", wa[..., 0], b_[..., 1])) / Dg
+    x0, y0 = ms[:, 0], ms[:, 1]
+    c = md[:, 0] - a * x0 - b * y0
+    c2 = md[:, 1] + b * x0 - a * y0
+    a, b, c, c2 = (np.where(ok, v, np.nan) for v in (a, b, c, c2))
     x, y = src[..., 0], src[..., 1]
-    one, zero = np.ones_like(x), np.zeros_like(x)
-    A = np.concatenate([np.stack([x, y, one, zero], -1), np.stack([y, -x, zero, one], -1)], -2)
-    l = np.concatenate([dst[..., 0], dst[..., 1]], axis=1)
-    ww = None if w is None else np.concatenate([np.asarray(w, float)] * 2, axis=-1)
-    f = lstsq(A, l, ww)
-    a, b, c, c2 = (f.x[:, i, 0] for i in range(4))
+    res = np.stack([dst[..., 0] - (a[:, None] * x + b[:, None] * y + c[:, None]),
+                    dst[..., 1] - (-b[:, None] * x + a[:, None] * y + c2[:, None])], -1)
+    vtpv = np.einsum("tn,tnc,tnc->t", w, res, res)
+    dof = 2 * n - 4
+    s0 = np.sqrt(vtpv / dof) if dof > 0 else np.full(T, np.nan)
+    iD, z = 1.0 / Dg, np.zeros(T)
+    qc = 1.0 / np.where(ok, W, 1.0) + (x0 * x0 + y0 * y0) * iD
+    Q = np.stack([np.stack(r, -1) for r in ((iD, z, -x0 * iD, -y0 * iD),
+                                            (z, iD, -y0 * iD, x0 * iD),
+                                            (-x0 * iD, -y0 * iD, qc, z),
+                                            (-y0 * iD, x0 * iD, z, qc))], -2)
+    status = np.where(fin, np.where(ok, 0, 2), 3).astype(np.int8)
     s = np.hypot(a, b)
     R = np.stack([np.stack([a, b], -1), np.stack([-b, a], -1)], -2) / s[:, None, None]
-    res = np.stack([f.residuals[:, :n, 0], f.residuals[:, n:, 0]], -1)
-    return Similarity(s, R, np.stack([c, c2], -1), res, f.s0, f.dof, f.status, f)
+    lin = LinearFit(np.stack([a, b, c, c2], -1)[..., None],
+                    np.concatenate([res[..., 0], res[..., 1]], 1)[..., None], vtpv[:, None],
+                    dof, status, shared, None, Q)
+    return Similarity(s, R, np.stack([c, c2], -1), res, s0, dof, status, lin)
 
 
 def _similarity_3d(src, dst, w) -> Similarity:

@@ -81,6 +81,8 @@ class PolyFit:
     norm_mm : coordinate normalisation.
     ok : ``(T,)`` the fit was estimable (the scaled singularity rule of :mod:`sim.lsq.linear`).
     rms_mm : ``(T, 2)`` rms residual per axis on the fitting data.
+    corrected_mm : ``(T, n, 2)`` the fitting data corrected, ``X + P(X, Y)`` (the numbers of
+        :func:`apply_poly` at the measured points, without building their design again).
     """
 
     coef: np.ndarray
@@ -88,6 +90,7 @@ class PolyFit:
     norm_mm: float
     ok: np.ndarray
     rms_mm: np.ndarray
+    corrected_mm: np.ndarray | None = None
 
     @property
     def degree(self) -> int:
@@ -118,7 +121,7 @@ def fit_poly(measured: np.ndarray, true: np.ndarray, degree: int | None = 3, ter
     A = design(measured, terms, norm_mm)                  # (T, n, p): one R0 for all trials
     f = lstsq(A, true - measured)
     rms = np.sqrt(np.mean(f.residuals ** 2, axis=1))
-    return PolyFit(f.x, terms, float(norm_mm), f.ok, rms)
+    return PolyFit(f.x, terms, float(norm_mm), f.ok, rms, measured + np.matmul(A, f.x))
 
 
 def fit_wolf(measured: np.ndarray, true: np.ndarray, norm_mm: float = 100.0) -> PolyFit:

@@ -88,3 +88,41 @@ def test_degenerate_similarity_is_flagged_not_raised(d):
     f = geo.similarity_fit(src, dst)
     assert list(f.status) == [0, 2, 0]
     assert np.isnan(f.scale[1]) and np.allclose(f.scale[[0, 2]], 1.5)
+
+
+@pytest.mark.parametrize("shared", [False, True])
+def test_closed_form_similarity_2d_is_the_linear_fit_of_a_b_c(shared):
+    """The 2-D closed form equals the engine's linear fit of ``(a, b, c, c')`` on the explicit
+    design: solution, residuals, s0, cofactor, and the scaled rule's decisions (a trial of
+    coincident points, a nearly coincident one and a NaN observation among good trials)."""
+    from sim.lsq.linear import lstsq
+
+    rng = np.random.default_rng(8)
+    T, n = 8, 12
+    src = rng.uniform(-100, 100, (n, 2)) + 40.0 if shared else \
+        rng.uniform(-100, 100, (T, n, 2)) + 40.0
+    th = rng.normal(0, 0.01, T)
+    R = np.stack([np.stack([np.cos(th), -np.sin(th)], -1), np.stack([np.sin(th), np.cos(th)], -1)], -2)
+    dst = 1.001 * np.einsum("tij,tnj->tni", R, np.broadcast_to(src, (T, n, 2))) + 3.0
+    dst = dst + rng.normal(0, 0.01, dst.shape)
+    if not shared:
+        src[2] = src[2, :1]                                    # coincident: singular
+        src[5] = src[5, :1] + 1e-7 * rng.normal(size=(n, 2))   # nearly: eigenvalue ratio ~1e-18
+    dst[4, 3, 1] = np.nan
+    w = rng.uniform(0.5, 2.0, n)
+    for ww in (None, w):
+        f = geo.similarity_fit(src, dst, ww)
+        S = np.broadcast_to(src, (T, n, 2))
+        x, y, one, zero = S[..., 0], S[..., 1], np.ones((T, n)), np.zeros((T, n))
+        A = np.concatenate([np.stack([x, y, one, zero], -1), np.stack([y, -x, zero, one], -1)], 1)
+        ref = lstsq(A, np.concatenate([dst[..., 0], dst[..., 1]], 1),
+                    None if ww is None else np.concatenate([ww, ww]))
+        assert np.array_equal(f.status, ref.status)
+        ok = ref.ok
+        assert ok.sum() == (T - 1 if shared else T - 3)
+        np.testing.assert_allclose(f.linear.x[ok], ref.x[ok], rtol=1e-11, atol=1e-11)
+        np.testing.assert_allclose(f.linear.residuals[ok], ref.residuals[ok], atol=1e-10)
+        np.testing.assert_allclose(f.s0[ok], ref.s0[ok], rtol=1e-9)
+        np.testing.assert_allclose(f.linear.cofactor()[ok], ref.cofactor()[ok], rtol=1e-10,
+                                   atol=1e-16)
+        assert np.isnan(f.scale[~ok]).all() and np.isnan(f.linear.cofactor()[~ok]).all()

@@ -127,3 +127,16 @@ def test_screened_rule_decides_like_the_eigenvalue_ratio():
         good = ref & (eps > 1e-3)
         xr = np.linalg.lstsq(A[good][0], b[good][0], rcond=None)[0]
         np.testing.assert_allclose(f.x[good][0, :, 0], xr, rtol=1e-9, atol=1e-12)
+
+
+def test_inputs_are_left_unchanged():
+    """The residuals never overwrite the caller's observations (one trial of a shared design,
+    whose transposed right-hand sides are a view of ``b``)."""
+    rng = np.random.default_rng(7)
+    for A, b in ((rng.normal(size=(9, 3)), rng.normal(size=(1, 9, 2))),
+                 (rng.normal(size=(9, 3)), rng.normal(size=(4, 9, 2))),
+                 (rng.normal(size=(4, 9, 3)), rng.normal(size=(4, 9, 1)))):
+        A0, b0 = A.copy(), b.copy()
+        f = lstsq(A, b)
+        assert np.array_equal(A, A0) and np.array_equal(b, b0)
+        np.testing.assert_allclose(f.residuals, b - np.matmul(A, f.x), atol=1e-13)

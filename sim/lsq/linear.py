@@ -68,8 +68,9 @@ class LinearFit:
     dof: int
     status: np.ndarray
     shared: bool
-    _P: np.ndarray = field(repr=False)                  # (p, p) or (T, p, p) preconditioner
+    _P: np.ndarray | None = field(repr=False)           # (p, p) or (T, p, p) preconditioner
     _NBinv: np.ndarray | None = field(repr=False)       # (T, p, p) inverse of B'B (per trial)
+    # (_P None: _NBinv is the cofactor itself, from a closed form such as the 2-D similarity)
 
     @property
     def ok(self) -> np.ndarray:
@@ -93,7 +94,9 @@ class LinearFit:
     def cofactor(self) -> np.ndarray:
         """Cofactor matrix ``Q = (A' W A)^-1`` ``(T, p, p)`` (NaN for unsolved trials)."""
         T, p = self.x.shape[:2]
-        if self._NBinv is None:                                    # shared: P = R^-1
+        if self._P is None:
+            Q = np.array(self._NBinv, float)
+        elif self._NBinv is None:                                    # shared: P = R^-1
             Q = np.broadcast_to(self._P @ self._P.T, (T, p, p)).copy()
         else:
             P = self._P
@@ -143,22 +146,32 @@ def lstsq(A, b, w=None, rcond: float = RCOND) -> LinearFit:
     return _per_trial(np.broadcast_to(A, (T, m, p)), b, w, fin_b, rcond)
 
 
-def _finish(A, b, w, x, status, shared, P, NBinv) -> LinearFit:
+def _finish(A, b, w, x, status, shared, P, NBinv, v=None) -> LinearFit:
+    """Residuals ``v = b - A x`` (or the given ``v``) and ``v' W v``; NaN solution where not
+    solved."""
     bad = status != 0
-    x[bad] = np.nan
+    if bad.any():
+        x[bad] = np.nan
     T, m, k = b.shape
     p = A.shape[-1]
-    if A.ndim == 3:
-        fitted = np.matmul(A, x)
+    if v is None:
+        if A.ndim == 3:
+            fitted = np.matmul(A, x)
+        else:
+            fitted = (A @ x.transpose(1, 0, 2).reshape(p, T * k)).reshape(m, T, k).transpose(1, 0, 2)
+        v = b - fitted
+    if w is None and k > 1:  # the same sums as below (over m in order), without a temporary
+        vtpv = np.einsum("tmk,tmk->tk", v, v)
     else:
-        fitted = (A @ x.transpose(1, 0, 2).reshape(p, T * k)).reshape(m, T, k).transpose(1, 0, 2)
-    v = b - fitted
-    vv = v * v if w is None else v * v * np.broadcast_to(w, (T, m))[..., None]
-    vtpv = vv.sum(axis=1)
+        vv = v * v if w is None else v * v * np.broadcast_to(w, (T, m))[..., None]
+        vtpv = vv.sum(axis=1)
     return LinearFit(x, v, vtpv, m - p, status, shared, P, NBinv)
 
 
 def _shared(A, b, w, fin_b, rcond) -> LinearFit:
+    """One factorisation for all trials: ``sqrt(W) A = Q R``; every trial's right-hand sides
+    are solved in one matrix product (columns ``(trial, k)``) and one triangular solve, and
+    their residuals in one more product."""
     T, m, k = b.shape
     p = A.shape[1]
     sw = np.ones(m) if w is None else np.sqrt(np.clip(w, 0.0, None))
@@ -171,10 +184,17 @@ def _shared(A, b, w, fin_b, rcond) -> LinearFit:
                        np.full((p, p), np.nan), None)
     Qf, R = np.linalg.qr(Aw)                                        # once for all trials
     Rinv = linalg.solve_triangular(R, np.eye(p))
-    bw = np.where(fin_b[:, None, None], b, 0.0) * sw[None, :, None]
-    y = Qf.T @ bw.transpose(1, 0, 2).reshape(m, T * k)              # all trials at once
-    x = linalg.solve_triangular(R, y).reshape(p, T, k).transpose(1, 0, 2)
-    return _finish(A, b, w, x, status, True, Rinv, None)
+    plain = w is None and bool(fin_b.all())                         # b needs no masking
+    bw = b if plain else np.where(fin_b[:, None, None], b, 0.0) * sw[None, :, None]
+    bT = bw.transpose(1, 0, 2).reshape(m, T * k)                    # columns (trial, k)
+    xT = linalg.solve_triangular(R, Qf.T @ bT, check_finite=False)  # all trials at once
+    x = xT.reshape(p, T, k).transpose(1, 0, 2)
+    if not plain or k == 1:
+        return _finish(A, b, w, x, status, True, Rinv, None)
+    own = not np.shares_memory(bT, b)                 # bT a copy of b: residuals go there
+    vT = np.subtract(bT, A @ xT, out=bT if own else None)
+    return _finish(A, b, w, x, status, True, Rinv, None,
+                   vT.reshape(m, T, k).transpose(1, 0, 2))
 
 
 def _equilibrated(Aw):
@@ -223,7 +243,7 @@ def _per_trial(A, b, w, fin_b, rcond) -> LinearFit:
         bw = np.where(fin[:, None, None], bw, 0.0)
     R0 = None
     if fin.any():  # right preconditioner: R0 of the trial-mean design, factorised once
-        Am = Aw[fin].mean(axis=0)
+        Am = Aw.mean(axis=0) if fin.all() else Aw[fin].mean(axis=0)
         if m >= p and scaled_rcond(Am.T @ Am) > rcond:
             R0 = np.linalg.qr(Am, mode="r")
     if R0 is not None:

@@ -88,7 +88,7 @@ def _reduce_readings(cfg: dict, D: dict, cell: dict, full: bool, keep_vectors: b
     meas = red.transpose(1, 0, 2, 3).reshape(-1, S * nG, 2)             # pooled sets
     T = meas.shape[0]
     before = (meas - np.tile(G, (S, 1))) * 1000.0
-    after = (pl.apply_poly(fit, meas) - np.tile(G, (S, 1))) * 1000.0
+    after = (fit.corrected_mm - np.tile(G, (S, 1))) * 1000.0       # apply_poly(fit, meas)
     stats_cols("before", before, out)
     stats_cols("after", after, out)
     # check points of the same sets (cell centres), reduced with each set's transform
