@@ -44,7 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import lsq
+from . import lsq, similarity_jit
 from .geometry import rotation, similarity_fit
 from .lsq.groups import chol_solve
 
@@ -209,10 +209,13 @@ class SimilarityModel:
     of ``s <- s (1 + dl)``, ``R <- R(dtheta) R``, ``t' <- t' + dt`` (b = 7); the state
     ``theta`` (T, M, 13) holds ``s``, ``R`` (9) and ``t' = t + s R c``. Rows: model points
     ``x_mj - [s R (x_mj - c_m) + t'_m - X_j]`` (weights w_obs) and control
-    ``X_j^control - X_j`` (weights w_ctrl); metres.
+    ``X_j^control - X_j`` (weights w_ctrl); metres. Linearised by the compiled kernel of
+    :mod:`sim.similarity_jit` when numba is there (``jit``), else by NumPy.
     """
 
     point_dim = 3
+    #: linearise by the compiled kernel of :mod:`sim.similarity_jit` when numba is there
+    jit = True
 
     def __init__(self, st: BlockStructure, xm, c, w_obs, ctrl_xyz, w_ctrl, solver="auto"):
         self.structure, self.xm, self.c, self.solver = st, xm, c, solver
@@ -225,13 +228,20 @@ class SimilarityModel:
     def linearize(self, X, theta, globals_needed=True) -> lsq.GroupLinearization:
         st = self.structure
         om, op = st.obs_model, st.obs_point
+        T, C = X.shape[0], st.ctrl_point.size
+        fast = None if not self.jit else similarity_jit.linearize(self.xm, self.c, theta, X, om, op)
+        if fast is not None:
+            return lsq.GroupLinearization(
+                fast[0], np.broadcast_to(-np.eye(3), fast[0].shape + (3,)), fast[1], self.w,
+                self.ctrl - X[:, st.ctrl_point], np.broadcast_to(np.eye(3), (T, C, 3, 3)),
+                self.wc)
         s, R, t = theta[..., 0], theta[..., 1:10].reshape(theta.shape[:2] + (3, 3)), theta[..., 10:]
         d = self.xm - self.c[:, om]
         Rk = R[:, om]                                         # y = s R (x - c), unrolled
         y = s[:, om, None] * (Rk[..., 0] * d[..., 0, None] + Rk[..., 1] * d[..., 1, None]
                               + Rk[..., 2] * d[..., 2, None])
         e = y + t[:, om] - X[:, op]
-        T, K = y.shape[:2]
+        K = y.shape[1]
         J = np.zeros((T, K, 3, 7))
         J[..., 0] = y
         J[..., 0, 2] = y[..., 2]                              # -skew(y): d(R y) / dtheta
@@ -241,7 +251,6 @@ class SimilarityModel:
         J[..., 2, 1] = y[..., 1]
         J[..., 2, 2] = -y[..., 0]
         J[..., 0, 4] = J[..., 1, 5] = J[..., 2, 6] = 1.0
-        C = st.ctrl_point.size
         return lsq.GroupLinearization(-e, np.broadcast_to(-np.eye(3), (T, K, 3, 3)), J, self.w,
                                       self.ctrl - X[:, st.ctrl_point],
                                       np.broadcast_to(np.eye(3), (T, C, 3, 3)), self.wc)

@@ -103,9 +103,28 @@ def test_compiled_kernels_equal_numpy(setup):
                  (gs.chol_subst(L, y[..., None])[..., 0], group_kernel.chol_vec(L, y))):
         assert np.abs(c - a).max() <= 1e-12 * np.abs(a).max()
     assert r1.ok.tolist() == r0.ok.tolist()
+    for a, c in zip(gs.scaled(gs.dense(st, r0.blocks)), group_kernel.dense_scaled(st, r0.blocks)):
+        assert np.array_equal(a, c)
     cof = groups.cofactors(st, lin)
     for pts in (None, b.is_pass):
         q0, q1 = cof.residuals(lin, pts, jit=False), cof.residuals(lin, pts, jit=True)
         assert np.array_equal(np.isnan(q0), np.isnan(q1))
         # relative to the scale of Q_vv, W^-1 (a point seen once has q_vv = 0)
         assert np.nanmax(np.abs(q1 - q0) * w) <= 1e-12
+
+
+def test_compiled_linearisation_equals_numpy(setup):
+    """The compiled similarity linearisation (sim.similarity_jit) equals the NumPy one."""
+    from sim import similarity_jit
+    b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
+    c = np.random.default_rng(4).normal(size=(xm.shape[0], st.n_models, 3))
+    model = im.SimilarityModel(st, xm, c, w, cx, wc)
+    theta = im._state(s0, R0, t0)
+    if similarity_jit.linearize(xm, c, theta, X0, st.obs_model, st.obs_point) is None:
+        pytest.skip("numba not installed")
+    fast = model.linearize(X0, theta)
+    model.jit = False
+    ref = model.linearize(X0, theta)
+    for a, f in ((ref.r, fast.r), (ref.Jg, fast.Jg), (ref.Jp, fast.Jp), (ref.rc, fast.rc)):
+        assert a.shape == f.shape
+        assert np.abs(f - a).max() <= 1e-12 * np.abs(a).max()

@@ -24,7 +24,7 @@ import os
 
 import numpy as np
 
-__all__ = ["available", "pair_blocks", "diag_reduce", "points_step", "chol_vec",
+__all__ = ["available", "pair_blocks", "diag_reduce", "points_step", "dense_scaled", "chol_vec",
            "residual_cofactors"]
 
 _compiled: dict | None = None
@@ -77,8 +77,8 @@ def _pair_blocks(Npg, F, Jg, w, r, up, og, op, pk1, pk2, pq, mir_dst, mir_src, d
 
 def _residual_cofactors(Q, F, Ninv, Jg, Jp, w, og, op, pts, pstart, pobs, out):
     # pragma: no cover - compiled
-    T, K, d, b = F.shape
-    m = Jg.shape[2]
+    T = F.shape[0]
+    d, b, m = D_POINT, B_GROUP, M_ROWS    # compile-time constants (see _specialised)
     nmax = 0
     for j in pts:
         nmax = max(nmax, pstart[j + 1] - pstart[j])
@@ -149,7 +149,7 @@ def _residual_cofactors(Q, F, Ninv, Jg, Jp, w, og, op, pts, pstart, pobs, out):
 def _diag_reduce(Jg, w, r, wc, rc, jp, jc, og, op, rows, diag_obs, xk1, xk2, xq, mir_dst,
                  mir_src, npp, up, Npg, F, ok, blocks, ubar):  # pragma: no cover - compiled
     T, K = Jg.shape[0], Jg.shape[1]
-    m, b = M_ROWS, B_GROUP    # compile-time constants (see _specialised)
+    m, b = D_POINT, B_GROUP    # compile-time constants (see _specialised); m = d here
     P = npp.shape[1]
     C = rows.shape[0]
     for t in range(T):
@@ -238,6 +238,24 @@ def _points_step(Npg, Ninv, up, dg, og, op, out):  # pragma: no cover - compiled
                 out[t, j, a] = v
 
 
+def _dense_scaled(blocks, pg1, pg2, N, s):  # pragma: no cover - compiled
+    T, n_p, b = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+    n = N.shape[1]
+    for t in range(T):
+        N[t] = 0.0
+        for p in range(n_p):
+            r0, c0 = pg1[p] * b, pg2[p] * b
+            for i in range(b):
+                for j in range(b):
+                    N[t, r0 + i, c0 + j] = blocks[t, p, i, j]
+        for i in range(n):
+            dg = abs(N[t, i, i])
+            s[t, i] = 1.0 / np.sqrt(dg) if dg > 0 else 1.0
+        for i in range(n):
+            for j in range(n):
+                N[t, i, j] = N[t, i, j] * s[t, i] * s[t, j]
+
+
 def _chol_vec(L, y, x):  # pragma: no cover - compiled
     T, n = y.shape
     z = np.empty(n)
@@ -268,26 +286,26 @@ def _kernels() -> dict | None:
                 _compiled = {}
             else:
                 jit = njit(cache=True, error_model="numpy")
-                _compiled = {"pairs": jit(_pair_blocks), "resid": jit(_residual_cofactors),
+                _compiled = {"pairs": jit(_pair_blocks), "dense": jit(_dense_scaled),
                              "points": jit(_points_step),
                              "chol": jit(_chol_vec)}
     return _compiled or None
 
 
-def _specialised(m: int, b: int):
-    """:func:`_diag_reduce` compiled with the block sizes ``m`` (rows = point dimension) and
-    ``b`` (group unknowns) frozen to constants (numba treats globals as such), which lets the
-    compiler unroll and vectorise the small loops; cached on disk under its own name."""
+def _specialised(fn, d: int, b: int, m: int):
+    """``fn`` compiled with the block sizes ``d`` (point unknowns), ``b`` (group unknowns)
+    and ``m`` (rows per observation) frozen to constants (numba treats globals as such),
+    which lets the compiler unroll and vectorise the small loops; cached on disk under its
+    own name."""
     import types
 
     from numba import njit
 
-    key = ("diag", m, b)
+    key = (fn.__name__, d, b, m)
     if key not in _compiled:
-        fn = _diag_reduce
-        name = f"_diag_reduce_{m}_{b}"
-        f = types.FunctionType(fn.__code__, dict(fn.__globals__, M_ROWS=m, B_GROUP=b), name,
-                               fn.__defaults__, fn.__closure__)
+        name = f"{fn.__name__}_{d}_{b}_{m}"
+        f = types.FunctionType(fn.__code__, dict(fn.__globals__, D_POINT=d, B_GROUP=b, M_ROWS=m),
+                               name, fn.__defaults__, fn.__closure__)
         f.__qualname__ = name
         _compiled[key] = njit(cache=True, error_model="numpy")(f)
     return _compiled[key]
@@ -329,7 +347,7 @@ def diag_reduce(st, lin, jp: np.ndarray, jc: np.ndarray):
     blocks = np.empty((T, st.pair_g1.size, b, b))
     ubar = np.empty((T, st.n_groups, b))
     _kernels()
-    _specialised(m, b)(_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc),
+    _specialised(_diag_reduce, m, b, m)(_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc),
                        ix["og"], ix["op"], ix["rows"], ix["diag_obs"], ix["xk1"], ix["xk2"],
                        ix["xq"], ix["mir_dst"], ix["mir_src"], ninv, up, Npg, F, ok, blocks,
                        ubar)
@@ -344,6 +362,17 @@ def points_step(st, Npg, Ninv, up, dg) -> np.ndarray:
     return out
 
 
+def dense_scaled(st, blocks: np.ndarray):
+    """The reduced normal matrix (T, G b, G b) from its pair blocks, scaled to unit diagonal,
+    and the scale ``s`` (T, G b): :func:`sim.lsq.group_solve.dense` then ``scaled``."""
+    T, n_p, b = blocks.shape[:3]
+    n = st.n_groups * b
+    N, s = np.empty((T, n, n)), np.empty((T, n))
+    ix = st.kernel_index
+    _kernels()["dense"](_c(blocks), ix["pg1"], ix["pg2"], N, s)
+    return N, s
+
+
 def chol_vec(L: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Solve ``L L' x = y`` for ``L`` (T, n, n) lower triangular, ``y`` (T, n)."""
     x = np.empty(y.shape)
@@ -356,7 +385,9 @@ def residual_cofactors(st, Q, F, Ninv, Jg, Jp, w, points: np.ndarray) -> np.ndar
     elsewhere and where the weight is zero; ``Q`` (T, G b, G b) the group cofactors."""
     ix = st.kernel_index
     out = np.full(w.shape, np.nan)
-    _kernels()["resid"](_c(Q), _c(F), _c(Ninv), _c(Jg), _c(Jp), _c(w), ix["og"], ix["op"],
+    T, K, d, b = F.shape
+    _kernels()
+    _specialised(_residual_cofactors, d, b, Jg.shape[2])(_c(Q), _c(F), _c(Ninv), _c(Jg), _c(Jp), _c(w), ix["og"], ix["op"],
                         np.asarray(points, np.int64), ix["pstart"], ix["pobs"], out)
     return out
 
@@ -379,7 +410,7 @@ def index(og: np.ndarray, op: np.ndarray, pk1: np.ndarray, pk2: np.ndarray,
     counts = np.bincount(op, minlength=n_points)
     i64 = lambda a: np.ascontiguousarray(a, np.int64)  # noqa: E731
     return {"og": i64(og), "op": i64(op), "pk1": i64(pk1[lower]), "pk2": i64(pk2[lower]),
-            "pq": i64(pair_of[lower]), "mir_dst": i64(mir), "mir_src": i64(src),
+            "pq": i64(pair_of[lower]), "pg1": i64(pair_g1), "pg2": i64(pair_g2), "mir_dst": i64(mir), "mir_src": i64(src),
             "diag_obs": i64(diag_of_group[og]), "xk1": i64(pk1[cross]),
             "xk2": i64(pk2[cross]), "xq": i64(pair_of[cross]), "rows": i64(rows),
             "pstart": i64(np.concatenate([[0], np.cumsum(counts)])), "pobs": i64(order)}

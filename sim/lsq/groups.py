@@ -237,7 +237,8 @@ def solve(st: GroupStructure, red: GroupReduced, solver: str = "auto",
         if solver == "sparse":
             dg, ok = band_solve(st, red.blocks, rhs)
         else:
-            Ns, s = scaled(dense(st, red.blocks))
+            Ns, s = (group_kernel.dense_scaled(st, red.blocks) if group_kernel.available()
+                     else scaled(dense(st, red.blocks)))
             L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)), rcond, check)
             if group_kernel.available():
                 dg = group_kernel.chol_vec(L, rhs * s) * s
@@ -346,9 +347,9 @@ class GroupCofactors:
 def cofactors(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND) -> GroupCofactors:
     """Cofactors (dense inverse of the reduced normals; NaN for singular trials)."""
     red = reduce(st, lin, rcond)
-    N = dense(st, red.blocks)
-    T, n = N.shape[:2]
-    Ns, s = scaled(N)
+    Ns, s = (group_kernel.dense_scaled(st, red.blocks) if group_kernel.available()
+             else scaled(dense(st, red.blocks)))
+    T, n = Ns.shape[:2]
     L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)) & red.ok, rcond, True)
     Q = chol_subst(L, np.broadcast_to(np.eye(n), (T, n, n)).copy())
     Q = Q * s[:, :, None] * s[:, None, :]
