@@ -14,7 +14,9 @@ with ``RSS_min`` the residual sum of squares after adjusting the points with the
 matrix. The prior on ``b`` (not on ``beta``) is flat, so ``b`` may be negative.
 
 Randomness: the sampler's legacy ``RandomState`` is seeded from an explicit
-``numpy.random.SeedSequence`` (emcee 3 draws from its own ``RandomState``).
+``numpy.random.SeedSequence`` (emcee 3 draws from its own ``RandomState``). The chains run on
+:func:`sim.ensemble.stretch_chain`, emcee's algorithm step for step (the same chain for the
+same seed) without emcee's per-walker Python bookkeeping.
 """
 from __future__ import annotations
 
@@ -23,7 +25,8 @@ from typing import Callable
 
 import numpy as np
 
-from . import multilateration as ml
+from . import multilateration as ml, positions as po
+from .ensemble import stretch_chain
 
 __all__ = ["Chain", "run_emcee", "brown_log_posterior", "linear_log_posterior"]
 
@@ -42,22 +45,36 @@ class Chain:
 
 
 def run_emcee(log_prob: Callable[[np.ndarray], np.ndarray], p0: np.ndarray, steps: int,
-              seed: np.random.SeedSequence, burn: int | None = None) -> Chain:
-    """Run ``emcee.EnsembleSampler`` (vectorised log-probability over walkers).
+              seed: np.random.SeedSequence, burn: int | None = None,
+              engine: str = "vectorised") -> Chain:
+    """Run emcee's ensemble sampler (stretch move, vectorised log-probability over walkers).
 
     p0 : (walkers, d) initial positions. ``burn`` defaults to a quarter of ``steps``.
+    engine : ``vectorised`` (:func:`sim.ensemble.stretch_chain`, emcee's algorithm step for
+    step without its per-walker Python loop: the same chain) or ``emcee``
+    (``emcee.EnsembleSampler`` itself, the reference).
     """
-    import emcee
+    from emcee.autocorr import integrated_time
 
     W, d = p0.shape
-    sampler = emcee.EnsembleSampler(W, d, log_prob, vectorize=True)
-    sampler.random_state = np.random.RandomState(np.random.MT19937(seed)).get_state()
-    sampler.run_mcmc(p0, steps, progress=False)
+    rs = np.random.RandomState(np.random.MT19937(seed))
+    if engine == "vectorised":
+        chain, _, n_acc = stretch_chain(log_prob, p0, steps, rs)
+        acceptance = n_acc / float(steps)
+    elif engine == "emcee":
+        import emcee
+
+        sampler = emcee.EnsembleSampler(W, d, log_prob, vectorize=True)
+        sampler.random_state = rs.get_state()
+        sampler.run_mcmc(p0, steps, progress=False)
+        chain, acceptance = sampler.get_chain(), sampler.acceptance_fraction
+    else:
+        raise ValueError(f"engine must be vectorised or emcee, not {engine!r}")
     burn = steps // 4 if burn is None else burn
-    tau = sampler.get_autocorr_time(discard=burn, tol=0)
-    chain = sampler.get_chain(discard=burn, flat=True)
+    tau = integrated_time(chain[burn:], tol=0)
+    kept = chain[burn:].reshape(-1, d)
     n_eff = (steps - burn) * W / float(np.max(tau))
-    return Chain(chain, tau, n_eff, float(np.mean(sampler.acceptance_fraction)), steps, W, burn)
+    return Chain(kept, tau, n_eff, float(np.mean(acceptance)), steps, W, burn)
 
 
 def linear_log_posterior(A: np.ndarray, y: np.ndarray, sigma: float):
@@ -77,14 +94,19 @@ def brown_log_posterior(r_obs: np.ndarray, sigma_mm: float, tol_mm: float = 1e-1
     """
     r_obs = np.asarray(r_obs, float)
 
+    model = po.RangeModel(None, ml.BROWN_LAYOUT, P=4)
+
     def lp(theta: np.ndarray) -> np.ndarray:
         W = theta.shape[0]
         R = np.broadcast_to(r_obs, (W,) + r_obs.shape)
         res = ml.adjust(R, "known", theta, tol_mm=tol_mm, max_iter=20)
         rss = np.einsum("tnk,tnk->t", res.residuals, res.residuals)
-        Qpp = res.point_cofactors()
-        logdetQ = np.log(np.maximum(Qpp[..., 0, 0] * Qpp[..., 1, 1] - Qpp[..., 0, 1] ** 2,
-                                    1e-300)).sum(1)
+        # the point cofactors Qpp = Npp^-1 of the known model (the engine's 2x2 inverse)
+        Jp = model.linearize(res.points, theta, False).Jp
+        Npp = np.swapaxes(Jp, -1, -2) @ Jp
+        a, b, c = Npp[..., 0, 0], Npp[..., 0, 1], Npp[..., 1, 1]
+        inv = 1.0 / (a * c - b * b)
+        logdetQ = np.log(np.maximum((c * inv) * (a * inv) - (-b * inv) ** 2, 1e-300)).sum(1)
         out = -0.5 * rss / sigma_mm ** 2 + 0.5 * logdetQ
         return np.where(res.converged & np.isfinite(out), out, -np.inf)
 

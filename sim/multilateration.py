@@ -69,7 +69,10 @@ for _row, _col, _v in ((1, 0, 1), (2, 1, 1), (3, 2, 1), (5, 3, 1), (6, 4, 1), (7
 
 
 def _model(r_obs: np.ndarray | None) -> po.RangeModel:
-    return po.RangeModel(r_obs, BROWN_LAYOUT, P=4)
+    # dense: Brown's studies keep the engine's reference route, bit for bit (the compiled
+    # kernel is this model's fast adjustment; ties between symmetric points in their notes
+    # are decided by the last bits of the cofactors)
+    return po.RangeModel(r_obs, BROWN_LAYOUT, P=4, dense=True)
 
 
 def ranges(points: np.ndarray, theta: np.ndarray) -> np.ndarray:
@@ -176,5 +179,5 @@ def covariance(points: np.ndarray, theta: np.ndarray, model: str,
         cof = lsq.cofactors(_model(None), points, theta, lsq.Datum(np.arange(p)))
     else:
         th = np.concatenate([np.reshape(station_xy, (-1, 8)), theta[:, 5:7]], 1)
-        cof = lsq.cofactors(po.RangeModel(None, P=4), points, th, lsq.Datum(np.arange(0)))
+        cof = lsq.cofactors(po.RangeModel(None, P=4, dense=True), points, th, lsq.Datum(np.arange(0)))
     return cof.points, cof.Qgg, cof.K, cof.Ninv

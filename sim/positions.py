@@ -133,16 +133,21 @@ class RangeModel:
     globals are ``X_1, Y_1, ..., X_P, Y_P, alpha, b``) or a constant matrix ``B``
     ``(2P + 2, q)`` mapping the model's own ``q`` globals to that vector (Brown's datum in
     :mod:`sim.multilateration`). ``P`` is taken from ``r_obs`` or from ``stations``.
+    The engine forms the normal equations from :meth:`normal_blocks` (the sparse structure);
+    ``dense=True`` makes it use the dense Jacobian of :meth:`linearize` instead (the same
+    normals to rounding).
     """
 
     point_dim = 2
 
     def __init__(self, r_obs: np.ndarray | None, layout: np.ndarray | None = None,
-                 P: int | None = None):
+                 P: int | None = None, dense: bool = False):
         self.r_obs = None if r_obs is None else np.asarray(r_obs, float)
         self.layout = layout
         self.P = self.r_obs.shape[2] if P is None else P
         self.n_global = 2 * self.P + 2 if layout is None else layout.shape[1]
+        if dense:   # the engine forms the normals from the dense Jacobian (the reference)
+            self.normal_blocks = None
 
     def full(self, theta: np.ndarray) -> np.ndarray:
         """The station/alpha/b vector ``(T, 2P + 2)`` of the globals."""
@@ -171,6 +176,67 @@ class RangeModel:
         J[..., 2 * P] = -1.0
         J[..., 2 * P + 1] = -0.5 / q
         return lsq.Linearization(r, Jp, J if self.layout is None else J @ self.layout)
+
+    def normal_blocks(self, points, theta, free):
+        """Normal-equation blocks of the free globals formed directly (for :mod:`sim.lsq`):
+        the reading of station ``k`` at point ``j`` touches only ``x_j, y_j``, ``X_k, Y_k``,
+        ``alpha`` and ``b``, so with ``u`` the unit vector station -> point and ``g = 1 / 2q``
+
+            Npp_j = sum_k u u',  Npg_j = [-u_k u_k' (station k) | -sum_k u | -sum_k g u],
+            Ngg = diag_k(sum_j u u') bordered by sum_j u, sum_j g u, n, sum g, sum g^2
+
+        (the dense Jacobian ``(T, n, P, 2P + 2)`` is never built). Returns ``(Npp, up, Npg,
+        Ngg, ug)`` for :func:`sim.lsq.normals.reduce_blocks`."""
+        th = self.full(theta)
+        S = stations(th)
+        dx = points[:, :, None, 0] - S[:, None, :, 0]      # (T, n, P)
+        dy = points[:, :, None, 1] - S[:, None, :, 1]
+        q = np.sqrt(np.maximum(dx * dx + dy * dy - th[:, None, None, -1], 1e-300))
+        ux, uy = dx / q, dy / q
+        r = (np.zeros_like(q) if self.r_obs is None
+             else self.r_obs - (q - th[:, None, None, -2]))
+        xx, xy, yy = ux * ux, ux * uy, uy * uy
+        T, n, P = q.shape
+        on_k, on_j = np.ones(P), np.ones(n)   # sums over stations / points as products
+        Npp = np.empty((T, n, 2, 2))
+        Npp[..., 0, 0] = xx @ on_k
+        Npp[..., 0, 1] = Npp[..., 1, 0] = xy @ on_k
+        Npp[..., 1, 1] = yy @ on_k
+        up = np.stack([(ux * r) @ on_k, (uy * r) @ on_k], -1)
+        if len(free) == 0:
+            return Npp, up, np.zeros((T, n, 2, 0)), np.zeros((T, 0, 0)), np.zeros((T, 0))
+        g = 0.5 / q
+        gx, gy = g * ux, g * uy
+        q_all = 2 * P + 2
+        Npg = np.empty((T, n, 2, q_all))
+        Npg[:, :, 0, 0:2 * P:2] = -xx
+        Npg[:, :, 0, 1:2 * P:2] = Npg[:, :, 1, 0:2 * P:2] = -xy
+        Npg[:, :, 1, 1:2 * P:2] = -yy
+        Npg[:, :, 0, 2 * P] = -(ux @ on_k)
+        Npg[:, :, 1, 2 * P] = -(uy @ on_k)
+        Npg[:, :, 0, 2 * P + 1] = -(gx @ on_k)
+        Npg[:, :, 1, 2 * P + 1] = -(gy @ on_k)
+        Ngg = np.zeros((T, q_all, q_all))
+        k = np.arange(P)
+        sx, sy = 2 * k, 2 * k + 1
+        Ngg[:, sx, sx] = on_j @ xx
+        Ngg[:, sx, sy] = Ngg[:, sy, sx] = on_j @ xy
+        Ngg[:, sy, sy] = on_j @ yy
+        for col, (ax, ay) in ((2 * P, (ux, uy)), (2 * P + 1, (gx, gy))):
+            Ngg[:, sx, col] = Ngg[:, col, sx] = on_j @ ax
+            Ngg[:, sy, col] = Ngg[:, col, sy] = on_j @ ay
+        Ngg[:, 2 * P, 2 * P] = n * P
+        Ngg[:, 2 * P, 2 * P + 1] = Ngg[:, 2 * P + 1, 2 * P] = g.sum(axis=(1, 2))
+        Ngg[:, 2 * P + 1, 2 * P + 1] = (g * g).sum(axis=(1, 2))
+        ug = np.empty((T, q_all))
+        ug[:, 0:2 * P:2] = -(on_j @ (ux * r))
+        ug[:, 1:2 * P:2] = -(on_j @ (uy * r))
+        ug[:, 2 * P] = -r.sum(axis=(1, 2))
+        ug[:, 2 * P + 1] = -(g * r).sum(axis=(1, 2))
+        if self.layout is not None:      # the model's own globals: Jg = J_full L
+            L = self.layout
+            Npg, Ngg, ug = Npg @ L, L.T @ Ngg @ L, ug @ L
+        return Npp, up, Npg[..., free], Ngg[:, free][:, :, free], ug[:, free]
 
 
 def _datum(theta: np.ndarray, P: int, model: str, datum: str) -> lsq.Datum:
@@ -220,8 +286,9 @@ def covariance(points: np.ndarray, theta: np.ndarray, model: str, datum: str = "
 
 
 def full_point_covariance(points: np.ndarray, theta: np.ndarray, model: str,
-                          datum: str = "inner") -> np.ndarray:
-    """The full ``(T, 2n, 2n)`` cofactor of all point coordinates (x1, y1, x2, ...)."""
+                          datum: str = "inner", dense: bool = False) -> np.ndarray:
+    """The full ``(T, 2n, 2n)`` cofactor of all point coordinates (x1, y1, x2, ...);
+    ``dense``: normals from the dense Jacobian (:class:`RangeModel`)."""
     P = (theta.shape[-1] - 2) // 2
-    return lsq.cofactors(RangeModel(None, P=P), points, theta,
+    return lsq.cofactors(RangeModel(None, P=P, dense=dense), points, theta,
                          _datum(theta, P, model, datum)).full_points

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import groups
-from .normals import RCOND, bordered_solve, reduce
+from .normals import RCOND, bordered_solve, reduced_normals
 from .problem import Datum, fast_path
 from .result import Result
 
@@ -102,8 +102,7 @@ def gauss_newton(model, theta0: np.ndarray, points0: np.ndarray | None = None,
                else np.array(points0, float, copy=True))
         prog = _Progress(T)
         for it in range(1, max_iter + 1):
-            lin = model.linearize(pts, theta, p > 0)
-            red = reduce(lin.r, lin.Jp, lin.Jg[..., free] if p else None, lin.w, rcond)
+            red = reduced_normals(model, pts, theta, free, rcond)
             ok = red.ok
             if p:
                 dg, okg = bordered_solve(red.Nbar, red.ubar, C, rcond)

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["RCOND", "scaled_rcond", "inv_blocks", "Reduced", "reduce", "bordered_solve",
-           "bordered_inverse"]
+__all__ = ["RCOND", "scaled_rcond", "inv_blocks", "Reduced", "reduce", "reduce_blocks",
+           "reduced_normals", "bordered_solve", "bordered_inverse"]
 
 #: default reciprocal condition number below which a scaled matrix counts as singular
 RCOND = 1e-10
@@ -132,11 +132,45 @@ def reduce(r, Jp, Jg, w=None, rcond: float = RCOND) -> Reduced:
     if d == 0:
         return Reduced(Ninv, np.zeros((T, n, 0, p)), Nbar, ubar, dp0, ok)
     Npg = np.swapaxes(WJp, -1, -2) @ Jg                     # (T, n, d, p)
+    return _eliminate(Ninv, ok, up, dp0, Npg, Nbar, ubar)
+
+
+def _eliminate(Ninv, ok, up, dp0, Npg, Ngg, ug) -> Reduced:
+    T, n, d, p = Npg.shape
     K = Ninv @ Npg
     Kt = K.reshape(T, n * d, p).transpose(0, 2, 1)
-    Nbar = Nbar - Kt @ Npg.reshape(T, n * d, p)
-    ubar = ubar - (Kt @ up.reshape(T, n * d, 1))[..., 0]
+    Nbar = Ngg - Kt @ Npg.reshape(T, n * d, p)
+    ubar = ug - (Kt @ up.reshape(T, n * d, 1))[..., 0]
     return Reduced(Ninv, K, Nbar, ubar, dp0, ok)
+
+
+def reduce_blocks(Npp, up, Npg, Ngg, ug, rcond: float = RCOND) -> Reduced:
+    """:func:`reduce` from normal-equation blocks that a model formed itself -- the route of
+    a model whose Jacobian is mostly zero (each observation touching one point and a few
+    globals, e.g. one station's coordinates in :mod:`sim.positions`), which then never
+    builds the dense ``(T, n, k, p)`` Jacobian.
+
+    Npp : (T, n, d, d) point blocks; up : (T, n, d); Npg : (T, n, d, p); Ngg : (T, p, p);
+    ug : (T, p) (``Jp' W r``, ``Jp' W Jg``, ``Jg' W Jg``, ``Jg' W r`` of the free globals).
+    The same elimination and singularity rule as :func:`reduce`.
+    """
+    Ninv, ok = inv_blocks(Npp, rcond)
+    dp0 = (Ninv @ up[..., None])[..., 0]
+    if Npg.shape[-1] == 0:
+        return Reduced(Ninv, Npg, Ngg, ug, dp0, ok)
+    return _eliminate(Ninv, ok, up, dp0, Npg, Ngg, ug)
+
+
+def reduced_normals(model, points, theta, free, rcond: float = RCOND):
+    """The reduced normals of ``model`` at one linearisation point: from the blocks the model
+    forms itself (``model.normal_blocks``, for Jacobians that are mostly zero) when it has
+    them, else from its dense Jacobians (:func:`sim.lsq.normals.reduce`)."""
+    blocks = getattr(model, "normal_blocks", None)
+    if blocks is not None:
+        return reduce_blocks(*blocks(points, theta, free), rcond=rcond)
+    p = len(free)
+    lin = model.linearize(points, theta, p > 0)
+    return reduce(lin.r, lin.Jp, lin.Jg[..., free] if p else None, lin.w, rcond)
 
 
 def _scaled_system(N: np.ndarray, C: np.ndarray | None):

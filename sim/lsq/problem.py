@@ -18,8 +18,11 @@ An **observation model** is any object with
   ``(T, n, k, d)`` and all ``q`` globals ``Jg`` ``(T, n, k, q)`` (None when not needed);
   optional weights ``w`` broadcastable to ``(T, n, k)``;
 * ``initial_points(theta) -> (T, n, d)``: a start for the points from the globals;
-* optionally ``n_obs`` (observations per trial, default ``n k``) and
-  ``retract(points, theta, dp, dg) -> (points, theta)`` (default: additive updates).
+* optionally ``n_obs`` (observations per trial, default ``n k``),
+  ``retract(points, theta, dp, dg) -> (points, theta)`` (default: additive updates) and
+  ``normal_blocks(points, theta, free) -> (Npp, up, Npg, Ngg, ug)``: the normal-equation
+  blocks of the free globals formed directly, for a Jacobian that is mostly zero (the engine
+  then never builds the dense one; :func:`sim.lsq.normals.reduce_blocks`).
 
 The Jacobian sign convention: ``r ~ Jp dp + Jg dg`` (corrections that reduce the misclosure).
 

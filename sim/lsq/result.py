@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .normals import RCOND, bordered_inverse, reduce
+from .normals import RCOND, bordered_inverse, reduced_normals
 from .problem import Datum
 
 __all__ = ["STATUS", "Cofactors", "cofactors", "Result"]
@@ -76,9 +76,7 @@ def cofactors(model, points: np.ndarray, theta: np.ndarray, datum: Datum | None 
     datum = Datum() if datum is None else datum
     free = datum.free_index(model.n_global)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        lin = model.linearize(points, theta, len(free) > 0)
-        Jg = lin.Jg[..., free] if len(free) else None
-        red = reduce(lin.r, lin.Jp, Jg, lin.w, rcond)
+        red = reduced_normals(model, points, theta, free, rcond)
         if len(free):
             Qgg, ok = bordered_inverse(red.Nbar, datum.constraint_matrix(theta), rcond)
             ok &= red.ok

@@ -59,8 +59,10 @@ def budget_chunk(bcfg, pts, th, sources, setting_sigma, settings, rng, n):
 
 
 def coverage_chunk(pts, th, sigma_um, alpha_test, rng, T):
-    """Pivot model in Brown's datum: per-point 95 % ellipse coverage (known sigma; s0 with F),
-    the global chi-square test, sigma0 (um) and the b = beta^2 / beta intervals."""
+    """Pivot model in Brown's datum (Brown's 7 globals, :mod:`sim.multilateration`: its
+    compiled kernel, the same adjustment as :mod:`sim.positions` in the ``brown`` datum):
+    per-point 95 % ellipse coverage (known sigma; s0 with F), the global chi-square test,
+    sigma0 (um) and the b = beta^2 / beta intervals."""
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # flagged trials
         n = len(pts)
         dof = 4 * n - (2 * n + 7)
@@ -69,8 +71,10 @@ def coverage_chunk(pts, th, sigma_um, alpha_test, rng, T):
         Pt = np.broadcast_to(pts, (T,) + pts.shape)
         TH = np.broadcast_to(thp, (T, 10))
         r = po.ranges(Pt, TH) + rng.normal(0.0, sigma_um * 1e-3, (T, n, 4))
-        res = po.adjust(r, "pivot", _start(thp), "brown", max_iter=60)
-        Qpp, Qgg = po.covariance(res.points, res.theta, "pivot", "brown")[:2]
+        t0 = np.array(th, float)
+        t0[5:] = 0.0
+        res = ml.adjust(r, "pivot", t0, max_iter=60)
+        Qpp, Qgg = ml.covariance(res.points, res.theta, "pivot")[:2]
         e = (res.points - Pt) * 1e3
         s0 = res.sigma0 * 1e3
         ink = cv.ellipse_inside(e, Qpp, sigma=sigma_um).mean(1)

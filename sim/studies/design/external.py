@@ -14,7 +14,11 @@ calibrated points):
   comparisons): Gaussian plates ``N(0, S F S^T sigma^2)`` with ``F`` the pivot model's
   cofactor (:func:`sim.positions.full_point_covariance`), ``S`` the rigid-fit projector and
   ``sigma`` the range sigma (Table 1's model: double settings of 1.7 um and 1.1 um of random
-  comparator error); the Zeiss comparison adds the grid's 0.8 um per coordinate.
+  comparator error); the Zeiss comparison adds the grid's 0.8 um per coordinate. The plates
+  are drawn along the eigenvectors of ``S F S^T``, which within a (nearly) repeated
+  eigenvalue turn with the last bits of ``F``: a rounding change of ``F`` would redraw a
+  plate (the same distribution, another sample), so ``F`` comes from the dense reference
+  route of the engine, bit for bit as before.
 """
 from __future__ import annotations
 
@@ -81,8 +85,8 @@ def plate_rms(cfg: dict, pts: np.ndarray, offset: float, beta: float, sr_um: flo
     all points: without and with ``extra_um`` of independent per-coordinate error (a reference
     grid's) added before the fit."""
     th = _theta(cfg, offset, beta)
-    with np.errstate(invalid="ignore"):
-        F = po.full_point_covariance(pts[None], th[None], "pivot", "inner")[0]
+    with np.errstate(invalid="ignore"):  # dense: the plates below depend on F's last bits
+        F = po.full_point_covariance(pts[None], th[None], "pivot", "inner", dense=True)[0]
     S = dm.s_matrix(dm.null_basis(pts))
     C = S @ F @ S.T * sr_um ** 2
     w, V = np.linalg.eigh((C + C.T) / 2)
