@@ -128,3 +128,17 @@ def test_compiled_linearisation_equals_numpy(setup):
     for a, f in ((ref.r, fast.r), (ref.Jg, fast.Jg), (ref.Jp, fast.Jp), (ref.rc, fast.rc)):
         assert a.shape == f.shape
         assert np.abs(f - a).max() <= 1e-12 * np.abs(a).max()
+
+
+def test_singular_and_non_finite_trials_are_flagged(setup):
+    """A trial whose model 0 lost every observation (singular normals) and one with a
+    non-finite model coordinate are flagged; the others are the same as adjusted alone."""
+    b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
+    xm, w = xm.copy(), w.copy()
+    w[0, st.obs_model == 0] = 0.0
+    xm[2, 3, 1] = np.nan
+    res = im.adjust_block(st, xm, w, cx, wc, s0, R0, t0, X0)
+    assert res.status[0] == 2 and res.status[2] != 0 and not res.converged[[0, 2]].any()
+    one = im.adjust_block(st, xm[1:2], w[1:2], cx[1:2], wc, s0[1:2], R0[1:2], t0[1:2], X0[1:2])
+    assert res.status[1] == 0
+    assert np.allclose(res.X[1], one.X[0], rtol=0, atol=1e-9)
