@@ -16,9 +16,6 @@ import numpy as np
 
 __all__ = ["linearize"]
 
-_kernel = None
-
-
 def _linearize(xm, c, theta, X, om, op, r, J):  # pragma: no cover - compiled
     T, K = xm.shape[0], xm.shape[1]
     d = np.empty(3)
@@ -47,22 +44,16 @@ def _linearize(xm, c, theta, X, om, op, r, J):  # pragma: no cover - compiled
 
 
 def _compiled():
-    global _kernel
-    if _kernel is None:
-        from .lsq import group_kernel
+    from .lsq import group_kernel
 
-        if not group_kernel.available():   # numba missing or SIM_NO_JIT: the NumPy code
-            _kernel = False
-        else:
-            from numba import njit
-            _kernel = njit(cache=True, error_model="numpy")(_linearize)
-    return _kernel
+    # numba missing or SIM_NO_JIT: None, and the NumPy code runs
+    return group_kernel.compiled(_linearize) if group_kernel.available() else None
 
 
 def linearize(xm, c, theta, X, om, op):
     """``(r (T, K, 3), J (T, K, 3, 7))`` as described above, or None without numba."""
     k = _compiled()
-    if not k:
+    if k is None:
         return None
     T, K = xm.shape[:2]
     r, J = np.empty((T, K, 3)), np.empty((T, K, 3, 7))

@@ -82,7 +82,7 @@ def test_chol_subst_blocks_match_numpy():
 def test_compiled_kernels_equal_numpy(setup):
     """The compiled pair blocks and residual cofactors (sim.lsq.group_kernel) equal the NumPy
     path to rounding, with a removed observation (weight 0)."""
-    from sim.lsq import group_kernel
+    from sim.lsq import group_kernel, group_kernel_solve
     if not group_kernel.available():
         pytest.skip("numba not installed")
     b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
@@ -100,10 +100,13 @@ def test_compiled_kernels_equal_numpy(setup):
                  (groups.points_step(st, r0, dg),
                   np.einsum("tpij,tpj->tpi", r0.Ninv, r0.up - groups.scatter(
                       st.S_point, (r0.Npg * dg[:, st.obs_group, None, :]).sum(-1)))),
-                 (gs.chol_subst(L, y[..., None])[..., 0], group_kernel.chol_vec(L, y))):
+                 (gs.chol_subst(L, y[..., None])[..., 0], group_kernel_solve.chol_vec(L, y)),
+                 (gs.chol_subst(L, np.broadcast_to(np.eye(L.shape[1]), L.shape).copy()),
+                  group_kernel_solve.chol_inv(L))):
         assert np.abs(c - a).max() <= 1e-12 * np.abs(a).max()
     assert r1.ok.tolist() == r0.ok.tolist()
-    for a, c in zip(gs.scaled(gs.dense(st, r0.blocks)), group_kernel.dense_scaled(st, r0.blocks)):
+    for a, c in zip(gs.scaled(gs.dense(st, r0.blocks)),
+                    group_kernel_solve.dense_scaled(st, r0.blocks)):
         assert np.array_equal(a, c)
     cof = groups.cofactors(st, lin)
     for pts in (None, b.is_pass):

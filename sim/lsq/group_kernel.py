@@ -1,22 +1,24 @@
-"""Compiled kernels of the group-block engine (:mod:`sim.lsq.groups`), via numba.
+"""Compiled kernels of the group-block engine (:mod:`sim.lsq.groups`): the reduction, via numba.
 
 Seed of the method: Agnard, Nolette & Gagnon (``003_5ce730a990a7ebc5.txt``, the reduced
-normals of SPACE-M's block of independent models). Two loops that NumPy can only do with
-large gathered temporaries (one copy of the Jacobians per pair of observations of a point):
+normals of SPACE-M's block of independent models). Loops that NumPy can only do with large
+gathered temporaries (one copy of the Jacobians per pair of observations of a point):
 
 * :func:`pair_blocks` -- the group-pair blocks of the reduced normals,
   ``Nbar[g1, g2] = delta Ngg[g1] - sum_{k1, k2 on one point} Npg_k1' Npp^-1 Npg_k2``, and the
   reduced right-hand side ``ubar[g] = sum_{k of g} (Jg_k' W_k r_k - F_k' up_j)``, with
   ``F_k = Npp_j^-1 Npg_k``. Only the pairs with ``g1 <= g2`` are summed; the others are the
   transposes (the matrix is symmetric).
-* :func:`residual_cofactors` -- the diagonal of ``Q_vv = W^-1 - A Q_xx A'`` of the
-  observation rows of chosen points, from the dense group cofactors ``Q`` (T, G b, G b):
-  ``H_k = sum_{k2 on j} Q[g_k, g_k2] F_k2'``, ``Q(p_j) = Npp_j^-1 + sum_{k on j} F_k H_k``.
+* :func:`diag_reduce` -- the whole reduction when the point Jacobians are one constant
+  diagonal matrix (coordinates observed directly): diagonal point blocks, their inverse,
+  and the pair blocks, ``Ngg_k`` and the pair ``(k, k)`` summed as one term.
+* :func:`points_step` -- the point corrections ``Npp^-1 (up - sum_k Npg_k dg_k)``.
 
-Every trial is the same arithmetic as the NumPy path of :mod:`sim.lsq.groups`, summed in
-another order: the two agree to rounding (a test holds them to 1e-12 relative). Units: those
-of the model. numba is imported on first use and the compiled code cached on disk; without
-numba (or with ``SIM_NO_JIT`` set) :data:`AVAILABLE` is False and the NumPy path runs.
+The solve and the cofactors are in :mod:`sim.lsq.group_kernel_solve`. Every trial is the
+same arithmetic as the NumPy path of :mod:`sim.lsq.groups`, summed in another order: the
+two agree to rounding (tests hold them to 1e-12 relative). Units: those of the model. numba
+is imported on first use and the compiled code cached on disk (:func:`compiled`); without
+numba, or with ``SIM_NO_JIT`` set, :func:`available` is False and the NumPy path runs.
 """
 from __future__ import annotations
 
@@ -24,8 +26,7 @@ import os
 
 import numpy as np
 
-__all__ = ["available", "pair_blocks", "diag_reduce", "points_step", "dense_scaled", "chol_vec",
-           "residual_cofactors"]
+__all__ = ["available", "compiled", "pair_blocks", "diag_reduce", "points_step", "index"]
 
 _compiled: dict | None = None
 
@@ -75,81 +76,10 @@ def _pair_blocks(Npg, F, Jg, w, r, up, og, op, pk1, pk2, pq, mir_dst, mir_src, d
                     blocks[t, mir_dst[e], i, j] = blocks[t, mir_src[e], j, i]
 
 
-def _residual_cofactors(Q, F, Ninv, Jg, Jp, w, og, op, pts, pstart, pobs, out):
-    # pragma: no cover - compiled
-    T = F.shape[0]
-    d, b, m = D_POINT, B_GROUP, M_ROWS    # compile-time constants (see _specialised)
-    nmax = 0
-    for j in pts:
-        nmax = max(nmax, pstart[j + 1] - pstart[j])
-    H = np.empty((nmax, b, d))
-    Qpp = np.empty((d, d))
-    JH = np.empty((m, d))
-    JQ = np.empty((m, b))
-    for t in range(T):
-        for j in pts:
-            s0, s1 = pstart[j], pstart[j + 1]
-            n = s1 - s0
-            for u in range(n):
-                k = pobs[s0 + u]
-                gk = og[k] * b
-                for i in range(b):
-                    for a in range(d):
-                        H[u, i, a] = 0.0
-                for u2 in range(n):
-                    k2 = pobs[s0 + u2]
-                    g2 = og[k2] * b
-                    for i in range(b):
-                        for jj in range(b):
-                            qv = Q[t, gk + i, g2 + jj]
-                            for a in range(d):
-                                H[u, i, a] += qv * F[t, k2, a, jj]
-            for a in range(d):
-                for c in range(d):
-                    Qpp[a, c] = Ninv[t, j, a, c]
-            for u in range(n):
-                k = pobs[s0 + u]
-                for a in range(d):
-                    for c in range(d):
-                        v = 0.0
-                        for i in range(b):
-                            v += F[t, k, a, i] * H[u, i, c]
-                        Qpp[a, c] += v
-            for u in range(n):
-                k = pobs[s0 + u]
-                gk = og[k] * b
-                for c in range(m):
-                    for i in range(b):
-                        v = 0.0
-                        for jj in range(b):
-                            v += Jg[t, k, c, jj] * Q[t, gk + jj, gk + i]
-                        JQ[c, i] = v
-                    for a in range(d):
-                        v = 0.0
-                        for i in range(b):
-                            v += Jg[t, k, c, i] * H[u, i, a]
-                        JH[c, a] = v
-                for c in range(m):
-                    aqa = 0.0
-                    for i in range(b):
-                        aqa += JQ[c, i] * Jg[t, k, c, i]
-                    x = 0.0
-                    for a in range(d):
-                        x += JH[c, a] * Jp[t, k, c, a]
-                    aqa -= 2.0 * x
-                    for a in range(d):
-                        v = 0.0
-                        for e in range(d):
-                            v += Jp[t, k, c, e] * Qpp[e, a]
-                        aqa += v * Jp[t, k, c, a]
-                    wc = w[t, k, c]
-                    out[t, k, c] = 1.0 / wc - aqa if wc > 0 else np.nan
-
-
 def _diag_reduce(Jg, w, r, wc, rc, jp, jc, og, op, rows, diag_obs, xk1, xk2, xq, mir_dst,
                  mir_src, npp, up, Npg, F, ok, blocks, ubar):  # pragma: no cover - compiled
     T, K = Jg.shape[0], Jg.shape[1]
-    m, b = D_POINT, B_GROUP    # compile-time constants (see _specialised); m = d here
+    m, b = D_POINT, B_GROUP    # compile-time constants (see compiled); m = d here
     P = npp.shape[1]
     C = rows.shape[0]
     for t in range(T):
@@ -238,82 +168,43 @@ def _points_step(Npg, Ninv, up, dg, og, op, out):  # pragma: no cover - compiled
                 out[t, j, a] = v
 
 
-def _dense_scaled(blocks, pg1, pg2, N, s):  # pragma: no cover - compiled
-    T, n_p, b = blocks.shape[0], blocks.shape[1], blocks.shape[2]
-    n = N.shape[1]
-    for t in range(T):
-        N[t] = 0.0
-        for p in range(n_p):
-            r0, c0 = pg1[p] * b, pg2[p] * b
-            for i in range(b):
-                for j in range(b):
-                    N[t, r0 + i, c0 + j] = blocks[t, p, i, j]
-        for i in range(n):
-            dg = abs(N[t, i, i])
-            s[t, i] = 1.0 / np.sqrt(dg) if dg > 0 else 1.0
-        for i in range(n):
-            for j in range(n):
-                N[t, i, j] = N[t, i, j] * s[t, i] * s[t, j]
-
-
-def _chol_vec(L, y, x):  # pragma: no cover - compiled
-    T, n = y.shape
-    z = np.empty(n)
-    for t in range(T):
-        for i in range(n):
-            v = y[t, i]
-            for k in range(i):
-                v -= L[t, i, k] * z[k]
-            z[i] = v / L[t, i, i]
-        for i in range(n - 1, -1, -1):
-            v = z[i]
-            for k in range(i + 1, n):
-                v -= L[t, k, i] * x[t, k]
-            x[t, i] = v / L[t, i, i]
-
-
-def _kernels() -> dict | None:
-    """The compiled kernels (compiled or loaded from the disk cache once per process), or
-    None without numba."""
+def _numba():
+    """numba's ``njit``, or None without numba or with ``SIM_NO_JIT`` set."""
     global _compiled
     if _compiled is None:
-        if os.environ.get("SIM_NO_JIT"):
-            _compiled = {}
-        else:
+        _compiled = {}
+        if not os.environ.get("SIM_NO_JIT"):
             try:
                 from numba import njit
             except ImportError:  # pragma: no cover - the NumPy path runs
-                _compiled = {}
+                pass
             else:
-                jit = njit(cache=True, error_model="numpy")
-                _compiled = {"pairs": jit(_pair_blocks), "dense": jit(_dense_scaled),
-                             "points": jit(_points_step),
-                             "chol": jit(_chol_vec)}
-    return _compiled or None
+                _compiled["njit"] = njit
+    return _compiled.get("njit")
 
 
-def _specialised(fn, d: int, b: int, m: int):
-    """``fn`` compiled with the block sizes ``d`` (point unknowns), ``b`` (group unknowns)
-    and ``m`` (rows per observation) frozen to constants (numba treats globals as such),
-    which lets the compiler unroll and vectorise the small loops; cached on disk under its
-    own name."""
+def compiled(fn, **consts):
+    """``fn`` compiled by numba (once per process; cached on disk). ``consts`` (e.g. block
+    sizes ``D_POINT``, ``B_GROUP``, ``M_ROWS``) are frozen into its globals as compile-time
+    constants (numba treats globals as such), which lets the compiler unroll and vectorise
+    the small loops; each variant is cached under its own name. Needs :func:`available`."""
     import types
 
-    from numba import njit
-
-    key = (fn.__name__, d, b, m)
+    key = (fn.__module__, fn.__name__) + tuple(sorted(consts.items()))
     if key not in _compiled:
-        name = f"{fn.__name__}_{d}_{b}_{m}"
-        f = types.FunctionType(fn.__code__, dict(fn.__globals__, D_POINT=d, B_GROUP=b, M_ROWS=m),
-                               name, fn.__defaults__, fn.__closure__)
-        f.__qualname__ = name
-        _compiled[key] = njit(cache=True, error_model="numpy")(f)
+        f = fn
+        if consts:
+            name = "_".join([fn.__name__] + [str(v) for _, v in sorted(consts.items())])
+            f = types.FunctionType(fn.__code__, dict(fn.__globals__, **consts), name,
+                                   fn.__defaults__, fn.__closure__)
+            f.__qualname__ = name
+        _compiled[key] = _numba()(cache=True, error_model="numpy")(f)
     return _compiled[key]
 
 
 def available() -> bool:
     """Whether the compiled kernels run (numba installed and ``SIM_NO_JIT`` unset)."""
-    return _kernels() is not None
+    return _numba() is not None
 
 
 def _c(a: np.ndarray) -> np.ndarray:
@@ -327,7 +218,7 @@ def pair_blocks(st, Npg, F, Jg, w, r, up):
     blocks = np.empty((T, st.pair_g1.size, b, b))
     ubar = np.empty((T, st.n_groups, b))
     ix = st.kernel_index
-    _kernels()["pairs"](_c(Npg), _c(F), _c(Jg), _c(w), _c(r), _c(up), ix["og"], ix["op"],
+    compiled(_pair_blocks)(_c(Npg), _c(F), _c(Jg), _c(w), _c(r), _c(up), ix["og"], ix["op"],
                         ix["pk1"], ix["pk2"], ix["pq"], ix["mir_dst"], ix["mir_src"],
                         ix["diag_obs"], blocks, ubar)
     return blocks, ubar
@@ -346,8 +237,7 @@ def diag_reduce(st, lin, jp: np.ndarray, jc: np.ndarray):
     ok = np.empty(T, np.bool_)
     blocks = np.empty((T, st.pair_g1.size, b, b))
     ubar = np.empty((T, st.n_groups, b))
-    _kernels()
-    _specialised(_diag_reduce, m, b, m)(_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc),
+    compiled(_diag_reduce, D_POINT=m, B_GROUP=b)(_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc),
                        ix["og"], ix["op"], ix["rows"], ix["diag_obs"], ix["xk1"], ix["xk2"],
                        ix["xq"], ix["mir_dst"], ix["mir_src"], ninv, up, Npg, F, ok, blocks,
                        ubar)
@@ -358,37 +248,7 @@ def points_step(st, Npg, Ninv, up, dg) -> np.ndarray:
     """Point corrections ``Npp^-1 (up - sum_k Npg_k dg_k)`` (T, P, d)."""
     ix = st.kernel_index
     out = np.empty(up.shape)
-    _kernels()["points"](_c(Npg), _c(Ninv), _c(up), _c(dg), ix["og"], ix["op"], out)
-    return out
-
-
-def dense_scaled(st, blocks: np.ndarray):
-    """The reduced normal matrix (T, G b, G b) from its pair blocks, scaled to unit diagonal,
-    and the scale ``s`` (T, G b): :func:`sim.lsq.group_solve.dense` then ``scaled``."""
-    T, n_p, b = blocks.shape[:3]
-    n = st.n_groups * b
-    N, s = np.empty((T, n, n)), np.empty((T, n))
-    ix = st.kernel_index
-    _kernels()["dense"](_c(blocks), ix["pg1"], ix["pg2"], N, s)
-    return N, s
-
-
-def chol_vec(L: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Solve ``L L' x = y`` for ``L`` (T, n, n) lower triangular, ``y`` (T, n)."""
-    x = np.empty(y.shape)
-    _kernels()["chol"](_c(L), _c(y), x)
-    return x
-
-
-def residual_cofactors(st, Q, F, Ninv, Jg, Jp, w, points: np.ndarray) -> np.ndarray:
-    """Diagonal of ``Q_vv`` (T, K, m) for the observations of ``points`` (indices), NaN
-    elsewhere and where the weight is zero; ``Q`` (T, G b, G b) the group cofactors."""
-    ix = st.kernel_index
-    out = np.full(w.shape, np.nan)
-    T, K, d, b = F.shape
-    _kernels()
-    _specialised(_residual_cofactors, d, b, Jg.shape[2])(_c(Q), _c(F), _c(Ninv), _c(Jg), _c(Jp), _c(w), ix["og"], ix["op"],
-                        np.asarray(points, np.int64), ix["pstart"], ix["pobs"], out)
+    compiled(_points_step)(_c(Npg), _c(Ninv), _c(up), _c(dg), ix["og"], ix["op"], out)
     return out
 
 

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from . import group_kernel
+from . import group_kernel, group_kernel_solve
 from .group_solve import (band_order, band_solve, chol_solve, chol_subst, dense, factor,
                           inv_points, regular, regular_points, scaled)
 from .normals import RCOND
@@ -237,11 +237,11 @@ def solve(st: GroupStructure, red: GroupReduced, solver: str = "auto",
         if solver == "sparse":
             dg, ok = band_solve(st, red.blocks, rhs)
         else:
-            Ns, s = (group_kernel.dense_scaled(st, red.blocks) if group_kernel.available()
+            Ns, s = (group_kernel_solve.dense_scaled(st, red.blocks) if group_kernel.available()
                      else scaled(dense(st, red.blocks)))
             L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)), rcond, check)
             if group_kernel.available():
-                dg = group_kernel.chol_vec(L, rhs * s) * s
+                dg = group_kernel_solve.chol_vec(L, rhs * s) * s
             else:
                 dg = chol_subst(L, (rhs * s)[..., None])[..., 0] * s
     ok &= red.ok
@@ -315,7 +315,7 @@ class GroupCofactors:
         """Diagonal of ``Q_vv = W^-1 - A Q_xx A'`` of the observation rows (T, K, m); NaN
         where the weight is zero, and, with ``points`` (bool (P,)), for the observations of
         the other points (not computed). ``jit`` (None: when numba is there): by the
-        compiled kernel :func:`sim.lsq.group_kernel.residual_cofactors`."""
+        compiled kernel :func:`sim.lsq.group_kernel_solve.residual_cofactors`."""
         st = self.st
         og, op = st.obs_group, st.obs_point
         if group_kernel.available() if jit is None else jit:
@@ -323,7 +323,7 @@ class GroupCofactors:
             Q = self.Q.transpose(0, 1, 3, 2, 4).reshape(T, G * b, G * b)
             pts = (np.arange(st.n_points) if points is None
                    else np.flatnonzero(np.asarray(points, bool)))
-            return group_kernel.residual_cofactors(st, Q, self.red.NinvK, self.red.Ninv,
+            return group_kernel_solve.residual_cofactors(st, Q, self.red.NinvK, self.red.Ninv,
                                                    lin.Jg, lin.Jp, lin.w, pts)
         if points is None:
             ks, H, Qpp = slice(None), self.H, self.points
@@ -347,11 +347,12 @@ class GroupCofactors:
 def cofactors(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND) -> GroupCofactors:
     """Cofactors (dense inverse of the reduced normals; NaN for singular trials)."""
     red = reduce(st, lin, rcond)
-    Ns, s = (group_kernel.dense_scaled(st, red.blocks) if group_kernel.available()
+    Ns, s = (group_kernel_solve.dense_scaled(st, red.blocks) if group_kernel.available()
              else scaled(dense(st, red.blocks)))
     T, n = Ns.shape[:2]
     L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)) & red.ok, rcond, True)
-    Q = chol_subst(L, np.broadcast_to(np.eye(n), (T, n, n)).copy())
+    Q = (group_kernel_solve.chol_inv(L) if group_kernel.available()
+         else chol_subst(L, np.broadcast_to(np.eye(n), (T, n, n)).copy()))
     Q = Q * s[:, :, None] * s[:, None, :]
     Q[~ok] = np.nan
     G = st.n_groups
