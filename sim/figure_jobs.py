@@ -4,7 +4,9 @@ A study's figures are independent of each other and are drawn after its chunks a
 the workers of a local process pool (``--workers N``) or of a local Dask cluster sit idle.
 :func:`draw_figures` sends each figure job there; without a pool (``--workers 1``, a remote
 Dask scheduler that may not see the output directory) it draws them in this process, in the
-given order. A job is ``(fn, args)`` with ``fn`` a module-level function (picklable) that
+given order. :func:`start_figures` sends them and returns at once, so the figures are drawn
+while this process goes on with the run (the sweeps, the claims); its ``wait`` collects them.
+A job is ``(fn, args)`` with ``fn`` a module-level function (picklable) that
 draws one figure and saves it (:func:`sim.plotting.save`); the files are the same either way.
 """
 from __future__ import annotations
@@ -12,7 +14,7 @@ from __future__ import annotations
 from concurrent.futures import Executor
 from typing import Callable, Sequence
 
-__all__ = ["draw_figures"]
+__all__ = ["draw_figures", "start_figures"]
 
 
 def _submitter(executor) -> Callable | None:
@@ -25,15 +27,27 @@ def _submitter(executor) -> Callable | None:
     return None
 
 
+def start_figures(jobs: Sequence[tuple[Callable, tuple]], executor=None) -> Callable[[], None]:
+    """Send every ``fn(*args)`` of ``jobs`` to the executor's local workers when it has some
+    (in order: put the dearest first), else draw them here at once. Returns ``wait()``, which
+    returns when every figure is drawn and raises a job's exception here."""
+    submit = _submitter(executor)
+    if submit is None:
+        for fn, args in jobs:
+            fn(*args)
+        return lambda: None
+    futures = [submit(fn, *args) for fn, args in jobs]
+
+    def wait() -> None:
+        for f in futures:
+            f.result()
+    return wait
+
+
 def draw_figures(jobs: Sequence[tuple[Callable, tuple]], executor=None) -> None:
     """Run every ``fn(*args)`` of ``jobs``: on the executor's local workers when it has some,
     else here. Put the dearest figures first (the pool takes them in order). An exception in
     a job is raised here."""
-    submit = _submitter(executor) if len(jobs) > 1 else None
-    if submit is None:
-        for fn, args in jobs:
-            fn(*args)
-        return
-    futures = [submit(fn, *args) for fn, args in jobs]
-    for f in futures:
-        f.result()
+    if len(jobs) < 2:
+        executor = None
+    start_figures(jobs, executor)()

@@ -84,13 +84,36 @@ def same_files(a: Path, b: Path) -> None:
         assert same_table(a / f, b / f), f
 
 
+CLUSTER = """
+import sys
+from dask.distributed import LocalCluster
+with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                  dashboard_address=None) as cluster:
+    print(cluster.scheduler_address, flush=True)
+    sys.stdin.read()                     # until the test module closes our stdin
+"""
+
+
 @pytest.fixture(scope="module")
 def scheduler():
-    """A Dask LocalCluster with 2 single-threaded worker processes, shared by the studies."""
-    distributed = pytest.importorskip("dask.distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
-        yield cluster.scheduler_address
+    """A Dask LocalCluster with 2 single-threaded worker processes, shared by the studies. It
+    lives in a process of its own, so nothing the test process does (forks, signals) reaches
+    its workers."""
+    pytest.importorskip("dask.distributed")
+    p = subprocess.Popen([sys.executable, "-c", CLUSTER], cwd=ROOT, stdin=subprocess.PIPE,
+                         stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                         start_new_session=True)
+    try:
+        address = p.stdout.readline().strip()
+        assert address.startswith("tcp://"), "the Dask cluster did not start"
+        yield address
+    finally:
+        p.stdin.close()
+        try:
+            p.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
 
 
 @pytest.mark.parametrize("study", sorted(MODULES))

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ...claims import write_claims
+from ...figure_jobs import start_figures
 from ...storage import provenance, write_table
 from .. import RunContext
 from . import figures as F
@@ -53,19 +54,21 @@ def run_dilution(cfg: dict, out: Path, ctx: RunContext) -> None:
         "dil_mean_pct": [float(curve[k].mean()) for k in ks],
         "dil_max_pct": [float(curve[k].max()) for k in ks],
         "pivot_extra_max_pct": [float(extra[k].max()) for k in ks]}, prov)
+    unit = {m: an[m] / sr for m in MODEL_NAMES}
+    drawn = start_figures([   # on the idle workers while the claims and the sweep are made here
+        (F.fig_dilution_points, (cfg, pts, theta, unit, out / "dilution_points.png")),
+        (F.fig_sigma_maps, (cfg, pts, theta, out / "sigma_maps.png")),
+        (F.fig_mc_vs_analytic, (cols, mc.N, out / "mc_vs_analytic.png")),
+        (F.fig_dilution_vs_points, (out / "dilution_vs_points.parquet",
+                                    out / "dilution_vs_points.png"))], ctx.executor)
 
     book = load_book("brown_dilution")
-    unit = {m: an[m] / sr for m in MODEL_NAMES}
     rows = score_dilution(book, cfg, pts, theta, unit, mc, sim, curve, extra, mono)
     write_claims(out / "claims.parquet", rows, prov, book)
     sw = sweep_dilution(cfg, load_book("brown_dilution"), pts)
     _write_sweep(out, sw, cfg, prov)
-
-    F.fig_sigma_maps(cfg, pts, theta, out / "sigma_maps.png")
-    F.fig_dilution_points(cfg, pts, theta, unit, out / "dilution_points.png")
-    F.fig_dilution_vs_points(out / "dilution_vs_points.parquet", out / "dilution_vs_points.png")
-    F.fig_mc_vs_analytic(cols, mc.N, out / "mc_vs_analytic.png")
     F.fig_consistent_set(out, out / "consistent_set.png")
+    drawn()
 
 
 def run_table1(cfg: dict, out: Path, ctx: RunContext) -> None:
@@ -83,8 +86,9 @@ def run_table1(cfg: dict, out: Path, ctx: RunContext) -> None:
     book = load_book("brown_table1")
     rows = score_table1(book, cfg, pts, an["pivot"], sr, mc, t1)
     write_claims(out / "claims.parquet", rows, prov, book)
+    drawn = start_figures([(F.fig_table1, (cfg, pts, theta, an["pivot"], t1, out / "table1.png"))],
+                          ctx.executor)   # on an idle worker while the sweep is made here
     sw = sweep_table1(cfg, load_book("brown_table1"), pts, sr)
     _write_sweep(out, sw, cfg, prov)
-
-    F.fig_table1(cfg, pts, theta, an["pivot"], t1, out / "table1.png")
     F.fig_consistent_set(out, out / "consistent_set.png")
+    drawn()

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ...claims import write_claims
+from ...figure_jobs import start_figures
 from ...intervals import spread
 from ...runner import chunk_rng, run_chunks
 from ...storage import provenance, write_table
@@ -80,15 +81,18 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     beyond = beyond_table(res, ratios, j_true)
     write_table(out / "beyond.parquet", beyond, prov)
     rows, book = score(cfg, res, beyond, {"j_true": j_true})
+    paper = [(r, book.spec(f"twoplate.weight_ratio.grid_sigma_1to{r}_um")["ref"]) for r in (2, 3)]
+    drawn = start_figures([   # on the idle workers while the sweep is made here
+        (F.fig_params, (cfg, res, out / "parameters.png")),
+        (F.fig_coverage, (cov, ratio_true, out / "coverage.png")),
+        (F.fig_chi2, (ch, sgt, out / "chi2_power.png")),
+        (F.fig_implied, (imp, cfg["grid.sigma_stated_um"], paper, out / "implied_grid.png"))],
+        ctx.executor)
     det, cons = run_sweep(book, cfg)
     write_table(out / "sweep.parquet", det, prov)
     write_table(out / "consistent_set.parquet", cons, prov)
     ex = simulate(cfg, chunk_rng(cfg["seed"], 1, 0), 1)  # one calibration, its own stream
     write_table(out / "example_plate.parquet", F.fig_residuals(cfg, ex, out / "residuals.png"), prov)
-    F.fig_params(cfg, res, out / "parameters.png")
-    F.fig_coverage(cov, ratio_true, out / "coverage.png")
-    F.fig_chi2(ch, sgt, out / "chi2_power.png")
-    paper = [(r, book.spec(f"twoplate.weight_ratio.grid_sigma_1to{r}_um")["ref"]) for r in (2, 3)]
-    F.fig_implied(imp, cfg["grid.sigma_stated_um"], paper, out / "implied_grid.png")
     F.fig_consistent(det, cons, out / "consistent_set.png")
+    drawn()
     write_claims(out / "claims.parquet", rows, prov, book)

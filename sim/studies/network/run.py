@@ -18,6 +18,7 @@ import numpy as np
 
 from ...claims import ClaimBook, write_claims
 from ...config import ConfigError, StudyError
+from ...figure_jobs import draw_figures
 from ...runner import jackknife, run_chunks
 from ...storage import provenance, write_table
 from .analysis import CHI2_2_95, analyse, ellipse, in_datum, mc_chunk
@@ -170,8 +171,8 @@ def run(cfg: dict, out: Path, ctx) -> None:
               "r_min": float(an.redundancy.min()), "mdb_mm": an.mdb[~np.isin(net.kind, (1, 2))],
               "sigma_rms": float(np.sqrt(np.mean(an_sig ** 2)))}
     _claims(out, prov, an, ratio, cover_mean, alarm, cfg, n_tot, design)
-    network_figure(net, an, pts, out / "network.png")
-    reliability_figure(net, an, out / "reliability.png")
+    draw_figures([(network_figure, (net, an, pts, out / "network.png")),
+                  (reliability_figure, (net, an, out / "reliability.png"))], ctx.executor)
 
 
 def _parameters(net: Network, an, sim: dict, n_ok: np.ndarray, out: Path, prov: dict) -> None:

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ...claims import write_claims
+from ...figure_jobs import start_figures
 from ...runner import chunk_rng, run_chunks
 from ...storage import provenance, write_table
 from .. import RunContext
@@ -52,14 +53,18 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
                     cfg["chunk"], part=3, label="vertical", quiet=ctx.quiet, ctx=ctx)
     write_table(out / "trials_vertical.parquet", vt, prov)
     rows, book = score(cfg, dec, rec, zs, vt)
+    drawn = start_figures([(F.fig_recovery, (rec, cfg, out / "recovery.png")),
+                           (F.fig_power, (sw, out / "power.png"))],
+                          ctx.executor)   # on the idle workers while the sweep is made here
     det, cons = run_sweep(book, cfg)
     write_table(out / "sweep.parquet", det, prov)
     write_table(out / "consistent_set.parquet", cons, prov)
     ex = simulate_chain(cfg, chunk_rng(cfg["seed"], 1, 0), 1, return_all=True)
-    F.fig_residuals(ex, cfg, out / "residuals.png")
-    F.fig_recovery(rec, cfg, out / "recovery.png")
-    F.fig_power(sw, out / "power.png")
     r = next(x for x in rows if x["claim"] == "salsig.vertical_halved.rms_ratio")
-    F.fig_vertical(det, (r["zone_low"], r["zone_high"]), out / "vertical.png")
+    more = start_figures([(F.fig_vertical, (det, (r["zone_low"], r["zone_high"]),
+                                            out / "vertical.png")),
+                          (F.fig_residuals, (ex, cfg, out / "residuals.png"))], ctx.executor)
     F.fig_consistent(det, cons, out / "consistent_set.png")
+    drawn()
+    more()
     write_claims(out / "claims.parquet", rows, prov, book)
