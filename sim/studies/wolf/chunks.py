@@ -8,7 +8,9 @@ The main experiment draws one set of instruments, placements and noise per chunk
 overrides the pointing sigma, the readings per point, the approach, the monocomparator sigma
 the restitution amplitude, the drifting share of the field or a common factor on the field
 amplitudes. Cells of one chunk share their random numbers, so
-the sweeps of the unprinted inputs and the readings trade-off compare like with like.
+the sweeps of the unprinted inputs and the readings trade-off compare like with like. Every
+chunk keeps freed memory in its process's heap (:func:`sim.heap.keep_heap`: fewer page
+faults, the same numbers).
 """
 from __future__ import annotations
 
@@ -19,6 +21,7 @@ import numpy as np
 
 from ... import errorfields as ef
 from ... import polynomial as pl
+from ...heap import keep_heap
 from .model import (Instrument, calib_dates, calibrate, correct_plate, ls_map, measure,
                     measure_parts, place, photo_points, read_placed, stats_cols, true_plate)
 from .schema import _index, grid_nodes, mid_cells
@@ -39,7 +42,7 @@ def _dates(cfg: dict, later) -> tuple[np.ndarray, np.ndarray]:
     return dates[order], rank
 
 
-def draw_main(cfg: dict, rng: np.random.Generator, T: int, nmax: int) -> dict:
+def draw_main(cfg: dict, rng: np.random.Generator, T: int, nmax: int, full: bool = True) -> dict:
     """Everything random about the main experiment for ``T`` instruments: the calibration sets
     (grid and cell centres), an independent plate read ``check.age_weeks`` after the last set,
     a P-30 photograph read on two dates (Table 1) and its monocomparator noise (Table 2)."""
@@ -62,8 +65,11 @@ def draw_main(cfg: dict, rng: np.random.Generator, T: int, nmax: int) -> dict:
     ph = photo_points(rng, cfg, T)
     rep = [place(rng, inst, int(rank[j]), ph, rot, shift, nmax) for j in (S + 1, S + 2)]
     mono_z = rng.normal(size=ph.shape)
-    comp = ef.evaluate_components(inst.spec, inst.static, G)
-    comp_rms = {k: math.sqrt(1 - inst.f) * np.sqrt((v ** 2).mean((1, 2))) for k, v in comp.items()}
+    comp_rms = {}
+    if full:  # the components' rms on the grid (no random numbers drawn here)
+        comp = ef.evaluate_components(inst.spec, inst.static, G)
+        comp_rms = {k: math.sqrt(1 - inst.f) * np.sqrt((v ** 2).mean((1, 2)))
+                    for k, v in comp.items()}
     return {"G": G, "Cm": Cm, "cal": cal, "pk": pk, "chk": chk, "ph": ph, "rep": rep,
             "mono_z": mono_z, "comp_rms": comp_rms}
 
@@ -145,8 +151,9 @@ def _cell(cfg: dict, over) -> dict:
 
 def _main_chunk_impl(cfg, cells, full, keep_vectors, rng: np.random.Generator, T: int) -> dict:
     """Chunk function of the main experiment; ``cells`` = ((tag, ((key, value), ...)), ...)."""
+    keep_heap()
     cl = [(tag, _cell(cfg, over)) for tag, over in cells]
-    D = draw_main(cfg, rng, T, max(c["reading.n"] for _, c in cl))
+    D = draw_main(cfg, rng, T, max(c["reading.n"] for _, c in cl), full)
     out, done = {}, {}
     for tag, c in cl:
         # cells that differ only in the monocomparator sigma (or not at all) read and reduce
@@ -181,6 +188,7 @@ def _degree_chunk_impl(cfg, spacing, rng: np.random.Generator, T: int) -> dict:
     least-squares similarity). NaN where the grid has fewer rows or columns than the degree
     needs (the polynomial is then not determined by the nominal grid).
     """
+    keep_heap()
     area = cfg["plate.area_mm"]
     G = grid_nodes(area, spacing)
     nx, ny = len(np.unique(G[:, 0])), len(np.unique(G[:, 1]))
@@ -222,6 +230,7 @@ def degree_chunk(cfg: dict, spacing: float):
 def _stability_chunk_impl(cfg, fractions, ages, rng_: np.random.Generator, T: int) -> dict:
     """Calibrate on the first ``calib.n_sets`` dates, read an independent plate at each age after
     the last set, for each drifting share ``f``: rms (um, both axes) before and after."""
+    keep_heap()
     S = cfg["calib.n_sets"]
     t_cal = calib_dates(cfg, S)
     dates = np.concatenate([t_cal, t_cal[-1] + np.asarray(ages, float)])

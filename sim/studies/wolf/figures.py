@@ -9,9 +9,10 @@ import matplotlib.colors
 import matplotlib.ticker
 import numpy as np
 
-from ...figure_jobs import draw_figures
+from ...figure_jobs import draw_figures, start_figures
 from ...plotting import plt, save
 from ...storage import read_table
+from .claims import load_book
 from .model import ls_map
 
 _UM_PER_MM = 2.5  # vector plots: 1 mm of plot = 2.5 um of discrepancy (50 um = 20 mm)
@@ -33,13 +34,32 @@ def _quiver(ax, x, y, dx, dy, title, key_um=20.0, um_per_mm=_UM_PER_MM):
     ax.set_ylabel("y (mm)")
 
 
+#: the figures whose tables the run writes before its trade-offs (the dearest first), and the
+#: others
+EARLY = ("consistent_figure", "components_figure", "vectors_figure", "readings_figure")
+LATE = ("stability_figure", "degree_figure", "table1_figure")
+
+
+def _jobs(names, cfg: dict, out: Path) -> list:
+    return [(globals()[n], (cfg, out) if n == "stability_figure" else (out,)) for n in names]
+
+
 def figures(cfg: dict, out: Path, executor=None) -> None:
     """Every figure of the study from its Parquet files, on the run's idle workers when
     there are some (:func:`sim.figure_jobs.draw_figures`), the dearest first."""
-    draw_figures([(consistent_figure, (out,)), (components_figure, (out,)),
-                  (vectors_figure, (out,)), (stability_figure, (cfg, out)),
-                  (degree_figure, (out,)), (readings_figure, (out,)),
-                  (table1_figure, (out,))], executor)
+    draw_figures(_jobs(EARLY + LATE, cfg, out), executor)
+
+
+def start_early(cfg: dict, out: Path, executor=None):
+    """Send the :data:`EARLY` figures to the run's workers (their tables are written) while
+    the trade-offs run; returns the function that waits for them
+    (:func:`sim.figure_jobs.start_figures`)."""
+    return start_figures(_jobs(EARLY, cfg, out), executor)
+
+
+def late(cfg: dict, out: Path, executor=None) -> None:
+    """The :data:`LATE` figures (drawn once the trade-offs' tables are written)."""
+    draw_figures(_jobs(LATE, cfg, out), executor)
 
 
 def vectors_figure(out: Path) -> None:
@@ -182,13 +202,26 @@ _LABEL = {"reading.pointing_sigma_um": "pointing sigma of one reading (um)",
           "field.drift_fraction": "drifting share of the field's variance"}
 
 
+def _references() -> dict:
+    """``claim -> {"ref_low", "ref_high"}`` of the claim book (the study's claim data, the
+    same numbers as those columns of ``claims.parquet``; None where the paper prints none), so
+    the figure needs no table written after the sweeps."""
+    out = {}
+    for cid, s in load_book().specs.items():
+        ref = s.get("ref")
+        ref = (None, None) if ref is None else (ref if isinstance(ref, list) else [ref, ref])
+        out[cid] = {"ref_low": None if ref[0] is None else float(ref[0]),
+                    "ref_high": None if ref[1] is None else float(ref[1])}
+    return out
+
+
 def consistent_figure(out: Path) -> None:
     """Claims against each unprinted input: left, the simulated rms (median and 95 % range of
     instruments) with the paper's printed rms values as dotted lines; right, where each
     dependent claim is consistent (bars) and the consistent set (shaded)."""
     v = {k: np.asarray(a) for k, a in read_table(out / "sweep_values.parquet").to_pydict().items()}
     c = read_table(out / "consistent_set.parquet").to_pylist()
-    cl = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
+    cl = _references()
     inputs = list(dict.fromkeys(v["input"]))
     fig, axs = plt.subplots(len(inputs), 2, figsize=(13, 6.0 * len(inputs)), squeeze=False,
                             gridspec_kw={"width_ratios": [1, 1.25], "wspace": 0.45,

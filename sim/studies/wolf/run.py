@@ -89,6 +89,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     vals, cons = consistent.evaluate(cfg, res, book)
     write_table(out / "sweep_values.parquet", vals, prov)
     write_table(out / "consistent_set.parquet", cons, prov)
+    wait_early = figures.start_early(cfg, out, ctx.executor)   # drawn while the trade-offs run
 
     degt = _degree(cfg, out, prov, ctx)
     _stability(cfg, out, prov, ctx)
@@ -98,7 +99,8 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_table(out / "table1_real.parquet", t1, prov)
     write_table(out / "table3_real.parquet", t3, prov)
     write_claims(out / "claims.parquet", cl.rows(cfg, main, t1, t3, degt, book), prov, book)
-    figures.figures(cfg, out, ctx.executor)
+    figures.late(cfg, out, ctx.executor)
+    wait_early()
 
 
 def _vectors_and_components(cfg, out, prov):
