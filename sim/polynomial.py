@@ -52,23 +52,28 @@ def poly_terms(degree: int) -> tuple[tuple[int, int], ...]:
 def design(pts: np.ndarray, terms, norm_mm: float = 100.0) -> np.ndarray:
     """Design matrix ``(..., n, p)`` of the monomials ``terms`` at ``pts`` ``(..., n, 2)`` mm.
 
-    Columns are ``(X / norm)^i (Y / norm)^j``.
+    Columns are ``(X / norm)^i (Y / norm)^j``. Each column is built as one contiguous vector
+    over all trials and points (the returned array is a transposed view of a ``(p, ...)``
+    array: every trial's block is Fortran-ordered, which the matrix products take as it is).
     """
     u = np.asarray(pts, float) / norm_mm
-    x, y = u[..., 0], u[..., 1]
+    lead = u.shape[:-1]
+    N = int(np.prod(lead))
+    x = np.ascontiguousarray(u[..., 0]).reshape(N)
+    y = np.ascontiguousarray(u[..., 1]).reshape(N)
     mx = max(i for i, _ in terms)
     my = max(j for _, j in terms)
-    px = np.empty((mx + 1,) + x.shape)    # powers first: each power a contiguous array
-    py = np.empty((my + 1,) + y.shape)
+    px = np.empty((mx + 1, N))            # powers first: each power a contiguous array
+    py = np.empty((my + 1, N))
     px[0], py[0] = 1.0, 1.0
     for i in range(mx):                   # successive products: the same numbers as x**i
         np.multiply(px[i], x, out=px[i + 1])
     for j in range(my):
         np.multiply(py[j], y, out=py[j + 1])
-    A = np.empty(x.shape + (len(terms),))
+    A = np.empty((len(terms), N))
     for c, (i, j) in enumerate(terms):    # over the p terms, not trials
-        np.multiply(px[i], py[j], out=A[..., c])
-    return A
+        np.multiply(px[i], py[j], out=A[c])
+    return A.T.reshape(lead + (len(terms),))
 
 
 @dataclass(frozen=True)
@@ -82,7 +87,8 @@ class PolyFit:
     ok : ``(T,)`` the fit was estimable (the scaled singularity rule of :mod:`sim.lsq.linear`).
     rms_mm : ``(T, 2)`` rms residual per axis on the fitting data.
     corrected_mm : ``(T, n, 2)`` the fitting data corrected, ``X + P(X, Y)`` (the numbers of
-        :func:`apply_poly` at the measured points, without building their design again).
+        :func:`apply_poly` at the measured points, without building their design again), when
+        asked for (``fit_poly(..., corrected=True)``), else None.
     """
 
     coef: np.ndarray
@@ -103,7 +109,7 @@ class PolyFit:
 
 
 def fit_poly(measured: np.ndarray, true: np.ndarray, degree: int | None = 3, terms=None,
-             norm_mm: float = 100.0) -> PolyFit:
+             norm_mm: float = 100.0, corrected: bool = False) -> PolyFit:
     """Fit the correction ``true - measured = P(measured)`` by least squares, per trial.
 
     Parameters
@@ -112,6 +118,7 @@ def fit_poly(measured: np.ndarray, true: np.ndarray, degree: int | None = 3, ter
         concatenating them along the point axis.
     degree : total degree of the complete polynomial (ignored when ``terms`` is given).
     terms : explicit exponents, e.g. :data:`WOLF_TERMS`.
+    corrected : also return the fitting data corrected (:attr:`PolyFit.corrected_mm`).
 
     A degree-1 polynomial is the general affine transformation ``x = X + A1 + A2 X + A4 Y``.
     """
@@ -121,7 +128,8 @@ def fit_poly(measured: np.ndarray, true: np.ndarray, degree: int | None = 3, ter
     A = design(measured, terms, norm_mm)                  # (T, n, p): one R0 for all trials
     f = lstsq(A, true - measured)
     rms = np.sqrt(np.mean(f.residuals ** 2, axis=1))
-    return PolyFit(f.x, terms, float(norm_mm), f.ok, rms, measured + np.matmul(A, f.x))
+    return PolyFit(f.x, terms, float(norm_mm), f.ok, rms,
+                   measured + np.matmul(A, f.x) if corrected else None)
 
 
 def fit_wolf(measured: np.ndarray, true: np.ndarray, norm_mm: float = 100.0) -> PolyFit:

@@ -49,7 +49,9 @@ class Case:
     a leading trial axis), ``one(t)`` solves trial ``t`` with SciPy (the same quantity);
     ``tol`` is the largest absolute difference allowed, in ``unit``; ``scipy`` names the
     SciPy call; ``why`` says in words why the loop is hard to beat, for a row below the
-    target."""
+    target; ``floor(t)``, when given, is the bare compiled call of trial ``t`` under the SciPy
+    loop (e.g. the LAPACK routine alone, its inputs prepared beforehand), timed for the note
+    of a row below the target as ``floor_label``."""
 
     n_points: int
     engine: Callable[[], np.ndarray]
@@ -58,6 +60,8 @@ class Case:
     unit: str
     scipy: str
     why: str = ""
+    floor: Callable[[int], object] | None = None
+    floor_label: str = ""
 
 
 def _lsq_scipy(fun, z0, jac=None, sparsity=None):
@@ -207,6 +211,16 @@ def agreement(case: Case, trials: int) -> float:
     return max(float(np.abs(np.asarray(case.one(t)) - eng[t]).max()) for t in range(trials))
 
 
+def _floor(case: Case, trials: int) -> str:
+    """``", <label> <t> us"``: the bare compiled call of the SciPy loop per trial, or ""."""
+    if case.floor is None:
+        return ""
+    for t in range(trials):          # inputs prepared (and caches warm) outside the timing
+        case.floor(t)
+    tf = cpu_time(lambda: [case.floor(t) for t in range(trials)], 1) / trials
+    return f", {case.floor_label} {tf * 1e6:.3g} us"
+
+
 def engine_rows(quick: bool = False, only=None) -> dict[str, list]:
     """The columns of ``engines.parquet``, one row per case (``only``: a subset of names).
 
@@ -233,7 +247,7 @@ def engine_rows(quick: bool = False, only=None) -> dict[str, list]:
         x = ts / te
         note = "" if x >= TARGET_SPEEDUP else (
             f"below the {TARGET_SPEEDUP:.0f}x target: {case.why} (engine {te / T * 1e6:.3g} us, "
-            f"SciPy {ts / T * 1e6:.3g} us per trial)")
+            f"SciPy {ts / T * 1e6:.3g} us per trial{_floor(case, Ts)})")
         for c, v in zip(cols, (name, case.n_points, T, Ts, te, ts, T / te, T / ts, x,
                                TARGET_SPEEDUP, diff, case.tol, case.unit, case.scipy, note)):
             rows[c].append(v)

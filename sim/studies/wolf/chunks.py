@@ -89,7 +89,7 @@ def _reduce_readings(cfg: dict, D: dict, cell: dict, full: bool, keep_vectors: b
                            restitution_um=cell["field.restitution_um"])
     counts = [rd(p) for p in D["cal"]]
     red, tps, fit, mtp = calibrate(cfg, G, [c[:, :nG] for c in counts], ia, ib,
-                                   cfg["calib.degree"], terms)
+                                   cfg["calib.degree"], terms, corrected=True)
     out: dict = {}
     meas = red.transpose(1, 0, 2, 3).reshape(-1, S * nG, 2)             # pooled sets
     T = meas.shape[0]

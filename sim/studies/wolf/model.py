@@ -202,17 +202,18 @@ def calib_dates(cfg: dict, n_sets: int) -> np.ndarray:
     return np.linspace(0.0, cfg["calib.span_weeks"], n_sets) if n_sets > 1 else np.zeros(1)
 
 
-def calibrate(cfg, G, counts_sets, ia, ib, degree, terms=None):
+def calibrate(cfg, G, counts_sets, ia, ib, degree, terms=None, corrected=False):
     """Reduce each set two-point, fit the polynomial to the pooled sets.
 
-    Returns the reduced sets ``(S, T, n, 2)``, the two-point transforms, the fit, and the mean
-    reduction (scale, centre-cross reading, alpha) used for later plates.
+    Returns the reduced sets ``(S, T, n, 2)``, the two-point transforms, the fit (with the
+    pooled sets corrected when ``corrected``), and the mean reduction (scale, centre-cross
+    reading, alpha) used for later plates.
     """
     tps = [pl.two_point_transform(c[:, ia], c[:, ib], G[ia], G[ib]) for c in counts_sets]
     red = np.stack([pl.apply_two_point(tp, c) for tp, c in zip(tps, counts_sets)])
     S, T, n, _ = red.shape
     meas = red.transpose(1, 0, 2, 3).reshape(T, S * n, 2)
-    fit = pl.fit_poly(meas, np.tile(G, (S, 1)), degree=degree, terms=terms)
+    fit = pl.fit_poly(meas, np.tile(G, (S, 1)), degree=degree, terms=terms, corrected=corrected)
     mean_tp = pl.TwoPoint(np.mean([tp.scale for tp in tps], 0), np.mean([tp.origin for tp in tps], 0),
                           np.mean([tp.alpha for tp in tps], 0), np.asarray(G[ia], float))
     return red, tps, fit, mean_tp
