@@ -29,7 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import lsq
+from . import lsq, positions_kernel as pk
+from .lsq.normals import Reduced, inv_blocks, reduce_blocks
 
 __all__ = ["MODELS", "DATUMS", "circle_stations", "design_theta", "stations", "ranges",
            "n_free", "initial_points", "adjust", "covariance", "full_point_covariance",
@@ -133,9 +134,10 @@ class RangeModel:
     globals are ``X_1, Y_1, ..., X_P, Y_P, alpha, b``) or a constant matrix ``B``
     ``(2P + 2, q)`` mapping the model's own ``q`` globals to that vector (Brown's datum in
     :mod:`sim.multilateration`). ``P`` is taken from ``r_obs`` or from ``stations``.
-    The engine forms the normal equations from :meth:`normal_blocks` (the sparse structure);
-    ``dense=True`` makes it use the dense Jacobian of :meth:`linearize` instead (the same
-    normals to rounding).
+    The engine takes the reduced normals from :meth:`reduced` (the sparse structure,
+    compiled by :mod:`sim.positions_kernel`, else :meth:`normal_blocks`); ``dense=True``
+    makes it use the dense Jacobian of :meth:`linearize` instead (the same normals to
+    rounding).
     """
 
     point_dim = 2
@@ -147,7 +149,7 @@ class RangeModel:
         self.P = self.r_obs.shape[2] if P is None else P
         self.n_global = 2 * self.P + 2 if layout is None else layout.shape[1]
         if dense:   # the engine forms the normals from the dense Jacobian (the reference)
-            self.normal_blocks = None
+            self.reduced = None
 
     def full(self, theta: np.ndarray) -> np.ndarray:
         """The station/alpha/b vector ``(T, 2P + 2)`` of the globals."""
@@ -177,6 +179,28 @@ class RangeModel:
         J[..., 2 * P + 1] = -0.5 / q
         return lsq.Linearization(r, Jp, J if self.layout is None else J @ self.layout)
 
+    def reduced(self, points, theta, free, rcond: float = lsq.RCOND) -> Reduced:
+        """Reduced normals of the free globals (for :mod:`sim.lsq`) without a Jacobian: the
+        compiled passes of :mod:`sim.positions_kernel` (points eliminated over all ``2P + 2``
+        globals, then mapped to the model's free ones), or :meth:`normal_blocks` and
+        :func:`~sim.lsq.normals.reduce_blocks` without numba."""
+        if not pk.AVAILABLE:
+            return reduce_blocks(*self.normal_blocks(points, theta, free), rcond=rcond)
+        th = self.full(theta)
+        Npp, up = pk.point_normals(points, th, self.r_obs)
+        Ninv, ok = inv_blocks(Npp, rcond)
+        T, n = points.shape[:2]
+        if len(free) == 0:
+            return Reduced(Ninv, np.zeros((T, n, 2, 0)), np.zeros((T, 0, 0)), np.zeros((T, 0)),
+                           (Ninv @ up[..., None])[..., 0], ok)
+        K, Nbar, ubar, dp0 = pk.eliminate(points, th, self.r_obs, Ninv, up)
+        if self.layout is not None:      # the model's own globals: Jg = J_full L
+            L = self.layout
+            K, Nbar, ubar = K @ L, L.T @ Nbar @ L, ubar @ L
+        if len(free) < K.shape[-1]:
+            K, Nbar, ubar = K[..., free], Nbar[:, free][:, :, free], ubar[:, free]
+        return Reduced(Ninv, K, Nbar, ubar, dp0, ok)
+
     def normal_blocks(self, points, theta, free):
         """Normal-equation blocks of the free globals formed directly (for :mod:`sim.lsq`):
         the reading of station ``k`` at point ``j`` touches only ``x_j, y_j``, ``X_k, Y_k``,
@@ -186,7 +210,8 @@ class RangeModel:
             Ngg = diag_k(sum_j u u') bordered by sum_j u, sum_j g u, n, sum g, sum g^2
 
         (the dense Jacobian ``(T, n, P, 2P + 2)`` is never built). Returns ``(Npp, up, Npg,
-        Ngg, ug)`` for :func:`sim.lsq.normals.reduce_blocks`."""
+        Ngg, ug)`` for :func:`sim.lsq.normals.reduce_blocks` (NumPy; :meth:`reduced` uses it
+        without numba)."""
         th = self.full(theta)
         S = stations(th)
         dx = points[:, :, None, 0] - S[:, None, :, 0]      # (T, n, P)

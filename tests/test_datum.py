@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from sim import datum as dm
+from sim import lsq
 from sim import multilateration as ml
 from sim import positions as po
 from sim.intervals import std_rel_se
@@ -133,3 +134,44 @@ def test_result_in_datum_and_coverage_use_the_engine_result():
     assert np.allclose(F, ref, rtol=1e-12, atol=1e-15)
     inside = cv.result_inside(res, pts, sigma=1e-3).mean()
     assert abs(inside - 0.95) < 4 * np.sqrt(0.95 * 0.05 / (T * len(pts)))  # points independent
+
+
+@pytest.mark.parametrize("P, brown", [(3, False), (4, False), (6, False), (4, True)])
+def test_sparse_and_compiled_reduced_normals_equal_the_dense_jacobians(P, brown):
+    """RangeModel's own reduced normals (compiled, and the NumPy blocks) are the engine's
+    reduction of the dense Jacobian to 1e-12 relative, for any free set, with and without
+    readings; the adjustment gives the same solution and status."""
+    from sim import multilateration as ml
+    from sim.lsq import normals as nm
+
+    rng = np.random.default_rng(P)
+    T = 6
+    th = po.design_theta(P, 160.0, 0.5, 1.0)
+    TH = np.broadcast_to(th, (T, th.size)).copy()
+    pts = PTS[None] + rng.normal(0, 1e-3, (T,) + PTS.shape)
+    r = po.ranges(pts, TH) + rng.normal(0, 1e-3, (T, len(PTS), P))
+    layout = ml.BROWN_LAYOUT if brown else None
+    if brown:
+        TH = np.broadcast_to(ml.design_theta(160.0, 0.5, 1.0), (T, 7)).copy()
+    for robs in (r, None):
+        m = po.RangeModel(robs, layout, P=P)
+        q = m.n_global
+        for free in (np.arange(q), np.arange(0), np.arange(q - 2), np.array([0, 2, 3])):
+            lin = m.linearize(pts, TH, True)
+            ref = nm.reduce(lin.r, lin.Jp, lin.Jg[..., free] if len(free) else None)
+            for red in (m.reduced(pts, TH, free),
+                        nm.reduce_blocks(*m.normal_blocks(pts, TH, free))):
+                assert np.array_equal(red.ok, ref.ok)
+                for f in ("Ninv", "K", "Nbar", "ubar", "dp0"):
+                    a, b = getattr(red, f), getattr(ref, f)
+                    assert a.shape == b.shape
+                    scale = max(np.abs(b).max(initial=0.0), 1e-3 if robs is None else 0.0)
+                    assert np.abs(a - b).max(initial=0.0) <= 1e-12 * scale, f
+    if not brown:
+        t0 = th.copy()
+        t0[-2:] = 0.0
+        a = po.adjust(r, "pivot", t0, "inner")
+        b = lsq.gauss_newton(po.RangeModel(r, dense=True), np.broadcast_to(t0, TH.shape),
+                             None, po._datum(TH, P, "pivot", "inner"), engine="numpy")
+        assert np.array_equal(a.status, b.status)
+        assert np.abs(a.points - b.points).max() < 1e-11

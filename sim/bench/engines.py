@@ -26,6 +26,7 @@ from typing import Callable
 import numpy as np
 from scipy.optimize import least_squares
 
+from ..heap import keep_heap
 from ..plate import grid_points
 from . import cpu_time
 
@@ -227,8 +228,10 @@ def engine_rows(quick: bool = False, only=None) -> dict[str, list]:
     Both sides are checked to agree on the first trials before anything is timed
     (RuntimeError otherwise). ``engine_s`` is the best CPU time of the engine over all
     ``trials``; ``scipy_s`` the CPU time of the SciPy loop over ``scipy_trials`` trials,
-    scaled to ``trials``; ``speedup = scipy_s / engine_s``.
+    scaled to ``trials``; ``speedup = scipy_s / engine_s``. Both sides run with freed memory
+    kept in the process's heap, as the studies' chunks run (:func:`sim.heap.keep_heap`).
     """
+    keep_heap()
     cols = ("engine", "n_points", "trials", "scipy_trials", "engine_s", "scipy_s",
             "engine_trials_per_s", "scipy_trials_per_s", "speedup", "target_speedup",
             "max_abs_diff", "tolerance", "diff_unit", "scipy_method", "note")

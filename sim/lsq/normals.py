@@ -162,12 +162,13 @@ def reduce_blocks(Npp, up, Npg, Ngg, ug, rcond: float = RCOND) -> Reduced:
 
 
 def reduced_normals(model, points, theta, free, rcond: float = RCOND):
-    """The reduced normals of ``model`` at one linearisation point: from the blocks the model
-    forms itself (``model.normal_blocks``, for Jacobians that are mostly zero) when it has
-    them, else from its dense Jacobians (:func:`sim.lsq.normals.reduce`)."""
-    blocks = getattr(model, "normal_blocks", None)
-    if blocks is not None:
-        return reduce_blocks(*blocks(points, theta, free), rcond=rcond)
+    """The reduced normals of ``model`` at one linearisation point: the model's own
+    elimination (``model.reduced``, for Jacobians that are mostly zero: from blocks it forms
+    itself, e.g. with :func:`reduce_blocks`) when it has one, else from its dense Jacobians
+    (:func:`reduce`)."""
+    own = getattr(model, "reduced", None)
+    if own is not None:
+        return own(points, theta, free, rcond)
     p = len(free)
     lin = model.linearize(points, theta, p > 0)
     return reduce(lin.r, lin.Jp, lin.Jg[..., free] if p else None, lin.w, rcond)

@@ -20,9 +20,11 @@ An **observation model** is any object with
 * ``initial_points(theta) -> (T, n, d)``: a start for the points from the globals;
 * optionally ``n_obs`` (observations per trial, default ``n k``),
   ``retract(points, theta, dp, dg) -> (points, theta)`` (default: additive updates) and
-  ``normal_blocks(points, theta, free) -> (Npp, up, Npg, Ngg, ug)``: the normal-equation
-  blocks of the free globals formed directly, for a Jacobian that is mostly zero (the engine
-  then never builds the dense one; :func:`sim.lsq.normals.reduce_blocks`).
+  ``reduced(points, theta, free, rcond) -> Reduced``: the model's own reduced normals of the
+  free globals, for a Jacobian that is mostly zero (the engine then never builds the dense
+  one): the normal-equation blocks formed directly and eliminated by
+  :func:`sim.lsq.normals.reduce_blocks`, or compiled, with the engine's singularity rule
+  (:func:`sim.lsq.normals.inv_blocks`) on the point blocks.
 
 The Jacobian sign convention: ``r ~ Jp dp + Jg dg`` (corrections that reduce the misclosure).
 
