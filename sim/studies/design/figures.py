@@ -7,13 +7,12 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
-from ...figure_jobs import draw_figures
 from ...plotting import plt, save
 from ... import distributions as D
 from .cells import pareto_front
 from .claims import load_book
 
-__all__ = ["all_figures"]
+__all__ = ["figure_jobs"]
 
 
 def _log_ticks(ax, axis: str, lo: float, hi: float) -> None:
@@ -253,24 +252,38 @@ def fig_consistent(sv, cs, path):
     save(fig, path)
 
 
-def all_figures(cfg, out, cols, bcols, dcols, ccols, samples, bay, tcols, tsamples, sv, cs,
-                executor=None):
-    """Every figure of the study, on the run's idle workers when there are some
-    (:func:`sim.figure_jobs.draw_figures`), the dearest first."""
-    from ... import multilateration as ml
-    jp = int(np.flatnonzero(cols["paper_design"])[0])
-    same_n = (np.array(cols["feasible"])
-              & np.isclose(np.array(cols["setting_sigma_um"]), cols["setting_sigma_um"][jp])
-              & (np.array(cols["n_points"]) == cols["n_points"][jp])
-              & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp]))
-    jobs = [(fig_consistent, (sv, cs, out / "consistent_set.png")),
-            (fig_corner, (samples, bay["theta_ls"], bay["Q"], ml.PARAM_NAMES,
-                          out / "corner.png")),
-            (fig_coverage, (ccols, out / "coverage.png"))]
-    if tcols is not None:
-        jobs.append((fig_twoplate, (tcols, tsamples, out / "twoplate_ratio.png")))
-    jobs += [(fig_pareto, (cols, out / "pareto.png", same_n)),
-             (fig_datum, (cfg, dcols, out / "datum.png")),
-             (fig_budget, (bcols, out / "budget.png",
-                           float(load_book().spec("brown.results.zeiss_comparator_um")["ref"])))]
-    draw_figures(jobs, executor)
+def figure_jobs(stage: str, out, *data) -> list:
+    """The figure jobs ``(fn, args)`` of one stage of the run, for
+    :func:`sim.figure_jobs.start_figures` as soon as the stage's tables exist (so they are
+    drawn on idle workers while the run goes on): ``design`` (cols), ``datum`` (cfg, dcols),
+    ``budget`` (bcols), ``coverage`` (ccols), ``bayes`` (samples, values), ``twoplate``
+    (tcols, tsamples) and ``consistent`` (sweep values, consistent set)."""
+    if stage == "design":
+        (cols,) = data
+        jp = int(np.flatnonzero(cols["paper_design"])[0])
+        same_n = (np.array(cols["feasible"])
+                  & np.isclose(np.array(cols["setting_sigma_um"]), cols["setting_sigma_um"][jp])
+                  & (np.array(cols["n_points"]) == cols["n_points"][jp])
+                  & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp]))
+        return [(fig_pareto, (cols, out / "pareto.png", same_n))]
+    if stage == "datum":
+        cfg, dcols = data
+        return [(fig_datum, (cfg, dcols, out / "datum.png"))]
+    if stage == "budget":
+        ref = float(load_book().spec("brown.results.zeiss_comparator_um")["ref"])
+        return [(fig_budget, (data[0], out / "budget.png", ref))]
+    if stage == "coverage":
+        return [(fig_coverage, (data[0], out / "coverage.png"))]
+    if stage == "bayes":
+        from ... import multilateration as ml
+        samples, bay = data
+        return [(fig_corner, (samples, bay["theta_ls"], bay["Q"], ml.PARAM_NAMES,
+                              out / "corner.png"))]
+    if stage == "twoplate":
+        tcols, tsamples = data
+        return [] if tcols is None else [(fig_twoplate, (tcols, tsamples,
+                                                         out / "twoplate_ratio.png"))]
+    if stage == "consistent":
+        sv, cs = data
+        return [(fig_consistent, (sv, cs, out / "consistent_set.png"))]
+    raise ValueError(f"no figure stage {stage!r}")

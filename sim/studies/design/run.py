@@ -14,6 +14,7 @@ import numpy as np
 
 from ... import datum as dm, positions as po
 from ...claims import write_claims
+from ...figure_jobs import start_figures
 from ...intervals import bootstrap_ci
 from ...runner import chunk_rng, run_chunks
 from ...storage import provenance, write_table
@@ -127,9 +128,19 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     prov = provenance(cfg)
     book = load_book()
     R: dict = {}
+    drawn = []   # each stage's figures go to idle workers as soon as its tables exist
+
+    def figs(stage, *data):
+        drawn.append(start_figures(figures.figure_jobs(stage, out, *data), ctx.executor))
+
     # 1. design trade-off (analytic) and its Monte-Carlo check
     cols = design_cells(cfg)
     write_table(out / "design.parquet", cols, prov)
+    figs("design", cols)
+    # the sweep of the unprinted inputs needs only the design table: made here, its figure
+    # (the dearest) drawn on a worker while the Monte-Carlo parts run
+    cs, sv = sweep_unprinted(cfg, book, cols)
+    figs("consistent", sv, cs)
     R["design"] = _design(cfg, cols)
     R["time"] = (measuring_time(cfg, 4, cfg["time.images"], 1),
                  measuring_time(cfg, 4, cfg["time.images"], 2))
@@ -142,24 +153,28 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     bcols, R["budget_sims"] = budget_analysis(cfg, pts, th, ctx)
     R["budget"] = bcols
     write_table(out / "budget.parquet", bcols, prov)
+    figs("budget", bcols)
     # 3. datum
     dcols, R["datum"] = datum_analysis(cfg)
     R["datum"]["geometry"] = (f"{cfg['datum.grid']}x{cfg['datum.grid']} points at "
                               f"{cfg['datum.spacing_mm']:g} mm, stations "
                               f"{cfg['datum.offset_mm']:g} mm out")
     write_table(out / "datum.parquet", dcols, prov)
+    figs("datum", cfg, dcols)
     # 4. coverage
     ccols = coverage_analysis(cfg, ctx)
     R["coverage"] = ccols
     write_table(out / "coverage.parquet", ccols, prov)
+    figs("coverage", ccols)
     # 5. emcee
     bycols, R["bayes"], samples = bayes_analysis(cfg, pts, sr, ctx)
+    figs("bayes", samples, R["bayes"])
     tcols, _, tsamples, why = twoplate_analysis(cfg, ctx)
     R["twoplate"] = tcols
-    # 6. external comparisons at the configured inputs, and the sweep of the unprinted ones
+    figs("twoplate", tcols, tsamples)
+    # 6. external comparisons at the configured inputs
     R["external"] = external_at(cfg, cfg["paper.offset_mm"], cfg["paper.beta_mm"],
                                 cfg["zeiss.half_extent_mm"], cfg["budget.pitch_mm"])
-    cs, sv = sweep_unprinted(cfg, book, cols)
     rows = [_unbounded_as_null(r) for r in score_all(book, cfg, R)]
     prov_t = provenance(cfg, tolerances=_tolerances(R))
     write_table(out / "bayes.parquet", bycols, prov_t)
@@ -170,5 +185,5 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_table(out / "consistent_set.parquet", cs, prov)
     write_table(out / "sweep_values.parquet", sv, prov)
     write_claims(out / "claims.parquet", rows, prov_t, book)
-    figures.all_figures(cfg, out, cols, bcols, dcols, ccols, samples, R["bayes"], tcols,
-                        tsamples, sv, cs, ctx.executor)
+    for wait in drawn:
+        wait()
