@@ -300,7 +300,7 @@ def reading_error_rms(rng, count_um, n, sigma_um, backlash_um, approach, size=20
     noise = rng.normal(0.0, sigma_um, (size, n))
     bl = backlash_um / 2 if approach == "one_side" else backlash_um / 2 * rng.choice(
         np.array([-1.0, 1.0]), (size, n))
-    e = np.round((x + noise + bl) / count_um).mean(1) * count_um - x[:, 0]
+    e = _mean_counts(np.round((x + noise + bl) / count_um)) * count_um - x[:, 0]
     e = e - (backlash_um / 2 if approach == "one_side" else 0.0)
     return float(np.sqrt(np.mean(e ** 2)))
 
