@@ -24,8 +24,12 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP) ## create the virtual environment and install the project
 
-test: $(STAMP) ## run the test suite (sets up the environment first)
-	$(PY) -m pytest
+# The test files run side by side on TEST_WORKERS processes (pytest-xdist), a file on one process
+# (its module fixtures, such as the shared Dask cluster, start once); TEST_WORKERS=0: one process.
+TEST_WORKERS ?= 2
+
+test: $(STAMP) ## run the test suite on TEST_WORKERS=2 processes (sets up the environment first)
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile
 
 fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=300, FUZZ_SEED, FUZZ_SAVE)
 	FUZZ_CASES=$${FUZZ_CASES:-300} $(PY) -m pytest tests/test_fuzz.py -p no:cacheprovider
