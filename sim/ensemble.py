@@ -42,12 +42,11 @@ def _independent(coords: np.ndarray) -> bool:
 
 
 def _log_prob(fn: Callable[[np.ndarray], np.ndarray], x: np.ndarray) -> np.ndarray:
-    if np.any(np.isinf(x)):
-        raise ValueError("At least one parameter value was infinite")
-    if np.any(np.isnan(x)):
-        raise ValueError("At least one parameter value was NaN")
+    if not np.isfinite(x).all():
+        raise ValueError("At least one parameter value was "
+                         + ("infinite" if np.isinf(x).any() else "NaN"))
     lp = np.asarray(fn(x), float).reshape(len(x))
-    if np.any(np.isnan(lp)):
+    if np.isnan(lp).any():
         raise ValueError("Probability function returned NaN")
     return lp
 
@@ -72,27 +71,25 @@ def stretch_chain(log_prob: Callable[[np.ndarray], np.ndarray], p0: np.ndarray, 
     chain = np.empty((steps, W, d))
     lps = np.empty((steps, W))
     n_acc = np.zeros(W, int)
-    all_inds = np.arange(W)
+    parity = np.arange(W) % 2
     for i in range(steps):
         random.random_sample()       # emcee's choice of its one move (choice(moves, p=...))
         accepted = np.zeros(W, bool)
-        inds = all_inds % 2
+        inds = parity.copy()
         random.shuffle(inds)
         for split in range(2):
-            S1 = inds == split
-            s, c = coords[S1], coords[~S1]
+            j = np.flatnonzero(inds == split)                # this half, in walker order
+            s, c = coords[j], coords[inds != split]
             Ns, Nc = len(s), len(c)
             zz = ((a - 1.0) * random.rand(Ns) + 1) ** 2.0 / a
             factors = (d - 1.0) * np.log(zz)
-            rint = random.randint(Nc, size=(Ns,))
-            q = c[rint] - (c[rint] - s) * zz[:, None]
+            cr = c[random.randint(Nc, size=(Ns,))]
+            q = cr - (cr - s) * zz[:, None]
             new_lp = _log_prob(log_prob, q)
-            j = all_inds[S1]
             acc = factors + new_lp - lp[j] > np.log(random.rand(Ns))
             accepted[j] = acc
-            m1 = S1 & accepted
-            coords[m1] = q[acc]
-            lp[m1] = new_lp[acc]
+            coords[j[acc]] = q[acc]
+            lp[j[acc]] = new_lp[acc]
         chain[i] = coords
         lps[i] = lp
         n_acc += accepted

@@ -142,16 +142,13 @@ def fig_coverage(c, path):
 
 def fig_corner(samples, mean, Q, names, path):
     d = samples.shape[1]
-    fig, axs = plt.subplots(d, d, figsize=(10, 10))
+    fig = plt.figure(figsize=(10, 10))
     sd = np.sqrt(np.diag(Q))
     z = (samples - mean) / sd
     t = np.linspace(0, 2 * np.pi, 100)
     for i in range(d):
-        for j in range(d):
-            ax = axs[i, j]
-            if j > i:
-                ax.axis("off")
-                continue
+        for j in range(i + 1):   # the lower triangle only (the upper one stays empty)
+            ax = fig.add_subplot(d, d, i * d + j + 1)
             if i == j:
                 ax.hist(z[:, i], bins=40, density=True, color="tab:blue", alpha=0.7)
                 xx = np.linspace(-4, 4, 100)
