@@ -392,31 +392,6 @@ def test_chunk_functions_pickle():
         assert pickle.loads(pickle.dumps(fn)).func is fn.func
 
 
-def test_workers_give_identical_tables(tmp_path):
-    """One and two workers, and a resumed run, give the same trial table."""
-    from sim.runner import ChunkStore, make_executor
-    from sim.storage import read_table
-    from sim.studies import RunContext
-
-    study, cfg = load_study(STUDY, _tiny_overrides(), trials=4)
-    tabs = []
-    for w in (1, 2):
-        out = tmp_path / f"w{w}"
-        out.mkdir()
-        ex = make_executor("local", w)
-        try:
-            study.run(cfg, out, RunContext(quiet=True, executor=ex,
-                                           store=ChunkStore(out / "trials")))
-        finally:
-            ex.close()
-        tabs.append(read_table(out / "trials.parquet"))
-    assert tabs[0].equals(tabs[1])
-    # resume: a second run over the same chunk store loads every chunk and agrees
-    out = tmp_path / "w1"
-    study.run(cfg, out, RunContext(quiet=True, store=ChunkStore(out / "trials")))
-    assert read_table(out / "trials.parquet").equals(tabs[0])
-
-
 def test_sparse_and_dense_reduced_solutions_agree(small):
     rng = np.random.default_rng(13)
     T = 2

@@ -88,14 +88,6 @@ def test_dask_local_cluster_equals_local(tmp_path):
         assert same_result(outs["local"] / f, outs["dask"] / f), f
 
 
-def test_workers_give_bit_identical_files(tmp_path):
-    for w in ("1", "2"):
-        assert main(["run", str(STUDY), "--out", str(tmp_path / w), "--trials", "60", "--quiet",
-                     "--workers", w, "--set", "chunk=20"]) == 0
-    for f in ("claims.parquet", "points.parquet", "trials/part-0/chunk-000001.parquet"):
-        assert same_result(tmp_path / "1" / f, tmp_path / "2" / f), f
-
-
 def test_refuses_to_mix_a_different_config(tmp_path, capsys):
     o = tmp_path / "o"
     args = ["run", str(STUDY), "--out", str(o), "--trials", "20", "--quiet", "--set", "chunk=10"]
