@@ -219,8 +219,8 @@ def pair_blocks(st, Npg, F, Jg, w, r, up):
     ubar = np.empty((T, st.n_groups, b))
     ix = st.kernel_index
     compiled(_pair_blocks)(_c(Npg), _c(F), _c(Jg), _c(w), _c(r), _c(up), ix["og"], ix["op"],
-                        ix["pk1"], ix["pk2"], ix["pq"], ix["mir_dst"], ix["mir_src"],
-                        ix["diag_obs"], blocks, ubar)
+                           ix["pk1"], ix["pk2"], ix["pq"], ix["mir_dst"], ix["mir_src"],
+                           ix["diag_obs"], blocks, ubar)
     return blocks, ubar
 
 
@@ -237,10 +237,10 @@ def diag_reduce(st, lin, jp: np.ndarray, jc: np.ndarray):
     ok = np.empty(T, np.bool_)
     blocks = np.empty((T, st.pair_g1.size, b, b))
     ubar = np.empty((T, st.n_groups, b))
-    compiled(_diag_reduce, D_POINT=m, B_GROUP=b)(_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc),
-                       ix["og"], ix["op"], ix["rows"], ix["diag_obs"], ix["xk1"], ix["xk2"],
-                       ix["xq"], ix["mir_dst"], ix["mir_src"], ninv, up, Npg, F, ok, blocks,
-                       ubar)
+    kernel = compiled(_diag_reduce, D_POINT=m, B_GROUP=b)
+    kernel(_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc), ix["og"],
+           ix["op"], ix["rows"], ix["diag_obs"], ix["xk1"], ix["xk2"], ix["xq"], ix["mir_dst"],
+           ix["mir_src"], ninv, up, Npg, F, ok, blocks, ubar)
     return blocks, ubar, ninv[..., :, None] * np.eye(m), up, Npg, F, ok
 
 
@@ -270,7 +270,8 @@ def index(og: np.ndarray, op: np.ndarray, pk1: np.ndarray, pk2: np.ndarray,
     counts = np.bincount(op, minlength=n_points)
     i64 = lambda a: np.ascontiguousarray(a, np.int64)  # noqa: E731
     return {"og": i64(og), "op": i64(op), "pk1": i64(pk1[lower]), "pk2": i64(pk2[lower]),
-            "pq": i64(pair_of[lower]), "pg1": i64(pair_g1), "pg2": i64(pair_g2), "mir_dst": i64(mir), "mir_src": i64(src),
+            "pq": i64(pair_of[lower]), "pg1": i64(pair_g1), "pg2": i64(pair_g2),
+            "mir_dst": i64(mir), "mir_src": i64(src),
             "diag_obs": i64(diag_of_group[og]), "xk1": i64(pk1[cross]),
             "xk2": i64(pk2[cross]), "xq": i64(pair_of[cross]), "rows": i64(rows),
             "pstart": i64(np.concatenate([[0], np.cumsum(counts)])), "pobs": i64(order)}

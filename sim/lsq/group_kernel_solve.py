@@ -191,6 +191,7 @@ def residual_cofactors(st, Q, F, Ninv, Jg, Jp, w, points: np.ndarray) -> np.ndar
     ix = st.kernel_index
     out = np.full(w.shape, np.nan)
     T, K, d, b = F.shape
-    compiled(_residual_cofactors, D_POINT=d, B_GROUP=b, M_ROWS=Jg.shape[2])(_c(Q), _c(F), _c(Ninv), _c(Jg), _c(Jp), _c(w), ix["og"], ix["op"],
-                        np.asarray(points, np.int64), ix["pstart"], ix["pobs"], out)
+    kernel = compiled(_residual_cofactors, D_POINT=d, B_GROUP=b, M_ROWS=Jg.shape[2])
+    kernel(_c(Q), _c(F), _c(Ninv), _c(Jg), _c(Jp), _c(w), ix["og"], ix["op"],
+           np.asarray(points, np.int64), ix["pstart"], ix["pobs"], out)
     return out
