@@ -7,8 +7,8 @@ the run context (executor, chunk store), with picklable chunk functions
 (:mod:`.chunks`), so ``--workers``, Dask and resumption after a kill apply.
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
 tables, ``sweep_five.parquet``, ``sweep_claims.parquet``, ``consistent_set.parquet``,
-``claims.parquet`` + ``not_reproduced.parquet`` and the figures (drawn on the run's idle
-workers when it has some, :func:`sim.figure_jobs.draw_figures`).
+``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each sent to the run's
+workers, when it has some, as soon as its data exist: :func:`sim.figure_jobs.start_figures`).
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ import numpy as np
 from ... import independent_models as im
 from ...block_layout import select_control
 from ...claims import write_claims
-from ...figure_jobs import draw_figures
+from ...figure_jobs import start_figures
 from ...runner import run_chunks
 from ...storage import provenance, write_table
 from .. import RunContext
@@ -164,12 +164,18 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     prov = provenance(cfg, sparse_from_models=im.SPARSE_FROM_MODELS)
     book = load_book()
     T = cfg["trials"]
+    c5 = select_control(block, cfg["control.few"])
+    c21 = select_control(block, cfg["control.many"])
+    insets = cfg["sweep.five_inset"]
+    ctrl_idx = [five_control(block, u) for u in insets]
+    # figures go to idle workers as soon as their data exist (sim.figure_jobs.start_figures)
+    drawn = [start_figures([(fg.fig_scanner, (cfg, out / "scanner_field.png")),
+                            (fg.fig_layout, (block, c5, c21, out / "block_layout.png",
+                                             ctrl_idx, insets))], ctx.executor)]
     sim = _run(partial(ch.main_chunk, cfg, block), T, cfg, 0, "2x8 block", ctx)
     per_trial = {k: v for k, v in sim.items() if not k.startswith(ch.CHUNK)}
     write_table(out / "trials.parquet", {"trial": np.arange(T), **per_trial}, prov)
 
-    c5 = select_control(block, cfg["control.few"])
-    c21 = select_control(block, cfg["control.many"])
     kind = np.full(block.n_points, "check", dtype=object)
     kind[block.is_pass] = "pass"
     kind[c21] = "control_many"
@@ -179,6 +185,8 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
                                          "z_m": block.points[:, 2], "kind": kind.astype(str),
                                          "models": nmod}, prov)
     vec = _check_vectors(cfg, block, sim, c5, c21, T, prov, out)
+    drawn.append(start_figures([(fg.fig_residuals, (vec, out / "check_residuals.png"))],
+                               ctx.executor))
     scan_t = _scanner_table(cfg, block, per_trial, ctx, prov, out)
     lay_t = _control_table(cfg, block, sim, prov, out)
     base = 1 + len(cfg["tradeoff.dpis"])
@@ -190,12 +198,10 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     # --- the unprinted five-point layout, swept
     sw = _run(partial(ch.sweep_chunk, cfg, block), cfg["sweep.trials"], cfg, base, "five-point "
               "layouts", ctx)
-    insets = cfg["sweep.five_inset"]
     sweep_t = {"inset": np.repeat(insets, cfg["sweep.trials"]),
                "trial": np.tile(np.arange(cfg["sweep.trials"]), len(insets))}
     for k in sorted({k.split(".", 1)[1] for k in sw}):
         sweep_t[k] = np.concatenate([sw[f"inset{i}.{k}"] for i in range(len(insets))])
-    ctrl_idx = [five_control(block, u) for u in insets]
     write_table(out / "sweep_five.parquet", sweep_t, prov)
     sweeps = {"sweep.five_inset": {float(u): five_samples(sw, i) for i, u in enumerate(insets)},
               "pugging.recentre_px": {rc: {RECENTRE_CLAIMS[0]: s} for rc, s in pug.items()}}
@@ -209,9 +215,8 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
 
     write_claims(out / "claims.parquet", claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug,
                                                     book), prov, book)
-    draw_figures([(fg.fig_consistent, (long, cs, out / "consistent_set.png")),   # dearest first
-                  (fg.fig_tradeoffs, (scan_t, lay_t, size_t, out / "tradeoffs.png")),
-                  (fg.fig_scanner, (cfg, out / "scanner_field.png")),
-                  (fg.fig_residuals, (vec, out / "check_residuals.png")),
-                  (fg.fig_layout, (block, c5, c21, out / "block_layout.png", ctrl_idx, insets))],
-                 ctx.executor)
+    drawn.append(start_figures([(fg.fig_consistent, (long, cs, out / "consistent_set.png")),
+                                (fg.fig_tradeoffs, (scan_t, lay_t, size_t,
+                                                    out / "tradeoffs.png"))], ctx.executor))
+    for wait in drawn:
+        wait()
