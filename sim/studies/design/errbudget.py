@@ -1,7 +1,8 @@
 """The comparator's error budget (seed ``004``, *Calibration*): each error source of
 :mod:`sim.budget` alone, and in combinations, on the Table-1 plate of the paper's design
 (pivot model), as the rms coordinate error after a rigid fit over all points (um) and the
-closure sigma0 (um). Trial counts are adaptive (:mod:`.adaptive`, through the runner).
+closure sigma0 (um). Trial counts are adaptive (:mod:`.adaptive`, through the runner); the
+rows run side by side (:mod:`.parts`).
 """
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import numpy as np
 
 from .adaptive import run_adaptive
 from .chunks import budget_chunk
+from .parts import side_by_side
 
 __all__ = ["BUDGET_ROWS", "budget_analysis", "rms_stat", "PART0"]
 
@@ -46,14 +48,19 @@ def budget_analysis(cfg: dict, pts: np.ndarray, th: np.ndarray, ctx) -> tuple[di
     bcfg["comparator.sigma_um"] = cfg["comparator.sigma_um"]
     cols = {k: [] for k in ("source", "description", "rms_um", "se_um", "trials", "s0_um",
                             "settings")}
-    sims = {}
-    for i, (name, srcs, sett, desc) in enumerate(BUDGET_ROWS):
+    def row(i, srcs, sett, name):
         fn = partial(budget_chunk, bcfg, pts, th, srcs,
                      cfg["paper.setting_sigma_um"] if sett else 0.0, cfg["paper.settings"])
-        res, st = run_adaptive(fn, rms_stat, cfg["budget.target_se_um"], cfg["seed"],
-                               cfg["chunk"], part=PART0 + i, min_trials=2 * cfg["chunk"],
-                               max_trials=cfg["budget.max_trials"], label=f"budget {name}",
-                               ctx=ctx)
+        return run_adaptive(fn, rms_stat, cfg["budget.target_se_um"], cfg["seed"],
+                            cfg["chunk"], part=PART0 + i, min_trials=2 * cfg["chunk"],
+                            max_trials=cfg["budget.max_trials"], label=f"budget {name}",
+                            ctx=ctx)
+
+    done = side_by_side({name: partial(row, i, srcs, sett, name)
+                         for i, (name, srcs, sett, _) in enumerate(BUDGET_ROWS)}, ctx)
+    sims = {}
+    for name, srcs, sett, desc in BUDGET_ROWS:
+        res, st = done[name]
         sims[name] = res
         ok = res["ok"]
         cols["source"].append(name)

@@ -4,7 +4,7 @@ Coverage of the 95 % point ellipses (known sigma; s0 with the F distribution), t
 rate of the global chi-square test and E[s0] / sigma, for Brown's pivot model (Brown's datum)
 over noise, point count and beta, and for an affine calibration (a linear model). Every case
 is one :func:`sim.runner.run_chunks` call of a picklable chunk function, so its chunks run on
-the run's executor.
+the run's executor; the cases run side by side (:mod:`.parts`).
 """
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ from ... import coverage as cv, multilateration as ml
 from ...plate import grid_points
 from ...runner import run_chunks
 from .chunks import affine_chunk, coverage_chunk
+from .parts import side_by_side
 
 __all__ = ["coverage_analysis", "summarize_cov", "COLUMNS", "PART0"]
 
@@ -65,24 +66,29 @@ def coverage_analysis(cfg: dict, ctx) -> dict:
 
     h = cfg["plate.format_mm"] / 2 + cfg["datum.offset_mm"]
     ext = (cfg["datum.grid"] - 1) * cfg["datum.spacing_mm"] / 2
-    part = PART0
-    for scen, k, sig, beta, T in _cases(cfg):
+    sig0 = cfg["coverage.sigma_um"]
+    tasks = {}
+    for part, (scen, k, sig, beta, T) in enumerate(_cases(cfg), PART0):
         pts = grid_points(k, 2 * ext / (k - 1))
         th = ml.design_theta(h, cfg["comparator.alpha_mm"], beta)
-        dof = 4 * len(pts) - (2 * len(pts) + 7)
         fn = partial(coverage_chunk, pts, th, sig, cfg["coverage.alpha"])
-        sim = run_chunks(fn, T, cfg["seed"], cfg["chunk"], part=part, label=f"coverage {scen}",
-                         ctx=ctx)
-        part += 1
-        add("pivot", scen, k, sig, beta, summarize_cov(sim, sig, dof))
-    sig0 = cfg["coverage.sigma_um"]
-    for k, T in ((cfg["datum.grid"], cfg["coverage.trials"]), (2, cfg["coverage.sweep_trials"])):
+        tasks[part] = partial(run_chunks, fn, T, cfg["seed"], cfg["chunk"], part=part,
+                              label=f"coverage {scen}", ctx=ctx)
+    affine = ((cfg["datum.grid"], cfg["coverage.trials"]), (2, cfg["coverage.sweep_trials"]))
+    for part, (k, T) in enumerate(affine, PART0 + len(tasks)):
         grid = grid_points(k, 2 * 110.0 / (k - 1))
         fn = partial(affine_chunk, grid, sig0, _AFFINE, cfg["coverage.alpha"])
-        sim = run_chunks(fn, T, cfg["seed"], cfg["chunk"], part=part, label="coverage affine",
-                         ctx=ctx)
+        tasks[part] = partial(run_chunks, fn, T, cfg["seed"], cfg["chunk"], part=part,
+                              label="coverage affine", ctx=ctx)
+    sims = side_by_side(tasks, ctx)
+    part = PART0
+    for scen, k, sig, beta, T in _cases(cfg):
+        dof = 4 * k * k - (2 * k * k + 7)
+        add("pivot", scen, k, sig, beta, summarize_cov(sims[part], sig, dof))
         part += 1
-        summ = summarize_cov(sim, sig0, 2 * k * k - 6)
+    for k, T in affine:
+        summ = summarize_cov(sims[part], sig0, 2 * k * k - 6)
+        part += 1
         summ["b_coverage"] = summ["beta_coverage"] = np.nan
         add("affine", "nominal" if k == cfg["datum.grid"] else "points", k, sig0, np.nan, summ)
     return cols

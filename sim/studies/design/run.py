@@ -29,6 +29,7 @@ from .dilution import datum_analysis
 from .errbudget import budget_analysis
 from .external import external_at
 from .formal import coverage_analysis
+from .parts import side_by_side
 from .posterior import bayes_analysis, twoplate_analysis
 from .schema import max_offset_mm
 
@@ -148,30 +149,47 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
                           cfg["paper.offset_mm"], cfg["paper.beta_mm"])
     sr = float(range_sigma(cfg["paper.setting_sigma_um"], cfg["paper.settings"],
                            cfg["comparator.sigma_um"]))
-    R["mc_ratio"] = _mc_check(cfg, pts, th, sr, ctx)
-    # 2. error budget (adaptive, through the runner)
-    bcols, R["budget_sims"] = budget_analysis(cfg, pts, th, ctx)
-    R["budget"] = bcols
-    write_table(out / "budget.parquet", bcols, prov)
-    figs("budget", bcols)
-    # 3. datum
+    # 3. datum (analytic)
     dcols, R["datum"] = datum_analysis(cfg)
     R["datum"]["geometry"] = (f"{cfg['datum.grid']}x{cfg['datum.grid']} points at "
                               f"{cfg['datum.spacing_mm']:g} mm, stations "
                               f"{cfg['datum.offset_mm']:g} mm out")
     write_table(out / "datum.parquet", dcols, prov)
     figs("datum", cfg, dcols)
-    # 4. coverage
-    ccols = coverage_analysis(cfg, ctx)
-    R["coverage"] = ccols
-    write_table(out / "coverage.parquet", ccols, prov)
-    figs("coverage", ccols)
-    # 5. emcee
-    bycols, R["bayes"], samples = bayes_analysis(cfg, pts, sr, ctx)
-    figs("bayes", samples, R["bayes"])
-    tcols, _, tsamples, why = twoplate_analysis(cfg, ctx)
+
+    # the Monte-Carlo parts, side by side on the workers (.parts); each writes its table and
+    # sends its figures as soon as it is done
+    def budget():  # 2. error budget (adaptive, through the runner)
+        bcols, sims = budget_analysis(cfg, pts, th, ctx)
+        write_table(out / "budget.parquet", bcols, prov)
+        figs("budget", bcols)
+        return bcols, sims
+
+    def coverage():  # 4. coverage
+        ccols = coverage_analysis(cfg, ctx)
+        write_table(out / "coverage.parquet", ccols, prov)
+        figs("coverage", ccols)
+        return ccols
+
+    def bayes():  # 5. emcee
+        bycols, vals, samples = bayes_analysis(cfg, pts, sr, ctx)
+        figs("bayes", samples, vals)
+        return bycols, vals
+
+    def twoplate():
+        tcols, _, tsamples, why = twoplate_analysis(cfg, ctx)
+        figs("twoplate", tcols, tsamples)
+        return tcols, why
+
+    done = side_by_side({"bayes": bayes, "twoplate": twoplate, "budget": budget,
+                         "coverage": coverage, "mc": lambda: _mc_check(cfg, pts, th, sr, ctx)},
+                        ctx)
+    R["mc_ratio"] = done["mc"]
+    R["budget"], R["budget_sims"] = done["budget"]
+    R["coverage"] = done["coverage"]
+    bycols, R["bayes"] = done["bayes"]
+    tcols, why = done["twoplate"]
     R["twoplate"] = tcols
-    figs("twoplate", tcols, tsamples)
     # 6. external comparisons at the configured inputs
     R["external"] = external_at(cfg, cfg["paper.offset_mm"], cfg["paper.beta_mm"],
                                 cfg["zeiss.half_extent_mm"], cfg["budget.pitch_mm"])

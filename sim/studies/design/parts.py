@@ -1,0 +1,34 @@
+"""Independent parts of the ``brown_design`` run side by side (seed ``004``, Brown 1968).
+
+Each Monte-Carlo part of the run (the check of the paper's design, every error-budget row,
+every coverage case, each emcee posterior) is one or more :func:`sim.runner.run_chunks`
+calls, and each call waits for its last chunk: with few chunks per call (an adaptive stage of
+one or three chunks, a posterior of four chains) one worker would often sit idle.
+:func:`side_by_side` runs independent parts in threads of this process when the run's
+executor sends chunks to other processes (a local pool or Dask), so their chunks share the
+workers' queue; with the in-process executor the parts run one after another. The numbers do
+not depend on it: every chunk draws from its own stream (``spawn_key = (part, chunk)``) and
+each part assembles its chunks in chunk order.
+"""
+from __future__ import annotations
+
+from concurrent.futures import ThreadPoolExecutor
+from typing import Callable, Mapping
+
+__all__ = ["side_by_side", "parallel"]
+
+
+def parallel(ctx) -> bool:
+    """True when the run's executor computes chunks in other processes."""
+    ex = getattr(ctx, "executor", None)
+    return getattr(ex, "pool", None) is not None or getattr(ex, "client", None) is not None
+
+
+def side_by_side(tasks: Mapping[str, Callable[[], object]], ctx) -> dict:
+    """``{name: task()}`` for independent callables: in threads when :func:`parallel`,
+    else in the given order. An exception of a task is raised here."""
+    if len(tasks) < 2 or not parallel(ctx):
+        return {k: f() for k, f in tasks.items()}
+    with ThreadPoolExecutor(len(tasks), thread_name_prefix="brown_design") as tp:
+        futs = {k: tp.submit(f) for k, f in tasks.items()}
+        return {k: f.result() for k, f in futs.items()}
