@@ -17,16 +17,19 @@ Jacobian:
    ``Npg_j' K_j`` is one matrix product per trial).
 
 The same quantities as :func:`sim.lsq.normals.reduce` on the dense Jacobian, to rounding (a
-test holds them to 1e-12 relative). Without numba (:data:`AVAILABLE` false) the caller uses
-the NumPy blocks of :meth:`sim.positions.RangeModel.normal_blocks` instead.
+test holds them to 1e-12 relative). Without numba, or with ``SIM_NO_JIT`` set
+(:data:`AVAILABLE` false), the caller uses the NumPy blocks of
+:meth:`sim.positions.RangeModel.normal_blocks` instead.
 """
 from __future__ import annotations
+
+import os
 
 import numpy as np
 
 try:
     from numba import njit
-    AVAILABLE = True
+    AVAILABLE = not os.environ.get("SIM_NO_JIT")
 except ImportError:  # pragma: no cover - the NumPy blocks are used instead
     AVAILABLE = False
 
