@@ -12,7 +12,7 @@ each part assembles its chunks in chunk order.
 """
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
 from typing import Callable, Mapping
 
 __all__ = ["side_by_side", "parallel"]
@@ -26,9 +26,20 @@ def parallel(ctx) -> bool:
 
 def side_by_side(tasks: Mapping[str, Callable[[], object]], ctx) -> dict:
     """``{name: task()}`` for independent callables: in threads when :func:`parallel`,
-    else in the given order. An exception of a task is raised here."""
+    else in the given order. An exception of a task (or an interrupt) is raised here at
+    once."""
     if len(tasks) < 2 or not parallel(ctx):
         return {k: f() for k, f in tasks.items()}
-    with ThreadPoolExecutor(len(tasks), thread_name_prefix="brown_design") as tp:
+    tp = ThreadPoolExecutor(len(tasks), thread_name_prefix="brown_design")
+    try:
         futs = {k: tp.submit(f) for k, f in tasks.items()}
-        return {k: f.result() for k, f in futs.items()}
+        done, _ = wait(futs.values(), return_when=FIRST_EXCEPTION)
+        for f in done:
+            if f.exception() is not None:
+                f.result()
+        out = {k: f.result() for k, f in futs.items()}
+    except BaseException:   # an interrupt or a failed part: raise now, without waiting for
+        tp.shutdown(wait=False, cancel_futures=True)  # the other parts (the run's executor
+        raise               # is then closed, which ends their chunk calls)
+    tp.shutdown()
+    return out
