@@ -158,15 +158,20 @@ class RangeModel:
     def initial_points(self, theta: np.ndarray) -> np.ndarray:
         return initial_points(self.r_obs, self.full(theta))
 
-    def linearize(self, points, theta, globals_needed=True) -> lsq.Linearization:
+    def _ranges(self, points, theta):
+        """``q = sqrt(d^2 - b)`` (T, n, P) mm, the unit vector ``(ux, uy)`` station -> point
+        over ``q``, and the residual ``r = r_obs - (q - alpha)`` (zeros without readings)."""
         th = self.full(theta)
         S = stations(th)                                   # (T, P, 2)
         dx = points[:, :, None, 0] - S[:, None, :, 0]      # (T, n, P)
         dy = points[:, :, None, 1] - S[:, None, :, 1]
         q = np.sqrt(np.maximum(dx * dx + dy * dy - th[:, None, None, -1], 1e-300))
-        ux, uy = dx / q, dy / q
         r = (np.zeros_like(q) if self.r_obs is None
              else self.r_obs - (q - th[:, None, None, -2]))
+        return q, dx / q, dy / q, r
+
+    def linearize(self, points, theta, globals_needed=True) -> lsq.Linearization:
+        q, ux, uy, r = self._ranges(points, theta)
         Jp = np.stack([ux, uy], -1)
         if not globals_needed:
             return lsq.Linearization(r, Jp, None)
@@ -212,14 +217,7 @@ class RangeModel:
         (the dense Jacobian ``(T, n, P, 2P + 2)`` is never built). Returns ``(Npp, up, Npg,
         Ngg, ug)`` for :func:`sim.lsq.normals.reduce_blocks` (NumPy; :meth:`reduced` uses it
         without numba)."""
-        th = self.full(theta)
-        S = stations(th)
-        dx = points[:, :, None, 0] - S[:, None, :, 0]      # (T, n, P)
-        dy = points[:, :, None, 1] - S[:, None, :, 1]
-        q = np.sqrt(np.maximum(dx * dx + dy * dy - th[:, None, None, -1], 1e-300))
-        ux, uy = dx / q, dy / q
-        r = (np.zeros_like(q) if self.r_obs is None
-             else self.r_obs - (q - th[:, None, None, -2]))
+        q, ux, uy, r = self._ranges(points, theta)
         xx, xy, yy = ux * ux, ux * uy, uy * uy
         T, n, P = q.shape
         on_k, on_j = np.ones(P), np.ones(n)   # sums over stations / points as products
