@@ -103,6 +103,21 @@ def to_model_frame(ground_xyz: np.ndarray, obs_model: np.ndarray, s, R, t) -> np
     return np.einsum("tkji,tkj->tki", R[:, obs_model], d) / s[:, obs_model, None]
 
 
+def noisy_models(block, rng: np.random.Generator, trials: int, sigma_m=0.0):
+    """Model coordinates of every observation of ``block`` (:mod:`sim.block_layout`) in
+    random model frames, for checks of the adjustment: each model point formed from its
+    error-free image coordinates, shifted to the ground frame, plus Gaussian errors of
+    ``sigma_m`` (m; a scalar or one per axis), then expressed in frames of
+    :func:`random_similarities`. Returns ``xm (T, K, 3)`` and the frames ``(s, R, t)``."""
+    xl = block.image_coords(block.obs_left, block.obs_point)
+    xr = block.image_coords(block.obs_right, block.obs_point)
+    G = form_models(xl, xr, block.focal_mm, block.base_m) + block.photos.reshape(-1, 3)[
+        block.obs_left]
+    G = G + rng.normal(0.0, 1.0, (trials,) + G.shape) * np.asarray(sigma_m, float)
+    s, R, t = random_similarities(rng, (trials, block.n_models))
+    return to_model_frame(G, block.obs_model, s, R, t), (s, R, t)
+
+
 def pointing_errors(rng: np.random.Generator, trials: int, obs_left: np.ndarray,
                     obs_right: np.ndarray, obs_point: np.ndarray, photos_per_strip: int,
                     n_strips: int, n_points: int, *, mark_um: float, parallax_um: float,

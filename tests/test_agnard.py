@@ -23,17 +23,6 @@ def small():
     return make_block(2, 3, n_ground=40, pass_rows=3)
 
 
-def _models(block, T, rng, noise_m=0.0):
-    """Model coordinates of every observation in random model frames, and the frames."""
-    xl = block.image_coords(block.obs_left, block.obs_point)
-    xr = block.image_coords(block.obs_right, block.obs_point)
-    G = im.form_models(xl, xr, block.focal_mm, block.base_m) + block.photos.reshape(-1, 3)[
-        block.obs_left]
-    G = np.broadcast_to(G, (T,) + G.shape) + rng.normal(0, noise_m, (T,) + G.shape)
-    s, R, t = im.random_similarities(rng, (T, block.n_models))
-    return im.to_model_frame(G, block.obs_model, s, R, t), (s, R, t)
-
-
 def _start(block, st, xm, rng, T):
     X0 = block.points + rng.normal(0, 2.0, (T,) + block.points.shape)
     return im.initial_values(st, xm, X0) + (X0,)
@@ -115,7 +104,7 @@ def test_fiducial_affine_removes_affine_errors():
 def test_noise_free_gives_zero_residuals_and_true_parameters(small):
     rng = np.random.default_rng(7)
     T = 3
-    xm, (s, R, t) = _models(small, T, rng)
+    xm, (s, R, t) = im.noisy_models(small, rng, T)
     ctrl = select_control(small, "five")
     st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
     s0, R0, t0, X0 = _start(small, st, xm, rng, T)
@@ -133,7 +122,7 @@ def test_all_control_reproduces_each_model_similarity(small):
     7-parameter fit per model: the closed-form (Horn/Umeyama) similarity."""
     rng = np.random.default_rng(11)
     T = 2
-    xm, _ = _models(small, T, rng, noise_m=0.3)
+    xm, _ = im.noisy_models(small, rng, T, 0.3)
     ctrl = np.arange(small.n_points)
     ctrl_xyz = small.points + rng.normal(0, 0.1, (T,) + small.points.shape)
     st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
@@ -152,7 +141,7 @@ def test_all_control_reproduces_each_model_similarity(small):
 def test_reduced_normals_equal_dense_solve(small):
     rng = np.random.default_rng(5)
     T = 2
-    xm, _ = _models(small, T, rng, noise_m=0.2)
+    xm, _ = im.noisy_models(small, rng, T, 0.2)
     ctrl = select_control(small, "full")
     st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
     s0, R0, t0, X0 = _start(small, st, xm, rng, T)
@@ -171,7 +160,7 @@ def test_reduced_normals_equal_dense_solve(small):
 def test_residual_cofactors_equal_dense(small):
     rng = np.random.default_rng(9)
     T = 2
-    xm, _ = _models(small, T, rng, noise_m=0.1)
+    xm, _ = im.noisy_models(small, rng, T, 0.1)
     ctrl = select_control(small, "full")
     P, M, K, C = small.n_points, small.n_models, small.obs_model.size, ctrl.size
     st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, M, P)
@@ -395,7 +384,7 @@ def test_chunk_functions_pickle():
 def test_sparse_and_dense_reduced_solutions_agree(small):
     rng = np.random.default_rng(13)
     T = 2
-    xm, _ = _models(small, T, rng, noise_m=0.2)
+    xm, _ = im.noisy_models(small, rng, T, 0.2)
     ctrl = select_control(small, "perimeter")
     st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
     s0, R0, t0, X0 = _start(small, st, xm, rng, T)
@@ -413,12 +402,7 @@ def test_monte_carlo_point_errors_match_adjustment_covariance(small):
     rng = np.random.default_rng(21)
     T = 600
     sig = np.array([0.13, 0.13, 0.22])
-    xl = b.image_coords(b.obs_left, b.obs_point)
-    xr = b.image_coords(b.obs_right, b.obs_point)
-    G = im.form_models(xl, xr, b.focal_mm, b.base_m) + b.photos.reshape(-1, 3)[b.obs_left]
-    G = G + rng.normal(0, 1, (T,) + G.shape) * sig
-    s, R, t = im.random_similarities(rng, (T, b.n_models))
-    xm = im.to_model_frame(G, b.obs_model, s, R, t)
+    xm, (s, R, t) = im.noisy_models(b, rng, T, sig)
     ctrl = select_control(b, "full")
     st = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points)
     sc_ = 0.05

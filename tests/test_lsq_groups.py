@@ -17,12 +17,7 @@ def setup():
     b = make_block(2, 4, n_ground=50, pass_rows=3)
     rng = np.random.default_rng(3)
     T = 3
-    xl = b.image_coords(b.obs_left, b.obs_point)
-    xr = b.image_coords(b.obs_right, b.obs_point)
-    G = im.form_models(xl, xr, b.focal_mm, b.base_m) + b.photos.reshape(-1, 3)[b.obs_left]
-    G = G + rng.normal(0, 0.1, (T,) + G.shape)
-    s, R, t = im.random_similarities(rng, (T, b.n_models))
-    xm = im.to_model_frame(G, b.obs_model, s, R, t)
+    xm, _ = im.noisy_models(b, rng, T, 0.1)
     ctrl = select_control(b, "perimeter")
     st = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points)
     X0 = b.points + rng.normal(0, 2.0, (T,) + b.points.shape)
