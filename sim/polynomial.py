@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import polynomial_kernel
 from .lsq.linear import lstsq
 
 __all__ = ["WOLF_TERMS", "poly_terms", "design", "PolyFit", "fit_poly", "fit_wolf", "apply_poly",
@@ -109,7 +110,7 @@ class PolyFit:
 
 
 def fit_poly(measured: np.ndarray, true: np.ndarray, degree: int | None = 3, terms=None,
-             norm_mm: float = 100.0, corrected: bool = False) -> PolyFit:
+             norm_mm: float = 100.0, corrected: bool = False, jit: bool = True) -> PolyFit:
     """Fit the correction ``true - measured = P(measured)`` by least squares, per trial.
 
     Parameters
@@ -119,17 +120,32 @@ def fit_poly(measured: np.ndarray, true: np.ndarray, degree: int | None = 3, ter
     degree : total degree of the complete polynomial (ignored when ``terms`` is given).
     terms : explicit exponents, e.g. :data:`WOLF_TERMS`.
     corrected : also return the fitting data corrected (:attr:`PolyFit.corrected_mm`).
+    jit : use the compiled fast path where numba is installed (:mod:`sim.polynomial_kernel`,
+        equal to the NumPy path to rounding); False: the NumPy path
+        (:func:`sim.lsq.linear.lstsq` on the batch's designs).
 
     A degree-1 polynomial is the general affine transformation ``x = X + A1 + A2 X + A4 Y``.
     """
     measured = np.asarray(measured, float)
     true = np.broadcast_to(np.asarray(true, float), measured.shape)
     terms = tuple(terms) if terms is not None else poly_terms(degree)
+    if jit and measured.ndim == 3 and polynomial_kernel.available():
+        return _fit_compiled(measured, true, terms, float(norm_mm), corrected)
     A = design(measured, terms, norm_mm)                  # (T, n, p): one R0 for all trials
     f = lstsq(A, true - measured)
     rms = np.sqrt(np.mean(f.residuals ** 2, axis=1))
     return PolyFit(f.x, terms, float(norm_mm), f.ok, rms,
                    measured + np.matmul(A, f.x) if corrected else None)
+
+
+def _fit_compiled(measured, true, terms, norm_mm, corrected) -> PolyFit:
+    """:func:`fit_poly` on the compiled fast path (:mod:`sim.polynomial_kernel`): each
+    trial's normal equations formed from its points in the cache, solved by the engine's
+    :func:`sim.lsq.linear.solve_normals` (the same scaled rule and status as
+    :func:`sim.lsq.linear.lstsq`)."""
+    true_ = true[0] if true.strides[0] == 0 else true         # broadcast: one set of points
+    x, status, sq, corr = polynomial_kernel.fit(measured, true_, terms, norm_mm, corrected)
+    return PolyFit(x, terms, norm_mm, status == 0, np.sqrt(sq / measured.shape[1]), corr)
 
 
 def fit_wolf(measured: np.ndarray, true: np.ndarray, norm_mm: float = 100.0) -> PolyFit:

@@ -9,17 +9,19 @@ trial) and 2 um of reading noise. Compared on the coefficients (mm, on the monom
 coordinates / 100 mm).
 
 * ``polynomial``: as the study fits it (:func:`sim.polynomial.fit_wolf`): the design is
-  built from each trial's *measured* coordinates, so it differs per trial; the engine
-  (:func:`sim.lsq.linear.lstsq`) factorises the trial-mean design once and solves every
-  trial with batched matrix products.
+  built from each trial's *measured* coordinates, so it differs per trial; the engine's
+  compiled fast path (:mod:`sim.polynomial_kernel`) forms each trial's design in the cache,
+  its normal equations from their distinct entries, and solves them eight trials at a time
+  by the engine's scaled rule (:mod:`sim.lsq.linear_kernel`).
 * ``polynomial_shared``: the same polynomial with its design on the grid's nominal
   coordinates (the correction as a function of position), shared by all trials: one QR for
-  all trials, then one matrix product.
+  all trials (:func:`sim.lsq.linear.lstsq`), then every trial's solution and ``v' W v`` in a
+  compiled pass over its observations.
 
 The SciPy side is what a user would write for one trial: ``scipy.linalg.lstsq`` (LAPACK
-``gelsd``) of the trial's design against its two right-hand sides. Neither row reaches the
-issue's 50x: a row's note times, beside both sides, LAPACK's QR least squares (``dgels``)
-alone on a prepared design per trial, the floor of any per-trial loop, and says why.
+``gelsd``) of the trial's design against its two right-hand sides. Where a row falls below
+the issue's 50x, its note times, beside both sides, LAPACK's QR least squares (``dgels``)
+alone on a prepared design per trial, the floor of any per-trial loop.
 """
 from __future__ import annotations
 
@@ -38,8 +40,8 @@ TOL_POLY_MM = 1e-13
 _SCIPY = "scipy.linalg.lstsq (gelsd), per trial"
 _WHY = ("a linear fit is one LAPACK call per trial, already compiled; the loop's overhead is "
         "Python's per call and the engine's cost is memory traffic over the trials' data")
-_WHY_PER_TRIAL = (_WHY + "; with a design per trial the engine builds and reads every trial's "
-                  "198 x 10 design (16 kB) several times, so it is bound by memory, and the "
+_WHY_PER_TRIAL = (_WHY + "; with a design per trial the engine forms every trial's 198 x 10 "
+                  "design and its normal equations, about 60 products of 198 terms, and the "
                   "SciPy loop is within a few times of LAPACK's own per-trial floor")
 _FLOOR = "LAPACK dgels alone (design prepared)"
 

@@ -183,14 +183,23 @@ def _numba():
     return _compiled.get("njit")
 
 
-def compiled(fn, **consts):
+#: the floating-point licences of :func:`compiled` with ``reassociate=True``: sums may be
+#: reordered (vectorised) and multiply-adds fused; no licence to assume finite numbers, so
+#: NaN and infinity still propagate and the non-finite checks of the kernels hold
+REASSOCIATE = frozenset({"reassoc", "contract"})
+
+
+def compiled(fn, reassociate: bool = False, **consts):
     """``fn`` compiled by numba (once per process; cached on disk). ``consts`` (e.g. block
     sizes ``D_POINT``, ``B_GROUP``, ``M_ROWS``) are frozen into its globals as compile-time
     constants (numba treats globals as such), which lets the compiler unroll and vectorise
-    the small loops; each variant is cached under its own name. Needs :func:`available`."""
+    the small loops; each variant is cached under its own name. ``reassociate``: compile
+    with :data:`REASSOCIATE` (long dot products vectorised; the sums are deterministic but
+    rounded in another order than a sequential loop). Needs :func:`available`."""
     import types
 
-    key = (fn.__module__, fn.__name__) + tuple(sorted(consts.items()))
+    njit = _numba()
+    key = (fn.__module__, fn.__name__, reassociate) + tuple(sorted(consts.items()))
     if key not in _compiled:
         f = fn
         if consts:
@@ -198,7 +207,8 @@ def compiled(fn, **consts):
             f = types.FunctionType(fn.__code__, dict(fn.__globals__, **consts), name,
                                    fn.__defaults__, fn.__closure__)
             f.__qualname__ = name
-        _compiled[key] = _numba()(cache=True, error_model="numpy")(f)
+        opts = {"fastmath": set(REASSOCIATE)} if reassociate else {}
+        _compiled[key] = njit(cache=True, error_model="numpy", **opts)(f)
     return _compiled[key]
 
 

@@ -20,7 +20,10 @@ the other trials.
 
 * *Shared design* (``A`` of shape ``(m, p)`` and weights shared by all trials, ``w`` of
   shape ``(m,)`` or none): ``sqrt(W) A = Q R`` is factorised once and every trial's
-  right-hand side is solved in one matrix product, ``x = R^-1 Q' sqrt(W) b``.
+  right-hand side is solved by one operator, ``x = R^-1 Q' sqrt(W) b``: in a compiled
+  kernel, one trial at a time in the cache, summing ``v' W v`` without storing the
+  residuals (formed on first use, :attr:`LinearFit.residuals`); without numba in one matrix
+  product over all trials (:mod:`sim.lsq.linear_kernel`).
 * *Per-trial design* ``(T, m, p)`` (or per-trial weights): the designs of a Monte Carlo are
   perturbations of one nominal design, so the QR ``R0`` of the trial-mean (weighted) design
   is computed once and used as a right preconditioner: ``B_t = sqrt(W_t) A_t R0^-1`` is
@@ -40,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import linalg
 
+from . import linear_kernel
 from .normals import RCOND, scaled_rcond
 
 __all__ = ["LinearFit", "lstsq", "LINEAR_STATUS"]
@@ -63,7 +67,7 @@ class LinearFit:
     """
 
     x: np.ndarray
-    residuals: np.ndarray
+    _v: np.ndarray | None = field(repr=False)           # residuals, or None: formed when asked
     vtpv: np.ndarray
     dof: int
     status: np.ndarray
@@ -71,6 +75,16 @@ class LinearFit:
     _P: np.ndarray | None = field(repr=False)           # (p, p) or (T, p, p) preconditioner
     _NBinv: np.ndarray | None = field(repr=False)       # (T, p, p) inverse of B'B (per trial)
     # (_P None: _NBinv is the cofactor itself, from a closed form such as the 2-D similarity)
+    _Ab: tuple | None = field(default=None, repr=False)  # (A, b) to form the residuals from
+
+    @property
+    def residuals(self) -> np.ndarray:
+        """``(T, m, k)`` residuals ``b - A x`` (NaN for unsolved trials); formed on first use
+        where the solve summed ``v' W v`` without storing them (the compiled shared path)."""
+        if self._v is None:
+            A, b = self._Ab
+            self._v = b - _fitted(A, self.x)
+        return self._v
 
     @property
     def ok(self) -> np.ndarray:
@@ -140,10 +154,19 @@ def lstsq(A, b, w=None, rcond: float = RCOND) -> LinearFit:
     A, b, w, _ = _prepare(A, b, w)
     T, m, k = b.shape
     p = A.shape[-1]
-    fin_b = np.isfinite(b).all(axis=(1, 2))
     if A.ndim == 2 and (w is None or w.ndim == 1):
-        return _shared(A, b, w, fin_b, rcond)
+        return _shared(A, b, w, rcond)
+    fin_b = np.isfinite(b).all(axis=(1, 2))
     return _per_trial(np.broadcast_to(A, (T, m, p)), b, w, fin_b, rcond)
+
+
+def _fitted(A, x):
+    """``A x`` (T, m, k) for a shared (m, p) or per-trial (T, m, p) design."""
+    if A.ndim == 3:
+        return np.matmul(A, x)
+    T, p, k = x.shape
+    m = A.shape[0]
+    return (A @ x.transpose(1, 0, 2).reshape(p, T * k)).reshape(m, T, k).transpose(1, 0, 2)
 
 
 def _finish(A, b, w, x, status, shared, P, NBinv, v=None) -> LinearFit:
@@ -155,11 +178,7 @@ def _finish(A, b, w, x, status, shared, P, NBinv, v=None) -> LinearFit:
     T, m, k = b.shape
     p = A.shape[-1]
     if v is None:
-        if A.ndim == 3:
-            fitted = np.matmul(A, x)
-        else:
-            fitted = (A @ x.transpose(1, 0, 2).reshape(p, T * k)).reshape(m, T, k).transpose(1, 0, 2)
-        v = b - fitted
+        v = b - _fitted(A, x)
     if w is None and k > 1:  # the same sums as below (over m in order), without a temporary
         vtpv = np.einsum("tmk,tmk->tk", v, v)
     else:
@@ -168,22 +187,28 @@ def _finish(A, b, w, x, status, shared, P, NBinv, v=None) -> LinearFit:
     return LinearFit(x, v, vtpv, m - p, status, shared, P, NBinv)
 
 
-def _shared(A, b, w, fin_b, rcond) -> LinearFit:
+def _shared(A, b, w, rcond) -> LinearFit:
     """One factorisation for all trials: ``sqrt(W) A = Q R``; every trial's right-hand sides
-    are solved in one matrix product (columns ``(trial, k)``) and one triangular solve, and
-    their residuals in one more product."""
+    are solved by the compiled kernel (:func:`sim.lsq.linear_kernel.shared_solve`), or without
+    numba in one matrix product (columns ``(trial, k)``) and one triangular solve, and their
+    residuals in one more product."""
     T, m, k = b.shape
     p = A.shape[1]
     sw = np.ones(m) if w is None else np.sqrt(np.clip(w, 0.0, None))
     Aw = A * sw[:, None]
-    status = np.where(fin_b, 0, 3).astype(np.int8)
     good = bool(np.isfinite(Aw).all()) and m >= p and scaled_rcond(Aw.T @ Aw) > rcond
     if not good:
-        status[:] = np.where(np.isfinite(Aw).all(), 2, 3)
+        status = np.full(T, 2 if np.isfinite(Aw).all() else 3, np.int8)
         return _finish(A, b, w, np.full((T, p, k), np.nan), status, True,
                        np.full((p, p), np.nan), None)
     Qf, R = np.linalg.qr(Aw)                                        # once for all trials
     Rinv = linalg.solve_triangular(R, np.eye(p))
+    if linear_kernel.available():       # x = R^-1 Q' sqrt(W) b per trial, in the cache
+        x, vtpv, st = linear_kernel.shared_solve(Rinv @ (Qf.T * sw[None, :]), A, w, b)
+        status = np.where(st == linear_kernel.SOLVED, 0, 3).astype(np.int8)
+        return LinearFit(x, None, vtpv, m - p, status, True, Rinv, None, (A, b))
+    fin_b = np.isfinite(b).all(axis=(1, 2))
+    status = np.where(fin_b, 0, 3).astype(np.int8)
     plain = w is None and bool(fin_b.all())                         # b needs no masking
     bw = b if plain else np.where(fin_b[:, None, None], b, 0.0) * sw[None, :, None]
     bT = bw.transpose(1, 0, 2).reshape(m, T * k)                    # columns (trial, k)
@@ -277,3 +302,4 @@ def _per_trial(A, b, w, fin_b, rcond) -> LinearFit:
     y = np.matmul(NBinv, np.matmul(np.swapaxes(B, 1, 2), bw))
     x = np.matmul(P, y)
     return _finish(A, b, w, x, status, False, P, NBinv)
+
