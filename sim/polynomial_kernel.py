@@ -8,13 +8,15 @@ designs and hands them to :func:`sim.lsq.linear.lstsq`; that writes and reads ev
 design (16 kB for Wolf's 198 points and ten terms) through memory several times. Here each
 trial's design is formed in the processor's cache from its points and never stored:
 
-* :func:`normals` -- ``N_t = A_t' A_t`` (upper triangle) and ``u_t = A_t' (true - measured)``
-  (``p x 2``), one pass over the trial's points; the columns are the same numbers as
-  :func:`sim.polynomial.design` (powers by successive products);
-* the engine solves them (:func:`sim.lsq.linear.solve_normals`: the one scaled
-  singularity rule, per-trial status);
-* :func:`residuals` -- ``P(measured)``, the residual square sums per axis and, when asked,
-  the corrected points ``measured + A_t x_t``.
+* per trial (:func:`_points`): the monomials ``(X * (1 / norm))^i (Y * (1 / norm))^j``
+  (powers by successive products, as :func:`sim.polynomial.design`) and
+  ``D = true - measured``; ``N_t = A_t' A_t`` from its distinct entries (the moments) and
+  ``u_t = A_t' D``, four products per pass over the points (:func:`_plan`);
+* eight trials at a time, the engine's scaled rule and solve
+  (:func:`sim.lsq.linear_kernel.solve_lanes`); trials it cannot prove regular are fitted
+  again by :func:`sim.lsq.linear.lstsq` (the exact rule), so the decisions are the engine's;
+* ``P(measured)``, the residual square sums per axis and, when asked, the corrected points
+  ``measured + A_t x_t``.
 
 The normal equations square the design's condition number; with coordinates normalised by
 ``norm`` (100 mm) Wolf's design has a condition number of about 44, so the coefficients

@@ -80,7 +80,9 @@ class LinearFit:
     @property
     def residuals(self) -> np.ndarray:
         """``(T, m, k)`` residuals ``b - A x`` (NaN for unsolved trials); formed on first use
-        where the solve summed ``v' W v`` without storing them (the compiled shared path)."""
+        where the solve summed ``v' W v`` without storing them (the compiled shared path),
+        from the arrays given to :func:`lstsq` (not copied: do not change them in place
+        before asking)."""
         if self._v is None:
             A, b = self._Ab
             self._v = b - _fitted(A, self.x)

@@ -148,25 +148,21 @@ def solve_lanes(N, u, x, ok, s, L, G, e, fro, g2, rcond):  # pragma: no cover - 
                 fro[b] += w * cij * cij
                 L[i, j, b] = cij
     for j in range(p):                              # Cholesky C = L L'; G[j, j] = 1 / L[j, j]
-        for b in range(LANES):
-            e[b] = L[j, j, b]
-        for q in range(j):
-            for b in range(LANES):
-                e[b] -= L[j, q, b] * L[j, q, b]
-        for b in range(LANES):
-            okd = e[b] > 0.0
-            ok[b] &= okd
-            d = np.sqrt(e[b] if okd else 1.0)
-            L[j, j, b] = d
-            G[j, j, b] = 1.0 / d
-        for i in range(j + 1, p):
+        for i in range(j, p):                       # the diagonal first, then below it
             for b in range(LANES):
                 e[b] = L[i, j, b]
             for q in range(j):
                 for b in range(LANES):
                     e[b] -= L[i, q, b] * L[j, q, b]
             for b in range(LANES):
-                L[i, j, b] = e[b] * G[j, j, b]
+                if i == j:
+                    okd = e[b] > 0.0
+                    ok[b] &= okd
+                    d = np.sqrt(e[b] if okd else 1.0)
+                    L[j, j, b] = d
+                    G[j, j, b] = 1.0 / d
+                else:
+                    L[i, j, b] = e[b] * G[j, j, b]
     for j in range(p):                              # G = L^-1 (lower), ||G||_F^2
         for b in range(LANES):
             g2[b] += G[j, j, b] * G[j, j, b]
