@@ -8,6 +8,9 @@ STAMP  := $(VENV)/.installed
 RUN_FLAGS ?= --workers 2
 STUDY_FILES := $(wildcard studies/*.toml)
 STUDIES := $(basename $(notdir $(STUDY_FILES)))
+# every `python -m sim ...` is a fresh process: let Python keep the compiled modules
+# (__pycache__) even where the environment asks it not to, or each run compiles them again
+unexport PYTHONDONTWRITEBYTECODE
 
 .DEFAULT_GOAL := help
 .PHONY: help venv test reproduce rerun verify report bench clean fuzz

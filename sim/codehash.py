@@ -1,7 +1,7 @@
 """Which code a study's results depend on, and whether committed results are current.
 
 A study's *code* is the closure of the ``sim`` modules its package imports (read statically
-from the sources, so nothing is imported or run), plus the data files inside its package
+from the sources' import lines, so nothing is imported or run), plus the data files inside its package
 (the claim book). Its hash decides staleness per study: editing one study's caption re-runs
 that study only, and a fresh clone (whose file times are the checkout's) does not re-run
 anything that is current.
@@ -12,9 +12,9 @@ Makefile's ``reproduce`` uses it.
 """
 from __future__ import annotations
 
-import ast
 import hashlib
 import json
+import re
 from functools import lru_cache
 from pathlib import Path
 
@@ -53,21 +53,38 @@ def _module_name(f: Path) -> str:
     return ".".join(parts)
 
 
+#: an import statement at the start of a line (indented or not): ``from <mod> import <names>``
+#: (a parenthesised list may span lines) or ``import <mods>``
+_IMPORT = re.compile(r"^[ \t]*(?:from[ \t]+(\.*[\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^\n]*)"
+                     r"|import[ \t]+([^\n]*))", re.M)
+
+
+def _names(text: str) -> list[str]:
+    """``a.b as c, (d,\n e)  # note`` -> ``["a.b", "d", "e"]``."""
+    text = re.sub(r"#[^\n]*", "", text).strip("() \t\n")
+    return [w.split()[0] for w in text.split(",") if w.split()]
+
+
 def _imports(f: Path) -> set[str]:
-    """Absolute names of the ``sim`` modules ``f`` imports (``from . import x`` included)."""
-    tree = ast.parse(f.read_text(), str(f))
+    """Absolute names of the ``sim`` modules ``f`` imports (``from . import x`` included).
+
+    Read by a pattern over the source's lines, not by parsing it (a parse of every module
+    costs most of a second per run): an import-like line inside a string counts too, which
+    can only add a file to a study's code, never leave one out."""
     pkg = _module_name(f).split(".")
     if f.name != "__init__.py":
         pkg = pkg[:-1]
     out: set[str] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            out.update(a.name for a in node.names)
-        elif isinstance(node, ast.ImportFrom):
-            base = pkg[:len(pkg) - node.level + 1] if node.level else []
-            mod = ".".join(base + (node.module.split(".") if node.module else []))
-            out.add(mod)
-            out.update(f"{mod}.{a.name}" for a in node.names)  # submodules imported by name
+    for m in _IMPORT.finditer(f.read_text().replace("\\\n", " ")):
+        if m.group(3) is not None:
+            out.update(_names(m.group(3)))
+            continue
+        spec = m.group(1)
+        level = len(spec) - len(spec.lstrip("."))
+        base = pkg[:len(pkg) - level + 1] if level else []
+        mod = ".".join(base + ([p for p in spec[level:].split(".") if p]))
+        out.add(mod)
+        out.update(f"{mod}.{a}" for a in _names(m.group(2)))  # submodules imported by name
     return {m for m in out if m.split(".")[0] == "sim"}
 
 

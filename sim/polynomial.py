@@ -140,9 +140,10 @@ def fit_poly(measured: np.ndarray, true: np.ndarray, degree: int | None = 3, ter
 
 def _fit_compiled(measured, true, terms, norm_mm, corrected) -> PolyFit:
     """:func:`fit_poly` on the compiled fast path (:mod:`sim.polynomial_kernel`): each
-    trial's normal equations formed from its points in the cache, solved by the engine's
-    :func:`sim.lsq.linear.solve_normals` (the same scaled rule and status as
-    :func:`sim.lsq.linear.lstsq`)."""
+    trial's normal equations formed from its points in the cache, solved eight trials at a
+    time by the engine's :func:`sim.lsq.linear_kernel.solve_lanes` (the scaled rule; trials
+    it cannot prove regular go to :func:`sim.lsq.linear.lstsq`, so status and decisions are
+    the engine's)."""
     true_ = true[0] if true.strides[0] == 0 else true         # broadcast: one set of points
     x, status, sq, corr = polynomial_kernel.fit(measured, true_, terms, norm_mm, corrected)
     return PolyFit(x, terms, norm_mm, status == 0, np.sqrt(sq / measured.shape[1]), corr)

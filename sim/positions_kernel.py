@@ -13,8 +13,8 @@ Jacobian:
 2. :func:`eliminate`: the normals of the ``2P + 2`` globals (``X_1, Y_1, ..., alpha, b``)
    with every point eliminated (Brown's reduced normals): ``Nbar = Ngg - sum_j Npg_j' K_j``,
    ``ubar = ug - sum_j K_j' up_j`` with ``K_j = Ninv_j Npg_j``, and ``dp0_j = Ninv_j up_j``
-   (the compiled pass forms ``Npg``, ``K``, ``Ngg``, ``ubar`` and ``dp0``; the sum of
-   ``Npg_j' K_j`` is one matrix product per trial).
+   (one compiled pass: each point's ``Npg_j`` is formed in a small scratch block, its
+   ``K_j`` stored, and ``Npg_j' K_j`` taken from ``Nbar`` above the diagonal at once).
 
 The same quantities as :func:`sim.lsq.normals.reduce` on the dense Jacobian, to rounding (a
 test holds them to 1e-12 relative). Without numba, or with ``SIM_NO_JIT`` set
@@ -67,11 +67,12 @@ def _point_normals(pts, S, th, r_obs, has_r, Npp, up):  # pragma: no cover - com
             up[t, j, 1] = u1
 
 
-def _eliminate(pts, S, th, r_obs, has_r, Ninv, up, K, Npg, Ngg, ubar, dp0):  # pragma: no cover
+def _eliminate(pts, S, th, r_obs, has_r, Ninv, up, K, Ngg, ubar, dp0):  # pragma: no cover
     T, n, _ = pts.shape
     P = S.shape[1]
     m = 2 * P + 2
     A, B = 2 * P, 2 * P + 1
+    G = np.empty((2, m))
     for t in range(T):
         alpha, b = th[t, A], th[t, B]
         N = Ngg[t]
@@ -79,7 +80,6 @@ def _eliminate(pts, S, th, r_obs, has_r, Ninv, up, K, Npg, Ngg, ubar, dp0):  # p
         N[:, :] = 0.0
         u[:] = 0.0
         for j in range(n):
-            G = Npg[t, j]
             G[:, :] = 0.0
             for k in range(P):
                 ux, uy, q = _unit(pts[t, j, 0], pts[t, j, 1], S[t, k, 0], S[t, k, 1], b)
@@ -113,12 +113,17 @@ def _eliminate(pts, S, th, r_obs, has_r, Ninv, up, K, Npg, Ngg, ubar, dp0):  # p
             up0, up1 = up[t, j, 0], up[t, j, 1]
             dp0[t, j, 0] = n00 * up0 + n01 * up1
             dp0[t, j, 1] = n10 * up0 + n11 * up1
+            Kj = K[t, j]
             for c in range(m):
                 k0 = n00 * G[0, c] + n01 * G[1, c]
                 k1 = n10 * G[0, c] + n11 * G[1, c]
-                K[t, j, 0, c] = k0
-                K[t, j, 1, c] = k1
+                Kj[0, c] = k0
+                Kj[1, c] = k1
                 u[c] -= k0 * up0 + k1 * up1
+            for c in range(m):      # Nbar = Ngg - sum_j Npg_j' K_j, above the diagonal
+                g0, g1 = G[0, c], G[1, c]
+                for e in range(c, m):
+                    N[c, e] -= g0 * Kj[0, e] + g1 * Kj[1, e]
         for c in range(m):          # filled above the diagonal only: mirror
             for e in range(c):
                 N[c, e] = N[e, c]
@@ -154,10 +159,8 @@ def eliminate(points, theta, r_obs, Ninv: np.ndarray, up: np.ndarray):
     pts, S, th, r, has_r = _args(points, theta, r_obs)
     T, n, _ = pts.shape
     m = th.shape[1]
-    K, Npg, Ngg = np.empty((T, n, 2, m)), np.empty((T, n, 2, m)), np.empty((T, m, m))
+    K, Nbar = np.empty((T, n, 2, m)), np.empty((T, m, m))
     ubar, dp0 = np.empty((T, m)), np.empty((T, n, 2))
     _eliminate(pts, S, th, r, has_r, np.ascontiguousarray(Ninv), np.ascontiguousarray(up),
-               K, Npg, Ngg, ubar, dp0)
-    # sum_j Npg_j' K_j as one product per trial (BLAS)
-    Nbar = Ngg - K.reshape(T, 2 * n, m).transpose(0, 2, 1) @ Npg.reshape(T, 2 * n, m)
+               K, Nbar, ubar, dp0)
     return K, Nbar, ubar, dp0

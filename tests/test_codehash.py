@@ -38,3 +38,29 @@ def test_results_are_current_until_the_config_changes(tmp_path):
     assert is_current(study, out)
     study.write_text(study.read_text().replace("seed = ", "seed = 11 # ", 1))
     assert not is_current(study, out)
+
+
+def test_import_lines_are_read_in_every_form(tmp_path, monkeypatch):
+    """Relative and absolute imports, aliases, lists over several lines, imports inside
+    functions, comments; ``from __future__`` and other packages are not ``sim`` code."""
+    import sim.codehash as ch
+
+    pkg = tmp_path / "sim" / "studies" / "demo"
+    pkg.mkdir(parents=True)
+    f = pkg / "run.py"
+    f.write_text(
+        "from __future__ import annotations\n"
+        "import numpy as np, sim.heap as hp  # a comment\n"
+        "from ... import (errorfields as ef,  # the fields\n"
+        "                 plate,\n"
+        ")\n"
+        "from .model import Instrument\n"
+        "from ...lsq.linear import \\\n    lstsq\n"
+        "def f():\n"
+        "    from ... import storage\n"
+        "x = 'import os'  # not at a line's start: not an import\n")
+    monkeypatch.setattr(ch, "ROOT", tmp_path / "sim")
+    assert ch._imports(f) == {
+        "sim.heap", "sim", "sim.errorfields", "sim.plate", "sim.studies.demo.model",
+        "sim.studies.demo.model.Instrument", "sim.lsq.linear", "sim.lsq.linear.lstsq",
+        "sim.storage"}

@@ -109,3 +109,24 @@ def test_normal_solve_proves_regular_or_leaves_to_the_exact_rule():
     err = np.abs(x[solved] - ref).max(axis=(1, 2)) / np.abs(ref).max(axis=(1, 2))
     assert (err <= 10 * cond * EPS).all()
     assert polynomial_kernel.available()
+
+
+def test_polynomial_square_sums_from_the_normals_only_where_exact_enough():
+    """Without corrected points the kernel takes ``v'v = D'D - 2 x'u + x'N x`` from the sums it
+    already has, but only where its rounding bound is below 1e-9 of ``v'v``: a trial fitted
+    exactly (``v'v`` all rounding) goes through the explicit residuals, and equals them bit for
+    bit; the other trials equal them within 1e-9 relative."""
+    g, meas = _wolf_batch(T=9)
+    true = np.repeat(g[None], 9, axis=0)
+    A = pl.design(meas[3], pl.WOLF_TERMS)
+    true[3] = meas[3] + A @ np.linspace(-1e-3, 1e-3, 20).reshape(10, 2)  # D: the polynomial
+    terms = pl.WOLF_TERMS
+    _, st, q_id, _ = polynomial_kernel.fit(meas, true, terms, 100.0, corrected=False)
+    _, st2, q_ex, _ = polynomial_kernel.fit(meas, true, terms, 100.0, corrected=True)
+    assert (st == 0).all() and (st2 == 0).all()
+    np.testing.assert_array_equal(q_id[3], q_ex[3])                # the explicit pass
+    n_pts = g.shape[0]                              # an exact fit: rounding of D = true - meas
+    assert q_ex[3].max() <= n_pts * (4 * EPS * np.abs(true[3]).max()) ** 2
+    rest = np.arange(9) != 3
+    assert (np.abs(q_id[rest] - q_ex[rest]) <= 1e-9 * q_ex[rest]).all()
+    assert not np.array_equal(q_id[rest], q_ex[rest])                # the identity was used
