@@ -39,16 +39,17 @@ fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=30
 
 # A study is re-run when its results are not current: run.json must record the study file's
 # config and the hash of the code that study imports (sim/codehash.py). Decided by content,
-# not by file times, so a fresh clone re-runs nothing that is current.
+# not by file times, so a fresh clone re-runs nothing that is current. The studies run
+# RUN_JOBS at a time, each in its own process with RUN_FLAGS (sim/batch.py; quiet when
+# RUN_JOBS > 1, the slowest first).
+RUN_JOBS ?= 2
+
 reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md
-	@for s in $(STUDIES); do \
-	  if $(PY) -c "import sys; from sim.codehash import is_current; sys.exit(not is_current(*sys.argv[1:]))" \
-	       studies/$$s.toml results/$$s; then echo "$$s: up to date"; \
-	  else $(PY) -m sim run studies/$$s.toml --out results/$$s --overwrite $(RUN_FLAGS) || exit 1; fi; done
+	$(PY) -m sim.batch --stale-only --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
 rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report
-	@for s in $(STUDIES); do $(PY) -m sim run studies/$$s.toml --out results/$$s --overwrite $(RUN_FLAGS) || exit 1; done
+	$(PY) -m sim.batch --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
 verify: $(STAMP) ## re-run every study into a scratch directory and compare with results/ (tolerances per column)

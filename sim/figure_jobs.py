@@ -8,13 +8,20 @@ given order. :func:`start_figures` sends them and returns at once, so the figure
 while this process goes on with the run (the sweeps, the claims); its ``wait`` collects them.
 A job is ``(fn, args)`` with ``fn`` a module-level function (picklable) that
 draws one figure and saves it (:func:`sim.plotting.save`); the files are the same either way.
+matplotlib is not thread-safe: figures drawn in this process (parts of a run side by side in
+threads, e.g. ``brown_design`` with a remote Dask scheduler) are drawn one at a time under
+:data:`DRAWING`.
 """
 from __future__ import annotations
 
+import threading
 from concurrent.futures import Executor
 from typing import Callable, Sequence
 
-__all__ = ["draw_figures", "start_figures"]
+__all__ = ["draw_figures", "start_figures", "DRAWING"]
+
+#: held while this process draws a figure (matplotlib's state is shared by its threads)
+DRAWING = threading.Lock()
 
 
 def _submitter(executor) -> Callable | None:
@@ -34,7 +41,8 @@ def start_figures(jobs: Sequence[tuple[Callable, tuple]], executor=None) -> Call
     submit = _submitter(executor)
     if submit is None:
         for fn, args in jobs:
-            fn(*args)
+            with DRAWING:
+                fn(*args)
         return lambda: None
     futures = [submit(fn, *args) for fn, args in jobs]
 

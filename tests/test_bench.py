@@ -29,9 +29,11 @@ def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
     rr = pq.read_table(out / "rerun.parquet").to_pydict()
     assert rr["study"] == ["network_testfield", "report", "total"] * 2
     assert rr["workers"] == [1, 1, 1, 2, 2, 2]
+    assert rr["jobs"] == [2] * 6                          # make rerun's studies side by side
     for w in (1, 2):
         i = [k for k in range(6) if rr["workers"][k] == w]
-        assert rr["wall_s"][i[2]] == pytest.approx(rr["wall_s"][i[0]] + rr["wall_s"][i[1]])
+        # one study file: the total spans its run and the report (and the driver's own time)
+        assert rr["wall_s"][i[2]] >= rr["wall_s"][i[0]] + rr["wall_s"][i[1]]
         assert rr["target_s"][i[2]] == 90.0 and np.isnan(rr["target_s"][i[0]])
     assert (out / "engines.png").stat().st_size > 0
     assert not (out / "bench.parquet").exists()          # a section left out is not written

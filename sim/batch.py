@@ -1,0 +1,176 @@
+"""Run many study files side by side: the driver of ``make reproduce`` and ``make rerun``.
+
+``python -m sim.batch [--jobs J] [--stale-only] [--results DIR] FILE ... [-- RUN_OPTIONS]``
+
+Each study file runs in a process of its own, exactly as ``python -m sim run FILE --out
+DIR/<file name> --overwrite RUN_OPTIONS`` (so its ``--workers`` pool, its staging directory
+and its lock are as for one run), ``J`` of them at a time. Two studies side by side keep both
+cores busy while one of them waits on its last chunk, draws a figure or writes its tables;
+the slowest studies (:data:`SLOW_FIRST`) are started first so that the side-by-side runs end
+together. On POSIX the driver imports the suite and the studies' modules once and forks a
+child per study (:func:`sim.cli.main` with that command line), so no run pays the second or
+two of importing NumPy, SciPy, pyarrow, matplotlib and numba again; elsewhere each run is a
+fresh ``python -m sim run``. With ``J > 1`` the runs are quiet (progress bars of several runs
+would overwrite each other); each study's line is printed when it ends. ``--stale-only``:
+only the studies whose results are not current (:func:`sim.codehash.is_current`), the others
+are reported up to date. A run that fails prints its own one-line message; the others go on,
+and the exit code is that of the first failure (1 when a run was killed). A missing study
+file is bad input: one line, exit 2.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+__all__ = ["SLOW_FIRST", "order", "run_all", "main"]
+
+#: the studies that take longest (``make bench``'s rerun rows), started first in this order
+SLOW_FIRST = ("wolf_polynomial", "brown_design", "agnard_block", "salsig_encoders",
+              "gridplate_two_plates", "brown_dilution")
+
+
+def order(files: list[Path]) -> list[Path]:
+    """``files`` with those named in :data:`SLOW_FIRST` first (in its order), then the rest in
+    the given order."""
+    rank = {s: i for i, s in enumerate(SLOW_FIRST)}
+    return sorted(files, key=lambda f: rank.get(f.stem, len(rank)))
+
+
+def run_all(files: list[Path], results: Path, jobs: int = 2, run_args=(), stale_only=False,
+            log=print, extra=None) -> dict[str, tuple[int, float]]:
+    """Run every study file of ``files`` into ``results/<stem>``, ``jobs`` at a time, with
+    ``run_args`` (and ``extra[stem]``, more arguments of one study's run). Returns
+    ``{stem: (exit code, wall seconds)}`` of the runs made (up-to-date studies are left out)."""
+    from .codehash import is_current
+
+    todo = []
+    for f in order(files):
+        if stale_only and is_current(f, results / f.stem):
+            log(f"{f.stem}: up to date")
+        else:
+            todo.append(f)
+    quiet = ["--quiet"] if jobs > 1 and "--quiet" not in run_args else []
+
+    def argv(f: Path) -> list[str]:
+        return ["run", str(f), "--out", str(results / f.stem), "--overwrite", *run_args,
+                *quiet, *(extra or {}).get(f.stem, ())]
+
+    if hasattr(os, "fork") and todo:
+        return _forked(todo, argv, jobs)
+
+    def one(f: Path):
+        cmd = [sys.executable, "-m", "sim", *argv(f)]
+        t = time.perf_counter()
+        done = subprocess.run(cmd, stdout=subprocess.PIPE if jobs > 1 else None, text=True)
+        wall = time.perf_counter() - t
+        if jobs > 1 and done.stdout:
+            log(done.stdout.rstrip())
+        return f.stem, done.returncode, wall
+
+    out: dict[str, tuple[int, float]] = {}
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        for stem, code, wall in pool.map(one, todo):
+            out[stem] = (code, wall)
+    return out
+
+
+def _preload(files: list[Path]) -> None:
+    """Import the command line and the modules of the studies in ``files`` (a file whose
+    study cannot be read is left to its run, which reports it)."""
+    import importlib
+    import tomllib
+
+    from . import cli  # noqa: F401
+    from .studies import MODULES
+
+    for f in files:
+        try:
+            mod = MODULES.get(tomllib.loads(f.read_text()).get("study"))
+            if mod:
+                importlib.import_module(mod)
+        except Exception:  # noqa: BLE001 - the run itself reports a bad study file
+            pass
+
+
+def _child(args: list[str]) -> None:  # pragma: no cover - runs in a forked child
+    from .cli import main
+
+    code = 1
+    try:
+        code = main(args)
+    except SystemExit as e:
+        code = e.code if isinstance(e.code, int) else 1
+    except BaseException:  # noqa: BLE001 - main reports its own errors; anything else: 1
+        code = 1
+    finally:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+
+
+def _forked(todo: list[Path], argv, jobs: int) -> dict[str, tuple[int, float]]:
+    """Run ``todo`` in forked children, ``jobs`` at a time (the driver has no threads)."""
+    _preload(todo)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    running: dict[int, tuple[str, float]] = {}
+    out: dict[str, tuple[int, float]] = {}
+    queue = list(todo)
+    try:
+        while queue or running:
+            while queue and len(running) < jobs:
+                f = queue.pop(0)
+                pid = os.fork()
+                if pid == 0:  # pragma: no cover - the child
+                    _child(argv(f))
+                running[pid] = (f.stem, time.perf_counter())
+            pid, status = os.wait()
+            stem, t = running.pop(pid)
+            out[stem] = (os.waitstatus_to_exitcode(status), time.perf_counter() - t)
+    except KeyboardInterrupt:
+        for pid in running:             # the children got the interrupt too: let them clean up
+            try:
+                os.waitpid(pid, 0)
+            except ChildProcessError:
+                pass
+        raise
+    return {f.stem: out[f.stem] for f in todo}
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    run_args = []
+    if "--" in argv:
+        i = argv.index("--")
+        argv, run_args = argv[:i], argv[i + 1:]
+    ap = argparse.ArgumentParser(prog="python -m sim.batch", description=__doc__.splitlines()[0])
+    ap.add_argument("files", nargs="+", help="study files")
+    ap.add_argument("--jobs", type=int, default=2, help="studies run at a time (default 2)")
+    ap.add_argument("--results", default="results", help="results directory (default results)")
+    ap.add_argument("--stale-only", action="store_true",
+                    help="only the studies whose results are not current")
+    args = ap.parse_args(argv)
+    files = [Path(f) for f in args.files]
+    bad = [f for f in files if not f.is_file()]
+    if bad:
+        print(f"sim.batch: no study file {bad[0]}", file=sys.stderr)
+        return 2
+    if not 1 <= args.jobs <= 64:
+        print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
+        return 2
+    try:
+        done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only)
+    except KeyboardInterrupt:       # the runs got the interrupt too and cleaned up
+        print("sim.batch: interrupted", file=sys.stderr)
+        return 130
+    failed = [code for code, _ in done.values() if code != 0]
+    return (failed[0] if failed[0] > 0 else 1) if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,87 @@
+"""make reproduce's and make rerun's driver (sim.batch): studies side by side give the same
+files as one after the other, the slowest start first, up-to-date studies are skipped, a
+failed run does not stop the others, and bad input is one line with exit 2."""
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+
+from sim import batch
+from sim.bench.cli import tiny_overrides
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _tiny(tmp_path, study_file: str):
+    """A copy of a study file and the ``--set`` arguments of its tiny configuration."""
+    src = ROOT / "studies" / study_file
+    f = tmp_path / study_file
+    f.write_text(src.read_text())
+    return f, list(tiny_overrides(src))
+
+
+def test_order_puts_the_slowest_first():
+    files = [Path(f"studies/{s}.toml") for s in ("agnard_block", "network_plate",
+                                                  "wolf_polynomial", "brown_design")]
+    assert [f.stem for f in batch.order(files)] == ["wolf_polynomial", "brown_design",
+                                                    "agnard_block", "network_plate"]
+
+
+def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
+    """Forked children two at a time give the files of fresh processes one at a time."""
+    fa, sa = _tiny(tmp_path, "network_testfield.toml")
+    fb, sb = _tiny(tmp_path, "brown_table1.toml")
+    extra = {fa.stem: sa, fb.stem: sb}
+    two = batch.run_all([fa, fb], tmp_path / "two", 2, [], extra=extra)
+    monkeypatch.delattr(batch.os, "fork")           # the portable path: python -m sim run
+    one = batch.run_all([fa, fb], tmp_path / "one", 1, ["--quiet"], extra=extra)
+    assert {k: v[0] for k, v in one.items()} == {k: v[0] for k, v in two.items()} == \
+        {fa.stem: 0, fb.stem: 0}
+    for stem in (fa.stem, fb.stem):
+        names = sorted(p.name for p in (tmp_path / "one" / stem).glob("*.parquet"))
+        assert names
+        for n in names:
+            a = pq.read_table(tmp_path / "one" / stem / n).to_pydict()
+            b = pq.read_table(tmp_path / "two" / stem / n).to_pydict()
+            assert list(a) == list(b), (stem, n)
+            for col in a:                               # NaN equal to NaN
+                np.testing.assert_array_equal(np.array(a[col], dtype=object if any(
+                    isinstance(v, str) for v in a[col]) else None),
+                    np.array(b[col], dtype=object if any(isinstance(v, str) for v in b[col])
+                             else None), err_msg=f"{stem} {n} {col}")
+
+
+def test_stale_only_skips_the_current_studies(tmp_path, monkeypatch):
+    import sim.codehash
+
+    fa, sa = _tiny(tmp_path, "network_testfield.toml")
+    fb, _ = _tiny(tmp_path, "brown_table1.toml")
+    monkeypatch.setattr(sim.codehash, "is_current", lambda f, res: Path(f).stem == fb.stem)
+    logged = []
+    done = batch.run_all([fa, fb], tmp_path / "r", 2, [], stale_only=True, log=logged.append,
+                         extra={fa.stem: sa})
+    assert list(done) == [fa.stem] and done[fa.stem][0] == 0
+    assert f"{fb.stem}: up to date" in logged
+    assert not (tmp_path / "r" / fb.stem).exists()
+
+
+def test_a_failed_run_does_not_stop_the_others_and_sets_the_exit_code(tmp_path, capfd):
+    fa, sa = _tiny(tmp_path, "network_testfield.toml")
+    bad = tmp_path / "broken.toml"
+    bad.write_text("study = 'brown_table1'\nnot_a_key = 1\n")
+    done = batch.run_all([bad, fa], tmp_path / "r", 2, [], extra={fa.stem: sa})
+    assert done["broken"][0] == 2 and done[fa.stem][0] == 0
+    assert (tmp_path / "r" / fa.stem / "run.json").is_file()
+    assert "not_a_key" in capfd.readouterr().err
+    # the first failure's exit code (the bad file runs first: it is not among the slowest)
+    assert batch.main(["--results", str(tmp_path / "m"), str(bad), str(fa), "--", *sa]) == 2
+    assert (tmp_path / "m" / fa.stem / "run.json").is_file()
+
+
+def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys):
+    assert batch.main([str(tmp_path / "missing.toml")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "missing.toml" in err[0]
+    f, _ = _tiny(tmp_path, "network_testfield.toml")
+    assert batch.main(["--jobs", "0", str(f)]) == 2
+    assert "--jobs" in capsys.readouterr().err
