@@ -42,10 +42,11 @@ def order(files: list[Path]) -> list[Path]:
 
 
 def run_all(files: list[Path], results: Path, jobs: int = 2, run_args=(), stale_only=False,
-            log=print, extra=None) -> dict[str, tuple[int, float]]:
+            log=print, extra=None) -> dict[str, tuple[int, float, float]]:
     """Run every study file of ``files`` into ``results/<stem>``, ``jobs`` at a time, with
     ``run_args`` (and ``extra[stem]``, more arguments of one study's run). Returns
-    ``{stem: (exit code, wall seconds)}`` of the runs made (up-to-date studies are left out)."""
+    ``{stem: (exit code, wall seconds, start in seconds after the first start)}`` of the runs
+    made (up-to-date studies are left out)."""
     from .codehash import is_current
 
     todo = []
@@ -62,6 +63,7 @@ def run_all(files: list[Path], results: Path, jobs: int = 2, run_args=(), stale_
 
     if hasattr(os, "fork") and todo:
         return _forked(todo, argv, jobs)
+    t0 = time.perf_counter()
 
     def one(f: Path):
         cmd = [sys.executable, "-m", "sim", *argv(f)]
@@ -70,12 +72,12 @@ def run_all(files: list[Path], results: Path, jobs: int = 2, run_args=(), stale_
         wall = time.perf_counter() - t
         if jobs > 1 and done.stdout:
             log(done.stdout.rstrip())
-        return f.stem, done.returncode, wall
+        return f.stem, done.returncode, wall, t - t0
 
-    out: dict[str, tuple[int, float]] = {}
+    out: dict[str, tuple[int, float, float]] = {}
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        for stem, code, wall in pool.map(one, todo):
-            out[stem] = (code, wall)
+        for stem, code, wall, start in pool.map(one, todo):
+            out[stem] = (code, wall, start)
     return out
 
 
@@ -113,14 +115,15 @@ def _child(args: list[str]) -> None:  # pragma: no cover - runs in a forked chil
         os._exit(code)
 
 
-def _forked(todo: list[Path], argv, jobs: int) -> dict[str, tuple[int, float]]:
+def _forked(todo: list[Path], argv, jobs: int) -> dict[str, tuple[int, float, float]]:
     """Run ``todo`` in forked children, ``jobs`` at a time (the driver has no threads)."""
     _preload(todo)
     sys.stdout.flush()
     sys.stderr.flush()
     running: dict[int, tuple[str, float]] = {}
-    out: dict[str, tuple[int, float]] = {}
+    out: dict[str, tuple[int, float, float]] = {}
     queue = list(todo)
+    t0 = time.perf_counter()
     try:
         while queue or running:
             while queue and len(running) < jobs:
@@ -131,7 +134,7 @@ def _forked(todo: list[Path], argv, jobs: int) -> dict[str, tuple[int, float]]:
                 running[pid] = (f.stem, time.perf_counter())
             pid, status = os.wait()
             stem, t = running.pop(pid)
-            out[stem] = (os.waitstatus_to_exitcode(status), time.perf_counter() - t)
+            out[stem] = (os.waitstatus_to_exitcode(status), time.perf_counter() - t, t - t0)
     except KeyboardInterrupt:
         for pid in running:             # the children got the interrupt too: let them clean up
             try:
@@ -168,7 +171,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:       # the runs got the interrupt too and cleaned up
         print("sim.batch: interrupted", file=sys.stderr)
         return 130
-    failed = [code for code, _ in done.values() if code != 0]
+    failed = [v[0] for v in done.values() if v[0] != 0]
     return (failed[0] if failed[0] > 0 else 1) if failed else 0
 
 

@@ -34,6 +34,8 @@ def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
         i = [k for k in range(6) if rr["workers"][k] == w]
         # one study file: the total spans its run and the report (and the driver's own time)
         assert rr["wall_s"][i[2]] >= rr["wall_s"][i[0]] + rr["wall_s"][i[1]]
+        assert rr["start_s"][i[0]] >= 0.0                  # the study first, then the report
+        assert rr["start_s"][i[1]] >= rr["start_s"][i[0]] + rr["wall_s"][i[0]]
         assert rr["target_s"][i[2]] == 90.0 and np.isnan(rr["target_s"][i[0]])
     assert (out / "engines.png").stat().st_size > 0
     assert not (out / "bench.parquet").exists()          # a section left out is not written

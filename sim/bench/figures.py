@@ -71,20 +71,42 @@ def _speedups(ax, eng):
 
 
 def _rerun(ax, rerun):
+    """A timeline per worker count: each study's run from its start to its end (two lanes
+    when the studies run side by side), the report after them, the 90 s target."""
     study = np.asarray(rerun["study"])
     workers = np.asarray(rerun["workers"])
     wall = np.asarray(rerun["wall_s"], float)
+    start = np.asarray(rerun.get("start_s", np.zeros(len(study))), float)
     ws = sorted(set(workers.tolist()))
     parts = [s for s in dict.fromkeys(study.tolist()) if s != "total"]
-    bottom = np.zeros(len(ws))
     cmap = plt.get_cmap("tab20")
-    for k, s in enumerate(parts):
-        h = np.array([wall[(study == s) & (workers == w)].sum() for w in ws])
-        ax.bar([str(w) for w in ws], h, bottom=bottom, color=cmap(k % 20), label=s)
-        bottom += h
+    color = {s: cmap(k % 20) for k, s in enumerate(parts)}
+    jobs = rerun.get("jobs")
+    gap = (int(max(jobs)) if jobs else 1) + 1   # rows per worker count: a lane per job
+    yt, yl = [], []
+    for g, w in enumerate(ws):
+        lanes: list[float] = []                 # each lane: when its last bar ends
+        sel = [i for i in range(len(study)) if workers[i] == w and study[i] != "total"]
+        for i in sorted(sel, key=lambda i: start[i]):
+            k = next((k for k, end in enumerate(lanes) if end <= start[i] + 1e-6), None)
+            if k is None:                       # every lane busy: a new one
+                lanes.append(0.0)
+                k = len(lanes) - 1
+            lanes[k] = start[i] + wall[i]
+            y = g * gap + k
+            ax.barh(y, wall[i], left=start[i], color=color[study[i]], edgecolor="white",
+                    label=study[i] if g == 0 else None)
+        tot = wall[(study == "total") & (workers == w)]
+        if tot.size:
+            ax.annotate(f"total {tot[0]:.0f} s", (tot[0], g * gap + (gap - 2) / 2),
+                        xytext=(4, 0),
+                        textcoords="offset points", va="center", fontsize=8)
+        yt.append(g * gap + (gap - 2) / 2)
+        yl.append(f"{w} worker{'s' if w > 1 else ''}")
     tgt = np.asarray(rerun["target_s"], float)
-    ax.axhline(np.nanmax(tgt), color="0.3", ls="--", label=f"target {np.nanmax(tgt):.0f} s")
-    ax.set_xlabel("workers")
-    ax.set_ylabel("wall time of make rerun (s)")
-    ax.set_title("make rerun, study by study")
+    ax.axvline(np.nanmax(tgt), color="0.3", ls="--", label=f"target {np.nanmax(tgt):.0f} s")
+    ax.set_yticks(yt, yl)
+    ax.invert_yaxis()
+    ax.set_xlabel("wall time since make rerun started (s)")
+    ax.set_title("make rerun, study by study" + (f" ({jobs[0]} side by side)" if jobs else ""))
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))

@@ -6,7 +6,8 @@ fresh process, ``python -m sim run <file> --out <dir>/<name> --overwrite --worke
 results (``make rerun``'s last step), for ``N`` = 1 and 2 workers. The results go to a
 scratch directory (``results/`` is never touched) that is removed afterwards. One row per
 study and worker count (``study`` = the file's name, or ``report``; its ``wall_s`` is that
-run's own wall time, which overlaps its neighbour's), and a ``total`` row per worker count:
+run's own wall time, which overlaps its neighbour's; ``start_s`` when it started, after the
+first start), and a ``total`` row per worker count:
 the wall time from the first start to the report's end, against the 90 s target of issue 12
 (``target_s``; NaN on the other rows). ``jobs``: the studies run at a time. Wall clock, so
 the machine must be quiet.
@@ -50,21 +51,22 @@ def _wall(cmd: list[str], what: str) -> float:
 
 def rerun_rows(files: list[Path], workers=(1, 2), extra=None, jobs: int | None = None
                ) -> dict[str, list]:
-    """The columns of ``rerun.parquet``: ``study``, ``workers``, ``jobs``, ``wall_s``,
-    ``target_s``, ``within_target`` (true/false on the total rows, false elsewhere).
+    """The columns of ``rerun.parquet``: ``study``, ``workers``, ``jobs``, ``start_s``,
+    ``wall_s``, ``target_s``, ``within_target`` (true/false on the total rows, false elsewhere).
     ``extra`` maps a study file's name (stem) to more arguments of its ``sim run`` (e.g.
     ``--set trials=...`` for a smoke run); ``jobs`` defaults to ``make rerun``'s."""
     from ..batch import run_all
 
     jobs = JOBS if jobs is None else jobs
     extra = extra or {}
-    rows: dict[str, list] = {c: [] for c in ("study", "workers", "jobs", "wall_s", "target_s",
-                                             "within_target")}
+    rows: dict[str, list] = {c: [] for c in ("study", "workers", "jobs", "start_s", "wall_s",
+                                             "target_s", "within_target")}
 
-    def add(study, n, wall, target=np.nan):
+    def add(study, n, wall, target=np.nan, start=0.0):
         rows["study"].append(study)
         rows["workers"].append(n)
         rows["jobs"].append(jobs)
+        rows["start_s"].append(start)
         rows["wall_s"].append(wall)
         rows["target_s"].append(target)
         rows["within_target"].append(bool(wall < target))
@@ -77,12 +79,14 @@ def rerun_rows(files: list[Path], workers=(1, 2), extra=None, jobs: int | None =
             done = run_all(files, res, jobs, ["--workers", str(n), "--quiet"], log=_quiet,
                            extra=extra)
             for f in files:
-                code, wall = done[f.stem]
+                code, wall, start = done[f.stem]
                 if code != 0:
                     raise RuntimeError(f"bench: sim run {f} failed (exit {code})")
-                add(f.stem, n, wall)
+                add(f.stem, n, wall, start=start)
                 print(f"{f.stem:>22} workers={n} {wall:7.1f} s")
-            add("report", n, _wall([*py, "report", "--results", str(res)], "sim report"))
+            t1 = time.perf_counter() - t0
+            add("report", n, _wall([*py, "report", "--results", str(res)], "sim report"),
+                start=t1)
             total = time.perf_counter() - t0
             add("total", n, total, TARGET_S)
             print(f"{'make rerun':>22} workers={n} jobs={jobs} {total:7.1f} s "
