@@ -107,6 +107,7 @@ def _rerun(ax, rerun):
     ax.axvline(np.nanmax(tgt), color="0.3", ls="--", label=f"target {np.nanmax(tgt):.0f} s")
     ax.set_yticks(yt, yl)
     ax.invert_yaxis()
+    ax.set_xlim(left=0.0)
     ax.set_xlabel("wall time since make rerun started (s)")
     ax.set_title("make rerun, study by study" + (f" ({jobs[0]} side by side)" if jobs else ""))
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
