@@ -1,14 +1,15 @@
 """Run many study files side by side: the driver of ``make reproduce`` and ``make rerun``.
 
-``python -m sim.batch [--jobs J] [--stale-only] [--results DIR] FILE ... [-- RUN_OPTIONS]``
+``python -m sim.batch [--jobs J] [--stale-only] [--results DIR] [--timings F] FILE ...
+[-- RUN_OPTIONS]``
 
 Each study file runs in a process of its own, exactly as ``python -m sim run FILE --out
 DIR/<file name> --overwrite RUN_OPTIONS`` (so its ``--workers`` pool, its staging directory
 and its lock are as for one run), ``J`` of them at a time. Two studies side by side keep both
 cores busy while one of them waits on its last chunk, draws a figure or writes its tables;
 the slowest studies (:data:`SLOW_FIRST`) are started first so that the side-by-side runs end
-together. On POSIX the driver imports the suite and the studies' modules once and forks a
-child per study (:func:`sim.cli.main` with that command line), so no run pays the second or
+together. On POSIX, in a process without other threads (``make`` starts it fresh), the driver
+imports the suite and the studies' modules once and forks a child per study (:func:`sim.cli.main` with that command line), so no run pays the second or
 two of importing NumPy, SciPy, pyarrow, matplotlib and numba again; elsewhere each run is a
 fresh ``python -m sim run``. With ``J > 1`` the runs are quiet (progress bars of several runs
 would overwrite each other); each study's line is printed when it ends. ``--stale-only``:
@@ -20,9 +21,11 @@ file is bad input: one line, exit 2.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import subprocess
 import sys
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -61,8 +64,8 @@ def run_all(files: list[Path], results: Path, jobs: int = 2, run_args=(), stale_
         return ["run", str(f), "--out", str(results / f.stem), "--overwrite", *run_args,
                 *quiet, *(extra or {}).get(f.stem, ())]
 
-    if hasattr(os, "fork") and todo:
-        return _forked(todo, argv, jobs)
+    if hasattr(os, "fork") and threading.active_count() == 1 and todo:
+        return _forked(todo, argv, jobs)    # fork only a process without other threads
     t0 = time.perf_counter()
 
     def one(f: Path):
@@ -157,6 +160,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--results", default="results", help="results directory (default results)")
     ap.add_argument("--stale-only", action="store_true",
                     help="only the studies whose results are not current")
+    ap.add_argument("--timings", help="write {study: [exit code, wall s, start s]} (JSON) here")
     args = ap.parse_args(argv)
     files = [Path(f) for f in args.files]
     bad = [f for f in files if not f.is_file()]
@@ -171,6 +175,8 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:       # the runs got the interrupt too and cleaned up
         print("sim.batch: interrupted", file=sys.stderr)
         return 130
+    if args.timings:
+        Path(args.timings).write_text(json.dumps(done))
     failed = [v[0] for v in done.values() if v[0] != 0]
     return (failed[0] if failed[0] > 0 else 1) if failed else 0
 

@@ -1,6 +1,8 @@
 """make reproduce's and make rerun's driver (sim.batch): studies side by side give the same
 files as one after the other, the slowest start first, up-to-date studies are skipped, a
 failed run does not stop the others, and bad input is one line with exit 2."""
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -27,28 +29,34 @@ def test_order_puts_the_slowest_first():
                                                     "agnard_block", "network_plate"]
 
 
+def _same_tables(a_dir: Path, b_dir: Path):
+    names = sorted(p.name for p in a_dir.glob("*.parquet"))
+    assert names and names == sorted(p.name for p in b_dir.glob("*.parquet"))
+    for n in names:
+        a = pq.read_table(a_dir / n).to_pydict()
+        b = pq.read_table(b_dir / n).to_pydict()
+        assert list(a) == list(b), n
+        for col in a:                                   # NaN equal to NaN
+            kind = object if any(isinstance(v, str) for v in a[col]) else None
+            np.testing.assert_array_equal(np.array(a[col], dtype=kind),
+                                          np.array(b[col], dtype=kind), err_msg=f"{n} {col}")
+
+
 def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
-    """Forked children two at a time give the files of fresh processes one at a time."""
-    fa, sa = _tiny(tmp_path, "network_testfield.toml")
-    fb, sb = _tiny(tmp_path, "brown_table1.toml")
-    extra = {fa.stem: sa, fb.stem: sb}
-    two = batch.run_all([fa, fb], tmp_path / "two", 2, [], extra=extra)
+    """``python -m sim.batch`` as make runs it (a fresh process: forked children, two at a
+    time) gives the files of fresh ``python -m sim run`` processes one at a time."""
+    fa, sets = _tiny(tmp_path, "network_testfield.toml")
+    fb, _ = _tiny(tmp_path, "network_plate.toml")       # the same study kind: the same sets
+    r = subprocess.run([sys.executable, "-m", "sim.batch", "--jobs", "2", "--results",
+                        str(tmp_path / "two"), str(fa), str(fb), "--", *sets],
+                       cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.count("results in") == 2
     monkeypatch.delattr(batch.os, "fork")           # the portable path: python -m sim run
-    one = batch.run_all([fa, fb], tmp_path / "one", 1, ["--quiet"], extra=extra)
-    assert {k: v[0] for k, v in one.items()} == {k: v[0] for k, v in two.items()} == \
-        {fa.stem: 0, fb.stem: 0}
+    one = batch.run_all([fa, fb], tmp_path / "one", 1, ["--quiet", *sets])
+    assert {k: v[0] for k, v in one.items()} == {fa.stem: 0, fb.stem: 0}
     for stem in (fa.stem, fb.stem):
-        names = sorted(p.name for p in (tmp_path / "one" / stem).glob("*.parquet"))
-        assert names
-        for n in names:
-            a = pq.read_table(tmp_path / "one" / stem / n).to_pydict()
-            b = pq.read_table(tmp_path / "two" / stem / n).to_pydict()
-            assert list(a) == list(b), (stem, n)
-            for col in a:                               # NaN equal to NaN
-                np.testing.assert_array_equal(np.array(a[col], dtype=object if any(
-                    isinstance(v, str) for v in a[col]) else None),
-                    np.array(b[col], dtype=object if any(isinstance(v, str) for v in b[col])
-                             else None), err_msg=f"{stem} {n} {col}")
+        _same_tables(tmp_path / "one" / stem, tmp_path / "two" / stem)
 
 
 def test_stale_only_skips_the_current_studies(tmp_path, monkeypatch):

@@ -1,7 +1,7 @@
 """Rerun rows of the benchmark (``rerun.parquet``): the wall time of ``make rerun``.
 
-Every study file is run the way ``make rerun`` runs it (:func:`sim.batch.run_all`): each in a
-fresh process, ``python -m sim run <file> --out <dir>/<name> --overwrite --workers N --quiet``,
+Every study file is run the way ``make rerun`` runs it: ``python -m sim.batch`` in a fresh
+process (its ``--timings``), each study in a process of its own, ``python -m sim run <file> --out <dir>/<name> --overwrite --workers N --quiet``,
 :data:`JOBS` studies side by side, the slowest first; then ``python -m sim report`` over the
 results (``make rerun``'s last step), for ``N`` = 1 and 2 workers. The results go to a
 scratch directory (``results/`` is never touched) that is removed afterwards. One row per
@@ -14,6 +14,7 @@ the machine must be quiet.
 """
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import tempfile
@@ -55,8 +56,6 @@ def rerun_rows(files: list[Path], workers=(1, 2), extra=None, jobs: int | None =
     ``wall_s``, ``target_s``, ``within_target`` (true/false on the total rows, false elsewhere).
     ``extra`` maps a study file's name (stem) to more arguments of its ``sim run`` (e.g.
     ``--set trials=...`` for a smoke run); ``jobs`` defaults to ``make rerun``'s."""
-    from ..batch import run_all
-
     jobs = JOBS if jobs is None else jobs
     extra = extra or {}
     rows: dict[str, list] = {c: [] for c in ("study", "workers", "jobs", "start_s", "wall_s",
@@ -76,8 +75,12 @@ def rerun_rows(files: list[Path], workers=(1, 2), extra=None, jobs: int | None =
         for n in workers:
             res = Path(tmp) / f"workers{n}"
             t0 = time.perf_counter()
-            done = run_all(files, res, jobs, ["--workers", str(n), "--quiet"], log=_quiet,
-                           extra=extra)
+            done = {}
+            # make rerun's command; a smoke run's per-study sets: one batch per file
+            for group in ([[f] for f in files] if extra else [files]):
+                done.update(_batch(group, res, jobs, n, extra.get(group[0].stem, ())
+                                   if extra else (), Path(tmp) / "timings.json",
+                                   time.perf_counter() - t0))
             for f in files:
                 code, wall, start = done[f.stem]
                 if code != 0:
@@ -94,5 +97,16 @@ def rerun_rows(files: list[Path], workers=(1, 2), extra=None, jobs: int | None =
     return rows
 
 
-def _quiet(*_):
-    pass
+def _batch(files, res, jobs, n, sets, timings: Path, offset: float) -> dict:
+    """``python -m sim.batch`` over ``files`` (what ``make rerun`` runs): ``{stem: (exit
+    code, wall s, start s)}``, the starts shifted by ``offset``."""
+    cmd = [sys.executable, "-m", "sim.batch", "--jobs", str(jobs), "--results", str(res),
+           "--timings", str(timings), *map(str, files), "--", "--workers", str(n), "--quiet",
+           *sets]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if not timings.is_file():
+        last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+        raise RuntimeError(f"bench: sim.batch failed (exit {done.returncode}): {last}")
+    out = json.loads(timings.read_text())
+    timings.unlink()
+    return {k: (c, w, s + offset) for k, (c, w, s) in out.items()}
