@@ -47,7 +47,9 @@ def order(files: list[Path]) -> list[Path]:
 def run_all(files: list[Path], results: Path, jobs: int = 2, run_args=(), stale_only=False,
             log=print, extra=None) -> dict[str, tuple[int, float, float]]:
     """Run every study file of ``files`` into ``results/<stem>``, ``jobs`` at a time, with
-    ``run_args`` (and ``extra[stem]``, more arguments of one study's run). Returns
+    ``run_args`` (and ``extra[stem]``, more arguments of one study's run). ``log`` gets the
+    up-to-date lines and, for fresh processes side by side, each run's output when it ends
+    (forked children print their own). Returns
     ``{stem: (exit code, wall seconds, start in seconds after the first start)}`` of the runs
     made (up-to-date studies are left out)."""
     from .codehash import is_current

@@ -144,6 +144,7 @@ def _fit(meas, true, ax, ay, mx, my, rows, h1, h2, ho, jq, norm, rcond, x, sq, c
                 sq[t, 0] = sq[t, 1] = np.nan
                 continue
             if not want:                        # v'v = D'D - 2 x'u + x'N x, if exact enough
+                exact = True
                 for c in range(2):
                     xu = axu = xnx = axnx = 0.0
                     for j in range(p):
@@ -154,11 +155,11 @@ def _fit(meas, true, ax, ay, mx, my, rows, h1, h2, ho, jq, norm, rcond, x, sq, c
                             v = xb[j, c, b] * Nb[j, q, b] * xb[q, c, b]
                             xnx += v
                             axnx += abs(v)
-                    qc = dd[c, b] - 2.0 * xu + xnx
-                    sq[t, c] = qc if qc > (n + p * p) * EPS * (dd[c, b] + 2.0 * axu + axnx) \
-                        * 1e9 else -1.0         # -1: the rounding bound is not small: below
-                if sq[t, 0] >= 0.0 and sq[t, 1] >= 0.0:
-                    continue
+                    sq[t, c] = dd[c, b] - 2.0 * xu + xnx
+                    bound = (n + p * p) * EPS * (dd[c, b] + 2.0 * axu + axnx)
+                    exact &= bound < 1e-9 * sq[t, c]
+                if exact:
+                    continue                    # else: the explicit residuals below
             Ab, Db = A[b], A[b, nr - 2:]
             for i in range(n):                  # P(measured), term by term over the points
                 F[0, i] = F[1, i] = 0.0

@@ -82,9 +82,7 @@ def rerun_rows(files: list[Path], workers=(1, 2), extra=None, jobs: int | None =
                                    if extra else (), Path(tmp) / "timings.json",
                                    time.perf_counter() - t0))
             for f in files:
-                code, wall, start = done[f.stem]
-                if code != 0:
-                    raise RuntimeError(f"bench: sim run {f} failed (exit {code})")
+                _, wall, start = done[f.stem]
                 add(f.stem, n, wall, start=start)
                 print(f"{f.stem:>22} workers={n} {wall:7.1f} s")
             t1 = time.perf_counter() - t0
@@ -109,4 +107,8 @@ def _batch(files, res, jobs, n, sets, timings: Path, offset: float) -> dict:
         raise RuntimeError(f"bench: sim.batch failed (exit {done.returncode}): {last}")
     out = json.loads(timings.read_text())
     timings.unlink()
+    for k, (c, _, _) in out.items():
+        if c != 0:
+            last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+            raise RuntimeError(f"bench: sim run of {k} failed (exit {c}): {last}")
     return {k: (c, w, s + offset) for k, (c, w, s) in out.items()}
