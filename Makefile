@@ -31,14 +31,17 @@ venv: $(STAMP) ## create the virtual environment and install the project
 # (its module fixtures, such as the shared Dask cluster, start once); TEST_WORKERS=0: one process.
 TEST_WORKERS ?= 2
 
-test: $(STAMP) ## run the test suite on TEST_WORKERS=2 processes (sets up the environment first)
+test: $(STAMP) ## lint (ruff), the layer contracts (import-linter), then the test suite on TEST_WORKERS=2 processes
+	$(VENV)/bin/ruff check sim tests benchmarks
+	$(VENV)/bin/ruff format --check sim tests benchmarks
+	$(VENV)/bin/lint-imports
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile
 
 fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=300, FUZZ_SEED, FUZZ_SAVE)
 	FUZZ_CASES=$${FUZZ_CASES:-300} $(PY) -m pytest tests/test_fuzz.py -p no:cacheprovider
 
 # A study is re-run when its results are not current: run.json must record the study file's
-# config and the hash of the code that study imports (sim/codehash.py). Decided by content,
+# config and the hash of the code that study imports (sim/mc/codehash.py). Decided by content,
 # not by file times, so a fresh clone re-runs nothing that is current. The studies run
 # RUN_JOBS at a time, each in its own process with RUN_FLAGS (sim/batch.py; quiet when
 # RUN_JOBS > 1, the slowest first).
@@ -53,19 +56,19 @@ rerun: $(STAMP) ## re-run every study even if its results are up to date, then t
 	$(PY) -m sim report --results results
 
 verify: $(STAMP) ## re-run every study into a scratch directory and compare with results/ (tolerances per column)
-	$(PY) -m sim.verify --results results --workers 2
+	$(PY) -m sim.report.verify --results results --workers 2
 	$(PY) -m sim report --results results
 
 report: $(STAMP) ## rebuild results/REPORT.md from the Parquet files alone
 	$(PY) -m sim report --results results
 
 # BENCH_FLAGS: e.g. "--quick" (a smoke run: small sizes, tiny study configurations),
-# "--no-rerun" (leave out the make rerun rows), "--only engines"; see python -m sim.bench -h
+# "--no-rerun" (leave out the make rerun rows), "--only engines"; see python -m benchmarks -h
 BENCH_FLAGS ?=
 BENCH_OUT ?= results/bench
 
 bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/; BENCH_FLAGS=--quick: smoke)
-	$(PY) -m sim.bench --out $(BENCH_OUT) $(BENCH_FLAGS)
+	$(PY) -m benchmarks --out $(BENCH_OUT) $(BENCH_FLAGS)
 
 clean: ## remove the virtual environment and caches (results/ is kept)
 	rm -rf $(VENV) .pytest_cache sim.egg-info

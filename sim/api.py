@@ -8,10 +8,11 @@
 
 Overrides are config keys by their dotted names, with ``__`` standing for a dot in keyword
 form (``plate__grid=7`` is ``plate.grid = 7``); they are validated exactly like a study file
-(:class:`sim.config.ConfigError`, one line naming the key). A run goes through the same
+(:class:`sim.mc.config.ConfigError`, one line naming the key). A run goes through the same
 machinery as ``sim run``: the estimate and its limits, the locked staging directory, the
 executors, and the rule that nothing the suite did not write is ever replaced.
 """
+
 from __future__ import annotations
 
 import os
@@ -22,7 +23,7 @@ from typing import Any
 
 import pyarrow as pa
 
-from .config import ConfigError, load_study
+from sim.mc.config import ConfigError, load_study
 
 __all__ = ["load", "StudyHandle", "Results"]
 
@@ -49,8 +50,9 @@ class Results:
 
         p = self.path / (name if name == "trials" else f"{name}.parquet")
         if not p.exists():
-            raise ConfigError("table", f"{self.study} has no table {name!r}; it has "
-                              f"{', '.join(self.names())}")
+            raise ConfigError(
+                "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
+            )
         return pq.read_table(p)
 
     def claims(self) -> pa.Table:
@@ -73,8 +75,8 @@ class StudyHandle:
         return self.config["study"]
 
     def estimate(self):
-        """Work and memory of a run (:class:`sim.estimate.Estimate`)."""
-        from .estimate import estimate
+        """Work and memory of a run (:class:`sim.mc.estimate.Estimate`)."""
+        from sim.mc.estimate import estimate
 
         return estimate(self.config, self.sweep)
 
@@ -82,31 +84,59 @@ class StudyHandle:
         """A new handle with more overrides."""
         return load(self.path, **{**self.overrides, **{_key(k): v for k, v in overrides.items()}})
 
-    def run(self, out: str | os.PathLike | None = None, executor: str = "local",
-            workers: int = 1, trials: int | None = None, seed: int | None = None, *,
-            scheduler: str | None = None, overwrite: bool = False, quiet: bool = True) -> Results:
+    def run(
+        self,
+        out: str | os.PathLike | None = None,
+        executor: str = "local",
+        workers: int = 1,
+        trials: int | None = None,
+        seed: int | None = None,
+        *,
+        scheduler: str | None = None,
+        overwrite: bool = False,
+        quiet: bool = True,
+    ) -> Results:
         """Run the study into ``out`` (default: a new temporary directory) and return its
         :class:`Results`. ``executor``: ``local`` (a process pool when ``workers > 1``) or
         ``dask``. Output is identical for every executor and worker count."""
-        from .cli import execute
+        from sim.cli import execute
 
-        h = self if trials is None and seed is None else load(
-            self.path, **{**self.overrides, **({"trials": trials} if trials is not None else {}),
-                          **({"seed": seed} if seed is not None else {})})
+        h = (
+            self
+            if trials is None and seed is None
+            else load(
+                self.path,
+                **{
+                    **self.overrides,
+                    **({"trials": trials} if trials is not None else {}),
+                    **({"seed": seed} if seed is not None else {}),
+                },
+            )
+        )
         if out is None:
             base = Path(tempfile.mkdtemp(prefix=f"sim-{h.name}-"))
             out = base / h.name
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
         out = Path(os.path.abspath(out))
-        execute(h.study, h.config, h.sweep, out, str(out), executor=executor, workers=workers,
-                scheduler=scheduler, overwrite=overwrite, quiet=quiet)
+        execute(
+            h.study,
+            h.config,
+            h.sweep,
+            out,
+            str(out),
+            executor=executor,
+            workers=workers,
+            scheduler=scheduler,
+            overwrite=overwrite,
+            quiet=quiet,
+        )
         return Results(out, h.name)
 
 
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
-    from .sweep import read_sweep
+    from sim.mc.sweep import read_sweep
 
     vals = {_key(k): v for k, v in overrides.items()}
     study, cfg = load_study(study_file, values=vals)

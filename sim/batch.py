@@ -13,11 +13,12 @@ imports the suite and the studies' modules once and forks a child per study (:fu
 two of importing NumPy, SciPy, pyarrow, matplotlib and numba again; elsewhere each run is a
 fresh ``python -m sim run``. With ``J > 1`` the runs are quiet (progress bars of several runs
 would overwrite each other); each study's line is printed when it ends. ``--stale-only``:
-only the studies whose results are not current (:func:`sim.codehash.is_current`), the others
+only the studies whose results are not current (:func:`sim.mc.codehash.is_current`), the others
 are reported up to date. A run that fails prints its own one-line message; the others go on,
 and the exit code is that of the first failure (1 when a run was killed). A missing study
 file is bad input: one line, exit 2.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -33,8 +34,14 @@ from pathlib import Path
 __all__ = ["SLOW_FIRST", "order", "run_all", "main"]
 
 #: the studies that take longest (``make bench``'s rerun rows), started first in this order
-SLOW_FIRST = ("wolf_polynomial", "brown_design", "agnard_block", "salsig_encoders",
-              "gridplate_two_plates", "brown_dilution")
+SLOW_FIRST = (
+    "wolf_polynomial",
+    "brown_design",
+    "agnard_block",
+    "salsig_encoders",
+    "gridplate_two_plates",
+    "brown_dilution",
+)
 
 
 def order(files: list[Path]) -> list[Path]:
@@ -44,15 +51,22 @@ def order(files: list[Path]) -> list[Path]:
     return sorted(files, key=lambda f: rank.get(f.stem, len(rank)))
 
 
-def run_all(files: list[Path], results: Path, jobs: int = 2, run_args=(), stale_only=False,
-            log=print, extra=None) -> dict[str, tuple[int, float, float]]:
+def run_all(
+    files: list[Path],
+    results: Path,
+    jobs: int = 2,
+    run_args=(),
+    stale_only=False,
+    log=print,
+    extra=None,
+) -> dict[str, tuple[int, float, float]]:
     """Run every study file of ``files`` into ``results/<stem>``, ``jobs`` at a time, with
     ``run_args`` (and ``extra[stem]``, more arguments of one study's run). ``log`` gets the
     up-to-date lines and, for fresh processes side by side, each run's output when it ends
     (forked children print their own). Returns
     ``{stem: (exit code, wall seconds, start in seconds after the first start)}`` of the runs
     made (up-to-date studies are left out)."""
-    from .codehash import is_current
+    from sim.mc.codehash import is_current
 
     todo = []
     for f in order(files):
@@ -63,11 +77,19 @@ def run_all(files: list[Path], results: Path, jobs: int = 2, run_args=(), stale_
     quiet = ["--quiet"] if jobs > 1 and "--quiet" not in run_args else []
 
     def argv(f: Path) -> list[str]:
-        return ["run", str(f), "--out", str(results / f.stem), "--overwrite", *run_args,
-                *quiet, *(extra or {}).get(f.stem, ())]
+        return [
+            "run",
+            str(f),
+            "--out",
+            str(results / f.stem),
+            "--overwrite",
+            *run_args,
+            *quiet,
+            *(extra or {}).get(f.stem, ()),
+        ]
 
     if hasattr(os, "fork") and threading.active_count() == 1 and todo:
-        return _forked(todo, argv, jobs)    # fork only a process without other threads
+        return _forked(todo, argv, jobs)  # fork only a process without other threads
     t0 = time.perf_counter()
 
     def one(f: Path):
@@ -92,8 +114,7 @@ def _preload(files: list[Path]) -> None:
     import importlib
     import tomllib
 
-    from . import cli  # noqa: F401
-    from .studies import MODULES
+    from sim.studies import MODULES
 
     for f in files:
         try:
@@ -105,7 +126,7 @@ def _preload(files: list[Path]) -> None:
 
 
 def _child(args: list[str]) -> None:  # pragma: no cover - runs in a forked child
-    from .cli import main
+    from sim.cli import main
 
     code = 1
     try:
@@ -141,7 +162,7 @@ def _forked(todo: list[Path], argv, jobs: int) -> dict[str, tuple[int, float, fl
             stem, t = running.pop(pid)
             out[stem] = (os.waitstatus_to_exitcode(status), time.perf_counter() - t, t - t0)
     except KeyboardInterrupt:
-        for pid in running:             # the children got the interrupt too: let them clean up
+        for pid in running:  # the children got the interrupt too: let them clean up
             try:
                 os.waitpid(pid, 0)
             except ChildProcessError:
@@ -155,13 +176,14 @@ def main(argv: list[str] | None = None) -> int:
     run_args = []
     if "--" in argv:
         i = argv.index("--")
-        argv, run_args = argv[:i], argv[i + 1:]
+        argv, run_args = argv[:i], argv[i + 1 :]
     ap = argparse.ArgumentParser(prog="python -m sim.batch", description=__doc__.splitlines()[0])
     ap.add_argument("files", nargs="+", help="study files")
     ap.add_argument("--jobs", type=int, default=2, help="studies run at a time (default 2)")
     ap.add_argument("--results", default="results", help="results directory (default results)")
-    ap.add_argument("--stale-only", action="store_true",
-                    help="only the studies whose results are not current")
+    ap.add_argument(
+        "--stale-only", action="store_true", help="only the studies whose results are not current"
+    )
     ap.add_argument("--timings", help="write {study: [exit code, wall s, start s]} (JSON) here")
     args = ap.parse_args(argv)
     files = [Path(f) for f in args.files]
@@ -174,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only)
-    except KeyboardInterrupt:       # the runs got the interrupt too and cleaned up
+    except KeyboardInterrupt:  # the runs got the interrupt too and cleaned up
         print("sim.batch: interrupted", file=sys.stderr)
         return 130
     if args.timings:

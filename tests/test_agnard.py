@@ -1,5 +1,6 @@
 """Tests of the Agnard, Nolette & Gagnon study: block geometry, scanner model, independent-
 model block adjustment (reduced normals), data snooping, study config and a tiny run."""
+
 from __future__ import annotations
 
 import math
@@ -7,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from sim import data_snooping as ds
-from sim import independent_models as im
-from sim.geometry import similarity_fit
-from sim import scanner as sc
-from sim.block_layout import CONTROL_PATTERNS, make_block, select_control
-from sim.config import ConfigError, load_study
+from sim.instruments.block import data_snooping as ds
+from sim.instruments.block import independent_models as im
+from sim.instruments.block import scanner as sc
+from sim.instruments.block.layout import CONTROL_PATTERNS, make_block, select_control
+from sim.instruments.geometry import similarity_fit
+from sim.mc.config import ConfigError, load_study
 
 STUDY = "studies/agnard_block.toml"
 
@@ -62,10 +63,14 @@ def test_height_error_matches_parallax_propagation(small):
     xr = b.image_coords(b.obs_right[[k]], b.obs_point[[k]])[0]
     N, sp = 20000, 0.02  # mm of x-parallax
     d = rng.normal(0, sp, N)
-    Z = im.form_models(np.column_stack([xl[0] + d, np.full(N, xl[1])]),
-                       np.broadcast_to(xr, (N, 2)), b.focal_mm, b.base_m)[:, 2]
+    Z = im.form_models(
+        np.column_stack([xl[0] + d, np.full(N, xl[1])]),
+        np.broadcast_to(xr, (N, 2)),
+        b.focal_mm,
+        b.base_m,
+    )[:, 2]
     hz = b.H_m - b.points[b.obs_point[k], 2]
-    expect = hz ** 2 / (b.focal_mm * b.base_m) * sp
+    expect = hz**2 / (b.focal_mm * b.base_m) * sp
     assert abs(Z.std(ddof=1) / expect - 1) < 4 / math.sqrt(2 * (N - 1))
 
 
@@ -77,12 +82,14 @@ def test_scanner_field_peaks_and_calibration():
     f = sc.random_field(rng, 20, max_x_um=20.0, max_y_um=40.0, n_eval=47)
     g = np.linspace(-115, 115, 47)
     d = sc.evaluate(f, np.stack(np.meshgrid(g, g), -1).reshape(-1, 2))
-    assert np.allclose(np.abs(d[..., 0]).max(1), 20.0) and np.allclose(np.abs(d[..., 1]).max(1), 40.0)
+    assert np.allclose(np.abs(d[..., 0]).max(1), 20.0) and np.allclose(
+        np.abs(d[..., 1]).max(1), 40.0
+    )
     nodes, disp = sc.scan_grid(f, rng, 5.0, 0.0)
     xy = rng.uniform(-115, 115, (500, 2))
     r = sc.evaluate(f, xy) - sc.interpolate(nodes, disp, xy)
     # a noise-free 5 mm grid removes the smooth field to a few per cent
-    assert np.sqrt((r ** 2).mean()) < 0.03 * np.sqrt((sc.evaluate(f, xy) ** 2).mean())
+    assert np.sqrt((r**2).mean()) < 0.03 * np.sqrt((sc.evaluate(f, xy) ** 2).mean())
     # nodes are reproduced exactly
     nn = np.stack(np.meshgrid(nodes, nodes), -1).reshape(-1, 2)
     assert np.allclose(sc.interpolate(nodes, disp, nn), disp.reshape(20, -1, 2))
@@ -90,7 +97,7 @@ def test_scanner_field_peaks_and_calibration():
 
 def test_fiducial_affine_removes_affine_errors():
     fid = sc.corner_fiducials(110.0)
-    A = np.array([[3.0, 2e-3, -1e-3], [-2.0, 5e-4, 4e-3]])           # um, um/mm
+    A = np.array([[3.0, 2e-3, -1e-3], [-2.0, 5e-4, 4e-3]])  # um, um/mm
     xy = np.random.default_rng(0).uniform(-110, 110, (30, 2))
     lin = lambda p: np.column_stack([np.ones(len(p)), p]) @ A.T  # noqa: E731
     beta = sc.fiducial_affine(lin(fid)[None], fid)[0]
@@ -108,8 +115,18 @@ def test_noise_free_gives_zero_residuals_and_true_parameters(small):
     ctrl = select_control(small, "five")
     st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
     s0, R0, t0, X0 = _start(small, st, xm, rng, T)
-    res = im.adjust_block(st, xm, np.ones(3), np.broadcast_to(small.points[ctrl], (T, 5, 3)),
-                          np.full((5, 3), 10.0), s0, R0, t0, X0, tol_m=1e-9)
+    res = im.adjust_block(
+        st,
+        xm,
+        np.ones(3),
+        np.broadcast_to(small.points[ctrl], (T, 5, 3)),
+        np.full((5, 3), 10.0),
+        s0,
+        R0,
+        t0,
+        X0,
+        tol_m=1e-9,
+    )
     assert res.converged.all()
     assert np.abs(res.v_obs).max() < 1e-7 and np.abs(res.v_ctrl).max() < 1e-7
     assert np.allclose(res.X, small.points, atol=1e-7)
@@ -127,8 +144,9 @@ def test_all_control_reproduces_each_model_similarity(small):
     ctrl_xyz = small.points + rng.normal(0, 0.1, (T,) + small.points.shape)
     st = im.BlockStructure(small.obs_model, small.obs_point, ctrl, small.n_models, small.n_points)
     s0, R0, t0, X0 = _start(small, st, xm, rng, T)
-    res = im.adjust_block(st, xm, np.ones(3), ctrl_xyz, np.full((ctrl.size, 3), 1e9), s0, R0,
-                          t0, X0, tol_m=1e-10)
+    res = im.adjust_block(
+        st, xm, np.ones(3), ctrl_xyz, np.full((ctrl.size, 3), 1e9), s0, R0, t0, X0, tol_m=1e-10
+    )
     for m in range(small.n_models):
         k = small.obs_model == m
         f = similarity_fit(xm[:, k], ctrl_xyz[:, small.obs_point[k]])
@@ -167,20 +185,30 @@ def test_residual_cofactors_equal_dense(small):
     s0, R0, t0, X0 = _start(small, st, xm, rng, T)
     w = rng.uniform(0.5, 2.0, (T, K, 3))
     wc = np.full((C, 3), 25.0)
-    res = im.adjust_block(st, xm, w, np.broadcast_to(small.points[ctrl], (T, C, 3)), wc, s0, R0,
-                          t0, X0, keep_normals=True)
+    res = im.adjust_block(
+        st,
+        xm,
+        w,
+        np.broadcast_to(small.points[ctrl], (T, C, 3)),
+        wc,
+        s0,
+        R0,
+        t0,
+        X0,
+        keep_normals=True,
+    )
     q = ds.residual_cofactors(st, res, w)
     J = res.J
     A = np.zeros((T, 3 * K + 3 * C, 7 * M + 3 * P))
     for k in range(K):
-        A[:, 3 * k:3 * k + 3, 7 * st.obs_model[k]:7 * st.obs_model[k] + 7] = J[:, k]
-        A[:, 3 * k:3 * k + 3, 7 * M + 3 * st.obs_point[k] + np.arange(3)] = -np.eye(3)
+        A[:, 3 * k : 3 * k + 3, 7 * st.obs_model[k] : 7 * st.obs_model[k] + 7] = J[:, k]
+        A[:, 3 * k : 3 * k + 3, 7 * M + 3 * st.obs_point[k] + np.arange(3)] = -np.eye(3)
     for i, j in enumerate(ctrl):
-        A[:, 3 * K + 3 * i:3 * K + 3 * i + 3, 7 * M + 3 * j + np.arange(3)] = np.eye(3)
+        A[:, 3 * K + 3 * i : 3 * K + 3 * i + 3, 7 * M + 3 * j + np.arange(3)] = np.eye(3)
     W = np.concatenate([w.reshape(T, -1), np.broadcast_to(wc, (T, C, 3)).reshape(T, -1)], 1)
     Qx = np.linalg.inv(np.einsum("toi,to,toj->tij", A, W, A))
     Qv = 1 / W - np.einsum("toi,tij,toj->to", A, Qx, A)
-    assert np.allclose(q, Qv[:, :3 * K].reshape(T, K, 3), atol=1e-9)
+    assert np.allclose(q, Qv[:, : 3 * K].reshape(T, K, 3), atol=1e-9)
 
 
 def test_chol_solve_matches_numpy():
@@ -208,19 +236,42 @@ def test_digital_pugging_shares_image_coordinates(small):
     b = small
     rng = np.random.default_rng(6)
     F = b.models + 1
-    el, er, _ = im.pointing_errors(rng, 4, b.obs_left, b.obs_right, b.obs_point, F, b.strips,
-                                   b.n_points, mark_um=21.0, parallax_um=21.0, digital=b.is_pass)
-    ml, mr, _ = im.pointing_errors(rng, 4, b.obs_left, b.obs_right, b.obs_point, F, b.strips,
-                                   b.n_points, mark_um=21.0, parallax_um=21.0,
-                                   mechanical=b.is_pass, transfer_um=10.0, recentre_um=21.0)
+    el, er, _ = im.pointing_errors(
+        rng,
+        4,
+        b.obs_left,
+        b.obs_right,
+        b.obs_point,
+        F,
+        b.strips,
+        b.n_points,
+        mark_um=21.0,
+        parallax_um=21.0,
+        digital=b.is_pass,
+    )
+    ml, mr, _ = im.pointing_errors(
+        rng,
+        4,
+        b.obs_left,
+        b.obs_right,
+        b.obs_point,
+        F,
+        b.strips,
+        b.n_points,
+        mark_um=21.0,
+        parallax_um=21.0,
+        mechanical=b.is_pass,
+        transfer_um=10.0,
+        recentre_um=21.0,
+    )
     # a pass point on the photo that is the right of model m and the left of model m + 1
     found = 0
     for k1 in np.flatnonzero(b.is_pass[b.obs_point]):
         k2 = np.flatnonzero((b.obs_point == b.obs_point[k1]) & (b.obs_left == b.obs_right[k1]))
         for k in k2:
             found += 1
-            assert np.array_equal(er[:, k1], el[:, k])          # digital: the very same pixel
-            assert not np.allclose(mr[:, k1], ml[:, k])         # mechanical: re-centred
+            assert np.array_equal(er[:, k1], el[:, k])  # digital: the very same pixel
+            assert not np.allclose(mr[:, k1], ml[:, k])  # mechanical: re-centred
     assert found > 0
 
 
@@ -228,8 +279,18 @@ def test_parallax_error_statistics(small):
     """Signalised points: x-parallax error std = parallax_um (within the sampling error)."""
     b = small
     rng = np.random.default_rng(8)
-    el, er, _ = im.pointing_errors(rng, 400, b.obs_left, b.obs_right, b.obs_point, b.models + 1,
-                                   b.strips, b.n_points, mark_um=21.0, parallax_um=15.0)
+    el, er, _ = im.pointing_errors(
+        rng,
+        400,
+        b.obs_left,
+        b.obs_right,
+        b.obs_point,
+        b.models + 1,
+        b.strips,
+        b.n_points,
+        mark_um=21.0,
+        parallax_um=15.0,
+    )
     p = (el[..., 0] - er[..., 0]).ravel()
     assert abs(p.std(ddof=1) / 15.0 - 1) < 4 / math.sqrt(2 * (p.size - 1))
 
@@ -243,17 +304,30 @@ def test_snooping_finds_a_planted_blunder(small):
     xr = b.image_coords(b.obs_right, b.obs_point)
     G = im.form_models(xl, xr, b.focal_mm, b.base_m) + b.photos.reshape(-1, 3)[b.obs_left]
     G = G + rng.normal(0, 1, (T,) + G.shape) * [sxy, sxy, sz]
-    k_bad = int(np.flatnonzero(b.is_pass[b.obs_point] & (np.bincount(b.obs_point)[b.obs_point] >= 3))[0])
-    G[:, k_bad, 2] += 20 * sz                                    # a 20-sigma height blunder
+    k_bad = int(
+        np.flatnonzero(b.is_pass[b.obs_point] & (np.bincount(b.obs_point)[b.obs_point] >= 3))[0]
+    )
+    G[:, k_bad, 2] += 20 * sz  # a 20-sigma height blunder
     s, R, t = im.random_similarities(rng, (T, b.n_models))
     xm = im.to_model_frame(G, b.obs_model, s, R, t)
     ctrl = select_control(b, "full")
     st = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points)
     s0, R0, t0, X0 = _start(b, st, xm, rng, T)
-    w = np.array([1 / sxy ** 2, 1 / sxy ** 2, 1 / sz ** 2])
-    rej, _, wmax, rounds = ds.snoop(st, xm, w, np.broadcast_to(b.points[ctrl], (T, ctrl.size, 3)),
-                                      np.full((ctrl.size, 3), 1e4), s0, R0, t0, X0, b.is_pass,
-                                      crit=3.29, max_reject=10)
+    w = np.array([1 / sxy**2, 1 / sxy**2, 1 / sz**2])
+    rej, _, wmax, rounds = ds.snoop(
+        st,
+        xm,
+        w,
+        np.broadcast_to(b.points[ctrl], (T, ctrl.size, 3)),
+        np.full((ctrl.size, 3), 1e4),
+        s0,
+        R0,
+        t0,
+        X0,
+        b.is_pass,
+        crit=3.29,
+        max_reject=10,
+    )
     assert rej[:, b.obs_point[k_bad]].all() and (rounds >= 1).all()
     assert (wmax <= 3.29).all()
 
@@ -282,6 +356,7 @@ def test_bad_config_names_the_key():
 
 def _tiny_overrides():
     from pathlib import Path
+
     lines = (Path(__file__).parent / "data" / "tiny" / "agnard_block.txt").read_text().split()
     return [ln for ln in lines if not ln.startswith("trials=")]
 
@@ -297,27 +372,34 @@ def tiny_run(tmp_path_factory):
 
 
 def test_tiny_run_writes_claims_and_report(tiny_run):
-    from sim.claims import KINDS
-    from sim.storage import read_table
+    from sim.claims.book import KINDS
+    from sim.mc.storage import read_table
     from sim.studies.agnard.claims import load_book
 
     study, cfg, out = tiny_run
     rows = read_table(out / "claims.parquet").to_pylist()
     names = [r["claim"] for r in rows]
-    assert len(names) == len(set(names)) == len(load_book().specs)   # each claim scored once
+    assert len(names) == len(set(names)) == len(load_book().specs)  # each claim scored once
     assert all(r["kind"] in KINDS for r in rows)
     nr = read_table(out / "not_reproduced.parquet").to_pylist()
     assert nr and all(r["why"] for r in nr)
     text = study.report(out)
     assert f"{out.name}/block_layout.png" in text and "w-test" in text
     assert f"{out.name}/consistent_set.png" in text
-    for f in ("scanner_field.png", "block_layout.png", "check_residuals.png", "tradeoffs.png",
-              "consistent_set.png", "trials.parquet", "consistent_set.parquet"):
+    for f in (
+        "scanner_field.png",
+        "block_layout.png",
+        "check_residuals.png",
+        "tradeoffs.png",
+        "consistent_set.png",
+        "trials.parquet",
+        "consistent_set.parquet",
+    ):
         assert (out / f).is_file()
 
 
 def test_consistent_set_table(tiny_run):
-    from sim.storage import read_table
+    from sim.mc.storage import read_table
 
     _, cfg, out = tiny_run
     cs = read_table(out / "consistent_set.parquet").to_pydict()
@@ -339,7 +421,7 @@ def test_consistent_set_table(tiny_run):
 def test_table1_with_rows_are_paper_checks_recomputed_from_tables_2_3(tiny_run):
     """The contradiction is a paper-check whose value is the nearer of the paper's own
     Tables 2-3 numbers; the simulation is not scored against Table 1's 'with' rows."""
-    from sim.storage import read_table
+    from sim.mc.storage import read_table
     from sim.studies.agnard.claims import load_book
 
     book = load_book()
@@ -348,8 +430,10 @@ def test_table1_with_rows_are_paper_checks_recomputed_from_tables_2_3(tiny_run):
         for c in ("x", "y"):
             r = rows[f"agnard.table1.with_{w}_{c}_m"]
             assert r["kind"] == "paper-check" and r["interval"] == "exact"
-            t23 = [book.spec(f"agnard.{n}.{w}_{c}_cm")["ref"] / 100
-                   for n in ("control_5", "control_21")]
+            t23 = [
+                book.spec(f"agnard.{n}.{w}_{c}_cm")["ref"] / 100
+                for n in ("control_5", "control_21")
+            ]
             assert r["value"] == min(t23, key=lambda v: abs(v - book.spec(r["claim"])["ref"]))
             assert rows[f"agnard.table1.without_{w}_{c}_m"]["verdict"] == "not comparable"
     # the paper's control rms in Table 1 is 2-3 x its Tables 2-3: an erratum
@@ -363,8 +447,8 @@ def test_budget_recomputation_and_pointing_model():
     _, cfg = load_study(STUDY)
     pix_cm = 25.4e-3 / cfg["scan.dpi"] * cfg["block.scale"] * 100
     sxy, sz = model_sigmas(cfg)
-    assert math.isclose(100 * sxy, pix_cm * math.hypot(0.5, 0.25))          # 14.7 cm
-    assert math.isclose(100 * sz, 0.5 * pix_cm * 152 / 90)                   # 22.2 cm
+    assert math.isclose(100 * sxy, pix_cm * math.hypot(0.5, 0.25))  # 14.7 cm
+    assert math.isclose(100 * sz, 0.5 * pix_cm * 152 / 90)  # 22.2 cm
 
 
 def test_chunk_functions_pickle():
@@ -376,8 +460,12 @@ def test_chunk_functions_pickle():
 
     _, cfg = load_study(STUDY)
     b = block_of(cfg)
-    for fn in (partial(ch.main_chunk, cfg, b), partial(ch.sweep_chunk, cfg, b),
-               partial(ch.pugging_chunk, cfg, b, 0.5), partial(ch.scanner_chunk, cfg, b, 300.0)):
+    for fn in (
+        partial(ch.main_chunk, cfg, b),
+        partial(ch.sweep_chunk, cfg, b),
+        partial(ch.pugging_chunk, cfg, b, 0.5),
+        partial(ch.scanner_chunk, cfg, b, 300.0),
+    ):
         assert pickle.loads(pickle.dumps(fn)).func is fn.func
 
 
@@ -408,12 +496,13 @@ def test_monte_carlo_point_errors_match_adjustment_covariance(small):
     sc_ = 0.05
     cx = b.points[ctrl] + rng.normal(0, sc_, (T, ctrl.size, 3))
     X0 = np.broadcast_to(b.points, (T,) + b.points.shape)
-    res = im.adjust_block(st, xm, 1 / sig ** 2, cx, np.full((ctrl.size, 3), 1 / sc_ ** 2), s, R, t,
-                          X0, keep_normals=True)
+    res = im.adjust_block(
+        st, xm, 1 / sig**2, cx, np.full((ctrl.size, 3), 1 / sc_**2), s, R, t, X0, keep_normals=True
+    )
     q = im.point_cofactors(st, res)
     err = (res.X - b.points)[:, ~np.isin(np.arange(b.n_points), ctrl)]
     expect = np.sqrt(q[0])[~np.isin(np.arange(b.n_points), ctrl)]
-    ratio = np.sqrt((err ** 2).mean(0)) / expect          # true errors: mean is zero
+    ratio = np.sqrt((err**2).mean(0)) / expect  # true errors: mean is zero
     tol = 4 / math.sqrt(2 * T)
     # every coordinate within 4 standard errors of the std; the mean ratio within the bound
     # that holds even for fully correlated coordinates
@@ -424,21 +513,30 @@ def test_monte_carlo_point_errors_match_adjustment_covariance(small):
 def test_consistent_set_from_constructed_samples():
     """Claim by claim, the swept values where the book's rule gives holds / not fails, and
     the consistent set as their intersection."""
-    from sim.claims import ClaimBook
+    from sim.claims.book import ClaimBook
     from sim.studies.agnard.sweep import evaluate
 
-    base = {"source": "s", "paper": "p", "kind": "prediction", "form": "one-plate",
-            "decimals": 0}
-    book = ClaimBook([{**base, "id": "a", "ref": 10, "tol": 2.0},
-                      {**base, "id": "b", "ref": 20, "tol": 4.0}], [], "<test>")
+    base = {"source": "s", "paper": "p", "kind": "prediction", "form": "one-plate", "decimals": 0}
+    book = ClaimBook(
+        [{**base, "id": "a", "ref": 10, "tol": 2.0}, {**base, "id": "b", "ref": 20, "tol": 4.0}],
+        [],
+        "<test>",
+    )
     rng = np.random.default_rng(0)
     centres = {0.0: (5, 20), 0.1: (10, 20.1), 0.2: (10.2, 30), 0.3: (20, 20)}
-    sweeps = {"u": {u: {"a": a + rng.normal(0, 0.3, 400), "b": b + rng.normal(0, 0.3, 400)}
-                    for u, (a, b) in centres.items()}}
+    sweeps = {
+        "u": {
+            u: {"a": a + rng.normal(0, 0.3, 400), "b": b + rng.normal(0, 0.3, 400)}
+            for u, (a, b) in centres.items()
+        }
+    }
     long, cs = evaluate(book, sweeps)
-    rows = {c: (lo, hi, ol, oh) for c, lo, hi, ol, oh in zip(cs["claim"], cs["holds_low"],
-                                                             cs["holds_high"], cs["ok_low"],
-                                                             cs["ok_high"])}
+    rows = {
+        c: (lo, hi, ol, oh)
+        for c, lo, hi, ol, oh in zip(
+            cs["claim"], cs["holds_low"], cs["holds_high"], cs["ok_low"], cs["ok_high"]
+        )
+    }
     assert rows["a"] == (0.1, 0.2, 0.1, 0.2)
     assert rows["b"][:2] == (0.0, 0.3)
     assert rows["ALL"] == (0.1, 0.1, 0.1, 0.1)
@@ -453,8 +551,10 @@ def test_input_rows_follow_the_config():
     _, cfg = load_study(STUDY, ["scan.max_y_um=30.0"])
     b = block_of(cfg)
     book = load_book()
-    rows = {r["claim"]: r for r in input_rows(book, cfg, b, select_control(b, "five"),
-                                              select_control(b, "full"))}
+    rows = {
+        r["claim"]: r
+        for r in input_rows(book, cfg, b, select_control(b, "five"), select_control(b, "full"))
+    }
     assert rows["agnard.input.scan.max_y_um"]["value"] == 30.0
     assert rows["agnard.input.scan.max_y_um"]["verdict"] == "input"
-    assert rows["agnard.scanner.pixel_um"]["verdict"] == "holds"          # 25.4 mm / 600
+    assert rows["agnard.scanner.pixel_um"]["verdict"] == "holds"  # 25.4 mm / 600

@@ -10,6 +10,7 @@ path where ``--executor dask`` starts its own LocalCluster is tested in ``test_r
 Each study provides ``tests/data/tiny/<study>.txt``: one ``KEY=VALUE`` override per line for a
 run of a few seconds with at least two chunks.
 """
+
 import os
 import signal
 import subprocess
@@ -20,7 +21,7 @@ from pathlib import Path
 import pyarrow.parquet as pq
 import pytest
 
-from sim.storage import read_provenance
+from sim.mc.storage import read_provenance
 from sim.studies import MODULES
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -39,8 +40,20 @@ FILES = {"network": "network_testfield"}
 
 
 def command(study: str, out: Path, workers: int, *extra: str) -> list[str]:
-    return [sys.executable, "-m", "sim", "run", str(ROOT / "studies" / f"{FILES.get(study, study)}.toml"),
-            "--out", str(out), "--quiet", "--workers", str(workers), *extra, *overrides(study)]
+    return [
+        sys.executable,
+        "-m",
+        "sim",
+        "run",
+        str(ROOT / "studies" / f"{FILES.get(study, study)}.toml"),
+        "--out",
+        str(out),
+        "--quiet",
+        "--workers",
+        str(workers),
+        *extra,
+        *overrides(study),
+    ]
 
 
 def same_table(a: Path, b: Path) -> bool:
@@ -63,10 +76,16 @@ def same_table(a: Path, b: Path) -> bool:
 
 
 def same_files(a: Path, b: Path) -> None:
-    fa = sorted(p.relative_to(a).as_posix() for p in a.rglob("*") if p.is_file()
-                and p.suffix in (".parquet", ".png") and "trials" not in p.parts)
-    fb = sorted(p.relative_to(b).as_posix() for p in b.rglob("*") if p.is_file()
-                and p.suffix in (".parquet", ".png") and "trials" not in p.parts)
+    fa = sorted(
+        p.relative_to(a).as_posix()
+        for p in a.rglob("*")
+        if p.is_file() and p.suffix in (".parquet", ".png") and "trials" not in p.parts
+    )
+    fb = sorted(
+        p.relative_to(b).as_posix()
+        for p in b.rglob("*")
+        if p.is_file() and p.suffix in (".parquet", ".png") and "trials" not in p.parts
+    )
     assert fa == fb and fa
     for f in fa:
         if f.endswith(".png"):
@@ -75,10 +94,16 @@ def same_files(a: Path, b: Path) -> None:
         assert same_table(a / f, b / f), f
         pa_, pb_ = read_provenance(a / f), read_provenance(b / f)
         assert pa_.get("config") == pb_.get("config") and pa_.get("seed") == pb_.get("seed"), f
-    ta = sorted(p.relative_to(a).as_posix() for p in (a / "trials").rglob("*.parquet")) \
-        if (a / "trials").is_dir() else []
-    tb = sorted(p.relative_to(b).as_posix() for p in (b / "trials").rglob("*.parquet")) \
-        if (b / "trials").is_dir() else []
+    ta = (
+        sorted(p.relative_to(a).as_posix() for p in (a / "trials").rglob("*.parquet"))
+        if (a / "trials").is_dir()
+        else []
+    )
+    tb = (
+        sorted(p.relative_to(b).as_posix() for p in (b / "trials").rglob("*.parquet"))
+        if (b / "trials").is_dir()
+        else []
+    )
     assert ta == tb
     for f in ta:
         assert same_table(a / f, b / f), f
@@ -100,9 +125,15 @@ def scheduler():
     lives in a process of its own, so nothing the test process does (forks, signals) reaches
     its workers."""
     pytest.importorskip("dask.distributed")
-    p = subprocess.Popen([sys.executable, "-c", CLUSTER], cwd=ROOT, stdin=subprocess.PIPE,
-                         stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
-                         start_new_session=True)
+    p = subprocess.Popen(
+        [sys.executable, "-c", CLUSTER],
+        cwd=ROOT,
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        start_new_session=True,
+    )
     try:
         address = p.stdout.readline().strip()
         assert address.startswith("tcp://"), "the Dask cluster did not start"
@@ -119,13 +150,19 @@ def scheduler():
 @pytest.mark.parametrize("study", sorted(MODULES))
 def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path, scheduler):
     one = tmp_path / "one"
-    r = subprocess.run(command(study, one, 1), cwd=ROOT, capture_output=True, text=True,
-                       timeout=300)
+    r = subprocess.run(
+        command(study, one, 1), cwd=ROOT, capture_output=True, text=True, timeout=300
+    )
     assert r.returncode == 0, r.stderr
     two = tmp_path / "two"
     stage = tmp_path / ".two.partial"
-    p = subprocess.Popen(command(study, two, 2), cwd=ROOT, stdout=subprocess.DEVNULL,
-                         stderr=subprocess.DEVNULL, start_new_session=True)
+    p = subprocess.Popen(
+        command(study, two, 2),
+        cwd=ROOT,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     t0 = time.monotonic()
     while p.poll() is None and time.monotonic() - t0 < 120:
         if list(stage.rglob("chunk-*.parquet")):
@@ -134,9 +171,14 @@ def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path, sched
         time.sleep(0.05)
     p.wait(timeout=60)
     assert p.returncode == -signal.SIGKILL, "the run finished before it could be killed"
-    assert not two.exists() and list(stage.rglob("chunk-*.parquet"))   # killed mid-run
-    r = subprocess.run(command(study, two, 2, "--executor", "dask", "--scheduler", scheduler),
-                       cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert not two.exists() and list(stage.rglob("chunk-*.parquet"))  # killed mid-run
+    r = subprocess.run(
+        command(study, two, 2, "--executor", "dask", "--scheduler", scheduler),
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     assert "resuming" in r.stderr
     same_files(one, two)

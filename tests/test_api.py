@@ -1,4 +1,5 @@
 """The Python API (sim.api): the README's worked example, validation and the output rules."""
+
 from pathlib import Path
 
 import numpy as np
@@ -16,12 +17,12 @@ def test_readme_worked_example(tmp_path):
     import sim
 
     st = sim.load(STUDY, trials=200, chunk=50, **{"errors.settings": 3})  # dotted keys
-    st = st.replace(comparator__beta_mm=0.5)       # keyword form: __ stands for the dot
-    print(st.estimate().describe())                # trials, adjustments, unknowns, memory
-    res = st.run(out=tmp_path / "t1", workers=2)   # or executor="dask"; out=None: a temp dir
-    claims = res.claims()                          # pyarrow.Table
+    st = st.replace(comparator__beta_mm=0.5)  # keyword form: __ stands for the dot
+    print(st.estimate().describe())  # trials, adjustments, unknowns, memory
+    res = st.run(out=tmp_path / "t1", workers=2)  # or executor="dask"; out=None: a temp dir
+    claims = res.claims()  # pyarrow.Table
     print(claims.select(["claim", "value", "ci_low", "ci_high", "holds"]).to_pylist()[:2])
-    points = res.table("points")                   # any table by name; "trials" per trial
+    points = res.table("points")  # any table by name; "trials" per trial
     # ----------------------------------------------------------------------------------------
     assert isinstance(claims, pa.Table) and isinstance(points, pa.Table)
     assert res.table("trials").num_rows == 200
@@ -30,13 +31,33 @@ def test_readme_worked_example(tmp_path):
     # the same run from the command line gives the same tables
     from sim.cli import main
 
-    assert main(["run", str(STUDY), "--out", str(tmp_path / "cli"), "--quiet", "--trials", "200",
-                 "--set", "chunk=50", "--set", "errors.settings=3",
-                 "--set", "comparator.beta_mm=0.5"]) == 0
-    from sim.storage import read_table
+    assert (
+        main(
+            [
+                "run",
+                str(STUDY),
+                "--out",
+                str(tmp_path / "cli"),
+                "--quiet",
+                "--trials",
+                "200",
+                "--set",
+                "chunk=50",
+                "--set",
+                "errors.settings=3",
+                "--set",
+                "comparator.beta_mm=0.5",
+            ]
+        )
+        == 0
+    )
+    from sim.mc.storage import read_table
 
-    assert read_table(tmp_path / "cli" / "claims.parquet").select(["value"]).equals(
-        claims.select(["value"]))
+    assert (
+        read_table(tmp_path / "cli" / "claims.parquet")
+        .select(["value"])
+        .equals(claims.select(["value"]))
+    )
 
 
 def test_api_errors_name_the_key(tmp_path):

@@ -3,6 +3,7 @@
 Each file in ``tests/data/bad/`` starts with ``# expect: <text>``: the text the error line
 must contain (files without it, e.g. binary garbage, only need the clean failure).
 """
+
 from pathlib import Path
 
 import pytest

@@ -1,6 +1,7 @@
 """make reproduce's and make rerun's driver (sim.batch): studies side by side give the same
 files as one after the other, the slowest start first, up-to-date studies are skipped, a
 failed run does not stop the others, and bad input is one line with exit 2."""
+
 import subprocess
 import sys
 from pathlib import Path
@@ -8,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 
+from benchmarks.cli import tiny_overrides
 from sim import batch
-from sim.bench.cli import tiny_overrides
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -23,10 +24,16 @@ def _tiny(tmp_path, study_file: str):
 
 
 def test_order_puts_the_slowest_first():
-    files = [Path(f"studies/{s}.toml") for s in ("agnard_block", "network_plate",
-                                                  "wolf_polynomial", "brown_design")]
-    assert [f.stem for f in batch.order(files)] == ["wolf_polynomial", "brown_design",
-                                                    "agnard_block", "network_plate"]
+    files = [
+        Path(f"studies/{s}.toml")
+        for s in ("agnard_block", "network_plate", "wolf_polynomial", "brown_design")
+    ]
+    assert [f.stem for f in batch.order(files)] == [
+        "wolf_polynomial",
+        "brown_design",
+        "agnard_block",
+        "network_plate",
+    ]
 
 
 def _same_tables(a_dir: Path, b_dir: Path):
@@ -36,23 +43,40 @@ def _same_tables(a_dir: Path, b_dir: Path):
         a = pq.read_table(a_dir / n).to_pydict()
         b = pq.read_table(b_dir / n).to_pydict()
         assert list(a) == list(b), n
-        for col in a:                                   # NaN equal to NaN
+        for col in a:  # NaN equal to NaN
             kind = object if any(isinstance(v, str) for v in a[col]) else None
-            np.testing.assert_array_equal(np.array(a[col], dtype=kind),
-                                          np.array(b[col], dtype=kind), err_msg=f"{n} {col}")
+            np.testing.assert_array_equal(
+                np.array(a[col], dtype=kind), np.array(b[col], dtype=kind), err_msg=f"{n} {col}"
+            )
 
 
 def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
     """``python -m sim.batch`` as make runs it (a fresh process: forked children, two at a
     time) gives the files of fresh ``python -m sim run`` processes one at a time."""
     fa, sets = _tiny(tmp_path, "network_testfield.toml")
-    fb, _ = _tiny(tmp_path, "network_plate.toml")       # the same study kind: the same sets
-    r = subprocess.run([sys.executable, "-m", "sim.batch", "--jobs", "2", "--results",
-                        str(tmp_path / "two"), str(fa), str(fb), "--", *sets],
-                       cwd=ROOT, capture_output=True, text=True, timeout=300)
+    fb, _ = _tiny(tmp_path, "network_plate.toml")  # the same study kind: the same sets
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "sim.batch",
+            "--jobs",
+            "2",
+            "--results",
+            str(tmp_path / "two"),
+            str(fa),
+            str(fb),
+            "--",
+            *sets,
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     assert r.stdout.count("results in") == 2
-    monkeypatch.delattr(batch.os, "fork")           # the portable path: python -m sim run
+    monkeypatch.delattr(batch.os, "fork")  # the portable path: python -m sim run
     one = batch.run_all([fa, fb], tmp_path / "one", 1, ["--quiet", *sets])
     assert {k: v[0] for k, v in one.items()} == {fa.stem: 0, fb.stem: 0}
     for stem in (fa.stem, fb.stem):
@@ -60,14 +84,15 @@ def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
 
 
 def test_stale_only_skips_the_current_studies(tmp_path, monkeypatch):
-    import sim.codehash
+    import sim.mc.codehash
 
     fa, sa = _tiny(tmp_path, "network_testfield.toml")
     fb, _ = _tiny(tmp_path, "brown_table1.toml")
-    monkeypatch.setattr(sim.codehash, "is_current", lambda f, res: Path(f).stem == fb.stem)
+    monkeypatch.setattr(sim.mc.codehash, "is_current", lambda f, res: Path(f).stem == fb.stem)
     logged = []
-    done = batch.run_all([fa, fb], tmp_path / "r", 2, [], stale_only=True, log=logged.append,
-                         extra={fa.stem: sa})
+    done = batch.run_all(
+        [fa, fb], tmp_path / "r", 2, [], stale_only=True, log=logged.append, extra={fa.stem: sa}
+    )
     assert list(done) == [fa.stem] and done[fa.stem][0] == 0
     assert f"{fb.stem}: up to date" in logged
     assert not (tmp_path / "r" / fb.stem).exists()

@@ -1,9 +1,10 @@
 """emcee cross-check: a linear-Gaussian posterior, and Brown's marginal posterior."""
+
 import numpy as np
 
-from sim import bayes
-from sim import multilateration as ml
-from sim.plate import grid_points
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import bayes
+from sim.instruments.ranges import multilateration as ml
 
 
 def test_emcee_posterior_of_a_linear_gaussian_model_matches_the_analytic_one():
@@ -12,11 +13,12 @@ def test_emcee_posterior_of_a_linear_gaussian_model_matches_the_analytic_one():
     x_true = np.array([0.3, -1.2, 0.7])
     sigma = 0.2
     y = A @ x_true + rng.normal(0, sigma, 12)
-    cov = sigma ** 2 * np.linalg.inv(A.T @ A)
+    cov = sigma**2 * np.linalg.inv(A.T @ A)
     mean = np.linalg.solve(A.T @ A, A.T @ y)
     p0 = rng.multivariate_normal(mean, cov, size=24)
-    ch = bayes.run_emcee(bayes.linear_log_posterior(A, y, sigma), p0, 4000,
-                         np.random.SeedSequence(7))
+    ch = bayes.run_emcee(
+        bayes.linear_log_posterior(A, y, sigma), p0, 4000, np.random.SeedSequence(7)
+    )
     assert ch.n_eff > 1000
     sd = np.sqrt(np.diag(cov))
     # mean within 5 standard errors (N_eff independent samples)
@@ -27,8 +29,12 @@ def test_emcee_posterior_of_a_linear_gaussian_model_matches_the_analytic_one():
     corr = cov / np.outer(sd, sd)
     assert np.abs(np.corrcoef(ch.samples.T) - corr).max() < 5 / np.sqrt(ch.n_eff)
     # the same seed gives the same chain
-    ch2 = bayes.run_emcee(bayes.linear_log_posterior(A, y, sigma), p0, 200, np.random.SeedSequence(7))
-    ch3 = bayes.run_emcee(bayes.linear_log_posterior(A, y, sigma), p0, 200, np.random.SeedSequence(7))
+    ch2 = bayes.run_emcee(
+        bayes.linear_log_posterior(A, y, sigma), p0, 200, np.random.SeedSequence(7)
+    )
+    ch3 = bayes.run_emcee(
+        bayes.linear_log_posterior(A, y, sigma), p0, 200, np.random.SeedSequence(7)
+    )
     assert np.array_equal(ch2.samples, ch3.samples)
 
 
@@ -43,7 +49,7 @@ def test_brown_marginal_posterior_is_the_least_squares_gaussian():
     t0 = th.copy()
     t0[5:] = 0.0
     ls = ml.adjust(r[None], "pivot", t0, tol_mm=1e-12)
-    Q = ml.covariance(ls.points, ls.theta, "pivot")[1][0] * sig ** 2
+    Q = ml.covariance(ls.points, ls.theta, "pivot")[1][0] * sig**2
     lp = bayes.brown_log_posterior(r, sig, tol_mm=1e-12)
     d = rng.multivariate_normal(np.zeros(7), Q, size=40)
     vals = lp(ls.theta + d) - lp(ls.theta)[0]
@@ -52,7 +58,7 @@ def test_brown_marginal_posterior_is_the_least_squares_gaussian():
 
 
 def test_vectorised_sampler_is_emcee_step_for_step():
-    """sim.ensemble runs emcee's stretch move: the same seed gives emcee's chain, acceptance
+    """sim.instruments.ranges.ensemble runs emcee's stretch move: the same seed gives emcee's chain, acceptance
     and autocorrelation times exactly (a posterior with -inf regions and a skewed one)."""
     rng = np.random.default_rng(3)
     A = np.column_stack([np.ones(10), np.linspace(-1, 1, 10)])

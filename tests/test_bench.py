@@ -1,14 +1,15 @@
-"""The benchmark at smoke size (``python -m sim.bench --quick``): every engine row is present
+"""The benchmark at smoke size (``python -m benchmarks --quick``): every engine row is present
 and both sides of each agree; the rerun rows time the study files as ``make rerun`` runs them;
 a disagreement or bad input stops it with one line. No timings are asserted."""
+
 from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from sim.bench import cli, engines
-from sim.bench.engines_linear import polynomial
+from benchmarks import cli, engines
+from benchmarks.engines_linear import polynomial
 
 ROOT = Path(__file__).resolve().parent.parent
 ENGINES = {"pposition", "gridplate", "block", "polynomial", "polynomial_shared"}
@@ -17,8 +18,20 @@ ENGINES = {"pposition", "gridplate", "block", "polynomial", "polynomial_shared"}
 def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
     monkeypatch.chdir(ROOT)
     out = tmp_path / "bench"
-    assert cli.main(["--quick", "--only", "engines,rerun", "--out", str(out),
-                     "--rerun-files", "studies/network_testfield.toml"]) == 0
+    assert (
+        cli.main(
+            [
+                "--quick",
+                "--only",
+                "engines,rerun",
+                "--out",
+                str(out),
+                "--rerun-files",
+                "studies/network_testfield.toml",
+            ]
+        )
+        == 0
+    )
     eng = pq.read_table(out / "engines.parquet").to_pydict()
     assert set(eng["engine"]) == ENGINES == set(engines.cases())
     for i, name in enumerate(eng["engine"]):
@@ -29,30 +42,30 @@ def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
     rr = pq.read_table(out / "rerun.parquet").to_pydict()
     assert rr["study"] == ["network_testfield", "report", "total"] * 2
     assert rr["workers"] == [1, 1, 1, 2, 2, 2]
-    assert rr["jobs"] == [2] * 6                          # make rerun's studies side by side
+    assert rr["jobs"] == [2] * 6  # make rerun's studies side by side
     for w in (1, 2):
         i = [k for k in range(6) if rr["workers"][k] == w]
         # one study file: the total spans its run and the report (and the driver's own time)
         assert rr["wall_s"][i[2]] >= rr["wall_s"][i[0]] + rr["wall_s"][i[1]]
-        assert rr["start_s"][i[0]] >= 0.0                  # the study first, then the report
+        assert rr["start_s"][i[0]] >= 0.0  # the study first, then the report
         assert rr["start_s"][i[1]] >= rr["start_s"][i[0]] + rr["wall_s"][i[0]]
         assert rr["target_s"][i[2]] == 90.0 and np.isnan(rr["target_s"][i[0]])
     assert (out / "engines.png").stat().st_size > 0
-    assert not (out / "bench.parquet").exists()          # a section left out is not written
+    assert not (out / "bench.parquet").exists()  # a section left out is not written
 
 
 def test_the_polynomial_engine_is_the_study_fit_and_agrees_with_scipy():
     case = polynomial(6)
     coef = case.engine()
-    assert coef.shape == (6, 10, 2)                       # ten terms per axis, per trial
+    assert coef.shape == (6, 10, 2)  # ten terms per axis, per trial
     assert engines.agreement(case, 6) <= case.tol
 
 
 def test_a_disagreement_stops_the_bench(monkeypatch, capsys):
     def wrong(T):
         c = polynomial(T)
-        return engines.Case(c.n_points, c.engine, lambda t: c.one(t) + 1e-6, c.tol, c.unit,
-                            c.scipy)
+        return engines.Case(c.n_points, c.engine, lambda t: c.one(t) + 1e-6, c.tol, c.unit, c.scipy)
+
     monkeypatch.setattr(engines, "cases", lambda: {"polynomial": (wrong, 40, 5)})
     with pytest.raises(RuntimeError, match="differ by"):
         engines.engine_rows(quick=True)
@@ -61,8 +74,12 @@ def test_a_disagreement_stops_the_bench(monkeypatch, capsys):
 
 
 def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys):
-    assert cli.main(["--only", "rerun", "--rerun-files", str(tmp_path / "*.toml"),
-                     "--out", str(tmp_path)]) == 2
+    assert (
+        cli.main(
+            ["--only", "rerun", "--rerun-files", str(tmp_path / "*.toml"), "--out", str(tmp_path)]
+        )
+        == 2
+    )
     assert "no study file matches" in capsys.readouterr().err
     for bad in (["--only", "nothing"], ["--rerun-workers", "0"], ["--rerun-workers", "a"]):
         with pytest.raises(SystemExit) as e:

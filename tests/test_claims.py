@@ -1,11 +1,12 @@
-"""The verdict rules of sim.claims on constructed cases (issue 11)."""
+"""The verdict rules of sim.claims.book on constructed cases (issue 11)."""
+
 import math
 
 import numpy as np
 import pytest
 
-from sim.claims import ClaimBook, claim, decide
-from sim.config import ConfigError, StudyError
+from sim.claims.book import ClaimBook, claim, decide
+from sim.mc.config import ConfigError, StudyError
 
 
 def book(**spec):
@@ -35,9 +36,14 @@ def test_range_contained_and_not():
     r = b.score("t.c", elems=(np.array([7.0, 12.0]), np.array([8.5, 14.0])))
     assert r["verdict"] == "holds" and r["value"] == 7.75 and r["value_high"] == 13.0
     b = book(form="range", ref=[5, 15], tol=0)
-    assert b.score("t.c", elems=(np.array([7.0, 15.5]), np.array([8.0, 16.0])))["verdict"] == "fails"
+    assert (
+        b.score("t.c", elems=(np.array([7.0, 15.5]), np.array([8.0, 16.0])))["verdict"] == "fails"
+    )
     b = book(form="range", ref=[5, 15], tol=0)
-    assert b.score("t.c", elems=(np.array([7.0, 14.0]), np.array([8.0, 16.0])))["verdict"] == "inconclusive"
+    assert (
+        b.score("t.c", elems=(np.array([7.0, 14.0]), np.array([8.0, 16.0])))["verdict"]
+        == "inconclusive"
+    )
 
 
 def test_bounds():
@@ -106,8 +112,13 @@ def test_book_validation_names_the_key():
 
 
 def test_every_declared_claim_must_be_scored():
-    b = ClaimBook([{"id": "a", "source": "s", "paper": "p", "kind": "finding"},
-                   {"id": "b", "source": "s", "paper": "p", "kind": "finding"}], [])
+    b = ClaimBook(
+        [
+            {"id": "a", "source": "s", "paper": "p", "kind": "finding"},
+            {"id": "b", "source": "s", "paper": "p", "kind": "finding"},
+        ],
+        [],
+    )
     b.score("a", 1.0, interval="exact")
     with pytest.raises(ValueError, match="not scored: b"):
         b.check_complete()
@@ -123,12 +134,30 @@ def test_older_interface_maps_rounding_to_the_zone():
 def test_not_comparable_rows_are_written_with_no_number(tmp_path):
     import pyarrow.parquet as pq
 
-    from sim.claims import write_claims
+    from sim.claims.book import write_claims
 
-    b = ClaimBook([{"id": "t.nc", "source": "s", "paper": "p", "kind": "not comparable",
-                    "why": "the setup is not printed"},
-                   {"id": "t.v", "source": "s", "paper": "p", "kind": "prediction",
-                    "form": "value", "ref": 1.0, "tol": 0.1}], [], "<test>")
+    b = ClaimBook(
+        [
+            {
+                "id": "t.nc",
+                "source": "s",
+                "paper": "p",
+                "kind": "not comparable",
+                "why": "the setup is not printed",
+            },
+            {
+                "id": "t.v",
+                "source": "s",
+                "paper": "p",
+                "kind": "prediction",
+                "form": "value",
+                "ref": 1.0,
+                "tol": 0.1,
+            },
+        ],
+        [],
+        "<test>",
+    )
     rows = [b.not_comparable("t.nc"), b.score("t.v", 1.0, (0.95, 1.05))]
     write_claims(tmp_path / "claims.parquet", rows, {"study": "t"}, b)
     t = pq.read_table(tmp_path / "claims.parquet").to_pydict()
@@ -139,8 +168,8 @@ def test_not_comparable_rows_are_written_with_no_number(tmp_path):
 def test_a_bound_is_written_with_its_open_side_null(tmp_path):
     import pyarrow.parquet as pq
 
-    from sim.claims import write_claims
-    from sim.report import claims_markdown
+    from sim.claims.book import write_claims
+    from sim.report.markdown import claims_markdown
 
     b = book(form="upper", ref=2.0, tol=0)
     write_claims(tmp_path / "claims.parquet", [b.score("t.c", 1.0, (0.5, 1.5))], {"study": "t"}, b)

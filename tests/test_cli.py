@@ -1,4 +1,5 @@
 """The study-file contract: validation, one-line errors, outputs, provenance, determinism."""
+
 import subprocess
 import sys
 from pathlib import Path
@@ -8,8 +9,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from sim.cli import main
-from sim.config import ConfigError, load_study, parse_override
-from sim.storage import read_provenance
+from sim.mc.config import ConfigError, load_study, parse_override
+from sim.mc.storage import read_provenance
 
 ROOT = Path(__file__).resolve().parent.parent
 BROWN = ROOT / "studies" / "brown_table1.toml"
@@ -24,28 +25,37 @@ def write(tmp_path, text, name="study.toml"):
 BASE = 'study = "brown_table1"\ntrials = 20\nchunk = 10\n'
 
 
-@pytest.mark.parametrize("body, key", [
-    ("[plate]\ngird = 5\n", "plate.gird"),                       # unknown key
-    ("bogus = 1\n", "bogus"),
-    ("[errors]\nsetting_sigma_um = -1.0\n", "errors.setting_sigma_um"),  # negative sigma
-    ("[errors]\nsetting_sigma_um = 0.0\n", "errors.setting_sigma_um"),   # zero sigma
-    ("[errors]\ncomparator_sigma_um = nan\n", "errors.comparator_sigma_um"),
-    ("[errors]\nsettings = 0\n", "errors.settings"),
-    ("[errors]\nsettings = 1.5\n", "errors.settings"),             # wrong type
-    ("[plate]\ngrid = \"five\"\n", "plate.grid"),
-    ("[plate]\ngrid = 1\n", "plate.grid"),                         # fewer than 3 points
-    ("[plate]\npattern = \"list\"\npoints = [[0.0, 0.0], [10.0, 0.0]]\n", "plate.points"),
-    ("[plate]\npattern = \"list\"\npoints = [[0.0, 0.0], [10.0, 0.0], [20.0, 0.0], [30.0, 0.0]]\n",
-     "plate.points"),                                              # collinear
-    ("[plate]\npattern = \"list\"\npoints = [[0.0, 0.0], [10.0, 5.0], [10.0, 5.0], [3.0, 30.0]]\n",
-     "plate.points"),                                              # duplicate
-    ("[plate]\npattern = \"list\"\npoints = [[0.0, 0.0], [10.0, 5.0], [200.0, 5.0], [3.0, 30.0]]\n",
-     "plate.points"),                                              # outside the format
-    ("[plate]\nspacing_mm = 80.0\n", "plate.spacing_mm"),          # grid outside the format
-    ("[plate]\npattern = \"hexagon\"\n", "plate.pattern"),
-    ("[comparator]\nstation_offset_mm = 0.0\n", "comparator.station_offset_mm"),  # inside
-    ("[comparator]\nbeta_mm = inf\n", "comparator.beta_mm"),
-])
+@pytest.mark.parametrize(
+    "body, key",
+    [
+        ("[plate]\ngird = 5\n", "plate.gird"),  # unknown key
+        ("bogus = 1\n", "bogus"),
+        ("[errors]\nsetting_sigma_um = -1.0\n", "errors.setting_sigma_um"),  # negative sigma
+        ("[errors]\nsetting_sigma_um = 0.0\n", "errors.setting_sigma_um"),  # zero sigma
+        ("[errors]\ncomparator_sigma_um = nan\n", "errors.comparator_sigma_um"),
+        ("[errors]\nsettings = 0\n", "errors.settings"),
+        ("[errors]\nsettings = 1.5\n", "errors.settings"),  # wrong type
+        ('[plate]\ngrid = "five"\n', "plate.grid"),
+        ("[plate]\ngrid = 1\n", "plate.grid"),  # fewer than 3 points
+        ('[plate]\npattern = "list"\npoints = [[0.0, 0.0], [10.0, 0.0]]\n', "plate.points"),
+        (
+            '[plate]\npattern = "list"\npoints = [[0.0, 0.0], [10.0, 0.0], [20.0, 0.0], [30.0, 0.0]]\n',
+            "plate.points",
+        ),  # collinear
+        (
+            '[plate]\npattern = "list"\npoints = [[0.0, 0.0], [10.0, 5.0], [10.0, 5.0], [3.0, 30.0]]\n',
+            "plate.points",
+        ),  # duplicate
+        (
+            '[plate]\npattern = "list"\npoints = [[0.0, 0.0], [10.0, 5.0], [200.0, 5.0], [3.0, 30.0]]\n',
+            "plate.points",
+        ),  # outside the format
+        ("[plate]\nspacing_mm = 80.0\n", "plate.spacing_mm"),  # grid outside the format
+        ('[plate]\npattern = "hexagon"\n', "plate.pattern"),
+        ("[comparator]\nstation_offset_mm = 0.0\n", "comparator.station_offset_mm"),  # inside
+        ("[comparator]\nbeta_mm = inf\n", "comparator.beta_mm"),
+    ],
+)
 def test_bad_config_names_the_key(tmp_path, body, key):
     p = write(tmp_path, BASE + body)
     with pytest.raises(ConfigError) as e:
@@ -63,17 +73,23 @@ def test_cli_bad_input_one_line_exit_2_no_output(tmp_path, capsys):
     assert not out.exists() and not list(tmp_path.glob(".res*"))
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["run", "nonexistent.toml"], "no such study file"),
-    (["run", "{bad}"], "malformed TOML"),
-    (["run", "{ok}", "--set", "plate.grid=1"], "plate.grid"),
-    (["run", "{ok}", "--set", "nokey"], "key=value"),
-    (["run", "{ok}", "--trials", "1"], "trials"),
-    (["run", "{unknown_study}"], "unknown study"),
-])
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["run", "nonexistent.toml"], "no such study file"),
+        (["run", "{bad}"], "malformed TOML"),
+        (["run", "{ok}", "--set", "plate.grid=1"], "plate.grid"),
+        (["run", "{ok}", "--set", "nokey"], "key=value"),
+        (["run", "{ok}", "--trials", "1"], "trials"),
+        (["run", "{unknown_study}"], "unknown study"),
+    ],
+)
 def test_cli_errors(tmp_path, capsys, args, needle):
-    files = {"bad": write(tmp_path, "study = \n", "bad.toml"), "ok": write(tmp_path, BASE, "ok.toml"),
-             "unknown_study": write(tmp_path, 'study = "nope"\n', "u.toml")}
+    files = {
+        "bad": write(tmp_path, "study = \n", "bad.toml"),
+        "ok": write(tmp_path, BASE, "ok.toml"),
+        "unknown_study": write(tmp_path, 'study = "nope"\n', "u.toml"),
+    }
     args = [a.format(**files) for a in args]
     assert main(args + ["--out", str(tmp_path / "o"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
@@ -98,19 +114,33 @@ def test_overrides_parse_toml_values():
 
 def test_run_writes_contract_files_with_provenance(tmp_path):
     out = tmp_path / "t1"
-    assert main(["run", str(BROWN), "--out", str(out), "--trials", "60", "--quiet",
-                 "--set", "chunk=25"]) == 0
+    assert (
+        main(
+            ["run", str(BROWN), "--out", str(out), "--trials", "60", "--quiet", "--set", "chunk=25"]
+        )
+        == 0
+    )
     pts = pq.read_table(out / "points.parquet").to_pydict()
-    for col in ("model", "point", "x_mm", "y_mm", "sigma_x_um", "sigma_y_um", "mc_sigma_x_um",
-                "mc_sigma_y_um", "mc_trials"):
+    for col in (
+        "model",
+        "point",
+        "x_mm",
+        "y_mm",
+        "sigma_x_um",
+        "sigma_y_um",
+        "mc_sigma_x_um",
+        "mc_sigma_y_um",
+        "mc_trials",
+    ):
         assert col in pts
     assert set(pts["model"]) == {"known", "stations", "pivot"}
     claims = pq.read_table(out / "claims.parquet").to_pydict()
     for col in ("claim", "source", "paper", "value", "ci_low", "ci_high", "holds", "kind", "note"):
         assert col in claims
-    from sim.claims import KINDS
+    from sim.claims.book import KINDS
+
     assert set(claims["kind"]) <= set(KINDS)
-    trials = pq.read_table(out / "trials").to_pydict()   # partitioned dataset, one file a chunk
+    trials = pq.read_table(out / "trials").to_pydict()  # partitioned dataset, one file a chunk
     assert len(trials["chunk"]) == 60 and sorted(set(trials["chunk"])) == [0, 1, 2]
     for m in ("known", "stations", "pivot"):
         assert {f"{m}_converged", f"{m}_iterations", f"{m}_sigma0_um", f"{m}_status"} <= set(trials)
@@ -124,25 +154,62 @@ def test_run_writes_contract_files_with_provenance(tmp_path):
 def test_same_seed_same_files_and_chunking_by_stream(tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
     for o in (a, b):
-        assert main(["run", str(BROWN), "--out", str(o), "--trials", "40", "--quiet",
-                     "--set", "chunk=16"]) == 0
-    for f in ("points.parquet", "claims.parquet", "trials/part-0/chunk-000001.parquet", "table1.png"):
+        assert (
+            main(
+                [
+                    "run",
+                    str(BROWN),
+                    "--out",
+                    str(o),
+                    "--trials",
+                    "40",
+                    "--quiet",
+                    "--set",
+                    "chunk=16",
+                ]
+            )
+            == 0
+        )
+    for f in (
+        "points.parquet",
+        "claims.parquet",
+        "trials/part-0/chunk-000001.parquet",
+        "table1.png",
+    ):
         assert (a / f).read_bytes() == (b / f).read_bytes(), f
     c = tmp_path / "c"
-    assert main(["run", str(BROWN), "--out", str(c), "--trials", "40", "--seed", "5",
-                 "--quiet", "--set", "chunk=16"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(BROWN),
+                "--out",
+                str(c),
+                "--trials",
+                "40",
+                "--seed",
+                "5",
+                "--quiet",
+                "--set",
+                "chunk=16",
+            ]
+        )
+        == 0
+    )
     ta = pq.read_table(a / "trials").column("pivot_sigma0_um").to_numpy()
     tc = pq.read_table(c / "trials").column("pivot_sigma0_um").to_numpy()
     assert not np.allclose(ta, tc)
 
 
 def test_python_dash_m_entry_point(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "sim", "check", str(BROWN)], capture_output=True,
-                       text=True, cwd=ROOT)
+    r = subprocess.run(
+        [sys.executable, "-m", "sim", "check", str(BROWN)], capture_output=True, text=True, cwd=ROOT
+    )
     assert r.returncode == 0 and "plate.spacing_mm = 45.0" in r.stdout
 
 
 # --- nothing the suite did not write is replaced; one-line option errors -------------------
+
 
 def _run(tmp_path, out, *extra):
     p = write(tmp_path, BASE, "ok.toml")
@@ -188,16 +255,19 @@ def test_an_empty_directory_and_our_own_results_are_replaced(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.toml", "res"]
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["--out", ""], "--out: is empty"),
-    (["--trials", "2.5"], "invalid int value: '2.5'"),
-    (["--workers", "0"], "--workers"),
-    (["--scheduler", "not an address", "--executor", "dask"], "--scheduler"),
-    (["--scheduler", "tcp://127.0.0.1:8786"], "needs --executor dask"),
-    (["--trials", "20", "--set", "chunk=20"], "at least 2 chunks"),
-    (["--max-memory-gb", "nan"], "--max-memory-gb"),
-    (["--bogus"], "unrecognized arguments"),
-])
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--out", ""], "--out: is empty"),
+        (["--trials", "2.5"], "invalid int value: '2.5'"),
+        (["--workers", "0"], "--workers"),
+        (["--scheduler", "not an address", "--executor", "dask"], "--scheduler"),
+        (["--scheduler", "tcp://127.0.0.1:8786"], "needs --executor dask"),
+        (["--trials", "20", "--set", "chunk=20"], "at least 2 chunks"),
+        (["--max-memory-gb", "nan"], "--max-memory-gb"),
+        (["--bogus"], "unrecognized arguments"),
+    ],
+)
 def test_option_errors_are_one_line(tmp_path, capsys, args, needle):
     p = write(tmp_path, BASE, "ok.toml")
     argv = ["run", str(p), "--quiet", *args]
@@ -214,7 +284,7 @@ def test_a_live_lock_stops_a_second_run_and_overwrite(tmp_path, capsys):
     without --overwrite, stops at once naming the holder, and removes nothing."""
     import os
 
-    from sim.storage import StageLock
+    from sim.mc.storage import StageLock
 
     out = tmp_path / "res"
     stage = tmp_path / ".res.partial"
@@ -232,8 +302,9 @@ def test_a_live_lock_stops_a_second_run_and_overwrite(tmp_path, capsys):
     assert _run(tmp_path, out) == 0 and (out / "claims.parquet").is_file()
 
 
-def test_a_failed_run_says_where_and_does_not_block_the_corrected_command(tmp_path, capsys,
-                                                                          monkeypatch):
+def test_a_failed_run_says_where_and_does_not_block_the_corrected_command(
+    tmp_path, capsys, monkeypatch
+):
     import dataclasses
 
     import sim.studies as studies
@@ -244,12 +315,13 @@ def test_a_failed_run_says_where_and_does_not_block_the_corrected_command(tmp_pa
         st = real(name)
 
         def run(cfg, out, ctx):
-            from sim.runner import ChunkStore
+            from sim.mc.runner import ChunkStore
 
             ChunkStore(out / "trials").save(0, 0, 2, {"x": np.zeros(2)})  # one finished chunk
             if cfg["errors.settings"] == 2:
                 raise np.linalg.LinAlgError("SVD did not converge")
             return st.run(cfg, out, ctx)
+
         return dataclasses.replace(st, run=run)
 
     monkeypatch.setattr(studies, "get_study", failing)
@@ -257,7 +329,7 @@ def test_a_failed_run_says_where_and_does_not_block_the_corrected_command(tmp_pa
     assert _run(tmp_path, out, "--set", "errors.settings=2") == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "LinAlgError: SVD did not converge" in err[0], err
-    assert (tmp_path / ".res.partial" / "run.json").is_file()    # kept: it holds a chunk
+    assert (tmp_path / ".res.partial" / "run.json").is_file()  # kept: it holds a chunk
     monkeypatch.setattr(studies, "get_study", real)
-    assert _run(tmp_path, out, "--set", "errors.settings=3") == 0   # corrected: replaces it
+    assert _run(tmp_path, out, "--set", "errors.settings=3") == 0  # corrected: replaces it
     assert not (tmp_path / ".res.partial").exists()

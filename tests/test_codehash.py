@@ -1,7 +1,8 @@
 """Staleness per study: a study's code hash covers the modules it imports, and only those."""
+
 from pathlib import Path
 
-from sim.codehash import study_files
+from sim.mc.codehash import study_files
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -12,10 +13,11 @@ def names(study):
 
 def test_closure_follows_imports_and_stops_there():
     brown, wolf = names("brown_table1"), names("wolf_polynomial")
-    assert "multilateration.py" in brown and "polynomial.py" in wolf
-    assert "polynomial.py" not in brown        # Brown does not import the Wolf model
-    assert not any(f.startswith("bench/") for f in brown | wolf)  # the benchmark is not study code
-    assert "claims.py" in brown and "storage.py" in wolf
+    assert "instruments/ranges/multilateration.py" in brown
+    assert "instruments/plotter/polynomial.py" in wolf
+    assert "instruments/plotter/polynomial.py" not in brown  # Brown does not import the Wolf model
+    assert "report/verify.py" not in brown | wolf  # the verification is not study code
+    assert "claims/book.py" in brown and "mc/storage.py" in wolf
 
 
 def test_every_study_has_its_own_closure():
@@ -27,13 +29,15 @@ def test_every_study_has_its_own_closure():
 
 def test_results_are_current_until_the_config_changes(tmp_path):
     from sim.cli import main
-    from sim.codehash import is_current
+    from sim.mc.codehash import is_current
 
     text = (ROOT / "studies" / "brown_table1.toml").read_text()
     study = tmp_path / "brown_table1.toml"
-    study.write_text(text.replace("trials = ", "trials = 40 # ", 1).replace("chunk = ", "chunk = 20 # ", 1))
+    study.write_text(
+        text.replace("trials = ", "trials = 40 # ", 1).replace("chunk = ", "chunk = 20 # ", 1)
+    )
     out = tmp_path / "out"
-    assert not is_current(study, out)                       # nothing there yet
+    assert not is_current(study, out)  # nothing there yet
     assert main(["run", str(study), "--out", str(out), "--quiet"]) == 0
     assert is_current(study, out)
     study.write_text(study.read_text().replace("seed = ", "seed = 11 # ", 1))
@@ -43,24 +47,33 @@ def test_results_are_current_until_the_config_changes(tmp_path):
 def test_import_lines_are_read_in_every_form(tmp_path, monkeypatch):
     """Relative and absolute imports, aliases, lists over several lines, imports inside
     functions, comments; ``from __future__`` and other packages are not ``sim`` code."""
-    import sim.codehash as ch
+    import sim.mc.codehash as ch
 
     pkg = tmp_path / "sim" / "studies" / "demo"
     pkg.mkdir(parents=True)
     f = pkg / "run.py"
     f.write_text(
         "from __future__ import annotations\n"
-        "import numpy as np, sim.heap as hp  # a comment\n"
-        "from ... import (errorfields as ef,  # the fields\n"
-        "                 plate,\n"
+        "import numpy as np, sim.mc.heap as hp  # a comment\n"
+        "from ...instruments.plotter import (errorfields as ef,  # the fields\n"
+        "                 polynomial,\n"
         ")\n"
         "from .model import Instrument\n"
         "from ...lsq.linear import \\\n    lstsq\n"
         "def f():\n"
-        "    from ... import storage\n"
-        "x = 'import os'  # not at a line's start: not an import\n")
+        "    from ...mc import storage\n"
+        "x = 'import os'  # not at a line's start: not an import\n"
+    )
     monkeypatch.setattr(ch, "ROOT", tmp_path / "sim")
     assert ch._imports(f) == {
-        "sim.heap", "sim", "sim.errorfields", "sim.plate", "sim.studies.demo.model",
-        "sim.studies.demo.model.Instrument", "sim.lsq.linear", "sim.lsq.linear.lstsq",
-        "sim.storage"}
+        "sim.mc.heap",
+        "sim.instruments.plotter",
+        "sim.instruments.plotter.errorfields",
+        "sim.instruments.plotter.polynomial",
+        "sim.studies.demo.model",
+        "sim.studies.demo.model.Instrument",
+        "sim.lsq.linear",
+        "sim.lsq.linear.lstsq",
+        "sim.mc",
+        "sim.mc.storage",
+    }

@@ -1,13 +1,14 @@
 """P-position multilateration and the datum: S-transformations are datum-invariant."""
+
 import numpy as np
 import pytest
 
-from sim import datum as dm
 from sim import lsq
-from sim import multilateration as ml
-from sim import positions as po
-from sim.intervals import std_rel_se
-from sim.plate import grid_points
+from sim.claims.intervals import std_rel_se
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import multilateration as ml
+from sim.instruments.ranges import positions as po
+from sim.lsq import datum as dm
 
 H = 122.5 + 45.0
 PTS = grid_points(5, 55.0)
@@ -28,7 +29,7 @@ def test_four_positions_in_browns_datum_equal_multilateration(model):
     rng = np.random.default_rng(3)
     r = ml.ranges(batch(PTS, 20), batch(th7, 20)) + rng.normal(0, 1e-3, (20, 25, 4))
     t7 = th7.copy()
-    t7[5:ml.MODELS[model]] = 0.0
+    t7[5 : ml.MODELS[model]] = 0.0
     a = ml.adjust(r, model, t7)
     b = po.adjust(r, model, po.from_brown_theta(t7), "brown")
     assert a.converged.all() and b.converged.all()
@@ -42,9 +43,9 @@ def test_s_transformed_covariance_is_the_same_from_any_datum(model, target):
     th = po.design_theta(4, H, 0.5, 1.0)[None]
     Fb = po.full_point_covariance(PTS[None], th, model, "brown")[0]
     Fi = po.full_point_covariance(PTS[None], th, model, "inner")[0]
-    assert np.abs(Fb - Fi).max() > 1e-2          # the datums really differ ...
+    assert np.abs(Fb - Fi).max() > 1e-2  # the datums really differ ...
     S = dm.inner(PTS) if target == "inner" else dm.similarity_onto(PTS, dm.corner_indices(PTS))
-    assert np.allclose(S @ Fb @ S.T, S @ Fi @ S.T, atol=1e-12)   # ... the S-transform does not
+    assert np.allclose(S @ Fb @ S.T, S @ Fi @ S.T, atol=1e-12)  # ... the S-transform does not
     # minimum trace of the inner-constraint datum
     Si = dm.inner(PTS)
     assert np.trace(Si @ Fb @ Si.T) < np.trace(Fb)
@@ -86,7 +87,7 @@ def test_p_positions_noise_free_recovery(P):
     r = po.ranges(batch(PTS, T), batch(th, T))
     t0 = th.copy()
     t0[-2:] = 0.0
-    t0[:2 * P] += np.tile([0.8, -0.5], P)  # a poor start (in the inner datum's frame)
+    t0[: 2 * P] += np.tile([0.8, -0.5], P)  # a poor start (in the inner datum's frame)
     res = po.adjust(r, "pivot", t0, "inner")
     assert res.converged.all()
     assert np.abs(res.residuals).max() < 1e-9
@@ -108,10 +109,12 @@ def test_p_positions_monte_carlo_matches_analytic(P):
     assert res.converged.all()
     S = dm.inner(PTS)
     e = (res.points - PTS).reshape(T, -1) @ S.T * 1e3
-    an = np.sqrt(np.diag(S @ po.full_point_covariance(PTS[None], th[None], "pivot", "inner")[0] @ S.T))
+    an = np.sqrt(
+        np.diag(S @ po.full_point_covariance(PTS[None], th[None], "pivot", "inner")[0] @ S.T)
+    )
     ratio = e.std(0, ddof=1) / an
     assert np.all(np.abs(ratio - 1) < 4.5 * std_rel_se(T))
-    assert abs(np.mean(res.sigma0 ** 2) * 1e6 - 1) < 4 * np.sqrt(2 / res.dof / T)
+    assert abs(np.mean(res.sigma0**2) * 1e6 - 1) < 4 * np.sqrt(2 / res.dof / T)
 
 
 def test_brown_datum_needs_four_stations():
@@ -120,7 +123,8 @@ def test_brown_datum_needs_four_stations():
 
 
 def test_result_in_datum_and_coverage_use_the_engine_result():
-    from sim import coverage as cv
+    from sim.instruments.ranges import coverage as cv
+
     T = 400
     rng = np.random.default_rng(21)
     pts = grid_points(4, 60.0)
@@ -141,7 +145,7 @@ def test_sparse_and_compiled_reduced_normals_equal_the_dense_jacobians(P, brown)
     """RangeModel's own reduced normals (compiled, and the NumPy blocks) are the engine's
     reduction of the dense Jacobian to 1e-12 relative, for any free set, with and without
     readings; the adjustment gives the same solution and status."""
-    from sim import multilateration as ml
+    from sim.instruments.ranges import multilateration as ml
     from sim.lsq import normals as nm
 
     rng = np.random.default_rng(P)
@@ -159,8 +163,10 @@ def test_sparse_and_compiled_reduced_normals_equal_the_dense_jacobians(P, brown)
         for free in (np.arange(q), np.arange(0), np.arange(q - 2), np.array([0, 2, 3])):
             lin = m.linearize(pts, TH, True)
             ref = nm.reduce(lin.r, lin.Jp, lin.Jg[..., free] if len(free) else None)
-            for red in (m.reduced(pts, TH, free),
-                        nm.reduce_blocks(*m.normal_blocks(pts, TH, free))):
+            for red in (
+                m.reduced(pts, TH, free),
+                nm.reduce_blocks(*m.normal_blocks(pts, TH, free)),
+            ):
                 assert np.array_equal(red.ok, ref.ok)
                 for f in ("Ninv", "K", "Nbar", "ubar", "dp0"):
                     a, b = getattr(red, f), getattr(ref, f)
@@ -171,7 +177,12 @@ def test_sparse_and_compiled_reduced_normals_equal_the_dense_jacobians(P, brown)
         t0 = th.copy()
         t0[-2:] = 0.0
         a = po.adjust(r, "pivot", t0, "inner")
-        b = lsq.gauss_newton(po.RangeModel(r, dense=True), np.broadcast_to(t0, TH.shape),
-                             None, po._datum(TH, P, "pivot", "inner"), engine="numpy")
+        b = lsq.gauss_newton(
+            po.RangeModel(r, dense=True),
+            np.broadcast_to(t0, TH.shape),
+            None,
+            po._datum(TH, P, "pivot", "inner"),
+            engine="numpy",
+        )
         assert np.array_equal(a.status, b.status)
         assert np.abs(a.points - b.points).max() < 1e-11

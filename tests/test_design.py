@@ -1,5 +1,6 @@
 """brown_design: sweeps, adaptive trial counts, error budget, design constraints, coverage,
 claim book, consistent set."""
+
 import pickle
 from functools import partial
 from pathlib import Path
@@ -7,14 +8,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim import budget, coverage as cv, datum as dm, positions as po
 from sim.cli import main
-from sim.config import ConfigError, validate
-from sim.plate import grid_points
-from sim.runner import run_chunks
-from sim.storage import read_provenance, read_table
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import budget
+from sim.instruments.ranges import coverage as cv
+from sim.instruments.ranges import positions as po
+from sim.lsq import datum as dm
+from sim.mc.config import ConfigError, validate
+from sim.mc.runner import run_chunks
+from sim.mc.storage import read_provenance, read_table
+from sim.mc.sweep import cell_seed, expand, run_adaptive
 from sim.studies import design
-from sim.sweep import cell_seed, expand, run_adaptive
 
 TABLE1 = """study = "brown_table1"
 trials = {trials}
@@ -33,15 +37,28 @@ def test_sweep_of_one_cell_equals_the_single_run_with_the_same_seed(tmp_path):
     single.write_text(TABLE1.format(trials=20))
     for mode in ("common", "spawn"):
         sw = tmp_path / f"sweep_{mode}.toml"
-        sw.write_text(TABLE1.format(trials=20) + f'\n[sweep]\nseed_mode = "{mode}"\n'
-                      '"errors.settings" = [2]\n')
+        sw.write_text(
+            TABLE1.format(trials=20) + f'\n[sweep]\nseed_mode = "{mode}"\n"errors.settings" = [2]\n'
+        )
         assert main(["run", str(sw), "--out", str(tmp_path / f"sw_{mode}"), "--quiet"]) == 0
         rows = read_table(tmp_path / f"sw_{mode}" / "sweep.parquet").to_pydict()
         assert rows["cell"] == [0] and rows["feasible"] == [True]
         seed = rows["seed"][0]
         assert seed == (77 if mode == "common" else cell_seed(77, 0, 0))
-        assert main(["run", str(single), "--out", str(tmp_path / f"one_{mode}"), "--seed",
-                     str(seed), "--quiet"]) == 0
+        assert (
+            main(
+                [
+                    "run",
+                    str(single),
+                    "--out",
+                    str(tmp_path / f"one_{mode}"),
+                    "--seed",
+                    str(seed),
+                    "--quiet",
+                ]
+            )
+            == 0
+        )
         a = _claims(tmp_path / f"sw_{mode}" / "cells" / "cell0000_r0" / "claims.parquet")
         b = _claims(tmp_path / f"one_{mode}" / "claims.parquet")
         assert a == b
@@ -50,14 +67,16 @@ def test_sweep_of_one_cell_equals_the_single_run_with_the_same_seed(tmp_path):
 
 def test_sweep_records_infeasible_cells_with_the_reason(tmp_path):
     sw = tmp_path / "sw.toml"
-    sw.write_text(TABLE1.format(trials=20) + '\n[sweep]\nreplicates = 2\n[sweep.plate]\n'
-                  'spacing_mm = [45.0, 80.0]\n')
+    sw.write_text(
+        TABLE1.format(trials=20) + "\n[sweep]\nreplicates = 2\n[sweep.plate]\n"
+        "spacing_mm = [45.0, 80.0]\n"
+    )
     assert main(["run", str(sw), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     rows = read_table(tmp_path / "o" / "sweep.parquet").to_pydict()
     assert rows["plate.spacing_mm"] == [45.0, 45.0, 80.0, 80.0]
     assert rows["feasible"] == [True, True, False, False]
     assert "outside the 245 mm format" in rows["reason"][2]
-    assert rows["seed"][0] != rows["seed"][1]          # replicates: independent streams
+    assert rows["seed"][0] != rows["seed"][1]  # replicates: independent streams
     assert not (tmp_path / "o" / "cells" / "cell0001_r0").exists()
     assert read_provenance(tmp_path / "o" / "sweep.parquet")["sweep_keys"] == ["plate.spacing_mm"]
 
@@ -70,8 +89,13 @@ def test_sweep_table_errors_name_the_key(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
     with pytest.raises(ConfigError, match="sweep.x"):
         expand({"x": {"start": 0, "stop": 1}})
-    keys, cells, reps, mode = expand({"a": {"start": 1, "stop": 2, "num": 3},
-                                      "b": {"start": 2, "stop": 8, "step": 3}, "replicates": 2})
+    keys, cells, reps, mode = expand(
+        {
+            "a": {"start": 1, "stop": 2, "num": 3},
+            "b": {"start": 2, "stop": 8, "step": 3},
+            "replicates": 2,
+        }
+    )
     assert keys == ["a", "b"] and reps == 2 and mode == "spawn"
     assert [c["a"] for c in cells] == [1.0, 1.0, 1.0, 1.5, 1.5, 1.5, 2.0, 2.0, 2.0]
     assert [c["b"] for c in cells[:3]] == [2, 5, 8]
@@ -120,7 +144,9 @@ def test_graduation_error_is_shared_by_readings_on_one_graduation():
     r = np.random.default_rng(1).uniform(0, 261, (400, 50))
     big = budget.graduation_error(r, np.random.default_rng(2), 0.54)
     # one draw per (trial, graduation): those are the independent samples of the std
-    first = np.unique(np.floor(r).astype(int) + 1000 * np.arange(400)[:, None], return_index=True)[1]
+    first = np.unique(np.floor(r).astype(int) + 1000 * np.arange(400)[:, None], return_index=True)[
+        1
+    ]
     g = big.ravel()[first]
     assert abs(g.std() / 0.54 - 1) < 4 / np.sqrt(2 * (g.size - 1))
 
@@ -157,19 +183,23 @@ def test_paper_design_must_be_in_the_grid_and_fit_its_hardware():
     with pytest.raises(ConfigError, match="unprinted.zeiss_extents_mm"):
         validate({"unprinted.zeiss_extents_mm": [20.0, 90.0]}, design.SCHEMA, design.check)
     with pytest.raises(ConfigError, match="design.offsets_mm"):
-        validate({"design.offsets_mm": list(np.arange(1.0, 2001.0) / 2)}, design.SCHEMA,
-                 design.check)
+        validate(
+            {"design.offsets_mm": list(np.arange(1.0, 2001.0) / 2)}, design.SCHEMA, design.check
+        )
 
 
 def test_chunk_functions_pickle_and_give_the_same_chunks():
     from sim.studies.design import chunks
+
     cfg = validate({}, design.SCHEMA, design.check)
     pts = grid_points(4, 60.0)
     th = po.design_theta(4, 152.5, 0.5, 1.0)
     bcfg = {k: v for k, v in cfg.items() if k.startswith("budget.")}
     bcfg["comparator.sigma_um"] = 1.1
-    for fn in (partial(chunks.design_chunk, pts, th, 1.4),
-               partial(chunks.budget_chunk, bcfg, pts, th, ("scale", "screw"), 1.7, 2)):
+    for fn in (
+        partial(chunks.design_chunk, pts, th, 1.4),
+        partial(chunks.budget_chunk, bcfg, pts, th, ("scale", "screw"), 1.7, 2),
+    ):
         back = pickle.loads(pickle.dumps(fn))
         a = run_chunks(fn, 30, 3, 10, quiet=True)
         b = run_chunks(back, 30, 3, 10, quiet=True)
@@ -177,7 +207,7 @@ def test_chunk_functions_pickle_and_give_the_same_chunks():
 
 
 def test_adaptive_loop_runs_through_the_runner_and_reuses_chunks(tmp_path):
-    from sim.runner import ChunkStore
+    from sim.mc.runner import ChunkStore
     from sim.studies import RunContext
     from sim.studies.design.adaptive import run_adaptive as adaptive
 
@@ -187,18 +217,21 @@ def test_adaptive_loop_runs_through_the_runner_and_reuses_chunks(tmp_path):
 
     fn = partial(_normal_chunk, 1.0)
     ctx = RunContext(quiet=True, store=ChunkStore(tmp_path / "trials"))
-    res, st = adaptive(fn, stat, 0.02, seed=5, chunk=500, part=3, min_trials=1000,
-                       max_trials=50_000, ctx=ctx)
+    res, st = adaptive(
+        fn, stat, 0.02, seed=5, chunk=500, part=3, min_trials=1000, max_trials=50_000, ctx=ctx
+    )
     n = len(res["x"])
     assert st["mean"][1] < 0.02 and n % 500 == 0 and n < 5000
     assert len(list((tmp_path / "trials" / "part-3").glob("chunk-*.parquet"))) == n // 500
     assert np.array_equal(run_chunks(fn, n, 5, 500, part=3, quiet=True)["x"], res["x"])
-    res2, _ = adaptive(fn, stat, 0.02, seed=5, chunk=500, part=3, min_trials=1000,
-                       max_trials=50_000)          # no store: a temporary one
+    res2, _ = adaptive(
+        fn, stat, 0.02, seed=5, chunk=500, part=3, min_trials=1000, max_trials=50_000
+    )  # no store: a temporary one
     assert np.array_equal(res2["x"], res["x"])
-    capped, st = adaptive(fn, stat, 1e-6, seed=5, chunk=500, part=3, min_trials=500,
-                          max_trials=1700)
-    assert len(capped["x"]) == 1500 and st["mean"][1] > 1e-6   # stops at whole chunks
+    capped, st = adaptive(
+        fn, stat, 1e-6, seed=5, chunk=500, part=3, min_trials=500, max_trials=1700
+    )
+    assert len(capped["x"]) == 1500 and st["mean"][1] > 1e-6  # stops at whole chunks
 
 
 def _normal_chunk(scale, rng, n):
@@ -207,9 +240,10 @@ def _normal_chunk(scale, rng, n):
 
 def test_tolerances_of_the_calibration_section_are_analytic():
     from sim.studies.design import external as ex
+
     cfg = validate({}, design.SCHEMA, design.check)
     t = ex.tolerances(cfg, 50.0, 0.5)
-    assert t["lateral_error_um"] == pytest.approx(0.1 ** 2 / (2 * 50.0) * 1e3)   # 0.1 um
+    assert t["lateral_error_um"] == pytest.approx(0.1**2 / (2 * 50.0) * 1e3)  # 0.1 um
     assert t["linearity_tol_um"] == pytest.approx(np.sqrt(2 * 50.0 * 1e-3) * 1e3)
     assert t["axis_tilt_deg"] == pytest.approx(np.degrees(np.arctan(0.01)))
     assert t["drum_graduation_um"] == pytest.approx(15 / 1296000 * 500)
@@ -220,20 +254,22 @@ def test_tolerances_of_the_calibration_section_are_analytic():
 
 def test_linearised_plate_rms_matches_its_covariance():
     from sim.studies.design import external as ex
+
     cfg = validate({"unprinted.plates": 20000}, design.SCHEMA, design.check)
     pts = ex.paper_points(cfg)
     a, b = ex.plate_rms(cfg, pts, 30.0, 1.0, 1.0, 0.8, 91)
     F = po.full_point_covariance(pts[None], ex._theta(cfg, 30.0, 1.0)[None], "pivot", "inner")[0]
     S = dm.s_matrix(dm.null_basis(pts))
     ms = np.trace(S @ F @ S.T) / (2 * len(pts))
-    se = (a ** 2).std() / np.sqrt(len(a))
-    assert abs((a ** 2).mean() - ms) < 4 * se
-    extra = 0.8 ** 2 * (2 * len(pts) - 3) / (2 * len(pts))      # the fit removes 3 of 2n
-    assert abs((b ** 2).mean() - ms - extra) < 4 * (b ** 2).std() / np.sqrt(len(b))
+    se = (a**2).std() / np.sqrt(len(a))
+    assert abs((a**2).mean() - ms) < 4 * se
+    extra = 0.8**2 * (2 * len(pts) - 3) / (2 * len(pts))  # the fit removes 3 of 2n
+    assert abs((b**2).mean() - ms - extra) < 4 * (b**2).std() / np.sqrt(len(b))
 
 
 def test_claim_book_classes_the_datum_and_emcee_rows():
     from sim.studies.design.claims import load_book
+
     book = load_book()
     for cid, s in book.specs.items():
         if cid.startswith("brown.datum."):
@@ -252,18 +288,23 @@ def test_tiny_run_end_to_end(tmp_path):
     V = dict(zip(cl["claim"], cl["verdict"]))
     assert all(V[c] == "finding" for c in V if c.startswith("brown.datum."))
     assert all(V[c] == "self-check" for c in V if c.startswith("bayes.brown_agreement."))
-    assert V["brown.calibration.scale_combined_um"] == "holds"     # a paper-check
+    assert V["brown.calibration.scale_combined_um"] == "holds"  # a paper-check
     assert not any(v is None for v in cl["verdict"])
     tol = read_provenance(out / "claims.parquet")["tolerances"]
     assert 0 < tol["bayes.parquet"]["ratio"] < 0.5 and "value" in tol["claims.parquet"]
     cs = read_table(out / "consistent_set.parquet").to_pydict()
     assert {"input", "claim", "holds_low", "holds_high"} <= set(cs)
-    assert set(cs["input"]) >= {"paper.offset_mm", "paper.beta_mm", "time.pass_min",
-                                "zeiss.half_extent_mm", "budget.pitch_mm"}
+    assert set(cs["input"]) >= {
+        "paper.offset_mm",
+        "paper.beta_mm",
+        "time.pass_min",
+        "zeiss.half_extent_mm",
+        "budget.pitch_mm",
+    }
     assert cs["claim"].count("ALL") == len(set(cs["input"]))
     sv = read_table(out / "sweep_values.parquet").to_pydict()
     hmax = dict(zip(cl["claim"], cl["value"]))["brown.design.max_offset_paper_grid_mm"]
-    for i, x, v in zip(sv["input"], sv["value"], sv["verdict"]):   # hardware decides
+    for i, x, v in zip(sv["input"], sv["value"], sv["verdict"]):  # hardware decides
         if i == "paper.offset_mm" and x > hmax:
             assert v == "infeasible"
     for f in ("pareto.png", "consistent_set.png", "corner.png"):
@@ -283,22 +324,27 @@ def test_coverage_of_a_linear_models_ellipses_is_95_percent():
     per_trial = inside.mean(1)
     se = per_trial.std(ddof=1) / np.sqrt(T)
     assert abs(per_trial.mean() - 0.95) < 4 * se
-    inside_f = cv.ellipse_inside(r["err_um"], np.broadcast_to(Q, (16, 2, 2)), s0=r["s0_um"],
-                                 dof=r["dof"]).mean(1)
+    inside_f = cv.ellipse_inside(
+        r["err_um"], np.broadcast_to(Q, (16, 2, 2)), s0=r["s0_um"], dof=r["dof"]
+    ).mean(1)
     assert abs(inside_f.mean() - 0.95) < 4 * inside_f.std(ddof=1) / np.sqrt(T)
     rej = cv.chi2_reject(r["s0_um"], 1.5, r["dof"], 0.05)
     assert abs(rej.mean() - 0.05) < 4 * np.sqrt(0.05 * 0.95 / T)
-    assert abs(r["s0_um"].mean() / 1.5 - cv.c4(r["dof"] + 1)) < 4 * r["s0_um"].std() / 1.5 / np.sqrt(T)
+    assert abs(r["s0_um"].mean() / 1.5 - cv.c4(r["dof"] + 1)) < 4 * r[
+        "s0_um"
+    ].std() / 1.5 / np.sqrt(T)
     # a wrong (too small) sigma is detected: coverage falls well below 95 %
     assert cv.ellipse_inside(r["err_um"], np.broadcast_to(Q, (16, 2, 2)), sigma=1.0).mean() < 0.85
 
 
 def test_sweep_rows_draw_and_tabulate(tmp_path):
-    from sim.sweep import sweep_markdown
+    from sim.mc.sweep import sweep_markdown
 
     sw = tmp_path / "sw.toml"
-    sw.write_text(TABLE1.format(trials=20) + '\n[sweep]\n"errors.settings" = [1, 2]\n'
-                  '"plate.spacing_mm" = [45.0, 80.0]\n')
+    sw.write_text(
+        TABLE1.format(trials=20) + '\n[sweep]\n"errors.settings" = [1, 2]\n'
+        '"plate.spacing_mm" = [45.0, 80.0]\n'
+    )
     assert main(["run", str(sw), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     assert (tmp_path / "o" / "sweep.png").is_file()
     md = sweep_markdown(tmp_path / "o")

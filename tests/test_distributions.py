@@ -1,11 +1,12 @@
-"""sim.distributions equals scipy.stats (which it replaces to save a second of import per
-process), and sim.intervals keeps the coverage of its intervals."""
+"""sim.lsq.distributions equals scipy.stats (which it replaces to save a second of import per
+process), and sim.claims.intervals keeps the coverage of its intervals."""
+
 import numpy as np
 import pytest
 from scipy import stats
 
-from sim import distributions as D
-from sim.intervals import sd_interval, std_ci
+from sim.claims.intervals import sd_interval, std_ci
+from sim.lsq import distributions as D
 
 
 @pytest.mark.parametrize("df", [1, 2, 3, 7.5, 49, 400])

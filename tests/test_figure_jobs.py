@@ -1,17 +1,18 @@
 """Figures drawn in the run's own process never overlap: matplotlib is not thread-safe, and a
 study may run its parts in threads (brown_design with a remote Dask scheduler drew two
 figures at once and failed in matplotlib's text parser)."""
+
 import threading
 import time
 
-from sim import figure_jobs
+from sim.report import figure_jobs
 
 EVENTS = []
 
 
 def _job(name):
     EVENTS.append(("in", name))
-    time.sleep(0.05)        # long enough for the other thread to start its figure
+    time.sleep(0.05)  # long enough for the other thread to start its figure
     EVENTS.append(("out", name))
 
 
@@ -29,6 +30,6 @@ def test_figures_drawn_here_from_two_threads_do_not_overlap():
     for t in threads:
         t.join()
     assert len(EVENTS) == 8
-    for k in range(0, 8, 2):                      # every figure ends before the next begins
+    for k in range(0, 8, 2):  # every figure ends before the next begins
         assert EVENTS[k][0] == "in" and EVENTS[k + 1] == ("out", EVENTS[k][1])
     assert not figure_jobs.DRAWING.locked()

@@ -14,6 +14,7 @@ nothing outside the output directory but, after a failed run, its staging direct
 ``FUZZ_SAVE`` a directory that keeps the study file of every failing case (the failure
 message prints the command that reproduces it).
 """
+
 from __future__ import annotations
 
 import json
@@ -31,7 +32,7 @@ import numpy as np
 import pytest
 
 from sim.cli import main
-from sim.config import _flatten, load_study
+from sim.mc.config import _flatten, load_study
 
 ROOT = Path(__file__).resolve().parent.parent
 CASES = int(os.environ.get("FUZZ_CASES", "14"))
@@ -40,42 +41,145 @@ TIMEOUT = float(os.environ.get("FUZZ_TIMEOUT", "300"))
 
 #: each study shrunk to a run of a few seconds (keys that the mutations then perturb)
 SMALL = {
-    "brown_dilution": {"trials": 8, "chunk": 4, "dilution.grids": [3, 5],
-                       "consistency.offset_step_mm": 10.0, "consistency.extents_mm": [90.0]},
+    "brown_dilution": {
+        "trials": 8,
+        "chunk": 4,
+        "dilution.grids": [3, 5],
+        "consistency.offset_step_mm": 10.0,
+        "consistency.extents_mm": [90.0],
+    },
     "brown_table1": {"trials": 8, "chunk": 4},
-    "brown_design": {"trials": 8, "chunk": 4, "design.positions": [4], "design.offsets_mm": [30.0],
-                     "design.grids": [5], "design.extents_mm": [90.0], "design.settings": [2],
-                     "design.setting_sigma_um": [1.7], "design.beta_mm": [1.0],
-                     "budget.max_trials": 40, "coverage.trials": 10, "coverage.sweep_trials": 10,
-                     "coverage.noise_um": [1.0], "coverage.grids": [3], "coverage.betas_mm": [1.0],
-                     "bayes.walkers": 16, "bayes.steps": 100},
-    "gridplate_two_plates": {"trials": 8, "chunk": 4, "analysis.ratios": [1.0],
-                             "analysis.stated_sigmas_um": [0.7]},
-    "salsig_encoders": {"trials": 8, "chunk": 4, "power.trials": 10, "power.marks": [3],
-                        "power.sigma_um": [5.0], "consistency.trials": 10,
-                        "consistency.relief_mm": [2.0], "consistency.sigma_z_um": [40.0],
-                        "consistency.control": [6], "consistency.b8_sigma_um": [25.0],
-                        "consistency.comparator_sigma_um": [3.0]},
-    "wolf_polynomial": {"trials": 8, "chunk": 4, "trade.trials": 4, "trade.degrees": [2, 3],
-                        "trade.spacings_mm": [20.0], "trade.n_sets": [3], "trade.readings": [3],
-                        "trade.pointing_sigmas_um": [7.0], "trade.ages_weeks": [1.0],
-                        "trade.drift_fractions": [0.25], "unprinted.trials": 4,
-                        "unprinted.pointing_sigmas_um": [7.0], "unprinted.field_scales": [1.0],
-                        "unprinted.mono_sigmas_um": [0.0]},
-    "agnard_block": {"trials": 8, "chunk": 4, "tradeoff.dpis": [600.0], "tradeoff.trials": 4,
-                     "tradeoff.block_strips": [2], "tradeoff.block_models": [8],
-                     "tradeoff.recentre_px": [0.5], "tradeoff.block_trials": 4,
-                     "sweep.trials": 4, "sweep.five_inset": [0.0, 0.17]},
+    "brown_design": {
+        "trials": 8,
+        "chunk": 4,
+        "design.positions": [4],
+        "design.offsets_mm": [30.0],
+        "design.grids": [5],
+        "design.extents_mm": [90.0],
+        "design.settings": [2],
+        "design.setting_sigma_um": [1.7],
+        "design.beta_mm": [1.0],
+        "budget.max_trials": 40,
+        "coverage.trials": 10,
+        "coverage.sweep_trials": 10,
+        "coverage.noise_um": [1.0],
+        "coverage.grids": [3],
+        "coverage.betas_mm": [1.0],
+        "bayes.walkers": 16,
+        "bayes.steps": 100,
+    },
+    "gridplate_two_plates": {
+        "trials": 8,
+        "chunk": 4,
+        "analysis.ratios": [1.0],
+        "analysis.stated_sigmas_um": [0.7],
+    },
+    "salsig_encoders": {
+        "trials": 8,
+        "chunk": 4,
+        "power.trials": 10,
+        "power.marks": [3],
+        "power.sigma_um": [5.0],
+        "consistency.trials": 10,
+        "consistency.relief_mm": [2.0],
+        "consistency.sigma_z_um": [40.0],
+        "consistency.control": [6],
+        "consistency.b8_sigma_um": [25.0],
+        "consistency.comparator_sigma_um": [3.0],
+    },
+    "wolf_polynomial": {
+        "trials": 8,
+        "chunk": 4,
+        "trade.trials": 4,
+        "trade.degrees": [2, 3],
+        "trade.spacings_mm": [20.0],
+        "trade.n_sets": [3],
+        "trade.readings": [3],
+        "trade.pointing_sigmas_um": [7.0],
+        "trade.ages_weeks": [1.0],
+        "trade.drift_fractions": [0.25],
+        "unprinted.trials": 4,
+        "unprinted.pointing_sigmas_um": [7.0],
+        "unprinted.field_scales": [1.0],
+        "unprinted.mono_sigmas_um": [0.0],
+    },
+    "agnard_block": {
+        "trials": 8,
+        "chunk": 4,
+        "tradeoff.dpis": [600.0],
+        "tradeoff.trials": 4,
+        "tradeoff.block_strips": [2],
+        "tradeoff.block_models": [8],
+        "tradeoff.recentre_px": [0.5],
+        "tradeoff.block_trials": 4,
+        "sweep.trials": 4,
+        "sweep.five_inset": [0.0, 0.17],
+    },
 }
 NAMES = sorted(SMALL)
 
 NAN, INF = math.nan, math.inf
-SCALARS = [0, -1, 1, 2, 3, 7, 10**6, 10**9, 2**63 - 1, -2**63, 0.0, -0.0, -1.0, 0.5, 1.5, 1e-300,
-           1e-12, 1e-9, 1e6, 1e9, 1e155, 1e300, NAN, INF, -INF, True, False, "", "7", "1.0",
-           "π☃ü", "../../../etc/passwd", "/dev/zero", "/", "/tmp", "studies", "x" * 5000]
-LISTS = [[], [NAN], [INF], [-INF], [1e300], [1e-300], [0], [-1], [0.0], ["a"], [[1, 2]], [True],
-         [3] * 20000, [1.0] * 3, list(range(1, 60)), [2, 3, 3], ["π"], [[0.0, 0.0]] * 10,
-         [[NAN, 1.0]] * 4, [[1e300, 1e300], [0.0, 1.0], [1.0, 0.0]]]
+SCALARS = [
+    0,
+    -1,
+    1,
+    2,
+    3,
+    7,
+    10**6,
+    10**9,
+    2**63 - 1,
+    -(2**63),
+    0.0,
+    -0.0,
+    -1.0,
+    0.5,
+    1.5,
+    1e-300,
+    1e-12,
+    1e-9,
+    1e6,
+    1e9,
+    1e155,
+    1e300,
+    NAN,
+    INF,
+    -INF,
+    True,
+    False,
+    "",
+    "7",
+    "1.0",
+    "π☃ü",
+    "../../../etc/passwd",
+    "/dev/zero",
+    "/",
+    "/tmp",
+    "studies",
+    "x" * 5000,
+]
+LISTS = [
+    [],
+    [NAN],
+    [INF],
+    [-INF],
+    [1e300],
+    [1e-300],
+    [0],
+    [-1],
+    [0.0],
+    ["a"],
+    [[1, 2]],
+    [True],
+    [3] * 20000,
+    [1.0] * 3,
+    list(range(1, 60)),
+    [2, 3, 3],
+    ["π"],
+    [[0.0, 0.0]] * 10,
+    [[NAN, 1.0]] * 4,
+    [[1e300, 1e300], [0.0, 1.0], [1.0, 0.0]],
+]
 
 
 def toml_value(v) -> str:
@@ -84,7 +188,9 @@ def toml_value(v) -> str:
     if isinstance(v, int):
         return str(v)
     if isinstance(v, float):
-        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf") if math.isinf(v) else repr(v)
+        return (
+            "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf") if math.isinf(v) else repr(v)
+        )
     if isinstance(v, str):
         return json.dumps(v, ensure_ascii=False)
     if isinstance(v, list):
@@ -110,9 +216,9 @@ def small(name: str) -> dict:
         if k in schema:
             f = schema[k]
             short = isinstance(v, list) and len(v) < f.min_len and isinstance(f.default, list)
-            out[k] = f.default[:f.min_len] if short else v
+            out[k] = f.default[: f.min_len] if short else v
             if isinstance(v, (int, float)) and f.lo is not None and v < f.lo:
-                out[k] = type(v)(f.lo)   # the schema's smallest size
+                out[k] = type(v)(f.lo)  # the schema's smallest size
     return out
 
 
@@ -126,11 +232,14 @@ def base(name: str) -> dict:
 def mutate_value(rng: random.Random, old):
     r = rng.random()
     if r < 0.35 and isinstance(old, (int, float)) and not isinstance(old, bool) and old:
-        return type(old)(old * 10.0 ** rng.choice([-300, -12, -6, -3, 3, 6, 12, 155, 300])) \
-            if isinstance(old, float) else old * rng.choice([0, -1, 10, 1000, 10**6, 10**9])
+        return (
+            type(old)(old * 10.0 ** rng.choice([-300, -12, -6, -3, 3, 6, 12, 155, 300]))
+            if isinstance(old, float)
+            else old * rng.choice([0, -1, 10, 1000, 10**6, 10**9])
+        )
     if r < 0.5 and isinstance(old, list) and old:
         i = rng.randrange(len(old))
-        return old[:i] + [mutate_value(rng, old[i])] + old[i + 1:]
+        return old[:i] + [mutate_value(rng, old[i])] + old[i + 1 :]
     return rng.choice(LISTS if rng.random() < 0.4 else SCALARS)
 
 
@@ -151,13 +260,34 @@ def make_case(i: int):
         desc = ", ".join(f"{k}={toml_value(flat[k])[:60]}" for k in keys)
     elif kind == "set":
         k = rng.choice(schema)
-        text = rng.choice([toml_value(mutate_value(rng, flat.get(k, 1.0))), "[1, 2", "{a = 1}",
-                           "nan", "", "'π'", "0x10", "1e999", "[[]]"])
+        text = rng.choice(
+            [
+                toml_value(mutate_value(rng, flat.get(k, 1.0))),
+                "[1, 2",
+                "{a = 1}",
+                "nan",
+                "",
+                "'π'",
+                "0x10",
+                "1e999",
+                "[[]]",
+            ]
+        )
         extra += ["--set", f"{k}={text}"]
         desc = f"--set {k}={text[:60]}"
     elif kind == "structure":
-        what = rng.choice(["unknown", "study", "nostudy", "garbage", "empty", "unicode_key",
-                           "table_for_value", "huge_list"])
+        what = rng.choice(
+            [
+                "unknown",
+                "study",
+                "nostudy",
+                "garbage",
+                "empty",
+                "unicode_key",
+                "table_for_value",
+                "huge_list",
+            ]
+        )
         desc = what
         if what == "unknown":
             flat["bogus.key"] = 1
@@ -177,22 +307,34 @@ def make_case(i: int):
             flat[rng.choice(schema)] = [1.0] * 100_000
     elif kind == "sweep":
         k = rng.choice(schema)
-        rngv = rng.choice([
-            {"start": 1.0, "stop": NAN, "num": 2}, {"start": "a", "stop": 2, "num": 2},
-            {"start": 1.0, "stop": 2.0, "step": 1e-12}, {"start": 1, "stop": 2, "num": 5_000_000},
-            {"start": 1, "stop": 2, "num": 2}, {"start": 0.5, "stop": 1.5, "step": 0.5},
-            [flat.get(k, 1), mutate_value(rng, flat.get(k, 1))], [], {"start": 1}])
+        rngv = rng.choice(
+            [
+                {"start": 1.0, "stop": NAN, "num": 2},
+                {"start": "a", "stop": 2, "num": 2},
+                {"start": 1.0, "stop": 2.0, "step": 1e-12},
+                {"start": 1, "stop": 2, "num": 5_000_000},
+                {"start": 1, "stop": 2, "num": 2},
+                {"start": 0.5, "stop": 1.5, "step": 0.5},
+                [flat.get(k, 1), mutate_value(rng, flat.get(k, 1))],
+                [],
+                {"start": 1},
+            ]
+        )
         sweep = {k: rngv}
         if rng.random() < 0.3:
             sweep["replicates"] = rng.choice([0, 2, 3_000_000, "x"])
         desc = f"[sweep] {k} = {toml_value(rngv)[:80]}"
     else:
-        opt = rng.choice([["--trials", rng.choice(["0", "-1", "2.5", "abc", "1000000000", "1"])],
-                          ["--seed", rng.choice(["-1", str(2**70), "x", "0"])],
-                          ["--workers", rng.choice(["0", "-3", "1000000", "two"])],
-                          ["--scheduler", rng.choice(["foo", "tcp://", "tcp://h:99999", ""])],
-                          ["--max-memory-gb", rng.choice(["0", "nan", "-1", "1e-9"])],
-                          ["--out", rng.choice(["", "/", ".", "{file}", "π☃/ü", "x" * 300])]])
+        opt = rng.choice(
+            [
+                ["--trials", rng.choice(["0", "-1", "2.5", "abc", "1000000000", "1"])],
+                ["--seed", rng.choice(["-1", str(2**70), "x", "0"])],
+                ["--workers", rng.choice(["0", "-3", "1000000", "two"])],
+                ["--scheduler", rng.choice(["foo", "tcp://", "tcp://h:99999", ""])],
+                ["--max-memory-gb", rng.choice(["0", "nan", "-1", "1e-9"])],
+                ["--out", rng.choice(["", "/", ".", "{file}", "π☃/ü", "x" * 300])],
+            ]
+        )
         extra += opt
         desc = " ".join(opt)[:80]
     return name, flat, sweep, extra, f"{name}: {kind}: {desc}", raw
@@ -204,7 +346,7 @@ def run_case(case_dir: Path, study: Path, extra: list[str], timeout: float):
     argv = ["run", str(study), "--quiet"]
     if "--out" in extra:
         j = extra.index("--out")
-        extra = extra[:j + 1] + [extra[j + 1].replace("{file}", str(study))] + extra[j + 2:]
+        extra = extra[: j + 1] + [extra[j + 1].replace("{file}", str(study))] + extra[j + 2 :]
     else:
         argv += ["--out", str(out)]
     argv += extra
@@ -274,7 +416,7 @@ def check_case(case_dir: Path, code, err: str, extra) -> str | None:
     if left and "--out" not in extra:
         return f"left behind: {sorted(left)}"
     if code == 0 and "--out" not in extra:
-        from sim.storage import read_table
+        from sim.mc.storage import read_table
 
         out = case_dir / "out"
         for f in ("claims.parquet", "sweep.parquet"):
@@ -291,7 +433,9 @@ def check_case(case_dir: Path, code, err: str, extra) -> str | None:
 
 
 def fuzz(n: int, tmp: Path) -> list[str]:
-    before = sorted(p.name for p in (ROOT / "results").iterdir()) if (ROOT / "results").is_dir() else []
+    before = (
+        sorted(p.name for p in (ROOT / "results").iterdir()) if (ROOT / "results").is_dir() else []
+    )
     top = sorted(p.name for p in ROOT.iterdir())
     failures = []
     save = os.environ.get("FUZZ_SAVE")
@@ -309,10 +453,14 @@ def fuzz(n: int, tmp: Path) -> list[str]:
                 Path(save).mkdir(parents=True, exist_ok=True)
                 where = Path(save) / f"case{i:04d}.toml"
                 shutil.copy(study, where)
-            failures.append(f"case {i} ({desc}; {secs:.1f} s): {bad}\n    reproduce: sim "
-                            + argv.replace(str(study), str(where)))
+            failures.append(
+                f"case {i} ({desc}; {secs:.1f} s): {bad}\n    reproduce: sim "
+                + argv.replace(str(study), str(where))
+            )
         shutil.rmtree(d, ignore_errors=True)
-    after = sorted(p.name for p in (ROOT / "results").iterdir()) if (ROOT / "results").is_dir() else []
+    after = (
+        sorted(p.name for p in (ROOT / "results").iterdir()) if (ROOT / "results").is_dir() else []
+    )
     if after != before or sorted(p.name for p in ROOT.iterdir()) != top:
         failures.append("the repository gained or lost files")
     return failures
@@ -321,14 +469,17 @@ def fuzz(n: int, tmp: Path) -> list[str]:
 def test_fuzz_bases_run():
     """The tiny base of every study is valid (else the mutations test nothing)."""
     for name in NAMES:
-        load_study(ROOT / "studies" / f"{name}.toml",
-                   [f"{k}={toml_value(v)}" for k, v in small(name).items()])
+        load_study(
+            ROOT / "studies" / f"{name}.toml",
+            [f"{k}={toml_value(v)}" for k, v in small(name).items()],
+        )
 
 
 def test_fuzz(tmp_path):
     failures = fuzz(CASES, tmp_path)
-    assert not failures, f"{len(failures)} of {CASES} fuzz cases broke the contract:\n" + \
-        "\n".join(failures)
+    assert not failures, f"{len(failures)} of {CASES} fuzz cases broke the contract:\n" + "\n".join(
+        failures
+    )
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz

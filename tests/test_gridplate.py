@@ -1,14 +1,15 @@
 """Seed 001: combined adjustment with weighted grid coordinates, precision, chi-square test."""
+
 from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy import stats
 
-from sim import gridplate as gp
-from sim import transforms2d as t2
-from sim.config import ConfigError, load_study
-from sim.plate import grid_points
+from sim.instruments import gridplate as gp
+from sim.instruments import transforms2d as t2
+from sim.instruments.plates import grid_points
+from sim.mc.config import ConfigError, load_study
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -18,8 +19,9 @@ N = G.shape[0]
 
 
 def _plates(rng, T, sx_um=1.2, sg_um=0.7):
-    p = t2.affine_from_rows(1 - 7.5e-6, 1 + 7.5e-6, 3.8 * t2.ARCSEC,
-                            rng.uniform(-0.02, 0.02, T), (120.0, 118.0))
+    p = t2.affine_from_rows(
+        1 - 7.5e-6, 1 + 7.5e-6, 3.8 * t2.ARCSEC, rng.uniform(-0.02, 0.02, T), (120.0, 118.0)
+    )
     comp = t2.apply_affine(p, G) + rng.normal(0, sx_um * UM, (T, N, 2))
     cert = G + rng.normal(0, sg_um * UM, (T, N, 2))
     return p, comp, cert
@@ -31,13 +33,15 @@ def test_infinite_grid_weight_is_ordinary_affine():
     fa = t2.fit_affine(cert, comp)
     for k in (0, 1):
         r = gp.combined_adjustment(comp[..., k], cert, 1.0, np.inf)
-        np.testing.assert_allclose(r.params, fa.params[:, 3 * k:3 * k + 3], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(r.params, fa.params[:, 3 * k : 3 * k + 3], rtol=0, atol=1e-12)
         Qa = fa.cofactor[:, :3, :3]  # compared relative to sqrt(Q_ii Q_jj): rounding level
         sd = np.sqrt(np.einsum("tii->ti", Qa))
-        np.testing.assert_allclose((r.cofactor - Qa) / sd[:, :, None] / sd[:, None, :], 0,
-                                   atol=1e-12)
-        np.testing.assert_allclose(r.s0, np.sqrt((fa.residuals[..., k] ** 2).sum(1) / (N - 3)),
-                                   rtol=1e-10)
+        np.testing.assert_allclose(
+            (r.cofactor - Qa) / sd[:, :, None] / sd[:, None, :], 0, atol=1e-12
+        )
+        np.testing.assert_allclose(
+            r.s0, np.sqrt((fa.residuals[..., k] ** 2).sum(1) / (N - 3)), rtol=1e-10
+        )
         assert np.all(r.v_grid == 0)
 
 
@@ -46,7 +50,7 @@ def test_noise_free_recovered_exactly():
     p, comp, cert = _plates(rng, 20, sx_um=0.0, sg_um=0.0)
     for k in (0, 1):
         r = gp.combined_adjustment(comp[..., k], cert, 1.0, 3.0)
-        np.testing.assert_allclose(r.params, p[:, 3 * k:3 * k + 3], atol=1e-11)
+        np.testing.assert_allclose(r.params, p[:, 3 * k : 3 * k + 3], atol=1e-11)
         np.testing.assert_allclose(r.grid, cert, atol=1e-11)
         assert np.all(r.s0 < 1e-10)
 
@@ -68,7 +72,7 @@ def test_combined_residual_equals_misclosure_theory():
     k = r.params[:, 0] ** 2 + r.params[:, 1] ** 2
     f = t2.fit_affine(cert, comp)
     sw2 = (f.residuals[..., 0] ** 2).sum(1) / (N - 3)
-    np.testing.assert_allclose(r.s0 ** 2 * (1 + k / 2.5), sw2, rtol=1e-6)
+    np.testing.assert_allclose(r.s0**2 * (1 + k / 2.5), sw2, rtol=1e-6)
 
 
 def test_a_posteriori_variance_unbiased_with_right_weights():
@@ -76,7 +80,7 @@ def test_a_posteriori_variance_unbiased_with_right_weights():
     T = 4000
     _, comp, cert = _plates(rng, T)
     r = gp.combined_adjustment(comp[..., 0], cert, 1 / (1.2 * UM) ** 2, 1 / (0.7 * UM) ** 2)
-    m = np.mean(r.s0 ** 2)
+    m = np.mean(r.s0**2)
     assert abs(m - 1) < 4 * np.sqrt(2 / r.dof / T)
 
 
@@ -86,9 +90,9 @@ def test_chi2_rejects_wrong_grid_sigma_at_expected_rate(stated_um):
     T = 6000
     _, comp, cert = _plates(rng, T)
     sx = 1.2 * UM
-    r = gp.combined_adjustment(comp[..., 0], cert, 1.0, sx ** 2 / (stated_um * UM) ** 2)
+    r = gp.combined_adjustment(comp[..., 0], cert, 1.0, sx**2 / (stated_um * UM) ** 2)
     _, _, rej = gp.chi2_test(r.s0, r.dof, sx, 0.05)
-    c = (1.2 ** 2 + 0.7 ** 2) / (1.2 ** 2 + stated_um ** 2)
+    c = (1.2**2 + 0.7**2) / (1.2**2 + stated_um**2)
     lo, hi = stats.chi2.ppf(0.025, r.dof), stats.chi2.ppf(0.975, r.dof)
     expect = stats.chi2.cdf(lo / c, r.dof) + stats.chi2.sf(hi / c, r.dof)
     assert abs(rej.mean() - expect) < 4 * np.sqrt(expect * (1 - expect) / T)
@@ -102,8 +106,8 @@ def test_repeat_precision_unbiased():
     readings = rng.normal(0, 1.5, (T, P, N, L, 2)) + rng.normal(0, 5, (T, P, N, 1, 2))
     si, s = gp.repeat_precision(readings)
     dof = 2 * P * N * (L - 1)
-    assert abs(np.mean(s ** 2) / 1.5 ** 2 - 1) < 4 * np.sqrt(2 / dof / T)
-    assert abs(np.mean(si ** 2) / (2 * 1.5 ** 2) - 1) < 4 * np.sqrt(2 / (2 * (L - 1)) / (T * P * N))
+    assert abs(np.mean(s**2) / 1.5**2 - 1) < 4 * np.sqrt(2 / dof / T)
+    assert abs(np.mean(si**2) / (2 * 1.5**2) - 1) < 4 * np.sqrt(2 / (2 * (L - 1)) / (T * P * N))
 
 
 def test_reweight_reaches_the_fixed_point():
@@ -130,20 +134,35 @@ def test_bad_config_names_the_key(tmp_path):
         load_study(f)
 
 
-@pytest.mark.parametrize("over, key", [
-    ("grid.sigma_stated_um=1e-9", "grid.sigma_stated_um"),     # no re-weighting ratio passes
-    ("grid.sigma_stated_um=5.0", "grid.sigma_stated_um"),      # no positive fixed point
-    ("comparator.nonorth_arcsec=3000.0", "comparator.scale_diff_ppm"),
-    ("chunk=100000", "chunk"),
-])
+@pytest.mark.parametrize(
+    "over, key",
+    [
+        ("grid.sigma_stated_um=1e-9", "grid.sigma_stated_um"),  # no re-weighting ratio passes
+        ("grid.sigma_stated_um=5.0", "grid.sigma_stated_um"),  # no positive fixed point
+        ("comparator.nonorth_arcsec=3000.0", "comparator.scale_diff_ppm"),
+        ("chunk=100000", "chunk"),
+    ],
+)
 def test_values_that_would_break_later_give_one_line(tmp_path, capsys, over, key):
     from sim.cli import main
 
-    extra = ["--trials", "40"] + (["--set", "readings.sigma_um=1.0"] if "coord_sigma" in over else [])
+    extra = ["--trials", "40"] + (
+        ["--set", "readings.sigma_um=1.0"] if "coord_sigma" in over else []
+    )
     if over.startswith("chunk"):
         extra = ["--set", "plate.grid=15", "--set", "readings.count=50", "--trials", "200000"]
-    rc = main(["run", str(ROOT / "studies/gridplate_two_plates.toml"), "--quiet", "--set", over,
-               *extra, "--out", str(tmp_path / "o")])
+    rc = main(
+        [
+            "run",
+            str(ROOT / "studies/gridplate_two_plates.toml"),
+            "--quiet",
+            "--set",
+            over,
+            *extra,
+            "--out",
+            str(tmp_path / "o"),
+        ]
+    )
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and key in err[0]
     assert not (tmp_path / "o").exists()
@@ -159,7 +178,7 @@ def test_closed_form_equals_iterated_combined_adjustment():
     k = fa.params[:, 0] ** 2 + fa.params[:, 1] ** 2
     for r in (0.5, 3.0, 30.0):
         res = gp.combined_adjustment(comp[..., 0], cert, 1.0, r)
-        np.testing.assert_allclose(res.s0 ** 2, sw2 / (1 + k / r), rtol=1e-6)
+        np.testing.assert_allclose(res.s0**2, sw2 / (1 + k / r), rtol=1e-6)
         want = (1 + k / r)[:, None, None] * fa.cofactor[:, :3, :3]
         np.testing.assert_allclose(res.cofactor, want, rtol=1e-6, atol=1e-9 * np.abs(want).max())
         np.testing.assert_allclose(res.params, fa.params[:, :3], rtol=0, atol=1e-9)
@@ -170,10 +189,10 @@ def test_paper_literal_reweighting_counts():
 
     dof, st = 22, 0.7
     # implied sigma at the start 1:2 is exactly the stated one: no re-weighting needed
-    sw2 = np.array([[st ** 2 * 3.0]])
+    sw2 = np.array([[st**2 * 3.0]])
     assert reweight_trials(sw2, np.ones_like(sw2), st, dof, 2.0, 0.05)[0, 0] == 0
     # far too large a misclosure variance at the start: one re-weighting brings it in
-    sw2 = np.array([[st ** 2 * 3.0 * 4.0]])
+    sw2 = np.array([[st**2 * 3.0 * 4.0]])
     n = reweight_trials(sw2, np.ones_like(sw2), st, dof, 2.0, 0.05)[0, 0]
     assert 1 <= n <= 3
 
@@ -181,15 +200,17 @@ def test_paper_literal_reweighting_counts():
 def test_sweep_draws_match_the_simulation():
     """The sweep's chi-square draws give the same affine-sigma distribution as the full
     simulation (medians within their sampling error)."""
-    from sim.config import validate
+    from sim.mc.config import validate
     from sim.studies.gridplate import model, sweep
     from sim.studies.gridplate.schema import SCHEMA, check
 
     cfg = validate({}, SCHEMA, check)
     res = model.chunk(cfg, np.random.default_rng(10), 400)
     d = sweep.draws(cfg, np.random.default_rng(11), 20000)
-    for key, col in (("aff_sigma_um", "twoplate.similarity_vs_affine.affine_sigma_um"),
-                     ("sim_sigma_um", "twoplate.similarity_vs_affine.similarity_sigma_um")):
+    for key, col in (
+        ("aff_sigma_um", "twoplate.similarity_vs_affine.affine_sigma_um"),
+        ("sim_sigma_um", "twoplate.similarity_vs_affine.similarity_sigma_um"),
+    ):
         a, b = np.median(res[key]), np.median(d[col])
         se = 1.2533 * np.std(res[key]) / np.sqrt(400)
         assert abs(a - b) < 4 * se + 0.01, key
@@ -197,14 +218,25 @@ def test_sweep_draws_match_the_simulation():
 
 def test_study_runs_small(tmp_path):
     from sim.cli import main
+    from sim.mc.storage import read_table
     from sim.studies.gridplate.report import report
-    from sim.storage import read_table
 
     out = tmp_path / "gp"
-    sets = [x for line in (ROOT / "tests/data/tiny/gridplate_two_plates.txt").read_text().splitlines()
-            for x in ("--set", line)]
-    rc = main(["run", str(ROOT / "studies/gridplate_two_plates.toml"), "--quiet", *sets,
-               "--out", str(out)])
+    sets = [
+        x
+        for line in (ROOT / "tests/data/tiny/gridplate_two_plates.txt").read_text().splitlines()
+        for x in ("--set", line)
+    ]
+    rc = main(
+        [
+            "run",
+            str(ROOT / "studies/gridplate_two_plates.toml"),
+            "--quiet",
+            *sets,
+            "--out",
+            str(out),
+        ]
+    )
     assert rc == 0
     t = read_table(out / "claims.parquet").to_pydict()
     v = dict(zip(t["claim"], t["verdict"]))
@@ -216,8 +248,14 @@ def test_study_runs_small(tmp_path):
     cs = read_table(out / "consistent_set.parquet").to_pydict()
     assert cs["claim"].count("ALL") == 5
     assert (read_table(out / "not_reproduced.parquet").num_rows) >= 5
-    for fig in ("residuals", "parameters", "coverage", "chi2_power", "implied_grid",
-                "consistent_set"):
+    for fig in (
+        "residuals",
+        "parameters",
+        "coverage",
+        "chi2_power",
+        "implied_grid",
+        "consistent_set",
+    ):
         assert (out / f"{fig}.png").is_file()
     text = report(out)
     assert "Consistent sets" in text and "erratum" in text

@@ -1,5 +1,6 @@
 """The one linear least-squares routine (sim.lsq.linear): per-trial status, shared design,
 weights, cofactors, against a per-trial SciPy solve."""
+
 import numpy as np
 import pytest
 from scipy import linalg
@@ -31,14 +32,14 @@ def test_per_trial_equals_scipy_and_cofactor_is_inverse_normals():
     np.testing.assert_allclose(Q, np.linalg.inv(np.swapaxes(A, 1, 2) @ A), rtol=1e-11)
     np.testing.assert_allclose(f.residuals, b - A @ f.x, atol=1e-13)
     assert f.dof == 11 and f.ok.all() and not f.shared
-    np.testing.assert_allclose(f.s0, np.sqrt((f.residuals ** 2).sum((1, 2)) / (2 * 11)))
+    np.testing.assert_allclose(f.s0, np.sqrt((f.residuals**2).sum((1, 2)) / (2 * 11)))
 
 
 def test_singular_trial_is_flagged_not_raised_and_others_are_untouched():
     rng = np.random.default_rng(2)
     A, b = _batch(rng)
-    A[2, :, 3] = 2.0 * A[2, :, 1]                 # rank deficient: two proportional columns
-    b[4, 7, 0] = np.nan                           # a non-finite observation
+    A[2, :, 3] = 2.0 * A[2, :, 1]  # rank deficient: two proportional columns
+    b[4, 7, 0] = np.nan  # a non-finite observation
     f = lstsq(A, b)
     assert list(f.status) == [0, 0, 2, 0, 3, 0]
     assert f.message[2] == LINEAR_STATUS[2] and f.message[4] == LINEAR_STATUS[3]
@@ -64,14 +65,18 @@ def test_shared_design_equals_per_trial_path():
     w = rng.uniform(0.5, 2.0, 20)
     for ww in (None, w):
         s = lstsq(A, b, ww)
-        p = lstsq(np.broadcast_to(A, (50, 20, 5)).copy(), b, None if ww is None
-                  else np.broadcast_to(ww, (50, 20)).copy())
+        p = lstsq(
+            np.broadcast_to(A, (50, 20, 5)).copy(),
+            b,
+            None if ww is None else np.broadcast_to(ww, (50, 20)).copy(),
+        )
         assert s.shared and not p.shared
         np.testing.assert_allclose(s.x, p.x, rtol=1e-12, atol=1e-14)
         np.testing.assert_allclose(s.cofactor(), p.cofactor(), rtol=1e-11, atol=1e-15)
         np.testing.assert_allclose(s.vtpv, p.vtpv, rtol=1e-10)
-    np.testing.assert_allclose(s.x, _reference(np.broadcast_to(A, (50, 20, 5)), b, w),
-                               rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(
+        s.x, _reference(np.broadcast_to(A, (50, 20, 5)), b, w), rtol=1e-12, atol=1e-14
+    )
 
 
 def test_weights_scale_the_observations_and_zero_weight_drops_one():
@@ -80,8 +85,9 @@ def test_weights_scale_the_observations_and_zero_weight_drops_one():
     w = rng.uniform(0.2, 5.0, (4, 12))
     f = lstsq(A, b, w)
     np.testing.assert_allclose(f.x, _reference(A, b, w), rtol=1e-12, atol=1e-13)
-    np.testing.assert_allclose(f.cofactor(), np.linalg.inv(np.einsum("tmi,tm,tmj->tij", A, w, A)),
-                               rtol=1e-11)
+    np.testing.assert_allclose(
+        f.cofactor(), np.linalg.inv(np.einsum("tmi,tm,tmj->tij", A, w, A)), rtol=1e-11
+    )
     np.testing.assert_allclose(f.vtpv[:, 0], (w * f.residuals[..., 0] ** 2).sum(1), rtol=1e-12)
     w0 = np.ones((4, 12))
     w0[:, 5] = 0.0
@@ -96,7 +102,7 @@ def test_designs_far_from_the_trial_mean_stay_exact(spread):
     rng = np.random.default_rng(6)
     A0 = rng.normal(size=(30, 6))
     A = A0 + spread * rng.normal(size=(8, 30, 6))
-    A[3] *= 1e3                                       # a badly scaled trial
+    A[3] *= 1e3  # a badly scaled trial
     b = rng.normal(size=(8, 30))
     f = lstsq(A, b)
     np.testing.assert_allclose(f.x, _reference(A, b[..., None]), rtol=1e-10, atol=1e-13)
@@ -117,7 +123,7 @@ def test_screened_rule_decides_like_the_eigenvalue_ratio():
     rng = np.random.default_rng(11)
     T, m = 300, 12
     x = rng.uniform(-1, 1, (T, m))
-    eps = 10.0 ** rng.uniform(-13, 0, T)                     # near-collinear third column
+    eps = 10.0 ** rng.uniform(-13, 0, T)  # near-collinear third column
     A = np.stack([np.ones((T, m)), x, x + eps[:, None] * rng.normal(size=(T, m))], -1)
     b = rng.normal(size=(T, m))
     for rc in (1e-10, 1e-6):
@@ -133,9 +139,11 @@ def test_inputs_are_left_unchanged():
     """The residuals never overwrite the caller's observations (one trial of a shared design,
     whose transposed right-hand sides are a view of ``b``)."""
     rng = np.random.default_rng(7)
-    for A, b in ((rng.normal(size=(9, 3)), rng.normal(size=(1, 9, 2))),
-                 (rng.normal(size=(9, 3)), rng.normal(size=(4, 9, 2))),
-                 (rng.normal(size=(4, 9, 3)), rng.normal(size=(4, 9, 1)))):
+    for A, b in (
+        (rng.normal(size=(9, 3)), rng.normal(size=(1, 9, 2))),
+        (rng.normal(size=(9, 3)), rng.normal(size=(4, 9, 2))),
+        (rng.normal(size=(4, 9, 3)), rng.normal(size=(4, 9, 1))),
+    ):
         A0, b0 = A.copy(), b.copy()
         f = lstsq(A, b)
         assert np.array_equal(A, A0) and np.array_equal(b, b0)

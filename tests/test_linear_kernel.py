@@ -1,11 +1,12 @@
-"""The compiled paths of the linear case (sim.lsq.linear_kernel, sim.polynomial_kernel) against
+"""The compiled paths of the linear case (sim.lsq.linear_kernel, sim.instruments.plotter.polynomial_kernel) against
 the NumPy paths they replace: equal to a tolerance derived from each design's condition
 number, the same per-trial status (singular, non-finite), and the scaled rule's bound."""
+
 import numpy as np
 import pytest
 
-from sim import polynomial as pl
-from sim import polynomial_kernel
+from sim.instruments.plotter import polynomial as pl
+from sim.instruments.plotter import polynomial_kernel
 from sim.lsq import linear_kernel
 from sim.lsq.linear import lstsq
 from sim.lsq.normals import RCOND, scaled_rcond
@@ -36,22 +37,24 @@ def test_shared_design_compiled_equals_numpy_path(monkeypatch):
     fits.append(lstsq(A, b, w))
     c, n = fits
     cond = np.linalg.cond(A * np.sqrt(w)[:, None])
-    tol = 10 * cond * EPS                           # backward-stable solves, relative
+    tol = 10 * cond * EPS  # backward-stable solves, relative
     np.testing.assert_array_equal(c.status, n.status)
     assert c.status[7] == 3 and np.isnan(c.x[7]).all() and np.isnan(c.vtpv[7]).all()
     ok = c.ok
     scale = np.abs(n.x[ok]).max()
     assert np.abs(c.x[ok] - n.x[ok]).max() <= tol * scale
     np.testing.assert_allclose(c.vtpv[ok], n.vtpv[ok], rtol=tol)
-    np.testing.assert_allclose(c.residuals[ok], n.residuals[ok], rtol=0, atol=tol * np.abs(b[ok]).max())
+    np.testing.assert_allclose(
+        c.residuals[ok], n.residuals[ok], rtol=0, atol=tol * np.abs(b[ok]).max()
+    )
     assert np.isnan(c.residuals[7]).all()
     np.testing.assert_allclose(c.cofactor()[ok], n.cofactor()[ok], rtol=1e-13)
 
 
 def test_polynomial_compiled_equals_numpy_path_within_its_condition():
     g, meas = _wolf_batch()
-    meas[5, 10, 0] = np.inf                         # a non-finite trial
-    meas[9] = np.column_stack([meas[9, :, 0], 0.3 * meas[9, :, 0]])   # points on one line
+    meas[5, 10, 0] = np.inf  # a non-finite trial
+    meas[9] = np.column_stack([meas[9, :, 0], 0.3 * meas[9, :, 0]])  # points on one line
     for terms, corrected in ((pl.WOLF_TERMS, True), (pl.poly_terms(2), False)):
         c = pl.fit_poly(meas, g, terms=terms, corrected=corrected)
         n = pl.fit_poly(meas, g, terms=terms, corrected=corrected, jit=False)
@@ -59,8 +62,8 @@ def test_polynomial_compiled_equals_numpy_path_within_its_condition():
         assert not c.ok[5] and not c.ok[9] and c.ok.sum() == len(meas) - 2
         assert np.isnan(c.coef[5]).all() and np.isnan(c.coef[9]).all()
         A = pl.design(meas[c.ok], terms)
-        cond = np.linalg.cond(A)                    # per trial; normal equations square it
-        tol = 20 * cond ** 2 * EPS * np.abs(n.coef[c.ok]).max(axis=(1, 2))
+        cond = np.linalg.cond(A)  # per trial; normal equations square it
+        tol = 20 * cond**2 * EPS * np.abs(n.coef[c.ok]).max(axis=(1, 2))
         assert (np.abs(c.coef[c.ok] - n.coef[c.ok]).max(axis=(1, 2)) <= tol).all()
         # |d rms| <= ||A dx|| / sqrt(n) <= sigma_max(A) sqrt(p) |dx|_max / sqrt(n); the
         # corrected points move by |A dx| <= (row sum of |A|) |dx|_max; plus their rounding
@@ -70,19 +73,18 @@ def test_polynomial_compiled_equals_numpy_path_within_its_condition():
         assert (np.abs(c.rms_mm[c.ok] - n.rms_mm[c.ok]).max(1) <= drms).all()
         if corrected:
             dcor = np.abs(A).sum(2).max(1) * tol + 4 * EPS * np.abs(meas[c.ok]).max((1, 2))
-            assert (np.abs(c.corrected_mm[c.ok] - n.corrected_mm[c.ok]).max((1, 2))
-                    <= dcor).all()
+            assert (np.abs(c.corrected_mm[c.ok] - n.corrected_mm[c.ok]).max((1, 2)) <= dcor).all()
 
 
 def test_polynomial_trials_do_not_depend_on_their_neighbours():
     """A trial's fit is the same alone as in a batch with a singular and a non-finite trial
     (the lanes of the compiled solve are independent)."""
     g, meas = _wolf_batch(T=11)
-    meas[2, :, 1] = 5.0                             # all Y equal: singular
+    meas[2, :, 1] = 5.0  # all Y equal: singular
     meas[4, 0, 1] = np.nan
     batch = pl.fit_wolf(meas, g)
     for t in (0, 3, 10):
-        alone = pl.fit_wolf(meas[t:t + 1], g)
+        alone = pl.fit_wolf(meas[t : t + 1], g)
         np.testing.assert_array_equal(alone.coef[0], batch.coef[t])
         np.testing.assert_array_equal(alone.rms_mm[0], batch.rms_mm[t])
     assert list(np.flatnonzero(~batch.ok)) == [2, 4]
@@ -93,15 +95,15 @@ def test_normal_solve_proves_regular_or_leaves_to_the_exact_rule():
     p, T = 7, 12
     Q = np.linalg.qr(rng.normal(size=(T, p, p)))[0]
     ev = np.tile(np.geomspace(1.0, 1e-3, p), (T, 1))
-    ev[3, -1] = 1e-12                               # below rcond: singular by the rule
-    d = rng.uniform(0.1, 100.0, (T, p))             # the rule is invariant to this scaling
+    ev[3, -1] = 1e-12  # below rcond: singular by the rule
+    d = rng.uniform(0.1, 100.0, (T, p))  # the rule is invariant to this scaling
     C = np.einsum("tij,tj,tkj->tik", Q, ev, Q)
     N = C * d[:, :, None] * d[:, None, :]
     u = rng.normal(size=(T, p, 2))
     x, st = linear_kernel.normal_solve(N, u, RCOND)
     solved = st == linear_kernel.SOLVED
     rc = scaled_rcond(N)
-    assert (rc[solved] > RCOND).all()               # the bound never passes a singular trial
+    assert (rc[solved] > RCOND).all()  # the bound never passes a singular trial
     assert not solved[3] and solved.sum() == T - 1  # the rest are proved regular
     assert np.isnan(x[~solved]).all()
     ref = np.linalg.solve(N[solved], u[solved])
@@ -124,9 +126,9 @@ def test_polynomial_square_sums_from_the_normals_only_where_exact_enough():
     _, st, q_id, _ = polynomial_kernel.fit(meas, true, terms, 100.0, corrected=False)
     _, st2, q_ex, _ = polynomial_kernel.fit(meas, true, terms, 100.0, corrected=True)
     assert (st == 0).all() and (st2 == 0).all()
-    np.testing.assert_array_equal(q_id[3], q_ex[3])                # the explicit pass
-    n_pts = g.shape[0]                              # an exact fit: rounding of D = true - meas
+    np.testing.assert_array_equal(q_id[3], q_ex[3])  # the explicit pass
+    n_pts = g.shape[0]  # an exact fit: rounding of D = true - meas
     assert q_ex[3].max() <= n_pts * (4 * EPS * np.abs(true[3]).max()) ** 2
     rest = np.arange(9) != 3
     assert (np.abs(q_id[rest] - q_ex[rest]) <= 1e-9 * q_ex[rest]).all()
-    assert not np.array_equal(q_id[rest], q_ex[rest])                # the identity was used
+    assert not np.array_equal(q_id[rest], q_ex[rest])  # the identity was used

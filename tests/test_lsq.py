@@ -1,11 +1,12 @@
 """The batched least-squares engine (sim.lsq): fast path, singularity rule, cofactors."""
+
 import numpy as np
 import pytest
 
 from sim import lsq
-from sim import multilateration as ml
-from sim import positions as po
-from sim.plate import grid_points
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import multilateration as ml
+from sim.instruments.ranges import positions as po
 
 H = 122.5 + 45.0
 PTS = grid_points(5, 55.0)
@@ -28,10 +29,9 @@ def test_generic_engine_equals_compiled_fast_path(model):
     tolerances are the tightest these levels allow."""
     T = 200
     rng = np.random.default_rng(5)
-    r = ml.simulate_ranges(batch(PTS, T), batch(THETA, T), rng, setting_sigma_um=2.0,
-                           settings=1)
+    r = ml.simulate_ranges(batch(PTS, T), batch(THETA, T), rng, setting_sigma_um=2.0, settings=1)
     t0 = THETA.copy()
-    t0[5:ml.MODELS[model]] = 0.0
+    t0[5 : ml.MODELS[model]] = 0.0
     a = ml.adjust(r, model, t0, engine="numpy")
     b = ml.adjust(r, model, t0, engine="numba")
     assert np.array_equal(a.status, b.status) and a.converged.all()
@@ -94,12 +94,12 @@ def test_bordered_cofactors_equal_dense_constrained_inverse(datum):
     lin = m.linearize(PTS[None], th[None], True)
     A = np.zeros((P * n, 2 * n + 2 * P + 2))
     for j in range(n):
-        A[P * j:P * j + P, 2 * j:2 * j + 2] = lin.Jp[0, j]
-        A[P * j:P * j + P, 2 * n:] = lin.Jg[0, j]
+        A[P * j : P * j + P, 2 * j : 2 * j + 2] = lin.Jp[0, j]
+        A[P * j : P * j + P, 2 * n :] = lin.Jg[0, j]
     C = np.zeros((2 * n + 2 * P + 2, 3))
-    C[2 * n:] = po.datum_constraints(th[None], 2 * P + 2, datum)[0]
+    C[2 * n :] = po.datum_constraints(th[None], 2 * P + 2, datum)[0]
     M = np.block([[A.T @ A, C], [C.T, np.zeros((3, 3))]])
-    dense = np.linalg.inv(M)[:2 * n, :2 * n]
+    dense = np.linalg.inv(M)[: 2 * n, : 2 * n]
     full = po.full_point_covariance(PTS[None], th[None], "pivot", datum)[0]
     assert np.allclose(full, dense, rtol=1e-7, atol=1e-9 * np.abs(dense).max())
     Qpp = po.covariance(PTS[None], th[None], "pivot", datum)[0][0]
@@ -150,12 +150,12 @@ def test_compiled_2x2_point_blocks_equal_the_numpy_closed_form(monkeypatch):
     rng = np.random.default_rng(0)
     N = rng.normal(size=(60, 25, 2, 2))
     N = N @ N.transpose(0, 1, 3, 2)
-    N[3, 4] = [[1.0, 1.0], [1.0, 1.0]]                 # singular
+    N[3, 4] = [[1.0, 1.0], [1.0, 1.0]]  # singular
     N[5, 6, 0, 1] = np.nan
-    N[7, 1] = [[1e-30, 0.0], [0.0, 1.0]]               # regular once scaled
+    N[7, 1] = [[1e-30, 0.0], [0.0, 1.0]]  # regular once scaled
     N[8, 2] = 0.0
     N[9, 3, 0, 0] = np.inf
-    N[10, 0] = [[1.0, 1.0], [1.0, 1.0 + 1e-12]]        # below rcond
+    N[10, 0] = [[1.0, 1.0], [1.0, 1.0 + 1e-12]]  # below rcond
     fast, ok_fast = normals.inv_blocks(N)
     monkeypatch.setattr(group_kernel, "available", lambda: False)
     ref, ok_ref = normals.inv_blocks(N)

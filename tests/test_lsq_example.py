@@ -6,6 +6,7 @@ mm. Everything the engine needs is the class below: misclosures and Jacobians ov
 leading trial axis and a start for the points. The Monte-Carlo spread of the estimates must
 match the engine's analytic covariance ``sigma^2 Q`` within the sampling error.
 """
+
 import numpy as np
 
 from sim import lsq
@@ -23,9 +24,9 @@ class ScaledDistances:
     n_global = 1
 
     def __init__(self, d_obs, beacons):
-        self.d_obs, self.b = d_obs, beacons              # (T, n, B), (B, 2)
+        self.d_obs, self.b = d_obs, beacons  # (T, n, B), (B, 2)
 
-    def initial_points(self, theta):                     # beacons' centroid
+    def initial_points(self, theta):  # beacons' centroid
         T, n, _ = self.d_obs.shape
         return np.broadcast_to(self.b.mean(0), (T, n, 2)).copy()
 
@@ -55,15 +56,15 @@ def test_new_model_monte_carlo_matches_analytic_covariance():
     full[:2, :2] = cof.points[0, 0]
     full[:2, 2] = full[2, :2] = cof.point_global[0, 0, :, 0]
     full[2, 2] = cof.Qgg[0, 0, 0]
-    C = SIGMA ** 2 * full
+    C = SIGMA**2 * full
     se = np.sqrt(np.diag(C) / T)
-    assert np.all(np.abs(est.mean(0) - truth) < 4 * se)               # no bias beyond MC error
+    assert np.all(np.abs(est.mean(0) - truth) < 4 * se)  # no bias beyond MC error
     emp = np.cov(est.T)
     # variances: relative standard error sqrt(2 / (T - 1)) of a sample variance
     assert np.all(np.abs(np.diag(emp) / np.diag(C) - 1) < 4 * np.sqrt(2 / (T - 1)))
     # correlations: standard error (1 - rho^2) / sqrt(T)
     sd_e, sd_a = np.sqrt(np.diag(emp)), np.sqrt(np.diag(C))
     r_e, r_a = emp / np.outer(sd_e, sd_e), C / np.outer(sd_a, sd_a)
-    assert np.all(np.abs(r_e - r_a) < 4 * (1 - r_a ** 2) / np.sqrt(T) + 1e-12)
+    assert np.all(np.abs(r_e - r_a) < 4 * (1 - r_a**2) / np.sqrt(T) + 1e-12)
     # sigma0^2 estimates sigma^2 (linearised model: E[s0^2] = sigma^2)
-    assert abs((res.sigma0 ** 2).mean() / SIGMA ** 2 - 1) < 4 * np.sqrt(2 / (res.dof * T))
+    assert abs((res.sigma0**2).mean() / SIGMA**2 - 1) < 4 * np.sqrt(2 / (res.dof * T))

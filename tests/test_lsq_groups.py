@@ -1,13 +1,14 @@
 """The group-block engine (sim.lsq.groups, sim.lsq.group_solve) on a small block of
 independent models: the banded elimination equals the dense solve, cofactors restricted to
 some points equal the full ones, a non-positive-definite trial is flagged, not raised."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from sim import independent_models as im
-from sim.block_layout import make_block, select_control
+from sim.instruments.block import independent_models as im
+from sim.instruments.block.layout import make_block, select_control
 from sim.lsq import group_solve as gs
 from sim.lsq import groups
 
@@ -34,7 +35,7 @@ def test_banded_solve_equals_dense(setup):
     args = (st, xm, c, s0, R0, t0, X0, w, cx, np.broadcast_to(wc, (xm.shape[0],) + wc.shape))
     dg, dX = im.normal_step(*args, solver="dense")
     dg2, dX2 = im.normal_step(*args, solver="sparse")
-    assert st.band.width < st.n_groups          # the reordering gives a band narrower than G
+    assert st.band.width < st.n_groups  # the reordering gives a band narrower than G
     assert np.allclose(dg2, dg, rtol=1e-8, atol=1e-10 * np.abs(dg).max())
     assert np.allclose(dX2, dX, rtol=1e-8, atol=1e-10 * np.abs(dX).max())
 
@@ -45,7 +46,7 @@ def test_band_solve_flags_an_indefinite_trial(setup):
     lin = model.linearize(X0, im._state(s0, R0, t0))
     red = groups.reduce(st, lin)
     blocks = red.blocks.copy()
-    blocks[1, st.diag_of_group[2]] *= -1.0   # trial 1 no longer positive definite
+    blocks[1, st.diag_of_group[2]] *= -1.0  # trial 1 no longer positive definite
     x, ok = gs.band_solve(st, blocks, red.ubar.reshape(xm.shape[0], -1))
     assert ok.tolist() == [True, False, True]
     x0, _ = gs.band_solve(st, red.blocks, red.ubar.reshape(xm.shape[0], -1))
@@ -78,6 +79,7 @@ def test_compiled_kernels_equal_numpy(setup):
     """The compiled pair blocks and residual cofactors (sim.lsq.group_kernel) equal the NumPy
     path to rounding, with a removed observation (weight 0)."""
     from sim.lsq import group_kernel, group_kernel_solve
+
     if not group_kernel.available():
         pytest.skip("numba not installed")
     b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
@@ -90,18 +92,33 @@ def test_compiled_kernels_equal_numpy(setup):
     dg = np.random.default_rng(5).normal(size=r0.ubar.shape)
     L = np.linalg.cholesky(gs.dense(st, r0.blocks))
     y = r0.ubar.reshape(len(L), -1)
-    for a, c in ((r0.blocks, r1.blocks), (r0.ubar, r1.ubar), (r0.Ninv, r1.Ninv),
-                 (r0.NinvK, r1.NinvK), (r0.up, r1.up), (r0.blocks, blocks), (r0.ubar, ubar),
-                 (groups.points_step(st, r0, dg),
-                  np.einsum("tpij,tpj->tpi", r0.Ninv, r0.up - groups.scatter(
-                      st.S_point, (r0.Npg * dg[:, st.obs_group, None, :]).sum(-1)))),
-                 (gs.chol_subst(L, y[..., None])[..., 0], group_kernel_solve.chol_vec(L, y)),
-                 (gs.chol_subst(L, np.broadcast_to(np.eye(L.shape[1]), L.shape).copy()),
-                  group_kernel_solve.chol_inv(L))):
+    for a, c in (
+        (r0.blocks, r1.blocks),
+        (r0.ubar, r1.ubar),
+        (r0.Ninv, r1.Ninv),
+        (r0.NinvK, r1.NinvK),
+        (r0.up, r1.up),
+        (r0.blocks, blocks),
+        (r0.ubar, ubar),
+        (
+            groups.points_step(st, r0, dg),
+            np.einsum(
+                "tpij,tpj->tpi",
+                r0.Ninv,
+                r0.up - groups.scatter(st.S_point, (r0.Npg * dg[:, st.obs_group, None, :]).sum(-1)),
+            ),
+        ),
+        (gs.chol_subst(L, y[..., None])[..., 0], group_kernel_solve.chol_vec(L, y)),
+        (
+            gs.chol_subst(L, np.broadcast_to(np.eye(L.shape[1]), L.shape).copy()),
+            group_kernel_solve.chol_inv(L),
+        ),
+    ):
         assert np.abs(c - a).max() <= 1e-12 * np.abs(a).max()
     assert r1.ok.tolist() == r0.ok.tolist()
-    for a, c in zip(gs.scaled(gs.dense(st, r0.blocks)),
-                    group_kernel_solve.dense_scaled(st, r0.blocks)):
+    for a, c in zip(
+        gs.scaled(gs.dense(st, r0.blocks)), group_kernel_solve.dense_scaled(st, r0.blocks)
+    ):
         assert np.array_equal(a, c)
     cof = groups.cofactors(st, lin)
     for pts in (None, b.is_pass):
@@ -112,8 +129,9 @@ def test_compiled_kernels_equal_numpy(setup):
 
 
 def test_compiled_linearisation_equals_numpy(setup):
-    """The compiled similarity linearisation (sim.similarity_jit) equals the NumPy one."""
-    from sim import similarity_jit
+    """The compiled similarity linearisation (sim.instruments.block.similarity_jit) equals the NumPy one."""
+    from sim.instruments.block import similarity_jit
+
     b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
     c = np.random.default_rng(4).normal(size=(xm.shape[0], st.n_models, 3))
     model = im.SimilarityModel(st, xm, c, w, cx, wc)

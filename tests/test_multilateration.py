@@ -1,10 +1,11 @@
 """Brown's multilateration: analytic covariance, solver, invariances, Monte Carlo."""
+
 import numpy as np
 import pytest
 
-from sim import multilateration as ml
-from sim.intervals import std_rel_se
-from sim.plate import grid_points
+from sim.claims.intervals import std_rel_se
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import multilateration as ml
 
 H = 122.5 + 45.0
 PTS = grid_points(5, 55.0)
@@ -22,10 +23,10 @@ def sigmas(pts, theta, model):
 
 def test_known_centre_is_sigma_over_root2():
     s = sigmas(np.array([[0.0, 0.0], [50.0, 20.0], [-30.0, 70.0]]), ml.design_theta(H), "known")
-    assert s[0] == pytest.approx([2 ** -0.5, 2 ** -0.5], abs=1e-12)
+    assert s[0] == pytest.approx([2**-0.5, 2**-0.5], abs=1e-12)
     # four unit vectors: trace(N) = 4, so the pooled sigma is >= 1/sqrt(2), equal only at
     # the centre where N is isotropic
-    assert np.all(np.sqrt((s[1:] ** 2).mean(1)) > 2 ** -0.5 + 1e-6)
+    assert np.all(np.sqrt((s[1:] ** 2).mean(1)) > 2**-0.5 + 1e-6)
 
 
 @pytest.mark.parametrize("model", list(ml.MODELS))
@@ -35,7 +36,7 @@ def test_noise_free_ranges_recover_truth(model):
     r = ml.ranges(P, batch(THETA, T))
     t0 = THETA.copy()
     p = ml.MODELS[model]
-    t0[:min(p, 5)] += np.array([2.0, -1.5, 0.8, 1.2, -2.0])[:min(p, 5)]  # a poor start
+    t0[: min(p, 5)] += np.array([2.0, -1.5, 0.8, 1.2, -2.0])[: min(p, 5)]  # a poor start
     t0[5:p] = 0.0
     res = ml.adjust(r, model, t0, tol_mm=1e-12)
     assert res.converged.all()
@@ -50,7 +51,7 @@ def _cov_full(pts, theta, model):
     n = len(pts)
     full = np.einsum("iap,pq,jbq->iajb", K[0], Qgg[0], K[0]).reshape(2 * n, 2 * n)
     for j in range(n):
-        full[2 * j:2 * j + 2, 2 * j:2 * j + 2] += Ninv[0, j]
+        full[2 * j : 2 * j + 2, 2 * j : 2 * j + 2] += Ninv[0, j]
     return full
 
 
@@ -59,14 +60,14 @@ def test_reduced_normals_equal_dense_inverse(model):
     """Schur-complement covariance equals the inverse of the dense normal matrix."""
     P = PTS[None]
     lin = ml._model(None).linearize(P, THETA[None], True)
-    Jp, Jg = lin.Jp, lin.Jg[..., :ml.MODELS[model]]
+    Jp, Jg = lin.Jp, lin.Jg[..., : ml.MODELS[model]]
     n = len(PTS)
     A = np.zeros((4 * n, 2 * n + ml.MODELS[model]))
     for j in range(n):
-        A[4 * j:4 * j + 4, 2 * j:2 * j + 2] = Jp[0, j]
+        A[4 * j : 4 * j + 4, 2 * j : 2 * j + 2] = Jp[0, j]
         if Jg is not None:
-            A[4 * j:4 * j + 4, 2 * n:] = Jg[0, j]
-    dense = np.linalg.inv(A.T @ A)[:2 * n, :2 * n]
+            A[4 * j : 4 * j + 4, 2 * n :] = Jg[0, j]
+    dense = np.linalg.inv(A.T @ A)[: 2 * n, : 2 * n]
     assert np.allclose(_cov_full(PTS, THETA, model), dense, rtol=1e-8, atol=1e-10)
 
 
@@ -103,7 +104,7 @@ def test_monte_carlo_matches_analytic(model):
     TH = batch(THETA, T)
     r = ml.simulate_ranges(P, TH, rng, setting_sigma_um=1.0, settings=1)
     t0 = THETA.copy()
-    t0[5:ml.MODELS[model]] = 0.0
+    t0[5 : ml.MODELS[model]] = 0.0
     res = ml.adjust(r, model, t0)
     assert res.converged.all()
     mc = (res.points - P).std(axis=0, ddof=1) * 1e3
@@ -114,10 +115,10 @@ def test_monte_carlo_matches_analytic(model):
     se = std_rel_se(T)
     assert np.all(np.abs(ratio - 1) < 4.5 * se)
     # the pooled ratio is much tighter
-    assert abs(np.sqrt(np.mean(ratio ** 2)) - 1) < 4 * se / np.sqrt(10)
+    assert abs(np.sqrt(np.mean(ratio**2)) - 1) < 4 * se / np.sqrt(10)
     # a-posteriori sigma0 is unbiased for the range sigma (dof = 4n - unknowns)
     s0 = res.sigma0 * 1e3
-    assert abs(np.mean(s0 ** 2) - 1) < 4 * np.sqrt(2 / res.dof / T)
+    assert abs(np.mean(s0**2) - 1) < 4 * np.sqrt(2 / res.dof / T)
 
 
 def test_constant_bias_is_absorbed_by_alpha():
@@ -192,8 +193,7 @@ def test_simd_lanes_are_bit_identical_to_one_trial_at_a_time():
     T = 2 * ml.jit.LANES + 7
     assert ml.jit.use_lanes(T, len(PTS)) and not ml.jit.use_lanes(1, len(PTS))
     rng = np.random.default_rng(9)
-    r = ml.simulate_ranges(batch(PTS, T), batch(THETA, T), rng, setting_sigma_um=2.0,
-                           settings=1)
+    r = ml.simulate_ranges(batch(PTS, T), batch(THETA, T), rng, setting_sigma_um=2.0, settings=1)
     r[3, 2, 1] = np.nan
     r[T - 2, 0, 0] = 1e300
     t0 = THETA.copy()
@@ -204,6 +204,6 @@ def test_simd_lanes_are_bit_identical_to_one_trial_at_a_time():
     ok[[3, T - 2]] = False
     assert block.converged[ok].all()
     for t in (0, 3, ml.jit.LANES - 1, ml.jit.LANES, T - 2, T - 1):
-        one = ml.adjust(r[t:t + 1], "pivot", t0, engine="numba")
+        one = ml.adjust(r[t : t + 1], "pivot", t0, engine="numba")
         for f in ("points", "theta", "residuals", "sigma0", "iterations", "status"):
             assert np.array_equal(getattr(one, f)[0], getattr(block, f)[t], equal_nan=True), (t, f)

@@ -1,5 +1,6 @@
 """The network study kind (issue 14): Brown as a network, MC against analytic, reliability,
 datum invariance, gama-local round trip, bad networks."""
+
 import math
 import subprocess
 import sys
@@ -9,8 +10,8 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from sim import multilateration as ml
-from sim.config import ConfigError, load_study
+from sim.instruments.ranges import multilateration as ml
+from sim.mc.config import ConfigError, load_study
 from sim.studies.network.analysis import analyse, in_datum
 from sim.studies.network.definition import build
 from sim.studies.network.gama import merge_gama, read_gama, write_gama
@@ -40,7 +41,7 @@ def test_brown_as_a_network_equals_the_brown_models():
     theta = ml.design_theta(139.5, 0.5, 1.0)[None]
     pts = net.xy[p_idx][None]
     for model, an in (("known", known), ("stations", stations)):
-        Q = ml.covariance(pts, theta, model)[0][0] * 1e-6        # unit range sigma 1 um
+        Q = ml.covariance(pts, theta, model)[0][0] * 1e-6  # unit range sigma 1 um
         np.testing.assert_allclose(an.cov[p_idx], Q, rtol=1e-9, atol=1e-18)
     assert stations.dof == 2 * 4 * 25 // 2 - (2 * 25 + 5) and known.dof == 100 - 50
 
@@ -52,9 +53,23 @@ def test_brown_network_example_equals_the_brown_dilution_study_files(tmp_path):
     runs = {"brown": ("brown_dilution", tiny), "net": ("network_brown", ["trials=400"])}
     for key, (name, sets) in runs.items():
         args = [a for s in sets for a in ("--set", s)]
-        r = subprocess.run([sys.executable, "-m", "sim", "run", str(ROOT / f"studies/{name}.toml"),
-                            "--out", str(tmp_path / key), "--quiet", *args], cwd=ROOT,
-                           capture_output=True, text=True, timeout=600)
+        r = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "sim",
+                "run",
+                str(ROOT / f"studies/{name}.toml"),
+                "--out",
+                str(tmp_path / key),
+                "--quiet",
+                *args,
+            ],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            timeout=600,
+        )
         assert r.returncode == 0, r.stderr
     b = pq.read_table(tmp_path / "brown/points.parquet").to_pydict()
     n = pq.read_table(tmp_path / "net/points.parquet").to_pydict()
@@ -64,15 +79,20 @@ def test_brown_network_example_equals_the_brown_dilution_study_files(tmp_path):
     assert len(set(net_rows)) == 25
     bx, by = np.array(b["sigma_x_um"]), np.array(b["sigma_y_um"])
     # the example's own parameterisation (stations estimated, alpha and beta known), in um
-    np.testing.assert_allclose(np.array(n["sigma_x_mm"])[net_rows] * 1e3, bx[rows["stations"]],
-                               rtol=1e-9)
-    np.testing.assert_allclose(np.array(n["sigma_y_mm"])[net_rows] * 1e3, by[rows["stations"]],
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        np.array(n["sigma_x_mm"])[net_rows] * 1e3, bx[rows["stations"]], rtol=1e-9
+    )
+    np.testing.assert_allclose(
+        np.array(n["sigma_y_mm"])[net_rows] * 1e3, by[rows["stations"]], rtol=1e-9
+    )
     # its dilution column is Brown's "stations recovered" against "stations known"
     pooled = {m: np.sqrt((bx[r] ** 2 + by[r] ** 2) / 2) for m, r in rows.items()}
-    np.testing.assert_allclose(np.array(n["dilution_pct"])[net_rows],
-                               100 * (pooled["stations"] / pooled["known"] - 1), rtol=1e-7,
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        np.array(n["dilution_pct"])[net_rows],
+        100 * (pooled["stations"] / pooled["known"] - 1),
+        rtol=1e-7,
+        atol=1e-9,
+    )
 
 
 def test_redundancy_numbers_sum_to_the_degrees_of_freedom():
@@ -87,29 +107,53 @@ def test_precision_is_datum_invariant_after_s_transformation():
     cfg = load("network_testfield")
     free = {**cfg, "network.points": [{**p, "role": "free"} for p in cfg["network.points"]]}
     net, inner = pre({**free, "datum.kind": "inner"})
-    _, minimal = pre({**free, "datum.kind": "constraints",
-                      "datum.constraints": [{"A.x": 1.0}, {"A.y": 1.0}, {"B.y": 1.0}]})
+    _, minimal = pre(
+        {
+            **free,
+            "datum.kind": "constraints",
+            "datum.constraints": [{"A.x": 1.0}, {"A.y": 1.0}, {"B.y": 1.0}],
+        }
+    )
     _, fixed = pre(cfg)
     assert inner.ok and minimal.ok and inner.dof == minimal.dof == fixed.dof - 8 + 3
-    assert not np.allclose(inner.cov, minimal.cov)            # two different datums ...
+    assert not np.allclose(inner.cov, minimal.cov)  # two different datums ...
     sel = [net.index(n) for n in net.names if n.startswith("N")]
-    np.testing.assert_allclose(in_datum(net, inner, sel), in_datum(net, minimal, sel),
-                               rtol=1e-7, atol=1e-12)        # ... one precision
+    np.testing.assert_allclose(
+        in_datum(net, inner, sel), in_datum(net, minimal, sel), rtol=1e-7, atol=1e-12
+    )  # ... one precision
     np.testing.assert_allclose(inner.redundancy, minimal.redundancy, atol=1e-9)
 
 
 def test_monte_carlo_agrees_with_analytic_within_sampling_error(tmp_path):
     out = tmp_path / "tf"
-    r = subprocess.run([sys.executable, "-m", "sim", "run", str(ROOT / "studies/network_testfield.toml"),
-                        "--out", str(out), "--trials", "600", "--set", "chunk=60", "--quiet"],
-                       cwd=ROOT, capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "sim",
+            "run",
+            str(ROOT / "studies/network_testfield.toml"),
+            "--out",
+            str(out),
+            "--trials",
+            "600",
+            "--set",
+            "chunk=60",
+            "--quiet",
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     p = pq.read_table(out / "points.parquet").to_pydict()
     n = 600
-    se = 1 / math.sqrt(2 * (n - 1))                 # relative SE of a Gaussian sample sigma
-    ratio = np.array(p["mc_sigma_x_mm"] + p["mc_sigma_y_mm"]) / \
-        np.array(p["sigma_x_mm"] + p["sigma_y_mm"])
-    assert np.all(np.abs(ratio - 1) < 4.5 * se), ratio     # 24 coordinates, two-sided 4.5 SE
+    se = 1 / math.sqrt(2 * (n - 1))  # relative SE of a Gaussian sample sigma
+    ratio = np.array(p["mc_sigma_x_mm"] + p["mc_sigma_y_mm"]) / np.array(
+        p["sigma_x_mm"] + p["sigma_y_mm"]
+    )
+    assert np.all(np.abs(ratio - 1) < 4.5 * se), ratio  # 24 coordinates, two-sided 4.5 SE
     cov = np.array(p["coverage95"])
     assert np.all(np.abs(cov - 0.95) < 4.5 * math.sqrt(0.95 * 0.05 / n)), cov
     claims = pq.read_table(out / "claims.parquet").to_pydict()
@@ -132,8 +176,9 @@ def test_gama_local_round_trip(tmp_path):
     assert net2.stations == net.stations
     # via the study file too: network.gama_xml replaces the declared network
     _, an1 = pre(cfg)
-    _, an2 = pre({**cfg2, "network.points": [], "network.observations": [],
-                  "network.gama_xml": str(path)})
+    _, an2 = pre(
+        {**cfg2, "network.points": [], "network.observations": [], "network.gama_xml": str(path)}
+    )
     np.testing.assert_allclose(an1.cov, an2.cov, rtol=1e-9)
 
 
@@ -144,17 +189,39 @@ def test_gama_export_refuses_what_gama_local_cannot_say(tmp_path):
         write_gama(build(load("network_plate")), tmp_path / "p.xml")
 
 
-@pytest.mark.parametrize("override,key", [
-    ('network.generate=[{kind="distance", from="A", to="Q*", sigma_mm=1.0}]', "network.generate"),
-    ('network.observations=[{kind="distance", from="A", to="B", sigma_mm=-1.0}]', "sigma_mm"),
-    ('datum.kind="inner"', None),
-    ('network.observations=[{kind="bearing", from="A", to="B", sigma_mm=1.0}]', "kind"),
-    ('network.points=[{name="A", x_mm=0.0, y_mm=0.0}, {name="A", x_mm=1.0, y_mm=0.0}]', "duplicate"),
-])
+@pytest.mark.parametrize(
+    "override,key",
+    [
+        (
+            'network.generate=[{kind="distance", from="A", to="Q*", sigma_mm=1.0}]',
+            "network.generate",
+        ),
+        ('network.observations=[{kind="distance", from="A", to="B", sigma_mm=-1.0}]', "sigma_mm"),
+        ('datum.kind="inner"', None),
+        ('network.observations=[{kind="bearing", from="A", to="B", sigma_mm=1.0}]', "kind"),
+        (
+            'network.points=[{name="A", x_mm=0.0, y_mm=0.0}, {name="A", x_mm=1.0, y_mm=0.0}]',
+            "duplicate",
+        ),
+    ],
+)
 def test_bad_networks_are_one_line_errors(override, key, tmp_path):
-    r = subprocess.run([sys.executable, "-m", "sim", "check", str(ROOT / "studies/network_testfield.toml"),
-                        "--set", override], cwd=ROOT, capture_output=True, text=True, timeout=120)
-    if key is None:              # inner constraints over fixed pillars are still a valid datum
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "sim",
+            "check",
+            str(ROOT / "studies/network_testfield.toml"),
+            "--set",
+            override,
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    if key is None:  # inner constraints over fixed pillars are still a valid datum
         assert r.returncode == 0, r.stderr
         return
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
@@ -162,18 +229,38 @@ def test_bad_networks_are_one_line_errors(override, key, tmp_path):
 
 
 def test_too_few_observations_is_named():
-    r = subprocess.run([sys.executable, "-m", "sim", "check", str(ROOT / "studies/network_plate.toml"),
-                        "--set", "network.generate=[]"], cwd=ROOT, capture_output=True, text=True,
-                       timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "sim",
+            "check",
+            str(ROOT / "studies/network_plate.toml"),
+            "--set",
+            "network.generate=[]",
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 2 and "0 degrees of freedom" in r.stderr, r.stderr
 
 
 def test_rank_defect_not_covered_by_the_datum_names_it(tmp_path):
     study = tmp_path / "free.toml"
-    study.write_text((ROOT / "studies/network_testfield.toml").read_text()
-                     .replace('role = "fixed"', 'role = "free"'))
-    r = subprocess.run([sys.executable, "-m", "sim", "check", str(study)], cwd=ROOT,
-                       capture_output=True, text=True, timeout=120)
+    study.write_text(
+        (ROOT / "studies/network_testfield.toml")
+        .read_text()
+        .replace('role = "fixed"', 'role = "free"')
+    )
+    r = subprocess.run(
+        [sys.executable, "-m", "sim", "check", str(study)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 2 and "rank defect of 3" in r.stderr, r.stderr
 
 
@@ -181,9 +268,11 @@ def test_jacobian_matches_finite_differences_with_constant_and_scale():
     """The model's Jacobian (every kind, the additive constant, the offset and the scale) is
     the derivative of its computed observations: central differences agree to 1e-6."""
     from sim.studies.network.model import computed
-    for name, over in (("network_brown", ("network.scale_ppm=50.0",)),
-                       ("network_testfield", ("network.scale_ppm=-30.0",
-                                              "network.constant_mm=0.2"))):
+
+    for name, over in (
+        ("network_brown", ("network.scale_ppm=50.0",)),
+        ("network_testfield", ("network.scale_ppm=-30.0", "network.constant_mm=0.2")),
+    ):
         net = build(load(name, *over))
         theta = net.theta_true() + 1e-3 * np.random.default_rng(3).standard_normal(net.q)
         _, J = computed(net, theta[None], jac=True)
@@ -195,17 +284,37 @@ def test_jacobian_matches_finite_differences_with_constant_and_scale():
             e = np.zeros(net.q)
             e[g] = h[g]
             d = computed(net, (theta + e)[None])[0] - computed(net, (theta - e)[None])[0]
-            d[ang] = (d[ang] + np.pi) % (2 * np.pi) - np.pi     # an angle's difference, wrapped
+            d[ang] = (d[ang] + np.pi) % (2 * np.pi) - np.pi  # an angle's difference, wrapped
             num[:, g] = d / (2 * h[g])
         np.testing.assert_allclose(J[0], num, rtol=1e-6, atol=1e-9 * np.abs(J).max())
 
 
 def test_an_estimated_scale_is_recovered_without_bias_and_with_its_analytic_sigma(tmp_path):
     out = tmp_path / "scale"
-    r = subprocess.run([sys.executable, "-m", "sim", "run", str(ROOT / "studies/network_testfield.toml"),
-                        "--out", str(out), "--trials", "600", "--set", "chunk=60", "--quiet",
-                        "--set", "network.estimate_scale=true", "--set", "network.scale_ppm=20.0"],
-                       cwd=ROOT, capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "sim",
+            "run",
+            str(ROOT / "studies/network_testfield.toml"),
+            "--out",
+            str(out),
+            "--trials",
+            "600",
+            "--set",
+            "chunk=60",
+            "--quiet",
+            "--set",
+            "network.estimate_scale=true",
+            "--set",
+            "network.scale_ppm=20.0",
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     p = pq.read_table(out / "parameters.parquet").to_pydict()
     k = p["parameter"].index("scale")
@@ -213,9 +322,9 @@ def test_an_estimated_scale_is_recovered_without_bias_and_with_its_analytic_sigm
     n = 600
     assert abs(p["mc_sigma"][k] / p["sigma"][k] - 1) < 4.5 / math.sqrt(2 * (n - 1))
     assert abs(p["mc_mean_error"][k]) < 4.5 * p["sigma"][k] / math.sqrt(n)
-    assert len(p["parameter"]) == 5                        # four orientations and the scale
+    assert len(p["parameter"]) == 5  # four orientations and the scale
     s = pq.read_table(out / "summary.parquet").to_pydict()
-    assert "scale" in s["gama_xml"][0]                     # gama-local cannot say it: refused
+    assert "scale" in s["gama_xml"][0]  # gama-local cannot say it: refused
     # one more unknown never improves precision: every coordinate variance grows or stays
     _, fixed = pre(load("network_testfield"))
     _, scaled = pre(load("network_testfield", "network.estimate_scale=true"))
@@ -226,31 +335,65 @@ def test_an_estimated_scale_is_recovered_without_bias_and_with_its_analytic_sigm
 
 def test_an_estimated_scale_adds_the_scale_defect_to_a_free_distance_network():
     cfg = load("network_testfield", "network.estimate_scale=true")
-    free = {**cfg, "network.points": [{**p, "role": "free"} for p in cfg["network.points"]],
-            "network.generate": [g for g in cfg["network.generate"] if g["kind"] == "distance"]
-            + [{"kind": "distance", "from": ["A", "B", "C", "D"], "to": ["A", "B", "C", "D"],
-                "sigma_mm": 1.0}],
-            "network.observations": []}
+    free = {
+        **cfg,
+        "network.points": [{**p, "role": "free"} for p in cfg["network.points"]],
+        "network.generate": [g for g in cfg["network.generate"] if g["kind"] == "distance"]
+        + [
+            {
+                "kind": "distance",
+                "from": ["A", "B", "C", "D"],
+                "to": ["A", "B", "C", "D"],
+                "sigma_mm": 1.0,
+            }
+        ],
+        "network.observations": [],
+    }
     net, inner = pre({**free, "datum.kind": "inner"})
     C = datum(net, {**free, "datum.kind": "inner"}).constraint_matrix(net.theta_true()[None])
-    assert inner.ok and C.shape[-1] == 4                  # translation x, y, rotation, scale
+    assert inner.ok and C.shape[-1] == 4  # translation x, y, rotation, scale
     _, without = pre({**free, "network.estimate_scale": False, "datum.kind": "inner"})
-    assert without.ok and inner.dof == without.dof        # one unknown more, one defect more
+    assert without.ok and inner.dof == without.dof  # one unknown more, one defect more
     from sim.studies.network.schema import check
+
     with pytest.raises(ConfigError, match=r"rank defect of 4 .* \(3 constraints\)"):
-        check({**free, "datum.kind": "constraints",
-               "datum.constraints": [{"A.x": 1.0}, {"A.y": 1.0}, {"B.y": 1.0}]})
+        check(
+            {
+                **free,
+                "datum.kind": "constraints",
+                "datum.constraints": [{"A.x": 1.0}, {"A.y": 1.0}, {"B.y": 1.0}],
+            }
+        )
 
 
 def test_a_sweep_tabulates_the_design_figures_per_cell(tmp_path):
     """A [sweep] over a network key gives, per cell, the analytic design figures; an estimated
     scale is one more unknown, so no point sigma may shrink."""
     study = tmp_path / "sweep.toml"
-    study.write_text((ROOT / "studies/network_testfield.toml").read_text()
-                     + '\n[sweep]\n"network.estimate_scale" = [false, true]\n')
-    r = subprocess.run([sys.executable, "-m", "sim", "run", str(study), "--out", str(tmp_path / "s"),
-                        "--quiet", "--set", "trials=200", "--set", "chunk=50"], cwd=ROOT,
-                       capture_output=True, text=True, timeout=300)
+    study.write_text(
+        (ROOT / "studies/network_testfield.toml").read_text()
+        + '\n[sweep]\n"network.estimate_scale" = [false, true]\n'
+    )
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "sim",
+            "run",
+            str(study),
+            "--out",
+            str(tmp_path / "s"),
+            "--quiet",
+            "--set",
+            "trials=200",
+            "--set",
+            "chunk=50",
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     t = pq.read_table(tmp_path / "s/sweep.parquet").to_pydict()
     assert t["network.estimate_scale"] == [False, True] and all(t["feasible"])
@@ -259,4 +402,4 @@ def test_a_sweep_tabulates_the_design_figures_per_cell(tmp_path):
     assert t["network.design.redundancy_min"][1] <= t["network.design.redundancy_min"][0] + 1e-12
     _, fixed = pre(load("network_testfield"))
     sig = np.sqrt(np.einsum("nii->ni", fixed.cov)[fixed.cov[:, 0, 0] > 0])
-    assert abs(rms[0] - np.sqrt(np.mean(sig ** 2))) < 1e-12 * rms[0]
+    assert abs(rms[0] - np.sqrt(np.mean(sig**2))) < 1e-12 * rms[0]

@@ -1,7 +1,8 @@
 """The progress bar (tqdm) draws on a terminal only."""
+
 import io
 
-from sim.progress import Progress
+from sim.mc.progress import Progress
 
 
 class Tty(io.StringIO):

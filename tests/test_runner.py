@@ -1,4 +1,5 @@
 """Runner reliability: executors give identical output, killed runs resume, no mixing."""
+
 import os
 import signal
 import subprocess
@@ -11,7 +12,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from sim.cli import main
-from sim.runner import ChunkStore, chunk_rng, jackknife, make_executor, run_chunks
+from sim.mc.runner import ChunkStore, chunk_rng, jackknife, make_executor, run_chunks
 from sim.studies import RunContext
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -21,7 +22,7 @@ STUDY = ROOT / "studies" / "brown_table1.toml"
 def same_result(a: Path, b: Path) -> bool:
     """Bit-for-bit equal data and equal provenance apart from the code version (which other
     work in the tree may change between two runs)."""
-    from sim.storage import read_provenance
+    from sim.mc.storage import read_provenance
 
     ta, tb = pq.read_table(a), pq.read_table(b)
     pa_, pb_ = read_provenance(a), read_provenance(b)
@@ -56,12 +57,14 @@ def test_store_resumes_and_gives_the_same_result(tmp_path):
         return _toy(rng, n)
 
     res = run_chunks(counting, 50, 9, 8, ctx=ctx)
-    assert len(calls) == 4                     # 7 chunks in all, 3 were done
+    assert len(calls) == 4  # 7 chunks in all, 3 were done
     for k in full:
         assert np.array_equal(full[k], res[k])
     rows = pq.read_table(tmp_path / "trials").to_pydict()
-    assert len(rows["x0"]) == 50               # none lost, none twice
-    assert sorted(zip(rows["chunk"], rows["trial_in_chunk"])) == sorted(set(zip(rows["chunk"], rows["trial_in_chunk"])))
+    assert len(rows["x0"]) == 50  # none lost, none twice
+    assert sorted(zip(rows["chunk"], rows["trial_in_chunk"])) == sorted(
+        set(zip(rows["chunk"], rows["trial_in_chunk"]))
+    )
 
 
 def test_process_pool_equals_in_process():
@@ -80,11 +83,30 @@ def test_dask_local_cluster_equals_local(tmp_path):
     outs = {}
     for name, extra in (("local", []), ("dask", ["--executor", "dask", "--workers", "2"])):
         o = tmp_path / name
-        assert main(["run", str(STUDY), "--out", str(o), "--trials", "60", "--quiet",
-                     "--set", "chunk=20"] + extra) == 0
+        assert (
+            main(
+                [
+                    "run",
+                    str(STUDY),
+                    "--out",
+                    str(o),
+                    "--trials",
+                    "60",
+                    "--quiet",
+                    "--set",
+                    "chunk=20",
+                ]
+                + extra
+            )
+            == 0
+        )
         outs[name] = o
-    for f in ("claims.parquet", "points.parquet", "table1_trials.parquet",
-              "trials/part-0/chunk-000002.parquet"):
+    for f in (
+        "claims.parquet",
+        "points.parquet",
+        "table1_trials.parquet",
+        "trials/part-0/chunk-000002.parquet",
+    ):
         assert same_result(outs["local"] / f, outs["dask"] / f), f
 
 
@@ -118,17 +140,30 @@ def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path, capsys):
     lives stops at once (exit 2, naming its pid), the workers die with it, no partial ``.tmp``
     stays, and the same command finishes the missing chunks."""
     out = tmp_path / "res"
-    cmd = [sys.executable, "-m", "sim", "run", str(STUDY), "--out", str(out), "--trials", "20000",
-           "--quiet", "--set", "chunk=50"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "sim",
+        "run",
+        str(STUDY),
+        "--out",
+        str(out),
+        "--trials",
+        "20000",
+        "--quiet",
+        "--set",
+        "chunk=50",
+    ]
     stage = tmp_path / ".res.partial" / "trials" / "part-0"
-    p = subprocess.Popen(cmd + ["--workers", "2"], cwd=ROOT, stdout=subprocess.DEVNULL,
-                         stderr=subprocess.DEVNULL)
+    p = subprocess.Popen(
+        cmd + ["--workers", "2"], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
     t0 = time.time()
     while time.time() - t0 < 120:
         if stage.exists() and len(list(stage.glob("chunk-*.parquet"))) >= 3:
             break
         time.sleep(0.05)
-    second = main(cmd[3:] + ["--overwrite"])   # the same --out while the first one lives
+    second = main(cmd[3:] + ["--overwrite"])  # the same --out while the first one lives
     err = capsys.readouterr().err.strip().splitlines()
     workers = _children(p.pid)
     os.kill(p.pid, signal.SIGKILL)
@@ -136,7 +171,7 @@ def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path, capsys):
     assert second == 2 and len(err) == 1 and f"running sim (pid {p.pid})" in err[0], err
     done = len(list(stage.glob("chunk-*.parquet")))
     assert 3 <= done < 400, "the run finished before it could be killed; make it longer"
-    assert not out.exists()                      # nothing that looks complete
+    assert not out.exists()  # nothing that looks complete
     assert workers, "the pool had no workers"
     t0 = time.time()
     while any(_alive(w) for w in workers) and time.time() - t0 < 20:
@@ -151,8 +186,22 @@ def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path, capsys):
     assert len(set(zip(rows["chunk"], rows["trial_in_chunk"]))) == 20000
     # identical to an uninterrupted run
     ref = tmp_path / "ref"
-    assert main(["run", str(STUDY), "--out", str(ref), "--trials", "20000", "--quiet",
-                 "--set", "chunk=50"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(STUDY),
+                "--out",
+                str(ref),
+                "--trials",
+                "20000",
+                "--quiet",
+                "--set",
+                "chunk=50",
+            ]
+        )
+        == 0
+    )
     for f in ("claims.parquet", "points.parquet", "table1_trials.parquet"):
         assert same_result(out / f, ref / f), f
 
@@ -160,15 +209,19 @@ def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path, capsys):
 def test_full_disk_is_one_line_and_no_result(tmp_path, capsys, monkeypatch):
     import errno
 
-    import sim.runner as runner
+    import sim.mc.runner as runner
 
     def full(*a, **k):
         raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(runner.pq, "write_table", full)
     out = tmp_path / "o"
-    assert main(["run", str(STUDY), "--out", str(out), "--trials", "20", "--quiet",
-                 "--set", "chunk=10"]) == 2
+    assert (
+        main(
+            ["run", str(STUDY), "--out", str(out), "--trials", "20", "--quiet", "--set", "chunk=10"]
+        )
+        == 2
+    )
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "No space left" in err[0]
     assert not out.exists()
@@ -176,23 +229,26 @@ def test_full_disk_is_one_line_and_no_result(tmp_path, capsys, monkeypatch):
 
 def test_jackknife_of_a_mean_matches_the_standard_error():
     rng = np.random.default_rng(4)
-    x = rng.normal(2.0, 3.0, size=(40, 50))              # 40 chunks of 50 draws
+    x = rng.normal(2.0, 3.0, size=(40, 50))  # 40 chunks of 50 draws
     sums = np.stack([x.sum(1), np.full(40, 50.0)], 1)
     est, lo, hi = jackknife(lambda t: t[0] / t[1], sums)
     se = x.std(ddof=1) / np.sqrt(x.size)
     assert est == pytest.approx(x.mean())
     # the jackknife SE of a mean over equal chunks is the between-chunk SE of the mean
     from scipy import stats
+
     assert (hi - lo) / 2 / stats.t.ppf(0.975, 39) == pytest.approx(
-        x.mean(1).std(ddof=1) / np.sqrt(40), rel=1e-9)
+        x.mean(1).std(ddof=1) / np.sqrt(40), rel=1e-9
+    )
     assert 0.6 < (hi - lo) / 2 / 1.96 / se < 1.4
 
 
 def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, capsys):
     """A 2 x 2 grid passes validation but makes the pivot model's reduced normals singular."""
     f = tmp_path / "s.toml"
-    f.write_text('study = "brown_table1"\ntrials = 20\nchunk = 10\n'
-                 '[sweep]\n"plate.grid" = [2, 5]\n')
+    f.write_text(
+        'study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n"plate.grid" = [2, 5]\n'
+    )
     out = tmp_path / "sw"
     assert main(["run", str(f), "--out", str(out), "--quiet"]) == 0
     t = pq.read_table(out / "sweep.parquet").to_pydict()
@@ -209,14 +265,21 @@ def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, 
 
 # --- sweeps are bounded, estimates stop oversized runs, statistics are numbers -------------
 
-@pytest.mark.parametrize("sweep, needle", [
-    ('"errors.setting_sigma_um" = {start = 1.0, stop = nan, num = 2}', "stop must be a finite"),
-    ('"errors.setting_sigma_um" = {start = "a", stop = 2.0, num = 2}', "start must be a finite"),
-    ('"errors.setting_sigma_um" = {start = 1.0, stop = 2.0, step = 1e-12}', "more than 10000"),
-    ('"errors.setting_sigma_um" = {start = 1.0, stop = 2.0, num = 5000000}', "num must be"),
-    ('replicates = 3000000\n"errors.settings" = [2]', "sweep.replicates"),
-    ('"errors.settings" = [2, 3]\n"plate.grid" = {start = 3, stop = 9000, step = 1}', "cells"),
-])
+
+@pytest.mark.parametrize(
+    "sweep, needle",
+    [
+        ('"errors.setting_sigma_um" = {start = 1.0, stop = nan, num = 2}', "stop must be a finite"),
+        (
+            '"errors.setting_sigma_um" = {start = "a", stop = 2.0, num = 2}',
+            "start must be a finite",
+        ),
+        ('"errors.setting_sigma_um" = {start = 1.0, stop = 2.0, step = 1e-12}', "more than 10000"),
+        ('"errors.setting_sigma_um" = {start = 1.0, stop = 2.0, num = 5000000}', "num must be"),
+        ('replicates = 3000000\n"errors.settings" = [2]', "sweep.replicates"),
+        ('"errors.settings" = [2, 3]\n"plate.grid" = {start = 3, stop = 9000, step = 1}', "cells"),
+    ],
+)
 def test_sweep_cell_count_is_finite_and_bounded(tmp_path, capsys, sweep, needle):
     f = tmp_path / "s.toml"
     f.write_text(f'study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n{sweep}\n')
@@ -227,26 +290,32 @@ def test_sweep_cell_count_is_finite_and_bounded(tmp_path, capsys, sweep, needle)
 
 
 def test_dotted_range_syntax_and_sweep_chunks_carry_provenance(tmp_path):
-    from sim.storage import read_provenance
+    from sim.mc.storage import read_provenance
 
     f = tmp_path / "s.toml"
-    f.write_text('study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n'
-                 'errors.settings = {start = 2, stop = 3, num = 2}\n')
+    f.write_text(
+        'study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n'
+        "errors.settings = {start = 2, stop = 3, num = 2}\n"
+    )
     assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     t = pq.read_table(tmp_path / "o" / "sweep.parquet").to_pydict()
     assert t["errors.settings"] == [2.0, 3.0] and t["feasible"] == [True, True]
-    prov = read_provenance(tmp_path / "o" / "cells" / "cell0001_r0" / "trials" / "part-0" /
-                           "chunk-000001.parquet")
+    prov = read_provenance(
+        tmp_path / "o" / "cells" / "cell0001_r0" / "trials" / "part-0" / "chunk-000001.parquet"
+    )
     assert prov["config"]["errors.settings"] == 3 and prov["sweep_cell"] == "cell0001_r0"
     assert prov["spawn_key"] == [0, 1] and "numpy" in prov["versions"]
     import json
+
     assert "tqdm" in json.loads((tmp_path / "o" / "run.json").read_text())["versions"]
 
 
 def test_a_sweep_whose_every_cell_fails_exits_2_with_the_reasons(tmp_path, capsys):
     f = tmp_path / "s.toml"
-    f.write_text('study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n'
-                 '"plate.spacing_mm" = [80.0, 90.0]\n')
+    f.write_text(
+        'study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n'
+        '"plate.spacing_mm" = [80.0, 90.0]\n'
+    )
     assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "every cell failed (2 of 2)" in err[0] and "plate" in err[0]
@@ -254,14 +323,14 @@ def test_a_sweep_whose_every_cell_fails_exits_2_with_the_reasons(tmp_path, capsy
 
 
 def test_the_estimate_stops_an_oversized_run_at_once(tmp_path, capsys, monkeypatch):
-    from sim.config import load_study
-    from sim.estimate import estimate
+    from sim.mc.config import load_study
+    from sim.mc.estimate import estimate
 
     _, cfg = load_study(STUDY)
     small = estimate(cfg)
     _, cfg = load_study(STUDY, ["plate.grid=200", "plate.spacing_mm=1.0"])
     big = estimate(cfg)
-    assert big.unknowns == 2 * 200 ** 2 + 7 and big.bytes > 1000 * small.bytes
+    assert big.unknowns == 2 * 200**2 + 7 and big.bytes > 1000 * small.bytes
     args = ["run", str(STUDY), "--out", str(tmp_path / "o"), "--quiet", "--set", "chunk=100"]
     assert main(args + ["--max-memory-gb", "0.001"]) == 2
     monkeypatch.setenv("SIM_MAX_ADJUSTMENTS", "1000")
@@ -272,22 +341,39 @@ def test_the_estimate_stops_an_oversized_run_at_once(tmp_path, capsys, monkeypat
 
 
 def test_require_finite_and_write_table_refuse_non_finite_statistics(tmp_path):
-    from sim.config import StudyError
-    from sim.runner import require_finite
-    from sim.storage import NonFiniteError, write_table
+    from sim.mc.config import StudyError
+    from sim.mc.runner import require_finite
+    from sim.mc.storage import NonFiniteError, write_table
 
     assert require_finite("x", [1.0, 2.0], "part").tolist() == [1.0, 2.0]
     with pytest.raises(StudyError, match="dilution: sigma_um is not finite .*change errors.x"):
         require_finite("sigma_um", [1.0, np.inf, np.nan], "dilution", key="errors.x")
-    write_table(tmp_path / "ok.parquet", {"a": [1.0, np.nan]}, {})      # NaN may mean missing
+    write_table(tmp_path / "ok.parquet", {"a": [1.0, np.nan]}, {})  # NaN may mean missing
     with pytest.raises(NonFiniteError, match="column a is inf"):
         write_table(tmp_path / "bad.parquet", {"a": [1.0, np.inf]}, {})
     with pytest.raises(NonFiniteError, match="claim c2"):
-        write_table(tmp_path / "claims.parquet", {"claim": ["c1", "c2"], "value": [1.0, 2.0],
-                                                  "ci_low": [0.5, np.nan], "ci_high": [2.0, 3.0],
-                                                  "verdict": ["holds", "fails"]}, {})
+        write_table(
+            tmp_path / "claims.parquet",
+            {
+                "claim": ["c1", "c2"],
+                "value": [1.0, 2.0],
+                "ci_low": [0.5, np.nan],
+                "ci_high": [2.0, 3.0],
+                "verdict": ["holds", "fails"],
+            },
+            {},
+        )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.parquet"]
-    write_table(tmp_path / "claims.parquet", {"claim": ["c1"], "value": [None], "ci_low": [None],
-                                              "ci_high": [None], "verdict": ["not comparable"]}, {})
+    write_table(
+        tmp_path / "claims.parquet",
+        {
+            "claim": ["c1"],
+            "value": [None],
+            "ci_low": [None],
+            "ci_high": [None],
+            "verdict": ["not comparable"],
+        },
+        {},
+    )
     with pytest.raises(StudyError, match="at least 2 chunks"):
         jackknife(lambda t: t[0], np.ones((1, 2)))

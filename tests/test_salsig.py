@@ -1,11 +1,12 @@
 """Seed 002 (Salsig): encoder pieces, the calibration chain, the study's claims."""
+
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from sim import encoders as enc
-from sim.config import ConfigError, load_study, validate
+from sim.instruments import encoders as enc
+from sim.mc.config import ConfigError, load_study, validate
 from sim.studies import salsig
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -19,8 +20,9 @@ def _cfg(**over):
 def test_published_decompositions_claims():
     d = salsig.decompositions()
     assert d["quantity"][:3] == ["SX", "SY", "E_arcsec"]
-    got = {(f, q): (v, p) for f, q, v, p in zip(d["figure"], d["quantity"], d["value"],
-                                                d["printed"])}
+    got = {
+        (f, q): (v, p) for f, q, v, p in zip(d["figure"], d["quantity"], d["value"], d["printed"])
+    }
     for q, tol in (("SX", 1e-9), ("SY", 1e-9), ("E_arcsec", 0.05)):
         v, p = got[("FIG. 3", q)]
         assert abs(v - p) <= tol, q
@@ -63,14 +65,24 @@ def test_conformal3d_is_least_squares():
     base = np.sum(f["residuals"] ** 2)
     for _ in range(50):
         dR = enc.rotation_matrix(*rng.normal(0, 1e-4, 3))
-        Y2 = enc.apply_conformal3d(f["scale"] * (1 + rng.normal(0, 1e-5, 1)), (dR @ f["R"][0])[None],
-                                   f["t"] + rng.normal(0, 1e-2, (1, 3)), X)
+        Y2 = enc.apply_conformal3d(
+            f["scale"] * (1 + rng.normal(0, 1e-5, 1)),
+            (dR @ f["R"][0])[None],
+            f["t"] + rng.normal(0, 1e-2, (1, 3)),
+            X,
+        )
         assert np.sum((Y - Y2) ** 2) >= base - 1e-9
 
 
 def test_z_scale_correction_removes_vertical_residuals_without_noise():
-    cfg = _cfg(**{"vertical.sigma_xy_um": 0.0, "vertical.sigma_z_um": 1e-9,
-                  "b8.sy_mm_per_digit": 12.700082809, "b8.e_arcsec": 0.0})
+    cfg = _cfg(
+        **{
+            "vertical.sigma_xy_um": 0.0,
+            "vertical.sigma_z_um": 1e-9,
+            "b8.sy_mm_per_digit": 12.700082809,
+            "b8.e_arcsec": 0.0,
+        }
+    )
     r = salsig.simulate_vertical(cfg, np.random.default_rng(4), 50)
     assert np.all(r["rms_z_after_um"] < 1e-6)
     assert np.all(r["rms_z_before_um"] > 1.0)
@@ -108,16 +120,32 @@ def test_bad_config_names_the_key(tmp_path):
         load_study(f)
 
 
-@pytest.mark.parametrize("over, key", [
-    ("marks.placement_sd_mm=20.0", "marks.placement_sd_mm"),   # marks coincide: singular fit
-    ("marks.extent_mm=10.0", "marks.placement_sd_mm"),
-    ("b8.sx_mm_per_digit=1000.0", "b8.sx_mm_per_digit"),
-])
+@pytest.mark.parametrize(
+    "over, key",
+    [
+        ("marks.placement_sd_mm=20.0", "marks.placement_sd_mm"),  # marks coincide: singular fit
+        ("marks.extent_mm=10.0", "marks.placement_sd_mm"),
+        ("b8.sx_mm_per_digit=1000.0", "b8.sx_mm_per_digit"),
+    ],
+)
 def test_values_that_would_break_later_give_one_line(tmp_path, capsys, over, key):
     from sim.cli import main
 
-    rc = main(["run", str(ROOT / "studies/salsig_encoders.toml"), "--quiet", "--trials", "40",
-               "--set", "chunk=20", "--set", over, "--out", str(tmp_path / "o")])
+    rc = main(
+        [
+            "run",
+            str(ROOT / "studies/salsig_encoders.toml"),
+            "--quiet",
+            "--trials",
+            "40",
+            "--set",
+            "chunk=20",
+            "--set",
+            over,
+            "--out",
+            str(tmp_path / "o"),
+        ]
+    )
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and key in err[0]
     assert not (tmp_path / "o").exists()
@@ -128,31 +156,42 @@ def test_printed_residuals_reproduce_the_unit_weight_errors():
     from sim.studies.salsig.claims import marks_layout, s0_from_residuals
 
     m, lo, hi = s0_from_residuals(printed.FIG2_RES)
-    assert lo < m < hi and 0.0025 <= m <= 0.0035          # printed .003
+    assert lo < m < hi and 0.0025 <= m <= 0.0035  # printed .003
     m, lo, hi = s0_from_residuals(printed.FIG3_RES)
-    assert lo < m < hi and 0.0015 <= m <= 0.0025          # printed .002
+    assert lo < m < hi and 0.0015 <= m <= 0.0025  # printed .002
     lay = marks_layout()
     assert abs(lay["spacing_mm"] - 50) < 2.5 and 0.3 < lay["placement_rms_mm"] < 3.0
 
 
 def test_study_runs_small(tmp_path):
     from sim.cli import main
-    from sim.storage import read_table
+    from sim.mc.storage import read_table
     from sim.studies.salsig.report import report
 
     out = tmp_path / "ss"
-    sets = [x for line in (ROOT / "tests/data/tiny/salsig_encoders.txt").read_text().splitlines()
-            for x in ("--set", line)]
-    rc = main(["run", str(ROOT / "studies/salsig_encoders.toml"), "--quiet", *sets,
-               "--out", str(out)])
+    sets = [
+        x
+        for line in (ROOT / "tests/data/tiny/salsig_encoders.txt").read_text().splitlines()
+        for x in ("--set", line)
+    ]
+    rc = main(
+        ["run", str(ROOT / "studies/salsig_encoders.toml"), "--quiet", *sets, "--out", str(out)]
+    )
     assert rc == 0
     t = read_table(out / "claims.parquet").to_pydict()
     v = dict(zip(t["claim"], t["verdict"]))
     # the printed FIG. 2 SY disagrees with its own A-F: an erratum, the others hold
     assert v["salsig.decompose_grid.SY"] == "erratum"
-    for q in ("decompose_grid.SX", "decompose_grid.E", "decompose_b8.SX", "decompose_b8.SY",
-              "decompose_b8.E", "paper_check.s0_fig2_from_residuals",
-              "paper_check.s0_fig3_from_residuals", "paper_check.mark_spacing_mm"):
+    for q in (
+        "decompose_grid.SX",
+        "decompose_grid.E",
+        "decompose_b8.SX",
+        "decompose_b8.SY",
+        "decompose_b8.E",
+        "paper_check.s0_fig2_from_residuals",
+        "paper_check.s0_fig3_from_residuals",
+        "paper_check.mark_spacing_mm",
+    ):
         assert v["salsig." + q] == "holds", q
     # 'cut roughly in half' over models this spread cannot be a hold
     assert v["salsig.vertical_halved.rms_ratio"] in ("inconclusive", "fails")

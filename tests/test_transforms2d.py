@@ -1,14 +1,17 @@
 """2-D transformations: published decompositions, exact recovery, covariance vs Monte Carlo."""
+
 import numpy as np
 import pytest
 
-from sim import transforms2d as t2
-from sim.plate import grid_points
+from sim.instruments import transforms2d as t2
+from sim.instruments.plates import grid_points
 
-FIG2 = np.array([0.999929623, 0.011191034, -117.846539270, -0.011258985, 0.999916040,
-                 -116.507525374])
-FIG3 = np.array([12.700044103, 0.027714040, -2625.077266139, -0.031355021, 12.701997895,
-                 -5081.092972783])
+FIG2 = np.array(
+    [0.999929623, 0.011191034, -117.846539270, -0.011258985, 0.999916040, -116.507525374]
+)
+FIG3 = np.array(
+    [12.700044103, 0.027714040, -2625.077266139, -0.031355021, 12.701997895, -5081.092972783]
+)
 # each of A, B, D, E is rounded to 9 decimals: the scales can move by ~|A|+|D| times 0.5e-9
 RND = 0.5e-9 * 1.02
 
@@ -39,13 +42,26 @@ def test_noise_free_recovered_exactly(fit, n_par):
     rng = np.random.default_rng(3)
     G = grid_points(5, 40.0)
     if n_par == 6:
-        p = np.column_stack([1 + rng.normal(0, 1e-3, 7), rng.normal(0, 0.01, 7),
-                             rng.normal(0, 50, 7), rng.normal(0, 0.01, 7),
-                             1 + rng.normal(0, 1e-3, 7), rng.normal(0, 50, 7)])
+        p = np.column_stack(
+            [
+                1 + rng.normal(0, 1e-3, 7),
+                rng.normal(0, 0.01, 7),
+                rng.normal(0, 50, 7),
+                rng.normal(0, 0.01, 7),
+                1 + rng.normal(0, 1e-3, 7),
+                rng.normal(0, 50, 7),
+            ]
+        )
         dst = t2.apply_affine(p, G)
     else:
-        p = np.column_stack([1 + rng.normal(0, 1e-3, 7), rng.normal(0, 0.01, 7),
-                             rng.normal(0, 50, 7), rng.normal(0, 50, 7)])
+        p = np.column_stack(
+            [
+                1 + rng.normal(0, 1e-3, 7),
+                rng.normal(0, 0.01, 7),
+                rng.normal(0, 50, 7),
+                rng.normal(0, 50, 7),
+            ]
+        )
         dst = t2.apply_similarity(p, G)
     f = fit(G, dst)
     np.testing.assert_allclose(f.params, p, rtol=0, atol=1e-10)
@@ -90,7 +106,7 @@ def test_affine_covariance_matches_monte_carlo():
         stated = np.sqrt(np.mean(d["cov"][:, i, i]))
         assert abs(mc / stated - 1) < tol + 0.01, k
     # s0 unbiased for sigma^2
-    assert abs(np.mean(f.s0 ** 2) / sig ** 2 - 1) < 4 * np.sqrt(2 / f.dof / T)
+    assert abs(np.mean(f.s0**2) / sig**2 - 1) < 4 * np.sqrt(2 / f.dof / T)
 
 
 def test_inverse_decomposition_matches_direct():
@@ -98,9 +114,9 @@ def test_inverse_decomposition_matches_direct():
     G = grid_points(5, 50.0)
     p = t2.affine_from_columns(12.7, 12.702, -59.2 * t2.ARCSEC, 0.01)
     x2 = t2.apply_affine(t2.invert_affine(p), G[None] + rng.normal(0, 0.02, (400, 25, 2)))
-    f = t2.fit_affine(G, x2)                 # residuals on X2, as Salsig's program
+    f = t2.fit_affine(G, x2)  # residuals on X2, as Salsig's program
     d = t2.inverse_decomposition(f.params, f.cov)
-    g = t2.fit_affine(x2, np.broadcast_to(G, x2.shape))   # residuals on X1
+    g = t2.fit_affine(x2, np.broadcast_to(G, x2.shape))  # residuals on X1
     e = t2.decompose_columns(g.params, g.cov)
     # the two directions agree to second order; their stated sds to a few per cent
     assert np.max(np.abs(d["E"] - e["E"])) < 0.05 * np.sqrt(np.mean(e["cov"][:, 2, 2]))

@@ -1,4 +1,5 @@
 """`sim verify`: a re-run within tolerance passes; a number or verdict edited by hand fails."""
+
 from pathlib import Path
 
 import pyarrow as pa
@@ -6,7 +7,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from sim.cli import main
-from sim.verify import compare_dirs, markdown, write_record
+from sim.report.verify import compare_dirs, markdown, write_record
 
 ROOT = Path(__file__).resolve().parent.parent
 BROWN = ROOT / "studies" / "brown_table1.toml"
@@ -16,8 +17,22 @@ BROWN = ROOT / "studies" / "brown_table1.toml"
 def two_runs(tmp_path_factory):
     d = tmp_path_factory.mktemp("verify")
     for name in ("committed", "rerun"):
-        assert main(["run", str(BROWN), "--out", str(d / name), "--trials", "40", "--quiet",
-                     "--set", "chunk=20"]) == 0
+        assert (
+            main(
+                [
+                    "run",
+                    str(BROWN),
+                    "--out",
+                    str(d / name),
+                    "--trials",
+                    "40",
+                    "--quiet",
+                    "--set",
+                    "chunk=20",
+                ]
+            )
+            == 0
+        )
     return d
 
 
@@ -26,7 +41,9 @@ def _edit(path: Path, column: str, row: int, value) -> None:
     t = pq.read_table(path)
     col = t.column(column).to_pylist()
     col[row] = value
-    t = t.set_column(t.column_names.index(column), column, pa.array(col, t.schema.field(column).type))
+    t = t.set_column(
+        t.column_names.index(column), column, pa.array(col, t.schema.field(column).type)
+    )
     pq.write_table(t, path)
 
 
@@ -65,7 +82,7 @@ def test_a_changed_verdict_fails(two_runs, tmp_path):
 
 
 def test_declared_tolerance_is_used(tmp_path):
-    from sim.storage import write_table
+    from sim.mc.storage import write_table
 
     a, b = tmp_path / "a", tmp_path / "b"
     prov = {"study": "x", "tolerances": {"t.parquet": {"chain_mean": 0.05}}}

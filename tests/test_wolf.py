@@ -1,4 +1,5 @@
 """Wolf & Pearsall (seed 000): polynomial correction, two-point reduction, error fields, study."""
+
 from __future__ import annotations
 
 import math
@@ -7,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim import errorfields as ef
-from sim import polynomial as pl
-from sim import transforms2d as tf
-from sim.config import ConfigError, validate
+from sim.instruments import transforms2d as tf
+from sim.instruments.plotter import errorfields as ef
+from sim.instruments.plotter import polynomial as pl
+from sim.mc.config import ConfigError, validate
 from sim.studies import wolf
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -57,7 +58,7 @@ def test_cubic_field_removed_to_the_noise_level():
     fit = pl.fit_wolf(X, true)
     res = pl.apply_poly(fit, X) - true
     dof = T * 2 * (66 - 10)
-    ratio = np.sum(res ** 2) / dof / sigma_mm ** 2
+    ratio = np.sum(res**2) / dof / sigma_mm**2
     assert abs(ratio - 1) < 4 * math.sqrt(2 / dof)
     # the field itself (tens of um) is gone: residual rms ~ sigma, not the field's size
     assert np.sqrt(np.mean((true - X) ** 2)) > 20 * sigma_mm
@@ -90,7 +91,8 @@ def test_two_point_reproduces_a_and_b_exactly():
     ga, gb = np.array([0.0, 0.0]), np.array([100.0, 0.0])
     ra = rng.uniform(-5000, 5000, (T, 2))
     rb = ra + rng.uniform(20000, 30000, (T, 1)) * np.stack(
-        [np.cos(th := rng.uniform(-0.5, 0.5, T)), np.sin(th)], -1)
+        [np.cos(th := rng.uniform(-0.5, 0.5, T)), np.sin(th)], -1
+    )
     tp = pl.two_point_transform(ra, rb, ga, gb)
     out = pl.apply_two_point(tp, np.stack([ra, rb], 1))
     assert np.abs(out[:, 0] - ga).max() < 1e-12
@@ -108,7 +110,9 @@ def test_two_point_undoes_a_similarity():
     T = 10
     s = rng.uniform(200, 300, T)
     th = rng.uniform(-0.2, 0.2, T)
-    R = np.stack([np.stack([np.cos(th), -np.sin(th)], -1), np.stack([np.sin(th), np.cos(th)], -1)], -2)
+    R = np.stack(
+        [np.stack([np.cos(th), -np.sin(th)], -1), np.stack([np.sin(th), np.cos(th)], -1)], -2
+    )
     C = s[:, None, None] * np.einsum("tij,nj->tni", R, G) + rng.uniform(-1e4, 1e4, (T, 1, 2))
     ia, ib = wolf._index(G, (0, 0)), wolf._index(G, (100, 0))
     out = pl.apply_two_point(pl.two_point_transform(C[:, ia], C[:, ib], G[ia], G[ib]), C)
@@ -206,7 +210,7 @@ def test_table3_recomputation_and_its_erratum():
     d = table3_discrepancies(t)
     y505 = wolf.summary(d["dy_printed_um"][d["photo"] == "505"])
     assert y505["max"] == 17 and round(y505["mean"], 1) == 9.1
-    assert abs(y505["rms"] - math.sqrt(1108 / 11)) < 1e-12      # printed 9.7: an erratum
+    assert abs(y505["rms"] - math.sqrt(1108 / 11)) < 1e-12  # printed 9.7: an erratum
     x501 = wolf.summary(d["dx_printed_um"][d["photo"] == "501"])
     assert (x501["max"], round(x501["rms"], 1), round(x501["mean"], 1)) == (16, 8.2, 6.2)
     # the coordinates agree with the printed differences except where the note says so
@@ -238,10 +242,20 @@ def test_cli_bad_table_file_is_one_line_exit_2(tmp_path, content):
 
     f = tmp_path / "table.csv"
     f.write_bytes(content)
-    p = subprocess.run([sys.executable, "-m", "sim", "check",
-                        str(ROOT / "studies/wolf_polynomial.toml"),
-                        "--set", f"table1.file={str(f)!r}"], capture_output=True, text=True,
-                       cwd=ROOT)
+    p = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "sim",
+            "check",
+            str(ROOT / "studies/wolf_polynomial.toml"),
+            "--set",
+            f"table1.file={str(f)!r}",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
     assert p.returncode == 2
     lines = p.stderr.strip().splitlines()
     assert len(lines) == 1 and "table1.file" in lines[0] and "Traceback" not in p.stderr
@@ -278,10 +292,18 @@ def test_main_chunk_before_after_and_noise_free_limit():
     cfg = _cfg()
     out = wolf.main_chunk(cfg)(np.random.default_rng(12), 40)
     assert np.median(out["after.rms_x_um"]) < 0.5 * np.median(out["before.rms_x_um"])
-    clean = _cfg(**{"reading.pointing_sigma_um": 0.0, "field.drift_fraction": 0.0,
-                    "field.restitution_um": 0.0, "field.stress_um": 0.0,
-                    "field.encoder_periodic_um": 0.0, "field.gimbal_eccentricity_um": 0.0,
-                    "plate.grid_sigma_um": 0.0, "reading.count_um": 0.01})
+    clean = _cfg(
+        **{
+            "reading.pointing_sigma_um": 0.0,
+            "field.drift_fraction": 0.0,
+            "field.restitution_um": 0.0,
+            "field.stress_um": 0.0,
+            "field.encoder_periodic_um": 0.0,
+            "field.gimbal_eccentricity_um": 0.0,
+            "plate.grid_sigma_um": 0.0,
+            "reading.count_um": 0.01,
+        }
+    )
     o = wolf.main_chunk(clean)(np.random.default_rng(13), 20)
     assert np.max(o["after.rms_x_um"]) < 0.5 and np.max(o["after.rms_y_um"]) < 0.5
     assert np.median(o["after.rms_x_um"]) < 0.02 * np.median(o["before.rms_x_um"])
@@ -291,8 +313,11 @@ def test_chunk_functions_pickle():
     import pickle
 
     cfg = _cfg()
-    for fn in (wolf.main_chunk(cfg, (("a.", {"reading.n": 2}),), full=False),
-               wolf.degree_chunk(cfg, 20.0), wolf.stability_chunk(cfg, [0.5], [0.0])):
+    for fn in (
+        wolf.main_chunk(cfg, (("a.", {"reading.n": 2}),), full=False),
+        wolf.degree_chunk(cfg, 20.0),
+        wolf.stability_chunk(cfg, [0.5], [0.0]),
+    ):
         g = pickle.loads(pickle.dumps(fn))
         assert g.func is fn.func
 
@@ -334,8 +359,9 @@ def test_restitution_and_drift_cells_equal_the_configured_model():
 def test_cells_share_instruments_and_default_cell_equals_main():
     cfg = _cfg()
     main = wolf.main_chunk(cfg, full=False)(np.random.default_rng(5), 6)
-    cells = wolf.main_chunk(cfg, (("d.", {}), ("s.", {"reading.pointing_sigma_um": 0.5})),
-                            full=False)(np.random.default_rng(5), 6)
+    cells = wolf.main_chunk(
+        cfg, (("d.", {}), ("s.", {"reading.pointing_sigma_um": 0.5})), full=False
+    )(np.random.default_rng(5), 6)
     for k, v in main.items():
         assert np.array_equal(cells["d." + k], v)
     # less pointing noise: the date-to-date repeatability shrinks on the same instruments
@@ -343,25 +369,39 @@ def test_cells_share_instruments_and_default_cell_equals_main():
 
 
 def test_study_runs_and_reports(tmp_path):
+    from sim.mc.storage import read_table
     from sim.studies import RunContext
-    from sim.storage import read_table
 
-    cfg = {"study": "wolf_polynomial", **_cfg(**{
-        "trade.degrees": [1, 3], "trade.spacings_mm": [20.0, 50.0], "trade.n_sets": [1, 3],
-        "trade.readings": [1, 3], "trade.pointing_sigmas_um": [7.0],
-        "trade.ages_weeks": [0.0, 52.0], "trade.drift_fractions": [0.5],
-        "unprinted.pointing_sigmas_um": [3.0, 7.0], "unprinted.field_scales": [1.0],
-        "unprinted.mono_sigmas_um": [0.0, 3.0]})}
+    cfg = {
+        "study": "wolf_polynomial",
+        **_cfg(
+            **{
+                "trade.degrees": [1, 3],
+                "trade.spacings_mm": [20.0, 50.0],
+                "trade.n_sets": [1, 3],
+                "trade.readings": [1, 3],
+                "trade.pointing_sigmas_um": [7.0],
+                "trade.ages_weeks": [0.0, 52.0],
+                "trade.drift_fractions": [0.5],
+                "unprinted.pointing_sigmas_um": [3.0, 7.0],
+                "unprinted.field_scales": [1.0],
+                "unprinted.mono_sigmas_um": [0.0, 3.0],
+            }
+        ),
+    }
     wolf.run(cfg, tmp_path, RunContext(quiet=True))
     claims = read_table(tmp_path / "claims.parquet").to_pydict()
     by = {c: i for i, c in enumerate(claims["claim"])}
     from sim.studies.wolf.claims import load_book
 
-    assert set(by) == set(load_book().specs)               # every declared claim, once
+    assert set(by) == set(load_book().specs)  # every declared claim, once
     # the paper's errata: its own coordinates contradict its summary lines
-    for cid, v in (("wolf.table1.p003.rms_y_um", math.sqrt(53.0)),
-                   ("wolf.table1.p003.mean_y_um", 5.8), ("wolf.table1.p005.mean_x_um", 4.7),
-                   ("wolf.table3_check.p505.rms_y_um", math.sqrt(1108 / 11))):
+    for cid, v in (
+        ("wolf.table1.p003.rms_y_um", math.sqrt(53.0)),
+        ("wolf.table1.p003.mean_y_um", 5.8),
+        ("wolf.table1.p005.mean_x_um", 4.7),
+        ("wolf.table3_check.p505.rms_y_um", math.sqrt(1108 / 11)),
+    ):
         i = by[cid]
         assert claims["verdict"][i] == "erratum" and claims["kind"][i] == "paper-check"
         assert abs(claims["value"][i] - v) < 1e-9 and claims["holds"][i] is False
@@ -375,11 +415,15 @@ def test_study_runs_and_reports(tmp_path):
         assert len(allr) == 1
         feas = [r for r in cs if r["input"] == name and r["claim"] == "ALL-feasible"]
         assert len(feas) == 1 and feas[0]["n_consistent"] >= allr[0]["n_consistent"]
-        if allr[0]["n_consistent"]:                        # inside every dependent claim's set
+        if allr[0]["n_consistent"]:  # inside every dependent claim's set
             for r in cs:
                 if r["input"] == name and r["depends"] and not r["claim"].startswith("ALL"):
-                    assert r["holds_low"] <= allr[0]["holds_low"] <= allr[0]["holds_high"] \
+                    assert (
+                        r["holds_low"]
+                        <= allr[0]["holds_low"]
+                        <= allr[0]["holds_high"]
                         <= r["holds_high"]
+                    )
     mono = {r["claim"]: r["depends"] for r in cs if r["input"] == "mono.sigma_um"}
     assert not mono["wolf.after.rms_x_um"] and mono["wolf.table2.p003.set1.rms_x_um"]
     d = read_table(tmp_path / "degree.parquet").to_pydict()
@@ -388,6 +432,14 @@ def test_study_runs_and_reports(tmp_path):
     md = wolf.report(tmp_path)
     assert "wolf.after.rms_x_um" in md and f"{tmp_path.name}/vectors.png" in md
     assert "Consistent set of `reading.pointing_sigma_um`" in md
-    for f in ("vectors.png", "components.png", "degree.png", "readings.png", "stability.png",
-              "table1_real.png", "consistent_set.png", "trials.parquet"):
+    for f in (
+        "vectors.png",
+        "components.png",
+        "degree.png",
+        "readings.png",
+        "stability.png",
+        "table1_real.png",
+        "consistent_set.png",
+        "trials.parquet",
+    ):
         assert (tmp_path / f).is_file()

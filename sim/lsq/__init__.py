@@ -13,15 +13,31 @@
   shared by all trials, the same scaled singularity rule and per-trial status.
 Seed of the method: Brown 1968 (``004_f5bd9e86c308241f.txt``).
 """
-from . import groups
-from .gauss_newton import degrees_of_freedom, gauss_newton
-from .groups import GroupLinearization, GroupStructure
-from .linear import LINEAR_STATUS, LinearFit, lstsq
-from .normals import RCOND, scaled_rcond
-from .problem import Datum, Linearization, register_fast_path
-from .result import STATUS, Cofactors, Result, cofactors
 
-__all__ = ["gauss_newton", "degrees_of_freedom", "RCOND", "scaled_rcond", "Datum",
-           "Linearization", "register_fast_path", "STATUS", "Cofactors", "Result", "cofactors",
-           "lstsq", "LinearFit", "LINEAR_STATUS", "groups", "GroupStructure",
-           "GroupLinearization"]
+from sim.lsq import groups
+from sim.lsq.gauss_newton import degrees_of_freedom, gauss_newton
+from sim.lsq.groups import GroupLinearization, GroupStructure
+from sim.lsq.linear import LINEAR_STATUS, LinearFit, lstsq
+from sim.lsq.normals import RCOND, scaled_rcond
+from sim.lsq.problem import Datum, Linearization, register_fast_path
+from sim.lsq.result import STATUS, Cofactors, Result, cofactors
+
+__all__ = [
+    "gauss_newton",
+    "degrees_of_freedom",
+    "RCOND",
+    "scaled_rcond",
+    "Datum",
+    "Linearization",
+    "register_fast_path",
+    "STATUS",
+    "Cofactors",
+    "Result",
+    "cofactors",
+    "lstsq",
+    "LinearFit",
+    "LINEAR_STATUS",
+    "groups",
+    "GroupStructure",
+    "GroupLinearization",
+]

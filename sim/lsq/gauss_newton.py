@@ -10,14 +10,15 @@ last two corrections -- falls below ``tol``; a singular trial (the one scaled ru
 frozen; nothing raises, so one bad trial never kills its chunk. Seed of the method: Brown
 1968 (``004_f5bd9e86c308241f.txt``, iterated reduced normal equations).
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from . import groups
-from .normals import RCOND, bordered_solve, reduced_normals
-from .problem import Datum, fast_path
-from .result import Result
+from sim.lsq import groups
+from sim.lsq.normals import RCOND, bordered_solve, reduced_normals
+from sim.lsq.problem import Datum, fast_path
+from sim.lsq.result import Result
 
 __all__ = ["gauss_newton", "degrees_of_freedom"]
 
@@ -50,8 +51,9 @@ class _Progress:
         return upd
 
 
-def degrees_of_freedom(model, n_points: int, datum: Datum, theta: np.ndarray,
-                       rows: int | None = None) -> int:
+def degrees_of_freedom(
+    model, n_points: int, datum: Datum, theta: np.ndarray, rows: int | None = None
+) -> int:
     """Observations (``model.n_obs``, else ``rows``) minus unknowns plus datum constraints."""
     free = datum.free_index(model.n_global)
     m = getattr(model, "n_obs", None)
@@ -67,9 +69,17 @@ def _retract(model, points, theta, dp, dg_full):
     return points + dp, theta + dg_full
 
 
-def gauss_newton(model, theta0: np.ndarray, points0: np.ndarray | None = None,
-                 datum: Datum | None = None, tol: float = 1e-10, max_iter: int = 30,
-                 rcond: float = RCOND, engine: str = "auto", step_scale=None) -> Result:
+def gauss_newton(
+    model,
+    theta0: np.ndarray,
+    points0: np.ndarray | None = None,
+    datum: Datum | None = None,
+    tol: float = 1e-10,
+    max_iter: int = 30,
+    rcond: float = RCOND,
+    engine: str = "auto",
+    step_scale=None,
+) -> Result:
     """Batched Gauss-Newton adjustment of ``model`` (see :mod:`sim.lsq.problem`).
 
     theta0 : (T, q) the fixed globals and the start of the free ones; points0 : (T, n, d)
@@ -98,8 +108,9 @@ def gauss_newton(model, theta0: np.ndarray, points0: np.ndarray | None = None,
     C = datum.constraint_matrix(theta) if p else None
     scale = None if step_scale is None else np.asarray(step_scale, float)[free]
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        pts = (model.initial_points(theta) if points0 is None
-               else np.array(points0, float, copy=True))
+        pts = (
+            model.initial_points(theta) if points0 is None else np.array(points0, float, copy=True)
+        )
         prog = _Progress(T)
         for it in range(1, max_iter + 1):
             red = reduced_normals(model, pts, theta, free, rcond)
@@ -114,13 +125,15 @@ def gauss_newton(model, theta0: np.ndarray, points0: np.ndarray | None = None,
             if p:
                 g = np.abs(dg) if scale is None else np.abs(dg) / scale
                 step = np.maximum(step, g.max(axis=1))
-            step = np.where(np.isfinite(dp).all(axis=(1, 2)) & np.isfinite(dg).all(axis=1),
-                            step, np.nan)
+            step = np.where(
+                np.isfinite(dp).all(axis=(1, 2)) & np.isfinite(dg).all(axis=1), step, np.nan
+            )
             upd = prog.update(it, ok, step, tol)
             dg_full = np.zeros_like(theta)
             dg_full[:, free] = np.where(upd[:, None], dg, 0.0)
-            new_pts, new_theta = _retract(model, pts, theta, np.where(upd[:, None, None], dp, 0.0),
-                                          dg_full)
+            new_pts, new_theta = _retract(
+                model, pts, theta, np.where(upd[:, None, None], dp, 0.0), dg_full
+            )
             pts = np.where(upd[:, None, None], new_pts, pts)
             theta = np.where(upd[:, None], new_theta, theta)
             if not prog.active.any():
@@ -151,14 +164,16 @@ def _grouped(model, theta, points0, datum, tol, max_iter, rcond, step_scale) -> 
     scale = None if step_scale is None else np.asarray(step_scale, float)
     solver = getattr(model, "solver", "auto")
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        pts = (model.initial_points(theta) if points0 is None
-               else np.array(points0, float, copy=True))
+        pts = (
+            model.initial_points(theta) if points0 is None else np.array(points0, float, copy=True)
+        )
         prog = _Progress(T)
         for it in range(1, max_iter + 1):
             act = np.flatnonzero(prog.active)
-            if act.size < T and hasattr(model, "take"):   # only the trials still iterating
-                dp_a, dg_a, ok_a = groups.step(st, model.take(act).linearize(pts[act], theta[act]),
-                                               solver, rcond, it == 1)
+            if act.size < T and hasattr(model, "take"):  # only the trials still iterating
+                dp_a, dg_a, ok_a = groups.step(
+                    st, model.take(act).linearize(pts[act], theta[act]), solver, rcond, it == 1
+                )
                 dp, dg = np.zeros_like(pts), np.zeros((T,) + dg_a.shape[1:])
                 ok = np.ones(T, bool)
                 dp[act], dg[act], ok[act] = dp_a, dg_a, ok_a
@@ -166,21 +181,28 @@ def _grouped(model, theta, points0, datum, tol, max_iter, rcond, step_scale) -> 
                 dp, dg, ok = groups.step(st, model.linearize(pts, theta), solver, rcond, it == 1)
             g = np.abs(dg) if scale is None else np.abs(dg) / scale
             step = np.maximum(np.abs(dp).max(axis=(1, 2)), g.max(axis=1))
-            step = np.where(np.isfinite(dp).all(axis=(1, 2)) & np.isfinite(dg).all(axis=1),
-                            step, np.nan)
+            step = np.where(
+                np.isfinite(dp).all(axis=(1, 2)) & np.isfinite(dg).all(axis=1), step, np.nan
+            )
             upd = prog.update(it, ok, step, tol)
-            new_pts, new_theta = model.retract(pts, theta, np.where(upd[:, None, None], dp, 0.0),
-                                               np.where(upd[:, None], dg, 0.0))
+            new_pts, new_theta = model.retract(
+                pts, theta, np.where(upd[:, None, None], dp, 0.0), np.where(upd[:, None], dg, 0.0)
+            )
             pts = np.where(upd[:, None, None], new_pts, pts)
             theta = np.where(_bcast(upd, theta), new_theta, theta)
             if not prog.active.any():
                 break
         lin = model.linearize(pts, theta)
-        vpv = (np.einsum("tkm,tkm->t", lin.w * lin.r, lin.r)
-               + np.einsum("tcm,tcm->t", lin.wc * lin.rc, lin.rc))
-    present = (groups.scatter(st.S_point, lin.w) + groups.scatter(st.S_rows, lin.wc) > 0)
-    dof = ((lin.w > 0).sum(axis=(1, 2)) + (lin.wc > 0).sum(axis=(1, 2))
-           - st.n_groups * lin.Jg.shape[-1] - model.point_dim * present.any(-1).sum(-1))
+        vpv = np.einsum("tkm,tkm->t", lin.w * lin.r, lin.r) + np.einsum(
+            "tcm,tcm->t", lin.wc * lin.rc, lin.rc
+        )
+    present = groups.scatter(st.S_point, lin.w) + groups.scatter(st.S_rows, lin.wc) > 0
+    dof = (
+        (lin.w > 0).sum(axis=(1, 2))
+        + (lin.wc > 0).sum(axis=(1, 2))
+        - st.n_groups * lin.Jg.shape[-1]
+        - model.point_dim * present.any(-1).sum(-1)
+    )
     s0 = np.sqrt(vpv / np.maximum(dof, 1))
     res = Result(pts, theta, lin.r, s0, dof, prog.iters, prog.status, model, datum)
     res.point_residuals = lin.rc

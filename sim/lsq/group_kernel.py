@@ -20,6 +20,7 @@ two agree to rounding (tests hold them to 1e-12 relative). Units: those of the m
 is imported on first use and the compiled code cached on disk (:func:`compiled`); without
 numba, or with ``SIM_NO_JIT`` set, :func:`available` is False and the NumPy path runs.
 """
+
 from __future__ import annotations
 
 import os
@@ -31,8 +32,9 @@ __all__ = ["available", "compiled", "pair_blocks", "diag_reduce", "points_step",
 _compiled: dict | None = None
 
 
-def _pair_blocks(Npg, F, Jg, w, r, up, og, op, pk1, pk2, pq, mir_dst, mir_src, diag_obs,
-                 blocks, ubar):  # pragma: no cover - compiled
+def _pair_blocks(
+    Npg, F, Jg, w, r, up, og, op, pk1, pk2, pq, mir_dst, mir_src, diag_obs, blocks, ubar
+):  # pragma: no cover - compiled
     T, K, d, b = Npg.shape
     m = Jg.shape[2]
     n_pk = pk1.shape[0]
@@ -76,10 +78,33 @@ def _pair_blocks(Npg, F, Jg, w, r, up, og, op, pk1, pk2, pq, mir_dst, mir_src, d
                     blocks[t, mir_dst[e], i, j] = blocks[t, mir_src[e], j, i]
 
 
-def _diag_reduce(Jg, w, r, wc, rc, jp, jc, og, op, rows, diag_obs, xk1, xk2, xq, mir_dst,
-                 mir_src, npp, up, Npg, F, ok, blocks, ubar):  # pragma: no cover - compiled
+def _diag_reduce(
+    Jg,
+    w,
+    r,
+    wc,
+    rc,
+    jp,
+    jc,
+    og,
+    op,
+    rows,
+    diag_obs,
+    xk1,
+    xk2,
+    xq,
+    mir_dst,
+    mir_src,
+    npp,
+    up,
+    Npg,
+    F,
+    ok,
+    blocks,
+    ubar,
+):  # pragma: no cover - compiled
     T, K = Jg.shape[0], Jg.shape[1]
-    m, b = D_POINT, B_GROUP    # compile-time constants (see compiled); m = d here
+    m, b = D_POINT, B_GROUP  # compile-time constants (see compiled); m = d here  # noqa: F821 (set by the compile helper)
     P = npp.shape[1]
     C = rows.shape[0]
     for t in range(T):
@@ -110,7 +135,7 @@ def _diag_reduce(Jg, w, r, wc, rc, jp, jc, og, op, rows, diag_obs, xk1, xk2, xq,
             if not (use or absent):
                 good = False
             for a in range(m):
-                npp[t, j, a] = 1.0 / npp[t, j, a] if use else 0.0   # now Npp^-1
+                npp[t, j, a] = 1.0 / npp[t, j, a] if use else 0.0  # now Npp^-1
         ok[t] = good
         blocks[t] = 0.0
         ubar[t] = 0.0
@@ -124,7 +149,7 @@ def _diag_reduce(Jg, w, r, wc, rc, jp, jc, og, op, rows, diag_obs, xk1, xk2, xq,
                     x = wp * Jg[t, k, a, i]
                     Npg[t, k, a, i] = x
                     F[t, k, a, i] = ni * x
-                coef = wa - wp * wp * ni     # Ngg_k minus the pair (k, k)
+                coef = wa - wp * wp * ni  # Ngg_k minus the pair (k, k)
                 for i in range(b):
                     x = coef * Jg[t, k, a, i]
                     for jj in range(b):
@@ -204,8 +229,9 @@ def compiled(fn, reassociate: bool = False, **consts):
         f = fn
         if consts:
             name = "_".join([fn.__name__] + [str(v) for _, v in sorted(consts.items())])
-            f = types.FunctionType(fn.__code__, dict(fn.__globals__, **consts), name,
-                                   fn.__defaults__, fn.__closure__)
+            f = types.FunctionType(
+                fn.__code__, dict(fn.__globals__, **consts), name, fn.__defaults__, fn.__closure__
+            )
             f.__qualname__ = name
         opts = {"fastmath": set(REASSOCIATE)} if reassociate else {}
         _compiled[key] = njit(cache=True, error_model="numpy", **opts)(f)
@@ -228,9 +254,24 @@ def pair_blocks(st, Npg, F, Jg, w, r, up):
     blocks = np.empty((T, st.pair_g1.size, b, b))
     ubar = np.empty((T, st.n_groups, b))
     ix = st.kernel_index
-    compiled(_pair_blocks)(_c(Npg), _c(F), _c(Jg), _c(w), _c(r), _c(up), ix["og"], ix["op"],
-                           ix["pk1"], ix["pk2"], ix["pq"], ix["mir_dst"], ix["mir_src"],
-                           ix["diag_obs"], blocks, ubar)
+    compiled(_pair_blocks)(
+        _c(Npg),
+        _c(F),
+        _c(Jg),
+        _c(w),
+        _c(r),
+        _c(up),
+        ix["og"],
+        ix["op"],
+        ix["pk1"],
+        ix["pk2"],
+        ix["pq"],
+        ix["mir_dst"],
+        ix["mir_src"],
+        ix["diag_obs"],
+        blocks,
+        ubar,
+    )
     return blocks, ubar
 
 
@@ -248,9 +289,31 @@ def diag_reduce(st, lin, jp: np.ndarray, jc: np.ndarray):
     blocks = np.empty((T, st.pair_g1.size, b, b))
     ubar = np.empty((T, st.n_groups, b))
     kernel = compiled(_diag_reduce, D_POINT=m, B_GROUP=b)
-    kernel(_c(lin.Jg), _c(lin.w), _c(lin.r), _c(lin.wc), _c(lin.rc), _c(jp), _c(jc), ix["og"],
-           ix["op"], ix["rows"], ix["diag_obs"], ix["xk1"], ix["xk2"], ix["xq"], ix["mir_dst"],
-           ix["mir_src"], ninv, up, Npg, F, ok, blocks, ubar)
+    kernel(
+        _c(lin.Jg),
+        _c(lin.w),
+        _c(lin.r),
+        _c(lin.wc),
+        _c(lin.rc),
+        _c(jp),
+        _c(jc),
+        ix["og"],
+        ix["op"],
+        ix["rows"],
+        ix["diag_obs"],
+        ix["xk1"],
+        ix["xk2"],
+        ix["xq"],
+        ix["mir_dst"],
+        ix["mir_src"],
+        ninv,
+        up,
+        Npg,
+        F,
+        ok,
+        blocks,
+        ubar,
+    )
     return blocks, ubar, ninv[..., :, None] * np.eye(m), up, Npg, F, ok
 
 
@@ -262,9 +325,18 @@ def points_step(st, Npg, Ninv, up, dg) -> np.ndarray:
     return out
 
 
-def index(og: np.ndarray, op: np.ndarray, pk1: np.ndarray, pk2: np.ndarray,
-          pair_of: np.ndarray, pair_g1: np.ndarray, pair_g2: np.ndarray,
-          diag_of_group: np.ndarray, n_points: int, rows: np.ndarray) -> dict:
+def index(
+    og: np.ndarray,
+    op: np.ndarray,
+    pk1: np.ndarray,
+    pk2: np.ndarray,
+    pair_of: np.ndarray,
+    pair_g1: np.ndarray,
+    pair_g2: np.ndarray,
+    diag_of_group: np.ndarray,
+    n_points: int,
+    rows: np.ndarray,
+) -> dict:
     """Integer arrays the kernels read (structure only, built once): the observation pairs
     with ``g1 <= g2`` and their pair block ``pq``, the mirrored pair blocks, each
     observation's diagonal block, the pairs of distinct observations (``xk1, xk2, xq``)
@@ -279,9 +351,21 @@ def index(og: np.ndarray, op: np.ndarray, pk1: np.ndarray, pk2: np.ndarray,
     order = np.argsort(op, kind="stable")
     counts = np.bincount(op, minlength=n_points)
     i64 = lambda a: np.ascontiguousarray(a, np.int64)  # noqa: E731
-    return {"og": i64(og), "op": i64(op), "pk1": i64(pk1[lower]), "pk2": i64(pk2[lower]),
-            "pq": i64(pair_of[lower]), "pg1": i64(pair_g1), "pg2": i64(pair_g2),
-            "mir_dst": i64(mir), "mir_src": i64(src),
-            "diag_obs": i64(diag_of_group[og]), "xk1": i64(pk1[cross]),
-            "xk2": i64(pk2[cross]), "xq": i64(pair_of[cross]), "rows": i64(rows),
-            "pstart": i64(np.concatenate([[0], np.cumsum(counts)])), "pobs": i64(order)}
+    return {
+        "og": i64(og),
+        "op": i64(op),
+        "pk1": i64(pk1[lower]),
+        "pk2": i64(pk2[lower]),
+        "pq": i64(pair_of[lower]),
+        "pg1": i64(pair_g1),
+        "pg2": i64(pair_g2),
+        "mir_dst": i64(mir),
+        "mir_src": i64(src),
+        "diag_obs": i64(diag_of_group[og]),
+        "xk1": i64(pk1[cross]),
+        "xk2": i64(pk2[cross]),
+        "xq": i64(pair_of[cross]),
+        "rows": i64(rows),
+        "pstart": i64(np.concatenate([[0], np.cumsum(counts)])),
+        "pobs": i64(order),
+    }

@@ -17,11 +17,12 @@ Each equals the NumPy path of :mod:`sim.lsq.groups` / :mod:`sim.lsq.group_solve`
 rounding (tests). Units: those of the model; cofactors for unit weight. Call only when
 :func:`sim.lsq.group_kernel.available`.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from .group_kernel import _c, compiled
+from sim.lsq.group_kernel import _c, compiled
 
 __all__ = ["dense_scaled", "chol_vec", "chol_inv", "residual_cofactors"]
 
@@ -64,7 +65,7 @@ def _chol_inv(L, Q):  # pragma: no cover - compiled
     T, n = L.shape[0], L.shape[1]
     X = np.empty((n, n))
     for t in range(T):
-        for i in range(n):            # X = L^-1 by rows (contiguous axpys)
+        for i in range(n):  # X = L^-1 by rows (contiguous axpys)
             for j in range(i + 1):
                 X[i, j] = 0.0
             for k in range(i):
@@ -75,7 +76,7 @@ def _chol_inv(L, Q):  # pragma: no cover - compiled
             inv = 1.0 / L[t, i, i]
             for j in range(i + 1):
                 X[i, j] *= inv
-        for i in range(n):            # Q = X' X, lower triangle by rank-one updates
+        for i in range(n):  # Q = X' X, lower triangle by rank-one updates
             for j in range(i + 1):
                 Q[t, i, j] = 0.0
         for k in range(n):
@@ -91,7 +92,7 @@ def _chol_inv(L, Q):  # pragma: no cover - compiled
 def _residual_cofactors(Q, F, Ninv, Jg, Jp, w, og, op, pts, pstart, pobs, out):
     # pragma: no cover - compiled
     T = F.shape[0]
-    d, b, m = D_POINT, B_GROUP, M_ROWS    # compile-time constants (see compiled)
+    d, b, m = D_POINT, B_GROUP, M_ROWS  # compile-time constants (see compiled)  # noqa: F821 (set by the compile helper)
     nmax = 0
     for j in pts:
         nmax = max(nmax, pstart[j + 1] - pstart[j])
@@ -192,6 +193,18 @@ def residual_cofactors(st, Q, F, Ninv, Jg, Jp, w, points: np.ndarray) -> np.ndar
     out = np.full(w.shape, np.nan)
     T, K, d, b = F.shape
     kernel = compiled(_residual_cofactors, D_POINT=d, B_GROUP=b, M_ROWS=Jg.shape[2])
-    kernel(_c(Q), _c(F), _c(Ninv), _c(Jg), _c(Jp), _c(w), ix["og"], ix["op"],
-           np.asarray(points, np.int64), ix["pstart"], ix["pobs"], out)
+    kernel(
+        _c(Q),
+        _c(F),
+        _c(Ninv),
+        _c(Jg),
+        _c(Jp),
+        _c(w),
+        ix["og"],
+        ix["op"],
+        np.asarray(points, np.int64),
+        ix["pstart"],
+        ix["pobs"],
+        out,
+    )
     return out

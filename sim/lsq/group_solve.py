@@ -9,6 +9,7 @@ a factorisation that fails in the banded elimination is located trial by trial).
 Seed of the method: Agnard, Nolette & Gagnon (``003_5ce730a990a7ebc5.txt``, SPACE-M's
 reduced normals of the models); Brown 1968 (``004_f5bd9e86c308241f.txt``) for the rule.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -16,10 +17,22 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from .normals import RCOND, scaled_rcond
+from sim.lsq.normals import RCOND, scaled_rcond
 
-__all__ = ["Band", "band_order", "chol_factor", "chol_subst", "chol_solve", "regular", "factor",
-           "inv_points", "regular_points", "dense", "scaled", "band_solve"]
+__all__ = [
+    "Band",
+    "band_order",
+    "chol_factor",
+    "chol_subst",
+    "chol_solve",
+    "regular",
+    "factor",
+    "inv_points",
+    "regular_points",
+    "dense",
+    "scaled",
+    "band_solve",
+]
 
 
 @dataclass
@@ -52,8 +65,15 @@ def band_order(pair_g1: np.ndarray, pair_g2: np.ndarray, G: int) -> Band:
     nblk = -(-G // w)
     b1, b2 = p1 // w, p2 // w
     d, s = np.flatnonzero(b1 == b2), np.flatnonzero(b1 == b2 + 1)
-    return Band(perm, pos, w, nblk, nblk * w - G, (d, b1[d], p1[d] % w, p2[d] % w),
-                (s, b2[s], p1[s] % w, p2[s] % w))
+    return Band(
+        perm,
+        pos,
+        w,
+        nblk,
+        nblk * w - G,
+        (d, b1[d], p1[d] % w, p2[d] % w),
+        (s, b2[s], p1[s] % w, p2[s] % w),
+    )
 
 
 def chol_factor(N: np.ndarray) -> np.ndarray:
@@ -138,8 +158,14 @@ def inv_points(Npp: np.ndarray, use: np.ndarray) -> np.ndarray:
     c12 = a[..., 0, 2] * a[..., 1, 0] - a[..., 0, 0] * a[..., 1, 2]
     c22 = a[..., 0, 0] * a[..., 1, 1] - a[..., 0, 1] * a[..., 1, 0]
     det = a[..., 0, 0] * c00 + a[..., 1, 0] * c01 + a[..., 2, 0] * c02
-    inv = np.stack([np.stack([c00, c01, c02], -1), np.stack([c01, c11, c12], -1),
-                    np.stack([c02, c12, c22], -1)], -2)
+    inv = np.stack(
+        [
+            np.stack([c00, c01, c02], -1),
+            np.stack([c01, c11, c12], -1),
+            np.stack([c02, c12, c22], -1),
+        ],
+        -2,
+    )
     inv = inv / np.where(use, det, 1.0)[..., None, None]
     return inv * s[..., :, None] * s[..., None, :]
 
@@ -207,12 +233,15 @@ def band_solve(st, blocks: np.ndarray, rhs: np.ndarray):
     D = D * s[..., :, None] * s[..., None, :]
     E = E * s[:, 1:, :, None] * s[:, :-1, None, :]
     y = y * s
-    ok = (np.isfinite(D).all(axis=(1, 2, 3)) & np.isfinite(E).all(axis=(1, 2, 3))
-          & np.isfinite(y).all(axis=(1, 2)))
+    ok = (
+        np.isfinite(D).all(axis=(1, 2, 3))
+        & np.isfinite(E).all(axis=(1, 2, 3))
+        & np.isfinite(y).all(axis=(1, 2))
+    )
     D = np.where(ok[:, None, None, None], D, np.eye(B))
     E = np.where(ok[:, None, None, None], E, 0.0)
     y = np.where(ok[:, None, None], y, 0.0)[..., None]
-    Ls, Ms = [], []    # inverse diagonal factors, sub-diagonal blocks L_{i+1,i}
+    Ls, Ms = [], []  # inverse diagonal factors, sub-diagonal blocks L_{i+1,i}
     for i in range(nb):
         A = D[:, i] - Ms[-1] @ np.swapaxes(Ms[-1], -1, -2) if i else D[:, i]
         try:

@@ -27,6 +27,7 @@ optionally only for the points asked for. A point block whose
 normal matrix is exactly zero (every observation of the point removed) is absent: its
 unknowns are not corrected and do not count. Units: those of the model.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -34,10 +35,19 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from . import group_kernel, group_kernel_solve
-from .group_solve import (band_order, band_solve, chol_solve, chol_subst, dense, factor,
-                          inv_points, regular, regular_points, scaled)
-from .normals import RCOND
+from sim.lsq import group_kernel, group_kernel_solve
+from sim.lsq.group_solve import (
+    band_order,
+    band_solve,
+    chol_solve,
+    chol_subst,
+    dense,
+    factor,
+    inv_points,
+    regular_points,
+    scaled,
+)
+from sim.lsq.normals import RCOND
 
 __all__ = ["GroupStructure", "GroupLinearization", "chol_solve", "step", "cofactors"]
 
@@ -64,8 +74,11 @@ def _buckets(keys: np.ndarray, n: int) -> list[tuple[np.ndarray, np.ndarray]]:
     order = np.argsort(keys, kind="stable")
     counts = np.bincount(keys, minlength=n)
     starts = np.cumsum(counts) - counts
-    return [(ids, order[starts[ids][:, None] + np.arange(c)])
-            for c in np.unique(counts[counts > 0]) for ids in [np.flatnonzero(counts == c)]]
+    return [
+        (ids, order[starts[ids][:, None] + np.arange(c)])
+        for c in np.unique(counts[counts > 0])
+        for ids in [np.flatnonzero(counts == c)]
+    ]
 
 
 class GroupStructure:
@@ -78,8 +91,9 @@ class GroupStructure:
     observations of each group and ``point_buckets`` those of each point, bucketed by count.
     """
 
-    def __init__(self, obs_group, obs_point, point_rows, n_groups: int, n_points: int,
-                 sparse_from: int = 60):
+    def __init__(
+        self, obs_group, obs_point, point_rows, n_groups: int, n_points: int, sparse_from: int = 60
+    ):
         og = np.asarray(obs_group, np.intp)
         op = np.asarray(obs_point, np.intp)
         self.obs_group, self.obs_point = og, op
@@ -113,8 +127,17 @@ class GroupStructure:
         """Index arrays of the compiled kernels (:func:`sim.lsq.group_kernel.index`)."""
         if self._kernel_index is None:
             self._kernel_index = group_kernel.index(
-                self.obs_group, self.obs_point, self.pk1, self.pk2, self.pair_of,
-                self.pair_g1, self.pair_g2, self.diag_of_group, self.n_points, self.point_rows)
+                self.obs_group,
+                self.obs_point,
+                self.pk1,
+                self.pk2,
+                self.pair_of,
+                self.pair_g1,
+                self.pair_g2,
+                self.diag_of_group,
+                self.n_points,
+                self.point_rows,
+            )
         return self._kernel_index
 
 
@@ -135,13 +158,13 @@ class GroupLinearization:
 
 @dataclass
 class GroupReduced:
-    blocks: np.ndarray   # (T, n_pairs, b, b)
-    ubar: np.ndarray     # (T, G, b)
-    Ninv: np.ndarray     # (T, P, d, d), zero for absent points
-    up: np.ndarray       # (T, P, d)
-    Npg: np.ndarray      # (T, K, d, b)
-    NinvK: np.ndarray    # (T, K, d, b) = Ninv_j Npg_k
-    ok: np.ndarray       # (T,)
+    blocks: np.ndarray  # (T, n_pairs, b, b)
+    ubar: np.ndarray  # (T, G, b)
+    Ninv: np.ndarray  # (T, P, d, d), zero for absent points
+    up: np.ndarray  # (T, P, d)
+    Npg: np.ndarray  # (T, K, d, b)
+    NinvK: np.ndarray  # (T, K, d, b) = Ninv_j Npg_k
+    ok: np.ndarray  # (T,)
 
 
 def _tn(A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -165,29 +188,31 @@ def _point_blocks(st: GroupStructure, lin: GroupLinearization, rcond: float):
     jp, jc = _const_diag(lin.Jp), _const_diag(lin.Jc)
     if jp is not None and jc is not None and (jp != 0).all():
         wp, wc = lin.w * jp, lin.wc * jc
-        npp = scatter(st.S_point, wp * jp) + scatter(st.S_rows, wc * jc)   # (T, P, d)
+        npp = scatter(st.S_point, wp * jp) + scatter(st.S_rows, wc * jc)  # (T, P, d)
         up = scatter(st.S_point, wp * lin.r) + scatter(st.S_rows, wc * lin.rc)
         absent = ~np.any(npp != 0, axis=-1)
-        use = (npp > 0).all(-1) & np.isfinite(npp).all(-1)    # scaled: the identity
+        use = (npp > 0).all(-1) & np.isfinite(npp).all(-1)  # scaled: the identity
         ok = (use | absent).all(axis=1)
         ninv = np.where(use[..., None], 1.0 / np.where(use[..., None], npp, 1.0), 0.0)
         Ninv = ninv[..., :, None] * np.eye(npp.shape[-1])
-        Npg = wp[..., None] * lin.Jg                                      # (T, K, d, b)
+        Npg = wp[..., None] * lin.Jg  # (T, K, d, b)
         return Ninv, up, Npg, ninv[:, st.obs_point, :, None] * Npg, ok
     WJp = lin.w[..., None] * lin.Jp
     WJc = lin.wc[..., None] * lin.Jc
     Npp = scatter(st.S_point, _tn(WJp, lin.Jp)) + scatter(st.S_rows, _tn(WJc, lin.Jc))
-    up = (scatter(st.S_point, np.einsum("tkmi,tkm->tki", WJp, lin.r))
-          + scatter(st.S_rows, np.einsum("tkmi,tkm->tki", WJc, lin.rc)))
+    up = scatter(st.S_point, np.einsum("tkmi,tkm->tki", WJp, lin.r)) + scatter(
+        st.S_rows, np.einsum("tkmi,tkm->tki", WJc, lin.rc)
+    )
     absent = ~np.any(Npp != 0, axis=(-1, -2))
     good = regular_points(Npp, rcond) | absent
     Ninv = inv_points(Npp, good & ~absent)
-    Npg = _tn(WJp, lin.Jg)                                              # (T, K, d, b)
+    Npg = _tn(WJp, lin.Jg)  # (T, K, d, b)
     return Ninv, up, Npg, Ninv[:, st.obs_point] @ Npg, good.all(axis=1)
 
 
-def reduce(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND,
-           jit: bool | None = None) -> GroupReduced:
+def reduce(
+    st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND, jit: bool | None = None
+) -> GroupReduced:
     """Normal equations with the point blocks eliminated (pair blocks of the groups): the
     compiled kernel :func:`sim.lsq.group_kernel.pair_blocks` (``jit`` None: when numba is
     there), else one batched product per bucket of group pairs with the same number of
@@ -220,8 +245,13 @@ def reduce(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND,
     return GroupReduced(blocks, ubar, Ninv, up, Npg, NinvK, ok)
 
 
-def solve(st: GroupStructure, red: GroupReduced, solver: str = "auto",
-          rcond: float = RCOND, check: bool = True):
+def solve(
+    st: GroupStructure,
+    red: GroupReduced,
+    solver: str = "auto",
+    rcond: float = RCOND,
+    check: bool = True,
+):
     """Group corrections ``dg`` (T, G, b) and ``ok`` (T,); singular trials get zeros.
 
     ``check``: apply the scaled singularity rule (:func:`~sim.lsq.group_solve.regular`; the loop applies it at the
@@ -237,8 +267,11 @@ def solve(st: GroupStructure, red: GroupReduced, solver: str = "auto",
         if solver == "sparse":
             dg, ok = band_solve(st, red.blocks, rhs)
         else:
-            Ns, s = (group_kernel_solve.dense_scaled(st, red.blocks) if group_kernel.available()
-                     else scaled(dense(st, red.blocks)))
+            Ns, s = (
+                group_kernel_solve.dense_scaled(st, red.blocks)
+                if group_kernel.available()
+                else scaled(dense(st, red.blocks))
+            )
             L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)), rcond, check)
             if group_kernel.available():
                 dg = group_kernel_solve.chol_vec(L, rhs * s) * s
@@ -256,8 +289,13 @@ def points_step(st: GroupStructure, red: GroupReduced, dg: np.ndarray) -> np.nda
     return (red.Ninv @ u[..., None])[..., 0]
 
 
-def step(st: GroupStructure, lin: GroupLinearization, solver: str = "auto",
-         rcond: float = RCOND, check: bool = True):
+def step(
+    st: GroupStructure,
+    lin: GroupLinearization,
+    solver: str = "auto",
+    rcond: float = RCOND,
+    check: bool = True,
+):
     """One Gauss-Newton correction: ``(dp (T, P, d), dg (T, G b), ok (T,))``."""
     red = reduce(st, lin, rcond)
     dg, ok = solve(st, red, solver, rcond, check)
@@ -292,7 +330,7 @@ class GroupCofactors:
             if n == 0:
                 continue
             g = og[items]
-            Qj = Q[:, g[:, :, None], g[:, None, :]]                     # (T, n, c, c, b, b)
+            Qj = Q[:, g[:, :, None], g[:, None, :]]  # (T, n, c, c, b, b)
             Qj = Qj.transpose(0, 1, 2, 4, 3, 5).reshape(T, n, c * b, c * b)
             Fj = np.swapaxes(F[:, items], -1, -2).reshape(T, n, c * b, d)
             H[:, items] = (Qj @ Fj).reshape(T, n, c, b, d)
@@ -310,8 +348,9 @@ class GroupCofactors:
         """Point cofactor blocks ``Ninv + Ninv (sum Npg_k1 Q Npg_k2') Ninv`` (T, P, d, d)."""
         return self.red.Ninv + scatter(self.st.S_point, self.red.NinvK @ self.H)
 
-    def residuals(self, lin: GroupLinearization, points: np.ndarray | None = None,
-                  jit: bool | None = None) -> np.ndarray:
+    def residuals(
+        self, lin: GroupLinearization, points: np.ndarray | None = None, jit: bool | None = None
+    ) -> np.ndarray:
         """Diagonal of ``Q_vv = W^-1 - A Q_xx A'`` of the observation rows (T, K, m); NaN
         where the weight is zero, and, with ``points`` (bool (P,)), for the observations of
         the other points (not computed). ``jit`` (None: when numba is there): by the
@@ -321,10 +360,14 @@ class GroupCofactors:
         if group_kernel.available() if jit is None else jit:
             T, G, _, b, _ = self.Q.shape
             Q = self.Q.transpose(0, 1, 3, 2, 4).reshape(T, G * b, G * b)
-            pts = (np.arange(st.n_points) if points is None
-                   else np.flatnonzero(np.asarray(points, bool)))
-            return group_kernel_solve.residual_cofactors(st, Q, self.red.NinvK, self.red.Ninv,
-                                                   lin.Jg, lin.Jp, lin.w, pts)
+            pts = (
+                np.arange(st.n_points)
+                if points is None
+                else np.flatnonzero(np.asarray(points, bool))
+            )
+            return group_kernel_solve.residual_cofactors(
+                st, Q, self.red.NinvK, self.red.Ninv, lin.Jg, lin.Jp, lin.w, pts
+            )
         if points is None:
             ks, H, Qpp = slice(None), self.H, self.points
         else:
@@ -335,7 +378,7 @@ class GroupCofactors:
             X[:, ks] = self.red.NinvK[:, ks] @ H[:, ks]
             Qpp = self.red.Ninv + scatter(st.S_point, X)
         Jg, Jp, w = lin.Jg[:, ks], lin.Jp[:, ks], lin.w[:, ks]
-        Qgg = self.Q[:, og[ks], og[ks]]                                 # (T, k, b, b)
+        Qgg = self.Q[:, og[ks], og[ks]]  # (T, k, b, b)
         aqa = ((Jg @ Qgg) * Jg).sum(-1)
         aqa -= 2 * ((Jg @ H[:, ks]) * Jp).sum(-1)
         aqa += ((Jp @ Qpp[:, op[ks]]) * Jp).sum(-1)
@@ -347,12 +390,18 @@ class GroupCofactors:
 def cofactors(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND) -> GroupCofactors:
     """Cofactors (dense inverse of the reduced normals; NaN for singular trials)."""
     red = reduce(st, lin, rcond)
-    Ns, s = (group_kernel_solve.dense_scaled(st, red.blocks) if group_kernel.available()
-             else scaled(dense(st, red.blocks)))
+    Ns, s = (
+        group_kernel_solve.dense_scaled(st, red.blocks)
+        if group_kernel.available()
+        else scaled(dense(st, red.blocks))
+    )
     T, n = Ns.shape[:2]
     L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)) & red.ok, rcond, True)
-    Q = (group_kernel_solve.chol_inv(L) if group_kernel.available()
-         else chol_subst(L, np.broadcast_to(np.eye(n), (T, n, n)).copy()))
+    Q = (
+        group_kernel_solve.chol_inv(L)
+        if group_kernel.available()
+        else chol_subst(L, np.broadcast_to(np.eye(n), (T, n, n)).copy())
+    )
     Q = Q * s[:, :, None] * s[:, None, :]
     Q[~ok] = np.nan
     G = st.n_groups

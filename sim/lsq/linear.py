@@ -36,6 +36,7 @@ Seed of the method: Brown 1968 (``004_f5bd9e86c308241f.txt``): least squares by 
 equations with the cofactors of the unknowns; Wolf & Pearsall 1976 (``000``) for the
 polynomial calibration whose design is the same for every trial.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -43,16 +44,18 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import linalg
 
-from . import linear_kernel
-from .normals import RCOND, scaled_rcond
+from sim.lsq import linear_kernel
+from sim.lsq.normals import RCOND, scaled_rcond
 
 __all__ = ["LinearFit", "lstsq", "LINEAR_STATUS"]
 
 
 #: per-trial status codes of :func:`lstsq` (the codes of the engine's ``STATUS`` where shared)
-LINEAR_STATUS = {0: "solved",
-                 2: "singular normal equations (scaled reciprocal condition below rcond)",
-                 3: "non-finite design, weights or observations"}
+LINEAR_STATUS = {
+    0: "solved",
+    2: "singular normal equations (scaled reciprocal condition below rcond)",
+    3: "non-finite design, weights or observations",
+}
 
 
 @dataclass
@@ -67,13 +70,13 @@ class LinearFit:
     """
 
     x: np.ndarray
-    _v: np.ndarray | None = field(repr=False)           # residuals, or None: formed when asked
+    _v: np.ndarray | None = field(repr=False)  # residuals, or None: formed when asked
     vtpv: np.ndarray
     dof: int
     status: np.ndarray
     shared: bool
-    _P: np.ndarray | None = field(repr=False)           # (p, p) or (T, p, p) preconditioner
-    _NBinv: np.ndarray | None = field(repr=False)       # (T, p, p) inverse of B'B (per trial)
+    _P: np.ndarray | None = field(repr=False)  # (p, p) or (T, p, p) preconditioner
+    _NBinv: np.ndarray | None = field(repr=False)  # (T, p, p) inverse of B'B (per trial)
     # (_P None: _NBinv is the cofactor itself, from a closed form such as the 2-D similarity)
     _Ab: tuple | None = field(default=None, repr=False)  # (A, b) to form the residuals from
 
@@ -112,7 +115,7 @@ class LinearFit:
         T, p = self.x.shape[:2]
         if self._P is None:
             Q = np.array(self._NBinv, float)
-        elif self._NBinv is None:                                    # shared: P = R^-1
+        elif self._NBinv is None:  # shared: P = R^-1
             Q = np.broadcast_to(self._P @ self._P.T, (T, p, p)).copy()
         else:
             P = self._P
@@ -201,27 +204,27 @@ def _shared(A, b, w, rcond) -> LinearFit:
     good = bool(np.isfinite(Aw).all()) and m >= p and scaled_rcond(Aw.T @ Aw) > rcond
     if not good:
         status = np.full(T, 2 if np.isfinite(Aw).all() else 3, np.int8)
-        return _finish(A, b, w, np.full((T, p, k), np.nan), status, True,
-                       np.full((p, p), np.nan), None)
-    Qf, R = np.linalg.qr(Aw)                                        # once for all trials
+        return _finish(
+            A, b, w, np.full((T, p, k), np.nan), status, True, np.full((p, p), np.nan), None
+        )
+    Qf, R = np.linalg.qr(Aw)  # once for all trials
     Rinv = linalg.solve_triangular(R, np.eye(p))
-    if linear_kernel.available():       # x = R^-1 Q' sqrt(W) b per trial, in the cache
+    if linear_kernel.available():  # x = R^-1 Q' sqrt(W) b per trial, in the cache
         x, vtpv, st = linear_kernel.shared_solve(Rinv @ (Qf.T * sw[None, :]), A, w, b)
         status = np.where(st == linear_kernel.SOLVED, 0, 3).astype(np.int8)
         return LinearFit(x, None, vtpv, m - p, status, True, Rinv, None, (A, b))
     fin_b = np.isfinite(b).all(axis=(1, 2))
     status = np.where(fin_b, 0, 3).astype(np.int8)
-    plain = w is None and bool(fin_b.all())                         # b needs no masking
+    plain = w is None and bool(fin_b.all())  # b needs no masking
     bw = b if plain else np.where(fin_b[:, None, None], b, 0.0) * sw[None, :, None]
-    bT = bw.transpose(1, 0, 2).reshape(m, T * k)                    # columns (trial, k)
+    bT = bw.transpose(1, 0, 2).reshape(m, T * k)  # columns (trial, k)
     xT = linalg.solve_triangular(R, Qf.T @ bT, check_finite=False)  # all trials at once
     x = xT.reshape(p, T, k).transpose(1, 0, 2)
     if not plain or k == 1:
         return _finish(A, b, w, x, status, True, Rinv, None)
-    own = not np.shares_memory(bT, b)                 # bT a copy of b: residuals go there
+    own = not np.shares_memory(bT, b)  # bT a copy of b: residuals go there
     vT = np.subtract(bT, A @ xT, out=bT if own else None)
-    return _finish(A, b, w, x, status, True, Rinv, None,
-                   vT.reshape(m, T, k).transpose(1, 0, 2))
+    return _finish(A, b, w, x, status, True, Rinv, None, vT.reshape(m, T, k).transpose(1, 0, 2))
 
 
 def _equilibrated(Aw):
@@ -249,8 +252,9 @@ def _screened_rule(N, NB, Q, cand, rcond):
         sc = np.where(d > 0, 1.0 / np.sqrt(d), 1.0)
         ss = sc[:, :, None] * sc[:, None, :]
         C, Cinv = N * ss, Ninv / ss
-        lb = 1.0 / (np.sqrt(np.einsum("tij,tij->t", C, C))
-                    * np.sqrt(np.einsum("tij,tij->t", Cinv, Cinv)))
+        lb = 1.0 / (
+            np.sqrt(np.einsum("tij,tij->t", C, C)) * np.sqrt(np.einsum("tij,tij->t", Cinv, Cinv))
+        )
     ok = cand & (lb > 4.0 * rcond)
     rest = cand & ~ok
     if rest.any():
@@ -280,7 +284,7 @@ def _per_trial(A, b, w, fin_b, rcond) -> LinearFit:
         # Gershgorin: the eigenvalues of B'B lie within [1 - g, 1 + g]; keep R0 where g < 1/2
         near = np.abs(NB - np.eye(p)).sum(axis=-1).max(axis=-1) < 0.5
         P = np.broadcast_to(R0inv, (T, p, p))
-        N = np.matmul(np.matmul(R0.T, NB), R0)                      # A'WA for the rule
+        N = np.matmul(np.matmul(R0.T, NB), R0)  # A'WA for the rule
         if not near.all():
             far = ~near
             B[far], D = _equilibrated(Aw[far])
@@ -292,16 +296,15 @@ def _per_trial(A, b, w, fin_b, rcond) -> LinearFit:
     else:
         B, P = _equilibrated(Aw)
         NB = np.matmul(np.swapaxes(B, 1, 2), B)
-        N = NB                             # the rule is invariant to the diagonal scaling
+        N = NB  # the rule is invariant to the diagonal scaling
     ok, NBinv = _screened_rule(N, NB, P if R0 is not None else None, fin & (m >= p), rcond)
     status = np.where(fin, np.where(ok, 0, 2), 3).astype(np.int8)
     if NBinv is None:
         NB = np.where(ok[:, None, None], NB, np.eye(p))
         try:
             NBinv = np.linalg.inv(NB)
-        except np.linalg.LinAlgError:              # exactly singular although above rcond
+        except np.linalg.LinAlgError:  # exactly singular although above rcond
             NBinv = np.linalg.pinv(NB, hermitian=True)
     y = np.matmul(NBinv, np.matmul(np.swapaxes(B, 1, 2), bw))
     x = np.matmul(P, y)
     return _finish(A, b, w, x, status, False, P, NBinv)
-

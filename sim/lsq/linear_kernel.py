@@ -20,7 +20,7 @@ Model, per trial ``t`` (``k`` right-hand sides sharing the design)::
   above ``4 rcond``; otherwise it is left *undecided* and the caller applies the exact rule
   (:func:`sim.lsq.normals.scaled_rcond`) and the NumPy path to it, so every decision is the
   engine's one rule. For model kernels that form their normal equations in the cache
-  (e.g. :mod:`sim.polynomial_kernel`, which hands its undecided trials to
+  (e.g. :mod:`sim.instruments.plotter.polynomial_kernel`, which hands its undecided trials to
   :func:`sim.lsq.linear.lstsq`).
 
 Sums are compiled with :data:`sim.lsq.group_kernel.REASSOCIATE` (reordered into vector
@@ -31,23 +31,35 @@ method: Brown 1968 (``004_f5bd9e86c308241f.txt``), least squares by normal equat
 Wolf & Pearsall 1976 (``000_668e60e68f004f98.txt``) for the polynomial calibration whose
 design is the same for every trial.
 """
-from __future__ import annotations
 
-import numpy as np
+from __future__ import annotations
 
 import zlib
 from pathlib import Path
 
-from . import group_kernel
+import numpy as np
+
+from sim.lsq import group_kernel
 
 try:  # solve_scaled is compiled into the kernels that call it
     from numba.extending import register_jitable
 except ImportError:  # pragma: no cover - the NumPy path runs
+
     def register_jitable(f):
         return f
 
-__all__ = ["available", "shared_solve", "normal_solve", "solve_lanes", "LANES", "SOURCE_TAG",
-           "SOLVED", "UNDECIDED", "NONFINITE"]
+
+__all__ = [
+    "available",
+    "shared_solve",
+    "normal_solve",
+    "solve_lanes",
+    "LANES",
+    "SOURCE_TAG",
+    "SOLVED",
+    "UNDECIDED",
+    "NONFINITE",
+]
 
 #: statuses of the kernels: solved (as :data:`sim.lsq.linear.LINEAR_STATUS` 0), left to the
 #: exact rule, non-finite input (as :data:`sim.lsq.linear.LINEAR_STATUS` 3)
@@ -69,17 +81,17 @@ def available() -> bool:
 
 def _shared_solve(M, At, w, b, x, vtpv, status):  # pragma: no cover - compiled
     T, m = b.shape[0], At.shape[1]
-    p, k = P_TERMS, K_RHS           # compile-time constants: the small loops unroll
+    p, k = P_TERMS, K_RHS  # compile-time constants: the small loops unroll  # noqa: F821 (set by the compile helper)
     bb, xx = np.empty((k, m)), np.empty((p, k))
     for t in range(T):
         bt, z = b[t], 0.0
-        for i in range(m):                      # the trial's right-hand sides, one per row
+        for i in range(m):  # the trial's right-hand sides, one per row
             for c in range(k):
                 v = bt[i * k + c]
                 bb[c, i] = v
-                z += v * 0.0                    # NaN unless every observation is finite
+                z += v * 0.0  # NaN unless every observation is finite
         fin = z == 0.0
-        for j in range(0, p, 2):                # x = M b, two rows by two right-hand sides
+        for j in range(0, p, 2):  # x = M b, two rows by two right-hand sides
             j2 = min(j + 1, p - 1)
             Ma, Mb = M[j], M[j2]
             for c in range(0, k, 2):
@@ -92,7 +104,7 @@ def _shared_solve(M, At, w, b, x, vtpv, status):  # pragma: no cover - compiled
                     s10 += Mb[i] * b0[i]
                     s11 += Mb[i] * b1[i]
                 xx[j, c], xx[j, c2], xx[j2, c], xx[j2, c2] = s00, s01, s10, s11
-        for c in range(k):                      # v' W v, point by point over the unknowns
+        for c in range(k):  # v' W v, point by point over the unknowns
             bc, q = bb[c], 0.0
             for i in range(m):
                 f = 0.0
@@ -116,7 +128,8 @@ def shared_solve(M: np.ndarray, A: np.ndarray, w: np.ndarray | None, b: np.ndarr
     status = np.empty(T, np.int8)
     c = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
     group_kernel.compiled(_shared_solve, reassociate=True, P_TERMS=p, K_RHS=k)(
-        c(M), c(A.T), np.ones(m) if w is None else c(w), c(b).reshape(T, m * k), x, vtpv, status)
+        c(M), c(A.T), np.ones(m) if w is None else c(w), c(b).reshape(T, m * k), x, vtpv, status
+    )
     return x, vtpv, status
 
 
@@ -140,15 +153,15 @@ def solve_lanes(N, u, x, ok, s, L, G, e, fro, g2, rcond):  # pragma: no cover - 
             okd = d > 0.0 and d < np.inf
             ok[b] &= okd
             s[j, b] = 1.0 / np.sqrt(d if okd else 1.0)
-    for j in range(p):                              # C = S N S, ||C||_F^2
+    for j in range(p):  # C = S N S, ||C||_F^2
         for i in range(j, p):
             w = 1.0 if i == j else 2.0
             for b in range(LANES):
                 cij = N[j, i, b] * s[j, b] * s[i, b]
                 fro[b] += w * cij * cij
                 L[i, j, b] = cij
-    for j in range(p):                              # Cholesky C = L L'; G[j, j] = 1 / L[j, j]
-        for i in range(j, p):                       # the diagonal first, then below it
+    for j in range(p):  # Cholesky C = L L'; G[j, j] = 1 / L[j, j]
+        for i in range(j, p):  # the diagonal first, then below it
             for b in range(LANES):
                 e[b] = L[i, j, b]
             for q in range(j):
@@ -163,7 +176,7 @@ def solve_lanes(N, u, x, ok, s, L, G, e, fro, g2, rcond):  # pragma: no cover - 
                     G[j, j, b] = 1.0 / d
                 else:
                     L[i, j, b] = e[b] * G[j, j, b]
-    for j in range(p):                              # G = L^-1 (lower), ||G||_F^2
+    for j in range(p):  # G = L^-1 (lower), ||G||_F^2
         for b in range(LANES):
             g2[b] += G[j, j, b] * G[j, j, b]
         for i in range(j + 1, p):
@@ -176,9 +189,9 @@ def solve_lanes(N, u, x, ok, s, L, G, e, fro, g2, rcond):  # pragma: no cover - 
                 v = e[b] * G[i, i, b]
                 G[i, j, b] = v
                 g2[b] += v * v
-    for b in range(LANES):                          # the bound of the scaled rule
+    for b in range(LANES):  # the bound of the scaled rule
         ok[b] &= 1.0 / (np.sqrt(fro[b]) * g2[b]) > 4.0 * rcond
-    for c in range(k):                              # x = S G' G S u (G S u on L's diagonal)
+    for c in range(k):  # x = S G' G S u (G S u on L's diagonal)
         for i in range(p):
             for b in range(LANES):
                 e[b] = 0.0
@@ -204,7 +217,7 @@ def _normal_solve(N, u, x, status, rcond):  # pragma: no cover - compiled
     e, fro, g2, ok = np.empty(LANES), np.empty(LANES), np.empty(LANES), np.empty(LANES, np.bool_)
     for t0 in range(0, T, LANES):
         nb = min(LANES, T - t0)
-        for b in range(LANES):                      # spare lanes repeat the block's first
+        for b in range(LANES):  # spare lanes repeat the block's first
             tb = t0 + b if b < nb else t0
             for j in range(p):
                 for q in range(p):

@@ -22,14 +22,24 @@ smallest to its largest eigenvalue modulus is not above ``rcond`` (default :data
 ten digits lost) or any entry is not finite. The same rule is applied to every point block
 and to the (bordered) reduced normals; a singular trial is flagged, never raised.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["RCOND", "scaled_rcond", "inv_blocks", "Reduced", "reduce", "reduce_blocks",
-           "reduced_normals", "bordered_solve", "bordered_inverse"]
+__all__ = [
+    "RCOND",
+    "scaled_rcond",
+    "inv_blocks",
+    "Reduced",
+    "reduce",
+    "reduce_blocks",
+    "reduced_normals",
+    "bordered_solve",
+    "bordered_inverse",
+]
 
 #: default reciprocal condition number below which a scaled matrix counts as singular
 RCOND = 1e-10
@@ -70,8 +80,12 @@ def _inv2(N, rcond, out, good):  # pragma: no cover - compiled
         s0 = 1.0 / np.sqrt(d0) if d0 > 0 else 1.0
         s1 = 1.0 / np.sqrt(d1) if d1 > 0 else 1.0
         a, b, c = m00 * s0 * s0, m01 * s0 * s1, m11 * s1 * s1
-        fin = (np.isfinite(a) and np.isfinite(b) and np.isfinite(c)
-               and np.isfinite(N[k, 1, 0] * s1 * s0))
+        fin = (
+            np.isfinite(a)
+            and np.isfinite(b)
+            and np.isfinite(c)
+            and np.isfinite(N[k, 1, 0] * s1 * s0)
+        )
         rc = 0.0
         if fin:
             h, g = 0.5 * (a + c), np.sqrt((0.5 * (a - c)) ** 2 + b * b)
@@ -96,15 +110,19 @@ def inv_blocks(N: np.ndarray, rcond: float = RCOND):
     2 x 2 blocks run compiled where numba is present (the same arithmetic)."""
     d = N.shape[-1]
     if d == 2:
-        from . import group_kernel
+        from sim.lsq import group_kernel
 
         if group_kernel.available():
             T, n = N.shape[:2]
             out, good = np.empty((T * n, 2, 2)), np.empty(T * n, np.bool_)
-            group_kernel.compiled(_inv2)(np.ascontiguousarray(N, dtype=np.float64).reshape(
-                T * n, 2, 2), float(rcond), out, good)
+            group_kernel.compiled(_inv2)(
+                np.ascontiguousarray(N, dtype=np.float64).reshape(T * n, 2, 2),
+                float(rcond),
+                out,
+                good,
+            )
             return out.reshape(T, n, 2, 2), good.reshape(T, n).all(axis=1)
-    good = scaled_rcond(N) > rcond                         # (T, n)
+    good = scaled_rcond(N) > rcond  # (T, n)
     ok = good.all(axis=1)
     Ns = np.where(good[..., None, None], N, np.eye(d))
     if d == 1:
@@ -112,8 +130,9 @@ def inv_blocks(N: np.ndarray, rcond: float = RCOND):
     if d == 2:
         a, b, c = Ns[..., 0, 0], Ns[..., 0, 1], Ns[..., 1, 1]
         inv = 1.0 / (a * c - b * b)
-        return np.stack([np.stack([c * inv, -b * inv], -1),
-                         np.stack([-b * inv, a * inv], -1)], -2), ok
+        return np.stack(
+            [np.stack([c * inv, -b * inv], -1), np.stack([-b * inv, a * inv], -1)], -2
+        ), ok
     return np.linalg.inv(Ns), ok
 
 
@@ -158,20 +177,19 @@ def reduce(r, Jp, Jg, w=None, rcond: float = RCOND) -> Reduced:
     else:
         d = Jp.shape[-1]
         WJp = Jp if w is None else w[..., None] * Jp
-        Npp = np.swapaxes(WJp, -1, -2) @ Jp                 # (T, n, d, d)
+        Npp = np.swapaxes(WJp, -1, -2) @ Jp  # (T, n, d, d)
         Ninv, ok = inv_blocks(Npp, rcond)
         up = np.einsum("tnki,tnk->tni", Jp, wr)
         dp0 = (Ninv @ up[..., None])[..., 0]
     if p == 0:
-        return Reduced(Ninv, np.zeros((T, n, d, 0)), np.zeros((T, 0, 0)), np.zeros((T, 0)),
-                       dp0, ok)
+        return Reduced(Ninv, np.zeros((T, n, d, 0)), np.zeros((T, 0, 0)), np.zeros((T, 0)), dp0, ok)
     Jf = Jg.reshape(T, n * k, p)
     WJf = Jf if w is None else (np.broadcast_to(w, r.shape).reshape(T, n * k, 1) * Jf)
     Nbar = np.swapaxes(WJf, -1, -2) @ Jf
     ubar = (np.swapaxes(Jf, -1, -2) @ wr.reshape(T, n * k, 1))[..., 0]
     if d == 0:
         return Reduced(Ninv, np.zeros((T, n, 0, p)), Nbar, ubar, dp0, ok)
-    Npg = np.swapaxes(WJp, -1, -2) @ Jg                     # (T, n, d, p)
+    Npg = np.swapaxes(WJp, -1, -2) @ Jg  # (T, n, d, p)
     return _eliminate(Ninv, ok, up, dp0, Npg, Nbar, ubar)
 
 
@@ -187,7 +205,7 @@ def _eliminate(Ninv, ok, up, dp0, Npg, Ngg, ug) -> Reduced:
 def reduce_blocks(Npp, up, Npg, Ngg, ug, rcond: float = RCOND) -> Reduced:
     """:func:`reduce` from normal-equation blocks that a model formed itself -- the route of
     a model whose Jacobian is mostly zero (each observation touching one point and a few
-    globals, e.g. one station's coordinates in :mod:`sim.positions`), which then never
+    globals, e.g. one station's coordinates in :mod:`sim.instruments.ranges.positions`), which then never
     builds the dense ``(T, n, k, p)`` Jacobian.
 
     Npp : (T, n, d, d) point blocks; up : (T, n, d); Npg : (T, n, d, p); Ngg : (T, p, p);
@@ -259,8 +277,9 @@ def _screened_inverse(M: np.ndarray, rcond: float):
         d = np.abs(np.einsum("tii->ti", Ms))
         sc = np.where(d > 0, 1.0 / np.sqrt(d), 1.0)
         Cs = Ms * sc[:, :, None] * sc[:, None, :]
-        lb = sc.min(axis=1) ** 2 / (np.sqrt(np.einsum("tij,tij->t", Cs, Cs))
-                                    * np.sqrt(np.einsum("tij,tij->t", Minv, Minv)))
+        lb = sc.min(axis=1) ** 2 / (
+            np.sqrt(np.einsum("tij,tij->t", Cs, Cs)) * np.sqrt(np.einsum("tij,tij->t", Minv, Minv))
+        )
     ok = fin & (lb > 4.0 * rcond)
     rest = fin & ~ok
     if rest.any():
@@ -276,7 +295,7 @@ def bordered_solve(Nbar, ubar, C=None, rcond: float = RCOND):
     Minv, ok = _screened_inverse(M, rcond)
     rhs = np.zeros((T, M.shape[-1]))
     rhs[:, :p] = np.where(np.isfinite(ubar), ubar, 0.0) * s
-    if Minv is not None:            # the rule's inverse solves the system too
+    if Minv is not None:  # the rule's inverse solves the system too
         y = np.einsum("tij,tj->ti", Minv, rhs)
     else:
         try:

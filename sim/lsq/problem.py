@@ -31,13 +31,14 @@ The Jacobian sign convention: ``r ~ Jp dp + Jg dg`` (corrections that reduce the
 A **datum** picks the free globals (the rest stay at their given values) and optionally
 constrains their corrections by ``C' dg = 0`` (``C`` ``(T, p, c)``: minimal constraints such
 as Brown's ``x1 = x3 = 0, y4 = -y2`` or inner constraints); any other datum of the points
-follows by an S-transformation (:mod:`sim.datum`).
+follows by an S-transformation (:mod:`sim.lsq.datum`).
 
 **Fast paths**: a compiled kernel may be registered for a model class
 (:func:`register_fast_path`); the engine calls it first and falls back to the generic loop
 when it returns ``None`` (not applicable). Seed of the method: Brown 1968
 (``004_f5bd9e86c308241f.txt``).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -63,8 +64,9 @@ class Model(Protocol):  # pragma: no cover - documentation of the interface
     point_dim: int
     n_global: int
 
-    def linearize(self, points: np.ndarray, theta: np.ndarray,
-                  globals_needed: bool) -> Linearization: ...
+    def linearize(
+        self, points: np.ndarray, theta: np.ndarray, globals_needed: bool
+    ) -> Linearization: ...
 
     def initial_points(self, theta: np.ndarray) -> np.ndarray: ...
 

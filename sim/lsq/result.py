@@ -9,22 +9,25 @@ or the estimate ``sigma0^2``) for covariances. With the point blocks eliminated
 ``Qgg`` the bordered inverse of the reduced normals in the datum. Seed of the method: Brown
 1968 (``004_f5bd9e86c308241f.txt``, "rigorous error propagation" of the EMBET solution).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .normals import RCOND, bordered_inverse, reduced_normals
-from .problem import Datum
+from sim.lsq.normals import RCOND, bordered_inverse, reduced_normals
+from sim.lsq.problem import Datum
 
 __all__ = ["STATUS", "Cofactors", "cofactors", "Result"]
 
 #: per-trial status codes and their messages
-STATUS = {0: "converged",
-          1: "not converged within the iteration limit",
-          2: "singular normal equations (scaled reciprocal condition below rcond)",
-          3: "non-finite corrections (diverged or bad observations)"}
+STATUS = {
+    0: "converged",
+    1: "not converged within the iteration limit",
+    2: "singular normal equations (scaled reciprocal condition below rcond)",
+    3: "non-finite corrections (diverged or bad observations)",
+}
 
 
 @dataclass
@@ -65,12 +68,14 @@ class Cofactors:
         return -np.einsum("tnip,tpq->tniq", self.K, self.Qgg)
 
 
-def cofactors(model, points: np.ndarray, theta: np.ndarray, datum: Datum | None = None,
-              rcond: float = RCOND) -> Cofactors:
+def cofactors(
+    model, points: np.ndarray, theta: np.ndarray, datum: Datum | None = None, rcond: float = RCOND
+) -> Cofactors:
     """Cofactors of ``model`` at ``points`` (T, n, d), ``theta`` (T, q) in ``datum`` (a
     :class:`sim.lsq.groups.GroupCofactors` for group-block models)."""
     if getattr(model, "structure", None) is not None:  # group blocks
-        from .groups import cofactors as group_cofactors
+        from sim.lsq.groups import cofactors as group_cofactors
+
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             return group_cofactors(model.structure, model.linearize(points, theta), rcond)
     datum = Datum() if datum is None else datum

@@ -4,6 +4,7 @@ Each study module defines ``STUDIES = {name: Study(...)}``. ``run(cfg, out, ctx)
 study's Parquet files and figures into ``out``; ``report(out)`` returns the Markdown section
 of ``results/REPORT.md`` built from those files alone.
 """
+
 from __future__ import annotations
 
 import importlib
@@ -12,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Mapping
 
-from ..config import ConfigError, Field
+from sim.mc.config import ConfigError, Field
 
 __all__ = ["Study", "RunContext", "get_study", "MODULES"]
 
@@ -32,13 +33,13 @@ MODULES = {
 @dataclass(frozen=True)
 class RunContext:
     """What a study's ``run`` gets besides its config: pass it to
-    :func:`sim.runner.run_chunks` (``ctx=ctx``) so chunks use the chosen executor and are
+    :func:`sim.mc.runner.run_chunks` (``ctx=ctx``) so chunks use the chosen executor and are
     stored for resumption, and share the run's one progress bar."""
 
     quiet: bool = False
-    executor: object = None   # from sim.runner.make_executor; None = in-process
-    store: object = None      # sim.runner.ChunkStore of the run's staging directory
-    estimate: object = None   # sim.estimate.Estimate of the run (the progress bar's total)
+    executor: object = None  # from sim.mc.runner.make_executor; None = in-process
+    store: object = None  # sim.mc.runner.ChunkStore of the run's staging directory
+    estimate: object = None  # sim.mc.estimate.Estimate of the run (the progress bar's total)
     bars: list = field(default_factory=list, compare=False)  # the open shared bar, if any
 
     @property
@@ -49,7 +50,7 @@ class RunContext:
     @contextmanager
     def progress_bar(self, label: str):
         """One bar for the whole run; its total is the estimate's trial count."""
-        from ..progress import Progress
+        from sim.mc.progress import Progress
 
         total = getattr(self.estimate, "trials", 0) or 0
         with Progress(total, label, quiet=self.quiet) as p:

@@ -14,13 +14,24 @@ Modules: :mod:`.schema` (config and checks), :mod:`.simulate` and :mod:`.chunks`
 of blocks and its adjustments), :mod:`.run` (through the runner), ``claims.toml`` +
 :mod:`.claims` (scoring), :mod:`.sweep` (consistent set), :mod:`.figures`, :mod:`.report`.
 """
+
 from __future__ import annotations
 
-from .. import Study
-from .report import report
-from .run import run
-from .schema import NAME, SCHEMA, SEED, check
+from sim.studies import Study
+from sim.studies.agnard.report import report
+from sim.studies.agnard.run import run
+from sim.studies.agnard.schema import NAME, SCHEMA, SEED, check
 
-STUDIES = {NAME: Study(name=NAME, title="Agnard, Nolette & Gagnon: digital pugging, scanner "
-                       "calibration and a block of independent models", seed_file=SEED,
-                       schema=SCHEMA, run=run, report=report, check=check, order=50)}
+STUDIES = {
+    NAME: Study(
+        name=NAME,
+        title="Agnard, Nolette & Gagnon: digital pugging, scanner "
+        "calibration and a block of independent models",
+        seed_file=SEED,
+        schema=SCHEMA,
+        run=run,
+        report=report,
+        check=check,
+        order=50,
+    )
+}

@@ -5,27 +5,36 @@ Each is a module-level function ``f(cfg, block, ..., rng, n)``; the run hands th
 process pools and Dask workers and are stored for resumption. Everything a chunk produces
 leaves it through its returned arrays: per-trial values (leading axis ``n``) and per-chunk
 sums or examples (leading axis 1, keys ``chunk.*``). Each keeps freed memory in its
-process's heap (:func:`sim.heap.keep_heap`: fewer page faults, same numbers). Lengths in
+process's heap (:func:`sim.mc.heap.keep_heap`: fewer page faults, same numbers). Lengths in
 metres.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ...data_snooping import snoop
-from ...heap import keep_heap
-from ...block_layout import Block
-from ... import distributions as D
-from .schema import five_control, paper_weights, snoop_weights
-from .simulate import Adjuster, Simulated, _rms, accuracy
+from sim.instruments.block.data_snooping import snoop
+from sim.instruments.block.layout import Block
+from sim.lsq import distributions as D
+from sim.mc.heap import keep_heap
+from sim.studies.agnard.schema import five_control, paper_weights, snoop_weights
+from sim.studies.agnard.simulate import Adjuster, Simulated, _rms, accuracy
 
 #: keys of per-chunk (not per-trial) arrays
 CHUNK = "chunk."
 
 
 def _layouts(cfg: dict) -> list[str]:
-    return list(dict.fromkeys([cfg["control.table1"], cfg["control.few"], cfg["control.many"],
-                               *cfg["tradeoff.layouts"]]))
+    return list(
+        dict.fromkeys(
+            [
+                cfg["control.table1"],
+                cfg["control.few"],
+                cfg["control.many"],
+                *cfg["tradeoff.layouts"],
+            ]
+        )
+    )
 
 
 def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dict:
@@ -56,8 +65,9 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
     # first pass: weak control (started from the 21-control solution of the same blocks)
     res21 = done[cfg["control.many"]]
     wo1, wc1 = paper_weights(cfg, first_pass=True)
-    _, _, res = adj.adjust(sim, ("digital", "corrected"), cfg["control.many"], wo1, wc1,
-                           start=res21)
+    _, _, res = adj.adjust(
+        sim, ("digital", "corrected"), cfg["control.many"], wo1, wc1, start=res21
+    )
     pas = block.is_pass[block.obs_point]
     v = res.v_obs[:, pas]
     out["first.pass_xy_m"] = np.sqrt(np.mean(v[..., 0] ** 2 + v[..., 1] ** 2, 1))
@@ -70,10 +80,21 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
     ctrl, st = adj.structure(cfg["control.many"])
     n_pass = int(block.is_pass.sum())
     for mode in ("digital", "mechanical"):
-        rej, s0, _, _ = snoop(st, sim.xm[(mode, "corrected")], ws, sim.ctrl_obs[:, ctrl],
-                                 np.broadcast_to(wsc, (ctrl.size, 3)), res21.s, res21.R,
-                                 res21.t, res21.X, block.is_pass, crit,
-                                 cfg["snoop.max_reject"], cfg["snoop.test"] == "tau")
+        rej, s0, _, _ = snoop(
+            st,
+            sim.xm[(mode, "corrected")],
+            ws,
+            sim.ctrl_obs[:, ctrl],
+            np.broadcast_to(wsc, (ctrl.size, 3)),
+            res21.s,
+            res21.R,
+            res21.t,
+            res21.X,
+            block.is_pass,
+            crit,
+            cfg["snoop.max_reject"],
+            cfg["snoop.test"] == "tau",
+        )
         out[f"snoop_{mode}.rejected"] = rej[:, block.is_pass].sum(1)
         out[f"snoop_{mode}.share_pct"] = 100.0 * out[f"snoop_{mode}.rejected"] / n_pass
         out[f"snoop_{mode}.sigma0"] = s0
@@ -100,8 +121,9 @@ def scanner_chunk(cfg: dict, block: Block, dpi: float, rng: np.random.Generator,
     return out
 
 
-def pugging_chunk(cfg: dict, block: Block, recentre_px: float, rng: np.random.Generator,
-                  n: int) -> dict:
+def pugging_chunk(
+    cfg: dict, block: Block, recentre_px: float, rng: np.random.Generator, n: int
+) -> dict:
     """Data snooping under mechanical pugging with another re-centring error (px)."""
     keep_heap()
     c2 = {**cfg, "pugging.recentre_px": recentre_px}
@@ -109,24 +131,37 @@ def pugging_chunk(cfg: dict, block: Block, recentre_px: float, rng: np.random.Ge
     crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
     ws, wsc = snoop_weights(cfg)
     sim = Simulated(c2, block, rng, n, cfg["scan.dpi"], mechanical=True, uncorrected=False)
-    ctrl, st, res0 = adj.adjust(sim, ("mechanical", "corrected"), cfg["control.many"],
-                                *paper_weights(cfg))
-    rej = snoop(st, sim.xm[("mechanical", "corrected")], ws, sim.ctrl_obs[:, ctrl],
-                   np.broadcast_to(wsc, (ctrl.size, 3)), res0.s, res0.R, res0.t, res0.X,
-                   block.is_pass, crit, cfg["snoop.max_reject"], cfg["snoop.test"] == "tau")[0]
+    ctrl, st, res0 = adj.adjust(
+        sim, ("mechanical", "corrected"), cfg["control.many"], *paper_weights(cfg)
+    )
+    rej = snoop(
+        st,
+        sim.xm[("mechanical", "corrected")],
+        ws,
+        sim.ctrl_obs[:, ctrl],
+        np.broadcast_to(wsc, (ctrl.size, 3)),
+        res0.s,
+        res0.R,
+        res0.t,
+        res0.X,
+        block.is_pass,
+        crit,
+        cfg["snoop.max_reject"],
+        cfg["snoop.test"] == "tau",
+    )[0]
     return {"share_pct": 100.0 * rej[:, block.is_pass].sum(1) / block.is_pass.sum()}
 
 
-def size_chunk(cfg: dict, block: Block, centre: np.ndarray, rng: np.random.Generator,
-               n: int) -> dict:
+def size_chunk(
+    cfg: dict, block: Block, centre: np.ndarray, rng: np.random.Generator, n: int
+) -> dict:
     """Another block size at the same point density (``tradeoff.block_control`` layout)."""
     keep_heap()
     adj = Adjuster(block)
     wo, wc = paper_weights(cfg)
     sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], uncorrected=False)
     out: dict[str, np.ndarray] = {}
-    ctrl, _, res = adj.adjust(sim, ("digital", "corrected"), cfg["tradeoff.block_control"],
-                              wo, wc)
+    ctrl, _, res = adj.adjust(sim, ("digital", "corrected"), cfg["tradeoff.block_control"], wo, wc)
     accuracy(block, ctrl, res, out, "size", centre=centre)
     return out
 
@@ -141,7 +176,8 @@ def sweep_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> di
     out: dict[str, np.ndarray] = {}
     _, _, start = adj.adjust(sim, ("digital", "corrected"), cfg["control.many"], wo, wc)
     for i, u in enumerate(cfg["sweep.five_inset"]):
-        ctrl, _, res = adj.adjust(sim, ("digital", "corrected"), five_control(block, u), wo, wc,
-                                  start=start)
+        ctrl, _, res = adj.adjust(
+            sim, ("digital", "corrected"), five_control(block, u), wo, wc, start=start
+        )
         accuracy(block, ctrl, res, out, f"inset{i}")
     return out

@@ -3,18 +3,19 @@
 The claims are data (``claims.toml`` beside this module: the paper's words, forms, printed
 references and deciding widths); this module only supplies what the simulation produced and
 the recomputations from the paper's printed tables (paper-checks). The verdicts follow from
-the rules of :mod:`sim.claims`. Notes are computed from the run, never typed conclusions.
+the rules of :mod:`sim.claims.book`. Notes are computed from the run, never typed conclusions.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ... import scanner as sc
-from ...block_layout import Block
-from ...claims import ClaimBook
-from .schema import model_sigmas, pixel_ground_m
+from sim.claims.book import ClaimBook
+from sim.instruments.block import scanner as sc
+from sim.instruments.block.layout import Block
+from sim.studies.agnard.schema import model_sigmas, pixel_ground_m
 
 BOOK = Path(__file__).with_name("claims.toml")
 AXES = ("x", "y", "xy", "z")
@@ -42,37 +43,60 @@ def table1_rows(book: ClaimBook, cfg: dict, sim: dict) -> list[dict]:
         for c in ("x", "y"):
             cid = f"agnard.table1.with_{w}_{c}_m"
             t1 = ref(book, cid)
-            t23 = {n: ref(book, f"agnard.{n}.{w}_{c}_cm") / 100 for n in ("control_5", "control_21")}
+            t23 = {
+                n: ref(book, f"agnard.{n}.{w}_{c}_cm") / 100 for n in ("control_5", "control_21")
+            }
             best = min(t23.values(), key=lambda v: abs(v - t1))
             s = book.spec(cid)
-            rows.append(book.score(cid, best, interval="exact", note=(
-                f"recomputed from the paper's own Tables 2-3 (the same block, scanner-corrected "
-                f"600 DPI scans): {w} {c.upper()} rms {100 * t23['control_5']:.0f} cm with 5 "
-                f"control and {100 * t23['control_21']:.0f} cm with 21; the nearer, "
-                f"{100 * best:.0f} cm, is {t1 / best:.1f} x below Table 1's {t1:.2f} m. "
-                f"Tolerance {s['tol']:.3f} m = {100 * s['tol'] / t1:.0f} % of the reference, the "
-                "largest change between Tables 2 and 3 for one quantity. The simulated "
-                "adjustment with correction is scored once, against Tables 2-3 "
-                "(agnard.control_21.*)")))
+            rows.append(
+                book.score(
+                    cid,
+                    best,
+                    interval="exact",
+                    note=(
+                        f"recomputed from the paper's own Tables 2-3 (the same block, scanner-corrected "
+                        f"600 DPI scans): {w} {c.upper()} rms {100 * t23['control_5']:.0f} cm with 5 "
+                        f"control and {100 * t23['control_21']:.0f} cm with 21; the nearer, "
+                        f"{100 * best:.0f} cm, is {t1 / best:.1f} x below Table 1's {t1:.2f} m. "
+                        f"Tolerance {s['tol']:.3f} m = {100 * s['tol'] / t1:.0f} % of the reference, the "
+                        "largest change between Tables 2 and 3 for one quantity. The simulated "
+                        "adjustment with correction is scored once, against Tables 2-3 "
+                        "(agnard.control_21.*)"
+                    ),
+                )
+            )
             key = f"{w}_{c}_m"
             x = sim[f"without.{key}"]
             lo, med, hi = np.percentile(100 * x, [2.5, 50, 97.5])
-            rows.append(book.not_comparable(f"agnard.table1.without_{key}", note=(
-                f"For information, the simulated rms without correction ({lay} control) is "
-                f"{med:.1f} cm (95 % of {x.size} blocks {lo:.1f}-{hi:.1f} cm).")))
+            rows.append(
+                book.not_comparable(
+                    f"agnard.table1.without_{key}",
+                    note=(
+                        f"For information, the simulated rms without correction ({lay} control) is "
+                        f"{med:.1f} cm (95 % of {x.size} blocks {lo:.1f}-{hi:.1f} cm)."
+                    ),
+                )
+            )
             ratio = sim[f"without.{key}"] / sim[f"layout_{lay}.{key}"]
             rid = f"agnard.table1.ratio_{w}_{c}"
-            rows.append(book.score(rid, samples=ratio, note=(
-                f"per-block ratio of the rms {w} {c.upper()} without and with the grid "
-                f"correction (the same measurements, {lay} control, paper weights; scanner "
-                f"peaking at {cfg['scan.max_x_um']:g} / {cfg['scan.max_y_um']:g} um in x / y, "
-                f"affine part removed by the fiducials); median and 95 % of "
-                f"{ratio.size} blocks; {_where(ref(book, rid), ratio)}. Without correction the "
-                f"median rms is {100 * np.median(sim['without.' + key]):.1f} cm, the "
-                f"deformation's peak {cfg['scan.max_y_um'] * cfg['block.scale'] * 1e-4:.1f} cm "
-                f"on the ground (y); Table 1's 'without' value is "
-                f"{ref(book, rid) * ref(book, cid) / (cfg['block.scale'] * 1e-6):.0f} um at photo "
-                "scale")))
+            rows.append(
+                book.score(
+                    rid,
+                    samples=ratio,
+                    note=(
+                        f"per-block ratio of the rms {w} {c.upper()} without and with the grid "
+                        f"correction (the same measurements, {lay} control, paper weights; scanner "
+                        f"peaking at {cfg['scan.max_x_um']:g} / {cfg['scan.max_y_um']:g} um in x / y, "
+                        f"affine part removed by the fiducials); median and 95 % of "
+                        f"{ratio.size} blocks; {_where(ref(book, rid), ratio)}. Without correction the "
+                        f"median rms is {100 * np.median(sim['without.' + key]):.1f} cm, the "
+                        f"deformation's peak {cfg['scan.max_y_um'] * cfg['block.scale'] * 1e-4:.1f} cm "
+                        f"on the ground (y); Table 1's 'without' value is "
+                        f"{ref(book, rid) * ref(book, cid) / (cfg['block.scale'] * 1e-6):.0f} um at photo "
+                        "scale"
+                    ),
+                )
+            )
     return rows
 
 
@@ -84,35 +108,73 @@ def scanner_rows(book: ClaimBook, scan_t: dict) -> list[dict]:
         cid = f"agnard.scanner.gain_{d:.0f}dpi_pct"
         i = np.flatnonzero((dpi == d) & (cal == "corrected"))
         if i.size == 0:
-            rows.append(book.score(cid, 0.0, interval="exact", note=f"{d:g} DPI not in "
-                                   "tradeoff.dpis: not simulated in this run"))
+            rows.append(
+                book.score(
+                    cid,
+                    0.0,
+                    interval="exact",
+                    note=f"{d:g} DPI not in tradeoff.dpis: not simulated in this run",
+                )
+            )
             continue
         g, h = scan_t["gain_xy_pct"][i[0]], 1.96 * scan_t["gain_xy_pct_se"][i[0]]
-        rows.append(book.score(cid, g, (g - h, g + h), note=(
-            f"reduction of the check-point XY rms by the grid calibration at {d:g} DPI "
-            f"(21 control; mean over {scan_t['trials'][i[0]]} blocks of the per-block relative "
-            "gain, the same measurements with and without; 95 % confidence interval)")))
+        rows.append(
+            book.score(
+                cid,
+                g,
+                (g - h, g + h),
+                note=(
+                    f"reduction of the check-point XY rms by the grid calibration at {d:g} DPI "
+                    f"(21 control; mean over {scan_t['trials'][i[0]]} blocks of the per-block relative "
+                    "gain, the same measurements with and without; 95 % confidence interval)"
+                ),
+            )
+        )
     return rows
 
 
 def input_rows(book: ClaimBook, cfg: dict, block: Block, c5, c21) -> list[dict]:
     rows = []
     for cid, s in book.specs.items():
-        if cid.startswith("agnard.input.") and cid[len("agnard.input."):] in cfg:
-            rows.append(book.score(cid, float(cfg[cid[len("agnard.input."):]]), interval="exact"))
+        if cid.startswith("agnard.input.") and cid[len("agnard.input.") :] in cfg:
+            rows.append(book.score(cid, float(cfg[cid[len("agnard.input.") :]]), interval="exact"))
     ng = block.n_ground
-    for cid, v in (("control_5_n", c5.size), ("control_5_check_n", ng - c5.size),
-                   ("control_21_n", c21.size), ("control_21_check_n", ng - c21.size)):
-        rows.append(book.score(f"agnard.input.{cid}", float(v), interval="exact",
-                               note="control layouts control.few / control.many"))
+    for cid, v in (
+        ("control_5_n", c5.size),
+        ("control_5_check_n", ng - c5.size),
+        ("control_21_n", c21.size),
+        ("control_21_check_n", ng - c21.size),
+    ):
+        rows.append(
+            book.score(
+                f"agnard.input.{cid}",
+                float(v),
+                interval="exact",
+                note="control layouts control.few / control.many",
+            )
+        )
     npass = int(block.is_pass.sum())
-    rows.append(book.score("agnard.input.pass_points", float(npass), interval="exact", note=(
-        f"the pass-point pattern is not printed: block.pass_rows = {cfg['block.pass_rows']} "
-        f"rows per strip at the photo nadirs and model centres give {npass} pass points "
-        f"against the paper's {ref(book, 'agnard.input.pass_points'):.0f}")))
+    rows.append(
+        book.score(
+            "agnard.input.pass_points",
+            float(npass),
+            interval="exact",
+            note=(
+                f"the pass-point pattern is not printed: block.pass_rows = {cfg['block.pass_rows']} "
+                f"rows per strip at the photo nadirs and model centres give {npass} pass points "
+                f"against the paper's {ref(book, 'agnard.input.pass_points'):.0f}"
+            ),
+        )
+    )
     pix = sc.pixel_um(cfg["scan.dpi"])
-    rows.append(book.score("agnard.scanner.pixel_um", pix, interval="exact",
-                           note=f"25.4 mm / {cfg['scan.dpi']:g} DPI = {pix:.2f} um"))
+    rows.append(
+        book.score(
+            "agnard.scanner.pixel_um",
+            pix,
+            interval="exact",
+            note=f"25.4 mm / {cfg['scan.dpi']:g} DPI = {pix:.2f} um",
+        )
+    )
     return rows
 
 
@@ -124,67 +186,118 @@ def budget_rows(book: ClaimBook, cfg: dict) -> list[dict]:
     fb = cfg["block.focal_mm"] / cfg["block.base_mm"]
     sxy, sz = model_sigmas(cfg)
     return [
-        book.score("agnard.budget.half_pixel_cm", half, interval="exact", note=(
-            f"half a pixel on the ground: 0.5 x {sc.pixel_um(cfg['scan.dpi']):.2f} um x "
-            f"{cfg['block.scale']:g} = {half:.2f} cm")),
-        book.score("agnard.budget.planimetry_cm", half * np.sqrt(2), interval="exact", note=(
-            f"radial planimetric error of {half:.2f} cm per coordinate: {half:.2f} x sqrt 2 = "
-            f"{half * np.sqrt(2):.2f} cm")),
-        book.score("agnard.budget.height_cm", half * fb, interval="exact", note=(
-            f"{half:.2f} cm x f / b = {half:.2f} x {cfg['block.focal_mm']:g} / "
-            f"{cfg['block.base_mm']:g} = {half * fb:.2f} cm (the paper's own rounded 13 cm gives "
-            f"{ref(book, 'agnard.budget.half_pixel_cm') * fb:.2f})")),
-        book.score("agnard.budget.model_xy_cm", 100 * sxy, interval="exact", note=(
-            f"the simulation's pointing model: a setting error of {cfg['measure.pointing_px']:g} "
-            f"px per coordinate plus the mean of the two photos' x-parallax errors "
-            f"({cfg['measure.parallax_px']:g} px / 2) gives {100 * sxy:.2f} cm per planimetric "
-            f"model coordinate, against the half pixel alone ({half:.2f} cm) of the paper's "
-            "budget, which counts the x-parallax error in height only")),
-        book.score("agnard.budget.model_z_cm", 100 * sz, interval="exact", note=(
-            f"x-parallax setting error {cfg['measure.parallax_px']:g} px x f / b = "
-            f"{100 * sz:.2f} cm in height (measure.parallax_px set from the paper's 22 cm)")),
+        book.score(
+            "agnard.budget.half_pixel_cm",
+            half,
+            interval="exact",
+            note=(
+                f"half a pixel on the ground: 0.5 x {sc.pixel_um(cfg['scan.dpi']):.2f} um x "
+                f"{cfg['block.scale']:g} = {half:.2f} cm"
+            ),
+        ),
+        book.score(
+            "agnard.budget.planimetry_cm",
+            half * np.sqrt(2),
+            interval="exact",
+            note=(
+                f"radial planimetric error of {half:.2f} cm per coordinate: {half:.2f} x sqrt 2 = "
+                f"{half * np.sqrt(2):.2f} cm"
+            ),
+        ),
+        book.score(
+            "agnard.budget.height_cm",
+            half * fb,
+            interval="exact",
+            note=(
+                f"{half:.2f} cm x f / b = {half:.2f} x {cfg['block.focal_mm']:g} / "
+                f"{cfg['block.base_mm']:g} = {half * fb:.2f} cm (the paper's own rounded 13 cm gives "
+                f"{ref(book, 'agnard.budget.half_pixel_cm') * fb:.2f})"
+            ),
+        ),
+        book.score(
+            "agnard.budget.model_xy_cm",
+            100 * sxy,
+            interval="exact",
+            note=(
+                f"the simulation's pointing model: a setting error of {cfg['measure.pointing_px']:g} "
+                f"px per coordinate plus the mean of the two photos' x-parallax errors "
+                f"({cfg['measure.parallax_px']:g} px / 2) gives {100 * sxy:.2f} cm per planimetric "
+                f"model coordinate, against the half pixel alone ({half:.2f} cm) of the paper's "
+                "budget, which counts the x-parallax error in height only"
+            ),
+        ),
+        book.score(
+            "agnard.budget.model_z_cm",
+            100 * sz,
+            interval="exact",
+            note=(
+                f"x-parallax setting error {cfg['measure.parallax_px']:g} px x f / b = "
+                f"{100 * sz:.2f} cm in height (measure.parallax_px set from the paper's 22 cm)"
+            ),
+        ),
     ]
 
 
 def table_note(cfg: dict, book: ClaimBook, cid: str, lay: str, ctrl, n_chk: int, x, alt=None):
-    what = ("model-point residuals at control points (transformed model minus adjusted "
-            "coordinates, as an independent-model program lists them)" if ".ctrl_" in cid
-            else "check-point errors (adjusted minus true)")
+    what = (
+        "model-point residuals at control points (transformed model minus adjusted "
+        "coordinates, as an independent-model program lists them)"
+        if ".ctrl_" in cid
+        else "check-point errors (adjusted minus true)"
+    )
     p = ref(book, cid)
     tol = book.spec(cid)["tol"]
-    note = (f"rms of the {what} of one block ({lay} layout, {len(ctrl)} control + {n_chk} check; "
-            f"weights control {cfg['weights.control_xy']:g}/{cfg['weights.control_z']:g}, model "
-            f"points {cfg['weights.pass']:g}), scanner-corrected measurements; median and 95 % of "
-            f"{len(x)} blocks; {_where(p, x)}; tolerance {tol:g} cm "
-            f"({100 * tol / p:.0f} % of the paper's value)" if p else "")
+    note = (
+        f"rms of the {what} of one block ({lay} layout, {len(ctrl)} control + {n_chk} check; "
+        f"weights control {cfg['weights.control_xy']:g}/{cfg['weights.control_z']:g}, model "
+        f"points {cfg['weights.pass']:g}), scanner-corrected measurements; median and 95 % of "
+        f"{len(x)} blocks; {_where(p, x)}; tolerance {tol:g} cm "
+        f"({100 * tol / p:.0f} % of the paper's value)"
+        if p
+        else ""
+    )
     if alt is not None:
-        note += (f". Read instead as adjusted minus given control coordinates: median "
-                 f"{100 * np.median(alt):.1f} cm")
+        note += (
+            f". Read instead as adjusted minus given control coordinates: median "
+            f"{100 * np.median(alt):.1f} cm"
+        )
     return note
 
 
 def tables23_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, c5, c21) -> list[dict]:
     rows = []
-    for name, lay, ctrl in (("control_5", cfg["control.few"], c5),
-                            ("control_21", cfg["control.many"], c21)):
+    for name, lay, ctrl in (
+        ("control_5", cfg["control.few"], c5),
+        ("control_21", cfg["control.many"], c21),
+    ):
         n_chk = block.n_ground - ctrl.size
         for where in ("ctrl", "check"):
             for c in AXES:
                 cid = f"agnard.{name}.{where}_{c}_cm"
                 x = 100 * sim[f"layout_{lay}.{where}_{c}_m"]
                 alt = sim[f"layout_{lay}.ctrl_given_{c}_m"] if where == "ctrl" else None
-                rows.append(book.score(cid, samples=x, note=table_note(cfg, book, cid, lay, ctrl,
-                                                                       n_chk, x, alt)))
+                rows.append(
+                    book.score(
+                        cid, samples=x, note=table_note(cfg, book, cid, lay, ctrl, n_chk, x, alt)
+                    )
+                )
         for c in ("xy", "z"):
             cid = f"agnard.max_residual.{name}_{c}_cm"
             x = 100 * sim[f"layout_{lay}.ctrl_max_{c}_m"]
             alt = 100 * sim[f"layout_{lay}.ctrl_given_max_{c}_m"]
-            rows.append(book.score(cid, samples=x, note=(
-                f"largest {'radial planimetric' if c == 'xy' else 'height'} model-point residual "
-                f"at the {ctrl.size} control points of one block ({lay} layout); median and 95 % "
-                f"of {x.size} blocks; {_where(ref(book, cid), x)}. Read as adjusted minus given "
-                f"control coordinates: median {np.median(alt):.1f} cm, "
-                f"{100 * np.mean(alt <= ref(book, cid) + 0.5):.0f} % of blocks within the bound")))
+            rows.append(
+                book.score(
+                    cid,
+                    samples=x,
+                    note=(
+                        f"largest {'radial planimetric' if c == 'xy' else 'height'} model-point residual "
+                        f"at the {ctrl.size} control points of one block ({lay} layout); median and 95 % "
+                        f"of {x.size} blocks; {_where(ref(book, cid), x)}. Read as adjusted minus given "
+                        f"control coordinates: median {np.median(alt):.1f} cm, "
+                        f"{100 * np.mean(alt <= ref(book, cid) + 0.5):.0f} % of blocks within the bound"
+                    ),
+                )
+            )
     return rows
 
 
@@ -192,25 +305,46 @@ def first_pass_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict) -> list
     pix_cm = 100 * pixel_ground_m(cfg)
     n_pass = int(block.is_pass.sum())
     rows = []
-    for q, lab in (("xy", "radial XY (the paper's 'planimetry': its Tables' XY column is the "
-                          "radial rms)"), ("z", "Z")):
+    for q, lab in (
+        ("xy", "radial XY (the paper's 'planimetry': its Tables' XY column is the radial rms)"),
+        ("z", "Z"),
+    ):
         cid = f"agnard.first_pass.pass_{q}_cm"
         x = 100 * sim[f"first.pass_{q}_m"]
         extra = ""
         if q == "xy":
-            extra = (f"; per coordinate X {100 * np.median(sim['first.pass_x_m']):.1f} cm, Y "
-                     f"{100 * np.median(sim['first.pass_y_m']):.1f} cm")
-        rows.append(book.score(cid, samples=x, note=(
-            f"rms of the model-point residuals at the {n_pass} pass points, {lab}{extra}; "
-            f"{cfg['control.many']} control at weight {cfg['weights.first_pass_control']:g} "
-            f"against {cfg['weights.first_pass_pass']:g}; median and 95 % of {x.size} blocks; "
-            f"{_where(ref(book, cid), x)}")))
-    for cid, src in (("agnard.first_pass.quarter_pixel", "agnard.first_pass.pass_xy_cm"),
-                     ("agnard.first_pass.third_pixel", "agnard.first_pass.pass_z_cm")):
+            extra = (
+                f"; per coordinate X {100 * np.median(sim['first.pass_x_m']):.1f} cm, Y "
+                f"{100 * np.median(sim['first.pass_y_m']):.1f} cm"
+            )
+        rows.append(
+            book.score(
+                cid,
+                samples=x,
+                note=(
+                    f"rms of the model-point residuals at the {n_pass} pass points, {lab}{extra}; "
+                    f"{cfg['control.many']} control at weight {cfg['weights.first_pass_control']:g} "
+                    f"against {cfg['weights.first_pass_pass']:g}; median and 95 % of {x.size} blocks; "
+                    f"{_where(ref(book, cid), x)}"
+                ),
+            )
+        )
+    for cid, src in (
+        ("agnard.first_pass.quarter_pixel", "agnard.first_pass.pass_xy_cm"),
+        ("agnard.first_pass.third_pixel", "agnard.first_pass.pass_z_cm"),
+    ):
         cm = ref(book, src)
-        rows.append(book.score(cid, cm / pix_cm, interval="exact", note=(
-            f"recomputed from the paper's own numbers: {cm:g} cm / ({sc.pixel_um(cfg['scan.dpi']):.2f}"
-            f" um x {cfg['block.scale']:g} = {pix_cm:.2f} cm) = {cm / pix_cm:.3f} pixel")))
+        rows.append(
+            book.score(
+                cid,
+                cm / pix_cm,
+                interval="exact",
+                note=(
+                    f"recomputed from the paper's own numbers: {cm:g} cm / ({sc.pixel_um(cfg['scan.dpi']):.2f}"
+                    f" um x {cfg['block.scale']:g} = {pix_cm:.2f} cm) = {cm / pix_cm:.3f} pixel"
+                ),
+            )
+        )
     return rows
 
 
@@ -220,17 +354,27 @@ def rejection_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, pug: dic
     sens = ", ".join(f"{r:g} px: {np.mean(s):.1f} %" for r, s in pug.items())
     sh = sim["snoop_mechanical.share_pct"]
     return [
-        book.score("agnard.pass_rejections.digital", samples=rej, note=(
-            f"pass points (of {n_pass}) removed by iterative data snooping (Baarda w-test, "
-            f"alpha {cfg['snoop.alpha']:g}, {cfg['snoop.test']}-test) under digital pugging; "
-            f"{100 * np.mean(rej == 0):.0f} % of {rej.size} blocks lose none; median a-posteriori "
-            f"sigma0 {np.median(sim['snoop_digital.sigma0']):.2f}")),
-        book.score("agnard.pass_rejections.mechanical_pct", samples=sh, note=(
-            f"share of the {n_pass} pass points removed under mechanical pugging (no gross "
-            f"errors at pugging.gross_rate {cfg['pugging.gross_rate']:g}; hole transfer "
-            f"{cfg['pugging.transfer_um']:g} um, re-centring {cfg['pugging.recentre_px']:g} px "
-            f"per photo: unprinted, swept in consistent_set); {_where(ref(book, 'agnard.pass_rejections.mechanical_pct'), sh)}; "
-            f"mean share against the re-centring error: {sens}")),
+        book.score(
+            "agnard.pass_rejections.digital",
+            samples=rej,
+            note=(
+                f"pass points (of {n_pass}) removed by iterative data snooping (Baarda w-test, "
+                f"alpha {cfg['snoop.alpha']:g}, {cfg['snoop.test']}-test) under digital pugging; "
+                f"{100 * np.mean(rej == 0):.0f} % of {rej.size} blocks lose none; median a-posteriori "
+                f"sigma0 {np.median(sim['snoop_digital.sigma0']):.2f}"
+            ),
+        ),
+        book.score(
+            "agnard.pass_rejections.mechanical_pct",
+            samples=sh,
+            note=(
+                f"share of the {n_pass} pass points removed under mechanical pugging (no gross "
+                f"errors at pugging.gross_rate {cfg['pugging.gross_rate']:g}; hole transfer "
+                f"{cfg['pugging.transfer_um']:g} um, re-centring {cfg['pugging.recentre_px']:g} px "
+                f"per photo: unprinted, swept in consistent_set); {_where(ref(book, 'agnard.pass_rejections.mechanical_pct'), sh)}; "
+                f"mean share against the re-centring error: {sens}"
+            ),
+        ),
     ]
 
 
@@ -239,31 +383,50 @@ def anisotropy_samples(cfg: dict, sim: dict) -> np.ndarray:
     eight (X, Y) pairs (Table 1 without/with, control and check; Tables 2-3)."""
     keys = [f"without.{w}" for w in ("ctrl", "check")]
     keys += [f"layout_{cfg['control.table1']}.{w}" for w in ("ctrl", "check")]
-    keys += [f"layout_{lay}.{w}" for lay in (cfg["control.few"], cfg["control.many"])
-             for w in ("ctrl", "check")]
+    keys += [
+        f"layout_{lay}.{w}"
+        for lay in (cfg["control.few"], cfg["control.many"])
+        for w in ("ctrl", "check")
+    ]
     r = np.stack([np.log(sim[k + "_y_m"] / sim[k + "_x_m"]) for k in keys])
     return np.exp(r.mean(0))
 
 
 def anisotropy_rows(book: ClaimBook, cfg: dict, sim: dict) -> list[dict]:
     g = anisotropy_samples(cfg, sim)
-    yx21 = sim[f"layout_{cfg['control.many']}.check_y_m"] / sim[f"layout_{cfg['control.many']}.check_x_m"]
-    return [book.score("agnard.anisotropy.y_over_x", samples=g, note=(
-        f"per block the geometric mean of Y/X over the eight simulated counterparts; "
-        f"{_where(ref(book, 'agnard.anisotropy.y_over_x'), g)}; 21-control check points alone: "
-        f"median Y/X {np.median(yx21):.2f}; the simulated pointing error is "
-        f"{cfg['measure.pointing_px']:g} px in both x and y, the scanner deformation peaks at "
-        f"{cfg['scan.max_y_um']:g} um in y and {cfg['scan.max_x_um']:g} um in x")),
+    yx21 = (
+        sim[f"layout_{cfg['control.many']}.check_y_m"]
+        / sim[f"layout_{cfg['control.many']}.check_x_m"]
+    )
+    return [
+        book.score(
+            "agnard.anisotropy.y_over_x",
+            samples=g,
+            note=(
+                f"per block the geometric mean of Y/X over the eight simulated counterparts; "
+                f"{_where(ref(book, 'agnard.anisotropy.y_over_x'), g)}; 21-control check points alone: "
+                f"median Y/X {np.median(yx21):.2f}; the simulated pointing error is "
+                f"{cfg['measure.pointing_px']:g} px in both x and y, the scanner deformation peaks at "
+                f"{cfg['scan.max_y_um']:g} um in y and {cfg['scan.max_x_um']:g} um in x"
+            ),
+        ),
     ]
 
 
-def claim_rows(cfg: dict, block: Block, sim: dict, c5, c21, scan_t: dict, pug: dict,
-               book: ClaimBook) -> list[dict]:
+def claim_rows(
+    cfg: dict, block: Block, sim: dict, c5, c21, scan_t: dict, pug: dict, book: ClaimBook
+) -> list[dict]:
     """Every claim of the book, scored once."""
-    rows = (table1_rows(book, cfg, sim) + scanner_rows(book, scan_t)
-            + input_rows(book, cfg, block, c5, c21) + budget_rows(book, cfg)
-            + tables23_rows(book, cfg, block, sim, c5, c21) + first_pass_rows(book, cfg, block, sim)
-            + rejection_rows(book, cfg, block, sim, pug) + anisotropy_rows(book, cfg, sim))
+    rows = (
+        table1_rows(book, cfg, sim)
+        + scanner_rows(book, scan_t)
+        + input_rows(book, cfg, block, c5, c21)
+        + budget_rows(book, cfg)
+        + tables23_rows(book, cfg, block, sim, c5, c21)
+        + first_pass_rows(book, cfg, block, sim)
+        + rejection_rows(book, cfg, block, sim, pug)
+        + anisotropy_rows(book, cfg, sim)
+    )
     for r in rows:  # an unbounded side of a bound's zone is "no number" (null), not infinity
         for k in ("zone_low", "zone_high"):
             if not np.isfinite(r[k]):

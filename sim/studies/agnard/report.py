@@ -1,16 +1,17 @@
 """Report section of ``agnard_block`` (seed ``003_5ce730a990a7ebc5.txt``), built from the
 study's Parquet files and its claim book alone; every number and verdict word in the text
 is read from them."""
+
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ...report import claims_markdown, fmt, inputs_markdown, md_table
-from ...storage import read_provenance, read_table
-from ... import distributions as D
-from .schema import SCHEMA
+from sim.lsq import distributions as D
+from sim.mc.storage import read_provenance, read_table
+from sim.report.markdown import claims_markdown, fmt, inputs_markdown, md_table
+from sim.studies.agnard.schema import SCHEMA
 
 
 def _claims(out: Path) -> dict:
@@ -29,33 +30,62 @@ def consistent_markdown(out: Path) -> str:
     sw = read_table(out / "sweep_claims.parquet").to_pydict()
     rows = []
     for r in cs:
-        sel = [k for k, (i, c) in enumerate(zip(sw["input"], sw["claim"]))
-               if i == r["input"] and (c == r["claim"] or r["claim"] == "ALL")]
+        sel = [
+            k
+            for k, (i, c) in enumerate(zip(sw["input"], sw["claim"]))
+            if i == r["input"] and (c == r["claim"] or r["claim"] == "ALL")
+        ]
         vals = sorted({sw["value"][k] for k in sel})
-        rows.append([f"`{r['input']}`", r["claim"].replace("agnard.", ""),
-                     _range(r["holds_low"], r["holds_high"]), _range(r["ok_low"], r["ok_high"]),
-                     ", ".join(fmt(v) for v in vals)])
+        rows.append(
+            [
+                f"`{r['input']}`",
+                r["claim"].replace("agnard.", ""),
+                _range(r["holds_low"], r["holds_high"]),
+                _range(r["ok_low"], r["ok_high"]),
+                ", ".join(fmt(v) for v in vals),
+            ]
+        )
     conflicts = []
     for inp in dict.fromkeys(r["input"] for r in cs):
         allr = [r for r in cs if r["input"] == inp and r["claim"] == "ALL"][0]
         if allr["ok_low"] is None or not np.isfinite(allr["ok_low"]):
-            bad = [r["claim"].replace("agnard.", "") for r in cs if r["input"] == inp
-                   and r["claim"] != "ALL" and r["ok_low"] is not None and np.isfinite(r["ok_low"])]
-            never = [r["claim"].replace("agnard.", "") for r in cs if r["input"] == inp
-                     and r["claim"] != "ALL" and (r["ok_low"] is None or not np.isfinite(r["ok_low"]))]
-            conflicts.append(f"- `{inp}`: no swept value lets every claim stand; failing at "
-                             f"every value: {', '.join(never) or 'none'}; the others do not fail "
-                             f"somewhere: {', '.join(bad) or 'none'}.")
+            bad = [
+                r["claim"].replace("agnard.", "")
+                for r in cs
+                if r["input"] == inp
+                and r["claim"] != "ALL"
+                and r["ok_low"] is not None
+                and np.isfinite(r["ok_low"])
+            ]
+            never = [
+                r["claim"].replace("agnard.", "")
+                for r in cs
+                if r["input"] == inp
+                and r["claim"] != "ALL"
+                and (r["ok_low"] is None or not np.isfinite(r["ok_low"]))
+            ]
+            conflicts.append(
+                f"- `{inp}`: no swept value lets every claim stand; failing at "
+                f"every value: {', '.join(never) or 'none'}; the others do not fail "
+                f"somewhere: {', '.join(bad) or 'none'}."
+            )
         else:
-            conflicts.append(f"- `{inp}`: no claim fails for {_range(allr['ok_low'], allr['ok_high'])}"
-                             f"; all hold together {_range(allr['holds_low'], allr['holds_high'])}.")
-    return "\n".join([
-        "**Unprinted inputs, swept** (the paper's Figure 5, the five-point layout, is lost: the "
-        "four outer points moved inwards along the strips by a share of the block length, the "
-        "fifth at the centre; the mechanical re-centring error is not printed). Per claim, the "
-        "swept values where it holds and where it does not fail, by the claim book's rule:",
-        "", md_table(["input", "claim", "holds for", "does not fail for", "swept values"], rows),
-        "", *conflicts])
+            conflicts.append(
+                f"- `{inp}`: no claim fails for {_range(allr['ok_low'], allr['ok_high'])}"
+                f"; all hold together {_range(allr['holds_low'], allr['holds_high'])}."
+            )
+    return "\n".join(
+        [
+            "**Unprinted inputs, swept** (the paper's Figure 5, the five-point layout, is lost: the "
+            "four outer points moved inwards along the strips by a share of the block length, the "
+            "fifth at the centre; the mechanical re-centring error is not printed). Per claim, the "
+            "swept values where it holds and where it does not fail, by the claim book's rule:",
+            "",
+            md_table(["input", "claim", "holds for", "does not fail for", "swept values"], rows),
+            "",
+            *conflicts,
+        ]
+    )
 
 
 def anisotropy_text(c: dict, out: Path, cfg: dict) -> str:
@@ -65,20 +95,30 @@ def anisotropy_text(c: dict, out: Path, cfg: dict) -> str:
     yx = lambda k: fmt(float(np.median(np.asarray(tr[k + "_y_m"]) / np.asarray(tr[k + "_x_m"]))), 3)  # noqa: E731
     many = f"layout_{cfg['control.many']}.check"
     iso = cfg["measure.pointing_px"] > 0 and cfg["scan.max_y_um"] > cfg["scan.max_x_um"]
-    return (f"- *Y against X*: the paper's eight printed (X, Y) pairs give Y/X "
-            f"{fmt((r['ref_low'] + r['ref_high']) / 2)} (geometric mean, claim book); the "
-            f"simulated blocks give {fmt(r['value'])} (95 % of blocks {fmt(r['ci_low'])}-"
-            f"{fmt(r['ci_high'])}), verdict *{r['verdict']}*. Check points with "
-            f"{cfg['control.many']} control: Y/X {yx('without.check')} without the scanner "
-            f"correction and {yx(many)} with it. The simulated pointing error is the same in x "
-            "and y" + (f", and the only anisotropic input, the scanner's larger y deformation "
-                       f"(+-{cfg['scan.max_y_um']:g} against +-{cfg['scan.max_x_um']:g} um), "
-                       "is what the two ratios above show after the fiducial affine and the "
-                       "grid calibration" if iso else "")
-            + ("; a Y/X of the paper's size would need an error the simulation does not carry "
-               "(a y-scale of the scanner's stepper drive left in the scans, a deformation "
-               "changing from scan to scan, or an anisotropic test field)."
-               if r["verdict"] == "fails" else "."))
+    return (
+        f"- *Y against X*: the paper's eight printed (X, Y) pairs give Y/X "
+        f"{fmt((r['ref_low'] + r['ref_high']) / 2)} (geometric mean, claim book); the "
+        f"simulated blocks give {fmt(r['value'])} (95 % of blocks {fmt(r['ci_low'])}-"
+        f"{fmt(r['ci_high'])}), verdict *{r['verdict']}*. Check points with "
+        f"{cfg['control.many']} control: Y/X {yx('without.check')} without the scanner "
+        f"correction and {yx(many)} with it. The simulated pointing error is the same in x "
+        "and y"
+        + (
+            f", and the only anisotropic input, the scanner's larger y deformation "
+            f"(+-{cfg['scan.max_y_um']:g} against +-{cfg['scan.max_x_um']:g} um), "
+            "is what the two ratios above show after the fiducial affine and the "
+            "grid calibration"
+            if iso
+            else ""
+        )
+        + (
+            "; a Y/X of the paper's size would need an error the simulation does not carry "
+            "(a y-scale of the scanner's stepper drive left in the scans, a deformation "
+            "changing from scan to scan, or an anisotropic test field)."
+            if r["verdict"] == "fails"
+            else "."
+        )
+    )
 
 
 def findings(out: Path) -> str:
@@ -88,52 +128,62 @@ def findings(out: Path) -> str:
     pt = read_table(out / "tradeoff_pugging.parquet").to_pydict()
     v = lambda k: fmt(c[k]["value"])  # noqa: E731
     vd = lambda k: c[k]["verdict"]  # noqa: E731
-    sens = ", ".join(f"{fmt(r)} px: {fmt(m, 2)} %" for r, m in zip(pt["recentre_px"],
-                                                                   pt["mean_share_pct"]))
+    sens = ", ".join(
+        f"{fmt(r)} px: {fmt(m, 2)} %" for r, m in zip(pt["recentre_px"], pt["mean_share_pct"])
+    )
     errata = [k for k, r in c.items() if r["verdict"] == "erratum"]
     g3, g6 = c["agnard.scanner.gain_300dpi_pct"], c["agnard.scanner.gain_600dpi_pct"]
     apart = g6["ci_low"] > g3["ci_high"]
-    return "\n".join([
-        f"- *Table 1*: its 'with correction' rows against the paper's own Tables 2-3: "
-        + "; ".join(f"{k.split('.')[-1]} {fmt(c[k]['ref_low'] + 0.005, 2)} m vs {v(k)} m "
-                    f"(*{vd(k)}*)" for k in c if k.startswith("agnard.table1.with_"))
-        + ". The simulated without/with ratio of the check points in Y is "
-        f"{v('agnard.table1.ratio_check_y')} (paper {fmt(c['agnard.table1.ratio_check_y']['ref_low'])}, "
-        f"*{vd('agnard.table1.ratio_check_y')}*). Calibration gains {fmt(g3['value'], 2)} % at 300 "
-        f"DPI and {fmt(g6['value'], 2)} % at 600 DPI in check-point XY rms"
-        + (" (the 600 DPI gain's interval lies above the 300 DPI one)." if apart else
-           " (the two intervals overlap)."),
-        f"- *Tables 2-3*: 21 control: check XY {v('agnard.control_21.check_xy_cm')} cm "
-        f"(*{vd('agnard.control_21.check_xy_cm')}*), Z {v('agnard.control_21.check_z_cm')} cm "
-        f"(*{vd('agnard.control_21.check_z_cm')}*); 5 control: check XY "
-        f"{v('agnard.control_5.check_xy_cm')} cm (*{vd('agnard.control_5.check_xy_cm')}*), Z "
-        f"{v('agnard.control_5.check_z_cm')} cm (*{vd('agnard.control_5.check_z_cm')}*). See the "
-        "swept five-point layouts below for which layouts the 5-control rows stand.",
-        f"- *Precision budget*: the paper's 13 / 19 / 22 cm recompute to "
-        f"{v('agnard.budget.half_pixel_cm')} / {v('agnard.budget.planimetry_cm')} / "
-        f"{v('agnard.budget.height_cm')} cm; the simulation's pointing model gives "
-        f"{v('agnard.budget.model_xy_cm')} cm per planimetric coordinate "
-        f"(*{vd('agnard.budget.model_xy_cm')}* against 13: it adds half the x-parallax error) "
-        f"and {v('agnard.budget.model_z_cm')} cm in height.",
-        f"- *First pass*: pass-point residuals {v('agnard.first_pass.pass_xy_cm')} cm XY "
-        f"(*{vd('agnard.first_pass.pass_xy_cm')}*), {v('agnard.first_pass.pass_z_cm')} cm Z "
-        f"(*{vd('agnard.first_pass.pass_z_cm')}*); the paper's own 10 and 15 cm are "
-        f"{v('agnard.first_pass.quarter_pixel')} and {v('agnard.first_pass.third_pixel')} pixel, "
-        "not a quarter and a third.",
-        f"- *Maximum control residuals* (21 control): {v('agnard.max_residual.control_21_xy_cm')} "
-        f"cm XY (*{vd('agnard.max_residual.control_21_xy_cm')}* against at most 21), "
-        f"{v('agnard.max_residual.control_21_z_cm')} cm Z "
-        f"(*{vd('agnard.max_residual.control_21_z_cm')}* against at most 16).",
-        f"- *Pass-point rejection*: digital pugging removes a median "
-        f"{v('agnard.pass_rejections.digital')} pass points "
-        f"(*{vd('agnard.pass_rejections.digital')}*); mechanical pugging "
-        f"{v('agnard.pass_rejections.mechanical_pct')} % "
-        f"(*{vd('agnard.pass_rejections.mechanical_pct')}*), mean share against the unprinted "
-        f"re-centring error: {sens}.",
-        anisotropy_text(c, out, cfg),
-        f"- *Errata* (paper-checks the paper's own printed data contradict): {len(errata)}: "
-        + (", ".join(e.replace("agnard.", "") for e in errata) or "none") + ".",
-    ])
+    return "\n".join(
+        [
+            "- *Table 1*: its 'with correction' rows against the paper's own Tables 2-3: "
+            + "; ".join(
+                f"{k.split('.')[-1]} {fmt(c[k]['ref_low'] + 0.005, 2)} m vs {v(k)} m (*{vd(k)}*)"
+                for k in c
+                if k.startswith("agnard.table1.with_")
+            )
+            + ". The simulated without/with ratio of the check points in Y is "
+            f"{v('agnard.table1.ratio_check_y')} (paper {fmt(c['agnard.table1.ratio_check_y']['ref_low'])}, "
+            f"*{vd('agnard.table1.ratio_check_y')}*). Calibration gains {fmt(g3['value'], 2)} % at 300 "
+            f"DPI and {fmt(g6['value'], 2)} % at 600 DPI in check-point XY rms"
+            + (
+                " (the 600 DPI gain's interval lies above the 300 DPI one)."
+                if apart
+                else " (the two intervals overlap)."
+            ),
+            f"- *Tables 2-3*: 21 control: check XY {v('agnard.control_21.check_xy_cm')} cm "
+            f"(*{vd('agnard.control_21.check_xy_cm')}*), Z {v('agnard.control_21.check_z_cm')} cm "
+            f"(*{vd('agnard.control_21.check_z_cm')}*); 5 control: check XY "
+            f"{v('agnard.control_5.check_xy_cm')} cm (*{vd('agnard.control_5.check_xy_cm')}*), Z "
+            f"{v('agnard.control_5.check_z_cm')} cm (*{vd('agnard.control_5.check_z_cm')}*). See the "
+            "swept five-point layouts below for which layouts the 5-control rows stand.",
+            f"- *Precision budget*: the paper's 13 / 19 / 22 cm recompute to "
+            f"{v('agnard.budget.half_pixel_cm')} / {v('agnard.budget.planimetry_cm')} / "
+            f"{v('agnard.budget.height_cm')} cm; the simulation's pointing model gives "
+            f"{v('agnard.budget.model_xy_cm')} cm per planimetric coordinate "
+            f"(*{vd('agnard.budget.model_xy_cm')}* against 13: it adds half the x-parallax error) "
+            f"and {v('agnard.budget.model_z_cm')} cm in height.",
+            f"- *First pass*: pass-point residuals {v('agnard.first_pass.pass_xy_cm')} cm XY "
+            f"(*{vd('agnard.first_pass.pass_xy_cm')}*), {v('agnard.first_pass.pass_z_cm')} cm Z "
+            f"(*{vd('agnard.first_pass.pass_z_cm')}*); the paper's own 10 and 15 cm are "
+            f"{v('agnard.first_pass.quarter_pixel')} and {v('agnard.first_pass.third_pixel')} pixel, "
+            "not a quarter and a third.",
+            f"- *Maximum control residuals* (21 control): {v('agnard.max_residual.control_21_xy_cm')} "
+            f"cm XY (*{vd('agnard.max_residual.control_21_xy_cm')}* against at most 21), "
+            f"{v('agnard.max_residual.control_21_z_cm')} cm Z "
+            f"(*{vd('agnard.max_residual.control_21_z_cm')}* against at most 16).",
+            f"- *Pass-point rejection*: digital pugging removes a median "
+            f"{v('agnard.pass_rejections.digital')} pass points "
+            f"(*{vd('agnard.pass_rejections.digital')}*); mechanical pugging "
+            f"{v('agnard.pass_rejections.mechanical_pct')} % "
+            f"(*{vd('agnard.pass_rejections.mechanical_pct')}*), mean share against the unprinted "
+            f"re-centring error: {sens}.",
+            anisotropy_text(c, out, cfg),
+            f"- *Errata* (paper-checks the paper's own printed data contradict): {len(errata)}: "
+            + (", ".join(e.replace("agnard.", "") for e in errata) or "none")
+            + ".",
+        ]
+    )
 
 
 def report(out: Path) -> str:
@@ -150,7 +200,10 @@ def report(out: Path) -> str:
     n_ground = int((kinds != "pass").sum())
     crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
     c = _claims(out)
-    sxy, sz = c["agnard.budget.model_xy_cm"]["value"] / 100, c["agnard.budget.model_z_cm"]["value"] / 100
+    sxy, sz = (
+        c["agnard.budget.model_xy_cm"]["value"] / 100,
+        c["agnard.budget.model_z_cm"]["value"] / 100,
+    )
     pix_um = 25.4e3 / cfg["scan.dpi"]
     conv = all(all(v) for k, v in tr.items() if k.endswith(".converged"))
     name = out.name
@@ -226,46 +279,114 @@ def report(out: Path) -> str:
         "",
         "**Trade-off: scan resolution and calibration** (21 control, mean rms over trials ± s.e.):",
         "",
-        md_table(["DPI", "calibration", "trials", "check XY (m)", "check Z (m)", "control XY (m)",
-                  "control Z (m)", "XY gain of calibration (%)"],
-                 [[fmt(d), "grid" if c == "corrected" else "none", n, f"{fmt(a)} ± {fmt(b, 2)}",
-                   f"{fmt(e)} ± {fmt(f, 2)}", fmt(g), fmt(h),
-                   f"{fmt(gn)} ± {fmt(gs, 2)}" if c == "corrected" else ""]
-                  for d, c, n, a, b, e, f, g, h, gn, gs in zip(
-                      st["dpi"], st["calibration"], st["trials"], st["check_xy_m"],
-                      st["check_xy_m_se"], st["check_z_m"], st["check_z_m_se"], st["ctrl_xy_m"],
-                      st["ctrl_z_m"], st["gain_xy_pct"], st["gain_xy_pct_se"])]),
+        md_table(
+            [
+                "DPI",
+                "calibration",
+                "trials",
+                "check XY (m)",
+                "check Z (m)",
+                "control XY (m)",
+                "control Z (m)",
+                "XY gain of calibration (%)",
+            ],
+            [
+                [
+                    fmt(d),
+                    "grid" if c == "corrected" else "none",
+                    n,
+                    f"{fmt(a)} ± {fmt(b, 2)}",
+                    f"{fmt(e)} ± {fmt(f, 2)}",
+                    fmt(g),
+                    fmt(h),
+                    f"{fmt(gn)} ± {fmt(gs, 2)}" if c == "corrected" else "",
+                ]
+                for d, c, n, a, b, e, f, g, h, gn, gs in zip(
+                    st["dpi"],
+                    st["calibration"],
+                    st["trials"],
+                    st["check_xy_m"],
+                    st["check_xy_m_se"],
+                    st["check_z_m"],
+                    st["check_z_m_se"],
+                    st["ctrl_xy_m"],
+                    st["ctrl_z_m"],
+                    st["gain_xy_pct"],
+                    st["gain_xy_pct_se"],
+                )
+            ],
+        ),
         "",
         "**Trade-off: control layout** (600 DPI calibrated, same trials as the claims):",
         "",
-        md_table(["layout", "control", "check XY (m)", "check Z (m)", "control XY (m)",
-                  "control Z (m)"],
-                 [[a, n, f"{fmt(b)} ± {fmt(c, 2)}", f"{fmt(d)} ± {fmt(e, 2)}", fmt(f), fmt(g)]
-                  for a, n, b, c, d, e, f, g in zip(lt["layout"], lt["n_control"], lt["check_xy_m"],
-                                                    lt["check_xy_m_se"], lt["check_z_m"],
-                                                    lt["check_z_m_se"], lt["ctrl_xy_m"],
-                                                    lt["ctrl_z_m"])]),
+        md_table(
+            ["layout", "control", "check XY (m)", "check Z (m)", "control XY (m)", "control Z (m)"],
+            [
+                [a, n, f"{fmt(b)} ± {fmt(c, 2)}", f"{fmt(d)} ± {fmt(e, 2)}", fmt(f), fmt(g)]
+                for a, n, b, c, d, e, f, g in zip(
+                    lt["layout"],
+                    lt["n_control"],
+                    lt["check_xy_m"],
+                    lt["check_xy_m_se"],
+                    lt["check_z_m"],
+                    lt["check_z_m_se"],
+                    lt["ctrl_xy_m"],
+                    lt["ctrl_z_m"],
+                )
+            ],
+        ),
         "",
         f"**Trade-off: block size** ({cfg['tradeoff.block_control']} control, same point density, "
         f"{cfg['tradeoff.block_trials']} trials each; 'centre' = the "
         f"{cfg['tradeoff.centre_points']} check points nearest the block centre):",
         "",
-        md_table(["strips x models", "points", "control", "centre XY (m)", "centre Z (m)",
-                  "all check XY (m)", "all check Z (m)"],
-                 [[f"{s} x {m}", p, c, f"{fmt(a)} ± {fmt(b, 2)}", f"{fmt(d)} ± {fmt(e, 2)}",
-                   fmt(f), fmt(g)]
-                  for s, m, p, c, a, b, d, e, f, g in zip(
-                      bt["strips"], bt["models"], bt["n_points"], bt["n_control"],
-                      bt["centre_xy_m"], bt["centre_xy_m_se"], bt["centre_z_m"],
-                      bt["centre_z_m_se"], bt["check_xy_m"], bt["check_z_m"])]),
+        md_table(
+            [
+                "strips x models",
+                "points",
+                "control",
+                "centre XY (m)",
+                "centre Z (m)",
+                "all check XY (m)",
+                "all check Z (m)",
+            ],
+            [
+                [
+                    f"{s} x {m}",
+                    p,
+                    c,
+                    f"{fmt(a)} ± {fmt(b, 2)}",
+                    f"{fmt(d)} ± {fmt(e, 2)}",
+                    fmt(f),
+                    fmt(g),
+                ]
+                for s, m, p, c, a, b, d, e, f, g in zip(
+                    bt["strips"],
+                    bt["models"],
+                    bt["n_points"],
+                    bt["n_control"],
+                    bt["centre_xy_m"],
+                    bt["centre_xy_m_se"],
+                    bt["centre_z_m"],
+                    bt["centre_z_m_se"],
+                    bt["check_xy_m"],
+                    bt["check_z_m"],
+                )
+            ],
+        ),
         "",
         "**Sensitivity: mechanical re-centring error against pass-point rejections** "
         "(no gross errors; the snooping weights are those of digital measurement):",
         "",
-        md_table(["re-centring (px)", "trials", "pass points rejected (%)"],
-                 [[fmt(r), n, f"{fmt(m)} ± {fmt(e, 2)}"] for r, n, m, e in
-                  zip(pt["recentre_px"], pt["trials"], pt["mean_share_pct"],
-                      pt["mean_share_pct_se"])]),
+        md_table(
+            ["re-centring (px)", "trials", "pass points rejected (%)"],
+            [
+                [fmt(r), n, f"{fmt(m)} ± {fmt(e, 2)}"]
+                for r, n, m, e in zip(
+                    pt["recentre_px"], pt["trials"], pt["mean_share_pct"], pt["mean_share_pct_se"]
+                )
+            ],
+        ),
         "",
         f"![scanner deformation]({name}/scanner_field.png)",
         f"![block layout]({name}/block_layout.png)",

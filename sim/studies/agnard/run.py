@@ -2,14 +2,15 @@
 
 Streams (``part``): 0 the 2 x 8 block with every adjustment of the paper; then one per scan
 resolution, one per block size, one per mechanical re-centring error, and one for the sweep
-of the five-point control layout. Every part goes through :func:`sim.runner.run_chunks` with
+of the five-point control layout. Every part goes through :func:`sim.mc.runner.run_chunks` with
 the run context (executor, chunk store), with picklable chunk functions
 (:mod:`.chunks`), so ``--workers``, Dask and resumption after a kill apply.
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
 tables, ``sweep_five.parquet``, ``sweep_claims.parquet``, ``consistent_set.parquet``,
 ``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each sent to the run's
-workers, when it has some, as soon as its data exist: :func:`sim.figure_jobs.start_figures`).
+workers, when it has some, as soon as its data exist: :func:`sim.report.figure_jobs.start_figures`).
 """
+
 from __future__ import annotations
 
 from functools import partial
@@ -17,19 +18,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ... import independent_models as im
-from ...block_layout import select_control
-from ...claims import write_claims
-from ...figure_jobs import start_figures
-from ...runner import run_chunks
-from ...storage import provenance, write_table
-from .. import RunContext
-from . import chunks as ch
-from . import figures as fg
-from .claims import claim_rows, load_book
-from .schema import NAME, block_of, five_control
-from .simulate import centre_points
-from .sweep import RECENTRE_CLAIMS, evaluate, five_samples
+from sim.claims.book import write_claims
+from sim.instruments.block import independent_models as im
+from sim.instruments.block.layout import select_control
+from sim.mc.runner import run_chunks
+from sim.mc.storage import provenance, write_table
+from sim.report.figure_jobs import start_figures
+from sim.studies import RunContext
+from sim.studies.agnard import chunks as ch
+from sim.studies.agnard import figures as fg
+from sim.studies.agnard.claims import claim_rows, load_book
+from sim.studies.agnard.schema import NAME, block_of, five_control
+from sim.studies.agnard.simulate import centre_points
+from sim.studies.agnard.sweep import RECENTRE_CLAIMS, evaluate, five_samples
 
 
 def _mean_se(x: np.ndarray) -> tuple[float, float]:
@@ -41,8 +42,9 @@ def _run(fn, trials, cfg, part, label, ctx, chunk=None):
     """One part through the runner, in at least four chunks (when it has the trials) so that
     the parts, run one after the other, keep every worker busy."""
     chunk = chunk or min(cfg["chunk"], max(1, -(-trials // 4)))
-    return run_chunks(fn, trials, cfg["seed"], chunk, part=part, label=f"{NAME} {label}",
-                      quiet=ctx.quiet, ctx=ctx)
+    return run_chunks(
+        fn, trials, cfg["seed"], chunk, part=part, label=f"{NAME} {label}", quiet=ctx.quiet, ctx=ctx
+    )
 
 
 def _check_vectors(cfg, block, sim, c5, c21, T, prov, out):
@@ -51,12 +53,18 @@ def _check_vectors(cfg, block, sim, c5, c21, T, prov, out):
     for lay, ctrl in (("few", c5), ("many", c21)):
         first = sim[f"{ch.CHUNK}{lay}_first_e_m"][0]
         mean = sim[f"{ch.CHUNK}{lay}_sum_e_m"].sum(0) / T
-        parts.append({"layout": np.full(ng, lay), "point": np.arange(ng),
-                      "x_m": block.points[:ng, 0], "y_m": block.points[:ng, 1],
-                      **{f"e{c}_m": first[:, a] for a, c in enumerate("xyz")},
-                      **{f"mean_e{c}_m": mean[:, a] for a, c in enumerate("xyz")},
-                      "is_control": np.isin(np.arange(ng), ctrl),
-                      "mean_over_trials": np.full(ng, T)})
+        parts.append(
+            {
+                "layout": np.full(ng, lay),
+                "point": np.arange(ng),
+                "x_m": block.points[:ng, 0],
+                "y_m": block.points[:ng, 1],
+                **{f"e{c}_m": first[:, a] for a, c in enumerate("xyz")},
+                **{f"mean_e{c}_m": mean[:, a] for a, c in enumerate("xyz")},
+                "is_control": np.isin(np.arange(ng), ctrl),
+                "mean_over_trials": np.full(ng, T),
+            }
+        )
     vec = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     write_table(out / "check_vectors.parquet", vec, prov)
     return vec
@@ -65,18 +73,39 @@ def _check_vectors(cfg, block, sim, c5, c21, T, prov, out):
 def _scanner_table(cfg, block, sim, ctx, prov, out):
     """Scan resolution x calibration; the run's own resolution reuses the main blocks when
     their 'without' adjustment has the 21-control layout."""
-    t = {k: [] for k in ("dpi", "calibration", "trials", "check_xy_m", "check_xy_m_se",
-                         "check_z_m", "check_z_m_se", "ctrl_xy_m", "ctrl_z_m", "gain_xy_pct",
-                         "gain_xy_pct_se")}
+    t = {
+        k: []
+        for k in (
+            "dpi",
+            "calibration",
+            "trials",
+            "check_xy_m",
+            "check_xy_m_se",
+            "check_z_m",
+            "check_z_m_se",
+            "ctrl_xy_m",
+            "ctrl_z_m",
+            "gain_xy_pct",
+            "gain_xy_pct_se",
+        )
+    }
     for i, dpi in enumerate(cfg["tradeoff.dpis"]):
         if dpi == cfg["scan.dpi"] and cfg["control.table1"] == cfg["control.many"]:
-            r = {f"{cal}.{q}": sim[f"{pre}.{q}"] for cal, pre in
-                 (("raw", "without"), ("corrected", f"layout_{cfg['control.many']}"))
-                 for q in ("check_xy_m", "check_z_m", "ctrl_xy_m", "ctrl_z_m")}
+            r = {
+                f"{cal}.{q}": sim[f"{pre}.{q}"]
+                for cal, pre in (("raw", "without"), ("corrected", f"layout_{cfg['control.many']}"))
+                for q in ("check_xy_m", "check_z_m", "ctrl_xy_m", "ctrl_z_m")
+            }
             r["gain_xy_pct"] = 100 * (1 - r["corrected.check_xy_m"] / r["raw.check_xy_m"])
         else:
-            r = _run(partial(ch.scanner_chunk, cfg, block, dpi), cfg["tradeoff.trials"], cfg,
-                     1 + i, f"{dpi:g} DPI", ctx)
+            r = _run(
+                partial(ch.scanner_chunk, cfg, block, dpi),
+                cfg["tradeoff.trials"],
+                cfg,
+                1 + i,
+                f"{dpi:g} DPI",
+                ctx,
+            )
         for cal in ("raw", "corrected"):
             t["dpi"].append(dpi)
             t["calibration"].append(cal)
@@ -95,8 +124,19 @@ def _scanner_table(cfg, block, sim, ctx, prov, out):
 
 
 def _control_table(cfg, block, sim, prov, out):
-    t = {k: [] for k in ("layout", "n_control", "check_xy_m", "check_xy_m_se", "check_z_m",
-                         "check_z_m_se", "ctrl_xy_m", "ctrl_z_m")}
+    t = {
+        k: []
+        for k in (
+            "layout",
+            "n_control",
+            "check_xy_m",
+            "check_xy_m_se",
+            "check_z_m",
+            "check_z_m_se",
+            "ctrl_xy_m",
+            "ctrl_z_m",
+        )
+    }
     for lay in cfg["tradeoff.layouts"]:
         t["layout"].append(lay)
         t["n_control"].append(int(select_control(block, lay).size))
@@ -113,19 +153,42 @@ def _control_table(cfg, block, sim, prov, out):
 def _size_table(cfg, block, ctx, base, prov, out):
     x0, x1, y0, y1 = block.extent()
     density = block.n_ground / ((x1 - x0) * (y1 - y0) * 1e-6)
-    t = {k: [] for k in ("strips", "models", "n_models", "n_points", "n_control", "centre_xy_m",
-                         "centre_xy_m_se", "centre_z_m", "centre_z_m_se", "check_xy_m",
-                         "check_xy_m_se", "check_z_m", "check_z_m_se")}
+    t = {
+        k: []
+        for k in (
+            "strips",
+            "models",
+            "n_models",
+            "n_points",
+            "n_control",
+            "centre_xy_m",
+            "centre_xy_m_se",
+            "centre_z_m",
+            "centre_z_m_se",
+            "check_xy_m",
+            "check_xy_m_se",
+            "check_z_m",
+            "check_z_m_se",
+        )
+    }
     for i, (S, M) in enumerate(zip(cfg["tradeoff.block_strips"], cfg["tradeoff.block_models"])):
         b = block_of(cfg, S, M, density=density)
         ctrl = select_control(b, cfg["tradeoff.block_control"])
         cen = centre_points(b, ctrl, cfg["tradeoff.centre_points"])
         # bound the memory of the pair blocks (trials x observation pairs x 7 x 7)
         npair = im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points).pk1.size
-        chunk = max(1, min(cfg["chunk"], 4_000_000 // (49 * npair),
-                           -(-cfg["tradeoff.block_trials"] // 4)))  # >= 4 chunks: parallel
-        r = _run(partial(ch.size_chunk, cfg, b, cen), cfg["tradeoff.block_trials"], cfg, base + i,
-                 f"{S}x{M}", ctx, chunk)
+        chunk = max(
+            1, min(cfg["chunk"], 4_000_000 // (49 * npair), -(-cfg["tradeoff.block_trials"] // 4))
+        )  # >= 4 chunks: parallel
+        r = _run(
+            partial(ch.size_chunk, cfg, b, cen),
+            cfg["tradeoff.block_trials"],
+            cfg,
+            base + i,
+            f"{S}x{M}",
+            ctx,
+            chunk,
+        )
         t["strips"].append(S)
         t["models"].append(M)
         t["n_models"].append(S * M)
@@ -147,8 +210,14 @@ def _pugging(cfg, block, sim, ctx, base, prov, out):
         if rc == cfg["pugging.recentre_px"]:
             r = {"share_pct": sim["snoop_mechanical.share_pct"]}
         else:
-            r = _run(partial(ch.pugging_chunk, cfg, block, rc), cfg["tradeoff.trials"], cfg,
-                     base + i, f"re-centring {rc:g} px", ctx)
+            r = _run(
+                partial(ch.pugging_chunk, cfg, block, rc),
+                cfg["tradeoff.trials"],
+                cfg,
+                base + i,
+                f"re-centring {rc:g} px",
+                ctx,
+            )
         per[float(rc)] = r["share_pct"]
         m, se = _mean_se(r["share_pct"])
         t["recentre_px"].append(rc)
@@ -168,10 +237,16 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     c21 = select_control(block, cfg["control.many"])
     insets = cfg["sweep.five_inset"]
     ctrl_idx = [five_control(block, u) for u in insets]
-    # figures go to idle workers as soon as their data exist (sim.figure_jobs.start_figures)
-    drawn = [start_figures([(fg.fig_scanner, (cfg, out / "scanner_field.png")),
-                            (fg.fig_layout, (block, c5, c21, out / "block_layout.png",
-                                             ctrl_idx, insets))], ctx.executor)]
+    # figures go to idle workers as soon as their data exist (sim.report.figure_jobs.start_figures)
+    drawn = [
+        start_figures(
+            [
+                (fg.fig_scanner, (cfg, out / "scanner_field.png")),
+                (fg.fig_layout, (block, c5, c21, out / "block_layout.png", ctrl_idx, insets)),
+            ],
+            ctx.executor,
+        )
+    ]
     sim = _run(partial(ch.main_chunk, cfg, block), T, cfg, 0, "2x8 block", ctx)
     per_trial = {k: v for k, v in sim.items() if not k.startswith(ch.CHUNK)}
     write_table(out / "trials.parquet", {"trial": np.arange(T), **per_trial}, prov)
@@ -181,12 +256,21 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     kind[c21] = "control_many"
     kind[c5] = np.where(np.isin(c5, c21), "control_both", "control_few")
     nmod = np.bincount(block.obs_point, minlength=block.n_points)
-    write_table(out / "layout.parquet", {"x_m": block.points[:, 0], "y_m": block.points[:, 1],
-                                         "z_m": block.points[:, 2], "kind": kind.astype(str),
-                                         "models": nmod}, prov)
+    write_table(
+        out / "layout.parquet",
+        {
+            "x_m": block.points[:, 0],
+            "y_m": block.points[:, 1],
+            "z_m": block.points[:, 2],
+            "kind": kind.astype(str),
+            "models": nmod,
+        },
+        prov,
+    )
     vec = _check_vectors(cfg, block, sim, c5, c21, T, prov, out)
-    drawn.append(start_figures([(fg.fig_residuals, (vec, out / "check_residuals.png"))],
-                               ctx.executor))
+    drawn.append(
+        start_figures([(fg.fig_residuals, (vec, out / "check_residuals.png"))], ctx.executor)
+    )
     scan_t = _scanner_table(cfg, block, per_trial, ctx, prov, out)
     lay_t = _control_table(cfg, block, sim, prov, out)
     base = 1 + len(cfg["tradeoff.dpis"])
@@ -196,27 +280,53 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     base += len(cfg["tradeoff.recentre_px"])
 
     # --- the unprinted five-point layout, swept
-    sw = _run(partial(ch.sweep_chunk, cfg, block), cfg["sweep.trials"], cfg, base, "five-point "
-              "layouts", ctx)
-    sweep_t = {"inset": np.repeat(insets, cfg["sweep.trials"]),
-               "trial": np.tile(np.arange(cfg["sweep.trials"]), len(insets))}
+    sw = _run(
+        partial(ch.sweep_chunk, cfg, block),
+        cfg["sweep.trials"],
+        cfg,
+        base,
+        "five-point layouts",
+        ctx,
+    )
+    sweep_t = {
+        "inset": np.repeat(insets, cfg["sweep.trials"]),
+        "trial": np.tile(np.arange(cfg["sweep.trials"]), len(insets)),
+    }
     for k in sorted({k.split(".", 1)[1] for k in sw}):
         sweep_t[k] = np.concatenate([sw[f"inset{i}.{k}"] for i in range(len(insets))])
     write_table(out / "sweep_five.parquet", sweep_t, prov)
-    sweeps = {"sweep.five_inset": {float(u): five_samples(sw, i) for i, u in enumerate(insets)},
-              "pugging.recentre_px": {rc: {RECENTRE_CLAIMS[0]: s} for rc, s in pug.items()}}
+    sweeps = {
+        "sweep.five_inset": {float(u): five_samples(sw, i) for i, u in enumerate(insets)},
+        "pugging.recentre_px": {rc: {RECENTRE_CLAIMS[0]: s} for rc, s in pug.items()},
+    }
     long, cs = evaluate(book, sweeps)
     write_table(out / "sweep_claims.parquet", long, prov)
     write_table(out / "consistent_set.parquet", cs, prov)
-    write_table(out / "sweep_layouts.parquet",
-                {"inset": np.repeat(insets, 5), "point": np.concatenate(ctrl_idx),
-                 "x_m": block.points[np.concatenate(ctrl_idx), 0],
-                 "y_m": block.points[np.concatenate(ctrl_idx), 1]}, prov)
+    write_table(
+        out / "sweep_layouts.parquet",
+        {
+            "inset": np.repeat(insets, 5),
+            "point": np.concatenate(ctrl_idx),
+            "x_m": block.points[np.concatenate(ctrl_idx), 0],
+            "y_m": block.points[np.concatenate(ctrl_idx), 1],
+        },
+        prov,
+    )
 
-    write_claims(out / "claims.parquet", claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug,
-                                                    book), prov, book)
-    drawn.append(start_figures([(fg.fig_consistent, (long, cs, out / "consistent_set.png")),
-                                (fg.fig_tradeoffs, (scan_t, lay_t, size_t,
-                                                    out / "tradeoffs.png"))], ctx.executor))
+    write_claims(
+        out / "claims.parquet",
+        claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book),
+        prov,
+        book,
+    )
+    drawn.append(
+        start_figures(
+            [
+                (fg.fig_consistent, (long, cs, out / "consistent_set.png")),
+                (fg.fig_tradeoffs, (scan_t, lay_t, size_t, out / "tradeoffs.png")),
+            ],
+            ctx.executor,
+        )
+    )
     for wait in drawn:
         wait()

@@ -2,32 +2,46 @@
 simulated blocks (scanner, grid calibration, image measurements under digital and
 mechanical pugging, model formation, random model frames) and the block adjustments of
 that chunk with a chosen control layout, and the rms and maximum errors per trial (m).
-The numerics live in :mod:`sim.block_layout`, :mod:`sim.scanner` and
-:mod:`sim.independent_models`.
+The numerics live in :mod:`sim.instruments.block.layout`, :mod:`sim.instruments.block.scanner` and
+:mod:`sim.instruments.block.independent_models`.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ... import independent_models as im
-from ... import scanner as sc
-from ...block_layout import Block, select_control
+from sim.instruments.block import independent_models as im
+from sim.instruments.block import scanner as sc
+from sim.instruments.block.layout import Block, select_control
+
 
 class Simulated:
     """One chunk of simulated blocks: model coordinates in their own frames and the truth."""
 
-    def __init__(self, cfg: dict, block: Block, rng: np.random.Generator, n: int, dpi: float,
-                 mechanical: bool = False, uncorrected: bool = True):
+    def __init__(
+        self,
+        cfg: dict,
+        block: Block,
+        rng: np.random.Generator,
+        n: int,
+        dpi: float,
+        mechanical: bool = False,
+        uncorrected: bool = True,
+    ):
         pix = sc.pixel_um(dpi)
         sig = cfg["scan.fiducial_sigma_px"] * pix
         b = block
         K = b.obs_model.size
         n_ph = b.photos.shape[0] * b.photos.shape[1]
-        field = sc.random_field(rng, n, max_x_um=cfg["scan.max_x_um"],
-                                max_y_um=cfg["scan.max_y_um"],
-                                stepper_share=cfg["scan.stepper_share"],
-                                wavelength_mm=cfg["scan.wavelength_mm"],
-                                half_mm=cfg["block.format_mm"] / 2)
+        field = sc.random_field(
+            rng,
+            n,
+            max_x_um=cfg["scan.max_x_um"],
+            max_y_um=cfg["scan.max_y_um"],
+            stepper_share=cfg["scan.stepper_share"],
+            wavelength_mm=cfg["scan.wavelength_mm"],
+            half_mm=cfg["block.format_mm"] / 2,
+        )
         grid = sc.scan_grid(field, rng, cfg["scan.grid_mm"], cfg["scan.grid_sigma_px"] * pix)
         xl = b.image_coords(b.obs_left, b.obs_point)
         xr = b.image_coords(b.obs_right, b.obs_point)
@@ -41,32 +55,52 @@ class Simulated:
         modes = {"digital": {}}
         if mechanical:
             modes["mechanical"] = dict(
-                mechanical=b.is_pass, transfer_um=cfg["pugging.transfer_um"],
+                mechanical=b.is_pass,
+                transfer_um=cfg["pugging.transfer_um"],
                 recentre_um=cfg["pugging.recentre_px"] * pix,
                 gross_rate=cfg["pugging.gross_rate"],
-                gross_um=tuple(g * pix for g in cfg["pugging.gross_px"]))
+                gross_um=tuple(g * pix for g in cfg["pugging.gross_px"]),
+            )
         self.s, self.R, self.t = im.random_similarities(rng, (n, b.n_models))
         centre = b.photos.reshape(-1, 3)[b.obs_left]
         self.xm = {}
         self.gross = {}
         for mode, kw in modes.items():
             el, er, g = im.pointing_errors(
-                rng, n, b.obs_left, b.obs_right, b.obs_point, b.models + 1, b.strips, b.n_points,
+                rng,
+                n,
+                b.obs_left,
+                b.obs_right,
+                b.obs_point,
+                b.models + 1,
+                b.strips,
+                b.n_points,
                 mark_um=cfg["measure.pointing_px"] * pix,
                 parallax_um=cfg["measure.parallax_px"] * pix,
-                digital=b.is_pass if mode == "digital" else None, **kw)
+                digital=b.is_pass if mode == "digital" else None,
+                **kw,
+            )
             self.gross[mode] = g
             for which, e in scan.items():
                 if mode == "mechanical" and which == "raw":
                     continue
-                G = im.form_models(xl + 1e-3 * (e[:, :K] + el), xr + 1e-3 * (e[:, K:] + er),
-                                   b.focal_mm, b.base_m) + centre
+                G = (
+                    im.form_models(
+                        xl + 1e-3 * (e[:, :K] + el),
+                        xr + 1e-3 * (e[:, K:] + er),
+                        b.focal_mm,
+                        b.base_m,
+                    )
+                    + centre
+                )
                 self.xm[(mode, which)] = im.to_model_frame(G, b.obs_model, self.s, self.R, self.t)
-        self.ctrl_obs = b.points + rng.normal(0.0, cfg["measure.control_sigma_m"],
-                                              (n,) + b.points.shape)
+        self.ctrl_obs = b.points + rng.normal(
+            0.0, cfg["measure.control_sigma_m"], (n,) + b.points.shape
+        )
         self.X0 = b.points + rng.normal(0.0, 1.0, (n,) + b.points.shape)
-        st = im.BlockStructure(b.obs_model, b.obs_point, np.zeros(0, np.intp), b.n_models,
-                               b.n_points)
+        st = im.BlockStructure(
+            b.obs_model, b.obs_point, np.zeros(0, np.intp), b.n_models, b.n_points
+        )
         self.init = im.initial_values(st, self.xm[("digital", "corrected")], self.X0)
         self.block = b
         self.n = n
@@ -83,31 +117,49 @@ class Adjuster:
         """Control indices and block structure of a named pattern or an index array."""
         key = pattern if isinstance(pattern, str) else tuple(int(i) for i in pattern)
         if key not in self._st:
-            ctrl = (select_control(self.block, pattern) if isinstance(pattern, str)
-                    else np.asarray(pattern, np.intp))
+            ctrl = (
+                select_control(self.block, pattern)
+                if isinstance(pattern, str)
+                else np.asarray(pattern, np.intp)
+            )
             b = self.block
-            self._st[key] = (ctrl, im.BlockStructure(b.obs_model, b.obs_point, ctrl,
-                                                         b.n_models, b.n_points))
+            self._st[key] = (
+                ctrl,
+                im.BlockStructure(b.obs_model, b.obs_point, ctrl, b.n_models, b.n_points),
+            )
         return self._st[key]
 
     def adjust(self, sim: Simulated, key, pattern: str, w_obs, w_ctrl, start=None):
         """Adjust the models ``sim.xm[key]`` with control ``pattern``; ``start`` (a previous
         result on the same trials) only shortens the iterations."""
         ctrl, st = self.structure(pattern)
-        s, R, t, X = sim.init + (sim.X0,) if start is None else (start.s, start.R, start.t,
-                                                                  start.X)
-        res = im.adjust_block(st, sim.xm[key], np.asarray(w_obs, float),
-                              sim.ctrl_obs[:, ctrl], np.broadcast_to(w_ctrl, (ctrl.size, 3)),
-                              s, R, t, X)
+        s, R, t, X = sim.init + (sim.X0,) if start is None else (start.s, start.R, start.t, start.X)
+        res = im.adjust_block(
+            st,
+            sim.xm[key],
+            np.asarray(w_obs, float),
+            sim.ctrl_obs[:, ctrl],
+            np.broadcast_to(w_ctrl, (ctrl.size, 3)),
+            s,
+            R,
+            t,
+            X,
+        )
         return ctrl, st, res
 
 
 def _rms(a: np.ndarray, axis) -> np.ndarray:
-    return np.sqrt(np.mean(a ** 2, axis=axis))
+    return np.sqrt(np.mean(a**2, axis=axis))
 
 
-def accuracy(block: Block, ctrl: np.ndarray, res: im.AdjustResult, out: dict, prefix: str,
-             centre: np.ndarray | None = None) -> None:
+def accuracy(
+    block: Block,
+    ctrl: np.ndarray,
+    res: im.AdjustResult,
+    out: dict,
+    prefix: str,
+    centre: np.ndarray | None = None,
+) -> None:
     """rms per trial at control and check points, X Y XY Z, in m.
 
     Control (``ctrl``): the model-point residuals at control points (transformed model

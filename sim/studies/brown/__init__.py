@@ -9,19 +9,36 @@ no further dilution"), and the immunity to a constant personal bias.
 double settings of 1.7 um, about 1.1 um from the comparator: rms closure 1.6 um on 43 degrees
 of freedom; point standard deviations mostly 1.1-1.3 um, two points up to 1.5 um.
 
-The numerics live in :mod:`sim.multilateration`; this module simulates, tabulates, draws and
+The numerics live in :mod:`sim.instruments.ranges.multilateration`; this module simulates, tabulates, draws and
 reports. Coordinates in mm, standard deviations in um.
 """
+
 from __future__ import annotations
 
-from .. import Study
-from .report import report_dilution, report_table1
-from .run import run_dilution, run_table1
-from .schema import DILUTION, SEED, TABLE1, check
+from sim.studies import Study
+from sim.studies.brown.report import report_dilution, report_table1
+from sim.studies.brown.run import run_dilution, run_table1
+from sim.studies.brown.schema import DILUTION, SEED, TABLE1, check
 
 STUDIES = {
-    "brown_dilution": Study("brown_dilution", "Brown: known stations, dilution, pivot offsets",
-                            SEED, DILUTION, run_dilution, report_dilution, check, order=10),
-    "brown_table1": Study("brown_table1", "Brown: the production test (Table 1)", SEED, TABLE1,
-                          run_table1, report_table1, check, order=11),
+    "brown_dilution": Study(
+        "brown_dilution",
+        "Brown: known stations, dilution, pivot offsets",
+        SEED,
+        DILUTION,
+        run_dilution,
+        report_dilution,
+        check,
+        order=10,
+    ),
+    "brown_table1": Study(
+        "brown_table1",
+        "Brown: the production test (Table 1)",
+        SEED,
+        TABLE1,
+        run_table1,
+        report_table1,
+        check,
+        order=11,
+    ),
 }

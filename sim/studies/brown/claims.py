@@ -5,6 +5,7 @@ only supplies values: analytic predictions for the nominal geometry (the same fu
 the sweep, :mod:`.values`), Monte-Carlo distributions of one-plate statistics, and the
 self-checks of Monte Carlo against the analytic covariance. Seed paper 004 (Brown 1968).
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -12,12 +13,12 @@ from pathlib import Path
 import numpy as np
 from scipy import optimize
 
-from ... import multilateration as ml
-from ...claims import ClaimBook
-from ...intervals import std_rel_se
-from ...runner import chunk_rng
-from . import values as V
-from .schema import MODEL_NAMES
+from sim.claims.book import ClaimBook
+from sim.claims.intervals import std_rel_se
+from sim.instruments.ranges import multilateration as ml
+from sim.mc.runner import chunk_rng
+from sim.studies.brown import values as V
+from sim.studies.brown.schema import MODEL_NAMES
 
 BOOK = Path(__file__).with_name("claims.toml")
 
@@ -41,9 +42,15 @@ def mc_agreement(book, cid, mc, i, a, trials) -> dict:
     band = 1.96 * std_rel_se(mc.N)
     v, *ci = mc.jack(lambda sd: (sd[i] / a).mean())
     r = mc.sd[i] / a
-    return book.score(cid, v, tuple(ci), note=(
-        f"{int((np.abs(r - 1) < band).sum())} of {r.size} coordinates inside the 95 % sampling "
-        f"band +-{band:.3f}; {mc.N} of {trials} trials converged in all models"))
+    return book.score(
+        cid,
+        v,
+        tuple(ci),
+        note=(
+            f"{int((np.abs(r - 1) < band).sum())} of {r.size} coordinates inside the 95 % sampling "
+            f"band +-{band:.3f}; {mc.N} of {trials} trials converged in all models"
+        ),
+    )
 
 
 def min_points_stations(cfg: dict, theta: np.ndarray) -> tuple[int, str]:
@@ -56,9 +63,12 @@ def min_points_stations(cfg: dict, theta: np.ndarray) -> tuple[int, str]:
         Qgg = ml.covariance(g[None, :n], theta[None], "stations")[1]
         reg.append(bool(np.all(np.isfinite(Qgg))))
     n_min = 1 + reg.index(True) if any(reg) else 0
-    return n_min, ("regular normal equations for n = " + ", ".join(
-        str(n + 1) for n, r in enumerate(reg) if r) + f" of 1-8 generic points; 4n equations, "
-        "2n + 5 unknowns")
+    return n_min, (
+        "regular normal equations for n = "
+        + ", ".join(str(n + 1) for n, r in enumerate(reg) if r)
+        + " of 1-8 generic points; 4n equations, "
+        "2n + 5 unknowns"
+    )
 
 
 def idealised_offset(cfg: dict, pts: np.ndarray) -> tuple[float, float]:
@@ -67,12 +77,20 @@ def idealised_offset(cfg: dict, pts: np.ndarray) -> tuple[float, float]:
     0.5-300 mm."""
     e = cfg["idealised.half_extent_mm"]
     P = pts * (e / np.abs(pts).max())
-    f = lambda o: V.sigmas(P[None], V.thetas(cfg["plate.format_mm"], [o], 0.0, 0.0),  # noqa: E731
-                           "known").max() - 0.85
+    f = lambda o: (
+        V.sigmas(
+            P[None],
+            V.thetas(cfg["plate.format_mm"], [o], 0.0, 0.0),  # noqa: E731
+            "known",
+        ).max()
+        - 0.85
+    )
     if not f(0.5) > 0 > f(300.0):
         return float("nan"), float("nan")
     o = optimize.brentq(f, 0.5, 300.0, xtol=1e-4)
-    th = V.thetas(cfg["plate.format_mm"], [o], cfg["comparator.alpha_mm"], cfg["comparator.beta_mm"])
+    th = V.thetas(
+        cfg["plate.format_mm"], [o], cfg["comparator.alpha_mm"], cfg["comparator.beta_mm"]
+    )
     return float(o), float(ml.ranges(P[None], th).max())
 
 
@@ -86,129 +104,269 @@ def score_dilution(book, cfg, pts, theta, an, mc, sim, curve, extra, mono) -> li
     d = (V.pooled(an["stations"]) / V.pooled(kn) - 1) * 100
     ex = (V.pooled(an["pivot"]) / V.pooled(an["stations"]) - 1) * 100
     ext = float(np.abs(pts).max())
-    geo = (f"{len(pts)} points to +-{ext:g} mm, stations {cfg['comparator.station_offset_mm']:g} "
-           "mm outside the midsides (nominal; unprinted, swept in consistent_set)")
+    geo = (
+        f"{len(pts)} points to +-{ext:g} mm, stations {cfg['comparator.station_offset_mm']:g} "
+        "mm outside the midsides (nominal; unprinted, swept in consistent_set)"
+    )
     notes = {
         "brown.known_center.ratio": f"analytic, {_pt(pts, c)}: 1/sqrt(2) at the centre for "
-                                    f"every offset; {geo}",
+        f"every offset; {geo}",
         "brown.known_edge.ratio": f"analytic, largest sigma/sigma_r over the points ("
-                                  f"{'xy'[jx[1]]} at {_pt(pts, jx[0])}); {geo}",
+        f"{'xy'[jx[1]]} at {_pt(pts, jx[0])}); {geo}",
         "brown.dilution.range_pct": f"analytic per-point dilution of 'stations' over 'known' "
-                                    f"(rms of sigma_x, sigma_y): every point must lie in 5-15 %; "
-                                    f"smallest at {_pt(pts, int(np.argmin(d)))}, largest at "
-                                    f"{_pt(pts, int(np.argmax(d)))}; {geo}",
+        f"(rms of sigma_x, sigma_y): every point must lie in 5-15 %; "
+        f"smallest at {_pt(pts, int(np.argmin(d)))}, largest at "
+        f"{_pt(pts, int(np.argmax(d)))}; {geo}",
         "brown.dilution_falls_with_points.monotone": "analytic: 1 when the mean and the largest "
-                                                     "per-point dilution fall at every step of "
-                                                     f"k x k grids k = {list(curve)} (same extent)",
+        "per-point dilution fall at every step of "
+        f"k x k grids k = {list(curve)} (same extent)",
         "brown.pivot_extra_dilution.range_pct": f"analytic per-point extra dilution of 'pivot' over 'stations'"
-                                              f", largest at {_pt(pts, int(np.argmax(ex)))} "
-                                              f"(median over points {np.median(ex):.1f} %). "
-                                              "'Essentially none' is taken as 0-2 % at every point; beta^2 "
-                                              "shifts each range by about beta^2/(2d), most at "
-                                              "short ranges",
+        f", largest at {_pt(pts, int(np.argmax(ex)))} "
+        f"(median over points {np.median(ex):.1f} %). "
+        "'Essentially none' is taken as 0-2 % at every point; beta^2 "
+        "shifts each range by about beta^2/(2d), most at "
+        "short ranges",
     }
     rows = [book.score(cid, note=notes[cid], **kw) for cid, kw in args.items()]
     k_last = max(curve)
     v = float(curve[k_last].max())
-    rows.append(book.score("brown.dilution_falls_with_points.max_pct_largest_grid", v,
-                           interval="exact", note=f"largest per-point dilution (%) of a "
-                           f"{k_last} x {k_last} grid, same extent; " + ", ".join(
-                               f"{k * k} points: {curve[k].max():.1f} %" for k in curve)))
-    a_only = float(((V.pooled(V.sigmas(pts[None], theta[None], "alpha")[0])
-                     / V.pooled(an["stations"]) - 1) * 100).max())
-    rows.append(book.score("brown.pivot_extra_dilution.alpha_only_max_pct", a_only,
-                           interval="exact", note="largest extra dilution (%) from freeing alpha "
-                           f"alone (beta^2 known); with beta^2 too: {ex.max():.2f} %"))
+    rows.append(
+        book.score(
+            "brown.dilution_falls_with_points.max_pct_largest_grid",
+            v,
+            interval="exact",
+            note=f"largest per-point dilution (%) of a "
+            f"{k_last} x {k_last} grid, same extent; "
+            + ", ".join(f"{k * k} points: {curve[k].max():.1f} %" for k in curve),
+        )
+    )
+    a_only = float(
+        (
+            (V.pooled(V.sigmas(pts[None], theta[None], "alpha")[0]) / V.pooled(an["stations"]) - 1)
+            * 100
+        ).max()
+    )
+    rows.append(
+        book.score(
+            "brown.pivot_extra_dilution.alpha_only_max_pct",
+            a_only,
+            interval="exact",
+            note="largest extra dilution (%) from freeing alpha "
+            f"alone (beta^2 known); with beta^2 too: {ex.max():.2f} %",
+        )
+    )
     n_min, note = min_points_stations(cfg, theta)
-    rows.append(book.score("brown.structure.min_points_stations", float(n_min),
-                           interval="exact", note=note))
+    rows.append(
+        book.score("brown.structure.min_points_stations", float(n_min), interval="exact", note=note)
+    )
     nb = int(sim["bias.n"].sum())
-    rows.append(book.score("brown.bias_invariance.max_point_shift_mm",
-                           float(sim["bias.max_point_shift_mm"].max()), interval="exact",
-                           note=f"largest coordinate change over {nb} Monte-Carlo plates when "
-                           f"{cfg['checks.bias_shift_um']:g} um is added to every range (pivot "
-                           "model); zero to rounding"))
-    rows.append(book.score("brown.bias_invariance.alpha_shift_error_mm",
-                           float(sim["bias.alpha_err_mm"].max()), interval="exact",
-                           note="largest |change of alpha + constant| over the same plates"))
+    rows.append(
+        book.score(
+            "brown.bias_invariance.max_point_shift_mm",
+            float(sim["bias.max_point_shift_mm"].max()),
+            interval="exact",
+            note=f"largest coordinate change over {nb} Monte-Carlo plates when "
+            f"{cfg['checks.bias_shift_um']:g} um is added to every range (pivot "
+            "model); zero to rounding",
+        )
+    )
+    rows.append(
+        book.score(
+            "brown.bias_invariance.alpha_shift_error_mm",
+            float(sim["bias.alpha_err_mm"].max()),
+            interval="exact",
+            note="largest |change of alpha + constant| over the same plates",
+        )
+    )
     o, rmax = idealised_offset(cfg, pts)
     lim = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
     if np.isfinite(o):
-        rows.append(book.score("brown.idealised.offset_for_085_mm", o, interval="exact", note=(
-            f"idealised four-station system (Figure 1), not the built comparator: the offset at "
-            f"which the largest known-station ratio of the pattern scaled to +-"
-            f"{cfg['idealised.half_extent_mm']:g} mm is 0.85; its longest range is {rmax:.1f} mm "
-            f"against {lim:g} mm of scale plus micrometer")))
+        rows.append(
+            book.score(
+                "brown.idealised.offset_for_085_mm",
+                o,
+                interval="exact",
+                note=(
+                    f"idealised four-station system (Figure 1), not the built comparator: the offset at "
+                    f"which the largest known-station ratio of the pattern scaled to +-"
+                    f"{cfg['idealised.half_extent_mm']:g} mm is 0.85; its longest range is {rmax:.1f} mm "
+                    f"against {lim:g} mm of scale plus micrometer"
+                ),
+            )
+        )
     else:
-        rows.append(book.score("brown.idealised.offset_for_085_mm", -1.0, interval="exact",
-                               note="no offset in 0.5-300 mm gives 0.85 (value -1: none)"))
+        rows.append(
+            book.score(
+                "brown.idealised.offset_for_085_mm",
+                -1.0,
+                interval="exact",
+                note="no offset in 0.5-300 mm gives 0.85 (value -1: none)",
+            )
+        )
     for i, m in enumerate(MODEL_NAMES):
-        rows.append(mc_agreement(book, f"brown.mc_agreement.{m}.mean_ratio", mc, i, an[m],
-                                 cfg["trials"]))
+        rows.append(
+            mc_agreement(book, f"brown.mc_agreement.{m}.mean_ratio", mc, i, an[m], cfg["trials"])
+        )
     return rows
 
 
 def score_table1(book, cfg, pts, an_pivot, sr, mc, t1) -> list[dict]:
     """All rows of brown_table1. ``t1``: per-plate statistics of the converged trials."""
     dof = 4 * len(pts) - (2 * len(pts) + 7)
-    rows = [book.score("brown.table1_closure.dof", float(dof), interval="exact",
-                       note="4n ranges - (2n + 7) unknowns of the pivot model")]
+    rows = [
+        book.score(
+            "brown.table1_closure.dof",
+            float(dof),
+            interval="exact",
+            note="4n ranges - (2n + 7) unknowns of the pivot model",
+        )
+    ]
     s0 = t1["sigma0_um"]
-    rows.append(book.score("brown.table1_closure.rms_um", samples=s0, note=(
-        f"a-posteriori sigma0 of one plate over {len(s0)} simulated plates; its expectation is "
-        f"the range sigma {sr:.2f} um built from 1.7 um per setting (double) and the comparator's "
-        "1.1 um, which the paper derived from this 1.6: agreement by construction")))
+    rows.append(
+        book.score(
+            "brown.table1_closure.rms_um",
+            samples=s0,
+            note=(
+                f"a-posteriori sigma0 of one plate over {len(s0)} simulated plates; its expectation is "
+                f"the range sigma {sr:.2f} um built from 1.7 um per setting (double) and the comparator's "
+                "1.1 um, which the paper derived from this 1.6: agreement by construction"
+            ),
+        )
+    )
     q25, q75 = np.percentile(s0, [25, 75])
     inside = float(np.mean((s0 >= 1.45) & (s0 < 2.05)))
-    rows.append(book.score("brown.table1_closure.typical_range_um",
-                           float(q25), value_high=float(q75), interval="spread",
-                           elems=(np.array([q25]), np.array([q75])), note=(
-        f"'typically': the middle half (25-75 %) of simulated plates' sigma0 ({q25:.2f}-"
-        f"{q75:.2f} um) must lie in 1.5-2.0 um; {inside:.0%} of plates print inside. One "
-        "comparator calibrated on Table 1; other production models may differ")))
+    rows.append(
+        book.score(
+            "brown.table1_closure.typical_range_um",
+            float(q25),
+            value_high=float(q75),
+            interval="spread",
+            elems=(np.array([q25]), np.array([q75])),
+            note=(
+                f"'typically': the middle half (25-75 %) of simulated plates' sigma0 ({q25:.2f}-"
+                f"{q75:.2f} um) must lie in 1.5-2.0 um; {inside:.0%} of plates print inside. One "
+                "comparator calibrated on Table 1; other production models may differ"
+            ),
+        )
+    )
     if cfg["errors.settings"] > 1:
-        rows.append(book.score("brown.table1_setting.sigma_um", samples=t1["setting_sigma_um"],
-                               note="recovered per plate from the differences of the repeated "
-                               "settings; the simulated setting sigma is the paper's value"))
+        rows.append(
+            book.score(
+                "brown.table1_setting.sigma_um",
+                samples=t1["setting_sigma_um"],
+                note="recovered per plate from the differences of the repeated "
+                "settings; the simulated setting sigma is the paper's value",
+            )
+        )
     else:
-        rows.append(book.score("brown.table1_setting.sigma_um", cfg["errors.setting_sigma_um"],
-                               interval="exact", note="single settings: the setting sigma cannot "
-                               "be recovered from the plate; the value is the input"))
-    rows.append(book.score("brown.table1_setting.pair_mean_um", 1.7 / np.sqrt(2), interval="exact",
-                           note="recomputed: 1.7 / sqrt(2)"))
-    rows.append(book.score("brown.table1_closure.comparator_um", float(np.sqrt(1.6 ** 2 - 1.2 ** 2)),
-                           interval="exact", note="recomputed: sqrt(1.6^2 - 1.2^2)"))
-    rows.append(book.score("brown.table1_external.equal_share_low_um", 2 / np.sqrt(2),
-                           interval="exact", note="recomputed: 2 / sqrt(2)"))
-    rows.append(book.score("brown.table1_external.equal_share_high_um", 3 / np.sqrt(2),
-                           interval="exact", note="recomputed: 3 / sqrt(2)"))
-    rows.append(book.score("brown.table1_external.zeiss_comparator_um",
-                           float(np.sqrt(1.5 ** 2 - 0.8 ** 2)), interval="exact",
-                           note="recomputed: sqrt(1.50^2 - 0.8^2)"))
-    geo = (f"stations {cfg['comparator.station_offset_mm']:g} mm outside the midsides (nominal; "
-           "unprinted, swept in consistent_set)")
-    one = (f"one-plate statistic: median and 95 % range over {len(s0)} simulated plates, p = "
-           "probability of a plate at least as extreme as the paper's; a-posteriori sigmas "
-           "(sigma0 x sqrt(cofactor), pivot model, as printed to one decimal); " + geo)
-    rows.append(book.score("brown.table1_point_sigma.share_1p1_1p3", samples=t1["share_1p1_1p3"],
-                           note="share of the 50 sigmas printing as 1.1-1.3 um; " + one))
-    rows.append(book.score("brown.table1_point_sigma.points_ge_1p45",
-                           samples=t1["points_ge_1p45"], note="points whose larger sigma prints "
-                           ">= 1.5 um; with a symmetric design they come in fours; " + one))
-    rows.append(book.score("brown.table1_point_sigma.max_um", samples=t1["max_sigma_um"],
-                           note="largest of the 50 sigmas; " + one))
+        rows.append(
+            book.score(
+                "brown.table1_setting.sigma_um",
+                cfg["errors.setting_sigma_um"],
+                interval="exact",
+                note="single settings: the setting sigma cannot "
+                "be recovered from the plate; the value is the input",
+            )
+        )
+    rows.append(
+        book.score(
+            "brown.table1_setting.pair_mean_um",
+            1.7 / np.sqrt(2),
+            interval="exact",
+            note="recomputed: 1.7 / sqrt(2)",
+        )
+    )
+    rows.append(
+        book.score(
+            "brown.table1_closure.comparator_um",
+            float(np.sqrt(1.6**2 - 1.2**2)),
+            interval="exact",
+            note="recomputed: sqrt(1.6^2 - 1.2^2)",
+        )
+    )
+    rows.append(
+        book.score(
+            "brown.table1_external.equal_share_low_um",
+            2 / np.sqrt(2),
+            interval="exact",
+            note="recomputed: 2 / sqrt(2)",
+        )
+    )
+    rows.append(
+        book.score(
+            "brown.table1_external.equal_share_high_um",
+            3 / np.sqrt(2),
+            interval="exact",
+            note="recomputed: 3 / sqrt(2)",
+        )
+    )
+    rows.append(
+        book.score(
+            "brown.table1_external.zeiss_comparator_um",
+            float(np.sqrt(1.5**2 - 0.8**2)),
+            interval="exact",
+            note="recomputed: sqrt(1.50^2 - 0.8^2)",
+        )
+    )
+    geo = (
+        f"stations {cfg['comparator.station_offset_mm']:g} mm outside the midsides (nominal; "
+        "unprinted, swept in consistent_set)"
+    )
+    one = (
+        f"one-plate statistic: median and 95 % range over {len(s0)} simulated plates, p = "
+        "probability of a plate at least as extreme as the paper's; a-posteriori sigmas "
+        "(sigma0 x sqrt(cofactor), pivot model, as printed to one decimal); " + geo
+    )
+    rows.append(
+        book.score(
+            "brown.table1_point_sigma.share_1p1_1p3",
+            samples=t1["share_1p1_1p3"],
+            note="share of the 50 sigmas printing as 1.1-1.3 um; " + one,
+        )
+    )
+    rows.append(
+        book.score(
+            "brown.table1_point_sigma.points_ge_1p45",
+            samples=t1["points_ge_1p45"],
+            note="points whose larger sigma prints "
+            ">= 1.5 um; with a symmetric design they come in fours; " + one,
+        )
+    )
+    rows.append(
+        book.score(
+            "brown.table1_point_sigma.max_um",
+            samples=t1["max_sigma_um"],
+            note="largest of the 50 sigmas; " + one,
+        )
+    )
     args = V.table1_values(an_pivot[None] / sr, np.array([sr]))[0]
     cof = an_pivot / sr
-    at = ("sigma0 = the paper's printed 1.6 um, so the geometry alone decides; interval over "
-          f"its rounding 1.55-1.65 um; sqrt(cofactor) {cof.min():.3f}-{cof.max():.3f}; " + geo)
-    for cid, what in (("share_at_paper_closure", "share of the 50 sigmas printing as 1.1-1.3 um"),
-                      ("count_at_paper_closure", "points whose larger sigma prints >= 1.5 um"),
-                      ("max_at_paper_closure_um", "largest of the 50 sigmas (um)")):
-        rows.append(book.score(f"brown.table1_point_sigma.{cid}", note=f"{what}; {at}",
-                               **args[f"brown.table1_point_sigma.{cid}"]))
-    rows.append(book.score("brown.table1_point_sigma.below_closure",
-                           note="every sigma / sigma0 = sqrt(cofactor) (pivot model) must be "
-                           "below 1; " + geo, **args["brown.table1_point_sigma.below_closure"]))
-    rows.append(mc_agreement(book, "brown.table1_mc_agreement.pivot.mean_ratio", mc, 2, an_pivot,
-                             cfg["trials"]))
+    at = (
+        "sigma0 = the paper's printed 1.6 um, so the geometry alone decides; interval over "
+        f"its rounding 1.55-1.65 um; sqrt(cofactor) {cof.min():.3f}-{cof.max():.3f}; " + geo
+    )
+    for cid, what in (
+        ("share_at_paper_closure", "share of the 50 sigmas printing as 1.1-1.3 um"),
+        ("count_at_paper_closure", "points whose larger sigma prints >= 1.5 um"),
+        ("max_at_paper_closure_um", "largest of the 50 sigmas (um)"),
+    ):
+        rows.append(
+            book.score(
+                f"brown.table1_point_sigma.{cid}",
+                note=f"{what}; {at}",
+                **args[f"brown.table1_point_sigma.{cid}"],
+            )
+        )
+    rows.append(
+        book.score(
+            "brown.table1_point_sigma.below_closure",
+            note="every sigma / sigma0 = sqrt(cofactor) (pivot model) must be below 1; " + geo,
+            **args["brown.table1_point_sigma.below_closure"],
+        )
+    )
+    rows.append(
+        mc_agreement(
+            book, "brown.table1_mc_agreement.pivot.mean_ratio", mc, 2, an_pivot, cfg["trials"]
+        )
+    )
     return rows

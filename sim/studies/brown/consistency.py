@@ -16,19 +16,43 @@ or inconclusive), and rows with claim ``ALL`` (every swept prediction holds) and
 ``ALL_SATISFIABLE`` (every swept prediction that holds somewhere), with the claims that hold
 nowhere or pairwise exclude each other in ``conflicts``.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ... import multilateration as ml
-from ...claims import ClaimBook
-from . import values as V
-from .schema import sweep_offsets
+from sim.claims.book import ClaimBook
+from sim.instruments.ranges import multilateration as ml
+from sim.studies.brown import values as V
+from sim.studies.brown.schema import sweep_offsets
 
-CS_COLUMNS = ["input", "fixed", "claim", "holds_low", "holds_high", "contiguous", "ok_low",
-              "ok_high", "swept_low", "swept_high", "feasible_high", "conflicts"]
-SWEEP_COLUMNS = ["half_extent_mm", "offset_mm", "feasible", "max_range_mm", "claim", "kind",
-                 "value", "ci_low", "ci_high", "p_plate", "verdict"]
+CS_COLUMNS = [
+    "input",
+    "fixed",
+    "claim",
+    "holds_low",
+    "holds_high",
+    "contiguous",
+    "ok_low",
+    "ok_high",
+    "swept_low",
+    "swept_high",
+    "feasible_high",
+    "conflicts",
+]
+SWEEP_COLUMNS = [
+    "half_extent_mm",
+    "offset_mm",
+    "feasible",
+    "max_range_mm",
+    "claim",
+    "kind",
+    "value",
+    "ci_low",
+    "ci_high",
+    "p_plate",
+    "verdict",
+]
 
 
 def fresh(book: ClaimBook) -> ClaimBook:
@@ -52,11 +76,19 @@ def _score_rows(book, args_list, ext, offs, ok, rmax, out):
         b = fresh(book)
         for cid, kw in args.items():
             r = b.score(cid, **kw)
-            for k, v in (("half_extent_mm", ext[g]), ("offset_mm", offs[g]),
-                         ("feasible", bool(ok[g])), ("max_range_mm", rmax[g]), ("claim", cid),
-                         ("kind", r["kind"]), ("value", r["value"]), ("ci_low", r["ci_low"]),
-                         ("ci_high", r["ci_high"]), ("p_plate", r["p_plate"]),
-                         ("verdict", r["verdict"] if r["kind"] != "input" else r["outcome"])):
+            for k, v in (
+                ("half_extent_mm", ext[g]),
+                ("offset_mm", offs[g]),
+                ("feasible", bool(ok[g])),
+                ("max_range_mm", rmax[g]),
+                ("claim", cid),
+                ("kind", r["kind"]),
+                ("value", r["value"]),
+                ("ci_low", r["ci_low"]),
+                ("ci_high", r["ci_high"]),
+                ("p_plate", r["p_plate"]),
+                ("verdict", r["verdict"] if r["kind"] != "input" else r["outcome"]),
+            ):
                 out[k].append(v)
 
 
@@ -70,8 +102,7 @@ def sweep_dilution(cfg: dict, book: ClaimBook, pts: np.ndarray) -> dict:
     TH = V.thetas(cfg["plate.format_mm"], O, cfg["comparator.alpha_mm"], cfg["comparator.beta_mm"])
     ok, rmax = feasible(cfg, P, TH)
     sig = {m: V.sigmas(P, TH, m) for m in ("known", "stations", "pivot")}
-    curve, _ = V.dilution_curve(cfg["plate.format_mm"], cfg["dilution.grids"], E, O,
-                                pivot=False)
+    curve, _ = V.dilution_curve(cfg["plate.format_mm"], cfg["dilution.grids"], E, O, pivot=False)
     args = V.dilution_values(P, sig, V.monotone(curve))
     out = {c: [] for c in SWEEP_COLUMNS}
     _score_rows(book, args, E, O, ok, rmax, out)
@@ -82,7 +113,9 @@ def sweep_table1(cfg: dict, book: ClaimBook, pts: np.ndarray, range_sigma_um: fl
     """Score the geometry-dependent Table-1 claims over the station offsets."""
     offs = sweep_offsets(cfg)
     P = np.broadcast_to(pts, (len(offs),) + pts.shape).copy()
-    TH = V.thetas(cfg["plate.format_mm"], offs, cfg["comparator.alpha_mm"], cfg["comparator.beta_mm"])
+    TH = V.thetas(
+        cfg["plate.format_mm"], offs, cfg["comparator.alpha_mm"], cfg["comparator.beta_mm"]
+    )
     ok, rmax = feasible(cfg, P, TH)
     dof = 4 * len(pts) - (2 * len(pts) + 7)
     args = V.table1_values(V.sigmas(P, TH, "pivot"), V.closure_quantiles(range_sigma_um, dof))
@@ -115,10 +148,20 @@ def consistent_set(sw: dict, cfg: dict) -> dict:
     def add(inp, fixed, claim, x, hold, okm, fh, conflicts=""):
         lo, hi, cont = _hull(x, hold)
         olo, ohi, _ = _hull(x, okm)
-        for k, v in (("input", inp), ("fixed", fixed), ("claim", claim), ("holds_low", lo),
-                     ("holds_high", hi), ("contiguous", cont), ("ok_low", olo), ("ok_high", ohi),
-                     ("swept_low", float(x.min())), ("swept_high", float(x.max())),
-                     ("feasible_high", fh), ("conflicts", conflicts)):
+        for k, v in (
+            ("input", inp),
+            ("fixed", fixed),
+            ("claim", claim),
+            ("holds_low", lo),
+            ("holds_high", hi),
+            ("contiguous", cont),
+            ("ok_low", olo),
+            ("ok_high", ohi),
+            ("swept_low", float(x.min())),
+            ("swept_high", float(x.max())),
+            ("feasible_high", fh),
+            ("conflicts", conflicts),
+        ):
             cols[k].append(v)
 
     per_ext = {}
@@ -137,10 +180,16 @@ def consistent_set(sw: dict, cfg: dict) -> dict:
             add("comparator.station_offset_mm", fixed, c, x, H[c], K[c], fh)
         nowhere = [c for c in preds if not H[c].any()]
         some = [c for c in preds if H[c].any()]
-        pairs = [f"{a} / {b}" for i, a in enumerate(some) for b in some[i + 1:]
-                 if not (H[a] & H[b]).any()]
-        conf = "; ".join(([f"hold nowhere: {', '.join(nowhere)}"] if nowhere else [])
-                         + ([f"disjoint: {', '.join(pairs)}"] if pairs else []))
+        pairs = [
+            f"{a} / {b}"
+            for i, a in enumerate(some)
+            for b in some[i + 1 :]
+            if not (H[a] & H[b]).any()
+        ]
+        conf = "; ".join(
+            ([f"hold nowhere: {', '.join(nowhere)}"] if nowhere else [])
+            + ([f"disjoint: {', '.join(pairs)}"] if pairs else [])
+        )
         allh = np.logical_and.reduce([H[c] for c in preds])
         allk = np.logical_and.reduce([K[c] for c in preds])
         add("comparator.station_offset_mm", fixed, "ALL", x, allh, allk, fh, conf)
@@ -153,13 +202,31 @@ def consistent_set(sw: dict, cfg: dict) -> dict:
         fe = np.array([per_ext[e][4].any() for e in exts])
         fh = float(xe[fe].max()) if fe.any() else np.nan
         for c in preds:
-            add("plate.half_extent_mm", "some feasible station offset", c, xe,
+            add(
+                "plate.half_extent_mm",
+                "some feasible station offset",
+                c,
+                xe,
                 np.array([per_ext[e][0][c].any() for e in exts]),
-                np.array([per_ext[e][1][c].any() for e in exts]), fh)
-        add("plate.half_extent_mm", "some feasible station offset", "ALL", xe,
+                np.array([per_ext[e][1][c].any() for e in exts]),
+                fh,
+            )
+        add(
+            "plate.half_extent_mm",
+            "some feasible station offset",
+            "ALL",
+            xe,
             np.array([per_ext[e][2].any() for e in exts]),
-            np.array([per_ext[e][5].any() for e in exts]), fh)
-        add("plate.half_extent_mm", "some feasible station offset", "ALL_SATISFIABLE", xe,
+            np.array([per_ext[e][5].any() for e in exts]),
+            fh,
+        )
+        add(
+            "plate.half_extent_mm",
+            "some feasible station offset",
+            "ALL_SATISFIABLE",
+            xe,
             np.array([per_ext[e][3].any() for e in exts]),
-            np.array([per_ext[e][6].any() for e in exts]), fh)
+            np.array([per_ext[e][6].any() for e in exts]),
+            fh,
+        )
     return cols

@@ -3,17 +3,18 @@
 
 Coordinates in mm, standard deviations in um. Seed paper 004 (Brown 1968).
 """
+
 from __future__ import annotations
 
 from functools import partial
 
 import numpy as np
 
-from ... import multilateration as ml
-from ...config import StudyError
-from ...runner import jackknife, run_chunks
-from .. import RunContext
-from .schema import MODEL_NAMES
+from sim.instruments.ranges import multilateration as ml
+from sim.mc.config import StudyError
+from sim.mc.runner import jackknife, run_chunks
+from sim.studies import RunContext
+from sim.studies.brown.schema import MODEL_NAMES
 
 
 def analytic_sigma(pts: np.ndarray, theta: np.ndarray, model: str, sigma_um: float = 1.0):
@@ -25,16 +26,30 @@ def analytic_sigma(pts: np.ndarray, theta: np.ndarray, model: str, sigma_um: flo
 def start_theta(theta: np.ndarray, model: str) -> np.ndarray:
     """Initial globals: the design (true) stations; alpha and beta^2 start at 0 when free."""
     t0 = theta.copy()
-    t0[5 + (model == "alpha"):ml.MODELS[model]] = 0.0
+    t0[5 + (model == "alpha") : ml.MODELS[model]] = 0.0
     return t0
 
 
-SIM_KEYS = ("errors.setting_sigma_um", "errors.settings", "errors.comparator_sigma_um",
-            "errors.bias_um", "solver.tol_mm", "solver.max_iter")
+SIM_KEYS = (
+    "errors.setting_sigma_um",
+    "errors.settings",
+    "errors.comparator_sigma_um",
+    "errors.bias_um",
+    "solver.tol_mm",
+    "solver.max_iter",
+)
 
 
-def chunk(rng: np.random.Generator, n: int, *, sim: dict, pts: np.ndarray, theta: np.ndarray,
-          shift_um: float | None = None, table1: bool = False) -> dict[str, np.ndarray]:
+def chunk(
+    rng: np.random.Generator,
+    n: int,
+    *,
+    sim: dict,
+    pts: np.ndarray,
+    theta: np.ndarray,
+    shift_um: float | None = None,
+    table1: bool = False,
+) -> dict[str, np.ndarray]:
     """One chunk of ``n`` simulated plates, adjusted with all three models.
 
     Returns per-trial rows (``rows.*``: sigma0, iterations, status and globals per model),
@@ -46,38 +61,57 @@ def chunk(rng: np.random.Generator, n: int, *, sim: dict, pts: np.ndarray, theta
     """
     P = np.broadcast_to(pts, (n,) + pts.shape)
     TH = np.broadcast_to(theta, (n, 7))
-    obs, sett = ml.simulate_ranges(P, TH, rng, setting_sigma_um=sim["errors.setting_sigma_um"],
-                                   settings=sim["errors.settings"],
-                                   comparator_sigma_um=sim["errors.comparator_sigma_um"],
-                                   bias_um=sim["errors.bias_um"], return_settings=True)
+    obs, sett = ml.simulate_ranges(
+        P,
+        TH,
+        rng,
+        setting_sigma_um=sim["errors.setting_sigma_um"],
+        settings=sim["errors.settings"],
+        comparator_sigma_um=sim["errors.comparator_sigma_um"],
+        bias_um=sim["errors.bias_um"],
+        return_settings=True,
+    )
     out: dict[str, np.ndarray] = {}
     errs, ok_all = [], np.ones(n, bool)
     res_by = {}
     for m in MODEL_NAMES:
-        res = ml.adjust(obs, m, start_theta(theta, m), tol_mm=sim["solver.tol_mm"],
-                        max_iter=sim["solver.max_iter"])
+        res = ml.adjust(
+            obs,
+            m,
+            start_theta(theta, m),
+            tol_mm=sim["solver.tol_mm"],
+            max_iter=sim["solver.max_iter"],
+        )
         res_by[m] = res
         out[f"rows.{m}_converged"] = res.converged
         out[f"rows.{m}_status"] = res.status
         out[f"rows.{m}_iterations"] = res.iterations
         out[f"rows.{m}_sigma0_um"] = res.sigma0 * 1e3
-        for i, name in enumerate(ml.PARAM_NAMES[:ml.MODELS[m]]):
+        for i, name in enumerate(ml.PARAM_NAMES[: ml.MODELS[m]]):
             out[f"rows.{m}_{name}"] = res.theta[:, i]
-        errs.append((res.points - pts) * 1e3)                        # um
+        errs.append((res.points - pts) * 1e3)  # um
         ok_all &= res.converged
-    e = np.stack(errs, 1)[ok_all]                                     # (n_ok, 3, n_pts, 2)
+    e = np.stack(errs, 1)[ok_all]  # (n_ok, 3, n_pts, 2)
     out["sum.n"] = np.array([ok_all.sum()], float)
     out["sum.e1"] = e.sum(0)[None]
     out["sum.e2"] = (e * e).sum(0)[None]
     out["sum.nfail"] = np.array([[(~res_by[m].converged).sum() for m in MODEL_NAMES]], float)
     if shift_um is not None:
         r0 = res_by["pivot"]
-        r2 = ml.adjust(obs + shift_um * 1e-3, "pivot", start_theta(theta, "pivot"),
-                       tol_mm=sim["solver.tol_mm"], max_iter=sim["solver.max_iter"])
+        r2 = ml.adjust(
+            obs + shift_um * 1e-3,
+            "pivot",
+            start_theta(theta, "pivot"),
+            tol_mm=sim["solver.tol_mm"],
+            max_iter=sim["solver.max_iter"],
+        )
         both = r0.converged & r2.converged
-        out["bias.max_point_shift_mm"] = np.array([np.abs(r2.points - r0.points)[both].max(initial=0.0)])
+        out["bias.max_point_shift_mm"] = np.array(
+            [np.abs(r2.points - r0.points)[both].max(initial=0.0)]
+        )
         out["bias.alpha_err_mm"] = np.array(
-            [np.abs(r2.theta[both, 5] - r0.theta[both, 5] + shift_um * 1e-3).max(initial=0.0)])
+            [np.abs(r2.theta[both, 5] - r0.theta[both, 5] + shift_um * 1e-3).max(initial=0.0)]
+        )
         out["bias.n"] = np.array([both.sum()])
     if table1:
         r = res_by["pivot"]
@@ -89,18 +123,28 @@ def chunk(rng: np.random.Generator, n: int, *, sim: dict, pts: np.ndarray, theta
         out["t1.max_sigma_um"] = ap.max(axis=(1, 2)) * nan
         out["t1.points_ge_1p45"] = (ap.max(axis=2) >= 1.45).sum(axis=1) * nan
         L = sett.shape[-1]  # the setting sigma needs repeated settings
-        out["t1.setting_sigma_um"] = (np.sqrt(sett.var(axis=-1, ddof=1).mean(axis=(1, 2))) * nan
-                                      if L > 1 else np.full(n, np.nan))
+        out["t1.setting_sigma_um"] = (
+            np.sqrt(sett.var(axis=-1, ddof=1).mean(axis=(1, 2))) * nan
+            if L > 1
+            else np.full(n, np.nan)
+        )
         for k in ("share_1p1_1p3", "max_sigma_um", "points_ge_1p45"):
             out[f"rows.pivot_{k}"] = out[f"t1.{k}"]
     return out
 
 
 def run_mc(cfg: dict, pts, theta, ctx: RunContext, shift_um=None, table1=False) -> dict:
-    fn = partial(chunk, sim={k: cfg[k] for k in SIM_KEYS}, pts=pts, theta=theta,
-                 shift_um=shift_um, table1=table1)
-    return run_chunks(fn, cfg["trials"], cfg["seed"], cfg["chunk"], part=0, label=cfg["study"],
-                      ctx=ctx)
+    fn = partial(
+        chunk,
+        sim={k: cfg[k] for k in SIM_KEYS},
+        pts=pts,
+        theta=theta,
+        shift_um=shift_um,
+        table1=table1,
+    )
+    return run_chunks(
+        fn, cfg["trials"], cfg["seed"], cfg["chunk"], part=0, label=cfg["study"], ctx=ctx
+    )
 
 
 class MC:
@@ -108,7 +152,7 @@ class MC:
 
     ``sums`` (C, 3, n, 2, 2) holds per chunk the first and second moments of the errors of
     each model; ``cnt`` (C,) the trials they cover. Intervals are delete-one-chunk jackknife
-    intervals (:func:`sim.runner.jackknife`) or chi-square intervals for single sigmas.
+    intervals (:func:`sim.mc.runner.jackknife`) or chi-square intervals for single sigmas.
     """
 
     def __init__(self, sim: dict):
@@ -119,9 +163,11 @@ class MC:
         self.N = int(self.cnt.sum())
         self.nfail = sim["sum.nfail"].sum(0)
         if self.N < 2:
-            raise StudyError(f"only {self.N} trials converged in all models (non-converged: "
-                             + ", ".join(f"{m} {int(f)}" for m, f in zip(MODEL_NAMES, self.nfail))
-                             + "): singular reduced normal matrix, the geometry is degenerate")
+            raise StudyError(
+                f"only {self.N} trials converged in all models (non-converged: "
+                + ", ".join(f"{m} {int(f)}" for m, f in zip(MODEL_NAMES, self.nfail))
+                + "): singular reduced normal matrix, the geometry is degenerate"
+            )
 
     def sd_from(self, total: np.ndarray) -> np.ndarray:
         """(3, n, 2) standard deviations from a packed total [N, sums...]."""
@@ -142,9 +188,23 @@ def points_table(pts, an: dict, mc: MC, sr: float) -> dict:
     """Rows of points.parquet: one per model and point (sigmas in um)."""
     n = len(pts)
     k_pt = pooled_sigma(an["known"])
-    cols: dict[str, list] = {k: [] for k in ("model", "point", "x_mm", "y_mm", "sigma_x_um",
-                                             "sigma_y_um", "mc_sigma_x_um", "mc_sigma_y_um",
-                                             "mc_trials", "ratio_x", "ratio_y", "dilution_pct")}
+    cols: dict[str, list] = {
+        k: []
+        for k in (
+            "model",
+            "point",
+            "x_mm",
+            "y_mm",
+            "sigma_x_um",
+            "sigma_y_um",
+            "mc_sigma_x_um",
+            "mc_sigma_y_um",
+            "mc_trials",
+            "ratio_x",
+            "ratio_y",
+            "dilution_pct",
+        )
+    }
     sd = mc.sd
     for i, m in enumerate(MODEL_NAMES):
         a = an[m]
@@ -165,4 +225,4 @@ def points_table(pts, an: dict, mc: MC, sr: float) -> dict:
 
 def pooled_sigma(a: np.ndarray) -> np.ndarray:
     """sigma of a point: rms of its sigma_x and sigma_y, (n,)."""
-    return np.sqrt((a ** 2).mean(axis=-1))
+    return np.sqrt((a**2).mean(axis=-1))

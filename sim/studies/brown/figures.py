@@ -1,5 +1,6 @@
 """Figures of the Brown studies (PNG, deterministic). Every figure uses a constrained layout
 so that labels of neighbouring panels never overlap."""
+
 from __future__ import annotations
 
 import math
@@ -7,12 +8,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ... import multilateration as ml
-from ...intervals import std_rel_se
-from ...plotting import plt, save
-from ...storage import read_table
-from .schema import MODEL_NAMES
-from .values import pooled
+from sim.claims.intervals import std_rel_se
+from sim.instruments.ranges import multilateration as ml
+from sim.mc.storage import read_table
+from sim.report.plotting import plt, save
+from sim.studies.brown.schema import MODEL_NAMES
+from sim.studies.brown.values import pooled
 
 
 def _fig(nrows, ncols, w, h):
@@ -44,14 +45,21 @@ def fig_sigma_maps(cfg, pts, theta, path):
     scale = 12.0  # mm of plot per unit ratio
     for i, (ax, m) in enumerate(zip(axs[0], MODEL_NAMES)):
         Qpp = ml.covariance(pts[None], theta[None], m)[0][0]
-        _plate_axes(ax, cfg, theta, f"{m}: 1-sigma ellipses (x{scale:.0f} mm per sigma_r)",
-                    ylabel=i == 0)
+        _plate_axes(
+            ax, cfg, theta, f"{m}: 1-sigma ellipses (x{scale:.0f} mm per sigma_r)", ylabel=i == 0
+        )
         ax.plot(pts[:, 0], pts[:, 1], ".", color="0.4", ms=3)
         for j in range(len(pts)):
             _ellipse(ax, pts[j, 0], pts[j, 1], Qpp[j], scale, color="tab:blue", lw=1)
         s = np.sqrt(np.stack([Qpp[:, 0, 0], Qpp[:, 1, 1]], 1))
-        ax.text(0.02, 0.02, f"sigma/sigma_r {s.min():.3f}-{s.max():.3f}", transform=ax.transAxes,
-                fontsize=8, bbox=dict(fc="w", alpha=0.8))
+        ax.text(
+            0.02,
+            0.02,
+            f"sigma/sigma_r {s.min():.3f}-{s.max():.3f}",
+            transform=ax.transAxes,
+            fontsize=8,
+            bbox=dict(fc="w", alpha=0.8),
+        )
     save(fig, path)
 
 
@@ -64,8 +72,14 @@ def fig_dilution_points(cfg, pts, theta, unit, path):
         sc = ax.scatter(pts[:, 0], pts[:, 1], c=d, cmap="viridis", s=60)
         if len(pts) <= 49:
             for j in range(len(pts)):
-                ax.annotate(f"{d[j]:.1f}", pts[j], textcoords="offset points", xytext=(0, 6),
-                            ha="center", fontsize=7)
+                ax.annotate(
+                    f"{d[j]:.1f}",
+                    pts[j],
+                    textcoords="offset points",
+                    xytext=(0, 6),
+                    ha="center",
+                    fontsize=7,
+                )
         fig.colorbar(sc, ax=ax, label="%", shrink=0.8)
     save(fig, path)
 
@@ -75,8 +89,11 @@ def fig_dilution_vs_points(table: Path, path):
     fig, axs = _fig(1, 1, 6.5, 4.2)
     ax = axs[0, 0]
     n = np.asarray(tab["n_points"])
-    for col, lab in (("dil_max_pct", "max over points"), ("dil_mean_pct", "mean"),
-                     ("dil_min_pct", "min over points")):
+    for col, lab in (
+        ("dil_max_pct", "max over points"),
+        ("dil_mean_pct", "mean"),
+        ("dil_min_pct", "min over points"),
+    ):
         ax.plot(n, tab[col], "o-", label=lab)
     ax.set_xscale("log")
     ax.set_xlabel("number of points (k x k grid, same extent)")
@@ -93,9 +110,12 @@ def fig_mc_vs_analytic(cols, n_trials, path):
     band = 1.96 * std_rel_se(n_trials)
     for m, mk in zip(MODEL_NAMES, "os^"):
         sel = model == m
-        a = np.concatenate([np.asarray(cols["sigma_x_um"])[sel], np.asarray(cols["sigma_y_um"])[sel]])
-        s = np.concatenate([np.asarray(cols["mc_sigma_x_um"])[sel],
-                            np.asarray(cols["mc_sigma_y_um"])[sel]])
+        a = np.concatenate(
+            [np.asarray(cols["sigma_x_um"])[sel], np.asarray(cols["sigma_y_um"])[sel]]
+        )
+        s = np.concatenate(
+            [np.asarray(cols["mc_sigma_x_um"])[sel], np.asarray(cols["mc_sigma_y_um"])[sel]]
+        )
         ax.plot(a, s / a, mk, ms=4, label=m, alpha=0.7)
     ax.axhspan(1 - band, 1 + band, color="0.8", alpha=0.5, label="95 % sampling band")
     ax.axhline(1, color="k", lw=0.8)
@@ -143,8 +163,12 @@ def fig_consistent_set(out: Path, path):
     exts = sorted(set(E))
     P = read_table(out / "points.parquet").to_pydict()
     e0 = float(max(np.abs(P["x_mm"]).max(), np.abs(P["y_mm"]).max()))
-    fixed0 = next(r["fixed"] for r in cs if r["input"] == "comparator.station_offset_mm"
-                  and r["fixed"].startswith(f"half extent of the points {e0:g} mm"))
+    fixed0 = next(
+        r["fixed"]
+        for r in cs
+        if r["input"] == "comparator.station_offset_mm"
+        and r["fixed"].startswith(f"half extent of the points {e0:g} mm")
+    )
     row_all = next(r for r in cs if r["claim"] == "ALL" and r["fixed"] == fixed0)
     multi = len(exts) > 1
     n = len(claims) + multi
@@ -171,8 +195,14 @@ def fig_consistent_set(out: Path, path):
         if zl is not None and zh is not None:
             yl = ax.get_ylim()
             if zh - zl > 1e-3 * (yl[1] - yl[0]):
-                ax.axhspan(max(zl, yl[0] - 1e3), min(zh, yl[1] + 1e3), color="tab:orange",
-                           alpha=0.25, lw=0, label="paper (decision zone)")
+                ax.axhspan(
+                    max(zl, yl[0] - 1e3),
+                    min(zh, yl[1] + 1e3),
+                    color="tab:orange",
+                    alpha=0.25,
+                    lw=0,
+                    label="paper (decision zone)",
+                )
             else:
                 ax.axhline(zl, color="tab:orange", lw=2, label="paper (decision zone)")
             ax.set_ylim(yl)
@@ -191,8 +221,9 @@ def fig_consistent_set(out: Path, path):
             for j, o in enumerate(xo):
                 s = (E == e) & (O == o)
                 grid[i, j] = (v[s] == "holds").sum() if feas[s].all() else np.nan
-        im = ax.pcolormesh(xo, exts, grid, shading="nearest", cmap="Greens",
-                           vmin=0, vmax=len(claims))
+        im = ax.pcolormesh(
+            xo, exts, grid, shading="nearest", cmap="Greens", vmin=0, vmax=len(claims)
+        )
         fig.colorbar(im, ax=ax, label="claims that hold", shrink=0.8)
         ax.set_xlabel("station offset outside the midsides (mm)")
         ax.set_ylabel("half extent of the points (mm)")
@@ -200,11 +231,16 @@ def fig_consistent_set(out: Path, path):
     for ax in list(axs.flat)[n:]:
         ax.set_visible(False)
     handles = {}
-    for ax in list(axs.flat)[:len(claims)]:
+    for ax in list(axs.flat)[: len(claims)]:
         for h, lab in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(lab, h)
-    fig.legend(list(handles.values()), list(handles), loc="outside lower center",
-               ncols=min(len(handles), 5), fontsize=8)
+    fig.legend(
+        list(handles.values()),
+        list(handles),
+        loc="outside lower center",
+        ncols=min(len(handles), 5),
+        fontsize=8,
+    )
     save(fig, path)
 
 
@@ -214,14 +250,32 @@ def _shade(ax, row_all, cid, cs):
         ax.axvspan(fh, hi, color="0.6", alpha=0.25, lw=0, label="idealised (off the scale)")
     own = next((r for r in cs if r["claim"] == cid and r["fixed"] == row_all["fixed"]), None)
     if own and _some(own):
-        ax.axvspan(own["holds_low"], own["holds_high"], color="tab:blue", alpha=0.12, lw=0,
-                   label=f"this claim holds ({own['fixed'].replace('half extent of the points', '+-')})")
+        ax.axvspan(
+            own["holds_low"],
+            own["holds_high"],
+            color="tab:blue",
+            alpha=0.12,
+            lw=0,
+            label=f"this claim holds ({own['fixed'].replace('half extent of the points', '+-')})",
+        )
     if _some(row_all):
-        ax.axvspan(row_all["holds_low"], row_all["holds_high"], color="tab:green", alpha=0.15,
-                   lw=0, label="consistent set (all claims hold)")
+        ax.axvspan(
+            row_all["holds_low"],
+            row_all["holds_high"],
+            color="tab:green",
+            alpha=0.15,
+            lw=0,
+            label="consistent set (all claims hold)",
+        )
     elif _some(row_all, "ok"):
-        ax.axvspan(row_all["ok_low"], row_all["ok_high"], color="tab:green", alpha=0.15, lw=0,
-                   label="no claim contradicted (holds or inconclusive)")
+        ax.axvspan(
+            row_all["ok_low"],
+            row_all["ok_high"],
+            color="tab:green",
+            alpha=0.15,
+            lw=0,
+            label="no claim contradicted (holds or inconclusive)",
+        )
 
 
 def _some(r, which="holds") -> bool:

@@ -1,13 +1,14 @@
 """Report sections of the Brown studies, built from their Parquet files alone (and the
 schema's key descriptions). Every number and verdict in the prose is read from a file."""
+
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
-from ...report import claims_markdown, fmt, inputs_markdown, md_table
-from ...storage import read_provenance, read_table
-from .schema import DILUTION, TABLE1
+from sim.mc.storage import read_provenance, read_table
+from sim.report.markdown import claims_markdown, fmt, inputs_markdown, md_table
+from sim.studies.brown.schema import DILUTION, TABLE1
 
 OFFSET = "comparator.station_offset_mm"
 
@@ -33,33 +34,46 @@ def consistency_markdown(out: Path) -> str:
     fixed = list(dict.fromkeys(r["fixed"] for r in off))
     claims = list(dict.fromkeys(r["claim"] for r in off))
     get = {(r["fixed"], r["claim"]): r for r in off}
-    head = ["claim"] + [f"{f} (feasible to {fmt(get[(f, 'ALL')]['feasible_high'])} mm)"
-                        for f in fixed]
-    rows = [[f"`{c}`" if not c.startswith("ALL") else f"**{c}**"]
-            + [_cell(get[(f, c)]) for f in fixed] for c in claims]
+    head = ["claim"] + [
+        f"{f} (feasible to {fmt(get[(f, 'ALL')]['feasible_high'])} mm)" for f in fixed
+    ]
+    rows = [
+        [f"`{c}`" if not c.startswith("ALL") else f"**{c}**"] + [_cell(get[(f, c)]) for f in fixed]
+        for c in claims
+    ]
     sw_lo, sw_hi = off[0]["swept_low"], off[0]["swept_high"]
-    txt = [f"Station offsets (mm) at which each claim holds, swept from {fmt(sw_lo)} to "
-           f"{fmt(sw_hi)} mm; only offsets whose ranges all fit the scale plus micrometer "
-           "count (the rest are idealised). **ALL**: every swept prediction holds; "
-           "**ALL_SATISFIABLE**: every swept prediction that holds somewhere.", "",
-           md_table(head, rows), ""]
+    txt = [
+        f"Station offsets (mm) at which each claim holds, swept from {fmt(sw_lo)} to "
+        f"{fmt(sw_hi)} mm; only offsets whose ranges all fit the scale plus micrometer "
+        "count (the rest are idealised). **ALL**: every swept prediction holds; "
+        "**ALL_SATISFIABLE**: every swept prediction that holds somewhere.",
+        "",
+        md_table(head, rows),
+        "",
+    ]
     for f in fixed:
         a = get[(f, "ALL")]
         ok = _iv(a["ok_low"], a["ok_high"], unit=" mm")
-        line = (f"- {f}: consistent set "
-                f"{_iv(a['holds_low'], a['holds_high'], a['contiguous'], ' mm')}; no swept claim "
-                f"contradicted (each holds or is inconclusive): {ok}")
+        line = (
+            f"- {f}: consistent set "
+            f"{_iv(a['holds_low'], a['holds_high'], a['contiguous'], ' mm')}; no swept claim "
+            f"contradicted (each holds or is inconclusive): {ok}"
+        )
         if a["conflicts"]:
             sat = get[(f, "ALL_SATISFIABLE")]
-            line += (f"; {a['conflicts']}; the claims that hold somewhere hold together for "
-                     f"{_iv(sat['holds_low'], sat['holds_high'], sat['contiguous'], ' mm')}")
+            line += (
+                f"; {a['conflicts']}; the claims that hold somewhere hold together for "
+                f"{_iv(sat['holds_low'], sat['holds_high'], sat['contiguous'], ' mm')}"
+            )
         txt.append(line + ".")
     ext = [r for r in cs if r["input"] == "plate.half_extent_mm"]
     if ext:
-        txt += ["", "Half extents of the points (mm) for which some feasible offset makes the "
-                "claim hold:", "",
-                md_table(["claim", "half extents (mm)"],
-                         [[r["claim"], _cell(r)] for r in ext])]
+        txt += [
+            "",
+            "Half extents of the points (mm) for which some feasible offset makes the claim hold:",
+            "",
+            md_table(["claim", "half extents (mm)"], [[r["claim"], _cell(r)] for r in ext]),
+        ]
     return "\n".join(txt)
 
 
@@ -70,10 +84,12 @@ def report_dilution(out: Path) -> str:
     dvp = read_table(out / "dilution_vs_points.parquet").to_pydict()
     n = len(set(pts["point"]))
     name = out.name
-    scale = (f"every range on the {cfg['comparator.scale_length_mm']:g} mm scale plus "
-             f"{cfg['comparator.micrometer_mm']:g} mm of micrometer"
-             if cfg["comparator.scale_length_mm"] > 0 else
-             "scale length not enforced (idealised comparator)")
+    scale = (
+        f"every range on the {cfg['comparator.scale_length_mm']:g} mm scale plus "
+        f"{cfg['comparator.micrometer_mm']:g} mm of micrometer"
+        if cfg["comparator.scale_length_mm"] > 0
+        else "scale length not enforced (idealised comparator)"
+    )
     txt = [
         f"Design simulation of the paper's *Concept* section. Plate {cfg['plate.format_mm']:g} mm, "
         f"{cfg['plate.pattern']} pattern ({n} points), stations "
@@ -108,10 +124,19 @@ def report_dilution(out: Path) -> str:
         "**Dilution against the number of points** (analytic, k x k grid over the same extent, "
         "nominal offset):",
         "",
-        md_table(["points", "min %", "mean %", "max %", "pivot extra, max %"],
-                 [[k, fmt(a), fmt(b), fmt(c), fmt(d)] for k, a, b, c, d in
-                  zip(dvp["n_points"], dvp["dil_min_pct"], dvp["dil_mean_pct"], dvp["dil_max_pct"],
-                      dvp["pivot_extra_max_pct"])]),
+        md_table(
+            ["points", "min %", "mean %", "max %", "pivot extra, max %"],
+            [
+                [k, fmt(a), fmt(b), fmt(c), fmt(d)]
+                for k, a, b, c, d in zip(
+                    dvp["n_points"],
+                    dvp["dil_min_pct"],
+                    dvp["dil_mean_pct"],
+                    dvp["dil_max_pct"],
+                    dvp["pivot_extra_max_pct"],
+                )
+            ],
+        ),
         "",
         f"![claims against the station offset]({name}/consistent_set.png)",
         f"![sigma maps]({name}/sigma_maps.png)",
@@ -126,28 +151,30 @@ def report_table1(out: Path) -> str:
     prov = read_provenance(out / "claims.parquet")
     cfg = prov["config"]
     name = out.name
-    return "\n".join([
-        f"The paper's production test: a 5 x 5 array at {cfg['plate.spacing_mm']:g} mm, "
-        f"{cfg['errors.settings']} settings of {cfg['errors.setting_sigma_um']:g} um each and "
-        f"{cfg['errors.comparator_sigma_um']:g} um from the comparator (range sigma "
-        f"{prov['range_sigma_um']:.2f} um), reduced with the `pivot` model (2n + 7 unknowns); "
-        f"stations {cfg['comparator.station_offset_mm']:g} mm outside the midsides (nominal), "
-        f"every range on the {cfg['comparator.scale_length_mm']:g} mm scale plus "
-        f"{cfg['comparator.micrometer_mm']:g} mm of micrometer. The paper's listing of the "
-        "residuals is lost; its summary line survives. The paper's numbers describe one plate: "
-        "*one-plate* rows give the median and the 95 % range over simulated plates and p, the "
-        "probability of a plate at least as extreme as the paper's. The *at paper closure* "
-        "rows take the paper's own sigma0 (1.6 um as printed), so only the geometry decides.",
-        "",
-        "**The unprinted station offset, swept** (the grid is printed; one-plate rows "
-        "semi-analytically, sigma0 from its chi-square distribution):",
-        "",
-        consistency_markdown(out),
-        "",
-        claims_markdown(out / "claims.parquet"),
-        "",
-        inputs_markdown(cfg, TABLE1),
-        "",
-        f"![claims against the station offset]({name}/consistent_set.png)",
-        f"![table 1]({name}/table1.png)",
-    ])
+    return "\n".join(
+        [
+            f"The paper's production test: a 5 x 5 array at {cfg['plate.spacing_mm']:g} mm, "
+            f"{cfg['errors.settings']} settings of {cfg['errors.setting_sigma_um']:g} um each and "
+            f"{cfg['errors.comparator_sigma_um']:g} um from the comparator (range sigma "
+            f"{prov['range_sigma_um']:.2f} um), reduced with the `pivot` model (2n + 7 unknowns); "
+            f"stations {cfg['comparator.station_offset_mm']:g} mm outside the midsides (nominal), "
+            f"every range on the {cfg['comparator.scale_length_mm']:g} mm scale plus "
+            f"{cfg['comparator.micrometer_mm']:g} mm of micrometer. The paper's listing of the "
+            "residuals is lost; its summary line survives. The paper's numbers describe one plate: "
+            "*one-plate* rows give the median and the 95 % range over simulated plates and p, the "
+            "probability of a plate at least as extreme as the paper's. The *at paper closure* "
+            "rows take the paper's own sigma0 (1.6 um as printed), so only the geometry decides.",
+            "",
+            "**The unprinted station offset, swept** (the grid is printed; one-plate rows "
+            "semi-analytically, sigma0 from its chi-square distribution):",
+            "",
+            consistency_markdown(out),
+            "",
+            claims_markdown(out / "claims.parquet"),
+            "",
+            inputs_markdown(cfg, TABLE1),
+            "",
+            f"![claims against the station offset]({name}/consistent_set.png)",
+            f"![table 1]({name}/table1.png)",
+        ]
+    )

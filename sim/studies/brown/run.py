@@ -4,22 +4,23 @@
 their Parquet files and figures into ``out``; the Monte Carlo goes through the runner
 (chunk functions pickle), everything else is analytic and batched. Seed paper 004.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ...claims import write_claims
-from ...figure_jobs import start_figures
-from ...storage import provenance, write_table
-from .. import RunContext
-from . import figures as F
-from . import values as V
-from .claims import load_book, score_dilution, score_table1
-from .consistency import consistent_set, sweep_dilution, sweep_table1
-from .core import MC, analytic_sigma, points_table, run_mc
-from .schema import MODEL_NAMES, range_sigma_um, setup
+from sim.claims.book import write_claims
+from sim.mc.storage import provenance, write_table
+from sim.report.figure_jobs import start_figures
+from sim.studies import RunContext
+from sim.studies.brown import figures as F
+from sim.studies.brown import values as V
+from sim.studies.brown.claims import load_book, score_dilution, score_table1
+from sim.studies.brown.consistency import consistent_set, sweep_dilution, sweep_table1
+from sim.studies.brown.core import MC, analytic_sigma, points_table, run_mc
+from sim.studies.brown.schema import MODEL_NAMES, range_sigma_um, setup
 
 
 def _common(cfg, ctx, **kw):
@@ -44,23 +45,36 @@ def run_dilution(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_table(out / "points.parquet", cols, prov)
 
     ext = float(np.abs(pts).max())
-    curve, extra = V.dilution_curve(cfg["plate.format_mm"], cfg["dilution.grids"], ext,
-                                    cfg["comparator.station_offset_mm"])
+    curve, extra = V.dilution_curve(
+        cfg["plate.format_mm"], cfg["dilution.grids"], ext, cfg["comparator.station_offset_mm"]
+    )
     mono = bool(V.monotone(curve)[0])
     ks = list(curve)
-    write_table(out / "dilution_vs_points.parquet", {
-        "grid": ks, "n_points": [k * k for k in ks],
-        "dil_min_pct": [float(curve[k].min()) for k in ks],
-        "dil_mean_pct": [float(curve[k].mean()) for k in ks],
-        "dil_max_pct": [float(curve[k].max()) for k in ks],
-        "pivot_extra_max_pct": [float(extra[k].max()) for k in ks]}, prov)
+    write_table(
+        out / "dilution_vs_points.parquet",
+        {
+            "grid": ks,
+            "n_points": [k * k for k in ks],
+            "dil_min_pct": [float(curve[k].min()) for k in ks],
+            "dil_mean_pct": [float(curve[k].mean()) for k in ks],
+            "dil_max_pct": [float(curve[k].max()) for k in ks],
+            "pivot_extra_max_pct": [float(extra[k].max()) for k in ks],
+        },
+        prov,
+    )
     unit = {m: an[m] / sr for m in MODEL_NAMES}
-    drawn = start_figures([   # on the idle workers while the claims and the sweep are made here
-        (F.fig_dilution_points, (cfg, pts, theta, unit, out / "dilution_points.png")),
-        (F.fig_sigma_maps, (cfg, pts, theta, out / "sigma_maps.png")),
-        (F.fig_mc_vs_analytic, (cols, mc.N, out / "mc_vs_analytic.png")),
-        (F.fig_dilution_vs_points, (out / "dilution_vs_points.parquet",
-                                    out / "dilution_vs_points.png"))], ctx.executor)
+    drawn = start_figures(
+        [  # on the idle workers while the claims and the sweep are made here
+            (F.fig_dilution_points, (cfg, pts, theta, unit, out / "dilution_points.png")),
+            (F.fig_sigma_maps, (cfg, pts, theta, out / "sigma_maps.png")),
+            (F.fig_mc_vs_analytic, (cols, mc.N, out / "mc_vs_analytic.png")),
+            (
+                F.fig_dilution_vs_points,
+                (out / "dilution_vs_points.parquet", out / "dilution_vs_points.png"),
+            ),
+        ],
+        ctx.executor,
+    )
 
     book = load_book("brown_dilution")
     rows = score_dilution(book, cfg, pts, theta, unit, mc, sim, curve, extra, mono)
@@ -75,19 +89,35 @@ def run_table1(cfg: dict, out: Path, ctx: RunContext) -> None:
     pts, theta, sr, an, sim, mc = _common(cfg, ctx, table1=True)
     prov = provenance(cfg, range_sigma_um=sr)
     write_table(out / "points.parquet", points_table(pts, an, mc, sr), prov)
-    ok = np.isfinite(sim["t1.sigma0_um"])                     # converged pivot adjustments
-    t1 = {k: sim[f"t1.{k}"][ok] for k in ("sigma0_um", "share_1p1_1p3", "max_sigma_um",
-                                           "points_ge_1p45", "setting_sigma_um")}
-    write_table(out / "table1_trials.parquet", {
-        "trial": np.flatnonzero(ok), "sigma0_um": t1["sigma0_um"],
-        "share_sigma_1p1_1p3": t1["share_1p1_1p3"], "max_sigma_um": t1["max_sigma_um"],
-        "points_sigma_ge_1p45": t1["points_ge_1p45"],
-        "setting_sigma_est_um": t1["setting_sigma_um"]}, prov)
+    ok = np.isfinite(sim["t1.sigma0_um"])  # converged pivot adjustments
+    t1 = {
+        k: sim[f"t1.{k}"][ok]
+        for k in (
+            "sigma0_um",
+            "share_1p1_1p3",
+            "max_sigma_um",
+            "points_ge_1p45",
+            "setting_sigma_um",
+        )
+    }
+    write_table(
+        out / "table1_trials.parquet",
+        {
+            "trial": np.flatnonzero(ok),
+            "sigma0_um": t1["sigma0_um"],
+            "share_sigma_1p1_1p3": t1["share_1p1_1p3"],
+            "max_sigma_um": t1["max_sigma_um"],
+            "points_sigma_ge_1p45": t1["points_ge_1p45"],
+            "setting_sigma_est_um": t1["setting_sigma_um"],
+        },
+        prov,
+    )
     book = load_book("brown_table1")
     rows = score_table1(book, cfg, pts, an["pivot"], sr, mc, t1)
     write_claims(out / "claims.parquet", rows, prov, book)
-    drawn = start_figures([(F.fig_table1, (cfg, pts, theta, an["pivot"], t1, out / "table1.png"))],
-                          ctx.executor)   # on an idle worker while the sweep is made here
+    drawn = start_figures(
+        [(F.fig_table1, (cfg, pts, theta, an["pivot"], t1, out / "table1.png"))], ctx.executor
+    )  # on an idle worker while the sweep is made here
     sw = sweep_table1(cfg, load_book("brown_table1"), pts, sr)
     _write_sweep(out, sw, cfg, prov)
     F.fig_consistent_set(out, out / "consistent_set.png")

@@ -2,14 +2,15 @@
 
 Coordinates in mm, standard deviations in um.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ... import multilateration as ml
-from ...config import COMMON, ConfigError, Field
-from ...plate import pattern_points
-from ...runner import chunk_rng
+from sim.instruments.plates import pattern_points
+from sim.instruments.ranges import multilateration as ml
+from sim.mc.config import COMMON, ConfigError, Field
+from sim.mc.runner import chunk_rng
 
 SEED = "004_f5bd9e86c308241f.txt"
 MODEL_NAMES = ("known", "stations", "pivot")
@@ -21,90 +22,165 @@ BASE = {
     "plate.format_mm": Field(245.0, "float", "side of the square plate format", lo=1.0, unit="mm"),
     "plate.pattern": Field("grid", "str", "point pattern", choices=("grid", "random", "list")),
     "plate.grid": Field(5, "int", "points per side of the grid pattern", lo=2, hi=200),
-    "plate.spacing_mm": Field(45.0, "float", "grid spacing (Table 1: 45 mm; the Concept section "
-                              "prints no layout, its extent is swept)", lo=0.0, lo_open=True,
-                              unit="mm"),
+    "plate.spacing_mm": Field(
+        45.0,
+        "float",
+        "grid spacing (Table 1: 45 mm; the Concept section prints no layout, its extent is swept)",
+        lo=0.0,
+        lo_open=True,
+        unit="mm",
+    ),
     "plate.n_random": Field(25, "int", "number of points of the random pattern", lo=3, hi=100000),
-    "plate.random_half_extent_mm": Field(110.0, "float", "random points lie in |x|,|y| <= this",
-                                         lo=0.0, lo_open=True, unit="mm"),
+    "plate.random_half_extent_mm": Field(
+        110.0, "float", "random points lie in |x|,|y| <= this", lo=0.0, lo_open=True, unit="mm"
+    ),
     "plate.points": Field([], "points", "explicit point list [[x, y], ...] for pattern 'list'"),
     "comparator.station_offset_mm": Field(
-        17.0, "float", "distance of the stations outside the midsides of the format; the paper "
+        17.0,
+        "float",
+        "distance of the stations outside the midsides of the format; the paper "
         "says only 'a short distance' (nominal value: the middle of the 0-34 mm that fit the "
-        "261 mm scale for a +-90 mm grid; swept in consistency.*)", lo=0.0, lo_open=True,
-        unit="mm"),
-    "comparator.alpha_mm": Field(0.5, "float", "radial pivot offset alpha (true value)",
-                                 lo=-50.0, hi=50.0, unit="mm"),
-    "comparator.beta_mm": Field(1.0, "float", "tangential pivot offset beta (true value)",
-                                lo=0.0, hi=50.0, unit="mm"),
+        "261 mm scale for a +-90 mm grid; swept in consistency.*)",
+        lo=0.0,
+        lo_open=True,
+        unit="mm",
+    ),
+    "comparator.alpha_mm": Field(
+        0.5, "float", "radial pivot offset alpha (true value)", lo=-50.0, hi=50.0, unit="mm"
+    ),
+    "comparator.beta_mm": Field(
+        1.0, "float", "tangential pivot offset beta (true value)", lo=0.0, hi=50.0, unit="mm"
+    ),
     "comparator.scale_length_mm": Field(
-        261.0, "float", "graduated length of the scale (paper: 261 mm); every range must fit on "
-        "it plus the micrometer travel. 0 = not enforced (an idealised comparator)", lo=0.0,
-        unit="mm"),
-    "comparator.micrometer_mm": Field(1.0, "float", "micrometer travel added to the scale "
-                                      "(paper: at most 1 mm)", lo=0.0, unit="mm"),
-    "errors.setting_sigma_um": Field(1.0, "float", "standard deviation of one setting", lo=0.0,
-                                     lo_open=True, unit="um"),
+        261.0,
+        "float",
+        "graduated length of the scale (paper: 261 mm); every range must fit on "
+        "it plus the micrometer travel. 0 = not enforced (an idealised comparator)",
+        lo=0.0,
+        unit="mm",
+    ),
+    "comparator.micrometer_mm": Field(
+        1.0,
+        "float",
+        "micrometer travel added to the scale (paper: at most 1 mm)",
+        lo=0.0,
+        unit="mm",
+    ),
+    "errors.setting_sigma_um": Field(
+        1.0, "float", "standard deviation of one setting", lo=0.0, lo_open=True, unit="um"
+    ),
     "errors.settings": Field(1, "int", "settings per point and position, averaged", lo=1, hi=100),
-    "errors.comparator_sigma_um": Field(0.0, "float", "comparator random error per reading",
-                                        lo=0.0, unit="um"),
-    "errors.bias_um": Field(0.0, "float", "constant personal bias added to every range",
-                            lo=-1e4, hi=1e4, unit="um"),
-    "solver.tol_mm": Field(1e-10, "float", "convergence: largest correction below this", lo=0.0,
-                           lo_open=True, hi=1e-3, unit="mm"),
+    "errors.comparator_sigma_um": Field(
+        0.0, "float", "comparator random error per reading", lo=0.0, unit="um"
+    ),
+    "errors.bias_um": Field(
+        0.0, "float", "constant personal bias added to every range", lo=-1e4, hi=1e4, unit="um"
+    ),
+    "solver.tol_mm": Field(
+        1e-10,
+        "float",
+        "convergence: largest correction below this",
+        lo=0.0,
+        lo_open=True,
+        hi=1e-3,
+        unit="mm",
+    ),
     "solver.max_iter": Field(30, "int", "Gauss-Newton iteration limit", lo=1, hi=1000),
-    "consistency.offset_min_mm": Field(0.5, "float", "smallest station offset of the sweep",
-                                       lo=0.0, lo_open=True, unit="mm"),
-    "consistency.offset_max_mm": Field(60.0, "float", "largest station offset of the sweep "
-                                       "(offsets whose ranges do not fit the scale are shown as "
-                                       "idealised, never scored)", lo=0.0, lo_open=True,
-                                       unit="mm"),
-    "consistency.offset_step_mm": Field(0.5, "float", "step of the station-offset sweep", lo=0.0,
-                                        lo_open=True, unit="mm"),
+    "consistency.offset_min_mm": Field(
+        0.5, "float", "smallest station offset of the sweep", lo=0.0, lo_open=True, unit="mm"
+    ),
+    "consistency.offset_max_mm": Field(
+        60.0,
+        "float",
+        "largest station offset of the sweep "
+        "(offsets whose ranges do not fit the scale are shown as "
+        "idealised, never scored)",
+        lo=0.0,
+        lo_open=True,
+        unit="mm",
+    ),
+    "consistency.offset_step_mm": Field(
+        0.5, "float", "step of the station-offset sweep", lo=0.0, lo_open=True, unit="mm"
+    ),
 }
 
 DILUTION = {
     **BASE,
     "trials": Field(4000, "int", "Monte-Carlo trials", lo=2, hi=100_000_000),
-    "dilution.grids": Field([3, 4, 5, 7, 10, 14, 20], "list[int]",
-                            "grid sizes (points per side, same extent) for dilution vs point count",
-                            lo=2, hi=200, min_len=2),
-    "consistency.extents_mm": Field([60.0, 70.0, 80.0, 90.0, 100.0, 110.0], "list[float]",
-                                    "half extents of the k x k grid swept with the station "
-                                    "offset (the Concept section prints no layout)", lo=0.0,
-                                    lo_open=True, min_len=1, unit="mm"),
-    "idealised.half_extent_mm": Field(110.0, "float", "half extent of the idealised four-station "
-                                      "layout (no scale): the offset giving 0.85 at the edges",
-                                      lo=0.0, lo_open=True, unit="mm"),
-    "checks.bias_shift_um": Field(100.0, "float", "constant added to all ranges in the bias "
-                                  "invariance check", lo=-1e5, hi=1e5, unit="um"),
+    "dilution.grids": Field(
+        [3, 4, 5, 7, 10, 14, 20],
+        "list[int]",
+        "grid sizes (points per side, same extent) for dilution vs point count",
+        lo=2,
+        hi=200,
+        min_len=2,
+    ),
+    "consistency.extents_mm": Field(
+        [60.0, 70.0, 80.0, 90.0, 100.0, 110.0],
+        "list[float]",
+        "half extents of the k x k grid swept with the station "
+        "offset (the Concept section prints no layout)",
+        lo=0.0,
+        lo_open=True,
+        min_len=1,
+        unit="mm",
+    ),
+    "idealised.half_extent_mm": Field(
+        110.0,
+        "float",
+        "half extent of the idealised four-station "
+        "layout (no scale): the offset giving 0.85 at the edges",
+        lo=0.0,
+        lo_open=True,
+        unit="mm",
+    ),
+    "checks.bias_shift_um": Field(
+        100.0,
+        "float",
+        "constant added to all ranges in the bias invariance check",
+        lo=-1e5,
+        hi=1e5,
+        unit="um",
+    ),
 }
 
 TABLE1 = {
     **BASE,
     "trials": Field(4000, "int", "Monte-Carlo trials", lo=2, hi=100_000_000),
-    "plate.spacing_mm": Field(45.0, "float", "grid spacing (paper: 45 mm)", lo=0.0, lo_open=True,
-                              input=True, unit="mm"),
-    "errors.setting_sigma_um": Field(1.7, "float", "one setting (paper: 1.7 um)", lo=0.0,
-                                     lo_open=True, input=True, unit="um"),
+    "plate.spacing_mm": Field(
+        45.0, "float", "grid spacing (paper: 45 mm)", lo=0.0, lo_open=True, input=True, unit="mm"
+    ),
+    "errors.setting_sigma_um": Field(
+        1.7, "float", "one setting (paper: 1.7 um)", lo=0.0, lo_open=True, input=True, unit="um"
+    ),
     "errors.settings": Field(2, "int", "double settings (paper)", lo=1, hi=100, input=True),
-    "errors.comparator_sigma_um": Field(1.1, "float", "comparator contribution (paper: about "
-                                        "1.1 um)", lo=0.0, input=True, unit="um"),
+    "errors.comparator_sigma_um": Field(
+        1.1, "float", "comparator contribution (paper: about 1.1 um)", lo=0.0, input=True, unit="um"
+    ),
 }
 
 
 def range_sigma_um(cfg: dict) -> float:
     """sigma of one (averaged) range: sqrt(setting^2 / settings + comparator^2), um."""
-    return float(np.sqrt(cfg["errors.setting_sigma_um"] ** 2 / cfg["errors.settings"]
-                         + cfg["errors.comparator_sigma_um"] ** 2))
+    return float(
+        np.sqrt(
+            cfg["errors.setting_sigma_um"] ** 2 / cfg["errors.settings"]
+            + cfg["errors.comparator_sigma_um"] ** 2
+        )
+    )
 
 
 def points_of(cfg: dict) -> np.ndarray:
     """The plate's points (n, 2) mm; a random pattern is drawn once from stream part 99."""
-    return pattern_points(cfg["plate.pattern"], grid=cfg["plate.grid"],
-                          spacing_mm=cfg["plate.spacing_mm"], n_random=cfg["plate.n_random"],
-                          half_extent_mm=cfg["plate.random_half_extent_mm"],
-                          points=cfg["plate.points"], rng=chunk_rng(cfg["seed"], 99, 0))
+    return pattern_points(
+        cfg["plate.pattern"],
+        grid=cfg["plate.grid"],
+        spacing_mm=cfg["plate.spacing_mm"],
+        n_random=cfg["plate.n_random"],
+        half_extent_mm=cfg["plate.random_half_extent_mm"],
+        points=cfg["plate.points"],
+        rng=chunk_rng(cfg["seed"], 99, 0),
+    )
 
 
 #: the most geometries one sweep may evaluate (memory: about 1 kB per geometry and point)
@@ -123,10 +199,13 @@ def max_offset_mm(cfg: dict, half_extent_mm: float) -> float:
     from station 1 (0, h) is (+-e, -e): r = sqrt(e^2 + (h + e)^2 - beta^2) - alpha."""
     if cfg["comparator.scale_length_mm"] <= 0:
         return float("inf")
-    reach = (cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
-             + cfg["comparator.alpha_mm"])
+    reach = (
+        cfg["comparator.scale_length_mm"]
+        + cfg["comparator.micrometer_mm"]
+        + cfg["comparator.alpha_mm"]
+    )
     e = half_extent_mm
-    d2 = reach ** 2 + cfg["comparator.beta_mm"] ** 2 - e ** 2
+    d2 = reach**2 + cfg["comparator.beta_mm"] ** 2 - e**2
     return float(np.sqrt(d2) - e - cfg["plate.format_mm"] / 2) if d2 > 0 else -float("inf")
 
 
@@ -135,11 +214,15 @@ def check_sweep(cfg: dict) -> None:
     if cfg["consistency.offset_max_mm"] < cfg["consistency.offset_min_mm"]:
         raise ConfigError("consistency.offset_max_mm", "must be >= consistency.offset_min_mm")
     n = (cfg["consistency.offset_max_mm"] - cfg["consistency.offset_min_mm"]) / cfg[
-        "consistency.offset_step_mm"] + 1
+        "consistency.offset_step_mm"
+    ] + 1
     n_ext = len(cfg.get("consistency.extents_mm", [0]))
     if n * n_ext > MAX_SWEEP:
-        raise ConfigError("consistency.offset_step_mm", f"the sweep would evaluate {n * n_ext:.3g} "
-                          f"geometries (limit {MAX_SWEEP}); use a larger step")
+        raise ConfigError(
+            "consistency.offset_step_mm",
+            f"the sweep would evaluate {n * n_ext:.3g} "
+            f"geometries (limit {MAX_SWEEP}); use a larger step",
+        )
     half = cfg["plate.format_mm"] / 2
     for key in ("consistency.extents_mm", "idealised.half_extent_mm"):
         v = cfg.get(key)
@@ -151,23 +234,33 @@ def check(cfg: dict) -> None:
     """Cross-key rules: points inside the format, enough points, no duplicates/collinearity,
     every range on the scale, a bounded sweep."""
     check_sweep(cfg)
-    key = {"grid": "plate.grid", "random": "plate.n_random", "list": "plate.points"}[cfg["plate.pattern"]]
+    key = {"grid": "plate.grid", "random": "plate.n_random", "list": "plate.points"}[
+        cfg["plate.pattern"]
+    ]
     half = cfg["plate.format_mm"] / 2
     if cfg["plate.pattern"] == "grid":
         ext = (cfg["plate.grid"] - 1) / 2 * cfg["plate.spacing_mm"]
         if ext > half:
-            raise ConfigError("plate.spacing_mm", f"grid of {cfg['plate.grid']} at "
-                              f"{cfg['plate.spacing_mm']:g} mm reaches {ext:g} mm from the centre, "
-                              f"outside the {cfg['plate.format_mm']:g} mm format")
+            raise ConfigError(
+                "plate.spacing_mm",
+                f"grid of {cfg['plate.grid']} at "
+                f"{cfg['plate.spacing_mm']:g} mm reaches {ext:g} mm from the centre, "
+                f"outside the {cfg['plate.format_mm']:g} mm format",
+            )
     if cfg["plate.pattern"] == "random" and cfg["plate.random_half_extent_mm"] > half:
-        raise ConfigError("plate.random_half_extent_mm", "random points would lie outside the format")
+        raise ConfigError(
+            "plate.random_half_extent_mm", "random points would lie outside the format"
+        )
     pts = points_of(cfg)
     n = len(pts)
     if n < 3:
         raise ConfigError(key, f"needs at least 3 points (got {n})")
     if n < 4:
-        raise ConfigError(key, f"{n} points give {4 * n} ranges for {2 * n + 7} unknowns of the "
-                          "pivot model: at least 4 points are needed")
+        raise ConfigError(
+            key,
+            f"{n} points give {4 * n} ranges for {2 * n + 7} unknowns of the "
+            "pivot model: at least 4 points are needed",
+        )
     if np.any(np.abs(pts) > half):
         raise ConfigError(key, f"points outside the {cfg['plate.format_mm']:g} mm format")
     if len(np.unique(np.round(pts, 9), axis=0)) < n:
@@ -175,15 +268,19 @@ def check(cfg: dict) -> None:
     c = pts - pts.mean(0)
     sv = np.linalg.svd(c, compute_uv=False)
     if sv[-1] <= 1e-9 * max(sv[0], 1e-300):
-        raise ConfigError(key, "all points are collinear: the station coordinates cannot be recovered")
+        raise ConfigError(
+            key, "all points are collinear: the station coordinates cannot be recovered"
+        )
     if cfg["comparator.scale_length_mm"] > 0:
         _, theta = setup(cfg)
         r = ml.ranges(pts[None], theta[None])
         reach = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
         if r.max() > reach or r.min() < 0:
-            raise ConfigError("comparator.scale_length_mm",
-                              f"ranges run from {r.min():.1f} to {r.max():.1f} mm but the scale "
-                              f"reads 0 to {reach:g} mm (move the stations in, or use alpha)")
+            raise ConfigError(
+                "comparator.scale_length_mm",
+                f"ranges run from {r.min():.1f} to {r.max():.1f} mm but the scale "
+                f"reads 0 to {reach:g} mm (move the stations in, or use alpha)",
+            )
 
 
 def setup(cfg: dict):
@@ -191,4 +288,3 @@ def setup(cfg: dict):
     h = cfg["plate.format_mm"] / 2 + cfg["comparator.station_offset_mm"]
     theta = ml.design_theta(h, cfg["comparator.alpha_mm"], cfg["comparator.beta_mm"])
     return pts, theta
-

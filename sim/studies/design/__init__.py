@@ -8,19 +8,35 @@ runner), :mod:`.errbudget` (error budget), :mod:`.dilution` (datum), :mod:`.form
 :mod:`.consistent` (the unprinted inputs swept), :mod:`.claims` with ``claims.toml`` (the claim
 book), :mod:`.run`, :mod:`.figures`, :mod:`.report`.
 """
+
 from __future__ import annotations
 
-from .. import Study
-from .cells import geometry_eval, measuring_time, pareto_front, time_model
-from .report import report
-from .run import run
-from .schema import SCHEMA, SEED, check
+from sim.studies import Study
+from sim.studies.design.cells import geometry_eval, measuring_time, pareto_front, time_model
+from sim.studies.design.report import report
+from sim.studies.design.run import run
+from sim.studies.design.schema import SCHEMA, SEED, check
 
-__all__ = ["STUDIES", "SCHEMA", "check", "geometry_eval", "measuring_time", "pareto_front",
-           "time_model"]
+__all__ = [
+    "STUDIES",
+    "SCHEMA",
+    "check",
+    "geometry_eval",
+    "measuring_time",
+    "pareto_front",
+    "time_model",
+]
 
 STUDIES = {
-    "brown_design": Study("brown_design", "Brown: design trade-offs, calibration tolerances, error "
-                          "budget, datum, coverage, Bayesian check", SEED, SCHEMA, run, report,
-                          check, order=12),
+    "brown_design": Study(
+        "brown_design",
+        "Brown: design trade-offs, calibration tolerances, error "
+        "budget, datum, coverage, Bayesian check",
+        SEED,
+        SCHEMA,
+        run,
+        report,
+        check,
+        order=12,
+    ),
 }

@@ -1,6 +1,6 @@
 """Adaptive Monte-Carlo trial counts through the runner (in the spirit of JCGM 101 §7.9).
 
-:func:`run_adaptive` runs whole chunks of one stream with :func:`sim.runner.run_chunks`, so
+:func:`run_adaptive` runs whole chunks of one stream with :func:`sim.mc.runner.run_chunks`, so
 the chunks go to the run's executor (process pool, Dask) and its chunk store, and a killed run
 resumes. After each stage it asks ``stat(results)`` for ``{name: (value, standard error)}``;
 while a standard error exceeds the target, it predicts the trials needed from ``se ~ 1/sqrt(N)``
@@ -8,6 +8,7 @@ while a standard error exceeds the target, it predicts the trials needed from ``
 stage re-requests chunks ``0 .. K-1`` of the same stream: finished chunks come from the store
 (a temporary one when the run has none), so the first ``N`` trials equal a fixed run of ``N``.
 """
+
 from __future__ import annotations
 
 import math
@@ -16,23 +17,35 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from ...runner import ChunkStore, run_chunks
-from .. import RunContext
+from sim.mc.runner import ChunkStore, run_chunks
+from sim.studies import RunContext
 
 __all__ = ["run_adaptive"]
 
 
-def run_adaptive(fn, stat: Callable[[dict], Mapping[str, tuple[float, float]]], target: float,
-                 seed: int, chunk: int, part: int, min_trials: int, max_trials: int,
-                 label: str = "", ctx: RunContext | None = None):
+def run_adaptive(
+    fn,
+    stat: Callable[[dict], Mapping[str, tuple[float, float]]],
+    target: float,
+    seed: int,
+    chunk: int,
+    part: int,
+    min_trials: int,
+    max_trials: int,
+    label: str = "",
+    ctx: RunContext | None = None,
+):
     """Returns ``(results, stats)``; ``len`` of a per-trial result is the trials it took."""
-    top = max(chunk, (max_trials // chunk) * chunk)       # whole chunks only
+    top = max(chunk, (max_trials // chunk) * chunk)  # whole chunks only
     N = min(top, max(chunk, math.ceil(min_trials / chunk) * chunk))
     tmp = None
     if ctx is None or ctx.store is None:
         tmp = tempfile.TemporaryDirectory(prefix="sim-adaptive-")
-        ctx = RunContext(quiet=getattr(ctx, "quiet", True), executor=getattr(ctx, "executor", None),
-                         store=ChunkStore(tmp.name))
+        ctx = RunContext(
+            quiet=getattr(ctx, "quiet", True),
+            executor=getattr(ctx, "executor", None),
+            store=ChunkStore(tmp.name),
+        )
     try:
         while True:
             res = run_chunks(fn, N, seed, chunk, part=part, label=label, ctx=ctx)
@@ -40,7 +53,7 @@ def run_adaptive(fn, stat: Callable[[dict], Mapping[str, tuple[float, float]]], 
             worst = max((se / target for _, se in st.values()), default=0.0)
             if worst < 1.0 or N >= top:
                 return res, st
-            need = N * worst ** 2 * 1.05 if np.isfinite(worst) else 2 * N
+            need = N * worst**2 * 1.05 if np.isfinite(worst) else 2 * N
             N = min(top, max(N + chunk, math.ceil(need / chunk) * chunk))
     finally:
         if tmp is not None:

@@ -7,16 +7,26 @@ range sigma ``sqrt(setting^2 / settings + comparator^2)`` (um); its cost the pap
 time (min); it is *feasible* when every range fits on the scale plus the micrometer, the points
 lie on the format and the pivot stays outside the plate in every position.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ... import datum as dm, positions as po
-from ...plate import grid_points
-from ...sweep import expand
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import positions as po
+from sim.lsq import datum as dm
+from sim.mc.sweep import expand
 
-__all__ = ["time_model", "measuring_time", "range_sigma", "geometry_eval", "design_cells",
-           "pareto_front", "within_front", "plate_setup"]
+__all__ = [
+    "time_model",
+    "measuring_time",
+    "range_sigma",
+    "geometry_eval",
+    "design_cells",
+    "pareto_front",
+    "within_front",
+    "plate_setup",
+]
 
 
 def time_model(cfg: dict):
@@ -32,25 +42,29 @@ def measuring_time(cfg, P, n, L):
 
 
 def range_sigma(s_set, L, s_comp):
-    return np.sqrt(np.asarray(s_set) ** 2 / np.asarray(L) + s_comp ** 2)
+    return np.sqrt(np.asarray(s_set) ** 2 / np.asarray(L) + s_comp**2)
 
 
 def geometry_eval(cfg: dict, P: int, k: int, ext: float, offsets, betas) -> dict:
     """Analytic cofactor sigmas (datum-free: inner constraints over the points) and the
     feasibility of one point grid for all offsets x betas (batched as the trial axis)."""
     half = cfg["plate.format_mm"] / 2
-    O, B = (a.ravel() for a in np.meshgrid(np.asarray(offsets, float), np.asarray(betas, float),
-                                           indexing="ij"))
+    O, B = (
+        a.ravel()
+        for a in np.meshgrid(np.asarray(offsets, float), np.asarray(betas, float), indexing="ij")
+    )
     pts = grid_points(k, 2 * ext / (k - 1))
     G = len(O)
-    TH = np.stack([po.design_theta(P, half + o, cfg["comparator.alpha_mm"], b) for o, b in zip(O, B)])
+    TH = np.stack(
+        [po.design_theta(P, half + o, cfg["comparator.alpha_mm"], b) for o, b in zip(O, B)]
+    )
     Pb = np.broadcast_to(pts, (G,) + pts.shape).copy()
     S = dm.inner(pts)
     sig = {}
     for m in ("known", "pivot"):
         with np.errstate(invalid="ignore"):  # singular geometries give NaN (recorded as such)
             Fm = dm.s_transform(po.full_point_covariance(Pb, TH, m, "inner"), S)
-        sig[m] = np.sqrt((dm.point_sigmas(Fm) ** 2).mean(-1))          # (G, n) pooled
+        sig[m] = np.sqrt((dm.point_sigmas(Fm) ** 2).mean(-1))  # (G, n) pooled
     r = po.ranges(Pb, TH)
     rmax, rmin = r.max(axis=(1, 2)), r.min(axis=(1, 2))
     St = po.stations(TH)
@@ -73,18 +87,32 @@ def geometry_eval(cfg: dict, P: int, k: int, ext: float, offsets, betas) -> dict
         if not np.all(np.isfinite(sig["pivot"][g])):
             why.append("singular geometry")
         reasons.append("; ".join(why))
-    return {"offset_mm": O, "beta_mm": B, "n": k * k, "known_worst": sig["known"].max(1),
-            "known_mean": np.sqrt((sig["known"] ** 2).mean(1)), "pivot_worst": sig["pivot"].max(1),
-            "pivot_mean": np.sqrt((sig["pivot"] ** 2).mean(1)), "rmax_mm": rmax, "rmin_mm": rmin,
-            "reason": reasons, "dof": dof}
+    return {
+        "offset_mm": O,
+        "beta_mm": B,
+        "n": k * k,
+        "known_worst": sig["known"].max(1),
+        "known_mean": np.sqrt((sig["known"] ** 2).mean(1)),
+        "pivot_worst": sig["pivot"].max(1),
+        "pivot_mean": np.sqrt((sig["pivot"] ** 2).mean(1)),
+        "rmax_mm": rmax,
+        "rmin_mm": rmin,
+        "reason": reasons,
+        "dof": dof,
+    }
 
 
 def design_cells(cfg: dict) -> dict:
-    """One row per design cell (the grid of :func:`sim.sweep.expand`)."""
-    table = {"positions": cfg["design.positions"], "grid": cfg["design.grids"],
-             "extent_mm": cfg["design.extents_mm"], "offset_mm": cfg["design.offsets_mm"],
-             "beta_mm": cfg["design.beta_mm"], "settings": cfg["design.settings"],
-             "setting_sigma_um": cfg["design.setting_sigma_um"]}
+    """One row per design cell (the grid of :func:`sim.mc.sweep.expand`)."""
+    table = {
+        "positions": cfg["design.positions"],
+        "grid": cfg["design.grids"],
+        "extent_mm": cfg["design.extents_mm"],
+        "offset_mm": cfg["design.offsets_mm"],
+        "beta_mm": cfg["design.beta_mm"],
+        "settings": cfg["design.settings"],
+        "setting_sigma_um": cfg["design.setting_sigma_um"],
+    }
     keys, cells, _, _ = expand(table)
     geo = {}
     for P in cfg["design.positions"]:
@@ -92,16 +120,36 @@ def design_cells(cfg: dict) -> dict:
             for e in cfg["design.extents_mm"]:
                 g = geometry_eval(cfg, P, k, e, cfg["design.offsets_mm"], cfg["design.beta_mm"])
                 for i, (o, b) in enumerate(zip(g["offset_mm"], g["beta_mm"])):
-                    geo[(P, k, e, o, b)] = {kk: (v[i] if isinstance(v, (np.ndarray, list)) else v)
-                                            for kk, v in g.items()}
-    cols: dict[str, list] = {c: [] for c in keys + [
-        "n_points", "range_sigma_um", "worst_sigma_um", "mean_sigma_um", "known_worst_sigma_um",
-        "dilution_mean_pct", "time_min", "max_range_mm", "dof", "feasible", "reason",
-        "paper_design", "pareto"]}
+                    geo[(P, k, e, o, b)] = {
+                        kk: (v[i] if isinstance(v, (np.ndarray, list)) else v)
+                        for kk, v in g.items()
+                    }
+    cols: dict[str, list] = {
+        c: []
+        for c in keys
+        + [
+            "n_points",
+            "range_sigma_um",
+            "worst_sigma_um",
+            "mean_sigma_um",
+            "known_worst_sigma_um",
+            "dilution_mean_pct",
+            "time_min",
+            "max_range_mm",
+            "dof",
+            "feasible",
+            "reason",
+            "paper_design",
+            "pareto",
+        ]
+    }
     for cell in cells:
-        g = geo[(cell["positions"], cell["grid"], cell["extent_mm"], cell["offset_mm"],
-                 cell["beta_mm"])]
-        sr = float(range_sigma(cell["setting_sigma_um"], cell["settings"], cfg["comparator.sigma_um"]))
+        g = geo[
+            (cell["positions"], cell["grid"], cell["extent_mm"], cell["offset_mm"], cell["beta_mm"])
+        ]
+        sr = float(
+            range_sigma(cell["setting_sigma_um"], cell["settings"], cfg["comparator.sigma_um"])
+        )
         for kk in keys:
             cols[kk].append(cell[kk])
         n = cell["grid"] ** 2
@@ -116,23 +164,33 @@ def design_cells(cfg: dict) -> dict:
         cols["dof"].append(g["dof"])
         cols["feasible"].append(g["reason"] == "")
         cols["reason"].append(g["reason"])
-        cols["paper_design"].append(bool(
-            cell["positions"] == cfg["paper.positions"] and cell["grid"] == cfg["paper.grid"]
-            and np.isclose(cell["extent_mm"], cfg["paper.extent_mm"])
-            and np.isclose(cell["offset_mm"], cfg["paper.offset_mm"])
-            and np.isclose(cell["beta_mm"], cfg["paper.beta_mm"])
-            and cell["settings"] == cfg["paper.settings"]
-            and np.isclose(cell["setting_sigma_um"], cfg["paper.setting_sigma_um"])))
-    cols["pareto"] = list(pareto_front(np.array(cols["time_min"]), np.array(cols["worst_sigma_um"]),
-                                       np.array(cols["feasible"])))
+        cols["paper_design"].append(
+            bool(
+                cell["positions"] == cfg["paper.positions"]
+                and cell["grid"] == cfg["paper.grid"]
+                and np.isclose(cell["extent_mm"], cfg["paper.extent_mm"])
+                and np.isclose(cell["offset_mm"], cfg["paper.offset_mm"])
+                and np.isclose(cell["beta_mm"], cfg["paper.beta_mm"])
+                and cell["settings"] == cfg["paper.settings"]
+                and np.isclose(cell["setting_sigma_um"], cfg["paper.setting_sigma_um"])
+            )
+        )
+    cols["pareto"] = list(
+        pareto_front(
+            np.array(cols["time_min"]), np.array(cols["worst_sigma_um"]), np.array(cols["feasible"])
+        )
+    )
     return cols
 
 
 def pareto_front(cost: np.ndarray, acc: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """Feasible cells not dominated in (cost, acc), both to be minimised."""
     c, a = np.where(ok, cost, np.inf), np.where(ok, acc, np.inf)
-    dom = ((c[None, :] <= c[:, None]) & (a[None, :] <= a[:, None])
-           & ((c[None, :] < c[:, None]) | (a[None, :] < a[:, None])))
+    dom = (
+        (c[None, :] <= c[:, None])
+        & (a[None, :] <= a[:, None])
+        & ((c[None, :] < c[:, None]) | (a[None, :] < a[:, None]))
+    )
     return ok & ~dom.any(axis=1)
 
 

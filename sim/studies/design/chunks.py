@@ -3,21 +3,32 @@
 Every function here is module-level and takes plain arguments first, so
 ``functools.partial(fn, *args)`` pickles: the runner sends it to process-pool or Dask workers
 and stores each chunk for resumption. The last two arguments are always ``(rng, n)``: the
-chunk's generator (:func:`sim.runner.chunk_rng`) and its number of trials. The adjusting
-chunks keep freed memory in their process's heap (:func:`sim.heap.keep_heap`: fewer page
+chunk's generator (:func:`sim.mc.runner.chunk_rng`) and its number of trials. The adjusting
+chunks keep freed memory in their process's heap (:func:`sim.mc.heap.keep_heap`: fewer page
 faults for the solvers' temporaries, the same numbers). Units: ranges and coordinates in mm
 inside the solvers, errors in um in the outputs.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ... import bayes, budget, coverage as cv, datum as dm, multilateration as ml, positions as po
-from ... import distributions as D
-from ...heap import keep_heap
+from sim.instruments.ranges import bayes, budget
+from sim.instruments.ranges import coverage as cv
+from sim.instruments.ranges import multilateration as ml
+from sim.instruments.ranges import positions as po
+from sim.lsq import datum as dm
+from sim.lsq import distributions as D
+from sim.mc.heap import keep_heap
 
-__all__ = ["design_chunk", "budget_chunk", "coverage_chunk", "affine_chunk", "brown_chain_chunk",
-           "twoplate_chain_chunk"]
+__all__ = [
+    "design_chunk",
+    "budget_chunk",
+    "coverage_chunk",
+    "affine_chunk",
+    "brown_chain_chunk",
+    "twoplate_chain_chunk",
+]
 
 
 def _start(th: np.ndarray) -> np.ndarray:
@@ -39,7 +50,7 @@ def design_chunk(pts, th, sigma_um, rng, n):
 
 
 def budget_chunk(bcfg, pts, th, sources, setting_sigma, settings, rng, n):
-    """Ranges with the chosen error sources (:mod:`sim.budget`), pivot adjustment, mean square
+    """Ranges with the chosen error sources (:mod:`sim.instruments.ranges.budget`), pivot adjustment, mean square
     coordinate error after a rigid fit over all points (um^2), sigma0 (um).
 
     bcfg : plain dict with the ``budget.*`` amplitudes and ``comparator.sigma_um``.
@@ -54,18 +65,20 @@ def budget_chunk(bcfg, pts, th, sources, setting_sigma, settings, rng, n):
     if setting_sigma > 0:
         e += rng.normal(0.0, setting_sigma, r.shape + (settings,)).mean(-1)
     for s in sources:
-        e += (rng.normal(0.0, bcfg["comparator.sigma_um"], r.shape) if s == "comparator"
-              else budget.source_error(s, r, psi, rng, bcfg))
+        e += (
+            rng.normal(0.0, bcfg["comparator.sigma_um"], r.shape)
+            if s == "comparator"
+            else budget.source_error(s, r, psi, rng, bcfg)
+        )
     res = po.adjust(r + e * 1e-3, "pivot", _start(th), "inner")
     err = ((res.points - P) * 1e3).reshape(n, -1) @ S.T
     ok = res.status == 0
-    return {"ms_um2": np.where(ok, (err ** 2).mean(1), np.nan), "s0_um": res.sigma0 * 1e3,
-            "ok": ok}
+    return {"ms_um2": np.where(ok, (err**2).mean(1), np.nan), "s0_um": res.sigma0 * 1e3, "ok": ok}
 
 
 def coverage_chunk(pts, th, sigma_um, alpha_test, rng, T):
-    """Pivot model in Brown's datum (Brown's 7 globals, :mod:`sim.multilateration`: its
-    compiled kernel, the same adjustment as :mod:`sim.positions` in the ``brown`` datum):
+    """Pivot model in Brown's datum (Brown's 7 globals, :mod:`sim.instruments.ranges.multilateration`: its
+    compiled kernel, the same adjustment as :mod:`sim.instruments.ranges.positions` in the ``brown`` datum):
     per-point 95 % ellipse coverage (known sigma; s0 with F), the global chi-square test,
     sigma0 (um) and the b = beta^2 / beta intervals."""
     keep_heap()
@@ -84,16 +97,22 @@ def coverage_chunk(pts, th, sigma_um, alpha_test, rng, T):
         e = (res.points - Pt) * 1e3
         s0 = res.sigma0 * 1e3
         ink = cv.ellipse_inside(e, Qpp, sigma=sigma_um).mean(1)
-        inf_ = (cv.ellipse_inside(e, Qpp, s0=s0, dof=dof).mean(1) if dof > 0
-                else np.full(T, np.nan))
+        inf_ = cv.ellipse_inside(e, Qpp, s0=s0, dof=dof).mean(1) if dof > 0 else np.full(T, np.nan)
         sb = sigma_um * 1e-3 * np.sqrt(Qgg[:, -1, -1])
         b_in = np.abs(res.theta[:, -1] - th[6]) <= zq * sb
         bhat = np.sqrt(np.maximum(res.theta[:, -1], 0.0))
         sbeta = sb / (2 * np.maximum(bhat, 1e-300))
         beta_in = np.abs(bhat - np.sqrt(th[6])) <= zq * sbeta
         rej = cv.chi2_reject(s0, sigma_um, dof, alpha_test) if dof > 0 else np.zeros(T, bool)
-    return {"ok": res.status == 0, "cov_known": ink, "cov_f": inf_, "reject": rej, "s0_um": s0,
-            "b_in": b_in, "beta_in": beta_in}
+    return {
+        "ok": res.status == 0,
+        "cov_known": ink,
+        "cov_f": inf_,
+        "reject": rej,
+        "s0_um": s0,
+        "b_in": b_in,
+        "beta_in": beta_in,
+    }
 
 
 def affine_chunk(grid, sigma_um, aff, alpha_test, rng, n):
@@ -101,15 +120,19 @@ def affine_chunk(grid, sigma_um, aff, alpha_test, rng, n):
     :func:`coverage_chunk` (no b / beta)."""
     r = cv.affine_trials(rng, n, grid, sigma_um, aff)
     Q = np.broadcast_to(r["leverage"][:, None, None] * np.eye(2), (len(grid), 2, 2))
-    return {"cov_known": cv.ellipse_inside(r["err_um"], Q, sigma=sigma_um).mean(1),
-            "cov_f": cv.ellipse_inside(r["err_um"], Q, s0=r["s0_um"], dof=r["dof"]).mean(1),
-            "reject": cv.chi2_reject(r["s0_um"], sigma_um, r["dof"], alpha_test),
-            "s0_um": r["s0_um"], "ok": np.ones(n, bool), "b_in": np.full(n, np.nan),
-            "beta_in": np.full(n, np.nan)}
+    return {
+        "cov_known": cv.ellipse_inside(r["err_um"], Q, sigma=sigma_um).mean(1),
+        "cov_f": cv.ellipse_inside(r["err_um"], Q, s0=r["s0_um"], dof=r["dof"]).mean(1),
+        "reject": cv.chi2_reject(r["s0_um"], sigma_um, r["dof"], alpha_test),
+        "s0_um": r["s0_um"],
+        "ok": np.ones(n, bool),
+        "b_in": np.full(n, np.nan),
+        "beta_in": np.full(n, np.nan),
+    }
 
 
 def _emcee_seed(rng) -> np.random.SeedSequence:
-    return np.random.SeedSequence(int(rng.integers(0, 2 ** 63 - 1)))
+    return np.random.SeedSequence(int(rng.integers(0, 2**63 - 1)))
 
 
 def brown_chain_chunk(r_obs, sig_mm, theta_ls, Q, walkers, steps, rng, n):
@@ -123,8 +146,11 @@ def brown_chain_chunk(r_obs, sig_mm, theta_ls, Q, walkers, steps, rng, n):
     p0 = rng.multivariate_normal(theta_ls, Q, size=walkers)
     ch = bayes.run_emcee(bayes.brown_log_posterior(r_obs, sig_mm), p0, steps, _emcee_seed(rng))
     S = ch.samples.shape[0] // walkers
-    return {"samples": ch.samples.reshape(1, S, walkers, -1), "tau": ch.tau[None],
-            "acceptance": np.array([ch.acceptance])}
+    return {
+        "samples": ch.samples.reshape(1, S, walkers, -1),
+        "tau": ch.tau[None],
+        "acceptance": np.array([ch.acceptance]),
+    }
 
 
 def twoplate_chain_chunk(comp, grid, prior, x0, sd, walkers, steps, rng, n):
@@ -136,8 +162,11 @@ def twoplate_chain_chunk(comp, grid, prior, x0, sd, walkers, steps, rng, n):
     lp = bayes.twoplate_log_posterior(comp, grid, prior)
     ch = bayes.run_emcee(lp, p0, steps, _emcee_seed(rng))
     S = ch.samples.shape[0] // walkers
-    return {"samples": ch.samples[:, -2:].reshape(1, S, walkers, 2), "tau": ch.tau[None, -2:],
-            "acceptance": np.array([ch.acceptance])}
+    return {
+        "samples": ch.samples[:, -2:].reshape(1, S, walkers, 2),
+        "tau": ch.tau[None, -2:],
+        "acceptance": np.array([ch.acceptance]),
+    }
 
 
 def brown_lsq(pts, th, sig_mm, rng):
@@ -147,5 +176,5 @@ def brown_lsq(pts, th, sig_mm, rng):
     t0 = np.array(th, float)
     t0[5:] = 0.0
     ls = ml.adjust(r[None], "pivot", t0)
-    Q = ml.covariance(ls.points, ls.theta, "pivot")[1][0] * sig_mm ** 2
+    Q = ml.covariance(ls.points, ls.theta, "pivot")[1][0] * sig_mm**2
     return r, ls.theta[0], Q

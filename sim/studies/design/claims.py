@@ -1,7 +1,8 @@
 """Scoring of study ``brown_design``: what the simulation produced, per claim of the claim book
-``claims.toml`` (seed ``004``). The verdicts follow from :mod:`sim.claims`'s rules; nothing
+``claims.toml`` (seed ``004``). The verdicts follow from :mod:`sim.claims.book`'s rules; nothing
 here knows a paper number except through the book.
 """
+
 from __future__ import annotations
 
 import math
@@ -9,9 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ...claims import ClaimBook
-from ...intervals import spread
-from .errbudget import BUDGET_ROWS
+from sim.claims.book import ClaimBook
+from sim.studies.design.errbudget import BUDGET_ROWS
 
 __all__ = ["BOOK", "load_book", "EXTERNAL", "score_external", "score_all"]
 
@@ -32,31 +32,46 @@ def _central_half(x):
 EXTERNAL = {
     "brown.operation.lateral_offset_error_um": (
         lambda e: {"value": e["lateral_error_um"], "interval": "exact"},
-        lambda e: f"d^2 / (2 r_min) at the plate's shortest range r_min = {e['r_min_mm']:.1f} mm"),
+        lambda e: f"d^2 / (2 r_min) at the plate's shortest range r_min = {e['r_min_mm']:.1f} mm",
+    ),
     "brown.calibration.linearity_tolerance_um": (
         lambda e: {"value": e["linearity_tol_um"], "interval": "exact"},
-        lambda e: f"lateral offset d with d^2 / (2 r_min) = the accuracy, at r_min = "
-                  f"{e['r_min_mm']:.1f} mm"),
+        lambda e: (
+            f"lateral offset d with d^2 / (2 r_min) = the accuracy, at r_min = "
+            f"{e['r_min_mm']:.1f} mm"
+        ),
+    ),
     "brown.calibration.drum_graduation_um": (
         lambda e: {"value": e["drum_graduation_um"], "interval": "exact"},
-        lambda e: "the dividing error as a fraction of one turn of the screw (pitch not printed)"),
+        lambda e: "the dividing error as a fraction of one turn of the screw (pitch not printed)",
+    ),
     "brown.results.two_screw_agreement_um": (
         lambda e: _central_half(e["two_screw_rms"]),
-        lambda e: "sqrt(2) x one plate's rms (the paper's equal attribution), Table 1's plate "
-                  "and error model, linearised; the interval is the central half of the plates "
-                  "('usually')"),
+        lambda e: (
+            "sqrt(2) x one plate's rms (the paper's equal attribution), Table 1's plate "
+            "and error model, linearised; the interval is the central half of the plates "
+            "('usually')"
+        ),
+    ),
     "brown.results.accuracy_range_um": (
         lambda e: _central_half(e["table1_rms"]),
-        lambda e: "one plate's rms after translation and rotation, Table 1's plate and error "
-                  "model (double settings + random comparator error), linearised; central half "
-                  "of the plates ('generally')"),
+        lambda e: (
+            "one plate's rms after translation and rotation, Table 1's plate and error "
+            "model (double settings + random comparator error), linearised; central half "
+            "of the plates ('generally')"
+        ),
+    ),
     "brown.results.zeiss_discrepancy_um": (
         lambda e: {"samples": e["zeiss_rms"]},
-        lambda e: "33-point stand-in layout (1 cm intersections drawn from the seed), Table 1's "
-                  "error model plus the grid's stated error, linearised"),
+        lambda e: (
+            "33-point stand-in layout (1 cm intersections drawn from the seed), Table 1's "
+            "error model plus the grid's stated error, linearised"
+        ),
+    ),
     "brown.results.zeiss_comparator_um": (
         lambda e: {"samples": e["zeiss_comparator_rms"]},
-        lambda e: "the comparator's part of the Zeiss comparison alone (no grid error)"),
+        lambda e: "the comparator's part of the Zeiss comparison alone (no grid error)",
+    ),
 }
 
 
@@ -80,66 +95,160 @@ def score_all(book: ClaimBook, cfg: dict, R: dict) -> list[dict]:
     for cid in EXTERNAL:
         rows.append(score_external(book, cid, ext))
     t = ext
-    rows.append(_exact(book, "brown.calibration.axis_tilt_deg", t["axis_tilt_deg"],
-                       "atan(accuracy / gap) at the larger printed gap"))
-    rows.append(_exact(book, "brown.calibration.scale_combined_um", math.hypot(0.5, 0.2),
-                       "recomputed from the paper's 0.5 and 0.2 micron"))
-    rows.append(_exact(book, "brown.operation.measurements_per_point",
-                       cfg["paper.positions"] * 2, "positions x 2 settings"))
-    rows.append(_exact(book, "brown.operation.single_settings_min", R["time"][0],
-                       "the time model at 30 images, 4 positions, single settings"))
-    rows.append(_exact(book, "brown.operation.double_settings_min", R["time"][1],
-                       "the time model at 30 images, 4 positions, double settings"))
-    rows.append(book.score("brown.results.accuracy_range_recomputed", elems=(
-        np.array([2 / math.sqrt(2), 3 / math.sqrt(2)]),) * 2, interval="exact",
-        note="2 / sqrt(2) and 3 / sqrt(2) from the paper's 2-3 microns"))
-    rows.append(_exact(book, "brown.results.zeiss_comparator_recomputed",
-                       math.sqrt(1.5 ** 2 - 0.8 ** 2), "sqrt(1.5^2 - 0.8^2) from the paper's numbers"))
-    rows.append(_exact(book, "brown.results.comparator_contribution_recomputed",
-                       math.sqrt(1.6 ** 2 - 1.2 ** 2), "sqrt(1.6^2 - 1.2^2)"))
-    rows.append(_exact(book, "brown.results.mean_of_two_settings_recomputed",
-                       1.7 / math.sqrt(2), "1.7 / sqrt(2)"))
+    rows.append(
+        _exact(
+            book,
+            "brown.calibration.axis_tilt_deg",
+            t["axis_tilt_deg"],
+            "atan(accuracy / gap) at the larger printed gap",
+        )
+    )
+    rows.append(
+        _exact(
+            book,
+            "brown.calibration.scale_combined_um",
+            math.hypot(0.5, 0.2),
+            "recomputed from the paper's 0.5 and 0.2 micron",
+        )
+    )
+    rows.append(
+        _exact(
+            book,
+            "brown.operation.measurements_per_point",
+            cfg["paper.positions"] * 2,
+            "positions x 2 settings",
+        )
+    )
+    rows.append(
+        _exact(
+            book,
+            "brown.operation.single_settings_min",
+            R["time"][0],
+            "the time model at 30 images, 4 positions, single settings",
+        )
+    )
+    rows.append(
+        _exact(
+            book,
+            "brown.operation.double_settings_min",
+            R["time"][1],
+            "the time model at 30 images, 4 positions, double settings",
+        )
+    )
+    rows.append(
+        book.score(
+            "brown.results.accuracy_range_recomputed",
+            elems=(np.array([2 / math.sqrt(2), 3 / math.sqrt(2)]),) * 2,
+            interval="exact",
+            note="2 / sqrt(2) and 3 / sqrt(2) from the paper's 2-3 microns",
+        )
+    )
+    rows.append(
+        _exact(
+            book,
+            "brown.results.zeiss_comparator_recomputed",
+            math.sqrt(1.5**2 - 0.8**2),
+            "sqrt(1.5^2 - 0.8^2) from the paper's numbers",
+        )
+    )
+    rows.append(
+        _exact(
+            book,
+            "brown.results.comparator_contribution_recomputed",
+            math.sqrt(1.6**2 - 1.2**2),
+            "sqrt(1.6^2 - 1.2^2)",
+        )
+    )
+    rows.append(
+        _exact(
+            book,
+            "brown.results.mean_of_two_settings_recomputed",
+            1.7 / math.sqrt(2),
+            "1.7 / sqrt(2)",
+        )
+    )
     # error budget
     b = R["budget"]
     B = {s: (r, se, n) for s, r, se, n in zip(b["source"], b["rms_um"], b["se_um"], b["trials"])}
     desc = {n: d for n, _, _, d in BUDGET_ROWS}
-    for name in ("scale", "scale_spec", "screw", "drum_periodic", "wobble_3kg", "wobble_3kg_h1",
-                 "sphericity"):
+    for name in (
+        "scale",
+        "scale_spec",
+        "screw",
+        "drum_periodic",
+        "wobble_3kg",
+        "wobble_3kg_h1",
+        "sphericity",
+    ):
         r, se, n = B[name]
-        rows.append(book.score(f"brown.budget.{name}_um", r, (r - 1.96 * se, r + 1.96 * se),
-                               note=f"rms coordinate error after a rigid fit, this source alone "
-                               f"({desc[name]}); {n} trials (adaptive) to a standard error of "
-                               f"{se:.4f} um; setting error alone: {B['setting'][0]:.3f} um"))
+        rows.append(
+            book.score(
+                f"brown.budget.{name}_um",
+                r,
+                (r - 1.96 * se, r + 1.96 * se),
+                note=f"rms coordinate error after a rigid fit, this source alone "
+                f"({desc[name]}); {n} trials (adaptive) to a standard error of "
+                f"{se:.4f} um; setting error alone: {B['setting'][0]:.3f} um",
+            )
+        )
     r, se, n = B["table1_model"]
     lin = float(np.sqrt(np.mean(ext["table1_rms"] ** 2)))
-    rows.append(book.score("brown.budget.table1_model_mc_vs_linear", r / lin,
-                           ((r - 1.96 * se) / lin, (r + 1.96 * se) / lin),
-                           note=f"rms of the Monte Carlo (Table 1's model, pivot solver) over "
-                           f"the linearised plate model's {lin:.3f} um"))
+    rows.append(
+        book.score(
+            "brown.budget.table1_model_mc_vs_linear",
+            r / lin,
+            ((r - 1.96 * se) / lin, (r + 1.96 * se) / lin),
+            note=f"rms of the Monte Carlo (Table 1's model, pivot solver) over "
+            f"the linearised plate model's {lin:.3f} um",
+        )
+    )
     prod = R["budget_sims"]["production"]
-    rows.append(book.score("brown.budget.closure_named_elements_um",
-                           samples=prod["s0_um"][prod["ok"]],
-                           note="sigma0 of the pivot adjustment with the settings and the "
-                           "calibrated scale and screw only (no other comparator error)"))
+    rows.append(
+        book.score(
+            "brown.budget.closure_named_elements_um",
+            samples=prod["s0_um"][prod["ok"]],
+            note="sigma0 of the pivot adjustment with the settings and the "
+            "calibrated scale and screw only (no other comparator error)",
+        )
+    )
     # design
     D = R["design"]
-    for cid in ("brown.design.paper_on_pareto_front", "brown.design.paper_on_front_same_setting_sigma",
-                "brown.design.paper_on_front_same_points", "brown.design.paper_worst_sigma_um",
-                "brown.design.max_offset_paper_grid_mm", "brown.design.max_offset_dilution_grid_mm"):
+    for cid in (
+        "brown.design.paper_on_pareto_front",
+        "brown.design.paper_on_front_same_setting_sigma",
+        "brown.design.paper_on_front_same_points",
+        "brown.design.paper_worst_sigma_um",
+        "brown.design.max_offset_paper_grid_mm",
+        "brown.design.max_offset_dilution_grid_mm",
+    ):
         v, note = D[cid]
         rows.append(_exact(book, cid, v, note))
     v, ci, note = R["mc_ratio"]
     rows.append(book.score("brown.design.mc_agreement.pooled_ratio", v, ci, note=note))
     # datum
     dr = R["datum"]
-    ideal = "" if dr["feasible"] else (f" Idealised: the longest range, {dr['max_range_mm']:.1f} "
-                                       "mm, does not fit the scale plus micrometer.")
+    ideal = (
+        ""
+        if dr["feasible"]
+        else (
+            f" Idealised: the longest range, {dr['max_range_mm']:.1f} "
+            "mm, does not fit the scale plus micrometer."
+        )
+    )
     for m in ("stations", "pivot"):
         for dn, lab in (("brown", "brown"), ("inner", "invariant"), ("corners", "corners")):
             lo, hi = dr[(m, dn)]
-            rows.append(book.score(f"brown.datum.{lab}.{m}_pct", lo, (lo, lo), "exact",
-                                   value_high=hi, note=f"per-point dilution {lo:.1f} to {hi:.1f} % "
-                                   f"(analytic); {dr['geometry']}.{ideal}"))
+            rows.append(
+                book.score(
+                    f"brown.datum.{lab}.{m}_pct",
+                    lo,
+                    (lo, lo),
+                    "exact",
+                    value_high=hi,
+                    note=f"per-point dilution {lo:.1f} to {hi:.1f} % "
+                    f"(analytic); {dr['geometry']}.{ideal}",
+                )
+            )
     # coverage
     c = R["coverage"]
     model, scen = np.array(c["model"]), np.array(c["scenario"])
@@ -149,44 +258,77 @@ def score_all(book: ClaimBook, cfg: dict, R: dict) -> list[dict]:
         for key in ("coverage_known", "coverage_f", "false_alarm"):
             v = c[key][i]
             se = math.sqrt(max(v * (1 - v), 1e-12) / N)  # per-trial averages: conservative
-            rows.append(book.score(f"coverage.{m}.{key}", v, (v - 1.96 * se, v + 1.96 * se),
-                                   note=f"empirical rate over {N} trials x {c['grid'][i] ** 2} "
-                                   f"points; binomial interval over trials"))
+            rows.append(
+                book.score(
+                    f"coverage.{m}.{key}",
+                    v,
+                    (v - 1.96 * se, v + 1.96 * se),
+                    note=f"empirical rate over {N} trials x {c['grid'][i] ** 2} "
+                    f"points; binomial interval over trials",
+                )
+            )
         v = c["s0_ratio"][i] / c["s0_expected"][i]
         se = c["s0_ratio_se"][i] / c["s0_expected"][i]
-        rows.append(book.score(f"coverage.{m}.sigma0_over_c4", v, (v - 1.96 * se, v + 1.96 * se),
-                               note=f"E[s0] / sigma = {c['s0_ratio'][i]:.4f} on {c['dof'][i]} "
-                               f"degrees of freedom, c4 = {c['s0_expected'][i]:.4f}; E[s0^2] / "
-                               f"sigma^2 = {c['s0sq_ratio'][i]:.4f}"))
+        rows.append(
+            book.score(
+                f"coverage.{m}.sigma0_over_c4",
+                v,
+                (v - 1.96 * se, v + 1.96 * se),
+                note=f"E[s0] / sigma = {c['s0_ratio'][i]:.4f} on {c['dof'][i]} "
+                f"degrees of freedom, c4 = {c['s0_expected'][i]:.4f}; E[s0^2] / "
+                f"sigma^2 = {c['s0sq_ratio'][i]:.4f}",
+            )
+        )
     # emcee
     by = R["bayes"]
     for nm, (v, se, tau, neff) in by["ratio"].items():
         short = nm.rsplit("_", 1)[0]
-        rows.append(book.score(f"bayes.brown_agreement.{short}", float(v),
-                               (float(v - 1.96 * se), float(v + 1.96 * se)),
-                               note=f"posterior / least-squares sigma, one plate; {by['chains']} "
-                               f"chains x {by['steps']} steps x {by['walkers']} walkers; tau = "
-                               f"{tau:.0f} steps, N_eff = {neff:.0f}; interval +-1.96 MC s.e."))
+        rows.append(
+            book.score(
+                f"bayes.brown_agreement.{short}",
+                float(v),
+                (float(v - 1.96 * se), float(v + 1.96 * se)),
+                note=f"posterior / least-squares sigma, one plate; {by['chains']} "
+                f"chains x {by['steps']} steps x {by['walkers']} walkers; tau = "
+                f"{tau:.0f} steps, N_eff = {neff:.0f}; interval +-1.96 MC s.e.",
+            )
+        )
     v, se, a, bb = by["max_corr_diff"]
-    rows.append(book.score("bayes.brown_agreement.max_corr_diff", v, (v - 1.96 * se, v + 1.96 * se),
-                           note=f"largest at ({a}, {bb}); interval +-1.96 MC s.e. of that "
-                           "correlation"))
+    rows.append(
+        book.score(
+            "bayes.brown_agreement.max_corr_diff",
+            v,
+            (v - 1.96 * se, v + 1.96 * se),
+            note=f"largest at ({a}, {bb}); interval +-1.96 MC s.e. of that correlation",
+        )
+    )
     tp = R.get("twoplate")
     if tp is not None:
         j = tp["prior"].index("certificate")
-        rows.append(book.score("bayes.twoplate_ratio", tp["rho_median"][j],
-                               (tp["rho_q025"][j], tp["rho_q975"][j]), "spread",
-                               note=f"posterior median and 95 % interval of sigma_c^2 / "
-                               f"sigma_g^2 with the certificate prior on sigma_g; re-weighting "
-                               f"{tp['rw_ratio_mean'][j]:.2f}, truth {tp['true_ratio'][j]:.2f}"))
+        rows.append(
+            book.score(
+                "bayes.twoplate_ratio",
+                tp["rho_median"][j],
+                (tp["rho_q025"][j], tp["rho_q975"][j]),
+                "spread",
+                note=f"posterior median and 95 % interval of sigma_c^2 / "
+                f"sigma_g^2 with the certificate prior on sigma_g; re-weighting "
+                f"{tp['rw_ratio_mean'][j]:.2f}, truth {tp['true_ratio'][j]:.2f}",
+            )
+        )
         f = tp["prior"].index("flat")
         w, se = tp["log10_width"][f], tp["log10_width_se"][f]
-        rows.append(book.score("bayes.twoplate_ratio.flat_prior_decades", w,
-                               (w - 1.96 * se, w + 1.96 * se),
-                               note="width (decades) of the 95 % posterior interval of the ratio "
-                               "with log-uniform priors on both sigmas: the misclosures fix only "
-                               "sigma_c^2 + (A^2 + B^2) sigma_g^2; interval +-1.96 MC s.e. of the "
-                               "quantiles (N_eff from tau)"))
+        rows.append(
+            book.score(
+                "bayes.twoplate_ratio.flat_prior_decades",
+                w,
+                (w - 1.96 * se, w + 1.96 * se),
+                note="width (decades) of the 95 % posterior interval of the ratio "
+                "with log-uniform priors on both sigmas: the misclosures fix only "
+                "sigma_c^2 + (A^2 + B^2) sigma_g^2; interval +-1.96 MC s.e. of the "
+                "quantiles (N_eff from tau)",
+            )
+        )
     else:
         for cid in ("bayes.twoplate_ratio", "bayes.twoplate_ratio.flat_prior_decades"):
             book._scored.add(cid)

@@ -9,26 +9,33 @@ with the simulated plates but too spread to "hold"). The pass time and
 the screw pitch enter no printed claim but the drum's; the offset, beta and the Zeiss layout
 enter the tolerances and the external comparisons.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from .cells import measuring_time, pareto_front
-from .claims import EXTERNAL, verdict_of
-from .external import external_at
+from sim.studies.design.cells import measuring_time, pareto_front
+from sim.studies.design.claims import verdict_of
+from sim.studies.design.external import external_at
 
 __all__ = ["sweep_unprinted", "INPUTS"]
 
 #: unprinted input -> (config key of its swept values, claims that depend on it)
-_OFFSET_CLAIMS = ("brown.operation.lateral_offset_error_um",
-                  "brown.calibration.linearity_tolerance_um",
-                  "brown.results.two_screw_agreement_um", "brown.results.accuracy_range_um",
-                  "brown.results.zeiss_discrepancy_um", "brown.results.zeiss_comparator_um")
+_OFFSET_CLAIMS = (
+    "brown.operation.lateral_offset_error_um",
+    "brown.calibration.linearity_tolerance_um",
+    "brown.results.two_screw_agreement_um",
+    "brown.results.accuracy_range_um",
+    "brown.results.zeiss_discrepancy_um",
+    "brown.results.zeiss_comparator_um",
+)
 INPUTS = {
     "paper.offset_mm": ("unprinted.offsets_mm", _OFFSET_CLAIMS),
     "paper.beta_mm": ("unprinted.betas_mm", _OFFSET_CLAIMS),
-    "zeiss.half_extent_mm": ("unprinted.zeiss_extents_mm", ("brown.results.zeiss_discrepancy_um",
-                                                        "brown.results.zeiss_comparator_um")),
+    "zeiss.half_extent_mm": (
+        "unprinted.zeiss_extents_mm",
+        ("brown.results.zeiss_discrepancy_um", "brown.results.zeiss_comparator_um"),
+    ),
     "budget.pitch_mm": ("unprinted.pitches_mm", ("brown.calibration.drum_graduation_um",)),
     "time.pass_min": ("unprinted.pass_min", ("brown.design.paper_on_front_same_points",)),
 }
@@ -37,26 +44,57 @@ _ZEISS = ("brown.results.zeiss_discrepancy_um", "brown.results.zeiss_comparator_
 
 def _front_same_points(cfg, cols, pass_min):
     c = dict(cfg, **{"time.pass_min": pass_min})
-    cost = measuring_time(c, np.array(cols["positions"]), np.array(cols["n_points"]),
-                          np.array(cols["settings"]))
+    cost = measuring_time(
+        c, np.array(cols["positions"]), np.array(cols["n_points"]), np.array(cols["settings"])
+    )
     jp = int(np.flatnonzero(cols["paper_design"])[0])
-    sel = (np.array(cols["feasible"])
-           & np.isclose(np.array(cols["setting_sigma_um"]), cols["setting_sigma_um"][jp])
-           & (np.array(cols["n_points"]) == cols["n_points"][jp])
-           & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp]))
+    sel = (
+        np.array(cols["feasible"])
+        & np.isclose(np.array(cols["setting_sigma_um"]), cols["setting_sigma_um"][jp])
+        & (np.array(cols["n_points"]) == cols["n_points"][jp])
+        & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp])
+    )
     return bool(pareto_front(cost, np.array(cols["worst_sigma_um"]), sel)[jp])
 
 
 def sweep_unprinted(cfg: dict, book, design_cols: dict) -> tuple[dict, dict]:
     """Returns ``(consistent_set columns, per-value columns)``."""
-    base = {"paper.offset_mm": cfg["paper.offset_mm"], "paper.beta_mm": cfg["paper.beta_mm"],
-            "zeiss.half_extent_mm": cfg["zeiss.half_extent_mm"],
-            "budget.pitch_mm": cfg["budget.pitch_mm"]}
-    vals = {c: [] for c in ("input", "value", "claim", "sim_value", "sim_low", "sim_high",
-                            "zone_low", "zone_high", "verdict", "feasible")}
-    cs = {c: [] for c in ("input", "claim", "holds_low", "holds_high", "n_holds",
-                          "compatible_low", "compatible_high", "n_compatible", "n_values",
-                          "note")}
+    base = {
+        "paper.offset_mm": cfg["paper.offset_mm"],
+        "paper.beta_mm": cfg["paper.beta_mm"],
+        "zeiss.half_extent_mm": cfg["zeiss.half_extent_mm"],
+        "budget.pitch_mm": cfg["budget.pitch_mm"],
+    }
+    vals = {
+        c: []
+        for c in (
+            "input",
+            "value",
+            "claim",
+            "sim_value",
+            "sim_low",
+            "sim_high",
+            "zone_low",
+            "zone_high",
+            "verdict",
+            "feasible",
+        )
+    }
+    cs = {
+        c: []
+        for c in (
+            "input",
+            "claim",
+            "holds_low",
+            "holds_high",
+            "n_holds",
+            "compatible_low",
+            "compatible_high",
+            "n_compatible",
+            "n_values",
+            "note",
+        )
+    }
     for inp, (key, claims) in INPUTS.items():
         xs = [float(x) for x in cfg[key]]
         holds = {c: [] for c in claims}
@@ -64,23 +102,52 @@ def sweep_unprinted(cfg: dict, book, design_cols: dict) -> tuple[dict, dict]:
         for x in xs:
             if inp == "time.pass_min":
                 on = _front_same_points(cfg, design_cols, x)
-                for c, v in zip(vals, (inp, x, claims[0], float(on), float(on), float(on),
-                                       np.nan, np.nan, "finding", True)):
+                for c, v in zip(
+                    vals,
+                    (
+                        inp,
+                        x,
+                        claims[0],
+                        float(on),
+                        float(on),
+                        float(on),
+                        np.nan,
+                        np.nan,
+                        "finding",
+                        True,
+                    ),
+                ):
                     vals[c].append(v)
                 holds[claims[0]].append(on)
                 compat[claims[0]].append(on)
                 continue
             p = dict(base, **{inp: x})
-            e = external_at(cfg, p["paper.offset_mm"], p["paper.beta_mm"],
-                            p["zeiss.half_extent_mm"], p["budget.pitch_mm"],
-                            plates=inp != "budget.pitch_mm")
+            e = external_at(
+                cfg,
+                p["paper.offset_mm"],
+                p["paper.beta_mm"],
+                p["zeiss.half_extent_mm"],
+                p["budget.pitch_mm"],
+                plates=inp != "budget.pitch_mm",
+            )
             for cid in claims:
                 ok = e["feasible"] and (e["zeiss_feasible"] if cid in _ZEISS else True)
                 row = verdict_of(book, cid, e)
-                for c, v in zip(vals, (inp, x, cid, row["value"], row["ci_low"], row["ci_high"],
-                                       _finite_or_nan(row["zone_low"]),
-                                       _finite_or_nan(row["zone_high"]),
-                                       row["verdict"] if ok else "infeasible", bool(ok))):
+                for c, v in zip(
+                    vals,
+                    (
+                        inp,
+                        x,
+                        cid,
+                        row["value"],
+                        row["ci_low"],
+                        row["ci_high"],
+                        _finite_or_nan(row["zone_low"]),
+                        _finite_or_nan(row["zone_high"]),
+                        row["verdict"] if ok else "infeasible",
+                        bool(ok),
+                    ),
+                ):
                     vals[c].append(v)
                 holds[cid].append(ok and row["verdict"] == "holds")
                 compat[cid].append(ok and row["verdict"] in ("holds", "inconclusive"))
@@ -92,7 +159,9 @@ def sweep_unprinted(cfg: dict, book, design_cols: dict) -> tuple[dict, dict]:
             if cid in printed:
                 allh &= h
                 allc &= cp
-            _append(cs, inp, cid, xs, h, cp, "" if cid in printed else "a finding (no paper number)")
+            _append(
+                cs, inp, cid, xs, h, cp, "" if cid in printed else "a finding (no paper number)"
+            )
         note = "" if printed else "no printed claim depends on this input"
         if printed and not allc.any():
             fail = [c for c in printed if not all(compat[c])]
@@ -117,6 +186,8 @@ def _append(cs, inp, cid, xs, h, cp, note):
     cs["compatible_high"].append(float(xc.max()) if len(xc) else np.nan)
     cs["n_compatible"].append(int(cp.sum()))
     cs["n_values"].append(len(xs))
-    contiguous = len(x) == 0 or np.all(h[np.flatnonzero(h)[0]:np.flatnonzero(h)[-1] + 1])
-    cs["note"].append(note or ("" if contiguous else "holds at the values in the range only in "
-                               "part (not contiguous)"))
+    contiguous = len(x) == 0 or np.all(h[np.flatnonzero(h)[0] : np.flatnonzero(h)[-1] + 1])
+    cs["note"].append(
+        note
+        or ("" if contiguous else "holds at the values in the range only in part (not contiguous)")
+    )

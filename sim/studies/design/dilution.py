@@ -7,12 +7,14 @@ does not lean on the stations) and to a similarity onto the four corner points; 
 compared datum by datum. The geometry is brown_dilution's; it is flagged ``feasible = False``
 (idealised) when its ranges do not fit on the scale plus the micrometer.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ... import datum as dm, positions as po
-from ...plate import grid_points
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import positions as po
+from sim.lsq import datum as dm
 
 __all__ = ["datum_analysis", "DATUMS"]
 
@@ -31,15 +33,30 @@ def datum_analysis(cfg: dict) -> tuple[dict, dict]:
     rmax = float(po.ranges(pts[None], th[None]).max())
     feasible = rmax <= cfg["scale.graduated_mm"] + cfg["scale.micrometer_mm"]
     corners = dm.corner_indices(pts)
-    Ss = {"brown": np.eye(2 * n), "inner": dm.inner(pts),
-          "corners": dm.similarity_onto(pts, corners)}
+    Ss = {
+        "brown": np.eye(2 * n),
+        "inner": dm.inner(pts),
+        "corners": dm.similarity_onto(pts, corners),
+    }
     pooled = {}
     for m in ("known", "stations", "pivot"):
         Fm = po.full_point_covariance(pts[None], th[None], m, "brown")[0]
         for dn, S in Ss.items():
             pooled[(m, dn)] = np.sqrt((dm.point_sigmas(S @ Fm @ S.T) ** 2).mean(-1))
-    cols = {c: [] for c in ("model", "datum", "point", "x_mm", "y_mm", "pooled", "dilution_pct",
-                            "corner", "feasible")}
+    cols = {
+        c: []
+        for c in (
+            "model",
+            "datum",
+            "point",
+            "x_mm",
+            "y_mm",
+            "pooled",
+            "dilution_pct",
+            "corner",
+            "feasible",
+        )
+    }
     ranges = {"feasible": feasible, "max_range_mm": rmax}
     nc = ~np.isin(np.arange(n), corners)
     for m in ("known", "stations", "pivot"):

@@ -1,18 +1,19 @@
 """The comparator's error budget (seed ``004``, *Calibration*): each error source of
-:mod:`sim.budget` alone, and in combinations, on the Table-1 plate of the paper's design
+:mod:`sim.instruments.ranges.budget` alone, and in combinations, on the Table-1 plate of the paper's design
 (pivot model), as the rms coordinate error after a rigid fit over all points (um) and the
 closure sigma0 (um). Trial counts are adaptive (:mod:`.adaptive`, through the runner); the
 rows run side by side (:mod:`.parts`).
 """
+
 from __future__ import annotations
 
 from functools import partial
 
 import numpy as np
 
-from .adaptive import run_adaptive
-from .chunks import budget_chunk
-from .parts import side_by_side
+from sim.studies.design.adaptive import run_adaptive
+from sim.studies.design.chunks import budget_chunk
+from sim.studies.design.parts import side_by_side
 
 __all__ = ["BUDGET_ROWS", "budget_analysis", "rms_stat", "PART0"]
 
@@ -46,18 +47,40 @@ def budget_analysis(cfg: dict, pts: np.ndarray, th: np.ndarray, ctx) -> tuple[di
     """Returns the budget table and the per-trial results of each row."""
     bcfg = {k: v for k, v in cfg.items() if k.startswith("budget.")}
     bcfg["comparator.sigma_um"] = cfg["comparator.sigma_um"]
-    cols = {k: [] for k in ("source", "description", "rms_um", "se_um", "trials", "s0_um",
-                            "settings")}
-    def row(i, srcs, sett, name):
-        fn = partial(budget_chunk, bcfg, pts, th, srcs,
-                     cfg["paper.setting_sigma_um"] if sett else 0.0, cfg["paper.settings"])
-        return run_adaptive(fn, rms_stat, cfg["budget.target_se_um"], cfg["seed"],
-                            cfg["chunk"], part=PART0 + i, min_trials=2 * cfg["chunk"],
-                            max_trials=cfg["budget.max_trials"], label=f"budget {name}",
-                            ctx=ctx)
+    cols = {
+        k: [] for k in ("source", "description", "rms_um", "se_um", "trials", "s0_um", "settings")
+    }
 
-    done = side_by_side({name: partial(row, i, srcs, sett, name)
-                         for i, (name, srcs, sett, _) in enumerate(BUDGET_ROWS)}, ctx)
+    def row(i, srcs, sett, name):
+        fn = partial(
+            budget_chunk,
+            bcfg,
+            pts,
+            th,
+            srcs,
+            cfg["paper.setting_sigma_um"] if sett else 0.0,
+            cfg["paper.settings"],
+        )
+        return run_adaptive(
+            fn,
+            rms_stat,
+            cfg["budget.target_se_um"],
+            cfg["seed"],
+            cfg["chunk"],
+            part=PART0 + i,
+            min_trials=2 * cfg["chunk"],
+            max_trials=cfg["budget.max_trials"],
+            label=f"budget {name}",
+            ctx=ctx,
+        )
+
+    done = side_by_side(
+        {
+            name: partial(row, i, srcs, sett, name)
+            for i, (name, srcs, sett, _) in enumerate(BUDGET_ROWS)
+        },
+        ctx,
+    )
     sims = {}
     for name, srcs, sett, desc in BUDGET_ROWS:
         res, st = done[name]
@@ -68,7 +91,8 @@ def budget_analysis(cfg: dict, pts: np.ndarray, th: np.ndarray, ctx) -> tuple[di
         cols["rms_um"].append(st["rms"][0])
         cols["se_um"].append(st["rms"][1])
         cols["trials"].append(len(ok))
-        cols["s0_um"].append(float(np.sqrt(np.mean(res["s0_um"][ok] ** 2))) if ok.any()
-                             else float("nan"))
+        cols["s0_um"].append(
+            float(np.sqrt(np.mean(res["s0_um"][ok] ** 2))) if ok.any() else float("nan")
+        )
         cols["settings"].append(bool(sett))
     return cols, sims

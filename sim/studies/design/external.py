@@ -12,7 +12,7 @@ calibrated points):
   by ``g tan t``; a drum graduation error of ``a`` arc seconds is ``a / 1296000`` of the pitch.
 * one plate's rms coordinate error after a translation and rotation (the paper's external
   comparisons): Gaussian plates ``N(0, S F S^T sigma^2)`` with ``F`` the pivot model's
-  cofactor (:func:`sim.positions.full_point_covariance`), ``S`` the rigid-fit projector and
+  cofactor (:func:`sim.instruments.ranges.positions.full_point_covariance`), ``S`` the rigid-fit projector and
   ``sigma`` the range sigma (Table 1's model: double settings of 1.7 um and 1.1 um of random
   comparator error); the Zeiss comparison adds the grid's 0.8 um per coordinate. The plates
   are drawn along the eigenvectors of ``S F S^T``, which within a (nearly) repeated
@@ -20,16 +20,24 @@ calibrated points):
   plate (the same distribution, another sample), so ``F`` comes from the dense reference
   route of the engine, bit for bit as before.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ... import datum as dm, positions as po
-from ...plate import grid_points
-from ...runner import chunk_rng
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import positions as po
+from sim.lsq import datum as dm
+from sim.mc.runner import chunk_rng
 
-__all__ = ["shortest_range_mm", "tolerances", "plate_rms", "zeiss_points", "external_at",
-           "paper_points"]
+__all__ = [
+    "shortest_range_mm",
+    "tolerances",
+    "plate_rms",
+    "zeiss_points",
+    "external_at",
+    "paper_points",
+]
 
 
 def paper_points(cfg: dict) -> np.ndarray:
@@ -37,8 +45,12 @@ def paper_points(cfg: dict) -> np.ndarray:
 
 
 def _theta(cfg, offset, beta, P=None):
-    return po.design_theta(P or cfg["paper.positions"], cfg["plate.format_mm"] / 2 + offset,
-                           cfg["comparator.alpha_mm"], beta)
+    return po.design_theta(
+        P or cfg["paper.positions"],
+        cfg["plate.format_mm"] / 2 + offset,
+        cfg["comparator.alpha_mm"],
+        beta,
+    )
 
 
 def shortest_range_mm(cfg: dict, pts: np.ndarray, offset: float, beta: float) -> float:
@@ -54,12 +66,14 @@ def tolerances(cfg: dict, r_min_mm: float, pitch_mm: float) -> dict:
     tolerance (um), axis tilt tolerance (degrees), drum graduation error (um)."""
     d = cfg["operation.lateral_offset_um"] * 1e-3
     acc = cfg["calibration.accuracy_um"] * 1e-3
-    return {"lateral_error_um": d ** 2 / (2 * r_min_mm) * 1e3,
-            "linearity_tol_um": np.sqrt(2 * r_min_mm * acc) * 1e3,
-            "axis_tilt_deg": float(np.degrees(np.arctan(cfg["calibration.accuracy_um"]
-                                                        / cfg["operation.gap_um"]))),
-            "drum_graduation_um": cfg["calibration.drum_dividing_arcsec"] / 1296000.0
-            * pitch_mm * 1e3}
+    return {
+        "lateral_error_um": d**2 / (2 * r_min_mm) * 1e3,
+        "linearity_tol_um": np.sqrt(2 * r_min_mm * acc) * 1e3,
+        "axis_tilt_deg": float(
+            np.degrees(np.arctan(cfg["calibration.accuracy_um"] / cfg["operation.gap_um"]))
+        ),
+        "drum_graduation_um": cfg["calibration.drum_dividing_arcsec"] / 1296000.0 * pitch_mm * 1e3,
+    }
 
 
 def zeiss_points(cfg: dict, half_extent_mm: float) -> np.ndarray:
@@ -70,17 +84,22 @@ def zeiss_points(cfg: dict, half_extent_mm: float) -> np.ndarray:
     ax = np.arange(-m, m + 1) * 10.0
     lat = np.stack(np.meshgrid(ax, ax, indexing="ij"), -1).reshape(-1, 2)
     order = chunk_rng(cfg["seed"], 90, 0).permutation(len(lat))
-    return lat[np.sort(order[:cfg["zeiss.points"]])]
+    return lat[np.sort(order[: cfg["zeiss.points"]])]
 
 
 def range_sigma_um(cfg: dict) -> float:
     """Table 1's model: the mean of the paper's settings plus the random comparator error."""
-    return float(np.sqrt(cfg["paper.setting_sigma_um"] ** 2 / cfg["paper.settings"]
-                         + cfg["comparator.sigma_um"] ** 2))
+    return float(
+        np.sqrt(
+            cfg["paper.setting_sigma_um"] ** 2 / cfg["paper.settings"]
+            + cfg["comparator.sigma_um"] ** 2
+        )
+    )
 
 
-def plate_rms(cfg: dict, pts: np.ndarray, offset: float, beta: float, sr_um: float,
-              extra_um: float, part: int) -> tuple[np.ndarray, np.ndarray]:
+def plate_rms(
+    cfg: dict, pts: np.ndarray, offset: float, beta: float, sr_um: float, extra_um: float, part: int
+) -> tuple[np.ndarray, np.ndarray]:
     """rms coordinate error (um) of ``unprinted.plates`` Gaussian plates after a rigid fit over
     all points: without and with ``extra_um`` of independent per-coordinate error (a reference
     grid's) added before the fit."""
@@ -88,26 +107,30 @@ def plate_rms(cfg: dict, pts: np.ndarray, offset: float, beta: float, sr_um: flo
     with np.errstate(invalid="ignore"):  # dense: the plates below depend on F's last bits
         F = po.full_point_covariance(pts[None], th[None], "pivot", "inner", dense=True)[0]
     S = dm.s_matrix(dm.null_basis(pts))
-    C = S @ F @ S.T * sr_um ** 2
+    C = S @ F @ S.T * sr_um**2
     w, V = np.linalg.eigh((C + C.T) / 2)
     w = np.clip(w, 0.0, None)
     rng = chunk_rng(cfg["seed"], part, 0)
     z = rng.standard_normal((cfg["unprinted.plates"], len(w)))
     e = (z * np.sqrt(w)) @ V.T
     g = e + rng.normal(0.0, extra_um, e.shape) @ S.T
-    return np.sqrt((e ** 2).mean(1)), np.sqrt((g ** 2).mean(1))
+    return np.sqrt((e**2).mean(1)), np.sqrt((g**2).mean(1))
 
 
-def external_at(cfg: dict, offset: float, beta: float, zeiss_extent: float, pitch: float,
-                plates: bool = True) -> dict:
+def external_at(
+    cfg: dict, offset: float, beta: float, zeiss_extent: float, pitch: float, plates: bool = True
+) -> dict:
     """Every linearised claim value at one setting of the unprinted inputs (``plates=False``:
     the tolerances only). Plates use fixed streams (parts 91, 92), so a sweep compares like
     with like."""
     pts = paper_points(cfg)
     sr = range_sigma_um(cfg)
     r_min = shortest_range_mm(cfg, pts, offset, beta)
-    out = {"r_min_mm": r_min, "r_max_mm": longest_range_mm(cfg, pts, offset, beta),
-           **tolerances(cfg, r_min, pitch)}
+    out = {
+        "r_min_mm": r_min,
+        "r_max_mm": longest_range_mm(cfg, pts, offset, beta),
+        **tolerances(cfg, r_min, pitch),
+    }
     out["feasible"] = out["r_max_mm"] <= cfg["scale.graduated_mm"] + cfg["scale.micrometer_mm"]
     zp = zeiss_points(cfg, zeiss_extent)
     zr = longest_range_mm(cfg, zp, offset, beta)
@@ -115,6 +138,7 @@ def external_at(cfg: dict, offset: float, beta: float, zeiss_extent: float, pitc
     if plates:
         out["table1_rms"] = plate_rms(cfg, pts, offset, beta, sr, 0.0, 91)[0]
         out["zeiss_comparator_rms"], out["zeiss_rms"] = plate_rms(
-            cfg, zp, offset, beta, sr, cfg["zeiss.grid_sigma_um"], 92)
+            cfg, zp, offset, beta, sr, cfg["zeiss.grid_sigma_um"], 92
+        )
         out["two_screw_rms"] = np.sqrt(2) * out["table1_rms"]
     return out

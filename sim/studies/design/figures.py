@@ -2,15 +2,16 @@
 coverage, the emcee corner plot, the two-plate ratio and the consistent set of the unprinted
 inputs. Log axes carry a few labelled ticks only (plain numbers), so labels never overlap.
 """
+
 from __future__ import annotations
 
 import numpy as np
 from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
-from ...plotting import plt, save
-from ... import distributions as D
-from .cells import pareto_front
-from .claims import load_book
+from sim.lsq import distributions as D
+from sim.report.plotting import plt, save
+from sim.studies.design.cells import pareto_front
+from sim.studies.design.claims import load_book
 
 __all__ = ["figure_jobs"]
 
@@ -20,9 +21,13 @@ def _log_ticks(ax, axis: str, lo: float, hi: float) -> None:
     mantissas that gives at least three ticks between ``lo`` and ``hi``, at most eight; no
     minor labels (so labels never overlap)."""
     e0, e1 = int(np.floor(np.log10(lo))), int(np.ceil(np.log10(hi)))
-    for mant in ((1, 2, 5), (1, 2, 3, 5, 7), (1, 1.2, 1.4, 1.6, 1.8, 2, 2.5, 3, 4, 5, 6, 7, 8, 9),
-                 tuple(np.round(np.arange(1.0, 10.0, 0.05), 2))):
-        ticks = [m * 10.0 ** e for e in range(e0, e1 + 1) for m in mant]
+    for mant in (
+        (1, 2, 5),
+        (1, 2, 3, 5, 7),
+        (1, 1.2, 1.4, 1.6, 1.8, 2, 2.5, 3, 4, 5, 6, 7, 8, 9),
+        tuple(np.round(np.arange(1.0, 10.0, 0.05), 2)),
+    ):
+        ticks = [m * 10.0**e for e in range(e0, e1 + 1) for m in mant]
         ticks = [t for t in ticks if lo <= t <= hi]
         if len(ticks) >= 3:
             break
@@ -54,22 +59,40 @@ def fig_pareto(cols, path, same_n):
     for s_, ls in zip(sorted(set(ss.tolist())), ("--", ":", "-.")):
         f = pareto_front(t, a, ok & (ss == s_))
         o = np.argsort(t[f])
-        ax.step(t[f][o], a[f][o], where="post", color="0.3", ls=ls, lw=1,
-                label=f"front, setting sigma {s_:g} um")
+        ax.step(
+            t[f][o],
+            a[f][o],
+            where="post",
+            color="0.3",
+            ls=ls,
+            lw=1,
+            label=f"front, setting sigma {s_:g} um",
+        )
     ax.set_title("all designs (any number of points)")
     ax = axs[1]
     L = np.array(cols["settings"])
     for p, mk in zip(sorted(set(P.tolist())), "osD^v<>"):
-        for l_, c in zip(sorted(set(L.tolist())), ("tab:blue", "tab:orange", "tab:green", "tab:red")):
+        for l_, c in zip(
+            sorted(set(L.tolist())), ("tab:blue", "tab:orange", "tab:green", "tab:red")
+        ):
             sel = same_n & (P == p) & (L == l_)
             if sel.any():
-                ax.scatter(t[sel], a[sel], s=18, marker=mk, color=c, alpha=0.7,
-                           label=f"P = {p}, {l_} setting(s)")
+                ax.scatter(
+                    t[sel],
+                    a[sel],
+                    s=18,
+                    marker=mk,
+                    color=c,
+                    alpha=0.7,
+                    label=f"P = {p}, {l_} setting(s)",
+                )
     f = pareto_front(t, a, same_n)
     o = np.argsort(t[f])
     ax.step(t[f][o], a[f][o], where="post", color="k", lw=1.2, label="Pareto front")
-    ax.set_title(f"the paper's plate: {cols['n_points'][j]} points at +-{cols['extent_mm'][j]:g} mm,\n"
-                 f"setting sigma {cols['setting_sigma_um'][j]:g} um (feasible only)")
+    ax.set_title(
+        f"the paper's plate: {cols['n_points'][j]} points at +-{cols['extent_mm'][j]:g} mm,\n"
+        f"setting sigma {cols['setting_sigma_um'][j]:g} um (feasible only)"
+    )
     fin = np.isfinite(a) & (a > 0)
     for ax, sel in zip(axs, (fin, fin & same_n)):
         ax.plot(t[j], a[j], "r*", ms=16, label="paper's design (Table 1)")
@@ -87,8 +110,12 @@ def fig_pareto(cols, path, same_n):
 def fig_budget(b, path, ref):
     fig, ax = plt.subplots(figsize=(9, 5))
     y = np.arange(len(b["source"]))
-    ax.barh(y, b["rms_um"], xerr=1.96 * np.array(b["se_um"]), color=["tab:gray" if s else "tab:blue"
-                                                                     for s in b["settings"]])
+    ax.barh(
+        y,
+        b["rms_um"],
+        xerr=1.96 * np.array(b["se_um"]),
+        color=["tab:gray" if s else "tab:blue" for s in b["settings"]],
+    )
     ax.set_yticks(y, [f"{s} ({d})" for s, d in zip(b["source"], b["description"])], fontsize=7)
     ax.axvline(ref, color="tab:red", ls="--", lw=1, label=f"paper: {ref:g} um (Zeiss grid)")
     ax.set_xlabel("rms coordinate error after a rigid fit (um)")
@@ -117,19 +144,33 @@ def fig_coverage(c, path):
     model = np.array(c["model"])
     scen = np.array(c["scenario"])
     fig, axs = plt.subplots(1, 3, figsize=(15, 4.5))
-    for ax, (s, xkey, xl) in zip(axs, (("noise", "sigma_um", "range sigma (um)"),
-                                      ("points", "grid", "points per side"),
-                                      ("beta", "beta_mm", "beta (mm)"))):
+    for ax, (s, xkey, xl) in zip(
+        axs,
+        (
+            ("noise", "sigma_um", "range sigma (um)"),
+            ("points", "grid", "points per side"),
+            ("beta", "beta_mm", "beta (mm)"),
+        ),
+    ):
         sel = (scen == s) & (model == "pivot")
         x = np.array(c[xkey], float)[sel]
         N = np.array(c["trials"])[sel]
-        for key, lab in (("coverage_known", "ellipses, known sigma"),
-                         ("coverage_f", "ellipses, s0 and F"), ("b_coverage", "b = beta^2 interval"),
-                         ("beta_coverage", "beta interval (delta method)")):
-            ax.plot(np.where(x > 0, x, x[x > 0].min() / 3 if (x > 0).any() else 1), np.array(c[key])[sel],
-                    "o-", label=lab)
+        for key, lab in (
+            ("coverage_known", "ellipses, known sigma"),
+            ("coverage_f", "ellipses, s0 and F"),
+            ("b_coverage", "b = beta^2 interval"),
+            ("beta_coverage", "beta interval (delta method)"),
+        ):
+            ax.plot(
+                np.where(x > 0, x, x[x > 0].min() / 3 if (x > 0).any() else 1),
+                np.array(c[key])[sel],
+                "o-",
+                label=lab,
+            )
         se = np.sqrt(0.95 * 0.05 / max(int(N[N > 0].min()) if (N > 0).any() else 1, 1))
-        ax.axhspan(0.95 - 1.96 * se, 0.95 + 1.96 * se, color="0.8", label="nominal 95 % +- MC error")
+        ax.axhspan(
+            0.95 - 1.96 * se, 0.95 + 1.96 * se, color="0.8", label="nominal 95 % +- MC error"
+        )
         ax.set_xscale("log" if s != "points" else "linear")
         ax.set_xlabel(xl + (" (0 drawn at left edge)" if s == "beta" else ""))
         ax.set_ylabel("empirical coverage")
@@ -147,15 +188,20 @@ def fig_corner(samples, mean, Q, names, path):
     z = (samples - mean) / sd
     t = np.linspace(0, 2 * np.pi, 100)
     for i in range(d):
-        for j in range(i + 1):   # the lower triangle only (the upper one stays empty)
+        for j in range(i + 1):  # the lower triangle only (the upper one stays empty)
             ax = fig.add_subplot(d, d, i * d + j + 1)
             if i == j:
                 ax.hist(z[:, i], bins=40, density=True, color="tab:blue", alpha=0.7)
                 xx = np.linspace(-4, 4, 100)
                 ax.plot(xx, D.norm_pdf(xx), "r-", lw=1)
             else:
-                ax.plot(z[::max(1, len(z) // 4000), j], z[::max(1, len(z) // 4000), i], ",",
-                        color="tab:blue", alpha=0.5)
+                ax.plot(
+                    z[:: max(1, len(z) // 4000), j],
+                    z[:: max(1, len(z) // 4000), i],
+                    ",",
+                    color="tab:blue",
+                    alpha=0.5,
+                )
                 C = Q[np.ix_([j, i], [j, i])] / np.outer(sd[[j, i]], sd[[j, i]])
                 w, v = np.linalg.eigh(C)
                 e = v @ (np.sqrt(w)[:, None] * np.vstack([np.cos(t), np.sin(t)])) * 2.45
@@ -169,11 +215,12 @@ def fig_corner(samples, mean, Q, names, path):
                 ax.set_yticklabels([])
             else:
                 ax.set_ylabel(names[i], fontsize=7)
-    fig.suptitle("posterior samples (blue) in units of the least-squares sigma about the LS "
-                 "estimate; red: LS Gaussian / 95 % ellipses", y=0.92)
+    fig.suptitle(
+        "posterior samples (blue) in units of the least-squares sigma about the LS "
+        "estimate; red: LS Gaussian / 95 % ellipses",
+        y=0.92,
+    )
     save(fig, path)
-
-
 
 
 def fig_twoplate(cols, samples, path):
@@ -190,16 +237,23 @@ def fig_twoplate(cols, samples, path):
     save(fig, path)
 
 
-_SHORT = {"brown.operation.lateral_offset_error_um": "reticle offset error (um)",
-          "brown.calibration.linearity_tolerance_um": "linearity tolerance (um)",
-          "brown.calibration.drum_graduation_um": "drum graduation error (um)",
-          "brown.results.two_screw_agreement_um": "two-screw agreement (um)",
-          "brown.results.accuracy_range_um": "rms accuracy (um)",
-          "brown.results.zeiss_discrepancy_um": "Zeiss discrepancy (um)",
-          "brown.results.zeiss_comparator_um": "Zeiss, comparator part (um)",
-          "brown.design.paper_on_front_same_points": "paper's design on front (finding)"}
-_COLOR = {"holds": "tab:green", "fails": "tab:red", "inconclusive": "tab:orange",
-          "infeasible": "0.6", "finding": "tab:blue"}
+_SHORT = {
+    "brown.operation.lateral_offset_error_um": "reticle offset error (um)",
+    "brown.calibration.linearity_tolerance_um": "linearity tolerance (um)",
+    "brown.calibration.drum_graduation_um": "drum graduation error (um)",
+    "brown.results.two_screw_agreement_um": "two-screw agreement (um)",
+    "brown.results.accuracy_range_um": "rms accuracy (um)",
+    "brown.results.zeiss_discrepancy_um": "Zeiss discrepancy (um)",
+    "brown.results.zeiss_comparator_um": "Zeiss, comparator part (um)",
+    "brown.design.paper_on_front_same_points": "paper's design on front (finding)",
+}
+_COLOR = {
+    "holds": "tab:green",
+    "fails": "tab:red",
+    "inconclusive": "tab:orange",
+    "infeasible": "0.6",
+    "finding": "tab:blue",
+}
 
 
 def fig_consistent(sv, cs, path):
@@ -208,13 +262,19 @@ def fig_consistent(sv, cs, path):
     (no claim fails) shaded."""
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
+
     inp, cl = np.array(sv["input"]), np.array(sv["claim"])
     pairs = list(dict.fromkeys(zip(sv["input"], sv["claim"])))
     ncol = 4
     nrow = int(np.ceil(len(pairs) / ncol))
     fig, axs = plt.subplots(nrow, ncol, figsize=(3.6 * ncol, 2.7 * nrow), squeeze=False)
-    comp = {i: (lo, hi) for i, c, lo, hi in zip(cs["input"], cs["claim"], cs["compatible_low"],
-                                                 cs["compatible_high"]) if c == "ALL"}
+    comp = {
+        i: (lo, hi)
+        for i, c, lo, hi in zip(
+            cs["input"], cs["claim"], cs["compatible_low"], cs["compatible_high"]
+        )
+        if c == "ALL"
+    }
     for ax, (i, c) in zip(axs.ravel(), pairs):
         sel = (inp == i) & (cl == c)
         x = np.array(sv["value"], float)[sel]
@@ -224,9 +284,13 @@ def fig_consistent(sv, cs, path):
         v = np.array(sv["verdict"])[sel]
         zl, zh = np.array(sv["zone_low"], float)[sel][0], np.array(sv["zone_high"], float)[sel][0]
         if np.isfinite(zl) or np.isfinite(zh):
-            ax.axhspan(zl if np.isfinite(zl) else min(np.nanmin(lo), zh),
-                       zh if np.isfinite(zh) else max(np.nanmax(hi), zl),
-                       color="tab:orange", alpha=0.2, lw=0)
+            ax.axhspan(
+                zl if np.isfinite(zl) else min(np.nanmin(lo), zh),
+                zh if np.isfinite(zh) else max(np.nanmax(hi), zl),
+                color="tab:orange",
+                alpha=0.2,
+                lw=0,
+            )
         a, b = comp.get(i, (np.nan, np.nan))
         if a is not None and np.isfinite(a):
             d = 0.02 * (x.max() - x.min())
@@ -238,30 +302,40 @@ def fig_consistent(sv, cs, path):
         ax.set_xlabel(i, fontsize=8)
         ax.set_title(_SHORT.get(c, c), fontsize=8)
         ax.tick_params(labelsize=7)
-    for ax in axs.ravel()[len(pairs):]:
+    for ax in axs.ravel()[len(pairs) :]:
         ax.axis("off")
-    handles = ([Line2D([], [], marker="o", ls="", color=col, label=k) for k, col in _COLOR.items()]
-               + [Patch(color="tab:orange", alpha=0.2, label="paper's decision zone"),
-                  Patch(color="tab:green", alpha=0.12, label="consistent set (no claim fails)")])
-    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8,
-               bbox_to_anchor=(0.5, 0.0))
+    handles = [
+        Line2D([], [], marker="o", ls="", color=col, label=k) for k, col in _COLOR.items()
+    ] + [
+        Patch(color="tab:orange", alpha=0.2, label="paper's decision zone"),
+        Patch(color="tab:green", alpha=0.12, label="consistent set (no claim fails)"),
+    ]
+    fig.legend(
+        handles=handles,
+        loc="lower center",
+        ncol=len(handles),
+        fontsize=8,
+        bbox_to_anchor=(0.5, 0.0),
+    )
     fig.tight_layout(rect=(0, 0.04, 1, 1))
     save(fig, path)
 
 
 def figure_jobs(stage: str, out, *data) -> list:
     """The figure jobs ``(fn, args)`` of one stage of the run, for
-    :func:`sim.figure_jobs.start_figures` as soon as the stage's tables exist (so they are
+    :func:`sim.report.figure_jobs.start_figures` as soon as the stage's tables exist (so they are
     drawn on idle workers while the run goes on): ``design`` (cols), ``datum`` (cfg, dcols),
     ``budget`` (bcols), ``coverage`` (ccols), ``bayes`` (samples, values), ``twoplate``
     (tcols, tsamples) and ``consistent`` (sweep values, consistent set)."""
     if stage == "design":
         (cols,) = data
         jp = int(np.flatnonzero(cols["paper_design"])[0])
-        same_n = (np.array(cols["feasible"])
-                  & np.isclose(np.array(cols["setting_sigma_um"]), cols["setting_sigma_um"][jp])
-                  & (np.array(cols["n_points"]) == cols["n_points"][jp])
-                  & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp]))
+        same_n = (
+            np.array(cols["feasible"])
+            & np.isclose(np.array(cols["setting_sigma_um"]), cols["setting_sigma_um"][jp])
+            & (np.array(cols["n_points"]) == cols["n_points"][jp])
+            & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp])
+        )
         return [(fig_pareto, (cols, out / "pareto.png", same_n))]
     if stage == "datum":
         cfg, dcols = data
@@ -272,14 +346,17 @@ def figure_jobs(stage: str, out, *data) -> list:
     if stage == "coverage":
         return [(fig_coverage, (data[0], out / "coverage.png"))]
     if stage == "bayes":
-        from ... import multilateration as ml
+        from sim.instruments.ranges import multilateration as ml
+
         samples, bay = data
-        return [(fig_corner, (samples, bay["theta_ls"], bay["Q"], ml.PARAM_NAMES,
-                              out / "corner.png"))]
+        return [
+            (fig_corner, (samples, bay["theta_ls"], bay["Q"], ml.PARAM_NAMES, out / "corner.png"))
+        ]
     if stage == "twoplate":
         tcols, tsamples = data
-        return [] if tcols is None else [(fig_twoplate, (tcols, tsamples,
-                                                         out / "twoplate_ratio.png"))]
+        return (
+            [] if tcols is None else [(fig_twoplate, (tcols, tsamples, out / "twoplate_ratio.png"))]
+        )
     if stage == "consistent":
         sv, cs = data
         return [(fig_consistent, (sv, cs, out / "consistent_set.png"))]

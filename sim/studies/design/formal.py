@@ -3,46 +3,71 @@
 Coverage of the 95 % point ellipses (known sigma; s0 with the F distribution), the false-alarm
 rate of the global chi-square test and E[s0] / sigma, for Brown's pivot model (Brown's datum)
 over noise, point count and beta, and for an affine calibration (a linear model). Every case
-is one :func:`sim.runner.run_chunks` call of a picklable chunk function, so its chunks run on
+is one :func:`sim.mc.runner.run_chunks` call of a picklable chunk function, so its chunks run on
 the run's executor; the cases run side by side (:mod:`.parts`).
 """
+
 from __future__ import annotations
 
 from functools import partial
 
 import numpy as np
 
-from ... import coverage as cv, multilateration as ml
-from ...plate import grid_points
-from ...runner import run_chunks
-from .chunks import affine_chunk, coverage_chunk
-from .parts import side_by_side
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import coverage as cv
+from sim.instruments.ranges import multilateration as ml
+from sim.mc.runner import run_chunks
+from sim.studies.design.chunks import affine_chunk, coverage_chunk
+from sim.studies.design.parts import side_by_side
 
 __all__ = ["coverage_analysis", "summarize_cov", "COLUMNS", "PART0"]
 
 PART0 = 30
-COLUMNS = ("model", "scenario", "grid", "sigma_um", "beta_mm", "trials", "nonconverged", "dof",
-           "coverage_known", "coverage_f", "false_alarm", "s0_ratio", "s0_ratio_se", "s0sq_ratio",
-           "s0_expected", "b_coverage", "beta_coverage")
+COLUMNS = (
+    "model",
+    "scenario",
+    "grid",
+    "sigma_um",
+    "beta_mm",
+    "trials",
+    "nonconverged",
+    "dof",
+    "coverage_known",
+    "coverage_f",
+    "false_alarm",
+    "s0_ratio",
+    "s0_ratio_se",
+    "s0sq_ratio",
+    "s0_expected",
+    "b_coverage",
+    "beta_coverage",
+)
 _AFFINE = np.array([[1.00002, 3e-5, 0.01], [-2e-5, 0.99997, -0.02]])
 
 
 def summarize_cov(sim: dict, sigma_um: float, dof: int) -> dict:
     ok = sim["ok"]
     N = int(ok.sum())
-    base = {"trials": N, "nonconverged": int((~ok).sum()), "dof": dof,
-            "s0_expected": cv.c4(dof + 1) if dof > 0 else np.nan}
+    base = {
+        "trials": N,
+        "nonconverged": int((~ok).sum()),
+        "dof": dof,
+        "s0_expected": cv.c4(dof + 1) if dof > 0 else np.nan,
+    }
     if N < 2:  # every trial singular or diverged: recorded, not skipped
         return base
     s0 = sim["s0_um"][ok] / sigma_um
-    return {**base, "coverage_known": float(sim["cov_known"][ok].mean()),
-            "coverage_f": float(np.nanmean(sim["cov_f"][ok])) if dof > 0 else np.nan,
-            "false_alarm": float(sim["reject"][ok].mean()) if dof > 0 else np.nan,
-            "s0_ratio": float(s0.mean()) if dof > 0 else np.nan,
-            "s0_ratio_se": float(s0.std(ddof=1) / np.sqrt(N)) if dof > 0 else np.nan,
-            "s0sq_ratio": float((s0 ** 2).mean()) if dof > 0 else np.nan,
-            "b_coverage": float(np.mean(sim["b_in"][ok])),
-            "beta_coverage": float(np.mean(sim["beta_in"][ok]))}
+    return {
+        **base,
+        "coverage_known": float(sim["cov_known"][ok].mean()),
+        "coverage_f": float(np.nanmean(sim["cov_f"][ok])) if dof > 0 else np.nan,
+        "false_alarm": float(sim["reject"][ok].mean()) if dof > 0 else np.nan,
+        "s0_ratio": float(s0.mean()) if dof > 0 else np.nan,
+        "s0_ratio_se": float(s0.std(ddof=1) / np.sqrt(N)) if dof > 0 else np.nan,
+        "s0sq_ratio": float((s0**2).mean()) if dof > 0 else np.nan,
+        "b_coverage": float(np.mean(sim["b_in"][ok])),
+        "beta_coverage": float(np.mean(sim["beta_in"][ok])),
+    }
 
 
 def _cases(cfg):
@@ -72,14 +97,30 @@ def coverage_analysis(cfg: dict, ctx) -> dict:
         pts = grid_points(k, 2 * ext / (k - 1))
         th = ml.design_theta(h, cfg["comparator.alpha_mm"], beta)
         fn = partial(coverage_chunk, pts, th, sig, cfg["coverage.alpha"])
-        tasks[part] = partial(run_chunks, fn, T, cfg["seed"], cfg["chunk"], part=part,
-                              label=f"coverage {scen}", ctx=ctx)
+        tasks[part] = partial(
+            run_chunks,
+            fn,
+            T,
+            cfg["seed"],
+            cfg["chunk"],
+            part=part,
+            label=f"coverage {scen}",
+            ctx=ctx,
+        )
     affine = ((cfg["datum.grid"], cfg["coverage.trials"]), (2, cfg["coverage.sweep_trials"]))
     for part, (k, T) in enumerate(affine, PART0 + len(tasks)):
         grid = grid_points(k, 2 * 110.0 / (k - 1))
         fn = partial(affine_chunk, grid, sig0, _AFFINE, cfg["coverage.alpha"])
-        tasks[part] = partial(run_chunks, fn, T, cfg["seed"], cfg["chunk"], part=part,
-                              label="coverage affine", ctx=ctx)
+        tasks[part] = partial(
+            run_chunks,
+            fn,
+            T,
+            cfg["seed"],
+            cfg["chunk"],
+            part=part,
+            label="coverage affine",
+            ctx=ctx,
+        )
     sims = side_by_side(tasks, ctx)
     part = PART0
     for scen, k, sig, beta, T in _cases(cfg):

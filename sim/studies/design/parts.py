@@ -1,7 +1,7 @@
 """Independent parts of the ``brown_design`` run side by side (seed ``004``, Brown 1968).
 
 Each Monte-Carlo part of the run (the check of the paper's design, every error-budget row,
-every coverage case, each emcee posterior) is one or more :func:`sim.runner.run_chunks`
+every coverage case, each emcee posterior) is one or more :func:`sim.mc.runner.run_chunks`
 calls, and each call waits for its last chunk: with few chunks per call (an adaptive stage of
 one or three chunks, a posterior of four chains) one worker would often sit idle.
 :func:`side_by_side` runs independent parts in threads of this process when the run's
@@ -10,6 +10,7 @@ workers' queue; with the in-process executor the parts run one after another. Th
 not depend on it: every chunk draws from its own stream (``spawn_key = (part, chunk)``) and
 each part assembles its chunks in chunk order.
 """
+
 from __future__ import annotations
 
 from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
@@ -38,8 +39,8 @@ def side_by_side(tasks: Mapping[str, Callable[[], object]], ctx) -> dict:
             if f.exception() is not None:
                 f.result()
         out = {k: f.result() for k, f in futs.items()}
-    except BaseException:   # an interrupt or a failed part: raise now, without waiting for
+    except BaseException:  # an interrupt or a failed part: raise now, without waiting for
         tp.shutdown(wait=False, cancel_futures=True)  # the other parts (the run's executor
-        raise               # is then closed, which ends their chunk calls)
+        raise  # is then closed, which ends their chunk calls)
     tp.shutdown()
     return out

@@ -1,7 +1,7 @@
 """Bayesian cross-checks with ``emcee`` (seed ``004``; the two-plate case after seed ``001``).
 
 1. The posterior of Brown's 7 globals for one simulated plate of the paper's design (points
-   marginalised analytically, :func:`sim.bayes.brown_log_posterior`) against the least-squares
+   marginalised analytically, :func:`sim.instruments.ranges.bayes.brown_log_posterior`) against the least-squares
    covariance.
 2. The comparator / grid variance ratio of one simulated two-plate calibration
    (``gridplate_two_plates``'s default configuration) against the chi-square re-weighting.
@@ -14,15 +14,16 @@ autocorrelation time (``emcee``'s ``get_autocorr_time``): ``N_eff = kept steps x
 tau`` summed over chains; ``se(sd) = sd / sqrt(2 N_eff)``; ``se(q_p) = sqrt(p (1-p) / N_eff) /
 f(q_p)`` for a quantile.
 """
+
 from __future__ import annotations
 
 from functools import partial
 
 import numpy as np
 
-from ... import multilateration as ml
-from ...runner import chunk_rng, run_chunks
-from .chunks import brown_chain_chunk, brown_lsq, twoplate_chain_chunk
+from sim.instruments.ranges import multilateration as ml
+from sim.mc.runner import chunk_rng, run_chunks
+from sim.studies.design.chunks import brown_chain_chunk, brown_lsq, twoplate_chain_chunk
 
 __all__ = ["bayes_analysis", "twoplate_analysis", "quantile_se", "PART_BROWN", "PART_TWOPLATE"]
 
@@ -50,8 +51,9 @@ def bayes_analysis(cfg: dict, pts: np.ndarray, sr_um: float, ctx) -> tuple[dict,
     sig = sr_um * 1e-3
     r, theta_ls, Q = brown_lsq(pts, th, sig, chunk_rng(cfg["seed"], 60, 0))
     fn = partial(brown_chain_chunk, r, sig, theta_ls, Q, cfg["bayes.walkers"], cfg["bayes.steps"])
-    sim = run_chunks(fn, cfg["bayes.chains"], cfg["seed"], 1, part=PART_BROWN,
-                     label="emcee (Brown)", ctx=ctx)
+    sim = run_chunks(
+        fn, cfg["bayes.chains"], cfg["seed"], 1, part=PART_BROWN, label="emcee (Brown)", ctx=ctx
+    )
     X = sim["samples"].reshape(-1, sim["samples"].shape[-1])
     neff = _n_eff(sim)
     ps = X.std(0, ddof=1)
@@ -63,30 +65,48 @@ def bayes_analysis(cfg: dict, pts: np.ndarray, sr_um: float, ctx) -> tuple[dict,
     diff = np.abs(pc - lc)
     i, j = np.unravel_index(np.argmax(diff), diff.shape)
     corr_se = float((1 - pc[i, j] ** 2) / np.sqrt(min(neff[i], neff[j])))
-    chain_ratio = np.stack([c.reshape(-1, c.shape[-1]).std(0, ddof=1) for c in sim["samples"]]) / lsd
+    chain_ratio = (
+        np.stack([c.reshape(-1, c.shape[-1]).std(0, ddof=1) for c in sim["samples"]]) / lsd
+    )
     names = list(ml.PARAM_NAMES)
-    cols = {"param": names, "ls_estimate": theta_ls, "ls_sigma_mm": lsd,
-            "post_mean": X.mean(0), "post_mean_se": ps / np.sqrt(neff), "post_sigma_mm": ps,
-            "ratio": ratio, "ratio_se": ratio_se,
-            "ratio_chain_spread": chain_ratio.std(0, ddof=1),
-            "tau_steps": sim["tau"].mean(0), "n_eff": neff,
-            "acceptance": np.full(len(names), float(sim["acceptance"].mean())),
-            "max_abs_corr_diff": np.full(len(names), float(diff.max()))}
-    vals = {"ratio": dict(zip(names, zip(ratio, ratio_se, sim["tau"].mean(0), neff))),
-            "max_corr_diff": (float(diff.max()), corr_se, names[i], names[j]),
-            "chains": cfg["bayes.chains"], "steps": cfg["bayes.steps"],
-            "walkers": cfg["bayes.walkers"], "Q": Q, "theta_ls": theta_ls}
+    cols = {
+        "param": names,
+        "ls_estimate": theta_ls,
+        "ls_sigma_mm": lsd,
+        "post_mean": X.mean(0),
+        "post_mean_se": ps / np.sqrt(neff),
+        "post_sigma_mm": ps,
+        "ratio": ratio,
+        "ratio_se": ratio_se,
+        "ratio_chain_spread": chain_ratio.std(0, ddof=1),
+        "tau_steps": sim["tau"].mean(0),
+        "n_eff": neff,
+        "acceptance": np.full(len(names), float(sim["acceptance"].mean())),
+        "max_abs_corr_diff": np.full(len(names), float(diff.max())),
+    }
+    vals = {
+        "ratio": dict(zip(names, zip(ratio, ratio_se, sim["tau"].mean(0), neff))),
+        "max_corr_diff": (float(diff.max()), corr_se, names[i], names[j]),
+        "chains": cfg["bayes.chains"],
+        "steps": cfg["bayes.steps"],
+        "walkers": cfg["bayes.walkers"],
+        "Q": Q,
+        "theta_ls": theta_ls,
+    }
     return cols, vals, X
 
 
 def _twoplate_data(cfg: dict):
     """One simulated two-plate calibration of ``gridplate_two_plates`` (its defaults)."""
-    from ... import gridplate as gp, transforms2d as t2
-    from ...config import validate
-    from ..gridplate import model as gm, schema as gs
+    from sim.instruments import gridplate as gp
+    from sim.instruments import transforms2d as t2
+    from sim.mc.config import validate
+    from sim.studies.gridplate import model as gm
+    from sim.studies.gridplate import schema as gs
+
     gcfg = validate({}, gs.SCHEMA, gs.check)
     sim = gm.simulate(gcfg, chunk_rng(cfg["seed"], 70, 0), 1)
-    mean = sim["readings"].mean(axis=3)[0]                  # (plates, N, 2)
+    mean = sim["readings"].mean(axis=3)[0]  # (plates, N, 2)
     cert = sim["cert"][0]
     comp = np.concatenate([mean[..., 0], mean[..., 1]], 0)  # rows x' (plates), y' (plates)
     g = np.concatenate([cert, cert], 0)
@@ -109,24 +129,48 @@ def twoplate_analysis(cfg: dict, ctx):
     x0 = np.concatenate([abc.ravel(), [np.log(gcfg["comparator.coord_sigma_um"]), np.log(sg)]])
     sd = np.concatenate([np.tile([2e-5, 2e-5, 5e-4], R), [0.1, 0.3]])
     W = max(cfg["bayes.walkers"], 2 * len(x0) + 2)
-    cols = {k: [] for k in ("prior", "rho_q025", "rho_median", "rho_q975", "log10_width",
-                            "log10_width_se", "log10_q_se", "sigma_c_median_um", "sigma_g_median_um",
-                            "tau_max", "n_eff", "rw_ratio_mean", "true_ratio")}
+    cols = {
+        k: []
+        for k in (
+            "prior",
+            "rho_q025",
+            "rho_median",
+            "rho_q975",
+            "log10_width",
+            "log10_width_se",
+            "log10_q_se",
+            "sigma_c_median_um",
+            "sigma_g_median_um",
+            "tau_max",
+            "n_eff",
+            "rw_ratio_mean",
+            "true_ratio",
+        )
+    }
     samples = {}
-    for part, (name, prior) in zip(PART_TWOPLATE, (("flat", None), ("certificate", (
-            np.log(sg), cfg["bayes.grid_prior_log_sd"])))):
+    for part, (name, prior) in zip(
+        PART_TWOPLATE,
+        (("flat", None), ("certificate", (np.log(sg), cfg["bayes.grid_prior_log_sd"]))),
+    ):
         fn = partial(twoplate_chain_chunk, comp, g, prior, x0, sd, W, 2 * cfg["bayes.steps"])
-        sim = run_chunks(fn, cfg["bayes.chains"], cfg["seed"], 1, part=part,
-                         label=f"emcee (two plates, {name})", ctx=ctx)
+        sim = run_chunks(
+            fn,
+            cfg["bayes.chains"],
+            cfg["seed"],
+            1,
+            part=part,
+            label=f"emcee (two plates, {name})",
+            ctx=ctx,
+        )
         Y = sim["samples"].reshape(-1, 2)
         lc, lg = Y[:, 0], Y[:, 1]
-        lrho = 2 * (lc - lg) / np.log(10)                      # log10 of the ratio
+        lrho = 2 * (lc - lg) / np.log(10)  # log10 of the ratio
         neff = float(_n_eff(sim).min())
         q = np.quantile(lrho, [0.025, 0.5, 0.975])
         se_w = np.hypot(quantile_se(lrho, 0.025, neff), quantile_se(lrho, 0.975, neff))
-        samples[name] = 10 ** lrho
+        samples[name] = 10**lrho
         cols["prior"].append(name)
-        for c, v in zip(("rho_q025", "rho_median", "rho_q975"), 10 ** q):
+        for c, v in zip(("rho_q025", "rho_median", "rho_q975"), 10**q):
             cols[c].append(float(v))
         cols["log10_width"].append(float(q[2] - q[0]))
         cols["log10_width_se"].append(se_w)
@@ -136,7 +180,8 @@ def twoplate_analysis(cfg: dict, ctx):
         cols["tau_max"].append(float(sim["tau"].max()))
         cols["n_eff"].append(neff)
         cols["rw_ratio_mean"].append(float(np.nanmean(rw["ratio"])))
-        cols["true_ratio"].append((gcfg["comparator.coord_sigma_um"]
-                                   / gcfg["grid.sigma_true_um"]) ** 2)
+        cols["true_ratio"].append(
+            (gcfg["comparator.coord_sigma_um"] / gcfg["grid.sigma_true_um"]) ** 2
+        )
     vals = {"sg": sg, "rw_rows": [float(v) for v in rw["ratio"]]}
     return cols, vals, samples, ""

@@ -1,15 +1,16 @@
 """Report section of study ``brown_design`` (seed ``004``): built from the study's Parquet
 files and its claim book only, never from live model code. Every number and verdict in the
 prose is read from those files."""
+
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ...report import claims_markdown, fmt, inputs_markdown, md_table
-from ...storage import read_provenance, read_table
-from .schema import SCHEMA
+from sim.mc.storage import read_provenance, read_table
+from sim.report.markdown import claims_markdown, fmt, inputs_markdown, md_table
+from sim.studies.design.schema import SCHEMA
 
 __all__ = ["report"]
 
@@ -20,19 +21,25 @@ def _t(out, name):
 
 def _datum_findings(V, VH, feas_note):
     g = lambda k: (V.get(k, np.nan), VH.get(k, np.nan))  # noqa: E731
-    (bl, bh), (il, ih), (cl, ch) = (g(f"brown.datum.{d}.stations_pct")
-                                    for d in ("brown", "invariant", "corners"))
-    (pil, pih), (pcl, pch) = g("brown.datum.invariant.pivot_pct"), g("brown.datum.corners.pivot_pct")
-    return (f"* *Datum of the dilution* (findings, not scored against Brown's sentence): in "
-            f"Brown's datum the `stations` dilution of brown_dilution's geometry is "
-            f"{bl:.1f}-{bh:.1f} %; after the S-transformation to inner constraints over the points "
-            f"it is {il:.1f}-{ih:.1f} %, after a similarity onto the four corners {cl:.1f}-{ch:.1f} %. "
-            f"So {100 * (1 - ih / bh):.0f} % of the largest and {100 * (1 - il / bl):.0f} % of the "
-            "smallest dilution belong to the station-defined datum (the station estimates' errors "
-            "carried into every point as a translation and rotation), not to the precision of the "
-            "point configuration. For `pivot` the inner-constraint dilution is "
-            f"{pil:.1f}-{pih:.1f} % and the corner-similarity one {pcl:.1f}-{pch:.1f} %: a "
-            f"similarity removes most of beta's extra, scale-like dilution.{feas_note}")
+    (bl, bh), (il, ih), (cl, ch) = (
+        g(f"brown.datum.{d}.stations_pct") for d in ("brown", "invariant", "corners")
+    )
+    (pil, pih), (pcl, pch) = (
+        g("brown.datum.invariant.pivot_pct"),
+        g("brown.datum.corners.pivot_pct"),
+    )
+    return (
+        f"* *Datum of the dilution* (findings, not scored against Brown's sentence): in "
+        f"Brown's datum the `stations` dilution of brown_dilution's geometry is "
+        f"{bl:.1f}-{bh:.1f} %; after the S-transformation to inner constraints over the points "
+        f"it is {il:.1f}-{ih:.1f} %, after a similarity onto the four corners {cl:.1f}-{ch:.1f} %. "
+        f"So {100 * (1 - ih / bh):.0f} % of the largest and {100 * (1 - il / bl):.0f} % of the "
+        "smallest dilution belong to the station-defined datum (the station estimates' errors "
+        "carried into every point as a translation and rotation), not to the precision of the "
+        "point configuration. For `pivot` the inner-constraint dilution is "
+        f"{pil:.1f}-{pih:.1f} % and the corner-similarity one {pcl:.1f}-{pch:.1f} %: a "
+        f"similarity removes most of beta's extra, scale-like dilution.{feas_note}"
+    )
 
 
 def _where(lo, hi):
@@ -42,11 +49,26 @@ def _where(lo, hi):
 def _consistent_md(cs):
     rows = []
     for i, c, lo, hi, n, clo, chi, nc, N, note in zip(
-            cs["input"], cs["claim"], cs["holds_low"], cs["holds_high"], cs["n_holds"],
-            cs["compatible_low"], cs["compatible_high"], cs["n_compatible"], cs["n_values"],
-            cs["note"]):
-        rows.append([f"`{i}`", "**consistent set**" if c == "ALL" else f"`{c}`",
-                     f"{_where(lo, hi)} ({n} of {N})", f"{_where(clo, chi)} ({nc} of {N})", note])
+        cs["input"],
+        cs["claim"],
+        cs["holds_low"],
+        cs["holds_high"],
+        cs["n_holds"],
+        cs["compatible_low"],
+        cs["compatible_high"],
+        cs["n_compatible"],
+        cs["n_values"],
+        cs["note"],
+    ):
+        rows.append(
+            [
+                f"`{i}`",
+                "**consistent set**" if c == "ALL" else f"`{c}`",
+                f"{_where(lo, hi)} ({n} of {N})",
+                f"{_where(clo, chi)} ({nc} of {N})",
+                note,
+            ]
+        )
     return md_table(["unprinted input", "claim", "holds at", "does not fail at", "note"], rows)
 
 
@@ -61,8 +83,12 @@ def report(out: Path) -> str:
     VH = dict(zip(cl["claim"], cl["value_high"]))
     N = dict(zip(cl["claim"], cl["note"]))
     dt = _t(out, "datum.parquet")
-    feas_note = ("" if all(dt["feasible"]) else " (That geometry is *idealised*: its longest "
-                 "range does not fit on the scale plus micrometer; the rows are findings.)")
+    feas_note = (
+        ""
+        if all(dt["feasible"])
+        else " (That geometry is *idealised*: its longest "
+        "range does not fit on the scale plus micrometer; the rows are findings.)"
+    )
     ok = np.array(d["feasible"])
     reasons: dict[str, int] = {}
     for r in np.array(d["reason"])[~ok]:
@@ -73,13 +99,20 @@ def report(out: Path) -> str:
     pf = pf[np.argsort(np.array(d["time_min"])[pf])]
     jp = int(np.flatnonzero(d["paper_design"])[0])
     bud = dict(zip(b["source"], b["rms_um"]))
-    allrow = {i: (lo, hi) for i, cc, lo, hi in zip(cs["input"], cs["claim"],
-                                                   cs["compatible_low"], cs["compatible_high"])
-              if cc == "ALL"}
+    allrow = {
+        i: (lo, hi)
+        for i, cc, lo, hi in zip(
+            cs["input"], cs["claim"], cs["compatible_low"], cs["compatible_high"]
+        )
+        if cc == "ALL"
+    }
     lo, hi = allrow.get("paper.offset_mm", (None, None))
-    off_txt = ("at no swept station offset are the paper's claims free of a failure" if lo is None
-               or not np.isfinite(lo) else f"no claim of the paper fails for station offsets "
-               f"from {fmt(lo)} to {fmt(hi)} mm among the swept values")
+    off_txt = (
+        "at no swept station offset are the paper's claims free of a failure"
+        if lo is None or not np.isfinite(lo)
+        else f"no claim of the paper fails for station offsets "
+        f"from {fmt(lo)} to {fmt(hi)} mm among the swept values"
+    )
     txt = [
         "The questions Brown answered by simulation before building the comparator, asked "
         "systematically, and the printed numbers of his *Operation*, *Calibration* and "
@@ -123,12 +156,35 @@ def report(out: Path) -> str:
         f"Measuring time: the paper's 60 and 90 minutes for 30 images, with "
         f"{fmt(cfg['time.pass_min'])} min per plate position (not printed; swept).",
         "",
-        md_table(["P", "grid", "extent (mm)", "offset (mm)", "beta (mm)", "settings",
-                  "setting sigma (um)", "time (min)", "worst sigma (um)", "mean sigma (um)"],
-                 [[d["positions"][i], d["grid"][i], fmt(d["extent_mm"][i]), fmt(d["offset_mm"][i]),
-                   fmt(d["beta_mm"][i]), d["settings"][i], fmt(d["setting_sigma_um"][i]),
-                   fmt(d["time_min"][i]), fmt(d["worst_sigma_um"][i]), fmt(d["mean_sigma_um"][i])]
-                  for i in pf]),
+        md_table(
+            [
+                "P",
+                "grid",
+                "extent (mm)",
+                "offset (mm)",
+                "beta (mm)",
+                "settings",
+                "setting sigma (um)",
+                "time (min)",
+                "worst sigma (um)",
+                "mean sigma (um)",
+            ],
+            [
+                [
+                    d["positions"][i],
+                    d["grid"][i],
+                    fmt(d["extent_mm"][i]),
+                    fmt(d["offset_mm"][i]),
+                    fmt(d["beta_mm"][i]),
+                    d["settings"][i],
+                    fmt(d["setting_sigma_um"][i]),
+                    fmt(d["time_min"][i]),
+                    fmt(d["worst_sigma_um"][i]),
+                    fmt(d["mean_sigma_um"][i]),
+                ]
+                for i in pf
+            ],
+        ),
         "",
         f"The paper's design: {fmt(d['time_min'][jp])} min, worst sigma "
         f"{fmt(d['worst_sigma_um'][jp])} um, mean {fmt(d['mean_sigma_um'][jp])} um.",
@@ -141,10 +197,15 @@ def report(out: Path) -> str:
         "fit over all points; adaptive trial counts through the runner (target standard error "
         f"{fmt(cfg['budget.target_se_um'])} um).",
         "",
-        md_table(["source", "what", "rms (um)", "MC s.e. (um)", "trials", "rms sigma0 (um)"],
-                 [[s, de, fmt(r), fmt(se), t, fmt(s0)] for s, de, r, se, t, s0 in
-                  zip(b["source"], b["description"], b["rms_um"], b["se_um"], b["trials"],
-                      b["s0_um"])]),
+        md_table(
+            ["source", "what", "rms (um)", "MC s.e. (um)", "trials", "rms sigma0 (um)"],
+            [
+                [s, de, fmt(r), fmt(se), t, fmt(s0)]
+                for s, de, r, se, t, s0 in zip(
+                    b["source"], b["description"], b["rms_um"], b["se_um"], b["trials"], b["s0_um"]
+                )
+            ],
+        ),
         "",
         f"![error budget]({name}/budget.png)",
         "",
@@ -158,14 +219,45 @@ def report(out: Path) -> str:
         "",
         "### Formal against empirical",
         "",
-        md_table(["model", "scenario", "grid", "sigma (um)", "beta (mm)", "trials",
-                  "not converged", "dof", "ellipse cov. (known sigma)", "ellipse cov. (s0, F)",
-                  "chi2 false alarm", "E[s0]/sigma", "c4", "b cov.", "beta cov."],
-                 [[c["model"][i], c["scenario"][i], c["grid"][i], fmt(c["sigma_um"][i]),
-                   fmt(c["beta_mm"][i]), c["trials"][i], c["nonconverged"][i], c["dof"][i],
-                   fmt(c["coverage_known"][i]), fmt(c["coverage_f"][i]), fmt(c["false_alarm"][i]),
-                   fmt(c["s0_ratio"][i]), fmt(c["s0_expected"][i]), fmt(c["b_coverage"][i]),
-                   fmt(c["beta_coverage"][i])] for i in range(len(c["model"]))]),
+        md_table(
+            [
+                "model",
+                "scenario",
+                "grid",
+                "sigma (um)",
+                "beta (mm)",
+                "trials",
+                "not converged",
+                "dof",
+                "ellipse cov. (known sigma)",
+                "ellipse cov. (s0, F)",
+                "chi2 false alarm",
+                "E[s0]/sigma",
+                "c4",
+                "b cov.",
+                "beta cov.",
+            ],
+            [
+                [
+                    c["model"][i],
+                    c["scenario"][i],
+                    c["grid"][i],
+                    fmt(c["sigma_um"][i]),
+                    fmt(c["beta_mm"][i]),
+                    c["trials"][i],
+                    c["nonconverged"][i],
+                    c["dof"][i],
+                    fmt(c["coverage_known"][i]),
+                    fmt(c["coverage_f"][i]),
+                    fmt(c["false_alarm"][i]),
+                    fmt(c["s0_ratio"][i]),
+                    fmt(c["s0_expected"][i]),
+                    fmt(c["b_coverage"][i]),
+                    fmt(c["beta_coverage"][i]),
+                ]
+                for i in range(len(c["model"]))
+            ],
+        ),
         "",
         f"![coverage]({name}/coverage.png)",
         "",
@@ -178,12 +270,31 @@ def report(out: Path) -> str:
         "do not change with the BLAS's last bits; `make verify` compares these columns with "
         "tolerances of that size.",
         "",
-        md_table(["parameter", "LS sigma (mm)", "posterior sigma (mm)", "ratio", "MC s.e.",
-                  "spread over chains", "tau (steps)", "N_eff"],
-                 [[p, fmt(a), fmt(s), fmt(r), fmt(se), fmt(sp), fmt(t), fmt(n)]
-                  for p, a, s, r, se, sp, t, n in
-                  zip(by["param"], by["ls_sigma_mm"], by["post_sigma_mm"], by["ratio"],
-                      by["ratio_se"], by["ratio_chain_spread"], by["tau_steps"], by["n_eff"])]),
+        md_table(
+            [
+                "parameter",
+                "LS sigma (mm)",
+                "posterior sigma (mm)",
+                "ratio",
+                "MC s.e.",
+                "spread over chains",
+                "tau (steps)",
+                "N_eff",
+            ],
+            [
+                [p, fmt(a), fmt(s), fmt(r), fmt(se), fmt(sp), fmt(t), fmt(n)]
+                for p, a, s, r, se, sp, t, n in zip(
+                    by["param"],
+                    by["ls_sigma_mm"],
+                    by["post_sigma_mm"],
+                    by["ratio"],
+                    by["ratio_se"],
+                    by["ratio_chain_spread"],
+                    by["tau_steps"],
+                    by["n_eff"],
+                )
+            ],
+        ),
         "",
         f"Acceptance {fmt(by['acceptance'][0])}; largest correlation difference "
         f"{fmt(by['max_abs_corr_diff'][0])}.",
@@ -192,17 +303,46 @@ def report(out: Path) -> str:
     ]
     if (out / "bayes_twoplate.parquet").is_file():
         tp = _t(out, "bayes_twoplate.parquet")
-        txt += ["", "**Two-plate calibration (seed 001): variance components.** One simulated "
-                "calibration of `gridplate_two_plates` (its defaults), the true grid coordinates "
-                "integrated out exactly. Posterior of sigma_c^2 / sigma_g^2 (= P_cx / P_x):", "",
-                md_table(["prior", "2.5 %", "median", "97.5 %", "width (decades)", "MC s.e.",
-                          "sigma_c (um)", "sigma_g (um)", "tau max", "N_eff", "re-weighting",
-                          "truth"],
-                         [[tp["prior"][i], fmt(tp["rho_q025"][i]), fmt(tp["rho_median"][i]),
-                           fmt(tp["rho_q975"][i]), fmt(tp["log10_width"][i]),
-                           fmt(tp["log10_width_se"][i]), fmt(tp["sigma_c_median_um"][i]),
-                           fmt(tp["sigma_g_median_um"][i]), fmt(tp["tau_max"][i]),
-                           fmt(tp["n_eff"][i]), fmt(tp["rw_ratio_mean"][i]),
-                           fmt(tp["true_ratio"][i])] for i in range(len(tp["prior"]))]),
-                "", f"![two-plate ratio]({name}/twoplate_ratio.png)"]
+        txt += [
+            "",
+            "**Two-plate calibration (seed 001): variance components.** One simulated "
+            "calibration of `gridplate_two_plates` (its defaults), the true grid coordinates "
+            "integrated out exactly. Posterior of sigma_c^2 / sigma_g^2 (= P_cx / P_x):",
+            "",
+            md_table(
+                [
+                    "prior",
+                    "2.5 %",
+                    "median",
+                    "97.5 %",
+                    "width (decades)",
+                    "MC s.e.",
+                    "sigma_c (um)",
+                    "sigma_g (um)",
+                    "tau max",
+                    "N_eff",
+                    "re-weighting",
+                    "truth",
+                ],
+                [
+                    [
+                        tp["prior"][i],
+                        fmt(tp["rho_q025"][i]),
+                        fmt(tp["rho_median"][i]),
+                        fmt(tp["rho_q975"][i]),
+                        fmt(tp["log10_width"][i]),
+                        fmt(tp["log10_width_se"][i]),
+                        fmt(tp["sigma_c_median_um"][i]),
+                        fmt(tp["sigma_g_median_um"][i]),
+                        fmt(tp["tau_max"][i]),
+                        fmt(tp["n_eff"][i]),
+                        fmt(tp["rw_ratio_mean"][i]),
+                        fmt(tp["true_ratio"][i]),
+                    ]
+                    for i in range(len(tp["prior"]))
+                ],
+            ),
+            "",
+            f"![two-plate ratio]({name}/twoplate_ratio.png)",
+        ]
     return "\n".join(txt)

@@ -5,6 +5,7 @@ Parts and chunk streams (``spawn_key = (part, chunk)``): 0 the Monte-Carlo check
 paper's design; 10-20 the error budget (adaptive); 30-50 coverage; 60-72 emcee (one chain per
 chunk); 90-93 the linearised plates of the external comparisons.
 """
+
 from __future__ import annotations
 
 from functools import partial
@@ -12,26 +13,33 @@ from pathlib import Path
 
 import numpy as np
 
-from ... import datum as dm, positions as po
-from ...claims import write_claims
-from ...figure_jobs import start_figures
-from ...intervals import bootstrap_ci
-from ...runner import chunk_rng, run_chunks
-from ...storage import provenance, write_table
-from .. import RunContext
-from . import figures
-from .cells import (design_cells, measuring_time, pareto_front, plate_setup, range_sigma,
-                    within_front)
-from .chunks import design_chunk
-from .claims import load_book, score_all
-from .consistent import sweep_unprinted
-from .dilution import datum_analysis
-from .errbudget import budget_analysis
-from .external import external_at
-from .formal import coverage_analysis
-from .parts import side_by_side
-from .posterior import bayes_analysis, twoplate_analysis
-from .schema import max_offset_mm
+from sim.claims.book import write_claims
+from sim.claims.intervals import bootstrap_ci
+from sim.instruments.ranges import positions as po
+from sim.lsq import datum as dm
+from sim.mc.runner import chunk_rng, run_chunks
+from sim.mc.storage import provenance, write_table
+from sim.report.figure_jobs import start_figures
+from sim.studies import RunContext
+from sim.studies.design import figures
+from sim.studies.design.cells import (
+    design_cells,
+    measuring_time,
+    pareto_front,
+    plate_setup,
+    range_sigma,
+    within_front,
+)
+from sim.studies.design.chunks import design_chunk
+from sim.studies.design.claims import load_book, score_all
+from sim.studies.design.consistent import sweep_unprinted
+from sim.studies.design.dilution import datum_analysis
+from sim.studies.design.errbudget import budget_analysis
+from sim.studies.design.external import external_at
+from sim.studies.design.formal import coverage_analysis
+from sim.studies.design.parts import side_by_side
+from sim.studies.design.posterior import bayes_analysis, twoplate_analysis
+from sim.studies.design.schema import max_offset_mm
 
 __all__ = ["run"]
 
@@ -41,51 +49,99 @@ def _design(cfg, cols):
     ok = np.array(cols["feasible"])
     jp = int(np.flatnonzero(cols["paper_design"])[0])
     same = ok & np.isclose(np.array(cols["setting_sigma_um"]), cfg["paper.setting_sigma_um"])
-    same_n = (same & (np.array(cols["n_points"]) == cols["n_points"][jp])
-              & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp]))
+    same_n = (
+        same
+        & (np.array(cols["n_points"]) == cols["n_points"][jp])
+        & np.isclose(np.array(cols["extent_mm"]), cols["extent_mm"][jp])
+    )
     better = np.flatnonzero(same_n & (cost <= cost[jp] + 1e-9) & (acc < acc[jp] - 1e-12))
     b = int(better[np.argmin(acc[better])]) if len(better) else jp
     ext_d = (cfg["datum.grid"] - 1) * cfg["datum.spacing_mm"] / 2
     return {
-        "brown.design.paper_on_pareto_front": (float(cols["pareto"][jp]), (
-            f"on the front of worst-point sigma against time over {int(ok.sum())} feasible of "
-            f"{len(ok)} cells: 1 = yes; worst sigma {within_front(cost, acc, ok, jp):.3f} x the "
-            "best available at no more time")),
-        "brown.design.paper_on_front_same_setting_sigma": (float(pareto_front(cost, acc, same)[jp]), (
-            f"among the {int(same.sum())} feasible cells with the paper's setting sigma: worst "
-            f"sigma {within_front(cost, acc, same, jp):.3f} x the best at no more time")),
-        "brown.design.paper_on_front_same_points": (float(pareto_front(cost, acc, same_n)[jp]), (
-            f"among the {int(same_n.sum())} feasible cells with the paper's setting sigma and "
-            f"its {cols['n_points'][jp]} points: worst sigma "
-            f"{within_front(cost, acc, same_n, jp):.3f} x the best at no more time (best: P = "
-            f"{cols['positions'][b]}, offset {cols['offset_mm'][b]:g} mm, {cols['settings'][b]} "
-            f"settings, {cost[b]:.0f} min, {acc[b]:.3f} um)")),
-        "brown.design.paper_worst_sigma_um": (acc[jp], (
-            f"analytic worst-point sigma of the paper's design (pivot model, inner datum over "
-            f"the points, range sigma {cols['range_sigma_um'][jp]:.2f} um); mean "
-            f"{cols['mean_sigma_um'][jp]:.3f} um")),
-        "brown.design.max_offset_paper_grid_mm": (max_offset_mm(cfg, cfg["paper.extent_mm"]), (
-            f"largest station offset with every range of a +-{cfg['paper.extent_mm']:g} mm grid "
-            "on the scale plus micrometer")),
-        "brown.design.max_offset_dilution_grid_mm": (max_offset_mm(cfg, ext_d), (
-            f"the same for brown_dilution's +-{ext_d:g} mm grid (its station offset is "
-            f"{cfg['datum.offset_mm']:g} mm)")),
+        "brown.design.paper_on_pareto_front": (
+            float(cols["pareto"][jp]),
+            (
+                f"on the front of worst-point sigma against time over {int(ok.sum())} feasible of "
+                f"{len(ok)} cells: 1 = yes; worst sigma {within_front(cost, acc, ok, jp):.3f} x the "
+                "best available at no more time"
+            ),
+        ),
+        "brown.design.paper_on_front_same_setting_sigma": (
+            float(pareto_front(cost, acc, same)[jp]),
+            (
+                f"among the {int(same.sum())} feasible cells with the paper's setting sigma: worst "
+                f"sigma {within_front(cost, acc, same, jp):.3f} x the best at no more time"
+            ),
+        ),
+        "brown.design.paper_on_front_same_points": (
+            float(pareto_front(cost, acc, same_n)[jp]),
+            (
+                f"among the {int(same_n.sum())} feasible cells with the paper's setting sigma and "
+                f"its {cols['n_points'][jp]} points: worst sigma "
+                f"{within_front(cost, acc, same_n, jp):.3f} x the best at no more time (best: P = "
+                f"{cols['positions'][b]}, offset {cols['offset_mm'][b]:g} mm, {cols['settings'][b]} "
+                f"settings, {cost[b]:.0f} min, {acc[b]:.3f} um)"
+            ),
+        ),
+        "brown.design.paper_worst_sigma_um": (
+            acc[jp],
+            (
+                f"analytic worst-point sigma of the paper's design (pivot model, inner datum over "
+                f"the points, range sigma {cols['range_sigma_um'][jp]:.2f} um); mean "
+                f"{cols['mean_sigma_um'][jp]:.3f} um"
+            ),
+        ),
+        "brown.design.max_offset_paper_grid_mm": (
+            max_offset_mm(cfg, cfg["paper.extent_mm"]),
+            (
+                f"largest station offset with every range of a +-{cfg['paper.extent_mm']:g} mm grid "
+                "on the scale plus micrometer"
+            ),
+        ),
+        "brown.design.max_offset_dilution_grid_mm": (
+            max_offset_mm(cfg, ext_d),
+            (
+                f"the same for brown_dilution's +-{ext_d:g} mm grid (its station offset is "
+                f"{cfg['datum.offset_mm']:g} mm)"
+            ),
+        ),
     }
 
 
 def _mc_check(cfg, pts, th, sr, ctx):
-    sim = run_chunks(partial(design_chunk, pts, th, sr), cfg["trials"], cfg["seed"], cfg["chunk"],
-                     part=0, label="design MC", ctx=ctx)
+    sim = run_chunks(
+        partial(design_chunk, pts, th, sr),
+        cfg["trials"],
+        cfg["seed"],
+        cfg["chunk"],
+        part=0,
+        label="design MC",
+        ctx=ctx,
+    )
     good = sim["status"] == 0
     E = sim["err_um"][good]
-    Fan = dm.s_transform(po.full_point_covariance(pts[None], th[None], "pivot", "inner"),
-                         dm.inner(pts))[0] * sr ** 2
+    Fan = (
+        dm.s_transform(
+            po.full_point_covariance(pts[None], th[None], "pivot", "inner"), dm.inner(pts)
+        )[0]
+        * sr**2
+    )
     an2 = np.diag(Fan)
-    v, ci = bootstrap_ci(lambda a: np.sqrt(a.var(0, ddof=1).mean() / an2.mean()), E,
-                         chunk_rng(cfg["seed"], 98, 0), n_boot=200)
-    return v, ci, (f"pooled MC sigma / analytic sigma over {an2.size} coordinates of the paper's "
-                   f"design, P-position solver, inner datum; {int(good.sum())} converged of "
-                   f"{len(good)} trials; bootstrap interval")
+    v, ci = bootstrap_ci(
+        lambda a: np.sqrt(a.var(0, ddof=1).mean() / an2.mean()),
+        E,
+        chunk_rng(cfg["seed"], 98, 0),
+        n_boot=200,
+    )
+    return (
+        v,
+        ci,
+        (
+            f"pooled MC sigma / analytic sigma over {an2.size} coordinates of the paper's "
+            f"design, P-position solver, inner datum; {int(good.sum())} converged of "
+            f"{len(good)} trials; bootstrap interval"
+        ),
+    )
 
 
 def _tolerances(R: dict) -> dict:
@@ -94,22 +150,38 @@ def _tolerances(R: dict) -> dict:
     by = R["bayes"]
     rel = max(4 * se / v for v, se, _, _ in by["ratio"].values())
     v, se, _, _ = by["max_corr_diff"]
-    tol = {"bayes.parquet": {"post_mean": 1e-3, "post_sigma_mm": rel, "ratio": rel,
-                             "ratio_se": 0.5, "ratio_chain_spread": 1.0, "tau_steps": 0.5,
-                             "n_eff": 0.5, "acceptance": 0.05,
-                             "max_abs_corr_diff": 4 * se / max(v, 1e-12)},
-           "claims.parquet": {}}
+    tol = {
+        "bayes.parquet": {
+            "post_mean": 1e-3,
+            "post_sigma_mm": rel,
+            "ratio": rel,
+            "ratio_se": 0.5,
+            "ratio_chain_spread": 1.0,
+            "tau_steps": 0.5,
+            "n_eff": 0.5,
+            "acceptance": 0.05,
+            "max_abs_corr_diff": 4 * se / max(v, 1e-12),
+        },
+        "claims.parquet": {},
+    }
     claim_rel = max(rel, 4 * se / max(v, 1e-12))
     tp = R.get("twoplate")
     if tp is not None:
         f = tp["prior"].index("flat")
         w_rel = 4 * tp["log10_width_se"][f] / tp["log10_width"][f]
-        q_rel = float(np.expm1(4 * np.log(10) * max(tp["log10_q_se"])))   # ratio quantiles
+        q_rel = float(np.expm1(4 * np.log(10) * max(tp["log10_q_se"])))  # ratio quantiles
         tol["bayes_twoplate.parquet"] = {c: q_rel for c in ("rho_q025", "rho_median", "rho_q975")}
-        tol["bayes_twoplate.parquet"].update({"log10_width": w_rel, "log10_width_se": 0.5,
-                                              "log10_q_se": 0.5, "tau_max": 0.5, "n_eff": 0.5,
-                                              "sigma_c_median_um": q_rel,
-                                              "sigma_g_median_um": q_rel})
+        tol["bayes_twoplate.parquet"].update(
+            {
+                "log10_width": w_rel,
+                "log10_width_se": 0.5,
+                "log10_q_se": 0.5,
+                "tau_max": 0.5,
+                "n_eff": 0.5,
+                "sigma_c_median_um": q_rel,
+                "sigma_g_median_um": q_rel,
+            }
+        )
         j = tp["prior"].index("certificate")
         claim_rel = max(claim_rel, w_rel, float(np.expm1(4 * np.log(10) * tp["log10_q_se"][j])))
     tol["claims.parquet"] = {c: claim_rel for c in ("value", "value_high", "ci_low", "ci_high")}
@@ -118,7 +190,7 @@ def _tolerances(R: dict) -> dict:
 
 def _unbounded_as_null(row: dict) -> dict:
     """An open side of a bound's decision zone (+-inf) is stored as null: tables refuse
-    infinities (:func:`sim.storage.check_finite_table`)."""
+    infinities (:func:`sim.mc.storage.check_finite_table`)."""
     for k in ("zone_low", "zone_high"):
         if isinstance(row[k], float) and np.isinf(row[k]):
             row[k] = float("nan")
@@ -129,7 +201,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     prov = provenance(cfg)
     book = load_book()
     R: dict = {}
-    drawn = []   # each stage's figures go to idle workers as soon as its tables exist
+    drawn = []  # each stage's figures go to idle workers as soon as its tables exist
 
     def figs(stage, *data):
         drawn.append(start_figures(figures.figure_jobs(stage, out, *data), ctx.executor))
@@ -143,17 +215,30 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     cs, sv = sweep_unprinted(cfg, book, cols)
     figs("consistent", sv, cs)
     R["design"] = _design(cfg, cols)
-    R["time"] = (measuring_time(cfg, 4, cfg["time.images"], 1),
-                 measuring_time(cfg, 4, cfg["time.images"], 2))
-    pts, th = plate_setup(cfg, cfg["paper.positions"], cfg["paper.grid"], cfg["paper.extent_mm"],
-                          cfg["paper.offset_mm"], cfg["paper.beta_mm"])
-    sr = float(range_sigma(cfg["paper.setting_sigma_um"], cfg["paper.settings"],
-                           cfg["comparator.sigma_um"]))
+    R["time"] = (
+        measuring_time(cfg, 4, cfg["time.images"], 1),
+        measuring_time(cfg, 4, cfg["time.images"], 2),
+    )
+    pts, th = plate_setup(
+        cfg,
+        cfg["paper.positions"],
+        cfg["paper.grid"],
+        cfg["paper.extent_mm"],
+        cfg["paper.offset_mm"],
+        cfg["paper.beta_mm"],
+    )
+    sr = float(
+        range_sigma(
+            cfg["paper.setting_sigma_um"], cfg["paper.settings"], cfg["comparator.sigma_um"]
+        )
+    )
     # 3. datum (analytic)
     dcols, R["datum"] = datum_analysis(cfg)
-    R["datum"]["geometry"] = (f"{cfg['datum.grid']}x{cfg['datum.grid']} points at "
-                              f"{cfg['datum.spacing_mm']:g} mm, stations "
-                              f"{cfg['datum.offset_mm']:g} mm out")
+    R["datum"]["geometry"] = (
+        f"{cfg['datum.grid']}x{cfg['datum.grid']} points at "
+        f"{cfg['datum.spacing_mm']:g} mm, stations "
+        f"{cfg['datum.offset_mm']:g} mm out"
+    )
     write_table(out / "datum.parquet", dcols, prov)
     figs("datum", cfg, dcols)
 
@@ -181,9 +266,16 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         figs("twoplate", tcols, tsamples)
         return tcols, why
 
-    done = side_by_side({"bayes": bayes, "twoplate": twoplate, "budget": budget,
-                         "coverage": coverage, "mc": lambda: _mc_check(cfg, pts, th, sr, ctx)},
-                        ctx)
+    done = side_by_side(
+        {
+            "bayes": bayes,
+            "twoplate": twoplate,
+            "budget": budget,
+            "coverage": coverage,
+            "mc": lambda: _mc_check(cfg, pts, th, sr, ctx),
+        },
+        ctx,
+    )
     R["mc_ratio"] = done["mc"]
     R["budget"], R["budget_sims"] = done["budget"]
     R["coverage"] = done["coverage"]
@@ -191,8 +283,13 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     tcols, why = done["twoplate"]
     R["twoplate"] = tcols
     # 6. external comparisons at the configured inputs
-    R["external"] = external_at(cfg, cfg["paper.offset_mm"], cfg["paper.beta_mm"],
-                                cfg["zeiss.half_extent_mm"], cfg["budget.pitch_mm"])
+    R["external"] = external_at(
+        cfg,
+        cfg["paper.offset_mm"],
+        cfg["paper.beta_mm"],
+        cfg["zeiss.half_extent_mm"],
+        cfg["budget.pitch_mm"],
+    )
     rows = [_unbounded_as_null(r) for r in score_all(book, cfg, R)]
     prov_t = provenance(cfg, tolerances=_tolerances(R))
     write_table(out / "bayes.parquet", bycols, prov_t)

@@ -5,17 +5,25 @@ Modules: :mod:`.schema` (config and checks), :mod:`.model` (simulation and per-c
 reduction), :mod:`.run` (the run), :mod:`.sweep` (unprinted inputs, consistent set),
 ``claims.toml`` + :mod:`.claims` (scoring), :mod:`.figures`, :mod:`.report`.
 """
+
 from __future__ import annotations
 
-from .. import Study
-from .report import report
-from .run import run
-from .schema import SCHEMA, check
+from sim.studies import Study
+from sim.studies.gridplate.report import report
+from sim.studies.gridplate.run import run
+from sim.studies.gridplate.schema import SCHEMA, check
 
 SEED = "001_7e3a2951e7fed426.txt"
 
 STUDIES = {
-    "gridplate_two_plates": Study("gridplate_two_plates",
-                                  "Calibration of a comparator with two grid plates", SEED,
-                                  SCHEMA, run, report, check, order=20),
+    "gridplate_two_plates": Study(
+        "gridplate_two_plates",
+        "Calibration of a comparator with two grid plates",
+        SEED,
+        SCHEMA,
+        run,
+        report,
+        check,
+        order=20,
+    ),
 }

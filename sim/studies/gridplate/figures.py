@@ -1,17 +1,18 @@
 """Figures of ``gridplate_two_plates``: residuals of one calibration, parameter spread,
 interval coverage against the weight ratio, chi-square rejection, implied grid sigma, and the
 claims against every unprinted input (consistent set)."""
+
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ... import gridplate as gp
-from ... import transforms2d as t2
-from ...plotting import plt, save
-from .model import PARAM_LABEL, PARAMS, truth_rows
-from .schema import UM
+from sim.instruments import gridplate as gp
+from sim.instruments import transforms2d as t2
+from sim.report.plotting import plt, save
+from sim.studies.gridplate.model import PARAM_LABEL, PARAMS, truth_rows
+from sim.studies.gridplate.schema import UM
 
 
 def fig_residuals(cfg: dict, sim: dict, path: Path) -> dict:
@@ -21,8 +22,12 @@ def fig_residuals(cfg: dict, sim: dict, path: Path) -> dict:
     g = sim["cert"][0, 0]
     fa = t2.fit_affine(g, mean)
     comp2 = np.stack([mean[:, 0], mean[:, 1]])
-    rw = gp.reweight(comp2, np.stack([g, g]), cfg["grid.sigma_stated_um"] * UM,
-                     ratio0=float(cfg["analysis.ratio_start"]))
+    rw = gp.reweight(
+        comp2,
+        np.stack([g, g]),
+        cfg["grid.sigma_stated_um"] * UM,
+        ratio0=float(cfg["analysis.ratio_start"]),
+    )
     res = rw["result"]
     vc = np.stack([res.v_comp[0], res.v_comp[1]], -1)
     vg = np.stack([res.v_grid[0], res.v_grid[1]], 0)
@@ -32,22 +37,54 @@ def fig_residuals(cfg: dict, sim: dict, path: Path) -> dict:
         ax.set_aspect("equal")
         ax.set_xlabel("grid x (mm)")
         ax.set_ylabel("grid y (mm)")
-    q = axs[0].quiver(g[:, 0], g[:, 1], fa.residuals[0, :, 0], fa.residuals[0, :, 1],
-                      angles="xy", scale_units="xy", scale=qs, color="k")
+    q = axs[0].quiver(
+        g[:, 0],
+        g[:, 1],
+        fa.residuals[0, :, 0],
+        fa.residuals[0, :, 1],
+        angles="xy",
+        scale_units="xy",
+        scale=qs,
+        color="k",
+    )
     axs[0].set_title(f"affine, grid fixed: s0 = {fa.s0[0] / UM:.2f} um", pad=16)
-    q2 = axs[1].quiver(g[:, 0], g[:, 1], vc[:, 0], vc[:, 1], angles="xy", scale_units="xy",
-                       scale=qs, color="tab:blue", label="comparator v")
-    axs[1].quiver(g[:, 0], g[:, 1], vg[0, :, 0], vg[1, :, 1], angles="xy", scale_units="xy",
-                  scale=qs, color="tab:red", label="grid v (x from x' run, y from y' run)")
+    q2 = axs[1].quiver(
+        g[:, 0],
+        g[:, 1],
+        vc[:, 0],
+        vc[:, 1],
+        angles="xy",
+        scale_units="xy",
+        scale=qs,
+        color="tab:blue",
+        label="comparator v",
+    )
+    axs[1].quiver(
+        g[:, 0],
+        g[:, 1],
+        vg[0, :, 0],
+        vg[1, :, 1],
+        angles="xy",
+        scale_units="xy",
+        scale=qs,
+        color="tab:red",
+        label="grid v (x from x' run, y from y' run)",
+    )
     axs[1].set_title(f"combined, P_x:P_cx = 1:{np.nanmean(rw['ratio']):.2f}", pad=16)
     axs[1].legend(loc="lower left", fontsize=7)
     for ax, qq in zip(axs, (q, q2)):
         ax.quiverkey(qq, 0.85, 1.02, 2 * UM, "2 um", labelpos="E", coordinates="axes")
     save(fig, path)
-    return {"x_mm": g[:, 0], "y_mm": g[:, 1], "aff_vx_um": fa.residuals[0, :, 0] / UM,
-            "aff_vy_um": fa.residuals[0, :, 1] / UM, "comb_vx_um": vc[:, 0] / UM,
-            "comb_vy_um": vc[:, 1] / UM, "grid_vx_um": vg[0, :, 0] / UM,
-            "grid_vy_um": vg[1, :, 1] / UM}
+    return {
+        "x_mm": g[:, 0],
+        "y_mm": g[:, 1],
+        "aff_vx_um": fa.residuals[0, :, 0] / UM,
+        "aff_vy_um": fa.residuals[0, :, 1] / UM,
+        "comb_vx_um": vc[:, 0] / UM,
+        "comb_vy_um": vc[:, 1] / UM,
+        "grid_vx_um": vg[0, :, 0] / UM,
+        "grid_vy_um": vg[1, :, 1] / UM,
+    }
 
 
 def fig_params(cfg: dict, res: dict, path: Path) -> None:
@@ -71,8 +108,10 @@ def fig_coverage(cov: dict, ratio_true: float, path: Path) -> None:
     fig, axs = plt.subplots(1, 3, figsize=(12, 3.8), sharey=True)
     r = np.asarray(cov["ratio"])
     for ax, k in zip(axs, PARAMS):
-        for tag, c, lab in (("pri", "tab:blue", "a-priori sigma"), ("post", "tab:orange",
-                                                                     "a-posteriori s0")):
+        for tag, c, lab in (
+            ("pri", "tab:blue", "a-priori sigma"),
+            ("post", "tab:orange", "a-posteriori s0"),
+        ):
             ax.plot(r, cov[f"{k}_{tag}"], "o-", color=c, label=f"weighted, {lab}")
             ax.axhline(cov[f"{k}_fixed_{tag}"][0], color=c, ls=":", label=f"grid fixed, {lab}")
         ax.axhline(0.95, color="k", lw=0.8)
@@ -89,9 +128,14 @@ def fig_coverage(cov: dict, ratio_true: float, path: Path) -> None:
 def fig_chi2(tab: dict, true_um: float, path: Path) -> None:
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
     ax.plot(tab["stated_um"], tab["analytic"], "-", color="k", label="analytic")
-    ax.errorbar(tab["stated_um"], tab["reject"], yerr=[np.subtract(tab["reject"], tab["lo"]),
-                np.subtract(tab["hi"], tab["reject"])], fmt="o", color="tab:red",
-                label="Monte Carlo (95 % CI)")
+    ax.errorbar(
+        tab["stated_um"],
+        tab["reject"],
+        yerr=[np.subtract(tab["reject"], tab["lo"]), np.subtract(tab["hi"], tab["reject"])],
+        fmt="o",
+        color="tab:red",
+        label="Monte Carlo (95 % CI)",
+    )
     ax.axvline(true_um, color="tab:green", label="true grid sigma")
     ax.set_xlabel("stated grid sigma (um)")
     ax.set_ylabel("rejection rate of the chi-square test")
@@ -102,8 +146,9 @@ def fig_chi2(tab: dict, true_um: float, path: Path) -> None:
 def fig_implied(tab: dict, stated_um: float, paper: list[tuple[float, float]], path: Path) -> None:
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
     r = np.asarray(tab["ratio"])
-    ax.fill_between(r, tab["lo"], tab["hi"], color="tab:blue", alpha=0.25,
-                    label="95 % range over calibrations")
+    ax.fill_between(
+        r, tab["lo"], tab["hi"], color="tab:blue", alpha=0.25, label="95 % range over calibrations"
+    )
     ax.plot(r, tab["median"], "o-", color="tab:blue", label="median")
     ax.axhline(stated_um, color="tab:green", label="stated grid sigma")
     ax.plot([p[0] for p in paper], [p[1] for p in paper], "k*", ms=10, label="paper")
@@ -121,22 +166,35 @@ def fig_consistent(det: dict, cons: dict, path: Path) -> None:
     """Outcome of every swept claim against each unprinted input; consistent set shaded."""
     inputs = list(dict.fromkeys(det["input"]))
     claims = list(dict.fromkeys(det["claim"]))
-    fig, axs = plt.subplots(len(inputs), 1, figsize=(9, 2.0 + 0.32 * len(claims) * len(inputs)),
-                            squeeze=False)
+    fig, axs = plt.subplots(
+        len(inputs), 1, figsize=(9, 2.0 + 0.32 * len(claims) * len(inputs)), squeeze=False
+    )
     short = [c.split(".", 1)[1] for c in claims]
     for ax, key in zip(axs[:, 0], inputs):
         idx = [i for i, k in enumerate(det["input"]) if k == key]
         xs = sorted({det["input_value"][i] for i in idx})
         pos = {x: n for n, x in enumerate(xs)}
-        ax.scatter([pos[det["input_value"][i]] for i in idx],
-                   [claims.index(det["claim"][i]) for i in idx], s=40, marker="s",
-                   c=[_COL.get(det["outcome"][i], "grey") for i in idx])
-        allrow = [j for j, (k, c) in enumerate(zip(cons["input"], cons["claim"]))
-                  if k == key and c == "ALL"][0]
+        ax.scatter(
+            [pos[det["input_value"][i]] for i in idx],
+            [claims.index(det["claim"][i]) for i in idx],
+            s=40,
+            marker="s",
+            c=[_COL.get(det["outcome"][i], "grey") for i in idx],
+        )
+        allrow = [
+            j
+            for j, (k, c) in enumerate(zip(cons["input"], cons["claim"]))
+            if k == key and c == "ALL"
+        ][0]
         lo, hi = cons["holds_low"][allrow], cons["holds_high"][allrow]
         if np.isfinite(lo):
-            ax.axvspan(pos[lo] - 0.45, pos[hi] + 0.45, color="tab:green", alpha=0.12,
-                       label="consistent set (all claims not contradicted)")
+            ax.axvspan(
+                pos[lo] - 0.45,
+                pos[hi] + 0.45,
+                color="tab:green",
+                alpha=0.12,
+                label="consistent set (all claims not contradicted)",
+            )
         d = cons["default"][allrow]
         if d in pos:
             ax.axvline(pos[d], color="k", ls=":", lw=1, label="value used in the run")

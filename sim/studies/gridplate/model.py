@@ -13,19 +13,20 @@ equally weighted points is, to first order, the affine least-squares fit with th
 cofactor ``(1 + k/r)``, ``k = A^2 + B^2`` (Gauss-Helmert form): ``s0^2 = s_w^2 / (1 + k/r)``,
 ``Q_r = (1 + k/r) Q_affine``, where ``s_w^2`` is the affine fit's residual variance of the row.
 So the weight-ratio and stated-sigma sweeps are evaluated from ONE affine fit per plate; the
-iterated combined adjustment (:func:`sim.gridplate.reweight`) runs once per plate (the paper's
+iterated combined adjustment (:func:`sim.instruments.gridplate.reweight`) runs once per plate (the paper's
 procedure, and the check of the closed form: ``closed_form_rel``), and its Gauss-Newton
 iterations are counted on ``analysis.iter_sample`` adjustments per chunk.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ... import gridplate as gp
-from ... import transforms2d as t2
-from ...plate import grid_points
-from .schema import UM
-from ... import distributions as D
+from sim.instruments import gridplate as gp
+from sim.instruments import transforms2d as t2
+from sim.instruments.plates import grid_points
+from sim.lsq import distributions as D
+from sim.studies.gridplate.schema import UM
 
 PARAMS = ("S", "S2", "eps")
 PARAM_LABEL = {"S": "S", "S2": "S'", "eps": "eps"}
@@ -52,7 +53,7 @@ def simulate(cfg: dict, rng: np.random.Generator, n: int) -> dict[str, np.ndarra
     true = t2.affine_from_rows(S, S2, eps, kap, (shift[..., 0], shift[..., 1]))
     ideal = t2.apply_affine(true.reshape(-1, 6), G).reshape(n, P, N, 2)
     sp, sc = cfg["readings.sigma_um"] * UM, cfg["comparator.coord_sigma_um"] * UM
-    s_point = np.sqrt(max(sc ** 2 - sp ** 2 / L, 0.0))
+    s_point = np.sqrt(max(sc**2 - sp**2 / L, 0.0))
     comp_err = rng.normal(0.0, 1.0, (n, P, N, 2)) * s_point
     readings = (ideal + comp_err)[:, :, :, None, :] + rng.normal(0.0, sp, (n, P, N, L, 2))
     cert = G + rng.normal(0.0, 1.0, (n, P, N, 2)) * cfg["grid.sigma_true_um"] * UM
@@ -66,8 +67,9 @@ def _decomp_errors(p, cov, S, S2, eps):
     return err, sd
 
 
-def reweight_trials(sw2: np.ndarray, k: np.ndarray, stated: float, dof: int, start: float,
-                    alpha: float) -> np.ndarray:
+def reweight_trials(
+    sw2: np.ndarray, k: np.ndarray, stated: float, dof: int, start: float, alpha: float
+) -> np.ndarray:
     """The paper's re-weighting, literally: adjust at ``P_cx = start`` (``P_x = 1``); while the
     chi-square test of the implied grid variance ``s0^2 / P_cx`` against ``stated^2`` rejects,
     set ``P_cx <- s0^2 / stated^2`` and adjust again. Returns the number of re-weightings
@@ -79,9 +81,9 @@ def reweight_trials(sw2: np.ndarray, k: np.ndarray, stated: float, dof: int, sta
     done = np.zeros(sw2.shape, bool)
     for _ in range(MAX_TRIALS):
         s02 = sw2 / (1.0 + k / r)
-        x = dof * (s02 / r) / stated ** 2
+        x = dof * (s02 / r) / stated**2
         done |= (x >= lo) & (x <= hi)
-        r = np.where(done, r, s02 / stated ** 2)
+        r = np.where(done, r, s02 / stated**2)
         count += ~done
     return count
 
@@ -89,19 +91,21 @@ def reweight_trials(sw2: np.ndarray, k: np.ndarray, stated: float, dof: int, sta
 def iterations(comp: np.ndarray, g: np.ndarray, ratio: np.ndarray, tol_mm: float) -> np.ndarray:
     """Gauss-Newton iterations of the combined adjustment until the correction is negligible.
 
-    The adjustment starts, as :func:`sim.gridplate.combined_adjustment` does, from the affine
+    The adjustment starts, as :func:`sim.instruments.gridplate.combined_adjustment` does, from the affine
     fit with the grid fixed; iteration ``j`` is the ``j``-th solve of the combined normals.
     Counted: the first ``j`` whose largest correction (parameters mapped to the grid's
     coordinates, and adjusted grid coordinates) is below ``tol_mm``; the iteration that shows
     the convergence counts, as in the paper's program. At most 6."""
     ext = np.abs(g).max(axis=(1, 2)) + 1.0
-    prev_p = None
+    prev_p = prev_u = None
     count = np.full(comp.shape[0], 6)
     for j in range(1, 7):
         r = gp.combined_adjustment(comp, g, 1.0, ratio, max_iter=j, tol=0.0)
         if prev_p is not None:
             dp = np.abs(r.params - prev_p)
-            corr = np.maximum((dp[:, :2].max(1)) * ext + dp[:, 2], np.abs(r.grid - prev_u).max((1, 2)))
+            corr = np.maximum(
+                (dp[:, :2].max(1)) * ext + dp[:, 2], np.abs(r.grid - prev_u).max((1, 2))
+            )
             count = np.where((count == 6) & (corr < tol_mm), j, count)
         prev_p, prev_u = r.params, r.grid
         if np.all(count < 6):
@@ -114,7 +118,7 @@ def reduce_chunk(cfg: dict, sim: dict) -> dict[str, np.ndarray]:
     readings, cert = sim["readings"], sim["cert"]
     n, P, N, L, _ = readings.shape
     S, S2, eps = truth_rows(cfg)
-    sx = cfg["comparator.coord_sigma_um"] * UM          # a-priori comparator sigma
+    sx = cfg["comparator.coord_sigma_um"] * UM  # a-priori comparator sigma
     sg = cfg["grid.sigma_stated_um"] * UM
     alpha, dof = cfg["analysis.alpha"], N - 3
     z = D.norm_ppf(0.975)
@@ -124,19 +128,23 @@ def reduce_chunk(cfg: dict, sim: dict) -> dict[str, np.ndarray]:
     out: dict[str, np.ndarray] = {"sigma_obs_um": sigma_obs / UM}
     fs = t2.fit_similarity(g, mean)
     fa = t2.fit_affine(g, mean)
-    out["sim_sigma_um"] = np.sqrt((fs.s0 ** 2).reshape(n, P).mean(1)) / UM
-    out["aff_sigma_um"] = np.sqrt((fa.s0 ** 2).reshape(n, P).mean(1)) / UM
+    out["sim_sigma_um"] = np.sqrt((fs.s0**2).reshape(n, P).mean(1)) / UM
+    out["aff_sigma_um"] = np.sqrt((fa.s0**2).reshape(n, P).mean(1)) / UM
     # per row (x', y') of each plate: misclosure variance and k = A^2 + B^2
-    sw2 = np.stack([(fa.residuals[..., c] ** 2).sum(1) / dof for c in (0, 1)], 1)   # (nP, 2)
-    kk = np.stack([fa.params[:, 0] ** 2 + fa.params[:, 1] ** 2,
-                   fa.params[:, 3] ** 2 + fa.params[:, 4] ** 2], 1)
+    sw2 = np.stack([(fa.residuals[..., c] ** 2).sum(1) / dof for c in (0, 1)], 1)  # (nP, 2)
+    kk = np.stack(
+        [fa.params[:, 0] ** 2 + fa.params[:, 1] ** 2, fa.params[:, 3] ** 2 + fa.params[:, 4] ** 2],
+        1,
+    )
     Q = fa.cofactor
 
     def rowscale(x):  # (nP, 2) per-row factor -> (nP, 6, 6) block scaling of Q
         f = np.repeat(x, 3, axis=1)
-        return np.sqrt(f[:, :, None] * f[:, None, :]) * (np.arange(6)[:, None] // 3 == np.arange(6) // 3)
+        return np.sqrt(f[:, :, None] * f[:, None, :]) * (
+            np.arange(6)[:, None] // 3 == np.arange(6) // 3
+        )
 
-    for tag, cov in (("fixed_pri", Q * sx ** 2), ("fixed_post", fa.cov)):
+    for tag, cov in (("fixed_pri", Q * sx**2), ("fixed_post", fa.cov)):
         err, sd = _decomp_errors(fa.params, cov, S, S2, eps)
         for i, k in enumerate(PARAMS):
             out[f"{k}_err_{tag}"] = err[:, i].reshape(n, P)
@@ -147,7 +155,7 @@ def reduce_chunk(cfg: dict, sim: dict) -> dict[str, np.ndarray]:
     for j, r in enumerate(cfg["analysis.ratios"]):
         f = 1.0 + kk / r
         out[f"implied_grid_um_r{j}"] = np.sqrt((sw2 / (r + kk)).reshape(n, 2 * P).mean(1)) / UM
-        for tag, scale in (("pri", sx ** 2 * f), ("post", sw2)):
+        for tag, scale in (("pri", sx**2 * f), ("post", sw2)):
             err, sd = _decomp_errors(fa.params, Q * rowscale(scale), S, S2, eps)
             for i, k in enumerate(PARAMS):
                 out[f"{k}_cov_w{tag}_r{j}"] = (np.abs(err[:, i]) <= z * sd[:, i]).reshape(n, P)
@@ -156,24 +164,27 @@ def reduce_chunk(cfg: dict, sim: dict) -> dict[str, np.ndarray]:
     # chi-square test with a-priori weights P_x = 1/sx^2, P_cx = 1/stated^2 (closed form)
     lo, hi = D.chi2_ppf(alpha / 2, dof), D.chi2_ppf(1 - alpha / 2, dof)
     for j, st in enumerate(cfg["analysis.stated_sigmas_um"]):
-        s02 = sw2 / (sx ** 2 + kk * (st * UM) ** 2)
+        s02 = sw2 / (sx**2 + kk * (st * UM) ** 2)
         x = dof * s02
         out[f"reject_s{j}"] = ((x < lo) | (x > hi)).reshape(n, 2 * P)
     # the paper's re-weighting at its fixed point (closed form): P_cx = s_w^2/sg^2 - k,
     # s0^2 = s_w^2 - k sg^2 (the comparator variance); NaN where no positive fixed point
-    closed = sw2 / sg ** 2 - kk
+    closed = sw2 / sg**2 - kk
     ok = closed > 0
     ratio = np.where(ok, closed, np.nan)
     okn = ok.reshape(n, 2 * P).all(1)
-    s0sq = np.where(ok, sw2 - kk * sg ** 2, np.nan).reshape(n, 2 * P)
+    s0sq = np.where(ok, sw2 - kk * sg**2, np.nan).reshape(n, 2 * P)
     out["ratio_rw"] = ratio.reshape(n, 2 * P)
-    out["comp_sigma_um"] = np.where(okn, np.sqrt(np.where(okn[:, None], s0sq, 1.0).mean(1)),
-                                    np.nan) / UM
-    out["ratio_rw_mean"] = np.where(okn, np.where(okn[:, None], ratio.reshape(n, 2 * P), 1.0).mean(1),
-                                    np.nan)
-    out["rw_trials"] = reweight_trials(sw2, kk, sg, dof, cfg["analysis.ratio_start"],
-                                       alpha).reshape(n, 2 * P)
-    # the iterated combined adjustment (sim.gridplate.reweight) on a sample of adjustments:
+    out["comp_sigma_um"] = (
+        np.where(okn, np.sqrt(np.where(okn[:, None], s0sq, 1.0).mean(1)), np.nan) / UM
+    )
+    out["ratio_rw_mean"] = np.where(
+        okn, np.where(okn[:, None], ratio.reshape(n, 2 * P), 1.0).mean(1), np.nan
+    )
+    out["rw_trials"] = reweight_trials(
+        sw2, kk, sg, dof, cfg["analysis.ratio_start"], alpha
+    ).reshape(n, 2 * P)
+    # the iterated combined adjustment (sim.instruments.gridplate.reweight) on a sample of adjustments:
     # check of the closed form, pass rate after re-weighting, Gauss-Newton iterations
     comp2 = np.concatenate([mean[..., 0], mean[..., 1]], 0)[: cfg["analysis.iter_sample"]]
     g2 = np.concatenate([g, g], 0)[: cfg["analysis.iter_sample"]]

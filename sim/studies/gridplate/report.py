@@ -1,13 +1,20 @@
 """Report section of ``gridplate_two_plates``: built from the study's Parquet files and its
 claim book only (no model code)."""
+
 from __future__ import annotations
 
 from pathlib import Path
 
-from ...report import (claims_markdown, consistent_rows, consistent_sets_sentence,
-                        fmt, inputs_markdown, md_table)
-from ...storage import read_provenance, read_table
-from .schema import SCHEMA
+from sim.mc.storage import read_provenance, read_table
+from sim.report.markdown import (
+    claims_markdown,
+    consistent_rows,
+    consistent_sets_sentence,
+    fmt,
+    inputs_markdown,
+    md_table,
+)
+from sim.studies.gridplate.schema import SCHEMA
 
 PARAM_LABEL = {"S": "S", "S2": "S'", "eps": "eps"}
 
@@ -53,8 +60,14 @@ def report(out: Path) -> str:
         "plate), so the test cannot confirm the stated grid sigma.",
         "",
         "**Errata** (the paper against its own printed numbers): "
-        + ("; ".join(f"`{r['claim']}`: printed {fmt(r['ref_low'] + (r['ref_high'] - r['ref_low']) / 2)}, "
-                     f"recomputed {fmt(r['value'])} ({r['note']})" for r in errata) or "none")
+        + (
+            "; ".join(
+                f"`{r['claim']}`: printed {fmt(r['ref_low'] + (r['ref_high'] - r['ref_low']) / 2)}, "
+                f"recomputed {fmt(r['value'])} ({r['note']})"
+                for r in errata
+            )
+            or "none"
+        )
         + ".",
         "",
         claims_markdown(out / "claims.parquet"),
@@ -75,9 +88,13 @@ def report(out: Path) -> str:
         "",
         "**Grid sigma implied by the weight ratio** (`s0/sqrt(P_cx)`, median and 95 % range):",
         "",
-        md_table(["P_cx : P_x", "median (um)", "95 % range (um)"],
-                 [[fmt(r), fmt(m), f"{fmt(lo)}-{fmt(hi)}"] for r, m, lo, hi in
-                  zip(imp["ratio"], imp["median"], imp["lo"], imp["hi"])]),
+        md_table(
+            ["P_cx : P_x", "median (um)", "95 % range (um)"],
+            [
+                [fmt(r), fmt(m), f"{fmt(lo)}-{fmt(hi)}"]
+                for r, m, lo, hi in zip(imp["ratio"], imp["median"], imp["lo"], imp["hi"])
+            ],
+        ),
         "",
         f"![implied grid sigma]({name}/implied_grid.png)",
         "",
@@ -85,20 +102,41 @@ def report(out: Path) -> str:
         "over all simulated plates; `stated sd` is the rms of the stated standard deviations "
         "(grid fixed: a-posteriori s0; weighted: a-priori weights).",
         "",
-        md_table(["parameter", "method", "bias", "95 % CI", "sd", "stated sd", "unit"],
-                 [[p, m, fmt(b), f"[{fmt(lo)}, {fmt(hi)}]", fmt(s), fmt(st), u]
-                  for p, m, b, lo, hi, s, st, u in zip(be["param"], be["method"], be["bias"],
-                                                       be["bias_lo"], be["bias_hi"], be["sd"],
-                                                       be["stated_sd_rms"], be["unit"])]),
+        md_table(
+            ["parameter", "method", "bias", "95 % CI", "sd", "stated sd", "unit"],
+            [
+                [p, m, fmt(b), f"[{fmt(lo)}, {fmt(hi)}]", fmt(s), fmt(st), u]
+                for p, m, b, lo, hi, s, st, u in zip(
+                    be["param"],
+                    be["method"],
+                    be["bias"],
+                    be["bias_lo"],
+                    be["bias_hi"],
+                    be["sd"],
+                    be["stated_sd_rms"],
+                    be["unit"],
+                )
+            ],
+        ),
         "",
         "Coverage of the nominal 95 % intervals:",
         "",
-        md_table(["P_cx : P_x"] + [f"{PARAM_LABEL[p]} a-priori" for p in PARAM_LABEL]
-                 + [f"{PARAM_LABEL[p]} a-post." for p in PARAM_LABEL],
-                 [[fmt(r)] + [fmt(cov[f"{p}_pri"][i]) for p in PARAM_LABEL]
-                  + [fmt(cov[f"{p}_post"][i]) for p in PARAM_LABEL] for i, r in enumerate(cov["ratio"])]
-                 + [["grid fixed"] + [fmt(cov[f"{p}_fixed_pri"][0]) for p in PARAM_LABEL]
-                    + [fmt(cov[f"{p}_fixed_post"][0]) for p in PARAM_LABEL]]),
+        md_table(
+            ["P_cx : P_x"]
+            + [f"{PARAM_LABEL[p]} a-priori" for p in PARAM_LABEL]
+            + [f"{PARAM_LABEL[p]} a-post." for p in PARAM_LABEL],
+            [
+                [fmt(r)]
+                + [fmt(cov[f"{p}_pri"][i]) for p in PARAM_LABEL]
+                + [fmt(cov[f"{p}_post"][i]) for p in PARAM_LABEL]
+                for i, r in enumerate(cov["ratio"])
+            ]
+            + [
+                ["grid fixed"]
+                + [fmt(cov[f"{p}_fixed_pri"][0]) for p in PARAM_LABEL]
+                + [fmt(cov[f"{p}_fixed_post"][0]) for p in PARAM_LABEL]
+            ],
+        ),
         "",
         f"![coverage]({name}/coverage.png)",
         f"![parameters]({name}/parameters.png)",
@@ -107,9 +145,15 @@ def report(out: Path) -> str:
         f"`P_x = 1/sx'^2`, `P_cx = 1/sg_stated^2`, two-sided at {cfg['analysis.alpha']:g}, "
         "one test per coordinate and plate):",
         "",
-        md_table(["stated sigma (um)", "rejection rate", "95 % CI", "analytic"],
-                 [[fmt(s), fmt(r), f"[{fmt(lo)}, {fmt(hi)}]", fmt(a)] for s, r, lo, hi, a in
-                  zip(ch["stated_um"], ch["reject"], ch["lo"], ch["hi"], ch["analytic"])]),
+        md_table(
+            ["stated sigma (um)", "rejection rate", "95 % CI", "analytic"],
+            [
+                [fmt(s), fmt(r), f"[{fmt(lo)}, {fmt(hi)}]", fmt(a)]
+                for s, r, lo, hi, a in zip(
+                    ch["stated_um"], ch["reject"], ch["lo"], ch["hi"], ch["analytic"]
+                )
+            ],
+        ),
         "",
         f"![chi-square]({name}/chi2_power.png)",
         "",

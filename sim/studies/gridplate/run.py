@@ -1,5 +1,6 @@
 """Run of ``gridplate_two_plates``: the chunks through the runner, tables, figures, claims and
 the sweep of the unprinted inputs."""
+
 from __future__ import annotations
 
 from functools import partial
@@ -7,38 +8,46 @@ from pathlib import Path
 
 import numpy as np
 
-from ...claims import write_claims
-from ...figure_jobs import start_figures
-from ...intervals import spread
-from ...runner import chunk_rng, run_chunks
-from ...storage import provenance, write_table
-from .. import RunContext
-from . import figures as F
-from .claims import beyond_table, score
-from .model import PARAMS, chunk, simulate
-from .sweep import run_sweep
-from ... import distributions as D
+from sim.claims.book import write_claims
+from sim.claims.intervals import spread
+from sim.lsq import distributions as D
+from sim.mc.runner import chunk_rng, run_chunks
+from sim.mc.storage import provenance, write_table
+from sim.report.figure_jobs import start_figures
+from sim.studies import RunContext
+from sim.studies.gridplate import figures as F
+from sim.studies.gridplate.claims import beyond_table, score
+from sim.studies.gridplate.model import PARAMS, chunk, simulate
+from sim.studies.gridplate.sweep import run_sweep
 
 
 def analytic_reject(cfg: dict, stated_um: float, dof: int) -> float:
     """Rejection rate of the two-sided test when the grid sigma is stated wrongly:
     ``dof s0^2 / sigma_x'^2 ~ c chi2(dof)``, ``c = (sx^2 + sg_true^2) / (sx^2 + sg_stated^2)``."""
     sx, st = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
-    c = (sx ** 2 + st ** 2) / (sx ** 2 + stated_um ** 2)
+    c = (sx**2 + st**2) / (sx**2 + stated_um**2)
     a = cfg["analysis.alpha"]
     lo, hi = D.chi2_ppf(a / 2, dof), D.chi2_ppf(1 - a / 2, dof)
     return float(D.chi2_cdf(lo / c, dof) + D.chi2_sf(hi / c, dof))
 
 
 def run(cfg: dict, out: Path, ctx: RunContext) -> None:
-    res = run_chunks(partial(chunk, cfg), cfg["trials"], cfg["seed"], cfg["chunk"], part=0,
-                     label="gridplate", quiet=ctx.quiet, ctx=ctx)
+    res = run_chunks(
+        partial(chunk, cfg),
+        cfg["trials"],
+        cfg["seed"],
+        cfg["chunk"],
+        part=0,
+        label="gridplate",
+        quiet=ctx.quiet,
+        ctx=ctx,
+    )
     prov = provenance(cfg)
     T = res["sim_sigma_um"].shape[0]
     dof = cfg["plate.grid"] ** 2 - 3
     ratios = list(cfg["analysis.ratios"])
     sx, sgt = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
-    ratio_true = sx ** 2 / sgt ** 2 if sgt > 0 else np.inf
+    ratio_true = sx**2 / sgt**2 if sgt > 0 else np.inf
     cols = {"trial": np.arange(T)}
     for k, v in res.items():
         v = np.asarray(v)
@@ -50,14 +59,17 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
             for p in range(v.shape[1]):
                 cols[f"{k}_{p + 1}"] = v[:, p]
     write_table(out / "trials.parquet", cols, prov)
-    write_table(out / "adjustments_sample.parquet",
-                {k: np.asarray(res[k]) for k in ("gn_iterations", "closed_form_rel", "passes_rw")},
-                prov)
+    write_table(
+        out / "adjustments_sample.parquet",
+        {k: np.asarray(res[k]) for k in ("gn_iterations", "closed_form_rel", "passes_rw")},
+        prov,
+    )
     cov = {"ratio": np.asarray(ratios)}
     for k in PARAMS:
         for tag in ("pri", "post"):
-            cov[f"{k}_{tag}"] = np.array([res[f"{k}_cov_w{tag}_r{j}"].mean()
-                                          for j in range(len(ratios))])
+            cov[f"{k}_{tag}"] = np.array(
+                [res[f"{k}_cov_w{tag}_r{j}"].mean() for j in range(len(ratios))]
+            )
             cov[f"{k}_fixed_{tag}"] = np.full(len(ratios), res[f"{k}_cov_fixed_{tag}"].mean())
     write_table(out / "coverage.parquet", cov, prov)
     imp = {"ratio": np.asarray(ratios), "median": [], "lo": [], "hi": []}
@@ -67,32 +79,51 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         imp["lo"].append(lo)
         imp["hi"].append(hi)
     write_table(out / "implied_grid.parquet", imp, prov)
-    ch = {"stated_um": np.asarray(cfg["analysis.stated_sigmas_um"]), "reject": [], "lo": [],
-          "hi": [], "analytic": [], "tests": []}
+    ch = {
+        "stated_um": np.asarray(cfg["analysis.stated_sigmas_um"]),
+        "reject": [],
+        "lo": [],
+        "hi": [],
+        "analytic": [],
+        "tests": [],
+    }
     for j, st in enumerate(cfg["analysis.stated_sigmas_um"]):
         x = res[f"reject_s{j}"].ravel()
         lo, hi = D.wilson_ci(int(x.sum()), x.size, 0.95)
-        for col, v in (("reject", x.mean()), ("lo", lo), ("hi", hi),
-                       ("analytic", analytic_reject(cfg, st, dof)), ("tests", x.size)):
+        for col, v in (
+            ("reject", x.mean()),
+            ("lo", lo),
+            ("hi", hi),
+            ("analytic", analytic_reject(cfg, st, dof)),
+            ("tests", x.size),
+        ):
             ch[col].append(v)
     write_table(out / "chi2_power.parquet", ch, prov)
-    j_true = (int(np.argmin(np.abs(np.log(np.asarray(ratios) / ratio_true))))
-              if np.isfinite(ratio_true) else int(np.argmax(ratios)))
+    j_true = (
+        int(np.argmin(np.abs(np.log(np.asarray(ratios) / ratio_true))))
+        if np.isfinite(ratio_true)
+        else int(np.argmax(ratios))
+    )
     beyond = beyond_table(res, ratios, j_true)
     write_table(out / "beyond.parquet", beyond, prov)
     rows, book = score(cfg, res, beyond, {"j_true": j_true})
     paper = [(r, book.spec(f"twoplate.weight_ratio.grid_sigma_1to{r}_um")["ref"]) for r in (2, 3)]
-    drawn = start_figures([   # on the idle workers while the sweep is made here
-        (F.fig_params, (cfg, res, out / "parameters.png")),
-        (F.fig_coverage, (cov, ratio_true, out / "coverage.png")),
-        (F.fig_chi2, (ch, sgt, out / "chi2_power.png")),
-        (F.fig_implied, (imp, cfg["grid.sigma_stated_um"], paper, out / "implied_grid.png"))],
-        ctx.executor)
+    drawn = start_figures(
+        [  # on the idle workers while the sweep is made here
+            (F.fig_params, (cfg, res, out / "parameters.png")),
+            (F.fig_coverage, (cov, ratio_true, out / "coverage.png")),
+            (F.fig_chi2, (ch, sgt, out / "chi2_power.png")),
+            (F.fig_implied, (imp, cfg["grid.sigma_stated_um"], paper, out / "implied_grid.png")),
+        ],
+        ctx.executor,
+    )
     det, cons = run_sweep(book, cfg)
     write_table(out / "sweep.parquet", det, prov)
     write_table(out / "consistent_set.parquet", cons, prov)
     ex = simulate(cfg, chunk_rng(cfg["seed"], 1, 0), 1)  # one calibration, its own stream
-    write_table(out / "example_plate.parquet", F.fig_residuals(cfg, ex, out / "residuals.png"), prov)
+    write_table(
+        out / "example_plate.parquet", F.fig_residuals(cfg, ex, out / "residuals.png"), prov
+    )
     F.fig_consistent(det, cons, out / "consistent_set.png")
     drawn()
     write_claims(out / "claims.parquet", rows, prov, book)

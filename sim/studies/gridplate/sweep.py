@@ -12,47 +12,56 @@ from their exact sampling distributions (cheap: no adjustment is run):
   ``SSR_sys`` is the similarity residual of the noise-free affine comparator on the grid;
 * the paper's statistics follow in closed form (see :mod:`.model`).
 
-Each claim is decided by the claim book's own rule (:func:`sim.claims.ClaimBook.score`). A
+Each claim is decided by the claim book's own rule (:func:`sim.claims.book.ClaimBook.score`). A
 sweep value is in a claim's set when the outcome is not ``fails`` (the paper's number is
 not contradicted: ``holds`` or ``inconclusive``); the *consistent set* of an input is where
 every claim of the sweep (paper-checks excepted: they do not depend on the simulation) is.
 """
+
 from __future__ import annotations
 
 import math
 
 import numpy as np
 
-from ... import transforms2d as t2
-from ...claims import ClaimBook
-from ...plate import grid_points
-from .model import reweight_trials
-from .schema import UM
+from sim.claims.book import ClaimBook
+from sim.instruments import transforms2d as t2
+from sim.instruments.plates import grid_points
+from sim.studies.gridplate.model import reweight_trials
+from sim.studies.gridplate.schema import UM
 
 #: input key -> config list of swept values
-INPUTS = {"plate.grid": "consistency.grid", "plate.spacing_mm": "consistency.spacing_mm",
-          "readings.count": "consistency.readings",
-          "comparator.scale_diff_ppm": "consistency.scale_diff_ppm",
-          "grid.sigma_true_um": "consistency.grid_sigma_true_um"}
+INPUTS = {
+    "plate.grid": "consistency.grid",
+    "plate.spacing_mm": "consistency.spacing_mm",
+    "readings.count": "consistency.readings",
+    "comparator.scale_diff_ppm": "consistency.scale_diff_ppm",
+    "grid.sigma_true_um": "consistency.grid_sigma_true_um",
+}
 #: claims evaluated in the sweep
-CLAIMS = ("twoplate.weight_ratio.grid_sigma_1to2_um", "twoplate.weight_ratio.grid_sigma_1to3_um",
-          "twoplate.weight_ratio.converged_ratio", "twoplate.weight_ratio.reweight_trials",
-          "twoplate.comparator_sigma.sigma_um", "twoplate.comparator_sigma.mean_of_L",
-          "twoplate.similarity_vs_affine.similarity_sigma_um",
-          "twoplate.similarity_vs_affine.affine_sigma_um",
-          "twoplate.similarity_vs_affine.scale_share_linear_um",
-          "twoplate.similarity_vs_affine.grid_share_linear_um")
+CLAIMS = (
+    "twoplate.weight_ratio.grid_sigma_1to2_um",
+    "twoplate.weight_ratio.grid_sigma_1to3_um",
+    "twoplate.weight_ratio.converged_ratio",
+    "twoplate.weight_ratio.reweight_trials",
+    "twoplate.comparator_sigma.sigma_um",
+    "twoplate.comparator_sigma.mean_of_L",
+    "twoplate.similarity_vs_affine.similarity_sigma_um",
+    "twoplate.similarity_vs_affine.affine_sigma_um",
+    "twoplate.similarity_vs_affine.scale_share_linear_um",
+    "twoplate.similarity_vs_affine.grid_share_linear_um",
+)
 
 
 def sys_ssr_um2(cfg: dict) -> float:
     """Similarity residual sum of squares (um^2, one plate) of the noise-free comparator."""
-    from .model import truth_rows
+    from sim.studies.gridplate.model import truth_rows
 
     G = grid_points(cfg["plate.grid"], cfg["plate.spacing_mm"])
     S, S2, eps = truth_rows(cfg)
     ideal = t2.apply_affine(t2.affine_from_rows(S, S2, eps, 0.0, (120.0, 120.0))[None], G[None])
     f = t2.fit_similarity(G[None], ideal)
-    return float((f.residuals ** 2).sum()) / UM ** 2
+    return float((f.residuals**2).sum()) / UM**2
 
 
 def draws(cfg: dict, rng: np.random.Generator, M: int) -> dict[str, np.ndarray]:
@@ -60,30 +69,34 @@ def draws(cfg: dict, rng: np.random.Generator, M: int) -> dict[str, np.ndarray]:
     N, P = cfg["plate.grid"] ** 2, cfg["plate.count"]
     dof = N - 3
     sx, st = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_stated_um"]
-    sw2_true = sx ** 2 + cfg["grid.sigma_true_um"] ** 2
+    sw2_true = sx**2 + cfg["grid.sigma_true_um"] ** 2
     sw2 = sw2_true * rng.chisquare(dof, (M, 2 * P)) / dof
     ssr = sys_ssr_um2(cfg)
     # an exact similarity (no scale difference) leaves a residual of rounding size only: a
     # residual rms below 1 pm is zero, so the draws do not hinge on the fit's last bits
     lam = ssr / sw2_true if ssr > 2 * N * 1e-12 else 0.0
-    extra = sw2_true * (rng.noncentral_chisquare(2, lam, (M, P)) if lam > 0
-                        else rng.chisquare(2, (M, P)))
+    extra = sw2_true * (
+        rng.noncentral_chisquare(2, lam, (M, P)) if lam > 0 else rng.chisquare(2, (M, P))
+    )
     ssr_aff = sw2.sum(1) * dof
     aff = np.sqrt(ssr_aff / (P * (2 * N - 6)))
     sim = np.sqrt((ssr_aff + extra.sum(1)) / (P * (2 * N - 4)))
-    comp2 = sw2 - st ** 2
+    comp2 = sw2 - st**2
     ok = (comp2 > 0).all(1)
     comp = np.sqrt(np.where(ok, comp2.mean(1), np.nan))
-    return {"twoplate.weight_ratio.grid_sigma_1to2_um": np.sqrt((sw2 / 3).mean(1)),
-            "twoplate.weight_ratio.grid_sigma_1to3_um": np.sqrt((sw2 / 4).mean(1)),
-            "twoplate.weight_ratio.converged_ratio": np.where(ok, (sw2 / st ** 2 - 1).mean(1), np.nan),
-            "rw_trials": reweight_trials(sw2, np.ones_like(sw2), st, dof,
-                                         cfg["analysis.ratio_start"], cfg["analysis.alpha"]),
-            "twoplate.comparator_sigma.sigma_um": comp,
-            "twoplate.similarity_vs_affine.similarity_sigma_um": sim,
-            "twoplate.similarity_vs_affine.affine_sigma_um": aff,
-            "twoplate.similarity_vs_affine.scale_share_linear_um": sim - aff,
-            "twoplate.similarity_vs_affine.grid_share_linear_um": aff - comp}
+    return {
+        "twoplate.weight_ratio.grid_sigma_1to2_um": np.sqrt((sw2 / 3).mean(1)),
+        "twoplate.weight_ratio.grid_sigma_1to3_um": np.sqrt((sw2 / 4).mean(1)),
+        "twoplate.weight_ratio.converged_ratio": np.where(ok, (sw2 / st**2 - 1).mean(1), np.nan),
+        "rw_trials": reweight_trials(
+            sw2, np.ones_like(sw2), st, dof, cfg["analysis.ratio_start"], cfg["analysis.alpha"]
+        ),
+        "twoplate.comparator_sigma.sigma_um": comp,
+        "twoplate.similarity_vs_affine.similarity_sigma_um": sim,
+        "twoplate.similarity_vs_affine.affine_sigma_um": aff,
+        "twoplate.similarity_vs_affine.scale_share_linear_um": sim - aff,
+        "twoplate.similarity_vs_affine.grid_share_linear_um": aff - comp,
+    }
 
 
 def _outcome(spec: dict, **kw) -> dict:
@@ -100,8 +113,11 @@ def evaluate(book: ClaimBook, cfg: dict, rng: np.random.Generator) -> dict[str, 
             x = d["rw_trials"].ravel()
             row = _outcome(spec, value=float(np.percentile(x, 95)), interval="exact")
         elif cid == "twoplate.comparator_sigma.mean_of_L":
-            row = _outcome(spec, value=cfg["readings.sigma_um"] / math.sqrt(cfg["readings.count"]),
-                           interval="exact")
+            row = _outcome(
+                spec,
+                value=cfg["readings.sigma_um"] / math.sqrt(cfg["readings.count"]),
+                interval="exact",
+            )
         else:
             x = d[cid]
             x = x[np.isfinite(x)]
@@ -116,8 +132,19 @@ def evaluate(book: ClaimBook, cfg: dict, rng: np.random.Generator) -> dict[str, 
 def run_sweep(book: ClaimBook, cfg: dict) -> tuple[dict, dict]:
     """Sweep every unprinted input; returns the detail table and the consistent-set table."""
     det = {k: [] for k in ("input", "input_value", "claim", "kind", "outcome", "value", "p_plate")}
-    cons = {k: [] for k in ("input", "claim", "kind", "holds_low", "holds_high", "n_values",
-                            "n_holds", "default")}
+    cons = {
+        k: []
+        for k in (
+            "input",
+            "claim",
+            "kind",
+            "holds_low",
+            "holds_high",
+            "n_values",
+            "n_holds",
+            "default",
+        )
+    }
     for i, (key, listkey) in enumerate(INPUTS.items()):
         vals = sorted(cfg[listkey])
         ok_all = np.ones(len(vals), bool)
@@ -127,8 +154,11 @@ def run_sweep(book: ClaimBook, cfg: dict) -> tuple[dict, dict]:
             c[key] = v
             if key == "comparator.scale_diff_ppm":  # eps in the configured proportion
                 base = cfg["comparator.scale_diff_ppm"]
-                c["comparator.nonorth_arcsec"] = (cfg["comparator.nonorth_arcsec"] * v / base
-                                                  if base else cfg["comparator.nonorth_arcsec"])
+                c["comparator.nonorth_arcsec"] = (
+                    cfg["comparator.nonorth_arcsec"] * v / base
+                    if base
+                    else cfg["comparator.nonorth_arcsec"]
+                )
             rng = np.random.default_rng(np.random.SeedSequence(cfg["seed"], spawn_key=(900, i, j)))
             rows = evaluate(book, c, rng)
             for cid, r in rows.items():
@@ -137,9 +167,15 @@ def run_sweep(book: ClaimBook, cfg: dict) -> tuple[dict, dict]:
                 per_claim[cid][j] = good
                 if kind != "paper-check":
                     ok_all[j] &= good
-                for col, val in (("input", key), ("input_value", float(v)), ("claim", cid),
-                                 ("kind", kind), ("outcome", r["outcome"]),
-                                 ("value", r["value"]), ("p_plate", r["p_plate"])):
+                for col, val in (
+                    ("input", key),
+                    ("input_value", float(v)),
+                    ("claim", cid),
+                    ("kind", kind),
+                    ("outcome", r["outcome"]),
+                    ("value", r["value"]),
+                    ("p_plate", r["p_plate"]),
+                ):
                     det[col].append(val)
         for cid, good in list(per_claim.items()) + [("ALL", ok_all)]:
             hv = np.asarray(vals, float)[good]

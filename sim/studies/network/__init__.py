@@ -9,14 +9,23 @@ and their effect on the coordinates, the false-alarm rate of the global test, th
 against a second parameterisation, other datums by S-transformation, and the network in
 GNU Gama's ``gama-local`` XML (:mod:`.gama`). Examples: ``studies/network_*.toml``.
 """
+
 from __future__ import annotations
 
-from .. import Study
-from .report import report
-from .run import run
-from .schema import SCHEMA, check
+from sim.studies import Study
+from sim.studies.network.report import report
+from sim.studies.network.run import run
+from sim.studies.network.schema import SCHEMA, check
 
 STUDIES = {
-    "network": Study("network", "Network design study (your own instrument as data)", "",
-                     SCHEMA, run, report, check, order=90),
+    "network": Study(
+        "network",
+        "Network design study (your own instrument as data)",
+        "",
+        SCHEMA,
+        run,
+        report,
+        check,
+        order=90,
+    ),
 }

@@ -2,7 +2,7 @@
 
 Analytic (at the true coordinates, one linearisation): the covariance of the unknowns in the
 datum, per point standard deviations and 95 % error ellipses, the same in other datums by
-S-transformation (:mod:`sim.datum`), per observation the redundancy number
+S-transformation (:mod:`sim.lsq.datum`), per observation the redundancy number
 ``r_i = 1 - (A Q A' P)_ii`` (they sum to the degrees of freedom), Baarda's minimal detectable
 bias ``MDB_i = delta0 sigma_i / sqrt(r_i)`` (internal reliability; ``delta0`` from the test's
 ``alpha0`` and power), its effect on the coordinates (external reliability: the largest point
@@ -14,17 +14,18 @@ analytic 95 % ellipses and the count of global-test rejections (``v'Pv`` against
 chi-square quantile with the a-priori unit variance). Units: mm and rad; sigmas in the
 tables in mm. Seeds: Baarda's reliability theory as used for comparator networks (``004``).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from ... import lsq
-from ...datum import null_basis, s_matrix, s_transform
-from .definition import Network
-from .model import NetworkModel, simulate
-from ... import distributions as D
+from sim import lsq
+from sim.lsq import distributions as D
+from sim.lsq.datum import null_basis, s_matrix, s_transform
+from sim.studies.network.definition import Network
+from sim.studies.network.model import NetworkModel, simulate
 
 __all__ = ["Analytic", "analyse", "delta0", "mc_chunk", "point_cov_in"]
 
@@ -57,7 +58,7 @@ def point_cov_in(net: Network, free: np.ndarray, Q: np.ndarray) -> np.ndarray:
     """The full ``(2n, 2n)`` coordinate covariance (zeros for fixed coordinates)."""
     full = np.zeros((net.q, net.q))
     full[np.ix_(free, free)] = Q
-    return full[:2 * net.n, :2 * net.n]
+    return full[: 2 * net.n, : 2 * net.n]
 
 
 def analyse(net: Network, datum: lsq.Datum, a0: float, power: float) -> Analytic:
@@ -69,7 +70,7 @@ def analyse(net: Network, datum: lsq.Datum, a0: float, power: float) -> Analytic
     Q = cof.Qgg[0]
     ok = bool(cof.ok[0])
     lin = model.linearize(np.zeros((1, net.m, 0)), theta, True)
-    Aw = lin.Jg[0, :, 0][:, free] / net.sigma[:, None]          # weighted design (m, p)
+    Aw = lin.Jg[0, :, 0][:, free] / net.sigma[:, None]  # weighted design (m, p)
     if not ok:
         nan = np.full(net.m, np.nan)
         return Analytic(free, Q, np.full((net.n, 2, 2), np.nan), nan, nan, nan, nan, 0, False)
@@ -83,10 +84,10 @@ def analyse(net: Network, datum: lsq.Datum, a0: float, power: float) -> Analytic
         mdb = np.where(controlled, d0 * net.sigma / np.sqrt(r), np.inf)
         bnr = np.where(controlled, d0 * np.sqrt((1 - r) / r), np.inf)
         # shift of the unknowns by an undetected MDB on observation i: Q Aw_i' (mdb_i / sigma_i)
-        shift = (Q @ Aw.T) * np.where(controlled, mdb / net.sigma, 0.0)   # (p, m)
+        shift = (Q @ Aw.T) * np.where(controlled, mdb / net.sigma, 0.0)  # (p, m)
     full = np.zeros((net.q, net.m))
     full[free] = shift
-    disp = np.hypot(full[0:2 * net.n:2], full[1:2 * net.n:2])          # (n, m)
+    disp = np.hypot(full[0 : 2 * net.n : 2], full[1 : 2 * net.n : 2])  # (n, m)
     ext = np.where(controlled, disp.max(axis=0), np.inf)
     cov2 = point_cov_in(net, free, Q).reshape(net.n, 2, net.n, 2)
     cov = cov2[np.arange(net.n), :, np.arange(net.n), :]
@@ -95,7 +96,7 @@ def analyse(net: Network, datum: lsq.Datum, a0: float, power: float) -> Analytic
 
 def in_datum(net: Network, an: Analytic, points: list[int]) -> np.ndarray:
     """Point covariances ``(n, 2, 2)`` stated in the inner-constraint datum over ``points``
-    (S-transformation; translation and rotation, as :func:`sim.datum.inner`)."""
+    (S-transformation; translation and rotation, as :func:`sim.lsq.datum.inner`)."""
     w = np.zeros(2 * net.n)
     w[np.repeat(points, 2) * 2 + np.tile([0, 1], len(points))] = 1.0
     S = s_matrix(null_basis(net.xy), w)
@@ -106,33 +107,52 @@ def in_datum(net: Network, an: Analytic, points: list[int]) -> np.ndarray:
 def ellipse(cov: np.ndarray):
     """1-sigma semi-axes ``a >= b`` and the bearing of ``a`` (rad from +x) of ``(n, 2, 2)``."""
     sxx, syy, sxy = cov[:, 0, 0], cov[:, 1, 1], cov[:, 0, 1]
-    h, g = (sxx + syy) / 2, np.sqrt(((sxx - syy) / 2) ** 2 + sxy ** 2)
-    return np.sqrt(np.maximum(h + g, 0)), np.sqrt(np.maximum(h - g, 0)), \
-        0.5 * np.arctan2(2 * sxy, sxx - syy)
+    h, g = (sxx + syy) / 2, np.sqrt(((sxx - syy) / 2) ** 2 + sxy**2)
+    return (
+        np.sqrt(np.maximum(h + g, 0)),
+        np.sqrt(np.maximum(h - g, 0)),
+        0.5 * np.arctan2(2 * sxy, sxx - syy),
+    )
 
 
-def mc_chunk(rng: np.random.Generator, n: int, net: Network, free: np.ndarray,
-             C: np.ndarray | None, cov_inv: np.ndarray, pts: np.ndarray, crit: float,
-             tol: float, max_iter: int, par: np.ndarray | None = None) -> dict:
+def mc_chunk(
+    rng: np.random.Generator,
+    n: int,
+    net: Network,
+    free: np.ndarray,
+    C: np.ndarray | None,
+    cov_inv: np.ndarray,
+    pts: np.ndarray,
+    crit: float,
+    tol: float,
+    max_iter: int,
+    par: np.ndarray | None = None,
+) -> dict:
     """One chunk of ``n`` simulated adjustments (see the module doc). ``pts`` are the point
     indices whose coordinates are estimated; ``cov_inv`` (len(pts), 2, 2) their inverse
     analytic covariances; ``crit`` the global test's chi-square critical value; ``par`` the
     indices of the estimated globals that are not coordinates (their errors are summed)."""
     obs = simulate(net, rng, n)
     theta = np.repeat(net.theta_true()[None], n, 0)
-    res = lsq.gauss_newton(NetworkModel(net, obs), theta, datum=lsq.Datum(free, C), tol=tol,
-                           max_iter=max_iter)
+    res = lsq.gauss_newton(
+        NetworkModel(net, obs), theta, datum=lsq.Datum(free, C), tol=tol, max_iter=max_iter
+    )
     ok = res.converged
-    e = (res.theta - theta)[:, :2 * net.n].reshape(n, net.n, 2)[:, pts][ok]     # (N, k, 2)
+    e = (res.theta - theta)[:, : 2 * net.n].reshape(n, net.n, 2)[:, pts][ok]  # (N, k, 2)
     inside = np.einsum("tki,kij,tkj->tk", e, cov_inv, e) <= CHI2_2_95
-    vpv = res.sigma0 ** 2 * res.dof if res.dof > 0 else np.zeros(n)
+    vpv = res.sigma0**2 * res.dof if res.dof > 0 else np.zeros(n)
     par = np.zeros(0, int) if par is None else np.asarray(par, int)
-    g = (res.theta - theta)[:, par][ok]                                        # (N, k_par)
-    return {"sum.n": np.array([[ok.sum()]], float),
-            "sum.pe": g.sum(0)[None], "sum.pee": (g * g).sum(0)[None],
-            "sum.e": e.sum(0)[None], "sum.ee": np.einsum("tki,tkj->kij", e, e)[None],
-            "sum.inside": inside.sum(0)[None].astype(float),
-            "sum.reject": np.array([[(vpv[ok] > crit).sum()]], float),
-            "rows.converged": ok, "rows.status": res.status.astype(np.int8),
-            "rows.sigma0": np.where(np.isfinite(res.sigma0), res.sigma0, -1.0),
-            "rows.iterations": res.iterations}
+    g = (res.theta - theta)[:, par][ok]  # (N, k_par)
+    return {
+        "sum.n": np.array([[ok.sum()]], float),
+        "sum.pe": g.sum(0)[None],
+        "sum.pee": (g * g).sum(0)[None],
+        "sum.e": e.sum(0)[None],
+        "sum.ee": np.einsum("tki,tkj->kij", e, e)[None],
+        "sum.inside": inside.sum(0)[None].astype(float),
+        "sum.reject": np.array([[(vpv[ok] > crit).sum()]], float),
+        "rows.converged": ok,
+        "rows.status": res.status.astype(np.int8),
+        "rows.sigma0": np.where(np.isfinite(res.sigma0), res.sigma0, -1.0),
+        "rows.iterations": res.iterations,
+    }

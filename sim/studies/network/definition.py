@@ -22,8 +22,9 @@ plane system; bearings are measured from +x towards +y, as ``gama-local``'s ``ax
   meter's or a scale's unknown scale).
 
 :func:`build` turns the validated config into a :class:`Network` of arrays, or raises
-:class:`~sim.config.ConfigError` naming the bad entry.
+:class:`~sim.mc.config.ConfigError` naming the bad entry.
 """
+
 from __future__ import annotations
 
 import fnmatch
@@ -32,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...config import ConfigError
+from sim.mc.config import ConfigError
 
 __all__ = ["Network", "build", "KINDS", "ARCSEC"]
 
@@ -105,12 +106,13 @@ class Network:
 
     def theta_true(self) -> np.ndarray:
         """(q,) true globals: coordinates, orientations (0), constant, scale."""
-        return np.concatenate([self.xy.reshape(-1), np.zeros(len(self.stations)),
-                               [self.constant_mm, self.scale_ppm]])
+        return np.concatenate(
+            [self.xy.reshape(-1), np.zeros(len(self.stations)), [self.constant_mm, self.scale_ppm]]
+        )
 
     def free_index(self, extra_fixed: tuple = ()) -> np.ndarray:
         """Indices of the estimated globals (``extra_fixed``: point indices held fixed too)."""
-        fixed = (self.role == 1)
+        fixed = self.role == 1
         fixed[list(extra_fixed)] = True
         coords = np.flatnonzero(np.repeat(~fixed, 2))
         orient = 2 * self.n + np.arange(len(self.stations))
@@ -211,7 +213,9 @@ def _points(cfg: dict, rng: np.random.Generator):
             role.append(r)
             sig.append(s)
     if len(names) > MAX_POINTS:
-        raise ConfigError("network.points", f"{len(names)} points is over the limit of {MAX_POINTS}")
+        raise ConfigError(
+            "network.points", f"{len(names)} points is over the limit of {MAX_POINTS}"
+        )
     if len(names) < 2:
         raise ConfigError("network.points", "a network needs at least two points")
     dup = sorted({x for x in names if names.count(x) > 1})
@@ -220,8 +224,11 @@ def _points(cfg: dict, rng: np.random.Generator):
     xy = np.array(xy, float)
     scale = np.abs(xy).max()
     if scale > 1e9:
-        raise ConfigError("network.points", f"coordinates up to {scale:.3g} mm: over 1000 km, "
-                          "out of range for double-precision adjustment at the um level")
+        raise ConfigError(
+            "network.points",
+            f"coordinates up to {scale:.3g} mm: over 1000 km, "
+            "out of range for double-precision adjustment at the um level",
+        )
     return names, xy, np.array(role), np.array(sig)
 
 
@@ -239,8 +246,18 @@ def _match(key: str, pats, names: list[str]) -> list[int]:
     return out
 
 
-_OBS = {"kind", "from", "to", "at", "sigma_mm", "sigma_arcsec", "settings", "bias_mm",
-        "bias_arcsec", "nearest"}
+_OBS = {
+    "kind",
+    "from",
+    "to",
+    "at",
+    "sigma_mm",
+    "sigma_arcsec",
+    "settings",
+    "bias_mm",
+    "bias_arcsec",
+    "nearest",
+}
 
 
 def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
@@ -265,7 +282,7 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
     if rng is None:
         rng = np.random.default_rng(np.random.SeedSequence(cfg["seed"], spawn_key=(99,)))
     names, xy, role, csig = _points(cfg, rng)
-    rows: list[tuple] = []   # (kind, i, j, k, sigma, bias)
+    rows: list[tuple] = []  # (kind, i, j, k, sigma, bias)
     for a, rec in enumerate(cfg["network.observations"]):
         key = f"network.observations[{a}]"
         _keys(key, rec, _OBS - {"nearest"}, {"kind", "to"})
@@ -283,20 +300,26 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
             raise ConfigError(f"{key}.at", f"only an angle has 'at' (this is a {KINDS[code]})")
         fr, to = (_match(f"{key}.{f}", rec[f], names) for f in ("from", "to"))
         if len(fr) != 1 or len(to) != 1:
-            raise ConfigError(f"{key}.to", "one observation names one point each for from and "
-                              "to (use network.generate for many)")
+            raise ConfigError(
+                f"{key}.to",
+                "one observation names one point each for from and "
+                "to (use network.generate for many)",
+            )
         rows.append((code, fr[0], to[0], -1, sig, bias))
     for a, rec in enumerate(cfg["network.generate"]):
         key = f"network.generate[{a}]"
         _keys(key, rec, _OBS - {"at"}, {"kind", "from", "to"})
         code, sig, bias = _obs_common(key, rec)
         if code == 2:
-            raise ConfigError(f"{key}.kind", "angles are declared one by one (network.observations)")
+            raise ConfigError(
+                f"{key}.kind", "angles are declared one by one (network.observations)"
+            )
         fr, to = (_match(f"{key}.{f}", rec[f], names) for f in ("from", "to"))
         k = _num(f"{key}.nearest", rec.get("nearest", 0), 0, integer=True)
         if len(rows) + len(fr) * len(to) > 4 * MAX_OBS:
-            raise ConfigError(key, f"{len(fr)} x {len(to)} observations is over the limit of "
-                              f"{MAX_OBS}")
+            raise ConfigError(
+                key, f"{len(fr)} x {len(to)} observations is over the limit of {MAX_OBS}"
+            )
         for s in fr:
             tgt = [t for t in to if t != s]
             if k:
@@ -308,25 +331,48 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
     if not rows:
         raise ConfigError("network.observations", "the network has no observations")
     if len(rows) > MAX_OBS:
-        raise ConfigError("network.generate", f"{len(rows)} observations is over the limit of "
-                          f"{MAX_OBS}")
+        raise ConfigError(
+            "network.generate", f"{len(rows)} observations is over the limit of {MAX_OBS}"
+        )
     kind, i, j, kk, sig, bias = (np.array(c) for c in zip(*rows))
     for code, a, b in zip(kind, i, j):
         if code < 5 and a == b:
-            raise ConfigError("network.observations", f"a {KINDS[code]} from {names[a]!r} to "
-                              "itself")
+            raise ConfigError(
+                "network.observations", f"a {KINDS[code]} from {names[a]!r} to itself"
+            )
         if code in (0, 1) and np.allclose(xy[a], xy[b]):
-            raise ConfigError("network.points", f"points {names[a]!r} and {names[b]!r} coincide:"
-                              f" a {KINDS[code]} between them is undefined")
+            raise ConfigError(
+                "network.points",
+                f"points {names[a]!r} and {names[b]!r} coincide:"
+                f" a {KINDS[code]} between them is undefined",
+            )
     stations = tuple(dict.fromkeys(names[a] for a, c in zip(i, kind) if c == 1))
     oset = np.array([stations.index(names[a]) if c == 1 else -1 for a, c in zip(i, kind)], int)
     beta = cfg["network.offset_mm"]
     if beta and np.any(kind == 0):
         d = np.hypot(*(xy[j[kind == 0]] - xy[i[kind == 0]]).T)
         if d.min() <= beta:
-            raise ConfigError("network.offset_mm", f"the offset {beta:g} mm is not shorter than "
-                              f"the shortest distance ({d.min():.3g} mm)")
-    return Network(cfg["network.name"], tuple(names), xy, role, kind.astype(int), i.astype(int),
-                   j.astype(int), kk.astype(int), sig.astype(float), bias.astype(float), oset,
-                   stations, cfg["network.constant_mm"], cfg["network.estimate_constant"], beta,
-                   cfg["network.scale_ppm"], cfg["network.estimate_scale"])
+            raise ConfigError(
+                "network.offset_mm",
+                f"the offset {beta:g} mm is not shorter than "
+                f"the shortest distance ({d.min():.3g} mm)",
+            )
+    return Network(
+        cfg["network.name"],
+        tuple(names),
+        xy,
+        role,
+        kind.astype(int),
+        i.astype(int),
+        j.astype(int),
+        kk.astype(int),
+        sig.astype(float),
+        bias.astype(float),
+        oset,
+        stations,
+        cfg["network.constant_mm"],
+        cfg["network.estimate_constant"],
+        beta,
+        cfg["network.scale_ppm"],
+        cfg["network.estimate_scale"],
+    )

@@ -1,13 +1,14 @@
 """Figures of a network study: the network with its 95 % ellipses, and its reliability."""
+
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ...plotting import plt, save
-from .analysis import CHI2_2_95, ellipse
-from .definition import KINDS
+from sim.report.plotting import plt, save
+from sim.studies.network.analysis import CHI2_2_95, ellipse
+from sim.studies.network.definition import KINDS
 
 __all__ = ["network_figure", "reliability_figure"]
 
@@ -26,11 +27,19 @@ def network_figure(net, an, pts, path: Path) -> Path:
         seen.add(key)
         ax.plot(net.xy[[a, b], 0], net.xy[[a, b], 1], color="0.8", lw=0.5, zorder=1)
     fixed = net.role == 1
-    ax.scatter(net.xy[~fixed, 0], net.xy[~fixed, 1], s=10, color="C0", zorder=3,
-               label="estimated point")
+    ax.scatter(
+        net.xy[~fixed, 0], net.xy[~fixed, 1], s=10, color="C0", zorder=3, label="estimated point"
+    )
     if fixed.any():
-        ax.scatter(net.xy[fixed, 0], net.xy[fixed, 1], marker="^", s=40, color="C3", zorder=3,
-                   label="fixed point")
+        ax.scatter(
+            net.xy[fixed, 0],
+            net.xy[fixed, 1],
+            marker="^",
+            s=40,
+            color="C3",
+            zorder=3,
+            label="fixed point",
+        )
     a95, b95, th = ellipse(an.cov[pts])
     k = np.sqrt(CHI2_2_95)
     span = np.ptp(net.xy, axis=0).max() or 1.0
@@ -63,6 +72,8 @@ def reliability_figure(net, an, path: Path) -> Path:
     a1.legend(fontsize=8, ncol=4, loc="upper right")
     a2.set_ylabel("bias-to-noise ratio")
     a2.set_xlabel("observation")
-    a1.set_title(f"sum of redundancy numbers {an.redundancy.sum():.3f}; degrees of freedom {an.dof}")
+    a1.set_title(
+        f"sum of redundancy numbers {an.redundancy.sum():.3f}; degrees of freedom {an.dof}"
+    )
     fig.tight_layout()
     return save(fig, path)

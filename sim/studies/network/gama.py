@@ -22,6 +22,7 @@ and settings are folded into the standard deviation; biases, the additive consta
 offset, the scale of distances and coordinate differences have no ``gama-local`` form and
 are refused.
 """
+
 from __future__ import annotations
 
 import math
@@ -30,16 +31,24 @@ from pathlib import Path
 
 import numpy as np
 
-from ...config import ConfigError
-from .definition import ARCSEC, KINDS, Network
-from .model import computed
+from sim.mc.config import ConfigError
+from sim.studies.network.definition import ARCSEC, KINDS, Network
+from sim.studies.network.model import computed
 
 __all__ = ["read_gama", "write_gama", "merge_gama"]
 
 NS = "http://www.gnu.org/software/gama/gama-local"
-CC = math.pi / 200 / 10000          # one centesimal second in rad
-_UNSUPPORTED = ("s-distance", "z-angle", "azimuth", "vectors", "height-differences", "dh",
-                "vec", "h-diff")
+CC = math.pi / 200 / 10000  # one centesimal second in rad
+_UNSUPPORTED = (
+    "s-distance",
+    "z-angle",
+    "azimuth",
+    "vectors",
+    "height-differences",
+    "dh",
+    "vec",
+    "h-diff",
+)
 
 
 def _tag(e) -> str:
@@ -95,33 +104,60 @@ def read_gama(path: str | Path, key: str = "network.gama_xml") -> dict:
             if not pid:
                 raise ConfigError(key, f"{path}: a <point> without id")
             if e.get("x") is None or e.get("y") is None:
-                raise ConfigError(key, f"{path}: point {pid!r} has no coordinates; the "
-                                  "simulation needs every point's coordinates")
+                raise ConfigError(
+                    key,
+                    f"{path}: point {pid!r} has no coordinates; the "
+                    "simulation needs every point's coordinates",
+                )
             fix, adj = e.get("fix", ""), e.get("adj", "")
             role = "fixed" if fix.lower() == "xy" else "free"
             if role == "free" and adj.lower() != "xy":
-                raise ConfigError(key, f"{path}: point {pid!r}: only fix=\"xy\" or adj=\"xy\"/"
-                                  "\"XY\" is supported")
+                raise ConfigError(
+                    key, f'{path}: point {pid!r}: only fix="xy" or adj="xy"/"XY" is supported'
+                )
             if adj == "XY":
                 datum_pts.append(pid)
-            points[pid] = {"name": pid, "x_mm": _f(key, e, "x") * 1000,
-                           "y_mm": _f(key, e, "y") * 1000, "role": role}
+            points[pid] = {
+                "name": pid,
+                "x_mm": _f(key, e, "x") * 1000,
+                "y_mm": _f(key, e, "y") * 1000,
+                "role": role,
+            }
         elif t == "obs":
             st = e.get("from")
             for o in e:
                 ot = _tag(o)
                 if ot == "direction":
                     s = _f(key, o, "stdev", _default(key, dstd["direction"]))
-                    obs.append({"kind": "direction", "from": st, "to": o.get("to"),
-                                "sigma_arcsec": s * sunit / ARCSEC})
+                    obs.append(
+                        {
+                            "kind": "direction",
+                            "from": st,
+                            "to": o.get("to"),
+                            "sigma_arcsec": s * sunit / ARCSEC,
+                        }
+                    )
                 elif ot == "distance":
                     s = _f(key, o, "stdev", _default(key, dstd["distance"]))
-                    obs.append({"kind": "distance", "from": o.get("from", st), "to": o.get("to"),
-                                "sigma_mm": s})
+                    obs.append(
+                        {
+                            "kind": "distance",
+                            "from": o.get("from", st),
+                            "to": o.get("to"),
+                            "sigma_mm": s,
+                        }
+                    )
                 elif ot == "angle":
                     s = _f(key, o, "stdev", _default(key, dstd["angle"]))
-                    obs.append({"kind": "angle", "at": o.get("from", st), "from": o.get("bs"),
-                                "to": o.get("fs"), "sigma_arcsec": s * sunit / ARCSEC})
+                    obs.append(
+                        {
+                            "kind": "angle",
+                            "at": o.get("from", st),
+                            "from": o.get("bs"),
+                            "to": o.get("fs"),
+                            "sigma_arcsec": s * sunit / ARCSEC,
+                        }
+                    )
                 elif ot != "cov-mat":
                     raise ConfigError(key, f"{path}: <{ot}> in <obs> is not supported")
         elif t == "coordinates":
@@ -130,16 +166,20 @@ def read_gama(path: str | Path, key: str = "network.gama_xml") -> dict:
             if cm is None:
                 raise ConfigError(key, f"{path}: <coordinates> needs a <cov-mat>")
             if int(_f(key, cm, "band", 0)) != 0:
-                raise ConfigError(key, f"{path}: only a diagonal <cov-mat band=\"0\"> is supported")
+                raise ConfigError(key, f'{path}: only a diagonal <cov-mat band="0"> is supported')
             var = [float(v) for v in (cm.text or "").split()]
             if len(var) != 2 * len(pts):
-                raise ConfigError(key, f"{path}: <cov-mat> has {len(var)} variances for "
-                                  f"{len(pts)} points")
+                raise ConfigError(
+                    key, f"{path}: <cov-mat> has {len(var)} variances for {len(pts)} points"
+                )
             for a, p in enumerate(pts):
                 vx, vy = var[2 * a], var[2 * a + 1]
                 if not (vx > 0 and math.isclose(vx, vy, rel_tol=1e-9)):
-                    raise ConfigError(key, f"{path}: point {p.get('id')!r}: observed x and y "
-                                      "need one positive variance")
+                    raise ConfigError(
+                        key,
+                        f"{path}: point {p.get('id')!r}: observed x and y "
+                        "need one positive variance",
+                    )
                 coords.append((p.get("id"), math.sqrt(vx)))
         elif t not in ("description",):
             raise ConfigError(key, f"{path}: <{t}> is not supported")
@@ -147,8 +187,11 @@ def read_gama(path: str | Path, key: str = "network.gama_xml") -> dict:
         if pid not in points:
             raise ConfigError(key, f"{path}: observed coordinates of unknown point {pid!r}")
         points[pid].update(role="observed", sigma_mm=s)
-    return {"network.points": list(points.values()), "network.observations": obs,
-            "datum.points": datum_pts}
+    return {
+        "network.points": list(points.values()),
+        "network.observations": obs,
+        "datum.points": datum_pts,
+    }
 
 
 def _default(key: str, v) -> float | None:
@@ -160,14 +203,23 @@ def merge_gama(cfg: dict) -> dict:
     path = cfg.get("network.gama_xml")
     if not path:
         return cfg
-    for k in ("network.points", "network.grids", "network.random", "network.observations",
-              "network.generate"):
+    for k in (
+        "network.points",
+        "network.grids",
+        "network.random",
+        "network.observations",
+        "network.generate",
+    ):
         if cfg[k]:
-            raise ConfigError(k, "give the network either in the study file or in "
-                              "network.gama_xml, not both")
+            raise ConfigError(
+                k, "give the network either in the study file or in network.gama_xml, not both"
+            )
     rec = read_gama(path)
-    out = {**cfg, "network.points": rec["network.points"],
-           "network.observations": rec["network.observations"]}
+    out = {
+        **cfg,
+        "network.points": rec["network.points"],
+        "network.observations": rec["network.observations"],
+    }
     if rec["datum.points"] and not cfg["datum.points"]:
         out["datum.points"] = rec["datum.points"]
     return out
@@ -180,16 +232,20 @@ def _fmt(x: float) -> str:
 def write_gama(net: Network, path: str | Path) -> Path:
     """Write ``net`` as ``gama-local`` XML (see the module doc for what is refused)."""
     if np.any(net.bias != 0):
-        raise ConfigError("network.observations", "gama-local has no observation bias: "
-                          "export a network without bias_*")
+        raise ConfigError(
+            "network.observations",
+            "gama-local has no observation bias: export a network without bias_*",
+        )
     if net.constant_mm or net.estimate_constant or net.offset_mm:
-        raise ConfigError("network.constant_mm", "gama-local has no additive constant or "
-                          "offset of distances")
+        raise ConfigError(
+            "network.constant_mm", "gama-local has no additive constant or offset of distances"
+        )
     if net.scale_ppm or net.estimate_scale:
         raise ConfigError("network.scale_ppm", "gama-local has no scale parameter of distances")
     if np.any((net.kind == 3) | (net.kind == 4)):
-        raise ConfigError("network.observations", "gama-local has no 2-D coordinate "
-                          "differences (dx, dy)")
+        raise ConfigError(
+            "network.observations", "gama-local has no 2-D coordinate differences (dx, dy)"
+        )
     val = computed(net, net.theta_true()[None])[0]
     root = ET.Element("gama-local", xmlns=NS)
     nw = ET.SubElement(root, "network", {"axes-xy": "ne", "angles": "400"})
@@ -204,22 +260,49 @@ def write_gama(net: Network, path: str | Path) -> Path:
         for r in np.flatnonzero((net.i == a) & (net.kind <= 2)):
             kd = KINDS[net.kind[r]]
             if kd == "distance":
-                ET.SubElement(o, "distance", {"to": net.names[net.j[r]],
-                                              "val": _fmt(val[r] / 1000), "stdev": _fmt(net.sigma[r])})
+                ET.SubElement(
+                    o,
+                    "distance",
+                    {
+                        "to": net.names[net.j[r]],
+                        "val": _fmt(val[r] / 1000),
+                        "stdev": _fmt(net.sigma[r]),
+                    },
+                )
             elif kd == "direction":
-                ET.SubElement(o, "direction", {"to": net.names[net.j[r]],
-                                               "val": _fmt(val[r] / (math.pi / 200) % 400),
-                                               "stdev": _fmt(net.sigma[r] / CC)})
+                ET.SubElement(
+                    o,
+                    "direction",
+                    {
+                        "to": net.names[net.j[r]],
+                        "val": _fmt(val[r] / (math.pi / 200) % 400),
+                        "stdev": _fmt(net.sigma[r] / CC),
+                    },
+                )
             else:
-                ET.SubElement(o, "angle", {"bs": net.names[net.j[r]], "fs": net.names[net.k[r]],
-                                           "val": _fmt(val[r] / (math.pi / 200)),
-                                           "stdev": _fmt(net.sigma[r] / CC)})
+                ET.SubElement(
+                    o,
+                    "angle",
+                    {
+                        "bs": net.names[net.j[r]],
+                        "fs": net.names[net.k[r]],
+                        "val": _fmt(val[r] / (math.pi / 200)),
+                        "stdev": _fmt(net.sigma[r] / CC),
+                    },
+                )
     obs_pts = np.flatnonzero(net.role == 2)
     if obs_pts.size:
         c = ET.SubElement(po, "coordinates")
         for a in obs_pts:
-            ET.SubElement(c, "point", {"id": net.names[a], "x": _fmt(net.xy[a, 0] / 1000),
-                                       "y": _fmt(net.xy[a, 1] / 1000)})
+            ET.SubElement(
+                c,
+                "point",
+                {
+                    "id": net.names[a],
+                    "x": _fmt(net.xy[a, 0] / 1000),
+                    "y": _fmt(net.xy[a, 1] / 1000),
+                },
+            )
         sig = {int(a): s for a, s in zip(net.i[net.kind == 5], net.sigma[net.kind == 5])}
         cm = ET.SubElement(c, "cov-mat", {"dim": str(2 * obs_pts.size), "band": "0"})
         cm.text = " ".join(_fmt(sig[int(a)] ** 2) for a in obs_pts for _ in (0, 1))

@@ -9,15 +9,16 @@ covariances. The datum (:func:`datum`) frees the estimated globals and adds fixe
 inner constraints over chosen points, or a user's minimal constraints. Seed papers: Brown 1968
 (``004``: ranges with the pivot offsets) and the grid plates of ``001`` (weighted coordinates).
 """
+
 from __future__ import annotations
 
 import fnmatch
 
 import numpy as np
 
-from ... import lsq
-from ...config import ConfigError
-from .definition import Network
+from sim import lsq
+from sim.mc.config import ConfigError
+from sim.studies.network.definition import Network
 
 __all__ = ["NetworkModel", "computed", "simulate", "datum", "null_space"]
 
@@ -32,12 +33,12 @@ def computed(net: Network, theta: np.ndarray, jac: bool = False):
     """Computed observations ``(T, m)`` at globals ``theta`` ``(T, q)`` and, with ``jac``,
     their Jacobian ``(T, m, q)`` (dense)."""
     T = theta.shape[0]
-    xy = theta[:, :2 * net.n].reshape(T, net.n, 2)
+    xy = theta[:, : 2 * net.n].reshape(T, net.n, 2)
     kind, i, j, k = net.kind, net.i, net.j, net.k
     pi, pj = xy[:, i], xy[:, np.where(j >= 0, j, 0)]
     dx, dy = pj[..., 0] - pi[..., 0], pj[..., 1] - pi[..., 1]
     d2 = dx * dx + dy * dy
-    beta2 = net.offset_mm ** 2
+    beta2 = net.offset_mm**2
     with np.errstate(invalid="ignore", divide="ignore"):
         s = np.sqrt(np.maximum(d2 - beta2, 0.0))
         bear = np.arctan2(dy, dx)
@@ -47,12 +48,14 @@ def computed(net: Network, theta: np.ndarray, jac: bool = False):
     pk = xy[:, np.where(k >= 0, k, 0)]
     ex, ey = pk[..., 0] - pi[..., 0], pk[..., 1] - pi[..., 1]
     bear_k = np.arctan2(ey, ex)
-    val = np.select([kind == 0, kind == 1, kind == 2, kind == 3, kind == 4, kind == 5],
-                    [f * s - alpha, bear - ori, (bear_k - bear) % _TWO_PI, dx, dy, pi[..., 0]],
-                    pi[..., 1])
+    val = np.select(
+        [kind == 0, kind == 1, kind == 2, kind == 3, kind == 4, kind == 5],
+        [f * s - alpha, bear - ori, (bear_k - bear) % _TWO_PI, dx, dy, pi[..., 0]],
+        pi[..., 1],
+    )
     if not jac:
         return val
-    J = np.zeros((T, net.m, net.q + 1))           # the last column collects padding
+    J = np.zeros((T, net.m, net.q + 1))  # the last column collects padding
     rows = np.arange(net.m)
     cx_i, cy_i = 2 * i, 2 * i + 1
     cx_j = np.where(j >= 0, 2 * j, net.q)
@@ -70,15 +73,19 @@ def computed(net: Network, theta: np.ndarray, jac: bool = False):
     J[:, rows, cy_j] = np.where(lin, gy, np.where(kind == 4, 1.0, 0.0))
     J[:, rows, cx_k] = hx
     J[:, rows, cy_k] = hy
-    J[:, rows, cx_i] = np.where(lin, -(gx + hx), np.select([kind == 3, kind == 5], [-1.0, 1.0], 0.0))
-    J[:, rows, cy_i] = np.where(lin, -(gy + hy), np.select([kind == 4, kind == 6], [-1.0, 1.0], 0.0))
+    J[:, rows, cx_i] = np.where(
+        lin, -(gx + hx), np.select([kind == 3, kind == 5], [-1.0, 1.0], 0.0)
+    )
+    J[:, rows, cy_i] = np.where(
+        lin, -(gy + hy), np.select([kind == 4, kind == 6], [-1.0, 1.0], 0.0)
+    )
     if len(net.stations):
         d = kind == 1
         J[:, rows[d], 2 * net.n + net.oset[d]] = -1.0
     dist = rows[kind == 0]
     J[:, dist, net.i_constant] = -1.0
     J[:, dist, net.i_scale] = 1e-6 * s[:, kind == 0]
-    return val, J[..., :net.q]
+    return val, J[..., : net.q]
 
 
 def simulate(net: Network, rng: np.random.Generator, T: int) -> np.ndarray:
@@ -97,7 +104,7 @@ class NetworkModel:
         self.obs = obs
         self.n_global = net.q
         self.n_obs = net.m
-        self.w = (1.0 / net.sigma ** 2)[None, :, None]
+        self.w = (1.0 / net.sigma**2)[None, :, None]
 
     def linearize(self, points, theta, globals_needed):
         val, J = computed(self.net, theta, jac=True)
@@ -105,8 +112,9 @@ class NetworkModel:
         r = obs - val
         ang = (self.net.kind == 1) | (self.net.kind == 2)
         r = np.where(ang, _wrap(r), r)
-        return lsq.Linearization(r[..., None], None, J[:, :, None, :] if globals_needed else None,
-                                 self.w)
+        return lsq.Linearization(
+            r[..., None], None, J[:, :, None, :] if globals_needed else None, self.w
+        )
 
     def initial_points(self, theta):
         return np.zeros((theta.shape[0], self.net.m, 0))
@@ -118,11 +126,11 @@ def null_space(net: Network, free: np.ndarray) -> np.ndarray:
     error of the distances shrinks as the coordinates grow)."""
     c = net.xy - net.xy.mean(axis=0)
     G = np.zeros((net.q, 4))
-    G[0:2 * net.n:2, 0] = 1
-    G[1:2 * net.n:2, 1] = 1
-    G[0:2 * net.n:2, 2], G[1:2 * net.n:2, 2] = -c[:, 1], c[:, 0]
-    G[2 * net.n:2 * net.n + len(net.stations), 2] = 1.0
-    G[0:2 * net.n:2, 3], G[1:2 * net.n:2, 3] = c[:, 0], c[:, 1]
+    G[0 : 2 * net.n : 2, 0] = 1
+    G[1 : 2 * net.n : 2, 1] = 1
+    G[0 : 2 * net.n : 2, 2], G[1 : 2 * net.n : 2, 2] = -c[:, 1], c[:, 0]
+    G[2 * net.n : 2 * net.n + len(net.stations), 2] = 1.0
+    G[0 : 2 * net.n : 2, 3], G[1 : 2 * net.n : 2, 3] = c[:, 0], c[:, 1]
     G[net.i_scale, 3] = -(1e6 + net.scale_ppm)
     return G[free]
 
@@ -132,7 +140,9 @@ def _param_index(net: Network, key: str, name: str) -> int:
         pt, ax = name.rsplit(".", 1)
         return 2 * net.index(pt) + "xy".index(ax)
     except ValueError:
-        raise ConfigError(key, f"{name!r} is not <point>.x or <point>.y of a network point") from None
+        raise ConfigError(
+            key, f"{name!r} is not <point>.x or <point>.y of a network point"
+        ) from None
 
 
 def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
@@ -154,10 +164,12 @@ def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
                 g = _param_index(net, f"datum.constraints[{b}]", name)
                 if g not in pos:
                     if g // 2 in extra_fixed:
-                        continue            # held fixed in this parameterisation
+                        continue  # held fixed in this parameterisation
                     raise ConfigError(f"datum.constraints[{b}]", f"{name} is not a free unknown")
                 if isinstance(coef, bool) or not isinstance(coef, (int, float)):
-                    raise ConfigError(f"datum.constraints[{b}]", f"{name}: coefficient must be a number")
+                    raise ConfigError(
+                        f"datum.constraints[{b}]", f"{name}: coefficient must be a number"
+                    )
                 C[pos[g], b] = coef
         keep = np.abs(C).sum(0) > 0
         return lsq.Datum(free, C[:, keep] if keep.any() else None)
@@ -175,6 +187,6 @@ def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
     if not defect.any():
         return lsq.Datum(free)
     mask = np.zeros(net.q)
-    mask[:2 * net.n] = np.repeat(sel, 2)
+    mask[: 2 * net.n] = np.repeat(sel, 2)
     C = G[:, defect] * mask[free][:, None]
     return lsq.Datum(free, C)

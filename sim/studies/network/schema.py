@@ -6,93 +6,155 @@ tables, checked field by field by :func:`sim.studies.network.definition.build`; 
 also builds the datum and refuses a rank defect the datum does not cover, and a run whose
 arrays would not fit in memory.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ...config import COMMON, ConfigError, Field
+from sim.mc.config import COMMON, ConfigError, Field
 
 __all__ = ["SCHEMA", "check"]
 
 #: bytes of one chunk's dense Jacobians above which a configuration is refused
-MAX_CHUNK_BYTES = 2 * 1024 ** 3
+MAX_CHUNK_BYTES = 2 * 1024**3
 
 SCHEMA = {
     **COMMON,
     "network.name": Field("network", "str", "name of the network (report title)"),
-    "network.gama_xml": Field("", "str", "read the points and observations from this "
-                              "gama-local XML file instead (a path relative to the working "
-                              "directory, or absolute)"),
+    "network.gama_xml": Field(
+        "",
+        "str",
+        "read the points and observations from this "
+        "gama-local XML file instead (a path relative to the working "
+        "directory, or absolute)",
+    ),
     "network.points": Field([], "records", "points {name, x_mm, y_mm, role, sigma_mm}"),
-    "network.grids": Field([], "records", "grids {prefix, nx, ny, spacing_mm, origin_mm, role, "
-                           "sigma_mm}"),
-    "network.random": Field([], "records", "random points {prefix, n, half_extent_mm, center_mm, "
-                            "role, sigma_mm}, drawn once from the seed"),
-    "network.observations": Field([], "records", "single observations {kind, from, to, at, "
-                                  "sigma_mm | sigma_arcsec, settings, bias_mm | bias_arcsec}"),
-    "network.generate": Field([], "records", "generated observations {kind, from, to, nearest, "
-                              "sigma_*, settings, bias_*}: every 'from' point to every 'to' point"),
-    "network.constant_mm": Field(0.0, "float", "true additive constant of every distance "
-                                 "(Brown's alpha)", lo=-1e6, hi=1e6, unit="mm"),
+    "network.grids": Field(
+        [], "records", "grids {prefix, nx, ny, spacing_mm, origin_mm, role, sigma_mm}"
+    ),
+    "network.random": Field(
+        [],
+        "records",
+        "random points {prefix, n, half_extent_mm, center_mm, "
+        "role, sigma_mm}, drawn once from the seed",
+    ),
+    "network.observations": Field(
+        [],
+        "records",
+        "single observations {kind, from, to, at, "
+        "sigma_mm | sigma_arcsec, settings, bias_mm | bias_arcsec}",
+    ),
+    "network.generate": Field(
+        [],
+        "records",
+        "generated observations {kind, from, to, nearest, "
+        "sigma_*, settings, bias_*}: every 'from' point to every 'to' point",
+    ),
+    "network.constant_mm": Field(
+        0.0,
+        "float",
+        "true additive constant of every distance (Brown's alpha)",
+        lo=-1e6,
+        hi=1e6,
+        unit="mm",
+    ),
     "network.estimate_constant": Field(False, "bool", "estimate the additive constant"),
-    "network.offset_mm": Field(0.0, "float", "known perpendicular offset of every distance "
-                               "(Brown's beta): reads sqrt(d^2 - beta^2)", lo=0.0, hi=1e6,
-                               unit="mm"),
-    "network.scale_ppm": Field(0.0, "float", "true scale error of every distance: reads "
-                               "(1 + s) times the distance", lo=-1e5, hi=1e5, unit="ppm"),
+    "network.offset_mm": Field(
+        0.0,
+        "float",
+        "known perpendicular offset of every distance (Brown's beta): reads sqrt(d^2 - beta^2)",
+        lo=0.0,
+        hi=1e6,
+        unit="mm",
+    ),
+    "network.scale_ppm": Field(
+        0.0,
+        "float",
+        "true scale error of every distance: reads (1 + s) times the distance",
+        lo=-1e5,
+        hi=1e5,
+        unit="ppm",
+    ),
     "network.estimate_scale": Field(False, "bool", "estimate the scale error of the distances"),
-    "datum.kind": Field("fixed", "str", "fixed points, inner constraints over datum.points, or "
-                        "explicit minimal constraints", choices=("fixed", "inner", "constraints")),
-    "datum.points": Field([], "list[str]", "name patterns of the inner-constraint points "
-                          "(default: all)"),
-    "datum.constraints": Field([], "records", "minimal constraints, each {\"P.x\" = coef, ...}: "
-                               "sum of coef x correction = 0"),
-    "output.inner_over": Field([], "list[str]", "also state the point precision in the inner "
-                               "datum over these name patterns (S-transformation)"),
-    "compare.fix": Field([], "list[str]", "a second parameterisation with these points known: "
-                         "the dilution of every other point between the two"),
-    "reliability.alpha0": Field(0.001, "float", "significance level of Baarda's w-test",
-                                lo=1e-12, hi=0.5),
+    "datum.kind": Field(
+        "fixed",
+        "str",
+        "fixed points, inner constraints over datum.points, or explicit minimal constraints",
+        choices=("fixed", "inner", "constraints"),
+    ),
+    "datum.points": Field(
+        [], "list[str]", "name patterns of the inner-constraint points (default: all)"
+    ),
+    "datum.constraints": Field(
+        [], "records", 'minimal constraints, each {"P.x" = coef, ...}: sum of coef x correction = 0'
+    ),
+    "output.inner_over": Field(
+        [],
+        "list[str]",
+        "also state the point precision in the inner "
+        "datum over these name patterns (S-transformation)",
+    ),
+    "compare.fix": Field(
+        [],
+        "list[str]",
+        "a second parameterisation with these points known: "
+        "the dilution of every other point between the two",
+    ),
+    "reliability.alpha0": Field(
+        0.001, "float", "significance level of Baarda's w-test", lo=1e-12, hi=0.5
+    ),
     "reliability.power": Field(0.80, "float", "power of the w-test (MDB)", lo=0.05, hi=0.9999),
-    "test.alpha": Field(0.05, "float", "significance level of the global (chi-square) test",
-                        lo=1e-6, hi=0.5),
-    "solver.tol_mm": Field(1e-9, "float", "convergence on the corrections", lo=1e-15, hi=1.0,
-                           lo_open=True, unit="mm"),
+    "test.alpha": Field(
+        0.05, "float", "significance level of the global (chi-square) test", lo=1e-6, hi=0.5
+    ),
+    "solver.tol_mm": Field(
+        1e-9, "float", "convergence on the corrections", lo=1e-15, hi=1.0, lo_open=True, unit="mm"
+    ),
     "solver.max_iter": Field(20, "int", "Gauss-Newton iteration limit", lo=1, hi=200),
 }
 SCHEMA["trials"] = Field(2000, "int", "Monte-Carlo trials", lo=2, hi=10_000_000)
-SCHEMA["chunk"] = Field(100, "int", "trials per chunk (intervals are over chunks: >= 2 chunks)",
-                        lo=1, hi=100_000)
+SCHEMA["chunk"] = Field(
+    100, "int", "trials per chunk (intervals are over chunks: >= 2 chunks)", lo=1, hi=100_000
+)
 
 
 def check(cfg: dict) -> None:
     """Cross-key rules: the network builds, its datum covers every rank defect, the chunk
     fits in memory, and the run has at least two chunks."""
-    from .analysis import analyse
-    from .definition import build
-    from .gama import merge_gama
-    from .model import datum
+    from sim.studies.network.analysis import analyse
+    from sim.studies.network.definition import build
+    from sim.studies.network.gama import merge_gama
+    from sim.studies.network.model import datum
 
     if cfg["trials"] < 2 * cfg["chunk"]:
-        raise ConfigError("chunk", f"{cfg['trials']} trials in chunks of {cfg['chunk']} give "
-                          "fewer than 2 chunks: the intervals are taken over chunks")
+        raise ConfigError(
+            "chunk",
+            f"{cfg['trials']} trials in chunks of {cfg['chunk']} give "
+            "fewer than 2 chunks: the intervals are taken over chunks",
+        )
     cfg = merge_gama(cfg)
     net = build(cfg)
     nbytes = cfg["chunk"] * net.m * (net.q + 1) * 8
     if nbytes > MAX_CHUNK_BYTES:
-        raise ConfigError("chunk", f"a chunk of {cfg['chunk']} trials needs "
-                          f"{nbytes / 1024 ** 3:.1f} GiB of Jacobians ({net.m} observations x "
-                          f"{net.q} unknowns); use a smaller chunk")
+        raise ConfigError(
+            "chunk",
+            f"a chunk of {cfg['chunk']} trials needs "
+            f"{nbytes / 1024**3:.1f} GiB of Jacobians ({net.m} observations x "
+            f"{net.q} unknowns); use a smaller chunk",
+        )
     dt = datum(net, cfg)
     an = analyse(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
         _defect(net, dt, "datum.kind")
     if an.dof < 1:
-        raise ConfigError("network.observations", f"{net.m} observations for "
-                          f"{len(an.free)} unknowns leave {an.dof} degrees of freedom: add "
-                          "observations")
+        raise ConfigError(
+            "network.observations",
+            f"{net.m} observations for "
+            f"{len(an.free)} unknowns leave {an.dof} degrees of freedom: add "
+            "observations",
+        )
     if cfg["compare.fix"]:
-        from .run import compare_points
+        from sim.studies.network.run import compare_points
 
         extra = compare_points(net, cfg)
         an2 = analyse(net, datum(net, cfg, tuple(extra)), 0.001, 0.8)
@@ -101,7 +163,7 @@ def check(cfg: dict) -> None:
 
 
 def _defect(net, dt, key: str) -> None:
-    from .model import computed
+    from sim.studies.network.model import computed
 
     free = dt.free_index(net.q)
     _, J = computed(net, net.theta_true()[None], jac=True)
@@ -110,6 +172,9 @@ def _defect(net, dt, key: str) -> None:
     rank = int((sv > sv[0] * 1e-10).sum()) if sv.size else 0
     C = dt.constraint_matrix(net.theta_true()[None])
     c = 0 if C is None else C.shape[-1]
-    raise ConfigError(key, f"the network has a rank defect of {len(free) - rank} ({len(free)} "
-                      f"unknowns, rank {rank}) that the datum ({c} constraints) does not cover: "
-                      "fix points, add observations, or use datum.kind = inner")
+    raise ConfigError(
+        key,
+        f"the network has a rank defect of {len(free) - rank} ({len(free)} "
+        f"unknowns, rank {rank}) that the datum ({c} constraints) does not cover: "
+        "fix points, add observations, or use datum.kind = inner",
+    )

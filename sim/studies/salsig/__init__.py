@@ -5,17 +5,31 @@ Modules: :mod:`.schema` (config and checks), :mod:`.printed` (the paper's printe
 :mod:`.model` (simulation, chunk functions), :mod:`.run`, :mod:`.sweep` (unprinted inputs,
 consistent set), ``claims.toml`` + :mod:`.claims` (scoring), :mod:`.figures`, :mod:`.report`.
 """
+
 from __future__ import annotations
 
-from .. import Study
-from .model import decompositions, simulate_chain, simulate_vertical, simulate_zscale  # noqa: F401
-from .report import report
-from .run import run
-from .schema import SCHEMA, check
+from sim.studies import Study
+from sim.studies.salsig.model import (  # noqa: F401
+    decompositions,
+    simulate_chain,
+    simulate_vertical,
+    simulate_zscale,
+)
+from sim.studies.salsig.report import report
+from sim.studies.salsig.run import run
+from sim.studies.salsig.schema import SCHEMA, check
 
 SEED = "002_fb81c7b0481438c4.txt"
 
 STUDIES = {
-    "salsig_encoders": Study("salsig_encoders", "Salsig: calibrating stereo plotter encoders", SEED,
-                             SCHEMA, run, report, check, order=30),
+    "salsig_encoders": Study(
+        "salsig_encoders",
+        "Salsig: calibrating stereo plotter encoders",
+        SEED,
+        SCHEMA,
+        run,
+        report,
+        check,
+        order=30,
+    ),
 }

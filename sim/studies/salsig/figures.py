@@ -1,13 +1,14 @@
 """Figures of ``salsig_encoders``: residuals of one simulated calibration, recovery of the B8
 scales and angle, detection power, vertical ratio against relief, and the claims against the
 unprinted inputs (consistent set)."""
+
 from __future__ import annotations
 
 from pathlib import Path
 
-from ...plotting import plt, save
-from ..gridplate.figures import fig_consistent  # noqa: F401  (one outcome map for both studies)
-from .schema import UM
+from sim.report.plotting import plt, save
+from sim.studies.gridplate.figures import fig_consistent  # noqa: F401  (one outcome map for both studies)
+from sim.studies.salsig.schema import UM
 
 
 def fig_residuals(ex: dict, cfg: dict, path: Path) -> None:
@@ -15,13 +16,29 @@ def fig_residuals(ex: dict, cfg: dict, path: Path) -> None:
     G, r2 = ex["grid"], ex["res2"][0] / UM
     mg, r3 = ex["marks_grid"][0], ex["res3"][0]
     sig = cfg["b8.sx_mm_per_digit"]
-    a = axs[0].quiver(G[:, 0], G[:, 1], r2[:, 0], r2[:, 1], angles="xy", scale_units="xy",
-                      scale=5.0 / 12.5, color="k")
+    a = axs[0].quiver(
+        G[:, 0],
+        G[:, 1],
+        r2[:, 0],
+        r2[:, 1],
+        angles="xy",
+        scale_units="xy",
+        scale=5.0 / 12.5,
+        color="k",
+    )
     axs[0].quiverkey(a, 0.85, 1.02, 5, "5 um", labelpos="E", coordinates="axes")
     axs[0].set_title("FIG. 2 analogue: comparator residuals on the grid", pad=16)
     r3um = r3 * sig / UM
-    b = axs[1].quiver(mg[:, 0], mg[:, 1], r3um[:, 0], r3um[:, 1], angles="xy",
-                      scale_units="xy", scale=50.0 / 12.5, color="tab:red")
+    b = axs[1].quiver(
+        mg[:, 0],
+        mg[:, 1],
+        r3um[:, 0],
+        r3um[:, 1],
+        angles="xy",
+        scale_units="xy",
+        scale=50.0 / 12.5,
+        color="tab:red",
+    )
     axs[1].quiverkey(b, 0.85, 1.02, 50, "50 um", labelpos="E", coordinates="axes")
     axs[1].set_title("FIG. 3 analogue: B8 residuals at the marks (model um)", pad=16)
     for ax in axs:
@@ -33,9 +50,11 @@ def fig_residuals(ex: dict, cfg: dict, path: Path) -> None:
 
 def fig_recovery(res: dict, cfg: dict, path: Path) -> None:
     fig, axs = plt.subplots(1, 3, figsize=(12, 3.6))
-    items = (("SX", cfg["b8.sx_mm_per_digit"], "SX (mm/digit)"),
-             ("SY", cfg["b8.sy_mm_per_digit"], "SY (mm/digit)"),
-             ("E_arcsec", cfg["b8.e_arcsec"], "E (arcsec)"))
+    items = (
+        ("SX", cfg["b8.sx_mm_per_digit"], "SX (mm/digit)"),
+        ("SY", cfg["b8.sy_mm_per_digit"], "SY (mm/digit)"),
+        ("E_arcsec", cfg["b8.e_arcsec"], "E (arcsec)"),
+    )
     for ax, (k, tr, lab) in zip(axs, items):
         ax.hist(res[k], bins=60, color="tab:blue", alpha=0.7)
         ax.axvline(tr, color="tab:green", lw=2, label="truth")
@@ -53,12 +72,18 @@ def fig_recovery(res: dict, cfg: dict, path: Path) -> None:
 def fig_power(sw: dict, path: Path) -> None:
     fig, axs = plt.subplots(1, 2, figsize=(11, 3.8), sharey=True)
     sig = sorted(set(sw["sigma_um"]))
-    for ax, key, title in ((axs[0], "power_E", "non-perpendicularity E = -59.2\""),
-                           (axs[1], "power_scale", "scale difference SY - SX (0.016 %)")):
+    for ax, key, title in (
+        (axs[0], "power_E", 'non-perpendicularity E = -59.2"'),
+        (axs[1], "power_scale", "scale difference SY - SX (0.016 %)"),
+    ):
         for s in sig:
             idx = [i for i, v in enumerate(sw["sigma_um"]) if v == s]
-            ax.plot([sw["n_marks"][i] for i in idx], [sw[key][i] for i in idx], "o-",
-                    label=f"B8 sigma {s:g} um")
+            ax.plot(
+                [sw["n_marks"][i] for i in idx],
+                [sw[key][i] for i in idx],
+                "o-",
+                label=f"B8 sigma {s:g} um",
+            )
         ax.axhline(0.95, color="k", lw=0.8)
         ax.set_xlabel("number of marks")
         ax.set_title(f"power to detect {title}")
@@ -69,11 +94,19 @@ def fig_power(sw: dict, path: Path) -> None:
 
 def fig_vertical(det: dict, zone: tuple[float, float], path: Path) -> None:
     """Median ratio after/before of the vertical rms against the control relief (sweep)."""
-    idx = [i for i, (k, c) in enumerate(zip(det["input"], det["claim"]))
-           if k == "vertical.relief_mm" and c == "salsig.vertical_halved.rms_ratio"]
+    idx = [
+        i
+        for i, (k, c) in enumerate(zip(det["input"], det["claim"]))
+        if k == "vertical.relief_mm" and c == "salsig.vertical_halved.rms_ratio"
+    ]
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
-    ax.plot([det["input_value"][i] for i in idx], [det["value"][i] for i in idx], "o-",
-            color="tab:blue", label="median over models")
+    ax.plot(
+        [det["input_value"][i] for i in idx],
+        [det["value"][i] for i in idx],
+        "o-",
+        color="tab:blue",
+        label="median over models",
+    )
     ax.axhspan(*zone, color="tab:orange", alpha=0.15, label="'cut roughly in half' (zone)")
     ax.set_xscale("log")
     ax.set_xlabel("relief of the control heights, rms (model mm)")

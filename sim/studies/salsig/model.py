@@ -13,26 +13,38 @@
 Chunk functions are module-level (bind the config with functools.partial: they pickle).
 Model/grid coordinates in mm, B8 readings in digits, errors in um.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ... import encoders as enc
-from ... import transforms2d as t2
-from ...plate import grid_points
-from .printed import FIG2, FIG2_PRINTED, FIG3, FIG3_PRINTED
-from .schema import UM
-from ... import distributions as D
+from sim.instruments import encoders as enc
+from sim.instruments import transforms2d as t2
+from sim.instruments.plates import grid_points
+from sim.lsq import distributions as D
+from sim.studies.salsig.printed import FIG2, FIG2_PRINTED, FIG3, FIG3_PRINTED
+from sim.studies.salsig.schema import UM
 
 
 def b8_truth(cfg: dict) -> np.ndarray:
     """True affine B8 digits -> model mm (x axis along model x), (6,)."""
-    return t2.affine_from_columns(cfg["b8.sx_mm_per_digit"], cfg["b8.sy_mm_per_digit"],
-                                  cfg["b8.e_arcsec"] * t2.ARCSEC, 0.0, (0.0, 0.0))
+    return t2.affine_from_columns(
+        cfg["b8.sx_mm_per_digit"],
+        cfg["b8.sy_mm_per_digit"],
+        cfg["b8.e_arcsec"] * t2.ARCSEC,
+        0.0,
+        (0.0, 0.0),
+    )
 
 
-def simulate_chain(cfg: dict, rng: np.random.Generator, n: int, k_marks: int | None = None,
-                   sigma_b8_um: float | None = None, return_all: bool = False):
+def simulate_chain(
+    cfg: dict,
+    rng: np.random.Generator,
+    n: int,
+    k_marks: int | None = None,
+    sigma_b8_um: float | None = None,
+    return_all: bool = False,
+):
     """Simulate ``n`` calibrations and reduce them as the paper does.
 
     Marks: ``k x k`` nominal array over ``marks.extent_mm`` plus placement scatter (model
@@ -48,11 +60,12 @@ def simulate_chain(cfg: dict, rng: np.random.Generator, n: int, k_marks: int | N
     sc = cfg["comparator.sigma_um"] * UM
     nom = grid_points(k, cfg["marks.extent_mm"] / (k - 1))
     M = nom.shape[0]
-    marks = nom + rng.normal(0.0, cfg["marks.placement_sd_mm"], (n, M, 2))     # model mm
+    marks = nom + rng.normal(0.0, cfg["marks.placement_sd_mm"], (n, M, 2))  # model mm
     b8 = b8_truth(cfg)
     b8_inv = t2.invert_affine(b8)
-    b8_read = t2.apply_affine(np.broadcast_to(b8_inv, (n, 6)),
-                              marks + rng.normal(0.0, sb8, (n, M, 2)))           # digits
+    b8_read = t2.apply_affine(
+        np.broadcast_to(b8_inv, (n, 6)), marks + rng.normal(0.0, sb8, (n, M, 2))
+    )  # digits
     # film on the grid: rotation and offset of the film (model) frame in the grid frame
     rot = rng.uniform(-2, 2, n) * np.pi / 180
     off = rng.uniform(-10, 10, (n, 2))
@@ -61,17 +74,20 @@ def simulate_chain(cfg: dict, rng: np.random.Generator, n: int, k_marks: int | N
     marks_grid_true = t2.apply_affine(film2grid, marks)
     G = grid_points(cfg["grid.points"], cfg["grid.spacing_mm"])
     # comparator: grid frame -> comparator readings through the FIG. 2-like affine (inverse)
-    cg = t2.affine_from_columns(cfg["comparator.sx"], cfg["comparator.sy"],
-                                cfg["comparator.e_arcsec"] * t2.ARCSEC,
-                                rng.uniform(-1, 1, n) * np.pi / 180,
-                                (rng.uniform(-120, -110, n), rng.uniform(-120, -110, n)))
+    cg = t2.affine_from_columns(
+        cfg["comparator.sx"],
+        cfg["comparator.sy"],
+        cfg["comparator.e_arcsec"] * t2.ARCSEC,
+        rng.uniform(-1, 1, n) * np.pi / 180,
+        (rng.uniform(-120, -110, n), rng.uniform(-120, -110, n)),
+    )
     g2c = t2.invert_affine(cg)
     comp_grid = t2.apply_affine(g2c, G) + rng.normal(0.0, sc, (n, G.shape[0], 2))
     comp_marks = t2.apply_affine(g2c, marks_grid_true) + rng.normal(0.0, sc, (n, M, 2))
     # FIG. 2: comparator (X2, observed) as a function of the grid (X1, control)
     f2 = t2.fit_affine(G, comp_grid)
-    p2 = t2.invert_affine(f2.params)                 # X1 = A X2 + B Y2 + C
-    marks_grid = t2.apply_affine(p2, comp_marks)     # FIG. 2 "transformed points"
+    p2 = t2.invert_affine(f2.params)  # X1 = A X2 + B Y2 + C
+    marks_grid = t2.apply_affine(p2, comp_marks)  # FIG. 2 "transformed points"
     # FIG. 3: B8 (X2, observed) as a function of the grid-system marks (X1, control)
     f3 = t2.fit_affine(marks_grid, b8_read)
     d3 = t2.inverse_decomposition(f3.params, f3.cov)
@@ -79,15 +95,32 @@ def simulate_chain(cfg: dict, rng: np.random.Generator, n: int, k_marks: int | N
     diff = d3["SX"] - d3["SY"]
     sd_diff = np.sqrt(d3["cov"][:, 0, 0] + d3["cov"][:, 1, 1] - 2 * d3["cov"][:, 0, 1])
     zc = D.norm_ppf(1 - cfg["analysis.alpha"] / 2)
-    out = {"SX": d3["SX"], "SY": d3["SY"], "E_arcsec": d3["E"] / t2.ARCSEC,
-           "sd_SX": sd[:, 0], "sd_SY": sd[:, 1], "sd_E_arcsec": sd[:, 2] / t2.ARCSEC,
-           "scale_diff_ppm": diff / d3["SX"] * 1e6, "sd_scale_diff_ppm": sd_diff / d3["SX"] * 1e6,
-           "detect_E": np.abs(d3["E"]) > zc * sd[:, 2],
-           "detect_scale": np.abs(diff) > zc * sd_diff,
-           "s0_fig2_mm": f2.s0, "s0_fig3_digits": f3.s0}
+    out = {
+        "SX": d3["SX"],
+        "SY": d3["SY"],
+        "E_arcsec": d3["E"] / t2.ARCSEC,
+        "sd_SX": sd[:, 0],
+        "sd_SY": sd[:, 1],
+        "sd_E_arcsec": sd[:, 2] / t2.ARCSEC,
+        "scale_diff_ppm": diff / d3["SX"] * 1e6,
+        "sd_scale_diff_ppm": sd_diff / d3["SX"] * 1e6,
+        "detect_E": np.abs(d3["E"]) > zc * sd[:, 2],
+        "detect_scale": np.abs(diff) > zc * sd_diff,
+        "s0_fig2_mm": f2.s0,
+        "s0_fig3_digits": f3.s0,
+    }
     if return_all:
-        out.update({"marks_grid": marks_grid, "b8_read": b8_read, "res3": f3.residuals,
-                    "grid": G, "comp_grid": comp_grid, "res2": f2.residuals, "p3": d3["params"]})
+        out.update(
+            {
+                "marks_grid": marks_grid,
+                "b8_read": b8_read,
+                "res3": f3.residuals,
+                "grid": G,
+                "comp_grid": comp_grid,
+                "res2": f2.residuals,
+                "p3": d3["params"],
+            }
+        )
     return out
 
 
@@ -112,8 +145,9 @@ def simulate_zscale(cfg: dict, rng: np.random.Generator, n: int) -> dict[str, np
 # ----------------------------------------------------------------------------- vertical
 
 
-def simulate_vertical(cfg: dict, rng: np.random.Generator, n: int,
-                      relief_mm: float | None = None) -> dict[str, np.ndarray]:
+def simulate_vertical(
+    cfg: dict, rng: np.random.Generator, n: int, relief_mm: float | None = None
+) -> dict[str, np.ndarray]:
     """Stereomodels fitted to control by a 3-D conformal transformation.
 
     True model points: ``vertical.control`` points spread over the model area, heights = a
@@ -130,9 +164,9 @@ def simulate_vertical(cfg: dict, rng: np.random.Generator, n: int,
     plane = rng.normal(0.0, 0.02, (n, 2))
     zr = rng.normal(0.0, 1.0, (n, m))
     zr -= zr.mean(1, keepdims=True)
-    zr *= relief / np.sqrt(np.maximum((zr ** 2).mean(1, keepdims=True), 1e-300))
+    zr *= relief / np.sqrt(np.maximum((zr**2).mean(1, keepdims=True), 1e-300))
     z = 200.0 + np.einsum("tmk,tk->tm", xy, plane) + zr
-    true = np.concatenate([xy, z[..., None]], -1)                            # model mm
+    true = np.concatenate([xy, z[..., None]], -1)  # model mm
     sxy, sz = cfg["vertical.sigma_xy_um"] * UM, cfg["vertical.sigma_z_um"] * UM
     meas = true + rng.normal(0.0, 1.0, true.shape) * np.array([sxy, sxy, sz])
     # digitise: x, y through the B8 affine, z through the z encoder
@@ -145,8 +179,9 @@ def simulate_vertical(cfg: dict, rng: np.random.Generator, n: int,
     after[..., 2] *= cfg["zscale.s_mm_per_digit"] / fac
     # ground control: similarity of the truth (scale 10 m per model mm) -- errors are in meas
     lam = 10.0
-    R = enc.rotation_matrix(rng.normal(0, 0.02, n), rng.normal(0, 0.02, n),
-                            rng.uniform(-np.pi, np.pi, n))
+    R = enc.rotation_matrix(
+        rng.normal(0, 0.02, n), rng.normal(0, 0.02, n), rng.uniform(-np.pi, np.pi, n)
+    )
     ground = lam * np.einsum("tij,tnj->tni", R, true) + rng.uniform(-1e3, 1e3, (n, 1, 3))
     out = {}
     for tag, X in (("before", before), ("after", after)):
@@ -171,8 +206,11 @@ def decompositions() -> dict:
         P = np.broadcast_to(p, (corners.shape[0], 6)).copy()
         P[:, [0, 1, 3, 4]] += corners
         d0, dc = t2.decompose_columns(p), t2.decompose_columns(P)
-        for q, conv, pr in (("SX", 1.0, printed[0]), ("SY", 1.0, printed[1]),
-                            ("E_arcsec", 1 / t2.ARCSEC, printed[2])):
+        for q, conv, pr in (
+            ("SX", 1.0, printed[0]),
+            ("SY", 1.0, printed[1]),
+            ("E_arcsec", 1 / t2.ARCSEC, printed[2]),
+        ):
             key = "E" if q == "E_arcsec" else q
             rows["figure"].append(fig)
             rows["quantity"].append(q)

@@ -1,12 +1,19 @@
 """Report section of ``salsig_encoders``: from the study's Parquet files and claim book only."""
+
 from __future__ import annotations
 
 from pathlib import Path
 
-from ...report import (claims_markdown, consistent_rows, consistent_sets_sentence,
-                        fmt, inputs_markdown, md_table)
-from ...storage import read_provenance, read_table
-from .schema import SCHEMA
+from sim.mc.storage import read_provenance, read_table
+from sim.report.markdown import (
+    claims_markdown,
+    consistent_rows,
+    consistent_sets_sentence,
+    fmt,
+    inputs_markdown,
+    md_table,
+)
+from sim.studies.salsig.schema import SCHEMA
 
 
 def report(out: Path) -> str:
@@ -28,7 +35,8 @@ def report(out: Path) -> str:
         "therefore in X2 units: mm of the comparator in FIG. 2, *digits* of the B8 in FIG. 3.",
         "",
         "**Errata** (the paper against its own printed data): "
-        + ("; ".join(f"`{r['claim']}`: {r['note']}" for r in errata) or "none") + ".",
+        + ("; ".join(f"`{r['claim']}`: {r['note']}" for r in errata) or "none")
+        + ".",
         "",
         "**The calibration chain.** Marks: a "
         f"{cfg['marks.grid']} x {cfg['marks.grid']} array over {cfg['marks.extent_mm']:g} mm, "
@@ -63,11 +71,20 @@ def report(out: Path) -> str:
         "**Detection power against the design** (share of calibrations in which E, resp. "
         "SX - SY, differs from zero at the 95 % level):",
         "",
-        md_table(["marks", "B8 sigma (um)", "power E", "power SX-SY", "sd E (\")",
-                  "sd SX-SY (ppm)"],
-                 [[n, fmt(s), fmt(a), fmt(b), fmt(e), fmt(d)] for n, s, a, b, e, d in
-                  zip(sw["n_marks"], sw["sigma_um"], sw["power_E"], sw["power_scale"],
-                      sw["sd_E_arcsec"], sw["sd_scale_diff_ppm"])]),
+        md_table(
+            ["marks", "B8 sigma (um)", "power E", "power SX-SY", 'sd E (")', "sd SX-SY (ppm)"],
+            [
+                [n, fmt(s), fmt(a), fmt(b), fmt(e), fmt(d)]
+                for n, s, a, b, e, d in zip(
+                    sw["n_marks"],
+                    sw["sigma_um"],
+                    sw["power_E"],
+                    sw["power_scale"],
+                    sw["sd_E_arcsec"],
+                    sw["sd_scale_diff_ppm"],
+                )
+            ],
+        ),
         "",
         f"![power]({name}/power.png)",
     ]

@@ -5,89 +5,227 @@ Keys marked *input* carry a number the paper prints. The magnitudes the paper do
 points, the glass-scale span and setting error, the grid spacing) are swept by
 ``consistency.*`` where a claim depends on them (:mod:`sim.studies.salsig.sweep`).
 """
+
 from __future__ import annotations
 
-import numpy as np
-
-from ...config import COMMON, ConfigError, Field
+from sim.mc.config import COMMON, ConfigError, Field
 
 UM = 1e-3
 
 SCHEMA = {
     **COMMON,
-    "trials": Field(4000, "int", "Monte-Carlo trials of the calibration chain", lo=2,
-                    hi=10_000_000),
+    "trials": Field(
+        4000, "int", "Monte-Carlo trials of the calibration chain", lo=2, hi=10_000_000
+    ),
     "chunk": Field(1000, "int", "trials per chunk", lo=1, hi=1_000_000),
-    "b8.sx_mm_per_digit": Field(12.700082809, "float", "true x scale SX of the B8 (FIG. 3)",
-                                lo=0.0, lo_open=True, input=True, unit="mm/digit"),
-    "b8.sy_mm_per_digit": Field(12.702028129, "float", "true y scale SY of the B8 (FIG. 3)",
-                                lo=0.0, lo_open=True, input=True, unit="mm/digit"),
-    "b8.e_arcsec": Field(-59.2, "float", "true non-perpendicularity E of the B8 (FIG. 3)",
-                         lo=-3600.0, hi=3600.0, input=True, unit="arcsec"),
-    "b8.sigma_um": Field(25.0, "float",
-                         "B8 marking error per coordinate (model space); not printed, swept "
-                         "(FIG. 3's unit-weight error .002 digit is the claim it decides)",
-                         lo=0.0, lo_open=True, hi=1000.0, unit="um"),
+    "b8.sx_mm_per_digit": Field(
+        12.700082809,
+        "float",
+        "true x scale SX of the B8 (FIG. 3)",
+        lo=0.0,
+        lo_open=True,
+        input=True,
+        unit="mm/digit",
+    ),
+    "b8.sy_mm_per_digit": Field(
+        12.702028129,
+        "float",
+        "true y scale SY of the B8 (FIG. 3)",
+        lo=0.0,
+        lo_open=True,
+        input=True,
+        unit="mm/digit",
+    ),
+    "b8.e_arcsec": Field(
+        -59.2,
+        "float",
+        "true non-perpendicularity E of the B8 (FIG. 3)",
+        lo=-3600.0,
+        hi=3600.0,
+        input=True,
+        unit="arcsec",
+    ),
+    "b8.sigma_um": Field(
+        25.0,
+        "float",
+        "B8 marking error per coordinate (model space); not printed, swept "
+        "(FIG. 3's unit-weight error .002 digit is the claim it decides)",
+        lo=0.0,
+        lo_open=True,
+        hi=1000.0,
+        unit="um",
+    ),
     "marks.grid": Field(5, "int", "marks per side (k x k array)", lo=2, hi=20),
-    "marks.extent_mm": Field(200.0, "float", "side of the mark array (5 x 5 at 50 mm: 200)",
-                             lo=10.0, hi=600.0, unit="mm"),
-    "marks.placement_sd_mm": Field(2.0, "float", "scatter of the inked circles about the nominal "
-                                   "array", lo=0.0, hi=20.0, unit="mm"),
-    "comparator.sigma_um": Field(3.0, "float", "comparator error per coordinate for grid "
-                                 "intersections and film marks; not printed, swept (FIG. 2's "
-                                 "unit-weight error .003 mm is the claim it decides)",
-                                 lo=0.0, lo_open=True, hi=100.0, unit="um"),
-    "comparator.sx": Field(0.999993007, "float", "comparator -> grid scale SX (FIG. 2)",
-                           lo=0.0, lo_open=True, input=True),
-    "comparator.sy": Field(0.999978669, "float", "comparator -> grid scale SY (FIG. 2)",
-                           lo=0.0, lo_open=True, input=True),
-    "comparator.e_arcsec": Field(-14.0, "float", "comparator -> grid non-perpendicularity (FIG. 2)",
-                                 lo=-3600.0, hi=3600.0, input=True, unit="arcsec"),
-    "grid.points": Field(5, "int", "grid intersections per side measured on the comparator",
-                         lo=2, hi=20),
-    "grid.spacing_mm": Field(50.0, "float", "grid spacing (not printed)", lo=1.0, hi=100.0,
-                             unit="mm"),
-    "analysis.alpha": Field(0.05, "float", "level of the detection tests", lo=0.0, lo_open=True,
-                            hi=0.5),
-    "power.marks": Field([3, 4, 5, 6, 7], "list[int]", "marks per side swept (same extent)",
-                         lo=2, hi=20, min_len=1),
-    "power.sigma_um": Field([2.0, 5.0, 10.0, 25.0, 50.0], "list[float]",
-                            "B8 marking sigmas swept (um)", lo=0.0, lo_open=True, min_len=1,
-                            unit="um"),
+    "marks.extent_mm": Field(
+        200.0, "float", "side of the mark array (5 x 5 at 50 mm: 200)", lo=10.0, hi=600.0, unit="mm"
+    ),
+    "marks.placement_sd_mm": Field(
+        2.0,
+        "float",
+        "scatter of the inked circles about the nominal array",
+        lo=0.0,
+        hi=20.0,
+        unit="mm",
+    ),
+    "comparator.sigma_um": Field(
+        3.0,
+        "float",
+        "comparator error per coordinate for grid "
+        "intersections and film marks; not printed, swept (FIG. 2's "
+        "unit-weight error .003 mm is the claim it decides)",
+        lo=0.0,
+        lo_open=True,
+        hi=100.0,
+        unit="um",
+    ),
+    "comparator.sx": Field(
+        0.999993007,
+        "float",
+        "comparator -> grid scale SX (FIG. 2)",
+        lo=0.0,
+        lo_open=True,
+        input=True,
+    ),
+    "comparator.sy": Field(
+        0.999978669,
+        "float",
+        "comparator -> grid scale SY (FIG. 2)",
+        lo=0.0,
+        lo_open=True,
+        input=True,
+    ),
+    "comparator.e_arcsec": Field(
+        -14.0,
+        "float",
+        "comparator -> grid non-perpendicularity (FIG. 2)",
+        lo=-3600.0,
+        hi=3600.0,
+        input=True,
+        unit="arcsec",
+    ),
+    "grid.points": Field(
+        5, "int", "grid intersections per side measured on the comparator", lo=2, hi=20
+    ),
+    "grid.spacing_mm": Field(
+        50.0, "float", "grid spacing (not printed)", lo=1.0, hi=100.0, unit="mm"
+    ),
+    "analysis.alpha": Field(
+        0.05, "float", "level of the detection tests", lo=0.0, lo_open=True, hi=0.5
+    ),
+    "power.marks": Field(
+        [3, 4, 5, 6, 7], "list[int]", "marks per side swept (same extent)", lo=2, hi=20, min_len=1
+    ),
+    "power.sigma_um": Field(
+        [2.0, 5.0, 10.0, 25.0, 50.0],
+        "list[float]",
+        "B8 marking sigmas swept (um)",
+        lo=0.0,
+        lo_open=True,
+        min_len=1,
+        unit="um",
+    ),
     "power.trials": Field(1000, "int", "trials per sweep cell", lo=2, hi=1_000_000),
-    "zscale.s_mm_per_digit": Field(12.5, "float", "true z scale (paper's result 12.500)", lo=0.0,
-                                   lo_open=True, input=True, unit="mm/digit"),
+    "zscale.s_mm_per_digit": Field(
+        12.5,
+        "float",
+        "true z scale (paper's result 12.500)",
+        lo=0.0,
+        lo_open=True,
+        input=True,
+        unit="mm/digit",
+    ),
     "zscale.points": Field(9, "int", "elevations read on the glass scale", lo=3, hi=100),
-    "zscale.range_mm": Field(160.0, "float", "span of the elevations (not printed)", lo=1.0,
-                             hi=1000.0, unit="mm"),
-    "zscale.sigma_um": Field(20.0, "float", "setting error on a glass-scale graduation (not "
-                             "printed)", lo=0.0, lo_open=True, hi=1000.0, unit="um"),
+    "zscale.range_mm": Field(
+        160.0, "float", "span of the elevations (not printed)", lo=1.0, hi=1000.0, unit="mm"
+    ),
+    "zscale.sigma_um": Field(
+        20.0,
+        "float",
+        "setting error on a glass-scale graduation (not printed)",
+        lo=0.0,
+        lo_open=True,
+        hi=1000.0,
+        unit="um",
+    ),
     "vertical.control": Field(6, "int", "control points per stereomodel", lo=3, hi=100),
-    "vertical.extent_mm": Field(180.0, "float", "side of the model area holding the control",
-                                lo=10.0, hi=600.0, unit="mm"),
-    "vertical.relief_mm": Field(4.0, "float", "rms of control heights about their plane "
-                                "(model mm); not printed, swept", lo=0.0, hi=100.0, unit="mm"),
-    "vertical.sigma_xy_um": Field(15.0, "float", "model x, y error of a control point "
-                                  "(measurement and control)", lo=0.0, hi=1000.0, unit="um"),
-    "vertical.sigma_z_um": Field(40.0, "float", "model z error of a control point (measurement "
-                                 "and control); not printed, swept", lo=0.0, lo_open=True,
-                                 hi=1000.0, unit="um"),
-    "consistency.relief_mm": Field([0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 12.0, 20.0],
-                                   "list[float]", "vertical.relief_mm values swept", lo=0.0,
-                                   hi=100.0, min_len=2, unit="mm"),
-    "consistency.sigma_z_um": Field([10.0, 20.0, 30.0, 40.0, 60.0, 80.0, 120.0, 200.0],
-                                    "list[float]", "vertical.sigma_z_um values swept", lo=0.0,
-                                    lo_open=True, hi=1000.0, min_len=2, unit="um"),
-    "consistency.control": Field([4, 5, 6, 8, 10, 15, 20], "list[int]",
-                                 "vertical.control values swept", lo=3, hi=100, min_len=2),
-    "consistency.b8_sigma_um": Field([2.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 50.0],
-                                     "list[float]", "b8.sigma_um values swept", lo=0.0,
-                                     lo_open=True, hi=1000.0, min_len=2, unit="um"),
-    "consistency.comparator_sigma_um": Field([1.0, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 8.0],
-                                             "list[float]", "comparator.sigma_um values swept",
-                                             lo=0.0, lo_open=True, hi=100.0, min_len=2, unit="um"),
-    "consistency.trials": Field(1000, "int", "simulated calibrations or models per sweep value",
-                                lo=50, hi=1_000_000),
+    "vertical.extent_mm": Field(
+        180.0, "float", "side of the model area holding the control", lo=10.0, hi=600.0, unit="mm"
+    ),
+    "vertical.relief_mm": Field(
+        4.0,
+        "float",
+        "rms of control heights about their plane (model mm); not printed, swept",
+        lo=0.0,
+        hi=100.0,
+        unit="mm",
+    ),
+    "vertical.sigma_xy_um": Field(
+        15.0,
+        "float",
+        "model x, y error of a control point (measurement and control)",
+        lo=0.0,
+        hi=1000.0,
+        unit="um",
+    ),
+    "vertical.sigma_z_um": Field(
+        40.0,
+        "float",
+        "model z error of a control point (measurement and control); not printed, swept",
+        lo=0.0,
+        lo_open=True,
+        hi=1000.0,
+        unit="um",
+    ),
+    "consistency.relief_mm": Field(
+        [0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 12.0, 20.0],
+        "list[float]",
+        "vertical.relief_mm values swept",
+        lo=0.0,
+        hi=100.0,
+        min_len=2,
+        unit="mm",
+    ),
+    "consistency.sigma_z_um": Field(
+        [10.0, 20.0, 30.0, 40.0, 60.0, 80.0, 120.0, 200.0],
+        "list[float]",
+        "vertical.sigma_z_um values swept",
+        lo=0.0,
+        lo_open=True,
+        hi=1000.0,
+        min_len=2,
+        unit="um",
+    ),
+    "consistency.control": Field(
+        [4, 5, 6, 8, 10, 15, 20],
+        "list[int]",
+        "vertical.control values swept",
+        lo=3,
+        hi=100,
+        min_len=2,
+    ),
+    "consistency.b8_sigma_um": Field(
+        [2.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 50.0],
+        "list[float]",
+        "b8.sigma_um values swept",
+        lo=0.0,
+        lo_open=True,
+        hi=1000.0,
+        min_len=2,
+        unit="um",
+    ),
+    "consistency.comparator_sigma_um": Field(
+        [1.0, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 8.0],
+        "list[float]",
+        "comparator.sigma_um values swept",
+        lo=0.0,
+        lo_open=True,
+        hi=100.0,
+        min_len=2,
+        unit="um",
+    ),
+    "consistency.trials": Field(
+        1000, "int", "simulated calibrations or models per sweep value", lo=50, hi=1_000_000
+    ),
 }
 
 
@@ -101,24 +239,39 @@ def check(cfg: dict) -> None:
         raise ConfigError("zscale.points", "needs at least 3 elevations")
     spacing = cfg["marks.extent_mm"] / (cfg["marks.grid"] - 1)
     if cfg["marks.placement_sd_mm"] > spacing / 4:
-        raise ConfigError("marks.placement_sd_mm", f"{cfg['marks.placement_sd_mm']:g} mm is more "
-                          f"than a quarter of the mark spacing {spacing:g} mm: marks would "
-                          "coincide and the affine would be singular")
+        raise ConfigError(
+            "marks.placement_sd_mm",
+            f"{cfg['marks.placement_sd_mm']:g} mm is more "
+            f"than a quarter of the mark spacing {spacing:g} mm: marks would "
+            "coincide and the affine would be singular",
+        )
     if cfg["b8.sigma_um"] * UM > 0.01 * cfg["marks.extent_mm"]:
-        raise ConfigError("b8.sigma_um", "exceeds 1 % of the mark array: the affine's geometry "
-                          "is meaningless")
+        raise ConfigError(
+            "b8.sigma_um", "exceeds 1 % of the mark array: the affine's geometry is meaningless"
+        )
     if cfg["comparator.sigma_um"] * UM > 0.01 * cfg["grid.spacing_mm"] * (cfg["grid.points"] - 1):
         raise ConfigError("comparator.sigma_um", "exceeds 1 % of the grid extent")
     if cfg["zscale.sigma_um"] * UM > 0.1 * cfg["zscale.range_mm"]:
-        raise ConfigError("zscale.sigma_um", "exceeds 10 % of zscale.range_mm: the line fit "
-                          "cannot find a scale")
-    if max(cfg["vertical.sigma_xy_um"], cfg["vertical.sigma_z_um"]) * UM > 0.01 * cfg["vertical.extent_mm"]:
-        raise ConfigError("vertical.sigma_z_um", "the control error exceeds 1 % of the model "
-                          "area: the conformal fit is meaningless")
+        raise ConfigError(
+            "zscale.sigma_um", "exceeds 10 % of zscale.range_mm: the line fit cannot find a scale"
+        )
+    if (
+        max(cfg["vertical.sigma_xy_um"], cfg["vertical.sigma_z_um"]) * UM
+        > 0.01 * cfg["vertical.extent_mm"]
+    ):
+        raise ConfigError(
+            "vertical.sigma_z_um",
+            "the control error exceeds 1 % of the model area: the conformal fit is meaningless",
+        )
     for key in ("b8.sx_mm_per_digit", "b8.sy_mm_per_digit"):
         if not 0.5 < cfg[key] / cfg["zscale.s_mm_per_digit"] < 2.0:
-            raise ConfigError(key, "differs from the z scale by more than a factor 2 (the "
-                              "digitiser model assumes nearly equal scales)")
+            raise ConfigError(
+                key,
+                "differs from the z scale by more than a factor 2 (the "
+                "digitiser model assumes nearly equal scales)",
+            )
     if cfg["power.trials"] < 2 or max(cfg["power.marks"]) ** 2 * cfg["power.trials"] > 5e7:
-        raise ConfigError("power.trials", "the detection-power sweep asks for more than 5e7 "
-                          "simulated marks per cell")
+        raise ConfigError(
+            "power.trials",
+            "the detection-power sweep asks for more than 5e7 simulated marks per cell",
+        )

@@ -2,10 +2,10 @@
 
 Study ``wolf_polynomial``. A grid plate (66 intersections, 20 mm quadrille over 100 x 200 mm,
 coordinates known to about 1 um) is read in a plotter whose measuring system carries a
-smooth systematic error field (:mod:`sim.errorfields`), in counts of about 4 um, three
+smooth systematic error field (:mod:`sim.instruments.plotter.errorfields`), in counts of about 4 um, three
 readings per intersection averaged; each set is reduced with the paper's non-redundant
 two-point transformation and the ten-term cubic is fitted to the pooled sets
-(:mod:`sim.polynomial`) and applied to check points, an independent plate and photographs.
+(:mod:`sim.instruments.plotter.polynomial`) and applied to check points, an independent plate and photographs.
 The paper's Tables 1-3 are recomputed from their printed coordinates (paper checks).
 Coordinates in mm, discrepancies in um.
 
@@ -14,22 +14,45 @@ Modules: :mod:`.schema` (config and checks), :mod:`.tables` (the transcribed tab
 :mod:`.consistent` (sweeps of the unprinted inputs), :mod:`.claims` with ``claims.toml``,
 :mod:`.run`, :mod:`.figures`, :mod:`.report`.
 """
+
 from __future__ import annotations
 
-from .. import Study
-from .chunks import degree_chunk, main_chunk, stability_chunk
-from .model import reading_error_rms
-from .report import report
-from .run import run
-from .schema import SCHEMA, SEED, _index, check, grid_nodes, mid_cells
-from .tables import load_table1, load_table3, summary, table1_discrepancies
+from sim.studies import Study
+from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk
+from sim.studies.wolf.model import reading_error_rms
+from sim.studies.wolf.report import report
+from sim.studies.wolf.run import run
+from sim.studies.wolf.schema import SCHEMA, SEED, _index, check, grid_nodes, mid_cells
+from sim.studies.wolf.tables import load_table1, load_table3, summary, table1_discrepancies
 
-__all__ = ["STUDIES", "SCHEMA", "check", "run", "report", "grid_nodes", "mid_cells", "main_chunk",
-           "degree_chunk", "stability_chunk", "reading_error_rms", "load_table1", "load_table3",
-           "table1_discrepancies", "summary", "_index"]
+__all__ = [
+    "STUDIES",
+    "SCHEMA",
+    "check",
+    "run",
+    "report",
+    "grid_nodes",
+    "mid_cells",
+    "main_chunk",
+    "degree_chunk",
+    "stability_chunk",
+    "reading_error_rms",
+    "load_table1",
+    "load_table3",
+    "table1_discrepancies",
+    "summary",
+    "_index",
+]
 
 STUDIES = {
-    "wolf_polynomial": Study("wolf_polynomial",
-                             "Wolf & Pearsall: the Kern PG-2 as a monocomparator", SEED,
-                             SCHEMA, run, report, check, order=40),
+    "wolf_polynomial": Study(
+        "wolf_polynomial",
+        "Wolf & Pearsall: the Kern PG-2 as a monocomparator",
+        SEED,
+        SCHEMA,
+        run,
+        report,
+        check,
+        order=40,
+    ),
 }

@@ -9,9 +9,10 @@ overrides the pointing sigma, the readings per point, the approach, the monocomp
 the restitution amplitude, the drifting share of the field or a common factor on the field
 amplitudes. Cells of one chunk share their random numbers, so
 the sweeps of the unprinted inputs and the readings trade-off compare like with like. Every
-chunk keeps freed memory in its process's heap (:func:`sim.heap.keep_heap`: fewer page
+chunk keeps freed memory in its process's heap (:func:`sim.mc.heap.keep_heap`: fewer page
 faults, the same numbers).
 """
+
 from __future__ import annotations
 
 import functools
@@ -19,16 +20,35 @@ import math
 
 import numpy as np
 
-from ... import errorfields as ef
-from ... import polynomial as pl
-from ...heap import keep_heap
-from .model import (Instrument, calib_dates, calibrate, correct_plate, ls_map, measure,
-                    measure_parts, place, photo_points, read_placed, stats_cols, true_plate)
-from .schema import _index, grid_nodes, mid_cells
+from sim.instruments.plotter import errorfields as ef
+from sim.instruments.plotter import polynomial as pl
+from sim.mc.heap import keep_heap
+from sim.studies.wolf.model import (
+    Instrument,
+    calib_dates,
+    calibrate,
+    correct_plate,
+    ls_map,
+    measure,
+    measure_parts,
+    photo_points,
+    place,
+    read_placed,
+    stats_cols,
+    true_plate,
+)
+from sim.studies.wolf.schema import _index, grid_nodes, mid_cells
 
 #: the config keys a cell may override, and the field-amplitude factor
-CELL_KEYS = ("reading.n", "reading.pointing_sigma_um", "reading.approach", "mono.sigma_um",
-             "field.restitution_um", "field.drift_fraction", "field_scale")
+CELL_KEYS = (
+    "reading.n",
+    "reading.pointing_sigma_um",
+    "reading.approach",
+    "mono.sigma_um",
+    "field.restitution_um",
+    "field.drift_fraction",
+    "field_scale",
+)
 
 
 def _dates(cfg: dict, later) -> tuple[np.ndarray, np.ndarray]:
@@ -57,21 +77,39 @@ def draw_main(cfg: dict, rng: np.random.Generator, T: int, nmax: int, full: bool
     plate = true_plate(rng, np.concatenate([G, Cm]), T, gs)
     cal = [place(rng, inst, int(rank[j]), plate, rot, shift, nmax) for j in range(S)]
     m5 = 5.0  # margin so that the placed points stay (nearly) inside the calibrated area
-    pk = rng.uniform([area[0] + m5, area[2] + m5], [area[1] - m5, area[3] - m5],
-                     (T, cfg["check.n_points"], 2))
+    pk = rng.uniform(
+        [area[0] + m5, area[2] + m5], [area[1] - m5, area[3] - m5], (T, cfg["check.n_points"], 2)
+    )
     ptrue = pk + rng.normal(0.0, gs * 1e-3, pk.shape)
-    chk = place(rng, inst, int(rank[S]), ptrue, cfg["check.rotation_sigma_deg"],
-                cfg["check.shift_sigma_mm"], nmax)
+    chk = place(
+        rng,
+        inst,
+        int(rank[S]),
+        ptrue,
+        cfg["check.rotation_sigma_deg"],
+        cfg["check.shift_sigma_mm"],
+        nmax,
+    )
     ph = photo_points(rng, cfg, T)
     rep = [place(rng, inst, int(rank[j]), ph, rot, shift, nmax) for j in (S + 1, S + 2)]
     mono_z = rng.normal(size=ph.shape)
     comp_rms = {}
     if full:  # the components' rms on the grid (no random numbers drawn here)
         comp = ef.evaluate_components(inst.spec, inst.static, G)
-        comp_rms = {k: math.sqrt(1 - inst.f) * np.sqrt((v ** 2).mean((1, 2)))
-                    for k, v in comp.items()}
-    return {"G": G, "Cm": Cm, "cal": cal, "pk": pk, "chk": chk, "ph": ph, "rep": rep,
-            "mono_z": mono_z, "comp_rms": comp_rms}
+        comp_rms = {
+            k: math.sqrt(1 - inst.f) * np.sqrt((v**2).mean((1, 2))) for k, v in comp.items()
+        }
+    return {
+        "G": G,
+        "Cm": Cm,
+        "cal": cal,
+        "pk": pk,
+        "chk": chk,
+        "ph": ph,
+        "rep": rep,
+        "mono_z": mono_z,
+        "comp_rms": comp_rms,
+    }
 
 
 def _reduce_readings(cfg: dict, D: dict, cell: dict, full: bool, keep_vectors: bool):
@@ -83,18 +121,26 @@ def _reduce_readings(cfg: dict, D: dict, cell: dict, full: bool, keep_vectors: b
     terms = pl.WOLF_TERMS if cfg["calib.degree"] == 3 else None
     n, sg = cell["reading.n"], cell["reading.pointing_sigma_um"]
     appr, fs = cell["reading.approach"], cell["field_scale"]
-    rd = functools.partial(read_placed, count_um=cfg["reading.count_um"], n=n, sigma_um=sg,
-                           backlash_um=cfg["reading.backlash_um"], approach=appr, field_scale=fs,
-                           drift_fraction=cell["field.drift_fraction"],
-                           restitution_um=cell["field.restitution_um"])
+    rd = functools.partial(
+        read_placed,
+        count_um=cfg["reading.count_um"],
+        n=n,
+        sigma_um=sg,
+        backlash_um=cfg["reading.backlash_um"],
+        approach=appr,
+        field_scale=fs,
+        drift_fraction=cell["field.drift_fraction"],
+        restitution_um=cell["field.restitution_um"],
+    )
     counts = [rd(p) for p in D["cal"]]
-    red, tps, fit, mtp = calibrate(cfg, G, [c[:, :nG] for c in counts], ia, ib,
-                                   cfg["calib.degree"], terms, corrected=True)
+    red, tps, fit, mtp = calibrate(
+        cfg, G, [c[:, :nG] for c in counts], ia, ib, cfg["calib.degree"], terms, corrected=True
+    )
     out: dict = {}
-    meas = red.transpose(1, 0, 2, 3).reshape(-1, S * nG, 2)             # pooled sets
+    meas = red.transpose(1, 0, 2, 3).reshape(-1, S * nG, 2)  # pooled sets
     T = meas.shape[0]
     before = (meas - np.tile(G, (S, 1))) * 1000.0
-    after = (fit.corrected_mm - np.tile(G, (S, 1))) * 1000.0       # apply_poly(fit, meas)
+    after = (fit.corrected_mm - np.tile(G, (S, 1))) * 1000.0  # apply_poly(fit, meas)
     stats_cols("before", before, out)
     stats_cols("after", after, out)
     # check points of the same sets (cell centres), reduced with each set's transform
@@ -130,12 +176,14 @@ def _mono(D: dict, rep0: np.ndarray, mono_sigma_um: float, out: dict) -> None:
     stats_cols("mono", (rep0 - mono)[:, 4:], out)
 
 
-def reduce_main(cfg: dict, D: dict, cell: dict, full: bool = True, keep_vectors: bool = False,
-                _reduced=None):
+def reduce_main(
+    cfg: dict, D: dict, cell: dict, full: bool = True, keep_vectors: bool = False, _reduced=None
+):
     """Read and reduce the drawn experiment ``D`` for one cell; per-trial statistics (um).
     ``_reduced``: the result of :func:`_reduce_readings` for this cell, when known."""
-    out, rep0, tail = (_reduce_readings(cfg, D, cell, full, keep_vectors) if _reduced is None
-                       else _reduced)
+    out, rep0, tail = (
+        _reduce_readings(cfg, D, cell, full, keep_vectors) if _reduced is None else _reduced
+    )
     out = dict(out)
     _mono(D, rep0, cell["mono.sigma_um"], out)
     out.update(tail)
@@ -201,8 +249,10 @@ def _degree_chunk_impl(cfg, spacing, rng: np.random.Generator, T: int) -> dict:
 
     inst = Instrument(cfg, rng, T, dates)
     plate = true_plate(rng, G, T, cfg["plate.grid_sigma_um"])
-    counts = [measure(rng, inst, j, plate, cfg["plate.rotation_sigma_deg"],
-                      cfg["plate.shift_sigma_mm"]) for j in range(nmax)]
+    counts = [
+        measure(rng, inst, j, plate, cfg["plate.rotation_sigma_deg"], cfg["plate.shift_sigma_mm"])
+        for j in range(nmax)
+    ]
     ck = rng.uniform(lo, hi, (T, m, 2))
     ct = ck + rng.normal(0.0, cfg["plate.grid_sigma_um"] * 1e-3, ck.shape)
     cc = measure(rng, inst, nmax, ct, cfg["check.rotation_sigma_deg"], 0.0)
@@ -210,7 +260,7 @@ def _degree_chunk_impl(cfg, spacing, rng: np.random.Generator, T: int) -> dict:
     for ns in cfg["trade.n_sets"]:
         for d in cfg["trade.degrees"]:
             red, _, fit, mtp = calibrate(cfg, G, counts[:ns], ia, ib, d)
-            fr = np.sqrt((fit.rms_mm ** 2).mean(1)) * 1000.0
+            fr = np.sqrt((fit.rms_mm**2).mean(1)) * 1000.0
             cr = np.sqrt((correct_plate(fit, mtp, cc, ck) ** 2).mean((1, 2)))
             bad = ~fit.ok | (min(nx, ny) < d + 1)
             fr[bad] = np.nan
@@ -220,11 +270,9 @@ def _degree_chunk_impl(cfg, spacing, rng: np.random.Generator, T: int) -> dict:
     return out
 
 
-
 def degree_chunk(cfg: dict, spacing: float):
     """Picklable chunk function ``fn(rng, n)`` (see :func:`_degree_chunk_impl`)."""
     return functools.partial(_degree_chunk_impl, cfg, spacing)
-
 
 
 def _stability_chunk_impl(cfg, fractions, ages, rng_: np.random.Generator, T: int) -> dict:
@@ -248,30 +296,51 @@ def _stability_chunk_impl(cfg, fractions, ages, rng_: np.random.Generator, T: in
     rng = rng_
     inst = Instrument(cfg, rng, T, dates[order])
     plate = true_plate(rng, G, T, gs)
-    cal = [measure_parts(rng, inst, int(rank[j]), plate, cfg["plate.rotation_sigma_deg"],
-                         cfg["plate.shift_sigma_mm"]) for j in range(S)]
+    cal = [
+        measure_parts(
+            rng,
+            inst,
+            int(rank[j]),
+            plate,
+            cfg["plate.rotation_sigma_deg"],
+            cfg["plate.shift_sigma_mm"],
+        )
+        for j in range(S)
+    ]
     checks = []
     for i in range(len(ages)):
-        pk = rng.uniform([area[0] + m5, area[2] + m5], [area[1] - m5, area[3] - m5],
-                         (T, cfg["check.n_points"], 2))
+        pk = rng.uniform(
+            [area[0] + m5, area[2] + m5],
+            [area[1] - m5, area[3] - m5],
+            (T, cfg["check.n_points"], 2),
+        )
         pt = pk + rng.normal(0.0, gs * 1e-3, pk.shape)
-        checks.append((pk, measure_parts(rng, inst, int(rank[S + i]), pt,
-                                         cfg["check.rotation_sigma_deg"],
-                                         cfg["check.shift_sigma_mm"])))
+        checks.append(
+            (
+                pk,
+                measure_parts(
+                    rng,
+                    inst,
+                    int(rank[S + i]),
+                    pt,
+                    cfg["check.rotation_sigma_deg"],
+                    cfg["check.shift_sigma_mm"],
+                ),
+            )
+        )
     out = {}
     for f in fractions:
-        _, _, fit, mtp = calibrate(cfg, G, [r.counts(f) for r in cal], ia, ib,
-                                   cfg["calib.degree"], terms)
+        _, _, fit, mtp = calibrate(
+            cfg, G, [r.counts(f) for r in cal], ia, ib, cfg["calib.degree"], terms
+        )
         for i, (pk, r) in enumerate(checks):
             c = r.counts(f)
             for tag, use in (("before", False), ("after", True)):
                 d = correct_plate(fit, mtp, c, pk, use_poly=use)
-                out[f"{tag}.{f}.{i}"] = np.sqrt((d ** 2).mean((1, 2)))
+                out[f"{tag}.{f}.{i}"] = np.sqrt((d**2).mean((1, 2)))
     return out
-
 
 
 def stability_chunk(cfg: dict, fractions, ages):
     """Picklable chunk function ``fn(rng, n)`` (see :func:`_stability_chunk_impl`)."""
     return functools.partial(_stability_chunk_impl, cfg, tuple(fractions), tuple(ages))
-

@@ -3,23 +3,28 @@ words and numbers; this module only supplies what the simulation and the recompu
 the paper's own printed data produced). Wolf & Pearsall 1976, seed ``000_668e60e68f004f98.txt``.
 Discrepancies in um.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ...claims import ClaimBook
-from ...intervals import bootstrap_ci
-from ...runner import chunk_rng
-from .tables import STATS, recomputation, summary
+from sim.claims.book import ClaimBook
+from sim.claims.intervals import bootstrap_ci
+from sim.mc.runner import chunk_rng
+from sim.studies.wolf.tables import STATS, recomputation, summary
 
 BOOK = Path(__file__).with_name("claims.toml")
 AXES = ("x", "y")
 
 #: claim-id prefix -> the per-trial statistic of the main experiment it is scored on
-SIMULATED = {"wolf.before.": "before", "wolf.after.": "after", "wolf.repeatability.": "repeat",
-             "wolf.table2.": "mono"}
+SIMULATED = {
+    "wolf.before.": "before",
+    "wolf.after.": "after",
+    "wolf.repeatability.": "repeat",
+    "wolf.table2.": "mono",
+}
 HEADLINE = "wolf.headline.mean_vs_mono_um"
 
 
@@ -49,13 +54,16 @@ def score_simulated(book: ClaimBook, cid: str, stats: dict, n_inst: int, note: s
     """Score one simulated claim on the per-trial statistics ``stats`` (one per instrument)."""
     if cid == HEADLINE:
         el = [_spread(stats[f"mono.mean_{ax}_um"]) for ax in AXES]
-        return book.score(cid, interval="spread",
-                          elems=(np.concatenate([e[0] for e in el]),
-                                 np.concatenate([e[1] for e in el])),
-                          note=note or "Elements: the mean |discrepancy| in X and in Y of one "
-                          "simulated plate (10 PUG marks) against a monocomparator, each with its "
-                          f"2.5-97.5 % range over {n_inst} simulated instruments and plates; "
-                          "holds when both ranges lie in the paper's 3-9 um")
+        return book.score(
+            cid,
+            interval="spread",
+            elems=(np.concatenate([e[0] for e in el]), np.concatenate([e[1] for e in el])),
+            note=note
+            or "Elements: the mean |discrepancy| in X and in Y of one "
+            "simulated plate (10 PUG marks) against a monocomparator, each with its "
+            f"2.5-97.5 % range over {n_inst} simulated instruments and plates; "
+            "holds when both ranges lie in the paper's 3-9 um",
+        )
     return book.score(cid, samples=stats[stat_key(cid)], note=note)
 
 
@@ -66,20 +74,20 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
     out = []
     notes = {
         "wolf.before.": f"over the pooled {S} calibration sets after the non-redundant two-point "
-                        f"reduction; distribution over {T} simulated instruments. The field "
-                        "amplitudes (field.*) were chosen so these look like the paper's; "
-                        "unprinted.field_scales gives the factors that the claims allow",
+        f"reduction; distribution over {T} simulated instruments. The field "
+        "amplitudes (field.*) were chosen so these look like the paper's; "
+        "unprinted.field_scales gives the factors that the claims allow",
         "wolf.after.": f"residuals of the ten-term cubic fitted to the {S} pooled sets; "
-                       f"distribution over {T} instruments",
+        f"distribution over {T} instruments",
         "wolf.repeatability.": f"{cfg['repeat.n_points']} points of a simulated P-30 photograph "
-                               f"read {cfg['repeat.gap_weeks']:g} week(s) apart, each set "
-                               "corrected and fitted to its four fiducials; the default pointing "
-                               "sigma was chosen from these (unprinted.pointing_sigmas_um "
-                               "gives the values they allow)",
+        f"read {cfg['repeat.gap_weeks']:g} week(s) apart, each set "
+        "corrected and fitted to its four fiducials; the default pointing "
+        "sigma was chosen from these (unprinted.pointing_sigmas_um "
+        "gives the values they allow)",
         "wolf.table2.": "Set 1 of the simulated photograph against a monocomparator reading "
-                        f"(sigma {cfg['mono.sigma_um']:g} um per coordinate, not printed), both "
-                        "fitted to the fiducials; every plate and set has the same simulated "
-                        "distribution",
+        f"(sigma {cfg['mono.sigma_um']:g} um per coordinate, not printed), both "
+        "fitted to the fiducials; every plate and set has the same simulated "
+        "distribution",
     }
     for cid in book.specs:
         if stat_key(cid) is not None or cid == HEADLINE:
@@ -89,16 +97,24 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
     for pre in ("check_after", "plate_after", "plate_before"):
         for s in ("max", "rms"):
             for ax in AXES:
-                out.append(book.score(f"wolf.{pre}.{s}_{ax}_um", samples=main[f"{pre}.{s}_{ax}_um"],
-                                      note=f"{s} over the points; distribution over {T} "
-                                      "instruments"))
+                out.append(
+                    book.score(
+                        f"wolf.{pre}.{s}_{ax}_um",
+                        samples=main[f"{pre}.{s}_{ax}_um"],
+                        note=f"{s} over the points; distribution over {T} instruments",
+                    )
+                )
     for kind in ("similarity", "affine"):
         for ax in AXES:
-            out.append(book.score(f"wolf.before_{kind}.rms_{ax}_um",
-                                  samples=main[f"before_{kind}.rms_{ax}_um"],
-                                  note=f"each set fitted to all grid points by a least-squares "
-                                  f"{kind}, pooled sets; the fit absorbs part of the systematic "
-                                  "error the paper wanted to preserve"))
+            out.append(
+                book.score(
+                    f"wolf.before_{kind}.rms_{ax}_um",
+                    samples=main[f"before_{kind}.rms_{ax}_um"],
+                    note=f"each set fitted to all grid points by a least-squares "
+                    f"{kind}, pooled sets; the fit absorbs part of the systematic "
+                    "error the paper wanted to preserve",
+                )
+            )
     out.append(_cubic_excess(cfg, degt, book))
     return out
 
@@ -112,10 +128,15 @@ def _table_checks(book: ClaimBook, t1: dict, t3: dict) -> list[dict]:
         for s in STATS:
             for ax in AXES:
                 d = t1[f"d{ax}_sets_um"][sel]
-                out.append(book.score(
-                    f"wolf.table1.p{plate}.{s}_{ax}_um", summary(d)[s], interval="exact",
-                    note="recomputed from Table 1's Set 1 and Set 2 coordinates: "
-                    + recomputation(d, s)))
+                out.append(
+                    book.score(
+                        f"wolf.table1.p{plate}.{s}_{ax}_um",
+                        summary(d)[s],
+                        interval="exact",
+                        note="recomputed from Table 1's Set 1 and Set 2 coordinates: "
+                        + recomputation(d, s),
+                    )
+                )
         means += [summary(t1[f"d{ax}_sets_um"][sel])["mean"] for ax in AXES]
     line = {s: [] for s in STATS}
     for plate in ("003", "005"):
@@ -126,34 +147,65 @@ def _table_checks(book: ClaimBook, t1: dict, t3: dict) -> list[dict]:
                 sm = summary(d)
                 for s in STATS:
                     line[s].append(sm[s])
-                    out.append(book.score(
-                        f"wolf.table2_check.p{plate}.set{st}.{s}_{ax}_um", sm[s], interval="exact",
-                        note=f"recomputed from Set {st} (Table 1) minus the Foster coordinates "
-                        "(Table 2): " + recomputation(d, s)))
+                    out.append(
+                        book.score(
+                            f"wolf.table2_check.p{plate}.set{st}.{s}_{ax}_um",
+                            sm[s],
+                            interval="exact",
+                            note=f"recomputed from Set {st} (Table 1) minus the Foster coordinates "
+                            "(Table 2): " + recomputation(d, s),
+                        )
+                    )
                 means.append(sm["mean"])
     for s in STATS:
         v = line[s]
-        out.append(book.score(f"wolf.table2_check.overall_{s}_um", float(np.mean(v)),
-                              interval="exact", note=f"mean of the {len(v)} recomputed {s} values "
-                              + ", ".join(f"{x:.2f}" for x in v) + f" = {np.mean(v):.3f}"))
+        out.append(
+            book.score(
+                f"wolf.table2_check.overall_{s}_um",
+                float(np.mean(v)),
+                interval="exact",
+                note=f"mean of the {len(v)} recomputed {s} values "
+                + ", ".join(f"{x:.2f}" for x in v)
+                + f" = {np.mean(v):.3f}",
+            )
+        )
     for ph in ("501", "505"):
         sel = t3["photo"] == ph
         for ax in AXES:
             d = t3[f"d{ax}_printed_um"][sel]
             dc = np.abs(t3[f"d{ax}_coord_um"][sel])
-            odd = [f"point {p}: {a} from the coordinates, {b} printed" for p, a, b in
-                   zip(t3["point"][sel], dc, d) if a != b]
+            odd = [
+                f"point {p}: {a} from the coordinates, {b} printed"
+                for p, a, b in zip(t3["point"][sel], dc, d)
+                if a != b
+            ]
             for s in STATS:
-                out.append(book.score(
-                    f"wolf.table3_check.p{ph}.{s}_{ax}_um", summary(d)[s], interval="exact",
-                    note="recomputed from Table 3's printed differences: " + recomputation(d, s)
-                    + (". The coordinates disagree with the printed difference at "
-                       + "; ".join(odd) if odd else "")))
+                out.append(
+                    book.score(
+                        f"wolf.table3_check.p{ph}.{s}_{ax}_um",
+                        summary(d)[s],
+                        interval="exact",
+                        note="recomputed from Table 3's printed differences: "
+                        + recomputation(d, s)
+                        + (
+                            ". The coordinates disagree with the printed difference at "
+                            + "; ".join(odd)
+                            if odd
+                            else ""
+                        ),
+                    )
+                )
             means.append(summary(d)["mean"])
     m = np.array(means)
-    out.append(book.score("wolf.summary.mean_range_check", interval="exact", elems=(m, m),
-                          note=f"the {m.size} mean lines of Tables 1-3 recomputed from the "
-                          f"paper's own data range from {m.min():.2f} to {m.max():.2f} um"))
+    out.append(
+        book.score(
+            "wolf.summary.mean_range_check",
+            interval="exact",
+            elems=(m, m),
+            note=f"the {m.size} mean lines of Tables 1-3 recomputed from the "
+            f"paper's own data range from {m.min():.2f} to {m.max():.2f} um",
+        )
+    )
     return out
 
 
@@ -164,10 +216,14 @@ def _cubic_excess(cfg: dict, degt: dict, book: ClaimBook) -> dict:
     sel = (degt["spacing_mm"] == sp) & (degt["n_sets"] == ns)
     degs = np.unique(degt["degree"][sel]) if sel.any() else np.array([])
     if 3 not in degs or len(degs) < 2:
-        return book.score(cid, 0.0, interval="exact",
-                          note="not evaluated: the degree trade-off (trade.degrees, "
-                          "trade.spacings_mm, trade.n_sets) does not compare the cubic with "
-                          "another degree at the study's spacing and number of sets")
+        return book.score(
+            cid,
+            0.0,
+            interval="exact",
+            note="not evaluated: the degree trade-off (trade.degrees, "
+            "trade.spacings_mm, trade.n_sets) does not compare the cubic with "
+            "another degree at the study's spacing and number of sets",
+        )
     mat = np.stack([degt["check_rms_um"][sel & (degt["degree"] == d)] for d in degs], 1)
     ok = np.isfinite(mat).all(0)
     mat, dd = mat[:, ok], degs[ok]
@@ -175,8 +231,16 @@ def _cubic_excess(cfg: dict, degt: dict, book: ClaimBook) -> dict:
     stat = lambda a: float((a[:, k3].mean() / a.mean(0).min() - 1) * 100)  # noqa: E731
     v, ci = bootstrap_ci(stat, mat, chunk_rng(cfg["seed"], 98, 0))
     m = mat.mean(0)
-    return book.score(cid, v, ci, note=(
-        f"excess of the cubic's mean rms on an independent plate over the best degree tried "
-        f"({sp:g} mm grid, {ns} sets, {cfg['trade.trials']} trials, bootstrap CI); mean rms by "
-        "degree: " + ", ".join(f"{int(d)}: {x:.2f}" for d, x in zip(dd, m)) + " um. The ranking "
-        "depends on the assumed field families (inputs)"))
+    return book.score(
+        cid,
+        v,
+        ci,
+        note=(
+            f"excess of the cubic's mean rms on an independent plate over the best degree tried "
+            f"({sp:g} mm grid, {ns} sets, {cfg['trade.trials']} trials, bootstrap CI); mean rms by "
+            "degree: "
+            + ", ".join(f"{int(d)}: {x:.2f}" for d, x in zip(dd, m))
+            + " um. The ranking "
+            "depends on the assumed field families (inputs)"
+        ),
+    )

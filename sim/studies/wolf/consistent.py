@@ -14,20 +14,22 @@ least as extreme is not rarer than 5 % (the outcome is not ``fails``). The *cons
 consistent together; ``ALL-feasible`` the same without the claims that are consistent at no
 value tried (named in the ``ALL`` row's note), which would otherwise empty it.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
-from ...claims import ClaimBook
-from .claims import HEADLINE, score_simulated, swept_claims
+from sim.claims.book import ClaimBook
+from sim.studies.wolf.claims import HEADLINE, score_simulated, swept_claims
 
 #: swept input -> (config key of its values, the cell key it overrides)
-INPUTS = {"reading.pointing_sigma_um": ("unprinted.pointing_sigmas_um",
-                                        "reading.pointing_sigma_um"),
-          "field_scale": ("unprinted.field_scales", "field_scale"),
-          "field.restitution_um": ("unprinted.restitutions_um", "field.restitution_um"),
-          "field.drift_fraction": ("unprinted.drift_fractions", "field.drift_fraction"),
-          "mono.sigma_um": ("unprinted.mono_sigmas_um", "mono.sigma_um")}
+INPUTS = {
+    "reading.pointing_sigma_um": ("unprinted.pointing_sigmas_um", "reading.pointing_sigma_um"),
+    "field_scale": ("unprinted.field_scales", "field_scale"),
+    "field.restitution_um": ("unprinted.restitutions_um", "field.restitution_um"),
+    "field.drift_fraction": ("unprinted.drift_fractions", "field.drift_fraction"),
+    "mono.sigma_um": ("unprinted.mono_sigmas_um", "mono.sigma_um"),
+}
 
 
 #: the consistent set of the claims that are consistent somewhere in the sweep
@@ -62,20 +64,51 @@ def evaluate(cfg: dict, res: dict, book: ClaimBook) -> tuple[dict, dict]:
     """
     cids = swept_claims(book)
     specs = list(book.specs.values())
-    vals = {k: [] for k in ("input", "value", "claim", "median", "lo", "hi", "p_plate", "outcome",
-                            "consistent")}
+    vals = {
+        k: []
+        for k in (
+            "input",
+            "value",
+            "claim",
+            "median",
+            "lo",
+            "hi",
+            "p_plate",
+            "outcome",
+            "consistent",
+        )
+    }
     for tag, name, v, _ in sweep_cells(cfg):
-        stats = {k[len(tag):]: a for k, a in res.items() if k.startswith(tag)}
+        stats = {k[len(tag) :]: a for k, a in res.items() if k.startswith(tag)}
         fresh = ClaimBook(specs, [], book.path)
         for cid in cids:
             r = score_simulated(fresh, cid, stats, cfg["unprinted.trials"])
-            for k, x in (("input", name), ("value", v), ("claim", cid), ("median", r["value"]),
-                         ("lo", r["ci_low"]), ("hi", r["ci_high"]), ("p_plate", r["p_plate"]),
-                         ("outcome", r["outcome"]),
-                         ("consistent", _consistent(r, book.specs[cid]))):
+            for k, x in (
+                ("input", name),
+                ("value", v),
+                ("claim", cid),
+                ("median", r["value"]),
+                ("lo", r["ci_low"]),
+                ("hi", r["ci_high"]),
+                ("p_plate", r["p_plate"]),
+                ("outcome", r["outcome"]),
+                ("consistent", _consistent(r, book.specs[cid])),
+            ):
                 vals[k].append(x)
-    cons = {k: [] for k in ("input", "claim", "criterion", "depends", "holds_low", "holds_high",
-                            "n_values", "n_consistent", "note")}
+    cons = {
+        k: []
+        for k in (
+            "input",
+            "claim",
+            "criterion",
+            "depends",
+            "holds_low",
+            "holds_high",
+            "n_values",
+            "n_consistent",
+            "note",
+        )
+    }
     V = {k: np.asarray(a) for k, a in vals.items()}
     for name in INPUTS:
         m = V["input"] == name
@@ -89,9 +122,20 @@ def evaluate(cfg: dict, res: dict, book: ClaimBook) -> tuple[dict, dict]:
             if depends:
                 oks[cid] = ok
             lo, hi = (float(x[ok].min()), float(x[ok].max())) if ok.any() else (np.nan, np.nan)
-            _add(cons, name, cid, _criterion(book.specs[cid]), depends, lo, hi, xs.size,
-                 int(ok.sum()), "" if ok.all() or not ok.any() or
-                 np.all(np.diff(np.flatnonzero(ok)) == 1) else "not contiguous")
+            _add(
+                cons,
+                name,
+                cid,
+                _criterion(book.specs[cid]),
+                depends,
+                lo,
+                hi,
+                xs.size,
+                int(ok.sum()),
+                ""
+                if ok.all() or not ok.any() or np.all(np.diff(np.flatnonzero(ok)) == 1)
+                else "not contiguous",
+            )
         empty = [c for c, ok in oks.items() if not ok.any()]
         for label, use in (("ALL", list(oks)), (ALL_FEASIBLE, [c for c in oks if c not in empty])):
             together = np.ones(xs.size, bool)
@@ -106,12 +150,26 @@ def evaluate(cfg: dict, res: dict, book: ClaimBook) -> tuple[dict, dict]:
                 b = min(rng, key=lambda c: rng[c][1])
                 note = f"conflict: {a} needs >= {rng[a][0]:g}, {b} needs <= {rng[b][1]:g}"
             if label != "ALL" and empty:
-                note = ((note + "; " if note else "")
-                        + f"without the {len(empty)} consistent nowhere")
-            lo, hi = ((float(xs[together].min()), float(xs[together].max())) if together.any()
-                      else (np.nan, np.nan))
-            _add(cons, name, label, "every dependent claim consistent", True, lo, hi, xs.size,
-                 int(together.sum()), note)
+                note = (
+                    note + "; " if note else ""
+                ) + f"without the {len(empty)} consistent nowhere"
+            lo, hi = (
+                (float(xs[together].min()), float(xs[together].max()))
+                if together.any()
+                else (np.nan, np.nan)
+            )
+            _add(
+                cons,
+                name,
+                label,
+                "every dependent claim consistent",
+                True,
+                lo,
+                hi,
+                xs.size,
+                int(together.sum()),
+                note,
+            )
     return vals, cons
 
 

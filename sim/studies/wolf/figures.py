@@ -1,5 +1,6 @@
 """Figures of ``wolf_polynomial``, drawn from its Parquet files alone. Wolf & Pearsall 1976
 (seed ``000_668e60e68f004f98.txt``); positions mm, discrepancies um."""
+
 from __future__ import annotations
 
 import math
@@ -9,23 +10,39 @@ import matplotlib.colors
 import matplotlib.ticker
 import numpy as np
 
-from ...figure_jobs import draw_figures, start_figures
-from ...plotting import plt, save
-from ...storage import read_table
-from .claims import load_book
-from .model import ls_map
+from sim.mc.storage import read_table
+from sim.report.figure_jobs import draw_figures, start_figures
+from sim.report.plotting import plt, save
+from sim.studies.wolf.claims import load_book
+from sim.studies.wolf.model import ls_map
 
 _UM_PER_MM = 2.5  # vector plots: 1 mm of plot = 2.5 um of discrepancy (50 um = 20 mm)
 
 
 def _quiver(ax, x, y, dx, dy, title, key_um=20.0, um_per_mm=_UM_PER_MM):
-    ax.quiver(x, y, dx, dy, angles="xy", scale_units="xy", scale=um_per_mm, width=0.004,
-              color="tab:blue")
+    ax.quiver(
+        x, y, dx, dy, angles="xy", scale_units="xy", scale=um_per_mm, width=0.004, color="tab:blue"
+    )
     ax.plot(x, y, ".", color="0.5", ms=2)
-    ax.quiver([x.min()], [y.max() + 25], [key_um], [0], angles="xy", scale_units="xy",
-              scale=um_per_mm, width=0.004, color="tab:red")
-    ax.text(x.min() + key_um / um_per_mm + 3, y.max() + 25, f"{key_um:g} um", va="center",
-            fontsize=7, color="tab:red")
+    ax.quiver(
+        [x.min()],
+        [y.max() + 25],
+        [key_um],
+        [0],
+        angles="xy",
+        scale_units="xy",
+        scale=um_per_mm,
+        width=0.004,
+        color="tab:red",
+    )
+    ax.text(
+        x.min() + key_um / um_per_mm + 3,
+        y.max() + 25,
+        f"{key_um:g} um",
+        va="center",
+        fontsize=7,
+        color="tab:red",
+    )
     ax.set_aspect("equal")
     ax.set_xlim(x.min() - 25, x.max() + 25)
     ax.set_ylim(y.min() - 20, y.max() + 35)
@@ -46,14 +63,14 @@ def _jobs(names, cfg: dict, out: Path) -> list:
 
 def figures(cfg: dict, out: Path, executor=None) -> None:
     """Every figure of the study from its Parquet files, on the run's idle workers when
-    there are some (:func:`sim.figure_jobs.draw_figures`), the dearest first."""
+    there are some (:func:`sim.report.figure_jobs.draw_figures`), the dearest first."""
     draw_figures(_jobs(EARLY + LATE, cfg, out), executor)
 
 
 def start_early(cfg: dict, out: Path, executor=None):
     """Send the :data:`EARLY` figures to the run's workers (their tables are written) while
     the trade-offs run; returns the function that waits for them
-    (:func:`sim.figure_jobs.start_figures`)."""
+    (:func:`sim.report.figure_jobs.start_figures`)."""
     return start_figures(_jobs(EARLY, cfg, out), executor)
 
 
@@ -66,18 +83,36 @@ def vectors_figure(out: Path) -> None:
     v = read_table(out / "vectors.parquet").to_pydict()
     v = {k: np.asarray(a) for k, a in v.items()}
     sets = np.unique(v["set"])
-    fig, axs = plt.subplots(2, len(sets), figsize=(4.2 * len(sets), 6.4), squeeze=False,
-                            constrained_layout=True)
+    fig, axs = plt.subplots(
+        2, len(sets), figsize=(4.2 * len(sets), 6.4), squeeze=False, constrained_layout=True
+    )
     for j, st in enumerate(sets):
         m = v["set"] == st
         rb = np.sqrt(np.mean(v["dx_before_um"][m] ** 2 + v["dy_before_um"][m] ** 2) / 2)
         ra = np.sqrt(np.mean(v["dx_after_um"][m] ** 2 + v["dy_after_um"][m] ** 2) / 2)
-        _quiver(axs[0, j], v["x_mm"][m], v["y_mm"][m], v["dx_before_um"][m], v["dy_before_um"][m],
-                f"set {st}: before (rms {rb:.1f} um)", 50.0)
-        _quiver(axs[1, j], v["x_mm"][m], v["y_mm"][m], v["dx_after_um"][m], v["dy_after_um"][m],
-                f"set {st}: after the cubic (rms {ra:.1f} um, arrows x2.5)", 20.0, 1.0)
-    fig.suptitle("Discrepancy vectors of one simulated instrument, three dates (cf. the paper's "
-                 "Figure 2)", fontsize=10)
+        _quiver(
+            axs[0, j],
+            v["x_mm"][m],
+            v["y_mm"][m],
+            v["dx_before_um"][m],
+            v["dy_before_um"][m],
+            f"set {st}: before (rms {rb:.1f} um)",
+            50.0,
+        )
+        _quiver(
+            axs[1, j],
+            v["x_mm"][m],
+            v["y_mm"][m],
+            v["dx_after_um"][m],
+            v["dy_after_um"][m],
+            f"set {st}: after the cubic (rms {ra:.1f} um, arrows x2.5)",
+            20.0,
+            1.0,
+        )
+    fig.suptitle(
+        "Discrepancy vectors of one simulated instrument, three dates (cf. the paper's Figure 2)",
+        fontsize=10,
+    )
     save(fig, out / "vectors.png")
 
 
@@ -96,18 +131,34 @@ def components_figure(out: Path) -> None:
     for ax, nm in zip(axs.ravel(), names):
         m = c["component"] == nm
         r = np.sqrt(np.mean(c["dx_um"][m] ** 2 + c["dy_um"][m] ** 2) / 2)
-        auto(ax, c["x_mm"][m], c["y_mm"][m], c["dx_um"][m], c["dy_um"][m],
-             f"{nm}\nA = {c['amplitude_um'][m][0]:g} um, rms {r:.1f} um")
+        auto(
+            ax,
+            c["x_mm"][m],
+            c["y_mm"][m],
+            c["dx_um"][m],
+            c["dy_um"][m],
+            f"{nm}\nA = {c['amplitude_um'][m][0]:g} um, rms {r:.1f} um",
+        )
     sel = c["component"] == names[0]
     P = np.column_stack([c["x_mm"][sel], c["y_mm"][sel]])
-    tot = np.column_stack([sum(c[k][c["component"] == nm] for nm in names)
-                           for k in ("dx_um", "dy_um")])
-    moved = P[None] + tot[None] * 1e-3                               # what a similarity removes
+    tot = np.column_stack(
+        [sum(c[k][c["component"] == nm] for nm in names) for k in ("dx_um", "dy_um")]
+    )
+    moved = P[None] + tot[None] * 1e-3  # what a similarity removes
     rest = (ls_map("similarity", moved, P, moved)[0] - P) * 1000.0
-    auto(axs.ravel()[-1], P[:, 0], P[:, 1], rest[:, 0], rest[:, 1],
-         "sum, less its best similarity\n(scale, rotation, shift are absorbed)")
-    fig.suptitle("Error-field components of one random draw at the default amplitudes (inputs); "
-                 "each panel has its own arrow scale", fontsize=10)
+    auto(
+        axs.ravel()[-1],
+        P[:, 0],
+        P[:, 1],
+        rest[:, 0],
+        rest[:, 1],
+        "sum, less its best similarity\n(scale, rotation, shift are absorbed)",
+    )
+    fig.suptitle(
+        "Error-field components of one random draw at the default amplitudes (inputs); "
+        "each panel has its own arrow scale",
+        fontsize=10,
+    )
     save(fig, out / "components.png")
 
 
@@ -142,10 +193,20 @@ def readings_figure(out: Path) -> None:
     for ax, appr in zip(axs, ("one_side", "random")):
         for k, sg in enumerate(dict.fromkeys(r["pointing_sigma_um"])):
             m = (r["approach"] == appr) & (r["pointing_sigma_um"] == sg)
-            ax.plot(r["readings"][m], r["after_plate_rms_um"][m], "o-", color=f"C{k}",
-                    label=f"sigma {sg:g} um: independent plate, corrected")
-            ax.plot(r["readings"][m], r["reading_error_um"][m], "x:", color=f"C{k}",
-                    label=f"sigma {sg:g} um: the averaged reading alone")
+            ax.plot(
+                r["readings"][m],
+                r["after_plate_rms_um"][m],
+                "o-",
+                color=f"C{k}",
+                label=f"sigma {sg:g} um: independent plate, corrected",
+            )
+            ax.plot(
+                r["readings"][m],
+                r["reading_error_um"][m],
+                "x:",
+                color=f"C{k}",
+                label=f"sigma {sg:g} um: the averaged reading alone",
+            )
         ax.set_xscale("log")
         ax.set_xticks(sorted(set(r["readings"].tolist())))
         ax.xaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
@@ -164,8 +225,9 @@ def stability_figure(cfg: dict, out: Path) -> None:
     for k, f in enumerate(dict.fromkeys(s["drift_fraction"])):
         m = s["drift_fraction"] == f
         x = np.maximum(s["age_weeks"][m], 0.5)
-        ax.plot(x, s["after_rms_um"][m], "o-", color=f"C{k}",
-                label=f"corrected, drifting share {f:g}")
+        ax.plot(
+            x, s["after_rms_um"][m], "o-", color=f"C{k}", label=f"corrected, drifting share {f:g}"
+        )
         ax.plot(x, s["before_rms_um"][m], ":", color=f"C{k}")
     ax.set_xscale("log")
     ax.set_xlabel("age of the calibration (weeks; 0 plotted at 0.5)")
@@ -181,8 +243,16 @@ def table1_figure(out: Path) -> None:
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
     for ax, plate in zip(axs, ("003", "005")):
         m = t["plate"] == plate
-        _quiver(ax, t["x_set1_mm"][m], t["y_set1_mm"][m], t["dx_sets_um"][m], t["dy_sets_um"][m],
-                f"plate {plate}: Set 1 - Set 2 (Table 1, 10 um = 20 mm)", 10.0, 0.5)
+        _quiver(
+            ax,
+            t["x_set1_mm"][m],
+            t["y_set1_mm"][m],
+            t["dx_sets_um"][m],
+            t["dy_sets_um"][m],
+            f"plate {plate}: Set 1 - Set 2 (Table 1, 10 um = 20 mm)",
+            10.0,
+            0.5,
+        )
         for x, y, p in zip(t["x_set1_mm"][m], t["y_set1_mm"][m], t["point"][m]):
             ax.annotate(str(p), (x, y), textcoords="offset points", xytext=(3, -8), fontsize=7)
     save(fig, out / "table1_real.png")
@@ -190,16 +260,20 @@ def table1_figure(out: Path) -> None:
 
 #: the per-trial statistics drawn against each swept input, with the claim prefix of their
 #: paper values
-_GROUPS = (("before", "wolf.before.rms_", "before correction"),
-           ("after", "wolf.after.rms_", "after the cubic"),
-           ("repeat", "wolf.repeatability.", "Set 1 - Set 2 (Table 1)"),
-           ("mono", "wolf.table2.", "PG-2 - monocomparator (Table 2)"))
+_GROUPS = (
+    ("before", "wolf.before.rms_", "before correction"),
+    ("after", "wolf.after.rms_", "after the cubic"),
+    ("repeat", "wolf.repeatability.", "Set 1 - Set 2 (Table 1)"),
+    ("mono", "wolf.table2.", "PG-2 - monocomparator (Table 2)"),
+)
 _CMAP = matplotlib.colors.ListedColormap(["#e8a0a0", "#9fd49f"])
-_LABEL = {"reading.pointing_sigma_um": "pointing sigma of one reading (um)",
-          "field_scale": "common factor on the field amplitudes",
-          "mono.sigma_um": "monocomparator sigma (um)",
-          "field.restitution_um": "restitution field, rms per axis (um)",
-          "field.drift_fraction": "drifting share of the field's variance"}
+_LABEL = {
+    "reading.pointing_sigma_um": "pointing sigma of one reading (um)",
+    "field_scale": "common factor on the field amplitudes",
+    "mono.sigma_um": "monocomparator sigma (um)",
+    "field.restitution_um": "restitution field, rms per axis (um)",
+    "field.drift_fraction": "drifting share of the field's variance",
+}
 
 
 def _references() -> dict:
@@ -210,8 +284,10 @@ def _references() -> dict:
     for cid, s in load_book().specs.items():
         ref = s.get("ref")
         ref = (None, None) if ref is None else (ref if isinstance(ref, list) else [ref, ref])
-        out[cid] = {"ref_low": None if ref[0] is None else float(ref[0]),
-                    "ref_high": None if ref[1] is None else float(ref[1])}
+        out[cid] = {
+            "ref_low": None if ref[0] is None else float(ref[0]),
+            "ref_high": None if ref[1] is None else float(ref[1]),
+        }
     return out
 
 
@@ -223,9 +299,13 @@ def consistent_figure(out: Path) -> None:
     c = read_table(out / "consistent_set.parquet").to_pylist()
     cl = _references()
     inputs = list(dict.fromkeys(v["input"]))
-    fig, axs = plt.subplots(len(inputs), 2, figsize=(13, 6.0 * len(inputs)), squeeze=False,
-                            gridspec_kw={"width_ratios": [1, 1.25], "wspace": 0.45,
-                                         "hspace": 0.25})
+    fig, axs = plt.subplots(
+        len(inputs),
+        2,
+        figsize=(13, 6.0 * len(inputs)),
+        squeeze=False,
+        gridspec_kw={"width_ratios": [1, 1.25], "wspace": 0.45, "hspace": 0.25},
+    )
     for row, name in enumerate(inputs):
         ax = axs[row, 0]
         for k, (exp, pre, label) in enumerate(_GROUPS):
@@ -237,8 +317,11 @@ def consistent_figure(out: Path) -> None:
             x = v["value"][m][o]
             ax.plot(x, v["median"][m][o], "o-", color=f"C{k}", label=f"{label}, rms x")
             ax.fill_between(x, v["lo"][m][o], v["hi"][m][o], color=f"C{k}", alpha=0.15)
-            for p in {r["ref_low"] + (r["ref_high"] - r["ref_low"]) / 2 for i, r in cl.items()
-                      if i.startswith(pre) and "rms_" in i and r["ref_low"] is not None}:
+            for p in {
+                r["ref_low"] + (r["ref_high"] - r["ref_low"]) / 2
+                for i, r in cl.items()
+                if i.startswith(pre) and "rms_" in i and r["ref_low"] is not None
+            }:
                 ax.axhline(p, color=f"C{k}", ls=":", lw=1)
         ax.set_yscale("log")
         ax.yaxis.set_major_locator(matplotlib.ticker.FixedLocator([2, 3, 5, 10, 20, 30, 50, 100]))
@@ -246,12 +329,14 @@ def consistent_figure(out: Path) -> None:
         ax.yaxis.set_minor_locator(matplotlib.ticker.NullLocator())
         ax.set_xlabel(_LABEL.get(name, name))
         ax.set_ylabel("rms discrepancy (um)")
-        ax.set_title("simulated (median, 95 % of instruments); dotted: paper's rms values",
-                     fontsize=9)
+        ax.set_title(
+            "simulated (median, 95 % of instruments); dotted: paper's rms values", fontsize=9
+        )
         ax.legend(fontsize=7)
         ax = axs[row, 1]
-        rows = [r for r in c if r["input"] == name and r["depends"]
-                and not r["claim"].startswith("ALL")]
+        rows = [
+            r for r in c if r["input"] == name and r["depends"] and not r["claim"].startswith("ALL")
+        ]
         xs = np.unique(v["value"][v["input"] == name])
         mat = np.zeros((len(rows), xs.size))
         for i, r in enumerate(rows):
@@ -262,10 +347,15 @@ def consistent_figure(out: Path) -> None:
         edges = np.concatenate([[xs[0] - w / 2], mid, [xs[-1] + w / 2]])
         ax.pcolormesh(edges, np.arange(len(rows) + 1) - 0.5, mat, cmap=_CMAP, vmin=0, vmax=1)
         allr = next(r for r in c if r["input"] == name and r["claim"] == "ALL")
-        feas = next(r for r in c if r["input"] == name and r["claim"] != "ALL"
-                    and r["claim"].startswith("ALL"))
-        for r, hatch, lab in ((allr, "//", "consistent set"),
-                              (feas, "..", "consistent set of the claims consistent somewhere")):
+        feas = next(
+            r
+            for r in c
+            if r["input"] == name and r["claim"] != "ALL" and r["claim"].startswith("ALL")
+        )
+        for r, hatch, lab in (
+            (allr, "//", "consistent set"),
+            (feas, "..", "consistent set of the claims consistent somewhere"),
+        ):
             if r["n_consistent"] and (r is allr or not allr["n_consistent"]):
                 lo = edges[np.searchsorted(xs, r["holds_low"])]
                 hi = edges[np.searchsorted(xs, r["holds_high"]) + 1]
@@ -275,7 +365,9 @@ def consistent_figure(out: Path) -> None:
         ax.set_yticklabels([r["claim"].replace("wolf.", "") for r in rows], fontsize=5)
         ax.set_ylim(-0.5, len(rows) - 0.5)
         ax.set_xlabel(_LABEL.get(name, name))
-        ax.set_title("green: claim consistent, red: contradicted"
-                     + ("" if allr["n_consistent"] else " (no value is consistent with all)"),
-                     fontsize=9)
+        ax.set_title(
+            "green: claim consistent, red: contradicted"
+            + ("" if allr["n_consistent"] else " (no value is consistent with all)"),
+            fontsize=9,
+        )
     save(fig, out / "consistent_set.png")

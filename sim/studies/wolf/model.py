@@ -1,14 +1,14 @@
 """The simulated PG-2: error field over dates, placements, quantised readings, reductions.
 
 Wolf & Pearsall 1976 (seed ``000_668e60e68f004f98.txt``). A plotter whose measuring system
-carries a smooth systematic error field (:mod:`sim.errorfields`: the six sources the paper
+carries a smooth systematic error field (:mod:`sim.instruments.plotter.errorfields`: the six sources the paper
 lists), read in *counts* of about 4 um, ``n`` readings per point averaged, approached from one
 side (backlash ``+b/2``). Dates and drift: the field of date ``t`` is
 ``sqrt(1 - f) F + sqrt(f) D(t)`` with ``D`` an AR(1) sequence of independent draws
-(:func:`sim.errorfields.ar1_weights`, time constant ``tau``), plus a fresh small
+(:func:`sim.instruments.plotter.errorfields.ar1_weights`, time constant ``tau``), plus a fresh small
 *restitution* field at every placement of a plate. Each calibration set is reduced with the
 paper's non-redundant two-point transformation and the polynomial is fitted to the pooled sets
-(:mod:`sim.polynomial`). Coordinates in mm, displacements and discrepancies in um.
+(:mod:`sim.instruments.plotter.polynomial`). Coordinates in mm, displacements and discrepancies in um.
 
 :func:`place` draws everything random about one reading of a plate once (placement, field
 and restitution displacements, standard-normal pointing noise for up to ``nmax`` readings,
@@ -16,6 +16,7 @@ approach signs); :func:`read_placed` turns it into averaged counts for a given p
 number of readings, approach and common factor on the field amplitudes (the field is linear
 in its amplitudes). So sweeps over these inputs use common random numbers.
 """
+
 from __future__ import annotations
 
 import math
@@ -23,26 +24,31 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ... import errorfields as ef
-from ... import polynomial as pl
-from ... import transforms2d as tf
+from sim.instruments import transforms2d as tf
+from sim.instruments.plotter import errorfields as ef
+from sim.instruments.plotter import polynomial as pl
 
 AXES = ("x", "y")
 STATS = ("max", "rms", "mean")
 
+
 def field_spec(cfg: dict, **over) -> ef.FieldSpec:
     kw = {name + "_um": cfg[f"field.{name}_um"] for name in ef.COMPONENTS}
-    kw.update(encoder_period_mm=cfg["field.encoder_period_mm"],
-              gimbal_height_mm=cfg["field.gimbal_height_mm"],
-              stress_length_mm=cfg["field.stress_length_mm"], spread_lo=cfg["field.spread"][0],
-              spread_hi=cfg["field.spread"][1])
+    kw.update(
+        encoder_period_mm=cfg["field.encoder_period_mm"],
+        gimbal_height_mm=cfg["field.gimbal_height_mm"],
+        stress_length_mm=cfg["field.stress_length_mm"],
+        spread_lo=cfg["field.spread"][0],
+        spread_hi=cfg["field.spread"][1],
+    )
     kw.update(over)
     return ef.FieldSpec(**kw)
 
 
 def restitution_spec(cfg: dict) -> ef.FieldSpec:
-    return ef.FieldSpec(stress_um=cfg["field.restitution_um"],
-                        stress_length_mm=cfg["field.restitution_length_mm"])
+    return ef.FieldSpec(
+        stress_um=cfg["field.restitution_um"], stress_length_mm=cfg["field.restitution_length_mm"]
+    )
 
 
 # ----------------------------------------------------------------------------- simulation core
@@ -52,8 +58,14 @@ class Instrument:
     """``T`` simulated plotters: a static field, a drifting field over given dates, and the
     reading process. ``disp(k, P)`` is the systematic displacement (um) on date ``k``."""
 
-    def __init__(self, cfg: dict, rng: np.random.Generator, T: int, dates_weeks,
-                 drift_fraction: float | None = None):
+    def __init__(
+        self,
+        cfg: dict,
+        rng: np.random.Generator,
+        T: int,
+        dates_weeks,
+        drift_fraction: float | None = None,
+    ):
         self.cfg, self.T = cfg, T
         self.spec = field_spec(cfg)
         self.rspec = restitution_spec(cfg)
@@ -85,8 +97,11 @@ class Instrument:
     def restitution(self, rng, P, unit: bool = False):
         """A fresh restitution field at ``P`` (rms ``field.restitution_um``, or 1 um with
         ``unit``: the field is linear in its amplitude and draws the same numbers)."""
-        spec = ef.FieldSpec(stress_um=1.0, stress_length_mm=self.rspec.stress_length_mm) \
-            if unit else self.rspec
+        spec = (
+            ef.FieldSpec(stress_um=1.0, stress_length_mm=self.rspec.stress_length_mm)
+            if unit
+            else self.rspec
+        )
         return ef.evaluate(spec, ef.draw(spec, rng, self.T), P)
 
 
@@ -95,8 +110,7 @@ def rotate(P: np.ndarray, th: np.ndarray) -> np.ndarray:
     return np.stack([c * P[..., 0] - s * P[..., 1], s * P[..., 0] + c * P[..., 1]], -1)
 
 
-def reading_noise(rng, shape: tuple, n: int, sigma_um: float, backlash_um: float,
-                  approach: str):
+def reading_noise(rng, shape: tuple, n: int, sigma_um: float, backlash_um: float, approach: str):
     """The random part of ``n`` readings of coordinates of shape ``shape``: pointing noise and
     backlash (um), each ``shape + (n,)`` (or a scalar)."""
     noise = rng.normal(0.0, sigma_um, tuple(shape) + (n,)) if sigma_um > 0 else 0.0
@@ -125,8 +139,16 @@ def _mean_counts(r: np.ndarray) -> np.ndarray:
     return s / r.shape[-1]
 
 
-def read_counts(rng, P_mm: np.ndarray, d_um: np.ndarray, count_um: float, n: int, sigma_um: float,
-                backlash_um: float, approach: str) -> np.ndarray:
+def read_counts(
+    rng,
+    P_mm: np.ndarray,
+    d_um: np.ndarray,
+    count_um: float,
+    n: int,
+    sigma_um: float,
+    backlash_um: float,
+    approach: str,
+) -> np.ndarray:
     """Mean of ``n`` quantised readings (counts) of carrier positions ``P_mm (T, m, 2)`` with
     systematic displacement ``d_um``: each reading adds pointing noise and backlash and is
     rounded to whole counts."""
@@ -162,9 +184,18 @@ class Reading:
         return quantise(self.P, d + self.rest, self.noise, self.bl, self.count_um)
 
 
-def measure_parts(rng, inst: Instrument, k: int, plate_true: np.ndarray, rot_sigma_deg: float,
-                  shift_sigma_mm: float, n: int | None = None, sigma_um: float | None = None,
-                  approach: str | None = None, drift: bool = True) -> Reading:
+def measure_parts(
+    rng,
+    inst: Instrument,
+    k: int,
+    plate_true: np.ndarray,
+    rot_sigma_deg: float,
+    shift_sigma_mm: float,
+    n: int | None = None,
+    sigma_um: float | None = None,
+    approach: str | None = None,
+    drift: bool = True,
+) -> Reading:
     """Place a plate (true coordinates ``(T, m, 2)`` mm in its own system) on date ``k``, draw
     everything random about reading it (the draws of :func:`measure`) and evaluate the
     fields (the drifting ones only with ``drift``)."""
@@ -173,24 +204,45 @@ def measure_parts(rng, inst: Instrument, k: int, plate_true: np.ndarray, rot_sig
     sh = rng.normal(0.0, shift_sigma_mm, (T, 2))
     P = rotate(plate_true, th) + sh[:, None, :]
     static = ef.evaluate(inst.spec, inst.static, P)
-    dr = tuple((inst.W[k, j], ef.evaluate(inst.spec, inst.drift[j], P))
-               for j in range(k + 1) if inst.W[k, j] != 0) if drift else ()
+    dr = (
+        tuple(
+            (inst.W[k, j], ef.evaluate(inst.spec, inst.drift[j], P))
+            for j in range(k + 1)
+            if inst.W[k, j] != 0
+        )
+        if drift
+        else ()
+    )
     rest = inst.restitution(rng, P)
-    noise, bl = reading_noise(rng, P.shape, cfg["reading.n"] if n is None else n,
-                              cfg["reading.pointing_sigma_um"] if sigma_um is None else sigma_um,
-                              cfg["reading.backlash_um"],
-                              cfg["reading.approach"] if approach is None else approach)
+    noise, bl = reading_noise(
+        rng,
+        P.shape,
+        cfg["reading.n"] if n is None else n,
+        cfg["reading.pointing_sigma_um"] if sigma_um is None else sigma_um,
+        cfg["reading.backlash_um"],
+        cfg["reading.approach"] if approach is None else approach,
+    )
     return Reading(P, static, dr, rest, noise, bl, cfg["reading.count_um"])
 
 
-def measure(rng, inst: Instrument, k: int, plate_true: np.ndarray, rot_sigma_deg: float,
-            shift_sigma_mm: float, n: int | None = None, sigma_um: float | None = None,
-            approach: str | None = None, f: float | None = None):
+def measure(
+    rng,
+    inst: Instrument,
+    k: int,
+    plate_true: np.ndarray,
+    rot_sigma_deg: float,
+    shift_sigma_mm: float,
+    n: int | None = None,
+    sigma_um: float | None = None,
+    approach: str | None = None,
+    f: float | None = None,
+):
     """Place a plate (true coordinates ``(T, m, 2)`` mm in its own system) on date ``k`` and read
     every point: averaged counts ``(T, m, 2)``."""
     f = inst.f if f is None else f
-    return measure_parts(rng, inst, k, plate_true, rot_sigma_deg, shift_sigma_mm, n, sigma_um,
-                         approach, drift=f > 0).counts(f)
+    return measure_parts(
+        rng, inst, k, plate_true, rot_sigma_deg, shift_sigma_mm, n, sigma_um, approach, drift=f > 0
+    ).counts(f)
 
 
 def true_plate(rng, known: np.ndarray, T: int, sigma_um: float) -> np.ndarray:
@@ -214,8 +266,12 @@ def calibrate(cfg, G, counts_sets, ia, ib, degree, terms=None, corrected=False):
     S, T, n, _ = red.shape
     meas = red.transpose(1, 0, 2, 3).reshape(T, S * n, 2)
     fit = pl.fit_poly(meas, np.tile(G, (S, 1)), degree=degree, terms=terms, corrected=corrected)
-    mean_tp = pl.TwoPoint(np.mean([tp.scale for tp in tps], 0), np.mean([tp.origin for tp in tps], 0),
-                          np.mean([tp.alpha for tp in tps], 0), np.asarray(G[ia], float))
+    mean_tp = pl.TwoPoint(
+        np.mean([tp.scale for tp in tps], 0),
+        np.mean([tp.origin for tp in tps], 0),
+        np.mean([tp.alpha for tp in tps], 0),
+        np.asarray(G[ia], float),
+    )
     return red, tps, fit, mean_tp
 
 
@@ -227,8 +283,9 @@ def correct_plate(fit, mean_tp, counts, known, use_poly=True, fiducials=None):
     if use_poly:
         X = pl.apply_poly(fit, X)
     sel = slice(None) if fiducials is None else fiducials
-    return (ls_map("similarity", X[:, sel], known[sel] if known.ndim == 2 else known[:, sel], X)
-            - known) * 1000.0
+    return (
+        ls_map("similarity", X[:, sel], known[sel] if known.ndim == 2 else known[:, sel], X) - known
+    ) * 1000.0
 
 
 def stats_cols(prefix: str, d_um: np.ndarray, out: dict):
@@ -243,8 +300,9 @@ def photo_points(rng, cfg, T):
     w, h = cfg["repeat.format_mm"]
     cx, cy = cfg["repeat.centre_mm"]
     fid = np.array([[-w / 2, 0.0], [w / 2, 0.0], [0.0, -h / 2], [0.0, h / 2]])
-    pts = rng.uniform([-w / 2 * 0.95, -h / 2 * 0.95], [w / 2 * 0.95, h / 2 * 0.95],
-                      (T, cfg["repeat.n_points"], 2))
+    pts = rng.uniform(
+        [-w / 2 * 0.95, -h / 2 * 0.95], [w / 2 * 0.95, h / 2 * 0.95], (T, cfg["repeat.n_points"], 2)
+    )
     allp = np.concatenate([np.broadcast_to(fid, (T, 4, 2)), pts], axis=1)
     return allp + np.array([cx, cy])
 
@@ -267,8 +325,15 @@ class Placed:
     sign: np.ndarray
 
 
-def place(rng, inst: "Instrument", k: int, plate_true: np.ndarray, rot_sigma_deg: float,
-          shift_sigma_mm: float, nmax: int) -> Placed:
+def place(
+    rng,
+    inst: "Instrument",
+    k: int,
+    plate_true: np.ndarray,
+    rot_sigma_deg: float,
+    shift_sigma_mm: float,
+    nmax: int,
+) -> Placed:
     """Place a plate (true coordinates ``(T, m, 2)`` mm in its own system) on date ``k``."""
     T = inst.T
     th = np.deg2rad(rot_sigma_deg) * rng.normal(size=T)
@@ -281,9 +346,17 @@ def place(rng, inst: "Instrument", k: int, plate_true: np.ndarray, rot_sigma_deg
     return Placed(P, static, drift, rest, z, sign)
 
 
-def read_placed(pl_: Placed, count_um: float, n: int, sigma_um: float, backlash_um: float,
-                approach: str, field_scale: float = 1.0, drift_fraction: float = 0.0,
-                restitution_um: float = 0.0) -> np.ndarray:
+def read_placed(
+    pl_: Placed,
+    count_um: float,
+    n: int,
+    sigma_um: float,
+    backlash_um: float,
+    approach: str,
+    field_scale: float = 1.0,
+    drift_fraction: float = 0.0,
+    restitution_um: float = 0.0,
+) -> np.ndarray:
     """Mean of ``n`` quantised readings (counts) of a :class:`Placed` plate ``(T, m, 2)``."""
     f = drift_fraction
     field = math.sqrt(1 - f) * pl_.static + (math.sqrt(f) * pl_.drift if f > 0 else 0.0)
@@ -292,26 +365,26 @@ def read_placed(pl_: Placed, count_um: float, n: int, sigma_um: float, backlash_
     return _mean_counts(np.round((true_um + sigma_um * pl_.z[..., :n] + bl) / count_um))
 
 
-
 def reading_error_rms(rng, count_um, n, sigma_um, backlash_um, approach, size=200_000):
     """rms error (um, per coordinate) of the mean of ``n`` quantised readings, true positions
     uniform within a count, after removing the constant one-sided backlash offset."""
     x = rng.uniform(0.0, count_um, (size, 1))
     noise = rng.normal(0.0, sigma_um, (size, n))
-    bl = backlash_um / 2 if approach == "one_side" else backlash_um / 2 * rng.choice(
-        np.array([-1.0, 1.0]), (size, n))
+    bl = (
+        backlash_um / 2
+        if approach == "one_side"
+        else backlash_um / 2 * rng.choice(np.array([-1.0, 1.0]), (size, n))
+    )
     e = _mean_counts(np.round((x + noise + bl) / count_um)) * count_um - x[:, 0]
     e = e - (backlash_um / 2 if approach == "one_side" else 0.0)
-    return float(np.sqrt(np.mean(e ** 2)))
-
+    return float(np.sqrt(np.mean(e**2)))
 
 
 def ls_map(kind: str, src: np.ndarray, dst: np.ndarray, pts: np.ndarray) -> np.ndarray:
     """Fit a least-squares ``similarity`` or ``affine`` mapping ``src`` (T, n, 2) onto ``dst``
-    ((T, n, 2) or (n, 2)) with :mod:`sim.transforms2d` and apply it to ``pts`` (T, m, 2)."""
+    ((T, n, 2) or (n, 2)) with :mod:`sim.instruments.transforms2d` and apply it to ``pts`` (T, m, 2)."""
     src = np.asarray(src, float)
     dst = np.broadcast_to(np.asarray(dst, float), src.shape)
     if kind == "similarity":
         return tf.apply_similarity(tf.fit_similarity(src, dst).params, pts)
     return tf.apply_affine(tf.fit_affine(src, dst).params, pts)
-

@@ -2,6 +2,7 @@
 (every number and verdict word below is read from them). Wolf & Pearsall 1976, seed
 ``000_668e60e68f004f98.txt``; discrepancies um.
 """
+
 from __future__ import annotations
 
 import math
@@ -9,10 +10,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errorfields import COMPONENTS
-from ...report import claims_markdown, fmt, inputs_markdown, md_table
-from ...storage import read_provenance, read_table
-from .schema import SCHEMA
+from sim.instruments.plotter.errorfields import COMPONENTS
+from sim.mc.storage import read_provenance, read_table
+from sim.report.markdown import claims_markdown, fmt, inputs_markdown, md_table
+from sim.studies.wolf.schema import SCHEMA
 
 
 def _t(out: Path, name: str) -> dict:
@@ -29,34 +30,49 @@ def findings(out: Path) -> list[str]:
     cs = read_table(out / "consistent_set.parquet").to_pylist()
     lines = ["**Findings** (medians [95 % range over simulated instruments], um).", ""]
     if "wolf.before.rms_x_um" in c:
-        lines.append(f"- Before correction the simulated rms is {_med(c['wolf.before.rms_x_um'])} "
-                     f"in x and {_med(c['wolf.before.rms_y_um'])} in y; after the cubic "
-                     f"{_med(c['wolf.after.rms_x_um'])} and {_med(c['wolf.after.rms_y_um'])}; "
-                     "on an independent plate read later, corrected: "
-                     f"{_med(c['wolf.plate_after.rms_x_um'])} in x (uncorrected, after a "
-                     f"similarity: {_med(c['wolf.plate_before.rms_x_um'])}).")
+        lines.append(
+            f"- Before correction the simulated rms is {_med(c['wolf.before.rms_x_um'])} "
+            f"in x and {_med(c['wolf.before.rms_y_um'])} in y; after the cubic "
+            f"{_med(c['wolf.after.rms_x_um'])} and {_med(c['wolf.after.rms_y_um'])}; "
+            "on an independent plate read later, corrected: "
+            f"{_med(c['wolf.plate_after.rms_x_um'])} in x (uncorrected, after a "
+            f"similarity: {_med(c['wolf.plate_before.rms_x_um'])})."
+        )
     h = c.get("wolf.headline.mean_vs_mono_um")
     if h:
-        lines.append(f"- Headline (PG-2 against a monocomparator, mean discrepancies of 3-9 um): "
-                     f"the simulated plate means span {h['ci_low']:.1f}-{h['ci_high']:.1f} um "
-                     f"over instruments; verdict **{h['verdict']}**.")
+        lines.append(
+            f"- Headline (PG-2 against a monocomparator, mean discrepancies of 3-9 um): "
+            f"the simulated plate means span {h['ci_low']:.1f}-{h['ci_high']:.1f} um "
+            f"over instruments; verdict **{h['verdict']}**."
+        )
     err = [r for r in c.values() if r["verdict"] == "erratum"]
     chk = [r for r in c.values() if r["kind"] == "paper-check"]
     if chk:
-        lines.append(f"- Paper checks: {len(chk)} printed summary numbers recomputed from the "
-                     f"paper's own printed data; {len(err)} are errata: " + "; ".join(
-                         f"`{r['claim']}` printed {_printed(r)}, recomputed {r['value']:.2f}"
-                         for r in err) + ".")
+        lines.append(
+            f"- Paper checks: {len(chk)} printed summary numbers recomputed from the "
+            f"paper's own printed data; {len(err)} are errata: "
+            + "; ".join(
+                f"`{r['claim']}` printed {_printed(r)}, recomputed {r['value']:.2f}" for r in err
+            )
+            + "."
+        )
     for r in cs:
         if not r["claim"].startswith("ALL"):
             continue
-        what = (f"{r['holds_low']:g} to {r['holds_high']:g} ({r['n_consistent']} of "
-                f"{r['n_values']} values tried)" if r["n_consistent"] else
-                f"none of the {r['n_values']} values tried")
-        label = ("Consistent set" if r["claim"] == "ALL" else
-                 "Consistent set of the claims consistent somewhere")
-        lines.append(f"- {label} of `{r['input']}`: {what}" + (f" ({r['note']})" if r["note"]
-                                                              else "") + ".")
+        what = (
+            f"{r['holds_low']:g} to {r['holds_high']:g} ({r['n_consistent']} of "
+            f"{r['n_values']} values tried)"
+            if r["n_consistent"]
+            else f"none of the {r['n_values']} values tried"
+        )
+        label = (
+            "Consistent set"
+            if r["claim"] == "ALL"
+            else "Consistent set of the claims consistent somewhere"
+        )
+        lines.append(
+            f"- {label} of `{r['input']}`: {what}" + (f" ({r['note']})" if r["note"] else "") + "."
+        )
     return lines
 
 
@@ -68,11 +84,19 @@ def _printed(r: dict) -> str:
 
 def _consistent_md(out: Path) -> str:
     cs = read_table(out / "consistent_set.parquet").to_pylist()
-    rows = [[f"`{r['input']}`", f"`{r['claim']}`", r["criterion"],
-             fmt(r["holds_low"]) if r["n_consistent"] else "nowhere",
-             fmt(r["holds_high"]) if r["n_consistent"] else "",
-             f"{r['n_consistent']} / {r['n_values']}", r["note"]]
-            for r in cs if r["depends"]]
+    rows = [
+        [
+            f"`{r['input']}`",
+            f"`{r['claim']}`",
+            r["criterion"],
+            fmt(r["holds_low"]) if r["n_consistent"] else "nowhere",
+            fmt(r["holds_high"]) if r["n_consistent"] else "",
+            f"{r['n_consistent']} / {r['n_values']}",
+            r["note"],
+        ]
+        for r in cs
+        if r["depends"]
+    ]
     return md_table(["input", "claim", "criterion", "from", "to", "values", "note"], rows)
 
 
@@ -81,20 +105,48 @@ def report(out: Path) -> str:
     cfg = prov["config"]
     name = out.name
     tr = _t(out, "trials.parquet")
-    crow = [[f"`{k}`", COMPONENTS[k], fmt(cfg[f"field.{k}_um"]),
-             fmt(float(np.median(tr[f"component.{k}_rms_um"])))] for k in COMPONENTS
-            if f"component.{k}_rms_um" in tr]
+    crow = [
+        [
+            f"`{k}`",
+            COMPONENTS[k],
+            fmt(cfg[f"field.{k}_um"]),
+            fmt(float(np.median(tr[f"component.{k}_rms_um"]))),
+        ]
+        for k in COMPONENTS
+        if f"component.{k}_rms_um" in tr
+    ]
     t1 = read_table(out / "table1_real.parquet").to_pydict()
-    t1rows = [list(r) for r in zip(t1["plate"], t1["point"], t1["dx_sets_um"], t1["dy_sets_um"],
-                                   t1["dx_set1_foster_um"], t1["dx_set2_foster_um"],
-                                   t1["dy_set1_foster_um"], t1["dy_set2_foster_um"])]
+    t1rows = [
+        list(r)
+        for r in zip(
+            t1["plate"],
+            t1["point"],
+            t1["dx_sets_um"],
+            t1["dy_sets_um"],
+            t1["dx_set1_foster_um"],
+            t1["dx_set2_foster_um"],
+            t1["dy_set1_foster_um"],
+            t1["dy_set2_foster_um"],
+        )
+    ]
     t3 = read_table(out / "table3_real.parquet").to_pydict()
-    t3rows = [list(r) for r in zip(t3["photo"], t3["point"], t3["dx_printed_um"],
-                                   t3["dx_coord_um"], t3["dy_printed_um"], t3["dy_coord_um"],
-                                   t3["note"])]
-    sizes = (f"{len(tr['trial'])} simulated instruments (seed {cfg['seed']}); the sweeps and "
-             f"the readings trade-off use {cfg['unprinted.trials']}, the other trade-offs "
-             f"{cfg['trade.trials']}")
+    t3rows = [
+        list(r)
+        for r in zip(
+            t3["photo"],
+            t3["point"],
+            t3["dx_printed_um"],
+            t3["dx_coord_um"],
+            t3["dy_printed_um"],
+            t3["dy_coord_um"],
+            t3["note"],
+        )
+    ]
+    sizes = (
+        f"{len(tr['trial'])} simulated instruments (seed {cfg['seed']}); the sweeps and "
+        f"the readings trade-off use {cfg['unprinted.trials']}, the other trade-offs "
+        f"{cfg['trade.trials']}"
+    )
     txt = [
         "**Model.** A grid plate (a "
         f"{cfg['plate.spacing_mm']:g} mm quadrille over the area {cfg['plate.area_mm']} mm; grid "
@@ -117,8 +169,10 @@ def report(out: Path) -> str:
         "numbers describe one instrument and one plate each, so most claims are *one-plate* "
         "claims, decided by where the paper's value falls among simulated plates.",
         "",
-        md_table(["component", "paper's source", "amplitude (um, input)",
-                  "median rms at the grid (um)"], crow),
+        md_table(
+            ["component", "paper's source", "amplitude (um, input)", "median rms at the grid (um)"],
+            crow,
+        ),
         "",
         f"![error-field components]({name}/components.png)",
         "",
@@ -127,8 +181,12 @@ def report(out: Path) -> str:
         claims_markdown(out / "claims.parquet"),
         "",
         "**Unprinted inputs swept.** The paper does not print these inputs: "
-        + ", ".join(f"`{i}`" for i in dict.fromkeys(
-            read_table(out / "consistent_set.parquet").column("input").to_pylist()))
+        + ", ".join(
+            f"`{i}`"
+            for i in dict.fromkeys(
+                read_table(out / "consistent_set.parquet").column("input").to_pylist()
+            )
+        )
         + " (`field_scale` is a common factor on the seven field amplitudes). Each is swept with "
         "the others at their configured values, on the same simulated instruments; per claim, "
         "the swept values "
@@ -148,16 +206,37 @@ def report(out: Path) -> str:
         "`wolf.table2_check` rows). Per point, Set 1 - Set 2 and each set minus the H. Dell "
         f"Foster coordinates, in um, from the transcription `{cfg['table1.file']}`:",
         "",
-        md_table(["plate", "point", "X set1-set2", "Y set1-set2", "X s1-Foster", "X s2-Foster",
-                  "Y s1-Foster", "Y s2-Foster"], t1rows),
+        md_table(
+            [
+                "plate",
+                "point",
+                "X set1-set2",
+                "Y set1-set2",
+                "X s1-Foster",
+                "X s2-Foster",
+                "Y s1-Foster",
+                "Y s2-Foster",
+            ],
+            t1rows,
+        ),
         "",
         f"![Table 1 vectors]({name}/table1_real.png)",
         "",
         f"**Table 3** (`{cfg['table3.file']}`): the printed differences and those from the "
         "coordinates, um (the `wolf.table3_check` rows use the printed differences):",
         "",
-        md_table(["photo", "point", "dX printed", "dX coordinates", "dY printed",
-                  "dY coordinates", "note"], t3rows),
+        md_table(
+            [
+                "photo",
+                "point",
+                "dX printed",
+                "dX coordinates",
+                "dY printed",
+                "dY coordinates",
+                "note",
+            ],
+            t3rows,
+        ),
         "",
         *_tradeoffs(out, cfg, name),
     ]
@@ -168,68 +247,153 @@ def _tradeoffs(out: Path, cfg: dict, name: str) -> list[str]:
     d = read_table(out / "degree.parquet").to_pydict()
     r = read_table(out / "readings.parquet").to_pydict()
     s = read_table(out / "stability.parquet").to_pydict()
-    drows = [[fmt(a), n, ns, dg, t, fmt(f), fmt(c), fmt(e)] for a, n, ns, dg, t, f, c, e in zip(
-        d["spacing_mm"], d["n_points"], d["n_sets"], d["degree"], d["terms"], d["fit_rms_um"],
-        d["check_rms_um"], d["estimable_share"])]
-    rrows = [[a, fmt(g), n, fmt(e), fmt(c), fmt(p)] for a, g, n, e, c, p in zip(
-        r["approach"], r["pointing_sigma_um"], r["readings"], r["reading_error_um"],
-        r["after_check_rms_um"], r["after_plate_rms_um"])]
-    srows = [[fmt(f), fmt(a), fmt(b), fmt(c), fmt(w)] for f, a, b, c, w in zip(
-        s["drift_fraction"], s["age_weeks"], s["before_rms_um"], s["after_rms_um"],
-        s["share_after_better"])]
+    drows = [
+        [fmt(a), n, ns, dg, t, fmt(f), fmt(c), fmt(e)]
+        for a, n, ns, dg, t, f, c, e in zip(
+            d["spacing_mm"],
+            d["n_points"],
+            d["n_sets"],
+            d["degree"],
+            d["terms"],
+            d["fit_rms_um"],
+            d["check_rms_um"],
+            d["estimable_share"],
+        )
+    ]
+    rrows = [
+        [a, fmt(g), n, fmt(e), fmt(c), fmt(p)]
+        for a, g, n, e, c, p in zip(
+            r["approach"],
+            r["pointing_sigma_um"],
+            r["readings"],
+            r["reading_error_um"],
+            r["after_check_rms_um"],
+            r["after_plate_rms_um"],
+        )
+    ]
+    srows = [
+        [fmt(f), fmt(a), fmt(b), fmt(c), fmt(w)]
+        for f, a, b, c, w in zip(
+            s["drift_fraction"],
+            s["age_weeks"],
+            s["before_rms_um"],
+            s["after_rms_um"],
+            s["share_after_better"],
+        )
+    ]
     ans = []
     sp0, ns0 = cfg["plate.spacing_mm"], cfg["calib.n_sets"]
-    m = [(dg, c, f) for sp, ns, dg, c, f in zip(d["spacing_mm"], d["n_sets"], d["degree"],
-                                                  d["check_rms_um"], d["fit_rms_um"])
-         if sp == sp0 and ns == ns0 and c is not None and np.isfinite(c)]
+    m = [
+        (dg, c, f)
+        for sp, ns, dg, c, f in zip(
+            d["spacing_mm"], d["n_sets"], d["degree"], d["check_rms_um"], d["fit_rms_um"]
+        )
+        if sp == sp0 and ns == ns0 and c is not None and np.isfinite(c)
+    ]
     if m:
         best = min(m, key=lambda t: t[1])
-        ans.append(f"- *Degree* ({sp0:g} mm grid, {ns0} sets): the independent-plate rms is "
-                   f"lowest at degree {best[0]} ({best[1]:.2f} um); " + ", ".join(
-                       f"degree {dg}: fit {f:.2f} / plate {c:.2f}" for dg, c, f in m) + " um.")
-    one = [(n, p) for a, g, n, p in zip(r["approach"], r["pointing_sigma_um"], r["readings"],
-                                       r["after_plate_rms_um"])
-           if a == cfg["reading.approach"] and g == cfg["reading.pointing_sigma_um"]]
+        ans.append(
+            f"- *Degree* ({sp0:g} mm grid, {ns0} sets): the independent-plate rms is "
+            f"lowest at degree {best[0]} ({best[1]:.2f} um); "
+            + ", ".join(f"degree {dg}: fit {f:.2f} / plate {c:.2f}" for dg, c, f in m)
+            + " um."
+        )
+    one = [
+        (n, p)
+        for a, g, n, p in zip(
+            r["approach"], r["pointing_sigma_um"], r["readings"], r["after_plate_rms_um"]
+        )
+        if a == cfg["reading.approach"] and g == cfg["reading.pointing_sigma_um"]
+    ]
     if len(one) > 1:
-        ans.append(f"- *Readings* (pointing sigma {cfg['reading.pointing_sigma_um']:g} um, "
-                   f"{cfg['reading.approach']}): independent-plate rms " + ", ".join(
-                       f"{n} reading(s): {p:.2f}" for n, p in one) + " um.")
+        ans.append(
+            f"- *Readings* (pointing sigma {cfg['reading.pointing_sigma_um']:g} um, "
+            f"{cfg['reading.approach']}): independent-plate rms "
+            + ", ".join(f"{n} reading(s): {p:.2f}" for n, p in one)
+            + " um."
+        )
     tau = cfg["field.drift_tau_weeks"]
     for f in dict.fromkeys(s["drift_fraction"]):
-        rf = [(a, b, c) for ff, a, b, c in zip(s["drift_fraction"], s["age_weeks"],
-                                                s["before_rms_um"], s["after_rms_um"]) if ff == f]
+        rf = [
+            (a, b, c)
+            for ff, a, b, c in zip(
+                s["drift_fraction"], s["age_weeks"], s["before_rms_um"], s["after_rms_um"]
+            )
+            if ff == f
+        ]
         worse = [a for a, b, c in rf if c >= b]
         ok = [a for a, b, c in rf if c < b]
-        theory = (f"noise-free theory: {tau * math.log(2 * f / (2 * f - 1)):.0f} weeks"
-                  if f > 0.5 else "noise-free theory: it always helps")
-        when = (f"the correction stops helping between {max(ok or [0.0]):g} and {worse[0]:g} "
-                "weeks" if worse else "the correction still helps at the oldest age tried")
-        ans.append(f"- *Stability*, drifting share {f:g}: corrected rms {rf[0][2]:.1f} um at age "
-                   f"{rf[0][0]:g} weeks, {rf[-1][2]:.1f} um at {rf[-1][0]:g} weeks (uncorrected "
-                   f"{rf[-1][1]:.1f}); {when} ({theory}).")
+        theory = (
+            f"noise-free theory: {tau * math.log(2 * f / (2 * f - 1)):.0f} weeks"
+            if f > 0.5
+            else "noise-free theory: it always helps"
+        )
+        when = (
+            f"the correction stops helping between {max(ok or [0.0]):g} and {worse[0]:g} weeks"
+            if worse
+            else "the correction still helps at the oldest age tried"
+        )
+        ans.append(
+            f"- *Stability*, drifting share {f:g}: corrected rms {rf[0][2]:.1f} um at age "
+            f"{rf[0][0]:g} weeks, {rf[-1][2]:.1f} um at {rf[-1][0]:g} weeks (uncorrected "
+            f"{rf[-1][1]:.1f}); {when} ({theory})."
+        )
     return [
-        "**Design trade-offs.**", "", *ans, "",
+        "**Design trade-offs.**",
+        "",
+        *ans,
+        "",
         "The drifting part decorrelates as exp(-age/tau); the correction removes the "
         "calibration-time field, so the error it leaves grows as 2 f (1 - exp(-age/tau)) of the "
         "field's variance and passes the uncorrected variance at age tau ln(2f / (2f - 1)) when "
-        "more than half of the field drifts.", "",
+        "more than half of the field drifts.",
+        "",
         f"Degree against grid spacing and number of sets ({cfg['trade.trials']} trials per cell; "
         "median rms per coordinate, um; fit = residuals on the pooled fitting data; plate = an "
         "independent plate of random points inside the grid's extent, read "
         f"{cfg['check.age_weeks']:g} week(s) after the last set, corrected and fitted by a "
-        "similarity; empty where the grid has fewer rows or columns than the degree needs):", "",
-        md_table(["spacing (mm)", "points", "sets", "degree", "terms", "fit rms", "plate rms",
-                  "estimable share"], drows), "",
-        f"![degree trade-off]({name}/degree.png)", "",
+        "similarity; empty where the grid has fewer rows or columns than the degree needs):",
+        "",
+        md_table(
+            [
+                "spacing (mm)",
+                "points",
+                "sets",
+                "degree",
+                "terms",
+                "fit rms",
+                "plate rms",
+                "estimable share",
+            ],
+            drows,
+        ),
+        "",
+        f"![degree trade-off]({name}/degree.png)",
+        "",
         "Readings per point (um): the rms error of the averaged reading alone, and the median rms "
         "after correction on the cell-centre check points and on an independent plate "
-        f"({cfg['unprinted.trials']} instruments, the same for every cell):", "",
-        md_table(["approach", "pointing sigma", "readings", "reading error", "check after",
-                  "plate after"], rrows), "",
-        f"![readings]({name}/readings.png)", "",
+        f"({cfg['unprinted.trials']} instruments, the same for every cell):",
+        "",
+        md_table(
+            [
+                "approach",
+                "pointing sigma",
+                "readings",
+                "reading error",
+                "check after",
+                "plate after",
+            ],
+            rrows,
+        ),
+        "",
+        f"![readings]({name}/readings.png)",
+        "",
         "Stability: calibration on the paper's sets, an independent plate read at a later age "
-        "(median rms per coordinate, um; share of instruments where the correction helps):", "",
-        md_table(["drifting share", "age (weeks)", "uncorrected", "corrected", "share helped"],
-                 srows), "",
+        "(median rms per coordinate, um; share of instruments where the correction helps):",
+        "",
+        md_table(
+            ["drifting share", "age (weeks)", "uncorrected", "corrected", "share helped"], srows
+        ),
+        "",
         f"![stability]({name}/stability.png)",
     ]

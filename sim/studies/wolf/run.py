@@ -11,22 +11,23 @@ Writes ``trials.parquet``, ``vectors.parquet``, ``components.parquet``, ``degree
 ``table1_real.parquet``, ``table3_real.parquet``, ``sweep_values.parquet``,
 ``consistent_set.parquet``, ``claims.parquet``, ``not_reproduced.parquet`` and the figures.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ... import errorfields as ef
-from ...claims import write_claims
-from ...runner import chunk_rng, run_chunks
-from ...storage import provenance, write_table
-from .. import RunContext
-from . import claims as cl
-from . import consistent, figures, tables
-from .chunks import degree_chunk, main_chunk, stability_chunk
-from .model import field_spec, reading_error_rms
-from .schema import grid_nodes, table_path
+from sim.claims.book import write_claims
+from sim.instruments.plotter import errorfields as ef
+from sim.mc.runner import chunk_rng, run_chunks
+from sim.mc.storage import provenance, write_table
+from sim.studies import RunContext
+from sim.studies.wolf import claims as cl
+from sim.studies.wolf import consistent, figures, tables
+from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk
+from sim.studies.wolf.model import field_spec, reading_error_rms
+from sim.studies.wolf.schema import grid_nodes, table_path
 
 APPROACHES = ("one_side", "random")
 
@@ -52,9 +53,19 @@ def reading_cells(cfg: dict) -> list[tuple[str, str, float, int, dict]]:
     for a in APPROACHES:
         for sg in cfg["trade.pointing_sigmas_um"]:
             for n in cfg["trade.readings"]:
-                out.append((f"r.{a}.{sg:g}.{n}.", a, float(sg), int(n),
-                            {"reading.approach": a, "reading.pointing_sigma_um": float(sg),
-                             "reading.n": int(n)}))
+                out.append(
+                    (
+                        f"r.{a}.{sg:g}.{n}.",
+                        a,
+                        float(sg),
+                        int(n),
+                        {
+                            "reading.approach": a,
+                            "reading.pointing_sigma_um": float(sg),
+                            "reading.n": int(n),
+                        },
+                    )
+                )
     return out
 
 
@@ -70,18 +81,45 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     rc, sc = reading_cells(cfg), consistent.sweep_cells(cfg)
     cells = [(t, o) for t, *_, o in rc] + [(t, o) for t, _, _, o in sc]
     Ts = cfg["unprinted.trials"]
-    res = run_chunks(main_chunk(cfg, cells, full=False), Ts, seed, sub_chunk(Ts, ch), part=1,
-                     ctx=ctx, label="wolf cells", quiet=q)
+    res = run_chunks(
+        main_chunk(cfg, cells, full=False),
+        Ts,
+        seed,
+        sub_chunk(Ts, ch),
+        part=1,
+        ctx=ctx,
+        label="wolf cells",
+        quiet=q,
+    )
     er = chunk_rng(seed, 30, 0)
-    rd = {k: [] for k in ("approach", "pointing_sigma_um", "readings", "reading_error_um",
-                          "after_check_rms_um", "after_check_lo_um", "after_check_hi_um",
-                          "after_plate_rms_um", "after_plate_lo_um", "after_plate_hi_um")}
+    rd = {
+        k: []
+        for k in (
+            "approach",
+            "pointing_sigma_um",
+            "readings",
+            "reading_error_um",
+            "after_check_rms_um",
+            "after_check_lo_um",
+            "after_check_hi_um",
+            "after_plate_rms_um",
+            "after_plate_lo_um",
+            "after_plate_hi_um",
+        )
+    }
     for tag, a, sg, n, _ in rc:
-        ca, pa = (np.sqrt((res[f"{tag}{e}.rms_x_um"] ** 2 + res[f"{tag}{e}.rms_y_um"] ** 2) / 2)
-                  for e in ("check_after", "plate_after"))
-        vals = (a, sg, n, reading_error_rms(er, cfg["reading.count_um"], n, sg,
-                                            cfg["reading.backlash_um"], a),
-                *_summ(ca), *_summ(pa))
+        ca, pa = (
+            np.sqrt((res[f"{tag}{e}.rms_x_um"] ** 2 + res[f"{tag}{e}.rms_y_um"] ** 2) / 2)
+            for e in ("check_after", "plate_after")
+        )
+        vals = (
+            a,
+            sg,
+            n,
+            reading_error_rms(er, cfg["reading.count_um"], n, sg, cfg["reading.backlash_um"], a),
+            *_summ(ca),
+            *_summ(pa),
+        )
         for k, v in zip(rd, vals):
             rd[k].append(v)
     write_table(out / "readings.parquet", rd, prov)
@@ -89,7 +127,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     vals, cons = consistent.evaluate(cfg, res, book)
     write_table(out / "sweep_values.parquet", vals, prov)
     write_table(out / "consistent_set.parquet", cons, prov)
-    wait_early = figures.start_early(cfg, out, ctx.executor)   # drawn while the trade-offs run
+    wait_early = figures.start_early(cfg, out, ctx.executor)  # drawn while the trade-offs run
 
     degt = _degree(cfg, out, prov, ctx)
     _stability(cfg, out, prov, ctx)
@@ -109,44 +147,91 @@ def _vectors_and_components(cfg, out, prov):
     G = grid_nodes(cfg["plate.area_mm"], cfg["plate.spacing_mm"])
     S = cfg["calib.n_sets"]
     vb, va = rep["vec.before"][0], rep["vec.after"][0]
-    write_table(out / "vectors.parquet", {
-        "set": np.repeat(np.arange(1, S + 1), len(G)), "x_mm": np.tile(G[:, 0], S),
-        "y_mm": np.tile(G[:, 1], S), "dx_before_um": vb[..., 0].ravel(),
-        "dy_before_um": vb[..., 1].ravel(), "dx_after_um": va[..., 0].ravel(),
-        "dy_after_um": va[..., 1].ravel()}, prov)
+    write_table(
+        out / "vectors.parquet",
+        {
+            "set": np.repeat(np.arange(1, S + 1), len(G)),
+            "x_mm": np.tile(G[:, 0], S),
+            "y_mm": np.tile(G[:, 1], S),
+            "dx_before_um": vb[..., 0].ravel(),
+            "dy_before_um": vb[..., 1].ravel(),
+            "dx_after_um": va[..., 0].ravel(),
+            "dy_after_um": va[..., 1].ravel(),
+        },
+        prov,
+    )
     spec = field_spec(cfg)
     comp = ef.evaluate_components(spec, ef.draw(spec, chunk_rng(seed, 91, 0), 1), G)
     names = list(ef.COMPONENTS)
-    write_table(out / "components.parquet", {
-        "component": np.repeat(names, len(G)), "x_mm": np.tile(G[:, 0], len(names)),
-        "y_mm": np.tile(G[:, 1], len(names)),
-        "dx_um": np.concatenate([comp[k][0, :, 0] for k in names]),
-        "dy_um": np.concatenate([comp[k][0, :, 1] for k in names]),
-        "amplitude_um": np.repeat([spec.amplitude(k) for k in names], len(G))}, prov)
+    write_table(
+        out / "components.parquet",
+        {
+            "component": np.repeat(names, len(G)),
+            "x_mm": np.tile(G[:, 0], len(names)),
+            "y_mm": np.tile(G[:, 1], len(names)),
+            "dx_um": np.concatenate([comp[k][0, :, 0] for k in names]),
+            "dy_um": np.concatenate([comp[k][0, :, 1] for k in names]),
+            "amplitude_um": np.repeat([spec.amplitude(k) for k in names], len(G)),
+        },
+        prov,
+    )
 
 
 def _degree(cfg, out, prov, ctx) -> dict:
     seed, q = cfg["seed"], ctx.quiet
     Tt = cfg["trade.trials"]
     cht = sub_chunk(Tt, cfg["chunk"])
-    rows = {k: [] for k in ("spacing_mm", "n_points", "n_sets", "degree", "terms", "fit_rms_um",
-                            "fit_lo_um", "fit_hi_um", "check_rms_um", "check_lo_um",
-                            "check_hi_um", "estimable_share")}
-    trials = {k: [] for k in ("spacing_mm", "n_sets", "degree", "trial", "fit_rms_um",
-                              "check_rms_um")}
+    rows = {
+        k: []
+        for k in (
+            "spacing_mm",
+            "n_points",
+            "n_sets",
+            "degree",
+            "terms",
+            "fit_rms_um",
+            "fit_lo_um",
+            "fit_hi_um",
+            "check_rms_um",
+            "check_lo_um",
+            "check_hi_um",
+            "estimable_share",
+        )
+    }
+    trials = {
+        k: [] for k in ("spacing_mm", "n_sets", "degree", "trial", "fit_rms_um", "check_rms_um")
+    }
     for i, sp in enumerate(cfg["trade.spacings_mm"]):
-        r = run_chunks(degree_chunk(cfg, sp), Tt, seed, cht, part=10 + i, ctx=ctx,
-                       label=f"degree, {sp:g} mm", quiet=q)
+        r = run_chunks(
+            degree_chunk(cfg, sp),
+            Tt,
+            seed,
+            cht,
+            part=10 + i,
+            ctx=ctx,
+            label=f"degree, {sp:g} mm",
+            quiet=q,
+        )
         npts = len(grid_nodes(cfg["plate.area_mm"], sp))
         for ns in cfg["trade.n_sets"]:
             for d in cfg["trade.degrees"]:
                 fr, cr = r[f"fit.{ns}.{d}"], r[f"check.{ns}.{d}"]
-                vals = (sp, npts, ns, d, (d + 1) * (d + 2) // 2, *_summ(fr), *_summ(cr),
-                        float(np.isfinite(fr).mean()))
+                vals = (
+                    sp,
+                    npts,
+                    ns,
+                    d,
+                    (d + 1) * (d + 2) // 2,
+                    *_summ(fr),
+                    *_summ(cr),
+                    float(np.isfinite(fr).mean()),
+                )
                 for k, v in zip(rows, vals):
                     rows[k].append(v)
-                for k, v in zip(trials, (np.full(Tt, sp), np.full(Tt, ns), np.full(Tt, d),
-                                         np.arange(Tt), fr, cr)):
+                for k, v in zip(
+                    trials,
+                    (np.full(Tt, sp), np.full(Tt, ns), np.full(Tt, d), np.arange(Tt), fr, cr),
+                ):
                     trials[k].append(v)
     write_table(out / "degree.parquet", rows, prov)
     degt = {k: np.concatenate(v) for k, v in trials.items()}
@@ -158,11 +243,30 @@ def _stability(cfg, out, prov, ctx) -> None:
     Tt = cfg["trade.trials"]
     cht = sub_chunk(Tt, cfg["chunk"])
     fr_, ages = cfg["trade.drift_fractions"], cfg["trade.ages_weeks"]
-    r = run_chunks(stability_chunk(cfg, fr_, ages), Tt, cfg["seed"], cht, part=40, ctx=ctx,
-                   label="stability", quiet=ctx.quiet)
-    stb = {k: [] for k in ("drift_fraction", "age_weeks", "before_rms_um", "before_lo_um",
-                           "before_hi_um", "after_rms_um", "after_lo_um", "after_hi_um",
-                           "share_after_better")}
+    r = run_chunks(
+        stability_chunk(cfg, fr_, ages),
+        Tt,
+        cfg["seed"],
+        cht,
+        part=40,
+        ctx=ctx,
+        label="stability",
+        quiet=ctx.quiet,
+    )
+    stb = {
+        k: []
+        for k in (
+            "drift_fraction",
+            "age_weeks",
+            "before_rms_um",
+            "before_lo_um",
+            "before_hi_um",
+            "after_rms_um",
+            "after_lo_um",
+            "after_hi_um",
+            "share_after_better",
+        )
+    }
     for f in fr_:
         for i, age in enumerate(ages):
             b, a = r[f"before.{f}.{i}"], r[f"after.{f}.{i}"]

@@ -7,6 +7,7 @@ read with the DBA comparator and the PG-2, with the printed differences (mm).
 A file that is not the table (binary, other columns, non-numbers) is a :class:`ConfigError`
 naming the config key, raised when the study is loaded.
 """
+
 from __future__ import annotations
 
 import csv
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...config import ConfigError
+from sim.mc.config import ConfigError
 
 STATS = ("max", "rms", "mean")
 T1_NUM = ("x_set1_mm", "x_set2_mm", "y_set1_mm", "y_set2_mm", "x_foster_mm", "y_foster_mm")
@@ -30,8 +31,9 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
         with open(p, newline="", encoding="utf-8") as fh:
             text = fh.read(2_000_000)
     except UnicodeDecodeError:
-        raise ConfigError(key, f"{p} is not a text file (not UTF-8): expected the CSV "
-                          "transcription") from None
+        raise ConfigError(
+            key, f"{p} is not a text file (not UTF-8): expected the CSV transcription"
+        ) from None
     except OSError as e:
         raise ConfigError(key, f"cannot read {p}: {e.strerror}") from None
     if "\x00" in text:
@@ -45,8 +47,11 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
     header = set(rows[0]) if rows else set()
     missing = [c for c in cols if c not in header]
     if missing:
-        raise ConfigError(key, f"{p} is not the expected table: missing column(s) "
-                          f"{', '.join(missing)} (needs {', '.join(cols)})")
+        raise ConfigError(
+            key,
+            f"{p} is not the expected table: missing column(s) "
+            f"{', '.join(missing)} (needs {', '.join(cols)})",
+        )
     out: dict[str, list] = {c: [] for c in cols}
     for i, r in enumerate(rows, start=1):
         try:
@@ -58,8 +63,9 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
                     raise ValueError(c)
                 out[c].append(v)
         except (TypeError, ValueError) as e:
-            raise ConfigError(key, f"{p}: data row {i} has a bad value ({e}): numbers in mm "
-                              "expected") from None
+            raise ConfigError(
+                key, f"{p}: data row {i} has a bad value ({e}): numbers in mm expected"
+            ) from None
         out["note"].append(r["note"] or "")
     res = {k: np.array(v) for k, v in out.items()}
     for g in need:
@@ -85,31 +91,40 @@ def _um(a):
 def table1_discrepancies(t: dict) -> dict[str, np.ndarray]:
     """Per point: Set 1 - Set 2 and Set - Foster in um (whole um: the coordinates are printed
     to 1 um)."""
-    return {"plate": t["plate"], "point": t["point"],
-            "dx_sets_um": _um(t["x_set1_mm"] - t["x_set2_mm"]),
-            "dy_sets_um": _um(t["y_set1_mm"] - t["y_set2_mm"]),
-            "dx_set1_foster_um": _um(t["x_set1_mm"] - t["x_foster_mm"]),
-            "dx_set2_foster_um": _um(t["x_set2_mm"] - t["x_foster_mm"]),
-            "dy_set1_foster_um": _um(t["y_set1_mm"] - t["y_foster_mm"]),
-            "dy_set2_foster_um": _um(t["y_set2_mm"] - t["y_foster_mm"]),
-            "x_set1_mm": t["x_set1_mm"], "y_set1_mm": t["y_set1_mm"], "note": t["note"]}
+    return {
+        "plate": t["plate"],
+        "point": t["point"],
+        "dx_sets_um": _um(t["x_set1_mm"] - t["x_set2_mm"]),
+        "dy_sets_um": _um(t["y_set1_mm"] - t["y_set2_mm"]),
+        "dx_set1_foster_um": _um(t["x_set1_mm"] - t["x_foster_mm"]),
+        "dx_set2_foster_um": _um(t["x_set2_mm"] - t["x_foster_mm"]),
+        "dy_set1_foster_um": _um(t["y_set1_mm"] - t["y_foster_mm"]),
+        "dy_set2_foster_um": _um(t["y_set2_mm"] - t["y_foster_mm"]),
+        "x_set1_mm": t["x_set1_mm"],
+        "y_set1_mm": t["y_set1_mm"],
+        "note": t["note"],
+    }
 
 
 def table3_discrepancies(t: dict) -> dict[str, np.ndarray]:
     """Per point: the printed differences and PG-2 - DBA from the coordinates, in um."""
-    return {"photo": t["photo"], "point": t["point"],
-            "dx_printed_um": _um(np.abs(t["dx_printed_mm"])),
-            "dy_printed_um": _um(np.abs(t["dy_printed_mm"])),
-            "dx_coord_um": _um(t["x_pg2_mm"] - t["x_dba_mm"]),
-            "dy_coord_um": _um(t["y_pg2_mm"] - t["y_dba_mm"]),
-            "x_dba_mm": t["x_dba_mm"], "y_dba_mm": t["y_dba_mm"], "note": t["note"]}
+    return {
+        "photo": t["photo"],
+        "point": t["point"],
+        "dx_printed_um": _um(np.abs(t["dx_printed_mm"])),
+        "dy_printed_um": _um(np.abs(t["dy_printed_mm"])),
+        "dx_coord_um": _um(t["x_pg2_mm"] - t["x_dba_mm"]),
+        "dy_coord_um": _um(t["y_pg2_mm"] - t["y_dba_mm"]),
+        "x_dba_mm": t["x_dba_mm"],
+        "y_dba_mm": t["y_dba_mm"],
+        "note": t["note"],
+    }
 
 
 def summary(v) -> dict[str, float]:
     """The paper's summary line of discrepancies ``v`` (um): max, rms and mean of ``|v|``."""
     a = np.abs(np.asarray(v, float))
-    return {"max": float(a.max()), "rms": float(np.sqrt(np.mean(a ** 2))),
-            "mean": float(a.mean())}
+    return {"max": float(a.max()), "rms": float(np.sqrt(np.mean(a**2))), "mean": float(a.mean())}
 
 
 def recomputation(v, stat: str) -> str:
@@ -120,5 +135,5 @@ def recomputation(v, stat: str) -> str:
         return f"|d| = {lst} um: max {a.max()}"
     if stat == "mean":
         return f"|d| = {lst} um: sum {a.sum()} / {a.size} = {a.sum() / a.size:.2f}"
-    s2 = int(np.sum(a ** 2))
+    s2 = int(np.sum(a**2))
     return f"|d| = {lst} um: sum of squares {s2} / {a.size}, rms {math.sqrt(s2 / a.size):.2f}"

@@ -1,0 +1,163 @@
+"""Command line of the benchmark: ``python -m benchmarks --out results/bench`` (``make bench``).
+
+Sections (``--only``, default all): ``brown`` (``bench.parquet``, ``bench.png``:
+:mod:`benchmarks.brown`), ``engines`` (``engines.parquet``: :mod:`benchmarks.engines`) and
+``rerun`` (``rerun.parquet``: :mod:`benchmarks.rerun`; ``--no-rerun`` leaves it out), the last
+two drawn in ``engines.png``. ``--quick`` is a smoke run: small sizes, and the rerun rows with
+the test suite's tiny configuration of each study (``tests/data/tiny/<study>.txt``), so its
+rerun times say nothing about the 90 s target.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from sim.mc.storage import provenance, write_table
+
+__all__ = ["main", "run"]
+
+SECTIONS = ("brown", "engines", "rerun")
+TINY = Path(__file__).resolve().parent.parent / "tests" / "data" / "tiny"
+
+
+def tiny_overrides(study_file: Path) -> tuple[str, ...]:
+    """``--set`` arguments of the test suite's tiny configuration of a study file's study."""
+    study = tomllib.loads(study_file.read_text()).get("study")
+    f = TINY / f"{study}.txt"
+    if not f.is_file():
+        raise FileNotFoundError(f"bench --quick: no tiny configuration {f} for {study_file}")
+    lines = [ln.strip() for ln in f.read_text().splitlines()]
+    return tuple(a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln))
+
+
+def run(
+    out: Path,
+    quick: bool = False,
+    sections=SECTIONS,
+    rerun_files: str = "studies/*.toml",
+    rerun_workers=(1, 2),
+) -> dict[str, dict]:
+    """Measure ``sections`` and write their tables and figures under ``out``; returns the
+    tables' columns by file name."""
+    from benchmarks.figures import brown_figure, engines_figure
+
+    prov = {"study": "bench", "seed": 1, "quick": quick}
+    tables: dict[str, dict] = {}
+    if "brown" in sections:
+        from benchmarks.brown import brown_rows
+
+        rows, extra = brown_rows(out, quick)
+        write_table(out / "bench.parquet", rows, provenance(prov, **extra))
+        brown_figure(rows, out / "bench.png", extra["solutions_agree_mm"])
+        tables["bench.parquet"] = rows
+    if "engines" in sections:
+        from benchmarks.engines import engine_rows
+
+        tables["engines.parquet"] = engine_rows(quick)
+        write_table(out / "engines.parquet", tables["engines.parquet"], provenance(prov))
+    if "rerun" in sections:
+        from benchmarks.rerun import rerun_rows, study_files
+
+        files = study_files(rerun_files)
+        extra = {f.stem: tiny_overrides(f) for f in files} if quick else {}
+        tables["rerun.parquet"] = rerun_rows(files, rerun_workers, extra)
+        write_table(
+            out / "rerun.parquet",
+            tables["rerun.parquet"],
+            provenance(prov, files=[f.as_posix() for f in files], tiny_configurations=quick),
+        )
+    if "engines" in sections or "rerun" in sections:
+        engines_figure(
+            tables.get("engines.parquet"), tables.get("rerun.parquet"), out / "engines.png"
+        )
+    return tables
+
+
+def _csv(kind, choices=None):
+    def parse(text: str):
+        items = [s.strip() for s in text.split(",") if s.strip()]
+        try:
+            vals = [kind(s) for s in items]
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"not a comma-separated list of {kind.__name__}: {text!r}"
+            )
+        bad = [
+            v
+            for v in vals
+            if (choices is not None and v not in choices) or (kind is int and not 1 <= v <= 64)
+        ]
+        if not vals or bad:
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: expected a comma-separated subset of "
+                f"{', '.join(choices) if choices else '1 ... 64'}"
+            )
+        return tuple(vals)
+
+    return parse
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks",
+        description="Benchmark of the batched solvers and of make rerun (see README, Benchmark)",
+    )
+    ap.add_argument(
+        "--out", default="results/bench", help="output directory (default results/bench)"
+    )
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="small sizes and tiny study configurations (a smoke run)",
+    )
+    ap.add_argument(
+        "--only",
+        type=_csv(str, SECTIONS),
+        default=SECTIONS,
+        help=f"comma-separated sections to measure ({', '.join(SECTIONS)}; default all)",
+    )
+    ap.add_argument(
+        "--rerun",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="time every study file run as make rerun runs it, with 1 and 2 workers "
+        "(--no-rerun: leave it out)",
+    )
+    ap.add_argument(
+        "--rerun-files",
+        default="studies/*.toml",
+        help="study files of the rerun rows (default studies/*.toml)",
+    )
+    ap.add_argument(
+        "--rerun-workers",
+        type=_csv(int),
+        default=(1, 2),
+        help="worker counts of the rerun rows (default 1,2)",
+    )
+    ap.add_argument("--million-child", type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--chunk", type=int, default=10000, help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    if a.million_child:
+        from benchmarks.brown import million, peak_rss_mib
+
+        million(Path(a.out), a.million_child, a.chunk)
+        print(f"{peak_rss_mib():.1f}")
+        return 0
+    sections = tuple(s for s in a.only if a.rerun or s != "rerun")
+    try:
+        tables = run(Path(a.out), a.quick, sections, a.rerun_files, a.rerun_workers)
+    except (FileNotFoundError, RuntimeError) as e:
+        print(f"benchmarks: error: {e}".splitlines()[0], file=sys.stderr)
+        return 2
+    if "bench.parquet" in tables:
+        b = tables["bench.parquet"]
+        case, tps = np.array(b["case"]), np.array(b["trials_per_s"])
+        print(
+            f"speed-up over the scipy loop: {tps[case == 'batched'][0] / tps[case == 'scipy_loop'][0]:.0f}x"
+        )
+    return 0

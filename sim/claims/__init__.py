@@ -1,0 +1,1 @@
+"""Claims: the claim book, the intervals and the verdict rules."""

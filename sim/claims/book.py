@@ -1,0 +1,500 @@
+"""Claims: a paper's statement, what the simulation produced, and a verdict with a stated rule.
+
+A study declares its claims as data (a TOML *claim book*, see :class:`ClaimBook`): the
+paper's text, where it stands, its *form*, its printed reference and the width that decides.
+The study's code only supplies what the simulation produced (an estimate with its interval,
+per-element intervals, or the per-plate distribution); the verdict follows from the rule
+below, never from code that knows the answer.
+
+Forms (``form``)
+================
+``value``      a printed number: it stands for ``ref`` +- half a unit of its last printed
+               decimal (``decimals``); the *decision zone* widens that by ``tol``.
+``share``      a printed proportion (0-1), as ``value``.
+``count``      a printed count, as ``value``.
+``upper``      a bound "at most ``ref``" (zone ``(-inf, ref + rounding + tol]``).
+``lower``      a bound "at least ``ref``" (zone ``[ref - rounding - tol, inf)``).
+``range``      "from a to b": every element (e.g. every point's dilution) is to lie in
+               ``[a, b]`` (widened by the rounding and ``tol``).
+``one-plate``  the paper's number is one plate's statistic (one observed rms, one count):
+               the simulation gives its distribution over plates.
+
+Verdicts (``verdict``)
+======================
+With ``I`` the simulated interval and ``Z`` the decision zone:
+
+* ``value``/``share``/``count``/``upper``/``lower``: **holds** iff ``I`` lies inside ``Z``;
+  **fails** iff ``I`` and ``Z`` do not meet; otherwise **inconclusive** (the interval covers
+  both values that agree and values that contradict the claim). An ``exact`` interval (a
+  deterministic computation) is a point, so it is never inconclusive.
+* ``range``: **holds** iff every element's interval lies inside ``Z``; **fails** iff some
+  element's interval lies wholly outside ``Z``; otherwise **inconclusive**.
+* ``one-plate``: with ``q`` the simulated probability of a plate at or below the paper's
+  value, ``p = 2 min(q, 1 - q)`` is the probability of a plate at least as extreme.
+  **fails** iff ``p < 0.05``; **holds** iff ``p >= 0.05`` and the central 95 % of plates lies
+  inside ``Z`` (the simulation is sharp enough to decide); otherwise **inconclusive**.
+
+The rule's result is the ``outcome`` column. The ``verdict`` is the outcome for
+``kind = "prediction"`` and for ``"paper-check"`` (where a failing outcome is an
+**erratum**: the paper contradicts its own printed data, and ``value`` is the recomputation
+from that data); the other kinds are counted apart: ``input`` (a simulation input set to
+match the paper: agreement by construction), ``self-check`` (Monte Carlo against analytic,
+coverage, posterior against least squares), ``finding`` (the project's own result, no paper
+number) and ``not comparable`` (the paper's number comes from a setup its text does not let
+us simulate; ``note`` says why).
+
+Columns of ``claims.parquet``: ``CLAIM_COLUMNS``. ``holds`` is derived from ``verdict``
+(true for holds, false for fails and erratum, null otherwise). Printed numbers that are not
+claims are listed, with the reason, in ``not_reproduced.parquet``.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+import numpy as np
+
+from sim.mc.config import ConfigError, StudyError
+from sim.mc.storage import write_table
+
+__all__ = [
+    "ClaimBook",
+    "decide",
+    "claim",
+    "write_claims",
+    "CLAIM_COLUMNS",
+    "VERDICTS",
+    "KINDS",
+    "FORMS",
+]
+
+FORMS = ("value", "share", "count", "upper", "lower", "range", "one-plate")
+KINDS = ("prediction", "input", "self-check", "paper-check", "finding", "not comparable")
+VERDICTS = (
+    "holds",
+    "fails",
+    "inconclusive",
+    "erratum",
+    "input",
+    "self-check",
+    "finding",
+    "not comparable",
+)
+#: the probability of a plate at least as extreme below which a one-plate claim fails
+P_FAIL = 0.05
+
+CLAIM_COLUMNS = [
+    "claim",
+    "source",
+    "paper",
+    "form",
+    "kind",
+    "headline",
+    "value",
+    "value_high",
+    "ci_low",
+    "ci_high",
+    "interval",
+    "ref_low",
+    "ref_high",
+    "tol",
+    "zone_low",
+    "zone_high",
+    "p_plate",
+    "outcome",
+    "verdict",
+    "holds",
+    "note",
+]
+NOT_REPRODUCED_COLUMNS = ["source", "printed", "why"]
+
+_SPEC_KEYS = {"id", "source", "paper", "form", "ref", "decimals", "tol", "kind", "headline", "why"}
+
+
+# --------------------------------------------------------------------------- decision rule
+def _zone(form: str, ref: tuple[float, float], half: float, tol: float) -> tuple[float, float]:
+    lo, hi = ref[0] - half - tol, ref[1] + half + tol
+    if form == "upper":
+        lo = -math.inf
+    elif form == "lower":
+        hi = math.inf
+    return lo, hi
+
+
+def decide(
+    form: str,
+    interval: tuple[float, float],
+    zone: tuple[float, float],
+    *,
+    elems: tuple[np.ndarray, np.ndarray] | None = None,
+    p_plate: float | None = None,
+) -> str:
+    """The outcome ``holds`` / ``fails`` / ``inconclusive`` of one claim (see the module doc).
+
+    interval : (lo, hi) of the simulated value (a confidence interval, the 2.5-97.5 % spread
+        of a one-plate statistic, or (v, v) for an exact value).
+    zone : the decision zone (lo, hi), possibly half-infinite.
+    elems : for ``range``, the per-element intervals ``(lo[k], hi[k])``.
+    p_plate : for ``one-plate``, the probability of a plate at least as extreme.
+    """
+    zl, zh = zone
+    if form == "range":
+        if elems is None:
+            elems = (np.array([interval[0]]), np.array([interval[1]]))
+        lo, hi = (np.asarray(e, float) for e in elems)
+        if np.any((hi < zl) | (lo > zh)):
+            return "fails"
+        return "holds" if np.all((lo >= zl) & (hi <= zh)) else "inconclusive"
+    lo, hi = interval
+    if form == "one-plate":
+        if p_plate is None or not math.isfinite(p_plate):
+            raise ValueError("a one-plate claim needs p_plate")
+        if p_plate < P_FAIL:
+            return "fails"
+        return "holds" if (lo >= zl and hi <= zh) else "inconclusive"
+    if hi < zl or lo > zh:
+        return "fails"
+    return "holds" if (lo >= zl and hi <= zh) else "inconclusive"
+
+
+def _verdict(kind: str, outcome: str | None) -> str:
+    if kind == "prediction":
+        return outcome or "finding"
+    if kind == "paper-check":
+        return {"fails": "erratum"}.get(outcome, outcome or "finding")
+    return kind
+
+
+def _holds(verdict: str):
+    return {"holds": True, "fails": False, "erratum": False}.get(verdict)
+
+
+# --------------------------------------------------------------------------- claim books
+class ClaimBook:
+    """A study's claims as data: ``[[claim]]`` and ``[[not_reproduced]]`` tables of a TOML file.
+
+    Each ``[[claim]]`` has ``id``, ``source``, ``paper`` (the paper's words), ``kind`` and,
+    unless the paper prints no number (``kind = "finding"`` or ``"not comparable"``),
+    ``form``, ``ref`` (a number, or ``[a, b]`` for ``range``), ``decimals`` (the printed
+    rounding; omit for an exact reference) and ``tol`` (the half-width beyond the rounding that
+    decides; 0 lets the rounding alone decide). ``headline = true`` puts the claim in the
+    report's referee summary; ``why`` is the reason of a ``not comparable`` row.
+    Each ``[[not_reproduced]]`` has ``source``, ``printed`` and ``why``.
+    The study scores every declared claim exactly once (:meth:`check_complete`).
+    """
+
+    def __init__(self, specs: list[dict], not_reproduced: list[dict], path: str = "<claims>"):
+        self.path = path
+        self.specs: dict[str, dict] = {}
+        for i, s in enumerate(specs):
+            where = f"{path}: claim {i + 1}"
+            bad = set(s) - _SPEC_KEYS
+            if bad:
+                raise ConfigError(f"claim.{sorted(bad)[0]}", f"{where}: unknown key")
+            for k in ("id", "source", "paper", "kind"):
+                if not isinstance(s.get(k), str) or not s[k]:
+                    raise ConfigError(f"claim.{k}", f"{where}: missing or not text")
+            if s["kind"] not in KINDS:
+                raise ConfigError(
+                    "claim.kind",
+                    f"{where} ({s['id']}): {s['kind']!r} is not one of {', '.join(KINDS)}",
+                )
+            if s["id"] in self.specs:
+                raise ConfigError("claim.id", f"{where}: duplicate id {s['id']!r}")
+            if "ref" in s:
+                if s.get("form") not in FORMS:
+                    raise ConfigError(
+                        "claim.form", f"{where} ({s['id']}): form must be one of {', '.join(FORMS)}"
+                    )
+                ref = s["ref"]
+                ref = ref if isinstance(ref, list) else [ref, ref]
+                if (
+                    len(ref) != 2
+                    or not all(isinstance(r, (int, float)) for r in ref)
+                    or not all(math.isfinite(r) for r in ref)
+                    or ref[0] > ref[1]
+                ):
+                    raise ConfigError(
+                        "claim.ref",
+                        f"{where} ({s['id']}): ref must be a finite number or [low, high]",
+                    )
+                if (s["form"] == "range") != (ref[0] != ref[1] or isinstance(s["ref"], list)):
+                    raise ConfigError(
+                        "claim.ref",
+                        f"{where} ({s['id']}): a range needs "
+                        "[low, high], the other forms one number",
+                    )
+                if not isinstance(s.get("tol"), (int, float)) or not s["tol"] >= 0:
+                    raise ConfigError(
+                        "claim.tol", f"{where} ({s['id']}): state the deciding half-width tol >= 0"
+                    )
+            elif s["kind"] in ("prediction", "paper-check"):
+                raise ConfigError(
+                    "claim.ref",
+                    f"{where} ({s['id']}): a {s['kind']} needs the paper's number (ref)",
+                )
+            self.specs[s["id"]] = dict(s)
+        self.not_reproduced = []
+        for i, n in enumerate(not_reproduced):
+            if set(n) != {"source", "printed", "why"}:
+                raise ConfigError(
+                    "not_reproduced", f"{path}: entry {i + 1} needs exactly source, printed and why"
+                )
+            self.not_reproduced.append(dict(n))
+        self._scored: set[str] = set()
+
+    @classmethod
+    def load(cls, path: str | Path) -> "ClaimBook":
+        try:
+            with open(path, "rb") as f:
+                data = tomllib.load(f)
+        except (OSError, tomllib.TOMLDecodeError) as e:
+            raise ConfigError("claims", f"cannot read the claim book {path}: {e}") from None
+        bad = set(data) - {"claim", "not_reproduced"}
+        if bad:
+            raise ConfigError(sorted(bad)[0], f"{path}: unknown table")
+        return cls(data.get("claim", []), data.get("not_reproduced", []), str(path))
+
+    def spec(self, cid: str) -> dict:
+        if cid not in self.specs:
+            raise KeyError(f"claim {cid!r} is not declared in {self.path}")
+        return self.specs[cid]
+
+    def score(
+        self,
+        cid: str,
+        value: float | None = None,
+        ci: tuple[float, float] | None = None,
+        interval: str = "ci",
+        note: str = "",
+        *,
+        value_high: float | None = None,
+        elems: tuple[np.ndarray, np.ndarray] | None = None,
+        samples: np.ndarray | None = None,
+    ) -> dict[str, Any]:
+        """The row of claim ``cid`` from what the simulation produced.
+
+        value, ci : the estimate and its 95 % interval (``interval`` says which kind:
+            ``ci`` Monte-Carlo confidence interval, ``spread`` 2.5-97.5 % over plates,
+            ``exact`` a deterministic number; ``ci`` may then be omitted).
+        elems : ``range`` claims: per-element interval arrays ``(lo, hi)``; ``value`` and
+            ``value_high`` default to the smallest and largest element midpoints.
+        samples : ``one-plate`` claims: the statistic over simulated plates (1-D); value is
+            their median, the interval their 2.5-97.5 % spread.
+        """
+        s = self.spec(cid)
+        if cid in self._scored:
+            raise ValueError(f"claim {cid!r} scored twice")
+        self._scored.add(cid)
+        form = s.get("form", "value")
+        p_plate = math.nan
+        if samples is not None:
+            x = np.asarray(samples, float)
+            _finite(cid, x, "samples")
+            lo, med, hi = np.percentile(x, [2.5, 50, 97.5])
+            value, ci, interval = float(med), (float(lo), float(hi)), "spread"
+            if "ref" in s:
+                r = float(s["ref"])
+                q = (np.sum(x < r) + 0.5 * np.sum(x == r)) / x.size
+                p_plate = float(min(1.0, 2 * min(q, 1 - q)))
+        if elems is not None:
+            el, eh = (np.asarray(e, float) for e in elems)
+            _finite(cid, np.concatenate([el, eh]), "element intervals")
+            mid = (el + eh) / 2
+            value = float(mid.min()) if value is None else value
+            value_high = float(mid.max()) if value_high is None else value_high
+            ci = (float(el.min()), float(eh.max()))
+        if interval == "exact" and ci is None:
+            ci = (value, value)
+        if value is None or ci is None:
+            raise ValueError(f"claim {cid!r}: give value and ci (or elems / samples)")
+        if interval not in ("ci", "spread", "exact"):
+            raise ValueError(f"interval must be ci, spread or exact, not {interval!r}")
+        _finite(
+            cid, np.array([value, *ci] + ([value_high] if value_high is not None else [])), "value"
+        )
+        rlo = rhi = zlo = zhi = math.nan
+        tol = math.nan
+        outcome = None
+        if "ref" in s:
+            ref = s["ref"] if isinstance(s["ref"], list) else [s["ref"], s["ref"]]
+            rlo, rhi = float(ref[0]), float(ref[1])
+            half = 0.5 * 10.0 ** (-s["decimals"]) if "decimals" in s else 0.0
+            tol = float(s["tol"])
+            zlo, zhi = _zone(form, (rlo, rhi), half, tol)
+            rlo, rhi = rlo - half, rhi + half
+            # a one-plate claim given no plates (e.g. an exact input) is decided as a value
+            rule = "value" if form == "one-plate" and samples is None else form
+            outcome = decide(
+                rule,
+                (float(ci[0]), float(ci[1])),
+                (zlo, zhi),
+                elems=elems,
+                p_plate=p_plate if rule == "one-plate" else None,
+            )
+        verdict = _verdict(s["kind"], outcome)
+        if s["kind"] == "not comparable":
+            note = s.get("why", "") + (f" {note}" if note else "")
+        return _row(
+            s,
+            form=form if "ref" in s else "",
+            value=float(value),
+            value_high=math.nan if value_high is None else float(value_high),
+            ci=(float(ci[0]), float(ci[1])),
+            interval=interval,
+            ref=(rlo, rhi),
+            tol=tol,
+            zone=(zlo, zhi),
+            p_plate=p_plate,
+            outcome=outcome,
+            verdict=verdict,
+            note=note,
+        )
+
+    def not_comparable(self, cid: str, note: str = "") -> dict[str, Any]:
+        """The row of a ``not comparable`` claim: nothing simulated, the reason in ``note``."""
+        s = self.spec(cid)
+        if s["kind"] != "not comparable":
+            raise ValueError(f"claim {cid!r} is declared {s['kind']!r}, not 'not comparable'")
+        self._scored.add(cid)
+        ref = s.get("ref", math.nan)
+        ref = ref if isinstance(ref, list) else [ref, ref]
+        return _row(
+            s,
+            form=s.get("form", ""),
+            value=math.nan,
+            value_high=math.nan,
+            ci=(math.nan, math.nan),
+            interval="exact",
+            ref=(float(ref[0]), float(ref[1])),
+            tol=math.nan,
+            zone=(math.nan, math.nan),
+            p_plate=math.nan,
+            outcome=None,
+            verdict="not comparable",
+            note=(s.get("why", "") + " " + note).strip(),
+        )
+
+    def check_complete(self) -> None:
+        missing = [c for c in self.specs if c not in self._scored]
+        if missing:
+            raise ValueError(f"{self.path}: declared claims not scored: {', '.join(missing)}")
+
+
+def _finite(cid: str, x: np.ndarray, what: str) -> None:
+    if not np.all(np.isfinite(x)):
+        raise StudyError(
+            f"claim {cid}: the simulated {what} is not finite (NaN or infinite); "
+            "the run's configuration gives no usable number here"
+        )
+
+
+def _row(
+    s: Mapping[str, Any],
+    *,
+    form,
+    value,
+    value_high,
+    ci,
+    interval,
+    ref,
+    tol,
+    zone,
+    p_plate,
+    outcome,
+    verdict,
+    note,
+) -> dict[str, Any]:
+    return {
+        "claim": s["id"],
+        "source": s["source"],
+        "paper": s["paper"],
+        "form": form,
+        "kind": s["kind"],
+        "headline": bool(s.get("headline", False)),
+        "value": value,
+        "value_high": value_high,
+        "ci_low": ci[0],
+        "ci_high": ci[1],
+        "interval": interval,
+        "ref_low": ref[0],
+        "ref_high": ref[1],
+        "tol": tol,
+        "zone_low": zone[0],
+        "zone_high": zone[1],
+        "p_plate": p_plate,
+        "outcome": outcome,
+        "verdict": verdict,
+        "holds": _holds(verdict),
+        "note": note,
+    }
+
+
+def claim(
+    name: str,
+    source: str,
+    paper: str,
+    value: float,
+    ci: tuple[float, float],
+    kind: str,
+    note: str = "",
+    ref: tuple[float, float] | float | None = None,
+    interval: str = "ci",
+    *,
+    form: str = "value",
+    tol: float = 0.0,
+    headline: bool = False,
+) -> dict[str, Any]:
+    """One claims row without a claim book (the older interface, kept while the studies move
+    their claims into books). ``kind`` ``predicted`` means ``prediction``; ``ref`` is the
+    interval the paper's number stands for (its rounding)."""
+    kind = {"predicted": "prediction"}.get(kind, kind)
+    if ref is None and kind == "prediction":
+        kind = "finding"
+    spec: dict[str, Any] = {
+        "id": name,
+        "source": source,
+        "paper": paper,
+        "kind": kind,
+        "headline": headline,
+    }
+    if ref is not None:
+        r = [float(ref), float(ref)] if np.isscalar(ref) else [float(ref[0]), float(ref[1])]
+        spec.update(form=form, ref=r if form == "range" or r[0] != r[1] else r[0], tol=tol)
+        if form != "range" and r[0] != r[1]:  # a rounding interval: centre and decimals
+            spec.update(ref=(r[0] + r[1]) / 2, tol=tol + (r[1] - r[0]) / 2)
+    book = ClaimBook([spec], [], "<inline>")
+    return book.score(name, value, ci, interval, note)
+
+
+def rounding(x: float, decimals: int) -> tuple[float, float]:
+    """The interval a number printed with ``decimals`` decimals stands for."""
+    h = 0.5 * 10.0 ** (-decimals)
+    return (x - h, x + h)
+
+
+def write_claims(
+    path, rows: Iterable[Mapping[str, Any]], prov: Mapping[str, Any], book: ClaimBook | None = None
+):
+    """Write ``claims.parquet`` (and, with a book, ``not_reproduced.parquet`` beside it).
+    With a book, every declared claim must have been scored."""
+    rows = list(rows)
+    if book is not None:
+        book.check_complete()
+        nr = book.not_reproduced
+        write_table(
+            Path(path).with_name("not_reproduced.parquet"),
+            {c: [n[c] for n in nr] for c in NOT_REPRODUCED_COLUMNS},
+            prov,
+        )
+    cols = {c: [_null(r[c]) for r in rows] for c in CLAIM_COLUMNS}
+    return write_table(path, cols, prov)
+
+
+def _null(x):
+    """NaN marks 'no number' in a row and an infinite zone side 'unbounded' (a bound's open
+    side); Parquet stores both as null (missing), never as NaN or infinity."""
+    return None if isinstance(x, float) and not math.isfinite(x) else x

@@ -1,0 +1,2 @@
+"""Agnard, Nolette & Gagnon: a scanner, a block of independent models and its data
+snooping."""

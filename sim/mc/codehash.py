@@ -1,0 +1,135 @@
+"""Which code a study's results depend on, and whether committed results are current.
+
+A study's *code* is the closure of the ``sim`` modules its package imports (read statically
+from the parsed sources, so nothing is imported or run), plus the data files inside its package
+(the claim book). Its hash decides staleness per study: editing one study's caption re-runs
+that study only, and a fresh clone (whose file times are the checkout's) does not re-run
+anything that is current.
+
+:func:`is_current` (``STUDY_FILE``, ``RESULTS_DIR``) is true when ``RESULTS_DIR/run.json``
+records the study file's configuration and this code hash (the results are current); the
+Makefile's ``reproduce`` uses it.
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import json
+from functools import lru_cache
+from pathlib import Path
+
+__all__ = ["study_modules", "study_files", "study_code_hash", "is_current", "not_study_code"]
+
+ROOT = Path(__file__).resolve().parents[1]  # .../sim
+#: library files (paths relative to ``sim/``) that no study result depends on (the
+#: verification, which the report imports for its reproducibility section only)
+NOT_STUDY_CODE = ("report/verify.py",)
+
+
+def not_study_code(rel: str) -> bool:
+    """True for a path relative to ``sim/`` (``report/verify.py``) that :data:`NOT_STUDY_CODE`
+    names or lies inside."""
+    return any(rel == x or rel.startswith(x + "/") for x in NOT_STUDY_CODE)
+
+
+def _module_file(name: str) -> Path | None:
+    """``sim.a.b`` -> its file (module or package ``__init__``), None if not ours."""
+    parts = name.split(".")
+    if parts[0] != "sim":
+        return None
+    base = ROOT.joinpath(*parts[1:])
+    for f in (base.with_suffix(".py"), base / "__init__.py"):
+        if f.is_file():
+            return f
+    return None
+
+
+def _module_name(f: Path) -> str:
+    rel = f.relative_to(ROOT.parent).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _imports(f: Path) -> set[str]:
+    """Absolute names of the ``sim`` modules ``f`` imports (``from . import x`` included, and
+    imports inside functions): every ``import`` node of the parsed source."""
+    pkg = _module_name(f).split(".")
+    if f.name != "__init__.py":
+        pkg = pkg[:-1]
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(f.read_text(), str(f))):
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = pkg[: len(pkg) - node.level + 1] if node.level else []
+            mod = ".".join(base + (node.module.split(".") if node.module else []))
+            out.add(mod)
+            out.update(f"{mod}.{a.name}" for a in node.names)  # submodules imported by name
+    return {m for m in out if m.split(".")[0] == "sim"}
+
+
+@lru_cache(maxsize=None)
+def study_modules(module: str) -> tuple[Path, ...]:
+    """Every source file of ``sim`` that ``module`` (e.g. ``sim.studies.brown``) reaches,
+    parent packages included."""
+    seen: dict[Path, None] = {}
+    todo = [module]
+    while todo:
+        name = todo.pop()
+        parts = name.split(".")
+        for k in range(1, len(parts) + 1):  # a module imports its parent packages
+            f = _module_file(".".join(parts[:k]))
+            if f is None or f in seen or not_study_code(f.relative_to(ROOT).as_posix()):
+                continue
+            seen[f] = None
+            todo.extend(_imports(f))
+    return tuple(sorted(seen))
+
+
+def _study_module(study: str) -> str:
+    from sim.studies import MODULES
+
+    return MODULES.get(study, "sim.studies")
+
+
+def study_files(study: str) -> list[Path]:
+    """The files whose content decides the results of the study named ``study``: its code
+    closure and the data files (claim book, tables) inside its package directory."""
+    module = _study_module(study)
+    files = list(study_modules(module))
+    f0 = _module_file(module)
+    if f0 is not None and f0.name == "__init__.py":
+        files += [
+            p
+            for p in sorted(f0.parent.rglob("*"))
+            if p.is_file() and p.suffix in (".toml", ".csv", ".json")
+        ]
+    return sorted(set(files))
+
+
+@lru_cache(maxsize=None)
+def study_code_hash(study: str) -> str:
+    """sha256 (16 hex digits) of :func:`study_files` of the study named ``study``
+    (e.g. ``brown_table1``)."""
+    h = hashlib.sha256()
+    for f in study_files(study):
+        h.update(f.relative_to(ROOT).as_posix().encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def is_current(study_file: str | Path, results: str | Path) -> bool:
+    """True when ``results/run.json`` records the study file's resolved config and the
+    study's current code hash."""
+    from sim.mc.config import ConfigError, StudyError, load_study
+
+    try:
+        record = json.loads((Path(results) / "run.json").read_text())
+        _, cfg = load_study(study_file)
+    except (OSError, ValueError, ConfigError, StudyError):
+        return False
+    want = study_code_hash(cfg["study"])
+    return record.get("config") == json.loads(json.dumps(cfg)) and record.get("code_hash") == want

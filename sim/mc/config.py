@@ -1,0 +1,260 @@
+"""Study configuration: TOML files validated against a typed schema.
+
+A study file is TOML with a top-level ``study = "<name>"`` that selects the schema
+(see :mod:`sim.studies`). Every key of the schema has a type, a default, a range and
+a one-line description; unknown keys, wrong types, NaN/inf and out-of-range values
+raise :class:`ConfigError`, whose message names the dotted key. Command-line
+overrides (``--set plate.grid=6``) are parsed as TOML values and validated the same
+way. The resolved configuration is a flat ``{dotted.key: value}`` dict, stored in the
+provenance of every result file.
+
+Keys marked ``input=True`` are simulation inputs set to match a paper (for example an
+error amplitude); the report lists them so nobody mistakes them for predictions.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+__all__ = [
+    "ConfigError",
+    "StudyError",
+    "Field",
+    "load_study",
+    "parse_override",
+    "validate",
+    "check_chunks",
+]
+
+
+class ConfigError(ValueError):
+    """A bad study configuration. ``str(err)`` is one line naming the key."""
+
+    def __init__(self, key: str | None, message: str):
+        self.key = key
+        super().__init__(f"{key}: {message}" if key else message)
+
+
+class StudyError(RuntimeError):
+    """The input passed validation but the study cannot produce results from it (e.g. a
+    singular reduced normal matrix in every trial). One line, like :class:`ConfigError`."""
+
+
+@dataclass(frozen=True)
+class Field:
+    """One configuration key.
+
+    kind : "int", "float", "str", "bool", "list[float]", "list[int]",
+        "list[str]", "points" (a list of [x, y] pairs in mm) or "records" (a list of tables,
+        e.g. a network's observations; their fields are checked by the study's ``check``).
+    lo, hi : inclusive bounds for numbers (and for every element of a list).
+    lo_open : if True, ``lo`` itself is excluded (``> lo``).
+    choices : allowed values for strings (and elements of string lists).
+    min_len : minimum length of lists.
+    input : the value was set to match a paper (reported as *input*).
+    """
+
+    default: Any
+    kind: str
+    doc: str
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    choices: tuple | None = None
+    min_len: int = 0
+    input: bool = False
+    unit: str = ""
+
+
+def _num(key: str, v: Any, want_int: bool) -> float | int:
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise ConfigError(key, f"must be {'an integer' if want_int else 'a number'} (got {v!r})")
+    if want_int and not isinstance(v, int):
+        if float(v).is_integer():
+            v = int(v)
+        else:
+            raise ConfigError(key, f"must be an integer (got {v!r})")
+    if not math.isfinite(v):
+        raise ConfigError(key, f"must be finite (got {v!r})")
+    return v if want_int else float(v)
+
+
+def _bounds(key: str, f: Field, v: float) -> None:
+    if f.lo is not None:
+        if f.lo_open and not v > f.lo:
+            raise ConfigError(key, f"must be > {f.lo:g} (got {v!r})")
+        if not f.lo_open and not v >= f.lo:
+            raise ConfigError(key, f"must be >= {f.lo:g} (got {v!r})")
+    if f.hi is not None and not v <= f.hi:
+        raise ConfigError(key, f"must be <= {f.hi:g} (got {v!r})")
+
+
+def check_value(key: str, f: Field, v: Any) -> Any:
+    """Validate and normalise one value against its field; return the clean value."""
+    k = f.kind
+    if k in ("int", "float"):
+        v = _num(key, v, k == "int")
+        _bounds(key, f, v)
+        return v
+    if k == "bool":
+        if not isinstance(v, bool):
+            raise ConfigError(key, f"must be true or false (got {v!r})")
+        return v
+    if k == "str":
+        if not isinstance(v, str):
+            raise ConfigError(key, f"must be a string (got {v!r})")
+        if f.choices and v not in f.choices:
+            raise ConfigError(key, f"must be one of {', '.join(map(str, f.choices))} (got {v!r})")
+        return v
+    if k == "records":
+        if not isinstance(v, list) or not all(isinstance(e, dict) for e in v):
+            raise ConfigError(key, f"must be a list of tables {{key = value, ...}} (got {v!r:.60})")
+        if len(v) < f.min_len:
+            raise ConfigError(key, f"needs at least {f.min_len} entries (got {len(v)})")
+        return v
+    if k.startswith("list[") or k == "points":
+        if not isinstance(v, list):
+            raise ConfigError(key, f"must be a list (got {v!r})")
+        if len(v) < f.min_len:
+            raise ConfigError(key, f"needs at least {f.min_len} entries (got {len(v)})")
+        if k == "points":
+            out = []
+            for i, p in enumerate(v):
+                if not (isinstance(p, list) and len(p) == 2):
+                    raise ConfigError(key, f"entry {i} must be a pair [x, y] (got {p!r})")
+                out.append([_num(f"{key}[{i}]", c, False) for c in p])
+            return out
+        inner = k[5:-1]
+        sub = Field(None, inner, f.doc, f.lo, f.hi, f.lo_open, f.choices)
+        return [check_value(f"{key}[{i}]", sub, e) for i, e in enumerate(v)]
+    raise AssertionError(f"unknown field kind {k}")  # programming error
+
+
+def _flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, dict):
+            out.update(_flatten(v, key + "."))
+        else:
+            out[key] = v
+    return out
+
+
+def validate(
+    raw: Mapping[str, Any], schema: Mapping[str, Field], check: Callable[[dict], None] | None = None
+) -> dict[str, Any]:
+    """Resolve a flat ``{dotted: value}`` mapping against ``schema``.
+
+    Unknown keys are errors; missing keys take their defaults. ``check`` receives the
+    resolved dict for cross-key rules and raises :class:`ConfigError` itself.
+    """
+    for key in raw:
+        if key not in schema:
+            near = [s for s in schema if s.split(".")[-1] == key.split(".")[-1]]
+            hint = f" (did you mean {near[0]}?)" if near else ""
+            raise ConfigError(key, f"unknown key{hint}")
+    cfg = {}
+    for key, f in schema.items():
+        v = raw.get(key, f.default)
+        if v is None:
+            raise ConfigError(key, "is required")
+        cfg[key] = check_value(key, f, v)
+    if check is not None:
+        check(cfg)
+    return cfg
+
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """Parse ``key=value`` where value is a TOML value (bare words are strings)."""
+    if "=" not in text:
+        raise ConfigError(None, f"--set needs key=value (got {text!r})")
+    key, val = text.split("=", 1)
+    key = key.strip()
+    if not key:
+        raise ConfigError(None, f"--set needs key=value (got {text!r})")
+    try:
+        value = tomllib.loads(f"v = {val.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = val.strip()
+    return key, value
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML study file; a missing or malformed file is a ConfigError."""
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError(None, f"{p}: no such study file")
+    try:
+        with p.open("rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as e:
+        raise ConfigError(None, f"{p}: malformed TOML: {e}") from None
+    except UnicodeDecodeError:
+        raise ConfigError(None, f"{p}: not UTF-8 text") from None
+
+
+def load_study(
+    path: str | Path,
+    overrides: list[str] | tuple = (),
+    trials: int | None = None,
+    seed: int | None = None,
+    values: Mapping[str, Any] | None = None,
+):
+    """Load, override and validate a study file.
+
+    ``overrides``: ``"key=value"`` strings (values read as TOML, as ``--set``); ``values``:
+    ``{dotted.key: value}`` with Python values (the Python API).
+
+    Returns ``(study, cfg)`` where ``study`` is the registered :class:`sim.studies.Study`
+    and ``cfg`` the resolved flat configuration (including ``study``).
+    """
+    from sim.studies import get_study  # local: the registry imports the study modules
+
+    doc = read_toml(path)
+    flat = _flatten({k: v for k, v in doc.items() if k != "sweep"})  # [sweep]: sim.mc.sweep
+    name = flat.pop("study", None)
+    if name is None:
+        raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
+    study = get_study(name)
+    for text in overrides:
+        key, value = parse_override(text)
+        if key == "study":
+            raise ConfigError("study", "cannot be overridden")
+        flat[key] = value
+    for key, value in (values or {}).items():
+        if key == "study":
+            raise ConfigError("study", "cannot be overridden")
+        flat[key] = list(value) if isinstance(value, tuple) else value
+    if trials is not None:
+        flat["trials"] = trials
+    if seed is not None:
+        flat["seed"] = seed
+    cfg = validate(flat, study.schema, study.check)
+    return study, {"study": name, **cfg}
+
+
+def check_chunks(cfg: Mapping[str, Any]) -> None:
+    """A run needs at least 2 chunks: the Monte-Carlo intervals are delete-one-chunk jackknife
+    intervals, undefined for one chunk. Checked by ``sim run`` (and its sweep cells and the
+    Python API) for every study that has ``trials`` and ``chunk``."""
+    if "trials" in cfg and "chunk" in cfg and cfg["chunk"] >= cfg["trials"]:
+        raise ConfigError(
+            "chunk",
+            f"{cfg['chunk']} >= trials ({cfg['trials']}) gives one chunk; "
+            "the jackknife intervals need at least 2 chunks (make chunk smaller "
+            "than trials)",
+        )
+
+
+COMMON = {
+    "trials": Field(1000, "int", "Monte-Carlo trials", lo=2, hi=100_000_000),
+    "seed": Field(20261122, "int", "root seed of numpy.random.SeedSequence", lo=0, hi=2**63 - 1),
+    "chunk": Field(
+        1000, "int", "trials per chunk (each chunk has its own spawned stream)", lo=1, hi=1_000_000
+    ),
+}

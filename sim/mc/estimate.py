@@ -1,0 +1,343 @@
+"""Work and memory a study file asks for, estimated before the run.
+
+From the resolved configuration alone (no model code runs): the Monte-Carlo trials over all
+parts of a study (the progress bar's total), the number of least-squares adjustments, the
+unknowns of the largest adjustment and the bytes of the largest working set one chunk needs
+(times the workers that hold a chunk at once). One estimator per study kind; each is an
+order-of-magnitude model of the study's arrays (observations x unknowns x trials in a chunk,
+with a safety factor for copies), meant to stop a run that would hang or be killed for want
+of memory, not to predict its time.
+
+Limits: ``--max-memory-gb`` (env ``SIM_MAX_MEMORY_GB``, default 8 GiB: a third of a 24 GiB
+machine) and ``--max-adjustments`` (env ``SIM_MAX_ADJUSTMENTS``, default 5e8: hours on two
+cores). A run over a limit stops at once with the estimate in the message (exit 2). Sweeps are
+bounded too: at most :data:`MAX_CELLS` cells times replicates.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+from sim.mc.config import ConfigError
+from sim.mc.sweep import MAX_CELLS
+
+__all__ = [
+    "Estimate",
+    "estimate",
+    "check_limits",
+    "MAX_CELLS",
+    "DEFAULT_MAX_MEMORY_GB",
+    "DEFAULT_MAX_ADJUSTMENTS",
+]
+
+DEFAULT_MAX_MEMORY_GB = 8.0
+DEFAULT_MAX_ADJUSTMENTS = 5e8
+F8 = 8.0  # bytes of a float64
+COPIES = 6.0  # working copies of the largest array (residuals, Jacobian, ...)
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """What a run will need (orders of magnitude)."""
+
+    study: str
+    trials: int  # Monte-Carlo trials over all parts (and sweep cells)
+    adjustments: float  # least-squares adjustments (solves), every trial and part
+    unknowns: int  # unknowns of the largest adjustment
+    bytes: float  # largest working set of one chunk, bytes
+    cells: int = 1  # sweep cells x replicates
+
+    def describe(self, workers: int = 1) -> str:
+        cells = f" in {self.cells} sweep cells" if self.cells > 1 else ""
+        return (
+            f"{self.trials:,} trials{cells}, about {self.adjustments:.3g} adjustments of up "
+            f"to {self.unknowns:,} unknowns, about {_gib(self.bytes * max(workers, 1))} of "
+            "memory"
+        )
+
+
+def _gib(b: float) -> str:
+    return f"{b / 2**30:.3g} GiB" if b >= 2**27 else f"{b / 2**20:.3g} MiB"
+
+
+def _n(v: Any) -> float:
+    try:
+        return float(len(v)) if isinstance(v, (list, tuple)) else float(v)
+    except (TypeError, ValueError):
+        return 0.0
+
+
+def _max(v, default=0.0) -> float:
+    return max((float(x) for x in v), default=default) if isinstance(v, (list, tuple)) else default
+
+
+def _min(v, default=1.0) -> float:
+    return min((float(x) for x in v), default=default) if isinstance(v, (list, tuple)) else default
+
+
+def _grid_count(span: float, step: float) -> float:
+    return math.floor(abs(span) / step) + 1 if step > 0 else math.inf
+
+
+# ---- one estimator per study kind: (trials, adjustments, unknowns, bytes) -------------------
+
+
+def _brown(c: Mapping) -> tuple:
+    pat = c.get("plate.pattern", "grid")
+    n = (
+        c.get("plate.grid", 5) ** 2
+        if pat == "grid"
+        else c.get("plate.n_random", 25)
+        if pat == "random"
+        else max(len(c.get("plate.points", [])), 1)
+    )
+    T, ch = c["trials"], min(c["chunk"], c["trials"])
+    U = 2 * n + 7
+    per = 3 * (2 if "checks.bias_shift_um" in c else 1)
+    grids = c.get("dilution.grids", [])
+    n_an = max([n] + [g * g for g in grids])
+    analytic = 3 * (
+        len(grids) + _n(c.get("dilution.offsets_mm", [])) + _n(c.get("dilution.extents_mm", []))
+    )
+    b = max(ch * 4 * n * U * F8, 4 * n_an * 7 * F8 * 3) * COPIES
+    return T, T * per + analytic, max(U, 2 * n_an + 7), b
+
+
+def _design(c: Mapping) -> tuple:
+    lists = [
+        c.get(f"design.{k}", [1])
+        for k in (
+            "positions",
+            "offsets_mm",
+            "grids",
+            "extents_mm",
+            "settings",
+            "setting_sigma_um",
+            "beta_mm",
+        )
+    ]
+    cells = math.prod(max(len(v), 1) for v in lists)
+    P, G = _max(c.get("design.positions"), 4), _max(c.get("design.grids"), 5)
+    n = G * G
+    U = 2 * n + 7
+    T, ch = c["trials"], min(c["chunk"], c["trials"])
+    cov_T = c.get("coverage.trials", 0)
+    sw_T = c.get("coverage.sweep_trials", 0) * (
+        _n(c.get("coverage.noise_um", []))
+        + _n(c.get("coverage.grids", []))
+        + _n(c.get("coverage.betas_mm", []))
+    )
+    budget = 6 * c.get("budget.max_trials", 0)
+    bayes = c.get("bayes.walkers", 0) * c.get("bayes.steps", 0) * 2
+    trials = T + cov_T + sw_T + budget
+    adj = cells * 3 + T * 3 + cov_T * 2 + sw_T * 2 + budget + bayes
+    nc = max(_max(c.get("coverage.grids"), 5) ** 2, c.get("datum.grid", 5) ** 2, n)
+    b = ch * P * nc * (2 * nc + 7) * F8 * COPIES
+    return trials, adj, max(U, 2 * int(nc) + 7), b
+
+
+def _gridplate(c: Mapping) -> tuple:
+    N = c.get("plate.grid", 5) ** 2
+    P, L = c.get("plate.count", 2), c.get("readings.count", 4)
+    T, ch = c["trials"], min(c["chunk"], c["trials"])
+    per = 3 + _n(c.get("analysis.ratios", [])) + _n(c.get("analysis.stated_sigmas_um", []))
+    U = 2 * N + 3
+    b = ch * (P * N * L * 2 + P * N * 2 * 4 * 3) * F8 * COPIES * 4
+    return T, T * per, U, b
+
+
+def _salsig(c: Mapping) -> tuple:
+    T, ch = c["trials"], min(c["chunk"], c["trials"])
+    marks = c.get("marks.grid", 5) ** 2
+    grid = c.get("grid.points", 5) ** 2
+    pm = _max(c.get("power.marks"), 5) ** 2
+    cells = _n(c.get("power.marks", [])) * _n(c.get("power.sigma_um", []))
+    pT = c.get("power.trials", 0)
+    relief = _n(c.get("vertical.relief_sweep_mm", [])) * min(T, 5000) + c.get(
+        "consistency.trials", 0
+    ) * sum(_n(v) for k, v in c.items() if k.startswith("consistency.") and isinstance(v, list))
+    trials = 3 * T + cells * pT + relief
+    adj = 6 * T + 3 * cells * pT + 2 * relief
+    n = max(marks, grid, pm, c.get("zscale.points", 9), c.get("vertical.control", 6) ** 2)
+    b = ch * n * 2 * 6 * F8 * COPIES * 4
+    return trials, adj, 7, b
+
+
+def _wolf(c: Mapping) -> tuple:
+    T, ch = c["trials"], min(c["chunk"], c["trials"])
+    area = c.get("plate.area_mm", [-100.0, 100.0, -40.0, 60.0])
+    ax = area[1] - area[0] if len(area) >= 4 else 200.0
+    ay = area[3] - area[2] if len(area) >= 4 else 100.0
+
+    def points(sp: float) -> float:
+        return _grid_count(ax, sp) * _grid_count(ay, sp)
+
+    d = c.get("calib.degree", 3)
+    U = (d + 1) * (d + 2)
+    sets, rd = c.get("calib.n_sets", 3), c.get("reading.n", 3)
+    n = points(c.get("plate.spacing_mm", 20.0))
+    chk = max(
+        c.get("check.n_points", 0), c.get("repeat.n_points", 0), c.get("trade.check_points", 0)
+    )
+    Tt, cht = c.get("trade.trials", 0), min(c.get("trade.trials", 1) or 1, ch)
+    dmax = _max(c.get("trade.degrees"), d)
+    Ut = int((dmax + 1) * (dmax + 2))
+    nt = points(_min(c.get("trade.spacings_mm"), c.get("plate.spacing_mm", 20.0)))
+    nsets = _max(c.get("trade.n_sets"), sets)
+    deg_cells = (
+        _n(c.get("trade.spacings_mm", []))
+        * _n(c.get("trade.n_sets", []))
+        * _n(c.get("trade.degrees", []))
+    )
+    rd_cells = 2 * _n(c.get("trade.pointing_sigmas_um", [])) * _n(c.get("trade.readings", []))
+    ages = _n(c.get("trade.ages_weeks", [])) * _n(c.get("trade.drift_fractions", []))
+    # the unprinted inputs: every swept value re-reduces the same simulated instruments
+    Tu = c.get("unprinted.trials", 0)
+    u_cells = sum(
+        _n(c.get(f"unprinted.{k}", []))
+        for k in (
+            "pointing_sigmas_um",
+            "field_scales",
+            "restitutions_um",
+            "drift_fractions",
+            "mono_sigmas_um",
+        )
+    )
+    trials = T + Tt * (_n(c.get("trade.spacings_mm", [])) + rd_cells + 1) + Tu
+    adj = (
+        T * (sets + 2) + Tt * (deg_cells + rd_cells * (sets + 2) + ages) + Tu * u_cells * (sets + 2)
+    )
+    b = (
+        max(
+            ch * (n * sets * rd * 2 + n * U) * F8,
+            cht * nt * nsets * (2 + Ut) * F8,
+            ch * chk * U * F8,
+            cht * (n * _max(c.get("trade.readings"), rd) * 2) * F8,
+        )
+        * COPIES
+    )
+    return trials, adj, max(U, Ut), b
+
+
+def _agnard(c: Mapping) -> tuple:
+    T, ch = c["trials"], min(c["chunk"], c["trials"])
+    M = c.get("block.strips", 2) * c.get("block.models", 8)
+    pts = c.get("block.ground_points", 178) + M * c.get("block.pass_rows", 4) * 3
+    U = 7 * M + 3 * pts
+    fmt, g = c.get("block.format_mm", 230.0), c.get("scan.grid_mm", 10.0)
+    scan_nodes = _grid_count(fmt, g) ** 2
+    sizes = list(zip(c.get("tradeoff.block_strips", []), c.get("tradeoff.block_models", [])))
+    Mt = max([S * Mo for S, Mo in sizes] + [M])
+    pts_t = pts * Mt / max(M, 1)
+    Ut = 7 * Mt + 3 * pts_t
+    layouts = _n(c.get("tradeoff.layouts", []))
+    tT, bT = c.get("tradeoff.trials", 0), c.get("tradeoff.block_trials", 0)
+    dp, rc = _n(c.get("tradeoff.dpis", [])), _n(c.get("tradeoff.recentre_px", []))
+    sT, s_cells = c.get("sweep.trials", 0), _n(c.get("sweep.five_inset", []))  # swept layout
+    trials = T + tT * (dp + rc) + bT * len(sizes) + sT * s_cells
+    snoop = 1 + c.get("snoop.max_reject", 0)
+    adj = (
+        T * (3 + layouts) * snoop
+        + tT * (2 * dp + rc) * snoop
+        + bT * len(sizes) * 2
+        + sT * s_cells * 3 * snoop
+    )
+    # reduced normal equations of the models (7 x 7 blocks coupled through the points); the
+    # block-size trade-off bounds its chunk by the pair blocks (4e6 floats)
+    npair = Mt * 40.0
+    ch_t = max(1.0, min(ch, bT or 1, 4e6 // (49 * npair)))
+    b = max(
+        COPIES * max(ch * (7 * M) ** 2 * F8, ch * scan_nodes * 2 * F8, ch * pts * M * 6 * F8),
+        2 * (ch_t * (7 * Mt) ** 2 * F8 + 4e6 * F8),
+    )
+    return trials, adj, int(max(U, Ut)), b
+
+
+def _generic(c: Mapping) -> tuple:
+    T, ch = c.get("trials", 1), min(c.get("chunk", 1), c.get("trials", 1))
+    return T, T, 0, ch * 1e4
+
+
+ESTIMATORS: dict[str, Callable[[Mapping], tuple]] = {
+    "brown_dilution": _brown,
+    "brown_table1": _brown,
+    "brown_design": _design,
+    "gridplate_two_plates": _gridplate,
+    "salsig_encoders": _salsig,
+    "wolf_polynomial": _wolf,
+    "agnard_block": _agnard,
+}
+
+
+def _one(cfg: Mapping) -> tuple:
+    fn = ESTIMATORS.get(cfg.get("study"), _generic)
+    try:
+        t, a, u, b = fn(cfg)
+    except (TypeError, ValueError, KeyError, OverflowError, ZeroDivisionError):
+        t, a, u, b = _generic(cfg)
+    fix = lambda x: x if isinstance(x, (int, float)) and not math.isnan(x) else math.inf  # noqa: E731
+    return fix(t), fix(a), fix(u), fix(b)
+
+
+def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> Estimate:
+    """The estimate of a run of ``cfg`` (and of every cell of its ``[sweep]`` table)."""
+    cfgs = [cfg]
+    reps = 1
+    if sweep:
+        from sim.mc.sweep import expand
+
+        _, cells, reps, _ = expand(sweep)
+        cfgs = [{**cfg, **cell} for cell in cells]
+    parts = [_one(c) for c in cfgs]
+    T = sum(p[0] for p in parts) * reps
+    A = sum(p[1] for p in parts) * reps
+    U = max(p[2] for p in parts)
+    B = max(p[3] for p in parts)
+    big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
+    return Estimate(str(cfg.get("study")), big(T), float(A), big(U), float(B), len(cfgs) * reps)
+
+
+def _limit(given: float | None, env: str, default: float, key: str) -> float:
+    if given is None:
+        txt = os.environ.get(env)
+        if txt is None or not txt.strip():
+            return default
+        try:
+            given = float(txt)
+        except ValueError:
+            raise ConfigError(env, f"must be a number (got {txt!r})") from None
+        key = env
+    if not math.isfinite(given) or given <= 0:
+        raise ConfigError(key, f"must be a positive number (got {given!r})")
+    return given
+
+
+def check_limits(
+    est: Estimate,
+    max_memory_gb: float | None = None,
+    max_adjustments: float | None = None,
+    workers: int = 1,
+) -> None:
+    """Stop (ConfigError, one line with the estimate) a run over the memory or work limit."""
+    mem = _limit(max_memory_gb, "SIM_MAX_MEMORY_GB", DEFAULT_MAX_MEMORY_GB, "--max-memory-gb")
+    adj = _limit(
+        max_adjustments, "SIM_MAX_ADJUSTMENTS", DEFAULT_MAX_ADJUSTMENTS, "--max-adjustments"
+    )
+    need = est.bytes * max(workers, 1)
+    if not need <= mem * 2**30:
+        raise ConfigError(
+            None,
+            f"{est.study}: the run needs {est.describe(workers)}, over the "
+            f"{mem:g} GiB limit (--max-memory-gb or SIM_MAX_MEMORY_GB); reduce "
+            "chunk, trials or the sizes in the study file",
+        )
+    if not est.adjustments <= adj:
+        raise ConfigError(
+            None,
+            f"{est.study}: the run needs {est.describe(workers)}, over the "
+            f"limit of {adj:.3g} adjustments (--max-adjustments or "
+            "SIM_MAX_ADJUSTMENTS); reduce trials or the lists in the study file",
+        )

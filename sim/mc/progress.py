@@ -1,0 +1,68 @@
+"""The progress bar (tqdm): trials done, trials per second, time left.
+
+Drawn on standard error only when it is a terminal (and not ``quiet``); silent otherwise,
+so logs and CI output stay clean. A run shares one bar over all its parts (see
+:class:`sim.studies.RunContext`), whose total comes from the run's estimate
+(:mod:`sim.mc.estimate`).
+"""
+
+from __future__ import annotations
+
+import sys
+
+from tqdm import tqdm
+
+__all__ = ["Progress"]
+
+_FORMAT = (
+    "{desc} {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} trials "
+    "[{elapsed}<{remaining}, {rate_fmt}{postfix}]"
+)
+
+
+class Progress:
+    """``with Progress(total, label) as p: p.update(n)``; ``chunks`` > 0 adds ``chunk i/N``."""
+
+    def __init__(
+        self,
+        total: int,
+        label: str = "",
+        quiet: bool = False,
+        stream=None,
+        min_interval: float = 0.2,
+        chunks: int = 0,
+    ):
+        self.total = int(total)
+        self.chunks = int(chunks)
+        self.chunks_done = 0
+        self.done = 0
+        stream = stream if stream is not None else sys.stderr
+        self.enabled = not quiet and hasattr(stream, "isatty") and stream.isatty()
+        self.bar = tqdm(
+            total=self.total,
+            desc=label,
+            file=stream,
+            disable=not self.enabled,
+            mininterval=min_interval,
+            unit=" trials",
+            bar_format=_FORMAT,
+            leave=False,
+            dynamic_ncols=True,
+        )
+
+    def __enter__(self) -> "Progress":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.bar.close()
+
+    def update(self, n: int, chunks: int = 0) -> None:
+        self.done += int(n)
+        self.chunks_done += int(chunks)
+        if not self.enabled:
+            return
+        if self.done > self.bar.total:  # an estimate that was short: grow, never overflow
+            self.bar.total = self.done
+        if self.chunks:
+            self.bar.set_postfix_str(f"chunk {self.chunks_done}/{self.chunks}", refresh=False)
+        self.bar.update(int(n))

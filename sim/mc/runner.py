@@ -1,0 +1,349 @@
+"""Monte-Carlo runner: trials in chunks, one spawned random stream per chunk.
+
+Chunk ``k`` of stream ``part`` draws from
+``numpy.random.SeedSequence(seed, spawn_key=(part, k))`` -- the same stream that
+``SeedSequence(seed).spawn(part + 1)[part].spawn(k + 1)[k]`` gives -- so a result does not
+depend on how many workers run the chunks, in which order, or on which machine; only
+``seed``, ``part`` and the chunk size fix it.
+
+A chunk function ``fn(rng, n)`` returns a dict of arrays:
+
+* ``rows.<name>``: one value per trial (1-D, length ``n``): per-trial rows. They are
+  written to the chunk's file and *not* kept in memory (unless ``keep_rows``), so the
+  memory of a run does not grow with the number of trials.
+* any other key: kept and concatenated along axis 0 over the chunks -- per-trial scalars
+  (leading axis ``n``) or per-chunk statistics such as sums (leading axis 1).
+
+With a :class:`ChunkStore` each finished chunk is written atomically (temporary file, then
+rename) to ``<dir>/part-<p>/chunk-<k>.parquet``; a run that was killed and started again
+loads the finished chunks and computes only the missing ones.
+
+Executors (:func:`make_executor`): in-process (default), a local process pool
+(``workers > 1``), or a ``dask.distributed`` client. The output is bit-for-bit the same.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import pickle
+import signal
+import sys
+import threading
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Mapping
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from sim.lsq import distributions as D
+from sim.mc.progress import Progress
+from sim.mc.storage import atomic_path
+
+__all__ = ["chunk_rng", "run_chunks", "ChunkStore", "make_executor", "jackknife", "require_finite"]
+
+ROWS = "rows."
+_ARRAYS = b"sim.arrays"
+
+
+def chunk_rng(seed: int, part: int, k: int) -> np.random.Generator:
+    """The generator of chunk ``k`` of stream ``part``."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(part, k)))
+
+
+def require_finite(name: str, array, part: str, key: str | None = None) -> np.ndarray:
+    """``array`` as a float array, or :class:`sim.mc.config.StudyError` (one line naming the study
+    ``part``, the quantity ``name`` and, when given, the config ``key`` to change) if any entry
+    is NaN or infinite. Study code calls it where a number is required (NaN that stands for
+    "missing" must not go through it)."""
+    from sim.mc.config import StudyError
+
+    a = np.asarray(array, float)
+    bad = ~np.isfinite(a)
+    if bad.any():
+        hint = f"; change {key}" if key else ""
+        raise StudyError(
+            f"{part}: {name} is not finite ({int(bad.sum())} of {a.size} values "
+            f"NaN or infinite){hint}"
+        )
+    return a
+
+
+def _call_chunk(fn, seed: int, part: int, k: int, n: int) -> dict:
+    out = fn(chunk_rng(seed, part, k), n)
+    return {key: np.asarray(v) for key, v in out.items()}
+
+
+@dataclass(frozen=True)
+class ChunkStore:
+    """A directory of finished chunks: ``<root>/part-<p>/chunk-<k>.parquet``.
+
+    ``prov``: provenance written into every chunk file's metadata (``sim.provenance``).
+    """
+
+    root: Path
+    prov: dict | None = None
+
+    def path(self, part: int, k: int) -> Path:
+        return Path(self.root) / f"part-{part}" / f"chunk-{k:06d}.parquet"
+
+    def save(self, part: int, k: int, n: int, data: Mapping[str, np.ndarray]) -> None:
+        rows = {key[len(ROWS) :]: v for key, v in data.items() if key.startswith(ROWS)}
+        kept = {key: v for key, v in data.items() if not key.startswith(ROWS)}
+        buf = io.BytesIO()
+        np.savez(buf, **kept)
+        table = pa.table(
+            {
+                "chunk": np.full(n, k, np.int32),
+                "trial_in_chunk": np.arange(n, dtype=np.int32),
+                **rows,
+            }
+        )
+        meta = {_ARRAYS: buf.getvalue(), b"n": str(n).encode()}
+        if self.prov is not None:
+            meta[b"sim.provenance"] = json.dumps(
+                {**self.prov, "chunk": k, "part": part, "spawn_key": [part, k]}, sort_keys=True
+            ).encode()
+        table = table.replace_schema_metadata(meta)
+        with atomic_path(self.path(part, k)) as tmp:
+            pq.write_table(table, tmp)
+
+    def load(self, part: int, k: int, keep_rows: bool = False) -> dict | None:
+        p = self.path(part, k)
+        if not p.is_file():
+            return None
+        try:
+            table = pq.read_table(p)
+            meta = table.schema.metadata
+            with np.load(io.BytesIO(meta[_ARRAYS])) as z:
+                out = {key: z[key] for key in z.files}
+        except (OSError, KeyError, ValueError, pa.ArrowInvalid):
+            return None  # unreadable: recompute it
+        if keep_rows:
+            for name in table.column_names:
+                if name not in ("chunk", "trial_in_chunk"):
+                    out[ROWS + name] = table.column(name).to_numpy()
+        return out
+
+
+class _InProcess:
+    """Runs chunks one after another in this process."""
+
+    def run(self, fn, seed, part, jobs):
+        for k, n in jobs:
+            yield k, n, _call_chunk(fn, seed, part, k, n)
+
+    def close(self, kill: bool = False):
+        pass
+
+
+def _watch_parent(ppid: int) -> None:
+    import time
+
+    while True:
+        if os.getppid() != ppid:
+            os._exit(1)
+        time.sleep(0.5)
+
+
+def _worker_init(ppid: int) -> None:
+    """In each pool worker: ignore SIGINT (the parent handles Ctrl-C and stops the pool) and
+    die with the parent, even after ``kill -9`` (PR_SET_PDEATHSIG on Linux; a thread that
+    watches the parent everywhere)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != ppid:  # the parent died before we got here
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(ppid,), daemon=True).start()
+
+
+class _Pool:
+    """A local process pool (``concurrent.futures``); its workers die with the parent."""
+
+    def __init__(self, workers: int):
+        self.pool = ProcessPoolExecutor(
+            max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),)
+        )
+
+    def run(self, fn, seed, part, jobs):
+        futs = {self.pool.submit(_call_chunk, fn, seed, part, k, n): (k, n) for k, n in jobs}
+        for f in as_completed(futs):
+            k, n = futs[f]
+            yield k, n, f.result()
+
+    def close(self, kill: bool = False):
+        """Stop the pool; ``kill``: terminate running workers at once (interrupt, failure)."""
+        if kill:
+            procs = list((getattr(self.pool, "_processes", None) or {}).values())
+            for p in procs:
+                try:
+                    p.kill()
+                except (OSError, AttributeError):
+                    pass
+            for p in procs:
+                p.join(5)
+        self.pool.shutdown(wait=True, cancel_futures=True)
+
+
+class _Dask:
+    """A ``dask.distributed`` client: a given scheduler, or a LocalCluster for the run."""
+
+    def __init__(self, workers: int, scheduler: str | None):
+        try:
+            from dask.distributed import Client, LocalCluster
+            from dask.distributed import as_completed as dask_completed
+        except ImportError:
+            raise RuntimeError(
+                "the dask executor needs dask[distributed]: pip install -e '.[dask]'"
+            ) from None
+        self._completed = dask_completed
+        self.cluster = None
+        if scheduler:
+            self.client = Client(scheduler, timeout="10s")
+        else:
+            self.cluster = LocalCluster(
+                n_workers=max(workers, 1),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+            )
+            self.client = Client(self.cluster)
+
+    def run(self, fn, seed, part, jobs):
+        futs = {}  # the chunk function is small: send it with each task (no scatter)
+        for k, n in jobs:
+            futs[self.client.submit(_call_chunk, fn, seed, part, k, n, pure=False)] = (k, n)
+        for f in self._completed(list(futs)):
+            k, n = futs[f]
+            yield k, n, f.result()
+
+    def close(self, kill: bool = False):
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def make_executor(kind: str = "local", workers: int = 1, scheduler: str | None = None):
+    """``local`` (in-process when ``workers == 1``, else a process pool) or ``dask``."""
+    if kind == "local":
+        return _InProcess() if workers <= 1 else _Pool(workers)
+    if kind == "dask":
+        return _Dask(workers, scheduler)
+    raise ValueError(f"unknown executor {kind!r} (local or dask)")
+
+
+def _picklable(fn) -> bool:
+    try:
+        pickle.dumps(fn)
+        return True
+    except Exception:  # noqa: BLE001 - any pickling failure means: run in-process
+        return False
+
+
+class _Shared:
+    """The run's shared bar, used by one :func:`run_chunks` call (it is not closed here)."""
+
+    def __init__(self, bar):
+        self.bar = bar
+
+    def __enter__(self):
+        return self.bar
+
+    def __exit__(self, *exc):
+        return None
+
+
+def run_chunks(
+    fn: Callable[[np.random.Generator, int], Mapping[str, np.ndarray]],
+    trials: int,
+    seed: int,
+    chunk: int,
+    part: int = 0,
+    label: str = "",
+    quiet: bool = False,
+    ctx=None,
+    keep_rows: bool = False,
+) -> dict[str, np.ndarray]:
+    """Run ``fn(rng, n)`` over chunks of at most ``chunk`` trials and concatenate.
+
+    ``ctx`` (a :class:`sim.studies.RunContext`) supplies the executor and the chunk store;
+    without it the chunks run in this process and nothing is stored. Returns the kept arrays
+    concatenated over chunks in chunk order (``rows.*`` only with ``keep_rows``).
+    """
+    if trials < 1:
+        raise ValueError("trials must be >= 1")
+    sizes = [min(chunk, trials - s) for s in range(0, trials, chunk)]
+    store = getattr(ctx, "store", None)
+    executor = getattr(ctx, "executor", None)
+    quiet = quiet or getattr(ctx, "quiet", False)
+    results: dict[int, dict] = {}
+    todo = []
+    for k, n in enumerate(sizes):
+        got = store.load(part, k, keep_rows) if store is not None else None
+        if got is not None:
+            results[k] = got
+        else:
+            todo.append((k, n))
+    if executor is None or (not isinstance(executor, _InProcess) and not _picklable(fn)):
+        if executor is not None and not isinstance(executor, _InProcess):
+            print(
+                f"sim: note: {label or 'this study'} runs in-process (its chunk function "
+                "cannot be sent to workers)",
+                file=sys.stderr,
+            )
+        executor = _InProcess()
+    done_trials = sum(sizes[k] for k in results)
+    shared = getattr(ctx, "bar", None)
+    with (
+        _Shared(shared)
+        if shared is not None
+        else Progress(trials, label, quiet=quiet, chunks=len(sizes))
+    ) as bar:
+        bar.update(done_trials, len(results))
+        for k, n, out in executor.run(fn, seed, part, todo):
+            if store is not None:
+                store.save(part, k, n, out)
+            if not keep_rows:
+                out = {key: v for key, v in out.items() if not key.startswith(ROWS)}
+            results[k] = out
+            bar.update(n, 1)
+    keys = results[0].keys() if results else []
+    return {
+        key: np.concatenate([results[k][key] for k in range(len(sizes))], axis=0) for key in keys
+    }
+
+
+def jackknife(stat: Callable[[np.ndarray], np.ndarray], sums: np.ndarray, level: float = 0.95):
+    """Delete-one-chunk jackknife for a smooth function of per-chunk sums.
+
+    sums : (C, ...) per-chunk sufficient statistics (C >= 2, else StudyError); ``stat`` maps the total
+    (shape ``sums.shape[1:]``) to an estimate (scalar or array). Returns
+    ``(estimate, lo, hi)`` with a Student-t interval (C - 1 degrees of freedom) from the
+    jackknife standard error.
+    Streaming-friendly: memory grows with the number of chunks, not of trials.
+    """
+    sums = np.asarray(sums, float)
+    C = sums.shape[0]
+    total = sums.sum(axis=0)
+    est = np.asarray(stat(total), float)
+    if C < 2:
+        from sim.mc.config import StudyError
+
+        raise StudyError(
+            "the jackknife interval needs at least 2 chunks (make chunk smaller than trials)"
+        )
+    loo = np.stack([np.asarray(stat(total - sums[c]), float) for c in range(C)])
+    se = np.sqrt((C - 1) / C * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
+    z = D.t_ppf(0.5 + level / 2, C - 1)
+    return est, est - z * se, est + z * se

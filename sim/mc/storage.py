@@ -1,0 +1,288 @@
+"""Parquet result files with provenance, written atomically.
+
+Every file carries, in its schema metadata under ``sim.provenance``, a JSON object with
+the resolved study configuration, the root seed, package versions and the git commit
+of the code that produced it. Writes go to a temporary file in the same directory and
+are renamed into place, so a reader never sees a half-written file. No timestamps are
+stored, so the same code and config give byte-identical files.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from functools import lru_cache
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from sim.mc.codehash import NOT_STUDY_CODE, not_study_code  # code no study result depends on
+
+__all__ = [
+    "provenance",
+    "write_table",
+    "read_table",
+    "read_provenance",
+    "atomic_path",
+    "read_record",
+    "StageLock",
+    "NonFiniteError",
+]
+
+_KEY = b"sim.provenance"
+
+
+@lru_cache(maxsize=None)
+def git_commit(study: str | None = None) -> str:
+    """The last commit that changed the code or definition of ``study`` (its modules, see
+    :mod:`sim.mc.codehash`, its study file and ``pyproject.toml``; without a study: all of
+    ``sim/`` but the benchmark, and ``studies/``), ``-dirty`` if they have uncommitted changes.
+    A commit of results, or of another study's code, does not change it, so re-running gives
+    byte-identical files."""
+    root = Path(__file__).resolve().parents[2]
+    if study is None:
+        paths = [
+            "sim",
+            "studies",
+            "pyproject.toml",
+            *(f":(exclude)sim/{f}" for f in NOT_STUDY_CODE),
+        ]
+    else:
+        from sim.mc.codehash import study_files
+
+        paths = [p.relative_to(root).as_posix() for p in study_files(study)]
+        paths += [f"studies/{study}.toml", "pyproject.toml"]
+    try:
+        head = subprocess.run(
+            ["git", "log", "-1", "--format=%H", "--", *paths],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=10,
+        )
+        if head.returncode != 0 or not head.stdout.strip():
+            return "unknown"
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--", *paths],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=10,
+        ).stdout.strip()
+        return head.stdout.strip() + ("-dirty" if dirty else "")
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def code_hash(study: str | None = None) -> str:
+    """sha256 of the code ``study`` depends on (:func:`sim.mc.codehash.study_code_hash`), or,
+    without a study, of the library's source (every ``sim/**/*.py`` but the benchmark)."""
+    import hashlib
+
+    if study is not None:
+        from sim.mc.codehash import study_code_hash
+
+        return study_code_hash(study)
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        if not_study_code(f.relative_to(root).as_posix()):
+            continue
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def versions() -> dict[str, str]:
+    """Versions of Python and of every package a result can depend on (``not installed`` for
+    the optional ones: without numba the NumPy engine runs)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {"python": sys.version.split()[0]}
+    for pkg in ("numpy", "scipy", "pyarrow", "matplotlib", "emcee", "numba", "tqdm"):
+        try:
+            out[pkg] = version(pkg)
+        except PackageNotFoundError:
+            out[pkg] = "not installed"
+    return out
+
+
+def provenance(cfg: Mapping[str, Any], **extra: Any) -> dict[str, Any]:
+    """Provenance record for a run: resolved config, seed, versions, git commit."""
+    return {
+        "study": cfg.get("study"),
+        "config": dict(cfg),
+        "seed": cfg.get("seed"),
+        "versions": versions(),
+        "git_commit": git_commit(cfg.get("study")),
+        "code_hash": code_hash(cfg.get("study")),
+        **extra,
+    }
+
+
+def _jsonable(o: Any) -> Any:
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, Path):
+        return str(o)
+    raise TypeError(f"not JSON serialisable: {type(o)}")
+
+
+class atomic_path:
+    """Context manager yielding a temporary path that is renamed to ``path`` on success."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
+
+    def __enter__(self) -> Path:
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        return self.tmp
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            os.replace(self.tmp, self.path)
+        else:
+            self.tmp.unlink(missing_ok=True)
+
+
+class NonFiniteError(ValueError):
+    """A statistic that must be a number is NaN or infinite (one line naming the table and
+    column)."""
+
+
+#: columns of a claims table that must hold finite numbers (a NaN reference is "no number")
+CLAIM_NUMBERS = ("value", "ci_low", "ci_high")
+
+
+def check_finite_table(name: str, table: pa.Table) -> None:
+    """No float column may hold +-inf (NaN may mean "missing"), and a claims table's value and
+    interval must be finite: a non-finite verdict is an error, never a result (a null, e.g. in
+    a ``not comparable`` row, is "no number" and allowed)."""
+    is_claims = {"claim", *CLAIM_NUMBERS} <= set(table.column_names)
+    for col, arr in zip(table.column_names, table.columns):
+        if not pa.types.is_floating(arr.type):
+            continue
+        v = arr.to_numpy(zero_copy_only=False).astype(float)
+        valid = np.asarray(arr.is_valid())  # a null is "no number" (a not-comparable claim)
+        bad = np.isinf(v) | (np.isnan(v) & valid if is_claims and col in CLAIM_NUMBERS else False)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            what = f" (claim {table.column('claim')[i].as_py()})" if is_claims else f" (row {i})"
+            raise NonFiniteError(
+                f"{name}: column {col} is {v[i]}{what}: a statistic that must "
+                "be a number is not finite"
+            )
+
+
+def write_table(
+    path: str | Path, columns: Mapping[str, Any] | pa.Table, prov: Mapping[str, Any]
+) -> Path:
+    """Write ``columns`` (name -> 1-D array/list, or a pyarrow Table) to Parquet.
+
+    Raises :class:`NonFiniteError` (nothing written) for an infinite value in a float column
+    or a non-finite claim value or interval (see :func:`check_finite_table`)."""
+    table = (
+        columns
+        if isinstance(columns, pa.Table)
+        else pa.table(
+            {k: (np.asarray(v) if not isinstance(v, list) else v) for k, v in columns.items()}
+        )
+    )
+    check_finite_table(Path(path).name, table)
+    meta = dict(table.schema.metadata or {})
+    meta[_KEY] = json.dumps(prov, sort_keys=True, default=_jsonable).encode()
+    table = table.replace_schema_metadata(meta)
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp, compression="zstd")
+    return Path(path)
+
+
+def read_table(path: str | Path) -> pa.Table:
+    return pq.read_table(path)
+
+
+def read_provenance(path: str | Path) -> dict[str, Any]:
+    meta = pq.read_schema(path).metadata or {}
+    return json.loads(meta.get(_KEY, b"{}"))
+
+
+# --- the output directory: what the suite wrote, and who is writing it -----------------------
+
+RECORD = "run.json"
+LOCK = ".lock"
+
+
+def read_record(d: str | Path) -> dict | None:
+    """The run record (``run.json``) of a directory the suite wrote, or None (none, or not one
+    of ours)."""
+    try:
+        rec = json.loads((Path(d) / RECORD).read_text())
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+    return rec if isinstance(rec, dict) and "config" in rec and "code_hash" in rec else None
+
+
+def write_record(d: str | Path, record: Mapping[str, Any]) -> None:
+    """Write ``run.json`` atomically."""
+    with atomic_path(Path(d) / RECORD) as tmp:
+        tmp.write_text(json.dumps(record, sort_keys=True, indent=1, default=_jsonable))
+
+
+class Locked(RuntimeError):
+    """Another live process holds the lock; ``pid`` is its process id (or None)."""
+
+    def __init__(self, pid: int | None):
+        self.pid = pid
+        super().__init__(f"locked by pid {pid}")
+
+
+class StageLock:
+    """An exclusive ``flock`` on ``<stage>/.lock`` for the life of a run.
+
+    The kernel drops the lock when the process dies (even ``kill -9``), so a stale lock file
+    never blocks a later run. The holder's pid is written into the file for the message a
+    second run prints.
+    """
+
+    def __init__(self, stage: str | Path):
+        self.stage = Path(stage)
+        self.fd: int | None = None
+        self.created = False
+
+    def acquire(self) -> "StageLock":
+        import fcntl
+
+        self.created = not self.stage.exists()
+        self.stage.mkdir(parents=True, exist_ok=True)
+        fd = os.open(self.stage / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            try:
+                pid = int(os.read(fd, 32).decode().strip() or 0) or None
+            except (OSError, ValueError):
+                pid = None
+            os.close(fd)
+            raise Locked(pid) from None
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+        self.fd = fd
+        return self
+
+    def release(self, unlink: Path | None = None) -> None:
+        """Drop the lock; ``unlink``: the lock file's current path, removed first (a finished
+        run's lock file must not stay in its results)."""
+        if self.fd is None:
+            return
+        if unlink is not None:
+            (Path(unlink) / LOCK).unlink(missing_ok=True)
+        os.close(self.fd)  # closing the descriptor releases the flock
+        self.fd = None

@@ -1,0 +1,387 @@
+"""Sweeps as data: parameter grids over any study's configuration, and adaptive trial counts.
+
+A study file may declare a ``[sweep]`` table whose entries are config keys (dotted, or as
+nested tables) with a list of values, or a range given as an inline table
+``{start = a, stop = b, num = k}`` (``k`` values, ``linspace``) or ``{start, stop, step}``
+(``stop`` included when it falls on the step). The cells are the Cartesian product in the
+order the keys are written. Two reserved entries:
+
+The rows are drawn by :func:`fig_sweep` (``sweep.png``: every claim against the first
+swept key) and tabulated by :func:`sweep_markdown`.
+
+``replicates`` (int, default 1)
+    independent repetitions of every cell;
+``seed_mode`` (``"spawn"`` default, or ``"common"``)
+    ``spawn``: cell ``i``, replicate ``r`` runs with its own root seed, drawn from
+    ``SeedSequence(seed, spawn_key=(SWEEP_KEY, i, r))``; ``common``: every cell uses the
+    study's seed (replicate ``r > 0``: the spawned seed of cell 0), i.e. common random
+    numbers, so differences between cells carry no Monte-Carlo noise from the streams.
+
+Each cell's configuration is validated with the study's schema and ``check``; a cell that
+fails (a constraint of the design, e.g. a point outside the format) is recorded as
+infeasible with the reason and not run. A feasible cell runs the study into
+``cells/<label>/`` and contributes one row per cell and replicate to ``sweep.parquet``:
+``cell, replicate, label, seed, feasible, reason``, the swept keys, and for each claim of
+the cell ``<claim>`` (value), ``<claim>:lo``, ``<claim>:hi`` (its 95 % interval). A cell
+with its recorded seed reproduces ``sim run`` of the study with that seed exactly.
+
+:func:`run_adaptive` adds chunks until the Monte-Carlo standard error of every reported
+statistic is below its target (GUM Supplement 1, JCGM 101:2008, 7.9: the adaptive Monte
+Carlo procedure), drawing the same chunk streams as :func:`sim.mc.runner.run_chunks`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from sim.mc.config import ConfigError, StudyError, check_chunks, read_toml, validate
+from sim.mc.progress import Progress
+from sim.mc.runner import chunk_rng
+
+__all__ = [
+    "SWEEP_KEY",
+    "read_sweep",
+    "expand",
+    "cell_seed",
+    "cell_label",
+    "run_sweep",
+    "run_adaptive",
+    "fig_sweep",
+    "sweep_markdown",
+]
+
+SWEEP_KEY = 0x5EE9  # spawn-key tag of the sweep's seed streams
+RESERVED = ("replicates", "seed_mode")
+MAX_CELLS = 10_000  # cells x replicates of one sweep (sim.mc.estimate uses the same bound)
+
+
+def _flatten_sweep(d: Mapping, prefix: str = "") -> dict[str, Any]:
+    """Flatten nested tables to dotted keys, keeping range tables ``{start, stop, ...}`` whole
+    (``errors.settings = {start = 1, stop = 2, num = 2}`` is the range of one key)."""
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, dict) and not _is_range(v):
+            out.update(_flatten_sweep(v, key + "."))
+        else:
+            out[key] = v
+    return out
+
+
+def read_sweep(path: str | Path, schema: Mapping | None = None) -> dict[str, Any]:
+    """The ``[sweep]`` table of a study file, flattened (``{}`` if there is none); checked
+    against ``schema`` when given (unknown keys and bad ranges raise ConfigError)."""
+    doc = read_toml(path)
+    sw = doc.get("sweep", {})
+    if not isinstance(sw, dict):
+        raise ConfigError("sweep", "must be a table")
+    flat = _flatten_sweep(sw)
+    if "sweep" in doc and not flat:
+        raise ConfigError("sweep", "is empty: give at least one key to sweep")
+    if flat and schema is not None:
+        expand(flat, schema)
+    return flat
+
+
+def _is_range(v: Any) -> bool:
+    return isinstance(v, dict) and "start" in v and "stop" in v
+
+
+def _finite(key: str, name: str, x: Any) -> float:
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+        raise ConfigError(f"sweep.{key}", f"{name} must be a finite number (got {x!r})")
+    return x
+
+
+def _values(key: str, v: Any) -> list:
+    if isinstance(v, list):
+        if not v:
+            raise ConfigError(f"sweep.{key}", "needs at least one value")
+        if len(v) > MAX_CELLS:
+            raise ConfigError(f"sweep.{key}", f"has {len(v)} values (at most {MAX_CELLS})")
+        return v
+    if isinstance(v, dict) and not _is_range(v):
+        raise ConfigError(f"sweep.{key}", "a range needs start and stop")
+    if _is_range(v):
+        extra = set(v) - {"start", "stop", "num", "step"}
+        if extra:
+            raise ConfigError(f"sweep.{key}", f"unknown range entries {sorted(extra)}")
+        a, b = _finite(key, "start", v["start"]), _finite(key, "stop", v["stop"])
+        if "num" in v and "step" in v:
+            raise ConfigError(f"sweep.{key}", "give num or step, not both")
+        if "num" in v:
+            n = v["num"]
+            if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_CELLS:
+                raise ConfigError(
+                    f"sweep.{key}", f"num must be an integer from 1 to {MAX_CELLS} (got {n!r})"
+                )
+            out = np.linspace(a, b, n)
+        elif "step" in v:
+            s = _finite(key, "step", v["step"])
+            if s == 0 or (b - a) / s < 0:
+                raise ConfigError(
+                    f"sweep.{key}", "step must be non-zero and point from start to stop"
+                )
+            count = (b - a) / s
+            if not count < MAX_CELLS:
+                raise ConfigError(
+                    f"sweep.{key}",
+                    f"step {s!r} gives more than {MAX_CELLS} values from {a!r} to {b!r}",
+                )
+            k = int(math.floor(count + 1e-9))
+            out = a + s * np.arange(k + 1)
+        else:
+            raise ConfigError(f"sweep.{key}", "a range needs num or step")
+        if not np.isfinite(out).all():
+            raise ConfigError(f"sweep.{key}", "the range's values are not finite")
+        if all(isinstance(x, int) for x in (a, b, v.get("step", 0))) and "num" not in v:
+            return [int(x) for x in out]
+        return [float(x) for x in out]
+    return [v]
+
+
+def expand(table: Mapping[str, Any], schema: Mapping | None = None):
+    """Cells of a sweep table: ``(keys, cells, replicates, seed_mode)``, ``cells`` a list of
+    ``{key: value}`` dicts in Cartesian-product order. At most :data:`MAX_CELLS` cells times
+    replicates."""
+    reps = table.get("replicates", 1)
+    if not isinstance(reps, int) or isinstance(reps, bool) or not 1 <= reps <= MAX_CELLS:
+        raise ConfigError(
+            "sweep.replicates", f"must be an integer from 1 to {MAX_CELLS} (got {reps!r})"
+        )
+    mode = table.get("seed_mode", "spawn")
+    if mode not in ("spawn", "common"):
+        raise ConfigError("sweep.seed_mode", f"must be spawn or common (got {mode!r})")
+    keys = [k for k in table if k not in RESERVED]
+    for k in keys:
+        if k in ("seed", "study"):
+            raise ConfigError(f"sweep.{k}", "cannot be swept (use replicates for seeds)")
+        if schema is not None and k not in schema:
+            raise ConfigError(f"sweep.{k}", "unknown key")
+    vals = [_values(k, table[k]) for k in keys]
+    total = math.prod(len(v) for v in vals) * reps
+    if total > MAX_CELLS:
+        raise ConfigError("sweep", f"{total:,} cells x replicates (at most {MAX_CELLS:,})")
+    cells = [dict(zip(keys, combo)) for combo in itertools.product(*vals)]
+    return keys, cells, reps, mode
+
+
+def cell_seed(seed: int, cell: int, replicate: int, mode: str = "spawn") -> int:
+    """Root seed of one cell and replicate (see the module docstring)."""
+    if mode == "common":
+        if replicate == 0:
+            return int(seed)
+        cell = 0
+    ss = np.random.SeedSequence(seed, spawn_key=(SWEEP_KEY, cell, replicate))
+    return int(ss.generate_state(1, np.uint32)[0])
+
+
+def cell_label(i: int, r: int) -> str:
+    return f"cell{i:04d}_r{r}"
+
+
+def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dict:
+    """Run every cell of ``table`` for ``study`` from the resolved base ``cfg``; write
+    ``out/sweep.parquet`` and ``out/cells/<label>/``. Returns the table's columns."""
+    from sim.mc.storage import provenance, read_table, write_table
+
+    keys, cells, reps, mode = expand(table, study.schema)
+    base = {k: v for k, v in cfg.items() if k != "study"}
+    rows: list[dict[str, Any]] = []
+    for i, cell in enumerate(cells):
+        for r in range(reps):
+            seed = cell_seed(cfg["seed"], i, r, mode)
+            row: dict[str, Any] = {
+                "cell": i,
+                "replicate": r,
+                "label": cell_label(i, r),
+                "seed": seed,
+                "feasible": True,
+                "reason": "",
+            }
+            row.update({k: cell[k] for k in keys})
+            try:
+                ccfg = {
+                    "study": cfg["study"],
+                    **validate({**base, **cell, "seed": seed}, study.schema, study.check),
+                }
+                check_chunks(ccfg)
+            except ConfigError as e:
+                row.update(feasible=False, reason=str(e))
+                rows.append(row)
+                continue
+            d = out / "cells" / row["label"]
+            d.mkdir(parents=True, exist_ok=True)
+            cctx = ctx
+            if getattr(ctx, "store", None) is not None:  # each cell its own chunk store
+                cctx = dataclasses.replace(
+                    ctx,
+                    store=type(ctx.store)(
+                        d / "trials", provenance(ccfg, sweep_cell=row["label"], sweep=dict(table))
+                    ),
+                )
+            try:
+                study.run(ccfg, d, cctx)
+            except (KeyboardInterrupt, SystemExit):
+                raise
+            except Exception as e:  # noqa: BLE001 - a failed cell is recorded, the sweep goes on
+                row.update(feasible=False, reason=f"failed: {e}".splitlines()[0])
+                rows.append(row)
+                continue
+            if (d / "claims.parquet").is_file():
+                for c in read_table(d / "claims.parquet").to_pylist():
+                    row[c["claim"]] = c["value"]
+                    row[c["claim"] + ":lo"] = c["ci_low"]
+                    row[c["claim"] + ":hi"] = c["ci_high"]
+            rows.append(row)
+    if rows and not any(r["feasible"] for r in rows):
+        reasons = list(dict.fromkeys(r["reason"] for r in rows))
+        raise StudyError(
+            f"sweep: every cell failed ({len(rows)} of {len(rows)}): "
+            + "; ".join(reasons[:3])[:500]
+            + (" ..." if len(reasons) > 3 else "")
+        )
+    cols: dict[str, list] = {}
+    names = list(dict.fromkeys(k for row in rows for k in row))
+    for k in names:
+        vals = [row.get(k) for row in rows]
+        if all(
+            isinstance(v, (int, float, np.floating, np.integer)) or v is None for v in vals
+        ) and any(isinstance(v, (float, np.floating)) for v in vals):
+            vals = [np.nan if v is None else float(v) for v in vals]
+        elif any(isinstance(v, list) for v in vals):
+            vals = [repr(v) for v in vals]
+        cols[k] = vals
+    write_table(
+        out / "sweep.parquet",
+        cols,
+        provenance(cfg, sweep=dict(table), sweep_keys=keys, seed_mode=mode),
+    )
+    fig_sweep(out / "sweep.parquet", out / "sweep.png")
+    return cols
+
+
+def _claim_columns(t: dict, keys: list) -> list[str]:
+    skip = set(keys) | {"cell", "replicate", "label", "seed", "feasible", "reason"}
+    return [c for c in t if c not in skip and not c.endswith((":lo", ":hi")) and c + ":lo" in t]
+
+
+def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
+    """Each claim's value (with its 95 % interval) against the first swept key, one line per
+    combination of the other keys; infeasible cells marked on the axis. Drawn from the rows
+    of ``sweep.parquet`` alone."""
+    from sim.mc.storage import read_provenance, read_table
+    from sim.report.plotting import plt, save
+
+    t = read_table(path).to_pydict()
+    keys = read_provenance(path).get("sweep_keys", [])
+    claims = _claim_columns(t, keys)[:max_panels]
+    if not keys or not claims:
+        return None
+    x = np.array(
+        [float(v) if isinstance(v, (int, float)) else i for i, v in enumerate(t[keys[0]])], float
+    )
+    other = [tuple(t[k][i] for k in keys[1:]) for i in range(len(x))]
+    feas = np.array(t["feasible"], bool)
+    ncol = min(3, len(claims))
+    nrow = -(-len(claims) // ncol)
+    fig, axs = plt.subplots(nrow, ncol, figsize=(4.6 * ncol, 3.4 * nrow), squeeze=False)
+    for ax, c in zip(axs.ravel(), claims):
+        v = np.array([np.nan if a is None else a for a in t[c]], float)
+        lo = np.array([np.nan if a is None else a for a in t[c + ":lo"]], float)
+        hi = np.array([np.nan if a is None else a for a in t[c + ":hi"]], float)
+        for grp in dict.fromkeys(other):
+            sel = np.array([o == grp for o in other]) & feas
+            o = np.argsort(x[sel])
+            lab = ", ".join(f"{k}={g}" for k, g in zip(keys[1:], grp)) or None
+            ax.errorbar(
+                x[sel][o],
+                v[sel][o],
+                yerr=[v[sel][o] - lo[sel][o], hi[sel][o] - v[sel][o]],
+                fmt="o-",
+                ms=3,
+                capsize=2,
+                label=lab,
+            )
+        for xi in x[~feas]:
+            ax.axvline(xi, color="tab:red", alpha=0.3, lw=3)
+        ax.set_title(c, fontsize=7)
+        ax.set_xlabel(keys[0] + " (red: infeasible)")
+        if other[0]:
+            ax.legend(fontsize=6)
+    for ax in axs.ravel()[len(claims) :]:
+        ax.axis("off")
+    return save(fig, png)
+
+
+def sweep_markdown(out: Path, name: str | None = None) -> str:
+    """Markdown for a sweep directory from ``sweep.parquet`` alone: the cells with their
+    feasibility and claim values, and the figure (for ``sim report``)."""
+    from sim.mc.storage import read_provenance, read_table
+    from sim.report.markdown import fmt, md_table
+
+    t = read_table(Path(out) / "sweep.parquet").to_pydict()
+    keys = read_provenance(Path(out) / "sweep.parquet").get("sweep_keys", [])
+    claims = _claim_columns(t, keys)
+    rows = [
+        [
+            t["label"][i],
+            *[fmt(t[k][i]) for k in keys],
+            t["seed"][i],
+            "yes" if t["feasible"][i] else f"no: {t['reason'][i]}",
+            *[fmt(t[c][i]) for c in claims],
+        ]
+        for i in range(len(t["cell"]))
+    ]
+    txt = md_table(["cell", *keys, "seed", "feasible", *[f"`{c}`" for c in claims]], rows)
+    if (Path(out) / "sweep.png").is_file():
+        txt += f"\n\n![sweep]({name or Path(out).name}/sweep.png)"
+    return txt
+
+
+def run_adaptive(
+    fn: Callable[[np.random.Generator, int], Mapping[str, np.ndarray]],
+    stats: Callable[[dict], Mapping[str, tuple[float, float]]],
+    target: float | Mapping[str, float],
+    seed: int,
+    chunk: int,
+    part: int = 0,
+    min_trials: int = 0,
+    max_trials: int = 1_000_000,
+    label: str = "",
+    quiet: bool = False,
+) -> tuple[dict[str, np.ndarray], dict[str, tuple[float, float]]]:
+    """Add chunks of ``chunk`` trials until every statistic's standard error is below target.
+
+    ``stats(results)`` returns ``{name: (value, standard_error)}`` from the concatenated
+    results so far; ``target`` is one number or ``{name: target}``. Stops at ``max_trials``
+    (the returned standard errors then show the shortfall). Chunk ``k`` uses the stream of
+    :func:`sim.mc.runner.run_chunks`, so the first ``N`` trials equal a fixed run of ``N``.
+    Returns ``(results, stats)``; ``len`` of any result is the number of trials it took.
+    """
+    parts: dict[str, list[np.ndarray]] = {}
+    k = done = 0
+    st: Mapping[str, tuple[float, float]] = {}
+    with Progress(max_trials, label, quiet=quiet) as bar:
+        while done < max_trials:
+            n = min(chunk, max_trials - done)
+            for key, v in fn(chunk_rng(seed, part, k), n).items():
+                parts.setdefault(key, []).append(np.asarray(v))
+            done += n
+            k += 1
+            bar.update(n)
+            if done < min_trials:
+                continue
+            res = {kk: np.concatenate(v, axis=0) for kk, v in parts.items()}
+            st = stats(res)
+            tg = target if isinstance(target, Mapping) else {s: target for s in st}
+            if all(se < tg.get(s, np.inf) for s, (_, se) in st.items()):
+                break
+    res = {kk: np.concatenate(v, axis=0) for kk, v in parts.items()}
+    return res, dict(stats(res))

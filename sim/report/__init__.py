@@ -1,0 +1,1 @@
+"""Report: the Markdown report, figure helpers and the verification of results."""
