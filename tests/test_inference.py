@@ -194,7 +194,8 @@ def test_region_row_carries_the_region_verdict():
                 "ref": 7.5,
                 "tol": 0.0,
             }
-        ]
+        ],
+        [],
     )
     r = region()
     st = Statement("b", (7.5, 7.5), "lower")
