@@ -351,9 +351,15 @@ def test_sweep_rows_draw_and_tabulate(tmp_path):
     assert md.count("\n") >= 5 and "no: plate.spacing_mm" in md and "sweep.png" in md
 
 
-def test_the_two_plate_posterior_finds_the_grid_plate_study():
-    # the cross-check must not be skipped silently when the grid-plate study moves
-    from sim.studies.design.posterior import _twoplate_data
+def test_the_two_plate_posterior_uses_the_grid_plate_study_defaults():
+    # the design study's two-plate calibration is gridplate_two_plates's default one
+    from sim.mc.config import validate
+    from sim.studies.design.posterior import TWO_PLATES, TWO_PLATES_STATED_UM, _twoplate_data
+    from sim.studies.gridplate import model as gm
+    from sim.studies.gridplate import schema as gs
 
-    gcfg, comp, g, sg, rw, fa = _twoplate_data({"seed": 1})
-    assert comp.shape == g.shape[:2] and comp.shape[0] == 2 * gcfg["plate.count"]
+    gcfg = validate({}, gs.SCHEMA, gs.check)
+    assert TWO_PLATES == gm.calibration_args(gcfg)
+    assert TWO_PLATES_STATED_UM == gcfg["grid.sigma_stated_um"]
+    tp, comp, g, sg, rw, fa = _twoplate_data({"seed": 1})
+    assert comp.shape == g.shape[:2] and comp.shape[0] == 2 * tp["plates"]
