@@ -45,10 +45,10 @@ SMALL = {
         "trials": 8,
         "chunk": 4,
         "dilution.grids": [3, 5],
-        "consistency.offset_step_mm": 10.0,
-        "consistency.extents_mm": [90.0],
+        "region.points": 256,
+        "region.rounds": 1,
     },
-    "brown_table1": {"trials": 8, "chunk": 4},
+    "brown_table1": {"trials": 8, "chunk": 4, "region.points": 256, "region.rounds": 1},
     "brown_design": {
         "trials": 8,
         "chunk": 4,

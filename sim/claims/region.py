@@ -122,7 +122,11 @@ def region_row(book, cid: str, rv: RegionVerdict, values, note: str = "") -> dic
     v = np.asarray(values, float)
     v = v[np.isfinite(v)]
     lo, hi = (float(v.min()), float(v.max())) if v.size else (np.nan, np.nan)
-    row = book.score(cid, lo, (lo, lo) if v.size else (0.0, 0.0), "exact", value_high=hi)
+    if v.size:
+        row = book.score(cid, lo, (lo, lo), "exact", value_high=hi)
+    else:  # an empty region: no value (written as null), the verdict says why
+        row = book.score(cid, 0.0, (0.0, 0.0), "exact")
+        row.update(value_high=hi)
     where = {
         "holds": f"holds at all {rv.n_points} points of the region",
         "fails": f"fails at all {rv.n_points} points of the region",

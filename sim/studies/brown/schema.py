@@ -92,8 +92,8 @@ BASE = {
         "int",
         "size of the space-filling (Sobol) design of the joint exploration of the unprinted "
         "inputs (sim.claims.inference), rounded up to a power of 2",
-        lo=16,
-        hi=65536,
+        lo=256,
+        hi=16384,
     ),
     "region.rounds": Field(
         3,
