@@ -53,7 +53,7 @@ SMALL = {
         "trials": 8,
         "chunk": 4,
         "design.positions": [4],
-        "design.offsets_mm": [30.0],
+        "design.offsets_mm": [17.0],
         "design.grids": [5],
         "design.extents_mm": [90.0],
         "design.settings": [2],
@@ -67,6 +67,9 @@ SMALL = {
         "coverage.betas_mm": [1.0],
         "bayes.walkers": 16,
         "bayes.steps": 100,
+        "region.points": 256,
+        "region.rounds": 1,
+        "region.plate_points": 8,
     },
     "gridplate_two_plates": {
         "trials": 8,

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.claims.inference import HOLDS, Region, Statement, explore, parse_declaration
-from sim.claims.region import decide_over, outcomes, region_row, region_table
+from sim.claims.region import decide_over, outcomes, region_row, region_table, statement_of
 from sim.instruments.ranges import brown as B
 from sim.mc.runner import chunk_rng
 from sim.studies.brown import values as V
@@ -62,21 +62,6 @@ def inputs(names):
     return [by[n] for n in names]
 
 
-def statement(book, cid: str, form: str | None = None) -> Statement:
-    """A claim-book row as a statement (its zone: the printed rounding widened by tol)."""
-    s = book.spec(cid)
-    ref = s["ref"] if isinstance(s["ref"], list) else [s["ref"], s["ref"]]
-    return Statement(
-        cid,
-        (float(ref[0]), float(ref[1])),
-        form or s["form"],
-        s.get("decimals"),
-        float(s["tol"]),
-        s["paper"],
-        s["source"],
-    )
-
-
 def _edge_points() -> np.ndarray:
     """Points on the format's edge ``(4 EDGE_POINTS - 4, 2)``."""
     h = B.FORMAT_MM / 2
@@ -115,14 +100,14 @@ def _joint(region: Region, preds: list[Statement]) -> np.ndarray:
 def table1_region(cfg: dict, book):
     """``(region, predictions, verdicts)`` of Table 1's statements over the region of
     (station offset, beta, sigma0) allowed by the hardware and the printed closure."""
-    cons = [SCALE, statement(book, "brown.table1_closure.rms_um", "value")]
-    preds = [statement(book, c) for c in T1_PREDICTIONS]
+    cons = [SCALE, statement_of(book, "brown.table1_closure.rms_um", "value")]
+    preds = [statement_of(book, c) for c in T1_PREDICTIONS]
     names = ("station_offset_mm", "beta_mm", "sigma0_um")
     rng = chunk_rng(cfg["seed"], 97, 0)
     n, rounds = cfg["region.points"], cfg["region.rounds"]
     reg = explore(inputs(names), cons, table1_model, rng, n=n, rounds=rounds, refine_on=preds)
     reg.outputs[T1_JOINT] = _joint(reg, preds)
-    joint = statement(book, T1_JOINT)
+    joint = statement_of(book, T1_JOINT)
     verdicts = {p.id: decide_over(reg, p) for p in preds + [joint]}
     return reg, preds + [joint], verdicts
 
@@ -167,7 +152,7 @@ def monotone_at(x: dict) -> np.ndarray:
 def concept_region(cfg: dict, book):
     """``(region, predictions, verdicts)`` of the Concept over (station offset, beta, half
     extent of the 25 points) allowed by the hardware."""
-    preds = [statement(book, c) for c in CONCEPT_PREDICTIONS]
+    preds = [statement_of(book, c) for c in CONCEPT_PREDICTIONS]
     names = ("station_offset_mm", "beta_mm", "half_extent_mm")
     rng = chunk_rng(cfg["seed"], 97, 0)
     n, rounds = cfg["region.points"], cfg["region.rounds"]
