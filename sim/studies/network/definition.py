@@ -257,7 +257,11 @@ _OBS = {
     "bias_mm",
     "bias_arcsec",
     "nearest",
+    "set",
 }
+#: accepted ranges of the standard deviations: the weights 1 / sigma^2 stay far from
+#: overflow and underflow, and the normal equations within double precision
+SIGMA_RANGE = {"mm": (1e-9, 1e9), "arcsec": (1e-9, 1e6)}
 
 
 def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
@@ -271,10 +275,45 @@ def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
     if f"sigma_{unit}" not in rec:
         raise ConfigError(f"{key}.sigma_{unit}", "missing")
     sig = _num(f"{key}.sigma_{unit}", rec[f"sigma_{unit}"], 0.0, lo_open=True)
+    lo, hi = SIGMA_RANGE[unit]
+    if not lo <= sig <= hi:
+        raise ConfigError(
+            f"{key}.sigma_{unit}",
+            f"{sig:g} is outside [{lo:g}, {hi:g}] {unit}: its weight would over- or underflow",
+        )
+    if "set" in rec and code != 1:
+        raise ConfigError(f"{key}.set", f"only a direction has an orientation set (a {kind})")
+    if "set" in rec and not isinstance(rec["set"], str):
+        raise ConfigError(f"{key}.set", f"must be a name (got {rec['set']!r})")
     settings = _num(f"{key}.settings", rec.get("settings", 1), 1, integer=True)
     bias = _num(f"{key}.bias_{unit}", rec.get(f"bias_{unit}", 0.0))
     f = ARCSEC if code in _ANGULAR else 1.0
     return code, sig * f / math.sqrt(settings), bias * f
+
+
+def _degenerate(names, xy, kind, i, j, k) -> None:
+    """Refuse an observation whose geometry is undefined: a sight from a point to itself or
+    to a point at the same place, an angle whose back- or fore-sight is its station or whose
+    two sights coincide (names the observation by its points)."""
+    span = max(float(np.ptp(xy, axis=0).max()), 1e-300)
+    for code, a, b, c in zip(kind, i, j, k):
+        if code >= 5:
+            continue
+        what = f"a {KINDS[code]} from {names[a]!r} to {names[b]!r}"
+        if code == 2:
+            what = f"an angle at {names[a]!r} from {names[b]!r} to {names[c]!r}"
+            if c == a or b == a:
+                raise ConfigError("network.observations", f"{what}: a sight to its own station")
+            if b == c:
+                raise ConfigError("network.observations", f"{what}: the two sights are one")
+        if a == b:
+            raise ConfigError("network.observations", f"{what}: a sight to itself")
+        for t in (b, c) if code == 2 else (b,):
+            if code in (0, 1, 2) and np.hypot(*(xy[t] - xy[a])) <= 1e-12 * span:
+                raise ConfigError(
+                    "network.points",
+                    f"points {names[a]!r} and {names[t]!r} coincide: {what} is undefined",
+                )
 
 
 def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
@@ -308,7 +347,7 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
         rows.append((code, fr[0], to[0], -1, sig, bias))
     for a, rec in enumerate(cfg["network.generate"]):
         key = f"network.generate[{a}]"
-        _keys(key, rec, _OBS - {"at"}, {"kind", "from", "to"})
+        _keys(key, rec, _OBS - {"at", "set"}, {"kind", "from", "to"})
         code, sig, bias = _obs_common(key, rec)
         if code == 2:
             raise ConfigError(
@@ -335,27 +374,23 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
             "network.generate", f"{len(rows)} observations is over the limit of {MAX_OBS}"
         )
     kind, i, j, kk, sig, bias = (np.array(c) for c in zip(*rows))
-    for code, a, b in zip(kind, i, j):
-        if code < 5 and a == b:
-            raise ConfigError(
-                "network.observations", f"a {KINDS[code]} from {names[a]!r} to itself"
-            )
-        if code in (0, 1) and np.allclose(xy[a], xy[b]):
-            raise ConfigError(
-                "network.points",
-                f"points {names[a]!r} and {names[b]!r} coincide:"
-                f" a {KINDS[code]} between them is undefined",
-            )
-    stations = tuple(dict.fromkeys(names[a] for a, c in zip(i, kind) if c == 1))
-    oset = np.array([stations.index(names[a]) if c == 1 else -1 for a, c in zip(i, kind)], int)
+    _degenerate(names, xy, kind, i, j, kk)
+    n_single = len(cfg["network.observations"])
+    label = [str(r.get("set", "")) for r in cfg["network.observations"]]
+    label += [""] * (len(rows) - n_single)
+    key = [f"{names[a]}/{lb}" if lb else names[a] for a, lb in zip(i, label)]
+    stations = tuple(dict.fromkeys(s for s, c in zip(key, kind) if c == 1))
+    oset = np.array([stations.index(s) if c == 1 else -1 for s, c in zip(key, kind)], int)
     beta = cfg["network.offset_mm"]
     if beta and np.any(kind == 0):
-        d = np.hypot(*(xy[j[kind == 0]] - xy[i[kind == 0]]).T)
-        if d.min() <= beta:
+        rows_d = np.flatnonzero(kind == 0)
+        d = np.hypot(*(xy[j[rows_d]] - xy[i[rows_d]]).T)
+        if d.min() <= beta * (1 + 1e-6):
+            r = rows_d[int(np.argmin(d))]
             raise ConfigError(
                 "network.offset_mm",
-                f"the offset {beta:g} mm is not shorter than "
-                f"the shortest distance ({d.min():.3g} mm)",
+                f"the offset {beta:g} mm is not shorter than the distance from "
+                f"{names[i[r]]!r} to {names[j[r]]!r} ({d.min():.6g} mm)",
             )
     return Network(
         cfg["network.name"],
