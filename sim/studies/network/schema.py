@@ -9,6 +9,8 @@ arrays would not fit in memory.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from sim.mc.config import COMMON, ConfigError, Field
@@ -214,6 +216,18 @@ def _conditioned(net, an, key: str) -> None:
     A = J[0][:, an.free] / net.sigma[:, None]
     n_ii = np.einsum("ij,ij->j", A, A)
     q_ii = np.diag(an.Q)
+    span = float(np.ptp(net.xy, axis=0).max())
+    coord = an.free < 2 * net.n
+    loose = np.flatnonzero(coord & (np.sqrt(np.maximum(q_ii, 0)) > span))
+    if loose.size:
+        par = int(an.free[loose[0]])
+        raise ConfigError(
+            key,
+            f"the network is near-singular: point {net.names[par // 2]!r} "
+            f"({'xy'[par % 2]}) has a sigma of {math.sqrt(q_ii[loose[0]]):.3g} mm, more than "
+            f"the network's extent ({span:.3g} mm); points nearly on one line, or nearly "
+            "undetermined",
+        )
     vif = q_ii * n_ii
     if not np.all(np.isfinite(vif)) or vif.max() > MAX_INFLATION:
         g = int(np.argmax(np.where(np.isfinite(vif), vif, np.inf)))
