@@ -38,7 +38,7 @@ from sim.studies.network.definition import Network
 from sim.studies.network.gama_read import CC, NS, read_bytes, read_gama
 from sim.studies.network.model import computed
 
-__all__ = ["read_gama", "write_gama", "merge_gama", "export", "gama_digest"]
+__all__ = ["read_gama", "write_gama", "merge_gama", "export", "gama_digest", "import_note"]
 
 _GON = math.pi / 200
 
@@ -46,6 +46,12 @@ _GON = math.pi / 200
 def gama_digest(path: str | Path, key: str = "network.gama_xml") -> str:
     """sha256 of the file's bytes (the file is read as :func:`read_gama` reads it)."""
     return hashlib.sha256(read_bytes(path, key)).hexdigest()
+
+
+def import_note(cfg: dict) -> str:
+    """The sentence the report gives about ``network.gama_xml`` (its convention), or ``""``."""
+    path = cfg.get("network.gama_xml")
+    return f"{Path(path).name}: {read_gama(path)['note']}" if path else ""
 
 
 def merge_gama(cfg: dict) -> dict:

@@ -34,7 +34,7 @@ from sim.studies.network.analysis import (
 )
 from sim.studies.network.definition import KINDS, Network, build
 from sim.studies.network.figures import network_figure, reliability_figure
-from sim.studies.network.gama import export, merge_gama
+from sim.studies.network.gama import export, import_note, merge_gama
 from sim.studies.network.model import datum
 
 __all__ = ["run", "compare_points"]
@@ -215,6 +215,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
             "compare_fix": [", ".join(cfg["compare.fix"])],
             "held_by_datum": [", ".join(held)],
             "gama_xml": [gama],
+            "gama_input": [import_note(cfg)],
         },
         prov,
     )
