@@ -534,3 +534,98 @@ def test_check_refusals_are_one_line_exit_2(tmp_path):
     )
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "'B'" in r.stderr and "Traceback" not in r.stderr
+
+
+GARBAGE = [
+    "",
+    " ",
+    "abc",
+    "-1",
+    "0",
+    "1e400",
+    "nan",
+    "inf",
+    "1-2-3",
+    "400",
+    "XY",
+    "z",
+    "A",
+    "1 2 3 4",
+    "0x10",
+    "\u00e9",
+    "99-99-99",
+]
+
+
+def _mutate(text: str, rng: np.random.Generator) -> str:
+    """One seeded mutation of a gama-local file: an attribute's value replaced by garbage or
+    removed, an element duplicated or removed, or the file truncated."""
+    import re
+
+    attrs = list(re.finditer(r'(\w[\w-]*)="([^"]*)"', text))
+    elems = list(re.finditer(r"<(\w[\w-]*) [^<>]*/>", text))
+    op = rng.integers(5)
+    if not attrs or not elems:
+        op = 4
+    if op == 0:
+        m = attrs[rng.integers(len(attrs))]
+        g = GARBAGE[rng.integers(len(GARBAGE))]
+        return text[: m.start(2)] + g + text[m.end(2) :]
+    if op == 1:
+        m = attrs[rng.integers(len(attrs))]
+        return text[: m.start()] + text[m.end() :]
+    if op == 2:
+        m = elems[rng.integers(len(elems))]
+        return text[: m.end()] + m.group(0) + text[m.end() :]
+    if op == 3:
+        m = elems[rng.integers(len(elems))]
+        return text[: m.start()] + text[m.end() :]
+    return text[: rng.integers(len(text))]
+
+
+@pytest.mark.parametrize("case", ["two_sets", "user_dms", "plate"])
+def test_fuzzed_gama_files_give_a_network_or_one_config_error(case, tmp_path):
+    """Seeded mutations of the reference files: each either loads (sim check passes) or is a
+    one-line ConfigError naming network.gama_xml or another key; never another exception."""
+    rng = np.random.default_rng(2024)
+    text = (DATA / f"{case}.xml").read_text()
+    base = tmp_path / "s.toml"
+    path = tmp_path / "m.xml"
+    base.write_text(
+        f'study = "network"\ntrials = 200\nchunk = 50\n[network]\ngama_xml = "{path}"\n'
+    )
+    outcomes = {"ok": 0, "refused": 0}
+    for _ in range(60):
+        path.write_text(_mutate(text, rng))
+        try:
+            load_study(base)
+            outcomes["ok"] += 1
+        except ConfigError as e:
+            assert "\n" not in str(e) and e.key, str(e)
+            outcomes["refused"] += 1
+    assert outcomes["refused"] > 0
+
+
+LAUGHS = (
+    '<?xml version="1.0"?><!DOCTYPE l [<!ENTITY a "aaaaaaaaaa">'
+    + "".join(f'<!ENTITY {c} "{("&" + p + ";") * 10}">' for p, c in zip("abcdefg", "bcdefgh"))
+    + "]><gama-local><network><description>&h;</description></network></gama-local>"
+)
+
+
+@pytest.mark.parametrize(
+    "text,msg",
+    [
+        (LAUGHS, "is not XML"),
+        ('<?xml version="1.0" encoding="foo"?><gama-local/>', "cannot be decoded"),
+        ("", "is not XML"),
+        ("<other/>", "not <gama-local>"),
+        ("<gama-local><network/><network/></gama-local>", "2 <network> elements"),
+        ("<gama-local>junk<network/></gama-local>", "unexpected text"),
+    ],
+)
+def test_hostile_gama_files_are_one_line(text, msg, tmp_path):
+    path = tmp_path / "h.xml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=msg):
+        read_gama(path)

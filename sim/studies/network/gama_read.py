@@ -184,6 +184,10 @@ class _File:
                 raise self.err(e, f"not supported: {_REFUSED[t]} (2-D networks only)")
             if t not in VOCAB:
                 raise self.err(e, "unknown element (not in gama-local's vocabulary)")
+            if t not in ("description", "cov-mat") and (e.text or "").strip():
+                raise self.err(e, f"unexpected text {e.text.strip()[:20]!r}")
+            if (e.tail or "").strip() and e is not root:
+                raise self.err(e, f"unexpected text {e.tail.strip()[:20]!r} after it")
             for a, v in e.attrib.items():
                 if a.startswith("{") or a == "xmlns":
                     continue
@@ -394,6 +398,8 @@ def read_gama(path: str | Path, key: str = "network.gama_xml") -> dict:
         root = ET.fromstring(data)
     except ET.ParseError as e:
         raise ConfigError(key, f"{path} is not XML: {e}") from None
+    except (LookupError, ValueError) as e:  # an unknown encoding declared, undecodable bytes
+        raise ConfigError(key, f"{path} cannot be decoded: {e}") from None
     if _tag(root) != "gama-local":
         raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
     f.vocab(root)
