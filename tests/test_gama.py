@@ -22,6 +22,7 @@ from sim.mc.codehash import is_current
 from sim.mc.config import ConfigError, load_study
 from sim.studies.network.analysis import analyse, in_datum
 from sim.studies.network.definition import build
+from sim.studies.network.figures import natural_unit
 from sim.studies.network.gama import _distance_sigma, export, merge_gama, write_gama
 from sim.studies.network.gama_read import CC, MAX_BYTES, read_gama
 from sim.studies.network.model import datum
@@ -629,3 +630,37 @@ def test_hostile_gama_files_are_one_line(text, msg, tmp_path):
     path.write_text(text)
     with pytest.raises(ConfigError, match=msg):
         read_gama(path)
+
+
+def test_field_networks_in_metres_equal_the_same_in_mm():
+    """Issue 25 item 7: x_m, spacing_m, origin_m (metres) give the same network as mm."""
+    cfg = load_study(ROOT / "studies/network_testfield.toml")[1]
+    assert "x_m" in cfg["network.points"][0]
+    mm = {
+        **cfg,
+        "network.points": [
+            {"name": p["name"], "x_mm": p["x_m"] * 1000, "y_mm": p["y_m"] * 1000, "role": p["role"]}
+            for p in cfg["network.points"]
+        ],
+        "network.grids": [
+            {
+                "prefix": "N",
+                "nx": 4,
+                "ny": 3,
+                "spacing_mm": 25000.0,
+                "origin_mm": [12500.0, 15000.0],
+            }
+        ],
+    }
+    a, b = build(cfg), build(mm)
+    assert a.names == b.names and np.array_equal(a.xy, b.xy)
+    bad = [{"name": "A", "x_m": 1.0, "x_mm": 1000.0, "y_m": 0.0}]
+    with pytest.raises(ConfigError, match="x_mm or x_m, not both"):
+        build({**cfg, "network.points": bad})
+    with pytest.raises(ConfigError, match="missing"):
+        build({**cfg, "network.points": [{"name": "A", "y_m": 0.0}]})
+
+
+def test_figures_label_field_networks_in_metres():
+    assert natural_unit(build(study("testfield")).xy) == ("m", 1000.0)
+    assert natural_unit(build(study("plate")).xy) == ("mm", 1.0)
