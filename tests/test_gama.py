@@ -8,8 +8,10 @@ significant digits and adjusted stdevs to 16: the comparisons hold to 1e-6 (rela
 largest variance of the network for covariances, absolute for redundancy numbers).
 """
 
+import json
 import math
 import os
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -18,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim.mc.codehash import is_current
+from sim.mc.codehash import is_current, study_code_hash
 from sim.mc.config import ConfigError, load_study
 from sim.studies.network.analysis import analyse, in_datum
 from sim.studies.network.definition import build
@@ -403,7 +405,9 @@ def test_an_edited_gama_file_changes_the_resolved_config(tmp_path):
     assert len(c1["network.gama_sha256"]) == 64
     res = tmp_path / "res"
     res.mkdir()
-    (res / "run.json").write_text(__import__("json").dumps({"config": c1, "code_hash": "x"}))
+    rec = {"config": c1, "code_hash": study_code_hash("network")}
+    (res / "run.json").write_text(json.dumps(rec))
+    assert is_current(study_file, res)
     path.write_text(path.read_text().replace('stdev="2.0"', 'stdev="4.0"'))
     _, c2 = load_study(study_file)
     assert c2["network.gama_sha256"] != c1["network.gama_sha256"]
@@ -561,8 +565,6 @@ GARBAGE = [
 def _mutate(text: str, rng: np.random.Generator) -> str:
     """One seeded mutation of a gama-local file: an attribute's value replaced by garbage or
     removed, an element duplicated or removed, or the file truncated."""
-    import re
-
     attrs = list(re.finditer(r'(\w[\w-]*)="([^"]*)"', text))
     elems = list(re.finditer(r"<(\w[\w-]*) [^<>]*/>", text))
     op = rng.integers(5)

@@ -54,7 +54,8 @@ def delta0(alpha0: float, power: float) -> float:
 class Analytic:
     """Analytic pre-analysis. ``free`` (p,) indices of the estimated globals; ``Q`` (p, p)
     their covariance (mm^2, rad^2); ``cov`` (n, 2, 2) point covariances (zero for points held
-    fixed); ``redundancy``, ``mdb``, ``ext_max_mm``, ``bnr`` (m,); ``dof``; ``ok``."""
+    fixed); ``redundancy``, ``mdb``, ``ext_max_mm``, ``bnr`` (m,); ``dof``; ``ok``; ``n_diag`` (p,) the
+    diagonal of the normal matrix (for the variance inflation ``Q_ii N_ii``)."""
 
     free: np.ndarray
     Q: np.ndarray
@@ -65,6 +66,7 @@ class Analytic:
     bnr: np.ndarray
     dof: int
     ok: bool
+    n_diag: np.ndarray | None = None  # (p,) diagonal of the normal matrix A'PA
 
 
 def point_cov_in(net: Network, free: np.ndarray, Q: np.ndarray) -> np.ndarray:
@@ -104,7 +106,8 @@ def analyse(net: Network, datum: lsq.Datum, a0: float, power: float) -> Analytic
     ext = np.where(controlled, disp.max(axis=0), np.inf)
     cov2 = point_cov_in(net, free, Q).reshape(net.n, 2, net.n, 2)
     cov = cov2[np.arange(net.n), :, np.arange(net.n), :]
-    return Analytic(free, Q, cov, r, mdb, ext, bnr, int(dof), True)
+    n_diag = np.einsum("ij,ij->j", Aw, Aw)
+    return Analytic(free, Q, cov, r, mdb, ext, bnr, int(dof), True, n_diag)
 
 
 def inner_defect(net: Network) -> np.ndarray:

@@ -212,9 +212,7 @@ def _conditioned(net, an, key: str) -> None:
     """Refuse a near-singular network (e.g. free points on the line through two fixed
     points): an unknown whose variance is over :data:`MAX_INFLATION` times what its own
     observations alone would give loses more than ten of the sixteen digits."""
-    _, J = computed(net, net.theta_true()[None], jac=True)
-    A = J[0][:, an.free] / net.sigma[:, None]
-    n_ii = np.einsum("ij,ij->j", A, A)
+    n_ii = an.n_diag
     q_ii = np.diag(an.Q)
     span = float(np.ptp(net.xy, axis=0).max())
     coord = an.free < 2 * net.n
