@@ -20,8 +20,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim.mc.codehash import is_current, study_code_hash
-from sim.mc.config import ConfigError, load_study
+from sim.batch import is_current
+from sim.mc.codehash import study_code_hash
+from sim.mc.config import ConfigError
+from sim.studies import load_study
 from sim.studies.network.analysis import analyse, in_datum
 from sim.studies.network.definition import build
 from sim.studies.network.figures import natural_unit

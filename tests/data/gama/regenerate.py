@@ -24,7 +24,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[2]
 sys.path.insert(0, str(ROOT))
 
-from sim.mc.config import load_study  # noqa: E402
+from sim.studies import load_study  # noqa: E402
 from sim.studies.network.definition import build  # noqa: E402
 from sim.studies.network.gama import export, merge_gama  # noqa: E402
 
