@@ -14,6 +14,7 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.intervals import mean_ci, std_ci
+from sim.instruments import transforms2d as t2
 from sim.lsq import distributions as D
 from sim.mc.config import StudyError
 from sim.studies.gridplate.model import PARAM_LABEL, PARAMS
@@ -344,8 +345,6 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
 
 def beyond_table(res: dict, ratios: list, j_true: int) -> dict:
     """Bias and spread of S, S', eps (grid fixed and weighted at the ratio nearest the truth)."""
-    from sim.instruments import transforms2d as t2
-
     conv = {"S": 1e6, "S2": 1e6, "eps": 1 / t2.ARCSEC}
     b = {
         k: []

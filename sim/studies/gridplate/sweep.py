@@ -27,7 +27,7 @@ import numpy as np
 from sim.claims.book import ClaimBook
 from sim.instruments import transforms2d as t2
 from sim.instruments.plates import grid_points
-from sim.studies.gridplate.model import reweight_trials
+from sim.studies.gridplate.model import reweight_trials, truth_rows
 from sim.studies.gridplate.schema import UM
 
 #: input key -> config list of swept values
@@ -55,8 +55,6 @@ CLAIMS = (
 
 def sys_ssr_um2(cfg: dict) -> float:
     """Similarity residual sum of squares (um^2, one plate) of the noise-free comparator."""
-    from sim.studies.gridplate.model import truth_rows
-
     G = grid_points(cfg["plate.grid"], cfg["plate.spacing_mm"])
     S, S2, eps = truth_rows(cfg)
     ideal = t2.apply_affine(t2.affine_from_rows(S, S2, eps, 0.0, (120.0, 120.0))[None], G[None])

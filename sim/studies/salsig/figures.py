@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from sim.report.outcome_map import fig_consistent  # noqa: F401  (one outcome map for both studies)
 from sim.report.plotting import plt, save
-from sim.studies.gridplate.figures import fig_consistent  # noqa: F401  (one outcome map for both studies)
 from sim.studies.salsig.schema import UM
 
 
