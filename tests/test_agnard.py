@@ -418,27 +418,17 @@ def test_consistent_set_table(tiny_run):
             assert all(lo[i] <= lo[allk] and hi[allk] <= hi[i] for i in k)
 
 
-def test_table1_with_rows_are_paper_checks_recomputed_from_tables_2_3(tiny_run):
-    """The contradiction is a paper-check whose value is the nearer of the paper's own
-    Tables 2-3 numbers; the simulation is not scored against Table 1's 'with' rows."""
+def test_table1_rows_are_not_comparable(tiny_run):
+    """Table 1's setup is not printed and the simulated scanner cannot reach its 'without'
+    rms: every Table 1 row (with, without, ratio) is 'not comparable', none an erratum."""
     from sim.mc.storage import read_table
-    from sim.studies.agnard.claims import load_book
 
-    book = load_book()
     rows = {r["claim"]: r for r in read_table(tiny_run[2] / "claims.parquet").to_pylist()}
-    for w in ("ctrl", "check"):
-        for c in ("x", "y"):
-            r = rows[f"agnard.table1.with_{w}_{c}_m"]
-            assert r["kind"] == "paper-check" and r["interval"] == "exact"
-            t23 = [
-                book.spec(f"agnard.{n}.{w}_{c}_cm")["ref"] / 100
-                for n in ("control_5", "control_21")
-            ]
-            assert r["value"] == min(t23, key=lambda v: abs(v - book.spec(r["claim"])["ref"]))
-            assert rows[f"agnard.table1.without_{w}_{c}_m"]["verdict"] == "not comparable"
-    # the paper's control rms in Table 1 is 2-3 x its Tables 2-3: an erratum
-    assert rows["agnard.table1.with_ctrl_x_m"]["verdict"] == "erratum"
-    assert rows["agnard.table1.with_ctrl_y_m"]["verdict"] == "erratum"
+    t1 = [k for k in rows if k.startswith("agnard.table1.")]
+    assert len(t1) == 12
+    for k in t1:
+        assert rows[k]["verdict"] == "not comparable", k
+        assert rows[k]["note"], k
 
 
 def test_budget_recomputation_and_pointing_model():

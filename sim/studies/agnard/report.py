@@ -136,15 +136,11 @@ def findings(out: Path) -> str:
     apart = g6["ci_low"] > g3["ci_high"]
     return "\n".join(
         [
-            "- *Table 1*: its 'with correction' rows against the paper's own Tables 2-3: "
-            + "; ".join(
-                f"{k.split('.')[-1]} {fmt(c[k]['ref_low'] + 0.005, 2)} m vs {v(k)} m (*{vd(k)}*)"
-                for k in c
-                if k.startswith("agnard.table1.with_")
-            )
-            + ". The simulated without/with ratio of the check points in Y is "
-            f"{v('agnard.table1.ratio_check_y')} (paper {fmt(c['agnard.table1.ratio_check_y']['ref_low'])}, "
-            f"*{vd('agnard.table1.ratio_check_y')}*). Calibration gains {fmt(g3['value'], 2)} % at 300 "
+            "- *Table 1* (not comparable: its setup is not printed, and the simulated scanner, "
+            "peaking at the paper's +-20 / +-40 um, cannot produce its 1.0-1.5 m rms without "
+            "correction; its 'with' rows are 2-3 times the Tables 2-3 rms of the same kind of "
+            "point, a gap recorded, not an erratum). Calibration gains "
+            f"{fmt(g3['value'], 2)} % at 300 "
             f"DPI and {fmt(g6['value'], 2)} % at 600 DPI in check-point XY rms"
             + (
                 " (the 600 DPI gain's interval lies above the 300 DPI one)."
@@ -168,16 +164,19 @@ def findings(out: Path) -> str:
             f"(*{vd('agnard.first_pass.pass_z_cm')}*); the paper's own 10 and 15 cm are "
             f"{v('agnard.first_pass.quarter_pixel')} and {v('agnard.first_pass.third_pixel')} pixel, "
             "not a quarter and a third.",
-            f"- *Maximum control residuals* (21 control): {v('agnard.max_residual.control_21_xy_cm')} "
-            f"cm XY (*{vd('agnard.max_residual.control_21_xy_cm')}* against at most 21), "
+            "- *Acceptance limits* (the client's 21 cm planimetry / 16 cm height on the control "
+            "residuals, which the paper 'satisfied' with its 21-control rms of 15 / 14 cm; "
+            "scored as limits on one block's control rms): "
+            f"{v('agnard.max_residual.control_21_xy_cm')} cm XY "
+            f"(*{vd('agnard.max_residual.control_21_xy_cm')}*), "
             f"{v('agnard.max_residual.control_21_z_cm')} cm Z "
-            f"(*{vd('agnard.max_residual.control_21_z_cm')}* against at most 16).",
+            f"(*{vd('agnard.max_residual.control_21_z_cm')}*).",
             f"- *Pass-point rejection*: digital pugging removes a median "
             f"{v('agnard.pass_rejections.digital')} pass points "
             f"(*{vd('agnard.pass_rejections.digital')}*); mechanical pugging "
             f"{v('agnard.pass_rejections.mechanical_pct')} % "
-            f"(*{vd('agnard.pass_rejections.mechanical_pct')}*), mean share against the unprinted "
-            f"re-centring error: {sens}.",
+            "(an input: the unprinted re-centring error is set so the share matches), mean "
+            f"share against that re-centring error: {sens}.",
             anisotropy_text(c, out, cfg),
             f"- *Errata* (paper-checks the paper's own printed data contradict): {len(errata)}: "
             + (", ".join(e.replace("agnard.", "") for e in errata) or "none")
