@@ -240,10 +240,12 @@ def test_study_runs_small(tmp_path):
     assert rc == 0
     t = read_table(out / "claims.parquet").to_pydict()
     v = dict(zip(t["claim"], t["verdict"]))
-    # the paper's 1.5 um contradicts its own 1.2 and 0.7 um: an erratum, not a failure
-    assert v["twoplate.paper_check.affine_from_comparator_and_grid"] == "erratum"
+    # sqrt(1.2^2 + 0.7^2) over the printed roundings (1.321-1.458) reaches the 1.5's zone
+    # (1.45-1.55): a tension, not an erratum; the precision of a mean lies under 1.2
+    assert v["twoplate.paper_check.affine_from_comparator_and_grid"] == "inconclusive"
     assert v["twoplate.paper_check.scale_share_arithmetic"] == "holds"
-    assert v["twoplate.comparator_sigma.mean_of_L"] == "erratum"
+    assert v["twoplate.comparator_sigma.mean_of_L"] == "holds"
+    assert "erratum" not in v.values()
     assert v["twoplate.combined.iterations"] in ("holds", "fails")
     cs = read_table(out / "consistent_set.parquet").to_pydict()
     assert cs["claim"].count("ALL") == 5
@@ -258,4 +260,4 @@ def test_study_runs_small(tmp_path):
     ):
         assert (out / f"{fig}.png").is_file()
     text = report(out)
-    assert "Consistent sets" in text and "erratum" in text
+    assert "Consistent sets" in text and "Errata" in text
