@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 
+from sim.claims.book import ClaimBook
 from sim.claims.inference import (
     FAILS,
     HOLDS,
@@ -17,7 +18,7 @@ from sim.claims.inference import (
     parse_declaration,
     status,
 )
-from sim.claims.region import decide_over, region_table
+from sim.claims.region import decide_over, region_row, region_table
 from sim.mc.config import ConfigError
 
 A = Input("a_mm", 0.0, 10.0)
@@ -179,3 +180,26 @@ def test_declaration_validated():
         with pytest.raises(ConfigError) as e:
             parse_declaration(d)
         assert str(e.value).startswith(key), str(e.value)
+
+
+def test_region_row_carries_the_region_verdict():
+    book = ClaimBook(
+        [
+            {
+                "id": "b",
+                "source": "s",
+                "paper": "p",
+                "kind": "prediction",
+                "form": "lower",
+                "ref": 7.5,
+                "tol": 0.0,
+            }
+        ],
+        [],
+    )
+    r = region()
+    st = Statement("b", (7.5, 7.5), "lower")
+    row = region_row(book, "b", decide_over(r, st), r.points()["b_mm"], "extra")
+    assert row["verdict"] == "depends" and row["holds"] is None and row["interval"] == "region"
+    assert row["value"] == pytest.approx(r.bounds()["b_mm"][0]) and row["value_high"] <= 10
+    assert "holds for" in row["note"] and row["note"].endswith("extra")

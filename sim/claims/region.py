@@ -26,7 +26,14 @@ import numpy as np
 
 from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Region, Statement, status
 
-__all__ = ["RegionVerdict", "decide_over", "region_table", "REGION_VERDICTS", "OUTCOME_NAMES"]
+__all__ = [
+    "RegionVerdict",
+    "decide_over",
+    "region_table",
+    "region_row",
+    "REGION_VERDICTS",
+    "OUTCOME_NAMES",
+]
 
 REGION_VERDICTS = ("holds", "fails", "depends", "undecidable")
 OUTCOME_NAMES = {HOLDS: "holds", FAILS: "fails", UNDECIDED: "undecided"}
@@ -105,3 +112,33 @@ def region_table(
         v = np.asarray(ev["value"] if isinstance(ev, dict) else ev, float)
         cols[f"{vid}__value"] = v[acc].tolist()
     return cols
+
+
+def region_row(book, cid: str, rv: RegionVerdict, values, note: str = "") -> dict[str, Any]:
+    """The claims row of prediction ``cid`` decided over the region: ``value``/``value_high``
+    and the interval are the smallest and largest value over the region's points
+    (``interval = "region"``), ``outcome``/``verdict`` the region verdict (holds / fails /
+    depends / undecidable), and the note says where it holds and fails."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    lo, hi = (float(v.min()), float(v.max())) if v.size else (np.nan, np.nan)
+    row = book.score(cid, lo, (lo, lo) if v.size else (0.0, 0.0), "exact", value_high=hi)
+    where = {
+        "holds": f"holds at all {rv.n_points} points of the region",
+        "fails": f"fails at all {rv.n_points} points of the region",
+        "depends": f"holds for {rv.holds_where}; fails for {rv.fails_where} ({rv.note})",
+        "undecidable": f"undecidable: {rv.note}",
+    }[rv.verdict]
+    row.update(
+        ci_low=lo,
+        ci_high=hi,
+        value=lo,
+        interval="region",
+        outcome=rv.verdict,
+        verdict=rv.verdict if row["kind"] in ("prediction", "paper-check") else row["verdict"],
+        holds={"holds": True, "fails": False}.get(rv.verdict),
+        note="; ".join(x for x in (where, note) if x),
+    )
+    if row["kind"] == "paper-check" and rv.verdict == "fails":
+        row["verdict"], row["holds"] = "erratum", False
+    return row
