@@ -1,6 +1,6 @@
 """Figures of ``gridplate_two_plates``: residuals of one calibration, parameter spread,
 interval coverage against the weight ratio, chi-square rejection, implied grid sigma, and the
-claims against every unprinted input (consistent set)."""
+claims against every unprinted input (the consistent region, sim.report.region)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,6 @@ import numpy as np
 
 from sim.instruments import gridplate as gp
 from sim.instruments import transforms2d as t2
-from sim.report.outcome_map import fig_consistent  # noqa: F401  (one outcome map for both studies)
 from sim.report.plotting import plt, save
 from sim.studies.gridplate.model import PARAM_LABEL, PARAMS, truth_rows
 from sim.studies.gridplate.schema import UM
