@@ -133,7 +133,10 @@ def region_rows(
         rv = decide_over(region, st)
         ev = region.outputs[cid]
         v = np.asarray(ev["value"] if isinstance(ev, Mapping) else ev, float)
-        rows.append(region_row(book, cid, rv, v[region.accepted], (notes or {}).get(cid, "")))
+        va = v[region.accepted]
+        if not np.isfinite(va).any():  # an empty region: the range over every explored vector
+            va = v
+        rows.append(region_row(book, cid, rv, va, (notes or {}).get(cid, "")))
     return rows
 
 

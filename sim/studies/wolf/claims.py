@@ -80,14 +80,13 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
         "wolf.before.": f"over the pooled {S} calibration sets after the non-redundant two-point "
         f"reduction; distribution over {T} simulated instruments. The field "
         "amplitudes (field.*) were chosen so these look like the paper's; "
-        "unprinted.field_scales gives the factors that the claims allow",
+        "these rows constrain the consistent region (consistent_region.parquet)",
         "wolf.after.": f"residuals of the ten-term cubic fitted to the {S} pooled sets; "
         f"distribution over {T} instruments",
         "wolf.repeatability.": f"{cfg['repeat.n_points']} points of a simulated P-30 photograph "
         f"read {cfg['repeat.gap_weeks']:g} week(s) apart, each set "
         "corrected and fitted to its four fiducials; the default pointing "
-        "sigma was chosen from these (unprinted.pointing_sigmas_um "
-        "gives the values they allow)",
+        "sigma was chosen from these; they constrain the consistent region",
         "wolf.table2.": "Set 1 of the simulated photograph against a monocomparator reading "
         f"(sigma {cfg['mono.sigma_um']:g} um per coordinate, not printed), both "
         "fitted to the fiducials; every plate and set has the same simulated "
