@@ -12,7 +12,7 @@ size; the unprinted five-point layout and re-centring error are swept (consisten
 
 Modules: :mod:`.schema` (config and checks), :mod:`.simulate` and :mod:`.chunks` (one chunk
 of blocks and its adjustments), :mod:`.run` (through the runner), ``claims.toml`` +
-:mod:`.claims` (scoring), :mod:`.sweep` (consistent set), :mod:`.figures`, :mod:`.report`.
+:mod:`.claims` (scoring), :mod:`.region` (consistent region), :mod:`.figures`, :mod:`.report`.
 """
 
 from __future__ import annotations
