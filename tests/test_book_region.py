@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 from sim.claims.book import ClaimBook
-from sim.claims.book_region import load_declaration, region_rows, sample_evidence, statement
+from sim.claims.book_region import load_declaration, region_rows, sample_evidence
 from sim.claims.inference import FAILS, HOLDS, UNDECIDED, explore, status
+from sim.claims.region import statement_of
 from sim.mc.config import ConfigError
 
 BASE = {"source": "s", "paper": "p", "kind": "prediction"}
@@ -35,7 +36,7 @@ def test_statement_zone_is_the_books_zone(spec):
     """The inference statement of a claim decides on the zone the claim book writes."""
     book = _book(spec)
     row = book.score(spec["id"], 0.0, (0.0, 0.0), "exact")
-    zl, zh = statement(book.spec(spec["id"])).zone
+    zl, zh = statement_of(book, spec["id"]).zone
     assert zl == row["zone_low"] and zh == row["zone_high"]
 
 
@@ -52,7 +53,7 @@ def test_sample_evidence_matches_the_books_one_plate_rule():
         assert math.isclose(ev["low"][i], row["ci_low"]) and math.isclose(
             ev["high"][i], row["ci_high"]
         )
-    st = status(statement(spec), ev, 3)
+    st = status(statement_of(_book(spec), "a"), ev, 3)
     # far below the zone with p ~ 0: fails; centred: undecided (one plate spreads wider)
     assert st[0] == FAILS and st[2] == FAILS and st[1] == UNDECIDED
 
@@ -73,7 +74,7 @@ def test_region_rows_depend_on_where_the_prediction_holds():
     )
     (row,) = region_rows(book, reg, ["p"])
     assert row["verdict"] == "depends" and row["interval"] == "region"
-    held = reg.x["x_mm"][status(statement(book.spec("p")), reg.outputs["p"], reg.n) == HOLDS]
+    held = reg.x["x_mm"][status(statement_of(book, "p"), reg.outputs["p"], reg.n) == HOLDS]
     assert held.max() <= 0.3 and "x_mm" in row["note"]
 
 

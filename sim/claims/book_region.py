@@ -15,20 +15,19 @@ from __future__ import annotations
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.inference import Input, Region, Statement, parse_declaration
-from sim.claims.region import decide_over, region_row, region_table
+from sim.claims.inference import HOLDS, Input, Region, Statement, parse_declaration
+from sim.claims.region import decide_over, outcomes, region_row, region_table, statement_of
 from sim.mc.config import ConfigError
 from sim.mc.storage import write_table
 
 __all__ = [
     "Declaration",
     "load_declaration",
-    "statement",
     "statements",
     "sample_evidence",
     "region_rows",
@@ -88,22 +87,9 @@ def load_declaration(path: str | Path, book: ClaimBook) -> Declaration:
     return Declaration(inputs, hard + statements(book, cons), list(preds), ex)
 
 
-def statement(spec: Mapping[str, Any]) -> Statement:
-    """The inference statement of one claim-book spec (the same decision zone)."""
-    ref = spec["ref"] if isinstance(spec["ref"], list) else [spec["ref"], spec["ref"]]
-    return Statement(
-        spec["id"],
-        (float(ref[0]), float(ref[1])),
-        spec.get("form", "value"),
-        spec.get("decimals"),
-        float(spec.get("tol", 0.0)),
-        spec.get("paper", ""),
-        spec.get("source", ""),
-    )
-
-
 def statements(book: ClaimBook, ids: Sequence[str]) -> list[Statement]:
-    return [statement(book.spec(c)) for c in ids]
+    """The inference statements of claims ``ids`` (the book's decision zones)."""
+    return [statement_of(book, c) for c in ids]
 
 
 def sample_evidence(x: np.ndarray, ref: float | None = None) -> dict[str, np.ndarray]:
@@ -129,8 +115,7 @@ def region_rows(
     ``region.outputs``): holds / fails / depends (where) / undecidable."""
     rows = []
     for cid in ids:
-        st = statement(book.spec(cid))
-        rv = decide_over(region, st)
+        rv = decide_over(region, statement_of(book, cid))
         ev = region.outputs[cid]
         v = np.asarray(ev["value"] if isinstance(ev, Mapping) else ev, float)
         va = v[region.accepted]
@@ -144,40 +129,52 @@ def write_region(path, region: Region, book: ClaimBook, predictions: Sequence[st
     """``consistent_region.parquet``: one row per accepted input vector, the inputs (named with
     their units), ``confirmed``, one outcome column per statement and prediction, and the
     predictions' per-point median (``<id>__value``); beside it
-    ``consistent_region_inputs.parquet``: per input its possible range, the region's
-    projection, the design's resolution (interior, boundary) and why the range is what it is."""
+    ``region_inputs.parquet`` (the columns brown's studies write): per input why and its
+    declared range, the region's projection, the design's resolution (interior, boundary),
+    the projection of the points where every prediction holds together, and the counts."""
     cols = region_table(region, statements(book, predictions), predictions)
     write_table(path, cols, prov)
-    acc = region.accepted
+    sts = statements(book, predictions)
+    together = region.accepted.copy()
+    for st in sts:
+        together &= outcomes(region, st) == HOLDS
+    b, t = region.bounds(), region.bounds(together)
     inp = {
         k: []
         for k in (
             "input",
-            "possible_low",
-            "possible_high",
+            "why",
+            "declared_low",
+            "declared_high",
             "region_low",
             "region_high",
-            "resolution",
+            "resolution_interior",
             "resolution_boundary",
-            "why",
+            "together_low",
+            "together_high",
+            "n_points",
+            "n_region",
+            "n_together",
         )
     }
     for i in region.inputs:
-        x = region.x[i.name][acc]
         for k, v in zip(
             inp,
             (
                 i.name,
+                i.why,
                 i.low,
                 i.high,
-                float(x.min()) if x.size else float("nan"),
-                float(x.max()) if x.size else float("nan"),
+                *b[i.name],
                 *region.resolution[i.name],
-                i.why,
+                *t[i.name],
+                region.n,
+                int(region.accepted.sum()),
+                int(together.sum()),
             ),
         ):
             inp[k].append(v)
-    write_table(Path(path).with_name("consistent_region_inputs.parquet"), inp, prov)
+    write_table(Path(path).with_name("region_inputs.parquet"), inp, prov)
 
 
 def region_summary(region: Region) -> str:

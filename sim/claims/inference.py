@@ -361,13 +361,13 @@ def _scale(inputs: Sequence[Input], u: np.ndarray) -> dict[str, np.ndarray]:
     return {i.name: i.low + (i.high - i.low) * u[:, k] for k, i in enumerate(inputs)}
 
 
-def _boundary(u: np.ndarray, acc: np.ndarray, radius: float) -> np.ndarray:
-    """Points with a neighbour (within ``radius`` in the unit cube) of the other kind."""
-    if acc.all() or not acc.any():
+def _boundary(u: np.ndarray, label: np.ndarray, radius: float) -> np.ndarray:
+    """Points with a neighbour (within ``radius`` in the unit cube) of another label."""
+    if (label == label[0]).all():
         return np.zeros(len(u), bool)
     tree = cKDTree(u)
     nb = tree.query_ball_point(u, r=radius)
-    return np.array([acc[j].any() != acc[j].all() for j in nb])
+    return np.array([(label[j] != label[j[0]]).any() for j in nb])
 
 
 def explore(
@@ -381,6 +381,7 @@ def explore(
     per_point: int = 4,
     max_new: int = 4096,
     level: float = 0.95,
+    refine_on: Sequence[Statement] = (),
 ) -> Region:
     """The consistent region of ``inputs`` under ``statements`` (see the module doc).
 
@@ -388,6 +389,8 @@ def explore(
     (exact (N,) or (N, m) values, or a dict with ``value``/``low``/``high``/``p``); it may
     return more keys (predictions), kept in :attr:`Region.outputs`. ``rng`` seeds the
     scrambled design and the refinement. Inputs with ``low == high`` are fixed.
+    ``refine_on``: predictions (evaluated by the same model) whose holds/not-holds boundary
+    inside the region is refined as well, so that "holds for a-b" is resolved like the region.
     """
     if n < 2 or rounds < 0 or per_point < 1 or not 0 < level < 1:
         raise ValueError("explore: need n >= 2, rounds >= 0, per_point >= 1, 0 < level < 1")
@@ -406,7 +409,10 @@ def explore(
     st = evaluate(statements, out, len(u), level)
     for _ in range(rounds if free else 0):
         acc = (st != FAILS).all(axis=1)
-        edge = np.flatnonzero(_boundary(u[:, free], acc, 1.5 * h * math.sqrt(d)))
+        label = acc.astype(np.int64)
+        for k, p in enumerate(refine_on):
+            label += (2 << k) * (acc & (status(p, out[p.id], len(u), level) == HOLDS))
+        edge = np.flatnonzero(_boundary(u[:, free], label, 1.5 * h * math.sqrt(d)))
         if edge.size == 0:
             break
         if edge.size * per_point > max_new:

@@ -31,6 +31,8 @@ __all__ = [
     "decide_over",
     "region_table",
     "region_row",
+    "statement_of",
+    "evidence_of_row",
     "REGION_VERDICTS",
     "OUTCOME_NAMES",
 ]
@@ -54,9 +56,38 @@ class RegionVerdict:
 
     @property
     def text(self) -> str:
+        if self.verdict == "depends" and self.n_holds == 0:
+            return f"depends: holds nowhere; fails for {self.fails_where}, undecided elsewhere"
         if self.verdict == "depends":
             return f"depends: holds for {self.holds_where}; fails for {self.fails_where}"
         return self.verdict + (f" ({self.note})" if self.note else "")
+
+
+def statement_of(book, cid: str, form: str | None = None) -> Statement:
+    """A claim-book row (:class:`sim.claims.book.ClaimBook`) as a statement: its printed
+    reference, rounding and tol give the same decision zone as the book's rule."""
+    s = book.spec(cid)
+    ref = s["ref"] if isinstance(s["ref"], list) else [s["ref"], s["ref"]]
+    return Statement(
+        cid,
+        (float(ref[0]), float(ref[1])),
+        form or s["form"],
+        s.get("decimals"),
+        float(s["tol"]),
+        s["paper"],
+        s["source"],
+    )
+
+
+def evidence_of_row(row: dict) -> dict:
+    """A scored claims row as evidence at one point: its interval (and p for one-plate)."""
+    p = row.get("p_plate")
+    return {
+        "value": row["value"],
+        "low": row["ci_low"],
+        "high": row["ci_high"],
+        "p": p if row.get("form") == "one-plate" else None,
+    }
 
 
 def outcomes(region: Region, spec: Statement, evidence: Any = None) -> np.ndarray:
@@ -122,11 +153,20 @@ def region_row(book, cid: str, rv: RegionVerdict, values, note: str = "") -> dic
     v = np.asarray(values, float)
     v = v[np.isfinite(v)]
     lo, hi = (float(v.min()), float(v.max())) if v.size else (np.nan, np.nan)
-    row = book.score(cid, lo, (lo, lo) if v.size else (0.0, 0.0), "exact", value_high=hi)
+    if v.size:
+        row = book.score(cid, lo, (lo, lo), "exact", value_high=hi)
+    else:  # an empty region: no value (written as null), the verdict says why
+        row = book.score(cid, 0.0, (0.0, 0.0), "exact")
+        row.update(value_high=hi)
     where = {
         "holds": f"holds at all {rv.n_points} points of the region",
         "fails": f"fails at all {rv.n_points} points of the region",
-        "depends": f"holds for {rv.holds_where}; fails for {rv.fails_where} ({rv.note})",
+        "depends": (
+            f"holds for {rv.holds_where}; fails for {rv.fails_where} ({rv.note})"
+            if rv.n_holds
+            else f"holds nowhere in the region; fails for {rv.fails_where}, undecided at the "
+            f"rest ({rv.note})"
+        ),
         "undecidable": f"undecidable: {rv.note}",
     }[rv.verdict]
     row.update(

@@ -66,21 +66,22 @@ def fig_region(
 def region_markdown(out: Path, claims: list[dict]) -> str:
     """The report's opening for a study decided over its consistent region: the region (per
     input, its possible range and what the printed statements leave, with the resolution),
-    then the verdicts of the predictions over it (from ``consistent_region_inputs.parquet``
-    and the claims rows whose interval is ``region``)."""
+    then the verdicts of the predictions over it (from ``region_inputs.parquet``
+    and the claims rows whose interval is ``region``; ``region_inputs.parquet`` as brown's
+    studies write it)."""
 
-    t = read_table(out / "consistent_region_inputs.parquet").to_pylist()
+    t = read_table(out / "region_inputs.parquet").to_pylist()
     n = read_table(out / "consistent_region.parquet").num_rows
     rows = [
         [
             f"`{r['input']}`",
-            f"{_g(r['possible_low'])}-{_g(r['possible_high'])}",
+            f"{_g(r['declared_low'])}-{_g(r['declared_high'])}",
             "none" if r["region_low"] is None else f"{_g(r['region_low'])}-{_g(r['region_high'])}",
-            f"{_g(r['resolution'])} ({_g(r['resolution_boundary'])})",
+            f"{_g(r['resolution_interior'])} ({_g(r['resolution_boundary'])})",
             r["why"],
         ]
         for r in t
-        if r["possible_high"] > r["possible_low"]
+        if r["declared_high"] > r["declared_low"]
     ]
     verdicts = [
         [f"`{c['claim']}`", c["verdict"], c["note"].split("; at the configured")[0]]

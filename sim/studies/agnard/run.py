@@ -6,8 +6,8 @@ of the unprinted five-point control layout (:mod:`.region`). Every part goes thr
 the run context (executor, chunk store), with picklable chunk functions
 (:mod:`.chunks`), so ``--workers``, Dask and resumption after a kill apply.
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
-tables, ``region_five.parquet`` (per block and layout), ``consistent_region.parquet`` (+
-``_inputs``), ``region_layouts.parquet``,
+tables, ``region_five.parquet`` (per block and layout), ``consistent_region.parquet``,
+``region_inputs.parquet``, ``region_layouts.parquet``,
 ``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each sent to the run's
 workers, when it has some, as soon as its data exist: :func:`sim.report.figure_jobs.start_figures`).
 """

@@ -9,7 +9,7 @@ streams (reading-error table, the vector figure's instrument, one field draw, th
 Writes ``trials.parquet``, ``vectors.parquet``, ``components.parquet``, ``degree.parquet``,
 ``trials_degree.parquet``, ``readings.parquet``, ``stability.parquet``,
 ``table1_real.parquet``, ``table3_real.parquet``, ``consistent_region.parquet`` (and
-``consistent_region_inputs.parquet``), ``claims.parquet``, ``not_reproduced.parquet`` and the
+``region_inputs.parquet``), ``claims.parquet``, ``not_reproduced.parquet`` and the
 figures. Parts 2, 3, ...: the joint exploration of the unprinted inputs
 (:mod:`sim.studies.wolf.region`), one cells run per batch of input vectors.
 """
