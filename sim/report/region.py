@@ -13,8 +13,8 @@ import numpy as np
 
 from sim.claims.inference import Region
 from sim.mc.storage import read_table
-from sim.report.markdown import md_table
 from sim.report.plotting import plt, save
+from sim.report.tables import md_table
 
 __all__ = ["fig_region", "region_markdown"]
 
