@@ -2,7 +2,7 @@
 Nolette & Gagnon): block geometry, scanner, measurement, pugging, weights, control layouts,
 data snooping, trade-offs and the region of the unprinted five-point control layout; the
 cross-key rules (:func:`check`) and the small derived quantities every part uses
-(:func:`block_of`, :func:`model_sigmas`, the weights, the swept layouts).
+(:func:`block_of`, :func:`model_sigmas`, the weights, the layouts of the region).
 Units: lengths in m on the ground, mm and um on the photo, px of the scan.
 """
 
@@ -360,7 +360,7 @@ def snoop_weights(cfg: dict):
 
 
 def five_targets(block: Block, inset: float) -> np.ndarray:
-    """The swept five-point layout (5, 2): the corners of the ``five`` pattern moved inwards
+    """A five-point layout of the region (5, 2): the corners of the ``five`` pattern moved inwards
     along the strips by ``inset`` times the block length, and the centre."""
     t = control_targets(block, "five")
     x0, x1 = t[:4, 0].min(), t[:4, 0].max()

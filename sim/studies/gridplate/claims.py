@@ -177,7 +177,7 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
             note=f"sqrt(sum(vx^2+vy^2)/(2N-4)) of a similarity fit, grid fixed, two plates "
             f"pooled; the comparator's scale difference ({cfg['comparator.scale_diff_ppm']:g}"
             f' ppm) and non-orthogonality ({cfg["comparator.nonorth_arcsec"]:g}") are not '
-            "printed: swept in consistent_set.parquet.",
+            "printed: an example; the region (consistent_region.parquet) decides this row.",
         )
     )
     add(
@@ -272,7 +272,7 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
             (lo / a_med - 1, hi / a_med - 1),
             note=f"Monte-Carlo median of the affine sigma {med:.4f} um against the analytic "
             f"{a_med:.4f} um (chi-square, {nu} degrees of freedom), relative; the sweep "
-            "(consistent_set) uses these chi-square distributions.",
+            "(consistent_region.parquet) uses these chi-square distributions.",
         )
     )
     for i in range(len(beyond["param"])):

@@ -23,7 +23,11 @@ SCHEMA = {
     ),
     "chunk": Field(250, "int", "trials per chunk", lo=1, hi=100_000),
     "plate.grid": Field(
-        5, "int", "points per side of each grid plate (k x k); not printed, swept", lo=3, hi=15
+        5,
+        "int",
+        "points per side of each grid plate (k x k); not printed, an example (region.toml)",
+        lo=3,
+        hi=15,
     ),
     "plate.spacing_mm": Field(
         40.0, "float", "grid spacing (mm); not printed", lo=1.0, hi=100.0, unit="mm"
@@ -37,7 +41,7 @@ SCHEMA = {
         hi=45.0,
         unit="deg",
     ),
-    "readings.count": Field(4, "int", "readings L per point; not printed, swept", lo=2, hi=50),
+    "readings.count": Field(4, "int", "readings L per point; not printed", lo=2, hi=50),
     "readings.sigma_um": Field(
         1.5,
         "float",
@@ -62,7 +66,7 @@ SCHEMA = {
     "comparator.scale_diff_ppm": Field(
         15.0,
         "float",
-        "S' - S of the comparator (ppm); not printed, swept with eps in proportion",
+        "S' - S of the comparator (ppm); not printed, an example (region.toml explores it, eps in proportion)",
         lo=-1e4,
         hi=1e4,
         unit="ppm",
@@ -79,7 +83,7 @@ SCHEMA = {
         0.7,
         "float",
         "true sigma of the grid-plate coordinates; not "
-        "printed (the paper gives the stated one), swept",
+        "printed (the paper gives the stated one), an example (region.toml)",
         lo=0.0,
         hi=50.0,
         unit="um",

@@ -2,8 +2,9 @@
 
 Keys marked *input* carry a number the paper prints. The magnitudes the paper does not print
 (B8 marking error, comparator error, control relief, vertical error, number of control
-points, the glass-scale span and setting error, the grid spacing) are swept by
-the consistent region where a prediction depends on them (:mod:`sim.studies.salsig.region`).
+points, the glass-scale span and setting error, the grid spacing) are examples: the B8 and
+comparator errors are set to reproduce the printed unit-weight errors (inputs), and the
+vertical test's are explored in the consistent region (:mod:`sim.studies.salsig.region`).
 """
 
 from __future__ import annotations
@@ -48,8 +49,8 @@ SCHEMA = {
     "b8.sigma_um": Field(
         25.0,
         "float",
-        "B8 marking error per coordinate (model space); not printed, swept "
-        "(FIG. 3's unit-weight error .002 digit is the claim it decides)",
+        "B8 marking error per coordinate (model space); not printed, set to reproduce "
+        "FIG. 3's unit-weight error .002 digit (an input)",
         lo=0.0,
         lo_open=True,
         hi=1000.0,
@@ -71,8 +72,8 @@ SCHEMA = {
         3.0,
         "float",
         "comparator error per coordinate for grid "
-        "intersections and film marks; not printed, swept (FIG. 2's "
-        "unit-weight error .003 mm is the claim it decides)",
+        "intersections and film marks; not printed, set to reproduce FIG. 2's "
+        "unit-weight error .003 mm (an input)",
         lo=0.0,
         lo_open=True,
         hi=100.0,

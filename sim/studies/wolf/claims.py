@@ -44,11 +44,6 @@ def stat_key(cid: str) -> str | None:
     return None
 
 
-def swept_claims(book: ClaimBook) -> list[str]:
-    """The claims that depend on the swept inputs (pointing sigma, field amplitudes, mono sigma)."""
-    return [c for c in book.specs if stat_key(c) is not None or c == HEADLINE]
-
-
 def _spread(x) -> tuple[np.ndarray, np.ndarray]:
     lo, hi = np.percentile(np.asarray(x, float), [2.5, 97.5])
     return np.array([lo]), np.array([hi])
