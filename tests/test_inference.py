@@ -203,3 +203,20 @@ def test_region_row_carries_the_region_verdict():
     assert row["verdict"] == "depends" and row["holds"] is None and row["interval"] == "region"
     assert row["value"] == pytest.approx(r.bounds()["b_mm"][0]) and row["value_high"] <= 10
     assert "holds for" in row["note"] and row["note"].endswith("extra")
+
+
+def test_refine_on_resolves_where_a_prediction_holds():
+    pred = Statement("b", (7.5, 7.5), "lower")
+    plain = region(rounds=3)
+    refined = explore(
+        [A, B], [SUM, A_UP], model, np.random.default_rng(1), n=1024, rounds=3, refine_on=[pred]
+    )
+    h = refined.resolution["b_mm"][1]
+
+    def low(r):
+        return decide_over(r, pred).holds_where.split("b_mm ")[1].split("-")[0]
+
+    # the refined lower end of "holds for b >= 7.5" is within the boundary spacing of 7.5,
+    # and closer than the unrefined one
+    assert 7.5 <= float(low(refined)) <= 7.5 + h
+    assert float(low(refined)) - 7.5 <= float(low(plain)) - 7.5

@@ -52,7 +52,7 @@ CONCEPT_PREDICTIONS = (
 #: points per side of the format's edge at which "points near the edges" are evaluated
 EDGE_POINTS = 25
 #: grids of the "more points, less dilution" prediction over the region (same extent)
-MONOTONE_GRIDS = (3, 4, 5, 7, 10)
+MONOTONE_GRIDS = (3, 5, 7)
 
 
 def inputs(names):
