@@ -10,7 +10,9 @@ kill and replaces ``<out>`` only when everything succeeded, a ``[sweep]`` over t
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import os
+import re
 import shutil
 import sys
 from pathlib import Path
@@ -45,6 +47,7 @@ def _check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
 
     if not out.name or out == out.parent:
         raise ConfigError("--out", f"{shown} is not a directory the suite can write into")
+    _check_not_nested(out, shown)
     if out.is_symlink():
         raise ConfigError("--out", f"{shown} is a symbolic link; sim never replaces it")
     if not out.exists():
@@ -72,6 +75,61 @@ def _check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
         else "a different code version"
     )
     raise ConfigError("--out", f"{shown} holds results of {why}; use --overwrite to replace it")
+
+
+#: a Dask scheduler address: tcp://HOST:PORT (or another Dask protocol)
+_SCHEDULER = re.compile(
+    r"^(?:(?:tcp|tls|ucx|ws|wss)://)?(?:\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+)"
+    r":(\d{1,5})/?$"
+)
+
+
+def _check_options(executor: Any, workers: Any, scheduler: Any) -> None:
+    """The run options every door passes (``sim run``, the Python API): one line naming the
+    option."""
+    if executor not in ("local", "dask"):
+        raise ConfigError("executor", f"must be 'local' or 'dask' (got {executor!r})")
+    top = max(4 * (os.cpu_count() or 1), 8)
+    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)):
+        raise ConfigError("workers", f"must be an integer between 1 and {top} (got {workers!r})")
+    if not 1 <= workers <= top:
+        raise ConfigError("workers", f"must be between 1 and {top} (got {workers})")
+    if scheduler is not None:
+        m = _SCHEDULER.match(scheduler) if isinstance(scheduler, str) else None
+        if not m or not 0 < int(m.group(1)) < 65536:
+            raise ConfigError(
+                "scheduler", f"not a scheduler address like tcp://HOST:8786 (got {scheduler!r})"
+            )
+        if executor != "dask":
+            raise ConfigError("scheduler", "needs executor dask")
+
+
+def _check_not_nested(out: Path, shown: str) -> None:
+    """Refuse an output directory inside another run's results or staging directory (its
+    ``run.json``, its ``.partial`` staging directory or its ``trials/`` dataset): a re-run of
+    that study would replace it, and chunk files there would join that run's trials."""
+    for up in out.parents:
+        if up == up.parent:
+            break
+        if (up / "run.json").is_file() or up.name.endswith(".partial") or up.name == "trials":
+            raise ConfigError(
+                "--out",
+                f"{shown} lies inside {up}, which belongs to another run; choose a directory "
+                "outside every results directory",
+            )
+
+
+def _damage(stage: Path) -> str | None:
+    """What is wrong with a staging directory's chunk store, if anything: a chunk path that is
+    not a regular file (a directory, a link)."""
+    t = stage / "trials"
+    if t.is_symlink() or (t.exists() and not t.is_dir()):
+        return f"{t} is not a directory"
+    if t.is_dir():
+        for p in sorted(t.rglob("*")):
+            if p.is_symlink() or (p.name.startswith("chunk-") and not p.is_file()):
+                return f"{p} is not a chunk file"
+    return None
 
 
 def _same(a: dict | None, b: dict) -> bool:
@@ -125,6 +183,15 @@ def _prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: 
     except OSError as e:
         raise ConfigError("--out", f"cannot write to {out.parent}: {e.strerror}") from None
     try:
+        damage = _damage(stage) if stage.is_dir() else None
+        if damage is not None:
+            if not overwrite:
+                raise ConfigError(
+                    "--out",
+                    f"the staging directory of {shown} is damaged ({damage}); "
+                    "run again with --overwrite to replace it",
+                )
+            _clear(stage)
         old = read_record(stage)
         resumed = 0
         if old is not None and _same(old, record) and not old.get("failed"):
@@ -229,6 +296,7 @@ def execute(
     Returns the run's :class:`sim.mc.estimate.Estimate`."""
 
     shown = shown or str(out)
+    _check_options(executor, workers, scheduler)
     check_chunks(cfg)
     est = estimate(cfg, sweep)
     check_limits(est, max_memory_gb, max_adjustments, workers)
@@ -280,6 +348,7 @@ def execute(
     ex.close()
     try:
         _check_out(out, shown, record, True)  # again, under the lock: still ours or absent
+        _seal(stage, ctx.store)
         _publish(stage, out)
     except BaseException:
         _drop_stage(stage, lock)
@@ -288,11 +357,62 @@ def execute(
     return est
 
 
-def _publish(stage: Path, out: Path) -> None:
-    """Replace ``out`` (checked: ours or absent) by the finished staging directory."""
+def _files(d: Path) -> list[str]:
+    """The regular files under ``d`` (relative, POSIX), but the run record and the lock."""
+    return sorted(
+        p.relative_to(d).as_posix()
+        for p in d.rglob("*")
+        if p.is_file() and not p.is_symlink() and p.name not in ("run.json", LOCK)
+    )
 
+
+def _seal(stage: Path, store: ChunkStore | None) -> None:
+    """Before publishing: drop chunk files this run neither wrote nor read (left over or copied
+    in), and record in ``run.json`` every file the run wrote and each chunk file's sha256, so
+    that a later run keeps a file it did not write and a reader can check a chunk's content."""
+    if store is not None:
+        for p in store.strays():
+            p.unlink()
+    files = _files(stage)
+    chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
+    write_record(stage, {**read_record(stage), "files": files, "chunk_sha256": chunks})
+
+
+def _sha256(p: Path) -> str:
+    h = hashlib.sha256()
+    with open(p, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _foreign(out: Path) -> list[str]:
+    """Files in an earlier results directory that its run did not write (a user's notes):
+    they are carried into the new results. Results recorded before runs listed their files
+    count as wholly written by the suite."""
+    rec = read_record(out)
+    if not rec or "files" not in rec:
+        return []
+    mine = set(rec["files"])
+    return [f for f in _files(out) if f not in mine]
+
+
+def _publish(stage: Path, out: Path) -> None:
+    """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
+    files in ``out`` that the suite did not write."""
     for tmp in stage.rglob("*.tmp"):
         tmp.unlink(missing_ok=True)
+    keep = _foreign(out) if out.is_dir() else []
+    clash = [f for f in keep if (stage / f).exists()]
+    if clash:
+        raise ConfigError(
+            "--out",
+            f"{out / clash[0]} was not written by sim but the new run writes a file of that "
+            "name; move it away and run again",
+        )
+    for f in keep:
+        (stage / f).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(out / f, stage / f)
     old = out.parent / f".{out.name}.old.{os.getpid()}"
     if out.exists():
         os.replace(out, old)
