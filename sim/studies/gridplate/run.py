@@ -44,7 +44,9 @@ def decide_over_region(cfg: dict, book, rows: list[dict], out: Path, prov) -> li
         out / "consistent_region.png",
         title="seed 001: unprinted inputs left by the printed statements",
         nominal=nominal(cfg),
-        boundary={("grid_points_1", "spacing_mm"): lambda g: 230.0 / np.maximum(g - 1, 1e-9)},
+        boundary={
+            ("grid_points_1", "spacing_mm"): lambda g: 230.0 / np.maximum(np.round(g) - 1, 1)
+        },
     )
     by = {r["claim"]: r for r in rows}
     fresh = type(book)(list(book.specs.values()), [], book.path)
