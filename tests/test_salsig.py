@@ -193,12 +193,18 @@ def test_study_runs_small(tmp_path):
         "paper_check.mark_spacing_mm",
     ):
         assert v["salsig." + q] == "holds", q
-    # 'cut roughly in half' over models this spread cannot be a hold
-    assert v["salsig.vertical_halved.rms_ratio"] in ("inconclusive", "fails")
-    assert v["salsig.vertical_halved.dramatic_horizontal"] in ("holds", "fails", "inconclusive")
-    cs = read_table(out / "consistent_set.parquet").to_pydict()
-    assert cs["claim"].count("ALL") == 5
-    for fig in ("residuals", "recovery", "power", "vertical", "consistent_set"):
+    # decided over the region of the unprinted relief, errors and control (never at one
+    # nominal relief); 'cut roughly in half' over models this spread cannot hold everywhere
+    assert v["salsig.vertical_halved.rms_ratio"] in ("depends", "fails", "undecidable")
+    assert v["salsig.vertical_halved.dramatic_horizontal"] in (
+        "holds",
+        "fails",
+        "depends",
+        "undecidable",
+    )
+    reg = read_table(out / "consistent_region.parquet").to_pydict()
+    assert len(reg["relief_mm"]) == 8  # nothing printed constrains them: every vector stays
+    for fig in ("residuals", "recovery", "power", "vertical", "consistent_region"):
         assert (out / f"{fig}.png").is_file()
     text = report(out)
-    assert "Consistent sets" in text and "erratum" in text
+    assert "Consistent region" in text and "erratum" in text

@@ -8,11 +8,12 @@ measurements, forms the models, and adjusts the block several ways: with and wit
 scanner correction (Table 1), with 5 and 21 control points (Tables 2 and 3), with weak
 control (the first pass), and with data snooping of the pass points under digital and
 mechanical pugging. Trade-offs: scanner resolution x calibration, control layout, block
-size; the unprinted five-point layout and re-centring error are swept (consistent set).
+size; the unprinted five-point layout is explored in the consistent region (region.toml),
+the re-centring error of mechanical pugging set to reproduce the printed share (an input).
 
 Modules: :mod:`.schema` (config and checks), :mod:`.simulate` and :mod:`.chunks` (one chunk
 of blocks and its adjustments), :mod:`.run` (through the runner), ``claims.toml`` +
-:mod:`.claims` (scoring), :mod:`.sweep` (consistent set), :mod:`.figures`, :mod:`.report`.
+:mod:`.claims` (scoring), :mod:`.region` (consistent region), :mod:`.figures`, :mod:`.report`.
 """
 
 from __future__ import annotations

@@ -166,16 +166,16 @@ def size_chunk(
     return out
 
 
-def sweep_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dict:
-    """The unprinted five-point layout swept (``sweep.five_inset``): the 5-control pass
-    adjusted once per swept layout on the same simulated blocks."""
+def sweep_chunk(cfg: dict, block: Block, insets, rng: np.random.Generator, n: int) -> dict:
+    """The unprinted five-point layout at each of ``insets`` (the region's input vectors): the
+    5-control pass adjusted once per layout on the same simulated blocks."""
     keep_heap()
     adj = Adjuster(block)
     wo, wc = paper_weights(cfg)
     sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], uncorrected=False)
     out: dict[str, np.ndarray] = {}
     _, _, start = adj.adjust(sim, ("digital", "corrected"), cfg["control.many"], wo, wc)
-    for i, u in enumerate(cfg["sweep.five_inset"]):
+    for i, u in enumerate(insets):
         ctrl, _, res = adj.adjust(
             sim, ("digital", "corrected"), five_control(block, u), wo, wc, start=start
         )

@@ -1,6 +1,6 @@
 """Figures of ``agnard_block`` (seed ``003_5ce730a990a7ebc5.txt``): one drawn scanner field
 before and after calibration, the block layout, check-point error vectors, the trade-offs,
-and the consistent set of the unprinted inputs (claims against the swept input)."""
+and the five-point layouts of the consistent region."""
 
 from __future__ import annotations
 
@@ -132,7 +132,7 @@ def fig_layout(block: Block, ctrl5, ctrl21, path: Path, sweep_ctrl=(), insets=()
             color=plt.cm.viridis(i / max(len(insets) - 1, 1)),
             ms=12 + 3 * i,
             lw=0.8,
-            label=f"swept five, inset {u:g}",
+            label=f"region five, inset {u:.2f}",
         )
     ax.set_aspect("equal")
     ax.set_xlabel("X along the strips (m)")
@@ -247,58 +247,4 @@ def fig_tradeoffs(scan_t: dict, lay_t: dict, size_t: dict, path: Path) -> None:
     ax.set_ylabel("rms error (m)")
     ax.set_title("block size (perimeter control)")
     ax.legend(fontsize=7)
-    save(fig, path)
-
-
-def fig_consistent(sweep: dict, cs: dict, path: Path) -> None:
-    """Per swept input and claim: the simulated median and 95 % plate range against the
-    input, the paper's value band (decision zone), the consistent set shaded."""
-    panels = list(dict.fromkeys(zip(sweep["input"], sweep["claim"])))
-    ncol = min(4, len(panels))
-    nrow = -(-len(panels) // ncol)
-    fig, axs = plt.subplots(nrow, ncol, figsize=(3.6 * ncol, 3.0 * nrow), squeeze=False)
-    fig.subplots_adjust(wspace=0.45, hspace=0.8)
-    col = {"holds": "tab:green", "inconclusive": "tab:orange", "fails": "tab:red"}
-    for ax, (inp, cl) in zip(axs.flat, panels):
-        sel = [
-            k
-            for k, (i, c) in enumerate(zip(sweep["input"], sweep["claim"]))
-            if i == inp and c == cl
-        ]
-        x = np.asarray(sweep["value"])[sel]
-        med, lo, hi = (np.asarray(sweep[q])[sel] for q in ("median", "lo", "hi"))
-        zl, zh = sweep["zone_low"][sel[0]], sweep["zone_high"][sel[0]]
-        ax.axhspan(
-            zl if np.isfinite(zl) else min(0.0, lo.min()),
-            zh if np.isfinite(zh) else hi.max(),
-            color="0.85",
-        )
-        ax.errorbar(x, med, yerr=[med - lo, hi - med], fmt="none", ecolor="0.4", capsize=2)
-        for k in sel:
-            ax.plot(
-                sweep["value"][k],
-                sweep["median"][k],
-                "o",
-                color=col.get(sweep["outcome"][k], "k"),
-                ms=5,
-            )
-        allrow = [
-            k for k, (i, c) in enumerate(zip(cs["input"], cs["claim"])) if i == inp and c == "ALL"
-        ]
-        a_lo, a_hi = cs["ok_low"][allrow[0]], cs["ok_high"][allrow[0]]
-        if np.isfinite(a_lo):
-            pad = 0.02 * (x.max() - x.min() or 1.0)
-            ax.axvspan(a_lo - pad, a_hi + pad, color="tab:green", alpha=0.15)
-        ax.set_title(cl.replace("agnard.", ""), fontsize=8)
-        ax.set_xlabel(inp, fontsize=8)
-        ax.set_ylabel(sweep["unit"][sel[0]], fontsize=8)
-        ax.tick_params(labelsize=7)
-    for ax in list(axs.flat)[len(panels) :]:
-        ax.axis("off")
-    fig.suptitle(
-        "claims against the unprinted inputs: dot = median block, bar = 95 % of blocks, "
-        "grey = paper's decision zone;\ndot green: holds, orange: inconclusive, red: "
-        "fails; green band: consistent set (no claim of that input fails)",
-        fontsize=9,
-    )
     save(fig, path)

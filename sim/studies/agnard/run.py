@@ -1,12 +1,13 @@
 """Run of ``agnard_block`` (seed ``003_5ce730a990a7ebc5.txt``) through the runner.
 
 Streams (``part``): 0 the 2 x 8 block with every adjustment of the paper; then one per scan
-resolution, one per block size, one per mechanical re-centring error, and one for the sweep
-of the five-point control layout. Every part goes through :func:`sim.mc.runner.run_chunks` with
+resolution, one per block size, one per mechanical re-centring error, and one for the region
+of the unprinted five-point control layout (:mod:`.region`). Every part goes through :func:`sim.mc.runner.run_chunks` with
 the run context (executor, chunk store), with picklable chunk functions
 (:mod:`.chunks`), so ``--workers``, Dask and resumption after a kill apply.
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
-tables, ``sweep_five.parquet``, ``sweep_claims.parquet``, ``consistent_set.parquet``,
+tables, ``region_five.parquet`` (per block and layout), ``consistent_region.parquet``,
+``region_inputs.parquet``, ``region_layouts.parquet``,
 ``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each sent to the run's
 workers, when it has some, as soon as its data exist: :func:`sim.report.figure_jobs.start_figures`).
 """
@@ -18,19 +19,21 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.claims.book import write_claims
+from sim.claims.book import ClaimBook, write_claims
+from sim.claims.book_region import region_rows, write_region
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
 from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import start_figures
+from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.agnard import chunks as ch
 from sim.studies.agnard import figures as fg
 from sim.studies.agnard.claims import claim_rows, load_book
+from sim.studies.agnard.region import explore_region
 from sim.studies.agnard.schema import NAME, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
-from sim.studies.agnard.sweep import RECENTRE_CLAIMS, evaluate, five_samples
 
 
 def _mean_se(x: np.ndarray) -> tuple[float, float]:
@@ -228,6 +231,41 @@ def _pugging(cfg, block, sim, ctx, base, prov, out):
     return per
 
 
+def _five_region(cfg, block, book, rows, ctx, part, prov, out):
+    """Explore the five-point layout (``region.toml``), write its tables and figure, and
+    replace the 5-control rows by their verdicts over the region (the configured layout's
+    result kept in the note as an example). Returns the rows and the explored insets."""
+    region, preds, stats = explore_region(
+        cfg,
+        block,
+        book,
+        lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx),
+        part,
+    )
+    write_region(out / "consistent_region.parquet", region, book, preds, prov)
+    insets = [float(u) for u in region.x["five_inset_1"]]
+    T = cfg["region.trials"]
+    tab = {"inset": np.repeat(insets, T), "trial": np.tile(np.arange(T), len(insets))}
+    for c in preds:
+        tab[c.split(".", 1)[1]] = np.concatenate([s[c] for s in stats])
+    write_table(out / "region_five.parquet", tab, prov)
+    fig_region(
+        region,
+        out / "consistent_region.png",
+        title="seed 003: the lost five-point layout (no printed statement constrains it)",
+        nominal={"five_inset_1": 0.0},
+    )
+    by = {r["claim"]: r for r in rows}
+    fresh = ClaimBook(list(book.specs.values()), [], book.path)
+    notes = {
+        c: f"at the configured layout (an example): median {by[c]['value']:.3g} cm, 95 % of "
+        f"blocks {by[c]['ci_low']:.3g}-{by[c]['ci_high']:.3g}, outcome {by[c]['outcome']}"
+        for c in preds
+    }
+    new = {r["claim"]: r for r in region_rows(fresh, region, preds, notes)}
+    return [new.get(r["claim"], r) for r in rows], insets
+
+
 def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     block = block_of(cfg)
     prov = provenance(cfg, sparse_from_models=im.SPARSE_FROM_MODELS)
@@ -235,18 +273,8 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     T = cfg["trials"]
     c5 = select_control(block, cfg["control.few"])
     c21 = select_control(block, cfg["control.many"])
-    insets = cfg["sweep.five_inset"]
-    ctrl_idx = [five_control(block, u) for u in insets]
     # figures go to idle workers as soon as their data exist (sim.report.figure_jobs.start_figures)
-    drawn = [
-        start_figures(
-            [
-                (fg.fig_scanner, (cfg, out / "scanner_field.png")),
-                (fg.fig_layout, (block, c5, c21, out / "block_layout.png", ctrl_idx, insets)),
-            ],
-            ctx.executor,
-        )
-    ]
+    drawn = [start_figures([(fg.fig_scanner, (cfg, out / "scanner_field.png"))], ctx.executor)]
     sim = _run(partial(ch.main_chunk, cfg, block), T, cfg, 0, "2x8 block", ctx)
     per_trial = {k: v for k, v in sim.items() if not k.startswith(ch.CHUNK)}
     write_table(out / "trials.parquet", {"trial": np.arange(T), **per_trial}, prov)
@@ -279,31 +307,12 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     pug = _pugging(cfg, block, per_trial, ctx, base, prov, out)
     base += len(cfg["tradeoff.recentre_px"])
 
-    # --- the unprinted five-point layout, swept
-    sw = _run(
-        partial(ch.sweep_chunk, cfg, block),
-        cfg["sweep.trials"],
-        cfg,
-        base,
-        "five-point layouts",
-        ctx,
-    )
-    sweep_t = {
-        "inset": np.repeat(insets, cfg["sweep.trials"]),
-        "trial": np.tile(np.arange(cfg["sweep.trials"]), len(insets)),
-    }
-    for k in sorted({k.split(".", 1)[1] for k in sw}):
-        sweep_t[k] = np.concatenate([sw[f"inset{i}.{k}"] for i in range(len(insets))])
-    write_table(out / "sweep_five.parquet", sweep_t, prov)
-    sweeps = {
-        "sweep.five_inset": {float(u): five_samples(sw, i) for i, u in enumerate(insets)},
-        "pugging.recentre_px": {rc: {RECENTRE_CLAIMS[0]: s} for rc, s in pug.items()},
-    }
-    long, cs = evaluate(book, sweeps)
-    write_table(out / "sweep_claims.parquet", long, prov)
-    write_table(out / "consistent_set.parquet", cs, prov)
+    # --- the unprinted five-point layout: its region, the 5-control rows decided over it
+    rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book)
+    rows, insets = _five_region(cfg, block, book, rows, ctx, base, prov, out)
+    ctrl_idx = [five_control(block, u) for u in insets]
     write_table(
-        out / "sweep_layouts.parquet",
+        out / "region_layouts.parquet",
         {
             "inset": np.repeat(insets, 5),
             "point": np.concatenate(ctrl_idx),
@@ -312,18 +321,12 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         },
         prov,
     )
-
-    write_claims(
-        out / "claims.parquet",
-        claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book),
-        prov,
-        book,
-    )
+    write_claims(out / "claims.parquet", rows, prov, book)
     drawn.append(
         start_figures(
             [
-                (fg.fig_consistent, (long, cs, out / "consistent_set.png")),
                 (fg.fig_tradeoffs, (scan_t, lay_t, size_t, out / "tradeoffs.png")),
+                (fg.fig_layout, (block, c5, c21, out / "block_layout.png", ctrl_idx, insets)),
             ],
             ctx.executor,
         )

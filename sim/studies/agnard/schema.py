@@ -1,8 +1,8 @@
 """Configuration schema of ``agnard_block`` (seed ``003_5ce730a990a7ebc5.txt``, Agnard,
 Nolette & Gagnon): block geometry, scanner, measurement, pugging, weights, control layouts,
-data snooping, trade-offs and the sweep of the unprinted five-point control layout; the
+data snooping, trade-offs and the region of the unprinted five-point control layout; the
 cross-key rules (:func:`check`) and the small derived quantities every part uses
-(:func:`block_of`, :func:`model_sigmas`, the weights, the swept layouts).
+(:func:`block_of`, :func:`model_sigmas`, the weights, the layouts of the region).
 Units: lengths in m on the ground, mm and um on the photo, px of the scan.
 """
 
@@ -243,20 +243,15 @@ SCHEMA = {
         lo=1,
         hi=10_000,
     ),
-    "sweep.trials": Field(
-        150, "int", "trials per value of the swept five-point control layout", lo=2, hi=1_000_000
+    "region.trials": Field(
+        150,
+        "int",
+        "simulated blocks per input vector of the region (region.toml)",
+        lo=2,
+        hi=1_000_000,
     ),
-    "sweep.five_inset": Field(
-        [0.0, 0.08, 0.17, 0.25, 0.33],
-        "list[float]",
-        "unprinted input "
-        "(Figure 5 lost): the four outer control points of the five-point "
-        "layout moved inwards along the strips by this share of the block "
-        "length (0: block corners; 1/6, 1/3: the second and third column "
-        "of a 3 x 7 layout of 21), the fifth at the centre",
-        lo=0.0,
-        hi=0.45,
-        min_len=2,
+    "region.points": Field(
+        8, "int", "five-point layouts of the region's space-filling design", lo=2, hi=64
     ),
 }
 
@@ -277,8 +272,6 @@ def check(cfg: dict) -> None:
         )
     if cfg["block.strips"] * cfg["block.models"] < 2:
         raise ConfigError("block.models", "a block needs at least two models")
-    if len(set(cfg["sweep.five_inset"])) != len(cfg["sweep.five_inset"]):
-        raise ConfigError("sweep.five_inset", "values must be distinct")
     # memory of the largest adjustment: trials x observation pairs x 7 x 7 doubles per chunk
     try:
         block = block_of(cfg)
@@ -367,7 +360,7 @@ def snoop_weights(cfg: dict):
 
 
 def five_targets(block: Block, inset: float) -> np.ndarray:
-    """The swept five-point layout (5, 2): the corners of the ``five`` pattern moved inwards
+    """A five-point layout of the region (5, 2): the corners of the ``five`` pattern moved inwards
     along the strips by ``inset`` times the block length, and the centre."""
     t = control_targets(block, "five")
     x0, x1 = t[:4, 0].min(), t[:4, 0].max()

@@ -2,8 +2,8 @@
 
 Keys marked *input* carry a number the paper prints. Every other magnitude the paper does not
 print (grid size and spacing, readings per point, the comparator's scale difference and
-non-orthogonality, the true grid sigma) is swept by ``consistency.*`` (see
-:mod:`sim.studies.gridplate.sweep`). :func:`check` enforces what the model can compute.
+non-orthogonality, the true grid sigma) is explored jointly over its possible range (see
+:mod:`sim.studies.gridplate.region`; ``region.*`` sizes the exploration). :func:`check` enforces what the model can compute.
 """
 
 from __future__ import annotations
@@ -23,7 +23,11 @@ SCHEMA = {
     ),
     "chunk": Field(250, "int", "trials per chunk", lo=1, hi=100_000),
     "plate.grid": Field(
-        5, "int", "points per side of each grid plate (k x k); not printed, swept", lo=3, hi=15
+        5,
+        "int",
+        "points per side of each grid plate (k x k); not printed, an example (region.toml)",
+        lo=3,
+        hi=15,
     ),
     "plate.spacing_mm": Field(
         40.0, "float", "grid spacing (mm); not printed", lo=1.0, hi=100.0, unit="mm"
@@ -37,7 +41,7 @@ SCHEMA = {
         hi=45.0,
         unit="deg",
     ),
-    "readings.count": Field(4, "int", "readings L per point; not printed, swept", lo=2, hi=50),
+    "readings.count": Field(4, "int", "readings L per point; not printed", lo=2, hi=50),
     "readings.sigma_um": Field(
         1.5,
         "float",
@@ -62,7 +66,7 @@ SCHEMA = {
     "comparator.scale_diff_ppm": Field(
         15.0,
         "float",
-        "S' - S of the comparator (ppm); not printed, swept with eps in proportion",
+        "S' - S of the comparator (ppm); not printed, an example (region.toml explores it, eps in proportion)",
         lo=-1e4,
         hi=1e4,
         unit="ppm",
@@ -79,7 +83,7 @@ SCHEMA = {
         0.7,
         "float",
         "true sigma of the grid-plate coordinates; not "
-        "printed (the paper gives the stated one), swept",
+        "printed (the paper gives the stated one), an example (region.toml)",
         lo=0.0,
         hi=50.0,
         unit="um",
@@ -140,52 +144,16 @@ SCHEMA = {
         lo=1,
         hi=10_000,
     ),
-    "consistency.grid": Field(
-        [3, 4, 5, 6, 7, 8, 9, 10, 11, 13, 15],
-        "list[int]",
-        "plate.grid values swept for the consistent set",
-        lo=3,
-        hi=15,
-        min_len=2,
+    "region.points": Field(
+        128, "int", "input vectors of the space-filling design (region.toml)", lo=4, hi=65536
     ),
-    "consistency.spacing_mm": Field(
-        [10.0, 20.0, 30.0, 40.0, 50.0, 60.0],
-        "list[float]",
-        "plate.spacing_mm values swept",
-        lo=1.0,
-        hi=100.0,
-        min_len=2,
-        unit="mm",
-    ),
-    "consistency.readings": Field(
-        [2, 3, 4, 5, 6, 8, 10, 15, 20],
-        "list[int]",
-        "readings.count values swept",
-        lo=2,
-        hi=50,
-        min_len=2,
-    ),
-    "consistency.scale_diff_ppm": Field(
-        [0.0, 5.0, 10.0, 12.5, 15.0, 17.5, 20.0, 22.5, 25.0, 30.0, 40.0],
-        "list[float]",
-        "systematic amplitude swept: S' - S (ppm), eps in the "
-        "proportion of the two comparator keys",
-        lo=0.0,
-        hi=1e4,
-        min_len=2,
-        unit="ppm",
-    ),
-    "consistency.grid_sigma_true_um": Field(
-        [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1],
-        "list[float]",
-        "true grid sigmas swept",
-        lo=0.0,
-        hi=50.0,
-        min_len=2,
-        unit="um",
-    ),
-    "consistency.draws": Field(
-        20000, "int", "simulated plates per sweep value (chi-square draws)", lo=200, hi=1_000_000
+    "region.rounds": Field(2, "int", "refinement rounds at the region's boundary", lo=0, hi=6),
+    "region.draws": Field(
+        1000,
+        "int",
+        "simulated calibrations per input vector (chi-square draws)",
+        lo=50,
+        hi=1_000_000,
     ),
 }
 
@@ -246,5 +214,3 @@ def check(cfg: dict) -> None:
             f"about {n * min(cfg['chunk'], cfg['trials']) * 6 / 1e9:.1f} GB; "
             "use a smaller chunk",
         )
-    if min(cfg["consistency.grid_sigma_true_um"]) < 0:
-        raise ConfigError("consistency.grid_sigma_true_um", "must be >= 0")

@@ -156,7 +156,7 @@ def score(cfg: dict, dec: dict, rec: dict, zs: dict, vt: dict) -> tuple[list[dic
             samples=rec["s0_fig3_digits"],
             note="a-posteriori unit-weight error of the B8 -> grid affine in the units of "
             "the observed system X2 (B8 digits), as the program's residuals VX2, VY2 "
-            f"are ({design}); b8.sigma_um is not printed: swept (consistent_set).",
+            f"are ({design}); b8.sigma_um is not printed: set to reproduce the .002 (an input).",
         )
     )
     add(
@@ -164,7 +164,7 @@ def score(cfg: dict, dec: dict, rec: dict, zs: dict, vt: dict) -> tuple[list[dic
             "salsig.recovery.s0_fig2_mm",
             samples=rec["s0_fig2_mm"],
             note="unit-weight error of the comparator -> grid affine (mm); "
-            "comparator.sigma_um is not printed: swept (consistent_set).",
+            "comparator.sigma_um is not printed: set to reproduce the .003 (an input).",
         )
     )
     for cid, key, what in (
@@ -219,7 +219,7 @@ def score(cfg: dict, dec: dict, rec: dict, zs: dict, vt: dict) -> tuple[list[dic
     )
     vdesc = (
         f"{cfg['vertical.control']} control points, relief {cfg['vertical.relief_mm']:g} mm "
-        f"rms, z error {cfg['vertical.sigma_z_um']:g} um (model; none printed: swept)"
+        f"rms, z error {cfg['vertical.sigma_z_um']:g} um (model; none printed: an example, the region decides)"
     )
     add(
         book.score(

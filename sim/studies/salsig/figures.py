@@ -1,13 +1,14 @@
 """Figures of ``salsig_encoders``: residuals of one simulated calibration, recovery of the B8
-scales and angle, detection power, vertical ratio against relief, and the claims against the
-unprinted inputs (consistent set)."""
+scales and angle, detection power, and the vertical ratio against relief over the consistent
+region."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from sim.report.plotting import plt, save
-from sim.studies.gridplate.figures import fig_consistent  # noqa: F401  (one outcome map for both studies)
 from sim.studies.salsig.schema import UM
 
 
@@ -92,21 +93,15 @@ def fig_power(sw: dict, path: Path) -> None:
     save(fig, path)
 
 
-def fig_vertical(det: dict, zone: tuple[float, float], path: Path) -> None:
-    """Median ratio after/before of the vertical rms against the control relief (sweep)."""
-    idx = [
-        i
-        for i, (k, c) in enumerate(zip(det["input"], det["claim"]))
-        if k == "vertical.relief_mm" and c == "salsig.vertical_halved.rms_ratio"
-    ]
+def fig_vertical(relief_mm, ratio: dict, zone: tuple[float, float], path: Path) -> None:
+    """Ratio after/before of the vertical rms (median and 95 % of models at each explored
+    input vector) against the control relief; the other inputs vary across the region."""
+    relief_mm = np.asarray(relief_mm, float)
+    o = np.argsort(relief_mm)
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
-    ax.plot(
-        [det["input_value"][i] for i in idx],
-        [det["value"][i] for i in idx],
-        "o-",
-        color="tab:blue",
-        label="median over models",
-    )
+    ax.vlines(relief_mm[o], ratio["low"][o], ratio["high"][o], color="0.8", lw=0.8,
+              label="95 % of models")  # fmt: skip
+    ax.plot(relief_mm[o], ratio["value"][o], ".", color="tab:blue", label="median over models")
     ax.axhspan(*zone, color="tab:orange", alpha=0.15, label="'cut roughly in half' (zone)")
     ax.set_xscale("log")
     ax.set_xlabel("relief of the control heights, rms (model mm)")

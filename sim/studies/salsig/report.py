@@ -7,12 +7,11 @@ from pathlib import Path
 from sim.mc.storage import read_provenance, read_table
 from sim.report.markdown import (
     claims_markdown,
-    consistent_rows,
-    consistent_sets_sentence,
     fmt,
     inputs_markdown,
     md_table,
 )
+from sim.report.region import region_markdown
 from sim.studies.salsig.schema import SCHEMA
 
 
@@ -22,9 +21,13 @@ def report(out: Path) -> str:
     name = out.name
     c = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
     sw = read_table(out / "power.parquet").to_pydict()
-    cons = read_table(out / "consistent_set.parquet").to_pydict()
     errata = [r for r in c.values() if r["verdict"] == "erratum"]
     txt = [
+        region_markdown(out, list(c.values())),
+        "",
+        f"![consistent region]({name}/consistent_region.png)",
+        f"![vertical]({name}/vertical.png)",
+        "",
         "**Conventions.** Salsig's program prints the affine `X1 = A X2 + B Y2 + C`, "
         "`Y1 = D X2 + E Y2 + F` from the observed system X2 (comparator, or B8 digits) to the "
         "control X1 (grid plate). The scales are the lengths of the columns, "
@@ -52,18 +55,6 @@ def report(out: Path) -> str:
         claims_markdown(out / "claims.parquet"),
         "",
         inputs_markdown(cfg, SCHEMA),
-        "",
-        "**Unprinted inputs, swept** (`consistent_set.parquet`): each claim that depends on an "
-        f"unprinted input is evaluated on {cfg['consistency.trials']} simulated calibrations or "
-        "models per value and decided by its own rule; a value is in a claim's set when the "
-        "claim is not contradicted there (holds or inconclusive).",
-        "",
-        md_table(["input", "claim", "kind", "not contradicted for"], consistent_rows(cons)),
-        "",
-        consistent_sets_sentence(cons),
-        "",
-        f"![consistent set]({name}/consistent_set.png)",
-        f"![vertical]({name}/vertical.png)",
         "",
         f"![residuals]({name}/residuals.png)",
         f"![recovery]({name}/recovery.png)",

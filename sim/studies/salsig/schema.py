@@ -2,8 +2,9 @@
 
 Keys marked *input* carry a number the paper prints. The magnitudes the paper does not print
 (B8 marking error, comparator error, control relief, vertical error, number of control
-points, the glass-scale span and setting error, the grid spacing) are swept by
-``consistency.*`` where a claim depends on them (:mod:`sim.studies.salsig.sweep`).
+points, the glass-scale span and setting error, the grid spacing) are examples: the B8 and
+comparator errors are set to reproduce the printed unit-weight errors (inputs), and the
+vertical test's are explored in the consistent region (:mod:`sim.studies.salsig.region`).
 """
 
 from __future__ import annotations
@@ -48,8 +49,8 @@ SCHEMA = {
     "b8.sigma_um": Field(
         25.0,
         "float",
-        "B8 marking error per coordinate (model space); not printed, swept "
-        "(FIG. 3's unit-weight error .002 digit is the claim it decides)",
+        "B8 marking error per coordinate (model space); not printed, set to reproduce "
+        "FIG. 3's unit-weight error .002 digit (an input)",
         lo=0.0,
         lo_open=True,
         hi=1000.0,
@@ -71,8 +72,8 @@ SCHEMA = {
         3.0,
         "float",
         "comparator error per coordinate for grid "
-        "intersections and film marks; not printed, swept (FIG. 2's "
-        "unit-weight error .003 mm is the claim it decides)",
+        "intersections and film marks; not printed, set to reproduce FIG. 2's "
+        "unit-weight error .003 mm (an input)",
         lo=0.0,
         lo_open=True,
         hi=100.0,
@@ -154,7 +155,7 @@ SCHEMA = {
     "vertical.relief_mm": Field(
         4.0,
         "float",
-        "rms of control heights about their plane (model mm); not printed, swept",
+        "rms of control heights about their plane (model mm); not printed (region.toml)",
         lo=0.0,
         hi=100.0,
         unit="mm",
@@ -170,61 +171,17 @@ SCHEMA = {
     "vertical.sigma_z_um": Field(
         40.0,
         "float",
-        "model z error of a control point (measurement and control); not printed, swept",
+        "model z error of a control point (measurement and control); not printed (region.toml)",
         lo=0.0,
         lo_open=True,
         hi=1000.0,
         unit="um",
     ),
-    "consistency.relief_mm": Field(
-        [0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 12.0, 20.0],
-        "list[float]",
-        "vertical.relief_mm values swept",
-        lo=0.0,
-        hi=100.0,
-        min_len=2,
-        unit="mm",
+    "region.points": Field(
+        128, "int", "input vectors of the space-filling design (region.toml)", lo=4, hi=65536
     ),
-    "consistency.sigma_z_um": Field(
-        [10.0, 20.0, 30.0, 40.0, 60.0, 80.0, 120.0, 200.0],
-        "list[float]",
-        "vertical.sigma_z_um values swept",
-        lo=0.0,
-        lo_open=True,
-        hi=1000.0,
-        min_len=2,
-        unit="um",
-    ),
-    "consistency.control": Field(
-        [4, 5, 6, 8, 10, 15, 20],
-        "list[int]",
-        "vertical.control values swept",
-        lo=3,
-        hi=100,
-        min_len=2,
-    ),
-    "consistency.b8_sigma_um": Field(
-        [2.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 50.0],
-        "list[float]",
-        "b8.sigma_um values swept",
-        lo=0.0,
-        lo_open=True,
-        hi=1000.0,
-        min_len=2,
-        unit="um",
-    ),
-    "consistency.comparator_sigma_um": Field(
-        [1.0, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 8.0],
-        "list[float]",
-        "comparator.sigma_um values swept",
-        lo=0.0,
-        lo_open=True,
-        hi=100.0,
-        min_len=2,
-        unit="um",
-    ),
-    "consistency.trials": Field(
-        1000, "int", "simulated calibrations or models per sweep value", lo=50, hi=1_000_000
+    "region.trials": Field(
+        200, "int", "simulated models per input vector of the region", lo=20, hi=1_000_000
     ),
 }
 

@@ -6,14 +6,12 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib.colors
 import matplotlib.ticker
 import numpy as np
 
 from sim.mc.storage import read_table
 from sim.report.figure_jobs import draw_figures, start_figures
 from sim.report.plotting import plt, save
-from sim.studies.wolf.claims import load_book
 from sim.studies.wolf.model import ls_map
 
 _UM_PER_MM = 2.5  # vector plots: 1 mm of plot = 2.5 um of discrepancy (50 um = 20 mm)
@@ -53,7 +51,7 @@ def _quiver(ax, x, y, dx, dy, title, key_um=20.0, um_per_mm=_UM_PER_MM):
 
 #: the figures whose tables the run writes before its trade-offs (the dearest first), and the
 #: others
-EARLY = ("consistent_figure", "components_figure", "vectors_figure", "readings_figure")
+EARLY = ("components_figure", "vectors_figure", "readings_figure")
 LATE = ("stability_figure", "degree_figure", "table1_figure")
 
 
@@ -256,118 +254,3 @@ def table1_figure(out: Path) -> None:
         for x, y, p in zip(t["x_set1_mm"][m], t["y_set1_mm"][m], t["point"][m]):
             ax.annotate(str(p), (x, y), textcoords="offset points", xytext=(3, -8), fontsize=7)
     save(fig, out / "table1_real.png")
-
-
-#: the per-trial statistics drawn against each swept input, with the claim prefix of their
-#: paper values
-_GROUPS = (
-    ("before", "wolf.before.rms_", "before correction"),
-    ("after", "wolf.after.rms_", "after the cubic"),
-    ("repeat", "wolf.repeatability.", "Set 1 - Set 2 (Table 1)"),
-    ("mono", "wolf.table2.", "PG-2 - monocomparator (Table 2)"),
-)
-_CMAP = matplotlib.colors.ListedColormap(["#e8a0a0", "#9fd49f"])
-_LABEL = {
-    "reading.pointing_sigma_um": "pointing sigma of one reading (um)",
-    "field_scale": "common factor on the field amplitudes",
-    "mono.sigma_um": "monocomparator sigma (um)",
-    "field.restitution_um": "restitution field, rms per axis (um)",
-    "field.drift_fraction": "drifting share of the field's variance",
-}
-
-
-def _references() -> dict:
-    """``claim -> {"ref_low", "ref_high"}`` of the claim book (the study's claim data, the
-    same numbers as those columns of ``claims.parquet``; None where the paper prints none), so
-    the figure needs no table written after the sweeps."""
-    out = {}
-    for cid, s in load_book().specs.items():
-        ref = s.get("ref")
-        ref = (None, None) if ref is None else (ref if isinstance(ref, list) else [ref, ref])
-        out[cid] = {
-            "ref_low": None if ref[0] is None else float(ref[0]),
-            "ref_high": None if ref[1] is None else float(ref[1]),
-        }
-    return out
-
-
-def consistent_figure(out: Path) -> None:
-    """Claims against each unprinted input: left, the simulated rms (median and 95 % range of
-    instruments) with the paper's printed rms values as dotted lines; right, where each
-    dependent claim is consistent (bars) and the consistent set (shaded)."""
-    v = {k: np.asarray(a) for k, a in read_table(out / "sweep_values.parquet").to_pydict().items()}
-    c = read_table(out / "consistent_set.parquet").to_pylist()
-    cl = _references()
-    inputs = list(dict.fromkeys(v["input"]))
-    fig, axs = plt.subplots(
-        len(inputs),
-        2,
-        figsize=(13, 6.0 * len(inputs)),
-        squeeze=False,
-        gridspec_kw={"width_ratios": [1, 1.25], "wspace": 0.45, "hspace": 0.25},
-    )
-    for row, name in enumerate(inputs):
-        ax = axs[row, 0]
-        for k, (exp, pre, label) in enumerate(_GROUPS):
-            cid = next((x for x in cl if x.startswith(pre) and x.endswith("rms_x_um")), None)
-            m = (v["input"] == name) & (v["claim"] == cid)
-            if cid is None or not m.any():
-                continue
-            o = np.argsort(v["value"][m])
-            x = v["value"][m][o]
-            ax.plot(x, v["median"][m][o], "o-", color=f"C{k}", label=f"{label}, rms x")
-            ax.fill_between(x, v["lo"][m][o], v["hi"][m][o], color=f"C{k}", alpha=0.15)
-            for p in {
-                r["ref_low"] + (r["ref_high"] - r["ref_low"]) / 2
-                for i, r in cl.items()
-                if i.startswith(pre) and "rms_" in i and r["ref_low"] is not None
-            }:
-                ax.axhline(p, color=f"C{k}", ls=":", lw=1)
-        ax.set_yscale("log")
-        ax.yaxis.set_major_locator(matplotlib.ticker.FixedLocator([2, 3, 5, 10, 20, 30, 50, 100]))
-        ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
-        ax.yaxis.set_minor_locator(matplotlib.ticker.NullLocator())
-        ax.set_xlabel(_LABEL.get(name, name))
-        ax.set_ylabel("rms discrepancy (um)")
-        ax.set_title(
-            "simulated (median, 95 % of instruments); dotted: paper's rms values", fontsize=9
-        )
-        ax.legend(fontsize=7)
-        ax = axs[row, 1]
-        rows = [
-            r for r in c if r["input"] == name and r["depends"] and not r["claim"].startswith("ALL")
-        ]
-        xs = np.unique(v["value"][v["input"] == name])
-        mat = np.zeros((len(rows), xs.size))
-        for i, r in enumerate(rows):
-            m = (v["input"] == name) & (v["claim"] == r["claim"])
-            mat[i, np.searchsorted(xs, v["value"][m])] = v["consistent"][m]
-        mid = (xs[:-1] + xs[1:]) / 2 if xs.size > 1 else np.array([])
-        w = (xs[-1] - xs[0]) / max(xs.size - 1, 1) if xs.size > 1 else 1.0
-        edges = np.concatenate([[xs[0] - w / 2], mid, [xs[-1] + w / 2]])
-        ax.pcolormesh(edges, np.arange(len(rows) + 1) - 0.5, mat, cmap=_CMAP, vmin=0, vmax=1)
-        allr = next(r for r in c if r["input"] == name and r["claim"] == "ALL")
-        feas = next(
-            r
-            for r in c
-            if r["input"] == name and r["claim"] != "ALL" and r["claim"].startswith("ALL")
-        )
-        for r, hatch, lab in (
-            (allr, "//", "consistent set"),
-            (feas, "..", "consistent set of the claims consistent somewhere"),
-        ):
-            if r["n_consistent"] and (r is allr or not allr["n_consistent"]):
-                lo = edges[np.searchsorted(xs, r["holds_low"])]
-                hi = edges[np.searchsorted(xs, r["holds_high"]) + 1]
-                ax.axvspan(lo, hi, fill=False, hatch=hatch, ec="k", lw=1.5, label=lab)
-                ax.legend(fontsize=7, loc="upper right")
-        ax.set_yticks(range(len(rows)))
-        ax.set_yticklabels([r["claim"].replace("wolf.", "") for r in rows], fontsize=5)
-        ax.set_ylim(-0.5, len(rows) - 0.5)
-        ax.set_xlabel(_LABEL.get(name, name))
-        ax.set_title(
-            "green: claim consistent, red: contradicted"
-            + ("" if allr["n_consistent"] else " (no value is consistent with all)"),
-            fontsize=9,
-        )
-    save(fig, out / "consistent_set.png")

@@ -3,13 +3,15 @@ picklable, so ``--workers``, Dask and resume work). Wolf & Pearsall 1976, seed
 ``000_668e60e68f004f98.txt``.
 
 Parts (spawn keys): 0 the main experiment (``trials``); 1 the cells run (``unprinted.trials``):
-the readings trade-off and the sweeps of the unprinted inputs, all on the same instruments;
+the readings trade-off;
 10+i the degree trade-off at spacing i; 40 the stability trade-off; 30, 90, 91, 98 single
 streams (reading-error table, the vector figure's instrument, one field draw, the bootstrap).
 Writes ``trials.parquet``, ``vectors.parquet``, ``components.parquet``, ``degree.parquet``,
 ``trials_degree.parquet``, ``readings.parquet``, ``stability.parquet``,
-``table1_real.parquet``, ``table3_real.parquet``, ``sweep_values.parquet``,
-``consistent_set.parquet``, ``claims.parquet``, ``not_reproduced.parquet`` and the figures.
+``table1_real.parquet``, ``table3_real.parquet``, ``consistent_region.parquet`` (and
+``region_inputs.parquet``), ``claims.parquet``, ``not_reproduced.parquet`` and the
+figures. Parts 2, 3, ...: the joint exploration of the unprinted inputs
+(:mod:`sim.studies.wolf.region`), one cells run per batch of input vectors.
 """
 
 from __future__ import annotations
@@ -18,15 +20,18 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.claims.book import write_claims
+from sim.claims.book import ClaimBook, write_claims
+from sim.claims.book_region import region_rows, write_region
 from sim.instruments.plotter import errorfields as ef
 from sim.mc.runner import chunk_rng, run_chunks
 from sim.mc.storage import provenance, write_table
+from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.wolf import claims as cl
-from sim.studies.wolf import consistent, figures, tables
+from sim.studies.wolf import figures, tables
 from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk
 from sim.studies.wolf.model import field_spec, reading_error_rms
+from sim.studies.wolf.region import explore_region, nominal
 from sim.studies.wolf.schema import grid_nodes, table_path
 
 APPROACHES = ("one_side", "random")
@@ -69,6 +74,20 @@ def reading_cells(cfg: dict) -> list[tuple[str, str, float, int, dict]]:
     return out
 
 
+def over_region(book: ClaimBook, region, preds: list[str], rows: list[dict]) -> list[dict]:
+    """Each prediction's row replaced by its verdict over the region (the configured inputs'
+    result kept in the note as an example)."""
+    by = {r["claim"]: r for r in rows}
+    fresh = ClaimBook(list(book.specs.values()), [], book.path)
+    notes = {
+        c: f"at the configured inputs (an example): {by[c]['value']:.3g} "
+        f"({by[c]['ci_low']:.3g}-{by[c]['ci_high']:.3g}), outcome {by[c]['outcome']}"
+        for c in preds
+    }
+    new = {r["claim"]: r for r in region_rows(fresh, region, preds, notes)}
+    return [new.get(r["claim"], r) for r in rows]
+
+
 def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     q = ctx.quiet
     prov = provenance(cfg)
@@ -77,9 +96,9 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_table(out / "trials.parquet", {"trial": np.arange(T), **main}, prov)
     _vectors_and_components(cfg, out, prov)
 
-    # the readings trade-off and the sweeps of the unprinted inputs: one cells run
-    rc, sc = reading_cells(cfg), consistent.sweep_cells(cfg)
-    cells = [(t, o) for t, *_, o in rc] + [(t, o) for t, _, _, o in sc]
+    # the readings trade-off: one cells run
+    rc = reading_cells(cfg)
+    cells = [(t, o) for t, *_, o in rc]
     Ts = cfg["unprinted.trials"]
     res = run_chunks(
         main_chunk(cfg, cells, full=False),
@@ -124,9 +143,8 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
             rd[k].append(v)
     write_table(out / "readings.parquet", rd, prov)
     book = cl.load_book()
-    vals, cons = consistent.evaluate(cfg, res, book)
-    write_table(out / "sweep_values.parquet", vals, prov)
-    write_table(out / "consistent_set.parquet", cons, prov)
+    region, preds = explore_region(cfg, book, ctx)
+    write_region(out / "consistent_region.parquet", region, book, preds, prov)
     wait_early = figures.start_early(cfg, out, ctx.executor)  # drawn while the trade-offs run
 
     degt = _degree(cfg, out, prov, ctx)
@@ -136,7 +154,19 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     t3 = tables.table3_discrepancies(tables.load_table3(table_path(cfg, "table3.file")))
     write_table(out / "table1_real.parquet", t1, prov)
     write_table(out / "table3_real.parquet", t3, prov)
-    write_claims(out / "claims.parquet", cl.rows(cfg, main, t1, t3, degt, book), prov, book)
+    rows = over_region(book, region, preds, cl.rows(cfg, main, t1, t3, degt, book))
+    write_claims(out / "claims.parquet", rows, prov, book)
+    fig_region(
+        region,
+        out / "consistent_region.png",
+        title="seed 000: unprinted inputs left by the 'before' rows and Table 1",
+        nominal=nominal(cfg),
+        labels={
+            "pointing_sigma_um": "pointing sigma of one reading (um)",
+            "field_scale_1": "factor on the field amplitudes",
+            "mono_sigma_um": "monocomparator sigma (um)",
+        },
+    )
     figures.late(cfg, out, ctx.executor)
     wait_early()
 

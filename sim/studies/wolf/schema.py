@@ -2,8 +2,9 @@
 
 Seed paper ``000_668e60e68f004f98.txt`` (Wolf & Pearsall 1976). Coordinates in mm,
 discrepancies in um. Keys marked ``input`` were set to match the paper; those the paper does
-not print (pointing sigma, field amplitudes, monocomparator sigma) are also swept
-(``unprinted.*``) and the report gives the values for which the paper's claims hold.
+not print (pointing sigma, field amplitudes, monocomparator sigma) are explored jointly over
+their possible ranges (``region.toml``, sized by ``region.*``); the configured values are an
+example.
 """
 
 from __future__ import annotations
@@ -103,9 +104,8 @@ SCHEMA = {
     "reading.pointing_sigma_um": Field(
         7.0,
         "float",
-        "pointing error of one reading (not printed; "
-        "swept in unprinted.pointing_sigmas_um: the report gives the "
-        "values the paper's claims allow)",
+        "pointing error of one reading (not printed; an example: the "
+        "predictions are decided over the region region.toml declares)",
         lo=0.0,
         hi=100.0,
         input=True,
@@ -282,8 +282,7 @@ SCHEMA = {
         1.5,
         "float",
         "error of one monocomparator coordinate (H. Dell Foster, "
-        "Table 2; not printed: 'accurate enough', swept in "
-        "unprinted.mono_sigmas_um)",
+        "Table 2; not printed: 'accurate enough'; an example, region.toml)",
         lo=0.0,
         hi=100.0,
         input=True,
@@ -292,55 +291,20 @@ SCHEMA = {
     "unprinted.trials": Field(
         400,
         "int",
-        "trials per value of the sweeps of the unprinted inputs "
-        "(common random numbers: the same instruments for every value)",
+        "instruments per cell of the readings trade-off and of the region's input vectors "
+        "(common random numbers: the same instruments for every cell)",
         lo=2,
         hi=10_000_000,
     ),
-    "unprinted.pointing_sigmas_um": Field(
-        [2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 12.0],
-        "list[float]",
-        "pointing sigmas swept (reading.pointing_sigma_um)",
-        lo=0.0,
-        hi=100.0,
-        min_len=1,
-        unit="um",
+    "region.points": Field(
+        32,
+        "int",
+        "input vectors of the joint exploration's space-filling design (region.toml); each "
+        "one cell on unprinted.trials instruments",
+        lo=4,
+        hi=4096,
     ),
-    "unprinted.field_scales": Field(
-        [0.5, 0.625, 0.75, 0.875, 1.0, 1.125, 1.25, 1.5, 1.75],
-        "list[float]",
-        "common factors on the seven field.*_um amplitudes "
-        "swept (their mix fixed; 1 = the configured amplitudes)",
-        lo=0.0,
-        hi=100.0,
-        min_len=1,
-    ),
-    "unprinted.restitutions_um": Field(
-        [0.0, 1.0, 2.0, 3.0, 4.0, 6.0],
-        "list[float]",
-        "restitution amplitudes swept (field.restitution_um)",
-        lo=0.0,
-        hi=100.0,
-        min_len=1,
-        unit="um",
-    ),
-    "unprinted.drift_fractions": Field(
-        [0.0, 0.1, 0.25, 0.5, 0.75],
-        "list[float]",
-        "drifting shares of the field swept (field.drift_fraction)",
-        lo=0.0,
-        hi=1.0,
-        min_len=1,
-    ),
-    "unprinted.mono_sigmas_um": Field(
-        [0.0, 1.0, 2.0, 3.0, 4.0, 6.0],
-        "list[float]",
-        "monocomparator sigmas swept (mono.sigma_um)",
-        lo=0.0,
-        hi=100.0,
-        min_len=1,
-        unit="um",
-    ),
+    "region.rounds": Field(1, "int", "refinement rounds at the region's boundary", lo=0, hi=4),
     "trade.trials": Field(
         400, "int", "trials per cell of the design trade-offs", lo=2, hi=10_000_000
     ),

@@ -1,0 +1,200 @@
+"""Claim-book rows decided over a consistent region (issue 21 items 1-2), for the studies that
+keep their printed statements in a claim book (``claims.toml``).
+
+The bridge between :mod:`sim.claims.book` and :mod:`sim.claims.inference` /
+:mod:`sim.claims.region`: a claim's spec becomes a :class:`~sim.claims.inference.Statement`
+(the same zone: printed rounding widened by ``tol``, one-sided for bounds), per-point
+Monte-Carlo samples become evidence with the book's own rules (one-plate: the 2.5-97.5 %
+spread and the probability ``p`` of a plate at least as extreme; other forms: the spread
+alone), and the region verdicts become claims rows (:func:`sim.claims.region.region_row`).
+Arrays in, arrays out: samples have a leading point axis ``(N, M)``.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from sim.claims.book import ClaimBook
+from sim.claims.inference import HOLDS, Input, Region, Statement, parse_declaration
+from sim.claims.region import decide_over, outcomes, region_row, region_table, statement_of
+from sim.mc.config import ConfigError
+from sim.mc.storage import write_table
+
+__all__ = [
+    "Declaration",
+    "load_declaration",
+    "statements",
+    "sample_evidence",
+    "region_rows",
+    "write_region",
+    "region_summary",
+]
+
+
+_EXPLORE = {"n": (4, 65536), "rounds": (0, 10), "per_point": (1, 64), "draws": (50, 1_000_000)}
+
+
+@dataclass(frozen=True)
+class Declaration:
+    """A paper's unprinted inputs (ranges), the statements that constrain them (hardware
+    limits declared here, printed ones by claim id from the claim book), the predictions
+    decided over the region, and the exploration's size."""
+
+    inputs: list[Input]
+    statements: list[Statement]
+    predictions: list[str]
+    explore: dict[str, int]
+
+
+def load_declaration(path: str | Path, book: ClaimBook) -> Declaration:
+    """Read ``region.toml``: ``constraints`` and ``predictions`` (claim ids of ``book``),
+    ``[inputs]`` and ``[statements]`` as :func:`sim.claims.inference.parse_declaration`
+    (hardware limits; the printed statements come from the book), and ``[explore]`` (``n``,
+    ``rounds``, ``per_point``, ``draws``). Unknown keys and ids raise ConfigError naming them."""
+    p = Path(path)
+    try:
+        doc = tomllib.loads(p.read_text())
+    except OSError as e:
+        raise ConfigError(str(p), f"cannot read the region declaration: {e.strerror}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ConfigError(str(p), f"not valid TOML: {e}") from None
+    cons, preds = doc.pop("constraints", []), doc.pop("predictions", [])
+    explore = doc.pop("explore", {})
+    for key, ids in (("constraints", cons), ("predictions", preds)):
+        if not isinstance(ids, list) or not all(isinstance(i, str) for i in ids):
+            raise ConfigError(key, "must be a list of claim ids")
+        for i in ids:
+            if i not in book.specs:
+                raise ConfigError(key, f"{i!r} is not a claim of {book.path}")
+            if "ref" not in book.specs[i]:
+                raise ConfigError(key, f"{i!r} prints no number (no ref)")
+    if not isinstance(explore, dict):
+        raise ConfigError("explore", "must be a table")
+    ex = {}
+    for k, v in explore.items():
+        if k not in _EXPLORE:
+            raise ConfigError(f"explore.{k}", f"unknown key (allowed: {', '.join(_EXPLORE)})")
+        lo, hi = _EXPLORE[k]
+        if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
+            raise ConfigError(f"explore.{k}", f"must be an integer in [{lo}, {hi}]")
+        ex[k] = v
+    inputs, hard = parse_declaration(doc)
+    return Declaration(inputs, hard + statements(book, cons), list(preds), ex)
+
+
+def statements(book: ClaimBook, ids: Sequence[str]) -> list[Statement]:
+    """The inference statements of claims ``ids`` (the book's decision zones)."""
+    return [statement_of(book, c) for c in ids]
+
+
+def sample_evidence(x: np.ndarray, ref: float | None = None) -> dict[str, np.ndarray]:
+    """Evidence of per-point samples ``x`` (N points, M plates each; NaN-free rows).
+
+    ``value`` the median, ``low``/``high`` the 2.5 / 97.5 % spread of one plate; with ``ref``
+    (a one-plate claim) also ``p = 2 min(q, 1 - q)``, ``q`` the share of plates below ``ref``
+    (ties counted half): the book's one-plate rule, point by point."""
+    x = np.asarray(x, float)
+    lo, med, hi = np.nanpercentile(x, [2.5, 50, 97.5], axis=1)
+    ev = {"value": med, "low": lo, "high": hi}
+    if ref is not None:
+        n = np.sum(np.isfinite(x), axis=1)
+        q = (np.sum(x < ref, axis=1) + 0.5 * np.sum(x == ref, axis=1)) / np.maximum(n, 1)
+        ev["p"] = np.minimum(1.0, 2 * np.minimum(q, 1 - q))
+    return ev
+
+
+def region_rows(
+    book: ClaimBook, region: Region, ids: Sequence[str], notes: Mapping[str, str] | None = None
+) -> list[dict]:
+    """The claims rows of ``ids`` decided over the region (their evidence is in
+    ``region.outputs``): holds / fails / depends (where) / undecidable."""
+    rows = []
+    for cid in ids:
+        rv = decide_over(region, statement_of(book, cid))
+        ev = region.outputs[cid]
+        v = np.asarray(ev["value"] if isinstance(ev, Mapping) else ev, float)
+        va = v[region.accepted]
+        if not np.isfinite(va).any():  # an empty region: the range over every explored vector
+            va = v
+        rows.append(region_row(book, cid, rv, va, (notes or {}).get(cid, "")))
+    return rows
+
+
+def write_region(path, region: Region, book: ClaimBook, predictions: Sequence[str], prov) -> None:
+    """``consistent_region.parquet``: one row per accepted input vector, the inputs (named with
+    their units), ``confirmed``, one outcome column per statement and prediction, and the
+    predictions' per-point median (``<id>__value``); beside it
+    ``region_inputs.parquet`` (the columns brown's studies write): per input why and its
+    declared range, the region's projection, the design's resolution (interior, boundary),
+    the projection of the points where every prediction holds together, and the counts."""
+    cols = region_table(region, statements(book, predictions), predictions)
+    write_table(path, cols, prov)
+    sts = statements(book, predictions)
+    together = region.accepted.copy()
+    for st in sts:
+        together &= outcomes(region, st) == HOLDS
+    b, t = region.bounds(), region.bounds(together)
+    inp = {
+        k: []
+        for k in (
+            "input",
+            "why",
+            "declared_low",
+            "declared_high",
+            "region_low",
+            "region_high",
+            "resolution_interior",
+            "resolution_boundary",
+            "together_low",
+            "together_high",
+            "n_points",
+            "n_region",
+            "n_together",
+        )
+    }
+    for i in region.inputs:
+        for k, v in zip(
+            inp,
+            (
+                i.name,
+                i.why,
+                i.low,
+                i.high,
+                *b[i.name],
+                *region.resolution[i.name],
+                *t[i.name],
+                region.n,
+                int(region.accepted.sum()),
+                int(together.sum()),
+            ),
+        ):
+            inp[k].append(v)
+    write_table(Path(path).with_name("region_inputs.parquet"), inp, prov)
+
+
+def region_summary(region: Region) -> str:
+    """One sentence: where the region lies, how many points, its resolution."""
+    if region.empty:
+        conf = "; ".join(" + ".join(c) for c in region.conflicts)
+        return (
+            f"No input vector of the {region.n} explored is consistent with the printed "
+            f"statements (conflicting: {conf})."
+        )
+    res = ", ".join(
+        f"{k} {_g(a)} ({_g(b)} at the boundary)"
+        for k, (a, b) in region.resolution.items()
+        if not any(i.name == k and i.low == i.high for i in region.inputs)
+    )
+    return (
+        f"The printed statements leave {int(region.accepted.sum())} of the {region.n} explored "
+        f"input vectors: {region.describe()} (resolution: {res})."
+    )
+
+
+def _g(x: float) -> str:
+    return f"{x:.3g}"

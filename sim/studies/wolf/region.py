@@ -1,0 +1,113 @@
+"""The consistent region of ``wolf_polynomial``'s unprinted inputs (seed 000) and the verdicts of
+its predictions over it (issue 21, :mod:`sim.claims.inference`).
+
+Wolf & Pearsall print neither the pointing error of one reading, nor the sizes of the
+systematic error sources, nor the monocomparator's error. ``region.toml`` declares them with
+their physically possible ranges and the printed statements that constrain them: the
+'before correction' statistics (the size of the field) and Table 1's repeatability (the
+pointing error), all inputs of the simulation. The inputs are explored jointly on the
+runner's workers: each input vector is a *cell* of the main experiment
+(:func:`sim.studies.wolf.chunks.main_chunk`), all cells on the same simulated instruments
+(common random numbers, ``unprinted.trials`` of them). Each statistic is evidence with the
+claim book's own rules (:func:`sim.claims.book_region.sample_evidence`); the headline's two
+elements (the plate mean in X and in Y) with their spread; Table 2 as one statement by Holm's
+step-down over its 24 one-plate p values at each input vector
+(:func:`sim.studies.wolf.claims.holm`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from sim.claims.book import ClaimBook
+from sim.claims.book_region import load_declaration, sample_evidence
+from sim.claims.inference import Region, explore
+from sim.mc.runner import chunk_rng, run_chunks
+from sim.studies.wolf.chunks import main_chunk
+from sim.studies.wolf.claims import AXES, HEADLINE, JOINT, holm, stat_key
+
+DECLARATION = Path(__file__).with_name("region.toml")
+#: region input -> the cell key it overrides
+CELL = {
+    "pointing_sigma_um": "reading.pointing_sigma_um",
+    "field_scale_1": "field_scale",
+    "mono_sigma_um": "mono.sigma_um",
+}
+
+
+def nominal(cfg: dict) -> dict[str, float]:
+    """The configured inputs in the region's names (an example in the figure)."""
+    return {
+        "pointing_sigma_um": float(cfg["reading.pointing_sigma_um"]),
+        "field_scale_1": 1.0,
+        "mono_sigma_um": float(cfg["mono.sigma_um"]),
+    }
+
+
+def _cells(x: dict[str, np.ndarray], call: int) -> list[tuple[str, dict]]:
+    n = len(x["pointing_sigma_um"])
+    return [(f"g{call}.{i}.", {CELL[k]: float(x[k][i]) for k in CELL}) for i in range(n)]
+
+
+def evidence(book: ClaimBook, ids: list[str], res: dict, tags: list[str]) -> dict:
+    """Per-point evidence of every claim in ``ids`` from the cells' per-trial statistics."""
+    out = {}
+    t2 = [c for c in book.specs if c.startswith("wolf.table2.p")]
+    for cid in dict.fromkeys(ids + t2):
+        if cid in (HEADLINE, JOINT):
+            continue
+        x = np.stack([res[t + stat_key(cid)] for t in tags])
+        spec = book.spec(cid)
+        out[cid] = sample_evidence(x, float(spec["ref"]) if spec["form"] == "one-plate" else None)
+    if HEADLINE in ids:
+        el = [
+            sample_evidence(np.stack([res[f"{t}mono.mean_{ax}_um"] for t in tags])) for ax in AXES
+        ]
+        out[HEADLINE] = {
+            "value": np.stack([e["value"] for e in el], 1),
+            "low": np.stack([e["low"] for e in el], 1),
+            "high": np.stack([e["high"] for e in el], 1),
+        }
+    if JOINT in ids:
+        p = np.stack([out[c]["p"] for c in t2], 1)
+        adj = np.array([holm(row).min() for row in p])
+        out[JOINT] = {"value": adj, "low": adj, "high": adj}
+    return out
+
+
+def explore_region(cfg: dict, book: ClaimBook, ctx) -> tuple[Region, list[str]]:
+    """Explore the declared inputs jointly; each batch of input vectors is one cells run of
+    the main experiment on the runner's workers (parts 2, 3, ...)."""
+    dec = load_declaration(DECLARATION, book)
+    ids = [s.id for s in dec.statements if s.id in book.specs] + dec.predictions
+    Ts = cfg["unprinted.trials"]
+    calls = [0]
+
+    def model(x: dict[str, np.ndarray]) -> dict:
+        calls[0] += 1
+        cells = _cells(x, calls[0])
+        res = run_chunks(
+            main_chunk(cfg, cells, full=False),
+            Ts,
+            cfg["seed"],
+            max(1, min(cfg["chunk"], -(-Ts // 4))),
+            part=1 + calls[0],
+            ctx=ctx,
+            label=f"wolf region {calls[0]}",
+            quiet=ctx.quiet,
+        )
+        return evidence(book, ids, res, [t for t, _ in cells])
+
+    region = explore(
+        dec.inputs,
+        dec.statements,
+        model,
+        chunk_rng(cfg["seed"], 900, 0),
+        n=cfg["region.points"],
+        rounds=cfg["region.rounds"],
+        per_point=1,
+        max_new=max(1, cfg["region.points"] // 4),
+    )
+    return region, dec.predictions
