@@ -17,7 +17,7 @@ def batch(a, T):
     return np.broadcast_to(a, (T,) + a.shape).copy()
 
 
-@pytest.mark.skipif(not ml.jit.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not ml.jit.available(), reason="numba not installed")
 @pytest.mark.parametrize("model", list(ml.MODELS))
 def test_generic_engine_equals_compiled_fast_path(model):
     """The engine's loop and the registered numba kernel on the same trials.
@@ -143,9 +143,9 @@ def test_screened_rule_decides_like_the_eigenvalue_ratio():
 def test_compiled_2x2_point_blocks_equal_the_numpy_closed_form(monkeypatch):
     """inv_blocks of 2 x 2 blocks runs compiled with the NumPy path's arithmetic: the same
     inverses and decisions bit for bit, singular, NaN, infinite and zero blocks included."""
-    from sim.lsq import group_kernel, normals
+    from sim.lsq import compile, normals
 
-    if not group_kernel.available():
+    if not compile.available():
         pytest.skip("numba not installed")
     rng = np.random.default_rng(0)
     N = rng.normal(size=(60, 25, 2, 2))
@@ -157,7 +157,7 @@ def test_compiled_2x2_point_blocks_equal_the_numpy_closed_form(monkeypatch):
     N[9, 3, 0, 0] = np.inf
     N[10, 0] = [[1.0, 1.0], [1.0, 1.0 + 1e-12]]  # below rcond
     fast, ok_fast = normals.inv_blocks(N)
-    monkeypatch.setattr(group_kernel, "available", lambda: False)
+    monkeypatch.setenv("SIM_NO_JIT", "1")
     ref, ok_ref = normals.inv_blocks(N)
     np.testing.assert_array_equal(ok_fast, ok_ref)
     np.testing.assert_array_equal(fast, ref)

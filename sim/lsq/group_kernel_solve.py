@@ -1,5 +1,5 @@
 """Compiled kernels of the group-block engine (:mod:`sim.lsq.groups`): the solve and the
-cofactors, via numba (compiled by :func:`sim.lsq.group_kernel.compiled`).
+cofactors, via numba (compiled by :func:`sim.lsq.compile.compiled`).
 
 Seed of the method: Agnard, Nolette & Gagnon (``003_5ce730a990a7ebc5.txt``, SPACE-M's
 reduced normals and Baarda's data snooping on the residuals of the block).
@@ -15,14 +15,15 @@ reduced normals and Baarda's data snooping on the residuals of the block).
 
 Each equals the NumPy path of :mod:`sim.lsq.groups` / :mod:`sim.lsq.group_solve` to
 rounding (tests). Units: those of the model; cofactors for unit weight. Call only when
-:func:`sim.lsq.group_kernel.available`.
+:func:`sim.lsq.compile.available`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from sim.lsq.group_kernel import _c, compiled
+from sim.lsq.compile import compiled
+from sim.lsq.group_kernel import _c
 
 __all__ = ["dense_scaled", "chol_vec", "chol_inv", "residual_cofactors"]
 
@@ -92,7 +93,7 @@ def _chol_inv(L, Q):  # pragma: no cover - compiled
 def _residual_cofactors(Q, F, Ninv, Jg, Jp, w, og, op, pts, pstart, pobs, out):
     # pragma: no cover - compiled
     T = F.shape[0]
-    d, b, m = D_POINT, B_GROUP, M_ROWS  # compile-time constants (see compiled)  # noqa: F821 (set by the compile helper)
+    d, b, m = D_POINT, B_GROUP, M_ROWS  # noqa: F821 (compile-time constants, set by compile.compiled)
     nmax = 0
     for j in pts:
         nmax = max(nmax, pstart[j + 1] - pstart[j])
