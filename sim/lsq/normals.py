@@ -29,8 +29,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim.lsq import compile
-
 __all__ = [
     "RCOND",
     "scaled_rcond",
@@ -77,8 +75,8 @@ def block2_rcond(m00, m01, m10, m11):  # pragma: no cover - compiled into the ke
     """:func:`scaled_rcond` of one 2 x 2 block, operation for operation (the closed form):
     the block scaled to unit diagonal, the ratio of its smaller to its larger |eigenvalue|;
     0 where an entry of the scaled block is not finite. Scalars in, a scalar out: the one
-    singularity rule of the 2 x 2 blocks, called by the compiled kernels (:func:`_inv2`,
-    :mod:`sim.instruments.ranges.multilateration_kernel`)."""
+    singularity rule of the 2 x 2 blocks in the compiled kernels
+    (:mod:`sim.instruments.ranges.multilateration_kernel`)."""
     d0, d1 = abs(m00), abs(m11)
     s0 = 1.0 / np.sqrt(d0) if d0 > 0 else 1.0
     s1 = 1.0 / np.sqrt(d1) if d1 > 0 else 1.0
@@ -91,39 +89,10 @@ def block2_rcond(m00, m01, m10, m11):  # pragma: no cover - compiled into the ke
     return rc if np.isfinite(rc) else 0.0
 
 
-def _inv2(N, rcond, out, good):  # pragma: no cover - compiled
-    """:func:`inv_blocks` of 2 x 2 blocks ``N`` (B, 2, 2) into ``out``, ``good`` (B,): the
-    rule :func:`block2_rcond` and the closed-form inverse of the NumPy path, operation for
-    operation (no reassociation), in one pass."""
-    for k in range(N.shape[0]):
-        m00, m01, m11 = N[k, 0, 0], N[k, 0, 1], N[k, 1, 1]
-        ok = block2_rcond(m00, m01, N[k, 1, 0], m11) > rcond
-        good[k] = ok
-        if not ok:
-            m00, m01, m11 = 1.0, 0.0, 1.0
-        inv = 1.0 / (m00 * m11 - m01 * m01)
-        out[k, 0, 0] = m11 * inv
-        out[k, 0, 1] = -m01 * inv
-        out[k, 1, 0] = -m01 * inv
-        out[k, 1, 1] = m00 * inv
-
-
 def inv_blocks(N: np.ndarray, rcond: float = RCOND):
     """Inverse of symmetric blocks ``N`` ``(T, n, d, d)`` and ``ok`` ``(T,)`` (every block of
-    the trial regular by the scaled rule). Singular blocks are replaced by the identity.
-    2 x 2 blocks run compiled where numba is present (the same arithmetic)."""
+    the trial regular by the scaled rule). Singular blocks are replaced by the identity."""
     d = N.shape[-1]
-    if d == 2:
-        if compile.available():
-            T, n = N.shape[:2]
-            out, good = np.empty((T * n, 2, 2)), np.empty(T * n, np.bool_)
-            compile.compiled(_inv2, helpers=(block2_rcond,))(
-                np.ascontiguousarray(N, dtype=np.float64).reshape(T * n, 2, 2),
-                float(rcond),
-                out,
-                good,
-            )
-            return out.reshape(T, n, 2, 2), good.reshape(T, n).all(axis=1)
     good = scaled_rcond(N) > rcond  # (T, n)
     ok = good.all(axis=1)
     Ns = np.where(good[..., None, None], N, np.eye(d))
