@@ -18,11 +18,12 @@ The command line is :mod:`benchmarks.cli`. Nothing here is study code (:mod:`sim
 
 from __future__ import annotations
 
+import os
 import time
 
 import numpy as np
 
-__all__ = ["main", "cpu_time"]
+__all__ = ["main", "cpu_time", "numpy_path"]
 
 
 def cpu_time(f, repeat: int = 3) -> float:
@@ -35,6 +36,19 @@ def cpu_time(f, repeat: int = 3) -> float:
         f()
         best = min(best, time.process_time() - t)
     return best
+
+
+def numpy_path(f):
+    """``f()`` with the compiled kernels off (``SIM_NO_JIT=1``, :mod:`sim.lsq.compile`)."""
+    old = os.environ.get("SIM_NO_JIT")
+    os.environ["SIM_NO_JIT"] = "1"
+    try:
+        return f()
+    finally:
+        if old is None:
+            del os.environ["SIM_NO_JIT"]
+        else:
+            os.environ["SIM_NO_JIT"] = old
 
 
 def main(argv=None) -> int:

@@ -1,9 +1,11 @@
 """Command line of the benchmark: ``python -m benchmarks --out results/bench`` (``make bench``).
 
 Sections (``--only``, default all): ``brown`` (``bench.parquet``, ``bench.png``:
-:mod:`benchmarks.brown`), ``engines`` (``engines.parquet``: :mod:`benchmarks.engines`) and
-``rerun`` (``rerun.parquet``: :mod:`benchmarks.rerun`; ``--no-rerun`` leaves it out), the last
-two drawn in ``engines.png``. ``--quick`` is a smoke run: small sizes, and the rerun rows with
+:mod:`benchmarks.brown`), ``engines`` (``engines.parquet``: :mod:`benchmarks.engines`),
+``studies`` (``studies.parquet``: :mod:`benchmarks.studies`) and ``rerun``
+(``rerun.parquet``: :mod:`benchmarks.rerun`; ``--no-rerun`` leaves it out), engines and rerun
+drawn in ``engines.png``; ``README.md`` (:mod:`benchmarks.page`) names each compiled module and
+the row that keeps it. ``--quick`` is a smoke run: small sizes, and the rerun rows with
 the test suite's tiny configuration of each study (``tests/data/tiny/<study>.txt``), so its
 rerun times say nothing about the 90 s target.
 """
@@ -21,7 +23,7 @@ from sim.mc.storage import provenance, write_table
 
 __all__ = ["main", "run"]
 
-SECTIONS = ("brown", "engines", "rerun")
+SECTIONS = ("brown", "engines", "studies", "rerun")
 TINY = Path(__file__).resolve().parent.parent / "tests" / "data" / "tiny"
 
 
@@ -60,6 +62,22 @@ def run(
 
         tables["engines.parquet"] = engine_rows(quick)
         write_table(out / "engines.parquet", tables["engines.parquet"], provenance(prov))
+    if "studies" in sections:
+        from benchmarks.studies import STUDIES, study_rows
+
+        files = [Path("studies") / f"{s}.toml" for s in STUDIES]
+        extra = {f.stem: tiny_overrides(f) for f in files} if quick else {}
+        tables["studies.parquet"] = study_rows(files, extra)
+        write_table(out / "studies.parquet", tables["studies.parquet"], provenance(prov))
+    if "engines" in sections or "studies" in sections:
+        from benchmarks.page import write_page
+
+        write_page(
+            out / "README.md",
+            tables.get("engines.parquet"),
+            tables.get("studies.parquet"),
+            quick,
+        )
     if "rerun" in sections:
         from benchmarks.rerun import rerun_rows, study_files
 
