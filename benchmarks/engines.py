@@ -37,7 +37,6 @@ from benchmarks import cpu_time, numpy_path
 from sim.instruments.plates import grid_points
 from sim.instruments.ranges import multilateration as ml
 from sim.lsq import compile
-from sim.mc.heap import keep_heap
 
 __all__ = ["Case", "TARGET_SPEEDUP", "KEEP_RATIO", "cases", "agreement", "engine_rows"]
 
@@ -319,11 +318,8 @@ def engine_rows(quick: bool = False, only=None) -> dict[str, list]:
     ``trials`` (compiled kernels on), ``numpy_s`` the same trials on the NumPy path
     (``SIM_NO_JIT=1``, or the case's own NumPy side), ``compiled_vs_numpy`` their ratio;
     ``scipy_s`` the CPU time of the SciPy loop over ``scipy_trials`` trials, scaled to
-    ``trials``; ``speedup = scipy_s / compiled_s`` (NumPy's time without numba). Both sides
-    run with freed memory kept in the process's heap, as the studies' chunks run
-    (:func:`sim.mc.heap.keep_heap`).
+    ``trials``; ``speedup = scipy_s / compiled_s`` (NumPy's time without numba).
     """
-    keep_heap()
     cols = (
         "engine",
         "compiled_module",
