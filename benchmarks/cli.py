@@ -19,6 +19,12 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks import studies
+from benchmarks.brown import brown_rows, million, peak_rss_mib
+from benchmarks.engines import engine_rows
+from benchmarks.figures import brown_figure, engines_figure
+from benchmarks.page import write_page
+from benchmarks.rerun import rerun_rows, study_files
 from sim.mc.storage import provenance, write_table
 
 __all__ = ["main", "run"]
@@ -46,32 +52,22 @@ def run(
 ) -> dict[str, dict]:
     """Measure ``sections`` and write their tables and figures under ``out``; returns the
     tables' columns by file name."""
-    from benchmarks.figures import brown_figure, engines_figure
-
     prov = {"study": "bench", "seed": 1, "quick": quick}
     tables: dict[str, dict] = {}
     if "brown" in sections:
-        from benchmarks.brown import brown_rows
-
         rows, extra = brown_rows(out, quick)
         write_table(out / "bench.parquet", rows, provenance(prov, **extra))
         brown_figure(rows, out / "bench.png", extra["solutions_agree_mm"])
         tables["bench.parquet"] = rows
     if "engines" in sections:
-        from benchmarks.engines import engine_rows
-
         tables["engines.parquet"] = engine_rows(quick)
         write_table(out / "engines.parquet", tables["engines.parquet"], provenance(prov))
     if "studies" in sections:
-        from benchmarks.studies import STUDIES, study_rows
-
-        files = [Path("studies") / f"{s}.toml" for s in STUDIES]
+        files = [Path("studies") / f"{s}.toml" for s in studies.STUDIES]
         extra = {f.stem: tiny_overrides(f) for f in files} if quick else {}
-        tables["studies.parquet"] = study_rows(files, extra)
+        tables["studies.parquet"] = studies.study_rows(files, extra)
         write_table(out / "studies.parquet", tables["studies.parquet"], provenance(prov))
     if "engines" in sections or "studies" in sections:
-        from benchmarks.page import write_page
-
         write_page(
             out / "README.md",
             tables.get("engines.parquet"),
@@ -79,8 +75,6 @@ def run(
             quick,
         )
     if "rerun" in sections:
-        from benchmarks.rerun import rerun_rows, study_files
-
         files = study_files(rerun_files)
         extra = {f.stem: tiny_overrides(f) for f in files} if quick else {}
         tables["rerun.parquet"] = rerun_rows(files, rerun_workers, extra)
@@ -161,8 +155,6 @@ def main(argv=None) -> int:
     ap.add_argument("--chunk", type=int, default=10000, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.million_child:
-        from benchmarks.brown import million, peak_rss_mib
-
         million(Path(a.out), a.million_child, a.chunk)
         print(f"{peak_rss_mib():.1f}")
         return 0

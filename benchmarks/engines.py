@@ -27,15 +27,19 @@ the case's tolerance (:class:`Case`); a disagreement stops the benchmark.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable
-
 import numpy as np
 from scipy.optimize import least_squares
 
-from benchmarks import cpu_time, numpy_path
+from benchmarks.brown import _obs, _scipy_one
+from benchmarks.case import Case
+from benchmarks.engines_linear import polynomial, polynomial_shared, stress, stress_sincos
+from benchmarks.timing import cpu_time, numpy_path
+from sim.instruments import gridplate as gp
+from sim.instruments.block import independent_models as im
+from sim.instruments.block.layout import make_block, select_control
 from sim.instruments.plates import grid_points
 from sim.instruments.ranges import multilateration as ml
+from sim.instruments.ranges import positions as po
 from sim.lsq import compile
 
 __all__ = ["Case", "TARGET_SPEEDUP", "KEEP_RATIO", "cases", "agreement", "engine_rows"]
@@ -57,32 +61,6 @@ TARGET_SPEEDUP = 50.0
 KEEP_RATIO = 3.0
 
 
-@dataclass(frozen=True)
-class Case:
-    """One engine case on ``T`` trials: ``engine()`` solves all trials at once (an array with
-    a leading trial axis), ``one(t)`` solves trial ``t`` with SciPy (the same quantity);
-    ``tol`` is the largest absolute difference allowed, in ``unit``; ``scipy`` names the
-    SciPy call; ``why`` says in words why the loop is hard to beat, for a row below the
-    target; ``floor(t)``, when given, is the bare compiled call of trial ``t`` under the SciPy
-    loop (e.g. the LAPACK routine alone, its inputs prepared beforehand), timed for the note
-    of a row below the target as ``floor_label``."""
-
-    n_points: int
-    engine: Callable[[], np.ndarray]
-    one: Callable[[int], np.ndarray]
-    tol: float
-    unit: str
-    scipy: str
-    why: str = ""
-    floor: Callable[[int], object] | None = None
-    floor_label: str = ""
-    #: the compiled module(s) the row times against their NumPy path ("" none)
-    module: str = ""
-    #: the NumPy side when it is not ``engine`` under ``SIM_NO_JIT=1`` (e.g. another kernel)
-    numpy: Callable[[], np.ndarray] | None = None
-    numpy_label: str = "the NumPy path (SIM_NO_JIT=1)"
-
-
 def _lsq_scipy(fun, z0, jac=None, sparsity=None):
     return least_squares(
         fun,
@@ -102,8 +80,6 @@ _LSQ = "scipy.optimize.least_squares (trf)"
 
 def _pposition(T: int, seed: int = 3):
     """P-position design cell: 6 positions, 5 x 5 points over 220 mm, pivot model."""
-    from sim.instruments.ranges import positions as po
-
     rng = np.random.default_rng(seed)
     pts = grid_points(5, 55.0)
     th = po.design_theta(6, 155.0, 0.5, 1.0)
@@ -155,8 +131,6 @@ def _pposition(T: int, seed: int = 3):
 
 def _gridplate(T: int, seed: int = 4):
     """Two-grid-plate combined adjustment of one coordinate, 7 x 7 points, P_cx = 4."""
-    from sim.instruments import gridplate as gp
-
     rng = np.random.default_rng(seed)
     g = grid_points(7, 36.0)
     N = len(g)
@@ -189,9 +163,6 @@ def _gridplate(T: int, seed: int = 4):
 def _block(T: int, seed: int = 5):
     """Independent-model block of 2 strips x 3 models, 40 ground points, control on the
     pattern "full" (the SciPy loop differentiates numerically on the sparsity pattern)."""
-    from sim.instruments.block import independent_models as im
-    from sim.instruments.block.layout import make_block, select_control
-
     rng = np.random.default_rng(seed)
     b = make_block(2, 3, n_ground=40, pass_rows=3)
     xm, _ = im.noisy_models(b, rng, T, 0.05)
@@ -244,8 +215,6 @@ def _block(T: int, seed: int = 5):
 
 def _multilateration(T: int, seed: int = 1):
     """Brown's 25-point adjustment, the pivot model (7 globals), as brown_table1 runs it."""
-    from benchmarks.brown import _obs, _scipy_one
-
     pts, theta, obs, t0 = _obs(25, T, seed)
     p0 = ml.initial_points(obs, np.broadcast_to(t0, (T, 7)))
 
@@ -268,8 +237,6 @@ def _multilateration(T: int, seed: int = 1):
 
 def cases() -> dict:
     """name -> (make(T) -> :class:`Case`, engine trials, SciPy trials timed) at full size."""
-    from benchmarks.engines_linear import polynomial, polynomial_shared, stress, stress_sincos
-
     return {
         "multilateration": (_multilateration, 4000, 50),
         "pposition": (_pposition, 400, 10),

@@ -37,8 +37,9 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import linalg
+from scipy.linalg import lapack
 
-from benchmarks.engines import Case
+from benchmarks.case import Case
 from sim.instruments.plotter import errorfield_kernel as ek
 from sim.instruments.plotter import errorfields as ef
 from sim.instruments.plotter import polynomial as pl
@@ -65,8 +66,6 @@ _FLOOR = "LAPACK dgels alone (design prepared)"
 
 def _dgels(As, bs):
     """``floor(t)``: LAPACK ``dgels`` on trial ``t``'s prepared (Fortran-ordered) design."""
-    from scipy.linalg import lapack
-
     m, p = As[0].shape
     lwork = int(lapack.dgels_lwork(m, p, bs[0].shape[1])[0])
     return lambda t: lapack.dgels(As[t], bs[t], lwork=lwork)
