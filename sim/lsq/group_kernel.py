@@ -33,6 +33,8 @@ __all__ = ["pair_blocks", "diag_reduce", "points_step", "index"]
 def _pair_blocks(
     Npg, F, Jg, w, r, up, og, op, pk1, pk2, pq, mir_dst, mir_src, diag_obs, blocks, ubar
 ):  # pragma: no cover - compiled
+    """The NumPy path of :func:`sim.lsq.groups.reduce` after ``_point_blocks``: the pair
+    blocks (its batched products per bucket) and ``ubar``, trial by trial."""
     T, K, d, b = Npg.shape
     m = Jg.shape[2]
     n_pk = pk1.shape[0]
@@ -101,6 +103,10 @@ def _diag_reduce(
     blocks,
     ubar,
 ):  # pragma: no cover - compiled
+    """:func:`sim.lsq.groups.reduce` (``_point_blocks``, then the pair blocks) where the
+    point Jacobians are the constant diagonal ``jp`` (rows ``jc`` of the point-only rows):
+    diagonal point blocks, their inverse by the rule of ``_point_blocks`` (positive and
+    finite, or a point without observations), and ``Ngg_k`` with the pair ``(k, k)``."""
     T, K = Jg.shape[0], Jg.shape[1]
     m, b = D_POINT, B_GROUP  # noqa: F821 (compile-time constants, set by compile.compiled; m = d)
     P = npp.shape[1]
@@ -171,6 +177,8 @@ def _diag_reduce(
 
 
 def _points_step(Npg, Ninv, up, dg, og, op, out):  # pragma: no cover - compiled
+    """The NumPy path of :func:`sim.lsq.groups.points_step`:
+    ``Ninv @ (up - scatter(Npg @ dg[og]))`` per trial and point."""
     T, K, d, b = Npg.shape
     P = up.shape[1]
     u = np.empty((P, d))

@@ -57,6 +57,8 @@ LANES = 8
 
 
 def _shared_solve(M, At, w, b, x, vtpv, status):  # pragma: no cover - compiled
+    """The NumPy path of :func:`sim.lsq.linear._shared`: ``x = M b`` and ``v' W v`` of
+    ``v = b - A x``, trial by trial (``At`` = ``A'``)."""
     T, m = b.shape[0], At.shape[1]
     p, k = P_TERMS, K_RHS  # compile-time constants: the small loops unroll  # noqa: F821 (set by the compile helper)
     bb, xx = np.empty((k, m)), np.empty((p, k))
@@ -187,6 +189,8 @@ def solve_lanes(N, u, x, ok, s, L, G, e, fro, g2, rcond):  # pragma: no cover - 
 
 
 def _normal_solve(N, u, x, status, rcond):  # pragma: no cover - compiled
+    """``np.linalg.solve(N, u)`` where ``scaled_rcond(N) > rcond`` is proved by the bound,
+    :data:`LANES` trials at a time (:func:`solve_lanes`)."""
     T, p, k = u.shape
     Nb, ub, xb = np.empty((p, p, LANES)), np.empty((p, k, LANES)), np.empty((p, k, LANES))
     s, L, G = np.empty((p, LANES)), np.empty((p, p, LANES)), np.empty((p, p, LANES))

@@ -33,7 +33,7 @@ UNDECIDED = 4
 
 def _lane_stations(TH, Sx, Sy):  # pragma: no cover
     """Station coordinates (4, lanes) from the globals (7, lanes) in Brown's datum
-    (x1 = x3 = 0, y4 = -y2)."""
+    (x1 = x3 = 0, y4 = -y2): :func:`sim.instruments.ranges.multilateration.stations`."""
     for w in range(TH.shape[1]):
         Sx[0, w] = 0.0
         Sy[0, w] = TH[0, w]
@@ -48,8 +48,8 @@ def _lane_stations(TH, Sx, Sy):  # pragma: no cover
 def _kernel(
     r_obs, theta, pts, p, tol, max_iter, rcond, status, iters, idx, cnt, res, ssq
 ):  # pragma: no cover
-    """Gauss-Newton on blocks of ``W`` trials (``W`` a compile-time constant, see
-    :func:`_compile`). Every array below keeps the lane (trial) axis last, so each
+    """:func:`sim.lsq.gauss_newton` of Brown's range model on blocks of ``W`` trials (``W`` a
+    compile-time constant, :func:`sim.lsq.compile.compiled`). Every array below keeps the lane (trial) axis last, so each
     ``for w in range(W)`` loop is one SIMD-vectorisable sweep over the block's trials; the
     arithmetic of each lane is exactly the scalar algorithm's (no reassociation, no FMA
     contraction), so the result does not depend on ``W`` or on a trial's position. A block
