@@ -18,27 +18,7 @@ The command line is :mod:`benchmarks.cli`. Nothing here is study code (:mod:`sim
 
 from __future__ import annotations
 
-import time
+from benchmarks.cli import main
+from benchmarks.timing import cpu_time, numpy_path
 
-import numpy as np
-
-__all__ = ["main", "cpu_time"]
-
-
-def cpu_time(f, repeat: int = 3) -> float:
-    """Best CPU time of this process over ``repeat`` calls of ``f()`` (s). Single-threaded
-    work: CPU time is steadier than wall time on a shared machine; executors and study runs
-    are timed by wall clock."""
-    best = np.inf
-    for _ in range(repeat):
-        t = time.process_time()
-        f()
-        best = min(best, time.process_time() - t)
-    return best
-
-
-def main(argv=None) -> int:
-    """``python -m benchmarks`` (see :mod:`benchmarks.cli`)."""
-    from benchmarks.cli import main as _main
-
-    return _main(argv)
+__all__ = ["main", "cpu_time", "numpy_path"]

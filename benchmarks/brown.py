@@ -13,15 +13,22 @@
 
 from __future__ import annotations
 
+import resource
+import shutil
+import subprocess
+import sys
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from benchmarks import cpu_time
+from benchmarks.timing import cpu_time
 from sim.instruments.plates import grid_points, random_points
 from sim.instruments.ranges import multilateration as ml
+from sim.mc.runner import ChunkStore, make_executor, run_chunks
+from sim.studies import RunContext
 
 __all__ = ["brown_rows", "pivot_chunk", "executors", "million", "peak_memory", "peak_rss_mib"]
 
@@ -87,8 +94,6 @@ def pivot_chunk(rng: np.random.Generator, n: int, *, pts: np.ndarray, theta: np.
 
 
 def _pivot_fn():
-    from functools import partial
-
     k = 5
     return partial(
         pivot_chunk, pts=grid_points(k, 220.0 / (k - 1)), theta=ml.design_theta(167.5, 0.5, 1.0)
@@ -97,9 +102,6 @@ def _pivot_fn():
 
 def executors(trials: int, chunk: int) -> list[tuple[str, int, float]]:
     """Trials per second of the streaming pivot case for each executor."""
-    from sim.mc.runner import make_executor, run_chunks
-    from sim.studies import RunContext
-
     rows = []
     for kind, workers in (("local", 1), ("local", 2), ("dask", 2)):
         try:
@@ -122,11 +124,6 @@ def executors(trials: int, chunk: int) -> list[tuple[str, int, float]]:
 
 def million(out: Path, trials: int, chunk: int) -> None:
     """Child process: stream ``trials`` pivot trials through the chunk store."""
-    import shutil
-
-    from sim.mc.runner import ChunkStore, run_chunks
-    from sim.studies import RunContext
-
     store_dir = out / "million_trials.tmp"
     shutil.rmtree(store_dir, ignore_errors=True)
     res = run_chunks(
@@ -142,17 +139,13 @@ def peak_rss_mib() -> float:
     for line in Path("/proc/self/status").read_text().splitlines():
         if line.startswith("VmHWM:"):
             return int(line.split()[1]) / 1024.0
-    import resource  # not Linux: the (possibly inherited) maximum
-
+    # not Linux: the (possibly inherited) maximum
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
 def peak_memory(out: Path, trials: int, chunk: int) -> tuple[float, float]:
     """Run :func:`million` in a child process; its peak memory (MiB, as the child reports it)
     and wall time (s)."""
-    import subprocess
-    import sys
-
     t = time.perf_counter()
     done = subprocess.run(
         [

@@ -1,9 +1,11 @@
 """Command line of the benchmark: ``python -m benchmarks --out results/bench`` (``make bench``).
 
 Sections (``--only``, default all): ``brown`` (``bench.parquet``, ``bench.png``:
-:mod:`benchmarks.brown`), ``engines`` (``engines.parquet``: :mod:`benchmarks.engines`) and
-``rerun`` (``rerun.parquet``: :mod:`benchmarks.rerun`; ``--no-rerun`` leaves it out), the last
-two drawn in ``engines.png``. ``--quick`` is a smoke run: small sizes, and the rerun rows with
+:mod:`benchmarks.brown`), ``engines`` (``engines.parquet``: :mod:`benchmarks.engines`),
+``studies`` (``studies.parquet``: :mod:`benchmarks.studies`) and ``rerun``
+(``rerun.parquet``: :mod:`benchmarks.rerun`; ``--no-rerun`` leaves it out), engines and rerun
+drawn in ``engines.png``; ``README.md`` (:mod:`benchmarks.page`) names each compiled module and
+the row that keeps it. ``--quick`` is a smoke run: small sizes, and the rerun rows with
 the test suite's tiny configuration of each study (``tests/data/tiny/<study>.txt``), so its
 rerun times say nothing about the 90 s target.
 """
@@ -17,11 +19,17 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks import studies
+from benchmarks.brown import brown_rows, million, peak_rss_mib
+from benchmarks.engines import engine_rows
+from benchmarks.figures import brown_figure, engines_figure
+from benchmarks.page import write_page
+from benchmarks.rerun import rerun_rows, study_files
 from sim.mc.storage import provenance, write_table
 
 __all__ = ["main", "run"]
 
-SECTIONS = ("brown", "engines", "rerun")
+SECTIONS = ("brown", "engines", "studies", "rerun")
 TINY = Path(__file__).resolve().parent.parent / "tests" / "data" / "tiny"
 
 
@@ -44,25 +52,29 @@ def run(
 ) -> dict[str, dict]:
     """Measure ``sections`` and write their tables and figures under ``out``; returns the
     tables' columns by file name."""
-    from benchmarks.figures import brown_figure, engines_figure
-
     prov = {"study": "bench", "seed": 1, "quick": quick}
     tables: dict[str, dict] = {}
     if "brown" in sections:
-        from benchmarks.brown import brown_rows
-
         rows, extra = brown_rows(out, quick)
         write_table(out / "bench.parquet", rows, provenance(prov, **extra))
         brown_figure(rows, out / "bench.png", extra["solutions_agree_mm"])
         tables["bench.parquet"] = rows
     if "engines" in sections:
-        from benchmarks.engines import engine_rows
-
         tables["engines.parquet"] = engine_rows(quick)
         write_table(out / "engines.parquet", tables["engines.parquet"], provenance(prov))
+    if "studies" in sections:
+        files = [Path("studies") / f"{s}.toml" for s in studies.STUDIES]
+        extra = {f.stem: tiny_overrides(f) for f in files} if quick else {}
+        tables["studies.parquet"] = studies.study_rows(files, extra)
+        write_table(out / "studies.parquet", tables["studies.parquet"], provenance(prov))
+    if "engines" in sections or "studies" in sections:
+        write_page(
+            out / "README.md",
+            tables.get("engines.parquet"),
+            tables.get("studies.parquet"),
+            quick,
+        )
     if "rerun" in sections:
-        from benchmarks.rerun import rerun_rows, study_files
-
         files = study_files(rerun_files)
         extra = {f.stem: tiny_overrides(f) for f in files} if quick else {}
         tables["rerun.parquet"] = rerun_rows(files, rerun_workers, extra)
@@ -143,8 +155,6 @@ def main(argv=None) -> int:
     ap.add_argument("--chunk", type=int, default=10000, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.million_child:
-        from benchmarks.brown import million, peak_rss_mib
-
         million(Path(a.out), a.million_child, a.chunk)
         print(f"{peak_rss_mib():.1f}")
         return 0

@@ -1,5 +1,9 @@
 """Engine rows of the benchmark (``engines.parquet``): each adjustment on the engine of
-:mod:`sim.lsq` against a per-trial SciPy loop of the same adjustment on the same observations.
+:mod:`sim.lsq`, compiled and on its NumPy path (``SIM_NO_JIT=1``, :mod:`sim.lsq.compile`),
+against a per-trial SciPy loop of the same adjustment on the same observations. A row names
+the compiled module it times (``compiled_module``); ``compiled_vs_numpy`` is the ratio that
+keeps that module in the suite (at least :data:`KEEP_RATIO`, or a study row of
+:mod:`benchmarks.studies`).
 
 The Gauss-Newton cases are here (the linear ones in :mod:`benchmarks.engines_linear`):
 
@@ -12,7 +16,9 @@ The Gauss-Newton cases are here (the linear ones in :mod:`benchmarks.engines_lin
 * ``block``: seed ``003``'s independent-model block (:func:`sim.instruments.block.independent_models.adjust_block`),
   2 strips x 3 models, 40 ground points, full control; compared on the ground points (m).
 
-The SciPy side is ``scipy.optimize.least_squares`` (``trf``, tolerances near machine
+Further rows: ``multilateration`` (Brown's 25-point pivot adjustment, the compiled kernel of
+:mod:`sim.instruments.ranges.multilateration_jit`) and, in :mod:`benchmarks.engines_linear`,
+the polynomial fits and the stress field. The SciPy side is ``scipy.optimize.least_squares`` (``trf``, tolerances near machine
 precision), with the analytic Jacobian where the module exposes one (``pposition``) and finite
 differences otherwise (on the Jacobian's sparsity pattern for the block). It is timed on a few trials and scaled to the
 engine's count. Before anything is timed both sides solve the same trials and must agree to
@@ -21,17 +27,22 @@ the case's tolerance (:class:`Case`); a disagreement stops the benchmark.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable
-
 import numpy as np
 from scipy.optimize import least_squares
 
-from benchmarks import cpu_time
+from benchmarks.brown import _obs, _scipy_one
+from benchmarks.case import Case
+from benchmarks.engines_linear import polynomial, polynomial_shared, stress, stress_sincos
+from benchmarks.timing import cpu_time, numpy_path
+from sim.instruments import gridplate as gp
+from sim.instruments.block import independent_models as im
+from sim.instruments.block.layout import make_block, select_control
 from sim.instruments.plates import grid_points
-from sim.mc.heap import keep_heap
+from sim.instruments.ranges import multilateration as ml
+from sim.instruments.ranges import positions as po
+from sim.lsq import compile
 
-__all__ = ["Case", "TARGET_SPEEDUP", "cases", "agreement", "engine_rows"]
+__all__ = ["Case", "TARGET_SPEEDUP", "KEEP_RATIO", "cases", "agreement", "engine_rows"]
 
 #: largest differences allowed between the engine's and SciPy's solutions: sigma0 (mm) of
 #: the P-position cell; the affine parameters of the grid-plate adjustment (scale near 1,
@@ -40,30 +51,14 @@ __all__ = ["Case", "TARGET_SPEEDUP", "cases", "agreement", "engine_rows"]
 #: determined directions (its sum of squares stays above the engine's), so the points agree
 #: to about a thousandth of the noise, not to rounding
 TOL_PPOSITION, TOL_GRIDPLATE, TOL_BLOCK = 1e-12, 1e-9, 5e-4
+#: Brown's points (mm): both sides stop on corrections of about 1e-10 mm
+TOL_MULTILATERATION = 1e-6
 
 #: the issue's target: each engine at least this many times its per-trial SciPy loop
 TARGET_SPEEDUP = 50.0
-
-
-@dataclass(frozen=True)
-class Case:
-    """One engine case on ``T`` trials: ``engine()`` solves all trials at once (an array with
-    a leading trial axis), ``one(t)`` solves trial ``t`` with SciPy (the same quantity);
-    ``tol`` is the largest absolute difference allowed, in ``unit``; ``scipy`` names the
-    SciPy call; ``why`` says in words why the loop is hard to beat, for a row below the
-    target; ``floor(t)``, when given, is the bare compiled call of trial ``t`` under the SciPy
-    loop (e.g. the LAPACK routine alone, its inputs prepared beforehand), timed for the note
-    of a row below the target as ``floor_label``."""
-
-    n_points: int
-    engine: Callable[[], np.ndarray]
-    one: Callable[[int], np.ndarray]
-    tol: float
-    unit: str
-    scipy: str
-    why: str = ""
-    floor: Callable[[int], object] | None = None
-    floor_label: str = ""
+#: issue 22: a compiled path stays where it is at least this many times its NumPy path on its
+#: engine row (or saves at least :data:`benchmarks.studies.KEEP_SHARE` of a study's time)
+KEEP_RATIO = 3.0
 
 
 def _lsq_scipy(fun, z0, jac=None, sparsity=None):
@@ -85,8 +80,6 @@ _LSQ = "scipy.optimize.least_squares (trf)"
 
 def _pposition(T: int, seed: int = 3):
     """P-position design cell: 6 positions, 5 x 5 points over 220 mm, pivot model."""
-    from sim.instruments.ranges import positions as po
-
     rng = np.random.default_rng(seed)
     pts = grid_points(5, 55.0)
     th = po.design_theta(6, 155.0, 0.5, 1.0)
@@ -138,8 +131,6 @@ def _pposition(T: int, seed: int = 3):
 
 def _gridplate(T: int, seed: int = 4):
     """Two-grid-plate combined adjustment of one coordinate, 7 x 7 points, P_cx = 4."""
-    from sim.instruments import gridplate as gp
-
     rng = np.random.default_rng(seed)
     g = grid_points(7, 36.0)
     N = len(g)
@@ -172,9 +163,6 @@ def _gridplate(T: int, seed: int = 4):
 def _block(T: int, seed: int = 5):
     """Independent-model block of 2 strips x 3 models, 40 ground points, control on the
     pattern "full" (the SciPy loop differentiates numerically on the sparsity pattern)."""
-    from sim.instruments.block import independent_models as im
-    from sim.instruments.block.layout import make_block, select_control
-
     rng = np.random.default_rng(seed)
     b = make_block(2, 3, n_ground=40, pass_rows=3)
     xm, _ = im.noisy_models(b, rng, T, 0.05)
@@ -221,19 +209,43 @@ def _block(T: int, seed: int = 5):
         "m (ground points)",
         _LSQ + ", finite differences on the Jacobian's sparsity pattern",
         "every trial is a small problem that least_squares solves in few iterations",
+        module="sim.lsq.group_kernel, sim.lsq.group_kernel_solve",
+    )
+
+
+def _multilateration(T: int, seed: int = 1):
+    """Brown's 25-point adjustment, the pivot model (7 globals), as brown_table1 runs it."""
+    pts, theta, obs, t0 = _obs(25, T, seed)
+    p0 = ml.initial_points(obs, np.broadcast_to(t0, (T, 7)))
+
+    def engine():
+        return ml.adjust(obs, "pivot", t0).points
+
+    def one(t):
+        return _scipy_one(obs[t], t0, p0[t]).x[:50].reshape(25, 2)
+
+    return Case(
+        25,
+        engine,
+        one,
+        TOL_MULTILATERATION,
+        "mm (points)",
+        "scipy.optimize.least_squares (lm), analytic Jacobian",
+        module="sim.instruments.ranges.multilateration_jit",
     )
 
 
 def cases() -> dict:
     """name -> (make(T) -> :class:`Case`, engine trials, SciPy trials timed) at full size."""
-    from benchmarks.engines_linear import polynomial, polynomial_shared
-
     return {
+        "multilateration": (_multilateration, 4000, 50),
         "pposition": (_pposition, 400, 10),
         "gridplate": (_gridplate, 400, 10),
         "block": (_block, 40, 2),
         "polynomial": (polynomial, 20000, 400),
         "polynomial_shared": (polynomial_shared, 20000, 400),
+        "stress_field": (stress, 2000, 200),
+        "stress_sincos": (stress_sincos, 2000, 200),
     }
 
 
@@ -253,23 +265,39 @@ def _floor(case: Case, trials: int) -> str:
     return f", {case.floor_label} {tf * 1e6:.3g} us"
 
 
+def _compiled_and_numpy(case: Case, repeat: int) -> tuple[float, float]:
+    """Best CPU times of the compiled engine and of its NumPy side, in alternating rounds
+    (the machine's speed drifts); NaN compiled time without numba."""
+    numpy_side = case.numpy or (lambda: numpy_path(case.engine))
+    tc, tn = [], []
+    for _ in range(2):
+        if compile.available():
+            tc.append(cpu_time(case.engine, repeat))
+        tn.append(cpu_time(numpy_side, max(1, repeat // 2)))
+    return (min(tc) if tc else np.nan), min(tn)
+
+
 def engine_rows(quick: bool = False, only=None) -> dict[str, list]:
     """The columns of ``engines.parquet``, one row per case (``only``: a subset of names).
 
     Both sides are checked to agree on the first trials before anything is timed
-    (RuntimeError otherwise). ``engine_s`` is the best CPU time of the engine over all
-    ``trials``; ``scipy_s`` the CPU time of the SciPy loop over ``scipy_trials`` trials,
-    scaled to ``trials``; ``speedup = scipy_s / engine_s``. Both sides run with freed memory
-    kept in the process's heap, as the studies' chunks run (:func:`sim.mc.heap.keep_heap`).
+    (RuntimeError otherwise). ``compiled_s`` is the best CPU time of the engine over all
+    ``trials`` (compiled kernels on), ``numpy_s`` the same trials on the NumPy path
+    (``SIM_NO_JIT=1``, or the case's own NumPy side), ``compiled_vs_numpy`` their ratio;
+    ``scipy_s`` the CPU time of the SciPy loop over ``scipy_trials`` trials, scaled to
+    ``trials``; ``speedup = scipy_s / compiled_s`` (NumPy's time without numba).
     """
-    keep_heap()
     cols = (
         "engine",
+        "compiled_module",
         "n_points",
         "trials",
         "scipy_trials",
-        "engine_s",
+        "compiled_s",
+        "numpy_s",
         "scipy_s",
+        "compiled_vs_numpy",
+        "numpy_side",
         "engine_trials_per_s",
         "scipy_trials_per_s",
         "speedup",
@@ -292,7 +320,8 @@ def engine_rows(quick: bool = False, only=None) -> dict[str, list]:
                 f"bench: {name}: the engine and {case.scipy} differ by {diff:.2e} "
                 f"{case.unit} (tolerance {case.tol:.0e})"
             )
-        te = cpu_time(case.engine, 1 if quick else 3)
+        tc, tn = _compiled_and_numpy(case, 1 if quick else 3)
+        te = tn if np.isnan(tc) else tc
         ts = cpu_time(lambda: [case.one(t) for t in range(Ts)], 1) * T / Ts
         x = ts / te
         note = (
@@ -307,11 +336,15 @@ def engine_rows(quick: bool = False, only=None) -> dict[str, list]:
             cols,
             (
                 name,
+                case.module,
                 case.n_points,
                 T,
                 Ts,
-                te,
+                tc,
+                tn,
                 ts,
+                tn / tc,
+                case.numpy_label,
                 T / te,
                 T / ts,
                 x,
@@ -325,7 +358,8 @@ def engine_rows(quick: bool = False, only=None) -> dict[str, list]:
         ):
             rows[c].append(v)
         print(
-            f"{name:>18}: engine {T / te:10.1f} trials/s, scipy loop {T / ts:8.2f} trials/s, "
-            f"x{x:.0f}; solutions differ by {diff:.1e} {case.unit}"
+            f"{name:>18}: compiled {T / tc:10.1f} trials/s, NumPy {T / tn:10.1f} trials/s "
+            f"(x{tn / tc:.1f}), scipy loop {T / ts:8.2f} trials/s (x{x:.0f}); "
+            f"solutions differ by {diff:.1e} {case.unit}"
         )
     return rows

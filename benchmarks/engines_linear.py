@@ -1,4 +1,5 @@
-"""Linear engine rows of the benchmark: Wolf & Pearsall's polynomial calibration.
+"""Linear engine rows of the benchmark: Wolf & Pearsall's polynomial calibration, and the
+stress field of its error model.
 
 Seed ``000_668e60e68f004f98.txt`` (Wolf & Pearsall 1976): the ten-term third-degree
 correction polynomial per axis (:data:`sim.instruments.plotter.polynomial.WOLF_TERMS`) fitted by least squares to
@@ -18,7 +19,15 @@ coordinates / 100 mm).
   all trials (:func:`sim.lsq.linear.lstsq`), then every trial's solution and ``v' W v`` in a
   compiled pass over its observations.
 
-The SciPy side is what a user would write for one trial: ``scipy.linalg.lstsq`` (LAPACK
+* ``stress_field``: the ``stress`` component of the plotter's error field
+  (:mod:`sim.instruments.plotter.errorfields`, the study's 8 um over 70 mm, 16 waves) at the
+  198 points, compiled (:mod:`sim.instruments.plotter.errorfield_kernel`) and NumPy; its
+  per-trial loop is NumPy's own formula trial by trial (no SciPy routine does this).
+* ``stress_sincos``: the same compiled kernel with its own sine and cosine (fdlibm's
+  polynomials, vectorised) against the same kernel calling the library's ``sin`` and ``cos``
+  (its ``numpy_s``): the row that keeps the hand-written sine and cosine.
+
+The SciPy side of the polynomial rows is what a user would write for one trial: ``scipy.linalg.lstsq`` (LAPACK
 ``gelsd``) of the trial's design against its two right-hand sides. Where a row falls below
 the issue's 50x, its note times, beside both sides, LAPACK's QR least squares (``dgels``)
 alone on a prepared design per trial, the floor of any per-trial loop.
@@ -28,12 +37,16 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import linalg
+from scipy.linalg import lapack
 
-from benchmarks.engines import Case
+from benchmarks.case import Case
+from sim.instruments.plotter import errorfield_kernel as ek
+from sim.instruments.plotter import errorfields as ef
 from sim.instruments.plotter import polynomial as pl
+from sim.lsq import compile
 from sim.lsq.linear import lstsq
 
-__all__ = ["polynomial", "polynomial_shared"]
+__all__ = ["polynomial", "polynomial_shared", "stress", "stress_sincos"]
 
 #: coefficients of both sides agree to this (mm); the fits are well conditioned (the
 #: coordinates are normalised by 100 mm), so the difference is a few units of rounding
@@ -53,8 +66,6 @@ _FLOOR = "LAPACK dgels alone (design prepared)"
 
 def _dgels(As, bs):
     """``floor(t)``: LAPACK ``dgels`` on trial ``t``'s prepared (Fortran-ordered) design."""
-    from scipy.linalg import lapack
-
     m, p = As[0].shape
     lwork = int(lapack.dgels_lwork(m, p, bs[0].shape[1])[0])
     return lambda t: lapack.dgels(As[t], bs[t], lwork=lwork)
@@ -97,6 +108,7 @@ def polynomial(T: int, seed: int = 6) -> Case:
         _WHY_PER_TRIAL,
         _dgels(As, bs),
         _FLOOR,
+        module="sim.instruments.plotter.polynomial_kernel (with sim.lsq.linear_kernel.solve_lanes)",
     )
 
 
@@ -124,4 +136,106 @@ def polynomial_shared(T: int, seed: int = 6) -> Case:
         _WHY,
         _dgels([Af] * n, [np.asfortranarray(d[t]) for t in range(n)]),
         _FLOOR,
+        module="sim.lsq.linear_kernel (shared_solve)",
+    )
+
+
+#: the stress field's values agree to this (um; values of a few um, rounding of 16 terms)
+TOL_STRESS_UM = 1e-11
+_STRESS_WHY = "a field evaluation per trial is a few NumPy calls; its cost is the sines"
+
+
+def _stress_draw(T: int, seed: int):
+    """The study's stress field (8 um rms, 70 mm, 16 waves) drawn for ``T`` trials, at the
+    198 calibration points: ``(spec, params, points (198, 2) mm)``."""
+    g, _ = _calibration(1, seed)
+    spec = ef.FieldSpec(stress_um=8.0, stress_length_mm=70.0)
+    return spec, ef.draw(spec, np.random.default_rng(seed), T), g
+
+
+def _stress_one(params, g):
+    """Trial ``t``'s field by NumPy's formula (the loop side)."""
+    q = params["stress"]
+    K = q["w"].shape[1]
+
+    def one(t):
+        ph = g @ q["w"][t].T
+        bc, bs = q["b"][t] * np.cos(q["phi"][t]), q["b"][t] * np.sin(q["phi"][t])
+        return q["a"][t] * np.sqrt(2.0 / K) * (np.cos(ph) @ bc - np.sin(ph) @ bs)
+
+    return one
+
+
+def stress(T: int, seed: int = 7) -> Case:
+    """The stress component, compiled or NumPy, at the 198 points."""
+    spec, params, g = _stress_draw(T, seed)
+
+    def engine():
+        return ef.evaluate_components(spec, params, g, skip_zero=True)["stress"]
+
+    return Case(
+        len(g),
+        engine,
+        _stress_one(params, g),
+        TOL_STRESS_UM,
+        "um (displacements)",
+        "NumPy per trial (no SciPy routine)",
+        _STRESS_WHY,
+        module="sim.instruments.plotter.errorfield_kernel",
+    )
+
+
+def _stress_libm(X, Y, w, bc, bs, scale, out):  # pragma: no cover - compiled
+    """errorfield_kernel._stress with the library's ``np.sin``, ``np.cos`` (the bench's
+    counterpart of the hand-written :func:`~sim.instruments.plotter.errorfield_kernel.sincos`)."""
+    T, n = X.shape
+    K = w.shape[1]
+    f0, f1 = np.empty(n), np.empty(n)
+    for t in range(T):
+        f0[:] = 0.0
+        f1[:] = 0.0
+        for k in range(K):
+            wx, wy = w[t, k, 0], w[t, k, 1]
+            c0, c1, s0, s1 = bc[t, k, 0], bc[t, k, 1], bs[t, k, 0], bs[t, k, 1]
+            for i in range(n):
+                ph = X[t, i] * wx + Y[t, i] * wy
+                s, c = np.sin(ph), np.cos(ph)
+                f0[i] += c * c0 - s * s0
+                f1[i] += c * c1 - s * s1
+        for i in range(n):
+            out[t, i, 0] = scale[t] * f0[i]
+            out[t, i, 1] = scale[t] * f1[i]
+
+
+def stress_sincos(T: int, seed: int = 7) -> Case:
+    """The compiled stress kernel with its own sine and cosine against the library's."""
+    spec, params, g = _stress_draw(T, seed)
+    q = params["stress"]
+    P = np.broadcast_to(g, (T,) + g.shape)
+    scale = q["a"] * np.sqrt(2.0 / q["w"].shape[1])
+
+    def engine():
+        return ek.stress_field(P, q["w"], q["b"], q["phi"], scale)
+
+    def libm():
+        X = np.ascontiguousarray(P[..., 0])
+        Y = np.ascontiguousarray(P[..., 1])
+        bc = np.ascontiguousarray(q["b"] * np.cos(q["phi"]))
+        bs = np.ascontiguousarray(q["b"] * np.sin(q["phi"]))
+        out = np.empty((T, len(g), 2))
+        if compile.available():
+            compile.compiled(_stress_libm)(X, Y, q["w"], bc, bs, scale, out)
+        return out
+
+    return Case(
+        len(g),
+        engine,
+        _stress_one(params, g),
+        TOL_STRESS_UM,
+        "um (displacements)",
+        "NumPy per trial (no SciPy routine)",
+        _STRESS_WHY,
+        module="sim.instruments.plotter.errorfield_kernel (sincos)",
+        numpy=libm,
+        numpy_label="the same compiled kernel with the library's sin and cos",
     )

@@ -1,6 +1,8 @@
 """The benchmark at smoke size (``python -m benchmarks --quick``): every engine row is present
-and both sides of each agree; the rerun rows time the study files as ``make rerun`` runs them;
-a disagreement or bad input stops it with one line. No timings are asserted."""
+with its compiled, NumPy and loop times, and both sides of each agree; the study rows time a
+study in each variant; the page names every compiled module of the suite; the rerun rows time
+the study files as ``make rerun`` runs them; a disagreement or bad input stops it with one
+line. No timings are asserted."""
 
 from pathlib import Path
 
@@ -8,22 +10,41 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from benchmarks import cli, engines
+from benchmarks import cli, engines, studies
 from benchmarks.engines_linear import polynomial
 
 ROOT = Path(__file__).resolve().parent.parent
-ENGINES = {"pposition", "gridplate", "block", "polynomial", "polynomial_shared"}
+ENGINES = {
+    "multilateration",
+    "pposition",
+    "gridplate",
+    "block",
+    "polynomial",
+    "polynomial_shared",
+    "stress_field",
+    "stress_sincos",
+}
+#: every compiled module of the suite (a file whose kernels sim.lsq.compile compiles)
+COMPILED = {
+    "sim/lsq/group_kernel.py",
+    "sim/lsq/group_kernel_solve.py",
+    "sim/lsq/linear_kernel.py",
+    "sim/instruments/ranges/multilateration_jit.py",
+    "sim/instruments/plotter/polynomial_kernel.py",
+    "sim/instruments/plotter/errorfield_kernel.py",
+}
 
 
 def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
     monkeypatch.chdir(ROOT)
+    monkeypatch.setattr(studies, "STUDIES", ("network_testfield",))
     out = tmp_path / "bench"
     assert (
         cli.main(
             [
                 "--quick",
                 "--only",
-                "engines,rerun",
+                "engines,studies,rerun",
                 "--out",
                 str(out),
                 "--rerun-files",
@@ -36,9 +57,30 @@ def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
     assert set(eng["engine"]) == ENGINES == set(engines.cases())
     for i, name in enumerate(eng["engine"]):
         assert eng["max_abs_diff"][i] <= eng["tolerance"][i], name
-        assert eng["engine_s"][i] > 0 and eng["scipy_s"][i] > 0
-        assert eng["speedup"][i] == pytest.approx(eng["scipy_s"][i] / eng["engine_s"][i])
+        assert eng["compiled_s"][i] > 0 and eng["numpy_s"][i] > 0 and eng["scipy_s"][i] > 0
+        assert eng["speedup"][i] == pytest.approx(eng["scipy_s"][i] / eng["compiled_s"][i])
+        assert eng["compiled_vs_numpy"][i] == pytest.approx(
+            eng["numpy_s"][i] / eng["compiled_s"][i]
+        )
         assert (eng["speedup"][i] < eng["target_speedup"][i]) == eng["note"][i].startswith("below")
+    # every compiled module of the suite has a row, and the page names it with a verdict
+    named = {m.split(" ")[0].rstrip(",") for m in eng["compiled_module"] if m}
+    named |= {m.split(", ")[1] for m in eng["compiled_module"] if ", " in m}
+    assert {f[:-3].replace("/", ".") for f in COMPILED} == named
+    on_disk = {
+        p.relative_to(ROOT).as_posix()
+        for p in (ROOT / "sim").rglob("*.py")
+        if "compile.compiled(" in p.read_text()
+        or "from sim.lsq.compile import compiled" in p.read_text()
+    }
+    assert on_disk == COMPILED
+    page = (out / "README.md").read_text()
+    for m in named | {"sim.report.figure_jobs"}:
+        assert m in page, m
+    st = pq.read_table(out / "studies.parquet").to_pydict()
+    assert st["study"] == ["network_testfield"] * 4
+    assert st["variant"] == list(studies.VARIANTS)
+    assert all(x > 0 for x in st["seconds"])
     rr = pq.read_table(out / "rerun.parquet").to_pydict()
     assert rr["study"] == ["network_testfield", "report", "total"] * 2
     assert rr["workers"] == [1, 1, 1, 2, 2, 2]

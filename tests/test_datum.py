@@ -141,8 +141,8 @@ def test_result_in_datum_and_coverage_use_the_engine_result():
 
 
 @pytest.mark.parametrize("P, brown", [(3, False), (4, False), (6, False), (4, True)])
-def test_sparse_and_compiled_reduced_normals_equal_the_dense_jacobians(P, brown):
-    """RangeModel's own reduced normals (compiled, and the NumPy blocks) are the engine's
+def test_sparse_reduced_normals_equal_the_dense_jacobians(P, brown):
+    """RangeModel's own reduced normals (the sparse NumPy blocks) are the engine's
     reduction of the dense Jacobian to 1e-12 relative, for any free set, with and without
     readings; the adjustment gives the same solution and status."""
     from sim.instruments.ranges import multilateration as ml

@@ -8,8 +8,9 @@ import pytest
 
 from sim.instruments.plotter import errorfield_kernel as ek
 from sim.instruments.plotter import errorfields as ef
+from sim.lsq import compile
 
-pytestmark = pytest.mark.skipif(not ek.available(), reason="numba not installed")
+pytestmark = pytest.mark.skipif(not compile.available(), reason="numba not installed")
 EPS = np.finfo(float).eps
 
 
@@ -42,7 +43,7 @@ def test_stress_field_equals_numpy_path(monkeypatch):
     P = rng.uniform(-130.0, 130.0, (T, n, 2))
     P[4, 9, 1] = np.nan
     fast = ef.evaluate_components(spec, params, P, skip_zero=True)["stress"]
-    monkeypatch.setattr(ek, "available", lambda: False)
+    monkeypatch.setenv("SIM_NO_JIT", "1")
     ref = ef.evaluate_components(spec, params, P, skip_zero=True)["stress"]
     # bound: each of the K terms |b| (|d sin| + |d cos|) with both sides' sine and cosine
     # within 4 ulp of max(1, |phase|), plus the two summation orders (K terms each)

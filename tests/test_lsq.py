@@ -17,7 +17,7 @@ def batch(a, T):
     return np.broadcast_to(a, (T,) + a.shape).copy()
 
 
-@pytest.mark.skipif(not ml.jit.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not ml.jit.available(), reason="numba not installed")
 @pytest.mark.parametrize("model", list(ml.MODELS))
 def test_generic_engine_equals_compiled_fast_path(model):
     """The engine's loop and the registered numba kernel on the same trials.
@@ -140,25 +140,22 @@ def test_screened_rule_decides_like_the_eigenvalue_ratio():
         np.testing.assert_array_equal(Minv[ok], np.linalg.inv(M[ok]))
 
 
-def test_compiled_2x2_point_blocks_equal_the_numpy_closed_form(monkeypatch):
-    """inv_blocks of 2 x 2 blocks runs compiled with the NumPy path's arithmetic: the same
-    inverses and decisions bit for bit, singular, NaN, infinite and zero blocks included."""
-    from sim.lsq import group_kernel, normals
+def test_block2_rcond_is_the_scaled_rule_of_2x2_blocks():
+    """The scalar rule the compiled kernels apply to 2 x 2 blocks (normals.block2_rcond)
+    equals scaled_rcond bit for bit, singular, NaN, infinite and zero blocks included."""
+    from sim.lsq import normals
 
-    if not group_kernel.available():
-        pytest.skip("numba not installed")
     rng = np.random.default_rng(0)
-    N = rng.normal(size=(60, 25, 2, 2))
-    N = N @ N.transpose(0, 1, 3, 2)
-    N[3, 4] = [[1.0, 1.0], [1.0, 1.0]]  # singular
-    N[5, 6, 0, 1] = np.nan
-    N[7, 1] = [[1e-30, 0.0], [0.0, 1.0]]  # regular once scaled
-    N[8, 2] = 0.0
-    N[9, 3, 0, 0] = np.inf
-    N[10, 0] = [[1.0, 1.0], [1.0, 1.0 + 1e-12]]  # below rcond
-    fast, ok_fast = normals.inv_blocks(N)
-    monkeypatch.setattr(group_kernel, "available", lambda: False)
-    ref, ok_ref = normals.inv_blocks(N)
-    np.testing.assert_array_equal(ok_fast, ok_ref)
-    np.testing.assert_array_equal(fast, ref)
-    assert list(np.flatnonzero(~ok_ref)) == [3, 5, 8, 9, 10]
+    N = rng.normal(size=(300, 2, 2))
+    N = N @ N.transpose(0, 2, 1)
+    N[3] = [[1.0, 1.0], [1.0, 1.0]]  # singular
+    N[5, 0, 1] = np.nan
+    N[7] = [[1e-30, 0.0], [0.0, 1.0]]  # regular once scaled
+    N[8] = 0.0
+    N[9, 0, 0] = np.inf
+    N[10] = [[1.0, 1.0], [1.0, 1.0 + 1e-12]]  # below rcond
+    N[11] = [[-2.0, 0.5], [0.5, 3.0]]  # indefinite
+    with np.errstate(invalid="ignore"):
+        rc = np.array([normals.block2_rcond(m[0, 0], m[0, 1], m[1, 0], m[1, 1]) for m in N])
+    np.testing.assert_array_equal(rc, normals.scaled_rcond(N))
+    assert list(np.flatnonzero(~(rc > normals.RCOND))) == [3, 5, 8, 9, 10]

@@ -9,8 +9,8 @@ import pytest
 
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import make_block, select_control
+from sim.lsq import compile, group_kernel, group_kernel_solve, groups
 from sim.lsq import group_solve as gs
-from sim.lsq import groups
 
 
 @pytest.fixture(scope="module")
@@ -78,9 +78,7 @@ def test_chol_subst_blocks_match_numpy():
 def test_compiled_kernels_equal_numpy(setup):
     """The compiled pair blocks and residual cofactors (sim.lsq.group_kernel) equal the NumPy
     path to rounding, with a removed observation (weight 0)."""
-    from sim.lsq import group_kernel, group_kernel_solve
-
-    if not group_kernel.available():
+    if not compile.available():
         pytest.skip("numba not installed")
     b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
     w = w.copy()
@@ -126,24 +124,6 @@ def test_compiled_kernels_equal_numpy(setup):
         assert np.array_equal(np.isnan(q0), np.isnan(q1))
         # relative to the scale of Q_vv, W^-1 (a point seen once has q_vv = 0)
         assert np.nanmax(np.abs(q1 - q0) * w) <= 1e-12
-
-
-def test_compiled_linearisation_equals_numpy(setup):
-    """The compiled similarity linearisation (sim.instruments.block.similarity_jit) equals the NumPy one."""
-    from sim.instruments.block import similarity_jit
-
-    b, st, xm, w, cx, wc, (s0, R0, t0, X0) = setup
-    c = np.random.default_rng(4).normal(size=(xm.shape[0], st.n_models, 3))
-    model = im.SimilarityModel(st, xm, c, w, cx, wc)
-    theta = im._state(s0, R0, t0)
-    if similarity_jit.linearize(xm, c, theta, X0, st.obs_model, st.obs_point) is None:
-        pytest.skip("numba not installed")
-    fast = model.linearize(X0, theta)
-    model.jit = False
-    ref = model.linearize(X0, theta)
-    for a, f in ((ref.r, fast.r), (ref.Jg, fast.Jg), (ref.Jp, fast.Jp), (ref.rc, fast.rc)):
-        assert a.shape == f.shape
-        assert np.abs(f - a).max() <= 1e-12 * np.abs(a).max()
 
 
 def test_singular_and_non_finite_trials_are_flagged(setup):

@@ -176,7 +176,7 @@ def test_bad_arguments_rejected():
         ml.adjust(np.ones((1, 3, 4)) * 150, "pivot", THETA)
 
 
-@pytest.mark.skipif(not ml.jit.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not ml.jit.available(), reason="numba not installed")
 def test_compiled_engine_flags_singular_geometry():
     pts = np.stack([np.linspace(-50, 50, 6), np.zeros(6)], 1)
     r = ml.ranges(batch(pts, 3), batch(THETA, 3))
@@ -184,7 +184,7 @@ def test_compiled_engine_flags_singular_geometry():
     assert not res.converged.any() and set(res.status.tolist()) <= {2, 3}
 
 
-@pytest.mark.skipif(not ml.jit.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not ml.jit.available(), reason="numba not installed")
 def test_simd_lanes_are_bit_identical_to_one_trial_at_a_time():
     """The SIMD kernel adjusts blocks of LANES trials in lock-step: every trial's result must
     be bit-identical to adjusting it alone, wherever it sits in a block (full blocks, a

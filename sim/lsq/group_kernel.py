@@ -16,25 +16,25 @@ gathered temporaries (one copy of the Jacobians per pair of observations of a po
 
 The solve and the cofactors are in :mod:`sim.lsq.group_kernel_solve`. Every trial is the
 same arithmetic as the NumPy path of :mod:`sim.lsq.groups`, summed in another order: the
-two agree to rounding (tests hold them to 1e-12 relative). Units: those of the model. numba
-is imported on first use and the compiled code cached on disk (:func:`compiled`); without
-numba, or with ``SIM_NO_JIT`` set, :func:`available` is False and the NumPy path runs.
+two agree to rounding (tests hold them to 1e-12 relative). Units: those of the model.
+Compiled by :func:`sim.lsq.compile.compiled`; the caller runs them where
+:func:`sim.lsq.compile.available`, else the NumPy path.
 """
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
-__all__ = ["available", "compiled", "pair_blocks", "diag_reduce", "points_step", "index"]
+from sim.lsq.compile import compiled
 
-_compiled: dict | None = None
+__all__ = ["pair_blocks", "diag_reduce", "points_step", "index"]
 
 
 def _pair_blocks(
     Npg, F, Jg, w, r, up, og, op, pk1, pk2, pq, mir_dst, mir_src, diag_obs, blocks, ubar
 ):  # pragma: no cover - compiled
+    """The NumPy path of :func:`sim.lsq.groups.reduce` after ``_point_blocks``: the pair
+    blocks (its batched products per bucket) and ``ubar``, trial by trial."""
     T, K, d, b = Npg.shape
     m = Jg.shape[2]
     n_pk = pk1.shape[0]
@@ -103,8 +103,12 @@ def _diag_reduce(
     blocks,
     ubar,
 ):  # pragma: no cover - compiled
+    """:func:`sim.lsq.groups.reduce` (``_point_blocks``, then the pair blocks) where the
+    point Jacobians are the constant diagonal ``jp`` (rows ``jc`` of the point-only rows):
+    diagonal point blocks, their inverse by the rule of ``_point_blocks`` (positive and
+    finite, or a point without observations), and ``Ngg_k`` with the pair ``(k, k)``."""
     T, K = Jg.shape[0], Jg.shape[1]
-    m, b = D_POINT, B_GROUP  # compile-time constants (see compiled); m = d here  # noqa: F821 (set by the compile helper)
+    m, b = D_POINT, B_GROUP  # noqa: F821 (compile-time constants, set by compile.compiled; m = d)
     P = npp.shape[1]
     C = rows.shape[0]
     for t in range(T):
@@ -173,6 +177,8 @@ def _diag_reduce(
 
 
 def _points_step(Npg, Ninv, up, dg, og, op, out):  # pragma: no cover - compiled
+    """The NumPy path of :func:`sim.lsq.groups.points_step`:
+    ``Ninv @ (up - scatter(Npg @ dg[og]))`` per trial and point."""
     T, K, d, b = Npg.shape
     P = up.shape[1]
     u = np.empty((P, d))
@@ -191,56 +197,6 @@ def _points_step(Npg, Ninv, up, dg, og, op, out):  # pragma: no cover - compiled
                 for c in range(d):
                     v += Ninv[t, j, a, c] * u[j, c]
                 out[t, j, a] = v
-
-
-def _numba():
-    """numba's ``njit``, or None without numba or with ``SIM_NO_JIT`` set."""
-    global _compiled
-    if _compiled is None:
-        _compiled = {}
-        if not os.environ.get("SIM_NO_JIT"):
-            try:
-                from numba import njit
-            except ImportError:  # pragma: no cover - the NumPy path runs
-                pass
-            else:
-                _compiled["njit"] = njit
-    return _compiled.get("njit")
-
-
-#: the floating-point licences of :func:`compiled` with ``reassociate=True``: sums may be
-#: reordered (vectorised) and multiply-adds fused; no licence to assume finite numbers, so
-#: NaN and infinity still propagate and the non-finite checks of the kernels hold
-REASSOCIATE = frozenset({"reassoc", "contract"})
-
-
-def compiled(fn, reassociate: bool = False, **consts):
-    """``fn`` compiled by numba (once per process; cached on disk). ``consts`` (e.g. block
-    sizes ``D_POINT``, ``B_GROUP``, ``M_ROWS``) are frozen into its globals as compile-time
-    constants (numba treats globals as such), which lets the compiler unroll and vectorise
-    the small loops; each variant is cached under its own name. ``reassociate``: compile
-    with :data:`REASSOCIATE` (long dot products vectorised; the sums are deterministic but
-    rounded in another order than a sequential loop). Needs :func:`available`."""
-    import types
-
-    njit = _numba()
-    key = (fn.__module__, fn.__name__, reassociate) + tuple(sorted(consts.items()))
-    if key not in _compiled:
-        f = fn
-        if consts:
-            name = "_".join([fn.__name__] + [str(v) for _, v in sorted(consts.items())])
-            f = types.FunctionType(
-                fn.__code__, dict(fn.__globals__, **consts), name, fn.__defaults__, fn.__closure__
-            )
-            f.__qualname__ = name
-        opts = {"fastmath": set(REASSOCIATE)} if reassociate else {}
-        _compiled[key] = njit(cache=True, error_model="numpy", **opts)(f)
-    return _compiled[key]
-
-
-def available() -> bool:
-    """Whether the compiled kernels run (numba installed and ``SIM_NO_JIT`` unset)."""
-    return _numba() is not None
 
 
 def _c(a: np.ndarray) -> np.ndarray:

@@ -1,5 +1,5 @@
 """Compiled kernels of the group-block engine (:mod:`sim.lsq.groups`): the solve and the
-cofactors, via numba (compiled by :func:`sim.lsq.group_kernel.compiled`).
+cofactors, via numba (compiled by :func:`sim.lsq.compile.compiled`).
 
 Seed of the method: Agnard, Nolette & Gagnon (``003_5ce730a990a7ebc5.txt``, SPACE-M's
 reduced normals and Baarda's data snooping on the residuals of the block).
@@ -15,19 +15,21 @@ reduced normals and Baarda's data snooping on the residuals of the block).
 
 Each equals the NumPy path of :mod:`sim.lsq.groups` / :mod:`sim.lsq.group_solve` to
 rounding (tests). Units: those of the model; cofactors for unit weight. Call only when
-:func:`sim.lsq.group_kernel.available`.
+:func:`sim.lsq.compile.available`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from sim.lsq.group_kernel import _c, compiled
+from sim.lsq.compile import compiled
+from sim.lsq.group_kernel import _c
 
 __all__ = ["dense_scaled", "chol_vec", "chol_inv", "residual_cofactors"]
 
 
 def _dense_scaled(blocks, pg1, pg2, N, s):  # pragma: no cover - compiled
+    """:func:`sim.lsq.group_solve.scaled` of :func:`sim.lsq.group_solve.dense`."""
     T, n_p, b = blocks.shape[0], blocks.shape[1], blocks.shape[2]
     n = N.shape[1]
     for t in range(T):
@@ -46,6 +48,7 @@ def _dense_scaled(blocks, pg1, pg2, N, s):  # pragma: no cover - compiled
 
 
 def _chol_vec(L, y, x):  # pragma: no cover - compiled
+    """:func:`sim.lsq.group_solve.chol_subst` of one right-hand side per trial."""
     T, n = y.shape
     z = np.empty(n)
     for t in range(T):
@@ -62,6 +65,8 @@ def _chol_vec(L, y, x):  # pragma: no cover - compiled
 
 
 def _chol_inv(L, Q):  # pragma: no cover - compiled
+    """``chol_subst(L, I)`` (:func:`sim.lsq.group_solve.chol_subst`), the inverse of
+    ``L L'``, as ``L^-T L^-1``."""
     T, n = L.shape[0], L.shape[1]
     X = np.empty((n, n))
     for t in range(T):
@@ -91,8 +96,10 @@ def _chol_inv(L, Q):  # pragma: no cover - compiled
 
 def _residual_cofactors(Q, F, Ninv, Jg, Jp, w, og, op, pts, pstart, pobs, out):
     # pragma: no cover - compiled
+    """The NumPy path of :meth:`sim.lsq.groups.GroupCofactors.residuals`:
+    ``1 / w - (Jg Qgg Jg' - 2 Jg H Jp' + Jp Qpp Jp')`` per observation row."""
     T = F.shape[0]
-    d, b, m = D_POINT, B_GROUP, M_ROWS  # compile-time constants (see compiled)  # noqa: F821 (set by the compile helper)
+    d, b, m = D_POINT, B_GROUP, M_ROWS  # noqa: F821 (compile-time constants, set by compile.compiled)
     nmax = 0
     for j in pts:
         nmax = max(nmax, pstart[j + 1] - pstart[j])

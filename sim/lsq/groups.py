@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from sim.lsq import group_kernel, group_kernel_solve
+from sim.lsq import compile, group_kernel, group_kernel_solve
 from sim.lsq.group_solve import (
     band_order,
     band_solve,
@@ -217,7 +217,7 @@ def reduce(
     compiled kernel :func:`sim.lsq.group_kernel.pair_blocks` (``jit`` None: when numba is
     there), else one batched product per bucket of group pairs with the same number of
     shared points."""
-    jit = group_kernel.available() if jit is None else jit
+    jit = compile.available() if jit is None else jit
     if jit:
         jp, jc = _const_diag(lin.Jp), _const_diag(lin.Jc)
         if jp is not None and jc is not None and (jp != 0).all():
@@ -269,11 +269,11 @@ def solve(
         else:
             Ns, s = (
                 group_kernel_solve.dense_scaled(st, red.blocks)
-                if group_kernel.available()
+                if compile.available()
                 else scaled(dense(st, red.blocks))
             )
             L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)), rcond, check)
-            if group_kernel.available():
+            if compile.available():
                 dg = group_kernel_solve.chol_vec(L, rhs * s) * s
             else:
                 dg = chol_subst(L, (rhs * s)[..., None])[..., 0] * s
@@ -283,7 +283,7 @@ def solve(
 
 def points_step(st: GroupStructure, red: GroupReduced, dg: np.ndarray) -> np.ndarray:
     """Point corrections ``Npp^-1 (up - sum_k Npg_k dg_k)`` (T, P, d)."""
-    if group_kernel.available():
+    if compile.available():
         return group_kernel.points_step(st, red.Npg, red.Ninv, red.up, dg)
     u = red.up - scatter(st.S_point, (red.Npg * dg[:, st.obs_group, None, :]).sum(-1))
     return (red.Ninv @ u[..., None])[..., 0]
@@ -357,7 +357,7 @@ class GroupCofactors:
         compiled kernel :func:`sim.lsq.group_kernel_solve.residual_cofactors`."""
         st = self.st
         og, op = st.obs_group, st.obs_point
-        if group_kernel.available() if jit is None else jit:
+        if compile.available() if jit is None else jit:
             T, G, _, b, _ = self.Q.shape
             Q = self.Q.transpose(0, 1, 3, 2, 4).reshape(T, G * b, G * b)
             pts = (
@@ -392,14 +392,14 @@ def cofactors(st: GroupStructure, lin: GroupLinearization, rcond: float = RCOND)
     red = reduce(st, lin, rcond)
     Ns, s = (
         group_kernel_solve.dense_scaled(st, red.blocks)
-        if group_kernel.available()
+        if compile.available()
         else scaled(dense(st, red.blocks))
     )
     T, n = Ns.shape[:2]
     L, ok = factor(Ns, np.isfinite(Ns).all(axis=(1, 2)) & red.ok, rcond, True)
     Q = (
         group_kernel_solve.chol_inv(L)
-        if group_kernel.available()
+        if compile.available()
         else chol_subst(L, np.broadcast_to(np.eye(n), (T, n, n)).copy())
     )
     Q = Q * s[:, :, None] * s[:, None, :]

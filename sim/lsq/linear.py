@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import linalg
 
-from sim.lsq import linear_kernel
+from sim.lsq import compile, linear_kernel
 from sim.lsq.normals import RCOND, scaled_rcond
 
 __all__ = ["LinearFit", "lstsq", "LINEAR_STATUS"]
@@ -209,7 +209,7 @@ def _shared(A, b, w, rcond) -> LinearFit:
         )
     Qf, R = np.linalg.qr(Aw)  # once for all trials
     Rinv = linalg.solve_triangular(R, np.eye(p))
-    if linear_kernel.available():  # x = R^-1 Q' sqrt(W) b per trial, in the cache
+    if compile.available():  # x = R^-1 Q' sqrt(W) b per trial, in the cache
         x, vtpv, st = linear_kernel.shared_solve(Rinv @ (Qf.T * sw[None, :]), A, w, b)
         status = np.where(st == linear_kernel.SOLVED, 0, 3).astype(np.int8)
         return LinearFit(x, None, vtpv, m - p, status, True, Rinv, None, (A, b))

@@ -23,7 +23,7 @@ Model, per trial ``t`` (``k`` right-hand sides sharing the design)::
   (e.g. :mod:`sim.instruments.plotter.polynomial_kernel`, which hands its undecided trials to
   :func:`sim.lsq.linear.lstsq`).
 
-Sums are compiled with :data:`sim.lsq.group_kernel.REASSOCIATE` (reordered into vector
+Sums are compiled with :data:`sim.lsq.compile.REASSOCIATE` (reordered into vector
 lanes, deterministic): the numbers equal the NumPy path to rounding (tests hold them to a
 tolerance from the design's condition number). A trial with a non-finite observation is
 found by the sum of ``b * 0`` (NaN unless every term is finite) and flagged. Seed of the
@@ -34,28 +34,15 @@ design is the same for every trial.
 
 from __future__ import annotations
 
-import zlib
-from pathlib import Path
-
 import numpy as np
 
-from sim.lsq import group_kernel
-
-try:  # solve_scaled is compiled into the kernels that call it
-    from numba.extending import register_jitable
-except ImportError:  # pragma: no cover - the NumPy path runs
-
-    def register_jitable(f):
-        return f
-
+from sim.lsq import compile
 
 __all__ = [
-    "available",
     "shared_solve",
     "normal_solve",
     "solve_lanes",
     "LANES",
-    "SOURCE_TAG",
     "SOLVED",
     "UNDECIDED",
     "NONFINITE",
@@ -68,18 +55,10 @@ SOLVED, UNDECIDED, NONFINITE = 0, 1, 3
 #: trials solved side by side by :func:`solve_lanes` (a multiple of the vector width)
 LANES = 8
 
-#: a checksum of this file: kernels of other modules that call :func:`solve_lanes` compile
-#: it into their name (numba's disk cache sees only the caller's own file), so an edit here
-#: compiles them again
-SOURCE_TAG = zlib.crc32(Path(__file__).read_bytes())
-
-
-def available() -> bool:
-    """Whether the compiled kernels run (numba installed and ``SIM_NO_JIT`` unset)."""
-    return group_kernel.available()
-
 
 def _shared_solve(M, At, w, b, x, vtpv, status):  # pragma: no cover - compiled
+    """The NumPy path of :func:`sim.lsq.linear._shared`: ``x = M b`` and ``v' W v`` of
+    ``v = b - A x``, trial by trial (``At`` = ``A'``)."""
     T, m = b.shape[0], At.shape[1]
     p, k = P_TERMS, K_RHS  # compile-time constants: the small loops unroll  # noqa: F821 (set by the compile helper)
     bb, xx = np.empty((k, m)), np.empty((p, k))
@@ -127,13 +106,12 @@ def shared_solve(M: np.ndarray, A: np.ndarray, w: np.ndarray | None, b: np.ndarr
     x, vtpv = np.empty((T, p, k)), np.empty((T, k))
     status = np.empty(T, np.int8)
     c = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
-    group_kernel.compiled(_shared_solve, reassociate=True, P_TERMS=p, K_RHS=k)(
+    compile.compiled(_shared_solve, reassociate=True, P_TERMS=p, K_RHS=k)(
         c(M), c(A.T), np.ones(m) if w is None else c(w), c(b).reshape(T, m * k), x, vtpv, status
     )
     return x, vtpv, status
 
 
-@register_jitable
 def solve_lanes(N, u, x, ok, s, L, G, e, fro, g2, rcond):  # pragma: no cover - compiled
     """:data:`LANES` trials at once: ``N x = u`` per lane ``b`` (``N`` (p, p, LANES)
     symmetric, upper triangle read; ``u``, ``x`` (p, k, LANES)) by the scaled rule of the
@@ -141,7 +119,7 @@ def solve_lanes(N, u, x, ok, s, L, G, e, fro, g2, rcond):  # pragma: no cover - 
     it is left to the exact rule. Scratch: ``s`` (p, LANES), ``L``, ``G`` (p, p, LANES),
     ``e``, ``fro``, ``g2`` (LANES,). The trials are the innermost axis, so every step runs
     in vector lanes, without the latency of one small factorisation after another.
-    Callable from other compiled kernels."""
+    Compiled into the kernels that call it (``helpers`` of :func:`sim.lsq.compile.compiled`)."""
     p, k = u.shape[0], u.shape[1]
     for b in range(LANES):
         ok[b] = True
@@ -211,6 +189,8 @@ def solve_lanes(N, u, x, ok, s, L, G, e, fro, g2, rcond):  # pragma: no cover - 
 
 
 def _normal_solve(N, u, x, status, rcond):  # pragma: no cover - compiled
+    """``np.linalg.solve(N, u)`` where ``scaled_rcond(N) > rcond`` is proved by the bound,
+    :data:`LANES` trials at a time (:func:`solve_lanes`)."""
     T, p, k = u.shape
     Nb, ub, xb = np.empty((p, p, LANES)), np.empty((p, k, LANES)), np.empty((p, k, LANES))
     s, L, G = np.empty((p, LANES)), np.empty((p, p, LANES)), np.empty((p, p, LANES))
@@ -240,5 +220,5 @@ def normal_solve(N: np.ndarray, u: np.ndarray, rcond: float):
     x = np.empty((T, p, k))
     status = np.empty(T, np.int8)
     c = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
-    group_kernel.compiled(_normal_solve)(c(N), c(u), x, status, float(rcond))
+    compile.compiled(_normal_solve, helpers=(solve_lanes,))(c(N), c(u), x, status, float(rcond))
     return x, status

@@ -32,6 +32,7 @@ import numpy as np
 __all__ = [
     "RCOND",
     "scaled_rcond",
+    "block2_rcond",
     "inv_blocks",
     "Reduced",
     "reduce",
@@ -70,58 +71,28 @@ def scaled_rcond(M: np.ndarray) -> np.ndarray:
     return np.where(fin & np.isfinite(rc), rc, 0.0)
 
 
-def _inv2(N, rcond, out, good):  # pragma: no cover - compiled
-    """:func:`inv_blocks` of 2 x 2 blocks ``N`` (B, 2, 2) into ``out``, ``good`` (B,): the
-    arithmetic of :func:`scaled_rcond`'s closed form and of the NumPy inverse, operation for
-    operation (no reassociation), in one pass."""
-    for k in range(N.shape[0]):
-        m00, m01, m11 = N[k, 0, 0], N[k, 0, 1], N[k, 1, 1]
-        d0, d1 = abs(m00), abs(m11)
-        s0 = 1.0 / np.sqrt(d0) if d0 > 0 else 1.0
-        s1 = 1.0 / np.sqrt(d1) if d1 > 0 else 1.0
-        a, b, c = m00 * s0 * s0, m01 * s0 * s1, m11 * s1 * s1
-        fin = (
-            np.isfinite(a)
-            and np.isfinite(b)
-            and np.isfinite(c)
-            and np.isfinite(N[k, 1, 0] * s1 * s0)
-        )
-        rc = 0.0
-        if fin:
-            h, g = 0.5 * (a + c), np.sqrt((0.5 * (a - c)) ** 2 + b * b)
-            l1, l2 = abs(h + g), abs(h - g)
-            rc = min(l1, l2) / max(l1, l2)
-            if not np.isfinite(rc):
-                rc = 0.0
-        ok = rc > rcond
-        good[k] = ok
-        if not ok:
-            m00, m01, m11 = 1.0, 0.0, 1.0
-        inv = 1.0 / (m00 * m11 - m01 * m01)
-        out[k, 0, 0] = m11 * inv
-        out[k, 0, 1] = -m01 * inv
-        out[k, 1, 0] = -m01 * inv
-        out[k, 1, 1] = m00 * inv
+def block2_rcond(m00, m01, m10, m11):  # pragma: no cover - compiled into the kernels
+    """:func:`scaled_rcond` of one 2 x 2 block, operation for operation (the closed form):
+    the block scaled to unit diagonal, the ratio of its smaller to its larger |eigenvalue|;
+    0 where an entry of the scaled block is not finite. Scalars in, a scalar out: the one
+    singularity rule of the 2 x 2 blocks in the compiled kernels
+    (:mod:`sim.instruments.ranges.multilateration_kernel`)."""
+    d0, d1 = abs(m00), abs(m11)
+    s0 = 1.0 / np.sqrt(d0) if d0 > 0 else 1.0
+    s1 = 1.0 / np.sqrt(d1) if d1 > 0 else 1.0
+    a, b, c = m00 * s0 * s0, m01 * s0 * s1, m11 * s1 * s1
+    if not (np.isfinite(a) and np.isfinite(b) and np.isfinite(c) and np.isfinite(m10 * s1 * s0)):
+        return 0.0
+    h, g = 0.5 * (a + c), np.sqrt((0.5 * (a - c)) ** 2 + b * b)
+    l1, l2 = abs(h + g), abs(h - g)
+    rc = min(l1, l2) / max(l1, l2)
+    return rc if np.isfinite(rc) else 0.0
 
 
 def inv_blocks(N: np.ndarray, rcond: float = RCOND):
     """Inverse of symmetric blocks ``N`` ``(T, n, d, d)`` and ``ok`` ``(T,)`` (every block of
-    the trial regular by the scaled rule). Singular blocks are replaced by the identity.
-    2 x 2 blocks run compiled where numba is present (the same arithmetic)."""
+    the trial regular by the scaled rule). Singular blocks are replaced by the identity."""
     d = N.shape[-1]
-    if d == 2:
-        from sim.lsq import group_kernel
-
-        if group_kernel.available():
-            T, n = N.shape[:2]
-            out, good = np.empty((T * n, 2, 2)), np.empty(T * n, np.bool_)
-            group_kernel.compiled(_inv2)(
-                np.ascontiguousarray(N, dtype=np.float64).reshape(T * n, 2, 2),
-                float(rcond),
-                out,
-                good,
-            )
-            return out.reshape(T, n, 2, 2), good.reshape(T, n).all(axis=1)
     good = scaled_rcond(N) > rcond  # (T, n)
     ok = good.all(axis=1)
     Ns = np.where(good[..., None, None], N, np.eye(d))

@@ -3,8 +3,9 @@
 A study's figures are independent of each other and are drawn after its chunks are done, when
 the workers of a local process pool (``--workers N``) or of a local Dask cluster sit idle.
 :func:`draw_figures` sends each figure job there; without a pool (``--workers 1``, a remote
-Dask scheduler that may not see the output directory) it draws them in this process, in the
-given order. :func:`start_figures` sends them and returns at once, so the figures are drawn
+Dask scheduler that may not see the output directory, or ``SIM_FIGURES_HERE`` set: the
+benchmark's comparison, :mod:`benchmarks.studies`) it draws them in this process, in the given
+order. :func:`start_figures` sends them and returns at once, so the figures are drawn
 while this process goes on with the run (the sweeps, the claims); its ``wait`` collects them.
 A job is ``(fn, args)`` with ``fn`` a module-level function (picklable) that
 draws one figure and saves it (:func:`sim.report.plotting.save`); the files are the same either way.
@@ -15,6 +16,7 @@ threads, e.g. ``brown_design`` with a remote Dask scheduler) are drawn one at a 
 
 from __future__ import annotations
 
+import os
 import threading
 from concurrent.futures import Executor
 from typing import Callable, Sequence
@@ -26,6 +28,8 @@ DRAWING = threading.Lock()
 
 
 def _submitter(executor) -> Callable | None:
+    if os.environ.get("SIM_FIGURES_HERE"):
+        return None
     pool = getattr(executor, "pool", None)
     if isinstance(pool, Executor):
         return pool.submit

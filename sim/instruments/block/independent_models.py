@@ -46,7 +46,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim import lsq
-from sim.instruments.block import similarity_jit
 from sim.instruments.geometry import rotation, similarity_fit
 from sim.lsq.groups import chol_solve
 
@@ -268,13 +267,10 @@ class SimilarityModel:
     of ``s <- s (1 + dl)``, ``R <- R(dtheta) R``, ``t' <- t' + dt`` (b = 7); the state
     ``theta`` (T, M, 13) holds ``s``, ``R`` (9) and ``t' = t + s R c``. Rows: model points
     ``x_mj - [s R (x_mj - c_m) + t'_m - X_j]`` (weights w_obs) and control
-    ``X_j^control - X_j`` (weights w_ctrl); metres. Linearised by the compiled kernel of
-    :mod:`sim.instruments.block.similarity_jit` when numba is there (``jit``), else by NumPy.
+    ``X_j^control - X_j`` (weights w_ctrl); metres.
     """
 
     point_dim = 3
-    #: linearise by the compiled kernel of :mod:`sim.instruments.block.similarity_jit` when numba is there
-    jit = True
 
     def __init__(self, st: BlockStructure, xm, c, w_obs, ctrl_xyz, w_ctrl, solver="auto"):
         self.structure, self.xm, self.c, self.solver = st, xm, c, solver
@@ -288,17 +284,6 @@ class SimilarityModel:
         st = self.structure
         om, op = st.obs_model, st.obs_point
         T, C = X.shape[0], st.ctrl_point.size
-        fast = None if not self.jit else similarity_jit.linearize(self.xm, self.c, theta, X, om, op)
-        if fast is not None:
-            return lsq.GroupLinearization(
-                fast[0],
-                np.broadcast_to(-np.eye(3), fast[0].shape + (3,)),
-                fast[1],
-                self.w,
-                self.ctrl - X[:, st.ctrl_point],
-                np.broadcast_to(np.eye(3), (T, C, 3, 3)),
-                self.wc,
-            )
         s, R, t = theta[..., 0], theta[..., 1:10].reshape(theta.shape[:2] + (3, 3)), theta[..., 10:]
         d = self.xm - self.c[:, om]
         Rk = R[:, om]  # y = s R (x - c), unrolled

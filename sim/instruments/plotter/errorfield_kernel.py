@@ -18,25 +18,17 @@ on most machines (about 27 ns each here). Here the field is summed in one compil
 So a sine or cosine differs from the library's by a few units in the last place of
 ``max(1, |x|)`` (a test holds it to ``4 eps max(1, |x|)`` over the phases of the study); the
 field itself is summed in another order than NumPy's matrix products, so the two paths agree
-to rounding (a test). Without numba, or with ``SIM_NO_JIT`` set, :func:`available` is False
-and :func:`sim.instruments.plotter.errorfields.evaluate_components` runs the NumPy path.
+to rounding (a test). Where :func:`sim.lsq.compile.available` is False,
+:func:`sim.instruments.plotter.errorfields.evaluate_components` runs the NumPy path.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from sim.lsq import group_kernel
+from sim.lsq import compile
 
-try:
-    from numba.extending import register_jitable
-except ImportError:  # pragma: no cover - the NumPy path runs
-
-    def register_jitable(f):
-        return f
-
-
-__all__ = ["available", "sincos", "stress_field"]
+__all__ = ["sincos", "sincos_array", "stress_field"]
 
 # fdlibm (e_rem_pio2.c, k_sin.c, k_cos.c)
 _INVPIO2 = 6.36619772367581382433e-01
@@ -50,14 +42,9 @@ _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.1359
 _ROUND = 6755399441055744.0
 
 
-def available() -> bool:
-    """Whether the compiled kernel runs (numba installed and ``SIM_NO_JIT`` unset)."""
-    return group_kernel.available()
-
-
-@register_jitable
 def sincos(x):  # pragma: no cover - compiled (the test calls it through the kernel)
-    """``(sin x, cos x)`` of a double with ``|x| < 2^20 pi / 2``, without branches."""
+    """``(np.sin(x), np.cos(x))`` to a few units in the last place, for a double with
+    ``|x| < 2^20 pi / 2``, without branches (compiled into the kernels that call it)."""
     n = (x * _INVPIO2 + _ROUND) - _ROUND
     r = (x - n * _PIO2_1) - n * _PIO2_1T
     z = r * r
@@ -80,7 +67,8 @@ def sincos(x):  # pragma: no cover - compiled (the test calls it through the ker
 
 def _stress(X, Y, w, bc, bs, scale, out):  # pragma: no cover - compiled
     """``out[t, i, c] = scale[t] sum_k (cos(ph) bc[t, k, c] - sin(ph) bs[t, k, c])`` with
-    ``ph = X[t, i] w[t, k, 0] + Y[t, i] w[t, k, 1]``; the points are the inner loop (the
+    ``ph = X[t, i] w[t, k, 0] + Y[t, i] w[t, k, 1]``: the NumPy path's
+    ``scale * (cos(P @ w.T) @ bc - sin(P @ w.T) @ bs)``; the points are the inner loop (the
     compiler's vector lanes), the waves the outer one."""
     T, n = X.shape
     K = w.shape[1]
@@ -111,7 +99,7 @@ def sincos_array(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`sincos` of every element of ``x`` (for the tests)."""
     x = np.ascontiguousarray(x, dtype=np.float64).ravel()
     s, c = np.empty_like(x), np.empty_like(x)
-    group_kernel.compiled(_sincos_array)(x, s, c)
+    compile.compiled(_sincos_array, helpers=(sincos,))(x, s, c)
     return s, c
 
 
@@ -129,7 +117,7 @@ def stress_field(
     bc = np.ascontiguousarray(b * np.cos(phi))
     bs = np.ascontiguousarray(b * np.sin(phi))
     out = np.empty((T, n, 2))
-    group_kernel.compiled(_stress)(
+    compile.compiled(_stress, helpers=(sincos,))(
         X,
         Y,
         np.ascontiguousarray(w, dtype=np.float64),

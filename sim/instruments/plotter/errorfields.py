@@ -41,6 +41,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from sim.instruments.plotter import errorfield_kernel
+from sim.lsq import compile
 
 __all__ = ["COMPONENTS", "FieldSpec", "draw", "evaluate", "evaluate_components", "ar1_weights"]
 
@@ -175,7 +176,7 @@ def evaluate_components(
         q = params["stress"]
         K = q["w"].shape[1]
         scale = q["a"] * np.sqrt(2.0 / K)
-        if errorfield_kernel.available():  # one compiled pass, vectorised sine and cosine
+        if compile.available():  # one compiled pass, vectorised sine and cosine
             out["stress"] = errorfield_kernel.stress_field(P, q["w"], q["b"], q["phi"], scale)
         else:
             ph = np.matmul(P, q["w"].transpose(0, 2, 1))  # (T, n, K)

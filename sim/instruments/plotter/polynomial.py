@@ -31,7 +31,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.instruments.plotter import polynomial_kernel
+from sim.lsq import compile
 from sim.lsq.linear import lstsq
+from sim.lsq.normals import RCOND
 
 __all__ = [
     "WOLF_TERMS",
@@ -147,7 +149,7 @@ def fit_poly(
     measured = np.asarray(measured, float)
     true = np.broadcast_to(np.asarray(true, float), measured.shape)
     terms = tuple(terms) if terms is not None else poly_terms(degree)
-    if jit and measured.ndim == 3 and polynomial_kernel.available():
+    if jit and measured.ndim == 3 and compile.available():
         return _fit_compiled(measured, true, terms, float(norm_mm), corrected)
     A = design(measured, terms, norm_mm)  # (T, n, p): one R0 for all trials
     f = lstsq(A, true - measured)
@@ -160,11 +162,18 @@ def fit_poly(
 def _fit_compiled(measured, true, terms, norm_mm, corrected) -> PolyFit:
     """:func:`fit_poly` on the compiled fast path (:mod:`sim.instruments.plotter.polynomial_kernel`): each
     trial's normal equations formed from its points in the cache, solved eight trials at a
-    time by the engine's :func:`sim.lsq.linear_kernel.solve_lanes` (the scaled rule; trials
-    it cannot prove regular go to :func:`sim.lsq.linear.lstsq`, so status and decisions are
-    the engine's)."""
+    time by the engine's :func:`sim.lsq.linear_kernel.solve_lanes` (the scaled rule); trials
+    it cannot prove regular are fitted again by :func:`sim.lsq.linear.lstsq` on their designs
+    (the exact rule), so status and decisions are the engine's."""
     true_ = true[0] if true.strides[0] == 0 else true  # broadcast: one set of points
-    x, status, sq, corr = polynomial_kernel.fit(measured, true_, terms, norm_mm, corrected)
+    x, status, sq, corr = polynomial_kernel.fit(measured, true_, terms, norm_mm, corrected, RCOND)
+    rest = np.flatnonzero(status == polynomial_kernel.UNDECIDED)
+    if rest.size:  # the exact rule: the engine's NumPy path
+        A = design(measured[rest], terms, norm_mm)
+        g = lstsq(A, true[rest] - measured[rest], rcond=RCOND)
+        x[rest], status[rest], sq[rest] = g.x, g.status, g.vtpv
+        if corrected:
+            corr[rest] = measured[rest] + np.matmul(A, g.x)
     return PolyFit(x, terms, norm_mm, status == 0, np.sqrt(sq / measured.shape[1]), corr)
 
 

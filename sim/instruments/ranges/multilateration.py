@@ -36,6 +36,7 @@ import numpy as np
 from sim import lsq
 from sim.instruments.ranges import multilateration_jit as jit
 from sim.instruments.ranges import positions as po
+from sim.instruments.ranges.multilateration_kernel import UNDECIDED
 
 __all__ = [
     "MODELS",
@@ -176,7 +177,7 @@ def adjust(
         raise ValueError(f"{n} points give {4 * n} observations for {2 * n + p} unknowns")
     if engine not in ("auto", "numpy", "numba"):
         raise ValueError(f"engine must be auto, numpy or numba, not {engine!r}")
-    if engine == "numba" and not jit.AVAILABLE:
+    if engine == "numba" and not jit.available():
         raise ValueError("engine 'numba' needs numba installed")
     theta = np.broadcast_to(np.asarray(theta0, float), (T, 7)).copy()
     eng = {"auto": "auto", "numpy": "numpy", "numba": "fast"}[engine]
@@ -187,10 +188,12 @@ def adjust(
 
 
 def _kernel_path(model: po.RangeModel, theta, datum: lsq.Datum, tol, max_iter):
-    """Fast path of the engine for Brown's layout (the compiled kernel), or None."""
+    """Fast path of the engine for Brown's layout (the compiled kernel), or None. Trials the
+    kernel leaves undecided (it could not prove their reduced normals regular) are adjusted
+    again by the NumPy engine, whose exact rule decides them."""
     free = datum.free_index(model.n_global)
     if (
-        not jit.AVAILABLE
+        not jit.available()
         or model.layout is not BROWN_LAYOUT
         or model.r_obs is None
         or datum.constraints is not None
@@ -200,9 +203,17 @@ def _kernel_path(model: po.RangeModel, theta, datum: lsq.Datum, tol, max_iter):
     r_obs = model.r_obs
     T, n, _ = r_obs.shape
     p = len(free)
+    theta0 = theta.copy()
     pts, status, iters, res, ssq = jit.gauss_newton(r_obs, theta, None, p, tol, max_iter)
     dof = 4 * n - (2 * n + p)
     s0 = np.sqrt(ssq / dof) if dof > 0 else np.full(T, np.nan)
+    rest = np.flatnonzero(status == UNDECIDED)
+    if rest.size:  # the engine's exact rule on the NumPy path
+        g = lsq.gauss_newton(
+            _model(r_obs[rest]), theta0[rest], None, datum, tol, max_iter, engine="numpy"
+        )
+        pts[rest], theta[rest], res[rest] = g.points, g.theta, g.residuals
+        s0[rest], iters[rest], status[rest] = g.sigma0, g.iterations, g.status
     return lsq.Result(pts, theta, res, s0, dof, iters, status, model, datum)
 
 

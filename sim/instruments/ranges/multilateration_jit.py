@@ -7,61 +7,38 @@ eliminated per point (reduced normal equations, Brown's EMBET), a scaled Cholesk
 the p x p reduced normals (p <= 7), convergence when the largest correction -- or the
 remaining error estimated from the observed contraction, rho / (1 - rho) x correction with
 rho the ratio of the last two corrections -- is below the tolerance. No Python runs per
-trial: the kernel is compiled, and it adjusts ``LANES`` trials at a time in lock-step with
+trial: the kernel (source :mod:`sim.instruments.ranges.multilateration_kernel`) is compiled
+by :func:`sim.lsq.compile.compiled` and adjusts ``LANES`` trials at a time in lock-step with
 the trial axis innermost, so the compiler turns each sweep over the trials into SIMD
-instructions (AVX on x86). Each trial's arithmetic is the scalar algorithm's, operation for
-operation, so the results are bit-identical whatever the lane width; a test checks this.
-The NumPy engine stays the reference implementation and the tests require both to agree.
-The kernel's source is :mod:`sim.instruments.ranges.multilateration_kernel`; this module compiles it (per lane
-width), starts the points and dispatches.
+instructions. Each trial's arithmetic is the scalar algorithm's, operation for operation, so
+the results are bit-identical whatever the lane width; a test checks this.
 
-Status codes as in :class:`sim.instruments.ranges.multilateration.AdjustResult`: 0 converged, 1 iteration limit,
-2 singular normals (a 2x2 point block with det below ``rcond`` of its scale, or a squared
-Cholesky pivot of the scaled reduced normals below ``rcond_g`` = 1e-10, i.e. a condition
-number of about 1e10: ten digits lost), 3 non-finite corrections.
+Status codes as in :class:`sim.lsq.Result`: 0 converged, 1 iteration limit, 2 singular
+normals (a point block by the engine's rule :func:`sim.lsq.normals.block2_rcond`), 3
+non-finite corrections; and
+:data:`~sim.instruments.ranges.multilateration_kernel.UNDECIDED` (4) where the kernel could
+not prove the reduced normals regular by the engine's rule (the caller re-runs those trials
+on the NumPy engine).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from sim.instruments.ranges.multilateration_kernel import (  # the kernel's source
-    _kernel,
-    _lane_stations,
-    _start,
-)
+from sim.instruments.ranges.multilateration_kernel import _kernel, _lane_stations, _start
+from sim.lsq import compile
+from sim.lsq.normals import RCOND, block2_rcond
 
-try:
-    from numba import njit
-
-    AVAILABLE = True
-except ImportError:  # pragma: no cover - the NumPy engine is used instead
-    AVAILABLE = False
-
-__all__ = ["AVAILABLE", "LANES", "gauss_newton"]
+__all__ = ["available", "LANES", "gauss_newton", "use_lanes"]
 
 LANES = 64  # trials per SIMD block; 8 or 16 leave the sweeps scalar (see make bench)
 _LANE_BYTES = 216  # bytes of lane arrays per point and lane (R, X, Y, K, Ninv, up, D)
 _MAX_LANE_MEMORY = 256 * 2**20
 
 
-def _compile(fn, name: str, width: int):
-    """``fn`` compiled with the global ``W`` frozen to ``width`` (numba treats globals as
-    compile-time constants), cached on disk under its own name."""
-    import types
-
-    glb = dict(fn.__globals__, W=width, _lane_stations=_lane_stations)  # the compiled one
-    f = types.FunctionType(fn.__code__, glb, name, fn.__defaults__, fn.__closure__)
-    f.__qualname__ = name
-    # error_model="numpy": no ZeroDivisionError branches, which would block vectorisation
-    return njit(cache=True, error_model="numpy")(f)
-
-
-if AVAILABLE:
-    _lane_stations = njit(cache=True)(_lane_stations)
-    _kernel_lanes = _compile(_kernel, "_kernel_lanes", LANES)
-    _kernel_one = _compile(_kernel, "_kernel_one", 1)
-    _start = njit(cache=True)(_start)
+def available() -> bool:
+    """Whether the compiled kernel runs (:func:`sim.lsq.compile.available`)."""
+    return compile.available()
 
 
 def gauss_newton(
@@ -71,43 +48,29 @@ def gauss_newton(
     p: int,
     tol: float,
     max_iter: int,
-    rcond: float = 1e-13,
-    rcond_g: float = 1e-10,
+    rcond: float = RCOND,
 ):
     """Run the compiled kernel in place on ``theta`` (T, 7) (and ``pts`` (T, n, 2); None:
-    start from linear trilateration). Needs numba (:data:`AVAILABLE`).
+    start from linear trilateration). Needs :func:`available`.
 
     Returns ``(points, status, iterations, residuals, sum of squared residuals)``.
     """
-    if not AVAILABLE:
-        raise RuntimeError("numba is not installed")
     r_obs = np.ascontiguousarray(r_obs, dtype=np.float64)
     T, n, _ = r_obs.shape
     if pts is None:
         pts = np.empty((T, n, 2))
-        _start(r_obs, theta, pts)
+        compile.compiled(_start)(r_obs, theta, pts)
     status = np.ones(T, np.int8)
     iters = np.zeros(T, np.int32)
     res = np.empty((T, n, 4))
     ssq = np.empty(T)
     idx, cnt = _sparsity(p)
-    kernel = _kernel_lanes if use_lanes(T, n) else _kernel_one
+    width = LANES if use_lanes(T, n) else 1
+    kernel = compile.compiled(_kernel, W=width, helpers=(_lane_stations, block2_rcond))
     kernel(
-        r_obs,
-        theta,
-        pts,
-        int(p),
-        float(tol),
-        int(max_iter),
-        float(rcond),
-        float(rcond_g),
-        status,
-        iters,
-        idx,
-        cnt,
-        res,
-        ssq,
-    )
+        r_obs, theta, pts, int(p), float(tol), int(max_iter), float(rcond),
+        status, iters, idx, cnt, res, ssq,
+    )  # fmt: skip
     return pts, status, iters, res, ssq
 
 

@@ -1,29 +1,39 @@
 """Source of the compiled Gauss-Newton kernel of Brown's multilateration (numba-compilable
-Python; :mod:`sim.instruments.ranges.multilateration_jit` compiles it and runs it).
+Python; :mod:`sim.instruments.ranges.multilateration_jit` compiles it by
+:func:`sim.lsq.compile.compiled` and runs it).
 
 Seed ``004_f5bd9e86c308241f.txt`` (Brown): ranges ``r = sqrt(d^2 - b) - alpha`` (mm) with
 ``b = beta^2``, Brown's datum (x1 = x3 = 0, y4 = -y2), the 2x2 point blocks eliminated per
-point (reduced normal equations), a scaled Cholesky solve of the p x p reduced normals. The
-functions here are plain Python loops over scalars, written for the compiler: every lane
-array keeps the trial axis last, and ``W`` (the lane width) is a module global that
-:func:`sim.instruments.ranges.multilateration_jit._compile` freezes to a compile-time constant per variant.
-Nothing here is meant to be called uncompiled except in a debugger (it is correct, but slow).
+point (reduced normal equations), a scaled Cholesky solve of the p x p reduced normals. It
+equals :func:`sim.lsq.gauss_newton` on :class:`sim.instruments.ranges.positions.RangeModel`
+with Brown's layout (the NumPy engine: :func:`sim.lsq.normals.reduced_normals`, then
+:func:`sim.lsq.normals.bordered_solve`), trial by trial, to rounding. Singularity is the
+engine's one rule: a point block is singular when :func:`sim.lsq.normals.block2_rcond` is
+not above ``rcond`` (exact); the reduced normals are regular where the lower bound
+``1 / (||C||_F ||L^-1||_F^2)`` of the scaled matrix's eigenvalue ratio is above ``4 rcond``,
+else the trial is left *undecided* (status :data:`UNDECIDED`) and the caller runs it on the
+NumPy engine, whose exact rule decides. The functions are plain loops over scalars, written
+for the compiler: every lane array keeps the trial axis last, and ``W`` (the lane width) is a
+module global frozen to a compile-time constant per variant. Not meant to be called
+uncompiled except in a debugger (it is correct, but slow).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__: list[
-    str
-] = []  # private: compiled and dispatched by sim.instruments.ranges.multilateration_jit
+from sim.lsq.normals import block2_rcond  # compiled with the kernel (its helper)
+
+__all__ = ["UNDECIDED"]  # the kernels are compiled and run by multilateration_jit
 
 W = 1  # the lane width the kernel is compiled with; bound per variant by the compiler
+#: status of a trial whose reduced normals the kernel's bound could not prove regular
+UNDECIDED = 4
 
 
 def _lane_stations(TH, Sx, Sy):  # pragma: no cover
     """Station coordinates (4, lanes) from the globals (7, lanes) in Brown's datum
-    (x1 = x3 = 0, y4 = -y2)."""
+    (x1 = x3 = 0, y4 = -y2): :func:`sim.instruments.ranges.multilateration.stations`."""
     for w in range(TH.shape[1]):
         Sx[0, w] = 0.0
         Sy[0, w] = TH[0, w]
@@ -36,10 +46,10 @@ def _lane_stations(TH, Sx, Sy):  # pragma: no cover
 
 
 def _kernel(
-    r_obs, theta, pts, p, tol, max_iter, rcond, rcond_g, status, iters, idx, cnt, res, ssq
+    r_obs, theta, pts, p, tol, max_iter, rcond, status, iters, idx, cnt, res, ssq
 ):  # pragma: no cover
-    """Gauss-Newton on blocks of ``W`` trials (``W`` a compile-time constant, see
-    :func:`_compile`). Every array below keeps the lane (trial) axis last, so each
+    """:func:`sim.lsq.gauss_newton` of Brown's range model on blocks of ``W`` trials (``W`` a
+    compile-time constant, :func:`sim.lsq.compile.compiled`). Every array below keeps the lane (trial) axis last, so each
     ``for w in range(W)`` loop is one SIMD-vectorisable sweep over the block's trials; the
     arithmetic of each lane is exactly the scalar algorithm's (no reassociation, no FMA
     contraction), so the result does not depend on ``W`` or on a trial's position. A block
@@ -72,6 +82,10 @@ def _kernel(
     U0 = np.empty(W)
     U1 = np.empty(W)
     L = np.empty((7, 7, W))
+    Linv = np.empty((7, 7, W))
+    FRO = np.empty(W)
+    LINV2 = np.empty(W)
+    und = np.empty(W, np.bool_)
     dsc = np.empty((7, W))
     dg = np.empty((7, W))
     V = np.empty(W)
@@ -105,6 +119,7 @@ def _kernel(
             _lane_stations(TH, Sx, Sy)
             for w in range(W):
                 sing[w] = False
+                und[w] = False
             for r in range(p):
                 for w in range(W):
                     u[r, w] = 0.0
@@ -170,7 +185,7 @@ def _kernel(
                     c = C[w]
                     bb = B[w]
                     det = a * c - bb * bb
-                    if not det > rcond * (a + c) * (a + c):
+                    if not block2_rcond(a, bb, bb, c) > rcond:  # the engine's rule
                         sing[w] = True
                         det = 1.0
                     Ninv[j, 0, w] = c / det
@@ -190,28 +205,51 @@ def _kernel(
                             N[r, s, w] -= (
                                 K[j, 0, r, w] * Npg[0, s, w] + K[j, 1, r, w] * Npg[1, s, w]
                             )
-            # scaled Cholesky of the reduced normals, lane by lane (a failed pivot marks the
-            # lane singular and is replaced by 1 so the other lanes go on)
+            # scaled Cholesky C = L L' of the reduced normals, lane by lane (a failed pivot
+            # leaves the lane undecided and is replaced by 1 so the other lanes go on)
             for r in range(p):
                 for w in range(W):
                     dsc[r, w] = np.sqrt(abs(N[r, r, w])) + 1e-300
+            for w in range(W):
+                FRO[w] = 0.0
+                LINV2[w] = 0.0
             for r in range(p):
                 for s in range(r + 1):
                     for w in range(W):
                         V[w] = N[s, r, w] / (dsc[r, w] * dsc[s, w])
+                        FRO[w] += (1.0 if r == s else 2.0) * V[w] * V[w]  # ||C||_F^2
                     for m in range(s):
                         for w in range(W):
                             V[w] -= L[r, m, w] * L[s, m, w]
                     if r == s:
                         for w in range(W):
-                            if V[w] > rcond_g:
+                            if V[w] > 0.0:
                                 L[r, r, w] = np.sqrt(V[w])
                             else:
-                                sing[w] = True
+                                und[w] = True
                                 L[r, r, w] = 1.0
                     else:
                         for w in range(W):
                             L[r, s, w] = V[w] / L[s, s, w]
+            # the engine's rule by its bound: lambda_min / lambda_max of C is at least
+            # 1 / (||C||_F ||L^-1||_F^2); L^-1 column by column
+            for s in range(p):
+                for w in range(W):
+                    Linv[s, s, w] = 1.0 / L[s, s, w]
+                    LINV2[w] += Linv[s, s, w] * Linv[s, s, w]
+                for r in range(s + 1, p):
+                    for w in range(W):
+                        V[w] = 0.0
+                    for m in range(s, r):
+                        for w in range(W):
+                            V[w] -= L[r, m, w] * Linv[m, s, w]
+                    for w in range(W):
+                        Linv[r, s, w] = V[w] / L[r, r, w]
+                        LINV2[w] += Linv[r, s, w] * Linv[r, s, w]
+            if p:
+                for w in range(W):
+                    if not 1.0 / (np.sqrt(FRO[w]) * LINV2[w]) > 4.0 * rcond:
+                        und[w] = True
             for r in range(p):
                 for w in range(W):
                     V[w] = u[r, w] / dsc[r, w]
@@ -253,6 +291,9 @@ def _kernel(
                 ok = act[w]
                 if ok and sing[w]:
                     st[w] = 2
+                    ok = False
+                elif ok and und[w]:
+                    st[w] = UNDECIDED
                     ok = False
                 elif ok and not FIN[w] == 0.0:
                     st[w] = 3

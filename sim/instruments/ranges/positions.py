@@ -31,8 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim import lsq
-from sim.instruments.ranges import positions_kernel as pk
-from sim.lsq.normals import Reduced, inv_blocks, reduce_blocks
+from sim.lsq.normals import Reduced, reduce_blocks
 
 __all__ = [
     "MODELS",
@@ -151,7 +150,7 @@ class RangeModel:
     ``(2P + 2, q)`` mapping the model's own ``q`` globals to that vector (Brown's datum in
     :mod:`sim.instruments.ranges.multilateration`). ``P`` is taken from ``r_obs`` or from ``stations``.
     The engine takes the reduced normals from :meth:`reduced` (the sparse structure,
-    compiled by :mod:`sim.instruments.ranges.positions_kernel`, else :meth:`normal_blocks`); ``dense=True``
+    :meth:`normal_blocks`); ``dense=True``
     makes it use the dense Jacobian of :meth:`linearize` instead (the same normals to
     rounding).
     """
@@ -205,32 +204,9 @@ class RangeModel:
         return lsq.Linearization(r, Jp, J if self.layout is None else J @ self.layout)
 
     def reduced(self, points, theta, free, rcond: float = lsq.RCOND) -> Reduced:
-        """Reduced normals of the free globals (for :mod:`sim.lsq`) without a Jacobian: the
-        compiled passes of :mod:`sim.instruments.ranges.positions_kernel` (points eliminated over all ``2P + 2``
-        globals, then mapped to the model's free ones), or :meth:`normal_blocks` and
-        :func:`~sim.lsq.normals.reduce_blocks` without numba."""
-        if not pk.AVAILABLE:
-            return reduce_blocks(*self.normal_blocks(points, theta, free), rcond=rcond)
-        th = self.full(theta)
-        Npp, up = pk.point_normals(points, th, self.r_obs)
-        Ninv, ok = inv_blocks(Npp, rcond)
-        T, n = points.shape[:2]
-        if len(free) == 0:
-            return Reduced(
-                Ninv,
-                np.zeros((T, n, 2, 0)),
-                np.zeros((T, 0, 0)),
-                np.zeros((T, 0)),
-                (Ninv @ up[..., None])[..., 0],
-                ok,
-            )
-        K, Nbar, ubar, dp0 = pk.eliminate(points, th, self.r_obs, Ninv, up)
-        if self.layout is not None:  # the model's own globals: Jg = J_full L
-            L = self.layout
-            K, Nbar, ubar = K @ L, L.T @ Nbar @ L, ubar @ L
-        if len(free) < K.shape[-1]:
-            K, Nbar, ubar = K[..., free], Nbar[:, free][:, :, free], ubar[:, free]
-        return Reduced(Ninv, K, Nbar, ubar, dp0, ok)
+        """Reduced normals of the free globals (for :mod:`sim.lsq`) without a Jacobian:
+        :meth:`normal_blocks`, then :func:`~sim.lsq.normals.reduce_blocks`."""
+        return reduce_blocks(*self.normal_blocks(points, theta, free), rcond=rcond)
 
     def normal_blocks(self, points, theta, free):
         """Normal-equation blocks of the free globals formed directly (for :mod:`sim.lsq`):
@@ -241,8 +217,7 @@ class RangeModel:
             Ngg = diag_k(sum_j u u') bordered by sum_j u, sum_j g u, n, sum g, sum g^2
 
         (the dense Jacobian ``(T, n, P, 2P + 2)`` is never built). Returns ``(Npp, up, Npg,
-        Ngg, ug)`` for :func:`sim.lsq.normals.reduce_blocks` (NumPy; :meth:`reduced` uses it
-        without numba)."""
+        Ngg, ug)`` for :func:`sim.lsq.normals.reduce_blocks`."""
         q, ux, uy, r = self._ranges(points, theta)
         xx, xy, yy = ux * ux, ux * uy, uy * uy
         T, n, P = q.shape

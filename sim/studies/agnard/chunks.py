@@ -4,9 +4,7 @@ Each is a module-level function ``f(cfg, block, ..., rng, n)``; the run hands th
 ``functools.partial(f, cfg, block, ...)`` (plain, picklable arguments), so chunks go to
 process pools and Dask workers and are stored for resumption. Everything a chunk produces
 leaves it through its returned arrays: per-trial values (leading axis ``n``) and per-chunk
-sums or examples (leading axis 1, keys ``chunk.*``). Each keeps freed memory in its
-process's heap (:func:`sim.mc.heap.keep_heap`: fewer page faults, same numbers). Lengths in
-metres.
+sums or examples (leading axis 1, keys ``chunk.*``). Lengths in metres.
 """
 
 from __future__ import annotations
@@ -16,7 +14,6 @@ import numpy as np
 from sim.instruments.block.data_snooping import snoop
 from sim.instruments.block.layout import Block
 from sim.lsq import distributions as D
-from sim.mc.heap import keep_heap
 from sim.studies.agnard.schema import five_control, paper_weights, snoop_weights
 from sim.studies.agnard.simulate import Adjuster, Simulated, _rms, accuracy
 
@@ -42,7 +39,6 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
     layouts, the first pass, data snooping under digital and mechanical pugging; and, per
     chunk, trial 0's and the summed check-point errors of the 5- and 21-control passes (for
     the figures)."""
-    keep_heap()
     adj = Adjuster(block)
     crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
     sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], mechanical=True)
@@ -108,7 +104,6 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
 
 def scanner_chunk(cfg: dict, block: Block, dpi: float, rng: np.random.Generator, n: int) -> dict:
     """The 21-control block at another scan resolution, with and without the calibration."""
-    keep_heap()
     adj = Adjuster(block)
     wo, wc = paper_weights(cfg)
     sim = Simulated(cfg, block, rng, n, dpi)
@@ -125,7 +120,6 @@ def pugging_chunk(
     cfg: dict, block: Block, recentre_px: float, rng: np.random.Generator, n: int
 ) -> dict:
     """Data snooping under mechanical pugging with another re-centring error (px)."""
-    keep_heap()
     c2 = {**cfg, "pugging.recentre_px": recentre_px}
     adj = Adjuster(block)
     crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
@@ -156,7 +150,6 @@ def size_chunk(
     cfg: dict, block: Block, centre: np.ndarray, rng: np.random.Generator, n: int
 ) -> dict:
     """Another block size at the same point density (``tradeoff.block_control`` layout)."""
-    keep_heap()
     adj = Adjuster(block)
     wo, wc = paper_weights(cfg)
     sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], uncorrected=False)
@@ -169,7 +162,6 @@ def size_chunk(
 def sweep_chunk(cfg: dict, block: Block, insets, rng: np.random.Generator, n: int) -> dict:
     """The unprinted five-point layout at each of ``insets`` (the region's input vectors): the
     5-control pass adjusted once per layout on the same simulated blocks."""
-    keep_heap()
     adj = Adjuster(block)
     wo, wc = paper_weights(cfg)
     sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], uncorrected=False)

@@ -3,9 +3,7 @@
 Every function here is module-level and takes plain arguments first, so
 ``functools.partial(fn, *args)`` pickles: the runner sends it to process-pool or Dask workers
 and stores each chunk for resumption. The last two arguments are always ``(rng, n)``: the
-chunk's generator (:func:`sim.mc.runner.chunk_rng`) and its number of trials. The adjusting
-chunks keep freed memory in their process's heap (:func:`sim.mc.heap.keep_heap`: fewer page
-faults for the solvers' temporaries, the same numbers). Units: ranges and coordinates in mm
+chunk's generator (:func:`sim.mc.runner.chunk_rng`) and its number of trials. Units: ranges and coordinates in mm
 inside the solvers, errors in um in the outputs.
 """
 
@@ -19,7 +17,6 @@ from sim.instruments.ranges import multilateration as ml
 from sim.instruments.ranges import positions as po
 from sim.lsq import datum as dm
 from sim.lsq import distributions as D
-from sim.mc.heap import keep_heap
 
 __all__ = [
     "design_chunk",
@@ -40,7 +37,6 @@ def _start(th: np.ndarray) -> np.ndarray:
 def design_chunk(pts, th, sigma_um, rng, n):
     """The paper's design in the P-position solver: coordinate errors (um) in the inner datum
     over the points, and the solver status per trial."""
-    keep_heap()
     P = np.broadcast_to(pts, (n,) + pts.shape)
     TH = np.broadcast_to(th, (n, len(th)))
     noise = rng.normal(0.0, sigma_um, (n, len(pts), (len(th) - 2) // 2)) * 1e-3
@@ -55,7 +51,6 @@ def budget_chunk(bcfg, pts, th, sources, setting_sigma, settings, rng, n):
 
     bcfg : plain dict with the ``budget.*`` amplitudes and ``comparator.sigma_um``.
     """
-    keep_heap()
     S = dm.s_matrix(dm.null_basis(pts))
     P = np.broadcast_to(pts, (n,) + pts.shape)
     TH = np.broadcast_to(th, (n, len(th)))
@@ -81,7 +76,6 @@ def coverage_chunk(pts, th, sigma_um, alpha_test, rng, T):
     compiled kernel, the same adjustment as :mod:`sim.instruments.ranges.positions` in the ``brown`` datum):
     per-point 95 % ellipse coverage (known sigma; s0 with F), the global chi-square test,
     sigma0 (um) and the b = beta^2 / beta intervals."""
-    keep_heap()
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # flagged trials
         n = len(pts)
         dof = 4 * n - (2 * n + 7)
@@ -140,7 +134,6 @@ def brown_chain_chunk(r_obs, sig_mm, theta_ls, Q, walkers, steps, rng, n):
     plate, started from the least-squares estimate and covariance. Returns the kept samples
     ``(1, S, W, 7)`` (step, walker, parameter), the integrated autocorrelation times
     (``emcee``'s ``get_autocorr_time``) and the acceptance."""
-    keep_heap()
     if n != 1:
         raise ValueError("an emcee chunk is one chain: chunk size 1")
     p0 = rng.multivariate_normal(theta_ls, Q, size=walkers)

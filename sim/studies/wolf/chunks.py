@@ -8,9 +8,7 @@ The main experiment draws one set of instruments, placements and noise per chunk
 overrides the pointing sigma, the readings per point, the approach, the monocomparator sigma
 the restitution amplitude, the drifting share of the field or a common factor on the field
 amplitudes. Cells of one chunk share their random numbers, so
-the sweeps of the unprinted inputs and the readings trade-off compare like with like. Every
-chunk keeps freed memory in its process's heap (:func:`sim.mc.heap.keep_heap`: fewer page
-faults, the same numbers).
+the sweeps of the unprinted inputs and the readings trade-off compare like with like.
 """
 
 from __future__ import annotations
@@ -22,7 +20,6 @@ import numpy as np
 
 from sim.instruments.plotter import errorfields as ef
 from sim.instruments.plotter import polynomial as pl
-from sim.mc.heap import keep_heap
 from sim.studies.wolf.model import (
     Instrument,
     calib_dates,
@@ -199,7 +196,6 @@ def _cell(cfg: dict, over) -> dict:
 
 def _main_chunk_impl(cfg, cells, full, keep_vectors, rng: np.random.Generator, T: int) -> dict:
     """Chunk function of the main experiment; ``cells`` = ((tag, ((key, value), ...)), ...)."""
-    keep_heap()
     cl = [(tag, _cell(cfg, over)) for tag, over in cells]
     D = draw_main(cfg, rng, T, max(c["reading.n"] for _, c in cl), full)
     out, done = {}, {}
@@ -236,7 +232,6 @@ def _degree_chunk_impl(cfg, spacing, rng: np.random.Generator, T: int) -> dict:
     least-squares similarity). NaN where the grid has fewer rows or columns than the degree
     needs (the polynomial is then not determined by the nominal grid).
     """
-    keep_heap()
     area = cfg["plate.area_mm"]
     G = grid_nodes(area, spacing)
     nx, ny = len(np.unique(G[:, 0])), len(np.unique(G[:, 1]))
@@ -278,7 +273,6 @@ def degree_chunk(cfg: dict, spacing: float):
 def _stability_chunk_impl(cfg, fractions, ages, rng_: np.random.Generator, T: int) -> dict:
     """Calibrate on the first ``calib.n_sets`` dates, read an independent plate at each age after
     the last set, for each drifting share ``f``: rms (um, both axes) before and after."""
-    keep_heap()
     S = cfg["calib.n_sets"]
     t_cal = calib_dates(cfg, S)
     dates = np.concatenate([t_cal, t_cal[-1] + np.asarray(ages, float)])

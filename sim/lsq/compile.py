@@ -1,0 +1,86 @@
+"""The one compile mechanism of the suite: a kernel written as plain Python loops, compiled by
+numba when it is installed and ``SIM_NO_JIT`` is unset.
+
+Every compiled module of the suite (the group-block reductions and solves of
+:mod:`sim.lsq.group_kernel`, the linear solves of :mod:`sim.lsq.linear_kernel`, the Brown
+multilateration kernel, the polynomial fit, the stress field) is compiled here and only here:
+
+* :func:`available` -- whether compiled kernels run: numba importable and the environment
+  variable ``SIM_NO_JIT`` unset or empty (read at every call, so a test or the bench can
+  switch it); each caller then runs its NumPy twin instead, the reference implementation;
+* :func:`compiled` -- a kernel compiled once per process and cached on disk, with block
+  sizes frozen into it as compile-time constants and its helper functions compiled with it;
+* :data:`REASSOCIATE` -- the floating-point licences of a kernel whose long sums may be
+  vectorised (deterministic, but rounded in another order than a sequential loop).
+
+Singular matrices are decided by the engine's one rule, :func:`sim.lsq.normals.scaled_rcond`
+with :data:`sim.lsq.normals.RCOND`; a kernel proves regularity with
+:func:`sim.lsq.normals.block2_rcond` (2 x 2 blocks, exact) or leaves a trial undecided and
+its caller applies the NumPy rule. numba is a heavy optional dependency: it is imported on
+the first compile, not when the suite is imported.
+"""
+
+from __future__ import annotations
+
+import os
+import types
+import zlib
+from pathlib import Path
+
+__all__ = ["available", "compiled", "REASSOCIATE"]
+
+#: the floating-point licences of :func:`compiled` with ``reassociate=True``: sums may be
+#: reordered (vectorised) and multiply-adds fused; no licence to assume finite numbers, so
+#: NaN and infinity still propagate and the non-finite checks of the kernels hold
+REASSOCIATE = frozenset({"reassoc", "contract"})
+
+_njit: list = []  # numba's njit once imported ([None] without numba)
+_kernels: dict = {}
+
+
+def _numba():
+    """numba's ``njit``, or None without numba."""
+    if not _njit:
+        try:  # heavy optional dependency: imported on first use only
+            from numba import njit
+        except ImportError:  # pragma: no cover - the NumPy paths run
+            njit = None
+        _njit.append(njit)
+    return _njit[0]
+
+
+def available() -> bool:
+    """Whether the compiled kernels run (numba installed and ``SIM_NO_JIT`` unset)."""
+    return not os.environ.get("SIM_NO_JIT") and _numba() is not None
+
+
+def _source_tag(fn) -> str:
+    """A checksum of the file that defines ``fn``: numba's disk cache sees only the kernel's
+    own file, so a helper's edit must change the kernel's cached name."""
+    return f"{zlib.crc32(Path(fn.__code__.co_filename).read_bytes()):08x}"
+
+
+def compiled(fn, reassociate: bool = False, helpers=(), **consts):
+    """``fn`` compiled by numba (once per process; cached on disk; needs :func:`available`).
+
+    ``consts`` (e.g. block sizes ``P_TERMS``, ``W``) are frozen into its globals as
+    compile-time constants (numba treats globals as such), which lets the compiler unroll and
+    vectorise the small loops; each variant is compiled under its own name. ``helpers``:
+    functions ``fn`` calls by their global name, compiled here (without ``reassociate``) and
+    bound in its globals. ``reassociate``: compile ``fn`` with :data:`REASSOCIATE`. Every
+    kernel has ``error_model="numpy"``: a division by zero gives inf or NaN, as in NumPy,
+    and no exception branch blocks vectorisation."""
+    njit = _numba()
+    key = (fn.__module__, fn.__name__, reassociate)
+    key += tuple(sorted(consts.items())) + tuple(h.__name__ for h in helpers)
+    if key not in _kernels:
+        glb = dict(fn.__globals__, **consts)
+        for h in helpers:
+            glb[h.__name__] = compiled(h)
+        parts = [str(v) for _, v in sorted(consts.items())] + [_source_tag(h) for h in helpers]
+        name = "_".join([fn.__name__] + parts)
+        f = types.FunctionType(fn.__code__, glb, name, fn.__defaults__, fn.__closure__)
+        f.__qualname__ = name
+        opts = {"fastmath": set(REASSOCIATE)} if reassociate else {}
+        _kernels[key] = njit(cache=True, error_model="numpy", **opts)(f)
+    return _kernels[key]
