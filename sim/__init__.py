@@ -14,7 +14,6 @@ import os as _os
 for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     _os.environ.setdefault(_v, "1")
 from sim.api import Results, StudyHandle, load  # noqa: E402
-from sim.claims.book import claim  # noqa: E402
 from sim.mc.config import ConfigError, StudyError, load_study  # noqa: E402
 from sim.mc.runner import run_chunks  # noqa: E402
 from sim.mc.storage import read_provenance, write_table  # noqa: E402
@@ -32,7 +31,6 @@ __all__ = [
     "design_theta",
     "ranges",
     "simulate_ranges",
-    "claim",
     "write_table",
     "read_provenance",
 ]

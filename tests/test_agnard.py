@@ -540,7 +540,19 @@ def test_consistent_set_from_constructed_samples():
     assert rows["a"] == (0.1, 0.2, 0.1, 0.2)
     assert rows["b"][:2] == (0.0, 0.3)
     assert rows["ALL"] == (0.1, 0.1, 0.1, 0.1)
-    assert len(long["claim"]) == 8 and set(long["outcome"]) <= {"holds", "fails", "inconclusive"}
+    # each sample is its centre +- 0.3: the 95 % of plates spans +- 0.6, the zones a +- 2.5 and
+    # b +- 4.5 (decimals 0 and tol), so a centre inside its zone holds and one 10 away fails
+    got = {(c, v): o for c, v, o in zip(long["claim"], long["value"], long["outcome"])}
+    assert got == {
+        ("a", 0.0): "fails",
+        ("a", 0.1): "holds",
+        ("a", 0.2): "holds",
+        ("a", 0.3): "fails",
+        ("b", 0.0): "holds",
+        ("b", 0.1): "holds",
+        ("b", 0.2): "fails",
+        ("b", 0.3): "holds",
+    }
 
 
 def test_input_rows_follow_the_config():

@@ -14,16 +14,18 @@ from sim.instruments.ranges import budget
 from sim.instruments.ranges import coverage as cv
 from sim.instruments.ranges import positions as po
 from sim.lsq import datum as dm
-from sim.mc.config import ConfigError, validate
+from sim.mc.config import ConfigError, load_study, validate
 from sim.mc.runner import run_chunks
 from sim.mc.storage import read_provenance, read_table
 from sim.mc.sweep import cell_seed, expand, run_adaptive
 from sim.studies import design
 
+ROOT = Path(__file__).resolve().parent.parent
+
 TABLE1 = """study = "brown_table1"
 trials = {trials}
 seed = 77
-chunk = 10
+chunk = 1
 """
 
 
@@ -351,9 +353,29 @@ def test_sweep_rows_draw_and_tabulate(tmp_path):
     assert md.count("\n") >= 5 and "no: plate.spacing_mm" in md and "sweep.png" in md
 
 
-def test_the_two_plate_posterior_finds_the_grid_plate_study():
-    # the cross-check must not be skipped silently when the grid-plate study moves
+def test_the_two_plate_posterior_reads_the_grid_plate_study():
+    """The cross-check must not be skipped silently when the grid-plate study moves: its data
+    are the grid-plate study's own configuration (the study file's printed values), and a
+    missing study is reported as such, not as a posterior."""
+    from sim.studies.design import posterior
     from sim.studies.design.posterior import _twoplate_data
 
     gcfg, comp, g, sg, rw, fa = _twoplate_data({"seed": 1})
-    assert comp.shape == g.shape[:2] and comp.shape[0] == 2 * gcfg["plate.count"]
+    _, study = load_study(ROOT / "studies" / "gridplate_two_plates.toml")
+    for key in ("plate.count", "grid.sigma_stated_um", "comparator.coord_sigma_um"):
+        assert gcfg[key] == study[key], key
+    assert (gcfg["plate.count"], sg) == (2, 0.7)  # the paper's two plates and 0.7 um
+    P = gcfg["plate.count"]
+    assert comp.shape == g.shape[:2] and comp.shape[0] == 2 * P
+    assert np.array_equal(g[:P], g[P:])  # x' and y' rows share the certificate
+
+    def moved(cfg):
+        raise ImportError("no module named sim.studies.gridplate")
+
+    orig = posterior._twoplate_data
+    posterior._twoplate_data = moved
+    try:
+        cols, _, _, why = posterior.twoplate_analysis({"seed": 1}, None)
+    finally:
+        posterior._twoplate_data = orig
+    assert cols is None and why.startswith("not available (ImportError")

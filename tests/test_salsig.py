@@ -104,7 +104,7 @@ def test_chain_spread_matches_stated_sd():
     tol = 4 / np.sqrt(2 * (T - 1))
     for k in ("E_arcsec", "scale_diff_ppm"):
         ratio = np.std(r[k], ddof=1) / np.sqrt(np.mean(r["sd_" + k] ** 2))
-        assert abs(ratio - 1) < tol + 0.01, k
+        assert abs(ratio - 1) < tol, k
 
 
 def test_bad_config_names_the_key(tmp_path):
@@ -193,9 +193,25 @@ def test_study_runs_small(tmp_path):
         "paper_check.mark_spacing_mm",
     ):
         assert v["salsig." + q] == "holds", q
-    # 'cut roughly in half' over models this spread cannot be a hold
-    assert v["salsig.vertical_halved.rms_ratio"] in ("inconclusive", "fails")
-    assert v["salsig.vertical_halved.dramatic_horizontal"] in ("holds", "fails", "inconclusive")
+    # 'cut roughly in half' (zone 0.4-0.6): the ratio over models spreads about 0.15-1.7
+    # around a median near 0.46, so a plate like the paper's is common (no fail) and the
+    # spread is far wider than the zone (no hold)
+    assert v["salsig.vertical_halved.rms_ratio"] == "inconclusive"
+    # 'dramatic horizontally' read as a factor >= 1.5 (zone [1.5, inf)): a case next to the
+    # boundary, where the rule decides. Over many models (4000, drawn apart from the study)
+    # 97.5 % improve by less than 1.5: a large run fails the claim. The 60 models of this run
+    # put the 97.5 % point between the two largest ratios, at or above 1.5, so the spread
+    # meets the zone: inconclusive, never a hold (its low end is far below 1.5)
+    _, cfg = load_study(ROOT / "studies/salsig_encoders.toml", [s for s in sets if s != "--set"])
+    vt = salsig.simulate_vertical(cfg, np.random.default_rng(99), 4000)
+    assert np.percentile(vt["rms_xy_before_um"] / vt["rms_xy_after_um"], 97.5) < 1.5
+    mine = read_table(out / "trials_vertical.parquet").to_pydict()
+    horiz = np.array(mine["rms_xy_before_um"]) / np.array(mine["rms_xy_after_um"])
+    row = t["claim"].index("salsig.vertical_halved.dramatic_horizontal")
+    lo, hi = np.percentile(horiz, [2.5, 97.5])
+    assert (t["ci_low"][row], t["ci_high"][row]) == pytest.approx((lo, hi), rel=1e-12)
+    assert horiz.size == 60 and lo < 1.5 <= hi
+    assert v["salsig.vertical_halved.dramatic_horizontal"] == "inconclusive"
     cs = read_table(out / "consistent_set.parquet").to_pydict()
     assert cs["claim"].count("ALL") == 5
     for fig in ("residuals", "recovery", "power", "vertical", "consistent_set"):

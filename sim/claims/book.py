@@ -57,13 +57,13 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
+from sim.claims.intervals import LEVEL, METHODS, MIN_CHUNKS, plate_p, spread
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.storage import write_table
 
 __all__ = [
     "ClaimBook",
     "decide",
-    "claim",
     "write_claims",
     "CLAIM_COLUMNS",
     "VERDICTS",
@@ -294,12 +294,10 @@ class ClaimBook:
         if samples is not None:
             x = np.asarray(samples, float)
             _finite(cid, x, "samples")
-            lo, med, hi = np.percentile(x, [2.5, 50, 97.5])
-            value, ci, interval = float(med), (float(lo), float(hi)), "spread"
+            value, ci = spread(x)
+            interval = "spread"
             if "ref" in s:
-                r = float(s["ref"])
-                q = (np.sum(x < r) + 0.5 * np.sum(x == r)) / x.size
-                p_plate = float(min(1.0, 2 * min(q, 1 - q)))
+                p_plate = plate_p(x, float(s["ref"]))
         if elems is not None:
             el, eh = (np.asarray(e, float) for e in elems)
             _finite(cid, np.concatenate([el, eh]), "element intervals")
@@ -433,49 +431,6 @@ def _row(
     }
 
 
-def claim(
-    name: str,
-    source: str,
-    paper: str,
-    value: float,
-    ci: tuple[float, float],
-    kind: str,
-    note: str = "",
-    ref: tuple[float, float] | float | None = None,
-    interval: str = "ci",
-    *,
-    form: str = "value",
-    tol: float = 0.0,
-    headline: bool = False,
-) -> dict[str, Any]:
-    """One claims row without a claim book (the older interface, kept while the studies move
-    their claims into books). ``kind`` ``predicted`` means ``prediction``; ``ref`` is the
-    interval the paper's number stands for (its rounding)."""
-    kind = {"predicted": "prediction"}.get(kind, kind)
-    if ref is None and kind == "prediction":
-        kind = "finding"
-    spec: dict[str, Any] = {
-        "id": name,
-        "source": source,
-        "paper": paper,
-        "kind": kind,
-        "headline": headline,
-    }
-    if ref is not None:
-        r = [float(ref), float(ref)] if np.isscalar(ref) else [float(ref[0]), float(ref[1])]
-        spec.update(form=form, ref=r if form == "range" or r[0] != r[1] else r[0], tol=tol)
-        if form != "range" and r[0] != r[1]:  # a rounding interval: centre and decimals
-            spec.update(ref=(r[0] + r[1]) / 2, tol=tol + (r[1] - r[0]) / 2)
-    book = ClaimBook([spec], [], "<inline>")
-    return book.score(name, value, ci, interval, note)
-
-
-def rounding(x: float, decimals: int) -> tuple[float, float]:
-    """The interval a number printed with ``decimals`` decimals stands for."""
-    h = 0.5 * 10.0 ** (-decimals)
-    return (x - h, x + h)
-
-
 def write_claims(
     path, rows: Iterable[Mapping[str, Any]], prov: Mapping[str, Any], book: ClaimBook | None = None
 ):
@@ -491,7 +446,23 @@ def write_claims(
             prov,
         )
     cols = {c: [_null(r[c]) for r in rows] for c in CLAIM_COLUMNS}
-    return write_table(path, cols, prov)
+    return write_table(path, cols, {**prov, "intervals": interval_provenance()})
+
+
+def interval_provenance() -> dict[str, Any]:
+    """How every interval and verdict of a claims table was made, for its provenance: the
+    interval methods (:data:`sim.claims.intervals.METHODS`) and the decision thresholds."""
+    return {
+        "level": LEVEL,
+        "methods": dict(METHODS),
+        "min_chunks": MIN_CHUNKS,
+        "one_plate_p_fail": P_FAIL,
+        "interval_column": {
+            "ci": "a Monte-Carlo confidence interval (mean, sd, share, bootstrap or jackknife)",
+            "spread": "the one-plate 2.5-97.5 % range over simulated plates",
+            "exact": "a deterministic value",
+        },
+    }
 
 
 def _null(x):

@@ -19,6 +19,7 @@ import math
 import numpy as np
 
 from sim.claims.book import ClaimBook
+from sim.claims.intervals import spread
 from sim.studies.salsig.model import simulate_chain, simulate_vertical
 
 VERTICAL = (
@@ -41,8 +42,8 @@ def _score(spec: dict, x: np.ndarray) -> dict:
     b = ClaimBook([spec], [], "<sweep>")
     if spec["form"] == "one-plate":
         return b.score(spec["id"], samples=x)
-    lo, med, hi = np.percentile(x, [2.5, 50, 97.5])
-    return b.score(spec["id"], float(med), (float(lo), float(hi)), "spread")
+    med, ci = spread(x)
+    return b.score(spec["id"], med, ci, "spread")
 
 
 def evaluate(book: ClaimBook, cfg: dict, claims: tuple, rng: np.random.Generator) -> dict:
