@@ -138,6 +138,8 @@ def test_binomial_ci_broadcasts_and_stays_inside_0_1():
         with pytest.raises(ValueError, match="^a proportion needs counts 0 <= k <= n and n >= 1$"):
             iv.binomial_ci(*bad)
     assert iv.binomial_ci(1, 1)[1:] == pytest.approx((1 / (1 + 1.959963984540054**2), 1.0))
+    # rounding carries Wilson's upper bound at k = n = 16 to 1 + 2e-16: clipped to 1
+    assert iv.binomial_ci(16, 16)[2] == 1.0 and iv.binomial_ci([0, 16], 16)[2][1] == 1.0
 
 
 @pytest.mark.parametrize("n,p", [(100, 0.05), (200, 0.5), (400, 0.95), (1000, 0.05)])

@@ -108,6 +108,7 @@ def test_bounds_are_half_infinite_zones(form, interval, outcome):
         ([1.5, 2.5], [2.0, 3.0], "inconclusive"),  # one straddles the upper edge
         ([1.0, 2.0], [1.5, 2.5], "inconclusive"),  # one straddles the lower edge
         ([1.5, 2.75], [2.0, 3.0], "inconclusive"),  # one starts on the upper edge
+        ([1.0, 1.5], [1.25, 2.0], "inconclusive"),  # one ends on the lower edge
         ([1.5, ABOVE], [2.0, 3.0], "fails"),  # one wholly above
         ([0.0, 1.5], [BELOW, 2.0], "fails"),  # one wholly below
         ([0.0, 2.5], [BELOW, 3.0], "fails"),  # a failing element outweighs a straddling one
@@ -154,7 +155,7 @@ def test_one_plate_rule(p, interval, outcome):
 
 def test_one_plate_needs_a_p():
     for p in (None, math.nan):
-        with pytest.raises(ValueError, match="p_plate"):
+        with pytest.raises(ValueError, match="^a one-plate claim needs p_plate$"):
             decide("one-plate", (1.5, 2.5), ZONE, p_plate=p)
 
 
@@ -262,7 +263,11 @@ def test_claims_tables_state_their_interval_methods(tmp_path):
         "spread",
         "exact",
     }
-    assert set(iv["interval_column"]) == {"ci", "spread", "exact"}
+    assert iv["interval_column"] == {
+        "ci": "a Monte-Carlo confidence interval (mean, sd, share, bootstrap or jackknife)",
+        "spread": "the one-plate 2.5-97.5 % range over simulated plates",
+        "exact": "a deterministic value",
+    }
     assert pq.read_table(path).column("interval").to_pylist() == ["ci"]
 
 
@@ -493,6 +498,8 @@ def test_not_comparable_rows():
     assert (r["ref_low"], r["ref_high"], r["note"]) == (1.0, 2.0, "w")
     r = ClaimBook([spec], [], "<t>").not_comparable("c")
     assert math.isnan(r["ref_low"]) and r["form"] == ""
+    del spec["why"]  # no reason in the book: the note alone
+    assert ClaimBook([spec], [], "<t>").not_comparable("c", note="n")["note"] == "n"
     b = one(form="value", ref=2, tol=0.5)
     with pytest.raises(ValueError, match=r"^claim 'c' is declared 'prediction', not 'not comp"):
         b.not_comparable("c")
@@ -500,9 +507,11 @@ def test_not_comparable_rows():
 
 def test_write_claims_checks_the_book_and_writes_not_reproduced(tmp_path):
     nr = {"source": "s", "printed": "1.0", "why": "w"}
-    specs = [{"id": i, "source": "s", "paper": "p", "kind": "finding"} for i in ("a", "b")]
+    specs = [{"id": i, "source": "s", "paper": "p", "kind": "finding"} for i in ("a", "b", "c")]
     b = ClaimBook(specs, [nr], "<t>")
-    rows = [b.score("a", 1.0, interval="exact")]
+    with pytest.raises(ValueError, match=r"^<t>: declared claims not scored: a, b, c$"):
+        b.check_complete()
+    rows = [b.score("a", 1.0, interval="exact"), b.score("c", 1.0, interval="exact")]
     with pytest.raises(ValueError, match=r"^<t>: declared claims not scored: b$"):
         write_claims(tmp_path / "claims.parquet", rows, {}, b)
     assert not (tmp_path / "claims.parquet").exists()
@@ -512,7 +521,9 @@ def test_write_claims_checks_the_book_and_writes_not_reproduced(tmp_path):
     assert t == {"source": ["s"], "printed": ["1.0"], "why": ["w"]}
     assert read_provenance(tmp_path / "not_reproduced.parquet") == {"study": "t"}
     t = pq.read_table(tmp_path / "claims.parquet").to_pydict()
-    assert t["claim"] == ["a", "b"] and t["ci_low"] == [1.0, 1.0] and t["zone_low"] == [None] * 2
+    assert (
+        t["claim"] == ["a", "c", "b"] and t["ci_low"] == [1.0] * 3 and t["zone_low"] == [None] * 3
+    )
     write_claims(tmp_path / "bare.parquet", rows, {})  # without a book: rows only
     assert not (tmp_path / "bare_not_reproduced.parquet").exists()
     assert bk._null(math.inf) is None and bk._null(-math.inf) is None and bk._null(1.5) == 1.5

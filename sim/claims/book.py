@@ -144,7 +144,7 @@ def decide(
     if form == "range":
         if elems is None:
             elems = (np.array([interval[0]]), np.array([interval[1]]))
-        lo, hi = (np.asarray(e, float) for e in elems)
+        lo, hi = (np.asarray(e) for e in elems)
         if np.any((hi < zl) | (lo > zh)):
             return "fails"
         return "holds" if np.all((lo >= zl) & (hi <= zh)) else "inconclusive"
