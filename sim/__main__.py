@@ -1,5 +1,12 @@
+"""``python -m sim`` and the ``sim`` command: BLAS single-threaded, then the command line."""
+
 import sys
 
-from sim.cli import main
+from sim.threads import single_threaded_blas
 
-sys.exit(main())
+single_threaded_blas()  # before NumPy loads (sim.cli imports it)
+
+from sim.cli import main  # noqa: E402
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -22,8 +22,13 @@ from pathlib import Path
 from typing import Any
 
 import pyarrow as pa
+import pyarrow.parquet as pq
 
-from sim.mc.config import ConfigError, load_study
+from sim.execute import execute
+from sim.mc.config import ConfigError
+from sim.mc.estimate import estimate
+from sim.mc.sweep import read_sweep
+from sim.studies import load_study
 
 __all__ = ["load", "StudyHandle", "Results"]
 
@@ -46,8 +51,6 @@ class Results:
 
     def table(self, name: str) -> pa.Table:
         """The table ``name`` (``claims``, ``points``, ..., or ``trials``) as a pyarrow Table."""
-        import pyarrow.parquet as pq
-
         p = self.path / (name if name == "trials" else f"{name}.parquet")
         if not p.exists():
             raise ConfigError(
@@ -76,8 +79,6 @@ class StudyHandle:
 
     def estimate(self):
         """Work and memory of a run (:class:`sim.mc.estimate.Estimate`)."""
-        from sim.mc.estimate import estimate
-
         return estimate(self.config, self.sweep)
 
     def replace(self, **overrides) -> "StudyHandle":
@@ -99,8 +100,6 @@ class StudyHandle:
         """Run the study into ``out`` (default: a new temporary directory) and return its
         :class:`Results`. ``executor``: ``local`` (a process pool when ``workers > 1``) or
         ``dask``. Output is identical for every executor and worker count."""
-        from sim.cli import execute
-
         h = (
             self
             if trials is None and seed is None
@@ -136,8 +135,6 @@ class StudyHandle:
 
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
-    from sim.mc.sweep import read_sweep
-
     vals = {_key(k): v for k, v in overrides.items()}
     study, cfg = load_study(study_file, values=vals)
     return StudyHandle(Path(study_file), study, cfg, vals, read_sweep(study_file, study.schema))

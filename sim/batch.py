@@ -31,6 +31,16 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from sim.threads import single_threaded_blas
+
+single_threaded_blas()  # before NumPy loads (sim.cli imports it)
+
+from sim.cli import main as cli_main  # noqa: E402
+from sim.mc.codehash import study_code_hash  # noqa: E402
+from sim.mc.config import ConfigError, StudyError  # noqa: E402
+from sim.mc.registry import MODULES  # noqa: E402
+from sim.studies import load_study  # noqa: E402
+
 __all__ = ["SLOW_FIRST", "order", "run_all", "main"]
 
 #: the studies that take longest (``make bench``'s rerun rows), started first in this order
@@ -42,6 +52,18 @@ SLOW_FIRST = (
     "gridplate_two_plates",
     "brown_dilution",
 )
+
+
+def is_current(study_file: str | Path, results: str | Path) -> bool:
+    """True when ``results/run.json`` records the study file's resolved config and the
+    study's current code hash."""
+    try:
+        record = json.loads((Path(results) / "run.json").read_text())
+        _, cfg = load_study(study_file)
+    except (OSError, ValueError, ConfigError, StudyError):
+        return False
+    want = study_code_hash(cfg["study"])
+    return record.get("config") == json.loads(json.dumps(cfg)) and record.get("code_hash") == want
 
 
 def order(files: list[Path]) -> list[Path]:
@@ -66,8 +88,6 @@ def run_all(
     (forked children print their own). Returns
     ``{stem: (exit code, wall seconds, start in seconds after the first start)}`` of the runs
     made (up-to-date studies are left out)."""
-    from sim.mc.codehash import is_current
-
     todo = []
     for f in order(files):
         if stale_only and is_current(f, results / f.stem):
@@ -114,8 +134,6 @@ def _preload(files: list[Path]) -> None:
     import importlib
     import tomllib
 
-    from sim.studies import MODULES
-
     for f in files:
         try:
             mod = MODULES.get(tomllib.loads(f.read_text()).get("study"))
@@ -126,11 +144,9 @@ def _preload(files: list[Path]) -> None:
 
 
 def _child(args: list[str]) -> None:  # pragma: no cover - runs in a forked child
-    from sim.cli import main
-
     code = 1
     try:
-        code = main(args)
+        code = cli_main(args)
     except SystemExit as e:
         code = e.code if isinstance(e.code, int) else 1
     except BaseException:  # noqa: BLE001 - main reports its own errors; anything else: 1

@@ -13,7 +13,8 @@ from sim.instruments.block import independent_models as im
 from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import CONTROL_PATTERNS, make_block, select_control
 from sim.instruments.geometry import similarity_fit
-from sim.mc.config import ConfigError, load_study
+from sim.mc.config import ConfigError
+from sim.studies import load_study
 
 STUDY = "studies/agnard_block.toml"
 

@@ -11,8 +11,9 @@ import pytest
 
 from sim.claims.book import ClaimBook
 from sim.cli import main
-from sim.mc.config import ConfigError, load_study
+from sim.mc.config import ConfigError
 from sim.mc.storage import read_table
+from sim.studies import load_study
 from sim.studies.brown import values as V
 from sim.studies.brown.claims import BOOK, load_book
 from sim.studies.brown.consistency import SWEEP_COLUMNS, consistent_set, feasible, sweep_table1

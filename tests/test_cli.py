@@ -9,8 +9,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from sim.cli import main
-from sim.mc.config import ConfigError, load_study, parse_override
+from sim.mc.config import ConfigError, parse_override
 from sim.mc.storage import read_provenance
+from sim.studies import load_study
 
 ROOT = Path(__file__).resolve().parent.parent
 BROWN = ROOT / "studies" / "brown_table1.toml"

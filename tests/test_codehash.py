@@ -28,8 +28,8 @@ def test_every_study_has_its_own_closure():
 
 
 def test_results_are_current_until_the_config_changes(tmp_path):
+    from sim.batch import is_current
     from sim.cli import main
-    from sim.mc.codehash import is_current
 
     text = (ROOT / "studies" / "brown_table1.toml").read_text()
     study = tmp_path / "brown_table1.toml"

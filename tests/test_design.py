@@ -340,7 +340,7 @@ def test_coverage_of_a_linear_models_ellipses_is_95_percent():
 
 
 def test_sweep_rows_draw_and_tabulate(tmp_path):
-    from sim.mc.sweep import sweep_markdown
+    from sim.report.sweep import sweep_markdown
 
     sw = tmp_path / "sw.toml"
     sw.write_text(

@@ -32,7 +32,8 @@ import numpy as np
 import pytest
 
 from sim.cli import main
-from sim.mc.config import _flatten, load_study
+from sim.mc.config import flatten
+from sim.studies import load_study
 
 ROOT = Path(__file__).resolve().parent.parent
 CASES = int(os.environ.get("FUZZ_CASES", "14"))
@@ -224,7 +225,7 @@ def small(name: str) -> dict:
 
 def base(name: str) -> dict:
     doc = tomllib.loads((ROOT / "studies" / f"{name}.toml").read_text())
-    flat = _flatten({k: v for k, v in doc.items() if k != "sweep"})
+    flat = flatten({k: v for k, v in doc.items() if k != "sweep"})
     flat.update(small(name))
     return flat
 

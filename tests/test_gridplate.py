@@ -10,7 +10,8 @@ from scipy import stats
 from sim.instruments import gridplate as gp
 from sim.instruments import transforms2d as t2
 from sim.instruments.plates import grid_points
-from sim.mc.config import ConfigError, load_study
+from sim.mc.config import ConfigError
+from sim.studies import load_study
 
 ROOT = Path(__file__).resolve().parents[1]
 

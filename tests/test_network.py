@@ -11,7 +11,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from sim.instruments.ranges import multilateration as ml
-from sim.mc.config import ConfigError, load_study
+from sim.mc.config import ConfigError
+from sim.studies import load_study
 from sim.studies.network.analysis import analyse, in_datum
 from sim.studies.network.definition import build
 from sim.studies.network.gama import merge_gama, read_gama, write_gama

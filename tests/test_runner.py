@@ -287,8 +287,8 @@ def test_a_sweep_whose_every_cell_fails_exits_2_with_the_reasons(tmp_path, capsy
 
 
 def test_the_estimate_stops_an_oversized_run_at_once(tmp_path, capsys, monkeypatch):
-    from sim.mc.config import load_study
     from sim.mc.estimate import estimate
+    from sim.studies import load_study
 
     _, cfg = load_study(STUDY)
     small = estimate(cfg)

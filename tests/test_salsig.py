@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from sim.instruments import encoders as enc
-from sim.mc.config import ConfigError, load_study, validate
-from sim.studies import salsig
+from sim.mc.config import ConfigError, validate
+from sim.studies import load_study, salsig
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sim.lsq.groups import cofactors as group_cofactors
 from sim.lsq.normals import RCOND, bordered_inverse, reduced_normals
 from sim.lsq.problem import Datum
 
@@ -74,8 +75,6 @@ def cofactors(
     """Cofactors of ``model`` at ``points`` (T, n, d), ``theta`` (T, q) in ``datum`` (a
     :class:`sim.lsq.groups.GroupCofactors` for group-block models)."""
     if getattr(model, "structure", None) is not None:  # group blocks
-        from sim.lsq.groups import cofactors as group_cofactors
-
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             return group_cofactors(model.structure, model.linearize(points, theta), rcond)
     datum = Datum() if datum is None else datum

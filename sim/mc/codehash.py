@@ -6,20 +6,21 @@ from the parsed sources, so nothing is imported or run), plus the data files ins
 that study only, and a fresh clone (whose file times are the checkout's) does not re-run
 anything that is current.
 
-:func:`is_current` (``STUDY_FILE``, ``RESULTS_DIR``) is true when ``RESULTS_DIR/run.json``
-records the study file's configuration and this code hash (the results are current); the
-Makefile's ``reproduce`` uses it.
+:func:`sim.batch.is_current` (``STUDY_FILE``, ``RESULTS_DIR``) is true when
+``RESULTS_DIR/run.json`` records the study file's configuration and this code hash (the results
+are current); the Makefile's ``reproduce`` uses it.
 """
 
 from __future__ import annotations
 
 import ast
 import hashlib
-import json
 from functools import lru_cache
 from pathlib import Path
 
-__all__ = ["study_modules", "study_files", "study_code_hash", "is_current", "not_study_code"]
+from sim.mc.registry import MODULES
+
+__all__ = ["study_modules", "study_files", "study_code_hash", "not_study_code"]
 
 ROOT = Path(__file__).resolve().parents[1]  # .../sim
 #: library files (paths relative to ``sim/``) that no study result depends on (the
@@ -90,8 +91,6 @@ def study_modules(module: str) -> tuple[Path, ...]:
 
 
 def _study_module(study: str) -> str:
-    from sim.studies import MODULES
-
     return MODULES.get(study, "sim.studies")
 
 
@@ -119,17 +118,3 @@ def study_code_hash(study: str) -> str:
         h.update(f.relative_to(ROOT).as_posix().encode())
         h.update(f.read_bytes())
     return h.hexdigest()[:16]
-
-
-def is_current(study_file: str | Path, results: str | Path) -> bool:
-    """True when ``results/run.json`` records the study file's resolved config and the
-    study's current code hash."""
-    from sim.mc.config import ConfigError, StudyError, load_study
-
-    try:
-        record = json.loads((Path(results) / "run.json").read_text())
-        _, cfg = load_study(study_file)
-    except (OSError, ValueError, ConfigError, StudyError):
-        return False
-    want = study_code_hash(cfg["study"])
-    return record.get("config") == json.loads(json.dumps(cfg)) and record.get("code_hash") == want

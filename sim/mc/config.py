@@ -24,7 +24,6 @@ __all__ = [
     "ConfigError",
     "StudyError",
     "Field",
-    "load_study",
     "parse_override",
     "validate",
     "check_chunks",
@@ -134,12 +133,12 @@ def check_value(key: str, f: Field, v: Any) -> Any:
     raise AssertionError(f"unknown field kind {k}")  # programming error
 
 
-def _flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
+def flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in d.items():
         key = f"{prefix}{k}"
         if isinstance(v, dict):
-            out.update(_flatten(v, key + "."))
+            out.update(flatten(v, key + "."))
         else:
             out[key] = v
     return out
@@ -196,46 +195,6 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         raise ConfigError(None, f"{p}: malformed TOML: {e}") from None
     except UnicodeDecodeError:
         raise ConfigError(None, f"{p}: not UTF-8 text") from None
-
-
-def load_study(
-    path: str | Path,
-    overrides: list[str] | tuple = (),
-    trials: int | None = None,
-    seed: int | None = None,
-    values: Mapping[str, Any] | None = None,
-):
-    """Load, override and validate a study file.
-
-    ``overrides``: ``"key=value"`` strings (values read as TOML, as ``--set``); ``values``:
-    ``{dotted.key: value}`` with Python values (the Python API).
-
-    Returns ``(study, cfg)`` where ``study`` is the registered :class:`sim.studies.Study`
-    and ``cfg`` the resolved flat configuration (including ``study``).
-    """
-    from sim.studies import get_study  # local: the registry imports the study modules
-
-    doc = read_toml(path)
-    flat = _flatten({k: v for k, v in doc.items() if k != "sweep"})  # [sweep]: sim.mc.sweep
-    name = flat.pop("study", None)
-    if name is None:
-        raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
-    study = get_study(name)
-    for text in overrides:
-        key, value = parse_override(text)
-        if key == "study":
-            raise ConfigError("study", "cannot be overridden")
-        flat[key] = value
-    for key, value in (values or {}).items():
-        if key == "study":
-            raise ConfigError("study", "cannot be overridden")
-        flat[key] = list(value) if isinstance(value, tuple) else value
-    if trials is not None:
-        flat["trials"] = trials
-    if seed is not None:
-        flat["seed"] = seed
-    cfg = validate(flat, study.schema, study.check)
-    return study, {"study": name, **cfg}
 
 
 def check_chunks(cfg: Mapping[str, Any]) -> None:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
 from sim.mc.config import ConfigError
-from sim.mc.sweep import MAX_CELLS
+from sim.mc.sweep import MAX_CELLS, expand
 
 __all__ = [
     "Estimate",
@@ -287,8 +287,6 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
     cfgs = [cfg]
     reps = 1
     if sweep:
-        from sim.mc.sweep import expand
-
         _, cells, reps, _ = expand(sweep)
         cfgs = [{**cfg, **cell} for cell in cells]
     parts = [_one(c) for c in cfgs]

@@ -32,7 +32,8 @@ import signal
 import sys
 import threading
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Mapping
 
@@ -365,3 +366,32 @@ def jackknife(
     se = np.sqrt((C - 1) / C * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
     z = D.t_ppf(0.5 + level / 2, C - 1)
     return est, est - z * se, est + z * se
+
+
+@dataclass(frozen=True)
+class RunContext:
+    """What a study's ``run`` gets besides its config: pass it to
+    :func:`sim.mc.runner.run_chunks` (``ctx=ctx``) so chunks use the chosen executor and are
+    stored for resumption, and share the run's one progress bar."""
+
+    quiet: bool = False
+    executor: object = None  # from sim.mc.runner.make_executor; None = in-process
+    store: object = None  # sim.mc.runner.ChunkStore of the run's staging directory
+    estimate: object = None  # sim.mc.estimate.Estimate of the run (the progress bar's total)
+    bars: list = field(default_factory=list, compare=False)  # the open shared bar, if any
+
+    @property
+    def bar(self):
+        """The run's shared progress bar while :meth:`progress_bar` is open, else None."""
+        return self.bars[-1] if self.bars else None
+
+    @contextmanager
+    def progress_bar(self, label: str):
+        """One bar for the whole run; its total is the estimate's trial count."""
+        total = getattr(self.estimate, "trials", 0) or 0
+        with Progress(total, label, quiet=self.quiet) as p:
+            self.bars.append(p)
+            try:
+                yield p
+            finally:
+                self.bars.remove(p)

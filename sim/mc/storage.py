@@ -21,7 +21,12 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.mc.codehash import NOT_STUDY_CODE, not_study_code  # code no study result depends on
+from sim.mc.codehash import (  # code no study result depends on
+    NOT_STUDY_CODE,
+    not_study_code,
+    study_code_hash,
+    study_files,
+)
 
 __all__ = [
     "provenance",
@@ -53,8 +58,6 @@ def git_commit(study: str | None = None) -> str:
             *(f":(exclude)sim/{f}" for f in NOT_STUDY_CODE),
         ]
     else:
-        from sim.mc.codehash import study_files
-
         paths = [p.relative_to(root).as_posix() for p in study_files(study)]
         paths += [f"studies/{study}.toml", "pyproject.toml"]
     try:
@@ -85,8 +88,6 @@ def code_hash(study: str | None = None) -> str:
     import hashlib
 
     if study is not None:
-        from sim.mc.codehash import study_code_hash
-
         return study_code_hash(study)
     root = Path(__file__).resolve().parents[1]
     h = hashlib.sha256()

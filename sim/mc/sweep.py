@@ -6,9 +6,6 @@ nested tables) with a list of values, or a range given as an inline table
 (``stop`` included when it falls on the step). The cells are the Cartesian product in the
 order the keys are written. Two reserved entries:
 
-The rows are drawn by :func:`fig_sweep` (``sweep.png``: every claim against the first
-swept key) and tabulated by :func:`sweep_markdown`.
-
 ``replicates`` (int, default 1)
     independent repetitions of every cell;
 ``seed_mode`` (``"spawn"`` default, or ``"common"``)
@@ -32,7 +29,6 @@ Carlo procedure), drawing the same chunk streams as :func:`sim.mc.runner.run_chu
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
 from pathlib import Path
@@ -40,7 +36,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from sim.mc.config import ConfigError, StudyError, check_chunks, read_toml, validate
+from sim.mc.config import ConfigError, read_toml
 from sim.mc.progress import Progress
 from sim.mc.runner import chunk_rng
 
@@ -50,10 +46,7 @@ __all__ = [
     "expand",
     "cell_seed",
     "cell_label",
-    "run_sweep",
     "run_adaptive",
-    "fig_sweep",
-    "sweep_markdown",
 ]
 
 SWEEP_KEY = 0x5EE9  # spawn-key tag of the sweep's seed streams
@@ -184,165 +177,6 @@ def cell_seed(seed: int, cell: int, replicate: int, mode: str = "spawn") -> int:
 
 def cell_label(i: int, r: int) -> str:
     return f"cell{i:04d}_r{r}"
-
-
-def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dict:
-    """Run every cell of ``table`` for ``study`` from the resolved base ``cfg``; write
-    ``out/sweep.parquet`` and ``out/cells/<label>/``. Returns the table's columns."""
-    from sim.mc.storage import provenance, read_table, write_table
-
-    keys, cells, reps, mode = expand(table, study.schema)
-    base = {k: v for k, v in cfg.items() if k != "study"}
-    rows: list[dict[str, Any]] = []
-    for i, cell in enumerate(cells):
-        for r in range(reps):
-            seed = cell_seed(cfg["seed"], i, r, mode)
-            row: dict[str, Any] = {
-                "cell": i,
-                "replicate": r,
-                "label": cell_label(i, r),
-                "seed": seed,
-                "feasible": True,
-                "reason": "",
-            }
-            row.update({k: cell[k] for k in keys})
-            try:
-                ccfg = {
-                    "study": cfg["study"],
-                    **validate({**base, **cell, "seed": seed}, study.schema, study.check),
-                }
-                check_chunks(ccfg)
-            except ConfigError as e:
-                row.update(feasible=False, reason=str(e))
-                rows.append(row)
-                continue
-            d = out / "cells" / row["label"]
-            d.mkdir(parents=True, exist_ok=True)
-            cctx = ctx
-            if getattr(ctx, "store", None) is not None:  # each cell its own chunk store
-                cctx = dataclasses.replace(
-                    ctx,
-                    store=type(ctx.store)(
-                        d / "trials", provenance(ccfg, sweep_cell=row["label"], sweep=dict(table))
-                    ),
-                )
-            try:
-                study.run(ccfg, d, cctx)
-            except (KeyboardInterrupt, SystemExit):
-                raise
-            except Exception as e:  # noqa: BLE001 - a failed cell is recorded, the sweep goes on
-                row.update(feasible=False, reason=f"failed: {e}".splitlines()[0])
-                rows.append(row)
-                continue
-            if (d / "claims.parquet").is_file():
-                for c in read_table(d / "claims.parquet").to_pylist():
-                    row[c["claim"]] = c["value"]
-                    row[c["claim"] + ":lo"] = c["ci_low"]
-                    row[c["claim"] + ":hi"] = c["ci_high"]
-            rows.append(row)
-    if rows and not any(r["feasible"] for r in rows):
-        reasons = list(dict.fromkeys(r["reason"] for r in rows))
-        raise StudyError(
-            f"sweep: every cell failed ({len(rows)} of {len(rows)}): "
-            + "; ".join(reasons[:3])[:500]
-            + (" ..." if len(reasons) > 3 else "")
-        )
-    cols: dict[str, list] = {}
-    names = list(dict.fromkeys(k for row in rows for k in row))
-    for k in names:
-        vals = [row.get(k) for row in rows]
-        if all(
-            isinstance(v, (int, float, np.floating, np.integer)) or v is None for v in vals
-        ) and any(isinstance(v, (float, np.floating)) for v in vals):
-            vals = [np.nan if v is None else float(v) for v in vals]
-        elif any(isinstance(v, list) for v in vals):
-            vals = [repr(v) for v in vals]
-        cols[k] = vals
-    write_table(
-        out / "sweep.parquet",
-        cols,
-        provenance(cfg, sweep=dict(table), sweep_keys=keys, seed_mode=mode),
-    )
-    fig_sweep(out / "sweep.parquet", out / "sweep.png")
-    return cols
-
-
-def _claim_columns(t: dict, keys: list) -> list[str]:
-    skip = set(keys) | {"cell", "replicate", "label", "seed", "feasible", "reason"}
-    return [c for c in t if c not in skip and not c.endswith((":lo", ":hi")) and c + ":lo" in t]
-
-
-def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
-    """Each claim's value (with its 95 % interval) against the first swept key, one line per
-    combination of the other keys; infeasible cells marked on the axis. Drawn from the rows
-    of ``sweep.parquet`` alone."""
-    from sim.mc.storage import read_provenance, read_table
-    from sim.report.plotting import plt, save
-
-    t = read_table(path).to_pydict()
-    keys = read_provenance(path).get("sweep_keys", [])
-    claims = _claim_columns(t, keys)[:max_panels]
-    if not keys or not claims:
-        return None
-    x = np.array(
-        [float(v) if isinstance(v, (int, float)) else i for i, v in enumerate(t[keys[0]])], float
-    )
-    other = [tuple(t[k][i] for k in keys[1:]) for i in range(len(x))]
-    feas = np.array(t["feasible"], bool)
-    ncol = min(3, len(claims))
-    nrow = -(-len(claims) // ncol)
-    fig, axs = plt.subplots(nrow, ncol, figsize=(4.6 * ncol, 3.4 * nrow), squeeze=False)
-    for ax, c in zip(axs.ravel(), claims):
-        v = np.array([np.nan if a is None else a for a in t[c]], float)
-        lo = np.array([np.nan if a is None else a for a in t[c + ":lo"]], float)
-        hi = np.array([np.nan if a is None else a for a in t[c + ":hi"]], float)
-        for grp in dict.fromkeys(other):
-            sel = np.array([o == grp for o in other]) & feas
-            o = np.argsort(x[sel])
-            lab = ", ".join(f"{k}={g}" for k, g in zip(keys[1:], grp)) or None
-            ax.errorbar(
-                x[sel][o],
-                v[sel][o],
-                yerr=[v[sel][o] - lo[sel][o], hi[sel][o] - v[sel][o]],
-                fmt="o-",
-                ms=3,
-                capsize=2,
-                label=lab,
-            )
-        for xi in x[~feas]:
-            ax.axvline(xi, color="tab:red", alpha=0.3, lw=3)
-        ax.set_title(c, fontsize=7)
-        ax.set_xlabel(keys[0] + " (red: infeasible)")
-        if other[0]:
-            ax.legend(fontsize=6)
-    for ax in axs.ravel()[len(claims) :]:
-        ax.axis("off")
-    return save(fig, png)
-
-
-def sweep_markdown(out: Path, name: str | None = None) -> str:
-    """Markdown for a sweep directory from ``sweep.parquet`` alone: the cells with their
-    feasibility and claim values, and the figure (for ``sim report``)."""
-    from sim.mc.storage import read_provenance, read_table
-    from sim.report.markdown import fmt, md_table
-
-    t = read_table(Path(out) / "sweep.parquet").to_pydict()
-    keys = read_provenance(Path(out) / "sweep.parquet").get("sweep_keys", [])
-    claims = _claim_columns(t, keys)
-    rows = [
-        [
-            t["label"][i],
-            *[fmt(t[k][i]) for k in keys],
-            t["seed"][i],
-            "yes" if t["feasible"][i] else f"no: {t['reason'][i]}",
-            *[fmt(t[c][i]) for c in claims],
-        ]
-        for i in range(len(t["cell"]))
-    ]
-    txt = md_table(["cell", *keys, "seed", "feasible", *[f"`{c}`" for c in claims]], rows)
-    if (Path(out) / "sweep.png").is_file():
-        txt += f"\n\n![sweep]({name or Path(out).name}/sweep.png)"
-    return txt
 
 
 def run_adaptive(

@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-
-import numpy as np
+from typing import Callable
 
 from sim.mc.storage import atomic_path, read_provenance, read_table
+from sim.report.sweep import sweep_markdown
+from sim.report.tables import fmt, md_table
+from sim.report.verify import markdown as reproducibility_markdown
 
 __all__ = [
     "build_report",
@@ -26,31 +28,6 @@ __all__ = [
     "verdict_counts",
     "referee_summary",
 ]
-
-
-def fmt(x, digits: int = 3) -> str:
-    if x is None:
-        return ""
-    if isinstance(x, (bool, np.bool_)):
-        return "yes" if x else "no"
-    if isinstance(x, (int, np.integer)):
-        return str(int(x))
-    if isinstance(x, (float, np.floating)):
-        if not math.isfinite(x):
-            return ""
-        if x == 0:
-            return "0"
-        mag = math.floor(math.log10(abs(x)))
-        dec = max(0, digits - 1 - mag)
-        return f"{x:.{min(dec, 9)}f}"
-    return str(x)
-
-
-def md_table(header: list[str], rows: list[list]) -> str:
-    esc = lambda s: str(s).replace("|", "\\|").replace("\n", " ")  # noqa: E731
-    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    out += ["| " + " | ".join(esc(c) for c in r) + " |" for r in rows]
-    return "\n".join(out)
 
 
 _VERDICT_TEXT = {
@@ -294,9 +271,9 @@ def referee_summary(entries: list[tuple]) -> str:
     return "\n".join(parts)
 
 
-def build_report(results: Path) -> str:
-    from sim.studies import get_study
-
+def build_report(results: Path, get_study: Callable) -> str:
+    """The report of every results directory under ``results``; ``get_study(name)`` gives the
+    registered study (its title, seed file, order and ``report`` section)."""
     results = Path(results)
     sections = []
     entries = []
@@ -334,8 +311,6 @@ def build_report(results: Path) -> str:
         for p in results.iterdir()
         if (p / "sweep.parquet").is_file() and not (p / "claims.parquet").is_file()
     ):
-        from sim.mc.sweep import sweep_markdown
-
         prov = read_provenance(d / "sweep.parquet")
         study = get_study(prov["study"])
         sections.append(
@@ -374,8 +349,6 @@ def build_report(results: Path) -> str:
         [e[4] for e in entries],
     )
     summary = referee_summary(entries)
-    from sim.report.verify import markdown as reproducibility_markdown
-
     repro = reproducibility_markdown(results)
     repro = "\n" + repro if repro else ""
     return (
@@ -391,8 +364,8 @@ def build_report(results: Path) -> str:
     )
 
 
-def write_report(results: Path) -> Path:
-    text = build_report(results)
+def write_report(results: Path, get_study: Callable) -> Path:
+    text = build_report(results, get_study)
     out = Path(results) / "REPORT.md"
     with atomic_path(out) as tmp:
         tmp.write_text(text)

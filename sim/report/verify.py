@@ -32,6 +32,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.mc.storage import read_provenance, versions, write_table
+from sim.report.tables import fmt, md_table
 
 __all__ = ["compare_dirs", "verify", "DEFAULT_RTOL", "DEFAULT_ATOL", "Comparison"]
 
@@ -221,8 +222,6 @@ def write_record(results: Path, comps: list[Comparison]) -> Path:
 
 def markdown(results: Path) -> str:
     """The report's *Reproducibility* section from ``reproducibility.parquet`` (empty if none)."""
-    from sim.report.markdown import fmt, md_table
-
     p = Path(results) / "reproducibility.parquet"
     if not p.is_file():
         return ""

@@ -8,57 +8,15 @@ of ``results/REPORT.md`` built from those files alone.
 from __future__ import annotations
 
 import importlib
-from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Mapping
+from typing import Any, Callable, Mapping
 
-from sim.mc.config import ConfigError, Field
+from sim.mc.config import ConfigError, Field, flatten, parse_override, read_toml, validate
+from sim.mc.registry import MODULES
+from sim.mc.runner import RunContext
 
-__all__ = ["Study", "RunContext", "get_study", "MODULES"]
-
-#: study name -> module that defines it (imported on demand)
-MODULES = {
-    "brown_dilution": "sim.studies.brown",
-    "brown_table1": "sim.studies.brown",
-    "gridplate_two_plates": "sim.studies.gridplate",
-    "salsig_encoders": "sim.studies.salsig",
-    "wolf_polynomial": "sim.studies.wolf",
-    "agnard_block": "sim.studies.agnard",
-    "brown_design": "sim.studies.design",
-    "network": "sim.studies.network",
-}
-
-
-@dataclass(frozen=True)
-class RunContext:
-    """What a study's ``run`` gets besides its config: pass it to
-    :func:`sim.mc.runner.run_chunks` (``ctx=ctx``) so chunks use the chosen executor and are
-    stored for resumption, and share the run's one progress bar."""
-
-    quiet: bool = False
-    executor: object = None  # from sim.mc.runner.make_executor; None = in-process
-    store: object = None  # sim.mc.runner.ChunkStore of the run's staging directory
-    estimate: object = None  # sim.mc.estimate.Estimate of the run (the progress bar's total)
-    bars: list = field(default_factory=list, compare=False)  # the open shared bar, if any
-
-    @property
-    def bar(self):
-        """The run's shared progress bar while :meth:`progress_bar` is open, else None."""
-        return self.bars[-1] if self.bars else None
-
-    @contextmanager
-    def progress_bar(self, label: str):
-        """One bar for the whole run; its total is the estimate's trial count."""
-        from sim.mc.progress import Progress
-
-        total = getattr(self.estimate, "trials", 0) or 0
-        with Progress(total, label, quiet=self.quiet) as p:
-            self.bars.append(p)
-            try:
-                yield p
-            finally:
-                self.bars.remove(p)
+__all__ = ["Study", "RunContext", "get_study", "load_study", "MODULES"]
 
 
 @dataclass(frozen=True)
@@ -83,3 +41,41 @@ def get_study(name: str) -> Study:
             raise ConfigError("study", f"study {name!r} is not implemented yet") from None
         raise
     return mod.STUDIES[name]
+
+
+def load_study(
+    path: str | Path,
+    overrides: list[str] | tuple = (),
+    trials: int | None = None,
+    seed: int | None = None,
+    values: Mapping[str, Any] | None = None,
+):
+    """Load, override and validate a study file.
+
+    ``overrides``: ``"key=value"`` strings (values read as TOML, as ``--set``); ``values``:
+    ``{dotted.key: value}`` with Python values (the Python API).
+
+    Returns ``(study, cfg)`` where ``study`` is the registered :class:`sim.studies.Study`
+    and ``cfg`` the resolved flat configuration (including ``study``).
+    """
+    doc = read_toml(path)
+    flat = flatten({k: v for k, v in doc.items() if k != "sweep"})  # [sweep]: sim.mc.sweep
+    name = flat.pop("study", None)
+    if name is None:
+        raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
+    study = get_study(name)
+    for text in overrides:
+        key, value = parse_override(text)
+        if key == "study":
+            raise ConfigError("study", "cannot be overridden")
+        flat[key] = value
+    for key, value in (values or {}).items():
+        if key == "study":
+            raise ConfigError("study", "cannot be overridden")
+        flat[key] = list(value) if isinstance(value, tuple) else value
+    if trials is not None:
+        flat["trials"] = trials
+    if seed is not None:
+        flat["seed"] = seed
+    cfg = validate(flat, study.schema, study.check)
+    return study, {"study": name, **cfg}

@@ -1,0 +1,34 @@
+"""Numbers and tables as Markdown text: the formatting every report section shares."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["fmt", "md_table"]
+
+
+def fmt(x, digits: int = 3) -> str:
+    if x is None:
+        return ""
+    if isinstance(x, (bool, np.bool_)):
+        return "yes" if x else "no"
+    if isinstance(x, (int, np.integer)):
+        return str(int(x))
+    if isinstance(x, (float, np.floating)):
+        if not math.isfinite(x):
+            return ""
+        if x == 0:
+            return "0"
+        mag = math.floor(math.log10(abs(x)))
+        dec = max(0, digits - 1 - mag)
+        return f"{x:.{min(dec, 9)}f}"
+    return str(x)
+
+
+def md_table(header: list[str], rows: list[list]) -> str:
+    esc = lambda s: str(s).replace("|", "\\|").replace("\n", " ")  # noqa: E731
+    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(esc(c) for c in r) + " |" for r in rows]
+    return "\n".join(out)
