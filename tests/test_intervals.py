@@ -173,6 +173,10 @@ def test_bootstrap_ci_is_the_2_5_and_97_5_percentiles_of_the_resamples():
     def stat(d):
         return float(d[:, 0].mean() - d[:, 1].mean())
 
+    default = iv.bootstrap_ci(stat, data, np.random.default_rng(6))
+    rng = np.random.default_rng(6)
+    reps = [stat(data[rng.integers(0, 40, 40)]) for _ in range(400)]  # 400 resamples
+    assert default[1] == pytest.approx(tuple(np.percentile(reps, [2.5, 97.5])), rel=1e-12)
     est, (lo, hi) = iv.bootstrap_ci(stat, data, np.random.default_rng(6), n_boot=300)
     rng = np.random.default_rng(6)  # the same resamples, by hand
     reps = np.sort([stat(data[rng.integers(0, 40, 40)]) for _ in range(300)])

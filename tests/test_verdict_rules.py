@@ -153,6 +153,13 @@ def test_one_plate_rule(p, interval, outcome):
     assert decide("one-plate", interval, ZONE, p_plate=p) == outcome
 
 
+def test_decide_knows_only_the_forms():
+    with pytest.raises(
+        ValueError, match=r"^form must be one of value, share, count, upper, lower, "
+    ):
+        decide("roughly", (1.5, 2.5), ZONE)
+
+
 def test_one_plate_needs_a_p():
     for p in (None, math.nan):
         with pytest.raises(ValueError, match="^a one-plate claim needs p_plate$"):
@@ -240,6 +247,8 @@ def test_kinds_without_a_number():
         [],
     )
     assert b.score("c", 1.0, (0.5, 1.5))["note"] == "no setup"
+    b = ClaimBook([{"id": "c", "source": "s", "paper": "p", "kind": "not comparable"}], [])
+    assert b.path == "<claims>" and b.score("c", 1.0, (0.5, 1.5), note="n")["note"] == "n"
     assert bk._verdict("prediction", None) == "finding"
     assert bk._verdict("paper-check", None) == "finding"
     assert bk._verdict("paper-check", "fails") == "erratum"

@@ -140,6 +140,8 @@ def decide(
     elems : for ``range``, the per-element intervals ``(lo[k], hi[k])``.
     p_plate : for ``one-plate``, the probability of a plate at least as extreme.
     """
+    if form not in FORMS:
+        raise ValueError(f"form must be one of {', '.join(FORMS)}, not {form!r}")
     zl, zh = zone
     if form == "range":
         if elems is None:
@@ -221,7 +223,7 @@ class ClaimBook:
                         "claim.ref",
                         f"{where} ({s['id']}): ref must be a finite number or [low, high]",
                     )
-                if (s["form"] == "range") != (ref[0] != ref[1] or isinstance(s["ref"], list)):
+                if (s["form"] == "range") != isinstance(s["ref"], list):
                     raise ConfigError(
                         "claim.ref",
                         f"{where} ({s['id']}): a range needs "
@@ -289,17 +291,17 @@ class ClaimBook:
         if cid in self._scored:
             raise ValueError(f"claim {cid!r} scored twice")
         self._scored.add(cid)
-        form = s.get("form", "value")
+        form = s.get("form")  # None only for a claim without a number (no "ref")
         p_plate = math.nan
         if samples is not None:
-            x = np.asarray(samples, float)
+            x = np.asarray(samples)
             _finite(cid, x, "samples")
             value, ci = spread(x)
             interval = "spread"
             if "ref" in s:
                 p_plate = plate_p(x, float(s["ref"]))
         if elems is not None:
-            el, eh = (np.asarray(e, float) for e in elems)
+            el, eh = (np.asarray(e) for e in elems)
             _finite(cid, np.concatenate([el, eh]), "element intervals")
             mid = (el + eh) / 2
             value = float(mid.min()) if value is None else value
@@ -327,15 +329,11 @@ class ClaimBook:
             # a one-plate claim given no plates (e.g. an exact input) is decided as a value
             rule = "value" if form == "one-plate" and samples is None else form
             outcome = decide(
-                rule,
-                (float(ci[0]), float(ci[1])),
-                (zlo, zhi),
-                elems=elems,
-                p_plate=p_plate if rule == "one-plate" else None,
+                rule, (float(ci[0]), float(ci[1])), (zlo, zhi), elems=elems, p_plate=p_plate
             )
         verdict = _verdict(s["kind"], outcome)
         if s["kind"] == "not comparable":
-            note = s.get("why", "") + (f" {note}" if note else "")
+            note = (s.get("why", "") + " " + note).strip()
         return _row(
             s,
             form=form if "ref" in s else "",
@@ -412,7 +410,7 @@ def _row(
         "paper": s["paper"],
         "form": form,
         "kind": s["kind"],
-        "headline": bool(s.get("headline", False)),
+        "headline": bool(s.get("headline")),
         "value": value,
         "value_high": value_high,
         "ci_low": ci[0],

@@ -77,7 +77,7 @@ def _half(level: float) -> float:
 
 def mean_ci(x: np.ndarray, level: float = LEVEL) -> tuple[float, tuple[float, float]]:
     """Mean of ``x`` (1-D, N >= 2) and its Student-t confidence interval."""
-    x = np.asarray(x, float)
+    x = np.asarray(x)
     if x.size < 2:
         raise ValueError("a mean's interval needs at least 2 values")
     m = x.mean()
