@@ -11,6 +11,9 @@ import math
 from pathlib import Path
 from typing import Callable
 
+import pyarrow as pa
+
+from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_table
 from sim.report.sweep import sweep_markdown
 from sim.report.tables import fmt, md_table
@@ -34,6 +37,8 @@ _VERDICT_TEXT = {
     "holds": "holds",
     "fails": "**fails**",
     "inconclusive": "inconclusive",
+    "depends": "depends",
+    "undecidable": "undecidable",
     "erratum": "**erratum**",
     "input": "input",
     "self-check": "self-check",
@@ -173,6 +178,8 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
             "holds",
             "fails",
             "inconclusive",
+            "depends",
+            "undecidable",
             "erratum",
             "paper ok",
             "input",
@@ -185,7 +192,11 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
     for r in claims:
         v, k = r["verdict"], r["kind"]
         if k == "prediction":
-            c[v if v in ("holds", "fails", "inconclusive") else "finding"] += 1
+            c[
+                v
+                if v in ("holds", "fails", "inconclusive", "depends", "undecidable")
+                else "finding"
+            ] += 1
         elif k == "paper-check":
             c["erratum" if v == "erratum" else "paper ok"] += 1
         elif k == "self-check":
@@ -211,6 +222,8 @@ _COUNT_COLS = [
     ("holds", "holds"),
     ("fails", "fails"),
     ("inconclusive", "inconclusive"),
+    ("depends", "depends"),
+    ("undecidable", "undecidable"),
     ("not comparable", "not comparable"),
     ("erratum", "errata"),
     ("paper ok", "paper consistent"),
@@ -271,16 +284,30 @@ def referee_summary(entries: list[tuple]) -> str:
     return "\n".join(parts)
 
 
+def _claims_of(d: Path, get_study: Callable):
+    """``(study, provenance, claim rows)`` of a results directory, or one line naming the file
+    when its ``claims.parquet`` is not a claims table written by the suite."""
+    f = d / "claims.parquet"
+    try:
+        prov = read_provenance(f) or {}
+        claims = read_table(f).to_pylist()
+    except (OSError, ValueError, pa.ArrowException) as e:
+        raise ConfigError("--results", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+    if "study" not in prov or (claims and not {"claim", "verdict"} <= set(claims[0])):
+        raise ConfigError("--results", f"{f} is not a claims table written by sim")
+    return get_study(prov["study"]), prov, claims
+
+
 def build_report(results: Path, get_study: Callable) -> str:
     """The report of every results directory under ``results``; ``get_study(name)`` gives the
     registered study (its title, seed file, order and ``report`` section)."""
     results = Path(results)
+    if not results.is_dir():
+        raise ConfigError("--results", f"{results} is not a results directory")
     sections = []
     entries = []
     for d in sorted(p for p in results.iterdir() if (p / "claims.parquet").is_file()):
-        prov = read_provenance(d / "claims.parquet")
-        study = get_study(prov["study"])
-        claims = read_table(d / "claims.parquet").to_pylist()
+        study, prov, claims = _claims_of(d, get_study)
         c = verdict_counts(claims)
         nr = d / "not_reproduced.parquet"
         n_nr = read_table(nr).num_rows if nr.is_file() else 0
@@ -364,9 +391,29 @@ def build_report(results: Path, get_study: Callable) -> str:
     )
 
 
+#: the first line of every REPORT.md the suite writes: a file without it is the user's
+MARK = "<!-- written by `sim report` from the Parquet files alone; edits are overwritten -->"
+
+
+def _ours(path: Path) -> bool:
+    """True for a REPORT.md the suite wrote (its mark, or the heading the reports had before)."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            first = f.readline().rstrip("\n")
+    except OSError:
+        return False
+    return first in (MARK, "# Reproducibility report")
+
+
 def write_report(results: Path, get_study: Callable) -> Path:
-    text = build_report(results, get_study)
+    """Write ``results/REPORT.md``; a REPORT.md there that the suite did not write is refused
+    (one line naming it), never replaced."""
     out = Path(results) / "REPORT.md"
+    if out.is_symlink() or (out.exists() and not _ours(out)):
+        raise ConfigError(
+            "--results", f"{out} was not written by sim report; sim never replaces it"
+        )
+    text = MARK + "\n" + build_report(results, get_study)
     with atomic_path(out) as tmp:
         tmp.write_text(text)
     return out
