@@ -13,7 +13,7 @@ STUDIES := $(basename $(notdir $(STUDY_FILES)))
 unexport PYTHONDONTWRITEBYTECODE
 
 .DEFAULT_GOAL := help
-.PHONY: help venv test reproduce rerun verify report bench clean fuzz
+.PHONY: help venv test reproduce rerun verify report bench clean fuzz mutation
 
 help: ## list the targets
 	@grep -E '^[a-zA-Z_%/.-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/:.*## /\t/' | sort | \
@@ -39,6 +39,16 @@ test: $(STAMP) ## lint (ruff), the layer contracts (import-linter), then the tes
 
 fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=300, FUZZ_SEED, FUZZ_SAVE)
 	FUZZ_CASES=$${FUZZ_CASES:-300} $(PY) -m pytest tests/test_fuzz.py -p no:cacheprovider
+
+# Mutation testing of the verdict rules and interval methods ([tool.mutmut] in pyproject.toml);
+# not part of `make test`: about 10-20 minutes on 2 cores. Writes docs/mutation.md.
+MUTATION_WORKERS ?= 2
+
+mutation: $(STAMP) ## mutate sim/claims/{book,intervals}.py, run their tests, write docs/mutation.md
+	$(PY) -m pip install --quiet -e ".[dev,mutation]"
+	rm -rf mutants
+	$(VENV)/bin/mutmut run --max-children $(MUTATION_WORKERS) > /dev/null
+	$(PY) tests/mutation_report.py
 
 # A study is re-run when its results are not current: run.json must record the study file's
 # config and the hash of the code that study imports (sim/mc/codehash.py). Decided by content,
@@ -71,4 +81,4 @@ bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 a
 	$(PY) -m benchmarks --out $(BENCH_OUT) $(BENCH_FLAGS)
 
 clean: ## remove the virtual environment and caches (results/ is kept)
-	rm -rf $(VENV) .pytest_cache sim.egg-info
+	rm -rf $(VENV) .pytest_cache sim.egg-info mutants

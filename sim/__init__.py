@@ -17,7 +17,6 @@ _EXPORTS = {
     "StudyError": "sim.mc.config",
     "load_study": "sim.studies",
     "run_chunks": "sim.mc.runner",
-    "claim": "sim.claims.book",
     "write_table": "sim.mc.storage",
     "read_provenance": "sim.mc.storage",
 }

@@ -16,7 +16,7 @@ def test_readme_worked_example(tmp_path):
     # --- README: Python API --------------------------------------------------------------
     import sim
 
-    st = sim.load(STUDY, trials=200, chunk=50, **{"errors.settings": 3})  # dotted keys
+    st = sim.load(STUDY, trials=200, chunk=10, **{"errors.settings": 3})  # dotted keys
     st = st.replace(comparator__beta_mm=0.5)  # keyword form: __ stands for the dot
     print(st.estimate().describe())  # trials, adjustments, unknowns, memory
     res = st.run(out=tmp_path / "t1", workers=2)  # or executor="dask"; out=None: a temp dir
@@ -42,7 +42,7 @@ def test_readme_worked_example(tmp_path):
                 "--trials",
                 "200",
                 "--set",
-                "chunk=50",
+                "chunk=10",
                 "--set",
                 "errors.settings=3",
                 "--set",
@@ -65,7 +65,7 @@ def test_api_errors_name_the_key(tmp_path):
         sim.load(STUDY, plate__grid="five")
     with pytest.raises(sim.ConfigError, match="plate.gird"):
         sim.load(STUDY, **{"plate.gird": 5})
-    st = sim.load(STUDY, trials=20, chunk=10)
+    st = sim.load(STUDY, trials=20, chunk=1)
     f = tmp_path / "mine.txt"
     f.write_text("mine")
     with pytest.raises(sim.ConfigError, match="is a file"):

@@ -55,13 +55,11 @@ def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
     )
     eng = pq.read_table(out / "engines.parquet").to_pydict()
     assert set(eng["engine"]) == ENGINES == set(engines.cases())
+    # the agreement itself is checked against SciPy in the tests below (a disagreement stops
+    # the bench); here only that each row was measured
     for i, name in enumerate(eng["engine"]):
-        assert eng["max_abs_diff"][i] <= eng["tolerance"][i], name
+        assert 0 <= eng["max_abs_diff"][i] <= eng["tolerance"][i], name
         assert eng["compiled_s"][i] > 0 and eng["numpy_s"][i] > 0 and eng["scipy_s"][i] > 0
-        assert eng["speedup"][i] == pytest.approx(eng["scipy_s"][i] / eng["compiled_s"][i])
-        assert eng["compiled_vs_numpy"][i] == pytest.approx(
-            eng["numpy_s"][i] / eng["compiled_s"][i]
-        )
         assert (eng["speedup"][i] < eng["target_speedup"][i]) == eng["note"][i].startswith("below")
     # every compiled module of the suite has a row, and the page names it with a verdict
     named = {m.split(" ")[0].rstrip(",") for m in eng["compiled_module"] if m}

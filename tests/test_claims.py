@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from sim.claims.book import ClaimBook, claim, decide
+from sim.claims.book import ClaimBook
 from sim.mc.config import ConfigError, StudyError
 
 
@@ -122,13 +122,6 @@ def test_every_declared_claim_must_be_scored():
     b.score("a", 1.0, interval="exact")
     with pytest.raises(ValueError, match="not scored: b"):
         b.check_complete()
-
-
-def test_older_interface_maps_rounding_to_the_zone():
-    r = claim("x", "s", "p", 0.706, (0.696, 0.718), "predicted", ref=(0.705, 0.715))
-    assert r["kind"] == "prediction" and r["verdict"] == "inconclusive"
-    assert math.isclose(r["zone_low"], 0.705) and math.isclose(r["zone_high"], 0.715)
-    assert decide("value", (0.706, 0.714), (0.705, 0.715)) == "holds"
 
 
 def test_not_comparable_rows_are_written_with_no_number(tmp_path):

@@ -23,7 +23,7 @@ def write(tmp_path, text, name="study.toml"):
     return p
 
 
-BASE = 'study = "brown_table1"\ntrials = 20\nchunk = 10\n'
+BASE = 'study = "brown_table1"\ntrials = 20\nchunk = 1\n'
 
 
 @pytest.mark.parametrize(
@@ -117,7 +117,7 @@ def test_run_writes_contract_files_with_provenance(tmp_path):
     out = tmp_path / "t1"
     assert (
         main(
-            ["run", str(BROWN), "--out", str(out), "--trials", "60", "--quiet", "--set", "chunk=25"]
+            ["run", str(BROWN), "--out", str(out), "--trials", "60", "--quiet", "--set", "chunk=3"]
         )
         == 0
     )
@@ -142,7 +142,7 @@ def test_run_writes_contract_files_with_provenance(tmp_path):
 
     assert set(claims["kind"]) <= set(KINDS)
     trials = pq.read_table(out / "trials").to_pydict()  # partitioned dataset, one file a chunk
-    assert len(trials["chunk"]) == 60 and sorted(set(trials["chunk"])) == [0, 1, 2]
+    assert len(trials["chunk"]) == 60 and sorted(set(trials["chunk"])) == list(range(20))
     for m in ("known", "stations", "pivot"):
         assert {f"{m}_converged", f"{m}_iterations", f"{m}_sigma0_um", f"{m}_status"} <= set(trials)
     assert {"pivot_alpha_mm", "pivot_beta2_mm2", "stations_y1_mm"} <= set(trials)
@@ -152,32 +152,14 @@ def test_run_writes_contract_files_with_provenance(tmp_path):
     assert (out / "table1.png").stat().st_size > 1000
 
 
-def test_same_seed_same_files_and_chunking_by_stream(tmp_path):
-    a, b = tmp_path / "a", tmp_path / "b"
-    for o in (a, b):
-        assert (
-            main(
-                [
-                    "run",
-                    str(BROWN),
-                    "--out",
-                    str(o),
-                    "--trials",
-                    "40",
-                    "--quiet",
-                    "--set",
-                    "chunk=16",
-                ]
-            )
-            == 0
-        )
-    for f in (
-        "points.parquet",
-        "claims.parquet",
-        "trials/part-0/chunk-000001.parquet",
-        "table1.png",
-    ):
-        assert (a / f).read_bytes() == (b / f).read_bytes(), f
+def test_a_new_seed_gives_new_trials(tmp_path):
+    # two runs with the same seed give the same files byte for byte: test_all_studies.py shows
+    # it for every study (one worker against two, killed and resumed); here a new seed
+    a = tmp_path / "a"
+    assert (
+        main(["run", str(BROWN), "--out", str(a), "--trials", "40", "--quiet", "--set", "chunk=2"])
+        == 0
+    )
     c = tmp_path / "c"
     assert (
         main(
@@ -192,7 +174,7 @@ def test_same_seed_same_files_and_chunking_by_stream(tmp_path):
                 "5",
                 "--quiet",
                 "--set",
-                "chunk=16",
+                "chunk=2",
             ]
         )
         == 0

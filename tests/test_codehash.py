@@ -34,7 +34,7 @@ def test_results_are_current_until_the_config_changes(tmp_path):
     text = (ROOT / "studies" / "brown_table1.toml").read_text()
     study = tmp_path / "brown_table1.toml"
     study.write_text(
-        text.replace("trials = ", "trials = 40 # ", 1).replace("chunk = ", "chunk = 20 # ", 1)
+        text.replace("trials = ", "trials = 40 # ", 1).replace("chunk = ", "chunk = 2 # ", 1)
     )
     out = tmp_path / "out"
     assert not is_current(study, out)  # nothing there yet

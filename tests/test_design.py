@@ -23,7 +23,7 @@ from sim.studies import design
 TABLE1 = """study = "brown_table1"
 trials = {trials}
 seed = 77
-chunk = 10
+chunk = 1
 """
 
 

@@ -42,14 +42,14 @@ TIMEOUT = float(os.environ.get("FUZZ_TIMEOUT", "300"))
 
 #: each study shrunk to a run of a few seconds (keys that the mutations then perturb)
 SMALL = {
-    "brown_dilution": {
-        "trials": 8,
-        "chunk": 4,
+    "brown_dilution": {  # the jackknife intervals need 20 chunks
+        "trials": 20,
+        "chunk": 1,
         "dilution.grids": [3, 5],
         "region.points": 256,
         "region.rounds": 1,
     },
-    "brown_table1": {"trials": 8, "chunk": 4, "region.points": 256, "region.rounds": 1},
+    "brown_table1": {"trials": 20, "chunk": 1, "region.points": 256, "region.rounds": 1},
     "brown_design": {
         "trials": 8,
         "chunk": 4,
@@ -471,12 +471,17 @@ def fuzz(n: int, tmp: Path) -> list[str]:
 
 
 def test_fuzz_bases_run():
-    """The tiny base of every study is valid (else the mutations test nothing)."""
+    """The tiny base of every study is valid (else the mutations test nothing) and takes
+    the tiny sizes (else the fuzz cases run at full size)."""
     for name in NAMES:
-        load_study(
+        sizes = small(name)
+        _, cfg = load_study(
             ROOT / "studies" / f"{name}.toml",
-            [f"{k}={toml_value(v)}" for k, v in small(name).items()],
+            [f"{k}={toml_value(v)}" for k, v in sizes.items()],
         )
+        assert sizes and all(cfg[k] == v for k, v in sizes.items()), name
+        if "chunk" in cfg:  # a run needs two chunks (and a jackknife 20: brown in SMALL)
+            assert cfg["trials"] >= 2 * cfg["chunk"], name
 
 
 def test_fuzz(tmp_path):

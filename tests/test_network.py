@@ -51,7 +51,7 @@ def test_brown_network_example_equals_the_brown_dilution_study_files(tmp_path):
     """studies/network_brown.toml run through `sim run` gives the point sigmas that
     `brown_dilution` writes for its `known` and `stations` models (same geometry, 1 um)."""
     tiny = (ROOT / "tests/data/tiny/brown_dilution.txt").read_text().split()
-    runs = {"brown": ("brown_dilution", tiny), "net": ("network_brown", ["trials=400"])}
+    runs = {"brown": ("brown_dilution", tiny), "net": ("network_brown", ["trials=400", "chunk=20"])}
     for key, (name, sets) in runs.items():
         args = [a for s in sets for a in ("--set", s)]
         r = subprocess.run(
@@ -139,7 +139,7 @@ def test_monte_carlo_agrees_with_analytic_within_sampling_error(tmp_path):
             "--trials",
             "600",
             "--set",
-            "chunk=60",
+            "chunk=30",
             "--quiet",
         ],
         cwd=ROOT,
@@ -308,7 +308,7 @@ def test_an_estimated_scale_is_recovered_without_bias_and_with_its_analytic_sigm
             "--trials",
             "600",
             "--set",
-            "chunk=60",
+            "chunk=30",
             "--quiet",
             "--set",
             "network.estimate_scale=true",
@@ -392,7 +392,7 @@ def test_a_sweep_tabulates_the_design_figures_per_cell(tmp_path):
             "--set",
             "trials=200",
             "--set",
-            "chunk=50",
+            "chunk=10",
         ],
         cwd=ROOT,
         capture_output=True,

@@ -94,7 +94,7 @@ def test_dask_local_cluster_equals_local(tmp_path):
                     "60",
                     "--quiet",
                     "--set",
-                    "chunk=20",
+                    "chunk=3",
                 ]
                 + extra
             )
@@ -112,7 +112,7 @@ def test_dask_local_cluster_equals_local(tmp_path):
 
 def test_refuses_to_mix_a_different_config(tmp_path, capsys):
     o = tmp_path / "o"
-    args = ["run", str(STUDY), "--out", str(o), "--trials", "20", "--quiet", "--set", "chunk=10"]
+    args = ["run", str(STUDY), "--out", str(o), "--trials", "20", "--quiet", "--set", "chunk=1"]
     assert main(args) == 0
     assert main(args + ["--seed", "2"]) == 2
     err = capsys.readouterr().err
@@ -184,26 +184,8 @@ def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path, capsys):
     assert not list(out.rglob("*.tmp")) and not (out / ".lock").exists()
     assert len(rows["chunk"]) == 20000
     assert len(set(zip(rows["chunk"], rows["trial_in_chunk"]))) == 20000
-    # identical to an uninterrupted run
-    ref = tmp_path / "ref"
-    assert (
-        main(
-            [
-                "run",
-                str(STUDY),
-                "--out",
-                str(ref),
-                "--trials",
-                "20000",
-                "--quiet",
-                "--set",
-                "chunk=50",
-            ]
-        )
-        == 0
-    )
-    for f in ("claims.parquet", "points.parquet", "table1_trials.parquet"):
-        assert same_result(out / f, ref / f), f
+    # that a killed and resumed run equals an uninterrupted one is shown for every study in
+    # test_all_studies.py (a second full 20,000-trial run here would repeat it)
 
 
 def test_full_disk_is_one_line_and_no_result(tmp_path, capsys, monkeypatch):
@@ -218,7 +200,7 @@ def test_full_disk_is_one_line_and_no_result(tmp_path, capsys, monkeypatch):
     out = tmp_path / "o"
     assert (
         main(
-            ["run", str(STUDY), "--out", str(out), "--trials", "20", "--quiet", "--set", "chunk=10"]
+            ["run", str(STUDY), "--out", str(out), "--trials", "20", "--quiet", "--set", "chunk=1"]
         )
         == 2
     )
@@ -227,28 +209,10 @@ def test_full_disk_is_one_line_and_no_result(tmp_path, capsys, monkeypatch):
     assert not out.exists()
 
 
-def test_jackknife_of_a_mean_matches_the_standard_error():
-    rng = np.random.default_rng(4)
-    x = rng.normal(2.0, 3.0, size=(40, 50))  # 40 chunks of 50 draws
-    sums = np.stack([x.sum(1), np.full(40, 50.0)], 1)
-    est, lo, hi = jackknife(lambda t: t[0] / t[1], sums)
-    se = x.std(ddof=1) / np.sqrt(x.size)
-    assert est == pytest.approx(x.mean())
-    # the jackknife SE of a mean over equal chunks is the between-chunk SE of the mean
-    from scipy import stats
-
-    assert (hi - lo) / 2 / stats.t.ppf(0.975, 39) == pytest.approx(
-        x.mean(1).std(ddof=1) / np.sqrt(40), rel=1e-9
-    )
-    assert 0.6 < (hi - lo) / 2 / 1.96 / se < 1.4
-
-
 def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, capsys):
     """A 2 x 2 grid passes validation but makes the pivot model's reduced normals singular."""
     f = tmp_path / "s.toml"
-    f.write_text(
-        'study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n"plate.grid" = [2, 5]\n'
-    )
+    f.write_text('study = "brown_table1"\ntrials = 20\nchunk = 1\n[sweep]\n"plate.grid" = [2, 5]\n')
     out = tmp_path / "sw"
     assert main(["run", str(f), "--out", str(out), "--quiet"]) == 0
     t = pq.read_table(out / "sweep.parquet").to_pydict()
@@ -257,7 +221,7 @@ def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, 
     assert "singular" in t["reason"][0]
     # a plain run of the degenerate cell is a one-line error, exit 2
     g = tmp_path / "g.toml"
-    g.write_text('study = "brown_table1"\ntrials = 20\nchunk = 10\n[plate]\ngrid = 2\n')
+    g.write_text('study = "brown_table1"\ntrials = 20\nchunk = 1\n[plate]\ngrid = 2\n')
     assert main(["run", str(g), "--out", str(tmp_path / "g"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "singular" in err[0]
@@ -282,7 +246,7 @@ def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, 
 )
 def test_sweep_cell_count_is_finite_and_bounded(tmp_path, capsys, sweep, needle):
     f = tmp_path / "s.toml"
-    f.write_text(f'study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n{sweep}\n')
+    f.write_text(f'study = "brown_table1"\ntrials = 20\nchunk = 1\n[sweep]\n{sweep}\n')
     assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and needle in err[0], err
@@ -294,7 +258,7 @@ def test_dotted_range_syntax_and_sweep_chunks_carry_provenance(tmp_path):
 
     f = tmp_path / "s.toml"
     f.write_text(
-        'study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n'
+        'study = "brown_table1"\ntrials = 20\nchunk = 1\n[sweep]\n'
         "errors.settings = {start = 2, stop = 3, num = 2}\n"
     )
     assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 0
@@ -313,7 +277,7 @@ def test_dotted_range_syntax_and_sweep_chunks_carry_provenance(tmp_path):
 def test_a_sweep_whose_every_cell_fails_exits_2_with_the_reasons(tmp_path, capsys):
     f = tmp_path / "s.toml"
     f.write_text(
-        'study = "brown_table1"\ntrials = 20\nchunk = 10\n[sweep]\n'
+        'study = "brown_table1"\ntrials = 20\nchunk = 1\n[sweep]\n'
         '"plate.spacing_mm" = [80.0, 90.0]\n'
     )
     assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 2
@@ -375,5 +339,5 @@ def test_require_finite_and_write_table_refuse_non_finite_statistics(tmp_path):
         },
         {},
     )
-    with pytest.raises(StudyError, match="at least 2 chunks"):
+    with pytest.raises(StudyError, match="at least 20 chunks"):
         jackknife(lambda t: t[0], np.ones((1, 2)))

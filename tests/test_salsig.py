@@ -104,7 +104,7 @@ def test_chain_spread_matches_stated_sd():
     tol = 4 / np.sqrt(2 * (T - 1))
     for k in ("E_arcsec", "scale_diff_ppm"):
         ratio = np.std(r[k], ddof=1) / np.sqrt(np.mean(r["sd_" + k] ** 2))
-        assert abs(ratio - 1) < tol + 0.01, k
+        assert abs(ratio - 1) < tol, k
 
 
 def test_bad_config_names_the_key(tmp_path):
@@ -196,12 +196,6 @@ def test_study_runs_small(tmp_path):
     # decided over the region of the unprinted relief, errors and control (never at one
     # nominal relief); 'cut roughly in half' over models this spread cannot hold everywhere
     assert v["salsig.vertical_halved.rms_ratio"] in ("depends", "fails", "undecidable")
-    assert v["salsig.vertical_halved.dramatic_horizontal"] in (
-        "holds",
-        "fails",
-        "depends",
-        "undecidable",
-    )
     reg = read_table(out / "consistent_region.parquet").to_pydict()
     assert len(reg["relief_mm"]) == 8  # nothing printed constrains them: every vector stays
     for fig in ("residuals", "recovery", "power", "vertical", "consistent_region"):

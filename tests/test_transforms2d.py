@@ -104,7 +104,7 @@ def test_affine_covariance_matches_monte_carlo():
     for i, k in enumerate(("SX", "SY", "E")):
         mc = np.std(d[k], ddof=1)
         stated = np.sqrt(np.mean(d["cov"][:, i, i]))
-        assert abs(mc / stated - 1) < tol + 0.01, k
+        assert abs(mc / stated - 1) < tol, k
     # s0 unbiased for sigma^2
     assert abs(np.mean(f.s0**2) / sig**2 - 1) < 4 * np.sqrt(2 / f.dof / T)
 
@@ -118,6 +118,8 @@ def test_inverse_decomposition_matches_direct():
     d = t2.inverse_decomposition(f.params, f.cov)
     g = t2.fit_affine(x2, np.broadcast_to(G, x2.shape))  # residuals on X1
     e = t2.decompose_columns(g.params, g.cov)
-    # the two directions agree to second order; their stated sds to a few per cent
+    # the two directions agree to second order: their stated sds differ by the relative noise
+    # (0.02 mm on a 100 mm grid, 2e-4) times a factor of order one; 5x that is the bound
     assert np.max(np.abs(d["E"] - e["E"])) < 0.05 * np.sqrt(np.mean(e["cov"][:, 2, 2]))
-    np.testing.assert_allclose(np.sqrt(d["cov"][:, 2, 2]), np.sqrt(e["cov"][:, 2, 2]), rtol=0.03)
+    rel = 0.02 / 100.0
+    np.testing.assert_allclose(np.sqrt(d["cov"][:, 2, 2]), np.sqrt(e["cov"][:, 2, 2]), rtol=5 * rel)

@@ -28,7 +28,7 @@ def two_runs(tmp_path_factory):
                     "40",
                     "--quiet",
                     "--set",
-                    "chunk=20",
+                    "chunk=2",
                 ]
             )
             == 0

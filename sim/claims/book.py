@@ -61,13 +61,13 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
+from sim.claims.intervals import LEVEL, METHODS, MIN_CHUNKS, plate_p, spread
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.storage import write_table
 
 __all__ = [
     "ClaimBook",
     "decide",
-    "claim",
     "write_claims",
     "CLAIM_COLUMNS",
     "VERDICTS",
@@ -146,11 +146,13 @@ def decide(
     elems : for ``range``, the per-element intervals ``(lo[k], hi[k])``.
     p_plate : for ``one-plate``, the probability of a plate at least as extreme.
     """
+    if form not in FORMS:
+        raise ValueError(f"form must be one of {', '.join(FORMS)}, not {form!r}")
     zl, zh = zone
     if form == "range":
         if elems is None:
             elems = (np.array([interval[0]]), np.array([interval[1]]))
-        lo, hi = (np.asarray(e, float) for e in elems)
+        lo, hi = (np.asarray(e) for e in elems)
         if np.any((hi < zl) | (lo > zh)):
             return "fails"
         return "holds" if np.all((lo >= zl) & (hi <= zh)) else "inconclusive"
@@ -227,7 +229,7 @@ class ClaimBook:
                         "claim.ref",
                         f"{where} ({s['id']}): ref must be a finite number or [low, high]",
                     )
-                if (s["form"] == "range") != (ref[0] != ref[1] or isinstance(s["ref"], list)):
+                if (s["form"] == "range") != isinstance(s["ref"], list):
                     raise ConfigError(
                         "claim.ref",
                         f"{where} ({s['id']}): a range needs "
@@ -295,19 +297,17 @@ class ClaimBook:
         if cid in self._scored:
             raise ValueError(f"claim {cid!r} scored twice")
         self._scored.add(cid)
-        form = s.get("form", "value")
+        form = s.get("form")  # None only for a claim without a number (no "ref")
         p_plate = math.nan
         if samples is not None:
-            x = np.asarray(samples, float)
+            x = np.asarray(samples)
             _finite(cid, x, "samples")
-            lo, med, hi = np.percentile(x, [2.5, 50, 97.5])
-            value, ci, interval = float(med), (float(lo), float(hi)), "spread"
+            value, ci = spread(x)
+            interval = "spread"
             if "ref" in s:
-                r = float(s["ref"])
-                q = (np.sum(x < r) + 0.5 * np.sum(x == r)) / x.size
-                p_plate = float(min(1.0, 2 * min(q, 1 - q)))
+                p_plate = plate_p(x, float(s["ref"]))
         if elems is not None:
-            el, eh = (np.asarray(e, float) for e in elems)
+            el, eh = (np.asarray(e) for e in elems)
             _finite(cid, np.concatenate([el, eh]), "element intervals")
             mid = (el + eh) / 2
             value = float(mid.min()) if value is None else value
@@ -335,15 +335,11 @@ class ClaimBook:
             # a one-plate claim given no plates (e.g. an exact input) is decided as a value
             rule = "value" if form == "one-plate" and samples is None else form
             outcome = decide(
-                rule,
-                (float(ci[0]), float(ci[1])),
-                (zlo, zhi),
-                elems=elems,
-                p_plate=p_plate if rule == "one-plate" else None,
+                rule, (float(ci[0]), float(ci[1])), (zlo, zhi), elems=elems, p_plate=p_plate
             )
         verdict = _verdict(s["kind"], outcome)
         if s["kind"] == "not comparable":
-            note = s.get("why", "") + (f" {note}" if note else "")
+            note = (s.get("why", "") + " " + note).strip()
         return _row(
             s,
             form=form if "ref" in s else "",
@@ -420,7 +416,7 @@ def _row(
         "paper": s["paper"],
         "form": form,
         "kind": s["kind"],
-        "headline": bool(s.get("headline", False)),
+        "headline": bool(s.get("headline")),
         "value": value,
         "value_high": value_high,
         "ci_low": ci[0],
@@ -439,49 +435,6 @@ def _row(
     }
 
 
-def claim(
-    name: str,
-    source: str,
-    paper: str,
-    value: float,
-    ci: tuple[float, float],
-    kind: str,
-    note: str = "",
-    ref: tuple[float, float] | float | None = None,
-    interval: str = "ci",
-    *,
-    form: str = "value",
-    tol: float = 0.0,
-    headline: bool = False,
-) -> dict[str, Any]:
-    """One claims row without a claim book (the older interface, kept while the studies move
-    their claims into books). ``kind`` ``predicted`` means ``prediction``; ``ref`` is the
-    interval the paper's number stands for (its rounding)."""
-    kind = {"predicted": "prediction"}.get(kind, kind)
-    if ref is None and kind == "prediction":
-        kind = "finding"
-    spec: dict[str, Any] = {
-        "id": name,
-        "source": source,
-        "paper": paper,
-        "kind": kind,
-        "headline": headline,
-    }
-    if ref is not None:
-        r = [float(ref), float(ref)] if np.isscalar(ref) else [float(ref[0]), float(ref[1])]
-        spec.update(form=form, ref=r if form == "range" or r[0] != r[1] else r[0], tol=tol)
-        if form != "range" and r[0] != r[1]:  # a rounding interval: centre and decimals
-            spec.update(ref=(r[0] + r[1]) / 2, tol=tol + (r[1] - r[0]) / 2)
-    book = ClaimBook([spec], [], "<inline>")
-    return book.score(name, value, ci, interval, note)
-
-
-def rounding(x: float, decimals: int) -> tuple[float, float]:
-    """The interval a number printed with ``decimals`` decimals stands for."""
-    h = 0.5 * 10.0 ** (-decimals)
-    return (x - h, x + h)
-
-
 def write_claims(
     path, rows: Iterable[Mapping[str, Any]], prov: Mapping[str, Any], book: ClaimBook | None = None
 ):
@@ -497,7 +450,23 @@ def write_claims(
             prov,
         )
     cols = {c: [_null(r[c]) for r in rows] for c in CLAIM_COLUMNS}
-    return write_table(path, cols, prov)
+    return write_table(path, cols, {**prov, "intervals": interval_provenance()})
+
+
+def interval_provenance() -> dict[str, Any]:
+    """How every interval and verdict of a claims table was made, for its provenance: the
+    interval methods (:data:`sim.claims.intervals.METHODS`) and the decision thresholds."""
+    return {
+        "level": LEVEL,
+        "methods": dict(METHODS),
+        "min_chunks": MIN_CHUNKS,
+        "one_plate_p_fail": P_FAIL,
+        "interval_column": {
+            "ci": "a Monte-Carlo confidence interval (mean, sd, share, bootstrap or jackknife)",
+            "spread": "the one-plate 2.5-97.5 % range over simulated plates",
+            "exact": "a deterministic value",
+        },
+    }
 
 
 def _null(x):

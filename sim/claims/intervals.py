@@ -1,9 +1,24 @@
-"""Confidence intervals of sample statistics over Monte-Carlo trials.
+"""Confidence intervals of sample statistics over Monte-Carlo trials, and the one-plate spread.
 
-Normal-theory interval of a mean, chi-square interval of a standard deviation (exact for
-Gaussian samples: ``(N - 1) s^2 / sigma^2 ~ chi2(N - 1)``), its relative standard error,
-a percentile bootstrap over the trial axis and the central range of a spread. The claims of
-every study (:mod:`sim.claims.book`) are decided on these intervals.
+Every interval a claim is decided on comes from one function here (or from the delete-one-chunk
+jackknife, :func:`sim.mc.runner.jackknife`); ``METHODS`` names each in words and is written
+into the provenance of every ``claims.parquet`` (:func:`sim.claims.book.write_claims`).
+
+* :func:`mean_ci` -- Student-t interval of a mean, ``m +- t(1 - a/2, N - 1) s / sqrt(N)``
+  (exact for Gaussian samples, the normal interval's large-N limit otherwise).
+* :func:`std_ci` / :func:`sd_interval` -- chi-square interval of a standard deviation, exact for
+  Gaussian samples: ``(N - 1) s^2 / sigma^2 ~ chi2(N - 1)``; :func:`std_rel_se` its relative
+  standard error ``1 / sqrt(2 (N - 1))``.
+* :func:`binomial_ci` / :func:`share_ci` -- Wilson score interval of a proportion from its
+  counts (Wilson 1927), always inside [0, 1]; proportions never get a normal or jackknife
+  interval.
+* :func:`bootstrap_ci` -- percentile bootstrap over the trial axis (Efron 1979).
+* :func:`spread` / :func:`plate_p` -- the *one-plate* distribution: a paper's number is one
+  plate's statistic, the simulation gives its distribution over plates; the median, the
+  central ``level`` range (2.5-97.5 % at 95 %) and ``p``, the probability of a plate at least
+  as extreme as the paper's value (two-sided).
+
+``level`` is the two-sided confidence level, 0.95 throughout the suite (``LEVEL``).
 """
 
 from __future__ import annotations
@@ -14,40 +29,89 @@ from typing import Callable
 import numpy as np
 
 from sim.lsq import distributions as D
+from sim.mc.runner import MIN_CHUNKS
 
-__all__ = ["mean_ci", "std_ci", "sd_interval", "std_rel_se", "bootstrap_ci", "spread"]
+__all__ = [
+    "LEVEL",
+    "METHODS",
+    "MIN_CHUNKS",
+    "mean_ci",
+    "std_ci",
+    "sd_interval",
+    "std_rel_se",
+    "binomial_ci",
+    "share_ci",
+    "bootstrap_ci",
+    "spread",
+    "plate_p",
+]
+
+#: the two-sided confidence level of every interval in the suite
+LEVEL = 0.95
+
+#: each interval method in words: written into every claims.parquet's provenance
+METHODS = {
+    "mean": "Student-t interval of a mean over trials, m +- t(0.975, N-1) s/sqrt(N)",
+    "sd": "chi-square interval of a standard deviation, (N-1) s^2/sigma^2 ~ chi2(N-1)",
+    "share": "Wilson score interval of a proportion from its counts, inside [0, 1]",
+    "bootstrap": "percentile bootstrap over trials, 2.5-97.5 % of the resampled statistic",
+    "jackknife": (
+        f"delete-one-chunk jackknife over per-chunk sums, Student-t with C-1 degrees of "
+        f"freedom; computed only from C >= {MIN_CHUNKS} chunks (fewer are refused)"
+    ),
+    "spread": (
+        "one plate: median and 2.5-97.5 % range of the statistic over simulated plates; "
+        "p = 2 min(q, 1-q), q the share of plates at or below the paper's value "
+        "(ties count half)"
+    ),
+    "exact": "a deterministic computation: the interval is the value itself",
+}
 
 
-def mean_ci(x: np.ndarray, level: float = 0.95) -> tuple[float, tuple[float, float]]:
-    """Mean of ``x`` (1-D) and its normal-theory confidence interval."""
-    x = np.asarray(x, float)
+def _half(level: float) -> float:
+    """The lower tail ``(1 - level) / 2`` of a two-sided ``level`` interval."""
+    if not 0 < level < 1:
+        raise ValueError(f"level must lie in (0, 1), not {level!r}")
+    return (1 - level) / 2
+
+
+def mean_ci(x: np.ndarray, level: float = LEVEL) -> tuple[float, tuple[float, float]]:
+    """Mean of ``x`` (1-D, N >= 2) and its Student-t confidence interval."""
+    x = np.asarray(x)
+    if x.size < 2:
+        raise ValueError("a mean's interval needs at least 2 values")
     m = x.mean()
-    h = D.norm_ppf(0.5 + level / 2) * x.std(ddof=1) / math.sqrt(x.size)
+    h = D.t_ppf(1 - _half(level), x.size - 1) * x.std(ddof=1) / math.sqrt(x.size)
     return float(m), (float(m - h), float(m + h))
 
 
-def std_ci(x: np.ndarray, level: float = 0.95, axis: int = 0):
+def std_ci(x: np.ndarray, level: float = LEVEL, axis: int = 0):
     """Sample standard deviation along ``axis`` with its chi-square confidence interval.
 
     Exact for Gaussian samples: (N-1) s^2 / sigma^2 ~ chi2(N-1).
     Returns ``(s, lo, hi)`` with the shape of ``x`` less ``axis``.
     """
-    x = np.asarray(x, float)
+    x = np.asarray(x)
     n = x.shape[axis]
     s = x.std(axis=axis, ddof=1)
-    a = (1 - level) / 2
-    lo = s * np.sqrt((n - 1) / D.chi2_ppf(1 - a, n - 1))
-    hi = s * np.sqrt((n - 1) / D.chi2_ppf(a, n - 1))
-    return s, lo, hi
+    lo, hi = _sd_factors(n, level)
+    return s, s * lo, s * hi
 
 
-def sd_interval(s: float, n: int, level: float = 0.95) -> tuple[float, float]:
-    """Chi-square confidence interval of a standard deviation ``s`` from ``n`` Gaussian draws."""
-    a = (1 - level) / 2
+def _sd_factors(n: int, level: float) -> tuple[float, float]:
+    if n < 2:
+        raise ValueError("a standard deviation's interval needs at least 2 values")
+    a = _half(level)
     return (
-        float(s * np.sqrt((n - 1) / D.chi2_ppf(1 - a, n - 1))),
-        float(s * np.sqrt((n - 1) / D.chi2_ppf(a, n - 1))),
+        float(np.sqrt((n - 1) / D.chi2_ppf(1 - a, n - 1))),
+        float(np.sqrt((n - 1) / D.chi2_ppf(a, n - 1))),
     )
+
+
+def sd_interval(s: float, n: int, level: float = LEVEL) -> tuple[float, float]:
+    """Chi-square confidence interval of a standard deviation ``s`` from ``n`` Gaussian draws."""
+    lo, hi = _sd_factors(n, level)
+    return float(s * lo), float(s * hi)
 
 
 def std_rel_se(n: int) -> float:
@@ -55,12 +119,41 @@ def std_rel_se(n: int) -> float:
     return 1.0 / math.sqrt(2.0 * (n - 1))
 
 
+def binomial_ci(k, n, level: float = LEVEL):
+    """Proportion ``k / n`` and its Wilson score interval (no continuity correction).
+
+    ``k`` and ``n`` are counts (arrays broadcast); ``n >= 1``. Returns ``(p, lo, hi)``, each
+    inside [0, 1]; equal to ``scipy.stats.binomtest(k, n).proportion_ci(level, "wilson")``.
+    """
+    k, n = np.asarray(k), np.asarray(n)
+    if np.any(n < 1) or np.any(k < 0) or np.any(k > n):
+        raise ValueError("a proportion needs counts 0 <= k <= n and n >= 1")
+    z = float(D.norm_ppf(1 - _half(level)))
+    p = k / n
+    denom = 2 * (n + z * z)
+    centre = (2 * n * p + z * z) / denom
+    half = z * np.sqrt(4 * n * p * (1 - p) + z * z) / denom
+    # rounding can carry the bounds a few ulp outside [0, 1] (k = n = 16: 1 + 2e-16)
+    lo = np.maximum(centre - half, 0.0)  # pragma: no mutate -- not seen below 0 for n <= 3000
+    return p, lo, np.minimum(centre + half, 1.0)
+
+
+def share_ci(x: np.ndarray, level: float = LEVEL) -> tuple[float, tuple[float, float]]:
+    """Share of true values in ``x`` (0/1 or boolean, any shape) with its Wilson interval;
+    the same return shape as :func:`mean_ci`."""
+    x = np.asarray(x)
+    if x.size == 0 or not np.all((x == 0) | (x == 1)):
+        raise ValueError("a share needs a non-empty array of 0/1 values")
+    p, lo, hi = binomial_ci(int(np.count_nonzero(x)), x.size, level)
+    return float(p), (float(lo), float(hi))
+
+
 def bootstrap_ci(
     stat: Callable[[np.ndarray], float],
     data: np.ndarray,
     rng: np.random.Generator,
     n_boot: int = 400,
-    level: float = 0.95,
+    level: float = LEVEL,
 ) -> tuple[float, tuple[float, float]]:
     """Percentile bootstrap over the leading (trial) axis of ``data``.
 
@@ -73,14 +166,29 @@ def bootstrap_ci(
     reps = np.empty(n_boot)
     for b in range(n_boot):  # n_boot resamples, not a per-trial loop
         reps[b] = stat(data[rng.integers(0, n, n)])
-    a = (1 - level) / 2 * 100
+    a = _half(level) * 100
     lo, hi = np.percentile(reps, [a, 100 - a])
     return est, (float(lo), float(hi))
 
 
-def spread(x: np.ndarray, level: float = 0.95) -> tuple[float, tuple[float, float]]:
-    """Median of ``x`` and its central ``level`` range over trials."""
-    x = np.asarray(x, float)
-    a = (1 - level) / 2 * 100
+def spread(x: np.ndarray, level: float = LEVEL) -> tuple[float, tuple[float, float]]:
+    """Median of ``x`` and its central ``level`` range over trials (plates): the one-plate
+    distribution of a statistic. Linear interpolation between order statistics
+    (``numpy.percentile``'s default)."""
+    x = np.asarray(x)
+    if x.size == 0:
+        raise ValueError("a spread needs at least one value")
+    a = _half(level) * 100
     lo, med, hi = np.percentile(x, [a, 50, 100 - a])
     return float(med), (float(lo), float(hi))
+
+
+def plate_p(x: np.ndarray, ref: float) -> float:
+    """The probability of a simulated plate at least as extreme as the paper's value ``ref``:
+    ``p = 2 min(q, 1 - q)`` with ``q`` the share of plates below ``ref`` (a plate equal
+    to ``ref`` counts half)."""
+    x = np.asarray(x)
+    if x.size == 0:
+        raise ValueError("a one-plate p needs at least one plate")
+    q = (np.count_nonzero(x < ref) + 0.5 * np.count_nonzero(x == ref)) / x.size
+    return float(2 * min(q, 1 - q))  # at most 1: min(q, 1 - q) <= 1/2

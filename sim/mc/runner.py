@@ -46,8 +46,20 @@ from sim.mc.config import StudyError
 from sim.mc.progress import Progress
 from sim.mc.storage import atomic_path, config_hash
 
-__all__ = ["chunk_rng", "run_chunks", "ChunkStore", "make_executor", "jackknife", "require_finite"]
+__all__ = [
+    "chunk_rng",
+    "run_chunks",
+    "ChunkStore",
+    "make_executor",
+    "jackknife",
+    "require_finite",
+    "MIN_CHUNKS",
+]
 
+#: the fewest chunks a jackknife interval is computed from: with C chunks the interval's
+#: standard error has C - 1 degrees of freedom, and below about 20 it is itself too uncertain
+#: to decide a claim on (the issue-25 run of 2 chunks gave a proportion's interval [0.07, 0.07])
+MIN_CHUNKS = 20
 ROWS = "rows."
 _ARRAYS = b"sim.arrays"
 _IDENTITY = b"sim.chunk"  # a chunk file's identity, checked when it is read back
@@ -365,23 +377,32 @@ def run_chunks(
     }
 
 
-def jackknife(stat: Callable[[np.ndarray], np.ndarray], sums: np.ndarray, level: float = 0.95):
+def jackknife(
+    stat: Callable[[np.ndarray], np.ndarray],
+    sums: np.ndarray,
+    level: float = 0.95,
+    min_chunks: int = MIN_CHUNKS,
+):
     """Delete-one-chunk jackknife for a smooth function of per-chunk sums.
 
-    sums : (C, ...) per-chunk sufficient statistics (C >= 2, else StudyError); ``stat`` maps the total
-    (shape ``sums.shape[1:]``) to an estimate (scalar or array). Returns
-    ``(estimate, lo, hi)`` with a Student-t interval (C - 1 degrees of freedom) from the
-    jackknife standard error.
+    sums : (C, ...) per-chunk sufficient statistics; ``stat`` maps the total (shape
+    ``sums.shape[1:]``) to an estimate (scalar or array). Returns ``(estimate, lo, hi)`` with a
+    Student-t interval (C - 1 degrees of freedom) from the jackknife standard error
+    ``se^2 = (C - 1) / C * sum_c (theta_(c) - mean theta_(.))^2`` (Quenouille 1956, Tukey 1958).
+    The rule: an interval is computed only from ``C >= min_chunks`` chunks (``MIN_CHUNKS``,
+    20); fewer raise :class:`StudyError` naming the chunk size to use. Not for proportions:
+    those get :func:`sim.claims.intervals.binomial_ci` from their counts.
     Streaming-friendly: memory grows with the number of chunks, not of trials.
     """
     sums = np.asarray(sums, float)
     C = sums.shape[0]
+    if C < max(min_chunks, 2):
+        raise StudyError(
+            f"the jackknife interval needs at least {max(min_chunks, 2)} chunks, the run has "
+            f"{C}: make chunk at most trials/{max(min_chunks, 2)}"
+        )
     total = sums.sum(axis=0)
     est = np.asarray(stat(total), float)
-    if C < 2:
-        raise StudyError(
-            "the jackknife interval needs at least 2 chunks (make chunk smaller than trials)"
-        )
     loo = np.stack([np.asarray(stat(total - sums[c]), float) for c in range(C)])
     se = np.sqrt((C - 1) / C * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
     z = D.t_ppf(0.5 + level / 2, C - 1)

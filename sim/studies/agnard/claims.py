@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
+from sim.claims.intervals import spread
 from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import Block
 from sim.studies.agnard.schema import model_sigmas, pixel_ground_m
@@ -61,7 +62,7 @@ def table1_rows(book: ClaimBook, cfg: dict, sim: dict) -> list[dict]:
             )
             key = f"{w}_{c}_m"
             x = sim[f"without.{key}"]
-            lo, med, hi = np.percentile(100 * x, [2.5, 50, 97.5])
+            med, (lo, hi) = spread(100 * x)
             rows.append(
                 book.not_comparable(
                     f"agnard.table1.without_{key}",

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.intervals import mean_ci, std_ci
+from sim.claims.intervals import mean_ci, share_ci, std_ci
 from sim.instruments import transforms2d as t2
 from sim.lsq import distributions as D
 from sim.mc.config import StudyError
@@ -110,8 +110,8 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
             + f"/{np.mean(t > 2):.3f}.",
         )
     )
-    pr = res["passes_rw"].astype(float)
-    m, ci = mean_ci(pr)
+    pr = res["passes_rw"]
+    m, ci = share_ci(pr)
     add(
         book.score(
             "twoplate.weight_ratio.pass_after_reweighting",
@@ -310,7 +310,7 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
             ),
             ("wpost", f"{k}_cov_wpost_r{j_true}", "weighted, a-posteriori s0"),
         ):
-            m, ci = mean_ci(res[key].ravel().astype(float))
+            m, ci = share_ci(res[key])
             add(
                 book.score(
                     f"twoplate.beyond.coverage_{k}_{tag}",

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook, write_claims
+from sim.claims.intervals import binomial_ci
 from sim.lsq import distributions as D
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.runner import jackknife, run_chunks
@@ -120,9 +121,10 @@ def run(cfg: dict, out: Path, ctx) -> None:
     an_sig = np.sqrt(np.stack([an.cov[pts, 0, 0], an.cov[pts, 1, 1]], 1)).reshape(-1)
     s_mc, s_lo, s_hi = jackknife(sig, sums)
     ratio = jackknife(lambda t: np.atleast_1d(np.mean(sig(t) / an_sig)), sums)
-    cover = jackknife(lambda t: t[1 + 4 * k : 1 + 5 * k] / t[0], sums)
+    tot = sums.sum(axis=0)  # proportions: Wilson intervals from the counts, inside [0, 1]
+    cover = binomial_ci(tot[1 + 4 * k : 1 + 5 * k], tot[0])
     cover_mean = jackknife(lambda t: np.atleast_1d(np.mean(t[1 + 4 * k : 1 + 5 * k] / t[0])), sums)
-    alarm = jackknife(lambda t: np.atleast_1d(t[-1] / t[0]), sums)
+    alarm = binomial_ci(tot[-1:], tot[0])
 
     a95, b95, th = ellipse(an.cov[pts])
     extra = compare_points(net, cfg)
@@ -397,7 +399,10 @@ def _claims(out, prov, an, ratio, cover, alarm, cfg, n_tot, design) -> None:
         [],
         "<network self-checks>",
     )
-    note = f"{int(n_tot)} converged of {cfg['trials']} trials; jackknife CI over chunks"
+    note = (
+        f"{int(n_tot)} converged of {cfg['trials']} trials; sigma ratio: jackknife CI over "
+        "chunks, shares: Wilson interval from the counts"
+    )
     rows = [
         book.score(spec[0][0], ratio[0][0], (ratio[1][0], ratio[2][0]), note=note),
         book.score(spec[1][0], cover[0][0], (cover[1][0], cover[2][0]), note=note),

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.intervals import mean_ci, std_ci
+from sim.claims.intervals import share_ci, spread, std_ci
 from sim.instruments import transforms2d as t2
 from sim.studies.salsig import printed as pr
 
@@ -171,7 +171,7 @@ def score(cfg: dict, dec: dict, rec: dict, zs: dict, vt: dict) -> tuple[list[dic
         ("salsig.recovery.power_E", "detect_E", "E"),
         ("salsig.recovery.power_scale_diff", "detect_scale", "SY - SX"),
     ):
-        m, ci = mean_ci(rec[key].astype(float))
+        m, ci = share_ci(rec[key])
         add(
             book.score(
                 cid,
@@ -206,7 +206,7 @@ def score(cfg: dict, dec: dict, rec: dict, zs: dict, vt: dict) -> tuple[list[dic
             "error (span and error not printed); the truth is an input.",
         )
     )
-    m, sp = float(np.median(zs["se_S"] * 1e3)), tuple(np.percentile(zs["se_S"] * 1e3, [2.5, 97.5]))
+    m, sp = spread(zs["se_S"] * 1e3)
     add(
         book.score(
             "salsig.z_scale.se_S_um_per_digit",
@@ -235,7 +235,7 @@ def score(cfg: dict, dec: dict, rec: dict, zs: dict, vt: dict) -> tuple[list[dic
         ("salsig.vertical_halved.dramatic_horizontal", "xy"),
     ):
         x = vt[f"rms_{key}_before_um"] / vt[f"rms_{key}_after_um"]
-        lo, med, hi = np.percentile(x, [2.5, 50, 97.5])
+        med, (lo, hi) = spread(x)
         add(
             book.score(
                 cid,
@@ -249,7 +249,7 @@ def score(cfg: dict, dec: dict, rec: dict, zs: dict, vt: dict) -> tuple[list[dic
         )
     for tag in ("before", "after"):
         x = vt[f"rms_z_{tag}_um"]
-        lo, med, hi = np.percentile(x, [2.5, 50, 97.5])
+        med, (lo, hi) = spread(x)
         add(
             book.score(
                 f"salsig.vertical_halved.rms_z_{tag}_um",

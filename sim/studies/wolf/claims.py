@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.intervals import bootstrap_ci
+from sim.claims.intervals import bootstrap_ci, spread
 from sim.mc.runner import chunk_rng
 from sim.studies.wolf.tables import STATS, recomputation, summary
 
@@ -45,7 +45,7 @@ def stat_key(cid: str) -> str | None:
 
 
 def _spread(x) -> tuple[np.ndarray, np.ndarray]:
-    lo, hi = np.percentile(np.asarray(x, float), [2.5, 97.5])
+    _, (lo, hi) = spread(x)
     return np.array([lo]), np.array([hi])
 
 

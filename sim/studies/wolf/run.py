@@ -22,6 +22,7 @@ import numpy as np
 
 from sim.claims.book import ClaimBook, write_claims
 from sim.claims.book_region import region_rows, write_region
+from sim.claims.intervals import spread
 from sim.instruments.plotter import errorfields as ef
 from sim.mc.runner import chunk_rng, run_chunks
 from sim.mc.storage import provenance, write_table
@@ -42,8 +43,8 @@ def _summ(x):
     x = x[np.isfinite(x)]
     if x.size == 0:
         return np.nan, np.nan, np.nan
-    lo, med, hi = np.percentile(x, [2.5, 50, 97.5])
-    return float(med), float(lo), float(hi)
+    med, (lo, hi) = spread(x)
+    return med, lo, hi
 
 
 def sub_chunk(trials: int, chunk: int) -> int:
