@@ -9,11 +9,14 @@ stored, so the same code and config give byte-identical files.
 
 from __future__ import annotations
 
+import fcntl
+import hashlib
 import json
 import os
 import subprocess
 import sys
 from functools import lru_cache
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -21,13 +24,20 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.mc.codehash import NOT_STUDY_CODE, not_study_code  # code no study result depends on
+from sim.mc import tolerance
+from sim.mc.codehash import (  # NOT_STUDY_CODE: code no study result depends on
+    NOT_STUDY_CODE,
+    not_study_code,
+    study_code_hash,
+    study_files,
+)
 
 __all__ = [
     "provenance",
     "write_table",
     "read_table",
     "read_provenance",
+    "read_tolerances",
     "atomic_path",
     "read_record",
     "StageLock",
@@ -53,8 +63,6 @@ def git_commit(study: str | None = None) -> str:
             *(f":(exclude)sim/{f}" for f in NOT_STUDY_CODE),
         ]
     else:
-        from sim.mc.codehash import study_files
-
         paths = [p.relative_to(root).as_posix() for p in study_files(study)]
         paths += [f"studies/{study}.toml", "pyproject.toml"]
     try:
@@ -82,11 +90,7 @@ def git_commit(study: str | None = None) -> str:
 def code_hash(study: str | None = None) -> str:
     """sha256 of the code ``study`` depends on (:func:`sim.mc.codehash.study_code_hash`), or,
     without a study, of the library's source (every ``sim/**/*.py`` but the benchmark)."""
-    import hashlib
-
     if study is not None:
-        from sim.mc.codehash import study_code_hash
-
         return study_code_hash(study)
     root = Path(__file__).resolve().parents[1]
     h = hashlib.sha256()
@@ -101,8 +105,6 @@ def code_hash(study: str | None = None) -> str:
 def versions() -> dict[str, str]:
     """Versions of Python and of every package a result can depend on (``not installed`` for
     the optional ones: without numba the NumPy engine runs)."""
-    from importlib.metadata import PackageNotFoundError, version
-
     out = {"python": sys.version.split()[0]}
     for pkg in ("numpy", "scipy", "pyarrow", "matplotlib", "emcee", "numba", "tqdm"):
         try:
@@ -183,12 +185,20 @@ def check_finite_table(name: str, table: pa.Table) -> None:
 
 
 def write_table(
-    path: str | Path, columns: Mapping[str, Any] | pa.Table, prov: Mapping[str, Any]
+    path: str | Path,
+    columns: Mapping[str, Any] | pa.Table,
+    prov: Mapping[str, Any],
+    tolerances: Mapping[str, Mapping[str, Any]] | None = None,
 ) -> Path:
     """Write ``columns`` (name -> 1-D array/list, or a pyarrow Table) to Parquet.
 
+    ``tolerances``: column -> the rule by which ``make verify`` compares a re-run with it (the
+    kind of number it is, :mod:`sim.mc.tolerance`), stored in the schema metadata
+    (``sim.tolerances``); a column without one is compared by the default of its type.
+
     Raises :class:`NonFiniteError` (nothing written) for an infinite value in a float column
-    or a non-finite claim value or interval (see :func:`check_finite_table`)."""
+    or a non-finite claim value or interval (see :func:`check_finite_table`), ValueError for
+    a tolerance that names no column or is not a valid rule."""
     table = (
         columns
         if isinstance(columns, pa.Table)
@@ -199,6 +209,8 @@ def write_table(
     check_finite_table(Path(path).name, table)
     meta = dict(table.schema.metadata or {})
     meta[_KEY] = json.dumps(prov, sort_keys=True, default=_jsonable).encode()
+    if tolerances:
+        meta[tolerance.TOLERANCE_KEY] = tolerance.encode(tolerance.validate(tolerances, table))
     table = table.replace_schema_metadata(meta)
     with atomic_path(path) as tmp:
         pq.write_table(table, tmp, compression="zstd")
@@ -212,6 +224,11 @@ def read_table(path: str | Path) -> pa.Table:
 def read_provenance(path: str | Path) -> dict[str, Any]:
     meta = pq.read_schema(path).metadata or {}
     return json.loads(meta.get(_KEY, b"{}"))
+
+
+def read_tolerances(path: str | Path) -> dict[str, dict]:
+    """The tolerances declared with a table's columns ({} if none; :mod:`sim.mc.tolerance`)."""
+    return tolerance.decode(pq.read_schema(path).metadata)
 
 
 # --- the output directory: what the suite wrote, and who is writing it -----------------------
@@ -258,8 +275,6 @@ class StageLock:
         self.created = False
 
     def acquire(self) -> "StageLock":
-        import fcntl
-
         self.created = not self.stage.exists()
         self.stage.mkdir(parents=True, exist_ok=True)
         fd = os.open(self.stage / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
