@@ -5,8 +5,8 @@
 by column, the Parquet tables there with the committed ones, each column by the rule declared
 with it for the kind of number it holds (:mod:`sim.mc.tolerance`; docs/reproducibility.md):
 
-* ``exact`` (labels, counts, flags, and the ``verdict``, ``outcome`` and ``holds`` of every
-  claim): any change fails;
+* ``exact`` (labels, counts, flags, and every ``verdict``, ``outcome`` and ``holds`` column,
+  in any table): any change fails;
 * ``arithmetic``: within the bound from its conditioning, ``cond * eps`` relative plus ``atol``
   (the default for a number that declares nothing: 1e-7 relative plus 1e-9);
 * ``mc``: beyond that, a fraction of its Monte-Carlo standard error (from its row's interval);
@@ -113,7 +113,7 @@ def _specs(a: Path, b: Path) -> tuple[dict, dict]:
 def _spec(specs: dict, name: str, col: str, t: pa.DataType) -> dict | None:
     if col in specs:
         return specs[col]
-    if name == "claims.parquet" and col in VERDICT_COLUMNS:
+    if col in VERDICT_COLUMNS:  # a decision, in any table
         return tl.exact()
     return tl.default_for(t)
 
