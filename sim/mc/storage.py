@@ -13,6 +13,7 @@ import fcntl
 import hashlib
 import json
 import os
+import platform
 import subprocess
 import sys
 from functools import lru_cache
@@ -114,13 +115,23 @@ def versions() -> dict[str, str]:
     return out
 
 
+def numerics() -> dict[str, str]:
+    """The machine and numerical path a result was computed on (``make verify`` names both:
+    docs/reproducibility.md): system, CPU architecture, and ``OPENBLAS_CORETYPE`` and
+    ``SIM_NO_JIT`` where set."""
+    out = {"system": platform.system(), "machine": platform.machine()}
+    out.update({k: os.environ[k] for k in ("OPENBLAS_CORETYPE", "SIM_NO_JIT") if os.environ.get(k)})
+    return out
+
+
 def provenance(cfg: Mapping[str, Any], **extra: Any) -> dict[str, Any]:
-    """Provenance record for a run: resolved config, seed, versions, git commit."""
+    """Provenance record for a run: resolved config, seed, versions, machine, git commit."""
     return {
         "study": cfg.get("study"),
         "config": dict(cfg),
         "seed": cfg.get("seed"),
         "versions": versions(),
+        "numerics": numerics(),
         "git_commit": git_commit(cfg.get("study")),
         "code_hash": code_hash(cfg.get("study")),
         **extra,

@@ -430,6 +430,7 @@ def markdown(results: Path) -> str:
     ver = ", ".join(
         f"{k} {v}" for k, v in m.items() if k not in ("machine", "system", "processor", "cpus")
     )
+    made = _committed_on(Path(results))
     rows = [
         [
             r["study"],
@@ -451,7 +452,7 @@ def markdown(results: Path) -> str:
         f"bound of its conditioning for arithmetic (by default {DEFAULT_RTOL:g} relative); "
         "within a fraction of its Monte-Carlo standard error for a Monte-Carlo statistic and "
         "its Monte-Carlo interval for a chain's output; modulo the period for an angle. A "
-        "changed verdict fails.\n\n"
+        f"changed verdict fails. {made}\n\n"
         + md_table(
             [
                 "study",
@@ -466,6 +467,27 @@ def markdown(results: Path) -> str:
         )
         + "\n"
     )
+
+
+def _committed_on(results: Path) -> str:
+    """Which machine, numerical path and versions produced the committed results (from the
+    provenance of the studies' claims tables), as a sentence."""
+    seen = set()
+    for p in sorted(results.glob("*/claims.parquet")):
+        try:
+            prov = read_provenance(p)
+        except (OSError, pa.ArrowException, ValueError):
+            continue
+        n, v = prov.get("numerics") or {}, prov.get("versions") or {}
+        where = (
+            " ".join(str(n[k]) for k in ("system", "machine") if k in n) or "an unrecorded machine"
+        )
+        path = ", ".join(f"{k}={n[k]}" for k in ("OPENBLAS_CORETYPE", "SIM_NO_JIT") if k in n)
+        ver = ", ".join(f"{k} {x}" for k, x in sorted(v.items()))
+        seen.add(f"{where}{f' ({path})' if path else ''} with {ver}" if ver else where)
+    if not seen:
+        return ""
+    return "The committed results were made on " + "; and on ".join(sorted(seen)) + "."
 
 
 # --- command line -----------------------------------------------------------------------------

@@ -8,7 +8,9 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import write_claims
+from sim.instruments import transforms2d as t2
 from sim.lsq import distributions as D
+from sim.mc import tolerance as tl
 from sim.mc.runner import chunk_rng, run_chunks
 from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import start_figures
@@ -23,6 +25,13 @@ from sim.studies.salsig.model import (
     vertical_chunk,
 )
 from sim.studies.salsig.sweep import run_sweep
+
+#: ``make verify`` (:mod:`sim.mc.tolerance`): E and SX - SY are small differences of numbers of
+#: order pi and 12.7, so their rounding is absolute: 1e3 eps of what they are computed from
+RECOVERY_TOLERANCES = {
+    "E_arcsec": tl.arithmetic(atol=1e3 * tl.EPS * np.pi / t2.ARCSEC),
+    "scale_diff_ppm": tl.arithmetic(atol=1e3 * tl.EPS * 1e6),
+}
 
 
 def run(cfg: dict, out: Path, ctx: RunContext) -> None:
@@ -39,7 +48,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         quiet=ctx.quiet,
         ctx=ctx,
     )
-    write_table(out / "trials_recovery.parquet", rec, prov)
+    write_table(out / "trials_recovery.parquet", rec, prov, RECOVERY_TOLERANCES)
     sw = {
         k: []
         for k in (
