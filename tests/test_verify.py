@@ -197,6 +197,15 @@ def test_scratch_keeps_what_the_suite_did_not_write(capsys, tmp_path, two_runs):
     mine.write_text("mine")
     line = _one_line(capsys, ["--results", str(results), "--scratch", str(scratch)], 2)
     assert "not a results directory of the suite" in line and mine.read_text() == "mine"
+    # an earlier re-run (its run.json) with the user's note in it: refused too, note kept
+    shutil.copytree(two_runs / "rerun", scratch / "brown_table1", dirs_exist_ok=True)
+    line = _one_line(capsys, ["--results", str(results), "--scratch", str(scratch)], 2)
+    assert "'notes.txt', which the suite did not write" in line and mine.read_text() == "mine"
+    # without it, the earlier re-run is replaced (the same 40 trials: every column compared)
+    mine.unlink()
+    argv = ["--results", str(results), "--scratch", str(scratch), "--trials", "40"]
+    assert verify_main([*argv, "--set", "chunk=20", "--study", "brown_table1"]) == 0
+    assert "brown_table1: ok" in capsys.readouterr().out
 
 
 # --- another machine inside CI ----------------------------------------------------------------

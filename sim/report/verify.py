@@ -338,11 +338,26 @@ def _target(scratch: Path, name: str) -> tuple[Path, bool]:
     if not target.exists() and not target.is_symlink():
         return target, False
     if target.is_dir() and not target.is_symlink() and read_record(target) is not None:
+        foreign = [p.name for p in target.iterdir() if not _ours(p)]
+        if foreign:
+            raise VerifyError(
+                f"--scratch: {target} holds {foreign[0]!r}, which the suite did not write: "
+                "refusing to replace it"
+            )
         return target, True
     raise VerifyError(
         f"--scratch: {target} exists and is not a results directory of the suite "
         "(no run.json): refusing to replace it"
     )
+
+
+def _ours(p: Path) -> bool:
+    """A file or directory a study run writes into its results directory."""
+    if p.is_symlink():
+        return False
+    if p.is_dir():
+        return p.name in ("trials", "cells")
+    return p.name == "run.json" or p.suffix in (".parquet", ".png", ".xml")
 
 
 def rerun_study(
