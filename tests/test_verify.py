@@ -11,17 +11,23 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+import sim
 from sim.cli import main
+from sim.instruments import transforms2d as t2
+from sim.instruments.ranges import positions as po
 from sim.mc import tolerance as tl
 from sim.mc.codehash import is_current
 from sim.mc.storage import write_table
 from sim.report.verify import compare_dirs, markdown, verify, write_record
 from sim.report.verify import main as verify_main
 from sim.studies import MODULES
+from sim.studies.design import external as ex
+from sim.studies.design.cells import pareto_front
 
 ROOT = Path(__file__).resolve().parent.parent
 BROWN = ROOT / "studies" / "brown_table1.toml"
@@ -268,3 +274,57 @@ def test_fewer_trials_elsewhere_agree_with_the_committed_results(study, tmp_path
     assert c.ok, c.failures
     assert c.files >= 3 and not any("claims.parquet" in n for n in c.not_compared)
     assert 0 < c.max_ratio <= 1  # Monte-Carlo values were compared, within their errors
+
+
+# --- no result that flips on the last bit -----------------------------------------------------
+
+
+def test_design_plates_do_not_turn_with_the_last_bits(monkeypatch):
+    """brown_design's Gaussian plates: a last-bit change of the covariance (as another BLAS
+    kernel leaves) moves the plates' rms by rounding only; drawn along the eigenvectors of the
+    symmetric grid's repeated eigenvalues, it moved them by a percent."""
+    cfg = sim.load(ROOT / "studies" / "brown_design.toml", **{"unprinted.plates": 400}).config
+    sr, grid = ex.range_sigma_um(cfg), cfg["zeiss.grid_sigma_um"]
+    off = cfg["paper.offset_mm"]
+
+    def zeiss():  # the Zeiss comparison at beta 0 (a sweep value): plates plus the grid's error
+        return np.concatenate(
+            [
+                ex.plate_rms(cfg, ex.zeiss_points(cfg, h), off, 0.0, sr, grid, 92)[1]
+                for h in (60, 80)
+            ]
+        )
+
+    base = zeiss()
+    F0 = po.full_point_covariance
+    rng = np.random.default_rng(27)
+
+    def nudged(*a, **k):
+        F = F0(*a, **k)
+        d = rng.uniform(-4, 4, F.shape) * np.finfo(float).eps
+        return F * (1 + (d + np.swapaxes(d, -1, -2)) / 2)
+
+    monkeypatch.setattr(po, "full_point_covariance", nudged)
+    np.testing.assert_allclose(zeiss(), base, rtol=1e-9)
+
+
+def test_salsig_sd_e_keeps_its_digits():
+    """Salsig's sd of E from the analytic Jacobian: a last-bit change of the fitted parameters
+    moves it by rounding only (the central difference it replaced moved it by ~1e-7)."""
+    rng = np.random.default_rng(2)
+    p = t2.affine_from_columns(0.0127, 0.012702, -59.2 * t2.ARCSEC, 0.01, (-115.0, -118.0))
+    p = p + rng.normal(0, 1e-9, (200, 6))
+    cov = np.broadcast_to(np.diag([1e-16, 1e-16, 1e-9, 1e-16, 1e-16, 1e-9]), (200, 6, 6))
+    a = np.sqrt(t2.inverse_decomposition(p, cov)["cov"][:, 2, 2])
+    q = p * (1 + rng.uniform(-2, 2, p.shape) * np.finfo(float).eps)
+    b = np.sqrt(t2.inverse_decomposition(q, cov)["cov"][:, 2, 2])
+    np.testing.assert_allclose(b, a, rtol=1e-12)
+
+
+def test_pareto_ties_are_not_decided_by_the_last_bit():
+    cost = np.array([60.0, 60.0, 90.0])
+    ok = np.ones(3, bool)
+    for d in (1e-15, -1e-15):  # two designs equal but for rounding: both on the front
+        acc = np.array([1.0, 1.0 + d, 0.9])
+        assert pareto_front(cost, acc, ok).tolist() == [True, True, True]
+    assert pareto_front(cost, np.array([1.0, 1.001, 0.9]), ok).tolist() == [True, False, True]
