@@ -203,6 +203,10 @@ def test_scratch_keeps_what_the_suite_did_not_write(capsys, tmp_path, two_runs):
     mine.write_text("mine")
     line = _one_line(capsys, ["--results", str(results), "--scratch", str(scratch)], 2)
     assert "not a results directory of the suite" in line and mine.read_text() == "mine"
+    before = sorted(p.name for p in (results / "brown_table1").iterdir())
+    line = _one_line(capsys, ["--results", str(results), "--scratch", str(results)], 2)
+    assert "inside) the committed results" in line
+    assert sorted(p.name for p in (results / "brown_table1").iterdir()) == before
     # an earlier re-run (its run.json) with the user's note in it: refused too, note kept
     shutil.copytree(two_runs / "rerun", scratch / "brown_table1", dirs_exist_ok=True)
     line = _one_line(capsys, ["--results", str(results), "--scratch", str(scratch)], 2)

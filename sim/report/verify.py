@@ -393,6 +393,10 @@ def verify(
     if scratch.exists() and not scratch.is_dir():
         raise VerifyError(f"--scratch: {scratch} is not a directory")
     todo = study_dirs(results, only)
+    if scratch.resolve() == Path(results).resolve() or Path(results).resolve() in (
+        scratch.resolve().parents
+    ):
+        raise VerifyError(f"--scratch: {scratch} is (inside) the committed results {results}")
     # every target checked before anything runs: a foreign directory stops it at once
     replace = {d: _target(scratch, d.name)[1] for d, _ in todo} if rerun else {}
     out = []
