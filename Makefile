@@ -65,8 +65,11 @@ rerun: $(STAMP) ## re-run every study even if its results are up to date, then t
 	$(PY) -m sim.batch --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
-verify: $(STAMP) ## re-run every study into a scratch directory and compare with results/ (tolerances per column)
-	$(PY) -m sim.report.verify --results results --workers 2
+# VERIFY_FLAGS: e.g. "--study brown_table1", "--scratch DIR" (see python -m sim.report.verify -h)
+VERIFY_FLAGS ?=
+
+verify: $(STAMP) ## re-run every study into a scratch directory and compare with results/ (a rule per kind of column; VERIFY_FLAGS)
+	$(PY) -m sim.report.verify --results results --workers 2 $(VERIFY_FLAGS)
 	$(PY) -m sim report --results results
 
 report: $(STAMP) ## rebuild results/REPORT.md from the Parquet files alone

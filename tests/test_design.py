@@ -16,7 +16,7 @@ from sim.instruments.ranges import positions as po
 from sim.lsq import datum as dm
 from sim.mc.config import ConfigError, validate
 from sim.mc.runner import run_chunks
-from sim.mc.storage import read_provenance, read_table
+from sim.mc.storage import read_provenance, read_table, read_tolerances
 from sim.mc.sweep import cell_seed, expand, run_adaptive
 from sim.studies import design
 
@@ -291,8 +291,9 @@ def test_tiny_run_end_to_end(tmp_path):
     assert all(V[c] == "self-check" for c in V if c.startswith("bayes.brown_agreement."))
     assert V["brown.calibration.scale_combined_um"] == "holds"  # a paper-check
     assert not any(v is None for v in cl["verdict"])
-    tol = read_provenance(out / "claims.parquet")["tolerances"]
-    assert 0 < tol["bayes.parquet"]["ratio"] < 0.5 and "value" in tol["claims.parquet"]
+    tol = read_tolerances(out / "bayes.parquet")["ratio"]  # chain output: its MC interval
+    assert tol["kind"] == "chain" and 0 < tol["rtol"] < 0.5
+    assert read_tolerances(out / "claims.parquet")["value"]["kind"] == "mc"
     # the tolerances and external comparisons are decided over the region, not at a nominal
     cr = read_table(out / "consistent_region.parquet").to_pydict()
     ins = read_table(out / "region_inputs.parquet").to_pylist()

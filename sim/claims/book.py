@@ -62,6 +62,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from sim.claims.intervals import LEVEL, METHODS, MIN_CHUNKS, plate_p, spread
+from sim.mc import tolerance as tl
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.storage import write_table
 
@@ -116,6 +117,17 @@ CLAIM_COLUMNS = [
     "note",
 ]
 NOT_REPRODUCED_COLUMNS = ["source", "printed", "why"]
+#: how ``make verify`` compares ``claims.parquet`` (:mod:`sim.mc.tolerance`): the claim book's
+#: columns exactly, also against a run with fewer trials; a value and its interval as a
+#: Monte-Carlo statistic whose standard error its own row's 95 % interval gives (an exact row's
+#: interval is its value: the arithmetic bound); a decision never changes
+CLAIM_TOLERANCES = {
+    **{c: tl.exact(analytic=True) for c in ("claim", "form", "kind", "headline", "interval")},
+    **{c: tl.arithmetic(analytic=True) for c in ("ref_low", "ref_high", "tol")},
+    **{c: tl.arithmetic(analytic=True) for c in ("zone_low", "zone_high")},
+    **{c: tl.mc(ci=("ci_low", "ci_high")) for c in ("value", "value_high", "ci_low", "ci_high")},
+    **{c: tl.exact() for c in ("outcome", "verdict", "holds")},
+}
 
 _SPEC_KEYS = {"id", "source", "paper", "form", "ref", "decimals", "tol", "kind", "headline", "why"}
 
@@ -450,7 +462,9 @@ def write_claims(
             prov,
         )
     cols = {c: [_null(r[c]) for r in rows] for c in CLAIM_COLUMNS}
-    return write_table(path, cols, {**prov, "intervals": interval_provenance()})
+    return write_table(
+        path, cols, {**prov, "intervals": interval_provenance()}, tolerances=CLAIM_TOLERANCES
+    )
 
 
 def interval_provenance() -> dict[str, Any]:

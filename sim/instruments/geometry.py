@@ -401,26 +401,36 @@ def invert_affine(params) -> np.ndarray:
     return np.stack([ia, ib, -(ia * c + ib * f), id_, ie, -(id_ * c + ie * f)], -1)
 
 
-def inverse_decomposition(params, cov, h: float = 1e-7) -> dict[str, np.ndarray]:
+def inverse_decomposition(params, cov) -> dict[str, np.ndarray]:
     """Seed 002's ``(SX, SY, E)`` of the *inverse* of a fitted affine, with covariance.
 
     Salsig's program fits the observed system ``X2`` as the function of the control ``X1``
     (residuals ``VX2``, ``VY2`` in ``X2`` units) and prints the parameters of
     ``X1 = A X2 + B Y2 + C``. ``params``/``cov`` (T, 6)/(T, 6, 6) are those of the fitted
-    direction ``X2 = f(X1)``; the Jacobian of inversion + decomposition is taken by central
-    differences (relative step ``h``).
+    direction ``X2 = f(X1)``. The Jacobian of inversion and decomposition is analytic: with
+    ``N = M^-1`` of the linear part ``M``, ``dN = -N dM N``, chained with the decomposition's
+    own Jacobian (the translation does not enter ``SX, SY, E``). A central difference, as
+    before, lost about seven digits to rounding in ``E``'s (issue 27: ``sd_E_arcsec`` moved by
+    3e-7 relative with the BLAS kernel).
     """
     p = np.asarray(params, float)
-    base = decompose_columns(invert_affine(p))
+    inv = invert_affine(p)
+    base = decompose_columns(inv)
+    A, B, D, E = inv[..., 0], inv[..., 1], inv[..., 3], inv[..., 4]
+    sx, sy = base["SX"], base["SY"]
+    # d(SX, SY, E) / d(A, B, D, E) of the inverse (as in decompose_columns)
+    Jd = np.zeros(p.shape[:-1] + (3, 4))
+    Jd[..., 0, 0], Jd[..., 0, 2] = A / sx, D / sx
+    Jd[..., 1, 1], Jd[..., 1, 3] = B / sy, E / sy
+    Jd[..., 2, 0], Jd[..., 2, 2] = -D / sx**2, A / sx**2
+    Jd[..., 2, 1], Jd[..., 2, 3] = E / sy**2, -B / sy**2
+    # d N_ij / d M_kl = -N_ik N_lj, with (A, B, D, E) = N_00, N_01, N_10, N_11 and the
+    # fitted a, b, d, e = M_00, M_01, M_10, M_11 at params 0, 1, 3, 4
+    N = np.stack([np.stack([A, B], -1), np.stack([D, E], -1)], -2)  # (..., 2, 2)
+    dN = -np.einsum("...ik,...lj->...ijkl", N, N).reshape(p.shape[:-1] + (4, 4))
     J = np.zeros(p.shape[:-1] + (3, 6))
-    for i in range(6):
-        step = h * np.maximum(np.abs(p[..., i]), 1e-3)
-        dp = np.zeros_like(p)
-        dp[..., i] = step
-        hi, lo = decompose_columns(invert_affine(p + dp)), decompose_columns(invert_affine(p - dp))
-        for j, k in enumerate(("SX", "SY", "E")):
-            J[..., j, i] = (hi[k] - lo[k]) / (2 * step)
-    base["params"] = invert_affine(p)
+    J[..., [0, 1, 3, 4]] = Jd @ dN
+    base["params"] = inv
     base["cov"] = propagate(J, cov)
     return base
 

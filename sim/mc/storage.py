@@ -9,12 +9,15 @@ stored, so the same code and config give byte-identical files.
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import os
+import platform
 import subprocess
 import sys
 from functools import lru_cache
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -22,6 +25,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from sim.mc import tolerance
 from sim.mc.codehash import (  # code no study result depends on
     NOT_STUDY_CODE,
     not_study_code,
@@ -34,6 +38,7 @@ __all__ = [
     "write_table",
     "read_table",
     "read_provenance",
+    "read_tolerances",
     "atomic_path",
     "read_record",
     "StageLock",
@@ -101,8 +106,6 @@ def code_hash(study: str | None = None) -> str:
 def versions() -> dict[str, str]:
     """Versions of Python and of every package a result can depend on (``not installed`` for
     the optional ones: without numba the NumPy engine runs)."""
-    from importlib.metadata import PackageNotFoundError, version
-
     out = {"python": sys.version.split()[0]}
     for pkg in ("numpy", "scipy", "pyarrow", "matplotlib", "emcee", "numba", "tqdm"):
         try:
@@ -119,13 +122,23 @@ def config_hash(config: Mapping[str, Any] | None, code: str | None = None) -> st
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
+def numerics() -> dict[str, str]:
+    """The machine and numerical path a result was computed on (``make verify`` names both:
+    docs/reproducibility.md): system, CPU architecture, and ``OPENBLAS_CORETYPE`` and
+    ``SIM_NO_JIT`` where set."""
+    out = {"system": platform.system(), "machine": platform.machine()}
+    out.update({k: os.environ[k] for k in ("OPENBLAS_CORETYPE", "SIM_NO_JIT") if os.environ.get(k)})
+    return out
+
+
 def provenance(cfg: Mapping[str, Any], **extra: Any) -> dict[str, Any]:
-    """Provenance record for a run: resolved config, seed, versions, git commit."""
+    """Provenance record for a run: resolved config, seed, versions, machine, git commit."""
     return {
         "study": cfg.get("study"),
         "config": dict(cfg),
         "seed": cfg.get("seed"),
         "versions": versions(),
+        "numerics": numerics(),
         "git_commit": git_commit(cfg.get("study")),
         "code_hash": code_hash(cfg.get("study")),
         **extra,
@@ -190,12 +203,20 @@ def check_finite_table(name: str, table: pa.Table) -> None:
 
 
 def write_table(
-    path: str | Path, columns: Mapping[str, Any] | pa.Table, prov: Mapping[str, Any]
+    path: str | Path,
+    columns: Mapping[str, Any] | pa.Table,
+    prov: Mapping[str, Any],
+    tolerances: Mapping[str, Mapping[str, Any]] | None = None,
 ) -> Path:
     """Write ``columns`` (name -> 1-D array/list, or a pyarrow Table) to Parquet.
 
+    ``tolerances``: column -> the rule by which ``make verify`` compares a re-run with it (the
+    kind of number it is, :mod:`sim.mc.tolerance`), stored in the schema metadata
+    (``sim.tolerances``); a column without one is compared by the default of its type.
+
     Raises :class:`NonFiniteError` (nothing written) for an infinite value in a float column
-    or a non-finite claim value or interval (see :func:`check_finite_table`)."""
+    or a non-finite claim value or interval (see :func:`check_finite_table`), ValueError for
+    a tolerance that names no column or is not a valid rule."""
     table = (
         columns
         if isinstance(columns, pa.Table)
@@ -206,6 +227,8 @@ def write_table(
     check_finite_table(Path(path).name, table)
     meta = dict(table.schema.metadata or {})
     meta[_KEY] = json.dumps(prov, sort_keys=True, default=_jsonable).encode()
+    if tolerances:
+        meta[tolerance.TOLERANCE_KEY] = tolerance.encode(tolerance.validate(tolerances, table))
     table = table.replace_schema_metadata(meta)
     with atomic_path(path) as tmp:
         pq.write_table(table, tmp, compression="zstd")
@@ -219,6 +242,11 @@ def read_table(path: str | Path) -> pa.Table:
 def read_provenance(path: str | Path) -> dict[str, Any]:
     meta = pq.read_schema(path).metadata or {}
     return json.loads(meta.get(_KEY, b"{}"))
+
+
+def read_tolerances(path: str | Path) -> dict[str, dict]:
+    """The tolerances declared with a table's columns ({} if none; :mod:`sim.mc.tolerance`)."""
+    return tolerance.decode(pq.read_schema(path).metadata)
 
 
 # --- the output directory: what the suite wrote, and who is writing it -----------------------
@@ -265,8 +293,6 @@ class StageLock:
         self.created = False
 
     def acquire(self) -> "StageLock":
-        import fcntl
-
         self.created = not self.stage.exists()
         self.stage.mkdir(parents=True, exist_ok=True)
         fd = os.open(self.stage / LOCK, os.O_RDWR | os.O_CREAT, 0o644)

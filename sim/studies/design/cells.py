@@ -183,13 +183,23 @@ def design_cells(cfg: dict) -> dict:
     return cols
 
 
+#: accuracies within this relative difference are a tie in the Pareto front: designs that are
+#: equal but for rounding (symmetric layouts) must not dominate each other by their last bits
+TIE_RTOL = 1e-9
+
+
 def pareto_front(cost: np.ndarray, acc: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """Feasible cells not dominated in (cost, acc), both to be minimised."""
+    """Feasible cells not dominated in (cost, acc), both to be minimised; costs within 1e-9
+    min and accuracies within :data:`TIE_RTOL` relative count as equal."""
     c, a = np.where(ok, cost, np.inf), np.where(ok, acc, np.inf)
+    ci, cj, ai, aj = c[:, None], c[None, :], a[:, None], a[None, :]
+    with np.errstate(invalid="ignore"):  # inf - inf of two infeasible cells: not a tie
+        same_a = np.abs(aj - ai) <= TIE_RTOL * np.maximum(np.abs(ai), np.abs(aj))
+        same_c = np.abs(cj - ci) <= 1e-9
     dom = (
-        (c[None, :] <= c[:, None])
-        & (a[None, :] <= a[:, None])
-        & ((c[None, :] < c[:, None]) | (a[None, :] < a[:, None]))
+        ((cj <= ci) | same_c)
+        & ((aj <= ai) | same_a)
+        & (((cj < ci) & ~same_c) | ((aj < ai) & ~same_a))
     )
     return ok & ~dom.any(axis=1)
 

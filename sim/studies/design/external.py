@@ -15,10 +15,12 @@ calibrated points):
   cofactor (:func:`sim.instruments.ranges.positions.full_point_covariance`), ``S`` the rigid-fit projector and
   ``sigma`` the range sigma (Table 1's model: double settings of 1.7 um and 1.1 um of random
   comparator error); the Zeiss comparison adds the grid's 0.8 um per coordinate. The plates
-  are drawn along the eigenvectors of ``S F S^T``, which within a (nearly) repeated
-  eigenvalue turn with the last bits of ``F``: a rounding change of ``F`` would redraw a
-  plate (the same distribution, another sample), so ``F`` comes from the dense reference
-  route of the engine, bit for bit as before.
+  are drawn as ``z R`` with ``R`` the symmetric square root of ``S F S^T`` (unique, and a
+  continuous function of ``F``). Drawn along its eigenvectors instead, as before, a plate
+  turned with the last bits of ``F`` within the repeated eigenvalues of the symmetric grid:
+  another BLAS kernel redrew the plates and moved the spread of the plates' rms by a percent
+  (issue 27). The rigid fit's three null eigenvalues (rounding, about 1e-17 of the largest)
+  are set to zero; the smallest real one is about 4e-2 of the largest.
 """
 
 from __future__ import annotations
@@ -87,6 +89,10 @@ def zeiss_points(cfg: dict, half_extent_mm: float) -> np.ndarray:
     return lat[np.sort(order[: cfg["zeiss.points"]])]
 
 
+#: eigenvalues of ``S F S^T`` below this share of the largest are the rigid fit's null space
+NULL_EIGENVALUE = 1e-9
+
+
 def range_sigma_um(cfg: dict) -> float:
     """Table 1's model: the mean of the paper's settings plus the random comparator error."""
     return float(
@@ -104,15 +110,16 @@ def plate_rms(
     all points: without and with ``extra_um`` of independent per-coordinate error (a reference
     grid's) added before the fit."""
     th = _theta(cfg, offset, beta)
-    with np.errstate(invalid="ignore"):  # dense: the plates below depend on F's last bits
+    with np.errstate(invalid="ignore"):  # the dense reference route of the engine
         F = po.full_point_covariance(pts[None], th[None], "pivot", "inner", dense=True)[0]
     S = dm.s_matrix(dm.null_basis(pts))
     C = S @ F @ S.T * sr_um**2
     w, V = np.linalg.eigh((C + C.T) / 2)
-    w = np.clip(w, 0.0, None)
+    w = np.where(w > NULL_EIGENVALUE * w.max(), w, 0.0)  # the rigid fit's null space: zero
+    R = (V * np.sqrt(w)) @ V.T  # symmetric square root: does not turn with F's last bits
     rng = chunk_rng(cfg["seed"], part, 0)
     z = rng.standard_normal((cfg["unprinted.plates"], len(w)))
-    e = (z * np.sqrt(w)) @ V.T
+    e = z @ R
     g = e + rng.normal(0.0, extra_um, e.shape) @ S.T
     return np.sqrt((e**2).mean(1)), np.sqrt((g**2).mean(1))
 

@@ -17,6 +17,7 @@ from sim.claims.book import write_claims
 from sim.claims.intervals import bootstrap_ci
 from sim.instruments.ranges import positions as po
 from sim.lsq import datum as dm
+from sim.mc import tolerance as tl
 from sim.mc.runner import chunk_rng, run_chunks
 from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import start_figures
@@ -145,26 +146,24 @@ def _mc_check(cfg, pts, th, sr, ctx):
 
 
 def _tolerances(R: dict) -> dict:
-    """Relative tolerances for ``make verify`` (issue 11.6): Monte-Carlo-error sized for the
-    columns of MCMC chains; deterministic columns need none."""
+    """How ``make verify`` compares the emcee tables (:mod:`sim.mc.tolerance`): chain output
+    within its Monte-Carlo interval, a relative half-width from the chains' own standard
+    errors; the claims' values are compared by their rows' intervals (``claims.parquet``)."""
     by = R["bayes"]
     rel = max(4 * se / v for v, se, _, _ in by["ratio"].values())
     v, se, _, _ = by["max_corr_diff"]
-    tol = {
-        "bayes.parquet": {
-            "post_mean": 1e-3,
-            "post_sigma_mm": rel,
-            "ratio": rel,
-            "ratio_se": 0.5,
-            "ratio_chain_spread": 1.0,
-            "tau_steps": 0.5,
-            "n_eff": 0.5,
-            "acceptance": 0.05,
-            "max_abs_corr_diff": 4 * se / max(v, 1e-12),
-        },
-        "claims.parquet": {},
+    bay = {
+        "post_mean": 1e-3,
+        "post_sigma_mm": rel,
+        "ratio": rel,
+        "ratio_se": 0.5,
+        "ratio_chain_spread": 1.0,
+        "tau_steps": 0.5,
+        "n_eff": 0.5,
+        "acceptance": 0.05,
+        "max_abs_corr_diff": 4 * se / max(v, 1e-12),
     }
-    claim_rel = max(rel, 4 * se / max(v, 1e-12))
+    tol = {"bayes.parquet": bay}
     tp = R.get("twoplate")
     if tp is not None:
         f = tp["prior"].index("flat")
@@ -182,10 +181,7 @@ def _tolerances(R: dict) -> dict:
                 "sigma_g_median_um": q_rel,
             }
         )
-        j = tp["prior"].index("certificate")
-        claim_rel = max(claim_rel, w_rel, float(np.expm1(4 * np.log(10) * tp["log10_q_se"][j])))
-    tol["claims.parquet"] = {c: claim_rel for c in ("value", "value_high", "ci_low", "ci_high")}
-    return tol
+    return {f: {c: tl.chain(rtol=r) for c, r in t.items()} for f, t in tol.items()}
 
 
 def _unbounded_as_null(row: dict) -> dict:
@@ -291,14 +287,14 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         cfg["budget.pitch_mm"],
     )
     rows = [_unbounded_as_null(r) for r in region_rows + score_all(book, cfg, R)]
-    prov_t = provenance(cfg, tolerances=_tolerances(R))
-    write_table(out / "bayes.parquet", bycols, prov_t)
+    tols = _tolerances(R)
+    write_table(out / "bayes.parquet", bycols, prov, tols["bayes.parquet"])
     if tcols is not None:
-        write_table(out / "bayes_twoplate.parquet", tcols, prov_t)
+        write_table(out / "bayes_twoplate.parquet", tcols, prov, tols["bayes_twoplate.parquet"])
     else:
         print(f"brown_design: bayes.twoplate_ratio skipped: {why}")
     write_table(out / "consistent_region.parquet", region_table, prov)
     write_table(out / "region_inputs.parquet", region_inputs, prov)
-    write_claims(out / "claims.parquet", rows, prov_t, book)
+    write_claims(out / "claims.parquet", rows, prov, book)
     for wait in drawn:
         wait()

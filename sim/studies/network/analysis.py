@@ -188,6 +188,28 @@ def ellipse(cov: np.ndarray):
     )
 
 
+#: an ellipse whose semi-axes differ by less than this share is a circle: its bearing is not
+#: defined (rounding alone would pick one), and stored as null with that reason
+CIRCLE_RTOL = 1e-6
+
+
+def bearing_deg(cov: np.ndarray) -> tuple[list, list[str]]:
+    """Bearing of the 1-sigma ellipse's major axis of ``(n, 2, 2)`` covariances, in degrees
+    from +x in ``(-90, 90]`` (an axis: compared modulo 180), and per point why it is None
+    (undefined): a circle (``(a - b) / a < CIRCLE_RTOL``) or a point without variance."""
+    sxx, syy, sxy = cov[:, 0, 0], cov[:, 1, 1], cov[:, 0, 1]
+    h, g = (sxx + syy) / 2, np.hypot((sxx - syy) / 2, sxy)
+    th = np.degrees(0.5 * np.arctan2(2 * sxy, sxx - syy))
+    th = np.where(th <= -90.0, th + 180.0, th)
+    why = [
+        "no variance"
+        if hh <= 0
+        else (f"a circle to {CIRCLE_RTOL:g}: no major axis" if gg <= CIRCLE_RTOL * hh else "")
+        for hh, gg in zip(h, g)
+    ]
+    return [None if w else float(t) for t, w in zip(th, why)], why
+
+
 def mc_chunk(
     rng: np.random.Generator,
     n: int,

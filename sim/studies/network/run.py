@@ -20,6 +20,7 @@ import numpy as np
 from sim.claims.book import ClaimBook, write_claims
 from sim.claims.intervals import binomial_ci
 from sim.lsq import distributions as D
+from sim.mc import tolerance as tol
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.runner import jackknife, run_chunks
 from sim.mc.storage import provenance, write_table
@@ -27,6 +28,7 @@ from sim.report.figure_jobs import draw_figures
 from sim.studies.network.analysis import (
     CHI2_2_95,
     analyse,
+    bearing_deg,
     ellipse,
     estimated_points,
     in_datum,
@@ -41,6 +43,24 @@ from sim.studies.network.model import datum
 __all__ = ["run", "compare_points"]
 
 K95 = float(np.sqrt(CHI2_2_95))
+
+
+_A = tol.arithmetic(analytic=True)
+#: how ``make verify`` compares ``points.parquet`` (:mod:`sim.mc.tolerance`): the analytic
+#: columns by their arithmetic, also against a run with fewer trials; the bearing as an axis
+#: (null, with its reason, for a circle); the Monte-Carlo columns at their intervals
+POINT_TOLERANCES = {
+    **{c: _A for c in ("x_mm", "y_mm", "sigma_x_mm", "sigma_y_mm", "dilution_pct")},
+    **{c: _A for c in ("ellipse95_a_mm", "ellipse95_b_mm")},
+    "ellipse_bearing_deg": tol.axial(180.0, null_reason="ellipse_bearing_null", analytic=True),
+    **{
+        f"mc_sigma_{a}{s}_mm": tol.mc(ci=(f"mc_sigma_{a}_lo_mm", f"mc_sigma_{a}_hi_mm"))
+        for a in "xy"
+        for s in ("", "_lo", "_hi")
+    },
+    **{c: tol.mc(ci=("coverage95_lo", "coverage95_hi")) for c in ("coverage95", "coverage95_lo")},
+    "coverage95_hi": tol.mc(ci=("coverage95_lo", "coverage95_hi")),
+}
 
 
 def compare_points(net: Network, cfg: dict) -> list[int]:
@@ -126,7 +146,8 @@ def run(cfg: dict, out: Path, ctx) -> None:
     cover_mean = jackknife(lambda t: np.atleast_1d(np.mean(t[1 + 4 * k : 1 + 5 * k] / t[0])), sums)
     alarm = binomial_ci(tot[-1:], tot[0])
 
-    a95, b95, th = ellipse(an.cov[pts])
+    a95, b95, _ = ellipse(an.cov[pts])
+    bearing, bearing_why = bearing_deg(an.cov[pts])
     extra = compare_points(net, cfg)
     dil = np.full(k, np.nan)
     if extra:
@@ -147,7 +168,8 @@ def run(cfg: dict, out: Path, ctx) -> None:
             "sigma_y_mm": an_sig[1::2],
             "ellipse95_a_mm": K95 * a95,
             "ellipse95_b_mm": K95 * b95,
-            "ellipse_bearing_deg": np.degrees(th),
+            "ellipse_bearing_deg": bearing,
+            "ellipse_bearing_null": bearing_why,
             "mc_sigma_x_mm": s_mc[0::2],
             "mc_sigma_x_lo_mm": s_lo[0::2],
             "mc_sigma_x_hi_mm": s_hi[0::2],
@@ -160,6 +182,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
             "dilution_pct": dil,
         },
         prov,
+        tolerances=POINT_TOLERANCES,
     )
     _parameters(net, an, sim, n_ok, out, prov)
     drows = {"datum": [], "point": [], "sigma_x_mm": [], "sigma_y_mm": []}

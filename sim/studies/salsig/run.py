@@ -10,7 +10,9 @@ import numpy as np
 
 from sim.claims.book import ClaimBook, write_claims
 from sim.claims.book_region import region_rows, write_region
+from sim.instruments import transforms2d as t2
 from sim.lsq import distributions as D
+from sim.mc import tolerance as tl
 from sim.mc.runner import chunk_rng, run_chunks
 from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import start_figures
@@ -42,6 +44,14 @@ def over_region(book: ClaimBook, region, preds: list[str], rows: list[dict]) -> 
     return [new.get(r["claim"], r) for r in rows]
 
 
+#: ``make verify`` (:mod:`sim.mc.tolerance`): E and SX - SY are small differences of numbers of
+#: order pi and 12.7, so their rounding is absolute: 1e3 eps of what they are computed from
+RECOVERY_TOLERANCES = {
+    "E_arcsec": tl.arithmetic(atol=1e3 * tl.EPS * np.pi / t2.ARCSEC),
+    "scale_diff_ppm": tl.arithmetic(atol=1e3 * tl.EPS * 1e6),
+}
+
+
 def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     prov = provenance(cfg)
     dec = decompositions()
@@ -56,7 +66,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         quiet=ctx.quiet,
         ctx=ctx,
     )
-    write_table(out / "trials_recovery.parquet", rec, prov)
+    write_table(out / "trials_recovery.parquet", rec, prov, RECOVERY_TOLERANCES)
     sw = {
         k: []
         for k in (
