@@ -17,11 +17,11 @@ import pyarrow.parquet as pq
 import pytest
 
 import sim
+from sim.batch import is_current
 from sim.cli import main
 from sim.instruments import transforms2d as t2
 from sim.instruments.ranges import positions as po
 from sim.mc import tolerance as tl
-from sim.mc.codehash import is_current
 from sim.mc.storage import write_table
 from sim.report.verify import compare_dirs, markdown, verify, write_record
 from sim.report.verify import main as verify_main
