@@ -67,8 +67,8 @@ def _panels_are_readable(figs: dict[str, list[dict]]) -> None:
 
 def test_brown_table1_histogram_shows_every_simulated_plate(tmp_path, figures):
     out = tmp_path / "t1"
-    _run("brown_table1", out, "trials=40", "chunk=2", "consistency.offset_step_mm=10.0")
-    assert {"table1.png", "consistent_set.png"} <= set(figures)
+    _run("brown_table1", out, "trials=40", "chunk=2", "region.points=256", "region.rounds=1")
+    assert "table1.png" in figures
     _panels_are_readable(figures)
     s0 = pq.read_table(out / "table1_trials.parquet").column("sigma0_um").to_numpy()
     hist = figures["table1.png"][0]

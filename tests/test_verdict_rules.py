@@ -252,7 +252,10 @@ def test_kinds_without_a_number():
     assert bk._verdict("prediction", None) == "finding"
     assert bk._verdict("paper-check", None) == "finding"
     assert bk._verdict("paper-check", "fails") == "erratum"
-    assert [bk._holds(v) for v in bk.VERDICTS] == [True, False, None, False] + [None] * 4
+    assert {v: bk._holds(v) for v in bk.VERDICTS} == {
+        v: {"holds": True, "fails": False, "erratum": False}.get(v) for v in bk.VERDICTS
+    }
+    assert [v for v in bk.VERDICTS if bk._holds(v) is not None] == ["holds", "fails", "erratum"]
 
 
 # --------------------------------------------------------------------------- provenance
@@ -276,6 +279,7 @@ def test_claims_tables_state_their_interval_methods(tmp_path):
         "ci": "a Monte-Carlo confidence interval (mean, sd, share, bootstrap or jackknife)",
         "spread": "the one-plate 2.5-97.5 % range over simulated plates",
         "exact": "a deterministic value",
+        "region": "decided over the consistent region of unprinted inputs (sim.claims.region)",
     }
     assert pq.read_table(path).column("interval").to_pylist() == ["ci"]
 
