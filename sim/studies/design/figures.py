@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
+from sim.instruments.ranges import multilateration as ml
 from sim.lsq import distributions as D
 from sim.report.plotting import plt, save
 from sim.studies.design.cells import pareto_front
@@ -290,8 +291,6 @@ def figure_jobs(stage: str, out, *data) -> list:
     if stage == "coverage":
         return [(fig_coverage, (data[0], out / "coverage.png"))]
     if stage == "bayes":
-        from sim.instruments.ranges import multilateration as ml
-
         samples, bay = data
         return [
             (fig_corner, (samples, bay["theta_ls"], bay["Q"], ml.PARAM_NAMES, out / "corner.png"))
