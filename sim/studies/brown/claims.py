@@ -15,6 +15,7 @@ from scipy import optimize
 
 from sim.claims.book import ClaimBook
 from sim.claims.intervals import std_rel_se
+from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.instruments.ranges import multilateration as ml
 from sim.mc.runner import chunk_rng
 from sim.studies.brown import values as V
@@ -37,13 +38,12 @@ def _pt(pts, j) -> str:
     return f"point {j + 1} ({pts[j, 0]:g}, {pts[j, 1]:g}) mm"
 
 
-def mc_agreement(book, cid, mc, i, a, trials) -> dict:
+def mc_agreement(mc, i, a, trials) -> Sim:
     """Mean over coordinates of MC sigma / analytic sigma (jackknife CI over chunks)."""
     band = 1.96 * std_rel_se(mc.N)
     v, *ci = mc.jack(lambda sd: (sd[i] / a).mean())
     r = mc.sd[i] / a
-    return book.score(
-        cid,
+    return Sim(
         v,
         tuple(ci),
         note=(
@@ -94,122 +94,71 @@ def idealised_offset(cfg: dict, pts: np.ndarray) -> tuple[float, float]:
     return float(o), float(ml.ranges(P[None], th).max())
 
 
+def _idealised(cfg: dict, pts: np.ndarray) -> Sim:
+    """The offset of the idealised four-station system (Figure 1) at the 0.85 ratio."""
+    o, rmax = idealised_offset(cfg, pts)
+    lim = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
+    if not np.isfinite(o):
+        return exact(-1.0, "no offset in 0.5-300 mm gives 0.85 (value -1: none)")
+    return exact(
+        o,
+        f"idealised four-station system (Figure 1), not the built comparator: the offset at "
+        f"which the largest known-station ratio of the pattern scaled to +-"
+        f"{cfg['idealised.half_extent_mm']:g} mm is 0.85; its longest range is {rmax:.1f} mm "
+        f"against {lim:g} mm of scale plus micrometer",
+    )
+
+
 def score_dilution(book, cfg, pts, theta, an, mc, sim, curve, extra, mono) -> list[dict]:
     """The rows of brown_dilution not decided over the region (:mod:`.region`): structure,
     bias invariance, findings and self-checks (an: model -> (n, 2) unit analytic sigmas)."""
     ex = (V.pooled(an["pivot"]) / V.pooled(an["stations"]) - 1) * 100
-    rows = []
     k_last = max(curve)
-    v = float(curve[k_last].max())
-    rows.append(
-        book.score(
-            "brown.dilution_falls_with_points.max_pct_largest_grid",
-            v,
-            interval="exact",
-            note=f"largest per-point dilution (%) of a "
-            f"{k_last} x {k_last} grid, same extent; "
-            + ", ".join(f"{k * k} points: {curve[k].max():.1f} %" for k in curve),
-        )
-    )
-    a_only = float(
-        (
-            (V.pooled(V.sigmas(pts[None], theta[None], "alpha")[0]) / V.pooled(an["stations"]) - 1)
-            * 100
-        ).max()
-    )
-    rows.append(
-        book.score(
-            "brown.pivot_extra_dilution.alpha_only_max_pct",
-            a_only,
-            interval="exact",
-            note="largest extra dilution (%) from freeing alpha "
-            f"alone (beta^2 known); with beta^2 too: {ex.max():.2f} %",
-        )
-    )
-    n_min, note = min_points_stations(cfg, theta)
-    rows.append(
-        book.score("brown.structure.min_points_stations", float(n_min), interval="exact", note=note)
-    )
+    alpha = V.pooled(V.sigmas(pts[None], theta[None], "alpha")[0])
+    a_only = float(((alpha / V.pooled(an["stations"]) - 1) * 100).max())
+    n_min, n_note = min_points_stations(cfg, theta)
     nb = int(sim["bias.n"].sum())
-    rows.append(
-        book.score(
-            "brown.bias_invariance.max_point_shift_mm",
-            float(sim["bias.max_point_shift_mm"].max()),
-            interval="exact",
-            note=f"largest coordinate change over {nb} Monte-Carlo plates when "
+    table = {
+        "brown.dilution_falls_with_points.max_pct_largest_grid": exact(
+            float(curve[k_last].max()),
+            f"largest per-point dilution (%) of a {k_last} x {k_last} grid, same extent; "
+            + ", ".join(f"{k * k} points: {curve[k].max():.1f} %" for k in curve),
+        ),
+        "brown.pivot_extra_dilution.alpha_only_max_pct": exact(
+            a_only,
+            "largest extra dilution (%) from freeing alpha "
+            f"alone (beta^2 known); with beta^2 too: {ex.max():.2f} %",
+        ),
+        "brown.structure.min_points_stations": exact(n_min, n_note),
+        "brown.bias_invariance.max_point_shift_mm": exact(
+            sim["bias.max_point_shift_mm"].max(),
+            f"largest coordinate change over {nb} Monte-Carlo plates when "
             f"{cfg['checks.bias_shift_um']:g} um is added to every range (pivot "
             "model); zero to rounding",
-        )
-    )
-    rows.append(
-        book.score(
-            "brown.bias_invariance.alpha_shift_error_mm",
-            float(sim["bias.alpha_err_mm"].max()),
-            interval="exact",
-            note="largest |change of alpha + constant| over the same plates",
-        )
-    )
-    o, rmax = idealised_offset(cfg, pts)
-    lim = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
-    if np.isfinite(o):
-        rows.append(
-            book.score(
-                "brown.idealised.offset_for_085_mm",
-                o,
-                interval="exact",
-                note=(
-                    f"idealised four-station system (Figure 1), not the built comparator: the offset at "
-                    f"which the largest known-station ratio of the pattern scaled to +-"
-                    f"{cfg['idealised.half_extent_mm']:g} mm is 0.85; its longest range is {rmax:.1f} mm "
-                    f"against {lim:g} mm of scale plus micrometer"
-                ),
-            )
-        )
-    else:
-        rows.append(
-            book.score(
-                "brown.idealised.offset_for_085_mm",
-                -1.0,
-                interval="exact",
-                note="no offset in 0.5-300 mm gives 0.85 (value -1: none)",
-            )
-        )
+        ),
+        "brown.bias_invariance.alpha_shift_error_mm": exact(
+            sim["bias.alpha_err_mm"].max(),
+            "largest |change of alpha + constant| over the same plates",
+        ),
+        "brown.idealised.offset_for_085_mm": _idealised(cfg, pts),
+    }
     for i, m in enumerate(MODEL_NAMES):
-        rows.append(
-            mc_agreement(book, f"brown.mc_agreement.{m}.mean_ratio", mc, i, an[m], cfg["trials"])
-        )
-    return rows
+        table[f"brown.mc_agreement.{m}.mean_ratio"] = mc_agreement(mc, i, an[m], cfg["trials"])
+    return claim_rows(book, table)
 
 
-def score_table1(book, cfg, pts, an_pivot, sr, mc, t1) -> list[dict]:
-    """The rows of brown_table1 not decided over the region (:mod:`.region`): the closure,
-    the paper's arithmetic, self-checks. ``t1``: per-plate statistics of the converged trials."""
-    dof = 4 * len(pts) - (2 * len(pts) + 7)
-    rows = [
-        book.score(
-            "brown.table1_closure.dof",
-            float(dof),
-            interval="exact",
-            note="4n ranges - (2n + 7) unknowns of the pivot model",
-        )
-    ]
-    s0 = t1["sigma0_um"]
-    rows.append(
-        book.score(
-            "brown.table1_closure.rms_um",
-            samples=s0,
-            note=(
-                f"a-posteriori sigma0 of one plate over {len(s0)} simulated plates; its expectation is "
-                f"the range sigma {sr:.2f} um built from 1.7 um per setting (double) and the comparator's "
-                "1.1 um, which the paper derived from this 1.6: agreement by construction"
-            ),
-        )
-    )
+def _closure(cfg, s0, sr) -> dict[str, Sim]:
+    """The closure rows of Table 1: sigma0 over plates, its typical range, the setting sigma."""
     q25, q75 = np.percentile(s0, [25, 75])
     inside = float(np.mean((s0 >= 1.45) & (s0 < 2.05)))
-    rows.append(
-        book.score(
-            "brown.table1_closure.typical_range_um",
+    return {
+        "brown.table1_closure.rms_um": plates(
+            s0,
+            f"a-posteriori sigma0 of one plate over {len(s0)} simulated plates; its expectation is "
+            f"the range sigma {sr:.2f} um built from 1.7 um per setting (double) and the comparator's "
+            "1.1 um, which the paper derived from this 1.6: agreement by construction",
+        ),
+        "brown.table1_closure.typical_range_um": Sim(
             float(q25),
             value_high=float(q75),
             interval="spread",
@@ -219,70 +168,48 @@ def score_table1(book, cfg, pts, an_pivot, sr, mc, t1) -> list[dict]:
                 f"{q75:.2f} um) must lie in 1.5-2.0 um; {inside:.0%} of plates print inside. One "
                 "comparator calibrated on Table 1; other production models may differ"
             ),
-        )
-    )
+        ),
+    }
+
+
+def _setting(cfg, t1) -> Sim:
     if cfg["errors.settings"] > 1:
-        rows.append(
-            book.score(
-                "brown.table1_setting.sigma_um",
-                samples=t1["setting_sigma_um"],
-                note="recovered per plate from the differences of the repeated "
-                "settings; the simulated setting sigma is the paper's value",
-            )
+        return plates(
+            t1["setting_sigma_um"],
+            "recovered per plate from the differences of the repeated "
+            "settings; the simulated setting sigma is the paper's value",
         )
-    else:
-        rows.append(
-            book.score(
-                "brown.table1_setting.sigma_um",
-                cfg["errors.setting_sigma_um"],
-                interval="exact",
-                note="single settings: the setting sigma cannot "
-                "be recovered from the plate; the value is the input",
-            )
-        )
-    rows.append(
-        book.score(
-            "brown.table1_setting.pair_mean_um",
-            1.7 / np.sqrt(2),
-            interval="exact",
-            note="recomputed: 1.7 / sqrt(2)",
-        )
+    return exact(
+        cfg["errors.setting_sigma_um"],
+        "single settings: the setting sigma cannot be recovered from the plate; the value is the input",
     )
-    rows.append(
-        book.score(
-            "brown.table1_closure.comparator_um",
-            float(np.sqrt(1.6**2 - 1.2**2)),
-            interval="exact",
-            note="recomputed: sqrt(1.6^2 - 1.2^2)",
-        )
-    )
-    rows.append(
-        book.score(
-            "brown.table1_external.equal_share_low_um",
-            2 / np.sqrt(2),
-            interval="exact",
-            note="recomputed: 2 / sqrt(2)",
-        )
-    )
-    rows.append(
-        book.score(
-            "brown.table1_external.equal_share_high_um",
-            3 / np.sqrt(2),
-            interval="exact",
-            note="recomputed: 3 / sqrt(2)",
-        )
-    )
-    rows.append(
-        book.score(
-            "brown.table1_external.zeiss_comparator_um",
-            float(np.sqrt(1.5**2 - 0.8**2)),
-            interval="exact",
-            note="recomputed: sqrt(1.50^2 - 0.8^2)",
-        )
-    )
-    rows.append(
-        mc_agreement(
-            book, "brown.table1_mc_agreement.pivot.mean_ratio", mc, 2, an_pivot, cfg["trials"]
-        )
-    )
-    return rows
+
+
+#: the paper's own arithmetic (paper checks): claim id -> (value, how it is recomputed)
+TABLE1_ARITHMETIC = {
+    "brown.table1_setting.pair_mean_um": (1.7 / np.sqrt(2), "recomputed: 1.7 / sqrt(2)"),
+    "brown.table1_closure.comparator_um": (
+        float(np.sqrt(1.6**2 - 1.2**2)),
+        "recomputed: sqrt(1.6^2 - 1.2^2)",
+    ),
+    "brown.table1_external.equal_share_low_um": (2 / np.sqrt(2), "recomputed: 2 / sqrt(2)"),
+    "brown.table1_external.equal_share_high_um": (3 / np.sqrt(2), "recomputed: 3 / sqrt(2)"),
+    "brown.table1_external.zeiss_comparator_um": (
+        float(np.sqrt(1.5**2 - 0.8**2)),
+        "recomputed: sqrt(1.50^2 - 0.8^2)",
+    ),
+}
+
+
+def score_table1(book, cfg, pts, an_pivot, sr, mc, t1) -> list[dict]:
+    """The rows of brown_table1 not decided over the region (:mod:`.region`): the closure,
+    the paper's arithmetic, self-checks. ``t1``: per-plate statistics of the converged trials."""
+    dof = 4 * len(pts) - (2 * len(pts) + 7)
+    table = {
+        "brown.table1_closure.dof": exact(dof, "4n ranges - (2n + 7) unknowns of the pivot model"),
+        **_closure(cfg, t1["sigma0_um"], sr),
+        "brown.table1_setting.sigma_um": _setting(cfg, t1),
+        **{cid: exact(v, note) for cid, (v, note) in TABLE1_ARITHMETIC.items()},
+        "brown.table1_mc_agreement.pivot.mean_ratio": mc_agreement(mc, 2, an_pivot, cfg["trials"]),
+    }
+    return claim_rows(book, table)

@@ -40,6 +40,78 @@ SIM_KEYS = (
 )
 
 
+def _adjust_all(obs, pts, theta, sim) -> tuple[dict, dict]:
+    """All three models on the same ranges: per-trial rows and the chunk's error sums (um)."""
+    n = obs.shape[0]
+    out: dict[str, np.ndarray] = {}
+    errs, ok_all = [], np.ones(n, bool)
+    res_by = {}
+    for m in MODEL_NAMES:
+        res = ml.adjust(
+            obs,
+            m,
+            start_theta(theta, m),
+            tol_mm=sim["solver.tol_mm"],
+            max_iter=sim["solver.max_iter"],
+        )
+        res_by[m] = res
+        out[f"rows.{m}_converged"] = res.converged
+        out[f"rows.{m}_status"] = res.status
+        out[f"rows.{m}_iterations"] = res.iterations
+        out[f"rows.{m}_sigma0_um"] = res.sigma0 * 1e3
+        for i, name in enumerate(ml.PARAM_NAMES[: ml.MODELS[m]]):
+            out[f"rows.{m}_{name}"] = res.theta[:, i]
+        errs.append((res.points - pts) * 1e3)  # um
+        ok_all &= res.converged
+    e = np.stack(errs, 1)[ok_all]  # (n_ok, 3, n_pts, 2)
+    out["sum.n"] = np.array([ok_all.sum()], float)
+    out["sum.e1"] = e.sum(0)[None]
+    out["sum.e2"] = (e * e).sum(0)[None]
+    out["sum.nfail"] = np.array([[(~res_by[m].converged).sum() for m in MODEL_NAMES]], float)
+    return out, res_by
+
+
+def _bias_rows(obs, theta, sim, r0, shift_um: float) -> dict[str, np.ndarray]:
+    """The pivot adjustment again with ``shift_um`` added to every range: the largest point
+    change (mm) and the error of alpha's change against the shift, over both converged."""
+    r2 = ml.adjust(
+        obs + shift_um * 1e-3,
+        "pivot",
+        start_theta(theta, "pivot"),
+        tol_mm=sim["solver.tol_mm"],
+        max_iter=sim["solver.max_iter"],
+    )
+    both = r0.converged & r2.converged
+    return {
+        "bias.max_point_shift_mm": np.array([np.abs(r2.points - r0.points)[both].max(initial=0.0)]),
+        "bias.alpha_err_mm": np.array(
+            [np.abs(r2.theta[both, 5] - r0.theta[both, 5] + shift_um * 1e-3).max(initial=0.0)]
+        ),
+        "bias.n": np.array([both.sum()]),
+    }
+
+
+def _table1_rows(r, sett) -> dict[str, np.ndarray]:
+    """Per-plate statistics of the a-posteriori point sigmas (um) of the pivot adjustment ``r``
+    (NaN where it did not converge); ``sett``: the individual settings."""
+    n = r.sigma0.shape[0]
+    out = {}
+    Qpp = ml.covariance(r.points, r.theta, "pivot")[0]
+    ap = r.sigma0[:, None, None] * 1e3 * np.sqrt(np.stack([Qpp[..., 0, 0], Qpp[..., 1, 1]], -1))
+    nan = np.where(r.converged, 1.0, np.nan)
+    out["t1.sigma0_um"] = r.sigma0 * 1e3 * nan
+    out["t1.share_1p1_1p3"] = ((ap >= 1.05) & (ap < 1.35)).mean(axis=(1, 2)) * nan
+    out["t1.max_sigma_um"] = ap.max(axis=(1, 2)) * nan
+    out["t1.points_ge_1p45"] = (ap.max(axis=2) >= 1.45).sum(axis=1) * nan
+    L = sett.shape[-1]  # the setting sigma needs repeated settings
+    out["t1.setting_sigma_um"] = (
+        np.sqrt(sett.var(axis=-1, ddof=1).mean(axis=(1, 2))) * nan if L > 1 else np.full(n, np.nan)
+    )
+    for k in ("share_1p1_1p3", "max_sigma_um", "points_ge_1p45"):
+        out[f"rows.pivot_{k}"] = out[f"t1.{k}"]
+    return out
+
+
 def chunk(
     rng: np.random.Generator,
     n: int,
@@ -71,65 +143,11 @@ def chunk(
         bias_um=sim["errors.bias_um"],
         return_settings=True,
     )
-    out: dict[str, np.ndarray] = {}
-    errs, ok_all = [], np.ones(n, bool)
-    res_by = {}
-    for m in MODEL_NAMES:
-        res = ml.adjust(
-            obs,
-            m,
-            start_theta(theta, m),
-            tol_mm=sim["solver.tol_mm"],
-            max_iter=sim["solver.max_iter"],
-        )
-        res_by[m] = res
-        out[f"rows.{m}_converged"] = res.converged
-        out[f"rows.{m}_status"] = res.status
-        out[f"rows.{m}_iterations"] = res.iterations
-        out[f"rows.{m}_sigma0_um"] = res.sigma0 * 1e3
-        for i, name in enumerate(ml.PARAM_NAMES[: ml.MODELS[m]]):
-            out[f"rows.{m}_{name}"] = res.theta[:, i]
-        errs.append((res.points - pts) * 1e3)  # um
-        ok_all &= res.converged
-    e = np.stack(errs, 1)[ok_all]  # (n_ok, 3, n_pts, 2)
-    out["sum.n"] = np.array([ok_all.sum()], float)
-    out["sum.e1"] = e.sum(0)[None]
-    out["sum.e2"] = (e * e).sum(0)[None]
-    out["sum.nfail"] = np.array([[(~res_by[m].converged).sum() for m in MODEL_NAMES]], float)
+    out, res_by = _adjust_all(obs, pts, theta, sim)
     if shift_um is not None:
-        r0 = res_by["pivot"]
-        r2 = ml.adjust(
-            obs + shift_um * 1e-3,
-            "pivot",
-            start_theta(theta, "pivot"),
-            tol_mm=sim["solver.tol_mm"],
-            max_iter=sim["solver.max_iter"],
-        )
-        both = r0.converged & r2.converged
-        out["bias.max_point_shift_mm"] = np.array(
-            [np.abs(r2.points - r0.points)[both].max(initial=0.0)]
-        )
-        out["bias.alpha_err_mm"] = np.array(
-            [np.abs(r2.theta[both, 5] - r0.theta[both, 5] + shift_um * 1e-3).max(initial=0.0)]
-        )
-        out["bias.n"] = np.array([both.sum()])
+        out.update(_bias_rows(obs, theta, sim, res_by["pivot"], shift_um))
     if table1:
-        r = res_by["pivot"]
-        Qpp = ml.covariance(r.points, r.theta, "pivot")[0]
-        ap = r.sigma0[:, None, None] * 1e3 * np.sqrt(np.stack([Qpp[..., 0, 0], Qpp[..., 1, 1]], -1))
-        nan = np.where(r.converged, 1.0, np.nan)
-        out["t1.sigma0_um"] = r.sigma0 * 1e3 * nan
-        out["t1.share_1p1_1p3"] = ((ap >= 1.05) & (ap < 1.35)).mean(axis=(1, 2)) * nan
-        out["t1.max_sigma_um"] = ap.max(axis=(1, 2)) * nan
-        out["t1.points_ge_1p45"] = (ap.max(axis=2) >= 1.45).sum(axis=1) * nan
-        L = sett.shape[-1]  # the setting sigma needs repeated settings
-        out["t1.setting_sigma_um"] = (
-            np.sqrt(sett.var(axis=-1, ddof=1).mean(axis=(1, 2))) * nan
-            if L > 1
-            else np.full(n, np.nan)
-        )
-        for k in ("share_1p1_1p3", "max_sigma_um", "points_ge_1p45"):
-            out[f"rows.pivot_{k}"] = out[f"t1.{k}"]
+        out.update(_table1_rows(res_by["pivot"], sett))
     return out
 
 

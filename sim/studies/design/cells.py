@@ -102,6 +102,71 @@ def geometry_eval(cfg: dict, P: int, k: int, ext: float, offsets, betas) -> dict
     }
 
 
+#: the derived columns of ``design.parquet`` after the cell keys
+DERIVED = (
+    "n_points",
+    "range_sigma_um",
+    "worst_sigma_um",
+    "mean_sigma_um",
+    "known_worst_sigma_um",
+    "dilution_mean_pct",
+    "time_min",
+    "max_range_mm",
+    "dof",
+    "feasible",
+    "reason",
+    "paper_design",
+    "pareto",
+)
+
+
+def _geometries(cfg: dict) -> dict[tuple, dict]:
+    """The analytic geometry of every (positions, grid, extent, offset, beta) cell."""
+    geo = {}
+    for P in cfg["design.positions"]:
+        for k in cfg["design.grids"]:
+            for e in cfg["design.extents_mm"]:
+                g = geometry_eval(cfg, P, k, e, cfg["design.offsets_mm"], cfg["design.beta_mm"])
+                for i, (o, b) in enumerate(zip(g["offset_mm"], g["beta_mm"])):
+                    geo[(P, k, e, o, b)] = {
+                        kk: (v[i] if isinstance(v, (np.ndarray, list)) else v)
+                        for kk, v in g.items()
+                    }
+    return geo
+
+
+def _is_paper_design(cfg: dict, cell: dict) -> bool:
+    return bool(
+        cell["positions"] == cfg["paper.positions"]
+        and cell["grid"] == cfg["paper.grid"]
+        and np.isclose(cell["extent_mm"], cfg["paper.extent_mm"])
+        and np.isclose(cell["offset_mm"], cfg["paper.offset_mm"])
+        and np.isclose(cell["beta_mm"], cfg["paper.beta_mm"])
+        and cell["settings"] == cfg["paper.settings"]
+        and np.isclose(cell["setting_sigma_um"], cfg["paper.setting_sigma_um"])
+    )
+
+
+def _cell_row(cfg: dict, cell: dict, g: dict) -> dict:
+    """The derived columns of one cell (all but ``pareto``) from its geometry ``g``."""
+    sr = float(range_sigma(cell["setting_sigma_um"], cell["settings"], cfg["comparator.sigma_um"]))
+    n = cell["grid"] ** 2
+    return {
+        "n_points": n,
+        "range_sigma_um": sr,
+        "worst_sigma_um": g["pivot_worst"] * sr,
+        "mean_sigma_um": g["pivot_mean"] * sr,
+        "known_worst_sigma_um": g["known_worst"] * sr,
+        "dilution_mean_pct": (g["pivot_mean"] / g["known_mean"] - 1) * 100,
+        "time_min": measuring_time(cfg, cell["positions"], n, cell["settings"]),
+        "max_range_mm": g["rmax_mm"],
+        "dof": g["dof"],
+        "feasible": g["reason"] == "",
+        "reason": g["reason"],
+        "paper_design": _is_paper_design(cfg, cell),
+    }
+
+
 def design_cells(cfg: dict) -> dict:
     """One row per design cell (the grid of :func:`sim.mc.sweep.expand`)."""
     table = {
@@ -114,67 +179,15 @@ def design_cells(cfg: dict) -> dict:
         "setting_sigma_um": cfg["design.setting_sigma_um"],
     }
     keys, cells, _, _ = expand(table)
-    geo = {}
-    for P in cfg["design.positions"]:
-        for k in cfg["design.grids"]:
-            for e in cfg["design.extents_mm"]:
-                g = geometry_eval(cfg, P, k, e, cfg["design.offsets_mm"], cfg["design.beta_mm"])
-                for i, (o, b) in enumerate(zip(g["offset_mm"], g["beta_mm"])):
-                    geo[(P, k, e, o, b)] = {
-                        kk: (v[i] if isinstance(v, (np.ndarray, list)) else v)
-                        for kk, v in g.items()
-                    }
-    cols: dict[str, list] = {
-        c: []
-        for c in keys
-        + [
-            "n_points",
-            "range_sigma_um",
-            "worst_sigma_um",
-            "mean_sigma_um",
-            "known_worst_sigma_um",
-            "dilution_mean_pct",
-            "time_min",
-            "max_range_mm",
-            "dof",
-            "feasible",
-            "reason",
-            "paper_design",
-            "pareto",
-        ]
-    }
+    geo = _geometries(cfg)
+    cols: dict[str, list] = {c: [] for c in keys + list(DERIVED)}
     for cell in cells:
-        g = geo[
-            (cell["positions"], cell["grid"], cell["extent_mm"], cell["offset_mm"], cell["beta_mm"])
-        ]
-        sr = float(
-            range_sigma(cell["setting_sigma_um"], cell["settings"], cfg["comparator.sigma_um"])
-        )
+        key = ("positions", "grid", "extent_mm", "offset_mm", "beta_mm")
+        row = _cell_row(cfg, cell, geo[tuple(cell[k] for k in key)])
         for kk in keys:
             cols[kk].append(cell[kk])
-        n = cell["grid"] ** 2
-        cols["n_points"].append(n)
-        cols["range_sigma_um"].append(sr)
-        cols["worst_sigma_um"].append(g["pivot_worst"] * sr)
-        cols["mean_sigma_um"].append(g["pivot_mean"] * sr)
-        cols["known_worst_sigma_um"].append(g["known_worst"] * sr)
-        cols["dilution_mean_pct"].append((g["pivot_mean"] / g["known_mean"] - 1) * 100)
-        cols["time_min"].append(measuring_time(cfg, cell["positions"], n, cell["settings"]))
-        cols["max_range_mm"].append(g["rmax_mm"])
-        cols["dof"].append(g["dof"])
-        cols["feasible"].append(g["reason"] == "")
-        cols["reason"].append(g["reason"])
-        cols["paper_design"].append(
-            bool(
-                cell["positions"] == cfg["paper.positions"]
-                and cell["grid"] == cfg["paper.grid"]
-                and np.isclose(cell["extent_mm"], cfg["paper.extent_mm"])
-                and np.isclose(cell["offset_mm"], cfg["paper.offset_mm"])
-                and np.isclose(cell["beta_mm"], cfg["paper.beta_mm"])
-                and cell["settings"] == cfg["paper.settings"]
-                and np.isclose(cell["setting_sigma_um"], cfg["paper.setting_sigma_um"])
-            )
-        )
+        for kk, v in row.items():
+            cols[kk].append(v)
     cols["pareto"] = list(
         pareto_front(
             np.array(cols["time_min"]), np.array(cols["worst_sigma_um"]), np.array(cols["feasible"])

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
+from sim.claims.table import Sim, claim_rows, exact, mc, plates
 from sim.studies.design.errbudget import BUDGET_ROWS
 
 __all__ = ["BOOK", "load_book", "EXTERNAL", "score_external", "score_all"]
@@ -85,113 +86,87 @@ def verdict_of(book: ClaimBook, cid: str, e: dict) -> dict:
     return score_external(ClaimBook([book.spec(cid)], [], book.path), cid, e)
 
 
-def _exact(book, cid, v, note, **kw):
-    return book.score(cid, float(v), interval="exact", note=note, **kw)
+#: the error-budget sources scored as claims ``brown.budget.<source>_um``
+BUDGET_CLAIMS = (
+    "scale",
+    "scale_spec",
+    "screw",
+    "drum_periodic",
+    "wobble_3kg",
+    "wobble_3kg_h1",
+    "sphericity",
+)
+
+#: the design rows (:mod:`.cells`), each an exact value with its note in ``R["design"]``
+DESIGN_CLAIMS = (
+    "brown.design.paper_on_pareto_front",
+    "brown.design.paper_on_front_same_setting_sigma",
+    "brown.design.paper_on_front_same_points",
+    "brown.design.paper_worst_sigma_um",
+    "brown.design.max_offset_paper_grid_mm",
+    "brown.design.max_offset_dilution_grid_mm",
+)
 
 
-def score_all(book: ClaimBook, cfg: dict, R: dict) -> list[dict]:
-    rows = []
-    ext = R["external"]  # at the labelled example; the EXTERNAL rows come from .region
-    t = ext
-    rows.append(
-        _exact(
-            book,
-            "brown.calibration.axis_tilt_deg",
-            t["axis_tilt_deg"],
-            "atan(accuracy / gap) at the larger printed gap",
-        )
-    )
-    rows.append(
-        _exact(
-            book,
-            "brown.calibration.scale_combined_um",
-            math.hypot(0.5, 0.2),
-            "recomputed from the paper's 0.5 and 0.2 micron",
-        )
-    )
-    rows.append(
-        _exact(
-            book,
-            "brown.operation.measurements_per_point",
-            cfg["paper.positions"] * 2,
-            "positions x 2 settings",
-        )
-    )
-    rows.append(
-        _exact(
-            book,
-            "brown.operation.single_settings_min",
-            R["time"][0],
-            "the time model at 30 images, 4 positions, single settings",
-        )
-    )
-    rows.append(
-        _exact(
-            book,
-            "brown.operation.double_settings_min",
-            R["time"][1],
-            "the time model at 30 images, 4 positions, double settings",
-        )
-    )
-    # error budget
+def _operation(cfg: dict, R: dict) -> dict[str, Sim]:
+    """Calibration and operation: the axis tilt, the paper's arithmetic, the time model."""
+    return {
+        "brown.calibration.axis_tilt_deg": exact(
+            R["external"]["axis_tilt_deg"], "atan(accuracy / gap) at the larger printed gap"
+        ),
+        "brown.calibration.scale_combined_um": exact(
+            math.hypot(0.5, 0.2), "recomputed from the paper's 0.5 and 0.2 micron"
+        ),
+        "brown.operation.measurements_per_point": exact(
+            cfg["paper.positions"] * 2, "positions x 2 settings"
+        ),
+        "brown.operation.single_settings_min": exact(
+            R["time"][0], "the time model at 30 images, 4 positions, single settings"
+        ),
+        "brown.operation.double_settings_min": exact(
+            R["time"][1], "the time model at 30 images, 4 positions, double settings"
+        ),
+    }
+
+
+def _budget(R: dict) -> dict[str, Sim]:
+    """The error budget (adaptive Monte Carlo, :mod:`.errbudget`): each source alone, the
+    Table-1 model against its linearisation, the closure of the named elements."""
     b = R["budget"]
     B = {s: (r, se, n) for s, r, se, n in zip(b["source"], b["rms_um"], b["se_um"], b["trials"])}
     desc = {n: d for n, _, _, d in BUDGET_ROWS}
-    for name in (
-        "scale",
-        "scale_spec",
-        "screw",
-        "drum_periodic",
-        "wobble_3kg",
-        "wobble_3kg_h1",
-        "sphericity",
-    ):
+    table = {}
+    for name in BUDGET_CLAIMS:
         r, se, n = B[name]
-        rows.append(
-            book.score(
-                f"brown.budget.{name}_um",
-                r,
-                (r - 1.96 * se, r + 1.96 * se),
-                note=f"rms coordinate error after a rigid fit, this source alone "
-                f"({desc[name]}); {n} trials (adaptive) to a standard error of "
-                f"{se:.4f} um; setting error alone: {B['setting'][0]:.3f} um",
-            )
+        table[f"brown.budget.{name}_um"] = mc(
+            r,
+            se,
+            f"rms coordinate error after a rigid fit, this source alone "
+            f"({desc[name]}); {n} trials (adaptive) to a standard error of "
+            f"{se:.4f} um; setting error alone: {B['setting'][0]:.3f} um",
         )
     r, se, n = B["table1_model"]
-    lin = float(np.sqrt(np.mean(ext["table1_rms"] ** 2)))
-    rows.append(
-        book.score(
-            "brown.budget.table1_model_mc_vs_linear",
-            r / lin,
-            ((r - 1.96 * se) / lin, (r + 1.96 * se) / lin),
-            note=f"rms of the Monte Carlo (Table 1's model, pivot solver) over "
-            f"the linearised plate model's {lin:.3f} um",
-        )
+    lin = float(np.sqrt(np.mean(R["external"]["table1_rms"] ** 2)))
+    table["brown.budget.table1_model_mc_vs_linear"] = Sim(
+        r / lin,
+        ((r - 1.96 * se) / lin, (r + 1.96 * se) / lin),
+        note=f"rms of the Monte Carlo (Table 1's model, pivot solver) over "
+        f"the linearised plate model's {lin:.3f} um",
     )
     prod = R["budget_sims"]["production"]
-    rows.append(
-        book.score(
-            "brown.budget.closure_named_elements_um",
-            samples=prod["s0_um"][prod["ok"]],
-            note="sigma0 of the pivot adjustment with the settings and the "
-            "calibrated scale and screw only (no other comparator error)",
-        )
+    table["brown.budget.closure_named_elements_um"] = plates(
+        prod["s0_um"][prod["ok"]],
+        "sigma0 of the pivot adjustment with the settings and the "
+        "calibrated scale and screw only (no other comparator error)",
     )
-    # design
-    D = R["design"]
-    for cid in (
-        "brown.design.paper_on_pareto_front",
-        "brown.design.paper_on_front_same_setting_sigma",
-        "brown.design.paper_on_front_same_points",
-        "brown.design.paper_worst_sigma_um",
-        "brown.design.max_offset_paper_grid_mm",
-        "brown.design.max_offset_dilution_grid_mm",
-    ):
-        v, note = D[cid]
-        rows.append(_exact(book, cid, v, note))
+    return table
+
+
+def _design(R: dict) -> dict[str, Sim]:
+    """The design trade-off (:mod:`.cells`) and the datum of the dilution (:mod:`.dilution`)."""
+    table = {cid: exact(*R["design"][cid]) for cid in DESIGN_CLAIMS}
     v, ci, note = R["mc_ratio"]
-    rows.append(book.score("brown.design.mc_agreement.pooled_ratio", v, ci, note=note))
-    # datum
+    table["brown.design.mc_agreement.pooled_ratio"] = Sim(v, ci, note=note)
     dr = R["datum"]
     ideal = (
         ""
@@ -204,98 +179,97 @@ def score_all(book: ClaimBook, cfg: dict, R: dict) -> list[dict]:
     for m in ("stations", "pivot"):
         for dn, lab in (("brown", "brown"), ("inner", "invariant"), ("corners", "corners")):
             lo, hi = dr[(m, dn)]
-            rows.append(
-                book.score(
-                    f"brown.datum.{lab}.{m}_pct",
-                    lo,
-                    (lo, lo),
-                    "exact",
-                    value_high=hi,
-                    note=f"per-point dilution {lo:.1f} to {hi:.1f} % "
-                    f"(analytic); {dr['geometry']}.{ideal}",
-                )
+            table[f"brown.datum.{lab}.{m}_pct"] = Sim(
+                lo,
+                (lo, lo),
+                "exact",
+                value_high=hi,
+                note=f"per-point dilution {lo:.1f} to {hi:.1f} % "
+                f"(analytic); {dr['geometry']}.{ideal}",
             )
-    # coverage
+    return table
+
+
+def _coverage(R: dict) -> dict[str, Sim]:
+    """Formal against empirical (:mod:`.formal`), nominal scenario of each model."""
     c = R["coverage"]
     model, scen = np.array(c["model"]), np.array(c["scenario"])
+    table = {}
     for m in ("pivot", "affine"):
         i = int(np.flatnonzero((model == m) & (scen == "nominal"))[0])
         N = c["trials"][i]
         for key in ("coverage_known", "coverage_f", "false_alarm"):
             v = c[key][i]
             se = math.sqrt(max(v * (1 - v), 1e-12) / N)  # per-trial averages: conservative
-            rows.append(
-                book.score(
-                    f"coverage.{m}.{key}",
-                    v,
-                    (v - 1.96 * se, v + 1.96 * se),
-                    note=f"empirical rate over {N} trials x {c['grid'][i] ** 2} "
-                    f"points; binomial interval over trials",
-                )
-            )
-        v = c["s0_ratio"][i] / c["s0_expected"][i]
-        se = c["s0_ratio_se"][i] / c["s0_expected"][i]
-        rows.append(
-            book.score(
-                f"coverage.{m}.sigma0_over_c4",
+            table[f"coverage.{m}.{key}"] = mc(
                 v,
-                (v - 1.96 * se, v + 1.96 * se),
-                note=f"E[s0] / sigma = {c['s0_ratio'][i]:.4f} on {c['dof'][i]} "
-                f"degrees of freedom, c4 = {c['s0_expected'][i]:.4f}; E[s0^2] / "
-                f"sigma^2 = {c['s0sq_ratio'][i]:.4f}",
+                se,
+                f"empirical rate over {N} trials x {c['grid'][i] ** 2} "
+                f"points; binomial interval over trials",
             )
+        table[f"coverage.{m}.sigma0_over_c4"] = mc(
+            c["s0_ratio"][i] / c["s0_expected"][i],
+            c["s0_ratio_se"][i] / c["s0_expected"][i],
+            f"E[s0] / sigma = {c['s0_ratio'][i]:.4f} on {c['dof'][i]} "
+            f"degrees of freedom, c4 = {c['s0_expected'][i]:.4f}; E[s0^2] / "
+            f"sigma^2 = {c['s0sq_ratio'][i]:.4f}",
         )
-    # emcee
+    return table
+
+
+def _bayes(R: dict) -> dict[str, Sim]:
+    """The emcee cross-check (:mod:`.posterior`): posterior against least-squares sigmas."""
     by = R["bayes"]
+    table = {}
     for nm, (v, se, tau, neff) in by["ratio"].items():
-        short = nm.rsplit("_", 1)[0]
-        rows.append(
-            book.score(
-                f"bayes.brown_agreement.{short}",
-                float(v),
-                (float(v - 1.96 * se), float(v + 1.96 * se)),
-                note=f"posterior / least-squares sigma, one plate; {by['chains']} "
-                f"chains x {by['steps']} steps x {by['walkers']} walkers; tau = "
-                f"{tau:.0f} steps, N_eff = {neff:.0f}; interval +-1.96 MC s.e.",
-            )
+        table[f"bayes.brown_agreement.{nm.rsplit('_', 1)[0]}"] = Sim(
+            float(v),
+            (float(v - 1.96 * se), float(v + 1.96 * se)),
+            note=f"posterior / least-squares sigma, one plate; {by['chains']} "
+            f"chains x {by['steps']} steps x {by['walkers']} walkers; tau = "
+            f"{tau:.0f} steps, N_eff = {neff:.0f}; interval +-1.96 MC s.e.",
         )
     v, se, a, bb = by["max_corr_diff"]
-    rows.append(
-        book.score(
-            "bayes.brown_agreement.max_corr_diff",
-            v,
-            (v - 1.96 * se, v + 1.96 * se),
-            note=f"largest at ({a}, {bb}); interval +-1.96 MC s.e. of that correlation",
-        )
+    table["bayes.brown_agreement.max_corr_diff"] = mc(
+        v, se, f"largest at ({a}, {bb}); interval +-1.96 MC s.e. of that correlation"
     )
-    tp = R.get("twoplate")
-    if tp is not None:
-        j = tp["prior"].index("certificate")
-        rows.append(
-            book.score(
-                "bayes.twoplate_ratio",
-                tp["rho_median"][j],
-                (tp["rho_q025"][j], tp["rho_q975"][j]),
-                "spread",
-                note=f"posterior median and 95 % interval of sigma_c^2 / "
-                f"sigma_g^2 with the certificate prior on sigma_g; re-weighting "
-                f"{tp['rw_ratio_mean'][j]:.2f}, truth {tp['true_ratio'][j]:.2f}",
-            )
-        )
-        f = tp["prior"].index("flat")
-        w, se = tp["log10_width"][f], tp["log10_width_se"][f]
-        rows.append(
-            book.score(
-                "bayes.twoplate_ratio.flat_prior_decades",
-                w,
-                (w - 1.96 * se, w + 1.96 * se),
-                note="width (decades) of the 95 % posterior interval of the ratio "
-                "with log-uniform priors on both sigmas: the misclosures fix only "
-                "sigma_c^2 + (A^2 + B^2) sigma_g^2; interval +-1.96 MC s.e. of the "
-                "quantiles (N_eff from tau)",
-            )
-        )
-    else:
-        for cid in ("bayes.twoplate_ratio", "bayes.twoplate_ratio.flat_prior_decades"):
-            book._scored.add(cid)
-    return rows
+    return table
+
+
+def _twoplate(tp: dict | None) -> dict[str, Sim | None]:
+    """The two-plate variance components (seed 001), or nothing when that part is off."""
+    if tp is None:
+        return {"bayes.twoplate_ratio": None, "bayes.twoplate_ratio.flat_prior_decades": None}
+    j, f = tp["prior"].index("certificate"), tp["prior"].index("flat")
+    return {
+        "bayes.twoplate_ratio": Sim(
+            tp["rho_median"][j],
+            (tp["rho_q025"][j], tp["rho_q975"][j]),
+            "spread",
+            note=f"posterior median and 95 % interval of sigma_c^2 / "
+            f"sigma_g^2 with the certificate prior on sigma_g; re-weighting "
+            f"{tp['rw_ratio_mean'][j]:.2f}, truth {tp['true_ratio'][j]:.2f}",
+        ),
+        "bayes.twoplate_ratio.flat_prior_decades": mc(
+            tp["log10_width"][f],
+            tp["log10_width_se"][f],
+            "width (decades) of the 95 % posterior interval of the ratio "
+            "with log-uniform priors on both sigmas: the misclosures fix only "
+            "sigma_c^2 + (A^2 + B^2) sigma_g^2; interval +-1.96 MC s.e. of the "
+            "quantiles (N_eff from tau)",
+        ),
+    }
+
+
+def score_all(book: ClaimBook, cfg: dict, R: dict) -> list[dict]:
+    """The rows of brown_design not decided over the region (the EXTERNAL rows come from
+    :mod:`.region`; ``R["external"]`` is at the labelled example)."""
+    table = {
+        **_operation(cfg, R),
+        **_budget(R),
+        **_design(R),
+        **_coverage(R),
+        **_bayes(R),
+        **_twoplate(R.get("twoplate")),
+    }
+    return claim_rows(book, table)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
+from sim.instruments.ranges import multilateration as ml
 from sim.lsq import distributions as D
 from sim.report.plotting import plt, save
 from sim.studies.design.cells import pareto_front
@@ -40,15 +41,9 @@ def _log_ticks(ax, axis: str, lo: float, hi: float) -> None:
     a.set_minor_formatter(NullFormatter())
 
 
-def fig_pareto(cols, path, same_n):
-    t = np.array(cols["time_min"])
-    a = np.array(cols["worst_sigma_um"])
-    ok = np.array(cols["feasible"])
-    P = np.array(cols["positions"])
+def _pareto_all(ax, cols, t, a, ok, P) -> None:
+    """Left panel: every cell, the front of all cells and one front per setting sigma."""
     pf = np.array(cols["pareto"])
-    j = int(np.flatnonzero(cols["paper_design"])[0])
-    fig, axs = plt.subplots(1, 2, figsize=(15, 6))
-    ax = axs[0]
     ax.scatter(t[~ok], a[~ok], s=6, c="0.85", label="infeasible (scale, format or pivot)")
     for p, mk in zip(sorted(set(P.tolist())), "osD^v<>"):
         sel = ok & (P == p)
@@ -69,7 +64,10 @@ def fig_pareto(cols, path, same_n):
             label=f"front, setting sigma {s_:g} um",
         )
     ax.set_title("all designs (any number of points)")
-    ax = axs[1]
+
+
+def _pareto_same(ax, cols, t, a, P, same_n, j) -> None:
+    """Right panel: the cells of the paper's plate by positions and settings, and their front."""
     L = np.array(cols["settings"])
     for p, mk in zip(sorted(set(P.tolist())), "osD^v<>"):
         for l_, c in zip(
@@ -93,6 +91,18 @@ def fig_pareto(cols, path, same_n):
         f"the paper's plate: {cols['n_points'][j]} points at +-{cols['extent_mm'][j]:g} mm,\n"
         f"setting sigma {cols['setting_sigma_um'][j]:g} um (feasible only)"
     )
+
+
+def fig_pareto(cols, path, same_n):
+    """Worst-point sigma (um) against measuring time (min): all cells, and the paper's plate."""
+    t = np.array(cols["time_min"])
+    a = np.array(cols["worst_sigma_um"])
+    ok = np.array(cols["feasible"])
+    P = np.array(cols["positions"])
+    j = int(np.flatnonzero(cols["paper_design"])[0])
+    fig, axs = plt.subplots(1, 2, figsize=(15, 6))
+    _pareto_all(axs[0], cols, t, a, ok, P)
+    _pareto_same(axs[1], cols, t, a, P, same_n, j)
     fin = np.isfinite(a) & (a > 0)
     for ax, sel in zip(axs, (fin, fin & same_n)):
         ax.plot(t[j], a[j], "r*", ms=16, label="paper's design (Table 1)")
@@ -281,8 +291,6 @@ def figure_jobs(stage: str, out, *data) -> list:
     if stage == "coverage":
         return [(fig_coverage, (data[0], out / "coverage.png"))]
     if stage == "bayes":
-        from sim.instruments.ranges import multilateration as ml
-
         samples, bay = data
         return [
             (fig_corner, (samples, bay["theta_ls"], bay["Q"], ml.PARAM_NAMES, out / "corner.png"))

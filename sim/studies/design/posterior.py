@@ -128,6 +128,29 @@ def _twoplate_data(cfg: dict):
     return TWO_PLATES, comp, g, sg, rw, fa
 
 
+def _twoplate_row(sim: dict, name: str, rw: dict, gcfg: dict) -> tuple[dict, np.ndarray]:
+    """One prior's row of ``bayes_twoplate.parquet`` from its chains, and the ratio samples."""
+    Y = sim["samples"].reshape(-1, 2)
+    lc, lg = Y[:, 0], Y[:, 1]
+    lrho = 2 * (lc - lg) / np.log(10)  # log10 of the ratio
+    neff = float(_n_eff(sim).min())
+    q = np.quantile(lrho, [0.025, 0.5, 0.975])
+    se_w = np.hypot(quantile_se(lrho, 0.025, neff), quantile_se(lrho, 0.975, neff))
+    row = {"prior": name}
+    for c, v in zip(("rho_q025", "rho_median", "rho_q975"), 10**q):
+        row[c] = float(v)
+    row["log10_width"] = float(q[2] - q[0])
+    row["log10_width_se"] = se_w
+    row["log10_q_se"] = max(quantile_se(lrho, p, neff) for p in (0.025, 0.5, 0.975))
+    row["sigma_c_median_um"] = float(np.median(np.exp(lc)))
+    row["sigma_g_median_um"] = float(np.median(np.exp(lg)))
+    row["tau_max"] = float(sim["tau"].max())
+    row["n_eff"] = neff
+    row["rw_ratio_mean"] = float(np.nanmean(rw["ratio"]))
+    row["true_ratio"] = (gcfg["coord_sigma_um"] / gcfg["grid_sigma_um"]) ** 2
+    return row, 10**lrho
+
+
 def twoplate_analysis(cfg: dict, ctx):
     """Posterior of sigma_c^2 / sigma_g^2 with flat and certificate priors. Returns
     ``(columns, values, samples, why)`` (``why`` is empty: kept for the callers)."""
@@ -170,24 +193,8 @@ def twoplate_analysis(cfg: dict, ctx):
             label=f"emcee (two plates, {name})",
             ctx=ctx,
         )
-        Y = sim["samples"].reshape(-1, 2)
-        lc, lg = Y[:, 0], Y[:, 1]
-        lrho = 2 * (lc - lg) / np.log(10)  # log10 of the ratio
-        neff = float(_n_eff(sim).min())
-        q = np.quantile(lrho, [0.025, 0.5, 0.975])
-        se_w = np.hypot(quantile_se(lrho, 0.025, neff), quantile_se(lrho, 0.975, neff))
-        samples[name] = 10**lrho
-        cols["prior"].append(name)
-        for c, v in zip(("rho_q025", "rho_median", "rho_q975"), 10**q):
-            cols[c].append(float(v))
-        cols["log10_width"].append(float(q[2] - q[0]))
-        cols["log10_width_se"].append(se_w)
-        cols["log10_q_se"].append(max(quantile_se(lrho, p, neff) for p in (0.025, 0.5, 0.975)))
-        cols["sigma_c_median_um"].append(float(np.median(np.exp(lc))))
-        cols["sigma_g_median_um"].append(float(np.median(np.exp(lg))))
-        cols["tau_max"].append(float(sim["tau"].max()))
-        cols["n_eff"].append(neff)
-        cols["rw_ratio_mean"].append(float(np.nanmean(rw["ratio"])))
-        cols["true_ratio"].append((gcfg["coord_sigma_um"] / gcfg["grid_sigma_um"]) ** 2)
+        row, samples[name] = _twoplate_row(sim, name, rw, gcfg)
+        for c, v in row.items():
+            cols[c].append(v)
     vals = {"sg": sg, "rw_rows": [float(v) for v in rw["ratio"]]}
     return cols, vals, samples, ""

@@ -57,7 +57,6 @@ def _design(cfg, cols):
     )
     better = np.flatnonzero(same_n & (cost <= cost[jp] + 1e-9) & (acc < acc[jp] - 1e-12))
     b = int(better[np.argmin(acc[better])]) if len(better) else jp
-    ext_d = (cfg["datum.grid"] - 1) * cfg["datum.spacing_mm"] / 2
     return {
         "brown.design.paper_on_pareto_front": (
             float(cols["pareto"][jp]),
@@ -92,6 +91,14 @@ def _design(cfg, cols):
                 f"{cols['mean_sigma_um'][jp]:.3f} um"
             ),
         ),
+        **_scale_length(cfg),
+    }
+
+
+def _scale_length(cfg) -> dict:
+    """The largest station offsets the scale plus micrometer allow (values with notes)."""
+    ext_d = (cfg["datum.grid"] - 1) * cfg["datum.spacing_mm"] / 2
+    return {
         "brown.design.max_offset_paper_grid_mm": (
             max_offset_mm(cfg, cfg["paper.extent_mm"]),
             (
@@ -193,28 +200,8 @@ def _unbounded_as_null(row: dict) -> dict:
     return row
 
 
-def run(cfg: dict, out: Path, ctx: RunContext) -> None:
-    prov = provenance(cfg)
-    book = load_book()
-    R: dict = {}
-    drawn = []  # each stage's figures go to idle workers as soon as its tables exist
-
-    def figs(stage, *data):
-        drawn.append(start_figures(figures.figure_jobs(stage, out, *data), ctx.executor))
-
-    # 1. design trade-off (analytic) and its Monte-Carlo check
-    cols = design_cells(cfg)
-    write_table(out / "design.parquet", cols, prov)
-    figs("design", cols)
-    # the unprinted inputs explored jointly (.region): the tolerances analytic, the external
-    # comparisons on a small design of plates
-    parts = {"tolerances": DR.tolerance_region(cfg, book), "plates": DR.plates_region(cfg, book)}
-    region_rows, region_table, region_inputs = DR.region_rows(book, parts)
-    R["design"] = _design(cfg, cols)
-    R["time"] = (
-        measuring_time(cfg, 4, cfg["time.images"], 1),
-        measuring_time(cfg, 4, cfg["time.images"], 2),
-    )
+def _paper_plate(cfg: dict):
+    """The paper's design: points and globals (mm) and its range sigma (um)."""
     pts, th = plate_setup(
         cfg,
         cfg["paper.positions"],
@@ -228,18 +215,27 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
             cfg["paper.setting_sigma_um"], cfg["paper.settings"], cfg["comparator.sigma_um"]
         )
     )
-    # 3. datum (analytic)
-    dcols, R["datum"] = datum_analysis(cfg)
-    R["datum"]["geometry"] = (
+    return pts, th, sr
+
+
+def _datum(cfg: dict, out: Path, prov: dict, figs) -> dict:
+    """3. The datum of the dilution (analytic): ``datum.parquet`` and its figure."""
+    dcols, dr = datum_analysis(cfg)
+    dr["geometry"] = (
         f"{cfg['datum.grid']}x{cfg['datum.grid']} points at "
         f"{cfg['datum.spacing_mm']:g} mm, stations "
         f"{cfg['datum.offset_mm']:g} mm out"
     )
     write_table(out / "datum.parquet", dcols, prov)
     figs("datum", cfg, dcols)
+    return dr
 
-    # the Monte-Carlo parts, side by side on the workers (.parts); each writes its table and
-    # sends its figures as soon as it is done
+
+def _mc_parts(cfg: dict, out: Path, prov: dict, ctx: RunContext, figs, plate) -> dict:
+    """The Monte-Carlo parts, side by side on the workers (:mod:`.parts`); each writes its
+    table and sends its figures as soon as it is done."""
+    pts, th, sr = plate
+
     def budget():  # 2. error budget (adaptive, through the runner)
         bcols, sims = budget_analysis(cfg, pts, th, ctx)
         write_table(out / "budget.parquet", bcols, prov)
@@ -262,7 +258,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         figs("twoplate", tcols, tsamples)
         return tcols, why
 
-    done = side_by_side(
+    return side_by_side(
         {
             "bayes": bayes,
             "twoplate": twoplate,
@@ -272,6 +268,34 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         },
         ctx,
     )
+
+
+def run(cfg: dict, out: Path, ctx: RunContext) -> None:
+    """Every part of ``brown_design``: tables, figures and the scored claims under ``out``."""
+    prov = provenance(cfg)
+    book = load_book()
+    R: dict = {}
+    drawn = []  # each stage's figures go to idle workers as soon as its tables exist
+
+    def figs(stage, *data):
+        drawn.append(start_figures(figures.figure_jobs(stage, out, *data), ctx.executor))
+
+    # 1. design trade-off (analytic) and its Monte-Carlo check
+    cols = design_cells(cfg)
+    write_table(out / "design.parquet", cols, prov)
+    figs("design", cols)
+    # the unprinted inputs explored jointly (.region): the tolerances analytic, the external
+    # comparisons on a small design of plates
+    parts = {"tolerances": DR.tolerance_region(cfg, book), "plates": DR.plates_region(cfg, book)}
+    region_rows, region_table, region_inputs = DR.region_rows(book, parts)
+    R["design"] = _design(cfg, cols)
+    R["time"] = (
+        measuring_time(cfg, 4, cfg["time.images"], 1),
+        measuring_time(cfg, 4, cfg["time.images"], 2),
+    )
+    plate = _paper_plate(cfg)
+    R["datum"] = _datum(cfg, out, prov, figs)
+    done = _mc_parts(cfg, out, prov, ctx, figs, plate)
     R["mc_ratio"] = done["mc"]
     R["budget"], R["budget_sims"] = done["budget"]
     R["coverage"] = done["coverage"]

@@ -443,6 +443,7 @@ def max_offset_mm(cfg: dict, extent_mm: float) -> float:
 
 
 def check(cfg: dict) -> None:
+    """Cross-key checks of a brown_design config (ConfigError naming the key)."""
     for key, lst in _PAPER_IN_GRID:
         if not any(np.isclose(cfg[key], v) for v in cfg[lst]):
             raise ConfigError(
@@ -458,6 +459,12 @@ def check(cfg: dict) -> None:
             raise ConfigError(
                 key, "four passes would take the whole single-setting time (time.single_min)"
             )
+    _check_geometry(cfg)
+    _check_sizes(cfg)
+
+
+def _check_geometry(cfg: dict) -> None:
+    """The paper's, the datum's and the Zeiss geometry fit the format and the hardware."""
     half = cfg["plate.format_mm"] / 2
     if cfg["paper.extent_mm"] > half:
         raise ConfigError("paper.extent_mm", "outside the format")
@@ -491,6 +498,10 @@ def check(cfg: dict) -> None:
                 f"+-{e:g} mm holds fewer 1 cm grid "
                 f"intersections than zeiss.points = {cfg['zeiss.points']}",
             )
+
+
+def _check_sizes(cfg: dict) -> None:
+    """The design grid, the plates and the budget's trials stay within the limits."""
     n_cells = 1
     for lst in (
         "design.positions",

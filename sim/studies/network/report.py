@@ -1,4 +1,6 @@
-"""The report section of a network study, from its Parquet files alone."""
+"""The report section of a network study (seed 004 for ``network_brown``; declared networks
+otherwise), from its Parquet files alone, on the shared skeleton :mod:`sim.report.section`.
+Coordinates and sigmas in mm, directions in arcsec."""
 
 from __future__ import annotations
 
@@ -6,20 +8,16 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.mc.storage import read_table
-from sim.report.markdown import claims_markdown, fmt, md_table
+from sim.report.section import section, table
+from sim.report.tables import fmt, md_table
 
 __all__ = ["report"]
 
 
-def report(out: Path) -> str:
-    out = Path(out)
-    s = read_table(out / "summary.parquet").to_pylist()[0]
-    p = read_table(out / "points.parquet").to_pydict()
-    o = read_table(out / "observations.parquet").to_pydict()
+def _summary(s: dict, p: dict, o: dict) -> str:
     r = np.array(o["redundancy"], float)
     worst = int(np.argmax(p["ellipse95_a_mm"]))
-    parts = [
+    return (
         f"Network **{s['network']}**: {s['points']} points, {s['observations']} observations, "
         f"{s['unknowns']} unknowns, datum `{s['datum']}` ({s['datum_constraints']} "
         f"constraints), {s['dof']} degrees of freedom. {s['converged']} of {s['trials']} "
@@ -35,20 +33,37 @@ def report(out: Path) -> str:
             f"listed): {s['held_by_datum']}."
             if s["held_by_datum"]
             else ""
-        ),
-        "",
-        claims_markdown(out / "claims.parquet"),
-        "",
-    ]
+        )
+    )
+
+
+def _mc(t: dict, col: str, a: int) -> str:
+    """``value [lo, hi]`` of a Monte-Carlo column and its 95 % interval columns."""
+    stem, unit = (col[:-3], "_mm") if col.endswith("_mm") else (col, "")
+    return f"{fmt(t[col][a])} [{fmt(t[stem + '_lo' + unit][a])}, {fmt(t[stem + '_hi' + unit][a])}]"
+
+
+_POINT_HEADER = [
+    "point",
+    "sigma x (mm)",
+    "sigma y (mm)",
+    "MC sigma x [95 %]",
+    "MC sigma y [95 %]",
+    "95 % a (mm)",
+    "95 % b (mm)",
+    "coverage",
+]
+
+
+def _points(s: dict, p: dict) -> list[str]:
+    """The point table (the 15 largest ellipses of a network over 30 points)."""
     rows = [
         [
             p["point"][a],
             fmt(p["sigma_x_mm"][a]),
             fmt(p["sigma_y_mm"][a]),
-            f"{fmt(p['mc_sigma_x_mm'][a])} [{fmt(p['mc_sigma_x_lo_mm'][a])}, "
-            f"{fmt(p['mc_sigma_x_hi_mm'][a])}]",
-            f"{fmt(p['mc_sigma_y_mm'][a])} [{fmt(p['mc_sigma_y_lo_mm'][a])}, "
-            f"{fmt(p['mc_sigma_y_hi_mm'][a])}]",
+            _mc(p, "mc_sigma_x_mm", a),
+            _mc(p, "mc_sigma_y_mm", a),
             fmt(p["ellipse95_a_mm"][a]),
             fmt(p["ellipse95_b_mm"][a]),
             fmt(p["coverage95"][a]),
@@ -56,47 +71,30 @@ def report(out: Path) -> str:
         ]
         for a in range(len(p["point"]))
     ]
+    lead = "Points:"
     if len(rows) > 30:
-        keep = sorted(np.argsort(p["ellipse95_a_mm"])[-15:])
-        rows = [rows[a] for a in keep]
-        parts.append(
+        rows = [rows[a] for a in sorted(np.argsort(p["ellipse95_a_mm"])[-15:])]
+        lead = (
             f"Points (the 15 with the largest ellipses of {len(p['point'])}; all in "
             "`points.parquet`):"
         )
-    else:
-        parts.append("Points:")
     dil = f"dilution vs {s['compare_fix']} known (%)" if s["compare_fix"] else "dilution (%)"
-    parts += [
-        "",
-        md_table(
-            [
-                "point",
-                "sigma x (mm)",
-                "sigma y (mm)",
-                "MC sigma x [95 %]",
-                "MC sigma y [95 %]",
-                "95 % a (mm)",
-                "95 % b (mm)",
-                "coverage",
-                dil,
-            ],
-            rows,
-        ),
-        "",
-    ]
-    order = np.argsort(r)[:10]
-    unit = lambda a: (
-        f"{fmt(o['mdb_mm'][a])} mm"
-        if o["mdb_mm"][a] is not None  # noqa: E731
-        else (
-            f"{fmt(o['mdb_arcsec'][a])} arcsec"
-            if o["mdb_arcsec"][a] is not None
-            else "uncontrolled"
-        )
-    )
-    parts += [
+    return [lead, md_table([*_POINT_HEADER, dil], rows)]
+
+
+def _mdb(o: dict, a: int) -> str:
+    if o["mdb_mm"][a] is not None:
+        return f"{fmt(o['mdb_mm'][a])} mm"
+    if o["mdb_arcsec"][a] is not None:
+        return f"{fmt(o['mdb_arcsec'][a])} arcsec"
+    return "uncontrolled"
+
+
+def _weakest(o: dict) -> list[str]:
+    """The ten observations with the smallest redundancy numbers."""
+    order = np.argsort(np.array(o["redundancy"], float))[:10]
+    return [
         "Weakest observations (smallest redundancy numbers; all in `observations.parquet`):",
-        "",
         md_table(
             ["kind", "at", "from", "to", "redundancy", "MDB", "external max (mm)"],
             [
@@ -106,53 +104,65 @@ def report(out: Path) -> str:
                     o["from"][a],
                     o["to"][a],
                     fmt(o["redundancy"][a]),
-                    unit(a),
+                    _mdb(o, a),
                     fmt(o["external_max_mm"][a]),
                 ]
                 for a in order
             ],
         ),
-        "",
     ]
-    g = (
-        read_table(out / "parameters.parquet").to_pydict()
-        if (out / "parameters.parquet").is_file()
-        else {"parameter": []}
-    )
-    if g["parameter"]:
-        parts += [
-            "Other estimated parameters (analytic and Monte-Carlo sigma; `parameters.parquet`):",
-            "",
-            md_table(
-                ["parameter", "unit", "true", "sigma", "MC sigma [95 %]", "MC mean error [95 %]"],
+
+
+def _parameters(out: Path) -> list[str]:
+    """Estimated parameters other than the points (``parameters.parquet``, if any)."""
+    if not (out / "parameters.parquet").is_file():
+        return []
+    g = table(out, "parameters.parquet")
+    if not g["parameter"]:
+        return []
+    return [
+        "Other estimated parameters (analytic and Monte-Carlo sigma; `parameters.parquet`):",
+        md_table(
+            ["parameter", "unit", "true", "sigma", "MC sigma [95 %]", "MC mean error [95 %]"],
+            [
                 [
-                    [
-                        g["parameter"][a],
-                        g["unit"][a],
-                        fmt(g["true"][a]),
-                        fmt(g["sigma"][a]),
-                        f"{fmt(g['mc_sigma'][a])} [{fmt(g['mc_sigma_lo'][a])}, "
-                        f"{fmt(g['mc_sigma_hi'][a])}]",
-                        f"{fmt(g['mc_mean_error'][a])} [{fmt(g['mc_mean_error_lo'][a])}, "
-                        f"{fmt(g['mc_mean_error_hi'][a])}]",
-                    ]
-                    for a in range(len(g["parameter"]))
-                ],
-            ),
-            "",
-        ]
-    d = read_table(out / "datums.parquet").to_pydict()
-    if d["datum"]:
-        for name in dict.fromkeys(d["datum"]):
-            sx = [v for v, n in zip(d["sigma_x_mm"], d["datum"]) if n == name]
-            sy = [v for v, n in zip(d["sigma_y_mm"], d["datum"]) if n == name]
-            parts.append(
-                f"In the datum *{name}* (S-transformation) the point sigmas range "
-                f"from {fmt(min(sx + sy))} to {fmt(max(sx + sy))} mm."
-            )
-        parts.append("")
-    parts += [
-        "![network](" + out.name + "/network.png)",
-        "![reliability](" + out.name + "/reliability.png)",
+                    g["parameter"][a],
+                    g["unit"][a],
+                    fmt(g["true"][a]),
+                    fmt(g["sigma"][a]),
+                    _mc(g, "mc_sigma", a),
+                    _mc(g, "mc_mean_error", a),
+                ]
+                for a in range(len(g["parameter"]))
+            ],
+        ),
     ]
-    return "\n".join(parts)
+
+
+def _datums(out: Path) -> list[str]:
+    """The range of the point sigmas in each S-transformed datum (``datums.parquet``)."""
+    d = table(out, "datums.parquet")
+    lines = []
+    for name in dict.fromkeys(d["datum"]):
+        sx = [v for v, n in zip(d["sigma_x_mm"], d["datum"]) if n == name]
+        sy = [v for v, n in zip(d["sigma_y_mm"], d["datum"]) if n == name]
+        lines.append(
+            f"In the datum *{name}* (S-transformation) the point sigmas range "
+            f"from {fmt(min(sx + sy))} to {fmt(max(sx + sy))} mm."
+        )
+    return ["\n".join(lines)] if lines else []
+
+
+def report(out: Path) -> str:
+    """The section of a network study: summary, claims, points, weakest observations,
+    other parameters, datums, figures."""
+    out = Path(out)
+    s = table(out, "summary.parquet")
+    s = {k: v[0] for k, v in s.items()}
+    p, o = table(out, "points.parquet"), table(out, "observations.parquet")
+    return section(
+        out,
+        intro=[_summary(s, p, o)],
+        body=[*_points(s, p), *_weakest(o), *_parameters(out), *_datums(out)],
+        figures=[("network", "network.png"), ("reliability", "reliability.png")],
+    )

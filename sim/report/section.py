@@ -1,0 +1,199 @@
+"""The skeleton of a study's report section, read from its Parquet files alone.
+
+Every study's section of ``REPORT.md`` has the same shape, in this order:
+
+1. the *lead*: for the studies that decide claims over the unprinted inputs, the consistent
+   region sentence, its table and the verdicts over it (:func:`region_lead`, or
+   :func:`region_by_part` for a region explored per part);
+2. the *intro*: the study's own paragraphs (model, geometry, trials, seed);
+3. the claims table and the printed numbers not reproduced
+   (:func:`sim.report.markdown.claims_markdown` of ``claims.parquet``);
+4. the inputs set to match the paper (the schema's ``input`` keys, values from the
+   provenance's config);
+5. the *body*: the study's particular tables and subsections;
+6. the figures, one ``![alt](<dir>/<file>)`` line each.
+
+A study's ``report(out)`` hook builds only what is particular to it (intro, body, figures)
+and calls :func:`section`, which joins the non-empty blocks with blank lines. Numbers come only
+from the files under ``out`` (:func:`table`, :func:`rows`, :func:`config`), never from live
+model code.
+
+Adopting it in a study still written by hand (wolf, salsig, gridplate, agnard): replace the
+function's list of paragraphs by ``section(out, intro=[...], schema=SCHEMA, body=[...],
+figures=[(alt, file), ...])``; a consistent-set sentence (one-input sweeps) goes into
+``lead``, a region explored with :mod:`sim.claims.inference` into ``lead=[region_lead(out,
+what)]``; subsections with their own figures go into ``body`` (with :func:`figure`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from sim.mc.storage import read_provenance, read_table
+from sim.report.markdown import claims_markdown, inputs_markdown
+from sim.report.tables import fmt, md_table
+
+__all__ = [
+    "config",
+    "figure",
+    "region_by_part",
+    "region_lead",
+    "region_verdicts",
+    "rows",
+    "section",
+    "span",
+    "table",
+]
+
+
+def table(out: Path, name: str) -> dict[str, list]:
+    """The columns of ``out/name`` (a Parquet table the study wrote)."""
+    return read_table(Path(out) / name).to_pydict()
+
+
+def rows(out: Path, name: str) -> list[dict[str, Any]]:
+    """The rows of ``out/name`` (a Parquet table the study wrote)."""
+    return read_table(Path(out) / name).to_pylist()
+
+
+def config(out: Path) -> dict[str, Any]:
+    """The provenance of the study's ``claims.parquet`` (its ``config`` and the run's facts)."""
+    return read_provenance(Path(out) / "claims.parquet")
+
+
+def figure(out: Path, file: str, alt: str) -> str:
+    """The Markdown line of one figure of the study, relative to the report."""
+    return f"![{alt}]({Path(out).name}/{file})"
+
+
+def span(lo, hi, unit: str = "") -> str:
+    """``lo–hi`` (or one value when they are equal), ``nowhere`` when missing or NaN."""
+    if lo is None or (isinstance(lo, float) and math.isnan(lo)):
+        return "nowhere"
+    return (f"{fmt(lo)}" if lo == hi else f"{fmt(lo)}–{fmt(hi)}") + unit
+
+
+def region_verdicts(out: Path) -> list[str]:
+    """One line per claim decided over the region: verdict and where it holds."""
+    return [
+        f"- `{r['claim']}`{' (headline)' if r['headline'] else ''}: **{r['verdict']}** — "
+        f"{r['note']}"
+        for r in rows(out, "claims.parquet")
+        if r["interval"] == "region"
+    ]
+
+
+_REGION_HOW = (
+    "The unprinted inputs are explored jointly (`sim.claims.inference`: a Sobol design "
+    "plus refinement at the boundaries; every value analytic). The region holds the input "
+    "vectors that the hardware and the printed inputs allow; a prediction *holds* or "
+    "*fails* over all of it, else *depends* (where it holds is given) "
+    "(`consistent_region.parquet`, `region_inputs.parquet`)."
+)
+
+
+def _region_sentence(ins: list[dict], what: str) -> str:
+    r0 = ins[0]
+    if not r0["n_together"]:
+        return (
+            f"**Consistent region.** {what} hold together for no input of the region "
+            f"({r0['n_region']} input vectors of {r0['n_points']} explored)."
+        )
+    imp = ", ".join(
+        f"{r['input']} {span(r['together_low'], r['together_high'])}"
+        for r in ins
+        if r["declared_low"] != r["declared_high"]
+    )
+    return (
+        f"**Consistent region.** {what} hold together for {imp} "
+        f"({r0['n_together']} of the {r0['n_region']} input vectors of the region; "
+        f"{r0['n_points']} explored)."
+    )
+
+
+def region_lead(out: Path, what: str) -> str:
+    """The lead of a study decided over a region of unprinted inputs: where ``what`` (the
+    predictions, in words) hold together, the region per input, and the verdicts over it
+    (``region_inputs.parquet``, ``claims.parquet``)."""
+    ins = rows(out, "region_inputs.parquet")
+    table_rows = [
+        [
+            f"`{r['input']}`",
+            f"{fmt(r['declared_low'])}–{fmt(r['declared_high'])}: {r['why']}",
+            span(r["region_low"], r["region_high"]),
+            span(r["together_low"], r["together_high"]),
+            f"{fmt(r['resolution_interior'])} / {fmt(r['resolution_boundary'])}",
+        ]
+        for r in ins
+    ]
+    header = [
+        "input",
+        "possible (hardware)",
+        "region",
+        "every prediction holds",
+        "resolution (interior / boundary)",
+    ]
+    return "\n".join(
+        [
+            _region_sentence(ins, what),
+            "",
+            _REGION_HOW,
+            "",
+            md_table(header, table_rows),
+            "",
+            "Verdicts over the region:",
+            "",
+            *region_verdicts(out),
+        ]
+    )
+
+
+def region_by_part(out: Path) -> str:
+    """A region explored per part (a ``part`` column in ``region_inputs.parquet``): per part,
+    where every prediction holds, the region, the resolution; then the verdicts over it."""
+    ins = rows(out, "region_inputs.parquet")
+    txt = []
+    for part in dict.fromkeys(r["part"] for r in ins):
+        rs = [r for r in ins if r["part"] == part]
+        r0 = rs[0]
+        txt.append(
+            f"*Part `{part}`* ({r0['n_region']} of {r0['n_points']} explored input vectors in the "
+            f"region; every prediction holds at {r0['n_together']}): "
+            + "; ".join(
+                f"`{r['input']}` possible {fmt(r['declared_low'])}–{fmt(r['declared_high'])}, "
+                f"region {span(r['region_low'], r['region_high'])}, all hold "
+                f"{span(r['together_low'], r['together_high'])} (resolution "
+                f"{fmt(r['resolution_interior'])} / {fmt(r['resolution_boundary'])})"
+                for r in rs
+            )
+            + "."
+        )
+    return "\n".join([*txt, "", "Verdicts over the region:", "", *region_verdicts(out)])
+
+
+def section(
+    out: Path,
+    *,
+    lead: Sequence[str] = (),
+    intro: Sequence[str] = (),
+    schema: Any = None,
+    body: Sequence[str] = (),
+    figures: Sequence[tuple[str, str]] = (),
+) -> str:
+    """A study's report section in the fixed order (lead, intro, claims table with the
+    numbers not reproduced, inputs of ``schema``, body, figures ``(alt, file)``); empty
+    blocks are left out, the others separated by one blank line."""
+    out = Path(out)
+    cfg = config(out)["config"]
+    blocks = [
+        *lead,
+        *intro,
+        claims_markdown(out / "claims.parquet"),
+        inputs_markdown(cfg, schema) if schema is not None else "",
+        *body,
+        "\n".join(figure(out, f, alt) for alt, f in figures),
+    ]
+    return "\n\n".join(b for b in blocks if b)
