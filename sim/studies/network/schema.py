@@ -121,10 +121,10 @@ SCHEMA["chunk"] = Field(
 def check(cfg: dict) -> None:
     """Cross-key rules: the network builds, its datum covers every rank defect, the chunk
     fits in memory, and the run has at least two chunks."""
-    from sim.studies.network.analysis import analyse
     from sim.studies.network.definition import build
     from sim.studies.network.gama import merge_gama
     from sim.studies.network.model import datum
+    from sim.studies.network.sparse_analysis import chunk_bytes, pre_analysis, use_sparse
 
     if cfg["trials"] < 2 * cfg["chunk"]:
         raise ConfigError(
@@ -134,17 +134,20 @@ def check(cfg: dict) -> None:
         )
     cfg = merge_gama(cfg)
     net = build(cfg)
-    nbytes = cfg["chunk"] * net.m * (net.q + 1) * 8
+    sparse = use_sparse(net)
+    nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
     if nbytes > MAX_CHUNK_BYTES:
         raise ConfigError(
             "chunk",
-            f"a chunk of {cfg['chunk']} trials needs "
-            f"{nbytes / 1024**3:.1f} GiB of Jacobians ({net.m} observations x "
-            f"{net.q} unknowns); use a smaller chunk",
+            f"a chunk of {cfg['chunk']} trials needs about "
+            f"{nbytes / 1024**3:.1f} GiB ({net.m} observations x "
+            f"{net.q} unknowns{', sparse' if sparse else ''}); use a smaller chunk",
         )
     dt = datum(net, cfg)
-    an = analyse(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
+    an = pre_analysis(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
+        if sparse:
+            raise ConfigError("datum.kind", f"{an.factor.message}: fix points or change the datum")
         _defect(net, dt, "datum.kind")
     if an.dof < 1:
         raise ConfigError(
@@ -157,7 +160,9 @@ def check(cfg: dict) -> None:
         from sim.studies.network.run import compare_points
 
         extra = compare_points(net, cfg)
-        an2 = analyse(net, datum(net, cfg, tuple(extra)), 0.001, 0.8)
+        an2 = pre_analysis(net, datum(net, cfg, tuple(extra)), 0.001, 0.8)
+        if not an2.ok and sparse:
+            raise ConfigError("compare.fix", f"{an2.factor.message} in the compared datum")
         if not an2.ok:
             _defect(net, datum(net, cfg, tuple(extra)), "compare.fix")
 
