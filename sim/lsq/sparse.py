@@ -82,18 +82,26 @@ def design(cols: np.ndarray, vals: np.ndarray, w: np.ndarray, free: np.ndarray, 
     return A
 
 
-def normals(cols, vals, w, free, q) -> sparse.csc_matrix:
+def normals(cols, vals, w, free, q, pairs=None) -> sparse.csc_matrix:
     """``N = A' W A`` over the free unknowns, sparse (CSC), summed row by row from each row's
     slot pairs: every pair of unknowns an observation joins is in the pattern, also where
-    its sum cancels to zero (the selected inverse is wanted there)."""
+    its sum cancels to zero (the selected inverse is wanted there); ``pairs`` (k, 2) global
+    indices of more pairs to hold in the pattern (e.g. x and y of every point)."""
     fc = _free_cols(cols, free, q)
     a = np.where(fc >= 0, vals * np.sqrt(w)[:, None], 0.0)
     r = np.broadcast_to(fc[:, :, None], fc.shape + fc.shape[1:2])
     c = np.swapaxes(r, 1, 2)
     use = (r >= 0) & (c >= 0)
     v = (a[:, :, None] * a[:, None, :])[use]
+    r, c = r[use], c[use]
+    if pairs is not None:
+        pp = _free_cols(np.asarray(pairs, np.int64), free, q)
+        pp = pp[(pp >= 0).all(axis=1)]
+        r = np.concatenate([r, pp[:, 0], pp[:, 1]])
+        c = np.concatenate([c, pp[:, 1], pp[:, 0]])
+        v = np.concatenate([v, np.zeros(2 * len(pp))])
     p = len(free)
-    return sparse.csc_matrix((v, (r[use], c[use])), shape=(p, p))
+    return sparse.csc_matrix((v, (r, c)), shape=(p, p))
 
 
 def factor_nonzeros(p: int, nnz_n: int) -> float:
@@ -122,6 +130,7 @@ class Factor:
     C: np.ndarray | None = None  # (p, c) constraints C' dx = 0
     P: np.ndarray | None = None  # (p, c): x = y - P C' y restores them
     terms: list = field(default_factory=list)  # [(Lm, Rm)]: Q += Lm Rm' (low rank)
+    transformed: bool = False  # Q = S Q_r S' (a datum over a rank defect)
     Zx: np.ndarray | None = field(default=None, repr=False)
     Zd: np.ndarray | None = field(default=None, repr=False)
 
@@ -150,6 +159,13 @@ class Factor:
         if self.P is not None:
             X = X - self.P @ (self.C.T @ X)
         return X
+
+    def cov_times(self, B: np.ndarray) -> np.ndarray:
+        """``Q B`` for any ``B`` (p, k): the cofactor matrix in the datum times ``B`` (where
+        :meth:`solve` takes right-hand sides of the normals, orthogonal to the defect)."""
+        if self.transformed:
+            B = B - self.C @ (self.P.T @ B)
+        return self.solve(B)
 
     def selected_inverse(self) -> None:
         """Compute (once) the selected inverse on the factor's pattern."""
@@ -268,7 +284,7 @@ def _constrain(f: Factor, G: np.ndarray | None, C: np.ndarray, rcond: float) -> 
             return
         U = G @ np.linalg.inv(CG)
         K = C.T @ W
-        f.C, f.P = C, U
+        f.C, f.P, f.transformed = C, U, True
         f.terms = [(-U, W), (-W, U), (U @ K, U)]
     else:  # regular normals with constraints: Q = Q_r - W (C' W)^-1 W'
         M = C.T @ W
@@ -308,10 +324,14 @@ def gauss_newton_shared(
                 break
             act = np.flatnonzero(prog.active)
             _, g = gradient(theta[act], act)
-            dx = factor.solve(np.ascontiguousarray(g.T)).T
+            dx = factor.cov_times(np.ascontiguousarray(g.T)).T  # the bordered step Q g
             step = np.where(np.isfinite(dx).all(axis=1), np.abs(dx).max(axis=1, initial=0), np.nan)
             full = np.full(T, np.nan)
             full[act] = step
+            # the step itself must fall below tol: with the normals of the nominal the
+            # corrections need not shrink at one rate (a pair of iterations can alternate a
+            # small and a large ratio), so the contraction estimate is not used here
+            prog.prev[:] = np.nan
             upd = prog.update(it, np.ones(T, bool), full, tol)
             theta[np.ix_(act[upd[act]], free)] += dx[upd[act]]
         r, _ = gradient(theta, np.arange(T))

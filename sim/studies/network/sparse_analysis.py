@@ -76,11 +76,24 @@ def chunk_bytes(net: Network, chunk: int) -> float:
     return 3.0 * 8 * (chunk * net.m * (s + 3) + 3 * chunk * net.q) + 3 * 16 * nnz_l
 
 
+def _pairs(net: Network) -> np.ndarray:
+    """Pairs of globals ``(k, 2)`` the pattern must hold beyond the Jacobian's: x and y of
+    every point (its covariance block) and every coordinate of the two points of a
+    coordinate difference (the displacement its MDB causes at its points)."""
+    a = np.arange(net.n)
+    out = [np.stack([2 * a, 2 * a + 1], 1)]
+    d = np.flatnonzero(np.isin(net.kind, (3, 4)))
+    if d.size:
+        c = np.stack([2 * net.i[d], 2 * net.i[d] + 1, 2 * net.j[d], 2 * net.j[d] + 1], 1)
+        out.append(np.stack(np.broadcast_arrays(c[:, :, None], c[:, None, :]), -1).reshape(-1, 2))
+    return np.concatenate(out)
+
+
 def factor(net: Network, datum: lsq.Datum) -> lsq_sparse.Factor:
     """The sparse factor of ``net``'s normals at the true coordinates in ``datum``."""
     free = datum.free_index(net.q)
     _, vals = jacobian_sparse(net, net.theta_true()[None])
-    N = lsq_sparse.normals(pattern(net), vals[0], 1.0 / net.sigma**2, free, net.q)
+    N = lsq_sparse.normals(pattern(net), vals[0], 1.0 / net.sigma**2, free, net.q, _pairs(net))
     C = datum.constraint_matrix(net.theta_true()[None])
     C = None if C is None else np.asarray(C[0], float)
     G, defect = defect_basis(net, free)
@@ -187,7 +200,7 @@ def in_datum_sparse(net: Network, an: SparseAnalytic, points: list[int]) -> np.n
     B = np.zeros((f.p, H.shape[1]))
     B[pos[est]] = V[est]
     QV = np.zeros_like(H)
-    QV[est] = f.solve(B)[pos[est]]
+    QV[est] = f.cov_times(B)[pos[est]]
     K = V.T @ QV
     Q0 = _point_blocks(net, _free_pos(net, an.free), f)
     out = np.empty_like(Q0)
