@@ -81,12 +81,10 @@ def test_sparse_equals_dense_on_small_networks(case, tmp_path):
     np.testing.assert_array_less(
         np.abs(s.bnr[fin] / d.bnr[fin] - 1), 1e-10 * np.maximum(1.0, 1 / r) + 1e-12
     )
-    # (to the MDB's own precision)
+    # the local external reliability is the largest displacement at the observation's own
+    # points: never above the dense path's largest over all points (to the MDB's precision)
     tol_ext = 1e-10 * np.maximum(1.0, 0.5 / r) + 1e-14
     assert np.all(s.ext_max_mm[fin] <= d.ext_max_mm[fin] * (1 + tol_ext))
-    # the local external reliability is the largest displacement at the observation's own
-    # points: never above the dense path's largest over all points
-
     par = np.arange(len(d.free))
     np.testing.assert_allclose(
         variances(s, par), variances(d, par), rtol=1e-9, atol=1e-12 * d.Q.diagonal().max()

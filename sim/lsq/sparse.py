@@ -304,13 +304,15 @@ def gauss_newton_shared(
     w: np.ndarray,
     tol: float,
     max_iter: int,
+    linear: bool = False,
 ):
     """Gauss-Newton of a batch that starts at the nominal unknowns ``theta0`` (T, q), with the
     normals factorised once there (``factor``) for every trial and iteration.
 
     ``gradient(theta, trials)`` returns ``r`` (k, m) observed minus computed and ``A' W r``
     (k, p) of the ``trials`` (k,) at their current unknowns ``theta`` (k, q) (the trial's own Jacobian: the fixed point is the least-squares
-    solution); ``w`` (m,) the weights. Returns ``theta`` (T, q), ``vpv`` (T,), ``iterations``
+    solution); ``w`` (m,) the weights; ``linear``: the observations are linear in the
+    unknowns, so the first step is the solution (status 0 after one iteration). Returns ``theta`` (T, q), ``vpv`` (T,), ``iterations``
     (T,) and ``status`` (T,) int8 (0 converged, 1 not within ``max_iter``, 2 singular,
     3 non-finite)."""
     theta = np.array(theta0, float, copy=True)
@@ -332,7 +334,7 @@ def gauss_newton_shared(
             # corrections need not shrink at one rate (a pair of iterations can alternate a
             # small and a large ratio), so the contraction estimate is not used here
             prog.prev[:] = np.nan
-            upd = prog.update(it, np.ones(T, bool), full, tol)
+            upd = prog.update(it, np.ones(T, bool), full, np.inf if linear else tol)
             theta[np.ix_(act[upd[act]], free)] += dx[upd[act]]
         r, _ = gradient(theta, np.arange(T))
         vpv = (w * r * r).sum(axis=1)

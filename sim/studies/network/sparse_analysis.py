@@ -243,6 +243,7 @@ def mc_chunk_sparse(
         1.0 / net.sigma**2,
         tol,
         max_iter,
+        linear=bool(np.isin(net.kind, (3, 4, 5, 6)).all()),
     )
     ok = status == 0
     err = theta - theta0
