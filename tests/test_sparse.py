@@ -258,3 +258,28 @@ def test_the_datum_must_cover_the_defect():
     bad = lsq_sparse.factorize(N, G, np.array([[1.0, 0], [0, 1], [0, 0], [0, 0]]))
     assert not bad.ok and "2 constraints for a rank defect of 1" in bad.message
     assert not lsq_sparse.factorize(N, G, None).ok
+
+
+def test_the_estimate_counts_nonzeros_and_bounds_a_network_by_memory(tmp_path):
+    """The network estimator: unknowns from the declaration, memory of the sparse path
+    growing with the chunk; a network too large for the memory limit is refused with the
+    estimate (exit 2 at the command line), not by a count."""
+    from sim.mc.config import ConfigError
+    from sim.mc.estimate import check_limits, estimate
+
+    _, cfg = load_study(ROOT / "studies" / "network_gridplate_2500.toml")
+    est = estimate(cfg)
+    assert est.unknowns >= 5000 and est.trials == cfg["trials"]
+    assert estimate({**cfg, "chunk": 200}).bytes > est.bytes
+    big = {**cfg, "network.grids": [{**cfg["network.grids"][0], "nx": 3000, "ny": 3000}]}
+    with pytest.raises(ConfigError, match="GiB"):
+        check_limits(estimate(big))
+    f = tmp_path / "huge.toml"
+    f.write_text(
+        'study = "network"\ntrials = 4\nchunk = 2\n[network]\n'
+        'grids = [ { prefix = "P", nx = 100000, ny = 100000, spacing_mm = 1.0 } ]\n'
+        'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 4, '
+        "sigma_mm = 1.0 } ]\n"
+    )
+    with pytest.raises(ConfigError, match="memory limit"):
+        load_study(f)
