@@ -17,6 +17,7 @@ rad. Seeds: Baarda's reliability theory (``004``), Takahashi et al. 1973.
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -172,9 +173,40 @@ def pre_analysis(net: Network, datum: lsq.Datum, a0: float, power: float) -> Ana
     """The analytic pre-analysis on the path the network's size calls for: the dense one
     (:func:`sim.studies.network.analysis.analyse`) below :data:`SPARSE_MIN_UNKNOWNS`
     unknowns, the sparse one from there."""
-    if use_sparse(net):
-        return analyse_sparse(net, datum, a0, power)
-    return analyse(net, datum, a0, power)
+    if not use_sparse(net):
+        return analyse(net, datum, a0, power)
+    key = _key(net, datum, a0, power)
+    if key not in _LAST:  # `sim run` checks the config, then runs it: one analysis for both
+        _LAST.clear()
+        _LAST[key] = analyse_sparse(net, datum, a0, power)
+    return _LAST[key]
+
+
+#: the last sparse pre-analysis of this process, by the digest of its inputs
+_LAST: dict[str, SparseAnalytic] = {}
+
+
+def _key(net: Network, datum: lsq.Datum, a0: float, power: float) -> str:
+    """Digest of everything a pre-analysis reads: the network's arrays and parameters, the
+    datum's free unknowns and constraints, the test's level and power."""
+    h = hashlib.sha256(repr((net.name, net.names, net.stations, a0, power)).encode())
+    for a in (net.xy, net.role, net.kind, net.i, net.j, net.k, net.sigma, net.oset):
+        h.update(np.ascontiguousarray(a).tobytes())
+    h.update(
+        repr(
+            (
+                net.constant_mm,
+                net.estimate_constant,
+                net.offset_mm,
+                net.scale_ppm,
+                net.estimate_scale,
+            )
+        ).encode()
+    )
+    h.update(np.asarray(datum.free_index(net.q)).tobytes())
+    C = datum.constraint_matrix(net.theta_true()[None])
+    h.update(b"" if C is None else np.ascontiguousarray(C).tobytes())
+    return h.hexdigest()
 
 
 def variances(an: Analytic, idx: np.ndarray) -> np.ndarray:
