@@ -11,6 +11,8 @@ import pytest
 from scipy import sparse
 
 from sim.lsq import sparse as lsq_sparse
+from sim.mc.config import ConfigError
+from sim.mc.estimate import check_limits, estimate
 from sim.studies import load_study
 from sim.studies.network.analysis import analyse, in_datum, mc_chunk
 from sim.studies.network.definition import _targets, build
@@ -266,9 +268,6 @@ def test_the_estimate_counts_nonzeros_and_bounds_a_network_by_memory(tmp_path):
     """The network estimator: unknowns from the declaration, memory of the sparse path
     growing with the chunk; a network too large for the memory limit is refused with the
     estimate (exit 2 at the command line), not by a count."""
-    from sim.mc.config import ConfigError
-    from sim.mc.estimate import check_limits, estimate
-
     _, cfg = load_study(ROOT / "studies" / "network_gridplate_2500.toml")
     est = estimate(cfg)
     assert est.unknowns >= 5000 and est.trials == cfg["trials"]
