@@ -14,7 +14,8 @@ from sim.lsq import sparse as lsq_sparse
 from sim.mc.config import ConfigError
 from sim.mc.estimate import check_limits, estimate
 from sim.studies import load_study
-from sim.studies.network.analysis import analyse, in_datum, mc_chunk
+from sim.studies.network import model
+from sim.studies.network.analysis import analyse, in_datum, inner_defect, mc_chunk
 from sim.studies.network.definition import _targets, build
 from sim.studies.network.gama import merge_gama
 from sim.studies.network.kernel import residual_gradient
@@ -284,3 +285,43 @@ def test_the_estimate_counts_nonzeros_and_bounds_a_network_by_memory(tmp_path):
     )
     with pytest.raises(ConfigError, match="memory limit"):
         load_study(f)
+
+
+def test_large_network_keeps_the_datum_semantics_on_the_sparse_path(tmp_path, monkeypatch):
+    """Above SPARSE_MIN_UNKNOWNS the defects come from the sparse design: a directions-only
+    network with one fixed point has the rotation and the scale about it as its defects (the
+    same span as the dense design gives); the inner datum over them and the inner_over
+    transformation (translation, rotation and scale: no length) equal the dense path's."""
+    f = tmp_path / "dir.toml"
+    f.write_text(
+        'study = "network"\ntrials = 40\nchunk = 20\nseed = 3\n[network]\n'
+        'points = [ { name = "F", x_mm = 0.0, y_mm = 0.0, role = "fixed" } ]\n'
+        'random = [ { prefix = "P", n = 225, half_extent_mm = 20000.0 } ]\n'
+        'generate = [ { kind = "direction", from = "*", to = "*", nearest = 6, '
+        'sigma_arcsec = 2.0 } ]\n[datum]\nkind = "inner"\n'
+    )
+    _, cfg = load_study(f)
+    net = build(cfg)
+    assert model.use_sparse(net)
+    dt = datum(net, cfg)
+    free = dt.free_index(net.q)
+    D_s = model.defect_basis(net, free)
+    s = analyse_sparse(net, dt, 0.001, 0.8)
+    with monkeypatch.context() as m:
+        m.setattr(model, "SPARSE_MIN_UNKNOWNS", 10**9)
+        D_d = model.defect_basis(net, free)
+        H_d = inner_defect(net)
+    assert D_s.shape[1] == D_d.shape[1] == 2 and H_d.shape[1] == 4
+    np.testing.assert_allclose(D_s @ D_s.T, D_d @ D_d.T, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(D_s.T @ D_s, np.eye(2), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(inner_defect(net) @ inner_defect(net).T, H_d @ H_d.T, atol=1e-10)
+    d = analyse(net, dt, 0.001, 0.8)
+    assert d.ok and s.ok and s.dof == d.dof
+    scale = np.sqrt(d.cov[:, [0, 1], [0, 1]]).max()
+    np.testing.assert_allclose(s.cov, d.cov, rtol=0, atol=1e-9 * scale**2)
+    np.testing.assert_allclose(s.redundancy, d.redundancy, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(s.n_diag, d.n_diag, rtol=1e-12)
+    pts = list(range(1, 40))
+    np.testing.assert_allclose(
+        in_datum_sparse(net, s, pts), in_datum(net, d, pts), rtol=0, atol=1e-9 * scale**2
+    )
