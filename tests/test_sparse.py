@@ -4,9 +4,12 @@ equals the dense Jacobian's, a batch of trials gives the same numbers however it
 the k-d tree finds the same nearest targets as a full sort, and a network the old count
 limits refused now checks."""
 
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
+import pyarrow.parquet as pq
 import pytest
 from scipy import sparse
 
@@ -325,3 +328,40 @@ def test_large_network_keeps_the_datum_semantics_on_the_sparse_path(tmp_path, mo
     np.testing.assert_allclose(
         in_datum_sparse(net, s, pts), in_datum(net, d, pts), rtol=0, atol=1e-9 * scale**2
     )
+
+
+def test_a_large_network_runs_end_to_end_on_the_sparse_path(tmp_path):
+    """`sim run` of a 20 x 20 grid (distances and directions to the nearest, inner datum,
+    estimated scale, another datum and a compared parameterisation): every table written,
+    Monte Carlo within its sampling error of the analytic sigmas, redundancy sum = dof."""
+    f = tmp_path / "big.toml"
+    f.write_text(
+        'study = "network"\ntrials = 60\nchunk = 20\nseed = 3\n[network]\n'
+        "estimate_scale = true\n"
+        'grids = [ { prefix = "P", nx = 20, ny = 20, spacing_mm = 10000.0 } ]\n'
+        'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 8, sigma_mm = 1.0 },'
+        ' { kind = "direction", from = "P*", to = "P*", nearest = 4, sigma_arcsec = 1.0 } ]\n'
+        '[datum]\nkind = "inner"\n[output]\ninner_over = ["P1?"]\n'
+        '[compare]\nfix = ["P1", "P400"]\n'
+    )
+    out = tmp_path / "out"
+    r = subprocess.run(
+        [sys.executable, "-m", "sim", "run", str(f), "--out", str(out), "--quiet"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert r.returncode == 0, r.stderr
+    s = pq.read_table(out / "summary.parquet").to_pydict()
+    assert s["points"] == [400] and s["converged"] == [60]
+    assert abs(s["redundancy_sum"][0] - s["dof"][0]) < 1e-6
+    # mean of 800 sigma ratios, each from 60 trials (sd about 1/sqrt(120) each, correlated):
+    # 10 % is several times the sampling error of the mean
+    assert abs(s["mc_over_analytic"][0] - 1) < 0.1
+    pts = pq.read_table(out / "points.parquet").to_pydict()
+    assert len(pts["point"]) == 400 and np.isfinite(pts["dilution_pct"]).sum() >= 398
+    par = pq.read_table(out / "parameters.parquet").to_pydict()
+    assert "scale" in par["parameter"] and all(np.isfinite(par["sigma"]))
+    d = pq.read_table(out / "datums.parquet").to_pydict()
+    assert len(d["point"]) == 400 and np.all(np.isfinite(d["sigma_x_mm"]))
+    assert (out / "network.png").is_file() and (out / "reliability.png").is_file()

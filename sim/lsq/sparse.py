@@ -29,7 +29,9 @@ slots of a row (``-1``: unused) and ``vals`` ``(..., m, s)`` the derivatives. We
   the nominal unknowns: the normals factorised there serve every iteration and every trial
   (each iteration's gradient is taken at the trial's current unknowns, so the fixed point is
   the least-squares solution; the contraction is the small change of the Jacobian over the
-  corrections). Status codes as :data:`sim.lsq.result.STATUS`.
+  corrections); a trial stops when its largest correction is below ``tol`` or below the
+  rounding of its largest free unknown (64 ulp). Status codes as
+  :data:`sim.lsq.result.STATUS`.
 
 Units are those of the problem (mm, rad, ...). Library: SciPy's SuperLU (``splu``), which
 installs with SciPy on every machine; the selected inversion and the block solves are the
@@ -338,6 +340,10 @@ def gauss_newton_shared(
             # corrections need not shrink at one rate (a pair of iterations can alternate a
             # small and a large ratio), so the contraction estimate is not used here
             prog.prev[:] = np.nan
+            # a correction below the unknowns' own rounding (64 ulp of the largest free one)
+            # cannot be resolved: in a field network of 10 km in mm it is about 1e-9 mm
+            floor = 64 * np.finfo(float).eps * np.abs(theta[act][:, free]).max(axis=1, initial=0)
+            full[act] = np.where(step <= floor, 0.0, step)
             upd = prog.update(it, np.ones(T, bool), full, np.inf if linear else tol)
             theta[np.ix_(act[upd[act]], free)] += dx[upd[act]]
         r, _ = gradient(theta, np.arange(T))
