@@ -5,7 +5,8 @@ Sections (``--only``, default all): ``brown`` (``bench.parquet``, ``bench.png``:
 ``studies`` (``studies.parquet``: :mod:`benchmarks.studies`) and ``rerun``
 (``rerun.parquet``: :mod:`benchmarks.rerun`; ``--no-rerun`` leaves it out), engines and rerun
 drawn in ``engines.png``; ``README.md`` (:mod:`benchmarks.page`) names each compiled module and
-the row that keeps it. ``--quick`` is a smoke run: small sizes, and the rerun rows with
+the row that keeps it; ``scaling`` (``scaling.parquet``, ``scaling.png``: the sparse path
+from 100 to 10,000 points and blocks of 10 to 200 models, :mod:`benchmarks.scaling`). ``--quick`` is a smoke run: small sizes, and the rerun rows with
 the test suite's tiny configuration of each study (``tests/data/tiny/<study>.txt``), so its
 rerun times say nothing about the 90 s target.
 """
@@ -29,7 +30,7 @@ from sim.mc.storage import provenance, write_table
 
 __all__ = ["main", "run"]
 
-SECTIONS = ("brown", "engines", "studies", "rerun")
+SECTIONS = ("brown", "engines", "studies", "rerun", "scaling")
 TINY = Path(__file__).resolve().parent.parent / "tests" / "data" / "tiny"
 
 
@@ -83,6 +84,16 @@ def run(
             tables["rerun.parquet"],
             provenance(prov, files=[f.as_posix() for f in files], tiny_configurations=quick),
         )
+    if "scaling" in sections:
+        from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
+
+        tables["scaling.parquet"] = scaling_rows(quick)
+        write_table(
+            out / "scaling.parquet",
+            tables["scaling.parquet"],
+            provenance(prov, gama_local=gama_local() or ""),
+        )
+        scaling_figure(tables["scaling.parquet"], out / "scaling.png")
     if "engines" in sections or "rerun" in sections:
         engines_figure(
             tables.get("engines.parquet"), tables.get("rerun.parquet"), out / "engines.png"

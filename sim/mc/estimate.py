@@ -16,6 +16,7 @@ bounded too: at most :data:`MAX_CELLS` cells times replicates.
 
 from __future__ import annotations
 
+import fnmatch
 import math
 import os
 from dataclasses import dataclass
@@ -256,6 +257,70 @@ def _agnard(c: Mapping) -> tuple:
     return trials, adj, int(max(U, Ut)), b
 
 
+#: unknowns from which the network kind takes the sparse path (as
+#: sim.studies.network.sparse_analysis.SPARSE_MIN_UNKNOWNS; a layer below, so stated twice)
+NETWORK_SPARSE_FROM = 400
+
+
+def _network_names(c: Mapping) -> list[str]:
+    """The point names a network config declares (grids and random sets by prefix)."""
+    names = [str(p.get("name", "")) for p in c.get("network.points", []) if isinstance(p, dict)]
+    for key, count in (("network.grids", ("nx", "ny")), ("network.random", ("n",))):
+        for rec in c.get(key, []):
+            if not isinstance(rec, dict):
+                continue
+            k = math.prod(int(rec.get(f, 1)) for f in count)
+            if k > 5e7:
+                raise OverflowError("too many points to list")
+            names += [f"{rec.get('prefix', '')}{b + 1}" for b in range(k)]
+    return names
+
+
+def _network(c: Mapping) -> tuple:
+    """A network: points and observations counted from the declaration (patterns matched
+    against the names; ``nearest`` bounds each generated set), then the memory of the path
+    the size takes -- the sparse one counts nonzeros (Jacobian slots per observation, the
+    factor ~ nnz(N) log2(unknowns) / 3, its selected inverse), the dense one trials x
+    observations x unknowns."""
+    T, ch = c["trials"], min(c["chunk"], c["trials"])
+    gama = c.get("network.gama_xml", "")
+    if gama:  # an imported file: about 80 bytes per observation, 4 observations a point
+        m = os.path.getsize(gama) / 80 if os.path.isfile(gama) else 1e3
+        n = m / 4
+    else:
+        names = _network_names(c)
+        n = len(names)
+
+        def count(pats) -> int:
+            pats = [pats] if isinstance(pats, str) else list(pats or [])
+            return sum(1 for nm in names if any(fnmatch.fnmatchcase(nm, str(p)) for p in pats))
+
+        m = float(len(c.get("network.observations", [])))
+        for g in c.get("network.generate", []):
+            if isinstance(g, dict):
+                k = int(g.get("nearest", 0) or 0)
+                fr = count(g.get("from", []))
+                m += fr * (k if k else count(g.get("to", [])))
+        m += 2 * sum(
+            rec.get("role") == "observed"
+            for rec in c.get("network.points", [])
+            if isinstance(rec, dict)
+        )
+        m += 2 * sum(
+            math.prod(int(rec.get(f, 1)) for f in ("nx", "ny"))
+            for rec in c.get("network.grids", [])
+            if isinstance(rec, dict) and rec.get("role") == "observed"
+        )
+    U = 2 * n + n / 4 + 2  # coordinates, orientations (at most a quarter), constant, scale
+    if U >= NETWORK_SPARSE_FROM:
+        s = 6.0  # Jacobian slots of a distance or direction row
+        nnz_l = m * s * s * max(math.log2(max(U, 2)), 1.0) / 3 + 4 * U
+        b = 3 * F8 * (ch * m * (s + 3) + 3 * ch * U) + 3 * 16 * nnz_l
+    else:
+        b = ch * m * (U + 1) * F8 * COPIES
+    return T, T + 2, int(U), b
+
+
 def _generic(c: Mapping) -> tuple:
     T, ch = c.get("trials", 1), min(c.get("chunk", 1), c.get("trials", 1))
     return T, T, 0, ch * 1e4
@@ -269,6 +334,7 @@ ESTIMATORS: dict[str, Callable[[Mapping], tuple]] = {
     "salsig_encoders": _salsig,
     "wolf_polynomial": _wolf,
     "agnard_block": _agnard,
+    "network": _network,
 }
 
 

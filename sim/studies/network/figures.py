@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.collections import LineCollection
 
 from sim.report.plotting import plt, save
 from sim.studies.network.analysis import CHI2_2_95, ellipse
@@ -24,14 +25,32 @@ def natural_unit(xy_mm: np.ndarray) -> tuple[str, float]:
     return ("m", 1000.0) if span >= FIELD_MM else ("mm", 1.0)
 
 
+#: above this many observations the figures draw collections (one artist for all lines,
+#: ellipses and bars): the same picture, in seconds for networks of thousands of points
+LARGE = 2000
+
+
+def _lines_large(ax, net, xy: np.ndarray) -> None:
+    """The observation lines of a large network as one collection (each pair once), at the
+    drawn coordinates ``xy`` (n, 2)."""
+    use = net.kind < 5
+    a = net.i[use]
+    b = np.where(net.kind[use] == 2, net.k[use], net.j[use])
+    pairs = np.unique(np.sort(np.stack([a, b], 1), axis=1), axis=0)
+    ax.add_collection(LineCollection(xy[pairs], colors="0.8", linewidths=0.5, zorder=1))
+
+
 def network_figure(net, an, pts, path: Path) -> Path:
     """Points (fixed as triangles), observation lines, 95 % ellipses magnified to be seen;
     axes in metres for a field network and in mm for a plate (:func:`natural_unit`)."""
     unit, f = natural_unit(net.xy)
     xy = net.xy / f
     fig, ax = plt.subplots(figsize=(6.5, 6.0))
+    large = net.m > LARGE
+    if large:
+        _lines_large(ax, net, xy)
     seen = set()
-    for r in range(net.m):
+    for r in range(0 if large else net.m):
         if net.kind[r] >= 5:
             continue
         a, b = net.i[r], (net.k[r] if net.kind[r] == 2 else net.j[r])
@@ -41,7 +60,14 @@ def network_figure(net, an, pts, path: Path) -> Path:
         seen.add(key)
         ax.plot(xy[[a, b], 0], xy[[a, b], 1], color="0.8", lw=0.5, zorder=1)
     fixed = net.role == 1
-    ax.scatter(xy[~fixed, 0], xy[~fixed, 1], s=10, color="C0", zorder=3, label="estimated point")
+    ax.scatter(
+        xy[~fixed, 0],
+        xy[~fixed, 1],
+        s=2 if large else 10,
+        color="C0",
+        zorder=3,
+        label="estimated point",
+    )
     if fixed.any():
         ax.scatter(
             xy[fixed, 0],
@@ -55,9 +81,16 @@ def network_figure(net, an, pts, path: Path) -> Path:
     a95, b95, th = ellipse(an.cov[pts])
     k = np.sqrt(CHI2_2_95)
     span = np.ptp(net.xy, axis=0).max() or 1.0
-    mag = 0.06 * span / max(float(k * a95.max()), 1e-300)  # both in mm
+    room = 0.4 * span / np.sqrt(net.n) if large else 0.06 * span  # a large net: the spacing
+    mag = room / max(float(k * a95.max()), 1e-300)  # both in mm
     t = np.linspace(0, 2 * np.pi, 61)
-    for p, A, B, T in zip(pts, a95, b95, th):
+    if large:
+        A, B, T = a95[:, None], b95[:, None], th[:, None]
+        ex = k * mag * (A * np.cos(t) * np.cos(T) - B * np.sin(t) * np.sin(T))
+        ey = k * mag * (A * np.cos(t) * np.sin(T) + B * np.sin(t) * np.cos(T))
+        seg = np.stack([xy[pts, 0, None] + ex / f, xy[pts, 1, None] + ey / f], -1)
+        ax.add_collection(LineCollection(seg, colors="C1", linewidths=0.9, zorder=2))
+    for p, A, B, T in zip(pts, a95, b95, th) if not large else ():
         ex = k * mag * (A * np.cos(t) * np.cos(T) - B * np.sin(t) * np.sin(T))
         ey = k * mag * (A * np.cos(t) * np.sin(T) + B * np.sin(t) * np.cos(T))
         ax.plot(xy[p, 0] + ex / f, xy[p, 1] + ey / f, color="C1", lw=0.9, zorder=2)
@@ -74,10 +107,18 @@ def reliability_figure(net, an, path: Path) -> Path:
     """Redundancy number per observation and the bias-to-noise ratio, by kind."""
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
     idx = np.arange(net.m)
-    for c in np.unique(net.kind):
+    for n_c, c in enumerate(np.unique(net.kind)):
         s = net.kind == c
-        a1.bar(idx[s], an.redundancy[s], width=1.0, label=KINDS[c])
         bnr = np.where(np.isfinite(an.bnr[s]), an.bnr[s], np.nan)
+        if net.m > LARGE:  # bars as one filled step outline per kind
+            r_all = np.where(s, an.redundancy, 0.0)
+            b_all = np.zeros(net.m)
+            b_all[s] = np.nan_to_num(bnr)
+            kw = dict(where=s, step="mid", color=f"C{n_c}", lw=0)
+            a1.fill_between(idx, 0, r_all, label=KINDS[c], **kw)
+            a2.fill_between(idx, 0, b_all, **kw)
+            continue
+        a1.bar(idx[s], an.redundancy[s], width=1.0, label=KINDS[c])
         a2.bar(idx[s], bnr, width=1.0)
     a1.set_ylabel("redundancy number")
     a1.set_ylim(0, 1)

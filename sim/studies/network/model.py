@@ -17,10 +17,23 @@ import fnmatch
 import numpy as np
 
 from sim import lsq
+from sim.lsq import sparse as lsq_sparse
 from sim.mc.config import ConfigError
 from sim.studies.network.definition import Network
 
-__all__ = ["NetworkModel", "computed", "simulate", "datum", "null_space", "defect_basis"]
+__all__ = [
+    "NetworkModel",
+    "computed",
+    "jacobian_sparse",
+    "pattern",
+    "simulate",
+    "datum",
+    "null_space",
+    "defect_basis",
+    "weighted_design",
+    "use_sparse",
+    "SPARSE_MIN_UNKNOWNS",
+]
 
 _TWO_PI = 2 * np.pi
 
@@ -29,9 +42,8 @@ def _wrap(a: np.ndarray) -> np.ndarray:
     return (a + np.pi) % _TWO_PI - np.pi
 
 
-def computed(net: Network, theta: np.ndarray, jac: bool = False):
-    """Computed observations ``(T, m)`` at globals ``theta`` ``(T, q)`` and, with ``jac``,
-    their Jacobian ``(T, m, q)`` (dense)."""
+def _terms(net: Network, theta: np.ndarray) -> dict:
+    """The computed observations ``val`` (T, m) and the pieces of their derivatives."""
     T = theta.shape[0]
     xy = theta[:, : 2 * net.n].reshape(T, net.n, 2)
     kind, i, j, k = net.kind, net.i, net.j, net.k
@@ -53,15 +65,13 @@ def computed(net: Network, theta: np.ndarray, jac: bool = False):
         [f * s - alpha, bear - ori, (bear_k - bear) % _TWO_PI, dx, dy, pi[..., 0]],
         pi[..., 1],
     )
-    if not jac:
-        return val
-    J = np.zeros((T, net.m, net.q + 1))  # the last column collects padding
-    rows = np.arange(net.m)
-    cx_i, cy_i = 2 * i, 2 * i + 1
-    cx_j = np.where(j >= 0, 2 * j, net.q)
-    cy_j = np.where(j >= 0, 2 * j + 1, net.q)
-    cx_k = np.where(k >= 0, 2 * k, net.q)
-    cy_k = np.where(k >= 0, 2 * k + 1, net.q)
+    return {"val": val, "dx": dx, "dy": dy, "d2": d2, "s": s, "f": f, "ex": ex, "ey": ey}
+
+
+def _derivatives(net: Network, t: dict) -> list[np.ndarray]:
+    """Derivatives ``(T, m)`` by x_i, y_i, x_j, y_j, x_k, y_k (see :func:`computed`)."""
+    kind = net.kind
+    dx, dy, d2, s, f, ex, ey = (t[a] for a in ("dx", "dy", "d2", "s", "f", "ex", "ey"))
     with np.errstate(invalid="ignore", divide="ignore"):
         gx = np.select([kind == 0, kind == 1, kind == 2], [f * dx / s, -dy / d2, dy / d2], 0.0)
         gy = np.select([kind == 0, kind == 1, kind == 2], [f * dy / s, dx / d2, -dx / d2], 0.0)
@@ -69,23 +79,89 @@ def computed(net: Network, theta: np.ndarray, jac: bool = False):
         hx, hy = np.where(kind == 2, -ey / e2, 0.0), np.where(kind == 2, ex / e2, 0.0)
     lin = kind <= 2
     # d/d(point j) = (gx, gy); d/d(point i) = -(gx + hx, gy + hy); d/d(point k) = (hx, hy)
-    J[:, rows, cx_j] = np.where(lin, gx, np.where(kind == 3, 1.0, 0.0))
-    J[:, rows, cy_j] = np.where(lin, gy, np.where(kind == 4, 1.0, 0.0))
+    return [
+        np.where(lin, -(gx + hx), np.select([kind == 3, kind == 5], [-1.0, 1.0], 0.0)),
+        np.where(lin, -(gy + hy), np.select([kind == 4, kind == 6], [-1.0, 1.0], 0.0)),
+        np.where(lin, gx, np.where(kind == 3, 1.0, 0.0)),
+        np.where(lin, gy, np.where(kind == 4, 1.0, 0.0)),
+        hx,
+        hy,
+    ]
+
+
+def computed(net: Network, theta: np.ndarray, jac: bool = False):
+    """Computed observations ``(T, m)`` at globals ``theta`` ``(T, q)`` and, with ``jac``,
+    their Jacobian ``(T, m, q)`` (dense)."""
+    t = _terms(net, theta)
+    if not jac:
+        return t["val"]
+    T = theta.shape[0]
+    i, j, k = net.i, net.j, net.k
+    J = np.zeros((T, net.m, net.q + 1))  # the last column collects padding
+    rows = np.arange(net.m)
+    cx_i, cy_i = 2 * i, 2 * i + 1
+    cx_j = np.where(j >= 0, 2 * j, net.q)
+    cy_j = np.where(j >= 0, 2 * j + 1, net.q)
+    cx_k = np.where(k >= 0, 2 * k, net.q)
+    cy_k = np.where(k >= 0, 2 * k + 1, net.q)
+    di, dyi, dj, dyj, hx, hy = _derivatives(net, t)
+    J[:, rows, cx_j] = dj
+    J[:, rows, cy_j] = dyj
     J[:, rows, cx_k] = hx
     J[:, rows, cy_k] = hy
-    J[:, rows, cx_i] = np.where(
-        lin, -(gx + hx), np.select([kind == 3, kind == 5], [-1.0, 1.0], 0.0)
-    )
-    J[:, rows, cy_i] = np.where(
-        lin, -(gy + hy), np.select([kind == 4, kind == 6], [-1.0, 1.0], 0.0)
-    )
+    J[:, rows, cx_i] = di
+    J[:, rows, cy_i] = dyi
     if len(net.stations):
-        d = kind == 1
+        d = net.kind == 1
         J[:, rows[d], 2 * net.n + net.oset[d]] = -1.0
-    dist = rows[kind == 0]
+    dist = rows[net.kind == 0]
     J[:, dist, net.i_constant] = -1.0
-    J[:, dist, net.i_scale] = 1e-6 * s[:, kind == 0]
-    return val, J[..., : net.q]
+    J[:, dist, net.i_scale] = 1e-6 * t["s"][:, net.kind == 0]
+    return t["val"], J[..., : net.q]
+
+
+def _slots(net: Network) -> np.ndarray:
+    """The column of each of the nine slots of each row ``(m, 9)`` (-1: unused): x_i, y_i,
+    x_j, y_j, x_k, y_k, orientation, constant, scale."""
+    i, j, k, kind = net.i, net.j, net.k, net.kind
+    pt = lambda a, c: np.where(a >= 0, 2 * a + c, -1)  # noqa: E731
+    return np.stack(
+        [
+            np.where((kind == 4) | (kind == 6), -1, 2 * i),
+            np.where((kind == 3) | (kind == 5), -1, 2 * i + 1),
+            np.where(kind == 4, -1, pt(j, 0)),
+            np.where(kind == 3, -1, pt(j, 1)),
+            pt(k, 0),
+            pt(k, 1),
+            np.where(kind == 1, 2 * net.n + net.oset, -1),
+            np.where(kind == 0, net.i_constant, -1),
+            np.where(kind == 0, net.i_scale, -1),
+        ],
+        1,
+    )
+
+
+def pattern(net: Network) -> np.ndarray:
+    """The Jacobian's pattern ``(m, s)``: the columns of the slots some row uses (see
+    :func:`_slots`; -1 where a row does not use a slot)."""
+    cols = _slots(net)
+    return cols[:, (cols >= 0).any(0)]
+
+
+def jacobian_sparse(net: Network, theta: np.ndarray):
+    """Computed observations ``(T, m)`` and the Jacobian on :func:`pattern`'s slots
+    ``(T, m, s)``: the same derivatives as :func:`computed`, without the dense array."""
+    t = _terms(net, theta)
+    T = theta.shape[0]
+    kind = net.kind
+    dist = (kind == 0)[None, :]
+    full = _derivatives(net, t) + [
+        np.broadcast_to(np.where(kind == 1, -1.0, 0.0), (T, net.m)),
+        np.broadcast_to(np.where(dist, -1.0, 0.0), (T, net.m)),
+        np.where(dist, 1e-6 * t["s"], 0.0),
+    ]
+    used = np.flatnonzero((_slots(net) >= 0).any(0))
+    return t["val"], np.stack([full[a] for a in used], -1)
 
 
 def simulate(net: Network, rng: np.random.Generator, T: int) -> np.ndarray:
@@ -139,11 +215,29 @@ def _similarity(net: Network) -> np.ndarray:
     return G
 
 
+#: networks with at least this many unknowns take the sparse path (smaller ones the dense one,
+#: the reference of the tests; :mod:`sim.studies.network.sparse_analysis`)
+SPARSE_MIN_UNKNOWNS = 400
+
+
+def use_sparse(net: Network) -> bool:
+    """Whether ``net`` is adjusted on the sparse path (:data:`SPARSE_MIN_UNKNOWNS`)."""
+    return net.q >= SPARSE_MIN_UNKNOWNS
+
+
+def weighted_design(net: Network, free: np.ndarray):
+    """The weighted design ``A / sigma`` ``(m, p)`` at the true coordinates (sparse CSR)."""
+    _, vals = jacobian_sparse(net, net.theta_true()[None])
+    return lsq_sparse.design(pattern(net), vals[0], 1.0 / net.sigma**2, free, net.q)
+
+
 def defect_basis(net: Network, free: np.ndarray) -> np.ndarray:
     """Orthonormal columns ``(p, d)`` spanning the datum defects of the design over the free
     globals ``free``: the similarity transformations (translation, rotation, scale) that
     leave every point held fixed in place and change no observation. With one fixed point
-    these are the rotation (and scale) about it; with none, those about the centroid."""
+    these are the rotation (and scale) about it; with none, those about the centroid. A
+    candidate is a defect where ``|A g| <= 1e-9 |A|_F`` for the weighted design ``A``: dense
+    below :data:`SPARSE_MIN_UNKNOWNS` unknowns, sparse (:func:`weighted_design`) from there."""
     G = _similarity(net)
     held = np.setdiff1d(np.arange(2 * net.n), free)
     K = np.eye(4)
@@ -154,12 +248,18 @@ def defect_basis(net: Network, free: np.ndarray) -> np.ndarray:
     if K.shape[1] == 0:
         return np.zeros((len(free), 0))
     Q, _ = np.linalg.qr(G[free] @ K)
-    _, J = computed(net, net.theta_true()[None], jac=True)
-    A = J[0][:, free] / net.sigma[:, None]
+    if use_sparse(net):
+        A = weighted_design(net, free)
+        norm_a = float(np.sqrt(np.sum(A.data**2)))
+    else:
+        _, J = computed(net, net.theta_true()[None], jac=True)
+        A = J[0][:, free] / net.sigma[:, None]
+        norm_a = float(np.linalg.norm(A))
     B = A @ Q
-    _, sv, vt = np.linalg.svd(B, full_matrices=True)
+    # U of B (m x m) is never wanted: the thin SVD, unless B has fewer rows than columns
+    _, sv, vt = np.linalg.svd(B, full_matrices=B.shape[0] < B.shape[1])
     sv = np.concatenate([sv, np.zeros(Q.shape[1] - sv.size)])
-    null = vt[sv <= 1e-9 * np.linalg.norm(A)]
+    null = vt[sv <= 1e-9 * norm_a]
     return Q @ null.T
 
 

@@ -27,7 +27,6 @@ from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import draw_figures
 from sim.studies.network.analysis import (
     CHI2_2_95,
-    analyse,
     bearing_deg,
     ellipse,
     estimated_points,
@@ -39,6 +38,13 @@ from sim.studies.network.definition import KINDS, Network, build
 from sim.studies.network.figures import network_figure, reliability_figure
 from sim.studies.network.gama import export, import_note, merge_gama
 from sim.studies.network.model import datum
+from sim.studies.network.sparse_analysis import (
+    SparseAnalytic,
+    in_datum_sparse,
+    mc_chunk_sparse,
+    pre_analysis,
+    variances,
+)
 
 __all__ = ["run", "compare_points"]
 
@@ -86,11 +92,9 @@ def _params(net: Network, an) -> np.ndarray:
 def _mc(net, an, C, pts, cfg, ctx):
     crit = float(D.chi2_ppf(1 - cfg["test.alpha"], an.dof))
     cov_inv = np.linalg.inv(an.cov[pts])
-    fn = partial(
-        mc_chunk,
+    common = dict(
         net=net,
         free=an.free,
-        C=None if C is None else C[0],
         cov_inv=cov_inv,
         pts=np.asarray(pts),
         crit=crit,
@@ -98,6 +102,10 @@ def _mc(net, an, C, pts, cfg, ctx):
         max_iter=cfg["solver.max_iter"],
         par=_params(net, an),
     )
+    if isinstance(an, SparseAnalytic):  # one factor for every trial and iteration
+        fn = partial(mc_chunk_sparse, fac=an.factor, dof=an.dof, **common)
+    else:
+        fn = partial(mc_chunk, C=None if C is None else C[0], **common)
     return run_chunks(
         fn, cfg["trials"], cfg["seed"], cfg["chunk"], part=0, label=cfg["study"], ctx=ctx
     )
@@ -108,7 +116,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
     full = merge_gama(cfg)
     net = build(full)
     dt = datum(net, full)
-    an = analyse(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
+    an = pre_analysis(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
         raise StudyError("datum.kind: the normal equations are singular in this datum")
     prov = provenance(cfg)
@@ -151,7 +159,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
     extra = compare_points(net, cfg)
     dil = np.full(k, np.nan)
     if extra:
-        an2 = analyse(net, datum(net, full, tuple(extra)), 0.001, 0.8)
+        an2 = pre_analysis(net, datum(net, full, tuple(extra)), 0.001, 0.8)
         if not an2.ok:
             raise StudyError("compare.fix: the compared parameterisation is singular")
         s1, s2 = _rms_sigma(an.cov[pts]), _rms_sigma(an2.cov[pts])
@@ -188,7 +196,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
     drows = {"datum": [], "point": [], "sigma_x_mm": [], "sigma_y_mm": []}
     if cfg["output.inner_over"]:  # the patterns form one set of datum points
         sel = match_points(net, "output.inner_over", cfg["output.inner_over"])
-        cov = in_datum(net, an, sel)
+        cov = in_datum_sparse(net, an, sel) if an.Q is None else in_datum(net, an, sel)
         for a in range(net.n):
             drows["datum"].append(f"inner over {', '.join(cfg['output.inner_over'])}")
             drows["point"].append(net.names[a])
@@ -276,7 +284,7 @@ def _parameters(net: Network, an, sim: dict, n_ok: np.ndarray, out: Path, prov: 
     rel = par - 2 * net.n
     pos = {g: a for a, g in enumerate(an.free)}
     an_sig = (
-        np.sqrt(np.maximum([an.Q[pos[g], pos[g]] for g in par], 0.0)) if len(par) else np.zeros(0)
+        np.sqrt(np.maximum(variances(an, [pos[g] for g in par]), 0.0)) if len(par) else np.zeros(0)
     )
     cols = {
         "parameter": [names[r] for r in rel],

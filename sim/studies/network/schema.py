@@ -15,7 +15,6 @@ import numpy as np
 
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.studies.network.analysis import (
-    analyse,
     check_inner,
     estimated_points,
     inner_defect,
@@ -23,7 +22,8 @@ from sim.studies.network.analysis import (
 )
 from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
-from sim.studies.network.model import computed, datum
+from sim.studies.network.model import computed, datum, use_sparse
+from sim.studies.network.sparse_analysis import chunk_bytes, pre_analysis, variances
 
 __all__ = ["SCHEMA", "check"]
 
@@ -139,8 +139,9 @@ SCHEMA["chunk"] = Field(
 def check(cfg: dict) -> None:
     """Cross-key rules: the network builds (every observation well defined), its datum covers
     every rank defect and is not near-singular, something is estimated, the chunk fits in
-    memory, the run has at least two chunks and ``output.inner_over`` can fix the defects.
-    Records the sha256 of ``network.gama_xml`` in ``network.gama_sha256``."""
+    memory (on the sparse path for a large network), the run has at least two chunks and
+    ``output.inner_over`` can fix the defects. Records the sha256 of ``network.gama_xml`` in
+    ``network.gama_sha256``."""
     if cfg["trials"] < 2 * cfg["chunk"]:
         raise ConfigError(
             "chunk",
@@ -150,13 +151,14 @@ def check(cfg: dict) -> None:
     _digest(cfg)
     full = merge_gama(cfg)
     net = build(full)
-    nbytes = cfg["chunk"] * net.m * (net.q + 1) * 8
+    sparse = use_sparse(net)
+    nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
     if nbytes > MAX_CHUNK_BYTES:
         raise ConfigError(
             "chunk",
-            f"a chunk of {cfg['chunk']} trials needs "
-            f"{nbytes / 1024**3:.1f} GiB of Jacobians ({net.m} observations x "
-            f"{net.q} unknowns); use a smaller chunk",
+            f"a chunk of {cfg['chunk']} trials needs about "
+            f"{nbytes / 1024**3:.1f} GiB ({net.m} observations x "
+            f"{net.q} unknowns{', sparse' if sparse else ''}); use a smaller chunk",
         )
     if not np.any(net.role != 1):
         raise ConfigError("network.points", "every point is fixed: nothing to estimate")
@@ -164,8 +166,10 @@ def check(cfg: dict) -> None:
     if full["datum.kind"] == "inner":
         pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
         check_inner(net, inner_defect(net), pts, "datum.points")
-    an = analyse(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
+    an = pre_analysis(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
+        if sparse:
+            raise ConfigError("datum.kind", f"{an.factor.message}: fix points or change the datum")
         _defect(net, dt, "datum.kind")
     _conditioned(net, an, "datum.kind")
     if not estimated_points(net, an):
@@ -181,7 +185,9 @@ def check(cfg: dict) -> None:
         )
     if cfg["compare.fix"]:
         extra = match_points(net, "compare.fix", cfg["compare.fix"])
-        an2 = analyse(net, datum(net, full, tuple(extra)), 0.001, 0.8)
+        an2 = pre_analysis(net, datum(net, full, tuple(extra)), 0.001, 0.8)
+        if not an2.ok and sparse:
+            raise ConfigError("compare.fix", f"{an2.factor.message} in the compared datum")
         if not an2.ok:
             _defect(net, datum(net, full, tuple(extra)), "compare.fix")
     if cfg["output.inner_over"]:
@@ -213,7 +219,7 @@ def _conditioned(net, an, key: str) -> None:
     points): an unknown whose variance is over :data:`MAX_INFLATION` times what its own
     observations alone would give loses more than ten of the sixteen digits."""
     n_ii = an.n_diag
-    q_ii = np.diag(an.Q)
+    q_ii = variances(an, np.arange(len(an.free)))  # the dense diagonal or the selected one
     span = float(np.ptp(net.xy, axis=0).max())
     coord = an.free < 2 * net.n
     loose = np.flatnonzero(coord & (np.sqrt(np.maximum(q_ii, 0)) > span))

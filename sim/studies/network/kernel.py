@@ -1,0 +1,121 @@
+"""Compiled residuals and gradient of a network's observations for the sparse Monte Carlo.
+
+One pass over trials x observations computes each reading's computed value (the model of
+:func:`sim.studies.network.model.computed`: distances ``(1 + s) sqrt(d^2 - beta^2) - alpha``
+in mm, directions and angles in rad, coordinate differences and coordinates in mm), the
+residual observed minus computed (angles wrapped to (-pi, pi]) and adds ``J' W r`` into the
+gradient of the free unknowns -- without the Jacobian array, which for a network of thousands
+of points and a chunk of trials would be the largest array of the run. Runs compiled by numba
+(:func:`sim.lsq.group_kernel.compiled`), as plain Python otherwise. Seed: Brown 1968 (``004``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sim.lsq import group_kernel
+from sim.studies.network.definition import Network
+
+__all__ = ["residual_gradient"]
+
+
+def _kernel(
+    theta, obs, kind, ii, jj, kk, oset, n2, ic, isc, beta2, w, fpos, r, g
+):  # pragma: no cover - compiled
+    """Residuals ``r`` (T, m) and gradient ``g`` (T, p) (zeroed here) at ``theta`` (T, q)."""
+    T, m = obs.shape
+    two_pi = 2.0 * math.pi
+    d = np.zeros(9)  # derivatives by x_i, y_i, x_j, y_j, x_k, y_k, orientation, constant, scale
+    for t in range(T):
+        for c in range(g.shape[1]):
+            g[t, c] = 0.0
+        alpha = theta[t, ic]
+        f = 1.0 + 1e-6 * theta[t, isc]
+        for row in range(m):
+            kd, i, j, k = kind[row], ii[row], jj[row], kk[row]
+            xi, yi = theta[t, 2 * i], theta[t, 2 * i + 1]
+            for a in range(9):
+                d[a] = 0.0
+            if kd == 5:
+                val = xi
+                d[0] = 1.0
+            elif kd == 6:
+                val = yi
+                d[1] = 1.0
+            else:
+                dx, dy = theta[t, 2 * j] - xi, theta[t, 2 * j + 1] - yi
+                d2 = dx * dx + dy * dy
+                if kd == 0:
+                    s = math.sqrt(max(d2 - beta2, 0.0))
+                    val = f * s - alpha
+                    gx, gy = f * dx / s, f * dy / s
+                    d[0], d[1], d[2], d[3], d[7], d[8] = -gx, -gy, gx, gy, -1.0, 1e-6 * s
+                elif kd == 1:
+                    val = math.atan2(dy, dx) - theta[t, n2 + oset[row]]
+                    gx, gy = -dy / d2, dx / d2
+                    d[0], d[1], d[2], d[3], d[6] = -gx, -gy, gx, gy, -1.0
+                elif kd == 2:
+                    ex, ey = theta[t, 2 * k] - xi, theta[t, 2 * k + 1] - yi
+                    val = (math.atan2(ey, ex) - math.atan2(dy, dx)) % two_pi
+                    gx, gy = dy / d2, -dx / d2
+                    e2 = ex * ex + ey * ey
+                    hx, hy = -ey / e2, ex / e2
+                    d[0], d[1], d[2], d[3] = -(gx + hx), -(gy + hy), gx, gy
+                    d[4], d[5] = hx, hy
+                elif kd == 3:
+                    val = dx
+                    d[0], d[2] = -1.0, 1.0
+                else:
+                    val = dy
+                    d[1], d[3] = -1.0, 1.0
+            res = obs[t, row] - val
+            if kd == 1 or kd == 2:
+                res = (res + math.pi) % two_pi - math.pi
+            r[t, row] = res
+            wr = w[row] * res
+            cols = (
+                2 * i,
+                2 * i + 1,
+                2 * j,
+                2 * j + 1,
+                2 * k,
+                2 * k + 1,
+                n2 + oset[row],
+                ic,
+                isc,
+            )
+            for a in range(9):
+                if d[a] != 0.0:
+                    fp = fpos[cols[a]]
+                    if fp >= 0:
+                        g[t, fp] += d[a] * wr
+
+
+def residual_gradient(net: Network, fpos: np.ndarray, theta: np.ndarray, obs: np.ndarray):
+    """Residuals ``r`` (T, m) and the gradient ``A' W r`` (T, p) at ``theta`` (T, q) of the
+    readings ``obs`` (T, m); ``fpos`` (q,) the position of each global among the free
+    unknowns (-1: held)."""
+    T = theta.shape[0]
+    p = int(fpos.max(initial=-1)) + 1
+    r, g = np.empty((T, net.m)), np.empty((T, p))
+    fn = group_kernel.compiled(_kernel) if group_kernel.available() else _kernel
+    fn(
+        np.ascontiguousarray(theta, dtype=np.float64),
+        np.ascontiguousarray(obs, dtype=np.float64),
+        net.kind.astype(np.int64),
+        net.i.astype(np.int64),
+        np.where(net.j >= 0, net.j, 0).astype(np.int64),
+        np.where(net.k >= 0, net.k, 0).astype(np.int64),
+        np.where(net.oset >= 0, net.oset, 0).astype(np.int64),
+        2 * net.n,
+        net.i_constant,
+        net.i_scale,
+        float(net.offset_mm**2),
+        1.0 / net.sigma**2,
+        np.asarray(fpos, np.int64),
+        r,
+        g,
+    )
+    return r, g
