@@ -147,6 +147,7 @@ def test_a_different_run_goes_to_scratch_and_leaves_results_alone(tmp_path, caps
     # (same code) goes to results/ as before
     assert main(["run", str(study), "--seed", "5", "--quiet"]) == 0
     assert len(list(Path("scratch").iterdir())) == 1
+    capsys.readouterr()
     assert main(["run", str(study), "--quiet"]) == 0
     assert "scratch" not in capsys.readouterr().err
     assert (committed / "run.json").read_text() == before
