@@ -63,8 +63,14 @@ UNITLESS = (
     "claim",
     "step",
     "iteration",
+    "plates",
+    "samples",
+    " per ",
+    "readings",
+    "observation",
 )
-_UNIT = re.compile(r"\(.+\)|\[.+\]|%|/|\b(mm|um|µm|m|cm|s|ppm|arcsec|gon|deg|rad)\b")
+_UNIT = re.compile(r"\(.+\)|\[.+\]|%|/|(?:\b|_)(mm2?|um|µm|m|cm|s|ppm|pct|arcsec|gon|deg|rad|px)\b")
+_NUMBER = re.compile(r"^[\s$]*[-−+]?[\d.,]*\d(?:[eE][-−+]?\d+)?\s*(?:%|°|×10.*)?[\s$]*$")
 _SLACK = 1.0  # pixels two boxes may share before they overlap
 
 
@@ -131,7 +137,8 @@ def _labels_problems(fig) -> list[str]:
             ("x", ax.xaxis, lambda o: abs(o.get_position().x0 - box.x0) < 1e-6),
             ("y", ax.yaxis, lambda o: abs(o.get_position().y0 - box.y0) < 1e-6),
         ):
-            if not any(t.get_visible() and t.get_text() for t in axis.get_majorticklabels()):
+            ticks = [t.get_text() for t in axis.get_majorticklabels() if t.get_visible()]
+            if not any(ticks):
                 continue  # no tick labels (an image, a map drawn without axes)
             label = axis.label.get_text().strip()
             if not label:
@@ -140,7 +147,8 @@ def _labels_problems(fig) -> list[str]:
                     probs.append(f"axes {i}: no {name} label")
                 continue
             low = label.lower()
-            if not (_UNIT.search(label) or any(w in low for w in UNITLESS)):
+            categorical = any(t and not (_NUMBER.match(t) or "mathdefault" in t) for t in ticks)
+            if not (categorical or _UNIT.search(label) or any(w in low for w in UNITLESS)):
                 probs.append(f"axes {i}: {name} label {label!r} names no unit")
     return probs
 
