@@ -296,13 +296,17 @@ def _show(args) -> int:
     return 0
 
 
+def _n(x: float) -> str:
+    return f"{int(x):_}" if float(x).is_integer() and abs(x) < 1e16 else f"{x:g}"
+
+
 def _bounds(f) -> str:
     if f.choices:
         return "one of " + ", ".join(map(str, f.choices))
     if f.lo is None and f.hi is None:
         return ""
-    lo = "" if f.lo is None else (f"> {f.lo:g}" if f.lo_open else f">= {f.lo:g}")
-    hi = "" if f.hi is None else f"<= {f.hi:g}"
+    lo = "" if f.lo is None else (f"> {_n(f.lo)}" if f.lo_open else f">= {_n(f.lo)}")
+    hi = "" if f.hi is None else f"<= {_n(f.hi)}"
     return ", ".join(x for x in (lo, hi) if x)
 
 

@@ -105,7 +105,7 @@ def test_trials_picks_a_chunk_size_giving_enough_chunks(tmp_path, capsys):
     assert "claims:" in text and "brown." in text
     assert f"report: {out}/README.md" in text
     readme = (out / "README.md").read_text()
-    assert readme.startswith("# Brown") and "**Verdicts:**" in readme
+    assert readme.startswith("# out: Brown") and "**Verdicts:**" in readme
     # --chunk chooses; the study file's own chunk stays without --trials
     out2 = tmp_path / "out2"
     assert main(["run", str(study), "--trials", "60", "--chunk", "30", "--out", str(out2)]) == 0

@@ -166,7 +166,7 @@ def run_markdown(out: Path, get_study: Callable) -> str:
     study = get_study(prov["study"])
     paper = paper_name(study.seed_file, full=True)
     head = [
-        f"# {study.title}",
+        f"# {out.name}: {study.title}",
         "",
         f"Study `{prov['study']}`"
         + (f", seed paper: {paper}." if paper else " (a declared network, no seed paper).")
@@ -182,7 +182,7 @@ def run_markdown(out: Path, get_study: Callable) -> str:
         if (reg := region_line(out)) is not None:
             head += [reg[0].upper() + reg[1:] + ".", ""]
         body = study.report(out)
-    return "\n".join(head) + _relink(body, out.name) + "\n"
+    return "\n".join(head) + "\n" + _relink(body, out.name) + "\n"
 
 
 def _relink(body: str, name: str) -> str:
