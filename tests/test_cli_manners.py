@@ -3,6 +3,7 @@ did-you-mean, sim check's documentation, no Broken pipe, --trials at any size, t
 on screen, sim show, and the committed results/ left alone by a different run."""
 
 import json
+import re
 import socket
 import subprocess
 import sys
@@ -14,6 +15,9 @@ import pytest
 
 from sim.cli import MIN_CHUNKS, main
 from sim.mc.runner import make_executor
+from sim.mc.storage import write_table
+from sim.report.claimtext import interval_text, sim_text
+from sim.report.run_summary import region_line, verdict_line
 
 ROOT = Path(__file__).resolve().parent.parent
 # brown_table1 at a tiny size: a few seconds
@@ -169,3 +173,58 @@ def test_the_dask_cluster_starts_without_a_dashboard_warning():
         assert not [w for w in caught if "already in use" in str(w.message)]
     finally:
         s.close()
+
+
+# --- the suite report and the numbers in it --------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "value, lo, hi, text",
+    [
+        (0.707123, 0.7065, 0.7078, "0.70712 [0.70650, 0.70780]"),  # half-width 6.5e-4: 5 decimals
+        (82.5, 39.3, 168.0, "82 [39, 168]"),  # half-width 64: units
+        (1.03, 0.86, 1.33, "1.03 [0.86, 1.33]"),
+        (1.0, 1.0, 1.0, "1.00 [1.00, 1.00]"),  # no width: 3 significant digits
+    ],
+)
+def test_numbers_at_the_precision_their_interval_supports(value, lo, hi, text):
+    r = {"value": value, "ci_low": lo, "ci_high": hi, "interval": "ci", "verdict": "holds"}
+    assert f"{sim_text(r)} {interval_text(r)}" == text
+
+
+def test_exact_numbers_keep_the_digits_that_decide():
+    r = {"value": 0.70708861, "interval": "exact", "zone_low": 0.7, "zone_high": 0.72}
+    assert sim_text(r) == "0.7071"
+    r = {"value": 1.0000000006, "interval": "exact", "zone_low": 1.0000000005, "zone_high": 1.1}
+    assert sim_text(r) == "1.000000001"  # inside by 1e-10: the digits that show it
+
+
+def test_region_line_and_new_verdicts_are_counted(tmp_path):
+    write_table(
+        tmp_path / "consistent_region.parquet",
+        {
+            "offset_mm": [1.0, 2.0, 4.0],
+            "confirmed": [True, False, True],
+            "brown.x": ["holds", "fails", "holds"],
+        },
+        {"study": "brown_table1"},
+    )
+    assert (
+        region_line(tmp_path) == "consistent region: 3 accepted input vectors (offset_mm 1.00–4.00)"
+    )
+    claims = [{"verdict": v} for v in ("holds", "depends", "undecidable", "depends")]
+    assert verdict_line(claims) == "4 claims: 1 holds, 2 depends, 1 undecidable"
+
+
+def test_the_suite_report_opens_with_one_screen_per_paper(tmp_path):
+    results = tmp_path / "results"
+    out = results / "brown_table1"
+    assert main(["run", str(_study(tmp_path)), "--out", str(out), "--quiet"]) == 0
+    (out / "README.md").unlink()
+    assert main(["report", "--results", str(results)]) == 0
+    text = (results / "REPORT.md").read_text()
+    opening = text.split("## Every headline claim")[0]
+    assert "## The verdicts at a glance" in opening and len(opening.splitlines()) < 40
+    assert "**Brown 1968** ([brown_table1](brown_table1/README.md))" in opening
+    assert not re.search(r"00\d_[0-9a-f]{16}", text)  # papers by authors and year
+    assert (out / "README.md").is_file()  # sim report writes each directory's README.md

@@ -140,6 +140,8 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
             "holds",
             "fails",
             "inconclusive",
+            "depends",
+            "undecidable",
             "erratum",
             "paper ok",
             "input",
@@ -152,7 +154,11 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
     for r in claims:
         v, k = r["verdict"], r["kind"]
         if k == "prediction":
-            c[v if v in ("holds", "fails", "inconclusive") else "finding"] += 1
+            c[
+                v
+                if v in ("holds", "fails", "inconclusive", "depends", "undecidable")
+                else "finding"
+            ] += 1
         elif k == "paper-check":
             c["erratum" if v == "erratum" else "paper ok"] += 1
         elif k == "self-check":
@@ -178,6 +184,8 @@ _COUNT_COLS = [
     ("holds", "holds"),
     ("fails", "fails"),
     ("inconclusive", "inconclusive"),
+    ("depends", "depends"),
+    ("undecidable", "undecidable"),
     ("not comparable", "not comparable"),
     ("erratum", "errata"),
     ("paper ok", "paper consistent"),
