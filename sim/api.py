@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -51,6 +52,8 @@ class Results:
 
     def table(self, name: str) -> pa.Table:
         """The table ``name`` (``claims``, ``points``, ..., or ``trials``) as a pyarrow Table."""
+        if not isinstance(name, str) or not name.isidentifier():
+            raise ConfigError("table", f"must be a table name such as 'claims' (got {name!r})")
         p = self.path / (name if name == "trials" else f"{name}.parquet")
         if not p.exists():
             raise ConfigError(
@@ -100,6 +103,13 @@ class StudyHandle:
         """Run the study into ``out`` (default: a new temporary directory) and return its
         :class:`Results`. ``executor``: ``local`` (a process pool when ``workers > 1``) or
         ``dask``. Output is identical for every executor and worker count."""
+        _check_path("out", out, none_ok=True)
+        for name, v in (("trials", trials), ("seed", seed)):
+            if v is not None:
+                _check_int(name, v)
+        for name, v in (("overwrite", overwrite), ("quiet", quiet)):
+            if not isinstance(v, bool):
+                raise ConfigError(name, f"must be True or False (got {v!r})")
         h = (
             self
             if trials is None and seed is None
@@ -133,8 +143,23 @@ class StudyHandle:
         return Results(out, h.name)
 
 
+def _check_path(name: str, v: Any, none_ok: bool = False) -> None:
+    if v is None and none_ok:
+        return
+    if not isinstance(v, (str, os.PathLike)) or "\0" in str(v) or not str(v).strip():
+        raise ConfigError(name, f"must be a path (a str or os.PathLike), got {v!r}")
+
+
+def _check_int(name: str, v: Any) -> None:
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+        raise ConfigError(name, f"must be an integer (got {v!r})")
+
+
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
+    _check_path("study_file", study_file)
+    if not Path(study_file).is_file():
+        raise ConfigError("study_file", f"{study_file} is not a study file")
     vals = {_key(k): v for k, v in overrides.items()}
     study, cfg = load_study(study_file, values=vals)
     return StudyHandle(Path(study_file), study, cfg, vals, read_sweep(study_file, study.schema))

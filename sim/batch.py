@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -112,19 +113,31 @@ def run_all(
         return _forked(todo, argv, jobs)  # fork only a process without other threads
     t0 = time.perf_counter()
 
+    procs: list[subprocess.Popen] = []
+
     def one(f: Path):
         cmd = [sys.executable, "-m", "sim", *argv(f)]
         t = time.perf_counter()
-        done = subprocess.run(cmd, stdout=subprocess.PIPE if jobs > 1 else None, text=True)
+        with subprocess.Popen(cmd, stdout=subprocess.PIPE if jobs > 1 else None, text=True) as proc:
+            procs.append(proc)
+            stdout, _ = proc.communicate()
         wall = time.perf_counter() - t
-        if jobs > 1 and done.stdout:
-            log(done.stdout.rstrip())
-        return f.stem, done.returncode, wall, t - t0
+        if jobs > 1 and stdout:
+            log(stdout.rstrip())
+        return f.stem, proc.returncode, wall, t - t0
 
     out: dict[str, tuple[int, float, float]] = {}
-    with ThreadPoolExecutor(max_workers=jobs) as pool:
-        for stem, code, wall, start in pool.map(one, todo):
-            out[stem] = (code, wall, start)
+    try:
+        with ThreadPoolExecutor(max_workers=jobs) as pool:
+            for stem, code, wall, start in pool.map(one, todo):
+                out[stem] = (code, wall, start)
+    except KeyboardInterrupt:
+        for proc in procs:  # SIGTERM reached only the driver: pass it on, then wait
+            if proc.poll() is None:
+                proc.terminate()
+        for proc in procs:
+            proc.wait()
+        raise
     return out
 
 
@@ -178,13 +191,40 @@ def _forked(todo: list[Path], argv, jobs: int) -> dict[str, tuple[int, float, fl
             stem, t = running.pop(pid)
             out[stem] = (os.waitstatus_to_exitcode(status), time.perf_counter() - t, t - t0)
     except KeyboardInterrupt:
-        for pid in running:  # the children got the interrupt too: let them clean up
+        for pid in running:  # Ctrl-C reached the children too; SIGTERM only the driver: pass it on
+            try:
+                os.kill(pid, signal.SIGTERM)
+            except ProcessLookupError:
+                pass
+        for pid in running:  # let them clean up
             try:
                 os.waitpid(pid, 0)
             except ChildProcessError:
                 pass
         raise
     return {f.stem: out[f.stem] for f in todo}
+
+
+def _clashes(files: list[Path], run_args: list[str]) -> str | None:
+    """Why these runs cannot share one batch: two of them would write one results directory
+    (the same file twice, two files of one name, or an ``--out`` in the run options)."""
+    if any(a == "--out" or a.startswith("--out=") for a in run_args):
+        return "--out cannot be a run option: each study writes <results>/<file name>"
+    seen: dict[str, Path] = {}
+    for f in files:
+        if f.stem in seen:
+            same = f.resolve() == seen[f.stem].resolve()
+            return (
+                f"{f} is listed twice"
+                if same
+                else f"{seen[f.stem]} and {f} would both write results/{f.stem}"
+            )
+        seen[f.stem] = f
+    return None
+
+
+def _on_sigterm(signum, frame):
+    raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -207,6 +247,17 @@ def main(argv: list[str] | None = None) -> int:
     if bad:
         print(f"sim.batch: no study file {bad[0]}", file=sys.stderr)
         return 2
+    why = _clashes(files, run_args)
+    if why:
+        print(f"sim.batch: {why}", file=sys.stderr)
+        return 2
+    if args.timings:
+        parent = Path(args.timings).resolve().parent
+        if not parent.is_dir() or not os.access(parent, os.W_OK):
+            print(f"sim.batch: --timings: cannot write into {parent}", file=sys.stderr)
+            return 2
+    if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, _on_sigterm)  # end the runs as Ctrl-C does
     if not 1 <= args.jobs <= 64:
         print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
         return 2

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import shutil
+import re
 import sys
 from pathlib import Path
 from typing import Any, Mapping
@@ -20,17 +20,13 @@ import numpy as np
 
 from sim.mc.config import ConfigError, StudyError, check_chunks, validate
 from sim.mc.estimate import check_limits, estimate
+from sim.mc.outputs import check_out, drop_stage, prepare_stage, publish, seal
 from sim.mc.runner import ChunkStore, RunContext, make_executor
 from sim.mc.storage import (
-    LOCK,
-    Locked,
-    StageLock,
     code_hash,
     provenance,
-    read_record,
     read_table,
     versions,
-    write_record,
     write_table,
 )
 from sim.mc.sweep import cell_label, cell_seed, expand
@@ -39,131 +35,31 @@ from sim.report.sweep import fig_sweep
 __all__ = ["execute", "run_sweep"]
 
 
-def _check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
-    """Refuse an output path the suite did not write (with or without ``--overwrite``) and,
-    without ``--overwrite``, results of a different config or code version."""
+#: a Dask scheduler address: tcp://HOST:PORT (or another Dask protocol)
+_SCHEDULER = re.compile(
+    r"^(?:(?:tcp|tls|ucx|ws|wss)://)?(?:\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+)"
+    r":(\d{1,5})/?$"
+)
 
-    if not out.name or out == out.parent:
-        raise ConfigError("--out", f"{shown} is not a directory the suite can write into")
-    if out.is_symlink():
-        raise ConfigError("--out", f"{shown} is a symbolic link; sim never replaces it")
-    if not out.exists():
-        return
-    if not out.is_dir():
-        raise ConfigError(
-            "--out",
-            f"{shown} is a file, not a results directory; sim never "
-            "replaces it (choose another --out)",
-        )
-    old = read_record(out)
-    if old is None:
-        if any(out.iterdir()):
+
+def _check_options(executor: Any, workers: Any, scheduler: Any) -> None:
+    """The run options every door passes (``sim run``, the Python API): one line naming the
+    option."""
+    if executor not in ("local", "dask"):
+        raise ConfigError("executor", f"must be 'local' or 'dask' (got {executor!r})")
+    top = max(4 * (os.cpu_count() or 1), 8)
+    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)):
+        raise ConfigError("workers", f"must be an integer between 1 and {top} (got {workers!r})")
+    if not 1 <= workers <= top:
+        raise ConfigError("workers", f"must be between 1 and {top} (got {workers})")
+    if scheduler is not None:
+        m = _SCHEDULER.match(scheduler) if isinstance(scheduler, str) else None
+        if not m or not 0 < int(m.group(1)) < 65536:
             raise ConfigError(
-                "--out",
-                f"{shown} holds files but no sim run record (run.json); "
-                "sim never replaces it, with or without --overwrite",
+                "scheduler", f"not a scheduler address like tcp://HOST:8786 (got {scheduler!r})"
             )
-        return
-    if _same(old, record) or overwrite:
-        return
-    why = (
-        "a different config"
-        if old.get("config") != record["config"]
-        else "a different code version"
-    )
-    raise ConfigError("--out", f"{shown} holds results of {why}; use --overwrite to replace it")
-
-
-def _same(a: dict | None, b: dict) -> bool:
-    return bool(a) and a.get("config") == b["config"] and a.get("code_hash") == b["code_hash"]
-
-
-def _clear(stage: Path) -> None:
-    """Remove everything in a staging directory we hold the lock of, but the lock file."""
-
-    for p in stage.iterdir():
-        if p.name == LOCK:
-            continue
-        if p.is_dir() and not p.is_symlink():
-            shutil.rmtree(p)
-        else:
-            p.unlink()
-
-
-def _chunks(stage: Path) -> int:
-    t = stage / "trials"
-    return sum(1 for _ in t.rglob("chunk-*.parquet")) if t.is_dir() else 0
-
-
-def _prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: bool):
-    """Lock the staging directory and make it hold ``record``. Returns ``(lock, resumed)``."""
-
-    if stage.is_symlink() or (stage.exists() and not stage.is_dir()):
-        raise ConfigError(
-            "--out",
-            f"{stage} is in the way (not a staging directory of sim); sim never replaces it",
-        )
-    if (
-        stage.is_dir()
-        and read_record(stage) is None
-        and not (stage / LOCK).exists()
-        and any(stage.iterdir())
-    ):
-        raise ConfigError(
-            "--out", f"{stage} holds files but no sim run record; sim never replaces it"
-        )
-    lock = StageLock(stage)
-    try:
-        lock.acquire()
-    except Locked as e:
-        who = f"pid {e.pid}" if e.pid else "another process"
-        raise ConfigError(
-            "--out",
-            f"{shown} is being written by a running sim ({who}); wait "
-            "for it to finish or choose another --out",
-        ) from None
-    except OSError as e:
-        raise ConfigError("--out", f"cannot write to {out.parent}: {e.strerror}") from None
-    try:
-        old = read_record(stage)
-        resumed = 0
-        if old is not None and _same(old, record) and not old.get("failed"):
-            resumed = _chunks(stage)
-        elif old is not None and _same(old, record):
-            resumed = _chunks(stage)  # a failed run of the same command: try again, resume
-        elif old is None or old.get("failed") or overwrite:
-            _clear(stage)  # ours (locked, a record or a lock file), and not resumable
-        else:
-            why = (
-                "a different config"
-                if old.get("config") != record["config"]
-                else "a different code version"
-            )
-            raise ConfigError(
-                "--out",
-                f"{stage} holds an unfinished run of {why}; run that "
-                "command again to finish it, or use --overwrite to replace it",
-            )
-        for tmp in stage.rglob("*.tmp"):  # a write cut short by a kill
-            tmp.unlink(missing_ok=True)
-        write_record(stage, record)
-    except BaseException:
-        _drop_stage(stage, lock)
-        raise
-    return lock, resumed
-
-
-def _drop_stage(stage: Path, lock, reason: str | None = None) -> None:
-    """After a failure: remove a staging directory with no finished chunk; otherwise mark it
-    failed (so the corrected command may replace it) and keep it for resumption."""
-
-    try:
-        if _chunks(stage) == 0:
-            shutil.rmtree(stage, ignore_errors=True)
-        elif reason is not None and (rec := read_record(stage)) is not None:
-            write_record(stage, {**rec, "failed": reason})
-    finally:
-        lock.release()
+        if executor != "dask":
+            raise ConfigError("scheduler", "needs executor dask")
 
 
 def _numeric_failure(e: BaseException, study, cfg: dict) -> StudyError:
@@ -229,6 +125,7 @@ def execute(
     Returns the run's :class:`sim.mc.estimate.Estimate`."""
 
     shown = shown or str(out)
+    _check_options(executor, workers, scheduler)
     check_chunks(cfg)
     est = estimate(cfg, sweep)
     check_limits(est, max_memory_gb, max_adjustments, workers)
@@ -237,7 +134,7 @@ def execute(
         "code_hash": code_hash(cfg["study"]),
         "versions": versions(),
     }
-    _check_out(out, shown, record, overwrite)
+    check_out(out, shown, record, overwrite)
     stage = out.parent / f".{out.name}.partial"
     try:
         ex = make_executor(executor, workers, scheduler)
@@ -247,7 +144,7 @@ def execute(
         raise ConfigError(key, f"cannot start the {executor} executor: {msg}") from None
     lock = None
     try:
-        lock, resumed = _prepare_stage(stage, out, shown, record, overwrite)
+        lock, resumed = prepare_stage(stage, out, shown, record, overwrite)
         if resumed:
             print(f"sim: resuming {cfg['study']}: {resumed} finished chunks found", file=sys.stderr)
         ctx = RunContext(
@@ -275,30 +172,18 @@ def execute(
         ex.close(kill=True)
         if lock is not None:  # a failure of the run (not an interrupt) is marked replaceable
             failed = isinstance(e, (ConfigError, StudyError))
-            _drop_stage(stage, lock, reason=str(e) if failed else None)
+            drop_stage(stage, lock, reason=str(e) if failed else None)
         raise
     ex.close()
     try:
-        _check_out(out, shown, record, True)  # again, under the lock: still ours or absent
-        _publish(stage, out)
+        check_out(out, shown, record, True)  # again, under the lock: still ours or absent
+        seal(stage, ctx.store)
+        publish(stage, out)
     except BaseException:
-        _drop_stage(stage, lock)
+        drop_stage(stage, lock)
         raise
     lock.release()
     return est
-
-
-def _publish(stage: Path, out: Path) -> None:
-    """Replace ``out`` (checked: ours or absent) by the finished staging directory."""
-
-    for tmp in stage.rglob("*.tmp"):
-        tmp.unlink(missing_ok=True)
-    old = out.parent / f".{out.name}.old.{os.getpid()}"
-    if out.exists():
-        os.replace(out, old)
-    os.replace(stage, out)
-    (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
-    shutil.rmtree(old, ignore_errors=True)
 
 
 def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dict:

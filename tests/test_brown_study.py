@@ -1,5 +1,5 @@
-"""Brown studies (seed 004): claim book, hardware feasibility, sweep of the unprinted station
-offset, consistent set, and a report computed from the Parquet files."""
+"""Brown studies (seed 004): claim book, the one instrument and its hardware feasibility, the
+consistent region of the unprinted inputs, and a report computed from the Parquet files."""
 
 from __future__ import annotations
 
@@ -11,14 +11,15 @@ import pytest
 
 from sim.claims.book import ClaimBook
 from sim.cli import main
+from sim.instruments.ranges import brown as B
 from sim.mc.config import ConfigError
 from sim.mc.storage import read_table
 from sim.studies import load_study
+from sim.studies.brown import region as RG
 from sim.studies.brown import values as V
 from sim.studies.brown.claims import BOOK, load_book
-from sim.studies.brown.consistency import SWEEP_COLUMNS, consistent_set, feasible, sweep_table1
 from sim.studies.brown.report import report_dilution, report_table1
-from sim.studies.brown.schema import max_offset_mm, setup, sweep_offsets
+from sim.studies.brown.schema import max_offset_mm, setup
 
 ROOT = Path(__file__).resolve().parents[1]
 DIL = ROOT / "studies" / "brown_dilution.toml"
@@ -33,9 +34,12 @@ def test_claim_book_splits_into_the_two_studies():
     assert len(d.not_reproduced) + len(t.not_reproduced) == len(full.not_reproduced)
     # the paper's "from 5 to 15 percent" is a range; one-plate numbers are one-plate
     assert d.spec("brown.dilution.range_pct")["form"] == "range"
-    for c in ("share_1p1_1p3", "points_ge_1p45"):
-        assert t.spec(f"brown.table1_point_sigma.{c}")["form"] == "one-plate"
+    assert t.spec("brown.table1_point_sigma.share_1p1_1p3")["form"] == "share"
     assert t.spec("brown.table1_closure.typical_range_um")["ref"] == [1.5, 2.0]
+    # inputs echoed are not predictions; each printed number is one row
+    assert t.spec("brown.table1_closure.typical_range_um")["kind"] == "input"
+    assert t.spec("brown.table1_closure.dof")["kind"] == "self-check"
+    assert not [c for c in full.specs if "at_paper_closure" in c]
 
 
 def test_study_files_fit_the_papers_scale_and_the_old_geometry_does_not():
@@ -43,8 +47,7 @@ def test_study_files_fit_the_papers_scale_and_the_old_geometry_does_not():
         _, cfg = load_study(f)
         assert cfg["comparator.scale_length_mm"] == 261.0 and cfg["comparator.micrometer_mm"] == 1.0
         pts, th = setup(cfg)
-        ok, rmax = feasible(cfg, pts[None], th[None])
-        assert ok[0] and rmax[0] <= 262.0
+        assert B.feasible(pts[None], th[None])[0]
     with pytest.raises(ConfigError, match="comparator.scale_length_mm"):
         load_study(T1, ["comparator.station_offset_mm=45.0"])
 
@@ -53,93 +56,68 @@ def test_largest_offset_is_where_the_longest_range_meets_the_scale():
     _, cfg = load_study(T1)
     h = max_offset_mm(cfg, 90.0)
     assert 33.0 < h < 35.0  # brown_design: about 33.6 mm for a +-90 mm grid
+    assert math.isclose(h, float(B.max_offset_mm(90.0, cfg["comparator.beta_mm"])), rel_tol=1e-12)
     pts, _ = setup(cfg)
-    th = V.thetas(
-        cfg["plate.format_mm"],
-        [h - 1e-6, h + 1e-3],
-        cfg["comparator.alpha_mm"],
-        cfg["comparator.beta_mm"],
+    th = B.thetas([h - 1e-6, h + 1e-3], cfg["comparator.beta_mm"], cfg["comparator.alpha_mm"])
+    P = np.stack([pts, pts])
+    assert B.feasible(P, th).tolist() == [True, False]
+    assert math.isclose(B.max_range_mm(P, th)[0], 262.0, abs_tol=1e-4)
+
+
+def test_region_keys_are_validated():
+    with pytest.raises(ConfigError, match="region.points"):
+        load_study(T1, ["region.points=4"])
+    with pytest.raises(ConfigError, match="region.rounds"):
+        load_study(DIL, ["region.rounds=-1"])
+    with pytest.raises(ConfigError, match="consistency"):
+        load_study(T1, ["consistency.offset_step_mm=0.5"])  # the old sweep is gone
+
+
+def _t1_region(n=256, rounds=1):
+    cfg = {"seed": 1967, "region.points": n, "region.rounds": rounds}
+    return RG.table1_region(cfg, load_book("brown_table1"))
+
+
+def test_table1_region_is_exactly_what_the_scale_and_the_printed_closure_allow():
+    reg, preds, verdicts = _t1_region()
+    x = reg.x
+    ok = (np.abs(x["sigma0_um"] - 1.6) <= 0.05 + 1e-12) & (
+        B.max_range_mm(
+            np.broadcast_to(B.table1_points(), (reg.n, 25, 2)),
+            B.thetas(x["station_offset_mm"], x["beta_mm"]),
+        )
+        <= 262.0
     )
-    ok, rmax = feasible(cfg, np.stack([pts, pts]), th)
-    assert ok.tolist() == [True, False]
-    assert math.isclose(rmax[0], 262.0, abs_tol=1e-4)
-
-
-def test_sweep_keys_are_validated():
-    with pytest.raises(ConfigError, match="consistency.offset_max_mm"):
-        load_study(T1, ["consistency.offset_max_mm=0.2"])
-    with pytest.raises(ConfigError, match="consistency.offset_step_mm"):
-        load_study(DIL, ["consistency.offset_step_mm=1e-4"])
-    with pytest.raises(ConfigError, match="consistency.extents_mm"):
-        load_study(DIL, ["consistency.extents_mm=[130.0]"])
-    _, cfg = load_study(
-        T1,
-        [
-            "consistency.offset_min_mm=1.0",
-            "consistency.offset_max_mm=2.0",
-            "consistency.offset_step_mm=0.5",
-        ],
+    assert np.array_equal(ok, reg.accepted)
+    # the scale bounds the offset at about 34 mm (beta 0) for the +-90 mm plate
+    lo, hi = reg.bounds()["station_offset_mm"]
+    assert (
+        hi <= float(B.max_offset_mm(90.0, 14.5))
+        and hi > 34.0 - reg.resolution["station_offset_mm"][0]
     )
-    assert sweep_offsets(cfg).tolist() == [1.0, 1.5, 2.0]
 
 
-def _long(rows):
-    """A long sweep table from (offset, claim, verdict, feasible) tuples."""
-    t = {c: [] for c in SWEEP_COLUMNS}
-    for o, c, v, f in rows:
-        for k, x in (
-            ("half_extent_mm", 90.0),
-            ("offset_mm", o),
-            ("feasible", f),
-            ("max_range_mm", 0.0),
-            ("claim", c),
-            ("kind", "prediction"),
-            ("value", 0.0),
-            ("ci_low", 0.0),
-            ("ci_high", 0.0),
-            ("p_plate", math.nan),
-            ("verdict", v),
-        ):
-            t[k].append(x)
-    return t
+def test_table1_together_points_satisfy_every_statement_by_direct_computation():
+    reg, preds, verdicts = _t1_region()
+    tog = RG.together(reg, preds)
+    assert tog.any() and not tog.all()
+    for j in np.flatnonzero(tog)[:5]:
+        o, b, s0 = (float(reg.x[k][j]) for k in ("station_offset_mm", "beta_mm", "sigma0_um"))
+        cof = V.sigmas(B.table1_points()[None], B.thetas(o, b), "pivot")[0]
+        sig = s0 * cof
+        share = np.mean((sig >= 1.05) & (sig < 1.35))
+        assert 0.745 <= share <= 0.855
+        assert 1.45 <= sig.max() < 1.55 and (sig.max(axis=1) >= 1.45).sum() >= 2
+        assert cof.max() < 1
+    assert verdicts[RG.T1_JOINT].verdict == "depends"
+    assert verdicts[RG.T1 + "below_closure"].verdict == "holds"
 
 
-def test_consistent_set_intersects_the_holding_offsets_and_names_conflicts():
-    v = {
-        "a": ["fails", "holds", "holds", "holds", "holds"],
-        "b": ["holds", "holds", "holds", "fails", "holds"],
-        "c": ["fails"] * 5,
-    }
-    feas = [True, True, True, True, False]
-    rows = [(o, c, v[c][i], feas[i]) for c in v for i, o in enumerate([1.0, 2.0, 3.0, 4.0, 5.0])]
-    cs = {r["claim"]: r for r in _rows(consistent_set(_long(rows), {}))}
-    assert (cs["a"]["holds_low"], cs["a"]["holds_high"], cs["a"]["contiguous"]) == (2.0, 4.0, True)
-    assert (cs["b"]["holds_low"], cs["b"]["holds_high"], cs["b"]["contiguous"]) == (1.0, 3.0, True)
-    assert cs["b"]["feasible_high"] == 4.0  # 5 mm is off the scale: never counted
-    assert math.isnan(cs["ALL"]["holds_low"]) and "hold nowhere: c" in cs["ALL"]["conflicts"]
-    assert (cs["ALL_SATISFIABLE"]["holds_low"], cs["ALL_SATISFIABLE"]["holds_high"]) == (2.0, 3.0)
-    rows = [(o, "d", ["holds", "fails", "holds"][i], True) for i, o in enumerate([1.0, 2.0, 3.0])]
-    rows += [(o, "e", ["fails", "holds", "fails"][i], True) for i, o in enumerate([1.0, 2.0, 3.0])]
-    cs = {r["claim"]: r for r in _rows(consistent_set(_long(rows), {}))}
-    assert cs["d"]["contiguous"] is False and "disjoint: d / e" in cs["ALL"]["conflicts"]
-
-
-def _rows(cols):
-    return [dict(zip(cols, vals)) for vals in zip(*cols.values())]
-
-
-def test_sweep_scores_the_same_rule_as_the_nominal_geometry():
+def test_nominal_17_mm_example_lies_in_the_table1_region():
     _, cfg = load_study(T1)
-    pts, th = setup(cfg)
-    sw = sweep_table1(cfg, load_book("brown_table1"), pts, 1.63)
-    # the at-paper-closure share rises as the stations come in (fewer sigmas above 1.35 um)
-    s = [
-        v
-        for c, v, f in zip(sw["claim"], sw["value"], sw["feasible"])
-        if c.endswith("share_at_paper_closure") and f
-    ]
-    assert s[0] > s[-1]
-    assert not any(f for f, r in zip(sw["feasible"], sw["max_range_mm"]) if r > 262.0)
+    reg, preds, _ = _t1_region(cfg["region.points"], cfg["region.rounds"])
+    lo, hi = reg.bounds(RG.together(reg, preds))["station_offset_mm"]
+    assert lo < cfg["comparator.station_offset_mm"] < hi
 
 
 @pytest.fixture(scope="module")
@@ -148,36 +126,31 @@ def runs(tmp_path_factory):
     for name, f in (("brown_dilution", DIL), ("brown_table1", T1)):
         o = tmp_path_factory.mktemp(name) / name
         tiny = (ROOT / "tests" / "data" / "tiny" / f"{name}.txt").read_text().splitlines()
-        sets = [
-            x for kv in tiny if not kv.startswith("consistency.offset_step") for x in ("--set", kv)
-        ]
-        sets += [
-            "--set",
-            "consistency.offset_min_mm=16.0",
-            "--set",
-            "consistency.offset_max_mm=18.0",
-            "--set",
-            "consistency.offset_step_mm=0.5",
-        ]
+        sets = [x for kv in tiny for x in ("--set", kv)]
         assert main(["run", str(f), "--out", str(o), "--quiet", *sets]) == 0
         out[name] = o
     return out
 
 
-def test_nominal_rows_equal_the_sweep_at_the_nominal_offset(runs):
+def test_consistent_region_table_one_row_per_accepted_vector(runs):
     for name, o in runs.items():
+        t = read_table(o / "consistent_region.parquet").to_pydict()
+        ins = read_table(o / "region_inputs.parquet").to_pydict()
+        n = ins["n_region"][0]
+        assert {len(v) for v in t.values()} == {n} and n > 0
+        for k in ins["input"]:
+            assert k.endswith(("_mm", "_um")) and k in t
+        assert set(t["hardware.scale_reads"]) <= {"holds", "undecided"}
+        assert sum(t["together"]) == ins["n_together"][0]
         claims = {r["claim"]: r for r in read_table(o / "claims.parquet").to_pylist()}
-        sw = read_table(o / "sweep.parquet").to_pylist()
-        e0 = max(r["half_extent_mm"] for r in sw if r["offset_mm"] == 17.0)  # the plate: 90
-        at = [r for r in sw if r["offset_mm"] == 17.0 and r["half_extent_mm"] == e0]
-        assert at
-        for r in at:
-            c = claims[r["claim"]]
-            if c["form"] == "one-plate":  # nominal: Monte Carlo; sweep: chi-square quantiles
-                continue
-            assert r["verdict"] == c["verdict"], r["claim"]
-            assert math.isclose(r["value"], c["value"], rel_tol=1e-9, abs_tol=1e-12), r["claim"]
-        assert (o / "consistent_set.png").stat().st_size > 0
+        region_rows = [c for c in claims.values() if c["interval"] == "region"]
+        assert region_rows and all(c["claim"] in t for c in region_rows)
+        for c in region_rows:
+            outs = set(t[c["claim"]])
+            v = c["verdict"]
+            assert (v == "holds") == (outs == {"holds"}), c["claim"]
+            assert (v == "fails") == (outs == {"fails"}), c["claim"]
+        assert (o / "consistent_region.png").stat().st_size > 0
 
 
 def test_report_prose_comes_from_the_parquet_files(runs, tmp_path):
@@ -189,15 +162,12 @@ def test_report_prose_comes_from_the_parquet_files(runs, tmp_path):
         o = tmp_path / name
         shutil.copytree(runs[name], o)
         before = rep(o)
-        p = o / "consistent_set.parquet"
+        p = o / "region_inputs.parquet"
         t = pq.read_table(p)
-        i = t.column_names.index("holds_low")
-        vals = [
-            47.77 if c == "ALL" else v
-            for c, v in zip(t.column("claim").to_pylist(), t.column("holds_low").to_pylist())
-        ]
+        i = t.column_names.index("region_low")
         import pyarrow as pa
 
-        pq.write_table(t.set_column(i, "holds_low", pa.array(vals, pa.float64())), p)
+        vals = [47.77] * t.num_rows
+        pq.write_table(t.set_column(i, "region_low", pa.array(vals, pa.float64())), p)
         after = rep(o)
         assert "47.8" in after and "47.8" not in before

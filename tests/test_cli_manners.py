@@ -21,7 +21,7 @@ from sim.report.run_summary import region_line, verdict_line
 
 ROOT = Path(__file__).resolve().parent.parent
 # brown_table1 at a tiny size: a few seconds
-TINY = 'study = "brown_table1"\ntrials = 40\nchunk = 20\n[consistency]\noffset_step_mm = 5.0\n'
+TINY = 'study = "brown_table1"\ntrials = 40\nchunk = 20\n[region]\npoints = 256\nrounds = 1\n'
 
 
 def _study(tmp_path, text=TINY, name="t1.toml"):
@@ -109,7 +109,8 @@ def test_trials_picks_a_chunk_size_giving_enough_chunks(tmp_path, capsys):
     assert "claims:" in text and "brown." in text
     assert f"report: {out}/README.md" in text
     readme = (out / "README.md").read_text()
-    assert readme.startswith("# out: Brown") and "**Verdicts:**" in readme
+    assert readme.splitlines()[1].startswith("# out: Brown") and "**Verdicts:**" in readme
+    assert "README.md" in json.loads((out / "run.json").read_text())["files"]
     # --chunk chooses; the study file's own chunk stays without --trials
     out2 = tmp_path / "out2"
     assert main(["run", str(study), "--trials", "60", "--chunk", "30", "--out", str(out2)]) == 0
@@ -128,7 +129,12 @@ def test_show_prints_a_results_directory(tmp_path, capsys):
     text = capsys.readouterr().out
     assert text.startswith("claim") and claims[0] in text and "claims:" in text
     assert main(["show", str(out), "--markdown"]) == 0
-    assert capsys.readouterr().out == (out / "README.md").read_text()
+    readme = (out / "README.md").read_text()
+    assert capsys.readouterr().out == readme.split("\n", 1)[1]  # the file without its mark
+    # a README.md of the user's is never replaced, by a run or by sim report
+    (out / "README.md").write_text("my notes\n")
+    assert main(["report", "--results", str(tmp_path)]) == 0
+    assert (out / "README.md").read_text() == "my notes\n"
     assert main(["show", str(tmp_path)]) == 2  # not a results directory: one line
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "not a results directory" in err

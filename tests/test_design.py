@@ -1,5 +1,5 @@
 """brown_design: sweeps, adaptive trial counts, error budget, design constraints, coverage,
-claim book, consistent set."""
+claim book, the consistent region of the unprinted inputs."""
 
 import pickle
 from functools import partial
@@ -178,10 +178,11 @@ def test_paper_design_must_be_in_the_grid_and_fit_its_hardware():
     # 45 mm is a cell of the grid, but a +-90 mm grid's ranges do not fit on 261 + 1 mm there
     with pytest.raises(ConfigError, match="paper.offset_mm: the paper's design must fit"):
         validate({"paper.offset_mm": 45.0}, design.SCHEMA, design.check)
-    with pytest.raises(ConfigError, match="unprinted.offsets_mm"):
-        validate({"unprinted.offsets_mm": [40.0, 60.0]}, design.SCHEMA, design.check)
-    with pytest.raises(ConfigError, match="unprinted.zeiss_extents_mm"):
-        validate({"unprinted.zeiss_extents_mm": [20.0, 90.0]}, design.SCHEMA, design.check)
+    # no unbuildable geometry: the datum's (brown_dilution's) must fit the scale too
+    with pytest.raises(ConfigError, match="datum.offset_mm: the datum geometry must be buildable"):
+        validate({"datum.spacing_mm": 55.0, "datum.offset_mm": 45.0}, design.SCHEMA, design.check)
+    with pytest.raises(ConfigError, match="region.points"):
+        validate({"region.points": 8}, design.SCHEMA, design.check)
     with pytest.raises(ConfigError, match="design.offsets_mm"):
         validate(
             {"design.offsets_mm": list(np.arange(1.0, 2001.0) / 2)}, design.SCHEMA, design.check
@@ -292,24 +293,28 @@ def test_tiny_run_end_to_end(tmp_path):
     assert not any(v is None for v in cl["verdict"])
     tol = read_provenance(out / "claims.parquet")["tolerances"]
     assert 0 < tol["bayes.parquet"]["ratio"] < 0.5 and "value" in tol["claims.parquet"]
-    cs = read_table(out / "consistent_set.parquet").to_pydict()
-    assert {"input", "claim", "holds_low", "holds_high"} <= set(cs)
-    assert set(cs["input"]) >= {
-        "paper.offset_mm",
-        "paper.beta_mm",
-        "time.pass_min",
-        "zeiss.half_extent_mm",
-        "budget.pitch_mm",
+    # the tolerances and external comparisons are decided over the region, not at a nominal
+    cr = read_table(out / "consistent_region.parquet").to_pydict()
+    ins = read_table(out / "region_inputs.parquet").to_pylist()
+    assert set(cr["part"]) == {"tolerances", "plates"}
+    assert {r["input"] for r in ins} == {
+        "station_offset_mm",
+        "beta_mm",
+        "screw_pitch_mm",
+        "zeiss_half_extent_mm",
     }
-    assert cs["claim"].count("ALL") == len(set(cs["input"]))
-    sv = read_table(out / "sweep_values.parquet").to_pydict()
-    hmax = dict(zip(cl["claim"], cl["value"]))["brown.design.max_offset_paper_grid_mm"]
-    for i, x, v in zip(sv["input"], sv["value"], sv["verdict"]):  # hardware decides
-        if i == "paper.offset_mm" and x > hmax:
-            assert v == "infeasible"
-    for f in ("pareto.png", "consistent_set.png", "corner.png"):
+    from sim.instruments.ranges import brown as B
+
+    hmax = B.max_offset_mm(90.0, np.asarray(cr["beta_mm"]))  # the hardware decides
+    assert np.all(np.asarray(cr["station_offset_mm"]) <= hmax + 1e-9)
+    rows = {c: r for c, r in zip(cl["claim"], read_table(out / "claims.parquet").to_pylist())}
+    lin = rows["brown.calibration.linearity_tolerance_um"]
+    assert lin["interval"] == "region" and lin["verdict"] in ("holds", "depends", "fails")
+    # each printed number is one row in one study: the Results arithmetic is brown_table1's
+    assert not [c for c in cl["claim"] if c.endswith("_recomputed")]
+    for f in ("pareto.png", "corner.png"):
         assert (out / f).is_file()
-    assert "consistent set" in design.report(out)
+    assert "Consistent region" in design.report(out)
 
 
 def test_coverage_of_a_linear_models_ellipses_is_95_percent():
@@ -351,9 +356,15 @@ def test_sweep_rows_draw_and_tabulate(tmp_path):
     assert md.count("\n") >= 5 and "no: plate.spacing_mm" in md and "sweep.png" in md
 
 
-def test_the_two_plate_posterior_finds_the_grid_plate_study():
-    # the cross-check must not be skipped silently when the grid-plate study moves
-    from sim.studies.design.posterior import _twoplate_data
+def test_the_two_plate_posterior_uses_the_grid_plate_study_defaults():
+    # the design study's two-plate calibration is gridplate_two_plates's default one
+    from sim.mc.config import validate
+    from sim.studies.design.posterior import TWO_PLATES, TWO_PLATES_STATED_UM, _twoplate_data
+    from sim.studies.gridplate import model as gm
+    from sim.studies.gridplate import schema as gs
 
-    gcfg, comp, g, sg, rw, fa = _twoplate_data({"seed": 1})
-    assert comp.shape == g.shape[:2] and comp.shape[0] == 2 * gcfg["plate.count"]
+    gcfg = validate({}, gs.SCHEMA, gs.check)
+    assert TWO_PLATES == gm.calibration_args(gcfg)
+    assert TWO_PLATES_STATED_UM == gcfg["grid.sigma_stated_um"]
+    tp, comp, g, sg, rw, fa = _twoplate_data({"seed": 1})
+    assert comp.shape == g.shape[:2] and comp.shape[0] == 2 * tp["plates"]

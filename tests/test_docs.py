@@ -186,4 +186,5 @@ OTHER_PAGES = {
     "sparse.md",
     "mutation.md",
     "benchmark.md",
+    "inference.md",
 }

@@ -184,10 +184,14 @@ def test_gama_local_round_trip(tmp_path):
 
 
 def test_gama_export_refuses_what_gama_local_cannot_say(tmp_path):
-    with pytest.raises(ConfigError, match="additive constant"):
-        write_gama(build(load("network_brown")), tmp_path / "b.xml")
-    with pytest.raises(ConfigError, match="coordinate"):
-        write_gama(build(load("network_plate")), tmp_path / "p.xml")
+    """(issue 24: beta, the known constant and dx/dy now export; see tests/test_gama.py)"""
+    cfg = load("network_brown")
+    with pytest.raises(ConfigError, match="additive-constant unknown"):
+        write_gama(build({**cfg, "network.estimate_constant": True}), tmp_path / "b.xml")
+    obs = [{"kind": "distance", "from": "A", "to": "N1", "sigma_mm": 1.0, "bias_mm": 0.1}]
+    cfg = load("network_testfield")
+    with pytest.raises(ConfigError, match="bias"):
+        write_gama(build({**cfg, "network.observations": obs}), tmp_path / "t.xml")
 
 
 @pytest.mark.parametrize(

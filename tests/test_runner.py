@@ -49,7 +49,7 @@ def test_store_resumes_and_gives_the_same_result(tmp_path):
     ctx = RunContext(quiet=True, store=store)
     # a run that stopped after 3 chunks: only those files exist
     for k in range(3):
-        store.save(0, k, 8, _toy(chunk_rng(9, 0, k), 8))
+        store.save(0, k, 8, _toy(chunk_rng(9, 0, k), 8), 9)
     calls = []
 
     def counting(rng, n):

@@ -34,6 +34,10 @@ With ``I`` the simulated interval and ``Z`` the decision zone:
   **fails** iff ``p < 0.05``; **holds** iff ``p >= 0.05`` and the central 95 % of plates lies
   inside ``Z`` (the simulation is sharp enough to decide); otherwise **inconclusive**.
 
+Over a consistent region of unprinted inputs (:mod:`sim.claims.region`) a prediction is
+**holds** / **fails** at every input of the region, **depends** (holds for part of it; the
+note says where) or **undecidable** (no input of the region decides it).
+
 The rule's result is the ``outcome`` column. The ``verdict`` is the outcome for
 ``kind = "prediction"`` and for ``"paper-check"`` (where a failing outcome is an
 **erratum**: the paper contradicts its own printed data, and ``value`` is the recomputation
@@ -77,6 +81,8 @@ VERDICTS = (
     "holds",
     "fails",
     "inconclusive",
+    "depends",
+    "undecidable",
     "erratum",
     "input",
     "self-check",
@@ -168,7 +174,7 @@ def _verdict(kind: str, outcome: str | None) -> str:
     return kind
 
 
-def _holds(verdict: str):
+def _holds(verdict: str):  # depends / undecidable (over a region, sim.claims.region): null
     return {"holds": True, "fails": False, "erratum": False}.get(verdict)
 
 

@@ -51,6 +51,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim import lsq
+from sim.instruments import transforms2d as t2
+from sim.instruments.plates import grid_points
 from sim.lsq import distributions as D
 
 __all__ = [
@@ -262,3 +264,44 @@ def reweight(
         "rounds": rounds,
         "result": res,
     }
+
+
+def simulate_calibrations(
+    rng: np.random.Generator,
+    n: int,
+    *,
+    grid: int,
+    spacing_mm: float,
+    plates: int,
+    readings: int,
+    scale_diff_ppm: float,
+    nonorth_arcsec: float,
+    kappa_deg: float,
+    reading_sigma_um: float,
+    coord_sigma_um: float,
+    grid_sigma_um: float,
+) -> dict[str, np.ndarray]:
+    """Readings and grid certificates of ``n`` two-plate calibrations (seed 001's setup).
+
+    A comparator whose x and y scales differ by ``scale_diff_ppm`` (S = 1 - d/2, S' = 1 + d/2)
+    with a non-orthogonality of ``nonorth_arcsec`` measures ``plates`` k x k grid plates
+    (``grid``, ``spacing_mm``; a uniform kappa rotation up to ``kappa_deg`` and a shift of
+    120 +- 5 mm each), ``readings`` readings per point with ``reading_sigma_um`` each and a
+    point error making the mean's coordinate sigma ``coord_sigma_um``; the certificate is
+    the grid with ``grid_sigma_um`` per coordinate. Returns ``readings`` (n, P, N, L, 2) mm,
+    ``cert`` (n, P, N, 2) mm and ``true`` (n, P, 6), the true affine grid -> comparator.
+    """
+    G = grid_points(grid, spacing_mm)
+    P, N, L = plates, G.shape[0], readings
+    d = scale_diff_ppm * 1e-6
+    S, S2, eps = 1.0 - d / 2, 1.0 + d / 2, nonorth_arcsec * t2.ARCSEC
+    kap = rng.uniform(-1, 1, (n, P)) * np.deg2rad(kappa_deg)
+    shift = rng.uniform(-5, 5, (n, P, 2)) + np.array([120.0, 120.0])
+    true = t2.affine_from_rows(S, S2, eps, kap, (shift[..., 0], shift[..., 1]))
+    ideal = t2.apply_affine(true.reshape(-1, 6), G).reshape(n, P, N, 2)
+    sp, sc = reading_sigma_um * 1e-3, coord_sigma_um * 1e-3
+    s_point = np.sqrt(max(sc**2 - sp**2 / L, 0.0))
+    comp_err = rng.normal(0.0, 1.0, (n, P, N, 2)) * s_point
+    rd = (ideal + comp_err)[:, :, :, None, :] + rng.normal(0.0, sp, (n, P, N, L, 2))
+    cert = G + rng.normal(0.0, 1.0, (n, P, N, 2)) * grid_sigma_um * 1e-3
+    return {"readings": rd, "cert": cert, "true": true}

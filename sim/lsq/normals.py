@@ -312,7 +312,15 @@ def bordered_inverse(Nbar, C=None, rcond: float = RCOND):
     M, s = _scaled_system(Nbar, C)
     Minv, ok = _screened_inverse(M, rcond)
     if Minv is None:
-        Minv = np.linalg.inv(_safe(M, ok))
+        try:
+            Minv = np.linalg.inv(_safe(M, ok))
+        except np.linalg.LinAlgError:  # exactly singular although above rcond: never raise
+            Minv, ok = np.full_like(M, np.nan), ok.copy()
+            for t in np.flatnonzero(ok):
+                try:
+                    Minv[t] = np.linalg.inv(M[t])
+                except np.linalg.LinAlgError:
+                    ok[t] = False
     Q = Minv[:, :p, :p] * s[:, :, None] * s[:, None, :]
     Q[~ok] = np.nan
     return Q, ok

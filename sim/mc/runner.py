@@ -45,12 +45,13 @@ import pyarrow.parquet as pq
 from sim.lsq import distributions as D
 from sim.mc.config import StudyError
 from sim.mc.progress import Progress
-from sim.mc.storage import atomic_path
+from sim.mc.storage import atomic_path, config_hash
 
 __all__ = ["chunk_rng", "run_chunks", "ChunkStore", "make_executor", "jackknife", "require_finite"]
 
 ROWS = "rows."
 _ARRAYS = b"sim.arrays"
+_IDENTITY = b"sim.chunk"  # a chunk file's identity, checked when it is read back
 
 
 def chunk_rng(seed: int, part: int, k: int) -> np.random.Generator:
@@ -88,11 +89,14 @@ class ChunkStore:
 
     root: Path
     prov: dict | None = None
+    used: set = field(default_factory=set, compare=False, repr=False)
 
     def path(self, part: int, k: int) -> Path:
         return Path(self.root) / f"part-{part}" / f"chunk-{k:06d}.parquet"
 
-    def save(self, part: int, k: int, n: int, data: Mapping[str, np.ndarray]) -> None:
+    def save(
+        self, part: int, k: int, n: int, data: Mapping[str, np.ndarray], seed: int | None = None
+    ) -> None:
         rows = {key[len(ROWS) :]: v for key, v in data.items() if key.startswith(ROWS)}
         kept = {key: v for key, v in data.items() if not key.startswith(ROWS)}
         buf = io.BytesIO()
@@ -105,6 +109,7 @@ class ChunkStore:
             }
         )
         meta = {_ARRAYS: buf.getvalue(), b"n": str(n).encode()}
+        meta[_IDENTITY] = json.dumps(self._identity(part, k, n, seed), sort_keys=True).encode()
         if self.prov is not None:
             meta[b"sim.provenance"] = json.dumps(
                 {**self.prov, "chunk": k, "part": part, "spawn_key": [part, k]}, sort_keys=True
@@ -112,23 +117,59 @@ class ChunkStore:
         table = table.replace_schema_metadata(meta)
         with atomic_path(self.path(part, k)) as tmp:
             pq.write_table(table, tmp)
+        self.used.add(self.path(part, k))
 
-    def load(self, part: int, k: int, keep_rows: bool = False) -> dict | None:
+    def _identity(self, part: int, k: int, n: int, seed: int | None) -> dict:
+        """What a chunk file must be to stand for chunk ``k`` of part ``part``: the study, the
+        hash of its resolved config and code, the part, the index, the trials and the seed
+        stream (``SeedSequence(seed, spawn_key=(part, k))``)."""
+        prov = self.prov or {}
+        return {
+            "study": prov.get("study"),
+            "config_hash": config_hash(prov.get("config"), prov.get("code_hash")),
+            "part": part,
+            "chunk": k,
+            "trials": n,
+            "seed": seed,
+            "spawn_key": [part, k],
+        }
+
+    def load(
+        self, part: int, k: int, keep_rows: bool = False, n: int | None = None, seed=None
+    ) -> dict | None:
+        """The stored chunk ``k`` of part ``part``, or None when it is missing, unreadable or
+        not what its name says (another study, config, part, index, size or seed): the caller
+        computes it again and the file is replaced."""
         p = self.path(part, k)
         if not p.is_file():
             return None
         try:
             table = pq.read_table(p)
-            meta = table.schema.metadata
+            meta = table.schema.metadata or {}
+            ident = json.loads(meta[_IDENTITY])
+            want = self._identity(part, k, n if n is not None else ident.get("trials"), seed)
+            if seed is None:
+                want["seed"] = ident.get("seed")
+            if ident != want or table.num_rows != want["trials"]:
+                return None
             with np.load(io.BytesIO(meta[_ARRAYS])) as z:
                 out = {key: z[key] for key in z.files}
-        except (OSError, KeyError, ValueError, pa.ArrowInvalid):
-            return None  # unreadable: recompute it
+        except (OSError, KeyError, ValueError, TypeError, pa.ArrowInvalid):
+            return None  # unreadable or foreign: recompute it
         if keep_rows:
             for name in table.column_names:
                 if name not in ("chunk", "trial_in_chunk"):
                     out[ROWS + name] = table.column(name).to_numpy()
+        self.used.add(p)
         return out
+
+    def strays(self) -> list[Path]:
+        """Chunk files under the store that this run neither wrote nor read (left over from
+        another run, or copied in): they are not part of its trials."""
+        root = Path(self.root)
+        if not root.is_dir():
+            return []
+        return sorted(p for p in root.rglob("*") if p not in self.used and p.is_file())
 
 
 class _InProcess:
@@ -294,7 +335,7 @@ def run_chunks(
     results: dict[int, dict] = {}
     todo = []
     for k, n in enumerate(sizes):
-        got = store.load(part, k, keep_rows) if store is not None else None
+        got = store.load(part, k, keep_rows, n, seed) if store is not None else None
         if got is not None:
             results[k] = got
         else:
@@ -317,7 +358,7 @@ def run_chunks(
         bar.update(done_trials, len(results))
         for k, n, out in executor.run(fn, seed, part, todo):
             if store is not None:
-                store.save(part, k, n, out)
+                store.save(part, k, n, out, seed)
             if not keep_rows:
                 out = {key: v for key, v in out.items() if not key.startswith(ROWS)}
             results[k] = out

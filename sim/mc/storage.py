@@ -9,6 +9,7 @@ stored, so the same code and config give byte-identical files.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import subprocess
@@ -85,8 +86,6 @@ def git_commit(study: str | None = None) -> str:
 def code_hash(study: str | None = None) -> str:
     """sha256 of the code ``study`` depends on (:func:`sim.mc.codehash.study_code_hash`), or,
     without a study, of the library's source (every ``sim/**/*.py`` but the benchmark)."""
-    import hashlib
-
     if study is not None:
         return study_code_hash(study)
     root = Path(__file__).resolve().parents[1]
@@ -111,6 +110,13 @@ def versions() -> dict[str, str]:
         except PackageNotFoundError:
             out[pkg] = "not installed"
     return out
+
+
+def config_hash(config: Mapping[str, Any] | None, code: str | None = None) -> str:
+    """sha256 (16 hex digits) of a resolved configuration and a code hash: what a chunk file
+    and a run record are checked against."""
+    text = json.dumps({"config": config, "code": code}, sort_keys=True, default=_jsonable)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 def provenance(cfg: Mapping[str, Any], **extra: Any) -> dict[str, Any]:

@@ -11,6 +11,9 @@ import math
 from pathlib import Path
 from typing import Callable
 
+import pyarrow as pa
+
+from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_table
 from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.papers import paper_name
@@ -36,6 +39,8 @@ _VERDICT_TEXT = {
     "holds": "holds",
     "fails": "**fails**",
     "inconclusive": "inconclusive",
+    "depends": "depends",
+    "undecidable": "undecidable",
     "erratum": "**erratum**",
     "input": "input",
     "self-check": "self-check",
@@ -311,6 +316,20 @@ def referee_summary(entries: list[tuple]) -> str:
     return "\n".join(parts)
 
 
+def _claims_of(d: Path, get_study: Callable):
+    """``(study, provenance, claim rows)`` of a results directory, or one line naming the file
+    when its ``claims.parquet`` is not a claims table written by the suite."""
+    f = d / "claims.parquet"
+    try:
+        prov = read_provenance(f) or {}
+        claims = read_table(f).to_pylist()
+    except (OSError, ValueError, pa.ArrowException) as e:
+        raise ConfigError("--results", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+    if "study" not in prov or (claims and not {"claim", "verdict"} <= set(claims[0])):
+        raise ConfigError("--results", f"{f} is not a claims table written by sim")
+    return get_study(prov["study"]), prov, claims
+
+
 _RULES = (
     "### How verdicts are decided\n\n"
     "Each claim declares its *form* and the half-width that decides (`tol`); the *decision "
@@ -333,9 +352,7 @@ _RULES = (
 
 
 def _entry(d: Path, get_study: Callable) -> tuple:
-    prov = read_provenance(d / "claims.parquet")
-    study = get_study(prov["study"])
-    claims = read_table(d / "claims.parquet").to_pylist()
+    study, prov, claims = _claims_of(d, get_study)
     c = verdict_counts(claims)
     nr = d / "not_reproduced.parquet"
     n_nr = read_table(nr).num_rows if nr.is_file() else 0
@@ -355,6 +372,8 @@ def build_report(results: Path, get_study: Callable) -> str:
     reproducibility check, and links to each directory's README.md (the detail).
     ``get_study(name)`` gives the registered study (title, seed file, order)."""
     results = Path(results)
+    if not results.is_dir():
+        raise ConfigError("--results", f"{results} is not a results directory")
     entries = [
         _entry(d, get_study)
         for d in sorted(p for p in results.iterdir() if (p / "claims.parquet").is_file())
@@ -394,14 +413,34 @@ def build_report(results: Path, get_study: Callable) -> str:
     )
 
 
+#: the first line of every REPORT.md the suite writes: a file without it is the user's
+MARK = "<!-- written by `sim report` from the Parquet files alone; edits are overwritten -->"
+
+
+def _ours(path: Path) -> bool:
+    """True for a REPORT.md the suite wrote (its mark, or the heading the reports had before)."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            first = f.readline().rstrip("\n")
+    except OSError:
+        return False
+    return first in (MARK, "# Reproducibility report")
+
+
 def write_report(results: Path, get_study: Callable) -> Path:
-    """Write each results directory's README.md and ``results/REPORT.md``."""
+    """Write each results directory's README.md (see
+    :func:`sim.report.run_summary.write_run_readme`) and ``results/REPORT.md``; a REPORT.md
+    there that the suite did not write is refused (one line naming it), never replaced."""
     results = Path(results)
+    out = results / "REPORT.md"
+    if out.is_symlink() or (out.exists() and not _ours(out)):
+        raise ConfigError(
+            "--results", f"{out} was not written by sim report; sim never replaces it"
+        )
+    text = MARK + "\n" + build_report(results, get_study)
     for d in sorted(results.iterdir()):
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             write_run_readme(d, get_study)
-    text = build_report(results, get_study)
-    out = results / "REPORT.md"
     with atomic_path(out) as tmp:
         tmp.write_text(text)
     return out

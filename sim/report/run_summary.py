@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Callable
 
 from sim.mc.config import ConfigError
-from sim.mc.storage import atomic_path, read_provenance, read_table
+from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.papers import paper_name
 from sim.report.sweep import sweep_markdown
@@ -28,6 +28,7 @@ __all__ = [
     "terminal_table",
     "run_markdown",
     "write_run_readme",
+    "README_MARK",
 ]
 
 #: verdicts in the order they are counted (others follow in alphabetical order)
@@ -191,10 +192,32 @@ def _relink(body: str, name: str) -> str:
     return body.replace(f"]({name}/", "](")
 
 
-def write_run_readme(out: Path, get_study: Callable) -> Path:
-    """Write ``out/README.md`` (see :func:`run_markdown`) atomically; returns its path."""
-    text = run_markdown(out, get_study)
-    path = Path(out) / "README.md"
+#: the first line of every README.md the suite writes in a results directory: a README.md
+#: without it is the user's, and is never replaced
+README_MARK = "<!-- written by sim from this directory's Parquet files; edits are overwritten -->"
+
+
+def _ours(path: Path) -> bool:
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            return f.readline().rstrip("\n") == README_MARK
+    except OSError:
+        return False
+
+
+def write_run_readme(out: Path, get_study: Callable) -> Path | None:
+    """Write ``out/README.md`` (see :func:`run_markdown`) atomically and list it among the
+    files the run wrote (``run.json``, so a later run into the directory replaces it rather
+    than keeping it as the user's). A README.md the suite did not write (no mark) is left as
+    it is: returns None then, else the path."""
+    out = Path(out)
+    path = out / "README.md"
+    if path.is_symlink() or (path.exists() and not _ours(path)):
+        return None
+    text = README_MARK + "\n" + run_markdown(out, get_study)
     with atomic_path(path) as tmp:
         tmp.write_text(text)
+    rec = read_record(out)
+    if rec is not None and isinstance(rec.get("files"), list) and "README.md" not in rec["files"]:
+        write_record(out, {**rec, "files": sorted([*rec["files"], "README.md"])})
     return path

@@ -26,7 +26,7 @@ SCHEMA = {
     "block.strips": Field(2, "int", "strips (paper: two)", lo=1, hi=50, input=True),
     "block.models": Field(8, "int", "models per strip (paper: eight)", lo=1, hi=200, input=True),
     "block.scale": Field(
-        6200.0, "float", "photo scale number (paper: 1/6 200)", lo=100.0, input=True
+        6200.0, "float", "photo scale number (paper: 1/6 200)", lo=100.0, hi=1e6, input=True
     ),
     "block.focal_mm": Field(
         152.0, "float", "camera constant (paper: 152 mm)", lo=10.0, hi=1000.0, input=True, unit="mm"

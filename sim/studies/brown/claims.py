@@ -95,39 +95,10 @@ def idealised_offset(cfg: dict, pts: np.ndarray) -> tuple[float, float]:
 
 
 def score_dilution(book, cfg, pts, theta, an, mc, sim, curve, extra, mono) -> list[dict]:
-    """All rows of brown_dilution (an: model -> (n, 2) unit analytic sigmas)."""
-    sig = {m: an[m][None] for m in MODEL_NAMES}
-    args = V.dilution_values(pts[None], sig, np.array([mono]))[0]
-    kn = an["known"]
-    c = V.centre_index(pts)
-    jx = np.unravel_index(np.argmax(kn), kn.shape)
-    d = (V.pooled(an["stations"]) / V.pooled(kn) - 1) * 100
+    """The rows of brown_dilution not decided over the region (:mod:`.region`): structure,
+    bias invariance, findings and self-checks (an: model -> (n, 2) unit analytic sigmas)."""
     ex = (V.pooled(an["pivot"]) / V.pooled(an["stations"]) - 1) * 100
-    ext = float(np.abs(pts).max())
-    geo = (
-        f"{len(pts)} points to +-{ext:g} mm, stations {cfg['comparator.station_offset_mm']:g} "
-        "mm outside the midsides (nominal; unprinted, swept in consistent_set)"
-    )
-    notes = {
-        "brown.known_center.ratio": f"analytic, {_pt(pts, c)}: 1/sqrt(2) at the centre for "
-        f"every offset; {geo}",
-        "brown.known_edge.ratio": f"analytic, largest sigma/sigma_r over the points ("
-        f"{'xy'[jx[1]]} at {_pt(pts, jx[0])}); {geo}",
-        "brown.dilution.range_pct": f"analytic per-point dilution of 'stations' over 'known' "
-        f"(rms of sigma_x, sigma_y): every point must lie in 5-15 %; "
-        f"smallest at {_pt(pts, int(np.argmin(d)))}, largest at "
-        f"{_pt(pts, int(np.argmax(d)))}; {geo}",
-        "brown.dilution_falls_with_points.monotone": "analytic: 1 when the mean and the largest "
-        "per-point dilution fall at every step of "
-        f"k x k grids k = {list(curve)} (same extent)",
-        "brown.pivot_extra_dilution.range_pct": f"analytic per-point extra dilution of 'pivot' over 'stations'"
-        f", largest at {_pt(pts, int(np.argmax(ex)))} "
-        f"(median over points {np.median(ex):.1f} %). "
-        "'Essentially none' is taken as 0-2 % at every point; beta^2 "
-        "shifts each range by about beta^2/(2d), most at "
-        "short ranges",
-    }
-    rows = [book.score(cid, note=notes[cid], **kw) for cid, kw in args.items()]
+    rows = []
     k_last = max(curve)
     v = float(curve[k_last].max())
     rows.append(
@@ -211,7 +182,8 @@ def score_dilution(book, cfg, pts, theta, an, mc, sim, curve, extra, mono) -> li
 
 
 def score_table1(book, cfg, pts, an_pivot, sr, mc, t1) -> list[dict]:
-    """All rows of brown_table1. ``t1``: per-plate statistics of the converged trials."""
+    """The rows of brown_table1 not decided over the region (:mod:`.region`): the closure,
+    the paper's arithmetic, self-checks. ``t1``: per-plate statistics of the converged trials."""
     dof = 4 * len(pts) - (2 * len(pts) + 7)
     rows = [
         book.score(
@@ -306,62 +278,6 @@ def score_table1(book, cfg, pts, an_pivot, sr, mc, t1) -> list[dict]:
             float(np.sqrt(1.5**2 - 0.8**2)),
             interval="exact",
             note="recomputed: sqrt(1.50^2 - 0.8^2)",
-        )
-    )
-    geo = (
-        f"stations {cfg['comparator.station_offset_mm']:g} mm outside the midsides (nominal; "
-        "unprinted, swept in consistent_set)"
-    )
-    one = (
-        f"one-plate statistic: median and 95 % range over {len(s0)} simulated plates, p = "
-        "probability of a plate at least as extreme as the paper's; a-posteriori sigmas "
-        "(sigma0 x sqrt(cofactor), pivot model, as printed to one decimal); " + geo
-    )
-    rows.append(
-        book.score(
-            "brown.table1_point_sigma.share_1p1_1p3",
-            samples=t1["share_1p1_1p3"],
-            note="share of the 50 sigmas printing as 1.1-1.3 um; " + one,
-        )
-    )
-    rows.append(
-        book.score(
-            "brown.table1_point_sigma.points_ge_1p45",
-            samples=t1["points_ge_1p45"],
-            note="points whose larger sigma prints "
-            ">= 1.5 um; with a symmetric design they come in fours; " + one,
-        )
-    )
-    rows.append(
-        book.score(
-            "brown.table1_point_sigma.max_um",
-            samples=t1["max_sigma_um"],
-            note="largest of the 50 sigmas; " + one,
-        )
-    )
-    args = V.table1_values(an_pivot[None] / sr, np.array([sr]))[0]
-    cof = an_pivot / sr
-    at = (
-        "sigma0 = the paper's printed 1.6 um, so the geometry alone decides; interval over "
-        f"its rounding 1.55-1.65 um; sqrt(cofactor) {cof.min():.3f}-{cof.max():.3f}; " + geo
-    )
-    for cid, what in (
-        ("share_at_paper_closure", "share of the 50 sigmas printing as 1.1-1.3 um"),
-        ("count_at_paper_closure", "points whose larger sigma prints >= 1.5 um"),
-        ("max_at_paper_closure_um", "largest of the 50 sigmas (um)"),
-    ):
-        rows.append(
-            book.score(
-                f"brown.table1_point_sigma.{cid}",
-                note=f"{what}; {at}",
-                **args[f"brown.table1_point_sigma.{cid}"],
-            )
-        )
-    rows.append(
-        book.score(
-            "brown.table1_point_sigma.below_closure",
-            note="every sigma / sigma0 = sqrt(cofactor) (pivot model) must be below 1; " + geo,
-            **args["brown.table1_point_sigma.below_closure"],
         )
     )
     rows.append(

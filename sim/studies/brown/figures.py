@@ -3,14 +3,14 @@ so that labels of neighbouring panels never overlap."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 
 from sim.claims.intervals import std_rel_se
+from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
-from sim.mc.storage import read_table
+from sim.mc.storage import read_provenance, read_table
 from sim.report.plotting import plt, save
 from sim.studies.brown.schema import MODEL_NAMES
 from sim.studies.brown.values import pooled
@@ -145,102 +145,47 @@ def fig_table1(cfg, pts, theta, an_pivot, t1, path):
     save(fig, path)
 
 
-def _short(cid: str) -> str:
-    return cid.replace("brown.", "").replace("table1_point_sigma.", "")
+_EXAMPLE = {"station_offset_mm": "comparator.station_offset_mm", "beta_mm": "comparator.beta_mm"}
 
 
-def fig_consistent_set(out: Path, path):
-    """Each swept claim against the station offset: the paper's decision zone (orange), the
-    infeasible offsets (grey: ranges longer than the scale; idealised), the consistent set of
-    the nominal extent (green), one line per swept extent."""
-    sw = read_table(out / "sweep.parquet").to_pydict()
-    cs = read_table(out / "consistent_set.parquet").to_pylist()
-    cl = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
-    claims = list(dict.fromkeys(sw["claim"]))
-    E = np.asarray(sw["half_extent_mm"])
-    O = np.asarray(sw["offset_mm"])
-    C = np.asarray(sw["claim"])
-    exts = sorted(set(E))
-    P = read_table(out / "points.parquet").to_pydict()
-    e0 = float(max(np.abs(P["x_mm"]).max(), np.abs(P["y_mm"]).max()))
-    fixed0 = next(
-        r["fixed"]
-        for r in cs
-        if r["input"] == "comparator.station_offset_mm"
-        and r["fixed"].startswith(f"half extent of the points {e0:g} mm")
-    )
-    row_all = next(r for r in cs if r["claim"] == "ALL" and r["fixed"] == fixed0)
-    multi = len(exts) > 1
-    n = len(claims) + multi
-    ncols = 3
-    fig, axs = _fig(math.ceil(n / ncols), ncols, 15, 3.6 * math.ceil(n / ncols))
-    cmap = plt.get_cmap("viridis")
-    for ax, cid in zip(axs.flat, claims):
-        for i, e in enumerate(exts):
-            s = (C == cid) & (E == e)
-            o = O[s]
-            v, lo, hi = (np.asarray(sw[k], float)[s] for k in ("value", "ci_low", "ci_high"))
-            f = np.asarray(sw["feasible"], bool)[s]
-            col = cmap(i / max(len(exts) - 1, 1)) if multi else "tab:blue"
-            lab = f"+-{e:g} mm" if multi else "simulated"
-            ax.plot(o, np.where(f, v, np.nan), "-", color=col, lw=1.6 if e == e0 else 1, label=lab)
-            ax.plot(o, np.where(f, np.nan, v), ":", color=col, lw=1)
-            if cl.get(cid, {}).get("form") == "range":  # the largest element too
-                ax.plot(o, np.where(f, hi, np.nan), "-", color=col, lw=1.6 if e == e0 else 1)
-                ax.plot(o, np.where(f, np.nan, hi), ":", color=col, lw=1)
-            if e == e0 and np.any(lo != hi):
-                ax.fill_between(o, lo, hi, color=col, alpha=0.15, lw=0)
-        r = cl.get(cid, {})
-        zl, zh = r.get("zone_low"), r.get("zone_high")
-        if zl is not None and zh is not None:
-            yl = ax.get_ylim()
-            if zh - zl > 1e-3 * (yl[1] - yl[0]):
-                ax.axhspan(
-                    max(zl, yl[0] - 1e3),
-                    min(zh, yl[1] + 1e3),
-                    color="tab:orange",
-                    alpha=0.25,
-                    lw=0,
-                    label="paper (decision zone)",
-                )
-            else:
-                ax.axhline(zl, color="tab:orange", lw=2, label="paper (decision zone)")
-            ax.set_ylim(yl)
-        _shade(ax, row_all, cid, cs)
-        ax.set_title(_short(cid), fontsize=9)
-        ax.set_xlabel("station offset outside the midsides (mm)")
-        ax.set_ylabel("simulated value")
-        ax.ticklabel_format(axis="y", useOffset=False)
-    if multi:
-        ax = axs.flat[len(claims)]
-        grid = np.zeros((len(exts), len(np.unique(O))))
-        xo = np.unique(O)
-        v = np.asarray(sw["verdict"])
-        feas = np.asarray(sw["feasible"], bool)
-        for i, e in enumerate(exts):
-            for j, o in enumerate(xo):
-                s = (E == e) & (O == o)
-                grid[i, j] = (v[s] == "holds").sum() if feas[s].all() else np.nan
-        im = ax.pcolormesh(
-            xo, exts, grid, shading="nearest", cmap="Greens", vmin=0, vmax=len(claims)
-        )
-        fig.colorbar(im, ax=ax, label="claims that hold", shrink=0.8)
-        ax.set_xlabel("station offset outside the midsides (mm)")
-        ax.set_ylabel("half extent of the points (mm)")
-        ax.set_title("claims holding (white: ranges longer than the scale)", fontsize=9)
-    for ax in list(axs.flat)[n:]:
-        ax.set_visible(False)
-    handles = {}
-    for ax in list(axs.flat)[: len(claims)]:
-        for h, lab in zip(*ax.get_legend_handles_labels()):
-            handles.setdefault(lab, h)
-    fig.legend(
-        list(handles.values()),
-        list(handles),
-        loc="outside lower center",
-        ncols=min(len(handles), 5),
-        fontsize=8,
-    )
+def _scale_limit(ax, xname, yname, reg):
+    """The scale's limit on the station offset (every range reads on 261 + 1 mm)."""
+    if xname != "station_offset_mm":
+        return
+    if yname == "half_extent_mm":
+        e = np.linspace(float(np.min(reg[yname])), B.FORMAT_MM / 2, 100)
+        ax.plot(B.max_offset_mm(e), e, "k--", lw=1.2, label="scale limit (beta 0)")
+    elif yname == "beta_mm":
+        b = np.linspace(0, B.SCALE_WIDTH_MM / 2, 50)
+        ax.plot(B.max_offset_mm(90.0, b), b, "k--", lw=1.2, label="scale limit (+-90 mm grid)")
+    else:
+        ax.axvline(float(B.max_offset_mm(90.0)), color="k", ls="--", lw=1.2, label="scale limit")
+
+
+def fig_region(out: Path, pairs, path):
+    """Pairwise projections of the consistent region (grey: inputs the hardware and the
+    constraining statements allow; green: where every prediction holds together), the declared
+    hardware box (dotted) and the scale's limit (dashed); the configured geometry as a labelled
+    example (star)."""
+    reg = read_table(out / "consistent_region.parquet").to_pydict()
+    ins = {r["input"]: r for r in read_table(out / "region_inputs.parquet").to_pylist()}
+    cfg = read_provenance(out / "claims.parquet")["config"]
+    tog = np.asarray(reg["together"], bool)
+    fig, axs = _fig(1, len(pairs), 5 * len(pairs), 4.4)
+    for ax, (xn, yn) in zip(axs.flat, pairs):
+        x, y = np.asarray(reg[xn]), np.asarray(reg[yn])
+        ax.scatter(x[~tog], y[~tog], s=3, color="0.6", label="region (hardware, printed inputs)")
+        ax.scatter(x[tog], y[tog], s=4, color="tab:green", label="every prediction holds")
+        for name, setter in ((xn, ax.axvline), (yn, ax.axhline)):
+            for v in (ins[name]["declared_low"], ins[name]["declared_high"]):
+                setter(v, color="tab:blue", ls=":", lw=1)
+        _scale_limit(ax, xn, yn, reg)
+        ex = [cfg.get(_EXAMPLE.get(n, ""), None) for n in (xn, yn)]
+        if all(v is not None for v in ex):
+            ax.plot(*ex, "*", color="tab:red", ms=11, label="configured example (not a verdict)")
+        ax.set_xlabel(xn)
+        ax.set_ylabel(yn)
+    axs.flat[0].legend(fontsize=7, loc="best")
     save(fig, path)
 
 

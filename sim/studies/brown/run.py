@@ -1,4 +1,4 @@
-"""Runs of the two Brown studies: simulate, sweep the unprinted inputs, score, draw.
+"""Runs of the two Brown studies: simulate, decide over the region of unprinted inputs, draw.
 
 ``run_dilution`` (the *Concept* section) and ``run_table1`` (the *Results* section) write
 their Parquet files and figures into ``out``; the Monte Carlo goes through the runner
@@ -16,9 +16,9 @@ from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import start_figures
 from sim.studies import RunContext
 from sim.studies.brown import figures as F
+from sim.studies.brown import region as RG
 from sim.studies.brown import values as V
 from sim.studies.brown.claims import load_book, score_dilution, score_table1
-from sim.studies.brown.consistency import consistent_set, sweep_dilution, sweep_table1
 from sim.studies.brown.core import MC, analytic_sigma, points_table, run_mc
 from sim.studies.brown.schema import MODEL_NAMES, range_sigma_um, setup
 
@@ -31,11 +31,11 @@ def _common(cfg, ctx, **kw):
     return pts, theta, sr, an, sim, MC(sim)
 
 
-def _write_sweep(out, sw, cfg, prov):
-    write_table(out / "sweep.parquet", sw, prov)
-    cs = consistent_set(sw, cfg)
-    write_table(out / "consistent_set.parquet", cs, prov)
-    return cs
+def _write_region(out, prov, book, reg, preds, verdicts, notes) -> list[dict]:
+    """``consistent_region.parquet``, ``region_inputs.parquet``; the region's claim rows."""
+    write_table(out / "consistent_region.parquet", RG.table_of(reg, preds), prov)
+    write_table(out / "region_inputs.parquet", RG.inputs_table(reg, preds, verdicts), prov)
+    return RG.rows_of(book, reg, preds, verdicts, notes)
 
 
 def run_dilution(cfg: dict, out: Path, ctx: RunContext) -> None:
@@ -78,10 +78,10 @@ def run_dilution(cfg: dict, out: Path, ctx: RunContext) -> None:
 
     book = load_book("brown_dilution")
     rows = score_dilution(book, cfg, pts, theta, unit, mc, sim, curve, extra, mono)
+    reg, preds, verdicts = RG.concept_region(cfg, book)
+    rows += _write_region(out, prov, book, reg, preds, verdicts, RG.CONCEPT_NOTES)
     write_claims(out / "claims.parquet", rows, prov, book)
-    sw = sweep_dilution(cfg, load_book("brown_dilution"), pts)
-    _write_sweep(out, sw, cfg, prov)
-    F.fig_consistent_set(out, out / "consistent_set.png")
+    F.fig_region(out, RG.CONCEPT_PAIRS, out / "consistent_region.png")
     drawn()
 
 
@@ -114,11 +114,11 @@ def run_table1(cfg: dict, out: Path, ctx: RunContext) -> None:
     )
     book = load_book("brown_table1")
     rows = score_table1(book, cfg, pts, an["pivot"], sr, mc, t1)
-    write_claims(out / "claims.parquet", rows, prov, book)
     drawn = start_figures(
         [(F.fig_table1, (cfg, pts, theta, an["pivot"], t1, out / "table1.png"))], ctx.executor
-    )  # on an idle worker while the sweep is made here
-    sw = sweep_table1(cfg, load_book("brown_table1"), pts, sr)
-    _write_sweep(out, sw, cfg, prov)
-    F.fig_consistent_set(out, out / "consistent_set.png")
+    )  # on an idle worker while the region is explored here
+    reg, preds, verdicts = RG.table1_region(cfg, book)
+    rows += _write_region(out, prov, book, reg, preds, verdicts, RG.TABLE1_NOTES)
+    write_claims(out / "claims.parquet", rows, prov, book)
+    F.fig_region(out, RG.TABLE1_PAIRS, out / "consistent_region.png")
     drawn()

@@ -40,7 +40,8 @@ BASE = {
         "float",
         "distance of the stations outside the midsides of the format; the paper "
         "says only 'a short distance' (nominal value: the middle of the 0-34 mm that fit the "
-        "261 mm scale for a +-90 mm grid; swept in consistency.*)",
+        "261 mm scale for a +-90 mm grid; a labelled example: the claims are decided over "
+        "the region of sim.instruments.ranges.brown)",
         lo=0.0,
         lo_open=True,
         unit="mm",
@@ -86,21 +87,20 @@ BASE = {
         unit="mm",
     ),
     "solver.max_iter": Field(30, "int", "Gauss-Newton iteration limit", lo=1, hi=1000),
-    "consistency.offset_min_mm": Field(
-        0.5, "float", "smallest station offset of the sweep", lo=0.0, lo_open=True, unit="mm"
+    "region.points": Field(
+        1024,
+        "int",
+        "size of the space-filling (Sobol) design of the joint exploration of the unprinted "
+        "inputs (sim.claims.inference), rounded up to a power of 2",
+        lo=256,
+        hi=16384,
     ),
-    "consistency.offset_max_mm": Field(
-        60.0,
-        "float",
-        "largest station offset of the sweep "
-        "(offsets whose ranges do not fit the scale are shown as "
-        "idealised, never scored)",
-        lo=0.0,
-        lo_open=True,
-        unit="mm",
-    ),
-    "consistency.offset_step_mm": Field(
-        0.5, "float", "step of the station-offset sweep", lo=0.0, lo_open=True, unit="mm"
+    "region.rounds": Field(
+        3,
+        "int",
+        "refinement rounds at the region's boundaries (each halves the spacing)",
+        lo=0,
+        hi=8,
     ),
 }
 
@@ -114,16 +114,6 @@ DILUTION = {
         lo=2,
         hi=200,
         min_len=2,
-    ),
-    "consistency.extents_mm": Field(
-        [60.0, 70.0, 80.0, 90.0, 100.0, 110.0],
-        "list[float]",
-        "half extents of the k x k grid swept with the station "
-        "offset (the Concept section prints no layout)",
-        lo=0.0,
-        lo_open=True,
-        min_len=1,
-        unit="mm",
     ),
     "idealised.half_extent_mm": Field(
         110.0,
@@ -183,16 +173,6 @@ def points_of(cfg: dict) -> np.ndarray:
     )
 
 
-#: the most geometries one sweep may evaluate (memory: about 1 kB per geometry and point)
-MAX_SWEEP = 20000
-
-
-def sweep_offsets(cfg: dict) -> np.ndarray:
-    """The station offsets of the consistency sweep (mm)."""
-    lo, hi, st = (cfg[f"consistency.offset_{k}_mm"] for k in ("min", "max", "step"))
-    return lo + st * np.arange(int(np.floor((hi - lo) / st + 1e-9)) + 1)
-
-
 def max_offset_mm(cfg: dict, half_extent_mm: float) -> float:
     """Largest station offset at which every range of a grid reaching +-half_extent_mm fits
     the scale plus the micrometer (inf when the scale is not enforced). The farthest point
@@ -209,31 +189,20 @@ def max_offset_mm(cfg: dict, half_extent_mm: float) -> float:
     return float(np.sqrt(d2) - e - cfg["plate.format_mm"] / 2) if d2 > 0 else -float("inf")
 
 
-def check_sweep(cfg: dict) -> None:
-    """The sweep keys: an ordered, non-empty, bounded grid of offsets (and extents)."""
-    if cfg["consistency.offset_max_mm"] < cfg["consistency.offset_min_mm"]:
-        raise ConfigError("consistency.offset_max_mm", "must be >= consistency.offset_min_mm")
-    n = (cfg["consistency.offset_max_mm"] - cfg["consistency.offset_min_mm"]) / cfg[
-        "consistency.offset_step_mm"
-    ] + 1
-    n_ext = len(cfg.get("consistency.extents_mm", [0]))
-    if n * n_ext > MAX_SWEEP:
-        raise ConfigError(
-            "consistency.offset_step_mm",
-            f"the sweep would evaluate {n * n_ext:.3g} "
-            f"geometries (limit {MAX_SWEEP}); use a larger step",
-        )
+def check_extents(cfg: dict) -> None:
+    """The idealised layout lies inside the format."""
     half = cfg["plate.format_mm"] / 2
-    for key in ("consistency.extents_mm", "idealised.half_extent_mm"):
-        v = cfg.get(key)
-        if v is not None and max(np.atleast_1d(v)) > half:
-            raise ConfigError(key, f"half extents must lie inside the format (<= {half:g} mm)")
+    v = cfg.get("idealised.half_extent_mm")
+    if v is not None and v > half:
+        raise ConfigError(
+            "idealised.half_extent_mm", f"half extents must lie inside the format (<= {half:g} mm)"
+        )
 
 
 def check(cfg: dict) -> None:
     """Cross-key rules: points inside the format, enough points, no duplicates/collinearity,
-    every range on the scale, a bounded sweep."""
-    check_sweep(cfg)
+    every range on the scale."""
+    check_extents(cfg)
     key = {"grid": "plate.grid", "random": "plate.n_random", "list": "plate.points"}[
         cfg["plate.pattern"]
     ]

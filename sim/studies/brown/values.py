@@ -1,11 +1,10 @@
 """What the Brown model predicts for each claim, batched over geometries (analytic).
 
-One function per study maps the cofactor sigmas of a batch of geometries (stations at
-different offsets, points at different extents; the geometries play the trial axis of
-:func:`sim.instruments.ranges.multilateration.covariance`) to the arguments of
-:meth:`sim.claims.book.ClaimBook.score` for every claim that depends on the geometry. The nominal
-run and the sweep of the unprinted inputs (:mod:`.consistency`) call the same functions, so a
-nominal row equals the sweep at the nominal offset.
+Cofactor sigmas of a batch of geometries (stations at different offsets, points at
+different extents; the geometries play the trial axis of
+:func:`sim.instruments.ranges.multilateration.covariance`), the dilution and the one-plate
+statistics of Table 1's printed sigmas. The region of the unprinted inputs (:mod:`.region`)
+and the nominal example call the same functions.
 
 Sigmas are per unit range sigma (dimensionless ratios) unless a name says ``_um``.
 Seed paper 004 (Brown 1968).
@@ -17,12 +16,6 @@ import numpy as np
 
 from sim.instruments.plates import pattern_points
 from sim.instruments.ranges import multilateration as ml
-from sim.lsq import distributions as D
-
-#: sigma0 values spanning the paper's printed closure 1.6 um (1.55-1.65 um)
-S0_PAPER_UM = np.linspace(1.55, 1.65, 21)
-#: quantile levels of the closure sigma0 over plates (semi-analytic one-plate statistics)
-N_QUANT = 1000
 
 
 def pooled(a: np.ndarray) -> np.ndarray:
@@ -71,46 +64,6 @@ def monotone(curve: dict) -> np.ndarray:
     return np.all(np.diff(mean, axis=1) < 0, axis=1) & np.all(np.diff(mx, axis=1) < 0, axis=1)
 
 
-def centre_index(pts: np.ndarray) -> int:
-    return int(np.argmin(np.hypot(pts[:, 0], pts[:, 1])))
-
-
-def dilution_values(pts: np.ndarray, sig: dict, mono: np.ndarray) -> list[dict]:
-    """Per geometry, the score arguments of the Concept claims that depend on the geometry.
-
-    pts : (G, n, 2) points; sig : model -> (G, n, 2) unit sigmas; mono : (G,) bools.
-    """
-    kn, st, pv = sig["known"], sig["stations"], sig["pivot"]
-    c = centre_index(pts[0])
-    centre = pooled(kn[:, c])
-    edge = kn.max(axis=(1, 2))
-    dil = (pooled(st) / pooled(kn) - 1) * 100
-    extra = (pooled(pv) / pooled(st) - 1) * 100
-    out = []
-    for g in range(len(kn)):
-        out.append(
-            {
-                "brown.known_center.ratio": dict(value=float(centre[g]), interval="exact"),
-                "brown.known_edge.ratio": dict(value=float(edge[g]), interval="exact"),
-                "brown.dilution.range_pct": dict(elems=(dil[g], dil[g]), interval="exact"),
-                "brown.dilution_falls_with_points.monotone": dict(
-                    value=float(mono[g]), interval="exact"
-                ),
-                "brown.pivot_extra_dilution.range_pct": dict(
-                    elems=(extra[g], extra[g]), interval="exact"
-                ),
-            }
-        )
-    return out
-
-
-def closure_quantiles(range_sigma_um: float, dof: int, n: int = N_QUANT) -> np.ndarray:
-    """sigma0 of one plate at ``n`` evenly spaced quantile levels: sigma0^2 dof / sigma^2 is
-    chi-square with ``dof`` degrees of freedom (a deterministic sample of the plates)."""
-    q = (np.arange(n) + 0.5) / n
-    return range_sigma_um * np.sqrt(D.chi2_ppf(q, dof) / dof)
-
-
 def point_sigma_stats(sig_um: np.ndarray) -> dict[str, np.ndarray]:
     """One-plate statistics of the point sigmas ``(..., n, 2)`` (um) as the paper prints them
     (one decimal): share in 1.1-1.3, points whose larger sigma prints >= 1.5, the largest."""
@@ -119,36 +72,3 @@ def point_sigma_stats(sig_um: np.ndarray) -> dict[str, np.ndarray]:
         "count": (sig_um.max(-1) >= 1.45).sum(-1).astype(float),
         "max": sig_um.max(axis=(-1, -2)),
     }
-
-
-def table1_values(cof: np.ndarray, s0_plates_um: np.ndarray) -> list[dict]:
-    """Per geometry, the score arguments of the Table-1 claims that depend on the geometry.
-
-    cof : (G, n, 2) cofactor sigmas of the pivot model (sigma / sigma0).
-    s0_plates_um : sigma0 of simulated plates (quantiles): the one-plate distributions.
-    The ``*_at_paper_closure`` claims take sigma0 as printed (1.6 um, i.e. 1.55-1.65): their
-    interval is the range over that rounding.
-    """
-    at = point_sigma_stats(S0_PAPER_UM[None, :, None, None] * cof[:, None])  # (G, S)
-    mid = len(S0_PAPER_UM) // 2
-    out = []
-    for g in range(len(cof)):
-        pl = point_sigma_stats(s0_plates_um[:, None, None] * cof[g][None])  # (Q,)
-        c = cof[g].ravel()
-        row = {
-            "brown.table1_point_sigma.below_closure": dict(elems=(c, c), interval="exact"),
-            "brown.table1_point_sigma.share_1p1_1p3": dict(samples=pl["share"]),
-            "brown.table1_point_sigma.points_ge_1p45": dict(samples=pl["count"]),
-            "brown.table1_point_sigma.max_um": dict(samples=pl["max"]),
-        }
-        for key, cid in (
-            ("share", "share_at_paper_closure"),
-            ("count", "count_at_paper_closure"),
-            ("max", "max_at_paper_closure_um"),
-        ):
-            v = at[key][g]
-            row[f"brown.table1_point_sigma.{cid}"] = dict(
-                value=float(v[mid]), ci=(float(v.min()), float(v.max())), interval="ci"
-            )
-        out.append(row)
-    return out

@@ -5,7 +5,7 @@ Modules: :mod:`.schema` (config and checks), :mod:`.cells` (the analytic design 
 :mod:`.chunks` (picklable chunk functions), :mod:`.adaptive` (adaptive trial counts through the
 runner), :mod:`.errbudget` (error budget), :mod:`.dilution` (datum), :mod:`.formal` (coverage),
 :mod:`.posterior` (emcee), :mod:`.external` (tolerances and external comparisons, linearised),
-:mod:`.consistent` (the unprinted inputs swept), :mod:`.claims` with ``claims.toml`` (the claim
+:mod:`.region` (the unprinted inputs explored jointly), :mod:`.claims` with ``claims.toml`` (the claim
 book), :mod:`.run`, :mod:`.figures`, :mod:`.report`.
 """
 

@@ -1,6 +1,6 @@
 """Figures of study ``brown_design`` (seed ``004``): Pareto front, error budget, datum,
-coverage, the emcee corner plot, the two-plate ratio and the consistent set of the unprinted
-inputs. Log axes carry a few labelled ticks only (plain numbers), so labels never overlap.
+coverage, the emcee corner plot and the two-plate ratio (the region of the unprinted inputs
+is drawn once for the paper, by brown_table1). Log axes carry a few labelled ticks only (plain numbers), so labels never overlap.
 """
 
 from __future__ import annotations
@@ -256,77 +256,12 @@ _COLOR = {
 }
 
 
-def fig_consistent(sv, cs, path):
-    """One panel per (unprinted input, claim): the simulated value and its interval against the
-    swept input, coloured by verdict; the paper's decision zone as a band; the consistent set
-    (no claim fails) shaded."""
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-
-    inp, cl = np.array(sv["input"]), np.array(sv["claim"])
-    pairs = list(dict.fromkeys(zip(sv["input"], sv["claim"])))
-    ncol = 4
-    nrow = int(np.ceil(len(pairs) / ncol))
-    fig, axs = plt.subplots(nrow, ncol, figsize=(3.6 * ncol, 2.7 * nrow), squeeze=False)
-    comp = {
-        i: (lo, hi)
-        for i, c, lo, hi in zip(
-            cs["input"], cs["claim"], cs["compatible_low"], cs["compatible_high"]
-        )
-        if c == "ALL"
-    }
-    for ax, (i, c) in zip(axs.ravel(), pairs):
-        sel = (inp == i) & (cl == c)
-        x = np.array(sv["value"], float)[sel]
-        y = np.array(sv["sim_value"], float)[sel]
-        lo = np.array(sv["sim_low"], float)[sel]
-        hi = np.array(sv["sim_high"], float)[sel]
-        v = np.array(sv["verdict"])[sel]
-        zl, zh = np.array(sv["zone_low"], float)[sel][0], np.array(sv["zone_high"], float)[sel][0]
-        if np.isfinite(zl) or np.isfinite(zh):
-            ax.axhspan(
-                zl if np.isfinite(zl) else min(np.nanmin(lo), zh),
-                zh if np.isfinite(zh) else max(np.nanmax(hi), zl),
-                color="tab:orange",
-                alpha=0.2,
-                lw=0,
-            )
-        a, b = comp.get(i, (np.nan, np.nan))
-        if a is not None and np.isfinite(a):
-            d = 0.02 * (x.max() - x.min())
-            ax.axvspan(a - d, b + d, color="tab:green", alpha=0.12, lw=0)
-        ax.plot(x, y, "-", color="0.6", lw=0.8)
-        colors = [_COLOR.get(vv, "k") for vv in v]
-        ax.vlines(x, lo, hi, colors=colors, lw=2)
-        ax.scatter(x, y, c=colors, s=14, zorder=3)
-        ax.set_xlabel(i, fontsize=8)
-        ax.set_title(_SHORT.get(c, c), fontsize=8)
-        ax.tick_params(labelsize=7)
-    for ax in axs.ravel()[len(pairs) :]:
-        ax.axis("off")
-    handles = [
-        Line2D([], [], marker="o", ls="", color=col, label=k) for k, col in _COLOR.items()
-    ] + [
-        Patch(color="tab:orange", alpha=0.2, label="paper's decision zone"),
-        Patch(color="tab:green", alpha=0.12, label="consistent set (no claim fails)"),
-    ]
-    fig.legend(
-        handles=handles,
-        loc="lower center",
-        ncol=len(handles),
-        fontsize=8,
-        bbox_to_anchor=(0.5, 0.0),
-    )
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
-    save(fig, path)
-
-
 def figure_jobs(stage: str, out, *data) -> list:
     """The figure jobs ``(fn, args)`` of one stage of the run, for
     :func:`sim.report.figure_jobs.start_figures` as soon as the stage's tables exist (so they are
     drawn on idle workers while the run goes on): ``design`` (cols), ``datum`` (cfg, dcols),
     ``budget`` (bcols), ``coverage`` (ccols), ``bayes`` (samples, values), ``twoplate``
-    (tcols, tsamples) and ``consistent`` (sweep values, consistent set)."""
+    (tcols, tsamples)."""
     if stage == "design":
         (cols,) = data
         jp = int(np.flatnonzero(cols["paper_design"])[0])
@@ -357,7 +292,4 @@ def figure_jobs(stage: str, out, *data) -> list:
         return (
             [] if tcols is None else [(fig_twoplate, (tcols, tsamples, out / "twoplate_ratio.png"))]
         )
-    if stage == "consistent":
-        sv, cs = data
-        return [(fig_consistent, (sv, cs, out / "consistent_set.png"))]
     raise ValueError(f"no figure stage {stage!r}")

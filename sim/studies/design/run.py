@@ -22,6 +22,7 @@ from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import start_figures
 from sim.studies import RunContext
 from sim.studies.design import figures
+from sim.studies.design import region as DR
 from sim.studies.design.cells import (
     design_cells,
     measuring_time,
@@ -32,7 +33,6 @@ from sim.studies.design.cells import (
 )
 from sim.studies.design.chunks import design_chunk
 from sim.studies.design.claims import load_book, score_all
-from sim.studies.design.consistent import sweep_unprinted
 from sim.studies.design.dilution import datum_analysis
 from sim.studies.design.errbudget import budget_analysis
 from sim.studies.design.external import external_at
@@ -210,10 +210,10 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     cols = design_cells(cfg)
     write_table(out / "design.parquet", cols, prov)
     figs("design", cols)
-    # the sweep of the unprinted inputs needs only the design table: made here, its figure
-    # (the dearest) drawn on a worker while the Monte-Carlo parts run
-    cs, sv = sweep_unprinted(cfg, book, cols)
-    figs("consistent", sv, cs)
+    # the unprinted inputs explored jointly (.region): the tolerances analytic, the external
+    # comparisons on a small design of plates
+    parts = {"tolerances": DR.tolerance_region(cfg, book), "plates": DR.plates_region(cfg, book)}
+    region_rows, region_table, region_inputs = DR.region_rows(book, parts)
     R["design"] = _design(cfg, cols)
     R["time"] = (
         measuring_time(cfg, 4, cfg["time.images"], 1),
@@ -290,15 +290,15 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         cfg["zeiss.half_extent_mm"],
         cfg["budget.pitch_mm"],
     )
-    rows = [_unbounded_as_null(r) for r in score_all(book, cfg, R)]
+    rows = [_unbounded_as_null(r) for r in region_rows + score_all(book, cfg, R)]
     prov_t = provenance(cfg, tolerances=_tolerances(R))
     write_table(out / "bayes.parquet", bycols, prov_t)
     if tcols is not None:
         write_table(out / "bayes_twoplate.parquet", tcols, prov_t)
     else:
         print(f"brown_design: bayes.twoplate_ratio skipped: {why}")
-    write_table(out / "consistent_set.parquet", cs, prov)
-    write_table(out / "sweep_values.parquet", sv, prov)
+    write_table(out / "consistent_region.parquet", region_table, prov)
+    write_table(out / "region_inputs.parquet", region_inputs, prov)
     write_claims(out / "claims.parquet", rows, prov_t, book)
     for wait in drawn:
         wait()

@@ -3,8 +3,9 @@
 
 Keys marked ``input`` were set to match a number the paper prints. Keys the paper does not
 print (station offset, beta, the pass time, the screw pitch, the layout of the Zeiss grid's
-33 calibrated points) carry a swept range under ``unprinted.*``: the study reports the values
-for which each claim holds and the consistent set (``consistent_set.parquet``).
+33 calibrated points) are explored jointly over their hardware ranges (:mod:`.region`); the
+claims that depend on them are decided over the consistent region
+(``consistent_region.parquet``).
 """
 
 from __future__ import annotations
@@ -75,7 +76,7 @@ SCHEMA = {
         [3, 4, 6, 8], "list[int]", "plate positions (stations)", lo=3, hi=24, min_len=1
     ),
     "design.offsets_mm": F(
-        [5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 80.0],
+        [5.0, 10.0, 17.0, 20.0, 30.0, 45.0, 60.0, 80.0],
         "list[float]",
         "station offsets outside the midsides",
         lo=0.0,
@@ -150,7 +151,7 @@ SCHEMA = {
         2.0,
         "float",
         "fixed cost of one plate position (turn the holder, swing "
-        "the arm; not printed: swept under unprinted.pass_min)",
+        "the arm; not printed: a labelled example)",
         lo=0.0,
         hi=1e4,
         unit="min",
@@ -182,10 +183,10 @@ SCHEMA = {
         unit="um",
     ),
     "paper.offset_mm": F(
-        30.0,
+        17.0,
         "float",
-        "station offset of the paper's design (not printed: "
-        "swept under unprinted.offsets_mm; must fit on the scale)",
+        "station offset of the paper's design (not printed: a labelled example, the "
+        "claims that depend on it are decided over the region; must fit on the scale)",
         lo=0.0,
         lo_open=True,
         hi=1000.0,
@@ -194,18 +195,18 @@ SCHEMA = {
     "paper.beta_mm": F(
         1.0,
         "float",
-        "beta of the paper's design (not printed: swept under unprinted.betas_mm)",
+        "beta of the paper's design (not printed: a labelled example; decided over the region)",
         lo=0.0,
         hi=50.0,
         unit="mm",
     ),
-    # datum (brown_dilution's geometry; an idealised one when it does not fit the scale)
+    # datum (brown_dilution's example geometry; must be buildable on the scale)
     "datum.grid": F(5, "int", "points per side (brown_dilution geometry)", lo=3, hi=30),
     "datum.spacing_mm": F(
-        55.0, "float", "grid spacing (brown_dilution geometry)", lo=0.01, hi=1000.0, unit="mm"
+        45.0, "float", "grid spacing (brown_dilution geometry)", lo=0.01, hi=1000.0, unit="mm"
     ),
     "datum.offset_mm": F(
-        45.0,
+        17.0,
         "float",
         "station offset (brown_dilution geometry)",
         lo=0.0,
@@ -258,7 +259,7 @@ SCHEMA = {
     "budget.pitch_mm": F(
         0.5,
         "float",
-        "screw pitch (not printed: swept under unprinted.pitches_mm)",
+        "screw pitch (not printed: a labelled example; decided over the region)",
         lo=0.01,
         hi=1.0,
         unit="mm",
@@ -315,7 +316,7 @@ SCHEMA = {
         90.0,
         "float",
         "half extent of the 33-point sample (layout not "
-        "printed: swept under unprinted.zeiss_extents_mm)",
+        "printed: a labelled example; decided over the region)",
         lo=1.0,
         hi=1000.0,
         unit="mm",
@@ -355,55 +356,25 @@ SCHEMA = {
         hi=3600.0,
         input=True,
     ),
-    # unprinted inputs swept (analytic / linearised per value)
-    "unprinted.offsets_mm": F(
-        [5.0, 10.0, 15.0, 20.0, 22.5, 25.0, 27.5, 30.0, 33.0, 40.0, 45.0, 60.0],
-        "list[float]",
-        "station offsets swept",
-        lo=0.0,
-        lo_open=True,
-        hi=1000.0,
-        min_len=2,
-        unit="mm",
+    # the joint exploration of the unprinted inputs (sim.claims.inference; .region)
+    "region.points": F(
+        1024,
+        "int",
+        "Sobol design size of the analytic tolerance region (offset x beta x screw pitch)",
+        lo=256,
+        hi=16384,
     ),
-    "unprinted.betas_mm": F(
-        [0.0, 0.5, 1.0, 2.0, 5.0, 10.0],
-        "list[float]",
-        "betas swept",
-        lo=0.0,
-        hi=50.0,
-        min_len=2,
-        unit="mm",
-    ),
-    "unprinted.pass_min": F(
-        [0.0, 1.0, 2.0, 4.0, 8.0, 12.0],
-        "list[float]",
-        "pass times swept",
-        lo=0.0,
-        hi=1e4,
-        min_len=2,
-        unit="min",
-    ),
-    "unprinted.pitches_mm": F(
-        [0.1, 0.25, 0.5, 1.0],
-        "list[float]",
-        "screw pitches swept",
-        lo=0.01,
-        hi=1.0,
-        min_len=2,
-        unit="mm",
-    ),
-    "unprinted.zeiss_extents_mm": F(
-        [40.0, 60.0, 80.0, 90.0, 100.0, 115.0],
-        "list[float]",
-        "half extents of the Zeiss 33-point sample swept",
-        lo=1.0,
-        hi=1000.0,
-        min_len=2,
-        unit="mm",
+    "region.rounds": F(3, "int", "refinement rounds of the tolerance region", lo=0, hi=8),
+    "region.plate_points": F(
+        32,
+        "int",
+        "Sobol design size of the plate region (offset x beta x Zeiss layout; each point "
+        "draws unprinted.plates plates)",
+        lo=8,
+        hi=1024,
     ),
     "unprinted.plates": F(
-        4000, "int", "Gaussian plates drawn per sweep value (linearised)", lo=100, hi=1_000_000
+        4000, "int", "Gaussian plates drawn per input vector (linearised)", lo=100, hi=1_000_000
     ),
     # coverage
     "coverage.trials": F(10000, "int", "trials of the nominal coverage runs", lo=10, hi=10_000_000),
@@ -481,8 +452,8 @@ def check(cfg: dict) -> None:
             )
     if cfg["time.double_min"] <= cfg["time.single_min"]:
         raise ConfigError("time.double_min", "must exceed time.single_min")
-    for key in ("time.pass_min", "unprinted.pass_min"):
-        v = cfg[key] if key == "time.pass_min" else max(cfg[key])
+    for key in ("time.pass_min",):
+        v = cfg[key]
         if 4 * v >= cfg["time.single_min"]:
             raise ConfigError(
                 key, "four passes would take the whole single-setting time (time.single_min)"
@@ -490,9 +461,9 @@ def check(cfg: dict) -> None:
     half = cfg["plate.format_mm"] / 2
     if cfg["paper.extent_mm"] > half:
         raise ConfigError("paper.extent_mm", "outside the format")
-    if cfg["zeiss.half_extent_mm"] > half or max(cfg["unprinted.zeiss_extents_mm"]) > half:
+    if cfg["zeiss.half_extent_mm"] > half:
         raise ConfigError(
-            "unprinted.zeiss_extents_mm",
+            "zeiss.half_extent_mm",
             f"the Zeiss sample must lie on the format (half side {half:g} mm)",
         )
     if (cfg["datum.grid"] - 1) * cfg["datum.spacing_mm"] / 2 > half:
@@ -506,14 +477,17 @@ def check(cfg: dict) -> None:
             f"plus micrometer (at most {hmax:.1f} mm fits a +-"
             f"{cfg['paper.extent_mm']:g} mm grid)",
         )
-    if not any(v <= hmax for v in cfg["unprinted.offsets_mm"]):
+    dmax = max_offset_mm(cfg, (cfg["datum.grid"] - 1) * cfg["datum.spacing_mm"] / 2)
+    if cfg["datum.offset_mm"] > dmax + 1e-9:
         raise ConfigError(
-            "unprinted.offsets_mm", f"no swept offset fits the scale (at most {hmax:.1f} mm)"
+            "datum.offset_mm",
+            f"the datum geometry must be buildable: at {cfg['datum.offset_mm']:g} mm its "
+            f"longest range exceeds the scale plus micrometer (at most {dmax:.1f} mm fits)",
         )
-    for e in [cfg["zeiss.half_extent_mm"], *cfg["unprinted.zeiss_extents_mm"]]:
+    for e in [cfg["zeiss.half_extent_mm"], 40.0]:  # 40 mm: the region's smallest layout
         if (2 * int(e // 10) + 1) ** 2 < cfg["zeiss.points"]:
             raise ConfigError(
-                "unprinted.zeiss_extents_mm",
+                "zeiss.points",
                 f"+-{e:g} mm holds fewer 1 cm grid "
                 f"intersections than zeiss.points = {cfg['zeiss.points']}",
             )

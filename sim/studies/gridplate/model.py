@@ -24,7 +24,6 @@ import numpy as np
 
 from sim.instruments import gridplate as gp
 from sim.instruments import transforms2d as t2
-from sim.instruments.plates import grid_points
 from sim.lsq import distributions as D
 from sim.studies.gridplate.schema import UM
 
@@ -40,24 +39,29 @@ def truth_rows(cfg: dict):
 
 
 def simulate(cfg: dict, rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
-    """Readings and grid certificates of ``n`` calibrations.
+    """Readings and grid certificates of ``n`` calibrations
+    (:func:`sim.instruments.gridplate.simulate_calibrations` with this study's config).
 
     Returns ``readings`` (n, P, N, L, 2) mm, ``cert`` (n, P, N, 2) mm (the grid coordinates
     as given), ``true`` (n, P, 6) the true affine grid -> comparator of each plate.
     """
-    G = grid_points(cfg["plate.grid"], cfg["plate.spacing_mm"])
-    P, N, L = cfg["plate.count"], G.shape[0], cfg["readings.count"]
-    S, S2, eps = truth_rows(cfg)
-    kap = rng.uniform(-1, 1, (n, P)) * np.deg2rad(cfg["plate.kappa_deg"])
-    shift = rng.uniform(-5, 5, (n, P, 2)) + np.array([120.0, 120.0])
-    true = t2.affine_from_rows(S, S2, eps, kap, (shift[..., 0], shift[..., 1]))
-    ideal = t2.apply_affine(true.reshape(-1, 6), G).reshape(n, P, N, 2)
-    sp, sc = cfg["readings.sigma_um"] * UM, cfg["comparator.coord_sigma_um"] * UM
-    s_point = np.sqrt(max(sc**2 - sp**2 / L, 0.0))
-    comp_err = rng.normal(0.0, 1.0, (n, P, N, 2)) * s_point
-    readings = (ideal + comp_err)[:, :, :, None, :] + rng.normal(0.0, sp, (n, P, N, L, 2))
-    cert = G + rng.normal(0.0, 1.0, (n, P, N, 2)) * cfg["grid.sigma_true_um"] * UM
-    return {"readings": readings, "cert": cert, "true": true}
+    return gp.simulate_calibrations(rng, n, **calibration_args(cfg))
+
+
+def calibration_args(cfg: dict) -> dict:
+    """The keyword arguments of :func:`sim.instruments.gridplate.simulate_calibrations`."""
+    return dict(
+        grid=cfg["plate.grid"],
+        spacing_mm=cfg["plate.spacing_mm"],
+        plates=cfg["plate.count"],
+        readings=cfg["readings.count"],
+        scale_diff_ppm=cfg["comparator.scale_diff_ppm"],
+        nonorth_arcsec=cfg["comparator.nonorth_arcsec"],
+        kappa_deg=cfg["plate.kappa_deg"],
+        reading_sigma_um=cfg["readings.sigma_um"],
+        coord_sigma_um=cfg["comparator.coord_sigma_um"],
+        grid_sigma_um=cfg["grid.sigma_true_um"],
+    )
 
 
 def _decomp_errors(p, cov, S, S2, eps):

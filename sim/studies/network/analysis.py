@@ -17,17 +17,30 @@ tables in mm. Seeds: Baarda's reliability theory as used for comparator networks
 
 from __future__ import annotations
 
+import fnmatch
 from dataclasses import dataclass
 
 import numpy as np
 
 from sim import lsq
 from sim.lsq import distributions as D
-from sim.lsq.datum import null_basis, s_matrix, s_transform
+from sim.lsq.datum import s_matrix, s_transform
+from sim.mc.config import ConfigError
 from sim.studies.network.definition import Network
-from sim.studies.network.model import NetworkModel, simulate
+from sim.studies.network.model import NetworkModel, defect_basis, simulate
 
-__all__ = ["Analytic", "analyse", "delta0", "mc_chunk", "point_cov_in"]
+__all__ = [
+    "Analytic",
+    "analyse",
+    "delta0",
+    "mc_chunk",
+    "point_cov_in",
+    "in_datum",
+    "inner_defect",
+    "check_inner",
+    "match_points",
+    "estimated_points",
+]
 
 CHI2_2_95 = float(D.chi2_ppf(0.95, 2))
 
@@ -41,7 +54,8 @@ def delta0(alpha0: float, power: float) -> float:
 class Analytic:
     """Analytic pre-analysis. ``free`` (p,) indices of the estimated globals; ``Q`` (p, p)
     their covariance (mm^2, rad^2); ``cov`` (n, 2, 2) point covariances (zero for points held
-    fixed); ``redundancy``, ``mdb``, ``ext_max_mm``, ``bnr`` (m,); ``dof``; ``ok``."""
+    fixed); ``redundancy``, ``mdb``, ``ext_max_mm``, ``bnr`` (m,); ``dof``; ``ok``; ``n_diag`` (p,) the
+    diagonal of the normal matrix (for the variance inflation ``Q_ii N_ii``)."""
 
     free: np.ndarray
     Q: np.ndarray
@@ -52,6 +66,7 @@ class Analytic:
     bnr: np.ndarray
     dof: int
     ok: bool
+    n_diag: np.ndarray | None = None  # (p,) diagonal of the normal matrix A'PA
 
 
 def point_cov_in(net: Network, free: np.ndarray, Q: np.ndarray) -> np.ndarray:
@@ -91,17 +106,75 @@ def analyse(net: Network, datum: lsq.Datum, a0: float, power: float) -> Analytic
     ext = np.where(controlled, disp.max(axis=0), np.inf)
     cov2 = point_cov_in(net, free, Q).reshape(net.n, 2, net.n, 2)
     cov = cov2[np.arange(net.n), :, np.arange(net.n), :]
-    return Analytic(free, Q, cov, r, mdb, ext, bnr, int(dof), True)
+    n_diag = np.einsum("ij,ij->j", Aw, Aw)
+    return Analytic(free, Q, cov, r, mdb, ext, bnr, int(dof), True, n_diag)
+
+
+def inner_defect(net: Network) -> np.ndarray:
+    """Coordinate rows ``(2n, d)`` of the datum defects of ``net`` with every point free
+    (translation, rotation and, for a network without a length, scale)."""
+    orient = 2 * net.n + np.arange(len(net.stations))
+    extra = [net.i_constant] * net.estimate_constant + [net.i_scale] * net.estimate_scale
+    free = np.concatenate([np.arange(2 * net.n), orient, extra]).astype(int)
+    return defect_basis(net, free)[: 2 * net.n]
+
+
+def match_points(net: Network, key: str, pats) -> list[int]:
+    """Indices of the points matching any of the name patterns (one set; each pattern must
+    match a point)."""
+    out: list[int] = []
+    for p in pats:
+        hit = [a for a, nm in enumerate(net.names) if fnmatch.fnmatchcase(nm, p)]
+        if not hit:
+            raise ConfigError(key, f"no point matches {p!r}")
+        out += [h for h in hit if h not in out]
+    return out
+
+
+def datum_weights(net: Network, points: list[int]) -> np.ndarray:
+    w = np.zeros(2 * net.n)
+    w[np.repeat(points, 2) * 2 + np.tile([0, 1], len(points))] = 1.0
+    return w
+
+
+def check_inner(net: Network, H: np.ndarray, points: list[int], key: str) -> None:
+    """Refuse inner constraints over ``points`` that cannot remove the defects ``H``
+    (``H' W H`` singular: e.g. one point against a rotation, collinear points against a
+    rotation and scale)."""
+    if not H.shape[1]:
+        return
+    w = datum_weights(net, points)
+    ev = np.linalg.eigvalsh((H.T * w) @ H)
+    if ev.min() <= 1e-10 * max(np.linalg.eigvalsh(H.T @ H).max(), 1e-300):
+        names = ", ".join(net.names[a] for a in points[:5]) + (" ..." if len(points) > 5 else "")
+        raise ConfigError(
+            key,
+            f"the points {names} cannot fix the network's {H.shape[1]} datum defects "
+            "(translation, rotation, scale): choose more points, not all on one line",
+        )
 
 
 def in_datum(net: Network, an: Analytic, points: list[int]) -> np.ndarray:
     """Point covariances ``(n, 2, 2)`` stated in the inner-constraint datum over ``points``
-    (S-transformation; translation and rotation, as :func:`sim.lsq.datum.inner`)."""
-    w = np.zeros(2 * net.n)
-    w[np.repeat(points, 2) * 2 + np.tile([0, 1], len(points))] = 1.0
-    S = s_matrix(null_basis(net.xy), w)
-    Qs = s_transform(point_cov_in(net, an.free, an.Q), S).reshape(net.n, 2, net.n, 2)
+    (S-transformation removing every defect the network has: translation, rotation and, for
+    a network without a length, scale; as ``gama-local``'s ``adj="XY"``)."""
+    H = inner_defect(net)
+    full = point_cov_in(net, an.free, an.Q)
+    if H.shape[1]:
+        full = s_transform(full, s_matrix(H, datum_weights(net, points)))
+    Qs = full.reshape(net.n, 2, net.n, 2)
     return Qs[np.arange(net.n), :, np.arange(net.n), :]
+
+
+def estimated_points(net: Network, an: Analytic) -> list[int]:
+    """Estimated points whose 2 x 2 covariance is regular (a point held by a datum
+    constraint, such as Brown's x1 = 0, has a singular block and no ellipse)."""
+    det = an.cov[:, 0, 0] * an.cov[:, 1, 1] - an.cov[:, 0, 1] ** 2
+    return [
+        a
+        for a in range(net.n)
+        if net.role[a] != 1 and det[a] > 1e-12 * ((an.cov[a, 0, 0] + an.cov[a, 1, 1]) / 2) ** 2
+    ]
 
 
 def ellipse(cov: np.ndarray):

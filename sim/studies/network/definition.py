@@ -5,7 +5,9 @@ plane system; bearings are measured from +x towards +y, as ``gama-local``'s ``ax
 
 * points: ``points`` (``{name, x_mm, y_mm, role, sigma_mm}``), ``grids`` (``{prefix, nx, ny,
   spacing_mm, origin_mm, role, sigma_mm}``) and ``random`` (``{prefix, n, half_extent_mm,
-  center_mm, role, sigma_mm}``, drawn once from the study seed). ``role`` is ``free``,
+  center_mm, role, sigma_mm}``, drawn once from the study seed); a field network may give
+  every length in metres instead (``x_m``, ``y_m``, ``spacing_m``, ``origin_m``,
+  ``half_extent_m``, ``center_m``; not both units for one field). ``role`` is ``free``,
   ``fixed`` (known, defines the datum) or ``observed`` (its coordinates are observations with
   standard deviation ``sigma_mm``: weighted coordinates, as the grid plates of seed 001);
 * observations: ``observations`` (one each) and ``generate`` (``from`` x ``to`` name patterns,
@@ -44,6 +46,9 @@ ROLES = ("free", "fixed", "observed")
 _ANGULAR = (1, 2)
 MAX_POINTS = 2000
 MAX_OBS = 20000
+#: accepted ranges of the standard deviations: the weights 1 / sigma^2 stay far from
+#: overflow and underflow, and the normal equations within double precision
+SIGMA_RANGE = {"mm": (1e-9, 1e9), "arcsec": (1e-9, 1e6)}
 
 
 @dataclass(frozen=True)
@@ -155,35 +160,59 @@ def _role(key: str, rec: dict) -> tuple[int, float]:
         if "sigma_mm" not in rec:
             raise ConfigError(f"{key}.sigma_mm", "an observed point needs its coordinate sigma")
         sig = _num(f"{key}.sigma_mm", rec["sigma_mm"], 0.0, lo_open=True)
+        lo, hi = SIGMA_RANGE["mm"]
+        if not lo <= sig <= hi:
+            raise ConfigError(
+                f"{key}.sigma_mm",
+                f"{sig:g} is outside [{lo:g}, {hi:g}] mm: its weight would over- or underflow",
+            )
     elif "sigma_mm" in rec:
         raise ConfigError(f"{key}.sigma_mm", f"only an observed point has a sigma (role {role})")
     return ROLES.index(role), sig
 
 
+def _mm(key: str, rec: dict, field: str, required: bool = True, default=None):
+    """``rec``'s ``field`` in mm, given as ``field_mm`` or as ``field_m`` (metres, for field
+    networks), not both; a pair ``[x, y]`` when the default is one."""
+    a, b = f"{field}_mm", f"{field}_m"
+    if a in rec and b in rec:
+        raise ConfigError(f"{key}.{b}", f"give {a} or {b}, not both")
+    name, f = (b, 1000.0) if b in rec else (a, 1.0)
+    if name not in rec:
+        if required:
+            raise ConfigError(f"{key}.{a}", f"missing (or give {b} in metres)")
+        return default
+    v = rec[name]
+    if isinstance(default, list):
+        if not (isinstance(v, list) and len(v) == 2):
+            raise ConfigError(f"{key}.{name}", "must be [x, y]")
+        return [_num(f"{key}.{name}", c) * f for c in v]
+    return _num(f"{key}.{name}", v) * f
+
+
 def _points(cfg: dict, rng: np.random.Generator):
     names, xy, role, sig = [], [], [], []
-    _p = {"name", "x_mm", "y_mm", "role", "sigma_mm"}
+    _p = {"name", "x_mm", "y_mm", "x_m", "y_m", "role", "sigma_mm"}
     for a, rec in enumerate(cfg["network.points"]):
         key = f"network.points[{a}]"
-        _keys(key, rec, _p, {"name", "x_mm", "y_mm"})
+        _keys(key, rec, _p, {"name"})
         r, s = _role(key, rec)
         names.append(_text(f"{key}.name", rec["name"]))
-        xy.append([_num(f"{key}.x_mm", rec["x_mm"]), _num(f"{key}.y_mm", rec["y_mm"])])
+        xy.append([_mm(key, rec, "x"), _mm(key, rec, "y")])
         role.append(r)
         sig.append(s)
-    _g = {"prefix", "nx", "ny", "spacing_mm", "origin_mm", "role", "sigma_mm"}
+    _g = {"prefix", "nx", "ny", "spacing_mm", "spacing_m", "origin_mm", "origin_m", "role"}
     for a, rec in enumerate(cfg["network.grids"]):
         key = f"network.grids[{a}]"
-        _keys(key, rec, _g, {"prefix", "nx", "ny", "spacing_mm"})
+        _keys(key, rec, _g | {"sigma_mm"}, {"prefix", "nx", "ny"})
         nx = _num(f"{key}.nx", rec["nx"], 1, integer=True)
         ny = _num(f"{key}.ny", rec["ny"], 1, integer=True)
         if nx * ny > MAX_POINTS:
             raise ConfigError(f"{key}.nx", f"{nx} x {ny} points is over the limit of {MAX_POINTS}")
-        h = _num(f"{key}.spacing_mm", rec["spacing_mm"], 0.0, lo_open=True)
-        o = rec.get("origin_mm", [-(nx - 1) * h / 2, -(ny - 1) * h / 2])
-        if not (isinstance(o, list) and len(o) == 2):
-            raise ConfigError(f"{key}.origin_mm", "must be [x, y]")
-        o = [_num(f"{key}.origin_mm", c) for c in o]
+        h = _mm(key, rec, "spacing")
+        if h <= 0:
+            raise ConfigError(f"{key}.spacing_mm", f"must be > 0 (got {h:g} mm)")
+        o = _mm(key, rec, "origin", False, [-(nx - 1) * h / 2, -(ny - 1) * h / 2])
         r, s = _role(key, rec)
         prefix = _text(f"{key}.prefix", rec["prefix"])
         for b in range(ny):
@@ -192,18 +221,17 @@ def _points(cfg: dict, rng: np.random.Generator):
                 xy.append([o[0] + c * h, o[1] + b * h])
                 role.append(r)
                 sig.append(s)
-    _r = {"prefix", "n", "half_extent_mm", "center_mm", "role", "sigma_mm"}
+    _r = {"prefix", "n", "half_extent_mm", "half_extent_m", "center_mm", "center_m", "role"}
     for a, rec in enumerate(cfg["network.random"]):
         key = f"network.random[{a}]"
-        _keys(key, rec, _r, {"prefix", "n", "half_extent_mm"})
+        _keys(key, rec, _r | {"sigma_mm"}, {"prefix", "n"})
         n = _num(f"{key}.n", rec["n"], 1, integer=True)
         if n > MAX_POINTS:
             raise ConfigError(f"{key}.n", f"{n} points is over the limit of {MAX_POINTS}")
-        e = _num(f"{key}.half_extent_mm", rec["half_extent_mm"], 0.0, lo_open=True)
-        c0 = rec.get("center_mm", [0.0, 0.0])
-        if not (isinstance(c0, list) and len(c0) == 2):
-            raise ConfigError(f"{key}.center_mm", "must be [x, y]")
-        c0 = [_num(f"{key}.center_mm", c) for c in c0]
+        e = _mm(key, rec, "half_extent")
+        if e <= 0:
+            raise ConfigError(f"{key}.half_extent_mm", f"must be > 0 (got {e:g} mm)")
+        c0 = _mm(key, rec, "center", False, [0.0, 0.0])
         r, s = _role(key, rec)
         prefix = _text(f"{key}.prefix", rec["prefix"])
         pts = rng.uniform(-e, e, (n, 2)) + np.array(c0)
@@ -257,6 +285,7 @@ _OBS = {
     "bias_mm",
     "bias_arcsec",
     "nearest",
+    "set",
 }
 
 
@@ -271,10 +300,45 @@ def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
     if f"sigma_{unit}" not in rec:
         raise ConfigError(f"{key}.sigma_{unit}", "missing")
     sig = _num(f"{key}.sigma_{unit}", rec[f"sigma_{unit}"], 0.0, lo_open=True)
+    lo, hi = SIGMA_RANGE[unit]
+    if not lo <= sig <= hi:
+        raise ConfigError(
+            f"{key}.sigma_{unit}",
+            f"{sig:g} is outside [{lo:g}, {hi:g}] {unit}: its weight would over- or underflow",
+        )
+    if "set" in rec and code != 1:
+        raise ConfigError(f"{key}.set", f"only a direction has an orientation set (a {kind})")
+    if "set" in rec and not isinstance(rec["set"], str):
+        raise ConfigError(f"{key}.set", f"must be a name (got {rec['set']!r})")
     settings = _num(f"{key}.settings", rec.get("settings", 1), 1, integer=True)
     bias = _num(f"{key}.bias_{unit}", rec.get(f"bias_{unit}", 0.0))
     f = ARCSEC if code in _ANGULAR else 1.0
     return code, sig * f / math.sqrt(settings), bias * f
+
+
+def _degenerate(names, xy, kind, i, j, k) -> None:
+    """Refuse an observation whose geometry is undefined: a sight from a point to itself or
+    to a point at the same place, an angle whose back- or fore-sight is its station or whose
+    two sights coincide (names the observation by its points)."""
+    span = max(float(np.ptp(xy, axis=0).max()), 1e-300)
+    for code, a, b, c in zip(kind, i, j, k):
+        if code >= 5:
+            continue
+        what = f"a {KINDS[code]} from {names[a]!r} to {names[b]!r}"
+        if code == 2:
+            what = f"an angle at {names[a]!r} from {names[b]!r} to {names[c]!r}"
+            if c == a or b == a:
+                raise ConfigError("network.observations", f"{what}: a sight to its own station")
+            if b == c:
+                raise ConfigError("network.observations", f"{what}: the two sights are one")
+        if a == b:
+            raise ConfigError("network.observations", f"{what}: a sight to itself")
+        for t in (b, c) if code == 2 else (b,):
+            if code in (0, 1, 2) and np.hypot(*(xy[t] - xy[a])) <= 1e-12 * span:
+                raise ConfigError(
+                    "network.points",
+                    f"points {names[a]!r} and {names[t]!r} coincide: {what} is undefined",
+                )
 
 
 def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
@@ -308,7 +372,7 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
         rows.append((code, fr[0], to[0], -1, sig, bias))
     for a, rec in enumerate(cfg["network.generate"]):
         key = f"network.generate[{a}]"
-        _keys(key, rec, _OBS - {"at"}, {"kind", "from", "to"})
+        _keys(key, rec, _OBS - {"at", "set"}, {"kind", "from", "to"})
         code, sig, bias = _obs_common(key, rec)
         if code == 2:
             raise ConfigError(
@@ -335,27 +399,23 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
             "network.generate", f"{len(rows)} observations is over the limit of {MAX_OBS}"
         )
     kind, i, j, kk, sig, bias = (np.array(c) for c in zip(*rows))
-    for code, a, b in zip(kind, i, j):
-        if code < 5 and a == b:
-            raise ConfigError(
-                "network.observations", f"a {KINDS[code]} from {names[a]!r} to itself"
-            )
-        if code in (0, 1) and np.allclose(xy[a], xy[b]):
-            raise ConfigError(
-                "network.points",
-                f"points {names[a]!r} and {names[b]!r} coincide:"
-                f" a {KINDS[code]} between them is undefined",
-            )
-    stations = tuple(dict.fromkeys(names[a] for a, c in zip(i, kind) if c == 1))
-    oset = np.array([stations.index(names[a]) if c == 1 else -1 for a, c in zip(i, kind)], int)
+    _degenerate(names, xy, kind, i, j, kk)
+    n_single = len(cfg["network.observations"])
+    label = [str(r.get("set", "")) for r in cfg["network.observations"]]
+    label += [""] * (len(rows) - n_single)
+    key = [f"{names[a]}/{lb}" if lb else names[a] for a, lb in zip(i, label)]
+    stations = tuple(dict.fromkeys(s for s, c in zip(key, kind) if c == 1))
+    oset = np.array([stations.index(s) if c == 1 else -1 for s, c in zip(key, kind)], int)
     beta = cfg["network.offset_mm"]
     if beta and np.any(kind == 0):
-        d = np.hypot(*(xy[j[kind == 0]] - xy[i[kind == 0]]).T)
-        if d.min() <= beta:
+        rows_d = np.flatnonzero(kind == 0)
+        d = np.hypot(*(xy[j[rows_d]] - xy[i[rows_d]]).T)
+        if d.min() <= beta * (1 + 1e-6):
+            r = rows_d[int(np.argmin(d))]
             raise ConfigError(
                 "network.offset_mm",
-                f"the offset {beta:g} mm is not shorter than "
-                f"the shortest distance ({d.min():.3g} mm)",
+                f"the offset {beta:g} mm is not shorter than the distance from "
+                f"{names[i[r]]!r} to {names[j[r]]!r} ({d.min():.6g} mm)",
             )
     return Network(
         cfg["network.name"],

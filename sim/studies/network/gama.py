@@ -1,30 +1,32 @@
-"""Read and write a network in the XML input format of GNU Gama's ``gama-local``.
+"""Write a network as GNU Gama's ``gama-local`` XML input (2.x), and read one into a study.
 
-Supported (2-D, ``axes-xy = "ne"``: x north, y east, bearings clockwise from x -- the same
-convention as this suite's x, y and bearings from +x towards +y):
+Export (``network.xml``, written by every network run when the network has that form):
+``<network axes-xy="ne">`` (left-handed angles, gama-local's default: x north, y east,
+bearings clockwise from x, as this suite's bearings from +x towards +y) with
+``<parameters sigma-apr="1" sigma-act="apriori"/>`` (a precision study: the stdevs are the
+observations' sigmas); points in metres, ``fix="xy"`` (fixed), ``adj="xy"`` (free or
+observed), ``adj="XY"`` on the points of an inner datum; directions grouped one ``<obs>`` per
+orientation set, angles and directions in gon with stdevs in cc, distances with stdevs in mm;
+observed coordinates as ``<coordinates>`` with a diagonal ``<cov-mat>`` (mm^2); ``dx``/``dy``
+pairs as ``<vectors>`` with every height fixed at 0 (``fix="z"``: the ``dz`` rows carry no
+unknown, so gama-local counts one more degree of freedom per vector). Brown's known offset
+beta, a known additive constant and a known scale error become a plain distance with the
+equivalent stdev ``sigma s / ((1 + scale) d)`` (``s = sqrt(d^2 - beta^2)``): the same row of
+the design, the same precision. ``val`` is the error-free value.
 
-* ``<point id x y fix="xy">`` (fixed), ``adj="xy"`` (free), ``adj="XY"`` (free and a datum
-  point of the inner constraints); coordinates in metres, here mm;
-* ``<obs from>`` sets of ``<direction to val stdev>`` (one orientation per set),
-  ``<distance to val stdev>`` (stdev mm) and ``<angle bs fs val stdev>``; angles in gon with
-  stdev in centesimal seconds (``angles = "400"``, the default) or in degrees with stdev in
-  arcseconds (``angles = "360"``, decimal degrees only);
-* ``<coordinates>`` with ``<point id x y>`` and a diagonal ``<cov-mat>`` (mm^2): observed
-  coordinates (role ``observed``; the x and y variances must be equal);
-* defaults ``distance-stdev``, ``direction-stdev``, ``angle-stdev`` of
-  ``<points-observations>``.
+Refused with one line (gama-local cannot express them): an estimated additive constant or
+scale, observation biases, a ``dx`` without its ``dy`` (a vector has both).
+``datum.kind = "constraints"`` is written as the free network in the inner datum over all its
+points (:func:`export`, which says so): its precision is this study's moved by an
+S-transformation (``output.inner_over``).
 
-Not supported (refused with a message): heights, slope distances, zenith angles, azimuths,
-vectors, height differences, correlated covariance blocks, other axes orientations. On import
-the observed values (``val``) are not used: the simulation draws readings from the points'
-coordinates, which every point must therefore have. On export, ``val`` is the error-free value,
-and settings are folded into the standard deviation; biases, the additive constant, the
-offset, the scale of distances and coordinate differences have no ``gama-local`` form and
-are refused.
+Import: :mod:`sim.studies.network.gama_read` (``network.gama_xml``).
 """
 
 from __future__ import annotations
 
+import fnmatch
+import hashlib
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -32,170 +34,24 @@ from pathlib import Path
 import numpy as np
 
 from sim.mc.config import ConfigError
-from sim.studies.network.definition import ARCSEC, KINDS, Network
+from sim.studies.network.definition import Network
+from sim.studies.network.gama_read import CC, NS, read_bytes, read_gama
 from sim.studies.network.model import computed
 
-__all__ = ["read_gama", "write_gama", "merge_gama"]
+__all__ = ["read_gama", "write_gama", "merge_gama", "export", "gama_digest", "import_note"]
 
-NS = "http://www.gnu.org/software/gama/gama-local"
-CC = math.pi / 200 / 10000  # one centesimal second in rad
-_UNSUPPORTED = (
-    "s-distance",
-    "z-angle",
-    "azimuth",
-    "vectors",
-    "height-differences",
-    "dh",
-    "vec",
-    "h-diff",
-)
+_GON = math.pi / 200
 
 
-def _tag(e) -> str:
-    return e.tag.split("}", 1)[-1]
+def gama_digest(path: str | Path, key: str = "network.gama_xml") -> str:
+    """sha256 of the file's bytes (the file is read as :func:`read_gama` reads it)."""
+    return hashlib.sha256(read_bytes(path, key)).hexdigest()
 
 
-def _f(key: str, e, attr: str, default: float | None = None) -> float:
-    v = e.get(attr)
-    if v is None:
-        if default is None:
-            raise ConfigError(key, f"<{_tag(e)}> lacks the attribute {attr!r}")
-        return default
-    try:
-        x = float(v)
-    except ValueError:
-        raise ConfigError(key, f"<{_tag(e)} {attr}={v!r}> is not a number") from None
-    if not math.isfinite(x):
-        raise ConfigError(key, f"<{_tag(e)} {attr}={v!r}> is not finite")
-    return x
-
-
-def read_gama(path: str | Path, key: str = "network.gama_xml") -> dict:
-    """Points and observations of a ``gama-local`` XML file as study records:
-    ``{"network.points": [...], "network.observations": [...], "datum.points": [...]}``."""
-    try:
-        root = ET.parse(path).getroot()
-    except OSError as e:
-        raise ConfigError(key, f"cannot read {path}: {e.strerror}") from None
-    except (ET.ParseError, UnicodeDecodeError) as e:
-        raise ConfigError(key, f"{path} is not XML: {e}") from None
-    if _tag(root) != "gama-local":
-        raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
-    net = next((e for e in root if _tag(e) == "network"), None)
-    if net is None:
-        raise ConfigError(key, f"{path}: no <network> element")
-    if net.get("axes-xy", "ne") != "ne":
-        raise ConfigError(key, f"{path}: axes-xy={net.get('axes-xy')!r}; only 'ne' is supported")
-    deg = net.get("angles", "400") == "360"
-    unit, sunit = (math.pi / 180, ARCSEC) if deg else (math.pi / 200, CC)
-    po = next((e for e in net if _tag(e) == "points-observations"), None)
-    if po is None:
-        raise ConfigError(key, f"{path}: no <points-observations> element")
-    dstd = {k: po.get(f"{k}-stdev") for k in ("distance", "direction", "angle")}
-    points, obs, datum_pts, coords = {}, [], [], []
-    for e in po.iter():
-        t = _tag(e)
-        if t in _UNSUPPORTED:
-            raise ConfigError(key, f"{path}: <{t}> is not supported (2-D networks only)")
-    for e in po:
-        t = _tag(e)
-        if t == "point":
-            pid = e.get("id")
-            if not pid:
-                raise ConfigError(key, f"{path}: a <point> without id")
-            if e.get("x") is None or e.get("y") is None:
-                raise ConfigError(
-                    key,
-                    f"{path}: point {pid!r} has no coordinates; the "
-                    "simulation needs every point's coordinates",
-                )
-            fix, adj = e.get("fix", ""), e.get("adj", "")
-            role = "fixed" if fix.lower() == "xy" else "free"
-            if role == "free" and adj.lower() != "xy":
-                raise ConfigError(
-                    key, f'{path}: point {pid!r}: only fix="xy" or adj="xy"/"XY" is supported'
-                )
-            if adj == "XY":
-                datum_pts.append(pid)
-            points[pid] = {
-                "name": pid,
-                "x_mm": _f(key, e, "x") * 1000,
-                "y_mm": _f(key, e, "y") * 1000,
-                "role": role,
-            }
-        elif t == "obs":
-            st = e.get("from")
-            for o in e:
-                ot = _tag(o)
-                if ot == "direction":
-                    s = _f(key, o, "stdev", _default(key, dstd["direction"]))
-                    obs.append(
-                        {
-                            "kind": "direction",
-                            "from": st,
-                            "to": o.get("to"),
-                            "sigma_arcsec": s * sunit / ARCSEC,
-                        }
-                    )
-                elif ot == "distance":
-                    s = _f(key, o, "stdev", _default(key, dstd["distance"]))
-                    obs.append(
-                        {
-                            "kind": "distance",
-                            "from": o.get("from", st),
-                            "to": o.get("to"),
-                            "sigma_mm": s,
-                        }
-                    )
-                elif ot == "angle":
-                    s = _f(key, o, "stdev", _default(key, dstd["angle"]))
-                    obs.append(
-                        {
-                            "kind": "angle",
-                            "at": o.get("from", st),
-                            "from": o.get("bs"),
-                            "to": o.get("fs"),
-                            "sigma_arcsec": s * sunit / ARCSEC,
-                        }
-                    )
-                elif ot != "cov-mat":
-                    raise ConfigError(key, f"{path}: <{ot}> in <obs> is not supported")
-        elif t == "coordinates":
-            pts = [o for o in e if _tag(o) == "point"]
-            cm = next((o for o in e if _tag(o) == "cov-mat"), None)
-            if cm is None:
-                raise ConfigError(key, f"{path}: <coordinates> needs a <cov-mat>")
-            if int(_f(key, cm, "band", 0)) != 0:
-                raise ConfigError(key, f'{path}: only a diagonal <cov-mat band="0"> is supported')
-            var = [float(v) for v in (cm.text or "").split()]
-            if len(var) != 2 * len(pts):
-                raise ConfigError(
-                    key, f"{path}: <cov-mat> has {len(var)} variances for {len(pts)} points"
-                )
-            for a, p in enumerate(pts):
-                vx, vy = var[2 * a], var[2 * a + 1]
-                if not (vx > 0 and math.isclose(vx, vy, rel_tol=1e-9)):
-                    raise ConfigError(
-                        key,
-                        f"{path}: point {p.get('id')!r}: observed x and y "
-                        "need one positive variance",
-                    )
-                coords.append((p.get("id"), math.sqrt(vx)))
-        elif t not in ("description",):
-            raise ConfigError(key, f"{path}: <{t}> is not supported")
-    for pid, s in coords:
-        if pid not in points:
-            raise ConfigError(key, f"{path}: observed coordinates of unknown point {pid!r}")
-        points[pid].update(role="observed", sigma_mm=s)
-    return {
-        "network.points": list(points.values()),
-        "network.observations": obs,
-        "datum.points": datum_pts,
-    }
-
-
-def _default(key: str, v) -> float | None:
-    return None if v is None else float(v)
+def import_note(cfg: dict) -> str:
+    """The sentence the report gives about ``network.gama_xml`` (its convention), or ``""``."""
+    path = cfg.get("network.gama_xml")
+    return f"{Path(path).name}: {read_gama(path)['note']}" if path else ""
 
 
 def merge_gama(cfg: dict) -> dict:
@@ -229,67 +85,129 @@ def _fmt(x: float) -> str:
     return repr(float(x))
 
 
-def write_gama(net: Network, path: str | Path) -> Path:
-    """Write ``net`` as ``gama-local`` XML (see the module doc for what is refused)."""
+def _refuse(net: Network) -> None:
     if np.any(net.bias != 0):
         raise ConfigError(
             "network.observations",
             "gama-local has no observation bias: export a network without bias_*",
         )
-    if net.constant_mm or net.estimate_constant or net.offset_mm:
+    if net.estimate_constant:
         raise ConfigError(
-            "network.constant_mm", "gama-local has no additive constant or offset of distances"
+            "network.estimate_constant", "gama-local has no additive-constant unknown"
         )
-    if net.scale_ppm or net.estimate_scale:
-        raise ConfigError("network.scale_ppm", "gama-local has no scale parameter of distances")
-    if np.any((net.kind == 3) | (net.kind == 4)):
+    if net.estimate_scale:
+        raise ConfigError("network.estimate_scale", "gama-local has no scale unknown")
+
+
+def _vector_pairs(net: Network) -> list[tuple[int, int]]:
+    """Rows ``(dx, dy)`` of each vector; a dx without its dy (or the reverse) is refused."""
+    dx = {}
+    for r in np.flatnonzero(net.kind == 3):
+        dx.setdefault((int(net.i[r]), int(net.j[r])), []).append(int(r))
+    pairs = []
+    for r in np.flatnonzero(net.kind == 4):
+        key = (int(net.i[r]), int(net.j[r]))
+        if not dx.get(key):
+            raise ConfigError(
+                "network.observations",
+                f"a dy from {net.names[key[0]]!r} to {net.names[key[1]]!r} without its dx: "
+                "a gama-local vector has both",
+            )
+        pairs.append((dx[key].pop(0), int(r)))
+    left = [k for k, v in dx.items() if v]
+    if left:
+        a, b = left[0]
         raise ConfigError(
-            "network.observations", "gama-local has no 2-D coordinate differences (dx, dy)"
+            "network.observations",
+            f"a dx from {net.names[a]!r} to {net.names[b]!r} without its dy: "
+            "a gama-local vector has both",
         )
+    return pairs
+
+
+def _distance_sigma(net: Network, r: int) -> float:
+    """The stdev of a plain distance with the same design row as row ``r`` (known offset,
+    constant and scale folded in)."""
+    d = float(np.hypot(*(net.xy[net.j[r]] - net.xy[net.i[r]])))
+    s = math.sqrt(max(d * d - net.offset_mm**2, 0.0))
+    return float(net.sigma[r]) * s / ((1 + 1e-6 * net.scale_ppm) * d)
+
+
+def _obs_sets(net: Network, po, val: np.ndarray) -> None:
+    """One ``<obs>`` per station and orientation set: the station's first ``<obs>`` holds its
+    distances and angles and its first direction set."""
+    lin = np.flatnonzero(net.kind <= 2)
+    for a in dict.fromkeys(int(x) for x in net.i[lin]):
+        rows = lin[net.i[lin] == a]
+        sets = list(dict.fromkeys(int(net.oset[r]) for r in rows if net.kind[r] == 1))
+        dirs = [[r for r in rows if net.kind[r] == 1 and net.oset[r] == s] for s in sets] or [[]]
+        groups = [dirs[0] + [r for r in rows if net.kind[r] != 1]] + dirs[1:]
+        for g in groups:
+            if not g:
+                continue
+            o = ET.SubElement(po, "obs", {"from": net.names[a]})
+            for r in g:
+                _one(net, o, int(r), val[r])
+
+
+def _one(net: Network, o, r: int, v: float) -> None:
+    if net.kind[r] == 0:
+        ET.SubElement(
+            o,
+            "distance",
+            {
+                "to": net.names[net.j[r]],
+                "val": _fmt(np.hypot(*(net.xy[net.j[r]] - net.xy[net.i[r]])) / 1000),
+                "stdev": _fmt(_distance_sigma(net, r)),
+            },
+        )
+    elif net.kind[r] == 1:
+        ET.SubElement(
+            o,
+            "direction",
+            {
+                "to": net.names[net.j[r]],
+                "val": _fmt(v / _GON % 400),
+                "stdev": _fmt(net.sigma[r] / CC),
+            },
+        )
+    else:
+        ET.SubElement(
+            o,
+            "angle",
+            {
+                "bs": net.names[net.j[r]],
+                "fs": net.names[net.k[r]],
+                "val": _fmt(v / _GON % 400),
+                "stdev": _fmt(net.sigma[r] / CC),
+            },
+        )
+
+
+def write_gama(net: Network, path: str | Path, inner: tuple | list = ()) -> Path:
+    """Write ``net`` as ``gama-local`` XML (see the module doc for the mapping and what is
+    refused); ``inner``: indices of the points of an inner datum (``adj="XY"``)."""
+    _refuse(net)
+    pairs = _vector_pairs(net)
     val = computed(net, net.theta_true()[None])[0]
     root = ET.Element("gama-local", xmlns=NS)
-    nw = ET.SubElement(root, "network", {"axes-xy": "ne", "angles": "400"})
+    nw = ET.SubElement(root, "network", {"axes-xy": "ne", "angles": "left-handed"})
     ET.SubElement(nw, "description").text = net.name
+    ET.SubElement(nw, "parameters", {"sigma-apr": "1", "sigma-act": "apriori"})
     po = ET.SubElement(nw, "points-observations")
+    inner = {int(a) for a in inner}
     for a, nm in enumerate(net.names):
         attr = {"id": nm, "x": _fmt(net.xy[a, 0] / 1000), "y": _fmt(net.xy[a, 1] / 1000)}
-        attr.update({"fix": "xy"} if net.role[a] == 1 else {"adj": "xy"})
+        if net.role[a] == 1:
+            attr["fix"] = "xyz" if pairs else "xy"
+        else:
+            attr["adj"] = "XY" if a in inner else "xy"
+            if pairs:
+                attr["fix"] = "z"
+        if pairs:
+            attr["z"] = "0"
         ET.SubElement(po, "point", attr)
-    for a in dict.fromkeys(net.i[net.kind <= 2]):
-        o = ET.SubElement(po, "obs", {"from": net.names[a]})
-        for r in np.flatnonzero((net.i == a) & (net.kind <= 2)):
-            kd = KINDS[net.kind[r]]
-            if kd == "distance":
-                ET.SubElement(
-                    o,
-                    "distance",
-                    {
-                        "to": net.names[net.j[r]],
-                        "val": _fmt(val[r] / 1000),
-                        "stdev": _fmt(net.sigma[r]),
-                    },
-                )
-            elif kd == "direction":
-                ET.SubElement(
-                    o,
-                    "direction",
-                    {
-                        "to": net.names[net.j[r]],
-                        "val": _fmt(val[r] / (math.pi / 200) % 400),
-                        "stdev": _fmt(net.sigma[r] / CC),
-                    },
-                )
-            else:
-                ET.SubElement(
-                    o,
-                    "angle",
-                    {
-                        "bs": net.names[net.j[r]],
-                        "fs": net.names[net.k[r]],
-                        "val": _fmt(val[r] / (math.pi / 200)),
-                        "stdev": _fmt(net.sigma[r] / CC),
-                    },
-                )
+    _obs_sets(net, po, val)
     obs_pts = np.flatnonzero(net.role == 2)
     if obs_pts.size:
         c = ET.SubElement(po, "coordinates")
@@ -306,7 +224,56 @@ def write_gama(net: Network, path: str | Path) -> Path:
         sig = {int(a): s for a, s in zip(net.i[net.kind == 5], net.sigma[net.kind == 5])}
         cm = ET.SubElement(c, "cov-mat", {"dim": str(2 * obs_pts.size), "band": "0"})
         cm.text = " ".join(_fmt(sig[int(a)] ** 2) for a in obs_pts for _ in (0, 1))
+    if pairs:
+        v = ET.SubElement(po, "vectors")
+        for rx, ry in pairs:
+            ET.SubElement(
+                v,
+                "vec",
+                {
+                    "from": net.names[net.i[rx]],
+                    "to": net.names[net.j[rx]],
+                    "dx": _fmt(val[rx] / 1000),
+                    "dy": _fmt(val[ry] / 1000),
+                    "dz": "0.0",
+                },
+            )
+        cm = ET.SubElement(v, "cov-mat", {"dim": str(3 * len(pairs)), "band": "0"})
+        cm.text = " ".join(
+            f"{_fmt(net.sigma[rx] ** 2)} {_fmt(net.sigma[ry] ** 2)} 1.0" for rx, ry in pairs
+        )
     ET.indent(root)
     path = Path(path)
     path.write_text('<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n")
     return path
+
+
+def inner_points(net: Network, cfg: dict) -> list[int]:
+    """Indices of the estimated points of ``datum.points`` (default: all)."""
+    pats = cfg["datum.points"] or ["*"]
+    return [
+        a
+        for a, nm in enumerate(net.names)
+        if net.role[a] != 1 and any(fnmatch.fnmatchcase(nm, p) for p in pats)
+    ]
+
+
+def export(net: Network, cfg: dict, path: str | Path) -> str:
+    """Write ``network.xml`` in the datum of ``cfg``; returns the sentence for the summary
+    (the file name, what was changed to say it in gama-local, or why it was not written)."""
+    kind = cfg["datum.kind"]
+    try:
+        if kind == "fixed":
+            write_gama(net, path)
+            return Path(path).name
+        pts = [a for a in range(net.n) if net.role[a] != 1]
+        write_gama(net, path, inner_points(net, cfg) if kind == "inner" else pts)
+    except ConfigError as e:
+        return f"not exported: {e}"
+    if kind == "inner":
+        return f'{Path(path).name} (inner datum: adj="XY" on the datum points)'
+    return (
+        f"{Path(path).name}: datum.kind = constraints has no gama-local form; written as the "
+        "free network in the inner datum over all its points (this study's precision moved "
+        "by an S-transformation)"
+    )

@@ -20,7 +20,7 @@ from sim import lsq
 from sim.mc.config import ConfigError
 from sim.studies.network.definition import Network
 
-__all__ = ["NetworkModel", "computed", "simulate", "datum", "null_space"]
+__all__ = ["NetworkModel", "computed", "simulate", "datum", "null_space", "defect_basis"]
 
 _TWO_PI = 2 * np.pi
 
@@ -124,6 +124,10 @@ def null_space(net: Network, free: np.ndarray) -> np.ndarray:
     """Candidate datum defects restricted to the free globals ``(p, 4)``: translation x, y,
     rotation and scale of every point (orientations turn with a rotation; an estimated scale
     error of the distances shrinks as the coordinates grow)."""
+    return _similarity(net)[free]
+
+
+def _similarity(net: Network) -> np.ndarray:
     c = net.xy - net.xy.mean(axis=0)
     G = np.zeros((net.q, 4))
     G[0 : 2 * net.n : 2, 0] = 1
@@ -132,7 +136,31 @@ def null_space(net: Network, free: np.ndarray) -> np.ndarray:
     G[2 * net.n : 2 * net.n + len(net.stations), 2] = 1.0
     G[0 : 2 * net.n : 2, 3], G[1 : 2 * net.n : 2, 3] = c[:, 0], c[:, 1]
     G[net.i_scale, 3] = -(1e6 + net.scale_ppm)
-    return G[free]
+    return G
+
+
+def defect_basis(net: Network, free: np.ndarray) -> np.ndarray:
+    """Orthonormal columns ``(p, d)`` spanning the datum defects of the design over the free
+    globals ``free``: the similarity transformations (translation, rotation, scale) that
+    leave every point held fixed in place and change no observation. With one fixed point
+    these are the rotation (and scale) about it; with none, those about the centroid."""
+    G = _similarity(net)
+    held = np.setdiff1d(np.arange(2 * net.n), free)
+    K = np.eye(4)
+    if held.size:
+        _, sv, vt = np.linalg.svd(G[held], full_matrices=True)
+        rank = int((sv > 1e-12 * max(sv.max(initial=0.0), 1.0)).sum())
+        K = vt[rank:].T
+    if K.shape[1] == 0:
+        return np.zeros((len(free), 0))
+    Q, _ = np.linalg.qr(G[free] @ K)
+    _, J = computed(net, net.theta_true()[None], jac=True)
+    A = J[0][:, free] / net.sigma[:, None]
+    B = A @ Q
+    _, sv, vt = np.linalg.svd(B, full_matrices=True)
+    sv = np.concatenate([sv, np.zeros(Q.shape[1] - sv.size)])
+    null = vt[sv <= 1e-9 * np.linalg.norm(A)]
+    return Q @ null.T
 
 
 def _param_index(net: Network, key: str, name: str) -> int:
@@ -166,9 +194,15 @@ def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
                     if g // 2 in extra_fixed:
                         continue  # held fixed in this parameterisation
                     raise ConfigError(f"datum.constraints[{b}]", f"{name} is not a free unknown")
-                if isinstance(coef, bool) or not isinstance(coef, (int, float)):
+                if (
+                    isinstance(coef, bool)
+                    or not isinstance(coef, (int, float))
+                    or not np.isfinite(coef)
+                    or abs(coef) > 1e12
+                ):
                     raise ConfigError(
-                        f"datum.constraints[{b}]", f"{name}: coefficient must be a number"
+                        f"datum.constraints[{b}]",
+                        f"{name}: coefficient must be a finite number up to 1e12 (got {coef!r})",
                     )
                 C[pos[g], b] = coef
         keep = np.abs(C).sum(0) > 0
@@ -180,13 +214,10 @@ def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
         sel |= np.array([fnmatch.fnmatchcase(nm, p) for nm in net.names])
     if not sel.any():
         raise ConfigError("datum.points", f"no point matches {pats}")
-    G = null_space(net, free)
-    _, J = computed(net, net.theta_true()[None], jac=True)
-    A = J[0][:, free] / net.sigma[:, None]
-    defect = np.linalg.norm(A @ G, axis=0) <= 1e-9 * np.linalg.norm(A) * np.linalg.norm(G, axis=0)
-    if not defect.any():
+    G = defect_basis(net, free)
+    if not G.shape[1]:
         return lsq.Datum(free)
     mask = np.zeros(net.q)
     mask[: 2 * net.n] = np.repeat(sel, 2)
-    C = G[:, defect] * mask[free][:, None]
+    C = G * mask[free][:, None]
     return lsq.Datum(free, C)

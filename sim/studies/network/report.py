@@ -29,6 +29,7 @@ def report(out: Path) -> str:
         f"Redundancy numbers range from {fmt(float(r.min()))} to {fmt(float(r.max()))}; "
         f"{int(np.sum(~np.array(o['controlled'])))} observations are uncontrolled (r = 0). "
         f"gama-local XML: {s['gama_xml']}."
+        + (f" Read from {s['gama_input']}." if s.get("gama_input") else "")
         + (
             f" Points held in part by the datum constraints (singular 2 x 2 covariance, not "
             f"listed): {s['held_by_datum']}."

@@ -23,10 +23,18 @@ from sim.mc.config import ConfigError, StudyError
 from sim.mc.runner import jackknife, run_chunks
 from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import draw_figures
-from sim.studies.network.analysis import CHI2_2_95, analyse, ellipse, in_datum, mc_chunk
+from sim.studies.network.analysis import (
+    CHI2_2_95,
+    analyse,
+    ellipse,
+    estimated_points,
+    in_datum,
+    match_points,
+    mc_chunk,
+)
 from sim.studies.network.definition import KINDS, Network, build
 from sim.studies.network.figures import network_figure, reliability_figure
-from sim.studies.network.gama import merge_gama, write_gama
+from sim.studies.network.gama import export, import_note, merge_gama
 from sim.studies.network.model import datum
 
 __all__ = ["run", "compare_points"]
@@ -83,14 +91,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
     if not an.ok:
         raise StudyError("datum.kind: the normal equations are singular in this datum")
     prov = provenance(cfg)
-    # estimated points whose 2 x 2 covariance is regular (a point held by a datum constraint,
-    # such as Brown's x1 = 0, has a singular block and no ellipse)
-    det = an.cov[:, 0, 0] * an.cov[:, 1, 1] - an.cov[:, 0, 1] ** 2
-    pts = [
-        a
-        for a in range(net.n)
-        if net.role[a] != 1 and det[a] > 1e-12 * ((an.cov[a, 0, 0] + an.cov[a, 1, 1]) / 2) ** 2
-    ]
+    pts = estimated_points(net, an)
     held = [net.names[a] for a in range(net.n) if net.role[a] != 1 and a not in pts]
     C = dt.constraint_matrix(net.theta_true()[None])
     sim = _mc(net, an, C, pts, cfg, ctx)
@@ -160,13 +161,11 @@ def run(cfg: dict, out: Path, ctx) -> None:
     )
     _parameters(net, an, sim, n_ok, out, prov)
     drows = {"datum": [], "point": [], "sigma_x_mm": [], "sigma_y_mm": []}
-    for pat in cfg["output.inner_over"]:
-        sel = [a for a in range(net.n) if fnmatch.fnmatchcase(net.names[a], pat)]
-        if not sel:
-            raise ConfigError("output.inner_over", f"no point matches {pat!r}")
+    if cfg["output.inner_over"]:  # the patterns form one set of datum points
+        sel = match_points(net, "output.inner_over", cfg["output.inner_over"])
         cov = in_datum(net, an, sel)
         for a in range(net.n):
-            drows["datum"].append(f"inner over {pat}")
+            drows["datum"].append(f"inner over {', '.join(cfg['output.inner_over'])}")
             drows["point"].append(net.names[a])
             drows["sigma_x_mm"].append(float(np.sqrt(max(cov[a, 0, 0], 0))))
             drows["sigma_y_mm"].append(float(np.sqrt(max(cov[a, 1, 1], 0))))
@@ -194,11 +193,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
         },
         prov,
     )
-    try:
-        write_gama(net, out / "network.xml")
-        gama = "network.xml"
-    except ConfigError as e:
-        gama = f"not exported: {e}"
+    gama = export(net, full, out / "network.xml")
     n_tot = float(n_ok.sum())
     write_table(
         out / "summary.parquet",
@@ -220,6 +215,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
             "compare_fix": [", ".join(cfg["compare.fix"])],
             "held_by_datum": [", ".join(held)],
             "gama_xml": [gama],
+            "gama_input": [import_note(cfg)],
         },
         prov,
     )

@@ -9,9 +9,21 @@ arrays would not fit in memory.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from sim.mc.config import COMMON, ConfigError, Field
+from sim.studies.network.analysis import (
+    analyse,
+    check_inner,
+    estimated_points,
+    inner_defect,
+    match_points,
+)
+from sim.studies.network.definition import build
+from sim.studies.network.gama import gama_digest, merge_gama
+from sim.studies.network.model import computed, datum
 
 __all__ = ["SCHEMA", "check"]
 
@@ -27,6 +39,12 @@ SCHEMA = {
         "read the points and observations from this "
         "gama-local XML file instead (a path relative to the working "
         "directory, or absolute)",
+    ),
+    "network.gama_sha256": Field(
+        "",
+        "str",
+        "sha256 of the network.gama_xml file's contents, filled in on load so that an edited "
+        "file makes the results stale (if given, the file must still have it)",
     ),
     "network.points": Field([], "records", "points {name, x_mm, y_mm, role, sigma_mm}"),
     "network.grids": Field(
@@ -119,21 +137,19 @@ SCHEMA["chunk"] = Field(
 
 
 def check(cfg: dict) -> None:
-    """Cross-key rules: the network builds, its datum covers every rank defect, the chunk
-    fits in memory, and the run has at least two chunks."""
-    from sim.studies.network.analysis import analyse
-    from sim.studies.network.definition import build
-    from sim.studies.network.gama import merge_gama
-    from sim.studies.network.model import datum
-
+    """Cross-key rules: the network builds (every observation well defined), its datum covers
+    every rank defect and is not near-singular, something is estimated, the chunk fits in
+    memory, the run has at least two chunks and ``output.inner_over`` can fix the defects.
+    Records the sha256 of ``network.gama_xml`` in ``network.gama_sha256``."""
     if cfg["trials"] < 2 * cfg["chunk"]:
         raise ConfigError(
             "chunk",
             f"{cfg['trials']} trials in chunks of {cfg['chunk']} give "
             "fewer than 2 chunks: the intervals are taken over chunks",
         )
-    cfg = merge_gama(cfg)
-    net = build(cfg)
+    _digest(cfg)
+    full = merge_gama(cfg)
+    net = build(full)
     nbytes = cfg["chunk"] * net.m * (net.q + 1) * 8
     if nbytes > MAX_CHUNK_BYTES:
         raise ConfigError(
@@ -142,10 +158,20 @@ def check(cfg: dict) -> None:
             f"{nbytes / 1024**3:.1f} GiB of Jacobians ({net.m} observations x "
             f"{net.q} unknowns); use a smaller chunk",
         )
-    dt = datum(net, cfg)
+    if not np.any(net.role != 1):
+        raise ConfigError("network.points", "every point is fixed: nothing to estimate")
+    dt = datum(net, full)
+    if full["datum.kind"] == "inner":
+        pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
+        check_inner(net, inner_defect(net), pts, "datum.points")
     an = analyse(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
         _defect(net, dt, "datum.kind")
+    _conditioned(net, an, "datum.kind")
+    if not estimated_points(net, an):
+        raise ConfigError(
+            "network.points", "no estimated point has a regular covariance: nothing to estimate"
+        )
     if an.dof < 1:
         raise ConfigError(
             "network.observations",
@@ -154,17 +180,70 @@ def check(cfg: dict) -> None:
             "observations",
         )
     if cfg["compare.fix"]:
-        from sim.studies.network.run import compare_points
-
-        extra = compare_points(net, cfg)
-        an2 = analyse(net, datum(net, cfg, tuple(extra)), 0.001, 0.8)
+        extra = match_points(net, "compare.fix", cfg["compare.fix"])
+        an2 = analyse(net, datum(net, full, tuple(extra)), 0.001, 0.8)
         if not an2.ok:
-            _defect(net, datum(net, cfg, tuple(extra)), "compare.fix")
+            _defect(net, datum(net, full, tuple(extra)), "compare.fix")
+    if cfg["output.inner_over"]:
+        pts = match_points(net, "output.inner_over", cfg["output.inner_over"])
+        check_inner(net, inner_defect(net), pts, "output.inner_over")
+
+
+def _digest(cfg: dict) -> None:
+    path, have = cfg["network.gama_xml"], cfg["network.gama_sha256"]
+    if not path:
+        if have:
+            raise ConfigError("network.gama_sha256", "only with network.gama_xml")
+        return
+    sha = gama_digest(path)
+    if have and have != sha:
+        raise ConfigError(
+            "network.gama_sha256",
+            f"{path} has changed (sha256 {sha[:12]}..., recorded {have[:12]}...)",
+        )
+    cfg["network.gama_sha256"] = sha
+
+
+#: largest variance inflation Q_ii N_ii of an unknown before the network counts as singular
+MAX_INFLATION = 1e10
+
+
+def _conditioned(net, an, key: str) -> None:
+    """Refuse a near-singular network (e.g. free points on the line through two fixed
+    points): an unknown whose variance is over :data:`MAX_INFLATION` times what its own
+    observations alone would give loses more than ten of the sixteen digits."""
+    n_ii = an.n_diag
+    q_ii = np.diag(an.Q)
+    span = float(np.ptp(net.xy, axis=0).max())
+    coord = an.free < 2 * net.n
+    loose = np.flatnonzero(coord & (np.sqrt(np.maximum(q_ii, 0)) > span))
+    if loose.size:
+        par = int(an.free[loose[0]])
+        raise ConfigError(
+            key,
+            f"the network is near-singular: point {net.names[par // 2]!r} "
+            f"({'xy'[par % 2]}) has a sigma of {math.sqrt(q_ii[loose[0]]):.3g} mm, more than "
+            f"the network's extent ({span:.3g} mm); points nearly on one line, or nearly "
+            "undetermined",
+        )
+    vif = q_ii * n_ii
+    if not np.all(np.isfinite(vif)) or vif.max() > MAX_INFLATION:
+        g = int(np.argmax(np.where(np.isfinite(vif), vif, np.inf)))
+        par = int(an.free[g])
+        what = (
+            f"point {net.names[par // 2]!r} ({'xy'[par % 2]})"
+            if par < 2 * net.n
+            else net.parameter_names()[par - 2 * net.n]
+        )
+        raise ConfigError(
+            key,
+            f"the network is near-singular: {what} is determined {vif[g]:.3g} times worse "
+            f"than its observations alone would give (limit {MAX_INFLATION:g}); points "
+            "nearly on one line, or nearly undetermined",
+        )
 
 
 def _defect(net, dt, key: str) -> None:
-    from sim.studies.network.model import computed
-
     free = dt.free_index(net.q)
     _, J = computed(net, net.theta_true()[None], jac=True)
     A = J[0][:, free] / net.sigma[:, None]

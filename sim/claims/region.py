@@ -1,0 +1,184 @@
+"""Verdicts of predictions over a consistent region (issue 21 item 2), not at a nominal input.
+
+With the region of :func:`sim.claims.inference.explore` (the input vectors no printed
+statement contradicts) and a prediction evaluated at each of its points (per point HOLDS /
+FAILS / UNDECIDED by the decision zone of :class:`~sim.claims.inference.Statement`):
+
+* **holds**       it holds at every point of the region;
+* **fails**       it fails at every point (no feasible input makes it true);
+* **depends**     anything else where at least one point decides it; ``holds_where`` gives
+                  the projections of the points where it holds ("offset_mm 5-27.5") and
+                  ``fails_where`` those where it fails;
+* **undecidable** no point of the region decides it (its interval covers values on both sides
+                  of the zone everywhere), or the region is empty; ``note`` says what would
+                  decide it (the statement's ``decide`` text, or the conflicting statements).
+
+Nominal input values have no place in these verdicts; they survive only as labelled examples
+in figures. :func:`region_table` gives the rows of ``consistent_region.parquet``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import numpy as np
+
+from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Region, Statement, status
+
+__all__ = [
+    "RegionVerdict",
+    "decide_over",
+    "region_table",
+    "region_row",
+    "statement_of",
+    "evidence_of_row",
+    "REGION_VERDICTS",
+    "OUTCOME_NAMES",
+]
+
+REGION_VERDICTS = ("holds", "fails", "depends", "undecidable")
+OUTCOME_NAMES = {HOLDS: "holds", FAILS: "fails", UNDECIDED: "undecided"}
+
+
+@dataclass(frozen=True)
+class RegionVerdict:
+    """A prediction's verdict over the region, with where it holds and fails."""
+
+    id: str
+    verdict: str
+    n_points: int
+    n_holds: int
+    n_fails: int
+    holds_where: str
+    fails_where: str
+    note: str
+
+    @property
+    def text(self) -> str:
+        if self.verdict == "depends" and self.n_holds == 0:
+            return f"depends: holds nowhere; fails for {self.fails_where}, undecided elsewhere"
+        if self.verdict == "depends":
+            return f"depends: holds for {self.holds_where}; fails for {self.fails_where}"
+        return self.verdict + (f" ({self.note})" if self.note else "")
+
+
+def statement_of(book, cid: str, form: str | None = None) -> Statement:
+    """A claim-book row (:class:`sim.claims.book.ClaimBook`) as a statement: its printed
+    reference, rounding and tol give the same decision zone as the book's rule."""
+    s = book.spec(cid)
+    ref = s["ref"] if isinstance(s["ref"], list) else [s["ref"], s["ref"]]
+    return Statement(
+        cid,
+        (float(ref[0]), float(ref[1])),
+        form or s["form"],
+        s.get("decimals"),
+        float(s["tol"]),
+        s["paper"],
+        s["source"],
+    )
+
+
+def evidence_of_row(row: dict) -> dict:
+    """A scored claims row as evidence at one point: its interval (and p for one-plate)."""
+    p = row.get("p_plate")
+    return {
+        "value": row["value"],
+        "low": row["ci_low"],
+        "high": row["ci_high"],
+        "p": p if row.get("form") == "one-plate" else None,
+    }
+
+
+def outcomes(region: Region, spec: Statement, evidence: Any = None) -> np.ndarray:
+    """The prediction's HOLDS/FAILS/UNDECIDED at every evaluated point of the region
+    (``evidence`` defaults to the model's output for ``spec.id``)."""
+    ev = region.outputs[spec.id] if evidence is None else evidence
+    return status(spec, ev, region.n, region.level)
+
+
+def decide_over(region: Region, spec: Statement, evidence: Any = None) -> RegionVerdict:
+    """The verdict of one prediction over the region (see the module doc)."""
+    acc = region.accepted
+    if not acc.any():
+        conf = "; ".join(" + ".join(c) for c in region.conflicts)
+        return RegionVerdict(
+            spec.id, "undecidable", 0, 0, 0, "nowhere", "nowhere",
+            f"no input is consistent with the printed statements (conflicting: {conf})",
+        )  # fmt: skip
+    o = outcomes(region, spec, evidence)
+    h, f = acc & (o == HOLDS), acc & (o == FAILS)
+    nh, nf, n = int(h.sum()), int(f.sum()), int(acc.sum())
+    hw = region.describe(h) if nh else "nowhere"
+    fw = region.describe(f) if nf else "nowhere"
+    if nh == n:
+        v, note = "holds", ""
+    elif nf == n:
+        v, note = "fails", ""
+    elif nh == 0 and nf == 0:
+        v = "undecidable"
+        note = spec.decide or "no input of the region decides it"
+    else:
+        v = "depends"
+        note = f"holds at {nh} of {n} region points, fails at {nf}"
+    return RegionVerdict(spec.id, v, n, nh, nf, hw, fw, note)
+
+
+def region_table(
+    region: Region, predictions: Sequence[Statement] = (), values: Sequence[str] = ()
+) -> dict[str, list]:
+    """Rows of ``consistent_region.parquet``: one per accepted input vector; a column per input
+    (named with its unit), ``confirmed`` (every printed statement holds, not only none
+    contradicted), one ``<id>`` outcome column per printed statement and prediction
+    (holds / fails / undecided), and a ``<id>__value`` column for the ids in ``values``."""
+    acc = region.accepted
+    cols: dict[str, list] = {k: v[acc].tolist() for k, v in region.x.items()}
+    cols["confirmed"] = region.confirmed[acc].tolist()
+    for j, s in enumerate(region.statements):
+        cols[s.id] = [OUTCOME_NAMES[int(o)] for o in region.status[acc, j]]
+    for p in predictions:
+        cols[p.id] = [OUTCOME_NAMES[int(o)] for o in outcomes(region, p)[acc]]
+    for vid in values:
+        ev = region.outputs[vid]
+        v = np.asarray(ev["value"] if isinstance(ev, dict) else ev, float)
+        cols[f"{vid}__value"] = v[acc].tolist()
+    return cols
+
+
+def region_row(book, cid: str, rv: RegionVerdict, values, note: str = "") -> dict[str, Any]:
+    """The claims row of prediction ``cid`` decided over the region: ``value``/``value_high``
+    and the interval are the smallest and largest value over the region's points
+    (``interval = "region"``), ``outcome``/``verdict`` the region verdict (holds / fails /
+    depends / undecidable), and the note says where it holds and fails."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    lo, hi = (float(v.min()), float(v.max())) if v.size else (np.nan, np.nan)
+    if v.size:
+        row = book.score(cid, lo, (lo, lo), "exact", value_high=hi)
+    else:  # an empty region: no value (written as null), the verdict says why
+        row = book.score(cid, 0.0, (0.0, 0.0), "exact")
+        row.update(value_high=hi)
+    where = {
+        "holds": f"holds at all {rv.n_points} points of the region",
+        "fails": f"fails at all {rv.n_points} points of the region",
+        "depends": (
+            f"holds for {rv.holds_where}; fails for {rv.fails_where} ({rv.note})"
+            if rv.n_holds
+            else f"holds nowhere in the region; fails for {rv.fails_where}, undecided at the "
+            f"rest ({rv.note})"
+        ),
+        "undecidable": f"undecidable: {rv.note}",
+    }[rv.verdict]
+    row.update(
+        ci_low=lo,
+        ci_high=hi,
+        value=lo,
+        interval="region",
+        outcome=rv.verdict,
+        verdict=rv.verdict if row["kind"] in ("prediction", "paper-check") else row["verdict"],
+        holds={"holds": True, "fails": False}.get(rv.verdict),
+        note="; ".join(x for x in (where, note) if x),
+    )
+    if row["kind"] == "paper-check" and rv.verdict == "fails":
+        row["verdict"], row["holds"] = "erratum", False
+    return row

@@ -1,0 +1,131 @@
+"""Brown's Multilaterative Comparator (seed 004, Brown 1968): the one instrument of the Brown
+studies (``brown_dilution``, ``brown_table1``, ``brown_design``).
+
+What the paper prints (hardware): a 245 x 245 mm format; a scale 29 mm wide, graduated over
+261 mm, translated by a micrometer by at most 1 mm (so a range reads 0 to 262 mm); the scale
+pivots about a ball bearing and the plate is turned by nominally 90 degrees between four
+positions, i.e. four stations on the axes, "a short distance from the midsides" of the format,
+with the pivot offsets alpha (along the scale) and beta (across it). Ranges in Brown's model:
+``(r + alpha)^2 + beta^2 = |point - station|^2``.
+
+What it does not print, with the range the hardware allows (:data:`INPUTS`, a declaration for
+:func:`sim.claims.inference.parse_declaration`): the station offset outside the midsides (the
+pivot stands beside the plate, not on it: >= 0.5 mm; the scale bounds it from above through
+:func:`max_range_mm`), beta (the pivot ball lies under the 29 mm wide scale: |beta| <= 14.5
+mm), and the extent of the Concept's "about 25 well-distributed points". alpha enters every
+range as a constant and no standard deviation; it is fixed at 0.5 mm.
+
+Every function is batched over a leading geometry axis ``G``. Lengths in mm.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sim.instruments.plates import grid_points
+from sim.instruments.ranges import multilateration as ml
+
+__all__ = [
+    "FORMAT_MM",
+    "SCALE_MM",
+    "MICROMETER_MM",
+    "REACH_MM",
+    "SCALE_WIDTH_MM",
+    "ALPHA_MM",
+    "TABLE1_GRID",
+    "TABLE1_SPACING_MM",
+    "INPUTS",
+    "thetas",
+    "table1_points",
+    "grid_of_extent",
+    "max_range_mm",
+    "min_range_mm",
+    "feasible",
+    "max_offset_mm",
+]
+
+FORMAT_MM = 245.0
+SCALE_MM = 261.0
+MICROMETER_MM = 1.0
+REACH_MM = SCALE_MM + MICROMETER_MM
+SCALE_WIDTH_MM = 29.0
+ALPHA_MM = 0.5
+#: Table 1's plate: a 5 x 5 array of PUG points evenly spaced at 45 mm
+TABLE1_GRID = 5
+TABLE1_SPACING_MM = 45.0
+
+#: the unprinted inputs and the ranges the hardware allows (declaration data)
+INPUTS = {
+    "inputs": {
+        "station_offset_mm": {
+            "low": 0.5,
+            "high": 80.0,
+            "why": "'a short distance from the midsides' (not printed): the pivot stands beside "
+            "the plate, not on its edge (>= 0.5 mm); above, the 261 + 1 mm scale bounds it "
+            "(every range must read: at most 71.5 mm out for a grid spread over half the "
+            "format), so 80 mm is never reached",
+        },
+        "beta_mm": {
+            "low": 0.0,
+            "high": SCALE_WIDTH_MM / 2,
+            "why": "pivot offset across the scale (not printed): the ball lies under the 29 mm "
+            "wide scale",
+        },
+        "half_extent_mm": {
+            "low": FORMAT_MM / 4,
+            "high": FORMAT_MM / 2,
+            "why": "the Concept's 'about 25 well-distributed points' (layout not printed): a 5 x 5 "
+            "grid spread over at least half the format, at most all of it",
+        },
+        "sigma0_um": {
+            "low": 1.45,
+            "high": 2.05,
+            "why": "the plate's rms error of closure: production models 'range typically from "
+            "1.5 to 2.0 microns' (at their rounding); Table 1 prints 1.6",
+        },
+    }
+}
+
+
+def thetas(offset_mm, beta_mm, alpha_mm: float = ALPHA_MM, format_mm: float = FORMAT_MM):
+    """Brown's 7 globals ``(G, 7)`` of stations ``offset_mm`` outside the midsides."""
+    o, b = np.broadcast_arrays(np.atleast_1d(offset_mm), np.atleast_1d(beta_mm))
+    h = format_mm / 2 + o
+    z = np.zeros_like(h, dtype=float)
+    return np.stack([h, h, z, -h, -h, z + alpha_mm, b**2], -1).astype(float)
+
+
+def table1_points() -> np.ndarray:
+    """Table 1's 5 x 5 points at 45 mm ``(25, 2)``."""
+    return grid_points(TABLE1_GRID, TABLE1_SPACING_MM)
+
+
+def grid_of_extent(k: int, half_extent_mm) -> np.ndarray:
+    """k x k grids reaching +-half_extent_mm ``(G, k*k, 2)``."""
+    e = np.atleast_1d(np.asarray(half_extent_mm, float))
+    return grid_points(k, 2.0 / (k - 1))[None] * e[:, None, None]
+
+
+def max_range_mm(P: np.ndarray, TH: np.ndarray) -> np.ndarray:
+    """The longest range of each geometry ``(G,)`` (points ``(G, n, 2)``, globals ``(G, 7)``)."""
+    return ml.ranges(P, TH).max(axis=(1, 2))
+
+
+def min_range_mm(P: np.ndarray, TH: np.ndarray) -> np.ndarray:
+    return ml.ranges(P, TH).min(axis=(1, 2))
+
+
+def feasible(P: np.ndarray, TH: np.ndarray) -> np.ndarray:
+    """True where every range reads on the scale plus micrometer (0 to 262 mm)."""
+    return (min_range_mm(P, TH) >= 0) & (max_range_mm(P, TH) <= REACH_MM)
+
+
+def max_offset_mm(half_extent_mm, beta_mm=0.0, alpha_mm: float = ALPHA_MM) -> np.ndarray:
+    """Largest station offset at which every range of a grid reaching +-half_extent_mm reads:
+    the farthest point from station 1 (0, h) is (+-e, -e), r = sqrt(e^2 + (h + e)^2 - beta^2)
+    - alpha <= 262 mm. NaN where no offset >= 0 reads (the scale is too short)."""
+    e = np.asarray(half_extent_mm, float)
+    d2 = (REACH_MM + alpha_mm) ** 2 + np.asarray(beta_mm, float) ** 2 - e**2
+    with np.errstate(invalid="ignore"):
+        o = np.sqrt(d2) - e - FORMAT_MM / 2
+    return np.where((d2 > 0) & (o >= 0), o, np.nan)

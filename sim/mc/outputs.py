@@ -1,0 +1,252 @@
+"""Results directories the suite owns: the output checks, the locked staging directory, and
+publishing a finished run.
+
+Nothing the suite did not write is ever deleted or replaced: ``--out`` must be new, empty, or
+an earlier results directory (its ``run.json``), and not inside another run's directory; a run
+works in a locked staging directory ``.<out>.partial/`` (resumed after a kill, named when
+damaged) that replaces ``<out>`` only when everything succeeded, keeping the files there that
+the suite did not write. ``run.json`` records the config, the code hash, every file the run
+wrote and each chunk file's sha256.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+from pathlib import Path
+
+from sim.mc.config import ConfigError
+from sim.mc.runner import ChunkStore
+from sim.mc.storage import LOCK, Locked, StageLock, read_record, write_record
+
+__all__ = ["check_out", "prepare_stage", "drop_stage", "seal", "publish"]
+
+
+def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
+    """Refuse an output path the suite did not write (with or without ``--overwrite``) and,
+    without ``--overwrite``, results of a different config or code version."""
+
+    if not out.name or out == out.parent:
+        raise ConfigError("--out", f"{shown} is not a directory the suite can write into")
+    _check_not_nested(out, shown)
+    if out.is_symlink():
+        raise ConfigError("--out", f"{shown} is a symbolic link; sim never replaces it")
+    if not out.exists():
+        return
+    if not out.is_dir():
+        raise ConfigError(
+            "--out",
+            f"{shown} is a file, not a results directory; sim never "
+            "replaces it (choose another --out)",
+        )
+    old = read_record(out)
+    if old is None:
+        if any(out.iterdir()):
+            raise ConfigError(
+                "--out",
+                f"{shown} holds files but no sim run record (run.json); "
+                "sim never replaces it, with or without --overwrite",
+            )
+        return
+    if _same(old, record) or overwrite:
+        return
+    why = (
+        "a different config"
+        if old.get("config") != record["config"]
+        else "a different code version"
+    )
+    raise ConfigError("--out", f"{shown} holds results of {why}; use --overwrite to replace it")
+
+
+def _check_not_nested(out: Path, shown: str) -> None:
+    """Refuse an output directory inside another run's results or staging directory (its
+    ``run.json``, its ``.partial`` staging directory or its ``trials/`` dataset): a re-run of
+    that study would replace it, and chunk files there would join that run's trials."""
+    for up in out.parents:
+        if up == up.parent:
+            break
+        if (up / "run.json").is_file() or up.name.endswith(".partial") or up.name == "trials":
+            raise ConfigError(
+                "--out",
+                f"{shown} lies inside {up}, which belongs to another run; choose a directory "
+                "outside every results directory",
+            )
+
+
+def _damage(stage: Path) -> str | None:
+    """What is wrong with a staging directory's chunk store, if anything: a chunk path that is
+    not a regular file (a directory, a link)."""
+    t = stage / "trials"
+    if t.is_symlink() or (t.exists() and not t.is_dir()):
+        return f"{t} is not a directory"
+    if t.is_dir():
+        for p in sorted(t.rglob("*")):
+            if p.is_symlink() or (p.name.startswith("chunk-") and not p.is_file()):
+                return f"{p} is not a chunk file"
+    return None
+
+
+def _same(a: dict | None, b: dict) -> bool:
+    return bool(a) and a.get("config") == b["config"] and a.get("code_hash") == b["code_hash"]
+
+
+def _clear(stage: Path) -> None:
+    """Remove everything in a staging directory we hold the lock of, but the lock file."""
+
+    for p in stage.iterdir():
+        if p.name == LOCK:
+            continue
+        if p.is_dir() and not p.is_symlink():
+            shutil.rmtree(p)
+        else:
+            p.unlink()
+
+
+def _chunks(stage: Path) -> int:
+    t = stage / "trials"
+    return sum(1 for _ in t.rglob("chunk-*.parquet")) if t.is_dir() else 0
+
+
+def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: bool):
+    """Lock the staging directory and make it hold ``record``. Returns ``(lock, resumed)``."""
+
+    if stage.is_symlink() or (stage.exists() and not stage.is_dir()):
+        raise ConfigError(
+            "--out",
+            f"{stage} is in the way (not a staging directory of sim); sim never replaces it",
+        )
+    if (
+        stage.is_dir()
+        and read_record(stage) is None
+        and not (stage / LOCK).exists()
+        and any(stage.iterdir())
+    ):
+        raise ConfigError(
+            "--out", f"{stage} holds files but no sim run record; sim never replaces it"
+        )
+    lock = StageLock(stage)
+    try:
+        lock.acquire()
+    except Locked as e:
+        who = f"pid {e.pid}" if e.pid else "another process"
+        raise ConfigError(
+            "--out",
+            f"{shown} is being written by a running sim ({who}); wait "
+            "for it to finish or choose another --out",
+        ) from None
+    except OSError as e:
+        raise ConfigError("--out", f"cannot write to {out.parent}: {e.strerror}") from None
+    try:
+        damage = _damage(stage) if stage.is_dir() else None
+        if damage is not None:
+            if not overwrite:
+                raise ConfigError(
+                    "--out",
+                    f"the staging directory of {shown} is damaged ({damage}); "
+                    "run again with --overwrite to replace it",
+                )
+            _clear(stage)
+        old = read_record(stage)
+        resumed = 0
+        if old is not None and _same(old, record) and not old.get("failed"):
+            resumed = _chunks(stage)
+        elif old is not None and _same(old, record):
+            resumed = _chunks(stage)  # a failed run of the same command: try again, resume
+        elif old is None or old.get("failed") or overwrite:
+            _clear(stage)  # ours (locked, a record or a lock file), and not resumable
+        else:
+            why = (
+                "a different config"
+                if old.get("config") != record["config"]
+                else "a different code version"
+            )
+            raise ConfigError(
+                "--out",
+                f"{stage} holds an unfinished run of {why}; run that "
+                "command again to finish it, or use --overwrite to replace it",
+            )
+        for tmp in stage.rglob("*.tmp"):  # a write cut short by a kill
+            tmp.unlink(missing_ok=True)
+        write_record(stage, record)
+    except BaseException:
+        drop_stage(stage, lock)
+        raise
+    return lock, resumed
+
+
+def drop_stage(stage: Path, lock, reason: str | None = None) -> None:
+    """After a failure: remove a staging directory with no finished chunk; otherwise mark it
+    failed (so the corrected command may replace it) and keep it for resumption."""
+
+    try:
+        if _chunks(stage) == 0:
+            shutil.rmtree(stage, ignore_errors=True)
+        elif reason is not None and (rec := read_record(stage)) is not None:
+            write_record(stage, {**rec, "failed": reason})
+    finally:
+        lock.release()
+
+
+def _files(d: Path) -> list[str]:
+    """The regular files under ``d`` (relative, POSIX), but the run record and the lock."""
+    return sorted(
+        p.relative_to(d).as_posix()
+        for p in d.rglob("*")
+        if p.is_file() and not p.is_symlink() and p.name not in ("run.json", LOCK)
+    )
+
+
+def seal(stage: Path, store: ChunkStore | None) -> None:
+    """Before publishing: drop chunk files this run neither wrote nor read (left over or copied
+    in), and record in ``run.json`` every file the run wrote and each chunk file's sha256, so
+    that a later run keeps a file it did not write and a reader can check a chunk's content."""
+    if store is not None:
+        for p in store.strays():
+            p.unlink()
+    files = _files(stage)
+    chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
+    write_record(stage, {**read_record(stage), "files": files, "chunk_sha256": chunks})
+
+
+def _sha256(p: Path) -> str:
+    h = hashlib.sha256()
+    with open(p, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _foreign(out: Path) -> list[str]:
+    """Files in an earlier results directory that its run did not write (a user's notes):
+    they are carried into the new results. Results recorded before runs listed their files
+    count as wholly written by the suite."""
+    rec = read_record(out)
+    if not rec or "files" not in rec:
+        return []
+    mine = set(rec["files"])
+    return [f for f in _files(out) if f not in mine]
+
+
+def publish(stage: Path, out: Path) -> None:
+    """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
+    files in ``out`` that the suite did not write."""
+    for tmp in stage.rglob("*.tmp"):
+        tmp.unlink(missing_ok=True)
+    keep = _foreign(out) if out.is_dir() else []
+    clash = [f for f in keep if (stage / f).exists()]
+    if clash:
+        raise ConfigError(
+            "--out",
+            f"{out / clash[0]} was not written by sim but the new run writes a file of that "
+            "name; move it away and run again",
+        )
+    for f in keep:
+        (stage / f).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(out / f, stage / f)
+    old = out.parent / f".{out.name}.old.{os.getpid()}"
+    if out.exists():
+        os.replace(out, old)
+    os.replace(stage, out)
+    (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
+    shutil.rmtree(old, ignore_errors=True)

@@ -1,0 +1,288 @@
+"""The Brown claims decided over the consistent region of the paper's unprinted inputs.
+
+The instrument and its unprinted inputs with their hardware ranges are declared once in
+:mod:`sim.instruments.ranges.brown`; the inference is :mod:`sim.claims.inference`. This module
+only supplies Brown's model (analytic cofactors, :mod:`.values`; no Monte-Carlo noise, so
+every value is exact) and which printed statements constrain the inputs:
+
+* every study: the 261 mm scale plus the 1 mm micrometer reads every range of the plate
+  (``hardware.scale_reads``);
+* ``brown_table1``: the plate's printed rms error of closure, 1.6 um (the sigma0 that
+  scales all 50 printed standard deviations; its rounding 1.55-1.65 um).
+
+The predictions are then decided over the region (:mod:`sim.claims.region`): holds, fails,
+depends (with where it holds) or undecidable. Inputs (mm, um): ``station_offset_mm``,
+``beta_mm`` (both studies), ``half_extent_mm`` (the Concept's 25 points), ``sigma0_um``
+(Table 1). Seed paper 004 (Brown 1968).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sim.claims.inference import HOLDS, Region, Statement, explore, parse_declaration
+from sim.claims.region import decide_over, outcomes, region_row, region_table, statement_of
+from sim.instruments.ranges import brown as B
+from sim.mc.runner import chunk_rng
+from sim.studies.brown import values as V
+
+SCALE = Statement(
+    "hardware.scale_reads",
+    (B.REACH_MM, B.REACH_MM),
+    "upper",
+    paper="graduated at one-millimeter intervals over a length of 261 mm ... the micrometer "
+    "limits this translation to at most one millimeter (the longest range, mm)",
+    source="004, Implementation of the Concept",
+)
+T1 = "brown.table1_point_sigma."
+T1_PREDICTIONS = (
+    T1 + "share_1p1_1p3",
+    T1 + "points_ge_1p45",
+    T1 + "max_um",
+    T1 + "below_closure",
+)
+T1_JOINT = T1 + "together"
+CONCEPT_PREDICTIONS = (
+    "brown.known_center.ratio",
+    "brown.known_edge.ratio",
+    "brown.dilution.range_pct",
+    "brown.pivot_extra_dilution.typical_pct",
+    "brown.dilution_falls_with_points.monotone",
+)
+#: points per side of the format's edge at which "points near the edges" are evaluated
+EDGE_POINTS = 25
+#: grids of the "more points, less dilution" prediction over the region (same extent)
+MONOTONE_GRIDS = (3, 5, 7)
+
+
+def inputs(names):
+    """The declared inputs ``names`` of the Brown comparator (hardware ranges)."""
+    ins, _ = parse_declaration(B.INPUTS)
+    by = {i.name: i for i in ins}
+    return [by[n] for n in names]
+
+
+def _edge_points() -> np.ndarray:
+    """Points on the format's edge ``(4 EDGE_POINTS - 4, 2)``."""
+    h = B.FORMAT_MM / 2
+    t = np.linspace(-h, h, EDGE_POINTS)
+    ring = [np.column_stack([t, np.full_like(t, s)]) for s in (-h, h)]
+    ring += [np.column_stack([np.full_like(t[1:-1], s), t[1:-1]]) for s in (-h, h)]
+    return np.concatenate(ring)
+
+
+# ----------------------------------------------------------------------------- Table 1
+def table1_model(x: dict) -> dict:
+    """Evidence and predictions at ``N`` input vectors (exact, analytic cofactors)."""
+    o, b, s0 = x["station_offset_mm"], x["beta_mm"], x["sigma0_um"]
+    N = len(o)
+    P = np.broadcast_to(B.table1_points(), (N, 25, 2)).copy()
+    TH = B.thetas(o, b)
+    cof = V.sigmas(P, TH, "pivot")  # (N, 25, 2) sigma / sigma0
+    st = V.point_sigma_stats(s0[:, None, None] * cof)
+    return {
+        SCALE.id: B.max_range_mm(P, TH),
+        "brown.table1_closure.rms_um": s0,
+        T1 + "share_1p1_1p3": st["share"],
+        T1 + "points_ge_1p45": st["count"],
+        T1 + "max_um": st["max"],
+        T1 + "below_closure": cof.reshape(N, -1),
+    }
+
+
+def _joint(region: Region, preds: list[Statement]) -> np.ndarray:
+    ok = np.ones(region.n, bool)
+    for p in preds:
+        ok &= outcomes(region, p) == HOLDS
+    return ok.astype(float)
+
+
+def table1_region(cfg: dict, book):
+    """``(region, predictions, verdicts)`` of Table 1's statements over the region of
+    (station offset, beta, sigma0) allowed by the hardware and the printed closure."""
+    cons = [SCALE, statement_of(book, "brown.table1_closure.rms_um", "value")]
+    preds = [statement_of(book, c) for c in T1_PREDICTIONS]
+    names = ("station_offset_mm", "beta_mm", "sigma0_um")
+    rng = chunk_rng(cfg["seed"], 97, 0)
+    n, rounds = cfg["region.points"], cfg["region.rounds"]
+    reg = explore(inputs(names), cons, table1_model, rng, n=n, rounds=rounds, refine_on=preds)
+    reg.outputs[T1_JOINT] = _joint(reg, preds)
+    joint = statement_of(book, T1_JOINT)
+    verdicts = {p.id: decide_over(reg, p) for p in preds + [joint]}
+    return reg, preds + [joint], verdicts
+
+
+# ----------------------------------------------------------------------------- Concept
+def concept_model(x: dict) -> dict:
+    """Evidence and predictions of the Concept at ``N`` input vectors (25 points, a 5 x 5
+    grid reaching the half extent; exact, analytic cofactors). The known-station ratios are
+    the idealised Figure-1 system: the edge one over points on the format's edge."""
+    o, b, e = x["station_offset_mm"], x["beta_mm"], x["half_extent_mm"]
+    N = len(o)
+    P = B.grid_of_extent(5, e)
+    TH = B.thetas(o, b)
+    kn, st, pv = (V.sigmas(P, TH, m) for m in ("known", "stations", "pivot"))
+    E = np.broadcast_to(_edge_points(), (N,) + _edge_points().shape).copy()
+    edge = V.sigmas(E, TH, "known").max(axis=(1, 2))
+    dil = (V.pooled(st) / V.pooled(kn) - 1) * 100
+    extra = (V.pooled(pv) / V.pooled(st) - 1) * 100
+    return {
+        SCALE.id: B.max_range_mm(P, TH),
+        "brown.known_center.ratio": V.pooled(kn[:, 12]),
+        "brown.known_edge.ratio": edge,
+        "brown.dilution.range_pct": dil,
+        "brown.pivot_extra_dilution.typical_pct": np.median(extra, axis=1),
+        "edge_reads": B.max_range_mm(E, TH) <= B.REACH_MM,
+    }
+
+
+def monotone_at(x: dict) -> np.ndarray:
+    """1 where the mean and the largest per-point dilution fall at every step of
+    :data:`MONOTONE_GRIDS` (same extent), else 0 ``(N,)``."""
+    o, b, e = x["station_offset_mm"], x["beta_mm"], x["half_extent_mm"]
+    TH = B.thetas(o, b)
+    curve = {}
+    for k in MONOTONE_GRIDS:
+        P = B.grid_of_extent(k, e)
+        kn, st = (V.pooled(V.sigmas(P, TH, m)) for m in ("known", "stations"))
+        curve[k] = (st / kn - 1) * 100
+    return V.monotone(curve).astype(float)
+
+
+def concept_region(cfg: dict, book):
+    """``(region, predictions, verdicts)`` of the Concept over (station offset, beta, half
+    extent of the 25 points) allowed by the hardware."""
+    preds = [statement_of(book, c) for c in CONCEPT_PREDICTIONS]
+    names = ("station_offset_mm", "beta_mm", "half_extent_mm")
+    rng = chunk_rng(cfg["seed"], 97, 0)
+    n, rounds = cfg["region.points"], cfg["region.rounds"]
+    reg = explore(
+        inputs(names), [SCALE], concept_model, rng, n=n, rounds=rounds, refine_on=preds[:4]
+    )
+    mono = np.full(reg.n, np.nan)
+    acc = reg.accepted
+    mono[acc] = monotone_at(reg.points())
+    reg.outputs["brown.dilution_falls_with_points.monotone"] = mono
+    verdicts = {p.id: decide_over(reg, p) for p in preds}
+    return reg, preds, verdicts
+
+
+_T1_AT = (
+    "; analytic (sigma0 x sqrt(cofactor), pivot model, printed to one decimal) over the region "
+    "of station offset, beta and sigma0 that the 261 + 1 mm scale and the printed closure "
+    "(1.6 um: 1.55-1.65) allow"
+)
+TABLE1_NOTES = {
+    T1 + "share_1p1_1p3": "share of the 50 sigmas printing as 1.1-1.3 um" + _T1_AT,
+    T1 + "points_ge_1p45": "points whose larger sigma prints >= 1.5 um (the model's four "
+    "stations are symmetric, so its points come in fours: read as 'at least 2')" + _T1_AT,
+    T1 + "max_um": "largest of the 50 sigmas (um)" + _T1_AT,
+    T1 + "below_closure": "every sigma / sigma0 = sqrt(cofactor) below 1" + _T1_AT,
+    T1_JOINT: "1 where the four statements above hold at the same input vector" + _T1_AT,
+}
+TABLE1_PAIRS = (
+    ("station_offset_mm", "sigma0_um"),
+    ("station_offset_mm", "beta_mm"),
+    ("beta_mm", "sigma0_um"),
+)
+_C_AT = (
+    "; analytic, over the region of station offset, beta and the half extent of a 5 x 5 grid "
+    "('about 25 well-distributed points') whose every range the 261 + 1 mm scale reads"
+)
+CONCEPT_NOTES = {
+    "brown.known_center.ratio": "sigma / sigma_range at the centre point, stations known "
+    "(rms of x and y)" + _C_AT,
+    "brown.known_edge.ratio": "largest sigma / sigma_range (x or y) over points on the "
+    "format's edge, stations known (the idealised Figure-1 system: the scale reads those edge "
+    "points nowhere in the region)" + _C_AT,
+    "brown.dilution.range_pct": "per-point dilution of 'stations' over 'known' (rms of "
+    "sigma_x, sigma_y): every one of the 25 points must lie in 5-15 %" + _C_AT,
+    "brown.pivot_extra_dilution.typical_pct": "median over the 25 points of the extra "
+    "dilution of 'pivot' (alpha and beta free) over 'stations' (%)" + _C_AT,
+    "brown.dilution_falls_with_points.monotone": "1 where the mean and the largest per-point "
+    f"dilution fall at every step of k x k grids k = {list(MONOTONE_GRIDS)} (same extent)" + _C_AT,
+}
+CONCEPT_PAIRS = (
+    ("station_offset_mm", "half_extent_mm"),
+    ("station_offset_mm", "beta_mm"),
+    ("half_extent_mm", "beta_mm"),
+)
+
+
+# ----------------------------------------------------------------------------- rows, table
+def _values(reg: Region, cid: str) -> np.ndarray:
+    v = np.asarray(reg.outputs[cid], float)
+    v = v[reg.accepted]
+    return v.reshape(len(v), -1)
+
+
+def rows_of(book, reg: Region, preds, verdicts, notes: dict) -> list[dict]:
+    """Claim rows of the predictions over the region (value: the range over the region; for
+    element predictions the smallest and largest element)."""
+    out = []
+    for p in preds:
+        v = _values(reg, p.id)
+        out.append(region_row(book, p.id, verdicts[p.id], v.ravel(), notes.get(p.id, "")))
+    return out
+
+
+def table_of(reg: Region, preds) -> dict:
+    """``consistent_region.parquet``: one row per accepted input vector, a column per input,
+    the statements' and predictions' outcomes, the scalar predictions' values, and
+    ``together`` (every prediction holds)."""
+    scalar = [p.id for p in preds if np.asarray(reg.outputs[p.id]).ndim == 1]
+    cols = region_table(reg, preds, values=scalar)
+    cols["together"] = together(reg, preds)[reg.accepted].tolist()
+    return cols
+
+
+def together(reg: Region, preds) -> np.ndarray:
+    """Accepted points where every prediction holds."""
+    ok = reg.accepted.copy()
+    for p in preds:
+        ok &= outcomes(reg, p) == HOLDS
+    return ok
+
+
+def inputs_table(reg: Region, preds, verdicts) -> dict:
+    """``region_inputs.parquet``: per input its declared range and why, the region's
+    projection, its resolution (interior, boundary), and the projection of the points where
+    every prediction holds together (``together_*``, NaN if nowhere)."""
+    b, t = reg.bounds(), reg.bounds(together(reg, preds))
+    n_t = int(together(reg, preds).sum())
+    cols = {
+        k: []
+        for k in (
+            "input",
+            "why",
+            "declared_low",
+            "declared_high",
+            "region_low",
+            "region_high",
+            "resolution_interior",
+            "resolution_boundary",
+            "together_low",
+            "together_high",
+            "n_points",
+            "n_region",
+            "n_together",
+        )
+    }
+    for i in reg.inputs:
+        for k, v in (
+            ("input", i.name),
+            ("why", i.why),
+            ("declared_low", i.low),
+            ("declared_high", i.high),
+            ("region_low", b[i.name][0]),
+            ("region_high", b[i.name][1]),
+            ("resolution_interior", reg.resolution[i.name][0]),
+            ("resolution_boundary", reg.resolution[i.name][1]),
+            ("together_low", t[i.name][0]),
+            ("together_high", t[i.name][1]),
+            ("n_points", reg.n),
+            ("n_region", int(reg.accepted.sum())),
+            ("n_together", n_t),
+        ):
+            cols[k].append(v)
+    return cols

@@ -1,0 +1,248 @@
+"""brown_design's tolerances and external comparisons decided over the consistent region of
+the paper's unprinted inputs (seed 004; replaces the one-input-at-a-time sweep).
+
+The comparator is the one instrument of the Brown studies
+(:mod:`sim.instruments.ranges.brown`: 261 + 1 mm scale, stations on the axes, the station
+offset and beta with their hardware ranges). Two parts, each explored jointly by
+:func:`sim.claims.inference.explore` and decided by :mod:`sim.claims.region`:
+
+* ``tolerances`` (analytic, dense): station offset x beta x screw pitch; the constraint is
+  that the scale reads every range of Table 1's plate (5 x 5 at 45 mm); predictions: the
+  lateral-offset error, the microscope's linearity tolerance, the drum graduation error
+  (:func:`.external.tolerances`).
+* ``plates`` (Monte-Carlo plates per point, a small design): station offset x beta x the half
+  extent of the Zeiss grid's 33 calibrated points (layout not printed); the scale must read
+  Table 1's plate and the Zeiss points; predictions: the two-screw agreement, the accuracy
+  range and the two Zeiss rows (:func:`.external.external_at`; their interval is the spread
+  over ``unprinted.plates`` plates, so the Monte-Carlo noise is part of each point's decision).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sim.claims.inference import HOLDS, Input, Region, Statement, explore, parse_declaration
+from sim.claims.region import (
+    decide_over,
+    evidence_of_row,
+    outcomes,
+    region_row,
+    region_table,
+    statement_of,
+)
+from sim.instruments.ranges import brown as B
+from sim.mc.runner import chunk_rng
+from sim.studies.design.claims import verdict_of
+from sim.studies.design.external import external_at, paper_points, tolerances, zeiss_points
+
+__all__ = ["TOLERANCES", "PLATES", "tolerance_region", "plates_region", "region_rows"]
+
+TOLERANCES = (
+    "brown.operation.lateral_offset_error_um",
+    "brown.calibration.linearity_tolerance_um",
+    "brown.calibration.drum_graduation_um",
+)
+PLATES = (
+    "brown.results.two_screw_agreement_um",
+    "brown.results.accuracy_range_um",
+    "brown.results.zeiss_discrepancy_um",
+    "brown.results.zeiss_comparator_um",
+)
+PITCH = Input(
+    "screw_pitch_mm",
+    0.1,
+    1.0,
+    "pitch of the 2 cm micrometer screw (not printed): fine to coarse micrometer screws",
+)
+ZEISS = Input(
+    "zeiss_half_extent_mm",
+    40.0,
+    115.0,
+    "half extent of the 33 calibrated intersections on the 23 x 23 cm Zeiss grid (layout not "
+    "printed): at most the grid's +-115 mm",
+)
+SCALE = Statement(
+    "hardware.scale_reads",
+    (B.REACH_MM, B.REACH_MM),
+    "upper",
+    paper="graduated over a length of 261 mm; the micrometer translates the scale by at most "
+    "one millimeter (the longest range of Table 1's plate, mm)",
+    source="004, Implementation of the Concept",
+)
+ZEISS_READS = Statement(
+    "hardware.scale_reads_zeiss",
+    (B.REACH_MM, B.REACH_MM),
+    "upper",
+    paper="(the longest range to the Zeiss grid's 33 points, mm)",
+    source="004, Implementation of the Concept; Results",
+)
+
+
+def _comparator_inputs():
+    ins, _ = parse_declaration(B.INPUTS)
+    by = {i.name: i for i in ins}
+    return [by["station_offset_mm"], by["beta_mm"]]
+
+
+def _longest(pts: np.ndarray, o, b) -> np.ndarray:
+    P = np.broadcast_to(pts, (len(o),) + pts.shape).copy()
+    return B.max_range_mm(P, B.thetas(o, b))
+
+
+def tolerance_model(cfg: dict):
+    pts = paper_points(cfg)
+
+    def model(x):
+        o, b, pitch = x["station_offset_mm"], x["beta_mm"], x["screw_pitch_mm"]
+        P = np.broadcast_to(pts, (len(o),) + pts.shape).copy()
+        TH = B.thetas(o, b, cfg["comparator.alpha_mm"])
+        t = tolerances(cfg, B.min_range_mm(P, TH), pitch)
+        return {
+            SCALE.id: B.max_range_mm(P, TH),
+            TOLERANCES[0]: t["lateral_error_um"],
+            TOLERANCES[1]: t["linearity_tol_um"],
+            TOLERANCES[2]: t["drum_graduation_um"],
+            "r_min_mm": B.min_range_mm(P, TH),
+        }
+
+    return model
+
+
+def plates_model(cfg: dict, book):
+    pts = paper_points(cfg)
+
+    def model(x):
+        o, b, z = x["station_offset_mm"], x["beta_mm"], x["zeiss_half_extent_mm"]
+        rows = {c: [] for c in PLATES}
+        for oi, bi, zi in zip(o, b, z):
+            e = external_at(cfg, float(oi), float(bi), float(zi), cfg["budget.pitch_mm"])
+            for c in PLATES:
+                rows[c].append(evidence_of_row(verdict_of(book, c, e)))
+        out = {
+            c: {
+                k: None if r[0][k] is None else np.array([v[k] for v in r], float)
+                for k in ("value", "low", "high", "p")
+            }
+            for c, r in rows.items()
+        }
+        out[SCALE.id] = _longest(pts, o, b)
+        zl = np.array(
+            [_longest(zeiss_points(cfg, zi), [oi], [bi])[0] for oi, bi, zi in zip(o, b, z)]
+        )
+        out[ZEISS_READS.id] = zl
+        return out
+
+    return model
+
+
+def tolerance_region(cfg: dict, book):
+    preds = [statement_of(book, c) for c in TOLERANCES]
+    reg = explore(
+        _comparator_inputs() + [PITCH],
+        [SCALE],
+        tolerance_model(cfg),
+        chunk_rng(cfg["seed"], 95, 0),
+        n=cfg["region.points"],
+        rounds=cfg["region.rounds"],
+        refine_on=preds,
+    )
+    return reg, preds, {p.id: decide_over(reg, p) for p in preds}
+
+
+def plates_region(cfg: dict, book):
+    preds = [statement_of(book, c) for c in PLATES]
+    reg = explore(
+        _comparator_inputs() + [ZEISS],
+        [SCALE, ZEISS_READS],
+        plates_model(cfg, book),
+        chunk_rng(cfg["seed"], 96, 0),
+        n=cfg["region.plate_points"],
+        rounds=0,
+    )
+    return reg, preds, {p.id: decide_over(reg, p) for p in preds}
+
+
+def _together(reg: Region, preds) -> np.ndarray:
+    ok = reg.accepted.copy()
+    for p in preds:
+        ok &= outcomes(reg, p) == HOLDS
+    return ok
+
+
+_NOTES = {
+    TOLERANCES[0]: "d^2 / (2 r_min) at the plate's shortest range",
+    TOLERANCES[1]: "lateral offset d with d^2 / (2 r_min) = the accuracy (1 um)",
+    TOLERANCES[2]: "the dividing error as a fraction of one turn of the screw",
+    PLATES[0]: "sqrt(2) x one plate's rms (equal attribution), central half of the plates",
+    PLATES[1]: "one plate's rms after translation and rotation, central half of the plates",
+    PLATES[2]: "33-point stand-in layout within the half extent, plus the grid's 0.8 um",
+    PLATES[3]: "the comparator's part of the Zeiss comparison alone",
+}
+
+
+def region_rows(book, parts) -> tuple[list[dict], dict, dict]:
+    """Claim rows of every part's predictions, ``consistent_region.parquet`` (the parts'
+    tables stacked, ``part`` naming each; an input a part does not have is NaN) and
+    ``region_inputs.parquet`` (per part and input: the declared range, the region's
+    projection, where every prediction of the part holds, the resolution)."""
+    rows, tables, ins = [], [], {k: [] for k in _INPUT_COLS}
+    for name, (reg, preds, verdicts) in parts.items():
+        where = f" (part '{name}': " + ", ".join(i.name for i in reg.inputs) + ")"
+        for p in preds:
+            v = np.asarray(
+                reg.outputs[p.id]["value"]
+                if isinstance(reg.outputs[p.id], dict)
+                else reg.outputs[p.id],
+                float,
+            )
+            rows.append(
+                region_row(book, p.id, verdicts[p.id], v[reg.accepted], _NOTES[p.id] + where)
+            )
+        t = region_table(reg, preds)
+        t["together"] = _together(reg, preds)[reg.accepted].tolist()
+        t["part"] = [name] * int(reg.accepted.sum())
+        tables.append(t)
+        b, tg = reg.bounds(), reg.bounds(_together(reg, preds))
+        for i in reg.inputs:
+            for k, val in (
+                ("part", name),
+                ("input", i.name),
+                ("why", i.why),
+                ("declared_low", i.low),
+                ("declared_high", i.high),
+                ("region_low", b[i.name][0]),
+                ("region_high", b[i.name][1]),
+                ("together_low", tg[i.name][0]),
+                ("together_high", tg[i.name][1]),
+                ("resolution_interior", reg.resolution[i.name][0]),
+                ("resolution_boundary", reg.resolution[i.name][1]),
+                ("n_points", reg.n),
+                ("n_region", int(reg.accepted.sum())),
+                ("n_together", int(_together(reg, preds).sum())),
+            ):
+                ins[k].append(val)
+    keys = list(dict.fromkeys(k for t in tables for k in t))
+    table = {k: [] for k in keys}
+    for t in tables:
+        n = len(t["part"])
+        for k in keys:
+            table[k] += t.get(k, [float("nan") if k.endswith("_mm") else ""] * n)
+    return rows, table, ins
+
+
+_INPUT_COLS = (
+    "part",
+    "input",
+    "why",
+    "declared_low",
+    "declared_high",
+    "region_low",
+    "region_high",
+    "together_low",
+    "together_high",
+    "resolution_interior",
+    "resolution_boundary",
+    "n_points",
+    "n_region",
+    "n_together",
+)

@@ -1,0 +1,496 @@
+"""Read a network from GNU Gama's ``gama-local`` XML input (version 2.x), defensively.
+
+Every element and attribute is checked against ``gama-local``'s own vocabulary (its schema
+``gama-local.xsd`` and its parser): an unknown element, attribute or value, a garbage number,
+a point declared twice with different coordinates, ... is one :class:`ConfigError` line that
+names the file, the element and the attribute. Only a regular file of at most
+:data:`MAX_BYTES` is read (a FIFO or a device is refused before it is opened).
+
+What maps to what (2-D, ``axes-xy = "ne"``, left-handed angles: x north, y east, bearings
+clockwise from x -- this suite's x, y and bearings from +x towards +y):
+
+* ``<point id x y fix="xy">`` -> role ``fixed``; ``adj="xy"`` -> ``free``; ``adj="XY"`` ->
+  free and a datum point of the inner constraints (``datum.points``); metres -> mm. A ``z``
+  is allowed only fixed (``fix="z"``, ``"xyz"``, ...): height unknowns are refused.
+* each ``<obs from>`` is one station set: its ``<direction>`` elements share one orientation
+  unknown (a second ``<obs>`` at the same station is a second set, ``set = "2"``);
+  ``<distance>`` (stdev mm) and ``<angle bs fs>``.
+* angle units as ``gama-local`` reads them, per value: a decimal ``val`` is in gon with its
+  stdev in centesimal seconds (cc); a ``d-m-s`` value (``57-32-28.4``) is in degrees with its
+  stdev in arcseconds. The default stdevs of ``<points-observations>`` follow the same rule,
+  and ``distance-stdev = "a b c"`` is ``a + b D^c`` mm with D the observed distance in km.
+* a ``<cov-mat>`` in ``<obs>``, ``<coordinates>`` or ``<vectors>`` gives the variances (mm^2,
+  cc^2 or arcsec^2); a non-zero covariance (correlated observations) is refused.
+* ``<coordinates>``: observed coordinates (role ``observed``; x and y variances equal);
+  ``<vectors>``: ``dx`` and ``dy`` observations (their ``dz`` needs fixed heights and is
+  dropped).
+* ``<parameters>`` is read and checked; the study always uses the a-priori standard
+  deviations (a pre-analysis has no residuals), and :func:`read_gama` says so in ``note``
+  when the file asks for ``sigma-act = "aposteriori"`` (``gama-local``'s default).
+
+Refused with one line: heights and 3-D data (``z-angle``, ``s-distance``,
+``height-differences``, free heights), azimuths, other axes orientations, right-handed angles,
+correlated covariance blocks. The observed values (``val``) are checked as numbers but not
+used otherwise: the simulation draws readings from the points' coordinates, which every point
+must therefore have.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import stat
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from sim.mc.config import ConfigError
+from sim.studies.network.definition import ARCSEC
+
+__all__ = ["read_gama", "read_bytes", "MAX_BYTES", "CC"]
+
+NS = "http://www.gnu.org/software/gama/gama-local"
+CC = math.pi / 200 / 10000  # one centesimal second in rad
+#: largest gama-local file read (bytes)
+MAX_BYTES = 16 * 1024**2
+_NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+_DMS = re.compile(r"^[+-]?\d+-\d+-\d+(\.\d*)?([eE][+-]?\d+)?$")
+_XYZ = ("xy", "XY", "z", "Z", "xyz", "XYZ", "XYz", "xyZ")
+#: gama-local's vocabulary: element -> its attributes
+VOCAB = {
+    "gama-local": {"version"},
+    "network": {"axes-xy", "angles", "epoch"},
+    "description": set(),
+    "parameters": {
+        "sigma-apr",
+        "conf-pr",
+        "tol-abs",
+        "sigma-act",
+        "update-constrained-coordinates",
+        "algorithm",
+        "language",
+        "encoding",
+        "angles",
+        "latitude",
+        "ellipsoid",
+        "cov-band",
+    },
+    "points-observations": {
+        "distance-stdev",
+        "direction-stdev",
+        "angle-stdev",
+        "zenith-angle-stdev",
+        "azimuth-stdev",
+    },
+    "point": {"id", "x", "y", "z", "fix", "adj"},
+    "obs": {"from", "orientation", "from_dh"},
+    "direction": {"to", "val", "stdev", "from_dh", "to_dh", "extern"},
+    "distance": {"from", "to", "val", "stdev", "from_dh", "to_dh", "extern"},
+    "angle": {
+        "from",
+        "bs",
+        "fs",
+        "to",
+        "rs",
+        "val",
+        "stdev",
+        "from_dh",
+        "bs_dh",
+        "fs_dh",
+        "extern",
+    },
+    "cov-mat": {"dim", "band"},
+    "coordinates": {"extern"},
+    "vectors": set(),
+    "vec": {"from", "to", "dx", "dy", "dz", "from_dh", "to_dh", "extern"},
+}
+_CHOICES = {
+    ("network", "axes-xy"): ("ne", "sw", "es", "wn", "en", "nw", "se", "ws"),
+    ("network", "angles"): ("left-handed", "right-handed"),
+    ("parameters", "sigma-act"): ("aposteriori", "apriori"),
+    ("parameters", "update-constrained-coordinates"): ("yes", "no"),
+    ("parameters", "algorithm"): ("gso", "svd", "cholesky", "envelope"),
+    ("parameters", "language"): tuple("en ca cz du es fi fr hu ru ua zh".split()),
+    ("parameters", "encoding"): ("utf-8", "iso-8859-2", "iso-8859-2-flat", "cp-1250", "cp-1251"),
+    ("parameters", "angles"): ("400", "360"),
+    ("point", "fix"): _XYZ,
+    ("point", "adj"): _XYZ,
+}
+_REFUSED = {
+    "s-distance": "slope distances are 3-D",
+    "z-angle": "zenith angles are 3-D",
+    "azimuth": "azimuths are not supported",
+    "height-differences": "height differences are 1-D (heights)",
+    "dh": "height differences are 1-D (heights)",
+}
+
+
+def _tag(e) -> str:
+    return e.tag.split("}", 1)[-1] if isinstance(e.tag, str) else ""
+
+
+class _File:
+    """Error helper: every message names the file, the element and the attribute."""
+
+    def __init__(self, key: str, path: Path):
+        self.key, self.path = key, path
+
+    def err(self, e, what: str, attr: str | None = None) -> ConfigError:
+        where = f"<{_tag(e)}>" if attr is None else f"<{_tag(e)}> attribute {attr!r}"
+        pid = e.get("id") or e.get("to")
+        at = f" ({'id' if e.get('id') else 'to'}={pid!r})" if pid and attr != "id" else ""
+        return ConfigError(self.key, f"{self.path}: {where}{at}: {what}")
+
+    def num(self, e, attr: str, default: float | None = None, lo: float | None = None) -> float:
+        v = e.get(attr)
+        if v is None:
+            if default is None:
+                raise self.err(e, "missing", attr)
+            return default
+        if not _NUM.match(v.strip()):
+            raise self.err(e, f"{v!r} is not a number", attr)
+        x = float(v)
+        if not math.isfinite(x):
+            raise self.err(e, f"{v!r} is out of range", attr)
+        if lo is not None and x <= lo:
+            raise self.err(e, f"{v!r} must be > {lo:g}", attr)
+        return x
+
+    def name(self, e, attr: str, default: str | None = None) -> str:
+        v = e.get(attr, default)
+        if v is None or not v.strip():
+            raise self.err(e, "missing point name", attr)
+        return v.strip()
+
+    def angle(self, e, attr: str = "val") -> bool:
+        """Check an angular value; True when it is d-m-s (degrees), False for gon."""
+        v = (e.get(attr) or "").strip()
+        if not v:
+            raise self.err(e, "missing", attr)
+        if _DMS.match(v):
+            d, m, s = v.lstrip("+-").split("-")
+            if int(m) >= 60 or float(s) >= 60:
+                raise self.err(e, f"{v!r}: minutes and seconds must be below 60", attr)
+            return True
+        self.num(e, attr)
+        return False
+
+    def vocab(self, root) -> None:
+        for e in root.iter():
+            t = _tag(e)
+            if t in _REFUSED:
+                raise self.err(e, f"not supported: {_REFUSED[t]} (2-D networks only)")
+            if t not in VOCAB:
+                raise self.err(e, "unknown element (not in gama-local's vocabulary)")
+            if t not in ("description", "cov-mat") and (e.text or "").strip():
+                raise self.err(e, f"unexpected text {e.text.strip()[:20]!r}")
+            if (e.tail or "").strip() and e is not root:
+                raise self.err(e, f"unexpected text {e.tail.strip()[:20]!r} after it")
+            for a, v in e.attrib.items():
+                if a.startswith("{") or a == "xmlns":
+                    continue
+                if a not in VOCAB[t]:
+                    raise self.err(e, "unknown attribute", a)
+                ch = _CHOICES.get((t, a))
+                if ch and v.strip() not in ch:
+                    raise self.err(e, f"{v!r} is not one of {', '.join(ch)}", a)
+
+
+def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
+    """The bytes of ``path``: a regular file of at most :data:`MAX_BYTES` (else one line)."""
+    path = Path(path)
+    try:
+        st = os.stat(path)
+    except OSError as e:
+        raise ConfigError(key, f"cannot read {path}: {e.strerror}") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise ConfigError(key, f"{path} is not a regular file")
+    if st.st_size > MAX_BYTES:
+        raise ConfigError(
+            key, f"{path} has {st.st_size} bytes; the limit is {MAX_BYTES} ({MAX_BYTES >> 20} MiB)"
+        )
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as fh:
+            data = fh.read(MAX_BYTES + 1)
+    except OSError as e:
+        raise ConfigError(key, f"cannot read {path}: {e.strerror}") from None
+    if len(data) > MAX_BYTES:
+        raise ConfigError(key, f"{path} is over the limit of {MAX_BYTES} bytes")
+    return data
+
+
+def _cov(f: _File, cm, n: int) -> np.ndarray:
+    """Variances of a ``<cov-mat dim band>`` of ``n`` observations; refuses covariances."""
+    dim = f.num(cm, "dim")
+    band = f.num(cm, "band")
+    if not (dim.is_integer() and band.is_integer() and 0 <= band < dim):
+        raise f.err(cm, f"dim {dim:g} and band {band:g}: need integers, 0 <= band < dim", "band")
+    dim, band = int(dim), int(band)
+    if dim != n:
+        raise f.err(cm, f"dim {dim} for {n} observations", "dim")
+    words = (cm.text or "").split()
+    need = dim * (band + 1) - band * (band + 1) // 2
+    if len(words) != need:
+        raise f.err(cm, f"{len(words)} numbers for dim {dim}, band {band} (need {need})")
+    if not all(_NUM.match(w) for w in words):
+        bad = next(w for w in words if not _NUM.match(w))
+        raise f.err(cm, f"{bad!r} is not a number")
+    vals = iter(float(w) for w in words)
+    var = np.zeros(dim)
+    for r in range(dim):
+        for c in range(r, min(dim, r + band + 1)):
+            v = next(vals)
+            if c == r:
+                var[r] = v
+            elif v != 0:
+                raise f.err(
+                    cm,
+                    "correlated observations (non-zero covariance) are not supported: "
+                    "give a diagonal matrix",
+                )
+    if not np.all(np.isfinite(var) & (var > 0)):
+        raise f.err(cm, "every variance must be a positive finite number")
+    return var
+
+
+def _defaults(f: _File, po) -> dict:
+    d = {}
+    words = (po.get("distance-stdev") or "").split()
+    if len(words) > 3:
+        raise f.err(po, "takes 'a [b [c]]' (a + b D^c mm, D in km)", "distance-stdev")
+    for w in words:
+        if not _NUM.match(w) or not math.isfinite(float(w)):
+            raise f.err(po, f"{w!r} is not a number", "distance-stdev")
+    abc = [float(w) for w in words] + [0.0, 0.0, 1.0][len(words) :]
+    d["distance"] = abc if words else None
+    for k in ("direction", "angle"):
+        d[k] = f.num(po, f"{k}-stdev") if po.get(f"{k}-stdev") is not None else None
+    return d
+
+
+def _sigma(f: _File, o, default, var: float | None) -> float:
+    if var is not None:
+        return math.sqrt(var)
+    if o.get("stdev") is not None:
+        return f.num(o, "stdev", lo=0.0)
+    if default is None:
+        raise f.err(o, "no stdev and no default in <points-observations>", "stdev")
+    if default <= 0:
+        raise f.err(o, "the default stdev is not positive", "stdev")
+    return default
+
+
+def _point(f: _File, e, points: dict, datum: list) -> None:
+    pid = f.name(e, "id")
+    fix, adj = e.get("fix", "").strip(), e.get("adj", "").strip()
+    if "z" in adj.lower():
+        raise f.err(e, f"adj={adj!r}: height unknowns are not supported (2-D networks)", "adj")
+    if fix and adj and "xy" in fix.lower() and "xy" in adj.lower():
+        raise f.err(e, f"point {pid!r} is both fixed and adjusted in xy", "fix")
+    rec = points.setdefault(pid, {"name": pid})
+    if e.get("x") is not None or e.get("y") is not None:
+        xy = (f.num(e, "x") * 1000, f.num(e, "y") * 1000)
+        if "x_mm" in rec and (rec["x_mm"], rec["y_mm"]) != xy:
+            raise f.err(e, f"point {pid!r} declared twice with different coordinates", "x")
+        rec["x_mm"], rec["y_mm"] = xy
+    if e.get("z") is not None:
+        f.num(e, "z")
+    role = "fixed" if "xy" in fix.lower() else "free" if "xy" in adj.lower() else None
+    if role is not None:
+        if rec.get("role", role) != role:
+            raise f.err(e, f"point {pid!r} declared fixed and adjusted", "fix" if fix else "adj")
+        rec["role"] = role
+    if "XY" in adj and pid not in datum:
+        datum.append(pid)
+
+
+def _obs(f: _File, e, dflt: dict, sets: dict, out: list) -> None:
+    st = f.name(e, "from") if e.get("from") is not None else None
+    if e.get("orientation") is not None:
+        f.num(e, "orientation")
+    if e.get("from_dh") is not None:
+        f.num(e, "from_dh")
+    kids = list(e)
+    cms = [o for o in kids if _tag(o) == "cov-mat"]
+    obs = [o for o in kids if _tag(o) != "cov-mat"]
+    if len(cms) > 1 or (cms and kids[-1] is not cms[0]):
+        raise f.err(cms[0], "one <cov-mat> after the observations of an <obs>")
+    var = list(_cov(f, cms[0], len(obs))) if cms else [None] * len(obs)
+    label = ""
+    if any(_tag(o) == "direction" for o in obs):
+        if st is None:
+            raise f.err(e, "directions need the station", "from")
+        sets[st] = sets.get(st, 0) + 1
+        label = "" if sets[st] == 1 else str(sets[st])
+    for o, v in zip(obs, var):
+        t = _tag(o)
+        for a in ("from_dh", "to_dh", "bs_dh", "fs_dh"):
+            if o.get(a) is not None:
+                f.num(o, a)
+        if t == "distance":
+            d_m = f.num(o, "val", lo=0.0)
+            abc = dflt["distance"]
+            dd = None if abc is None else abc[0] + abc[1] * (d_m / 1000) ** abc[2]
+            rec = {"kind": "distance", "from": f.name(o, "from", st), "to": f.name(o, "to")}
+            rec["sigma_mm"] = _sigma(f, o, dd, v)
+        elif t == "direction":
+            unit = ARCSEC if f.angle(o) else CC
+            s = _sigma(f, o, dflt["direction"], v)
+            rec = {"kind": "direction", "from": st, "to": f.name(o, "to")}
+            rec["sigma_arcsec"] = s * unit / ARCSEC
+            if label:
+                rec["set"] = label
+        else:  # angle
+            unit = ARCSEC if f.angle(o) else CC
+            s = _sigma(f, o, dflt["angle"], v)
+            bs = o.get("bs", o.get("to"))
+            fs = o.get("fs", o.get("rs"))
+            if bs is None or fs is None:
+                raise f.err(o, "an angle needs bs and fs", "bs" if bs is None else "fs")
+            rec = {"kind": "angle", "at": f.name(o, "from", st), "from": bs, "to": fs}
+            rec["sigma_arcsec"] = s * unit / ARCSEC
+        out.append(rec)
+
+
+def _coordinates(f: _File, e, coords: list) -> None:
+    pts = [o for o in e if _tag(o) == "point"]
+    cms = [o for o in e if _tag(o) == "cov-mat"]
+    if len(cms) != 1:
+        raise f.err(e, "needs one <cov-mat> (the variances of x and y, mm^2)")
+    for p in pts:
+        if p.get("z") is not None or p.get("fix") or p.get("adj"):
+            raise f.err(p, "observed coordinates take id, x and y only (2-D)", "z")
+    var = _cov(f, cms[0], 2 * len(pts))
+    for a, p in enumerate(pts):
+        vx, vy = var[2 * a], var[2 * a + 1]
+        if not math.isclose(vx, vy, rel_tol=1e-9):
+            raise f.err(cms[0], f"point {p.get('id')!r}: observed x and y need one variance")
+        pid = f.name(p, "id")
+        f.num(p, "x"), f.num(p, "y")
+        coords.append((pid, math.sqrt(vx)))
+
+
+def _vectors(f: _File, e, out: list) -> None:
+    vecs = [o for o in e if _tag(o) == "vec"]
+    cms = [o for o in e if _tag(o) == "cov-mat"]
+    if len(cms) != 1:
+        raise f.err(e, "needs one <cov-mat> (the variances of dx, dy, dz, mm^2)")
+    var = _cov(f, cms[0], 3 * len(vecs))
+    for a, v in enumerate(vecs):
+        fr, to = f.name(v, "from"), f.name(v, "to")
+        for c in ("dx", "dy", "dz"):
+            f.num(v, c)
+        out.append({"kind": "dx", "from": fr, "to": to, "sigma_mm": math.sqrt(var[3 * a])})
+        out.append({"kind": "dy", "from": fr, "to": to, "sigma_mm": math.sqrt(var[3 * a + 1])})
+
+
+def read_gama(path: str | Path, key: str = "network.gama_xml") -> dict:
+    """Points and observations of a ``gama-local`` XML file as study records:
+    ``{"network.points", "network.observations", "datum.points", "note"}`` (``note``: the
+    ``<parameters>`` convention used, one sentence)."""
+    path = Path(path)
+    data = read_bytes(path, key)
+    f = _File(key, path)
+    try:
+        root = ET.fromstring(data)
+    except ET.ParseError as e:
+        raise ConfigError(key, f"{path} is not XML: {e}") from None
+    except (LookupError, ValueError) as e:  # an unknown encoding declared, undecodable bytes
+        raise ConfigError(key, f"{path} cannot be decoded: {e}") from None
+    if _tag(root) != "gama-local":
+        raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
+    f.vocab(root)
+    nets = [e for e in root if _tag(e) == "network"]
+    if len(nets) != 1:
+        raise f.err(root, f"{len(nets)} <network> elements (need one)")
+    net = nets[0]
+    if net.get("axes-xy", "ne").strip() != "ne":
+        raise f.err(net, f"{net.get('axes-xy')!r}: only 'ne' is supported", "axes-xy")
+    if net.get("angles", "left-handed").strip() != "left-handed":
+        raise f.err(net, "only left-handed angles are supported", "angles")
+    if net.get("epoch") is not None:
+        f.num(net, "epoch")
+    note = _parameters(f, [e for e in net if _tag(e) == "parameters"])
+    pos = [e for e in net if _tag(e) == "points-observations"]
+    if len(pos) != 1:
+        raise f.err(net, f"{len(pos)} <points-observations> elements (need one)")
+    po = pos[0]
+    dflt = _defaults(f, po)
+    points: dict = {}
+    obs: list = []
+    datum: list = []
+    coords: list = []
+    sets: dict = {}
+    for e in po:
+        t = _tag(e)
+        if t == "point":
+            _point(f, e, points, datum)
+        elif t == "obs":
+            _obs(f, e, dflt, sets, obs)
+        elif t == "coordinates":
+            _coordinates(f, e, coords)
+        elif t == "vectors":
+            _vectors(f, e, obs)
+        else:
+            raise f.err(e, "not allowed in <points-observations>")
+    for pid, rec in points.items():
+        if "x_mm" not in rec:
+            raise ConfigError(
+                key,
+                f"{path}: <point id={pid!r}> has no coordinates; the simulation needs every "
+                "point's coordinates",
+            )
+        if "role" not in rec:
+            raise ConfigError(key, f"{path}: <point id={pid!r}> is neither fix nor adj in xy")
+    for pid, s in coords:
+        if pid not in points:
+            raise ConfigError(
+                key, f"{path}: <coordinates>: observed coordinates of unknown point {pid!r}"
+            )
+        if points[pid]["role"] == "fixed":
+            raise ConfigError(
+                key, f"{path}: <coordinates>: point {pid!r} is fixed; observe a free point"
+            )
+        points[pid].update(role="observed", sigma_mm=s)
+    for rec in obs:
+        for fld in ("from", "to", "at"):
+            if fld in rec and rec[fld] not in points:
+                raise ConfigError(
+                    key, f"{path}: <{rec['kind']}> {fld}={rec[fld]!r}: no such <point>"
+                )
+    return {
+        "network.points": list(points.values()),
+        "network.observations": obs,
+        "datum.points": datum,
+        "note": note,
+    }
+
+
+def _parameters(f: _File, pars: list) -> str:
+    if len(pars) > 1:
+        raise f.err(pars[1], "given twice")
+    p = pars[0] if pars else None
+    if p is not None:
+        for a, lo in (("sigma-apr", 0.0), ("tol-abs", 0.0)):
+            if p.get(a) is not None:
+                f.num(p, a, lo=lo)
+        if p.get("conf-pr") is not None:
+            c = f.num(p, "conf-pr", lo=0.0)
+            if c >= 1:
+                raise f.err(p, f"{c:g} must be below 1", "conf-pr")
+        if p.get("cov-band") is not None:
+            c = f.num(p, "cov-band")
+            if not c.is_integer() or c < -1:
+                raise f.err(p, f"{c:g} must be an integer >= -1", "cov-band")
+        if p.get("latitude") is not None:
+            f.angle(p, "latitude")
+    act = "aposteriori" if p is None else p.get("sigma-act", "aposteriori").strip()
+    if act == "apriori":
+        return "sigma-act = apriori, as this study: the stdevs are the observations' sigmas"
+    return (
+        "the file asks for sigma-act = aposteriori (gama-local's default); this study uses "
+        "the a-priori stdevs (a pre-analysis has no residuals)"
+    )
