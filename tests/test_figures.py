@@ -50,6 +50,8 @@ KNOWN = {
     "agnard_block": {"scanner_field.png", "consistent_set.png", "tradeoffs.png"},
     "network": {"reliability.png", "network.png"},
 }
+for _study in set(KNOWN) - {"network"}:  # the region figures belong to the inference helpers
+    KNOWN[_study] |= {"consistent_region.png"}
 
 
 def _old_sweep_figure():
