@@ -1,32 +1,49 @@
-"""Command line: ``sim run STUDY.toml``, ``sim check STUDY.toml``, ``sim report``.
+"""sim: Monte-Carlo checks of classic comparator and plotter calibration papers.
+
+Commands:
+  sim run STUDY.toml      run a study; prints its verdicts and writes DIR/README.md
+  sim show DIR            print one results directory (--markdown: its README.md)
+  sim check STUDY.toml    validate a study file; print each key, its meaning and the work
+  sim report              rebuild results/REPORT.md and every results/<study>/README.md
 
 Bad input (a bad study file, a bad override or option, an output path the suite did not
 write, a run that fails on its numbers) gives one line on standard error naming the problem
 and exit code 2, never a traceback. What the suite did not write is never deleted or
-replaced: ``--out`` must be a new path, an empty directory, or a results directory of an
-earlier run (its ``run.json``). A run works in a locked staging directory
-``.<out>.partial/`` that replaces ``<out>`` only when everything succeeded.
+replaced: --out must be a new path, an empty directory, or a results directory of an
+earlier run (its run.json). A run works in a locked staging directory .<out>.partial/ that
+replaces <out> only when everything succeeded. Without --out a run writes into
+results/<study>/ only when its config and code are those of the committed results there;
+any other run goes to scratch/<study>-<config hash>/ and says so (make reproduce and
+make rerun pass --out results/<study>).
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
 import os
 import re
 import signal
 import sys
+from importlib import metadata
 from pathlib import Path
 
 from sim.execute import execute
-from sim.mc.config import ConfigError, StudyError
+from sim.mc.config import ConfigError, StudyError, parse_override
+from sim.mc.estimate import estimate
+from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import read_sweep
 from sim.report.markdown import write_report
+from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.studies import get_study, load_study
 
 __all__ = ["main"]
 
 #: exit code of an internal error (a bug, not bad input): one line, traceback with SIM_DEBUG=1
 INTERNAL = 3
+#: chunks a run gets when --trials picks the chunk size (the intervals are taken over chunks)
+MIN_CHUNKS = 20
 
 
 class _Parser(argparse.ArgumentParser):
@@ -36,20 +53,49 @@ class _Parser(argparse.ArgumentParser):
         raise ConfigError(None, f"{self.prog}: {message} (see {self.prog} --help)")
 
 
+def _version() -> str:
+    try:
+        return metadata.version("sim")
+    except metadata.PackageNotFoundError:  # a source tree that was never installed
+        return "unknown"
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="sim", description=__doc__.splitlines()[0])
-    sub = p.add_subparsers(dest="cmd", required=True)
-    r = sub.add_parser("run", help="run a study and write its results directory")
+    p = _Parser(
+        prog="sim",
+        description=__doc__.split("\n\n")[0],
+        epilog="\n\n".join(__doc__.split("\n\n")[1:2]) + "\n\nsim COMMAND --help: its options.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--version", action="version", version=f"sim {_version()}")
+    sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+    r = sub.add_parser(
+        "run",
+        help="run a study, print its verdicts, write its results directory",
+        description="Run a study file and write its results directory (Parquet tables, "
+        "figures, README.md); print the verdict counts and the headline claims at the end.",
+    )
     r.add_argument("study", help="study file, e.g. studies/brown_dilution.toml")
-    r.add_argument("--out", help="output directory (default results/<study>)")
-    r.add_argument("--trials", type=int, help="override the number of Monte-Carlo trials")
+    r.add_argument(
+        "--out",
+        help="output directory (default: results/<study> when the run equals the committed "
+        "results, else scratch/<study>-<config hash>)",
+    )
+    r.add_argument(
+        "--trials",
+        type=int,
+        help=f"number of Monte-Carlo trials; also picks a chunk size giving at least "
+        f"{MIN_CHUNKS} chunks unless --chunk or chunk= is given",
+    )
+    r.add_argument("--chunk", type=int, help="trials per chunk (the intervals are over chunks)")
     r.add_argument("--seed", type=int, help="override the root seed")
     r.add_argument(
         "--set",
         action="append",
         default=[],
         metavar="KEY=VALUE",
-        help="override any config key with its dotted name (repeatable)",
+        help="override any config key by its dotted name, value read as TOML (repeatable); "
+        "sim check STUDY.toml lists the keys",
     )
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument(
@@ -81,11 +127,29 @@ def _parser() -> argparse.ArgumentParser:
         default=None,
         help="refuse a run with more least-squares adjustments than this (env SIM_MAX_ADJUSTMENTS)",
     )
-    c = sub.add_parser("check", help="validate a study file and print the resolved config")
-    c.add_argument("study")
+    sh = sub.add_parser(
+        "show",
+        help="print one results directory: its claims and verdicts",
+        description="Print the claims of one results directory (a table; --markdown: its "
+        "README.md). DIR may also be a study name under results/.",
+    )
+    sh.add_argument("dir", metavar="DIR", help="a results directory, e.g. results/brown_table1")
+    sh.add_argument("--markdown", action="store_true", help="print the directory's README.md")
+    c = sub.add_parser(
+        "check",
+        help="validate a study file; print each key with its meaning, unit, bounds and the work",
+        description="Validate a study file (and overrides) and print every key with its "
+        "resolved value, meaning, unit and bounds, then the work the run would do.",
+    )
+    c.add_argument("study", help="study file, e.g. studies/brown_dilution.toml")
     c.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    rep = sub.add_parser("report", help="rebuild results/REPORT.md from the Parquet files")
-    rep.add_argument("--results", default="results")
+    rep = sub.add_parser(
+        "report",
+        help="rebuild results/REPORT.md and each results/<study>/README.md from the Parquet files",
+        description="Rebuild REPORT.md and each results directory's README.md from the "
+        "Parquet files alone (nothing is run).",
+    )
+    rep.add_argument("--results", default="results", help="the results directory (default results)")
     return p
 
 
@@ -119,26 +183,150 @@ def _check_args(args) -> Path:
     return Path(os.path.abspath(args.out)) if args.out else None
 
 
+def _keys_set(overrides: list[str]) -> set[str]:
+    keys = set()
+    for text in overrides:
+        try:
+            keys.add(parse_override(text)[0])
+        except ConfigError:
+            pass  # load_study names the bad override
+    return keys
+
+
+def _load(args):
+    """The study and its resolved config. ``--trials`` (or ``--set trials=``) without a chunk
+    size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it."""
+    overrides = list(args.set) + ([f"chunk={args.chunk}"] if args.chunk is not None else [])
+    study, cfg = load_study(args.study, overrides, args.trials, args.seed)
+    given = _keys_set(args.set)
+    trials_given = args.trials is not None or "trials" in given
+    if trials_given and args.chunk is None and "chunk" not in given and "chunk" in cfg:
+        chunk = max(1, cfg["trials"] // MIN_CHUNKS)
+        if cfg["chunk"] > chunk:
+            study, cfg = load_study(
+                args.study, [*overrides, f"chunk={chunk}"], args.trials, args.seed
+            )
+    return study, cfg
+
+
+def _config_tag(record: dict) -> str:
+    text = json.dumps(record["config"], sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:8]
+
+
+def _differs(old: dict, record: dict) -> str:
+    """What differs between a committed run record and this run's, in a few words."""
+    a, b = old.get("config") or {}, record["config"]
+    keys = [k for k in dict.fromkeys([*a, *b]) if a.get(k) != b.get(k)]
+    if keys:
+        shown = ", ".join(f"{k} {a.get(k)!r} -> {b.get(k)!r}" for k in keys[:3])
+        return f"its config differs ({shown}{', ...' if len(keys) > 3 else ''})"
+    return "the code changed since they were made"
+
+
+def _default_out(cfg: dict, sweep: dict) -> tuple[Path, str, bool]:
+    """Without --out: ``results/<study>`` when it holds this very run (config and code) or
+    does not exist, else ``scratch/<study>-<config hash>`` (said on standard error). Returns
+    ``(absolute path, shown path, overwrite)``; a scratch directory is replaced freely."""
+    committed = Path("results") / cfg["study"]
+    record = {
+        "config": {**cfg, "sweep": sweep} if sweep else cfg,
+        "code_hash": code_hash(cfg["study"]),
+    }
+    old = read_record(committed)
+    if not committed.exists() or (
+        old is not None
+        and old.get("config") == record["config"]
+        and old.get("code_hash") == record["code_hash"]
+    ):
+        return Path(os.path.abspath(committed)), str(committed), False
+    scratch = Path("scratch") / f"{cfg['study']}-{_config_tag(record)}"
+    why = _differs(old, record) if old is not None else "it is not a results directory of sim"
+    print(
+        f"sim: {committed}/ holds the committed results and {why}: writing to {scratch}/ "
+        "(--out DIR to choose; make reproduce rewrites results/)",
+        file=sys.stderr,
+    )
+    return Path(os.path.abspath(scratch)), str(scratch), True
+
+
 def _run(args) -> int:
     out = _check_args(args)
-    study, cfg = load_study(args.study, args.set, args.trials, args.seed)
-    shown = args.out if args.out else str(Path("results") / cfg["study"])
+    study, cfg = _load(args)
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
+    overwrite = args.overwrite
+    if out is None:
+        out, shown, scratch = _default_out(cfg, sweep)
+        overwrite = overwrite or scratch
+    else:
+        shown = args.out
     execute(
         study,
         cfg,
         sweep,
-        out or Path(os.path.abspath(shown)),
+        out,
         shown,
         executor=args.executor,
         workers=args.workers,
         scheduler=args.scheduler,
-        overwrite=args.overwrite,
+        overwrite=overwrite,
         quiet=args.quiet,
         max_memory_gb=args.max_memory_gb,
         max_adjustments=args.max_adjustments,
     )
+    try:
+        write_run_readme(out, get_study)
+        summary = terminal_summary(out, shown=shown)
+    except (OSError, ValueError, KeyError) as e:  # the results stand; only their summary failed
+        summary = f"(no summary: {type(e).__name__}: {e})".splitlines()[0]
     print(f"{cfg['study']}: results in {shown}/")
+    if not args.quiet:
+        print(summary)
+    return 0
+
+
+def _show(args) -> int:
+    d = Path(args.dir)
+    if not d.exists() and (Path("results") / args.dir).is_dir():
+        d = Path("results") / args.dir
+    if not d.is_dir():
+        raise ConfigError("DIR", f"{args.dir} is not a directory")
+    print(run_markdown(d, get_study) if args.markdown else terminal_table(d), end="")
+    print("" if args.markdown else "\n", end="")
+    return 0
+
+
+def _n(x: float) -> str:
+    return f"{int(x):_}" if float(x).is_integer() and abs(x) < 1e16 else f"{x:g}"
+
+
+def _bounds(f) -> str:
+    if f.choices:
+        return "one of " + ", ".join(map(str, f.choices))
+    if f.lo is None and f.hi is None:
+        return ""
+    lo = "" if f.lo is None else (f"> {_n(f.lo)}" if f.lo_open else f">= {_n(f.lo)}")
+    hi = "" if f.hi is None else f"<= {_n(f.hi)}"
+    return ", ".join(x for x in (lo, hi) if x)
+
+
+def _check(args) -> int:
+    study, cfg = load_study(args.study, args.set)
+    sweep = read_sweep(args.study, study.schema)
+    print(f"# {cfg['study']}: {study.title}")
+    for k, v in cfg.items():
+        f = study.schema.get(k)
+        if f is None:
+            print(f"{k} = {v!r}")
+            continue
+        unit = f.unit or ""
+        notes = "; ".join(
+            x for x in (unit and f"unit {unit}", _bounds(f), "paper input" if f.input else "") if x
+        )
+        print(f"{k} = {v!r}  # {f.doc}" + (f" ({notes})" if notes else ""))
+    if sweep:
+        print(f"# [sweep] {', '.join(sweep)}")
+    print(f"# work: {estimate(cfg, sweep).describe()}")
     return 0
 
 
@@ -147,6 +335,22 @@ def _on_sigterm(signum, frame):
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        if not argv:  # usage, not an error message
+            _parser().print_help()
+            return 2
+        return _main(argv)
+    except BrokenPipeError:  # sim check ... | head: the reader left, nothing to say
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        return 141
+
+
+def _main(argv: list[str]) -> int:
     try:
         args = _parser().parse_args(argv)
         if args.cmd == "run":
@@ -154,10 +358,9 @@ def main(argv: list[str] | None = None) -> int:
                 signal.signal(signal.SIGTERM, _on_sigterm)  # clean up like Ctrl-C
             return _run(args)
         if args.cmd == "check":
-            _, cfg = load_study(args.study, args.set)
-            for k, v in cfg.items():
-                print(f"{k} = {v!r}")
-            return 0
+            return _check(args)
+        if args.cmd == "show":
+            return _show(args)
         if args.cmd == "report":
             print(write_report(Path(args.results), get_study))
             return 0
@@ -170,6 +373,8 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 130
+    except BrokenPipeError:
+        raise
     except OSError as e:  # a failing write (full disk, vanished directory): one line, no traceback
         print(
             f"sim: error: {e.strerror or e}: {getattr(e, 'filename', '') or ''}".rstrip(": "),

@@ -14,6 +14,7 @@ error amplitude); the report lists them so nobody mistakes them for predictions.
 
 from __future__ import annotations
 
+import difflib
 import math
 import tomllib
 from dataclasses import dataclass
@@ -27,6 +28,7 @@ __all__ = [
     "parse_override",
     "validate",
     "check_chunks",
+    "did_you_mean",
 ]
 
 
@@ -144,6 +146,18 @@ def flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
     return out
 
 
+def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
+    """The schema keys a mistyped ``key`` most likely meant (at most ``n``): the key with a
+    unit suffix (``comparator.beta`` -> ``comparator.beta_mm``), the same last part under
+    another table, or the closest spellings (difflib)."""
+    names = list(schema)
+    suffixed = [s for s in names if s.startswith(key + "_") and "." not in s[len(key) :]]
+    last = key.split(".")[-1]
+    same_last = [s for s in names if s.split(".")[-1] == last]
+    close = difflib.get_close_matches(key, names, n=n, cutoff=0.75)
+    return list(dict.fromkeys(suffixed + same_last + close))[:n]
+
+
 def validate(
     raw: Mapping[str, Any], schema: Mapping[str, Field], check: Callable[[dict], None] | None = None
 ) -> dict[str, Any]:
@@ -154,8 +168,8 @@ def validate(
     """
     for key in raw:
         if key not in schema:
-            near = [s for s in schema if s.split(".")[-1] == key.split(".")[-1]]
-            hint = f" (did you mean {near[0]}?)" if near else ""
+            near = did_you_mean(key, schema)
+            hint = f" (did you mean {' or '.join(near)}?)" if near else ""
             raise ConfigError(key, f"unknown key{hint}")
     cfg = {}
     for key, f in schema.items():

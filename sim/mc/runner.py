@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import io
 import json
+import logging
 import os
 import pickle
 import signal
@@ -269,7 +270,10 @@ class _Dask:
                 n_workers=max(workers, 1),
                 threads_per_worker=1,
                 processes=True,
-                dashboard_address=None,
+                # ":0": a free port, never the "Port 8787 is already in use" warning (None
+                # still means the default 8787); the nanny's closing chatter is not for users
+                dashboard_address=":0",
+                silence_logs=logging.ERROR,
             )
             self.client = Client(self.cluster)
 

@@ -15,7 +15,9 @@ import pyarrow as pa
 
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_table
-from sim.report.sweep import sweep_markdown
+from sim.report.claimtext import interval_text, ref_text, sim_text
+from sim.report.papers import paper_name
+from sim.report.run_summary import headline_rows, region_line, verdict_line, write_run_readme
 from sim.report.tables import fmt, md_table
 from sim.report.verify import markdown as reproducibility_markdown
 
@@ -45,41 +47,6 @@ _VERDICT_TEXT = {
     "finding": "finding",
     "not comparable": "not comparable",
 }
-
-
-def _ref_text(r) -> str:
-    """The paper's reference as the decision zone it stands for."""
-    lo, hi = r.get("zone_low"), r.get("zone_high")
-    none = lambda x: x is None or (isinstance(x, float) and not math.isfinite(x))  # noqa: E731
-    if none(lo) and none(hi):
-        return ""
-    f = (lambda x: f"{x:.10g}") if r["interval"] == "exact" else (lambda x: fmt(x, 4))  # noqa: E731
-    form = r.get("form") or ""
-    if form == "upper" or none(lo):
-        return f"≤ {f(hi)}"
-    if form == "lower" or none(hi):
-        return f"≥ {f(lo)}"
-    return f(lo) if lo == hi else f"{f(lo)}–{f(hi)}"
-
-
-def _sim_text(r) -> str:
-    val = f"{r['value']:.10g}" if r["interval"] == "exact" else fmt(r["value"])
-    vh = r.get("value_high")
-    if vh is not None and math.isfinite(vh):
-        val += f"–{fmt(vh)}"
-    return val
-
-
-def _interval_text(r) -> str:
-    if r["interval"] == "exact":
-        return "exact"
-    out = f"[{fmt(r['ci_low'])}, {fmt(r['ci_high'])}]" + (
-        " plates" if r["interval"] == "spread" else ""
-    )
-    p = r.get("p_plate")
-    if p is not None and math.isfinite(p):
-        out += f", p = {fmt(p, 2)}"
-    return out
 
 
 def number(x):
@@ -130,7 +97,7 @@ def claims_markdown(path: Path) -> str:
         if r["verdict"] == "not comparable":
             sim, ci = "", ""
         else:
-            sim, ci = _sim_text(r), _interval_text(r)
+            sim, ci = sim_text(r), interval_text(r)
         verdict = _VERDICT_TEXT.get(r["verdict"], r["verdict"])
         if r["kind"] in ("input", "self-check") and r.get("outcome"):
             verdict += f" ({r['outcome']})"
@@ -139,7 +106,7 @@ def claims_markdown(path: Path) -> str:
                 f"`{r['claim']}`",
                 r["paper"],
                 r.get("form") or "",
-                _ref_text(r),
+                ref_text(r),
                 sim,
                 ci,
                 verdict,
@@ -233,38 +200,103 @@ _COUNT_COLS = [
 ]
 
 
-def referee_summary(entries: list[tuple]) -> str:
-    """Per paper: the headline claims with their verdicts, then counts per verdict class."""
+def _headline_pick(studies: list[tuple], n: int = 3) -> list[tuple]:
+    """Up to ``n`` headline claims of one paper: one per study in turn, each in its claim
+    book's order. ``studies``: ``[(dir name, study, claims)]``."""
+    queues = [[(name, r) for r in headline_rows(claims)] for name, _, claims in studies]
+    out: list[tuple] = []
+    while len(out) < n and any(queues):
+        for q in queues:
+            if q and len(out) < n:
+                out.append(q.pop(0))
+    return out
+
+
+def _sig3(r: dict) -> str:
+    """A claim's simulated value at 3 significant digits (a range as low-high)."""
+    if r["verdict"] == "not comparable":
+        return ""
+    v = fmt(r["value"], 3)
+    vh = r.get("value_high")
+    if vh is not None and isinstance(vh, float) and math.isfinite(vh) and vh != r["value"]:
+        v += f"–{fmt(vh, 3)}"
+    if r["interval"] != "exact" and number(r.get("ci_low")) is not None:
+        v += f" [{fmt(r['ci_low'], 3)}, {fmt(r['ci_high'], 3)}]"
+    return v
+
+
+def _by_paper(entries: list[tuple]) -> dict[str, list]:
     by_seed: dict[str, list] = {}
     for _, name, study, claims, _ in entries:
-        if not study.seed_file:  # a user's network: no paper to referee
-            continue
-        by_seed.setdefault(study.seed_file, []).append((name, study, claims))
+        by_seed.setdefault(study.seed_file or "", []).append((name, study, claims))
+    return by_seed
+
+
+def opening(entries: list[tuple], results: Path) -> str:
+    """One screen: per paper, its studies (linked to their README.md), the verdict counts
+    and three headline verdicts at 3 significant digits; the consistent region's line where
+    a study has one; the network studies (no paper) with their counts."""
+    rows, notes = [], []
+    by_seed = _by_paper(entries)
+    for seed in sorted(s for s in by_seed if s):
+        studies = by_seed[seed]
+        links = ", ".join(f"[{name}]({name}/README.md)" for name, _, _ in studies)
+        counts = verdict_line([r for _, _, c in studies for r in c])
+        picks = _headline_pick(studies)
+        first = [f"**{paper_name(seed)}** ({links})", counts.split(": ", 1)[1]]
+        for j, (name, r) in enumerate(picks or [("", None)]):
+            cells = first if j == 0 else ["", ""]
+            if r is None:
+                rows.append(cells + ["_no headline claim_", "", ""])
+            else:
+                rows.append(
+                    cells
+                    + [f"`{r['claim']}`", _sig3(r), _VERDICT_TEXT.get(r["verdict"], r["verdict"])]
+                )
+        for name, _, _ in studies:
+            if (reg := region_line(results / name)) is not None:
+                notes.append(f"- `{name}`: {reg}")
+    nets = by_seed.get("", [])
+    if nets:
+        notes.append(
+            "- Network studies (a declared network, no paper): "
+            + "; ".join(
+                f"[{name}]({name}/README.md) {verdict_line(c).split(': ', 1)[1]}"
+                for name, _, c in nets
+            )
+        )
+    table = md_table(
+        ["paper (studies)", "verdicts", "headline claim", "simulated [95%]", "verdict"], rows
+    )
+    return "\n".join(["## The verdicts at a glance", "", table, "", *notes, ""])
+
+
+def referee_summary(entries: list[tuple]) -> str:
+    """Per paper: every headline claim with the paper's words, the decision zone, the
+    simulated value (at the precision its interval supports), the interval and the verdict."""
+    by_seed = _by_paper(entries)
     parts = [
-        "## Referee's summary\n",
-        "Each claim is decided by its stated rule (see *How verdicts are decided* below). "
-        "Predictions are counted apart from inputs (set to match the paper), self-checks "
-        "(Monte Carlo against analytic, coverage, posterior against least squares), paper "
-        "checks (the paper's printed numbers recomputed from its own printed data: a "
-        "disagreement is an *erratum*) and findings (no paper number).\n",
+        "## Every headline claim\n",
+        "Each claim is decided by its stated rule (see *How verdicts are decided* below); "
+        "the detail of each study is in its directory's README.md.\n",
     ]
-    for seed in sorted(by_seed):
+    for seed in sorted(s for s in by_seed if s):
         rows = []
         for name, study, claims in by_seed[seed]:
-            for r in claims:
-                if r.get("headline"):
-                    rows.append(
-                        [
-                            f"[`{r['claim']}`](#{name})",
-                            r["paper"],
-                            _ref_text(r),
-                            "" if r["verdict"] == "not comparable" else _sim_text(r),
-                            "" if r["verdict"] == "not comparable" else _interval_text(r),
-                            _VERDICT_TEXT.get(r["verdict"], r["verdict"]),
-                        ]
-                    )
+            for r in headline_rows(claims):
+                nc = r["verdict"] == "not comparable"
+                rows.append(
+                    [
+                        f"[`{r['claim']}`]({name}/README.md)",
+                        r["paper"],
+                        ref_text(r),
+                        "" if nc else sim_text(r),
+                        "" if nc else interval_text(r),
+                        _VERDICT_TEXT.get(r["verdict"], r["verdict"]),
+                    ]
+                )
         titles = "; ".join(study.title for _, study, _ in by_seed[seed])
-        parts.append(f"**`{seed}`** ({titles})\n")
+        parts.append(f"**{paper_name(seed, full=True)}** ({titles})\n")
         parts.append(
             md_table(
                 [
@@ -298,96 +330,86 @@ def _claims_of(d: Path, get_study: Callable):
     return get_study(prov["study"]), prov, claims
 
 
+_RULES = (
+    "### How verdicts are decided\n\n"
+    "Each claim declares its *form* and the half-width that decides (`tol`); the *decision "
+    "zone* is the interval the paper's printed number stands for (its rounding) widened by "
+    "that tolerance. For a value, share, count or bound the claim **holds** when the 95 % "
+    "interval of the simulated value lies inside the zone, **fails** when the two do not "
+    "meet, and is **inconclusive** otherwise (the interval covers both agreeing and "
+    'contradicting values). A *range* ("from 5 to 15 %") holds when every element\'s '
+    "interval lies inside it and fails when some element's interval lies wholly outside. "
+    "A *one-plate* statistic (the paper's one plate) fails when fewer than 5 % of "
+    "simulated plates are at least as extreme (`p < 0.05`) and holds when, besides, the "
+    "central 95 % of simulated plates lies inside the zone. A prediction decided over a "
+    "study's consistent region (the unprinted inputs the paper's statements leave) "
+    "**holds** or **fails** when it does so everywhere in the region, **depends** when it "
+    "holds in one part and fails in another, and is **undecidable** when no input of the "
+    "region decides it. A paper check whose recomputation from the paper's own printed data "
+    "fails is an **erratum**. Numbers are printed at the precision their interval supports "
+    "(two significant digits of its half-width).\n\n"
+)
+
+
+def _entry(d: Path, get_study: Callable) -> tuple:
+    study, prov, claims = _claims_of(d, get_study)
+    c = verdict_counts(claims)
+    nr = d / "not_reproduced.parquet"
+    n_nr = read_table(nr).num_rows if nr.is_file() else 0
+    row = [f"[{d.name}]({d.name}/README.md): {study.title}", paper_name(study.seed_file) or "—"]
+    row += [c[k] for k, _ in _COUNT_COLS]
+    if c["self-check failed"]:
+        row[2 + [k for k, _ in _COUNT_COLS].index("self-check")] = (
+            f"{c['self-check']} ({c['self-check failed']} failed)"
+        )
+    row += [n_nr, prov.get("git_commit", "")[:12]]
+    return (study.order, d.name, study, claims, row)
+
+
 def build_report(results: Path, get_study: Callable) -> str:
-    """The report of every results directory under ``results``; ``get_study(name)`` gives the
-    registered study (its title, seed file, order and ``report`` section)."""
+    """The suite's report over every results directory under ``results``: one screen of
+    verdicts per paper, every headline claim, the counts per study, the rules, the
+    reproducibility check, and links to each directory's README.md (the detail).
+    ``get_study(name)`` gives the registered study (title, seed file, order)."""
     results = Path(results)
     if not results.is_dir():
         raise ConfigError("--results", f"{results} is not a results directory")
-    sections = []
-    entries = []
-    for d in sorted(p for p in results.iterdir() if (p / "claims.parquet").is_file()):
-        study, prov, claims = _claims_of(d, get_study)
-        c = verdict_counts(claims)
-        nr = d / "not_reproduced.parquet"
-        n_nr = read_table(nr).num_rows if nr.is_file() else 0
-        row = [f"[{study.title}](#{d.name})", f"`{study.seed_file}`" if study.seed_file else "—"]
-        row += [c[k] for k, _ in _COUNT_COLS]
-        if c["self-check failed"]:
-            row[2 + [k for k, _ in _COUNT_COLS].index("self-check")] = (
-                f"{c['self-check']} ({c['self-check failed']} failed)"
-            )
-        row += [n_nr, prov.get("git_commit", "")[:12]]
-        entries.append((study.order, d.name, study, claims, row))
-        body = study.report(d)
-        sections.append(
-            (
-                study.order,
-                d.name,
-                f'<a id="{d.name}"></a>\n\n## {study.title}\n\nStudy `{d.name}` '
-                + (
-                    f"(seed paper `{study.seed_file}`)"
-                    if study.seed_file
-                    else "(a declared network, no seed paper)"
-                )
-                + f", results in `{d.name}/`.\n\n{body}\n",
-            )
-        )
-    for d in sorted(
-        p
+    entries = [
+        _entry(d, get_study)
+        for d in sorted(p for p in results.iterdir() if (p / "claims.parquet").is_file())
+    ]
+    entries.sort(key=lambda e: (e[0], e[1]))
+    sweeps = sorted(
+        p.name
         for p in results.iterdir()
         if (p / "sweep.parquet").is_file() and not (p / "claims.parquet").is_file()
-    ):
-        prov = read_provenance(d / "sweep.parquet")
-        study = get_study(prov["study"])
-        sections.append(
-            (
-                study.order + 1,
-                d.name,
-                f'<a id="{d.name}"></a>\n\n## Sweep: {study.title}\n\nSweep `{d.name}` over '
-                f"study `{prov['study']}`, results in `{d.name}/`.\n\n"
-                f"{sweep_markdown(d, d.name)}\n",
-            )
-        )
-    entries.sort(key=lambda e: (e[0], e[1]))
-    sections.sort()
+    )
     head = (
         "# Reproducibility report\n\n"
         "Every number below was produced by a run of the code (`make reproduce`); paper values "
-        "appear only as the reference of a claim. This file is rebuilt from the Parquet files "
-        "alone by `sim report`.\n\n"
-    )
-    rules = (
-        "### How verdicts are decided\n\n"
-        "Each claim declares its *form* and the half-width that decides (`tol`); the *decision "
-        "zone* is the interval the paper's printed number stands for (its rounding) widened by "
-        "that tolerance. For a value, share, count or bound the claim **holds** when the 95 % "
-        "interval of the simulated value lies inside the zone, **fails** when the two do not "
-        "meet, and is **inconclusive** otherwise (the interval covers both agreeing and "
-        'contradicting values). A *range* ("from 5 to 15 %") holds when every element\'s '
-        "interval lies inside it and fails when some element's interval lies wholly outside. "
-        "A *one-plate* statistic (the paper's one plate) fails when fewer than 5 % of "
-        "simulated plates are at least as extreme (`p < 0.05`) and holds when, besides, the "
-        "central 95 % of simulated plates lies inside the zone. A paper check whose "
-        "recomputation from the paper's own printed data fails is an **erratum**.\n\n"
+        "appear only as the reference of a claim. Rebuilt from the Parquet files alone by "
+        "`sim report`; each study's detail is its directory's README.md.\n\n"
     )
     table = md_table(
-        ["study", "seed"] + [t for _, t in _COUNT_COLS] + ["not reproduced", "code commit"],
+        ["study", "paper"] + [t for _, t in _COUNT_COLS] + ["not reproduced", "code commit"],
         [e[4] for e in entries],
     )
-    summary = referee_summary(entries)
     repro = reproducibility_markdown(results)
-    repro = "\n" + repro if repro else ""
+    details = [f"- [{e[1]}]({e[1]}/README.md): {e[2].title}" for e in entries]
+    details += [f"- [{s}]({s}/README.md): a sweep" for s in sweeps]
     return (
         head
-        + summary
+        + opening(entries, results)
+        + "\n"
+        + referee_summary(entries)
         + "\n### Counts per study\n\n"
         + table
         + "\n\n"
-        + rules
-        + repro
+        + _RULES
+        + ("\n" + repro if repro else "")
+        + "\n## The studies in detail\n\n"
+        + "\n".join(details)
         + "\n"
-        + "\n".join(s[2] for s in sections)
     )
 
 
@@ -406,14 +428,19 @@ def _ours(path: Path) -> bool:
 
 
 def write_report(results: Path, get_study: Callable) -> Path:
-    """Write ``results/REPORT.md``; a REPORT.md there that the suite did not write is refused
-    (one line naming it), never replaced."""
-    out = Path(results) / "REPORT.md"
+    """Write each results directory's README.md (see
+    :func:`sim.report.run_summary.write_run_readme`) and ``results/REPORT.md``; a REPORT.md
+    there that the suite did not write is refused (one line naming it), never replaced."""
+    results = Path(results)
+    out = results / "REPORT.md"
     if out.is_symlink() or (out.exists() and not _ours(out)):
         raise ConfigError(
             "--results", f"{out} was not written by sim report; sim never replaces it"
         )
     text = MARK + "\n" + build_report(results, get_study)
+    for d in sorted(results.iterdir()):
+        if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
+            write_run_readme(d, get_study)
     with atomic_path(out) as tmp:
         tmp.write_text(text)
     return out

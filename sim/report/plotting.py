@@ -1,8 +1,14 @@
-"""Matplotlib set-up shared by all figures: Agg backend, deterministic PNG output."""
+"""Matplotlib set-up shared by all figures: Agg backend, deterministic PNG output, and the
+layout check a figure can run on itself before it is saved (:func:`layout_problems`: text
+over text, text over a data area, additive offset tick labels, missing titles, axis labels
+or units), which the tests run on every figure a study draws (:func:`checking_figures`)."""
 
 from __future__ import annotations
 
+import re
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Callable, Iterator
 
 import matplotlib
 
@@ -11,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from sim.mc.storage import atomic_path  # noqa: E402
 
-__all__ = ["plt", "save"]
+__all__ = ["plt", "save", "layout_problems", "checking_figures", "UNITLESS"]
 
 plt.rcParams.update(
     {
@@ -25,9 +31,194 @@ plt.rcParams.update(
 )
 
 
+#: words that mark an axis label as a dimensionless quantity (no unit needed)
+UNITLESS = (
+    "ratio",
+    "count",
+    "number",
+    "share",
+    "proportion",
+    "probability",
+    "fraction",
+    "rate",
+    "trials",
+    "points",
+    "index",
+    "degree",
+    "sets",
+    "cells",
+    "density",
+    "frequency",
+    "coverage",
+    "factor",
+    "speedup",
+    "dilution",
+    "p-value",
+    "chi",
+    "sigma0",
+    "σ0",
+    "z-score",
+    "order",
+    "rank",
+    "claim",
+    "step",
+    "iteration",
+    "plates",
+    "samples",
+    " per ",
+    "readings",
+    "observation",
+)
+_UNIT = re.compile(r"\(.+\)|\[.+\]|%|/|(?:\b|_)(mm2?|um|µm|m|cm|s|ppm|pct|arcsec|gon|deg|rad|px)\b")
+_NUMBER = re.compile(r"^[\s$]*[-−+]?[\d.,]*\d(?:[eE][-−+]?\d+)?\s*(?:%|°|×10.*)?[\s$]*$")
+_SLACK = 1.0  # pixels two boxes may share before they overlap
+
+
+def _texts(fig, renderer) -> list[tuple[str, object, str]]:
+    """``(what, Text, role)`` of every visible, non-empty text: role ``layout`` (titles, axis
+    and tick labels, figure texts: placed by the layout, outside any data area) or ``label``
+    (legend entries and texts placed in the data)."""
+    out = []
+
+    def add(what, t, role):
+        if t is not None and t.get_visible() and t.get_text().strip():
+            out.append((what, t, role))
+
+    add("suptitle", getattr(fig, "_suptitle", None), "layout")
+    add("supxlabel", getattr(fig, "_supxlabel", None), "layout")
+    add("supylabel", getattr(fig, "_supylabel", None), "layout")
+    for t in fig.texts:
+        add("figure text", t, "layout")
+    for i, ax in enumerate(fig.axes):
+        if not ax.get_visible():
+            continue
+        for t in (ax.title, ax._left_title, ax._right_title):
+            add(f"axes {i} title", t, "layout")
+        add(f"axes {i} x label", ax.xaxis.label, "layout")
+        add(f"axes {i} y label", ax.yaxis.label, "layout")
+        for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+            lo, hi = sorted(axis.get_view_interval())
+            for loc, t in zip(axis.get_majorticklocs(), axis.get_majorticklabels()):
+                if lo - 1e-9 * (abs(lo) + abs(hi)) <= loc <= hi + 1e-9 * (abs(lo) + abs(hi)):
+                    add(f"axes {i} {name} tick label", t, "layout")
+        leg = ax.get_legend()
+        if leg is not None and leg.get_visible():
+            for t in leg.get_texts():
+                add(f"axes {i} legend", t, "label")
+            add(f"axes {i} legend title", leg.get_title(), "label")
+        for t in ax.texts:
+            add(f"axes {i} text", t, "label")
+    return out
+
+
+def _overlap(a, b, slack: float = _SLACK) -> bool:
+    return min(a.x1, b.x1) - max(a.x0, b.x0) > slack and min(a.y1, b.y1) - max(a.y0, b.y0) > slack
+
+
+def _has_data(ax) -> bool:
+    return bool(ax.lines or ax.collections or ax.images or ax.patches or ax.containers)
+
+
+def _labels_problems(fig) -> list[str]:
+    """Titles, axis labels and units: each rectilinear axes with data has a title (or the
+    figure a suptitle), and an x and y label (or a neighbour in its column/row has one) that
+    names a unit or a dimensionless quantity."""
+    probs = []
+    axes = [a for a in fig.axes if a.get_visible() and a.name == "rectilinear" and _has_data(a)]
+    sup = getattr(fig, "_suptitle", None)
+    has_sup = sup is not None and sup.get_text().strip()
+    for i, ax in enumerate(fig.axes):
+        if ax not in axes:
+            continue
+        if not (has_sup or ax.get_title() or ax.get_title("left") or ax.get_title("right")):
+            probs.append(f"axes {i}: no title")
+        box = ax.get_position()
+        for name, axis, near in (
+            ("x", ax.xaxis, lambda o: abs(o.get_position().x0 - box.x0) < 1e-6),
+            ("y", ax.yaxis, lambda o: abs(o.get_position().y0 - box.y0) < 1e-6),
+        ):
+            ticks = [t.get_text() for t in axis.get_majorticklabels() if t.get_visible()]
+            if not any(ticks):
+                continue  # no tick labels (an image, a map drawn without axes)
+            label = axis.label.get_text().strip()
+            if not label:
+                others = [o for o in axes if o is not ax and near(o)]
+                if not any((o.xaxis if name == "x" else o.yaxis).label.get_text() for o in others):
+                    probs.append(f"axes {i}: no {name} label")
+                continue
+            low = label.lower()
+            categorical = any(t and not (_NUMBER.match(t) or "mathdefault" in t) for t in ticks)
+            if not (categorical or _UNIT.search(label) or any(w in low for w in UNITLESS)):
+                probs.append(f"axes {i}: {name} label {label!r} names no unit")
+    return probs
+
+
+def layout_problems(fig) -> list[str]:
+    """What a reader would trip over in ``fig``, as it will be drawn, in short sentences:
+
+    - a text over another text (titles, axis and tick labels, legend entries, texts placed
+      in the data), where the layout engine can tell from the drawn boxes;
+    - a title, axis label or tick label over the data area of an axes;
+    - an additive offset on the tick labels (``1e-6+2.4353e-1``): the ticks should say the
+      numbers;
+    - an axes with data but no title, an axis without a label, a label without a unit (or a
+      word of :data:`UNITLESS`).
+
+    Empty when the figure reads cleanly. Draws the figure once (no file is written)."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    texts = [(w, t.get_window_extent(renderer), r) for w, t, r in _texts(fig, renderer)]
+    probs = []
+    for i in range(len(texts)):
+        for j in range(i + 1, len(texts)):
+            (wa, a, _), (wb, b, _) = texts[i], texts[j]
+            if wa.rsplit(" ", 1)[0] == wb.rsplit(" ", 1)[0] and "legend" in wa:
+                continue  # the entries of one legend are placed by the legend
+            if _overlap(a, b):
+                probs.append(f"{wa} overlaps {wb}")
+    areas = [
+        (k, ax.get_window_extent(renderer))
+        for k, ax in enumerate(fig.axes)
+        if ax.get_visible() and ax.name == "rectilinear" and _has_data(ax)
+    ]
+    for w, box, role in texts:
+        if role != "layout":
+            continue
+        for k, area in areas:
+            if _overlap(box, area, slack=2.0):
+                probs.append(f"{w} lies over the data area of axes {k}")
+    for i, ax in enumerate(fig.axes):
+        for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+            off = axis.get_offset_text()
+            if ax.get_visible() and off.get_visible() and "+" in off.get_text():
+                probs.append(f"axes {i}: {name} tick labels carry an offset {off.get_text()!r}")
+    return probs + _labels_problems(fig)
+
+
+_RECORDER: Callable[[Path, list[str]], None] | None = None
+
+
+@contextmanager
+def checking_figures() -> Iterator[dict[str, list[str]]]:
+    """Within the block, every figure :func:`save` writes in this process is checked by
+    :func:`layout_problems` first; yields ``{file name: problems}``, filled as they are
+    saved (the tests run a study at a tiny size inside it)."""
+    global _RECORDER
+    found: dict[str, list[str]] = {}
+    old = _RECORDER
+    _RECORDER = lambda path, probs: found.__setitem__(Path(path).name, probs)  # noqa: E731
+    try:
+        yield found
+    finally:
+        _RECORDER = old
+
+
 def save(fig, path: str | Path) -> Path:
-    """Save ``fig`` as PNG without a timestamp or version stamp, then close it."""
+    """Save ``fig`` as PNG without a timestamp or version stamp, then close it (checked by
+    :func:`layout_problems` first inside :func:`checking_figures`)."""
     path = Path(path)
+    if _RECORDER is not None:
+        _RECORDER(path, layout_problems(fig))
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", metadata={"Software": None}, bbox_inches="tight")
     plt.close(fig)

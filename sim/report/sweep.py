@@ -20,10 +20,47 @@ def _claim_columns(t: dict, keys: list) -> list[str]:
     return [c for c in t if c not in skip and not c.endswith((":lo", ":hi")) and c + ":lo" in t]
 
 
+#: unit suffixes of config keys and claim ids (the project names units in its names)
+_UNITS = {"_mm": "mm", "_um": "µm", "_m": "m", "_cm": "cm", "_pct": "%", "_ppm": "ppm"}
+_UNITS.update({"_arcsec": "arcsec", "_s": "s", "_mm2": "mm²", "_deg": "deg"})
+#: words of a claim id that mark a proportion (drawn, intervals included, inside [0, 1])
+_PROPORTION = ("coverage", "false_alarm", "share", "rate", "proportion", "fraction", "power")
+#: series colours: the default cycle without red, which marks infeasible cells
+_COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink"]
+_COLOURS += ["tab:gray", "tab:olive", "tab:cyan"]
+
+
+def unit_of(name: str) -> str:
+    """The unit a key or claim id names by its suffix (``plate.spacing_mm`` -> ``mm``)."""
+    for suffix in sorted(_UNITS, key=len, reverse=True):
+        if name.endswith(suffix):
+            return _UNITS[suffix]
+    return ""
+
+
+def _is_proportion(name: str, *arrays) -> bool:
+    vals = np.concatenate([a[np.isfinite(a)] for a in arrays[:1]]) if arrays else np.array([])
+    inside = vals.size == 0 or (vals.min() >= 0 and vals.max() <= 1)
+    return inside and any(w in name.split(".")[-1] or w in name for w in _PROPORTION)
+
+
+def _y_label(claim: str, proportion: bool) -> str:
+    if proportion:
+        return "proportion"
+    if unit_of(claim):
+        return f"simulated value ({unit_of(claim)})"
+    return "simulated ratio" if "ratio" in claim else "simulated value (no unit)"
+
+
+def _column(t: dict, name: str) -> np.ndarray:
+    return np.array([np.nan if a is None else a for a in t[name]], float)
+
+
 def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     """Each claim's value (with its 95 % interval) against the first swept key, one line per
-    combination of the other keys; infeasible cells marked on the axis. Drawn from the rows
-    of ``sweep.parquet`` alone."""
+    combination of the other keys; infeasible cells marked by a red band. Proportions (by
+    their names, values in [0, 1]) are drawn with their intervals clipped to [0, 1]; tick
+    labels say the numbers (no offset). Drawn from the rows of ``sweep.parquet`` alone."""
 
     t = read_table(path).to_pydict()
     keys = read_provenance(path).get("sweep_keys", [])
@@ -37,28 +74,42 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     feas = np.array(t["feasible"], bool)
     ncol = min(3, len(claims))
     nrow = -(-len(claims) // ncol)
-    fig, axs = plt.subplots(nrow, ncol, figsize=(4.6 * ncol, 3.4 * nrow), squeeze=False)
+    fig, axs = plt.subplots(
+        nrow, ncol, figsize=(4.8 * ncol, 3.6 * nrow), squeeze=False, layout="constrained"
+    )
+    xunit = unit_of(keys[0])
+    xlabel = f"{keys[0]} ({xunit or 'no unit'})" + (
+        " - red band: infeasible" if (~feas).any() else ""
+    )
     for ax, c in zip(axs.ravel(), claims):
-        v = np.array([np.nan if a is None else a for a in t[c]], float)
-        lo = np.array([np.nan if a is None else a for a in t[c + ":lo"]], float)
-        hi = np.array([np.nan if a is None else a for a in t[c + ":hi"]], float)
-        for grp in dict.fromkeys(other):
+        v, lo, hi = _column(t, c), _column(t, c + ":lo"), _column(t, c + ":hi")
+        prop = _is_proportion(c, v)
+        if prop:
+            lo, hi = np.clip(lo, 0.0, 1.0), np.clip(hi, 0.0, 1.0)
+        for n, grp in enumerate(dict.fromkeys(other)):
             sel = np.array([o == grp for o in other]) & feas
             o = np.argsort(x[sel])
             lab = ", ".join(f"{k}={g}" for k, g in zip(keys[1:], grp)) or None
             ax.errorbar(
                 x[sel][o],
                 v[sel][o],
-                yerr=[v[sel][o] - lo[sel][o], hi[sel][o] - v[sel][o]],
+                yerr=[np.maximum(v[sel][o] - lo[sel][o], 0), np.maximum(hi[sel][o] - v[sel][o], 0)],
                 fmt="o-",
                 ms=3,
                 capsize=2,
+                color=_COLOURS[n % len(_COLOURS)],
                 label=lab,
             )
         for xi in x[~feas]:
             ax.axvline(xi, color="tab:red", alpha=0.3, lw=3)
-        ax.set_title(c, fontsize=7)
-        ax.set_xlabel(keys[0] + " (red: infeasible)")
+        if prop:
+            ax.set_ylim(-0.02, 1.02) if np.nanmax(hi, initial=0) - np.nanmin(
+                lo, initial=1
+            ) > 0.5 else None
+        ax.ticklabel_format(axis="both", useOffset=False, style="plain")
+        ax.set_title(c, fontsize=8, wrap=True)
+        ax.set_xlabel(xlabel, fontsize=8)
+        ax.set_ylabel(_y_label(c, prop), fontsize=8)
         if other[0]:
             ax.legend(fontsize=6)
     for ax in axs.ravel()[len(claims) :]:

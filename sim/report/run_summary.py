@@ -1,0 +1,223 @@
+"""One results directory on its own, read from its Parquet files alone: the verdict counts and
+headline rows printed at the end of ``sim run`` and by ``sim show DIR``, and the directory's
+``README.md`` (its claims, its study's report section, or its sweep table).
+
+A directory is a study run (``claims.parquet``) or a ``[sweep]`` run (``sweep.parquet``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from pathlib import Path
+from typing import Callable
+
+from sim.mc.config import ConfigError
+from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
+from sim.report.claimtext import interval_text, sim_text
+from sim.report.papers import paper_name
+from sim.report.sweep import sweep_markdown
+from sim.report.tables import fmt
+
+__all__ = [
+    "VERDICT_ORDER",
+    "verdict_line",
+    "headline_rows",
+    "region_line",
+    "terminal_summary",
+    "terminal_table",
+    "run_markdown",
+    "write_run_readme",
+    "README_MARK",
+]
+
+#: verdicts in the order they are counted (others follow in alphabetical order)
+VERDICT_ORDER = (
+    "holds",
+    "fails",
+    "inconclusive",
+    "depends",
+    "undecidable",
+    "erratum",
+    "not comparable",
+    "input",
+    "self-check",
+    "finding",
+)
+
+
+def _kind_of(out: Path) -> str:
+    out = Path(out)
+    if (out / "claims.parquet").is_file():
+        return "study"
+    if (out / "sweep.parquet").is_file():
+        return "sweep"
+    raise ConfigError(
+        "DIR", f"{out} is not a results directory (no claims.parquet or sweep.parquet)"
+    )
+
+
+def verdict_line(claims: list[dict]) -> str:
+    """``"14 claims: 6 holds, 2 fails, ..."`` (every verdict value, in :data:`VERDICT_ORDER`)."""
+    c = Counter(r["verdict"] for r in claims)
+    order = [v for v in VERDICT_ORDER if c[v]] + sorted(v for v in c if v not in VERDICT_ORDER)
+    return f"{len(claims)} claims: " + ", ".join(f"{c[v]} {v}" for v in order)
+
+
+def headline_rows(claims: list[dict], n: int | None = None) -> list[dict]:
+    """The claims marked ``headline`` (at most ``n``), in the claim book's order."""
+    rows = [r for r in claims if r.get("headline")]
+    return rows if n is None else rows[:n]
+
+
+def region_line(out: Path) -> str | None:
+    """One line on ``consistent_region.parquet`` if the directory has it: the number of
+    accepted input vectors and each input's range over them (input columns are the numeric
+    ones, named with their units)."""
+    p = Path(out) / "consistent_region.parquet"
+    if not p.is_file():
+        return None
+    t = read_table(p)
+    parts = []
+    for name in t.column_names:
+        if name == "confirmed" or name.endswith("__value"):
+            continue
+        vals = [v for v in t.column(name).to_pylist() if isinstance(v, (int, float))]
+        vals = [v for v in vals if not isinstance(v, bool) and math.isfinite(v)]
+        if vals:
+            lo, hi = min(vals), max(vals)
+            parts.append(f"{name} {fmt(lo)}" + ("" if lo == hi else f"–{fmt(hi)}"))
+    where = f" ({'; '.join(parts)})" if parts else ""
+    return f"consistent region: {t.num_rows} accepted input vectors{where}"
+
+
+def _value_text(r: dict) -> str:
+    return "" if r["verdict"] == "not comparable" else sim_text(r)
+
+
+def _interval(r: dict) -> str:
+    return "" if r["verdict"] == "not comparable" else interval_text(r)
+
+
+def terminal_summary(out: Path, n: int = 5, shown: str | None = None) -> str:
+    """The closing lines of a run: the verdict counts, up to ``n`` headline rows (value,
+    95 % interval, verdict), the region line, and the path of the directory's README.md
+    (under ``shown``, the directory as the user named it, if given)."""
+    out = Path(out)
+    if _kind_of(out) == "sweep":
+        t = read_table(out / "sweep.parquet").to_pydict()
+        ok = sum(bool(f) for f in t.get("feasible", []))
+        lines = [f"sweep: {ok} of {len(t.get('feasible', []))} cells ran"]
+    else:
+        claims = read_table(out / "claims.parquet").to_pylist()
+        lines = [verdict_line(claims)]
+        for r in headline_rows(claims, n):
+            ci = _interval(r)
+            lines.append(
+                f"  {r['claim']}: {_value_text(r)}" + (f" {ci}" if ci else "") + f" {r['verdict']}"
+            )
+        if (reg := region_line(out)) is not None:
+            lines.append(reg)
+    if (out / "README.md").is_file():
+        lines.append(f"report: {Path(shown or out) / 'README.md'}")
+    return "\n".join(lines)
+
+
+def terminal_table(out: Path, width: int = 100) -> str:
+    """Every claim of a results directory as a plain-text table (claim, simulated, 95 %
+    interval, verdict), then the counts; a sweep directory as its cells."""
+    out = Path(out)
+    if _kind_of(out) == "sweep":
+        t = read_table(out / "sweep.parquet").to_pydict()
+        rows = [
+            [t["label"][i], "yes" if t["feasible"][i] else f"no: {t['reason'][i]}"]
+            for i in range(len(t["label"]))
+        ]
+        return _text_table(["cell", "feasible"], rows, width)
+    claims = read_table(out / "claims.parquet").to_pylist()
+    rows = [[r["claim"], _value_text(r), _interval(r), r["verdict"]] for r in claims]
+    table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
+    return table + "\n\n" + verdict_line(claims)
+
+
+def _text_table(header: list[str], rows: list[list], width: int) -> str:
+    cols = list(zip(header, *rows)) if rows else [(h,) for h in header]
+    w = [max(len(str(c)) for c in col) for col in cols]
+    if sum(w) + 2 * (len(w) - 1) > width and len(w) > 1:  # shorten the first column
+        w[0] = max(12, width - sum(w[1:]) - 2 * (len(w) - 1))
+
+    def line(cells):
+        return "  ".join(_cut(str(c), w[i]).ljust(w[i]) for i, c in enumerate(cells)).rstrip()
+
+    return "\n".join([line(header), line(["-" * x for x in w])] + [line(r) for r in rows])
+
+
+def _cut(s: str, n: int) -> str:
+    return s if len(s) <= n else s[: max(n - 3, 0)] + "..."
+
+
+def run_markdown(out: Path, get_study: Callable) -> str:
+    """The README.md of one results directory: what ran (study, paper, config), the verdict
+    counts, the region line, then the study's own report section (claims, tables, figures:
+    links relative to the directory) or the sweep's table."""
+    out = Path(out)
+    kind = _kind_of(out)
+    src = out / ("claims.parquet" if kind == "study" else "sweep.parquet")
+    prov = read_provenance(src)
+    study = get_study(prov["study"])
+    paper = paper_name(study.seed_file, full=True)
+    head = [
+        f"# {out.name}: {study.title}",
+        "",
+        f"Study `{prov['study']}`"
+        + (f", seed paper: {paper}." if paper else " (a declared network, no seed paper).")
+        + " Written by `sim run` from this directory's Parquet files "
+        f"(`sim show {out.name}` prints it again).",
+        "",
+    ]
+    if kind == "sweep":
+        body = sweep_markdown(out, ".")
+    else:
+        claims = read_table(src).to_pylist()
+        head += [f"**Verdicts:** {verdict_line(claims)}.", ""]
+        if (reg := region_line(out)) is not None:
+            head += [reg[0].upper() + reg[1:] + ".", ""]
+        body = study.report(out)
+    return "\n".join(head) + "\n" + _relink(body, out.name) + "\n"
+
+
+def _relink(body: str, name: str) -> str:
+    """Study report sections link files as ``<dir>/file`` (relative to ``results/``); in the
+    directory's own README they are relative to the directory."""
+    return body.replace(f"]({name}/", "](")
+
+
+#: the first line of every README.md the suite writes in a results directory: a README.md
+#: without it is the user's, and is never replaced
+README_MARK = "<!-- written by sim from this directory's Parquet files; edits are overwritten -->"
+
+
+def _ours(path: Path) -> bool:
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            return f.readline().rstrip("\n") == README_MARK
+    except OSError:
+        return False
+
+
+def write_run_readme(out: Path, get_study: Callable) -> Path | None:
+    """Write ``out/README.md`` (see :func:`run_markdown`) atomically and list it among the
+    files the run wrote (``run.json``, so a later run into the directory replaces it rather
+    than keeping it as the user's). A README.md the suite did not write (no mark) is left as
+    it is: returns None then, else the path."""
+    out = Path(out)
+    path = out / "README.md"
+    if path.is_symlink() or (path.exists() and not _ours(path)):
+        return None
+    text = README_MARK + "\n" + run_markdown(out, get_study)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text)
+    rec = read_record(out)
+    if rec is not None and isinstance(rec.get("files"), list) and "README.md" not in rec["files"]:
+        write_record(out, {**rec, "files": sorted([*rec["files"], "README.md"])})
+    return path
