@@ -21,6 +21,7 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.inference import HOLDS, Input, Region, Statement, parse_declaration
+from sim.claims.intervals import spread_rows
 from sim.claims.region import decide_over, outcomes, region_row, region_table, statement_of
 from sim.mc.config import ConfigError
 from sim.mc.storage import write_table
@@ -99,7 +100,7 @@ def sample_evidence(x: np.ndarray, ref: float | None = None) -> dict[str, np.nda
     (a one-plate claim) also ``p = 2 min(q, 1 - q)``, ``q`` the share of plates below ``ref``
     (ties counted half): the book's one-plate rule, point by point."""
     x = np.asarray(x, float)
-    lo, med, hi = np.nanpercentile(x, [2.5, 50, 97.5], axis=1)
+    med, lo, hi = spread_rows(x)
     ev = {"value": med, "low": lo, "high": hi}
     if ref is not None:
         n = np.sum(np.isfinite(x), axis=1)

@@ -183,6 +183,14 @@ def spread(x: np.ndarray, level: float = LEVEL) -> tuple[float, tuple[float, flo
     return float(med), (float(lo), float(hi))
 
 
+def spread_rows(x: np.ndarray, level: float = LEVEL) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`spread` of every row of ``x`` ``(N, M)`` (NaN ignored): the median and the
+    central ``level`` range of each row, ``(median, low, high)``, each ``(N,)``."""
+    a = _half(level) * 100
+    lo, med, hi = np.nanpercentile(np.asarray(x, float), [a, 50, 100 - a], axis=1)
+    return med, lo, hi
+
+
 def plate_p(x: np.ndarray, ref: float) -> float:
     """The probability of a simulated plate at least as extreme as the paper's value ``ref``:
     ``p = 2 min(q, 1 - q)`` with ``q`` the share of plates below ``ref`` (a plate equal

@@ -73,7 +73,7 @@ def table1_rows(book: ClaimBook, cfg: dict, sim: dict) -> list[dict]:
                 )
             )
             ratio = sim[f"without.{key}"] / sim[f"layout_{lay}.{key}"]
-            rlo, rmed, rhi = np.percentile(ratio, [2.5, 50, 97.5])
+            rmed, (rlo, rhi) = spread(ratio)
             rows.append(
                 book.not_comparable(
                     f"agnard.table1.ratio_{w}_{c}",
