@@ -4,7 +4,8 @@ directories; the README stays short and its links resolve.
 Per page, in a fresh working directory (``studies/`` linked, ``results/`` mirrored with its
 files linked, so nothing in the repository is written): the page's ``toml`` blocks are
 written to the file their first comment names, then its ``sh`` lines run in order and its
-``python`` blocks run as scripts. ``sim ...`` runs as ``python -m sim ...``; ``sim run``
+``python`` blocks run as scripts (but a block whose first line is ``# excerpt ...``, a part of
+a module shown to be read). ``sim ...`` runs as ``python -m sim ...``; ``sim run``
 gets its study's tiny configuration (``tests/data/tiny/``) in place of ``--trials``, and
 every ``/tmp/...`` path becomes a path in the scratch directory. ``make TARGET`` lines are
 checked to name a real target of the Makefile, not run. ``python -m MODULE ...`` of another
@@ -138,6 +139,8 @@ def test_every_command_of_the_page_runs(page, tmp_path):
                 if cmd is not None:
                     runner.run(cmd, f"{page.name}: {line.strip()}")
                     ran += 1
+        elif lang == "python" and text.startswith("# excerpt"):
+            continue  # a part of a module, shown to be read (its first line says from where)
         elif lang == "python":
             script = tmp_path / f"block_{i}.py"
             script.write_text(text)

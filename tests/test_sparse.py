@@ -336,7 +336,7 @@ def test_a_large_network_runs_end_to_end_on_the_sparse_path(tmp_path):
     Monte Carlo within its sampling error of the analytic sigmas, redundancy sum = dof."""
     f = tmp_path / "big.toml"
     f.write_text(
-        'study = "network"\ntrials = 60\nchunk = 20\nseed = 3\n[network]\n'
+        'study = "network"\ntrials = 60\nchunk = 3\nseed = 3\n[network]\n'
         "estimate_scale = true\n"
         'grids = [ { prefix = "P", nx = 20, ny = 20, spacing_mm = 10000.0 } ]\n'
         'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 8, sigma_mm = 1.0 },'

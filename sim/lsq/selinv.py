@@ -14,7 +14,7 @@ of the filled graph), so the work is the sum over columns of the squared column 
 dense inverse, no column-by-column solves. Seed of the method: K. Takahashi, J. Fagan and
 M.-S. Chen, "Formation of a sparse bus impedance matrix and its application to short circuit
 study" (1973); A. M. Erisman and W. F. Tinney (1975). Every kernel runs compiled by numba when
-present (:func:`sim.lsq.group_kernel.compiled`) and as plain Python otherwise (small problems,
+present (:func:`sim.lsq.compile.compiled`) and as plain Python otherwise (small problems,
 ``SIM_NO_JIT``).
 """
 
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.lsq import group_kernel
+from sim.lsq import compile as jit
 
 __all__ = ["symbolic", "filled", "forward", "backward", "takahashi", "lookup"]
 
@@ -150,7 +150,7 @@ def _lookup(indptr, indices, Zx, Zd, rows, cols, out):  # pragma: no cover - com
 
 
 def _fn(f):
-    return group_kernel.compiled(f) if group_kernel.available() else f
+    return jit.compiled(f) if jit.available() else f
 
 
 def symbolic(n: int, indptr: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -337,8 +337,10 @@ def _target(scratch: Path, name: str) -> tuple[Path, bool]:
     target = scratch / name
     if not target.exists() and not target.is_symlink():
         return target, False
-    if target.is_dir() and not target.is_symlink() and read_record(target) is not None:
-        foreign = [p.name for p in target.iterdir() if not _ours(p)]
+    record = read_record(target) if target.is_dir() and not target.is_symlink() else None
+    if record is not None:
+        listed = {f.split("/")[0] for f in record.get("files", [])}  # what its run wrote
+        foreign = [p.name for p in target.iterdir() if not _ours(p) and p.name not in listed]
         if foreign:
             raise VerifyError(
                 f"--scratch: {target} holds {foreign[0]!r}, which the suite did not write: "

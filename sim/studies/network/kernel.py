@@ -6,7 +6,7 @@ in mm, directions and angles in rad, coordinate differences and coordinates in m
 residual observed minus computed (angles wrapped to (-pi, pi]) and adds ``J' W r`` into the
 gradient of the free unknowns -- without the Jacobian array, which for a network of thousands
 of points and a chunk of trials would be the largest array of the run. Runs compiled by numba
-(:func:`sim.lsq.group_kernel.compiled`), as plain Python otherwise. Seed: Brown 1968 (``004``).
+(:func:`sim.lsq.compile.compiled`), as plain Python otherwise. Seed: Brown 1968 (``004``).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from sim.lsq import group_kernel
+from sim.lsq import compile as jit
 from sim.studies.network.definition import Network
 
 __all__ = ["residual_gradient"]
@@ -100,7 +100,7 @@ def residual_gradient(net: Network, fpos: np.ndarray, theta: np.ndarray, obs: np
     T = theta.shape[0]
     p = int(fpos.max(initial=-1)) + 1
     r, g = np.empty((T, net.m)), np.empty((T, p))
-    fn = group_kernel.compiled(_kernel) if group_kernel.available() else _kernel
+    fn = jit.compiled(_kernel) if jit.available() else _kernel
     fn(
         np.ascontiguousarray(theta, dtype=np.float64),
         np.ascontiguousarray(obs, dtype=np.float64),
