@@ -20,9 +20,15 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.inference import HOLDS, Input, Region, Statement, parse_declaration
+from sim.claims.inference import Input, Region, Statement, parse_declaration
 from sim.claims.intervals import spread_rows
-from sim.claims.region import decide_over, outcomes, region_row, region_table, statement_of
+from sim.claims.region import (
+    decide_over,
+    inputs_table,
+    region_row,
+    region_table,
+    statement_of,
+)
 from sim.mc.config import ConfigError
 from sim.mc.storage import write_table
 
@@ -135,46 +141,7 @@ def write_region(path, region: Region, book: ClaimBook, predictions: Sequence[st
     the projection of the points where every prediction holds together, and the counts."""
     cols = region_table(region, statements(book, predictions), predictions)
     write_table(path, cols, prov)
-    sts = statements(book, predictions)
-    together = region.accepted.copy()
-    for st in sts:
-        together &= outcomes(region, st) == HOLDS
-    b, t = region.bounds(), region.bounds(together)
-    inp = {
-        k: []
-        for k in (
-            "input",
-            "why",
-            "declared_low",
-            "declared_high",
-            "region_low",
-            "region_high",
-            "resolution_interior",
-            "resolution_boundary",
-            "together_low",
-            "together_high",
-            "n_points",
-            "n_region",
-            "n_together",
-        )
-    }
-    for i in region.inputs:
-        for k, v in zip(
-            inp,
-            (
-                i.name,
-                i.why,
-                i.low,
-                i.high,
-                *b[i.name],
-                *region.resolution[i.name],
-                *t[i.name],
-                region.n,
-                int(region.accepted.sum()),
-                int(together.sum()),
-            ),
-        ):
-            inp[k].append(v)
+    inp = inputs_table(region, statements(book, predictions))
     write_table(Path(path).with_name("region_inputs.parquet"), inp, prov)
 
 

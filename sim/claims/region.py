@@ -182,3 +182,54 @@ def region_row(book, cid: str, rv: RegionVerdict, values, note: str = "") -> dic
     if row["kind"] == "paper-check" and rv.verdict == "fails":
         row["verdict"], row["holds"] = "erratum", False
     return row
+
+
+#: columns of ``region_inputs.parquet``, in order
+INPUT_COLUMNS = (
+    "input",
+    "why",
+    "declared_low",
+    "declared_high",
+    "region_low",
+    "region_high",
+    "resolution_interior",
+    "resolution_boundary",
+    "together_low",
+    "together_high",
+    "n_points",
+    "n_region",
+    "n_together",
+)
+
+
+def holds_together(region: Region, statements: Sequence[Statement]) -> np.ndarray:
+    """The accepted points of ``region`` where every one of ``statements`` holds."""
+    ok = region.accepted.copy()
+    for st in statements:
+        ok &= outcomes(region, st) == HOLDS
+    return ok
+
+
+def inputs_table(region: Region, statements: Sequence[Statement]) -> dict[str, list]:
+    """``region_inputs.parquet``: per input its declared range and why, the region's
+    projection, the design's resolution (interior, boundary), the projection of the points
+    where every one of ``statements`` holds together (NaN where nowhere), and the counts."""
+    together = holds_together(region, statements)
+    b, t = region.bounds(), region.bounds(together)
+    cols: dict[str, list] = {k: [] for k in INPUT_COLUMNS}
+    for i in region.inputs:
+        values = (
+            i.name,
+            i.why,
+            i.low,
+            i.high,
+            *b[i.name],
+            *region.resolution[i.name],
+            *t[i.name],
+            region.n,
+            int(region.accepted.sum()),
+            int(together.sum()),
+        )
+        for k, v in zip(INPUT_COLUMNS, values):
+            cols[k].append(v)
+    return cols

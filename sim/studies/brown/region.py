@@ -21,7 +21,15 @@ from __future__ import annotations
 import numpy as np
 
 from sim.claims.inference import HOLDS, Region, Statement, explore, parse_declaration
-from sim.claims.region import decide_over, outcomes, region_row, region_table, statement_of
+from sim.claims.region import (
+    decide_over,
+    holds_together,
+    outcomes,
+    region_row,
+    region_table,
+    statement_of,
+)
+from sim.claims.region import inputs_table as region_inputs
 from sim.instruments.ranges import brown as B
 from sim.mc.runner import chunk_rng
 from sim.studies.brown import values as V
@@ -238,51 +246,9 @@ def table_of(reg: Region, preds) -> dict:
 
 def together(reg: Region, preds) -> np.ndarray:
     """Accepted points where every prediction holds."""
-    ok = reg.accepted.copy()
-    for p in preds:
-        ok &= outcomes(reg, p) == HOLDS
-    return ok
+    return holds_together(reg, preds)
 
 
 def inputs_table(reg: Region, preds, verdicts) -> dict:
-    """``region_inputs.parquet``: per input its declared range and why, the region's
-    projection, its resolution (interior, boundary), and the projection of the points where
-    every prediction holds together (``together_*``, NaN if nowhere)."""
-    b, t = reg.bounds(), reg.bounds(together(reg, preds))
-    n_t = int(together(reg, preds).sum())
-    cols = {
-        k: []
-        for k in (
-            "input",
-            "why",
-            "declared_low",
-            "declared_high",
-            "region_low",
-            "region_high",
-            "resolution_interior",
-            "resolution_boundary",
-            "together_low",
-            "together_high",
-            "n_points",
-            "n_region",
-            "n_together",
-        )
-    }
-    for i in reg.inputs:
-        for k, v in (
-            ("input", i.name),
-            ("why", i.why),
-            ("declared_low", i.low),
-            ("declared_high", i.high),
-            ("region_low", b[i.name][0]),
-            ("region_high", b[i.name][1]),
-            ("resolution_interior", reg.resolution[i.name][0]),
-            ("resolution_boundary", reg.resolution[i.name][1]),
-            ("together_low", t[i.name][0]),
-            ("together_high", t[i.name][1]),
-            ("n_points", reg.n),
-            ("n_region", int(reg.accepted.sum())),
-            ("n_together", n_t),
-        ):
-            cols[k].append(v)
-    return cols
+    """``region_inputs.parquet`` (:func:`sim.claims.region.inputs_table`)."""
+    return region_inputs(reg, preds)
