@@ -1,6 +1,9 @@
 """Report section of ``wolf_polynomial``, built from its Parquet files and claim book alone
 (every number and verdict word below is read from them). Wolf & Pearsall 1976, seed
-``000_668e60e68f004f98.txt``; discrepancies um.
+``000_668e60e68f004f98.txt``; discrepancies um. On the shared skeleton
+:mod:`sim.report.section`: the consistent region leads, then the model and its error-field
+components, the findings, the claims and inputs, the paper's tables recomputed from its
+coordinates, the design trade-offs (each table with its figure).
 """
 
 from __future__ import annotations
@@ -11,14 +14,16 @@ from pathlib import Path
 import numpy as np
 
 from sim.instruments.plotter.errorfields import COMPONENTS
-from sim.mc.storage import read_provenance, read_table
-from sim.report.markdown import claims_markdown, fmt, inputs_markdown, md_table
+from sim.report.markdown import fmt, md_table
 from sim.report.region import region_markdown
+from sim.report.section import config, figure, rows, section, table
 from sim.studies.wolf.schema import SCHEMA
+
+__all__ = ["findings", "report"]
 
 
 def _t(out: Path, name: str) -> dict:
-    return {k: np.asarray(v) for k, v in read_table(out / name).to_pydict().items()}
+    return {k: np.asarray(v) for k, v in table(out, name).items()}
 
 
 def _med(r: dict) -> str:
@@ -27,7 +32,7 @@ def _med(r: dict) -> str:
 
 def findings(out: Path) -> list[str]:
     """Sentences read off the claims table."""
-    c = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
+    c = {r["claim"]: r for r in rows(out, "claims.parquet")}
     lines = ["**Findings** (medians [95 % range over simulated instruments], um).", ""]
     if "wolf.before.rms_x_um" in c:
         lines.append(
@@ -66,58 +71,14 @@ def _printed(r: dict) -> str:
     return f"{mid:.{dec}f}"
 
 
-def report(out: Path) -> str:
-    prov = read_provenance(out / "claims.parquet")
-    cfg = prov["config"]
-    name = out.name
-    tr = _t(out, "trials.parquet")
-    crow = [
-        [
-            f"`{k}`",
-            COMPONENTS[k],
-            fmt(cfg[f"field.{k}_um"]),
-            fmt(float(np.median(tr[f"component.{k}_rms_um"]))),
-        ]
-        for k in COMPONENTS
-        if f"component.{k}_rms_um" in tr
-    ]
-    t1 = read_table(out / "table1_real.parquet").to_pydict()
-    t1rows = [
-        list(r)
-        for r in zip(
-            t1["plate"],
-            t1["point"],
-            t1["dx_sets_um"],
-            t1["dy_sets_um"],
-            t1["dx_set1_foster_um"],
-            t1["dx_set2_foster_um"],
-            t1["dy_set1_foster_um"],
-            t1["dy_set2_foster_um"],
-        )
-    ]
-    t3 = read_table(out / "table3_real.parquet").to_pydict()
-    t3rows = [
-        list(r)
-        for r in zip(
-            t3["photo"],
-            t3["point"],
-            t3["dx_printed_um"],
-            t3["dx_coord_um"],
-            t3["dy_printed_um"],
-            t3["dy_coord_um"],
-            t3["note"],
-        )
-    ]
+def _model_text(cfg: dict, n_trials: int) -> str:
+    """The simulated plate, error field, readings and calibration, with their inputs."""
     sizes = (
-        f"{len(tr['trial'])} simulated instruments (seed {cfg['seed']}); the region's input "
+        f"{n_trials} simulated instruments (seed {cfg['seed']}); the region's input "
         f"vectors and the readings trade-off use {cfg['unprinted.trials']}, the other trade-offs "
         f"{cfg['trade.trials']}"
     )
-    txt = [
-        region_markdown(out, read_table(out / "claims.parquet").to_pylist()),
-        "",
-        f"![consistent region]({name}/consistent_region.png)",
-        "",
+    return (
         "**Model.** A grid plate (a "
         f"{cfg['plate.spacing_mm']:g} mm quadrille over the area {cfg['plate.area_mm']} mm; grid "
         f"coordinates known to {cfg['plate.grid_sigma_um']:g} um) is read in a plotter whose "
@@ -137,103 +98,118 @@ def report(out: Path) -> str:
         f"a photograph's corrected PG-2 coordinates with a monocomparator of "
         f"{cfg['mono.sigma_um']:g} um per coordinate (not printed; an example). {sizes}. The paper's "
         "numbers describe one instrument and one plate each, so most claims are *one-plate* "
-        "claims, decided by where the paper's value falls among simulated plates.",
-        "",
-        md_table(
-            ["component", "paper's source", "amplitude (um, input)", "median rms at the grid (um)"],
-            crow,
-        ),
-        "",
-        f"![error-field components]({name}/components.png)",
-        "",
-        *findings(out),
-        "",
-        claims_markdown(out / "claims.parquet"),
-        "",
-        inputs_markdown(cfg, SCHEMA),
-        "",
-        f"![discrepancy vectors]({name}/vectors.png)",
-        "",
+        "claims, decided by where the paper's value falls among simulated plates."
+    )
+
+
+def _components_table(cfg: dict, tr: dict) -> str:
+    """Per error-field component: its source, its amplitude (an input) and its median rms."""
+    crow = [
+        [
+            f"`{k}`",
+            COMPONENTS[k],
+            fmt(cfg[f"field.{k}_um"]),
+            fmt(float(np.median(tr[f"component.{k}_rms_um"]))),
+        ]
+        for k in COMPONENTS
+        if f"component.{k}_rms_um" in tr
+    ]
+    return md_table(
+        ["component", "paper's source", "amplitude (um, input)", "median rms at the grid (um)"],
+        crow,
+    )
+
+
+def _columns(t: dict, cols: tuple[str, ...]) -> list[list]:
+    """The rows of the columns ``cols`` of table ``t``, as they are."""
+    return [list(r) for r in zip(*(t[k] for k in cols))]
+
+
+_TABLE1_COLUMNS = (
+    "plate",
+    "point",
+    "dx_sets_um",
+    "dy_sets_um",
+    "dx_set1_foster_um",
+    "dx_set2_foster_um",
+    "dy_set1_foster_um",
+    "dy_set2_foster_um",
+)
+_TABLE1_HEADER = [
+    "plate",
+    "point",
+    "X set1-set2",
+    "Y set1-set2",
+    "X s1-Foster",
+    "X s2-Foster",
+    "Y s1-Foster",
+    "Y s2-Foster",
+]
+_TABLE3_COLUMNS = (
+    "photo",
+    "point",
+    "dx_printed_um",
+    "dx_coord_um",
+    "dy_printed_um",
+    "dy_coord_um",
+    "note",
+)
+_TABLE3_HEADER = [
+    "photo",
+    "point",
+    "dX printed",
+    "dX coordinates",
+    "dY printed",
+    "dY coordinates",
+    "note",
+]
+
+
+def _paper_tables(out: Path, cfg: dict) -> list[str]:
+    """Tables 1 and 3 recomputed from the paper's transcribed coordinates (um)."""
+    t1 = table(out, "table1_real.parquet")
+    t3 = table(out, "table3_real.parquet")
+    return [
         "**Tables 1 and 2 from the paper's coordinates** (used by the `wolf.table1` and "
         "`wolf.table2_check` rows). Per point, Set 1 - Set 2 and each set minus the H. Dell "
         f"Foster coordinates, in um, from the transcription `{cfg['table1.file']}`:",
-        "",
-        md_table(
-            [
-                "plate",
-                "point",
-                "X set1-set2",
-                "Y set1-set2",
-                "X s1-Foster",
-                "X s2-Foster",
-                "Y s1-Foster",
-                "Y s2-Foster",
-            ],
-            t1rows,
-        ),
-        "",
-        f"![Table 1 vectors]({name}/table1_real.png)",
-        "",
+        md_table(_TABLE1_HEADER, _columns(t1, _TABLE1_COLUMNS)),
+        figure(out, "table1_real.png", "Table 1 vectors"),
         f"**Table 3** (`{cfg['table3.file']}`): the printed differences and those from the "
         "coordinates, um (the `wolf.table3_check` rows use the printed differences):",
-        "",
-        md_table(
-            [
-                "photo",
-                "point",
-                "dX printed",
-                "dX coordinates",
-                "dY printed",
-                "dY coordinates",
-                "note",
-            ],
-            t3rows,
-        ),
-        "",
-        *_tradeoffs(out, cfg, name),
+        md_table(_TABLE3_HEADER, _columns(t3, _TABLE3_COLUMNS)),
     ]
-    return "\n".join(txt)
 
 
-def _tradeoffs(out: Path, cfg: dict, name: str) -> list[str]:
-    d = read_table(out / "degree.parquet").to_pydict()
-    r = read_table(out / "readings.parquet").to_pydict()
-    s = read_table(out / "stability.parquet").to_pydict()
-    drows = [
-        [fmt(a), n, ns, dg, t, fmt(f), fmt(c), fmt(e)]
-        for a, n, ns, dg, t, f, c, e in zip(
-            d["spacing_mm"],
-            d["n_points"],
-            d["n_sets"],
-            d["degree"],
-            d["terms"],
-            d["fit_rms_um"],
-            d["check_rms_um"],
-            d["estimable_share"],
-        )
-    ]
-    rrows = [
-        [a, fmt(g), n, fmt(e), fmt(c), fmt(p)]
-        for a, g, n, e, c, p in zip(
-            r["approach"],
-            r["pointing_sigma_um"],
-            r["readings"],
-            r["reading_error_um"],
-            r["after_check_rms_um"],
-            r["after_plate_rms_um"],
-        )
-    ]
-    srows = [
-        [fmt(f), fmt(a), fmt(b), fmt(c), fmt(w)]
-        for f, a, b, c, w in zip(
-            s["drift_fraction"],
-            s["age_weeks"],
-            s["before_rms_um"],
-            s["after_rms_um"],
-            s["share_after_better"],
-        )
-    ]
-    ans = []
+def report(out: Path) -> str:
+    """The section of ``wolf_polynomial``: consistent region, model, components, findings,
+    claims, inputs, the paper's tables from its coordinates, the design trade-offs."""
+    out = Path(out)
+    cfg = config(out)["config"]
+    tr = _t(out, "trials.parquet")
+    return section(
+        out,
+        lead=[
+            region_markdown(out, rows(out, "claims.parquet")),
+            figure(out, "consistent_region.png", "consistent region"),
+        ],
+        intro=[
+            _model_text(cfg, len(tr["trial"])),
+            _components_table(cfg, tr),
+            figure(out, "components.png", "error-field components"),
+            "\n".join(findings(out)),
+        ],
+        schema=SCHEMA,
+        body=[
+            figure(out, "vectors.png", "discrepancy vectors"),
+            *_paper_tables(out, cfg),
+            *_tradeoffs(out, cfg),
+        ],
+    )
+
+
+def _degree_answer(d: dict, cfg: dict) -> list[str]:
+    """Which degree gives the lowest independent-plate rms at the paper's grid and sets."""
     sp0, ns0 = cfg["plate.spacing_mm"], cfg["calib.n_sets"]
     m = [
         (dg, c, f)
@@ -242,14 +218,19 @@ def _tradeoffs(out: Path, cfg: dict, name: str) -> list[str]:
         )
         if sp == sp0 and ns == ns0 and c is not None and np.isfinite(c)
     ]
-    if m:
-        best = min(m, key=lambda t: t[1])
-        ans.append(
-            f"- *Degree* ({sp0:g} mm grid, {ns0} sets): the independent-plate rms is "
-            f"lowest at degree {best[0]} ({best[1]:.2f} um); "
-            + ", ".join(f"degree {dg}: fit {f:.2f} / plate {c:.2f}" for dg, c, f in m)
-            + " um."
-        )
+    if not m:
+        return []
+    best = min(m, key=lambda t: t[1])
+    return [
+        f"- *Degree* ({sp0:g} mm grid, {ns0} sets): the independent-plate rms is "
+        f"lowest at degree {best[0]} ({best[1]:.2f} um); "
+        + ", ".join(f"degree {dg}: fit {f:.2f} / plate {c:.2f}" for dg, c, f in m)
+        + " um."
+    ]
+
+
+def _readings_answer(r: dict, cfg: dict) -> list[str]:
+    """The independent-plate rms against the number of readings at the configured pointing."""
     one = [
         (n, p)
         for a, g, n, p in zip(
@@ -257,14 +238,20 @@ def _tradeoffs(out: Path, cfg: dict, name: str) -> list[str]:
         )
         if a == cfg["reading.approach"] and g == cfg["reading.pointing_sigma_um"]
     ]
-    if len(one) > 1:
-        ans.append(
-            f"- *Readings* (pointing sigma {cfg['reading.pointing_sigma_um']:g} um, "
-            f"{cfg['reading.approach']}): independent-plate rms "
-            + ", ".join(f"{n} reading(s): {p:.2f}" for n, p in one)
-            + " um."
-        )
-    tau = cfg["field.drift_tau_weeks"]
+    if len(one) <= 1:
+        return []
+    return [
+        f"- *Readings* (pointing sigma {cfg['reading.pointing_sigma_um']:g} um, "
+        f"{cfg['reading.approach']}): independent-plate rms "
+        + ", ".join(f"{n} reading(s): {p:.2f}" for n, p in one)
+        + " um."
+    ]
+
+
+def _stability_answer(s: dict, tau: float) -> list[str]:
+    """Per drifting share: when the correction stops helping, against the noise-free theory
+    (drift time constant ``tau`` in weeks)."""
+    ans = []
     for f in dict.fromkeys(s["drift_fraction"]):
         rf = [
             (a, b, c)
@@ -290,62 +277,120 @@ def _tradeoffs(out: Path, cfg: dict, name: str) -> list[str]:
             f"{rf[0][0]:g} weeks, {rf[-1][2]:.1f} um at {rf[-1][0]:g} weeks (uncorrected "
             f"{rf[-1][1]:.1f}); {when} ({theory})."
         )
+    return ans
+
+
+_DRIFT_THEORY = (
+    "The drifting part decorrelates as exp(-age/tau); the correction removes the "
+    "calibration-time field, so the error it leaves grows as 2 f (1 - exp(-age/tau)) of the "
+    "field's variance and passes the uncorrected variance at age tau ln(2f / (2f - 1)) when "
+    "more than half of the field drifts."
+)
+
+
+def _degree_table(out: Path, d: dict, cfg: dict) -> list[str]:
+    """Degree against grid spacing and number of sets (``degree.parquet``), and its figure."""
+    drows = [
+        [fmt(a), n, ns, dg, t, fmt(f), fmt(c), fmt(e)]
+        for a, n, ns, dg, t, f, c, e in zip(
+            d["spacing_mm"],
+            d["n_points"],
+            d["n_sets"],
+            d["degree"],
+            d["terms"],
+            d["fit_rms_um"],
+            d["check_rms_um"],
+            d["estimable_share"],
+        )
+    ]
+    header = [
+        "spacing (mm)",
+        "points",
+        "sets",
+        "degree",
+        "terms",
+        "fit rms",
+        "plate rms",
+        "estimable share",
+    ]
     return [
-        "**Design trade-offs.**",
-        "",
-        *ans,
-        "",
-        "The drifting part decorrelates as exp(-age/tau); the correction removes the "
-        "calibration-time field, so the error it leaves grows as 2 f (1 - exp(-age/tau)) of the "
-        "field's variance and passes the uncorrected variance at age tau ln(2f / (2f - 1)) when "
-        "more than half of the field drifts.",
-        "",
         f"Degree against grid spacing and number of sets ({cfg['trade.trials']} trials per cell; "
         "median rms per coordinate, um; fit = residuals on the pooled fitting data; plate = an "
         "independent plate of random points inside the grid's extent, read "
         f"{cfg['check.age_weeks']:g} week(s) after the last set, corrected and fitted by a "
         "similarity; empty where the grid has fewer rows or columns than the degree needs):",
-        "",
-        md_table(
-            [
-                "spacing (mm)",
-                "points",
-                "sets",
-                "degree",
-                "terms",
-                "fit rms",
-                "plate rms",
-                "estimable share",
-            ],
-            drows,
-        ),
-        "",
-        f"![degree trade-off]({name}/degree.png)",
-        "",
+        md_table(header, drows),
+        figure(out, "degree.png", "degree trade-off"),
+    ]
+
+
+def _readings_table(out: Path, r: dict, cfg: dict) -> list[str]:
+    """The readings trade-off (``readings.parquet``), and its figure."""
+    rrows = [
+        [a, fmt(g), n, fmt(e), fmt(c), fmt(p)]
+        for a, g, n, e, c, p in zip(
+            r["approach"],
+            r["pointing_sigma_um"],
+            r["readings"],
+            r["reading_error_um"],
+            r["after_check_rms_um"],
+            r["after_plate_rms_um"],
+        )
+    ]
+    header = [
+        "approach",
+        "pointing sigma",
+        "readings",
+        "reading error",
+        "check after",
+        "plate after",
+    ]
+    return [
         "Readings per point (um): the rms error of the averaged reading alone, and the median rms "
         "after correction on the cell-centre check points and on an independent plate "
         f"({cfg['unprinted.trials']} instruments, the same for every cell):",
-        "",
-        md_table(
-            [
-                "approach",
-                "pointing sigma",
-                "readings",
-                "reading error",
-                "check after",
-                "plate after",
-            ],
-            rrows,
-        ),
-        "",
-        f"![readings]({name}/readings.png)",
-        "",
+        md_table(header, rrows),
+        figure(out, "readings.png", "readings"),
+    ]
+
+
+def _stability_table(out: Path, s: dict) -> list[str]:
+    """The stability trade-off (``stability.parquet``), and its figure."""
+    srows = [
+        [fmt(f), fmt(a), fmt(b), fmt(c), fmt(w)]
+        for f, a, b, c, w in zip(
+            s["drift_fraction"],
+            s["age_weeks"],
+            s["before_rms_um"],
+            s["after_rms_um"],
+            s["share_after_better"],
+        )
+    ]
+    header = ["drifting share", "age (weeks)", "uncorrected", "corrected", "share helped"]
+    return [
         "Stability: calibration on the paper's sets, an independent plate read at a later age "
         "(median rms per coordinate, um; share of instruments where the correction helps):",
-        "",
-        md_table(
-            ["drifting share", "age (weeks)", "uncorrected", "corrected", "share helped"], srows
-        ),
-        "",
-        f"![stability]({name}/stability.png)",
+        md_table(header, srows),
+        figure(out, "stability.png", "stability"),
+    ]
+
+
+def _tradeoffs(out: Path, cfg: dict) -> list[str]:
+    """The design trade-offs: the answers in words, then the degree, readings and stability
+    tables with their figures."""
+    d = table(out, "degree.parquet")
+    r = table(out, "readings.parquet")
+    s = table(out, "stability.parquet")
+    ans = [
+        *_degree_answer(d, cfg),
+        *_readings_answer(r, cfg),
+        *_stability_answer(s, cfg["field.drift_tau_weeks"]),
+    ]
+    return [
+        "**Design trade-offs.**",
+        "\n".join(ans),
+        _DRIFT_THEORY,
+        *_degree_table(out, d, cfg),
+        *_readings_table(out, r, cfg),
+        *_stability_table(out, s),
     ]
