@@ -1,0 +1,167 @@
+"""The claims of a network study: self-checks with decision zones stated a priori, and the
+design figures as findings. The book is built in code (a network study has no paper): Monte
+Carlo within 5 % of analytic, coverage and false-alarm rate within 2 points of their nominal
+values, redundancy numbers summing to the degrees of freedom to 1e-6. The findings (exact,
+analytic) let a ``[sweep]`` over any key tabulate them per cell: the largest and the rms point
+sigma, the largest 95 % semi-axis, the smallest redundancy number, the largest MDB of a length
+observation and the largest dilution against ``compare.fix``. Lengths in mm."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from sim.claims.book import ClaimBook, write_claims
+from sim.claims.table import Sim, claim_rows, exact
+from sim.studies.network.estimates import McEstimates
+
+__all__ = ["design_figures", "network_claims"]
+
+SOURCE = "this project (analytic pre-analysis)"
+
+
+def design_figures(net, an, a95_mm: np.ndarray, dil: np.ndarray, est: McEstimates) -> dict:
+    """The design figures the findings report: largest point sigma (analytic, Monte Carlo),
+    largest 95 % semi-axis ``a95_mm``, smallest redundancy number, the MDBs of the length
+    observations, the dilutions ``dil`` (%), the rms point sigma."""
+    an_sig, s_mc = est.an_sig, est.s_mc
+    return {
+        "sigma_max": (
+            float(np.max(np.maximum(an_sig[0::2], an_sig[1::2]))),
+            float(np.max(np.maximum(s_mc[0::2], s_mc[1::2]))),
+        ),
+        "a95_max": float(np.max(a95_mm)),
+        "dilution_max": dil,
+        "r_min": float(an.redundancy.min()),
+        "mdb_mm": an.mdb[~np.isin(net.kind, (1, 2))],
+        "sigma_rms": float(np.sqrt(np.mean(an_sig**2))),
+    }
+
+
+def _self_checks(alpha: float, dof: int) -> list[tuple[str, str, float, float]]:
+    """``(id, what, reference, tolerance)`` of the four self-checks."""
+    return [
+        (
+            "network.mc_agreement.mean_ratio",
+            "Monte-Carlo sigma / analytic sigma (mean over coordinates)",
+            1.0,
+            0.05,
+        ),
+        (
+            "network.coverage95.mean",
+            "share of adjusted points inside their analytic 95 % ellipse",
+            0.95,
+            0.02,
+        ),
+        (
+            "network.global_test.false_alarm",
+            f"rejection rate of the global test at alpha {alpha:g} (no blunders)",
+            alpha,
+            0.02,
+        ),
+        (
+            "network.redundancy.sum",
+            "redundancy numbers sum to the degrees of freedom",
+            float(dof),
+            1e-6,
+        ),
+    ]
+
+
+def _findings(design: dict) -> list[tuple[str, str, float, str]]:
+    """``(id, what, value, note)`` of the design findings this network has."""
+    mdb = design["mdb_mm"][np.isfinite(design["mdb_mm"])]
+    dil = design["dilution_max"][np.isfinite(design["dilution_max"])]
+    finds = [
+        (
+            "network.design.sigma_max_mm",
+            "largest point sigma (x or y), mm",
+            design["sigma_max"][0],
+            f"analytic; Monte Carlo {design['sigma_max'][1]:.4g} mm",
+        ),
+        (
+            "network.design.sigma_rms_mm",
+            "rms of the point sigmas (x and y), mm",
+            design["sigma_rms"],
+            "analytic",
+        ),
+        (
+            "network.design.ellipse95_max_mm",
+            "largest semi-axis of a 95 % ellipse, mm",
+            design["a95_max"],
+            "analytic",
+        ),
+        (
+            "network.design.redundancy_min",
+            "smallest redundancy number",
+            design["r_min"],
+            "analytic",
+        ),
+    ]
+    if mdb.size:  # a network of directions and angles only has no length MDB
+        finds.append(
+            (
+                "network.design.mdb_max_mm",
+                "largest minimal detectable bias of a "
+                "distance or coordinate observation (controlled ones), mm",
+                float(mdb.max()),
+                "analytic",
+            )
+        )
+    if dil.size:  # only with compare.fix
+        finds.append(
+            (
+                "network.design.dilution_max_pct",
+                "largest dilution against compare.fix known, %",
+                float(dil.max()),
+                "analytic",
+            )
+        )
+    return finds
+
+
+def _book(checks: list[tuple], finds: list[tuple]) -> ClaimBook:
+    return ClaimBook(
+        [
+            {
+                "id": i,
+                "source": SOURCE,
+                "paper": p,
+                "kind": "self-check",
+                "form": "value",
+                "ref": r,
+                "tol": t,
+            }
+            for i, p, r, t in checks
+        ]
+        + [{"id": f[0], "source": SOURCE, "paper": f[1], "kind": "finding"} for f in finds],
+        [],
+        "<network self-checks>",
+    )
+
+
+def _ci(est: tuple, note: str) -> Sim:
+    """A ``(value, lo, hi)`` estimate (arrays of one) as a claim's value and 95 % interval."""
+    return Sim(est[0][0], (est[1][0], est[2][0]), note=note)
+
+
+def network_claims(out: Path, prov: dict, an, est: McEstimates, cfg: dict, design: dict) -> None:
+    """Score the self-checks and findings of a network study into ``claims.parquet``."""
+    checks = _self_checks(cfg["test.alpha"], an.dof)
+    finds = _findings(design)
+    book = _book(checks, finds)
+    note = (
+        f"{int(float(est.n_ok.sum()))} converged of {cfg['trials']} trials; sigma ratio: "
+        "jackknife CI over chunks, shares: Wilson interval from the counts"
+    )
+    table = {
+        checks[0][0]: _ci(est.ratio, note),
+        checks[1][0]: _ci(est.cover_mean, note),
+        checks[2][0]: _ci(est.alarm, note),
+        checks[3][0]: exact(
+            float(an.redundancy.sum()), note=f"{len(an.redundancy)} observations, dof {an.dof}"
+        ),
+        **{i: exact(v, note=nt) for i, _, v, nt in finds},
+    }
+    write_claims(out / "claims.parquet", claim_rows(book, table), prov, book)

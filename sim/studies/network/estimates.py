@@ -1,0 +1,83 @@
+"""Monte-Carlo estimates of a network study from the runner's per-chunk sums: the point sigmas
+with jackknife intervals over chunks, their mean ratio to the analytic sigmas, the coverage
+of the analytic 95 % ellipses and the false-alarm rate of the global test (Wilson intervals
+from the counts). Coordinates and sigmas in mm. Every estimate is ``(value, lo, hi)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim.claims.intervals import binomial_ci
+from sim.mc.config import StudyError
+from sim.mc.runner import jackknife
+
+__all__ = ["McEstimates", "mc_estimates", "sample_sd"]
+
+
+def sample_sd(n, e, ee):
+    """The sample standard deviation (n - 1) from the count ``n``, the sum ``e`` and the sum of
+    squares ``ee`` of the errors (clipped at zero against rounding)."""
+    return np.sqrt(np.maximum(ee / n - (e / n) ** 2, 0) * n / (n - 1))
+
+
+@dataclass(frozen=True)
+class McEstimates:
+    """What the Monte Carlo gave over the estimated points ``pts`` (x and y interleaved).
+
+    n_ok : converged trials per chunk; an_sig : the analytic sigmas (mm); s_mc, s_lo, s_hi : the
+    Monte-Carlo sigmas and their 95 % interval (mm); ratio : mean MC / analytic sigma; cover :
+    per point, the share inside its 95 % ellipse; cover_mean : its mean over points; alarm :
+    the rejection rate of the global test. The last four as ``(value, lo, hi)`` arrays."""
+
+    n_ok: np.ndarray
+    an_sig: np.ndarray
+    s_mc: np.ndarray
+    s_lo: np.ndarray
+    s_hi: np.ndarray
+    ratio: tuple
+    cover: tuple
+    cover_mean: tuple
+    alarm: tuple
+
+
+def _sums(sim: dict) -> np.ndarray:
+    """Per chunk: converged count, error sums, squared-error sums, inside counts, rejections."""
+    n_ok = sim["sum.n"][:, 0]
+    return np.concatenate(
+        [
+            sim["sum.n"],
+            sim["sum.e"].reshape(len(n_ok), -1),
+            np.einsum("ckii->cki", sim["sum.ee"]).reshape(len(n_ok), -1),
+            sim["sum.inside"],
+            sim["sum.reject"],
+        ],
+        axis=1,
+    )
+
+
+def mc_estimates(an, pts: list[int], sim: dict) -> McEstimates:
+    """The estimates of the chunks ``sim`` for the points ``pts`` of the analysis ``an``;
+    :class:`StudyError` when fewer than two chunks have converged trials."""
+    n_ok = sim["sum.n"][:, 0]
+    if n_ok.sum() < 2 or np.count_nonzero(n_ok) < 2:
+        raise StudyError(
+            "solver.max_iter: fewer than two chunks have converged trials; the "
+            "network does not converge from its true coordinates"
+        )
+    sums = _sums(sim)
+    k = len(pts)
+
+    def sig(t):
+        return sample_sd(t[0], t[1 : 1 + 2 * k], t[1 + 2 * k : 1 + 4 * k])
+
+    an_sig = np.sqrt(np.stack([an.cov[pts, 0, 0], an.cov[pts, 1, 1]], 1)).reshape(-1)
+    s_mc, s_lo, s_hi = jackknife(sig, sums)
+    ratio = jackknife(lambda t: np.atleast_1d(np.mean(sig(t) / an_sig)), sums)
+    tot = sums.sum(axis=0)  # proportions: Wilson intervals from the counts, inside [0, 1]
+    cover = binomial_ci(tot[1 + 4 * k : 1 + 5 * k], tot[0])
+    cover_mean = jackknife(lambda t: np.atleast_1d(np.mean(t[1 + 4 * k : 1 + 5 * k] / t[0])), sums)
+    alarm = binomial_ci(tot[-1:], tot[0])
+    return McEstimates(n_ok, an_sig, s_mc, s_lo, s_hi, ratio, cover, cover_mean, alarm)
