@@ -34,15 +34,34 @@ def _layouts(cfg: dict) -> list[str]:
     )
 
 
-def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dict:
-    """The 2 x 8 block: every adjustment of the paper on the same trials, the control
-    layouts, the first pass, data snooping under digital and mechanical pugging; and, per
-    chunk, trial 0's and the summed check-point errors of the 5- and 21-control passes (for
-    the figures)."""
-    adj = Adjuster(block)
+def _snoop(cfg: dict, block: Block, st, ctrl: np.ndarray, sim: Simulated, key, start):
+    """Baarda's data snooping of the pass points (``snoop.*``: alpha two-sided, at most
+    ``snoop.max_reject`` rejections, w- or tau-test) on the model coordinates ``sim.xm[key]``
+    with the control ``ctrl``, started from the adjustment ``start``; returns what
+    :func:`sim.instruments.block.data_snooping.snoop` returns (rejections first)."""
     crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
-    sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], mechanical=True)
-    out: dict[str, np.ndarray] = {}
+    ws, wsc = snoop_weights(cfg)
+    return snoop(
+        st,
+        sim.xm[key],
+        ws,
+        sim.ctrl_obs[:, ctrl],
+        np.broadcast_to(wsc, (ctrl.size, 3)),
+        start.s,
+        start.R,
+        start.t,
+        start.X,
+        block.is_pass,
+        crit,
+        cfg["snoop.max_reject"],
+        cfg["snoop.test"] == "tau",
+    )
+
+
+def _layout_passes(cfg: dict, block: Block, adj: Adjuster, sim: Simulated, out: dict) -> dict:
+    """The pass without scanner correction (``control.table1``) and the corrected pass of
+    every layout; per chunk, trial 0's and the summed check-point errors (m) of the 5- and
+    21-control passes. Returns the corrected adjustments by layout."""
     wo, wc = paper_weights(cfg)
     ctrl, _, res0 = adj.adjust(sim, ("digital", "raw"), cfg["control.table1"], wo, wc)
     accuracy(block, ctrl, res0, out, "without")
@@ -58,8 +77,12 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
         e = done[lay].X[:, :ng] - block.points[:ng]
         out[f"{CHUNK}{tag}_first_e_m"] = e[:1]
         out[f"{CHUNK}{tag}_sum_e_m"] = e.sum(0, keepdims=True)
-    # first pass: weak control (started from the 21-control solution of the same blocks)
-    res21 = done[cfg["control.many"]]
+    return done
+
+
+def _first_pass(cfg: dict, block: Block, adj: Adjuster, sim: Simulated, res21, out: dict):
+    """The first pass with weak control (started from the 21-control solution of the same
+    blocks): rms of the pass-point residuals (m)."""
     wo1, wc1 = paper_weights(cfg, first_pass=True)
     _, _, res = adj.adjust(
         sim, ("digital", "corrected"), cfg["control.many"], wo1, wc1, start=res21
@@ -71,26 +94,15 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
     out["first.pass_x_m"] = _rms(v[..., 0], 1)
     out["first.pass_y_m"] = _rms(v[..., 1], 1)
     out["first.converged"] = res.converged
-    # data snooping, digital and mechanical pugging
-    ws, wsc = snoop_weights(cfg)
+
+
+def _snooping(cfg: dict, block: Block, adj: Adjuster, sim: Simulated, res21, n: int, out: dict):
+    """Data snooping under digital and mechanical pugging: pass points rejected (count and
+    share), sigma0, gross errors planted and found."""
     ctrl, st = adj.structure(cfg["control.many"])
     n_pass = int(block.is_pass.sum())
     for mode in ("digital", "mechanical"):
-        rej, s0, _, _ = snoop(
-            st,
-            sim.xm[(mode, "corrected")],
-            ws,
-            sim.ctrl_obs[:, ctrl],
-            np.broadcast_to(wsc, (ctrl.size, 3)),
-            res21.s,
-            res21.R,
-            res21.t,
-            res21.X,
-            block.is_pass,
-            crit,
-            cfg["snoop.max_reject"],
-            cfg["snoop.test"] == "tau",
-        )
+        rej, s0, _, _ = _snoop(cfg, block, st, ctrl, sim, (mode, "corrected"), res21)
         out[f"snoop_{mode}.rejected"] = rej[:, block.is_pass].sum(1)
         out[f"snoop_{mode}.share_pct"] = 100.0 * out[f"snoop_{mode}.rejected"] / n_pass
         out[f"snoop_{mode}.sigma0"] = s0
@@ -99,6 +111,20 @@ def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dic
         g[for_t, block.obs_point[for_k]] = True
         out[f"snoop_{mode}.gross_points"] = g.sum(1)
         out[f"snoop_{mode}.gross_found"] = (g & rej).sum(1)
+
+
+def main_chunk(cfg: dict, block: Block, rng: np.random.Generator, n: int) -> dict:
+    """The 2 x 8 block: every adjustment of the paper on the same trials, the control
+    layouts, the first pass, data snooping under digital and mechanical pugging; and, per
+    chunk, trial 0's and the summed check-point errors of the 5- and 21-control passes (for
+    the figures)."""
+    adj = Adjuster(block)
+    sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], mechanical=True)
+    out: dict[str, np.ndarray] = {}
+    done = _layout_passes(cfg, block, adj, sim, out)
+    res21 = done[cfg["control.many"]]
+    _first_pass(cfg, block, adj, sim, res21, out)
+    _snooping(cfg, block, adj, sim, res21, n, out)
     return out
 
 
@@ -122,27 +148,10 @@ def pugging_chunk(
     """Data snooping under mechanical pugging with another re-centring error (px)."""
     c2 = {**cfg, "pugging.recentre_px": recentre_px}
     adj = Adjuster(block)
-    crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
-    ws, wsc = snoop_weights(cfg)
     sim = Simulated(c2, block, rng, n, cfg["scan.dpi"], mechanical=True, uncorrected=False)
-    ctrl, st, res0 = adj.adjust(
-        sim, ("mechanical", "corrected"), cfg["control.many"], *paper_weights(cfg)
-    )
-    rej = snoop(
-        st,
-        sim.xm[("mechanical", "corrected")],
-        ws,
-        sim.ctrl_obs[:, ctrl],
-        np.broadcast_to(wsc, (ctrl.size, 3)),
-        res0.s,
-        res0.R,
-        res0.t,
-        res0.X,
-        block.is_pass,
-        crit,
-        cfg["snoop.max_reject"],
-        cfg["snoop.test"] == "tau",
-    )[0]
+    key = ("mechanical", "corrected")
+    ctrl, st, res0 = adj.adjust(sim, key, cfg["control.many"], *paper_weights(cfg))
+    rej = _snoop(cfg, block, st, ctrl, sim, key, res0)[0]
     return {"share_pct": 100.0 * rej[:, block.is_pass].sum(1) / block.is_pass.sum()}
 
 

@@ -41,6 +41,13 @@ def _mean_se(x: np.ndarray) -> tuple[float, float]:
     return float(x.mean()), float(x.std(ddof=1) / np.sqrt(x.size))
 
 
+def _add_mean_se(t: dict, q: str, x: np.ndarray) -> None:
+    """Append the mean of ``x`` to column ``q`` of ``t`` and its standard error to ``q_se``."""
+    m, se = _mean_se(x)
+    t[q].append(m)
+    t[q + "_se"].append(se)
+
+
 def _run(fn, trials, cfg, part, label, ctx, chunk=None):
     """One part through the runner, in at least four chunks (when it has the trials) so that
     the parts, run one after the other, keep every worker busy."""
@@ -114,14 +121,10 @@ def _scanner_table(cfg, block, sim, ctx, prov, out):
             t["calibration"].append(cal)
             t["trials"].append(len(r["gain_xy_pct"]))
             for q in ("check_xy_m", "check_z_m"):
-                m, se = _mean_se(r[f"{cal}.{q}"])
-                t[q].append(m)
-                t[q + "_se"].append(se)
+                _add_mean_se(t, q, r[f"{cal}.{q}"])
             t["ctrl_xy_m"].append(float(r[f"{cal}.ctrl_xy_m"].mean()))
             t["ctrl_z_m"].append(float(r[f"{cal}.ctrl_z_m"].mean()))
-            g, gse = _mean_se(r["gain_xy_pct"])  # paired: same trials with and without
-            t["gain_xy_pct"].append(g)
-            t["gain_xy_pct_se"].append(gse)
+            _add_mean_se(t, "gain_xy_pct", r["gain_xy_pct"])  # paired: same trials with, without
     write_table(out / "tradeoff_scanner.parquet", t, prov)
     return t
 
@@ -144,9 +147,7 @@ def _control_table(cfg, block, sim, prov, out):
         t["layout"].append(lay)
         t["n_control"].append(int(select_control(block, lay).size))
         for q in ("check_xy_m", "check_z_m"):
-            m, se = _mean_se(sim[f"layout_{lay}.{q}"])
-            t[q].append(m)
-            t[q + "_se"].append(se)
+            _add_mean_se(t, q, sim[f"layout_{lay}.{q}"])
         t["ctrl_xy_m"].append(float(sim[f"layout_{lay}.ctrl_xy_m"].mean()))
         t["ctrl_z_m"].append(float(sim[f"layout_{lay}.ctrl_z_m"].mean()))
     write_table(out / "tradeoff_control.parquet", t, prov)
@@ -198,9 +199,7 @@ def _size_table(cfg, block, ctx, base, prov, out):
         t["n_points"].append(b.n_points)
         t["n_control"].append(int(ctrl.size))
         for q in ("centre_xy_m", "centre_z_m", "check_xy_m", "check_z_m"):
-            m, se = _mean_se(r[f"size.{q}"])
-            t[q].append(m)
-            t[q + "_se"].append(se)
+            _add_mean_se(t, q, r[f"size.{q}"])
     write_table(out / "tradeoff_block.parquet", t, prov)
     return t
 
@@ -222,11 +221,9 @@ def _pugging(cfg, block, sim, ctx, base, prov, out):
                 ctx,
             )
         per[float(rc)] = r["share_pct"]
-        m, se = _mean_se(r["share_pct"])
         t["recentre_px"].append(rc)
         t["trials"].append(len(r["share_pct"]))
-        t["mean_share_pct"].append(m)
-        t["mean_share_pct_se"].append(se)
+        _add_mean_se(t, "mean_share_pct", r["share_pct"])
     write_table(out / "tradeoff_pugging.parquet", t, prov)
     return per
 
@@ -266,19 +263,9 @@ def _five_region(cfg, block, book, rows, ctx, part, prov, out):
     return [new.get(r["claim"], r) for r in rows], insets
 
 
-def run(cfg: dict, out: Path, ctx: RunContext) -> None:
-    block = block_of(cfg)
-    prov = provenance(cfg, sparse_from_models=im.SPARSE_FROM_MODELS)
-    book = load_book()
-    T = cfg["trials"]
-    c5 = select_control(block, cfg["control.few"])
-    c21 = select_control(block, cfg["control.many"])
-    # figures go to idle workers as soon as their data exist (sim.report.figure_jobs.start_figures)
-    drawn = [start_figures([(fg.fig_scanner, (cfg, out / "scanner_field.png"))], ctx.executor)]
-    sim = _run(partial(ch.main_chunk, cfg, block), T, cfg, 0, "2x8 block", ctx)
-    per_trial = {k: v for k, v in sim.items() if not k.startswith(ch.CHUNK)}
-    write_table(out / "trials.parquet", {"trial": np.arange(T), **per_trial}, prov)
-
+def _layout(block, c5, c21, prov, out) -> None:
+    """``layout.parquet``: every point of the block (m), its kind (check, pass, control of
+    the many- or few-point layout or both) and the number of models it appears in."""
     kind = np.full(block.n_points, "check", dtype=object)
     kind[block.is_pass] = "pass"
     kind[c21] = "control_many"
@@ -295,6 +282,41 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         },
         prov,
     )
+
+
+def _region_layouts(block, insets: list[float], prov, out) -> list[np.ndarray]:
+    """``region_layouts.parquet``: the five control points (m) of each explored inset; returns
+    their indices per inset."""
+    ctrl_idx = [five_control(block, u) for u in insets]
+    write_table(
+        out / "region_layouts.parquet",
+        {
+            "inset": np.repeat(insets, 5),
+            "point": np.concatenate(ctrl_idx),
+            "x_m": block.points[np.concatenate(ctrl_idx), 0],
+            "y_m": block.points[np.concatenate(ctrl_idx), 1],
+        },
+        prov,
+    )
+    return ctrl_idx
+
+
+def run(cfg: dict, out: Path, ctx: RunContext) -> None:
+    """The 2 x 8 block with every adjustment of the paper, its layout and check vectors, the
+    trade-offs (scan resolution, control layout, block size, re-centring), the claims with
+    the 5-control rows decided over the region of the lost layout, and the figures."""
+    block = block_of(cfg)
+    prov = provenance(cfg, sparse_from_models=im.SPARSE_FROM_MODELS)
+    book = load_book()
+    T = cfg["trials"]
+    c5 = select_control(block, cfg["control.few"])
+    c21 = select_control(block, cfg["control.many"])
+    # figures go to idle workers as soon as their data exist (sim.report.figure_jobs.start_figures)
+    drawn = [start_figures([(fg.fig_scanner, (cfg, out / "scanner_field.png"))], ctx.executor)]
+    sim = _run(partial(ch.main_chunk, cfg, block), T, cfg, 0, "2x8 block", ctx)
+    per_trial = {k: v for k, v in sim.items() if not k.startswith(ch.CHUNK)}
+    write_table(out / "trials.parquet", {"trial": np.arange(T), **per_trial}, prov)
+    _layout(block, c5, c21, prov, out)
     vec = _check_vectors(cfg, block, sim, c5, c21, T, prov, out)
     drawn.append(
         start_figures([(fg.fig_residuals, (vec, out / "check_residuals.png"))], ctx.executor)
@@ -310,17 +332,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     # --- the unprinted five-point layout: its region, the 5-control rows decided over it
     rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book)
     rows, insets = _five_region(cfg, block, book, rows, ctx, base, prov, out)
-    ctrl_idx = [five_control(block, u) for u in insets]
-    write_table(
-        out / "region_layouts.parquet",
-        {
-            "inset": np.repeat(insets, 5),
-            "point": np.concatenate(ctrl_idx),
-            "x_m": block.points[np.concatenate(ctrl_idx), 0],
-            "y_m": block.points[np.concatenate(ctrl_idx), 1],
-        },
-        prov,
-    )
+    ctrl_idx = _region_layouts(block, insets, prov, out)
     write_claims(out / "claims.parquet", rows, prov, book)
     drawn.append(
         start_figures(

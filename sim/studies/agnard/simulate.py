@@ -15,6 +15,49 @@ from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import Block, select_control
 
 
+def _scans(cfg: dict, b: Block, rng: np.random.Generator, n: int, pix: float, uncorrected: bool):
+    """One scanner field per trial, the scanned calibration grid and the fiducial centring
+    noise; returns the image coordinates of the left and right observations (mm) and their
+    scanner errors (um) after the fiducial affine, ``corrected`` by the grid and, when
+    ``uncorrected``, ``raw``."""
+    n_ph = b.photos.shape[0] * b.photos.shape[1]
+    field = sc.random_field(
+        rng,
+        n,
+        max_x_um=cfg["scan.max_x_um"],
+        max_y_um=cfg["scan.max_y_um"],
+        stepper_share=cfg["scan.stepper_share"],
+        wavelength_mm=cfg["scan.wavelength_mm"],
+        half_mm=cfg["block.format_mm"] / 2,
+    )
+    grid = sc.scan_grid(field, rng, cfg["scan.grid_mm"], cfg["scan.grid_sigma_px"] * pix)
+    xl = b.image_coords(b.obs_left, b.obs_point)
+    xr = b.image_coords(b.obs_right, b.obs_point)
+    xy = np.vstack([xl, xr])
+    ph = np.concatenate([b.obs_left, b.obs_right])
+    fid = sc.corner_fiducials(cfg["scan.fiducial_mm"])
+    fid_noise = rng.normal(0.0, cfg["scan.fiducial_sigma_px"] * pix, (n, n_ph) + fid.shape)
+    scan = {"corrected": sc.image_errors(field, xy, ph, fid, fid_noise, grid)}
+    if uncorrected:
+        scan["raw"] = sc.image_errors(field, xy, ph, fid, fid_noise)
+    return xl, xr, scan
+
+
+def _pugging_modes(cfg: dict, b: Block, pix: float, mechanical: bool) -> dict:
+    """The pointing-error options of digital pugging and, when ``mechanical``, of mechanical
+    pugging (drilled holes on the pass points, re-centring, gross errors; um)."""
+    modes = {"digital": {}}
+    if mechanical:
+        modes["mechanical"] = dict(
+            mechanical=b.is_pass,
+            transfer_um=cfg["pugging.transfer_um"],
+            recentre_um=cfg["pugging.recentre_px"] * pix,
+            gross_rate=cfg["pugging.gross_rate"],
+            gross_um=tuple(g * pix for g in cfg["pugging.gross_px"]),
+        )
+    return modes
+
+
 class Simulated:
     """One chunk of simulated blocks: model coordinates in their own frames and the truth."""
 
@@ -29,71 +72,15 @@ class Simulated:
         uncorrected: bool = True,
     ):
         pix = sc.pixel_um(dpi)
-        sig = cfg["scan.fiducial_sigma_px"] * pix
-        b = block
-        K = b.obs_model.size
-        n_ph = b.photos.shape[0] * b.photos.shape[1]
-        field = sc.random_field(
-            rng,
-            n,
-            max_x_um=cfg["scan.max_x_um"],
-            max_y_um=cfg["scan.max_y_um"],
-            stepper_share=cfg["scan.stepper_share"],
-            wavelength_mm=cfg["scan.wavelength_mm"],
-            half_mm=cfg["block.format_mm"] / 2,
-        )
-        grid = sc.scan_grid(field, rng, cfg["scan.grid_mm"], cfg["scan.grid_sigma_px"] * pix)
-        xl = b.image_coords(b.obs_left, b.obs_point)
-        xr = b.image_coords(b.obs_right, b.obs_point)
-        xy = np.vstack([xl, xr])
-        ph = np.concatenate([b.obs_left, b.obs_right])
-        fid = sc.corner_fiducials(cfg["scan.fiducial_mm"])
-        fid_noise = rng.normal(0.0, sig, (n, n_ph) + fid.shape)
-        scan = {"corrected": sc.image_errors(field, xy, ph, fid, fid_noise, grid)}
-        if uncorrected:
-            scan["raw"] = sc.image_errors(field, xy, ph, fid, fid_noise)
-        modes = {"digital": {}}
-        if mechanical:
-            modes["mechanical"] = dict(
-                mechanical=b.is_pass,
-                transfer_um=cfg["pugging.transfer_um"],
-                recentre_um=cfg["pugging.recentre_px"] * pix,
-                gross_rate=cfg["pugging.gross_rate"],
-                gross_um=tuple(g * pix for g in cfg["pugging.gross_px"]),
-            )
+        b = self.block = block
+        self.n = n
+        xl, xr, scan = _scans(cfg, b, rng, n, pix, uncorrected)
+        modes = _pugging_modes(cfg, b, pix, mechanical)
         self.s, self.R, self.t = im.random_similarities(rng, (n, b.n_models))
-        centre = b.photos.reshape(-1, 3)[b.obs_left]
         self.xm = {}
         self.gross = {}
         for mode, kw in modes.items():
-            el, er, g = im.pointing_errors(
-                rng,
-                n,
-                b.obs_left,
-                b.obs_right,
-                b.obs_point,
-                b.models + 1,
-                b.strips,
-                b.n_points,
-                mark_um=cfg["measure.pointing_px"] * pix,
-                parallax_um=cfg["measure.parallax_px"] * pix,
-                digital=b.is_pass if mode == "digital" else None,
-                **kw,
-            )
-            self.gross[mode] = g
-            for which, e in scan.items():
-                if mode == "mechanical" and which == "raw":
-                    continue
-                G = (
-                    im.form_models(
-                        xl + 1e-3 * (e[:, :K] + el),
-                        xr + 1e-3 * (e[:, K:] + er),
-                        b.focal_mm,
-                        b.base_m,
-                    )
-                    + centre
-                )
-                self.xm[(mode, which)] = im.to_model_frame(G, b.obs_model, self.s, self.R, self.t)
+            self._measure(cfg, rng, n, pix, mode, kw, xl, xr, scan)
         self.ctrl_obs = b.points + rng.normal(
             0.0, cfg["measure.control_sigma_m"], (n,) + b.points.shape
         )
@@ -102,8 +89,42 @@ class Simulated:
             b.obs_model, b.obs_point, np.zeros(0, np.intp), b.n_models, b.n_points
         )
         self.init = im.initial_values(st, self.xm[("digital", "corrected")], self.X0)
-        self.block = b
-        self.n = n
+
+    def _measure(self, cfg, rng, n, pix, mode, kw, xl, xr, scan) -> None:
+        """The pointing errors of one pugging ``mode`` (options ``kw``), then the models
+        formed from the image coordinates with each scan's errors (mechanical pugging only
+        on corrected scans), in their random model frames: ``xm[(mode, scan)]`` (m)."""
+        b = self.block
+        el, er, g = im.pointing_errors(
+            rng,
+            n,
+            b.obs_left,
+            b.obs_right,
+            b.obs_point,
+            b.models + 1,
+            b.strips,
+            b.n_points,
+            mark_um=cfg["measure.pointing_px"] * pix,
+            parallax_um=cfg["measure.parallax_px"] * pix,
+            digital=b.is_pass if mode == "digital" else None,
+            **kw,
+        )
+        self.gross[mode] = g
+        K = b.obs_model.size
+        centre = b.photos.reshape(-1, 3)[b.obs_left]
+        for which, e in scan.items():
+            if mode == "mechanical" and which == "raw":
+                continue
+            G = (
+                im.form_models(
+                    xl + 1e-3 * (e[:, :K] + el),
+                    xr + 1e-3 * (e[:, K:] + er),
+                    b.focal_mm,
+                    b.base_m,
+                )
+                + centre
+            )
+            self.xm[(mode, which)] = im.to_model_frame(G, b.obs_model, self.s, self.R, self.t)
 
 
 class Adjuster:

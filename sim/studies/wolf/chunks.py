@@ -20,6 +20,7 @@ import numpy as np
 
 from sim.instruments.plotter import errorfields as ef
 from sim.instruments.plotter import polynomial as pl
+from sim.studies.wolf.grid import grid_nodes, mid_cells, node_index
 from sim.studies.wolf.model import (
     Instrument,
     calib_dates,
@@ -34,7 +35,6 @@ from sim.studies.wolf.model import (
     stats_cols,
     true_plate,
 )
-from sim.studies.wolf.schema import _index, grid_nodes, mid_cells
 
 #: the config keys a cell may override, and the field-amplitude factor
 CELL_KEYS = (
@@ -114,7 +114,7 @@ def _reduce_readings(cfg: dict, D: dict, cell: dict, full: bool, keep_vectors: b
     to the repeatability, set 1 of the photograph (um) and the fit's status (and vectors)."""
     G, Cm = D["G"], D["Cm"]
     nG, S = len(G), cfg["calib.n_sets"]
-    ia, ib = _index(G, (0, 0)), _index(G, (cfg["reduce.ab_mm"], 0))
+    ia, ib = node_index(G, (0, 0)), node_index(G, (cfg["reduce.ab_mm"], 0))
     terms = pl.WOLF_TERMS if cfg["calib.degree"] == 3 else None
     n, sg = cell["reading.n"], cell["reading.pointing_sigma_um"]
     appr, fs = cell["reading.approach"], cell["field_scale"]
@@ -235,7 +235,7 @@ def _degree_chunk_impl(cfg, spacing, rng: np.random.Generator, T: int) -> dict:
     area = cfg["plate.area_mm"]
     G = grid_nodes(area, spacing)
     nx, ny = len(np.unique(G[:, 0])), len(np.unique(G[:, 1]))
-    ia, ib = _index(G, (0, 0)), _index(G, (cfg["reduce.ab_mm"], 0))
+    ia, ib = node_index(G, (0, 0)), node_index(G, (cfg["reduce.ab_mm"], 0))
     nmax = max(cfg["trade.n_sets"])
     t_cal = calib_dates(cfg, nmax)
     dates = np.concatenate([t_cal, [t_cal[-1] + cfg["check.age_weeks"]]])
@@ -270,37 +270,10 @@ def degree_chunk(cfg: dict, spacing: float):
     return functools.partial(_degree_chunk_impl, cfg, spacing)
 
 
-def _stability_chunk_impl(cfg, fractions, ages, rng_: np.random.Generator, T: int) -> dict:
-    """Calibrate on the first ``calib.n_sets`` dates, read an independent plate at each age after
-    the last set, for each drifting share ``f``: rms (um, both axes) before and after."""
-    S = cfg["calib.n_sets"]
-    t_cal = calib_dates(cfg, S)
-    dates = np.concatenate([t_cal, t_cal[-1] + np.asarray(ages, float)])
-    order = np.argsort(dates, kind="stable")
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    area, s = cfg["plate.area_mm"], cfg["plate.spacing_mm"]
-    G = grid_nodes(area, s)
-    ia, ib = _index(G, (0, 0)), _index(G, (cfg["reduce.ab_mm"], 0))
-    terms = pl.WOLF_TERMS if cfg["calib.degree"] == 3 else None
-
-    gs, m5 = cfg["plate.grid_sigma_um"], 5.0
-    # common random numbers: the same instruments, plates and readings for every drifting
-    # share f (the draws do not depend on f), read once; only their mixture depends on f
-    rng = rng_
-    inst = Instrument(cfg, rng, T, dates[order])
-    plate = true_plate(rng, G, T, gs)
-    cal = [
-        measure_parts(
-            rng,
-            inst,
-            int(rank[j]),
-            plate,
-            cfg["plate.rotation_sigma_deg"],
-            cfg["plate.shift_sigma_mm"],
-        )
-        for j in range(S)
-    ]
+def _age_reads(cfg, rng: np.random.Generator, inst, rank, ages, T: int) -> list:
+    """Per age after the last set: an independent plate of ``check.n_points`` random points
+    (5 mm inside the area), its true positions (mm) and its read parts."""
+    S, area, gs, m5 = cfg["calib.n_sets"], cfg["plate.area_mm"], cfg["plate.grid_sigma_um"], 5.0
     checks = []
     for i in range(len(ages)):
         pk = rng.uniform(
@@ -322,6 +295,33 @@ def _stability_chunk_impl(cfg, fractions, ages, rng_: np.random.Generator, T: in
                 ),
             )
         )
+    return checks
+
+
+def _stability_chunk_impl(cfg, fractions, ages, rng: np.random.Generator, T: int) -> dict:
+    """Calibrate on the first ``calib.n_sets`` dates, read an independent plate at each age after
+    the last set, for each drifting share ``f``: rms (um, both axes) before and after."""
+    S = cfg["calib.n_sets"]
+    dates, rank = _dates(cfg, ages)
+    G = grid_nodes(cfg["plate.area_mm"], cfg["plate.spacing_mm"])
+    ia, ib = node_index(G, (0, 0)), node_index(G, (cfg["reduce.ab_mm"], 0))
+    terms = pl.WOLF_TERMS if cfg["calib.degree"] == 3 else None
+    # common random numbers: the same instruments, plates and readings for every drifting
+    # share f (the draws do not depend on f), read once; only their mixture depends on f
+    inst = Instrument(cfg, rng, T, dates)
+    plate = true_plate(rng, G, T, cfg["plate.grid_sigma_um"])
+    cal = [
+        measure_parts(
+            rng,
+            inst,
+            int(rank[j]),
+            plate,
+            cfg["plate.rotation_sigma_deg"],
+            cfg["plate.shift_sigma_mm"],
+        )
+        for j in range(S)
+    ]
+    checks = _age_reads(cfg, rng, inst, rank, ages, T)
     out = {}
     for f in fractions:
         _, _, fit, mtp = calibrate(

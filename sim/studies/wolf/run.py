@@ -30,10 +30,11 @@ from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.wolf import claims as cl
 from sim.studies.wolf import figures, tables
+from sim.studies.wolf.checks import table_path
 from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk
+from sim.studies.wolf.grid import grid_nodes
 from sim.studies.wolf.model import field_spec, reading_error_rms
 from sim.studies.wolf.region import explore_region, nominal
-from sim.studies.wolf.schema import grid_nodes, table_path
 
 APPROACHES = ("one_side", "random")
 
@@ -89,44 +90,38 @@ def over_region(book: ClaimBook, region, preds: list[str], rows: list[dict]) -> 
     return [new.get(r["claim"], r) for r in rows]
 
 
-def run(cfg: dict, out: Path, ctx: RunContext) -> None:
-    q = ctx.quiet
-    prov = provenance(cfg)
-    T, seed, ch = cfg["trials"], cfg["seed"], cfg["chunk"]
-    main = run_chunks(main_chunk(cfg), T, seed, ch, part=0, label="wolf main", quiet=q, ctx=ctx)
-    write_table(out / "trials.parquet", {"trial": np.arange(T), **main}, prov)
-    _vectors_and_components(cfg, out, prov)
+_READING_COLUMNS = (
+    "approach",
+    "pointing_sigma_um",
+    "readings",
+    "reading_error_um",
+    "after_check_rms_um",
+    "after_check_lo_um",
+    "after_check_hi_um",
+    "after_plate_rms_um",
+    "after_plate_lo_um",
+    "after_plate_hi_um",
+)
 
-    # the readings trade-off: one cells run
+
+def _readings(cfg: dict, out: Path, prov: dict, ctx: RunContext) -> None:
+    """The readings trade-off (one cells run, part 1; the reading-error table from stream
+    30): ``readings.parquet``, per approach, pointing sigma and number of readings."""
     rc = reading_cells(cfg)
     cells = [(t, o) for t, *_, o in rc]
-    Ts = cfg["unprinted.trials"]
+    Ts, seed = cfg["unprinted.trials"], cfg["seed"]
     res = run_chunks(
         main_chunk(cfg, cells, full=False),
         Ts,
         seed,
-        sub_chunk(Ts, ch),
+        sub_chunk(Ts, cfg["chunk"]),
         part=1,
         ctx=ctx,
         label="wolf cells",
-        quiet=q,
+        quiet=ctx.quiet,
     )
     er = chunk_rng(seed, 30, 0)
-    rd = {
-        k: []
-        for k in (
-            "approach",
-            "pointing_sigma_um",
-            "readings",
-            "reading_error_um",
-            "after_check_rms_um",
-            "after_check_lo_um",
-            "after_check_hi_um",
-            "after_plate_rms_um",
-            "after_plate_lo_um",
-            "after_plate_hi_um",
-        )
-    }
+    rd = {k: [] for k in _READING_COLUMNS}
     for tag, a, sg, n, _ in rc:
         ca, pa = (
             np.sqrt((res[f"{tag}{e}.rms_x_um"] ** 2 + res[f"{tag}{e}.rms_y_um"] ** 2) / 2)
@@ -143,20 +138,18 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         for k, v in zip(rd, vals):
             rd[k].append(v)
     write_table(out / "readings.parquet", rd, prov)
-    book = cl.load_book()
-    region, preds = explore_region(cfg, book, ctx)
-    write_region(out / "consistent_region.parquet", region, book, preds, prov)
-    wait_early = figures.start_early(cfg, out, ctx.executor)  # drawn while the trade-offs run
 
-    degt = _degree(cfg, out, prov, ctx)
-    _stability(cfg, out, prov, ctx)
 
+def _paper_tables(cfg: dict, out: Path, prov: dict) -> tuple[dict, dict]:
+    """Tables 1 and 3 recomputed from the paper's transcribed coordinates (um), written."""
     t1 = tables.table1_discrepancies(tables.load_table1(table_path(cfg, "table1.file")))
     t3 = tables.table3_discrepancies(tables.load_table3(table_path(cfg, "table3.file")))
     write_table(out / "table1_real.parquet", t1, prov)
     write_table(out / "table3_real.parquet", t3, prov)
-    rows = over_region(book, region, preds, cl.rows(cfg, main, t1, t3, degt, book))
-    write_claims(out / "claims.parquet", rows, prov, book)
+    return t1, t3
+
+
+def _region_figure(cfg: dict, out: Path, region) -> None:
     fig_region(
         region,
         out / "consistent_region.png",
@@ -168,6 +161,31 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
             "mono_sigma_um": "monocomparator sigma (um)",
         },
     )
+
+
+def run(cfg: dict, out: Path, ctx: RunContext) -> None:
+    """The main experiment, the vectors and components, the readings trade-off, the region
+    of the unprinted inputs, the degree and stability trade-offs, the paper's tables, the
+    claims (predictions over the region), the figures."""
+    prov = provenance(cfg)
+    T, seed, ch = cfg["trials"], cfg["seed"], cfg["chunk"]
+    main = run_chunks(
+        main_chunk(cfg), T, seed, ch, part=0, label="wolf main", quiet=ctx.quiet, ctx=ctx
+    )
+    write_table(out / "trials.parquet", {"trial": np.arange(T), **main}, prov)
+    _vectors_and_components(cfg, out, prov)
+    _readings(cfg, out, prov, ctx)
+    book = cl.load_book()
+    region, preds = explore_region(cfg, book, ctx)
+    write_region(out / "consistent_region.parquet", region, book, preds, prov)
+    wait_early = figures.start_early(cfg, out, ctx.executor)  # drawn while the trade-offs run
+
+    degt = _degree(cfg, out, prov, ctx)
+    _stability(cfg, out, prov, ctx)
+    t1, t3 = _paper_tables(cfg, out, prov)
+    rows = over_region(book, region, preds, cl.rows(cfg, main, t1, t3, degt, book))
+    write_claims(out / "claims.parquet", rows, prov, book)
+    _region_figure(cfg, out, region)
     figures.late(cfg, out, ctx.executor)
     wait_early()
 

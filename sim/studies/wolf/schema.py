@@ -1,4 +1,5 @@
-"""Configuration of ``wolf_polynomial``: the schema, the grid, the cross-key rules.
+"""Configuration of ``wolf_polynomial``: the schema (keys, types, ranges, units, inputs). The
+grid geometry is :mod:`.grid`, the cross-key rules :mod:`.checks`.
 
 Seed paper ``000_668e60e68f004f98.txt`` (Wolf & Pearsall 1976). Coordinates in mm,
 discrepancies in um. Keys marked ``input`` were set to match the paper; those the paper does
@@ -9,15 +10,10 @@ example.
 
 from __future__ import annotations
 
-import math
-from pathlib import Path
+from sim.mc.config import COMMON, Field
 
-import numpy as np
+__all__ = ["SCHEMA", "SEED"]
 
-from sim.mc.config import COMMON, ConfigError, Field
-from sim.studies.wolf import tables
-
-ROOT = Path(__file__).resolve().parents[3]
 SEED = "000_668e60e68f004f98.txt"
 
 _amp = dict(lo=0.0, hi=1000.0, unit="um", input=True)
@@ -356,116 +352,3 @@ SCHEMA = {
         min_len=1,
     ),
 }
-
-
-#: work limit of the shared draws: trials x points x readings per chunk (about 8 bytes each)
-MAX_CHUNK_CELLS = 60_000_000
-
-
-def grid_nodes(area, spacing: float) -> np.ndarray:
-    """Intersections of a quadrille at ``spacing`` inside ``area`` = [xmin, xmax, ymin, ymax],
-    on multiples of the spacing (so the origin ``a`` is one), rows from the top, ``(n, 2)`` mm."""
-    x0, x1, y0, y1 = area
-    xs = spacing * np.arange(math.ceil(x0 / spacing - 1e-9), math.floor(x1 / spacing + 1e-9) + 1)
-    ys = spacing * np.arange(math.ceil(y0 / spacing - 1e-9), math.floor(y1 / spacing + 1e-9) + 1)
-    yy, xx = np.meshgrid(ys[::-1], xs, indexing="ij")
-    return np.column_stack([xx.ravel(), yy.ravel()])
-
-
-def mid_cells(area, spacing: float) -> np.ndarray:
-    """Check points at the centres of the grid cells, ``(m, 2)`` mm."""
-    g = grid_nodes(area, spacing)
-    xs, ys = np.unique(g[:, 0]), np.unique(g[:, 1])
-    cx, cy = (xs[:-1] + xs[1:]) / 2, (ys[:-1] + ys[1:]) / 2
-    yy, xx = np.meshgrid(cy[::-1], cx, indexing="ij")
-    return np.column_stack([xx.ravel(), yy.ravel()])
-
-
-def _index(g: np.ndarray, p) -> int:
-    d = np.hypot(g[:, 0] - p[0], g[:, 1] - p[1])
-    j = int(np.argmin(d))
-    return j if d[j] < 1e-6 else -1
-
-
-def _grid_ok(cfg, spacing, key):
-    area = cfg["plate.area_mm"]
-    ab = cfg["reduce.ab_mm"]
-    n = [(area[1] - area[0]) / spacing + 1, (area[3] - area[2]) / spacing + 1]
-    if n[0] * n[1] > 100_000:
-        raise ConfigError(
-            key,
-            f"a grid at {spacing:g} mm has about {n[0] * n[1]:.3g} points in the "
-            "area (more than 100000): the spacing is too fine",
-        )
-    g = grid_nodes(area, spacing)
-    if _index(g, (0.0, 0.0)) < 0 or _index(g, (ab, 0.0)) < 0:
-        raise ConfigError(
-            key,
-            f"a grid at {spacing:g} mm in the area has no intersection at a = "
-            f"(0, 0) or b = ({ab:g}, 0): the spacing must divide ab and b must lie "
-            "in the area",
-        )
-    return g
-
-
-def table_path(cfg: dict, key: str) -> Path:
-    p = Path(cfg[key])
-    return p if p.is_absolute() else ROOT / p
-
-
-def check(cfg: dict) -> None:
-    """Cross-key rules of ``wolf_polynomial``; the transcribed tables are parsed here too, so
-    a wrong file stops the run at load time with one line naming its key."""
-    a = cfg["plate.area_mm"]
-    if len(a) != 4 or not (a[0] < 0 < a[1] and a[2] < 0 < a[3]):
-        raise ConfigError("plate.area_mm", "must be [xmin, xmax, ymin, ymax] around the origin a")
-    if cfg["reduce.ab_mm"] > a[1]:
-        raise ConfigError("reduce.ab_mm", f"b = ({cfg['reduce.ab_mm']:g}, 0) lies outside the area")
-    g = _grid_ok(cfg, cfg["plate.spacing_mm"], "plate.spacing_mm")
-    d = cfg["calib.degree"]
-    nx, ny = len(np.unique(g[:, 0])), len(np.unique(g[:, 1]))
-    if min(nx, ny) < d + 1:
-        raise ConfigError(
-            "calib.degree",
-            f"a degree-{d} polynomial needs at least {d + 1} grid "
-            f"columns and rows (the grid has {nx} x {ny})",
-        )
-    for s in cfg["trade.spacings_mm"]:
-        _grid_ok(cfg, s, "trade.spacings_mm")
-    if (
-        3 not in cfg["trade.degrees"]
-        or len(set(cfg["trade.degrees"])) < 2
-        or cfg["plate.spacing_mm"] not in cfg["trade.spacings_mm"]
-        or cfg["calib.n_sets"] not in cfg["trade.n_sets"]
-    ):
-        raise ConfigError(
-            "trade.degrees",
-            "the degree trade-off must compare the cubic (3) with "
-            "another degree at plate.spacing_mm and calib.n_sets (they must be in "
-            "trade.spacings_mm and trade.n_sets): the claim on the cubic reads it",
-        )
-    if len(cfg["field.spread"]) != 2 or cfg["field.spread"][0] > cfg["field.spread"][1]:
-        raise ConfigError("field.spread", "must be [lo, hi] with lo <= hi")
-    for key in ("repeat.format_mm", "repeat.centre_mm"):
-        if len(cfg[key]) != 2:
-            raise ConfigError(key, "must have two entries")
-    (w, h), (cx, cy) = cfg["repeat.format_mm"], cfg["repeat.centre_mm"]
-    if cx - w / 2 < a[0] or cx + w / 2 > a[1] or cy - h / 2 < a[2] or cy + h / 2 > a[3]:
-        raise ConfigError(
-            "repeat.format_mm",
-            "the photograph must lie inside the calibrated area "
-            "(the polynomial is not meant to extrapolate)",
-        )
-    m = (len(g) + len(mid_cells(a, cfg["plate.spacing_mm"]))) * cfg["calib.n_sets"]
-    m += cfg["check.n_points"] + 2 * (cfg["repeat.n_points"] + 4)
-    nmax = max([cfg["reading.n"], *cfg["trade.readings"]])
-    for key in ("chunk", "trade.trials", "unprinted.trials"):
-        per = min(cfg[key], cfg["chunk"]) * m * 2 * nmax
-        if per > MAX_CHUNK_CELLS:
-            raise ConfigError(
-                key,
-                f"a chunk would hold {per:.3g} readings (trials x points x "
-                f"readings), more than {MAX_CHUNK_CELLS:g}: use a smaller chunk",
-            )
-    tables.load_table1(table_path(cfg, "table1.file"), "table1.file")
-    tables.load_table3(table_path(cfg, "table3.file"), "table3.file")
