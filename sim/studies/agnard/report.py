@@ -256,77 +256,48 @@ def model_choices(out: Path) -> str:
     )
 
 
-def _se(x, se) -> str:
-    """``value ± s.e.`` (the s.e. to two digits)."""
-    return f"{fmt(x)} ± {fmt(se, 2)}"
-
-
-_SCANNER_HEADER = [
-    "DPI",
-    "calibration",
-    "trials",
-    "check XY (m)",
-    "check Z (m)",
-    "control XY (m)",
-    "control Z (m)",
-    "XY gain of calibration (%)",
-]
-_SCANNER_COLUMNS = (
-    "dpi",
-    "calibration",
-    "trials",
-    "check_xy_m",
-    "check_xy_m_se",
-    "check_z_m",
-    "check_z_m_se",
-    "ctrl_xy_m",
-    "ctrl_z_m",
-    "gain_xy_pct",
-    "gain_xy_pct_se",
-)
+def _se(r: dict, q: str) -> str:
+    """``mean ± s.e.`` of column ``q`` of row ``r`` (its s.e. in ``q_se``, to two digits)."""
+    return f"{fmt(r[q])} ± {fmt(r[q + '_se'], 2)}"
 
 
 def _scanner_table(out: Path) -> list[str]:
     """Trade-off of scan resolution and calibration (``tradeoff_scanner.parquet``)."""
-    st = table(out, "tradeoff_scanner.parquet")
     body = [
         [
-            fmt(d),
-            "grid" if c == "corrected" else "none",
-            n,
-            _se(a, b),
-            _se(e, f),
-            fmt(g),
-            fmt(h),
-            _se(gn, gs) if c == "corrected" else "",
+            fmt(r["dpi"]),
+            "grid" if cal else "none",
+            r["trials"],
+            _se(r, "check_xy_m"),
+            _se(r, "check_z_m"),
+            fmt(r["ctrl_xy_m"]),
+            fmt(r["ctrl_z_m"]),
+            _se(r, "gain_xy_pct") if cal else "",
         ]
-        for d, c, n, a, b, e, f, g, h, gn, gs in zip(*(st[k] for k in _SCANNER_COLUMNS))
+        for r in rows(out, "tradeoff_scanner.parquet")
+        for cal in [r["calibration"] == "corrected"]
     ]
+    header = ["DPI", "calibration", "trials", "check XY (m)", "check Z (m)"]
+    header += ["control XY (m)", "control Z (m)", "XY gain of calibration (%)"]
     return [
         "**Trade-off: scan resolution and calibration** (21 control, mean rms over trials ± s.e.):",
-        md_table(_SCANNER_HEADER, body),
+        md_table(header, body),
     ]
-
-
-_LAYOUT_COLUMNS = (
-    "layout",
-    "n_control",
-    "check_xy_m",
-    "check_xy_m_se",
-    "check_z_m",
-    "check_z_m_se",
-    "ctrl_xy_m",
-    "ctrl_z_m",
-)
 
 
 def _layout_table(out: Path) -> list[str]:
     """Trade-off of the control layout (``tradeoff_control.parquet``)."""
-    lt = table(out, "tradeoff_control.parquet")
     header = ["layout", "control", "check XY (m)", "check Z (m)", "control XY (m)", "control Z (m)"]
     body = [
-        [a, n, _se(b, c), _se(d, e), fmt(f), fmt(g)]
-        for a, n, b, c, d, e, f, g in zip(*(lt[k] for k in _LAYOUT_COLUMNS))
+        [
+            r["layout"],
+            r["n_control"],
+            _se(r, "check_xy_m"),
+            _se(r, "check_z_m"),
+            fmt(r["ctrl_xy_m"]),
+            fmt(r["ctrl_z_m"]),
+        ]
+        for r in rows(out, "tradeoff_control.parquet")
     ]
     return [
         "**Trade-off: control layout** (600 DPI calibrated, same trials as the claims):",
@@ -334,55 +305,40 @@ def _layout_table(out: Path) -> list[str]:
     ]
 
 
-_BLOCK_HEADER = [
-    "strips x models",
-    "points",
-    "control",
-    "centre XY (m)",
-    "centre Z (m)",
-    "all check XY (m)",
-    "all check Z (m)",
-]
-_BLOCK_COLUMNS = (
-    "strips",
-    "models",
-    "n_points",
-    "n_control",
-    "centre_xy_m",
-    "centre_xy_m_se",
-    "centre_z_m",
-    "centre_z_m_se",
-    "check_xy_m",
-    "check_z_m",
-)
-
-
 def _block_table(out: Path, cfg: dict) -> list[str]:
     """Trade-off of the block size (``tradeoff_block.parquet``)."""
-    bt = table(out, "tradeoff_block.parquet")
     body = [
-        [f"{s} x {m}", p, c, _se(a, b), _se(d, e), fmt(f), fmt(g)]
-        for s, m, p, c, a, b, d, e, f, g in zip(*(bt[k] for k in _BLOCK_COLUMNS))
+        [
+            f"{r['strips']} x {r['models']}",
+            r["n_points"],
+            r["n_control"],
+            _se(r, "centre_xy_m"),
+            _se(r, "centre_z_m"),
+            fmt(r["check_xy_m"]),
+            fmt(r["check_z_m"]),
+        ]
+        for r in rows(out, "tradeoff_block.parquet")
     ]
+    header = ["strips x models", "points", "control", "centre XY (m)", "centre Z (m)"]
+    header += ["all check XY (m)", "all check Z (m)"]
     return [
         f"**Trade-off: block size** ({cfg['tradeoff.block_control']} control, same point density, "
         f"{cfg['tradeoff.block_trials']} trials each; 'centre' = the "
         f"{cfg['tradeoff.centre_points']} check points nearest the block centre):",
-        md_table(_BLOCK_HEADER, body),
+        md_table(header, body),
     ]
 
 
 def _pugging_table(out: Path) -> list[str]:
     """Sensitivity of the pass-point rejections to the re-centring error."""
-    pt = table(out, "tradeoff_pugging.parquet")
-    cols = ("recentre_px", "trials", "mean_share_pct", "mean_share_pct_se")
+    body = [
+        [fmt(r["recentre_px"]), r["trials"], _se(r, "mean_share_pct")]
+        for r in rows(out, "tradeoff_pugging.parquet")
+    ]
     return [
         "**Sensitivity: mechanical re-centring error against pass-point rejections** "
         "(no gross errors; the snooping weights are those of digital measurement):",
-        md_table(
-            ["re-centring (px)", "trials", "pass points rejected (%)"],
-            [[fmt(r), n, _se(m, e)] for r, n, m, e in zip(*(pt[k] for k in cols))],
-        ),
+        md_table(["re-centring (px)", "trials", "pass points rejected (%)"], body),
     ]
 
 

@@ -184,18 +184,9 @@ def _one(net: Network, o, r: int, v: float) -> None:
         )
 
 
-def write_gama(net: Network, path: str | Path, inner: tuple | list = ()) -> Path:
-    """Write ``net`` as ``gama-local`` XML (see the module doc for the mapping and what is
-    refused); ``inner``: indices of the points of an inner datum (``adj="XY"``)."""
-    _refuse(net)
-    pairs = _vector_pairs(net)
-    val = computed(net, net.theta_true()[None])[0]
-    root = ET.Element("gama-local", xmlns=NS)
-    nw = ET.SubElement(root, "network", {"axes-xy": "ne", "angles": "left-handed"})
-    ET.SubElement(nw, "description").text = net.name
-    ET.SubElement(nw, "parameters", {"sigma-apr": "1", "sigma-act": "apriori"})
-    po = ET.SubElement(nw, "points-observations")
-    inner = {int(a) for a in inner}
+def _points(net: Network, po: ET.Element, inner: set[int], pairs: bool) -> None:
+    """One ``<point>`` per point (m): fixed ones ``fix``, estimated ones ``adj`` (``XY`` in
+    the inner datum); with coordinate-difference vectors every point also gets z = 0 (fixed)."""
     for a, nm in enumerate(net.names):
         attr = {"id": nm, "x": _fmt(net.xy[a, 0] / 1000), "y": _fmt(net.xy[a, 1] / 1000)}
         if net.role[a] == 1:
@@ -207,41 +198,65 @@ def write_gama(net: Network, path: str | Path, inner: tuple | list = ()) -> Path
         if pairs:
             attr["z"] = "0"
         ET.SubElement(po, "point", attr)
-    _obs_sets(net, po, val)
+
+
+def _coordinates(net: Network, po: ET.Element) -> None:
+    """The observed coordinates (m) of the points with that role, with their diagonal
+    covariance matrix (mm^2)."""
     obs_pts = np.flatnonzero(net.role == 2)
-    if obs_pts.size:
-        c = ET.SubElement(po, "coordinates")
-        for a in obs_pts:
-            ET.SubElement(
-                c,
-                "point",
-                {
-                    "id": net.names[a],
-                    "x": _fmt(net.xy[a, 0] / 1000),
-                    "y": _fmt(net.xy[a, 1] / 1000),
-                },
-            )
-        sig = {int(a): s for a, s in zip(net.i[net.kind == 5], net.sigma[net.kind == 5])}
-        cm = ET.SubElement(c, "cov-mat", {"dim": str(2 * obs_pts.size), "band": "0"})
-        cm.text = " ".join(_fmt(sig[int(a)] ** 2) for a in obs_pts for _ in (0, 1))
-    if pairs:
-        v = ET.SubElement(po, "vectors")
-        for rx, ry in pairs:
-            ET.SubElement(
-                v,
-                "vec",
-                {
-                    "from": net.names[net.i[rx]],
-                    "to": net.names[net.j[rx]],
-                    "dx": _fmt(val[rx] / 1000),
-                    "dy": _fmt(val[ry] / 1000),
-                    "dz": "0.0",
-                },
-            )
-        cm = ET.SubElement(v, "cov-mat", {"dim": str(3 * len(pairs)), "band": "0"})
-        cm.text = " ".join(
-            f"{_fmt(net.sigma[rx] ** 2)} {_fmt(net.sigma[ry] ** 2)} 1.0" for rx, ry in pairs
+    if not obs_pts.size:
+        return
+    c = ET.SubElement(po, "coordinates")
+    for a in obs_pts:
+        ET.SubElement(
+            c,
+            "point",
+            {"id": net.names[a], "x": _fmt(net.xy[a, 0] / 1000), "y": _fmt(net.xy[a, 1] / 1000)},
         )
+    sig = {int(a): s for a, s in zip(net.i[net.kind == 5], net.sigma[net.kind == 5])}
+    cm = ET.SubElement(c, "cov-mat", {"dim": str(2 * obs_pts.size), "band": "0"})
+    cm.text = " ".join(_fmt(sig[int(a)] ** 2) for a in obs_pts for _ in (0, 1))
+
+
+def _vectors(net: Network, po: ET.Element, pairs: list, val: np.ndarray) -> None:
+    """The coordinate-difference pairs as 3-D ``<vec>`` (m, dz = 0) with their diagonal
+    covariance matrix (mm^2; the z variance 1)."""
+    if not pairs:
+        return
+    v = ET.SubElement(po, "vectors")
+    for rx, ry in pairs:
+        ET.SubElement(
+            v,
+            "vec",
+            {
+                "from": net.names[net.i[rx]],
+                "to": net.names[net.j[rx]],
+                "dx": _fmt(val[rx] / 1000),
+                "dy": _fmt(val[ry] / 1000),
+                "dz": "0.0",
+            },
+        )
+    cm = ET.SubElement(v, "cov-mat", {"dim": str(3 * len(pairs)), "band": "0"})
+    cm.text = " ".join(
+        f"{_fmt(net.sigma[rx] ** 2)} {_fmt(net.sigma[ry] ** 2)} 1.0" for rx, ry in pairs
+    )
+
+
+def write_gama(net: Network, path: str | Path, inner: tuple | list = ()) -> Path:
+    """Write ``net`` as ``gama-local`` XML (see the module doc for the mapping and what is
+    refused); ``inner``: indices of the points of an inner datum (``adj="XY"``)."""
+    _refuse(net)
+    pairs = _vector_pairs(net)
+    val = computed(net, net.theta_true()[None])[0]
+    root = ET.Element("gama-local", xmlns=NS)
+    nw = ET.SubElement(root, "network", {"axes-xy": "ne", "angles": "left-handed"})
+    ET.SubElement(nw, "description").text = net.name
+    ET.SubElement(nw, "parameters", {"sigma-apr": "1", "sigma-act": "apriori"})
+    po = ET.SubElement(nw, "points-observations")
+    _points(net, po, {int(a) for a in inner}, bool(pairs))
+    _obs_sets(net, po, val)
+    _coordinates(net, po)
+    _vectors(net, po, pairs, val)
     ET.indent(root)
     path = Path(path)
     path.write_text('<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n")

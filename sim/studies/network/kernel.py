@@ -29,21 +29,17 @@ def _kernel(
     two_pi = 2.0 * math.pi
     d = np.zeros(9)  # derivatives by x_i, y_i, x_j, y_j, x_k, y_k, orientation, constant, scale
     for t in range(T):
-        for c in range(g.shape[1]):
-            g[t, c] = 0.0
+        g[t, :] = 0.0
         alpha = theta[t, ic]
         f = 1.0 + 1e-6 * theta[t, isc]
         for row in range(m):
             kd, i, j, k = kind[row], ii[row], jj[row], kk[row]
             xi, yi = theta[t, 2 * i], theta[t, 2 * i + 1]
-            for a in range(9):
-                d[a] = 0.0
+            d[:] = 0.0
             if kd == 5:
-                val = xi
-                d[0] = 1.0
+                val, d[0] = xi, 1.0
             elif kd == 6:
-                val = yi
-                d[1] = 1.0
+                val, d[1] = yi, 1.0
             else:
                 dx, dy = theta[t, 2 * j] - xi, theta[t, 2 * j + 1] - yi
                 d2 = dx * dx + dy * dy
@@ -65,27 +61,15 @@ def _kernel(
                     d[0], d[1], d[2], d[3] = -(gx + hx), -(gy + hy), gx, gy
                     d[4], d[5] = hx, hy
                 elif kd == 3:
-                    val = dx
-                    d[0], d[2] = -1.0, 1.0
+                    val, d[0], d[2] = dx, -1.0, 1.0
                 else:
-                    val = dy
-                    d[1], d[3] = -1.0, 1.0
+                    val, d[1], d[3] = dy, -1.0, 1.0
             res = obs[t, row] - val
             if kd == 1 or kd == 2:
                 res = (res + math.pi) % two_pi - math.pi
             r[t, row] = res
             wr = w[row] * res
-            cols = (
-                2 * i,
-                2 * i + 1,
-                2 * j,
-                2 * j + 1,
-                2 * k,
-                2 * k + 1,
-                n2 + oset[row],
-                ic,
-                isc,
-            )
+            cols = (2 * i, 2 * i + 1, 2 * j, 2 * j + 1, 2 * k, 2 * k + 1, n2 + oset[row], ic, isc)
             for a in range(9):
                 if d[a] != 0.0:
                     fp = fpos[cols[a]]

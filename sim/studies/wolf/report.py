@@ -120,64 +120,45 @@ def _components_table(cfg: dict, tr: dict) -> str:
     )
 
 
-def _columns(t: dict, cols: tuple[str, ...]) -> list[list]:
-    """The rows of the columns ``cols`` of table ``t``, as they are."""
-    return [list(r) for r in zip(*(t[k] for k in cols))]
+#: the columns of Tables 1 and 3 as the report shows them: header -> column
+_TABLE1 = {
+    "plate": "plate",
+    "point": "point",
+    "X set1-set2": "dx_sets_um",
+    "Y set1-set2": "dy_sets_um",
+    "X s1-Foster": "dx_set1_foster_um",
+    "X s2-Foster": "dx_set2_foster_um",
+    "Y s1-Foster": "dy_set1_foster_um",
+    "Y s2-Foster": "dy_set2_foster_um",
+}
+_TABLE3 = {
+    "photo": "photo",
+    "point": "point",
+    "dX printed": "dx_printed_um",
+    "dX coordinates": "dx_coord_um",
+    "dY printed": "dy_printed_um",
+    "dY coordinates": "dy_coord_um",
+    "note": "note",
+}
 
 
-_TABLE1_COLUMNS = (
-    "plate",
-    "point",
-    "dx_sets_um",
-    "dy_sets_um",
-    "dx_set1_foster_um",
-    "dx_set2_foster_um",
-    "dy_set1_foster_um",
-    "dy_set2_foster_um",
-)
-_TABLE1_HEADER = [
-    "plate",
-    "point",
-    "X set1-set2",
-    "Y set1-set2",
-    "X s1-Foster",
-    "X s2-Foster",
-    "Y s1-Foster",
-    "Y s2-Foster",
-]
-_TABLE3_COLUMNS = (
-    "photo",
-    "point",
-    "dx_printed_um",
-    "dx_coord_um",
-    "dy_printed_um",
-    "dy_coord_um",
-    "note",
-)
-_TABLE3_HEADER = [
-    "photo",
-    "point",
-    "dX printed",
-    "dX coordinates",
-    "dY printed",
-    "dY coordinates",
-    "note",
-]
+def _as_is(out: Path, name: str, cols: dict[str, str]) -> str:
+    """The Markdown table of the columns ``cols`` (header -> column) of ``out/name``, with the
+    values as they are."""
+    return md_table(list(cols), [[r[c] for c in cols.values()] for r in rows(out, name)])
 
 
 def _paper_tables(out: Path, cfg: dict) -> list[str]:
     """Tables 1 and 3 recomputed from the paper's transcribed coordinates (um)."""
-    t1 = table(out, "table1_real.parquet")
-    t3 = table(out, "table3_real.parquet")
     return [
         "**Tables 1 and 2 from the paper's coordinates** (used by the `wolf.table1` and "
         "`wolf.table2_check` rows). Per point, Set 1 - Set 2 and each set minus the H. Dell "
         f"Foster coordinates, in um, from the transcription `{cfg['table1.file']}`:",
-        md_table(_TABLE1_HEADER, _columns(t1, _TABLE1_COLUMNS)),
+        _as_is(out, "table1_real.parquet", _TABLE1),
         figure(out, "table1_real.png", "Table 1 vectors"),
         f"**Table 3** (`{cfg['table3.file']}`): the printed differences and those from the "
         "coordinates, um (the `wolf.table3_check` rows use the printed differences):",
-        md_table(_TABLE3_HEADER, _columns(t3, _TABLE3_COLUMNS)),
+        _as_is(out, "table3_real.parquet", _TABLE3),
     ]
 
 
