@@ -8,6 +8,13 @@ ellipses with their coverage, per observation redundancy numbers, minimal detect
 and their effect on the coordinates, the false-alarm rate of the global test, the dilution
 against a second parameterisation, other datums by S-transformation, and the network in
 GNU Gama's ``gama-local`` XML (:mod:`.gama`). Examples: ``studies/network_*.toml``.
+
+Modules: :mod:`.schema`, :mod:`.definition` (the network from the study file), :mod:`.model`
+and :mod:`.kernel` (observation model), :mod:`.analysis` and :mod:`.sparse_analysis`
+(pre-analysis and Monte-Carlo chunks), :mod:`.run` (the steps), :mod:`.estimates`
+(Monte-Carlo estimates from the chunk sums), :mod:`.tables` (one writer per table),
+:mod:`.claims` (self-checks and findings), :mod:`.gama` and :mod:`.gama_read`,
+:mod:`.figures`, :mod:`.report`.
 """
 
 from __future__ import annotations

@@ -33,6 +33,7 @@ __all__ = [
     "Analytic",
     "analyse",
     "delta0",
+    "chunk_output",
     "mc_chunk",
     "point_cov_in",
     "in_datum",
@@ -210,6 +211,45 @@ def bearing_deg(cov: np.ndarray) -> tuple[list, list[str]]:
     return [None if w else float(t) for t, w in zip(th, why)], why
 
 
+def chunk_output(
+    net: Network,
+    err: np.ndarray,
+    ok: np.ndarray,
+    pts: np.ndarray,
+    cov_inv: np.ndarray,
+    vpv: np.ndarray,
+    crit: float,
+    par: np.ndarray | None,
+    status: np.ndarray,
+    sigma0: np.ndarray,
+    iterations: np.ndarray,
+) -> dict:
+    """What one chunk of ``n`` adjustments returns, from the errors ``err`` (n, q) of the
+    estimated globals (coordinates mm) and which trials converged (``ok``): per chunk, the
+    count, the sums and sums of squares of the coordinate errors of ``pts`` and of the
+    parameter errors ``par``, the points inside their analytic 95 % ellipse (``cov_inv``),
+    the global tests rejected (``vpv > crit``); per trial, status, sigma0 (-1: none) and
+    iterations."""
+    n = err.shape[0]
+    e = err[:, : 2 * net.n].reshape(n, net.n, 2)[:, pts][ok]  # (N, k, 2)
+    inside = np.einsum("tki,kij,tkj->tk", e, cov_inv, e) <= CHI2_2_95
+    par = np.zeros(0, int) if par is None else np.asarray(par, int)
+    g = err[:, par][ok]  # (N, k_par)
+    return {
+        "sum.n": np.array([[ok.sum()]], float),
+        "sum.pe": g.sum(0)[None],
+        "sum.pee": (g * g).sum(0)[None],
+        "sum.e": e.sum(0)[None],
+        "sum.ee": np.einsum("tki,tkj->kij", e, e)[None],
+        "sum.inside": inside.sum(0)[None].astype(float),
+        "sum.reject": np.array([[(vpv[ok] > crit).sum()]], float),
+        "rows.converged": ok,
+        "rows.status": status.astype(np.int8),
+        "rows.sigma0": np.where(np.isfinite(sigma0), sigma0, -1.0),
+        "rows.iterations": iterations,
+    }
+
+
 def mc_chunk(
     rng: np.random.Generator,
     n: int,
@@ -233,21 +273,8 @@ def mc_chunk(
         NetworkModel(net, obs), theta, datum=lsq.Datum(free, C), tol=tol, max_iter=max_iter
     )
     ok = res.converged
-    e = (res.theta - theta)[:, : 2 * net.n].reshape(n, net.n, 2)[:, pts][ok]  # (N, k, 2)
-    inside = np.einsum("tki,kij,tkj->tk", e, cov_inv, e) <= CHI2_2_95
     vpv = res.sigma0**2 * res.dof if res.dof > 0 else np.zeros(n)
-    par = np.zeros(0, int) if par is None else np.asarray(par, int)
-    g = (res.theta - theta)[:, par][ok]  # (N, k_par)
-    return {
-        "sum.n": np.array([[ok.sum()]], float),
-        "sum.pe": g.sum(0)[None],
-        "sum.pee": (g * g).sum(0)[None],
-        "sum.e": e.sum(0)[None],
-        "sum.ee": np.einsum("tki,tkj->kij", e, e)[None],
-        "sum.inside": inside.sum(0)[None].astype(float),
-        "sum.reject": np.array([[(vpv[ok] > crit).sum()]], float),
-        "rows.converged": ok,
-        "rows.status": res.status.astype(np.int8),
-        "rows.sigma0": np.where(np.isfinite(res.sigma0), res.sigma0, -1.0),
-        "rows.iterations": res.iterations,
-    }
+    err = res.theta - theta
+    return chunk_output(
+        net, err, ok, pts, cov_inv, vpv, crit, par, res.status, res.sigma0, res.iterations
+    )

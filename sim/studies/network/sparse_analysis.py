@@ -25,9 +25,9 @@ import numpy as np
 from sim import lsq
 from sim.lsq import sparse as lsq_sparse
 from sim.studies.network.analysis import (
-    CHI2_2_95,
     Analytic,
     analyse,
+    chunk_output,
     datum_weights,
     delta0,
     inner_defect,
@@ -284,23 +284,6 @@ def mc_chunk_sparse(
         linear=bool(np.isin(net.kind, (3, 4, 5, 6)).all()),
     )
     ok = status == 0
-    err = theta - theta0
-    e = err[:, : 2 * net.n].reshape(n, net.n, 2)[:, pts][ok]
-    inside = np.einsum("tki,kij,tkj->tk", e, cov_inv, e) <= CHI2_2_95
     vpv = vpv if dof > 0 else np.zeros(n)
-    par = np.zeros(0, int) if par is None else np.asarray(par, int)
-    g = err[:, par][ok]
     s0 = np.sqrt(vpv / dof) if dof > 0 else np.full(n, np.nan)
-    return {
-        "sum.n": np.array([[ok.sum()]], float),
-        "sum.pe": g.sum(0)[None],
-        "sum.pee": (g * g).sum(0)[None],
-        "sum.e": e.sum(0)[None],
-        "sum.ee": np.einsum("tki,tkj->kij", e, e)[None],
-        "sum.inside": inside.sum(0)[None].astype(float),
-        "sum.reject": np.array([[(vpv[ok] > crit).sum()]], float),
-        "rows.converged": ok,
-        "rows.status": status.astype(np.int8),
-        "rows.sigma0": np.where(np.isfinite(s0), s0, -1.0),
-        "rows.iterations": iters,
-    }
+    return chunk_output(net, theta - theta0, ok, pts, cov_inv, vpv, crit, par, status, s0, iters)
