@@ -87,9 +87,19 @@ def test_sparse_equals_dense_on_small_networks(case, tmp_path):
     np.testing.assert_array_less(
         np.abs(s.bnr[fin] / d.bnr[fin] - 1), 1e-10 * np.maximum(1.0, 1 / r) + 1e-12
     )
-    # the local external reliability is the largest displacement at the observation's own
-    # points: never above the dense path's largest over all points (to the MDB's precision)
+    # the sparse path's external reliability is exactly the local one: the largest
+    # displacement an undetected MDB causes at the observation's own points (from the dense
+    # shift Q Aw_i' MDB_i / sigma_i), never above the dense path's largest over all points
     tol_ext = 1e-10 * np.maximum(1.0, 0.5 / r) + 1e-14
+    Aw = model.weighted_design(net, d.free).toarray()
+    shift = np.zeros((net.q, net.m))
+    shift[d.free] = (d.Q @ Aw.T) * np.where(fin, d.mdb / net.sigma, 0.0)
+    disp = np.hypot(shift[0 : 2 * net.n : 2], shift[1 : 2 * net.n : 2])  # (n, m)
+    local = np.zeros(net.m)
+    for e in (net.i, net.j, net.k):
+        local = np.maximum(local, np.where(e >= 0, disp[np.maximum(e, 0), np.arange(net.m)], 0))
+    err = np.abs(s.ext_max_mm[fin] - local[fin])
+    assert np.all(err <= tol_ext * local[fin] + 1e-14 * local.max())
     assert np.all(s.ext_max_mm[fin] <= d.ext_max_mm[fin] * (1 + tol_ext))
     par = np.arange(len(d.free))
     np.testing.assert_allclose(
