@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 import tomllib
 from pathlib import Path
 
@@ -26,6 +27,7 @@ from benchmarks.engines import engine_rows
 from benchmarks.figures import brown_figure, engines_figure
 from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
+from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
 from sim.mc.storage import provenance, write_table
 
 __all__ = ["main", "run"]
@@ -85,8 +87,7 @@ def run(
             provenance(prov, files=[f.as_posix() for f in files], tiny_configurations=quick),
         )
     if "scaling" in sections:
-        from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
-
+        t0 = time.perf_counter()
         tables["scaling.parquet"] = scaling_rows(quick)
         write_table(
             out / "scaling.parquet",
@@ -94,6 +95,7 @@ def run(
             provenance(prov, gama_local=gama_local() or ""),
         )
         scaling_figure(tables["scaling.parquet"], out / "scaling.png")
+        print(f"benchmarks: scaling took {time.perf_counter() - t0:.0f} s", file=sys.stderr)
     if "engines" in sections or "rerun" in sections:
         engines_figure(
             tables.get("engines.parquet"), tables.get("rerun.parquet"), out / "engines.png"

@@ -17,10 +17,14 @@ their number, so one batched product per bucket; work grows with the pairs, not 
 square of the block). Point Jacobians that are one constant diagonal matrix (coordinates
 observed directly) make the point blocks diagonal and their elimination elementwise. Small
 blocks are solved densely, batched over trials (Cholesky of the matrix scaled to unit
-diagonal, after the one scaled singularity rule of :mod:`sim.lsq.normals`); from
-``sparse_from`` groups up the groups are reordered to a narrow band and eliminated block by
-block, still batched (:mod:`sim.lsq.group_solve`; there the rule is replaced by a finite
-solution check, an eigenvalue bound being dearer than the solve). Cofactors need only the
+diagonal, after the one scaled singularity rule of :mod:`sim.lsq.normals`); large ones (the
+engine's size rule, :func:`sim.lsq.size.use_sparse` on the ``G b`` reduced unknowns) by the
+sparse ``L D L'`` of :mod:`sim.lsq.sparse_batch`: the groups ordered by minimum degree and
+the factor's pattern analysed once per structure, every trial factorised on it in one
+compiled pass (a scaled pivot at or below ``rcond`` flags the trial). Without the compiled
+kernels, and as ``solver="band"``, the groups are reordered to a narrow band and eliminated
+block by block, still batched (:mod:`sim.lsq.group_solve`; there the rule is replaced by a
+finite solution check). Cofactors need only the
 group-pair blocks of the inverse: per observation ``H_k`` (see :class:`GroupCofactors`),
 one batched product per bucket of points with the same number of observations, and
 optionally only for the points asked for. A point block whose
@@ -35,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from sim.lsq import compile, group_kernel, group_kernel_solve
+from sim.lsq import compile, group_kernel, group_kernel_solve, sparse_batch
 from sim.lsq.group_solve import (
     band_order,
     band_solve,
@@ -48,6 +52,7 @@ from sim.lsq.group_solve import (
     scaled,
 )
 from sim.lsq.normals import RCOND
+from sim.lsq.size import use_sparse
 
 __all__ = ["GroupStructure", "GroupLinearization", "chol_solve", "step", "cofactors"]
 
@@ -85,14 +90,20 @@ class GroupStructure:
     """Which group observes which point, and the scatter operators derived from it once.
 
     obs_group, obs_point : (K,); point_rows : (C,) points of the point-only rows; n_groups,
-    n_points; sparse_from : groups from which the reduced normals are solved by the banded
-    elimination. ``pk1, pk2`` are all ordered pairs of observations of the same point;
+    n_points; sparse_from : groups from which the reduced normals are solved on the sparse
+    path (None: the engine's size rule on the reduced unknowns, :func:`sim.lsq.size.use_sparse`). ``pk1, pk2`` are all ordered pairs of observations of the same point;
     ``gp_buckets`` the observation pairs summed into each group pair, ``group_buckets`` the
     observations of each group and ``point_buckets`` those of each point, bucketed by count.
     """
 
     def __init__(
-        self, obs_group, obs_point, point_rows, n_groups: int, n_points: int, sparse_from: int = 60
+        self,
+        obs_group,
+        obs_point,
+        point_rows,
+        n_groups: int,
+        n_points: int,
+        sparse_from: int | None = None,
     ):
         og = np.asarray(obs_group, np.intp)
         op = np.asarray(obs_point, np.intp)
@@ -121,6 +132,20 @@ class GroupStructure:
         self.diag_of_group[self.pair_g1[diag]] = diag
         self.band = band_order(self.pair_g1, self.pair_g2, G)
         self._kernel_index = None
+        self._batch: dict = {}
+
+    def batch_pattern(self, b: int) -> sparse_batch.BatchPattern:
+        """The order and factor pattern of the reduced normals with ``b`` unknowns a group
+        (:func:`sim.lsq.sparse_batch.analyse`, once per structure)."""
+        if b not in self._batch:
+            self._batch[b] = sparse_batch.analyse(self.pair_g1, self.pair_g2, self.n_groups, b)
+        return self._batch[b]
+
+    def sparse(self, b: int) -> bool:
+        """Whether the reduced normals (``b`` unknowns a group) take the sparse path."""
+        if self.sparse_from is None:
+            return use_sparse(self.n_groups * b)
+        return self.n_groups >= self.sparse_from
 
     @property
     def kernel_index(self) -> dict:
@@ -256,15 +281,21 @@ def solve(
 
     ``check``: apply the scaled singularity rule (:func:`~sim.lsq.group_solve.regular`; the loop applies it at the
     first linearisation, where rank defects of the geometry show, and again whenever a
-    factorisation fails). ``sparse`` (from ``sparse_from`` groups up): the banded
-    elimination of :func:`~sim.lsq.group_solve.band_solve`, where a failed factorisation or a non-finite
-    solution flags the trial."""
+    factorisation fails). ``auto``: ``sparse`` where :meth:`GroupStructure.sparse` says so,
+    else ``dense``. ``sparse``: :func:`sim.lsq.sparse_batch.solve_batch` (a scaled pivot at or
+    below ``rcond``, or a non-finite solution, flags the trial) when the compiled kernels run,
+    else ``band``: the banded elimination of :func:`~sim.lsq.group_solve.band_solve`, where a
+    failed factorisation or a non-finite solution flags the trial."""
     T, G, b = red.ubar.shape
     rhs = red.ubar.reshape(T, G * b)
     if solver == "auto":
-        solver = "sparse" if G >= st.sparse_from else "dense"
+        solver = "sparse" if st.sparse(b) else "dense"
+    if solver == "sparse" and not compile.available():
+        solver = "band"
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         if solver == "sparse":
+            dg, ok = sparse_batch.solve_batch(st.batch_pattern(b), red.blocks, rhs, rcond)
+        elif solver == "band":
             dg, ok = band_solve(st, red.blocks, rhs)
         else:
             Ns, s = (

@@ -22,6 +22,7 @@ import os
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
+from sim.lsq.size import SPARSE_MIN_UNKNOWNS
 from sim.mc.config import ConfigError
 from sim.mc.sweep import MAX_CELLS, expand
 
@@ -257,9 +258,8 @@ def _agnard(c: Mapping) -> tuple:
     return trials, adj, int(max(U, Ut)), b
 
 
-#: unknowns from which the network kind takes the sparse path (as
-#: sim.studies.network.sparse_analysis.SPARSE_MIN_UNKNOWNS; a layer below, so stated twice)
-NETWORK_SPARSE_FROM = 400
+#: unknowns from which the network kind takes the sparse path (the engine's size rule)
+NETWORK_SPARSE_FROM = SPARSE_MIN_UNKNOWNS
 
 
 def _network_names(c: Mapping) -> list[str]:

@@ -18,6 +18,7 @@ import numpy as np
 
 from sim import lsq
 from sim.lsq import sparse as lsq_sparse
+from sim.lsq.size import SPARSE_MIN_UNKNOWNS
 from sim.mc.config import ConfigError
 from sim.studies.network.definition import Network
 
@@ -215,9 +216,8 @@ def _similarity(net: Network) -> np.ndarray:
     return G
 
 
-#: networks with at least this many unknowns take the sparse path (smaller ones the dense one,
-#: the reference of the tests; :mod:`sim.studies.network.sparse_analysis`)
-SPARSE_MIN_UNKNOWNS = 400
+# networks with at least SPARSE_MIN_UNKNOWNS unknowns take the sparse path (the engine's one
+# size rule, sim.lsq.size; smaller ones the dense one, the reference of the tests)
 
 
 def use_sparse(net: Network) -> bool:
