@@ -35,8 +35,11 @@ With ``I`` the simulated interval and ``Z`` the decision zone:
   inside ``Z`` (the simulation is sharp enough to decide); otherwise **inconclusive**.
 
 Over a consistent region of unprinted inputs (:mod:`sim.claims.region`) a prediction is
-**holds** / **fails** at every input of the region, **depends** (holds for part of it; the
-note says where) or **undecidable** (no input of the region decides it).
+**holds** / **fails** at every input of the region, **depends** (holds for part of it and
+fails for another; the note says where), **holds or undecided** / **fails or undecided**
+(holds, resp. fails, for part of it, the opposite nowhere, undecided at the rest) or
+**undecidable** (no input of the region decides it); the rule is
+:func:`sim.claims.region.region_verdict`.
 
 The rule's result is the ``outcome`` column. The ``verdict`` is the outcome for
 ``kind = "prediction"`` and for ``"paper-check"`` (where a failing outcome is an
@@ -83,6 +86,8 @@ VERDICTS = (
     "fails",
     "inconclusive",
     "depends",
+    "holds or undecided",
+    "fails or undecided",
     "undecidable",
     "erratum",
     "input",
