@@ -11,6 +11,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from sim.claims import book as bk
+from sim.claims import rules
 from sim.claims.book import P_FAIL, ClaimBook, decide, write_claims
 from sim.mc.storage import read_provenance
 
@@ -96,7 +97,7 @@ def test_bounds_are_half_infinite_zones(form, interval, outcome):
     else:
         assert r["zone_low"] == 1.25 and r["zone_high"] == math.inf
     assert r["outcome"] == outcome
-    assert bk._zone(form, (2.0, 2.0), 0.5, 0.25) == (r["zone_low"], r["zone_high"])
+    assert rules.zone(form, (2.0, 2.0), 0.5, 0.25) == (r["zone_low"], r["zone_high"])
 
 
 # --------------------------------------------------------------------------- range
@@ -249,13 +250,17 @@ def test_kinds_without_a_number():
     assert b.score("c", 1.0, (0.5, 1.5))["note"] == "no setup"
     b = ClaimBook([{"id": "c", "source": "s", "paper": "p", "kind": "not comparable"}], [])
     assert b.path == "<claims>" and b.score("c", 1.0, (0.5, 1.5), note="n")["note"] == "n"
-    assert bk._verdict("prediction", None) == "finding"
-    assert bk._verdict("paper-check", None) == "finding"
-    assert bk._verdict("paper-check", "fails") == "erratum"
-    assert {v: bk._holds(v) for v in bk.VERDICTS} == {
+    assert rules.verdict_of("prediction", None) == "finding"
+    assert rules.verdict_of("paper-check", None) == "finding"
+    assert rules.verdict_of("paper-check", "fails") == "erratum"
+    assert {v: rules.holds_of(v) for v in bk.VERDICTS} == {
         v: {"holds": True, "fails": False, "erratum": False}.get(v) for v in bk.VERDICTS
     }
-    assert [v for v in bk.VERDICTS if bk._holds(v) is not None] == ["holds", "fails", "erratum"]
+    assert [v for v in bk.VERDICTS if rules.holds_of(v) is not None] == [
+        "holds",
+        "fails",
+        "erratum",
+    ]
 
 
 # --------------------------------------------------------------------------- provenance

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from sim.claims.region import REGION_VERDICTS
 from sim.instruments import transforms2d as tf
 from sim.instruments.plotter import errorfields as ef
 from sim.instruments.plotter import polynomial as pl
@@ -415,7 +416,7 @@ def test_study_runs_and_reports(tmp_path):
         assert all(o != "fails" for o in reg[cid])
     for cid in ("wolf.headline.mean_vs_mono_um", "wolf.table2.joint_holm"):
         assert claims["interval"][by[cid]] == "region"
-        assert claims["verdict"][by[cid]] in ("holds", "fails", "depends", "undecidable")
+        assert claims["verdict"][by[cid]] in REGION_VERDICTS
     d = read_table(tmp_path / "degree.parquet").to_pydict()
     k = [j for j, (s, g) in enumerate(zip(d["spacing_mm"], d["degree"])) if s == 50.0 and g == 3]
     assert all(d["estimable_share"][j] == 0 for j in k)  # 2 rows cannot carry a cubic

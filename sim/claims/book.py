@@ -6,46 +6,7 @@ The study's code only supplies what the simulation produced (an estimate with it
 per-element intervals, or the per-plate distribution); the verdict follows from the rule
 below, never from code that knows the answer.
 
-Forms (``form``)
-================
-``value``      a printed number: it stands for ``ref`` +- half a unit of its last printed
-               decimal (``decimals``); the *decision zone* widens that by ``tol``.
-``share``      a printed proportion (0-1), as ``value``.
-``count``      a printed count, as ``value``.
-``upper``      a bound "at most ``ref``" (zone ``(-inf, ref + rounding + tol]``).
-``lower``      a bound "at least ``ref``" (zone ``[ref - rounding - tol, inf)``).
-``range``      "from a to b": every element (e.g. every point's dilution) is to lie in
-               ``[a, b]`` (widened by the rounding and ``tol``).
-``one-plate``  the paper's number is one plate's statistic (one observed rms, one count):
-               the simulation gives its distribution over plates.
-
-Verdicts (``verdict``)
-======================
-With ``I`` the simulated interval and ``Z`` the decision zone:
-
-* ``value``/``share``/``count``/``upper``/``lower``: **holds** iff ``I`` lies inside ``Z``;
-  **fails** iff ``I`` and ``Z`` do not meet; otherwise **inconclusive** (the interval covers
-  both values that agree and values that contradict the claim). An ``exact`` interval (a
-  deterministic computation) is a point, so it is never inconclusive.
-* ``range``: **holds** iff every element's interval lies inside ``Z``; **fails** iff some
-  element's interval lies wholly outside ``Z``; otherwise **inconclusive**.
-* ``one-plate``: with ``q`` the simulated probability of a plate at or below the paper's
-  value, ``p = 2 min(q, 1 - q)`` is the probability of a plate at least as extreme.
-  **fails** iff ``p < 0.05``; **holds** iff ``p >= 0.05`` and the central 95 % of plates lies
-  inside ``Z`` (the simulation is sharp enough to decide); otherwise **inconclusive**.
-
-Over a consistent region of unprinted inputs (:mod:`sim.claims.region`) a prediction is
-**holds** / **fails** at every input of the region, **depends** (holds for part of it; the
-note says where) or **undecidable** (no input of the region decides it).
-
-The rule's result is the ``outcome`` column. The ``verdict`` is the outcome for
-``kind = "prediction"`` and for ``"paper-check"`` (where a failing outcome is an
-**erratum**: the paper contradicts its own printed data, and ``value`` is the recomputation
-from that data); the other kinds are counted apart: ``input`` (a simulation input set to
-match the paper: agreement by construction), ``self-check`` (Monte Carlo against analytic,
-coverage, posterior against least squares), ``finding`` (the project's own result, no paper
-number) and ``not comparable`` (the paper's number comes from a setup its text does not let
-us simulate; ``note`` says why).
+The decision rules (forms, zones, verdicts) are in :mod:`sim.claims.rules`.
 
 Columns of ``claims.parquet``: ``CLAIM_COLUMNS``. ``holds`` is derived from ``verdict``
 (true for holds, false for fails and erratum, null otherwise). Printed numbers that are not
@@ -62,6 +23,17 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from sim.claims.intervals import LEVEL, METHODS, MIN_CHUNKS, plate_p, spread
+from sim.claims.rules import (
+    FORMS,
+    KINDS,
+    P_FAIL,
+    VERDICTS,
+    decide,
+    holds_of,
+    off_paper,
+    verdict_of,
+    zone,
+)
 from sim.mc import tolerance as tl
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.storage import write_table
@@ -75,23 +47,6 @@ __all__ = [
     "KINDS",
     "FORMS",
 ]
-
-FORMS = ("value", "share", "count", "upper", "lower", "range", "one-plate")
-KINDS = ("prediction", "input", "self-check", "paper-check", "finding", "not comparable")
-VERDICTS = (
-    "holds",
-    "fails",
-    "inconclusive",
-    "depends",
-    "undecidable",
-    "erratum",
-    "input",
-    "self-check",
-    "finding",
-    "not comparable",
-)
-#: the probability of a plate at least as extreme below which a one-plate claim fails
-P_FAIL = 0.05
 
 CLAIM_COLUMNS = [
     "claim",
@@ -130,66 +85,6 @@ CLAIM_TOLERANCES = {
 }
 
 _SPEC_KEYS = {"id", "source", "paper", "form", "ref", "decimals", "tol", "kind", "headline", "why"}
-
-
-# --------------------------------------------------------------------------- decision rule
-def _zone(form: str, ref: tuple[float, float], half: float, tol: float) -> tuple[float, float]:
-    lo, hi = ref[0] - half - tol, ref[1] + half + tol
-    if form == "upper":
-        lo = -math.inf
-    elif form == "lower":
-        hi = math.inf
-    return lo, hi
-
-
-def decide(
-    form: str,
-    interval: tuple[float, float],
-    zone: tuple[float, float],
-    *,
-    elems: tuple[np.ndarray, np.ndarray] | None = None,
-    p_plate: float | None = None,
-) -> str:
-    """The outcome ``holds`` / ``fails`` / ``inconclusive`` of one claim (see the module doc).
-
-    interval : (lo, hi) of the simulated value (a confidence interval, the 2.5-97.5 % spread
-        of a one-plate statistic, or (v, v) for an exact value).
-    zone : the decision zone (lo, hi), possibly half-infinite.
-    elems : for ``range``, the per-element intervals ``(lo[k], hi[k])``.
-    p_plate : for ``one-plate``, the probability of a plate at least as extreme.
-    """
-    if form not in FORMS:
-        raise ValueError(f"form must be one of {', '.join(FORMS)}, not {form!r}")
-    zl, zh = zone
-    if form == "range":
-        if elems is None:
-            elems = (np.array([interval[0]]), np.array([interval[1]]))
-        lo, hi = (np.asarray(e) for e in elems)
-        if np.any((hi < zl) | (lo > zh)):
-            return "fails"
-        return "holds" if np.all((lo >= zl) & (hi <= zh)) else "inconclusive"
-    lo, hi = interval
-    if form == "one-plate":
-        if p_plate is None or not math.isfinite(p_plate):
-            raise ValueError("a one-plate claim needs p_plate")
-        if p_plate < P_FAIL:
-            return "fails"
-        return "holds" if (lo >= zl and hi <= zh) else "inconclusive"
-    if hi < zl or lo > zh:
-        return "fails"
-    return "holds" if (lo >= zl and hi <= zh) else "inconclusive"
-
-
-def _verdict(kind: str, outcome: str | None) -> str:
-    if kind == "prediction":
-        return outcome or "finding"
-    if kind == "paper-check":
-        return {"fails": "erratum"}.get(outcome, outcome or "finding")
-    return kind
-
-
-def _holds(verdict: str):  # depends / undecidable (over a region, sim.claims.region): null
-    return {"holds": True, "fails": False, "erratum": False}.get(verdict)
 
 
 # --------------------------------------------------------------------------- claim books
@@ -342,14 +237,14 @@ class ClaimBook:
             rlo, rhi = float(ref[0]), float(ref[1])
             half = 0.5 * 10.0 ** (-s["decimals"]) if "decimals" in s else 0.0
             tol = float(s["tol"])
-            zlo, zhi = _zone(form, (rlo, rhi), half, tol)
+            zlo, zhi = zone(form, (rlo, rhi), half, tol)
             rlo, rhi = rlo - half, rhi + half
             # a one-plate claim given no plates (e.g. an exact input) is decided as a value
             rule = "value" if form == "one-plate" and samples is None else form
             outcome = decide(
                 rule, (float(ci[0]), float(ci[1])), (zlo, zhi), elems=elems, p_plate=p_plate
             )
-        verdict = _verdict(s["kind"], outcome)
+        verdict = verdict_of(s["kind"], outcome)
         if s["kind"] == "not comparable":
             note = (s.get("why", "") + " " + note).strip()
         return _row(
@@ -442,7 +337,7 @@ def _row(
         "p_plate": p_plate,
         "outcome": outcome,
         "verdict": verdict,
-        "holds": _holds(verdict),
+        "holds": holds_of(verdict),
         "note": note,
     }
 
@@ -461,6 +356,7 @@ def write_claims(
             {c: [n[c] for n in nr] for c in NOT_REPRODUCED_COLUMNS},
             prov,
         )
+    rows = off_paper(rows)
     cols = {c: [_null(r[c]) for r in rows] for c in CLAIM_COLUMNS}
     return write_table(
         path, cols, {**prov, "intervals": interval_provenance()}, tolerances=CLAIM_TOLERANCES

@@ -6,12 +6,21 @@ FAILS / UNDECIDED by the decision zone of :class:`~sim.claims.inference.Statemen
 
 * **holds**       it holds at every point of the region;
 * **fails**       it fails at every point (no feasible input makes it true);
-* **depends**     anything else where at least one point decides it; ``holds_where`` gives
-                  the projections of the points where it holds ("offset_mm 5-27.5") and
-                  ``fails_where`` those where it fails;
+* **depends**     it holds at some points and fails at others (undecided points may remain);
+                  ``holds_where`` gives the projections of the points where it holds
+                  ("offset_mm 5-27.5") and ``fails_where`` those where it fails;
+* **holds or undecided**  it holds at some points, fails at none, and is undecided at the
+                  rest: no feasible input contradicts it, but not every one confirms it;
+* **fails or undecided**  it fails at some points, holds at none, and is undecided at the
+                  rest: no feasible input confirms it (it is never shown to hold);
 * **undecidable** no point of the region decides it (its interval covers values on both sides
                   of the zone everywhere), or the region is empty; ``note`` says what would
                   decide it (the statement's ``decide`` text, or the conflicting statements).
+
+The rule in one line: the verdict names the set of per-point outcomes over the region
+({holds}, {fails}, {holds, fails[, undecided]}, {holds, undecided}, {fails, undecided},
+{undecided}); "depends" is kept for a prediction that really turns on the inputs (it holds
+somewhere *and* fails somewhere). See :func:`region_verdict`.
 
 Nominal input values have no place in these verdicts; they survive only as labelled examples
 in figures. :func:`region_table` gives the rows of ``consistent_region.parquet``.
@@ -34,10 +43,18 @@ __all__ = [
     "statement_of",
     "evidence_of_row",
     "REGION_VERDICTS",
+    "region_verdict",
     "OUTCOME_NAMES",
 ]
 
-REGION_VERDICTS = ("holds", "fails", "depends", "undecidable")
+REGION_VERDICTS = (
+    "holds",
+    "fails",
+    "depends",
+    "holds or undecided",
+    "fails or undecided",
+    "undecidable",
+)
 OUTCOME_NAMES = {HOLDS: "holds", FAILS: "fails", UNDECIDED: "undecided"}
 
 
@@ -56,11 +73,27 @@ class RegionVerdict:
 
     @property
     def text(self) -> str:
-        if self.verdict == "depends" and self.n_holds == 0:
-            return f"depends: holds nowhere; fails for {self.fails_where}, undecided elsewhere"
         if self.verdict == "depends":
             return f"depends: holds for {self.holds_where}; fails for {self.fails_where}"
+        if self.verdict == "holds or undecided":
+            return f"holds or undecided: holds for {self.holds_where}, fails nowhere"
+        if self.verdict == "fails or undecided":
+            return f"fails or undecided: holds nowhere; fails for {self.fails_where}"
         return self.verdict + (f" ({self.note})" if self.note else "")
+
+
+def region_verdict(n_points: int, n_holds: int, n_fails: int) -> str:
+    """The region verdict from the counts of accepted points where a prediction holds and
+    fails (the rest are undecided): the rule of the module doc, in one place."""
+    if n_points <= 0 or n_holds + n_fails == 0:
+        return "undecidable"
+    if n_holds == n_points:
+        return "holds"
+    if n_fails == n_points:
+        return "fails"
+    if n_holds and n_fails:
+        return "depends"
+    return "holds or undecided" if n_holds else "fails or undecided"
 
 
 def statement_of(book, cid: str, form: str | None = None) -> Statement:
@@ -111,16 +144,13 @@ def decide_over(region: Region, spec: Statement, evidence: Any = None) -> Region
     nh, nf, n = int(h.sum()), int(f.sum()), int(acc.sum())
     hw = region.describe(h) if nh else "nowhere"
     fw = region.describe(f) if nf else "nowhere"
-    if nh == n:
-        v, note = "holds", ""
-    elif nf == n:
-        v, note = "fails", ""
-    elif nh == 0 and nf == 0:
-        v = "undecidable"
+    v = region_verdict(n, nh, nf)
+    if v in ("holds", "fails"):
+        note = ""
+    elif v == "undecidable":
         note = spec.decide or "no input of the region decides it"
     else:
-        v = "depends"
-        note = f"holds at {nh} of {n} region points, fails at {nf}"
+        note = f"holds at {nh} of {n} region points, fails at {nf}, undecided at {n - nh - nf}"
     return RegionVerdict(spec.id, v, n, nh, nf, hw, fw, note)
 
 
@@ -161,11 +191,14 @@ def region_row(book, cid: str, rv: RegionVerdict, values, note: str = "") -> dic
     where = {
         "holds": f"holds at all {rv.n_points} points of the region",
         "fails": f"fails at all {rv.n_points} points of the region",
-        "depends": (
-            f"holds for {rv.holds_where}; fails for {rv.fails_where} ({rv.note})"
-            if rv.n_holds
-            else f"holds nowhere in the region; fails for {rv.fails_where}, undecided at the "
-            f"rest ({rv.note})"
+        "depends": f"holds for {rv.holds_where}; fails for {rv.fails_where} ({rv.note})",
+        "holds or undecided": (
+            f"holds for {rv.holds_where}, fails nowhere in the region, undecided at the rest "
+            f"({rv.note})"
+        ),
+        "fails or undecided": (
+            f"holds nowhere in the region; fails for {rv.fails_where}, undecided at the rest "
+            f"({rv.note})"
         ),
         "undecidable": f"undecidable: {rv.note}",
     }[rv.verdict]

@@ -40,6 +40,8 @@ _VERDICT_TEXT = {
     "fails": "**fails**",
     "inconclusive": "inconclusive",
     "depends": "depends",
+    "holds or undecided": "holds or undecided",
+    "fails or undecided": "fails or undecided",
     "undecidable": "undecidable",
     "erratum": "**erratum**",
     "input": "input",
@@ -47,6 +49,17 @@ _VERDICT_TEXT = {
     "finding": "finding",
     "not comparable": "not comparable",
 }
+
+
+_PREDICTION_VERDICTS = (
+    "holds",
+    "fails",
+    "inconclusive",
+    "depends",
+    "holds or undecided",
+    "fails or undecided",
+    "undecidable",
+)
 
 
 def number(x):
@@ -146,6 +159,8 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
             "fails",
             "inconclusive",
             "depends",
+            "holds or undecided",
+            "fails or undecided",
             "undecidable",
             "erratum",
             "paper ok",
@@ -159,11 +174,7 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
     for r in claims:
         v, k = r["verdict"], r["kind"]
         if k == "prediction":
-            c[
-                v
-                if v in ("holds", "fails", "inconclusive", "depends", "undecidable")
-                else "finding"
-            ] += 1
+            c[v if v in _PREDICTION_VERDICTS else "finding"] += 1
         elif k == "paper-check":
             c["erratum" if v == "erratum" else "paper ok"] += 1
         elif k == "self-check":
@@ -190,6 +201,8 @@ _COUNT_COLS = [
     ("fails", "fails"),
     ("inconclusive", "inconclusive"),
     ("depends", "depends"),
+    ("holds or undecided", "holds or undecided"),
+    ("fails or undecided", "fails or undecided"),
     ("undecidable", "undecidable"),
     ("not comparable", "not comparable"),
     ("erratum", "errata"),
@@ -344,8 +357,9 @@ _RULES = (
     "central 95 % of simulated plates lies inside the zone. A prediction decided over a "
     "study's consistent region (the unprinted inputs the paper's statements leave) "
     "**holds** or **fails** when it does so everywhere in the region, **depends** when it "
-    "holds in one part and fails in another, and is **undecidable** when no input of the "
-    "region decides it. A paper check whose recomputation from the paper's own printed data "
+    "holds in one part and fails in another, **holds or undecided** (**fails or undecided**) "
+    "when it holds (fails) in one part, the opposite nowhere and is undecided at the rest, "
+    "and is **undecidable** when no input of the region decides it. A paper check whose recomputation from the paper's own printed data "
     "fails is an **erratum**. Numbers are printed at the precision their interval supports "
     "(two significant digits of its half-width).\n\n"
 )

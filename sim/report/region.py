@@ -100,7 +100,7 @@ def region_markdown(out: Path, claims: list[dict]) -> str:
             ),
             "",
             "**Predictions over the region** (holds / fails everywhere in it, depends, "
-            "undecidable):",
+            "holds or undecided, fails or undecided, undecidable):",
             "",
             md_table(["claim", "verdict", "where"], verdicts),
         ]

@@ -37,6 +37,8 @@ VERDICT_ORDER = (
     "fails",
     "inconclusive",
     "depends",
+    "holds or undecided",
+    "fails or undecided",
     "undecidable",
     "erratum",
     "not comparable",

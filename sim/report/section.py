@@ -90,7 +90,9 @@ _REGION_HOW = (
     "The unprinted inputs are explored jointly (`sim.claims.inference`: a Sobol design "
     "plus refinement at the boundaries; every value analytic). The region holds the input "
     "vectors that the hardware and the printed inputs allow; a prediction *holds* or "
-    "*fails* over all of it, else *depends* (where it holds is given) "
+    "*fails* over all of it, else *depends* (holds in one part, fails in another; where "
+    "is given), *holds or undecided* / *fails or undecided* (one side nowhere) or "
+    "*undecidable* "
     "(`consistent_region.parquet`, `region_inputs.parquet`)."
 )
 

@@ -314,19 +314,30 @@ def first_pass_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict) -> list
                 ),
             )
         )
-    for cid, src in (
-        ("agnard.first_pass.quarter_pixel", "agnard.first_pass.pass_xy_cm"),
-        ("agnard.first_pass.third_pixel", "agnard.first_pass.pass_z_cm"),
+    # the paper's own budget turns a ground pixel into planimetry (radial: x sqrt 2, its
+    # "19 centimetres") and into height (x f / b, its "22 centimetres"); a pixel "in
+    # planimetry" and "in altimetry" is read the same way (claims.toml says why)
+    fb = cfg["block.focal_mm"] / cfg["block.base_mm"]
+    for cid, src, k, how in (
+        ("agnard.first_pass.quarter_pixel", "agnard.first_pass.pass_xy_cm", np.sqrt(2), "sqrt 2"),
+        (
+            "agnard.first_pass.third_pixel",
+            "agnard.first_pass.pass_z_cm",
+            fb,
+            f"f / b = {cfg['block.focal_mm']:g} / {cfg['block.base_mm']:g}",
+        ),
     ):
         cm = ref(book, src)
         rows.append(
             book.score(
                 cid,
-                cm / pix_cm,
+                cm / (pix_cm * k),
                 interval="exact",
                 note=(
-                    f"recomputed from the paper's own numbers: {cm:g} cm / ({sc.pixel_um(cfg['scan.dpi']):.2f}"
-                    f" um x {cfg['block.scale']:g} = {pix_cm:.2f} cm) = {cm / pix_cm:.3f} pixel"
+                    f"recomputed from the paper's own numbers: {cm:g} cm / ({pix_cm:.2f} cm "
+                    f"ground pixel ({sc.pixel_um(cfg['scan.dpi']):.2f} um x {cfg['block.scale']:g})"
+                    f" x {how} = {pix_cm * k:.2f} cm) = {cm / (pix_cm * k):.3f} pixel; per "
+                    f"ground coordinate alone it would be {cm / pix_cm:.3f}"
                 ),
             )
         )

@@ -94,8 +94,10 @@ def _claim_lines(c: dict) -> list[str]:
         f"- *First pass*: pass-point residuals {v('agnard.first_pass.pass_xy_cm')} cm XY "
         f"(*{vd('agnard.first_pass.pass_xy_cm')}*), {v('agnard.first_pass.pass_z_cm')} cm Z "
         f"(*{vd('agnard.first_pass.pass_z_cm')}*); the paper's own 10 and 15 cm are "
-        f"{v('agnard.first_pass.quarter_pixel')} and {v('agnard.first_pass.third_pixel')} pixel, "
-        "not a quarter and a third.",
+        f"{v('agnard.first_pass.quarter_pixel')} and {v('agnard.first_pass.third_pixel')} pixel "
+        "in planimetry and in height by the paper's own budget (sqrt 2 and f / b): a quarter "
+        f"(*{vd('agnard.first_pass.quarter_pixel')}*) and a third "
+        f"(*{vd('agnard.first_pass.third_pixel')}*).",
         "- *Acceptance limits* (the client's 21 cm planimetry / 16 cm height on the control "
         "residuals, which the paper 'satisfied' with its 21-control rms of 15 / 14 cm; "
         "scored as limits on one block's control rms): "

@@ -44,7 +44,6 @@ TOLERANCES = (
 )
 PLATES = (
     "brown.results.two_screw_agreement_um",
-    "brown.results.accuracy_range_um",
     "brown.results.zeiss_discrepancy_um",
     "brown.results.zeiss_comparator_um",
 )
@@ -174,9 +173,8 @@ _NOTES = {
     TOLERANCES[1]: "lateral offset d with d^2 / (2 r_min) = the accuracy (1 um)",
     TOLERANCES[2]: "the dividing error as a fraction of one turn of the screw",
     PLATES[0]: "sqrt(2) x one plate's rms (equal attribution), central half of the plates",
-    PLATES[1]: "one plate's rms after translation and rotation, central half of the plates",
-    PLATES[2]: "33-point stand-in layout within the half extent, plus the grid's 0.8 um",
-    PLATES[3]: "the comparator's part of the Zeiss comparison alone",
+    PLATES[1]: "33-point stand-in layout within the half extent, plus the grid's 0.8 um",
+    PLATES[2]: "the comparator's part of the Zeiss comparison alone",
 }
 
 

@@ -1,0 +1,184 @@
+"""The decision rules of the claims layer: a paper's claim, an interval, a verdict.
+
+:mod:`sim.claims.book` holds the claim books (the paper's words and numbers as data) and
+writes ``claims.parquet``; this module holds the one place where a verdict is decided from an
+interval and the decision zone (:func:`zone`, :func:`decide`), how the outcome becomes a
+verdict per kind (:func:`verdict_of`, :func:`holds_of`), and the rule for a run whose printed
+inputs differ from the paper's (:func:`off_paper`). Over a consistent region of unprinted
+inputs the verdict comes from :func:`sim.claims.region.region_verdict`.
+
+Forms (``form``)
+================
+``value``      a printed number: it stands for ``ref`` +- half a unit of its last printed
+               decimal (``decimals``); the *decision zone* widens that by ``tol``.
+``share``      a printed proportion (0-1), as ``value``.
+``count``      a printed count, as ``value``.
+``upper``      a bound "at most ``ref``" (zone ``(-inf, ref + rounding + tol]``).
+``lower``      a bound "at least ``ref``" (zone ``[ref - rounding - tol, inf)``).
+``range``      "from a to b": every element (e.g. every point's dilution) is to lie in
+               ``[a, b]`` (widened by the rounding and ``tol``).
+``one-plate``  the paper's number is one plate's statistic (one observed rms, one count):
+               the simulation gives its distribution over plates.
+
+Verdicts (``verdict``)
+======================
+With ``I`` the simulated interval and ``Z`` the decision zone:
+
+* ``value``/``share``/``count``/``upper``/``lower``: **holds** iff ``I`` lies inside ``Z``;
+  **fails** iff ``I`` and ``Z`` do not meet; otherwise **inconclusive** (the interval covers
+  both values that agree and values that contradict the claim). An ``exact`` interval (a
+  deterministic computation) is a point, so it is never inconclusive.
+* ``range``: **holds** iff every element's interval lies inside ``Z``; **fails** iff some
+  element's interval lies wholly outside ``Z``; otherwise **inconclusive**.
+* ``one-plate``: with ``q`` the simulated probability of a plate at or below the paper's
+  value, ``p = 2 min(q, 1 - q)`` is the probability of a plate at least as extreme.
+  **fails** iff ``p < 0.05``; **holds** iff ``p >= 0.05`` and the central 95 % of plates lies
+  inside ``Z`` (the simulation is sharp enough to decide); otherwise **inconclusive**.
+
+Over a consistent region of unprinted inputs (:mod:`sim.claims.region`) a prediction is
+**holds** / **fails** at every input of the region, **depends** (holds for part of it and
+fails for another; the note says where), **holds or undecided** / **fails or undecided**
+(holds, resp. fails, for part of it, the opposite nowhere, undecided at the rest) or
+**undecidable** (no input of the region decides it); the rule is
+:func:`sim.claims.region.region_verdict`.
+
+The rule's result is the ``outcome`` column. The ``verdict`` is the outcome for
+``kind = "prediction"`` and for ``"paper-check"`` (where a failing outcome is an
+**erratum**: the paper contradicts its own printed data, and ``value`` is the recomputation
+from that data); the other kinds are counted apart: ``input`` (a simulation input set to
+match the paper: agreement by construction), ``self-check`` (Monte Carlo against analytic,
+coverage, posterior against least squares), ``finding`` (the project's own result, no paper
+number) and ``not comparable`` (the paper's number comes from a setup its text does not let
+us simulate; ``note`` says why).
+
+Off the paper's setup
+=====================
+A prediction is a test of the paper only on a run whose printed inputs are the paper's. When
+an ``input`` row with an exact value (a configuration value the paper prints) fails its own
+rule, the run simulates another setup (e.g. a larger block): :func:`off_paper` keeps every
+prediction's ``outcome`` but makes its ``verdict`` a **finding** (about that setup, not the
+paper) and names the differing inputs in the note.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Iterable
+
+import numpy as np
+
+__all__ = [
+    "FORMS",
+    "KINDS",
+    "VERDICTS",
+    "P_FAIL",
+    "zone",
+    "decide",
+    "verdict_of",
+    "holds_of",
+    "off_paper",
+]
+
+FORMS = ("value", "share", "count", "upper", "lower", "range", "one-plate")
+KINDS = ("prediction", "input", "self-check", "paper-check", "finding", "not comparable")
+VERDICTS = (
+    "holds",
+    "fails",
+    "inconclusive",
+    "depends",
+    "holds or undecided",
+    "fails or undecided",
+    "undecidable",
+    "erratum",
+    "input",
+    "self-check",
+    "finding",
+    "not comparable",
+)
+#: the probability of a plate at least as extreme below which a one-plate claim fails
+P_FAIL = 0.05
+
+
+def zone(form: str, ref: tuple[float, float], half: float, tol: float) -> tuple[float, float]:
+    lo, hi = ref[0] - half - tol, ref[1] + half + tol
+    if form == "upper":
+        lo = -math.inf
+    elif form == "lower":
+        hi = math.inf
+    return lo, hi
+
+
+def decide(
+    form: str,
+    interval: tuple[float, float],
+    zone: tuple[float, float],
+    *,
+    elems: tuple[np.ndarray, np.ndarray] | None = None,
+    p_plate: float | None = None,
+) -> str:
+    """The outcome ``holds`` / ``fails`` / ``inconclusive`` of one claim (see the module doc).
+
+    interval : (lo, hi) of the simulated value (a confidence interval, the 2.5-97.5 % spread
+        of a one-plate statistic, or (v, v) for an exact value).
+    zone : the decision zone (lo, hi), possibly half-infinite.
+    elems : for ``range``, the per-element intervals ``(lo[k], hi[k])``.
+    p_plate : for ``one-plate``, the probability of a plate at least as extreme.
+    """
+    if form not in FORMS:
+        raise ValueError(f"form must be one of {', '.join(FORMS)}, not {form!r}")
+    zl, zh = zone
+    if form == "range":
+        if elems is None:
+            elems = (np.array([interval[0]]), np.array([interval[1]]))
+        lo, hi = (np.asarray(e) for e in elems)
+        if np.any((hi < zl) | (lo > zh)):
+            return "fails"
+        return "holds" if np.all((lo >= zl) & (hi <= zh)) else "inconclusive"
+    lo, hi = interval
+    if form == "one-plate":
+        if p_plate is None or not math.isfinite(p_plate):
+            raise ValueError("a one-plate claim needs p_plate")
+        if p_plate < P_FAIL:
+            return "fails"
+        return "holds" if (lo >= zl and hi <= zh) else "inconclusive"
+    if hi < zl or lo > zh:
+        return "fails"
+    return "holds" if (lo >= zl and hi <= zh) else "inconclusive"
+
+
+def verdict_of(kind: str, outcome: str | None) -> str:
+    if kind == "prediction":
+        return outcome or "finding"
+    if kind == "paper-check":
+        return {"fails": "erratum"}.get(outcome, outcome or "finding")
+    return kind
+
+
+def holds_of(verdict: str):  # depends / undecidable (over a region, sim.claims.region): null
+    return {"holds": True, "fails": False, "erratum": False}.get(verdict)
+
+
+def off_paper(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The rows of a run, with every prediction a **finding** when the run's printed inputs
+    differ from the paper's (an exact ``input`` row that fails its rule); see the module doc.
+    Rows of a run on the paper's setup come back unchanged."""
+    rows = list(rows)
+    bad = [
+        r["claim"]
+        for r in rows
+        if r["kind"] == "input" and r["interval"] == "exact" and r["outcome"] == "fails"
+    ]
+    if not bad:
+        return rows
+    why = (
+        "not a test of the paper: this run's printed inputs differ from the paper's ("
+        + ", ".join(bad)
+        + "), so the rule's outcome ({}) is a finding about this run's setup"
+    )
+    out = []
+    for r in rows:
+        if r["kind"] == "prediction" and r["verdict"] != "finding":
+            note = why.format(r["outcome"]) + ("; " + r["note"] if r["note"] else "")
+            r = {**r, "verdict": "finding", "holds": None, "note": note}
+        out.append(r)
+    return out
