@@ -11,6 +11,7 @@ from sim.instruments.plates import pattern_points
 from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.runner import chunk_rng
+from sim.mc.schema_helpers import count, counts, positive, real
 
 SEED = "004_f5bd9e86c308241f.txt"
 MODEL_NAMES = ("known", "stations", "pivot")
@@ -19,114 +20,85 @@ MODEL_NAMES = ("known", "stations", "pivot")
 
 BASE = {
     **COMMON,
-    "plate.format_mm": Field(245.0, "float", "side of the square plate format", lo=1.0, unit="mm"),
+    "plate.format_mm": real(245.0, "side of the square plate format", lo=1.0, unit="mm"),
     "plate.pattern": Field("grid", "str", "point pattern", choices=("grid", "random", "list")),
-    "plate.grid": Field(5, "int", "points per side of the grid pattern", lo=2, hi=200),
-    "plate.spacing_mm": Field(
+    "plate.grid": count(5, "points per side of the grid pattern", lo=2, hi=200),
+    "plate.spacing_mm": positive(
         45.0,
-        "float",
         "grid spacing (Table 1: 45 mm; the Concept section prints no layout, its extent is swept)",
-        lo=0.0,
-        lo_open=True,
         unit="mm",
     ),
-    "plate.n_random": Field(25, "int", "number of points of the random pattern", lo=3, hi=100000),
-    "plate.random_half_extent_mm": Field(
-        110.0, "float", "random points lie in |x|,|y| <= this", lo=0.0, lo_open=True, unit="mm"
+    "plate.n_random": count(25, "number of points of the random pattern", lo=3, hi=100000),
+    "plate.random_half_extent_mm": positive(
+        110.0, "random points lie in |x|,|y| <= this", unit="mm"
     ),
     "plate.points": Field([], "points", "explicit point list [[x, y], ...] for pattern 'list'"),
-    "comparator.station_offset_mm": Field(
+    "comparator.station_offset_mm": positive(
         17.0,
-        "float",
         "distance of the stations outside the midsides of the format; the paper "
         "says only 'a short distance' (nominal value: the middle of the 0-34 mm that fit the "
         "261 mm scale for a +-90 mm grid; a labelled example: the claims are decided over "
         "the region of sim.instruments.ranges.brown)",
-        lo=0.0,
-        lo_open=True,
         unit="mm",
     ),
-    "comparator.alpha_mm": Field(
-        0.5, "float", "radial pivot offset alpha (true value)", lo=-50.0, hi=50.0, unit="mm"
+    "comparator.alpha_mm": real(
+        0.5, "radial pivot offset alpha (true value)", lo=-50.0, hi=50.0, unit="mm"
     ),
-    "comparator.beta_mm": Field(
-        1.0, "float", "tangential pivot offset beta (true value)", lo=0.0, hi=50.0, unit="mm"
+    "comparator.beta_mm": real(
+        1.0, "tangential pivot offset beta (true value)", lo=0.0, hi=50.0, unit="mm"
     ),
-    "comparator.scale_length_mm": Field(
+    "comparator.scale_length_mm": real(
         261.0,
-        "float",
         "graduated length of the scale (paper: 261 mm); every range must fit on "
         "it plus the micrometer travel. 0 = not enforced (an idealised comparator)",
         lo=0.0,
         unit="mm",
     ),
-    "comparator.micrometer_mm": Field(
-        1.0,
-        "float",
-        "micrometer travel added to the scale (paper: at most 1 mm)",
-        lo=0.0,
-        unit="mm",
+    "comparator.micrometer_mm": real(
+        1.0, "micrometer travel added to the scale (paper: at most 1 mm)", lo=0.0, unit="mm"
     ),
-    "errors.setting_sigma_um": Field(
-        1.0, "float", "standard deviation of one setting", lo=0.0, lo_open=True, unit="um"
+    "errors.setting_sigma_um": positive(1.0, "standard deviation of one setting", unit="um"),
+    "errors.settings": count(1, "settings per point and position, averaged", lo=1, hi=100),
+    "errors.comparator_sigma_um": real(
+        0.0, "comparator random error per reading", lo=0.0, unit="um"
     ),
-    "errors.settings": Field(1, "int", "settings per point and position, averaged", lo=1, hi=100),
-    "errors.comparator_sigma_um": Field(
-        0.0, "float", "comparator random error per reading", lo=0.0, unit="um"
+    "errors.bias_um": real(
+        0.0, "constant personal bias added to every range", lo=-1e4, hi=1e4, unit="um"
     ),
-    "errors.bias_um": Field(
-        0.0, "float", "constant personal bias added to every range", lo=-1e4, hi=1e4, unit="um"
+    "solver.tol_mm": positive(
+        1e-10, "convergence: largest correction below this", hi=1e-3, unit="mm"
     ),
-    "solver.tol_mm": Field(
-        1e-10,
-        "float",
-        "convergence: largest correction below this",
-        lo=0.0,
-        lo_open=True,
-        hi=1e-3,
-        unit="mm",
-    ),
-    "solver.max_iter": Field(30, "int", "Gauss-Newton iteration limit", lo=1, hi=1000),
-    "region.points": Field(
+    "solver.max_iter": count(30, "Gauss-Newton iteration limit", lo=1, hi=1000),
+    "region.points": count(
         1024,
-        "int",
         "size of the space-filling (Sobol) design of the joint exploration of the unprinted "
         "inputs (sim.claims.inference), rounded up to a power of 2",
         lo=256,
         hi=16384,
     ),
-    "region.rounds": Field(
-        3,
-        "int",
-        "refinement rounds at the region's boundaries (each halves the spacing)",
-        lo=0,
-        hi=8,
+    "region.rounds": count(
+        3, "refinement rounds at the region's boundaries (each halves the spacing)", lo=0, hi=8
     ),
 }
 
 DILUTION = {
     **BASE,
-    "trials": Field(4000, "int", "Monte-Carlo trials", lo=2, hi=100_000_000),
-    "dilution.grids": Field(
+    "trials": count(4000, "Monte-Carlo trials", lo=2, hi=100_000_000),
+    "dilution.grids": counts(
         [3, 4, 5, 7, 10, 14, 20],
-        "list[int]",
         "grid sizes (points per side, same extent) for dilution vs point count",
         lo=2,
         hi=200,
         min_len=2,
     ),
-    "idealised.half_extent_mm": Field(
+    "idealised.half_extent_mm": positive(
         110.0,
-        "float",
         "half extent of the idealised four-station "
         "layout (no scale): the offset giving 0.85 at the edges",
-        lo=0.0,
-        lo_open=True,
         unit="mm",
     ),
-    "checks.bias_shift_um": Field(
+    "checks.bias_shift_um": real(
         100.0,
-        "float",
         "constant added to all ranges in the bias invariance check",
         lo=-1e5,
         hi=1e5,
@@ -136,16 +108,12 @@ DILUTION = {
 
 TABLE1 = {
     **BASE,
-    "trials": Field(4000, "int", "Monte-Carlo trials", lo=2, hi=100_000_000),
-    "plate.spacing_mm": Field(
-        45.0, "float", "grid spacing (paper: 45 mm)", lo=0.0, lo_open=True, input=True, unit="mm"
-    ),
-    "errors.setting_sigma_um": Field(
-        1.7, "float", "one setting (paper: 1.7 um)", lo=0.0, lo_open=True, input=True, unit="um"
-    ),
-    "errors.settings": Field(2, "int", "double settings (paper)", lo=1, hi=100, input=True),
-    "errors.comparator_sigma_um": Field(
-        1.1, "float", "comparator contribution (paper: about 1.1 um)", lo=0.0, input=True, unit="um"
+    "trials": count(4000, "Monte-Carlo trials", lo=2, hi=100_000_000),
+    "plate.spacing_mm": positive(45.0, "grid spacing (paper: 45 mm)", unit="mm", input=True),
+    "errors.setting_sigma_um": positive(1.7, "one setting (paper: 1.7 um)", unit="um", input=True),
+    "errors.settings": count(2, "double settings (paper)", lo=1, hi=100, input=True),
+    "errors.comparator_sigma_um": real(
+        1.1, "comparator contribution (paper: about 1.1 um)", lo=0.0, unit="um", input=True
     ),
 }
 

@@ -13,9 +13,10 @@ from __future__ import annotations
 
 from sim.studies import Study
 from sim.studies.design.cells import geometry_eval, measuring_time, pareto_front, time_model
+from sim.studies.design.checks import check
 from sim.studies.design.report import report
 from sim.studies.design.run import run
-from sim.studies.design.schema import SCHEMA, SEED, check
+from sim.studies.design.schema import SCHEMA, SEED
 
 __all__ = [
     "STUDIES",

@@ -3,7 +3,7 @@
 Coverage of the 95 % point ellipses (known sigma; s0 with the F distribution), the false-alarm
 rate of the global chi-square test and E[s0] / sigma, for Brown's pivot model (Brown's datum)
 over noise, point count and beta, and for an affine calibration (a linear model). Every case
-is one :func:`sim.mc.runner.run_chunks` call of a picklable chunk function, so its chunks run on
+is one :func:`sim.studies.run_steps.run_part` call of a picklable chunk function, so its chunks run on
 the run's executor; the cases run side by side (:mod:`.parts`).
 """
 
@@ -16,9 +16,9 @@ import numpy as np
 from sim.instruments.plates import grid_points
 from sim.instruments.ranges import coverage as cv
 from sim.instruments.ranges import multilateration as ml
-from sim.mc.runner import run_chunks
 from sim.studies.design.chunks import affine_chunk, coverage_chunk
 from sim.studies.design.parts import side_by_side
+from sim.studies.run_steps import run_part
 
 __all__ = ["coverage_analysis", "summarize_cov", "COLUMNS", "PART0"]
 
@@ -97,30 +97,12 @@ def coverage_analysis(cfg: dict, ctx) -> dict:
         pts = grid_points(k, 2 * ext / (k - 1))
         th = ml.design_theta(h, cfg["comparator.alpha_mm"], beta)
         fn = partial(coverage_chunk, pts, th, sig, cfg["coverage.alpha"])
-        tasks[part] = partial(
-            run_chunks,
-            fn,
-            T,
-            cfg["seed"],
-            cfg["chunk"],
-            part=part,
-            label=f"coverage {scen}",
-            ctx=ctx,
-        )
+        tasks[part] = partial(run_part, cfg, ctx, fn, part, f"coverage {scen}", T)
     affine = ((cfg["datum.grid"], cfg["coverage.trials"]), (2, cfg["coverage.sweep_trials"]))
     for part, (k, T) in enumerate(affine, PART0 + len(tasks)):
         grid = grid_points(k, 2 * 110.0 / (k - 1))
         fn = partial(affine_chunk, grid, sig0, _AFFINE, cfg["coverage.alpha"])
-        tasks[part] = partial(
-            run_chunks,
-            fn,
-            T,
-            cfg["seed"],
-            cfg["chunk"],
-            part=part,
-            label="coverage affine",
-            ctx=ctx,
-        )
+        tasks[part] = partial(run_part, cfg, ctx, fn, part, "coverage affine", T)
     sims = side_by_side(tasks, ctx)
     part = PART0
     for scen, k, sig, beta, T in _cases(cfg):

@@ -21,11 +21,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.claims.inference import HOLDS, Input, Region, Statement, explore, parse_declaration
+from sim.claims.inference import Input, Statement, explore, parse_declaration
 from sim.claims.region import (
     decide_over,
     evidence_of_row,
-    outcomes,
+    holds_together,
+    inputs_table,
     region_row,
     region_table,
     statement_of,
@@ -161,13 +162,6 @@ def plates_region(cfg: dict, book):
     return reg, preds, {p.id: decide_over(reg, p) for p in preds}
 
 
-def _together(reg: Region, preds) -> np.ndarray:
-    ok = reg.accepted.copy()
-    for p in preds:
-        ok &= outcomes(reg, p) == HOLDS
-    return ok
-
-
 _NOTES = {
     TOLERANCES[0]: "d^2 / (2 r_min) at the plate's shortest range",
     TOLERANCES[1]: "lateral offset d with d^2 / (2 r_min) = the accuracy (1 um)",
@@ -197,28 +191,13 @@ def region_rows(book, parts) -> tuple[list[dict], dict, dict]:
                 region_row(book, p.id, verdicts[p.id], v[reg.accepted], _NOTES[p.id] + where)
             )
         t = region_table(reg, preds)
-        t["together"] = _together(reg, preds)[reg.accepted].tolist()
+        t["together"] = holds_together(reg, preds)[reg.accepted].tolist()
         t["part"] = [name] * int(reg.accepted.sum())
         tables.append(t)
-        b, tg = reg.bounds(), reg.bounds(_together(reg, preds))
-        for i in reg.inputs:
-            for k, val in (
-                ("part", name),
-                ("input", i.name),
-                ("why", i.why),
-                ("declared_low", i.low),
-                ("declared_high", i.high),
-                ("region_low", b[i.name][0]),
-                ("region_high", b[i.name][1]),
-                ("together_low", tg[i.name][0]),
-                ("together_high", tg[i.name][1]),
-                ("resolution_interior", reg.resolution[i.name][0]),
-                ("resolution_boundary", reg.resolution[i.name][1]),
-                ("n_points", reg.n),
-                ("n_region", int(reg.accepted.sum())),
-                ("n_together", int(_together(reg, preds).sum())),
-            ):
-                ins[k].append(val)
+        part_ins = inputs_table(reg, preds)  # the columns every region study writes
+        part_ins["part"] = [name] * len(part_ins["input"])
+        for k in _INPUT_COLS:
+            ins[k] += part_ins[k]
     keys = list(dict.fromkeys(k for t in tables for k in t))
     table = {k: [] for k in keys}
     for t in tables:
@@ -228,6 +207,8 @@ def region_rows(book, parts) -> tuple[list[dict], dict, dict]:
     return rows, table, ins
 
 
+#: columns of ``region_inputs.parquet``: ``part``, then those of
+#: :func:`sim.claims.region.inputs_table` in the order this study has always written them
 _INPUT_COLS = (
     "part",
     "input",

@@ -18,7 +18,7 @@ from sim.claims.intervals import bootstrap_ci
 from sim.instruments.ranges import positions as po
 from sim.lsq import datum as dm
 from sim.mc import tolerance as tl
-from sim.mc.runner import chunk_rng, run_chunks
+from sim.mc.runner import chunk_rng
 from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import start_figures
 from sim.studies import RunContext
@@ -32,6 +32,7 @@ from sim.studies.design.cells import (
     range_sigma,
     within_front,
 )
+from sim.studies.design.checks import max_offset_mm
 from sim.studies.design.chunks import design_chunk
 from sim.studies.design.claims import load_book, score_all
 from sim.studies.design.dilution import datum_analysis
@@ -40,7 +41,7 @@ from sim.studies.design.external import external_at
 from sim.studies.design.formal import coverage_analysis
 from sim.studies.design.parts import side_by_side
 from sim.studies.design.posterior import bayes_analysis, twoplate_analysis
-from sim.studies.design.schema import max_offset_mm
+from sim.studies.run_steps import run_part
 
 __all__ = ["run"]
 
@@ -117,15 +118,7 @@ def _scale_length(cfg) -> dict:
 
 
 def _mc_check(cfg, pts, th, sr, ctx):
-    sim = run_chunks(
-        partial(design_chunk, pts, th, sr),
-        cfg["trials"],
-        cfg["seed"],
-        cfg["chunk"],
-        part=0,
-        label="design MC",
-        ctx=ctx,
-    )
+    sim = run_part(cfg, ctx, partial(design_chunk, pts, th, sr), part=0, label="design MC")
     good = sim["status"] == 0
     E = sim["err_um"][good]
     Fan = (

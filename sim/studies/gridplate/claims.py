@@ -14,6 +14,7 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.intervals import mean_ci, share_ci, std_ci
+from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.instruments import transforms2d as t2
 from sim.lsq import distributions as D
 from sim.mc.config import StudyError
@@ -47,88 +48,85 @@ def _finite(x, what: str, key: str) -> np.ndarray:
     return f
 
 
-def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], ClaimBook]:
-    book = load_book()
-    ref = {c: s.get("ref") for c, s in book.specs.items()}
-    rows = []
+def _readings(cfg: dict, res: dict) -> dict[str, Sim]:
+    """The precision of one reading (from the repeated readings) and the stated grid sigma."""
     L, N, P = cfg["readings.count"], cfg["plate.grid"] ** 2, cfg["plate.count"]
-    add = rows.append
-    add(
-        book.score(
-            "twoplate.precision.reading_sigma_um",
-            samples=res["sigma_obs_um"],
-            note=f"sigma = sqrt(sum sigma_i^2 / 4N) from {L} readings of {N} points on {P} "
+    return {
+        "twoplate.precision.reading_sigma_um": plates(
+            res["sigma_obs_um"],
+            f"sigma = sqrt(sum sigma_i^2 / 4N) from {L} readings of {N} points on {P} "
             f"plates; the reading sigma is an input ({cfg['readings.sigma_um']:g} um), so "
             f"this shows the estimator's spread ({2 * P * N * (L - 1)} degrees of "
             "freedom; the paper's '4N' is the divisor).",
-        )
-    )
-    add(
-        book.score(
-            "twoplate.grid.stated_sigma_um",
-            cfg["grid.sigma_stated_um"],
-            interval="exact",
-            note="the stated (certificate) grid sigma of the simulation",
-        )
-    )
+        ),
+        "twoplate.grid.stated_sigma_um": exact(
+            cfg["grid.sigma_stated_um"], "the stated (certificate) grid sigma of the simulation"
+        ),
+    }
+
+
+def _weighting(cfg: dict, res: dict) -> dict[str, Sim]:
+    """The paper's weightings 1:2 and 1:3 and its re-weighting to a passing chi-square test."""
+    N, P = cfg["plate.grid"] ** 2, cfg["plate.count"]
     sx, sgt = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
-    for r in (2, 3):
-        add(
-            book.score(
-                f"twoplate.weight_ratio.grid_sigma_1to{r}_um",
-                samples=res[f"grid_sigma_1to{r}_um"],
-                note=f"grid sigma implied by the weights, s0/sqrt(P_cx), P_x:P_cx = 1:{r}, "
-                "x' and y' of both plates pooled; expectation sqrt((sx'^2 + sg^2)/(1 + "
-                f"P_cx)) = {math.sqrt((sx**2 + sgt**2) / (1 + r)):.3f} um from the "
-                "simulated comparator and grid sigmas.",
-            )
+    table = {
+        f"twoplate.weight_ratio.grid_sigma_1to{r}_um": plates(
+            res[f"grid_sigma_1to{r}_um"],
+            f"grid sigma implied by the weights, s0/sqrt(P_cx), P_x:P_cx = 1:{r}, "
+            "x' and y' of both plates pooled; expectation sqrt((sx'^2 + sg^2)/(1 + "
+            f"P_cx)) = {math.sqrt((sx**2 + sgt**2) / (1 + r)):.3f} um from the "
+            "simulated comparator and grid sigmas.",
         )
+        for r in (2, 3)
+    }
     rr = _finite(res["ratio_rw_mean"], "the re-weighted ratio", "grid.sigma_stated_um")
-    add(
-        book.score(
-            "twoplate.weight_ratio.converged_ratio",
-            samples=rr,
-            note="P_cx/P_x at the fixed point of the paper's re-weighting (P_x = 1), mean "
-            f"of the {2 * P} adjustments of one calibration; "
-            f"{int(np.sum(~np.isfinite(res['ratio_rw_mean'])))} of "
-            f"{res['ratio_rw_mean'].size} calibrations had no positive fixed point. True "
-            f"ratio sx'^2/sg^2 = {sx**2 / max(sgt, 1e-9) ** 2:.2f}.",
-        )
+    table["twoplate.weight_ratio.converged_ratio"] = plates(
+        rr,
+        "P_cx/P_x at the fixed point of the paper's re-weighting (P_x = 1), mean "
+        f"of the {2 * P} adjustments of one calibration; "
+        f"{int(np.sum(~np.isfinite(res['ratio_rw_mean'])))} of "
+        f"{res['ratio_rw_mean'].size} calibrations had no positive fixed point. True "
+        f"ratio sx'^2/sg^2 = {sx**2 / max(sgt, 1e-9) ** 2:.2f}.",
     )
     t = res["rw_trials"].ravel()
     v, ci = quantile_ci(t, 0.95)
-    add(
-        book.score(
-            "twoplate.weight_ratio.reweight_trials",
-            v,
-            ci,
-            note=f"re-weightings P_cx <- s0^2/sg^2 until the chi-square test "
-            f"({N - 3} degrees of freedom) of s0^2/P_cx against the stated sigma passes, "
-            f"starting at 1:{cfg['analysis.ratio_start']:g}: 95th percentile over "
-            f"{t.size} adjustments (order-statistic interval); shares 0/1/2/more: "
-            + "/".join(f"{np.mean(t == k):.3f}" for k in (0, 1, 2))
-            + f"/{np.mean(t > 2):.3f}.",
-        )
+    table["twoplate.weight_ratio.reweight_trials"] = Sim(
+        v,
+        ci,
+        note=f"re-weightings P_cx <- s0^2/sg^2 until the chi-square test "
+        f"({N - 3} degrees of freedom) of s0^2/P_cx against the stated sigma passes, "
+        f"starting at 1:{cfg['analysis.ratio_start']:g}: 95th percentile over "
+        f"{t.size} adjustments (order-statistic interval); shares 0/1/2/more: "
+        + "/".join(f"{np.mean(t == k):.3f}" for k in (0, 1, 2))
+        + f"/{np.mean(t > 2):.3f}.",
     )
     pr = res["passes_rw"]
     m, ci = share_ci(pr)
-    add(
-        book.score(
-            "twoplate.weight_ratio.pass_after_reweighting",
-            m,
-            ci,
-            note=f"share of {pr.size} iterated re-weightings (sim.instruments.gridplate.reweight) whose "
-            "chi-square test passes: the re-weighting forces s0^2/P_cx to the stated "
-            "value, so the test passes by construction and cannot check the stated grid "
-            "sigma (only sx'^2 + sg^2 is estimable from one plate).",
-        )
+    table["twoplate.weight_ratio.pass_after_reweighting"] = Sim(
+        m,
+        ci,
+        note=f"share of {pr.size} iterated re-weightings (sim.instruments.gridplate.reweight) whose "
+        "chi-square test passes: the re-weighting forces s0^2/P_cx to the stated "
+        "value, so the test passes by construction and cannot check the stated grid "
+        "sigma (only sx'^2 + sg^2 is estimable from one plate).",
     )
+    return table
+
+
+def _comparator(book: ClaimBook, cfg: dict, res: dict) -> dict[str, Sim]:
+    """The combined adjustment's iterations, the comparator sigma after the re-weighting, and
+    the paper's explanation of it (the mean of L readings, recomputed)."""
     it = res["gn_iterations"]
     lo = quantile_ci(it, 0.025)[1][0]
     hi = quantile_ci(it, 0.975)[1][1]
-    add(
-        book.score(
-            "twoplate.combined.iterations",
+    sx, L = cfg["comparator.coord_sigma_um"], cfg["readings.count"]
+    comp = _finite(res["comp_sigma_um"], "the comparator sigma", "grid.sigma_stated_um")
+    r1p5 = book.spec("twoplate.precision.reading_sigma_um")["ref"]
+    r1p2 = book.spec("twoplate.comparator_sigma.sigma_um")["ref"]
+    h15 = 0.5 * 10.0 ** -book.spec("twoplate.precision.reading_sigma_um")["decimals"]
+    best = r1p5 / math.sqrt(2)
+    return {
+        "twoplate.combined.iterations": Sim(
             elems=(np.array([lo]), np.array([hi])),
             note=f"Gauss-Newton solves of the combined adjustment until the largest "
             f"correction is below {cfg['analysis.iter_tol_um']:g} um (the converging "
@@ -136,169 +134,162 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
             "adjustments with order-statistic bounds; counts "
             + ", ".join(f"{k}: {int(np.sum(it == k))}" for k in np.unique(it))
             + ".",
-        )
-    )
-    comp = _finite(res["comp_sigma_um"], "the comparator sigma", "grid.sigma_stated_um")
-    add(
-        book.score(
-            "twoplate.comparator_sigma.sigma_um",
-            samples=comp,
-            note=f"s0 (P_x = 1) of the re-weighted combined adjustment, x' and y' on both "
+        ),
+        "twoplate.comparator_sigma.sigma_um": plates(
+            comp,
+            f"s0 (P_x = 1) of the re-weighted combined adjustment, x' and y' on both "
             f"plates pooled; the truth is an input ({sx:g} um).",
-        )
-    )
-    r1p5, r1p2, r0p7 = (
-        ref["twoplate.precision.reading_sigma_um"],
-        ref["twoplate.comparator_sigma.sigma_um"],
-        ref["twoplate.grid.stated_sigma_um"],
-    )
-    h15 = 0.5 * 10.0 ** -book.spec("twoplate.precision.reading_sigma_um")["decimals"]
-    best = r1p5 / math.sqrt(2)
-    add(
-        book.score(
-            "twoplate.comparator_sigma.mean_of_L",
+        ),
+        "twoplate.comparator_sigma.mean_of_L": exact(
             best,
-            ((r1p5 - h15) / math.sqrt(2), (r1p5 + h15) / math.sqrt(2)),
-            interval="exact",
-            note=f"recomputed: the precision of a mean of L >= 2 readings, {r1p5:g}/sqrt(L), is "
+            f"recomputed: the precision of a mean of L >= 2 readings, {r1p5:g}/sqrt(L), is "
             f"at most {best:.3f} um ({(r1p5 - h15) / math.sqrt(2):.3f}-"
             f"{(r1p5 + h15) / math.sqrt(2):.3f} over the rounding of {r1p5:g}), below the "
             f"comparator sigma {r1p2:g} um of the means, as the paper's explanation needs; "
             f"the simulation adds a per-point comparator error of "
             f"{math.sqrt(max(sx**2 - cfg['readings.sigma_um'] ** 2 / L, 0)):.2f} um to make up "
             f"the {r1p2:g}.",
-        )
-    )
-    aff, sim_s = res["aff_sigma_um"], res["sim_sigma_um"]
-    add(
-        book.score(
-            "twoplate.similarity_vs_affine.similarity_sigma_um",
-            samples=sim_s,
-            note=f"sqrt(sum(vx^2+vy^2)/(2N-4)) of a similarity fit, grid fixed, two plates "
+            ci=((r1p5 - h15) / math.sqrt(2), (r1p5 + h15) / math.sqrt(2)),
+        ),
+    }
+
+
+def _fits(book: ClaimBook, cfg: dict, res: dict) -> dict[str, Sim]:
+    """The similarity and affine fits with the grid fixed (the paper's 1.65 and 1.5)."""
+    r1p2 = book.spec("twoplate.comparator_sigma.sigma_um")["ref"]
+    r0p7 = book.spec("twoplate.grid.stated_sigma_um")["ref"]
+    return {
+        "twoplate.similarity_vs_affine.similarity_sigma_um": plates(
+            res["sim_sigma_um"],
+            f"sqrt(sum(vx^2+vy^2)/(2N-4)) of a similarity fit, grid fixed, two plates "
             f"pooled; the comparator's scale difference ({cfg['comparator.scale_diff_ppm']:g}"
             f' ppm) and non-orthogonality ({cfg["comparator.nonorth_arcsec"]:g}") are not '
             "printed: an example; the region (consistent_region.parquet) decides this row.",
-        )
-    )
-    add(
-        book.score(
-            "twoplate.similarity_vs_affine.affine_sigma_um",
-            samples=aff,
-            note="sqrt(sum(vx^2+vy^2)/(2N-6)) of the affine fit, grid fixed, two plates "
+        ),
+        "twoplate.similarity_vs_affine.affine_sigma_um": plates(
+            res["aff_sigma_um"],
+            "sqrt(sum(vx^2+vy^2)/(2N-6)) of the affine fit, grid fixed, two plates "
             "pooled, against the printed 1.5 (the paper's 1.2 and 0.7 support "
-            f"{math.hypot(ref['twoplate.comparator_sigma.sigma_um'], ref['twoplate.grid.stated_sigma_um']):.2f}: "
+            f"{math.hypot(r1p2, r0p7):.2f}: "
             "paper_check.affine_from_comparator_and_grid).",
-        )
-    )
+        ),
+    }
+
+
+def _paper_checks(book: ClaimBook) -> dict[str, Sim]:
+    """The paper's arithmetic recomputed from its own printed numbers (the book's refs)."""
+
+    def ref(cid):
+        return book.spec(cid)["ref"]
+
+    r1p5 = ref("twoplate.precision.reading_sigma_um")
+    r1p2 = ref("twoplate.comparator_sigma.sigma_um")
+    r0p7 = ref("twoplate.grid.stated_sigma_um")
+    r12 = ref("twoplate.weight_ratio.grid_sigma_1to2_um")
+    r13 = ref("twoplate.weight_ratio.grid_sigma_1to3_um")
+    r165 = ref("twoplate.similarity_vs_affine.similarity_sigma_um")
     sup = math.hypot(r1p2, r0p7)
     h1 = 0.5 * 10.0 ** -book.spec("twoplate.comparator_sigma.sigma_um")["decimals"]
     h2 = 0.5 * 10.0 ** -book.spec("twoplate.grid.stated_sigma_um")["decimals"]
     corner = (math.hypot(r1p2 - h1, r0p7 - h2), math.hypot(r1p2 + h1, r0p7 + h2))
-    r12, r13 = (
-        ref["twoplate.weight_ratio.grid_sigma_1to2_um"],
-        ref["twoplate.weight_ratio.grid_sigma_1to3_um"],
-    )
-    add(
-        book.score(
-            "twoplate.paper_check.affine_from_comparator_and_grid",
+    return {
+        "twoplate.paper_check.affine_from_comparator_and_grid": exact(
             sup,
-            corner,
-            interval="exact",
-            note=f"recomputed: sqrt({r1p2:g}^2 + {r0p7:g}^2) = {sup:.3f} um (independent "
+            f"recomputed: sqrt({r1p2:g}^2 + {r0p7:g}^2) = {sup:.3f} um (independent "
             f"comparator and grid errors), {corner[0]:.3f}-{corner[1]:.3f} over the printed "
             f"rounding of {r1p2:g} and {r0p7:g}; the weightings give the same: sqrt(3 x "
             f"{r12:g}^2) = {math.sqrt(3) * r12:.3f} (1:2) and sqrt(4 x {r13:g}^2) = "
             f"{2 * r13:.3f} um (1:3). The interval reaches the printed 1.5's zone "
             "(1.45-1.55) only at its top corner: by the rule not an erratum, a tension.",
-        )
-    )
-    r165 = ref["twoplate.similarity_vs_affine.similarity_sigma_um"]
-    add(
-        book.score(
-            "twoplate.paper_check.scale_share_arithmetic",
+            ci=corner,
+        ),
+        "twoplate.paper_check.scale_share_arithmetic": exact(
             r165 - r1p5,
-            interval="exact",
-            note=f"recomputed {r165:g} - {r1p5:g} = {r165 - r1p5:.3f} um (a linear "
+            f"recomputed {r165:g} - {r1p5:g} = {r165 - r1p5:.3f} um (a linear "
             f"subtraction of sigmas; in quadrature sqrt({r165:g}^2 - {r1p5:g}^2) = "
             f"{math.sqrt(r165**2 - r1p5**2):.3f} um).",
-        )
-    )
-    add(
-        book.score(
-            "twoplate.paper_check.grid_share_arithmetic",
+        ),
+        "twoplate.paper_check.grid_share_arithmetic": exact(
             r1p5 - r1p2,
-            interval="exact",
-            note=f"recomputed {r1p5:g} - {r1p2:g} = {r1p5 - r1p2:.3f} um (linear; in "
+            f"recomputed {r1p5:g} - {r1p2:g} = {r1p5 - r1p2:.3f} um (linear; in "
             f"quadrature sqrt({r1p5:g}^2 - {r1p2:g}^2) = {math.sqrt(r1p5**2 - r1p2**2):.3f}"
             f" um, against the given grid sigma {r0p7:g}).",
-        )
-    )
-    add(
-        book.score(
-            "twoplate.similarity_vs_affine.scale_share_linear_um",
-            samples=sim_s - aff,
-            note="similarity minus affine sigma per calibration (the paper's linear "
+        ),
+    }
+
+
+def _shares(res: dict) -> dict[str, Sim]:
+    """The paper's linear subtractions of sigmas, per simulated calibration."""
+    aff = res["aff_sigma_um"]
+    return {
+        "twoplate.similarity_vs_affine.scale_share_linear_um": plates(
+            res["sim_sigma_um"] - aff,
+            "similarity minus affine sigma per calibration (the paper's linear "
             "subtraction), against the printed value.",
-        )
-    )
-    add(
-        book.score(
-            "twoplate.similarity_vs_affine.grid_share_linear_um",
-            samples=_finite(aff - res["comp_sigma_um"], "the grid share", "grid.sigma_stated_um"),
-            note="affine sigma (grid fixed) minus the re-weighted comparator sigma per "
+        ),
+        "twoplate.similarity_vs_affine.grid_share_linear_um": plates(
+            _finite(aff - res["comp_sigma_um"], "the grid share", "grid.sigma_stated_um"),
+            "affine sigma (grid fixed) minus the re-weighted comparator sigma per "
             "calibration (linear), against the printed value.",
-        )
-    )
+        ),
+    }
+
+
+def _self_checks(cfg: dict, res: dict) -> dict[str, Sim]:
+    """The closed-form re-weighting against the iterated one, and the affine sigma's Monte
+    Carlo against its chi-square distribution."""
     cf = res["closed_form_rel"][res["closed_form_ok"].astype(bool)]
     cfmax = float(cf.max()) if cf.size else 0.0
-    add(
-        book.score(
-            "twoplate.self_check.closed_form",
-            cfmax,
-            interval="exact",
-            note=f"largest relative difference over {cf.size} adjustments between "
-            "sim.instruments.gridplate.reweight (iterated) and the closed-form fixed point "
-            "s_w^2/sg^2 - (A^2 + B^2) used for all trials.",
-        )
-    )
+    N, P = cfg["plate.grid"] ** 2, cfg["plate.count"]
+    sx, sgt = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
     nu = P * (2 * N - 6)
     sw = math.sqrt(sx**2 + sgt**2)
     a_med = sw * math.sqrt(D.chi2_ppf(0.5, nu) / nu)
-    med, (lo, hi) = quantile_ci(aff, 0.5)
-    add(
-        book.score(
-            "twoplate.self_check.affine_sigma_analytic",
+    med, (lo, hi) = quantile_ci(res["aff_sigma_um"], 0.5)
+    return {
+        "twoplate.self_check.closed_form": exact(
+            cfmax,
+            f"largest relative difference over {cf.size} adjustments between "
+            "sim.instruments.gridplate.reweight (iterated) and the closed-form fixed point "
+            "s_w^2/sg^2 - (A^2 + B^2) used for all trials.",
+        ),
+        "twoplate.self_check.affine_sigma_analytic": Sim(
             med / a_med - 1,
             (lo / a_med - 1, hi / a_med - 1),
             note=f"Monte-Carlo median of the affine sigma {med:.4f} um against the analytic "
             f"{a_med:.4f} um (chi-square, {nu} degrees of freedom), relative; the sweep "
             "(consistent_region.parquet) uses these chi-square distributions.",
-        )
-    )
+        ),
+    }
+
+
+def _beyond(beyond: dict) -> dict[str, Sim]:
+    """Bias and spread of S, S', eps with the grid fixed (rows of ``beyond.parquet``)."""
+    table = {}
     for i in range(len(beyond["param"])):
         if not beyond["method"][i].startswith("grid fixed"):
             continue
         k = {"S": "S", "S'": "S2", "eps": "eps"}[beyond["param"][i]]
         u = beyond["unit"][i]
-        add(
-            book.score(
-                f"twoplate.beyond.fixed.bias_{k}",
-                beyond["bias"][i],
-                (beyond["bias_lo"][i], beyond["bias_hi"][i]),
-                note=f"mean error of {beyond['param'][i]} ({u}), grid fixed (the weighted "
-                "adjustment gives the same estimates to first order)",
-            )
+        table[f"twoplate.beyond.fixed.bias_{k}"] = Sim(
+            beyond["bias"][i],
+            (beyond["bias_lo"][i], beyond["bias_hi"][i]),
+            note=f"mean error of {beyond['param'][i]} ({u}), grid fixed (the weighted "
+            "adjustment gives the same estimates to first order)",
         )
-        add(
-            book.score(
-                f"twoplate.beyond.fixed.sd_{k}",
-                beyond["sd"][i],
-                (beyond["sd_lo"][i], beyond["sd_hi"][i]),
-                note=f"standard deviation of {beyond['param'][i]} over plates ({u}), "
-                "chi-square interval",
-            )
+        table[f"twoplate.beyond.fixed.sd_{k}"] = Sim(
+            beyond["sd"][i],
+            (beyond["sd_lo"][i], beyond["sd_hi"][i]),
+            note=f"standard deviation of {beyond['param'][i]} over plates ({u}), "
+            "chi-square interval",
         )
-    j_true = cov["j_true"]
+    return table
+
+
+def _coverage(cfg: dict, res: dict, j_true: int) -> dict[str, Sim]:
+    """Coverage of the nominal 95 % intervals of S, S', eps: grid fixed (a-priori and
+    a-posteriori sigma) and weighted at the ratio nearest the true one."""
+    table = {}
     for k in PARAMS:
         for tag, key, lab in (
             ("fixed_pri", f"{k}_cov_fixed_pri", "grid fixed, a-priori comparator sigma"),
@@ -311,18 +302,34 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
             ("wpost", f"{k}_cov_wpost_r{j_true}", "weighted, a-posteriori s0"),
         ):
             m, ci = share_ci(res[key])
-            add(
-                book.score(
-                    f"twoplate.beyond.coverage_{k}_{tag}",
-                    m,
-                    ci,
-                    note=f"share of plates whose interval {PARAM_LABEL[k]} +- 1.96 sd "
-                    f"contains the truth; {lab}"
-                    + (f" (1:{cfg['analysis.ratios'][j_true]:g})" if tag.startswith("w") else "")
-                    + ".",
-                )
+            table[f"twoplate.beyond.coverage_{k}_{tag}"] = Sim(
+                m,
+                ci,
+                note=f"share of plates whose interval {PARAM_LABEL[k]} +- 1.96 sd "
+                f"contains the truth; {lab}"
+                + (f" (1:{cfg['analysis.ratios'][j_true]:g})" if tag.startswith("w") else "")
+                + ".",
             )
-    return rows, book
+    return table
+
+
+def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], ClaimBook]:
+    """The claims rows of the run (``res``: the per-trial arrays; ``beyond``: the rows of
+    ``beyond.parquet``; ``cov["j_true"]``: the swept ratio nearest the true one), in the
+    order of the paper's reduction, then the self-checks and what lies beyond the paper."""
+    book = load_book()
+    table = {
+        **_readings(cfg, res),
+        **_weighting(cfg, res),
+        **_comparator(book, cfg, res),
+        **_fits(book, cfg, res),
+        **_paper_checks(book),
+        **_shares(res),
+        **_self_checks(cfg, res),
+        **_beyond(beyond),
+        **_coverage(cfg, res, cov["j_true"]),
+    }
+    return claim_rows(book, table), book
 
 
 def beyond_table(res: dict, ratios: list, j_true: int) -> dict:

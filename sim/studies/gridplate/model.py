@@ -117,15 +117,118 @@ def iterations(comp: np.ndarray, g: np.ndarray, ratio: np.ndarray, tol_mm: float
     return count
 
 
+def _rowscale(x: np.ndarray) -> np.ndarray:
+    """A per-row factor ``(nP, 2)`` as the ``(nP, 6, 6)`` block scaling of an affine
+    cofactor matrix (rows x' and y' of the affine, three parameters each)."""
+    f = np.repeat(x, 3, axis=1)
+    return np.sqrt(f[:, :, None] * f[:, None, :]) * (
+        np.arange(6)[:, None] // 3 == np.arange(6) // 3
+    )
+
+
+def _fixed_grid(cfg: dict, fa, n: int, P: int) -> dict[str, np.ndarray]:
+    """The affine fit with the grid fixed: errors of S, S', eps, coverage and stated sd with
+    the a-priori comparator sigma (``fixed_pri``) and the a-posteriori s0 (``fixed_post``)."""
+    sx = cfg["comparator.coord_sigma_um"] * UM  # a-priori comparator sigma
+    z = D.norm_ppf(0.975)
+    out: dict[str, np.ndarray] = {}
+    for tag, cov in (("fixed_pri", fa.cofactor * sx**2), ("fixed_post", fa.cov)):
+        err, sd = _decomp_errors(fa.params, cov, *truth_rows(cfg))
+        for i, k in enumerate(PARAMS):
+            out[f"{k}_err_{tag}"] = err[:, i].reshape(n, P)
+            out[f"{k}_cov_{tag}"] = (np.abs(err[:, i]) <= z * sd[:, i]).reshape(n, P)
+            out[f"{k}_sd_{tag}"] = sd[:, i].reshape(n, P)
+    return out
+
+
+def _weight_ratios(cfg: dict, fa, sw2: np.ndarray, kk: np.ndarray, n: int, P: int) -> dict:
+    """The weightings in closed form: the grid sigma implied by the paper's 1:2 and 1:3 and
+    by every swept ratio (um), and the coverage of S, S', eps at each swept ratio (a-priori
+    and a-posteriori sigma; the a-priori stated sd)."""
+    sx = cfg["comparator.coord_sigma_um"] * UM
+    z = D.norm_ppf(0.975)
+    out: dict[str, np.ndarray] = {}
+    for r in (2, 3):  # the paper's two printed weightings
+        out[f"grid_sigma_1to{r}_um"] = np.sqrt((sw2 / (r + kk)).reshape(n, 2 * P).mean(1)) / UM
+    for j, r in enumerate(cfg["analysis.ratios"]):
+        f = 1.0 + kk / r
+        out[f"implied_grid_um_r{j}"] = np.sqrt((sw2 / (r + kk)).reshape(n, 2 * P).mean(1)) / UM
+        for tag, scale in (("pri", sx**2 * f), ("post", sw2)):
+            err, sd = _decomp_errors(fa.params, fa.cofactor * _rowscale(scale), *truth_rows(cfg))
+            for i, k in enumerate(PARAMS):
+                out[f"{k}_cov_w{tag}_r{j}"] = (np.abs(err[:, i]) <= z * sd[:, i]).reshape(n, P)
+                if tag == "pri":
+                    out[f"{k}_sd_w_r{j}"] = sd[:, i].reshape(n, P)
+    return out
+
+
+def _chi2_rejections(cfg: dict, sw2: np.ndarray, kk: np.ndarray, N: int, n: int, P: int) -> dict:
+    """The chi-square test with a-priori weights ``P_x = 1/sx^2``, ``P_cx = 1/stated^2``
+    (closed form), per stated grid sigma: rejected or not, per row and plate."""
+    sx = cfg["comparator.coord_sigma_um"] * UM
+    alpha, dof = cfg["analysis.alpha"], N - 3
+    lo, hi = D.chi2_ppf(alpha / 2, dof), D.chi2_ppf(1 - alpha / 2, dof)
+    out = {}
+    for j, st in enumerate(cfg["analysis.stated_sigmas_um"]):
+        s02 = sw2 / (sx**2 + kk * (st * UM) ** 2)
+        x = dof * s02
+        out[f"reject_s{j}"] = ((x < lo) | (x > hi)).reshape(n, 2 * P)
+    return out
+
+
+def _reweighting(cfg: dict, sw2: np.ndarray, kk: np.ndarray, N: int, n: int, P: int):
+    """The paper's re-weighting at its fixed point (closed form): ``P_cx = s_w^2/sg^2 - k``,
+    ``s0^2 = s_w^2 - k sg^2`` (the comparator variance), NaN where no positive fixed point;
+    and the number of re-weightings of the literal procedure. Returns the arrays and the
+    closed-form ratio per row (for the check against the iterated adjustment)."""
+    sg = cfg["grid.sigma_stated_um"] * UM
+    closed = sw2 / sg**2 - kk
+    ok = closed > 0
+    ratio = np.where(ok, closed, np.nan)
+    okn = ok.reshape(n, 2 * P).all(1)
+    s0sq = np.where(ok, sw2 - kk * sg**2, np.nan).reshape(n, 2 * P)
+    out = {
+        "ratio_rw": ratio.reshape(n, 2 * P),
+        "comp_sigma_um": (
+            np.where(okn, np.sqrt(np.where(okn[:, None], s0sq, 1.0).mean(1)), np.nan) / UM
+        ),
+        "ratio_rw_mean": np.where(
+            okn, np.where(okn[:, None], ratio.reshape(n, 2 * P), 1.0).mean(1), np.nan
+        ),
+        "rw_trials": reweight_trials(
+            sw2, kk, sg, N - 3, cfg["analysis.ratio_start"], cfg["analysis.alpha"]
+        ).reshape(n, 2 * P),
+    }
+    return out, closed
+
+
+def _iterated(cfg: dict, mean: np.ndarray, g: np.ndarray, closed: np.ndarray) -> dict:
+    """The iterated combined adjustment (:func:`sim.instruments.gridplate.reweight`) on a
+    sample of adjustments: check of the closed form, pass rate after re-weighting,
+    Gauss-Newton iterations."""
+    sg = cfg["grid.sigma_stated_um"] * UM
+    comp2 = np.concatenate([mean[..., 0], mean[..., 1]], 0)[: cfg["analysis.iter_sample"]]
+    g2 = np.concatenate([g, g], 0)[: cfg["analysis.iter_sample"]]
+    m = comp2.shape[0]
+    start = cfg["analysis.ratio_start"]
+    rw = gp.reweight(comp2, g2, sg, ratio0=float(start), alpha=cfg["analysis.alpha"])
+    cf = np.concatenate([closed[:, 0], closed[:, 1]])[:m]
+    good = np.isfinite(rw["ratio"]) & (cf > 0)
+    r_it = np.where(np.isfinite(rw["ratio"]), rw["ratio"], start)
+    return {
+        "closed_form_rel": np.abs(np.where(good, rw["ratio"] / np.where(good, cf, 1.0) - 1, 0.0)),
+        "closed_form_ok": good,
+        "passes_rw": rw["passes"],
+        "gn_iterations": iterations(comp2, g2, r_it, cfg["analysis.iter_tol_um"] * UM),
+    }
+
+
 def reduce_chunk(cfg: dict, sim: dict) -> dict[str, np.ndarray]:
-    """The paper's reduction (and the coverage sweep) for the simulated calibrations."""
+    """The paper's reduction (and the coverage sweep) for the simulated calibrations: the
+    precision of the readings, similarity and affine fits with the grid fixed, the weightings
+    and the chi-square test in closed form, the re-weighting and the iterated adjustment."""
     readings, cert = sim["readings"], sim["cert"]
     n, P, N, L, _ = readings.shape
-    S, S2, eps = truth_rows(cfg)
-    sx = cfg["comparator.coord_sigma_um"] * UM  # a-priori comparator sigma
-    sg = cfg["grid.sigma_stated_um"] * UM
-    alpha, dof = cfg["analysis.alpha"], N - 3
-    z = D.norm_ppf(0.975)
     _, sigma_obs = gp.repeat_precision(readings)
     mean = readings.mean(axis=3).reshape(n * P, N, 2)
     g = cert.reshape(n * P, N, 2)
@@ -135,72 +238,17 @@ def reduce_chunk(cfg: dict, sim: dict) -> dict[str, np.ndarray]:
     out["sim_sigma_um"] = np.sqrt((fs.s0**2).reshape(n, P).mean(1)) / UM
     out["aff_sigma_um"] = np.sqrt((fa.s0**2).reshape(n, P).mean(1)) / UM
     # per row (x', y') of each plate: misclosure variance and k = A^2 + B^2
-    sw2 = np.stack([(fa.residuals[..., c] ** 2).sum(1) / dof for c in (0, 1)], 1)  # (nP, 2)
+    sw2 = np.stack([(fa.residuals[..., c] ** 2).sum(1) / (N - 3) for c in (0, 1)], 1)  # (nP, 2)
     kk = np.stack(
         [fa.params[:, 0] ** 2 + fa.params[:, 1] ** 2, fa.params[:, 3] ** 2 + fa.params[:, 4] ** 2],
         1,
     )
-    Q = fa.cofactor
-
-    def rowscale(x):  # (nP, 2) per-row factor -> (nP, 6, 6) block scaling of Q
-        f = np.repeat(x, 3, axis=1)
-        return np.sqrt(f[:, :, None] * f[:, None, :]) * (
-            np.arange(6)[:, None] // 3 == np.arange(6) // 3
-        )
-
-    for tag, cov in (("fixed_pri", Q * sx**2), ("fixed_post", fa.cov)):
-        err, sd = _decomp_errors(fa.params, cov, S, S2, eps)
-        for i, k in enumerate(PARAMS):
-            out[f"{k}_err_{tag}"] = err[:, i].reshape(n, P)
-            out[f"{k}_cov_{tag}"] = (np.abs(err[:, i]) <= z * sd[:, i]).reshape(n, P)
-            out[f"{k}_sd_{tag}"] = sd[:, i].reshape(n, P)
-    for r in (2, 3):  # the paper's two printed weightings
-        out[f"grid_sigma_1to{r}_um"] = np.sqrt((sw2 / (r + kk)).reshape(n, 2 * P).mean(1)) / UM
-    for j, r in enumerate(cfg["analysis.ratios"]):
-        f = 1.0 + kk / r
-        out[f"implied_grid_um_r{j}"] = np.sqrt((sw2 / (r + kk)).reshape(n, 2 * P).mean(1)) / UM
-        for tag, scale in (("pri", sx**2 * f), ("post", sw2)):
-            err, sd = _decomp_errors(fa.params, Q * rowscale(scale), S, S2, eps)
-            for i, k in enumerate(PARAMS):
-                out[f"{k}_cov_w{tag}_r{j}"] = (np.abs(err[:, i]) <= z * sd[:, i]).reshape(n, P)
-                if tag == "pri":
-                    out[f"{k}_sd_w_r{j}"] = sd[:, i].reshape(n, P)
-    # chi-square test with a-priori weights P_x = 1/sx^2, P_cx = 1/stated^2 (closed form)
-    lo, hi = D.chi2_ppf(alpha / 2, dof), D.chi2_ppf(1 - alpha / 2, dof)
-    for j, st in enumerate(cfg["analysis.stated_sigmas_um"]):
-        s02 = sw2 / (sx**2 + kk * (st * UM) ** 2)
-        x = dof * s02
-        out[f"reject_s{j}"] = ((x < lo) | (x > hi)).reshape(n, 2 * P)
-    # the paper's re-weighting at its fixed point (closed form): P_cx = s_w^2/sg^2 - k,
-    # s0^2 = s_w^2 - k sg^2 (the comparator variance); NaN where no positive fixed point
-    closed = sw2 / sg**2 - kk
-    ok = closed > 0
-    ratio = np.where(ok, closed, np.nan)
-    okn = ok.reshape(n, 2 * P).all(1)
-    s0sq = np.where(ok, sw2 - kk * sg**2, np.nan).reshape(n, 2 * P)
-    out["ratio_rw"] = ratio.reshape(n, 2 * P)
-    out["comp_sigma_um"] = (
-        np.where(okn, np.sqrt(np.where(okn[:, None], s0sq, 1.0).mean(1)), np.nan) / UM
-    )
-    out["ratio_rw_mean"] = np.where(
-        okn, np.where(okn[:, None], ratio.reshape(n, 2 * P), 1.0).mean(1), np.nan
-    )
-    out["rw_trials"] = reweight_trials(
-        sw2, kk, sg, dof, cfg["analysis.ratio_start"], alpha
-    ).reshape(n, 2 * P)
-    # the iterated combined adjustment (sim.instruments.gridplate.reweight) on a sample of adjustments:
-    # check of the closed form, pass rate after re-weighting, Gauss-Newton iterations
-    comp2 = np.concatenate([mean[..., 0], mean[..., 1]], 0)[: cfg["analysis.iter_sample"]]
-    g2 = np.concatenate([g, g], 0)[: cfg["analysis.iter_sample"]]
-    m = comp2.shape[0]
-    rw = gp.reweight(comp2, g2, sg, ratio0=float(cfg["analysis.ratio_start"]), alpha=alpha)
-    cf = np.concatenate([closed[:, 0], closed[:, 1]])[:m]
-    good = np.isfinite(rw["ratio"]) & (cf > 0)
-    out["closed_form_rel"] = np.abs(np.where(good, rw["ratio"] / np.where(good, cf, 1.0) - 1, 0.0))
-    out["closed_form_ok"] = good
-    out["passes_rw"] = rw["passes"]
-    r_it = np.where(np.isfinite(rw["ratio"]), rw["ratio"], cfg["analysis.ratio_start"])
-    out["gn_iterations"] = iterations(comp2, g2, r_it, cfg["analysis.iter_tol_um"] * UM)
+    out |= _fixed_grid(cfg, fa, n, P)
+    out |= _weight_ratios(cfg, fa, sw2, kk, n, P)
+    out |= _chi2_rejections(cfg, sw2, kk, N, n, P)
+    rw, closed = _reweighting(cfg, sw2, kk, N, n, P)
+    out |= rw
+    out |= _iterated(cfg, mean, g, closed)
     return out
 
 

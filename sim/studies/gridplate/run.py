@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import write_claims
-from sim.claims.book_region import region_rows, write_region
+from sim.claims.book_region import write_region
 from sim.claims.intervals import spread
 from sim.lsq import distributions as D
-from sim.mc.runner import chunk_rng, run_chunks
+from sim.mc.runner import chunk_rng
 from sim.mc.storage import provenance, write_table
 from sim.report.figure_jobs import start_figures
 from sim.report.region import fig_region
@@ -21,6 +21,7 @@ from sim.studies.gridplate import figures as F
 from sim.studies.gridplate.claims import beyond_table, score
 from sim.studies.gridplate.model import PARAMS, chunk, simulate
 from sim.studies.gridplate.region import explore_region, nominal
+from sim.studies.run_steps import over_region, run_part, spread_note
 
 
 def analytic_reject(cfg: dict, stated_um: float, dof: int) -> float:
@@ -48,34 +49,13 @@ def decide_over_region(cfg: dict, book, rows: list[dict], out: Path, prov) -> li
             ("grid_points_1", "spacing_mm"): lambda g: 230.0 / np.maximum(np.round(g) - 1, 1)
         },
     )
-    by = {r["claim"]: r for r in rows}
-    fresh = type(book)(list(book.specs.values()), [], book.path)
-    notes = {
-        c: f"at the configured inputs (an example): median {by[c]['value']:.3g}, 95 % of "
-        f"calibrations {by[c]['ci_low']:.3g}-{by[c]['ci_high']:.3g}, outcome {by[c]['outcome']}"
-        for c in preds
-    }
-    new = {r["claim"]: r for r in region_rows(fresh, region, preds, notes)}
-    return [new.get(r["claim"], r) for r in rows]
+    return over_region(book, region, preds, rows, spread_note("calibrations"))
 
 
-def run(cfg: dict, out: Path, ctx: RunContext) -> None:
-    res = run_chunks(
-        partial(chunk, cfg),
-        cfg["trials"],
-        cfg["seed"],
-        cfg["chunk"],
-        part=0,
-        label="gridplate",
-        quiet=ctx.quiet,
-        ctx=ctx,
-    )
-    prov = provenance(cfg)
+def trials_table(res: dict) -> dict[str, np.ndarray]:
+    """``trials.parquet``: one row per calibration, the per-trial arrays (a column per plate
+    or adjustment ``<name>_<k>`` where an array has more than one)."""
     T = res["sim_sigma_um"].shape[0]
-    dof = cfg["plate.grid"] ** 2 - 3
-    ratios = list(cfg["analysis.ratios"])
-    sx, sgt = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
-    ratio_true = sx**2 / sgt**2 if sgt > 0 else np.inf
     cols = {"trial": np.arange(T)}
     for k, v in res.items():
         v = np.asarray(v)
@@ -86,12 +66,12 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         else:
             for p in range(v.shape[1]):
                 cols[f"{k}_{p + 1}"] = v[:, p]
-    write_table(out / "trials.parquet", cols, prov)
-    write_table(
-        out / "adjustments_sample.parquet",
-        {k: np.asarray(res[k]) for k in ("gn_iterations", "closed_form_rel", "passes_rw")},
-        prov,
-    )
+    return cols
+
+
+def coverage_table(res: dict, ratios: list) -> dict[str, np.ndarray]:
+    """``coverage.parquet``: coverage of the nominal 95 % intervals of S, S', eps per swept
+    weight ratio (a-priori and a-posteriori sigma), and with the grid fixed."""
     cov = {"ratio": np.asarray(ratios)}
     for k in PARAMS:
         for tag in ("pri", "post"):
@@ -99,14 +79,25 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
                 [res[f"{k}_cov_w{tag}_r{j}"].mean() for j in range(len(ratios))]
             )
             cov[f"{k}_fixed_{tag}"] = np.full(len(ratios), res[f"{k}_cov_fixed_{tag}"].mean())
-    write_table(out / "coverage.parquet", cov, prov)
+    return cov
+
+
+def implied_table(res: dict, ratios: list) -> dict[str, list]:
+    """``implied_grid.parquet``: the grid sigma implied by each weight ratio (um), median and
+    the 2.5-97.5 % spread over calibrations."""
     imp = {"ratio": np.asarray(ratios), "median": [], "lo": [], "hi": []}
     for j in range(len(ratios)):
         m, (lo, hi) = spread(res[f"implied_grid_um_r{j}"])
         imp["median"].append(m)
         imp["lo"].append(lo)
         imp["hi"].append(hi)
-    write_table(out / "implied_grid.parquet", imp, prov)
+    return imp
+
+
+def chi2_table(cfg: dict, res: dict) -> dict[str, list]:
+    """``chi2_power.parquet``: rejection rate of the chi-square test per stated grid sigma,
+    its Wilson interval, the analytic rate and the number of tests."""
+    dof = cfg["plate.grid"] ** 2 - 3
     ch = {
         "stated_um": np.asarray(cfg["analysis.stated_sigmas_um"]),
         "reject": [],
@@ -126,22 +117,54 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
             ("tests", x.size),
         ):
             ch[col].append(v)
-    write_table(out / "chi2_power.parquet", ch, prov)
+    return ch
+
+
+def true_ratio(cfg: dict) -> tuple[float, int]:
+    """The true weight ratio ``sx'^2 / sg^2`` and the index of the swept ratio nearest it
+    (the largest when the grid is error-free)."""
+    ratios = list(cfg["analysis.ratios"])
+    sx, sgt = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
+    ratio_true = sx**2 / sgt**2 if sgt > 0 else np.inf
     j_true = (
         int(np.argmin(np.abs(np.log(np.asarray(ratios) / ratio_true))))
         if np.isfinite(ratio_true)
         else int(np.argmax(ratios))
     )
+    return ratio_true, j_true
+
+
+def run(cfg: dict, out: Path, ctx: RunContext) -> None:
+    """The calibrations through the runner, their tables and figures, the claims at the
+    configured inputs, then the predictions over the region (``claims.parquet``)."""
+    res = run_part(cfg, ctx, partial(chunk, cfg), part=0, label="gridplate")
+    prov = provenance(cfg)
+    ratios = list(cfg["analysis.ratios"])
+    ratio_true, j_true = true_ratio(cfg)
+    write_table(out / "trials.parquet", trials_table(res), prov)
+    write_table(
+        out / "adjustments_sample.parquet",
+        {k: np.asarray(res[k]) for k in ("gn_iterations", "closed_form_rel", "passes_rw")},
+        prov,
+    )
+    cov, imp, ch = coverage_table(res, ratios), implied_table(res, ratios), chi2_table(cfg, res)
     beyond = beyond_table(res, ratios, j_true)
-    write_table(out / "beyond.parquet", beyond, prov)
+    for name, t in (
+        ("coverage", cov),
+        ("implied_grid", imp),
+        ("chi2_power", ch),
+        ("beyond", beyond),
+    ):
+        write_table(out / f"{name}.parquet", t, prov)
     rows, book = score(cfg, res, beyond, {"j_true": j_true})
     paper = [(r, book.spec(f"twoplate.weight_ratio.grid_sigma_1to{r}_um")["ref"]) for r in (2, 3)]
+    sgt, stated = cfg["grid.sigma_true_um"], cfg["grid.sigma_stated_um"]
     drawn = start_figures(
         [  # on the idle workers while the sweep is made here
             (F.fig_params, (cfg, res, out / "parameters.png")),
             (F.fig_coverage, (cov, ratio_true, out / "coverage.png")),
             (F.fig_chi2, (ch, sgt, out / "chi2_power.png")),
-            (F.fig_implied, (imp, cfg["grid.sigma_stated_um"], paper, out / "implied_grid.png")),
+            (F.fig_implied, (imp, stated, paper, out / "implied_grid.png")),
         ],
         ctx.executor,
     )

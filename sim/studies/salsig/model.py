@@ -37,6 +37,72 @@ def b8_truth(cfg: dict) -> np.ndarray:
     )
 
 
+def _marks(cfg: dict, rng: np.random.Generator, n: int, k: int, sb8: float):
+    """The marks (model mm, ``k x k`` nominal array plus placement scatter) and their B8
+    readings (digits: the inverse of the true B8 affine of the marks plus the marking error
+    ``sb8`` mm)."""
+    nom = grid_points(k, cfg["marks.extent_mm"] / (k - 1))
+    M = nom.shape[0]
+    marks = nom + rng.normal(0.0, cfg["marks.placement_sd_mm"], (n, M, 2))  # model mm
+    b8_inv = t2.invert_affine(b8_truth(cfg))
+    b8_read = t2.apply_affine(
+        np.broadcast_to(b8_inv, (n, 6)), marks + rng.normal(0.0, sb8, (n, M, 2))
+    )  # digits
+    return marks, b8_read
+
+
+def _comparator(cfg: dict, rng: np.random.Generator, n: int, marks: np.ndarray):
+    """The film laid on the grid at a random small rotation and offset, and the comparator's
+    readings of the grid intersections and the marks through its FIG. 2-like affine with
+    ``comparator.sigma_um``. Returns the grid (mm) and the two sets of readings."""
+    sc = cfg["comparator.sigma_um"] * UM
+    M = marks.shape[1]
+    # film on the grid: rotation and offset of the film (model) frame in the grid frame
+    rot = rng.uniform(-2, 2, n) * np.pi / 180
+    off = rng.uniform(-10, 10, (n, 2))
+    c, s = np.cos(rot), np.sin(rot)
+    film2grid = np.stack([c, -s, off[:, 0], s, c, off[:, 1]], -1)
+    marks_grid_true = t2.apply_affine(film2grid, marks)
+    G = grid_points(cfg["grid.points"], cfg["grid.spacing_mm"])
+    # comparator: grid frame -> comparator readings through the FIG. 2-like affine (inverse)
+    cg = t2.affine_from_columns(
+        cfg["comparator.sx"],
+        cfg["comparator.sy"],
+        cfg["comparator.e_arcsec"] * t2.ARCSEC,
+        rng.uniform(-1, 1, n) * np.pi / 180,
+        (rng.uniform(-120, -110, n), rng.uniform(-120, -110, n)),
+    )
+    g2c = t2.invert_affine(cg)
+    comp_grid = t2.apply_affine(g2c, G) + rng.normal(0.0, sc, (n, G.shape[0], 2))
+    comp_marks = t2.apply_affine(g2c, marks_grid_true) + rng.normal(0.0, sc, (n, M, 2))
+    return G, comp_grid, comp_marks
+
+
+def _recovered(cfg: dict, f2, f3) -> tuple[dict[str, np.ndarray], dict]:
+    """SX, SY, E of the B8 from the FIG. 3 fit ``f3``, their sds, SX - SY (ppm), whether E and
+    SX - SY differ from zero at ``analysis.alpha``, and both fits' unit-weight errors; and
+    the decomposition itself."""
+    d3 = t2.inverse_decomposition(f3.params, f3.cov)
+    sd = np.sqrt(np.einsum("tii->ti", d3["cov"]))
+    diff = d3["SX"] - d3["SY"]
+    sd_diff = np.sqrt(d3["cov"][:, 0, 0] + d3["cov"][:, 1, 1] - 2 * d3["cov"][:, 0, 1])
+    zc = D.norm_ppf(1 - cfg["analysis.alpha"] / 2)
+    return {
+        "SX": d3["SX"],
+        "SY": d3["SY"],
+        "E_arcsec": d3["E"] / t2.ARCSEC,
+        "sd_SX": sd[:, 0],
+        "sd_SY": sd[:, 1],
+        "sd_E_arcsec": sd[:, 2] / t2.ARCSEC,
+        "scale_diff_ppm": diff / d3["SX"] * 1e6,
+        "sd_scale_diff_ppm": sd_diff / d3["SX"] * 1e6,
+        "detect_E": np.abs(d3["E"]) > zc * sd[:, 2],
+        "detect_scale": np.abs(diff) > zc * sd_diff,
+        "s0_fig2_mm": f2.s0,
+        "s0_fig3_digits": f3.s0,
+    }, d3
+
+
 def simulate_chain(
     cfg: dict,
     rng: np.random.Generator,
@@ -57,58 +123,15 @@ def simulate_chain(
     """
     k = cfg["marks.grid"] if k_marks is None else k_marks
     sb8 = (cfg["b8.sigma_um"] if sigma_b8_um is None else sigma_b8_um) * UM
-    sc = cfg["comparator.sigma_um"] * UM
-    nom = grid_points(k, cfg["marks.extent_mm"] / (k - 1))
-    M = nom.shape[0]
-    marks = nom + rng.normal(0.0, cfg["marks.placement_sd_mm"], (n, M, 2))  # model mm
-    b8 = b8_truth(cfg)
-    b8_inv = t2.invert_affine(b8)
-    b8_read = t2.apply_affine(
-        np.broadcast_to(b8_inv, (n, 6)), marks + rng.normal(0.0, sb8, (n, M, 2))
-    )  # digits
-    # film on the grid: rotation and offset of the film (model) frame in the grid frame
-    rot = rng.uniform(-2, 2, n) * np.pi / 180
-    off = rng.uniform(-10, 10, (n, 2))
-    c, s = np.cos(rot), np.sin(rot)
-    film2grid = np.stack([c, -s, off[:, 0], s, c, off[:, 1]], -1)
-    marks_grid_true = t2.apply_affine(film2grid, marks)
-    G = grid_points(cfg["grid.points"], cfg["grid.spacing_mm"])
-    # comparator: grid frame -> comparator readings through the FIG. 2-like affine (inverse)
-    cg = t2.affine_from_columns(
-        cfg["comparator.sx"],
-        cfg["comparator.sy"],
-        cfg["comparator.e_arcsec"] * t2.ARCSEC,
-        rng.uniform(-1, 1, n) * np.pi / 180,
-        (rng.uniform(-120, -110, n), rng.uniform(-120, -110, n)),
-    )
-    g2c = t2.invert_affine(cg)
-    comp_grid = t2.apply_affine(g2c, G) + rng.normal(0.0, sc, (n, G.shape[0], 2))
-    comp_marks = t2.apply_affine(g2c, marks_grid_true) + rng.normal(0.0, sc, (n, M, 2))
+    marks, b8_read = _marks(cfg, rng, n, k, sb8)
+    G, comp_grid, comp_marks = _comparator(cfg, rng, n, marks)
     # FIG. 2: comparator (X2, observed) as a function of the grid (X1, control)
     f2 = t2.fit_affine(G, comp_grid)
     p2 = t2.invert_affine(f2.params)  # X1 = A X2 + B Y2 + C
     marks_grid = t2.apply_affine(p2, comp_marks)  # FIG. 2 "transformed points"
     # FIG. 3: B8 (X2, observed) as a function of the grid-system marks (X1, control)
     f3 = t2.fit_affine(marks_grid, b8_read)
-    d3 = t2.inverse_decomposition(f3.params, f3.cov)
-    sd = np.sqrt(np.einsum("tii->ti", d3["cov"]))
-    diff = d3["SX"] - d3["SY"]
-    sd_diff = np.sqrt(d3["cov"][:, 0, 0] + d3["cov"][:, 1, 1] - 2 * d3["cov"][:, 0, 1])
-    zc = D.norm_ppf(1 - cfg["analysis.alpha"] / 2)
-    out = {
-        "SX": d3["SX"],
-        "SY": d3["SY"],
-        "E_arcsec": d3["E"] / t2.ARCSEC,
-        "sd_SX": sd[:, 0],
-        "sd_SY": sd[:, 1],
-        "sd_E_arcsec": sd[:, 2] / t2.ARCSEC,
-        "scale_diff_ppm": diff / d3["SX"] * 1e6,
-        "sd_scale_diff_ppm": sd_diff / d3["SX"] * 1e6,
-        "detect_E": np.abs(d3["E"]) > zc * sd[:, 2],
-        "detect_scale": np.abs(diff) > zc * sd_diff,
-        "s0_fig2_mm": f2.s0,
-        "s0_fig3_digits": f3.s0,
-    }
+    out, d3 = _recovered(cfg, f2, f3)
     if return_all:
         out.update(
             {

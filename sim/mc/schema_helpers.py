@@ -1,0 +1,96 @@
+"""Short constructors for the kinds of configuration key every study schema declares, and the
+one-line form of a cross-key rule (:mod:`sim.mc.config` holds :class:`Field` and the
+validation).
+
+A study schema (``sim/studies/<study>/schema.py``) is a dict ``{dotted key: Field}``; most of
+its keys are one of a few kinds, written here once:
+
+* :func:`count` -- an integer in ``[lo, hi]`` (points per side, trials of a sweep cell);
+* :func:`real` -- a number in ``[lo, hi]`` (either bound may be open-ended: ``None``);
+* :func:`positive` -- a number ``> 0`` (a standard deviation, a scale), at most ``hi``;
+* :func:`level` -- the level of a two-sided test, in ``(0, 0.5]``;
+* :func:`reals`, :func:`counts` -- lists of those (the values a sweep visits);
+* :func:`require` -- a cross-key rule of a study's ``check``: :class:`ConfigError` naming the
+  key when it does not hold.
+
+``unit`` names the key's unit for the report (``"um"``, ``"mm"``, ``"arcsec"``); ``input``
+marks a value set to match a paper. The fields are the same :class:`Field` objects a schema
+would spell out (equal field by field), so validation and the report are unchanged.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sim.mc.config import ConfigError, Field
+
+__all__ = ["count", "real", "positive", "level", "reals", "counts", "require"]
+
+
+def count(default: int, doc: str, lo: int, hi: int | None = None, *, input: bool = False) -> Field:
+    """An integer key in ``[lo, hi]``."""
+    return Field(default, "int", doc, lo=lo, hi=hi, input=input)
+
+
+def real(
+    default: float,
+    doc: str,
+    lo: float | None = None,
+    hi: float | None = None,
+    *,
+    unit: str = "",
+    input: bool = False,
+) -> Field:
+    """A number in ``[lo, hi]`` (``None``: no bound on that side)."""
+    return Field(default, "float", doc, lo=lo, hi=hi, input=input, unit=unit)
+
+
+def positive(
+    default: float, doc: str, hi: float | None = None, *, unit: str = "", input: bool = False
+) -> Field:
+    """A number ``> 0`` (and ``<= hi``): a standard deviation, a scale, a length."""
+    return Field(default, "float", doc, lo=0.0, hi=hi, lo_open=True, input=input, unit=unit)
+
+
+def level(default: float, doc: str) -> Field:
+    """The level of a two-sided test (alpha), in ``(0, 0.5]``."""
+    return Field(default, "float", doc, lo=0.0, hi=0.5, lo_open=True)
+
+
+def reals(
+    default: list[float],
+    doc: str,
+    lo: float | None = None,
+    hi: float | None = None,
+    *,
+    lo_open: bool = False,
+    min_len: int = 1,
+    unit: str = "",
+    input: bool = False,
+) -> Field:
+    """A list of at least ``min_len`` numbers, each in ``[lo, hi]`` (``(lo, hi]`` with
+    ``lo_open``)."""
+    return Field(
+        default,
+        "list[float]",
+        doc,
+        lo=lo,
+        hi=hi,
+        lo_open=lo_open,
+        min_len=min_len,
+        input=input,
+        unit=unit,
+    )
+
+
+def counts(
+    default: list[int], doc: str, lo: int, hi: int | None = None, *, min_len: int = 1
+) -> Field:
+    """A list of at least ``min_len`` integers, each in ``[lo, hi]``."""
+    return Field(default, "list[int]", doc, lo=lo, hi=hi, min_len=min_len)
+
+
+def require(ok: Any, key: str, message: str) -> None:
+    """A cross-key rule: :class:`ConfigError` ``"<key>: <message>"`` unless ``ok``."""
+    if not ok:
+        raise ConfigError(key, message)
