@@ -15,6 +15,7 @@ import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
 from sim.mc.storage import atomic_path  # noqa: E402
 from sim.report.figcheck import data_points, figure_facts, points_inside, reader_problems  # noqa: E402
@@ -307,3 +308,24 @@ def readable_limits(ax, axis: str = "y", rel: float = 1e-3) -> None:
         return
     half = rel * abs(centre) / 2
     (ax.set_ylim if axis == "y" else ax.set_xlim)(centre - half, centre + half)
+
+
+def plain_log(ax, axis: str = "x") -> None:
+    """Tick labels of a log axis as plain numbers (``2``, ``30``, not ``2×10⁰``); the
+    minor ticks labelled too when the axis spans under two decades."""
+    a = ax.xaxis if axis == "x" else ax.yaxis
+    lo, hi = sorted(ax.get_xlim() if axis == "x" else ax.get_ylim())
+    plain = FuncFormatter(lambda v, _: f"{v:g}")
+    a.set_major_formatter(plain)
+    few = lo > 0 and np.log10(hi / lo) < 2
+    a.set_minor_formatter(plain if few else NullFormatter())
+
+
+def times_ten(x: float, digits: int = 2) -> str:
+    """``x`` as a reader writes a very small or large number: ``1.0×10⁻¹²`` (plain ``0.25``
+    between 0.001 and 10000)."""
+    if x == 0 or not np.isfinite(x) or 1e-3 <= abs(x) < 1e4:
+        return f"{x:.{digits}g}"
+    e = int(np.floor(np.log10(abs(x))))
+    sup = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+    return f"{x / 10**e:.{digits - 1}f}×10{str(e).translate(sup)}"
