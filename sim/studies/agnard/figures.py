@@ -92,17 +92,23 @@ def fig_layout(block: Block, ctrl5, ctrl21, path: Path, sweep_ctrl=(), insets=()
         label=f"control, second pass ({ctrl21.size})",
     )
     ax.plot(*P[ctrl5].T, "s", color="tab:blue", ms=6, label=f"control, third pass ({ctrl5.size})")
-    for i, (c, u) in enumerate(zip(sweep_ctrl, insets)):
-        col = plt.cm.viridis(0.7 * i / max(len(insets) - 1, 1))  # the dark part: never pale
-        ax.plot(
-            *P[c].T,
-            "o",
-            mfc="none",
-            color=col,
-            ms=12 + 3 * i,
-            lw=0.8,
-            label=f"region five, inset {u:.2f}",
+    if len(insets):
+        span = (
+            f"insets {min(insets):.2f}–{max(insets):.2f}"
+            if len(insets) > 1
+            else f"inset {insets[0]:.2f}"
         )
+        for i, c in enumerate(sweep_ctrl):  # one colour, rings growing with the inset
+            lab = f"five-point layouts of the consistent region ({len(insets)}, {span})"
+            ax.plot(
+                *P[c].T,
+                "o",
+                mfc="none",
+                color="tab:purple",
+                ms=10 + 14 * insets[i],
+                lw=0.8,
+                label=None if i else lab,
+            )
     ax.set_aspect("equal")
     ax.set_xlabel("X along the strips (m)")
     ax.set_ylabel("Y across the strips (m)")
