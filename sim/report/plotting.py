@@ -15,7 +15,7 @@ import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
 from sim.mc.storage import atomic_path  # noqa: E402
 from sim.report.figcheck import data_points, figure_facts, points_inside, reader_problems  # noqa: E402
@@ -111,7 +111,9 @@ def _texts(fig, renderer) -> list[tuple[str, object, str]]:
         add(f"axes {i} y label", ax.yaxis.label, "layout")
         for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
             lo, hi = sorted(axis.get_view_interval())
-            for loc, t in zip(axis.get_majorticklocs(), axis.get_majorticklabels()):
+            locs = [*axis.get_majorticklocs(), *axis.get_minorticklocs()]
+            labels = [*axis.get_majorticklabels(), *axis.get_minorticklabels()]
+            for loc, t in zip(locs, labels):
                 if lo - 1e-9 * (abs(lo) + abs(hi)) <= loc <= hi + 1e-9 * (abs(lo) + abs(hi)):
                     add(f"axes {i} {name} tick label", t, "layout")
         leg = ax.get_legend()
@@ -293,7 +295,7 @@ def place_legend(ax, *args, **kw):
     for loc in _INSIDE:
         leg = ax.legend(*args, loc=loc, **kw)
         box = leg.get_window_extent(renderer)
-        if not points_inside(pts, box):
+        if not points_inside(pts, box, shrink=-4.0):  # with 4 px to spare
             return leg
     return ax.legend(*args, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, **kw)
 
@@ -311,14 +313,12 @@ def readable_limits(ax, axis: str = "y", rel: float = 1e-3) -> None:
 
 
 def plain_log(ax, axis: str = "x") -> None:
-    """Tick labels of a log axis as plain numbers (``2``, ``30``, not ``2×10⁰``); the
-    minor ticks labelled too when the axis spans under two decades."""
+    """Tick labels of a log axis as plain numbers at 1, 2 and 5 of each decade (``2``,
+    ``50``, not ``2×10⁰``); minor ticks unlabelled (they would crowd)."""
     a = ax.xaxis if axis == "x" else ax.yaxis
-    lo, hi = sorted(ax.get_xlim() if axis == "x" else ax.get_ylim())
-    plain = FuncFormatter(lambda v, _: f"{v:g}")
-    a.set_major_formatter(plain)
-    few = lo > 0 and np.log10(hi / lo) < 2
-    a.set_minor_formatter(plain if few else NullFormatter())
+    a.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    a.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    a.set_minor_formatter(NullFormatter())
 
 
 def times_ten(x: float, digits: int = 2) -> str:
