@@ -157,6 +157,10 @@ def test_every_figure_of_a_study_reads_cleanly(study, tmp_path):
             assert xpart in ax["xlabel"] and ypart in ax["ylabel"], (name, ax)
             assert ax["series"] >= series, (name, ax)
             assert ax["xlim"][0] < ax["xlim"][1] and ax["ylim"][0] < ax["ylim"][1]
+    if study == "agnard_block":  # one legend entry per kind of point, the block in metres
+        lay = facts["block_layout.png"][0]
+        assert 4 <= lay["series"] <= 5 and "(m)" in lay["xlabel"] and "(m)" in lay["ylabel"]
+        assert lay["ylim"][0] > -2000 and lay["ylim"][1] < 5000
     if study == "network":  # the 100 m test field in metres, not 100000 mm
         lo, hi = facts["network.png"][0]["xlim"]
         assert -20 < lo < 10 and 90 < hi < 130

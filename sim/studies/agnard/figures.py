@@ -80,18 +80,20 @@ def fig_layout(block: Block, ctrl5, ctrl21, path: Path, sweep_ctrl=(), insets=()
     _stereo_areas(ax, block)
     P = block.points
     chk = np.setdiff1d(np.arange(block.n_ground), ctrl21)
-    ax.plot(*P[chk].T, ".", color="0.45", ms=4, label=f"check ({chk.size} with 21 control)")
+    ax.plot(*P[chk, :2].T, ".", color="0.45", ms=4, label=f"check ({chk.size} with 21 control)")
     npass = int(block.is_pass.sum())
-    ax.plot(*P[block.is_pass].T, "x", color="tab:green", ms=5, label=f"pass points ({npass})")
+    ax.plot(*P[block.is_pass, :2].T, "x", color="tab:green", ms=5, label=f"pass points ({npass})")
     ax.plot(
-        *P[ctrl21].T,
+        *P[ctrl21, :2].T,
         "^",
         mfc="none",
         color="tab:red",
         ms=9,
         label=f"control, second pass ({ctrl21.size})",
     )
-    ax.plot(*P[ctrl5].T, "s", color="tab:blue", ms=6, label=f"control, third pass ({ctrl5.size})")
+    ax.plot(
+        *P[ctrl5, :2].T, "s", color="tab:blue", ms=6, label=f"control, third pass ({ctrl5.size})"
+    )
     if len(insets):
         span = (
             f"insets {min(insets):.2f}–{max(insets):.2f}"
@@ -101,7 +103,7 @@ def fig_layout(block: Block, ctrl5, ctrl21, path: Path, sweep_ctrl=(), insets=()
         for i, c in enumerate(sweep_ctrl):  # one colour, rings growing with the inset
             lab = f"five-point layouts of the consistent region ({len(insets)}, {span})"
             ax.plot(
-                *P[c].T,
+                *P[c, :2].T,
                 "o",
                 mfc="none",
                 color="tab:purple",
