@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.report.plotting import plt, save
+from sim.report.plotting import plt, save, times_ten
 
 __all__ = ["brown_figure", "engines_figure"]
 
@@ -20,7 +20,7 @@ def brown_figure(rows, path, agree):
     case = np.array(rows["case"])
     tps = np.array(rows["trials_per_s"])
     n = np.array(rows["n_points"])
-    fig, axs = plt.subplots(1, 3, figsize=(15, 4))
+    fig, axs = plt.subplots(1, 3, figsize=(15, 4.4), layout="constrained")
     b, s = tps[case == "batched"][0], tps[case == "scipy_loop"][0]
     bn = tps[case == "batched_numpy"][0]
     axs[0].bar(
@@ -30,7 +30,8 @@ def brown_figure(rows, path, agree):
     )
     axs[0].set_yscale("log")
     axs[0].set_ylabel("trials per second (25 points, pivot)")
-    axs[0].set_title(f"speed-up {b / s:.0f}x; solutions agree to {agree:.1e} mm")
+    axs[0].set_title(f"speed-up {b / s:.0f}×; solutions agree to {times_ten(agree)} mm")
+    axs[0].set_xlabel("engine")
     sel = case == "batched_points"
     cost = 1.0 / tps[sel]
     axs[1].loglog(n[sel], cost * 1e3, "o-", label="measured")
@@ -44,6 +45,7 @@ def brown_figure(rows, path, agree):
     axs[2].bar(ex, [tps[case == c][0] for c in ex], color="tab:green")
     axs[2].set_ylabel("trials per second (streamed)")
     axs[2].set_title("executors on this machine")
+    axs[2].set_xlabel("executor")
     save(fig, path)
 
 
@@ -51,7 +53,7 @@ def engines_figure(eng, rerun, path):
     """``eng``: columns of ``engines.parquet``, ``rerun``: of ``rerun.parquet`` (either None
     when not measured)."""
     k = bool(eng) + bool(rerun)
-    fig, axs = plt.subplots(1, k, figsize=(6.5 * k, 4.5), squeeze=False)
+    fig, axs = plt.subplots(1, k, figsize=(6.5 * k, 4.8), squeeze=False, layout="constrained")
     if eng:
         _speedups(axs[0, 0], eng)
     if rerun:
@@ -59,18 +61,33 @@ def engines_figure(eng, rerun, path):
     save(fig, path)
 
 
+#: the engines as a reader knows them (their names in engines.parquet are module names)
+_ENGINE = {
+    "pposition": "Brown\nP-position cell",
+    "gridplate": "grid plate",
+    "block": "Agnard\nblock",
+    "polynomial": "Wolf\npolynomial",
+    "polynomial_shared": "Wolf polynomial,\nshared design",
+}
+
+
+#: study colours of the timeline, no two alike (the pale halves of tab20 are not)
+_DISTINCT = [f"tab:{c}" for c in ("blue", "orange", "green", "red", "purple", "brown", "pink")]
+_DISTINCT += ["tab:gray", "tab:olive", "tab:cyan", "black", "gold", "navy"]
+
+
 def _speedups(ax, eng):
-    names = list(eng["engine"])
+    names = [_ENGINE.get(e, e) for e in eng["engine"]]
     x = np.asarray(eng["speedup"], float)
     target = float(eng["target_speedup"][0]) if names else 50.0
     ax.bar(names, x, color=["tab:blue" if v >= target else "tab:orange" for v in x])
-    ax.axhline(target, color="0.3", ls="--", label=f"target {target:.0f}x")
+    ax.axhline(target, color="0.3", ls="--", label=f"target {target:.0f}×")
     ax.set_yscale("log")
     ax.set_ylabel("speed-up over the per-trial SciPy loop (CPU time)")
     ax.set_title("engines of sim.lsq against SciPy on the same observations")
     for i, v in enumerate(x):
-        ax.annotate(f"{v:.0f}x", (i, v), ha="center", va="bottom", fontsize=9)
-    ax.tick_params(axis="x", rotation=20)
+        ax.annotate(f"{v:.0f}×", (i, v), ha="center", va="bottom", fontsize=9)
+    ax.set_xlabel("engine (study)")
     ax.legend()
 
 
@@ -83,8 +100,7 @@ def _rerun(ax, rerun):
     start = np.asarray(rerun.get("start_s", np.zeros(len(study))), float)
     ws = sorted(set(workers.tolist()))
     parts = [s for s in dict.fromkeys(study.tolist()) if s != "total"]
-    cmap = plt.get_cmap("tab20")
-    color = {s: cmap(k % 20) for k, s in enumerate(parts)}
+    color = {s: _DISTINCT[k % len(_DISTINCT)] for k, s in enumerate(parts)}
     jobs = rerun.get("jobs")
     gap = (int(max(jobs)) if jobs else 1) + 1  # rows per worker count: a lane per job
     yt, yl = [], []

@@ -362,7 +362,7 @@ def scaling_figure(cols: dict, path: Path) -> Path:
         x = np.array(cols["models"])[sel]
         a2.loglog(x, np.array(cols["analytic_s"])[sel], "o-", label="cofactors of one trial")
         a2.loglog(x, np.array(cols["mc_s_per_trial"])[sel], "s--", label="adjustment per trial")
-        a2.set_xlabel("models")
+        a2.set_xlabel("number of models")
         a2.set_title("independent-model blocks")
         a2.legend(fontsize=7)
     fig.tight_layout()

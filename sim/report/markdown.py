@@ -7,7 +7,6 @@ Markdown. Nothing here runs a simulation.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Callable
 
@@ -16,8 +15,10 @@ import pyarrow as pa
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_table
 from sim.report.claimtext import interval_text, ref_text, sim_text
+from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
+from sim.report.glance import by_paper, number, opening
 from sim.report.papers import paper_name
-from sim.report.run_summary import headline_rows, region_line, verdict_line, write_run_readme
+from sim.report.run_summary import headline_rows, write_run_readme
 from sim.report.tables import fmt, md_table
 from sim.report.verify import markdown as reproducibility_markdown
 
@@ -35,22 +36,6 @@ __all__ = [
 ]
 
 
-_VERDICT_TEXT = {
-    "holds": "holds",
-    "fails": "**fails**",
-    "inconclusive": "inconclusive",
-    "depends": "depends",
-    "holds or undecided": "holds or undecided",
-    "fails or undecided": "fails or undecided",
-    "undecidable": "undecidable",
-    "erratum": "**erratum**",
-    "input": "input",
-    "self-check": "self-check",
-    "finding": "finding",
-    "not comparable": "not comparable",
-}
-
-
 _PREDICTION_VERDICTS = (
     "holds",
     "fails",
@@ -60,11 +45,6 @@ _PREDICTION_VERDICTS = (
     "fails or undecided",
     "undecidable",
 )
-
-
-def number(x):
-    """A table cell as a number, or None where it is missing or NaN."""
-    return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
 
 
 def consistent_rows(cons: dict) -> list[list]:
@@ -213,81 +193,10 @@ _COUNT_COLS = [
 ]
 
 
-def _headline_pick(studies: list[tuple], n: int = 3) -> list[tuple]:
-    """Up to ``n`` headline claims of one paper: one per study in turn, each in its claim
-    book's order. ``studies``: ``[(dir name, study, claims)]``."""
-    queues = [[(name, r) for r in headline_rows(claims)] for name, _, claims in studies]
-    out: list[tuple] = []
-    while len(out) < n and any(queues):
-        for q in queues:
-            if q and len(out) < n:
-                out.append(q.pop(0))
-    return out
-
-
-def _sig3(r: dict) -> str:
-    """A claim's simulated value at 3 significant digits (a range as low-high)."""
-    if r["verdict"] == "not comparable":
-        return ""
-    v = fmt(r["value"], 3)
-    vh = r.get("value_high")
-    if vh is not None and isinstance(vh, float) and math.isfinite(vh) and vh != r["value"]:
-        v += f"–{fmt(vh, 3)}"
-    if r["interval"] != "exact" and number(r.get("ci_low")) is not None:
-        v += f" [{fmt(r['ci_low'], 3)}, {fmt(r['ci_high'], 3)}]"
-    return v
-
-
-def _by_paper(entries: list[tuple]) -> dict[str, list]:
-    by_seed: dict[str, list] = {}
-    for _, name, study, claims, _ in entries:
-        by_seed.setdefault(study.seed_file or "", []).append((name, study, claims))
-    return by_seed
-
-
-def opening(entries: list[tuple], results: Path) -> str:
-    """One screen: per paper, its studies (linked to their README.md), the verdict counts
-    and three headline verdicts at 3 significant digits; the consistent region's line where
-    a study has one; the network studies (no paper) with their counts."""
-    rows, notes = [], []
-    by_seed = _by_paper(entries)
-    for seed in sorted(s for s in by_seed if s):
-        studies = by_seed[seed]
-        links = ", ".join(f"[{name}]({name}/README.md)" for name, _, _ in studies)
-        counts = verdict_line([r for _, _, c in studies for r in c])
-        picks = _headline_pick(studies)
-        first = [f"**{paper_name(seed)}** ({links})", counts.split(": ", 1)[1]]
-        for j, (name, r) in enumerate(picks or [("", None)]):
-            cells = first if j == 0 else ["", ""]
-            if r is None:
-                rows.append(cells + ["_no headline claim_", "", ""])
-            else:
-                rows.append(
-                    cells
-                    + [f"`{r['claim']}`", _sig3(r), _VERDICT_TEXT.get(r["verdict"], r["verdict"])]
-                )
-        for name, _, _ in studies:
-            if (reg := region_line(results / name)) is not None:
-                notes.append(f"- `{name}`: {reg}")
-    nets = by_seed.get("", [])
-    if nets:
-        notes.append(
-            "- Network studies (a declared network, no paper): "
-            + "; ".join(
-                f"[{name}]({name}/README.md) {verdict_line(c).split(': ', 1)[1]}"
-                for name, _, c in nets
-            )
-        )
-    table = md_table(
-        ["paper (studies)", "verdicts", "headline claim", "simulated [95%]", "verdict"], rows
-    )
-    return "\n".join(["## The verdicts at a glance", "", table, "", *notes, ""])
-
-
 def referee_summary(entries: list[tuple]) -> str:
     """Per paper: every headline claim with the paper's words, the decision zone, the
     simulated value (at the precision its interval supports), the interval and the verdict."""
-    by_seed = _by_paper(entries)
+    by_seed = by_paper(entries)
     parts = [
         "## Every headline claim\n",
         "Each claim is decided by its stated rule (see *How verdicts are decided* below); "

@@ -11,13 +11,24 @@ from pathlib import Path
 from typing import Callable, Iterator
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
 from sim.mc.storage import atomic_path  # noqa: E402
+from sim.report.figcheck import data_points, figure_facts, points_inside, reader_problems  # noqa: E402
 
-__all__ = ["plt", "save", "layout_problems", "checking_figures", "UNITLESS"]
+__all__ = [
+    "plt",
+    "save",
+    "layout_problems",
+    "checking_figures",
+    "figure_facts",
+    "hist_bins",
+    "UNITLESS",
+]
 
 plt.rcParams.update(
     {
@@ -87,8 +98,10 @@ def _texts(fig, renderer) -> list[tuple[str, object, str]]:
     add("suptitle", getattr(fig, "_suptitle", None), "layout")
     add("supxlabel", getattr(fig, "_supxlabel", None), "layout")
     add("supylabel", getattr(fig, "_supylabel", None), "layout")
+    sup = {id(getattr(fig, n, None)) for n in ("_suptitle", "_supxlabel", "_supylabel")}
     for t in fig.texts:
-        add("figure text", t, "layout")
+        if id(t) not in sup:  # the suptitle is one of the figure's texts
+            add("figure text", t, "layout")
     for i, ax in enumerate(fig.axes):
         if not ax.get_visible():
             continue
@@ -98,7 +111,9 @@ def _texts(fig, renderer) -> list[tuple[str, object, str]]:
         add(f"axes {i} y label", ax.yaxis.label, "layout")
         for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
             lo, hi = sorted(axis.get_view_interval())
-            for loc, t in zip(axis.get_majorticklocs(), axis.get_majorticklabels()):
+            locs = [*axis.get_majorticklocs(), *axis.get_minorticklocs()]
+            labels = [*axis.get_majorticklabels(), *axis.get_minorticklabels()]
+            for loc, t in zip(locs, labels):
                 if lo - 1e-9 * (abs(lo) + abs(hi)) <= loc <= hi + 1e-9 * (abs(lo) + abs(hi)):
                     add(f"axes {i} {name} tick label", t, "layout")
         leg = ax.get_legend()
@@ -116,6 +131,9 @@ def _overlap(a, b, slack: float = _SLACK) -> bool:
 
 
 def _has_data(ax) -> bool:
+    """An axes that draws data (not a colour bar, which is labelled by its own label)."""
+    if getattr(ax, "_colorbar", None) is not None:
+        return False
     return bool(ax.lines or ax.collections or ax.images or ax.patches or ax.containers)
 
 
@@ -162,12 +180,16 @@ def layout_problems(fig) -> list[str]:
     - an additive offset on the tick labels (``1e-6+2.4353e-1``): the ticks should say the
       numbers;
     - an axes with data but no title, an axis without a label, a label without a unit (or a
-      word of :data:`UNITLESS`).
+      word of :data:`UNITLESS`);
+    - the checks of :func:`sim.report.figcheck.reader_problems`: legends over data, texts
+      over markers or cut off, tiny fonts, ASCII units, tick labels with too many digits,
+      comb histograms, pale or look-alike legend colours.
 
     Empty when the figure reads cleanly. Draws the figure once (no file is written)."""
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
-    texts = [(w, t.get_window_extent(renderer), r) for w, t, r in _texts(fig, renderer)]
+    drawn = _texts(fig, renderer)
+    texts = [(w, t.get_window_extent(renderer), r) for w, t, r in drawn]
     probs = []
     for i in range(len(texts)):
         for j in range(i + 1, len(texts)):
@@ -192,21 +214,32 @@ def layout_problems(fig) -> list[str]:
             off = axis.get_offset_text()
             if ax.get_visible() and off.get_visible() and "+" in off.get_text():
                 probs.append(f"axes {i}: {name} tick labels carry an offset {off.get_text()!r}")
-    return probs + _labels_problems(fig)
+    seen = {}
+    for w, t, _ in drawn:  # one sentence per artist kind and text (tick labels repeat)
+        seen.setdefault((w, t.get_text()), t)
+    style = reader_problems(fig, renderer, [(w, t) for (w, _), t in seen.items()])
+    return probs + _labels_problems(fig) + list(dict.fromkeys(style))
 
 
-_RECORDER: Callable[[Path, list[str]], None] | None = None
+_RECORDER: Callable[[Path, object], None] | None = None
 
 
 @contextmanager
-def checking_figures() -> Iterator[dict[str, list[str]]]:
+def checking_figures(facts: dict | None = None) -> Iterator[dict[str, list[str]]]:
     """Within the block, every figure :func:`save` writes in this process is checked by
     :func:`layout_problems` first; yields ``{file name: problems}``, filled as they are
-    saved (the tests run a study at a tiny size inside it)."""
+    saved (the tests run a study at a tiny size inside it). ``facts``, when given, is filled
+    with ``{file name: figure_facts(fig)}`` (:func:`sim.report.figcheck.figure_facts`)."""
     global _RECORDER
     found: dict[str, list[str]] = {}
     old = _RECORDER
-    _RECORDER = lambda path, probs: found.__setitem__(Path(path).name, probs)  # noqa: E731
+
+    def record(path, fig):
+        found[Path(path).name] = layout_problems(fig)
+        if facts is not None:
+            facts[Path(path).name] = figure_facts(fig)
+
+    _RECORDER = record
     try:
         yield found
     finally:
@@ -218,8 +251,81 @@ def save(fig, path: str | Path) -> Path:
     :func:`layout_problems` first inside :func:`checking_figures`)."""
     path = Path(path)
     if _RECORDER is not None:
-        _RECORDER(path, layout_problems(fig))
+        _RECORDER(path, fig)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", metadata={"Software": None}, bbox_inches="tight")
     plt.close(fig)
     return path
+
+
+def hist_bins(values, n: int = 50) -> np.ndarray:
+    """Histogram bin edges for ``values`` with about ``n`` bins that never comb: when the
+    values lie on a lattice (counts, shares of a fixed total, rounded readings), every bin
+    holds the same number of lattice values (edges halfway between them)."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return np.linspace(0.0, 1.0, n + 1)
+    lo, hi = float(v.min()), float(v.max())
+    if hi <= lo:
+        return np.array([lo - 0.5, lo + 0.5])
+    u = np.unique(v)
+    step = float(np.min(np.diff(u))) if u.size > 1 else hi - lo
+    on_lattice = u.size > 1 and np.allclose((u - lo) / step, np.round((u - lo) / step), atol=1e-6)
+    if not on_lattice or (hi - lo) / step > 20 * n:
+        return np.linspace(lo, hi, n + 1)
+    k = max(1, int(np.ceil((hi - lo) / step / n)))  # lattice values per bin
+    width = k * step
+    return np.arange(lo - step / 2, hi + width, width)
+
+
+_INSIDE = ("upper right", "upper left", "lower right", "lower left", "center right")
+_INSIDE += ("center left", "upper center", "lower center", "center")
+
+
+def place_legend(ax, *args, **kw):
+    """``ax.legend(*args, **kw)`` at the first place inside the axes where it hides no data
+    (markers, lines, bars: :func:`sim.report.figcheck.data_points`), else outside on the
+    right. Call it once the axes' data and limits are final."""
+    fig = ax.figure
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    pts = data_points(ax)
+    kw.setdefault("fontsize", 7)
+    for loc in _INSIDE:
+        leg = ax.legend(*args, loc=loc, **kw)
+        box = leg.get_window_extent(renderer)
+        if not points_inside(pts, box, shrink=-4.0):  # with 4 px to spare
+            return leg
+    return ax.legend(*args, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, **kw)
+
+
+def readable_limits(ax, axis: str = "y", rel: float = 1e-3) -> None:
+    """Widen a linear axis whose data span is below ``rel`` of its centre (values equal to
+    four digits): its tick labels then say the value in at most five digits instead of an
+    offset or seven digits (:data:`sim.report.figcheck.MAX_DIGITS`)."""
+    lo, hi = ax.get_ylim() if axis == "y" else ax.get_xlim()
+    centre, span = (lo + hi) / 2, hi - lo
+    if centre == 0 or span >= rel * abs(centre):
+        return
+    half = rel * abs(centre) / 2
+    (ax.set_ylim if axis == "y" else ax.set_xlim)(centre - half, centre + half)
+
+
+def plain_log(ax, axis: str = "x") -> None:
+    """Tick labels of a log axis as plain numbers at 1, 2 and 5 of each decade (``2``,
+    ``50``, not ``2×10⁰``); minor ticks unlabelled (they would crowd)."""
+    a = ax.xaxis if axis == "x" else ax.yaxis
+    a.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    a.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    a.set_minor_formatter(NullFormatter())
+
+
+def times_ten(x: float, digits: int = 2) -> str:
+    """``x`` as a reader writes a very small or large number: ``1.0×10⁻¹²`` (plain ``0.25``
+    between 0.001 and 10000)."""
+    if x == 0 or not np.isfinite(x) or 1e-3 <= abs(x) < 1e4:
+        return f"{x:.{digits}g}"
+    e = int(np.floor(np.log10(abs(x))))
+    sup = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+    return f"{x / 10**e:.{digits - 1}f}×10{str(e).translate(sup)}"

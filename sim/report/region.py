@@ -5,6 +5,7 @@ hardware boundary (a curve) and the configured nominal inputs as a labelled exam
 
 from __future__ import annotations
 
+import re
 from itertools import combinations
 from pathlib import Path
 from typing import Callable, Mapping
@@ -13,10 +14,51 @@ import numpy as np
 
 from sim.claims.inference import Region
 from sim.mc.storage import read_table
+from sim.report.papers import paper_name
 from sim.report.plotting import plt, save
 from sim.report.tables import md_table
 
-__all__ = ["fig_region", "region_markdown"]
+__all__ = ["fig_region", "region_markdown", "reader_label", "LABELS"]
+
+
+#: axis labels of the region inputs the studies declare (``region.toml``), with units
+LABELS = {
+    "five_inset_1": "inset of the five control points (share of the block length)",
+    "grid_points_1": "grid points per side",
+    "spacing_mm": "grid spacing (mm)",
+    "scale_diff_at_100mm_um": "scale difference S' - S over 100 mm (µm)",
+    "grid_sigma_true_um": "true σ of the grid coordinates (µm)",
+    "relief_mm": "relief of the control heights, rms (model mm)",
+    "sigma_z_um": "σ_z of a control point (model µm)",
+    "sigma_xy_um": "σ_xy of a control point (model µm)",
+    "control_1": "control points per model",
+    "pointing_sigma_um": "pointing σ of one reading (µm)",
+    "field_scale_1": "factor on the field amplitudes",
+    "mono_sigma_um": "monocomparator σ (µm)",
+}
+_PLAIN = ((re.compile(r"(?<![\w.])um(?![\w.])"), "µm"), (re.compile(r"\bsigma\b"), "σ"))
+_PLAIN += ((re.compile(r"\+-"), "±"),)
+
+
+def reader_label(name: str, labels: Mapping[str, str] | None = None) -> str:
+    """The axis label of input ``name``: the study's own label or :data:`LABELS`, with units
+    and symbols as a reader writes them (µm, σ, ±); else the name with the unit its suffix
+    names (``x_mm`` -> ``x (mm)``)."""
+    text = (labels or {}).get(name) or LABELS.get(name)
+    if text is None:
+        base, _, unit = name.rpartition("_")
+        unit = {"um": "µm", "mm": "mm", "m": "m", "deg": "deg"}.get(unit)
+        text = f"{base} ({unit})" if base and unit else name
+    for pat, rep in _PLAIN:
+        text = pat.sub(rep, text)
+    return text
+
+
+def _title(title: str) -> str:
+    """A title that names its paper by authors and year (``seed 003:`` -> ``Agnard, Nolette
+    & Gagnon (early 1990s):``)."""
+    m = re.match(r"seed (\d{3})\b", title)
+    return paper_name(m.group(1)) + title[m.end() :] if m else title
 
 
 def fig_region(
@@ -28,27 +70,32 @@ def fig_region(
     boundary: Mapping[tuple[str, str], Callable[[np.ndarray], np.ndarray]] | None = None,
     labels: Mapping[str, str] | None = None,
 ) -> None:
-    """Pairwise projections of ``region`` (inputs with ``low < high``).
+    """Pairwise projections of ``region`` (inputs with ``low < high``); one input alone is
+    drawn as the share of explored values consistent along its range. The legend is the
+    figure's, below the panels (never over the points).
 
     boundary : ``{(x input, y input): f}``, a hardware limit ``y = f(x)`` drawn as a line.
     nominal : the configured values, drawn as a star (an example, not a verdict).
     """
     free = [i for i in region.inputs if i.high > i.low]
-    pairs = list(combinations(free, 2)) or [(free[0], free[0])]
-    n = len(pairs)
+    pairs = list(combinations(free, 2))
+    n = max(len(pairs), 1)
     cols = min(3, n)
     rows = int(np.ceil(n / cols))
-    fig, axs = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.8 * rows), squeeze=False)
+    fig, axs = plt.subplots(
+        rows, cols, figsize=(4.4 * cols, 3.6 * rows + 0.8), squeeze=False, layout="constrained"
+    )
     acc = region.accepted
-    lab = dict(labels or {})
+    if not pairs:
+        _one_input(axs[0, 0], region, free[0], labels, nominal)
     for ax, (a, b) in zip(axs.ravel(), pairs):
         xa, xb = region.x[a.name], region.x[b.name]
-        ax.scatter(xa[~acc], xb[~acc], s=6, color="0.75", label="contradicted")
+        ax.scatter(xa[~acc], xb[~acc], s=6, color="0.6", label="contradicted")
         ax.scatter(xa[acc], xb[acc], s=8, color="tab:green", label="consistent")
         ax.set_xlim(a.low, a.high)
         ax.set_ylim(b.low, b.high)
-        ax.set_xlabel(lab.get(a.name, a.name))
-        ax.set_ylabel(lab.get(b.name, b.name))
+        ax.set_xlabel(reader_label(a.name, labels))
+        ax.set_ylabel(reader_label(b.name, labels))
         f = (boundary or {}).get((a.name, b.name))
         if f is not None:
             t = np.linspace(a.low, a.high, 200)
@@ -57,10 +104,30 @@ def fig_region(
             ax.plot(nominal[a.name], nominal[b.name], "k*", ms=10, label="nominal (example)")
     for ax in axs.ravel()[n:]:
         ax.set_visible(False)
-    axs[0, 0].legend(fontsize=7, loc="best")
-    if title:
-        fig.suptitle(title, fontsize=10)
+    handles = {}
+    for ax in axs.ravel()[:n]:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lab, h)
+    fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncol=len(handles))
+    fig.suptitle(_title(title) or "consistent region of the unprinted inputs", fontsize=10)
     save(fig, path)
+
+
+def _one_input(ax, region: Region, inp, labels, nominal) -> None:
+    """One free input: the explored values, consistent (green) or contradicted (grey),
+    against the input, spread vertically by their order (a strip)."""
+    x = region.x[inp.name]
+    acc = region.accepted
+    y = np.linspace(0.0, 1.0, x.size) if x.size > 1 else np.full(x.size, 0.5)
+    ax.scatter(x[~acc], y[~acc], s=8, color="0.6", label="contradicted")
+    ax.scatter(x[acc], y[acc], s=10, color="tab:green", label="consistent")
+    if nominal and inp.name in nominal:
+        ax.axvline(nominal[inp.name], color="k", ls="--", lw=1, label="nominal (example)")
+    ax.set_xlim(inp.low, inp.high)
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_yticks([])
+    ax.set_xlabel(reader_label(inp.name, labels))
+    ax.set_title(f"{int(acc.sum())} of {x.size} explored values consistent", fontsize=9)
 
 
 def region_markdown(out: Path, claims: list[dict]) -> str:

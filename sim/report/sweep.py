@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.mc.storage import read_provenance, read_table
-from sim.report.plotting import plt, save
+from sim.report.plotting import place_legend, plt, readable_limits, save
 from sim.report.tables import fmt, md_table
 
 __all__ = ["fig_sweep", "sweep_markdown"]
@@ -106,12 +106,13 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             ax.set_ylim(-0.02, 1.02) if np.nanmax(hi, initial=0) - np.nanmin(
                 lo, initial=1
             ) > 0.5 else None
+        readable_limits(ax, "y")
         ax.ticklabel_format(axis="both", useOffset=False, style="plain")
         ax.set_title(c, fontsize=8, wrap=True)
         ax.set_xlabel(xlabel, fontsize=8)
         ax.set_ylabel(_y_label(c, prop), fontsize=8)
         if other[0]:
-            ax.legend(fontsize=6)
+            place_legend(ax)
     for ax in axs.ravel()[len(claims) :]:
         ax.axis("off")
     return save(fig, png)

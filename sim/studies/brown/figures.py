@@ -1,5 +1,7 @@
-"""Figures of the Brown studies (PNG, deterministic). Every figure uses a constrained layout
-so that labels of neighbouring panels never overlap."""
+"""Figures of the Brown studies (Brown 1968, seed ``004``; PNG, deterministic): plate
+coordinates in mm, standard deviations in µm or in units of the range σ (σᵣ). Every figure
+uses a constrained layout so that labels of neighbouring panels never overlap, and puts its
+legends where they hide no data."""
 
 from __future__ import annotations
 
@@ -11,7 +13,8 @@ from sim.claims.intervals import std_rel_se
 from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
 from sim.mc.storage import read_provenance, read_table
-from sim.report.plotting import plt, save
+from sim.report.plotting import hist_bins, place_legend, plt, save
+from sim.report.region import reader_label
 from sim.studies.brown.schema import MODEL_NAMES
 from sim.studies.brown.values import pooled
 
@@ -40,14 +43,12 @@ def _ellipse(ax, x, y, cov, scale, **kw):
 
 
 def fig_sigma_maps(cfg, pts, theta, path):
-    """1-sigma ellipses (unit range sigma) of the three models, side by side."""
+    """1σ ellipses (unit range σ) of the three models, side by side."""
     fig, axs = _fig(1, 3, 15, 5.4)
     scale = 12.0  # mm of plot per unit ratio
     for i, (ax, m) in enumerate(zip(axs[0], MODEL_NAMES)):
         Qpp = ml.covariance(pts[None], theta[None], m)[0][0]
-        _plate_axes(
-            ax, cfg, theta, f"{m}: 1-sigma ellipses (x{scale:.0f} mm per sigma_r)", ylabel=i == 0
-        )
+        _plate_axes(ax, cfg, theta, f"{m}: 1σ ellipses (×{scale:.0f} mm per σᵣ)", ylabel=i == 0)
         ax.plot(pts[:, 0], pts[:, 1], ".", color="0.4", ms=3)
         for j in range(len(pts)):
             _ellipse(ax, pts[j, 0], pts[j, 1], Qpp[j], scale, color="tab:blue", lw=1)
@@ -55,7 +56,7 @@ def fig_sigma_maps(cfg, pts, theta, path):
         ax.text(
             0.02,
             0.02,
-            f"sigma/sigma_r {s.min():.3f}-{s.max():.3f}",
+            f"σ/σᵣ {s.min():.3f}–{s.max():.3f}",
             transform=ax.transAxes,
             fontsize=8,
             bbox=dict(fc="w", alpha=0.8),
@@ -80,7 +81,7 @@ def fig_dilution_points(cfg, pts, theta, unit, path):
                     ha="center",
                     fontsize=7,
                 )
-        fig.colorbar(sc, ax=ax, label="%", shrink=0.8)
+        fig.colorbar(sc, ax=ax, label="dilution (%)", shrink=0.8)
     save(fig, path)
 
 
@@ -98,8 +99,9 @@ def fig_dilution_vs_points(table: Path, path):
     ax.set_xscale("log")
     ax.set_xlabel("number of points (k x k grid, same extent)")
     ax.set_ylabel("dilution of 'stations' over 'known' (%)")
-    ax.axhspan(5, 15, color="tab:orange", alpha=0.15, label="paper, 25 points: 5-15 %")
-    ax.legend(fontsize=8)
+    ax.axhspan(5, 15, color="tab:orange", alpha=0.15, label="paper, 25 points: 5–15 %")
+    ax.set_title("dilution against the number of points")
+    place_legend(ax, fontsize=8)
     save(fig, path)
 
 
@@ -119,29 +121,35 @@ def fig_mc_vs_analytic(cols, n_trials, path):
         ax.plot(a, s / a, mk, ms=4, label=m, alpha=0.7)
     ax.axhspan(1 - band, 1 + band, color="0.8", alpha=0.5, label="95 % sampling band")
     ax.axhline(1, color="k", lw=0.8)
-    ax.set_xlabel("analytic sigma (um)")
-    ax.set_ylabel("Monte-Carlo sigma / analytic sigma")
-    ax.legend(fontsize=8)
+    ax.set_xlabel("analytic σ (µm)")
+    ax.set_ylabel("Monte-Carlo σ / analytic σ (ratio)")
+    ax.set_title("Monte Carlo against the analytic covariance")
+    place_legend(ax, fontsize=8)
     save(fig, path)
 
 
 def fig_table1(cfg, pts, theta, an_pivot, t1, path):
-    fig, axs = _fig(1, 3, 15, 4.6)
+    """Table 1 of Brown 1968 against simulated plates: the rms closure σ0, the share of the
+    50 σ printing 1.1-1.3 µm, and the analytic σ over the plate (pivot model)."""
+    fig, axs = _fig(1, 3, 15, 4.8)
     a0, a1, a2 = axs[0]
-    a0.hist(t1["sigma0_um"], bins=50, color="tab:blue", alpha=0.8)
-    a0.axvline(1.6, color="tab:red", ls="--", label="paper 1.6 um")
-    a0.axvspan(1.5, 2.0, color="tab:orange", alpha=0.12, label="paper: typically 1.5-2.0 um")
-    a0.set_xlabel("rms closure sigma0 (um) of one plate")
-    a0.set_ylabel("simulated plates")
-    a0.legend(fontsize=8)
-    a1.hist(t1["share_1p1_1p3"] * 100, bins=np.linspace(0, 100, 26), color="tab:green", alpha=0.8)
-    a1.axvline(80, color="tab:red", ls="--", label="paper: 80 %")
-    a1.set_xlabel("share of the 50 sigmas printing 1.1-1.3 um (%)")
-    a1.set_ylabel("simulated plates")
-    a1.legend(fontsize=8)
-    _plate_axes(a2, cfg, theta, "analytic sigma (um), pivot model")
+    _plate_axes(a2, cfg, theta, "analytic σ, pivot model")
     sc = a2.scatter(pts[:, 0], pts[:, 1], c=pooled(an_pivot), cmap="magma_r", s=70)
-    fig.colorbar(sc, ax=a2, label="um", shrink=0.8)
+    fig.colorbar(sc, ax=a2, label="σ (µm)", shrink=0.8)
+    a0.hist(t1["sigma0_um"], bins=hist_bins(t1["sigma0_um"]), color="tab:blue", alpha=0.8)
+    a0.axvline(1.6, color="tab:red", ls="--", label="paper: 1.6 µm")
+    a0.axvspan(1.5, 2.0, color="tab:orange", alpha=0.12, label="paper: typically 1.5–2.0 µm")
+    a0.set_xlabel("rms closure σ0 of one plate (µm)")
+    a0.set_ylabel("simulated plates")
+    a0.set_title("closure of one plate")
+    place_legend(a0, fontsize=8)
+    share = np.asarray(t1["share_1p1_1p3"], float) * 100
+    a1.hist(share, bins=hist_bins(np.round(share, 6), 25), color="tab:green", alpha=0.8)
+    a1.axvline(80, color="tab:red", ls="--", label="paper: 80 %")
+    a1.set_xlabel("share of the 50 σ printing 1.1–1.3 µm (%)")
+    a1.set_ylabel("simulated plates")
+    a1.set_title("printed σ in 1.1–1.3 µm")
+    place_legend(a1, fontsize=8)
     save(fig, path)
 
 
@@ -154,10 +162,10 @@ def _scale_limit(ax, xname, yname, reg):
         return
     if yname == "half_extent_mm":
         e = np.linspace(float(np.min(reg[yname])), B.FORMAT_MM / 2, 100)
-        ax.plot(B.max_offset_mm(e), e, "k--", lw=1.2, label="scale limit (beta 0)")
+        ax.plot(B.max_offset_mm(e), e, "k--", lw=1.2, label="scale limit")
     elif yname == "beta_mm":
         b = np.linspace(0, B.SCALE_WIDTH_MM / 2, 50)
-        ax.plot(B.max_offset_mm(90.0, b), b, "k--", lw=1.2, label="scale limit (+-90 mm grid)")
+        ax.plot(B.max_offset_mm(90.0, b), b, "k--", lw=1.2, label="scale limit")
     else:
         ax.axvline(float(B.max_offset_mm(90.0)), color="k", ls="--", lw=1.2, label="scale limit")
 
@@ -166,62 +174,45 @@ def fig_region(out: Path, pairs, path):
     """Pairwise projections of the consistent region (grey: inputs the hardware and the
     constraining statements allow; green: where every prediction holds together), the declared
     hardware box (dotted) and the scale's limit (dashed); the configured geometry as a labelled
-    example (star)."""
+    example (star). The legend is the figure's, below the panels."""
     reg = read_table(out / "consistent_region.parquet").to_pydict()
     ins = {r["input"]: r for r in read_table(out / "region_inputs.parquet").to_pylist()}
     cfg = read_provenance(out / "claims.parquet")["config"]
     tog = np.asarray(reg["together"], bool)
-    fig, axs = _fig(1, len(pairs), 5 * len(pairs), 4.4)
+    fig, axs = _fig(1, len(pairs), 4.6 * len(pairs), 4.6)
     for ax, (xn, yn) in zip(axs.flat, pairs):
-        x, y = np.asarray(reg[xn]), np.asarray(reg[yn])
-        ax.scatter(x[~tog], y[~tog], s=3, color="0.6", label="region (hardware, printed inputs)")
-        ax.scatter(x[tog], y[tog], s=4, color="tab:green", label="every prediction holds")
-        for name, setter in ((xn, ax.axvline), (yn, ax.axhline)):
-            for v in (ins[name]["declared_low"], ins[name]["declared_high"]):
-                setter(v, color="tab:blue", ls=":", lw=1)
-        _scale_limit(ax, xn, yn, reg)
-        ex = [cfg.get(_EXAMPLE.get(n, ""), None) for n in (xn, yn)]
-        if all(v is not None for v in ex):
-            ax.plot(*ex, "*", color="tab:red", ms=11, label="configured example (not a verdict)")
-        ax.set_xlabel(xn)
-        ax.set_ylabel(yn)
-    axs.flat[0].legend(fontsize=7, loc="best")
+        _region_panel(ax, reg, ins, cfg, tog, xn, yn)
+    handles = {}
+    for ax in axs.flat:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lab, h)
+    fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncol=3, fontsize=8)
+    fig.suptitle("Brown 1968: consistent region of the unprinted inputs", fontsize=10)
     save(fig, path)
 
 
-def _shade(ax, row_all, cid, cs):
-    fh, hi = row_all["feasible_high"], row_all["swept_high"]
-    if fh is not None and np.isfinite(fh) and fh < hi:
-        ax.axvspan(fh, hi, color="0.6", alpha=0.25, lw=0, label="idealised (off the scale)")
-    own = next((r for r in cs if r["claim"] == cid and r["fixed"] == row_all["fixed"]), None)
-    if own and _some(own):
-        ax.axvspan(
-            own["holds_low"],
-            own["holds_high"],
-            color="tab:blue",
-            alpha=0.12,
-            lw=0,
-            label=f"this claim holds ({own['fixed'].replace('half extent of the points', '+-')})",
-        )
-    if _some(row_all):
-        ax.axvspan(
-            row_all["holds_low"],
-            row_all["holds_high"],
-            color="tab:green",
-            alpha=0.15,
-            lw=0,
-            label="consistent set (all claims hold)",
-        )
-    elif _some(row_all, "ok"):
-        ax.axvspan(
-            row_all["ok_low"],
-            row_all["ok_high"],
-            color="tab:green",
-            alpha=0.15,
-            lw=0,
-            label="no claim contradicted (holds or inconclusive)",
-        )
+def _region_panel(ax, reg, ins, cfg, tog, xn, yn) -> None:
+    x, y = np.asarray(reg[xn]), np.asarray(reg[yn])
+    ax.scatter(x[~tog], y[~tog], s=3, color="0.6", label="region (hardware, printed inputs)")
+    ax.scatter(x[tog], y[tog], s=4, color="tab:green", label="every prediction holds")
+    for name, setter in ((xn, ax.axvline), (yn, ax.axhline)):
+        for v in (ins[name]["declared_low"], ins[name]["declared_high"]):
+            setter(v, color="tab:blue", ls=":", lw=1, label="declared hardware range")
+    _scale_limit(ax, xn, yn, reg)
+    ex = [cfg.get(_EXAMPLE.get(n, ""), None) for n in (xn, yn)]
+    if all(v is not None for v in ex):
+        ax.plot(*ex, "*", color="tab:red", ms=11, label="configured example (not a verdict)")
+    ax.set_xlabel(reader_label(xn, _LABELS))
+    ax.set_ylabel(reader_label(yn, _LABELS))
+    ax.ticklabel_format(useOffset=False)
 
 
-def _some(r, which="holds") -> bool:
-    return r[f"{which}_low"] is not None and np.isfinite(r[f"{which}_low"])
+#: axis labels of Brown's region inputs
+_LABELS = {
+    "station_offset_mm": "station offset (mm)",
+    "beta_mm": "β (mm)",
+    "half_extent_mm": "half extent of the points (mm)",
+    "sigma0_um": "setting σ0 (µm)",
+    "screw_pitch_mm": "screw pitch (mm)",
+    "zeiss_half_extent_mm": "half extent of the Zeiss grid (mm)",
+}

@@ -1,6 +1,8 @@
 """Figures of study ``brown_design`` (seed ``004``): Pareto front, error budget, datum,
 coverage, the emcee corner plot and the two-plate ratio (the region of the unprinted inputs
-is drawn once for the paper, by brown_table1). Log axes carry a few labelled ticks only (plain numbers), so labels never overlap.
+is drawn once for the paper, by brown_table1). σ in µm, times in minutes. Log axes carry a
+few labelled ticks only (plain numbers), so labels never overlap; legends go where they hide
+no data (:func:`sim.report.plotting.place_legend`).
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLo
 
 from sim.instruments.ranges import multilateration as ml
 from sim.lsq import distributions as D
-from sim.report.plotting import plt, save
+from sim.report.plotting import place_legend, plt, save
 from sim.studies.design.cells import pareto_front
 from sim.studies.design.claims import load_book
 
@@ -44,7 +46,9 @@ def _log_ticks(ax, axis: str, lo: float, hi: float) -> None:
 def _pareto_all(ax, cols, t, a, ok, P) -> None:
     """Left panel: every cell, the front of all cells and one front per setting sigma."""
     pf = np.array(cols["pareto"])
-    ax.scatter(t[~ok], a[~ok], s=6, c="0.85", label="infeasible (scale, format or pivot)")
+    ax.scatter(
+        t[~ok], a[~ok], s=6, marker="x", c="0.55", label="infeasible (scale, format or pivot)"
+    )
     for p, mk in zip(sorted(set(P.tolist())), "osD^v<>"):
         sel = ok & (P == p)
         ax.scatter(t[sel], a[sel], s=10, marker=mk, alpha=0.6, label=f"{p} positions")
@@ -61,7 +65,7 @@ def _pareto_all(ax, cols, t, a, ok, P) -> None:
             color="0.3",
             ls=ls,
             lw=1,
-            label=f"front, setting sigma {s_:g} um",
+            label=f"front, setting σ {s_:g} µm",
         )
     ax.set_title("all designs (any number of points)")
 
@@ -88,8 +92,8 @@ def _pareto_same(ax, cols, t, a, P, same_n, j) -> None:
     o = np.argsort(t[f])
     ax.step(t[f][o], a[f][o], where="post", color="k", lw=1.2, label="Pareto front")
     ax.set_title(
-        f"the paper's plate: {cols['n_points'][j]} points at +-{cols['extent_mm'][j]:g} mm,\n"
-        f"setting sigma {cols['setting_sigma_um'][j]:g} um (feasible only)"
+        f"the paper's plate: {cols['n_points'][j]} points at ±{cols['extent_mm'][j]:g} mm,\n"
+        f"setting σ {cols['setting_sigma_um'][j]:g} µm (feasible only)"
     )
 
 
@@ -100,7 +104,7 @@ def fig_pareto(cols, path, same_n):
     ok = np.array(cols["feasible"])
     P = np.array(cols["positions"])
     j = int(np.flatnonzero(cols["paper_design"])[0])
-    fig, axs = plt.subplots(1, 2, figsize=(15, 6))
+    fig, axs = plt.subplots(1, 2, figsize=(15, 6), layout="constrained")
     _pareto_all(axs[0], cols, t, a, ok, P)
     _pareto_same(axs[1], cols, t, a, P, same_n, j)
     fin = np.isfinite(a) & (a > 0)
@@ -111,14 +115,14 @@ def fig_pareto(cols, path, same_n):
         _log_ticks(ax, "x", t[sel].min() * 0.9, t[sel].max() * 1.1)
         _log_ticks(ax, "y", a[sel].min() * 0.95, a[sel].max() * 1.05)
         ax.set_xlabel("measuring time of one plate (min)")
-        ax.set_ylabel("worst-point sigma (um, datum-free)")
-        ax.legend(fontsize=7, loc="upper right")
-    fig.tight_layout()
+        ax.set_ylabel("worst-point σ, datum-free (µm)")
+    for ax in axs:
+        place_legend(ax)
     save(fig, path)
 
 
 def fig_budget(b, path, ref):
-    fig, ax = plt.subplots(figsize=(9, 5))
+    fig, ax = plt.subplots(figsize=(9, 5), layout="constrained")
     y = np.arange(len(b["source"]))
     ax.barh(
         y,
@@ -127,17 +131,19 @@ def fig_budget(b, path, ref):
         color=["tab:gray" if s else "tab:blue" for s in b["settings"]],
     )
     ax.set_yticks(y, [f"{s} ({d})" for s, d in zip(b["source"], b["description"])], fontsize=7)
-    ax.axvline(ref, color="tab:red", ls="--", lw=1, label=f"paper: {ref:g} um (Zeiss grid)")
-    ax.set_xlabel("rms coordinate error after a rigid fit (um)")
+    ax.axvline(ref, color="tab:red", ls="--", lw=1, label=f"paper: {ref:g} µm (Zeiss grid)")
+    ax.set_xlabel("rms coordinate error after a rigid fit (µm)")
+    ax.set_ylabel("error source (grey: setting errors)")
+    ax.set_title("error budget of the comparator (bars: 95 % Monte-Carlo interval)")
     ax.invert_yaxis()
-    ax.legend(fontsize=8)
+    place_legend(ax, fontsize=8)
     save(fig, path)
 
 
 def fig_datum(cfg, d, path):
     model = np.array(d["model"])
     dn = np.array(d["datum"])
-    fig, axs = plt.subplots(1, 2, figsize=(12, 4.5))
+    fig, axs = plt.subplots(1, 2, figsize=(12, 4.5), layout="constrained")
     for ax, m in zip(axs, ("stations", "pivot")):
         for name, mk in (("brown", "o"), ("inner", "s"), ("corners", "^")):
             sel = (model == m) & (dn == name) & ~np.array(d["corner"])
@@ -145,31 +151,32 @@ def fig_datum(cfg, d, path):
         ax.axhspan(5, 15, color="tab:orange", alpha=0.15, label="Brown's 5-15 % (his datum)")
         ax.set_xlabel("point number (row by row from the top left)")
         ax.set_ylabel(f"dilution of '{m}' over 'known' (%)")
-        ax.legend(fontsize=7)
-    fig.tight_layout()
+        ax.set_title(f"model '{m}': dilution by datum")
+    for ax in axs:
+        place_legend(ax)
     save(fig, path)
 
 
 def fig_coverage(c, path):
     model = np.array(c["model"])
     scen = np.array(c["scenario"])
-    fig, axs = plt.subplots(1, 3, figsize=(15, 4.5))
+    fig, axs = plt.subplots(1, 3, figsize=(15, 4.5), layout="constrained")
     for ax, (s, xkey, xl) in zip(
         axs,
         (
-            ("noise", "sigma_um", "range sigma (um)"),
+            ("noise", "sigma_um", "range σ (µm)"),
             ("points", "grid", "points per side"),
-            ("beta", "beta_mm", "beta (mm)"),
+            ("beta", "beta_mm", "β (mm)"),
         ),
     ):
         sel = (scen == s) & (model == "pivot")
         x = np.array(c[xkey], float)[sel]
         N = np.array(c["trials"])[sel]
         for key, lab in (
-            ("coverage_known", "ellipses, known sigma"),
+            ("coverage_known", "ellipses, known σ"),
             ("coverage_f", "ellipses, s0 and F"),
-            ("b_coverage", "b = beta^2 interval"),
-            ("beta_coverage", "beta interval (delta method)"),
+            ("b_coverage", "b = β² interval"),
+            ("beta_coverage", "β interval (delta method)"),
         ):
             ax.plot(
                 np.where(x > 0, x, x[x > 0].min() / 3 if (x > 0).any() else 1),
@@ -178,16 +185,14 @@ def fig_coverage(c, path):
                 label=lab,
             )
         se = np.sqrt(0.95 * 0.05 / max(int(N[N > 0].min()) if (N > 0).any() else 1, 1))
-        ax.axhspan(
-            0.95 - 1.96 * se, 0.95 + 1.96 * se, color="0.8", label="nominal 95 % +- MC error"
-        )
+        ax.axhspan(0.95 - 1.96 * se, 0.95 + 1.96 * se, color="0.8", label="nominal 95 % ± MC error")
         ax.set_xscale("log" if s != "points" else "linear")
         ax.set_xlabel(xl + (" (0 drawn at left edge)" if s == "beta" else ""))
         ax.set_ylabel("empirical coverage")
         ax.set_ylim(0.0, 1.02)
         ax.set_title(f"pivot model: {s}")
-        ax.legend(fontsize=7, loc="lower left")
-    fig.tight_layout()
+    for ax in axs:
+        place_legend(ax)
     save(fig, path)
 
 
@@ -226,7 +231,7 @@ def fig_corner(samples, mean, Q, names, path):
             else:
                 ax.set_ylabel(names[i], fontsize=7)
     fig.suptitle(
-        "posterior samples (blue) in units of the least-squares sigma about the LS "
+        "posterior samples (blue) in units of the least-squares σ about the LS "
         "estimate; red: LS Gaussian / 95 % ellipses",
         y=0.92,
     )
@@ -234,36 +239,17 @@ def fig_corner(samples, mean, Q, names, path):
 
 
 def fig_twoplate(cols, samples, path):
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
     bins = np.logspace(-6, 6, 121)
     for name, rho in samples.items():
         ax.hist(rho, bins=bins, histtype="step", lw=1.5, label=f"posterior, {name} prior")
     ax.axvline(cols["rw_ratio_mean"][0], color="tab:red", ls="--", label="chi-square re-weighting")
     ax.set_xscale("log")
-    ax.set_xlabel("sigma_comparator^2 / sigma_grid^2  (= P_cx / P_x)")
+    ax.set_xlabel("σ²(comparator) / σ²(grid) (ratio, = P_cx / P_x)")
     ax.set_ylabel("samples")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
+    ax.set_title("two-plate weight ratio: posterior against re-weighting")
+    place_legend(ax, fontsize=8)
     save(fig, path)
-
-
-_SHORT = {
-    "brown.operation.lateral_offset_error_um": "reticle offset error (um)",
-    "brown.calibration.linearity_tolerance_um": "linearity tolerance (um)",
-    "brown.calibration.drum_graduation_um": "drum graduation error (um)",
-    "brown.results.two_screw_agreement_um": "two-screw agreement (um)",
-    "brown.results.accuracy_range_um": "rms accuracy (um)",
-    "brown.results.zeiss_discrepancy_um": "Zeiss discrepancy (um)",
-    "brown.results.zeiss_comparator_um": "Zeiss, comparator part (um)",
-    "brown.design.paper_on_front_same_points": "paper's design on front (finding)",
-}
-_COLOR = {
-    "holds": "tab:green",
-    "fails": "tab:red",
-    "inconclusive": "tab:orange",
-    "infeasible": "0.6",
-    "finding": "tab:blue",
-}
 
 
 def figure_jobs(stage: str, out, *data) -> list:

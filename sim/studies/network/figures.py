@@ -40,17 +40,13 @@ def _lines_large(ax, net, xy: np.ndarray) -> None:
     ax.add_collection(LineCollection(xy[pairs], colors="0.8", linewidths=0.5, zorder=1))
 
 
-def network_figure(net, an, pts, path: Path) -> Path:
-    """Points (fixed as triangles), observation lines, 95 % ellipses magnified to be seen;
-    axes in metres for a field network and in mm for a plate (:func:`natural_unit`)."""
-    unit, f = natural_unit(net.xy)
-    xy = net.xy / f
-    fig, ax = plt.subplots(figsize=(6.5, 6.0))
-    large = net.m > LARGE
-    if large:
+def _lines(ax, net, xy: np.ndarray) -> None:
+    """The observation lines (each pair once; one collection for a large network)."""
+    if net.m > LARGE:
         _lines_large(ax, net, xy)
+        return
     seen = set()
-    for r in range(0 if large else net.m):
+    for r in range(net.m):
         if net.kind[r] >= 5:
             continue
         a, b = net.i[r], (net.k[r] if net.kind[r] == 2 else net.j[r])
@@ -59,53 +55,61 @@ def network_figure(net, an, pts, path: Path) -> Path:
             continue
         seen.add(key)
         ax.plot(xy[[a, b], 0], xy[[a, b], 1], color="0.8", lw=0.5, zorder=1)
-    fixed = net.role == 1
-    ax.scatter(
-        xy[~fixed, 0],
-        xy[~fixed, 1],
-        s=2 if large else 10,
-        color="C0",
-        zorder=3,
-        label="estimated point",
-    )
-    if fixed.any():
-        ax.scatter(
-            xy[fixed, 0],
-            xy[fixed, 1],
-            marker="^",
-            s=40,
-            color="C3",
-            zorder=3,
-            label="fixed point",
-        )
+
+
+def _ellipses(ax, net, an, pts, xy: np.ndarray, f: float) -> float:
+    """The 95 % ellipses of ``pts``, magnified to be seen (to 6 % of the extent, or 40 % of
+    the spacing for a large network); returns the magnification."""
+    large = net.m > LARGE
     a95, b95, th = ellipse(an.cov[pts])
     k = np.sqrt(CHI2_2_95)
     span = np.ptp(net.xy, axis=0).max() or 1.0
     room = 0.4 * span / np.sqrt(net.n) if large else 0.06 * span  # a large net: the spacing
     mag = room / max(float(k * a95.max()), 1e-300)  # both in mm
     t = np.linspace(0, 2 * np.pi, 61)
+    A, B, T = a95[:, None], b95[:, None], th[:, None]
+    ex = k * mag * (A * np.cos(t) * np.cos(T) - B * np.sin(t) * np.sin(T))
+    ey = k * mag * (A * np.cos(t) * np.sin(T) + B * np.sin(t) * np.cos(T))
+    seg = np.stack([xy[pts, 0, None] + ex / f, xy[pts, 1, None] + ey / f], -1)
     if large:
-        A, B, T = a95[:, None], b95[:, None], th[:, None]
-        ex = k * mag * (A * np.cos(t) * np.cos(T) - B * np.sin(t) * np.sin(T))
-        ey = k * mag * (A * np.cos(t) * np.sin(T) + B * np.sin(t) * np.cos(T))
-        seg = np.stack([xy[pts, 0, None] + ex / f, xy[pts, 1, None] + ey / f], -1)
         ax.add_collection(LineCollection(seg, colors="C1", linewidths=0.9, zorder=2))
-    for p, A, B, T in zip(pts, a95, b95, th) if not large else ():
-        ex = k * mag * (A * np.cos(t) * np.cos(T) - B * np.sin(t) * np.sin(T))
-        ey = k * mag * (A * np.cos(t) * np.sin(T) + B * np.sin(t) * np.cos(T))
-        ax.plot(xy[p, 0] + ex / f, xy[p, 1] + ey / f, color="C1", lw=0.9, zorder=2)
-    ax.plot([], [], color="C1", label=f"95 % ellipse x {mag:.3g}")
+    else:
+        for s_ in seg:
+            ax.plot(s_[:, 0], s_[:, 1], color="C1", lw=0.9, zorder=2)
+    return mag
+
+
+def _times(mag: float) -> str:
+    """A magnification as a reader writes it: ``×9360``, ``×2.5`` (never e-notation)."""
+    return f"×{mag:.0f}" if mag >= 100 else f"×{mag:.3g}"
+
+
+def network_figure(net, an, pts, path: Path) -> Path:
+    """Points (fixed as triangles), observation lines, 95 % ellipses magnified to be seen;
+    axes in metres for a field network and in mm for a plate (:func:`natural_unit`)."""
+    unit, f = natural_unit(net.xy)
+    xy = net.xy / f
+    fig, ax = plt.subplots(figsize=(6.5, 6.0), layout="constrained")
+    large = net.m > LARGE
+    _lines(ax, net, xy)
+    fixed = net.role == 1
+    ax.scatter(*xy[~fixed].T, s=2 if large else 10, color="C0", zorder=3, label="estimated point")
+    if fixed.any():
+        ax.scatter(*xy[fixed].T, marker="^", s=40, color="C3", zorder=3, label="fixed point")
+    mag = _ellipses(ax, net, an, pts, xy, f)
+    ax.plot([], [], color="C1", label=f"95 % ellipses, drawn {_times(mag)}")
+    ax.plot([], [], color="0.8", lw=0.5, label="observation")
     ax.set_aspect("equal")
     ax.set_xlabel(f"x ({unit})")
     ax.set_ylabel(f"y ({unit})")
     ax.set_title(f"{net.name}: {net.n} points, {net.m} observations")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2, fontsize=8)
     return save(fig, path)
 
 
 def reliability_figure(net, an, path: Path) -> Path:
     """Redundancy number per observation and the bias-to-noise ratio, by kind."""
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.0, 5.6), sharex=True, layout="constrained")
     idx = np.arange(net.m)
     for n_c, c in enumerate(np.unique(net.kind)):
         s = net.kind == c
@@ -118,15 +122,13 @@ def reliability_figure(net, an, path: Path) -> Path:
             a1.fill_between(idx, 0, r_all, label=KINDS[c], **kw)
             a2.fill_between(idx, 0, b_all, **kw)
             continue
-        a1.bar(idx[s], an.redundancy[s], width=1.0, label=KINDS[c])
-        a2.bar(idx[s], bnr, width=1.0)
+        a1.bar(idx[s], an.redundancy[s], width=1.0, label=KINDS[c], color=f"C{n_c}")
+        a2.bar(idx[s], bnr, width=1.0, color=f"C{n_c}")
     a1.set_ylabel("redundancy number")
     a1.set_ylim(0, 1)
-    a1.legend(fontsize=8, ncol=4, loc="upper right")
     a2.set_ylabel("bias-to-noise ratio")
-    a2.set_xlabel("observation")
-    a1.set_title(
-        f"sum of redundancy numbers {an.redundancy.sum():.3f}; degrees of freedom {an.dof}"
-    )
-    fig.tight_layout()
+    a2.set_xlabel("observation (index)")
+    a1.set_title(f"redundancy numbers: sum {an.redundancy.sum():.3f}, degrees of freedom {an.dof}")
+    a2.set_title("bias-to-noise ratio (internal reliability)")
+    fig.legend(*a1.get_legend_handles_labels(), loc="outside lower center", ncol=4, fontsize=8)
     return save(fig, path)

@@ -11,10 +11,10 @@ import numpy as np
 
 from sim.mc.storage import read_table
 from sim.report.figure_jobs import draw_figures, start_figures
-from sim.report.plotting import plt, save
+from sim.report.plotting import place_legend, plt, save
 from sim.studies.wolf.model import ls_map
 
-_UM_PER_MM = 2.5  # vector plots: 1 mm of plot = 2.5 um of discrepancy (50 um = 20 mm)
+_UM_PER_MM = 2.5  # vector plots: 1 mm of plot = 2.5 µm of discrepancy (50 µm = 20 mm)
 
 
 def _quiver(ax, x, y, dx, dy, title, key_um=20.0, um_per_mm=_UM_PER_MM):
@@ -36,7 +36,7 @@ def _quiver(ax, x, y, dx, dy, title, key_um=20.0, um_per_mm=_UM_PER_MM):
     ax.text(
         x.min() + key_um / um_per_mm + 3,
         y.max() + 25,
-        f"{key_um:g} um",
+        f"{key_um:g} µm",
         va="center",
         fontsize=7,
         color="tab:red",
@@ -94,7 +94,7 @@ def vectors_figure(out: Path) -> None:
             v["y_mm"][m],
             v["dx_before_um"][m],
             v["dy_before_um"][m],
-            f"set {st}: before (rms {rb:.1f} um)",
+            f"set {st}: before (rms {rb:.1f} µm)",
             50.0,
         )
         _quiver(
@@ -103,7 +103,7 @@ def vectors_figure(out: Path) -> None:
             v["y_mm"][m],
             v["dx_after_um"][m],
             v["dy_after_um"][m],
-            f"set {st}: after the cubic (rms {ra:.1f} um, arrows x2.5)",
+            f"set {st}: after the cubic (rms {ra:.1f} µm, arrows ×2.5)",
             20.0,
             1.0,
         )
@@ -124,7 +124,7 @@ def components_figure(out: Path) -> None:
         big = max(float(np.hypot(dx, dy).max()), 1e-9)
         key = float(10 ** math.floor(math.log10(big)))
         key = next(k * key for k in (5, 2, 1) if k * key <= big)
-        _quiver(ax, x, y, dx, dy, title + f", {big / 15:.2g} um/mm", key, big / 15)
+        _quiver(ax, x, y, dx, dy, title + f", {big / 15:.2g} µm/mm", key, big / 15)
 
     for ax, nm in zip(axs.ravel(), names):
         m = c["component"] == nm
@@ -135,7 +135,7 @@ def components_figure(out: Path) -> None:
             c["y_mm"][m],
             c["dx_um"][m],
             c["dy_um"][m],
-            f"{nm}\nA = {c['amplitude_um'][m][0]:g} um, rms {r:.1f} um",
+            f"{nm}\nA = {c['amplitude_um'][m][0]:g} µm, rms {r:.1f} µm",
         )
     sel = c["component"] == names[0]
     P = np.column_stack([c["x_mm"][sel], c["y_mm"][sel]])
@@ -164,7 +164,9 @@ def degree_figure(out: Path) -> None:
     d = read_table(out / "degree.parquet").to_pydict()
     d = {k: np.asarray(a) for k, a in d.items()}
     sps = list(dict.fromkeys(d["spacing_mm"]))
-    fig, axs = plt.subplots(1, len(sps), figsize=(4.2 * len(sps), 4), squeeze=False, sharey=True)
+    fig, axs = plt.subplots(
+        1, len(sps), figsize=(4.2 * len(sps), 4), squeeze=False, sharey=True, layout="constrained"
+    )
     for ax, sp in zip(axs[0], sps):
         for k, ns in enumerate(dict.fromkeys(d["n_sets"])):
             m = (d["spacing_mm"] == sp) & (d["n_sets"] == ns)
@@ -179,15 +181,16 @@ def degree_figure(out: Path) -> None:
         ax.set_xlim(min(degs) - 0.3, max(degs) + 0.3)
         ax.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
         ax.yaxis.set_minor_formatter(matplotlib.ticker.ScalarFormatter())
-    axs[0, 0].set_ylabel("median rms (um): dashed fit data, solid independent plate")
-    axs[0, 0].legend(fontsize=8)
+    axs[0, 0].set_ylabel("median rms (µm): dashed fit data, solid independent plate")
+    for ax in axs[0]:
+        place_legend(ax, fontsize=8)
     save(fig, out / "degree.png")
 
 
 def readings_figure(out: Path) -> None:
     r = read_table(out / "readings.parquet").to_pydict()
     r = {k: np.asarray(a) for k, a in r.items()}
-    fig, axs = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+    fig, axs = plt.subplots(1, 2, figsize=(11, 4), sharey=True, layout="constrained")
     for ax, appr in zip(axs, ("one_side", "random")):
         for k, sg in enumerate(dict.fromkeys(r["pointing_sigma_um"])):
             m = (r["approach"] == appr) & (r["pointing_sigma_um"] == sg)
@@ -196,14 +199,14 @@ def readings_figure(out: Path) -> None:
                 r["after_plate_rms_um"][m],
                 "o-",
                 color=f"C{k}",
-                label=f"sigma {sg:g} um: independent plate, corrected",
+                label=f"σ {sg:g} µm: independent plate, corrected",
             )
             ax.plot(
                 r["readings"][m],
                 r["reading_error_um"][m],
                 "x:",
                 color=f"C{k}",
-                label=f"sigma {sg:g} um: the averaged reading alone",
+                label=f"σ {sg:g} µm: the averaged reading alone",
             )
         ax.set_xscale("log")
         ax.set_xticks(sorted(set(r["readings"].tolist())))
@@ -211,15 +214,16 @@ def readings_figure(out: Path) -> None:
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xlabel("readings per point")
         ax.set_title(f"approach: {appr.replace('_', ' ')}")
-    axs[0].set_ylabel("rms per coordinate (um)")
-    axs[0].legend(fontsize=7)
+    axs[0].set_ylabel("rms per coordinate (µm)")
+    for ax in axs:
+        place_legend(ax)
     save(fig, out / "readings.png")
 
 
 def stability_figure(cfg: dict, out: Path) -> None:
     s = read_table(out / "stability.parquet").to_pydict()
     s = {k: np.asarray(a) for k, a in s.items()}
-    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    fig, ax = plt.subplots(figsize=(6.5, 4.2), layout="constrained")
     for k, f in enumerate(dict.fromkeys(s["drift_fraction"])):
         m = s["drift_fraction"] == f
         x = np.maximum(s["age_weeks"][m], 0.5)
@@ -229,16 +233,16 @@ def stability_figure(cfg: dict, out: Path) -> None:
         ax.plot(x, s["before_rms_um"][m], ":", color=f"C{k}")
     ax.set_xscale("log")
     ax.set_xlabel("age of the calibration (weeks; 0 plotted at 0.5)")
-    ax.set_ylabel("median rms on an independent plate (um)")
+    ax.set_ylabel("median rms on an independent plate (µm)")
     ax.set_title(f"drift time constant {cfg['field.drift_tau_weeks']:g} weeks; dotted: uncorrected")
-    ax.legend(fontsize=7)
+    place_legend(ax)
     save(fig, out / "stability.png")
 
 
 def table1_figure(out: Path) -> None:
     t = read_table(out / "table1_real.parquet").to_pydict()
     t = {k: np.asarray(a) for k, a in t.items()}
-    fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, axs = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained")
     for ax, plate in zip(axs, ("003", "005")):
         m = t["plate"] == plate
         _quiver(
@@ -247,7 +251,7 @@ def table1_figure(out: Path) -> None:
             t["y_set1_mm"][m],
             t["dx_sets_um"][m],
             t["dy_sets_um"][m],
-            f"plate {plate}: Set 1 - Set 2 (Table 1, 10 um = 20 mm)",
+            f"plate {plate}: Set 1 - Set 2 (Table 1, 10 µm = 20 mm)",
             10.0,
             0.5,
         )

@@ -1,0 +1,174 @@
+"""The first screen of ``results/REPORT.md`` (issue 25): per paper one row with its
+studies, the verdict counts and three headline verdicts at the precision their interval
+supports; the consistent regions, the variant runs of a study (counted apart) and the
+network studies below it. Built from the Parquet files alone."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pyarrow as pa
+
+from sim.mc.storage import read_provenance
+from sim.report.claimtext import decimals_for, fmt_at
+from sim.report.papers import paper_name
+from sim.report.run_summary import headline_rows, region_line, verdict_line
+from sim.report.tables import fmt, md_table
+
+__all__ = ["opening", "by_paper", "number", "VERDICT_TEXT"]
+
+
+VERDICT_TEXT = {
+    "holds": "holds",
+    "fails": "**fails**",
+    "inconclusive": "inconclusive",
+    "depends": "depends",
+    "holds or undecided": "holds or undecided",
+    "fails or undecided": "fails or undecided",
+    "undecidable": "undecidable",
+    "erratum": "**erratum**",
+    "input": "input",
+    "self-check": "self-check",
+    "finding": "finding",
+    "not comparable": "not comparable",
+}
+
+
+def number(x):
+    """A table cell as a number, or None where it is missing or NaN."""
+    return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
+
+
+def _headline_pick(studies: list[tuple], n: int = 3) -> list[tuple]:
+    """Up to ``n`` headline claims of one paper: one per study in turn, each in its claim
+    book's order. ``studies``: ``[(dir name, study, claims)]``."""
+    queues = [[(name, r) for r in headline_rows(claims)] for name, _, claims in studies]
+    out: list[tuple] = []
+    while len(out) < n and any(queues):
+        for q in queues:
+            if q and len(out) < n:
+                out.append(q.pop(0))
+    return out
+
+
+def _num(x, dec: int | None) -> str:
+    """``x`` at the decimals its interval supports (``dec``; see
+    :func:`sim.report.claimtext.decimals_for`) and at most 3 significant digits; a whole
+    number as such."""
+    if not isinstance(x, (int, float)) or not math.isfinite(x):
+        return fmt(x)
+    if float(x).is_integer() and abs(x) < 1e6 and not dec:
+        return str(int(x))
+    if x == 0:
+        return "0"
+    three = 2 - math.floor(math.log10(abs(x)))  # decimals of 3 significant digits
+    return fmt_at(x, three if dec is None else min(dec, three))
+
+
+def _sig3(r: dict) -> str:
+    """A claim's simulated value at the precision its interval supports, at most 3
+    significant digits (a range over a region as low–high); its 95 % interval after it
+    unless it is that range, or of zero width."""
+    if r["verdict"] == "not comparable":
+        return ""
+    lo, hi = number(r.get("ci_low")), number(r.get("ci_high"))
+    dec = decimals_for(lo, hi) if r["interval"] != "exact" else None
+    v = _num(r["value"], dec)
+    vh = number(r.get("value_high"))
+    if vh is not None and vh != r["value"]:
+        v += f"–{_num(vh, dec)}"
+    same = (lo, hi) == (r["value"], vh) or lo == hi
+    if r["interval"] != "exact" and lo is not None and not same:
+        v += f" [{_num(lo, dec)}, {_num(hi, dec)}]"
+    return v
+
+
+def by_paper(entries: list[tuple]) -> dict[str, list]:
+    by_seed: dict[str, list] = {}
+    for _, name, study, claims, _ in entries:
+        by_seed.setdefault(study.seed_file or "", []).append((name, study, claims))
+    return by_seed
+
+
+def _main_and_variants(studies: list[tuple]) -> tuple[list, list]:
+    """The studies of one paper split into its main runs (one per registered study, the
+    directory named as the study first) and the variants (another run of a study already
+    shown, e.g. ``agnard_block_104``: the same study at a real block's size)."""
+    main: dict[str, tuple] = {}
+    for entry in sorted(studies, key=lambda e: (e[0] != e[1].name, e[0])):
+        main.setdefault(entry[1].name, entry)
+    chosen = {id(e) for e in main.values()}
+    return [e for e in studies if id(e) in chosen], [e for e in studies if id(e) not in chosen]
+
+
+def _config_of(out: Path) -> dict:
+    try:
+        return dict(read_provenance(out / "claims.parquet").get("config") or {})
+    except (OSError, ValueError, pa.ArrowException):
+        return {}
+
+
+def _variant_note(results: Path, name: str, study, claims: list, of: str) -> str:
+    """One line on a variant run of study ``of``: what its config changes (at most four
+    keys), its counts, a link."""
+    mine, base = _config_of(results / name), _config_of(results / of)
+    skip = {"seed", "trials", "chunk"}
+    diff = [
+        k for k in mine if k not in skip and not k.startswith("region.") and mine[k] != base.get(k)
+    ]
+    what = ", ".join(f"`{k}` = {fmt(mine[k])}" for k in diff[:4]) + (
+        ", ..." if len(diff) > 4 else ""
+    )
+    return (
+        f"- [{name}]({name}/README.md) is the study `{of}` again at another configuration"
+        + (f" ({what})" if what else "")
+        + f": {verdict_line(claims).split(': ', 1)[1]}; not counted in the row above."
+    )
+
+
+def _paper_row(seed: str, studies: list[tuple]) -> list[str]:
+    """One row: the paper and its studies (linked), the counts, three headline claims with
+    their values and verdicts (one per line of the cell)."""
+    links = ", ".join(f"[{name}]({name}/README.md)" for name, _, _ in studies)
+    counts = verdict_line([r for _, _, c in studies for r in c]).split(": ", 1)[1]
+    picks = [r for _, r in _headline_pick(studies)]
+    if not picks:
+        return [f"**{paper_name(seed)}** ({links})", counts, "_no headline claim_", "", ""]
+    return [
+        f"**{paper_name(seed)}** ({links})",
+        counts,
+        "<br>".join(f"`{r['claim']}`" for r in picks),
+        "<br>".join(_sig3(r) or "—" for r in picks),
+        "<br>".join(VERDICT_TEXT.get(r["verdict"], r["verdict"]) for r in picks),
+    ]
+
+
+def opening(entries: list[tuple], results: Path) -> str:
+    """One screen: per paper one row (its studies linked to their README.md, the verdict
+    counts, three headline verdicts at the precision their interval supports); below it
+    each consistent region's line, the variant runs of a study (another configuration of
+    the same paper's study, counted apart) and the network studies (no paper)."""
+    rows, notes, variants = [], [], []
+    by_seed = by_paper(entries)
+    for seed in sorted(s for s in by_seed if s):
+        main, other = _main_and_variants(by_seed[seed])
+        rows.append(_paper_row(seed, main))
+        for name, study, claims in other:
+            variants.append(_variant_note(results, name, study, claims, study.name))
+        for name, _, _ in main:
+            if (reg := region_line(results / name)) is not None:
+                notes.append(f"- `{name}`: {reg}")
+    nets = by_seed.get("", [])
+    if nets:
+        notes.append(
+            "- Network studies (a declared network, no paper): "
+            + "; ".join(
+                f"[{name}]({name}/README.md) {verdict_line(c).split(': ', 1)[1]}"
+                for name, _, c in nets
+            )
+        )
+    table = md_table(
+        ["paper (studies)", "verdicts", "headline claims", "simulated [95%]", "verdict"], rows
+    )
+    return "\n".join(["## The verdicts at a glance", "", table, "", *variants, *notes, ""])
