@@ -330,6 +330,20 @@ def _check(args) -> int:
     return 0
 
 
+def _report(results: Path) -> int:
+    """``sim report``: only over a directory that holds study results (a directory of the
+    user's with none gets no REPORT.md written into it)."""
+    if results.is_dir() and not any(
+        (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
+        for d in results.iterdir()
+    ):
+        raise ConfigError(
+            "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
+        )
+    print(write_report(results, get_study))
+    return 0
+
+
 def _on_sigterm(signum, frame):
     raise KeyboardInterrupt
 
@@ -362,8 +376,7 @@ def _main(argv: list[str]) -> int:
         if args.cmd == "show":
             return _show(args)
         if args.cmd == "report":
-            print(write_report(Path(args.results), get_study))
-            return 0
+            return _report(Path(args.results))
     except (ConfigError, StudyError) as e:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)
         return INTERNAL if getattr(e, "internal", False) else 2

@@ -190,11 +190,15 @@ def parse_override(text: str) -> tuple[str, Any]:
     key = key.strip()
     if not key:
         raise ConfigError(None, f"--set needs key=value (got {text!r})")
+    if any(c in val for c in "\n\r\0"):  # one value: a line break would smuggle in more keys
+        raise ConfigError(key, f"--set value must be one line (got {val!r})")
     try:
-        value = tomllib.loads(f"v = {val.strip()}")["v"]
+        doc = tomllib.loads(f"v = {val.strip()}")
     except tomllib.TOMLDecodeError:
-        value = val.strip()
-    return key, value
+        return key, val.strip()
+    if list(doc) != ["v"]:
+        raise ConfigError(key, f"--set value must be one TOML value (got {val!r})")
+    return key, doc["v"]
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
