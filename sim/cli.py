@@ -60,15 +60,8 @@ def _version() -> str:
         return "unknown"
 
 
-def _parser() -> argparse.ArgumentParser:
-    p = _Parser(
-        prog="sim",
-        description=__doc__.split("\n\n")[0],
-        epilog="\n\n".join(__doc__.split("\n\n")[1:2]) + "\n\nsim COMMAND --help: its options.",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
-    p.add_argument("--version", action="version", version=f"sim {_version()}")
-    sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+def _run_parser(sub) -> None:
+    """The options of ``sim run``."""
     r = sub.add_parser(
         "run",
         help="run a study, print its verdicts, write its results directory",
@@ -127,6 +120,18 @@ def _parser() -> argparse.ArgumentParser:
         default=None,
         help="refuse a run with more least-squares adjustments than this (env SIM_MAX_ADJUSTMENTS)",
     )
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(
+        prog="sim",
+        description=__doc__.split("\n\n")[0],
+        epilog="\n\n".join(__doc__.split("\n\n")[1:2]) + "\n\nsim COMMAND --help: its options.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--version", action="version", version=f"sim {_version()}")
+    sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+    _run_parser(sub)
     sh = sub.add_parser(
         "show",
         help="print one results directory: its claims and verdicts",

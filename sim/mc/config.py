@@ -135,12 +135,19 @@ def check_value(key: str, f: Field, v: Any) -> Any:
     raise AssertionError(f"unknown field kind {k}")  # programming error
 
 
+class _EmptyTable(dict):
+    """An empty TOML table of a study file, kept by :func:`flatten`: an empty section is
+    dropped by :func:`validate`, a value written as ``{}`` is refused there."""
+
+
 def flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in d.items():
         key = f"{prefix}{k}"
-        if isinstance(v, dict):
+        if isinstance(v, dict) and v:
             out.update(flatten(v, key + "."))
+        elif isinstance(v, dict):  # an empty table: a section, or a value given as {} (validate)
+            out[key] = _EmptyTable()
         else:
             out[key] = v
     return out
@@ -166,6 +173,15 @@ def validate(
     Unknown keys are errors; missing keys take their defaults. ``check`` receives the
     resolved dict for cross-key rules and raises :class:`ConfigError` itself.
     """
+    raw = {
+        k: v
+        for k, v in raw.items()
+        if not (
+            isinstance(v, _EmptyTable)
+            and k not in schema
+            and any(s.startswith(k + ".") for s in schema)
+        )
+    }  # an empty section of the file ([compare] with nothing in it) says nothing
     for key in raw:
         if key not in schema:
             near = did_you_mean(key, schema)

@@ -198,9 +198,10 @@ def _points(cfg: dict, rng: np.random.Generator):
     xy = np.array(pts[1], float)
     scale = np.abs(xy).max()
     if scale > 1e9:
+        far = names[int(np.argmax(np.abs(xy).max(axis=1)))]
         raise ConfigError(
             "network.points",
-            f"coordinates up to {scale:.3g} mm: over 1000 km, "
+            f"point {far!r} at {scale:.3g} mm: over 1000 km, "
             "out of range for double-precision adjustment at the um level",
         )
     return names, xy, np.array(pts[2]), np.array(pts[3])
