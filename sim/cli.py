@@ -29,10 +29,13 @@ import sys
 from importlib import metadata
 from pathlib import Path
 
+import pyarrow as pa
+import pyarrow.parquet as pq
+
 from sim.execute import execute
 from sim.mc.config import ConfigError, StudyError, parse_override
 from sim.mc.estimate import estimate
-from sim.mc.storage import code_hash, read_record
+from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
 from sim.report.markdown import write_report
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
@@ -296,9 +299,22 @@ def _show(args) -> int:
         d = Path("results") / args.dir
     if not d.is_dir():
         raise ConfigError("DIR", f"{args.dir} is not a directory")
+    _check_claims(d / "claims.parquet")
     print(run_markdown(d, get_study) if args.markdown else terminal_table(d), end="")
     print("" if args.markdown else "\n", end="")
     return 0
+
+
+def _check_claims(f: Path) -> None:
+    """A results directory's claims table must be one the suite wrote (one line if not)."""
+    if not f.is_file():
+        return
+    try:
+        prov, names = read_provenance(f), pq.read_schema(f).names
+    except (OSError, ValueError, pa.ArrowException) as e:
+        raise ConfigError("DIR", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+    if "study" not in prov or not {"claim", "verdict"} <= set(names):
+        raise ConfigError("DIR", f"{f} is not a claims table written by sim")
 
 
 def _n(x: float) -> str:

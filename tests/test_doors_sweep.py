@@ -8,14 +8,22 @@ argument, and nothing is written.
 * ``sim report --results DIR`` on a directory of the user's without study results (it wrote
   ``REPORT.md`` into it);
 * a datum constraint whose coefficients are all zero (it was dropped, and the rank defect
-  blamed).
+  blamed);
+* ``make verify --no-rerun`` with a scratch directory that holds no re-run (it recorded a
+  failed comparison over the committed record), and a ``--set`` of ``make verify`` that the
+  re-run refuses (a failed comparison, exit 1);
+* ``sim show`` on a directory whose ``claims.parquet`` is someone else's table (a KeyError).
 """
 
 from pathlib import Path
 
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 
 from sim.cli import main
+from sim.mc.storage import write_table
+from sim.report.verify import main as verify_main
 
 ROOT = Path(__file__).resolve().parent.parent
 BROWN = ROOT / "studies" / "brown_table1.toml"
@@ -80,3 +88,40 @@ def test_an_all_zero_datum_constraint_is_named(tmp_path, capsys, coef):
     _one_line(capsys, main(["check", str(f)]), "datum.constraints[0]", "zero")
     f.write_text(NETWORK.replace("COEF", "1.0"))
     assert main(["check", str(f)]) == 0
+
+
+def _results(tmp_path: Path, name: str = "brown_table1") -> Path:
+    """A results directory whose one study holds a claims table (nothing else is read)."""
+    d = tmp_path / "res" / name
+    d.mkdir(parents=True)
+    write_table(d / "claims.parquet", {"claim": ["x"], "verdict": ["holds"]}, {"study": name})
+    return d.parent
+
+
+def test_verify_no_rerun_without_the_reruns_records_nothing(tmp_path, capsys):
+    res = _results(tmp_path)
+    (tmp_path / "scratch").mkdir()
+    argv = ["--results", str(res), "--scratch", str(tmp_path / "scratch"), "--no-rerun"]
+    assert verify_main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no re-run of brown_table1" in err
+    assert sorted(p.name for p in res.iterdir()) == ["brown_table1"]  # no record written
+
+
+def test_verify_names_a_rerun_option_the_study_refuses(tmp_path, capsys, monkeypatch):
+    res = _results(tmp_path)
+    monkeypatch.chdir(ROOT)  # the re-run reads studies/<study>.toml
+    argv = ["--results", str(res), "--scratch", str(tmp_path / "s"), "--trials", "40"]
+    assert verify_main([*argv, "--set", "nosuch.key=1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "nosuch.key" in err[-1] and "refused" in err[-1], err
+    assert sorted(p.name for p in res.iterdir()) == ["brown_table1"]
+
+
+def test_show_names_a_claims_table_that_is_not_ours(tmp_path, capsys):
+    d = tmp_path / "r"
+    d.mkdir()
+    pq.write_table(pa.table({"a": [1, 2]}), d / "claims.parquet")
+    _one_line(capsys, main(["show", str(d)]), "not a claims table")
+    (d / "claims.parquet").write_bytes(b"PAR1 truncated")
+    _one_line(capsys, main(["show", str(d)]), "cannot be read")

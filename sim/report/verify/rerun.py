@@ -109,7 +109,11 @@ def rerun_study(
     cmd = [sys.executable, "-m", "sim", "run", str(sf), "--out", str(target), "--quiet"]
     cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else []), *extra]
     print(f"sim verify: re-running {d.name}", file=sys.stderr, flush=True)
-    r = subprocess.run(cmd)
+    r = subprocess.run(cmd, stderr=subprocess.PIPE, text=True, errors="replace")
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    if r.returncode == 2 and extra and lines:  # the re-run refused the options verify passed
+        raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
+    sys.stderr.write(r.stderr)
     return None if r.returncode == 0 else f"the re-run exited with {r.returncode}"
 
 
@@ -135,6 +139,12 @@ def verify(
         raise VerifyError(f"--scratch: {scratch} is (inside) the committed results {results}")
     # every target checked before anything runs: a foreign directory stops it at once
     replace = {d: _target(scratch, d.name)[1] for d, _ in todo} if rerun else {}
+    missing = [d.name for d, _ in todo if not rerun and not (scratch / d.name).is_dir()]
+    if missing:  # nothing to compare: a request error, not a failed comparison to record
+        raise VerifyError(
+            f"--no-rerun: no re-run of {', '.join(missing)} in {scratch} "
+            "(run without --no-rerun, or choose the --scratch that holds them)"
+        )
     out = []
     for d, study in todo:
         target = scratch / d.name
@@ -146,11 +156,6 @@ def verify(
                 c.failures.append(why)
                 out.append(c)
                 continue
-        elif not target.is_dir():
-            c = Comparison(d.name)
-            c.failures.append(f"no re-run in {target}")
-            out.append(c)
-            continue
         out.append(compare_dirs(d, target, d.name, mode))
     return out
 
