@@ -12,7 +12,9 @@ argument, and nothing is written.
 * ``make verify --no-rerun`` with a scratch directory that holds no re-run (it recorded a
   failed comparison over the committed record), and a ``--set`` of ``make verify`` that the
   re-run refuses (a failed comparison, exit 1);
-* ``sim show`` on a directory whose ``claims.parquet`` is someone else's table (a KeyError).
+* ``sim show`` on a directory whose ``claims.parquet`` is someone else's table (a KeyError);
+* ``python -m sim.batch``: argparse's two-line usage errors, ``--timings`` naming a directory
+  (a traceback after every run) or a file of the user's (overwritten).
 """
 
 from pathlib import Path
@@ -21,6 +23,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from sim.batch import main as batch_main
 from sim.cli import main
 from sim.mc.storage import write_table
 from sim.report.verify import main as verify_main
@@ -125,3 +128,24 @@ def test_show_names_a_claims_table_that_is_not_ours(tmp_path, capsys):
     _one_line(capsys, main(["show", str(d)]), "not a claims table")
     (d / "claims.parquet").write_bytes(b"PAR1 truncated")
     _one_line(capsys, main(["show", str(d)]), "cannot be read")
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        ([], "required: files"),
+        (["--jobs", "x", str(BROWN)], "--jobs"),
+        (["--timings", "DIR", str(BROWN)], "not a regular file"),
+        (["--timings", "MINE", str(BROWN)], "not a timings file"),
+    ],
+)
+def test_batch_refuses_in_one_line_before_running(tmp_path, capsys, argv, words):
+    (tmp_path / "mine.txt").write_text("mine\n")
+    argv = [
+        str(tmp_path) if a == "DIR" else str(tmp_path / "mine.txt") if a == "MINE" else a
+        for a in argv
+    ]
+    assert batch_main([*argv, "--results", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err and err.startswith("sim.batch: "), err
+    assert not (tmp_path / "r").exists() and (tmp_path / "mine.txt").read_text() == "mine\n"
