@@ -227,13 +227,43 @@ def _on_sigterm(signum, frame):
     raise KeyboardInterrupt
 
 
+class _BadArgs(ValueError):
+    pass
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, exit 2 (main prints it)
+        raise _BadArgs(message)
+
+
+def _timings_problem(path: str) -> str | None:
+    """Why the timings cannot be written to ``path`` (checked before anything runs): its
+    directory must be writable, and an existing file must be an earlier timings file (a
+    JSON object of lists), never a file of the user's."""
+    p = Path(path)
+    parent = p.resolve().parent
+    if not parent.is_dir() or not os.access(parent, os.W_OK):
+        return f"cannot write into {parent}"
+    if p.is_symlink() or (p.exists() and not p.is_file()):
+        return f"{p} exists and is not a regular file"
+    if p.exists():
+        try:
+            old = json.loads(p.read_text())
+            ours = isinstance(old, dict) and all(isinstance(v, list) for v in old.values())
+        except (OSError, ValueError):
+            ours = False
+        if not ours:
+            return f"{p} exists and is not a timings file of sim.batch; sim never replaces it"
+    return None
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     run_args = []
     if "--" in argv:
         i = argv.index("--")
         argv, run_args = argv[:i], argv[i + 1 :]
-    ap = argparse.ArgumentParser(prog="python -m sim.batch", description=__doc__.splitlines()[0])
+    ap = _Parser(prog="python -m sim.batch", description=__doc__.splitlines()[0])
     ap.add_argument("files", nargs="+", help="study files")
     ap.add_argument("--jobs", type=int, default=2, help="studies run at a time (default 2)")
     ap.add_argument("--results", default="results", help="results directory (default results)")
@@ -241,7 +271,11 @@ def main(argv: list[str] | None = None) -> int:
         "--stale-only", action="store_true", help="only the studies whose results are not current"
     )
     ap.add_argument("--timings", help="write {study: [exit code, wall s, start s]} (JSON) here")
-    args = ap.parse_args(argv)
+    try:
+        args = ap.parse_args(argv)
+    except _BadArgs as e:
+        print(f"sim.batch: {e} (see python -m sim.batch --help)", file=sys.stderr)
+        return 2
     files = [Path(f) for f in args.files]
     bad = [f for f in files if not f.is_file()]
     if bad:
@@ -251,11 +285,10 @@ def main(argv: list[str] | None = None) -> int:
     if why:
         print(f"sim.batch: {why}", file=sys.stderr)
         return 2
-    if args.timings:
-        parent = Path(args.timings).resolve().parent
-        if not parent.is_dir() or not os.access(parent, os.W_OK):
-            print(f"sim.batch: --timings: cannot write into {parent}", file=sys.stderr)
-            return 2
+    why = _timings_problem(args.timings) if args.timings else None
+    if why:
+        print(f"sim.batch: --timings: {why}", file=sys.stderr)
+        return 2
     if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
         signal.signal(signal.SIGTERM, _on_sigterm)  # end the runs as Ctrl-C does
     if not 1 <= args.jobs <= 64:

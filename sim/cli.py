@@ -29,10 +29,13 @@ import sys
 from importlib import metadata
 from pathlib import Path
 
+import pyarrow as pa
+import pyarrow.parquet as pq
+
 from sim.execute import execute
 from sim.mc.config import ConfigError, StudyError, parse_override
 from sim.mc.estimate import estimate
-from sim.mc.storage import code_hash, read_record
+from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
 from sim.report.markdown import write_report
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
@@ -60,15 +63,8 @@ def _version() -> str:
         return "unknown"
 
 
-def _parser() -> argparse.ArgumentParser:
-    p = _Parser(
-        prog="sim",
-        description=__doc__.split("\n\n")[0],
-        epilog="\n\n".join(__doc__.split("\n\n")[1:2]) + "\n\nsim COMMAND --help: its options.",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
-    p.add_argument("--version", action="version", version=f"sim {_version()}")
-    sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+def _run_parser(sub) -> None:
+    """The options of ``sim run``."""
     r = sub.add_parser(
         "run",
         help="run a study, print its verdicts, write its results directory",
@@ -127,6 +123,18 @@ def _parser() -> argparse.ArgumentParser:
         default=None,
         help="refuse a run with more least-squares adjustments than this (env SIM_MAX_ADJUSTMENTS)",
     )
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(
+        prog="sim",
+        description=__doc__.split("\n\n")[0],
+        epilog="\n\n".join(__doc__.split("\n\n")[1:2]) + "\n\nsim COMMAND --help: its options.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--version", action="version", version=f"sim {_version()}")
+    sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+    _run_parser(sub)
     sh = sub.add_parser(
         "show",
         help="print one results directory: its claims and verdicts",
@@ -291,9 +299,22 @@ def _show(args) -> int:
         d = Path("results") / args.dir
     if not d.is_dir():
         raise ConfigError("DIR", f"{args.dir} is not a directory")
+    _check_claims(d / "claims.parquet")
     print(run_markdown(d, get_study) if args.markdown else terminal_table(d), end="")
     print("" if args.markdown else "\n", end="")
     return 0
+
+
+def _check_claims(f: Path) -> None:
+    """A results directory's claims table must be one the suite wrote (one line if not)."""
+    if not f.is_file():
+        return
+    try:
+        prov, names = read_provenance(f), pq.read_schema(f).names
+    except (OSError, ValueError, pa.ArrowException) as e:
+        raise ConfigError("DIR", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+    if "study" not in prov or not {"claim", "verdict"} <= set(names):
+        raise ConfigError("DIR", f"{f} is not a claims table written by sim")
 
 
 def _n(x: float) -> str:
@@ -330,6 +351,20 @@ def _check(args) -> int:
     return 0
 
 
+def _report(results: Path) -> int:
+    """``sim report``: only over a directory that holds study results (a directory of the
+    user's with none gets no REPORT.md written into it)."""
+    if results.is_dir() and not any(
+        (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
+        for d in results.iterdir()
+    ):
+        raise ConfigError(
+            "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
+        )
+    print(write_report(results, get_study))
+    return 0
+
+
 def _on_sigterm(signum, frame):
     raise KeyboardInterrupt
 
@@ -362,8 +397,7 @@ def _main(argv: list[str]) -> int:
         if args.cmd == "show":
             return _show(args)
         if args.cmd == "report":
-            print(write_report(Path(args.results), get_study))
-            return 0
+            return _report(Path(args.results))
     except (ConfigError, StudyError) as e:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)
         return INTERNAL if getattr(e, "internal", False) else 2

@@ -165,8 +165,13 @@ def test_report_never_replaces_a_report_it_did_not_write(tmp_path, capsys):
     d.mkdir()
     (d / "REPORT.md").write_text("# my own report\n")
     assert main(["report", "--results", str(d)]) == 2
-    assert "not written by sim report" in capsys.readouterr().err
-    assert (d / "REPORT.md").read_text() == "# my own report\n"
+    err = capsys.readouterr().err  # no study results there either: refused before anything
+    assert "not written by sim report" in err or "no study results in" in err
+    assert err.count("\n") == 1 and (d / "REPORT.md").read_text() == "# my own report\n"
+    (d / "notes.txt").write_text("mine\n")  # a directory of the user's, no REPORT.md
+    assert main(["report", "--results", str(d)]) == 2
+    assert "no study results in" in capsys.readouterr().err
+    assert sorted(p.name for p in d.iterdir()) == ["REPORT.md", "notes.txt"]
 
 
 def test_report_names_a_claims_table_that_is_not_ours(tmp_path, capsys):

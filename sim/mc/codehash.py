@@ -25,11 +25,11 @@ __all__ = ["study_modules", "study_files", "study_code_hash", "not_study_code"]
 ROOT = Path(__file__).resolve().parents[1]  # .../sim
 #: library files (paths relative to ``sim/``) that no study result depends on (the
 #: verification, which the report imports for its reproducibility section only)
-NOT_STUDY_CODE = ("report/verify.py",)
+NOT_STUDY_CODE = ("report/verify",)  # the package sim/report/verify/
 
 
 def not_study_code(rel: str) -> bool:
-    """True for a path relative to ``sim/`` (``report/verify.py``) that :data:`NOT_STUDY_CODE`
+    """True for a path relative to ``sim/`` (``report/verify/cli.py``) that :data:`NOT_STUDY_CODE`
     names or lies inside."""
     return any(rel == x or rel.startswith(x + "/") for x in NOT_STUDY_CODE)
 

@@ -135,12 +135,19 @@ def check_value(key: str, f: Field, v: Any) -> Any:
     raise AssertionError(f"unknown field kind {k}")  # programming error
 
 
+class _EmptyTable(dict):
+    """An empty TOML table of a study file, kept by :func:`flatten`: an empty section is
+    dropped by :func:`validate`, a value written as ``{}`` is refused there."""
+
+
 def flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in d.items():
         key = f"{prefix}{k}"
-        if isinstance(v, dict):
+        if isinstance(v, dict) and v:
             out.update(flatten(v, key + "."))
+        elif isinstance(v, dict):  # an empty table: a section, or a value given as {} (validate)
+            out[key] = _EmptyTable()
         else:
             out[key] = v
     return out
@@ -166,6 +173,15 @@ def validate(
     Unknown keys are errors; missing keys take their defaults. ``check`` receives the
     resolved dict for cross-key rules and raises :class:`ConfigError` itself.
     """
+    raw = {
+        k: v
+        for k, v in raw.items()
+        if not (
+            isinstance(v, _EmptyTable)
+            and k not in schema
+            and any(s.startswith(k + ".") for s in schema)
+        )
+    }  # an empty section of the file ([compare] with nothing in it) says nothing
     for key in raw:
         if key not in schema:
             near = did_you_mean(key, schema)
@@ -190,11 +206,15 @@ def parse_override(text: str) -> tuple[str, Any]:
     key = key.strip()
     if not key:
         raise ConfigError(None, f"--set needs key=value (got {text!r})")
+    if any(c in val for c in "\n\r\0"):  # one value: a line break would smuggle in more keys
+        raise ConfigError(key, f"--set value must be one line (got {val!r})")
     try:
-        value = tomllib.loads(f"v = {val.strip()}")["v"]
+        doc = tomllib.loads(f"v = {val.strip()}")
     except tomllib.TOMLDecodeError:
-        value = val.strip()
-    return key, value
+        return key, val.strip()
+    if list(doc) != ["v"]:
+        raise ConfigError(key, f"--set value must be one TOML value (got {val!r})")
+    return key, doc["v"]
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:

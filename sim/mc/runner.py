@@ -27,13 +27,14 @@ from __future__ import annotations
 import io
 import json
 import logging
+import multiprocessing
 import os
 import pickle
 import signal
 import sys
 import threading
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Mapping
@@ -266,16 +267,20 @@ class _Dask:
         if scheduler:
             self.client = Client(scheduler, timeout="10s")
         else:
-            self.cluster = LocalCluster(
-                n_workers=max(workers, 1),
-                threads_per_worker=1,
-                processes=True,
-                # ":0": a free port, never the "Port 8787 is already in use" warning (None
-                # still means the default 8787); the nanny's closing chatter is not for users
-                dashboard_address=":0",
-                silence_logs=logging.ERROR,
-            )
-            self.client = Client(self.cluster)
+            try:
+                self.cluster = LocalCluster(
+                    n_workers=max(workers, 1),
+                    threads_per_worker=1,
+                    processes=True,
+                    # ":0": a free port, never the "Port 8787 is already in use" warning (None
+                    # still means the default 8787); the nanny's closing chatter is not for users
+                    dashboard_address=":0",
+                    silence_logs=logging.ERROR,
+                )
+                self.client = Client(self.cluster)
+            except BaseException:  # a signal while the cluster starts: end what has started
+                _end_dask_clusters()
+                raise
 
     def run(self, fn, seed, part, jobs):
         futs = {}  # the chunk function is small: send it with each task (no scatter)
@@ -286,9 +291,38 @@ class _Dask:
             yield k, n, f.result()
 
     def close(self, kill: bool = False):
-        self.client.close()
+        if not kill:
+            self.client.close()
+            if self.cluster is not None:
+                self.cluster.close()
+            return
+        with suppress(Exception):  # interrupted: whatever state the workers are in
+            self.client.close(timeout=5)
         if self.cluster is not None:
-            self.cluster.close()
+            _end_dask_clusters()
+
+
+def _end_dask_clusters() -> None:
+    """End this process's dask clusters after an interrupt, quietly and for good: each is
+    closed once (a worker still starting makes dask's close raise), kept from dask's second
+    close at exit (which would print its traceback), and its worker processes are killed."""
+    import psutil  # installed with the dask extra (a dependency of distributed)
+    from distributed.deploy.spec import SpecCluster  # heavy optional dependency (dask extra)
+
+    for name in ("asyncio", "distributed", "tornado"):  # their chatter about the interrupted
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)  # start-up is not for users
+    for c in list(SpecCluster._instances):
+        c.shutdown_on_close = False
+        with suppress(Exception):
+            c.close(timeout=5)
+    with suppress(Exception):  # nannies and their workers (grandchildren) alike
+        for proc in psutil.Process().children(recursive=True):
+            with suppress(Exception):
+                if "resource_tracker" not in " ".join(proc.cmdline()):  # ends with us
+                    proc.kill()
+    for proc in multiprocessing.active_children():  # reaped, no zombies
+        with suppress(Exception):
+            proc.join(1)
 
 
 def make_executor(kind: str = "local", workers: int = 1, scheduler: str | None = None):

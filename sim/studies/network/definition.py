@@ -29,8 +29,6 @@ plane system; bearings are measured from +x towards +y, as ``gama-local``'s ``ax
 
 from __future__ import annotations
 
-import fnmatch
-import math
 from collections import Counter
 from dataclasses import dataclass
 
@@ -38,41 +36,22 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from sim.mc.config import ConfigError
-from sim.mc.estimate import DEFAULT_MAX_MEMORY_GB, _limit
+from sim.studies.network.validate import (
+    _OBS,
+    ARCSEC,
+    KINDS,
+    _degenerate,
+    _fits,
+    _keys,
+    _match,
+    _mm,
+    _num,
+    _obs_common,
+    _role,
+    _text,
+)
 
 __all__ = ["Network", "build", "KINDS", "ARCSEC"]
-
-#: observation kinds, in the order of their integer codes
-KINDS = ("distance", "direction", "angle", "dx", "dy", "x", "y")
-ARCSEC = math.pi / (180 * 3600)
-ROLES = ("free", "fixed", "observed")
-_ANGULAR = (1, 2)
-#: accepted ranges of the standard deviations: the weights 1 / sigma^2 stay far from
-#: overflow and underflow, and the normal equations within double precision
-SIGMA_RANGE = {"mm": (1e-9, 1e9), "arcsec": (1e-9, 1e6)}
-#: bytes of the sparse adjustment per point and per observation (the pattern, the factor and
-#: its selected inverse, one chunk's Jacobian): the order of magnitude that bounds a network
-#: by the memory limit (``SIM_MAX_MEMORY_GB``, default 8 GiB) instead of by counts
-BYTES_PER_POINT = 4096
-BYTES_PER_OBS = 2048
-
-
-def _memory_limit() -> float:
-    """The memory limit in bytes (``SIM_MAX_MEMORY_GB``, else the default)."""
-    return _limit(None, "SIM_MAX_MEMORY_GB", DEFAULT_MAX_MEMORY_GB, "SIM_MAX_MEMORY_GB") * 2**30
-
-
-def _fits(key: str, points: float, obs: float, what: str) -> None:
-    """Refuse (naming ``key``) a network whose points and observations do not fit the memory
-    limit by the per-point and per-observation estimate."""
-    need = points * BYTES_PER_POINT + obs * BYTES_PER_OBS
-    lim = _memory_limit()
-    if not need <= lim:
-        raise ConfigError(
-            key,
-            f"{what} need about {need / 2**30:.3g} GiB, over the {lim / 2**30:g} GiB memory "
-            "limit (SIM_MAX_MEMORY_GB)",
-        )
 
 
 @dataclass(frozen=True)
@@ -150,88 +129,30 @@ class Network:
         return np.concatenate([coords, orient, const, scale]).astype(int)
 
 
-def _num(key: str, v, lo: float | None = None, lo_open: bool = False, integer: bool = False):
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise ConfigError(key, f"must be a finite number (got {v!r})")
-    if integer and not float(v).is_integer():
-        raise ConfigError(key, f"must be an integer (got {v!r})")
-    if lo is not None and (v <= lo if lo_open else v < lo):
-        raise ConfigError(key, f"must be {'>' if lo_open else '>='} {lo:g} (got {v!r})")
-    return int(v) if integer else float(v)
-
-
-def _text(key: str, v) -> str:
-    if not isinstance(v, str) or not v.strip():
-        raise ConfigError(key, f"must be a non-empty name (got {v!r})")
-    return v
-
-
-def _keys(key: str, rec: dict, allowed: set, required: set) -> None:
-    bad = set(rec) - allowed
-    if bad:
-        raise ConfigError(f"{key}.{sorted(bad)[0]}", "unknown field")
-    miss = required - set(rec)
-    if miss:
-        raise ConfigError(f"{key}.{sorted(miss)[0]}", "missing")
-
-
-def _role(key: str, rec: dict) -> tuple[int, float]:
-    role = rec.get("role", "free")
-    if role not in ROLES:
-        raise ConfigError(f"{key}.role", f"must be one of {', '.join(ROLES)} (got {role!r})")
-    sig = 0.0
-    if role == "observed":
-        if "sigma_mm" not in rec:
-            raise ConfigError(f"{key}.sigma_mm", "an observed point needs its coordinate sigma")
-        sig = _num(f"{key}.sigma_mm", rec["sigma_mm"], 0.0, lo_open=True)
-        lo, hi = SIGMA_RANGE["mm"]
-        if not lo <= sig <= hi:
-            raise ConfigError(
-                f"{key}.sigma_mm",
-                f"{sig:g} is outside [{lo:g}, {hi:g}] mm: its weight would over- or underflow",
-            )
-    elif "sigma_mm" in rec:
-        raise ConfigError(f"{key}.sigma_mm", f"only an observed point has a sigma (role {role})")
-    return ROLES.index(role), sig
-
-
-def _mm(key: str, rec: dict, field: str, required: bool = True, default=None):
-    """``rec``'s ``field`` in mm, given as ``field_mm`` or as ``field_m`` (metres, for field
-    networks), not both; a pair ``[x, y]`` when the default is one."""
-    a, b = f"{field}_mm", f"{field}_m"
-    if a in rec and b in rec:
-        raise ConfigError(f"{key}.{b}", f"give {a} or {b}, not both")
-    name, f = (b, 1000.0) if b in rec else (a, 1.0)
-    if name not in rec:
-        if required:
-            raise ConfigError(f"{key}.{a}", f"missing (or give {b} in metres)")
-        return default
-    v = rec[name]
-    if isinstance(default, list):
-        if not (isinstance(v, list) and len(v) == 2):
-            raise ConfigError(f"{key}.{name}", "must be [x, y]")
-        return [_num(f"{key}.{name}", c) * f for c in v]
-    return _num(f"{key}.{name}", v) * f
-
-
-def _points(cfg: dict, rng: np.random.Generator):
-    names, xy, role, sig = [], [], [], []
+def _listed_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
+    """Append ``network.points`` to ``pts`` (names, xy, role codes, coordinate sigmas)."""
     _p = {"name", "x_mm", "y_mm", "x_m", "y_m", "role", "sigma_mm"}
     for a, rec in enumerate(cfg["network.points"]):
         key = f"network.points[{a}]"
         _keys(key, rec, _p, {"name"})
         r, s = _role(key, rec)
-        names.append(_text(f"{key}.name", rec["name"]))
-        xy.append([_mm(key, rec, "x"), _mm(key, rec, "y")])
-        role.append(r)
-        sig.append(s)
+        _add(pts, _text(f"{key}.name", rec["name"]), [_mm(key, rec, "x"), _mm(key, rec, "y")], r, s)
+
+
+def _add(pts: tuple[list, list, list, list], name: str, xy: list, role: int, sig: float) -> None:
+    for col, v in zip(pts, (name, xy, role, sig)):
+        col.append(v)
+
+
+def _grid_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
+    """Append the points of ``network.grids`` (row by row, named prefix + 1-based index)."""
     _g = {"prefix", "nx", "ny", "spacing_mm", "spacing_m", "origin_mm", "origin_m", "role"}
     for a, rec in enumerate(cfg["network.grids"]):
         key = f"network.grids[{a}]"
         _keys(key, rec, _g | {"sigma_mm"}, {"prefix", "nx", "ny"})
         nx = _num(f"{key}.nx", rec["nx"], 1, integer=True)
         ny = _num(f"{key}.ny", rec["ny"], 1, integer=True)
-        _fits(f"{key}.nx", len(names) + nx * ny, 0, f"{nx} x {ny} points")
+        _fits(f"{key}.nx", len(pts[0]) + nx * ny, 0, f"{nx} x {ny} points")
         h = _mm(key, rec, "spacing")
         if h <= 0:
             raise ConfigError(f"{key}.spacing_mm", f"must be > 0 (got {h:g} mm)")
@@ -240,135 +161,50 @@ def _points(cfg: dict, rng: np.random.Generator):
         prefix = _text(f"{key}.prefix", rec["prefix"])
         for b in range(ny):
             for c in range(nx):
-                names.append(f"{prefix}{b * nx + c + 1}")
-                xy.append([o[0] + c * h, o[1] + b * h])
-                role.append(r)
-                sig.append(s)
+                _add(pts, f"{prefix}{b * nx + c + 1}", [o[0] + c * h, o[1] + b * h], r, s)
+
+
+def _random_points(cfg: dict, rng: np.random.Generator, pts: tuple[list, list, list, list]):
+    """Append the points of ``network.random`` (uniform in a square, from ``rng``)."""
     _r = {"prefix", "n", "half_extent_mm", "half_extent_m", "center_mm", "center_m", "role"}
     for a, rec in enumerate(cfg["network.random"]):
         key = f"network.random[{a}]"
         _keys(key, rec, _r | {"sigma_mm"}, {"prefix", "n"})
         n = _num(f"{key}.n", rec["n"], 1, integer=True)
-        _fits(f"{key}.n", len(names) + n, 0, f"{n} points")
+        _fits(f"{key}.n", len(pts[0]) + n, 0, f"{n} points")
         e = _mm(key, rec, "half_extent")
         if e <= 0:
             raise ConfigError(f"{key}.half_extent_mm", f"must be > 0 (got {e:g} mm)")
         c0 = _mm(key, rec, "center", False, [0.0, 0.0])
         r, s = _role(key, rec)
         prefix = _text(f"{key}.prefix", rec["prefix"])
-        pts = rng.uniform(-e, e, (n, 2)) + np.array(c0)
+        xy = rng.uniform(-e, e, (n, 2)) + np.array(c0)
         for b in range(n):
-            names.append(f"{prefix}{b + 1}")
-            xy.append(list(pts[b]))
-            role.append(r)
-            sig.append(s)
+            _add(pts, f"{prefix}{b + 1}", list(xy[b]), r, s)
+
+
+def _points(cfg: dict, rng: np.random.Generator):
+    """Names, coordinates (n, 2) mm, role codes and coordinate sigmas of every point."""
+    pts: tuple[list, list, list, list] = ([], [], [], [])
+    _listed_points(cfg, pts)
+    _grid_points(cfg, pts)
+    _random_points(cfg, rng, pts)
+    names = pts[0]
     if len(names) < 2:
         raise ConfigError("network.points", "a network needs at least two points")
     dup = sorted(x for x, c in Counter(names).items() if c > 1)
     if dup:
         raise ConfigError("network.points", f"duplicate point name {dup[0]!r}")
-    xy = np.array(xy, float)
+    xy = np.array(pts[1], float)
     scale = np.abs(xy).max()
     if scale > 1e9:
+        far = names[int(np.argmax(np.abs(xy).max(axis=1)))]
         raise ConfigError(
             "network.points",
-            f"coordinates up to {scale:.3g} mm: over 1000 km, "
+            f"point {far!r} at {scale:.3g} mm: over 1000 km, "
             "out of range for double-precision adjustment at the um level",
         )
-    return names, xy, np.array(role), np.array(sig)
-
-
-def _match(key: str, pats, names: list[str]) -> list[int]:
-    pats = [pats] if isinstance(pats, str) else pats
-    if not isinstance(pats, list) or not pats:
-        raise ConfigError(key, "must be a point name, a pattern or a list of them")
-    out: list[int] = []
-    for p in pats:
-        _text(key, p)
-        hit = [a for a, nm in enumerate(names) if fnmatch.fnmatchcase(nm, p)]
-        if not hit:
-            raise ConfigError(key, f"no point named {p!r}")
-        out += [h for h in hit if h not in out]
-    return out
-
-
-_OBS = {
-    "kind",
-    "from",
-    "to",
-    "at",
-    "sigma_mm",
-    "sigma_arcsec",
-    "settings",
-    "bias_mm",
-    "bias_arcsec",
-    "nearest",
-    "set",
-}
-
-
-def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
-    kind = rec.get("kind")
-    if kind not in KINDS[:5]:
-        raise ConfigError(f"{key}.kind", f"must be one of {', '.join(KINDS[:5])} (got {kind!r})")
-    code = KINDS.index(kind)
-    unit, other = ("arcsec", "mm") if code in _ANGULAR else ("mm", "arcsec")
-    if f"sigma_{other}" in rec or f"bias_{other}" in rec:
-        raise ConfigError(f"{key}.sigma_{other}", f"a {kind} takes sigma_{unit} and bias_{unit}")
-    if f"sigma_{unit}" not in rec:
-        raise ConfigError(f"{key}.sigma_{unit}", "missing")
-    sig = _num(f"{key}.sigma_{unit}", rec[f"sigma_{unit}"], 0.0, lo_open=True)
-    lo, hi = SIGMA_RANGE[unit]
-    if not lo <= sig <= hi:
-        raise ConfigError(
-            f"{key}.sigma_{unit}",
-            f"{sig:g} is outside [{lo:g}, {hi:g}] {unit}: its weight would over- or underflow",
-        )
-    if "set" in rec and code != 1:
-        raise ConfigError(f"{key}.set", f"only a direction has an orientation set (a {kind})")
-    if "set" in rec and not isinstance(rec["set"], str):
-        raise ConfigError(f"{key}.set", f"must be a name (got {rec['set']!r})")
-    settings = _num(f"{key}.settings", rec.get("settings", 1), 1, integer=True)
-    bias = _num(f"{key}.bias_{unit}", rec.get(f"bias_{unit}", 0.0))
-    f = ARCSEC if code in _ANGULAR else 1.0
-    return code, sig * f / math.sqrt(settings), bias * f
-
-
-def _degenerate(names, xy, kind, i, j, k) -> None:
-    """Refuse an observation whose geometry is undefined: a sight from a point to itself or
-    to a point at the same place, an angle whose back- or fore-sight is its station or whose
-    two sights coincide (names the first such observation by its points). Vectorised over
-    the rows (a network of 100,000 rows checks in milliseconds); :func:`_refuse` words it."""
-    span = max(float(np.ptp(xy, axis=0).max()), 1e-300)
-    geo, ang = kind < 5, kind == 2
-    jb, kb = np.where(j >= 0, j, i), np.where(k >= 0, k, i)
-    near_j = np.hypot(*(xy[jb] - xy[i]).T) <= 1e-12 * span
-    near_k = np.hypot(*(xy[kb] - xy[i]).T) <= 1e-12 * span
-    bad = geo & (i == j)
-    bad |= ang & ((k == i) | (j == k))
-    bad |= np.isin(kind, (0, 1, 2)) & near_j
-    bad |= ang & near_k
-    for r in np.flatnonzero(bad)[:1]:
-        _refuse(names, xy, span, int(kind[r]), int(i[r]), int(j[r]), int(k[r]))
-
-
-def _refuse(names, xy, span: float, code: int, a: int, b: int, c: int) -> None:
-    """The one-line refusal of the degenerate observation ``code`` at ``a``, ``b``, ``c``."""
-    what = f"a {KINDS[code]} from {names[a]!r} to {names[b]!r}"
-    if code == 2:
-        what = f"an angle at {names[a]!r} from {names[b]!r} to {names[c]!r}"
-        if c == a or b == a:
-            raise ConfigError("network.observations", f"{what}: a sight to its own station")
-        if b == c:
-            raise ConfigError("network.observations", f"{what}: the two sights are one")
-    if a == b:
-        raise ConfigError("network.observations", f"{what}: a sight to itself")
-    for t in (b, c) if code == 2 else (b,):
-        if code in (0, 1, 2) and np.hypot(*(xy[t] - xy[a])) <= 1e-12 * span:
-            raise ConfigError(
-                "network.points",
-                f"points {names[a]!r} and {names[t]!r} coincide: {what} is undefined",
-            )
+    return names, xy, np.array(pts[2]), np.array(pts[3])
 
 
 def _targets(xy: np.ndarray, fr: list[int], to: list[int], k: int) -> list[list[int]]:
@@ -396,12 +232,9 @@ def _targets(xy: np.ndarray, fr: list[int], to: list[int], k: int) -> list[list[
     return out
 
 
-def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
-    """The :class:`Network` of a validated study config (``rng``: the layout stream)."""
-    if rng is None:
-        rng = np.random.default_rng(np.random.SeedSequence(cfg["seed"], spawn_key=(99,)))
-    names, xy, role, csig = _points(cfg, rng)
-    rows: list[tuple] = []  # (kind, i, j, k, sigma, bias)
+def _listed_obs(cfg: dict, names: list[str]) -> list[tuple]:
+    """The rows ``(kind, i, j, k, sigma, bias)`` of ``network.observations``, one each."""
+    rows: list[tuple] = []
     for a, rec in enumerate(cfg["network.observations"]):
         key = f"network.observations[{a}]"
         _keys(key, rec, _OBS - {"nearest"}, {"kind", "to"})
@@ -425,6 +258,12 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
                 "to (use network.generate for many)",
             )
         rows.append((code, fr[0], to[0], -1, sig, bias))
+    return rows
+
+
+def _generated_obs(cfg: dict, names: list[str], xy: np.ndarray, rows: list[tuple]) -> None:
+    """Append the rows of ``network.generate`` (every ``from`` to every, or the nearest,
+    ``to``), refusing a set that would not fit the memory limit before it is made."""
     for a, rec in enumerate(cfg["network.generate"]):
         key = f"network.generate[{a}]"
         _keys(key, rec, _OBS - {"at", "set"}, {"kind", "from", "to"})
@@ -439,30 +278,51 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
         _fits(key, len(names), len(rows) + len(fr) * per, f"{len(fr)} x {per} observations")
         for s, tgt in zip(fr, _targets(xy, fr, to, k)):
             rows += [(code, s, t, -1, sig, bias) for t in tgt]
+
+
+def _orientation_sets(cfg: dict, names, kind, i) -> tuple[np.ndarray, tuple[str, ...]]:
+    """Per row its orientation unknown (-1 for a non-direction) and the stations' set names
+    (``A``, or ``A/2`` for a second set at A)."""
+    n_single = len(cfg["network.observations"])
+    label = [str(r.get("set", "")) for r in cfg["network.observations"]]
+    label += [""] * (len(kind) - n_single)
+    key = [f"{names[a]}/{lb}" if lb else names[a] for a, lb in zip(i, label)]
+    stations = tuple(dict.fromkeys(s for s, c in zip(key, kind) if c == 1))
+    at = {s: b for b, s in enumerate(stations)}
+    return np.array([at[s] if c == 1 else -1 for s, c in zip(key, kind)], int), stations
+
+
+def _check_offset(beta: float, names, xy, kind, i, j) -> None:
+    """Brown's offset must be shorter than every distance it is taken from."""
+    if not beta or not np.any(kind == 0):
+        return
+    rows_d = np.flatnonzero(kind == 0)
+    d = np.hypot(*(xy[j[rows_d]] - xy[i[rows_d]]).T)
+    if d.min() <= beta * (1 + 1e-6):
+        r = rows_d[int(np.argmin(d))]
+        raise ConfigError(
+            "network.offset_mm",
+            f"the offset {beta:g} mm is not shorter than the distance from "
+            f"{names[i[r]]!r} to {names[j[r]]!r} ({d.min():.6g} mm)",
+        )
+
+
+def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
+    """The :class:`Network` of a validated study config (``rng``: the layout stream)."""
+    if rng is None:
+        rng = np.random.default_rng(np.random.SeedSequence(cfg["seed"], spawn_key=(99,)))
+    names, xy, role, csig = _points(cfg, rng)
+    rows = _listed_obs(cfg, names)
+    _generated_obs(cfg, names, xy, rows)
     for a in np.flatnonzero(role == 2):
         rows += [(5, a, -1, -1, csig[a], 0.0), (6, a, -1, -1, csig[a], 0.0)]
     if not rows:
         raise ConfigError("network.observations", "the network has no observations")
     kind, i, j, kk, sig, bias = (np.array(c) for c in zip(*rows))
     _degenerate(names, xy, kind, i, j, kk)
-    n_single = len(cfg["network.observations"])
-    label = [str(r.get("set", "")) for r in cfg["network.observations"]]
-    label += [""] * (len(rows) - n_single)
-    key = [f"{names[a]}/{lb}" if lb else names[a] for a, lb in zip(i, label)]
-    stations = tuple(dict.fromkeys(s for s, c in zip(key, kind) if c == 1))
-    at = {s: b for b, s in enumerate(stations)}
-    oset = np.array([at[s] if c == 1 else -1 for s, c in zip(key, kind)], int)
+    oset, stations = _orientation_sets(cfg, names, kind, i)
     beta = cfg["network.offset_mm"]
-    if beta and np.any(kind == 0):
-        rows_d = np.flatnonzero(kind == 0)
-        d = np.hypot(*(xy[j[rows_d]] - xy[i[rows_d]]).T)
-        if d.min() <= beta * (1 + 1e-6):
-            r = rows_d[int(np.argmin(d))]
-            raise ConfigError(
-                "network.offset_mm",
-                f"the offset {beta:g} mm is not shorter than the distance from "
-                f"{names[i[r]]!r} to {names[j[r]]!r} ({d.min():.6g} mm)",
-            )
+    _check_offset(beta, names, xy, kind, i, j)
     return Network(
         cfg["network.name"],
         tuple(names),

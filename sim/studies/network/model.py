@@ -305,6 +305,10 @@ def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
                         f"{name}: coefficient must be a finite number up to 1e12 (got {coef!r})",
                     )
                 C[pos[g], b] = coef
+            if all(c == 0 for c in rec.values() if isinstance(c, (int, float))):
+                raise ConfigError(
+                    f"datum.constraints[{b}]", "every coefficient is zero: it constrains nothing"
+                )
         keep = np.abs(C).sum(0) > 0
         return lsq.Datum(free, C[:, keep] if keep.any() else None)
     # inner constraints over the chosen points, for the defects the network really has

@@ -1,0 +1,57 @@
+"""Reproducibility verified, not promised: re-run the studies and compare with committed results.
+
+``python -m sim.report.verify`` (``make verify``) re-runs every study of a results directory
+(its study file in ``studies/``) into a scratch directory and compares, file by file and column
+by column, the Parquet tables there with the committed ones, each column by the rule declared
+with it for the kind of number it holds (:mod:`sim.mc.tolerance`; docs/reproducibility.md):
+
+* ``exact`` (labels, counts, flags, and every ``verdict``, ``outcome`` and ``holds`` column,
+  in any table): any change fails;
+* ``arithmetic``: within the bound from its conditioning, ``cond * eps`` relative plus ``atol``
+  (the default for a number that declares nothing: 1e-7 relative plus 1e-9);
+* ``mc``: beyond that, a fraction of its Monte-Carlo standard error (from its row's interval);
+* ``chain``: within its Monte-Carlo interval;
+* ``axial``/``circular``: modulo the period; a null (an undefined value, with its reason)
+  matches a null only;
+* other text columns: listed when they differ (notes format numbers), never a failure;
+* the set of files, their columns and row counts must be the same.
+
+``--trials N`` (with ``--set KEY=VALUE`` for other trial counts) re-runs with fewer trials and
+compares at the Monte-Carlo level: ``mc`` and ``chain`` columns within ``MC_K`` combined
+standard errors of the two runs, columns declared ``analytic`` by their rule, the rest not at
+all, and no verdict (a smaller run may be inconclusive where the full one decides).
+``tests/test_verify.py`` runs it under another numerical path (``OPENBLAS_CORETYPE``,
+``SIM_NO_JIT=1``, another worker count): the environment passes to the re-runs.
+
+A full comparison of every study is written to ``<results>/reproducibility.parquet`` (one row
+per study, with the machine and package versions in the provenance) for the report's
+*Reproducibility* section. A bad option, an unknown study or an empty results directory is one
+line and exit 2; a failed comparison exit 1. ``--scratch`` replaces only what the suite wrote
+there (a directory with its ``run.json``); anything else is refused, never deleted.
+"""
+
+from sim.report.verify.cli import main
+from sim.report.verify.rerun import markdown, rerun_study, study_dirs, verify, write_record
+from sim.report.verify.rules import (
+    DEFAULT_ATOL,
+    DEFAULT_RTOL,
+    Comparison,
+    VerifyError,
+    compare_dirs,
+    compare_tables,
+)
+
+__all__ = [
+    "compare_dirs",
+    "compare_tables",
+    "verify",
+    "main",
+    "markdown",
+    "rerun_study",
+    "study_dirs",
+    "write_record",
+    "DEFAULT_RTOL",
+    "DEFAULT_ATOL",
+    "Comparison",
+    "VerifyError",
+]

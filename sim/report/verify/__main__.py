@@ -1,0 +1,7 @@
+"""``python -m sim.report.verify``."""
+
+import sys
+
+from sim.report.verify.cli import main
+
+sys.exit(main())

@@ -1,0 +1,112 @@
+"""The command line of ``make verify``: ``python -m sim.report.verify``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+from sim.report.verify.rerun import verify, write_record
+from sim.report.verify.rules import Comparison, VerifyError
+
+__all__ = ["main"]
+
+DESCRIPTION = (
+    "Reproducibility verified, not promised: re-run the studies and compare with committed results."
+)
+
+
+# --- command line -----------------------------------------------------------------------------
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, exit 2 (main prints it)
+        raise VerifyError(message)
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="python -m sim.report.verify", description=DESCRIPTION)
+    p.add_argument("--results", default="results", help="the committed results (default: results)")
+    p.add_argument(
+        "--scratch", help="where to re-run (default: a temporary directory, removed after)"
+    )
+    p.add_argument("--workers", type=int, default=1, help="workers of each re-run")
+    p.add_argument("--study", action="append", help="only this study (repeatable)")
+    p.add_argument(
+        "--no-rerun",
+        action="store_true",
+        help="compare with the re-runs already in --scratch (e.g. made on another machine)",
+    )
+    p.add_argument(
+        "--trials",
+        type=int,
+        help="re-run with this many trials and compare at the Monte-Carlo level",
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a config override of the re-runs (repeatable; with --trials)",
+    )
+    p.add_argument(
+        "--no-record", action="store_true", help="do not write <results>/reproducibility.parquet"
+    )
+    return p
+
+
+def _check_args(a) -> None:
+    if a.workers < 1:
+        raise VerifyError(f"--workers: must be at least 1, not {a.workers}")
+    if a.trials is not None and a.trials < 2:
+        raise VerifyError(f"--trials: must be at least 2, not {a.trials}")
+    if a.set and a.trials is None:
+        raise VerifyError("--set: only with --trials (a re-run with other inputs is not a check)")
+    if a.no_rerun and not a.scratch:
+        raise VerifyError("--no-rerun: needs --scratch (the directory of the re-runs)")
+    for s in a.set:
+        if "=" not in s:
+            raise VerifyError(f"--set: {s!r} is not KEY=VALUE")
+
+
+def _print(comps: list[Comparison]) -> None:
+    for c in comps:
+        status = "ok" if c.ok else "FAILED"
+        print(
+            f"{c.study}: {status}; {c.files} files; largest relative deviation "
+            f"{c.max_rel:.2g}; largest deviation/tolerance {c.max_ratio:.2g} ({c.worst})"
+        )
+        for f in c.failures[:20]:
+            print(f"  {f}")
+        if c.not_compared:
+            print(f"  not compared (rows depend on the trials): {', '.join(c.not_compared)}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        a = _parser().parse_args(argv)
+        _check_args(a)
+        extra = [] if a.trials is None else ["--trials", str(a.trials)]
+        extra += [x for s in a.set for x in ("--set", s)]
+        mode = "full" if a.trials is None else "mc"
+        with tempfile.TemporaryDirectory(prefix="sim-verify-") as tmp:
+            comps = verify(
+                Path(a.results),
+                Path(a.scratch or tmp),
+                workers=a.workers,
+                only=a.study,
+                rerun=not a.no_rerun,
+                extra=extra,
+                mode=mode,
+            )
+    except VerifyError as e:
+        print(f"sim verify: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("sim verify: interrupted", file=sys.stderr)
+        return 130
+    _print(comps)
+    if not a.no_record and mode == "full" and not a.study:
+        write_record(Path(a.results), comps)
+    return 0 if all(c.ok for c in comps) else 1

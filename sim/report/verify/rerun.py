@@ -1,0 +1,250 @@
+"""Re-running the studies of a results directory into a scratch directory (only what the suite
+wrote there is ever replaced), the reproducibility record and the report's section."""
+
+from __future__ import annotations
+
+import os
+import platform
+import subprocess
+import sys
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from sim.mc.storage import read_provenance, read_record, versions, write_table
+from sim.report.tables import fmt, md_table
+from sim.report.verify.rules import DEFAULT_RTOL, Comparison, VerifyError, compare_dirs
+
+__all__ = ["study_dirs", "rerun_study", "verify", "write_record", "markdown"]
+
+
+# --- re-running -------------------------------------------------------------------------------
+
+
+def _machine() -> dict:
+    return {
+        "machine": platform.machine(),
+        "system": platform.system(),
+        "processor": platform.processor() or platform.machine(),
+        "cpus": os.cpu_count(),
+        **(
+            {"openblas_coretype": os.environ["OPENBLAS_CORETYPE"]}
+            if "OPENBLAS_CORETYPE" in os.environ
+            else {}
+        ),
+        **({"sim_no_jit": os.environ["SIM_NO_JIT"]} if os.environ.get("SIM_NO_JIT") else {}),
+        **versions(),
+    }
+
+
+def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path, str]]:
+    """(directory, study) of every study with committed results, or of those named in
+    ``only`` (a study or its directory name); VerifyError for none or an unknown name."""
+    results = Path(results)
+    if not results.is_dir():
+        raise VerifyError(f"--results: {results} is not a directory")
+    found = []
+    for d in sorted(p for p in results.iterdir() if (p / "claims.parquet").is_file()):
+        try:
+            study = read_provenance(d / "claims.parquet").get("study") or d.name
+        except (OSError, pa.ArrowException, ValueError):
+            study = d.name  # a damaged file: the comparison names it
+        found.append((d, str(study)))
+    if not found:
+        raise VerifyError(f"--results: no study results in {results} (no */claims.parquet)")
+    if only:
+        names = {n for d, s in found for n in (s, d.name)}
+        unknown = [s for s in only if s not in names]
+        if unknown:
+            raise VerifyError(
+                f"--study: no results of {', '.join(map(repr, unknown))} in {results} "
+                f"(there are: {', '.join(sorted(d.name for d, _ in found))})"
+            )
+        found = [(d, s) for d, s in found if s in only or d.name in only]
+    return found
+
+
+def _target(scratch: Path, name: str) -> tuple[Path, bool]:
+    """Where to re-run, and whether it holds an earlier re-run to replace (``--overwrite``).
+    Anything else already there is refused: verify deletes nothing it did not write."""
+    target = scratch / name
+    if not target.exists() and not target.is_symlink():
+        return target, False
+    record = read_record(target) if target.is_dir() and not target.is_symlink() else None
+    if record is not None:
+        listed = {f.split("/")[0] for f in record.get("files", [])}  # what its run wrote
+        foreign = [p.name for p in target.iterdir() if not _ours(p) and p.name not in listed]
+        if foreign:
+            raise VerifyError(
+                f"--scratch: {target} holds {foreign[0]!r}, which the suite did not write: "
+                "refusing to replace it"
+            )
+        return target, True
+    raise VerifyError(
+        f"--scratch: {target} exists and is not a results directory of the suite "
+        "(no run.json): refusing to replace it"
+    )
+
+
+def _ours(p: Path) -> bool:
+    """A file or directory a study run writes into its results directory."""
+    if p.is_symlink():
+        return False
+    if p.is_dir():
+        return p.name in ("trials", "cells")
+    return p.name == "run.json" or p.suffix in (".parquet", ".png", ".xml")
+
+
+def rerun_study(
+    d: Path, study: str, target: Path, overwrite: bool, workers: int, extra: list[str]
+) -> str | None:
+    """Run the study of committed results ``d`` into ``target``; the failure, or None."""
+    studies_dir = Path("studies")
+    # a study kind with several example files (network_*) is named by its directory
+    sf = studies_dir / f"{d.name}.toml"
+    sf = sf if sf.is_file() else studies_dir / f"{study}.toml"
+    if not sf.is_file():
+        return f"no study file {studies_dir / (d.name + '.toml')} to re-run"
+    cmd = [sys.executable, "-m", "sim", "run", str(sf), "--out", str(target), "--quiet"]
+    cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else []), *extra]
+    print(f"sim verify: re-running {d.name}", file=sys.stderr, flush=True)
+    r = subprocess.run(cmd, stderr=subprocess.PIPE, text=True, errors="replace")
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    if r.returncode == 2 and extra and lines:  # the re-run refused the options verify passed
+        raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
+    sys.stderr.write(r.stderr)
+    return None if r.returncode == 0 else f"the re-run exited with {r.returncode}"
+
+
+def verify(
+    results: Path,
+    scratch: Path,
+    workers: int = 1,
+    only: list[str] | None = None,
+    rerun: bool = True,
+    extra: list[str] | None = None,
+    mode: str = "full",
+) -> list[Comparison]:
+    """Re-run each study with committed results into ``scratch`` and compare (``rerun=False``:
+    compare with what ``scratch`` holds). ``extra``: further ``sim run`` arguments (``--trials
+    N``, ``--set K=V``); ``mode``: ``full``, or ``mc`` for a re-run with fewer trials."""
+    scratch = Path(scratch)
+    if scratch.exists() and not scratch.is_dir():
+        raise VerifyError(f"--scratch: {scratch} is not a directory")
+    todo = study_dirs(results, only)
+    if scratch.resolve() == Path(results).resolve() or Path(results).resolve() in (
+        scratch.resolve().parents
+    ):
+        raise VerifyError(f"--scratch: {scratch} is (inside) the committed results {results}")
+    # every target checked before anything runs: a foreign directory stops it at once
+    replace = {d: _target(scratch, d.name)[1] for d, _ in todo} if rerun else {}
+    missing = [d.name for d, _ in todo if not rerun and not (scratch / d.name).is_dir()]
+    if missing:  # nothing to compare: a request error, not a failed comparison to record
+        raise VerifyError(
+            f"--no-rerun: no re-run of {', '.join(missing)} in {scratch} "
+            "(run without --no-rerun, or choose the --scratch that holds them)"
+        )
+    out = []
+    for d, study in todo:
+        target = scratch / d.name
+        if rerun:
+            overwrite = replace[d]
+            why = rerun_study(d, study, target, overwrite, workers, extra or [])
+            if why:
+                c = Comparison(d.name)
+                c.failures.append(why)
+                out.append(c)
+                continue
+        out.append(compare_dirs(d, target, d.name, mode))
+    return out
+
+
+# --- the record and the report ----------------------------------------------------------------
+
+
+def write_record(results: Path, comps: list[Comparison]) -> Path:
+    cols = {
+        "study": [c.study for c in comps],
+        "files": [c.files for c in comps],
+        "max_rel_dev": [c.max_rel for c in comps],
+        "max_dev_over_tol": [c.max_ratio for c in comps],
+        "worst": [c.worst for c in comps],
+        "failures": [len(c.failures) for c in comps],
+        "first_failure": [c.failures[0] if c.failures else "" for c in comps],
+        "text_columns_changed": [", ".join(c.text_changes) for c in comps],
+        "ok": [c.ok for c in comps],
+    }
+    return write_table(
+        Path(results) / "reproducibility.parquet", cols, {"study": "verify", "machine": _machine()}
+    )
+
+
+def markdown(results: Path) -> str:
+    """The report's *Reproducibility* section from ``reproducibility.parquet`` (empty if none)."""
+    p = Path(results) / "reproducibility.parquet"
+    if not p.is_file():
+        return ""
+    t = pq.read_table(p).to_pylist()
+    m = read_provenance(p).get("machine", {})
+    ver = ", ".join(
+        f"{k} {v}" for k, v in m.items() if k not in ("machine", "system", "processor", "cpus")
+    )
+    made = _committed_on(Path(results))
+    rows = [
+        [
+            r["study"],
+            r["files"],
+            fmt(r["max_rel_dev"], 2),
+            fmt(r["max_dev_over_tol"], 2),
+            f"`{r['worst']}`" if r["worst"] else "",
+            "yes" if r["ok"] else f"**no**: {r['first_failure']}",
+            r["text_columns_changed"],
+        ]
+        for r in t
+    ]
+    return (
+        "## Reproducibility\n\n"
+        f"`make verify` re-ran every study into a scratch directory on {m.get('system', '?')} "
+        f"{m.get('machine', '?')} ({m.get('cpus', '?')} CPUs; {ver}) and compared each "
+        "Parquet column with the committed one by the rule declared for the kind of number it "
+        "holds (docs/reproducibility.md): exact for labels, counts and decisions; within the "
+        f"bound of its conditioning for arithmetic (by default {DEFAULT_RTOL:g} relative); "
+        "within a fraction of its Monte-Carlo standard error for a Monte-Carlo statistic and "
+        "its Monte-Carlo interval for a chain's output; modulo the period for an angle. A "
+        f"changed verdict fails. {made}\n\n"
+        + md_table(
+            [
+                "study",
+                "files",
+                "largest relative deviation",
+                "largest deviation / tolerance",
+                "where",
+                "within tolerance",
+                "text columns that differ",
+            ],
+            rows,
+        )
+        + "\n"
+    )
+
+
+def _committed_on(results: Path) -> str:
+    """Which machine, numerical path and versions produced the committed results (from the
+    provenance of the studies' claims tables), as a sentence."""
+    seen = set()
+    for p in sorted(results.glob("*/claims.parquet")):
+        try:
+            prov = read_provenance(p)
+        except (OSError, pa.ArrowException, ValueError):
+            continue
+        n, v = prov.get("numerics") or {}, prov.get("versions") or {}
+        where = (
+            " ".join(str(n[k]) for k in ("system", "machine") if k in n) or "an unrecorded machine"
+        )
+        path = ", ".join(f"{k}={n[k]}" for k in ("OPENBLAS_CORETYPE", "SIM_NO_JIT") if k in n)
+        ver = ", ".join(f"{k} {x}" for k, x in sorted(v.items()))
+        seen.add(f"{where}{f' ({path})' if path else ''} with {ver}" if ver else where)
+    if not seen:
+        return ""
+    return "The committed results were made on " + "; and on ".join(sorted(seen)) + "."

@@ -1,0 +1,188 @@
+"""GNU Gama's ``gama-local`` vocabulary (2.x: its schema ``gama-local.xsd`` and its parser):
+the elements, their attributes and the values an attribute may take, the elements refused
+(3-D and 1-D data), and the checked reading of a file and of its numbers -- every message
+one :class:`~sim.mc.config.ConfigError` line naming the file, the element and the attribute.
+Only a regular file of at most :data:`MAX_BYTES` is read (a FIFO or a device is refused
+before it is opened). The parser: :mod:`sim.studies.network.gama_read`."""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import stat
+from pathlib import Path
+
+from sim.mc.config import ConfigError
+
+__all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes"]
+
+NS = "http://www.gnu.org/software/gama/gama-local"
+CC = math.pi / 200 / 10000  # one centesimal second in rad
+#: largest gama-local file read (bytes)
+MAX_BYTES = 16 * 1024**2
+_NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+_DMS = re.compile(r"^[+-]?\d+-\d+-\d+(\.\d*)?([eE][+-]?\d+)?$")
+_XYZ = ("xy", "XY", "z", "Z", "xyz", "XYZ", "XYz", "xyZ")
+#: gama-local's vocabulary: element -> its attributes
+VOCAB = {
+    "gama-local": {"version"},
+    "network": {"axes-xy", "angles", "epoch"},
+    "description": set(),
+    "parameters": {
+        "sigma-apr",
+        "conf-pr",
+        "tol-abs",
+        "sigma-act",
+        "update-constrained-coordinates",
+        "algorithm",
+        "language",
+        "encoding",
+        "angles",
+        "latitude",
+        "ellipsoid",
+        "cov-band",
+    },
+    "points-observations": {
+        "distance-stdev",
+        "direction-stdev",
+        "angle-stdev",
+        "zenith-angle-stdev",
+        "azimuth-stdev",
+    },
+    "point": {"id", "x", "y", "z", "fix", "adj"},
+    "obs": {"from", "orientation", "from_dh"},
+    "direction": {"to", "val", "stdev", "from_dh", "to_dh", "extern"},
+    "distance": {"from", "to", "val", "stdev", "from_dh", "to_dh", "extern"},
+    "angle": {
+        "from",
+        "bs",
+        "fs",
+        "to",
+        "rs",
+        "val",
+        "stdev",
+        "from_dh",
+        "bs_dh",
+        "fs_dh",
+        "extern",
+    },
+    "cov-mat": {"dim", "band"},
+    "coordinates": {"extern"},
+    "vectors": set(),
+    "vec": {"from", "to", "dx", "dy", "dz", "from_dh", "to_dh", "extern"},
+}
+_CHOICES = {
+    ("network", "axes-xy"): ("ne", "sw", "es", "wn", "en", "nw", "se", "ws"),
+    ("network", "angles"): ("left-handed", "right-handed"),
+    ("parameters", "sigma-act"): ("aposteriori", "apriori"),
+    ("parameters", "update-constrained-coordinates"): ("yes", "no"),
+    ("parameters", "algorithm"): ("gso", "svd", "cholesky", "envelope"),
+    ("parameters", "language"): tuple("en ca cz du es fi fr hu ru ua zh".split()),
+    ("parameters", "encoding"): ("utf-8", "iso-8859-2", "iso-8859-2-flat", "cp-1250", "cp-1251"),
+    ("parameters", "angles"): ("400", "360"),
+    ("point", "fix"): _XYZ,
+    ("point", "adj"): _XYZ,
+}
+_REFUSED = {
+    "s-distance": "slope distances are 3-D",
+    "z-angle": "zenith angles are 3-D",
+    "azimuth": "azimuths are not supported",
+    "height-differences": "height differences are 1-D (heights)",
+    "dh": "height differences are 1-D (heights)",
+}
+
+
+def _tag(e) -> str:
+    return e.tag.split("}", 1)[-1] if isinstance(e.tag, str) else ""
+
+
+class _File:
+    """Error helper: every message names the file, the element and the attribute."""
+
+    def __init__(self, key: str, path: Path):
+        self.key, self.path = key, path
+
+    def err(self, e, what: str, attr: str | None = None) -> ConfigError:
+        where = f"<{_tag(e)}>" if attr is None else f"<{_tag(e)}> attribute {attr!r}"
+        pid = e.get("id") or e.get("to")
+        at = f" ({'id' if e.get('id') else 'to'}={pid!r})" if pid and attr != "id" else ""
+        return ConfigError(self.key, f"{self.path}: {where}{at}: {what}")
+
+    def num(self, e, attr: str, default: float | None = None, lo: float | None = None) -> float:
+        v = e.get(attr)
+        if v is None:
+            if default is None:
+                raise self.err(e, "missing", attr)
+            return default
+        if not _NUM.match(v.strip()):
+            raise self.err(e, f"{v!r} is not a number", attr)
+        x = float(v)
+        if not math.isfinite(x):
+            raise self.err(e, f"{v!r} is out of range", attr)
+        if lo is not None and x <= lo:
+            raise self.err(e, f"{v!r} must be > {lo:g}", attr)
+        return x
+
+    def name(self, e, attr: str, default: str | None = None) -> str:
+        v = e.get(attr, default)
+        if v is None or not v.strip():
+            raise self.err(e, "missing point name", attr)
+        return v.strip()
+
+    def angle(self, e, attr: str = "val") -> bool:
+        """Check an angular value; True when it is d-m-s (degrees), False for gon."""
+        v = (e.get(attr) or "").strip()
+        if not v:
+            raise self.err(e, "missing", attr)
+        if _DMS.match(v):
+            d, m, s = v.lstrip("+-").split("-")
+            if int(m) >= 60 or float(s) >= 60:
+                raise self.err(e, f"{v!r}: minutes and seconds must be below 60", attr)
+            return True
+        self.num(e, attr)
+        return False
+
+    def vocab(self, root) -> None:
+        for e in root.iter():
+            t = _tag(e)
+            if t in _REFUSED:
+                raise self.err(e, f"not supported: {_REFUSED[t]} (2-D networks only)")
+            if t not in VOCAB:
+                raise self.err(e, "unknown element (not in gama-local's vocabulary)")
+            if t not in ("description", "cov-mat") and (e.text or "").strip():
+                raise self.err(e, f"unexpected text {e.text.strip()[:20]!r}")
+            if (e.tail or "").strip() and e is not root:
+                raise self.err(e, f"unexpected text {e.tail.strip()[:20]!r} after it")
+            for a, v in e.attrib.items():
+                if a.startswith("{") or a == "xmlns":
+                    continue
+                if a not in VOCAB[t]:
+                    raise self.err(e, "unknown attribute", a)
+                ch = _CHOICES.get((t, a))
+                if ch and v.strip() not in ch:
+                    raise self.err(e, f"{v!r} is not one of {', '.join(ch)}", a)
+
+
+def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
+    """The bytes of ``path``: a regular file of at most :data:`MAX_BYTES` (else one line)."""
+    path = Path(path)
+    try:
+        st = os.stat(path)
+    except OSError as e:
+        raise ConfigError(key, f"cannot read {path}: {e.strerror}") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise ConfigError(key, f"{path} is not a regular file")
+    if st.st_size > MAX_BYTES:
+        raise ConfigError(
+            key, f"{path} has {st.st_size} bytes; the limit is {MAX_BYTES} ({MAX_BYTES >> 20} MiB)"
+        )
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as fh:
+            data = fh.read(MAX_BYTES + 1)
+    except OSError as e:
+        raise ConfigError(key, f"cannot read {path}: {e.strerror}") from None
+    if len(data) > MAX_BYTES:
+        raise ConfigError(key, f"{path} is over the limit of {MAX_BYTES} bytes")
+    return data

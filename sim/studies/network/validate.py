@@ -1,0 +1,208 @@
+"""Validation of a network's declaration, field by field: numbers, names, roles, units and
+sigmas of points and observations (weights that would over- or underflow are refused), name
+patterns, the memory a network of this size needs (by the per-point and per-observation
+estimate, against ``SIM_MAX_MEMORY_GB``), and degenerate observations (a sight to its own
+station, to a point at the same place). Each refusal is a one-line
+:class:`~sim.mc.config.ConfigError` naming the key or the observation by its points;
+:func:`sim.studies.network.definition.build` calls these while it builds the arrays."""
+
+from __future__ import annotations
+
+import fnmatch
+import math
+
+import numpy as np
+
+from sim.mc.config import ConfigError
+from sim.mc.estimate import DEFAULT_MAX_MEMORY_GB, _limit
+
+__all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE"]
+
+#: observation kinds, in the order of their integer codes
+KINDS = ("distance", "direction", "angle", "dx", "dy", "x", "y")
+ARCSEC = math.pi / (180 * 3600)
+ROLES = ("free", "fixed", "observed")
+_ANGULAR = (1, 2)
+#: accepted ranges of the standard deviations: the weights 1 / sigma^2 stay far from
+#: overflow and underflow, and the normal equations within double precision
+SIGMA_RANGE = {"mm": (1e-9, 1e9), "arcsec": (1e-9, 1e6)}
+#: bytes of the sparse adjustment per point and per observation (the pattern, the factor and
+#: its selected inverse, one chunk's Jacobian): the order of magnitude that bounds a network
+#: by the memory limit (``SIM_MAX_MEMORY_GB``, default 8 GiB) instead of by counts
+BYTES_PER_POINT = 4096
+BYTES_PER_OBS = 2048
+
+
+def _memory_limit() -> float:
+    """The memory limit in bytes (``SIM_MAX_MEMORY_GB``, else the default)."""
+    return _limit(None, "SIM_MAX_MEMORY_GB", DEFAULT_MAX_MEMORY_GB, "SIM_MAX_MEMORY_GB") * 2**30
+
+
+def _fits(key: str, points: float, obs: float, what: str) -> None:
+    """Refuse (naming ``key``) a network whose points and observations do not fit the memory
+    limit by the per-point and per-observation estimate."""
+    need = points * BYTES_PER_POINT + obs * BYTES_PER_OBS
+    lim = _memory_limit()
+    if not need <= lim:
+        raise ConfigError(
+            key,
+            f"{what} need about {need / 2**30:.3g} GiB, over the {lim / 2**30:g} GiB memory "
+            "limit (SIM_MAX_MEMORY_GB)",
+        )
+
+
+def _num(key: str, v, lo: float | None = None, lo_open: bool = False, integer: bool = False):
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ConfigError(key, f"must be a finite number (got {v!r})")
+    if integer and not float(v).is_integer():
+        raise ConfigError(key, f"must be an integer (got {v!r})")
+    if lo is not None and (v <= lo if lo_open else v < lo):
+        raise ConfigError(key, f"must be {'>' if lo_open else '>='} {lo:g} (got {v!r})")
+    return int(v) if integer else float(v)
+
+
+def _text(key: str, v) -> str:
+    if not isinstance(v, str) or not v.strip():
+        raise ConfigError(key, f"must be a non-empty name (got {v!r})")
+    return v
+
+
+def _keys(key: str, rec: dict, allowed: set, required: set) -> None:
+    bad = set(rec) - allowed
+    if bad:
+        raise ConfigError(f"{key}.{sorted(bad)[0]}", "unknown field")
+    miss = required - set(rec)
+    if miss:
+        raise ConfigError(f"{key}.{sorted(miss)[0]}", "missing")
+
+
+def _role(key: str, rec: dict) -> tuple[int, float]:
+    role = rec.get("role", "free")
+    if role not in ROLES:
+        raise ConfigError(f"{key}.role", f"must be one of {', '.join(ROLES)} (got {role!r})")
+    sig = 0.0
+    if role == "observed":
+        if "sigma_mm" not in rec:
+            raise ConfigError(f"{key}.sigma_mm", "an observed point needs its coordinate sigma")
+        sig = _num(f"{key}.sigma_mm", rec["sigma_mm"], 0.0, lo_open=True)
+        lo, hi = SIGMA_RANGE["mm"]
+        if not lo <= sig <= hi:
+            raise ConfigError(
+                f"{key}.sigma_mm",
+                f"{sig:g} is outside [{lo:g}, {hi:g}] mm: its weight would over- or underflow",
+            )
+    elif "sigma_mm" in rec:
+        raise ConfigError(f"{key}.sigma_mm", f"only an observed point has a sigma (role {role})")
+    return ROLES.index(role), sig
+
+
+def _mm(key: str, rec: dict, field: str, required: bool = True, default=None):
+    """``rec``'s ``field`` in mm, given as ``field_mm`` or as ``field_m`` (metres, for field
+    networks), not both; a pair ``[x, y]`` when the default is one."""
+    a, b = f"{field}_mm", f"{field}_m"
+    if a in rec and b in rec:
+        raise ConfigError(f"{key}.{b}", f"give {a} or {b}, not both")
+    name, f = (b, 1000.0) if b in rec else (a, 1.0)
+    if name not in rec:
+        if required:
+            raise ConfigError(f"{key}.{a}", f"missing (or give {b} in metres)")
+        return default
+    v = rec[name]
+    if isinstance(default, list):
+        if not (isinstance(v, list) and len(v) == 2):
+            raise ConfigError(f"{key}.{name}", "must be [x, y]")
+        return [_num(f"{key}.{name}", c) * f for c in v]
+    return _num(f"{key}.{name}", v) * f
+
+
+def _match(key: str, pats, names: list[str]) -> list[int]:
+    pats = [pats] if isinstance(pats, str) else pats
+    if not isinstance(pats, list) or not pats:
+        raise ConfigError(key, "must be a point name, a pattern or a list of them")
+    out: list[int] = []
+    for p in pats:
+        _text(key, p)
+        hit = [a for a, nm in enumerate(names) if fnmatch.fnmatchcase(nm, p)]
+        if not hit:
+            raise ConfigError(key, f"no point named {p!r}")
+        out += [h for h in hit if h not in out]
+    return out
+
+
+_OBS = {
+    "kind",
+    "from",
+    "to",
+    "at",
+    "sigma_mm",
+    "sigma_arcsec",
+    "settings",
+    "bias_mm",
+    "bias_arcsec",
+    "nearest",
+    "set",
+}
+
+
+def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
+    kind = rec.get("kind")
+    if kind not in KINDS[:5]:
+        raise ConfigError(f"{key}.kind", f"must be one of {', '.join(KINDS[:5])} (got {kind!r})")
+    code = KINDS.index(kind)
+    unit, other = ("arcsec", "mm") if code in _ANGULAR else ("mm", "arcsec")
+    if f"sigma_{other}" in rec or f"bias_{other}" in rec:
+        raise ConfigError(f"{key}.sigma_{other}", f"a {kind} takes sigma_{unit} and bias_{unit}")
+    if f"sigma_{unit}" not in rec:
+        raise ConfigError(f"{key}.sigma_{unit}", "missing")
+    sig = _num(f"{key}.sigma_{unit}", rec[f"sigma_{unit}"], 0.0, lo_open=True)
+    lo, hi = SIGMA_RANGE[unit]
+    if not lo <= sig <= hi:
+        raise ConfigError(
+            f"{key}.sigma_{unit}",
+            f"{sig:g} is outside [{lo:g}, {hi:g}] {unit}: its weight would over- or underflow",
+        )
+    if "set" in rec and code != 1:
+        raise ConfigError(f"{key}.set", f"only a direction has an orientation set (a {kind})")
+    if "set" in rec and not isinstance(rec["set"], str):
+        raise ConfigError(f"{key}.set", f"must be a name (got {rec['set']!r})")
+    settings = _num(f"{key}.settings", rec.get("settings", 1), 1, integer=True)
+    bias = _num(f"{key}.bias_{unit}", rec.get(f"bias_{unit}", 0.0))
+    f = ARCSEC if code in _ANGULAR else 1.0
+    return code, sig * f / math.sqrt(settings), bias * f
+
+
+def _degenerate(names, xy, kind, i, j, k) -> None:
+    """Refuse an observation whose geometry is undefined: a sight from a point to itself or
+    to a point at the same place, an angle whose back- or fore-sight is its station or whose
+    two sights coincide (names the first such observation by its points). Vectorised over
+    the rows (a network of 100,000 rows checks in milliseconds); :func:`_refuse` words it."""
+    span = max(float(np.ptp(xy, axis=0).max()), 1e-300)
+    geo, ang = kind < 5, kind == 2
+    jb, kb = np.where(j >= 0, j, i), np.where(k >= 0, k, i)
+    near_j = np.hypot(*(xy[jb] - xy[i]).T) <= 1e-12 * span
+    near_k = np.hypot(*(xy[kb] - xy[i]).T) <= 1e-12 * span
+    bad = geo & (i == j)
+    bad |= ang & ((k == i) | (j == k))
+    bad |= np.isin(kind, (0, 1, 2)) & near_j
+    bad |= ang & near_k
+    for r in np.flatnonzero(bad)[:1]:
+        _refuse(names, xy, span, int(kind[r]), int(i[r]), int(j[r]), int(k[r]))
+
+
+def _refuse(names, xy, span: float, code: int, a: int, b: int, c: int) -> None:
+    """The one-line refusal of the degenerate observation ``code`` at ``a``, ``b``, ``c``."""
+    what = f"a {KINDS[code]} from {names[a]!r} to {names[b]!r}"
+    if code == 2:
+        what = f"an angle at {names[a]!r} from {names[b]!r} to {names[c]!r}"
+        if c == a or b == a:
+            raise ConfigError("network.observations", f"{what}: a sight to its own station")
+        if b == c:
+            raise ConfigError("network.observations", f"{what}: the two sights are one")
+    if a == b:
+        raise ConfigError("network.observations", f"{what}: a sight to itself")
+    for t in (b, c) if code == 2 else (b,):
+        if code in (0, 1, 2) and np.hypot(*(xy[t] - xy[a])) <= 1e-12 * span:
+            raise ConfigError(
+                "network.points",
+                f"points {names[a]!r} and {names[t]!r} coincide: {what} is undefined",
+            )

@@ -1,0 +1,151 @@
+"""The failure classes of the second sweep of bad inputs over every door (issue 26), one
+parametrised case per class: each is refused with exit 2 and one line naming the key or the
+argument, and nothing is written.
+
+* a ``--set`` value that carries a line break (a second key smuggled in with the first);
+* a value written as an empty table ``{}`` (it vanished when the file was flattened, and the
+  default was used); an empty section stays allowed;
+* ``sim report --results DIR`` on a directory of the user's without study results (it wrote
+  ``REPORT.md`` into it);
+* a datum constraint whose coefficients are all zero (it was dropped, and the rank defect
+  blamed);
+* ``make verify --no-rerun`` with a scratch directory that holds no re-run (it recorded a
+  failed comparison over the committed record), and a ``--set`` of ``make verify`` that the
+  re-run refuses (a failed comparison, exit 1);
+* ``sim show`` on a directory whose ``claims.parquet`` is someone else's table (a KeyError);
+* ``python -m sim.batch``: argparse's two-line usage errors, ``--timings`` naming a directory
+  (a traceback after every run) or a file of the user's (overwritten).
+"""
+
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+from sim.batch import main as batch_main
+from sim.cli import main
+from sim.mc.storage import write_table
+from sim.report.verify import main as verify_main
+
+ROOT = Path(__file__).resolve().parent.parent
+BROWN = ROOT / "studies" / "brown_table1.toml"
+
+NETWORK = """study = "network"
+trials = 40
+chunk = 2
+[network]
+name = "n"
+points = [
+  { name = "A", x_mm = 0.0, y_mm = 0.0 },
+  { name = "B", x_mm = 1000.0, y_mm = 0.0 },
+  { name = "C", x_mm = 400.0, y_mm = 700.0 },
+]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 },
+             { kind = "direction", from = "*", to = "*", sigma_arcsec = 1.0 } ]
+[datum]
+kind = "constraints"
+constraints = [ { "A.x" = COEF }, { "A.y" = 1.0 }, { "B.y" = 1.0 } ]
+"""
+
+
+def _one_line(capsys, code: int, *names: str) -> str:
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and err.startswith("sim: error: "), err
+    assert "Traceback" not in err and all(n in err for n in names), err
+    return err
+
+
+@pytest.mark.parametrize(
+    "value, key",
+    [("40\nchunk=2", "trials"), ("40\rseed=3", "trials"), ("[3,\n5]", "dilution.grids")],
+)
+def test_a_set_value_is_one_line(capsys, value, key):
+    _one_line(capsys, main(["check", str(BROWN), "--set", f"{key}={value}"]), key, "one line")
+
+
+@pytest.mark.parametrize(
+    "text, key", [("[plate]\ngrid = {}\n", "plate.grid"), ("trials = {}\n", "trials")]
+)
+def test_an_empty_table_is_not_a_value(tmp_path, capsys, text, key):
+    f = tmp_path / "s.toml"
+    f.write_text('study = "brown_table1"\n' + text)
+    _one_line(capsys, main(["check", str(f)]), key, "{}")
+    f.write_text('study = "brown_table1"\n[plate]\n[errors]\nsettings = 2\n')  # empty section
+    assert main(["check", str(f)]) == 0
+    capsys.readouterr()
+    _one_line(capsys, main(["check", str(BROWN), "--set", "plate={}"]), "plate", "unknown key")
+
+
+def test_report_refuses_a_directory_without_study_results(tmp_path, capsys):
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("mine\n")
+    _one_line(capsys, main(["report", "--results", str(tmp_path / "mine")]), "no study results")
+    assert [p.name for p in (tmp_path / "mine").iterdir()] == ["notes.txt"]
+
+
+@pytest.mark.parametrize("coef", ["0.0", "0"])
+def test_an_all_zero_datum_constraint_is_named(tmp_path, capsys, coef):
+    f = tmp_path / "n.toml"
+    f.write_text(NETWORK.replace("COEF", coef))
+    _one_line(capsys, main(["check", str(f)]), "datum.constraints[0]", "zero")
+    f.write_text(NETWORK.replace("COEF", "1.0"))
+    assert main(["check", str(f)]) == 0
+
+
+def _results(tmp_path: Path, name: str = "brown_table1") -> Path:
+    """A results directory whose one study holds a claims table (nothing else is read)."""
+    d = tmp_path / "res" / name
+    d.mkdir(parents=True)
+    write_table(d / "claims.parquet", {"claim": ["x"], "verdict": ["holds"]}, {"study": name})
+    return d.parent
+
+
+def test_verify_no_rerun_without_the_reruns_records_nothing(tmp_path, capsys):
+    res = _results(tmp_path)
+    (tmp_path / "scratch").mkdir()
+    argv = ["--results", str(res), "--scratch", str(tmp_path / "scratch"), "--no-rerun"]
+    assert verify_main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no re-run of brown_table1" in err
+    assert sorted(p.name for p in res.iterdir()) == ["brown_table1"]  # no record written
+
+
+def test_verify_names_a_rerun_option_the_study_refuses(tmp_path, capsys, monkeypatch):
+    res = _results(tmp_path)
+    monkeypatch.chdir(ROOT)  # the re-run reads studies/<study>.toml
+    argv = ["--results", str(res), "--scratch", str(tmp_path / "s"), "--trials", "40"]
+    assert verify_main([*argv, "--set", "nosuch.key=1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "nosuch.key" in err[-1] and "refused" in err[-1], err
+    assert sorted(p.name for p in res.iterdir()) == ["brown_table1"]
+
+
+def test_show_names_a_claims_table_that_is_not_ours(tmp_path, capsys):
+    d = tmp_path / "r"
+    d.mkdir()
+    pq.write_table(pa.table({"a": [1, 2]}), d / "claims.parquet")
+    _one_line(capsys, main(["show", str(d)]), "not a claims table")
+    (d / "claims.parquet").write_bytes(b"PAR1 truncated")
+    _one_line(capsys, main(["show", str(d)]), "cannot be read")
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        ([], "required: files"),
+        (["--jobs", "x", str(BROWN)], "--jobs"),
+        (["--timings", "DIR", str(BROWN)], "not a regular file"),
+        (["--timings", "MINE", str(BROWN)], "not a timings file"),
+    ],
+)
+def test_batch_refuses_in_one_line_before_running(tmp_path, capsys, argv, words):
+    (tmp_path / "mine.txt").write_text("mine\n")
+    argv = [
+        str(tmp_path) if a == "DIR" else str(tmp_path / "mine.txt") if a == "MINE" else a
+        for a in argv
+    ]
+    assert batch_main([*argv, "--results", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err and err.startswith("sim.batch: "), err
+    assert not (tmp_path / "r").exists() and (tmp_path / "mine.txt").read_text() == "mine\n"
