@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from verdict_check import check_region_rows
 
 from sim.instruments.block import data_snooping as ds
 from sim.instruments.block import independent_models as im
@@ -410,8 +411,8 @@ def test_five_control_rows_decided_over_the_region(tiny_run):
     for c in ("ctrl", "check"):
         r = rows[f"agnard.control_5.{c}_xy_cm"]
         assert r["interval"] == "region"
-        assert r["verdict"] in ("holds", "fails", "depends", "undecidable")
         assert r["value"] <= r["value_high"]
+    assert check_region_rows(out) >= 2  # each region verdict is its points' rule
 
 
 def test_table1_rows_are_not_comparable(tiny_run):

@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from verdict_check import check_region_rows
 
 from sim.instruments import encoders as enc
 from sim.mc.config import ConfigError, validate
@@ -195,7 +196,8 @@ def test_study_runs_small(tmp_path):
         assert v["salsig." + q] == "holds", q
     # decided over the region of the unprinted relief, errors and control (never at one
     # nominal relief); 'cut roughly in half' over models this spread cannot hold everywhere
-    assert v["salsig.vertical_halved.rms_ratio"] in ("depends", "fails", "undecidable")
+    assert v["salsig.vertical_halved.rms_ratio"] != "holds"
+    assert check_region_rows(out) >= 3  # each region verdict is its points' rule
     reg = read_table(out / "consistent_region.parquet").to_pydict()
     assert len(reg["relief_mm"]) == 8  # nothing printed constrains them: every vector stays
     for fig in ("residuals", "recovery", "power", "vertical", "consistent_region"):
