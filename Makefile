@@ -29,13 +29,15 @@ venv: $(STAMP) ## create the virtual environment and install the project
 
 # The test files run side by side on TEST_WORKERS processes (pytest-xdist), a file on one process
 # (its module fixtures, such as the shared Dask cluster, start once); TEST_WORKERS=0: one process.
+# The slowest files are handed out first (tests/conftest.py SLOW_FIRST; --no-loadscope-reorder
+# keeps that order). SIM_TEST_CPU_LOG=FILE logs each test's CPU seconds (where the time goes).
 TEST_WORKERS ?= 2
 
 test: $(STAMP) ## lint (ruff), the layer contracts (import-linter), then the test suite on TEST_WORKERS=2 processes
 	$(VENV)/bin/ruff check sim tests benchmarks
 	$(VENV)/bin/ruff format --check sim tests benchmarks
 	$(VENV)/bin/lint-imports
-	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder
 
 fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=300, FUZZ_SEED, FUZZ_SAVE)
 	FUZZ_CASES=$${FUZZ_CASES:-300} $(PY) -m pytest tests/test_fuzz.py -p no:cacheprovider

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from verdict_check import check_region_rows
 
 from sim.claims.region import REGION_VERDICTS
 from sim.instruments.block import data_snooping as ds
@@ -413,6 +414,7 @@ def test_five_control_rows_decided_over_the_region(tiny_run):
         assert r["interval"] == "region"
         assert r["verdict"] in REGION_VERDICTS
         assert r["value"] <= r["value_high"]
+    assert check_region_rows(out) >= 2  # each region verdict is its points' rule
 
 
 def test_table1_rows_are_not_comparable(tiny_run):

@@ -171,3 +171,37 @@ def test_report_prose_comes_from_the_parquet_files(runs, tmp_path):
         pq.write_table(t.set_column(i, "region_low", pa.array(vals, pa.float64())), p)
         after = rep(o)
         assert "47.8" in after and "47.8" not in before
+
+
+def test_rows_known_in_closed_form_decide_as_computed_here(runs):
+    """Claims whose value follows from counting or the paper's own arithmetic, decided by the
+    rule with the numbers computed here; two of them lie within 0.01 um of a zone's edge."""
+    dil = {r["claim"]: r for r in read_table(runs["brown_dilution"] / "claims.parquet").to_pylist()}
+    t1 = {r["claim"]: r for r in read_table(runs["brown_table1"] / "claims.parquet").to_pylist()}
+    # 4n ranges against 2n + 5 unknowns: n >= 3 points; a count equal to both zone edges holds
+    r = dil["brown.structure.min_points_stations"]
+    assert min(n for n in range(1, 9) if 4 * n >= 2 * n + 5) == 3 == r["value"]
+    assert r["zone_low"] == r["zone_high"] == 3 and r["verdict"] == "holds"
+    # a shift of the range biases leaves every point where it was (to rounding): holds
+    for c in (
+        "brown.bias_invariance.max_point_shift_mm",
+        "brown.bias_invariance.alpha_shift_error_mm",
+    ):
+        assert abs(dil[c]["value"]) < 1e-10 and dil[c]["verdict"] == "holds", c
+    # 25 points: 2 * 25 - 7 = 43 degrees of freedom of the pivot model
+    assert t1["brown.table1_closure.dof"]["value"] == 4 * 25 - (2 * 25 + 7) == 43
+    assert t1["brown.table1_closure.dof"]["outcome"] == "holds"
+    for cid, value, verdict in (
+        # sqrt(1.6^2 - 1.2^2) = 1.0583 against 1.1 (zone 1.05-1.15): 0.008 inside the edge
+        ("brown.table1_closure.comparator_um", math.sqrt(1.6**2 - 1.2**2), "holds"),
+        ("brown.table1_setting.pair_mean_um", 1.7 / math.sqrt(2), "holds"),
+        ("brown.table1_external.equal_share_low_um", math.sqrt(2), "holds"),
+        ("brown.table1_external.equal_share_high_um", 3 / math.sqrt(2), "holds"),
+        # sqrt(1.5^2 - 0.8^2) = 1.2689 against 1.3 (zone 1.25-1.35): 0.019 inside the edge
+        ("brown.table1_external.zeiss_comparator_um", math.sqrt(1.5**2 - 0.8**2), "holds"),
+    ):
+        r = t1[cid]
+        assert r["value"] == pytest.approx(value, abs=1e-12) and r["interval"] == "exact", cid
+        ref = round(value, 1)  # the printed number: one decimal
+        assert (r["zone_low"], r["zone_high"]) == pytest.approx((ref - 0.05, ref + 0.05)), cid
+        assert r["verdict"] == verdict and r["kind"] == "paper-check", cid

@@ -171,6 +171,19 @@ def test_a_bound_is_written_with_its_open_side_null(tmp_path):
     assert "≤ 2" in claims_markdown(tmp_path / "claims.parquet")
 
 
+def test_claims_table_declares_how_each_column_is_compared(tmp_path):
+    """make verify compares a claims table by the rule declared with each column (exact for
+    the verdicts, within the interval for the values): write_claims must declare them."""
+    from sim.claims.book import CLAIM_TOLERANCES, write_claims
+    from sim.mc.storage import read_tolerances
+
+    b = book(form="value", ref=1.0, tol=0.1)
+    write_claims(tmp_path / "claims.parquet", [b.score("t.c", 1.0, (0.95, 1.05))], {}, b)
+    tol = read_tolerances(tmp_path / "claims.parquet")
+    assert set(tol) == set(CLAIM_TOLERANCES) and tol["verdict"]["kind"] == "exact"
+    assert tol["value"]["kind"] == "mc"
+
+
 def test_one_plate_claim_given_an_exact_value_is_decided_as_a_value():
     b = book(kind="input", form="one-plate", ref=1.7, decimals=1, tol=0)
     r = b.score("t.c", 1.7, interval="exact")

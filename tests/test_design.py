@@ -1,12 +1,14 @@
 """brown_design: sweeps, adaptive trial counts, error budget, design constraints, coverage,
 claim book, the consistent region of the unprinted inputs."""
 
+import math
 import pickle
 from functools import partial
 from pathlib import Path
 
 import numpy as np
 import pytest
+from verdict_check import check_region_rows
 
 from sim.claims.region import REGION_VERDICTS
 from sim.cli import main
@@ -290,7 +292,20 @@ def test_tiny_run_end_to_end(tmp_path):
     V = dict(zip(cl["claim"], cl["verdict"]))
     assert all(V[c] == "finding" for c in V if c.startswith("brown.datum."))
     assert all(V[c] == "self-check" for c in V if c.startswith("bayes.brown_agreement."))
-    assert V["brown.calibration.scale_combined_um"] == "holds"  # a paper-check
+    R = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
+    # the paper's sqrt(0.5^2 + 0.2^2) = 0.5385 against its printed 0.54 (zone 0.535-0.545):
+    # 0.0035 inside the edge that half a unit of the last printed digit sets: holds
+    r = R["brown.calibration.scale_combined_um"]
+    assert r["value"] == pytest.approx(math.sqrt(0.29), abs=1e-15) and r["interval"] == "exact"
+    assert (r["zone_low"], r["zone_high"]) == pytest.approx((0.535, 0.545))
+    assert r["verdict"] == "holds" and r["holds"] is True
+    # atan(1 um / 100 um) = 0.5730 deg (the study file's accuracy and larger gap) against 0.6
+    r = R["brown.calibration.axis_tilt_deg"]
+    assert r["value"] == pytest.approx(math.degrees(math.atan(0.01)), abs=1e-12)
+    assert r["verdict"] == "holds"
+    # 4 positions x 2 settings = 8 = the printed count: a count on its zone's edges holds
+    r = R["brown.operation.measurements_per_point"]
+    assert r["value"] == 8 and r["zone_low"] == r["zone_high"] == 8 and r["verdict"] == "holds"
     assert not any(v is None for v in cl["verdict"])
     tol = read_tolerances(out / "bayes.parquet")["ratio"]  # chain output: its MC interval
     assert tol["kind"] == "chain" and 0 < tol["rtol"] < 0.5
@@ -312,6 +327,8 @@ def test_tiny_run_end_to_end(tmp_path):
     rows = {c: r for c, r in zip(cl["claim"], read_table(out / "claims.parquet").to_pylist())}
     lin = rows["brown.calibration.linearity_tolerance_um"]
     assert lin["interval"] == "region" and lin["verdict"] in REGION_VERDICTS
+    assert lin["interval"] == "region"
+    assert check_region_rows(out) >= 7  # each region verdict is its points' rule
     # each printed number is one row in one study: the Results arithmetic is brown_table1's
     assert not [c for c in cl["claim"] if c.endswith("_recomputed")]
     for f in ("pareto.png", "corner.png"):

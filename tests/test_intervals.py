@@ -211,6 +211,22 @@ def test_spread_is_the_median_and_the_2_5_97_5_percent_order_statistics():
     assert iv.spread([3, 1, 2]) == (2.0, (1.05, 2.95))  # integers, linear interpolation
 
 
+def test_spread_rows_is_the_spread_of_every_row_with_nan_left_out():
+    x = np.random.default_rng(9).permutation(np.arange(201.0))
+    rows = np.stack([x, 2 * x, np.append(x[:-1], np.nan)])  # the last: 200 values, NaN out
+    med, lo, hi = iv.spread_rows(rows)
+    assert med.shape == lo.shape == hi.shape == (3,)
+    assert (med[:2], lo[:2], hi[:2]) == (
+        pytest.approx([100.0, 200.0]),
+        pytest.approx([5.0, 10.0]),
+        pytest.approx([195.0, 390.0]),
+    )
+    ref = np.percentile(x[:-1], [2.5, 50, 97.5])  # linear interpolation between ranks
+    assert (lo[2], med[2], hi[2]) == pytest.approx(tuple(ref), rel=1e-14)
+    med, lo, hi = iv.spread_rows(rows[:1], 0.90)
+    assert (lo[0], hi[0]) == pytest.approx((10.0, 190.0), rel=1e-14)
+
+
 def test_spread_of_many_plates_matches_the_normal_quantiles():
     n = 40000
     x = np.random.default_rng(9).normal(10.0, 2.0, n)

@@ -160,6 +160,18 @@ def test_monte_carlo_agrees_with_analytic_within_sampling_error(tmp_path):
     claims = pq.read_table(out / "claims.parquet").to_pydict()
     assert set(claims["kind"]) == {"self-check", "finding"} and "fails" not in claims["outcome"]
     assert sum(k == "self-check" for k in claims["kind"]) == 4
+    row = {c: r for c, r in zip(claims["claim"], pq.read_table(out / "claims.parquet").to_pylist())}
+    # counted from the study file: 4 pillars x 12 new points distances, 4 x 15 directions,
+    # 12 x 2 nearest-neighbour distances and one angle; 12 new points (x, y) and one
+    # orientation per pillar's direction set: 133 - 28 = 105 degrees of freedom, on both edges
+    # of the zone (105 +- 1e-6)
+    r = row["network.redundancy.sum"]
+    dof = (4 * 12 + 4 * 15 + 12 * 2 + 1) - (12 * 2 + 4)
+    assert r["value"] == pytest.approx(dof, abs=1e-9) and dof == 105 and r["outcome"] == "holds"
+    # the linear model's 95 % ellipses cover 95 % (the mean over 12 points of shares of 600
+    # trials: at most the binomial standard error of one point)
+    r = row["network.coverage95.mean"]
+    assert abs(r["value"] - 0.95) < 4 * math.sqrt(0.95 * 0.05 / n) and r["ci_low"] < r["ci_high"]
     assert (out / "network.png").stat().st_size > 1000 and (out / "network.xml").is_file()
 
 

@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from verdict_check import check_region_rows
 
 from sim.instruments import encoders as enc
 from sim.mc.config import ConfigError, validate
@@ -201,6 +202,8 @@ def test_study_runs_small(tmp_path):
         "fails or undecided",
         "undecidable",
     )
+    assert v["salsig.vertical_halved.rms_ratio"] != "holds"
+    assert check_region_rows(out) >= 3  # each region verdict is its points' rule
     reg = read_table(out / "consistent_region.parquet").to_pydict()
     assert len(reg["relief_mm"]) == 8  # nothing printed constrains them: every vector stays
     for fig in ("residuals", "recovery", "power", "vertical", "consistent_region"):

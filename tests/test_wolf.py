@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from verdict_check import check_region_rows, read_csv
 
 from sim.claims.region import REGION_VERDICTS
 from sim.instruments import transforms2d as tf
@@ -417,6 +418,32 @@ def test_study_runs_and_reports(tmp_path):
     for cid in ("wolf.headline.mean_vs_mono_um", "wolf.table2.joint_holm"):
         assert claims["interval"][by[cid]] == "region"
         assert claims["verdict"][by[cid]] in REGION_VERDICTS
+    assert check_region_rows(tmp_path) >= 2  # each region verdict is its points' rule
+    # Table 2 recomputed here from the transcribed coordinates with the csv module alone
+    rows = read_csv(ROOT / "studies" / "data" / "wolf_table1.csv")
+
+    def disc(plate, ax, st):
+        return np.array(
+            [
+                abs(round(1000 * (float(r[f"{ax}_set{st}_mm"]) - float(r[f"{ax}_foster_mm"]))))
+                for r in rows
+                if r["plate"] == plate
+            ]
+        )
+
+    # plate 003, Set 2, Y: rms 5.848 um against the printed 5.8 (zone 5.75-5.85): 0.002 um
+    # inside the zone's edge, so a half-unit of the last printed digit decides: holds
+    i = by["wolf.table2_check.p003.set2.rms_y_um"]
+    rms = math.sqrt(np.mean(disc("003", "y", 2) ** 2.0))
+    assert abs(claims["value"][i] - rms) < 1e-12 and 5.845 < rms < 5.85
+    assert claims["zone_high"][i] == pytest.approx(5.85) and claims["verdict"][i] == "holds"
+    # the overall mean of the eight recomputed means is 5.875 um against the printed 5.8:
+    # 0.025 um past the zone's edge, an erratum (a wider zone, or 'meets' read as 'inside',
+    # would call it holds or inconclusive)
+    means = [np.mean(disc(p, a, s)) for p in ("003", "005") for a in "xy" for s in (1, 2)]
+    i = by["wolf.table2_check.overall_mean_um"]
+    assert abs(claims["value"][i] - np.mean(means)) < 1e-12 and np.mean(means) == 5.875
+    assert claims["verdict"][i] == "erratum" and claims["holds"][i] is False
     d = read_table(tmp_path / "degree.parquet").to_pydict()
     k = [j for j, (s, g) in enumerate(zip(d["spacing_mm"], d["degree"])) if s == 50.0 and g == 3]
     assert all(d["estimable_share"][j] == 0 for j in k)  # 2 rows cannot carry a cubic
