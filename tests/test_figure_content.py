@@ -72,7 +72,7 @@ def test_brown_table1_histogram_shows_every_simulated_plate(tmp_path, figures):
     _panels_are_readable(figures)
     s0 = pq.read_table(out / "table1_trials.parquet").column("sigma0_um").to_numpy()
     hist = figures["table1.png"][0]
-    assert "sigma0" in hist["xlabel"] and "(um)" in hist["xlabel"]
+    assert "σ0" in hist["xlabel"] and "(µm)" in hist["xlabel"]
     assert hist["ylabel"] == "simulated plates"
     # the bars count the 40 simulated plates and span their sigma0 values
     assert sum(hist["heights"]) == pytest.approx(s0.size)
@@ -80,7 +80,8 @@ def test_brown_table1_histogram_shows_every_simulated_plate(tmp_path, figures):
     assert x0 <= s0.min() and s0.max() <= x0 + w
     field = figures["table1.png"][2]
     assert (field["xlabel"], field["ylabel"]) == ("x (mm)", "y (mm)")
-    assert "(um)" in field["title"]
+    assert "σ" in field["title"]
+    assert any(p["ylabel"] == "σ (µm)" for p in figures["table1.png"][3:])  # the colour bar
 
 
 def test_network_reliability_has_one_bar_per_observation(tmp_path, figures):

@@ -13,7 +13,8 @@ from sim.mc.storage import read_table
 def region_verdict(outcomes) -> str:
     """The rule of docs/verdict-rules.md 'Over a region', written out here independently of
     sim.claims.region: holds / fails at every point, undecidable when no point decides it,
-    depends otherwise. ``None`` or "" marks a row of another part of the region table."""
+    depends where it holds at some points and fails at others, 'holds or undecided' ('fails
+    or undecided') where it holds (fails) at some points and is undecided at the rest. ``None`` or "" marks a row of another part of the region table."""
     s = {o for o in outcomes if o}
     assert s <= {"holds", "fails", "undecided"}, s
     if not s:  # an empty region decides nothing
@@ -24,7 +25,9 @@ def region_verdict(outcomes) -> str:
         return "fails"
     if s == {"undecided"}:
         return "undecidable"
-    return "depends"
+    if {"holds", "fails"} <= s:
+        return "depends"
+    return "holds or undecided" if "holds" in s else "fails or undecided"
 
 
 def check_region_rows(out: Path) -> int:
