@@ -26,15 +26,9 @@ from __future__ import annotations
 
 import io
 import json
-import logging
-import multiprocessing
-import os
 import pickle
-import signal
 import sys
-import threading
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from contextlib import contextmanager, suppress
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Mapping
@@ -45,8 +39,10 @@ import pyarrow.parquet as pq
 
 from sim.lsq import distributions as D
 from sim.mc.config import StudyError
+from sim.mc.executors import InProcess, make_executor
 from sim.mc.progress import Progress
 from sim.mc.storage import atomic_path, config_hash
+from sim.mc.streams import chunk_rng
 
 __all__ = [
     "chunk_rng",
@@ -67,11 +63,6 @@ _ARRAYS = b"sim.arrays"
 _IDENTITY = b"sim.chunk"  # a chunk file's identity, checked when it is read back
 
 
-def chunk_rng(seed: int, part: int, k: int) -> np.random.Generator:
-    """The generator of chunk ``k`` of stream ``part``."""
-    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(part, k)))
-
-
 def require_finite(name: str, array, part: str, key: str | None = None) -> np.ndarray:
     """``array`` as a float array, or :class:`sim.mc.config.StudyError` (one line naming the study
     ``part``, the quantity ``name`` and, when given, the config ``key`` to change) if any entry
@@ -86,11 +77,6 @@ def require_finite(name: str, array, part: str, key: str | None = None) -> np.nd
             f"NaN or infinite){hint}"
         )
     return a
-
-
-def _call_chunk(fn, seed: int, part: int, k: int, n: int) -> dict:
-    out = fn(chunk_rng(seed, part, k), n)
-    return {key: np.asarray(v) for key, v in out.items()}
 
 
 @dataclass(frozen=True)
@@ -185,155 +171,6 @@ class ChunkStore:
         return sorted(p for p in root.rglob("*") if p not in self.used and p.is_file())
 
 
-class _InProcess:
-    """Runs chunks one after another in this process."""
-
-    def run(self, fn, seed, part, jobs):
-        for k, n in jobs:
-            yield k, n, _call_chunk(fn, seed, part, k, n)
-
-    def close(self, kill: bool = False):
-        pass
-
-
-def _watch_parent(ppid: int) -> None:
-    import time
-
-    while True:
-        if os.getppid() != ppid:
-            os._exit(1)
-        time.sleep(0.5)
-
-
-def _worker_init(ppid: int) -> None:
-    """In each pool worker: ignore SIGINT (the parent handles Ctrl-C and stops the pool) and
-    die with the parent, even after ``kill -9`` (PR_SET_PDEATHSIG on Linux; a thread that
-    watches the parent everywhere)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-
-            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG = 1
-        except (OSError, AttributeError):
-            pass
-    if os.getppid() != ppid:  # the parent died before we got here
-        os._exit(1)
-    threading.Thread(target=_watch_parent, args=(ppid,), daemon=True).start()
-
-
-class _Pool:
-    """A local process pool (``concurrent.futures``); its workers die with the parent."""
-
-    def __init__(self, workers: int):
-        self.pool = ProcessPoolExecutor(
-            max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),)
-        )
-
-    def run(self, fn, seed, part, jobs):
-        futs = {self.pool.submit(_call_chunk, fn, seed, part, k, n): (k, n) for k, n in jobs}
-        for f in as_completed(futs):
-            k, n = futs[f]
-            yield k, n, f.result()
-
-    def close(self, kill: bool = False):
-        """Stop the pool; ``kill``: terminate running workers at once (interrupt, failure)."""
-        if kill:
-            procs = list((getattr(self.pool, "_processes", None) or {}).values())
-            for p in procs:
-                try:
-                    p.kill()
-                except (OSError, AttributeError):
-                    pass
-            for p in procs:
-                p.join(5)
-        self.pool.shutdown(wait=True, cancel_futures=True)
-
-
-class _Dask:
-    """A ``dask.distributed`` client: a given scheduler, or a LocalCluster for the run."""
-
-    def __init__(self, workers: int, scheduler: str | None):
-        try:
-            from dask.distributed import Client, LocalCluster
-            from dask.distributed import as_completed as dask_completed
-        except ImportError:
-            raise RuntimeError(
-                "the dask executor needs dask[distributed]: pip install -e '.[dask]'"
-            ) from None
-        self._completed = dask_completed
-        self.cluster = None
-        if scheduler:
-            self.client = Client(scheduler, timeout="10s")
-        else:
-            try:
-                self.cluster = LocalCluster(
-                    n_workers=max(workers, 1),
-                    threads_per_worker=1,
-                    processes=True,
-                    # ":0": a free port, never the "Port 8787 is already in use" warning (None
-                    # still means the default 8787); the nanny's closing chatter is not for users
-                    dashboard_address=":0",
-                    silence_logs=logging.ERROR,
-                )
-                self.client = Client(self.cluster)
-            except BaseException:  # a signal while the cluster starts: end what has started
-                _end_dask_clusters()
-                raise
-
-    def run(self, fn, seed, part, jobs):
-        futs = {}  # the chunk function is small: send it with each task (no scatter)
-        for k, n in jobs:
-            futs[self.client.submit(_call_chunk, fn, seed, part, k, n, pure=False)] = (k, n)
-        for f in self._completed(list(futs)):
-            k, n = futs[f]
-            yield k, n, f.result()
-
-    def close(self, kill: bool = False):
-        if not kill:
-            self.client.close()
-            if self.cluster is not None:
-                self.cluster.close()
-            return
-        with suppress(Exception):  # interrupted: whatever state the workers are in
-            self.client.close(timeout=5)
-        if self.cluster is not None:
-            _end_dask_clusters()
-
-
-def _end_dask_clusters() -> None:
-    """End this process's dask clusters after an interrupt, quietly and for good: each is
-    closed once (a worker still starting makes dask's close raise), kept from dask's second
-    close at exit (which would print its traceback), and its worker processes are killed."""
-    import psutil  # installed with the dask extra (a dependency of distributed)
-    from distributed.deploy.spec import SpecCluster  # heavy optional dependency (dask extra)
-
-    for name in ("asyncio", "distributed", "tornado"):  # their chatter about the interrupted
-        logging.getLogger(name).setLevel(logging.CRITICAL + 1)  # start-up is not for users
-    for c in list(SpecCluster._instances):
-        c.shutdown_on_close = False
-        with suppress(Exception):
-            c.close(timeout=5)
-    with suppress(Exception):  # nannies and their workers (grandchildren) alike
-        for proc in psutil.Process().children(recursive=True):
-            with suppress(Exception):
-                if "resource_tracker" not in " ".join(proc.cmdline()):  # ends with us
-                    proc.kill()
-    for proc in multiprocessing.active_children():  # reaped, no zombies
-        with suppress(Exception):
-            proc.join(1)
-
-
-def make_executor(kind: str = "local", workers: int = 1, scheduler: str | None = None):
-    """``local`` (in-process when ``workers == 1``, else a process pool) or ``dask``."""
-    if kind == "local":
-        return _InProcess() if workers <= 1 else _Pool(workers)
-    if kind == "dask":
-        return _Dask(workers, scheduler)
-    raise ValueError(f"unknown executor {kind!r} (local or dask)")
-
-
 def _picklable(fn) -> bool:
     try:
         pickle.dumps(fn)
@@ -386,14 +223,14 @@ def run_chunks(
             results[k] = got
         else:
             todo.append((k, n))
-    if executor is None or (not isinstance(executor, _InProcess) and not _picklable(fn)):
-        if executor is not None and not isinstance(executor, _InProcess):
+    if executor is None or (not isinstance(executor, InProcess) and not _picklable(fn)):
+        if executor is not None and not isinstance(executor, InProcess):
             print(
                 f"sim: note: {label or 'this study'} runs in-process (its chunk function "
                 "cannot be sent to workers)",
                 file=sys.stderr,
             )
-        executor = _InProcess()
+        executor = InProcess()
     done_trials = sum(sizes[k] for k in results)
     shared = getattr(ctx, "bar", None)
     with (
