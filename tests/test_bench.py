@@ -4,6 +4,7 @@ study in each variant; the page names every compiled module of the suite; the re
 the study files as ``make rerun`` runs them; a disagreement or bad input stops it with one
 line. No timings are asserted."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +33,52 @@ COMPILED = {
     "sim/instruments/ranges/multilateration_jit.py",
     "sim/instruments/plotter/polynomial_kernel.py",
     "sim/instruments/plotter/errorfield_kernel.py",
+    "sim/lsq/selinv.py",
+    "sim/lsq/sparse_batch.py",
+    "sim/studies/network/kernel.py",
 }
+#: compiled modules that have no engine row yet (issue 22 item 3, open): shrink to empty
+NO_ROW_YET = {
+    "sim/lsq/selinv.py",
+    "sim/lsq/sparse_batch.py",
+    "sim/studies/network/kernel.py",
+}
+
+
+def compiles_through_sim_lsq_compile(text: str) -> bool:
+    """True if the source calls ``compiled`` of :mod:`sim.lsq.compile` under any name: the
+    module imported as ``compile`` or an alias (``from sim.lsq import compile as jit``) and
+    ``<alias>.compiled(`` called, or ``compiled`` imported from it (under any alias) and called."""
+    names = set()
+    for m in re.finditer(r"^from sim\.lsq import (.+)$", text, re.M):
+        for part in m.group(1).strip("()").split(","):
+            w = part.split()
+            if w and w[0] == "compile":
+                names.add(w[-1])
+    if re.search(r"^import sim\.lsq\.compile\b", text, re.M):
+        names.add(r"sim\.lsq\.compile")
+    if any(re.search(rf"\b{n}\.compiled\(", text) for n in names):
+        return True
+    for m in re.finditer(r"^from sim\.lsq\.compile import (.+)$", text, re.M):
+        for part in m.group(1).strip("()").split(","):
+            w = part.split()
+            if w and w[0] == "compiled" and re.search(rf"\b{w[-1]}\(", text):
+                return True
+    return False
+
+
+def test_scan_finds_compiled_modules_under_any_alias():
+    assert compiles_through_sim_lsq_compile(
+        "from sim.lsq import compile as jit\nf = jit.compiled(g)\n"
+    )
+    assert compiles_through_sim_lsq_compile(
+        "from sim.lsq import compile\nf = compile.compiled(g)\n"
+    )
+    assert compiles_through_sim_lsq_compile("from sim.lsq.compile import compiled as c\nf = c(g)\n")
+    assert not compiles_through_sim_lsq_compile(
+        "from sim.lsq import compile as jit\njit.available()\n"
+    )
+    assert not compiles_through_sim_lsq_compile("f = other.compiled(g)\n")
 
 
 def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
@@ -64,12 +110,11 @@ def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
     # every compiled module of the suite has a row, and the page names it with a verdict
     named = {m.split(" ")[0].rstrip(",") for m in eng["compiled_module"] if m}
     named |= {m.split(", ")[1] for m in eng["compiled_module"] if ", " in m}
-    assert {f[:-3].replace("/", ".") for f in COMPILED} == named
+    assert {f[:-3].replace("/", ".") for f in COMPILED - NO_ROW_YET} == named
     on_disk = {
         p.relative_to(ROOT).as_posix()
         for p in (ROOT / "sim").rglob("*.py")
-        if "compile.compiled(" in p.read_text()
-        or "from sim.lsq.compile import compiled" in p.read_text()
+        if compiles_through_sim_lsq_compile(p.read_text())
     }
     assert on_disk == COMPILED
     page = (out / "README.md").read_text()
