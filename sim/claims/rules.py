@@ -81,7 +81,8 @@ __all__ = [
 
 FORMS = ("value", "share", "count", "upper", "lower", "range", "one-plate")
 KINDS = ("prediction", "input", "self-check", "paper-check", "finding", "not comparable")
-VERDICTS = (
+#: the verdicts a prediction can get (in the order reports count them)
+PREDICTION_VERDICTS = (
     "holds",
     "fails",
     "inconclusive",
@@ -89,12 +90,8 @@ VERDICTS = (
     "holds or undecided",
     "fails or undecided",
     "undecidable",
-    "erratum",
-    "input",
-    "self-check",
-    "finding",
-    "not comparable",
 )
+VERDICTS = (*PREDICTION_VERDICTS, "erratum", "input", "self-check", "finding", "not comparable")
 #: the probability of a plate at least as extreme below which a one-plate claim fails
 P_FAIL = 0.05
 

@@ -12,6 +12,7 @@ from typing import Callable
 
 import pyarrow as pa
 
+from sim.claims.rules import PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_table
 from sim.report.claimtext import interval_text, ref_text, sim_text
@@ -34,17 +35,6 @@ __all__ = [
     "verdict_counts",
     "referee_summary",
 ]
-
-
-_PREDICTION_VERDICTS = (
-    "holds",
-    "fails",
-    "inconclusive",
-    "depends",
-    "holds or undecided",
-    "fails or undecided",
-    "undecidable",
-)
 
 
 def consistent_rows(cons: dict) -> list[list]:
@@ -135,13 +125,7 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
     c = {
         k: 0
         for k in (
-            "holds",
-            "fails",
-            "inconclusive",
-            "depends",
-            "holds or undecided",
-            "fails or undecided",
-            "undecidable",
+            *PREDICTION_VERDICTS,
             "erratum",
             "paper ok",
             "input",
@@ -154,7 +138,7 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
     for r in claims:
         v, k = r["verdict"], r["kind"]
         if k == "prediction":
-            c[v if v in _PREDICTION_VERDICTS else "finding"] += 1
+            c[v if v in PREDICTION_VERDICTS else "finding"] += 1
         elif k == "paper-check":
             c["erratum" if v == "erratum" else "paper ok"] += 1
         elif k == "self-check":

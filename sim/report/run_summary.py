@@ -12,6 +12,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Callable
 
+from sim.claims.rules import PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
 from sim.report.claimtext import interval_text, sim_text
@@ -33,13 +34,7 @@ __all__ = [
 
 #: verdicts in the order they are counted (others follow in alphabetical order)
 VERDICT_ORDER = (
-    "holds",
-    "fails",
-    "inconclusive",
-    "depends",
-    "holds or undecided",
-    "fails or undecided",
-    "undecidable",
+    *PREDICTION_VERDICTS,
     "erratum",
     "not comparable",
     "input",
