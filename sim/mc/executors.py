@@ -38,10 +38,13 @@ def _watch_parent(ppid: int) -> None:
         time.sleep(0.5)
 
 
-def _worker_init(ppid: int) -> None:
+def _worker_init(ppid: int | None) -> None:
     """In each pool worker: ignore SIGINT (the parent handles Ctrl-C and stops the pool) and
     die with the parent, even after ``kill -9`` (PR_SET_PDEATHSIG on Linux; a thread that
-    watches the parent everywhere)."""
+    watches the parent everywhere). ``ppid`` None: the worker's parent is a fork server,
+    which ends when the run's process does."""
+    if ppid is None:
+        ppid = os.getppid()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if sys.platform.startswith("linux"):
@@ -56,13 +59,42 @@ def _worker_init(ppid: int) -> None:
     threading.Thread(target=_watch_parent, args=(ppid,), daemon=True).start()
 
 
+def _start_method() -> str | None:
+    """How to start the pool's workers: the platform's default, except that a process with
+    other threads running is never forked. A fork copies only the calling thread, so a lock
+    another thread holds at that instant (a module's import lock while a figure thread imports
+    matplotlib, an I/O lock) stays held for ever in the child, and the worker hangs on its
+    first import (seen with ``brown_design``, ``--workers 2`` and ``SIM_FIGURES_HERE``). Then
+    ``forkserver`` starts the workers from a clean single-threaded server instead."""
+    methods = multiprocessing.get_all_start_methods()
+    if multiprocessing.get_start_method(allow_none=False) != "fork":
+        return None  # spawn (macOS, Windows) or a method the user chose: no fork hazard
+    if threading.active_count() == 1:
+        return "fork"
+    return "forkserver" if "forkserver" in methods else "spawn"
+
+
+def _ready() -> int:
+    return os.getpid()
+
+
 class _Pool:
-    """A local process pool (``concurrent.futures``); its workers die with the parent."""
+    """A local process pool (``concurrent.futures``); its workers die with the parent. They
+    are all started here, while the caller is the only thread that needs to exist (see
+    :func:`_start_method`), not later at the first chunk, when a run may have threads of its
+    own (the parts of ``brown_design``, figures drawn in this process)."""
 
     def __init__(self, workers: int):
+        method = _start_method()
         self.pool = ProcessPoolExecutor(
-            max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),)
+            max_workers=workers,
+            mp_context=multiprocessing.get_context(method) if method else None,
+            initializer=_worker_init,
+            initargs=(None if method == "forkserver" else os.getpid(),),
         )
+        self.start_method = method or multiprocessing.get_start_method()
+        for f in [self.pool.submit(_ready) for _ in range(workers)]:
+            f.result()  # every worker forked now (a fork pool starts them all at once)
 
     def run(self, fn, seed, part, jobs):
         futs = {self.pool.submit(_call_chunk, fn, seed, part, k, n): (k, n) for k, n in jobs}
