@@ -129,7 +129,7 @@ def test_section_keeps_the_order_and_leaves_out_empty_blocks(tmp_path):
     schema = {"k": _Field("the k of the paper", True), "j": _Field("not an input", False)}
     txt = section(
         out,
-        lead=[region_lead(out, "The predictions")],
+        lead=[region_lead(out, "The predictions", values="every value analytic")],
         intro=["INTRO"],
         schema=schema,
         body=["BODY", ""],
@@ -149,6 +149,14 @@ def test_section_keeps_the_order_and_leaves_out_empty_blocks(tmp_path):
     # the fixed input beta (declared as one value) is not named as implied
     assert "beta_mm 1" not in blocks[0]
     assert "(12 of the 30 input vectors of the region; 64 explored)" in txt
+    assert "at the boundaries; every value analytic)" in txt
+
+
+def test_region_lead_says_how_the_vectors_and_their_values_were_obtained(tmp_path):
+    out = _study(tmp_path)
+    txt = region_lead(out, "P", values="200 simulated models per vector", design="a Sobol design")
+    assert "(`sim.claims.inference`: a Sobol design; 200 simulated models per vector)" in txt
+    assert "analytic" not in txt and "refinement" not in txt
 
 
 def test_section_without_lead_schema_or_figures(tmp_path):
@@ -165,11 +173,11 @@ def test_region_lead_when_nothing_holds_together(tmp_path):
     t["n_together"] = [0, 0]
     write_table(out / "region_inputs.parquet", t, {"study": "st"})
     assert "hold together for no input of the region (30 input vectors of 64 explored)" in (
-        region_lead(out, "They")
+        region_lead(out, "They", values="every value analytic")
     )
 
 
 def test_a_missing_table_is_a_config_error_not_a_traceback(tmp_path):
     out = _study(tmp_path, region=False)
     with pytest.raises((ConfigError, OSError, FileNotFoundError)):
-        region_lead(out, "x")
+        region_lead(out, "x", values="every value analytic")

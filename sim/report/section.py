@@ -18,11 +18,12 @@ and calls :func:`section`, which joins the non-empty blocks with blank lines. Nu
 from the files under ``out`` (:func:`table`, :func:`rows`, :func:`config`), never from live
 model code.
 
-Adopting it in a study still written by hand (wolf, salsig, gridplate, agnard): replace the
-function's list of paragraphs by ``section(out, intro=[...], schema=SCHEMA, body=[...],
-figures=[(alt, file), ...])``; a consistent-set sentence (one-input sweeps) goes into
-``lead``, a region explored with :mod:`sim.claims.inference` into ``lead=[region_lead(out,
-what)]``; subsections with their own figures go into ``body`` (with :func:`figure`).
+Every study's report is built this way: ``section(out, lead=[...], intro=[...],
+schema=SCHEMA, body=[...], figures=[(alt, file), ...])``. A study decided over the region of its
+unprinted inputs (:mod:`sim.claims.inference`) leads with ``region_lead(out, what,
+values=how)``, ``how`` saying how the values at an input vector were obtained (analytic, or
+simulated draws whose noise enters the decision); subsections with their own figures go into
+``body`` (with :func:`figure`).
 """
 
 from __future__ import annotations
@@ -86,15 +87,20 @@ def region_verdicts(out: Path) -> list[str]:
     ]
 
 
-_REGION_HOW = (
-    "The unprinted inputs are explored jointly (`sim.claims.inference`: a Sobol design "
-    "plus refinement at the boundaries; every value analytic). The region holds the input "
-    "vectors that the hardware and the printed inputs allow; a prediction *holds* or "
-    "*fails* over all of it, else *depends* (holds in one part, fails in another; where "
-    "is given), *holds or undecided* / *fails or undecided* (one side nowhere) or "
-    "*undecidable* "
-    "(`consistent_region.parquet`, `region_inputs.parquet`)."
-)
+#: the joint exploration most studies run (:func:`sim.claims.inference.explore` with rounds)
+REFINED = "a Sobol design plus refinement at the boundaries"
+
+
+def _region_how(design: str, values: str) -> str:
+    return (
+        f"The unprinted inputs are explored jointly (`sim.claims.inference`: {design}; "
+        f"{values}). The region holds the input "
+        "vectors that the hardware and the printed inputs allow; a prediction *holds* or "
+        "*fails* over all of it, else *depends* (holds in one part, fails in another; where "
+        "is given), *holds or undecided* / *fails or undecided* (one side nowhere) or "
+        "*undecidable* "
+        "(`consistent_region.parquet`, `region_inputs.parquet`)."
+    )
 
 
 def _region_sentence(ins: list[dict], what: str) -> str:
@@ -116,10 +122,12 @@ def _region_sentence(ins: list[dict], what: str) -> str:
     )
 
 
-def region_lead(out: Path, what: str) -> str:
+def region_lead(out: Path, what: str, *, values: str, design: str = REFINED) -> str:
     """The lead of a study decided over a region of unprinted inputs: where ``what`` (the
-    predictions, in words) hold together, the region per input, and the verdicts over it
-    (``region_inputs.parquet``, ``claims.parquet``)."""
+    predictions, in words) hold together, how the input vectors were chosen (``design``)
+    and how the values at one were obtained (``values``, e.g. ``"every value analytic"`` or
+    the simulated draws per vector whose noise enters the decision), the region per input,
+    and the verdicts over it (``region_inputs.parquet``, ``claims.parquet``)."""
     ins = rows(out, "region_inputs.parquet")
     table_rows = [
         [
@@ -142,7 +150,7 @@ def region_lead(out: Path, what: str) -> str:
         [
             _region_sentence(ins, what),
             "",
-            _REGION_HOW,
+            _region_how(design, values),
             "",
             md_table(header, table_rows),
             "",

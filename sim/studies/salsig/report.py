@@ -6,8 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from sim.report.region import region_markdown
-from sim.report.section import config, figure, rows, section, table
+from sim.report.section import config, figure, region_lead, rows, section, table
 from sim.report.tables import fmt, md_table
 from sim.studies.salsig.schema import SCHEMA
 
@@ -70,7 +69,14 @@ def report(out: Path) -> str:
     return section(
         out,
         lead=[
-            region_markdown(out, claims),
+            region_lead(
+                out,
+                "The vertical test's predictions",
+                values=f"{cfg['region.trials']} simulated stereomodels per input vector, whose "
+                "noise enters the decision",
+                design=f"a Sobol design of {cfg['region.points']} input vectors, not refined (no "
+                "printed statement bounds the region)",
+            ),
             figure(out, "consistent_region.png", "consistent region")
             + "\n"
             + figure(out, "vertical.png", "vertical"),

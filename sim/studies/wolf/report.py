@@ -15,8 +15,7 @@ import numpy as np
 
 from sim.instruments.plotter.errorfields import COMPONENTS
 from sim.report.markdown import fmt, md_table
-from sim.report.region import region_markdown
-from sim.report.section import config, figure, rows, section, table
+from sim.report.section import config, figure, region_lead, rows, section, table
 from sim.studies.wolf.schema import SCHEMA
 
 __all__ = ["findings", "report"]
@@ -171,7 +170,12 @@ def report(out: Path) -> str:
     return section(
         out,
         lead=[
-            region_markdown(out, rows(out, "claims.parquet")),
+            region_lead(
+                out,
+                "The predictions (the corrected discrepancies and Table 2)",
+                values=f"each input vector simulated on the same {cfg['unprinted.trials']} "
+                "instruments (common random numbers), whose noise enters the decision",
+            ),
             figure(out, "consistent_region.png", "consistent region"),
         ],
         intro=[
