@@ -177,6 +177,23 @@ def test_region_lead_when_nothing_holds_together(tmp_path):
     )
 
 
+def test_a_region_explored_per_part_is_led_part_by_part(tmp_path):
+    out = _study(tmp_path)
+    from sim.mc.storage import read_table
+
+    t = read_table(out / "region_inputs.parquet").to_pydict()
+    t["part"] = ["tol", "plates"]
+    t["n_together"], t["n_region"], t["n_points"] = [12, 0], [30, 8], [64, 16]
+    write_table(out / "region_inputs.parquet", t, {"study": "st"})
+    txt = region_lead(out, "They", values="v")
+    assert (
+        "They, explored per part: in part `tol` they hold together for offset_mm 5.00–20.0 "
+        "(12 of the 30 input vectors of the region; 64 explored); in part `plates` they hold "
+        "together for no input of the region (8 input vectors of 16 explored)." in txt
+    )
+    assert "| part | input |" in txt and "| `plates` | `beta_mm` |" in txt
+
+
 def test_a_missing_table_is_a_config_error_not_a_traceback(tmp_path):
     out = _study(tmp_path, region=False)
     with pytest.raises((ConfigError, OSError, FileNotFoundError)):

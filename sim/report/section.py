@@ -3,8 +3,8 @@
 Every study's section of ``REPORT.md`` has the same shape, in this order:
 
 1. the *lead*: for the studies that decide claims over the unprinted inputs, the consistent
-   region sentence, its table and the verdicts over it (:func:`region_lead`, or
-   :func:`region_by_part` for a region explored per part);
+   region sentence, its table and the verdicts over it (:func:`region_lead`, part by part for
+   a region explored per part);
 2. the *intro*: the study's own paragraphs (model, geometry, trials, seed);
 3. the claims table and the printed numbers not reproduced
    (:func:`sim.report.markdown.claims_markdown` of ``claims.parquet``);
@@ -40,7 +40,6 @@ from sim.report.tables import fmt, md_table
 __all__ = [
     "config",
     "figure",
-    "region_by_part",
     "region_lead",
     "region_verdicts",
     "rows",
@@ -103,12 +102,13 @@ def _region_how(design: str, values: str) -> str:
     )
 
 
-def _region_sentence(ins: list[dict], what: str) -> str:
+def _together(ins: list[dict]) -> str:
+    """Where every prediction holds together over the region rows ``ins`` (one exploration)."""
     r0 = ins[0]
     if not r0["n_together"]:
         return (
-            f"**Consistent region.** {what} hold together for no input of the region "
-            f"({r0['n_region']} input vectors of {r0['n_points']} explored)."
+            f"hold together for no input of the region "
+            f"({r0['n_region']} input vectors of {r0['n_points']} explored)"
         )
     imp = ", ".join(
         f"{r['input']} {span(r['together_low'], r['together_high'])}"
@@ -116,9 +116,22 @@ def _region_sentence(ins: list[dict], what: str) -> str:
         if r["declared_low"] != r["declared_high"]
     )
     return (
-        f"**Consistent region.** {what} hold together for {imp} "
+        f"hold together for {imp} "
         f"({r0['n_together']} of the {r0['n_region']} input vectors of the region; "
-        f"{r0['n_points']} explored)."
+        f"{r0['n_points']} explored)"
+    )
+
+
+def _region_sentence(ins: list[dict], what: str) -> str:
+    parts = list(dict.fromkeys(r.get("part") for r in ins))
+    if parts == [None]:
+        return f"**Consistent region.** {what} {_together(ins)}."
+    return (
+        f"**Consistent region.** {what}, explored per part: "
+        + "; ".join(
+            f"in part `{p}` they {_together([r for r in ins if r['part'] == p])}" for p in parts
+        )
+        + "."
     )
 
 
@@ -127,10 +140,13 @@ def region_lead(out: Path, what: str, *, values: str, design: str = REFINED) -> 
     predictions, in words) hold together, how the input vectors were chosen (``design``)
     and how the values at one were obtained (``values``, e.g. ``"every value analytic"`` or
     the simulated draws per vector whose noise enters the decision), the region per input,
-    and the verdicts over it (``region_inputs.parquet``, ``claims.parquet``)."""
+    and the verdicts over it (``region_inputs.parquet``, ``claims.parquet``). A region
+    explored per part (a ``part`` column) is given part by part."""
     ins = rows(out, "region_inputs.parquet")
+    by_part = "part" in ins[0]
     table_rows = [
         [
+            *([f"`{r['part']}`"] if by_part else []),
             f"`{r['input']}`",
             f"{fmt(r['declared_low'])}–{fmt(r['declared_high'])}: {r['why']}",
             span(r["region_low"], r["region_high"]),
@@ -140,6 +156,7 @@ def region_lead(out: Path, what: str, *, values: str, design: str = REFINED) -> 
         for r in ins
     ]
     header = [
+        *(["part"] if by_part else []),
         "input",
         "possible (hardware)",
         "region",
@@ -159,29 +176,6 @@ def region_lead(out: Path, what: str, *, values: str, design: str = REFINED) -> 
             *region_verdicts(out),
         ]
     )
-
-
-def region_by_part(out: Path) -> str:
-    """A region explored per part (a ``part`` column in ``region_inputs.parquet``): per part,
-    where every prediction holds, the region, the resolution; then the verdicts over it."""
-    ins = rows(out, "region_inputs.parquet")
-    txt = []
-    for part in dict.fromkeys(r["part"] for r in ins):
-        rs = [r for r in ins if r["part"] == part]
-        r0 = rs[0]
-        txt.append(
-            f"*Part `{part}`* ({r0['n_region']} of {r0['n_points']} explored input vectors in the "
-            f"region; every prediction holds at {r0['n_together']}): "
-            + "; ".join(
-                f"`{r['input']}` possible {fmt(r['declared_low'])}–{fmt(r['declared_high'])}, "
-                f"region {span(r['region_low'], r['region_high'])}, all hold "
-                f"{span(r['together_low'], r['together_high'])} (resolution "
-                f"{fmt(r['resolution_interior'])} / {fmt(r['resolution_boundary'])})"
-                for r in rs
-            )
-            + "."
-        )
-    return "\n".join([*txt, "", "Verdicts over the region:", "", *region_verdicts(out)])
 
 
 def section(
