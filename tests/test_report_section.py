@@ -12,7 +12,7 @@ from sim.claims.book import ClaimBook, write_claims
 from sim.claims.table import Sim, claim_rows, exact, mc, plates
 from sim.mc.config import ConfigError
 from sim.mc.storage import write_table
-from sim.report.section import region_lead, section, span
+from sim.report.section import errata, printed, recomputed, region_lead, section, span
 
 SPECS = [
     {
@@ -91,6 +91,24 @@ def test_span():
     assert span(None, None) == "nowhere" and span(float("nan"), 1.0) == "nowhere"
     assert span(1.0, 1.0, " mm") == "1.00 mm"
     assert span(1.0, 2.5) == "1.00–2.50"
+
+
+def test_printed_and_recomputed_numbers_carry_the_papers_decimals():
+    row = {"ref_low": 6.95, "ref_high": 7.05, "value": 7.280109889, "note": "sum 530 / 10."}
+    assert printed(row) == "7.0" and recomputed(row) == "7.28"
+    fine = {"ref_low": 0.9999786685, "ref_high": 0.9999786695, "value": 0.99997866291}
+    assert printed(fine) == "0.999978669" and recomputed(fine) == "0.9999786629"
+    # a zone without width (an exact printed number): the interval-free format
+    assert printed({"ref_low": 43.0, "ref_high": 43.0, "value": 41.0}) == "43.0"
+    claims = [
+        row | {"claim": "t.x", "verdict": "erratum"},
+        row | {"claim": "t.y", "verdict": "holds"},
+    ]
+    assert errata(claims) == (
+        "**Errata** (the paper against its own printed data): `t.x`: printed 7.0, "
+        "recomputed 7.28 (sum 530 / 10)."
+    )
+    assert errata(claims[1:]).endswith("printed data): none.")
 
 
 def _study(tmp_path, region=True):

@@ -39,7 +39,10 @@ from sim.report.tables import fmt, md_table
 
 __all__ = [
     "config",
+    "errata",
     "figure",
+    "printed",
+    "recomputed",
     "region_lead",
     "region_verdicts",
     "rows",
@@ -74,6 +77,44 @@ def span(lo, hi, unit: str = "") -> str:
     if lo is None or (isinstance(lo, float) and math.isnan(lo)):
         return "nowhere"
     return (f"{fmt(lo)}" if lo == hi else f"{fmt(lo)}–{fmt(hi)}") + unit
+
+
+def _digits(r: dict) -> int | None:
+    """Decimals of the paper's printed number of a claims row (from the width of its rounding
+    zone ``ref_low``-``ref_high``), or None when the zone has no width."""
+    width = r["ref_high"] - r["ref_low"]
+    return max(0, -math.floor(math.log10(width) + 1e-9)) if width > 0 else None
+
+
+def printed(r: dict) -> str:
+    """The paper's printed number of a claims row: the middle of its rounding zone, at the
+    decimals it was printed with."""
+    mid, d = (r["ref_low"] + r["ref_high"]) / 2, _digits(r)
+    return fmt(mid) if d is None else f"{mid:.{d}f}"
+
+
+def recomputed(r: dict) -> str:
+    """The row's recomputed value, one decimal beyond the printed number's."""
+    d = _digits(r)
+    return fmt(r["value"]) if d is None else f"{r['value']:.{d + 1}f}"
+
+
+def errata(claims: Sequence[dict]) -> str:
+    """The paragraph of the paper-checks the paper's own printed data contradict: per
+    erratum, the printed and the recomputed number and the row's note (``none`` without)."""
+    return (
+        "**Errata** (the paper against its own printed data): "
+        + (
+            "; ".join(
+                f"`{r['claim']}`: printed {printed(r)}, recomputed {recomputed(r)} "
+                f"({r['note'].rstrip('.')})"
+                for r in claims
+                if r["verdict"] == "erratum"
+            )
+            or "none"
+        )
+        + "."
+    )
 
 
 def region_verdicts(out: Path) -> list[str]:
