@@ -49,9 +49,9 @@ def table_path(cfg: dict, key: str) -> Path:
     return p if p.is_absolute() else ROOT / p
 
 
-def check(cfg: dict) -> None:
-    """Cross-key rules of ``wolf_polynomial``; the transcribed tables are parsed here too, so
-    a wrong file stops the run at load time with one line naming its key."""
+def _grids(cfg: dict) -> np.ndarray:
+    """The area around a, the grid of the calibration (and the degree it supports), the
+    grids of the degree trade-off; the calibration grid's nodes."""
     a = cfg["plate.area_mm"]
     require(
         len(a) == 4 and a[0] < 0 < a[1] and a[2] < 0 < a[3],
@@ -81,12 +81,12 @@ def check(cfg: dict) -> None:
         "another degree at plate.spacing_mm and calib.n_sets (they must be in "
         "trade.spacings_mm and trade.n_sets): the claim on the cubic reads it",
     )
-    spread = cfg["field.spread"]
-    require(
-        len(spread) == 2 and spread[0] <= spread[1],
-        "field.spread",
-        "must be [lo, hi] with lo <= hi",
-    )
+    return g
+
+
+def _photograph(cfg: dict) -> None:
+    """The photograph of Tables 1 and 2 inside the calibrated area."""
+    a = cfg["plate.area_mm"]
     for key in ("repeat.format_mm", "repeat.centre_mm"):
         require(len(cfg[key]) == 2, key, "must have two entries")
     (w, h), (cx, cy) = cfg["repeat.format_mm"], cfg["repeat.centre_mm"]
@@ -96,8 +96,13 @@ def check(cfg: dict) -> None:
         "the photograph must lie inside the calibrated area "
         "(the polynomial is not meant to extrapolate)",
     )
-    m = (len(g) + len(mid_cells(a, cfg["plate.spacing_mm"]))) * cfg["calib.n_sets"]
-    m += cfg["check.n_points"] + 2 * (cfg["repeat.n_points"] + 4)
+
+
+def _chunk_work(cfg: dict, g: np.ndarray) -> None:
+    """At most :data:`MAX_CHUNK_CELLS` readings in a chunk of any part."""
+    mid = mid_cells(cfg["plate.area_mm"], cfg["plate.spacing_mm"])
+    m = (len(g) + len(mid)) * cfg["calib.n_sets"] + cfg["check.n_points"]
+    m += 2 * (cfg["repeat.n_points"] + 4)
     nmax = max([cfg["reading.n"], *cfg["trade.readings"]])
     for key in ("chunk", "trade.trials", "unprinted.trials"):
         per = min(cfg[key], cfg["chunk"]) * m * 2 * nmax
@@ -107,5 +112,20 @@ def check(cfg: dict) -> None:
             f"a chunk would hold {per:.3g} readings (trials x points x "
             f"readings), more than {MAX_CHUNK_CELLS:g}: use a smaller chunk",
         )
+
+
+def check(cfg: dict) -> None:
+    """Cross-key rules of ``wolf_polynomial``, in this order: the grids, the field's spread,
+    the photograph, the work per chunk; the transcribed tables are parsed here too, so a
+    wrong file stops the run at load time with one line naming its key."""
+    g = _grids(cfg)
+    spread = cfg["field.spread"]
+    require(
+        len(spread) == 2 and spread[0] <= spread[1],
+        "field.spread",
+        "must be [lo, hi] with lo <= hi",
+    )
+    _photograph(cfg)
+    _chunk_work(cfg, g)
     tables.load_table1(table_path(cfg, "table1.file"), "table1.file")
     tables.load_table3(table_path(cfg, "table3.file"), "table3.file")
