@@ -12,7 +12,7 @@ from sim.claims.book import ClaimBook, write_claims
 from sim.claims.table import Sim, claim_rows, exact, mc, plates
 from sim.mc.config import ConfigError
 from sim.mc.storage import write_table
-from sim.report.section import region_lead, section, span
+from sim.report.section import errata, printed, recomputed, region_lead, section, span
 
 SPECS = [
     {
@@ -93,6 +93,24 @@ def test_span():
     assert span(1.0, 2.5) == "1.00–2.50"
 
 
+def test_printed_and_recomputed_numbers_carry_the_papers_decimals():
+    row = {"ref_low": 6.95, "ref_high": 7.05, "value": 7.280109889, "note": "sum 530 / 10."}
+    assert printed(row) == "7.0" and recomputed(row) == "7.28"
+    fine = {"ref_low": 0.9999786685, "ref_high": 0.9999786695, "value": 0.99997866291}
+    assert printed(fine) == "0.999978669" and recomputed(fine) == "0.9999786629"
+    # a zone without width (an exact printed number): the interval-free format
+    assert printed({"ref_low": 43.0, "ref_high": 43.0, "value": 41.0}) == "43.0"
+    claims = [
+        row | {"claim": "t.x", "verdict": "erratum"},
+        row | {"claim": "t.y", "verdict": "holds"},
+    ]
+    assert errata(claims) == (
+        "**Errata** (the paper against its own printed data): `t.x`: printed 7.0, "
+        "recomputed 7.28 (sum 530 / 10)."
+    )
+    assert errata(claims[1:]).endswith("printed data): none.")
+
+
 def _study(tmp_path, region=True):
     out = tmp_path / "st"
     out.mkdir()
@@ -129,7 +147,7 @@ def test_section_keeps_the_order_and_leaves_out_empty_blocks(tmp_path):
     schema = {"k": _Field("the k of the paper", True), "j": _Field("not an input", False)}
     txt = section(
         out,
-        lead=[region_lead(out, "The predictions")],
+        lead=[region_lead(out, "The predictions", values="every value analytic")],
         intro=["INTRO"],
         schema=schema,
         body=["BODY", ""],
@@ -149,6 +167,14 @@ def test_section_keeps_the_order_and_leaves_out_empty_blocks(tmp_path):
     # the fixed input beta (declared as one value) is not named as implied
     assert "beta_mm 1" not in blocks[0]
     assert "(12 of the 30 input vectors of the region; 64 explored)" in txt
+    assert "at the boundaries; every value analytic)" in txt
+
+
+def test_region_lead_says_how_the_vectors_and_their_values_were_obtained(tmp_path):
+    out = _study(tmp_path)
+    txt = region_lead(out, "P", values="200 simulated models per vector", design="a Sobol design")
+    assert "(`sim.claims.inference`: a Sobol design; 200 simulated models per vector)" in txt
+    assert "analytic" not in txt and "refinement" not in txt
 
 
 def test_section_without_lead_schema_or_figures(tmp_path):
@@ -165,11 +191,28 @@ def test_region_lead_when_nothing_holds_together(tmp_path):
     t["n_together"] = [0, 0]
     write_table(out / "region_inputs.parquet", t, {"study": "st"})
     assert "hold together for no input of the region (30 input vectors of 64 explored)" in (
-        region_lead(out, "They")
+        region_lead(out, "They", values="every value analytic")
     )
+
+
+def test_a_region_explored_per_part_is_led_part_by_part(tmp_path):
+    out = _study(tmp_path)
+    from sim.mc.storage import read_table
+
+    t = read_table(out / "region_inputs.parquet").to_pydict()
+    t["part"] = ["tol", "plates"]
+    t["n_together"], t["n_region"], t["n_points"] = [12, 0], [30, 8], [64, 16]
+    write_table(out / "region_inputs.parquet", t, {"study": "st"})
+    txt = region_lead(out, "They", values="v")
+    assert (
+        "They, explored per part: in part `tol` they hold together for offset_mm 5.00–20.0 "
+        "(12 of the 30 input vectors of the region; 64 explored); in part `plates` they hold "
+        "together for no input of the region (8 input vectors of 16 explored)." in txt
+    )
+    assert "| part | input |" in txt and "| `plates` | `beta_mm` |" in txt
 
 
 def test_a_missing_table_is_a_config_error_not_a_traceback(tmp_path):
     out = _study(tmp_path, region=False)
     with pytest.raises((ConfigError, OSError, FileNotFoundError)):
-        region_lead(out, "x")
+        region_lead(out, "x", values="every value analytic")

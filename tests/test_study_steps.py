@@ -90,6 +90,10 @@ def test_run_part_is_the_runner_with_the_configs_trials_seed_and_chunk():
     assert np.array_equal(got["x"], want["x"]) and got["x"].size == 50
     other = run_part(cfg, None, _fn, part=4, label="t", trials=30, quiet=True)
     assert other["x"].size == 30 and not np.array_equal(other["x"], got["x"][:30])
+    # a part with its own chunk size is the runner at that chunk (its chunks' streams)
+    small = run_part(cfg, None, _fn, part=3, label="t", quiet=True, chunk=5)
+    assert np.array_equal(small["x"], run_chunks(_fn, 50, 11, 5, part=3, quiet=True)["x"])
+    assert set(small["n"]) == {5} and not np.array_equal(small["x"], got["x"])
 
 
 def test_over_region_replaces_the_predictions_rows_only_and_keeps_their_order():

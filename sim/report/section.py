@@ -3,8 +3,8 @@
 Every study's section of ``REPORT.md`` has the same shape, in this order:
 
 1. the *lead*: for the studies that decide claims over the unprinted inputs, the consistent
-   region sentence, its table and the verdicts over it (:func:`region_lead`, or
-   :func:`region_by_part` for a region explored per part);
+   region sentence, its table and the verdicts over it (:func:`region_lead`, part by part for
+   a region explored per part);
 2. the *intro*: the study's own paragraphs (model, geometry, trials, seed);
 3. the claims table and the printed numbers not reproduced
    (:func:`sim.report.markdown.claims_markdown` of ``claims.parquet``);
@@ -18,11 +18,13 @@ and calls :func:`section`, which joins the non-empty blocks with blank lines. Nu
 from the files under ``out`` (:func:`table`, :func:`rows`, :func:`config`), never from live
 model code.
 
-Adopting it in a study still written by hand (wolf, salsig, gridplate, agnard): replace the
-function's list of paragraphs by ``section(out, intro=[...], schema=SCHEMA, body=[...],
-figures=[(alt, file), ...])``; a consistent-set sentence (one-input sweeps) goes into
-``lead``, a region explored with :mod:`sim.claims.inference` into ``lead=[region_lead(out,
-what)]``; subsections with their own figures go into ``body`` (with :func:`figure`).
+Every study's report is built this way: ``section(out, lead=[...], intro=[...],
+schema=SCHEMA, body=[...], figures=[(alt, file), ...])``. A study decided over the region of its
+unprinted inputs (:mod:`sim.claims.inference`) leads with ``region_lead(out, what,
+values=how)``, ``how`` saying how the values at an input vector were obtained (analytic, or
+simulated draws whose noise enters the decision; ``agnard_block`` still leads with
+:func:`sim.report.region.region_markdown`); subsections with their own figures go into ``body``
+(with :func:`figure`).
 """
 
 from __future__ import annotations
@@ -38,8 +40,10 @@ from sim.report.tables import fmt, md_table
 
 __all__ = [
     "config",
+    "errata",
     "figure",
-    "region_by_part",
+    "printed",
+    "recomputed",
     "region_lead",
     "region_verdicts",
     "rows",
@@ -76,6 +80,44 @@ def span(lo, hi, unit: str = "") -> str:
     return (f"{fmt(lo)}" if lo == hi else f"{fmt(lo)}–{fmt(hi)}") + unit
 
 
+def _digits(r: dict) -> int | None:
+    """Decimals of the paper's printed number of a claims row (from the width of its rounding
+    zone ``ref_low``-``ref_high``), or None when the zone has no width."""
+    width = r["ref_high"] - r["ref_low"]
+    return max(0, -math.floor(math.log10(width) + 1e-9)) if width > 0 else None
+
+
+def printed(r: dict) -> str:
+    """The paper's printed number of a claims row: the middle of its rounding zone, at the
+    decimals it was printed with."""
+    mid, d = (r["ref_low"] + r["ref_high"]) / 2, _digits(r)
+    return fmt(mid) if d is None else f"{mid:.{d}f}"
+
+
+def recomputed(r: dict) -> str:
+    """The row's recomputed value, one decimal beyond the printed number's."""
+    d = _digits(r)
+    return fmt(r["value"]) if d is None else f"{r['value']:.{d + 1}f}"
+
+
+def errata(claims: Sequence[dict]) -> str:
+    """The paragraph of the paper-checks the paper's own printed data contradict: per
+    erratum, the printed and the recomputed number and the row's note (``none`` without)."""
+    return (
+        "**Errata** (the paper against its own printed data): "
+        + (
+            "; ".join(
+                f"`{r['claim']}`: printed {printed(r)}, recomputed {recomputed(r)} "
+                f"({r['note'].rstrip('.')})"
+                for r in claims
+                if r["verdict"] == "erratum"
+            )
+            or "none"
+        )
+        + "."
+    )
+
+
 def region_verdicts(out: Path) -> list[str]:
     """One line per claim decided over the region: verdict and where it holds."""
     return [
@@ -86,23 +128,29 @@ def region_verdicts(out: Path) -> list[str]:
     ]
 
 
-_REGION_HOW = (
-    "The unprinted inputs are explored jointly (`sim.claims.inference`: a Sobol design "
-    "plus refinement at the boundaries; every value analytic). The region holds the input "
-    "vectors that the hardware and the printed inputs allow; a prediction *holds* or "
-    "*fails* over all of it, else *depends* (holds in one part, fails in another; where "
-    "is given), *holds or undecided* / *fails or undecided* (one side nowhere) or "
-    "*undecidable* "
-    "(`consistent_region.parquet`, `region_inputs.parquet`)."
-)
+#: the joint exploration most studies run (:func:`sim.claims.inference.explore` with rounds)
+REFINED = "a Sobol design plus refinement at the boundaries"
 
 
-def _region_sentence(ins: list[dict], what: str) -> str:
+def _region_how(design: str, values: str) -> str:
+    return (
+        f"The unprinted inputs are explored jointly (`sim.claims.inference`: {design}; "
+        f"{values}). The region holds the input "
+        "vectors that the hardware and the printed inputs allow; a prediction *holds* or "
+        "*fails* over all of it, else *depends* (holds in one part, fails in another; where "
+        "is given), *holds or undecided* / *fails or undecided* (one side nowhere) or "
+        "*undecidable* "
+        "(`consistent_region.parquet`, `region_inputs.parquet`)."
+    )
+
+
+def _together(ins: list[dict]) -> str:
+    """Where every prediction holds together over the region rows ``ins`` (one exploration)."""
     r0 = ins[0]
     if not r0["n_together"]:
         return (
-            f"**Consistent region.** {what} hold together for no input of the region "
-            f"({r0['n_region']} input vectors of {r0['n_points']} explored)."
+            f"hold together for no input of the region "
+            f"({r0['n_region']} input vectors of {r0['n_points']} explored)"
         )
     imp = ", ".join(
         f"{r['input']} {span(r['together_low'], r['together_high'])}"
@@ -110,19 +158,37 @@ def _region_sentence(ins: list[dict], what: str) -> str:
         if r["declared_low"] != r["declared_high"]
     )
     return (
-        f"**Consistent region.** {what} hold together for {imp} "
+        f"hold together for {imp} "
         f"({r0['n_together']} of the {r0['n_region']} input vectors of the region; "
-        f"{r0['n_points']} explored)."
+        f"{r0['n_points']} explored)"
     )
 
 
-def region_lead(out: Path, what: str) -> str:
+def _region_sentence(ins: list[dict], what: str) -> str:
+    parts = list(dict.fromkeys(r.get("part") for r in ins))
+    if parts == [None]:
+        return f"**Consistent region.** {what} {_together(ins)}."
+    return (
+        f"**Consistent region.** {what}, explored per part: "
+        + "; ".join(
+            f"in part `{p}` they {_together([r for r in ins if r['part'] == p])}" for p in parts
+        )
+        + "."
+    )
+
+
+def region_lead(out: Path, what: str, *, values: str, design: str = REFINED) -> str:
     """The lead of a study decided over a region of unprinted inputs: where ``what`` (the
-    predictions, in words) hold together, the region per input, and the verdicts over it
-    (``region_inputs.parquet``, ``claims.parquet``)."""
+    predictions, in words) hold together, how the input vectors were chosen (``design``)
+    and how the values at one were obtained (``values``, e.g. ``"every value analytic"`` or
+    the simulated draws per vector whose noise enters the decision), the region per input,
+    and the verdicts over it (``region_inputs.parquet``, ``claims.parquet``). A region
+    explored per part (a ``part`` column) is given part by part."""
     ins = rows(out, "region_inputs.parquet")
+    by_part = "part" in ins[0]
     table_rows = [
         [
+            *([f"`{r['part']}`"] if by_part else []),
             f"`{r['input']}`",
             f"{fmt(r['declared_low'])}–{fmt(r['declared_high'])}: {r['why']}",
             span(r["region_low"], r["region_high"]),
@@ -132,6 +198,7 @@ def region_lead(out: Path, what: str) -> str:
         for r in ins
     ]
     header = [
+        *(["part"] if by_part else []),
         "input",
         "possible (hardware)",
         "region",
@@ -142,7 +209,7 @@ def region_lead(out: Path, what: str) -> str:
         [
             _region_sentence(ins, what),
             "",
-            _REGION_HOW,
+            _region_how(design, values),
             "",
             md_table(header, table_rows),
             "",
@@ -151,29 +218,6 @@ def region_lead(out: Path, what: str) -> str:
             *region_verdicts(out),
         ]
     )
-
-
-def region_by_part(out: Path) -> str:
-    """A region explored per part (a ``part`` column in ``region_inputs.parquet``): per part,
-    where every prediction holds, the region, the resolution; then the verdicts over it."""
-    ins = rows(out, "region_inputs.parquet")
-    txt = []
-    for part in dict.fromkeys(r["part"] for r in ins):
-        rs = [r for r in ins if r["part"] == part]
-        r0 = rs[0]
-        txt.append(
-            f"*Part `{part}`* ({r0['n_region']} of {r0['n_points']} explored input vectors in the "
-            f"region; every prediction holds at {r0['n_together']}): "
-            + "; ".join(
-                f"`{r['input']}` possible {fmt(r['declared_low'])}–{fmt(r['declared_high'])}, "
-                f"region {span(r['region_low'], r['region_high'])}, all hold "
-                f"{span(r['together_low'], r['together_high'])} (resolution "
-                f"{fmt(r['resolution_interior'])} / {fmt(r['resolution_boundary'])})"
-                for r in rs
-            )
-            + "."
-        )
-    return "\n".join([*txt, "", "Verdicts over the region:", "", *region_verdicts(out)])
 
 
 def section(

@@ -34,15 +34,16 @@ def run_part(
     label: str,
     trials: int | None = None,
     quiet: bool = False,
+    chunk: int | None = None,
 ) -> dict[str, np.ndarray]:
-    """``fn(rng, n)`` over chunks of ``cfg["chunk"]`` trials (``trials``, default
-    ``cfg["trials"]``) from stream ``part`` of ``cfg["seed"]``; quiet when ``quiet`` or
+    """``fn(rng, n)`` over chunks of ``chunk`` (default ``cfg["chunk"]``) trials (``trials``,
+    default ``cfg["trials"]``) from stream ``part`` of ``cfg["seed"]``; quiet when ``quiet`` or
     ``ctx.quiet``. The per-trial arrays concatenated over chunks."""
     return run_chunks(
         fn,
         cfg["trials"] if trials is None else trials,
         cfg["seed"],
-        cfg["chunk"],
+        cfg["chunk"] if chunk is None else chunk,
         part=part,
         label=label,
         quiet=quiet,

@@ -31,6 +31,9 @@ _UNPRINTED = (
     "decided over the region (first paragraph)."
 )
 
+#: how the region's values at an input vector are obtained (closed-form covariances)
+ANALYTIC = "every value analytic"
+
 
 def _dilution_intro(out: Path) -> str:
     prov = config(out)
@@ -71,7 +74,7 @@ def report_dilution(out: Path) -> str:
     """The section of ``brown_dilution``: the Concept's predictions over the region."""
     return section(
         out,
-        lead=[region_lead(out, "The Concept's predictions")],
+        lead=[region_lead(out, "The Concept's predictions", values=ANALYTIC)],
         intro=[_dilution_intro(out), _UNPRINTED],
         schema=DILUTION,
         body=[_BETA_NEAR_ZERO, _DATUM, *_dilution_vs_points(out)],
@@ -111,7 +114,7 @@ def report_table1(out: Path) -> str:
     )
     return section(
         out,
-        lead=[region_lead(out, what)],
+        lead=[region_lead(out, what, values=ANALYTIC)],
         intro=[_table1_intro(out)],
         schema=TABLE1,
         figures=[("consistent region", "consistent_region.png"), ("table 1", "table1.png")],

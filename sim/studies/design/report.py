@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.report.section import config, figure, region_by_part, section, table
+from sim.report.section import config, figure, region_lead, section, table
 from sim.report.tables import fmt, md_table
 from sim.studies.design.schema import SCHEMA
 
@@ -39,13 +39,28 @@ def _datum_findings(V, VH, feas_note):
     )
 
 
-_LEAD = (
-    "**Consistent region.** The tolerances and external comparisons that depend on the "
-    "unprinted station offset, beta, screw pitch and Zeiss layout are decided over the "
-    "region of those inputs that the comparator (the 261 + 1 mm scale reading Table 1's "
-    "plate, and the Zeiss points for the Zeiss rows) allows, explored jointly "
-    "(`consistent_region.parquet`, `region_inputs.parquet`; figure: brown_table1's region)."
+#: the predictions of the region, in words
+_WHAT = (
+    "The tolerances and external comparisons that depend on the unprinted station offset, "
+    "beta, screw pitch and Zeiss layout"
 )
+
+
+def _lead(out: Path, cfg: dict) -> list[str]:
+    """The region lead (two parts: the tolerances analytic on a refined design, the plate
+    comparisons with simulated plates on a small one) and what bounds the region."""
+    return [
+        region_lead(
+            out,
+            _WHAT,
+            design="per part a Sobol design (`tolerances` refined at the boundaries, `plates` not)",
+            values=f"`tolerances` every value analytic, `plates` {cfg['unprinted.plates']} "
+            "simulated plates per input vector, whose noise enters the decision",
+        ),
+        "The comparator bounds the region: its 261 + 1 mm scale must read Table 1's plate, "
+        "and the Zeiss points for the Zeiss rows (figure: brown_table1's region).",
+    ]
+
 
 _INTRO = (
     "The questions Brown answered by simulation before building the comparator, asked "
@@ -257,7 +272,7 @@ def report(out: Path) -> str:
     cfg = config(out)["config"]
     return section(
         out,
-        lead=[_LEAD, region_by_part(out)],
+        lead=_lead(out, cfg),
         intro=[_INTRO, _findings(out)],
         schema=SCHEMA,
         body=[

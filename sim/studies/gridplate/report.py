@@ -6,8 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from sim.report.region import region_markdown
-from sim.report.section import config, figure, rows, section, table
+from sim.report.section import config, errata, figure, region_lead, rows, section, table
 from sim.report.tables import fmt, md_table
 from sim.studies.gridplate.schema import SCHEMA
 
@@ -41,22 +40,6 @@ def _intro(cfg: dict) -> str:
         "falls among simulated calibrations (`p`), and whether the simulation is sharp enough "
         "to decide. The configured grid, scale difference and true grid sigma are one example "
         "point: the predictions above are decided over the whole region."
-    )
-
-
-def _errata(claims: list[dict]) -> str:
-    errata = [r for r in claims if r["verdict"] == "erratum"]
-    return (
-        "**Errata** (the paper against its own printed numbers): "
-        + (
-            "; ".join(
-                f"`{r['claim']}`: printed {fmt(r['ref_low'] + (r['ref_high'] - r['ref_low']) / 2)}, "
-                f"recomputed {fmt(r['value'])} ({r['note']})"
-                for r in errata
-            )
-            or "none"
-        )
-        + "."
     )
 
 
@@ -161,10 +144,16 @@ def report(out: Path) -> str:
     return section(
         out,
         lead=[
-            region_markdown(out, claims),
+            region_lead(
+                out,
+                "The paper's weighting and similarity-versus-affine predictions",
+                values=f"each input vector's statistics drawn from their exact sampling "
+                f"distributions, {cfg['region.draws']} simulated calibrations per vector, whose "
+                "noise enters the decision",
+            ),
             figure(out, "consistent_region.png", "consistent region"),
         ],
-        intro=[_intro(cfg), _MODEL, _errata(claims)],
+        intro=[_intro(cfg), _MODEL, errata(claims)],
         schema=SCHEMA,
         body=[
             *_implied(out),

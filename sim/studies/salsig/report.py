@@ -6,8 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from sim.report.region import region_markdown
-from sim.report.section import config, figure, rows, section, table
+from sim.report.section import config, errata, figure, region_lead, rows, section, table
 from sim.report.tables import fmt, md_table
 from sim.studies.salsig.schema import SCHEMA
 
@@ -21,15 +20,6 @@ _CONVENTIONS = (
     "the residuals on X2, as the program's `VX2, VY2` columns do; the unit-weight error is "
     "therefore in X2 units: mm of the comparator in FIG. 2, *digits* of the B8 in FIG. 3."
 )
-
-
-def _errata(claims: list[dict]) -> str:
-    errata = [r for r in claims if r["verdict"] == "erratum"]
-    return (
-        "**Errata** (the paper against its own printed data): "
-        + ("; ".join(f"`{r['claim']}`: {r['note']}" for r in errata) or "none")
-        + "."
-    )
 
 
 def _chain(cfg: dict) -> str:
@@ -70,12 +60,19 @@ def report(out: Path) -> str:
     return section(
         out,
         lead=[
-            region_markdown(out, claims),
+            region_lead(
+                out,
+                "The vertical test's predictions",
+                values=f"{cfg['region.trials']} simulated stereomodels per input vector, whose "
+                "noise enters the decision",
+                design=f"a Sobol design of {cfg['region.points']} input vectors, not refined (no "
+                "printed statement bounds the region)",
+            ),
             figure(out, "consistent_region.png", "consistent region")
             + "\n"
             + figure(out, "vertical.png", "vertical"),
         ],
-        intro=[_CONVENTIONS, _errata(claims), _chain(cfg)],
+        intro=[_CONVENTIONS, errata(claims), _chain(cfg)],
         schema=SCHEMA,
         body=_power(out),
         figures=[

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.mc.config import ConfigError
+from sim.mc.schema_helpers import require
 from sim.studies.wolf import tables
 from sim.studies.wolf.grid import grid_nodes, mid_cells, node_index
 
@@ -27,20 +27,20 @@ def _grid_ok(cfg, spacing, key):
     area = cfg["plate.area_mm"]
     ab = cfg["reduce.ab_mm"]
     n = [(area[1] - area[0]) / spacing + 1, (area[3] - area[2]) / spacing + 1]
-    if n[0] * n[1] > 100_000:
-        raise ConfigError(
-            key,
-            f"a grid at {spacing:g} mm has about {n[0] * n[1]:.3g} points in the "
-            "area (more than 100000): the spacing is too fine",
-        )
+    require(
+        n[0] * n[1] <= 100_000,
+        key,
+        f"a grid at {spacing:g} mm has about {n[0] * n[1]:.3g} points in the "
+        "area (more than 100000): the spacing is too fine",
+    )
     g = grid_nodes(area, spacing)
-    if node_index(g, (0.0, 0.0)) < 0 or node_index(g, (ab, 0.0)) < 0:
-        raise ConfigError(
-            key,
-            f"a grid at {spacing:g} mm in the area has no intersection at a = "
-            f"(0, 0) or b = ({ab:g}, 0): the spacing must divide ab and b must lie "
-            "in the area",
-        )
+    require(
+        node_index(g, (0.0, 0.0)) >= 0 and node_index(g, (ab, 0.0)) >= 0,
+        key,
+        f"a grid at {spacing:g} mm in the area has no intersection at a = "
+        f"(0, 0) or b = ({ab:g}, 0): the spacing must divide ab and b must lie "
+        "in the area",
+    )
     return g
 
 
@@ -49,59 +49,83 @@ def table_path(cfg: dict, key: str) -> Path:
     return p if p.is_absolute() else ROOT / p
 
 
-def check(cfg: dict) -> None:
-    """Cross-key rules of ``wolf_polynomial``; the transcribed tables are parsed here too, so
-    a wrong file stops the run at load time with one line naming its key."""
+def _grids(cfg: dict) -> np.ndarray:
+    """The area around a, the grid of the calibration (and the degree it supports), the
+    grids of the degree trade-off; the calibration grid's nodes."""
     a = cfg["plate.area_mm"]
-    if len(a) != 4 or not (a[0] < 0 < a[1] and a[2] < 0 < a[3]):
-        raise ConfigError("plate.area_mm", "must be [xmin, xmax, ymin, ymax] around the origin a")
-    if cfg["reduce.ab_mm"] > a[1]:
-        raise ConfigError("reduce.ab_mm", f"b = ({cfg['reduce.ab_mm']:g}, 0) lies outside the area")
+    require(
+        len(a) == 4 and a[0] < 0 < a[1] and a[2] < 0 < a[3],
+        "plate.area_mm",
+        "must be [xmin, xmax, ymin, ymax] around the origin a",
+    )
+    ab = cfg["reduce.ab_mm"]
+    require(ab <= a[1], "reduce.ab_mm", f"b = ({ab:g}, 0) lies outside the area")
     g = _grid_ok(cfg, cfg["plate.spacing_mm"], "plate.spacing_mm")
     d = cfg["calib.degree"]
     nx, ny = len(np.unique(g[:, 0])), len(np.unique(g[:, 1]))
-    if min(nx, ny) < d + 1:
-        raise ConfigError(
-            "calib.degree",
-            f"a degree-{d} polynomial needs at least {d + 1} grid "
-            f"columns and rows (the grid has {nx} x {ny})",
-        )
+    require(
+        min(nx, ny) >= d + 1,
+        "calib.degree",
+        f"a degree-{d} polynomial needs at least {d + 1} grid "
+        f"columns and rows (the grid has {nx} x {ny})",
+    )
     for s in cfg["trade.spacings_mm"]:
         _grid_ok(cfg, s, "trade.spacings_mm")
-    if (
-        3 not in cfg["trade.degrees"]
-        or len(set(cfg["trade.degrees"])) < 2
-        or cfg["plate.spacing_mm"] not in cfg["trade.spacings_mm"]
-        or cfg["calib.n_sets"] not in cfg["trade.n_sets"]
-    ):
-        raise ConfigError(
-            "trade.degrees",
-            "the degree trade-off must compare the cubic (3) with "
-            "another degree at plate.spacing_mm and calib.n_sets (they must be in "
-            "trade.spacings_mm and trade.n_sets): the claim on the cubic reads it",
-        )
-    if len(cfg["field.spread"]) != 2 or cfg["field.spread"][0] > cfg["field.spread"][1]:
-        raise ConfigError("field.spread", "must be [lo, hi] with lo <= hi")
+    require(
+        3 in cfg["trade.degrees"]
+        and len(set(cfg["trade.degrees"])) >= 2
+        and cfg["plate.spacing_mm"] in cfg["trade.spacings_mm"]
+        and cfg["calib.n_sets"] in cfg["trade.n_sets"],
+        "trade.degrees",
+        "the degree trade-off must compare the cubic (3) with "
+        "another degree at plate.spacing_mm and calib.n_sets (they must be in "
+        "trade.spacings_mm and trade.n_sets): the claim on the cubic reads it",
+    )
+    return g
+
+
+def _photograph(cfg: dict) -> None:
+    """The photograph of Tables 1 and 2 inside the calibrated area."""
+    a = cfg["plate.area_mm"]
     for key in ("repeat.format_mm", "repeat.centre_mm"):
-        if len(cfg[key]) != 2:
-            raise ConfigError(key, "must have two entries")
+        require(len(cfg[key]) == 2, key, "must have two entries")
     (w, h), (cx, cy) = cfg["repeat.format_mm"], cfg["repeat.centre_mm"]
-    if cx - w / 2 < a[0] or cx + w / 2 > a[1] or cy - h / 2 < a[2] or cy + h / 2 > a[3]:
-        raise ConfigError(
-            "repeat.format_mm",
-            "the photograph must lie inside the calibrated area "
-            "(the polynomial is not meant to extrapolate)",
-        )
-    m = (len(g) + len(mid_cells(a, cfg["plate.spacing_mm"]))) * cfg["calib.n_sets"]
-    m += cfg["check.n_points"] + 2 * (cfg["repeat.n_points"] + 4)
+    require(
+        a[0] <= cx - w / 2 and cx + w / 2 <= a[1] and a[2] <= cy - h / 2 and cy + h / 2 <= a[3],
+        "repeat.format_mm",
+        "the photograph must lie inside the calibrated area "
+        "(the polynomial is not meant to extrapolate)",
+    )
+
+
+def _chunk_work(cfg: dict, g: np.ndarray) -> None:
+    """At most :data:`MAX_CHUNK_CELLS` readings in a chunk of any part."""
+    mid = mid_cells(cfg["plate.area_mm"], cfg["plate.spacing_mm"])
+    m = (len(g) + len(mid)) * cfg["calib.n_sets"] + cfg["check.n_points"]
+    m += 2 * (cfg["repeat.n_points"] + 4)
     nmax = max([cfg["reading.n"], *cfg["trade.readings"]])
     for key in ("chunk", "trade.trials", "unprinted.trials"):
         per = min(cfg[key], cfg["chunk"]) * m * 2 * nmax
-        if per > MAX_CHUNK_CELLS:
-            raise ConfigError(
-                key,
-                f"a chunk would hold {per:.3g} readings (trials x points x "
-                f"readings), more than {MAX_CHUNK_CELLS:g}: use a smaller chunk",
-            )
+        require(
+            per <= MAX_CHUNK_CELLS,
+            key,
+            f"a chunk would hold {per:.3g} readings (trials x points x "
+            f"readings), more than {MAX_CHUNK_CELLS:g}: use a smaller chunk",
+        )
+
+
+def check(cfg: dict) -> None:
+    """Cross-key rules of ``wolf_polynomial``, in this order: the grids, the field's spread,
+    the photograph, the work per chunk; the transcribed tables are parsed here too, so a
+    wrong file stops the run at load time with one line naming its key."""
+    g = _grids(cfg)
+    spread = cfg["field.spread"]
+    require(
+        len(spread) == 2 and spread[0] <= spread[1],
+        "field.spread",
+        "must be [lo, hi] with lo <= hi",
+    )
+    _photograph(cfg)
+    _chunk_work(cfg, g)
     tables.load_table1(table_path(cfg, "table1.file"), "table1.file")
     tables.load_table3(table_path(cfg, "table3.file"), "table3.file")

@@ -36,6 +36,13 @@ from sim.studies.wolf.model import (
     true_plate,
 )
 
+
+def sub_chunk(trials: int, chunk: int) -> int:
+    """Chunk size of the smaller parts (trade-offs, cells): at most ``chunk``, and at least
+    four chunks, so they spread over the workers too."""
+    return max(1, min(chunk, -(-trials // 4)))
+
+
 #: the config keys a cell may override, and the field-amplitude factor
 CELL_KEYS = (
     "reading.n",

@@ -1,7 +1,8 @@
 """Scoring of ``wolf_polynomial``'s claims (the claim book ``claims.toml`` holds the paper's
 words and numbers; this module only supplies what the simulation and the recomputation from
-the paper's own printed data produced). Wolf & Pearsall 1976, seed ``000_668e60e68f004f98.txt``.
-Discrepancies in um.
+the paper's own printed data produced, as a table ``{claim id: Sim}`` that
+:func:`sim.claims.table.claim_rows` scores). Wolf & Pearsall 1976, seed
+``000_668e60e68f004f98.txt``. Discrepancies in um.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.intervals import bootstrap_ci, spread
+from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.mc.runner import chunk_rng
 from sim.studies.wolf.tables import STATS, recomputation, summary
 
@@ -26,6 +28,8 @@ SIMULATED = {
     "wolf.table2.": "mono",
 }
 HEADLINE = "wolf.headline.mean_vs_mono_um"
+#: the cubic against the other degrees of the trade-off
+CUBIC = "wolf.degree.cubic_excess_pct"
 #: Table 2 decided as one statement (Holm over its 24 one-plate rows)
 JOINT = "wolf.table2.joint_holm"
 
@@ -49,12 +53,12 @@ def _spread(x) -> tuple[np.ndarray, np.ndarray]:
     return np.array([lo]), np.array([hi])
 
 
-def score_simulated(book: ClaimBook, cid: str, stats: dict, n_inst: int, note: str = "") -> dict:
-    """Score one simulated claim on the per-trial statistics ``stats`` (one per instrument)."""
+def simulated(cid: str, stats: dict, n_inst: int, note: str = "") -> Sim:
+    """What the main experiment gave for one simulated claim, from the per-trial statistics
+    ``stats`` (one per instrument)."""
     if cid == HEADLINE:
         el = [_spread(stats[f"mono.mean_{ax}_um"]) for ax in AXES]
-        return book.score(
-            cid,
+        return Sim(
             interval="spread",
             elems=(np.concatenate([e[0] for e in el]), np.concatenate([e[1] for e in el])),
             note=note
@@ -63,15 +67,13 @@ def score_simulated(book: ClaimBook, cid: str, stats: dict, n_inst: int, note: s
             f"2.5-97.5 % range over {n_inst} simulated instruments and plates; "
             "holds when both ranges lie in Table 2's printed 3.0-8.3 um",
         )
-    return book.score(cid, samples=stats[stat_key(cid)], note=note)
+    return plates(stats[stat_key(cid)], note)
 
 
-def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook) -> list[dict]:
-    """Every claim of the book, scored."""
-    T = cfg["trials"]
-    S = cfg["calib.n_sets"]
-    out = []
-    notes = {
+def _simulated_notes(cfg: dict) -> dict[str, str]:
+    """Claim-id prefix -> the note of its simulated rows."""
+    T, S = cfg["trials"], cfg["calib.n_sets"]
+    return {
         "wolf.before.": f"over the pooled {S} calibration sets after the non-redundant two-point "
         f"reduction; distribution over {T} simulated instruments. The field "
         "amplitudes (field.*) were chosen so these look like the paper's; "
@@ -87,35 +89,56 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
         "fitted to the fiducials; every plate and set has the same simulated "
         "distribution",
     }
-    for cid in book.specs:
-        if stat_key(cid) is not None or cid == HEADLINE:
-            note = next((v for k, v in notes.items() if cid.startswith(k)), "")
-            out.append(score_simulated(book, cid, main, T, note))
-    out.append(joint_row(book, [r for r in out if r["claim"].startswith("wolf.table2.")]))
-    out += _table_checks(book, t1, t3)
-    for pre in ("check_after", "plate_after", "plate_before"):
-        for s in ("max", "rms"):
-            for ax in AXES:
-                out.append(
-                    book.score(
-                        f"wolf.{pre}.{s}_{ax}_um",
-                        samples=main[f"{pre}.{s}_{ax}_um"],
-                        note=f"{s} over the points; distribution over {T} instruments",
-                    )
-                )
+
+
+def _plate_stats(main: dict, T: int) -> dict[str, Sim]:
+    """The independent plate and the calibration plate after (and before) the correction,
+    and the similarity and affine fits of the uncorrected sets."""
+    table = {
+        f"wolf.{pre}.{s}_{ax}_um": plates(
+            main[f"{pre}.{s}_{ax}_um"],
+            f"{s} over the points; distribution over {T} instruments",
+        )
+        for pre in ("check_after", "plate_after", "plate_before")
+        for s in ("max", "rms")
+        for ax in AXES
+    }
     for kind in ("similarity", "affine"):
         for ax in AXES:
-            out.append(
-                book.score(
-                    f"wolf.before_{kind}.rms_{ax}_um",
-                    samples=main[f"before_{kind}.rms_{ax}_um"],
-                    note=f"each set fitted to all grid points by a least-squares "
-                    f"{kind}, pooled sets; the fit absorbs part of the systematic "
-                    "error the paper wanted to preserve",
-                )
+            table[f"wolf.before_{kind}.rms_{ax}_um"] = plates(
+                main[f"before_{kind}.rms_{ax}_um"],
+                f"each set fitted to all grid points by a least-squares "
+                f"{kind}, pooled sets; the fit absorbs part of the systematic "
+                "error the paper wanted to preserve",
             )
-    out.append(_cubic_excess(cfg, degt, book))
-    return out
+    return table
+
+
+def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook) -> list[dict]:
+    """Every claim of the book, scored: the simulated rows in the book's order, Table 2 as one
+    statement (it reads their p values), the paper-checks, the plate statistics, the cubic."""
+    T = cfg["trials"]
+    notes = _simulated_notes(cfg)
+    out = claim_rows(
+        book,
+        {
+            cid: simulated(
+                cid, main, T, next((v for k, v in notes.items() if cid.startswith(k)), "")
+            )
+            for cid in book.specs
+            if stat_key(cid) is not None or cid == HEADLINE
+        },
+    )
+    table2 = [r for r in out if r["claim"].startswith("wolf.table2.")]
+    return out + claim_rows(
+        book,
+        {
+            JOINT: joint(table2),
+            **_table_checks(t1, t3),
+            **_plate_stats(main, T),
+            CUBIC: _cubic_excess(cfg, degt),
+        },
+    )
 
 
 def holm(p) -> np.ndarray:
@@ -129,69 +152,57 @@ def holm(p) -> np.ndarray:
     return out
 
 
-def joint_row(book: ClaimBook, table_rows: list[dict]) -> dict:
+def joint(table_rows: list[dict]) -> Sim:
     """Table 2 decided as one statement: Holm over its one-plate rows' p values."""
     p = np.array([r["p_plate"] for r in table_rows], float)
     adj = holm(p)
     k = int(np.argmin(adj))
     n_row = int(np.sum(p < 0.05))
-    return book.score(
-        JOINT,
-        float(adj[k]),
-        interval="exact",
-        note=(
-            f"{p.size} rows; smallest raw p {p[k]:.3f} ({table_rows[k]['claim']}), Holm-adjusted "
-            f"{adj[k]:.3f}; {n_row} row(s) below 0.05 alone, "
-            f"{int(np.sum(adj < 0.05))} after the correction"
-        ),
+    return exact(
+        adj[k],
+        f"{p.size} rows; smallest raw p {p[k]:.3f} ({table_rows[k]['claim']}), Holm-adjusted "
+        f"{adj[k]:.3f}; {n_row} row(s) below 0.05 alone, "
+        f"{int(np.sum(adj < 0.05))} after the correction",
     )
 
 
-def _table_checks(book: ClaimBook, t1: dict, t3: dict) -> list[dict]:
+def _table_checks(t1: dict, t3: dict) -> dict[str, Sim]:
     """Paper-check rows: the summary lines recomputed from the paper's own printed data
     (Tables 1, 2 and 3, then the range of every recomputed mean line)."""
-    out, means = [], []
-    for part in (_table1_checks(book, t1), _table2_checks(book, t1), _table3_checks(book, t3)):
-        out += part[0]
+    table, means = {}, []
+    for part in (_table1_checks(t1), _table2_checks(t1), _table3_checks(t3)):
+        table |= part[0]
         means += part[1]
     m = np.array(means)
-    out.append(
-        book.score(
-            "wolf.summary.mean_range_check",
-            interval="exact",
-            elems=(m, m),
-            note=f"the {m.size} mean lines of Tables 1-3 recomputed from the "
-            f"paper's own data range from {m.min():.2f} to {m.max():.2f} um",
-        )
+    table["wolf.summary.mean_range_check"] = Sim(
+        interval="exact",
+        elems=(m, m),
+        note=f"the {m.size} mean lines of Tables 1-3 recomputed from the "
+        f"paper's own data range from {m.min():.2f} to {m.max():.2f} um",
     )
-    return out
+    return table
 
 
-def _table1_checks(book: ClaimBook, t1: dict) -> tuple[list[dict], list[float]]:
+def _table1_checks(t1: dict) -> tuple[dict[str, Sim], list[float]]:
     """Table 1's summary lines from its Set 1 and Set 2 coordinates; and its mean lines."""
-    out, means = [], []
+    table, means = {}, []
     for plate in ("003", "005"):
         sel = t1["plate"] == plate
         for s in STATS:
             for ax in AXES:
                 d = t1[f"d{ax}_sets_um"][sel]
-                out.append(
-                    book.score(
-                        f"wolf.table1.p{plate}.{s}_{ax}_um",
-                        summary(d)[s],
-                        interval="exact",
-                        note="recomputed from Table 1's Set 1 and Set 2 coordinates: "
-                        + recomputation(d, s),
-                    )
+                table[f"wolf.table1.p{plate}.{s}_{ax}_um"] = exact(
+                    summary(d)[s],
+                    "recomputed from Table 1's Set 1 and Set 2 coordinates: " + recomputation(d, s),
                 )
         means += [summary(t1[f"d{ax}_sets_um"][sel])["mean"] for ax in AXES]
-    return out, means
+    return table, means
 
 
-def _table2_checks(book: ClaimBook, t1: dict) -> tuple[list[dict], list[float]]:
+def _table2_checks(t1: dict) -> tuple[dict[str, Sim], list[float]]:
     """Table 2's summary lines (each Set minus the Foster coordinates) and the text's overall
     averages of them; and its mean lines."""
-    out, means = [], []
+    table, means = {}, []
     line = {s: [] for s in STATS}
     for plate in ("003", "005"):
         sel = t1["plate"] == plate
@@ -201,35 +212,27 @@ def _table2_checks(book: ClaimBook, t1: dict) -> tuple[list[dict], list[float]]:
                 sm = summary(d)
                 for s in STATS:
                     line[s].append(sm[s])
-                    out.append(
-                        book.score(
-                            f"wolf.table2_check.p{plate}.set{st}.{s}_{ax}_um",
-                            sm[s],
-                            interval="exact",
-                            note=f"recomputed from Set {st} (Table 1) minus the Foster coordinates "
-                            "(Table 2): " + recomputation(d, s),
-                        )
+                    table[f"wolf.table2_check.p{plate}.set{st}.{s}_{ax}_um"] = exact(
+                        sm[s],
+                        f"recomputed from Set {st} (Table 1) minus the Foster coordinates "
+                        "(Table 2): " + recomputation(d, s),
                     )
                 means.append(sm["mean"])
     for s in STATS:
         v = line[s]
-        out.append(
-            book.score(
-                f"wolf.table2_check.overall_{s}_um",
-                float(np.mean(v)),
-                interval="exact",
-                note=f"mean of the {len(v)} recomputed {s} values "
-                + ", ".join(f"{x:.2f}" for x in v)
-                + f" = {np.mean(v):.3f}",
-            )
+        table[f"wolf.table2_check.overall_{s}_um"] = exact(
+            np.mean(v),
+            f"mean of the {len(v)} recomputed {s} values "
+            + ", ".join(f"{x:.2f}" for x in v)
+            + f" = {np.mean(v):.3f}",
         )
-    return out, means
+    return table, means
 
 
-def _table3_checks(book: ClaimBook, t3: dict) -> tuple[list[dict], list[float]]:
+def _table3_checks(t3: dict) -> tuple[dict[str, Sim], list[float]]:
     """Table 3's summary lines from its printed differences (the points where the coordinates
     disagree with them named); and its mean lines."""
-    out, means = [], []
+    table, means = {}, []
     for ph in ("501", "505"):
         sel = t3["photo"] == ph
         for ax in AXES:
@@ -242,32 +245,25 @@ def _table3_checks(book: ClaimBook, t3: dict) -> tuple[list[dict], list[float]]:
             ]
             extra = ". The coordinates disagree with the printed difference at " + "; ".join(odd)
             for s in STATS:
-                out.append(
-                    book.score(
-                        f"wolf.table3_check.p{ph}.{s}_{ax}_um",
-                        summary(d)[s],
-                        interval="exact",
-                        note="recomputed from Table 3's printed differences: "
-                        + recomputation(d, s)
-                        + (extra if odd else ""),
-                    )
+                table[f"wolf.table3_check.p{ph}.{s}_{ax}_um"] = exact(
+                    summary(d)[s],
+                    "recomputed from Table 3's printed differences: "
+                    + recomputation(d, s)
+                    + (extra if odd else ""),
                 )
             means.append(summary(d)["mean"])
-    return out, means
+    return table, means
 
 
-def _cubic_excess(cfg: dict, degt: dict, book: ClaimBook) -> dict:
+def _cubic_excess(cfg: dict, degt: dict) -> Sim:
     """Excess (%) of the cubic's mean independent-plate rms over the best degree tried."""
-    cid = "wolf.degree.cubic_excess_pct"
     sp, ns = cfg["plate.spacing_mm"], cfg["calib.n_sets"]
     sel = (degt["spacing_mm"] == sp) & (degt["n_sets"] == ns)
     degs = np.unique(degt["degree"][sel]) if sel.any() else np.array([])
     if 3 not in degs or len(degs) < 2:
-        return book.score(
-            cid,
+        return exact(
             0.0,
-            interval="exact",
-            note="not evaluated: the degree trade-off (trade.degrees, "
+            "not evaluated: the degree trade-off (trade.degrees, "
             "trade.spacings_mm, trade.n_sets) does not compare the cubic with "
             "another degree at the study's spacing and number of sets",
         )
@@ -278,8 +274,7 @@ def _cubic_excess(cfg: dict, degt: dict, book: ClaimBook) -> dict:
     stat = lambda a: float((a[:, k3].mean() / a.mean(0).min() - 1) * 100)  # noqa: E731
     v, ci = bootstrap_ci(stat, mat, chunk_rng(cfg["seed"], 98, 0))
     m = mat.mean(0)
-    return book.score(
-        cid,
+    return Sim(
         v,
         ci,
         note=(

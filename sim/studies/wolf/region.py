@@ -24,8 +24,9 @@ import numpy as np
 from sim.claims.book import ClaimBook
 from sim.claims.book_region import load_declaration, sample_evidence
 from sim.claims.inference import Region, explore
-from sim.mc.runner import chunk_rng, run_chunks
-from sim.studies.wolf.chunks import main_chunk
+from sim.mc.runner import chunk_rng
+from sim.studies.run_steps import run_part
+from sim.studies.wolf.chunks import main_chunk, sub_chunk
 from sim.studies.wolf.claims import AXES, HEADLINE, JOINT, holm, stat_key
 
 DECLARATION = Path(__file__).with_name("region.toml")
@@ -88,15 +89,14 @@ def explore_region(cfg: dict, book: ClaimBook, ctx) -> tuple[Region, list[str]]:
     def model(x: dict[str, np.ndarray]) -> dict:
         calls[0] += 1
         cells = _cells(x, calls[0])
-        res = run_chunks(
+        res = run_part(
+            cfg,
+            ctx,
             main_chunk(cfg, cells, full=False),
-            Ts,
-            cfg["seed"],
-            max(1, min(cfg["chunk"], -(-Ts // 4))),
-            part=1 + calls[0],
-            ctx=ctx,
-            label=f"wolf region {calls[0]}",
-            quiet=ctx.quiet,
+            1 + calls[0],
+            f"wolf region {calls[0]}",
+            trials=Ts,
+            chunk=sub_chunk(Ts, cfg["chunk"]),
         )
         return evidence(book, ids, res, [t for t, _ in cells])
 

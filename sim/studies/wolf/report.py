@@ -15,8 +15,16 @@ import numpy as np
 
 from sim.instruments.plotter.errorfields import COMPONENTS
 from sim.report.markdown import fmt, md_table
-from sim.report.region import region_markdown
-from sim.report.section import config, figure, rows, section, table
+from sim.report.section import (
+    config,
+    figure,
+    printed,
+    recomputed,
+    region_lead,
+    rows,
+    section,
+    table,
+)
 from sim.studies.wolf.schema import SCHEMA
 
 __all__ = ["findings", "report"]
@@ -58,17 +66,11 @@ def findings(out: Path) -> list[str]:
             f"- Paper checks: {len(chk)} printed summary numbers recomputed from the "
             f"paper's own printed data; {len(err)} are errata: "
             + "; ".join(
-                f"`{r['claim']}` printed {_printed(r)}, recomputed {r['value']:.2f}" for r in err
+                f"`{r['claim']}` printed {printed(r)}, recomputed {recomputed(r)}" for r in err
             )
             + "."
         )
     return lines
-
-
-def _printed(r: dict) -> str:
-    mid = (r["ref_low"] + r["ref_high"]) / 2
-    dec = max(0, -int(math.floor(math.log10(r["ref_high"] - r["ref_low"]) + 1e-9)))
-    return f"{mid:.{dec}f}"
 
 
 def _model_text(cfg: dict, n_trials: int) -> str:
@@ -171,7 +173,12 @@ def report(out: Path) -> str:
     return section(
         out,
         lead=[
-            region_markdown(out, rows(out, "claims.parquet")),
+            region_lead(
+                out,
+                "The predictions (the corrected discrepancies and Table 2)",
+                values=f"each input vector simulated on the same {cfg['unprinted.trials']} "
+                "instruments (common random numbers), whose noise enters the decision",
+            ),
             figure(out, "consistent_region.png", "consistent region"),
         ],
         intro=[

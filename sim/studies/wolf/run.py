@@ -20,18 +20,19 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.claims.book import ClaimBook, write_claims
-from sim.claims.book_region import region_rows, write_region
+from sim.claims.book import write_claims
+from sim.claims.book_region import write_region
 from sim.claims.intervals import spread
 from sim.instruments.plotter import errorfields as ef
-from sim.mc.runner import chunk_rng, run_chunks
+from sim.mc.runner import chunk_rng
 from sim.mc.storage import provenance, write_table
 from sim.report.region import fig_region
 from sim.studies import RunContext
+from sim.studies.run_steps import over_region, run_part
 from sim.studies.wolf import claims as cl
 from sim.studies.wolf import figures, tables
 from sim.studies.wolf.checks import table_path
-from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk
+from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk, sub_chunk
 from sim.studies.wolf.grid import grid_nodes
 from sim.studies.wolf.model import field_spec, reading_error_rms
 from sim.studies.wolf.region import explore_region, nominal
@@ -46,12 +47,6 @@ def _summ(x):
         return np.nan, np.nan, np.nan
     med, (lo, hi) = spread(x)
     return med, lo, hi
-
-
-def sub_chunk(trials: int, chunk: int) -> int:
-    """Chunk size of the smaller parts: at most ``chunk``, and at least four chunks, so the
-    trade-offs and the sweeps spread over the workers too."""
-    return max(1, min(chunk, -(-trials // 4)))
 
 
 def reading_cells(cfg: dict) -> list[tuple[str, str, float, int, dict]]:
@@ -76,18 +71,13 @@ def reading_cells(cfg: dict) -> list[tuple[str, str, float, int, dict]]:
     return out
 
 
-def over_region(book: ClaimBook, region, preds: list[str], rows: list[dict]) -> list[dict]:
-    """Each prediction's row replaced by its verdict over the region (the configured inputs'
-    result kept in the note as an example)."""
-    by = {r["claim"]: r for r in rows}
-    fresh = ClaimBook(list(book.specs.values()), [], book.path)
-    notes = {
-        c: f"at the configured inputs (an example): {by[c]['value']:.3g} "
-        f"({by[c]['ci_low']:.3g}-{by[c]['ci_high']:.3g}), outcome {by[c]['outcome']}"
-        for c in preds
-    }
-    new = {r["claim"]: r for r in region_rows(fresh, region, preds, notes)}
-    return [new.get(r["claim"], r) for r in rows]
+def example_note(row: dict) -> str:
+    """The note of a prediction decided over the region: its result at the configured inputs
+    (value and interval) and the outcome, kept as an example."""
+    return (
+        f"at the configured inputs (an example): {row['value']:.3g} "
+        f"({row['ci_low']:.3g}-{row['ci_high']:.3g}), outcome {row['outcome']}"
+    )
 
 
 _READING_COLUMNS = (
@@ -110,15 +100,14 @@ def _readings(cfg: dict, out: Path, prov: dict, ctx: RunContext) -> None:
     rc = reading_cells(cfg)
     cells = [(t, o) for t, *_, o in rc]
     Ts, seed = cfg["unprinted.trials"], cfg["seed"]
-    res = run_chunks(
+    res = run_part(
+        cfg,
+        ctx,
         main_chunk(cfg, cells, full=False),
-        Ts,
-        seed,
-        sub_chunk(Ts, cfg["chunk"]),
-        part=1,
-        ctx=ctx,
-        label="wolf cells",
-        quiet=ctx.quiet,
+        1,
+        "wolf cells",
+        trials=Ts,
+        chunk=sub_chunk(Ts, cfg["chunk"]),
     )
     er = chunk_rng(seed, 30, 0)
     rd = {k: [] for k in _READING_COLUMNS}
@@ -168,10 +157,8 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     of the unprinted inputs, the degree and stability trade-offs, the paper's tables, the
     claims (predictions over the region), the figures."""
     prov = provenance(cfg)
-    T, seed, ch = cfg["trials"], cfg["seed"], cfg["chunk"]
-    main = run_chunks(
-        main_chunk(cfg), T, seed, ch, part=0, label="wolf main", quiet=ctx.quiet, ctx=ctx
-    )
+    T = cfg["trials"]
+    main = run_part(cfg, ctx, main_chunk(cfg), 0, "wolf main")
     write_table(out / "trials.parquet", {"trial": np.arange(T), **main}, prov)
     _vectors_and_components(cfg, out, prov)
     _readings(cfg, out, prov, ctx)
@@ -183,7 +170,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     degt = _degree(cfg, out, prov, ctx)
     _stability(cfg, out, prov, ctx)
     t1, t3 = _paper_tables(cfg, out, prov)
-    rows = over_region(book, region, preds, cl.rows(cfg, main, t1, t3, degt, book))
+    rows = over_region(book, region, preds, cl.rows(cfg, main, t1, t3, degt, book), example_note)
     write_claims(out / "claims.parquet", rows, prov, book)
     _region_figure(cfg, out, region)
     figures.late(cfg, out, ctx.executor)
@@ -227,7 +214,6 @@ def _vectors_and_components(cfg, out, prov):
 
 
 def _degree(cfg, out, prov, ctx) -> dict:
-    seed, q = cfg["seed"], ctx.quiet
     Tt = cfg["trade.trials"]
     cht = sub_chunk(Tt, cfg["chunk"])
     rows = {
@@ -251,15 +237,8 @@ def _degree(cfg, out, prov, ctx) -> dict:
         k: [] for k in ("spacing_mm", "n_sets", "degree", "trial", "fit_rms_um", "check_rms_um")
     }
     for i, sp in enumerate(cfg["trade.spacings_mm"]):
-        r = run_chunks(
-            degree_chunk(cfg, sp),
-            Tt,
-            seed,
-            cht,
-            part=10 + i,
-            ctx=ctx,
-            label=f"degree, {sp:g} mm",
-            quiet=q,
+        r = run_part(
+            cfg, ctx, degree_chunk(cfg, sp), 10 + i, f"degree, {sp:g} mm", trials=Tt, chunk=cht
         )
         npts = len(grid_nodes(cfg["plate.area_mm"], sp))
         for ns in cfg["trade.n_sets"]:
@@ -292,16 +271,7 @@ def _stability(cfg, out, prov, ctx) -> None:
     Tt = cfg["trade.trials"]
     cht = sub_chunk(Tt, cfg["chunk"])
     fr_, ages = cfg["trade.drift_fractions"], cfg["trade.ages_weeks"]
-    r = run_chunks(
-        stability_chunk(cfg, fr_, ages),
-        Tt,
-        cfg["seed"],
-        cht,
-        part=40,
-        ctx=ctx,
-        label="stability",
-        quiet=ctx.quiet,
-    )
+    r = run_part(cfg, ctx, stability_chunk(cfg, fr_, ages), 40, "stability", trials=Tt, chunk=cht)
     stb = {
         k: []
         for k in (

@@ -11,105 +11,89 @@ example.
 from __future__ import annotations
 
 from sim.mc.config import COMMON, Field
+from sim.mc.schema_helpers import count, counts, positive, real, reals
 
 __all__ = ["SCHEMA", "SEED"]
 
 SEED = "000_668e60e68f004f98.txt"
 
-_amp = dict(lo=0.0, hi=1000.0, unit="um", input=True)
+
+def _amp(default: float, doc: str) -> Field:
+    """A field amplitude (um at 100 mm from the centre), in [0, 1000], set to match the paper."""
+    return real(default, doc, lo=0.0, hi=1000.0, unit="um", input=True)
+
 
 SCHEMA = {
     **COMMON,
-    "trials": Field(
+    "trials": count(
         2000,
-        "int",
         "Monte-Carlo trials (simulated instruments) of the main experiment",
         lo=2,
         hi=100_000_000,
     ),
-    "chunk": Field(
-        500, "int", "trials per chunk (each chunk has its own spawned stream)", lo=1, hi=1_000_000
+    "chunk": count(
+        500, "trials per chunk (each chunk has its own spawned stream)", lo=1, hi=1_000_000
     ),
-    "plate.area_mm": Field(
+    "plate.area_mm": reals(
         [-100.0, 100.0, -40.0, 60.0],
-        "list[float]",
         "calibrated area [xmin, xmax, ymin, ymax] on the carrier, grid centre a "
         "at the origin (paper: 100 x 200 mm; a is an intersection, so the six "
         "rows cannot be symmetric about it)",
-        min_len=4,
-        hi=1000.0,
         lo=-1000.0,
-        input=True,
+        hi=1000.0,
+        min_len=4,
         unit="mm",
-    ),
-    "plate.spacing_mm": Field(
-        20.0,
-        "float",
-        "grid spacing (paper: 20 mm quadrille, 66 points)",
-        lo=0.0,
-        lo_open=True,
         input=True,
-        unit="mm",
     ),
-    "plate.grid_sigma_um": Field(
+    "plate.spacing_mm": positive(
+        20.0, "grid spacing (paper: 20 mm quadrille, 66 points)", unit="mm", input=True
+    ),
+    "plate.grid_sigma_um": real(
         1.0,
-        "float",
         "error of the known grid coordinates (paper: about +-1 um)",
         lo=0.0,
-        input=True,
         unit="um",
+        input=True,
     ),
-    "plate.rotation_sigma_deg": Field(
+    "plate.rotation_sigma_deg": real(
         0.1,
-        "float",
         "placement of a plate: rotation sigma (axes 'very nearly parallel')",
         lo=0.0,
         hi=10.0,
         unit="deg",
     ),
-    "plate.shift_sigma_mm": Field(
+    "plate.shift_sigma_mm": real(
         0.5,
-        "float",
         "placement of a plate: shift sigma per axis (a 'very near the centercross')",
         lo=0.0,
         hi=50.0,
         unit="mm",
     ),
-    "reduce.ab_mm": Field(
+    "reduce.ab_mm": positive(
         100.0,
-        "float",
         "length of line ab, b on the grid x axis (paper: 100 mm)",
-        lo=0.0,
-        lo_open=True,
-        input=True,
         unit="mm",
-    ),
-    "reading.count_um": Field(
-        4.0,
-        "float",
-        "size of one count on the plate (paper: roughly 4 um)",
-        lo=0.0,
-        lo_open=True,
-        hi=100.0,
         input=True,
+    ),
+    "reading.count_um": positive(
+        4.0,
+        "size of one count on the plate (paper: roughly 4 um)",
+        hi=100.0,
         unit="um",
+        input=True,
     ),
-    "reading.n": Field(
-        3, "int", "readings per point, averaged (paper: three)", lo=1, hi=100, input=True
-    ),
-    "reading.pointing_sigma_um": Field(
+    "reading.n": count(3, "readings per point, averaged (paper: three)", lo=1, hi=100, input=True),
+    "reading.pointing_sigma_um": real(
         7.0,
-        "float",
         "pointing error of one reading (not printed; an example: the "
         "predictions are decided over the region region.toml declares)",
         lo=0.0,
         hi=100.0,
-        input=True,
         unit="um",
+        input=True,
     ),
-    "reading.backlash_um": Field(
+    "reading.backlash_um": real(
         4.0,
-        "float",
         "backlash: a reading approached from one side is "
         "offset by +b/2 per axis, from the other by -b/2",
         lo=0.0,
@@ -123,142 +107,115 @@ SCHEMA = {
         choices=("one_side", "random"),
         input=True,
     ),
-    "field.plane_tilt_um": Field(
-        30.0, "float", "non-parallel measurement and carrier planes, displacement at 100 mm", **_amp
+    "field.plane_tilt_um": _amp(
+        30.0, "non-parallel measurement and carrier planes, displacement at 100 mm"
     ),
-    "field.xy_scale_um": Field(
-        45.0, "float", "different X and Y scales, difference over 100 mm", **_amp
-    ),
-    "field.ways_nonorthogonal_um": Field(
-        45.0, "float", "non-orthogonal ways, shear at 100 mm", **_amp
-    ),
-    "field.ways_curvature_um": Field(35.0, "float", "curved ways, bow at 100 mm", **_amp),
-    "field.encoder_periodic_um": Field(
-        2.5, "float", "periodic encoder non-linearity, amplitude", **_amp
-    ),
-    "field.encoder_period_mm": Field(
+    "field.xy_scale_um": _amp(45.0, "different X and Y scales, difference over 100 mm"),
+    "field.ways_nonorthogonal_um": _amp(45.0, "non-orthogonal ways, shear at 100 mm"),
+    "field.ways_curvature_um": _amp(35.0, "curved ways, bow at 100 mm"),
+    "field.encoder_periodic_um": _amp(2.5, "periodic encoder non-linearity, amplitude"),
+    "field.encoder_period_mm": real(
         50.0,
-        "float",
         "period of the encoder non-linearity",
         lo=1.0,
         hi=10000.0,
         unit="mm",
         input=True,
     ),
-    "field.gimbal_eccentricity_um": Field(
-        300.0,
-        "float",
-        "gimbal eccentricity along the space rod (most of it is a scale change)",
-        **_amp,
+    "field.gimbal_eccentricity_um": _amp(
+        300.0, "gimbal eccentricity along the space rod (most of it is a scale change)"
     ),
-    "field.gimbal_height_mm": Field(
+    "field.gimbal_height_mm": real(
         200.0,
-        "float",
         "height of the projection centre above the model plane",
         lo=10.0,
         hi=5000.0,
         unit="mm",
     ),
-    "field.stress_um": Field(8.0, "float", "position-dependent stress field, rms per axis", **_amp),
-    "field.stress_length_mm": Field(
-        70.0, "float", "correlation length of the stress field", lo=1.0, hi=10000.0, unit="mm"
+    "field.stress_um": _amp(8.0, "position-dependent stress field, rms per axis"),
+    "field.stress_length_mm": real(
+        70.0, "correlation length of the stress field", lo=1.0, hi=10000.0, unit="mm"
     ),
-    "field.spread": Field(
+    "field.spread": reals(
         [0.5, 1.5],
-        "list[float]",
         "each drawn amplitude is the set amplitude times U(lo, hi)",
         lo=0.0,
         hi=10.0,
         min_len=2,
     ),
-    "field.restitution_um": Field(
+    "field.restitution_um": real(
         2.0,
-        "float",
         "inconsistent mechanical restitution: a fresh "
         "smooth field at every placement, rms per axis",
         lo=0.0,
         hi=100.0,
         unit="um",
     ),
-    "field.restitution_length_mm": Field(
-        80.0, "float", "correlation length of the restitution field", lo=1.0, hi=10000.0, unit="mm"
+    "field.restitution_length_mm": real(
+        80.0, "correlation length of the restitution field", lo=1.0, hi=10000.0, unit="mm"
     ),
-    "field.drift_fraction": Field(
-        0.25,
-        "float",
-        "share of the field's variance that drifts with time (AR(1))",
-        lo=0.0,
-        hi=1.0,
-        unit="",
+    "field.drift_fraction": real(
+        0.25, "share of the field's variance that drifts with time (AR(1))", lo=0.0, hi=1.0
     ),
-    "field.drift_tau_weeks": Field(
-        52.0, "float", "time constant of the drift", lo=0.0, lo_open=True, unit="weeks"
+    "field.drift_tau_weeks": positive(52.0, "time constant of the drift", unit="weeks"),
+    "calib.n_sets": count(
+        3, "independent sets pooled in the fit (paper: three dates)", lo=1, hi=50, input=True
     ),
-    "calib.n_sets": Field(
-        3, "int", "independent sets pooled in the fit (paper: three dates)", lo=1, hi=50, input=True
-    ),
-    "calib.span_weeks": Field(
+    "calib.span_weeks": real(
         4.0,
-        "float",
         "the sets are spread over this period (paper: about a month)",
         lo=0.0,
         hi=520.0,
-        input=True,
         unit="weeks",
+        input=True,
     ),
-    "calib.degree": Field(
+    "calib.degree": count(
         3,
-        "int",
         "degree of the correction polynomial (3 = the paper's ten terms A1...A10)",
         lo=1,
         hi=8,
         input=True,
     ),
-    "check.age_weeks": Field(
+    "check.age_weeks": real(
         1.0,
-        "float",
         "the independent plate is read this long after the last calibration set",
         lo=0.0,
         hi=520.0,
         unit="weeks",
     ),
-    "check.n_points": Field(60, "int", "random points on the independent plate", lo=4, hi=10000),
-    "check.shift_sigma_mm": Field(
+    "check.n_points": count(60, "random points on the independent plate", lo=4, hi=10000),
+    "check.shift_sigma_mm": real(
         2.0,
-        "float",
         "independent plate: placement shift sigma per axis",
         lo=0.0,
         hi=100.0,
         unit="mm",
     ),
-    "check.rotation_sigma_deg": Field(
-        0.5, "float", "independent plate: placement rotation sigma", lo=0.0, hi=45.0, unit="deg"
+    "check.rotation_sigma_deg": real(
+        0.5, "independent plate: placement rotation sigma", lo=0.0, hi=45.0, unit="deg"
     ),
-    "repeat.n_points": Field(
-        10, "int", "points per photograph (paper, Table 1: 10 PUG marks)", lo=2, hi=1000, input=True
+    "repeat.n_points": count(
+        10, "points per photograph (paper, Table 1: 10 PUG marks)", lo=2, hi=1000, input=True
     ),
-    "repeat.format_mm": Field(
+    "repeat.format_mm": reals(
         [150.0, 100.0],
-        "list[float]",
         "photograph format (paper: P-30, 100 x 150 mm), fiducials at the midsides",
         lo=1.0,
         hi=1000.0,
         min_len=2,
-        input=True,
         unit="mm",
+        input=True,
     ),
-    "repeat.centre_mm": Field(
+    "repeat.centre_mm": reals(
         [0.0, 10.0],
-        "list[float]",
         "centre of the photograph on the carrier (middle of the calibrated area)",
         lo=-1000.0,
         hi=1000.0,
         min_len=2,
         unit="mm",
     ),
-    "repeat.gap_weeks": Field(
+    "repeat.gap_weeks": real(
         1.0,
-        "float",
         "time between the two sets of Table 1 (not stated)",
         lo=0.0,
         hi=520.0,
@@ -274,81 +231,55 @@ SCHEMA = {
         "str",
         "transcription of Table 3 (relative to the repository root)",
     ),
-    "mono.sigma_um": Field(
+    "mono.sigma_um": real(
         1.5,
-        "float",
         "error of one monocomparator coordinate (H. Dell Foster, "
         "Table 2; not printed: 'accurate enough'; an example, region.toml)",
         lo=0.0,
         hi=100.0,
-        input=True,
         unit="um",
+        input=True,
     ),
-    "unprinted.trials": Field(
+    "unprinted.trials": count(
         400,
-        "int",
         "instruments per cell of the readings trade-off and of the region's input vectors "
         "(common random numbers: the same instruments for every cell)",
         lo=2,
         hi=10_000_000,
     ),
-    "region.points": Field(
+    "region.points": count(
         32,
-        "int",
         "input vectors of the joint exploration's space-filling design (region.toml); each "
         "one cell on unprinted.trials instruments",
         lo=4,
         hi=4096,
     ),
-    "region.rounds": Field(1, "int", "refinement rounds at the region's boundary", lo=0, hi=4),
-    "trade.trials": Field(
-        400, "int", "trials per cell of the design trade-offs", lo=2, hi=10_000_000
-    ),
-    "trade.degrees": Field(
-        [1, 2, 3, 4, 5], "list[int]", "polynomial degrees compared", lo=1, hi=8, min_len=1
-    ),
-    "trade.spacings_mm": Field(
+    "region.rounds": count(1, "refinement rounds at the region's boundary", lo=0, hi=4),
+    "trade.trials": count(400, "trials per cell of the design trade-offs", lo=2, hi=10_000_000),
+    "trade.degrees": counts([1, 2, 3, 4, 5], "polynomial degrees compared", lo=1, hi=8),
+    "trade.spacings_mm": reals(
         [10.0, 20.0, 25.0, 50.0],
-        "list[float]",
         "grid spacings compared (each must divide ab)",
         lo=0.0,
         lo_open=True,
-        min_len=1,
         unit="mm",
     ),
-    "trade.n_sets": Field(
-        [1, 2, 3, 6], "list[int]", "numbers of pooled independent sets", lo=1, hi=50, min_len=1
+    "trade.n_sets": counts([1, 2, 3, 6], "numbers of pooled independent sets", lo=1, hi=50),
+    "trade.check_points": count(
+        100, "random independent points read in the same sets", lo=4, hi=10000
     ),
-    "trade.check_points": Field(
-        100, "int", "random independent points read in the same sets", lo=4, hi=10000
+    "trade.readings": counts([1, 2, 3, 5, 10], "readings per point compared", lo=1, hi=100),
+    "trade.pointing_sigmas_um": reals(
+        [2.0, 4.0, 7.0], "pointing sigmas compared", lo=0.0, hi=100.0, unit="um"
     ),
-    "trade.readings": Field(
-        [1, 2, 3, 5, 10], "list[int]", "readings per point compared", lo=1, hi=100, min_len=1
-    ),
-    "trade.pointing_sigmas_um": Field(
-        [2.0, 4.0, 7.0],
-        "list[float]",
-        "pointing sigmas compared",
-        lo=0.0,
-        hi=100.0,
-        min_len=1,
-        unit="um",
-    ),
-    "trade.ages_weeks": Field(
+    "trade.ages_weeks": reals(
         [0.0, 2.0, 4.0, 8.0, 13.0, 26.0, 52.0, 104.0, 208.0],
-        "list[float]",
         "ages of the calibration compared",
         lo=0.0,
         hi=5200.0,
-        min_len=1,
         unit="weeks",
     ),
-    "trade.drift_fractions": Field(
-        [0.25, 0.5, 0.75, 1.0],
-        "list[float]",
-        "drifting shares of the field compared",
-        lo=0.0,
-        hi=1.0,
-        min_len=1,
+    "trade.drift_fractions": reals(
+        [0.25, 0.5, 0.75, 1.0], "drifting shares of the field compared", lo=0.0, hi=1.0
     ),
 }
