@@ -194,18 +194,15 @@ def test_study_runs_small(tmp_path):
         "paper_check.mark_spacing_mm",
     ):
         assert v["salsig." + q] == "holds", q
-    # decided over the region of the unprinted relief, errors and control (never at one
-    # nominal relief); 'cut roughly in half' over models this spread cannot hold everywhere
-    assert v["salsig.vertical_halved.rms_ratio"] in (
-        "depends",
-        "fails",
-        "fails or undecided",
-        "undecidable",
-    )
-    assert v["salsig.vertical_halved.rms_ratio"] != "holds"
-    assert check_region_rows(out) >= 3  # each region verdict is its points' rule
+    # 'cut roughly in half' is the one printed number about the unprinted test models: it
+    # constrains their relief and errors (an input), and the same sentence's vertical
+    # 'dramatic' is its echo; the horizontal improvement is decided over the region
+    assert v["salsig.vertical_halved.rms_ratio"] == "input"
+    assert v["salsig.vertical_halved.dramatic_vertical"] == "input"
+    assert check_region_rows(out) == 2  # each region verdict is its points' rule
     reg = read_table(out / "consistent_region.parquet").to_pydict()
-    assert len(reg["relief_mm"]) == 8  # nothing printed constrains them: every vector stays
+    assert len(reg["relief_mm"]) <= 8  # the vectors where a halving is not rare stay
+    assert "fails" not in reg["salsig.vertical_halved.rms_ratio"]
     for fig in ("residuals", "recovery", "power", "vertical", "consistent_region"):
         assert (out / f"{fig}.png").is_file()
     text = report(out)

@@ -5,8 +5,11 @@ The instrument and its unprinted inputs with their hardware ranges are declared 
 only supplies Brown's model (analytic cofactors, :mod:`.values`; no Monte-Carlo noise, so
 every value is exact) and which printed statements constrain the inputs:
 
-* every study: the 261 mm scale plus the 1 mm micrometer reads every range of the plate
-  (``hardware.scale_reads``);
+* every study: the 261 mm scale plus the 1 mm micrometer reads every range of the plate,
+  from its zero mark: 0 to 262 mm (``hardware.scale_reads``). A point nearer a station than
+  the pivot offset beta has no real range (``(r + alpha)^2 + beta^2 = d^2`` with ``d < beta``)
+  and a negative range is not on the scale: such a geometry is not buildable and is excluded,
+  not left undecided;
 * ``brown_table1``: the plate's printed rms error of closure, 1.6 um (the sigma0 that
   scales all 50 printed standard deviations; its rounding 1.55-1.65 um).
 
@@ -31,15 +34,17 @@ from sim.claims.region import (
 )
 from sim.claims.region import inputs_table as region_inputs
 from sim.instruments.ranges import brown as B
+from sim.instruments.ranges import multilateration as ml
 from sim.mc.runner import chunk_rng
 from sim.studies.brown import values as V
 
 SCALE = Statement(
     "hardware.scale_reads",
-    (B.REACH_MM, B.REACH_MM),
-    "upper",
+    (0.0, B.REACH_MM),
+    "range",
     paper="graduated at one-millimeter intervals over a length of 261 mm ... the micrometer "
-    "limits this translation to at most one millimeter (the longest range, mm)",
+    "limits this translation to at most one millimeter (the shortest and the longest range, "
+    "mm: both on the scale)",
     source="004, Implementation of the Concept",
 )
 T1 = "brown.table1_point_sigma."
@@ -61,6 +66,14 @@ CONCEPT_PREDICTIONS = (
 EDGE_POINTS = 25
 #: grids of the "more points, less dilution" prediction over the region (same extent)
 MONOTONE_GRIDS = (3, 5, 7)
+
+
+def scale_evidence(P: np.ndarray, TH: np.ndarray) -> np.ndarray:
+    """The shortest and the longest range of each geometry ``(G, 2)`` (mm); a range that is
+    not real (a point nearer its station than beta) counts as -1 mm, off the scale."""
+    with np.errstate(invalid="ignore"):
+        r = np.nan_to_num(ml.ranges(P, TH), nan=-1.0)
+    return np.stack([r.min(axis=(1, 2)), r.max(axis=(1, 2))], -1)
 
 
 def inputs(names):
@@ -89,7 +102,7 @@ def table1_model(x: dict) -> dict:
     cof = V.sigmas(P, TH, "pivot")  # (N, 25, 2) sigma / sigma0
     st = V.point_sigma_stats(s0[:, None, None] * cof)
     return {
-        SCALE.id: B.max_range_mm(P, TH),
+        SCALE.id: scale_evidence(P, TH),
         "brown.table1_closure.rms_um": s0,
         T1 + "share_1p1_1p3": st["share"],
         T1 + "points_ge_1p45": st["count"],
@@ -135,7 +148,7 @@ def concept_model(x: dict) -> dict:
     dil = (V.pooled(st) / V.pooled(kn) - 1) * 100
     extra = (V.pooled(pv) / V.pooled(st) - 1) * 100
     return {
-        SCALE.id: B.max_range_mm(P, TH),
+        SCALE.id: scale_evidence(P, TH),
         "brown.known_center.ratio": V.pooled(kn[:, 12]),
         "brown.known_edge.ratio": edge,
         "brown.dilution.range_pct": dil,
@@ -183,7 +196,7 @@ _T1_AT = (
 TABLE1_NOTES = {
     T1 + "share_1p1_1p3": "share of the 50 sigmas printing as 1.1-1.3 um" + _T1_AT,
     T1 + "points_ge_1p45": "points whose larger sigma prints >= 1.5 um (the model's four "
-    "stations are symmetric, so its points come in fours: read as 'at least 2')" + _T1_AT,
+    "stations are symmetric, so its points come in fours: 'two points' read as 2-4)" + _T1_AT,
     T1 + "max_um": "largest of the 50 sigmas (um)" + _T1_AT,
     T1 + "below_closure": "every sigma / sigma0 = sqrt(cofactor) below 1" + _T1_AT,
     T1_JOINT: "1 where the four statements above hold at the same input vector" + _T1_AT,

@@ -5,9 +5,10 @@ Salsig's "the root-mean-square error of the vertical control point residuals was
 roughly in half" and "the improvement was dramatic, both horizontally and vertically" come
 from stereomodels he does not describe: their relief, the errors of their control points and
 how many there were are not printed. ``region.toml`` declares them with their physically
-possible ranges; no printed statement constrains them, so the region is the whole range and
-each prediction is decided over it (holds / fails everywhere, depends with where, or
-undecidable), never at one nominal relief. The model at each input vector simulates
+possible ranges; the one printed number about those models, the halving, constrains them (a
+point is in the region unless its models make a halving rare, the one-plate rule), and the
+horizontal improvement is decided over the region (holds / fails everywhere, depends with
+where, or undecidable), never at one nominal relief. The model at each input vector simulates
 ``region.trials`` models (:func:`sim.studies.salsig.model.simulate_vertical`): the ratio is a
 one-plate statistic (the book's rule: spread and ``p``), the "dramatic" factors are decided
 on their 2.5-97.5 % spread over models.
@@ -64,7 +65,7 @@ def explore_region(cfg: dict, book: ClaimBook, rng: np.random.Generator) -> tupl
 
     def model(x: dict[str, np.ndarray]) -> dict:
         m = len(x["relief_mm"])
-        s = {c: np.empty((m, n)) for c in dec.predictions}
+        s = {c: np.empty((m, n)) for c in (RATIO, DRAM_Z, DRAM_XY)}
         for i in range(m):
             for c, v in vertical_stats(cfg, x, i, rng, n).items():
                 s[c][i] = v

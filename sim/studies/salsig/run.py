@@ -129,7 +129,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     fig_region(
         region,
         out / "consistent_region.png",
-        title="seed 002: the vertical test's unprinted inputs (none constrained by the paper)",
+        title="seed 002: the vertical test's unprinted inputs (constrained by 'cut roughly in half')",
         nominal=nominal(cfg),
     )
     drawn()
