@@ -501,16 +501,15 @@ def test_monte_carlo_point_errors_match_adjustment_covariance(small):
 
 def test_input_rows_follow_the_config():
     """An input row reports the run's value (here changed by an override), never a typed one."""
+    from sim.claims.table import claim_rows
     from sim.studies.agnard.claims import input_rows, load_book
     from sim.studies.agnard.schema import block_of
 
     _, cfg = load_study(STUDY, ["scan.max_y_um=30.0"])
     b = block_of(cfg)
     book = load_book()
-    rows = {
-        r["claim"]: r
-        for r in input_rows(book, cfg, b, select_control(b, "five"), select_control(b, "full"))
-    }
+    table = input_rows(book, cfg, b, select_control(b, "five"), select_control(b, "full"))
+    rows = {r["claim"]: r for r in claim_rows(book, table)}
     assert rows["agnard.input.scan.max_y_um"]["value"] == 30.0
     assert rows["agnard.input.scan.max_y_um"]["verdict"] == "input"
     assert rows["agnard.scanner.pixel_um"]["verdict"] == "holds"  # 25.4 mm / 600

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.claims.book import ClaimBook, write_claims
-from sim.claims.book_region import region_rows, write_region
+from sim.claims.book import write_claims
+from sim.claims.book_region import write_region
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
 from sim.mc.runner import run_chunks
@@ -34,6 +34,7 @@ from sim.studies.agnard.claims import claim_rows, load_book
 from sim.studies.agnard.region import explore_region
 from sim.studies.agnard.schema import NAME, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
+from sim.studies.run_steps import over_region
 
 
 def _mean_se(x: np.ndarray) -> tuple[float, float]:
@@ -252,15 +253,15 @@ def _five_region(cfg, block, book, rows, ctx, part, prov, out):
         title="seed 003: the lost five-point layout (no printed statement constrains it)",
         nominal={"five_inset_1": 0.0},
     )
-    by = {r["claim"]: r for r in rows}
-    fresh = ClaimBook(list(book.specs.values()), [], book.path)
-    notes = {
-        c: f"at the configured layout (an example): median {by[c]['value']:.3g} cm, 95 % of "
-        f"blocks {by[c]['ci_low']:.3g}-{by[c]['ci_high']:.3g}, outcome {by[c]['outcome']}"
-        for c in preds
-    }
-    new = {r["claim"]: r for r in region_rows(fresh, region, preds, notes)}
-    return [new.get(r["claim"], r) for r in rows], insets
+    return over_region(book, region, preds, rows, _example_note), insets
+
+
+def _example_note(row: dict) -> str:
+    """The configured layout's result of a 5-control row, kept as an example."""
+    return (
+        f"at the configured layout (an example): median {row['value']:.3g} cm, 95 % of "
+        f"blocks {row['ci_low']:.3g}-{row['ci_high']:.3g}, outcome {row['outcome']}"
+    )
 
 
 def _layout(block, c5, c21, prov, out) -> None:
