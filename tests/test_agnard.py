@@ -17,6 +17,7 @@ from sim.instruments.block.layout import CONTROL_PATTERNS, make_block, select_co
 from sim.instruments.geometry import similarity_fit
 from sim.mc.config import ConfigError
 from sim.studies import load_study
+from sim.studies.agnard.region import SCANNER_KEYS
 
 STUDY = "studies/agnard_block.toml"
 
@@ -351,6 +352,8 @@ def test_bad_config_names_the_key():
         load_study(STUDY, ["block.ground_points=12"])
     with pytest.raises(ConfigError, match="region.points"):
         load_study(STUDY, ["region.points=1"])
+    with pytest.raises(ConfigError, match="table1.points"):
+        load_study(STUDY, ["table1.points=1"])
     with pytest.raises(ConfigError, match="chunk"):
         load_study(STUDY, ["chunk=1000000"])
 
@@ -395,6 +398,8 @@ def test_tiny_run_writes_claims_and_report(tiny_run):
         "consistent_region.png",
         "trials.parquet",
         "consistent_region.parquet",
+        "scanner_region.png",
+        "scanner_region.parquet",
     ):
         assert (out / f).is_file()
 
@@ -417,17 +422,45 @@ def test_five_control_rows_decided_over_the_region(tiny_run):
     assert check_region_rows(out) >= 2  # each region verdict is its points' rule
 
 
-def test_table1_rows_are_not_comparable(tiny_run):
-    """Table 1's setup is not printed and the simulated scanner cannot reach its 'without'
-    rms: every Table 1 row (with, without, ratio) is 'not comparable', none an erratum."""
+def test_table1_rows_are_not_comparable_because_the_scanner_region_is_empty(tiny_run):
+    """The scanner's unprinted inputs (scanner.toml) explored under Table 1: no vector
+    reproduces its 'without' rms (the printed +-40 um peak is 0.25 m on the ground), so the
+    region is empty, the conflicting statements are named, and every Table 1 row (with,
+    without, ratio) is 'not comparable' because of that, none an erratum."""
     from sim.mc.storage import read_table
 
-    rows = {r["claim"]: r for r in read_table(tiny_run[2] / "claims.parquet").to_pylist()}
+    _, cfg, out = tiny_run
+    reg = read_table(out / "scanner_region.parquet").to_pydict()
+    assert len(reg["accepted"]) == cfg["table1.points"] and not any(reg["accepted"])
+    for w in ("ctrl", "check"):
+        for c in ("x", "y"):
+            cid = f"agnard.table1.without_{w}_{c}_m"
+            assert set(reg[cid]) == {"fails"}, cid
+            assert max(reg[f"{cid}__value"]) < 0.5  # far below Table 1's 0.99-1.53 m
+    inp = read_table(out / "scanner_region_inputs.parquet").to_pydict()
+    assert inp["input"] == list(SCANNER_KEYS) and inp["n_region"] == [0] * len(SCANNER_KEYS)
+    rows = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
     t1 = [k for k in rows if k.startswith("agnard.table1.")]
     assert len(t1) == 12
     for k in t1:
         assert rows[k]["verdict"] == "not comparable", k
-        assert rows[k]["note"], k
+        assert "empty, no vector reproduces Table 1 (conflicting: " in rows[k]["note"], k
+        assert "without_ctrl_y_m" in rows[k]["note"], k
+
+
+def test_scanner_inputs_set_the_config_keys_they_name():
+    """Every input of scanner.toml sets an existing scan.* key, inside the key's own bounds."""
+    from sim.claims.book_region import load_declaration
+    from sim.studies.agnard.claims import load_book
+    from sim.studies.agnard.region import SCANNER
+    from sim.studies.agnard.schema import SCHEMA
+
+    dec = load_declaration(SCANNER, load_book())
+    assert [i.name for i in dec.inputs] == list(SCANNER_KEYS)
+    for i in dec.inputs:
+        f = SCHEMA[SCANNER_KEYS[i.name]]
+        assert f.lo <= i.low < i.high <= f.hi, i.name
+    assert len(dec.statements) == 8 and not dec.predictions
 
 
 def test_budget_recomputation_and_pointing_model():
@@ -454,6 +487,7 @@ def test_chunk_functions_pickle():
         partial(ch.sweep_chunk, cfg, b, (0.0, 0.17)),
         partial(ch.pugging_chunk, cfg, b, 0.5),
         partial(ch.scanner_chunk, cfg, b, 300.0),
+        partial(ch.table1_chunk, cfg, b, ({"scan.stepper_share": 0.5},)),
     ):
         assert pickle.loads(pickle.dumps(fn)).func is fn.func
 

@@ -83,7 +83,7 @@ HOLDS, UNDECIDED, FAILS = 1, 0, -1
 FORMS = ("value", "share", "count", "upper", "lower", "range", "one-plate")
 _INPUT_KEYS = {"low", "high", "why"}
 _STATEMENT_KEYS = {"paper", "source", "form", "ref", "decimals", "tol", "decide"}
-_UNITS = ("_mm", "_um", "_m", "_deg", "_pct", "_min", "_1")
+_UNITS = ("_mm", "_um", "_m", "_deg", "_pct", "_min", "_px", "_1")
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
+from sim.claims.inference import FAILS, Region
 from sim.claims.intervals import spread
 from sim.claims.table import Sim, exact, mc, plates
 from sim.claims.table import claim_rows as table_rows
@@ -37,54 +38,61 @@ def _where(p: float, x: np.ndarray) -> str:
     return f"{100 * np.mean(np.asarray(x) < p):.0f} % of the simulated blocks lie below the paper's value"
 
 
-def table1_rows(book: ClaimBook, cfg: dict, sim: dict) -> list[dict]:
-    """Table 1: every printed number is ``not comparable`` (its setup is not printed and the
-    simulated scanner cannot reach its 'without' rms); the notes give the gap to Tables 2-3
-    and the simulated without/with ratio for information."""
+def _over(region: Region, stats: list[dict], cid: str) -> str:
+    """A Table 1 row over the scanner region: the range of its per-vector medians and of the
+    blocks' 95 % spread, and at how many vectors the printed number is contradicted."""
+    med = np.array([np.median(p[cid]) for p in stats])
+    lo = min(spread(p[cid])[1][0] for p in stats)
+    hi = max(spread(p[cid])[1][1] for p in stats)
+    j = [st.id for st in region.statements].index(cid)
+    k = int((region.status[:, j] == FAILS).sum())
+    return (
+        f"simulated median {med.min():.2f}-{med.max():.2f} m over the {len(stats)} explored "
+        f"scanner vectors (95 % of blocks within {lo:.2f}-{hi:.2f} m); the printed "
+        f"{ref_of(region, cid):g} m is contradicted at {k} of {len(stats)}"
+    )
+
+
+def ref_of(region: Region, cid: str) -> float:
+    return next(st.ref[0] for st in region.statements if st.id == cid)
+
+
+def table1_rows(book: ClaimBook, region: Region, stats: list[dict]) -> list[dict]:
+    """Table 1: not comparable because no scanner vector reproduces it (the region of
+    ``scanner.toml`` is empty, the conflicting statements named in every note); when some
+    vector did, the rows would still be no prediction, and the note says where they stand.
+    Notes: each row's simulated values over the explored vectors."""
+    conf = "; ".join(" + ".join(c.split(".")[-1] for c in cs) for cs in region.conflicts)
+    head = (
+        f"Scanner region (scanner.toml: {region.describe(np.ones(region.n, bool))}, "
+        f"{region.n} vectors explored jointly): "
+        + (
+            f"empty, no vector reproduces Table 1 (conflicting: {conf})"
+            if region.empty
+            else f"{int(region.accepted.sum())} vectors consistent ({region.describe()})"
+        )
+    )
     rows = []
-    lay = cfg["control.table1"]
     for w in ("ctrl", "check"):
         for c in ("x", "y"):
-            cid = f"agnard.table1.with_{w}_{c}_m"
-            t1 = ref(book, cid)
-            t23 = {
-                n: ref(book, f"agnard.{n}.{w}_{c}_cm") / 100 for n in ("control_5", "control_21")
-            }
-            best = min(t23.values(), key=lambda v: abs(v - t1))
-            rows.append(
-                book.not_comparable(
-                    cid,
-                    note=(
-                        f"For information: Tables 2-3 give {w} {c.upper()} rms "
-                        f"{100 * t23['control_5']:.0f} cm with 5 control and "
-                        f"{100 * t23['control_21']:.0f} cm with 21; the nearer, {100 * best:.0f} cm, "
-                        f"is {t1 / best:.1f} x below Table 1's {t1:.2f} m."
-                    ),
+            for tag in ("with", "without"):
+                cid = f"agnard.table1.{tag}_{w}_{c}_m"
+                rows.append(
+                    book.not_comparable(cid, note=f"{head}. This row: {_over(region, stats, cid)}.")
                 )
-            )
-            key = f"{w}_{c}_m"
-            x = sim[f"without.{key}"]
-            med, (lo, hi) = spread(100 * x)
-            rows.append(
-                book.not_comparable(
-                    f"agnard.table1.without_{key}",
-                    note=(
-                        f"For information, the simulated rms without correction ({lay} control) is "
-                        f"{med:.1f} cm (95 % of {x.size} blocks {lo:.1f}-{hi:.1f} cm)."
-                    ),
+            ratio = [
+                np.median(
+                    p[f"agnard.table1.without_{w}_{c}_m"] / p[f"agnard.table1.with_{w}_{c}_m"]
                 )
-            )
-            ratio = sim[f"without.{key}"] / sim[f"layout_{lay}.{key}"]
-            rmed, (rlo, rhi) = spread(ratio)
+                for p in stats
+            ]
             rows.append(
                 book.not_comparable(
                     f"agnard.table1.ratio_{w}_{c}",
                     note=(
-                        f"For information: the simulated per-block ratio without / with the grid "
-                        f"correction ({lay} control, scanner peaking at {cfg['scan.max_x_um']:g} / "
-                        f"{cfg['scan.max_y_um']:g} um in x / y) is {rmed:.2f} (95 % of {ratio.size} "
-                        f"blocks {rlo:.2f}-{rhi:.2f}); the deformation's peak is "
-                        f"{cfg['scan.max_y_um'] * cfg['block.scale'] * 1e-4:.1f} cm on the ground (y)."
+                        f"{head}. The simulated per-block ratio without / with the grid "
+                        f"correction has median {min(ratio):.2f}-{max(ratio):.2f} over the "
+                        "explored vectors."
                     ),
                 )
             )
@@ -362,9 +370,19 @@ def anisotropy_rows(book: ClaimBook, cfg: dict, sim: dict) -> dict[str, Sim]:
 
 
 def claim_rows(
-    cfg: dict, block: Block, sim: dict, c5, c21, scan_t: dict, pug: dict, book: ClaimBook
+    cfg: dict,
+    block: Block,
+    sim: dict,
+    c5,
+    c21,
+    scan_t: dict,
+    pug: dict,
+    book: ClaimBook,
+    scanner: Region,
+    scanner_stats: list[dict],
 ) -> list[dict]:
-    """Every claim of the book, scored once."""
+    """Every claim of the book, scored once (Table 1 over the ``scanner`` region, with the
+    per-vector statistics ``scanner_stats``)."""
     table = {
         **scanner_rows(scan_t),
         **input_rows(book, cfg, block, c5, c21),
@@ -374,7 +392,7 @@ def claim_rows(
         **rejection_rows(book, cfg, block, sim, pug),
         **anisotropy_rows(book, cfg, sim),
     }
-    rows = table1_rows(book, cfg, sim) + table_rows(book, table)
+    rows = table1_rows(book, scanner, scanner_stats) + table_rows(book, table)
     for r in rows:  # an unbounded side of a bound's zone is "no number" (null), not infinity
         for k in ("zone_low", "zone_high"):
             if not np.isfinite(r[k]):

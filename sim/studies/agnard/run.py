@@ -1,13 +1,15 @@
 """Run of ``agnard_block`` (seed ``003_5ce730a990a7ebc5.txt``) through the runner.
 
 Streams (``part``): 0 the 2 x 8 block with every adjustment of the paper; then one per scan
-resolution, one per block size, one per mechanical re-centring error, and one for the region
-of the unprinted five-point control layout (:mod:`.region`). Every part goes through :func:`sim.mc.runner.run_chunks` with
+resolution, one per block size, one per mechanical re-centring error, one for the region
+of the unprinted five-point control layout, and (from 800, apart) the scanner region under
+Table 1 (:mod:`.region`). Every part goes through :func:`sim.mc.runner.run_chunks` with
 the run context (executor, chunk store), with picklable chunk functions
 (:mod:`.chunks`), so ``--workers``, Dask and resumption after a kill apply.
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
 tables, ``region_five.parquet`` (per block and layout), ``consistent_region.parquet``,
-``region_inputs.parquet``, ``region_layouts.parquet``,
+``region_inputs.parquet``, ``region_layouts.parquet``, ``scanner_region.parquet`` (every
+explored scanner vector) and ``scanner_region_inputs.parquet``,
 ``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each sent to the run's
 workers, when it has some, as soon as its data exist: :func:`sim.report.figure_jobs.start_figures`).
 """
@@ -20,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import write_claims
-from sim.claims.book_region import write_region
+from sim.claims.book_region import write_explored, write_region
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
 from sim.mc.runner import run_chunks
@@ -31,7 +33,7 @@ from sim.studies import RunContext
 from sim.studies.agnard import chunks as ch
 from sim.studies.agnard import figures as fg
 from sim.studies.agnard.claims import claim_rows, load_book
-from sim.studies.agnard.region import explore_region
+from sim.studies.agnard.region import SCANNER_KEYS, explore_region, explore_scanner
 from sim.studies.agnard.schema import NAME, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
 from sim.studies.run_steps import over_region
@@ -264,6 +266,25 @@ def _example_note(row: dict) -> str:
     )
 
 
+def _scanner_region(cfg, block, book, ctx, prov, out):
+    """Explore the scanner's unprinted inputs under Table 1 (``scanner.toml``); write
+    ``scanner_region.parquet`` (every explored vector), ``scanner_region_inputs.parquet`` and
+    its figure. Returns the region and the per-vector Table 1 statistics."""
+    region, stats = explore_scanner(
+        cfg, block, book, lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx)
+    )
+    write_explored(out / "scanner_region.parquet", region, prov)
+    nominal = {name: cfg[key] for name, key in SCANNER_KEYS.items()}
+    fig_region(
+        region,
+        out / "scanner_region.png",
+        title="seed 003: the scanner's unprinted inputs under Table 1"
+        + (" (no vector consistent)" if region.empty else ""),
+        nominal=nominal,
+    )
+    return region, stats
+
+
 def _layout(block, c5, c21, prov, out) -> None:
     """``layout.parquet``: every point of the block (m), its kind (check, pass, control of
     the many- or few-point layout or both) and the number of models it appears in."""
@@ -331,7 +352,9 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     base += len(cfg["tradeoff.recentre_px"])
 
     # --- the unprinted five-point layout: its region, the 5-control rows decided over it
-    rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book)
+    # --- the scanner's unprinted inputs under Table 1, then every claim
+    scanner, scanner_stats = _scanner_region(cfg, block, book, ctx, prov, out)
+    rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book, scanner, scanner_stats)
     rows, insets = _five_region(cfg, block, book, rows, ctx, base, prov, out)
     ctrl_idx = _region_layouts(block, insets, prov, out)
     write_claims(out / "claims.parquet", rows, prov, book)

@@ -164,6 +164,15 @@ SCHEMA = {
         150, "simulated blocks per input vector of the region (region.toml)", 2, 1_000_000
     ),
     "region.points": count(8, "five-point layouts of the region's space-filling design", 2, 64),
+    "table1.points": count(
+        32, "scanner vectors of the Table 1 region's space-filling design (scanner.toml)", 2, 256
+    ),
+    "table1.trials": count(
+        10, "simulated blocks per scanner vector of the Table 1 region", 2, 10_000
+    ),
+    "table1.rounds": count(
+        0, "boundary refinement rounds of the Table 1 region (none while it is empty)", 0, 5
+    ),
 }
 
 
