@@ -242,3 +242,15 @@ def test_write_explored_keeps_every_vector_of_an_empty_region(tmp_path):
 def test_pixel_inputs_are_declared_in_their_unit():
     (i,), _ = parse_declaration({"inputs": {"grid_sigma_px": {"low": 0, "high": 0.5}}})
     assert i.name == "grid_sigma_px"
+
+
+def test_setting_a_statement_aside_restores_what_the_others_leave():
+    """A statement that empties the region alone, set aside, leaves exactly the region of
+    the other statements on the same points."""
+    a_low = Statement("a_low", (11.0, 11.0), "lower")
+    r = region(a_low, n=256, rounds=0)
+    assert r.empty
+    rest = r.without(["a_low"])
+    assert [s.id for s in rest.statements] == ["sum", "a_up"] and rest.n == r.n
+    ok = (np.abs(r.x["a_mm"] + r.x["b_mm"] - 10) <= 0.5) & (r.x["a_mm"] <= 4.5)
+    assert np.array_equal(rest.accepted, ok) and ok.any()

@@ -26,6 +26,7 @@ from sim.claims.region import (
     OUTCOME_NAMES,
     decide_over,
     inputs_table,
+    outcomes,
     region_row,
     region_table,
     statement_of,
@@ -147,19 +148,22 @@ def write_region(path, region: Region, book: ClaimBook, predictions: Sequence[st
     write_table(Path(path).with_name("region_inputs.parquet"), inp, prov)
 
 
-def write_explored(path, region: Region, prov) -> None:
+def write_explored(path, region: Region, prov, predictions: Sequence[Statement] = ()) -> None:
     """``<name>.parquet``: one row per *explored* input vector (the region's and the others:
     an empty region still shows what was tried), the inputs (named with their units),
     ``accepted`` (no statement contradicted), ``confirmed``, and per statement its outcome
     (holds / fails / undecided) and its per-point value (``<id>__value``, the median for
     Monte-Carlo evidence); beside it ``<name>_inputs.parquet`` (the columns of
     ``region_inputs.parquet``: per input its declared range, the region's projection, the
-    design's resolution)."""
+    design's resolution). ``predictions`` (evaluated by the same model) add the same two
+    columns each."""
     cols: dict[str, list] = {k: v.tolist() for k, v in region.x.items()}
     cols["accepted"] = region.accepted.tolist()
     cols["confirmed"] = region.confirmed.tolist()
-    for j, st in enumerate(region.statements):
-        cols[st.id] = [OUTCOME_NAMES[int(o)] for o in region.status[:, j]]
+    status = [region.status[:, j] for j in range(len(region.statements))]
+    status += [outcomes(region, p) for p in predictions]
+    for st, o in zip([*region.statements, *predictions], status):
+        cols[st.id] = [OUTCOME_NAMES[int(k)] for k in o]
         ev = region.outputs[st.id]
         v = np.asarray(ev["value"] if isinstance(ev, Mapping) else ev, float)
         cols[f"{st.id}__value"] = v.reshape(region.n, -1)[:, 0].tolist()

@@ -103,20 +103,28 @@ def explore_region(
 
 
 def table1_samples(sw: dict, i: int) -> dict[str, np.ndarray]:
-    """Per-block Table 1 statistics (m) of scanner vector ``i`` keyed by claim id."""
-    return {
+    """Per-block statistics of scanner vector ``i`` keyed by claim id: Table 1's rms (m) and
+    the 21-control pass's (cm; its acceptance limits apply to the control rms)."""
+    out = {
         f"agnard.table1.{tag}_{w}_{c}_m": np.asarray(sw[f"s{i}.{tag}.{w}_{c}_m"])
         for tag in ("without", "with")
         for w in ("ctrl", "check")
         for c in ("x", "y")
     }
+    for w in ("ctrl", "check"):
+        for c in ("x", "y", "xy", "z"):
+            out[f"agnard.control_21.{w}_{c}_cm"] = 100 * np.asarray(sw[f"s{i}.many.{w}_{c}_m"])
+    for c in ("xy", "z"):
+        out[f"agnard.max_residual.control_21_{c}_cm"] = out[f"agnard.control_21.ctrl_{c}_cm"]
+    return out
 
 
 def explore_scanner(
     cfg: dict, block: Block, book: ClaimBook, runner: Callable[..., dict]
-) -> tuple[Region, list[dict]]:
-    """The scanner region under Table 1 and the per-vector Table 1 statistics of every
-    explored vector (``runner(fn, trials, part, label)`` runs one part through the runner)."""
+) -> tuple[Region, list[str], list[dict]]:
+    """The scanner region under Table 1, the predictions decided over the scanner's inputs
+    (``scanner.toml``), and the per-vector statistics of every explored vector
+    (``runner(fn, trials, part, label)`` runs one part through the runner)."""
     dec = load_declaration(SCANNER, book)
     stats: list[dict] = []
 
@@ -133,10 +141,15 @@ def explore_scanner(
         )
         per = [table1_samples(sw, j) for j in range(n)]
         stats.extend(per)
-        return {
+        ev = {
             s.id: sample_evidence(np.stack([p[s.id] for p in per]), s.ref[0])
             for s in dec.statements
         }
+        for c in dec.predictions:
+            one = book.spec(c)["form"] == "one-plate"
+            x = np.stack([p[c] for p in per])
+            ev[c] = sample_evidence(x, float(book.spec(c)["ref"]) if one else None)
+        return ev
 
     region = explore(
         dec.inputs,
@@ -146,4 +159,4 @@ def explore_scanner(
         n=cfg["table1.points"],
         rounds=cfg["table1.rounds"],
     )
-    return region, stats
+    return region, dec.predictions, stats

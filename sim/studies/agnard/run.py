@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import write_claims
-from sim.claims.book_region import write_explored, write_region
+from sim.claims.book_region import statements, write_explored, write_region
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
 from sim.mc.runner import run_chunks
@@ -255,13 +255,13 @@ def _five_region(cfg, block, book, rows, ctx, part, prov, out):
         title="seed 003: the lost five-point layout (no printed statement constrains it)",
         nominal={"five_inset_1": 0.0},
     )
-    return over_region(book, region, preds, rows, _example_note), insets
+    return over_region(book, region, preds, rows, partial(_example, "layout")), insets
 
 
-def _example_note(row: dict) -> str:
-    """The configured layout's result of a 5-control row, kept as an example."""
+def _example(what: str, row: dict) -> str:
+    """The configured ``what``'s (layout, scanner) result of a row, kept as an example."""
     return (
-        f"at the configured layout (an example): median {row['value']:.3g} cm, 95 % of "
+        f"at the configured {what} (an example): median {row['value']:.3g} cm, 95 % of "
         f"blocks {row['ci_low']:.3g}-{row['ci_high']:.3g}, outcome {row['outcome']}"
     )
 
@@ -269,11 +269,11 @@ def _example_note(row: dict) -> str:
 def _scanner_region(cfg, block, book, ctx, prov, out):
     """Explore the scanner's unprinted inputs under Table 1 (``scanner.toml``); write
     ``scanner_region.parquet`` (every explored vector), ``scanner_region_inputs.parquet`` and
-    its figure. Returns the region and the per-vector Table 1 statistics."""
-    region, stats = explore_scanner(
+    its figure. Returns the region, its predictions and the per-vector statistics."""
+    region, preds, stats = explore_scanner(
         cfg, block, book, lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx)
     )
-    write_explored(out / "scanner_region.parquet", region, prov)
+    write_explored(out / "scanner_region.parquet", region, prov, statements(book, preds))
     nominal = {name: cfg[key] for name, key in SCANNER_KEYS.items()}
     fig_region(
         region,
@@ -282,7 +282,7 @@ def _scanner_region(cfg, block, book, ctx, prov, out):
         + (" (no vector consistent)" if region.empty else ""),
         nominal=nominal,
     )
-    return region, stats
+    return region, preds, stats
 
 
 def _layout(block, c5, c21, prov, out) -> None:
@@ -353,8 +353,11 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
 
     # --- the unprinted five-point layout: its region, the 5-control rows decided over it
     # --- the scanner's unprinted inputs under Table 1, then every claim
-    scanner, scanner_stats = _scanner_region(cfg, block, book, ctx, prov, out)
+    scanner, spreds, scanner_stats = _scanner_region(cfg, block, book, ctx, prov, out)
     rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book, scanner, scanner_stats)
+    # the 21-control rows over the scanner's inputs, the not-comparable Table 1 set aside
+    aside = [s.id for s in scanner.statements if book.spec(s.id)["kind"] == "not comparable"]
+    rows = over_region(book, scanner.without(aside), spreds, rows, partial(_example, "scanner"))
     rows, insets = _five_region(cfg, block, book, rows, ctx, base, prov, out)
     ctrl_idx = _region_layouts(block, insets, prov, out)
     write_claims(out / "claims.parquet", rows, prov, book)

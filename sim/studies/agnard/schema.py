@@ -165,7 +165,7 @@ SCHEMA = {
     ),
     "region.points": count(8, "five-point layouts of the region's space-filling design", 2, 64),
     "table1.points": count(
-        32, "scanner vectors of the Table 1 region's space-filling design (scanner.toml)", 2, 256
+        16, "scanner vectors of the Table 1 region's space-filling design (scanner.toml)", 2, 256
     ),
     "table1.trials": count(
         10, "simulated blocks per scanner vector of the Table 1 region", 2, 10_000
