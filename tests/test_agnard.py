@@ -455,12 +455,20 @@ def test_scanner_inputs_set_the_config_keys_they_name():
     from sim.studies.agnard.region import SCANNER
     from sim.studies.agnard.schema import SCHEMA
 
-    dec = load_declaration(SCANNER, load_book())
+    book = load_book()
+    dec = load_declaration(SCANNER, book)
     assert [i.name for i in dec.inputs] == list(SCANNER_KEYS)
     for i in dec.inputs:
         f = SCHEMA[SCANNER_KEYS[i.name]]
         assert f.lo <= i.low < i.high <= f.hi, i.name
-    assert len(dec.statements) == 8 and dec.predictions == []
+    assert {s.id for s in dec.statements} == {
+        f"agnard.table1.{t}_{w}_{c}_m"
+        for t in ("with", "without")
+        for w in ("ctrl", "check")
+        for c in ("x", "y")
+    }
+    assert all(book.spec(s.id)["kind"] == "not comparable" for s in dec.statements)
+    assert dec.predictions == [] and all(i.why for i in dec.inputs)
 
 
 def test_budget_recomputation_and_pointing_model():

@@ -342,6 +342,14 @@ def _pugging_table(out: Path) -> list[str]:
     ]
 
 
+def _scanner_lead(out: Path) -> list[str]:
+    """The scanner region's section and figure (none for results written before the scanner
+    region existed)."""
+    if not (out / "scanner_region.parquet").is_file():
+        return []
+    return [_scanner_region(out), figure(out, "scanner_region.png", "scanner region under Table 1")]
+
+
 def _scanner_region(out: Path) -> str:
     """The scanner's unprinted inputs under Table 1 (``scanner_region*.parquet``): per input its
     possible range, what Table 1 leaves, the design's resolution; then the conflicts."""
@@ -412,8 +420,7 @@ def report(out: Path) -> str:
         lead=[
             region_markdown(out, [c for c in rows(out, "claims.parquet") if _five(c["claim"])]),
             figure(out, "consistent_region.png", "consistent region"),
-            _scanner_region(out),
-            figure(out, "scanner_region.png", "scanner region under Table 1"),
+            *_scanner_lead(out),
         ],
         intro=[_block_text(cfg, out), model_choices(out), "**Findings.**\n" + findings(out)],
         schema=SCHEMA,
