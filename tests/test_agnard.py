@@ -555,3 +555,41 @@ def test_input_rows_follow_the_config():
     assert rows["agnard.input.scan.max_y_um"]["value"] == 30.0
     assert rows["agnard.input.scan.max_y_um"]["verdict"] == "input"
     assert rows["agnard.scanner.pixel_um"]["verdict"] == "holds"  # 25.4 mm / 600
+
+
+@pytest.mark.parametrize("scale, empty", [(1.0, False), (0.15, True)])
+def test_table1_note_follows_the_region(scale, empty):
+    """Blocks at Table 1's own values leave a region, and the notes say the book's reason
+    (an empty region) fails for that run; blocks at 15 % of them empty it, every statement
+    named as conflicting."""
+    from sim.claims.book_region import load_declaration, sample_evidence
+    from sim.claims.inference import explore
+    from sim.studies.agnard.claims import load_book, table1_rows
+    from sim.studies.agnard.region import SCANNER
+
+    book = load_book()
+    dec = load_declaration(SCANNER, book)
+    rng = np.random.default_rng(3)
+    stats: list[dict] = []
+
+    def model(x):
+        n = len(x["grid_mm"])
+        per = [
+            {s.id: scale * s.ref[0] * (1 + 0.02 * rng.standard_normal(40)) for s in dec.statements}
+            for _ in range(n)
+        ]
+        stats.extend(per)
+        return {
+            s.id: sample_evidence(np.stack([p[s.id] for p in per]), s.ref[0])
+            for s in dec.statements
+        }
+
+    region = explore(dec.inputs, dec.statements, model, rng, n=4, rounds=0)
+    assert region.empty == empty
+    rows = table1_rows(book, region, stats)
+    assert len(rows) == 12 and all(r["verdict"] == "not comparable" for r in rows)
+    for r in rows:
+        if empty:
+            assert "empty, no vector reproduces Table 1 (conflicting: " in r["note"]
+        else:
+            assert "does not hold in this run" in r["note"]

@@ -49,19 +49,19 @@ def _over(region: Region, stats: list[dict], cid: str) -> str:
     return (
         f"simulated median {med.min():.2f}-{med.max():.2f} m over the {len(stats)} explored "
         f"scanner vectors (95 % of blocks within {lo:.2f}-{hi:.2f} m); the printed "
-        f"{ref_of(region, cid):g} m is contradicted at {k} of {len(stats)}"
+        f"{_ref_of(region, cid):g} m is contradicted at {k} of {len(stats)}"
     )
 
 
-def ref_of(region: Region, cid: str) -> float:
+def _ref_of(region: Region, cid: str) -> float:
     return next(st.ref[0] for st in region.statements if st.id == cid)
 
 
 def table1_rows(book: ClaimBook, region: Region, stats: list[dict]) -> list[dict]:
     """Table 1: not comparable because no scanner vector reproduces it (the region of
-    ``scanner.toml`` is empty, the conflicting statements named in every note); when some
-    vector did, the rows would still be no prediction, and the note says where they stand.
-    Notes: each row's simulated values over the explored vectors."""
+    ``scanner.toml`` is empty, the conflicting statements named in every note), with each
+    row's simulated values over the explored vectors. Should a run's region not be empty
+    (another configuration), the note says that the claim book's reason fails for it."""
     conf = "; ".join(" + ".join(c.split(".")[-1] for c in cs) for cs in region.conflicts)
     head = (
         f"Scanner region (scanner.toml: {region.describe(np.ones(region.n, bool))}, "
@@ -69,7 +69,8 @@ def table1_rows(book: ClaimBook, region: Region, stats: list[dict]) -> list[dict
         + (
             f"empty, no vector reproduces Table 1 (conflicting: {conf})"
             if region.empty
-            else f"{int(region.accepted.sum())} vectors consistent ({region.describe()})"
+            else f"{int(region.accepted.sum())} vectors consistent ({region.describe()}): the "
+            "claim book's reason for 'not comparable' (an empty region) does not hold in this run"
         )
     )
     rows = []
