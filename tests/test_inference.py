@@ -220,3 +220,37 @@ def test_refine_on_resolves_where_a_prediction_holds():
     # and closer than the unrefined one
     assert 7.5 <= float(low(refined)) <= 7.5 + h
     assert float(low(refined)) - 7.5 <= float(low(plain)) - 7.5
+
+
+def test_write_explored_keeps_every_vector_of_an_empty_region(tmp_path):
+    """An empty region still shows what was tried: one row per explored vector, none
+    accepted, each statement's outcome and value, and the inputs table beside it."""
+    from sim.claims.book_region import write_explored
+    from sim.mc.storage import read_table
+
+    r = region(Statement("a_low", (11.0, 11.0), "lower"), n=64, rounds=0)
+    write_explored(tmp_path / "scan_region.parquet", r, {})
+    t = read_table(tmp_path / "scan_region.parquet").to_pydict()
+    assert len(t["a_mm"]) == r.n == 64 and not any(t["accepted"])
+    assert set(t["a_low"]) == {"fails"}
+    assert np.allclose(t["sum__value"], np.add(t["a_mm"], t["b_mm"]))
+    inp = read_table(tmp_path / "scan_region_inputs.parquet").to_pydict()
+    assert inp["input"] == ["a_mm", "b_mm"] and inp["n_region"] == [0, 0]
+    assert all(math.isnan(v) for v in inp["region_low"])
+
+
+def test_pixel_inputs_are_declared_in_their_unit():
+    (i,), _ = parse_declaration({"inputs": {"grid_sigma_px": {"low": 0, "high": 0.5}}})
+    assert i.name == "grid_sigma_px"
+
+
+def test_setting_a_statement_aside_restores_what_the_others_leave():
+    """A statement that empties the region alone, set aside, leaves exactly the region of
+    the other statements on the same points."""
+    a_low = Statement("a_low", (11.0, 11.0), "lower")
+    r = region(a_low, n=256, rounds=0)
+    assert r.empty
+    rest = r.without(["a_low"])
+    assert [s.id for s in rest.statements] == ["sum", "a_up"] and rest.n == r.n
+    ok = (np.abs(r.x["a_mm"] + r.x["b_mm"] - 10) <= 0.5) & (r.x["a_mm"] <= 4.5)
+    assert np.array_equal(rest.accepted, ok) and ok.any()

@@ -23,8 +23,10 @@ from sim.claims.book import ClaimBook
 from sim.claims.inference import Input, Region, Statement, parse_declaration
 from sim.claims.intervals import spread_rows
 from sim.claims.region import (
+    OUTCOME_NAMES,
     decide_over,
     inputs_table,
+    outcomes,
     region_row,
     region_table,
     statement_of,
@@ -39,6 +41,7 @@ __all__ = [
     "sample_evidence",
     "region_rows",
     "write_region",
+    "write_explored",
     "region_summary",
 ]
 
@@ -143,6 +146,30 @@ def write_region(path, region: Region, book: ClaimBook, predictions: Sequence[st
     write_table(path, cols, prov)
     inp = inputs_table(region, statements(book, predictions))
     write_table(Path(path).with_name("region_inputs.parquet"), inp, prov)
+
+
+def write_explored(path, region: Region, prov, predictions: Sequence[Statement] = ()) -> None:
+    """``<name>.parquet``: one row per *explored* input vector (the region's and the others:
+    an empty region still shows what was tried), the inputs (named with their units),
+    ``accepted`` (no statement contradicted), ``confirmed``, and per statement its outcome
+    (holds / fails / undecided) and its per-point value (``<id>__value``, the median for
+    Monte-Carlo evidence); beside it ``<name>_inputs.parquet`` (the columns of
+    ``region_inputs.parquet``: per input its declared range, the region's projection, the
+    design's resolution). ``predictions`` (evaluated by the same model) add the same two
+    columns each."""
+    cols: dict[str, list] = {k: v.tolist() for k, v in region.x.items()}
+    cols["accepted"] = region.accepted.tolist()
+    cols["confirmed"] = region.confirmed.tolist()
+    status = [region.status[:, j] for j in range(len(region.statements))]
+    status += [outcomes(region, p) for p in predictions]
+    for st, o in zip([*region.statements, *predictions], status):
+        cols[st.id] = [OUTCOME_NAMES[int(k)] for k in o]
+        ev = region.outputs[st.id]
+        v = np.asarray(ev["value"] if isinstance(ev, Mapping) else ev, float)
+        cols[f"{st.id}__value"] = v.reshape(region.n, -1)[:, 0].tolist()
+    p = Path(path)
+    write_table(p, cols, prov)
+    write_table(p.with_name(f"{p.stem}_inputs.parquet"), inputs_table(region, []), prov)
 
 
 def region_summary(region: Region) -> str:

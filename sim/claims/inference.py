@@ -46,6 +46,10 @@ boundary (a face of the box of possible ranges is resolved to the interior spaci
 a corner of the region more coarsely). When the region is empty, :attr:`Region.conflicts` names the statements that
 conflict: each one contradicted alone (by every possible input), else a minimal set of
 statements whose non-contradicted sets do not meet (found by deletion).
+A conflicting statement that the study then reads as *not comparable* (the simulated
+hardware is not the set-up that printed it) says nothing about the inputs:
+:meth:`Region.without` sets it aside and gives what the other statements leave on the same
+explored points.
 
 Arrays in, arrays out: the model takes a dict ``{input name: (N,) array}`` and returns a dict
 ``{statement id: evidence}`` with a leading point axis. Verdicts of predictions over the
@@ -83,7 +87,7 @@ HOLDS, UNDECIDED, FAILS = 1, 0, -1
 FORMS = ("value", "share", "count", "upper", "lower", "range", "one-plate")
 _INPUT_KEYS = {"low", "high", "why"}
 _STATEMENT_KEYS = {"paper", "source", "form", "ref", "decimals", "tol", "decide"}
-_UNITS = ("_mm", "_um", "_m", "_deg", "_pct", "_min", "_1")
+_UNITS = ("_mm", "_um", "_m", "_deg", "_pct", "_min", "_px", "_1")
 
 
 @dataclass(frozen=True)
@@ -329,6 +333,21 @@ class Region:
             f"{k} {_g(lo, digits)}" + ("" if lo == hi else f"-{_g(hi, digits)}")
             for k, (lo, hi) in b.items()
             if not self._fixed(k)
+        )
+
+    def without(self, ids: Sequence[str]) -> "Region":
+        """The region the other statements leave when ``ids`` are set aside (a statement
+        found not comparable, e.g. because it alone empties the region, says nothing about
+        the simulated inputs): the same explored points, outputs and resolution."""
+        keep = [j for j, s in enumerate(self.statements) if s.id not in set(ids)]
+        return Region(
+            self.inputs,
+            [self.statements[j] for j in keep],
+            self.x,
+            self.status[:, keep],
+            self.level,
+            self.resolution,
+            self.outputs,
         )
 
     def _fixed(self, name: str) -> bool:

@@ -182,3 +182,34 @@ def sweep_chunk(cfg: dict, block: Block, insets, rng: np.random.Generator, n: in
         )
         accuracy(block, ctrl, res, out, f"inset{i}")
     return out
+
+
+def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n: int) -> dict:
+    """Table 1 and Tables 2-3's 21-control pass at each of ``scanners`` (the scanner region's
+    input vectors: dicts of ``scan.*`` overrides): ``n`` blocks adjusted with the
+    ``control.table1`` layout without and with the grid correction, and (corrected) with the
+    ``control.many`` layout (the same adjustment when the two layouts agree). The rms (m) at
+    control and check points, keys ``s<i>.without.*``, ``s<i>.with.*`` (X, Y) and
+    ``s<i>.many.*`` (X, Y, XY, Z). Every vector draws its blocks from the same stream (common
+    random numbers: the vectors differ by their inputs, not by their luck)."""
+    adj = Adjuster(block)
+    wo, wc = paper_weights(cfg)
+    seed = int(rng.integers(2**63))
+    out: dict[str, np.ndarray] = {}
+    for i, over in enumerate(scanners):
+        sim = Simulated({**cfg, **over}, block, np.random.default_rng(seed), n, cfg["scan.dpi"])
+        res = None
+        passes = [("raw", "without", cfg["control.table1"])]
+        passes.append(("corrected", "with", cfg["control.table1"]))
+        if cfg["control.many"] != cfg["control.table1"]:
+            passes.append(("corrected", "many", cfg["control.many"]))
+        for key, tag, lay in passes:
+            ctrl, _, res = adj.adjust(sim, ("digital", key), lay, wo, wc, res)
+            acc: dict[str, np.ndarray] = {}
+            accuracy(block, ctrl, res, acc, "a")
+            for w in ("ctrl", "check"):
+                for ax in ("x", "y", "xy", "z"):
+                    out[f"s{i}.{tag}.{w}_{ax}_m"] = acc[f"a.{w}_{ax}_m"]
+                    if tag == "with" and len(passes) == 2:
+                        out[f"s{i}.many.{w}_{ax}_m"] = acc[f"a.{w}_{ax}_m"]
+    return out

@@ -13,7 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
+from sim.claims.inference import FAILS, Region
 from sim.claims.intervals import spread
+from sim.claims.table import Sim, exact, mc, plates
+from sim.claims.table import claim_rows as table_rows
 from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import Block
 from sim.studies.agnard.schema import model_sigmas, pixel_ground_m
@@ -35,98 +38,93 @@ def _where(p: float, x: np.ndarray) -> str:
     return f"{100 * np.mean(np.asarray(x) < p):.0f} % of the simulated blocks lie below the paper's value"
 
 
-def table1_rows(book: ClaimBook, cfg: dict, sim: dict) -> list[dict]:
-    """Table 1: every printed number is ``not comparable`` (its setup is not printed and the
-    simulated scanner cannot reach its 'without' rms); the notes give the gap to Tables 2-3
-    and the simulated without/with ratio for information."""
+def _over(region: Region, stats: list[dict], cid: str) -> str:
+    """A Table 1 row over the scanner region: the range of its per-vector medians and of the
+    blocks' 95 % spread, and at how many vectors the printed number is contradicted."""
+    med = np.array([np.median(p[cid]) for p in stats])
+    lo = min(spread(p[cid])[1][0] for p in stats)
+    hi = max(spread(p[cid])[1][1] for p in stats)
+    j = [st.id for st in region.statements].index(cid)
+    k = int((region.status[:, j] == FAILS).sum())
+    return (
+        f"simulated median {med.min():.2f}-{med.max():.2f} m over the {len(stats)} explored "
+        f"scanner vectors (95 % of blocks within {lo:.2f}-{hi:.2f} m); the printed "
+        f"{_ref_of(region, cid):g} m is contradicted at {k} of {len(stats)}"
+    )
+
+
+def _ref_of(region: Region, cid: str) -> float:
+    return next(st.ref[0] for st in region.statements if st.id == cid)
+
+
+def table1_rows(book: ClaimBook, region: Region, stats: list[dict]) -> list[dict]:
+    """Table 1: not comparable because no scanner vector reproduces it (the region of
+    ``scanner.toml`` is empty, the conflicting statements named in every note), with each
+    row's simulated values over the explored vectors. Should a run's region not be empty
+    (another configuration), the note says that the claim book's reason fails for it."""
+    conf = "; ".join(" + ".join(c.split(".")[-1] for c in cs) for cs in region.conflicts)
+    head = (
+        f"Scanner region (scanner.toml: {region.describe(np.ones(region.n, bool))}, "
+        f"{region.n} vectors explored jointly): "
+        + (
+            f"empty, no vector reproduces Table 1 (conflicting: {conf})"
+            if region.empty
+            else f"{int(region.accepted.sum())} vectors consistent ({region.describe()}): the "
+            "claim book's reason for 'not comparable' (an empty region) does not hold in this run"
+        )
+    )
     rows = []
-    lay = cfg["control.table1"]
     for w in ("ctrl", "check"):
         for c in ("x", "y"):
-            cid = f"agnard.table1.with_{w}_{c}_m"
-            t1 = ref(book, cid)
-            t23 = {
-                n: ref(book, f"agnard.{n}.{w}_{c}_cm") / 100 for n in ("control_5", "control_21")
-            }
-            best = min(t23.values(), key=lambda v: abs(v - t1))
-            rows.append(
-                book.not_comparable(
-                    cid,
-                    note=(
-                        f"For information: Tables 2-3 give {w} {c.upper()} rms "
-                        f"{100 * t23['control_5']:.0f} cm with 5 control and "
-                        f"{100 * t23['control_21']:.0f} cm with 21; the nearer, {100 * best:.0f} cm, "
-                        f"is {t1 / best:.1f} x below Table 1's {t1:.2f} m."
-                    ),
+            for tag in ("with", "without"):
+                cid = f"agnard.table1.{tag}_{w}_{c}_m"
+                rows.append(
+                    book.not_comparable(cid, note=f"{head}. This row: {_over(region, stats, cid)}.")
                 )
-            )
-            key = f"{w}_{c}_m"
-            x = sim[f"without.{key}"]
-            med, (lo, hi) = spread(100 * x)
-            rows.append(
-                book.not_comparable(
-                    f"agnard.table1.without_{key}",
-                    note=(
-                        f"For information, the simulated rms without correction ({lay} control) is "
-                        f"{med:.1f} cm (95 % of {x.size} blocks {lo:.1f}-{hi:.1f} cm)."
-                    ),
+            ratio = [
+                np.median(
+                    p[f"agnard.table1.without_{w}_{c}_m"] / p[f"agnard.table1.with_{w}_{c}_m"]
                 )
-            )
-            ratio = sim[f"without.{key}"] / sim[f"layout_{lay}.{key}"]
-            rmed, (rlo, rhi) = spread(ratio)
+                for p in stats
+            ]
             rows.append(
                 book.not_comparable(
                     f"agnard.table1.ratio_{w}_{c}",
                     note=(
-                        f"For information: the simulated per-block ratio without / with the grid "
-                        f"correction ({lay} control, scanner peaking at {cfg['scan.max_x_um']:g} / "
-                        f"{cfg['scan.max_y_um']:g} um in x / y) is {rmed:.2f} (95 % of {ratio.size} "
-                        f"blocks {rlo:.2f}-{rhi:.2f}); the deformation's peak is "
-                        f"{cfg['scan.max_y_um'] * cfg['block.scale'] * 1e-4:.1f} cm on the ground (y)."
+                        f"{head}. The simulated per-block ratio without / with the grid "
+                        f"correction has median {min(ratio):.2f}-{max(ratio):.2f} over the "
+                        "explored vectors."
                     ),
                 )
             )
     return rows
 
 
-def scanner_rows(book: ClaimBook, scan_t: dict) -> list[dict]:
-    rows = []
+def scanner_rows(scan_t: dict) -> dict[str, Sim]:
+    rows = {}
     dpi = np.asarray(scan_t["dpi"])
     cal = np.asarray(scan_t["calibration"])
     for d in (300.0, 600.0):
         cid = f"agnard.scanner.gain_{d:.0f}dpi_pct"
         i = np.flatnonzero((dpi == d) & (cal == "corrected"))
         if i.size == 0:
-            rows.append(
-                book.score(
-                    cid,
-                    0.0,
-                    interval="exact",
-                    note=f"{d:g} DPI not in tradeoff.dpis: not simulated in this run",
-                )
-            )
+            rows[cid] = exact(0.0, f"{d:g} DPI not in tradeoff.dpis: not simulated in this run")
             continue
-        g, h = scan_t["gain_xy_pct"][i[0]], 1.96 * scan_t["gain_xy_pct_se"][i[0]]
-        rows.append(
-            book.score(
-                cid,
-                g,
-                (g - h, g + h),
-                note=(
-                    f"reduction of the check-point XY rms by the grid calibration at {d:g} DPI "
-                    f"(21 control; mean over {scan_t['trials'][i[0]]} blocks of the per-block relative "
-                    "gain, the same measurements with and without; 95 % confidence interval)"
-                ),
-            )
+        rows[cid] = mc(
+            scan_t["gain_xy_pct"][i[0]],
+            scan_t["gain_xy_pct_se"][i[0]],
+            f"reduction of the check-point XY rms by the grid calibration at {d:g} DPI "
+            f"(21 control; mean over {scan_t['trials'][i[0]]} blocks of the per-block relative "
+            "gain, the same measurements with and without; 95 % confidence interval)",
         )
     return rows
 
 
-def input_rows(book: ClaimBook, cfg: dict, block: Block, c5, c21) -> list[dict]:
-    rows = []
-    for cid, s in book.specs.items():
+def input_rows(book: ClaimBook, cfg: dict, block: Block, c5, c21) -> dict[str, Sim]:
+    rows = {}
+    for cid in book.specs:
         if cid.startswith("agnard.input.") and cid[len("agnard.input.") :] in cfg:
-            rows.append(book.score(cid, float(cfg[cid[len("agnard.input.") :]]), interval="exact"))
+            rows[cid] = exact(float(cfg[cid[len("agnard.input.") :]]))
     ng = block.n_ground
     for cid, v in (
         ("control_5_n", c5.size),
@@ -134,67 +132,47 @@ def input_rows(book: ClaimBook, cfg: dict, block: Block, c5, c21) -> list[dict]:
         ("control_21_n", c21.size),
         ("control_21_check_n", ng - c21.size),
     ):
-        rows.append(
-            book.score(
-                f"agnard.input.{cid}",
-                float(v),
-                interval="exact",
-                note="control layouts control.few / control.many",
-            )
-        )
+        rows[f"agnard.input.{cid}"] = exact(float(v), "control layouts control.few / control.many")
     pix = sc.pixel_um(cfg["scan.dpi"])
-    rows.append(
-        book.score(
-            "agnard.scanner.pixel_um",
-            pix,
-            interval="exact",
-            note=f"25.4 mm / {cfg['scan.dpi']:g} DPI = {pix:.2f} um",
-        )
+    rows["agnard.scanner.pixel_um"] = exact(
+        pix, f"25.4 mm / {cfg['scan.dpi']:g} DPI = {pix:.2f} um"
     )
     return rows
 
 
-def budget_rows(book: ClaimBook, cfg: dict) -> list[dict]:
+def budget_rows(book: ClaimBook, cfg: dict) -> dict[str, Sim]:
     """The paper's precision budget recomputed from its own numbers, and what the
     simulation's pointing model gives."""
     pix_cm = 100 * pixel_ground_m(cfg)
     half = 0.5 * pix_cm
     fb = cfg["block.focal_mm"] / cfg["block.base_mm"]
     sxy, sz = model_sigmas(cfg)
-    return [
-        book.score(
-            "agnard.budget.half_pixel_cm",
+    return {
+        "agnard.budget.half_pixel_cm": exact(
             half,
-            interval="exact",
-            note=(
+            (
                 f"half a pixel on the ground: 0.5 x {sc.pixel_um(cfg['scan.dpi']):.2f} um x "
                 f"{cfg['block.scale']:g} = {half:.2f} cm"
             ),
         ),
-        book.score(
-            "agnard.budget.planimetry_cm",
+        "agnard.budget.planimetry_cm": exact(
             half * np.sqrt(2),
-            interval="exact",
-            note=(
+            (
                 f"radial planimetric error of {half:.2f} cm per coordinate: {half:.2f} x sqrt 2 = "
                 f"{half * np.sqrt(2):.2f} cm"
             ),
         ),
-        book.score(
-            "agnard.budget.height_cm",
+        "agnard.budget.height_cm": exact(
             half * fb,
-            interval="exact",
-            note=(
+            (
                 f"{half:.2f} cm x f / b = {half:.2f} x {cfg['block.focal_mm']:g} / "
                 f"{cfg['block.base_mm']:g} = {half * fb:.2f} cm (the paper's own rounded 13 cm gives "
                 f"{ref(book, 'agnard.budget.half_pixel_cm') * fb:.2f})"
             ),
         ),
-        book.score(
-            "agnard.budget.model_xy_cm",
+        "agnard.budget.model_xy_cm": exact(
             100 * sxy,
-            interval="exact",
-            note=(
+            (
                 f"the simulation's pointing model: a setting error of {cfg['measure.pointing_px']:g} "
                 f"px per coordinate plus the mean of the two photos' x-parallax errors "
                 f"({cfg['measure.parallax_px']:g} px / 2) gives {100 * sxy:.2f} cm per planimetric "
@@ -202,16 +180,14 @@ def budget_rows(book: ClaimBook, cfg: dict) -> list[dict]:
                 "budget, which counts the x-parallax error in height only"
             ),
         ),
-        book.score(
-            "agnard.budget.model_z_cm",
+        "agnard.budget.model_z_cm": exact(
             100 * sz,
-            interval="exact",
-            note=(
+            (
                 f"x-parallax setting error {cfg['measure.parallax_px']:g} px x f / b = "
                 f"{100 * sz:.2f} cm in height (measure.parallax_px set from the paper's 22 cm)"
             ),
         ),
-    ]
+    }
 
 
 def table_note(cfg: dict, book: ClaimBook, cid: str, lay: str, ctrl, n_chk: int, x, alt=None):
@@ -240,8 +216,8 @@ def table_note(cfg: dict, book: ClaimBook, cid: str, lay: str, ctrl, n_chk: int,
     return note
 
 
-def tables23_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, c5, c21) -> list[dict]:
-    rows = []
+def tables23_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, c5, c21) -> dict[str, Sim]:
+    rows = {}
     for name, lay, ctrl in (
         ("control_5", cfg["control.few"], c5),
         ("control_21", cfg["control.many"], c21),
@@ -252,17 +228,15 @@ def tables23_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, c5, c21) 
                 cid = f"agnard.{name}.{where}_{c}_cm"
                 x = 100 * sim[f"layout_{lay}.{where}_{c}_m"]
                 alt = sim[f"layout_{lay}.ctrl_given_{c}_m"] if where == "ctrl" else None
-                rows.append(
-                    book.score(
-                        cid, samples=x, note=table_note(cfg, book, cid, lay, ctrl, n_chk, x, alt)
-                    )
-                )
+                rows[cid] = plates(x, table_note(cfg, book, cid, lay, ctrl, n_chk, x, alt))
         for c in ("xy", "z"):
-            rows.append(acceptance_row(book, cfg, name, lay, ctrl, c, sim))
+            rows[f"agnard.max_residual.{name}_{c}_cm"] = acceptance(
+                book, cfg, name, lay, ctrl, c, sim
+            )
     return rows
 
 
-def acceptance_row(book: ClaimBook, cfg: dict, name: str, lay: str, ctrl, c: str, sim: dict):
+def acceptance(book: ClaimBook, cfg: dict, name: str, lay: str, ctrl, c: str, sim: dict) -> Sim:
     """The acceptance limit on the control residuals (21 cm planimetry, 16 cm height at
     1/6 200), applied to one block's control rms, radial XY or Z (the paper's own evidence
     that it met the limit is its tabulated control rms); the largest single residual is
@@ -271,10 +245,9 @@ def acceptance_row(book: ClaimBook, cfg: dict, name: str, lay: str, ctrl, c: str
     lim = ref(book, cid)
     x = 100 * sim[f"layout_{lay}.ctrl_{c}_m"]
     mx = 100 * sim[f"layout_{lay}.ctrl_max_{c}_m"]
-    return book.score(
-        cid,
-        samples=x,
-        note=(
+    return plates(
+        x,
+        (
             f"rms of the {'radial planimetric' if c == 'xy' else 'height'} model-point residuals "
             f"at the {ctrl.size} control points of one block ({lay} layout); median and 95 % of "
             f"{x.size} blocks; {100 * np.mean(x <= lim + 0.5):.0f} % of the blocks meet the "
@@ -286,10 +259,10 @@ def acceptance_row(book: ClaimBook, cfg: dict, name: str, lay: str, ctrl, c: str
     )
 
 
-def first_pass_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict) -> list[dict]:
+def first_pass_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict) -> dict[str, Sim]:
     pix_cm = 100 * pixel_ground_m(cfg)
     n_pass = int(block.is_pass.sum())
-    rows = []
+    rows = {}
     for q, lab in (
         ("xy", "radial XY (the paper's 'planimetry': its Tables' XY column is the radial rms)"),
         ("z", "Z"),
@@ -302,17 +275,12 @@ def first_pass_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict) -> list
                 f"; per coordinate X {100 * np.median(sim['first.pass_x_m']):.1f} cm, Y "
                 f"{100 * np.median(sim['first.pass_y_m']):.1f} cm"
             )
-        rows.append(
-            book.score(
-                cid,
-                samples=x,
-                note=(
-                    f"rms of the model-point residuals at the {n_pass} pass points, {lab}{extra}; "
-                    f"{cfg['control.many']} control at weight {cfg['weights.first_pass_control']:g} "
-                    f"against {cfg['weights.first_pass_pass']:g}; median and 95 % of {x.size} blocks; "
-                    f"{_where(ref(book, cid), x)}"
-                ),
-            )
+        rows[cid] = plates(
+            x,
+            f"rms of the model-point residuals at the {n_pass} pass points, {lab}{extra}; "
+            f"{cfg['control.many']} control at weight {cfg['weights.first_pass_control']:g} "
+            f"against {cfg['weights.first_pass_pass']:g}; median and 95 % of {x.size} blocks; "
+            f"{_where(ref(book, cid), x)}",
         )
     # the paper's own budget turns a ground pixel into planimetry (radial: x sqrt 2, its
     # "19 centimetres") and into height (x f / b, its "22 centimetres"); a pixel "in
@@ -328,42 +296,36 @@ def first_pass_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict) -> list
         ),
     ):
         cm = ref(book, src)
-        rows.append(
-            book.score(
-                cid,
-                cm / (pix_cm * k),
-                interval="exact",
-                note=(
-                    f"recomputed from the paper's own numbers: {cm:g} cm / ({pix_cm:.2f} cm "
-                    f"ground pixel ({sc.pixel_um(cfg['scan.dpi']):.2f} um x {cfg['block.scale']:g})"
-                    f" x {how} = {pix_cm * k:.2f} cm) = {cm / (pix_cm * k):.3f} pixel; per "
-                    f"ground coordinate alone it would be {cm / pix_cm:.3f}"
-                ),
-            )
+        rows[cid] = exact(
+            cm / (pix_cm * k),
+            f"recomputed from the paper's own numbers: {cm:g} cm / ({pix_cm:.2f} cm "
+            f"ground pixel ({sc.pixel_um(cfg['scan.dpi']):.2f} um x {cfg['block.scale']:g})"
+            f" x {how} = {pix_cm * k:.2f} cm) = {cm / (pix_cm * k):.3f} pixel; per "
+            f"ground coordinate alone it would be {cm / pix_cm:.3f}",
         )
     return rows
 
 
-def rejection_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, pug: dict) -> list[dict]:
+def rejection_rows(
+    book: ClaimBook, cfg: dict, block: Block, sim: dict, pug: dict
+) -> dict[str, Sim]:
     n_pass = int(block.is_pass.sum())
     rej = sim["snoop_digital.rejected"].astype(float)
     sens = ", ".join(f"{r:g} px: {np.mean(s):.1f} %" for r, s in pug.items())
     sh = sim["snoop_mechanical.share_pct"]
-    return [
-        book.score(
-            "agnard.pass_rejections.digital",
-            samples=rej,
-            note=(
+    return {
+        "agnard.pass_rejections.digital": plates(
+            rej,
+            (
                 f"pass points (of {n_pass}) removed by iterative data snooping (Baarda w-test, "
                 f"alpha {cfg['snoop.alpha']:g}, {cfg['snoop.test']}-test) under digital pugging; "
                 f"{100 * np.mean(rej == 0):.0f} % of {rej.size} blocks lose none; median a-posteriori "
                 f"sigma0 {np.median(sim['snoop_digital.sigma0']):.2f}"
             ),
         ),
-        book.score(
-            "agnard.pass_rejections.mechanical_pct",
-            samples=sh,
-            note=(
+        "agnard.pass_rejections.mechanical_pct": plates(
+            sh,
+            (
                 f"share of the {n_pass} pass points removed under mechanical pugging (no gross "
                 f"errors at pugging.gross_rate {cfg['pugging.gross_rate']:g}; hole transfer "
                 f"{cfg['pugging.transfer_um']:g} um, re-centring {cfg['pugging.recentre_px']:g} px "
@@ -371,7 +333,7 @@ def rejection_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, pug: dic
                 f"mean share against the re-centring error: {sens}"
             ),
         ),
-    ]
+    }
 
 
 def anisotropy_samples(cfg: dict, sim: dict) -> np.ndarray:
@@ -388,17 +350,16 @@ def anisotropy_samples(cfg: dict, sim: dict) -> np.ndarray:
     return np.exp(r.mean(0))
 
 
-def anisotropy_rows(book: ClaimBook, cfg: dict, sim: dict) -> list[dict]:
+def anisotropy_rows(book: ClaimBook, cfg: dict, sim: dict) -> dict[str, Sim]:
     g = anisotropy_samples(cfg, sim)
     yx21 = (
         sim[f"layout_{cfg['control.many']}.check_y_m"]
         / sim[f"layout_{cfg['control.many']}.check_x_m"]
     )
-    return [
-        book.score(
-            "agnard.anisotropy.y_over_x",
-            samples=g,
-            note=(
+    return {
+        "agnard.anisotropy.y_over_x": plates(
+            g,
+            (
                 f"per block the geometric mean of Y/X over the eight simulated counterparts; "
                 f"{_where(ref(book, 'agnard.anisotropy.y_over_x'), g)}; 21-control check points alone: "
                 f"median Y/X {np.median(yx21):.2f}; the simulated pointing error is "
@@ -406,23 +367,33 @@ def anisotropy_rows(book: ClaimBook, cfg: dict, sim: dict) -> list[dict]:
                 f"{cfg['scan.max_y_um']:g} um in y and {cfg['scan.max_x_um']:g} um in x"
             ),
         ),
-    ]
+    }
 
 
 def claim_rows(
-    cfg: dict, block: Block, sim: dict, c5, c21, scan_t: dict, pug: dict, book: ClaimBook
+    cfg: dict,
+    block: Block,
+    sim: dict,
+    c5,
+    c21,
+    scan_t: dict,
+    pug: dict,
+    book: ClaimBook,
+    scanner: Region,
+    scanner_stats: list[dict],
 ) -> list[dict]:
-    """Every claim of the book, scored once."""
-    rows = (
-        table1_rows(book, cfg, sim)
-        + scanner_rows(book, scan_t)
-        + input_rows(book, cfg, block, c5, c21)
-        + budget_rows(book, cfg)
-        + tables23_rows(book, cfg, block, sim, c5, c21)
-        + first_pass_rows(book, cfg, block, sim)
-        + rejection_rows(book, cfg, block, sim, pug)
-        + anisotropy_rows(book, cfg, sim)
-    )
+    """Every claim of the book, scored once (Table 1 over the ``scanner`` region, with the
+    per-vector statistics ``scanner_stats``)."""
+    table = {
+        **scanner_rows(scan_t),
+        **input_rows(book, cfg, block, c5, c21),
+        **budget_rows(book, cfg),
+        **tables23_rows(book, cfg, block, sim, c5, c21),
+        **first_pass_rows(book, cfg, block, sim),
+        **rejection_rows(book, cfg, block, sim, pug),
+        **anisotropy_rows(book, cfg, sim),
+    }
+    rows = table1_rows(book, scanner, scanner_stats) + table_rows(book, table)
     for r in rows:  # an unbounded side of a bound's zone is "no number" (null), not infinity
         for k in ("zone_low", "zone_high"):
             if not np.isfinite(r[k]):

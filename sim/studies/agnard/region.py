@@ -1,5 +1,6 @@
-"""The consistent region of ``agnard_block``'s unprinted input (seed 003) and the verdicts of
-the 5-control predictions over it (issue 21, :mod:`sim.claims.inference`).
+"""The consistent regions of ``agnard_block``'s unprinted inputs (seed 003): the lost
+five-point layout, with the verdicts of the 5-control predictions over it, and the scanner,
+constrained by Table 1 (issue 21, :mod:`sim.claims.inference`).
 
 Figure 5, the layout of the five control points of the third pass, is lost. ``region.toml``
 declares the layout by one number, how far the four outer points stand inwards from the block
@@ -10,6 +11,17 @@ or undecidable. The model adjusts the same ``region.trials`` simulated blocks on
 layout (:func:`sim.studies.agnard.chunks.sweep_chunk`, on the runner's workers); each
 statistic is evidence with the claim book's rules
 (:func:`sim.claims.book_region.sample_evidence`).
+
+The scanner (``scanner.toml``): the paper prints its peaks (+-20 / +-40 um, to which every
+simulated field is scaled) but not the shape of its deformation (the stepper drive's share
+and period), its calibration grid or its centring errors. These five inputs are explored
+jointly over their possible ranges (a scrambled Sobol design of ``table1.points`` vectors),
+each vector adjusting the same ``table1.trials`` simulated blocks (common random numbers,
+:func:`sim.studies.agnard.chunks.table1_chunk`, on the runner's workers) without and with
+the grid correction; Table 1's eight printed rms are the constraints, one-block statistics
+decided by the book's one-plate rule. When no vector is consistent the region is empty and
+:attr:`~sim.claims.inference.Region.conflicts` names the statements that conflict: Table 1
+is then not comparable because of that (``claims.toml`` says so in the paper's words).
 """
 
 from __future__ import annotations
@@ -28,6 +40,18 @@ from sim.mc.runner import chunk_rng
 from sim.studies.agnard import chunks as ch
 
 DECLARATION = Path(__file__).with_name("region.toml")
+SCANNER = Path(__file__).with_name("scanner.toml")
+#: the scanner region's inputs and the config keys they set
+SCANNER_KEYS = {
+    "stepper_share_1": "scan.stepper_share",
+    "wavelength_mm": "scan.wavelength_mm",
+    "grid_mm": "scan.grid_mm",
+    "grid_sigma_px": "scan.grid_sigma_px",
+    "fiducial_sigma_px": "scan.fiducial_sigma_px",
+}
+#: the runner's stream of the scanner region's blocks (apart from every trade-off part) and
+#: of its design
+SCANNER_PART = 800
 
 
 def five_samples(sw: dict, i: int) -> dict[str, np.ndarray]:
@@ -74,5 +98,65 @@ def explore_region(
         chunk_rng(cfg["seed"], 900, 0),
         n=cfg["region.points"],
         rounds=0,
+    )
+    return region, dec.predictions, stats
+
+
+def table1_samples(sw: dict, i: int) -> dict[str, np.ndarray]:
+    """Per-block statistics of scanner vector ``i`` keyed by claim id: Table 1's rms (m) and
+    the 21-control pass's (cm; its acceptance limits apply to the control rms)."""
+    out = {
+        f"agnard.table1.{tag}_{w}_{c}_m": np.asarray(sw[f"s{i}.{tag}.{w}_{c}_m"])
+        for tag in ("without", "with")
+        for w in ("ctrl", "check")
+        for c in ("x", "y")
+    }
+    for w in ("ctrl", "check"):
+        for c in ("x", "y", "xy", "z"):
+            out[f"agnard.control_21.{w}_{c}_cm"] = 100 * np.asarray(sw[f"s{i}.many.{w}_{c}_m"])
+    for c in ("xy", "z"):
+        out[f"agnard.max_residual.control_21_{c}_cm"] = out[f"agnard.control_21.ctrl_{c}_cm"]
+    return out
+
+
+def explore_scanner(
+    cfg: dict, block: Block, book: ClaimBook, runner: Callable[..., dict]
+) -> tuple[Region, list[str], list[dict]]:
+    """The scanner region under Table 1, the predictions decided over the scanner's inputs
+    (``scanner.toml``), and the per-vector statistics of every explored vector
+    (``runner(fn, trials, part, label)`` runs one part through the runner)."""
+    dec = load_declaration(SCANNER, book)
+    stats: list[dict] = []
+
+    def model(x: dict[str, np.ndarray]) -> dict:
+        n = len(next(iter(x.values())))
+        scanners = tuple(
+            {key: float(x[name][j]) for name, key in SCANNER_KEYS.items()} for j in range(n)
+        )
+        sw = runner(
+            partial(ch.table1_chunk, cfg, block, scanners),
+            cfg["table1.trials"],
+            SCANNER_PART + len(stats),
+            "scanner vectors (Table 1)",
+        )
+        per = [table1_samples(sw, j) for j in range(n)]
+        stats.extend(per)
+        ev = {
+            s.id: sample_evidence(np.stack([p[s.id] for p in per]), s.ref[0])
+            for s in dec.statements
+        }
+        for c in dec.predictions:
+            one = book.spec(c)["form"] == "one-plate"
+            x = np.stack([p[c] for p in per])
+            ev[c] = sample_evidence(x, float(book.spec(c)["ref"]) if one else None)
+        return ev
+
+    region = explore(
+        dec.inputs,
+        dec.statements,
+        model,
+        chunk_rng(cfg["seed"], SCANNER_PART - 1, 0),
+        n=cfg["table1.points"],
+        rounds=cfg["table1.rounds"],
     )
     return region, dec.predictions, stats

@@ -1,13 +1,15 @@
 """Run of ``agnard_block`` (seed ``003_5ce730a990a7ebc5.txt``) through the runner.
 
 Streams (``part``): 0 the 2 x 8 block with every adjustment of the paper; then one per scan
-resolution, one per block size, one per mechanical re-centring error, and one for the region
-of the unprinted five-point control layout (:mod:`.region`). Every part goes through :func:`sim.mc.runner.run_chunks` with
+resolution, one per block size, one per mechanical re-centring error, one for the region
+of the unprinted five-point control layout, and (from 800, apart) the scanner region under
+Table 1 (:mod:`.region`). Every part goes through :func:`sim.mc.runner.run_chunks` with
 the run context (executor, chunk store), with picklable chunk functions
 (:mod:`.chunks`), so ``--workers``, Dask and resumption after a kill apply.
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
 tables, ``region_five.parquet`` (per block and layout), ``consistent_region.parquet``,
-``region_inputs.parquet``, ``region_layouts.parquet``,
+``region_inputs.parquet``, ``region_layouts.parquet``, ``scanner_region.parquet`` (every
+explored scanner vector) and ``scanner_region_inputs.parquet``,
 ``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each sent to the run's
 workers, when it has some, as soon as its data exist: :func:`sim.report.figure_jobs.start_figures`).
 """
@@ -19,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.claims.book import ClaimBook, write_claims
-from sim.claims.book_region import region_rows, write_region
+from sim.claims.book import write_claims
+from sim.claims.book_region import statements, write_explored, write_region
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
 from sim.mc.runner import run_chunks
@@ -31,9 +33,10 @@ from sim.studies import RunContext
 from sim.studies.agnard import chunks as ch
 from sim.studies.agnard import figures as fg
 from sim.studies.agnard.claims import claim_rows, load_book
-from sim.studies.agnard.region import explore_region
+from sim.studies.agnard.region import SCANNER_KEYS, explore_region, explore_scanner
 from sim.studies.agnard.schema import NAME, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
+from sim.studies.run_steps import over_region
 
 
 def _mean_se(x: np.ndarray) -> tuple[float, float]:
@@ -252,15 +255,34 @@ def _five_region(cfg, block, book, rows, ctx, part, prov, out):
         title="seed 003: the lost five-point layout (no printed statement constrains it)",
         nominal={"five_inset_1": 0.0},
     )
-    by = {r["claim"]: r for r in rows}
-    fresh = ClaimBook(list(book.specs.values()), [], book.path)
-    notes = {
-        c: f"at the configured layout (an example): median {by[c]['value']:.3g} cm, 95 % of "
-        f"blocks {by[c]['ci_low']:.3g}-{by[c]['ci_high']:.3g}, outcome {by[c]['outcome']}"
-        for c in preds
-    }
-    new = {r["claim"]: r for r in region_rows(fresh, region, preds, notes)}
-    return [new.get(r["claim"], r) for r in rows], insets
+    return over_region(book, region, preds, rows, partial(_example, "layout")), insets
+
+
+def _example(what: str, row: dict) -> str:
+    """The configured ``what``'s (layout, scanner) result of a row, kept as an example."""
+    return (
+        f"at the configured {what} (an example): median {row['value']:.3g} cm, 95 % of "
+        f"blocks {row['ci_low']:.3g}-{row['ci_high']:.3g}, outcome {row['outcome']}"
+    )
+
+
+def _scanner_region(cfg, block, book, ctx, prov, out):
+    """Explore the scanner's unprinted inputs under Table 1 (``scanner.toml``); write
+    ``scanner_region.parquet`` (every explored vector), ``scanner_region_inputs.parquet`` and
+    its figure. Returns the region, its predictions and the per-vector statistics."""
+    region, preds, stats = explore_scanner(
+        cfg, block, book, lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx)
+    )
+    write_explored(out / "scanner_region.parquet", region, prov, statements(book, preds))
+    nominal = {name: cfg[key] for name, key in SCANNER_KEYS.items()}
+    fig_region(
+        region,
+        out / "scanner_region.png",
+        title="seed 003: the scanner's unprinted inputs under Table 1"
+        + (" (no vector consistent)" if region.empty else ""),
+        nominal=nominal,
+    )
+    return region, preds, stats
 
 
 def _layout(block, c5, c21, prov, out) -> None:
@@ -330,7 +352,12 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     base += len(cfg["tradeoff.recentre_px"])
 
     # --- the unprinted five-point layout: its region, the 5-control rows decided over it
-    rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book)
+    # --- the scanner's unprinted inputs under Table 1, then every claim
+    scanner, spreds, scanner_stats = _scanner_region(cfg, block, book, ctx, prov, out)
+    rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book, scanner, scanner_stats)
+    # the 21-control rows over the scanner's inputs, the not-comparable Table 1 set aside
+    aside = [s.id for s in scanner.statements if book.spec(s.id)["kind"] == "not comparable"]
+    rows = over_region(book, scanner.without(aside), spreds, rows, partial(_example, "scanner"))
     rows, insets = _five_region(cfg, block, book, rows, ctx, base, prov, out)
     ctrl_idx = _region_layouts(block, insets, prov, out)
     write_claims(out / "claims.parquet", rows, prov, book)

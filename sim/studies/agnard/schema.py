@@ -13,166 +13,102 @@ import numpy as np
 from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import CONTROL_PATTERNS, Block, control_targets, make_block
 from sim.mc.config import COMMON, ConfigError, Field
+from sim.mc.schema_helpers import count, counts, positive, real, reals
 
 SEED = "003_5ce730a990a7ebc5.txt"
 NAME = "agnard_block"
 
 SCHEMA = {
     **COMMON,
-    "trials": Field(500, "int", "Monte-Carlo trials of the 2 x 8 block", lo=2, hi=100_000_000),
-    "chunk": Field(
-        50, "int", "trials per chunk (each chunk has its own spawned stream)", lo=1, hi=1_000_000
+    "trials": count(500, "Monte-Carlo trials of the 2 x 8 block", 2, 100_000_000),
+    "chunk": count(50, "trials per chunk (each chunk has its own spawned stream)", 1, 1_000_000),
+    "block.strips": count(2, "strips (paper: two)", 1, 50, input=True),
+    "block.models": count(8, "models per strip (paper: eight)", 1, 200, input=True),
+    "block.scale": real(6200.0, "photo scale number (paper: 1/6 200)", 100.0, 1e6, input=True),
+    "block.focal_mm": real(
+        152.0, "camera constant (paper: 152 mm)", 10.0, 1000.0, unit="mm", input=True
     ),
-    "block.strips": Field(2, "int", "strips (paper: two)", lo=1, hi=50, input=True),
-    "block.models": Field(8, "int", "models per strip (paper: eight)", lo=1, hi=200, input=True),
-    "block.scale": Field(
-        6200.0, "float", "photo scale number (paper: 1/6 200)", lo=100.0, hi=1e6, input=True
+    "block.base_mm": real(
+        90.0, "base at photo scale (paper: 90 mm)", 10.0, 200.0, unit="mm", input=True
     ),
-    "block.focal_mm": Field(
-        152.0, "float", "camera constant (paper: 152 mm)", lo=10.0, hi=1000.0, input=True, unit="mm"
+    "block.format_mm": real(230.0, "photo format side", 50.0, 500.0, unit="mm"),
+    "block.usable": real(0.92, "share of the half format where points are measured", 0.3, 1.0),
+    "block.sidelap": real(0.3, "sidelap between strips", 0.05, 0.8),
+    "block.ground_points": count(
+        178, "signalised test-field points (paper: 178)", 8, 100_000, input=True
     ),
-    "block.base_mm": Field(
-        90.0,
-        "float",
-        "base at photo scale (paper: 90 mm)",
-        lo=10.0,
-        hi=200.0,
-        input=True,
-        unit="mm",
+    "block.pass_rows": count(4, "pass-point rows per strip", 2, 20),
+    "block.relief_m": real(20.0, "terrain relief (peak to peak)", 0.0, 500.0, unit="m"),
+    "block.layout_seed": count(7, "seed of the test-field layout (fixed, not a trial stream)", 0),
+    "scan.dpi": real(
+        600.0, "scan resolution (paper: 600 DPI, pixel 42 um)", 50.0, 10000.0, input=True
     ),
-    "block.format_mm": Field(230.0, "float", "photo format side", lo=50.0, hi=500.0, unit="mm"),
-    "block.usable": Field(
-        0.92, "float", "share of the half format where points are measured", lo=0.3, hi=1.0
-    ),
-    "block.sidelap": Field(0.3, "float", "sidelap between strips", lo=0.05, hi=0.8),
-    "block.ground_points": Field(
-        178, "int", "signalised test-field points (paper: 178)", lo=8, hi=100_000, input=True
-    ),
-    "block.pass_rows": Field(4, "int", "pass-point rows per strip", lo=2, hi=20),
-    "block.relief_m": Field(
-        20.0, "float", "terrain relief (peak to peak)", lo=0.0, hi=500.0, unit="m"
-    ),
-    "block.layout_seed": Field(
-        7, "int", "seed of the test-field layout (fixed, not a trial stream)", lo=0
-    ),
-    "scan.dpi": Field(
-        600.0,
-        "float",
-        "scan resolution (paper: 600 DPI, pixel 42 um)",
-        lo=50.0,
-        hi=10000.0,
-        input=True,
-    ),
-    "scan.max_x_um": Field(
+    "scan.max_x_um": real(
         20.0,
-        "float",
         "largest scanner deformation in x (paper: +-20 um)",
-        lo=0.0,
-        hi=1000.0,
-        input=True,
-        unit="um",
-    ),
-    "scan.max_y_um": Field(
-        40.0,
-        "float",
-        "largest scanner deformation in y (paper: +-40 um)",
-        lo=0.0,
-        hi=1000.0,
-        input=True,
-        unit="um",
-    ),
-    "scan.stepper_share": Field(
-        0.3, "float", "periodic stepper term of dy relative to its polynomial part", lo=0.0, hi=10.0
-    ),
-    "scan.wavelength_mm": Field(
-        60.0, "float", "period of the stepper term", lo=1.0, hi=1000.0, unit="mm"
-    ),
-    "scan.grid_mm": Field(
-        10.0, "float", "spacing of the scanned calibration grid", lo=1.0, hi=230.0, unit="mm"
-    ),
-    "scan.grid_sigma_px": Field(
-        0.1, "float", "centring error of a grid node on the scan", lo=0.0, hi=10.0, unit="px"
-    ),
-    "scan.fiducial_mm": Field(
-        110.0, "float", "corner fiducials at (+-d, +-d)", lo=10.0, hi=250.0, unit="mm"
-    ),
-    "scan.fiducial_sigma_px": Field(
-        0.25, "float", "centring error of a fiducial mark", lo=0.0, hi=10.0, unit="px"
-    ),
-    "measure.pointing_px": Field(
-        0.5,
-        "float",
-        "planimetric setting error per coordinate (paper: half a pixel, '13 cm on the ground')",
-        lo=0.0,
-        lo_open=True,
-        hi=20.0,
-        input=True,
-        unit="px",
-    ),
-    "measure.parallax_px": Field(
-        0.5,
-        "float",
-        "x-parallax setting error (paper: 13 cm x f/B = 22 cm in height)",
-        lo=0.0,
-        lo_open=True,
-        hi=20.0,
-        input=True,
-        unit="px",
-    ),
-    "measure.control_sigma_m": Field(
-        0.02, "float", "error of the surveyed control coordinates", lo=0.0, hi=10.0, unit="m"
-    ),
-    "pugging.transfer_um": Field(
-        10.0,
-        "float",
-        "mechanical: error of a drilled hole (transfer to each photo)",
-        lo=0.0,
-        hi=1000.0,
-        unit="um",
-    ),
-    "pugging.recentre_px": Field(
-        0.5,
-        "float",
-        "mechanical: re-centring the mark in a hole, per measurement",
-        lo=0.0,
-        hi=20.0,
-        unit="px",
-    ),
-    "pugging.gross_rate": Field(
         0.0,
-        "float",
-        "mechanical: chance per model point that a hole is missed on one photo (off by default)",
-        lo=0.0,
-        hi=1.0,
-    ),
-    "pugging.gross_px": Field(
-        [2.0, 6.0],
-        "list[float]",
-        "mechanical: range of a missed hole's error",
-        lo=0.0,
-        hi=1000.0,
-        min_len=2,
-        unit="px",
-    ),
-    "weights.pass": Field(
-        0.1, "float", "weight of model points (paper: 0.1)", lo=0.0, lo_open=True, input=True
-    ),
-    "weights.control_xy": Field(
-        3.0, "float", "weight of control in planimetry (paper: 3)", lo=0.0, lo_open=True, input=True
-    ),
-    "weights.control_z": Field(
-        2.0, "float", "weight of control in height (paper: 2)", lo=0.0, lo_open=True, input=True
-    ),
-    "weights.first_pass_control": Field(
-        0.1, "float", "first pass: control weight (paper: 0.1)", lo=0.0, lo_open=True, input=True
-    ),
-    "weights.first_pass_pass": Field(
-        1.0,
-        "float",
-        "first pass: model-point weight (paper: 1.0)",
-        lo=0.0,
-        lo_open=True,
+        1000.0,
+        unit="um",
         input=True,
+    ),
+    "scan.max_y_um": real(
+        40.0,
+        "largest scanner deformation in y (paper: +-40 um)",
+        0.0,
+        1000.0,
+        unit="um",
+        input=True,
+    ),
+    "scan.stepper_share": real(
+        0.3, "periodic stepper term of dy relative to its polynomial part", 0.0, 10.0
+    ),
+    "scan.wavelength_mm": real(60.0, "period of the stepper term", 1.0, 1000.0, unit="mm"),
+    "scan.grid_mm": real(10.0, "spacing of the scanned calibration grid", 1.0, 230.0, unit="mm"),
+    "scan.grid_sigma_px": real(
+        0.1, "centring error of a grid node on the scan", 0.0, 10.0, unit="px"
+    ),
+    "scan.fiducial_mm": real(110.0, "corner fiducials at (+-d, +-d)", 10.0, 250.0, unit="mm"),
+    "scan.fiducial_sigma_px": real(0.25, "centring error of a fiducial mark", 0.0, 10.0, unit="px"),
+    "measure.pointing_px": positive(
+        0.5,
+        "planimetric setting error per coordinate (paper: half a pixel, '13 cm on the ground')",
+        20.0,
+        unit="px",
+        input=True,
+    ),
+    "measure.parallax_px": positive(
+        0.5,
+        "x-parallax setting error (paper: 13 cm x f/B = 22 cm in height)",
+        20.0,
+        unit="px",
+        input=True,
+    ),
+    "measure.control_sigma_m": real(
+        0.02, "error of the surveyed control coordinates", 0.0, 10.0, unit="m"
+    ),
+    "pugging.transfer_um": real(
+        10.0, "mechanical: error of a drilled hole (transfer to each photo)", 0.0, 1000.0, unit="um"
+    ),
+    "pugging.recentre_px": real(
+        0.5, "mechanical: re-centring the mark in a hole, per measurement", 0.0, 20.0, unit="px"
+    ),
+    "pugging.gross_rate": real(
+        0.0,
+        "mechanical: chance per model point that a hole is missed on one photo (off by default)",
+        0.0,
+        1.0,
+    ),
+    "pugging.gross_px": reals(
+        [2.0, 6.0], "mechanical: range of a missed hole's error", 0.0, 1000.0, min_len=2, unit="px"
+    ),
+    "weights.pass": positive(0.1, "weight of model points (paper: 0.1)", input=True),
+    "weights.control_xy": positive(3.0, "weight of control in planimetry (paper: 3)", input=True),
+    "weights.control_z": positive(2.0, "weight of control in height (paper: 2)", input=True),
+    "weights.first_pass_control": positive(
+        0.1, "first pass: control weight (paper: 0.1)", input=True
+    ),
+    "weights.first_pass_pass": positive(
+        1.0, "first pass: model-point weight (paper: 1.0)", input=True
     ),
     "control.table1": Field(
         "full", "str", "control layout of the Table 1 adjustments", choices=CONTROL_PATTERNS
@@ -183,9 +119,7 @@ SCHEMA = {
     "control.many": Field(
         "full", "str", "layout of the 21-control pass (Table 2 rows)", choices=CONTROL_PATTERNS
     ),
-    "snoop.alpha": Field(
-        0.001, "float", "significance level of one w-test (two-sided)", lo=1e-9, hi=0.5
-    ),
+    "snoop.alpha": real(0.001, "significance level of one w-test (two-sided)", 1e-09, 0.5),
     "snoop.test": Field(
         "w",
         "str",
@@ -193,17 +127,10 @@ SCHEMA = {
         "test with the block's a-posteriori sigma0",
         choices=("w", "tau"),
     ),
-    "snoop.max_reject": Field(25, "int", "most pass points removed per block", lo=0, hi=1000),
-    "tradeoff.dpis": Field(
-        [300.0, 600.0, 1200.0],
-        "list[float]",
-        "scan resolutions compared",
-        lo=50.0,
-        hi=10000.0,
-        min_len=1,
-    ),
-    "tradeoff.trials": Field(
-        150, "int", "trials per scan resolution and per re-centring error", lo=2, hi=1_000_000
+    "snoop.max_reject": count(25, "most pass points removed per block", 0, 1000),
+    "tradeoff.dpis": reals([300.0, 600.0, 1200.0], "scan resolutions compared", 50.0, 10000.0),
+    "tradeoff.trials": count(
+        150, "trials per scan resolution and per re-centring error", 2, 1_000_000
     ),
     "tradeoff.layouts": Field(
         list(CONTROL_PATTERNS),
@@ -212,46 +139,39 @@ SCHEMA = {
         choices=CONTROL_PATTERNS,
         min_len=1,
     ),
-    "tradeoff.block_strips": Field(
-        [1, 2, 2, 3, 4, 4], "list[int]", "strips of the blocks compared", lo=1, hi=50, min_len=1
-    ),
-    "tradeoff.block_models": Field(
+    "tradeoff.block_strips": counts([1, 2, 2, 3, 4, 4], "strips of the blocks compared", 1, 50),
+    "tradeoff.block_models": counts(
         [8, 4, 8, 12, 16, 24],
-        "list[int]",
         "models per strip of the blocks compared (same length as block_strips)",
-        lo=1,
-        hi=200,
-        min_len=1,
+        1,
+        200,
     ),
-    "tradeoff.recentre_px": Field(
+    "tradeoff.recentre_px": reals(
         [0.25, 0.5, 0.75],
-        "list[float]",
         "mechanical re-centring errors for the rejection sensitivity",
-        lo=0.0,
-        hi=20.0,
-        min_len=1,
+        0.0,
+        20.0,
         unit="px",
     ),
-    "tradeoff.block_trials": Field(30, "int", "trials per block size", lo=2, hi=1_000_000),
+    "tradeoff.block_trials": count(30, "trials per block size", 2, 1_000_000),
     "tradeoff.block_control": Field(
         "perimeter", "str", "control layout of the block-size runs", choices=CONTROL_PATTERNS
     ),
-    "tradeoff.centre_points": Field(
-        10,
-        "int",
-        "check points nearest the block centre used for 'accuracy at the centre'",
-        lo=1,
-        hi=10_000,
+    "tradeoff.centre_points": count(
+        10, "check points nearest the block centre used for 'accuracy at the centre'", 1, 10_000
     ),
-    "region.trials": Field(
-        150,
-        "int",
-        "simulated blocks per input vector of the region (region.toml)",
-        lo=2,
-        hi=1_000_000,
+    "region.trials": count(
+        150, "simulated blocks per input vector of the region (region.toml)", 2, 1_000_000
     ),
-    "region.points": Field(
-        8, "int", "five-point layouts of the region's space-filling design", lo=2, hi=64
+    "region.points": count(8, "five-point layouts of the region's space-filling design", 2, 64),
+    "table1.points": count(
+        16, "scanner vectors of the Table 1 region's space-filling design (scanner.toml)", 2, 256
+    ),
+    "table1.trials": count(
+        10, "simulated blocks per scanner vector of the Table 1 region", 2, 10_000
+    ),
+    "table1.rounds": count(
+        0, "boundary refinement rounds of the Table 1 region (none while it is empty)", 0, 5
     ),
 }
 
