@@ -171,18 +171,27 @@ PLATES = np.arange(1.0, 1001.0)  # 1000 plates 1, 2, ..., 1000: their shares are
 
 
 @pytest.mark.parametrize(
-    "ref, p, outcome",
+    "ref, decimals, p, outcome",
     [
-        (24.5, 0.048, "fails"),  # 24 plates below: q = 0.024
-        (25.5, 0.05, "holds"),  # 25 plates below: p = 0.05, at the threshold
-        (25.0, 0.049, "fails"),  # a tie counts half: q = 24.5 / 1000
-        (975.5, 0.05, "holds"),  # the upper tail, at the threshold
-        (976.5, 0.048, "fails"),
-        (500.5, 1.0, "holds"),
+        (24.5, 1, 0.048, "fails"),  # 24 plates below 24.55: q = 0.024
+        (25.5, 1, 0.05, "holds"),  # 25 plates below: p = 0.05, at the threshold
+        (25.0, None, 0.049, "fails"),  # no rounding given (h = 0): the tie counts half
+        (25.0, 1, 0.05, "holds"),  # "25.0" is 24.95-25.05: plate 25 prints as it, counts whole
+        (24.5, 0, 0.049, "fails"),  # "24" ... h = 0.5: the plate on the edge 25.0 counts half
+        (25.0, 0, 0.05, "holds"),  # h = 0.5: 25 plates below 25.5
+        (975.5, 1, 0.05, "holds"),  # the upper tail, at the threshold
+        (976.5, 1, 0.048, "fails"),
+        (976.0, 0, 0.05, "holds"),  # h = 0.5: 25 plates above 975.5
+        (976.5, 0, 0.049, "fails"),  # the plate on the edge 976.0 counts half
+        (500.5, 1, 1.0, "holds"),
     ],
 )
-def test_one_plate_claims_from_plates(ref, p, outcome):
-    r = one(form="one-plate", ref=ref, decimals=1, tol=1000.0).score("c", samples=PLATES)
+def test_one_plate_claims_from_plates(ref, decimals, p, outcome):
+    """The book passes half a unit of the printed last decimal to the one-plate p."""
+    spec = {"form": "one-plate", "ref": ref, "tol": 1000.0}
+    if decimals is not None:
+        spec["decimals"] = decimals
+    r = one(**spec).score("c", samples=PLATES)
     assert r["p_plate"] == pytest.approx(p, abs=1e-15) and r["outcome"] == outcome
     assert r["interval"] == "spread" and r["value"] == 500.5
     # the central 95 %: numpy's percentile at (n - 1) q between order statistics

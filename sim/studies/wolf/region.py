@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.book_region import load_declaration, sample_evidence
+from sim.claims.book_region import load_declaration, plate_ref, sample_evidence
 from sim.claims.inference import Region, explore
 from sim.mc.runner import chunk_rng
 from sim.studies.run_steps import run_part
@@ -60,8 +60,7 @@ def evidence(book: ClaimBook, ids: list[str], res: dict, tags: list[str]) -> dic
         if cid in (HEADLINE, JOINT):
             continue
         x = np.stack([res[t + stat_key(cid)] for t in tags])
-        spec = book.spec(cid)
-        out[cid] = sample_evidence(x, float(spec["ref"]) if spec["form"] == "one-plate" else None)
+        out[cid] = sample_evidence(x, *plate_ref(book.spec(cid)))
     if HEADLINE in ids:
         el = [
             sample_evidence(np.stack([res[f"{t}mono.mean_{ax}_um"] for t in tags])) for ax in AXES
