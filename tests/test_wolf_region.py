@@ -6,7 +6,11 @@ import numpy as np
 import pytest
 
 from sim.claims.intervals import plate_p
+from sim.mc.config import validate
+from sim.studies import wolf
+from sim.studies.wolf.chunks import draw_main
 from sim.studies.wolf.claims import HEADLINE, JOINT, holm, is_mean_row, load_book, stat_key
+from sim.studies.wolf.model import read_placed
 from sim.studies.wolf.region import evidence
 
 
@@ -62,3 +66,47 @@ def test_the_headline_is_decided_as_one_holm_test_of_the_eight_means():
     spec = load_book().spec(HEADLINE)
     assert spec["form"] == "lower" and spec["ref"] == 0.05 and spec["kind"] == "prediction"
     assert "ranged from 3 to 9" in spec["paper"] and "Holm" in spec["paper"]
+
+
+def _cfg(**over):
+    raw = {"trials": 20, "trade.trials": 10, "unprinted.trials": 10, **over}
+    return validate(raw, wolf.SCHEMA, wolf.check)
+
+
+NC_KEYS = ("field.stress_um", "field.encoder_periodic_um", "field.restitution_um")
+
+
+@pytest.mark.parametrize("g", [0.0, 2.0])
+def test_the_noncubic_factor_cell_equals_scaled_noncubic_amplitudes(g):
+    """A region cell's noncubic_factor reads the plates of an instrument configured with the
+    stresses, the encoder's periodic error and the restitution field times g (same random
+    numbers: the field draws do not depend on the amplitudes)."""
+    cfg = _cfg(**{"field.drift_fraction": 0.3})
+    cfg2 = dict(cfg, **{k: g * cfg[k] for k in NC_KEYS})
+    a = draw_main(cfg, np.random.default_rng(21), 5, 3)
+    b = draw_main(cfg2, np.random.default_rng(21), 5, 3)
+    kw = dict(count_um=1e-6, n=1, sigma_um=0.0, backlash_um=0.0, approach="one_side")
+    kw.update(drift_fraction=0.3, restitution_um=cfg["field.restitution_um"])
+    for pa, pb in zip(a["cal"] + a["rep"], b["cal"] + b["rep"]):
+        ra = read_placed(pa, noncubic_factor=g, **kw)
+        rb = read_placed(pb, **dict(kw, restitution_um=cfg2["field.restitution_um"]))
+        assert np.allclose(ra, rb, rtol=0, atol=1e-3)  # counts of 1e-6 um: 1e-9 um
+        # the cubic-fittable part is untouched; only the non-cubic part scales
+        assert np.allclose(pb.static - pb.static_nc, pa.static - pa.static_nc, atol=1e-9)
+        assert np.allclose(pb.drift_nc, g * pa.drift_nc, atol=1e-9)
+    # the non-cubic part is a real share of the field, not zero
+    assert np.sqrt(np.mean(a["cal"][0].static_nc ** 2)) > 1.0
+
+
+def test_cells_at_factor_1_read_the_configured_instrument_bit_for_bit():
+    cfg = _cfg()
+    main = wolf.main_chunk(cfg, full=False)(np.random.default_rng(5), 6)
+    cells = wolf.main_chunk(
+        cfg,
+        (("d.", {"noncubic_factor": 1.0}), ("z.", {"noncubic_factor": 0.0})),
+        full=False,
+    )(np.random.default_rng(5), 6)
+    for k, v in main.items():
+        assert np.array_equal(cells["d." + k], v)
+    # without the sources a cubic cannot fit, less is left after the cubic
+    assert np.mean(cells["z.after.rms_x_um"]) < np.mean(cells["d.after.rms_x_um"])

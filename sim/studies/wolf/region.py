@@ -37,6 +37,8 @@ CELL = {
     "pointing_sigma_um": "reading.pointing_sigma_um",
     "field_scale_1": "field_scale",
     "mono_sigma_um": "mono.sigma_um",
+    "drift_share_1": "field.drift_fraction",
+    "noncubic_factor_1": "noncubic_factor",
 }
 
 
@@ -46,6 +48,8 @@ def nominal(cfg: dict) -> dict[str, float]:
         "pointing_sigma_um": float(cfg["reading.pointing_sigma_um"]),
         "field_scale_1": 1.0,
         "mono_sigma_um": float(cfg["mono.sigma_um"]),
+        "drift_share_1": float(cfg["field.drift_fraction"]),
+        "noncubic_factor_1": 1.0,
     }
 
 
