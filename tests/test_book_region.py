@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from sim.claims.book import ClaimBook
-from sim.claims.book_region import load_declaration, region_rows, sample_evidence
+from sim.claims.book_region import load_declaration, plate_ref, region_rows, sample_evidence
 from sim.claims.inference import FAILS, HOLDS, UNDECIDED, explore, status
 from sim.claims.region import statement_of
 from sim.mc.config import ConfigError
@@ -45,8 +45,8 @@ def test_sample_evidence_matches_the_books_one_plate_rule():
     rng = np.random.default_rng(4)
     x = rng.normal([[1.0], [1.4], [2.5]], 0.2, (3, 400))
     ref = 1.5
-    ev = sample_evidence(x, ref)
     spec = {"id": "a", "form": "one-plate", "ref": ref, "decimals": 1, "tol": 0.1}
+    ev = sample_evidence(x, *plate_ref(spec))
     for i in range(3):
         row = _book(spec).score("a", samples=x[i])
         assert math.isclose(ev["p"][i], row["p_plate"], abs_tol=1e-12)

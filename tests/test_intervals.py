@@ -15,6 +15,7 @@ import pytest
 from scipy import special, stats
 
 from sim.claims import intervals as iv
+from sim.claims.book_region import sample_evidence
 from sim.mc.config import StudyError
 from sim.mc.runner import MIN_CHUNKS, jackknife
 
@@ -259,6 +260,44 @@ def test_plate_p_is_the_two_sided_tail_share_with_ties_half():
     assert iv.plate_p([1, 2, 3], 2) == 1.0  # integers: the middle plate, q = 1/2
 
 
+@pytest.mark.parametrize(
+    "ref, h, p",
+    [
+        (3.0, 0.0, 2 * 2.5 / 100),  # h = 0 is the old rule: the tie at 3 counts half
+        (3.0, 0.25, 2 * 3 / 100),  # 3 plates below 3.25 (none on an edge)
+        (3.0, 0.5, 2 * 3 / 100),  # below 3.5: 3 plates; above 2.5: 98
+        (3.0, 1.0, 2 * 3.5 / 100),  # the plate on the edge 4 counts half
+        (2.5, 1.5, 2 * 3.5 / 100),  # lower share 1, 2, 3 and half of the plate on 4
+        (97.0, 1.0, 2 * 4.5 / 100),  # upper tail: 97..100 above 96, and half the plate on 96
+        (97.0, 0.5, 2 * 4 / 100),  # above 96.5: 97..100
+        (0.0, 0.5, 0.0),  # nothing prints as 0 (-0.5 to 0.5): p = 0
+        (0.0, 1.0, 2 * 0.5 / 100),  # the first plate lies on the edge 0 + 1: it counts half
+        (50.0, 10.0, 1.0),  # 2 min(59.5, 60.5) / 100 = 1.19: capped at 1
+        (50.5, 0.25, 1.0),  # exactly the middle: 2 min(50, 50) / 100
+    ],
+)
+def test_plate_p_counts_every_value_that_prints_as_ref(ref, h, p):
+    """p = min(1, 2 min(P(X < ref + h), P(X > ref - h))), plates on an edge counted half."""
+    x = np.arange(1.0, 101.0)  # 1..100: every share is exact
+    assert iv.plate_p(x, ref, h) == pytest.approx(p, abs=1e-15)
+    assert iv.plate_p(x, ref, h) == iv.plate_p(-x, -ref, h)  # symmetric in the two tails
+
+
+def test_plate_p_at_h_0_is_the_old_rule_and_h_is_not_negative():
+    rng = np.random.default_rng(21)
+    x = np.round(rng.normal(0.0, 1.0, 500), 1)  # many ties
+    for ref in (-2.0, -0.3, 0.0, 0.1, 1.7, 2.5):
+        q = (np.count_nonzero(x < ref) + 0.5 * np.count_nonzero(x == ref)) / x.size
+        assert iv.plate_p(x, ref, 0.0) == pytest.approx(2 * min(q, 1 - q), abs=1e-15)
+        assert iv.plate_p(x, ref) == iv.plate_p(x, ref, 0.0)
+        # a wider rounding can only make the paper's number less rare
+        assert iv.plate_p(x, ref, 0.05) >= iv.plate_p(x, ref, 0.0)
+    with pytest.raises(ValueError, match=r"^the rounding half-unit h must be >= 0, not -0\.1$"):
+        iv.plate_p(x, 0.0, -0.1)
+    with pytest.raises(ValueError, match="^the rounding half-unit h must be >= 0, not nan$"):
+        iv.plate_p(x, 0.0, math.nan)
+
+
 def test_plate_p_of_a_true_plate_is_uniform():
     # the paper's plate drawn from the simulated distribution: P(p < 0.05) = 0.05
     R = 4000
@@ -309,3 +348,12 @@ def test_jackknife_refuses_fewer_than_the_minimum_of_chunks():
 def test_the_provenance_names_every_method():
     assert set(iv.METHODS) == {"mean", "sd", "share", "bootstrap", "jackknife", "spread", "exact"}
     assert str(MIN_CHUNKS) in iv.METHODS["jackknife"] and "Wilson" in iv.METHODS["share"]
+
+
+def test_sample_evidence_p_is_plate_p_row_by_row():
+    """The region's vectorised one-plate p (sim.claims.book_region) equals plate_p per point,
+    with the rounding's h, on plates with values on the edges."""
+    x = np.stack([np.arange(1.0, 101.0), np.arange(1.0, 101.0) / 2, -np.arange(1.0, 101.0)])
+    for ref, h in ((3.0, 0.0), (3.0, 1.0), (2.5, 0.5), (97.0, 1.0), (-3.0, 0.5), (50.0, 10.0)):
+        ev = sample_evidence(x, ref, h)
+        assert list(ev["p"]) == [iv.plate_p(r, ref, h) for r in x]

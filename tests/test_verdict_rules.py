@@ -13,6 +13,7 @@ import pytest
 from sim.claims import book as bk
 from sim.claims import rules
 from sim.claims.book import P_FAIL, ClaimBook, decide, write_claims
+from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Statement, status
 from sim.mc.storage import read_provenance
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -171,18 +172,27 @@ PLATES = np.arange(1.0, 1001.0)  # 1000 plates 1, 2, ..., 1000: their shares are
 
 
 @pytest.mark.parametrize(
-    "ref, p, outcome",
+    "ref, decimals, p, outcome",
     [
-        (24.5, 0.048, "fails"),  # 24 plates below: q = 0.024
-        (25.5, 0.05, "holds"),  # 25 plates below: p = 0.05, at the threshold
-        (25.0, 0.049, "fails"),  # a tie counts half: q = 24.5 / 1000
-        (975.5, 0.05, "holds"),  # the upper tail, at the threshold
-        (976.5, 0.048, "fails"),
-        (500.5, 1.0, "holds"),
+        (24.5, 1, 0.048, "fails"),  # 24 plates below 24.55: q = 0.024
+        (25.5, 1, 0.05, "holds"),  # 25 plates below: p = 0.05, at the threshold
+        (25.0, None, 0.049, "fails"),  # no rounding given (h = 0): the tie counts half
+        (25.0, 1, 0.05, "holds"),  # "25.0" is 24.95-25.05: plate 25 prints as it, counts whole
+        (24.5, 0, 0.049, "fails"),  # "24" ... h = 0.5: the plate on the edge 25.0 counts half
+        (25.0, 0, 0.05, "holds"),  # h = 0.5: 25 plates below 25.5
+        (975.5, 1, 0.05, "holds"),  # the upper tail, at the threshold
+        (976.5, 1, 0.048, "fails"),
+        (976.0, 0, 0.05, "holds"),  # h = 0.5: 25 plates above 975.5
+        (976.5, 0, 0.049, "fails"),  # the plate on the edge 976.0 counts half
+        (500.5, 1, 1.0, "holds"),
     ],
 )
-def test_one_plate_claims_from_plates(ref, p, outcome):
-    r = one(form="one-plate", ref=ref, decimals=1, tol=1000.0).score("c", samples=PLATES)
+def test_one_plate_claims_from_plates(ref, decimals, p, outcome):
+    """The book passes half a unit of the printed last decimal to the one-plate p."""
+    spec = {"form": "one-plate", "ref": ref, "tol": 1000.0}
+    if decimals is not None:
+        spec["decimals"] = decimals
+    r = one(**spec).score("c", samples=PLATES)
     assert r["p_plate"] == pytest.approx(p, abs=1e-15) and r["outcome"] == outcome
     assert r["interval"] == "spread" and r["value"] == 500.5
     # the central 95 %: numpy's percentile at (n - 1) q between order statistics
@@ -197,6 +207,35 @@ def test_one_plate_central_range_is_2_5_to_97_5_percent():
     assert r["p_plate"] == 1.0 and r["outcome"] == "inconclusive"
     r = one(form="one-plate", ref=500.5, decimals=0, tol=475.0).score("c", samples=PLATES)
     assert (r["zone_low"], r["zone_high"]) == (25.0, 976.0) and r["outcome"] == "holds"
+
+
+@pytest.mark.parametrize(
+    "interval, p, outcome",
+    [
+        ((ABOVE, 3.0), 0.5, "inconclusive"),  # spread wholly outside, p common: not a miss
+        ((1.0, BELOW), 0.05, "inconclusive"),  # at the threshold
+        ((1.5, 2.5), 0.049, "fails"),  # spread inside, p rare: fails
+        ((1.5, 2.5), 0.05, "holds"),
+        ((1.0, 1.5), 0.2, "inconclusive"),
+        ((ABOVE, 3.0), None, "fails"),  # no p: the interval's miss decides
+        ((1.5, 2.5), None, "holds"),
+    ],
+)
+def test_inference_status_with_a_one_plate_p_is_the_books_rule(interval, p, outcome):
+    """``sim.claims.inference.status``: a one-plate p replaces the interval's miss
+    (``p < 1 - level`` alone fails), exactly as ``decide`` does; without p the miss decides."""
+    st = Statement("c", (2.0, 2.0), form="one-plate", decimals=0, tol=0.25)
+    assert st.zone == ZONE
+    ev = {"low": np.array([interval[0]]), "high": np.array([interval[1]])}
+    if p is not None:
+        ev["p"] = np.array([p])
+        assert decide("one-plate", interval, ZONE, p_plate=p) == outcome
+    code = {"holds": HOLDS, "fails": FAILS, "inconclusive": UNDECIDED}[outcome]
+    assert status(st, ev, 1).tolist() == [code]
+    # the level sets the threshold: at 99 % a p of 0.02 is not rare enough to fail
+    if p == 0.049:
+        assert status(st, {**ev, "p": np.array([0.02])}, 1, level=0.99).tolist() == [HOLDS]
+        assert status(st, {**ev, "p": np.array([0.0099])}, 1, level=0.99).tolist() == [FAILS]
 
 
 def test_a_one_plate_claim_without_plates_is_a_value():

@@ -211,8 +211,9 @@ class ClaimBook:
             _finite(cid, x, "samples")
             value, ci = spread(x)
             interval = "spread"
-            if "ref" in s:
-                p_plate = plate_p(x, float(s["ref"]))
+            if "ref" in s:  # every value that prints as ref is as likely as ref itself
+                h = 0.5 * 10.0 ** (-s["decimals"]) if "decimals" in s else 0.0
+                p_plate = plate_p(x, float(s["ref"]), h)
         if elems is not None:
             el, eh = (np.asarray(e) for e in elems)
             _finite(cid, np.concatenate([el, eh]), "element intervals")

@@ -39,6 +39,7 @@ __all__ = [
     "load_declaration",
     "statements",
     "sample_evidence",
+    "plate_ref",
     "region_rows",
     "write_region",
     "write_explored",
@@ -102,20 +103,35 @@ def statements(book: ClaimBook, ids: Sequence[str]) -> list[Statement]:
     return [statement_of(book, c) for c in ids]
 
 
-def sample_evidence(x: np.ndarray, ref: float | None = None) -> dict[str, np.ndarray]:
+def sample_evidence(
+    x: np.ndarray, ref: float | None = None, h: float = 0.0
+) -> dict[str, np.ndarray]:
     """Evidence of per-point samples ``x`` (N points, M plates each; NaN-free rows).
 
     ``value`` the median, ``low``/``high`` the 2.5 / 97.5 % spread of one plate; with ``ref``
-    (a one-plate claim) also ``p = 2 min(q, 1 - q)``, ``q`` the share of plates below ``ref``
-    (ties counted half): the book's one-plate rule, point by point."""
+    (a one-plate claim) also ``p = min(1, 2 min(P(X < ref + h), P(X > ref - h)))``, ``h``
+    half a unit of the printed last decimal (:func:`plate_ref`), plates on an edge counted
+    half: the book's one-plate rule (:func:`sim.claims.intervals.plate_p`), point by point."""
     x = np.asarray(x, float)
     med, lo, hi = spread_rows(x)
     ev = {"value": med, "low": lo, "high": hi}
     if ref is not None:
+        if not h >= 0:
+            raise ValueError(f"the rounding half-unit h must be >= 0, not {h!r}")
         n = np.sum(np.isfinite(x), axis=1)
-        q = (np.sum(x < ref, axis=1) + 0.5 * np.sum(x == ref, axis=1)) / np.maximum(n, 1)
-        ev["p"] = np.minimum(1.0, 2 * np.minimum(q, 1 - q))
+        below = np.sum(x < ref + h, axis=1) + 0.5 * np.sum(x == ref + h, axis=1)
+        above = np.sum(x > ref - h, axis=1) + 0.5 * np.sum(x == ref - h, axis=1)
+        ev["p"] = np.minimum(1.0, 2 * np.minimum(below, above) / np.maximum(n, 1))
     return ev
+
+
+def plate_ref(spec: Mapping) -> tuple[float | None, float]:
+    """``(ref, h)`` for :func:`sample_evidence` from a claim's spec: the printed number and
+    half a unit of its last decimal for a one-plate claim, ``(None, 0.0)`` otherwise."""
+    if spec.get("form") != "one-plate":
+        return None, 0.0
+    h = 0.5 * 10.0 ** (-spec["decimals"]) if "decimals" in spec else 0.0
+    return float(spec["ref"]), h
 
 
 def region_rows(

@@ -251,15 +251,19 @@ def _evidence(sid: str, ev: Any, n: int):
 
 def status(st: Statement, ev: Any, n: int, level: float = 0.95) -> np.ndarray:
     """Per point: HOLDS (interval inside the zone), FAILS (misses it wholly; for elements:
-    some element does; one-plate: p < 1 - level) or UNDECIDED. NaN evidence is UNDECIDED."""
+    some element does) or UNDECIDED. NaN evidence is UNDECIDED. With a one-plate ``p`` the
+    fail test is ``p < 1 - level`` alone, replacing the interval's miss (the book's one-plate
+    rule, :func:`sim.claims.rules.decide`): a spread wholly outside the zone is the raw p again
+    and would undo any adjustment of ``p`` (the printed rounding, Holm's correction)."""
     lo, hi, p = _evidence(st.id, ev, n)
     zl, zh = st.zone
     lo2, hi2 = lo.reshape(n, -1), hi.reshape(n, -1)
     nan = np.isnan(lo2).any(axis=1) | np.isnan(hi2).any(axis=1)
-    miss = ((hi2 < zl) | (lo2 > zh)).any(axis=1)
     inside = ((lo2 >= zl) & (hi2 <= zh)).all(axis=1)
-    if p is not None:
-        miss |= p < 1 - level
+    if p is None:
+        miss = ((hi2 < zl) | (lo2 > zh)).any(axis=1)
+    else:  # 1 - 0.95 is 0.05000000000000004 in binary: round so that p = 0.05 passes, as in the book
+        miss = p < round(1 - level, 12)
     out = np.where(miss, FAILS, np.where(inside, HOLDS, UNDECIDED)).astype(np.int8)
     out[nan] = UNDECIDED
     return out

@@ -61,8 +61,9 @@ METHODS = {
     ),
     "spread": (
         "one plate: median and 2.5-97.5 % range of the statistic over simulated plates; "
-        "p = 2 min(q, 1-q), q the share of plates at or below the paper's value "
-        "(ties count half)"
+        "p = min(1, 2 min(P(X < ref + h), P(X > ref - h))) over the plates, h half a unit "
+        "of the paper's last printed decimal (plates on an edge count half; h = 0: "
+        "2 min(q, 1-q), q the share below the paper's value)"
     ),
     "exact": "a deterministic computation: the interval is the value itself",
 }
@@ -191,12 +192,18 @@ def spread_rows(x: np.ndarray, level: float = LEVEL) -> tuple[np.ndarray, np.nda
     return med, lo, hi
 
 
-def plate_p(x: np.ndarray, ref: float) -> float:
-    """The probability of a simulated plate at least as extreme as the paper's value ``ref``:
-    ``p = 2 min(q, 1 - q)`` with ``q`` the share of plates below ``ref`` (a plate equal
-    to ``ref`` counts half)."""
+def plate_p(x: np.ndarray, ref: float, h: float = 0.0) -> float:
+    """The probability of a simulated plate at least as extreme as *every* value that prints
+    as the paper's ``ref``: ``p = min(1, 2 min(P(X < ref + h), P(X > ref - h)))``, ``h`` half a
+    unit of the printed last decimal (0.05 for a printed "0.8": the paper's plate is rare only
+    if everything in 0.75-0.85 is rare). A plate on an edge (``ref + h`` for the lower share,
+    ``ref - h`` for the upper) counts half, as a plate equal to ``ref`` does at ``h = 0``,
+    where this is ``2 min(q, 1 - q)`` with ``q`` the share below ``ref`` (ties half)."""
     x = np.asarray(x)
     if x.size == 0:
         raise ValueError("a one-plate p needs at least one plate")
-    q = (np.count_nonzero(x < ref) + 0.5 * np.count_nonzero(x == ref)) / x.size
-    return float(2 * min(q, 1 - q))  # at most 1: min(q, 1 - q) <= 1/2
+    if not h >= 0:
+        raise ValueError(f"the rounding half-unit h must be >= 0, not {h!r}")
+    below = np.count_nonzero(x < ref + h) + 0.5 * np.count_nonzero(x == ref + h)
+    above = np.count_nonzero(x > ref - h) + 0.5 * np.count_nonzero(x == ref - h)
+    return float(min(1.0, 2 * min(below, above) / x.size))

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.book_region import Declaration, load_declaration, sample_evidence
+from sim.claims.book_region import Declaration, load_declaration, plate_ref, sample_evidence
 from sim.claims.inference import Region, explore
 from sim.instruments import transforms2d as t2
 from sim.instruments.plates import grid_points
@@ -121,8 +121,7 @@ def _evidence(book: ClaimBook, cid: str, x: np.ndarray) -> dict:
     if cid == RW:  # "one or two trials": the 95th percentile of the re-weightings, exact
         v = np.percentile(x, 95, axis=1)
         return {"value": v, "low": v, "high": v}
-    spec = book.spec(cid)
-    ev = sample_evidence(x, float(spec["ref"]) if spec.get("form") == "one-plate" else None)
+    ev = sample_evidence(x, *plate_ref(book.spec(cid)))
     bad = np.mean(np.isfinite(x), axis=1) < 0.5
     for k in ("value", "low", "high"):
         ev[k] = np.where(bad, np.inf, ev[k])

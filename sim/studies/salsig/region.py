@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.book_region import load_declaration, sample_evidence
+from sim.claims.book_region import load_declaration, plate_ref, sample_evidence
 from sim.claims.inference import Region, explore
 from sim.studies.salsig.model import simulate_vertical
 
@@ -69,9 +69,8 @@ def explore_region(cfg: dict, book: ClaimBook, rng: np.random.Generator) -> tupl
         for i in range(m):
             for c, v in vertical_stats(cfg, x, i, rng, n).items():
                 s[c][i] = v
-        ref = float(book.spec(RATIO)["ref"])
         return {
-            RATIO: sample_evidence(s[RATIO], ref),
+            RATIO: sample_evidence(s[RATIO], *plate_ref(book.spec(RATIO))),
             DRAM_Z: sample_evidence(s[DRAM_Z]),
             DRAM_XY: sample_evidence(s[DRAM_XY]),
         }

@@ -52,7 +52,10 @@ CELL_KEYS = (
     "field.restitution_um",
     "field.drift_fraction",
     "field_scale",
+    "noncubic_factor",
 )
+#: cell keys that are factors on the configured instrument (1 = as configured), not config keys
+FACTORS = ("field_scale", "noncubic_factor")
 
 
 def _dates(cfg: dict, later) -> tuple[np.ndarray, np.ndarray]:
@@ -135,6 +138,7 @@ def _reduce_readings(cfg: dict, D: dict, cell: dict, full: bool, keep_vectors: b
         field_scale=fs,
         drift_fraction=cell["field.drift_fraction"],
         restitution_um=cell["field.restitution_um"],
+        noncubic_factor=cell["noncubic_factor"],
     )
     counts = [rd(p) for p in D["cal"]]
     red, tps, fit, mtp = calibrate(
@@ -195,8 +199,8 @@ def reduce_main(
 
 
 def _cell(cfg: dict, over) -> dict:
-    cell = {k: cfg[k] for k in CELL_KEYS if k != "field_scale"}
-    cell["field_scale"] = 1.0
+    cell = {k: cfg[k] for k in CELL_KEYS if k not in FACTORS}
+    cell.update(dict.fromkeys(FACTORS, 1.0))
     cell.update(dict(over))
     return cell
 

@@ -30,6 +30,9 @@ from sim.instruments.plotter import polynomial as pl
 
 AXES = ("x", "y")
 STATS = ("max", "rms", "mean")
+#: the field components a cubic polynomial cannot fit (periodic and short-wave); with the
+#: restitution field they are scaled together by a region cell's ``noncubic_factor``
+NONCUBIC = ("encoder_periodic", "stress")
 
 
 def field_spec(cfg: dict, **over) -> ef.FieldSpec:
@@ -75,6 +78,16 @@ class Instrument:
         self.W = ef.ar1_weights(self.dates, cfg["field.drift_tau_weeks"])
         self.f = cfg["field.drift_fraction"] if drift_fraction is None else drift_fraction
 
+    def _field(self, params: dict, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A drawn field at ``P``: the total (as :func:`ef.evaluate`, bit for bit) and its part
+        a cubic cannot fit (``NONCUBIC``: the encoder's periodic error and the stresses)."""
+        comp = ef.evaluate_components(self.spec, params, P, skip_zero=True)
+        if not comp:
+            z = np.zeros(np.broadcast_shapes(np.shape(P), (self.T, 1, 2)))
+            return z, z
+        nc = [v for k, v in comp.items() if k in NONCUBIC]
+        return sum(comp.values()), (sum(nc) if nc else np.zeros_like(next(iter(comp.values()))))
+
     def disp(self, k: int, P: np.ndarray, f: float | None = None) -> np.ndarray:
         f = self.f if f is None else f
         d = math.sqrt(1 - f) * ef.evaluate(self.spec, self.static, P)
@@ -87,12 +100,20 @@ class Instrument:
     def parts(self, k: int, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The static field and the drifting field of date ``k`` at ``P``, each at full size:
         the displacement is ``sqrt(1 - f) static + sqrt(f) drift``."""
-        st = ef.evaluate(self.spec, self.static, P)
-        dr = np.zeros_like(st)
+        st, dr, _, _ = self.parts_noncubic(k, P)
+        return st, dr
+
+    def parts_noncubic(self, k: int, P: np.ndarray):
+        """:meth:`parts` and, of each, the part a cubic cannot fit (``NONCUBIC``):
+        ``(static, drift, static_nc, drift_nc)``, each ``(T, m, 2)`` um."""
+        st, st_nc = self._field(self.static, P)
+        dr, dr_nc = np.zeros_like(st), np.zeros_like(st)
         for j in range(k + 1):  # over dates, not trials
             if self.W[k, j] != 0:
-                dr = dr + self.W[k, j] * ef.evaluate(self.spec, self.drift[j], P)
-        return st, dr
+                d, d_nc = self._field(self.drift[j], P)
+                dr = dr + self.W[k, j] * d
+                dr_nc = dr_nc + self.W[k, j] * d_nc
+        return st, dr, st_nc, dr_nc
 
     def restitution(self, rng, P, unit: bool = False):
         """A fresh restitution field at ``P`` (rms ``field.restitution_um``, or 1 um with
@@ -314,7 +335,8 @@ class Placed:
     P : (T, m, 2) mm carrier positions; static, drift : (T, m, 2) um the static and the
     drifting field (:meth:`Instrument.parts`, at unit amplitude factor); rest : (T, m, 2) um
     restitution field of rms 1 um; z : (T, m, 2, nmax) standard-normal pointing noise;
-    sign : (T, m, 2, nmax) approach signs for the ``random`` approach.
+    sign : (T, m, 2, nmax) approach signs for the ``random`` approach; static_nc, drift_nc :
+    (T, m, 2) um the parts of static and drift a cubic cannot fit (``NONCUBIC``).
     """
 
     P: np.ndarray
@@ -323,6 +345,8 @@ class Placed:
     rest: np.ndarray
     z: np.ndarray
     sign: np.ndarray
+    static_nc: np.ndarray
+    drift_nc: np.ndarray
 
 
 def place(
@@ -339,11 +363,11 @@ def place(
     th = np.deg2rad(rot_sigma_deg) * rng.normal(size=T)
     sh = rng.normal(0.0, shift_sigma_mm, (T, 2))
     P = rotate(plate_true, th) + sh[:, None, :]
-    static, drift = inst.parts(k, P)
+    static, drift, st_nc, dr_nc = inst.parts_noncubic(k, P)
     rest = inst.restitution(rng, P, unit=True)
     z = rng.normal(size=P.shape + (nmax,))
     sign = rng.choice(np.array([-1.0, 1.0]), P.shape + (nmax,))
-    return Placed(P, static, drift, rest, z, sign)
+    return Placed(P, static, drift, rest, z, sign, st_nc, dr_nc)
 
 
 def read_placed(
@@ -356,11 +380,19 @@ def read_placed(
     field_scale: float = 1.0,
     drift_fraction: float = 0.0,
     restitution_um: float = 0.0,
+    noncubic_factor: float = 1.0,
 ) -> np.ndarray:
-    """Mean of ``n`` quantised readings (counts) of a :class:`Placed` plate ``(T, m, 2)``."""
-    f = drift_fraction
-    field = math.sqrt(1 - f) * pl_.static + (math.sqrt(f) * pl_.drift if f > 0 else 0.0)
-    true_um = (pl_.P * 1000.0 + field_scale * field + restitution_um * pl_.rest)[..., None]
+    """Mean of ``n`` quantised readings (counts) of a :class:`Placed` plate ``(T, m, 2)``.
+
+    ``noncubic_factor`` multiplies the sources a cubic cannot fit (the encoder's periodic
+    error, the stresses, the restitution field) on top of ``field_scale``; at 1 the readings
+    are those of the configured instrument, bit for bit."""
+    f, g = drift_fraction, noncubic_factor
+    st, dr = pl_.static, pl_.drift
+    if g != 1:
+        st, dr = st + (g - 1) * pl_.static_nc, dr + (g - 1) * pl_.drift_nc
+    field = math.sqrt(1 - f) * st + (math.sqrt(f) * dr if f > 0 else 0.0)
+    true_um = (pl_.P * 1000.0 + field_scale * field + g * restitution_um * pl_.rest)[..., None]
     bl = backlash_um / 2 if approach == "one_side" else backlash_um / 2 * pl_.sign[..., :n]
     return _mean_counts(np.round((true_um + sigma_um * pl_.z[..., :n] + bl) / count_um))
 

@@ -148,6 +148,8 @@ def _region_figure(cfg: dict, out: Path, region) -> None:
             "pointing_sigma_um": "pointing sigma of one reading (um)",
             "field_scale_1": "factor on the field amplitudes",
             "mono_sigma_um": "monocomparator sigma (um)",
+            "drift_share_1": "drifting share of the field's variance",
+            "noncubic_factor_1": "factor on the sources a cubic cannot fit",
         },
     )
 

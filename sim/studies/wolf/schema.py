@@ -248,7 +248,7 @@ SCHEMA = {
         hi=10_000_000,
     ),
     "region.points": count(
-        32,
+        48,
         "input vectors of the joint exploration's space-filling design (region.toml); each "
         "one cell on unprinted.trials instruments",
         lo=4,
