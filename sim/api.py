@@ -28,6 +28,7 @@ import pyarrow.parquet as pq
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
+from sim.mc.outputs import damaged_chunks
 from sim.mc.sweep import read_sweep
 from sim.studies import load_study
 
@@ -59,7 +60,12 @@ class Results:
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
             )
-        return pq.read_table(p)
+        if name == "trials" and (bad := damaged_chunks(self.path)):
+            raise ConfigError("table", f"trials: {bad}; run the study again")
+        try:
+            return pq.read_table(p)
+        except (OSError, pa.ArrowException) as e:
+            raise ConfigError("table", f"{p} cannot be read ({type(e).__name__})") from None
 
     def claims(self) -> pa.Table:
         """The claims table: each paper claim beside the simulated value and its verdict."""
@@ -146,7 +152,7 @@ class StudyHandle:
 def _check_path(name: str, v: Any, none_ok: bool = False) -> None:
     if v is None and none_ok:
         return
-    if not isinstance(v, (str, os.PathLike)) or "\0" in str(v) or not str(v).strip():
+    if not isinstance(v, (str, os.PathLike)) or not str(v).isprintable() or not str(v).strip():
         raise ConfigError(name, f"must be a path (a str or os.PathLike), got {v!r}")
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from sim.mc.config import ConfigError
 from sim.mc.estimate import DEFAULT_MAX_MEMORY_GB, _limit
 
-__all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE"]
+__all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE", "MAX_NAME", "MAX_TITLE", "title"]
 
 #: observation kinds, in the order of their integer codes
 KINDS = ("distance", "direction", "angle", "dx", "dy", "x", "y")
@@ -64,6 +64,41 @@ def _num(key: str, v, lo: float | None = None, lo_open: bool = False, integer: b
 def _text(key: str, v) -> str:
     if not isinstance(v, str) or not v.strip():
         raise ConfigError(key, f"must be a non-empty name (got {v!r})")
+    return v
+
+
+#: longest point name or grid/random prefix (a gama-local id, a table cell, a figure label)
+MAX_NAME = 64
+#: longest network name (the report's title)
+MAX_TITLE = 200
+
+
+def _point_name(key: str, v) -> str:
+    """A point name (or the prefix of generated names): printable on one line, no leading or
+    trailing space, none of the pattern characters ``* ? [ ]`` that ``from``/``to`` and the
+    datum keys match names with, at most :data:`MAX_NAME` characters."""
+    _text(key, v)
+    if v != v.strip() or not v.isprintable():
+        raise ConfigError(
+            key, f"{v!r}: a point name is printable on one line, without leading or trailing space"
+        )
+    if set(v) & set("*?[]"):
+        raise ConfigError(
+            key,
+            f"{v!r}: a point name has no pattern character (* ? [ ]): names are matched by them",
+        )
+    if len(v) > MAX_NAME:
+        raise ConfigError(key, f"{v[:20]!r}...: over {MAX_NAME} characters")
+    return v
+
+
+def title(key: str, v) -> str:
+    """The network's name: a non-empty title on one line of at most :data:`MAX_TITLE`."""
+    _text(key, v)
+    if not v.isprintable():
+        raise ConfigError(key, f"{v[:40]!r}: must be printable on one line")
+    if len(v) > MAX_TITLE:
+        raise ConfigError(key, f"{v[:20]!r}...: over {MAX_TITLE} characters")
     return v
 
 
