@@ -161,11 +161,19 @@ def _check_int(name: str, v: Any) -> None:
         raise ConfigError(name, f"must be an integer (got {v!r})")
 
 
+def _plain(v: Any) -> Any:
+    """A NumPy scalar or array as the Python value a study file would hold (``np.int64(40)``
+    is ``40``), so that it is validated like one; anything else as given."""
+    if isinstance(v, (np.generic, np.ndarray)):
+        return v.tolist()
+    return v
+
+
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
     if not Path(study_file).is_file():
         raise ConfigError("study_file", f"{study_file} is not a study file")
-    vals = {_key(k): v for k, v in overrides.items()}
+    vals = {_key(k): _plain(v) for k, v in overrides.items()}
     study, cfg = load_study(study_file, values=vals)
     return StudyHandle(Path(study_file), study, cfg, vals, read_sweep(study_file, study.schema))

@@ -67,6 +67,8 @@ def _text(key: str, v) -> str:
     return v
 
 
+#: most readings averaged into one observation (``settings``)
+MAX_SETTINGS = 1_000_000
 #: longest point name or grid/random prefix (a gama-local id, a table cell, a figure label)
 MAX_NAME = 64
 #: longest network name (the report's title)
@@ -198,10 +200,18 @@ def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
         )
     if "set" in rec and code != 1:
         raise ConfigError(f"{key}.set", f"only a direction has an orientation set (a {kind})")
-    if "set" in rec and not isinstance(rec["set"], str):
-        raise ConfigError(f"{key}.set", f"must be a name (got {rec['set']!r})")
+    if "set" in rec:
+        _point_name(f"{key}.set", rec["set"])
     settings = _num(f"{key}.settings", rec.get("settings", 1), 1, integer=True)
+    if not settings <= MAX_SETTINGS or not lo <= sig / math.sqrt(settings):
+        raise ConfigError(
+            f"{key}.settings",
+            f"{settings:g} readings of sigma {sig:g} {unit}: over {MAX_SETTINGS:g} or an "
+            f"averaged sigma under {lo:g} {unit}",
+        )
     bias = _num(f"{key}.bias_{unit}", rec.get(f"bias_{unit}", 0.0))
+    if not abs(bias) <= hi:
+        raise ConfigError(f"{key}.bias_{unit}", f"{bias:g} is outside [-{hi:g}, {hi:g}] {unit}")
     f = ARCSEC if code in _ANGULAR else 1.0
     return code, sig * f / math.sqrt(settings), bias * f
 
