@@ -305,6 +305,9 @@ def main(argv: list[str] | None = None) -> int:
     except _BadArgs as e:
         print(f"sim.batch: {e} (see python -m sim.batch --help)", file=sys.stderr)
         return 2
+    if not args.results.strip() or not args.results.isprintable():
+        print(f"sim.batch: --results: not a directory name (got {args.results!r})", file=sys.stderr)
+        return 2
     files = [Path(f) for f in args.files]
     bad = [f for f in files if not f.is_file()]
     if bad:

@@ -418,6 +418,8 @@ def _main(argv: list[str]) -> int:
         if args.cmd == "show":
             return _show(args)
         if args.cmd == "report":
+            if not args.results.strip() or not args.results.isprintable():
+                raise ConfigError("--results", f"not a directory name (got {args.results!r})")
             return _report(Path(args.results))
     except (ConfigError, StudyError) as e:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)

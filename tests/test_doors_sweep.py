@@ -292,3 +292,15 @@ def test_api_takes_numpy_scalars_and_names_a_damaged_table(tmp_path):
     (tmp_path / "o" / "points.parquet").write_bytes(b"PAR1 truncated")
     with pytest.raises(ConfigError, match="points.parquet cannot be read"):
         res.table("points")
+
+
+def test_an_empty_results_directory_name_is_not_the_working_directory(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)  # "" would have been read as "." and written here
+    assert batch_main([str(BROWN), "--results", ""]) == 2
+    assert "--results" in capsys.readouterr().err
+    assert verify_main(["--results", "", "--no-record"]) == 2
+    assert "--results" in capsys.readouterr().err
+    _one_line(capsys, main(["report", "--results", ""]), "--results")
+    assert list(tmp_path.iterdir()) == []
