@@ -314,7 +314,7 @@ def _show(args) -> int:
 def _not_as_written(d: Path, e: Exception) -> str:
     """show and report read the Parquet tables only: one that fails to read as its study's
     table was replaced or edited by hand."""
-    why = f"{type(e).__name__}: {e}".splitlines()[0][:100]
+    why = f"{type(e).__name__}: {e}".splitlines()[0][:240]
     return f"a table under {d} is not as sim wrote it ({why}); run its study again"
 
 
