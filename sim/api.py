@@ -28,6 +28,7 @@ import pyarrow.parquet as pq
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
+from sim.mc.outputs import damaged_chunks
 from sim.mc.sweep import read_sweep
 from sim.studies import load_study
 
@@ -59,7 +60,12 @@ class Results:
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
             )
-        return pq.read_table(p)
+        if name == "trials" and (bad := damaged_chunks(self.path)):
+            raise ConfigError("table", f"trials: {bad}; run the study again")
+        try:
+            return pq.read_table(p)
+        except (OSError, pa.ArrowException) as e:
+            raise ConfigError("table", f"{p} cannot be read ({type(e).__name__})") from None
 
     def claims(self) -> pa.Table:
         """The claims table: each paper claim beside the simulated value and its verdict."""
@@ -146,7 +152,7 @@ class StudyHandle:
 def _check_path(name: str, v: Any, none_ok: bool = False) -> None:
     if v is None and none_ok:
         return
-    if not isinstance(v, (str, os.PathLike)) or "\0" in str(v) or not str(v).strip():
+    if not isinstance(v, (str, os.PathLike)) or not str(v).isprintable() or not str(v).strip():
         raise ConfigError(name, f"must be a path (a str or os.PathLike), got {v!r}")
 
 
@@ -155,11 +161,19 @@ def _check_int(name: str, v: Any) -> None:
         raise ConfigError(name, f"must be an integer (got {v!r})")
 
 
+def _plain(v: Any) -> Any:
+    """A NumPy scalar or array as the Python value a study file would hold (``np.int64(40)``
+    is ``40``), so that it is validated like one; anything else as given."""
+    if isinstance(v, (np.generic, np.ndarray)):
+        return v.tolist()
+    return v
+
+
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
     if not Path(study_file).is_file():
         raise ConfigError("study_file", f"{study_file} is not a study file")
-    vals = {_key(k): v for k, v in overrides.items()}
+    vals = {_key(k): _plain(v) for k, v in overrides.items()}
     study, cfg = load_study(study_file, values=vals)
     return StudyHandle(Path(study_file), study, cfg, vals, read_sweep(study_file, study.schema))

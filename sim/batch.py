@@ -14,7 +14,8 @@ two of importing NumPy, SciPy, pyarrow, matplotlib and numba again; elsewhere ea
 fresh ``python -m sim run``. With ``J > 1`` the runs are quiet (progress bars of several runs
 would overwrite each other); each study's line is printed when it ends. ``--stale-only``:
 only the studies whose results are not current (:func:`sim.mc.codehash.is_current`), the others
-are reported up to date. A run that fails prints its own one-line message; the others go on,
+are reported up to date. A run that fails prints its own one-line message, which starts with the name of its study
+file; the others go on,
 and the exit code is that of the first failure (1 when a run was killed). A missing study
 file is bad input: one line, exit 2.
 """
@@ -38,7 +39,7 @@ single_threaded_blas()  # before NumPy loads (sim.cli imports it)
 
 from sim.cli import main as cli_main  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
-from sim.mc.config import ConfigError, StudyError  # noqa: E402
+from sim.mc.config import ConfigError, StudyError, read_toml  # noqa: E402
 from sim.mc.registry import MODULES  # noqa: E402
 from sim.studies import load_study  # noqa: E402
 
@@ -118,10 +119,15 @@ def run_all(
     def one(f: Path):
         cmd = [sys.executable, "-m", "sim", *argv(f)]
         t = time.perf_counter()
-        with subprocess.Popen(cmd, stdout=subprocess.PIPE if jobs > 1 else None, text=True) as proc:
+        with subprocess.Popen(
+            cmd, stdout=subprocess.PIPE if jobs > 1 else None, stderr=subprocess.PIPE, text=True
+        ) as proc:
             procs.append(proc)
-            stdout, _ = proc.communicate()
+            stdout, stderr = proc.communicate()
         wall = time.perf_counter() - t
+        named = _Named(sys.stderr, f.name)
+        named.write(stderr)
+        named.flush()
         if jobs > 1 and stdout:
             log(stdout.rstrip())
         return f.stem, proc.returncode, wall, t - t0
@@ -145,19 +151,42 @@ def _preload(files: list[Path]) -> None:
     """Import the command line and the modules of the studies in ``files`` (a file whose
     study cannot be read is left to its run, which reports it)."""
     import importlib
-    import tomllib
 
     for f in files:
         try:
-            mod = MODULES.get(tomllib.loads(f.read_text()).get("study"))
+            mod = MODULES.get(read_toml(f).get("study"))
             if mod:
                 importlib.import_module(mod)
         except Exception:  # noqa: BLE001 - the run itself reports a bad study file
             pass
 
 
+class _Named:
+    """Standard error of one study's run in a batch: every line starts with the study
+    file's name, so that a failure among many runs says which study failed."""
+
+    def __init__(self, stream, name: str):
+        self.stream, self.name, self.start = stream, name, True
+
+    def write(self, text: str) -> int:
+        for part in text.splitlines(keepends=True):
+            self.stream.write(f"{self.name}: {part}" if self.start else part)
+            self.start = part.endswith("\n")
+        return len(text)
+
+    def flush(self) -> None:
+        self.stream.flush()
+
+    def isatty(self) -> bool:
+        return self.stream.isatty()
+
+    def fileno(self) -> int:
+        return self.stream.fileno()
+
+
 def _child(args: list[str]) -> None:  # pragma: no cover - runs in a forked child
     code = 1
+    sys.stderr = _Named(sys.stderr, Path(args[1]).name)
     try:
         code = cli_main(args)
     except SystemExit as e:
@@ -275,6 +304,9 @@ def main(argv: list[str] | None = None) -> int:
         args = ap.parse_args(argv)
     except _BadArgs as e:
         print(f"sim.batch: {e} (see python -m sim.batch --help)", file=sys.stderr)
+        return 2
+    if not args.results.strip() or not args.results.isprintable():
+        print(f"sim.batch: --results: not a directory name (got {args.results!r})", file=sys.stderr)
         return 2
     files = [Path(f) for f in args.files]
     bad = [f for f in files if not f.is_file()]

@@ -186,8 +186,8 @@ def _check_args(args) -> Path:
     if args.out is not None:
         if not args.out.strip():
             raise ConfigError("--out", "is empty: name an output directory")
-        if "\0" in args.out:
-            raise ConfigError("--out", "contains a NUL character")
+        if not args.out.isprintable():
+            raise ConfigError("--out", f"contains a control character (got {args.out!r})")
     return Path(os.path.abspath(args.out)) if args.out else None
 
 
@@ -300,9 +300,22 @@ def _show(args) -> int:
     if not d.is_dir():
         raise ConfigError("DIR", f"{args.dir} is not a directory")
     _check_claims(d / "claims.parquet")
-    print(run_markdown(d, get_study) if args.markdown else terminal_table(d), end="")
+    try:
+        text = run_markdown(d, get_study) if args.markdown else terminal_table(d)
+    except ConfigError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
+        raise ConfigError("DIR", _not_as_written(d, e)) from None
+    print(text, end="")
     print("" if args.markdown else "\n", end="")
     return 0
+
+
+def _not_as_written(d: Path, e: Exception) -> str:
+    """show and report read the Parquet tables only: one that fails to read as its study's
+    table was replaced or edited by hand."""
+    why = f"{type(e).__name__}: {e}".splitlines()[0][:240]
+    return f"a table under {d} is not as sim wrote it ({why}); run its study again"
 
 
 def _check_claims(f: Path) -> None:
@@ -361,7 +374,15 @@ def _report(results: Path) -> int:
         raise ConfigError(
             "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
         )
-    print(write_report(results, get_study))
+    try:
+        text = write_report(results, get_study)
+    except ConfigError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
+        # report reads the Parquet tables only: one that fails here was not written as it is
+        # by sim (a table replaced or edited by hand)
+        raise ConfigError("--results", _not_as_written(results, e)) from None
+    print(text)
     return 0
 
 
@@ -397,6 +418,8 @@ def _main(argv: list[str]) -> int:
         if args.cmd == "show":
             return _show(args)
         if args.cmd == "report":
+            if not args.results.strip() or not args.results.isprintable():
+                raise ConfigError("--results", f"not a directory name (got {args.results!r})")
             return _report(Path(args.results))
     except (ConfigError, StudyError) as e:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)

@@ -17,12 +17,17 @@ argument, and nothing is written.
   (a traceback after every run) or a file of the user's (overwritten).
 """
 
+import subprocess
+import sys
 from pathlib import Path
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+import sim
+from sim import ConfigError
 from sim.batch import main as batch_main
 from sim.cli import main
 from sim.mc.storage import write_table
@@ -149,3 +154,153 @@ def test_batch_refuses_in_one_line_before_running(tmp_path, capsys, argv, words)
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and words in err and err.startswith("sim.batch: "), err
     assert not (tmp_path / "r").exists() and (tmp_path / "mine.txt").read_text() == "mine\n"
+
+
+# --- the third sweep (issue 26): one case per class -----------------------------------------
+
+THIRD = NETWORK.replace("COEF", "1.0")
+C_PT = '{ name = "C", x_mm = 400.0, y_mm = 700.0 }'
+
+
+@pytest.mark.parametrize(
+    "old, new, key",
+    [
+        ('name = "n"', 'name = ""', "network.name"),
+        ('name = "n"', 'name = "a\\nb"', "network.name"),
+        ('name = "n"', 'name = "' + "x" * 300 + '"', "network.name"),
+        (C_PT, C_PT.replace('"C"', '"C*"'), "network.points[2].name"),
+        (C_PT, C_PT.replace('"C"', '" C"'), "network.points[2].name"),
+        (C_PT, C_PT.replace('"C"', '"C\\u0000"'), "network.points[2].name"),
+    ],
+)
+def test_names_are_one_printable_line_without_patterns(tmp_path, capsys, old, new, key):
+    f = tmp_path / "n.toml"
+    f.write_text(THIRD.replace(old, new))
+    _one_line(capsys, main(["check", str(f)]), key)
+
+
+def test_a_deeply_nested_or_huge_study_file_is_one_line(tmp_path, capsys):
+    deep = "[" * 50_000 + "]" * 50_000
+    _one_line(capsys, main(["check", str(BROWN), "--set", f"dilution.grids={deep}"]), "nested")
+    f = tmp_path / "s.toml"
+    f.write_text(f"trials = {deep}\n")
+    _one_line(capsys, main(["check", str(f)]), "s.toml", "nested")
+    with f.open("wb") as fh:  # sparse: 17 MiB of nothing, never read
+        fh.truncate(17 * 1024**2)
+    _one_line(capsys, main(["check", str(f)]), "s.toml", "MiB")
+
+
+def test_show_and_report_name_a_table_replaced_by_hand(tmp_path, capsys):
+    d = tmp_path / "res" / "network"
+    assert main(["run", str(_net(tmp_path)), "--out", str(d), "--quiet"]) == 0
+    capsys.readouterr()
+    before = (d / "README.md").read_bytes()
+    (d / "summary.parquet").write_bytes((d / "datums.parquet").read_bytes())
+    _one_line(capsys, main(["show", str(d), "--markdown"]), "not as sim wrote it")
+    _one_line(capsys, main(["report", "--results", str(d.parent)]), "not as sim wrote it")
+    assert (d / "README.md").read_bytes() == before and not (d.parent / "REPORT.md").exists()
+
+
+def _net(tmp_path: Path, text: str = THIRD) -> Path:
+    f = tmp_path / "n.toml"
+    f.write_text(text)
+    return f
+
+
+def test_an_output_path_with_a_control_character_is_refused(tmp_path, capsys):
+    out = str(tmp_path / "a\nb")
+    _one_line(capsys, main(["run", str(BROWN), "--out", out]), "--out", "control character")
+    with pytest.raises(ConfigError, match="out"):
+        sim.load(BROWN, trials=40, chunk=2).run(out=out)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "extra, key",
+    [('points = ["A"]\n', "datum.points"), ('[compare]\nfix = ["C"]\n', "compare.fix")],
+)
+def test_a_key_without_effect_or_object_is_refused(tmp_path, capsys, extra, key):
+    text = THIRD.split("[datum]")[0].replace('"A", x_mm', '"A", role = "fixed", x_mm')
+    text = text.replace('"B", x_mm', '"B", role = "fixed", x_mm') + '[datum]\nkind = "fixed"\n'
+    assert main(["check", str(_net(tmp_path, text))]) == 0
+    capsys.readouterr()
+    _one_line(capsys, main(["check", str(_net(tmp_path, text + extra))]), key)
+
+
+GAMA = ROOT / "tests" / "data" / "gama" / "one_fixed.xml"
+
+
+@pytest.mark.parametrize(
+    "old, new, words",
+    [
+        ("gnu.org/software/gama/gama-local", "example.org/x", ["namespace"]),
+        ('stdev="2.0"', 'stdev="1e-300"', ["<distance>", "'stdev'"]),
+        ('x="250.0"', 'x="1e200"', ["<point>", "'x'"]),
+        ('id="B"', 'id="B*"', ["<point>", "'id'"]),
+    ],
+)
+def test_a_gama_value_out_of_range_names_the_file_and_element(tmp_path, capsys, old, new, words):
+    xml = tmp_path / "n.xml"
+    xml.write_text(GAMA.read_text().replace(old, new, 1))
+    f = _net(
+        tmp_path, f'study = "network"\n[network]\ngama_xml = "{xml}"\n[datum]\nkind = "inner"\n'
+    )
+    _one_line(capsys, main(["check", str(f)]), "n.xml", *words)
+
+
+@pytest.mark.parametrize(
+    "field, key",
+    [
+        ("settings = 1000000000000000", "settings"),
+        ("bias_mm = 1e300", "bias_mm"),
+        ('kind = "direction", set = ""', "set"),
+    ],
+)
+def test_weights_stay_in_range_after_settings_and_bias(tmp_path, capsys, field, key):
+    obs = f'observations = [ {{ kind = "distance", from = "C", to = "B", sigma_mm = 0.01, {field} }} ]'
+    if "direction" in field:
+        obs = obs.replace('kind = "distance", ', "").replace("sigma_mm", "sigma_arcsec")
+    f = _net(tmp_path, THIRD.replace("[datum]", obs + "\n[datum]"))
+    _one_line(capsys, main(["check", str(f)]), f"network.observations[0].{key}")
+
+
+def test_a_failing_run_in_a_batch_names_its_study_file(tmp_path):
+    bad = tmp_path / "mine_bad.toml"
+    bad.write_text("study = 5\n")
+    r = subprocess.run(
+        [sys.executable, "-m", "sim.batch", str(bad), "--results", str(tmp_path / "r")],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert r.stderr.startswith("mine_bad.toml: sim: error: study"), r.stderr
+
+
+def test_api_takes_numpy_scalars_and_names_a_damaged_table(tmp_path):
+    st = sim.load(_net(tmp_path), trials=np.int64(40), chunk=np.int32(2))
+    assert st.config["trials"] == 40 and type(st.config["trials"]) is int
+    res = st.run(out=tmp_path / "o")
+    assert res.table("trials").num_rows == 40
+    chunk = tmp_path / "o" / "trials" / "part-0" / "chunk-000003.parquet"
+    chunk.write_bytes(chunk.read_bytes()[:40])
+    with pytest.raises(ConfigError, match="chunk-000003.parquet is not the file the run wrote"):
+        res.table("trials")
+    chunk.unlink()
+    with pytest.raises(ConfigError, match="chunk-000003.parquet is missing"):
+        res.table("trials")
+    (tmp_path / "o" / "points.parquet").write_bytes(b"PAR1 truncated")
+    with pytest.raises(ConfigError, match="points.parquet cannot be read"):
+        res.table("points")
+
+
+def test_an_empty_results_directory_name_is_not_the_working_directory(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)  # "" would have been read as "." and written here
+    assert batch_main([str(BROWN), "--results", ""]) == 2
+    assert "--results" in capsys.readouterr().err
+    assert verify_main(["--results", "", "--no-record"]) == 2
+    assert "--results" in capsys.readouterr().err
+    _one_line(capsys, main(["report", "--results", ""]), "--results")
+    assert list(tmp_path.iterdir()) == []

@@ -212,21 +212,33 @@ def parse_override(text: str) -> tuple[str, Any]:
         doc = tomllib.loads(f"v = {val.strip()}")
     except tomllib.TOMLDecodeError:
         return key, val.strip()
+    except RecursionError:
+        raise ConfigError(key, "--set value is nested too deeply") from None
     if list(doc) != ["v"]:
         raise ConfigError(key, f"--set value must be one TOML value (got {val!r})")
     return key, doc["v"]
 
 
+#: largest study file read (bytes): a study file is a page of keys, not data
+MAX_STUDY_BYTES = 16 * 1024**2
+
+
 def read_toml(path: str | Path) -> dict[str, Any]:
-    """Read a TOML study file; a missing or malformed file is a ConfigError."""
+    """Read a TOML study file; a missing, oversized or malformed file is a ConfigError."""
     p = Path(path)
     if not p.is_file():
         raise ConfigError(None, f"{p}: no such study file")
     try:
+        if p.stat().st_size > MAX_STUDY_BYTES:
+            raise ConfigError(
+                None, f"{p}: over {MAX_STUDY_BYTES // 1024**2} MiB, too large for a study file"
+            )
         with p.open("rb") as fh:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as e:
         raise ConfigError(None, f"{p}: malformed TOML: {e}") from None
+    except RecursionError:
+        raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None
     except UnicodeDecodeError:
         raise ConfigError(None, f"{p}: not UTF-8 text") from None
 

@@ -20,7 +20,7 @@ from sim.mc.config import ConfigError
 from sim.mc.runner import ChunkStore
 from sim.mc.storage import LOCK, Locked, StageLock, read_record, write_record
 
-__all__ = ["check_out", "prepare_stage", "drop_stage", "seal", "publish"]
+__all__ = ["check_out", "prepare_stage", "drop_stage", "seal", "publish", "damaged_chunks"]
 
 
 def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
@@ -207,6 +207,28 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
     files = _files(stage)
     chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
     write_record(stage, {**read_record(stage), "files": files, "chunk_sha256": chunks})
+
+
+def damaged_chunks(out: Path) -> str | None:
+    """What is wrong with the per-trial chunk files of a finished results directory, against
+    the sha256 of each that its run recorded (``run.json`` ``chunk_sha256``), or None when
+    they are exactly the run's: a chunk missing, changed or added by hand. A run recorded
+    before chunks were hashed is not checked."""
+    rec = read_record(out)
+    want = (rec or {}).get("chunk_sha256")
+    if not isinstance(want, dict):
+        return None
+    have = sorted(
+        p.relative_to(out).as_posix() for p in (out / "trials").rglob("*") if not p.is_dir()
+    )
+    for f in sorted(set(want) | set(have)):
+        if f not in have:
+            return f"{out / f} is missing"
+        if f not in want:
+            return f"{out / f} is not one of the run's chunk files"
+        if not (out / f).is_file() or (out / f).is_symlink() or _sha256(out / f) != want[f]:
+            return f"{out / f} is not the file the run wrote (its sha256 differs)"
+    return None
 
 
 def _sha256(p: Path) -> str:

@@ -57,6 +57,9 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _check_args(a) -> None:
+    for name, v in (("--results", a.results), ("--scratch", a.scratch)):
+        if v is not None and (not v.strip() or not v.isprintable()):
+            raise VerifyError(f"{name}: not a directory name (got {v!r})")
     if a.workers < 1:
         raise VerifyError(f"--workers: must be at least 1, not {a.workers}")
     if a.trials is not None and a.trials < 2:

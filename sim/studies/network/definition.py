@@ -47,8 +47,9 @@ from sim.studies.network.validate import (
     _mm,
     _num,
     _obs_common,
+    _point_name,
     _role,
-    _text,
+    title,
 )
 
 __all__ = ["Network", "build", "KINDS", "ARCSEC"]
@@ -136,7 +137,13 @@ def _listed_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
         key = f"network.points[{a}]"
         _keys(key, rec, _p, {"name"})
         r, s = _role(key, rec)
-        _add(pts, _text(f"{key}.name", rec["name"]), [_mm(key, rec, "x"), _mm(key, rec, "y")], r, s)
+        _add(
+            pts,
+            _point_name(f"{key}.name", rec["name"]),
+            [_mm(key, rec, "x"), _mm(key, rec, "y")],
+            r,
+            s,
+        )
 
 
 def _add(pts: tuple[list, list, list, list], name: str, xy: list, role: int, sig: float) -> None:
@@ -158,7 +165,7 @@ def _grid_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
             raise ConfigError(f"{key}.spacing_mm", f"must be > 0 (got {h:g} mm)")
         o = _mm(key, rec, "origin", False, [-(nx - 1) * h / 2, -(ny - 1) * h / 2])
         r, s = _role(key, rec)
-        prefix = _text(f"{key}.prefix", rec["prefix"])
+        prefix = _point_name(f"{key}.prefix", rec["prefix"])
         for b in range(ny):
             for c in range(nx):
                 _add(pts, f"{prefix}{b * nx + c + 1}", [o[0] + c * h, o[1] + b * h], r, s)
@@ -177,7 +184,7 @@ def _random_points(cfg: dict, rng: np.random.Generator, pts: tuple[list, list, l
             raise ConfigError(f"{key}.half_extent_mm", f"must be > 0 (got {e:g} mm)")
         c0 = _mm(key, rec, "center", False, [0.0, 0.0])
         r, s = _role(key, rec)
-        prefix = _text(f"{key}.prefix", rec["prefix"])
+        prefix = _point_name(f"{key}.prefix", rec["prefix"])
         xy = rng.uniform(-e, e, (n, 2)) + np.array(c0)
         for b in range(n):
             _add(pts, f"{prefix}{b + 1}", list(xy[b]), r, s)
@@ -324,7 +331,7 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
     beta = cfg["network.offset_mm"]
     _check_offset(beta, names, xy, kind, i, j)
     return Network(
-        cfg["network.name"],
+        title("network.name", cfg["network.name"]),
         tuple(names),
         xy,
         role,

@@ -100,6 +100,15 @@ def _defaults(f: _File, po) -> dict:
 
 
 def _sigma(f: _File, o, default, var: float | None) -> float:
+    """The standard deviation of one observation (mm, cc or arcsec), within the range whose
+    weight neither over- nor underflows (the study's own range, named by the element)."""
+    sig = _stdev(f, o, default, var)
+    if not 1e-9 <= sig <= 1e6:
+        raise f.err(o, f"a standard deviation of {sig:g} is outside [1e-09, 1e+06]", "stdev")
+    return sig
+
+
+def _stdev(f: _File, o, default, var: float | None) -> float:
     if var is not None:
         return math.sqrt(var)
     if o.get("stdev") is not None:
@@ -121,6 +130,9 @@ def _point(f: _File, e, points: dict, datum: list) -> None:
     rec = points.setdefault(pid, {"name": pid})
     if e.get("x") is not None or e.get("y") is not None:
         xy = (f.num(e, "x") * 1000, f.num(e, "y") * 1000)
+        for ax, v in zip("xy", xy):
+            if not abs(v) <= 1e9:  # the study's own range (1000 km), named by the element
+                raise f.err(e, f"{v / 1000:g} m: over 1000 km, out of range", ax)
         if "x_mm" in rec and (rec["x_mm"], rec["y_mm"]) != xy:
             raise f.err(e, f"point {pid!r} declared twice with different coordinates", "x")
         rec["x_mm"], rec["y_mm"] = xy

@@ -14,6 +14,7 @@ import stat
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.studies.network.validate import _point_name
 
 __all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes"]
 
@@ -128,7 +129,10 @@ class _File:
         v = e.get(attr, default)
         if v is None or not v.strip():
             raise self.err(e, "missing point name", attr)
-        return v.strip()
+        try:
+            return _point_name(attr, v.strip())
+        except ConfigError as err:
+            raise self.err(e, str(err).split(": ", 1)[1], attr) from None
 
     def angle(self, e, attr: str = "val") -> bool:
         """Check an angular value; True when it is d-m-s (degrees), False for gon."""
@@ -146,6 +150,9 @@ class _File:
     def vocab(self, root) -> None:
         for e in root.iter():
             t = _tag(e)
+            ns = e.tag[1:].split("}", 1)[0] if isinstance(e.tag, str) and e.tag[:1] == "{" else NS
+            if ns != NS:
+                raise self.err(e, f"in the namespace {ns!r}, not gama-local's ({NS})")
             if t in _REFUSED:
                 raise self.err(e, f"not supported: {_REFUSED[t]} (2-D networks only)")
             if t not in VOCAB:

@@ -162,6 +162,8 @@ def check(cfg: dict) -> None:
         )
     if not np.any(net.role != 1):
         raise ConfigError("network.points", "every point is fixed: nothing to estimate")
+    if cfg["datum.points"] and cfg["datum.kind"] != "inner":
+        raise ConfigError("datum.points", "only with datum.kind = inner (it has no effect here)")
     dt = datum(net, full)
     if full["datum.kind"] == "inner":
         pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
@@ -185,6 +187,8 @@ def check(cfg: dict) -> None:
         )
     if cfg["compare.fix"]:
         extra = match_points(net, "compare.fix", cfg["compare.fix"])
+        if set(np.flatnonzero(net.role != 1)) <= set(extra):
+            raise ConfigError("compare.fix", "fixes every estimated point: nothing to compare")
         an2 = pre_analysis(net, datum(net, full, tuple(extra)), 0.001, 0.8)
         if not an2.ok and sparse:
             raise ConfigError("compare.fix", f"{an2.factor.message} in the compared datum")

@@ -16,7 +16,7 @@ import numpy as np
 from sim.mc.config import ConfigError
 from sim.mc.estimate import DEFAULT_MAX_MEMORY_GB, _limit
 
-__all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE"]
+__all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE", "MAX_NAME", "MAX_TITLE", "title"]
 
 #: observation kinds, in the order of their integer codes
 KINDS = ("distance", "direction", "angle", "dx", "dy", "x", "y")
@@ -64,6 +64,43 @@ def _num(key: str, v, lo: float | None = None, lo_open: bool = False, integer: b
 def _text(key: str, v) -> str:
     if not isinstance(v, str) or not v.strip():
         raise ConfigError(key, f"must be a non-empty name (got {v!r})")
+    return v
+
+
+#: most readings averaged into one observation (``settings``)
+MAX_SETTINGS = 1_000_000
+#: longest point name or grid/random prefix (a gama-local id, a table cell, a figure label)
+MAX_NAME = 64
+#: longest network name (the report's title)
+MAX_TITLE = 200
+
+
+def _point_name(key: str, v) -> str:
+    """A point name (or the prefix of generated names): printable on one line, no leading or
+    trailing space, none of the pattern characters ``* ? [ ]`` that ``from``/``to`` and the
+    datum keys match names with, at most :data:`MAX_NAME` characters."""
+    _text(key, v)
+    if v != v.strip() or not v.isprintable():
+        raise ConfigError(
+            key, f"{v!r}: a point name is printable on one line, without leading or trailing space"
+        )
+    if set(v) & set("*?[]"):
+        raise ConfigError(
+            key,
+            f"{v!r}: a point name has no pattern character (* ? [ ]): names are matched by them",
+        )
+    if len(v) > MAX_NAME:
+        raise ConfigError(key, f"{v[:20]!r}...: over {MAX_NAME} characters")
+    return v
+
+
+def title(key: str, v) -> str:
+    """The network's name: a non-empty title on one line of at most :data:`MAX_TITLE`."""
+    _text(key, v)
+    if not v.isprintable():
+        raise ConfigError(key, f"{v[:40]!r}: must be printable on one line")
+    if len(v) > MAX_TITLE:
+        raise ConfigError(key, f"{v[:20]!r}...: over {MAX_TITLE} characters")
     return v
 
 
@@ -163,10 +200,18 @@ def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
         )
     if "set" in rec and code != 1:
         raise ConfigError(f"{key}.set", f"only a direction has an orientation set (a {kind})")
-    if "set" in rec and not isinstance(rec["set"], str):
-        raise ConfigError(f"{key}.set", f"must be a name (got {rec['set']!r})")
+    if "set" in rec:
+        _point_name(f"{key}.set", rec["set"])
     settings = _num(f"{key}.settings", rec.get("settings", 1), 1, integer=True)
+    if not settings <= MAX_SETTINGS or not lo <= sig / math.sqrt(settings):
+        raise ConfigError(
+            f"{key}.settings",
+            f"{settings:g} readings of sigma {sig:g} {unit}: over {MAX_SETTINGS:g} or an "
+            f"averaged sigma under {lo:g} {unit}",
+        )
     bias = _num(f"{key}.bias_{unit}", rec.get(f"bias_{unit}", 0.0))
+    if not abs(bias) <= hi:
+        raise ConfigError(f"{key}.bias_{unit}", f"{bias:g} is outside [-{hi:g}, {hi:g}] {unit}")
     f = ARCSEC if code in _ANGULAR else 1.0
     return code, sig * f / math.sqrt(settings), bias * f
 
