@@ -17,8 +17,9 @@ The Gauss-Newton cases are here (the linear ones in :mod:`benchmarks.engines_lin
   2 strips x 3 models, 40 ground points, full control; compared on the ground points (m).
 
 Further rows: ``multilateration`` (Brown's 25-point pivot adjustment, the compiled kernel of
-:mod:`sim.instruments.ranges.multilateration_jit`) and, in :mod:`benchmarks.engines_linear`,
-the polynomial fits and the stress field. The SciPy side is ``scipy.optimize.least_squares`` (``trf``, tolerances near machine
+:mod:`sim.instruments.ranges.multilateration_jit`), in :mod:`benchmarks.engines_linear`
+the polynomial fits and the stress field, and in :mod:`benchmarks.engines_sparse` the sparse
+path's kernels (``selinv``, ``sparse_solve``, ``block_sparse``, ``network_gradient``). The SciPy side is ``scipy.optimize.least_squares`` (``trf``, tolerances near machine
 precision), with the analytic Jacobian where the module exposes one (``pposition``) and finite
 differences otherwise (on the Jacobian's sparsity pattern for the block). It is timed on a few trials and scaled to the
 engine's count. Before anything is timed both sides solve the same trials and must agree to
@@ -33,6 +34,7 @@ from scipy.optimize import least_squares
 from benchmarks.brown import _obs, _scipy_one
 from benchmarks.case import Case
 from benchmarks.engines_linear import polynomial, polynomial_shared, stress, stress_sincos
+from benchmarks.engines_sparse import block_sparse, network_gradient, selinv, sparse_solve
 from benchmarks.timing import cpu_time, numpy_path
 from sim.instruments import gridplate as gp
 from sim.instruments.block import independent_models as im
@@ -246,6 +248,10 @@ def cases() -> dict:
         "polynomial_shared": (polynomial_shared, 20000, 400),
         "stress_field": (stress, 2000, 200),
         "stress_sincos": (stress_sincos, 2000, 200),
+        "selinv": (selinv, 2500, 20),
+        "sparse_solve": (sparse_solve, 50, 10),
+        "block_sparse": (block_sparse, 20, 5),
+        "network_gradient": (network_gradient, 50, 10),
     }
 
 

@@ -125,6 +125,29 @@ def test_selected_inverse_equals_the_dense_inverse_on_the_pattern():
     np.testing.assert_allclose(f.solve(X), Q @ X, rtol=1e-10, atol=1e-12)
 
 
+def test_numpy_twins_equal_the_compiled_kernels(tmp_path, monkeypatch):
+    """SIM_NO_JIT=1: SciPy's substitutions and the network gradient's NumPy twin give the
+    compiled kernels' numbers to rounding (the same sums in another order)."""
+    rng = np.random.default_rng(5)
+    p = 60
+    B = sparse.random(p, p, density=0.05, random_state=6) + sparse.eye(p)
+    f = lsq_sparse.factorize((B @ B.T + sparse.eye(p)).tocsc())
+    X = rng.standard_normal((p, 5))
+    cfg = load("network_testfield")
+    net = build(cfg)
+    free = datum(net, cfg).free_index(net.q)
+    fpos = np.full(net.q, -1)
+    fpos[free] = np.arange(len(free))
+    theta = net.theta_true()[None] + rng.normal(0, 1e-3, (3, net.q))
+    obs = simulate(net, rng, 3)
+    x1, (r1, g1) = f.solve(X), residual_gradient(net, fpos, theta, obs)
+    monkeypatch.setenv("SIM_NO_JIT", "1")
+    x2, (r2, g2) = f.solve(X), residual_gradient(net, fpos, theta, obs)
+    np.testing.assert_allclose(x2, x1, rtol=0, atol=1e-13 * abs(x1).max())
+    np.testing.assert_allclose(r2, r1, rtol=0, atol=1e-12 * abs(r1).max())
+    np.testing.assert_allclose(g2, g1, rtol=0, atol=1e-12 * abs(g1).max())
+
+
 def test_a_singular_network_is_refused_with_its_pivot():
     p = 10
     d = np.r_[np.ones(p - 1), 1e-30]

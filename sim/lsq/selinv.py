@@ -14,13 +14,18 @@ of the filled graph), so the work is the sum over columns of the squared column 
 dense inverse, no column-by-column solves. Seed of the method: K. Takahashi, J. Fagan and
 M.-S. Chen, "Formation of a sparse bus impedance matrix and its application to short circuit
 study" (1973); A. M. Erisman and W. F. Tinney (1975). Every kernel runs compiled by numba when
-present (:func:`sim.lsq.compile.compiled`) and as plain Python otherwise (small problems,
-``SIM_NO_JIT``).
+present (:func:`sim.lsq.compile.compiled`); without it (``SIM_NO_JIT``) the substitutions are
+SciPy's (``spsolve_triangular``) and the symbolic analysis, the recurrence and the look-up run
+as plain Python (they have no NumPy form; small problems). Bench rows (``docs/benchmark.md``):
+``selinv`` (the recurrence against column solves with the same factor) and ``sparse_solve``
+(the substitutions against SciPy's).
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import spsolve_triangular
 
 from sim.lsq import compile as jit
 
@@ -180,14 +185,29 @@ def filled(n: int, lower, L) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return Lp, Li, data
 
 
+def _unit_lower(indptr, indices, data) -> sparse.csr_matrix:
+    """The unit lower triangle ``L`` (CSR) from its strictly lower part (CSC)."""
+    n = len(indptr) - 1
+    L = sparse.csc_matrix((data, indices, indptr), shape=(n, n))
+    return sparse.csr_matrix(L + sparse.identity(n, format="csc"))
+
+
 def forward(indptr, indices, data, D, X: np.ndarray) -> None:
     """``X <- D^-1 L^-1 X`` in place (``X`` C-contiguous float64 (n, T))."""
-    _fn(_forward)(indptr, indices, data, D, X)
+    if jit.available():
+        jit.compiled(_forward)(indptr, indices, data, D, X)
+    elif X.size:
+        L = _unit_lower(indptr, indices, data)
+        X[:] = spsolve_triangular(L, X, lower=True, unit_diagonal=True) / D[:, None]
 
 
 def backward(indptr, indices, data, X: np.ndarray) -> None:
-    """``X <- L'^-T X`` in place (``X`` C-contiguous float64 (n, T))."""
-    _fn(_backward)(indptr, indices, data, X)
+    """``X <- L'^-1 X`` in place (``X`` C-contiguous float64 (n, T))."""
+    if jit.available():
+        jit.compiled(_backward)(indptr, indices, data, X)
+    elif X.size:
+        LT = sparse.csr_matrix(_unit_lower(indptr, indices, data).T)
+        X[:] = spsolve_triangular(LT, X, lower=False, unit_diagonal=True)
 
 
 def takahashi(indptr, indices, data, D) -> tuple[np.ndarray, np.ndarray]:

@@ -6,7 +6,10 @@ in mm, directions and angles in rad, coordinate differences and coordinates in m
 residual observed minus computed (angles wrapped to (-pi, pi]) and adds ``J' W r`` into the
 gradient of the free unknowns -- without the Jacobian array, which for a network of thousands
 of points and a chunk of trials would be the largest array of the run. Runs compiled by numba
-(:func:`sim.lsq.compile.compiled`), as plain Python otherwise. Seed: Brown 1968 (``004``).
+(:func:`sim.lsq.compile.compiled`); without it (``SIM_NO_JIT``) its NumPy twin
+:func:`residual_gradient_numpy` runs: the Jacobian on the pattern's slots
+(:func:`sim.studies.network.model.jacobian_sparse`) and ``J' W r`` as one sparse product. The
+bench row ``network_gradient`` times the two (``docs/benchmark.md``). Seed: Brown 1968 (``004``).
 """
 
 from __future__ import annotations
@@ -14,11 +17,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import sparse
 
 from sim.lsq import compile as jit
 from sim.studies.network.definition import Network
+from sim.studies.network.model import jacobian_sparse, pattern
 
-__all__ = ["residual_gradient"]
+__all__ = ["residual_gradient", "residual_gradient_numpy"]
 
 
 def _kernel(
@@ -81,11 +86,12 @@ def residual_gradient(net: Network, fpos: np.ndarray, theta: np.ndarray, obs: np
     """Residuals ``r`` (T, m) and the gradient ``A' W r`` (T, p) at ``theta`` (T, q) of the
     readings ``obs`` (T, m); ``fpos`` (q,) the position of each global among the free
     unknowns (-1: held)."""
+    if not jit.available():
+        return residual_gradient_numpy(net, fpos, theta, obs)
     T = theta.shape[0]
     p = int(fpos.max(initial=-1)) + 1
     r, g = np.empty((T, net.m)), np.empty((T, p))
-    fn = jit.compiled(_kernel) if jit.available() else _kernel
-    fn(
+    jit.compiled(_kernel)(
         np.ascontiguousarray(theta, dtype=np.float64),
         np.ascontiguousarray(obs, dtype=np.float64),
         net.kind.astype(np.int64),
@@ -103,3 +109,21 @@ def residual_gradient(net: Network, fpos: np.ndarray, theta: np.ndarray, obs: np
         g,
     )
     return r, g
+
+
+def residual_gradient_numpy(net: Network, fpos: np.ndarray, theta: np.ndarray, obs: np.ndarray):
+    """:func:`residual_gradient` in NumPy: ``r = obs - computed`` (angles wrapped to
+    (-pi, pi]) and ``g = J' W r`` with the Jacobian on the pattern's slots (T, m, s) summed
+    into the free unknowns by one sparse product."""
+    theta = np.asarray(theta, np.float64)
+    val, vals = jacobian_sparse(net, theta)
+    r = np.asarray(obs, np.float64) - val
+    ang = np.isin(net.kind, (1, 2))
+    r[:, ang] = (r[:, ang] + math.pi) % (2.0 * math.pi) - math.pi
+    cols = pattern(net)
+    fc = np.where(cols >= 0, np.asarray(fpos, np.int64)[np.maximum(cols, 0)], -1).ravel()
+    p = int(np.max(fpos, initial=-1)) + 1
+    use = np.flatnonzero(fc >= 0)
+    S = sparse.csr_matrix((np.ones(use.size), (use, fc[use])), shape=(fc.size, p))
+    wjr = (vals * (r / net.sigma**2)[..., None]).reshape(theta.shape[0], -1)
+    return r, np.asarray((S.T @ wjr.T).T)
