@@ -1,8 +1,18 @@
 """BLAS single-threaded in the test processes, as in every ``sim`` process (:mod:`sim.threads`):
-the tests compare in-process runs with runs in worker processes bit for bit."""
+the tests compare in-process runs with runs in worker processes bit for bit.
 
+:func:`tiny_run`: each study file run once per test session at its tiny size, shared by the
+tests that read a whole study's output (test_all_studies, test_verify, test_docs and the
+studies' own end-to-end tests), across the processes of ``pytest -n``."""
+
+import fcntl
 import os
+import re
 import resource
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
 
 import pytest
 
@@ -45,7 +55,6 @@ SLOW_FIRST = {
     "test_verify.py": 16.2,
     "test_docs.py": 15.7,
     "test_bench.py": 5.3,
-    "test_no_jit.py": 4.4,
     "test_runner.py": 4.2,
     "test_sparse.py": 3.3,
     "test_design.py": 3.2,
@@ -63,3 +72,74 @@ def pytest_collection_modifyitems(config, items):
     tests of a file keep their order. Deterministic, so every xdist worker collects the same."""
     rank = {f: i for i, f in enumerate(sorted(SLOW_FIRST, key=lambda f: -SLOW_FIRST[f]))}
     items.sort(key=lambda it: rank.get(it.path.name, len(rank)))
+
+
+ROOT = Path(__file__).resolve().parent.parent
+TINY = ROOT / "tests" / "data" / "tiny"
+
+
+def tiny_overrides(study: str) -> list[str]:
+    """The ``--set`` arguments of a study kind's tiny configuration (``tests/data/tiny/``):
+    a run of a few seconds with at least two chunks."""
+    f = TINY / f"{study}.txt"
+    assert f.is_file(), f"{f} is missing: every study needs a tiny configuration"
+    lines = [ln.strip() for ln in f.read_text().splitlines()]
+    return [a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln)]
+
+
+def study_of(path: Path) -> str:
+    """The study kind a study file runs (its ``study`` key)."""
+    return tomllib.loads(path.read_text()).get("study", "")
+
+
+def tiny_command(name: str, out: Path, workers: int = 1, *extra: str) -> list[str]:
+    """``sim run studies/<name>.toml`` at its study's tiny size into ``out``."""
+    f = ROOT / "studies" / f"{name}.toml"
+    return [sys.executable, "-m", "sim", "run", str(f), "--out", str(out), "--quiet"] + [
+        "--workers",
+        str(workers),
+        *extra,
+        *tiny_overrides(study_of(f)),
+    ]
+
+
+#: another numerical path: OpenBLAS's AVX kernels (no AVX2/AVX-512), NumPy instead of numba
+ELSEWHERE = {"OPENBLAS_CORETYPE": "Sandybridge", "SIM_NO_JIT": "1"}
+
+
+@pytest.fixture(scope="session")
+def tiny_run(tmp_path_factory):
+    """``tiny_run(name, *options)``: the output directory of ``studies/<name>.toml`` run at
+    its tiny size on 1 worker with ``options`` (more ``sim run`` options, e.g. ``--executor
+    dask --workers 2``; :func:`tiny_command`), run once per session and shared by every test
+    (and every ``pytest -n`` process: a directory of the session's base, a lock per run, a
+    failure recorded once). ``elsewhere=True``: on 2 workers on another numerical path
+    (:data:`ELSEWHERE`), with every figure's layout check and facts written to
+    ``<dir>.figures.jsonl`` (``SIM_FIGURE_CHECK``, :func:`sim.report.plotting.save`).
+    READ ONLY: a test that edits a file copies it first."""
+    base = tmp_path_factory.getbasetemp()
+    cache = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "tiny-runs"
+    cache.mkdir(exist_ok=True)
+
+    def run(name: str, *options: str, elsewhere: bool = False) -> Path:
+        key = "_".join([name, *(o.strip("-").replace("=", "-") for o in options)])
+        key = f"{key}-elsewhere" if elsewhere else key
+        assert re.fullmatch(r"[\w.-]+", key), f"options {options} make no directory name"
+        out, failed = cache / key, cache / f"{key}.failed"
+        env = dict(os.environ)
+        if elsewhere:
+            env.update(ELSEWHERE, SIM_FIGURE_CHECK=str(cache / f"{key}.figures.jsonl"))
+        with open(cache / f"{key}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+            if not out.exists() and not failed.exists():
+                cmd = tiny_command(name, out, 2 if elsewhere else 1, *options)
+                r = subprocess.run(
+                    cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=600
+                )
+                if r.returncode != 0:
+                    failed.write_text(f"exit {r.returncode}\n{r.stderr[-3000:]}")
+        if failed.exists():
+            pytest.fail(f"the shared tiny run {key} failed: {failed.read_text()}")
+        return out
+
+    return run

@@ -10,6 +10,11 @@ gets its study's tiny configuration (``tests/data/tiny/``) in place of ``--trial
 every ``/tmp/...`` path becomes a path in the scratch directory. ``make TARGET`` lines are
 checked to name a real target of the Makefile, not run. ``python -m MODULE ...`` of another
 module is checked with ``--help``. Anything else is reported as unchecked (a warning).
+
+``sim run studies/<file>.toml [OPTIONS] [--out DIR]`` is, at the tiny size, the session's
+shared run of that file with those options (``tiny_run`` in conftest.py: the same command
+with ``--quiet``, which leaves out the progress lines, and ``--workers 1``, the default):
+its output is copied to DIR, and a run another test shares is not made twice.
 """
 
 import os
@@ -18,14 +23,12 @@ import shlex
 import shutil
 import subprocess
 import sys
-import tomllib
 import warnings
 from pathlib import Path
 
 import pytest
+from conftest import ROOT, study_of, tiny_overrides
 
-ROOT = Path(__file__).resolve().parent.parent
-TINY = ROOT / "tests" / "data" / "tiny"
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
 BLOCK = re.compile(r"^```(\w*)\n(.*?)^```", re.M | re.S)
 TIMEOUT = 900
@@ -55,21 +58,12 @@ def mirror_results(dest: Path) -> None:
                 (dest / rel / f).symlink_to(Path(d) / f)
 
 
-def study_of(path: Path) -> str:
-    return tomllib.loads(path.read_text()).get("study", "")
-
-
-def tiny_overrides(study: str) -> list[str]:
-    f = TINY / f"{study}.txt"
-    lines = [ln.strip() for ln in f.read_text().splitlines()] if f.is_file() else []
-    return [a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln)]
-
-
 class Page:
     """Runs the commands of one page in ``work``; ``/tmp/X`` becomes ``work/tmp/X``."""
 
-    def __init__(self, work: Path):
+    def __init__(self, work: Path, shared=None):
         self.work = work
+        self.shared = shared  # tiny_run: the session's tiny run of a study file
         self.unchecked: list[str] = []
 
     def path(self, arg: str) -> str:
@@ -91,8 +85,28 @@ class Page:
                     skip = True
                     continue
                 out.append(a)
+            if self.reuse(out):
+                return None
             args = out + tiny_overrides(study_of(study_file))
         return [sys.executable, "-m", "sim", *args]
+
+    def reuse(self, args: list[str]) -> bool:
+        """``run studies/<file>.toml [OPTIONS] [--out DIR]``: the shared tiny run with those
+        options, copied to DIR (with no --out, to no directory: the run goes to scratch/,
+        which no page reads)."""
+        if self.shared is None or len(args) < 2:
+            return False
+        f, options = Path(args[1]), args[2:]
+        if f.parent != Path("studies") or not (ROOT / f).is_file():
+            return False
+        out = None
+        if "--out" in options:
+            k = options.index("--out")
+            out, options = options[k + 1], options[:k] + options[k + 2 :]
+        done = self.shared(f.stem, *options)
+        if out is not None:
+            shutil.copytree(done, self.work / out)
+        return True
 
     def command(self, line: str) -> list[str] | None:
         words = shlex.split(line, comments=True)
@@ -122,10 +136,10 @@ class Page:
 
 
 @pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(ROOT)) for p in PAGES])
-def test_every_command_of_the_page_runs(page, tmp_path):
+def test_every_command_of_the_page_runs(page, tmp_path, tiny_run):
     (tmp_path / "studies").symlink_to(ROOT / "studies")
     mirror_results(tmp_path / "results")
-    runner = Page(tmp_path)
+    runner = Page(tmp_path, tiny_run)
     ran = 0
     for i, (lang, text) in enumerate(blocks(page)):
         if lang == "toml":
