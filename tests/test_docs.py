@@ -5,9 +5,9 @@ Per page, in a fresh working directory (``studies/`` linked, ``results/`` mirror
 files linked, so nothing in the repository is written): the page's ``toml`` blocks are
 written to the file their first comment names, then its ``sh`` lines run in order and its
 ``python`` blocks run as scripts (but a block whose first line is ``# excerpt ...``, a part of
-a module shown to be read). ``sim ...`` runs as ``python -m sim ...``; ``sim run``
-gets its study's tiny configuration (``tests/data/tiny/``) in place of ``--trials``, and
-every ``/tmp/...`` path becomes a path in the scratch directory. ``make TARGET`` lines are
+a module shown to be read). ``sim ...`` runs as ``python -m sim ...`` does, through
+:func:`sim.cli.main` in the test's process; ``sim run`` gets its study's tiny configuration
+(``tests/data/tiny/``) in place of ``--trials``, and every ``/tmp/...`` path becomes a path in the scratch directory. ``make TARGET`` lines are
 checked to name a real target of the Makefile, not run. ``python -m MODULE ...`` of another
 module is checked with ``--help``. Anything else is reported as unchecked (a warning).
 
@@ -17,6 +17,8 @@ with ``--quiet``, which leaves out the progress lines, and ``--workers 1``, the 
 its output is copied to DIR, and a run another test shares is not made twice.
 """
 
+import contextlib
+import io
 import os
 import re
 import shlex
@@ -28,6 +30,8 @@ from pathlib import Path
 
 import pytest
 from conftest import ROOT, study_of, tiny_overrides
+
+from sim.cli import main
 
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
 BLOCK = re.compile(r"^```(\w*)\n(.*?)^```", re.M | re.S)
@@ -128,11 +132,29 @@ class Page:
 
     def run(self, cmd: list[str], what: str) -> None:
         (self.work / "tmp").mkdir(exist_ok=True)
+        if cmd[1:3] == ["-m", "sim"]:  # in this process: a second start of Python saves nothing
+            return self.run_sim(cmd[3:], what)
         r = subprocess.run(
             cmd, cwd=self.work, capture_output=True, text=True, timeout=TIMEOUT, env=os.environ
         )
         assert r.returncode == 0, f"{what}: exit {r.returncode}\n{r.stderr[-2000:]}"
         assert "Traceback" not in r.stderr, f"{what}:\n{r.stderr[-2000:]}"
+
+    def run_sim(self, args: list[str], what: str) -> None:
+        """``sim ARGS`` as :func:`sim.cli.main` in ``work`` (the console script and ``python
+        -m sim`` are that function: test_cli.py); an exception fails the test with its
+        traceback."""
+        here, err = os.getcwd(), io.StringIO()
+        os.chdir(self.work)
+        try:
+            with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+                try:
+                    code = main(args)
+                except SystemExit as e:  # --version, --help
+                    code = e.code
+        finally:
+            os.chdir(here)
+        assert code in (0, None), f"{what}: exit {code}\n{err.getvalue()[-2000:]}"
 
 
 @pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(ROOT)) for p in PAGES])

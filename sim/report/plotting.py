@@ -297,7 +297,7 @@ def place_legend(ax, *args, **kw):
     (markers, lines, bars: :func:`sim.report.figcheck.data_points`), else outside on the
     right. Call it once the axes' data and limits are final."""
     fig = ax.figure
-    fig.canvas.draw()
+    fig.draw_without_rendering()  # the layout and text extents, no pixels
     renderer = fig.canvas.get_renderer()
     pts = data_points(ax)
     kw.setdefault("fontsize", 7)
