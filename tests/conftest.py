@@ -1,8 +1,18 @@
 """BLAS single-threaded in the test processes, as in every ``sim`` process (:mod:`sim.threads`):
-the tests compare in-process runs with runs in worker processes bit for bit."""
+the tests compare in-process runs with runs in worker processes bit for bit.
 
+:func:`tiny_run`: each study file run once per test session at its tiny size, shared by the
+tests that read a whole study's output (test_all_studies, test_verify, test_docs and the
+studies' own end-to-end tests), across the processes of ``pytest -n``."""
+
+import fcntl
 import os
+import re
 import resource
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
 
 import pytest
 
@@ -35,26 +45,26 @@ def pytest_runtest_protocol(item, nextitem):
 
 
 #: the test files that take longest, slowest first, with their share (%) of the suite's
-#: summed test time (measured 2026-11-26 on 2 cores: pytest --durations, per file). Under
-#: ``--dist loadfile`` a file runs on one process; handing out the slowest files first keeps
-#: one of them from starting last and running alone at the end (the critical path). The
-#: Makefile passes --no-loadscope-reorder, or pytest-xdist would hand out the files with
-#: the most tests first instead.
+#: summed test CPU time (measured 2026-11-26 on 2 cores: SIM_TEST_CPU_LOG, per file; a shared
+#: tiny run counts for the file that asks for it first). Under ``--dist loadfile`` a file runs
+#: on one process; handing out the slowest files first keeps one of them from starting last
+#: and running alone at the end (the critical path). The Makefile passes
+#: --no-loadscope-reorder, or pytest-xdist would hand out the files with the most tests first
+#: instead.
 SLOW_FIRST = {
-    "test_all_studies.py": 21.8,
-    "test_verify.py": 16.2,
-    "test_docs.py": 15.7,
-    "test_bench.py": 5.3,
-    "test_no_jit.py": 4.4,
-    "test_runner.py": 4.2,
-    "test_sparse.py": 3.3,
-    "test_design.py": 3.2,
-    "test_network.py": 3.1,
-    "test_figures.py": 2.8,
-    "test_bayes.py": 2.4,
-    "test_cli.py": 2.4,
-    "test_api.py": 2.2,
-    "test_batch.py": 2.1,
+    "test_all_studies.py": 22.1,
+    "test_verify.py": 17.4,
+    "test_docs.py": 11.6,
+    "test_design.py": 5.6,
+    "test_sparse.py": 5.4,
+    "test_bench.py": 5.1,
+    "test_runner.py": 4.8,
+    "test_network.py": 4.5,
+    "test_batch.py": 4.0,
+    "test_cli_manners.py": 3.8,
+    "test_cli.py": 3.5,
+    "test_doors.py": 3.1,
+    "test_wolf.py": 1.5,
 }
 
 
@@ -63,3 +73,74 @@ def pytest_collection_modifyitems(config, items):
     tests of a file keep their order. Deterministic, so every xdist worker collects the same."""
     rank = {f: i for i, f in enumerate(sorted(SLOW_FIRST, key=lambda f: -SLOW_FIRST[f]))}
     items.sort(key=lambda it: rank.get(it.path.name, len(rank)))
+
+
+ROOT = Path(__file__).resolve().parent.parent
+TINY = ROOT / "tests" / "data" / "tiny"
+
+
+def tiny_overrides(study: str) -> list[str]:
+    """The ``--set`` arguments of a study kind's tiny configuration (``tests/data/tiny/``):
+    a run of a few seconds with at least two chunks."""
+    f = TINY / f"{study}.txt"
+    assert f.is_file(), f"{f} is missing: every study needs a tiny configuration"
+    lines = [ln.strip() for ln in f.read_text().splitlines()]
+    return [a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln)]
+
+
+def study_of(path: Path) -> str:
+    """The study kind a study file runs (its ``study`` key)."""
+    return tomllib.loads(path.read_text()).get("study", "")
+
+
+def tiny_command(name: str, out: Path, workers: int = 1, *extra: str) -> list[str]:
+    """``sim run studies/<name>.toml`` at its study's tiny size into ``out``."""
+    f = ROOT / "studies" / f"{name}.toml"
+    return [sys.executable, "-m", "sim", "run", str(f), "--out", str(out), "--quiet"] + [
+        "--workers",
+        str(workers),
+        *extra,
+        *tiny_overrides(study_of(f)),
+    ]
+
+
+#: another numerical path: OpenBLAS's AVX kernels (no AVX2/AVX-512), NumPy instead of numba
+ELSEWHERE = {"OPENBLAS_CORETYPE": "Sandybridge", "SIM_NO_JIT": "1"}
+
+
+@pytest.fixture(scope="session")
+def tiny_run(tmp_path_factory):
+    """``tiny_run(name, *options)``: the output directory of ``studies/<name>.toml`` run at
+    its tiny size on 1 worker with ``options`` (more ``sim run`` options, e.g. ``--executor
+    dask --workers 2``; :func:`tiny_command`), run once per session and shared by every test
+    (and every ``pytest -n`` process: a directory of the session's base, a lock per run, a
+    failure recorded once). ``elsewhere=True``: on 2 workers on another numerical path
+    (:data:`ELSEWHERE`), with every figure's layout check and facts written to
+    ``<dir>.figures.jsonl`` (``SIM_FIGURE_CHECK``, :func:`sim.report.plotting.save`).
+    READ ONLY: a test that edits a file copies it first."""
+    base = tmp_path_factory.getbasetemp()
+    cache = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "tiny-runs"
+    cache.mkdir(exist_ok=True)
+
+    def run(name: str, *options: str, elsewhere: bool = False) -> Path:
+        key = "_".join([name, *(o.strip("-").replace("=", "-") for o in options)])
+        key = f"{key}-elsewhere" if elsewhere else key
+        assert re.fullmatch(r"[\w.-]+", key), f"options {options} make no directory name"
+        out, failed = cache / key, cache / f"{key}.failed"
+        env = dict(os.environ)
+        if elsewhere:
+            env.update(ELSEWHERE, SIM_FIGURE_CHECK=str(cache / f"{key}.figures.jsonl"))
+        with open(cache / f"{key}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+            if not out.exists() and not failed.exists():
+                cmd = tiny_command(name, out, 2 if elsewhere else 1, *options)
+                r = subprocess.run(
+                    cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=600
+                )
+                if r.returncode != 0:
+                    failed.write_text(f"exit {r.returncode}\n{r.stderr[-3000:]}")
+        if failed.exists():
+            pytest.fail(f"the shared tiny run {key} failed: {failed.read_text()}")
+        return out
+
+    return run

@@ -8,7 +8,9 @@ The Dask cluster is one for the module (a scheduler address given with ``--sched
 path where ``--executor dask`` starts its own LocalCluster is tested in ``test_runner.py``.
 
 Each study provides ``tests/data/tiny/<study>.txt``: one ``KEY=VALUE`` override per line for a
-run of a few seconds with at least two chunks.
+run of a few seconds with at least two chunks. The uninterrupted 1-worker run is the session's
+shared tiny run (``tiny_run`` in conftest.py), which test_verify.py also compares with a run
+on another numerical path.
 """
 
 import os
@@ -20,40 +22,13 @@ from pathlib import Path
 
 import pyarrow.parquet as pq
 import pytest
+from conftest import ROOT, tiny_command
 
 from sim.mc.storage import read_provenance
 from sim.studies import MODULES
 
-ROOT = Path(__file__).resolve().parent.parent
-TINY = ROOT / "tests" / "data" / "tiny"
-
-
-def overrides(study: str) -> list[str]:
-    f = TINY / f"{study}.txt"
-    assert f.is_file(), f"{f} is missing: every study needs a tiny configuration"
-    lines = [ln.strip() for ln in f.read_text().splitlines()]
-    return [a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln)]
-
-
 #: the study file that stands for a study kind with several example files
 FILES = {"network": "network_testfield"}
-
-
-def command(study: str, out: Path, workers: int, *extra: str) -> list[str]:
-    return [
-        sys.executable,
-        "-m",
-        "sim",
-        "run",
-        str(ROOT / "studies" / f"{FILES.get(study, study)}.toml"),
-        "--out",
-        str(out),
-        "--quiet",
-        "--workers",
-        str(workers),
-        *extra,
-        *overrides(study),
-    ]
 
 
 def same_table(a: Path, b: Path) -> bool:
@@ -148,16 +123,13 @@ def scheduler():
 
 
 @pytest.mark.parametrize("study", sorted(MODULES))
-def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path, scheduler):
-    one = tmp_path / "one"
-    r = subprocess.run(
-        command(study, one, 1), cwd=ROOT, capture_output=True, text=True, timeout=300
-    )
-    assert r.returncode == 0, r.stderr
+def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path, scheduler, tiny_run):
+    name = FILES.get(study, study)
+    one = tiny_run(name)  # 1 worker, in process
     two = tmp_path / "two"
     stage = tmp_path / ".two.partial"
     p = subprocess.Popen(
-        command(study, two, 2),
+        tiny_command(name, two, 2),
         cwd=ROOT,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
@@ -173,7 +145,7 @@ def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path, sched
     assert p.returncode == -signal.SIGKILL, "the run finished before it could be killed"
     assert not two.exists() and list(stage.rglob("chunk-*.parquet"))  # killed mid-run
     r = subprocess.run(
-        command(study, two, 2, "--executor", "dask", "--scheduler", scheduler),
+        tiny_command(name, two, 2, "--executor", "dask", "--scheduler", scheduler),
         cwd=ROOT,
         capture_output=True,
         text=True,

@@ -4,7 +4,6 @@ claim book, the consistent region of the unprinted inputs."""
 import math
 import pickle
 from functools import partial
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,10 +22,13 @@ from sim.mc.storage import read_provenance, read_table, read_tolerances
 from sim.mc.sweep import cell_seed, expand, run_adaptive
 from sim.studies import design
 
+#: brown_table1 at 20 trials, its region of unprinted inputs at the smallest size (the sweep
+#: tests do not look at it)
 TABLE1 = """study = "brown_table1"
 trials = {trials}
 seed = 77
 chunk = 1
+region = {{points = 256, rounds = 0}}
 """
 
 
@@ -283,11 +285,8 @@ def test_claim_book_classes_the_datum_and_emcee_rows():
     assert len(book.not_reproduced) >= 10
 
 
-def test_tiny_run_end_to_end(tmp_path):
-    tiny = Path(__file__).parent / "data" / "tiny" / "brown_design.txt"
-    sets = [a for line in tiny.read_text().split() for a in ("--set", line)]
-    out = tmp_path / "o"
-    assert main(["run", "studies/brown_design.toml", *sets, "--out", str(out), "--quiet"]) == 0
+def test_tiny_run_end_to_end(tiny_run):
+    out = tiny_run("brown_design")
     cl = read_table(out / "claims.parquet").to_pydict()
     V = dict(zip(cl["claim"], cl["verdict"]))
     assert all(V[c] == "finding" for c in V if c.startswith("brown.datum."))

@@ -5,27 +5,34 @@ Per page, in a fresh working directory (``studies/`` linked, ``results/`` mirror
 files linked, so nothing in the repository is written): the page's ``toml`` blocks are
 written to the file their first comment names, then its ``sh`` lines run in order and its
 ``python`` blocks run as scripts (but a block whose first line is ``# excerpt ...``, a part of
-a module shown to be read). ``sim ...`` runs as ``python -m sim ...``; ``sim run``
-gets its study's tiny configuration (``tests/data/tiny/``) in place of ``--trials``, and
-every ``/tmp/...`` path becomes a path in the scratch directory. ``make TARGET`` lines are
+a module shown to be read). ``sim ...`` runs as ``python -m sim ...`` does, through
+:func:`sim.cli.main` in the test's process; ``sim run`` gets its study's tiny configuration
+(``tests/data/tiny/``) in place of ``--trials``, and every ``/tmp/...`` path becomes a path in the scratch directory. ``make TARGET`` lines are
 checked to name a real target of the Makefile, not run. ``python -m MODULE ...`` of another
 module is checked with ``--help``. Anything else is reported as unchecked (a warning).
+
+``sim run studies/<file>.toml [OPTIONS] [--out DIR]`` is, at the tiny size, the session's
+shared run of that file with those options (``tiny_run`` in conftest.py: the same command
+with ``--quiet``, which leaves out the progress lines, and ``--workers 1``, the default):
+its output is copied to DIR, and a run another test shares is not made twice.
 """
 
+import contextlib
+import io
 import os
 import re
 import shlex
 import shutil
 import subprocess
 import sys
-import tomllib
 import warnings
 from pathlib import Path
 
 import pytest
+from conftest import ROOT, study_of, tiny_overrides
 
-ROOT = Path(__file__).resolve().parent.parent
-TINY = ROOT / "tests" / "data" / "tiny"
+from sim.cli import main
+
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
 BLOCK = re.compile(r"^```(\w*)\n(.*?)^```", re.M | re.S)
 TIMEOUT = 900
@@ -55,21 +62,12 @@ def mirror_results(dest: Path) -> None:
                 (dest / rel / f).symlink_to(Path(d) / f)
 
 
-def study_of(path: Path) -> str:
-    return tomllib.loads(path.read_text()).get("study", "")
-
-
-def tiny_overrides(study: str) -> list[str]:
-    f = TINY / f"{study}.txt"
-    lines = [ln.strip() for ln in f.read_text().splitlines()] if f.is_file() else []
-    return [a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln)]
-
-
 class Page:
     """Runs the commands of one page in ``work``; ``/tmp/X`` becomes ``work/tmp/X``."""
 
-    def __init__(self, work: Path):
+    def __init__(self, work: Path, shared=None):
         self.work = work
+        self.shared = shared  # tiny_run: the session's tiny run of a study file
         self.unchecked: list[str] = []
 
     def path(self, arg: str) -> str:
@@ -91,8 +89,28 @@ class Page:
                     skip = True
                     continue
                 out.append(a)
+            if self.reuse(out):
+                return None
             args = out + tiny_overrides(study_of(study_file))
         return [sys.executable, "-m", "sim", *args]
+
+    def reuse(self, args: list[str]) -> bool:
+        """``run studies/<file>.toml [OPTIONS] [--out DIR]``: the shared tiny run with those
+        options, copied to DIR (with no --out, to no directory: the run goes to scratch/,
+        which no page reads)."""
+        if self.shared is None or len(args) < 2:
+            return False
+        f, options = Path(args[1]), args[2:]
+        if f.parent != Path("studies") or not (ROOT / f).is_file():
+            return False
+        out = None
+        if "--out" in options:
+            k = options.index("--out")
+            out, options = options[k + 1], options[:k] + options[k + 2 :]
+        done = self.shared(f.stem, *options)
+        if out is not None:
+            shutil.copytree(done, self.work / out)
+        return True
 
     def command(self, line: str) -> list[str] | None:
         words = shlex.split(line, comments=True)
@@ -114,18 +132,36 @@ class Page:
 
     def run(self, cmd: list[str], what: str) -> None:
         (self.work / "tmp").mkdir(exist_ok=True)
+        if cmd[1:3] == ["-m", "sim"]:  # in this process: a second start of Python saves nothing
+            return self.run_sim(cmd[3:], what)
         r = subprocess.run(
             cmd, cwd=self.work, capture_output=True, text=True, timeout=TIMEOUT, env=os.environ
         )
         assert r.returncode == 0, f"{what}: exit {r.returncode}\n{r.stderr[-2000:]}"
         assert "Traceback" not in r.stderr, f"{what}:\n{r.stderr[-2000:]}"
 
+    def run_sim(self, args: list[str], what: str) -> None:
+        """``sim ARGS`` as :func:`sim.cli.main` in ``work`` (the console script and ``python
+        -m sim`` are that function: test_cli.py); an exception fails the test with its
+        traceback."""
+        here, err = os.getcwd(), io.StringIO()
+        os.chdir(self.work)
+        try:
+            with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+                try:
+                    code = main(args)
+                except SystemExit as e:  # --version, --help
+                    code = e.code
+        finally:
+            os.chdir(here)
+        assert code in (0, None), f"{what}: exit {code}\n{err.getvalue()[-2000:]}"
+
 
 @pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(ROOT)) for p in PAGES])
-def test_every_command_of_the_page_runs(page, tmp_path):
+def test_every_command_of_the_page_runs(page, tmp_path, tiny_run):
     (tmp_path / "studies").symlink_to(ROOT / "studies")
     mirror_results(tmp_path / "results")
-    runner = Page(tmp_path)
+    runner = Page(tmp_path, tiny_run)
     ran = 0
     for i, (lang, text) in enumerate(blocks(page)):
         if lang == "toml":

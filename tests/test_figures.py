@@ -5,6 +5,7 @@ digits, comb histograms, pale or look-alike colours), passes a clean figure, pas
 ``sweep.png``, and asserts on every PNG each study writes at its tiny size; what a reader
 relies on (axis labels with units, number of series, data range) is checked per figure."""
 
+import json
 import warnings
 from pathlib import Path
 
@@ -12,7 +13,6 @@ import numpy as np
 import pytest
 
 from benchmarks.figures import brown_figure, engines_figure
-from sim.cli import main
 from sim.mc.storage import read_table, write_table
 from sim.report.plotting import (
     checking_figures,
@@ -26,7 +26,6 @@ from sim.report.sweep import fig_sweep
 from sim.studies import MODULES
 
 ROOT = Path(__file__).resolve().parent.parent
-TINY = ROOT / "tests" / "data" / "tiny"
 FILES = {"network": "network_testfield"}
 
 #: figures whose check is only warned about (none: every figure a study writes must read
@@ -125,11 +124,6 @@ def test_sweep_png_clips_proportions_and_keeps_red_for_infeasible(tmp_path, monk
     plt.close(fig)
 
 
-def _tiny(study: str) -> list[str]:
-    lines = [ln.strip() for ln in (TINY / f"{study}.txt").read_text().splitlines()]
-    return [a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln)]
-
-
 #: what a reader relies on, per study and figure: ``{file: [(axes index, x label part, y
 #: label part, at least this many series)]}``
 READER = {
@@ -145,12 +139,14 @@ READER = {
 
 
 @pytest.mark.parametrize("study", sorted(MODULES))
-def test_every_figure_of_a_study_reads_cleanly(study, tmp_path):
-    out = tmp_path / study
-    args = ["run", str(ROOT / "studies" / f"{FILES.get(study, study)}.toml"), "--out", str(out)]
-    facts: dict = {}
-    with checking_figures(facts) as found:
-        assert main([*args, "--quiet", "--workers", "1", *_tiny(study)]) == 0
+def test_every_figure_of_a_study_reads_cleanly(study, tiny_run):
+    """Every figure of the study's shared tiny run on 2 workers (``tiny_run(...,
+    elsewhere=True)``: each figure checked where it is drawn, ``SIM_FIGURE_CHECK``)."""
+    out = tiny_run(FILES.get(study, study), elsewhere=True)
+    found, facts = {}, {}
+    for line in Path(f"{out}.figures.jsonl").read_text().splitlines():
+        rec = json.loads(line)
+        found[rec["file"]], facts[rec["file"]] = rec["problems"], rec["facts"]
     for name, wanted in READER.get(study, {}).items():
         for i, xpart, ypart, series in wanted:
             ax = facts[name][i]

@@ -222,28 +222,11 @@ def test_sweep_draws_match_the_simulation():
         assert abs(a - b) < 4 * se, key
 
 
-def test_study_runs_small(tmp_path):
-    from sim.cli import main
+def test_study_runs_small(tiny_run):
     from sim.mc.storage import read_table
     from sim.studies.gridplate.report import report
 
-    out = tmp_path / "gp"
-    sets = [
-        x
-        for line in (ROOT / "tests/data/tiny/gridplate_two_plates.txt").read_text().splitlines()
-        for x in ("--set", line)
-    ]
-    rc = main(
-        [
-            "run",
-            str(ROOT / "studies/gridplate_two_plates.toml"),
-            "--quiet",
-            *sets,
-            "--out",
-            str(out),
-        ]
-    )
-    assert rc == 0
+    out = tiny_run("gridplate_two_plates")
     t = read_table(out / "claims.parquet").to_pydict()
     v = dict(zip(t["claim"], t["verdict"]))
     row = {c: r for c, r in zip(t["claim"], read_table(out / "claims.parquet").to_pylist())}

@@ -47,33 +47,11 @@ def test_brown_as_a_network_equals_the_brown_models():
     assert stations.dof == 2 * 4 * 25 // 2 - (2 * 25 + 5) and known.dof == 100 - 50
 
 
-def test_brown_network_example_equals_the_brown_dilution_study_files(tmp_path):
+def test_brown_network_example_equals_the_brown_dilution_study_files(tiny_run):
     """studies/network_brown.toml run through `sim run` gives the point sigmas that
     `brown_dilution` writes for its `known` and `stations` models (same geometry, 1 um)."""
-    tiny = (ROOT / "tests/data/tiny/brown_dilution.txt").read_text().split()
-    runs = {"brown": ("brown_dilution", tiny), "net": ("network_brown", ["trials=400", "chunk=20"])}
-    for key, (name, sets) in runs.items():
-        args = [a for s in sets for a in ("--set", s)]
-        r = subprocess.run(
-            [
-                sys.executable,
-                "-m",
-                "sim",
-                "run",
-                str(ROOT / f"studies/{name}.toml"),
-                "--out",
-                str(tmp_path / key),
-                "--quiet",
-                *args,
-            ],
-            cwd=ROOT,
-            capture_output=True,
-            text=True,
-            timeout=600,
-        )
-        assert r.returncode == 0, r.stderr
-    b = pq.read_table(tmp_path / "brown/points.parquet").to_pydict()
-    n = pq.read_table(tmp_path / "net/points.parquet").to_pydict()
+    b = pq.read_table(tiny_run("brown_dilution") / "points.parquet").to_pydict()
+    n = pq.read_table(tiny_run("network_brown") / "points.parquet").to_pydict()
     at = {(round(x, 6), round(y, 6)): k for k, (x, y) in enumerate(zip(n["x_mm"], n["y_mm"]))}
     rows = {m: [k for k, mm in enumerate(b["model"]) if mm == m] for m in ("known", "stations")}
     net_rows = [at[(round(b["x_mm"][k], 6), round(b["y_mm"][k], 6))] for k in rows["stations"]]

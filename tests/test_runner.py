@@ -17,6 +17,10 @@ from sim.studies import RunContext
 
 ROOT = Path(__file__).resolve().parent.parent
 STUDY = ROOT / "studies" / "brown_table1.toml"
+#: brown_table1 at 20 trials, its region of unprinted inputs at the smallest size (no test
+#: here looks at it)
+SMALL = 'study = "brown_table1"\ntrials = 20\nchunk = 1\nregion = {points = 256, rounds = 0}\n'
+REGION = ["--set", "region.points=256", "--set", "region.rounds=0"]
 
 
 def same_result(a: Path, b: Path) -> bool:
@@ -78,41 +82,25 @@ def test_process_pool_equals_in_process():
         assert np.array_equal(a[k], b[k])
 
 
-def test_dask_local_cluster_equals_local(tmp_path):
+def test_dask_local_cluster_equals_local(tiny_run):
+    """``--executor dask`` starting its own LocalCluster gives the files of the 1-worker run
+    (the session's tiny run of brown_table1) bit for bit."""
     pytest.importorskip("distributed")
-    outs = {}
-    for name, extra in (("local", []), ("dask", ["--executor", "dask", "--workers", "2"])):
-        o = tmp_path / name
-        assert (
-            main(
-                [
-                    "run",
-                    str(STUDY),
-                    "--out",
-                    str(o),
-                    "--trials",
-                    "60",
-                    "--quiet",
-                    "--set",
-                    "chunk=3",
-                ]
-                + extra
-            )
-            == 0
-        )
-        outs[name] = o
+    local = tiny_run("brown_table1")
+    dask = tiny_run("brown_table1", "--executor", "dask", "--workers", "2")  # as docs/cli.md
     for f in (
         "claims.parquet",
         "points.parquet",
         "table1_trials.parquet",
         "trials/part-0/chunk-000002.parquet",
     ):
-        assert same_result(outs["local"] / f, outs["dask"] / f), f
+        assert same_result(local / f, dask / f), f
 
 
 def test_refuses_to_mix_a_different_config(tmp_path, capsys):
     o = tmp_path / "o"
     args = ["run", str(STUDY), "--out", str(o), "--trials", "20", "--quiet", "--set", "chunk=1"]
+    args += REGION
     assert main(args) == 0
     assert main(args + ["--seed", "2"]) == 2
     err = capsys.readouterr().err
@@ -153,6 +141,7 @@ def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path, capsys):
         "--quiet",
         "--set",
         "chunk=50",
+        *REGION,
     ]
     stage = tmp_path / ".res.partial" / "trials" / "part-0"
     p = subprocess.Popen(
@@ -212,7 +201,7 @@ def test_full_disk_is_one_line_and_no_result(tmp_path, capsys, monkeypatch):
 def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, capsys):
     """A 2 x 2 grid passes validation but makes the pivot model's reduced normals singular."""
     f = tmp_path / "s.toml"
-    f.write_text('study = "brown_table1"\ntrials = 20\nchunk = 1\n[sweep]\n"plate.grid" = [2, 5]\n')
+    f.write_text(SMALL + '[sweep]\n"plate.grid" = [2, 5]\n')
     out = tmp_path / "sw"
     assert main(["run", str(f), "--out", str(out), "--quiet"]) == 0
     t = pq.read_table(out / "sweep.parquet").to_pydict()
@@ -221,7 +210,7 @@ def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, 
     assert "singular" in t["reason"][0]
     # a plain run of the degenerate cell is a one-line error, exit 2
     g = tmp_path / "g.toml"
-    g.write_text('study = "brown_table1"\ntrials = 20\nchunk = 1\n[plate]\ngrid = 2\n')
+    g.write_text(SMALL + "[plate]\ngrid = 2\n")
     assert main(["run", str(g), "--out", str(tmp_path / "g"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "singular" in err[0]
@@ -246,7 +235,7 @@ def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, 
 )
 def test_sweep_cell_count_is_finite_and_bounded(tmp_path, capsys, sweep, needle):
     f = tmp_path / "s.toml"
-    f.write_text(f'study = "brown_table1"\ntrials = 20\nchunk = 1\n[sweep]\n{sweep}\n')
+    f.write_text(SMALL + f"[sweep]\n{sweep}\n")
     assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and needle in err[0], err
@@ -257,10 +246,7 @@ def test_dotted_range_syntax_and_sweep_chunks_carry_provenance(tmp_path):
     from sim.mc.storage import read_provenance
 
     f = tmp_path / "s.toml"
-    f.write_text(
-        'study = "brown_table1"\ntrials = 20\nchunk = 1\n[sweep]\n'
-        "errors.settings = {start = 2, stop = 3, num = 2}\n"
-    )
+    f.write_text(SMALL + "[sweep]\nerrors.settings = {start = 2, stop = 3, num = 2}\n")
     assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     t = pq.read_table(tmp_path / "o" / "sweep.parquet").to_pydict()
     assert t["errors.settings"] == [2.0, 3.0] and t["feasible"] == [True, True]
@@ -276,10 +262,7 @@ def test_dotted_range_syntax_and_sweep_chunks_carry_provenance(tmp_path):
 
 def test_a_sweep_whose_every_cell_fails_exits_2_with_the_reasons(tmp_path, capsys):
     f = tmp_path / "s.toml"
-    f.write_text(
-        'study = "brown_table1"\ntrials = 20\nchunk = 1\n[sweep]\n'
-        '"plate.spacing_mm" = [80.0, 90.0]\n'
-    )
+    f.write_text(SMALL + '[sweep]\n"plate.spacing_mm" = [80.0, 90.0]\n')
     assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "every cell failed (2 of 2)" in err[0] and "plate" in err[0]

@@ -164,21 +164,11 @@ def test_printed_residuals_reproduce_the_unit_weight_errors():
     assert abs(lay["spacing_mm"] - 50) < 2.5 and 0.3 < lay["placement_rms_mm"] < 3.0
 
 
-def test_study_runs_small(tmp_path):
-    from sim.cli import main
+def test_study_runs_small(tiny_run):
     from sim.mc.storage import read_table
     from sim.studies.salsig.report import report
 
-    out = tmp_path / "ss"
-    sets = [
-        x
-        for line in (ROOT / "tests/data/tiny/salsig_encoders.txt").read_text().splitlines()
-        for x in ("--set", line)
-    ]
-    rc = main(
-        ["run", str(ROOT / "studies/salsig_encoders.toml"), "--quiet", *sets, "--out", str(out)]
-    )
-    assert rc == 0
+    out = tiny_run("salsig_encoders")
     t = read_table(out / "claims.parquet").to_pydict()
     v = dict(zip(t["claim"], t["verdict"]))
     # the printed FIG. 2 SY disagrees with its own A-F: an erratum, the others hold

@@ -3,7 +3,11 @@ number or verdict edited by hand fails; bad requests are one line; and another m
 CI: every study kind re-run under another numerical path (another OpenBLAS kernel, the
 compiled paths off, another worker count) agrees with a run on the usual path by the same
 rules, and fast studies re-run with fewer trials agree with the committed results at the
-Monte-Carlo level."""
+Monte-Carlo level.
+
+The runs on the usual path are the session's shared tiny runs (``tiny_run`` in conftest.py;
+test_all_studies.py shows that they are reproduced bit for bit by other executors and by a
+killed and resumed run)."""
 
 import os
 import shutil
@@ -15,10 +19,10 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
+from conftest import ELSEWHERE, tiny_overrides
 
 import sim
 from sim.batch import is_current
-from sim.cli import main
 from sim.instruments import transforms2d as t2
 from sim.instruments.ranges import positions as po
 from sim.mc import tolerance as tl
@@ -30,20 +34,17 @@ from sim.studies.design import external as ex
 from sim.studies.design.cells import pareto_front
 
 ROOT = Path(__file__).resolve().parent.parent
-BROWN = ROOT / "studies" / "brown_table1.toml"
-TINY = ROOT / "tests" / "data" / "tiny"
 #: the study file that stands for a study kind with several example files
-FILES = {"network": "network_brown"}
-#: another numerical path: OpenBLAS's AVX kernels (no AVX2/AVX-512), NumPy instead of numba
-ELSEWHERE = {"OPENBLAS_CORETYPE": "Sandybridge", "SIM_NO_JIT": "1"}
+FILES = {"network": "network_testfield"}
 
 
 @pytest.fixture(scope="module")
-def two_runs(tmp_path_factory):
+def two_runs(tmp_path_factory, tiny_run):
+    """Two copies of brown_table1's tiny run, "committed" and "rerun" (that a re-run gives
+    the same files bit for bit is test_all_studies.py's)."""
     d = tmp_path_factory.mktemp("verify")
     for name in ("committed", "rerun"):
-        args = ["run", str(BROWN), "--out", str(d / name), "--trials", "40", "--quiet"]
-        assert main([*args, "--set", "chunk=2"]) == 0
+        shutil.copytree(tiny_run("brown_table1"), d / name)
     return d
 
 
@@ -211,19 +212,16 @@ def test_scratch_keeps_what_the_suite_did_not_write(capsys, tmp_path, two_runs):
     shutil.copytree(two_runs / "rerun", scratch / "brown_table1", dirs_exist_ok=True)
     line = _one_line(capsys, ["--results", str(results), "--scratch", str(scratch)], 2)
     assert "'notes.txt', which the suite did not write" in line and mine.read_text() == "mine"
-    # without it, the earlier re-run is replaced (the same 40 trials: every column compared)
+    # without it, the earlier re-run is replaced (the same tiny run: every column compared)
     mine.unlink()
-    argv = ["--results", str(results), "--scratch", str(scratch), "--trials", "40"]
-    assert verify_main([*argv, "--set", "chunk=2", "--study", "brown_table1"]) == 0
+    tiny = tiny_overrides("brown_table1")
+    assert tiny[:4] == ["--set", "trials=40", "--set", "chunk=2"]
+    argv = ["--results", str(results), "--scratch", str(scratch), "--trials", "40", *tiny[2:]]
+    assert verify_main([*argv, "--study", "brown_table1"]) == 0
     assert "brown_table1: ok" in capsys.readouterr().out
 
 
 # --- another machine inside CI ----------------------------------------------------------------
-
-
-def _tiny(study: str) -> list[str]:
-    lines = [ln.strip() for ln in (TINY / f"{study}.txt").read_text().splitlines()]
-    return [a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln)]
 
 
 def _run(study: str, out: Path, workers: int, env: dict, *extra: str) -> None:
@@ -235,18 +233,16 @@ def _run(study: str, out: Path, workers: int, env: dict, *extra: str) -> None:
     assert r.returncode == 0, r.stderr
 
 
-@pytest.mark.parametrize("kind", sorted(MODULES))
-def test_another_numerical_path_agrees_by_the_same_rules(kind, tmp_path):
-    """Every study kind at its tiny size: 1 worker on the usual path, then 2 workers with
-    OpenBLAS's Sandybridge kernels and the compiled paths off; every column by its rule,
-    every verdict equal."""
+@pytest.mark.parametrize("kind", sorted(MODULES, reverse=True))  # test_all_studies: forward
+def test_another_numerical_path_agrees_by_the_same_rules(kind, tiny_run):
+    """Every study kind at its tiny size: the shared 1-worker run on the usual path against
+    the shared run on 2 workers with OpenBLAS's Sandybridge kernels and the compiled paths
+    off (``SIM_NO_JIT=1``: every compiled kernel's NumPy twin; issue 22's whole-study check
+    of the compiled paths); every column by its rule, every verdict equal."""
     if any(k in os.environ for k in ELSEWHERE):
         pytest.skip("the environment already sets OPENBLAS_CORETYPE or SIM_NO_JIT")
     study = FILES.get(kind, kind)
-    here, there = tmp_path / "here" / study, tmp_path / "there" / study
-    _run(study, here, 1, {}, *_tiny(kind))
-    _run(study, there, 2, ELSEWHERE, *_tiny(kind))
-    c = compare_dirs(here, there, study)
+    c = compare_dirs(tiny_run(study), tiny_run(study, elsewhere=True), study)
     assert c.files >= 2 and c.ok, c.failures
 
 

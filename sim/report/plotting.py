@@ -5,6 +5,8 @@ or units), which the tests run on every figure a study draws (:func:`checking_fi
 
 from __future__ import annotations
 
+import json
+import os
 import re
 from contextlib import contextmanager
 from pathlib import Path
@@ -229,7 +231,10 @@ def checking_figures(facts: dict | None = None) -> Iterator[dict[str, list[str]]
     """Within the block, every figure :func:`save` writes in this process is checked by
     :func:`layout_problems` first; yields ``{file name: problems}``, filled as they are
     saved (the tests run a study at a tiny size inside it). ``facts``, when given, is filled
-    with ``{file name: figure_facts(fig)}`` (:func:`sim.report.figcheck.figure_facts`)."""
+    with ``{file name: figure_facts(fig)}`` (:func:`sim.report.figcheck.figure_facts`).
+    Outside the block, the environment variable ``SIM_FIGURE_CHECK=FILE`` does the same in
+    any process (a test hook: a ``sim run`` subprocess, its pool workers): one JSON line
+    ``{"file", "problems", "facts"}`` per figure appended to FILE."""
     global _RECORDER
     found: dict[str, list[str]] = {}
     old = _RECORDER
@@ -252,6 +257,10 @@ def save(fig, path: str | Path) -> Path:
     path = Path(path)
     if _RECORDER is not None:
         _RECORDER(path, fig)
+    elif os.environ.get("SIM_FIGURE_CHECK"):  # the same check in a `sim run` process (tests)
+        line = {"file": path.name, "problems": layout_problems(fig), "facts": figure_facts(fig)}
+        with open(os.environ["SIM_FIGURE_CHECK"], "a") as f:  # one short line per write
+            f.write(json.dumps(line) + "\n")
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", metadata={"Software": None}, bbox_inches="tight")
     plt.close(fig)
@@ -288,7 +297,7 @@ def place_legend(ax, *args, **kw):
     (markers, lines, bars: :func:`sim.report.figcheck.data_points`), else outside on the
     right. Call it once the axes' data and limits are final."""
     fig = ax.figure
-    fig.canvas.draw()
+    fig.draw_without_rendering()  # the layout and text extents, no pixels
     renderer = fig.canvas.get_renderer()
     pts = data_points(ax)
     kw.setdefault("fontsize", 7)
