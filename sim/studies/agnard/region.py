@@ -33,7 +33,7 @@ from typing import Callable
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.book_region import load_declaration, sample_evidence
+from sim.claims.book_region import load_declaration, plate_ref, sample_evidence
 from sim.claims.inference import Region, explore
 from sim.instruments.block.layout import Block
 from sim.mc.runner import chunk_rng
@@ -84,10 +84,7 @@ def explore_region(
         per = [five_samples(sw, i) for i in range(len(insets))]
         stats.extend(per)
         return {
-            c: sample_evidence(
-                np.stack([p[c] for p in per]),
-                float(book.spec(c)["ref"]) if book.spec(c)["form"] == "one-plate" else None,
-            )
+            c: sample_evidence(np.stack([p[c] for p in per]), *plate_ref(book.spec(c)))
             for c in dec.predictions
         }
 
@@ -146,9 +143,7 @@ def explore_scanner(
             for s in dec.statements
         }
         for c in dec.predictions:
-            one = book.spec(c)["form"] == "one-plate"
-            x = np.stack([p[c] for p in per])
-            ev[c] = sample_evidence(x, float(book.spec(c)["ref"]) if one else None)
+            ev[c] = sample_evidence(np.stack([p[c] for p in per]), *plate_ref(book.spec(c)))
         return ev
 
     region = explore(
