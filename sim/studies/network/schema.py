@@ -136,6 +136,18 @@ SCHEMA["chunk"] = Field(
 )
 
 
+def _check_compare(net, full: dict, fix: list, sparse: bool) -> None:
+    """``compare.fix``: the compared datum leaves something to estimate and covers the defects."""
+    extra = match_points(net, "compare.fix", fix)
+    if set(np.flatnonzero(net.role != 1)) <= set(extra):
+        raise ConfigError("compare.fix", "fixes every estimated point: nothing to compare")
+    an2 = pre_analysis(net, datum(net, full, tuple(extra)), 0.001, 0.8)
+    if not an2.ok and sparse:
+        raise ConfigError("compare.fix", f"{an2.factor.message} in the compared datum")
+    if not an2.ok:
+        _defect(net, datum(net, full, tuple(extra)), "compare.fix")
+
+
 def check(cfg: dict) -> None:
     """Cross-key rules: the network builds (every observation well defined), its datum covers
     every rank defect and is not near-singular, something is estimated, the chunk fits in
@@ -186,14 +198,7 @@ def check(cfg: dict) -> None:
             "observations",
         )
     if cfg["compare.fix"]:
-        extra = match_points(net, "compare.fix", cfg["compare.fix"])
-        if set(np.flatnonzero(net.role != 1)) <= set(extra):
-            raise ConfigError("compare.fix", "fixes every estimated point: nothing to compare")
-        an2 = pre_analysis(net, datum(net, full, tuple(extra)), 0.001, 0.8)
-        if not an2.ok and sparse:
-            raise ConfigError("compare.fix", f"{an2.factor.message} in the compared datum")
-        if not an2.ok:
-            _defect(net, datum(net, full, tuple(extra)), "compare.fix")
+        _check_compare(net, full, cfg["compare.fix"], sparse)
     if cfg["output.inner_over"]:
         pts = match_points(net, "output.inner_over", cfg["output.inner_over"])
         check_inner(net, inner_defect(net), pts, "output.inner_over")
