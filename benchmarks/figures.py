@@ -53,7 +53,10 @@ def engines_figure(eng, rerun, path):
     """``eng``: columns of ``engines.parquet``, ``rerun``: of ``rerun.parquet`` (either None
     when not measured)."""
     k = bool(eng) + bool(rerun)
-    fig, axs = plt.subplots(1, k, figsize=(6.5 * k, 4.8), squeeze=False, layout="constrained")
+    wide = 6.5 if not eng else max(6.5, 1.6 * len(eng["engine"]))  # room for every engine's name
+    fig, axs = plt.subplots(
+        1, k, figsize=(wide + 6.5 * (k - 1), 5.2), squeeze=False, layout="constrained"
+    )
     if eng:
         _speedups(axs[0, 0], eng)
     if rerun:
@@ -67,7 +70,14 @@ _ENGINE = {
     "gridplate": "grid plate",
     "block": "Agnard\nblock",
     "polynomial": "Wolf\npolynomial",
-    "polynomial_shared": "Wolf polynomial,\nshared design",
+    "polynomial_shared": "Wolf\npolynomial,\nshared design",
+    "multilateration": "Brown\nmulti-\nlateration",
+    "stress_field": "stress field",
+    "stress_sincos": "stress field,\nsin/cos",
+    "selinv": "selected\ninversion",
+    "sparse_solve": "sparse\nsolves",
+    "block_sparse": "Agnard block,\nsparse",
+    "network_gradient": "network\ngradient",
 }
 
 
@@ -88,6 +98,7 @@ def _speedups(ax, eng):
     for i, v in enumerate(x):
         ax.annotate(f"{v:.0f}×", (i, v), ha="center", va="bottom", fontsize=9)
     ax.set_xlabel("engine (study)")
+    ax.tick_params(axis="x", labelsize=8)
     ax.legend()
 
 
@@ -138,7 +149,8 @@ def _rerun(ax, rerun):
     ax.axvline(np.nanmax(tgt), color="0.3", ls="--", label=f"target {np.nanmax(tgt):.0f} s")
     ax.set_yticks(yt, yl)
     ax.invert_yaxis()
-    ax.set_xlim(left=0.0)
+    tmax = np.nanmax(wall[study == "total"]) if np.any(study == "total") else np.nanmax(wall)
+    ax.set_xlim(0.0, 1.2 * max(tmax, np.nanmax(tgt)))  # room for the "total" labels
     ax.set_xlabel("wall time since make rerun started (s)")
     ax.set_title("make rerun, study by study" + (f" ({jobs[0]} side by side)" if jobs else ""))
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))

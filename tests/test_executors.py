@@ -11,7 +11,6 @@ from __future__ import annotations
 import subprocess
 import sys
 import textwrap
-import threading
 
 from sim.mc import executors
 
@@ -20,15 +19,10 @@ def test_fork_only_when_single_threaded(monkeypatch):
     monkeypatch.setattr(
         executors.multiprocessing, "get_start_method", lambda allow_none=True: "fork"
     )
-    assert executors._start_method() == "fork"  # pytest itself runs one thread here
-    stop = threading.Event()
-    t = threading.Thread(target=stop.wait)
-    t.start()
-    try:
-        assert executors._start_method() in ("forkserver", "spawn")
-    finally:
-        stop.set()
-        t.join()
+    monkeypatch.setattr(executors.threading, "active_count", lambda: 1)
+    assert executors._start_method() == "fork"  # the only thread: a fork is safe
+    monkeypatch.setattr(executors.threading, "active_count", lambda: 3)
+    assert executors._start_method() in ("forkserver", "spawn")
     monkeypatch.setattr(
         executors.multiprocessing, "get_start_method", lambda allow_none=True: "spawn"
     )
