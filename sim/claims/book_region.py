@@ -12,7 +12,6 @@ Arrays in, arrays out: samples have a leading point axis ``(N, M)``.
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping, Sequence
@@ -20,6 +19,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from sim.claims.book import ClaimBook
+from sim.claims.declaration import read_toml
 from sim.claims.inference import Input, Region, Statement, parse_declaration
 from sim.claims.intervals import spread_rows
 from sim.claims.region import (
@@ -68,12 +68,7 @@ def load_declaration(path: str | Path, book: ClaimBook) -> Declaration:
     (hardware limits; the printed statements come from the book), and ``[explore]`` (``n``,
     ``rounds``, ``per_point``, ``draws``). Unknown keys and ids raise ConfigError naming them."""
     p = Path(path)
-    try:
-        doc = tomllib.loads(p.read_text())
-    except OSError as e:
-        raise ConfigError(str(p), f"cannot read the region declaration: {e.strerror}") from None
-    except tomllib.TOMLDecodeError as e:
-        raise ConfigError(str(p), f"not valid TOML: {e}") from None
+    doc = read_toml(p, "region declaration")
     cons, preds = doc.pop("constraints", []), doc.pop("predictions", [])
     explore = doc.pop("explore", {})
     for key, ids in (("constraints", cons), ("predictions", preds)):

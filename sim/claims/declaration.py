@@ -16,7 +16,7 @@ from typing import Any, Mapping
 
 from sim.mc.config import ConfigError
 
-__all__ = ["FORMS", "Input", "Statement", "parse_declaration", "load_declaration"]
+__all__ = ["FORMS", "Input", "Statement", "parse_declaration", "load_declaration", "read_toml"]
 
 FORMS = ("value", "share", "count", "upper", "lower", "range", "one-plate")
 _INPUT_KEYS = {"low", "high", "why"}
@@ -151,11 +151,15 @@ def parse_declaration(doc: Mapping[str, Any]) -> tuple[list[Input], list[Stateme
 
 def load_declaration(path: str | Path) -> tuple[list[Input], list[Statement]]:
     """Read a paper's declaration TOML (see the module doc)."""
+    return parse_declaration(read_toml(path, "declaration"))
+
+
+def read_toml(path: str | Path, what: str) -> dict:
+    """A TOML file's table; an unreadable or invalid file is one ConfigError naming it."""
     p = Path(path)
     try:
-        doc = tomllib.loads(p.read_text())
+        return tomllib.loads(p.read_text())
     except OSError as e:
-        raise ConfigError(str(p), f"cannot read the declaration: {e.strerror}") from None
+        raise ConfigError(str(p), f"cannot read the {what}: {e.strerror}") from None
     except tomllib.TOMLDecodeError as e:
         raise ConfigError(str(p), f"not valid TOML: {e}") from None
-    return parse_declaration(doc)
