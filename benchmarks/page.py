@@ -90,17 +90,6 @@ def write_page(path: Path, eng, studies, quick: bool) -> None:
                 measured += f"; studies `{study}`: saves {share:.0%} of its CPU time"
             out.append(f"| `{mod}` | {eng['engine'][i]} | {measured} | "
                        f"{_verdict(ratio, share, study)} |")  # fmt: skip
-    if studies:
-        shares = {
-            s: _share(studies, s, "figures_on_pool", "figures_here") for s in set(studies["study"])
-        }
-        best = max(shares, key=lambda s: -np.inf if np.isnan(shares[s]) else shares[s])
-        text = ", ".join(f"{s} {v:.0%}" for s, v in sorted(shares.items()))
-        out.append(
-            f"| `sim.report.figure_jobs` (figures on pool workers) | studies "
-            f"`figures_on_pool` / `figures_here` | wall time saved: {text} | "
-            f"{_verdict(0.0, shares[best], best)} |"
-        )
     out += ["", "## Engine rows (`engines.parquet`)", ""]
     out += _engines_table(eng) if eng else ["Not measured in this run."]
     out += ["", "## Study rows (`studies.parquet`)", ""]

@@ -26,7 +26,7 @@ import numpy as np
 
 __all__ = ["JOBS", "TARGET_S", "rerun_rows", "study_files"]
 
-#: issue 12: ``make rerun`` under 90 s on a 2-core machine with ``--workers 2``
+#: issue 12: ``make rerun`` under 90 s on a 2-core machine (its ``RUN_FLAGS``: ``--workers 1``)
 TARGET_S = 90.0
 #: studies run side by side by ``make rerun`` (the Makefile's ``RUN_JOBS``)
 JOBS = 2

@@ -1,19 +1,15 @@
-"""Study rows of the benchmark (``studies.parquet``): what the compiled kernels and the figures
-drawn on pool workers save of a whole study.
+"""Study rows of the benchmark (``studies.parquet``): what the compiled kernels save of a whole
+study.
 
 Issue 22 keeps a compiled path where its engine row shows at least
 :data:`benchmarks.engines.KEEP_RATIO` over its NumPy path, *or* where it saves at least
 :data:`KEEP_SHARE` of a study's time. The second is measured here: each study of
 :data:`STUDIES` is run as ``python -m sim run <file> --out <scratch> --quiet`` in a fresh
-process, in three variants:
-
-* ``compiled`` (1 worker) and ``numpy`` (1 worker, ``SIM_NO_JIT=1``: every kernel of
-  :mod:`sim.lsq.compile` off): CPU time of the child process (user + system, steadier than
-  wall time on a shared machine); ``saving`` = 1 - compiled / numpy, the share of the NumPy
-  run's time the kernels save;
-* ``figures_on_pool`` and ``figures_here`` (2 workers; ``SIM_FIGURES_HERE=1`` draws the
-  figures in the run's own process, :mod:`sim.report.figure_jobs`): wall time, the share the
-  pool saves of the study's wall time.
+process, in two variants, ``compiled`` (1 worker) and ``numpy`` (1 worker, ``SIM_NO_JIT=1``:
+every kernel of :mod:`sim.lsq.compile` off): CPU time of the child process (user + system,
+steadier than wall time on a shared machine); ``saving`` = 1 - compiled / numpy, the share of
+the NumPy run's time the kernels save. (Figures drawn on the pool's workers had two more
+variants; they saved under 20 % of every study's wall time, and went.)
 
 The results go to a scratch directory that is removed afterwards. ``--quick`` runs the test
 suite's tiny configurations, whose shares say nothing about the full studies.
@@ -31,7 +27,7 @@ from pathlib import Path
 
 __all__ = ["STUDIES", "KEEP_SHARE", "VARIANTS", "study_rows"]
 
-#: studies whose time decides a compiled path or the figure pool (the slowest of each family)
+#: studies whose time decides a compiled path (the slowest of each family)
 STUDIES = ("agnard_block", "brown_design", "wolf_polynomial")
 #: issue 22: a compiled path or micro-optimisation stays if it saves this share of a study
 KEEP_SHARE = 0.20
@@ -39,8 +35,6 @@ KEEP_SHARE = 0.20
 VARIANTS = {
     "compiled": (1, {}, "cpu"),
     "numpy": (1, {"SIM_NO_JIT": "1"}, "cpu"),
-    "figures_on_pool": (2, {}, "wall"),
-    "figures_here": (2, {"SIM_FIGURES_HERE": "1"}, "wall"),
 }
 
 
@@ -65,7 +59,7 @@ def study_rows(files: list[Path], extra=None) -> dict[str, list]:
     extra = extra or {}
     cols = ("study", "variant", "workers", "cpu_s", "wall_s", "seconds", "clock")
     rows: dict[str, list] = {c: [] for c in cols}
-    base = {k: v for k, v in os.environ.items() if k not in ("SIM_NO_JIT", "SIM_FIGURES_HERE")}
+    base = {k: v for k, v in os.environ.items() if k != "SIM_NO_JIT"}
     with tempfile.TemporaryDirectory(prefix="sim-bench-studies-") as tmp:
         for f in files:
             for variant, (workers, env, clock) in VARIANTS.items():

@@ -2,7 +2,7 @@
 
 A fork copies only the calling thread: a module import lock held by another thread at that
 instant stays held in the child, and the child's first import of that module waits for ever
-(the ``brown_design`` + ``--workers 2`` + ``SIM_FIGURES_HERE`` hang). The pool starts its
+(the ``brown_design`` + ``--workers 2`` hang, figures drawn in threads). The pool starts its
 workers when it is made, and with ``forkserver`` when other threads are running.
 """
 

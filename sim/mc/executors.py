@@ -64,7 +64,7 @@ def _start_method() -> str | None:
     other threads running is never forked. A fork copies only the calling thread, so a lock
     another thread holds at that instant (a module's import lock while a figure thread imports
     matplotlib, an I/O lock) stays held for ever in the child, and the worker hangs on its
-    first import (seen with ``brown_design``, ``--workers 2`` and ``SIM_FIGURES_HERE``). Then
+    first import (seen with ``brown_design``, ``--workers 2`` and its figures drawn in threads). Then
     ``forkserver`` starts the workers from a clean single-threaded server instead."""
     methods = multiprocessing.get_all_start_methods()
     if multiprocessing.get_start_method(allow_none=False) != "fork":

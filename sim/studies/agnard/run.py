@@ -10,8 +10,7 @@ Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the tr
 tables, ``region_five.parquet`` (per block and layout), ``consistent_region.parquet``,
 ``region_inputs.parquet``, ``region_layouts.parquet``, ``scanner_region.parquet`` (every
 explored scanner vector) and ``scanner_region_inputs.parquet``,
-``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each sent to the run's
-workers, when it has some, as soon as its data exist: :func:`sim.report.figure_jobs.start_figures`).
+``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each drawn as soon as its data exist).
 """
 
 from __future__ import annotations
@@ -27,7 +26,7 @@ from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
 from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance, write_table
-from sim.report.figure_jobs import start_figures
+from sim.report.plotting import draw
 from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.agnard import chunks as ch
@@ -333,16 +332,13 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     T = cfg["trials"]
     c5 = select_control(block, cfg["control.few"])
     c21 = select_control(block, cfg["control.many"])
-    # figures go to idle workers as soon as their data exist (sim.report.figure_jobs.start_figures)
-    drawn = [start_figures([(fg.fig_scanner, (cfg, out / "scanner_field.png"))], ctx.executor)]
+    draw([(fg.fig_scanner, (cfg, out / "scanner_field.png"))])
     sim = _run(partial(ch.main_chunk, cfg, block), T, cfg, 0, "2x8 block", ctx)
     per_trial = {k: v for k, v in sim.items() if not k.startswith(ch.CHUNK)}
     write_table(out / "trials.parquet", {"trial": np.arange(T), **per_trial}, prov)
     _layout(block, c5, c21, prov, out)
     vec = _check_vectors(cfg, block, sim, c5, c21, T, prov, out)
-    drawn.append(
-        start_figures([(fg.fig_residuals, (vec, out / "check_residuals.png"))], ctx.executor)
-    )
+    draw([(fg.fig_residuals, (vec, out / "check_residuals.png"))])
     scan_t = _scanner_table(cfg, block, per_trial, ctx, prov, out)
     lay_t = _control_table(cfg, block, sim, prov, out)
     base = 1 + len(cfg["tradeoff.dpis"])
@@ -361,14 +357,9 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     rows, insets = _five_region(cfg, block, book, rows, ctx, base, prov, out)
     ctrl_idx = _region_layouts(block, insets, prov, out)
     write_claims(out / "claims.parquet", rows, prov, book)
-    drawn.append(
-        start_figures(
-            [
-                (fg.fig_tradeoffs, (scan_t, lay_t, size_t, out / "tradeoffs.png")),
-                (fg.fig_layout, (block, c5, c21, out / "block_layout.png", ctrl_idx, insets)),
-            ],
-            ctx.executor,
-        )
+    draw(
+        [
+            (fg.fig_tradeoffs, (scan_t, lay_t, size_t, out / "tradeoffs.png")),
+            (fg.fig_layout, (block, c5, c21, out / "block_layout.png", ctrl_idx, insets)),
+        ]
     )
-    for wait in drawn:
-        wait()

@@ -13,7 +13,7 @@ import numpy as np
 
 from sim.claims.book import write_claims
 from sim.mc.storage import provenance, write_table
-from sim.report.figure_jobs import start_figures
+from sim.report.plotting import draw
 from sim.studies import RunContext
 from sim.studies.brown import figures as F
 from sim.studies.brown import region as RG
@@ -63,8 +63,8 @@ def run_dilution(cfg: dict, out: Path, ctx: RunContext) -> None:
         prov,
     )
     unit = {m: an[m] / sr for m in MODEL_NAMES}
-    drawn = start_figures(
-        [  # on the idle workers while the claims and the sweep are made here
+    draw(
+        [
             (F.fig_dilution_points, (cfg, pts, theta, unit, out / "dilution_points.png")),
             (F.fig_sigma_maps, (cfg, pts, theta, out / "sigma_maps.png")),
             (F.fig_mc_vs_analytic, (cols, mc.N, out / "mc_vs_analytic.png")),
@@ -72,8 +72,7 @@ def run_dilution(cfg: dict, out: Path, ctx: RunContext) -> None:
                 F.fig_dilution_vs_points,
                 (out / "dilution_vs_points.parquet", out / "dilution_vs_points.png"),
             ),
-        ],
-        ctx.executor,
+        ]
     )
 
     book = load_book("brown_dilution")
@@ -82,7 +81,6 @@ def run_dilution(cfg: dict, out: Path, ctx: RunContext) -> None:
     rows += _write_region(out, prov, book, reg, preds, verdicts, RG.CONCEPT_NOTES)
     write_claims(out / "claims.parquet", rows, prov, book)
     F.fig_region(out, RG.CONCEPT_PAIRS, out / "consistent_region.png")
-    drawn()
 
 
 def run_table1(cfg: dict, out: Path, ctx: RunContext) -> None:
@@ -114,11 +112,8 @@ def run_table1(cfg: dict, out: Path, ctx: RunContext) -> None:
     )
     book = load_book("brown_table1")
     rows = score_table1(book, cfg, pts, an["pivot"], sr, mc, t1)
-    drawn = start_figures(
-        [(F.fig_table1, (cfg, pts, theta, an["pivot"], t1, out / "table1.png"))], ctx.executor
-    )  # on an idle worker while the region is explored here
+    draw([(F.fig_table1, (cfg, pts, theta, an["pivot"], t1, out / "table1.png"))])
     reg, preds, verdicts = RG.table1_region(cfg, book)
     rows += _write_region(out, prov, book, reg, preds, verdicts, RG.TABLE1_NOTES)
     write_claims(out / "claims.parquet", rows, prov, book)
     F.fig_region(out, RG.TABLE1_PAIRS, out / "consistent_region.png")
-    drawn()

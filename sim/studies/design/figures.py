@@ -254,8 +254,7 @@ def fig_twoplate(cols, samples, path):
 
 def figure_jobs(stage: str, out, *data) -> list:
     """The figure jobs ``(fn, args)`` of one stage of the run, for
-    :func:`sim.report.figure_jobs.start_figures` as soon as the stage's tables exist (so they are
-    drawn on idle workers while the run goes on): ``design`` (cols), ``datum`` (cfg, dcols),
+    :func:`sim.report.plotting.draw` as soon as the stage's tables exist: ``design`` (cols), ``datum`` (cfg, dcols),
     ``budget`` (bcols), ``coverage`` (ccols), ``bayes`` (samples, values), ``twoplate``
     (tcols, tsamples)."""
     if stage == "design":

@@ -20,7 +20,7 @@ from sim.lsq import datum as dm
 from sim.mc import tolerance as tl
 from sim.mc.runner import chunk_rng
 from sim.mc.storage import provenance, write_table
-from sim.report.figure_jobs import start_figures
+from sim.report.plotting import draw
 from sim.studies import RunContext
 from sim.studies.design import figures
 from sim.studies.design import region as DR
@@ -268,10 +268,9 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     prov = provenance(cfg)
     book = load_book()
     R: dict = {}
-    drawn = []  # each stage's figures go to idle workers as soon as its tables exist
 
-    def figs(stage, *data):
-        drawn.append(start_figures(figures.figure_jobs(stage, out, *data), ctx.executor))
+    def figs(stage, *data):  # each stage's figures, as soon as its tables exist
+        draw(figures.figure_jobs(stage, out, *data))
 
     # 1. design trade-off (analytic) and its Monte-Carlo check
     cols = design_cells(cfg)
@@ -313,5 +312,3 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_table(out / "consistent_region.parquet", region_table, prov)
     write_table(out / "region_inputs.parquet", region_inputs, prov)
     write_claims(out / "claims.parquet", rows, prov, book)
-    for wait in drawn:
-        wait()

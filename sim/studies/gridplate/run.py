@@ -14,7 +14,7 @@ from sim.claims.intervals import spread
 from sim.lsq import distributions as D
 from sim.mc.runner import chunk_rng
 from sim.mc.storage import provenance, write_table
-from sim.report.figure_jobs import start_figures
+from sim.report.plotting import draw
 from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.gridplate import figures as F
@@ -159,19 +159,17 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     rows, book = score(cfg, res, beyond, {"j_true": j_true})
     paper = [(r, book.spec(f"twoplate.weight_ratio.grid_sigma_1to{r}_um")["ref"]) for r in (2, 3)]
     sgt, stated = cfg["grid.sigma_true_um"], cfg["grid.sigma_stated_um"]
-    drawn = start_figures(
-        [  # on the idle workers while the sweep is made here
+    draw(
+        [
             (F.fig_params, (cfg, res, out / "parameters.png")),
             (F.fig_coverage, (cov, ratio_true, out / "coverage.png")),
             (F.fig_chi2, (ch, sgt, out / "chi2_power.png")),
             (F.fig_implied, (imp, stated, paper, out / "implied_grid.png")),
-        ],
-        ctx.executor,
+        ]
     )
     rows = decide_over_region(cfg, book, rows, out, prov)
     ex = simulate(cfg, chunk_rng(cfg["seed"], 1, 0), 1)  # one calibration, its own stream
     write_table(
         out / "example_plate.parquet", F.fig_residuals(cfg, ex, out / "residuals.png"), prov
     )
-    drawn()
     write_claims(out / "claims.parquet", rows, prov, book)

@@ -21,7 +21,7 @@ from sim.lsq import distributions as D
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance
-from sim.report.figure_jobs import draw_figures
+from sim.report.plotting import draw
 from sim.studies.network.analysis import ellipse, estimated_points, mc_chunk
 from sim.studies.network.claims import design_figures, network_claims
 from sim.studies.network.definition import Network, build
@@ -125,10 +125,9 @@ def run(cfg: dict, out: Path, ctx) -> None:
     write_summary(out, net, an, cfg, facts, est, prov)
     a95 = K95 * ellipse(an.cov[pts])[0]
     network_claims(out, prov, an, est, cfg, design_figures(net, an, a95, dil, est))
-    draw_figures(
+    draw(
         [
             (network_figure, (net, an, pts, out / "network.png")),
             (reliability_figure, (net, an, out / "reliability.png")),
-        ],
-        ctx.executor,
+        ]
     )

@@ -15,7 +15,7 @@ from sim.lsq import distributions as D
 from sim.mc import tolerance as tl
 from sim.mc.runner import chunk_rng
 from sim.mc.storage import provenance, write_table
-from sim.report.figure_jobs import start_figures
+from sim.report.plotting import draw
 from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.run_steps import over_region, run_part, spread_note
@@ -103,28 +103,26 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_table(out / "decompositions.parquet", dec, prov)
     rec, sw, zs, vt = simulate_parts(cfg, out, ctx, prov)
     rows, book = score(cfg, dec, rec, zs, vt)
-    drawn = start_figures(
+    draw(
         [
             (F.fig_recovery, (rec, cfg, out / "recovery.png")),
             (F.fig_power, (sw, out / "power.png")),
-        ],
-        ctx.executor,
-    )  # on the idle workers while the sweep is made here
+        ]
+    )
     region, preds = explore_region(cfg, book, chunk_rng(cfg["seed"], 900, 0))
     write_region(out / "consistent_region.parquet", region, book, preds, prov)
     rows = over_region(book, region, preds, rows, spread_note("models"))
     ex = simulate_chain(cfg, chunk_rng(cfg["seed"], 1, 0), 1, return_all=True)
     r = next(x for x in rows if x["claim"] == RATIO)
     zone = (r["zone_low"], r["zone_high"])
-    more = start_figures(
+    draw(
         [
             (
                 F.fig_vertical,
                 (region.x["relief_mm"], region.outputs[RATIO], zone, out / "vertical.png"),
             ),
             (F.fig_residuals, (ex, cfg, out / "residuals.png")),
-        ],
-        ctx.executor,
+        ]
     )
     fig_region(
         region,
@@ -132,6 +130,4 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         title="seed 002: the vertical test's unprinted inputs (constrained by 'cut roughly in half')",
         nominal=nominal(cfg),
     )
-    drawn()
-    more()
     write_claims(out / "claims.parquet", rows, prov, book)

@@ -10,8 +10,7 @@ import matplotlib.ticker
 import numpy as np
 
 from sim.mc.storage import read_table
-from sim.report.figure_jobs import draw_figures, start_figures
-from sim.report.plotting import place_legend, plt, save
+from sim.report.plotting import draw, place_legend, plt, save
 from sim.studies.wolf.model import ls_map
 
 _UM_PER_MM = 2.5  # vector plots: 1 mm of plot = 2.5 µm of discrepancy (50 µm = 20 mm)
@@ -49,32 +48,18 @@ def _quiver(ax, x, y, dx, dy, title, key_um=20.0, um_per_mm=_UM_PER_MM):
     ax.set_ylabel("y (mm)")
 
 
-#: the figures whose tables the run writes before its trade-offs (the dearest first), and the
-#: others
-EARLY = ("components_figure", "vectors_figure", "readings_figure")
-LATE = ("stability_figure", "degree_figure", "table1_figure")
-
-
-def _jobs(names, cfg: dict, out: Path) -> list:
-    return [(globals()[n], (cfg, out) if n == "stability_figure" else (out,)) for n in names]
-
-
-def figures(cfg: dict, out: Path, executor=None) -> None:
-    """Every figure of the study from its Parquet files, on the run's idle workers when
-    there are some (:func:`sim.report.figure_jobs.draw_figures`), the dearest first."""
-    draw_figures(_jobs(EARLY + LATE, cfg, out), executor)
-
-
-def start_early(cfg: dict, out: Path, executor=None):
-    """Send the :data:`EARLY` figures to the run's workers (their tables are written) while
-    the trade-offs run; returns the function that waits for them
-    (:func:`sim.report.figure_jobs.start_figures`)."""
-    return start_figures(_jobs(EARLY, cfg, out), executor)
-
-
-def late(cfg: dict, out: Path, executor=None) -> None:
-    """The :data:`LATE` figures (drawn once the trade-offs' tables are written)."""
-    draw_figures(_jobs(LATE, cfg, out), executor)
+def figures(cfg: dict, out: Path) -> None:
+    """Every figure of the study from its Parquet files."""
+    draw(
+        [
+            (components_figure, (out,)),
+            (vectors_figure, (out,)),
+            (readings_figure, (out,)),
+            (stability_figure, (cfg, out)),
+            (degree_figure, (out,)),
+            (table1_figure, (out,)),
+        ]
+    )
 
 
 def vectors_figure(out: Path) -> None:

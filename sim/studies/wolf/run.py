@@ -167,16 +167,13 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     book = cl.load_book()
     region, preds = explore_region(cfg, book, ctx)
     write_region(out / "consistent_region.parquet", region, book, preds, prov)
-    wait_early = figures.start_early(cfg, out, ctx.executor)  # drawn while the trade-offs run
-
     degt = _degree(cfg, out, prov, ctx)
     _stability(cfg, out, prov, ctx)
     t1, t3 = _paper_tables(cfg, out, prov)
     rows = over_region(book, region, preds, cl.rows(cfg, main, t1, t3, degt, book), example_note)
     write_claims(out / "claims.parquet", rows, prov, book)
     _region_figure(cfg, out, region)
-    figures.late(cfg, out, ctx.executor)
-    wait_early()
+    figures.figures(cfg, out)
 
 
 def _vectors_and_components(cfg, out, prov):
