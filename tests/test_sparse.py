@@ -14,6 +14,7 @@ import pytest
 from scipy import sparse
 
 from sim.lsq import sparse as lsq_sparse
+from sim.mc import estimate as estimate_module
 from sim.mc.config import ConfigError
 from sim.mc.estimate import check_limits, estimate
 from sim.studies import load_study
@@ -301,7 +302,7 @@ def test_the_datum_must_cover_the_defect():
     assert not lsq_sparse.factorize(N, G, None).ok
 
 
-def test_the_estimate_counts_nonzeros_and_bounds_a_network_by_memory(tmp_path):
+def test_the_estimate_counts_nonzeros_and_bounds_a_network_by_memory(tmp_path, monkeypatch):
     """The network estimator: unknowns from the declaration, memory of the sparse path
     growing with the chunk; a network too large for the memory limit is refused with the
     estimate (exit 2 at the command line), not by a count."""
@@ -309,6 +310,11 @@ def test_the_estimate_counts_nonzeros_and_bounds_a_network_by_memory(tmp_path):
     est = estimate(cfg)
     assert est.unknowns >= 5000 and est.trials == cfg["trials"]
     assert estimate({**cfg, "chunk": 200}).bytes > est.bytes
+    # a set larger than NAME_SAMPLE is matched through evenly spaced names: close to the
+    # exact count (the declared 2,500-point grid through 500 of its names)
+    exact = est.bytes
+    monkeypatch.setattr(estimate_module, "NAME_SAMPLE", 500)
+    assert estimate(cfg).bytes == pytest.approx(exact, rel=0.02)
     big = {**cfg, "network.grids": [{**cfg["network.grids"][0], "nx": 3000, "ny": 3000}]}
     with pytest.raises(ConfigError, match="GiB"):
         check_limits(estimate(big))

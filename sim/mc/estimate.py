@@ -19,6 +19,7 @@ from __future__ import annotations
 import fnmatch
 import math
 import os
+import re
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
@@ -262,18 +263,34 @@ def _agnard(c: Mapping) -> tuple:
 NETWORK_SPARSE_FROM = SPARSE_MIN_UNKNOWNS
 
 
-def _network_names(c: Mapping) -> list[str]:
-    """The point names a network config declares (grids and random sets by prefix)."""
-    names = [str(p.get("name", "")) for p in c.get("network.points", []) if isinstance(p, dict)]
+#: a set of more points than this is matched against a pattern through this many evenly
+#: spaced names (each standing for its share of the set): the estimate of a network of
+#: millions of points takes a fraction of a second, not a minute of name matching
+NAME_SAMPLE = 20_000
+
+
+def _network_names(c: Mapping) -> list[tuple[list[str], float]]:
+    """The point names a network config declares, as ``(names, weight)`` groups: the listed
+    points (weight 1), then each grid and random set by prefix (``P1`` ... ``Pk``): all its
+    names when there are at most :data:`NAME_SAMPLE`, else that many evenly spaced ones, each
+    of weight k / NAME_SAMPLE."""
+    groups = [
+        ([str(p.get("name", "")) for p in c.get("network.points", []) if isinstance(p, dict)], 1.0)
+    ]
     for key, count in (("network.grids", ("nx", "ny")), ("network.random", ("n",))):
         for rec in c.get(key, []):
             if not isinstance(rec, dict):
                 continue
             k = math.prod(int(rec.get(f, 1)) for f in count)
-            if k > 5e7:
-                raise OverflowError("too many points to list")
-            names += [f"{rec.get('prefix', '')}{b + 1}" for b in range(k)]
-    return names
+            pre = rec.get("prefix", "")
+            if k <= NAME_SAMPLE:
+                groups.append(([f"{pre}{b + 1}" for b in range(k)], 1.0))
+            else:
+                picks = dict.fromkeys(
+                    round(1 + i * (k - 1) / (NAME_SAMPLE - 1)) for i in range(NAME_SAMPLE)
+                )
+                groups.append(([f"{pre}{b}" for b in picks], k / len(picks)))
+    return groups
 
 
 def _network(c: Mapping) -> tuple:
@@ -288,12 +305,13 @@ def _network(c: Mapping) -> tuple:
         m = os.path.getsize(gama) / 80 if os.path.isfile(gama) else 1e3
         n = m / 4
     else:
-        names = _network_names(c)
-        n = len(names)
+        groups = _network_names(c)
+        n = sum(len(names) * w for names, w in groups)
 
-        def count(pats) -> int:
+        def count(pats) -> float:
             pats = [pats] if isinstance(pats, str) else list(pats or [])
-            return sum(1 for nm in names if any(fnmatch.fnmatchcase(nm, str(p)) for p in pats))
+            rx = [re.compile(fnmatch.translate(str(p))).match for p in pats]  # = fnmatchcase
+            return sum(w * sum(1 for nm in names if any(m(nm) for m in rx)) for names, w in groups)
 
         m = float(len(c.get("network.observations", [])))
         for g in c.get("network.generate", []):
