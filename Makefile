@@ -46,7 +46,7 @@ fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=30
 # not part of `make test`: about 10-20 minutes on 2 cores. Writes docs/mutation.md.
 MUTATION_WORKERS ?= 2
 
-mutation: $(STAMP) ## mutate sim/claims/{book,intervals}.py, run their tests, write docs/mutation.md
+mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (sim/claims/), run their tests, write docs/mutation.md
 	$(PY) -m pip install --quiet -e ".[dev,mutation]"
 	rm -rf mutants
 	$(VENV)/bin/mutmut run --max-children $(MUTATION_WORKERS) > /dev/null
