@@ -58,7 +58,7 @@ def five_samples(sw: dict, i: int) -> dict[str, np.ndarray]:
     """Per-block statistics (cm) of layout ``i`` keyed by claim id."""
     out = {}
     for w in ("ctrl", "check"):
-        for c in ("x", "y", "xy", "z"):
+        for c in ("x", "y", "z"):  # XY is the paper-check of their quadrature, not simulated
             out[f"agnard.control_5.{w}_{c}_cm"] = 100 * np.asarray(sw[f"inset{i}.{w}_{c}_m"])
     for c in ("xy", "z"):  # the acceptance limit applies to the control rms
         out[f"agnard.max_residual.control_5_{c}_cm"] = 100 * np.asarray(sw[f"inset{i}.ctrl_{c}_m"])
