@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from sim.instruments.block.centres import with_centres
 from sim.instruments.block.data_snooping import snoop
 from sim.instruments.block.layout import Block
 from sim.lsq import distributions as D
-from sim.studies.agnard.schema import five_control, paper_weights, snoop_weights
+from sim.studies.agnard.schema import five_control, model_sigmas, paper_weights, snoop_weights
 from sim.studies.agnard.simulate import Adjuster, Simulated, _rms, accuracy
 
 #: keys of per-chunk (not per-trial) arrays
@@ -168,19 +169,26 @@ def size_chunk(
     return out
 
 
-def sweep_chunk(cfg: dict, block: Block, insets, rng: np.random.Generator, n: int) -> dict:
+def sweep_chunk(
+    cfg: dict, block: Block, insets, rng: np.random.Generator, n: int, centres: bool = False
+) -> dict:
     """The unprinted five-point layout at each of ``insets`` (the region's input vectors): the
-    5-control pass adjusted once per layout on the same simulated blocks."""
-    adj = Adjuster(block)
+    5-control pass adjusted once per layout on the same simulated blocks; with ``centres``
+    the models also carry their projection centres as model points
+    (:mod:`sim.instruments.block.centres`, an error of a model point's size, the model
+    points' weight), drawn after the blocks so that these are the same either way."""
+    key = ("digital", "corrected")
     wo, wc = paper_weights(cfg)
     sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], uncorrected=False)
+    if centres:
+        sxy, sz = model_sigmas(cfg)
+        sim = sim.centred(with_centres(block), rng, np.array([sxy, sxy, sz]), key)
+    adj = Adjuster(sim.block)
     out: dict[str, np.ndarray] = {}
-    _, _, start = adj.adjust(sim, ("digital", "corrected"), cfg["control.many"], wo, wc)
+    _, _, start = adj.adjust(sim, key, cfg["control.many"], wo, wc)
     for i, u in enumerate(insets):
-        ctrl, _, res = adj.adjust(
-            sim, ("digital", "corrected"), five_control(block, u), wo, wc, start=start
-        )
-        accuracy(block, ctrl, res, out, f"inset{i}")
+        ctrl, _, res = adj.adjust(sim, key, five_control(block, u), wo, wc, start=start)
+        accuracy(sim.block, ctrl, res, out, f"inset{i}")
     return out
 
 

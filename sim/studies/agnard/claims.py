@@ -28,8 +28,6 @@ AXES = ("x", "y", "xy", "z")
 JOINT = {b: f"agnard.{b}.check_xy_holm" for b in ("control_5", "control_21")}
 #: the members of each family
 MEMBERS = {j: [f"agnard.{b}.check_{c}_cm" for c in ("x", "y")] for b, j in JOINT.items()}
-#: 5-control check Z: a finding about the simulated block (no projection centres)
-NO_CENTRES = "agnard.control_5.check_z_cm"
 
 
 def load_book() -> ClaimBook:

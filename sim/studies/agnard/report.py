@@ -83,9 +83,10 @@ def _claim_lines(c: dict) -> list[str]:
         f"*{vd('agnard.control_21.check_y_cm')}*), Z {v('agnard.control_21.check_z_cm')} cm "
         f"(*{vd('agnard.control_21.check_z_cm')}*); 5 control: check X and Y as one Holm test "
         f"*{vd('agnard.control_5.check_xy_holm')}* over the lost layouts, Z "
-        f"{v('agnard.control_5.check_z_cm')} cm (*{vd('agnard.control_5.check_z_cm')}*: the "
-        "simulated block has no projection centres to tie its models in height, as the paper's "
-        "SPACE-M has). The printed XY columns are the quadrature of X and Y (paper-checks: "
+        f"{v('agnard.control_5.check_z_cm')}-{fmt(c['agnard.control_5.check_z_cm']['value_high'])} "
+        f"cm (*{vd('agnard.control_5.check_z_cm')}* over the layouts, with and without the "
+        "models' projection centres as model points: the centres tie consecutive models in "
+        "height). The printed XY columns are the quadrature of X and Y (paper-checks: "
         + ", ".join(
             f"{k.split('.')[1]} {k.split('.')[2][:-6]} *{vd(k)}*"
             for k in c
@@ -430,11 +431,12 @@ def report(out: Path) -> str:
             region_lead(
                 out,
                 "The 5-control predictions (Table 3, over the lost five-point layout of its "
-                "control points)",
+                "control points and the program's option of projection centres as model points)",
                 values=f"the same {cfg['region.trials']} simulated blocks adjusted once per "
                 "layout (common random numbers), whose noise enters the decision",
-                design=f"a Sobol design of {cfg['region.points']} layouts, not refined (no "
-                "printed statement bounds the region: Figure 5 is lost)",
+                design=f"a Sobol design of {cfg['region.points']} layouts, each without and "
+                "with the projection centres (centres_1 0 and 1), not refined (no printed "
+                "statement bounds the region: Figure 5 is lost)",
             ),
             figure(out, "consistent_region.png", "consistent region"),
             *_scanner_lead(out),

@@ -34,8 +34,8 @@ from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.agnard import chunks as ch
 from sim.studies.agnard import figures as fg
-from sim.studies.agnard.claims import JOINT, MEMBERS, NO_CENTRES, claim_rows, load_book
-from sim.studies.agnard.region import SCANNER_KEYS, explore_region, explore_scanner
+from sim.studies.agnard.claims import JOINT, MEMBERS, claim_rows, load_book
+from sim.studies.agnard.region import CENTRES, SCANNER_KEYS, explore_region, explore_scanner
 from sim.studies.agnard.schema import NAME, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
 from sim.studies.run_steps import over_region
@@ -247,35 +247,26 @@ def _five_region(cfg, block, book, rows, ctx, part, prov, out):
     _write_region(region, book, preds, prov, out)
     insets = [float(u) for u in region.x["five_inset_1"]]
     T = cfg["region.trials"]
-    tab = {"inset": np.repeat(insets, T), "trial": np.tile(np.arange(T), len(insets))}
+    tab = {
+        "inset": np.repeat(insets, T),
+        "centres": np.repeat(region.x[CENTRES] > 0.5, T),
+        "trial": np.tile(np.arange(T), len(insets)),
+    }
     for c in preds:
         tab[c.split(".", 1)[1]] = np.concatenate([s[c] for s in stats])
     write_table(out / "region_five.parquet", tab, prov)
     fig_region(
         region,
         out / "consistent_region.png",
-        title="seed 003: the lost five-point layout (no printed statement constrains it)",
-        nominal={"five_inset_1": 0.0},
+        title="seed 003: the lost five-point layout and the projection centres (no printed "
+        "statement constrains them)",
+        nominal={"five_inset_1": 0.0, CENTRES: 0.0},
     )
-    rows = over_region(book, region, preds, rows, _five_note)
+    rows = over_region(book, region, preds, rows, partial(_example, "layout"))
     fresh = ClaimBook(list(book.specs.values()), [], book.path)  # rows re-scored over the region
     j5 = JOINT["control_5"]
     five = family_over(fresh, region, j5, MEMBERS[j5])
-    return [five if r["claim"] == j5 else r for r in rows], insets
-
-
-def _five_note(row: dict) -> str:
-    """The configured layout's result as an example; for the 5-control check Z, why it is a
-    finding (the simulated block has no projection centres: claims.toml)."""
-    ex = _example("layout", row)
-    if row["claim"] != NO_CENTRES:
-        return ex
-    return (
-        "a finding about the simulated block, not a failed prediction: its models are tied by "
-        "pass and check points only, while the paper's SPACE-M also carries each model's "
-        "projection centres (the shared photo's centre ties consecutive models in height and "
-        f"tilt), which a 5-control block needs most; {ex}"
-    )
+    return [five if r["claim"] == j5 else r for r in rows], list(dict.fromkeys(insets))
 
 
 def _write_region(region, book, preds, prov, out) -> None:
@@ -283,7 +274,7 @@ def _write_region(region, book, preds, prov, out) -> None:
     (:func:`sim.claims.book_region.write_region`), with the joint X, Y row's per-point
     outcome as a column (decided from its members, not from evidence of its own)."""
     st = statements(book, preds)
-    cols = region_table(region, st)
+    cols = region_table(region, st, preds)
     j5 = JOINT["control_5"]
     fam = family_outcomes(book, region, MEMBERS[j5])[1][region.accepted]
     cols[j5] = [OUTCOME_NAMES[int(o)] for o in fam]
