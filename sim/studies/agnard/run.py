@@ -261,6 +261,7 @@ def _five_region(cfg, block, book, rows, ctx, part, prov, out):
         title="seed 003: the lost five-point layout and the projection centres (no printed "
         "statement constrains them)",
         nominal={"five_inset_1": 0.0, CENTRES: 0.0},
+        labels={CENTRES: "projection centres as model points (0 without, 1 with)"},
     )
     rows = over_region(book, region, preds, rows, partial(_example, "layout"))
     fresh = ClaimBook(list(book.specs.values()), [], book.path)  # rows re-scored over the region
