@@ -17,8 +17,8 @@ manner as any other point" is read as: the same weight in the adjustment, and an
 size of a model point's (``sigma_m`` per axis, drawn independently per model: the model's
 relative orientation places its centres no better than its points). The tie's strength
 follows that error: in a 2 x 8 block with five control points, centres as precise as the
-model points bring the check-point height rms from 0.7-2.4 m to about 0.3-0.5 m; four times
-worse centres give back most of the loss (``agnard_block``'s region, docs/referee-reading.md).
+model points bring the check-point height rms from 0.7-2.4 m to about 0.3-0.5 m, centres four
+times worse to about 0.5-0.9 m (``agnard_block``'s region, docs/referee-reading.md).
 Without the option the block is unchanged (the default everywhere).
 
 Arrays in, arrays out: model coordinates ``(T, K, 3)`` with a leading trial axis.
