@@ -58,14 +58,17 @@ SCANNER_KEYS = {
 SCANNER_PART = 800
 
 
-def five_samples(sw: dict, i: int) -> dict[str, np.ndarray]:
-    """Per-block statistics (cm) of layout ``i`` keyed by claim id."""
+def five_samples(sw: dict, i: int, pre: str = "") -> dict[str, np.ndarray]:
+    """Per-block statistics (cm) of layout ``i`` keyed by claim id (``pre``: ``"centres."``
+    for the layout with the projection centres, :func:`sim.studies.agnard.chunks.sweep_chunk`)."""
     out = {}
     for w in ("ctrl", "check"):
         for c in ("x", "y", "z"):  # XY is the paper-check of their quadrature, not simulated
-            out[f"agnard.control_5.{w}_{c}_cm"] = 100 * np.asarray(sw[f"inset{i}.{w}_{c}_m"])
+            out[f"agnard.control_5.{w}_{c}_cm"] = 100 * np.asarray(sw[f"{pre}inset{i}.{w}_{c}_m"])
     for c in ("xy", "z"):  # the acceptance limit applies to the control rms
-        out[f"agnard.max_residual.control_5_{c}_cm"] = 100 * np.asarray(sw[f"inset{i}.ctrl_{c}_m"])
+        out[f"agnard.max_residual.control_5_{c}_cm"] = 100 * np.asarray(
+            sw[f"{pre}inset{i}.ctrl_{c}_m"]
+        )
     return out
 
 
@@ -75,20 +78,29 @@ def explore_region(
     """The region, its predictions, and the per-layout statistics of every explored layout
     (``runner(fn, trials, part, label)`` runs one part through the runner). The layouts are
     one Sobol design of ``region.points`` insets, explored once without and once with the
-    projection centres (``centres_1`` 0 and 1, the same insets); the region is their union."""
+    projection centres (``centres_1`` 0 and 1, the same insets, on the same blocks: one run
+    of the runner gives both); the region is their union."""
     dec = load_declaration(DECLARATION, book)
     stats: list[dict] = []
+    both: dict[tuple, dict] = {}  # the half without centres computes the other half as well
+
+    def run(insets: tuple, options: tuple) -> dict:
+        return runner(
+            partial(ch.sweep_chunk, cfg, block, insets, centres=options),
+            cfg["region.trials"],
+            part + len(stats),
+            "five-point layouts"
+            + (", with and without projection centres" if len(options) > 1 else ""),
+        )
 
     def model(x: dict[str, np.ndarray]) -> dict:
         insets = tuple(float(u) for u in x["five_inset_1"])
-        centres = bool(x[CENTRES][0] > 0.5)
-        sw = runner(
-            partial(ch.sweep_chunk, cfg, block, insets, centres=centres),
-            cfg["region.trials"],
-            part + len(stats),
-            "five-point layouts" + (" with projection centres" if centres else ""),
-        )
-        per = [five_samples(sw, i) for i in range(len(insets))]
+        if x[CENTRES][0] > 0.5:  # the same blocks as the half without (common random numbers)
+            sw, pre = both.pop(insets, None) or run(insets, (True,)), "centres."
+        else:
+            sw = both[insets] = run(insets, (False, True))
+            pre = ""
+        per = [five_samples(sw, i, pre) for i in range(len(insets))]
         stats.extend(per)
         return {
             c: sample_evidence(np.stack([p[c] for p in per]), *plate_ref(book.spec(c)))
