@@ -2,12 +2,13 @@
 
 Streams (``part``): 0 the 2 x 8 block with every adjustment of the paper; then one per scan
 resolution, one per block size, one per mechanical re-centring error, one for the region
-of the unprinted five-point control layout, and (from 800, apart) the scanner region under
+of the unprinted five-point control layout (each layout without and with the models'
+projection centres, on the same blocks), and (from 800, apart) the scanner region under
 Table 1 (:mod:`.region`). Every part goes through :func:`sim.mc.runner.run_chunks` with
 the run context (executor, chunk store), with picklable chunk functions
 (:mod:`.chunks`), so ``--workers``, Dask and resumption after a kill apply.
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
-tables, ``region_five.parquet`` (per block and layout), ``consistent_region.parquet``,
+tables, ``region_five.parquet`` (per block, layout and centres option), ``consistent_region.parquet``,
 ``region_inputs.parquet``, ``region_layouts.parquet``, ``scanner_region.parquet`` (every
 explored scanner vector) and ``scanner_region_inputs.parquet``,
 ``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each sent to the run's
