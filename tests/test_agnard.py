@@ -411,15 +411,50 @@ def test_five_control_rows_decided_over_the_region(tiny_run):
 
     _, cfg, out = tiny_run
     reg = read_table(out / "consistent_region.parquet").to_pydict()
-    assert len(reg["five_inset_1"]) == cfg["region.points"]
+    n = cfg["region.points"]  # each layout without and with the projection centres
+    assert len(reg["five_inset_1"]) == 2 * n
     assert all(0.0 <= u <= 0.45 for u in reg["five_inset_1"])
+    assert reg["centres_1"] == [0.0] * n + [1.0] * n
+    assert reg["five_inset_1"][:n] == reg["five_inset_1"][n:]
     rows = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
     for c in ("ctrl", "check"):
-        r = rows[f"agnard.control_5.{c}_xy_cm"]
+        r = rows[f"agnard.control_5.{c}_x_cm"]
         assert r["interval"] == "region"
         assert r["verdict"] in REGION_VERDICTS
         assert r["value"] <= r["value_high"]
-    assert check_region_rows(out) == 10  # each region verdict is its points' rule
+    # 8 rows of region.toml and the joint X, Y row, each with its per-point column
+    assert check_region_rows(out) == 9
+
+
+def test_joint_xy_rows_and_xy_paper_checks(tiny_run):
+    """The XY columns are paper-checks (exact, not simulated); each check-point block's
+    headline is the Holm test of its X and Y rows (the 21-control one from the two rows'
+    p, the 5-control one over the layout region); the 5-control check Z is decided over the
+    layouts with and without projection centres; the Y/X ratio is a finding."""
+    from sim.claims.family import holm
+    from sim.mc.storage import read_table
+    from sim.studies.agnard.claims import JOINT, MEMBERS
+
+    study, _, out = tiny_run
+    rows = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
+    for b in ("control_5", "control_21"):
+        for w in ("ctrl", "check"):
+            r = rows[f"agnard.{b}.{w}_xy_cm"]
+            assert r["kind"] == "paper-check" and r["interval"] == "exact"
+            assert r["verdict"] == "holds" and not r["headline"]
+    j21 = rows[JOINT["control_21"]]
+    p = [rows[m]["p_plate"] for m in MEMBERS[JOINT["control_21"]]]
+    assert j21["headline"] and math.isclose(j21["value"], holm(p).min())
+    assert (j21["verdict"] == "fails") == (j21["value"] < 0.05)
+    j5 = rows[JOINT["control_5"]]
+    assert j5["headline"] and j5["interval"] == "region" and j5["verdict"] in REGION_VERDICTS
+    z = rows["agnard.control_5.check_z_cm"]
+    assert z["kind"] == "prediction" and z["headline"] and z["interval"] == "region"
+    assert rows["agnard.anisotropy.y_over_x"]["verdict"] == "finding"
+    text = study.report(out)
+    assert text.index("**Consistent region.**") < text.index("Verdicts over the region:")
+    assert f"`{JOINT['control_5']}` (headline)" in text
+    assert "check X and Y as one Holm test" in text
 
 
 def test_table1_rows_are_not_comparable_because_the_scanner_region_is_empty(tiny_run):

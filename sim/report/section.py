@@ -22,8 +22,7 @@ Every study's report is built this way: ``section(out, lead=[...], intro=[...],
 schema=SCHEMA, body=[...], figures=[(alt, file), ...])``. A study decided over the region of its
 unprinted inputs (:mod:`sim.claims.inference`) leads with ``region_lead(out, what,
 values=how)``, ``how`` saying how the values at an input vector were obtained (analytic, or
-simulated draws whose noise enters the decision; ``agnard_block`` still leads with
-:func:`sim.report.region.region_markdown`); subsections with their own figures go into ``body``
+simulated draws whose noise enters the decision); subsections with their own figures go into ``body``
 (with :func:`figure`).
 """
 

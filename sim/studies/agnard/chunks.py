@@ -9,12 +9,15 @@ sums or examples (leading axis 1, keys ``chunk.*``). Lengths in metres.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
+from sim.instruments.block.centres import with_centres
 from sim.instruments.block.data_snooping import snoop
 from sim.instruments.block.layout import Block
 from sim.lsq import distributions as D
-from sim.studies.agnard.schema import five_control, paper_weights, snoop_weights
+from sim.studies.agnard.schema import five_control, model_sigmas, paper_weights, snoop_weights
 from sim.studies.agnard.simulate import Adjuster, Simulated, _rms, accuracy
 
 #: keys of per-chunk (not per-trial) arrays
@@ -168,19 +171,34 @@ def size_chunk(
     return out
 
 
-def sweep_chunk(cfg: dict, block: Block, insets, rng: np.random.Generator, n: int) -> dict:
+def sweep_chunk(
+    cfg: dict, block: Block, insets, rng: np.random.Generator, n: int, centres=(False,)
+) -> dict:
     """The unprinted five-point layout at each of ``insets`` (the region's input vectors): the
-    5-control pass adjusted once per layout on the same simulated blocks."""
-    adj = Adjuster(block)
+    5-control pass adjusted once per layout on the same simulated blocks, for each option of
+    ``centres``: without (keys ``inset<i>.*``) and with the models' projection centres as
+    model points (keys ``centres.inset<i>.*``; :mod:`sim.instruments.block.centres`, an
+    error of a model point's size, the model points' weight). The centres' errors are drawn
+    after the blocks, so the blocks are the same either way (common random numbers)."""
+    key = ("digital", "corrected")
     wo, wc = paper_weights(cfg)
     sim = Simulated(cfg, block, rng, n, cfg["scan.dpi"], uncorrected=False)
     out: dict[str, np.ndarray] = {}
-    _, _, start = adj.adjust(sim, ("digital", "corrected"), cfg["control.many"], wo, wc)
-    for i, u in enumerate(insets):
-        ctrl, _, res = adj.adjust(
-            sim, ("digital", "corrected"), five_control(block, u), wo, wc, start=start
+    adj = Adjuster(block)
+    _, _, start = adj.adjust(sim, key, cfg["control.many"], wo, wc)
+    if True in centres:
+        sxy, sz = model_sigmas(cfg)
+        cb = with_centres(block)
+        sim_c = sim.centred(cb, rng, np.array([sxy, sxy, sz]), key)
+        adj_c = Adjuster(cb.block)
+        _, _, start_c = adj_c.adjust(
+            sim_c, key, cfg["control.many"], wo, wc, start=replace(start, X=cb.extend(start.X))
         )
-        accuracy(block, ctrl, res, out, f"inset{i}")
+    for c in centres:
+        a, s, s0, pre = (adj_c, sim_c, start_c, "centres.") if c else (adj, sim, start, "")
+        for i, u in enumerate(insets):
+            ctrl, _, res = a.adjust(s, key, five_control(block, u), wo, wc, start=s0)
+            accuracy(s.block, ctrl, res, out, f"{pre}inset{i}")
     return out
 
 

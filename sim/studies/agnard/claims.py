@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
+from sim.claims.family import family_row
 from sim.claims.inference import FAILS, Region
 from sim.claims.intervals import spread
 from sim.claims.table import Sim, exact, mc, plates
@@ -23,6 +24,10 @@ from sim.studies.agnard.schema import model_sigmas, pixel_ground_m
 
 BOOK = Path(__file__).with_name("claims.toml")
 AXES = ("x", "y", "xy", "z")
+#: per block of Tables 2-3, the headline: its check points' X and Y as one Holm family
+JOINT = {b: f"agnard.{b}.check_xy_holm" for b in ("control_5", "control_21")}
+#: the members of each family
+MEMBERS = {j: [f"agnard.{b}.check_{c}_cm" for c in ("x", "y")] for b, j in JOINT.items()}
 
 
 def load_book() -> ClaimBook:
@@ -216,6 +221,19 @@ def table_note(cfg: dict, book: ClaimBook, cid: str, lay: str, ctrl, n_chk: int,
     return note
 
 
+def quadrature_check(book: ClaimBook, cid: str) -> Sim:
+    """The paper's XY as the quadrature of its own printed X and Y (a paper-check): the value
+    from the printed numbers, the note with the range their rounding allows (the claim's tol
+    is that range's half-width)."""
+    x, y = (ref(book, cid.replace("_xy_", f"_{c}_")) for c in ("x", "y"))
+    lo, hi = np.hypot(x - 0.5, y - 0.5), np.hypot(x + 0.5, y + 0.5)
+    return exact(
+        np.hypot(x, y),
+        f"recomputed from the paper's own X and Y: sqrt({x:g}^2 + {y:g}^2) = "
+        f"{np.hypot(x, y):.2f} cm, {lo:.2f}-{hi:.2f} cm over their printed rounding",
+    )
+
+
 def tables23_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, c5, c21) -> dict[str, Sim]:
     rows = {}
     for name, lay, ctrl in (
@@ -226,6 +244,9 @@ def tables23_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, c5, c21) 
         for where in ("ctrl", "check"):
             for c in AXES:
                 cid = f"agnard.{name}.{where}_{c}_cm"
+                if c == "xy":  # the quadrature of X and Y: the paper's arithmetic
+                    rows[cid] = quadrature_check(book, cid)
+                    continue
                 x = 100 * sim[f"layout_{lay}.{where}_{c}_m"]
                 alt = sim[f"layout_{lay}.ctrl_given_{c}_m"] if where == "ctrl" else None
                 rows[cid] = plates(x, table_note(cfg, book, cid, lay, ctrl, n_chk, x, alt))
@@ -234,6 +255,16 @@ def tables23_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, c5, c21) 
                 book, cfg, name, lay, ctrl, c, sim
             )
     return rows
+
+
+def family_rows(book: ClaimBook, rows: list[dict]) -> list[dict]:
+    """``rows`` with the joint X, Y rows of Tables 2-3 after their XY paper-checks (Holm over
+    the two one-plate rows, at the run's configured inputs; the 5-control one is then decided
+    over the layout region)."""
+    by = {r["claim"]: r for r in rows}
+    fam = {j: family_row(book, j, [by[m] for m in MEMBERS[j]]) for j in JOINT.values()}
+    after = {j.replace("_holm", "_cm"): r for j, r in fam.items()}  # next to the XY check
+    return [x for r in rows for x in ([r, after[r["claim"]]] if r["claim"] in after else [r])]
 
 
 def acceptance(book: ClaimBook, cfg: dict, name: str, lay: str, ctrl, c: str, sim: dict) -> Sim:
@@ -360,7 +391,7 @@ def anisotropy_rows(book: ClaimBook, cfg: dict, sim: dict) -> dict[str, Sim]:
         "agnard.anisotropy.y_over_x": plates(
             g,
             (
-                f"per block the geometric mean of Y/X over the eight simulated counterparts; "
+                "a finding (the pairs are scored in their own rows); per block the geometric mean of Y/X over the eight simulated counterparts; "
                 f"{_where(ref(book, 'agnard.anisotropy.y_over_x'), g)}; 21-control check points alone: "
                 f"median Y/X {np.median(yx21):.2f}; the simulated pointing error is "
                 f"{cfg['measure.pointing_px']:g} px in both x and y, the scanner deformation peaks at "
@@ -394,6 +425,7 @@ def claim_rows(
         **anisotropy_rows(book, cfg, sim),
     }
     rows = table1_rows(book, scanner, scanner_stats) + table_rows(book, table)
+    rows = family_rows(book, rows)
     for r in rows:  # an unbounded side of a bound's zone is "no number" (null), not infinity
         for k in ("zone_low", "zone_high"):
             if not np.isfinite(r[k]):

@@ -4,10 +4,12 @@ constrained by Table 1 (issue 21, :mod:`sim.claims.inference`).
 
 Figure 5, the layout of the five control points of the third pass, is lost. ``region.toml``
 declares the layout by one number, how far the four outer points stand inwards from the block
-corners, over the range the block allows; nothing the paper prints constrains it (its
-Table's numbers are the predictions), so the region is the whole range and each 5-control
-row is decided over it: holds / fails everywhere, depends (with the insets where it holds),
-or undecidable. The model adjusts the same ``region.trials`` simulated blocks once per
+corners, over the range the block allows, and the program's option of carrying each model's
+projection centres as model points (SPACE-M does; the paper does not say whether its run
+did: ``centres_1``, explored at 0 and 1, :mod:`sim.instruments.block.centres`); nothing the
+paper prints constrains them (its Table's numbers are the predictions), so the region is the
+whole range and each 5-control row is decided over it: holds / fails everywhere, depends
+(with the insets and option where it holds), or undecidable. The model adjusts the same ``region.trials`` simulated blocks once per
 layout (:func:`sim.studies.agnard.chunks.sweep_chunk`, on the runner's workers); each
 statistic is evidence with the claim book's rules
 (:func:`sim.claims.book_region.sample_evidence`).
@@ -34,12 +36,14 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.book_region import load_declaration, plate_ref, sample_evidence
-from sim.claims.inference import Region, explore
+from sim.claims.inference import Input, Region, explore
 from sim.instruments.block.layout import Block
 from sim.mc.runner import chunk_rng
 from sim.studies.agnard import chunks as ch
 
 DECLARATION = Path(__file__).with_name("region.toml")
+#: the region's option: the program's models with (1) or without (0) projection centres
+CENTRES = "centres_1"
 SCANNER = Path(__file__).with_name("scanner.toml")
 #: the scanner region's inputs and the config keys they set
 SCANNER_KEYS = {
@@ -54,14 +58,17 @@ SCANNER_KEYS = {
 SCANNER_PART = 800
 
 
-def five_samples(sw: dict, i: int) -> dict[str, np.ndarray]:
-    """Per-block statistics (cm) of layout ``i`` keyed by claim id."""
+def five_samples(sw: dict, i: int, pre: str = "") -> dict[str, np.ndarray]:
+    """Per-block statistics (cm) of layout ``i`` keyed by claim id (``pre``: ``"centres."``
+    for the layout with the projection centres, :func:`sim.studies.agnard.chunks.sweep_chunk`)."""
     out = {}
     for w in ("ctrl", "check"):
-        for c in ("x", "y", "xy", "z"):
-            out[f"agnard.control_5.{w}_{c}_cm"] = 100 * np.asarray(sw[f"inset{i}.{w}_{c}_m"])
+        for c in ("x", "y", "z"):  # XY is the paper-check of their quadrature, not simulated
+            out[f"agnard.control_5.{w}_{c}_cm"] = 100 * np.asarray(sw[f"{pre}inset{i}.{w}_{c}_m"])
     for c in ("xy", "z"):  # the acceptance limit applies to the control rms
-        out[f"agnard.max_residual.control_5_{c}_cm"] = 100 * np.asarray(sw[f"inset{i}.ctrl_{c}_m"])
+        out[f"agnard.max_residual.control_5_{c}_cm"] = 100 * np.asarray(
+            sw[f"{pre}inset{i}.ctrl_{c}_m"]
+        )
     return out
 
 
@@ -69,34 +76,74 @@ def explore_region(
     cfg: dict, block: Block, book: ClaimBook, runner: Callable[..., dict], part: int
 ) -> tuple[Region, list[str], list[dict]]:
     """The region, its predictions, and the per-layout statistics of every explored layout
-    (``runner(fn, trials, part, label)`` runs one part through the runner)."""
+    (``runner(fn, trials, part, label)`` runs one part through the runner). The layouts are
+    one Sobol design of ``region.points`` insets, explored once without and once with the
+    projection centres (``centres_1`` 0 and 1, the same insets, on the same blocks: one run
+    of the runner gives both); the region is their union."""
     dec = load_declaration(DECLARATION, book)
     stats: list[dict] = []
+    both: dict[tuple, dict] = {}  # the half without centres computes the other half as well
+
+    def run(insets: tuple, options: tuple) -> dict:
+        return runner(
+            partial(ch.sweep_chunk, cfg, block, insets, centres=options),
+            cfg["region.trials"],
+            part + len(stats),
+            "five-point layouts"
+            + (", with and without projection centres" if len(options) > 1 else ""),
+        )
 
     def model(x: dict[str, np.ndarray]) -> dict:
         insets = tuple(float(u) for u in x["five_inset_1"])
-        sw = runner(
-            partial(ch.sweep_chunk, cfg, block, insets),
-            cfg["region.trials"],
-            part + len(stats),
-            "five-point layouts",
-        )
-        per = [five_samples(sw, i) for i in range(len(insets))]
+        if x[CENTRES][0] > 0.5:  # the same blocks as the half without (common random numbers)
+            sw, pre = both.pop(insets, None) or run(insets, (True,)), "centres."
+        else:
+            sw = both[insets] = run(insets, (False, True))
+            pre = ""
+        per = [five_samples(sw, i, pre) for i in range(len(insets))]
         stats.extend(per)
         return {
             c: sample_evidence(np.stack([p[c] for p in per]), *plate_ref(book.spec(c)))
             for c in dec.predictions
         }
 
-    region = explore(
-        dec.inputs,
-        dec.statements,
-        model,
-        chunk_rng(cfg["seed"], 900, 0),
-        n=cfg["region.points"],
-        rounds=0,
+    halves = [
+        explore(
+            [Input(i.name, v, v, i.why) if i.name == CENTRES else i for i in dec.inputs],
+            dec.statements,
+            model,
+            chunk_rng(cfg["seed"], 900, 0),
+            n=cfg["region.points"],
+            rounds=0,
+        )
+        for v in (0.0, 1.0)
+    ]
+    return union(halves, dec.inputs), dec.predictions, stats
+
+
+def union(parts: list[Region], inputs: list[Input]) -> Region:
+    """One region of the explored points of ``parts`` (the same statements, each explored
+    at one value of an input that is an option, fixed there): ``inputs`` as declared, the
+    resolution of the first part and 1 (both values) for the option."""
+    first = parts[0]
+    cat = lambda a: np.concatenate([np.asarray(v) for v in a])  # noqa: E731
+    outputs = {
+        k: (
+            {j: None if v[j] is None else cat([p.outputs[k][j] for p in parts]) for j in v}
+            if isinstance(v, dict)
+            else cat([p.outputs[k] for p in parts])
+        )
+        for k, v in first.outputs.items()
+    }
+    return Region(
+        inputs,
+        first.statements,
+        {k: cat([p.x[k] for p in parts]) for k in first.x},
+        np.concatenate([p.status for p in parts]),
+        first.level,
+        {i.name: first.resolution[i.name] if i.name != CENTRES else (1.0, 1.0) for i in inputs},
+        outputs,
     )
-    return region, dec.predictions, stats
 
 
 def table1_samples(sw: dict, i: int) -> dict[str, np.ndarray]:

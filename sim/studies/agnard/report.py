@@ -12,8 +12,8 @@ import numpy as np
 
 from sim.lsq import distributions as D
 from sim.report.markdown import fmt, md_table
-from sim.report.region import region_markdown
-from sim.report.section import config, figure, rows, section, table
+from sim.report.section import config, rows, section, table
+from sim.studies.agnard.leads import five_lead, scanner_lead
 from sim.studies.agnard.schema import SCHEMA
 
 __all__ = ["anisotropy_text", "findings", "model_choices", "report"]
@@ -77,12 +77,23 @@ def _claim_lines(c: dict) -> list[str]:
     v = lambda k: fmt(c[k]["value"])  # noqa: E731
     vd = lambda k: c[k]["verdict"]  # noqa: E731
     return [
-        f"- *Tables 2-3*: 21 control: check XY {v('agnard.control_21.check_xy_cm')} cm "
-        f"(*{vd('agnard.control_21.check_xy_cm')}*), Z {v('agnard.control_21.check_z_cm')} cm "
-        f"(*{vd('agnard.control_21.check_z_cm')}*); 5 control: check XY "
-        f"{v('agnard.control_5.check_xy_cm')} cm (*{vd('agnard.control_5.check_xy_cm')}*), Z "
-        f"{v('agnard.control_5.check_z_cm')} cm (*{vd('agnard.control_5.check_z_cm')}*). See the "
-        "consistent region above for the lost five-point layouts where the 5-control rows stand.",
+        f"- *Tables 2-3*: 21 control: check X and Y as one Holm test (Holm p "
+        f"{fmt(c['agnard.control_21.check_xy_holm']['value'], 2)}, "
+        f"*{vd('agnard.control_21.check_xy_holm')}*; X {v('agnard.control_21.check_x_cm')} cm "
+        f"*{vd('agnard.control_21.check_x_cm')}*, Y {v('agnard.control_21.check_y_cm')} cm "
+        f"*{vd('agnard.control_21.check_y_cm')}*), Z {v('agnard.control_21.check_z_cm')} cm "
+        f"(*{vd('agnard.control_21.check_z_cm')}*); 5 control: check X and Y as one Holm test "
+        f"*{vd('agnard.control_5.check_xy_holm')}* over the lost layouts, Z "
+        f"{v('agnard.control_5.check_z_cm')}-{fmt(c['agnard.control_5.check_z_cm']['value_high'])} "
+        f"cm (*{vd('agnard.control_5.check_z_cm')}* over the layouts, with and without the "
+        "models' projection centres as model points: the centres tie consecutive models in "
+        "height). The printed XY columns are the quadrature of X and Y (paper-checks: "
+        + ", ".join(
+            f"{k.split('.')[1]} {k.split('.')[2][:-6]} *{vd(k)}*"
+            for k in c
+            if k.endswith("_xy_cm") and c[k]["kind"] == "paper-check"
+        )
+        + "). See the consistent region above for the 5-control rows.",
         f"- *Precision budget*: the paper's 13 / 19 / 22 cm recompute to "
         f"{v('agnard.budget.half_pixel_cm')} / {v('agnard.budget.planimetry_cm')} / "
         f"{v('agnard.budget.height_cm')} cm; the simulation's pointing model gives "
@@ -342,74 +353,6 @@ def _pugging_table(out: Path) -> list[str]:
     ]
 
 
-def _scanner_lead(out: Path) -> list[str]:
-    """The scanner region's section and figure (none for results written before the scanner
-    region existed)."""
-    if not (out / "scanner_region.parquet").is_file():
-        return []
-    return [_scanner_region(out), figure(out, "scanner_region.png", "scanner region under Table 1")]
-
-
-def _scanner_region(out: Path) -> str:
-    """The scanner's unprinted inputs under Table 1 (``scanner_region*.parquet``): per input its
-    possible range, what Table 1 leaves, the design's resolution; then the conflicts."""
-    inp = rows(out, "scanner_region_inputs.parquet")
-    reg = table(out, "scanner_region.parquet")
-    n, k = len(reg["accepted"]), sum(reg["accepted"])
-    body = [
-        [
-            f"`{r['input']}`",
-            f"{fmt(r['declared_low'])}-{fmt(r['declared_high'])}",
-            "none" if not r["n_region"] else f"{fmt(r['region_low'])}-{fmt(r['region_high'])}",
-            f"{fmt(r['resolution_interior'])} ({n} vectors)",
-            r["why"],
-        ]
-        for r in inp
-    ]
-    ids = [c for c in reg if c.startswith("agnard.table1.") and not c.endswith("__value")]
-    fails = [c.split(".")[-1] for c in ids if all(o == "fails" for o in reg[c])]
-    verdict = (
-        f"**No vector is consistent**: {', '.join(fails) or 'no statement alone'} "
-        f"{'is' if len(fails) == 1 else 'are'} contradicted at every explored vector, so Table 1 "
-        "is *not comparable* (not a failed prediction): the simulated scanner is not the "
-        "set-up that produced it."
-        if k == 0
-        else f"{k} of {n} vectors are consistent with Table 1."
-    )
-    verdicts = [
-        [f"`{c['claim']}`", c["verdict"], c["note"].split("; at the configured")[0]]
-        for c in rows(out, "claims.parquet")
-        if c["interval"] == "region" and not _five(c["claim"])
-    ]
-    return "\n".join(
-        [
-            f"**Scanner region under Table 1** (`scanner_region.parquet`, {n} vectors explored "
-            "jointly, each adjusting the same simulated blocks without and with the grid "
-            "correction; every field scaled to the printed +-20 / +-40 um peaks): " + verdict,
-            "",
-            md_table(["input", "possible", "left by Table 1", "resolution", "why"], body),
-        ]
-        + (_scanner_predictions(verdicts) if verdicts else [])
-    )
-
-
-def _scanner_predictions(verdicts: list[list[str]]) -> list[str]:
-    return [
-        "",
-        "**Predictions over the scanner's inputs** (Table 1 set aside as not comparable, "
-        "so no printed statement constrains them and every explored vector counts; the "
-        "21-control pass hangs on the scanner through the residual after the grid "
-        "correction):",
-        "",
-        md_table(["claim", "verdict", "where"], verdicts),
-    ]
-
-
-def _five(cid: str) -> bool:
-    """A row decided over the five-point layout's region (not the scanner's)."""
-    return cid.startswith(("agnard.control_5.", "agnard.max_residual.control_5_"))
-
-
 def report(out: Path) -> str:
     """The section of ``agnard_block``: consistent region, block and model choices, findings,
     claims, inputs, the trade-off tables, figures."""
@@ -417,11 +360,7 @@ def report(out: Path) -> str:
     cfg = config(out)["config"]
     return section(
         out,
-        lead=[
-            region_markdown(out, [c for c in rows(out, "claims.parquet") if _five(c["claim"])]),
-            figure(out, "consistent_region.png", "consistent region"),
-            *_scanner_lead(out),
-        ],
+        lead=[*five_lead(out, cfg), *scanner_lead(out)],
         intro=[_block_text(cfg, out), model_choices(out), "**Findings.**\n" + findings(out)],
         schema=SCHEMA,
         body=[

@@ -2,12 +2,13 @@
 
 Streams (``part``): 0 the 2 x 8 block with every adjustment of the paper; then one per scan
 resolution, one per block size, one per mechanical re-centring error, one for the region
-of the unprinted five-point control layout, and (from 800, apart) the scanner region under
+of the unprinted five-point control layout (each layout without and with the models'
+projection centres, on the same blocks), and (from 800, apart) the scanner region under
 Table 1 (:mod:`.region`). Every part goes through :func:`sim.mc.runner.run_chunks` with
 the run context (executor, chunk store), with picklable chunk functions
 (:mod:`.chunks`), so ``--workers``, Dask and resumption after a kill apply.
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
-tables, ``region_five.parquet`` (per block and layout), ``consistent_region.parquet``,
+tables, ``region_five.parquet`` (per block, layout and centres option), ``consistent_region.parquet``,
 ``region_inputs.parquet``, ``region_layouts.parquet``, ``scanner_region.parquet`` (every
 explored scanner vector) and ``scanner_region_inputs.parquet``,
 ``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each drawn as soon as its data exist).
@@ -20,8 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.claims.book import write_claims
-from sim.claims.book_region import statements, write_explored, write_region
+from sim.claims.book import ClaimBook, write_claims
+from sim.claims.book_region import statements, write_explored
+from sim.claims.family import family_outcomes, family_over
+from sim.claims.region import OUTCOME_NAMES, inputs_table, region_table
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
 from sim.mc.runner import run_chunks
@@ -31,8 +34,8 @@ from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.agnard import chunks as ch
 from sim.studies.agnard import figures as fg
-from sim.studies.agnard.claims import claim_rows, load_book
-from sim.studies.agnard.region import SCANNER_KEYS, explore_region, explore_scanner
+from sim.studies.agnard.claims import JOINT, MEMBERS, claim_rows, load_book
+from sim.studies.agnard.region import CENTRES, SCANNER_KEYS, explore_region, explore_scanner
 from sim.studies.agnard.schema import NAME, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
 from sim.studies.run_steps import over_region
@@ -241,20 +244,43 @@ def _five_region(cfg, block, book, rows, ctx, part, prov, out):
         lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx),
         part,
     )
-    write_region(out / "consistent_region.parquet", region, book, preds, prov)
+    _write_region(region, book, preds, prov, out)
     insets = [float(u) for u in region.x["five_inset_1"]]
     T = cfg["region.trials"]
-    tab = {"inset": np.repeat(insets, T), "trial": np.tile(np.arange(T), len(insets))}
+    tab = {
+        "inset": np.repeat(insets, T),
+        "centres": np.repeat(region.x[CENTRES] > 0.5, T),
+        "trial": np.tile(np.arange(T), len(insets)),
+    }
     for c in preds:
         tab[c.split(".", 1)[1]] = np.concatenate([s[c] for s in stats])
     write_table(out / "region_five.parquet", tab, prov)
     fig_region(
         region,
         out / "consistent_region.png",
-        title="seed 003: the lost five-point layout (no printed statement constrains it)",
-        nominal={"five_inset_1": 0.0},
+        title="seed 003: the lost five-point layout and the projection centres (no printed "
+        "statement constrains them)",
+        nominal={"five_inset_1": 0.0, CENTRES: 0.0},
+        labels={CENTRES: "projection centres as model points (0 without, 1 with)"},
     )
-    return over_region(book, region, preds, rows, partial(_example, "layout")), insets
+    rows = over_region(book, region, preds, rows, partial(_example, "layout"))
+    fresh = ClaimBook(list(book.specs.values()), [], book.path)  # rows re-scored over the region
+    j5 = JOINT["control_5"]
+    five = family_over(fresh, region, j5, MEMBERS[j5])
+    return [five if r["claim"] == j5 else r for r in rows], list(dict.fromkeys(insets))
+
+
+def _write_region(region, book, preds, prov, out) -> None:
+    """``consistent_region.parquet`` and ``region_inputs.parquet``
+    (:func:`sim.claims.book_region.write_region`), with the joint X, Y row's per-point
+    outcome as a column (decided from its members, not from evidence of its own)."""
+    st = statements(book, preds)
+    cols = region_table(region, st, preds)
+    j5 = JOINT["control_5"]
+    fam = family_outcomes(book, region, MEMBERS[j5])[1][region.accepted]
+    cols[j5] = [OUTCOME_NAMES[int(o)] for o in fam]
+    write_table(out / "consistent_region.parquet", cols, prov)
+    write_table(out / "region_inputs.parquet", inputs_table(region, st), prov)
 
 
 def _example(what: str, row: dict) -> str:

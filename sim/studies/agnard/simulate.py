@@ -8,10 +8,13 @@ The numerics live in :mod:`sim.instruments.block.layout`, :mod:`sim.instruments.
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from sim.instruments.block import independent_models as im
 from sim.instruments.block import scanner as sc
+from sim.instruments.block.centres import Centred, centre_models
 from sim.instruments.block.layout import Block, select_control
 
 
@@ -89,6 +92,18 @@ class Simulated:
             b.obs_model, b.obs_point, np.zeros(0, np.intp), b.n_models, b.n_points
         )
         self.init = im.initial_values(st, self.xm[("digital", "corrected")], self.X0)
+
+    def centred(self, cb: Centred, rng: np.random.Generator, sigma_m, key) -> "Simulated":
+        """The same blocks with their projection centres as model points
+        (:mod:`sim.instruments.block.centres`): the models ``xm[key]`` merged with the
+        centres' model coordinates (error ``sigma_m`` per axis, m), the points' starting
+        values extended; the other measurements are left out."""
+        out = copy.copy(self)
+        out.block = cb.block
+        xc = centre_models(cb, rng, self.s, self.R, self.t, sigma_m)
+        out.xm = {key: cb.merge(self.xm[key], xc)}
+        out.X0 = cb.extend(self.X0)
+        return out
 
     def _measure(self, cfg, rng, n, pix, mode, kw, xl, xr, scan) -> None:
         """The pointing errors of one pugging ``mode`` (options ``kw``), then the models

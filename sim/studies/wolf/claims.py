@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
+from sim.claims.family import holm  # re-exported: wolf.region and the tests use it here
 from sim.claims.intervals import bootstrap_ci
 from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.mc.runner import chunk_rng
@@ -130,17 +131,6 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
             CUBIC: _cubic_excess(cfg, degt),
         },
     )
-
-
-def holm(p) -> np.ndarray:
-    """Holm's step-down adjusted p values (valid under any dependence between the tests)."""
-    p = np.asarray(p, float)
-    m = p.size
-    order = np.argsort(p)
-    adj = np.minimum(1.0, np.maximum.accumulate((m - np.arange(m)) * p[order]))
-    out = np.empty(m)
-    out[order] = adj
-    return out
 
 
 def joint(table_rows: list[dict]) -> Sim:

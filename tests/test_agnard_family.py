@@ -1,0 +1,135 @@
+"""The Holm family of one-plate rows (``sim.claims.family``), as Agnard's joint X, Y rows use
+it, and the XY columns as paper-checks of the quadrature of X and Y. No simulation: the
+rule on hand-made p values and statuses, and on a small synthetic region."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sim.claims.book import ClaimBook
+from sim.claims.family import family_over, family_row, family_status, holm
+from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Input, Region
+from sim.studies.agnard.claims import JOINT, MEMBERS, load_book, quadrature_check
+
+
+def test_holm_is_the_step_down_rule():
+    adj = holm([0.01, 0.04, 0.03, 0.005])
+    # sorted 0.005, 0.01, 0.03, 0.04 times 4, 3, 2, 1, then the running maximum
+    assert np.allclose(adj, [0.03, 0.06, 0.06, 0.02])
+    assert np.all(holm([0.9, 0.8]) == 1.0)
+
+
+def test_family_fails_holds_and_stays_undecided():
+    p = np.array(
+        [
+            [0.352, 0.012],  # Agnard's 21-control check X, Y: Holm 0.024 -> fails
+            [0.03, 0.6],  # fails alone (0.03), not after the correction (0.06)
+            [0.75, 0.9],  # neither contradicted, members undecided -> undecided
+            [0.5, 0.4],  # neither contradicted, both members hold -> holds
+        ]
+    )
+    members = np.array([[UNDECIDED, FAILS], [FAILS, HOLDS], [UNDECIDED, UNDECIDED], [HOLDS, HOLDS]])
+    hp, st = family_status(p, members)
+    assert np.allclose(hp, [0.024, 0.06, 1.0, 0.8])
+    assert list(st) == [FAILS, UNDECIDED, UNDECIDED, HOLDS]
+    with pytest.raises(ValueError, match="shape"):
+        family_status(p, members[:, :1])
+
+
+def _book() -> ClaimBook:
+    one = dict(source="s", kind="prediction", form="one-plate", decimals=0, tol=1.0)
+    return ClaimBook(
+        [
+            dict(id="t.x", paper="X 14", ref=14, **one),
+            dict(id="t.y", paper="Y 21", ref=21, **one),
+            dict(
+                id="t.xy",
+                source="s",
+                paper="X and Y",
+                kind="prediction",
+                form="lower",
+                ref=0.05,
+                tol=0,
+                headline=True,
+            ),
+        ],  # fmt: skip
+        [],
+    )
+
+
+@pytest.mark.parametrize(
+    ("px", "py", "ox", "oy", "verdict", "value"),
+    [
+        (0.352, 0.012, "inconclusive", "fails", "fails", 0.024),
+        (0.4, 0.7, "inconclusive", "inconclusive", "inconclusive", 0.8),
+        (0.4, 0.7, "holds", "holds", "holds", 0.8),
+    ],
+)
+def test_family_row_at_the_configured_inputs(px, py, ox, oy, verdict, value):
+    members = [
+        {"claim": "t.x", "p_plate": px, "outcome": ox},
+        {"claim": "t.y", "p_plate": py, "outcome": oy},
+    ]
+    row = family_row(_book(), "t.xy", members)
+    assert math.isclose(row["value"], value)
+    assert row["outcome"] == row["verdict"] == verdict
+    assert row["holds"] == {"holds": True, "fails": False}.get(verdict)
+    assert "Holm-adjusted" in row["note"]
+
+
+def _region(px, py, spread_x) -> Region:
+    """Three explored points, every one accepted (no constraints), the members' one-plate
+    evidence given per point: p and the 95 % spread of one plate."""
+    n = len(px)
+    sx, sy = np.asarray(spread_x, float), np.full(n, 2.0)
+    return Region(
+        [Input("a_1", 0.0, 1.0)],
+        [],
+        {"a_1": np.linspace(0, 1, n)},
+        np.zeros((n, 0), np.int8),
+        0.95,
+        {"a_1": (0.5, 0.5)},
+        {
+            "t.x": {"value": np.full(n, 14.0), "low": 14 - sx, "high": 14 + sx, "p": np.array(px)},
+            "t.y": {"value": np.full(n, 21.0), "low": 21 - sy, "high": 21 + sy, "p": np.array(py)},
+        },
+    )
+
+
+@pytest.mark.parametrize(
+    ("px", "py", "spread_x", "verdict"),
+    [
+        ([0.3, 0.5, 0.9], [0.4, 0.8, 0.6], [2.0, 2.0, 2.0], "undecidable"),  # wide spreads
+        ([0.01, 0.02, 0.001], [0.5, 0.5, 0.5], [2.0, 2.0, 2.0], "fails"),
+        ([0.01, 0.5, 0.5], [0.5, 0.5, 0.5], [2.0, 2.0, 2.0], "fails or undecided"),
+    ],
+)
+def test_family_over_a_region(px, py, spread_x, verdict):
+    row = family_over(_book(), _region(px, py, spread_x), "t.xy", ["t.x", "t.y"])
+    assert row["verdict"] == verdict and row["interval"] == "region"
+    hp = [holm([a, b]).min() for a, b in zip(px, py)]
+    assert math.isclose(row["value"], min(hp)) and math.isclose(row["value_high"], max(hp))
+
+
+def test_the_xy_columns_are_paper_checks_of_the_quadrature():
+    """Every XY row is a paper-check whose tol is the half-width of sqrt(X^2 + Y^2) over the
+    printed rounding of X and Y (to the 0.01 cm the book prints), and the paper's own
+    numbers pass it; the headline of each check-point block is its joint X, Y row."""
+    book = load_book()
+    xy = [c for c in book.specs if c.endswith("_xy_cm") and c.startswith("agnard.control_")]
+    assert len(xy) == 4
+    for cid in xy:
+        s = book.spec(cid)
+        x, y = (book.spec(cid.replace("_xy_", f"_{c}_"))["ref"] for c in ("x", "y"))
+        half = max(math.hypot(x + 0.5, y + 0.5) - math.hypot(x, y),
+                   math.hypot(x, y) - math.hypot(x - 0.5, y - 0.5))  # fmt: skip
+        assert s["kind"] == "paper-check" and not s.get("headline")
+        assert abs(s["tol"] - half) <= 0.01, cid
+        v = quadrature_check(book, cid).value
+        assert abs(v - s["ref"]) <= 0.5 + s["tol"], cid
+    for j in JOINT.values():
+        assert book.spec(j)["headline"] and book.spec(j)["form"] == "lower"
+        assert all(book.spec(m)["form"] == "one-plate" for m in MEMBERS[j])
