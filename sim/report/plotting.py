@@ -255,17 +255,20 @@ def checking_figures(facts: dict | None = None) -> Iterator[dict[str, list[str]]
 
 
 def save(fig, path: str | Path) -> Path:
-    """Save ``fig`` as PNG without a timestamp or version stamp, then close it (checked by
-    :func:`layout_problems` first inside :func:`checking_figures`)."""
+    """Save ``fig`` as PNG without a timestamp or version stamp, then close it. Inside
+    :func:`checking_figures` (or with ``SIM_FIGURE_CHECK`` set) the saved figure is then
+    checked by :func:`layout_problems`: after the file is written, since the check draws the
+    figure at the screen's resolution and a layout drawn twice can settle elsewhere (the PNG
+    is the same with the check on or off)."""
     path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", metadata={"Software": None}, bbox_inches="tight")
     if _RECORDER is not None:
         _RECORDER(path, fig)
     elif os.environ.get("SIM_FIGURE_CHECK"):  # the same check in a `sim run` process (tests)
         line = {"file": path.name, "problems": layout_problems(fig), "facts": figure_facts(fig)}
         with open(os.environ["SIM_FIGURE_CHECK"], "a") as f:  # one short line per write
             f.write(json.dumps(line) + "\n")
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", metadata={"Software": None}, bbox_inches="tight")
     plt.close(fig)
     return path
 
