@@ -24,6 +24,7 @@ from sim.report.plotting import (
 )
 from sim.report.sweep import fig_sweep
 from sim.studies import MODULES
+from sim.studies.wolf import figures as wolf_figures
 
 ROOT = Path(__file__).resolve().parent.parent
 FILES = {"network": "network_testfield"}
@@ -249,3 +250,24 @@ def test_bench_figures_read_cleanly(tmp_path):
     eng = facts["engines.png"][0]
     assert "speed-up" in eng["ylabel"] and "engine" in eng["xlabel"]
     assert eng["xlim"][1] - eng["xlim"][0] >= len(tables["engines"]["engine"]) - 1
+
+
+def test_checking_a_figure_leaves_its_png_unchanged(tiny_run, tmp_path):
+    """The layout check draws a figure once more (at the screen's resolution); it runs after
+    the PNG is written, so a checked run writes the same bytes as a plain one (wolf's vectors
+    and Table 1 figures, whose constrained layouts settled elsewhere when drawn twice)."""
+    shared = tiny_run("wolf_polynomial")
+    plain, checked = tmp_path / "plain", tmp_path / "checked"
+    for d in (plain, checked):
+        d.mkdir()
+        for f in shared.glob("*.parquet"):
+            (d / f.name).symlink_to(f)
+    for name, draw_it in (
+        ("vectors.png", wolf_figures.vectors_figure),
+        ("table1_real.png", wolf_figures.table1_figure),
+    ):
+        draw_it(plain)
+        with checking_figures() as found:
+            draw_it(checked)
+        assert name in found  # the check ran
+        assert (plain / name).read_bytes() == (checked / name).read_bytes(), name
