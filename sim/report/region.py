@@ -13,12 +13,10 @@ from typing import Callable, Mapping
 import numpy as np
 
 from sim.claims.inference import Region
-from sim.mc.storage import read_table
 from sim.report.papers import paper_name
 from sim.report.plotting import plt, save
-from sim.report.tables import md_table
 
-__all__ = ["fig_region", "region_markdown", "reader_label", "LABELS"]
+__all__ = ["fig_region", "reader_label", "LABELS"]
 
 
 #: axis labels of the region inputs the studies declare (``region.toml``), with units
@@ -128,51 +126,3 @@ def _one_input(ax, region: Region, inp, labels, nominal) -> None:
     ax.set_yticks([])
     ax.set_xlabel(reader_label(inp.name, labels))
     ax.set_title(f"{int(acc.sum())} of {x.size} explored values consistent", fontsize=9)
-
-
-def region_markdown(out: Path, claims: list[dict]) -> str:
-    """The report's opening for a study decided over its consistent region: the region (per
-    input, its possible range and what the printed statements leave, with the resolution),
-    then the verdicts of the predictions over it (from ``region_inputs.parquet``
-    and the claims rows whose interval is ``region``; ``region_inputs.parquet`` as brown's
-    studies write it)."""
-
-    t = read_table(out / "region_inputs.parquet").to_pylist()
-    n = read_table(out / "consistent_region.parquet").num_rows
-    rows = [
-        [
-            f"`{r['input']}`",
-            f"{_g(r['declared_low'])}-{_g(r['declared_high'])}",
-            "none" if r["region_low"] is None else f"{_g(r['region_low'])}-{_g(r['region_high'])}",
-            f"{_g(r['resolution_interior'])} ({_g(r['resolution_boundary'])})",
-            r["why"],
-        ]
-        for r in t
-        if r["declared_high"] > r["declared_low"]
-    ]
-    verdicts = [
-        [f"`{c['claim']}`", c["verdict"], c["note"].split("; at the configured")[0]]
-        for c in claims
-        if c.get("interval") == "region"
-    ]
-    return "\n".join(
-        [
-            f"**Consistent region** (`consistent_region.parquet`, {n} accepted input vectors): "
-            "the unprinted inputs explored jointly over their physically possible ranges; a "
-            "vector is in the region when no printed statement is contradicted at the 95 % "
-            "level (Monte-Carlo noise included).",
-            "",
-            md_table(
-                ["input", "possible", "left by the paper", "resolution (boundary)", "why"], rows
-            ),
-            "",
-            "**Predictions over the region** (holds / fails everywhere in it, depends, "
-            "holds or undecided, fails or undecided, undecidable):",
-            "",
-            md_table(["claim", "verdict", "where"], verdicts),
-        ]
-    )
-
-
-def _g(x) -> str:
-    return "n/a" if x is None else f"{x:.3g}"
