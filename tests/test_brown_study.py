@@ -205,3 +205,26 @@ def test_rows_known_in_closed_form_decide_as_computed_here(runs):
         ref = round(value, 1)  # the printed number: one decimal
         assert (r["zone_low"], r["zone_high"]) == pytest.approx((ref - 0.05, ref + 0.05)), cid
         assert r["verdict"] == verdict and r["kind"] == "paper-check", cid
+
+
+def test_pivot_extra_dilution_is_read_with_browns_own_virtually_no_dilution():
+    """ "essentially no further dilution" is bounded by the paper's own usage: 0.5 um combined
+    with 0.2 um (0.54 um) is "virtually no dilution" (Calibration), +7.7 %. So a buildable
+    geometry whose median extra dilution is 2-7.7 % holds (the old 1 % bound failed it), one
+    above 7.7 % fails, and over the Concept's region the headline depends (was: fails)."""
+    book = load_book("brown_dilution")
+    cid = "brown.pivot_extra_dilution.typical_pct"
+    spec = book.spec(cid)
+    yardstick = (math.hypot(0.5, 0.2) / 0.5 - 1) * 100  # 7.70 %
+    assert spec["form"] == "upper" and spec["ref"] == pytest.approx(yardstick, abs=0.01)
+    x = {k: np.array([v, v]) for k, v in (("beta_mm", 1.0), ("half_extent_mm", 90.0))}
+    x["station_offset_mm"] = np.array([10.0, 45.0])  # 10 mm: a Table 1 offset; 45 mm: far out
+    extra = RG.concept_model(x)[cid]
+    assert 1.0 < extra[0] < yardstick < extra[1]
+    for e, verdict in zip(extra, ("holds", "fails")):
+        one = load_book("brown_dilution")  # a book scores each claim once
+        assert one.score(cid, value=float(e), interval="exact")["verdict"] == verdict
+    cfg = {"seed": 1968, "region.points": 256, "region.rounds": 1}
+    reg, preds, verdicts = RG.concept_region(cfg, book)
+    v = verdicts[cid]
+    assert v.verdict == "depends" and v.n_holds > 0 and v.n_fails > 0

@@ -8,12 +8,17 @@ import pytest
 from scipy import stats
 from verdict_check import check_region_rows
 
-from sim.claims.region import REGION_VERDICTS
+from sim.claims.table import claim_rows
 from sim.instruments import gridplate as gp
 from sim.instruments import transforms2d as t2
 from sim.instruments.plates import grid_points
-from sim.mc.config import ConfigError
+from sim.mc.config import ConfigError, validate
 from sim.studies import load_study
+from sim.studies.gridplate import claims as gc
+from sim.studies.gridplate import model as gm
+from sim.studies.gridplate import region as gr
+from sim.studies.gridplate.schema import SCHEMA
+from sim.studies.gridplate.schema import check as check_cfg
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -257,7 +262,7 @@ def test_study_runs_small(tiny_run):
     assert reg["grid_sigma_true_um"] and all(
         o != "fails" for o in reg["twoplate.comparator_sigma.sigma_um"]
     )  # every accepted vector leaves the constraining statements uncontradicted
-    assert v["twoplate.weight_ratio.grid_sigma_1to2_um"] in REGION_VERDICTS
+    assert v["twoplate.weight_ratio.grid_sigma_1to2_um"] == "inconclusive"  # a paper-check
     assert check_region_rows(out) >= 5  # each region verdict is its points' rule
     assert (read_table(out / "not_reproduced.parquet").num_rows) >= 5
     for fig in (
@@ -271,3 +276,27 @@ def test_study_runs_small(tiny_run):
         assert (out / f"{fig}.png").is_file()
     text = report(out)
     assert "Consistent region" in text and "Errata" in text
+
+
+def test_sigma_at_1to2_is_the_1to3_input_times_sqrt_4_3_so_a_paper_check():
+    """ "On weighting 1:2, sigma_x becomes 0.8, and on 1:3 it becomes 0.7": both are one
+    adjustment's s_w^2 / (P_cx + A^2 + B^2) with A^2 + B^2 = 1 (same units), so on every
+    simulated plate sigma(1:2) = sigma(1:3) x sqrt(4/3). The 0.7 at 1:3 is an input
+    (a constraint of the region), so the 0.8 is the paper's arithmetic on it: a paper-check
+    (0.7 x 1.1547 = 0.808; 0.751-0.866 over the 0.7's rounding, meeting 0.8's zone
+    0.75-0.85), not a headline prediction scoring the same measurement a second time."""
+    cfg = validate({}, SCHEMA, check_cfg)
+    res = gm.chunk(cfg, np.random.default_rng(3), 40)
+    ratio = res["grid_sigma_1to2_um"] / res["grid_sigma_1to3_um"]
+    assert ratio == pytest.approx(np.full(40, math.sqrt(4 / 3)), rel=1e-4)
+    book = gc.load_book()
+    cid = "twoplate.weight_ratio.grid_sigma_1to2_um"
+    spec = book.spec(cid)
+    assert spec["kind"] == "paper-check" and not spec.get("headline", False)
+    assert cid not in gr.declaration(book).predictions
+    sim = gc._paper_checks(book)[cid]
+    lo, hi = 0.65 * math.sqrt(4 / 3), 0.75 * math.sqrt(4 / 3)
+    assert (sim.value, *sim.ci) == pytest.approx((0.7 * math.sqrt(4 / 3), lo, hi), abs=1e-12)
+    (row,) = claim_rows(book, {cid: sim})
+    assert (row["zone_low"], row["zone_high"]) == pytest.approx((0.75, 0.85))
+    assert row["verdict"] == "inconclusive"  # meets the zone: consistent, no erratum

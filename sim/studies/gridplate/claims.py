@@ -69,15 +69,14 @@ def _weighting(cfg: dict, res: dict) -> dict[str, Sim]:
     """The paper's weightings 1:2 and 1:3 and its re-weighting to a passing chi-square test."""
     N, P = cfg["plate.grid"] ** 2, cfg["plate.count"]
     sx, sgt = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
-    table = {
-        f"twoplate.weight_ratio.grid_sigma_1to{r}_um": plates(
-            res[f"grid_sigma_1to{r}_um"],
-            f"grid sigma implied by the weights, s0/sqrt(P_cx), P_x:P_cx = 1:{r}, "
+    table = {  # 1:2 is the paper's arithmetic on the same adjustment (_paper_checks)
+        "twoplate.weight_ratio.grid_sigma_1to3_um": plates(
+            res["grid_sigma_1to3_um"],
+            "grid sigma implied by the weights, s0/sqrt(P_cx), P_x:P_cx = 1:3, "
             "x' and y' of both plates pooled; expectation sqrt((sx'^2 + sg^2)/(1 + "
-            f"P_cx)) = {math.sqrt((sx**2 + sgt**2) / (1 + r)):.3f} um from the "
+            f"P_cx)) = {math.sqrt((sx**2 + sgt**2) / 4):.3f} um from the "
             "simulated comparator and grid sigmas.",
         )
-        for r in (2, 3)
     }
     rr = _finite(res["ratio_rw_mean"], "the re-weighted ratio", "grid.sigma_stated_um")
     table["twoplate.weight_ratio.converged_ratio"] = plates(
@@ -192,7 +191,17 @@ def _paper_checks(book: ClaimBook) -> dict[str, Sim]:
     h1 = 0.5 * 10.0 ** -book.spec("twoplate.comparator_sigma.sigma_um")["decimals"]
     h2 = 0.5 * 10.0 ** -book.spec("twoplate.grid.stated_sigma_um")["decimals"]
     corner = (math.hypot(r1p2 - h1, r0p7 - h2), math.hypot(r1p2 + h1, r0p7 + h2))
+    h13 = 0.5 * 10.0 ** -book.spec("twoplate.weight_ratio.grid_sigma_1to3_um")["decimals"]
+    f12 = math.sqrt(4 / 3)  # sigma_x(1:2) / sigma_x(1:3) = sqrt((3 + k) / (2 + k)), k = 1
     return {
+        "twoplate.weight_ratio.grid_sigma_1to2_um": exact(
+            r13 * f12,
+            f"recomputed: sigma_x at 1:2 = sigma_x at 1:3 x sqrt((3 + k)/(2 + k)) = {r13:g} x "
+            f"{f12:.4f} = {r13 * f12:.3f} um (one adjustment's s_w^2 / (P_cx + k), k = A^2 + "
+            f"B^2 = 1), {(r13 - h13) * f12:.3f}-{(r13 + h13) * f12:.3f} over the rounding of "
+            f"{r13:g}; the paper's two weightings are one measurement, its 1:3 value an input.",
+            ci=((r13 - h13) * f12, (r13 + h13) * f12),
+        ),
         "twoplate.paper_check.affine_from_comparator_and_grid": exact(
             sup,
             f"recomputed: sqrt({r1p2:g}^2 + {r0p7:g}^2) = {sup:.3f} um (independent "

@@ -101,7 +101,6 @@ def draws(cfg: dict, rng: np.random.Generator, M: int) -> dict[str, np.ndarray]:
     ok = (comp2 > 0).all(1)
     comp = np.sqrt(np.where(ok, comp2.mean(1), np.nan))
     return {
-        "twoplate.weight_ratio.grid_sigma_1to2_um": np.sqrt((sw2 / 3).mean(1)),
         "twoplate.weight_ratio.grid_sigma_1to3_um": np.sqrt((sw2 / 4).mean(1)),
         "twoplate.weight_ratio.converged_ratio": np.where(ok, (sw2 / st**2 - 1).mean(1), np.nan),
         RW: reweight_trials(
