@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from sim.claims.book import ClaimBook
-from sim.claims.family import family_over, family_row, family_status, holm
-from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Input, Region
+from sim.claims.family import family_evidence, family_over, family_row, family_status, holm
+from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Input, Region, Statement, status
 from sim.studies.agnard.claims import JOINT, MEMBERS, load_book, quadrature_check
 
 
@@ -133,3 +133,18 @@ def test_the_xy_columns_are_paper_checks_of_the_quadrature():
     for j in JOINT.values():
         assert book.spec(j)["headline"] and book.spec(j)["form"] == "lower"
         assert all(book.spec(m)["form"] == "one-plate" for m in MEMBERS[j])
+
+
+def test_family_evidence_gives_a_region_the_family_rule():
+    """Wolf's families reach the region through evidence (``family_evidence``): the region's
+    status of a lower bound 0.05 on the Holm p must be ``family_status`` at every point -- both
+    sides of 0.05 (0.049 and 0.05 exactly, in binary), a member short of holding, a NaN p."""
+    p = np.array([[0.0245, 0.9], [0.025, 0.9], [0.3, 0.04], [0.3, 0.6], [0.3, 0.6], [np.nan, 0.6]])
+    member = np.array(
+        [[HOLDS, HOLDS], [HOLDS, HOLDS], [HOLDS, FAILS], [HOLDS, UNDECIDED], [HOLDS, HOLDS],
+         [HOLDS, HOLDS]]
+    )  # fmt: skip
+    bound = Statement("family", (0.05, 0.05), form="lower")
+    got = status(bound, family_evidence(p, member), len(p))
+    assert got.tolist() == family_status(p, member)[1].tolist()
+    assert got.tolist() == [FAILS, HOLDS, UNDECIDED, UNDECIDED, HOLDS, UNDECIDED]

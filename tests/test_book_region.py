@@ -114,7 +114,7 @@ def test_each_paper_declares_its_region(study):
 
 
 def test_holm_adjusts_as_the_step_down_rule():
-    from sim.studies.wolf.claims import holm
+    from sim.claims.family import holm
 
     p = np.array([0.01, 0.04, 0.03, 0.005])
     # sorted 0.005, 0.01, 0.03, 0.04 times 4, 3, 2, 1, running maximum

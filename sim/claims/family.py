@@ -31,7 +31,14 @@ from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Region
 from sim.claims.region import RegionVerdict, outcomes, region_row, region_verdict, statement_of
 from sim.claims.rules import P_FAIL
 
-__all__ = ["holm", "family_status", "family_row", "family_outcomes", "family_over"]
+__all__ = [
+    "holm",
+    "family_status",
+    "family_evidence",
+    "family_row",
+    "family_outcomes",
+    "family_over",
+]
 
 
 def holm(p) -> np.ndarray:
@@ -57,7 +64,19 @@ def family_status(p: np.ndarray, member: np.ndarray) -> tuple[np.ndarray, np.nda
     hp = np.array([holm(row).min() if np.isfinite(row).all() else np.nan for row in p])
     st = np.where((member == HOLDS).all(axis=1), HOLDS, UNDECIDED).astype(np.int8)
     st[hp < P_FAIL] = FAILS
+    st[np.isnan(hp)] = UNDECIDED  # a member without a p decides nothing
     return hp, st
+
+
+def family_evidence(p: np.ndarray, member: np.ndarray) -> dict[str, np.ndarray]:
+    """The family's evidence at N points for a region explored by
+    :func:`sim.claims.inference.explore`, whose per-point status of the family's claim (a
+    ``lower`` bound 0.05 on its Holm p) is :func:`family_status`: ``value`` and ``high`` the
+    smallest Holm-adjusted p, ``low`` the same where every member holds and -inf elsewhere
+    (so: fails iff the Holm p < 0.05, holds iff not and every member holds, else undecided).
+    p, member : (N, K) as in :func:`family_status`."""
+    hp, st = family_status(p, member)
+    return {"value": hp, "low": np.where(st == HOLDS, hp, -np.inf), "high": hp}
 
 
 def _members_note(rows: Sequence[Mapping[str, Any]], adj: np.ndarray) -> str:

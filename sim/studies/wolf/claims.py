@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.family import holm  # re-exported: wolf.region and the tests use it here
+from sim.claims.family import family_row
 from sim.claims.intervals import bootstrap_ci
 from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.mc.runner import chunk_rng
@@ -121,30 +121,19 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
         },
     )
     table2 = [r for r in out if r["claim"].startswith("wolf.table2.")]
-    return out + claim_rows(
-        book,
-        {
-            HEADLINE: joint([r for r in table2 if is_mean_row(r["claim"])]),
-            JOINT: joint(table2),
-            **_table_checks(t1, t3),
-            **_plate_stats(main, T),
-            CUBIC: _cubic_excess(cfg, degt),
-        },
-    )
-
-
-def joint(table_rows: list[dict]) -> Sim:
-    """A family of Table 2 decided as one statement: Holm over its one-plate rows' p values
-    (all 24 rows for ``JOINT``, the eight plate means for ``HEADLINE``)."""
-    p = np.array([r["p_plate"] for r in table_rows], float)
-    adj = holm(p)
-    k = int(np.argmin(adj))
-    n_row = int(np.sum(p < 0.05))
-    return exact(
-        adj[k],
-        f"{p.size} rows; smallest raw p {p[k]:.3f} ({table_rows[k]['claim']}), Holm-adjusted "
-        f"{adj[k]:.3f}; {n_row} row(s) below 0.05 alone, "
-        f"{int(np.sum(adj < 0.05))} after the correction",
+    means = [r for r in table2 if is_mean_row(r["claim"])]
+    families = [family_row(book, HEADLINE, means), family_row(book, JOINT, table2)]
+    return (
+        out
+        + families
+        + claim_rows(
+            book,
+            {
+                **_table_checks(t1, t3),
+                **_plate_stats(main, T),
+                CUBIC: _cubic_excess(cfg, degt),
+            },
+        )
     )
 
 

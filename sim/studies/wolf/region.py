@@ -14,7 +14,8 @@ the printed rounding). Table 2's 24 one-plate rows are 24 correlated tests of on
 row's p is its Holm-adjusted p over the 24 at the same input vector
 (:func:`sim.studies.wolf.claims.holm`, valid under any dependence), Table 2 as one statement
 is the smallest of them, and the headline ("mean discrepancies ranged from 3 to 9") is the
-Holm family of the eight plate means alone.
+Holm family of the eight plate means alone; both families by the one rule of
+:mod:`sim.claims.family`.
 """
 
 from __future__ import annotations
@@ -25,11 +26,13 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.book_region import load_declaration, plate_ref, sample_evidence
-from sim.claims.inference import Region, explore
+from sim.claims.family import family_evidence, holm
+from sim.claims.inference import Region, explore, status
+from sim.claims.region import statement_of
 from sim.mc.runner import chunk_rng
 from sim.studies.run_steps import run_part
 from sim.studies.wolf.chunks import main_chunk, sub_chunk
-from sim.studies.wolf.claims import HEADLINE, JOINT, holm, is_mean_row, stat_key
+from sim.studies.wolf.claims import HEADLINE, JOINT, is_mean_row, stat_key
 
 DECLARATION = Path(__file__).with_name("region.toml")
 #: region input -> the cell key it overrides
@@ -76,12 +79,11 @@ def evidence(book: ClaimBook, ids: list[str], res: dict, tags: list[str]) -> dic
     adj = np.stack([holm(row) for row in raw])
     for k, c in enumerate(t2):
         out[c]["p"] = adj[:, k]
-    if HEADLINE in ids:
-        h = np.array([holm(row).min() for row in raw[:, means]])
-        out[HEADLINE] = {"value": h, "low": h, "high": h}
+    member = np.stack([status(statement_of(book, c), out[c], raw.shape[0]) for c in t2], 1)
+    if HEADLINE in ids:  # the families by the one rule of sim.claims.family
+        out[HEADLINE] = family_evidence(raw[:, means], member[:, means])
     if JOINT in ids:
-        j = adj.min(axis=1)
-        out[JOINT] = {"value": j, "low": j, "high": j}
+        out[JOINT] = family_evidence(raw, member)
     return out
 
 
