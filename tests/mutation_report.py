@@ -1,8 +1,10 @@
 """Write docs/mutation.md from a finished ``mutmut run`` (``make mutation``).
 
 Reads ``mutmut results --all true`` (one ``name: status`` line a mutant) and, for each mutant
-that was not killed, its diff (``mutmut show``). The score is killed / (all mutants); a
-mutant that no selected test reaches ("no tests") counts as surviving. Lines marked
+that was not killed, its diff (``mutmut show``). The score is killed / (all mutants), where a
+mutant that makes the tests run past mutmut's time limit ("timeout": e.g. a refinement step that
+no longer shrinks) counts as killed (the tests did not pass) and is listed apart; a mutant that
+no selected test reaches ("no tests") counts as surviving. Lines marked
 ``# pragma: no mutate`` in the mutated modules are listed with the reason written beside them
 (equivalent mutants: a change no test can see because the behaviour is the same).
 """
@@ -57,7 +59,7 @@ def main(out: Path = ROOT / "docs" / "mutation.md") -> int:
     by_module: dict[str, Counter] = {}
     for name, st in status.items():
         by_module.setdefault(name.split(".x")[0], Counter())[st] += 1
-    killed = sum(c["killed"] for c in by_module.values())
+    killed = sum(c["killed"] + c["timeout"] for c in by_module.values())
     total = len(status)
     lines = [
         "# Mutation testing of the verdict rules and intervals",
@@ -71,16 +73,18 @@ def main(out: Path = ROOT / "docs" / "mutation.md") -> int:
         "",
         f"**Score: {killed} of {total} mutants killed ({100 * killed / total:.1f} %).**",
         "",
-        "| module | mutants | killed | survived | no tests | other |",
-        "| --- | ---: | ---: | ---: | ---: | ---: |",
+        "| module | mutants | killed | timeout | score | survived | no tests | other |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     for mod, c in sorted(by_module.items()):
-        other = sum(c.values()) - c["killed"] - c["survived"] - c["no tests"]
+        n = sum(c.values())
+        k = c["killed"] + c["timeout"]
+        other = n - k - c["survived"] - c["no tests"]
         lines.append(
-            f"| `{mod}` | {sum(c.values())} | {c['killed']} | {c['survived']} | "
-            f"{c['no tests']} | {other} |"
+            f"| `{mod}` | {n} | {c['killed']} | {c['timeout']} | {100 * k / n:.1f} % | "
+            f"{c['survived']} | {c['no tests']} | {other} |"
         )
-    left = [n for n, st in status.items() if st != "killed"]
+    left = [n for n, st in status.items() if st not in ("killed", "timeout")]
     lines += ["", f"## Mutants not killed ({len(left)})", ""]
     if not left:
         lines.append("None.")
