@@ -462,3 +462,82 @@ def test_statement_of_a_book_row_keeps_its_words():
     s = statement_of(b, "q")
     assert s == Statement("q", (2.0, 2.0), "value", 0, 0.25, "about 2", "p. 3")
     assert s.zone == (1.25, 2.75) and statement_of(b, "q", "upper").zone == (-math.inf, 2.75)
+
+
+def test_missing_numbers_in_the_evidence_leave_a_point_undecided():
+    ev = interval_from_se([1.5, 1.5], [0.1, None])  # no standard error: no interval
+    assert np.isnan(ev["low"][1]) and np.isnan(ev["high"][1])
+    assert status(Z, ev, 2).tolist() == [HOLDS, UNDECIDED]
+    assert status(Z, {"low": [None, 1.2], "high": [0.5, 1.5]}, 2).tolist() == [UNDECIDED, HOLDS]
+    assert status(Z, {"low": [1.2, 1.2], "high": [1.5, None]}, 2).tolist() == [HOLDS, UNDECIDED]
+
+
+def _plate_model(x):
+    a = x["a_mm"]
+    p = np.where(a < 3.0, 0.01, np.where(a < 5.0, 0.07, 0.5))
+    return {"one": {"value": a, "low": a - 0.1, "high": a + 0.1, "p": p}}
+
+
+def test_explore_decides_a_one_plate_p_at_its_level_in_every_round():
+    one = Statement("one", (0.0, 0.0), "lower")
+    for level, edge in ((0.95, 3.0), (0.90, 5.0)):  # p = 0.07 passes at 95 %, fails at 90 %
+        r = explore([A, B], [one], _plate_model, np.random.default_rng(4), n=128, rounds=2,
+                    level=level, refine_on=[one])  # fmt: skip
+        assert r.n > 128
+        assert np.array_equal(r.accepted, r.x["a_mm"] >= edge), level
+        # as a prediction refined on (no statements: the whole box is the region), the
+        # boundary refined is where it starts to hold at the region's level
+        r = explore([A, B], [], _plate_model, np.random.default_rng(4), n=128, rounds=1,
+                    level=level, refine_on=[one])  # fmt: skip
+        a, h = r.x["a_mm"][128:], 128 ** (-1 / 2)
+        assert a.size > 0 and np.all(np.abs(a - edge) <= 10 * (1.5 * h * math.sqrt(2) + h / 2))
+
+
+def test_refinement_tells_apart_the_predictions_it_refines_on():
+    """Three predictions over a region that is the whole box: a <= 5, a >= 5 (each point
+    satisfies one or both) and b >= 5. The boundaries a = 5 (between the first two) and b = 5
+    (the third's) are refined, and nothing else."""
+
+    def m(x):
+        return {"lt": x["a_mm"], "ge": x["a_mm"], "b": x["b_mm"]}
+
+    preds = [Statement("lt", (5.0, 5.0), "upper"), Statement("ge", (5.0, 5.0), "lower")]
+    preds.append(Statement("b", (5.0, 5.0), "lower"))
+    r = explore([A, B], [], m, np.random.default_rng(6), n=256, rounds=1, refine_on=preds)
+    a, b, h = r.x["a_mm"][256:], r.x["b_mm"][256:], 256 ** (-1 / 2)
+    near_a, near_b = (np.abs(v - 5.0) <= 10 * (1.5 * h * math.sqrt(2) + h / 2) for v in (a, b))
+    assert np.all(near_a | near_b)
+    assert np.any(near_a & ~near_b) and np.any(near_b & ~near_a)
+
+
+def test_refinement_stays_within_its_radius_of_the_boundary():
+    """Round one refines points with a neighbour of the other label within 1.5 h sqrt(d) (unit
+    cube, h = n^(-1/d)) and jitters them by at most h/2: every new point lies within
+    1.5 h sqrt(d) + h/2 of the boundary a = 4.5 (10 mm per unit)."""
+    r = explore([A, B], [A_UP], model, np.random.default_rng(7), n=1024, rounds=1)
+    h = 1024 ** (-1 / 2)
+    new = r.x["a_mm"][1024:]
+    assert new.size > 0
+    assert np.max(np.abs(new - 4.5)) <= 10 * (1.5 * h * math.sqrt(2) + h / 2)
+
+
+def test_the_cap_on_new_points_applies_only_when_exceeded():
+    kw = dict(n=256, rounds=1, per_point=2)
+    free = explore([A, B], [SUM, A_UP], model, np.random.default_rng(8), max_new=10**6, **kw)
+    n_new = free.n - 256
+    assert n_new > 0
+    at = explore([A, B], [SUM, A_UP], model, np.random.default_rng(8), max_new=n_new, **kw)
+    assert np.array_equal(at.x["a_mm"], free.x["a_mm"])
+
+
+def test_a_region_of_fixed_inputs_is_not_refined():
+    """With every input fixed there is nothing to refine, even when a Monte-Carlo model's
+    statuses differ between the (identical) points."""
+    c = Input("c_mm", 3.0, 3.0)
+
+    def noisy(x):
+        return {"z": np.resize([1.5, 9.0], len(x["c_mm"]))}  # holds, fails, holds, ...
+
+    r = explore([c], [Z], noisy, np.random.default_rng(0), n=8, rounds=2)
+    assert r.n == 8 and r.accepted.tolist() == [True, False] * 4
+    assert r.resolution == {"c_mm": (0.0, 0.0)}
