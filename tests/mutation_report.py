@@ -1,8 +1,10 @@
 """Write docs/mutation.md from a finished ``mutmut run`` (``make mutation``).
 
 Reads ``mutmut results --all true`` (one ``name: status`` line a mutant) and, for each mutant
-that was not killed, its diff (``mutmut show``). The score is killed / (all mutants); a
-mutant that no selected test reaches ("no tests") counts as surviving. Lines marked
+that was not killed, its diff (``mutmut show``). The score is killed / (all mutants), where a
+mutant that makes the tests run past mutmut's time limit ("timeout": e.g. a refinement step that
+no longer shrinks) counts as killed (the tests did not pass) and is listed apart; a mutant that
+no selected test reaches ("no tests") counts as surviving. Lines marked
 ``# pragma: no mutate`` in the mutated modules are listed with the reason written beside them
 (equivalent mutants: a change no test can see because the behaviour is the same).
 """
@@ -35,6 +37,89 @@ NOTES = {
         )
         for k in (13, 15)
     },
+    **{
+        f"sim.claims.inference.x__evidence__mutmut_{k}": (
+            "equivalent: the value array without the float dtype; it is used only as the "
+            "default of low and high, which are converted to float on the next lines (a None "
+            "in it becomes NaN there), so status() sees the same arrays."
+        )
+        for k in (5, 7)
+    },
+    **{
+        f"sim.claims.inference.x_status__mutmut_{k}": (
+            "equivalent: reshape(n, -2) for reshape(n, -1); NumPy takes any negative size as "
+            "the one unknown dimension, so the arrays are the same."
+        )
+        for k in (16, 22)
+    },
+    "sim.claims.inference.x_status__mutmut_52": (
+        "equivalent for every level written with at most 12 decimals (0.95, 0.9, 0.99, ...): "
+        "round(1 - level, 13) and round(1 - level, 12) are then the same float (the rounding "
+        "only removes the binary error of 1 - level, e.g. 0.05000000000000004)."
+    ),
+    **{
+        f"sim.claims.inference.x__boundary__mutmut_{k}": (
+            "equivalent: the early return when every point has the same label is a shortcut. "
+            "Without it (or with label[1] for label[0], or a float array of zeros for the bool "
+            "one) every neighbourhood has one label, so no point is on the boundary either; "
+            "np.flatnonzero of float zeros is empty as of bool ones."
+        )
+        for k in (1, 2, 4, 6)
+    },
+    "sim.claims.inference.x_explore__mutmut_4": (
+        "equivalent at the default per_point = 4: the cap is max_new // per_point points, "
+        "4096 // 4 = 4097 // 4 = 1024, and edge.size * 4 > 4096 iff > 4097 (a multiple of 4). "
+        "It differs only for per_point = 1 with exactly 4097 boundary points."
+    ),
+    "sim.claims.inference.x_explore__mutmut_45": (
+        "equivalent: the unit-cube coordinate of a fixed input (low == high) is 0.5 or 1.5, "
+        "scaled by high - low = 0 to low either way; refinement jitters free inputs only."
+    ),
+    "sim.claims.inference.x_explore__mutmut_51": (
+        "equivalent: scipy's Sobol scrambles by default (scramble=True)."
+    ),
+    "sim.claims.inference.x_explore__mutmut_127": (
+        "equivalent: replace=None is falsy, rng.choice samples without replacement as with "
+        "replace=False."
+    ),
+    **{
+        f"sim.claims.inference.x_explore__mutmut_{k}": (
+            "equivalent: the refinement label only has to tell apart the combinations "
+            "(accepted, holds for prediction k); a float label, -= for +=, weights 3 << k "
+            "(3 times distinct powers of two) or the complement != HOLDS within the accepted "
+            "points give the same partition of the points, hence the same boundary points and "
+            "the same draws."
+        )
+        for k in (90, 93, 96, 106)
+    },
+    "sim.claims.inference.x_explore__mutmut_145": (
+        "equivalent in law: the jitter U(-h, h) is symmetric, so x - U and x + U have the same "
+        "distribution; the region's guarantees (every point tested exactly, resolution h) are "
+        "the same, only the particular seeded points differ, which no property pins."
+    ),
+    "sim.claims.region.x_region_verdict__mutmut_2": (
+        "equivalent: n_points < 0 for n_points <= 0; with n_points = 0 the counts of holding "
+        "and failing points (subsets of the region's points) are 0, so the second clause "
+        "gives 'undecidable' as well."
+    ),
+    **{
+        f"sim.claims.region.x_decide_over__mutmut_{k}": (
+            "equivalent: Region.describe of an empty mask is 'nowhere' already, so the "
+            "`if nh` / `if nf` shortcut does not change holds_where / fails_where."
+        )
+        for k in (51, 57)
+    },
+    **{
+        f"sim.claims.region.x_region_row__mutmut_{k}": (
+            "equivalent: book.score only builds the row's identity columns here; its value, "
+            "ci, interval and outcome are all overwritten by the row.update below (value, "
+            "ci_low/high, interval='region', outcome/verdict/holds of the region verdict), "
+            "and an exact score with no ci (or interval 'ci' with ci = (lo, lo)) decides the "
+            "same point interval without error. tests/test_region_rows.py pins every "
+            "overwritten column."
+        )
+        for k in (17, 23, 30, 35, 36, 37, 38)
+    },
 }
 
 
@@ -57,7 +142,7 @@ def main(out: Path = ROOT / "docs" / "mutation.md") -> int:
     by_module: dict[str, Counter] = {}
     for name, st in status.items():
         by_module.setdefault(name.split(".x")[0], Counter())[st] += 1
-    killed = sum(c["killed"] for c in by_module.values())
+    killed = sum(c["killed"] + c["timeout"] for c in by_module.values())
     total = len(status)
     lines = [
         "# Mutation testing of the verdict rules and intervals",
@@ -71,16 +156,18 @@ def main(out: Path = ROOT / "docs" / "mutation.md") -> int:
         "",
         f"**Score: {killed} of {total} mutants killed ({100 * killed / total:.1f} %).**",
         "",
-        "| module | mutants | killed | survived | no tests | other |",
-        "| --- | ---: | ---: | ---: | ---: | ---: |",
+        "| module | mutants | killed | timeout | score | survived | no tests | other |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     for mod, c in sorted(by_module.items()):
-        other = sum(c.values()) - c["killed"] - c["survived"] - c["no tests"]
+        n = sum(c.values())
+        k = c["killed"] + c["timeout"]
+        other = n - k - c["survived"] - c["no tests"]
         lines.append(
-            f"| `{mod}` | {sum(c.values())} | {c['killed']} | {c['survived']} | "
-            f"{c['no tests']} | {other} |"
+            f"| `{mod}` | {n} | {c['killed']} | {c['timeout']} | {100 * k / n:.1f} % | "
+            f"{c['survived']} | {c['no tests']} | {other} |"
         )
-    left = [n for n, st in status.items() if st != "killed"]
+    left = [n for n, st in status.items() if st not in ("killed", "timeout")]
     lines += ["", f"## Mutants not killed ({len(left)})", ""]
     if not left:
         lines.append("None.")

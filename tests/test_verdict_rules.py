@@ -585,3 +585,64 @@ def test_write_claims_checks_the_book_and_writes_not_reproduced(tmp_path):
     assert not (tmp_path / "bare_not_reproduced.parquet").exists()
     assert bk._null(math.inf) is None and bk._null(-math.inf) is None and bk._null(1.5) == 1.5
     assert bk._null(math.nan) is None and bk._null("x") == "x" and bk._null(None) is None
+
+
+# --------------------------------------------------------------------------- off the paper's setup
+def _row(claim, kind, outcome, interval="exact", note=""):
+    verdict = rules.verdict_of(kind, outcome)
+    return {
+        "claim": claim,
+        "kind": kind,
+        "interval": interval,
+        "outcome": outcome,
+        "verdict": verdict,
+        "holds": rules.holds_of(verdict),
+        "note": note,
+    }
+
+
+def test_off_paper_makes_every_prediction_a_finding_and_names_the_inputs():
+    rows = [
+        _row("block_mm", "input", "fails"),  # a printed input the run does not match
+        _row("n_plates", "input", "fails"),
+        _row("sigma_um", "input", "holds"),  # matches: not named
+        _row("noise_um", "input", "fails", interval="ci"),  # not exact: not a setup input
+        _row("p1", "prediction", "holds"),
+        _row("p2", "prediction", "fails", note="see fig. 3"),
+        _row("p3", "prediction", None),  # already a finding
+        _row("c1", "paper-check", "fails"),  # an erratum stays an erratum
+        _row("s1", "self-check", "holds"),
+    ]
+    out = rules.off_paper(rows)
+    assert len(out) == len(rows)
+    why = (
+        "not a test of the paper: this run's printed inputs differ from the paper's "
+        "(block_mm, n_plates), so the rule's outcome ({}) is a finding about this run's setup"
+    )
+    p1, p2 = out[4], out[5]
+    assert p1 == {**rows[4], "verdict": "finding", "holds": None, "note": why.format("holds")}
+    assert p2 == {
+        **rows[5],
+        "verdict": "finding",
+        "holds": None,
+        "note": why.format("fails") + "; see fig. 3",
+    }
+    assert p1["outcome"] == "holds" and p2["outcome"] == "fails"  # the rule's outcome is kept
+    for k in (0, 1, 2, 3, 6, 7, 8):
+        assert out[k] == rows[k]
+    assert out[7]["verdict"] == "erratum" and out[6]["verdict"] == "finding"
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        _row("x", "input", "holds"),  # the input matches the paper
+        _row("x", "input", "fails", interval="ci"),  # not an exact configuration value
+        _row("x", "self-check", "fails"),  # not an input
+        _row("x", "prediction", "fails"),
+    ],
+)
+def test_a_run_on_the_papers_setup_comes_back_unchanged(bad):
+    rows = [bad, _row("p1", "prediction", "holds"), _row("p2", "prediction", "fails")]
+    out = rules.off_paper(iter(rows))
+    assert out == rows

@@ -213,7 +213,7 @@ def region_row(book, cid: str, rv: RegionVerdict, values, note: str = "") -> dic
         note="; ".join(x for x in (where, note) if x),
     )
     if row["kind"] == "paper-check" and rv.verdict == "fails":
-        row["verdict"], row["holds"] = "erratum", False
+        row["verdict"] = "erratum"  # holds is already False (the region fails)
     return row
 
 
