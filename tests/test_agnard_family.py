@@ -112,6 +112,46 @@ def test_family_over_a_region(px, py, spread_x, verdict):
     assert row["verdict"] == verdict and row["interval"] == "region"
     hp = [holm([a, b]).min() for a, b in zip(px, py)]
     assert math.isclose(row["value"], min(hp)) and math.isclose(row["value_high"], max(hp))
+    assert "one test of t.x, t.y per point (Holm's step-down correction)" in row["note"]
+    why = {  # what the reader is told besides the verdict
+        "undecidable": "no point of the region decides it: the Holm p is 0.60-1.00 (never "
+        "below 0.05), and at every point some member's one-block spread reaches outside its "
+        "zone (the block neither confirms nor contradicts it)",
+        "fails": "",
+        "fails or undecided": "holds at 0 of 3 region points, fails at 1, undecided at 2",
+    }[verdict]
+    assert why in row["note"]
+    if verdict == "fails":
+        assert "undecided at" not in row["note"] and "decides it" not in row["note"]
+
+
+def test_family_over_an_empty_region_names_the_conflict():
+    reg = _region([0.5, 0.5], [0.5, 0.5], [0.1, 0.1])
+    empty = Region(
+        [Input("a_1", 0.0, 1.0)],
+        [Statement("c", (0.0, 0.0), form="upper")],
+        {"a_1": np.array([0.2, 0.8])},
+        np.full((2, 1), FAILS, np.int8),
+        0.95,
+        {"a_1": (0.5, 0.5)},
+        reg.outputs,
+    )
+    row = family_over(_book(), empty, "t.xy", ["t.x", "t.y"])
+    assert row["verdict"] == "undecidable"
+    assert "no input is consistent with the printed statements (conflicting: c)" in row["note"]
+
+
+def test_family_row_names_every_member_with_its_p():
+    members = [
+        {"claim": "t.x", "p_plate": 0.4, "outcome": "holds"},
+        {"claim": "t.y", "p_plate": 0.03, "outcome": "fails"},
+    ]
+    row = family_row(_book(), "t.xy", members, note="the block")
+    assert row["note"] == (
+        "one test of 2 one-plate rows (Holm's step-down correction): "
+        "t.x: p 0.400 (holds), Holm-adjusted 0.400; t.y: p 0.030 (fails), Holm-adjusted 0.060"
+        "; the block"
+    )
 
 
 def test_the_xy_columns_are_paper_checks_of_the_quadrature():
@@ -148,3 +188,8 @@ def test_family_evidence_gives_a_region_the_family_rule():
     got = status(bound, family_evidence(p, member), len(p))
     assert got.tolist() == family_status(p, member)[1].tolist()
     assert got.tolist() == [FAILS, HOLDS, UNDECIDED, UNDECIDED, HOLDS, UNDECIDED]
+    ev = family_evidence(p, member)
+    assert sorted(ev) == ["high", "low", "value"] and ev["low"].dtype == float
+    assert np.array_equal(ev["value"], ev["high"], equal_nan=True)
+    hp, st = family_status(p, member)
+    assert hp.dtype == float and st.dtype == np.int8 and np.isnan(hp[-1])

@@ -23,12 +23,13 @@ correlated tests without a multiplicity correction; read together they are one s
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Region
-from sim.claims.region import RegionVerdict, outcomes, region_row, region_verdict, statement_of
+from sim.claims.region import decide_over, outcomes, region_row, statement_of
 from sim.claims.rules import P_FAIL
 
 __all__ = [
@@ -116,35 +117,18 @@ def family_outcomes(book, region: Region, members: Sequence[str]) -> tuple[np.nd
 
 def family_over(book, region: Region, cid: str, members: Sequence[str], note: str = "") -> dict:
     """The claims row of family ``cid`` decided over ``region``: per point the family's
-    status (:func:`family_outcomes`), then the region verdict over the accepted points."""
+    status (:func:`family_outcomes`), then the region verdict over the accepted points
+    (:func:`sim.claims.region.decide_over`, the rule of every prediction)."""
     hp, st = family_outcomes(book, region, members)
     acc = region.accepted
-    h, f = acc & (st == HOLDS), acc & (st == FAILS)
-    nh, nf, n = int(h.sum()), int(f.sum()), int(acc.sum())
-    v = region_verdict(n, nh, nf)
-    why = (
-        ""
-        if v in ("holds", "fails")
-        else f"holds at {nh} of {n} region points, fails at {nf}, undecided at {n - nh - nf}"
-    )
-    if v == "undecidable" and n:
+    why = ""
+    if acc.any():
         why = (
             f"no point of the region decides it: the Holm p is {np.nanmin(hp[acc]):.2f}-"
             f"{np.nanmax(hp[acc]):.2f} (never below 0.05), and at every point some member's "
             "one-block spread reaches outside its zone (the block neither confirms nor "
             "contradicts it)"
         )
-    elif v == "undecidable":
-        why = "the region is empty: no input is consistent with the printed statements"
-    rv = RegionVerdict(
-        cid,
-        v,
-        n,
-        nh,
-        nf,
-        region.describe(h) if nh else "nowhere",
-        region.describe(f) if nf else "nowhere",
-        why,
-    )
+    rv = decide_over(region, replace(statement_of(book, cid), decide=why), outcome=st)
     text = f"one test of {', '.join(members)} per point (Holm's step-down correction)"
     return region_row(book, cid, rv, hp[acc], "; ".join(x for x in (text, note) if x))

@@ -130,8 +130,12 @@ def outcomes(region: Region, spec: Statement, evidence: Any = None) -> np.ndarra
     return status(spec, ev, region.n, region.level)
 
 
-def decide_over(region: Region, spec: Statement, evidence: Any = None) -> RegionVerdict:
-    """The verdict of one prediction over the region (see the module doc)."""
+def decide_over(
+    region: Region, spec: Statement, evidence: Any = None, outcome: np.ndarray | None = None
+) -> RegionVerdict:
+    """The verdict of one prediction over the region (see the module doc); ``outcome``: its
+    HOLDS/FAILS/UNDECIDED per point when decided otherwise (a family of rows,
+    :mod:`sim.claims.family`), else :func:`outcomes` of ``evidence``."""
     acc = region.accepted
     if not acc.any():
         conf = "; ".join(" + ".join(c) for c in region.conflicts)
@@ -139,7 +143,7 @@ def decide_over(region: Region, spec: Statement, evidence: Any = None) -> Region
             spec.id, "undecidable", 0, 0, 0, "nowhere", "nowhere",
             f"no input is consistent with the printed statements (conflicting: {conf})",
         )  # fmt: skip
-    o = outcomes(region, spec, evidence)
+    o = outcomes(region, spec, evidence) if outcome is None else np.asarray(outcome)
     h, f = acc & (o == HOLDS), acc & (o == FAILS)
     nh, nf, n = int(h.sum()), int(f.sum()), int(acc.sum())
     hw = region.describe(h) if nh else "nowhere"
