@@ -120,6 +120,44 @@ NOTES = {
         )
         for k in (17, 23, 30, 35, 36, 37, 38)
     },
+    **{
+        name: (
+            "equivalent: the p values without the float dtype; every caller passes floats "
+            "(one-plate p), and with integers or a list the arithmetic that follows (Holm's "
+            "products, np.minimum with 1.0, the comparisons with 0.05) gives the same numbers."
+        )
+        for name in (
+            "sim.claims.family.x_holm__mutmut_3",
+            "sim.claims.family.x_holm__mutmut_5",
+            "sim.claims.family.x_family_status__mutmut_4",
+            "sim.claims.family.x_family_status__mutmut_6",
+            "sim.claims.family.x_family_row__mutmut_4",
+            "sim.claims.family.x_family_row__mutmut_6",
+            "sim.claims.family.x_family_outcomes__mutmut_7",
+            "sim.claims.family.x_family_outcomes__mutmut_9",
+        )
+    },
+    "sim.claims.family.x_family_status__mutmut_13": (
+        "equivalent: the Holm p of a row holding a NaN is NaN either way (holm keeps the NaN "
+        "and .min() propagates it), and a NaN Holm p is then undecided."
+    ),
+    **{
+        f"sim.claims.family.x_family_{f}__mutmut_1": (
+            "a default argument (note = ''): mutmut's trampoline calls the mutant with the "
+            "original default, so no test can see it; the note itself is pinned by "
+            "tests/test_agnard_family.py (family_row_names_every_member_with_its_p, "
+            "family_over_a_region)."
+        )
+        for f in ("row", "over")
+    },
+    **{
+        f"sim.claims.family.x_family_over__mutmut_{k}": (
+            "equivalent: `why` is the statement's `decide` text, which decide_over reads only "
+            "for a non-empty region, and there it is always replaced by the Holm p range; for "
+            "an empty region decide_over names the conflicting statements instead."
+        )
+        for k in (10, 11)
+    },
 }
 
 

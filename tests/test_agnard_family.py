@@ -108,8 +108,9 @@ def _region(px, py, spread_x) -> Region:
     ],
 )
 def test_family_over_a_region(px, py, spread_x, verdict):
-    row = family_over(_book(), _region(px, py, spread_x), "t.xy", ["t.x", "t.y"])
+    row = family_over(_book(), _region(px, py, spread_x), "t.xy", ["t.x", "t.y"], note="n.b.")
     assert row["verdict"] == verdict and row["interval"] == "region"
+    assert "(Holm's step-down correction); n.b." in row["note"]
     hp = [holm([a, b]).min() for a, b in zip(px, py)]
     assert math.isclose(row["value"], min(hp)) and math.isclose(row["value_high"], max(hp))
     assert "one test of t.x, t.y per point (Holm's step-down correction)" in row["note"]
