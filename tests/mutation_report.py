@@ -107,7 +107,7 @@ NOTES = {
             "equivalent: Region.describe of an empty mask is 'nowhere' already, so the "
             "`if nh` / `if nf` shortcut does not change holds_where / fails_where."
         )
-        for k in (51, 57)
+        for k in (55, 61)
     },
     **{
         f"sim.claims.region.x_region_row__mutmut_{k}": (
