@@ -304,3 +304,67 @@ def test_an_empty_results_directory_name_is_not_the_working_directory(
     assert "--results" in capsys.readouterr().err
     _one_line(capsys, main(["report", "--results", ""]), "--results")
     assert list(tmp_path.iterdir()) == []
+
+
+# --- the fourth sweep (issue 26): one case per class -----------------------------------------
+
+FIXED = THIRD.split("[datum]")[0].replace('"A", x_mm', '"A", role = "fixed", x_mm')
+FIXED = FIXED.replace('"B", x_mm', '"B", role = "fixed", x_mm') + "[datum]\n"
+DIST = 'generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 },\n'
+
+
+@pytest.mark.parametrize(
+    "old, new, key",
+    [
+        ("[datum]\n", '[datum]\nkind = "fixed"\nconstraints = [ { "C.x" = 1.0 } ]\n', "kind ="),
+        (
+            "[datum]\n",
+            '[datum]\nkind = "constraints"\nconstraints = [ { "C.x" = 1.0 } ]\n',
+            "defect",
+        ),
+        ("[datum]\n", '[compare]\nfix = ["A"]\n[datum]\n', "only fixed points"),
+        ('from = "*", to = "*", sigma_mm', 'from = "C", to = "C", sigma_mm', "generate[0]"),
+        (DIST, "estimate_constant = true\ngenerate = [\n", "estimate_constant"),
+        (DIST, "estimate_scale = true\ngenerate = [\n", "estimate_scale"),
+    ],
+)
+def test_a_network_key_without_effect_is_named(tmp_path, capsys, old, new, key):
+    """Keys that did nothing (constraints of a fixed datum, more constraints than the datum
+    defect, a comparison fixing what is fixed, a generator with no pair) or were blamed on
+    the datum (a constant or scale to estimate in a network without distances)."""
+    assert old in FIXED and main(["check", str(_net(tmp_path, FIXED))]) == 0
+    capsys.readouterr()
+    _one_line(capsys, main(["check", str(_net(tmp_path, FIXED.replace(old, new, 1)))]), key)
+
+
+def test_an_empty_dir_or_a_deleted_working_directory_is_named(tmp_path, capsys, monkeypatch):
+    """``sim show ""`` read the working directory; a deleted one gave a bare OSError text."""
+    _one_line(capsys, main(["show", ""]), "DIR", "not a directory name")
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    _one_line(capsys, main(["run", str(BROWN), "--out", "out"]), "working directory")
+
+
+def test_trials_pick_the_chunk_when_the_files_chunk_is_too_large(tmp_path, capsys):
+    """``--trials`` picks a chunk giving MIN_CHUNKS chunks (``sim run -h``), also when the
+    file's own chunk leaves fewer than two (it was refused, and so was ``make verify
+    --trials``)."""
+    f = _net(tmp_path, THIRD.replace("chunk = 2", "chunk = 30"))
+    assert main(["run", str(f), "--trials", "40", "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert pq.read_table(tmp_path / "o" / "claims.parquet").num_rows > 0
+    assert len(list((tmp_path / "o" / "trials").rglob("chunk-*.parquet"))) == 20
+
+
+def test_verify_names_a_record_it_cannot_write_and_leaves_no_temporary(tmp_path, capsys):
+    res = _results(tmp_path)
+    scratch = tmp_path / "s"
+    scratch.mkdir()
+    (scratch / "brown_table1").symlink_to(res / "brown_table1")
+    (res / "reproducibility.parquet").mkdir()  # a directory where the record goes
+    argv = ["--results", str(res), "--scratch", str(scratch), "--no-rerun"]
+    assert verify_main(argv) == 2
+    err = capsys.readouterr().err
+    assert "cannot write" in err and "reproducibility.parquet" in err and "Traceback" not in err
+    assert sorted(p.name for p in res.iterdir()) == ["brown_table1", "reproducibility.parquet"]

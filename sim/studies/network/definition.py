@@ -283,8 +283,11 @@ def _generated_obs(cfg: dict, names: list[str], xy: np.ndarray, rows: list[tuple
         k = _num(f"{key}.nearest", rec.get("nearest", 0), 0, integer=True)
         per = min(k, len(to)) if k else len(to)
         _fits(key, len(names), len(rows) + len(fr) * per, f"{len(fr)} x {per} observations")
+        before = len(rows)
         for s, tgt in zip(fr, _targets(xy, fr, to, k)):
             rows += [(code, s, t, -1, sig, bias) for t in tgt]
+        if len(rows) == before:
+            raise ConfigError(key, "generates no observation: no 'to' point other than 'from'")
 
 
 def _orientation_sets(cfg: dict, names, kind, i) -> tuple[np.ndarray, tuple[str, ...]]:
