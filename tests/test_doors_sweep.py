@@ -368,3 +368,22 @@ def test_verify_names_a_record_it_cannot_write_and_leaves_no_temporary(tmp_path,
     err = capsys.readouterr().err
     assert "cannot write" in err and "reproducibility.parquet" in err and "Traceback" not in err
     assert sorted(p.name for p in res.iterdir()) == ["brown_table1", "reproducibility.parquet"]
+
+
+class _BytesPath:
+    def __fspath__(self):
+        return b"/tmp/x.toml"
+
+
+def test_api_paths_keys_and_results_are_checked(tmp_path):
+    """An os.PathLike giving bytes (a pathlib TypeError), an empty override key (an unnamed
+    "unknown key") and ``sim.Results`` made with a str path (a TypeError on the first table)."""
+    with pytest.raises(ConfigError, match="study_file: must be a path"):
+        sim.load(_BytesPath())
+    with pytest.raises(ConfigError, match="'': is not a config key"):
+        sim.load(BROWN, **{"": 1})
+    d = tmp_path / "r"
+    write_table(d / "claims.parquet", {"claim": ["x"], "verdict": ["holds"]}, {"study": "x"})
+    assert sim.Results(str(d), "x").claims().num_rows == 1
+    with pytest.raises(ConfigError, match="path: must be a path"):
+        sim.Results(5, "x")
