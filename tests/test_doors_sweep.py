@@ -387,3 +387,13 @@ def test_api_paths_keys_and_results_are_checked(tmp_path):
     assert sim.Results(str(d), "x").claims().num_rows == 1
     with pytest.raises(ConfigError, match="path: must be a path"):
         sim.Results(5, "x")
+
+
+@pytest.mark.parametrize(
+    "sweep, key",
+    [("[nan]", "must be finite"), ("[0.0, -1.0]", "must be >= 0"), ('["1"]', "a number")],
+)
+def test_a_swept_value_its_key_refuses_is_refused_by_check(tmp_path, capsys, sweep, key):
+    """``sim check`` passed a sweep whose every cell then failed at run time."""
+    f = _net(tmp_path, THIRD + f'[sweep]\n"network.offset_mm" = {sweep}\n')
+    _one_line(capsys, main(["check", str(f)]), "sweep.network.offset_mm", key)
