@@ -33,7 +33,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.execute import execute
-from sim.mc.config import ConfigError, StudyError, parse_override
+from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import estimate
 from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
@@ -356,6 +356,7 @@ def _bounds(f) -> str:
 
 def _check(args) -> int:
     study, cfg = load_study(args.study, args.set)
+    check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
     print(f"# {cfg['study']}: {study.title}")
     for k, v in cfg.items():

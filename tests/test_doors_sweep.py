@@ -28,6 +28,7 @@ import pytest
 
 import sim
 from sim import ConfigError
+from sim.batch import is_current
 from sim.batch import main as batch_main
 from sim.cli import main
 from sim.mc.storage import write_table
@@ -397,3 +398,19 @@ def test_a_swept_value_its_key_refuses_is_refused_by_check(tmp_path, capsys, swe
     """``sim check`` passed a sweep whose every cell then failed at run time."""
     f = _net(tmp_path, THIRD + f'[sweep]\n"network.offset_mm" = {sweep}\n')
     _one_line(capsys, main(["check", str(f)]), "sweep.network.offset_mm", key)
+
+
+def test_a_run_of_too_many_chunk_files_is_refused_before_it_starts(tmp_path, capsys):
+    """Two million trials in chunks of one ran for hours, writing a file per chunk."""
+    argv = ["--set", "trials=2000000", "--set", "chunk=1"]
+    _one_line(capsys, main(["check", str(_net(tmp_path)), *argv]), "chunk", "at most 100,000")
+    out = tmp_path / "o"
+    _one_line(capsys, main(["run", str(_net(tmp_path)), *argv, "--out", str(out)]), "chunk files")
+    assert not out.exists()
+
+
+def test_batch_stale_only_reads_a_run_record_of_another_shape_as_stale(tmp_path, capsys):
+    f = _net(tmp_path)
+    (tmp_path / "r" / "n").mkdir(parents=True)
+    (tmp_path / "r" / "n" / "run.json").write_text("[]")  # valid JSON, not a record
+    assert is_current(f, tmp_path / "r" / "n") is False
