@@ -17,6 +17,7 @@ argument, and nothing is written.
   (a traceback after every run) or a file of the user's (overwritten).
 """
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -414,3 +415,16 @@ def test_batch_stale_only_reads_a_run_record_of_another_shape_as_stale(tmp_path,
     (tmp_path / "r" / "n").mkdir(parents=True)
     (tmp_path / "r" / "n" / "run.json").write_text("[]")  # valid JSON, not a record
     assert is_current(f, tmp_path / "r" / "n") is False
+
+
+def test_a_run_record_listing_its_files_wrongly_is_named_not_a_traceback(tmp_path, capsys):
+    """run.json edited into valid JSON of another shape (``"files": 3``) gave a TypeError
+    after the whole re-run, when the new results replaced the old."""
+    out = tmp_path / "o"
+    assert main(["run", str(_net(tmp_path)), "--out", str(out), "--quiet"]) == 0
+    rec = json.loads((out / "run.json").read_text())
+    (out / "run.json").write_text(json.dumps({**rec, "files": 3}))
+    capsys.readouterr()
+    argv = ["run", str(_net(tmp_path)), "--out", str(out), "--quiet", "--overwrite", "--seed", "7"]
+    _one_line(capsys, main(argv), "run.json", "does not list the files")
+    assert json.loads((out / "run.json").read_text())["files"] == 3  # nothing replaced

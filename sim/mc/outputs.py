@@ -246,6 +246,12 @@ def _foreign(out: Path) -> list[str]:
     rec = read_record(out)
     if not rec or "files" not in rec:
         return []
+    if not isinstance(rec["files"], list) or not all(isinstance(f, str) for f in rec["files"]):
+        raise ConfigError(
+            "--out",
+            f"{out / 'run.json'} does not list the files its run wrote (edited by hand?): "
+            "move the directory away, or delete it, and run again",
+        )
     mine = set(rec["files"])
     return [f for f in _files(out) if f not in mine]
 
