@@ -15,6 +15,8 @@ argument, and nothing is written.
 * ``sim show`` on a directory whose ``claims.parquet`` is someone else's table (a KeyError);
 * ``python -m sim.batch``: argparse's two-line usage errors, ``--timings`` naming a directory
   (a traceback after every run) or a file of the user's (overwritten).
+
+The third and fourth sweeps follow, each marked by a section comment (one case per class).
 """
 
 import json
