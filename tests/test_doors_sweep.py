@@ -330,6 +330,7 @@ DIST = 'generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 
         ('from = "*", to = "*", sigma_mm', 'from = "C", to = "C", sigma_mm', "generate[0]"),
         (DIST, "estimate_constant = true\ngenerate = [\n", "estimate_constant"),
         (DIST, "estimate_scale = true\ngenerate = [\n", "estimate_scale"),
+        ("generate = [", "constant_mm = 1e6\ngenerate = [", "would read -"),
     ],
 )
 def test_a_network_key_without_effect_is_named(tmp_path, capsys, old, new, key):
