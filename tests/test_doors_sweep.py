@@ -431,3 +431,13 @@ def test_a_run_record_listing_its_files_wrongly_is_named_not_a_traceback(tmp_pat
     argv = ["run", str(_net(tmp_path)), "--out", str(out), "--quiet", "--overwrite", "--seed", "7"]
     _one_line(capsys, main(argv), "run.json", "does not list the files")
     assert json.loads((out / "run.json").read_text())["files"] == 3  # nothing replaced
+
+
+def test_a_chunk_hash_map_of_another_shape_is_not_read_as_no_check(tmp_path):
+    """``chunk_sha256`` edited into a list: ``Results.table("trials")`` returned the trials
+    unchecked, as for a run recorded before chunks were hashed."""
+    res = sim.load(_net(tmp_path)).run(out=tmp_path / "o")
+    rec = json.loads((tmp_path / "o" / "run.json").read_text())
+    (tmp_path / "o" / "run.json").write_text(json.dumps({**rec, "chunk_sha256": [1]}))
+    with pytest.raises(ConfigError, match="does not map the chunk files"):
+        res.table("trials")
