@@ -46,6 +46,10 @@ class Results:
     path: Path
     study: str
 
+    def __post_init__(self):  # Results("results/x", "x"): a str is taken as the path
+        _check_path("path", self.path)
+        object.__setattr__(self, "path", Path(self.path))
+
     def names(self) -> list[str]:
         """The tables of the run (``trials`` is the per-trial dataset, if any)."""
         names = sorted(p.stem for p in self.path.glob("*.parquet"))
@@ -152,8 +156,9 @@ class StudyHandle:
 def _check_path(name: str, v: Any, none_ok: bool = False) -> None:
     if v is None and none_ok:
         return
-    if not isinstance(v, (str, os.PathLike)) or not str(v).isprintable() or not str(v).strip():
-        raise ConfigError(name, f"must be a path (a str or os.PathLike), got {v!r}")
+    text = os.fspath(v) if isinstance(v, os.PathLike) else v  # an os.PathLike may give bytes
+    if not isinstance(text, str) or not text.isprintable() or not text.strip():
+        raise ConfigError(name, f"must be a path (a str or os.PathLike of a str), got {v!r}")
 
 
 def _check_int(name: str, v: Any) -> None:
@@ -174,6 +179,9 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     _check_path("study_file", study_file)
     if not Path(study_file).is_file():
         raise ConfigError("study_file", f"{study_file} is not a study file")
+    for k in overrides:
+        if not _key(k).strip(".").strip() or not k.isprintable():
+            raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
     vals = {_key(k): _plain(v) for k, v in overrides.items()}
     study, cfg = load_study(study_file, values=vals)
     return StudyHandle(Path(study_file), study, cfg, vals, read_sweep(study_file, study.schema))

@@ -64,6 +64,8 @@ def is_current(study_file: str | Path, results: str | Path) -> bool:
         _, cfg = load_study(study_file)
     except (OSError, ValueError, ConfigError, StudyError):
         return False
+    if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
+        return False
     want = study_code_hash(cfg["study"])
     return record.get("config") == json.loads(json.dumps(cfg)) and record.get("code_hash") == want
 

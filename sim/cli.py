@@ -33,7 +33,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.execute import execute
-from sim.mc.config import ConfigError, StudyError, parse_override
+from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import estimate
 from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
@@ -205,9 +205,17 @@ def _load(args):
     """The study and its resolved config. ``--trials`` (or ``--set trials=``) without a chunk
     size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it."""
     overrides = list(args.set) + ([f"chunk={args.chunk}"] if args.chunk is not None else [])
-    study, cfg = load_study(args.study, overrides, args.trials, args.seed)
     given = _keys_set(args.set)
     trials_given = args.trials is not None or "trials" in given
+    try:
+        study, cfg = load_study(args.study, overrides, args.trials, args.seed)
+    except ConfigError as e:
+        if not (e.key == "chunk" and trials_given and args.chunk is None and "chunk" not in given):
+            raise
+        # the file's chunk is too large for the trials asked for: --trials picks the chunk
+        _, cfg = load_study(args.study, [*overrides, "chunk=1"], args.trials, args.seed)
+        overrides = [*overrides, f"chunk={max(1, cfg['trials'] // MIN_CHUNKS)}"]
+        study, cfg = load_study(args.study, overrides, args.trials, args.seed)
     if trials_given and args.chunk is None and "chunk" not in given and "chunk" in cfg:
         chunk = max(1, cfg["trials"] // MIN_CHUNKS)
         if cfg["chunk"] > chunk:
@@ -294,6 +302,8 @@ def _run(args) -> int:
 
 
 def _show(args) -> int:
+    if not args.dir.strip() or not args.dir.isprintable():
+        raise ConfigError("DIR", f"not a directory name (got {args.dir!r})")
     d = Path(args.dir)
     if not d.exists() and (Path("results") / args.dir).is_dir():
         d = Path("results") / args.dir
@@ -346,6 +356,7 @@ def _bounds(f) -> str:
 
 def _check(args) -> int:
     study, cfg = load_study(args.study, args.set)
+    check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
     print(f"# {cfg['study']}: {study.title}")
     for k, v in cfg.items():
@@ -384,6 +395,14 @@ def _report(results: Path) -> int:
         raise ConfigError("--results", _not_as_written(results, e)) from None
     print(text)
     return 0
+
+
+def _cwd_exists() -> bool:
+    try:
+        os.getcwd()
+    except OSError:
+        return False
+    return True
 
 
 def _on_sigterm(signum, frame):
@@ -433,10 +452,10 @@ def _main(argv: list[str]) -> int:
     except BrokenPipeError:
         raise
     except OSError as e:  # a failing write (full disk, vanished directory): one line, no traceback
-        print(
-            f"sim: error: {e.strerror or e}: {getattr(e, 'filename', '') or ''}".rstrip(": "),
-            file=sys.stderr,
-        )
+        name = getattr(e, "filename", "") or ""
+        if not name and not _cwd_exists():
+            name = "the working directory (it was deleted)"
+        print(f"sim: error: {e.strerror or e}: {name}".rstrip(": "), file=sys.stderr)
         return 2
     except (ArithmeticError, ValueError, MemoryError) as e:  # e.g. a sweep cell table
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)

@@ -15,8 +15,11 @@ argument, and nothing is written.
 * ``sim show`` on a directory whose ``claims.parquet`` is someone else's table (a KeyError);
 * ``python -m sim.batch``: argparse's two-line usage errors, ``--timings`` naming a directory
   (a traceback after every run) or a file of the user's (overwritten).
+
+The third and fourth sweeps follow, each marked by a section comment (one case per class).
 """
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -28,6 +31,7 @@ import pytest
 
 import sim
 from sim import ConfigError
+from sim.batch import is_current
 from sim.batch import main as batch_main
 from sim.cli import main
 from sim.mc.storage import write_table
@@ -304,3 +308,136 @@ def test_an_empty_results_directory_name_is_not_the_working_directory(
     assert "--results" in capsys.readouterr().err
     _one_line(capsys, main(["report", "--results", ""]), "--results")
     assert list(tmp_path.iterdir()) == []
+
+
+# --- the fourth sweep (issue 26): one case per class -----------------------------------------
+
+FIXED = THIRD.split("[datum]")[0].replace('"A", x_mm', '"A", role = "fixed", x_mm')
+FIXED = FIXED.replace('"B", x_mm', '"B", role = "fixed", x_mm') + "[datum]\n"
+DIST = 'generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 },\n'
+
+
+@pytest.mark.parametrize(
+    "old, new, key",
+    [
+        ("[datum]\n", '[datum]\nkind = "fixed"\nconstraints = [ { "C.x" = 1.0 } ]\n', "kind ="),
+        (
+            "[datum]\n",
+            '[datum]\nkind = "constraints"\nconstraints = [ { "C.x" = 1.0 } ]\n',
+            "defect",
+        ),
+        ("[datum]\n", '[compare]\nfix = ["A"]\n[datum]\n', "only fixed points"),
+        ('from = "*", to = "*", sigma_mm', 'from = "C", to = "C", sigma_mm', "generate[0]"),
+        (DIST, "estimate_constant = true\ngenerate = [\n", "estimate_constant"),
+        (DIST, "estimate_scale = true\ngenerate = [\n", "estimate_scale"),
+        ("generate = [", "constant_mm = 1e6\ngenerate = [", "would read -"),
+    ],
+)
+def test_a_network_key_without_effect_is_named(tmp_path, capsys, old, new, key):
+    """Keys that did nothing (constraints of a fixed datum, more constraints than the datum
+    defect, a comparison fixing what is fixed, a generator with no pair) or were blamed on
+    the datum (a constant or scale to estimate in a network without distances)."""
+    assert old in FIXED and main(["check", str(_net(tmp_path, FIXED))]) == 0
+    capsys.readouterr()
+    _one_line(capsys, main(["check", str(_net(tmp_path, FIXED.replace(old, new, 1)))]), key)
+
+
+def test_an_empty_dir_or_a_deleted_working_directory_is_named(tmp_path, capsys, monkeypatch):
+    """``sim show ""`` read the working directory; a deleted one gave a bare OSError text."""
+    _one_line(capsys, main(["show", ""]), "DIR", "not a directory name")
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    _one_line(capsys, main(["run", str(BROWN), "--out", "out"]), "working directory")
+
+
+def test_trials_pick_the_chunk_when_the_files_chunk_is_too_large(tmp_path, capsys):
+    """``--trials`` picks a chunk giving MIN_CHUNKS chunks (``sim run -h``), also when the
+    file's own chunk leaves fewer than two (it was refused, and so was ``make verify
+    --trials``)."""
+    f = _net(tmp_path, THIRD.replace("chunk = 2", "chunk = 30"))
+    assert main(["run", str(f), "--trials", "40", "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert pq.read_table(tmp_path / "o" / "claims.parquet").num_rows > 0
+    assert len(list((tmp_path / "o" / "trials").rglob("chunk-*.parquet"))) == 20
+
+
+def test_verify_names_a_record_it_cannot_write_and_leaves_no_temporary(tmp_path, capsys):
+    res = _results(tmp_path)
+    scratch = tmp_path / "s"
+    scratch.mkdir()
+    (scratch / "brown_table1").symlink_to(res / "brown_table1")
+    (res / "reproducibility.parquet").mkdir()  # a directory where the record goes
+    argv = ["--results", str(res), "--scratch", str(scratch), "--no-rerun"]
+    assert verify_main(argv) == 2
+    err = capsys.readouterr().err
+    assert "cannot write" in err and "reproducibility.parquet" in err and "Traceback" not in err
+    assert sorted(p.name for p in res.iterdir()) == ["brown_table1", "reproducibility.parquet"]
+
+
+class _BytesPath:
+    def __fspath__(self):
+        return b"/tmp/x.toml"
+
+
+def test_api_paths_keys_and_results_are_checked(tmp_path):
+    """An os.PathLike giving bytes (a pathlib TypeError), an empty override key (an unnamed
+    "unknown key") and ``sim.Results`` made with a str path (a TypeError on the first table)."""
+    with pytest.raises(ConfigError, match="study_file: must be a path"):
+        sim.load(_BytesPath())
+    with pytest.raises(ConfigError, match="'': is not a config key"):
+        sim.load(BROWN, **{"": 1})
+    d = tmp_path / "r"
+    write_table(d / "claims.parquet", {"claim": ["x"], "verdict": ["holds"]}, {"study": "x"})
+    assert sim.Results(str(d), "x").claims().num_rows == 1
+    with pytest.raises(ConfigError, match="path: must be a path"):
+        sim.Results(5, "x")
+
+
+@pytest.mark.parametrize(
+    "sweep, key",
+    [("[nan]", "must be finite"), ("[0.0, -1.0]", "must be >= 0"), ('["1"]', "a number")],
+)
+def test_a_swept_value_its_key_refuses_is_refused_by_check(tmp_path, capsys, sweep, key):
+    """``sim check`` passed a sweep whose every cell then failed at run time."""
+    f = _net(tmp_path, THIRD + f'[sweep]\n"network.offset_mm" = {sweep}\n')
+    _one_line(capsys, main(["check", str(f)]), "sweep.network.offset_mm", key)
+
+
+def test_a_run_of_too_many_chunk_files_is_refused_before_it_starts(tmp_path, capsys):
+    """Two million trials in chunks of one ran for hours, writing a file per chunk."""
+    argv = ["--set", "trials=2000000", "--set", "chunk=1"]
+    _one_line(capsys, main(["check", str(_net(tmp_path)), *argv]), "chunk", "at most 100,000")
+    out = tmp_path / "o"
+    _one_line(capsys, main(["run", str(_net(tmp_path)), *argv, "--out", str(out)]), "chunk files")
+    assert not out.exists()
+
+
+def test_batch_stale_only_reads_a_run_record_of_another_shape_as_stale(tmp_path, capsys):
+    f = _net(tmp_path)
+    (tmp_path / "r" / "n").mkdir(parents=True)
+    (tmp_path / "r" / "n" / "run.json").write_text("[]")  # valid JSON, not a record
+    assert is_current(f, tmp_path / "r" / "n") is False
+
+
+def test_a_run_record_listing_its_files_wrongly_is_named_not_a_traceback(tmp_path, capsys):
+    """run.json edited into valid JSON of another shape (``"files": 3``) gave a TypeError
+    after the whole re-run, when the new results replaced the old."""
+    out = tmp_path / "o"
+    assert main(["run", str(_net(tmp_path)), "--out", str(out), "--quiet"]) == 0
+    rec = json.loads((out / "run.json").read_text())
+    (out / "run.json").write_text(json.dumps({**rec, "files": 3}))
+    capsys.readouterr()
+    argv = ["run", str(_net(tmp_path)), "--out", str(out), "--quiet", "--overwrite", "--seed", "7"]
+    _one_line(capsys, main(argv), "run.json", "does not list the files")
+    assert json.loads((out / "run.json").read_text())["files"] == 3  # nothing replaced
+
+
+def test_a_chunk_hash_map_of_another_shape_is_not_read_as_no_check(tmp_path):
+    """``chunk_sha256`` edited into a list: ``Results.table("trials")`` returned the trials
+    unchecked, as for a run recorded before chunks were hashed."""
+    res = sim.load(_net(tmp_path)).run(out=tmp_path / "o")
+    rec = json.loads((tmp_path / "o" / "run.json").read_text())
+    (tmp_path / "o" / "run.json").write_text(json.dumps({**rec, "chunk_sha256": [1]}))
+    with pytest.raises(ConfigError, match="does not map the chunk files"):
+        res.table("trials")

@@ -243,6 +243,10 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         raise ConfigError(None, f"{p}: not UTF-8 text") from None
 
 
+#: most chunks of one run (each is a file of the trials dataset, read back by every resume)
+MAX_CHUNKS = 100_000
+
+
 def check_chunks(cfg: Mapping[str, Any]) -> None:
     """A run needs at least 2 chunks: the Monte-Carlo intervals are delete-one-chunk jackknife
     intervals, undefined for one chunk. Checked by ``sim run`` (and its sweep cells and the
@@ -253,6 +257,13 @@ def check_chunks(cfg: Mapping[str, Any]) -> None:
             f"{cfg['chunk']} >= trials ({cfg['trials']}) gives one chunk; "
             "the jackknife intervals need at least 2 chunks (make chunk smaller "
             "than trials)",
+        )
+    if "trials" in cfg and "chunk" in cfg and -(-cfg["trials"] // cfg["chunk"]) > MAX_CHUNKS:
+        raise ConfigError(
+            "chunk",
+            f"{cfg['trials']:,} trials in chunks of {cfg['chunk']:,} make "
+            f"{-(-cfg['trials'] // cfg['chunk']):,} chunk files (at most {MAX_CHUNKS:,}): "
+            "make chunk larger",
         )
 
 

@@ -216,8 +216,10 @@ def damaged_chunks(out: Path) -> str | None:
     before chunks were hashed is not checked."""
     rec = read_record(out)
     want = (rec or {}).get("chunk_sha256")
-    if not isinstance(want, dict):
+    if want is None:
         return None
+    if not isinstance(want, dict) or not all(isinstance(v, str) for v in want.values()):
+        return f"{out / 'run.json'} does not map the chunk files to their sha256 (edited by hand?)"
     have = sorted(
         p.relative_to(out).as_posix() for p in (out / "trials").rglob("*") if not p.is_dir()
     )
@@ -246,6 +248,12 @@ def _foreign(out: Path) -> list[str]:
     rec = read_record(out)
     if not rec or "files" not in rec:
         return []
+    if not isinstance(rec["files"], list) or not all(isinstance(f, str) for f in rec["files"]):
+        raise ConfigError(
+            "--out",
+            f"{out / 'run.json'} does not list the files its run wrote (edited by hand?): "
+            "move the directory away, or delete it, and run again",
+        )
     mine = set(rec["files"])
     return [f for f in _files(out) if f not in mine]
 

@@ -36,7 +36,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from sim.mc.config import ConfigError, read_toml
+from sim.mc.config import ConfigError, Field, check_value, read_toml
 from sim.mc.progress import Progress
 from sim.mc.runner import chunk_rng
 
@@ -161,6 +161,10 @@ def expand(table: Mapping[str, Any], schema: Mapping | None = None):
     total = math.prod(len(v) for v in vals) * reps
     if total > MAX_CELLS:
         raise ConfigError("sweep", f"{total:,} cells x replicates (at most {MAX_CELLS:,})")
+    for k, vs in zip(keys, vals):  # a value its key refuses fails in every cell: refused here
+        if schema is not None and isinstance(schema[k], Field):
+            for v in vs:
+                check_value(f"sweep.{k}", schema[k], v.item() if isinstance(v, np.generic) else v)
     cells = [dict(zip(keys, combo)) for combo in itertools.product(*vals)]
     return keys, cells, reps, mode
 

@@ -111,5 +111,10 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     _print(comps)
     if not a.no_record and mode == "full" and not a.study:
-        write_record(Path(a.results), comps)
+        try:
+            write_record(Path(a.results), comps)
+        except OSError as e:  # e.g. a directory where the record goes: one line, no traceback
+            where = Path(a.results) / "reproducibility.parquet"
+            print(f"sim verify: error: cannot write {where}: {e.strerror or e}", file=sys.stderr)
+            return 2
     return 0 if all(c.ok for c in comps) else 1

@@ -283,8 +283,11 @@ def _generated_obs(cfg: dict, names: list[str], xy: np.ndarray, rows: list[tuple
         k = _num(f"{key}.nearest", rec.get("nearest", 0), 0, integer=True)
         per = min(k, len(to)) if k else len(to)
         _fits(key, len(names), len(rows) + len(fr) * per, f"{len(fr)} x {per} observations")
+        before = len(rows)
         for s, tgt in zip(fr, _targets(xy, fr, to, k)):
             rows += [(code, s, t, -1, sig, bias) for t in tgt]
+        if len(rows) == before:
+            raise ConfigError(key, "generates no observation: no 'to' point other than 'from'")
 
 
 def _orientation_sets(cfg: dict, names, kind, i) -> tuple[np.ndarray, tuple[str, ...]]:
@@ -314,6 +317,23 @@ def _check_offset(beta: float, names, xy, kind, i, j) -> None:
         )
 
 
+def _check_readings(cfg: dict, beta: float, names, xy, kind, i, j) -> None:
+    """Every distance reads a positive length: ``(1 + s) sqrt(d^2 - beta^2) - alpha > 0``."""
+    rows_d = np.flatnonzero(kind == 0)
+    if not rows_d.size:
+        return
+    d = np.hypot(*(xy[j[rows_d]] - xy[i[rows_d]]).T)
+    f = 1.0 + 1e-6 * cfg["network.scale_ppm"]
+    read = f * np.sqrt(np.maximum(d * d - beta * beta, 0.0)) - cfg["network.constant_mm"]
+    if read.min() <= 0:
+        r = rows_d[int(np.argmin(read))]
+        raise ConfigError(
+            "network.constant_mm",
+            f"the distance from {names[i[r]]!r} to {names[j[r]]!r} would read "
+            f"{read.min():.6g} mm: a reading is a positive length (constant_mm is subtracted)",
+        )
+
+
 def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
     """The :class:`Network` of a validated study config (``rng``: the layout stream)."""
     if rng is None:
@@ -330,6 +350,7 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
     oset, stations = _orientation_sets(cfg, names, kind, i)
     beta = cfg["network.offset_mm"]
     _check_offset(beta, names, xy, kind, i, j)
+    _check_readings(cfg, beta, names, xy, kind, i, j)
     return Network(
         title("network.name", cfg["network.name"]),
         tuple(names),

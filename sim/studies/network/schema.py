@@ -22,7 +22,7 @@ from sim.studies.network.analysis import (
 )
 from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
-from sim.studies.network.model import computed, datum, use_sparse
+from sim.studies.network.model import computed, datum, defect_basis, use_sparse
 from sim.studies.network.sparse_analysis import chunk_bytes, pre_analysis, variances
 
 __all__ = ["SCHEMA", "check"]
@@ -139,6 +139,8 @@ SCHEMA["chunk"] = Field(
 def _check_compare(net, full: dict, fix: list, sparse: bool) -> None:
     """``compare.fix``: the compared datum leaves something to estimate and covers the defects."""
     extra = match_points(net, "compare.fix", fix)
+    if all(net.role[e] == 1 for e in extra):
+        raise ConfigError("compare.fix", "names only fixed points: the compared datum is this one")
     if set(np.flatnonzero(net.role != 1)) <= set(extra):
         raise ConfigError("compare.fix", "fixes every estimated point: nothing to compare")
     an2 = pre_analysis(net, datum(net, full, tuple(extra)), 0.001, 0.8)
@@ -176,7 +178,10 @@ def check(cfg: dict) -> None:
         raise ConfigError("network.points", "every point is fixed: nothing to estimate")
     if cfg["datum.points"] and cfg["datum.kind"] != "inner":
         raise ConfigError("datum.points", "only with datum.kind = inner (it has no effect here)")
+    _no_effect(net, full)
     dt = datum(net, full)
+    if full["datum.kind"] == "constraints":
+        _minimal(net, dt)
     if full["datum.kind"] == "inner":
         pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
         check_inner(net, inner_defect(net), pts, "datum.points")
@@ -202,6 +207,34 @@ def check(cfg: dict) -> None:
     if cfg["output.inner_over"]:
         pts = match_points(net, "output.inner_over", cfg["output.inner_over"])
         check_inner(net, inner_defect(net), pts, "output.inner_over")
+
+
+def _no_effect(net, cfg: dict) -> None:
+    """Keys that would do nothing, or be blamed on the datum: constraints without
+    ``datum.kind = constraints``, an additive constant or scale to estimate without a distance."""
+    if cfg["datum.constraints"] and cfg["datum.kind"] != "constraints":
+        raise ConfigError(
+            "datum.constraints", "only with datum.kind = constraints (it has no effect here)"
+        )
+    for what, key in (("constant", "estimate_constant"), ("scale error", "estimate_scale")):
+        if cfg[f"network.{key}"] and not np.any(net.kind == 0):
+            raise ConfigError(
+                f"network.{key}",
+                f"the {what} of the distances cannot be estimated: the network has no distances",
+            )
+
+
+def _minimal(net, dt) -> None:
+    """``datum.constraints`` are minimal: no more of them than the network's datum defects
+    (a further one would hold an estimable quantity and bend the network)."""
+    c = dt.n_constraints()
+    d = defect_basis(net, dt.free_index(net.q)).shape[1]
+    if c > d:
+        raise ConfigError(
+            "datum.constraints",
+            f"{c} constraints for a datum defect of {d}: minimal constraints are as many as "
+            "the defect (the others would bend the network)",
+        )
 
 
 def _digest(cfg: dict) -> None:
