@@ -441,3 +441,17 @@ def test_a_chunk_hash_map_of_another_shape_is_not_read_as_no_check(tmp_path):
     (tmp_path / "o" / "run.json").write_text(json.dumps({**rec, "chunk_sha256": [1]}))
     with pytest.raises(ConfigError, match="does not map the chunk files"):
         res.table("trials")
+
+
+@pytest.mark.parametrize("drop", ["chunk_sha256", "config", "code_hash"])
+def test_trials_whose_record_cannot_check_them_are_refused(tmp_path, drop):
+    """``run.json`` with its chunk hashes, its config or its code hash deleted by hand (so no
+    longer a run record that lists the chunks): the trials were returned unchecked; now the
+    chunks that cannot be checked are refused, naming the record."""
+    res = sim.load(_net(tmp_path)).run(out=tmp_path / "o")
+    assert res.table("trials").num_rows > 0
+    rec = json.loads((tmp_path / "o" / "run.json").read_text())
+    del rec[drop]
+    (tmp_path / "o" / "run.json").write_text(json.dumps(rec))
+    with pytest.raises(ConfigError, match="run.json"):
+        res.table("trials")

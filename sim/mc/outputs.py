@@ -212,12 +212,13 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
 def damaged_chunks(out: Path) -> str | None:
     """What is wrong with the per-trial chunk files of a finished results directory, against
     the sha256 of each that its run recorded (``run.json`` ``chunk_sha256``), or None when
-    they are exactly the run's: a chunk missing, changed or added by hand. A run recorded
-    before chunks were hashed is not checked."""
+    they are exactly the run's: a chunk missing, changed or added by hand. Chunks that cannot
+    be checked (no run record, or a record without their hashes: edited by hand, or written
+    before runs hashed their chunks) are refused too: unchecked trials are never read."""
     rec = read_record(out)
-    want = (rec or {}).get("chunk_sha256")
-    if want is None:
-        return None
+    if rec is None:
+        return f"{out / 'run.json'} is missing or not a run record, so the chunks cannot be checked"
+    want = rec.get("chunk_sha256")
     if not isinstance(want, dict) or not all(isinstance(v, str) for v in want.values()):
         return f"{out / 'run.json'} does not map the chunk files to their sha256 (edited by hand?)"
     have = sorted(
