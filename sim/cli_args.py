@@ -1,0 +1,126 @@
+"""The arguments of the command line ``sim`` (:mod:`sim.cli`): the parser of every command
+and its options, with one-line errors (exit 2 through :func:`sim.cli.main`)."""
+
+from __future__ import annotations
+
+import argparse
+from importlib import metadata
+
+from sim.mc.config import ConfigError
+from sim.mc.runner import MIN_CHUNKS
+
+__all__ = ["parser"]
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (exit 2 through :func:`main`, no usage dump)."""
+
+    def error(self, message: str):
+        raise ConfigError(None, f"{self.prog}: {message} (see {self.prog} --help)")
+
+
+def _version() -> str:
+    try:
+        return metadata.version("sim")
+    except metadata.PackageNotFoundError:  # a source tree that was never installed
+        return "unknown"
+
+
+def _run_parser(sub) -> None:
+    """The options of ``sim run``."""
+    r = sub.add_parser(
+        "run",
+        help="run a study, print its verdicts, write its results directory",
+        description="Run a study file and write its results directory (Parquet tables, "
+        "figures, README.md); print the verdict counts and the headline claims at the end.",
+    )
+    r.add_argument("study", help="study file, e.g. studies/brown_dilution.toml")
+    r.add_argument(
+        "--out",
+        help="output directory (default: results/<study> when the run equals the committed "
+        "results, else scratch/<study>-<config hash>)",
+    )
+    r.add_argument(
+        "--trials",
+        type=int,
+        help=f"number of Monte-Carlo trials; also picks a chunk size giving at least "
+        f"{MIN_CHUNKS} chunks unless --chunk or chunk= is given",
+    )
+    r.add_argument("--chunk", type=int, help="trials per chunk (the intervals are over chunks)")
+    r.add_argument("--seed", type=int, help="override the root seed")
+    r.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override any config key by its dotted name, value read as TOML (repeatable); "
+        "sim check STUDY.toml lists the keys",
+    )
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument(
+        "--executor",
+        choices=("local", "dask"),
+        default="local",
+        help="local (in-process, or a process pool with --workers) or dask",
+    )
+    r.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    r.add_argument(
+        "--scheduler",
+        help="dask scheduler address tcp://HOST:PORT (default: a LocalCluster started for the run)",
+    )
+    r.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace results of a different config or code version (only results "
+        "directories the suite wrote are ever replaced)",
+    )
+    r.add_argument(
+        "--max-memory-gb",
+        type=float,
+        default=None,
+        help="refuse a run whose estimated memory exceeds this (env SIM_MAX_MEMORY_GB)",
+    )
+    r.add_argument(
+        "--max-adjustments",
+        type=float,
+        default=None,
+        help="refuse a run with more least-squares adjustments than this (env SIM_MAX_ADJUSTMENTS)",
+    )
+
+
+def parser(doc: str) -> argparse.ArgumentParser:
+    """The parser of ``sim``; ``doc``: the command line's module docstring (its first paragraph
+    the description, its second the epilog)."""
+    p = _Parser(
+        prog="sim",
+        description=doc.split("\n\n")[0],
+        epilog="\n\n".join(doc.split("\n\n")[1:2]) + "\n\nsim COMMAND --help: its options.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--version", action="version", version=f"sim {_version()}")
+    sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+    _run_parser(sub)
+    sh = sub.add_parser(
+        "show",
+        help="print one results directory: its claims and verdicts",
+        description="Print the claims of one results directory (a table; --markdown: its "
+        "README.md). DIR may also be a study name under results/.",
+    )
+    sh.add_argument("dir", metavar="DIR", help="a results directory, e.g. results/brown_table1")
+    sh.add_argument("--markdown", action="store_true", help="print the directory's README.md")
+    c = sub.add_parser(
+        "check",
+        help="validate a study file; print each key with its meaning, unit, bounds and the work",
+        description="Validate a study file (and overrides) and print every key with its "
+        "resolved value, meaning, unit and bounds, then the work the run would do.",
+    )
+    c.add_argument("study", help="study file, e.g. studies/brown_dilution.toml")
+    c.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    rep = sub.add_parser(
+        "report",
+        help="rebuild results/REPORT.md and each results/<study>/README.md from the Parquet files",
+        description="Rebuild REPORT.md and each results directory's README.md from the "
+        "Parquet files alone (nothing is run).",
+    )
+    rep.add_argument("--results", default="results", help="the results directory (default results)")
+    return p
