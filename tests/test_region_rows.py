@@ -7,9 +7,10 @@ import math
 
 import numpy as np
 import pytest
+from test_inference import A_UP, SUM, A, B  # the synthetic problem of the inference tests
 
 from sim.claims.book import ClaimBook
-from sim.claims.inference import Input, Statement, explore
+from sim.claims.inference import Statement, explore
 from sim.claims.region import (
     INPUT_COLUMNS,
     RegionVerdict,
@@ -21,10 +22,6 @@ from sim.claims.region import (
     region_table,
 )
 
-A = Input("a_mm", 0.0, 10.0)
-B = Input("b_mm", 0.0, 10.0)
-SUM = Statement("sum", (10.0, 10.0), "value", decimals=0)  # a + b in [9.5, 10.5]
-A_UP = Statement("a_up", (4.0, 4.0), "upper", decimals=0)  # a <= 4.5
 SPEC = {"source": "s", "paper": "p", "form": "lower", "ref": 5.0, "tol": 0.0}
 
 
