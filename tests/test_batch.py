@@ -51,8 +51,8 @@ def _same_tables(a_dir: Path, b_dir: Path):
 
 
 def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
-    """``python -m sim.batch`` as make runs it (a fresh process: forked children, two at a
-    time) gives the files of fresh ``python -m sim run`` processes one at a time."""
+    """``python -m sim.batch`` as make runs it (two runs at a time) gives the files of
+    ``python -m sim run`` processes one at a time."""
     fa, sets = _tiny(tmp_path, "network_testfield.toml")
     fb, _ = _tiny(tmp_path, "network_plate.toml")  # the same study kind: the same sets
     r = subprocess.run(
@@ -76,7 +76,6 @@ def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
     )
     assert r.returncode == 0, r.stderr
     assert r.stdout.count("results in") == 2
-    monkeypatch.delattr(batch.os, "fork")  # the portable path: python -m sim run
     one = batch.run_all([fa, fb], tmp_path / "one", 1, ["--quiet", *sets])
     assert {k: v[0] for k, v in one.items()} == {fa.stem: 0, fb.stem: 0}
     for stem in (fa.stem, fb.stem):
