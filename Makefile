@@ -56,8 +56,8 @@ mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (s
 # config and the hash of the code that study imports (sim/mc/codehash.py). Decided by content,
 # not by file times, so a fresh clone re-runs nothing that is current. The studies run
 # RUN_JOBS at a time, each in its own process with RUN_FLAGS (sim/batch.py; quiet when
-# RUN_JOBS > 1, the slowest first). Two studies of one worker each keep both cores busy and
-# beat two studies of two workers each (results/bench/rerun.parquet: 88.6 s against 100.8 s).
+# RUN_JOBS > 1, the slowest first). Two studies of one worker each keep both cores busy, as
+# fast as two of two workers each and without their pools (results/bench/rerun.parquet).
 RUN_JOBS ?= 2
 
 reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md
