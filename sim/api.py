@@ -109,15 +109,17 @@ class StudyHandle:
         scheduler: str | None = None,
         overwrite: bool = False,
         quiet: bool = True,
+        figures: bool = True,
     ) -> Results:
         """Run the study into ``out`` (default: a new temporary directory) and return its
         :class:`Results`. ``executor``: ``local`` (a process pool when ``workers > 1``) or
-        ``dask``. Output is identical for every executor and worker count."""
+        ``dask``. Output is identical for every executor and worker count. ``figures=False``:
+        no PNG is drawn (``sim run --no-figures``), the tables are the same."""
         _check_path("out", out, none_ok=True)
         for name, v in (("trials", trials), ("seed", seed)):
             if v is not None:
                 _check_int(name, v)
-        for name, v in (("overwrite", overwrite), ("quiet", quiet)):
+        for name, v in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures)):
             if not isinstance(v, bool):
                 raise ConfigError(name, f"must be True or False (got {v!r})")
         h = (
@@ -149,6 +151,7 @@ class StudyHandle:
             scheduler=scheduler,
             overwrite=overwrite,
             quiet=quiet,
+            figures=figures,
         )
         return Results(out, h.name)
 

@@ -54,13 +54,15 @@ SLOW_FIRST = (
 
 def is_current(study_file: str | Path, results: str | Path) -> bool:
     """True when ``results/run.json`` records the study file's resolved config and the
-    study's current code hash."""
+    study's current code hash, and the run drew its figures (not ``--no-figures``)."""
     try:
         record = json.loads((Path(results) / "run.json").read_text())
         _, cfg = load_study(study_file)
     except (OSError, ValueError, ConfigError, StudyError):
         return False
     if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
+        return False
+    if record.get("figures") is False:  # a run without figures (sim run --no-figures)
         return False
     want = study_code_hash(cfg["study"])
     return record.get("config") == json.loads(json.dumps(cfg)) and record.get("code_hash") == want

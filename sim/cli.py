@@ -173,6 +173,7 @@ def _run(args) -> int:
         quiet=args.quiet,
         max_memory_gb=args.max_memory_gb,
         max_adjustments=args.max_adjustments,
+        figures=not args.no_figures,
     )
     try:
         write_run_readme(out, get_study)

@@ -58,6 +58,13 @@ def _run_parser(sub) -> None:
     )
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument(
+        "--no-figures",
+        action="store_true",
+        help="draw no figure (PNG): the same tables, README.md and run.json in less time; "
+        "make verify re-runs this way (it compares tables). make reproduce re-runs such "
+        "results to draw them",
+    )
+    r.add_argument(
         "--executor",
         choices=("local", "dask"),
         default="local",

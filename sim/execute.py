@@ -13,6 +13,7 @@ import dataclasses
 import os
 import re
 import sys
+from contextlib import nullcontext
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -30,6 +31,7 @@ from sim.mc.storage import (
     write_table,
 )
 from sim.mc.sweep import cell_label, cell_seed, expand
+from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
 
 __all__ = ["execute", "run_sweep"]
@@ -118,11 +120,14 @@ def execute(
     quiet: bool = False,
     max_memory_gb: float | None = None,
     max_adjustments: float | None = None,
+    figures: bool = True,
 ):
     """Run a validated study config (and its sweep) into ``out`` (absolute): estimate and
     limits, output checks, executor, locked staging directory, the run, and the final
-    replacement of ``out``. Raises ConfigError/StudyError (one line) on any failure.
-    Returns the run's :class:`sim.mc.estimate.Estimate`."""
+    replacement of ``out``. ``figures=False``: no figure is drawn (the tables are the same;
+    ``run.json`` says ``"figures": false``, so ``make reproduce`` does not take the results
+    as up to date). Raises ConfigError/StudyError (one line) on any failure. Returns the
+    run's :class:`sim.mc.estimate.Estimate`."""
 
     shown = shown or str(out)
     _check_options(executor, workers, scheduler)
@@ -133,6 +138,7 @@ def execute(
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
         "code_hash": code_hash(cfg["study"]),
         "versions": versions(),
+        **({} if figures else {"figures": False}),
     }
     check_out(out, shown, record, overwrite)
     stage = out.parent / f".{out.name}.partial"
@@ -145,6 +151,9 @@ def execute(
     lock = None
     try:
         lock, resumed = prepare_stage(stage, out, shown, record, overwrite)
+        if not figures:  # figures of an earlier, killed attempt would pass for this run's
+            for png in stage.rglob("*.png"):
+                png.unlink()
         if resumed:
             print(f"sim: resuming {cfg['study']}: {resumed} finished chunks found", file=sys.stderr)
         ctx = RunContext(
@@ -154,7 +163,7 @@ def execute(
             estimate=est,
         )
         try:
-            with ctx.progress_bar(cfg["study"]):
+            with ctx.progress_bar(cfg["study"]), nullcontext() if figures else without_figures():
                 run_sweep(study, cfg, sweep, stage, ctx) if sweep else study.run(cfg, stage, ctx)
         except (ConfigError, StudyError):
             raise

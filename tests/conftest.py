@@ -114,9 +114,11 @@ def tiny_run(tmp_path_factory):
     its tiny size on 1 worker with ``options`` (more ``sim run`` options, e.g. ``--executor
     dask --workers 2``; :func:`tiny_command`), run once per session and shared by every test
     (and every ``pytest -n`` process: a directory of the session's base, a lock per run, a
-    failure recorded once). ``elsewhere=True``: on 2 workers on another numerical path
-    (:data:`ELSEWHERE`), with every figure's layout check and facts written to
-    ``<dir>.figures.jsonl`` (``SIM_FIGURE_CHECK``, :func:`sim.report.plotting.save`).
+    failure recorded once). Without options, every figure's layout check and facts are
+    written to ``<dir>.figures.jsonl`` (``SIM_FIGURE_CHECK``, :func:`sim.report.plotting.save`:
+    the check runs after the PNG is written and leaves it as it is). ``elsewhere=True``: on 2
+    workers on another numerical path (:data:`ELSEWHERE`) and without figures (``--no-figures``:
+    its tables are compared, and the figures are drawn by the run on the usual path).
     READ ONLY: a test that edits a file copies it first."""
     base = tmp_path_factory.getbasetemp()
     cache = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "tiny-runs"
@@ -129,7 +131,10 @@ def tiny_run(tmp_path_factory):
         out, failed = cache / key, cache / f"{key}.failed"
         env = dict(os.environ)
         if elsewhere:
-            env.update(ELSEWHERE, SIM_FIGURE_CHECK=str(cache / f"{key}.figures.jsonl"))
+            env.update(ELSEWHERE)
+            options = (*options, "--no-figures")
+        elif not options:
+            env.update(SIM_FIGURE_CHECK=str(cache / f"{key}.figures.jsonl"))
         with open(cache / f"{key}.lock", "w") as lock:
             fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
             if not out.exists() and not failed.exists():

@@ -71,5 +71,9 @@ def test_api_errors_name_the_key(tmp_path):
     with pytest.raises(sim.ConfigError, match="is a file"):
         st.run(out=f, overwrite=True)
     assert f.read_text() == "mine"
+    with pytest.raises(sim.ConfigError, match="figures"):
+        st.run(out=tmp_path / "o", figures="no")
+    r = st.run(out=tmp_path / "o", figures=False)  # the tables, no PNG
+    assert r.table("claims").num_rows and not list((tmp_path / "o").glob("*.png"))
     with pytest.raises(sim.ConfigError, match="no table"):
-        st.run(out=tmp_path / "o").table("nope")
+        r.table("nope")

@@ -67,6 +67,7 @@ def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
             str(fa),
             str(fb),
             "--",
+            "--no-figures",  # the tables are compared
             *sets,
         ],
         cwd=ROOT,
@@ -76,7 +77,7 @@ def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
     )
     assert r.returncode == 0, r.stderr
     assert r.stdout.count("results in") == 2
-    one = batch.run_all([fa, fb], tmp_path / "one", 1, ["--quiet", *sets])
+    one = batch.run_all([fa, fb], tmp_path / "one", 1, ["--quiet", "--no-figures", *sets])
     assert {k: v[0] for k, v in one.items()} == {fa.stem: 0, fb.stem: 0}
     for stem in (fa.stem, fb.stem):
         _same_tables(tmp_path / "one" / stem, tmp_path / "two" / stem)
@@ -99,12 +100,15 @@ def test_a_failed_run_does_not_stop_the_others_and_sets_the_exit_code(tmp_path, 
     fa, sa = _tiny(tmp_path, "network_testfield.toml")
     bad = tmp_path / "broken.toml"
     bad.write_text("study = 'brown_table1'\nnot_a_key = 1\n")
-    done = batch.run_all([bad, fa], tmp_path / "r", 2, [], extra={fa.stem: sa})
+    done = batch.run_all([bad, fa], tmp_path / "r", 2, ["--no-figures"], extra={fa.stem: sa})
     assert done["broken"][0] == 2 and done[fa.stem][0] == 0
     assert (tmp_path / "r" / fa.stem / "run.json").is_file()
     assert "not_a_key" in capfd.readouterr().err
     # the first failure's exit code (the bad file runs first: it is not among the slowest)
-    assert batch.main(["--results", str(tmp_path / "m"), str(bad), str(fa), "--", *sa]) == 2
+    assert (
+        batch.main(["--results", str(tmp_path / "m"), str(bad), str(fa), "--", *sa, "--no-figures"])
+        == 2
+    )
     assert (tmp_path / "m" / fa.stem / "run.json").is_file()
 
 

@@ -40,8 +40,12 @@ def test_results_are_current_until_the_config_changes(tmp_path):
     )
     out = tmp_path / "out"
     assert not is_current(study, out)  # nothing there yet
+    assert main(["run", str(study), "--out", str(out), "--quiet", "--no-figures"]) == 0
+    assert not is_current(study, out)  # results without figures: make reproduce draws them
+    assert not list(out.glob("*.png")) and "not drawn" in (out / "README.md").read_text()
     assert main(["run", str(study), "--out", str(out), "--quiet"]) == 0
-    assert is_current(study, out)
+    assert is_current(study, out) and list(out.glob("*.png"))
+    assert "not drawn" not in (out / "README.md").read_text()
     study.write_text(study.read_text().replace("seed = ", "seed = 11 # ", 1))
     assert not is_current(study, out)
 

@@ -45,7 +45,8 @@ def test_sweep_of_one_cell_equals_the_single_run_with_the_same_seed(tmp_path):
         sw.write_text(
             TABLE1.format(trials=20) + f'\n[sweep]\nseed_mode = "{mode}"\n"errors.settings" = [2]\n'
         )
-        assert main(["run", str(sw), "--out", str(tmp_path / f"sw_{mode}"), "--quiet"]) == 0
+        out = ["--out", str(tmp_path / f"sw_{mode}"), "--quiet", "--no-figures"]  # claims read
+        assert main(["run", str(sw), *out]) == 0
         rows = read_table(tmp_path / f"sw_{mode}" / "sweep.parquet").to_pydict()
         assert rows["cell"] == [0] and rows["feasible"] == [True]
         seed = rows["seed"][0]
@@ -60,6 +61,7 @@ def test_sweep_of_one_cell_equals_the_single_run_with_the_same_seed(tmp_path):
                     "--seed",
                     str(seed),
                     "--quiet",
+                    "--no-figures",
                 ]
             )
             == 0
@@ -363,16 +365,19 @@ def test_coverage_of_a_linear_models_ellipses_is_95_percent():
 
 
 def test_sweep_rows_draw_and_tabulate(tmp_path):
-    from sim.report.sweep import sweep_markdown
+    from sim.report.sweep import fig_sweep, sweep_markdown
 
     sw = tmp_path / "sw.toml"
     sw.write_text(
         TABLE1.format(trials=20) + '\n[sweep]\n"errors.settings" = [1, 2]\n'
         '"plate.spacing_mm" = [45.0, 80.0]\n'
     )
-    assert main(["run", str(sw), "--out", str(tmp_path / "o"), "--quiet"]) == 0
-    assert (tmp_path / "o" / "sweep.png").is_file()
-    md = sweep_markdown(tmp_path / "o")
+    # the cells' own figures are not read here: the sweep's figure is drawn from its table
+    assert main(["run", str(sw), "--out", str(tmp_path / "o"), "--quiet", "--no-figures"]) == 0
+    o = tmp_path / "o"
+    assert not list(o.rglob("*.png")) and "sweep.png" not in sweep_markdown(o)
+    assert fig_sweep(o / "sweep.parquet", o / "sweep.png") == o / "sweep.png"
+    md = sweep_markdown(o)
     assert md.count("\n") >= 5 and "no: plate.spacing_mm" in md and "sweep.png" in md
 
 

@@ -141,9 +141,9 @@ READER = {
 
 @pytest.mark.parametrize("study", sorted(MODULES))
 def test_every_figure_of_a_study_reads_cleanly(study, tiny_run):
-    """Every figure of the study's shared tiny run on 2 workers (``tiny_run(...,
-    elsewhere=True)``: each figure checked where it is drawn, ``SIM_FIGURE_CHECK``)."""
-    out = tiny_run(FILES.get(study, study), elsewhere=True)
+    """Every figure of the study's shared tiny run (``tiny_run``: each figure checked where it
+    is drawn, after its PNG is written, ``SIM_FIGURE_CHECK``)."""
+    out = tiny_run(FILES.get(study, study))
     found, facts = {}, {}
     for line in Path(f"{out}.figures.jsonl").read_text().splitlines():
         rec = json.loads(line)

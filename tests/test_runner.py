@@ -139,6 +139,7 @@ def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path, capsys):
         "--trials",
         "20000",
         "--quiet",
+        "--no-figures",  # its trials are read, not its figures
         "--set",
         "chunk=50",
         *REGION,

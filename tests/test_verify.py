@@ -242,8 +242,11 @@ def test_another_numerical_path_agrees_by_the_same_rules(kind, tiny_run):
     if any(k in os.environ for k in ELSEWHERE):
         pytest.skip("the environment already sets OPENBLAS_CORETYPE or SIM_NO_JIT")
     study = FILES.get(kind, kind)
-    c = compare_dirs(tiny_run(study), tiny_run(study, elsewhere=True), study)
+    usual, other = tiny_run(study), tiny_run(study, elsewhere=True)
+    c = compare_dirs(usual, other, study)
     assert c.files >= 2 and c.ok, c.failures
+    # the run elsewhere drew no figures (--no-figures): the same tables without them
+    assert list(usual.glob("*.png")) and not list(other.rglob("*.png"))
 
 
 #: the committed results (SIM_VERIFY_RESULTS: another results directory, e.g. a fresh make rerun)
@@ -266,7 +269,7 @@ def test_fewer_trials_elsewhere_agree_with_the_committed_results(study, tmp_path
     if not is_current(ROOT / "studies" / f"{study}.toml", committed):
         pytest.skip(f"the committed results of {study} are not current: make reproduce")
     scratch = tmp_path / "scratch"
-    _run(study, scratch / study, 2, ELSEWHERE, *REDUCED[study])
+    _run(study, scratch / study, 2, ELSEWHERE, "--no-figures", *REDUCED[study])
     results = tmp_path / "results"
     results.mkdir()
     (results / study).symlink_to(committed)

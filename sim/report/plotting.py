@@ -30,6 +30,7 @@ __all__ = [
     "DRAWING",
     "layout_problems",
     "checking_figures",
+    "without_figures",
     "figure_facts",
     "hist_bins",
     "UNITLESS",
@@ -254,6 +255,25 @@ def checking_figures(facts: dict | None = None) -> Iterator[dict[str, list[str]]
         _RECORDER = old
 
 
+#: set while a run draws no figures (:func:`without_figures`)
+_SKIP = threading.Event()
+
+
+@contextmanager
+def without_figures() -> Iterator[None]:
+    """Inside, no figure is drawn or written (``sim run --no-figures``, and the re-runs of
+    ``make verify``, which compares tables only): :func:`draw` skips its jobs, :func:`save`
+    closes the figure without a file, and :func:`place_legend` skips its layout pass. The
+    tables are the same: no figure function writes a table from its drawing."""
+    was = _SKIP.is_set()
+    _SKIP.set()
+    try:
+        yield
+    finally:
+        if not was:
+            _SKIP.clear()
+
+
 def save(fig, path: str | Path) -> Path:
     """Save ``fig`` as PNG without a timestamp or version stamp, then close it. Inside
     :func:`checking_figures` (or with ``SIM_FIGURE_CHECK`` set) the saved figure is then
@@ -261,6 +281,9 @@ def save(fig, path: str | Path) -> Path:
     figure at the screen's resolution and a layout drawn twice can settle elsewhere (the PNG
     is the same with the check on or off)."""
     path = Path(path)
+    if _SKIP.is_set():  # a run without figures (:func:`without_figures`)
+        plt.close(fig)
+        return path
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", metadata={"Software": None}, bbox_inches="tight")
     if _RECORDER is not None:
@@ -281,7 +304,10 @@ DRAWING = threading.Lock()
 def draw(jobs: Sequence[tuple[Callable, tuple]]) -> None:
     """Draw every figure job ``fn(*args)`` (``fn`` draws one figure and saves it) in this
     process, one at a time under :data:`DRAWING`. (Figures once went to the pool's idle
-    workers; ``make bench`` found that it saved under 20 % of any study's time, so it went.)"""
+    workers; ``make bench`` found that it saved under 20 % of any study's time, so it went.)
+    Nothing is drawn inside :func:`without_figures`."""
+    if _SKIP.is_set():
+        return
     for fn, args in jobs:
         with DRAWING:
             fn(*args)
@@ -316,6 +342,8 @@ def place_legend(ax, *args, **kw):
     """``ax.legend(*args, **kw)`` at the first place inside the axes where it hides no data
     (markers, lines, bars: :func:`sim.report.figcheck.data_points`), else outside on the
     right. Call it once the axes' data and limits are final."""
+    if _SKIP.is_set():  # no figure will be saved: no layout pass to place it
+        return ax.legend(*args, **kw)
     fig = ax.figure
     fig.draw_without_rendering()  # the layout and text extents, no pixels
     renderer = fig.canvas.get_renderer()

@@ -68,7 +68,10 @@ def config(out: Path) -> dict[str, Any]:
 
 
 def figure(out: Path, file: str, alt: str) -> str:
-    """The Markdown line of one figure of the study, relative to the report."""
+    """The Markdown line of one figure of the study, relative to the report; a line saying
+    so when the run drew no figures (``sim run --no-figures``)."""
+    if not (Path(out) / file).is_file():
+        return f"*{alt}: not drawn (`{file}` is missing: a run with `--no-figures`?)*"
     return f"![{alt}]({Path(out).name}/{file})"
 
 
