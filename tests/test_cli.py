@@ -157,8 +157,7 @@ def test_a_new_seed_gives_new_trials(tmp_path):
     # it for every study (one worker against two, killed and resumed); here a new seed
     a = tmp_path / "a"
     assert (
-        main(["run", str(BROWN), "--out", str(a), "--trials", "40", "--quiet", "--set", "chunk=2"])
-        == 0
+        main(["run", str(BROWN), "--out", str(a), "--trials", "40", "--quiet", "--no-figures"]) == 0
     )
     c = tmp_path / "c"
     assert (
@@ -173,8 +172,7 @@ def test_a_new_seed_gives_new_trials(tmp_path):
                 "--seed",
                 "5",
                 "--quiet",
-                "--set",
-                "chunk=2",
+                "--no-figures",
             ]
         )
         == 0
@@ -232,9 +230,9 @@ def test_a_symlink_and_a_foreign_staging_directory_are_never_replaced(tmp_path, 
 def test_an_empty_directory_and_our_own_results_are_replaced(tmp_path):
     out = tmp_path / "res"
     out.mkdir()
-    assert _run(tmp_path, out) == 0
+    assert _run(tmp_path, out, "--no-figures") == 0  # where the run writes, not what
     assert (out / "run.json").is_file() and not (out / ".lock").exists()
-    assert _run(tmp_path, out, "--seed", "3", "--overwrite") == 0
+    assert _run(tmp_path, out, "--seed", "3", "--overwrite", "--no-figures") == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.toml", "res"]
 
 

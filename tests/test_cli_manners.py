@@ -113,10 +113,13 @@ def test_trials_picks_a_chunk_size_giving_enough_chunks(tmp_path, capsys):
     assert "README.md" in json.loads((out / "run.json").read_text())["files"]
     # --chunk chooses; the study file's own chunk stays without --trials
     out2 = tmp_path / "out2"
-    assert main(["run", str(study), "--trials", "60", "--chunk", "3", "--out", str(out2)]) == 0
+    more = ["--quiet", "--no-figures"]  # the config is read, not the figures
+    assert (
+        main(["run", str(study), "--trials", "60", "--chunk", "3", "--out", str(out2), *more]) == 0
+    )
     assert json.loads((out2 / "run.json").read_text())["config"]["chunk"] == 3
     out3 = tmp_path / "out3"
-    assert main(["run", str(study), "--out", str(out3), "--quiet"]) == 0
+    assert main(["run", str(study), "--out", str(out3), *more]) == 0
     assert json.loads((out3 / "run.json").read_text())["config"]["chunk"] == 2
 
 
@@ -147,7 +150,7 @@ def test_a_different_run_goes_to_scratch_and_leaves_results_alone(tmp_path, caps
     assert main(["run", str(study), "--out", str(committed), "--quiet"]) == 0
     before = (committed / "run.json").read_text()
     capsys.readouterr()
-    assert main(["run", str(study), "--seed", "5", "--quiet"]) == 0
+    assert main(["run", str(study), "--seed", "5", "--quiet", "--no-figures"]) == 0
     err = capsys.readouterr().err
     assert "writing to scratch/brown_table1-" in err and "seed 20261122 -> 5" in err
     assert (committed / "run.json").read_text() == before
@@ -155,7 +158,7 @@ def test_a_different_run_goes_to_scratch_and_leaves_results_alone(tmp_path, caps
     assert json.loads((scratch / "run.json").read_text())["config"]["seed"] == 5
     # the same command again reuses its scratch directory; the committed run's own config
     # (same code) goes to results/ as before
-    assert main(["run", str(study), "--seed", "5", "--quiet"]) == 0
+    assert main(["run", str(study), "--seed", "5", "--quiet", "--no-figures"]) == 0
     assert len(list(Path("scratch").iterdir())) == 1
     capsys.readouterr()
     assert main(["run", str(study), "--quiet"]) == 0

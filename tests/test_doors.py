@@ -25,7 +25,8 @@ TINY = list(tiny_overrides(STUDY))
 
 
 def _run(out: Path, *extra: str) -> int:
-    return main(["run", str(STUDY), "--out", str(out), "--quiet", *TINY, *extra])
+    """A tiny run into ``out`` without figures (these tests are about what it writes where)."""
+    return main(["run", str(STUDY), "--out", str(out), "--quiet", "--no-figures", *TINY, *extra])
 
 
 # --- the Python API ------------------------------------------------------------------------

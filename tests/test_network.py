@@ -379,6 +379,7 @@ def test_a_sweep_tabulates_the_design_figures_per_cell(tmp_path):
             "--out",
             str(tmp_path / "s"),
             "--quiet",
+            "--no-figures",  # the cells' tables are read
             "--set",
             "trials=200",
             "--set",

@@ -100,7 +100,7 @@ def test_dask_local_cluster_equals_local(tiny_run):
 def test_refuses_to_mix_a_different_config(tmp_path, capsys):
     o = tmp_path / "o"
     args = ["run", str(STUDY), "--out", str(o), "--trials", "20", "--quiet", "--set", "chunk=1"]
-    args += REGION
+    args += [*REGION, "--no-figures"]
     assert main(args) == 0
     assert main(args + ["--seed", "2"]) == 2
     err = capsys.readouterr().err
@@ -204,7 +204,7 @@ def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, 
     f = tmp_path / "s.toml"
     f.write_text(SMALL + '[sweep]\n"plate.grid" = [2, 5]\n')
     out = tmp_path / "sw"
-    assert main(["run", str(f), "--out", str(out), "--quiet"]) == 0
+    assert main(["run", str(f), "--out", str(out), "--quiet", "--no-figures"]) == 0
     t = pq.read_table(out / "sweep.parquet").to_pydict()
     assert t["plate.grid"] == [2, 5]
     assert t["feasible"] == [False, True]
@@ -248,7 +248,7 @@ def test_dotted_range_syntax_and_sweep_chunks_carry_provenance(tmp_path):
 
     f = tmp_path / "s.toml"
     f.write_text(SMALL + "[sweep]\nerrors.settings = {start = 2, stop = 3, num = 2}\n")
-    assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet", "--no-figures"]) == 0
     t = pq.read_table(tmp_path / "o" / "sweep.parquet").to_pydict()
     assert t["errors.settings"] == [2.0, 3.0] and t["feasible"] == [True, True]
     prov = read_provenance(
