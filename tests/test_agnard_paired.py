@@ -14,11 +14,11 @@ from sim.claims.region import statement_of
 from sim.studies.agnard.claims import load_book
 from sim.studies.agnard.paired import (
     GRID,
-    Z_BOX,
     mapped,
     paired_evidence,
     paired_shift,
     variance_ratio,
+    z_box,
 )
 
 CID = "agnard.control_21.check_z_cm"  # printed 24 cm, tol 4.8: zone 18.7-29.3 cm
@@ -126,10 +126,11 @@ def test_the_map_stretches_only_where_the_pairs_show_the_spread_changed():
     assert x.shape == (2, GRID * GRID, 200)
     mid = GRID * GRID // 2
     assert np.allclose(x[1, mid], base * np.exp(used.delta[1]))
-    # the lattice reaches the interval's ends, +-Z_BOX standard errors
+    # the lattice reaches the interval's ends, +-z standard errors (Student, 47 dof)
+    assert used.z == z_box(48) == pytest.approx(2.3155, abs=1e-3)
     ends = np.log(x[1, :, 0] / base[0])
-    assert ends.min() == pytest.approx(used.delta[1] - Z_BOX * used.delta_se[1])
-    assert ends.max() == pytest.approx(used.delta[1] + Z_BOX * used.delta_se[1])
+    assert ends.min() == pytest.approx(used.delta[1] - used.z * used.delta_se[1])
+    assert ends.max() == pytest.approx(used.delta[1] + used.z * used.delta_se[1])
 
 
 def test_bad_blocks_decide_nothing():

@@ -24,6 +24,11 @@ the grid correction; Table 1's eight printed rms are the constraints, one-block 
 decided by the book's one-plate rule. When no vector is consistent the region is empty and
 :attr:`~sim.claims.inference.Region.conflicts` names the statements that conflict: Table 1
 is then not comparable because of that (``claims.toml`` says so in the paper's words).
+Set aside, Table 1 leaves every explored vector, and the 21-control predictions (Tables 2-3
+and the acceptance limits) are decided over them all: each vector's blocks are paired with
+the configured scanner's on the same seeds, and a row's evidence at the vector is the
+configured scanner's main blocks moved by the paired shift (:mod:`sim.studies.agnard.paired`,
+:func:`shift_table`).
 """
 
 from __future__ import annotations

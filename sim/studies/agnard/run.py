@@ -10,7 +10,8 @@ the run context (executor, chunk store), with picklable chunk functions
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
 tables, ``region_five.parquet`` (per block, layout and centres option), ``consistent_region.parquet``,
 ``region_inputs.parquet``, ``region_layouts.parquet``, ``scanner_region.parquet`` (every
-explored scanner vector) and ``scanner_region_inputs.parquet``,
+explored scanner vector, with the 21-control rows' per-vector outcomes),
+``scanner_region_inputs.parquet``, ``scanner_shift.parquet`` (each vector's paired shift),
 ``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each drawn as soon as its data exist).
 """
 
