@@ -136,16 +136,21 @@ def paired_shift(c: np.ndarray, v: np.ndarray) -> Shift:
         raise ValueError(f"need the same k >= 2 blocks for c and v, not {k} and {w.shape[1]}")
     d = w - u
     su, sw = u.std(ddof=1), w.std(axis=1, ddof=1)
+    uc, wc = u - u.mean(), w - w.mean(axis=1, keepdims=True)
     with np.errstate(divide="ignore", invalid="ignore"):
-        rho = np.clip(np.mean((w - w.mean(1, keepdims=True)) * (u - u.mean()), 1) * k
-                      / (k - 1) / (su * sw), -1.0, 1.0)  # fmt: skip
+        rho = np.clip((wc * uc).sum(1) / (k - 1) / (su * sw), -1.0, 1.0)
         log_beta = np.log(sw / su)
+        # 1 - rho^2 as the share of w's variance that u leaves unexplained (the regression's
+        # residuals): no cancellation near |rho| = 1, where 1 - rho^2 is rounding alone
+        res = wc - ((wc * uc).sum(1) / (uc * uc).sum())[:, None] * uc
+        unexplained = np.clip((res * res).sum(1) / (wc * wc).sum(1), 0.0, 1.0)
     rho = np.where(np.isfinite(rho), rho, 1.0 if su == 0 else 0.0)
+    unexplained = np.where(np.isfinite(unexplained), unexplained, 1.0 - rho**2)
     return Shift(
         d.mean(1),
         d.std(axis=1, ddof=1) / np.sqrt(k),
         log_beta,
-        np.sqrt(np.maximum(1.0 - rho**2, 0.0) / (k - 1)),
+        np.sqrt(unexplained / (k - 1)),
         rho,
         float(u.mean()),
         z_box(k),
