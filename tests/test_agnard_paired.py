@@ -145,3 +145,25 @@ def test_bad_blocks_decide_nothing():
         paired_shift(c, v[:, :5])
     with pytest.raises(ValueError, match="same k"):
         paired_shift(c[:1], v[:, :1])
+
+
+def test_a_grid_stream_of_its_own_keeps_blocks_of_two_grid_spacings_paired():
+    """The grid's node count depends on its spacing; with its noise from ``grid_rng`` every
+    other draw of two scanners' blocks is the same (model frames, control, pointing), without
+    it the main stream shifts and the blocks are no longer paired."""
+    from sim.studies import load_study
+    from sim.studies.agnard.schema import block_of
+    from sim.studies.agnard.simulate import Simulated
+
+    _, cfg = load_study("studies/agnard_block.toml")
+    b = block_of(cfg)
+
+    def sim(grid_mm, paired):
+        g = np.random.default_rng(2) if paired else None
+        c = {**cfg, "scan.grid_mm": grid_mm}
+        return Simulated(c, b, np.random.default_rng(1), 2, cfg["scan.dpi"], grid_rng=g)
+
+    for paired in (True, False):
+        a, z = sim(5.0, paired), sim(20.0, paired)
+        same = np.array_equal(a.ctrl_obs, z.ctrl_obs) and np.array_equal(a.R, z.R)
+        assert same == paired
