@@ -53,6 +53,7 @@ Arrays in, arrays out: the vectors' samples have a leading vector axis ``(N, k)`
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy import stats
@@ -75,6 +76,7 @@ __all__ = [
 LEVEL = 1 - 0.05 / 2
 
 
+@lru_cache(maxsize=None)
 def z_box(k: int) -> float:
     """Half-width of each parameter's interval in standard errors from ``k`` pairs: Student's
     two-sided :data:`LEVEL` point with ``k - 1`` degrees of freedom (2.31 at k = 48; the
