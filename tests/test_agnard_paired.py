@@ -14,6 +14,7 @@ from sim.claims.region import statement_of
 from sim.studies.agnard.claims import load_book
 from sim.studies.agnard.paired import (
     GRID,
+    MIN_TEST_PAIRS,
     mapped,
     paired_evidence,
     paired_shift,
@@ -111,7 +112,8 @@ def test_paired_variance_is_smaller_than_unpaired_by_the_derived_ratio():
 
 def test_the_map_stretches_only_where_the_pairs_show_the_spread_changed():
     """log v = 1.6 log c (spread 60 % wider): stretched, log beta ~ log 1.6; v = 1.1 c (the
-    same relative spread): not stretched, and the map is a pure shift."""
+    same relative spread): not stretched, and the map is a pure shift; on fewer pairs than
+    the test needs, stretched whatever they show."""
     rng = np.random.default_rng(5)
     c = 20 * np.exp(0.1 * rng.standard_normal(48))
     m = np.log(c).mean()
@@ -121,6 +123,10 @@ def test_the_map_stretches_only_where_the_pairs_show_the_spread_changed():
     assert sh.log_beta[0] == pytest.approx(np.log(1.6), abs=3 * sh.log_beta_se[0] + 0.01)
     used = sh.map_of()
     assert used.log_beta[1] == 0 and used.log_beta_se[1] == 0
+    # the same 10 % shift seen on 8 pairs only: too few to test the map, so it stretches
+    few = paired_shift(c[:8], 1.1 * c[None, :8] * np.exp(0.02 * rng.standard_normal(8)))
+    assert few.k == 8 < MIN_TEST_PAIRS and few.stretched[0]
+    assert few.map_of().log_beta_se[0] == few.log_beta_se[0] > 0
     base = 20 * np.exp(0.1 * rng.standard_normal(200))
     x = mapped(base, used)
     assert x.shape == (2, GRID * GRID, 200)

@@ -30,8 +30,9 @@ is positive and its spread grows with its level) the pair of samples ``u = log c
 The vector's blocks are then the configured ``base`` blocks shifted in logarithms,
 ``log x = log base + delta`` (:func:`mapped`): the configured distribution moved, its relative
 width kept. That is the map's assumption, and it is tested at every vector on its own pairs:
-where ``|log beta| > z`` standard errors (the pairs show the relative spread changed),
-the map stretches as well, ``log x = m + delta + beta (log base - m)`` (``m`` the mean of
+where ``|log beta| > z`` standard errors (the pairs show the relative spread changed), or
+where the pairs are too few for the test to see a 30 % change (:data:`MIN_TEST_PAIRS`), the
+map stretches as well, ``log x = m + delta + beta (log base - m)`` (``m`` the mean of
 ``u``) with ``log beta`` over its interval. At the configured scanner itself ``delta = 0``
 and ``beta = 1`` with no error, so the row's evidence there is exactly the book's over
 ``base``. Checked at full size against 500 blocks simulated directly at each of the 16
@@ -69,6 +70,7 @@ from sim.claims.book_region import sample_evidence
 __all__ = [
     "LEVEL",
     "GRID",
+    "MIN_TEST_PAIRS",
     "z_box",
     "Shift",
     "paired_shift",
@@ -92,6 +94,10 @@ def z_box(k: int) -> float:
 
 #: lattice points per parameter over its interval (odd: the estimate itself is one of them)
 GRID = 5
+#: fewer pairs than this cannot test the shift-only map, and the map always stretches: the
+#: test sees a change of the spread by 30 % (|log beta| 0.26) at the pairs' typical
+#: correlation 0.8 only when z sqrt((1 - 0.8^2) / (k - 1)) < 0.26 with z about 2.3, i.e. k >= 30
+MIN_TEST_PAIRS = 30
 
 
 @dataclass(frozen=True)
@@ -108,11 +114,14 @@ class Shift:
     rho: np.ndarray
     m: float
     z: float
+    k: int
 
     @property
     def stretched(self) -> np.ndarray:
         """Per vector: the pairs contradict the shift-only map (``|log beta| > z se``, beyond
-        the rounding of two equal spreads)."""
+        the rounding of two equal spreads), or are too few to test it (:data:`MIN_TEST_PAIRS`)."""
+        if self.k < MIN_TEST_PAIRS:
+            return np.ones(self.log_beta.shape, bool)
         return np.abs(self.log_beta) > self.z * self.log_beta_se + 1e-9
 
     def map_of(self) -> "Shift":
@@ -126,6 +135,7 @@ class Shift:
             self.rho,
             self.m,
             self.z,
+            self.k,
         )
 
 
@@ -162,6 +172,7 @@ def paired_shift(c: np.ndarray, v: np.ndarray) -> Shift:
         rho,
         float(u.mean()),
         z_box(k),
+        k,
     )
 
 
