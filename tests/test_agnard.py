@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from verdict_check import check_region_rows
+from verdict_check import region_verdict
 
 from sim.claims.region import REGION_VERDICTS
 from sim.instruments.block import data_snooping as ds
@@ -422,8 +422,28 @@ def test_five_control_rows_decided_over_the_region(tiny_run):
         assert r["interval"] == "region"
         assert r["verdict"] in REGION_VERDICTS
         assert r["value"] <= r["value_high"]
-    # 8 rows of region.toml and the joint X, Y row, each with its per-point column
-    assert check_region_rows(out) == 9
+    # 8 rows of region.toml and the joint X, Y row, each with its per-point column; as many of
+    # scanner.toml over the scanner's vectors
+    assert _check_region_rows(out) == (9, 9)
+
+
+def _check_region_rows(out) -> tuple[int, int]:
+    """Every row decided over a region has the verdict its per-point outcomes give: the
+    layout region's in consistent_region.parquet, the scanner's in scanner_region.parquet
+    (every explored vector: Table 1, which empties it, is set aside); the two counts."""
+    from sim.mc.storage import read_table
+
+    five = read_table(out / "consistent_region.parquet").to_pydict()
+    scan = read_table(out / "scanner_region.parquet").to_pydict()
+    claims = read_table(out / "claims.parquet").to_pylist()
+    n = [0, 0]
+    for c in (c for c in claims if c["interval"] == "region"):
+        in_scan = c["claim"] not in five
+        table = scan if in_scan else five
+        assert c["claim"] in table, c["claim"]
+        assert c["outcome"] == region_verdict(table[c["claim"]]), c["claim"]
+        n[in_scan] += 1
+    return n[0], n[1]
 
 
 def test_joint_xy_rows_and_xy_paper_checks(tiny_run):
@@ -431,7 +451,6 @@ def test_joint_xy_rows_and_xy_paper_checks(tiny_run):
     headline is the Holm test of its X and Y rows (the 21-control one from the two rows'
     p, the 5-control one over the layout region); the 5-control check Z is decided over the
     layouts with and without projection centres; the Y/X ratio is a finding."""
-    from sim.claims.family import holm
     from sim.mc.storage import read_table
     from sim.studies.agnard.claims import JOINT, MEMBERS
 
@@ -442,10 +461,12 @@ def test_joint_xy_rows_and_xy_paper_checks(tiny_run):
             r = rows[f"agnard.{b}.{w}_xy_cm"]
             assert r["kind"] == "paper-check" and r["interval"] == "exact"
             assert r["verdict"] == "holds" and not r["headline"]
-    j21 = rows[JOINT["control_21"]]
-    p = [rows[m]["p_plate"] for m in MEMBERS[JOINT["control_21"]]]
-    assert j21["headline"] and math.isclose(j21["value"], holm(p).min())
-    assert (j21["verdict"] == "fails") == (j21["value"] < 0.05)
+    j21 = rows[JOINT["control_21"]]  # over the scanner's vectors, from its members' p
+    assert j21["headline"] and j21["interval"] == "region" and j21["verdict"] in REGION_VERDICTS
+    shift = read_table(out / "scanner_shift.parquet").to_pydict()
+    for m in MEMBERS[JOINT["control_21"]]:
+        assert rows[m]["interval"] == "region" and "common random numbers" in rows[m]["note"]
+        assert m in shift["claim"]
     j5 = rows[JOINT["control_5"]]
     assert j5["headline"] and j5["interval"] == "region" and j5["verdict"] in REGION_VERDICTS
     z = rows["agnard.control_5.check_z_cm"]
@@ -453,6 +474,10 @@ def test_joint_xy_rows_and_xy_paper_checks(tiny_run):
     assert rows["agnard.anisotropy.y_over_x"]["verdict"] == "finding"
     text = study.report(out)
     assert text.index("**Consistent region.**") < text.index("Verdicts over the region:")
+    five = text[text.index("Verdicts over the region:") : text.index("**Scanner region")]
+    assert "agnard.control_5.check_z_cm" in five and "agnard.control_21." not in five
+    scanner = text[text.index("**Predictions over the scanner's inputs**") :]
+    assert "`agnard.control_21.check_z_cm`" in scanner and "common random numbers" in scanner
     assert f"`{JOINT['control_5']}` (headline)" in text
     assert "check X and Y as one Holm test" in text
 
@@ -503,7 +528,17 @@ def test_scanner_inputs_set_the_config_keys_they_name():
         for c in ("x", "y")
     }
     assert all(book.spec(s.id)["kind"] == "not comparable" for s in dec.statements)
-    assert dec.predictions == [] and all(i.why for i in dec.inputs)
+    assert all(i.why for i in dec.inputs)
+    # every simulated 21-control prediction (not the XY paper-checks, not the Holm row, which
+    # is decided from its members): Tables 2-3's and the acceptance limits'
+    assert set(dec.predictions) == {
+        c
+        for c, spec in book.specs.items()
+        if c.startswith(("agnard.control_21.", "agnard.max_residual.control_21_"))
+        and spec["kind"] == "prediction"
+        and spec["form"] in ("one-plate", "upper")
+    }
+    assert len(dec.predictions) == 8
 
 
 def test_budget_recomputation_and_pointing_model():

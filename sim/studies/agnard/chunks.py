@@ -208,14 +208,38 @@ def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n:
     ``control.table1`` layout without and with the grid correction, and (corrected) with the
     ``control.many`` layout (the same adjustment when the two layouts agree). The rms (m) at
     control and check points, keys ``s<i>.without.*``, ``s<i>.with.*`` (X, Y) and
-    ``s<i>.many.*`` (X, Y, XY, Z). Every vector draws its blocks from the same stream (common
-    random numbers: the vectors differ by their inputs, not by their luck)."""
+    ``s<i>.many.*`` (X, Y, XY, Z); and the configured scanner's ``control.many`` pass on the
+    same blocks, keys ``cfg.many.*``. Every vector draws its blocks from the same two seeds
+    (common random numbers, the grid's node noise on a stream of its own:
+    :class:`~sim.studies.agnard.simulate.Simulated`), so the vectors differ by their inputs,
+    not by their luck, and each is paired block by block with the configured scanner
+    (:mod:`sim.studies.agnard.paired`)."""
     adj = Adjuster(block)
     wo, wc = paper_weights(cfg)
-    seed = int(rng.integers(2**63))
+    seed, grid_seed = (int(s) for s in rng.integers(2**63, size=2))
     out: dict[str, np.ndarray] = {}
+
+    def blocks(over: dict) -> Simulated:
+        return Simulated(
+            {**cfg, **over},
+            block,
+            np.random.default_rng(seed),
+            n,
+            cfg["scan.dpi"],
+            grid_rng=np.random.default_rng(grid_seed),
+        )
+
+    def keep(tag: str, ctrl, res) -> None:
+        acc: dict[str, np.ndarray] = {}
+        accuracy(block, ctrl, res, acc, "a")
+        for w in ("ctrl", "check"):
+            for ax in ("x", "y", "xy", "z"):
+                out[f"{tag}.{w}_{ax}_m"] = acc[f"a.{w}_{ax}_m"]
+
+    ctrl, _, res = adj.adjust(blocks({}), ("digital", "corrected"), cfg["control.many"], wo, wc)
+    keep("cfg.many", ctrl, res)
     for i, over in enumerate(scanners):
-        sim = Simulated({**cfg, **over}, block, np.random.default_rng(seed), n, cfg["scan.dpi"])
+        sim = blocks(over)
         res = None
         passes = [("raw", "without", cfg["control.table1"])]
         passes.append(("corrected", "with", cfg["control.table1"]))
@@ -223,11 +247,7 @@ def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n:
             passes.append(("corrected", "many", cfg["control.many"]))
         for key, tag, lay in passes:
             ctrl, _, res = adj.adjust(sim, ("digital", key), lay, wo, wc, res)
-            acc: dict[str, np.ndarray] = {}
-            accuracy(block, ctrl, res, acc, "a")
-            for w in ("ctrl", "check"):
-                for ax in ("x", "y", "xy", "z"):
-                    out[f"s{i}.{tag}.{w}_{ax}_m"] = acc[f"a.{w}_{ax}_m"]
-                    if tag == "with" and len(passes) == 2:
-                        out[f"s{i}.many.{w}_{ax}_m"] = acc[f"a.{w}_{ax}_m"]
+            keep(f"s{i}.{tag}", ctrl, res)
+            if tag == "with" and len(passes) == 2:
+                keep(f"s{i}.many", ctrl, res)
     return out

@@ -24,6 +24,11 @@ the grid correction; Table 1's eight printed rms are the constraints, one-block 
 decided by the book's one-plate rule. When no vector is consistent the region is empty and
 :attr:`~sim.claims.inference.Region.conflicts` names the statements that conflict: Table 1
 is then not comparable because of that (``claims.toml`` says so in the paper's words).
+Set aside, Table 1 leaves every explored vector, and the 21-control predictions (Tables 2-3
+and the acceptance limits) are decided over them all: each vector's blocks are paired with
+the configured scanner's on the same seeds, and a row's evidence at the vector is the
+configured scanner's main blocks moved by the paired shift (:mod:`sim.studies.agnard.paired`,
+:func:`shift_table`).
 """
 
 from __future__ import annotations
@@ -40,6 +45,7 @@ from sim.claims.inference import Input, Region, explore
 from sim.instruments.block.layout import Block
 from sim.mc.runner import chunk_rng
 from sim.studies.agnard import chunks as ch
+from sim.studies.agnard.paired import paired_evidence, paired_shift
 
 DECLARATION = Path(__file__).with_name("region.toml")
 #: the region's option: the program's models with (1) or without (0) projection centres
@@ -56,6 +62,8 @@ SCANNER_KEYS = {
 #: the runner's stream of the scanner region's blocks (apart from every trade-off part) and
 #: of its design
 SCANNER_PART = 800
+#: key prefix of the configured scanner's statistics on a vector's blocks
+CONFIGURED = "configured:"
 
 
 def five_samples(sw: dict, i: int, pre: str = "") -> dict[str, np.ndarray]:
@@ -146,29 +154,43 @@ def union(parts: list[Region], inputs: list[Input]) -> Region:
     )
 
 
+def many_samples(sw: dict, pre: str) -> dict[str, np.ndarray]:
+    """Per-block statistics (cm) of the 21-control pass keyed by claim id (``pre``: ``s<i>``
+    for scanner vector ``i``, ``cfg`` for the configured scanner on the same blocks, or
+    ``layout_<control.many>`` of the main blocks); the acceptance limits apply to the control
+    rms."""
+    out = {
+        f"agnard.control_21.{w}_{c}_cm": 100 * np.asarray(sw[f"{pre}.{w}_{c}_m"])
+        for w in ("ctrl", "check")
+        for c in ("x", "y", "xy", "z")
+    }
+    for c in ("xy", "z"):
+        out[f"agnard.max_residual.control_21_{c}_cm"] = out[f"agnard.control_21.ctrl_{c}_cm"]
+    return out
+
+
 def table1_samples(sw: dict, i: int) -> dict[str, np.ndarray]:
     """Per-block statistics of scanner vector ``i`` keyed by claim id: Table 1's rms (m) and
-    the 21-control pass's (cm; its acceptance limits apply to the control rms)."""
+    the 21-control pass's (cm, :func:`many_samples`)."""
     out = {
         f"agnard.table1.{tag}_{w}_{c}_m": np.asarray(sw[f"s{i}.{tag}.{w}_{c}_m"])
         for tag in ("without", "with")
         for w in ("ctrl", "check")
         for c in ("x", "y")
     }
-    for w in ("ctrl", "check"):
-        for c in ("x", "y", "xy", "z"):
-            out[f"agnard.control_21.{w}_{c}_cm"] = 100 * np.asarray(sw[f"s{i}.many.{w}_{c}_m"])
-    for c in ("xy", "z"):
-        out[f"agnard.max_residual.control_21_{c}_cm"] = out[f"agnard.control_21.ctrl_{c}_cm"]
-    return out
+    return {**out, **many_samples(sw, f"s{i}.many")}
 
 
 def explore_scanner(
-    cfg: dict, block: Block, book: ClaimBook, runner: Callable[..., dict]
+    cfg: dict, block: Block, book: ClaimBook, runner: Callable[..., dict], base: dict
 ) -> tuple[Region, list[str], list[dict]]:
     """The scanner region under Table 1, the predictions decided over the scanner's inputs
-    (``scanner.toml``), and the per-vector statistics of every explored vector
-    (``runner(fn, trials, part, label)`` runs one part through the runner)."""
+    (``scanner.toml``) and the per-vector statistics of every explored vector, with the
+    configured scanner's on the same blocks (keys ``CONFIGURED + claim id``; ``runner(fn,
+    trials, part, label)`` runs one part through the runner). Table 1's statements are decided on
+    each vector's own blocks; the predictions by :func:`sim.studies.agnard.paired.
+    paired_evidence`: ``base`` (claim id: the configured scanner's per-block statistic over
+    the main blocks) shifted by each vector's paired shift from the configured scanner."""
     dec = load_declaration(SCANNER, book)
     stats: list[dict] = []
 
@@ -181,16 +203,20 @@ def explore_scanner(
             partial(ch.table1_chunk, cfg, block, scanners),
             cfg["table1.trials"],
             SCANNER_PART + len(stats),
-            "scanner vectors (Table 1)",
+            "scanner vectors (Table 1), each paired with the configured scanner",
         )
-        per = [table1_samples(sw, j) for j in range(n)]
+        c = many_samples(sw, "cfg.many")
+        per = [
+            {**table1_samples(sw, j), **{CONFIGURED + k: v for k, v in c.items()}} for j in range(n)
+        ]
         stats.extend(per)
         ev = {
             s.id: sample_evidence(np.stack([p[s.id] for p in per]), s.ref[0])
             for s in dec.statements
         }
-        for c in dec.predictions:
-            ev[c] = sample_evidence(np.stack([p[c] for p in per]), *plate_ref(book.spec(c)))
+        for cid in dec.predictions:
+            v = np.stack([p[cid] for p in per])
+            ev[cid] = paired_evidence(base[cid], c[cid], v, *plate_ref(book.spec(cid)))
         return ev
 
     region = explore(
@@ -202,3 +228,32 @@ def explore_scanner(
         rounds=cfg["table1.rounds"],
     )
     return region, dec.predictions, stats
+
+
+def shift_table(region: Region, preds: list[str], stats: list[dict]) -> dict[str, list]:
+    """``scanner_shift.parquet``: per explored vector and prediction, the inputs, the paired
+    log shift from the configured scanner and its standard error, the standard error the
+    same blocks would give unpaired (independent blocks of the two scanners), the log scale
+    of the spread and its error, the pairs' correlation and whether the map stretches
+    (:mod:`sim.studies.agnard.paired`)."""
+    cols: dict[str, list] = {k: [] for k in (*region.x, "claim", "delta_log", "delta_log_se")}
+    cols.update({k: [] for k in ("unpaired_se", "log_beta", "log_beta_se", "rho", "stretched")})
+    for cid in preds:
+        c = stats[0][CONFIGURED + cid]  # every call of the model pairs its own blocks
+        v = np.stack([p[cid] for p in stats])
+        cs = np.stack([p[CONFIGURED + cid] for p in stats])
+        sh = [paired_shift(cs[j], v[j : j + 1]) for j in range(len(stats))]
+        k = c.size
+        lu, lw = np.log(cs), np.log(v)
+        unpaired = np.sqrt((lu.var(axis=1, ddof=1) + lw.var(axis=1, ddof=1)) / k)
+        for name in region.x:
+            cols[name].extend(np.asarray(region.x[name], float).tolist())
+        cols["claim"].extend([cid] * len(stats))
+        cols["delta_log"].extend(float(s.delta[0]) for s in sh)
+        cols["delta_log_se"].extend(float(s.delta_se[0]) for s in sh)
+        cols["unpaired_se"].extend(unpaired.tolist())
+        cols["log_beta"].extend(float(s.log_beta[0]) for s in sh)
+        cols["log_beta_se"].extend(float(s.log_beta_se[0]) for s in sh)
+        cols["rho"].extend(float(s.rho[0]) for s in sh)
+        cols["stretched"].extend(bool(s.stretched[0]) for s in sh)
+    return cols

@@ -10,7 +10,8 @@ the run context (executor, chunk store), with picklable chunk functions
 Writes ``trials.parquet``, ``layout.parquet``, ``check_vectors.parquet``, the trade-off
 tables, ``region_five.parquet`` (per block, layout and centres option), ``consistent_region.parquet``,
 ``region_inputs.parquet``, ``region_layouts.parquet``, ``scanner_region.parquet`` (every
-explored scanner vector) and ``scanner_region_inputs.parquet``,
+explored scanner vector, with the 21-control rows' per-vector outcomes),
+``scanner_region_inputs.parquet``, ``scanner_shift.parquet`` (each vector's paired shift),
 ``claims.parquet`` + ``not_reproduced.parquet`` and the figures (each drawn as soon as its data exist).
 """
 
@@ -23,8 +24,8 @@ import numpy as np
 
 from sim.claims.book import ClaimBook, write_claims
 from sim.claims.book_region import statements, write_explored
-from sim.claims.family import family_outcomes, family_over
-from sim.claims.region import OUTCOME_NAMES, inputs_table, region_table
+from sim.claims.family import family_evidence, family_outcomes, family_over
+from sim.claims.region import OUTCOME_NAMES, inputs_table, outcomes, region_table, statement_of
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
 from sim.mc.runner import run_chunks
@@ -35,7 +36,15 @@ from sim.studies import RunContext
 from sim.studies.agnard import chunks as ch
 from sim.studies.agnard import figures as fg
 from sim.studies.agnard.claims import JOINT, MEMBERS, claim_rows, load_book
-from sim.studies.agnard.region import CENTRES, SCANNER_KEYS, explore_region, explore_scanner
+from sim.studies.agnard.leads import HOW
+from sim.studies.agnard.region import (
+    CENTRES,
+    SCANNER_KEYS,
+    explore_region,
+    explore_scanner,
+    many_samples,
+    shift_table,
+)
 from sim.studies.agnard.schema import NAME, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
 from sim.studies.run_steps import over_region
@@ -291,14 +300,26 @@ def _example(what: str, row: dict) -> str:
     )
 
 
-def _scanner_region(cfg, block, book, ctx, prov, out):
-    """Explore the scanner's unprinted inputs under Table 1 (``scanner.toml``); write
-    ``scanner_region.parquet`` (every explored vector), ``scanner_region_inputs.parquet`` and
-    its figure. Returns the region, its predictions and the per-vector statistics."""
+def _scanner_region(cfg, block, book, per_trial, ctx, prov, out):
+    """Explore the scanner's unprinted inputs under Table 1 (``scanner.toml``), the
+    21-control predictions paired with the configured scanner's main blocks
+    (:mod:`.paired`); write ``scanner_region.parquet`` (every explored vector),
+    ``scanner_region_inputs.parquet``, ``scanner_shift.parquet`` and its figure. Returns the
+    region, its predictions and the per-vector statistics."""
+    base = many_samples(per_trial, f"layout_{cfg['control.many']}")
     region, preds, stats = explore_scanner(
-        cfg, block, book, lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx)
+        cfg,
+        block,
+        book,
+        lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx),
+        base,
     )
-    write_explored(out / "scanner_region.parquet", region, prov, statements(book, preds))
+    j21 = JOINT["control_21"]  # its per-vector outcome beside its members' (family_status)
+    p = np.stack([region.outputs[m]["p"] for m in MEMBERS[j21]], axis=1)
+    member = np.stack([outcomes(region, statement_of(book, m)) for m in MEMBERS[j21]], axis=1)
+    region.outputs[j21] = family_evidence(p, member)
+    write_explored(out / "scanner_region.parquet", region, prov, statements(book, [*preds, j21]))
+    write_table(out / "scanner_shift.parquet", shift_table(region, preds, stats), prov)
     nominal = {name: cfg[key] for name, key in SCANNER_KEYS.items()}
     fig_region(
         region,
@@ -308,6 +329,32 @@ def _scanner_region(cfg, block, book, ctx, prov, out):
         nominal=nominal,
     )
     return region, preds, stats
+
+
+def _over_scanner(book, scanner, preds, rows, k: int) -> list[dict]:
+    """The 21-control rows decided over the scanner's inputs (the not-comparable Table 1 set
+    aside: every explored vector stays), each vector's evidence the configured scanner's main
+    blocks moved by its paired shift (:mod:`.paired`); the configured result kept in the note
+    as an example, and the joint X, Y row decided from its members per vector."""
+    aside = [s.id for s in scanner.statements if book.spec(s.id)["kind"] == "not comparable"]
+    region = scanner.without(aside)
+    how = HOW[2:] + (
+        f" {region.n} explored input vectors (scanner.toml), each "
+        f"paired with the configured scanner on the same {k} blocks (common random "
+        "numbers): the configured scanner's main blocks moved in logarithms by the paired "
+        "shift (and stretched where the pairs show the spread changed), over its 97.5 % "
+        "interval (sim.studies.agnard.paired)"
+    )
+    rows = over_region(book, region, preds, rows, lambda r: f"{how}; {_example('scanner', r)}")
+    fresh = ClaimBook(list(book.specs.values()), [], book.path)
+    j21 = JOINT["control_21"]
+    by = {r["claim"]: r for r in rows}
+    ex = (
+        f"at the configured scanner (an example): Holm p {by[j21]['value']:.3g}, outcome "
+        f"{by[j21]['outcome']}"
+    )
+    joint = family_over(fresh, region, j21, MEMBERS[j21], f"{how}; {ex}")
+    return [joint if r["claim"] == j21 else r for r in rows]
 
 
 def _layout(block, c5, c21, prov, out) -> None:
@@ -375,11 +422,9 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
 
     # --- the unprinted five-point layout: its region, the 5-control rows decided over it
     # --- the scanner's unprinted inputs under Table 1, then every claim
-    scanner, spreds, scanner_stats = _scanner_region(cfg, block, book, ctx, prov, out)
+    scanner, spreds, scanner_stats = _scanner_region(cfg, block, book, per_trial, ctx, prov, out)
     rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book, scanner, scanner_stats)
-    # the 21-control rows over the scanner's inputs, the not-comparable Table 1 set aside
-    aside = [s.id for s in scanner.statements if book.spec(s.id)["kind"] == "not comparable"]
-    rows = over_region(book, scanner.without(aside), spreds, rows, partial(_example, "scanner"))
+    rows = _over_scanner(book, scanner, spreds, rows, cfg["table1.trials"])
     rows, insets = _five_region(cfg, block, book, rows, ctx, base, prov, out)
     ctrl_idx = _region_layouts(block, insets, prov, out)
     write_claims(out / "claims.parquet", rows, prov, book)

@@ -168,7 +168,11 @@ SCHEMA = {
         16, "scanner vectors of the Table 1 region's space-filling design (scanner.toml)", 2, 256
     ),
     "table1.trials": count(
-        10, "simulated blocks per scanner vector of the Table 1 region", 2, 10_000
+        48,
+        "simulated blocks per scanner vector of the Table 1 region, the same blocks for every "
+        "vector and the configured scanner (the paired shift of the 21-control rows)",
+        2,
+        10_000,
     ),
     "table1.rounds": count(
         0, "boundary refinement rounds of the Table 1 region (none while it is empty)", 0, 5

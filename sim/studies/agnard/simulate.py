@@ -18,9 +18,17 @@ from sim.instruments.block.centres import Centred, centre_models
 from sim.instruments.block.layout import Block, select_control
 
 
-def _scans(cfg: dict, b: Block, rng: np.random.Generator, n: int, pix: float, uncorrected: bool):
-    """One scanner field per trial, the scanned calibration grid and the fiducial centring
-    noise; returns the image coordinates of the left and right observations (mm) and their
+def _scans(
+    cfg: dict,
+    b: Block,
+    rng: np.random.Generator,
+    n: int,
+    pix: float,
+    uncorrected: bool,
+    grid_rng: np.random.Generator | None = None,
+):
+    """One scanner field per trial, the scanned calibration grid (its nodes' centring noise
+    from ``grid_rng`` when given, else from ``rng``) and the fiducial centring noise; returns the image coordinates of the left and right observations (mm) and their
     scanner errors (um) after the fiducial affine, ``corrected`` by the grid and, when
     ``uncorrected``, ``raw``."""
     n_ph = b.photos.shape[0] * b.photos.shape[1]
@@ -33,7 +41,9 @@ def _scans(cfg: dict, b: Block, rng: np.random.Generator, n: int, pix: float, un
         wavelength_mm=cfg["scan.wavelength_mm"],
         half_mm=cfg["block.format_mm"] / 2,
     )
-    grid = sc.scan_grid(field, rng, cfg["scan.grid_mm"], cfg["scan.grid_sigma_px"] * pix)
+    grid = sc.scan_grid(
+        field, grid_rng or rng, cfg["scan.grid_mm"], cfg["scan.grid_sigma_px"] * pix
+    )
     xl = b.image_coords(b.obs_left, b.obs_point)
     xr = b.image_coords(b.obs_right, b.obs_point)
     xy = np.vstack([xl, xr])
@@ -62,7 +72,13 @@ def _pugging_modes(cfg: dict, b: Block, pix: float, mechanical: bool) -> dict:
 
 
 class Simulated:
-    """One chunk of simulated blocks: model coordinates in their own frames and the truth."""
+    """One chunk of simulated blocks: model coordinates in their own frames and the truth.
+
+    ``grid_rng``: a stream of its own for the calibration grid's node noise, whose count
+    depends on ``scan.grid_mm``; with it, every other draw of a block (scanner shape,
+    fiducials, pointing, model frames, control) takes the same numbers from ``rng`` whatever
+    the scanner's inputs, so blocks of two scanners drawn from equal seeds are paired
+    (common random numbers). Without it (the default) the grid noise comes from ``rng``."""
 
     def __init__(
         self,
@@ -73,11 +89,12 @@ class Simulated:
         dpi: float,
         mechanical: bool = False,
         uncorrected: bool = True,
+        grid_rng: np.random.Generator | None = None,
     ):
         pix = sc.pixel_um(dpi)
         b = self.block = block
         self.n = n
-        xl, xr, scan = _scans(cfg, b, rng, n, pix, uncorrected)
+        xl, xr, scan = _scans(cfg, b, rng, n, pix, uncorrected, grid_rng)
         modes = _pugging_modes(cfg, b, pix, mechanical)
         self.s, self.R, self.t = im.random_similarities(rng, (n, b.n_models))
         self.xm = {}
