@@ -275,6 +275,30 @@ def test_linearised_plate_rms_matches_its_covariance():
     assert abs((b**2).mean() - ms - extra) < 4 * (b**2).std() / np.sqrt(len(b))
 
 
+@pytest.mark.parametrize("sigma, verdict", [(0.5, "fails"), (1.5, "holds")])
+def test_two_screw_agreement_is_decided_over_the_other_comparators_unprinted_error(sigma, verdict):
+    """Third reading: the paper's equal attribution ("if one were to assume that the
+    discrepancies ... are equally attributable to both comparators") is how Brown reads his own
+    accuracy off the agreement, not a printed error of the two-screw comparator. The agreement
+    is the plate's error plus that comparator's (explored, 0.5-2.5 um), after the rigid fit:
+    a one-micron comparator of 0.5 um puts the central half of the plates at 1.2-1.4 um,
+    wholly under the 1.5 that prints as "2" (fails); 1.5 um puts it at 1.75-2.0 (holds). The
+    labelled example keeps the equal attribution, sqrt(2) x the plate's rms."""
+    from sim.studies.design import external as ex
+    from sim.studies.design.claims import load_book, verdict_of
+    from sim.studies.design.region import TWO_SCREW
+
+    cfg = validate({"unprinted.plates": 1000}, design.SCHEMA, design.check)
+    book, cid = load_book(), "brown.results.two_screw_agreement_um"
+    e = ex.external_at(cfg, 17.0, 10.0, 90.0, 0.5, two_screw_um=sigma)
+    assert verdict_of(book, cid, e)["verdict"] == verdict
+    assert not np.array_equal(e["two_screw_rms"], math.sqrt(2) * e["table1_rms"])
+    e0 = ex.external_at(cfg, 17.0, 10.0, 90.0, 0.5)
+    assert np.array_equal(e0["table1_rms"], e["table1_rms"])  # the same plates
+    assert np.array_equal(e0["two_screw_rms"], math.sqrt(2) * e0["table1_rms"])
+    assert (TWO_SCREW.low, TWO_SCREW.high) == (0.5, 2.5) and "one-micron" in TWO_SCREW.why
+
+
 def test_claim_book_classes_the_datum_and_emcee_rows():
     from sim.studies.design.claims import load_book
 
@@ -320,6 +344,7 @@ def test_tiny_run_end_to_end(tiny_run):
         "beta_mm",
         "screw_pitch_mm",
         "zeiss_half_extent_mm",
+        "two_screw_sigma_um",
     }
     from sim.instruments.ranges import brown as B
 

@@ -12,7 +12,7 @@ from sim.studies import wolf
 from sim.studies.wolf.chunks import draw_main
 from sim.studies.wolf.claims import HEADLINE, JOINT, is_mean_row, load_book, stat_key
 from sim.studies.wolf.model import read_placed
-from sim.studies.wolf.region import evidence
+from sim.studies.wolf.region import evidence, mc_p
 
 
 def _res(book, t2, tags, rng):
@@ -48,6 +48,7 @@ def test_table2_rows_carry_their_holm_adjusted_p_and_the_headline_is_the_means_f
             for t in tags
         ]
     )
+    raw = mc_p(raw, 400)
     adj = np.stack([holm(r) for r in raw])
     for k, c in enumerate(t2):
         assert ev[c]["p"] == pytest.approx(adj[:, k], abs=1e-15)
@@ -56,11 +57,41 @@ def test_table2_rows_carry_their_holm_adjusted_p_and_the_headline_is_the_means_f
     head = [holm(r[means]).min() for r in raw]
     assert ev[HEADLINE]["value"] == pytest.approx(head, abs=1e-15)
     # plates centred on the printed numbers: nothing is rare; shifted X plates: every X row
-    # is, even after the correction, and the headline's family with them
+    # is, and the headline's family of eight with them; 24 rows cannot fail on 400 plates
+    # (the smallest Monte-Carlo p is 2 / 401, 24 x that is 0.12)
     assert ev[JOINT]["value"][0] >= 0.05 and ev[HEADLINE]["value"][0] >= 0.05
-    assert ev[JOINT]["value"][1] < 0.05 and ev[HEADLINE]["value"][1] < 0.05
+    assert ev[HEADLINE]["value"][1] == pytest.approx(8 * 2 / 401, abs=1e-15)
+    assert ev[JOINT]["value"][1] == pytest.approx(24 * 2 / 401, abs=1e-15)
     # the adjustment only raises a row's p (Holm's factor is at least 1)
     assert np.all(adj >= raw - 1e-15)
+
+
+def _one_rare_plate(book, t2, k, rng):
+    """One cell whose mean-X plates put ``k`` of 400 below the printed 3.0 (plate 005, Set 2)
+    and none rare against the other three mean-X numbers; every other statistic centred."""
+    tag = "g1.0."
+    res = _res(book, t2, [tag, "g1.1."], rng)
+    x = np.concatenate([np.full(k, 2.0), np.linspace(3.2, 9.5, 400 - k)])
+    res[tag + stat_key("wolf.table2.p005.set2.mean_x_um")] = x
+    return res, [tag]
+
+
+@pytest.mark.parametrize("k, fails", [(0, True), (1, False)])
+def test_a_family_is_not_failed_by_one_simulated_plate_in_400(k, fails):
+    """Third reading: Holm multiplies the smallest p by the family's size, so the plug-in
+    2 k / n let one plate in 400 (p 0.005, 8 x 0.005 = 0.04) fail the headline's family of
+    eight. The Monte-Carlo test's p 2 (k + 1) / (n + 1) does not (0.08); no plate at all
+    (k = 0, 2 / 401, 8 x that is 0.0399) still fails it. The old plug-in failed both."""
+    book = load_book()
+    t2 = [c for c in book.specs if c.startswith("wolf.table2.p")]
+    res, tags = _one_rare_plate(book, t2, k, np.random.default_rng(11))
+    ev = evidence(book, [HEADLINE, JOINT], res, tags)
+    assert ev[HEADLINE]["value"][0] == pytest.approx(8 * 2 * (k + 1) / 401, abs=1e-12)
+    assert (ev[HEADLINE]["value"][0] < 0.05) == fails
+    # the plug-in p of the rare row, as the region used it before: 8 x 2k / 400 < 0.05
+    x = res[tags[0] + stat_key("wolf.table2.p005.set2.mean_x_um")]
+    assert 8 * plate_p(x, 3.0, 0.05) == pytest.approx(8 * 2 * k / 400) and 8 * 2 * k / 400 < 0.05
+    assert mc_p(np.array([0.0, 1.0, 0.05]), 400) == pytest.approx([2 / 401, 1.0, 22 / 401])
 
 
 def test_the_headline_is_decided_as_one_holm_test_of_the_eight_means():

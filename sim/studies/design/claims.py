@@ -49,9 +49,10 @@ EXTERNAL = {
     "brown.results.two_screw_agreement_um": (
         lambda e: _central_half(e["two_screw_rms"]),
         lambda e: (
-            "sqrt(2) x one plate's rms (the paper's equal attribution), Table 1's plate "
-            "and error model, linearised; the interval is the central half of the plates "
-            "('usually')"
+            "one plate's rms discrepancy with a two-screw comparator (its error not printed: "
+            "explored over the region; the labelled example takes the paper's equal "
+            "attribution, sqrt(2) x the plate's rms), Table 1's plate and error model, "
+            "linearised; the interval is the central half of the plates ('usually')"
         ),
     ),
     "brown.results.zeiss_discrepancy_um": (

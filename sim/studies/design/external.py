@@ -125,11 +125,19 @@ def plate_rms(
 
 
 def external_at(
-    cfg: dict, offset: float, beta: float, zeiss_extent: float, pitch: float, plates: bool = True
+    cfg: dict,
+    offset: float,
+    beta: float,
+    zeiss_extent: float,
+    pitch: float,
+    plates: bool = True,
+    two_screw_um: float | None = None,
 ) -> dict:
     """Every linearised claim value at one setting of the unprinted inputs (``plates=False``:
     the tolerances only). Plates use fixed streams (parts 91, 92), so a sweep compares like
-    with like."""
+    with like. ``two_screw_um``: the conventional two-screw comparator's error per coordinate
+    (not printed), added to the plate before the rigid fit; ``None`` (the labelled example)
+    takes the paper's equal attribution, sqrt(2) x the plate's rms."""
     pts = paper_points(cfg)
     sr = range_sigma_um(cfg)
     r_min = shortest_range_mm(cfg, pts, offset, beta)
@@ -143,9 +151,10 @@ def external_at(
     zr = longest_range_mm(cfg, zp, offset, beta)
     out["zeiss_feasible"] = zr <= cfg["scale.graduated_mm"] + cfg["scale.micrometer_mm"]
     if plates:
-        out["table1_rms"] = plate_rms(cfg, pts, offset, beta, sr, 0.0, 91)[0]
+        out["table1_rms"], mixed = plate_rms(cfg, pts, offset, beta, sr, two_screw_um or 0.0, 91)
         out["zeiss_comparator_rms"], out["zeiss_rms"] = plate_rms(
             cfg, zp, offset, beta, sr, cfg["zeiss.grid_sigma_um"], 92
         )
-        out["two_screw_rms"] = np.sqrt(2) * out["table1_rms"]
+        equal = two_screw_um is None  # the paper's equal attribution (the labelled example)
+        out["two_screw_rms"] = np.sqrt(2) * out["table1_rms"] if equal else mixed
     return out

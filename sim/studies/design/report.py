@@ -42,7 +42,7 @@ def _datum_findings(V, VH, feas_note):
 #: the predictions of the region, in words
 _WHAT = (
     "The tolerances and external comparisons that depend on the unprinted station offset, "
-    "beta, screw pitch and Zeiss layout"
+    "beta, screw pitch, Zeiss layout and the error of the two-screw comparator compared with"
 )
 
 

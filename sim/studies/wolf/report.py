@@ -56,7 +56,8 @@ def findings(out: Path) -> list[str]:
         lines.append(
             f"- Headline (PG-2 against a monocomparator, mean discrepancies of 3-9 um, of "
             "which Table 2's comparable eight plate means, 3.0-8.3 um, are scored as one "
-            "Holm family of one-plate tests): over the consistent region the smallest "
+            "Holm family of one-plate tests, each p the Monte-Carlo test's): over the "
+            "consistent region the smallest "
             f"Holm-adjusted p runs {h['ci_low']:.2f}-{h['ci_high']:.2f} (fails below 0.05; holds only "
             "where every plate mean also holds); "
             f"verdict **{h['verdict']}** ({h['note'].split('; at the configured')[0]})."
