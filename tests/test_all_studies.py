@@ -87,7 +87,13 @@ def same_files(a: Path, b: Path) -> None:
 
 CLUSTER = """
 import sys
+import dask
 from dask.distributed import LocalCluster
+# no statistical profiler (100 samples a second of every task) and slower monitors: the
+# cluster idles between the studies, and its CPU is the test's
+dask.config.set({"distributed.worker.profile.enabled": False,
+                 "distributed.admin.system-monitor.interval": "5s",
+                 "distributed.worker.memory.monitor-interval": "5s"})
 with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                   dashboard_address=None) as cluster:
     print(cluster.scheduler_address, flush=True)

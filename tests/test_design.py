@@ -78,7 +78,7 @@ def test_sweep_records_infeasible_cells_with_the_reason(tmp_path):
         TABLE1.format(trials=20) + "\n[sweep]\nreplicates = 2\n[sweep.plate]\n"
         "spacing_mm = [45.0, 80.0]\n"
     )
-    assert main(["run", str(sw), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert main(["run", str(sw), "--out", str(tmp_path / "o"), "--quiet", "--no-figures"]) == 0
     rows = read_table(tmp_path / "o" / "sweep.parquet").to_pydict()
     assert rows["plate.spacing_mm"] == [45.0, 45.0, 80.0, 80.0]
     assert rows["feasible"] == [True, True, False, False]
