@@ -1,0 +1,105 @@
+"""The failure classes of the sixth sweep of bad inputs (issue 26, part A: the network kind,
+GNU Gama files, the Python API and the chunk store), one case per class; each failed on the
+code before its fix.
+
+* a GNU Gama element of gama-local's vocabulary in a place gama-local does not allow it (a
+  ``<point>`` inside ``<parameters>``, an ``<obs>`` directly in ``<network>``, a
+  ``<distance>`` inside a ``<distance>``) was skipped without a word: the user's point or
+  observation vanished;
+* a number written in non-ASCII digits (Arabic-Indic ``٠.٤``, full-width ``０.４``) was read
+  as a number (Python's ``float`` takes them; gama-local does not);
+* a NUL character in ``network.gama_xml`` gave "ValueError: embedded null byte" without
+  the key;
+* a standard deviation the suite exports (a direction of 1e6 arcsec is 3.1e6 cc) was refused
+  on import: the import range was [1e-9, 1e6] in the file's own unit, not the study's.
+"""
+
+from pathlib import Path
+
+import pytest
+
+from sim.mc.config import ConfigError
+from sim.studies.network.gama_read import read_gama
+
+ROOT = Path(__file__).resolve().parent.parent
+GAMA = (ROOT / "tests" / "data" / "gama" / "one_fixed.xml").read_text()
+PT_B = '<point id="B" x="250.0" y="10.0" adj="XY" />'
+DIST = '<distance to="B" val="250.19992006393608" stdev="2.0" />'
+DIR = '<direction to="B" val="2.545122269598366" stdev="4.62962962962963" />'
+
+
+def _gama(tmp_path: Path, old: str, new: str) -> Path:
+    assert old in GAMA
+    p = tmp_path / "n.xml"
+    p.write_text(GAMA.replace(old, new, 1), encoding="utf-8")
+    return p
+
+
+def _refused(path, *words: str) -> str:
+    with pytest.raises(ConfigError) as e:
+        read_gama(path)
+    msg = str(e.value)
+    assert "\n" not in msg and all(w in msg for w in words), msg
+    return msg
+
+
+@pytest.mark.parametrize(
+    "old, new, words",
+    [
+        (
+            'sigma-act="apriori" />',
+            'sigma-act="apriori"><point id="Q" x="1" y="1" fix="xy"/></parameters>',
+            ["<point>", "inside <parameters>"],
+        ),
+        (
+            "<description>",
+            '<obs from="A"><distance to="B" val="1" stdev="1"/></obs><description>',
+            ["<obs>", "inside <network>"],
+        ),
+        (
+            DIST,
+            DIST.replace(" />", '><distance to="C" val="1" stdev="1"/></distance>'),
+            ["<distance>", "inside <distance>"],
+        ),
+        (
+            PT_B,
+            PT_B.replace(" />", '><point id="Q" x="1" y="1" fix="xy"/></point>'),
+            ["<point>", "inside <point>"],
+        ),
+    ],
+)
+def test_a_gama_element_out_of_its_place_is_refused(tmp_path, old, new, words):
+    _refused(_gama(tmp_path, old, new), "n.xml", *words)
+
+
+@pytest.mark.parametrize(
+    "old, new, attr",
+    [
+        ('x="250.0"', 'x="٢٥٠.٠"', "'x'"),  # Arabic-Indic digits
+        ('x="250.0"', 'x="２５０.０"', "'x'"),  # full-width digits
+        ('stdev="2.0"', 'stdev="٢"', "'stdev'"),
+        (DIR, DIR.replace('val="2.545122269598366"', 'val="٢-٣٠-٠٠"'), "'val'"),
+    ],
+)
+def test_a_number_in_non_ascii_digits_is_refused(tmp_path, old, new, attr):
+    _refused(_gama(tmp_path, old, new), "n.xml", attr, "not a number")
+
+
+def test_a_nul_in_the_gama_path_is_named(tmp_path):
+    _refused(str(tmp_path / "n.xml\0"), "network.gama_xml", "NUL")
+
+
+def test_the_gama_stdev_range_is_the_studys_in_its_unit(tmp_path):
+    """A direction of 3e6 cc is 925,926 arcsec, within the study's 1e6 arcsec (what the
+    suite exports for sigma_arcsec = 1e6 is 3.09e6 cc): read. 3.3e6 cc (1.07e6 arcsec) and
+    a distance over 1e9 mm are refused, naming the element and the unit."""
+    ok = read_gama(_gama(tmp_path, DIR, DIR.replace("4.62962962962963", "3e6")))
+    sig = [o["sigma_arcsec"] for o in ok["network.observations"] if o["kind"] == "direction"]
+    assert max(sig) == pytest.approx(3e6 * 3240 / 10000, rel=1e-12)
+    _refused(
+        _gama(tmp_path, DIR, DIR.replace("4.62962962962963", "3.3e6")),
+        "<direction>",
+        "'stdev'",
+        "arcsec",
+    )
+    _refused(_gama(tmp_path, DIST, DIST.replace('stdev="2.0"', 'stdev="2e9"')), "<distance>")
