@@ -16,12 +16,18 @@ code before its fix.
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+import sim
+from sim.cli import main
 from sim.mc.config import ConfigError
+from sim.mc.storage import write_table
 from sim.studies.network.gama_read import read_gama
 
 ROOT = Path(__file__).resolve().parent.parent
+NETWORK = ROOT / "studies" / "network_testfield.toml"
+BROWN = ROOT / "studies" / "brown_table1.toml"
 GAMA = (ROOT / "tests" / "data" / "gama" / "one_fixed.xml").read_text()
 PT_B = '<point id="B" x="250.0" y="10.0" adj="XY" />'
 DIST = '<distance to="B" val="250.19992006393608" stdev="2.0" />'
@@ -103,3 +109,71 @@ def test_the_gama_stdev_range_is_the_studys_in_its_unit(tmp_path):
         "arcsec",
     )
     _refused(_gama(tmp_path, DIST, DIST.replace('stdev="2.0"', 'stdev="2e9"')), "<distance>")
+
+
+def _one_line(capsys, code: int, *words: str) -> str:
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and err.startswith("sim: error: "), err
+    assert "Traceback" not in err and all(w in err for w in words), err
+    return err
+
+
+def test_an_integer_outside_64_bits_is_named(tmp_path, capsys):
+    big = 10**400
+    with pytest.raises(ConfigError, match="^trials: .*64-bit"):
+        sim.load(BROWN, trials=big)
+    f = tmp_path / "s.toml"
+    text = NETWORK.read_text()
+    f.write_text(
+        text.replace(
+            'kind = "fixed"', f'kind = "constraints"\nconstraints = [ {{ "N1.x" = {2**70} }} ]'
+        )
+    )
+    _one_line(capsys, main(["check", str(f)]), "datum.constraints", "64-bit")
+    f.write_text(text + f'[sweep]\n"network.scale_ppm" = {{ start = 0, stop = {big}, step = 1 }}\n')
+    _one_line(capsys, main(["check", str(f)]), "sweep.network.scale_ppm.stop", "64-bit")
+    f.write_text(text.replace("trials = 2000", "trials = " + "9" * 5000))
+    _one_line(capsys, main(["check", str(f)]), "s.toml", "malformed TOML", "4300 digits")
+
+
+def test_api_arguments_of_a_wrong_type_are_named(tmp_path):
+    class Broken:
+        def __fspath__(self):
+            return 5
+
+    with pytest.raises(ConfigError, match="^study_file: "):
+        sim.load(Broken())
+    est = sim.load(BROWN, trials=40, chunk=2).estimate()
+    for bad in ("2", 0, True, 1.5):
+        with pytest.raises(ConfigError, match="^workers: "):
+            est.describe(workers=bad)
+    assert "40 trials" in est.describe(workers=np.int64(2))
+    with pytest.raises(ConfigError, match="^study: "):
+        sim.Results(tmp_path, 5)
+
+
+def test_results_read_only_their_studys_tables(tmp_path):
+    d = tmp_path / "r"
+    d.mkdir()
+    write_table(d / "claims.parquet", {"claim": ["x"]}, {"study": "brown_table1"})
+    write_table(d / "points.parquet", {"a": [1.0]}, {"study": "network"})
+    (d / "datums.parquet").mkdir()  # a table replaced by a directory
+    res = sim.Results(d, "network")
+    assert res.table("points").num_rows == 1
+    with pytest.raises(ConfigError, match="a table of 'brown_table1', not of 'network'"):
+        res.claims()
+    with pytest.raises(ConfigError, match="datums.parquet is not a file"):
+        res.table("datums")
+    assert sim.Results(d, "brown_table1").claims().num_rows == 1
+    write_table(d / "claims.parquet", {"claim": ["x"]}, {})  # no study: not sim's
+    with pytest.raises(ConfigError, match="not a table sim wrote"):
+        sim.Results(d, "brown_table1").claims()
+
+
+def test_an_override_of_a_swept_key_is_refused(tmp_path, capsys):
+    f = tmp_path / "s.toml"
+    f.write_text(NETWORK.read_text() + '[sweep]\n"network.scale_ppm" = [0.0, 10.0]\n')
+    with pytest.raises(ConfigError, match="^network.scale_ppm: is swept"):
+        sim.load(f, network__scale_ppm=5.0)
+    _one_line(capsys, main(["check", str(f), "--set", "network.scale_ppm=5"]), "is swept")
+    assert sim.load(f, network__constant_mm=0.1).sweep == {"network.scale_ppm": [0.0, 10.0]}
