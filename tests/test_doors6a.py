@@ -17,12 +17,13 @@ code before its fix.
 from pathlib import Path
 
 import numpy as np
+import pyarrow.parquet as pq
 import pytest
 
 import sim
 from sim.cli import main
 from sim.mc.config import ConfigError
-from sim.mc.storage import write_table
+from sim.mc.storage import read_provenance, read_record, write_table
 from sim.studies.network.gama_read import read_gama
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -177,3 +178,16 @@ def test_an_override_of_a_swept_key_is_refused(tmp_path, capsys):
         sim.load(f, network__scale_ppm=5.0)
     _one_line(capsys, main(["check", str(f), "--set", "network.scale_ppm=5"]), "is swept")
     assert sim.load(f, network__constant_mm=0.1).sweep == {"network.scale_ppm": [0.0, 10.0]}
+
+
+def test_a_record_nested_too_deeply_is_not_a_record(tmp_path):
+    (tmp_path / "run.json").write_text("[" * 100_000 + "]" * 100_000)
+    assert read_record(tmp_path) is None
+    write_table(tmp_path / "t.parquet", {"a": [1]}, {"study": "x"})
+    t = pq.read_table(tmp_path / "t.parquet")
+    deep = b"[" * 100_000 + b"]" * 100_000
+    pq.write_table(t.replace_schema_metadata({b"sim.provenance": deep}), tmp_path / "t.parquet")
+    with pytest.raises(ValueError, match="nested too deeply"):
+        read_provenance(tmp_path / "t.parquet")
+    with pytest.raises(ConfigError, match="not a table sim wrote"):
+        sim.Results(tmp_path, "x").table("t")
