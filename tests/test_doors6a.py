@@ -191,3 +191,8 @@ def test_a_record_nested_too_deeply_is_not_a_record(tmp_path):
         read_provenance(tmp_path / "t.parquet")
     with pytest.raises(ConfigError, match="not a table sim wrote"):
         sim.Results(tmp_path, "x").table("t")
+
+
+def test_stations_so_far_out_that_ranges_overflow_are_named(capsys):
+    argv = ["check", str(BROWN), "--set", "comparator.station_offset_mm=1e308"]
+    _one_line(capsys, main(argv), "comparator.station_offset_mm", "overflow")
