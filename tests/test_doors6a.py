@@ -196,3 +196,15 @@ def test_a_record_nested_too_deeply_is_not_a_record(tmp_path):
 def test_stations_so_far_out_that_ranges_overflow_are_named(capsys):
     argv = ["check", str(BROWN), "--set", "comparator.station_offset_mm=1e308"]
     _one_line(capsys, main(argv), "comparator.station_offset_mm", "overflow")
+
+
+@pytest.mark.parametrize("key", ["network.gama_xml", "network.gama_sha256"])
+def test_the_gama_file_is_not_swept(tmp_path, capsys, key):
+    xml = tmp_path / "a.xml"
+    xml.write_text(GAMA)
+    f = tmp_path / "s.toml"
+    f.write_text(
+        f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{xml}"\n'
+        f'[datum]\nkind = "inner"\n[sweep]\n"{key}" = ["{xml}", "{xml}"]\n'
+    )
+    _one_line(capsys, main(["check", str(f)]), f"sweep.{key}", "cannot be swept")

@@ -57,6 +57,7 @@ class Field:
     choices : allowed values for strings (and elements of string lists).
     min_len : minimum length of lists.
     input : the value was set to match a paper (reported as *input*).
+    sweep : the key may be swept (``[sweep]``); None, or the reason it may not.
     """
 
     default: Any
@@ -69,6 +70,7 @@ class Field:
     min_len: int = 0
     input: bool = False
     unit: str = ""
+    sweep: str | None = None
 
 
 #: TOML's integers are 64-bit ("an integer that cannot be represented losslessly is an
