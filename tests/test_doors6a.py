@@ -208,3 +208,17 @@ def test_the_gama_file_is_not_swept(tmp_path, capsys, key):
         f'[datum]\nkind = "inner"\n[sweep]\n"{key}" = ["{xml}", "{xml}"]\n'
     )
     _one_line(capsys, main(["check", str(f)]), f"sweep.{key}", "cannot be swept")
+
+
+@pytest.mark.parametrize(
+    "obs, key",
+    [
+        ('{ kind = "distance", from = ["N1", "N2"], to = "A", sigma_mm = 1.0 }', "from"),
+        ('{ kind = "angle", at = "N6", from = "N*", to = "A", sigma_arcsec = 1.0 }', "from"),
+        ('{ kind = "direction", from = "A", to = "N?", sigma_arcsec = 1.0 }', "to"),
+    ],
+)
+def test_a_single_observation_names_the_field_matching_many(tmp_path, capsys, obs, key):
+    f = tmp_path / "s.toml"
+    f.write_text(NETWORK.read_text().replace("observations = [", f"observations = [ {obs},"))
+    _one_line(capsys, main(["check", str(f)]), f"network.observations[0].{key}", "matches")
