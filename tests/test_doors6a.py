@@ -5,7 +5,8 @@ code before its fix.
 * a GNU Gama element of gama-local's vocabulary in a place gama-local does not allow it (a
   ``<point>`` inside ``<parameters>``, an ``<obs>`` directly in ``<network>``, a
   ``<distance>`` inside a ``<distance>``) was skipped without a word: the user's point or
-  observation vanished;
+  observation vanished; so was an attribute in gama-local's namespace written with a prefix
+  (``g:fix="xy"``: the point stayed free);
 * a number written in non-ASCII digits (Arabic-Indic ``٠.٤``, full-width ``０.４``) was read
   as a number (Python's ``float`` takes them; gama-local does not);
 * a NUL character in ``network.gama_xml`` gave "ValueError: embedded null byte" without
@@ -77,6 +78,19 @@ def _refused(path, *words: str) -> str:
 )
 def test_a_gama_element_out_of_its_place_is_refused(tmp_path, old, new, words):
     _refused(_gama(tmp_path, old, new), "n.xml", *words)
+
+
+def test_a_gama_attribute_with_the_gama_prefix_is_refused(tmp_path):
+    ns = 'xmlns="http://www.gnu.org/software/gama/gama-local"'
+    p = _gama(tmp_path, ns, ns + ' xmlns:g="http://www.gnu.org/software/gama/gama-local"')
+    p.write_text(p.read_text().replace('adj="XY" />', 'adj="XY" g:fix="xy" />', 1))
+    _refused(p, "n.xml", "<point>", "fix", "prefix")
+    p.write_text(
+        GAMA.replace(ns, ns + ' xmlns:o="http://example.org/o"').replace(
+            'adj="XY" />', 'adj="XY" o:note="mine" />', 1
+        )
+    )
+    assert len(read_gama(p)["network.points"]) == 4  # another namespace's attribute: not ours
 
 
 @pytest.mark.parametrize(

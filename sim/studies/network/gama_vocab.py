@@ -187,7 +187,9 @@ class _File:
             if (e.tail or "").strip() and e is not root:
                 raise self.err(e, f"unexpected text {e.tail.strip()[:20]!r} after it")
             for a, v in e.attrib.items():
-                if a.startswith("{") or a == "xmlns":
+                if a.startswith("{" + NS + "}"):  # g:fix in gama-local's namespace: not fix
+                    raise self.err(e, "an attribute with a namespace prefix: write it plainly", a)
+                if a.startswith("{") or a == "xmlns":  # another namespace's (xsi:...): not ours
                     continue
                 if a not in VOCAB[t]:
                     raise self.err(e, "unknown attribute", a)
