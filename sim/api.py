@@ -29,6 +29,7 @@ from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
 from sim.mc.outputs import damaged_chunks
+from sim.mc.storage import read_provenance
 from sim.mc.sweep import read_sweep
 from sim.studies import load_study
 
@@ -48,6 +49,10 @@ class Results:
 
     def __post_init__(self):  # Results("results/x", "x"): a str is taken as the path
         _check_path("path", self.path)
+        if not isinstance(self.study, str) or not self.study.isidentifier():
+            raise ConfigError(
+                "study", f"must be a study name such as 'network' (got {self.study!r})"
+            )
         object.__setattr__(self, "path", Path(self.path))
 
     def names(self) -> list[str]:
@@ -66,10 +71,15 @@ class Results:
             )
         if name == "trials" and (bad := damaged_chunks(self.path)):
             raise ConfigError("table", f"trials: {bad}; run the study again")
+        if name != "trials" and not p.is_file():  # pyarrow reads a directory as a dataset
+            raise ConfigError("table", f"{p} is not a file; run the study again")
         try:
-            return pq.read_table(p)
+            table = pq.read_table(p)
         except (OSError, pa.ArrowException) as e:
             raise ConfigError("table", f"{p} cannot be read ({type(e).__name__})") from None
+        if name != "trials":
+            _check_owner(p, self.study)
+        return table
 
     def claims(self) -> pa.Table:
         """The claims table: each paper claim beside the simulated value and its verdict."""
@@ -156,10 +166,25 @@ class StudyHandle:
         return Results(out, h.name)
 
 
+def _check_owner(p: Path, study: str) -> None:
+    """A table is ``study``'s: its provenance (written with every table) names the study."""
+    try:
+        prov = read_provenance(p)
+    except (OSError, ValueError, pa.ArrowException):
+        prov = None
+    owner = prov.get("study") if isinstance(prov, dict) else None
+    if owner != study:
+        whose = f"a table of {owner!r}" if isinstance(owner, str) else "not a table sim wrote"
+        raise ConfigError("table", f"{p} is {whose}, not of {study!r}; run the study again")
+
+
 def _check_path(name: str, v: Any, none_ok: bool = False) -> None:
     if v is None and none_ok:
         return
-    text = os.fspath(v) if isinstance(v, os.PathLike) else v  # an os.PathLike may give bytes
+    try:  # an os.PathLike may give bytes, or (a broken one) neither str nor bytes
+        text = os.fspath(v) if isinstance(v, os.PathLike) else v
+    except TypeError:
+        text = None
     if not isinstance(text, str) or not text.isprintable() or not text.strip():
         raise ConfigError(name, f"must be a path (a str or os.PathLike of a str), got {v!r}")
 

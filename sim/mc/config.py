@@ -57,6 +57,7 @@ class Field:
     choices : allowed values for strings (and elements of string lists).
     min_len : minimum length of lists.
     input : the value was set to match a paper (reported as *input*).
+    sweep : the key may be swept (``[sweep]``); None, or the reason it may not.
     """
 
     default: Any
@@ -69,11 +70,33 @@ class Field:
     min_len: int = 0
     input: bool = False
     unit: str = ""
+    sweep: str | None = None
+
+
+#: TOML's integers are 64-bit ("an integer that cannot be represented losslessly is an
+#: error"); Python's tomllib and the API take any size, which overflowed float() and NumPy
+INT64 = 2**63
+
+
+def refuse_big_ints(key: str, v: Any) -> None:
+    """Refuse (naming ``key``) an integer outside TOML's 64-bit range anywhere in ``v`` (a
+    value, or nested lists and tables), walked without recursion."""
+    todo = [(key, v)]
+    while todo:
+        k, x = todo.pop()
+        if isinstance(x, int) and not isinstance(x, bool) and not -INT64 <= x < INT64:
+            digits = len(str(abs(x))) if abs(x) < 10**4000 else "over 4000"
+            raise ConfigError(k, f"an integer of {digits} digits is outside TOML's 64-bit range")
+        if isinstance(x, Mapping):
+            todo += [(f"{k}.{n}" if k else str(n), y) for n, y in x.items()]
+        elif isinstance(x, (list, tuple)):
+            todo += [(k, y) for y in x]
 
 
 def _num(key: str, v: Any, want_int: bool) -> float | int:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise ConfigError(key, f"must be {'an integer' if want_int else 'a number'} (got {v!r})")
+    refuse_big_ints(key, v)
     if want_int and not isinstance(v, int):
         if float(v).is_integer():
             v = int(v)
@@ -183,6 +206,7 @@ def validate(
         )
     }  # an empty section of the file ([compare] with nothing in it) says nothing
     for key in raw:
+        refuse_big_ints(key, raw[key])  # an API value, or a --set one
         if key not in schema:
             near = did_you_mean(key, schema)
             hint = f" (did you mean {' or '.join(near)}?)" if near else ""
@@ -234,13 +258,17 @@ def read_toml(path: str | Path) -> dict[str, Any]:
                 None, f"{p}: over {MAX_STUDY_BYTES // 1024**2} MiB, too large for a study file"
             )
         with p.open("rb") as fh:
-            return tomllib.load(fh)
+            doc = tomllib.load(fh)
+        refuse_big_ints("", doc)
+        return doc
     except tomllib.TOMLDecodeError as e:
         raise ConfigError(None, f"{p}: malformed TOML: {e}") from None
     except RecursionError:
         raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None
     except UnicodeDecodeError:
         raise ConfigError(None, f"{p}: not UTF-8 text") from None
+    except ValueError as e:  # an integer of over 4300 digits (Python's int-from-text limit)
+        raise ConfigError(None, f"{p}: malformed TOML: {str(e).split(';')[0]}") from None
 
 
 #: most chunks of one run (each is a file of the trials dataset, read back by every resume)

@@ -21,6 +21,7 @@ import math
 import os
 import re
 from dataclasses import dataclass
+from numbers import Integral
 from typing import Any, Callable, Mapping
 
 from sim.lsq.size import SPARSE_MIN_UNKNOWNS
@@ -54,6 +55,9 @@ class Estimate:
     cells: int = 1  # sweep cells x replicates
 
     def describe(self, workers: int = 1) -> str:
+        """One line: trials, adjustments, unknowns and the memory of ``workers`` processes."""
+        if isinstance(workers, bool) or not isinstance(workers, Integral) or workers < 1:
+            raise ConfigError("workers", f"must be a whole number >= 1 (got {workers!r})")
         cells = f" in {self.cells} sweep cells" if self.cells > 1 else ""
         return (
             f"{self.trials:,} trials{cells}, about {self.adjustments:.3g} adjustments of up "

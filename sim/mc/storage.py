@@ -245,7 +245,10 @@ def read_table(path: str | Path) -> pa.Table:
 
 def read_provenance(path: str | Path) -> dict[str, Any]:
     meta = pq.read_schema(path).metadata or {}
-    return json.loads(meta.get(_KEY, b"{}"))
+    try:
+        return json.loads(meta.get(_KEY, b"{}"))
+    except RecursionError:  # provenance nested too deeply: not ours, as garbage JSON is not
+        raise ValueError(f"{path}: provenance nested too deeply") from None
 
 
 def read_tolerances(path: str | Path) -> dict[str, dict]:
@@ -264,7 +267,7 @@ def read_record(d: str | Path) -> dict | None:
     of ours)."""
     try:
         rec = json.loads((Path(d) / RECORD).read_text())
-    except (OSError, ValueError, UnicodeDecodeError):
+    except (OSError, ValueError, RecursionError):  # RecursionError: JSON nested too deeply
         return None
     return rec if isinstance(rec, dict) and "config" in rec and "code_hash" in rec else None
 

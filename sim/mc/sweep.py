@@ -157,6 +157,8 @@ def expand(table: Mapping[str, Any], schema: Mapping | None = None):
             raise ConfigError(f"sweep.{k}", "cannot be swept (use replicates for seeds)")
         if schema is not None and k not in schema:
             raise ConfigError(f"sweep.{k}", "unknown key")
+        if schema is not None and getattr(schema[k], "sweep", None):
+            raise ConfigError(f"sweep.{k}", f"cannot be swept: {schema[k].sweep}")
     vals = [_values(k, table[k]) for k in keys]
     total = math.prod(len(v) for v in vals) * reps
     if total > MAX_CELLS:

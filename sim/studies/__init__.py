@@ -15,6 +15,7 @@ from typing import Any, Callable, Mapping
 from sim.mc.config import ConfigError, Field, flatten, parse_override, read_toml, validate
 from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
+from sim.mc.sweep import RESERVED, read_sweep
 
 __all__ = ["Study", "RunContext", "get_study", "load_study", "MODULES"]
 
@@ -43,6 +44,17 @@ def get_study(name: str) -> Study:
     return mod.STUDIES[name]
 
 
+def _overridable(key: str, swept: set) -> None:
+    """``study`` is never overridden; a key the file's ``[sweep]`` table sweeps neither (every
+    cell would set it again: the override would do nothing)."""
+    if key == "study":
+        raise ConfigError("study", "cannot be overridden")
+    if key in swept:
+        raise ConfigError(
+            key, "is swept by the file's [sweep] table: an override would have no effect"
+        )
+
+
 def load_study(
     path: str | Path,
     overrides: list[str] | tuple = (),
@@ -64,14 +76,13 @@ def load_study(
     if name is None:
         raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
     study = get_study(name)
+    swept = set(read_sweep(path)) - set(RESERVED) if "sweep" in doc else set()
     for text in overrides:
         key, value = parse_override(text)
-        if key == "study":
-            raise ConfigError("study", "cannot be overridden")
+        _overridable(key, swept)
         flat[key] = value
     for key, value in (values or {}).items():
-        if key == "study":
-            raise ConfigError("study", "cannot be overridden")
+        _overridable(key, swept)
         flat[key] = list(value) if isinstance(value, tuple) else value
     if trials is not None:
         flat["trials"] = trials

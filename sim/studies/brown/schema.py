@@ -211,6 +211,12 @@ def check(cfg: dict) -> None:
     if cfg["comparator.scale_length_mm"] > 0:
         _, theta = setup(cfg)
         r = ml.ranges(pts[None], theta[None])
+        if not np.all(np.isfinite(r)):  # the stations so far out that a range overflows
+            raise ConfigError(
+                "comparator.station_offset_mm",
+                f"{cfg['comparator.station_offset_mm']:g} mm puts the stations so far out "
+                "that the ranges overflow",
+            )
         reach = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
         if r.max() > reach or r.min() < 0:
             raise ConfigError(

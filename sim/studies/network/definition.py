@@ -249,8 +249,7 @@ def _listed_obs(cfg: dict, names: list[str]) -> list[tuple]:
         if code == 2:
             _keys(key, rec, _OBS, {"at", "from"})
             at, bs, fs = (_match(f"{key}.{f}", rec[f], names) for f in ("at", "from", "to"))
-            if len(at) != 1 or len(bs) != 1 or len(fs) != 1:
-                raise ConfigError(f"{key}.at", "an angle names one point each for at, from, to")
+            _one_each(key, {"at": at, "from": bs, "to": fs})
             rows.append((code, at[0], bs[0], fs[0], sig, bias))
             continue
         if "from" not in rec:
@@ -258,14 +257,22 @@ def _listed_obs(cfg: dict, names: list[str]) -> list[tuple]:
         if "at" in rec:
             raise ConfigError(f"{key}.at", f"only an angle has 'at' (this is a {KINDS[code]})")
         fr, to = (_match(f"{key}.{f}", rec[f], names) for f in ("from", "to"))
-        if len(fr) != 1 or len(to) != 1:
-            raise ConfigError(
-                f"{key}.to",
-                "one observation names one point each for from and "
-                "to (use network.generate for many)",
-            )
+        _one_each(key, {"from": fr, "to": to})
         rows.append((code, fr[0], to[0], -1, sig, bias))
     return rows
+
+
+def _one_each(key: str, matched: dict) -> None:
+    """One observation names one point in each of its fields (the one that matched more is
+    named)."""
+    for f, pts in matched.items():
+        if len(pts) != 1:
+            raise ConfigError(
+                f"{key}.{f}",
+                f"matches {len(pts)} points: one observation names one point each for "
+                f"{', '.join(matched)}"
+                + ("" if "at" in matched else " (use network.generate for many)"),
+            )
 
 
 def _generated_obs(cfg: dict, names: list[str], xy: np.ndarray, rows: list[tuple]) -> None:

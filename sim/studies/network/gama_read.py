@@ -46,6 +46,7 @@ import numpy as np
 from sim.mc.config import ConfigError
 from sim.studies.network.definition import ARCSEC
 from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes
+from sim.studies.network.validate import SIGMA_RANGE
 
 __all__ = ["read_gama", "read_bytes", "MAX_BYTES", "CC", "NS"]
 
@@ -99,12 +100,18 @@ def _defaults(f: _File, po) -> dict:
     return d
 
 
-def _sigma(f: _File, o, default, var: float | None) -> float:
-    """The standard deviation of one observation (mm, cc or arcsec), within the range whose
-    weight neither over- nor underflows (the study's own range, named by the element)."""
+def _sigma(f: _File, o, default, var: float | None, unit: float | None = None) -> float:
+    """The standard deviation of one observation (mm, cc or arcsec; ``unit`` the angle unit
+    in rad, None for mm), within the study's own range (:data:`SIGMA_RANGE`, in mm or
+    arcsec: what the suite exports, it reads back), named by the element."""
     sig = _stdev(f, o, default, var)
-    if not 1e-9 <= sig <= 1e6:
-        raise f.err(o, f"a standard deviation of {sig:g} is outside [1e-09, 1e+06]", "stdev")
+    lo, hi = SIGMA_RANGE["mm" if unit is None else "arcsec"]
+    study = sig if unit is None else sig * unit / ARCSEC
+    if not lo <= study <= hi:
+        what = "mm" if unit is None else f"{study:g} arcsec"
+        raise f.err(
+            o, f"a standard deviation of {sig:g} ({what}) is outside [{lo:g}, {hi:g}]", "stdev"
+        )
     return sig
 
 
@@ -178,14 +185,14 @@ def _obs(f: _File, e, dflt: dict, sets: dict, out: list) -> None:
             rec["sigma_mm"] = _sigma(f, o, dd, v)
         elif t == "direction":
             unit = ARCSEC if f.angle(o) else CC
-            s = _sigma(f, o, dflt["direction"], v)
+            s = _sigma(f, o, dflt["direction"], v, unit)
             rec = {"kind": "direction", "from": st, "to": f.name(o, "to")}
             rec["sigma_arcsec"] = s * unit / ARCSEC
             if label:
                 rec["set"] = label
         else:  # angle
             unit = ARCSEC if f.angle(o) else CC
-            s = _sigma(f, o, dflt["angle"], v)
+            s = _sigma(f, o, dflt["angle"], v, unit)
             bs = o.get("bs", o.get("to"))
             fs = o.get("fs", o.get("rs"))
             if bs is None or fs is None:

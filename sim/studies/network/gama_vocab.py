@@ -22,8 +22,10 @@ NS = "http://www.gnu.org/software/gama/gama-local"
 CC = math.pi / 200 / 10000  # one centesimal second in rad
 #: largest gama-local file read (bytes)
 MAX_BYTES = 16 * 1024**2
-_NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
-_DMS = re.compile(r"^[+-]?\d+-\d+-\d+(\.\d*)?([eE][+-]?\d+)?$")
+#: a number as gama-local's C parser reads it: ASCII digits only (Python's float and ``\d``
+#: would also take Arabic-Indic or full-width digits)
+_NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$", re.ASCII)
+_DMS = re.compile(r"^[+-]?\d+-\d+-\d+(\.\d*)?([eE][+-]?\d+)?$", re.ASCII)
 _XYZ = ("xy", "XY", "z", "Z", "xyz", "XYZ", "XYz", "xyZ")
 #: gama-local's vocabulary: element -> its attributes
 VOCAB = {
@@ -72,6 +74,24 @@ VOCAB = {
     "coordinates": {"extern"},
     "vectors": set(),
     "vec": {"from", "to", "dx", "dy", "dz", "from_dh", "to_dh", "extern"},
+}
+#: where each element may stand (gama-local.xsd): element -> the elements that may hold it; an
+#: element elsewhere (a <point> inside <parameters>, an <obs> directly in <network>) would be
+#: skipped by the reader, so it is refused
+PARENTS = {
+    "network": {"gama-local"},
+    "description": {"network"},
+    "parameters": {"network"},
+    "points-observations": {"network"},
+    "point": {"points-observations", "coordinates"},
+    "obs": {"points-observations"},
+    "direction": {"obs"},
+    "distance": {"obs"},
+    "angle": {"obs"},
+    "cov-mat": {"obs", "coordinates", "vectors"},
+    "coordinates": {"points-observations"},
+    "vectors": {"points-observations"},
+    "vec": {"vectors"},
 }
 _CHOICES = {
     ("network", "axes-xy"): ("ne", "sw", "es", "wn", "en", "nw", "se", "ws"),
@@ -148,6 +168,11 @@ class _File:
         return False
 
     def vocab(self, root) -> None:
+        for parent in root.iter():  # every element's place (iterative: any depth)
+            for e in parent:
+                if isinstance(e.tag, str) and _tag(parent) not in PARENTS.get(_tag(e), {""}):
+                    if _tag(e) in VOCAB and _tag(e) not in _REFUSED:
+                        raise self.err(e, f"not allowed inside <{_tag(parent)}>")
         for e in root.iter():
             t = _tag(e)
             ns = e.tag[1:].split("}", 1)[0] if isinstance(e.tag, str) and e.tag[:1] == "{" else NS
@@ -162,7 +187,9 @@ class _File:
             if (e.tail or "").strip() and e is not root:
                 raise self.err(e, f"unexpected text {e.tail.strip()[:20]!r} after it")
             for a, v in e.attrib.items():
-                if a.startswith("{") or a == "xmlns":
+                if a.startswith("{" + NS + "}"):  # g:fix in gama-local's namespace: not fix
+                    raise self.err(e, "an attribute with a namespace prefix: write it plainly", a)
+                if a.startswith("{") or a == "xmlns":  # another namespace's (xsi:...): not ours
                     continue
                 if a not in VOCAB[t]:
                     raise self.err(e, "unknown attribute", a)
@@ -174,6 +201,8 @@ class _File:
 def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
     """The bytes of ``path``: a regular file of at most :data:`MAX_BYTES` (else one line)."""
     path = Path(path)
+    if "\0" in str(path):
+        raise ConfigError(key, f"{str(path)!r} holds a NUL character: not a path")
     try:
         st = os.stat(path)
     except OSError as e:

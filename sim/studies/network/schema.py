@@ -39,12 +39,15 @@ SCHEMA = {
         "read the points and observations from this "
         "gama-local XML file instead (a path relative to the working "
         "directory, or absolute)",
+        sweep="each file is a network with its own sha256 (network.gama_sha256): "
+        "write one study file per network",
     ),
     "network.gama_sha256": Field(
         "",
         "str",
         "sha256 of the network.gama_xml file's contents, filled in on load so that an edited "
         "file makes the results stale (if given, the file must still have it)",
+        sweep="it is the sha256 of the one network.gama_xml file",
     ),
     "network.points": Field([], "records", "points {name, x_mm, y_mm, role, sigma_mm}"),
     "network.grids": Field(
