@@ -27,6 +27,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -108,18 +109,25 @@ def run_all(
         ]
 
     t0 = time.perf_counter()
-
     procs: list[subprocess.Popen] = []
+    stop = threading.Event()  # set on an interrupt: start no more runs, print nothing of theirs
+    starting = threading.Lock()
 
     def one(f: Path):
         cmd = [sys.executable, "-m", "sim", *argv(f)]
         t = time.perf_counter()
-        with subprocess.Popen(
-            cmd, stdout=subprocess.PIPE if jobs > 1 else None, stderr=subprocess.PIPE, text=True
-        ) as proc:
+        with starting:
+            if stop.is_set():
+                return f.stem, None, 0.0, t - t0
+            proc = subprocess.Popen(
+                cmd, stdout=subprocess.PIPE if jobs > 1 else None, stderr=subprocess.PIPE, text=True
+            )
             procs.append(proc)
+        with proc:
             stdout, stderr = proc.communicate()
         wall = time.perf_counter() - t
+        if stop.is_set():  # interrupted: the driver says so in one line
+            return f.stem, None, wall, t - t0
         named = _Named(sys.stderr, f.name)
         named.write(stderr)
         named.flush()
@@ -128,18 +136,42 @@ def run_all(
         return f.stem, proc.returncode, wall, t - t0
 
     out: dict[str, tuple[int, float, float]] = {}
+    pool = ThreadPoolExecutor(max_workers=jobs)
     try:
-        with ThreadPoolExecutor(max_workers=jobs) as pool:
-            for stem, code, wall, start in pool.map(one, todo):
-                out[stem] = (code, wall, start)
+        for stem, code, wall, start in pool.map(one, todo):
+            out[stem] = (code, wall, start)
     except KeyboardInterrupt:
-        for proc in procs:  # SIGTERM reached only the driver: pass it on, then wait
-            if proc.poll() is None:
-                proc.terminate()
-        for proc in procs:
-            proc.wait()
+        _stop_runs(stop, starting, procs)
+        pool.shutdown(wait=True, cancel_futures=True)
         raise
+    pool.shutdown()
     return out
+
+
+#: the signals that end a batch (and each of its runs) as Ctrl-C does
+STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+
+
+def _stop_runs(stop: threading.Event, starting: threading.Lock, procs: list) -> None:
+    """An interrupt reached the driver (Ctrl-C reaches the runs too; SIGTERM or SIGHUP only
+    the driver): start no more runs, pass SIGTERM on to the live ones (each cleans up as
+    after Ctrl-C), wait for them (killed after :data:`GRACE_S`)."""
+    for s in (signal.SIGINT, *STOP_SIGNALS):  # a second signal must not orphan the runs
+        signal.signal(s, signal.SIG_IGN)
+    with starting:
+        stop.set()
+    for proc in procs:
+        if proc.poll() is None:
+            proc.terminate()
+    for proc in procs:
+        try:
+            proc.wait(timeout=GRACE_S)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+
+
+#: seconds an interrupted run has to clean up before it is killed
+GRACE_S = 30
 
 
 class _Named:
@@ -212,7 +244,16 @@ def _timings_problem(path: str) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
+    old = {s: signal.getsignal(s) for s in (signal.SIGINT, *STOP_SIGNALS)}
+    try:
+        return _main(list(sys.argv[1:] if argv is None else argv))
+    finally:  # in-process callers (the tests) get their handlers back
+        for s, h in old.items():
+            if h is not None:
+                signal.signal(s, h)
+
+
+def _main(argv: list[str]) -> int:
     run_args = []
     if "--" in argv:
         i = argv.index("--")
@@ -233,6 +274,10 @@ def main(argv: list[str] | None = None) -> int:
     if not args.results.strip() or not args.results.isprintable():
         print(f"sim.batch: --results: not a directory name (got {args.results!r})", file=sys.stderr)
         return 2
+    for name, v in [("FILE", f) for f in args.files] + [("--timings", args.timings)]:
+        if v is not None and (not v.strip() or not v.isprintable()):
+            print(f"sim.batch: {name}: not a file name (got {v!r})", file=sys.stderr)
+            return 2
     files = [Path(f) for f in args.files]
     bad = [f for f in files if not f.is_file()]
     if bad:
@@ -242,21 +287,25 @@ def main(argv: list[str] | None = None) -> int:
     if why:
         print(f"sim.batch: {why}", file=sys.stderr)
         return 2
-    why = _timings_problem(args.timings) if args.timings else None
+    why = _timings_problem(args.timings) if args.timings is not None else None
     if why:
         print(f"sim.batch: --timings: {why}", file=sys.stderr)
         return 2
-    if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
-        signal.signal(signal.SIGTERM, _on_sigterm)  # end the runs as Ctrl-C does
+    for s in STOP_SIGNALS:
+        if signal.getsignal(s) is signal.SIG_DFL:
+            signal.signal(s, _on_sigterm)  # end the runs as Ctrl-C does
     if not 1 <= args.jobs <= 64:
         print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
         return 2
     try:
         done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only)
-    except KeyboardInterrupt:  # the runs got the interrupt too and cleaned up
-        print("sim.batch: interrupted", file=sys.stderr)
+    except KeyboardInterrupt:  # the runs were stopped and cleaned up
+        print(
+            "sim.batch: interrupted; the same command again resumes the unfinished runs",
+            file=sys.stderr,
+        )
         return 130
-    if args.timings:
+    if args.timings is not None:
         Path(args.timings).write_text(json.dumps(done))
     failed = [v[0] for v in done.values() if v[0] != 0]
     return (failed[0] if failed[0] > 0 else 1) if failed else 0

@@ -33,7 +33,7 @@ import pyarrow.parquet as pq
 from sim.cli_args import parser
 from sim.execute import execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
-from sim.mc.estimate import estimate
+from sim.mc.estimate import check_limits, estimate
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
@@ -242,6 +242,8 @@ def _check(args) -> int:
     study, cfg = load_study(args.study, args.set)
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
+    est = estimate(cfg, sweep)
+    check_limits(est)  # the limits sim run applies (SIM_MAX_MEMORY_GB, SIM_MAX_ADJUSTMENTS)
     print(f"# {cfg['study']}: {study.title}")
     for k, v in cfg.items():
         f = study.schema.get(k)
@@ -255,7 +257,7 @@ def _check(args) -> int:
         print(f"{k} = {v!r}  # {f.doc}" + (f" ({notes})" if notes else ""))
     if sweep:
         print(f"# [sweep] {', '.join(sweep)}")
-    print(f"# work: {estimate(cfg, sweep).describe()}")
+    print(f"# work: {est.describe()}")
     return 0
 
 
@@ -312,9 +314,14 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str]) -> int:
     try:
         args = parser(__doc__).parse_args(argv)
+        if args.cmd in ("run", "check") and (
+            not args.study.strip() or not args.study.isprintable()
+        ):
+            raise ConfigError("STUDY", f"not a study file name (got {args.study!r})")
         if args.cmd == "run":
-            if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
-                signal.signal(signal.SIGTERM, _on_sigterm)  # clean up like Ctrl-C
+            for s in (signal.SIGTERM, signal.SIGHUP):  # clean up like Ctrl-C (nohup: ignored)
+                if signal.getsignal(s) is signal.SIG_DFL:
+                    signal.signal(s, _on_sigterm)
             return _run(args)
         if args.cmd == "check":
             return _check(args)

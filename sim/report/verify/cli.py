@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import tempfile
 from pathlib import Path
@@ -86,7 +87,25 @@ def _print(comps: list[Comparison]) -> None:
             print(f"  not compared (rows depend on the trials): {', '.join(c.not_compared)}")
 
 
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
+    signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    old = {s: signal.getsignal(s) for s in signals}
+    for s in signals[1:]:  # end the re-run and clean up as Ctrl-C does
+        if old[s] is signal.SIG_DFL:
+            signal.signal(s, _interrupt)
+    try:
+        return _main(argv)
+    finally:
+        for s, h in old.items():
+            if h is not None:
+                signal.signal(s, h)
+
+
+def _main(argv: list[str] | None) -> int:
     try:
         a = _parser().parse_args(argv)
         _check_args(a)
@@ -107,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"sim verify: error: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("sim verify: interrupted", file=sys.stderr)
+        print("sim verify: interrupted; the re-run was stopped", file=sys.stderr)
         return 130
     _print(comps)
     if not a.no_record and mode == "full" and not a.study:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import platform
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -109,12 +110,35 @@ def rerun_study(
     cmd = [sys.executable, "-m", "sim", "run", str(sf), "--out", str(target), "--quiet"]
     cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else []), *extra]
     print(f"sim verify: re-running {d.name}", file=sys.stderr, flush=True)
-    r = subprocess.run(cmd, stderr=subprocess.PIPE, text=True, errors="replace")
-    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
-    if r.returncode == 2 and extra and lines:  # the re-run refused the options verify passed
+    with subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True, errors="replace") as proc:
+        try:
+            _, err = proc.communicate()
+        except KeyboardInterrupt:  # Ctrl-C reaches the re-run too, SIGTERM or SIGHUP only verify
+            _stop(proc)
+            raise
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    if proc.returncode == 2 and extra and lines:  # the re-run refused the options verify passed
         raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
-    sys.stderr.write(r.stderr)
-    return None if r.returncode == 0 else f"the re-run exited with {r.returncode}"
+    sys.stderr.write(err)
+    return None if proc.returncode == 0 else f"the re-run exited with {proc.returncode}"
+
+
+#: seconds an interrupted re-run has to clean up (its staging directory) before it is killed
+GRACE_S = 30
+
+
+def _stop(proc: subprocess.Popen) -> None:
+    """End an interrupted re-run as Ctrl-C does (SIGTERM: it marks its staging directory
+    resumable and ends its workers), without a word of its own; killed after GRACE_S."""
+    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):  # a second signal orphans nothing
+        signal.signal(s, signal.SIG_IGN)
+    if proc.poll() is None:
+        proc.terminate()
+    try:
+        proc.communicate(timeout=GRACE_S)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
 
 
 def verify(

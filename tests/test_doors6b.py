@@ -1,0 +1,117 @@
+"""The failure classes of the fifth sweep of bad inputs (issue 26, part B: the command line,
+``sim.batch``, ``make verify``, ``sim report`` and signals), one case per class: each is
+refused with exit 2 and one line naming the key or the argument, nothing is written, and a
+signal ends every process a command started.
+
+* ``sim check`` with a bad ``SIM_MAX_MEMORY_GB`` exited 0 (``sim run`` refuses it): it now
+  applies the limits of the run (``check_limits``) to its estimate;
+* an empty path (``--timings ''``, a study file ``''``) was taken for the working directory or
+  for no option at all;
+* SIGTERM or SIGHUP to ``python -m sim.batch`` or ``python -m sim.report.verify`` left their
+  ``sim run`` processes running (the batch waited for them to finish, verify died at once).
+"""
+
+import os
+import signal
+import stat
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from sim import batch
+from sim.cli import main
+from sim.mc.storage import write_table
+from sim.report.verify import main as verify_main
+
+ROOT = Path(__file__).resolve().parent.parent
+BROWN = ROOT / "studies" / "brown_table1.toml"
+
+
+def _one_line(capsys, code: int, prefix: str, *names: str) -> str:
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and err.startswith(prefix), err
+    assert "Traceback" not in err and all(n in err for n in names), err
+    return err
+
+
+@pytest.mark.parametrize(
+    "env, value", [("SIM_MAX_MEMORY_GB", "abc"), ("SIM_MAX_ADJUSTMENTS", "inf")]
+)
+def test_check_applies_the_limits_of_the_run(capsys, monkeypatch, env, value):
+    monkeypatch.setenv(env, value)
+    _one_line(capsys, main(["check", str(BROWN)]), "sim: error: ", env)
+    assert capsys.readouterr().out == ""
+
+
+def test_an_empty_path_is_named(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    _one_line(capsys, batch.main(["--timings", "", str(BROWN)]), "sim.batch: ", "--timings")
+    _one_line(capsys, batch.main(["", str(BROWN)]), "sim.batch: ", "FILE", "''")
+    _one_line(capsys, main(["check", ""]), "sim: error: ", "STUDY", "''")
+    assert list(tmp_path.iterdir()) == []
+
+
+def _fake_python(tmp_path: Path) -> Path:
+    """An "interpreter" that records its pid and sleeps: the run a signal must end."""
+    exe = tmp_path / "python"
+    exe.write_text(f"#!/bin/sh\necho $$ >> {tmp_path}/pids\nexec sleep 30\n")
+    exe.chmod(exe.stat().st_mode | stat.S_IXUSR)
+    return exe
+
+
+def _signal_soon(tmp_path: Path, sig: int) -> None:
+    """Send ``sig`` to this process once a run has started (its pid recorded)."""
+
+    def send():
+        for _ in range(200):
+            if (tmp_path / "pids").is_file():
+                break
+            time.sleep(0.01)
+        time.sleep(0.05)
+        os.kill(os.getpid(), sig)
+
+    threading.Thread(target=send, daemon=True).start()
+
+
+def _all_ended(tmp_path: Path) -> None:
+    for pid in map(int, (tmp_path / "pids").read_text().split()):
+        with pytest.raises(ProcessLookupError):  # ended and reaped
+            os.kill(pid, 0)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_to_batch_ends_its_runs(tmp_path, capsys, monkeypatch, sig):
+    monkeypatch.setattr(sys, "executable", str(_fake_python(tmp_path)))
+    _signal_soon(tmp_path, sig)
+    t = time.monotonic()
+    code = batch.main(
+        ["--results", str(tmp_path / "r"), str(BROWN), str(ROOT / "studies/wolf_polynomial.toml")]
+    )
+    assert code == 130 and time.monotonic() - t < 10
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "interrupted" in err, err
+    _all_ended(tmp_path)
+    assert signal.getsignal(sig) is signal.SIG_DFL  # the caller's handler is back
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_to_verify_ends_its_rerun(tmp_path, capsys, monkeypatch, sig):
+    d = tmp_path / "res" / "brown_table1"
+    d.mkdir(parents=True)
+    write_table(
+        d / "claims.parquet", {"claim": ["x"], "verdict": ["holds"]}, {"study": "brown_table1"}
+    )
+    monkeypatch.chdir(ROOT)  # the re-run reads studies/<study>.toml
+    monkeypatch.setattr(sys, "executable", str(_fake_python(tmp_path)))
+    _signal_soon(tmp_path, sig)
+    t = time.monotonic()
+    code = verify_main(["--results", str(d.parent), "--scratch", str(tmp_path / "s")])
+    assert code == 130 and time.monotonic() - t < 10
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "interrupted" in err[-1] and not any("Traceback" in e for e in err), err
+    _all_ended(tmp_path)
+    assert signal.getsignal(sig) is signal.SIG_DFL
+    assert sorted(p.name for p in d.parent.iterdir()) == ["brown_table1"]  # no record
