@@ -36,6 +36,7 @@ from sim.threads import single_threaded_blas
 
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 
+from sim.cli_args import name_problem  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
 from sim.studies import load_study  # noqa: E402
@@ -271,12 +272,13 @@ def _main(argv: list[str]) -> int:
     except _BadArgs as e:
         print(f"sim.batch: {e} (see python -m sim.batch --help)", file=sys.stderr)
         return 2
-    if not args.results.strip() or not args.results.isprintable():
-        print(f"sim.batch: --results: not a directory name (got {args.results!r})", file=sys.stderr)
+    if name_problem(args.results):
+        why = name_problem(args.results)
+        print(f"sim.batch: --results: {why} (got {args.results!r})", file=sys.stderr)
         return 2
     for name, v in [("FILE", f) for f in args.files] + [("--timings", args.timings)]:
-        if v is not None and (not v.strip() or not v.isprintable()):
-            print(f"sim.batch: {name}: not a file name (got {v!r})", file=sys.stderr)
+        if v is not None and name_problem(v):
+            print(f"sim.batch: {name}: {name_problem(v)} (got {v!r})", file=sys.stderr)
             return 2
     files = [Path(f) for f in args.files]
     bad = [f for f in files if not f.is_file()]

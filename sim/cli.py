@@ -30,7 +30,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.cli_args import parser
+from sim.cli_args import name_problem, parser
 from sim.execute import execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
@@ -70,8 +70,9 @@ def _check_args(args) -> Path:
     if args.out is not None:
         if not args.out.strip():
             raise ConfigError("--out", "is empty: name an output directory")
-        if not args.out.isprintable():
-            raise ConfigError("--out", f"contains a control character (got {args.out!r})")
+        why = name_problem(args.out)
+        if why:
+            raise ConfigError("--out", f"{why} (got {args.out!r})")
     return Path(os.path.abspath(args.out)) if args.out else None
 
 
@@ -186,8 +187,10 @@ def _run(args) -> int:
 
 
 def _show(args) -> int:
-    if not args.dir.strip() or not args.dir.isprintable():
-        raise ConfigError("DIR", f"not a directory name (got {args.dir!r})")
+    if name_problem(args.dir):
+        raise ConfigError(
+            "DIR", f"not a directory name: {name_problem(args.dir)} (got {args.dir!r})"
+        )
     d = Path(args.dir)
     if not d.exists() and (Path("results") / args.dir).is_dir():
         d = Path("results") / args.dir
@@ -291,12 +294,25 @@ def _cwd_exists() -> bool:
     return True
 
 
+def _why(e: OSError) -> str:
+    """The reason of an OSError in words: its strerror, or (pyarrow raises
+    ``FileNotFoundError(path)`` without one) the name of its kind."""
+    if e.strerror:
+        return e.strerror
+    if isinstance(e, FileNotFoundError):
+        return "No such file or directory"
+    if len(e.args) == 1 and isinstance(e.args[0], str):  # OSError(path): the path is all
+        return type(e).__name__
+    return str(e) or type(e).__name__
+
+
 def _on_sigterm(signum, frame):
     raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
+    old = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
     try:
         if not argv:  # usage, not an error message
             parser(__doc__).print_help()
@@ -309,15 +325,18 @@ def main(argv: list[str] | None = None) -> int:
         except (OSError, ValueError):
             pass
         return 141
+    finally:  # in-process callers (the tests, the API) get their handlers back
+        for s, h in old.items():
+            if h is not None:
+                signal.signal(s, h)
 
 
 def _main(argv: list[str]) -> int:
     try:
         args = parser(__doc__).parse_args(argv)
-        if args.cmd in ("run", "check") and (
-            not args.study.strip() or not args.study.isprintable()
-        ):
-            raise ConfigError("STUDY", f"not a study file name (got {args.study!r})")
+        if args.cmd in ("run", "check") and name_problem(args.study):
+            why = name_problem(args.study)
+            raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
         if args.cmd == "run":
             for s in (signal.SIGTERM, signal.SIGHUP):  # clean up like Ctrl-C (nohup: ignored)
                 if signal.getsignal(s) is signal.SIG_DFL:
@@ -328,8 +347,11 @@ def _main(argv: list[str]) -> int:
         if args.cmd == "show":
             return _show(args)
         if args.cmd == "report":
-            if not args.results.strip() or not args.results.isprintable():
-                raise ConfigError("--results", f"not a directory name (got {args.results!r})")
+            if name_problem(args.results):
+                why = name_problem(args.results)
+                raise ConfigError(
+                    "--results", f"not a directory name: {why} (got {args.results!r})"
+                )
             return _report(Path(args.results))
     except (ConfigError, StudyError) as e:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)
@@ -344,9 +366,11 @@ def _main(argv: list[str]) -> int:
         raise
     except OSError as e:  # a failing write (full disk, vanished directory): one line, no traceback
         name = getattr(e, "filename", "") or ""
+        if not name and not e.strerror and len(e.args) == 1 and isinstance(e.args[0], str):
+            name = e.args[0]  # pyarrow's FileNotFoundError(path)
         if not name and not _cwd_exists():
             name = "the working directory (it was deleted)"
-        print(f"sim: error: {e.strerror or e}: {name}".rstrip(": "), file=sys.stderr)
+        print(f"sim: error: {_why(e)}: {name}".rstrip(": "), file=sys.stderr)
         return 2
     except (ArithmeticError, ValueError, MemoryError) as e:  # e.g. a sweep cell table
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)

@@ -9,11 +9,22 @@ signal ends every process a command started.
   for no option at all;
 * SIGTERM or SIGHUP to ``python -m sim.batch`` or ``python -m sim.report.verify`` left their
   ``sim run`` processes running (the batch waited for them to finish, verify died at once).
+
+Found by the fresh set (``/tmp/doors6b``, outside the project):
+
+* a path of bytes that are not UTF-8 (a Latin-1 name; any non-ASCII name in a C locale
+  without UTF-8 mode) was refused as "a control character", or, as a study file's ``--out``,
+  failed at the end of the run (UnicodeEncodeError writing its provenance);
+* ``sim report`` on a results directory missing a table printed the bare path (pyarrow's
+  ``FileNotFoundError(path)`` has no reason);
+* a HOME or MPLCONFIGDIR that is not writable: matplotlib's two warning lines on every run.
 """
 
 import os
+import shutil
 import signal
 import stat
+import subprocess
 import sys
 import threading
 import time
@@ -85,6 +96,7 @@ def _all_ended(tmp_path: Path) -> None:
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
 def test_a_signal_to_batch_ends_its_runs(tmp_path, capsys, monkeypatch, sig):
     monkeypatch.setattr(sys, "executable", str(_fake_python(tmp_path)))
+    before = signal.getsignal(sig)
     _signal_soon(tmp_path, sig)
     t = time.monotonic()
     code = batch.main(
@@ -94,7 +106,7 @@ def test_a_signal_to_batch_ends_its_runs(tmp_path, capsys, monkeypatch, sig):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "interrupted" in err, err
     _all_ended(tmp_path)
-    assert signal.getsignal(sig) is signal.SIG_DFL  # the caller's handler is back
+    assert signal.getsignal(sig) is before  # the caller's handler is back
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
@@ -106,6 +118,7 @@ def test_a_signal_to_verify_ends_its_rerun(tmp_path, capsys, monkeypatch, sig):
     )
     monkeypatch.chdir(ROOT)  # the re-run reads studies/<study>.toml
     monkeypatch.setattr(sys, "executable", str(_fake_python(tmp_path)))
+    before = signal.getsignal(sig)
     _signal_soon(tmp_path, sig)
     t = time.monotonic()
     code = verify_main(["--results", str(d.parent), "--scratch", str(tmp_path / "s")])
@@ -113,5 +126,29 @@ def test_a_signal_to_verify_ends_its_rerun(tmp_path, capsys, monkeypatch, sig):
     err = capsys.readouterr().err.strip().splitlines()
     assert "interrupted" in err[-1] and not any("Traceback" in e for e in err), err
     _all_ended(tmp_path)
-    assert signal.getsignal(sig) is signal.SIG_DFL
+    assert signal.getsignal(sig) is before
     assert sorted(p.name for p in d.parent.iterdir()) == ["brown_table1"]  # no record
+
+
+@pytest.mark.parametrize("cmd", [["run", str(BROWN), "--out"], ["show"], ["check"]])
+def test_a_path_that_is_not_utf8_is_named(tmp_path, capsys, cmd):
+    name = str(tmp_path / "caf\udce9")  # b"caf\xe9" as Python keeps it
+    _one_line(capsys, main([*cmd, name]), "sim: error: ", "UTF-8")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_report_names_a_missing_table_and_why(tmp_path, capsys):
+    d = tmp_path / "r" / "network_testfield"
+    shutil.copytree(ROOT / "results" / "network_testfield", d)
+    gone = next(p for p in sorted(d.glob("*.parquet")) if p.name != "claims.parquet")
+    gone.unlink()
+    _one_line(capsys, main(["report", "--results", str(d.parent)]), "sim: error: ", "No such")
+    assert not (d.parent / "REPORT.md").exists()
+
+
+def test_an_unwritable_matplotlib_config_directory_is_not_reported(tmp_path):
+    env = {**os.environ, "MPLCONFIGDIR": str(tmp_path / "file" / "mpl"), "HOME": "/dev/null"}
+    (tmp_path / "file").write_text("")
+    code = "import sim.__main__, matplotlib.pyplot"
+    r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert r.returncode == 0 and r.stderr == "", r.stderr

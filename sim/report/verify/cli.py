@@ -6,6 +6,7 @@ import argparse
 import signal
 import sys
 import tempfile
+import unicodedata
 from pathlib import Path
 
 from sim.report.verify.rerun import verify, write_record
@@ -57,10 +58,23 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _name_problem(text: str) -> str | None:
+    """Why a path cannot name a directory of the suite (as sim.cli_args.name_problem, which
+    this layer cannot import)."""
+    if not text.strip():
+        return "is empty"
+    if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text):
+        return "contains a control character or a line break"
+    if any(unicodedata.category(c) == "Cs" for c in text):
+        return "contains bytes that are not UTF-8 text (a non-UTF-8 name or locale)"
+    return None
+
+
 def _check_args(a) -> None:
     for name, v in (("--results", a.results), ("--scratch", a.scratch)):
-        if v is not None and (not v.strip() or not v.isprintable()):
-            raise VerifyError(f"{name}: not a directory name (got {v!r})")
+        why = None if v is None else _name_problem(v)
+        if why:
+            raise VerifyError(f"{name}: {why} (got {v!r})")
     if a.workers < 1:
         raise VerifyError(f"--workers: must be at least 1, not {a.workers}")
     if a.trials is not None and a.trials < 2:
