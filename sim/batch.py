@@ -22,6 +22,8 @@ file is bad input: one line, exit 2.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import json
 import os
 import signal
@@ -36,7 +38,10 @@ from sim.threads import single_threaded_blas
 
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 
+from sim.cli import __doc__ as cli_doc  # noqa: E402
+from sim.cli import check_run_args  # noqa: E402
 from sim.cli_args import name_problem  # noqa: E402
+from sim.cli_args import parser as run_parser  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
 from sim.studies import load_study  # noqa: E402
@@ -60,8 +65,8 @@ def is_current(study_file: str | Path, results: str | Path) -> bool:
     try:
         record = json.loads((Path(results) / "run.json").read_text())
         _, cfg = load_study(study_file)
-    except (OSError, ValueError, ConfigError, StudyError):
-        return False
+    except (OSError, ValueError, RecursionError, ConfigError, StudyError):
+        return False  # RecursionError: a run.json nested too deep to read
     if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
         return False
     want = study_code_hash(cfg["study"])
@@ -194,11 +199,12 @@ class _Named:
 
 def _clashes(files: list[Path], run_args: list[str]) -> str | None:
     """Why these runs cannot share one batch: two of them would write one results directory
-    (the same file twice, two files of one name, or an ``--out`` in the run options)."""
-    if any(a == "--out" or a.startswith("--out=") for a in run_args):
-        return "--out cannot be a run option: each study writes <results>/<file name>"
+    (the same file twice, two files of one name), or a file's name is ``.toml`` or
+    ``...toml`` (its results would be <results> itself or its parent)."""
     seen: dict[str, Path] = {}
     for f in files:
+        if f.stem in ("", ".", ".."):
+            return f"{f}: a study file named like this would write <results>/{f.stem}"
         if f.stem in seen:
             same = f.resolve() == seen[f.stem].resolve()
             return (
@@ -207,6 +213,25 @@ def _clashes(files: list[Path], run_args: list[str]) -> str | None:
                 else f"{seen[f.stem]} and {f} would both write results/{f.stem}"
             )
         seen[f.stem] = f
+    return None
+
+
+def _run_options_problem(run_args: list[str]) -> str | None:
+    """Why the run options cannot go to every run, checked once before any starts (as
+    ``sim run`` reads them, abbreviations included): a bad option or value, an ``--out``
+    (each study writes <results>/<file name>), or ``--help`` (each run would print its help
+    and exit 0 without running)."""
+    text = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(text), contextlib.redirect_stderr(text):
+            args = run_parser(cli_doc).parse_args(["run", "STUDY.toml", *run_args])
+        if args.out is not None:
+            return "--out cannot be a run option: each study writes <results>/<file name>"
+        check_run_args(args)
+    except SystemExit:
+        return f"{' '.join(run_args)!r} would print the help of sim run and run nothing"
+    except ConfigError as e:
+        return str(e).removeprefix("sim: ")
     return None
 
 
@@ -228,7 +253,10 @@ def _timings_problem(path: str) -> str | None:
     directory must be writable, and an existing file must be an earlier timings file (a
     JSON object of lists), never a file of the user's."""
     p = Path(path)
-    parent = p.resolve().parent
+    try:
+        parent = p.resolve().parent
+    except (OSError, RuntimeError) as e:  # a symlink loop
+        return f"{p} cannot be resolved: {e}"
     if not parent.is_dir() or not os.access(parent, os.W_OK):
         return f"cannot write into {parent}"
     if p.is_symlink() or (p.exists() and not p.is_file()):
@@ -288,6 +316,10 @@ def _main(argv: list[str]) -> int:
     why = _clashes(files, run_args)
     if why:
         print(f"sim.batch: {why}", file=sys.stderr)
+        return 2
+    why = _run_options_problem(run_args)
+    if why:
+        print(f"sim.batch: run options: {why}", file=sys.stderr)
         return 2
     why = _timings_problem(args.timings) if args.timings is not None else None
     if why:

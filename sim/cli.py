@@ -41,7 +41,7 @@ from sim.report.markdown import write_report
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.studies import get_study, load_study
 
-__all__ = ["main"]
+__all__ = ["main", "check_run_args"]
 
 #: exit code of an internal error (a bug, not bad input): one line, traceback with SIM_DEBUG=1
 INTERNAL = 3
@@ -51,7 +51,7 @@ _SCHEDULER = re.compile(
 )
 
 
-def _check_args(args) -> Path:
+def check_run_args(args) -> Path:
     """Options that need no study: one line each. Returns the output path (absolute)."""
     if args.workers < 1 or args.workers > max(4 * (os.cpu_count() or 1), 8):
         raise ConfigError(
@@ -152,7 +152,7 @@ def _default_out(cfg: dict, sweep: dict) -> tuple[Path, str, bool]:
 
 
 def _run(args) -> int:
-    out = _check_args(args)
+    out = check_run_args(args)
     study, cfg = _load(args)
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
     overwrite = args.overwrite
@@ -372,7 +372,8 @@ def _main(argv: list[str]) -> int:
             name = "the working directory (it was deleted)"
         print(f"sim: error: {_why(e)}: {name}".rstrip(": "), file=sys.stderr)
         return 2
-    except (ArithmeticError, ValueError, MemoryError) as e:  # e.g. a sweep cell table
+    except (ArithmeticError, ValueError, MemoryError, RecursionError) as e:  # e.g. a sweep
+        # cell table; a file nested too deep to read (a run.json of 100,000 brackets)
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)
         return 2
     return 1

@@ -17,14 +17,22 @@ Found by the fresh set (``/tmp/doors6b``, outside the project):
   failed at the end of the run (UnicodeEncodeError writing its provenance);
 * ``sim report`` on a results directory missing a table printed the bare path (pyarrow's
   ``FileNotFoundError(path)`` has no reason);
-* a HOME or MPLCONFIGDIR that is not writable: matplotlib's two warning lines on every run.
+* a HOME or MPLCONFIGDIR that is not writable: matplotlib's two warning lines on every run;
+* run options of ``sim.batch`` read only by each run: ``-- --ou DIR`` (``--out`` abbreviated)
+  sent every study into one directory, each replacing the last (``--overwrite``); ``--help``
+  made every "run" exit 0 without running; a bad value gave one line per study;
+* a study file named ``...toml`` (stem ``..``) wrote its results over ``<results>/..``;
+* ``make verify --workers 100000`` (or a ``--scratch`` under a file) recorded a failed
+  comparison over the committed record instead of naming the option;
+* a symlink loop as ``--timings`` or ``--scratch``, and a ``run.json`` nested deeper than
+  the recursion limit: tracebacks.
 """
 
+import logging
 import os
 import shutil
 import signal
 import stat
-import subprocess
 import sys
 import threading
 import time
@@ -32,6 +40,7 @@ from pathlib import Path
 
 import pytest
 
+import sim.__main__  # noqa: F401 - the sim command's set-up (its log filter)
 from sim import batch
 from sim.cli import main
 from sim.mc.storage import write_table
@@ -146,9 +155,61 @@ def test_report_names_a_missing_table_and_why(tmp_path, capsys):
     assert not (d.parent / "REPORT.md").exists()
 
 
-def test_an_unwritable_matplotlib_config_directory_is_not_reported(tmp_path):
-    env = {**os.environ, "MPLCONFIGDIR": str(tmp_path / "file" / "mpl"), "HOME": "/dev/null"}
-    (tmp_path / "file").write_text("")
-    code = "import sim.__main__, matplotlib.pyplot"
-    r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
-    assert r.returncode == 0 and r.stderr == "", r.stderr
+def test_an_unwritable_matplotlib_config_directory_is_not_reported():
+    """The ``sim`` command (sim.__main__) drops matplotlib's warnings that its config
+    directory is not writable (it then uses a temporary one), and no other warning."""
+    log = logging.getLogger("matplotlib")
+    for msg, shown in [
+        ("mkdir -p failed for path %s: %s", False),
+        ("%s is not a writable directory", False),
+        ("Matplotlib created a temporary cache directory at %s because ...", False),
+        ("Duplicate key in file %r, line %d (%r)", True),
+    ]:
+        rec = log.makeRecord("matplotlib", logging.WARNING, __file__, 1, msg, (), None)
+        assert bool(log.filter(rec)) is shown, msg
+
+
+@pytest.mark.parametrize(
+    "opts, words",
+    [
+        (["--ou", "X"], "--out"),
+        (["--help"], "help"),
+        (["--workers", "0"], "--workers"),
+        (["--trials", "1e3"], "--trials"),
+    ],
+)
+def test_batch_reads_the_run_options_before_any_run(tmp_path, capsys, opts, words):
+    argv = ["--results", str(tmp_path / "r"), str(BROWN), "--", *opts]
+    _one_line(capsys, batch.main(argv), "sim.batch: run options: ", words)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_batch_refuses_a_study_file_named_dot_dot(tmp_path, capsys):
+    f = tmp_path / "...toml"
+    shutil.copy(BROWN, f)
+    _one_line(capsys, batch.main(["--results", str(tmp_path / "r" / "x"), str(f)]), "sim.batch: ")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["...toml"]
+
+
+def test_verify_names_a_worker_count_the_rerun_refuses(tmp_path, capsys):
+    d = tmp_path / "res" / "brown_table1"
+    d.mkdir(parents=True)
+    write_table(d / "claims.parquet", {"claim": ["x"], "verdict": ["h"]}, {"study": "brown_table1"})
+    code = verify_main(["--results", str(d.parent), "--workers", "100000"])
+    _one_line(capsys, code, "sim verify: error: ", "--workers")
+    assert sorted(p.name for p in d.parent.iterdir()) == ["brown_table1"]  # no record
+
+
+def test_a_symlink_loop_or_a_deep_run_record_is_one_line(tmp_path, capsys):
+    (tmp_path / "loop").symlink_to("loop")
+    argv = ["--timings", str(tmp_path / "loop"), str(BROWN)]
+    _one_line(capsys, batch.main(argv), "sim.batch: --timings", "loop")
+    d = tmp_path / "res" / "brown_table1"
+    d.mkdir(parents=True)
+    write_table(d / "claims.parquet", {"claim": ["x"], "verdict": ["h"]}, {"study": "brown_table1"})
+    argv = ["--results", str(d.parent), "--scratch", str(tmp_path / "loop")]
+    _one_line(capsys, verify_main(argv), "sim verify: error: --scratch", "loop")
+    (tmp_path / "o").mkdir()
+    (tmp_path / "o" / "run.json").write_text("[" * 100_000)
+    assert not batch.is_current(BROWN, tmp_path / "o")
+    _one_line(capsys, main(["run", str(BROWN), "--out", str(tmp_path / "o")]), "sim: error: ")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 import tempfile
@@ -75,8 +76,9 @@ def _check_args(a) -> None:
         why = None if v is None else _name_problem(v)
         if why:
             raise VerifyError(f"{name}: {why} (got {v!r})")
-    if a.workers < 1:
-        raise VerifyError(f"--workers: must be at least 1, not {a.workers}")
+    top = max(4 * (os.cpu_count() or 1), 8)  # the bound of sim run --workers
+    if not 1 <= a.workers <= top:
+        raise VerifyError(f"--workers: must be between 1 and {top}, not {a.workers}")
     if a.trials is not None and a.trials < 2:
         raise VerifyError(f"--trials: must be at least 2, not {a.trials}")
     if a.set and a.trials is None:

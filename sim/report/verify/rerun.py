@@ -117,7 +117,9 @@ def rerun_study(
             _stop(proc)
             raise
     lines = [ln for ln in err.splitlines() if ln.strip()]
-    if proc.returncode == 2 and extra and lines:  # the re-run refused the options verify passed
+    if proc.returncode == 2 and lines and (extra or lines[-1].startswith("sim: error: --")):
+        # the re-run refused the options verify passed (--trials, --set, --workers, the
+        # --out under --scratch): a request error, not a failed comparison to record
         raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
     sys.stderr.write(err)
     return None if proc.returncode == 0 else f"the re-run exited with {proc.returncode}"
@@ -157,9 +159,13 @@ def verify(
     if scratch.exists() and not scratch.is_dir():
         raise VerifyError(f"--scratch: {scratch} is not a directory")
     todo = study_dirs(results, only)
-    if scratch.resolve() == Path(results).resolve() or Path(results).resolve() in (
-        scratch.resolve().parents
-    ):
+    try:
+        inside = scratch.resolve() == Path(results).resolve() or Path(results).resolve() in (
+            scratch.resolve().parents
+        )
+    except (OSError, RuntimeError) as e:  # a symlink loop
+        raise VerifyError(f"--scratch: {scratch} cannot be resolved: {e}") from None
+    if inside:
         raise VerifyError(f"--scratch: {scratch} is (inside) the committed results {results}")
     # every target checked before anything runs: a foreign directory stops it at once
     replace = {d: _target(scratch, d.name)[1] for d, _ in todo} if rerun else {}
