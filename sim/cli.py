@@ -332,15 +332,16 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str]) -> int:
+    args = None
     try:
         args = parser(__doc__).parse_args(argv)
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
+        for s in (signal.SIGTERM, signal.SIGHUP):  # clean up like Ctrl-C (nohup: ignored): a
+            if signal.getsignal(s) is signal.SIG_DFL:  # run's stage, report's temporary files
+                signal.signal(s, _on_sigterm)
         if args.cmd == "run":
-            for s in (signal.SIGTERM, signal.SIGHUP):  # clean up like Ctrl-C (nohup: ignored)
-                if signal.getsignal(s) is signal.SIG_DFL:
-                    signal.signal(s, _on_sigterm)
             return _run(args)
         if args.cmd == "check":
             return _check(args)
@@ -357,10 +358,8 @@ def _main(argv: list[str]) -> int:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)
         return INTERNAL if getattr(e, "internal", False) else 2
     except KeyboardInterrupt:
-        print(
-            "sim: interrupted; run the same command again to finish the missing chunks",
-            file=sys.stderr,
-        )
+        again = "; run the same command again to finish the missing chunks"
+        print(f"sim: interrupted{again if args and args.cmd == 'run' else ''}", file=sys.stderr)
         return 130
     except BrokenPipeError:
         raise

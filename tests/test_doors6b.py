@@ -25,7 +25,9 @@ Found by the fresh set (``/tmp/doors6b``, outside the project):
 * ``make verify --workers 100000`` (or a ``--scratch`` under a file) recorded a failed
   comparison over the committed record instead of naming the option;
 * a symlink loop as ``--timings`` or ``--scratch``, and a ``run.json`` nested deeper than
-  the recursion limit: tracebacks.
+  the recursion limit: tracebacks;
+* SIGTERM to ``sim report`` (or ``check``, ``show``) killed it at once, leaving the temporary
+  file of a README.md being written; it now cleans up and says one line, as ``sim run``.
 """
 
 import logging
@@ -41,7 +43,7 @@ from pathlib import Path
 import pytest
 
 import sim.__main__  # noqa: F401 - the sim command's set-up (its log filter)
-from sim import batch
+from sim import batch, cli
 from sim.cli import main
 from sim.mc.storage import write_table
 from sim.report.verify import main as verify_main
@@ -213,3 +215,24 @@ def test_a_symlink_loop_or_a_deep_run_record_is_one_line(tmp_path, capsys):
     (tmp_path / "o" / "run.json").write_text("[" * 100_000)
     assert not batch.is_current(BROWN, tmp_path / "o")
     _one_line(capsys, main(["run", str(BROWN), "--out", str(tmp_path / "o")]), "sim: error: ")
+
+
+def test_a_signal_to_report_cleans_up_with_one_line(tmp_path, capsys, monkeypatch):
+    d = tmp_path / "r" / "network_testfield"
+    shutil.copytree(ROOT / "results" / "network_testfield", d)
+    tmp = d / ".README.md.tmp"
+
+    def write_report(results, get_study):  # killed while a file is half written
+        try:
+            tmp.write_text("half")
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(5)
+        finally:
+            tmp.unlink()
+
+    monkeypatch.setattr(cli, "write_report", write_report)
+    t = time.monotonic()
+    code = main(["report", "--results", str(d.parent)])
+    err = capsys.readouterr().err
+    assert code == 130 and err == "sim: interrupted\n" and time.monotonic() - t < 4, err
+    assert not tmp.exists() and signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
