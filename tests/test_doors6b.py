@@ -27,7 +27,11 @@ Found by the fresh set (``/tmp/doors6b``, outside the project):
 * a symlink loop as ``--timings`` or ``--scratch``, and a ``run.json`` nested deeper than
   the recursion limit: tracebacks;
 * SIGTERM to ``sim report`` (or ``check``, ``show``) killed it at once, leaving the temporary
-  file of a README.md being written; it now cleans up and says one line, as ``sim run``.
+  file of a README.md being written; it now cleans up and says one line, as ``sim run``;
+* SIGTERM to a Dask run (``--executor dask``) printed, about one time in seven, tornado's
+  "Exception in callback" traceback of a worker heartbeat's closed connection: the loggers
+  of the closing connections (each child logger, whatever level dask's config gave it) are
+  silenced before an interrupted run closes its client.
 """
 
 import logging
@@ -43,7 +47,7 @@ from pathlib import Path
 import pytest
 
 import sim.__main__  # noqa: F401 - the sim command's set-up (its log filter)
-from sim import batch, cli
+from sim import batch, cli, execute
 from sim.cli import main
 from sim.mc.storage import write_table
 from sim.report.verify import main as verify_main
@@ -236,3 +240,24 @@ def test_a_signal_to_report_cleans_up_with_one_line(tmp_path, capsys, monkeypatc
     err = capsys.readouterr().err
     assert code == 130 and err == "sim: interrupted\n" and time.monotonic() - t < 4, err
     assert not tmp.exists() and signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+
+
+def test_an_interrupted_dask_run_closes_without_dask_logs():
+    """Each logger below asyncio, distributed and tornado, whatever its level, is silenced
+    (the closing chatter came from child loggers dask's config set to INFO or ERROR)."""
+    loggers = [logging.getLogger(n) for n in ("distributed.comm.tcp", "tornado.application")]
+    for log in loggers:
+        log.setLevel(logging.INFO)
+    try:
+        execute._quiet_dask_logs()
+        assert not any(log.isEnabledFor(logging.CRITICAL) for log in loggers)
+        assert logging.getLogger("sim").isEnabledFor(logging.WARNING)
+    finally:
+        for n in (
+            "asyncio",
+            "distributed",
+            "tornado",
+            "distributed.comm.tcp",
+            "tornado.application",
+        ):
+            logging.getLogger(n).setLevel(logging.NOTSET)
