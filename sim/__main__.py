@@ -1,10 +1,27 @@
-"""``python -m sim`` and the ``sim`` command: BLAS single-threaded, then the command line."""
+"""``python -m sim`` and the ``sim`` command: BLAS single-threaded, matplotlib's notes about
+an unwritable config directory kept quiet, then the command line."""
 
+import logging
 import sys
 
 from sim.threads import single_threaded_blas
 
 single_threaded_blas()  # before NumPy loads (sim.cli imports it)
+
+
+class _CacheDirNotes(logging.Filter):
+    """Drops matplotlib's warnings that its config directory (``MPLCONFIGDIR``, else under
+    ``HOME`` or ``XDG_CACHE_HOME``) is not writable: it then uses a temporary one of its own,
+    removed at exit, and a run is as good as any other; two lines of advice on every run
+    (a read-only HOME, a container) are not the command's to print."""
+
+    WORDS = ("mkdir -p failed for path", "is not a writable directory", "temporary cache directory")
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not any(w in str(record.msg) for w in self.WORDS)
+
+
+logging.getLogger("matplotlib").addFilter(_CacheDirNotes())  # before matplotlib loads
 
 from sim.cli import main  # noqa: E402
 

@@ -22,11 +22,14 @@ file is bad input: one line, exit 2.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import json
 import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -35,6 +38,10 @@ from sim.threads import single_threaded_blas
 
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 
+from sim.cli import __doc__ as cli_doc  # noqa: E402
+from sim.cli import check_run_args  # noqa: E402
+from sim.cli_args import name_problem  # noqa: E402
+from sim.cli_args import parser as run_parser  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
 from sim.studies import load_study  # noqa: E402
@@ -58,8 +65,8 @@ def is_current(study_file: str | Path, results: str | Path) -> bool:
     try:
         record = json.loads((Path(results) / "run.json").read_text())
         _, cfg = load_study(study_file)
-    except (OSError, ValueError, ConfigError, StudyError):
-        return False
+    except (OSError, ValueError, RecursionError, ConfigError, StudyError):
+        return False  # RecursionError: a run.json nested too deep to read
     if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
         return False
     if record.get("figures") is False:  # a run without figures (sim run --no-figures)
@@ -110,18 +117,25 @@ def run_all(
         ]
 
     t0 = time.perf_counter()
-
     procs: list[subprocess.Popen] = []
+    stop = threading.Event()  # set on an interrupt: start no more runs, print nothing of theirs
+    starting = threading.Lock()
 
     def one(f: Path):
         cmd = [sys.executable, "-m", "sim", *argv(f)]
         t = time.perf_counter()
-        with subprocess.Popen(
-            cmd, stdout=subprocess.PIPE if jobs > 1 else None, stderr=subprocess.PIPE, text=True
-        ) as proc:
+        with starting:
+            if stop.is_set():
+                return f.stem, None, 0.0, t - t0
+            proc = subprocess.Popen(
+                cmd, stdout=subprocess.PIPE if jobs > 1 else None, stderr=subprocess.PIPE, text=True
+            )
             procs.append(proc)
+        with proc:
             stdout, stderr = proc.communicate()
         wall = time.perf_counter() - t
+        if stop.is_set():  # interrupted: the driver says so in one line
+            return f.stem, None, wall, t - t0
         named = _Named(sys.stderr, f.name)
         named.write(stderr)
         named.flush()
@@ -130,18 +144,42 @@ def run_all(
         return f.stem, proc.returncode, wall, t - t0
 
     out: dict[str, tuple[int, float, float]] = {}
+    pool = ThreadPoolExecutor(max_workers=jobs)
     try:
-        with ThreadPoolExecutor(max_workers=jobs) as pool:
-            for stem, code, wall, start in pool.map(one, todo):
-                out[stem] = (code, wall, start)
+        for stem, code, wall, start in pool.map(one, todo):
+            out[stem] = (code, wall, start)
     except KeyboardInterrupt:
-        for proc in procs:  # SIGTERM reached only the driver: pass it on, then wait
-            if proc.poll() is None:
-                proc.terminate()
-        for proc in procs:
-            proc.wait()
+        _stop_runs(stop, starting, procs)
+        pool.shutdown(wait=True, cancel_futures=True)
         raise
+    pool.shutdown()
     return out
+
+
+#: the signals that end a batch (and each of its runs) as Ctrl-C does
+STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+
+
+def _stop_runs(stop: threading.Event, starting: threading.Lock, procs: list) -> None:
+    """An interrupt reached the driver (Ctrl-C reaches the runs too; SIGTERM or SIGHUP only
+    the driver): start no more runs, pass SIGTERM on to the live ones (each cleans up as
+    after Ctrl-C), wait for them (killed after :data:`GRACE_S`)."""
+    for s in (signal.SIGINT, *STOP_SIGNALS):  # a second signal must not orphan the runs
+        signal.signal(s, signal.SIG_IGN)
+    with starting:
+        stop.set()
+    for proc in procs:
+        if proc.poll() is None:
+            proc.terminate()
+    for proc in procs:
+        try:
+            proc.wait(timeout=GRACE_S)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+
+
+#: seconds an interrupted run has to clean up before it is killed
+GRACE_S = 30
 
 
 class _Named:
@@ -163,11 +201,12 @@ class _Named:
 
 def _clashes(files: list[Path], run_args: list[str]) -> str | None:
     """Why these runs cannot share one batch: two of them would write one results directory
-    (the same file twice, two files of one name, or an ``--out`` in the run options)."""
-    if any(a == "--out" or a.startswith("--out=") for a in run_args):
-        return "--out cannot be a run option: each study writes <results>/<file name>"
+    (the same file twice, two files of one name), or a file's name is ``.toml`` or
+    ``...toml`` (its results would be <results> itself or its parent)."""
     seen: dict[str, Path] = {}
     for f in files:
+        if f.stem in ("", ".", ".."):
+            return f"{f}: a study file named like this would write <results>/{f.stem}"
         if f.stem in seen:
             same = f.resolve() == seen[f.stem].resolve()
             return (
@@ -176,6 +215,25 @@ def _clashes(files: list[Path], run_args: list[str]) -> str | None:
                 else f"{seen[f.stem]} and {f} would both write results/{f.stem}"
             )
         seen[f.stem] = f
+    return None
+
+
+def _run_options_problem(run_args: list[str]) -> str | None:
+    """Why the run options cannot go to every run, checked once before any starts (as
+    ``sim run`` reads them, abbreviations included): a bad option or value, an ``--out``
+    (each study writes <results>/<file name>), or ``--help`` (each run would print its help
+    and exit 0 without running)."""
+    text = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(text), contextlib.redirect_stderr(text):
+            args = run_parser(cli_doc).parse_args(["run", "STUDY.toml", *run_args])
+        if args.out is not None:
+            return "--out cannot be a run option: each study writes <results>/<file name>"
+        check_run_args(args)
+    except SystemExit:
+        return f"{' '.join(run_args)!r} would print the help of sim run and run nothing"
+    except ConfigError as e:
+        return str(e).removeprefix("sim: ")
     return None
 
 
@@ -197,7 +255,10 @@ def _timings_problem(path: str) -> str | None:
     directory must be writable, and an existing file must be an earlier timings file (a
     JSON object of lists), never a file of the user's."""
     p = Path(path)
-    parent = p.resolve().parent
+    try:
+        parent = p.resolve().parent
+    except (OSError, RuntimeError) as e:  # a symlink loop
+        return f"{p} cannot be resolved: {e}"
     if not parent.is_dir() or not os.access(parent, os.W_OK):
         return f"cannot write into {parent}"
     if p.is_symlink() or (p.exists() and not p.is_file()):
@@ -214,7 +275,16 @@ def _timings_problem(path: str) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
+    old = {s: signal.getsignal(s) for s in (signal.SIGINT, *STOP_SIGNALS)}
+    try:
+        return _main(list(sys.argv[1:] if argv is None else argv))
+    finally:  # in-process callers (the tests) get their handlers back
+        for s, h in old.items():
+            if h is not None:
+                signal.signal(s, h)
+
+
+def _main(argv: list[str]) -> int:
     run_args = []
     if "--" in argv:
         i = argv.index("--")
@@ -232,9 +302,14 @@ def main(argv: list[str] | None = None) -> int:
     except _BadArgs as e:
         print(f"sim.batch: {e} (see python -m sim.batch --help)", file=sys.stderr)
         return 2
-    if not args.results.strip() or not args.results.isprintable():
-        print(f"sim.batch: --results: not a directory name (got {args.results!r})", file=sys.stderr)
+    if name_problem(args.results):
+        why = name_problem(args.results)
+        print(f"sim.batch: --results: {why} (got {args.results!r})", file=sys.stderr)
         return 2
+    for name, v in [("FILE", f) for f in args.files] + [("--timings", args.timings)]:
+        if v is not None and name_problem(v):
+            print(f"sim.batch: {name}: {name_problem(v)} (got {v!r})", file=sys.stderr)
+            return 2
     files = [Path(f) for f in args.files]
     bad = [f for f in files if not f.is_file()]
     if bad:
@@ -244,21 +319,29 @@ def main(argv: list[str] | None = None) -> int:
     if why:
         print(f"sim.batch: {why}", file=sys.stderr)
         return 2
-    why = _timings_problem(args.timings) if args.timings else None
+    why = _run_options_problem(run_args)
+    if why:
+        print(f"sim.batch: run options: {why}", file=sys.stderr)
+        return 2
+    why = _timings_problem(args.timings) if args.timings is not None else None
     if why:
         print(f"sim.batch: --timings: {why}", file=sys.stderr)
         return 2
-    if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
-        signal.signal(signal.SIGTERM, _on_sigterm)  # end the runs as Ctrl-C does
+    for s in STOP_SIGNALS:
+        if signal.getsignal(s) is signal.SIG_DFL:
+            signal.signal(s, _on_sigterm)  # end the runs as Ctrl-C does
     if not 1 <= args.jobs <= 64:
         print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
         return 2
     try:
         done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only)
-    except KeyboardInterrupt:  # the runs got the interrupt too and cleaned up
-        print("sim.batch: interrupted", file=sys.stderr)
+    except KeyboardInterrupt:  # the runs were stopped and cleaned up
+        print(
+            "sim.batch: interrupted; the same command again resumes the unfinished runs",
+            file=sys.stderr,
+        )
         return 130
-    if args.timings:
+    if args.timings is not None:
         Path(args.timings).write_text(json.dumps(done))
     failed = [v[0] for v in done.values() if v[0] != 0]
     return (failed[0] if failed[0] > 0 else 1) if failed else 0

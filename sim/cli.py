@@ -30,10 +30,10 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.cli_args import parser
+from sim.cli_args import name_problem, parser
 from sim.execute import execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
-from sim.mc.estimate import estimate
+from sim.mc.estimate import check_limits, estimate
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
@@ -41,7 +41,7 @@ from sim.report.markdown import write_report
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.studies import get_study, load_study
 
-__all__ = ["main"]
+__all__ = ["main", "check_run_args"]
 
 #: exit code of an internal error (a bug, not bad input): one line, traceback with SIM_DEBUG=1
 INTERNAL = 3
@@ -51,7 +51,7 @@ _SCHEDULER = re.compile(
 )
 
 
-def _check_args(args) -> Path:
+def check_run_args(args) -> Path:
     """Options that need no study: one line each. Returns the output path (absolute)."""
     if args.workers < 1 or args.workers > max(4 * (os.cpu_count() or 1), 8):
         raise ConfigError(
@@ -70,8 +70,9 @@ def _check_args(args) -> Path:
     if args.out is not None:
         if not args.out.strip():
             raise ConfigError("--out", "is empty: name an output directory")
-        if not args.out.isprintable():
-            raise ConfigError("--out", f"contains a control character (got {args.out!r})")
+        why = name_problem(args.out)
+        if why:
+            raise ConfigError("--out", f"{why} (got {args.out!r})")
     return Path(os.path.abspath(args.out)) if args.out else None
 
 
@@ -151,7 +152,7 @@ def _default_out(cfg: dict, sweep: dict) -> tuple[Path, str, bool]:
 
 
 def _run(args) -> int:
-    out = _check_args(args)
+    out = check_run_args(args)
     study, cfg = _load(args)
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
     overwrite = args.overwrite
@@ -187,8 +188,10 @@ def _run(args) -> int:
 
 
 def _show(args) -> int:
-    if not args.dir.strip() or not args.dir.isprintable():
-        raise ConfigError("DIR", f"not a directory name (got {args.dir!r})")
+    if name_problem(args.dir):
+        raise ConfigError(
+            "DIR", f"not a directory name: {name_problem(args.dir)} (got {args.dir!r})"
+        )
     d = Path(args.dir)
     if not d.exists() and (Path("results") / args.dir).is_dir():
         d = Path("results") / args.dir
@@ -243,6 +246,8 @@ def _check(args) -> int:
     study, cfg = load_study(args.study, args.set)
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
+    est = estimate(cfg, sweep)
+    check_limits(est)  # the limits sim run applies (SIM_MAX_MEMORY_GB, SIM_MAX_ADJUSTMENTS)
     print(f"# {cfg['study']}: {study.title}")
     for k, v in cfg.items():
         f = study.schema.get(k)
@@ -256,7 +261,7 @@ def _check(args) -> int:
         print(f"{k} = {v!r}  # {f.doc}" + (f" ({notes})" if notes else ""))
     if sweep:
         print(f"# [sweep] {', '.join(sweep)}")
-    print(f"# work: {estimate(cfg, sweep).describe()}")
+    print(f"# work: {est.describe()}")
     return 0
 
 
@@ -290,12 +295,25 @@ def _cwd_exists() -> bool:
     return True
 
 
+def _why(e: OSError) -> str:
+    """The reason of an OSError in words: its strerror, or (pyarrow raises
+    ``FileNotFoundError(path)`` without one) the name of its kind."""
+    if e.strerror:
+        return e.strerror
+    if isinstance(e, FileNotFoundError):
+        return "No such file or directory"
+    if len(e.args) == 1 and isinstance(e.args[0], str):  # OSError(path): the path is all
+        return type(e).__name__
+    return str(e) or type(e).__name__
+
+
 def _on_sigterm(signum, frame):
     raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
+    old = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
     try:
         if not argv:  # usage, not an error message
             parser(__doc__).print_help()
@@ -308,41 +326,54 @@ def main(argv: list[str] | None = None) -> int:
         except (OSError, ValueError):
             pass
         return 141
+    finally:  # in-process callers (the tests, the API) get their handlers back
+        for s, h in old.items():
+            if h is not None:
+                signal.signal(s, h)
 
 
 def _main(argv: list[str]) -> int:
+    args = None
     try:
         args = parser(__doc__).parse_args(argv)
+        if args.cmd in ("run", "check") and name_problem(args.study):
+            why = name_problem(args.study)
+            raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
+        for s in (signal.SIGTERM, signal.SIGHUP):  # clean up like Ctrl-C (nohup: ignored): a
+            if signal.getsignal(s) is signal.SIG_DFL:  # run's stage, report's temporary files
+                signal.signal(s, _on_sigterm)
         if args.cmd == "run":
-            if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
-                signal.signal(signal.SIGTERM, _on_sigterm)  # clean up like Ctrl-C
             return _run(args)
         if args.cmd == "check":
             return _check(args)
         if args.cmd == "show":
             return _show(args)
         if args.cmd == "report":
-            if not args.results.strip() or not args.results.isprintable():
-                raise ConfigError("--results", f"not a directory name (got {args.results!r})")
+            if name_problem(args.results):
+                why = name_problem(args.results)
+                raise ConfigError(
+                    "--results", f"not a directory name: {why} (got {args.results!r})"
+                )
             return _report(Path(args.results))
     except (ConfigError, StudyError) as e:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)
         return INTERNAL if getattr(e, "internal", False) else 2
     except KeyboardInterrupt:
-        print(
-            "sim: interrupted; run the same command again to finish the missing chunks",
-            file=sys.stderr,
-        )
+        again = "; run the same command again to finish the missing chunks"
+        print(f"sim: interrupted{again if args and args.cmd == 'run' else ''}", file=sys.stderr)
         return 130
     except BrokenPipeError:
         raise
     except OSError as e:  # a failing write (full disk, vanished directory): one line, no traceback
         name = getattr(e, "filename", "") or ""
+        if not name and not e.strerror and len(e.args) == 1 and isinstance(e.args[0], str):
+            name = e.args[0]  # pyarrow's FileNotFoundError(path)
         if not name and not _cwd_exists():
             name = "the working directory (it was deleted)"
-        print(f"sim: error: {e.strerror or e}: {name}".rstrip(": "), file=sys.stderr)
+        print(f"sim: error: {_why(e)}: {name}".rstrip(": "), file=sys.stderr)
         return 2
-    except (ArithmeticError, ValueError, MemoryError) as e:  # e.g. a sweep cell table
+    except (ArithmeticError, ValueError, MemoryError, RecursionError) as e:  # e.g. a sweep
+        # cell table; a file nested too deep to read (a run.json of 100,000 brackets)
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)
         return 2
     return 1

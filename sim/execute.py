@@ -10,6 +10,7 @@ kill and replaces ``<out>`` only when everything succeeded, a ``[sweep]`` over t
 from __future__ import annotations
 
 import dataclasses
+import logging
 import os
 import re
 import sys
@@ -178,6 +179,8 @@ def execute(
             err.internal = True
             raise err from None
     except BaseException as e:
+        if executor == "dask":
+            _quiet_dask_logs()  # its closing chatter is not for users (one line is)
         ex.close(kill=True)
         if lock is not None:  # a failure of the run (not an interrupt) is marked replaceable
             failed = isinstance(e, (ConfigError, StudyError))
@@ -193,6 +196,20 @@ def execute(
         raise
     lock.release()
     return est
+
+
+def _quiet_dask_logs() -> None:
+    """Before an interrupted Dask run is closed: the loggers of this process that would print
+    the closing connections' errors (tornado's "Exception in callback", distributed's
+    CommClosedError of a worker's heartbeat), each of them, whatever level dask's config
+    gave it, are silenced."""
+    names = [
+        n
+        for n in list(logging.root.manager.loggerDict)
+        if n.split(".")[0] in ("asyncio", "distributed", "tornado")
+    ]
+    for n in ("asyncio", "distributed", "tornado", *names):
+        logging.getLogger(n).setLevel(logging.CRITICAL + 1)
 
 
 def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dict:

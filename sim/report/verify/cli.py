@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
 import tempfile
+import unicodedata
 from pathlib import Path
 
 from sim.report.verify.rerun import verify, write_record
@@ -56,12 +59,26 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _name_problem(text: str) -> str | None:
+    """Why a path cannot name a directory of the suite (as sim.cli_args.name_problem, which
+    this layer cannot import)."""
+    if not text.strip():
+        return "is empty"
+    if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text):
+        return "contains a control character or a line break"
+    if any(unicodedata.category(c) == "Cs" for c in text):
+        return "contains bytes that are not UTF-8 text (a non-UTF-8 name or locale)"
+    return None
+
+
 def _check_args(a) -> None:
     for name, v in (("--results", a.results), ("--scratch", a.scratch)):
-        if v is not None and (not v.strip() or not v.isprintable()):
-            raise VerifyError(f"{name}: not a directory name (got {v!r})")
-    if a.workers < 1:
-        raise VerifyError(f"--workers: must be at least 1, not {a.workers}")
+        why = None if v is None else _name_problem(v)
+        if why:
+            raise VerifyError(f"{name}: {why} (got {v!r})")
+    top = max(4 * (os.cpu_count() or 1), 8)  # the bound of sim run --workers
+    if not 1 <= a.workers <= top:
+        raise VerifyError(f"--workers: must be between 1 and {top}, not {a.workers}")
     if a.trials is not None and a.trials < 2:
         raise VerifyError(f"--trials: must be at least 2, not {a.trials}")
     if a.set and a.trials is None:
@@ -86,7 +103,25 @@ def _print(comps: list[Comparison]) -> None:
             print(f"  not compared (rows depend on the trials): {', '.join(c.not_compared)}")
 
 
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
+    signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    old = {s: signal.getsignal(s) for s in signals}
+    for s in signals[1:]:  # end the re-run and clean up as Ctrl-C does
+        if old[s] is signal.SIG_DFL:
+            signal.signal(s, _interrupt)
+    try:
+        return _main(argv)
+    finally:
+        for s, h in old.items():
+            if h is not None:
+                signal.signal(s, h)
+
+
+def _main(argv: list[str] | None) -> int:
     try:
         a = _parser().parse_args(argv)
         _check_args(a)
@@ -107,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"sim verify: error: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("sim verify: interrupted", file=sys.stderr)
+        print("sim verify: interrupted; the re-run was stopped", file=sys.stderr)
         return 130
     _print(comps)
     if not a.no_record and mode == "full" and not a.study:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import platform
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -111,12 +112,37 @@ def rerun_study(
     cmd += ["--no-figures"]
     cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else []), *extra]
     print(f"sim verify: re-running {d.name}", file=sys.stderr, flush=True)
-    r = subprocess.run(cmd, stderr=subprocess.PIPE, text=True, errors="replace")
-    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
-    if r.returncode == 2 and extra and lines:  # the re-run refused the options verify passed
+    with subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True, errors="replace") as proc:
+        try:
+            _, err = proc.communicate()
+        except KeyboardInterrupt:  # Ctrl-C reaches the re-run too, SIGTERM or SIGHUP only verify
+            _stop(proc)
+            raise
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    if proc.returncode == 2 and lines and (extra or lines[-1].startswith("sim: error: --")):
+        # the re-run refused the options verify passed (--trials, --set, --workers, the
+        # --out under --scratch): a request error, not a failed comparison to record
         raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
-    sys.stderr.write(r.stderr)
-    return None if r.returncode == 0 else f"the re-run exited with {r.returncode}"
+    sys.stderr.write(err)
+    return None if proc.returncode == 0 else f"the re-run exited with {proc.returncode}"
+
+
+#: seconds an interrupted re-run has to clean up (its staging directory) before it is killed
+GRACE_S = 30
+
+
+def _stop(proc: subprocess.Popen) -> None:
+    """End an interrupted re-run as Ctrl-C does (SIGTERM: it marks its staging directory
+    resumable and ends its workers), without a word of its own; killed after GRACE_S."""
+    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):  # a second signal orphans nothing
+        signal.signal(s, signal.SIG_IGN)
+    if proc.poll() is None:
+        proc.terminate()
+    try:
+        proc.communicate(timeout=GRACE_S)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
 
 
 def verify(
@@ -135,9 +161,13 @@ def verify(
     if scratch.exists() and not scratch.is_dir():
         raise VerifyError(f"--scratch: {scratch} is not a directory")
     todo = study_dirs(results, only)
-    if scratch.resolve() == Path(results).resolve() or Path(results).resolve() in (
-        scratch.resolve().parents
-    ):
+    try:
+        inside = scratch.resolve() == Path(results).resolve() or Path(results).resolve() in (
+            scratch.resolve().parents
+        )
+    except (OSError, RuntimeError) as e:  # a symlink loop
+        raise VerifyError(f"--scratch: {scratch} cannot be resolved: {e}") from None
+    if inside:
         raise VerifyError(f"--scratch: {scratch} is (inside) the committed results {results}")
     # every target checked before anything runs: a foreign directory stops it at once
     replace = {d: _target(scratch, d.name)[1] for d, _ in todo} if rerun else {}
