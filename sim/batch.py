@@ -63,7 +63,7 @@ def is_current(study_file: str | Path, results: str | Path) -> bool:
     """True when ``results/run.json`` records the study file's resolved config and the
     study's current code hash, and the run drew its figures (not ``--no-figures``)."""
     try:
-        record = json.loads((Path(results) / "run.json").read_text())
+        record = json.loads((Path(results) / "run.json").read_text(encoding="utf-8"))
         _, cfg = load_study(study_file)
     except (OSError, ValueError, RecursionError, ConfigError, StudyError):
         return False  # RecursionError: a run.json nested too deep to read
@@ -265,7 +265,7 @@ def _timings_problem(path: str) -> str | None:
         return f"{p} exists and is not a regular file"
     if p.exists():
         try:
-            old = json.loads(p.read_text())
+            old = json.loads(p.read_text(encoding="utf-8"))
             ours = isinstance(old, dict) and all(isinstance(v, list) for v in old.values())
         except (OSError, ValueError):
             ours = False
@@ -342,7 +342,7 @@ def _main(argv: list[str]) -> int:
         )
         return 130
     if args.timings is not None:
-        Path(args.timings).write_text(json.dumps(done))
+        Path(args.timings).write_text(json.dumps(done), encoding="utf-8")
     failed = [v[0] for v in done.values() if v[0] != 0]
     return (failed[0] if failed[0] > 0 else 1) if failed else 0
 

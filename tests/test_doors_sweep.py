@@ -123,7 +123,7 @@ def test_verify_no_rerun_without_the_reruns_records_nothing(tmp_path, capsys):
 def test_verify_names_a_rerun_option_the_study_refuses(tmp_path, capsys, monkeypatch):
     res = _results(tmp_path)
     monkeypatch.chdir(ROOT)  # the re-run reads studies/<study>.toml
-    argv = ["--results", str(res), "--scratch", str(tmp_path / "s"), "--trials", "40"]
+    argv = ["--results", str(res), "--scratch", str(tmp_path / "s"), "--trials", "400"]
     assert verify_main([*argv, "--set", "nosuch.key=1"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert "nosuch.key" in err[-1] and "refused" in err[-1], err

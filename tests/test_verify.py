@@ -217,7 +217,9 @@ def test_scratch_keeps_what_the_suite_did_not_write(capsys, tmp_path, two_runs):
     tiny = tiny_overrides("brown_table1")
     assert tiny[:4] == ["--set", "trials=40", "--set", "chunk=2"]
     argv = ["--results", str(results), "--scratch", str(scratch), "--trials", "40", *tiny[2:]]
-    assert verify_main([*argv, "--study", "brown_table1"]) == 0
+    assert "--trials: must be at least 400" in _one_line(capsys, argv, 2)  # too few
+    argv[argv.index("40")] = "400"
+    assert verify_main([*argv, "--set", "chunk=20", "--study", "brown_table1"]) == 0
     assert "brown_table1: ok" in capsys.readouterr().out
 
 

@@ -158,7 +158,7 @@ def read_toml(path: str | Path, what: str) -> dict:
     """A TOML file's table; an unreadable or invalid file is one ConfigError naming it."""
     p = Path(path)
     try:
-        return tomllib.loads(p.read_text())
+        return tomllib.loads(p.read_text(encoding="utf-8"))
     except OSError as e:
         raise ConfigError(str(p), f"cannot read the {what}: {e.strerror}") from None
     except tomllib.TOMLDecodeError as e:

@@ -61,7 +61,7 @@ def _imports(f: Path) -> set[str]:
     if f.name != "__init__.py":
         pkg = pkg[:-1]
     out: set[str] = set()
-    for node in ast.walk(ast.parse(f.read_text(), str(f))):
+    for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"), str(f))):
         if isinstance(node, ast.Import):
             out.update(a.name for a in node.names)
         elif isinstance(node, ast.ImportFrom):

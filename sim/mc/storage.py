@@ -266,7 +266,7 @@ def read_record(d: str | Path) -> dict | None:
     """The run record (``run.json``) of a directory the suite wrote, or None (none, or not one
     of ours)."""
     try:
-        rec = json.loads((Path(d) / RECORD).read_text())
+        rec = json.loads((Path(d) / RECORD).read_text(encoding="utf-8"))
     except (OSError, ValueError, RecursionError):  # RecursionError: JSON nested too deeply
         return None
     return rec if isinstance(rec, dict) and "config" in rec and "code_hash" in rec else None
@@ -275,7 +275,9 @@ def read_record(d: str | Path) -> dict | None:
 def write_record(d: str | Path, record: Mapping[str, Any]) -> None:
     """Write ``run.json`` atomically."""
     with atomic_path(Path(d) / RECORD) as tmp:
-        tmp.write_text(json.dumps(record, sort_keys=True, indent=1, default=_jsonable))
+        tmp.write_text(
+            json.dumps(record, sort_keys=True, indent=1, default=_jsonable), encoding="utf-8"
+        )
 
 
 class Locked(RuntimeError):

@@ -349,5 +349,5 @@ def write_report(results: Path, get_study: Callable) -> Path:
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             write_run_readme(d, get_study)
     with atomic_path(out) as tmp:
-        tmp.write_text(text)
+        tmp.write_text(text, encoding="utf-8")
     return out

@@ -290,7 +290,9 @@ def save(fig, path: str | Path) -> Path:
         _RECORDER(path, fig)
     elif os.environ.get("SIM_FIGURE_CHECK"):  # the same check in a `sim run` process (tests)
         line = {"file": path.name, "problems": layout_problems(fig), "facts": figure_facts(fig)}
-        with open(os.environ["SIM_FIGURE_CHECK"], "a") as f:  # one short line per write
+        with open(
+            os.environ["SIM_FIGURE_CHECK"], "a", encoding="utf-8"
+        ) as f:  # one short line per write
             f.write(json.dumps(line) + "\n")
     plt.close(fig)
     return path

@@ -213,7 +213,7 @@ def write_run_readme(out: Path, get_study: Callable) -> Path | None:
         return None
     text = README_MARK + "\n" + run_markdown(out, get_study)
     with atomic_path(path) as tmp:
-        tmp.write_text(text)
+        tmp.write_text(text, encoding="utf-8")
     rec = read_record(out)
     if rec is not None and isinstance(rec.get("files"), list) and "README.md" not in rec["files"]:
         write_record(out, {**rec, "files": sorted([*rec["files"], "README.md"])})

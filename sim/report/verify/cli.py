@@ -28,6 +28,13 @@ class _Parser(argparse.ArgumentParser):
         raise VerifyError(message)
 
 
+#: the fewest trials of a re-run compared at the Monte-Carlo level (``--trials``): the rule's
+#: standard errors come from each run's 95 % interval (a normal approximation). The tests check
+#: it at 400 trials; at 100 a network's sigma bounds failed it by chance, at 200 they reached
+#: 0.85 of their tolerance
+MIN_TRIALS = 400
+
+
 def _parser() -> argparse.ArgumentParser:
     p = _Parser(prog="python -m sim.report.verify", description=DESCRIPTION)
     p.add_argument("--results", default="results", help="the committed results (default: results)")
@@ -79,8 +86,12 @@ def _check_args(a) -> None:
     top = max(4 * (os.cpu_count() or 1), 8)  # the bound of sim run --workers
     if not 1 <= a.workers <= top:
         raise VerifyError(f"--workers: must be between 1 and {top}, not {a.workers}")
-    if a.trials is not None and a.trials < 2:
-        raise VerifyError(f"--trials: must be at least 2, not {a.trials}")
+    if a.trials is not None and a.trials < MIN_TRIALS:
+        raise VerifyError(
+            f"--trials: must be at least {MIN_TRIALS}, not {a.trials} (the Monte-Carlo rule takes "
+            "each run's standard error from its interval, which needs that many trials: at 100 a "
+            "network's interval bounds fail it by chance)"
+        )
     if a.set and a.trials is None:
         raise VerifyError("--set: only with --trials (a re-run with other inputs is not a check)")
     if a.no_rerun and not a.scratch:
