@@ -45,26 +45,26 @@ def pytest_runtest_protocol(item, nextitem):
 
 
 #: the test files that take longest, slowest first, with their share (%) of the suite's
-#: summed test CPU time (measured 2026-11-26 on 2 cores: SIM_TEST_CPU_LOG, per file; a shared
+#: summed test CPU time (measured 2026-11-27 on 2 cores: SIM_TEST_CPU_LOG, per file; a shared
 #: tiny run counts for the file that asks for it first). Under ``--dist loadfile`` a file runs
 #: on one process; handing out the slowest files first keeps one of them from starting last
 #: and running alone at the end (the critical path). The Makefile passes
 #: --no-loadscope-reorder, or pytest-xdist would hand out the files with the most tests first
 #: instead.
 SLOW_FIRST = {
-    "test_all_studies.py": 22.1,
-    "test_verify.py": 17.4,
-    "test_docs.py": 11.6,
-    "test_design.py": 5.6,
-    "test_sparse.py": 5.4,
-    "test_bench.py": 5.1,
-    "test_runner.py": 4.8,
-    "test_network.py": 4.5,
-    "test_batch.py": 4.0,
-    "test_cli_manners.py": 3.8,
-    "test_cli.py": 3.5,
-    "test_doors.py": 3.1,
-    "test_wolf.py": 1.5,
+    "test_all_studies.py": 22.9,
+    "test_docs.py": 15.7,
+    "test_verify.py": 15.4,
+    "test_batch.py": 5.1,
+    "test_network.py": 4.9,
+    "test_cli_manners.py": 3.5,
+    "test_cli.py": 3.4,
+    "test_bench.py": 3.3,
+    "test_wolf.py": 2.9,
+    "test_design.py": 2.8,
+    "test_runner.py": 2.4,
+    "test_doors_sweep.py": 2.3,
+    "test_agnard.py": 1.8,
 }
 
 
