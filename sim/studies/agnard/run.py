@@ -42,6 +42,7 @@ from sim.studies.agnard.region import (
     SCANNER_KEYS,
     explore_region,
     explore_scanner,
+    first_samples,
     many_samples,
     shift_table,
 )
@@ -307,7 +308,7 @@ def _scanner_region(cfg, block, book, per_trial, ctx, prov, out):
     (:mod:`.paired`); write ``scanner_region.parquet`` (every explored vector),
     ``scanner_region_inputs.parquet``, ``scanner_shift.parquet`` and its figure. Returns the
     region, its predictions and the per-vector statistics."""
-    base = many_samples(per_trial, f"layout_{cfg['control.many']}")
+    base = {**many_samples(per_trial, f"layout_{cfg['control.many']}"), **first_samples(per_trial)}
     region, preds, stats = explore_scanner(
         cfg,
         block,
