@@ -422,9 +422,9 @@ def test_five_control_rows_decided_over_the_region(tiny_run):
         assert r["interval"] == "region"
         assert r["verdict"] in REGION_VERDICTS
         assert r["value"] <= r["value_high"]
-    # 8 rows of region.toml and the joint X, Y row, each with its per-point column; as many of
-    # scanner.toml over the scanner's vectors
-    assert _check_region_rows(out) == (9, 9)
+    # 8 rows of region.toml and the joint X, Y row, each with its per-point column; of
+    # scanner.toml over the scanner's vectors the same 9 and the first pass's two
+    assert _check_region_rows(out) == (9, 11)
 
 
 def _check_region_rows(out) -> tuple[int, int]:
@@ -530,15 +530,16 @@ def test_scanner_inputs_set_the_config_keys_they_name():
     assert all(book.spec(s.id)["kind"] == "not comparable" for s in dec.statements)
     assert all(i.why for i in dec.inputs)
     # every simulated 21-control prediction (not the XY paper-checks, not the Holm row, which
-    # is decided from its members): Tables 2-3's and the acceptance limits'
+    # is decided from its members): Tables 2-3's and the acceptance limits'; and the first
+    # pass's two rows (the same blocks with weak control)
     assert set(dec.predictions) == {
         c
         for c, spec in book.specs.items()
         if c.startswith(("agnard.control_21.", "agnard.max_residual.control_21_"))
         and spec["kind"] == "prediction"
         and spec["form"] in ("one-plate", "upper")
-    }
-    assert len(dec.predictions) == 8
+    } | {"agnard.first_pass.pass_xy_cm", "agnard.first_pass.pass_z_cm"}
+    assert len(dec.predictions) == 10
 
 
 def test_budget_recomputation_and_pointing_model():
@@ -568,6 +569,23 @@ def test_chunk_functions_pickle():
         partial(ch.table1_chunk, cfg, b, ({"scan.stepper_share": 0.5},)),
     ):
         assert pickle.loads(pickle.dumps(fn)).func is fn.func
+
+
+def test_table1_chunk_pairs_the_first_pass_with_the_configured_scanner():
+    """The scanner region's first pass (brief P): at a vector equal to the configured scanner
+    the same blocks give the configured first pass (common random numbers; the vector's
+    21-control pass is reached through Table 1's passes, so to the solver's tolerance)."""
+    from sim.studies.agnard import chunks as ch
+    from sim.studies.agnard.region import first_samples
+    from sim.studies.agnard.schema import block_of
+
+    _, cfg = load_study(STUDY)
+    out = ch.table1_chunk(cfg, block_of(cfg), ({},), np.random.default_rng(5), 2)
+    v, c = first_samples(out, "s0"), first_samples(out, "cfg")
+    assert sorted(v) == ["agnard.first_pass.pass_xy_cm", "agnard.first_pass.pass_z_cm"]
+    for cid in v:
+        assert v[cid].shape == (2,) and np.all(v[cid] > 1.0)  # cm: a tenth of a pixel or more
+        assert np.allclose(v[cid], c[cid], rtol=1e-6), cid
 
 
 def test_sparse_and_dense_reduced_solutions_agree(small):

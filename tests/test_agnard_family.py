@@ -10,7 +10,15 @@ import numpy as np
 import pytest
 
 from sim.claims.book import ClaimBook
-from sim.claims.family import family_evidence, family_over, family_row, family_status, holm
+from sim.claims.family import (
+    family_evidence,
+    family_outcomes,
+    family_over,
+    family_row,
+    family_status,
+    holm,
+    mc_p,
+)
 from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Input, Region, Statement, status
 from sim.studies.agnard.claims import JOINT, MEMBERS, load_book, quadrature_check
 
@@ -60,12 +68,15 @@ def _book() -> ClaimBook:
     )
 
 
+N = 500  # Agnard's main blocks: the members' plug-in p are 2 k / 500
+
+
 @pytest.mark.parametrize(
     ("px", "py", "ox", "oy", "verdict", "value"),
-    [
-        (0.352, 0.012, "inconclusive", "fails", "fails", 0.024),
-        (0.4, 0.7, "inconclusive", "inconclusive", "inconclusive", 0.8),
-        (0.4, 0.7, "holds", "holds", "holds", 0.8),
+    [  # Y's 3 of 500 blocks: Monte-Carlo p 2 * 4 / 501, Holm twice that (plug-in: 0.024)
+        (0.352, 0.012, "inconclusive", "fails", "fails", 16 / 501),
+        (0.4, 0.7, "inconclusive", "inconclusive", "inconclusive", 404 / 501),
+        (0.4, 0.7, "holds", "holds", "holds", 404 / 501),
     ],
 )
 def test_family_row_at_the_configured_inputs(px, py, ox, oy, verdict, value):
@@ -73,7 +84,7 @@ def test_family_row_at_the_configured_inputs(px, py, ox, oy, verdict, value):
         {"claim": "t.x", "p_plate": px, "outcome": ox},
         {"claim": "t.y", "p_plate": py, "outcome": oy},
     ]
-    row = family_row(_book(), "t.xy", members)
+    row = family_row(_book(), "t.xy", members, n=N)
     assert math.isclose(row["value"], value)
     assert row["outcome"] == row["verdict"] == verdict
     assert row["holds"] == {"holds": True, "fails": False}.get(verdict)
@@ -108,14 +119,17 @@ def _region(px, py, spread_x) -> Region:
     ],
 )
 def test_family_over_a_region(px, py, spread_x, verdict):
-    row = family_over(_book(), _region(px, py, spread_x), "t.xy", ["t.x", "t.y"], note="n.b.")
+    row = family_over(_book(), _region(px, py, spread_x), "t.xy", ["t.x", "t.y"], note="n.b.", n=N)
     assert row["verdict"] == verdict and row["interval"] == "region"
-    assert "(Holm's step-down correction); n.b." in row["note"]
-    hp = [holm([a, b]).min() for a, b in zip(px, py)]
+    assert "Holm's step-down correction); n.b." in row["note"]
+    hp = [holm(mc_p([a, b], N)).min() for a, b in zip(px, py)]
     assert math.isclose(row["value"], min(hp)) and math.isclose(row["value_high"], max(hp))
-    assert "one test of t.x, t.y per point (Holm's step-down correction)" in row["note"]
+    assert (
+        "one test of t.x, t.y per point (the Monte-Carlo p 2(k+1)/(n+1) of 500 simulated "
+        "plates each, Holm's step-down correction)"
+    ) in row["note"]
     why = {  # what the reader is told besides the verdict
-        "undecidable": "no point of the region decides it: the Holm p is 0.60-1.00 (never "
+        "undecidable": "no point of the region decides it: the Holm p is 0.61-1.00 (never "
         "below 0.05), and at every point some member's one-block spread reaches outside its "
         "zone (the block neither confirms nor contradicts it)",
         "fails": "",
@@ -137,7 +151,7 @@ def test_family_over_an_empty_region_names_the_conflict():
         {"a_1": (0.5, 0.5)},
         reg.outputs,
     )
-    row = family_over(_book(), empty, "t.xy", ["t.x", "t.y"])
+    row = family_over(_book(), empty, "t.xy", ["t.x", "t.y"], n=N)
     assert row["verdict"] == "undecidable"
     assert "no input is consistent with the printed statements (conflicting: c)" in row["note"]
 
@@ -147,11 +161,12 @@ def test_family_row_names_every_member_with_its_p():
         {"claim": "t.x", "p_plate": 0.4, "outcome": "holds"},
         {"claim": "t.y", "p_plate": 0.03, "outcome": "fails"},
     ]
-    row = family_row(_book(), "t.xy", members, note="the block")
-    assert row["note"] == (
-        "one test of 2 one-plate rows (Holm's step-down correction): "
-        "t.x: p 0.400 (holds), Holm-adjusted 0.400; t.y: p 0.030 (fails), Holm-adjusted 0.060"
-        "; the block"
+    row = family_row(_book(), "t.xy", members, note="the block", n=N)
+    assert row["note"] == (  # Monte-Carlo p 202 / 501 and 17 / 501
+        "one test of 2 one-plate rows over 500 simulated plates each (the Monte-Carlo p "
+        "2(k+1)/(n+1), Holm's step-down correction): "
+        "t.x: p 0.400, Monte-Carlo p 0.403 (holds), Holm-adjusted 0.403; "
+        "t.y: p 0.030, Monte-Carlo p 0.034 (fails), Holm-adjusted 0.068; the block"
     )
 
 
@@ -194,3 +209,45 @@ def test_family_evidence_gives_a_region_the_family_rule():
     assert np.array_equal(ev["value"], ev["high"], equal_nan=True)
     hp, st = family_status(p, member)
     assert hp.dtype == float and st.dtype == np.int8 and np.isnan(hp[-1])
+
+
+@pytest.mark.parametrize("n", [1, 20, 500])
+def test_mc_p_is_the_monte_carlo_tests_p(n):
+    """2 (k + 1) / (n + 1) from the plug-in 2 k / n: k = 0 (never 0), k = 1/2 (a plate on the
+    edge), k = 1, and 1 where it would exceed 1 (k >= (n - 1) / 2) but not below."""
+    k = np.array([0.0, 0.5, 1.0])
+    want = np.minimum(1.0, 2 * (k + 1) / (n + 1))
+    assert mc_p(2 * k / n, n) == pytest.approx(want, rel=1e-12)
+    assert mc_p(np.array([1.0, (n - 1) / n]), n).tolist() == pytest.approx([1.0, 1.0])
+    if n > 3:
+        assert mc_p((n - 3) / n, n) == pytest.approx((n - 1) / (n + 1), rel=1e-12)
+    got = mc_p(np.zeros((2, 3)), n)  # arrays in, arrays out
+    assert got.shape == (2, 3) and got.dtype == float
+
+
+@pytest.mark.parametrize("n", [0, -1, 0.5, float("nan")])
+def test_mc_p_refuses_fewer_than_one_plate(n):
+    with pytest.raises(ValueError, match="simulated plates n must be >= 1"):
+        mc_p(np.array([0.1]), n)
+
+
+@pytest.mark.parametrize(("k", "st"), [(3, FAILS), (4, UNDECIDED)])
+def test_family_status_takes_the_monte_carlo_p_of_n_plates(k, st):
+    """At n = 399 a family of two fails at k = 3 (Holm 2 * 2 * 4 / 400 = 0.04) and not at
+    k = 4 (0.05 exactly), where the plug-in 2 * 2 * 4 / 399 = 0.040 would fail it."""
+    p = np.array([[2 * k / 399, 0.9]])
+    member = np.array([[FAILS, UNDECIDED]])
+    hp, got = family_status(p, member, 399)
+    assert hp[0] == pytest.approx(4 * (k + 1) / 400, rel=1e-12) and got.tolist() == [st]
+    assert family_status(p, member)[0][0] == pytest.approx(4 * k / 399, rel=1e-12)
+    assert family_status(p, member)[1].tolist() == [FAILS]
+    ev = family_evidence(p, member, 399)
+    assert ev["value"][0] == pytest.approx(hp[0]) and ev["high"][0] == pytest.approx(hp[0])
+
+
+def test_family_outcomes_over_a_region_use_n():
+    reg = _region([6 / 399, 0.5], [0.5, 0.5], [2.0, 2.0])  # X at k = 3, then k = 99.75
+    hp, st = family_outcomes(_book(), reg, ["t.x", "t.y"], n=399)
+    assert hp == pytest.approx([0.04, 1.0]) and st.tolist() == [FAILS, UNDECIDED]
+    hp1, _ = family_outcomes(_book(), reg, ["t.x", "t.y"], n=1)
+    assert hp1 == pytest.approx([1.0, 1.0])

@@ -5,14 +5,14 @@ means (issue 21; docs/referee-reading.md, Wolf)."""
 import numpy as np
 import pytest
 
-from sim.claims.family import holm
+from sim.claims.family import holm, mc_p
 from sim.claims.intervals import plate_p
 from sim.mc.config import validate
 from sim.studies import wolf
 from sim.studies.wolf.chunks import draw_main
 from sim.studies.wolf.claims import HEADLINE, JOINT, is_mean_row, load_book, stat_key
 from sim.studies.wolf.model import read_placed
-from sim.studies.wolf.region import evidence, mc_p
+from sim.studies.wolf.region import evidence
 
 
 def _res(book, t2, tags, rng):

@@ -208,8 +208,9 @@ def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n:
     ``control.table1`` layout without and with the grid correction, and (corrected) with the
     ``control.many`` layout (the same adjustment when the two layouts agree). The rms (m) at
     control and check points, keys ``s<i>.without.*``, ``s<i>.with.*`` (X, Y) and
-    ``s<i>.many.*`` (X, Y, XY, Z); and the configured scanner's ``control.many`` pass on the
-    same blocks, keys ``cfg.many.*``. Every vector draws its blocks from the same two seeds
+    ``s<i>.many.*`` (X, Y, XY, Z), the first pass's pass-point rms (XY, Z) started from it,
+    ``s<i>.first.*``; and the configured scanner's ``control.many`` and first passes on the
+    same blocks, keys ``cfg.many.*``, ``cfg.first.*``. Every vector draws its blocks from the same two seeds
     (common random numbers, the grid's node noise on a stream of its own:
     :class:`~sim.studies.agnard.simulate.Simulated`), so the vectors differ by their inputs,
     not by their luck, and each is paired block by block with the configured scanner
@@ -236,8 +237,16 @@ def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n:
             for ax in ("x", "y", "xy", "z"):
                 out[f"{tag}.{w}_{ax}_m"] = acc[f"a.{w}_{ax}_m"]
 
-    ctrl, _, res = adj.adjust(blocks({}), ("digital", "corrected"), cfg["control.many"], wo, wc)
+    def first(tag: str, sim: Simulated, res21) -> None:  # the first pass on the same blocks
+        acc: dict[str, np.ndarray] = {}
+        _first_pass(cfg, block, adj, sim, res21, acc)
+        for ax in ("xy", "z"):
+            out[f"{tag}.first.pass_{ax}_m"] = acc[f"first.pass_{ax}_m"]
+
+    base = blocks({})
+    ctrl, _, res = adj.adjust(base, ("digital", "corrected"), cfg["control.many"], wo, wc)
     keep("cfg.many", ctrl, res)
+    first("cfg", base, res)
     for i, over in enumerate(scanners):
         sim = blocks(over)
         res = None
@@ -250,4 +259,5 @@ def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n:
             keep(f"s{i}.{tag}", ctrl, res)
             if tag == "with" and len(passes) == 2:
                 keep(f"s{i}.many", ctrl, res)
+        first(f"s{i}", sim, res)  # res: the control.many pass
     return out

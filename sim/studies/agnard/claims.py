@@ -257,12 +257,12 @@ def tables23_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, c5, c21) 
     return rows
 
 
-def family_rows(book: ClaimBook, rows: list[dict]) -> list[dict]:
+def family_rows(book: ClaimBook, rows: list[dict], n: int) -> list[dict]:
     """``rows`` with the joint X, Y rows of Tables 2-3 after their XY paper-checks (Holm over
-    the two one-plate rows, at the run's configured inputs; the 5-control one is then decided
-    over the layout region)."""
+    the two one-plate rows' Monte-Carlo p, each over the ``n`` main blocks, at the run's
+    configured inputs; the 5-control one is then decided over the layout region)."""
     by = {r["claim"]: r for r in rows}
-    fam = {j: family_row(book, j, [by[m] for m in MEMBERS[j]]) for j in JOINT.values()}
+    fam = {j: family_row(book, j, [by[m] for m in MEMBERS[j]], n=n) for j in JOINT.values()}
     after = {j.replace("_holm", "_cm"): r for j, r in fam.items()}  # next to the XY check
     return [x for r in rows for x in ([r, after[r["claim"]]] if r["claim"] in after else [r])]
 
@@ -425,7 +425,7 @@ def claim_rows(
         **anisotropy_rows(book, cfg, sim),
     }
     rows = table1_rows(book, scanner, scanner_stats) + table_rows(book, table)
-    rows = family_rows(book, rows)
+    rows = family_rows(book, rows, cfg["trials"])
     for r in rows:  # an unbounded side of a bound's zone is "no number" (null), not infinity
         for k in ("zone_low", "zone_high"):
             if not np.isfinite(r[k]):

@@ -169,16 +169,27 @@ def many_samples(sw: dict, pre: str) -> dict[str, np.ndarray]:
     return out
 
 
+def first_samples(sw: dict, pre: str = "") -> dict[str, np.ndarray]:
+    """Per-block pass-point rms (cm) of the first pass (weak control) keyed by claim id
+    (``pre``: ``s<i>`` for scanner vector ``i``, ``cfg`` for the configured scanner on the
+    same blocks, ``""`` for the main blocks)."""
+    p = f"{pre}." if pre else ""
+    return {
+        f"agnard.first_pass.pass_{c}_cm": 100 * np.asarray(sw[f"{p}first.pass_{c}_m"])
+        for c in ("xy", "z")
+    }
+
+
 def table1_samples(sw: dict, i: int) -> dict[str, np.ndarray]:
     """Per-block statistics of scanner vector ``i`` keyed by claim id: Table 1's rms (m) and
-    the 21-control pass's (cm, :func:`many_samples`)."""
+    the 21-control and first passes' (cm, :func:`many_samples`, :func:`first_samples`)."""
     out = {
         f"agnard.table1.{tag}_{w}_{c}_m": np.asarray(sw[f"s{i}.{tag}.{w}_{c}_m"])
         for tag in ("without", "with")
         for w in ("ctrl", "check")
         for c in ("x", "y")
     }
-    return {**out, **many_samples(sw, f"s{i}.many")}
+    return {**out, **many_samples(sw, f"s{i}.many"), **first_samples(sw, f"s{i}")}
 
 
 def explore_scanner(
@@ -205,7 +216,7 @@ def explore_scanner(
             SCANNER_PART + len(stats),
             "scanner vectors (Table 1), each paired with the configured scanner",
         )
-        c = many_samples(sw, "cfg.many")
+        c = {**many_samples(sw, "cfg.many"), **first_samples(sw, "cfg")}
         per = [
             {**table1_samples(sw, j), **{CONFIGURED + k: v for k, v in c.items()}} for j in range(n)
         ]

@@ -109,9 +109,10 @@ def _claim_lines(c: dict) -> list[str]:
         f"{v('agnard.budget.model_xy_cm')} cm per planimetric coordinate "
         f"(*{vd('agnard.budget.model_xy_cm')}* against 13: it adds half the x-parallax error) "
         f"and {v('agnard.budget.model_z_cm')} cm in height.",
-        f"- *First pass*: pass-point residuals {v('agnard.first_pass.pass_xy_cm')} cm XY "
-        f"(*{vd('agnard.first_pass.pass_xy_cm')}*), {v('agnard.first_pass.pass_z_cm')} cm Z "
-        f"(*{vd('agnard.first_pass.pass_z_cm')}*); the paper's own 10 and 15 cm are "
+        "- *First pass* (over the scanner's inputs): pass-point residuals "
+        f"{_span(c['agnard.first_pass.pass_xy_cm'])} cm XY "
+        f"(*{vd('agnard.first_pass.pass_xy_cm')}*), {_span(c['agnard.first_pass.pass_z_cm'])} "
+        f"cm Z (*{vd('agnard.first_pass.pass_z_cm')}*); the paper's own 10 and 15 cm are "
         f"{v('agnard.first_pass.quarter_pixel')} and {v('agnard.first_pass.third_pixel')} pixel "
         "in planimetry and in height by the paper's own budget (sqrt 2 and f / b): a quarter "
         f"(*{vd('agnard.first_pass.quarter_pixel')}*) and a third "

@@ -42,6 +42,7 @@ from sim.studies.agnard.region import (
     SCANNER_KEYS,
     explore_region,
     explore_scanner,
+    first_samples,
     many_samples,
     shift_table,
 )
@@ -253,7 +254,7 @@ def _five_region(cfg, block, book, rows, ctx, part, prov, out):
         lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx),
         part,
     )
-    _write_region(region, book, preds, prov, out)
+    _write_region(region, book, preds, cfg["region.trials"], prov, out)
     insets = [float(u) for u in region.x["five_inset_1"]]
     T = cfg["region.trials"]
     tab = {
@@ -275,18 +276,19 @@ def _five_region(cfg, block, book, rows, ctx, part, prov, out):
     rows = over_region(book, region, preds, rows, partial(_example, "layout"))
     fresh = ClaimBook(list(book.specs.values()), [], book.path)  # rows re-scored over the region
     j5 = JOINT["control_5"]
-    five = family_over(fresh, region, j5, MEMBERS[j5])
+    five = family_over(fresh, region, j5, MEMBERS[j5], n=T)
     return [five if r["claim"] == j5 else r for r in rows], list(dict.fromkeys(insets))
 
 
-def _write_region(region, book, preds, prov, out) -> None:
+def _write_region(region, book, preds, n: int, prov, out) -> None:
     """``consistent_region.parquet`` and ``region_inputs.parquet``
     (:func:`sim.claims.book_region.write_region`), with the joint X, Y row's per-point
-    outcome as a column (decided from its members, not from evidence of its own)."""
+    outcome as a column (decided from its members' p over ``n`` blocks per point, not from
+    evidence of its own)."""
     st = statements(book, preds)
     cols = region_table(region, st, preds)
     j5 = JOINT["control_5"]
-    fam = family_outcomes(book, region, MEMBERS[j5])[1][region.accepted]
+    fam = family_outcomes(book, region, MEMBERS[j5], n=n)[1][region.accepted]
     cols[j5] = [OUTCOME_NAMES[int(o)] for o in fam]
     write_table(out / "consistent_region.parquet", cols, prov)
     write_table(out / "region_inputs.parquet", inputs_table(region, st), prov)
@@ -306,7 +308,7 @@ def _scanner_region(cfg, block, book, per_trial, ctx, prov, out):
     (:mod:`.paired`); write ``scanner_region.parquet`` (every explored vector),
     ``scanner_region_inputs.parquet``, ``scanner_shift.parquet`` and its figure. Returns the
     region, its predictions and the per-vector statistics."""
-    base = many_samples(per_trial, f"layout_{cfg['control.many']}")
+    base = {**many_samples(per_trial, f"layout_{cfg['control.many']}"), **first_samples(per_trial)}
     region, preds, stats = explore_scanner(
         cfg,
         block,
@@ -317,7 +319,7 @@ def _scanner_region(cfg, block, book, per_trial, ctx, prov, out):
     j21 = JOINT["control_21"]  # its per-vector outcome beside its members' (family_status)
     p = np.stack([region.outputs[m]["p"] for m in MEMBERS[j21]], axis=1)
     member = np.stack([outcomes(region, statement_of(book, m)) for m in MEMBERS[j21]], axis=1)
-    region.outputs[j21] = family_evidence(p, member)
+    region.outputs[j21] = family_evidence(p, member, n=cfg["trials"])  # p over the main blocks
     write_explored(out / "scanner_region.parquet", region, prov, statements(book, [*preds, j21]))
     write_table(out / "scanner_shift.parquet", shift_table(region, preds, stats), prov)
     nominal = {name: cfg[key] for name, key in SCANNER_KEYS.items()}
@@ -331,11 +333,12 @@ def _scanner_region(cfg, block, book, per_trial, ctx, prov, out):
     return region, preds, stats
 
 
-def _over_scanner(book, scanner, preds, rows, k: int) -> list[dict]:
+def _over_scanner(book, scanner, preds, rows, k: int, n: int) -> list[dict]:
     """The 21-control rows decided over the scanner's inputs (the not-comparable Table 1 set
     aside: every explored vector stays), each vector's evidence the configured scanner's main
     blocks moved by its paired shift (:mod:`.paired`); the configured result kept in the note
-    as an example, and the joint X, Y row decided from its members per vector."""
+    as an example, and the joint X, Y row decided from its members per vector (their p over
+    the ``n`` main blocks)."""
     aside = [s.id for s in scanner.statements if book.spec(s.id)["kind"] == "not comparable"]
     region = scanner.without(aside)
     how = HOW[2:] + (
@@ -353,7 +356,7 @@ def _over_scanner(book, scanner, preds, rows, k: int) -> list[dict]:
         f"at the configured scanner (an example): Holm p {by[j21]['value']:.3g}, outcome "
         f"{by[j21]['outcome']}"
     )
-    joint = family_over(fresh, region, j21, MEMBERS[j21], f"{how}; {ex}")
+    joint = family_over(fresh, region, j21, MEMBERS[j21], f"{how}; {ex}", n=n)
     return [joint if r["claim"] == j21 else r for r in rows]
 
 
@@ -424,7 +427,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     # --- the scanner's unprinted inputs under Table 1, then every claim
     scanner, spreds, scanner_stats = _scanner_region(cfg, block, book, per_trial, ctx, prov, out)
     rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book, scanner, scanner_stats)
-    rows = _over_scanner(book, scanner, spreds, rows, cfg["table1.trials"])
+    rows = _over_scanner(book, scanner, spreds, rows, cfg["table1.trials"], T)
     rows, insets = _five_region(cfg, block, book, rows, ctx, base, prov, out)
     ctrl_idx = _region_layouts(block, insets, prov, out)
     write_claims(out / "claims.parquet", rows, prov, book)

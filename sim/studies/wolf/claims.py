@@ -122,7 +122,7 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
     )
     table2 = [r for r in out if r["claim"].startswith("wolf.table2.")]
     means = [r for r in table2 if is_mean_row(r["claim"])]
-    families = [family_row(book, HEADLINE, means), family_row(book, JOINT, table2)]
+    families = [family_row(book, HEADLINE, means, n=T), family_row(book, JOINT, table2, n=T)]
     return (
         out
         + families

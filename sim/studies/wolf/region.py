@@ -26,7 +26,7 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.book_region import load_declaration, plate_ref, sample_evidence
-from sim.claims.family import family_evidence, holm
+from sim.claims.family import family_evidence, holm, mc_p
 from sim.claims.inference import Region, explore, status
 from sim.claims.region import statement_of
 from sim.mc.runner import chunk_rng
@@ -61,27 +61,13 @@ def _cells(x: dict[str, np.ndarray], call: int) -> list[tuple[str, dict]]:
     return [(f"g{call}.{i}.", {CELL[k]: float(x[k][i]) for k in CELL}) for i in range(n)]
 
 
-def mc_p(p: np.ndarray, n: int) -> np.ndarray:
-    """The Monte-Carlo p value of a one-plate ``p`` estimated from ``n`` simulated plates.
-
-    ``p = 2 k / n`` counts the ``k`` plates at least as extreme on the rarer side; the
-    Monte-Carlo test's own p is ``2 (k + 1) / (n + 1)`` (the paper's plate counted among the
-    simulated ones: Davison & Hinkley 1997, eq. 4.11; Phipson & Smyth 2010), never 0, and a
-    test rejecting when it is below 0.05 keeps its level with the Monte-Carlo noise included.
-    Holm multiplies the smallest p by the family's size (8, 24), and so the plug-in's
-    discreteness: at ``n = 400`` one plate in 400 (``k = 1``, 0.005) gave 0.04 over eight and
-    failed a family, two plates (0.08) did not: the region's fail/undecided boundary was
-    drawn by single simulated plates (docs/referee-reading.md, third reading)."""
-    return np.minimum(1.0, (np.asarray(p, float) * n + 2.0) / (n + 1.0))
-
-
 def evidence(book: ClaimBook, ids: list[str], res: dict, tags: list[str]) -> dict:
     """Per-point evidence of every claim in ``ids`` from the cells' per-trial statistics.
 
     Each Table 2 row's ``p`` is its Holm-adjusted p over the 24 rows at the same point (the
     rows are 24 correlated tests of one table); ``JOINT`` is the smallest of them, the
     headline (``HEADLINE``) the smallest Holm-adjusted p over the eight plate means alone.
-    The p values entering Holm are the Monte-Carlo test's (:func:`mc_p`)."""
+    The p values entering Holm are the Monte-Carlo test's (:func:`sim.claims.family.mc_p`)."""
     out = {}
     t2 = [c for c in book.specs if c.startswith("wolf.table2.p")]
     for cid in dict.fromkeys(ids + t2):
