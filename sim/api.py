@@ -64,13 +64,15 @@ class Results:
         """The table ``name`` (``claims``, ``points``, ..., or ``trials``) as a pyarrow Table."""
         if not isinstance(name, str) or not name.isidentifier():
             raise ConfigError("table", f"must be a table name such as 'claims' (got {name!r})")
+        if not self.path.is_dir():  # not "no table": the directory itself is wrong
+            raise ConfigError("path", f"{self.path} is not a results directory")
         p = self.path / (name if name == "trials" else f"{name}.parquet")
         if not p.exists():
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
             )
         if name == "trials" and (bad := damaged_chunks(self.path)):
-            raise ConfigError("table", f"trials: {bad}; run the study again")
+            raise ConfigError("table", f"trials: {bad}")
         if name != "trials" and not p.is_file():  # pyarrow reads a directory as a dataset
             raise ConfigError("table", f"{p} is not a file; run the study again")
         try:

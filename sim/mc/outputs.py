@@ -226,11 +226,14 @@ def damaged_chunks(out: Path) -> str | None:
     )
     for f in sorted(set(want) | set(have)):
         if f not in have:
-            return f"{out / f} is missing"
+            return f"{out / f} is missing; run the study again"
         if f not in want:
-            return f"{out / f} is not one of the run's chunk files"
+            # no run removes a file it did not write: re-running would not help
+            return f"{out / f} is not one of the run's chunk files (added by hand?): move it away"
         if not (out / f).is_file() or (out / f).is_symlink() or _sha256(out / f) != want[f]:
-            return f"{out / f} is not the file the run wrote (its sha256 differs)"
+            return (
+                f"{out / f} is not the file the run wrote (its sha256 differs); run the study again"
+            )
     return None
 
 

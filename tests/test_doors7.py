@@ -1,0 +1,43 @@
+"""The failure classes of the seventh sweep of bad inputs (issue 26), one case per class;
+each failed on the code before its fix.
+
+* a chunk file dropped by hand into a run's ``trials/`` (named like the run's own) survives
+  every re-run, ``--overwrite`` included (no run removes a file it did not write), yet
+  ``Results.table("trials")`` refused it with "run the study again", which never helped;
+* ``sim.Results`` of a directory that does not exist said "network has no table 'claims';
+  it has " (an empty list): the table was blamed for a wrong path.
+"""
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim.cli import main
+from sim.mc.config import ConfigError
+
+ROOT = Path(__file__).resolve().parent.parent
+NETWORK = ROOT / "studies" / "network_brown.toml"
+
+
+def test_a_chunk_added_by_hand_is_named_with_a_remedy_that_works(tmp_path, capsys):
+    d = tmp_path / "r"
+    run = ["run", str(NETWORK), "--trials", "40", "--no-figures", "--quiet", "--out", str(d)]
+    assert main(run) == 0
+    part = d / "trials" / "part-0"
+    shutil.copy(part / "chunk-000001.parquet", part / "chunk-000099.parquet")
+    assert main(run) == 0  # the re-run keeps the file it did not write
+    assert (part / "chunk-000099.parquet").is_file()
+    with pytest.raises(ConfigError) as e:
+        sim.Results(d, "network").table("trials")
+    msg = str(e.value)
+    assert "chunk-000099.parquet is not one of the run's chunk files" in msg
+    assert "move it away" in msg and "run the study again" not in msg
+    (part / "chunk-000099.parquet").unlink()
+    assert sim.Results(d, "network").table("trials").num_rows == 40
+
+
+def test_results_of_a_missing_directory_name_the_path(tmp_path):
+    with pytest.raises(ConfigError, match=r"^path: .*nowhere is not a results directory"):
+        sim.Results(tmp_path / "nowhere", "network").claims()
