@@ -29,6 +29,7 @@ from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
 from sim.mc.outputs import damaged_chunks
+from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import read_provenance
 from sim.mc.sweep import read_sweep
 from sim.studies import load_study
@@ -204,6 +205,24 @@ def _plain(v: Any) -> Any:
     return v
 
 
+def _load_picking_chunk(study_file, vals: dict):
+    """``load_study``; ``trials`` without ``chunk`` picks the largest chunk giving at least
+    MIN_CHUNKS chunks, as ``sim run --trials`` does (same config, same results)."""
+    if "trials" not in vals or "chunk" in vals:
+        return load_study(study_file, values=vals)
+    try:
+        study, cfg = load_study(study_file, values=vals)
+    except ConfigError as e:
+        if e.key != "chunk":
+            raise
+        # the file's chunk is too large for the trials asked for
+        _, cfg = load_study(study_file, values={**vals, "chunk": 1})
+        return load_study(study_file, values={**vals, "chunk": max(1, cfg["trials"] // MIN_CHUNKS)})
+    if "chunk" in cfg and cfg["chunk"] > (chunk := max(1, cfg["trials"] // MIN_CHUNKS)):
+        study, cfg = load_study(study_file, values={**vals, "chunk": chunk})
+    return study, cfg
+
+
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
@@ -213,5 +232,5 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
         if not _key(k).strip(".").strip() or not k.isprintable():
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
     vals = {_key(k): _plain(v) for k, v in overrides.items()}
-    study, cfg = load_study(study_file, values=vals)
+    study, cfg = _load_picking_chunk(study_file, vals)
     return StudyHandle(Path(study_file), study, cfg, vals, read_sweep(study_file, study.schema))

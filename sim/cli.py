@@ -243,7 +243,9 @@ def _bounds(f) -> str:
 
 
 def _check(args) -> int:
-    study, cfg = load_study(args.study, args.set)
+    # the config sim run would resolve: --set trials= without a chunk picks the chunk
+    args.trials = args.chunk = args.seed = None
+    study, cfg = _load(args)
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
     est = estimate(cfg, sweep)

@@ -5,7 +5,10 @@ each failed on the code before its fix.
   every re-run, ``--overwrite`` included (no run removes a file it did not write), yet
   ``Results.table("trials")`` refused it with "run the study again", which never helped;
 * ``sim.Results`` of a directory that does not exist said "network has no table 'claims';
-  it has " (an empty list): the table was blamed for a wrong path.
+  it has " (an empty list): the table was blamed for a wrong path;
+* the Python API's ``trials`` (``sim.load(f, trials=N)``, ``.run(trials=N)``) did not pick
+  the chunk as ``sim run --trials N`` does: ``trials=40`` on a file of ``chunk = 100`` was
+  refused, and a smaller count ran other chunks (other intervals) than the command.
 """
 
 import shutil
@@ -41,3 +44,14 @@ def test_a_chunk_added_by_hand_is_named_with_a_remedy_that_works(tmp_path, capsy
 def test_results_of_a_missing_directory_name_the_path(tmp_path):
     with pytest.raises(ConfigError, match=r"^path: .*nowhere is not a results directory"):
         sim.Results(tmp_path / "nowhere", "network").claims()
+
+
+def test_api_trials_picks_the_chunk_as_sim_run_trials_does(capsys):
+    """``sim run --trials 40`` on a file of chunk = 100 picks chunks of 2 (at least
+    MIN_CHUNKS chunks); ``sim.load(f, trials=40)`` and ``.run(trials=40)`` refused it."""
+    assert sim.load(NETWORK, trials=40).config["chunk"] == 2
+    assert sim.load(NETWORK, trials=400).config["chunk"] == 20
+    assert sim.load(NETWORK, trials=40, chunk=4).config["chunk"] == 4
+    assert sim.load(NETWORK, trials=4000).config["chunk"] == 100  # the file's, small enough
+    assert main(["check", str(NETWORK), "--set", "trials=40"]) == 0
+    assert "\nchunk = 2 " in capsys.readouterr().out
