@@ -8,7 +8,10 @@ each failed on the code before its fix.
   it has " (an empty list): the table was blamed for a wrong path;
 * the Python API's ``trials`` (``sim.load(f, trials=N)``, ``.run(trials=N)``) did not pick
   the chunk as ``sim run --trials N`` does: ``trials=40`` on a file of ``chunk = 100`` was
-  refused, and a smaller count ran other chunks (other intervals) than the command.
+  refused, and a smaller count ran other chunks (other intervals) than the command;
+  ``sim check --set trials=40`` refused what ``sim run --set trials=40`` runs;
+* Brown's ranges overflowing from a huge ``plate.format_mm`` were blamed on
+  ``comparator.station_offset_mm``.
 """
 
 import shutil
@@ -55,3 +58,13 @@ def test_api_trials_picks_the_chunk_as_sim_run_trials_does(capsys):
     assert sim.load(NETWORK, trials=4000).config["chunk"] == 100  # the file's, small enough
     assert main(["check", str(NETWORK), "--set", "trials=40"]) == 0
     assert "\nchunk = 2 " in capsys.readouterr().out
+
+
+def test_a_format_so_large_that_ranges_overflow_names_the_format(capsys):
+    """Brown's stations stand half the format plus the offset from the centre; a format of
+    1e300 mm was blamed on the 17 mm ``comparator.station_offset_mm``."""
+    argv = ["check", str(ROOT / "studies" / "brown_table1.toml"), "--set", "plate.format_mm=1e300"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("sim: error: plate.format_mm: ") and "overflow" in err
+    assert "\n" not in err
