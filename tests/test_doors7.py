@@ -11,7 +11,10 @@ each failed on the code before its fix.
   refused, and a smaller count ran other chunks (other intervals) than the command;
   ``sim check --set trials=40`` refused what ``sim run --set trials=40`` runs;
 * Brown's ranges overflowing from a huge ``plate.format_mm`` were blamed on
-  ``comparator.station_offset_mm``.
+  ``comparator.station_offset_mm``;
+* salsig's scales had no upper bound: ``comparator.sx = 1e308`` ran and recovered nonsense
+  without a word, ``zscale.s_mm_per_digit = 1e300`` (with the B8 scales) ran, printed a
+  NumPy overflow warning and failed only after the run.
 """
 
 import shutil
@@ -68,3 +71,19 @@ def test_a_format_so_large_that_ranges_overflow_names_the_format(capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("sim: error: plate.format_mm: ") and "overflow" in err
     assert "\n" not in err
+
+
+@pytest.mark.parametrize(
+    "setting, key",
+    [
+        ("comparator.sx=1e308", "comparator.sx"),
+        ("zscale.s_mm_per_digit=1e300", "zscale.s_mm_per_digit"),
+    ],
+)
+def test_salsig_scales_that_overflow_are_refused_on_load(capsys, setting, key):
+    """A comparator scale of 1e308 ran and recovered nonsense (SX 1000 digits); a z scale
+    (and B8 scales) of 1e300 ran, printed a NumPy warning and failed after the run."""
+    argv = ["check", str(ROOT / "studies" / "salsig_encoders.toml"), "--set", setting]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"sim: error: {key}: ") and "\n" not in err
