@@ -374,6 +374,14 @@ def _main(argv: list[str]) -> int:
             name = "the working directory (it was deleted)"
         print(f"sim: error: {_why(e)}: {name}".rstrip(": "), file=sys.stderr)
         return 2
+    except UnicodeEncodeError as e:  # a text the terminal's encoding cannot show (ascii)
+        what = ascii(e.object[e.start : e.end]) if isinstance(e.object, str) else "a character"
+        print(
+            f"sim: error: the output (encoding {e.encoding}) cannot show {what}: "
+            "set PYTHONIOENCODING=utf-8",
+            file=sys.stderr,
+        )
+        return 2
     except (ArithmeticError, ValueError, MemoryError, RecursionError) as e:  # e.g. a sweep
         # cell table; a file nested too deep to read (a run.json of 100,000 brackets)
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)

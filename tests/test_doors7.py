@@ -14,10 +14,15 @@ each failed on the code before its fix.
   ``comparator.station_offset_mm``;
 * salsig's scales had no upper bound: ``comparator.sx = 1e308`` ran and recovered nonsense
   without a word, ``zscale.s_mm_per_digit = 1e300`` (with the B8 scales) ran, printed a
-  NumPy overflow warning and failed only after the run.
+  NumPy overflow warning and failed only after the run;
+* an output whose encoding cannot show a name (``PYTHONIOENCODING=ascii``, a network named
+  'café') gave "UnicodeEncodeError: 'ascii' codec can't encode ..." without saying that the
+  output was the matter.
 """
 
+import io
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -87,3 +92,14 @@ def test_salsig_scales_that_overflow_are_refused_on_load(capsys, setting, key):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"sim: error: {key}: ") and "\n" not in err
+
+
+def test_an_output_that_cannot_show_a_name_is_named(capsys, monkeypatch):
+    """``PYTHONIOENCODING=ascii sim check`` of a network named 'café' said only
+    "UnicodeEncodeError: 'ascii' codec can't encode ...", not that the output was the matter."""
+    monkeypatch.setattr(sys, "stdout", io.TextIOWrapper(io.BytesIO(), encoding="ascii"))
+    assert main(["check", str(NETWORK), "--set", 'network.name="café"']) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "sim: error: the output (encoding ascii) cannot show '\\xe9': set PYTHONIOENCODING=utf-8"
+    )
