@@ -91,6 +91,9 @@ def _load(args):
     size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it."""
     overrides = list(args.set) + ([f"chunk={args.chunk}"] if args.chunk is not None else [])
     given = _keys_set(args.set)
+    for opt, key in (("--trials", "trials"), ("--seed", "seed"), ("--chunk", "chunk")):
+        if getattr(args, key) is not None and key in given:  # one would be dropped silently
+            raise ConfigError(opt, f"given twice, as {opt} and as --set {key}=: give one")
     trials_given = args.trials is not None or "trials" in given
     try:
         study, cfg = load_study(args.study, overrides, args.trials, args.seed)

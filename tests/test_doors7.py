@@ -17,7 +17,9 @@ each failed on the code before its fix.
   NumPy overflow warning and failed only after the run;
 * an output whose encoding cannot show a name (``PYTHONIOENCODING=ascii``, a network named
   'café') gave "UnicodeEncodeError: 'ascii' codec can't encode ..." without saying that the
-  output was the matter.
+  output was the matter;
+* ``sim run --trials 40 --set trials=60`` (or ``--seed`` with ``--set seed=``) dropped one of
+  the two silently, and so did ``make verify --trials 400 --set trials=40``.
 """
 
 import io
@@ -103,3 +105,16 @@ def test_an_output_that_cannot_show_a_name_is_named(capsys, monkeypatch):
     assert err == (
         "sim: error: the output (encoding ascii) cannot show '\\xe9': set PYTHONIOENCODING=utf-8"
     )
+
+
+@pytest.mark.parametrize(
+    "opts", [["--trials", "40", "--set", "trials=60"], ["--seed", "3", "--set", "seed=4"]]
+)
+def test_a_key_given_by_its_option_and_by_set_is_refused(tmp_path, capsys, opts):
+    """``sim run --trials 40 --set trials=60`` ran 40 trials without a word (and ``make
+    verify --trials 400 --set trials=40`` dropped the user's --set the same way)."""
+    argv = ["run", str(NETWORK), *opts, "--no-figures", "--quiet", "--out", str(tmp_path / "o")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"sim: error: {opts[0]}: given twice") and "\n" not in err
+    assert not (tmp_path / "o").exists()
