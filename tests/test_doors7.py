@@ -19,7 +19,9 @@ each failed on the code before its fix.
   'café') gave "UnicodeEncodeError: 'ascii' codec can't encode ..." without saying that the
   output was the matter;
 * ``sim run --trials 40 --set trials=60`` (or ``--seed`` with ``--set seed=``) dropped one of
-  the two silently, and so did ``make verify --trials 400 --set trials=40``.
+  the two silently, and so did ``make verify --trials 400 --set trials=40``;
+* ``python -m sim.batch --results out a/x.toml b/x.toml`` said they "would both write
+  results/x", not out/x.
 """
 
 import io
@@ -30,6 +32,7 @@ from pathlib import Path
 import pytest
 
 import sim
+from sim.batch import main as batch_main
 from sim.cli import main
 from sim.mc.config import ConfigError
 
@@ -118,3 +121,14 @@ def test_a_key_given_by_its_option_and_by_set_is_refused(tmp_path, capsys, opts)
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"sim: error: {opts[0]}: given twice") and "\n" not in err
     assert not (tmp_path / "o").exists()
+
+
+def test_batch_names_the_results_directory_two_files_would_share(tmp_path, capsys):
+    """``--results out`` with a/x.toml and b/x.toml said "would both write results/x"."""
+    for d in "ab":
+        (tmp_path / d).mkdir()
+        shutil.copy(NETWORK, tmp_path / d / "x.toml")
+    files = [str(tmp_path / d / "x.toml") for d in "ab"]
+    assert batch_main(["--results", str(tmp_path / "out"), *files]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith(f"would both write {tmp_path / 'out' / 'x'}") and "\n" not in err
