@@ -21,7 +21,10 @@ each failed on the code before its fix.
 * ``sim run --trials 40 --set trials=60`` (or ``--seed`` with ``--set seed=``) dropped one of
   the two silently, and so did ``make verify --trials 400 --set trials=40``;
 * ``python -m sim.batch --results out a/x.toml b/x.toml`` said they "would both write
-  results/x", not out/x.
+  results/x", not out/x;
+* a file of the run (a figure, a table) replaced by a directory holding a user's file made the
+  re-run fail at its very end with "File exists: .../.<out>.partial/network.png": the clash
+  with a foreign file was checked for the file's own name only.
 """
 
 import io
@@ -132,3 +135,20 @@ def test_batch_names_the_results_directory_two_files_would_share(tmp_path, capsy
     assert batch_main(["--results", str(tmp_path / "out"), *files]) == 2
     err = capsys.readouterr().err.strip()
     assert err.endswith(f"would both write {tmp_path / 'out' / 'x'}") and "\n" not in err
+
+
+def test_a_user_directory_named_like_a_file_of_the_run_is_named(tmp_path, capsys):
+    """A table replaced by a directory holding a user's file (``claims.parquet/notes.txt``):
+    the re-run failed at the end with "File exists: .../.r.partial/claims.parquet"."""
+    d = tmp_path / "r"
+    run = ["run", str(NETWORK), "--trials", "40", "--no-figures", "--quiet", "--out", str(d)]
+    assert main(run) == 0
+    (d / "claims.parquet").unlink()
+    (d / "claims.parquet").mkdir()
+    (d / "claims.parquet" / "notes.txt").write_text("mine")
+    capsys.readouterr()
+    assert main([*run, "--overwrite", "--seed", "5"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"sim: error: --out: {d / 'claims.parquet'} was not written by sim")
+    assert "\n" not in err
+    assert (d / "claims.parquet" / "notes.txt").read_text() == "mine"

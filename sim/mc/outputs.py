@@ -262,13 +262,25 @@ def _foreign(out: Path) -> list[str]:
     return [f for f in _files(out) if f not in mine]
 
 
+def _clash(stage: Path, f: str) -> str | None:
+    """The part of the foreign file ``f`` (relative) that the new run's files in ``stage``
+    take: ``f`` itself, or a directory of its path that the run writes as a file (a user's
+    ``network.png/notes.txt``), else None."""
+    parts = Path(f).parts
+    for i in range(1, len(parts)):
+        q = stage.joinpath(*parts[:i])
+        if q.exists() and not q.is_dir():
+            return Path(*parts[:i]).as_posix()
+    return f if (stage / f).exists() else None
+
+
 def publish(stage: Path, out: Path) -> None:
     """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
     files in ``out`` that the suite did not write."""
     for tmp in stage.rglob("*.tmp"):
         tmp.unlink(missing_ok=True)
     keep = _foreign(out) if out.is_dir() else []
-    clash = [f for f in keep if (stage / f).exists()]
+    clash = [c for f in keep if (c := _clash(stage, f))]
     if clash:
         raise ConfigError(
             "--out",
