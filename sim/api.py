@@ -56,8 +56,13 @@ class Results:
             )
         object.__setattr__(self, "path", Path(self.path))
 
+    def _check_dir(self) -> None:  # not "no table": the directory itself is wrong
+        if not self.path.is_dir():
+            raise ConfigError("path", f"{self.path} is not a results directory")
+
     def names(self) -> list[str]:
         """The tables of the run (``trials`` is the per-trial dataset, if any)."""
+        self._check_dir()
         names = sorted(p.stem for p in self.path.glob("*.parquet"))
         return names + (["trials"] if (self.path / "trials").is_dir() else [])
 
@@ -65,8 +70,7 @@ class Results:
         """The table ``name`` (``claims``, ``points``, ..., or ``trials``) as a pyarrow Table."""
         if not isinstance(name, str) or not name.isidentifier():
             raise ConfigError("table", f"must be a table name such as 'claims' (got {name!r})")
-        if not self.path.is_dir():  # not "no table": the directory itself is wrong
-            raise ConfigError("path", f"{self.path} is not a results directory")
+        self._check_dir()
         p = self.path / (name if name == "trials" else f"{name}.parquet")
         if not p.exists():
             raise ConfigError(

@@ -63,6 +63,8 @@ def test_a_chunk_added_by_hand_is_named_with_a_remedy_that_works(tmp_path, capsy
 def test_results_of_a_missing_directory_name_the_path(tmp_path):
     with pytest.raises(ConfigError, match=r"^path: .*nowhere is not a results directory"):
         sim.Results(tmp_path / "nowhere", "network").claims()
+    with pytest.raises(ConfigError, match=r"^path: .*nowhere is not a results directory"):
+        sim.Results(tmp_path / "nowhere", "network").names()  # was []
 
 
 def test_api_trials_picks_the_chunk_as_sim_run_trials_does(capsys):
