@@ -29,6 +29,7 @@ from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
 from sim.mc.outputs import damaged_chunks
+from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import read_provenance
 from sim.mc.sweep import read_sweep
 from sim.studies import load_study
@@ -55,8 +56,13 @@ class Results:
             )
         object.__setattr__(self, "path", Path(self.path))
 
+    def _check_dir(self) -> None:  # not "no table": the directory itself is wrong
+        if not self.path.is_dir():
+            raise ConfigError("path", f"{self.path} is not a results directory")
+
     def names(self) -> list[str]:
         """The tables of the run (``trials`` is the per-trial dataset, if any)."""
+        self._check_dir()
         names = sorted(p.stem for p in self.path.glob("*.parquet"))
         return names + (["trials"] if (self.path / "trials").is_dir() else [])
 
@@ -64,13 +70,14 @@ class Results:
         """The table ``name`` (``claims``, ``points``, ..., or ``trials``) as a pyarrow Table."""
         if not isinstance(name, str) or not name.isidentifier():
             raise ConfigError("table", f"must be a table name such as 'claims' (got {name!r})")
+        self._check_dir()
         p = self.path / (name if name == "trials" else f"{name}.parquet")
         if not p.exists():
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
             )
         if name == "trials" and (bad := damaged_chunks(self.path)):
-            raise ConfigError("table", f"trials: {bad}; run the study again")
+            raise ConfigError("table", f"trials: {bad}")
         if name != "trials" and not p.is_file():  # pyarrow reads a directory as a dataset
             raise ConfigError("table", f"{p} is not a file; run the study again")
         try:
@@ -202,6 +209,24 @@ def _plain(v: Any) -> Any:
     return v
 
 
+def _load_picking_chunk(study_file, vals: dict):
+    """``load_study``; ``trials`` without ``chunk`` picks the largest chunk giving at least
+    MIN_CHUNKS chunks, as ``sim run --trials`` does (same config, same results)."""
+    if "trials" not in vals or "chunk" in vals:
+        return load_study(study_file, values=vals)
+    try:
+        study, cfg = load_study(study_file, values=vals)
+    except ConfigError as e:
+        if e.key != "chunk":
+            raise
+        # the file's chunk is too large for the trials asked for
+        _, cfg = load_study(study_file, values={**vals, "chunk": 1})
+        return load_study(study_file, values={**vals, "chunk": max(1, cfg["trials"] // MIN_CHUNKS)})
+    if "chunk" in cfg and cfg["chunk"] > (chunk := max(1, cfg["trials"] // MIN_CHUNKS)):
+        study, cfg = load_study(study_file, values={**vals, "chunk": chunk})
+    return study, cfg
+
+
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
@@ -211,5 +236,5 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
         if not _key(k).strip(".").strip() or not k.isprintable():
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
     vals = {_key(k): _plain(v) for k, v in overrides.items()}
-    study, cfg = load_study(study_file, values=vals)
+    study, cfg = _load_picking_chunk(study_file, vals)
     return StudyHandle(Path(study_file), study, cfg, vals, read_sweep(study_file, study.schema))

@@ -199,7 +199,7 @@ class _Named:
         self.stream.flush()
 
 
-def _clashes(files: list[Path], run_args: list[str]) -> str | None:
+def _clashes(files: list[Path], run_args: list[str], results: str = "results") -> str | None:
     """Why these runs cannot share one batch: two of them would write one results directory
     (the same file twice, two files of one name), or a file's name is ``.toml`` or
     ``...toml`` (its results would be <results> itself or its parent)."""
@@ -212,7 +212,7 @@ def _clashes(files: list[Path], run_args: list[str]) -> str | None:
             return (
                 f"{f} is listed twice"
                 if same
-                else f"{seen[f.stem]} and {f} would both write results/{f.stem}"
+                else f"{seen[f.stem]} and {f} would both write {Path(results) / f.stem}"
             )
         seen[f.stem] = f
     return None
@@ -315,7 +315,7 @@ def _main(argv: list[str]) -> int:
     if bad:
         print(f"sim.batch: no study file {bad[0]}", file=sys.stderr)
         return 2
-    why = _clashes(files, run_args)
+    why = _clashes(files, run_args, args.results)
     if why:
         print(f"sim.batch: {why}", file=sys.stderr)
         return 2

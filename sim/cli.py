@@ -91,6 +91,9 @@ def _load(args):
     size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it."""
     overrides = list(args.set) + ([f"chunk={args.chunk}"] if args.chunk is not None else [])
     given = _keys_set(args.set)
+    for opt, key in (("--trials", "trials"), ("--seed", "seed"), ("--chunk", "chunk")):
+        if getattr(args, key) is not None and key in given:  # one would be dropped silently
+            raise ConfigError(opt, f"given twice, as {opt} and as --set {key}=: give one")
     trials_given = args.trials is not None or "trials" in given
     try:
         study, cfg = load_study(args.study, overrides, args.trials, args.seed)
@@ -243,7 +246,9 @@ def _bounds(f) -> str:
 
 
 def _check(args) -> int:
-    study, cfg = load_study(args.study, args.set)
+    # the config sim run would resolve: --set trials= without a chunk picks the chunk
+    args.trials = args.chunk = args.seed = None
+    study, cfg = _load(args)
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
     est = estimate(cfg, sweep)
@@ -371,6 +376,14 @@ def _main(argv: list[str]) -> int:
         if not name and not _cwd_exists():
             name = "the working directory (it was deleted)"
         print(f"sim: error: {_why(e)}: {name}".rstrip(": "), file=sys.stderr)
+        return 2
+    except UnicodeEncodeError as e:  # a text the terminal's encoding cannot show (ascii)
+        what = ascii(e.object[e.start : e.end]) if isinstance(e.object, str) else "a character"
+        print(
+            f"sim: error: the output (encoding {e.encoding}) cannot show {what}: "
+            "set PYTHONIOENCODING=utf-8",
+            file=sys.stderr,
+        )
         return 2
     except (ArithmeticError, ValueError, MemoryError, RecursionError) as e:  # e.g. a sweep
         # cell table; a file nested too deep to read (a run.json of 100,000 brackets)

@@ -226,11 +226,14 @@ def damaged_chunks(out: Path) -> str | None:
     )
     for f in sorted(set(want) | set(have)):
         if f not in have:
-            return f"{out / f} is missing"
+            return f"{out / f} is missing; run the study again"
         if f not in want:
-            return f"{out / f} is not one of the run's chunk files"
+            # no run removes a file it did not write: re-running would not help
+            return f"{out / f} is not one of the run's chunk files (added by hand?): move it away"
         if not (out / f).is_file() or (out / f).is_symlink() or _sha256(out / f) != want[f]:
-            return f"{out / f} is not the file the run wrote (its sha256 differs)"
+            return (
+                f"{out / f} is not the file the run wrote (its sha256 differs); run the study again"
+            )
     return None
 
 
@@ -259,13 +262,25 @@ def _foreign(out: Path) -> list[str]:
     return [f for f in _files(out) if f not in mine]
 
 
+def _clash(stage: Path, f: str) -> str | None:
+    """The part of the foreign file ``f`` (relative) that the new run's files in ``stage``
+    take: ``f`` itself, or a directory of its path that the run writes as a file (a user's
+    ``network.png/notes.txt``), else None."""
+    parts = Path(f).parts
+    for i in range(1, len(parts)):
+        q = stage.joinpath(*parts[:i])
+        if q.exists() and not q.is_dir():
+            return Path(*parts[:i]).as_posix()
+    return f if (stage / f).exists() else None
+
+
 def publish(stage: Path, out: Path) -> None:
     """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
     files in ``out`` that the suite did not write."""
     for tmp in stage.rglob("*.tmp"):
         tmp.unlink(missing_ok=True)
     keep = _foreign(out) if out.is_dir() else []
-    clash = [f for f in keep if (stage / f).exists()]
+    clash = [c for f in keep if (c := _clash(stage, f))]
     if clash:
         raise ConfigError(
             "--out",

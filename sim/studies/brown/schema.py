@@ -212,10 +212,11 @@ def check(cfg: dict) -> None:
         _, theta = setup(cfg)
         r = ml.ranges(pts[None], theta[None])
         if not np.all(np.isfinite(r)):  # the stations so far out that a range overflows
-            raise ConfigError(
-                "comparator.station_offset_mm",
-                f"{cfg['comparator.station_offset_mm']:g} mm puts the stations so far out "
-                "that the ranges overflow",
+            half, off = cfg["plate.format_mm"] / 2, cfg["comparator.station_offset_mm"]
+            raise ConfigError(  # the key of the larger part of the stations' distance
+                "plate.format_mm" if half >= off else "comparator.station_offset_mm",
+                f"stations {half + off:g} mm from the centre (half the {2 * half:g} mm format "
+                f"plus the {off:g} mm offset) are so far out that the ranges overflow",
             )
         reach = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
         if r.max() > reach or r.min() < 0:

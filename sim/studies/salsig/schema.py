@@ -77,7 +77,7 @@ SCHEMA = {
     ),
     "power.trials": count(1000, "trials per sweep cell", lo=2, hi=1_000_000),
     "zscale.s_mm_per_digit": positive(
-        12.5, "true z scale (paper's result 12.500)", unit="mm/digit", input=True
+        12.5, "true z scale (paper's result 12.500)", 1000.0, unit="mm/digit", input=True
     ),
     "zscale.points": count(9, "elevations read on the glass scale", lo=3, hi=100),
     "zscale.range_mm": real(
@@ -162,6 +162,13 @@ def check(cfg: dict) -> None:
             key,
             "differs from the z scale by more than a factor 2 (the digitiser model assumes "
             "nearly equal scales)",
+        )
+    for key in ("comparator.sx", "comparator.sy"):
+        require(  # 1e308 ran, overflowed the grid coordinates and recovered nonsense
+            0.5 < cfg[key] < 2.0,
+            key,
+            f"must lie between 0.5 and 2 (got {cfg[key]:g}): a scale between comparator and "
+            "grid lengths, near 1",
         )
     require(
         cfg["power.trials"] >= 2 and max(cfg["power.marks"]) ** 2 * cfg["power.trials"] <= 5e7,
