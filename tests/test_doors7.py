@@ -154,3 +154,16 @@ def test_a_user_directory_named_like_a_file_of_the_run_is_named(tmp_path, capsys
     assert err.startswith(f"sim: error: --out: {d / 'claims.parquet'} was not written by sim")
     assert "\n" not in err
     assert (d / "claims.parquet" / "notes.txt").read_text() == "mine"
+
+
+def test_a_block_too_large_to_build_is_refused_before_it_is_built(capsys):
+    """(lead, after the sixth sweep) 50 x 200 models: the block's visibility table asked for
+    12 GB in `sim check` (a kill by the system without a memory limit); now one line naming
+    the key, for the block and for the trade-off's blocks."""
+    f = str(ROOT / "studies" / "agnard_block.toml")
+    block = ["block.strips=50", "block.models=200"]
+    trade = ["tradeoff.block_strips=[50,1,1,1,1,1]", "tradeoff.block_models=[200,1,1,1,1,1]"]
+    for key, sets in (("block.models", block), ("tradeoff.block_models", trade)):
+        assert main(["check", f, *(a for s in sets for a in ("--set", s))]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"{key}: a block of 50 x 200 = 10000 models" in err[0], err

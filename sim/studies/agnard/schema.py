@@ -196,6 +196,19 @@ def check(cfg: dict) -> None:
         )
     if cfg["block.strips"] * cfg["block.models"] < 2:
         raise ConfigError("block.models", "a block needs at least two models")
+    # the block's visibility table (points x models) grows with the square of the models
+    for key, strips, models in [
+        ("block.models", [cfg["block.strips"]], [cfg["block.models"]]),
+        ("tradeoff.block_models", cfg["tradeoff.block_strips"], cfg["tradeoff.block_models"]),
+    ]:
+        for s_, m_ in zip(strips, models):
+            if s_ * m_ > MAX_MODELS:
+                raise ConfigError(
+                    key,
+                    f"a block of {s_} x {m_} = {s_ * m_} models is more than the simulated block "
+                    f"builds ({MAX_MODELS}: its table of which point each model sees grows with "
+                    "the square of the models)",
+                )
     # memory of the largest adjustment: trials x observation pairs x 7 x 7 doubles per chunk
     try:
         block = block_of(cfg)
@@ -222,6 +235,11 @@ def check(cfg: dict) -> None:
             f"{cfg['chunk'] * pairs * 49 * 8 / 1e9:.1f} GB for its normal "
             "equations; lower chunk",
         )
+
+
+#: the most models (strips x models per strip) of a simulated block: 1000 models see about
+#: 8,000 points, a visibility table of 128 MB (10,000 models asked for 12 GB in `sim check`)
+MAX_MODELS = 1000
 
 
 def block_of(
