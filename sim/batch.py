@@ -40,10 +40,10 @@ single_threaded_blas()  # before NumPy loads (the study modules import it)
 
 from sim.cli import __doc__ as cli_doc  # noqa: E402
 from sim.cli import check_run_args  # noqa: E402
-from sim.cli_args import name_problem  # noqa: E402
 from sim.cli_args import parser as run_parser  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
+from sim.mc.outputs import name_problem  # noqa: E402
 from sim.studies import load_study  # noqa: E402
 
 __all__ = ["SLOW_FIRST", "order", "run_all", "main"]

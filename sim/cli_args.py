@@ -4,28 +4,12 @@ and its options, with one-line errors (exit 2 through :func:`sim.cli.main`)."""
 from __future__ import annotations
 
 import argparse
-import unicodedata
 from importlib import metadata
 
 from sim.mc.config import ConfigError
 from sim.mc.runner import MIN_CHUNKS
 
-__all__ = ["parser", "name_problem"]
-
-
-def name_problem(text: str) -> str | None:
-    """Why a path given on the command line cannot name a file of the suite, in a few words
-    (None: it can): empty or blank, a control character or a line break, or bytes that are
-    not UTF-8 text (a Latin-1 name, or any non-ASCII name in a C locale without UTF-8 mode,
-    which Python keeps as surrogate escapes; the suite writes every path it records as UTF-8,
-    so such a run would fail at its end)."""
-    if not text.strip():
-        return "is empty"
-    if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text):
-        return "contains a control character or a line break"
-    if any(unicodedata.category(c) == "Cs" for c in text):
-        return "contains bytes that are not UTF-8 text (a non-UTF-8 name or locale)"
-    return None
+__all__ = ["parser"]
 
 
 class _Parser(argparse.ArgumentParser):

@@ -7,9 +7,9 @@ import os
 import signal
 import sys
 import tempfile
-import unicodedata
 from pathlib import Path
 
+from sim.mc.outputs import name_problem
 from sim.report.verify.rerun import verify, write_record
 from sim.report.verify.rules import Comparison, VerifyError
 
@@ -66,21 +66,9 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _name_problem(text: str) -> str | None:
-    """Why a path cannot name a directory of the suite (as sim.cli_args.name_problem, which
-    this layer cannot import)."""
-    if not text.strip():
-        return "is empty"
-    if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text):
-        return "contains a control character or a line break"
-    if any(unicodedata.category(c) == "Cs" for c in text):
-        return "contains bytes that are not UTF-8 text (a non-UTF-8 name or locale)"
-    return None
-
-
 def _check_args(a) -> None:
     for name, v in (("--results", a.results), ("--scratch", a.scratch)):
-        why = None if v is None else _name_problem(v)
+        why = None if v is None else name_problem(v)
         if why:
             raise VerifyError(f"{name}: {why} (got {v!r})")
     top = max(4 * (os.cpu_count() or 1), 8)  # the bound of sim run --workers
