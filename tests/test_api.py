@@ -19,7 +19,7 @@ def test_readme_worked_example(tmp_path):
     st = sim.load(STUDY, trials=200, chunk=10, **{"errors.settings": 3})  # dotted keys
     st = st.replace(comparator__beta_mm=0.5)  # keyword form: __ stands for the dot
     print(st.estimate().describe())  # trials, adjustments, unknowns, memory
-    res = st.run(out=tmp_path / "t1", workers=2)  # or executor="dask"; out=None: a temp dir
+    res = st.run(out=tmp_path / "t1", workers=2, figures=False)  # out=None: a temp dir
     claims = res.claims()  # pyarrow.Table
     print(claims.select(["claim", "value", "ci_low", "ci_high", "holds"]).to_pylist()[:2])
     points = res.table("points")  # any table by name; "trials" per trial
@@ -39,6 +39,7 @@ def test_readme_worked_example(tmp_path):
                 "--out",
                 str(tmp_path / "cli"),
                 "--quiet",
+                "--no-figures",  # tables compared; figures are test_figures.py's
                 "--trials",
                 "200",
                 "--set",

@@ -7,7 +7,9 @@ written to the file their first comment names, then its ``sh`` lines run in orde
 ``python`` blocks run as scripts (but a block whose first line is ``# excerpt ...``, a part of
 a module shown to be read). ``sim ...`` runs as ``python -m sim ...`` does, through
 :func:`sim.cli.main` in the test's process; ``sim run`` gets its study's tiny configuration
-(``tests/data/tiny/``) in place of ``--trials``, and every ``/tmp/...`` path becomes a path in the scratch directory. ``make TARGET`` lines are
+(``tests/data/tiny/``) in place of ``--trials`` and runs with ``--no-figures`` (each study's
+figures are drawn and layout-checked by its shared tiny run), and every ``/tmp/...`` path
+becomes a path in the scratch directory; a Python block's temporary directories go there too. ``make TARGET`` lines are
 checked to name a real target of the Makefile, not run. ``python -m MODULE ...`` of another
 module is checked with ``--help``. Anything else is reported as unchecked (a warning).
 
@@ -91,7 +93,10 @@ class Page:
                 out.append(a)
             if self.reuse(out):
                 return None
-            args = out + tiny_overrides(study_of(study_file))
+            # the figures of every study are drawn and layout-checked by its shared tiny
+            # run (tiny_run in conftest.py); a page's own run is checked for its tables
+            extra = [] if "--no-figures" in out else ["--no-figures"]
+            args = out + extra + tiny_overrides(study_of(study_file))
         return [sys.executable, "-m", "sim", *args]
 
     def reuse(self, args: list[str]) -> bool:
@@ -134,8 +139,11 @@ class Page:
         (self.work / "tmp").mkdir(exist_ok=True)
         if cmd[1:3] == ["-m", "sim"]:  # in this process: a second start of Python saves nothing
             return self.run_sim(cmd[3:], what)
+        # TMPDIR: a run of the Python API without ``out`` writes to a temporary directory of
+        # its own, which it leaves for the user to read; here it is the test's scratch
+        env = dict(os.environ, TMPDIR=str(self.work / "tmp"))
         r = subprocess.run(
-            cmd, cwd=self.work, capture_output=True, text=True, timeout=TIMEOUT, env=os.environ
+            cmd, cwd=self.work, capture_output=True, text=True, timeout=TIMEOUT, env=env
         )
         assert r.returncode == 0, f"{what}: exit {r.returncode}\n{r.stderr[-2000:]}"
         assert "Traceback" not in r.stderr, f"{what}:\n{r.stderr[-2000:]}"

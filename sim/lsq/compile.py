@@ -18,6 +18,12 @@ with :data:`sim.lsq.normals.RCOND`; a kernel proves regularity with
 :func:`sim.lsq.normals.block2_rcond` (2 x 2 blocks, exact) or leaves a trial undecided and
 its caller applies the NumPy rule. numba is a heavy optional dependency: it is imported on
 the first compile, not when the suite is imported.
+
+Compile time counts too (every process on a cold cache: a fresh clone's tests, a user's first
+run): kernels copy arrays element by element and sort slices in place, since numba compiles
+an array-to-array slice assignment with its broadcasting checks and their messages (about 4 s
+per process; ``tests/test_kernel_source.py``), and a lane width is an argument, not a
+constant (one compile for every width).
 """
 
 from __future__ import annotations

@@ -183,7 +183,9 @@ def _points_step(Npg, Ninv, up, dg, og, op, out):  # pragma: no cover - compiled
     P = up.shape[1]
     u = np.empty((P, d))
     for t in range(T):
-        u[:, :] = up[t]
+        for j in range(P):  # element by element: an array copy would compile numba's
+            for a in range(d):  # broadcasting checks and their messages (seconds per process)
+                u[j, a] = up[t, j, a]
         for k in range(K):
             j, g = op[k], og[k]
             for a in range(d):

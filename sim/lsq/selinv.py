@@ -51,7 +51,8 @@ def _symbolic(n, Ap, Ai, cap):  # pragma: no cover - compiled
                 mark[i] = j
                 if nz == Li.shape[0]:
                     grown = np.empty(2 * Li.shape[0], np.int64)
-                    grown[:nz] = Li[:nz]
+                    for q in range(nz):  # element by element: see compile.py on array copies
+                        grown[q] = Li[q]
                     Li = grown
                 Li[nz] = i
                 nz += 1
@@ -63,12 +64,13 @@ def _symbolic(n, Ap, Ai, cap):  # pragma: no cover - compiled
                     mark[i] = j
                     if nz == Li.shape[0]:
                         grown = np.empty(2 * Li.shape[0], np.int64)
-                        grown[:nz] = Li[:nz]
+                        for q in range(nz):  # element by element: see compile.py on array copies
+                            grown[q] = Li[q]
                         Li = grown
                     Li[nz] = i
                     nz += 1
             c = nxt[c]
-        Li[start:nz] = np.sort(Li[start:nz])
+        Li[start:nz].sort()  # in place (an array copy compiles slowly: see compile.py)
         Lp[j + 1] = nz
         if nz > start:
             par = Li[start]

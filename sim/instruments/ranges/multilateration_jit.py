@@ -66,10 +66,10 @@ def gauss_newton(
     ssq = np.empty(T)
     idx, cnt = _sparsity(p)
     width = LANES if use_lanes(T, n) else 1
-    kernel = compile.compiled(_kernel, W=width, helpers=(_lane_stations, block2_rcond))
+    kernel = compile.compiled(_kernel, helpers=(_lane_stations, block2_rcond))
     kernel(
         r_obs, theta, pts, int(p), float(tol), int(max_iter), float(rcond),
-        status, iters, idx, cnt, res, ssq,
+        status, iters, idx, cnt, res, ssq, width,
     )  # fmt: skip
     return pts, status, iters, res, ssq
 

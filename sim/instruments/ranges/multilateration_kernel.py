@@ -13,9 +13,11 @@ not above ``rcond`` (exact); the reduced normals are regular where the lower bou
 ``1 / (||C||_F ||L^-1||_F^2)`` of the scaled matrix's eigenvalue ratio is above ``4 rcond``,
 else the trial is left *undecided* (status :data:`UNDECIDED`) and the caller runs it on the
 NumPy engine, whose exact rule decides. The functions are plain loops over scalars, written
-for the compiler: every lane array keeps the trial axis last, and ``W`` (the lane width) is a
-module global frozen to a compile-time constant per variant. Not meant to be called
-uncompiled except in a debugger (it is correct, but slow).
+for the compiler: every lane array keeps the trial axis last, and ``W`` (the lane width) is an
+argument, so one compiled kernel serves every width (a width frozen as a compile-time
+constant ran no faster and cost a second compile of about 8 s per process on a cold cache:
+measured 2026-11-27, 4,000 trials of 25 points). Not meant to be called uncompiled except in
+a debugger (it is correct, but slow).
 """
 
 from __future__ import annotations
@@ -26,7 +28,6 @@ from sim.lsq.normals import block2_rcond  # compiled with the kernel (its helper
 
 __all__ = ["UNDECIDED"]  # the kernels are compiled and run by multilateration_jit
 
-W = 1  # the lane width the kernel is compiled with; bound per variant by the compiler
 #: status of a trial whose reduced normals the kernel's bound could not prove regular
 UNDECIDED = 4
 
@@ -46,10 +47,10 @@ def _lane_stations(TH, Sx, Sy):  # pragma: no cover
 
 
 def _kernel(
-    r_obs, theta, pts, p, tol, max_iter, rcond, status, iters, idx, cnt, res, ssq
+    r_obs, theta, pts, p, tol, max_iter, rcond, status, iters, idx, cnt, res, ssq, W
 ):  # pragma: no cover
-    """:func:`sim.lsq.gauss_newton` of Brown's range model on blocks of ``W`` trials (``W`` a
-    compile-time constant, :func:`sim.lsq.compile.compiled`). Every array below keeps the lane (trial) axis last, so each
+    """:func:`sim.lsq.gauss_newton` of Brown's range model on blocks of ``W`` trials (the lane
+    width, an argument). Every array below keeps the lane (trial) axis last, so each
     ``for w in range(W)`` loop is one SIMD-vectorisable sweep over the block's trials; the
     arithmetic of each lane is exactly the scalar algorithm's (no reassociation, no FMA
     contraction), so the result does not depend on ``W`` or on a trial's position. A block
