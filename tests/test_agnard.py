@@ -491,6 +491,27 @@ def test_joint_xy_rows_and_xy_paper_checks(tiny_run):
     assert "check X and Y as one Holm test" in text
 
 
+def test_digital_rejections_decided_over_the_scanner(tiny_run):
+    """'Not a single pass point had to be removed' is decided over the scanner's vectors by
+    the count's own estimator (not the log shift): one row per vector in
+    scanner_rejections.parquet, its outcome column the row's per-vector outcomes, the
+    share of blocks losing none a probability inside its interval, and the note says how."""
+    from sim.mc.storage import read_table
+
+    study, cfg, out = tiny_run
+    rows = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
+    r = rows[REJECTED]
+    assert r["interval"] == "region" and r["verdict"] in REGION_VERDICTS
+    assert "control variate" in r["note"] and "share of blocks that lose none" in r["note"]
+    t = read_table(out / "scanner_rejections.parquet").to_pydict()
+    assert len(t["share_zero"]) == cfg["table1.points"]
+    assert t["outcome"] == read_table(out / "scanner_region.parquet").to_pydict()[REJECTED]
+    for lo, z, hi in zip(t["share_zero_low"], t["share_zero"], t["share_zero_high"]):
+        assert 0.0 <= lo <= z <= hi <= 1.0
+    assert REJECTED not in read_table(out / "scanner_shift.parquet").to_pydict()["claim"]
+    assert "pass points per block over the scanner's" in study.report(out)
+
+
 def test_table1_rows_are_not_comparable_because_the_scanner_region_is_empty(tiny_run):
     """The scanner's unprinted inputs (scanner.toml) explored under Table 1: no vector
     reproduces its 'without' rms (the printed +-40 um peak is 0.25 m on the ground), so the

@@ -26,6 +26,7 @@ from sim.report.region import fig_region
 from sim.studies.agnard.claims import JOINT, MEMBERS
 from sim.studies.agnard.joint import joint_region, layout_points, pairs_of
 from sim.studies.agnard.leads import HOW
+from sim.studies.agnard.paired import z_box
 from sim.studies.agnard.paired_count import cdf_shift, mean_shift
 from sim.studies.agnard.region import (
     CENTRES,
@@ -182,14 +183,16 @@ def over_scanner(book, scanner, preds, rows, k: int, n: int) -> list[dict]:
         "Agresti-Min smoothed standard error, over its 97.5 % interval "
         "(sim.studies.agnard.paired_count; scanner_rejections.parquet)"
     )
+    counts = [c for c in preds if c in COUNTS]
     rows = over_region(
         book,
         region,
-        [c for c in preds if c in COUNTS],
+        counts,
         rows,
         lambda r: (
-            f"{counted}; at the configured scanner (an example): median {r['value']:.3g}, 95 % "
-            f"of blocks {r['ci_low']:.3g}-{r['ci_high']:.3g}, outcome {r['outcome']}"
+            f"{counted}; {_zeros(region, r['claim'], k)}; at the configured scanner (an "
+            f"example): median {r['value']:.3g}, 95 % of blocks {r['ci_low']:.3g}-"
+            f"{r['ci_high']:.3g}, outcome {r['outcome']}"
         ),
     )
     j21 = JOINT["control_21"]
@@ -200,6 +203,23 @@ def over_scanner(book, scanner, preds, rows, k: int, n: int) -> list[dict]:
     )
     joint = family_over(_fresh(book), region, j21, MEMBERS[j21], f"{how}; {ex}", n=n)
     return [joint if r["claim"] == j21 else r for r in rows]
+
+
+def _zeros(region, cid: str, k: int) -> str:
+    """What decides a count printed as none over the vectors: the share of blocks that lose
+    none, its range and the lowest upper end of its interval (the fail needs it < 2.5 %)."""
+    ev = region.outputs[cid]
+    z, hi = np.asarray(ev["share_zero"]), np.asarray(ev["share_zero_high"])
+    low = z < 0.1
+    f0 = 1 / (k + 2)  # the smoothed share of a table with no zero (paired_count)
+    return (
+        f"the share of blocks that lose none is {100 * z.min():.2g}-{100 * z.max():.2g} % "
+        f"over the vectors (under 10 % at {int(low.sum())} of {z.size}), the upper end of "
+        f"its interval at least {100 * hi.min():.2g} %: the row fails at a vector only where "
+        f"that end is under 2.5 % (a block losing none rarer than one in forty), which "
+        f"{k} pairs cannot show: with none of them losing none it still reaches about "
+        f"{100 * z_box(k) * np.sqrt(f0 * (1 - f0) / k):.2g} %"
+    )
 
 
 def _fresh(book) -> ClaimBook:

@@ -41,8 +41,10 @@ the blocks show, ``F = 1`` without error. Its interval is ``+- z`` standard erro
 :func:`.paired.z_box` (Student, 97.5 % two-sided at ``k - 1`` degrees of freedom, as the log
 shift: the decision reads ``F`` at two counts, the printed one and the 97.5 % point, so both
 at once cover at least 95 %). What 48 pairs cannot do: show ``P(X = 0) < 0.025`` (the fail),
-which needs a vector's blocks to lose none in fewer than one in forty; with the floor above
-its interval reaches ``2.31 / 50``, so the row can fail at a vector only with more blocks.
+which needs a vector's blocks to lose none in fewer than one in forty; with the floor above,
+a vector none of whose 48 blocks loses none still has an interval reaching about
+``2.31 sqrt(f (1 - f) / 48)`` with ``f = 1 / 50``, 4.7 %, so the row can fail at a vector
+only with more blocks (several hundred where a block loses none in one of fifty).
 
 The evidence at a vector (:func:`count_evidence`, for :func:`sim.claims.inference.status`):
 ``p`` from the book's one-plate rule on the distribution function (edges counted half, as
