@@ -1,5 +1,5 @@
 """The consistent regions of ``agnard_block``'s unprinted inputs (seed 003): the lost
-five-point layout, with the verdicts of the 5-control predictions over it, and the scanner,
+five-point layout, over which (with the scanner) the 5-control predictions are decided, and the scanner,
 constrained by Table 1 (issue 21, :mod:`sim.claims.inference`).
 
 Figure 5, the layout of the five control points of the third pass, is lost. ``region.toml``
@@ -9,8 +9,9 @@ projection centres as model points (SPACE-M does; the paper does not say whether
 did: ``centres_1``, explored at 0 and 1, :mod:`sim.instruments.block.centres`); nothing the
 paper prints constrains them (its Table's numbers are the predictions), so the region is the
 whole range and each 5-control row is decided over it: holds / fails everywhere, depends
-(with the insets and option where it holds), or undecidable. The model adjusts the same ``region.trials`` simulated blocks once per
-layout (:func:`sim.studies.agnard.chunks.sweep_chunk`, on the runner's workers); each
+(with the insets and option where it holds), or undecidable, over joint points of this
+region and the scanner's (:mod:`sim.studies.agnard.joint`). The model adjusts the same
+``region.trials`` simulated blocks once per layout (:func:`sim.studies.agnard.chunks.sweep_chunk`, on the runner's workers); each
 statistic is evidence with the claim book's rules
 (:func:`sim.claims.book_region.sample_evidence`).
 
@@ -28,7 +29,10 @@ Set aside, Table 1 leaves every explored vector, and the 21-control predictions 
 and the acceptance limits) are decided over them all: each vector's blocks are paired with
 the configured scanner's on the same seeds, and a row's evidence at the vector is the
 configured scanner's main blocks moved by the paired shift (:mod:`sim.studies.agnard.paired`,
-:func:`shift_table`).
+:func:`shift_table`); the pass points digital pugging's data snooping removes, a count with
+many zeros, by its distribution function with the configured scanner's as a control variate
+(:mod:`sim.studies.agnard.paired_count`). The same paired blocks also run the 5-control pass
+at the joint design's layout points (:mod:`sim.studies.agnard.joint`).
 """
 
 from __future__ import annotations
