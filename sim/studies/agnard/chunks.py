@@ -10,6 +10,7 @@ sums or examples (leading axis 1, keys ``chunk.*``). Lengths in metres.
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
@@ -260,23 +261,11 @@ def table1_chunk(
         for ax in ("xy", "z"):
             out[f"{tag}.first.pass_{ax}_m"] = acc[f"first.pass_{ax}_m"]
 
-    def more(tag: str, sim: Simulated, res21, which) -> None:  # snooping, the 5-control pass
-        if rejections:
-            ctrl, st = adj.structure(cfg["control.many"])
-            rej = _snoop(cfg, block, st, ctrl, sim, ("digital", "corrected"), res21)[0]
-            out[f"{tag}.snoop.rejected"] = rej[:, block.is_pass].sum(1)
-        for j in which:
-            b, ctrl, r = cen.adjust(adj, sim, res21, j)
-            acc: dict[str, np.ndarray] = {}
-            accuracy(b, ctrl, r, acc, "a")
-            for w in ("ctrl", "check"):
-                for ax in ("x", "y", "xy", "z"):
-                    out[f"{tag}.five{j}.{w}_{ax}_m"] = acc[f"a.{w}_{ax}_m"]
-
     base = blocks({})
     ctrl, _, res = adj.adjust(base, ("digital", "corrected"), cfg["control.many"], wo, wc)
     keep("cfg.many", ctrl, res)
     first("cfg", base, res)
+    more = partial(_more, cfg, block, adj, cen, rejections, out)
     more("cfg", base, res, range(len(five)))
     for i, over in enumerate(scanners):
         sim = blocks(over)
@@ -293,6 +282,23 @@ def table1_chunk(
         first(f"s{i}", sim, res)  # res: the control.many pass
         more(f"s{i}", sim, res, pairs[i] if pairs else ())
     return out
+
+
+def _more(cfg, block, adj, cen, rejections: bool, out: dict, tag: str, sim, res21, which):
+    """On the blocks ``sim`` of one scanner of :func:`table1_chunk`, started from its
+    21-control solution ``res21``: the digital snooping's rejected pass points (with
+    ``rejections``) and the 5-control pass at the layout points ``which`` (``cen``)."""
+    if rejections:
+        ctrl, st = adj.structure(cfg["control.many"])
+        rej = _snoop(cfg, block, st, ctrl, sim, ("digital", "corrected"), res21)[0]
+        out[f"{tag}.snoop.rejected"] = rej[:, block.is_pass].sum(1)
+    for j in which:
+        b, ctrl, r = cen.adjust(adj, sim, res21, j)
+        acc: dict[str, np.ndarray] = {}
+        accuracy(b, ctrl, r, acc, "a")
+        for w in ("ctrl", "check"):
+            for ax in ("x", "y", "xy", "z"):
+                out[f"{tag}.five{j}.{w}_{ax}_m"] = acc[f"a.{w}_{ax}_m"]
 
 
 class _CentredPasses:

@@ -240,17 +240,7 @@ def explore_scanner(
             SCANNER_PART + len(stats),
             "scanner vectors (Table 1), each paired with the configured scanner",
         )
-        c = {**many_samples(sw, "cfg.many"), **first_samples(sw, "cfg")}
-        c[REJECTED] = np.asarray(sw["cfg.snoop.rejected"])
-        for lay in range(len(five)):
-            c.update({f"five{lay}:{k}": v for k, v in five_of(sw, f"cfg.five{lay}").items()})
-        per = []
-        for j in range(n):
-            p = {**table1_samples(sw, j), **{CONFIGURED + k: v for k, v in c.items()}}
-            p[REJECTED] = np.asarray(sw[f"s{j}.snoop.rejected"])
-            for lay in pj[j]:
-                p.update({f"five{lay}:{k}": v for k, v in five_of(sw, f"s{j}.five{lay}").items()})
-            per.append(p)
+        c, per = _vector_stats(sw, len(five), pj)
         stats.extend(per)
         ev = {
             s.id: sample_evidence(np.stack([p[s.id] for p in per]), s.ref[0])
@@ -271,6 +261,25 @@ def explore_scanner(
         rounds=cfg["table1.rounds"],
     )
     return region, dec.predictions, stats
+
+
+def _vector_stats(sw: dict, n_five: int, pj: tuple) -> tuple[dict, list[dict]]:
+    """The configured scanner's per-block statistics on one call's paired blocks (claim id;
+    ``five<l>:`` + claim id at the ``n_five`` layout points) and each vector's, with the
+    configured ones beside them (``CONFIGURED +`` key; vector ``j`` at layout points
+    ``pj[j]``)."""
+    c = {**many_samples(sw, "cfg.many"), **first_samples(sw, "cfg")}
+    c[REJECTED] = np.asarray(sw["cfg.snoop.rejected"])
+    for lay in range(n_five):
+        c.update({f"five{lay}:{k}": v for k, v in five_of(sw, f"cfg.five{lay}").items()})
+    per = []
+    for j, lays in enumerate(pj):
+        p = {**table1_samples(sw, j), **{CONFIGURED + k: v for k, v in c.items()}}
+        p[REJECTED] = np.asarray(sw[f"s{j}.snoop.rejected"])
+        for lay in lays:
+            p.update({f"five{lay}:{k}": v for k, v in five_of(sw, f"s{j}.five{lay}").items()})
+        per.append(p)
+    return c, per
 
 
 def shift_table(region: Region, preds: list[str], stats: list[dict]) -> dict[str, list]:
