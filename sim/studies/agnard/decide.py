@@ -44,6 +44,9 @@ from sim.studies.run_steps import over_region
 
 __all__ = ["five_region", "scanner_region", "over_scanner", "over_joint"]
 
+#: how a region row undecided everywhere begins (sim.claims.region.region_row)
+UNDECIDABLE = "undecidable: no input of the region decides it"
+
 
 def five_region(cfg, block, book, runner, part, prov, out):
     """Explore the five-point layout (``region.toml``) at the configured scanner and write
@@ -195,6 +198,13 @@ def over_scanner(book, scanner, preds, rows, k: int, n: int) -> list[dict]:
             f"{r['ci_high']:.3g}, outcome {r['outcome']}"
         ),
     )
+    why = f"no vector decides it with {k} pairs (the share of blocks that lose none, below)"
+    rows = [
+        {**r, "note": r["note"].replace(UNDECIDABLE, f"undecidable: {why}", 1)}
+        if r["claim"] in counts
+        else r
+        for r in rows
+    ]
     j21 = JOINT["control_21"]
     by = {r["claim"]: r for r in rows}
     ex = (
