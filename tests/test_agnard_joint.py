@@ -167,3 +167,22 @@ def test_a_joint_point_is_decided_by_its_vectors_shift_at_its_layout():
     assert at[(0, 0)] == FAILS and at[(1, 0)] == UNDECIDED
     assert at[(0, 1)] == FAILS and at[(1, 1)] == FAILS
     assert set(np.asarray(joint.x["five_inset_1"])) == {0.2}
+
+
+def test_the_joint_points_map_is_always_stretched_so_never_narrower():
+    """At a joint point the spread's scale ranges over its interval even where the pairs do
+    not show it changed: the evidence is never narrower (lower low, higher high, larger p)
+    than the shift-only map's, and strictly wider where the shift-only map applies (pairs
+    consistent with an unchanged spread)."""
+    from sim.studies.agnard.paired import paired_evidence, paired_shift
+
+    rng = np.random.default_rng(9)
+    base = 27.0 * np.exp(0.2 * rng.standard_normal(150))
+    c = 27.0 * np.exp(0.2 * rng.standard_normal(48))
+    v = c[None] * np.exp(0.3 + 0.02 * rng.standard_normal((1, 48)))  # spread unchanged
+    assert not paired_shift(c, v).stretched[0]
+    plain = paired_evidence(base, c, v, 29.0, 0.5)
+    wide = paired_evidence(base, c, v, 29.0, 0.5, stretch=True)
+    assert wide["low"][0] < plain["low"][0] and wide["high"][0] > plain["high"][0]
+    assert wide["p"][0] >= plain["p"][0]
+    assert wide["value"][0] == pytest.approx(plain["value"][0], rel=0.01)  # beta near 1
