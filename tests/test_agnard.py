@@ -17,7 +17,7 @@ from sim.instruments.block.layout import CONTROL_PATTERNS, make_block, select_co
 from sim.instruments.geometry import similarity_fit
 from sim.mc.config import ConfigError
 from sim.studies import load_study
-from sim.studies.agnard.region import SCANNER_KEYS
+from sim.studies.agnard.region import REJECTED, SCANNER_KEYS
 
 STUDY = "studies/agnard_block.toml"
 
@@ -422,24 +422,33 @@ def test_five_control_rows_decided_over_the_region(tiny_run):
         assert r["interval"] == "region"
         assert r["verdict"] in REGION_VERDICTS
         assert r["value"] <= r["value_high"]
-    # 8 rows of region.toml and the joint X, Y row, each with its per-point column; of
-    # scanner.toml over the scanner's vectors the same 9 and the first pass's two
-    assert _check_region_rows(out) == (9, 11)
+    # 8 rows of region.toml and the joint X, Y row, each with its per-point column, over the
+    # joint (layout, scanner) points; of scanner.toml over the scanner's vectors the same 9,
+    # the first pass's two and the digital rejections
+    assert _check_region_rows(out) == (9, 12)
+    joint = read_table(out / "joint_region.parquet").to_pydict()
+    assert len(joint["five_inset_1"]) == 2 * cfg["table1.points"]  # each vector at 2 layouts
+    assert set(joint["centres_1"]) == {0.0, 1.0} and set(SCANNER_KEYS) <= set(joint)
+    assert (
+        "joint points of the lost layout and the scanner"
+        in rows["agnard.control_5.check_z_cm"]["note"]
+    )
 
 
 def _check_region_rows(out) -> tuple[int, int]:
     """Every row decided over a region has the verdict its per-point outcomes give: the
-    layout region's in consistent_region.parquet, the scanner's in scanner_region.parquet
-    (every explored vector: Table 1, which empties it, is set aside); the two counts."""
+    5-control rows' in joint_region.parquet (the layout and the scanner together), the
+    others' in scanner_region.parquet (every explored vector: Table 1, which empties it, is
+    set aside); the two counts."""
     from sim.mc.storage import read_table
 
-    five = read_table(out / "consistent_region.parquet").to_pydict()
+    joint = read_table(out / "joint_region.parquet").to_pydict()
     scan = read_table(out / "scanner_region.parquet").to_pydict()
     claims = read_table(out / "claims.parquet").to_pylist()
     n = [0, 0]
     for c in (c for c in claims if c["interval"] == "region"):
-        in_scan = c["claim"] not in five
-        table = scan if in_scan else five
+        in_scan = c["claim"] not in joint
+        table = scan if in_scan else joint
         assert c["claim"] in table, c["claim"]
         assert c["outcome"] == region_verdict(table[c["claim"]]), c["claim"]
         n[in_scan] += 1
@@ -480,6 +489,27 @@ def test_joint_xy_rows_and_xy_paper_checks(tiny_run):
     assert "`agnard.control_21.check_z_cm`" in scanner and "common random numbers" in scanner
     assert f"`{JOINT['control_5']}` (headline)" in text
     assert "check X and Y as one Holm test" in text
+
+
+def test_digital_rejections_decided_over_the_scanner(tiny_run):
+    """'Not a single pass point had to be removed' is decided over the scanner's vectors by
+    the count's own estimator (not the log shift): one row per vector in
+    scanner_rejections.parquet, its outcome column the row's per-vector outcomes, the
+    share of blocks losing none a probability inside its interval, and the note says how."""
+    from sim.mc.storage import read_table
+
+    study, cfg, out = tiny_run
+    rows = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
+    r = rows[REJECTED]
+    assert r["interval"] == "region" and r["verdict"] in REGION_VERDICTS
+    assert "control variate" in r["note"] and "share of blocks that lose none" in r["note"]
+    t = read_table(out / "scanner_rejections.parquet").to_pydict()
+    assert len(t["share_zero"]) == cfg["table1.points"]
+    assert t["outcome"] == read_table(out / "scanner_region.parquet").to_pydict()[REJECTED]
+    for lo, z, hi in zip(t["share_zero_low"], t["share_zero"], t["share_zero_high"]):
+        assert 0.0 <= lo <= z <= hi <= 1.0
+    assert REJECTED not in read_table(out / "scanner_shift.parquet").to_pydict()["claim"]
+    assert "pass points per block over the scanner's" in study.report(out)
 
 
 def test_table1_rows_are_not_comparable_because_the_scanner_region_is_empty(tiny_run):
@@ -531,15 +561,15 @@ def test_scanner_inputs_set_the_config_keys_they_name():
     assert all(i.why for i in dec.inputs)
     # every simulated 21-control prediction (not the XY paper-checks, not the Holm row, which
     # is decided from its members): Tables 2-3's and the acceptance limits'; and the first
-    # pass's two rows (the same blocks with weak control)
+    # pass's two rows (the same blocks with weak control); and the digital rejections (a count)
     assert set(dec.predictions) == {
         c
         for c, spec in book.specs.items()
         if c.startswith(("agnard.control_21.", "agnard.max_residual.control_21_"))
         and spec["kind"] == "prediction"
         and spec["form"] in ("one-plate", "upper")
-    } | {"agnard.first_pass.pass_xy_cm", "agnard.first_pass.pass_z_cm"}
-    assert len(dec.predictions) == 10
+    } | {"agnard.first_pass.pass_xy_cm", "agnard.first_pass.pass_z_cm", REJECTED}
+    assert len(dec.predictions) == 11
 
 
 def test_budget_recomputation_and_pointing_model():

@@ -10,6 +10,7 @@ sums or examples (leading axis 1, keys ``chunk.*``). Lengths in metres.
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
@@ -202,7 +203,16 @@ def sweep_chunk(
     return out
 
 
-def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n: int) -> dict:
+def table1_chunk(
+    cfg: dict,
+    block: Block,
+    scanners,
+    rng: np.random.Generator,
+    n: int,
+    five=(),
+    pairs=(),
+    rejections: bool = False,
+) -> dict:
     """Table 1 and Tables 2-3's 21-control pass at each of ``scanners`` (the scanner region's
     input vectors: dicts of ``scan.*`` overrides): ``n`` blocks adjusted with the
     ``control.table1`` layout without and with the grid correction, and (corrected) with the
@@ -214,11 +224,19 @@ def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n:
     (common random numbers, the grid's node noise on a stream of its own:
     :class:`~sim.studies.agnard.simulate.Simulated`), so the vectors differ by their inputs,
     not by their luck, and each is paired block by block with the configured scanner
-    (:mod:`sim.studies.agnard.paired`)."""
+    (:mod:`sim.studies.agnard.paired`). On the same blocks, started from each scanner's
+    21-control solution: with ``rejections``, the pass points digital pugging's data snooping removes (keys
+    ``cfg.snoop.rejected``, ``s<i>.snoop.rejected``: :mod:`sim.studies.agnard.paired_count`),
+    and the 5-control pass at the layout points ``five`` ((inset, with centres) pairs; the
+    configured scanner at every one, keys ``cfg.five<l>.*``, vector ``i`` at the indices
+    ``pairs[i]``, keys ``s<i>.five<l>.*``; the projection centres' errors from a seed of their
+    own, the same for every scanner: :mod:`sim.studies.agnard.joint`)."""
     adj = Adjuster(block)
     wo, wc = paper_weights(cfg)
     seed, grid_seed = (int(s) for s in rng.integers(2**63, size=2))
+    centre_seed = int(rng.integers(2**63))  # drawn after: the two seeds above stay as they were
     out: dict[str, np.ndarray] = {}
+    cen = _CentredPasses(cfg, block, five, centre_seed)
 
     def blocks(over: dict) -> Simulated:
         return Simulated(
@@ -247,6 +265,8 @@ def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n:
     ctrl, _, res = adj.adjust(base, ("digital", "corrected"), cfg["control.many"], wo, wc)
     keep("cfg.many", ctrl, res)
     first("cfg", base, res)
+    more = partial(_more, cfg, block, adj, cen, rejections, out)
+    more("cfg", base, res, range(len(five)))
     for i, over in enumerate(scanners):
         sim = blocks(over)
         res = None
@@ -260,4 +280,52 @@ def table1_chunk(cfg: dict, block: Block, scanners, rng: np.random.Generator, n:
             if tag == "with" and len(passes) == 2:
                 keep(f"s{i}.many", ctrl, res)
         first(f"s{i}", sim, res)  # res: the control.many pass
+        more(f"s{i}", sim, res, pairs[i] if pairs else ())
     return out
+
+
+def _more(cfg, block, adj, cen, rejections: bool, out: dict, tag: str, sim, res21, which):
+    """On the blocks ``sim`` of one scanner of :func:`table1_chunk`, started from its
+    21-control solution ``res21``: the digital snooping's rejected pass points (with
+    ``rejections``) and the 5-control pass at the layout points ``which`` (``cen``)."""
+    if rejections:
+        ctrl, st = adj.structure(cfg["control.many"])
+        rej = _snoop(cfg, block, st, ctrl, sim, ("digital", "corrected"), res21)[0]
+        out[f"{tag}.snoop.rejected"] = rej[:, block.is_pass].sum(1)
+    for j in which:
+        b, ctrl, r = cen.adjust(adj, sim, res21, j)
+        acc: dict[str, np.ndarray] = {}
+        accuracy(b, ctrl, r, acc, "a")
+        for w in ("ctrl", "check"):
+            for ax in ("x", "y", "xy", "z"):
+                out[f"{tag}.five{j}.{w}_{ax}_m"] = acc[f"a.{w}_{ax}_m"]
+
+
+class _CentredPasses:
+    """The 5-control passes of :func:`table1_chunk` at the layout points ``five`` ((inset,
+    with centres)), started from a scanner's 21-control solution; with centres, the blocks
+    get their projection centres as model points (:mod:`sim.instruments.block.centres`),
+    the centres' errors drawn from ``seed`` for every scanner alike (common random numbers)."""
+
+    def __init__(self, cfg: dict, block: Block, five, seed: int):
+        self.cfg, self.block, self.five, self.seed = cfg, block, tuple(five), seed
+        self.w = paper_weights(cfg)
+        self.sigma = np.array(model_sigmas(cfg))[[0, 0, 1]]
+        self._cb = self._adj = None
+
+    def adjust(self, adj: Adjuster, sim: Simulated, res21, j: int):
+        """Layout point ``j`` on ``sim``: (the block adjusted, control indices, result)."""
+        inset, centres = self.five[j]
+        key = ("digital", "corrected")
+        ctrl = five_control(self.block, float(inset))
+        if not centres:
+            _, _, r = adj.adjust(sim, key, ctrl, *self.w, start=res21)
+            return self.block, ctrl, r
+        if self._cb is None:
+            self._cb = with_centres(self.block)
+            self._adj = Adjuster(self._cb.block)
+        cb = self._cb
+        sc = sim.centred(cb, np.random.default_rng(self.seed), self.sigma, key)
+        start = replace(res21, X=cb.extend(res21.X))
+        _, _, r = self._adj.adjust(sc, key, ctrl, *self.w, start=start)
+        return cb.block, ctrl, r

@@ -1,7 +1,8 @@
 """The leads of ``agnard_block``'s report section (seed ``003_5ce730a990a7ebc5.txt``): the
 consistent region of the lost five-point layout and the projection-centres option, with the
-5-control verdicts over it (:func:`sim.report.section.region_lead`, as every study decided
-over a region), then the scanner's region under Table 1 (its own table: an empty region
+5-control verdicts over it and the scanner's inputs together
+(:func:`sim.report.section.region_lead`, as every study decided over a region), then the
+scanner's region under Table 1 (its own table: an empty region
 whose conflicting statements make Table 1 not comparable). Read from the study's Parquet
 files alone."""
 
@@ -21,14 +22,26 @@ HOW = "; decided over the scanner's"
 
 def five_lead(out: Path, cfg: dict) -> list[str]:
     """The five-point layout's region (``consistent_region.parquet``) and its figure; its
-    verdict lines only for the rows decided over it (the scanner's are in
-    :func:`scanner_lead`)."""
+    verdict lines only for the rows decided over it together with the scanner's inputs
+    (``joint_region.parquet``; the scanner's own rows are in :func:`scanner_lead`)."""
+    joint = out / "joint_region.parquet"
+    n = len(table(out, "joint_region.parquet")["five_inset_1"]) if joint.is_file() else 0
     lead = region_lead(
         out,
         "The 5-control predictions (Table 3, over the lost five-point layout of its "
-        "control points and the program's option of projection centres as model points)",
-        values=f"{cfg['region.trials']} simulated blocks per option, the same ones adjusted "
-        "once per layout (common random numbers), whose noise enters the decision",
+        "control points and the program's option of projection centres as model points"
+        + (", together with the scanner's unprinted inputs)" if n else ")"),
+        values=f"{cfg['region.trials']} simulated blocks per option at the configured "
+        "scanner, the same ones adjusted once per layout (common random numbers), whose "
+        "noise enters the decision"
+        + (
+            f"; each verdict is over {n} joint (layout, scanner) points, the layout's blocks "
+            "moved by each scanner vector's paired shift at that layout "
+            "(`joint_region.parquet`, sim.studies.agnard.joint); the region's columns "
+            "below are at the configured scanner"
+            if n
+            else ""
+        ),
         design=f"a Sobol design of {cfg['region.points']} layouts, each without and "
         "with the projection centres (centres_1 0 and 1), not refined (no printed "
         "statement bounds the region: Figure 5 is lost)",

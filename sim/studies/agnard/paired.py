@@ -124,9 +124,10 @@ class Shift:
             return np.ones(self.log_beta.shape, bool)
         return np.abs(self.log_beta) > self.z * self.log_beta_se + 1e-9
 
-    def map_of(self) -> "Shift":
-        """The map used: ``log beta`` (and its error) zero where not :attr:`stretched`."""
-        keep = self.stretched
+    def map_of(self, stretch: bool = False) -> "Shift":
+        """The map used: ``log beta`` (and its error) zero where not :attr:`stretched`
+        (everywhere kept with ``stretch``)."""
+        keep = np.ones(self.log_beta.shape, bool) if stretch else self.stretched
         return Shift(
             self.delta,
             self.delta_se,
@@ -189,14 +190,20 @@ def mapped(base: np.ndarray, sh: Shift, grid: int = GRID) -> np.ndarray:
 
 
 def paired_evidence(
-    base: np.ndarray, c: np.ndarray, v: np.ndarray, ref: float | None = None, h: float = 0.0
+    base: np.ndarray,
+    c: np.ndarray,
+    v: np.ndarray,
+    ref: float | None = None,
+    h: float = 0.0,
+    stretch: bool = False,
 ) -> dict[str, np.ndarray]:
     """The evidence of a row at N vectors (for :func:`sim.claims.inference.status`): the
     median of the mapped blocks at the estimate, the lowest 2.5 % and highest 97.5 % point
     and (one-plate, with ``ref`` and its rounding half-unit ``h``) the largest ``p`` over the
     lattice (:func:`sim.claims.book_region.sample_evidence` at every lattice point). A vector
-    whose blocks are not all finite and positive gets NaN (undecided)."""
-    sh = paired_shift(c, v).map_of()
+    whose blocks are not all finite and positive gets NaN (undecided). ``stretch``: the
+    spread's scale over its interval at every vector, tested or not (:mod:`.joint`)."""
+    sh = paired_shift(c, v).map_of(stretch)
     x = mapped(np.asarray(base, float), sh)
     n, g, m = x.shape
     ok = np.isfinite(x).all(axis=(1, 2))

@@ -1,5 +1,5 @@
 """The consistent regions of ``agnard_block``'s unprinted inputs (seed 003): the lost
-five-point layout, with the verdicts of the 5-control predictions over it, and the scanner,
+five-point layout, over which (with the scanner) the 5-control predictions are decided, and the scanner,
 constrained by Table 1 (issue 21, :mod:`sim.claims.inference`).
 
 Figure 5, the layout of the five control points of the third pass, is lost. ``region.toml``
@@ -9,8 +9,9 @@ projection centres as model points (SPACE-M does; the paper does not say whether
 did: ``centres_1``, explored at 0 and 1, :mod:`sim.instruments.block.centres`); nothing the
 paper prints constrains them (its Table's numbers are the predictions), so the region is the
 whole range and each 5-control row is decided over it: holds / fails everywhere, depends
-(with the insets and option where it holds), or undecidable. The model adjusts the same ``region.trials`` simulated blocks once per
-layout (:func:`sim.studies.agnard.chunks.sweep_chunk`, on the runner's workers); each
+(with the insets and option where it holds), or undecidable, over joint points of this
+region and the scanner's (:mod:`sim.studies.agnard.joint`). The model adjusts the same
+``region.trials`` simulated blocks once per layout (:func:`sim.studies.agnard.chunks.sweep_chunk`, on the runner's workers); each
 statistic is evidence with the claim book's rules
 (:func:`sim.claims.book_region.sample_evidence`).
 
@@ -28,7 +29,10 @@ Set aside, Table 1 leaves every explored vector, and the 21-control predictions 
 and the acceptance limits) are decided over them all: each vector's blocks are paired with
 the configured scanner's on the same seeds, and a row's evidence at the vector is the
 configured scanner's main blocks moved by the paired shift (:mod:`sim.studies.agnard.paired`,
-:func:`shift_table`).
+:func:`shift_table`); the pass points digital pugging's data snooping removes, a count with
+many zeros, by its distribution function with the configured scanner's as a control variate
+(:mod:`sim.studies.agnard.paired_count`). The same paired blocks also run the 5-control pass
+at the joint design's layout points (:mod:`sim.studies.agnard.joint`).
 """
 
 from __future__ import annotations
@@ -46,6 +50,7 @@ from sim.instruments.block.layout import Block
 from sim.mc.runner import chunk_rng
 from sim.studies.agnard import chunks as ch
 from sim.studies.agnard.paired import paired_evidence, paired_shift
+from sim.studies.agnard.paired_count import count_evidence
 
 DECLARATION = Path(__file__).with_name("region.toml")
 #: the region's option: the program's models with (1) or without (0) projection centres
@@ -64,19 +69,27 @@ SCANNER_KEYS = {
 SCANNER_PART = 800
 #: key prefix of the configured scanner's statistics on a vector's blocks
 CONFIGURED = "configured:"
+#: the count decided over the scanner's inputs: pass points removed from one block
+REJECTED = "agnard.pass_rejections.digital"
+#: predictions that are counts with many zeros (:mod:`sim.studies.agnard.paired_count`)
+COUNTS = frozenset({REJECTED})
 
 
 def five_samples(sw: dict, i: int, pre: str = "") -> dict[str, np.ndarray]:
     """Per-block statistics (cm) of layout ``i`` keyed by claim id (``pre``: ``"centres."``
     for the layout with the projection centres, :func:`sim.studies.agnard.chunks.sweep_chunk`)."""
+    return five_of(sw, f"{pre}inset{i}")
+
+
+def five_of(sw: dict, pre: str) -> dict[str, np.ndarray]:
+    """Per-block statistics (cm) of one 5-control pass, keys ``<pre>.<ctrl|check>_<axis>_m``
+    of ``sw``, keyed by claim id."""
     out = {}
     for w in ("ctrl", "check"):
         for c in ("x", "y", "z"):  # XY is the paper-check of their quadrature, not simulated
-            out[f"agnard.control_5.{w}_{c}_cm"] = 100 * np.asarray(sw[f"{pre}inset{i}.{w}_{c}_m"])
+            out[f"agnard.control_5.{w}_{c}_cm"] = 100 * np.asarray(sw[f"{pre}.{w}_{c}_m"])
     for c in ("xy", "z"):  # the acceptance limit applies to the control rms
-        out[f"agnard.max_residual.control_5_{c}_cm"] = 100 * np.asarray(
-            sw[f"{pre}inset{i}.ctrl_{c}_m"]
-        )
+        out[f"agnard.max_residual.control_5_{c}_cm"] = 100 * np.asarray(sw[f"{pre}.ctrl_{c}_m"])
     return out
 
 
@@ -193,7 +206,13 @@ def table1_samples(sw: dict, i: int) -> dict[str, np.ndarray]:
 
 
 def explore_scanner(
-    cfg: dict, block: Block, book: ClaimBook, runner: Callable[..., dict], base: dict
+    cfg: dict,
+    block: Block,
+    book: ClaimBook,
+    runner: Callable[..., dict],
+    base: dict,
+    five: tuple = (),
+    pairs: Callable[[int], tuple[int, ...]] | None = None,
 ) -> tuple[Region, list[str], list[dict]]:
     """The scanner region under Table 1, the predictions decided over the scanner's inputs
     (``scanner.toml``) and the per-vector statistics of every explored vector, with the
@@ -201,7 +220,11 @@ def explore_scanner(
     trials, part, label)`` runs one part through the runner). Table 1's statements are decided on
     each vector's own blocks; the predictions by :func:`sim.studies.agnard.paired.
     paired_evidence`: ``base`` (claim id: the configured scanner's per-block statistic over
-    the main blocks) shifted by each vector's paired shift from the configured scanner."""
+    the main blocks) shifted by each vector's paired shift from the configured scanner; a
+    count (:data:`COUNTS`) by :func:`sim.studies.agnard.paired_count.count_evidence`. With
+    ``five`` (layout points of the 5-control pass, :mod:`.joint`) the same blocks also give
+    the 5-control statistics, the configured scanner's at every point and vector ``j``'s at
+    ``pairs(j)`` (keys ``five<l>:<claim id>``, configured ``CONFIGURED + five<l>:<claim id>``)."""
     dec = load_declaration(SCANNER, book)
     stats: list[dict] = []
 
@@ -210,16 +233,14 @@ def explore_scanner(
         scanners = tuple(
             {key: float(x[name][j]) for name, key in SCANNER_KEYS.items()} for j in range(n)
         )
+        pj = tuple(pairs(len(stats) + j) if pairs else () for j in range(n))
         sw = runner(
-            partial(ch.table1_chunk, cfg, block, scanners),
+            partial(ch.table1_chunk, cfg, block, scanners, five=five, pairs=pj, rejections=True),
             cfg["table1.trials"],
             SCANNER_PART + len(stats),
             "scanner vectors (Table 1), each paired with the configured scanner",
         )
-        c = {**many_samples(sw, "cfg.many"), **first_samples(sw, "cfg")}
-        per = [
-            {**table1_samples(sw, j), **{CONFIGURED + k: v for k, v in c.items()}} for j in range(n)
-        ]
+        c, per = _vector_stats(sw, len(five), pj)
         stats.extend(per)
         ev = {
             s.id: sample_evidence(np.stack([p[s.id] for p in per]), s.ref[0])
@@ -227,7 +248,8 @@ def explore_scanner(
         }
         for cid in dec.predictions:
             v = np.stack([p[cid] for p in per])
-            ev[cid] = paired_evidence(base[cid], c[cid], v, *plate_ref(book.spec(cid)))
+            how = count_evidence if cid in COUNTS else paired_evidence
+            ev[cid] = how(base[cid], c[cid], v, *plate_ref(book.spec(cid)))
         return ev
 
     region = explore(
@@ -239,6 +261,25 @@ def explore_scanner(
         rounds=cfg["table1.rounds"],
     )
     return region, dec.predictions, stats
+
+
+def _vector_stats(sw: dict, n_five: int, pj: tuple) -> tuple[dict, list[dict]]:
+    """The configured scanner's per-block statistics on one call's paired blocks (claim id;
+    ``five<l>:`` + claim id at the ``n_five`` layout points) and each vector's, with the
+    configured ones beside them (``CONFIGURED +`` key; vector ``j`` at layout points
+    ``pj[j]``)."""
+    c = {**many_samples(sw, "cfg.many"), **first_samples(sw, "cfg")}
+    c[REJECTED] = np.asarray(sw["cfg.snoop.rejected"])
+    for lay in range(n_five):
+        c.update({f"five{lay}:{k}": v for k, v in five_of(sw, f"cfg.five{lay}").items()})
+    per = []
+    for j, lays in enumerate(pj):
+        p = {**table1_samples(sw, j), **{CONFIGURED + k: v for k, v in c.items()}}
+        p[REJECTED] = np.asarray(sw[f"s{j}.snoop.rejected"])
+        for lay in lays:
+            p.update({f"five{lay}:{k}": v for k, v in five_of(sw, f"s{j}.five{lay}").items()})
+        per.append(p)
+    return c, per
 
 
 def shift_table(region: Region, preds: list[str], stats: list[dict]) -> dict[str, list]:

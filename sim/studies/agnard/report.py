@@ -91,10 +91,11 @@ def _claim_lines(c: dict) -> list[str]:
         f"*{vd('agnard.control_21.check_xy_holm')}*; X {_span(c['agnard.control_21.check_x_cm'])} "
         f"cm *{vd('agnard.control_21.check_x_cm')}*, Y {_span(c['agnard.control_21.check_y_cm'])} "
         f"cm *{vd('agnard.control_21.check_y_cm')}*), Z {_span(c['agnard.control_21.check_z_cm'])} cm "
-        f"(*{vd('agnard.control_21.check_z_cm')}*); 5 control: check X and Y as one Holm test "
-        f"*{vd('agnard.control_5.check_xy_holm')}* over the lost layouts, Z "
+        f"(*{vd('agnard.control_21.check_z_cm')}*); 5 control, over the lost layouts and "
+        "the scanner's inputs together: check X and Y as one Holm test "
+        f"*{vd('agnard.control_5.check_xy_holm')}*, Z "
         f"{v('agnard.control_5.check_z_cm')}-{fmt(c['agnard.control_5.check_z_cm']['value_high'])} "
-        f"cm (*{vd('agnard.control_5.check_z_cm')}* over the layouts, with and without the "
+        f"cm (*{vd('agnard.control_5.check_z_cm')}*, with and without the "
         "models' projection centres as model points: the centres tie consecutive models in "
         "height). The printed XY columns are the quadrature of X and Y (paper-checks: "
         + ", ".join(
@@ -134,9 +135,20 @@ def _rejection_line(c: dict, out: Path) -> str:
         f"{fmt(r)} px: {fmt(m, 2)} %" for r, m in zip(pt["recentre_px"], pt["mean_share_pct"])
     )
     dig, mech = c["agnard.pass_rejections.digital"], c["agnard.pass_rejections.mechanical_pct"]
+    over = ""
+    if (out / "scanner_rejections.parquet").is_file():
+        sr = table(out, "scanner_rejections.parquet")
+        z, m = np.asarray(sr["share_zero"]), np.asarray(sr["mean_rejected"])
+        over = (
+            f" over the scanner's {z.size} explored vectors (the paper's block lost none; the "
+            f"share of blocks that lose none is {fmt(100 * z.min(), 2)}-{fmt(100 * z.max(), 2)} "
+            f"% over the vectors, and they lose {fmt(m.min(), 2)}-{fmt(m.max(), 2)} pass "
+            "points on average; "
+            "`scanner_rejections.parquet`)"
+        )
     return (
         f"- *Pass-point rejection*: digital pugging removes a median "
-        f"{fmt(dig['value'])} pass points "
+        f"{_span(dig)} pass points per block{over} "
         f"(*{dig['verdict']}*); mechanical pugging "
         f"{fmt(mech['value'])} % "
         "(an input: the unprinted re-centring error is set so the share matches), mean "

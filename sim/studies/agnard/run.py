@@ -22,33 +22,19 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.claims.book import ClaimBook, write_claims
-from sim.claims.book_region import statements, write_explored
-from sim.claims.family import family_evidence, family_outcomes, family_over
-from sim.claims.region import OUTCOME_NAMES, inputs_table, outcomes, region_table, statement_of
+from sim.claims.book import write_claims
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
 from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance, write_table
 from sim.report.plotting import draw
-from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.agnard import chunks as ch
+from sim.studies.agnard import decide as dc
 from sim.studies.agnard import figures as fg
-from sim.studies.agnard.claims import JOINT, MEMBERS, claim_rows, load_book
-from sim.studies.agnard.leads import HOW
-from sim.studies.agnard.region import (
-    CENTRES,
-    SCANNER_KEYS,
-    explore_region,
-    explore_scanner,
-    first_samples,
-    many_samples,
-    shift_table,
-)
+from sim.studies.agnard.claims import claim_rows, load_book
 from sim.studies.agnard.schema import NAME, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
-from sim.studies.run_steps import over_region
 
 
 def _mean_se(x: np.ndarray) -> tuple[float, float]:
@@ -243,123 +229,6 @@ def _pugging(cfg, block, sim, ctx, base, prov, out):
     return per
 
 
-def _five_region(cfg, block, book, rows, ctx, part, prov, out):
-    """Explore the five-point layout (``region.toml``), write its tables and figure, and
-    replace the 5-control rows by their verdicts over the region (the configured layout's
-    result kept in the note as an example). Returns the rows and the explored insets."""
-    region, preds, stats = explore_region(
-        cfg,
-        block,
-        book,
-        lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx),
-        part,
-    )
-    _write_region(region, book, preds, cfg["region.trials"], prov, out)
-    insets = [float(u) for u in region.x["five_inset_1"]]
-    T = cfg["region.trials"]
-    tab = {
-        "inset": np.repeat(insets, T),
-        "centres": np.repeat(region.x[CENTRES] > 0.5, T),
-        "trial": np.tile(np.arange(T), len(insets)),
-    }
-    for c in preds:
-        tab[c.split(".", 1)[1]] = np.concatenate([s[c] for s in stats])
-    write_table(out / "region_five.parquet", tab, prov)
-    fig_region(
-        region,
-        out / "consistent_region.png",
-        title="seed 003: the lost five-point layout and the projection centres (no printed "
-        "statement constrains them)",
-        nominal={"five_inset_1": 0.0, CENTRES: 0.0},
-        labels={CENTRES: "projection centres as model points (0 without, 1 with)"},
-    )
-    rows = over_region(book, region, preds, rows, partial(_example, "layout"))
-    fresh = ClaimBook(list(book.specs.values()), [], book.path)  # rows re-scored over the region
-    j5 = JOINT["control_5"]
-    five = family_over(fresh, region, j5, MEMBERS[j5], n=T)
-    return [five if r["claim"] == j5 else r for r in rows], list(dict.fromkeys(insets))
-
-
-def _write_region(region, book, preds, n: int, prov, out) -> None:
-    """``consistent_region.parquet`` and ``region_inputs.parquet``
-    (:func:`sim.claims.book_region.write_region`), with the joint X, Y row's per-point
-    outcome as a column (decided from its members' p over ``n`` blocks per point, not from
-    evidence of its own)."""
-    st = statements(book, preds)
-    cols = region_table(region, st, preds)
-    j5 = JOINT["control_5"]
-    fam = family_outcomes(book, region, MEMBERS[j5], n=n)[1][region.accepted]
-    cols[j5] = [OUTCOME_NAMES[int(o)] for o in fam]
-    write_table(out / "consistent_region.parquet", cols, prov)
-    write_table(out / "region_inputs.parquet", inputs_table(region, st), prov)
-
-
-def _example(what: str, row: dict) -> str:
-    """The configured ``what``'s (layout, scanner) result of a row, kept as an example."""
-    return (
-        f"at the configured {what} (an example): median {row['value']:.3g} cm, 95 % of "
-        f"blocks {row['ci_low']:.3g}-{row['ci_high']:.3g}, outcome {row['outcome']}"
-    )
-
-
-def _scanner_region(cfg, block, book, per_trial, ctx, prov, out):
-    """Explore the scanner's unprinted inputs under Table 1 (``scanner.toml``), the
-    21-control predictions paired with the configured scanner's main blocks
-    (:mod:`.paired`); write ``scanner_region.parquet`` (every explored vector),
-    ``scanner_region_inputs.parquet``, ``scanner_shift.parquet`` and its figure. Returns the
-    region, its predictions and the per-vector statistics."""
-    base = {**many_samples(per_trial, f"layout_{cfg['control.many']}"), **first_samples(per_trial)}
-    region, preds, stats = explore_scanner(
-        cfg,
-        block,
-        book,
-        lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx),
-        base,
-    )
-    j21 = JOINT["control_21"]  # its per-vector outcome beside its members' (family_status)
-    p = np.stack([region.outputs[m]["p"] for m in MEMBERS[j21]], axis=1)
-    member = np.stack([outcomes(region, statement_of(book, m)) for m in MEMBERS[j21]], axis=1)
-    region.outputs[j21] = family_evidence(p, member, n=cfg["trials"])  # p over the main blocks
-    write_explored(out / "scanner_region.parquet", region, prov, statements(book, [*preds, j21]))
-    write_table(out / "scanner_shift.parquet", shift_table(region, preds, stats), prov)
-    nominal = {name: cfg[key] for name, key in SCANNER_KEYS.items()}
-    fig_region(
-        region,
-        out / "scanner_region.png",
-        title="seed 003: the scanner's unprinted inputs under Table 1"
-        + (" (no vector consistent)" if region.empty else ""),
-        nominal=nominal,
-    )
-    return region, preds, stats
-
-
-def _over_scanner(book, scanner, preds, rows, k: int, n: int) -> list[dict]:
-    """The 21-control rows decided over the scanner's inputs (the not-comparable Table 1 set
-    aside: every explored vector stays), each vector's evidence the configured scanner's main
-    blocks moved by its paired shift (:mod:`.paired`); the configured result kept in the note
-    as an example, and the joint X, Y row decided from its members per vector (their p over
-    the ``n`` main blocks)."""
-    aside = [s.id for s in scanner.statements if book.spec(s.id)["kind"] == "not comparable"]
-    region = scanner.without(aside)
-    how = HOW[2:] + (
-        f" {region.n} explored input vectors (scanner.toml), each "
-        f"paired with the configured scanner on the same {k} blocks (common random "
-        "numbers): the configured scanner's main blocks moved in logarithms by the paired "
-        "shift (and stretched where the pairs show the spread changed), over its 97.5 % "
-        "interval (sim.studies.agnard.paired)"
-    )
-    rows = over_region(book, region, preds, rows, lambda r: f"{how}; {_example('scanner', r)}")
-    fresh = ClaimBook(list(book.specs.values()), [], book.path)
-    j21 = JOINT["control_21"]
-    by = {r["claim"]: r for r in rows}
-    ex = (
-        f"at the configured scanner (an example): Holm p {by[j21]['value']:.3g}, outcome "
-        f"{by[j21]['outcome']}"
-    )
-    joint = family_over(fresh, region, j21, MEMBERS[j21], f"{how}; {ex}", n=n)
-    return [joint if r["claim"] == j21 else r for r in rows]
-
-
 def _layout(block, c5, c21, prov, out) -> None:
     """``layout.parquet``: every point of the block (m), its kind (check, pass, control of
     the many- or few-point layout or both) and the number of models it appears in."""
@@ -423,12 +292,18 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     pug = _pugging(cfg, block, per_trial, ctx, base, prov, out)
     base += len(cfg["tradeoff.recentre_px"])
 
-    # --- the unprinted five-point layout: its region, the 5-control rows decided over it
-    # --- the scanner's unprinted inputs under Table 1, then every claim
-    scanner, spreds, scanner_stats = _scanner_region(cfg, block, book, per_trial, ctx, prov, out)
-    rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book, scanner, scanner_stats)
-    rows = _over_scanner(book, scanner, spreds, rows, cfg["table1.trials"], T)
-    rows, insets = _five_region(cfg, block, book, rows, ctx, base, prov, out)
+    # --- the unprinted five-point layout (at the configured scanner), the scanner's inputs
+    # --- under Table 1 (with the 5-control pass at the joint design's layout points), then
+    # --- every claim: over the scanner, and the 5-control rows over both together
+    runner = lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx)  # noqa: E731
+    layout, preds5, stats5, insets = dc.five_region(cfg, block, book, runner, base, prov, out)
+    scanner, spreds, sstats, five = dc.scanner_region(
+        cfg, block, book, per_trial, runner, layout, prov, out
+    )
+    rows = claim_rows(cfg, block, per_trial, c5, c21, scan_t, pug, book, scanner, sstats)
+    rows = dc.over_scanner(book, scanner, spreds, rows, cfg["table1.trials"], T)
+    regions = (layout, preds5, stats5, scanner, sstats)
+    rows = dc.over_joint(cfg, book, rows, regions, five, prov, out)
     ctrl_idx = _region_layouts(block, insets, prov, out)
     write_claims(out / "claims.parquet", rows, prov, book)
     draw(
