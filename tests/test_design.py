@@ -260,6 +260,49 @@ def test_tolerances_of_the_calibration_section_are_analytic():
     assert np.all(np.abs(z) <= 90.0) and np.all(z % 10 == 0)
 
 
+def test_tolerances_are_decided_where_table1_puts_the_same_comparators_stations():
+    """Fifth reading: "a lateral offset of as much as 100 microns will cause an error in
+    radial distance of only 0.1 micron in the worst case" and "for one micron accuracy the
+    linearity of the translation of the microscope need be good only to about +-300 microns"
+    are statements about the built comparator, the one that measured Table 1. Their region
+    is the joint one of that instrument: the scale reads Table 1's plate AND Table 1's
+    printed statements hold (closure, 80 % in 1.1-1.3, two points at 1.5, all below the
+    closure), which puts the stations 6.6-19.1 mm out. Over every offset the scale allows
+    (the old region) both depended: the lateral error exceeds 0.15 um only under ~4 mm and
+    the tolerance exceeds 350 um only over ~30 mm, offsets at which Table 1 is
+    contradicted."""
+    from sim.claims.region import statement_of
+    from sim.studies.brown import region as BR
+    from sim.studies.brown.claims import load_book as brown_book
+    from sim.studies.design import region as DR
+    from sim.studies.design.claims import load_book
+
+    t1 = brown_book("brown_table1")  # the same zones as brown_table1's rows
+    for s in DR.TABLE1:
+        b = statement_of(t1, s.id)
+        assert (s.zone, s.form, s.ref) == (b.zone, b.form, b.ref)
+    closure = statement_of(t1, "brown.table1_closure.rms_um", "value")
+    assert (DR.SIGMA0.low, DR.SIGMA0.high) == pytest.approx(closure.zone, abs=1e-12)
+    rng = np.random.default_rng(5)
+    x = {
+        "station_offset_mm": rng.uniform(0.5, 34.0, 64),
+        "beta_mm": rng.uniform(0.0, 14.5, 64),
+        "sigma0_um": rng.uniform(1.45, 2.05, 64),
+    }
+    ev, ref = DR.table1_evidence(*x.values()), BR.table1_model(x)
+    assert len(ev) == len(DR.TABLE1)
+    for k, v in ev.items():  # the same rule as brown_table1's
+        np.testing.assert_allclose(v, ref[k], rtol=1e-12, atol=1e-12)
+    cfg = validate({"region.points": 256, "region.rounds": 0}, design.SCHEMA, design.check)
+    reg, _, verdicts = DR.tolerance_region(cfg, load_book())
+    pts = reg.points()
+    assert len(pts["station_offset_mm"]) >= 5
+    assert 6.0 < pts["station_offset_mm"].min() and pts["station_offset_mm"].max() < 20.0
+    assert 1.55 <= pts["sigma0_um"].min() and pts["sigma0_um"].max() <= 1.6
+    for cid in DR.TOLERANCES:
+        assert verdicts[cid].verdict == "holds", cid
+
+
 def test_linearised_plate_rms_matches_its_covariance():
     from sim.studies.design import external as ex
 
@@ -343,6 +386,7 @@ def test_tiny_run_end_to_end(tiny_run):
         "station_offset_mm",
         "beta_mm",
         "screw_pitch_mm",
+        "sigma0_um",
         "zeiss_half_extent_mm",
         "two_screw_sigma_um",
     }

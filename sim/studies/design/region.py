@@ -6,10 +6,19 @@ The comparator is the one instrument of the Brown studies
 offset and beta with their hardware ranges). Two parts, each explored jointly by
 :func:`sim.claims.inference.explore` and decided by :mod:`sim.claims.region`:
 
-* ``tolerances`` (analytic, dense): station offset x beta x screw pitch; the constraint is
-  that the scale reads every range of Table 1's plate (5 x 5 at 45 mm); predictions: the
-  lateral-offset error, the microscope's linearity tolerance, the drum graduation error
-  (:func:`.external.tolerances`).
+* ``tolerances`` (analytic, dense): station offset x beta x screw pitch x sigma0; the
+  constraints are that the scale reads every range of Table 1's plate (5 x 5 at 45 mm) and
+  that Table 1's printed statements about the same comparator hold at once (sigma0 at the
+  printed closure's rounding, :data:`SIGMA0`; 80 % of the sigmas 1.1-1.3 um; two points at
+  1.5 um; all below the closure: :data:`TABLE1`, brown_table1's claim-book rows, analytic
+  pivot-model cofactors). The
+  tolerances are statements about the built comparator ("Operation of the Comparator",
+  "Calibration"), the instrument that measured Table 1, so they are decided where Table 1
+  puts its stations (6.6-19.1 mm out), not over every offset the scale allows (fifth
+  reading: the station offsets where the lateral-offset error exceeds 0.15 um, under 4 mm,
+  and where the linearity tolerance exceeds 350 um, over 30 mm, contradict Table 1).
+  Predictions: the lateral-offset error, the microscope's linearity tolerance, the drum
+  graduation error (:func:`.external.tolerances`).
 * ``plates`` (Monte-Carlo plates per point, a small design): station offset x beta x the half
   extent of the Zeiss grid's 33 calibrated points (layout not printed) x the error of the
   conventional two-screw comparator the plates were also measured on (not printed); the
@@ -38,11 +47,21 @@ from sim.claims.region import (
     statement_of,
 )
 from sim.instruments.ranges import brown as B
+from sim.instruments.ranges import multilateration as ml
 from sim.mc.runner import chunk_rng
 from sim.studies.design.claims import verdict_of
 from sim.studies.design.external import external_at, paper_points, tolerances, zeiss_points
 
-__all__ = ["TOLERANCES", "PLATES", "tolerance_region", "plates_region", "region_rows"]
+__all__ = [
+    "TOLERANCES",
+    "PLATES",
+    "TABLE1",
+    "SIGMA0",
+    "table1_evidence",
+    "tolerance_region",
+    "plates_region",
+    "region_rows",
+]
 
 TOLERANCES = (
     "brown.operation.lateral_offset_error_um",
@@ -91,6 +110,74 @@ ZEISS_READS = Statement(
     source="004, Implementation of the Concept; Results",
 )
 
+_T1 = "brown.table1_point_sigma."
+#: Table 1's printed closure, 1.6 um at its rounding: the range of sigma0 (the closure is a
+#: statement about sigma0 alone, so it bounds the input rather than thinning the design)
+SIGMA0 = Input(
+    "sigma0_um",
+    1.55,
+    1.65,
+    "the plate's rms error of closure: 'the rms error of closure turned out to be 1.6 "
+    "microns (Table 1)', at its rounding (brown_table1's input row)",
+)
+#: Table 1's printed statements about the comparator the tolerances are stated for: the same
+#: zones as brown_table1's claim-book rows of these ids (a test pins them), here constraints
+TABLE1 = (
+    Statement(
+        _T1 + "share_1p1_1p3",
+        (0.8, 0.8),
+        "share",
+        2,
+        0.05,
+        paper="80 percent of the standard deviations in x and y ranged between 1.1 and 1.3 "
+        "microns (share of the 50 sigmas printing 1.1-1.3 um)",
+        source="004, Results",
+    ),
+    Statement(
+        _T1 + "points_ge_1p45",
+        (2.0, 4.0),
+        "range",
+        paper="2 points had standard deviations as large as 1.5 microns (points whose larger "
+        "sigma prints >= 1.5 um; the model's points come in fours)",
+        source="004, Results",
+    ),
+    Statement(
+        _T1 + "max_um",
+        (1.5, 1.5),
+        "value",
+        1,
+        paper="2 points had standard deviations as large as 1.5 microns (the largest, um)",
+        source="004, Results",
+    ),
+    Statement(
+        _T1 + "below_closure",
+        (0.0, 1.0),
+        "range",
+        paper="the standard deviations ... will be somewhat smaller than the rms error of "
+        "closure (every sigma / sigma0)",
+        source="004, Results",
+    ),
+)
+
+
+def table1_evidence(o, b, s0, alpha_mm: float = B.ALPHA_MM) -> dict:
+    """Table 1's statements at ``N`` input vectors (station offset, beta, sigma0; mm, um):
+    the 50 printed sigmas are sigma0 x sqrt(cofactor) of the pivot model on Table 1's plate,
+    printed to one decimal (exact, analytic; the same rule as brown_table1's)."""
+    o, b, s0 = (np.asarray(v, float) for v in (o, b, s0))
+    N = len(o)
+    P = np.broadcast_to(B.table1_points(), (N, 25, 2)).copy()
+    with np.errstate(invalid="ignore"):
+        Q = ml.covariance(P, B.thetas(o, b, alpha_mm), "pivot")[0]
+        cof = np.sqrt(np.stack([Q[..., 0, 0], Q[..., 1, 1]], -1))  # (N, 25, 2)
+    sig = s0[:, None, None] * cof
+    return {
+        TABLE1[0].id: ((sig >= 1.05) & (sig < 1.35)).mean(axis=(1, 2)),
+        TABLE1[1].id: (sig.max(-1) >= 1.45).sum(-1).astype(float),
+        TABLE1[2].id: sig.max(axis=(1, 2)),
+        TABLE1[3].id: cof.reshape(N, -1),
+    }
+
 
 def _comparator_inputs():
     ins, _ = parse_declaration(B.INPUTS)
@@ -111,7 +198,9 @@ def tolerance_model(cfg: dict):
         P = np.broadcast_to(pts, (len(o),) + pts.shape).copy()
         TH = B.thetas(o, b, cfg["comparator.alpha_mm"])
         t = tolerances(cfg, B.min_range_mm(P, TH), pitch)
+        t1 = table1_evidence(o, b, x["sigma0_um"], cfg["comparator.alpha_mm"])
         return {
+            **t1,
             SCALE.id: B.max_range_mm(P, TH),
             TOLERANCES[0]: t["lateral_error_um"],
             TOLERANCES[1]: t["linearity_tol_um"],
@@ -159,8 +248,8 @@ def plates_model(cfg: dict, book):
 def tolerance_region(cfg: dict, book):
     preds = [statement_of(book, c) for c in TOLERANCES]
     reg = explore(
-        _comparator_inputs() + [PITCH],
-        [SCALE],
+        _comparator_inputs() + [SIGMA0, PITCH],
+        [SCALE, *TABLE1],
         tolerance_model(cfg),
         chunk_rng(cfg["seed"], 95, 0),
         n=cfg["region.points"],

@@ -270,7 +270,7 @@ SCHEMA = {
     # the joint exploration of the unprinted inputs (sim.claims.inference; .region)
     "region.points": count(
         1024,
-        "Sobol design size of the analytic tolerance region (offset x beta x screw pitch)",
+        "Sobol design size of the analytic tolerance region (offset x beta x sigma0 x screw pitch)",
         lo=256,
         hi=16384,
     ),
