@@ -41,6 +41,7 @@ single_threaded_blas()  # before NumPy loads (the study modules import it)
 from sim.cli import __doc__ as cli_doc  # noqa: E402
 from sim.cli import check_run_args  # noqa: E402
 from sim.cli_args import parser as run_parser  # noqa: E402
+from sim.mc.children import STOP_SIGNALS, stop_children  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
@@ -149,37 +150,17 @@ def run_all(
         for stem, code, wall, start in pool.map(one, todo):
             out[stem] = (code, wall, start)
     except KeyboardInterrupt:
-        _stop_runs(stop, starting, procs)
+        stop_children(procs, first=lambda: _set(stop, starting))
         pool.shutdown(wait=True, cancel_futures=True)
         raise
     pool.shutdown()
     return out
 
 
-#: the signals that end a batch (and each of its runs) as Ctrl-C does
-STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
-
-
-def _stop_runs(stop: threading.Event, starting: threading.Lock, procs: list) -> None:
-    """An interrupt reached the driver (Ctrl-C reaches the runs too; SIGTERM or SIGHUP only
-    the driver): start no more runs, pass SIGTERM on to the live ones (each cleans up as
-    after Ctrl-C), wait for them (killed after :data:`GRACE_S`)."""
-    for s in (signal.SIGINT, *STOP_SIGNALS):  # a second signal must not orphan the runs
-        signal.signal(s, signal.SIG_IGN)
+def _set(stop: threading.Event, starting: threading.Lock) -> None:
+    """Start no more runs (under the lock that starts one, so none starts after this)."""
     with starting:
         stop.set()
-    for proc in procs:
-        if proc.poll() is None:
-            proc.terminate()
-    for proc in procs:
-        try:
-            proc.wait(timeout=GRACE_S)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-
-
-#: seconds an interrupted run has to clean up before it is killed
-GRACE_S = 30
 
 
 class _Named:

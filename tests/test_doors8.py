@@ -1,0 +1,43 @@
+"""The failure classes of the eighth sweep of bad inputs (issue 26), one case per class, and
+the two leftovers of the seventh; each failed on the code before its fix.
+
+* ``sim.batch`` and ``make verify`` each had their own way of passing a signal on to their
+  child runs (a near-copy): one implementation, :func:`sim.mc.children.stop_children`;
+"""
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import sim.batch
+import sim.report.verify.rerun
+from sim.mc import children
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_batch_and_verify_stop_their_children_with_one_function(monkeypatch):
+    assert sim.batch.stop_children is children.stop_children
+    assert sim.report.verify.rerun.stop_children is children.stop_children
+    old = {s: signal.getsignal(s) for s in (signal.SIGINT, *children.STOP_SIGNALS)}
+    # one child ends on SIGTERM, one ignores it (killed after the grace), one fills its pipe
+    stubborn = "import signal, time; signal.signal(signal.SIGTERM, signal.SIG_IGN); time.sleep(30)"
+    chatty = "import sys, time; sys.stdout.write('x' * 10**6); sys.stdout.flush(); time.sleep(30)"
+    procs = [
+        subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"]),
+        subprocess.Popen([sys.executable, "-c", stubborn]),
+        subprocess.Popen([sys.executable, "-c", chatty], stdout=subprocess.PIPE),
+    ]
+    time.sleep(0.3)
+    called = []
+    try:
+        t = time.monotonic()
+        children.stop_children(procs, drain=True, first=lambda: called.append(1), grace=0.5)
+        assert time.monotonic() - t < 5 and called == [1]
+        assert [p.returncode for p in procs] == [-signal.SIGTERM, -signal.SIGKILL, -signal.SIGTERM]
+        assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN  # a second signal orphans none
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
