@@ -3,6 +3,10 @@ the two leftovers of the seventh; each failed on the code before its fix.
 
 * ``sim.batch`` and ``make verify`` each had their own way of passing a signal on to their
   child runs (a near-copy): one implementation, :func:`sim.mc.children.stop_children`;
+* Brown with ``plate.grid = 2`` (or four points in a square, or a 2 in ``dilution.grids``)
+  passed ``sim check``; every trial's pivot adjustment was then singular at run time ("only
+  0 trials converged", naming no key), or the dilution table's pivot column came out NaN
+  with exit 0;
 """
 
 import signal
@@ -11,8 +15,11 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 import sim.batch
 import sim.report.verify.rerun
+from sim.cli import main
 from sim.mc import children
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -41,3 +48,27 @@ def test_batch_and_verify_stop_their_children_with_one_function(monkeypatch):
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+
+
+@pytest.mark.parametrize(
+    "study, sets, key",
+    [
+        ("brown_table1", ["plate.grid=2"], "plate.grid"),
+        (
+            "brown_dilution",
+            ["plate.pattern=list", "plate.points=[[-9,-9],[9,-9],[-9,9],[9,9]]"],
+            "plate.points",
+        ),
+        ("brown_dilution", ["dilution.grids=[2,3]"], "dilution.grids"),
+    ],
+)
+def test_a_brown_geometry_the_pivot_model_cannot_solve_is_refused_by_check(
+    capsys, study, sets, key
+):
+    # passed sim check, then every trial's pivot adjustment was singular at run time (or the
+    # dilution curve's pivot column came out NaN, exit 0)
+    argv = ["check", str(ROOT / "studies" / f"{study}.toml")]
+    assert main([*argv, *(x for s in sets for x in ("--set", s))]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith(f"sim: error: {key}: the pivot model"), err
+    assert "singular" in err

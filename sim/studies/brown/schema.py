@@ -9,9 +9,12 @@ import numpy as np
 
 from sim.instruments.plates import pattern_points
 from sim.instruments.ranges import multilateration as ml
+from sim.instruments.ranges import positions as po
+from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.runner import chunk_rng
 from sim.mc.schema_helpers import count, counts, positive, real
+from sim.studies.brown.values import thetas
 
 SEED = "004_f5bd9e86c308241f.txt"
 MODEL_NAMES = ("known", "stations", "pivot")
@@ -224,6 +227,48 @@ def check(cfg: dict) -> None:
                 "comparator.scale_length_mm",
                 f"ranges run from {r.min():.1f} to {r.max():.1f} mm but the scale "
                 f"reads 0 to {reach:g} mm (move the stations in, or use alpha)",
+            )
+    check_pivot(cfg, key, pts)
+
+
+def pivot_rcond(pts: np.ndarray, theta: np.ndarray) -> float:
+    """The engine's singularity measure (:func:`sim.lsq.normals.scaled_rcond`, 0 for a
+    singular point block) of the pivot model's reduced normals -- the widest model the
+    studies adjust: stations, alpha and beta^2 free -- at the true points (n, 2) mm and
+    globals (7,), where the noise-free ranges are exact."""
+    r = ml.ranges(pts[None], theta[None])
+    model = po.RangeModel(r, ml.BROWN_LAYOUT, P=4, dense=True)
+    red = reduced_normals(model, pts[None], theta[None], np.arange(7))
+    return float(scaled_rcond(red.Nbar)[0]) if red.ok[0] else 0.0
+
+
+def check_pivot(cfg: dict, key: str, pts: np.ndarray) -> None:
+    """Every geometry the run adjusts with the pivot model can be solved by the engine's one
+    rule (a 2 x 2 grid cannot: its symmetry leaves the reduced normals singular, and every
+    trial failed at run time): the plate's points, and the grids of ``dilution.grids`` over
+    the plate's extent."""
+    _, theta = setup(cfg)
+    if not np.all(np.isfinite(ml.ranges(pts[None], theta[None]))):
+        return  # the scale check names the overflow when the scale is enforced
+    rc = pivot_rcond(pts, theta)
+    if not rc > RCOND:
+        raise ConfigError(
+            key,
+            f"the pivot model (stations, alpha and beta free) cannot be solved at these "
+            f"{len(pts)} points: its reduced normal matrix is singular (scaled reciprocal "
+            f"condition {rc:.2g}, the adjustment needs > {RCOND:g})",
+        )
+    ext = float(np.abs(pts).max())
+    th = thetas(cfg["plate.format_mm"], cfg["comparator.station_offset_mm"], 0.0, 0.0)[0]
+    for k in cfg.get("dilution.grids", ()):
+        g = pattern_points("grid", grid=k, spacing_mm=2.0 * ext / (k - 1))
+        rc = pivot_rcond(g, th)
+        if not rc > RCOND:
+            raise ConfigError(
+                "dilution.grids",
+                f"the pivot model cannot be solved on a {k} x {k} grid: its reduced normal "
+                f"matrix is singular (scaled reciprocal condition {rc:.2g}, the adjustment "
+                f"needs > {RCOND:g})",
             )
 
 
