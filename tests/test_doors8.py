@@ -6,7 +6,8 @@ the two leftovers of the seventh; each failed on the code before its fix.
 * Brown with ``plate.grid = 2`` (or four points in a square, or a 2 in ``dilution.grids``)
   passed ``sim check``; every trial's pivot adjustment was then singular at run time ("only
   0 trials converged", naming no key), or the dilution table's pivot column came out NaN
-  with exit 0;
+  with exit 0; ``brown_design`` with ``paper.grid = 2`` failed at run time in an eigenvalue
+  solver ("LinAlgError: Eigenvalues did not converge");
 """
 
 import signal
@@ -60,6 +61,7 @@ def test_batch_and_verify_stop_their_children_with_one_function(monkeypatch):
             "plate.points",
         ),
         ("brown_dilution", ["dilution.grids=[2,3]"], "dilution.grids"),
+        ("brown_design", ["paper.grid=2", "design.grids=[2,5]"], "paper.grid"),
     ],
 )
 def test_a_brown_geometry_the_pivot_model_cannot_solve_is_refused_by_check(
