@@ -8,6 +8,11 @@ the two leftovers of the seventh; each failed on the code before its fix.
   0 trials converged", naming no key), or the dilution table's pivot column came out NaN
   with exit 0; ``brown_design`` with ``paper.grid = 2`` failed at run time in an eigenvalue
   solver ("LinAlgError: Eigenvalues did not converge");
+* ``--set seed=3 --set seed=4`` ran with seed 4 and dropped the 3 silently (as ``--seed`` with
+  ``--set seed=`` did before the seventh sweep);
+* ``python -m sim.batch --stale-only FILE -- RUN_OPTIONS`` judged the results against the
+  study file alone: results of ``network.offset_mm = 1`` were "up to date" for ``-- --set
+  network.offset_mm=2.0``, and a batch with ``--trials`` was never up to date;
 """
 
 import signal
@@ -24,6 +29,7 @@ from sim.cli import main
 from sim.mc import children
 
 ROOT = Path(__file__).resolve().parent.parent
+NETWORK = ROOT / "studies" / "network_brown.toml"
 
 
 def test_batch_and_verify_stop_their_children_with_one_function(monkeypatch):
@@ -74,3 +80,27 @@ def test_a_brown_geometry_the_pivot_model_cannot_solve_is_refused_by_check(
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith(f"sim: error: {key}: the pivot model"), err
     assert "singular" in err
+
+
+def test_a_key_given_twice_by_set_is_refused(capsys):
+    # "--set seed=3 --set seed=4" ran with seed 4 and dropped 3 without a word
+    argv = ["check", str(ROOT / "studies" / "network_brown.toml"), "--set", "seed=3"]
+    assert main([*argv, "--set", "seed=4"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "sim: error: seed: given twice by --set: give one value", err
+
+
+def test_stale_only_reads_the_run_options(tmp_path, capsys):
+    # results of network.offset_mm = 1 were "up to date" for --set network.offset_mm=2.0, and
+    # a batch with --trials was never up to date: the run options were left out of the check
+    out = tmp_path / "r" / "network_brown"
+    small = ["--trials", "40", "--no-figures"]
+    assert main(["run", str(NETWORK), *small, "--quiet", "--out", str(out)]) == 0
+    assert sim.batch.is_current(NETWORK, out, small)
+    assert not sim.batch.is_current(NETWORK, out, [*small, "--set", "network.offset_mm=2.0"])
+    assert not sim.batch.is_current(NETWORK, out)  # the file's own trials, and figures
+    assert (
+        sim.batch.main(["--stale-only", "--results", str(out.parent), str(NETWORK), "--", *small])
+        == 0
+    )
+    assert "network_brown: up to date" in capsys.readouterr().out
