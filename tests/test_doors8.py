@@ -13,6 +13,9 @@ the two leftovers of the seventh; each failed on the code before its fix.
 * ``python -m sim.batch --stale-only FILE -- RUN_OPTIONS`` judged the results against the
   study file alone: results of ``network.offset_mm = 1`` were "up to date" for ``-- --set
   network.offset_mm=2.0``, and a batch with ``--trials`` was never up to date;
+* Brown with ``solver.max_iter = 2`` or ``solver.tol_mm = 1e-300`` (no trial can converge)
+  passed ``sim check`` and failed every trial with "singular reduced normal matrix, the
+  geometry is degenerate": the solver's limits were blamed on the geometry, naming no key;
 """
 
 import signal
@@ -104,3 +107,15 @@ def test_stale_only_reads_the_run_options(tmp_path, capsys):
         == 0
     )
     assert "network_brown: up to date" in capsys.readouterr().out
+
+
+def test_brown_solver_limits_are_named_not_blamed_on_the_geometry(tmp_path, capsys):
+    # a tolerance no trial can meet, or too few iterations, failed every trial with "singular
+    # reduced normal matrix, the geometry is degenerate", naming no key
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    assert main(["check", study, "--set", "solver.tol_mm=1e-300"]) == 2
+    assert capsys.readouterr().err.startswith("sim: error: solver.tol_mm: must be >= 1e-15")
+    run = ["run", study, "--trials", "40", "--no-figures", "--quiet", "--out", str(tmp_path / "o")]
+    assert main([*run, "--set", "solver.max_iter=2"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "solver.max_iter" in err, err

@@ -68,8 +68,13 @@ BASE = {
     "errors.bias_um": real(
         0.0, "constant personal bias added to every range", lo=-1e4, hi=1e4, unit="um"
     ),
-    "solver.tol_mm": positive(
-        1e-10, "convergence: largest correction below this", hi=1e-3, unit="mm"
+    "solver.tol_mm": real(
+        1e-10,
+        "convergence: largest correction below this (at least 1e-15 mm: a smaller one is "
+        "never met in double precision and every trial failed)",
+        lo=1e-15,
+        hi=1e-3,
+        unit="mm",
     ),
     "solver.max_iter": count(30, "Gauss-Newton iteration limit", lo=1, hi=1000),
     "region.points": count(
