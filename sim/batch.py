@@ -46,6 +46,7 @@ from sim.mc.children import STOP_SIGNALS, stop_children  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
+from sim.mc.storage import regular_text  # noqa: E402
 
 __all__ = ["SLOW_FIRST", "order", "run_all", "main"]
 
@@ -66,7 +67,7 @@ def is_current(study_file: str | Path, results: str | Path, run_args=()) -> bool
     ``--chunk``) and the study's current code hash, and the run drew its figures (not
     ``--no-figures``) unless ``run_args`` ask for none."""
     try:
-        record = json.loads((Path(results) / "run.json").read_text(encoding="utf-8"))
+        record = json.loads(regular_text(Path(results) / "run.json"))
         with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
             args = run_parser(cli_doc).parse_args(["run", str(study_file), *run_args])
         _, cfg = load_run(args)

@@ -16,11 +16,18 @@ the two leftovers of the seventh; each failed on the code before its fix.
 * Brown with ``solver.max_iter = 2`` or ``solver.tol_mm = 1e-300`` (no trial can converge)
   passed ``sim check`` and failed every trial with "singular reduced normal matrix, the
   geometry is degenerate": the solver's limits were blamed on the geometry, naming no key;
+* a FIFO put by hand where the suite keeps its own file (``REPORT.md`` in ``--results``,
+  ``run.json`` in a results or staging directory) made ``sim report``, ``sim run
+  --overwrite`` and ``sim.batch --stale-only`` block forever on opening it;
 """
 
+import contextlib
+import os
+import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -30,6 +37,10 @@ import sim.batch
 import sim.report.verify.rerun
 from sim.cli import main
 from sim.mc import children
+from sim.mc.config import ConfigError
+from sim.mc.storage import read_record
+from sim.report.markdown import write_report
+from sim.studies import get_study
 
 ROOT = Path(__file__).resolve().parent.parent
 NETWORK = ROOT / "studies" / "network_brown.toml"
@@ -119,3 +130,34 @@ def test_brown_solver_limits_are_named_not_blamed_on_the_geometry(tmp_path, caps
     assert main([*run, "--set", "solver.max_iter=2"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "solver.max_iter" in err, err
+
+
+def test_a_fifo_where_the_suite_keeps_its_own_file_never_blocks(tmp_path):
+    # a FIFO named REPORT.md in --results, or run.json in a results or staging directory, made
+    # sim report, sim run --overwrite and sim.batch --stale-only wait forever on it
+    d = tmp_path / "r" / "network_brown"
+    d.mkdir(parents=True)
+    shutil.copy(ROOT / "results" / "network_brown" / "claims.parquet", d)
+    fifos = [d / "run.json", d.parent / "REPORT.md"]
+    for f in fifos:
+        os.mkfifo(f)
+    got = []
+
+    def calls():
+        got.append(read_record(d))
+        got.append(sim.batch.is_current(NETWORK, d))
+        try:  # what sim report does first (main() sets signal handlers: the main thread only)
+            write_report(d.parent, get_study)
+        except ConfigError as e:
+            got.append(str(e))
+
+    t = threading.Thread(target=calls, daemon=True)
+    t.start()
+    t.join(20)
+    blocked = t.is_alive()
+    for f in fifos:  # a blocked reader gets end of file
+        with contextlib.suppress(OSError):
+            os.close(os.open(f, os.O_WRONLY | os.O_NONBLOCK))
+    t.join(5)
+    assert not blocked and got[:2] == [None, False], got
+    assert "REPORT.md was not written by sim report" in got[2], got
