@@ -19,6 +19,10 @@ the two leftovers of the seventh; each failed on the code before its fix.
 * a FIFO put by hand where the suite keeps its own file (``REPORT.md`` in ``--results``,
   ``run.json`` in a results or staging directory) made ``sim report``, ``sim run
   --overwrite`` and ``sim.batch --stale-only`` block forever on opening it;
+* a standard deviation so large that the model overflows passed ``sim check`` and failed at
+  run time: Brown's ``errors.setting_sigma_um = 1e300`` in an OverflowError, Wolf's
+  ``plate.grid_sigma_um = 1e300`` after a page of NumPy warnings, naming no key (Wolf's
+  other sigmas were bounded at 100 um, Brown's bias at 1e4 um; these now are too).
 """
 
 import contextlib
@@ -161,3 +165,19 @@ def test_a_fifo_where_the_suite_keeps_its_own_file_never_blocks(tmp_path):
     t.join(5)
     assert not blocked and got[:2] == [None, False], got
     assert "REPORT.md was not written by sim report" in got[2], got
+
+
+@pytest.mark.parametrize(
+    "study, key",
+    [
+        ("brown_table1", "errors.setting_sigma_um"),
+        ("brown_dilution", "errors.comparator_sigma_um"),
+        ("wolf_polynomial", "plate.grid_sigma_um"),
+    ],
+)
+def test_a_standard_deviation_that_overflows_the_model_is_refused_on_load(capsys, study, key):
+    # passed sim check, then failed at run time: Brown in an OverflowError, Wolf after a page
+    # of NumPy overflow warnings with "phases beyond 1e6 rad", naming no key
+    assert main(["check", str(ROOT / "studies" / f"{study}.toml"), "--set", f"{key}=1e300"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"sim: error: {key}: must be <= ") and "\n" not in err, err

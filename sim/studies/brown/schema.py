@@ -60,10 +60,12 @@ BASE = {
     "comparator.micrometer_mm": real(
         1.0, "micrometer travel added to the scale (paper: at most 1 mm)", lo=0.0, unit="mm"
     ),
-    "errors.setting_sigma_um": positive(1.0, "standard deviation of one setting", unit="um"),
+    "errors.setting_sigma_um": positive(
+        1.0, "standard deviation of one setting", hi=1e4, unit="um"
+    ),
     "errors.settings": count(1, "settings per point and position, averaged", lo=1, hi=100),
     "errors.comparator_sigma_um": real(
-        0.0, "comparator random error per reading", lo=0.0, unit="um"
+        0.0, "comparator random error per reading", lo=0.0, hi=1e4, unit="um"
     ),
     "errors.bias_um": real(
         0.0, "constant personal bias added to every range", lo=-1e4, hi=1e4, unit="um"
@@ -118,10 +120,17 @@ TABLE1 = {
     **BASE,
     "trials": count(4000, "Monte-Carlo trials", lo=2, hi=100_000_000),
     "plate.spacing_mm": positive(45.0, "grid spacing (paper: 45 mm)", unit="mm", input=True),
-    "errors.setting_sigma_um": positive(1.7, "one setting (paper: 1.7 um)", unit="um", input=True),
+    "errors.setting_sigma_um": positive(
+        1.7, "one setting (paper: 1.7 um)", hi=1e4, unit="um", input=True
+    ),
     "errors.settings": count(2, "double settings (paper)", lo=1, hi=100, input=True),
     "errors.comparator_sigma_um": real(
-        1.1, "comparator contribution (paper: about 1.1 um)", lo=0.0, unit="um", input=True
+        1.1,
+        "comparator contribution (paper: about 1.1 um)",
+        lo=0.0,
+        hi=1e4,
+        unit="um",
+        input=True,
     ),
 }
 
