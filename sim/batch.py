@@ -12,7 +12,8 @@ together. Each run is a fresh ``python -m sim run`` (a driver that imported the 
 and forked a child per study saved 4 % of ``make rerun``'s time, 57.3 against 59.6 s, under
 the 20 % that keeps such machinery, issue 22, so it went). With ``J > 1`` the runs are quiet (progress bars of several runs
 would overwrite each other); each study's line is printed when it ends. ``--stale-only``:
-only the studies whose results are not current (:func:`sim.mc.codehash.is_current`), the others
+only the studies whose results are not current (:func:`is_current`: their run record holds
+the config this run would resolve, run options included, and the current code), the others
 are reported up to date. A run that fails prints its own one-line message, which starts with the name of its study
 file; the others go on,
 and the exit code is that of the first failure (1 when a run was killed). A missing study
@@ -39,12 +40,13 @@ from sim.threads import single_threaded_blas
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 
 from sim.cli import __doc__ as cli_doc  # noqa: E402
-from sim.cli import check_run_args  # noqa: E402
+from sim.cli import check_run_args, load_run  # noqa: E402
 from sim.cli_args import parser as run_parser  # noqa: E402
+from sim.mc.children import STOP_SIGNALS, stop_children  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
-from sim.studies import load_study  # noqa: E402
+from sim.mc.storage import regular_text  # noqa: E402
 
 __all__ = ["SLOW_FIRST", "order", "run_all", "main"]
 
@@ -59,17 +61,21 @@ SLOW_FIRST = (
 )
 
 
-def is_current(study_file: str | Path, results: str | Path) -> bool:
-    """True when ``results/run.json`` records the study file's resolved config and the
-    study's current code hash, and the run drew its figures (not ``--no-figures``)."""
+def is_current(study_file: str | Path, results: str | Path, run_args=()) -> bool:
+    """True when ``results/run.json`` records the config ``sim run STUDY_FILE RUN_ARGS``
+    resolves (the study file with the run options' ``--set``, ``--trials``, ``--seed``,
+    ``--chunk``) and the study's current code hash, and the run drew its figures (not
+    ``--no-figures``) unless ``run_args`` ask for none."""
     try:
-        record = json.loads((Path(results) / "run.json").read_text(encoding="utf-8"))
-        _, cfg = load_study(study_file)
-    except (OSError, ValueError, RecursionError, ConfigError, StudyError):
+        record = json.loads(regular_text(Path(results) / "run.json"))
+        with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
+            args = run_parser(cli_doc).parse_args(["run", str(study_file), *run_args])
+        _, cfg = load_run(args)
+    except (OSError, ValueError, RecursionError, ConfigError, StudyError, SystemExit):
         return False  # RecursionError: a run.json nested too deep to read
     if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
         return False
-    if record.get("figures") is False:  # a run without figures (sim run --no-figures)
+    if record.get("figures") is False and not args.no_figures:  # sim run --no-figures
         return False
     want = study_code_hash(cfg["study"])
     return record.get("config") == json.loads(json.dumps(cfg)) and record.get("code_hash") == want
@@ -98,7 +104,7 @@ def run_all(
     made (up-to-date studies are left out)."""
     todo = []
     for f in order(files):
-        if stale_only and is_current(f, results / f.stem):
+        if stale_only and is_current(f, results / f.stem, run_args):
             log(f"{f.stem}: up to date")
         else:
             todo.append(f)
@@ -149,37 +155,17 @@ def run_all(
         for stem, code, wall, start in pool.map(one, todo):
             out[stem] = (code, wall, start)
     except KeyboardInterrupt:
-        _stop_runs(stop, starting, procs)
+        stop_children(procs, first=lambda: _set(stop, starting))
         pool.shutdown(wait=True, cancel_futures=True)
         raise
     pool.shutdown()
     return out
 
 
-#: the signals that end a batch (and each of its runs) as Ctrl-C does
-STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
-
-
-def _stop_runs(stop: threading.Event, starting: threading.Lock, procs: list) -> None:
-    """An interrupt reached the driver (Ctrl-C reaches the runs too; SIGTERM or SIGHUP only
-    the driver): start no more runs, pass SIGTERM on to the live ones (each cleans up as
-    after Ctrl-C), wait for them (killed after :data:`GRACE_S`)."""
-    for s in (signal.SIGINT, *STOP_SIGNALS):  # a second signal must not orphan the runs
-        signal.signal(s, signal.SIG_IGN)
+def _set(stop: threading.Event, starting: threading.Lock) -> None:
+    """Start no more runs (under the lock that starts one, so none starts after this)."""
     with starting:
         stop.set()
-    for proc in procs:
-        if proc.poll() is None:
-            proc.terminate()
-    for proc in procs:
-        try:
-            proc.wait(timeout=GRACE_S)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-
-
-#: seconds an interrupted run has to clean up before it is killed
-GRACE_S = 30
 
 
 class _Named:

@@ -78,17 +78,23 @@ def check_run_args(args) -> Path:
 
 
 def _keys_set(overrides: list[str]) -> set[str]:
+    """The keys of the ``--set`` overrides; a key set twice is refused (one of its values
+    would be dropped silently)."""
     keys = set()
     for text in overrides:
         try:
-            keys.add(parse_override(text)[0])
+            key = parse_override(text)[0]
         except ConfigError:
-            pass  # load_study names the bad override
+            continue  # load_study names the bad override
+        if key in keys:
+            raise ConfigError(key, "given twice by --set: give one value")
+        keys.add(key)
     return keys
 
 
-def _load(args):
-    """The study and its resolved config. ``--trials`` (or ``--set trials=``) without a chunk
+def load_run(args):
+    """The study and its resolved config, as ``sim run`` (or ``check``) with the parsed
+    ``args`` resolves them. ``--trials`` (or ``--set trials=``) without a chunk
     size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it."""
     overrides = list(args.set) + ([f"chunk={args.chunk}"] if args.chunk is not None else [])
     given = _keys_set(args.set)
@@ -157,7 +163,7 @@ def _default_out(cfg: dict, sweep: dict) -> tuple[Path, str, bool]:
 
 def _run(args) -> int:
     out = check_run_args(args)
-    study, cfg = _load(args)
+    study, cfg = load_run(args)
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
     overwrite = args.overwrite
     if out is None:
@@ -249,7 +255,7 @@ def _bounds(f) -> str:
 def _check(args) -> int:
     # the config sim run would resolve: --set trials= without a chunk picks the chunk
     args.trials = args.chunk = args.seed = None
-    study, cfg = _load(args)
+    study, cfg = load_run(args)
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
     est = estimate(cfg, sweep)

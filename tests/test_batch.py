@@ -86,7 +86,7 @@ def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
 def test_stale_only_skips_the_current_studies(tmp_path, monkeypatch):
     fa, sa = _tiny(tmp_path, "network_testfield.toml")
     fb, _ = _tiny(tmp_path, "brown_table1.toml")
-    monkeypatch.setattr(batch, "is_current", lambda f, res: Path(f).stem == fb.stem)
+    monkeypatch.setattr(batch, "is_current", lambda f, res, *_: Path(f).stem == fb.stem)
     logged = []
     done = batch.run_all(
         [fa, fb], tmp_path / "r", 2, [], stale_only=True, log=logged.append, extra={fa.stem: sa}

@@ -219,7 +219,8 @@ def test_scratch_keeps_what_the_suite_did_not_write(capsys, tmp_path, two_runs):
     argv = ["--results", str(results), "--scratch", str(scratch), "--trials", "40", *tiny[2:]]
     assert "--trials: must be at least 400" in _one_line(capsys, argv, 2)  # too few
     argv[argv.index("40")] = "400"
-    assert verify_main([*argv, "--set", "chunk=20", "--study", "brown_table1"]) == 0
+    argv[argv.index("chunk=2")] = "chunk=20"  # a key given twice by --set is refused
+    assert verify_main([*argv, "--study", "brown_table1"]) == 0
     assert "brown_table1: ok" in capsys.readouterr().out
 
 

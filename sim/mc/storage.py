@@ -14,6 +14,7 @@ import hashlib
 import json
 import os
 import platform
+import stat
 import subprocess
 import sys
 from functools import lru_cache
@@ -41,6 +42,7 @@ __all__ = [
     "read_tolerances",
     "atomic_path",
     "read_record",
+    "regular_text",
     "StageLock",
     "NonFiniteError",
 ]
@@ -262,11 +264,20 @@ RECORD = "run.json"
 LOCK = ".lock"
 
 
+def regular_text(p: str | Path) -> str:
+    """The UTF-8 text of the regular file ``p`` (a symlink followed). Anything else -- a FIFO
+    nobody writes to, a device, a directory -- raises OSError without being opened, so a
+    file put by hand where the suite keeps its own never blocks a command."""
+    if not stat.S_ISREG(os.stat(p).st_mode):
+        raise OSError(f"{p} is not a regular file")
+    return Path(p).read_text(encoding="utf-8")
+
+
 def read_record(d: str | Path) -> dict | None:
     """The run record (``run.json``) of a directory the suite wrote, or None (none, or not one
     of ours)."""
     try:
-        rec = json.loads((Path(d) / RECORD).read_text(encoding="utf-8"))
+        rec = json.loads(regular_text(Path(d) / RECORD))
     except (OSError, ValueError, RecursionError):  # RecursionError: JSON nested too deeply
         return None
     return rec if isinstance(rec, dict) and "config" in rec and "code_hash" in rec else None

@@ -326,6 +326,8 @@ MARK = "<!-- written by `sim report` from the Parquet files alone; edits are ove
 
 def _ours(path: Path) -> bool:
     """True for a REPORT.md the suite wrote (its mark, or the heading the reports had before)."""
+    if not path.is_file():  # a FIFO or a device is not ours, and is never opened (it blocks)
+        return False
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
             first = f.readline().rstrip("\n")

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 import platform
-import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -13,6 +12,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from sim.mc.children import stop_children
 from sim.mc.storage import read_provenance, read_record, versions, write_table
 from sim.report.tables import fmt, md_table
 from sim.report.verify.rules import DEFAULT_RTOL, Comparison, VerifyError, compare_dirs
@@ -116,7 +116,7 @@ def rerun_study(
         try:
             _, err = proc.communicate()
         except KeyboardInterrupt:  # Ctrl-C reaches the re-run too, SIGTERM or SIGHUP only verify
-            _stop(proc)
+            stop_children([proc], drain=True)  # as Ctrl-C does, without a word of its own
             raise
     lines = [ln for ln in err.splitlines() if ln.strip()]
     if proc.returncode == 2 and lines and (extra or lines[-1].startswith("sim: error: --")):
@@ -125,24 +125,6 @@ def rerun_study(
         raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
     sys.stderr.write(err)
     return None if proc.returncode == 0 else f"the re-run exited with {proc.returncode}"
-
-
-#: seconds an interrupted re-run has to clean up (its staging directory) before it is killed
-GRACE_S = 30
-
-
-def _stop(proc: subprocess.Popen) -> None:
-    """End an interrupted re-run as Ctrl-C does (SIGTERM: it marks its staging directory
-    resumable and ends its workers), without a word of its own; killed after GRACE_S."""
-    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):  # a second signal orphans nothing
-        signal.signal(s, signal.SIG_IGN)
-    if proc.poll() is None:
-        proc.terminate()
-    try:
-        proc.communicate(timeout=GRACE_S)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.communicate()
 
 
 def verify(

@@ -184,7 +184,8 @@ class MC:
             raise StudyError(
                 f"only {self.N} trials converged in all models (non-converged: "
                 + ", ".join(f"{m} {int(f)}" for m, f in zip(MODEL_NAMES, self.nfail))
-                + "): singular reduced normal matrix, the geometry is degenerate"
+                + "): a singular reduced normal matrix (a degenerate geometry), or the "
+                "solver stopped before converging (solver.max_iter, solver.tol_mm)"
             )
 
     def sd_from(self, total: np.ndarray) -> np.ndarray:

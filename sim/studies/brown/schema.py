@@ -9,9 +9,12 @@ import numpy as np
 
 from sim.instruments.plates import pattern_points
 from sim.instruments.ranges import multilateration as ml
+from sim.instruments.ranges import positions as po
+from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.runner import chunk_rng
 from sim.mc.schema_helpers import count, counts, positive, real
+from sim.studies.brown.values import thetas
 
 SEED = "004_f5bd9e86c308241f.txt"
 MODEL_NAMES = ("known", "stations", "pivot")
@@ -57,16 +60,23 @@ BASE = {
     "comparator.micrometer_mm": real(
         1.0, "micrometer travel added to the scale (paper: at most 1 mm)", lo=0.0, unit="mm"
     ),
-    "errors.setting_sigma_um": positive(1.0, "standard deviation of one setting", unit="um"),
+    "errors.setting_sigma_um": positive(
+        1.0, "standard deviation of one setting", hi=1e4, unit="um"
+    ),
     "errors.settings": count(1, "settings per point and position, averaged", lo=1, hi=100),
     "errors.comparator_sigma_um": real(
-        0.0, "comparator random error per reading", lo=0.0, unit="um"
+        0.0, "comparator random error per reading", lo=0.0, hi=1e4, unit="um"
     ),
     "errors.bias_um": real(
         0.0, "constant personal bias added to every range", lo=-1e4, hi=1e4, unit="um"
     ),
-    "solver.tol_mm": positive(
-        1e-10, "convergence: largest correction below this", hi=1e-3, unit="mm"
+    "solver.tol_mm": real(
+        1e-10,
+        "convergence: largest correction below this (at least 1e-15 mm: a smaller one is "
+        "never met in double precision and every trial failed)",
+        lo=1e-15,
+        hi=1e-3,
+        unit="mm",
     ),
     "solver.max_iter": count(30, "Gauss-Newton iteration limit", lo=1, hi=1000),
     "region.points": count(
@@ -110,10 +120,17 @@ TABLE1 = {
     **BASE,
     "trials": count(4000, "Monte-Carlo trials", lo=2, hi=100_000_000),
     "plate.spacing_mm": positive(45.0, "grid spacing (paper: 45 mm)", unit="mm", input=True),
-    "errors.setting_sigma_um": positive(1.7, "one setting (paper: 1.7 um)", unit="um", input=True),
+    "errors.setting_sigma_um": positive(
+        1.7, "one setting (paper: 1.7 um)", hi=1e4, unit="um", input=True
+    ),
     "errors.settings": count(2, "double settings (paper)", lo=1, hi=100, input=True),
     "errors.comparator_sigma_um": real(
-        1.1, "comparator contribution (paper: about 1.1 um)", lo=0.0, unit="um", input=True
+        1.1,
+        "comparator contribution (paper: about 1.1 um)",
+        lo=0.0,
+        hi=1e4,
+        unit="um",
+        input=True,
     ),
 }
 
@@ -224,6 +241,48 @@ def check(cfg: dict) -> None:
                 "comparator.scale_length_mm",
                 f"ranges run from {r.min():.1f} to {r.max():.1f} mm but the scale "
                 f"reads 0 to {reach:g} mm (move the stations in, or use alpha)",
+            )
+    check_pivot(cfg, key, pts)
+
+
+def pivot_rcond(pts: np.ndarray, theta: np.ndarray) -> float:
+    """The engine's singularity measure (:func:`sim.lsq.normals.scaled_rcond`, 0 for a
+    singular point block) of the pivot model's reduced normals -- the widest model the
+    studies adjust: stations, alpha and beta^2 free -- at the true points (n, 2) mm and
+    globals (7,), where the noise-free ranges are exact."""
+    r = ml.ranges(pts[None], theta[None])
+    model = po.RangeModel(r, ml.BROWN_LAYOUT, P=4, dense=True)
+    red = reduced_normals(model, pts[None], theta[None], np.arange(7))
+    return float(scaled_rcond(red.Nbar)[0]) if red.ok[0] else 0.0
+
+
+def check_pivot(cfg: dict, key: str, pts: np.ndarray) -> None:
+    """Every geometry the run adjusts with the pivot model can be solved by the engine's one
+    rule (a 2 x 2 grid cannot: its symmetry leaves the reduced normals singular, and every
+    trial failed at run time): the plate's points, and the grids of ``dilution.grids`` over
+    the plate's extent."""
+    _, theta = setup(cfg)
+    if not np.all(np.isfinite(ml.ranges(pts[None], theta[None]))):
+        return  # the scale check names the overflow when the scale is enforced
+    rc = pivot_rcond(pts, theta)
+    if not rc > RCOND:
+        raise ConfigError(
+            key,
+            f"the pivot model (stations, alpha and beta free) cannot be solved at these "
+            f"{len(pts)} points: its reduced normal matrix is singular (scaled reciprocal "
+            f"condition {rc:.2g}, the adjustment needs > {RCOND:g})",
+        )
+    ext = float(np.abs(pts).max())
+    th = thetas(cfg["plate.format_mm"], cfg["comparator.station_offset_mm"], 0.0, 0.0)[0]
+    for k in cfg.get("dilution.grids", ()):
+        g = pattern_points("grid", grid=k, spacing_mm=2.0 * ext / (k - 1))
+        rc = pivot_rcond(g, th)
+        if not rc > RCOND:
+            raise ConfigError(
+                "dilution.grids",
+                f"the pivot model cannot be solved on a {k} x {k} grid: its reduced normal "
+                f"matrix is singular (scaled reciprocal condition {rc:.2g}, the adjustment "
+                f"needs > {RCOND:g})",
             )
 
 

@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from sim.instruments.ranges import positions as po
 from sim.mc.schema_helpers import require
+from sim.studies.design.external import paper_points
 from sim.studies.design.schema import MAX_CELLS, MAX_POINTS
 
 __all__ = ["check", "max_offset_mm"]
@@ -54,6 +56,7 @@ def check(cfg: dict) -> None:
     )
     _check_geometry(cfg)
     _check_sizes(cfg)
+    _check_paper_solvable(cfg)
 
 
 def _check_geometry(cfg: dict) -> None:
@@ -89,6 +92,28 @@ def _check_geometry(cfg: dict) -> None:
             f"+-{e:g} mm holds fewer 1 cm grid intersections than zeiss.points = "
             f"{cfg['zeiss.points']}",
         )
+
+
+def _check_paper_solvable(cfg: dict) -> None:
+    """The pivot model (stations, alpha and beta free) can be solved on the paper's design by
+    the engine's one singularity rule (its cofactors are not finite where it is singular):
+    a 2 x 2 grid cannot, in any number of positions, and its run failed in an eigenvalue
+    solver naming no key."""
+    th = po.design_theta(
+        cfg["paper.positions"],
+        cfg["plate.format_mm"] / 2 + cfg["paper.offset_mm"],
+        cfg["comparator.alpha_mm"],
+        cfg["paper.beta_mm"],
+    )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        Qgg = po.covariance(paper_points(cfg)[None], th[None], "pivot")[1]
+    require(
+        bool(np.isfinite(Qgg).all()),
+        "paper.grid",
+        f"the pivot model (stations, alpha and beta free) cannot be solved on the paper's "
+        f"{cfg['paper.grid']} x {cfg['paper.grid']} grid in {cfg['paper.positions']} "
+        "positions: its reduced normal matrix is singular",
+    )
 
 
 _GRID_LISTS = (

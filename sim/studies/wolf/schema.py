@@ -52,6 +52,7 @@ SCHEMA = {
         1.0,
         "error of the known grid coordinates (paper: about +-1 um)",
         lo=0.0,
+        hi=100.0,
         unit="um",
         input=True,
     ),

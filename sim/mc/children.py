@@ -1,0 +1,51 @@
+"""Passing an interrupt on to child runs: what ``python -m sim.batch`` (its study runs) and
+``make verify`` (its re-run) do when Ctrl-C, SIGTERM or SIGHUP reaches them.
+
+Ctrl-C reaches every process of the terminal's group; SIGTERM or SIGHUP only the driver. So the
+driver ignores further signals (a second one must not orphan the children), sends SIGTERM to
+each live child (a ``sim run`` then cleans up as after Ctrl-C: its staging directory is kept
+resumable, its workers end) and waits for each, killing one still alive after
+:data:`GRACE_S` seconds.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+from collections.abc import Callable, Iterable
+
+__all__ = ["STOP_SIGNALS", "GRACE_S", "stop_children"]
+
+#: the signals that end a driver (and each of its runs) as Ctrl-C does
+STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+
+#: seconds an interrupted child run has to clean up before it is killed
+GRACE_S = 30
+
+
+def stop_children(
+    procs: Iterable[subprocess.Popen],
+    drain: bool = False,
+    first: Callable[[], None] | None = None,
+    grace: float | None = None,
+) -> None:
+    """Ignore SIGINT, SIGTERM and SIGHUP from now on, call ``first`` (e.g. a flag that starts
+    no more children), SIGTERM every live child of ``procs`` and wait for it (killed after
+    ``grace`` seconds, default :data:`GRACE_S`). ``drain``: the caller reads no pipe of the
+    children any more, so their pipes are read here (``communicate``) lest a child block on a
+    full pipe; without it, reader threads of the caller do that and a wait suffices."""
+    for s in (signal.SIGINT, *STOP_SIGNALS):
+        signal.signal(s, signal.SIG_IGN)
+    if first is not None:
+        first()
+    procs = list(procs)
+    for proc in procs:
+        if proc.poll() is None:
+            proc.terminate()
+    grace = GRACE_S if grace is None else grace
+    for proc in procs:
+        try:
+            proc.communicate(timeout=grace) if drain else proc.wait(timeout=grace)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate() if drain else proc.wait()
