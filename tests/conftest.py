@@ -52,19 +52,20 @@ def pytest_runtest_protocol(item, nextitem):
 #: --no-loadscope-reorder, or pytest-xdist would hand out the files with the most tests first
 #: instead.
 SLOW_FIRST = {
-    "test_all_studies.py": 22.9,
-    "test_docs.py": 15.7,
-    "test_verify.py": 15.4,
-    "test_batch.py": 5.1,
-    "test_network.py": 4.9,
-    "test_cli_manners.py": 3.5,
-    "test_cli.py": 3.4,
-    "test_bench.py": 3.3,
-    "test_wolf.py": 2.9,
-    "test_design.py": 2.8,
-    "test_runner.py": 2.4,
-    "test_doors_sweep.py": 2.3,
-    "test_agnard.py": 1.8,
+    "test_docs.py": 23.4,
+    "test_all_studies.py": 22.5,
+    "test_verify.py": 6.1,
+    "test_network.py": 4.2,
+    "test_bench.py": 4.1,
+    "test_batch.py": 3.8,
+    "test_cli_manners.py": 3.4,
+    "test_cli.py": 3.2,
+    "test_design.py": 3.1,
+    "test_runner.py": 2.9,
+    "test_bayes.py": 2.9,
+    "test_wolf.py": 2.8,
+    "test_doors_sweep.py": 2.7,
+    "test_figures.py": 2.3,
 }
 
 

@@ -16,7 +16,9 @@ def test_readme_worked_example(tmp_path):
     # --- README: Python API --------------------------------------------------------------
     import sim
 
-    st = sim.load(STUDY, trials=200, chunk=10, **{"errors.settings": 3})  # dotted keys
+    # the region of unprinted inputs at its smallest (docs/python.md runs it at full size)
+    small = {"region.points": 256, "region.rounds": 0}
+    st = sim.load(STUDY, trials=200, chunk=10, **{"errors.settings": 3}, **small)  # dotted keys
     st = st.replace(comparator__beta_mm=0.5)  # keyword form: __ stands for the dot
     print(st.estimate().describe())  # trials, adjustments, unknowns, memory
     res = st.run(out=tmp_path / "t1", workers=2, figures=False)  # out=None: a temp dir
@@ -48,6 +50,7 @@ def test_readme_worked_example(tmp_path):
                 "errors.settings=3",
                 "--set",
                 "comparator.beta_mm=0.5",
+                *(a for k, v in small.items() for a in ("--set", f"{k}={v}")),
             ]
         )
         == 0
