@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 from sim.batch import is_current
+from sim.cli import main
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError
 from sim.studies import load_study
@@ -523,24 +524,12 @@ def test_degenerate_networks_are_refused_at_check_naming_the_observation(values,
     assert e.value.key == key and msg in str(e.value), str(e.value)
 
 
-def test_check_refusals_are_one_line_exit_2(tmp_path):
-    r = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "sim",
-            "check",
-            str(TWO),
-            "--set",
-            'network.observations=[{kind="angle", at="B", from="B", to="F2", sigma_arcsec=1.0}]',
-        ],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
-    assert "'B'" in r.stderr and "Traceback" not in r.stderr
+def test_check_refusals_are_one_line_exit_2(capsys):
+    obs = 'network.observations=[{kind="angle", at="B", from="B", to="F2", sigma_arcsec=1.0}]'
+    code = main(["check", str(TWO), "--set", obs])  # sim check, in this process
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "'B'" in err and "Traceback" not in err
 
 
 GARBAGE = [

@@ -10,6 +10,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from sim.cli import main
 from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import ConfigError
 from sim.studies import load_study
@@ -200,46 +201,22 @@ def test_gama_export_refuses_what_gama_local_cannot_say(tmp_path):
         ),
     ],
 )
-def test_bad_networks_are_one_line_errors(override, key, tmp_path):
-    r = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "sim",
-            "check",
-            str(ROOT / "studies/network_testfield.toml"),
-            "--set",
-            override,
-        ],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+def test_bad_networks_are_one_line_errors(override, key, capsys):
+    # `sim check` in this process (the console script and python -m sim are sim.cli.main:
+    # test_cli.py)
+    code = main(["check", str(ROOT / "studies/network_testfield.toml"), "--set", override])
+    err = capsys.readouterr().err
     if key is None:  # inner constraints over fixed pillars are still a valid datum
-        assert r.returncode == 0, r.stderr
+        assert code == 0, err
         return
-    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
-    assert key in r.stderr and "Traceback" not in r.stderr
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert key in err and "Traceback" not in err
 
 
-def test_too_few_observations_is_named():
-    r = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "sim",
-            "check",
-            str(ROOT / "studies/network_plate.toml"),
-            "--set",
-            "network.generate=[]",
-        ],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert r.returncode == 2 and "0 degrees of freedom" in r.stderr, r.stderr
+def test_too_few_observations_is_named(capsys):
+    code = main(["check", str(ROOT / "studies/network_plate.toml"), "--set", "network.generate=[]"])
+    err = capsys.readouterr().err
+    assert code == 2 and "0 degrees of freedom" in err, err
 
 
 def test_rank_defect_not_covered_by_the_datum_names_it(tmp_path):

@@ -238,29 +238,16 @@ def test_table_files_that_are_not_the_table_are_rejected_by_key(tmp_path):
 
 
 @pytest.mark.parametrize("content", [bytes(range(256)) * 8, b"plate;point\n003;1\n"])
-def test_cli_bad_table_file_is_one_line_exit_2(tmp_path, content):
-    import subprocess
-    import sys
+def test_cli_bad_table_file_is_one_line_exit_2(tmp_path, content, capsys):
+    from sim.cli import main  # `sim check`, in this process (test_cli.py: the same function)
 
     f = tmp_path / "table.csv"
     f.write_bytes(content)
-    p = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "sim",
-            "check",
-            str(ROOT / "studies/wolf_polynomial.toml"),
-            "--set",
-            f"table1.file={str(f)!r}",
-        ],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-    )
-    assert p.returncode == 2
-    lines = p.stderr.strip().splitlines()
-    assert len(lines) == 1 and "table1.file" in lines[0] and "Traceback" not in p.stderr
+    study = str(ROOT / "studies/wolf_polynomial.toml")
+    assert main(["check", study, "--set", f"table1.file={str(f)!r}"]) == 2
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "table1.file" in lines[0] and "Traceback" not in err
 
 
 def _cfg(**over):
