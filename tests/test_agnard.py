@@ -422,17 +422,52 @@ def test_five_control_rows_decided_over_the_region(tiny_run):
         assert r["interval"] == "region"
         assert r["verdict"] in REGION_VERDICTS
         assert r["value"] <= r["value_high"]
-    # 8 rows of region.toml and the joint X, Y row, each with its per-point column, over the
-    # joint (layout, scanner) points; of scanner.toml over the scanner's vectors the same 9,
+    # 8 rows of region.toml and the joint X, Y row over the joint (layout, scanner) points
+    # with the projection centres, the check-Z finding over those without, each with its
+    # per-point column; of scanner.toml over the scanner's vectors the same 9,
     # the first pass's two and the digital rejections
-    assert _check_region_rows(out) == (9, 12)
+    assert _check_region_rows(out) == (10, 12)
     joint = read_table(out / "joint_region.parquet").to_pydict()
     assert len(joint["five_inset_1"]) == 2 * cfg["table1.points"]  # each vector at 2 layouts
     assert set(joint["centres_1"]) == {0.0, 1.0} and set(SCANNER_KEYS) <= set(joint)
     assert (
-        "joint points of the lost layout and the scanner"
-        in rows["agnard.control_5.check_z_cm"]["note"]
+        "of the lost layout and the scanner's inputs" in rows["agnard.control_5.check_z_cm"]["note"]
     )
+
+
+def test_five_control_predictions_over_the_papers_program_the_rest_a_finding(tiny_run):
+    """The paper names its program (SPACE-M), which carries the models' projection centres:
+    every 5-control prediction is decided over the joint points with them only (its note says
+    how many: half the joint points), and check Z without them is a finding row decided over
+    the other half, counted apart from the predictions."""
+    from sim.mc.storage import read_table
+    from sim.studies.agnard.claims import WITHOUT_CENTRES
+
+    _, cfg, out = tiny_run
+    rows = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
+    joint = read_table(out / "joint_region.parquet").to_pydict()
+    half = int(np.sum(np.asarray(joint["centres_1"]) > 0.5))
+    assert 2 * half == len(joint["centres_1"]) == 2 * cfg["table1.points"]
+    for cid in (*region_predictions(), "agnard.control_5.check_xy_holm"):
+        assert rows[cid]["interval"] == "region"  # max_residual.control_5_*: findings
+        assert f"the {half} joint points with the projection centres" in rows[cid]["note"]
+    assert WITHOUT_CENTRES == {
+        "agnard.control_5.check_z_cm": "agnard.finding.control_5_check_z_without_centres_cm"
+    }
+    f = rows["agnard.finding.control_5_check_z_without_centres_cm"]
+    assert f["kind"] == "finding" and f["interval"] == "region"
+    assert f["verdict"] == "finding"
+    assert f"the {half} joint points without the projection centres" in f["note"]
+    assert joint[f["claim"]] == joint["agnard.control_5.check_z_cm"]  # the same evidence
+
+
+def region_predictions() -> list[str]:
+    """The 5-control predictions of region.toml."""
+    from sim.claims.book_region import load_declaration
+    from sim.studies.agnard.claims import load_book
+    from sim.studies.agnard.region import DECLARATION
+
+    return list(load_declaration(DECLARATION, load_book()).predictions)
 
 
 def _check_region_rows(out) -> tuple[int, int]:
@@ -446,11 +481,15 @@ def _check_region_rows(out) -> tuple[int, int]:
     scan = read_table(out / "scanner_region.parquet").to_pydict()
     claims = read_table(out / "claims.parquet").to_pylist()
     n = [0, 0]
+    centres = np.asarray(joint["centres_1"]) > 0.5
     for c in (c for c in claims if c["interval"] == "region"):
         in_scan = c["claim"] not in joint
         table = scan if in_scan else joint
         assert c["claim"] in table, c["claim"]
-        assert c["outcome"] == region_verdict(table[c["claim"]]), c["claim"]
+        col = table[c["claim"]]
+        if not in_scan:  # a prediction over the points with centres, a finding without
+            col = [o for o, w in zip(col, centres) if w == (c["kind"] != "finding")]
+        assert c["outcome"] == region_verdict(col), c["claim"]
         n[in_scan] += 1
     return n[0], n[1]
 

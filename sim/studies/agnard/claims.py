@@ -28,6 +28,12 @@ AXES = ("x", "y", "xy", "z")
 JOINT = {b: f"agnard.{b}.check_xy_holm" for b in ("control_5", "control_21")}
 #: the members of each family
 MEMBERS = {j: [f"agnard.{b}.check_{c}_cm" for c in ("x", "y")] for b, j in JOINT.items()}
+#: the 5-control rows decided over the paper's program (its models with the projection
+#: centres, SPACE-M) whose result without them changes their meaning: the finding that keeps
+#: that result (decided over the layout points without centres, sim.studies.agnard.decide)
+WITHOUT_CENTRES = {
+    "agnard.control_5.check_z_cm": "agnard.finding.control_5_check_z_without_centres_cm",
+}
 
 
 def load_book() -> ClaimBook:
@@ -250,6 +256,8 @@ def tables23_rows(book: ClaimBook, cfg: dict, block: Block, sim: dict, c5, c21) 
                 x = 100 * sim[f"layout_{lay}.{where}_{c}_m"]
                 alt = sim[f"layout_{lay}.ctrl_given_{c}_m"] if where == "ctrl" else None
                 rows[cid] = plates(x, table_note(cfg, book, cid, lay, ctrl, n_chk, x, alt))
+                if cid in WITHOUT_CENTRES:  # at the configured inputs the same blocks
+                    rows[WITHOUT_CENTRES[cid]] = rows[cid]
         for c in ("xy", "z"):
             rows[f"agnard.max_residual.{name}_{c}_cm"] = acceptance(
                 book, cfg, name, lay, ctrl, c, sim
