@@ -442,6 +442,7 @@ def test_five_control_predictions_over_the_papers_program_the_rest_a_finding(tin
     the other half, counted apart from the predictions."""
     from sim.mc.storage import read_table
     from sim.studies.agnard.claims import WITHOUT_CENTRES
+    from sim.studies.agnard.leads import _five
 
     _, cfg, out = tiny_run
     rows = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
@@ -450,15 +451,19 @@ def test_five_control_predictions_over_the_papers_program_the_rest_a_finding(tin
     assert 2 * half == len(joint["centres_1"]) == 2 * cfg["table1.points"]
     for cid in (*region_predictions(), "agnard.control_5.check_xy_holm"):
         assert rows[cid]["interval"] == "region"  # max_residual.control_5_*: findings
-        assert f"the {half} joint points with the projection centres" in rows[cid]["note"]
+        note = rows[cid]["note"]
+        assert f"the {half} joint points of the lost layout" in note
+        assert "inputs with the projection centres (the paper's program SPACE-M" in note
     assert WITHOUT_CENTRES == {
         "agnard.control_5.check_z_cm": "agnard.finding.control_5_check_z_without_centres_cm"
     }
     f = rows["agnard.finding.control_5_check_z_without_centres_cm"]
     assert f["kind"] == "finding" and f["interval"] == "region"
     assert f["verdict"] == "finding"
-    assert f"the {half} joint points without the projection centres" in f["note"]
+    assert f"the {half} joint points of the lost layout" in f["note"]
+    assert "inputs without the projection centres (" in f["note"]
     assert joint[f["claim"]] == joint["agnard.control_5.check_z_cm"]  # the same evidence
+    assert _five(f["claim"])  # reported with the 5-control rows, not the scanner's
 
 
 def region_predictions() -> list[str]:

@@ -270,8 +270,8 @@ def over_joint(cfg, book, rows, regions, five, prov, out):
 
     def how(r: Region, centres: str) -> str:
         return (
-            f"decided over the {r.n} joint points {centres} of the lost layout and the "
-            f"scanner's inputs ({len(five)} layout points, half with and half without the "
+            f"decided over the {r.n} joint points of the lost layout and the scanner's "
+            f"inputs {centres} ({len(five)} layout points, half with and half without the "
             f"projection centres, each with 2 of the {scanner.n} scanner vectors, each vector "
             "at 2 layout points, one with and one without: sim.studies.agnard.joint): at "
             f"each, the layout's {T} blocks at the configured scanner moved by the vector's "
@@ -281,14 +281,15 @@ def over_joint(cfg, book, rows, regions, five, prov, out):
 
     def ex(cid: str) -> str:
         r = at_cfg[cid]
+        option = "without" if cid in WITHOUT_CENTRES.values() else "with"
         return (
-            f"over the layout region alone at the configured scanner (an example): "
-            f"{r['value']:.3g}-{r['value_high']:.3g}, {r['outcome']}"
+            f"over the layout region {option} the centres alone at the configured scanner "
+            f"(an example): {r['value']:.3g}-{r['value_high']:.3g}, {r['outcome']}"
         )
 
     paper = (
         "with the projection centres (the paper's program SPACE-M carries them: the paper "
-        "names it, Blais describes it), the points without them kept as a finding"
+        "names it, Blais describes it; the points without them decide a finding)"
     )
     rows = over_region(book, joint, preds, rows, lambda r: f"{how(joint, paper)}; {ex(r['claim'])}")
     rows = over_region(
