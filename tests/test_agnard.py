@@ -554,6 +554,15 @@ def test_digital_rejections_decided_over_the_scanner(tiny_run):
         assert 0.0 <= lo <= z <= hi <= 1.0
     assert REJECTED not in read_table(out / "scanner_shift.parquet").to_pydict()["claim"]
     assert "pass points per block over the scanner's" in study.report(out)
+    assert "names 82 pass points" in r["note"] and "82 is not buildable" in r["note"]
+
+
+def test_the_papers_82_pass_points_are_not_a_whole_row_pattern():
+    """The paper's first pass names 82 pass points; on its 2 x 8 block the regular pattern
+    (whole rows per strip) gives 62, 76 (the study's 4 rows) or 90, as the digital
+    rejections' note says: 82 is none of them."""
+    counts = [int(make_block(2, 8, pass_rows=r).is_pass.sum()) for r in (3, 4, 5)]
+    assert counts == [62, 76, 90] and 82 not in counts
 
 
 def test_table1_rows_are_not_comparable_because_the_scanner_region_is_empty(tiny_run):

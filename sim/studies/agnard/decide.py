@@ -24,7 +24,7 @@ from sim.claims.inference import Region
 from sim.claims.region import OUTCOME_NAMES, inputs_table, outcomes, region_table, statement_of
 from sim.mc.storage import write_table
 from sim.report.region import fig_region
-from sim.studies.agnard.claims import JOINT, MEMBERS, WITHOUT_CENTRES
+from sim.studies.agnard.claims import JOINT, MEMBERS, PASS_82, WITHOUT_CENTRES
 from sim.studies.agnard.joint import joint_region, layout_points, pairs_of, with_option
 from sim.studies.agnard.leads import HOW
 from sim.studies.agnard.paired import z_box
@@ -196,7 +196,7 @@ def over_scanner(book, scanner, preds, rows, k: int, n: int) -> list[dict]:
         lambda r: (
             f"{counted}; {_zeros(region, r['claim'], k)}; at the configured scanner (an "
             f"example): median {r['value']:.3g}, 95 % of blocks {r['ci_low']:.3g}-"
-            f"{r['ci_high']:.3g}, outcome {r['outcome']}"
+            f"{r['ci_high']:.3g}, outcome {r['outcome']}{_pass_count(r['note'])}"
         ),
     )
     why = f"no vector decides it with {k} pairs (the share of blocks that lose none, below)"
@@ -214,6 +214,13 @@ def over_scanner(book, scanner, preds, rows, k: int, n: int) -> list[dict]:
     )
     joint = family_over(_fresh(book), region, j21, MEMBERS[j21], f"{how}; {ex}", n=n)
     return [joint if r["claim"] == j21 else r for r in rows]
+
+
+def _pass_count(note: str) -> str:
+    """The configured row's word on the pass-point count (the paper's 82, the block's own),
+    kept in the row decided over the scanner."""
+    i = note.find(PASS_82)
+    return "" if i < 0 else ". " + note[i:]
 
 
 def _zeros(region, cid: str, k: int) -> str:
