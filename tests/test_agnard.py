@@ -422,17 +422,57 @@ def test_five_control_rows_decided_over_the_region(tiny_run):
         assert r["interval"] == "region"
         assert r["verdict"] in REGION_VERDICTS
         assert r["value"] <= r["value_high"]
-    # 8 rows of region.toml and the joint X, Y row, each with its per-point column, over the
-    # joint (layout, scanner) points; of scanner.toml over the scanner's vectors the same 9,
+    # 8 rows of region.toml and the joint X, Y row over the joint (layout, scanner) points
+    # with the projection centres, the check-Z finding over those without, each with its
+    # per-point column; of scanner.toml over the scanner's vectors the same 9,
     # the first pass's two and the digital rejections
-    assert _check_region_rows(out) == (9, 12)
+    assert _check_region_rows(out) == (10, 12)
     joint = read_table(out / "joint_region.parquet").to_pydict()
     assert len(joint["five_inset_1"]) == 2 * cfg["table1.points"]  # each vector at 2 layouts
     assert set(joint["centres_1"]) == {0.0, 1.0} and set(SCANNER_KEYS) <= set(joint)
     assert (
-        "joint points of the lost layout and the scanner"
-        in rows["agnard.control_5.check_z_cm"]["note"]
+        "of the lost layout and the scanner's inputs" in rows["agnard.control_5.check_z_cm"]["note"]
     )
+
+
+def test_five_control_predictions_over_the_papers_program_the_rest_a_finding(tiny_run):
+    """The paper names its program (SPACE-M), which carries the models' projection centres:
+    every 5-control prediction is decided over the joint points with them only (its note says
+    how many: half the joint points), and check Z without them is a finding row decided over
+    the other half, counted apart from the predictions."""
+    from sim.mc.storage import read_table
+    from sim.studies.agnard.claims import WITHOUT_CENTRES
+    from sim.studies.agnard.leads import _five
+
+    _, cfg, out = tiny_run
+    rows = {r["claim"]: r for r in read_table(out / "claims.parquet").to_pylist()}
+    joint = read_table(out / "joint_region.parquet").to_pydict()
+    half = int(np.sum(np.asarray(joint["centres_1"]) > 0.5))
+    assert 2 * half == len(joint["centres_1"]) == 2 * cfg["table1.points"]
+    for cid in (*region_predictions(), "agnard.control_5.check_xy_holm"):
+        assert rows[cid]["interval"] == "region"  # max_residual.control_5_*: findings
+        note = rows[cid]["note"]
+        assert f"the {half} joint points of the lost layout" in note
+        assert "inputs with the projection centres (the paper's program SPACE-M" in note
+    assert WITHOUT_CENTRES == {
+        "agnard.control_5.check_z_cm": "agnard.finding.control_5_check_z_without_centres_cm"
+    }
+    f = rows["agnard.finding.control_5_check_z_without_centres_cm"]
+    assert f["kind"] == "finding" and f["interval"] == "region"
+    assert f["verdict"] == "finding"
+    assert f"the {half} joint points of the lost layout" in f["note"]
+    assert "inputs without the projection centres (" in f["note"]
+    assert joint[f["claim"]] == joint["agnard.control_5.check_z_cm"]  # the same evidence
+    assert _five(f["claim"])  # reported with the 5-control rows, not the scanner's
+
+
+def region_predictions() -> list[str]:
+    """The 5-control predictions of region.toml."""
+    from sim.claims.book_region import load_declaration
+    from sim.studies.agnard.claims import load_book
+    from sim.studies.agnard.region import DECLARATION
+
+    return list(load_declaration(DECLARATION, load_book()).predictions)
 
 
 def _check_region_rows(out) -> tuple[int, int]:
@@ -446,11 +486,15 @@ def _check_region_rows(out) -> tuple[int, int]:
     scan = read_table(out / "scanner_region.parquet").to_pydict()
     claims = read_table(out / "claims.parquet").to_pylist()
     n = [0, 0]
+    centres = np.asarray(joint["centres_1"]) > 0.5
     for c in (c for c in claims if c["interval"] == "region"):
         in_scan = c["claim"] not in joint
         table = scan if in_scan else joint
         assert c["claim"] in table, c["claim"]
-        assert c["outcome"] == region_verdict(table[c["claim"]]), c["claim"]
+        col = table[c["claim"]]
+        if not in_scan:  # a prediction over the points with centres, a finding without
+            col = [o for o, w in zip(col, centres) if w == (c["kind"] != "finding")]
+        assert c["outcome"] == region_verdict(col), c["claim"]
         n[in_scan] += 1
     return n[0], n[1]
 
@@ -510,6 +554,15 @@ def test_digital_rejections_decided_over_the_scanner(tiny_run):
         assert 0.0 <= lo <= z <= hi <= 1.0
     assert REJECTED not in read_table(out / "scanner_shift.parquet").to_pydict()["claim"]
     assert "pass points per block over the scanner's" in study.report(out)
+    assert "names 82 pass points" in r["note"] and "82 is not buildable" in r["note"]
+
+
+def test_the_papers_82_pass_points_are_not_a_whole_row_pattern():
+    """The paper's first pass names 82 pass points; on its 2 x 8 block the regular pattern
+    (whole rows per strip) gives 62, 76 (the study's 4 rows) or 90, as the digital
+    rejections' note says: 82 is none of them."""
+    counts = [int(make_block(2, 8, pass_rows=r).is_pass.sum()) for r in (3, 4, 5)]
+    assert counts == [62, 76, 90] and 82 not in counts
 
 
 def test_table1_rows_are_not_comparable_because_the_scanner_region_is_empty(tiny_run):

@@ -9,11 +9,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.claims.book_region import load_declaration
+from sim.claims.book_region import load_declaration, region_rows
 from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Region, status
 from sim.claims.region import outcomes, statement_of
-from sim.studies.agnard.claims import load_book
-from sim.studies.agnard.joint import joint_region, layout_points, pairs_of
+from sim.studies.agnard.claims import WITHOUT_CENTRES, load_book
+from sim.studies.agnard.joint import joint_region, layout_points, pairs_of, with_option
 from sim.studies.agnard.paired import z_box
 from sim.studies.agnard.paired_count import cdf_shift, count_evidence, mean_shift
 from sim.studies.agnard.region import CENTRES, CONFIGURED, DECLARATION, REJECTED, SCANNER
@@ -130,14 +130,10 @@ def test_the_joint_design_is_balanced():
     assert set(use) == {2}
 
 
-def test_a_joint_point_is_decided_by_its_vectors_shift_at_its_layout():
-    """Check Z of one layout point, configured median 27 cm (95 % of blocks inside the
-    22.7-35.3 zone's neighbourhood: undecided). Vector 0 makes every paired block 60 %
-    larger at that layout: the joint point fails; vector 1 leaves it: undecided. At the
-    other layout point (with centres, blocks far below the zone) vector 1's +60 % still
-    leaves p < 0.05 below it (fails), vector 0's nothing (fails too): the shift is read at
-    the point's own layout, not at another."""
-    book = load_book()
+def _two_by_two(book) -> Region:
+    """The joint region of two layout points (inset 0.2 without and with centres: configured
+    check Z medians 27 and 12 cm) and two scanner vectors (vector 0 makes the blocks 60 %
+    larger at the point without centres, vector 1 at the one with)."""
     rng = np.random.default_rng(5)
     med = {0: 27.0, 1: 12.0}
     lay, stats = _layout_region(
@@ -158,6 +154,42 @@ def test_a_joint_point_is_decided_by_its_vectors_shift_at_its_layout():
             p[f"five{li}:{CHECK_Z}"] = cb * grow[(j, li)] * np.exp(0.01 * rng.standard_normal(48))
         sstats.append(p)
     joint = joint_region(book, lay, stats, scanner, sstats, five, [CHECK_Z])
+    return joint
+
+
+def test_the_predictions_use_the_centres_the_finding_the_rest():
+    """The paper's program carries the projection centres: a prediction decided over the
+    joint points with them (check Z fails at both: fails), the finding over those without
+    (fails at one, undecided at the other: fails or undecided), each region holding only
+    its option's points and their evidence."""
+    book = load_book()
+    joint = _two_by_two(book)
+    with_c, without = with_option(joint, True), with_option(joint, False)
+    assert with_c.n == without.n == 2
+    assert set(with_c.x[CENTRES]) == {1.0} and set(without.x[CENTRES]) == {0.0}
+    for r, v in ((with_c, 1.0), (without, 0.0)):
+        keep = np.asarray(joint.x[CENTRES]) == v
+        for q, a in joint.outputs[CHECK_Z].items():
+            assert np.array_equal(r.outputs[CHECK_Z][q], np.asarray(a)[keep])
+    finding = WITHOUT_CENTRES[CHECK_Z]
+    without.outputs[finding] = without.outputs[CHECK_Z]
+    (pred,) = region_rows(book, with_c, [CHECK_Z])
+    (found,) = region_rows(book, without, [finding])
+    assert pred["outcome"] == "fails" and pred["verdict"] == "fails"
+    assert found["outcome"] == "fails or undecided" and found["verdict"] == "finding"
+    assert book.spec(finding)["kind"] == "finding"
+    assert book.spec(finding)["ref"] == book.spec(CHECK_Z)["ref"]
+
+
+def test_a_joint_point_is_decided_by_its_vectors_shift_at_its_layout():
+    """Check Z of one layout point, configured median 27 cm (95 % of blocks inside the
+    22.7-35.3 zone's neighbourhood: undecided). Vector 0 makes every paired block 60 %
+    larger at that layout: the joint point fails; vector 1 leaves it: undecided. At the
+    other layout point (with centres, blocks far below the zone) vector 1's +60 % still
+    leaves p < 0.05 below it (fails), vector 0's nothing (fails too): the shift is read at
+    the point's own layout, not at another."""
+    book = load_book()
+    joint = _two_by_two(book)
     assert joint.n == 4 and joint.accepted.all()
     o = outcomes(joint, statement_of(book, CHECK_Z))
     at = {

@@ -20,11 +20,12 @@ import numpy as np
 from sim.claims.book import ClaimBook
 from sim.claims.book_region import statements, write_explored
 from sim.claims.family import family_evidence, family_outcomes, family_over
+from sim.claims.inference import Region
 from sim.claims.region import OUTCOME_NAMES, inputs_table, outcomes, region_table, statement_of
 from sim.mc.storage import write_table
 from sim.report.region import fig_region
-from sim.studies.agnard.claims import JOINT, MEMBERS
-from sim.studies.agnard.joint import joint_region, layout_points, pairs_of
+from sim.studies.agnard.claims import JOINT, MEMBERS, PASS_82, WITHOUT_CENTRES
+from sim.studies.agnard.joint import joint_region, layout_points, pairs_of, with_option
 from sim.studies.agnard.leads import HOW
 from sim.studies.agnard.paired import z_box
 from sim.studies.agnard.paired_count import cdf_shift, mean_shift
@@ -195,7 +196,7 @@ def over_scanner(book, scanner, preds, rows, k: int, n: int) -> list[dict]:
         lambda r: (
             f"{counted}; {_zeros(region, r['claim'], k)}; at the configured scanner (an "
             f"example): median {r['value']:.3g}, 95 % of blocks {r['ci_low']:.3g}-"
-            f"{r['ci_high']:.3g}, outcome {r['outcome']}"
+            f"{r['ci_high']:.3g}, outcome {r['outcome']}{_pass_count(r['note'])}"
         ),
     )
     why = f"no vector decides it with {k} pairs (the share of blocks that lose none, below)"
@@ -213,6 +214,13 @@ def over_scanner(book, scanner, preds, rows, k: int, n: int) -> list[dict]:
     )
     joint = family_over(_fresh(book), region, j21, MEMBERS[j21], f"{how}; {ex}", n=n)
     return [joint if r["claim"] == j21 else r for r in rows]
+
+
+def _pass_count(note: str) -> str:
+    """The configured row's word on the pass-point count (the paper's 82, the block's own),
+    kept in the row decided over the scanner."""
+    i = note.find(PASS_82)
+    return "" if i < 0 else ". " + note[i:]
 
 
 def _zeros(region, cid: str, k: int) -> str:
@@ -244,39 +252,73 @@ def _aside(book, region):
 
 
 def over_joint(cfg, book, rows, regions, five, prov, out):
-    """The 5-control rows decided over the joint (layout, scanner) points (:mod:`.joint`);
-    ``regions``: the layout region, its predictions and statistics, the scanner region and
-    its statistics. Their verdicts over the layout region at the configured scanner are kept
-    in the notes as an example. Writes ``joint_region.parquet`` (per joint point its inputs,
-    every row's outcome and value)."""
+    """The 5-control rows decided over the joint (layout, scanner) points (:mod:`.joint`)
+    with the projection centres: the paper's program, SPACE-M, carries them (the paper names
+    it; Blais's description), so its predictions are decided over those points only; each
+    row of :data:`~.claims.WITHOUT_CENTRES` keeps the result over the points without them as
+    a finding. ``regions``: the layout region, its predictions and statistics, the scanner
+    region and its statistics. Their verdicts over the layout region at the configured
+    scanner (with, for a finding without, the centres) are kept in the notes as an example.
+    Writes ``joint_region.parquet`` (per joint point, with and without centres, its inputs,
+    every row's outcome and value: a prediction's row decided over the points with centres,
+    a finding's over those without)."""
     layout, preds, layout_stats, scanner, scanner_stats = regions
     T = cfg["region.trials"]
     j5 = JOINT["control_5"]
-    at_cfg = over_region(book, layout, preds, rows, partial(_example, "layout"))
-    at_cfg = {r["claim"]: r for r in at_cfg}
-    at_cfg[j5] = family_over(_fresh(book), layout, j5, MEMBERS[j5], n=T)
-    joint = _aside(
-        book, joint_region(book, layout, layout_stats, scanner, scanner_stats, five, preds)
+    lay_with, lay_without = with_option(layout, True), _findings(with_option(layout, False))
+    at_cfg = {r["claim"]: r for r in over_region(book, lay_with, preds, rows, lambda r: "")}
+    found = over_region(book, lay_without, [*WITHOUT_CENTRES.values()], rows, lambda r: "")
+    at_cfg.update({r["claim"]: r for r in found if r["claim"] in WITHOUT_CENTRES.values()})
+    at_cfg[j5] = family_over(_fresh(book), lay_with, j5, MEMBERS[j5], n=T)
+    both = _findings(
+        _aside(book, joint_region(book, layout, layout_stats, scanner, scanner_stats, five, preds))
     )
-    how = (
-        f"decided over {joint.n} joint points of the lost layout and the scanner's inputs "
-        f"({len(five)} layout points, each with 2 of the {scanner.n} scanner vectors, each "
-        "vector at 2 layout points: sim.studies.agnard.joint): at each, the layout's "
-        f"{T} blocks at the configured scanner moved by the vector's paired shift on "
-        f"{cfg['table1.trials']} blocks adjusted with the same control (common random numbers)"
-    )
+    joint, without = with_option(both, True), with_option(both, False)
+
+    def how(r: Region, centres: str) -> str:
+        return (
+            f"decided over the {r.n} joint points of the lost layout and the scanner's "
+            f"inputs {centres} ({len(five)} layout points, half with and half without the "
+            f"projection centres, each with 2 of the {scanner.n} scanner vectors, each vector "
+            "at 2 layout points, one with and one without: sim.studies.agnard.joint): at "
+            f"each, the layout's {T} blocks at the configured scanner moved by the vector's "
+            f"paired shift on {cfg['table1.trials']} blocks adjusted with the same control "
+            "(common random numbers)"
+        )
 
     def ex(cid: str) -> str:
         r = at_cfg[cid]
+        option = "without" if cid in WITHOUT_CENTRES.values() else "with"
         return (
-            f"over the layout region alone at the configured scanner (an example): "
-            f"{r['value']:.3g}-{r['value_high']:.3g}, {r['outcome']}"
+            f"over the layout region {option} the centres alone at the configured scanner "
+            f"(an example): {r['value']:.3g}-{r['value_high']:.3g}, {r['outcome']}"
         )
 
-    rows = over_region(book, joint, preds, rows, lambda r: f"{how}; {ex(r['claim'])}")
-    five_row = family_over(_fresh(book), joint, j5, MEMBERS[j5], f"{how}; {ex(j5)}", n=T)
-    cols = region_table(joint, statements(book, preds), values=preds)
-    fam = family_outcomes(book, joint, MEMBERS[j5], n=T)[1][joint.accepted]
+    paper = (
+        "with the projection centres (the paper's program SPACE-M carries them: the paper "
+        "names it, Blais describes it; the points without them decide a finding)"
+    )
+    rows = over_region(book, joint, preds, rows, lambda r: f"{how(joint, paper)}; {ex(r['claim'])}")
+    rows = over_region(
+        book,
+        without,
+        [*WITHOUT_CENTRES.values()],
+        rows,
+        lambda r: f"{how(without, 'without the projection centres')}; {ex(r['claim'])}",
+    )
+    five_row = family_over(
+        _fresh(book), joint, j5, MEMBERS[j5], f"{how(joint, paper)}; {ex(j5)}", n=T
+    )
+    found = [*preds, *WITHOUT_CENTRES.values()]  # every point's outcome of each
+    cols = region_table(both, statements(book, found), values=found)
+    fam = family_outcomes(book, both, MEMBERS[j5], n=T)[1][both.accepted]
     cols[j5] = [OUTCOME_NAMES[int(o)] for o in fam]
     write_table(out / "joint_region.parquet", cols, prov)
     return [five_row if r["claim"] == j5 else r for r in rows]
+
+
+def _findings(region: Region) -> Region:
+    """``region`` (the points without the projection centres) with the evidence of each
+    finding row of :data:`~.claims.WITHOUT_CENTRES` that of its prediction there."""
+    region.outputs.update({f: region.outputs[c] for c, f in WITHOUT_CENTRES.items()})
+    return region

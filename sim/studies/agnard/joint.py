@@ -9,6 +9,11 @@ vector stays). The scanner moves the 5-control rows well beyond their Monte-Carl
 (check X / Y / Z up to +18 / +26 / +54 %), so a row is decided over *joint* points
 (layout, scanner): it holds if it holds at every one, fails if it fails at every one,
 otherwise depends, with where (:func:`sim.claims.region.region_verdict`).
+The paper names its program, SPACE-M, which carries each model's projection centres as
+model points (Blais's description of the program): the predictions are decided over the
+joint points *with* the centres only, and those without them decide the finding rows
+(what the rows would be had the program not carried them; :func:`with_option`,
+:func:`sim.studies.agnard.decide.over_joint`).
 
 The design: a balanced joint design, not the full product. The full product (32 layout
 points x 16 vectors, each pair on the scanner region's 48 paired blocks) costs one 5-control
@@ -19,7 +24,8 @@ options, and spreads the insets: :data:`JOINT_INSETS` insets of the layout regio
 its range (its smallest and largest among them) with and without centres, 16 layout points;
 vector ``j`` is paired with two of them, without centres at inset ``j mod L`` and with centres
 at inset ``(j + L/2) mod L`` (:func:`pairs_of`), so each vector sees both options at two
-insets half the range apart and each layout point two vectors: 32 joint points, 48
+insets half the range apart and each layout point two vectors: 32 joint points (16 with
+centres, deciding the predictions, 16 without, deciding the findings), 48
 adjustments (the configured scanner's 16 and the vectors' 32), about 6 s of CPU (measured
 with the digital snooping of :mod:`.paired_count` on the same blocks: the scanner part
 grows from 7.6-8.3 s to 18.7-19.1 s of CPU, main and this code back to back). Each
@@ -49,7 +55,7 @@ from sim.claims.inference import Region
 from sim.studies.agnard.paired import paired_evidence
 from sim.studies.agnard.region import CENTRES, CONFIGURED
 
-__all__ = ["JOINT_INSETS", "layout_points", "pairs_of", "joint_region"]
+__all__ = ["JOINT_INSETS", "layout_points", "pairs_of", "joint_region", "with_option"]
 
 #: insets of the layout region in the joint design (each with and without centres)
 JOINT_INSETS = 8
@@ -131,4 +137,30 @@ def joint_region(
         scanner.level,
         {**layout.resolution, **scanner.resolution},
         ev,
+    )
+
+
+def with_option(region: Region, centres: bool) -> Region:
+    """The points of ``region`` (a layout or joint region) with the projection centres
+    (``centres`` true: the paper's program, SPACE-M, carries them, so the predictions are
+    decided over these) or without them (the finding rows): the same inputs, statements and
+    resolution; the status and each evidence array (leading axis the points) of those
+    points only."""
+    keep = (np.asarray(region.x[CENTRES], float) > 0.5) == centres
+    n = region.n
+
+    def cut(v):
+        if isinstance(v, dict):
+            return {q: cut(a) for q, a in v.items()}
+        a = np.asarray(v) if v is not None else None
+        return a[keep] if a is not None and a.ndim >= 1 and a.shape[0] == n else v
+
+    return Region(
+        region.inputs,
+        region.statements,
+        {k: np.asarray(v)[keep] for k, v in region.x.items()},
+        region.status[keep],
+        region.level,
+        region.resolution,
+        {k: cut(v) for k, v in region.outputs.items()},
     )

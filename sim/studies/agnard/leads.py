@@ -35,8 +35,10 @@ def five_lead(out: Path, cfg: dict) -> list[str]:
         "scanner, the same ones adjusted once per layout (common random numbers), whose "
         "noise enters the decision"
         + (
-            f"; each verdict is over {n} joint (layout, scanner) points, the layout's blocks "
-            "moved by each scanner vector's paired shift at that layout "
+            f"; each prediction is decided over the {n // 2} of {n} joint (layout, scanner) "
+            "points with the projection centres (the paper's program, SPACE-M, carries "
+            "them), the finding of check Z without them over the other half, the layout's "
+            "blocks moved by each scanner vector's paired shift at that layout "
             "(`joint_region.parquet`, sim.studies.agnard.joint); the region's columns "
             "below are at the configured scanner"
             if n
@@ -124,4 +126,6 @@ def _scanner_predictions(verdicts: list[list[str]]) -> list[str]:
 
 def _five(cid: str) -> bool:
     """A row decided over the five-point layout's region (not the scanner's)."""
-    return cid.startswith(("agnard.control_5.", "agnard.max_residual.control_5_"))
+    return cid.startswith(
+        ("agnard.control_5.", "agnard.max_residual.control_5_", "agnard.finding.control_5_")
+    )

@@ -5,8 +5,9 @@ constrained by Table 1 (issue 21, :mod:`sim.claims.inference`).
 Figure 5, the layout of the five control points of the third pass, is lost. ``region.toml``
 declares the layout by one number, how far the four outer points stand inwards from the block
 corners, over the range the block allows, and the program's option of carrying each model's
-projection centres as model points (SPACE-M does; the paper does not say whether its run
-did: ``centres_1``, explored at 0 and 1, :mod:`sim.instruments.block.centres`); nothing the
+projection centres as model points (``centres_1``, explored at 0 and 1,
+:mod:`sim.instruments.block.centres`: the paper's program, SPACE-M, carries them, so the
+predictions are decided at 1 and the points at 0 decide findings); nothing the
 paper prints constrains them (its Table's numbers are the predictions), so the region is the
 whole range and each 5-control row is decided over it: holds / fails everywhere, depends
 (with the insets and option where it holds), or undecidable, over joint points of this

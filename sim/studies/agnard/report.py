@@ -13,6 +13,7 @@ import numpy as np
 from sim.lsq import distributions as D
 from sim.report.markdown import fmt, md_table
 from sim.report.section import config, rows, section, table
+from sim.studies.agnard.claims import WITHOUT_CENTRES
 from sim.studies.agnard.leads import five_lead, scanner_lead
 from sim.studies.agnard.schema import SCHEMA
 
@@ -72,6 +73,10 @@ def _table1_line(c: dict) -> str:
     )
 
 
+#: check Z of the 5-control pass without the projection centres (a finding)
+WITHOUT_Z = WITHOUT_CENTRES["agnard.control_5.check_z_cm"]
+
+
 def _span(row: dict, digits: int = 3) -> str:
     """A row's value, or its range over a region (``value``-``value_high``)."""
     lo, hi = row["value"], row.get("value_high")
@@ -95,9 +100,11 @@ def _claim_lines(c: dict) -> list[str]:
         "the scanner's inputs together: check X and Y as one Holm test "
         f"*{vd('agnard.control_5.check_xy_holm')}*, Z "
         f"{v('agnard.control_5.check_z_cm')}-{fmt(c['agnard.control_5.check_z_cm']['value_high'])} "
-        f"cm (*{vd('agnard.control_5.check_z_cm')}*, with and without the "
-        "models' projection centres as model points: the centres tie consecutive models in "
-        "height). The printed XY columns are the quadrature of X and Y (paper-checks: "
+        f"cm (*{vd('agnard.control_5.check_z_cm')}*), with the models' projection centres "
+        "as model points, as the paper's program SPACE-M carries them (the centres tie "
+        "consecutive models in height); without them, a finding: Z "
+        f"{_span(c[WITHOUT_Z])} cm (*{c[WITHOUT_Z]['outcome']}*). "
+        "The printed XY columns are the quadrature of X and Y (paper-checks: "
         + ", ".join(
             f"{k.split('.')[1]} {k.split('.')[2][:-6]} *{vd(k)}*"
             for k in c
