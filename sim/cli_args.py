@@ -9,10 +9,37 @@ from importlib import metadata
 from sim.mc.config import ConfigError
 from sim.mc.runner import MIN_CHUNKS
 
-__all__ = ["parser"]
+__all__ = ["OnceParser", "parser"]
 
 
-class _Parser(argparse.ArgumentParser):
+class _Once(argparse.Action):
+    """Store an option's value and refuse a second one: ``--trials 40 --trials 60`` (or
+    ``--out A --out B``, ``--results A --results B``) ran with the last and dropped the first
+    without a word, as ``--set seed=3 --set seed=4`` did before the eighth sweep."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = parser.__dict__.setdefault("given_once", set())
+        if self.dest in given:
+            parser.error(f"argument {'/'.join(self.option_strings)}: given twice: give one value")
+        given.add(self.dest)
+        setattr(namespace, self.dest, values)
+
+
+class OnceParser(argparse.ArgumentParser):
+    """argparse where an option that takes one value may be given once (lists use
+    ``action="append"``)."""
+
+    def add_argument(self, *args, **kwargs):
+        if args and str(args[0]).startswith("-") and "action" not in kwargs:
+            kwargs["action"] = _Once
+        return super().add_argument(*args, **kwargs)
+
+    def parse_known_args(self, args=None, namespace=None):
+        self.given_once = set()  # each parse starts afresh (a parser may be used again)
+        return super().parse_known_args(args, namespace)
+
+
+class _Parser(OnceParser):
     """argparse with one-line errors (exit 2 through :func:`main`, no usage dump)."""
 
     def error(self, message: str):
