@@ -25,12 +25,18 @@ class _Once(argparse.Action):
         setattr(namespace, self.dest, values)
 
 
+#: the options that decide what is computed or where it is written: given twice, one value
+#: would be dropped. The others (``--workers``, ``--executor``, ``--jobs``, the limits) change
+#: no number; a later one wins, as in argparse, so a default put first can be overridden
+#: (tests/conftest.py's ``--workers 1 ... --workers 2``, the Makefile's ``VERIFY_FLAGS``)
+ONCE = frozenset({"--out", "--trials", "--chunk", "--seed", "--results", "--timings"})
+
+
 class OnceParser(argparse.ArgumentParser):
-    """argparse where an option that takes one value may be given once (lists use
-    ``action="append"``)."""
+    """argparse where an option of :data:`ONCE` may be given once."""
 
     def add_argument(self, *args, **kwargs):
-        if args and str(args[0]).startswith("-") and "action" not in kwargs:
+        if args and args[0] in ONCE and "action" not in kwargs:
             kwargs["action"] = _Once
         return super().add_argument(*args, **kwargs)
 

@@ -8,7 +8,11 @@ failed on the code before its fix.
 * an option that takes one value given twice (``sim run --trials 40 --trials 60``, ``--out A
   --out B``, ``sim report --results A --results B``, ``python -m sim.batch --results A
   --results B``) ran with the last value and dropped the first without a word (the eighth
-  sweep's ``--set`` class, in the options themselves).
+  sweep's ``--set`` class, in the options themselves);
+* ``sim run`` without ``--out`` judged the run against ``results/<study kind>``: every
+  network file (kind ``network``) wrote into a new ``results/network/`` beside the committed
+  ``results/network_brown/``, and ``agnard_block_104.toml`` was compared with
+  ``results/agnard_block/``. It is now ``results/<file name>``, where ``make`` writes it.
 """
 
 from pathlib import Path
@@ -33,7 +37,7 @@ def test_an_option_given_twice_is_refused_not_dropped(capsys):
     study = str(ROOT / "studies" / "network_brown.toml")
     cases = [
         (main, ["run", study, "--trials", "40", "--trials", "60"], "--trials"),
-        (main, ["run", study, "--workers", "1", "--workers", "1"], "--workers"),
+        (main, ["run", study, "--seed", "1", "--seed", "1"], "--seed"),
         (main, ["report", "--results", "a", "--results", "b"], "--results"),
         (sim.batch.main, ["--results", "a", "--results", "b", study], "--results"),
         (sim.batch.main, [study, "--", "--out", "a", "--ou", "b"], "--out"),
@@ -42,3 +46,17 @@ def test_an_option_given_twice_is_refused_not_dropped(capsys):
         assert fn(argv) == 2, argv
         err = capsys.readouterr().err.strip()
         assert f"argument {opt}: given twice" in err and "\n" not in err, (argv, err)
+
+
+def test_a_run_without_out_is_judged_against_its_own_files_results(tmp_path, monkeypatch, capsys):
+    # sim run studies/network_brown.toml (no --out) wrote into a new results/network/ (the
+    # study kind's name): the committed results of the file are results/network_brown/
+    monkeypatch.chdir(tmp_path)
+    study = tmp_path / "network_brown.toml"
+    study.write_text((ROOT / "studies" / "network_brown.toml").read_text())
+    committed = tmp_path / "results" / "network_brown"
+    argv = ["run", str(study), "--quiet", "--no-figures", "--trials", "40"]
+    assert main([*argv, "--out", str(committed)]) == 0
+    assert main([*argv, "--seed", "5"]) == 0
+    assert "writing to scratch/network_brown-" in capsys.readouterr().err
+    assert sorted(p.name for p in (tmp_path / "results").iterdir()) == ["network_brown"]
