@@ -12,7 +12,9 @@ failed on the code before its fix.
 * ``sim run`` without ``--out`` judged the run against ``results/<study kind>``: every
   network file (kind ``network``) wrote into a new ``results/network/`` beside the committed
   ``results/network_brown/``, and ``agnard_block_104.toml`` was compared with
-  ``results/agnard_block/``. It is now ``results/<file name>``, where ``make`` writes it.
+  ``results/agnard_block/``. It is now ``results/<file name>``, where ``make`` writes it;
+* ``SIM_MAX_MEMORY_GB`` of non-ASCII digits (Arabic-Indic ``٨``) was read as 8 (the sixth
+  sweep's Gama class, in an environment variable; the option refuses it).
 """
 
 from pathlib import Path
@@ -60,3 +62,10 @@ def test_a_run_without_out_is_judged_against_its_own_files_results(tmp_path, mon
     assert main([*argv, "--seed", "5"]) == 0
     assert "writing to scratch/network_brown-" in capsys.readouterr().err
     assert sorted(p.name for p in (tmp_path / "results").iterdir()) == ["network_brown"]
+
+
+def test_a_limit_of_non_ascii_digits_in_the_environment_is_refused(capsys, monkeypatch):
+    monkeypatch.setenv("SIM_MAX_MEMORY_GB", "\u0668")
+    assert main(["check", str(ROOT / "studies" / "network_brown.toml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("sim: error: SIM_MAX_MEMORY_GB: must be a number") and "\n" not in err
