@@ -22,7 +22,6 @@ file is bad input: one line, exit 2.
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import io
 import json
@@ -41,6 +40,7 @@ single_threaded_blas()  # before NumPy loads (the study modules import it)
 
 from sim.cli import __doc__ as cli_doc  # noqa: E402
 from sim.cli import check_run_args, load_run  # noqa: E402
+from sim.cli_args import OnceParser  # noqa: E402
 from sim.cli_args import parser as run_parser  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, stop_children  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
@@ -231,7 +231,7 @@ class _BadArgs(ValueError):
     pass
 
 
-class _Parser(argparse.ArgumentParser):
+class _Parser(OnceParser):
     def error(self, message: str):  # one line, exit 2 (main prints it)
         raise _BadArgs(message)
 

@@ -135,11 +135,15 @@ def _differs(old: dict, record: dict) -> str:
     return "the code changed since they were made"
 
 
-def _default_out(cfg: dict, sweep: dict) -> tuple[Path, str, bool]:
-    """Without --out: ``results/<study>`` when it holds this very run (config and code) or
-    does not exist, else ``scratch/<study>-<config hash>`` (said on standard error). Returns
-    ``(absolute path, shown path, overwrite)``; a scratch directory is replaced freely."""
-    committed = Path("results") / cfg["study"]
+def _default_out(cfg: dict, sweep: dict, name: str) -> tuple[Path, str, bool]:
+    """Without --out: ``results/<name>`` (``name`` the study file's, where ``make reproduce``
+    writes it, or the study kind's when only that exists) when it holds this very run (config and code) or does not exist, else
+    ``scratch/<name>-<config hash>`` (said on standard error). Returns ``(absolute path,
+    shown path, overwrite)``; a scratch directory is replaced freely. (By the study kind,
+    ``studies/network_brown.toml`` wrote into a new ``results/network/``.)"""
+    if not (Path("results") / name).exists() and (Path("results") / cfg["study"]).exists():
+        name = cfg["study"]  # a copy of a study file under another name
+    committed = Path("results") / name
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
         "code_hash": code_hash(cfg["study"]),
@@ -151,7 +155,7 @@ def _default_out(cfg: dict, sweep: dict) -> tuple[Path, str, bool]:
         and old.get("code_hash") == record["code_hash"]
     ):
         return Path(os.path.abspath(committed)), str(committed), False
-    scratch = Path("scratch") / f"{cfg['study']}-{_config_tag(record)}"
+    scratch = Path("scratch") / f"{name}-{_config_tag(record)}"
     why = _differs(old, record) if old is not None else "it is not a results directory of sim"
     print(
         f"sim: {committed}/ holds the committed results and {why}: writing to {scratch}/ "
@@ -167,7 +171,7 @@ def _run(args) -> int:
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
     overwrite = args.overwrite
     if out is None:
-        out, shown, scratch = _default_out(cfg, sweep)
+        out, shown, scratch = _default_out(cfg, sweep, Path(args.study).stem)
         overwrite = overwrite or scratch
     else:
         shown = args.out

@@ -9,10 +9,43 @@ from importlib import metadata
 from sim.mc.config import ConfigError
 from sim.mc.runner import MIN_CHUNKS
 
-__all__ = ["parser"]
+__all__ = ["OnceParser", "parser"]
 
 
-class _Parser(argparse.ArgumentParser):
+class _Once(argparse.Action):
+    """Store an option's value and refuse a second one: ``--trials 40 --trials 60`` (or
+    ``--out A --out B``, ``--results A --results B``) ran with the last and dropped the first
+    without a word, as ``--set seed=3 --set seed=4`` did before the eighth sweep."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = parser.__dict__.setdefault("given_once", set())
+        if self.dest in given:
+            parser.error(f"argument {'/'.join(self.option_strings)}: given twice: give one value")
+        given.add(self.dest)
+        setattr(namespace, self.dest, values)
+
+
+#: the options that decide what is computed or where it is written: given twice, one value
+#: would be dropped. The others (``--workers``, ``--executor``, ``--jobs``, the limits) change
+#: no number; a later one wins, as in argparse, so a default put first can be overridden
+#: (tests/conftest.py's ``--workers 1 ... --workers 2``, the Makefile's ``VERIFY_FLAGS``)
+ONCE = frozenset({"--out", "--trials", "--chunk", "--seed", "--results", "--timings"})
+
+
+class OnceParser(argparse.ArgumentParser):
+    """argparse where an option of :data:`ONCE` may be given once."""
+
+    def add_argument(self, *args, **kwargs):
+        if args and args[0] in ONCE and "action" not in kwargs:
+            kwargs["action"] = _Once
+        return super().add_argument(*args, **kwargs)
+
+    def parse_known_args(self, args=None, namespace=None):
+        self.given_once = set()  # each parse starts afresh (a parser may be used again)
+        return super().parse_known_args(args, namespace)
+
+
+class _Parser(OnceParser):
     """argparse with one-line errors (exit 2 through :func:`main`, no usage dump)."""
 
     def error(self, message: str):

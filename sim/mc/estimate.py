@@ -391,8 +391,8 @@ def _limit(given: float | None, env: str, default: float, key: str) -> float:
         txt = os.environ.get(env)
         if txt is None or not txt.strip():
             return default
-        try:
-            given = float(txt)
+        try:  # ASCII digits, as --max-memory-gb reads them ('٨' was read as 8)
+            given = float(txt) if txt.isascii() else float("x")
         except ValueError:
             raise ConfigError(env, f"must be a number (got {txt!r})") from None
         key = env

@@ -140,6 +140,11 @@ def check(cfg: dict) -> None:
         "b8.sigma_um",
         "exceeds 1 % of the mark array: the affine's geometry is meaningless",
     )
+    require(  # 1e300 ran and filled the power table with NaN after a page of NumPy warnings
+        max(cfg["power.sigma_um"]) * UM <= 0.01 * cfg["marks.extent_mm"],
+        "power.sigma_um",
+        "exceeds 1 % of the mark array: the affine's geometry is meaningless",
+    )
     require(
         cfg["comparator.sigma_um"] * UM <= 0.01 * cfg["grid.spacing_mm"] * (cfg["grid.points"] - 1),
         "comparator.sigma_um",
