@@ -14,13 +14,13 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.family import family_row
-from sim.claims.inference import FAILS, Region
-from sim.claims.intervals import spread
+from sim.claims.inference import Region
 from sim.claims.table import Sim, exact, mc, plates
 from sim.claims.table import claim_rows as table_rows
 from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import Block
 from sim.studies.agnard.schema import model_sigmas, pixel_ground_m
+from sim.studies.agnard.table1_rows import table1_rows
 
 BOOK = Path(__file__).with_name("claims.toml")
 AXES = ("x", "y", "xy", "z")
@@ -51,68 +51,6 @@ def ref(book: ClaimBook, cid: str) -> float:
 def _where(p: float, x: np.ndarray) -> str:
     """Where the paper's value ``p`` falls in the simulated distribution ``x``."""
     return f"{100 * np.mean(np.asarray(x) < p):.0f} % of the simulated blocks lie below the paper's value"
-
-
-def _over(region: Region, stats: list[dict], cid: str) -> str:
-    """A Table 1 row over the scanner region: the range of its per-vector medians and of the
-    blocks' 95 % spread, and at how many vectors the printed number is contradicted."""
-    med = np.array([np.median(p[cid]) for p in stats])
-    lo = min(spread(p[cid])[1][0] for p in stats)
-    hi = max(spread(p[cid])[1][1] for p in stats)
-    j = [st.id for st in region.statements].index(cid)
-    k = int((region.status[:, j] == FAILS).sum())
-    return (
-        f"simulated median {med.min():.2f}-{med.max():.2f} m over the {len(stats)} explored "
-        f"scanner vectors (95 % of blocks within {lo:.2f}-{hi:.2f} m); the printed "
-        f"{_ref_of(region, cid):g} m is contradicted at {k} of {len(stats)}"
-    )
-
-
-def _ref_of(region: Region, cid: str) -> float:
-    return next(st.ref[0] for st in region.statements if st.id == cid)
-
-
-def table1_rows(book: ClaimBook, region: Region, stats: list[dict]) -> list[dict]:
-    """Table 1: not comparable because no scanner vector reproduces it (the region of
-    ``scanner.toml`` is empty, the conflicting statements named in every note), with each
-    row's simulated values over the explored vectors. Should a run's region not be empty
-    (another configuration), the note says that the claim book's reason fails for it."""
-    conf = "; ".join(" + ".join(c.split(".")[-1] for c in cs) for cs in region.conflicts)
-    head = (
-        f"Scanner region (scanner.toml: {region.describe(np.ones(region.n, bool))}, "
-        f"{region.n} vectors explored jointly): "
-        + (
-            f"empty, no vector reproduces Table 1 (conflicting: {conf})"
-            if region.empty
-            else f"{int(region.accepted.sum())} vectors consistent ({region.describe()}): the "
-            "claim book's reason for 'not comparable' (an empty region) does not hold in this run"
-        )
-    )
-    rows = []
-    for w in ("ctrl", "check"):
-        for c in ("x", "y"):
-            for tag in ("with", "without"):
-                cid = f"agnard.table1.{tag}_{w}_{c}_m"
-                rows.append(
-                    book.not_comparable(cid, note=f"{head}. This row: {_over(region, stats, cid)}.")
-                )
-            ratio = [
-                np.median(
-                    p[f"agnard.table1.without_{w}_{c}_m"] / p[f"agnard.table1.with_{w}_{c}_m"]
-                )
-                for p in stats
-            ]
-            rows.append(
-                book.not_comparable(
-                    f"agnard.table1.ratio_{w}_{c}",
-                    note=(
-                        f"{head}. The simulated per-block ratio without / with the grid "
-                        f"correction has median {min(ratio):.2f}-{max(ratio):.2f} over the "
-                        "explored vectors."
-                    ),
-                )
-            )
-    return rows
 
 
 def scanner_rows(scan_t: dict) -> dict[str, Sim]:
