@@ -37,6 +37,8 @@ __all__ = [
     "INPUTS",
     "thetas",
     "table1_points",
+    "table1_cofactors",
+    "table1_sigma_stats",
     "grid_of_extent",
     "max_range_mm",
     "min_range_mm",
@@ -98,6 +100,28 @@ def thetas(offset_mm, beta_mm, alpha_mm: float = ALPHA_MM, format_mm: float = FO
 def table1_points() -> np.ndarray:
     """Table 1's 5 x 5 points at 45 mm ``(25, 2)``."""
     return grid_points(TABLE1_GRID, TABLE1_SPACING_MM)
+
+
+def table1_cofactors(offset_mm, beta_mm, alpha_mm: float = ALPHA_MM) -> np.ndarray:
+    """sigma / sigma0 = sqrt(Q_xx), sqrt(Q_yy) of Table 1's 25 points in the pivot model
+    ``(G, 25, 2)`` at ``G`` (station offset, beta) pairs (exact, analytic; NaN where the
+    geometry is singular)."""
+    o = np.atleast_1d(np.asarray(offset_mm, float))
+    P = np.broadcast_to(table1_points(), (len(o), 25, 2)).copy()
+    with np.errstate(invalid="ignore"):
+        Q = ml.covariance(P, thetas(o, beta_mm, alpha_mm), "pivot")[0]
+        return np.sqrt(np.stack([Q[..., 0, 0], Q[..., 1, 1]], -1))
+
+
+def table1_sigma_stats(sig_um: np.ndarray) -> dict[str, np.ndarray]:
+    """Table 1's one-plate statistics of point sigmas ``(..., n, 2)`` (um) as the paper prints
+    them (one decimal): ``share`` in 1.1-1.3, ``count`` of points whose larger sigma prints
+    >= 1.5, ``max`` the largest."""
+    return {
+        "share": ((sig_um >= 1.05) & (sig_um < 1.35)).mean(axis=(-1, -2)),
+        "count": (sig_um.max(-1) >= 1.45).sum(-1).astype(float),
+        "max": sig_um.max(axis=(-1, -2)),
+    }
 
 
 def grid_of_extent(k: int, half_extent_mm) -> np.ndarray:

@@ -98,11 +98,10 @@ def table1_model(x: dict) -> dict:
     o, b, s0 = x["station_offset_mm"], x["beta_mm"], x["sigma0_um"]
     N = len(o)
     P = np.broadcast_to(B.table1_points(), (N, 25, 2)).copy()
-    TH = B.thetas(o, b)
-    cof = V.sigmas(P, TH, "pivot")  # (N, 25, 2) sigma / sigma0
-    st = V.point_sigma_stats(s0[:, None, None] * cof)
+    cof = B.table1_cofactors(o, b)  # (N, 25, 2) sigma / sigma0
+    st = B.table1_sigma_stats(s0[:, None, None] * cof)
     return {
-        SCALE.id: scale_evidence(P, TH),
+        SCALE.id: scale_evidence(P, B.thetas(o, b)),
         "brown.table1_closure.rms_um": s0,
         T1 + "share_1p1_1p3": st["share"],
         T1 + "points_ge_1p45": st["count"],

@@ -62,13 +62,3 @@ def monotone(curve: dict) -> np.ndarray:
     mean = np.stack([curve[k].mean(1) for k in ks], 1)
     mx = np.stack([curve[k].max(1) for k in ks], 1)
     return np.all(np.diff(mean, axis=1) < 0, axis=1) & np.all(np.diff(mx, axis=1) < 0, axis=1)
-
-
-def point_sigma_stats(sig_um: np.ndarray) -> dict[str, np.ndarray]:
-    """One-plate statistics of the point sigmas ``(..., n, 2)`` (um) as the paper prints them
-    (one decimal): share in 1.1-1.3, points whose larger sigma prints >= 1.5, the largest."""
-    return {
-        "share": ((sig_um >= 1.05) & (sig_um < 1.35)).mean(axis=(-1, -2)),
-        "count": (sig_um.max(-1) >= 1.45).sum(-1).astype(float),
-        "max": sig_um.max(axis=(-1, -2)),
-    }

@@ -47,7 +47,6 @@ from sim.claims.region import (
     statement_of,
 )
 from sim.instruments.ranges import brown as B
-from sim.instruments.ranges import multilateration as ml
 from sim.mc.runner import chunk_rng
 from sim.studies.design.claims import verdict_of
 from sim.studies.design.external import external_at, paper_points, tolerances, zeiss_points
@@ -163,19 +162,16 @@ TABLE1 = (
 def table1_evidence(o, b, s0, alpha_mm: float = B.ALPHA_MM) -> dict:
     """Table 1's statements at ``N`` input vectors (station offset, beta, sigma0; mm, um):
     the 50 printed sigmas are sigma0 x sqrt(cofactor) of the pivot model on Table 1's plate,
-    printed to one decimal (exact, analytic; the same rule as brown_table1's)."""
+    printed to one decimal (exact, analytic; the instrument's rule,
+    :func:`sim.instruments.ranges.brown.table1_sigma_stats`, as brown_table1's)."""
     o, b, s0 = (np.asarray(v, float) for v in (o, b, s0))
-    N = len(o)
-    P = np.broadcast_to(B.table1_points(), (N, 25, 2)).copy()
-    with np.errstate(invalid="ignore"):
-        Q = ml.covariance(P, B.thetas(o, b, alpha_mm), "pivot")[0]
-        cof = np.sqrt(np.stack([Q[..., 0, 0], Q[..., 1, 1]], -1))  # (N, 25, 2)
-    sig = s0[:, None, None] * cof
+    cof = B.table1_cofactors(o, b, alpha_mm)  # (N, 25, 2)
+    st = B.table1_sigma_stats(s0[:, None, None] * cof)
     return {
-        TABLE1[0].id: ((sig >= 1.05) & (sig < 1.35)).mean(axis=(1, 2)),
-        TABLE1[1].id: (sig.max(-1) >= 1.45).sum(-1).astype(float),
-        TABLE1[2].id: sig.max(axis=(1, 2)),
-        TABLE1[3].id: cof.reshape(N, -1),
+        TABLE1[0].id: st["share"],
+        TABLE1[1].id: st["count"],
+        TABLE1[2].id: st["max"],
+        TABLE1[3].id: cof.reshape(len(o), -1),
     }
 
 
