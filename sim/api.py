@@ -156,7 +156,7 @@ class StudyHandle:
             out = base / h.name
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
-        out = Path(os.path.abspath(out))
+        out = _absolute("out", out)
         execute(
             h.study,
             h.config,
@@ -196,6 +196,17 @@ def _check_path(name: str, v: Any, none_ok: bool = False) -> None:
         raise ConfigError(name, f"must be a path (a str or os.PathLike of a str), got {v!r}")
 
 
+def _absolute(name: str, v: str | os.PathLike) -> Path:
+    """``v`` made absolute against the working directory, which may have been deleted (then
+    one line naming the argument, not pathlib's FileNotFoundError)."""
+    try:
+        return Path(os.path.abspath(v))
+    except OSError as e:
+        raise ConfigError(
+            name, f"{os.fspath(v)} is relative, but the working directory is gone ({e.strerror})"
+        ) from None
+
+
 def _check_int(name: str, v: Any) -> None:
     if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
         raise ConfigError(name, f"must be an integer (got {v!r})")
@@ -232,9 +243,12 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     _check_path("study_file", study_file)
     if not Path(study_file).is_file():
         raise ConfigError("study_file", f"{study_file} is not a study file")
+    # absolute now: a handle re-loads its file (replace, run with trials or seed), and the
+    # working directory may have changed since (it would read another file of that name)
+    study_file = _absolute("study_file", study_file)
     for k in overrides:
         if not _key(k).strip(".").strip() or not k.isprintable():
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
     vals = {_key(k): _plain(v) for k, v in overrides.items()}
     study, cfg = _load_picking_chunk(study_file, vals)
-    return StudyHandle(Path(study_file), study, cfg, vals, read_sweep(study_file, study.schema))
+    return StudyHandle(study_file, study, cfg, vals, read_sweep(study_file, study.schema))

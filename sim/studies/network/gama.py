@@ -51,7 +51,9 @@ def gama_digest(path: str | Path, key: str = "network.gama_xml") -> str:
 def import_note(cfg: dict) -> str:
     """The sentence the report gives about ``network.gama_xml`` (its convention), or ``""``."""
     path = cfg.get("network.gama_xml")
-    return f"{Path(path).name}: {read_gama(path)['note']}" if path else ""
+    if not path:
+        return ""
+    return f"{Path(path).name}: {read_gama(path, sha256=cfg.get('network.gama_sha256'))['note']}"
 
 
 def merge_gama(cfg: dict) -> dict:
@@ -70,7 +72,7 @@ def merge_gama(cfg: dict) -> dict:
             raise ConfigError(
                 k, "give the network either in the study file or in network.gama_xml, not both"
             )
-    rec = read_gama(path)
+    rec = read_gama(path, sha256=cfg.get("network.gama_sha256"))
     out = {
         **cfg,
         "network.points": rec["network.points"],

@@ -37,6 +37,7 @@ must therefore have.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -193,13 +194,21 @@ def _obs(f: _File, e, dflt: dict, sets: dict, out: list) -> None:
         else:  # angle
             unit = ARCSEC if f.angle(o) else CC
             s = _sigma(f, o, dflt["angle"], v, unit)
-            bs = o.get("bs", o.get("to"))
-            fs = o.get("fs", o.get("rs"))
-            if bs is None or fs is None:
-                raise f.err(o, "an angle needs bs and fs", "bs" if bs is None else "fs")
+            bs, fs = (_sight(f, o, a, b) for a, b in (("bs", "to"), ("fs", "rs")))
             rec = {"kind": "angle", "at": f.name(o, "from", st), "from": bs, "to": fs}
             rec["sigma_arcsec"] = s * unit / ARCSEC
         out.append(rec)
+
+
+def _sight(f: _File, o, attr: str, alias: str) -> str:
+    """The point an angle's back or fore sight names: ``attr`` or its alias (``bs`` or
+    ``to``, ``fs`` or ``rs``), one of the two, read as a point name of the element."""
+    given = [a for a in (attr, alias) if o.get(a) is not None]
+    if not given:
+        raise f.err(o, "an angle needs bs and fs (or to and rs)", attr)
+    if len(given) == 2:
+        raise f.err(o, f"{attr!r} and {alias!r} both name this sight: give one", alias)
+    return f.name(o, given[0])
 
 
 def _coordinates(f: _File, e, coords: list) -> None:
@@ -290,13 +299,22 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
                 )
 
 
-def read_gama(path: str | Path, key: str = "network.gama_xml") -> dict:
+def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | None = None) -> dict:
     """Points and observations of a ``gama-local`` XML file as study records:
     ``{"network.points", "network.observations", "datum.points", "note"}`` (``note``: the
-    ``<parameters>`` convention used, one sentence)."""
+    ``<parameters>`` convention used, one sentence). ``sha256``: the digest the study recorded
+    on load; bytes of another digest (the file edited since) are refused, so a run never
+    simulates a network other than the one its config names."""
     path = Path(path)
     f = _File(key, path)
-    net = _network(f, read_bytes(path, key))
+    data = read_bytes(path, key)
+    if sha256 and (now := hashlib.sha256(data).hexdigest()) != sha256:
+        raise ConfigError(
+            "network.gama_sha256",
+            f"{path} has changed since the study was loaded (sha256 {now[:12]}..., recorded "
+            f"{sha256[:12]}...): load the study again",
+        )
+    net = _network(f, data)
     note = _parameters(f, [e for e in net if _tag(e) == "parameters"])
     pos = [e for e in net if _tag(e) == "points-observations"]
     if len(pos) != 1:

@@ -1,0 +1,88 @@
+"""The failure classes of the tenth sweep of bad inputs (issue 26), one case per class; each
+failed on the code before its fix.
+
+* a handle of the Python API kept its study file's path as given: after ``os.chdir``,
+  ``handle.replace(...)`` and ``handle.run(trials=...)`` (which load the file again) read
+  another file of that relative name, or none;
+* ``handle.run(out="o")`` in a working directory that was deleted ended in pathlib's
+  ``FileNotFoundError`` with a traceback;
+* a handle run after its ``network.gama_xml`` file was edited simulated the edited network
+  and recorded the sha256 of the file as loaded (results that are not what their run record
+  says);
+* a GNU Gama ``<angle>`` giving a sight twice (``bs`` and its alias ``to``, ``fs`` and
+  ``rs``) kept one without a word, and its sight was not read as a point name (``bs=" B "``
+  was "from=' B ': no such <point>", naming the suite's field, not the attribute).
+"""
+
+import os
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim.mc.config import ConfigError
+from sim.studies.network.gama_read import read_gama
+
+ROOT = Path(__file__).resolve().parent.parent
+GAMA = ROOT / "tests" / "data" / "gama" / "one_fixed.xml"
+
+
+def test_a_handle_reloads_its_own_file_after_a_chdir(tmp_path, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    h = sim.load("studies/network_brown.toml", trials=40)
+    (tmp_path / "studies").mkdir()  # another study file of the same relative name
+    (tmp_path / "studies" / "network_brown.toml").write_text('study = "salsig_encoders"\n')
+    monkeypatch.chdir(tmp_path)
+    assert h.path == ROOT / "studies" / "network_brown.toml"
+    assert h.replace(seed=3).name == "network"
+
+
+def test_a_relative_out_in_a_deleted_working_directory_is_named(tmp_path, monkeypatch):
+    h = sim.load(ROOT / "studies" / "network_brown.toml", trials=40)
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    with pytest.raises(ConfigError, match=r"^out: o is relative, but the working directory"):
+        h.run(out="o", figures=False)
+
+
+def test_a_run_refuses_a_gama_file_edited_since_the_study_was_loaded(tmp_path):
+    xml = tmp_path / "net.xml"
+    xml.write_text(GAMA.read_text())
+    study = tmp_path / "s.toml"
+    study.write_text(
+        f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{xml}"\n'
+        '[datum]\nkind = "inner"\n'
+    )
+    h = sim.load(study)
+    xml.write_text(GAMA.read_text().replace('stdev="2.0"', 'stdev="4.0"'))
+    with pytest.raises(ConfigError, match=r"^network.gama_sha256: .* has changed since"):
+        h.run(out=tmp_path / "o", figures=False)
+    assert sorted(os.listdir(tmp_path)) == ["net.xml", "s.toml"]  # nothing written
+
+
+@pytest.mark.parametrize(
+    "angle, words",
+    [
+        ('bs="B" to="A" fs="D"', "attribute 'to' (to='A'): 'bs' and 'to' both name this sight"),
+        ('bs="B" fs="D" rs="A"', "attribute 'rs': 'fs' and 'rs' both name this sight"),
+        ('bs="B\u202e" fs="D"', "attribute 'bs': 'B\\u202e': a point name is printable"),
+    ],
+)
+def test_an_angles_sights_are_read_once_as_point_names(tmp_path, angle, words):
+    old = '<distance to="D" val="256.7586415293553" stdev="2.0" />'
+    p = tmp_path / "a.xml"
+    p.write_text(GAMA.read_text().replace(old, f'<angle {angle} val="10.0" stdev="5" />'))
+    with pytest.raises(ConfigError) as e:
+        read_gama(p)
+    assert words in str(e.value) and "\n" not in str(e.value), str(e.value)
+    p.write_text(GAMA.read_text().replace(old, '<angle bs=" B " fs="D" val="10.0" stdev="5" />'))
+    (got,) = [o for o in read_gama(p)["network.observations"] if o["kind"] == "angle"]
+    assert got == {
+        "kind": "angle",
+        "at": "C",
+        "from": "B",
+        "to": "D",
+        "sigma_arcsec": pytest.approx(5 * 0.324),
+    }
