@@ -86,3 +86,21 @@ def test_an_angles_sights_are_read_once_as_point_names(tmp_path, angle, words):
         "to": "D",
         "sigma_arcsec": pytest.approx(5 * 0.324),
     }
+
+
+def test_a_users_link_fifo_and_empty_directory_survive_a_rerun(tmp_path):
+    # an --overwrite re-run kept a user's regular files only: a symbolic link (to data
+    # elsewhere), a FIFO and an empty directory in the results directory were deleted
+    h = sim.load(ROOT / "studies" / "network_brown.toml", trials=40)
+    out = tmp_path / "out"
+    h.run(out=out, figures=False)
+    (tmp_path / "data").mkdir()
+    (out / "data").symlink_to(tmp_path / "data")
+    (out / "dangling").symlink_to(tmp_path / "nowhere")
+    os.mkfifo(out / "pipe")
+    (out / "empty" / "deeper").mkdir(parents=True)
+    h.run(out=out, trials=60, figures=False, overwrite=True)
+    assert os.readlink(out / "data") == str(tmp_path / "data")
+    assert os.readlink(out / "dangling") == str(tmp_path / "nowhere")
+    assert (out / "pipe").is_fifo() and (out / "empty" / "deeper").is_dir()
+    assert sim.Results(out, "network").table("trials").num_rows == 60

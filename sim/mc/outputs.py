@@ -270,9 +270,10 @@ def _sha256(p: Path) -> str:
 
 
 def _foreign(out: Path) -> list[str]:
-    """Files in an earlier results directory that its run did not write (a user's notes):
-    they are carried into the new results. Results recorded before runs listed their files
-    count as wholly written by the suite."""
+    """Entries in an earlier results directory that its run did not write (a user's notes, a
+    symbolic link, a FIFO, an empty directory, given with a trailing ``/``): they are carried
+    into the new results. Results recorded before runs listed their files count as wholly
+    written by the suite."""
     rec = read_record(out)
     if not rec or "files" not in rec:
         return []
@@ -283,7 +284,38 @@ def _foreign(out: Path) -> list[str]:
             "move the directory away, or delete it, and run again",
         )
     mine = set(rec["files"])
-    return [f for f in _files(out) if f not in mine]
+    keep = []
+    for root, dirs, files in os.walk(out):  # a link to a directory is an entry, not followed
+        r = Path(root)
+        for n in files + [d for d in dirs if (r / d).is_symlink()]:
+            f = (r / n).relative_to(out).as_posix()
+            if f not in mine and n not in ("run.json", LOCK):
+                keep.append(f)
+        if r != out and not dirs and not files:
+            keep.append(r.relative_to(out).as_posix() + "/")
+    return sorted(keep)
+
+
+def _carry(src: Path, dst: Path) -> None:
+    """Copy a user's entry ``src`` of an earlier results directory to ``dst`` as what it is: a
+    regular file's bytes, a symbolic link's target (not followed), an empty directory, and a
+    FIFO, socket or device by a hard link (never opened: a FIFO would block)."""
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    if src.is_symlink():
+        os.symlink(os.readlink(src), dst)
+    elif src.is_dir():
+        dst.mkdir(exist_ok=True)
+    elif src.is_file():
+        shutil.copy2(src, dst)
+    else:
+        try:
+            os.link(src, dst, follow_symlinks=False)
+        except OSError as e:
+            raise ConfigError(
+                "--out",
+                f"{src} was not written by sim and cannot be kept ({e.strerror}); move it away "
+                "and run again",
+            ) from None
 
 
 def _clash(stage: Path, f: str) -> str | None:
@@ -295,7 +327,10 @@ def _clash(stage: Path, f: str) -> str | None:
         q = stage.joinpath(*parts[:i])
         if q.exists() and not q.is_dir():
             return Path(*parts[:i]).as_posix()
-    return f if (stage / f).exists() else None
+    q = stage / f
+    if f.endswith("/"):  # an empty directory: only a file of that name takes it
+        return f.rstrip("/") if q.exists() and not q.is_dir() else None
+    return f if q.exists() or q.is_symlink() else None
 
 
 def publish(stage: Path, out: Path) -> None:
@@ -312,8 +347,7 @@ def publish(stage: Path, out: Path) -> None:
             "name; move it away and run again",
         )
     for f in keep:
-        (stage / f).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(out / f, stage / f)
+        _carry(out / f, stage / f)
     old = out.parent / f".{out.name}.old.{os.getpid()}"
     if out.exists():
         os.replace(out, old)
