@@ -9,6 +9,8 @@ failed on the code before its fix.
 * a handle run after its ``network.gama_xml`` file was edited simulated the edited network
   and recorded the sha256 of the file as loaded (results that are not what their run record
   says);
+* ``SIM_FIGURE_CHECK`` naming a directory or a path that cannot be written ended the run
+  with "sim: error: Is a directory: DIR", not naming the variable;
 * a GNU Gama ``<angle>`` giving a sight twice (``bs`` and its alias ``to``, ``fs`` and
   ``rs``) kept one without a word, and its sight was not read as a point name (``bs=" B "``
   was "from=' B ': no such <point>", naming the suite's field, not the attribute).
@@ -17,10 +19,12 @@ failed on the code before its fix.
 import os
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import pytest
 
 import sim
 from sim.mc.config import ConfigError
+from sim.report.plotting import save
 from sim.studies.network.gama_read import read_gama
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -104,3 +108,11 @@ def test_a_users_link_fifo_and_empty_directory_survive_a_rerun(tmp_path):
     assert os.readlink(out / "dangling") == str(tmp_path / "nowhere")
     assert (out / "pipe").is_fifo() and (out / "empty" / "deeper").is_dir()
     assert sim.Results(out, "network").table("trials").num_rows == 60
+
+
+def test_a_figure_check_file_that_cannot_be_written_names_the_variable(tmp_path, monkeypatch):
+    monkeypatch.setenv("SIM_FIGURE_CHECK", str(tmp_path))
+    fig = plt.figure(figsize=(1, 1))
+    with pytest.raises(ConfigError, match=r"^SIM_FIGURE_CHECK: cannot append to .*: Is a dir"):
+        save(fig, tmp_path / "f.png")
+    plt.close(fig)

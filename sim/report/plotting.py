@@ -20,6 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
+from sim.mc.config import ConfigError  # noqa: E402
 from sim.mc.storage import atomic_path  # noqa: E402
 from sim.report.figcheck import data_points, figure_facts, points_inside, reader_problems  # noqa: E402
 
@@ -290,10 +291,12 @@ def save(fig, path: str | Path) -> Path:
         _RECORDER(path, fig)
     elif os.environ.get("SIM_FIGURE_CHECK"):  # the same check in a `sim run` process (tests)
         line = {"file": path.name, "problems": layout_problems(fig), "facts": figure_facts(fig)}
-        with open(
-            os.environ["SIM_FIGURE_CHECK"], "a", encoding="utf-8"
-        ) as f:  # one short line per write
-            f.write(json.dumps(line) + "\n")
+        log = os.environ["SIM_FIGURE_CHECK"]
+        try:
+            with open(log, "a", encoding="utf-8") as f:  # one short line per write
+                f.write(json.dumps(line) + "\n")
+        except OSError as e:  # the variable's file, named (not a bare "Is a directory")
+            raise ConfigError("SIM_FIGURE_CHECK", f"cannot append to {log}: {e.strerror}") from None
     plt.close(fig)
     return path
 
