@@ -11,6 +11,11 @@ failed on the code before its fix.
   says);
 * ``SIM_FIGURE_CHECK`` naming a directory or a path that cannot be written ended the run
   with "sim: error: Is a directory: DIR", not naming the variable;
+* number keys of Wolf and Agnard at the smallest positive double (5e-324, inside their open
+  bound 0: ``reduce.ab_mm``, ``reading.count_um``, ``field.drift_tau_weeks``,
+  ``measure.parallax_px``, ``weights.pass``) passed ``sim check`` and then failed at run time
+  naming an internal function (ZeroDivisionError, NonFiniteError), or ran with NumPy's
+  overflow warnings: each is now at least 1e-6 of the paper's value;
 * a GNU Gama ``<angle>`` giving a sight twice (``bs`` and its alias ``to``, ``fs`` and
   ``rs``) kept one without a word, and its sight was not read as a point name (``bs=" B "``
   was "from=' B ': no such <point>", naming the suite's field, not the attribute).
@@ -25,6 +30,7 @@ import pytest
 import sim
 from sim.mc.config import ConfigError
 from sim.report.plotting import save
+from sim.studies import load_study
 from sim.studies.network.gama_read import read_gama
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -116,3 +122,19 @@ def test_a_figure_check_file_that_cannot_be_written_names_the_variable(tmp_path,
     with pytest.raises(ConfigError, match=r"^SIM_FIGURE_CHECK: cannot append to .*: Is a dir"):
         save(fig, tmp_path / "f.png")
     plt.close(fig)
+
+
+@pytest.mark.parametrize(
+    "study, key, lo",
+    [
+        ("wolf_polynomial", "reduce.ab_mm", 1e-4),
+        ("wolf_polynomial", "reading.count_um", 4e-6),
+        ("wolf_polynomial", "field.drift_tau_weeks", 52e-6),
+        ("agnard_block", "measure.parallax_px", 5e-7),
+        ("agnard_block", "weights.pass", 1e-7),
+    ],
+)
+def test_a_positive_key_at_the_smallest_double_is_refused_on_load(study, key, lo):
+    # (the runs at each bound itself end with exit 0 and no warning: checked by the sweep)
+    with pytest.raises(ConfigError, match=rf"^{key}: must be >= {lo:g} \(got 5e-324\)$"):
+        load_study(ROOT / "studies" / f"{study}.toml", values={key: 5e-324})

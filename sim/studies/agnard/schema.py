@@ -76,10 +76,14 @@ SCHEMA = {
         unit="px",
         input=True,
     ),
-    "measure.parallax_px": positive(
+    # (tenth sweep) a parallax error or a pass weight of the smallest double (5e-324) passed
+    # check and overflowed the snooping weights (1 / sigma^2, control / pass) at run time: at
+    # least 1e-6 of the paper's value
+    "measure.parallax_px": real(
         0.5,
-        "x-parallax setting error (paper: 13 cm x f/B = 22 cm in height)",
-        20.0,
+        "x-parallax setting error (paper: 13 cm x f/B = 22 cm in height; at least 1e-6 of it)",
+        lo=5e-7,
+        hi=20.0,
         unit="px",
         input=True,
     ),
@@ -101,7 +105,9 @@ SCHEMA = {
     "pugging.gross_px": reals(
         [2.0, 6.0], "mechanical: range of a missed hole's error", 0.0, 1000.0, min_len=2, unit="px"
     ),
-    "weights.pass": positive(0.1, "weight of model points (paper: 0.1)", input=True),
+    "weights.pass": real(
+        0.1, "weight of model points (paper: 0.1; at least 1e-6 of it)", lo=1e-7, input=True
+    ),
     "weights.control_xy": positive(3.0, "weight of control in planimetry (paper: 3)", input=True),
     "weights.control_z": positive(2.0, "weight of control in height (paper: 2)", input=True),
     "weights.first_pass_control": positive(

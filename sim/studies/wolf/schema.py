@@ -70,15 +70,19 @@ SCHEMA = {
         hi=50.0,
         unit="mm",
     ),
-    "reduce.ab_mm": positive(
+    # (tenth sweep) a line or count of the smallest double (5e-324) passed check and overflowed
+    # the reduction (1 / length) at run time: at least 1e-6 of the paper's value
+    "reduce.ab_mm": real(
         100.0,
-        "length of line ab, b on the grid x axis (paper: 100 mm)",
+        "length of line ab, b on the grid x axis (paper: 100 mm; at least 1e-6 of it)",
+        lo=1e-4,
         unit="mm",
         input=True,
     ),
-    "reading.count_um": positive(
+    "reading.count_um": real(
         4.0,
-        "size of one count on the plate (paper: roughly 4 um)",
+        "size of one count on the plate (paper: roughly 4 um; at least 1e-6 of it)",
+        lo=4e-6,
         hi=100.0,
         unit="um",
         input=True,
@@ -158,7 +162,9 @@ SCHEMA = {
     "field.drift_fraction": real(
         0.25, "share of the field's variance that drifts with time (AR(1))", lo=0.0, hi=1.0
     ),
-    "field.drift_tau_weeks": positive(52.0, "time constant of the drift", unit="weeks"),
+    "field.drift_tau_weeks": real(
+        52.0, "time constant of the drift (at least 1e-6 of a year)", lo=52e-6, unit="weeks"
+    ),
     "calib.n_sets": count(
         3, "independent sets pooled in the fit (paper: three dates)", lo=1, hi=50, input=True
     ),
