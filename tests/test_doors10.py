@@ -15,7 +15,9 @@ failed on the code before its fix.
   bound 0: ``reduce.ab_mm``, ``reading.count_um``, ``field.drift_tau_weeks``,
   ``measure.parallax_px``, ``weights.pass``) passed ``sim check`` and then failed at run time
   naming an internal function (ZeroDivisionError, NonFiniteError), or ran with NumPy's
-  overflow warnings: each is now at least 1e-6 of the paper's value;
+  overflow warnings: each is now at least 1e-6 of the paper's value; Brown's range sigma
+  (``errors.setting_sigma_um = 5e-324`` without a comparator error, brown_dilution) is at
+  least 1e-6 um (its claims were NaN);
 * a GNU Gama ``<angle>`` giving a sight twice (``bs`` and its alias ``to``, ``fs`` and
   ``rs``) kept one without a word, and its sight was not read as a point name (``bs=" B "``
   was "from=' B ': no such <point>", naming the suite's field, not the attribute).
@@ -138,3 +140,10 @@ def test_a_positive_key_at_the_smallest_double_is_refused_on_load(study, key, lo
     # (the runs at each bound itself end with exit 0 and no warning: checked by the sweep)
     with pytest.raises(ConfigError, match=rf"^{key}: must be >= {lo:g} \(got 5e-324\)$"):
         load_study(ROOT / "studies" / f"{study}.toml", values={key: 5e-324})
+
+
+def test_a_brown_range_sigma_the_model_cannot_divide_by_is_refused_on_load():
+    study = ROOT / "studies" / "brown_dilution.toml"
+    with pytest.raises(ConfigError, match=r"^errors.setting_sigma_um: the range sigma .* is 0 um"):
+        load_study(study, values={"errors.setting_sigma_um": 5e-324})
+    assert load_study(study, values={"errors.setting_sigma_um": 1e-6})[1]["trials"] > 0

@@ -18,6 +18,8 @@ from sim.studies.brown.values import thetas
 
 SEED = "004_f5bd9e86c308241f.txt"
 MODEL_NAMES = ("known", "stations", "pivot")
+#: smallest sigma of one range (1 pm, 1e-6 of the paper's): the results are ratios to it
+MIN_RANGE_SIGMA_UM = 1e-6
 
 # ----------------------------------------------------------------------------- configuration
 
@@ -185,8 +187,17 @@ def check_extents(cfg: dict) -> None:
 
 
 def check(cfg: dict) -> None:
-    """Cross-key rules: points inside the format, enough points, no duplicates/collinearity,
-    every range on the scale."""
+    """Cross-key rules: a range sigma the model can divide by, points inside the format,
+    enough points, no duplicates/collinearity, every range on the scale."""
+    if range_sigma_um(cfg) < MIN_RANGE_SIGMA_UM:
+        # (tenth sweep) errors.setting_sigma_um = 5e-324 without a comparator error passed
+        # check; the run's ratios to the range sigma were NaN, its claims not finite
+        raise ConfigError(
+            "errors.setting_sigma_um",
+            f"the range sigma sqrt(setting^2 / settings + comparator^2) is "
+            f"{range_sigma_um(cfg):g} um, below {MIN_RANGE_SIGMA_UM:g} um (the results are "
+            "ratios to it): give a larger setting or comparator sigma",
+        )
     check_extents(cfg)
     key = {"grid": "plate.grid", "random": "plate.n_random", "list": "plate.points"}[
         cfg["plate.pattern"]
