@@ -18,6 +18,9 @@ failed on the code before its fix.
   overflow warnings: each is now at least 1e-6 of the paper's value; Brown's range sigma
   (``errors.setting_sigma_um = 5e-324`` without a comparator error, brown_dilution) is at
   least 1e-6 um (its claims were NaN);
+* ``make verify`` compared committed results made with other options (or stale against the
+  study file) with a re-run of the study file and reported the differing numbers as failures
+  to reproduce; it now names the config keys that differ;
 * a GNU Gama ``<angle>`` giving a sight twice (``bs`` and its alias ``to``, ``fs`` and
   ``rs``) kept one without a word, and its sight was not read as a point name (``bs=" B "``
   was "from=' B ': no such <point>", naming the suite's field, not the attribute).
@@ -32,6 +35,7 @@ import pytest
 import sim
 from sim.mc.config import ConfigError
 from sim.report.plotting import save
+from sim.report.verify.rerun import verify
 from sim.studies import load_study
 from sim.studies.network.gama_read import read_gama
 
@@ -147,3 +151,17 @@ def test_a_brown_range_sigma_the_model_cannot_divide_by_is_refused_on_load():
     with pytest.raises(ConfigError, match=r"^errors.setting_sigma_um: the range sigma .* is 0 um"):
         load_study(study, values={"errors.setting_sigma_um": 5e-324})
     assert load_study(study, values={"errors.setting_sigma_um": 1e-6})[1]["trials"] > 0
+
+
+def test_verify_names_committed_results_of_another_config_as_stale(tmp_path):
+    # results made with other options (trials 40) against a re-run of the study file (60):
+    # verify reported their numbers as failures to reproduce ("0.950185 committed, 0.950296
+    # re-run"), as if the suite were not reproducible
+    h = sim.load(ROOT / "studies" / "network_brown.toml", trials=40)
+    h.run(out=tmp_path / "results" / "network_brown", figures=False)
+    h.run(out=tmp_path / "scratch" / "network_brown", trials=60, figures=False)
+    (c,) = verify(tmp_path / "results", tmp_path / "scratch", rerun=False)
+    assert not c.ok and c.failures == [
+        "the committed results are of another config than the re-run (keys chunk, trials): "
+        "they are stale or were made with other options; run make reproduce, then verify"
+    ]

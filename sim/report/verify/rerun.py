@@ -170,8 +170,31 @@ def verify(
                 c.failures.append(why)
                 out.append(c)
                 continue
+        stale = _other_config(d, target) if mode == "full" else None
+        if stale:  # not a reproduction failure of these numbers: results of another input
+            c = Comparison(d.name)
+            c.failures.append(stale)
+            out.append(c)
+            continue
         out.append(compare_dirs(d, target, d.name, mode))
     return out
+
+
+def _other_config(d: Path, target: Path) -> str | None:
+    """Why the committed results ``d`` cannot be compared with the re-run ``target``: their
+    run records hold different configs (results left by a run with other options, or stale
+    against the study file), so numbers that differ would be no failure to reproduce."""
+    a, b = read_record(d), read_record(target)
+    if not isinstance(a, dict) or not isinstance(b, dict) or "config" not in a:
+        return None  # no record to tell: the comparison decides
+    ca, cb = a.get("config"), b.get("config")
+    if not isinstance(ca, dict) or not isinstance(cb, dict) or ca == cb:
+        return None
+    keys = sorted(k for k in set(ca) | set(cb) if ca.get(k) != cb.get(k))
+    return (
+        f"the committed results are of another config than the re-run (keys {', '.join(keys)}): "
+        "they are stale or were made with other options; run make reproduce, then verify"
+    )
 
 
 # --- the record and the report ----------------------------------------------------------------
