@@ -337,7 +337,7 @@ def test_iterations_are_decided_over_the_region():
     )  # fmt: skip
     forced = counts.copy()
     forced[np.flatnonzero(acc)[0]] = 4.0
-    reg4 = replace(reg, outputs={**reg.outputs, gr.IT: gr._iteration_evidence(forced)})
+    reg4 = replace(reg, outputs={**reg.outputs, gr.IT: gr.iteration_evidence(forced)})
     (row,) = region_rows(gc.load_book(), reg4, [gr.IT])
     assert (row["verdict"], row["ci_high"]) == ("depends", 4.0)
     assert "fails at 1, undecided at 0" in row["note"]

@@ -177,7 +177,7 @@ def iteration_counts(cfg: dict, x: dict, idx: np.ndarray, rng: np.random.Generat
     return out
 
 
-def _iteration_evidence(counts: np.ndarray) -> dict:
+def iteration_evidence(counts: np.ndarray) -> dict:
     """Per vector: the largest count (``value``, ``high``) and the smallest (``low``) of its
     adjustments, NaN (undecided) where none was counted; ``counts`` kept for the note."""
     ok = np.isfinite(counts).all(axis=1)
@@ -215,7 +215,7 @@ def model_fn(
         if IT in ids:
             acc = (evaluate(statements, out, n) != FAILS).all(axis=1)
             counts = iteration_counts(cfg, x, np.flatnonzero(acc), it_rng)
-            out[IT] = _iteration_evidence(counts)
+            out[IT] = iteration_evidence(counts)
         return out
 
     return model

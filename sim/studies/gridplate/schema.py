@@ -115,7 +115,7 @@ SCHEMA = {
         "simulated calibrations per region point whose combined adjustments (plate.count "
         "plates x rows x' and y') count their Gauss-Newton iterations",
         lo=1,
-        hi=1000,
+        hi=64,
     ),
 }
 
