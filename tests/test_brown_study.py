@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim.claims.book import ClaimBook
 from sim.cli import main
 from sim.instruments.ranges import brown as B
 from sim.mc.config import ConfigError
@@ -17,7 +16,7 @@ from sim.mc.storage import read_table
 from sim.studies import load_study
 from sim.studies.brown import region as RG
 from sim.studies.brown import values as V
-from sim.studies.brown.claims import BOOK, load_book
+from sim.studies.brown.claims import BOOK, full_book, load_book
 from sim.studies.brown.report import report_dilution, report_table1
 from sim.studies.brown.schema import max_offset_mm, setup
 
@@ -26,8 +25,40 @@ DIL = ROOT / "studies" / "brown_dilution.toml"
 T1 = ROOT / "studies" / "brown_table1.toml"
 
 
+def test_table1_statements_are_declared_once_in_the_instrument(tmp_path, monkeypatch):
+    """Table 1's printed statements (the closure, 80 % in 1.1-1.3 um, two points at 1.5 um,
+    the largest, all below the closure) are declared once, in the instrument module:
+    brown_table1's claim rows take their zones from there, and brown_design's region builds
+    its constraints and sigma0's range from the same declaration (it had a copy, kept equal
+    by a test). A claim-book row that states a declared key again is refused, naming it."""
+    import tomllib
+
+    from sim.claims.region import statement_of
+    from sim.studies.brown import claims as BC
+    from sim.studies.design import region as DR
+
+    declared = B.TABLE1["statements"]
+    raw = {c["id"]: c for c in tomllib.loads(BOOK.read_text())["claim"]}
+    book = load_book("brown_table1")
+    for cid, d in declared.items():
+        assert not set(BC.PRINTED_KEYS) & set(raw[cid])  # not repeated in the claim book
+        assert {k: book.spec(cid)[k] for k in BC.PRINTED_KEYS if k in d} == {
+            k: d[k] for k in BC.PRINTED_KEYS if k in d
+        }
+    printed = RG.table1_statements()
+    assert set(printed) == set(declared)
+    for s in DR.TABLE1:  # brown_design's constraints: the same statements, the same zones
+        assert s == printed[s.id] and s.zone == statement_of(book, s.id).zone
+    assert len(DR.TABLE1) == 4 and (DR.SIGMA0.low, DR.SIGMA0.high) == (1.55, 1.65)
+    bad = tmp_path / "claims.toml"
+    bad.write_text(BOOK.read_text().replace('kind = "input"', 'kind = "input"\ntol = 0.1', 1))
+    monkeypatch.setattr(BC, "BOOK", bad)
+    with pytest.raises(ConfigError, match=r"claim\.tol.*brown.table1_closure.rms_um.*declared"):
+        BC.full_book()
+
+
 def test_claim_book_splits_into_the_two_studies():
-    full = ClaimBook.load(BOOK)
+    full = full_book()
     d, t = load_book("brown_dilution"), load_book("brown_table1")
     assert set(d.specs) | set(t.specs) == set(full.specs)
     assert not set(d.specs) & set(t.specs)

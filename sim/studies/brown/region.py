@@ -55,6 +55,7 @@ T1_PREDICTIONS = (
     T1 + "below_closure",
 )
 T1_JOINT = T1 + "together"
+CLOSURE = "brown.table1_closure.rms_um"
 CONCEPT_PREDICTIONS = (
     "brown.known_center.ratio",
     "brown.known_edge.ratio",
@@ -93,6 +94,13 @@ def _edge_points() -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- Table 1
+def table1_statements() -> dict[str, Statement]:
+    """Table 1's printed statements (the closure and the four about the point sigmas) from
+    their one declaration, :data:`sim.instruments.ranges.brown.TABLE1` (the claim book's
+    rows take the same zones from it)."""
+    return {s.id: s for s in parse_declaration(B.TABLE1)[1]}
+
+
 def table1_model(x: dict) -> dict:
     """Evidence and predictions at ``N`` input vectors (exact, analytic cofactors)."""
     o, b, s0 = x["station_offset_mm"], x["beta_mm"], x["sigma0_um"]
@@ -120,8 +128,9 @@ def _joint(region: Region, preds: list[Statement]) -> np.ndarray:
 def table1_region(cfg: dict, book):
     """``(region, predictions, verdicts)`` of Table 1's statements over the region of
     (station offset, beta, sigma0) allowed by the hardware and the printed closure."""
-    cons = [SCALE, statement_of(book, "brown.table1_closure.rms_um", "value")]
-    preds = [statement_of(book, c) for c in T1_PREDICTIONS]
+    printed = table1_statements()
+    cons = [SCALE, printed[CLOSURE]]
+    preds = [printed[c] for c in T1_PREDICTIONS]
     names = ("station_offset_mm", "beta_mm", "sigma0_um")
     rng = chunk_rng(cfg["seed"], 97, 0)
     n, rounds = cfg["region.points"], cfg["region.rounds"]

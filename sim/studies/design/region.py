@@ -10,7 +10,8 @@ offset and beta with their hardware ranges). Two parts, each explored jointly by
   constraints are that the scale reads every range of Table 1's plate (5 x 5 at 45 mm) and
   that Table 1's printed statements about the same comparator hold at once (sigma0 at the
   printed closure's rounding, :data:`SIGMA0`; 80 % of the sigmas 1.1-1.3 um; two points at
-  1.5 um; all below the closure: :data:`TABLE1`, brown_table1's claim-book rows, analytic
+  1.5 um; all below the closure: :data:`TABLE1`, declared once in
+  :data:`sim.instruments.ranges.brown.TABLE1` for brown_table1's claim rows too; analytic
   pivot-model cofactors). The
   tolerances are statements about the built comparator ("Operation of the Comparator",
   "Calibration"), the instrument that measured Table 1, so they are decided where Table 1
@@ -126,56 +127,22 @@ ZEISS_READS = Statement(
     source="004, Implementation of the Concept; Results",
 )
 
+#: Table 1's printed statements about the comparator the tolerances are stated for, from their
+#: one declaration (:data:`sim.instruments.ranges.brown.TABLE1`, whose zones brown_table1's
+#: claim rows take too): the closure bounds sigma0 (:data:`SIGMA0`), the four statements about
+#: the 50 printed point sigmas (:data:`TABLE1`) are constraints
 _T1 = "brown.table1_point_sigma."
+_PRINTED = {s.id: s for s in parse_declaration(B.TABLE1)[1]}
+_CLOSURE = _PRINTED.pop("brown.table1_closure.rms_um")
 #: Table 1's printed closure, 1.6 um at its rounding: the range of sigma0 (the closure is a
 #: statement about sigma0 alone, so it bounds the input rather than thinning the design)
 SIGMA0 = Input(
     "sigma0_um",
-    1.55,
-    1.65,
+    *(round(z, 12) for z in _CLOSURE.zone),  # 1.6 +- 0.05 to the decimal it stands for
     "the plate's rms error of closure: 'the rms error of closure turned out to be 1.6 "
     "microns (Table 1)', at its rounding (brown_table1's input row)",
 )
-#: Table 1's printed statements about the comparator the tolerances are stated for: the same
-#: zones as brown_table1's claim-book rows of these ids (a test pins them), here constraints
-TABLE1 = (
-    Statement(
-        _T1 + "share_1p1_1p3",
-        (0.8, 0.8),
-        "share",
-        2,
-        0.05,
-        paper="80 percent of the standard deviations in x and y ranged between 1.1 and 1.3 "
-        "microns (share of the 50 sigmas printing 1.1-1.3 um)",
-        source="004, Results",
-    ),
-    Statement(
-        _T1 + "points_ge_1p45",
-        (2.0, 4.0),
-        "range",
-        paper="2 points had standard deviations as large as 1.5 microns (points whose larger "
-        "sigma prints >= 1.5 um; the model's points come in fours)",
-        source="004, Results",
-    ),
-    Statement(
-        _T1 + "max_um",
-        (1.5, 1.5),
-        "value",
-        1,
-        paper="2 points had standard deviations as large as 1.5 microns (the largest, um)",
-        source="004, Results",
-    ),
-    Statement(
-        _T1 + "below_closure",
-        (0.0, 1.0),
-        "range",
-        paper="the standard deviations ... will be somewhat smaller than the rms error of "
-        "closure (every sigma / sigma0)",
-        source="004, Results",
-    ),
-)
-
-
+TABLE1 = tuple(_PRINTED.values())
 #: the plates part's constraints: the tolerance part's (the scale reads Table 1's plate, Table
 #: 1's printed statements hold: the built comparator that measured Table 1, fifth reading)
 #: and the scale reads the Zeiss grid's points
@@ -191,10 +158,10 @@ def table1_evidence(o, b, s0, alpha_mm: float = B.ALPHA_MM) -> dict:
     cof = B.table1_cofactors(o, b, alpha_mm)  # (N, 25, 2)
     st = B.table1_sigma_stats(s0[:, None, None] * cof)
     return {
-        TABLE1[0].id: st["share"],
-        TABLE1[1].id: st["count"],
-        TABLE1[2].id: st["max"],
-        TABLE1[3].id: cof.reshape(len(o), -1),
+        _T1 + "share_1p1_1p3": st["share"],
+        _T1 + "points_ge_1p45": st["count"],
+        _T1 + "max_um": st["max"],
+        _T1 + "below_closure": cof.reshape(len(o), -1),
     }
 
 
