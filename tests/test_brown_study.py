@@ -144,6 +144,45 @@ def test_table1_together_points_satisfy_every_statement_by_direct_computation():
     assert verdicts[RG.T1 + "below_closure"].verdict == "holds"
 
 
+def test_table1_stations_are_the_table1_region_with_sigma0_projected_out():
+    """The stations of the comparator that measured Table 1 (the known-edge note's first
+    reading): every (offset, beta) where Table 1's statements hold together at some sigma0 of
+    the region is one of them; stations the region rejects at every sigma0 of its design
+    are not, and neither are stations beyond the scale's reach."""
+    reg, preds, _ = _t1_region(512, 0)
+    o, b, s0 = (reg.x[k] for k in ("station_offset_mm", "beta_mm", "sigma0_um"))
+    tog = RG.together(reg, [p for p in preds if p.id != RG.T1_JOINT])
+    st = RG.table1_stations(o, b)
+    assert tog.any() and st[tog].all()  # a sigma0 of the design is one of the grid's, nearly
+    assert 5.0 < o[st].min() and o[st].max() < 22.0  # Table 1 puts the stations 6-21 mm out
+    assert not RG.table1_stations(np.array([3.0, 30.0, 40.0]), np.array([1.0, 1.0, 1.0])).any()
+
+
+def test_known_edge_note_reads_the_built_comparator_first():
+    """Fifth reading: the row's "holds for stations 53-68 mm out" is the least natural of the
+    places where 0.85 appears. The note first gives what the comparator that measured Table
+    1 gives: on the outer ring of Table 1's own plate (5 x 5 to +-90 mm) about 0.85 (0.87 at
+    stations 5 mm out, 0.84 at 17 mm), and on the format's edge more than 0.9, failing at
+    every one of its stations; the Concept's idealised verdict follows."""
+    cfg = {"seed": 1968, "region.points": 256, "region.rounds": 0}
+    book = load_book("brown_dilution")
+    reg, preds, verdicts = RG.concept_region(cfg, book)
+    edge = next(p for p in preds if p.id == "brown.known_edge.ratio")
+    assert RG.ring_ratio(np.array([5.0, 17.0]), np.zeros(2)) == pytest.approx(
+        [0.87, 0.84], abs=0.01
+    )
+    t1 = reg.accepted & reg.outputs[RG.T1_STATIONS]
+    assert t1.any() and np.all(reg.outputs[RG.RING][t1] < 0.875)
+    assert np.all(np.asarray(reg.outputs[edge.id])[t1] > 0.9)
+    (row,) = [r for r in RG.rows_of(book, reg, preds, verdicts, {}) if r["claim"] == edge.id]
+    note = row["note"]
+    assert note.startswith("the comparator that measured Table 1 (stations where Table 1")
+    assert "on the outer ring of Table 1's own plate" in note
+    assert "on the format's edge" in note and f"fails at all {int(t1.sum())}." in note
+    lead, rest = note.split("The Concept's idealised system over every station its 25 points allow")
+    assert "outer ring" in lead and rest.startswith(" (the verdict): ")
+
+
 def test_nominal_17_mm_example_lies_in_the_table1_region():
     _, cfg = load_study(T1)
     reg, preds, _ = _t1_region(cfg["region.points"], cfg["region.rounds"])
