@@ -277,8 +277,8 @@ SCHEMA = {
     "region.rounds": count(3, "refinement rounds of the tolerance region", lo=0, hi=8),
     "region.plate_points": count(
         32,
-        "Sobol design size of the plate region (offset x beta x Zeiss layout; each point "
-        "draws unprinted.plates plates)",
+        "Sobol design size of the plate region (offset x beta x sigma0 x Zeiss layout x "
+        "two-screw error; each point Table 1 leaves in the region draws unprinted.plates plates)",
         lo=8,
         hi=1024,
     ),
