@@ -31,7 +31,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.cli_args import parser
-from sim.execute import execute
+from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem
@@ -262,6 +262,7 @@ def _check(args) -> int:
     study, cfg = load_run(args)
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
+    check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     est = estimate(cfg, sweep)
     check_limits(est)  # the limits sim run applies (SIM_MAX_MEMORY_GB, SIM_MAX_ADJUSTMENTS)
     print(f"# {cfg['study']}: {study.title}")
