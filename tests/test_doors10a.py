@@ -4,10 +4,12 @@ each failed on the code before its fix.
 * brown_design at allowed values of its keys failed at run time in an internal function
   (``comparator.alpha_mm = 50`` or ``-50``: "zero-size array" in ``cells.within_front``;
   ``datum.beta_mm = 50``: the arm's offset beyond the nearest point; ``coverage.sigma_um =
-  1e5``: ZeroDivisionError in ``claims._coverage``, no trial converged). Each is refused on
-  load with the instrument's reason: beta at most half the 29 mm scale's width, alpha below
-  the shortest distance the scale reads, the nominal coverage's noise at most 1 % of the
-  datum plate's spacing and shortest range (:mod:`sim.studies.design.checks`);
+  1e5`` or ``datum.spacing_mm = 0.01``: ZeroDivisionError in ``claims._coverage``, no trial
+  converged; ``zeiss.points = 3``: LinAlgError in ``external.plate_rms``). Each is refused
+  on load with the instrument's reason: beta at most half the 29 mm scale's width, alpha
+  below the shortest distance the scale reads, the nominal coverage's noise at most 1 % of
+  the datum plate's spacing and shortest station distance, the Zeiss sample redundant in
+  the pivot model (:mod:`sim.studies.design.checks`);
 * ``sim check`` accepted a ``[sweep]`` in which every cell is refused (the run then stopped
   with "every cell failed"); it is refused up front naming the swept key and its values, and
   the refused cells of a sweep that has others are named once (recorded, not run).
@@ -34,11 +36,13 @@ def test_brown_design_at_its_allowed_edges_is_refused_on_load_naming_the_key(cap
         ("comparator.alpha_mm=-50", "comparator.alpha_mm: the longest range", "296.5 mm"),
         ("datum.beta_mm=50", "datum.beta_mm: beta = 50 mm", "29 mm width of the scale"),
         ("coverage.sigma_um=1e5", "coverage.sigma_um: 100000 um", "at most 450 um"),
+        ("datum.spacing_mm=0.01", "coverage.sigma_um: 1 um", "0.01 mm spacing"),
+        ("zeiss.points=3", "zeiss.points: 3 points in 4 positions", "at least 4 points"),
     ]
     for setting, *needles in cases:
         _one_line(capsys, main(["check", str(DESIGN), "--set", setting]), *needles)
-    # just inside: alpha below the 49.49 mm shortest reading, the noise at 1 % of 45 mm
-    for setting in ("comparator.alpha_mm=49.4", "coverage.sigma_um=450"):
+    # just inside: alpha below the region's 29.64 mm shortest reading, the noise at 1 % of 45 mm
+    for setting in ("comparator.alpha_mm=29.6", "coverage.sigma_um=450"):
         assert main(["check", str(DESIGN), "--set", setting]) == 0, setting
 
 

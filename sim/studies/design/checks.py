@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.instruments.plates import grid_points
+from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import positions as po
 from sim.mc.schema_helpers import require
 from sim.studies.design.external import paper_points
@@ -110,6 +111,16 @@ def _check_geometry(cfg: dict) -> None:
         "datum.offset_mm",
         f"the datum geometry must be buildable: at {cfg['datum.offset_mm']:g} mm its "
         f"longest range exceeds the scale plus micrometer (at most {dmax:.1f} mm fits)",
+    )
+    P, n = cfg["paper.positions"], cfg["zeiss.points"]
+    dof = P * n - 2 * n - (2 * P + 2) + 3  # readings - unknowns (the rigid fit fixes 3)
+    need = int(np.floor((2 * P - 1) / (P - 2))) + 1
+    require(
+        dof > 0,
+        "zeiss.points",
+        f"{n} points in {P} positions give {P * n} readings for {2 * n} coordinates and "
+        f"{2 * P + 2} comparator parameters less the rigid fit's 3: no redundancy, the pivot "
+        f"model cannot be solved on the Zeiss sample (at least {need} points)",
     )
     for e in [cfg["zeiss.half_extent_mm"], 40.0]:  # 40 mm: the region's smallest layout
         require(
@@ -238,6 +249,7 @@ def _check_readings(cfg: dict) -> None:
         f"{cfg['plate.format_mm']:g} mm format: the pivot must stand beside the plate in every "
         f"position (more than {need:.1f} mm out)",
     )
+    _check_region_alpha(cfg)
     ext = (cfg["datum.grid"] - 1) * cfg["datum.spacing_mm"] / 2
     hd = half + cfg["datum.offset_mm"]
     for k in dict.fromkeys([cfg["datum.grid"], *cfg["coverage.grids"]]):
@@ -246,6 +258,29 @@ def _check_readings(cfg: dict) -> None:
         _reach(cfg, what, "datum.beta_mm", cfg["datum.beta_mm"], d)
         for b in cfg["coverage.betas_mm"]:
             _reach(cfg, what, "coverage.betas_mm", b, d)
+
+
+def region_alpha_max_mm() -> float:
+    """The shortest reading (alpha = 0) of Table 1's plate over the region of the unprinted
+    inputs (:mod:`.region`: stations from the lowest offset out, beta up to its highest;
+    :data:`sim.instruments.ranges.brown.INPUTS`): alpha must stay below it (mm)."""
+    ins = B.INPUTS["inputs"]
+    o, b = ins["station_offset_mm"]["low"], ins["beta_mm"]["high"]
+    return float(B.min_range_mm(B.table1_points()[None], B.thetas(o, b, 0.0))[0])
+
+
+def _check_region_alpha(cfg: dict) -> None:
+    """Every plate the region explores (Table 1's, the comparator that measured it) reads."""
+    top = region_alpha_max_mm()
+    ins = B.INPUTS["inputs"]
+    require(
+        cfg["comparator.alpha_mm"] < top,
+        "comparator.alpha_mm",
+        f"alpha = {cfg['comparator.alpha_mm']:g} mm must be below {top:.4g} mm, the shortest "
+        f"distance the scale reads on Table 1's plate over the region the study explores "
+        f"(stations from {ins['station_offset_mm']['low']:g} mm out, beta up to "
+        f"{ins['beta_mm']['high']:g} mm): its nearest point would read a negative range",
+    )
 
 
 def _check_coverage_noise(cfg: dict) -> None:
