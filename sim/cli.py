@@ -262,9 +262,9 @@ def _check(args) -> int:
     study, cfg = load_run(args)
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
-    check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     est = estimate(cfg, sweep)
     check_limits(est)  # the limits sim run applies (SIM_MAX_MEMORY_GB, SIM_MAX_ADJUSTMENTS)
+    check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
     for k, v in cfg.items():
         f = study.schema.get(k)

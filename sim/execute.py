@@ -133,9 +133,9 @@ def execute(
     shown = shown or str(out)
     _check_options(executor, workers, scheduler)
     check_chunks(cfg)
-    check_sweep(study, cfg, sweep, quiet)
     est = estimate(cfg, sweep)
     check_limits(est, max_memory_gb, max_adjustments, workers)
+    check_sweep(study, cfg, sweep, quiet)
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
         "code_hash": code_hash(cfg["study"]),
@@ -221,7 +221,7 @@ def check_sweep(study, cfg: dict, sweep: Mapping[str, Any], quiet: bool = False)
     ``quiet`` (``sweep.parquet`` records them with the reason)."""
     if not sweep:
         return
-    note = refused_note(sweep, refused_cells(study, cfg, sweep))
+    note = refused_note(sweep, *refused_cells(study, cfg, sweep))
     if note and not quiet:
         print(f"sim: {note}", file=sys.stderr)
 

@@ -60,3 +60,17 @@ def test_a_sweep_of_only_refused_cells_is_refused_by_check_and_run(tmp_path, cap
     err = capsys.readouterr().err.strip()
     assert err.startswith("sim: sweep: 1 of 2 cells are infeasible") and "\n" not in err, err
     assert "cell0001" in err and "cell0000" not in err
+
+
+def test_the_check_of_a_sweeps_cells_is_bounded_in_time(tmp_path):
+    # a cell of a 2,500-point network takes 0.7 s to validate: sim check of a large sweep
+    # must not take hours; the cells beyond the budget are validated when they run
+    from sim.mc.sweep import refused_cells, refused_note
+    from sim.studies import load_study
+
+    study, cfg = load_study(DESIGN)
+    table = {"comparator.alpha_mm": [49.5, 50.0, 40.0]}
+    bad, checked = refused_cells(study, cfg, table, budget_s=0.0)
+    assert checked == 1 and list(bad) == [0]  # not all checked: not refused as a whole
+    note = refused_note(table, bad, checked)
+    assert "1 of 3 cells are infeasible" in note and "first 1 of 3 cells checked" in note
