@@ -31,7 +31,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.cli_args import parser
-from sim.execute import execute
+from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem
@@ -264,6 +264,7 @@ def _check(args) -> int:
     sweep = read_sweep(args.study, study.schema)
     est = estimate(cfg, sweep)
     check_limits(est)  # the limits sim run applies (SIM_MAX_MEMORY_GB, SIM_MAX_ADJUSTMENTS)
+    check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
     for k, v in cfg.items():
         f = study.schema.get(k)

@@ -20,7 +20,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from sim.mc.config import ConfigError, StudyError, check_chunks, validate
+from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import check_out, drop_stage, prepare_stage, publish, seal
 from sim.mc.runner import ChunkStore, RunContext, make_executor
@@ -31,11 +31,11 @@ from sim.mc.storage import (
     versions,
     write_table,
 )
-from sim.mc.sweep import cell_label, cell_seed, expand
+from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cells, refused_note
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
 
-__all__ = ["execute", "run_sweep"]
+__all__ = ["execute", "run_sweep", "check_sweep"]
 
 
 #: a Dask scheduler address: tcp://HOST:PORT (or another Dask protocol)
@@ -135,6 +135,7 @@ def execute(
     check_chunks(cfg)
     est = estimate(cfg, sweep)
     check_limits(est, max_memory_gb, max_adjustments, workers)
+    check_sweep(study, cfg, sweep, quiet)
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
         "code_hash": code_hash(cfg["study"]),
@@ -212,12 +213,24 @@ def _quiet_dask_logs() -> None:
         logging.getLogger(n).setLevel(logging.CRITICAL + 1)
 
 
+def check_sweep(study, cfg: dict, sweep: Mapping[str, Any], quiet: bool = False) -> None:
+    """Before anything runs (``sim run``, ``sim check``, the API, ``sim.batch``): a sweep in
+    which the study refuses every cell is refused (:class:`ConfigError` naming the swept key
+    and its values); the cells it refuses of a sweep that has others are named once on
+    standard error (:func:`sim.mc.sweep.refused_note`; they are recorded, not run), unless
+    ``quiet`` (``sweep.parquet`` records them with the reason)."""
+    if not sweep:
+        return
+    note = refused_note(sweep, *refused_cells(study, cfg, sweep))
+    if note and not quiet:
+        print(f"sim: {note}", file=sys.stderr)
+
+
 def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dict:
     """Run every cell of ``table`` for ``study`` from the resolved base ``cfg``; write
     ``out/sweep.parquet`` and ``out/cells/<label>/``. Returns the table's columns."""
 
     keys, cells, reps, mode = expand(table, study.schema)
-    base = {k: v for k, v in cfg.items() if k != "study"}
     rows: list[dict[str, Any]] = []
     for i, cell in enumerate(cells):
         for r in range(reps):
@@ -232,11 +245,7 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
             }
             row.update({k: cell[k] for k in keys})
             try:
-                ccfg = {
-                    "study": cfg["study"],
-                    **validate({**base, **cell, "seed": seed}, study.schema, study.check),
-                }
-                check_chunks(ccfg)
+                ccfg = cell_config(study, cfg, cell, seed)
             except ConfigError as e:
                 row.update(feasible=False, reason=str(e))
                 rows.append(row)

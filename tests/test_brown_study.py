@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim.claims.book import ClaimBook
 from sim.cli import main
 from sim.instruments.ranges import brown as B
 from sim.mc.config import ConfigError
@@ -17,7 +16,7 @@ from sim.mc.storage import read_table
 from sim.studies import load_study
 from sim.studies.brown import region as RG
 from sim.studies.brown import values as V
-from sim.studies.brown.claims import BOOK, load_book
+from sim.studies.brown.claims import BOOK, full_book, load_book
 from sim.studies.brown.report import report_dilution, report_table1
 from sim.studies.brown.schema import max_offset_mm, setup
 
@@ -26,8 +25,40 @@ DIL = ROOT / "studies" / "brown_dilution.toml"
 T1 = ROOT / "studies" / "brown_table1.toml"
 
 
+def test_table1_statements_are_declared_once_in_the_instrument(tmp_path, monkeypatch):
+    """Table 1's printed statements (the closure, 80 % in 1.1-1.3 um, two points at 1.5 um,
+    the largest, all below the closure) are declared once, in the instrument module:
+    brown_table1's claim rows take their zones from there, and brown_design's region builds
+    its constraints and sigma0's range from the same declaration (it had a copy, kept equal
+    by a test). A claim-book row that states a declared key again is refused, naming it."""
+    import tomllib
+
+    from sim.claims.region import statement_of
+    from sim.studies.brown import claims as BC
+    from sim.studies.design import region as DR
+
+    declared = B.TABLE1["statements"]
+    raw = {c["id"]: c for c in tomllib.loads(BOOK.read_text())["claim"]}
+    book = load_book("brown_table1")
+    for cid, d in declared.items():
+        assert not set(BC.PRINTED_KEYS) & set(raw[cid])  # not repeated in the claim book
+        assert {k: book.spec(cid)[k] for k in BC.PRINTED_KEYS if k in d} == {
+            k: d[k] for k in BC.PRINTED_KEYS if k in d
+        }
+    printed = RG.table1_statements()
+    assert set(printed) == set(declared)
+    for s in DR.TABLE1:  # brown_design's constraints: the same statements, the same zones
+        assert s == printed[s.id] and s.zone == statement_of(book, s.id).zone
+    assert len(DR.TABLE1) == 4 and (DR.SIGMA0.low, DR.SIGMA0.high) == (1.55, 1.65)
+    bad = tmp_path / "claims.toml"
+    bad.write_text(BOOK.read_text().replace('kind = "input"', 'kind = "input"\ntol = 0.1', 1))
+    monkeypatch.setattr(BC, "BOOK", bad)
+    with pytest.raises(ConfigError, match=r"claim\.tol.*brown.table1_closure.rms_um.*declared"):
+        BC.full_book()
+
+
 def test_claim_book_splits_into_the_two_studies():
-    full = ClaimBook.load(BOOK)
+    full = full_book()
     d, t = load_book("brown_dilution"), load_book("brown_table1")
     assert set(d.specs) | set(t.specs) == set(full.specs)
     assert not set(d.specs) & set(t.specs)
@@ -111,6 +142,45 @@ def test_table1_together_points_satisfy_every_statement_by_direct_computation():
         assert cof.max() < 1
     assert verdicts[RG.T1_JOINT].verdict == "depends"
     assert verdicts[RG.T1 + "below_closure"].verdict == "holds"
+
+
+def test_table1_stations_are_the_table1_region_with_sigma0_projected_out():
+    """The stations of the comparator that measured Table 1 (the known-edge note's first
+    reading): every (offset, beta) where Table 1's statements hold together at some sigma0 of
+    the region is one of them; stations the region rejects at every sigma0 of its design
+    are not, and neither are stations beyond the scale's reach."""
+    reg, preds, _ = _t1_region(512, 0)
+    o, b, s0 = (reg.x[k] for k in ("station_offset_mm", "beta_mm", "sigma0_um"))
+    tog = RG.together(reg, [p for p in preds if p.id != RG.T1_JOINT])
+    st = RG.table1_stations(o, b)
+    assert tog.any() and st[tog].all()  # a sigma0 of the design is one of the grid's, nearly
+    assert 5.0 < o[st].min() and o[st].max() < 22.0  # Table 1 puts the stations 6-21 mm out
+    assert not RG.table1_stations(np.array([3.0, 30.0, 40.0]), np.array([1.0, 1.0, 1.0])).any()
+
+
+def test_known_edge_note_reads_the_built_comparator_first():
+    """Fifth reading: the row's "holds for stations 53-68 mm out" is the least natural of the
+    places where 0.85 appears. The note first gives what the comparator that measured Table
+    1 gives: on the outer ring of Table 1's own plate (5 x 5 to +-90 mm) about 0.85 (0.87 at
+    stations 5 mm out, 0.84 at 17 mm), and on the format's edge more than 0.9, failing at
+    every one of its stations; the Concept's idealised verdict follows."""
+    cfg = {"seed": 1968, "region.points": 256, "region.rounds": 0}
+    book = load_book("brown_dilution")
+    reg, preds, verdicts = RG.concept_region(cfg, book)
+    edge = next(p for p in preds if p.id == "brown.known_edge.ratio")
+    assert RG.ring_ratio(np.array([5.0, 17.0]), np.zeros(2)) == pytest.approx(
+        [0.87, 0.84], abs=0.01
+    )
+    t1 = reg.accepted & reg.outputs[RG.T1_STATIONS]
+    assert t1.any() and np.all(reg.outputs[RG.RING][t1] < 0.875)
+    assert np.all(np.asarray(reg.outputs[edge.id])[t1] > 0.9)
+    (row,) = [r for r in RG.rows_of(book, reg, preds, verdicts, {}) if r["claim"] == edge.id]
+    note = row["note"]
+    assert note.startswith("the comparator that measured Table 1 (stations where Table 1")
+    assert "on the outer ring of Table 1's own plate" in note
+    assert "on the format's edge" in note and f"fails at all {int(t1.sum())}." in note
+    lead, rest = note.split("The Concept's idealised system over every station its 25 points allow")
+    assert "outer ring" in lead and rest.startswith(" (the verdict): ")
 
 
 def test_nominal_17_mm_example_lies_in_the_table1_region():

@@ -303,6 +303,77 @@ def test_tolerances_are_decided_where_table1_puts_the_same_comparators_stations(
         assert verdicts[cid].verdict == "holds", cid
 
 
+def test_plates_part_is_decided_where_table1_puts_the_same_comparators_stations():
+    """The two-screw agreement ("an rms agreement of final coordinates ranging between +-2
+    and +-3 microns is usually obtained") and the Zeiss rows are statements about the plates
+    of the built comparator, the one that measured Table 1. Their part of the region has the
+    tolerance part's constraints (the scale reads Table 1's plate, Table 1's printed
+    statements hold) and simulates the plates with the point's closure sigma0 as the range
+    sigma. The old part sampled the stations over every offset the scale allows (0.8-33.8 mm
+    in the committed run) with Table 1's statements unasked, and drew every plate at the
+    labelled model's 1.63 um, a closure at which Table 1 fails at every station."""
+    from sim.claims.inference import FAILS, evaluate
+    from sim.studies.design import external as ex
+    from sim.studies.design import region as DR
+    from sim.studies.design.claims import load_book
+
+    assert {s.id for s in DR.TABLE1} <= {s.id for s in DR.PLATE_STATEMENTS}
+    cfg = validate(
+        {"region.plate_points": 256, "unprinted.plates": 100}, design.SCHEMA, design.check
+    )
+    reg, _, verdicts = DR.plates_region(cfg, load_book())
+    pts = reg.points()
+    assert 3 <= len(pts["station_offset_mm"]) <= 40  # Table 1 accepts about 3 % of the box
+    # every accepted point is one of Table 1's (the tolerance part's rule, recomputed)
+    t1 = DR.table1_evidence(pts["station_offset_mm"], pts["beta_mm"], pts["sigma0_um"])
+    assert (evaluate(DR.TABLE1, t1, len(pts["beta_mm"])) != FAILS).all()
+    assert 6.0 < pts["station_offset_mm"].min() and pts["station_offset_mm"].max() < 20.0
+    assert 1.55 <= pts["sigma0_um"].min() and pts["sigma0_um"].max() <= 1.6
+    # the labelled model's range sigma contradicts Table 1 everywhere the old part sampled
+    o = np.linspace(0.5, 34.0, 68)
+    ev = DR.table1_evidence(o, np.full_like(o, 5.0), np.full_like(o, ex.range_sigma_um(cfg)))
+    assert ex.range_sigma_um(cfg) > 1.6 and (evaluate(DR.TABLE1, ev, len(o)) == FAILS).any(1).all()
+    # the plates are drawn at the point's sigma0: the same plates, scaled by it
+    e0 = ex.external_at(cfg, 12.0, 5.0, 90.0, 0.5, two_screw_um=0.0)
+    e1 = ex.external_at(cfg, 12.0, 5.0, 90.0, 0.5, two_screw_um=0.0, sigma0_um=1.57)
+    np.testing.assert_allclose(
+        e1["table1_rms"], e0["table1_rms"] * 1.57 / ex.range_sigma_um(cfg), rtol=1e-9
+    )
+    # plates only at the points the analytic statements leave in the region
+    v = reg.outputs["brown.results.two_screw_agreement_um"]["value"]
+    assert np.isfinite(v[reg.accepted]).all() and np.isnan(v[~reg.accepted]).all()
+    assert verdicts["brown.results.two_screw_agreement_um"].n_points == reg.accepted.sum()
+
+
+def test_two_screw_note_says_the_other_comparators_error_decides_it():
+    """Last session found that the agreement's failing point fails because of the other
+    comparator's 0.53 um, not the station: the note says which input separates the failing
+    points from the holding ones, and only when it does (a synthetic region)."""
+    from sim.claims.inference import Input, Region
+    from sim.studies.design import region as DR
+    from sim.studies.design.claims import load_book
+
+    pred = DR.statement_of(load_book(), "brown.results.two_screw_agreement_um")
+    # zone 1.5-3.5 ("+-2 to +-3"): fails below 0.9 um, undecided at 0.95, holds from 1.0 um
+    ts = np.array([0.6, 0.7, 0.95, 1.4, 2.0, 0.8])
+    off = np.array([9.0, 17.0, 12.0, 8.0, 16.0, 30.0])
+    agree = {"value": ts + 0.55, "low": ts + 0.5, "high": ts + 0.6, "p": None}
+    ins = [Input("station_offset_mm", 0.5, 80.0, ""), Input("two_screw_sigma_um", 0.5, 2.5, "")]
+
+    def region(status):
+        x = {"station_offset_mm": off, "two_screw_sigma_um": ts}
+        res = {i.name: (1.0, 1.0) for i in ins}
+        return Region(ins, [], x, status, 0.95, res, {pred.id: agree})
+
+    acc = np.zeros((6, 1), np.int8)  # every point in the region
+    note = DR.decided_by(region(acc[:, :0]), pred, "two_screw_sigma_um")
+    assert "two_screw_sigma_um <= 0.8 (stations 9-30 mm out)" in note
+    assert "holds exactly where two_screw_sigma_um >= 1.4 (stations 8-16 mm out)" in note
+    assert "not the station" in note
+    # an input that does not separate them gives no sentence
+    assert DR.decided_by(region(acc[:, :0]), pred, "station_offset_mm") == ""
+
+
 def test_linearised_plate_rms_matches_its_covariance():
     from sim.studies.design import external as ex
 

@@ -63,7 +63,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
-from scipy import stats
+from scipy import special
 from scipy.spatial import cKDTree
 
 from sim.claims.declaration import FORMS, Input, Statement, load_declaration, parse_declaration
@@ -89,7 +89,7 @@ HOLDS, UNDECIDED, FAILS = 1, 0, -1
 def interval_from_se(value, se, level: float = 0.95) -> dict[str, np.ndarray]:
     """Evidence for a Monte-Carlo estimate: ``value +- z se`` at two-sided ``level``."""
     v, s = np.asarray(value, float), np.asarray(se, float)
-    z = stats.norm.ppf(0.5 + level / 2)
+    z = special.ndtri(0.5 + level / 2)  # the normal quantile (scipy.stats.norm.ppf)
     return {"value": v, "low": v - z * s, "high": v + z * s}
 
 
@@ -282,7 +282,11 @@ def explore(
     m = int(math.ceil(math.log2(n)))
     u = np.full((2**m, len(inputs)), 0.5)
     if free:
-        sob = stats.qmc.Sobol(d=len(free), scramble=True, seed=rng)
+        # scipy.stats costs about 0.5 s of CPU to import, in every process that imports the
+        # suite (a `sim check`, a pool worker); only an exploration needs it
+        from scipy.stats import qmc
+
+        sob = qmc.Sobol(d=len(free), scramble=True, seed=rng)
         u[:, free] = sob.random_base2(m)
     h0 = (2**m) ** (-1.0 / d)
     h = h0

@@ -23,7 +23,12 @@ Compile time counts too (every process on a cold cache: a fresh clone's tests, a
 run): kernels copy arrays element by element and sort slices in place, since numba compiles
 an array-to-array slice assignment with its broadcasting checks and their messages (about 4 s
 per process; ``tests/test_kernel_source.py``), and a lane width is an argument, not a
-constant (one compile for every width).
+constant (one compile for every width). numba types a read-only array apart from a writable
+one, so a read-only argument (e.g. a ``np.broadcast_to`` view of one trial, already
+contiguous) would compile the whole kernel a second time (the multilateration kernel
+about 11 s, the group reductions 2 s per argument pattern; about 22 s of CPU in a cold test
+run): :func:`compiled` hands the kernel a writable copy of such an argument (same values,
+same answers).
 """
 
 from __future__ import annotations
@@ -32,6 +37,9 @@ import os
 import types
 import zlib
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 __all__ = ["available", "compiled", "REASSOCIATE"]
 
@@ -41,7 +49,8 @@ __all__ = ["available", "compiled", "REASSOCIATE"]
 REASSOCIATE = frozenset({"reassoc", "contract"})
 
 _njit: list = []  # numba's njit once imported ([None] without numba)
-_kernels: dict = {}
+_kernels: dict = {}  # the numba dispatchers, by kernel and constants
+_callers: dict = {}  # what :func:`compiled` returns: the dispatcher behind writable arguments
 
 
 def _numba():
@@ -82,11 +91,30 @@ def compiled(fn, reassociate: bool = False, helpers=(), **consts):
     if key not in _kernels:
         glb = dict(fn.__globals__, **consts)
         for h in helpers:
-            glb[h.__name__] = compiled(h)
+            compiled(h)
+            glb[h.__name__] = _kernels[(h.__module__, h.__name__, False)]
         parts = [str(v) for _, v in sorted(consts.items())] + [_source_tag(h) for h in helpers]
         name = "_".join([fn.__name__] + parts)
         f = types.FunctionType(fn.__code__, glb, name, fn.__defaults__, fn.__closure__)
         f.__qualname__ = name
         opts = {"fastmath": set(REASSOCIATE)} if reassociate else {}
         _kernels[key] = njit(cache=True, error_model="numpy", **opts)(f)
-    return _kernels[key]
+        _callers[key] = _Writable(_kernels[key])
+    return _callers[key]
+
+
+def _writable(a: Any) -> Any:
+    """``a``, or a writable copy when ``a`` is a read-only array (see the module docstring)."""
+    return a.copy() if isinstance(a, np.ndarray) and not a.flags.writeable else a
+
+
+class _Writable:
+    """A compiled kernel called with writable arrays only: one compiled variant per kernel."""
+
+    __slots__ = ("dispatcher",)
+
+    def __init__(self, dispatcher) -> None:
+        self.dispatcher = dispatcher
+
+    def __call__(self, *args):
+        return self.dispatcher(*(_writable(a) for a in args))

@@ -22,12 +22,16 @@ from __future__ import annotations
 import re
 
 import numpy as np
-from matplotlib.cbook import STEP_LOOKUP_MAP
-from matplotlib.collections import LineCollection, PathCollection, PolyCollection
-from matplotlib.colors import to_rgba
-from matplotlib.container import BarContainer
-from matplotlib.lines import Line2D
-from matplotlib.quiver import Quiver
+
+from sim.report.mpl import collections as mcoll
+from sim.report.mpl import lazy
+
+_cbook, _colors = lazy("matplotlib.cbook"), lazy("matplotlib.colors")
+_container, _lines, _quiver = (
+    lazy("matplotlib.container"),
+    lazy("matplotlib.lines"),
+    lazy("matplotlib.quiver"),
+)
 
 __all__ = ["reader_problems", "figure_facts", "data_points", "points_inside"]
 __all__ += ["MIN_POINTS", "MAX_DIGITS"]
@@ -54,7 +58,7 @@ def _marker_points(ax) -> np.ndarray:
             xy = np.asarray(ln.get_xydata(), float)
             pts.append(ln.get_transform().transform(xy[np.isfinite(xy).all(1)]))
     for c in ax.collections:
-        if c.get_visible() and isinstance(c, (PathCollection, Quiver)):
+        if c.get_visible() and isinstance(c, (mcoll.PathCollection, _quiver.Quiver)):
             off = np.asarray(c.get_offsets(), float)
             if off.size:
                 pts.append(c.get_offset_transform().transform(off[np.isfinite(off).all(1)]))
@@ -79,18 +83,18 @@ def data_points(ax) -> np.ndarray:
     for ln in ax.lines:
         if ln.get_visible() and ln.get_linestyle() not in ("None", "", " "):
             xy = np.asarray(ln.get_xydata(), float)
-            if ln.get_drawstyle() in STEP_LOOKUP_MAP and ln.get_drawstyle() != "default":
-                xy = np.column_stack(STEP_LOOKUP_MAP[ln.get_drawstyle()](*xy.T))
+            if ln.get_drawstyle() in _cbook.STEP_LOOKUP_MAP and ln.get_drawstyle() != "default":
+                xy = np.column_stack(_cbook.STEP_LOOKUP_MAP[ln.get_drawstyle()](*xy.T))
             xy = ln.get_transform().transform(xy[np.isfinite(xy).all(1)])
             pts.append(_densify(xy))
     for c in ax.collections:
-        if c.get_visible() and isinstance(c, LineCollection) and len(c.get_segments()) < 3000:
+        if c.get_visible() and isinstance(c, mcoll.LineCollection) and len(c.get_segments()) < 3000:
             for seg in c.get_segments():
                 seg = np.asarray(seg, float)
                 if seg.size and np.isfinite(seg).all():
                     pts.append(_densify(c.get_transform().transform(seg)))
     for cont in ax.containers:
-        if isinstance(cont, BarContainer):
+        if isinstance(cont, _container.BarContainer):
             for p in cont.patches:
                 b = p.get_window_extent()
                 if b.width > 0 and b.height > 0:
@@ -165,7 +169,7 @@ def _tick_problems(i: int, ax) -> list[str]:
 def _comb_problems(i: int, ax) -> list[str]:
     probs = []
     for cont in ax.containers:
-        if not isinstance(cont, BarContainer) or len(cont.patches) < 10:
+        if not isinstance(cont, _container.BarContainer) or len(cont.patches) < 10:
             continue
         h = np.array([p.get_height() for p in cont.patches])
         nz = np.flatnonzero(h > 0)
@@ -181,13 +185,13 @@ def _comb_problems(i: int, ax) -> list[str]:
 
 
 def _handle_colour(h):
-    if isinstance(h, Line2D):
+    if isinstance(h, _lines.Line2D):
         c = h.get_color()
         if h.get_linestyle() in ("None", "") and h.get_markerfacecolor() != "none":
             c = h.get_markerfacecolor()  # a marker alone: its face, else its edge
-        return to_rgba(c, h.get_alpha()), (h.get_marker(), h.get_linestyle())
-    if isinstance(h, PathCollection) and len(h.get_facecolors()):
-        return to_rgba(h.get_facecolors()[0], h.get_alpha()), ("scatter", "")
+        return _colors.to_rgba(c, h.get_alpha()), (h.get_marker(), h.get_linestyle())
+    if isinstance(h, mcoll.PathCollection) and len(h.get_facecolors()):
+        return _colors.to_rgba(h.get_facecolors()[0], h.get_alpha()), ("scatter", "")
     return None, None
 
 
@@ -243,8 +247,10 @@ def _series(ax) -> int:
     if leg is not None:
         return len(leg.get_texts())
     n = sum(1 for ln in ax.lines if ln.get_visible())
-    n += sum(1 for c in ax.collections if c.get_visible() and not isinstance(c, PolyCollection))
-    return n + sum(1 for c in ax.containers if isinstance(c, BarContainer))
+    n += sum(
+        1 for c in ax.collections if c.get_visible() and not isinstance(c, mcoll.PolyCollection)
+    )
+    return n + sum(1 for c in ax.containers if isinstance(c, _container.BarContainer))
 
 
 def figure_facts(fig) -> list[dict]:

@@ -13,16 +13,13 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable, Iterator, Sequence
 
-import matplotlib
 import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
-
-from sim.mc.config import ConfigError  # noqa: E402
-from sim.mc.storage import atomic_path  # noqa: E402
-from sim.report.figcheck import data_points, figure_facts, points_inside, reader_problems  # noqa: E402
+from sim.mc.config import ConfigError
+from sim.mc.storage import atomic_path
+from sim.report.figcheck import data_points, figure_facts, points_inside, reader_problems
+from sim.report.mpl import pyplot as plt
+from sim.report.mpl import ticker
 
 __all__ = [
     "plt",
@@ -36,17 +33,6 @@ __all__ = [
     "hist_bins",
     "UNITLESS",
 ]
-
-plt.rcParams.update(
-    {
-        "figure.dpi": 100,
-        "savefig.dpi": 110,
-        "font.size": 9,
-        "axes.grid": True,
-        "grid.alpha": 0.3,
-        "svg.hashsalt": "sim",
-    }
-)
 
 
 #: words that mark an axis label as a dimensionless quantity (no unit needed)
@@ -378,9 +364,9 @@ def plain_log(ax, axis: str = "x") -> None:
     """Tick labels of a log axis as plain numbers at 1, 2 and 5 of each decade (``2``,
     ``50``, not ``2×10⁰``); minor ticks unlabelled (they would crowd)."""
     a = ax.xaxis if axis == "x" else ax.yaxis
-    a.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-    a.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    a.set_minor_formatter(NullFormatter())
+    a.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    a.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    a.set_minor_formatter(ticker.NullFormatter())
 
 
 def times_ten(x: float, digits: int = 2) -> str:

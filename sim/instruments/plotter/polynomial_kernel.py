@@ -39,9 +39,10 @@ __all__ = ["fit", "UNDECIDED"]
 
 def _fit(meas, true, ex, ey, norm, rcond, x, sq, corr, want, status):  # pragma: no cover
     """The fits of :func:`fit` (``meas`` (T, 2n), ``true`` (1 or T, 2n) with x, y
-    interleaved; ``ex``, ``ey`` the terms' exponents; ``P_TERMS`` their number, a
-    compile-time constant)."""
-    T, n, p = meas.shape[0], meas.shape[1] // 2, P_TERMS  # noqa: F821 (set by compile.compiled)
+    interleaved; ``ex``, ``ey`` the terms' exponents, their number an argument: one compile
+    serves every term count, with the same answers bit for bit as a count frozen into the
+    kernel, since only the sums over the points are vectorised)."""
+    T, n, p = meas.shape[0], meas.shape[1] // 2, ex.shape[0]
     px, py = np.empty((ex.max() + 1, n)), np.empty((ey.max() + 1, n))
     A, D, F = np.empty((LANES, p, n)), np.empty((LANES, 2, n)), np.empty((2, n))
     Nb, ub, xb = np.empty((p, p, LANES)), np.empty((p, 2, LANES)), np.empty((p, 2, LANES))
@@ -118,7 +119,7 @@ def fit(measured: np.ndarray, true: np.ndarray, terms, norm_mm: float, corrected
     ey = np.array([b for _, b in terms], np.int64)
     x, sq, status = np.empty((T, len(terms), k)), np.empty((T, k)), np.empty(T, np.int8)
     corr = np.full((T, n, k) if corrected else (1, 1, k), np.nan)
-    kernel = compile.compiled(_fit, reassociate=True, helpers=(solve_lanes,), P_TERMS=len(terms))
+    kernel = compile.compiled(_fit, reassociate=True, helpers=(solve_lanes,))
     kernel(
         meas.reshape(T, 2 * n), tr.reshape(tr.shape[0], 2 * n), ex, ey, float(norm_mm),
         float(rcond), x, sq, corr, bool(corrected), status,

@@ -35,6 +35,7 @@ __all__ = [
     "TABLE1_GRID",
     "TABLE1_SPACING_MM",
     "INPUTS",
+    "TABLE1",
     "thetas",
     "table1_points",
     "table1_cofactors",
@@ -89,6 +90,63 @@ INPUTS = {
 }
 
 
+_T1 = "brown.table1_point_sigma."
+#: Table 1's printed statements, declared once for every Brown study (declaration data for
+#: :func:`sim.claims.inference.parse_declaration`): the plate's rms error of closure, which
+#: bounds sigma0, and the four statements about its 50 printed point sigmas
+#: (:func:`table1_sigma_stats`, :func:`table1_cofactors`), each with the zone its printed
+#: number stands for (``form``, ``ref``, ``decimals``, ``tol``). brown_table1 scores them as
+#: claim rows (its claim book takes their zones from here); brown_design's region and
+#: brown_dilution's reading of the built comparator take them as constraints.
+TABLE1 = {
+    "inputs": {k: INPUTS["inputs"][k] for k in ("station_offset_mm", "beta_mm", "sigma0_um")},
+    "statements": {
+        "brown.table1_closure.rms_um": {
+            "form": "one-plate",
+            "ref": 1.6,
+            "decimals": 1,
+            "tol": 0.0,
+            "paper": "the rms error of closure turned out to be 1.6 microns (Table 1)",
+            "source": "004, Results (Table 1)",
+        },
+        _T1 + "share_1p1_1p3": {
+            "form": "share",
+            "ref": 0.8,
+            "decimals": 2,
+            "tol": 0.05,
+            "paper": "80 percent of the standard deviations in x and y ranged between 1.1 and "
+            "1.3 microns (share of the 50 sigmas printing 1.1-1.3 um; '80 percent' read as "
+            "75-85 %)",
+            "source": "004, Results",
+        },
+        _T1 + "points_ge_1p45": {
+            "form": "range",
+            "ref": [2, 4],
+            "tol": 0.0,
+            "paper": "2 points had standard deviations as large as 1.5 microns (points whose "
+            "larger sigma prints >= 1.5 um; the model's points come in fours: 2-4)",
+            "source": "004, Results",
+        },
+        _T1 + "max_um": {
+            "form": "value",
+            "ref": 1.5,
+            "decimals": 1,
+            "tol": 0.0,
+            "paper": "2 points had standard deviations as large as 1.5 microns (the largest, um)",
+            "source": "004, Results",
+        },
+        _T1 + "below_closure": {
+            "form": "range",
+            "ref": [0.0, 1.0],
+            "tol": 0.0,
+            "paper": "the standard deviations ... will be somewhat smaller than the rms error of "
+            "closure (every sigma / sigma0)",
+            "source": "004, Results",
+        },
+    },
+}
+
+
 def thetas(offset_mm, beta_mm, alpha_mm: float = ALPHA_MM, format_mm: float = FORMAT_MM):
     """Brown's 7 globals ``(G, 7)`` of stations ``offset_mm`` outside the midsides."""
     o, b = np.broadcast_arrays(np.atleast_1d(offset_mm), np.atleast_1d(beta_mm))
@@ -117,10 +175,11 @@ def table1_sigma_stats(sig_um: np.ndarray) -> dict[str, np.ndarray]:
     """Table 1's one-plate statistics of point sigmas ``(..., n, 2)`` (um) as the paper prints
     them (one decimal): ``share`` in 1.1-1.3, ``count`` of points whose larger sigma prints
     >= 1.5, ``max`` the largest."""
+    larger = np.maximum(sig_um[..., 0], sig_um[..., 1])  # per point (exact: a max)
     return {
         "share": ((sig_um >= 1.05) & (sig_um < 1.35)).mean(axis=(-1, -2)),
-        "count": (sig_um.max(-1) >= 1.45).sum(-1).astype(float),
-        "max": sig_um.max(axis=(-1, -2)),
+        "count": (larger >= 1.45).sum(-1).astype(float),
+        "max": larger.max(-1),
     }
 
 

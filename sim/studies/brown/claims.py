@@ -14,9 +14,12 @@ import numpy as np
 from scipy import optimize
 
 from sim.claims.book import ClaimBook
+from sim.claims.declaration import read_toml
 from sim.claims.intervals import std_rel_se
 from sim.claims.table import Sim, claim_rows, exact, plates
+from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
+from sim.mc.config import ConfigError
 from sim.mc.runner import chunk_rng
 from sim.studies.brown import values as V
 from sim.studies.brown.schema import MODEL_NAMES
@@ -24,10 +27,37 @@ from sim.studies.brown.schema import MODEL_NAMES
 BOOK = Path(__file__).with_name("claims.toml")
 
 
+#: the keys of a Table 1 row that its one declaration gives (the printed number and its zone)
+PRINTED_KEYS = ("form", "ref", "decimals", "tol")
+
+
+def full_book() -> ClaimBook:
+    """The whole claim book. The rows of Table 1's printed statements take their printed
+    number and zone (:data:`PRINTED_KEYS`) from their one declaration,
+    :data:`sim.instruments.ranges.brown.TABLE1`, which brown_design's region uses too; a row
+    that states one of them again is refused, naming it."""
+    data = read_toml(BOOK, "claim book")
+    bad = set(data) - {"claim", "not_reproduced"}
+    if bad:
+        raise ConfigError(sorted(bad)[0], f"{BOOK}: unknown table")
+    printed = B.TABLE1["statements"]
+    specs = []
+    for s in data.get("claim", []):
+        decl = printed.get(s.get("id"), {})
+        again = [k for k in PRINTED_KEYS if k in decl and k in s]
+        if again:
+            raise ConfigError(
+                f"claim.{again[0]}",
+                f"{BOOK} ({s['id']}): declared once, in sim.instruments.ranges.brown.TABLE1",
+            )
+        specs.append({**s, **{k: decl[k] for k in PRINTED_KEYS if k in decl}})
+    return ClaimBook(specs, data.get("not_reproduced", []), str(BOOK))
+
+
 def load_book(study: str) -> ClaimBook:
     """The part of the claim book that ``study`` scores: ids ``brown.table1*`` and the
     *Results* section for ``brown_table1``, the rest for ``brown_dilution``."""
-    full = ClaimBook.load(BOOK)
+    full = full_book()
     t1 = study == "brown_table1"
     specs = [s for cid, s in full.specs.items() if cid.startswith("brown.table1") == t1]
     nr = [n for n in full.not_reproduced if ("Results" in n["source"]) == t1]

@@ -23,7 +23,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.claims.inference import HOLDS, Region, Statement, explore, parse_declaration
+from sim.claims.inference import (
+    FAILS,
+    HOLDS,
+    Region,
+    Statement,
+    evaluate,
+    explore,
+    parse_declaration,
+    status,
+)
 from sim.claims.region import (
     decide_over,
     holds_together,
@@ -55,6 +64,11 @@ T1_PREDICTIONS = (
     T1 + "below_closure",
 )
 T1_JOINT = T1 + "together"
+CLOSURE = "brown.table1_closure.rms_um"
+#: the Concept region's outputs for the notes: the points at Table 1's stations, and the
+#: known-station ratio on the outer ring of Table 1's plate there
+T1_STATIONS = "table1_stations"
+RING = "brown.known_edge.ratio@table1_ring"
 CONCEPT_PREDICTIONS = (
     "brown.known_center.ratio",
     "brown.known_edge.ratio",
@@ -93,21 +107,71 @@ def _edge_points() -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- Table 1
+def table1_statements() -> dict[str, Statement]:
+    """Table 1's printed statements (the closure and the four about the point sigmas) from
+    their one declaration, :data:`sim.instruments.ranges.brown.TABLE1` (the claim book's
+    rows take the same zones from it)."""
+    return {s.id: s for s in parse_declaration(B.TABLE1)[1]}
+
+
 def table1_model(x: dict) -> dict:
     """Evidence and predictions at ``N`` input vectors (exact, analytic cofactors)."""
     o, b, s0 = x["station_offset_mm"], x["beta_mm"], x["sigma0_um"]
     N = len(o)
     P = np.broadcast_to(B.table1_points(), (N, 25, 2)).copy()
     cof = B.table1_cofactors(o, b)  # (N, 25, 2) sigma / sigma0
-    st = B.table1_sigma_stats(s0[:, None, None] * cof)
     return {
         SCALE.id: scale_evidence(P, B.thetas(o, b)),
         "brown.table1_closure.rms_um": s0,
+        **_sigma_evidence(cof, s0),
+    }
+
+
+def _sigma_evidence(cof: np.ndarray, s0: np.ndarray) -> dict:
+    """The four point-sigma statements' evidence from the cofactors ``(N, 25, 2)`` and sigma0
+    ``(N,)`` (um): the 50 sigmas as printed (:func:`sim.instruments.ranges.brown.table1_sigma_stats`)."""
+    st = B.table1_sigma_stats(s0[:, None, None] * cof)
+    return {
         T1 + "share_1p1_1p3": st["share"],
         T1 + "points_ge_1p45": st["count"],
         T1 + "max_um": st["max"],
-        T1 + "below_closure": cof.reshape(N, -1),
+        T1 + "below_closure": cof.reshape(len(cof), -1),
     }
+
+
+#: step (um) of the sigma0 grid over the printed closure's rounding on which
+#: :func:`table1_stations` looks for a sigma0 at which Table 1's statements hold
+SIGMA0_STEP_UM = 0.001
+
+
+def table1_stations(o: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``(N,)`` True where the stations (offset, beta; mm) are those of the comparator that
+    measured Table 1: the scale reads Table 1's plate and, at some sigma0 within the printed
+    closure's rounding (a grid of :data:`SIGMA0_STEP_UM`), no statement of Table 1 is
+    contradicted (brown_table1's region with sigma0 projected out; exact cofactors). The
+    grid is tried only where the two statements that bound each point's sigmas leave room
+    (all below the closure; the largest within the printed 1.5 at some sigma0)."""
+    printed = table1_statements()
+    lo, hi = printed[CLOSURE].zone
+    N = len(o)
+    P = np.broadcast_to(B.table1_points(), (N, 25, 2)).copy()
+    out = status(SCALE, scale_evidence(P, B.thetas(o, b)), N) != FAILS
+    j = np.flatnonzero(out)
+    cof = B.table1_cofactors(o[j], b[j])
+    top = cof.reshape(len(j), -1).max(axis=1)
+    span = {"low": top * lo, "high": top * hi}  # the largest sigma over the closure's rounding
+    room = (status(printed[T1 + "below_closure"], cof.reshape(len(j), -1), len(j)) != FAILS) & (
+        status(printed[T1 + "max_um"], span, len(j)) != FAILS
+    )
+    j, cof = j[room], cof[room]
+    preds = [printed[c] for c in T1_PREDICTIONS[:3]]  # below_closure: no sigma0, above
+    some = np.zeros(len(j), bool)
+    for s0 in np.arange(lo, hi + SIGMA0_STEP_UM / 2, SIGMA0_STEP_UM):
+        ev = _sigma_evidence(cof, np.full(len(j), s0))
+        some |= (evaluate(preds, ev, len(j)) != FAILS).all(axis=1)
+    out[:] = False
+    out[j[some]] = True
+    return out
 
 
 def _joint(region: Region, preds: list[Statement]) -> np.ndarray:
@@ -120,8 +184,9 @@ def _joint(region: Region, preds: list[Statement]) -> np.ndarray:
 def table1_region(cfg: dict, book):
     """``(region, predictions, verdicts)`` of Table 1's statements over the region of
     (station offset, beta, sigma0) allowed by the hardware and the printed closure."""
-    cons = [SCALE, statement_of(book, "brown.table1_closure.rms_um", "value")]
-    preds = [statement_of(book, c) for c in T1_PREDICTIONS]
+    printed = table1_statements()
+    cons = [SCALE, printed[CLOSURE]]
+    preds = [printed[c] for c in T1_PREDICTIONS]
     names = ("station_offset_mm", "beta_mm", "sigma0_um")
     rng = chunk_rng(cfg["seed"], 97, 0)
     n, rounds = cfg["region.points"], cfg["region.rounds"]
@@ -156,6 +221,15 @@ def concept_model(x: dict) -> dict:
     }
 
 
+def ring_ratio(o: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Largest sigma / sigma_range (x or y), stations known, over the outer ring of Table 1's
+    own plate (the 16 points at +-90 mm of its 5 x 5: its points near the edges) ``(N,)``."""
+    P = B.table1_points()
+    ring = P[np.abs(P).max(axis=1) == np.abs(P).max()]
+    R = np.broadcast_to(ring, (len(o),) + ring.shape).copy()
+    return V.sigmas(R, B.thetas(o, b), "known").max(axis=(1, 2))
+
+
 def monotone_at(x: dict) -> np.ndarray:
     """1 where the mean and the largest per-point dilution fall at every step of
     :data:`MONOTONE_GRIDS` (same extent), else 0 ``(N,)``."""
@@ -183,8 +257,44 @@ def concept_region(cfg: dict, book):
     acc = reg.accepted
     mono[acc] = monotone_at(reg.points())
     reg.outputs["brown.dilution_falls_with_points.monotone"] = mono
+    t1 = np.zeros(reg.n, bool)  # the built comparator's stations, for the notes
+    t1[acc] = table1_stations(reg.x["station_offset_mm"][acc], reg.x["beta_mm"][acc])
+    ring = np.full(reg.n, np.nan)
+    ring[t1] = ring_ratio(reg.x["station_offset_mm"][t1], reg.x["beta_mm"][t1])
+    reg.outputs[T1_STATIONS], reg.outputs[RING] = t1, ring
     verdicts = {p.id: decide_over(reg, p) for p in preds}
     return reg, preds, verdicts
+
+
+def _counts(st: Statement, v: np.ndarray) -> str:
+    o = status(st, v, len(v))
+    n, h, f = len(v), int((o == HOLDS).sum()), int((o == FAILS).sum())
+    if h == n or f == n:
+        return f"{'holds' if h == n else 'fails'} at all {n}"
+    return f"holds at {h}, fails at {f}, undecided at {n - h - f}"
+
+
+def known_edge_lead(reg: Region, st: Statement) -> str:
+    """What the paper's own comparator gives, before the Concept's idealised verdict: at the
+    region's points whose stations are Table 1's (:func:`table1_stations`), the ratio on
+    the format's edge (the row's points) and on the outer ring of Table 1's plate."""
+    t1 = reg.accepted & reg.outputs[T1_STATIONS]
+    if not t1.any():
+        return "no point of the region has the stations of the comparator that measured Table 1; "
+    off = reg.x["station_offset_mm"][t1]
+    edge, ring = np.asarray(reg.outputs[st.id], float)[t1], reg.outputs[RING][t1]
+    return (
+        "the comparator that measured Table 1 (stations where Table 1's statements hold, "
+        f"{off.min():.3g}-{off.max():.3g} mm out: {int(t1.sum())} of the "
+        f"{int(reg.accepted.sum())} region points) gives on the outer ring of Table 1's own "
+        f"plate (5 x 5 to +-90 mm: its points near the edges) {_span(ring)}, "
+        f"{_counts(st, ring)}; on the format's edge {_span(edge)}, {_counts(st, edge)}. "
+        "The Concept's idealised system over every station its 25 points allow (the verdict): "
+    )
+
+
+def _span(v: np.ndarray) -> str:
+    return f"{v.min():.3g}-{v.max():.3g}"
 
 
 _T1_AT = (
@@ -242,8 +352,15 @@ def rows_of(book, reg: Region, preds, verdicts, notes: dict) -> list[dict]:
     out = []
     for p in preds:
         v = _values(reg, p.id)
-        out.append(region_row(book, p.id, verdicts[p.id], v.ravel(), notes.get(p.id, "")))
+        row = region_row(book, p.id, verdicts[p.id], v.ravel(), notes.get(p.id, ""))
+        if p.id in LEADS:  # what the paper's own comparator gives, first
+            row["note"] = LEADS[p.id](reg, p) + row["note"]
+        out.append(row)
     return out
+
+
+#: predictions whose note opens with a reading of the built comparator (id -> lead)
+LEADS = {"brown.known_edge.ratio": known_edge_lead}
 
 
 def table_of(reg: Region, preds) -> dict:

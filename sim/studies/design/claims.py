@@ -12,6 +12,7 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.table import Sim, claim_rows, exact, mc, plates
+from sim.mc.config import StudyError
 from sim.studies.design.errbudget import BUDGET_ROWS
 
 __all__ = ["BOOK", "load_book", "EXTERNAL", "score_external", "score_all"]
@@ -201,6 +202,11 @@ def _coverage(R: dict) -> dict[str, Sim]:
     for m in ("pivot", "affine"):
         i = int(np.flatnonzero((model == m) & (scen == "nominal"))[0])
         N = c["trials"][i]
+        if N < 2:  # the load check keeps the noise small (checks.NOISE_SHARE); a guard
+            raise StudyError(
+                f"brown_design: the nominal {m} coverage has {N} converged trials of "
+                f"{N + c['nonconverged'][i]}: nothing to compute it from (lower coverage.sigma_um)"
+            )
         for key in ("coverage_known", "coverage_f", "false_alarm"):
             v = c[key][i]
             se = math.sqrt(max(v * (1 - v), 1e-12) / N)  # per-trial averages: conservative

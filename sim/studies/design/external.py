@@ -132,14 +132,17 @@ def external_at(
     pitch: float,
     plates: bool = True,
     two_screw_um: float | None = None,
+    sigma0_um: float | None = None,
 ) -> dict:
     """Every linearised claim value at one setting of the unprinted inputs (``plates=False``:
     the tolerances only). Plates use fixed streams (parts 91, 92), so a sweep compares like
     with like. ``two_screw_um``: the conventional two-screw comparator's error per coordinate
     (not printed), added to the plate before the rigid fit; ``None`` (the labelled example)
-    takes the paper's equal attribution, sqrt(2) x the plate's rms."""
+    takes the paper's equal attribution, sqrt(2) x the plate's rms. ``sigma0_um``: the range
+    sigma of the plates (um), the plate's closure at a point of the region (Table 1's sigma0);
+    ``None`` (the labelled example) takes :func:`range_sigma_um`, Table 1's error model."""
     pts = paper_points(cfg)
-    sr = range_sigma_um(cfg)
+    sr = range_sigma_um(cfg) if sigma0_um is None else float(sigma0_um)
     r_min = shortest_range_mm(cfg, pts, offset, beta)
     out = {
         "r_min_mm": r_min,

@@ -8,10 +8,10 @@ no data (:func:`sim.report.plotting.place_legend`).
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
 from sim.instruments.ranges import multilateration as ml
 from sim.lsq import distributions as D
+from sim.report.mpl import ticker
 from sim.report.plotting import place_legend, plt, save
 from sim.studies.design.cells import pareto_front
 from sim.studies.design.claims import load_book
@@ -37,10 +37,10 @@ def _log_ticks(ax, axis: str, lo: float, hi: float) -> None:
     while len(ticks) > 8:
         ticks = ticks[::2]
     a = ax.xaxis if axis == "x" else ax.yaxis
-    a.set_major_locator(FixedLocator(ticks))
-    a.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    a.set_minor_locator(NullLocator())
-    a.set_minor_formatter(NullFormatter())
+    a.set_major_locator(ticker.FixedLocator(ticks))
+    a.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    a.set_minor_locator(ticker.NullLocator())
+    a.set_minor_formatter(ticker.NullFormatter())
 
 
 def _pareto_all(ax, cols, t, a, ok, P) -> None:

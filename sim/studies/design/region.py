@@ -10,7 +10,8 @@ offset and beta with their hardware ranges). Two parts, each explored jointly by
   constraints are that the scale reads every range of Table 1's plate (5 x 5 at 45 mm) and
   that Table 1's printed statements about the same comparator hold at once (sigma0 at the
   printed closure's rounding, :data:`SIGMA0`; 80 % of the sigmas 1.1-1.3 um; two points at
-  1.5 um; all below the closure: :data:`TABLE1`, brown_table1's claim-book rows, analytic
+  1.5 um; all below the closure: :data:`TABLE1`, declared once in
+  :data:`sim.instruments.ranges.brown.TABLE1` for brown_table1's claim rows too; analytic
   pivot-model cofactors). The
   tolerances are statements about the built comparator ("Operation of the Comparator",
   "Calibration"), the instrument that measured Table 1, so they are decided where Table 1
@@ -19,29 +20,46 @@ offset and beta with their hardware ranges). Two parts, each explored jointly by
   and where the linearity tolerance exceeds 350 um, over 30 mm, contradict Table 1).
   Predictions: the lateral-offset error, the microscope's linearity tolerance, the drum
   graduation error (:func:`.external.tolerances`).
-* ``plates`` (Monte-Carlo plates per point, a small design): station offset x beta x the half
-  extent of the Zeiss grid's 33 calibrated points (layout not printed) x the error of the
-  conventional two-screw comparator the plates were also measured on (not printed); the
-  scale must read Table 1's plate and the Zeiss points; predictions: the two-screw agreement
-  and the two Zeiss rows (:func:`.external.external_at`; their interval is the spread over
+* ``plates`` (Monte-Carlo plates per point): station offset x beta x sigma0 x the half extent
+  of the Zeiss grid's 33 calibrated points (layout not printed) x the error of the
+  conventional two-screw comparator the plates were also measured on (not printed). The
+  plates are the same built comparator's, so this part has the tolerance part's constraints
+  (the scale reads Table 1's plate and Table 1's printed statements hold: the stations Table
+  1 puts 6.6-19.1 mm out, the closure 1.55-1.59 um) and the scale must read the Zeiss points
+  (:data:`PLATE_STATEMENTS`). Those are analytic, so they are evaluated first at every
+  point of a Sobol design and plates are simulated only at the points they leave in the
+  region (Table 1 accepts about 3 % of the box, so the design is large and the plates few),
+  with the point's sigma0 as the plates' range sigma (the labelled model's 1.63 um
+  contradicts Table 1 at every station). Predictions: the two-screw agreement and the two
+  Zeiss rows (:func:`.external.external_at`; their interval is the spread over
   ``unprinted.plates`` plates, so the Monte-Carlo noise is part of each point's decision).
   The two-screw agreement is the plate's error plus the other comparator's, after the
   rigid fit: the paper's equal attribution ("if one were to assume that the discrepancies
   ... are equally attributable to both comparators") is the hypothesis by which Brown reads
   his own accuracy off the agreement, not a printed error of the other comparator, so that
-  error is explored, not pinned at the simulated comparator's own (third reading).
+  error is explored, not pinned at the simulated comparator's own (third reading). Over the
+  region it is that error, not the station, that decides the row (:func:`decided_by`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from sim.claims.inference import Input, Statement, explore, parse_declaration
+from sim.claims.inference import (
+    FAILS,
+    HOLDS,
+    Input,
+    Statement,
+    evaluate,
+    explore,
+    parse_declaration,
+)
 from sim.claims.region import (
     decide_over,
     evidence_of_row,
     holds_together,
     inputs_table,
+    outcomes,
     region_row,
     region_table,
     statement_of,
@@ -109,54 +127,26 @@ ZEISS_READS = Statement(
     source="004, Implementation of the Concept; Results",
 )
 
+#: Table 1's printed statements about the comparator the tolerances are stated for, from their
+#: one declaration (:data:`sim.instruments.ranges.brown.TABLE1`, whose zones brown_table1's
+#: claim rows take too): the closure bounds sigma0 (:data:`SIGMA0`), the four statements about
+#: the 50 printed point sigmas (:data:`TABLE1`) are constraints
 _T1 = "brown.table1_point_sigma."
+_PRINTED = {s.id: s for s in parse_declaration(B.TABLE1)[1]}
+_CLOSURE = _PRINTED.pop("brown.table1_closure.rms_um")
 #: Table 1's printed closure, 1.6 um at its rounding: the range of sigma0 (the closure is a
 #: statement about sigma0 alone, so it bounds the input rather than thinning the design)
 SIGMA0 = Input(
     "sigma0_um",
-    1.55,
-    1.65,
+    *(round(z, 12) for z in _CLOSURE.zone),  # 1.6 +- 0.05 to the decimal it stands for
     "the plate's rms error of closure: 'the rms error of closure turned out to be 1.6 "
     "microns (Table 1)', at its rounding (brown_table1's input row)",
 )
-#: Table 1's printed statements about the comparator the tolerances are stated for: the same
-#: zones as brown_table1's claim-book rows of these ids (a test pins them), here constraints
-TABLE1 = (
-    Statement(
-        _T1 + "share_1p1_1p3",
-        (0.8, 0.8),
-        "share",
-        2,
-        0.05,
-        paper="80 percent of the standard deviations in x and y ranged between 1.1 and 1.3 "
-        "microns (share of the 50 sigmas printing 1.1-1.3 um)",
-        source="004, Results",
-    ),
-    Statement(
-        _T1 + "points_ge_1p45",
-        (2.0, 4.0),
-        "range",
-        paper="2 points had standard deviations as large as 1.5 microns (points whose larger "
-        "sigma prints >= 1.5 um; the model's points come in fours)",
-        source="004, Results",
-    ),
-    Statement(
-        _T1 + "max_um",
-        (1.5, 1.5),
-        "value",
-        1,
-        paper="2 points had standard deviations as large as 1.5 microns (the largest, um)",
-        source="004, Results",
-    ),
-    Statement(
-        _T1 + "below_closure",
-        (0.0, 1.0),
-        "range",
-        paper="the standard deviations ... will be somewhat smaller than the rms error of "
-        "closure (every sigma / sigma0)",
-        source="004, Results",
-    ),
-)
+TABLE1 = tuple(_PRINTED.values())
+#: the plates part's constraints: the tolerance part's (the scale reads Table 1's plate, Table
+#: 1's printed statements hold: the built comparator that measured Table 1, fifth reading)
+#: and the scale reads the Zeiss grid's points
+PLATE_STATEMENTS = (SCALE, *TABLE1, ZEISS_READS)
 
 
 def table1_evidence(o, b, s0, alpha_mm: float = B.ALPHA_MM) -> dict:
@@ -168,10 +158,10 @@ def table1_evidence(o, b, s0, alpha_mm: float = B.ALPHA_MM) -> dict:
     cof = B.table1_cofactors(o, b, alpha_mm)  # (N, 25, 2)
     st = B.table1_sigma_stats(s0[:, None, None] * cof)
     return {
-        TABLE1[0].id: st["share"],
-        TABLE1[1].id: st["count"],
-        TABLE1[2].id: st["max"],
-        TABLE1[3].id: cof.reshape(len(o), -1),
+        _T1 + "share_1p1_1p3": st["share"],
+        _T1 + "points_ge_1p45": st["count"],
+        _T1 + "max_um": st["max"],
+        _T1 + "below_closure": cof.reshape(len(o), -1),
     }
 
 
@@ -207,35 +197,55 @@ def tolerance_model(cfg: dict):
     return model
 
 
+def _plates_at(cfg: dict, book, x: dict, live: np.ndarray) -> dict:
+    """The plate predictions' evidence ``{id: {value, low, high, p}}`` with plates simulated
+    at the ``live`` points only (NaN elsewhere: a point a printed statement contradicts is
+    outside the region, and its verdict is never read)."""
+    n = len(live)
+    rows = {c: [] for c in PLATES}
+    for j in np.flatnonzero(live):
+        e = external_at(
+            cfg,
+            float(x["station_offset_mm"][j]),
+            float(x["beta_mm"][j]),
+            float(x[ZEISS.name][j]),
+            cfg["budget.pitch_mm"],
+            two_screw_um=float(x[TWO_SCREW.name][j]),
+            sigma0_um=float(x[SIGMA0.name][j]),
+        )
+        for c in PLATES:
+            rows[c].append(evidence_of_row(verdict_of(book, c, e)))
+    out = {}
+    for c, r in rows.items():
+        ev = {}
+        for k in ("value", "low", "high", "p"):
+            if book.spec(c)["form"] != "one-plate" and k == "p":
+                ev[k] = None  # the one-plate p exists for one-plate rows only
+                continue
+            v = np.full(n, np.nan)
+            v[live] = [np.nan if e[k] is None else e[k] for e in r]
+            ev[k] = v
+        out[c] = ev
+    return out
+
+
 def plates_model(cfg: dict, book):
+    """The plates part: the hardware and Table 1's printed statements first (analytic), then
+    ``unprinted.plates`` simulated plates at each point they leave in the region, with the
+    point's sigma0 as the plates' range sigma (the plates of the comparator that measured
+    Table 1, at a closure at which Table 1's statements hold)."""
     pts = paper_points(cfg)
+    alpha = cfg["comparator.alpha_mm"]
 
     def model(x):
-        o, b, z = x["station_offset_mm"], x["beta_mm"], x["zeiss_half_extent_mm"]
-        rows = {c: [] for c in PLATES}
-        for oi, bi, zi, si in zip(o, b, z, x[TWO_SCREW.name]):
-            e = external_at(
-                cfg,
-                float(oi),
-                float(bi),
-                float(zi),
-                cfg["budget.pitch_mm"],
-                two_screw_um=float(si),
-            )
-            for c in PLATES:
-                rows[c].append(evidence_of_row(verdict_of(book, c, e)))
-        out = {
-            c: {
-                k: None if r[0][k] is None else np.array([v[k] for v in r], float)
-                for k in ("value", "low", "high", "p")
-            }
-            for c, r in rows.items()
-        }
+        o, b, z = x["station_offset_mm"], x["beta_mm"], x[ZEISS.name]
+        out = table1_evidence(o, b, x[SIGMA0.name], alpha)
         out[SCALE.id] = _longest(pts, o, b)
-        zl = np.array(
+        out[ZEISS_READS.id] = np.array(
             [_longest(zeiss_points(cfg, zi), [oi], [bi])[0] for oi, bi, zi in zip(o, b, z)]
         )
-        out[ZEISS_READS.id] = zl
+        live = (evaluate(PLATE_STATEMENTS, out, len(o)) != FAILS).all(axis=1)
+        out.update(_plates_at(cfg, book, x, live))
         return out
 
     return model
@@ -258,8 +268,8 @@ def tolerance_region(cfg: dict, book):
 def plates_region(cfg: dict, book):
     preds = [statement_of(book, c) for c in PLATES]
     reg = explore(
-        _comparator_inputs() + [ZEISS, TWO_SCREW],
-        [SCALE, ZEISS_READS],
+        _comparator_inputs() + [SIGMA0, ZEISS, TWO_SCREW],
+        PLATE_STATEMENTS,
         plates_model(cfg, book),
         chunk_rng(cfg["seed"], 96, 0),
         n=cfg["region.plate_points"],
@@ -274,11 +284,39 @@ _NOTES = {
     TOLERANCES[2]: "the dividing error as a fraction of one turn of the screw",
     PLATES[0]: (
         "one plate's rms discrepancy with a two-screw comparator of error two_screw_sigma_um "
-        "per coordinate added, after translation and rotation; central half of the plates"
+        "per coordinate added, after translation and rotation; central half of the plates of "
+        "Table 1's plate at the stations and closure sigma0_um where Table 1's statements hold"
     ),
-    PLATES[1]: "33-point stand-in layout within the half extent, plus the grid's 0.8 um",
+    PLATES[1]: "33-point stand-in layout within the half extent, plus the grid's 0.8 um, at "
+    "the stations and closure where Table 1's statements hold",
     PLATES[2]: "the comparator's part of the Zeiss comparison alone",
 }
+
+
+def decided_by(reg, pred: Statement, name: str) -> str:
+    """The sentence saying that the input ``name`` alone separates the points where ``pred``
+    fails from those where it holds (every failing point below every holding one, the
+    undecided between), and at which stations each lies; "" when it does not."""
+    acc, o, x = reg.accepted, outcomes(reg, pred), reg.x[name]
+    f, h = acc & (o == FAILS), acc & (o == HOLDS)
+    if not (f.any() and h.any()):
+        return ""
+    a, b = x[f].max(), x[h].min()
+    if not (a < b and (o[acc & (x >= b)] == HOLDS).all() and (o[acc & (x <= a)] == FAILS).all()):
+        return ""
+    off = reg.x["station_offset_mm"]
+    fo, ho = (off[f].min(), off[f].max()), (off[h].min(), off[h].max())
+    same = fo[0] <= ho[1] and ho[0] <= fo[1]  # the failing and holding stations overlap
+    return (
+        f"what decides it is {name}{', not the station' if same else ''}: it fails exactly "
+        f"where {name} <= {a:.3g} (stations {fo[0]:.3g}-{fo[1]:.3g} mm out) and holds "
+        f"exactly where {name} >= {b:.3g} (stations {ho[0]:.3g}-{ho[1]:.3g} mm out), "
+        "undecided between; "
+    )
+
+
+#: per prediction, the input whose split :func:`decided_by` reports in the row's note
+_DECIDED_BY = {PLATES[0]: TWO_SCREW.name}
 
 
 def region_rows(book, parts) -> tuple[list[dict], dict, dict]:
@@ -297,7 +335,15 @@ def region_rows(book, parts) -> tuple[list[dict], dict, dict]:
                 float,
             )
             rows.append(
-                region_row(book, p.id, verdicts[p.id], v[reg.accepted], _NOTES[p.id] + where)
+                region_row(
+                    book,
+                    p.id,
+                    verdicts[p.id],
+                    v[reg.accepted],
+                    (decided_by(reg, p, _DECIDED_BY[p.id]) if p.id in _DECIDED_BY else "")
+                    + _NOTES[p.id]
+                    + where,
+                )
             )
         t = region_table(reg, preds)
         t["together"] = holds_together(reg, preds)[reg.accepted].tolist()

@@ -49,21 +49,23 @@ _WHAT = (
 
 def _lead(out: Path, cfg: dict) -> list[str]:
     """The region lead (two parts: the tolerances analytic on a refined design, the plate
-    comparisons with simulated plates on a small one) and what bounds the region."""
+    comparisons with simulated plates where Table 1 holds) and what bounds the region."""
     return [
         region_lead(
             out,
             _WHAT,
             design="per part a Sobol design (`tolerances` refined at the boundaries, `plates` not)",
             values=f"`tolerances` every value analytic, `plates` {cfg['unprinted.plates']} "
-            "simulated plates per input vector, whose noise enters the decision",
+            "simulated plates per input vector that Table 1's statements leave in the region, "
+            "whose noise enters the decision",
         ),
         "The comparator bounds the region: its 261 + 1 mm scale must read Table 1's plate, "
         "and the Zeiss points for the Zeiss rows (figure: brown_table1's region). The "
-        "tolerances are the built comparator's, the instrument that measured Table 1, so "
-        "their part also asks Table 1's printed statements to hold (closure 1.6 um, 80 % of "
-        "the sigmas in 1.1-1.3 um, two points at 1.5 um, all below the closure): they are "
-        "decided where Table 1 puts the stations (fifth reading).",
+        "tolerances and the plate comparisons are the built comparator's, the instrument "
+        "that measured Table 1, so both parts also ask Table 1's printed statements to hold "
+        "(closure 1.6 um, 80 % of the sigmas in 1.1-1.3 um, two points at 1.5 um, all below "
+        "the closure): they are decided where Table 1 puts the stations (fifth reading), and "
+        "the plates are drawn with each point's closure sigma0 as their range sigma.",
     ]
 
 

@@ -10,14 +10,19 @@ claims that depend on them are decided over the consistent region
 
 from __future__ import annotations
 
+from sim.instruments.ranges import brown as B
 from sim.mc.config import COMMON
 from sim.mc.schema_helpers import count, counts, level, positive, real, reals
 
-__all__ = ["SEED", "SCHEMA", "MAX_CELLS", "MAX_POINTS"]
+__all__ = ["SEED", "SCHEMA", "MAX_CELLS", "MAX_POINTS", "BETA_MAX_MM"]
 
 SEED = "004_f5bd9e86c308241f.txt"
 MAX_CELLS = 200_000  # design cells (each a batched analytic covariance)
 MAX_POINTS = 900  # points of one plate (covariances are (2n)^2 per cell)
+#: beta, the pivot ball's offset across the scale, is at most half the scale's width: the
+#: ball lies under the 29 mm wide scale (the instrument, :mod:`sim.instruments.ranges.brown`);
+#: checked by :mod:`.checks` with that reason (the beta keys have no ``hi`` of their own)
+BETA_MAX_MM = B.SCALE_WIDTH_MM / 2
 
 SCHEMA = {
     **COMMON,
@@ -46,7 +51,8 @@ SCHEMA = {
     ),
     "comparator.alpha_mm": real(
         0.5,
-        "radial pivot offset alpha (not printed; it drops out of the coordinates)",
+        "radial pivot offset alpha (not printed; it drops out of the coordinates; every "
+        "range must still read on the scale: checked on load)",
         lo=-50.0,
         hi=50.0,
         unit="mm",
@@ -85,7 +91,12 @@ SCHEMA = {
         unit="um",
         input=True,
     ),
-    "design.beta_mm": reals([1.0, 5.0], "tangential pivot offset beta", lo=0.0, hi=50.0, unit="mm"),
+    "design.beta_mm": reals(
+        [1.0, 5.0],
+        "tangential pivot offset beta (at most half the 29 mm scale's width: checked on load)",
+        lo=0.0,
+        unit="mm",
+    ),
     # measuring time
     "time.images": count(30, "images of the timed plate (paper: 30)", lo=1, hi=10_000, input=True),
     "time.single_min": positive(
@@ -127,9 +138,9 @@ SCHEMA = {
     ),
     "paper.beta_mm": real(
         1.0,
-        "beta of the paper's design (not printed: a labelled example; decided over the region)",
+        "beta of the paper's design (not printed: a labelled example; decided over the region; "
+        "at most half the 29 mm scale's width)",
         lo=0.0,
-        hi=50.0,
         unit="mm",
     ),
     # datum (brown_dilution's example geometry; must be buildable on the scale)
@@ -140,7 +151,9 @@ SCHEMA = {
     "datum.offset_mm": positive(
         17.0, "station offset (brown_dilution geometry)", hi=1000.0, unit="mm"
     ),
-    "datum.beta_mm": real(1.0, "beta", lo=0.0, hi=50.0, unit="mm"),
+    "datum.beta_mm": real(
+        1.0, "beta (at most half the 29 mm scale's width: checked on load)", lo=0.0, unit="mm"
+    ),
     # error budget
     "budget.graduation_um": real(
         0.54,
@@ -277,8 +290,8 @@ SCHEMA = {
     "region.rounds": count(3, "refinement rounds of the tolerance region", lo=0, hi=8),
     "region.plate_points": count(
         32,
-        "Sobol design size of the plate region (offset x beta x Zeiss layout; each point "
-        "draws unprinted.plates plates)",
+        "Sobol design size of the plate region (offset x beta x sigma0 x Zeiss layout x "
+        "two-screw error; each point Table 1 leaves in the region draws unprinted.plates plates)",
         lo=8,
         hi=1024,
     ),
@@ -290,7 +303,14 @@ SCHEMA = {
     "coverage.sweep_trials": count(
         2000, "trials per point of the coverage sweeps", lo=10, hi=10_000_000
     ),
-    "coverage.sigma_um": real(1.0, "range sigma of the nominal case", lo=1e-6, hi=1e5, unit="um"),
+    "coverage.sigma_um": real(
+        1.0,
+        "range sigma of the nominal case (at most 1 % of the datum plate's spacing and "
+        "shortest range: checked on load)",
+        lo=1e-6,
+        hi=1e5,
+        unit="um",
+    ),
     "coverage.noise_um": reals(
         [1.0, 300.0, 1000.0, 3000.0, 10000.0],
         "range sigmas of the noise sweep",
@@ -300,7 +320,10 @@ SCHEMA = {
     ),
     "coverage.grids": counts([2, 3, 4, 5], "grids of the point-count sweep", lo=2, hi=20),
     "coverage.betas_mm": reals(
-        [0.0, 0.003, 0.01, 0.03, 0.1, 1.0], "betas of the beta sweep", lo=0.0, hi=50.0, unit="mm"
+        [0.0, 0.003, 0.01, 0.03, 0.1, 1.0],
+        "betas of the beta sweep (at most half the 29 mm scale's width)",
+        lo=0.0,
+        unit="mm",
     ),
     "coverage.alpha": level(0.05, "level of the global chi-square test"),
     # bayes

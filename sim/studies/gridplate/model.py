@@ -117,6 +117,17 @@ def iterations(comp: np.ndarray, g: np.ndarray, ratio: np.ndarray, tol_mm: float
     return count
 
 
+def row_misclosure(fa, N: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per row (x', y') of each plate of the affine fit ``fa`` with the grid fixed: the
+    misclosure variance ``s_w^2`` (mm^2) and ``k = A^2 + B^2``, both ``(nP, 2)``."""
+    sw2 = np.stack([(fa.residuals[..., c] ** 2).sum(1) / (N - 3) for c in (0, 1)], 1)
+    kk = np.stack(
+        [fa.params[:, 0] ** 2 + fa.params[:, 1] ** 2, fa.params[:, 3] ** 2 + fa.params[:, 4] ** 2],
+        1,
+    )
+    return sw2, kk
+
+
 def _rowscale(x: np.ndarray) -> np.ndarray:
     """A per-row factor ``(nP, 2)`` as the ``(nP, 6, 6)`` block scaling of an affine
     cofactor matrix (rows x' and y' of the affine, three parameters each)."""
@@ -237,12 +248,7 @@ def reduce_chunk(cfg: dict, sim: dict) -> dict[str, np.ndarray]:
     fa = t2.fit_affine(g, mean)
     out["sim_sigma_um"] = np.sqrt((fs.s0**2).reshape(n, P).mean(1)) / UM
     out["aff_sigma_um"] = np.sqrt((fa.s0**2).reshape(n, P).mean(1)) / UM
-    # per row (x', y') of each plate: misclosure variance and k = A^2 + B^2
-    sw2 = np.stack([(fa.residuals[..., c] ** 2).sum(1) / (N - 3) for c in (0, 1)], 1)  # (nP, 2)
-    kk = np.stack(
-        [fa.params[:, 0] ** 2 + fa.params[:, 1] ** 2, fa.params[:, 3] ** 2 + fa.params[:, 4] ** 2],
-        1,
-    )
+    sw2, kk = row_misclosure(fa, N)
     out |= _fixed_grid(cfg, fa, n, P)
     out |= _weight_ratios(cfg, fa, sw2, kk, n, P)
     out |= _chi2_rejections(cfg, sw2, kk, N, n, P)

@@ -141,15 +141,17 @@ def report(out: Path) -> str:
     out = Path(out)
     cfg = config(out)["config"]
     claims = rows(out, "claims.parquet")
+    adj = 2 * cfg["plate.count"] * cfg.get("region.iter_calibrations", 1)  # results before it: 1
     return section(
         out,
         lead=[
             region_lead(
                 out,
-                "The paper's weighting and similarity-versus-affine predictions",
+                "The paper's weighting, iteration and similarity-versus-affine predictions",
                 values=f"each input vector's statistics drawn from their exact sampling "
                 f"distributions, {cfg['region.draws']} simulated calibrations per vector, whose "
-                "noise enters the decision",
+                "noise enters the decision; the combined adjustment's Gauss-Newton iterations "
+                f"counted by running it on {adj} adjustments per vector",
             ),
             figure(out, "consistent_region.png", "consistent region"),
         ],

@@ -20,7 +20,7 @@ from sim.studies import RunContext
 from sim.studies.gridplate import figures as F
 from sim.studies.gridplate.claims import beyond_table, score
 from sim.studies.gridplate.model import PARAMS, chunk, simulate
-from sim.studies.gridplate.region import explore_region, nominal
+from sim.studies.gridplate.region import IT, explore_region, iteration_note, nominal
 from sim.studies.run_steps import over_region, run_part, spread_note
 
 
@@ -34,11 +34,16 @@ def analytic_reject(cfg: dict, stated_um: float, dof: int) -> float:
     return float(D.chi2_cdf(lo / c, dof) + D.chi2_sf(hi / c, dof))
 
 
-def decide_over_region(cfg: dict, book, rows: list[dict], out: Path, prov) -> list[dict]:
+def decide_over_region(
+    cfg: dict, book, rows: list[dict], out: Path, prov, gn_iterations: np.ndarray
+) -> list[dict]:
     """Explore the unprinted inputs jointly (``region.toml``), write ``consistent_region.parquet``
     and its figure, and replace each prediction's row by its verdict over the region (the
-    configured inputs' result kept in the note as an example)."""
-    region, preds = explore_region(cfg, book, chunk_rng(cfg["seed"], 900, 0))
+    configured inputs' result kept in the note as an example; for the iterations, the run's
+    counts ``gn_iterations``)."""
+    region, preds = explore_region(
+        cfg, book, chunk_rng(cfg["seed"], 900, 0), chunk_rng(cfg["seed"], 901, 0)
+    )
     write_region(out / "consistent_region.parquet", region, book, preds, prov)
     fig_region(
         region,
@@ -49,7 +54,13 @@ def decide_over_region(cfg: dict, book, rows: list[dict], out: Path, prov) -> li
             ("grid_points_1", "spacing_mm"): lambda g: 230.0 / np.maximum(np.round(g) - 1, 1)
         },
     )
-    return over_region(book, region, preds, rows, spread_note("calibrations"))
+    spread = spread_note("calibrations")
+    it_note = iteration_note(cfg, region, np.asarray(gn_iterations))
+
+    def note(row: dict) -> str:
+        return it_note if row["claim"] == IT else spread(row)
+
+    return over_region(book, region, preds, rows, note)
 
 
 def trials_table(res: dict) -> dict[str, np.ndarray]:
@@ -167,7 +178,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
             (F.fig_implied, (imp, stated, paper, out / "implied_grid.png")),
         ]
     )
-    rows = decide_over_region(cfg, book, rows, out, prov)
+    rows = decide_over_region(cfg, book, rows, out, prov, res["gn_iterations"])
     ex = simulate(cfg, chunk_rng(cfg["seed"], 1, 0), 1)  # one calibration, its own stream
     write_table(
         out / "example_plate.parquet", F.fig_residuals(cfg, ex, out / "residuals.png"), prov

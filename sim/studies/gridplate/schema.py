@@ -110,6 +110,13 @@ SCHEMA = {
     "region.draws": count(
         1000, "simulated calibrations per input vector (chi-square draws)", lo=50, hi=1_000_000
     ),
+    "region.iter_calibrations": count(
+        1,
+        "simulated calibrations per region point whose combined adjustments (plate.count "
+        "plates x rows x' and y') count their Gauss-Newton iterations",
+        lo=1,
+        hi=64,
+    ),
 }
 
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.collections import LineCollection
 
+from sim.report.mpl import collections as mcoll
 from sim.report.plotting import plt, save
 from sim.studies.network.analysis import CHI2_2_95, ellipse
 from sim.studies.network.definition import KINDS
@@ -37,7 +37,7 @@ def _lines_large(ax, net, xy: np.ndarray) -> None:
     a = net.i[use]
     b = np.where(net.kind[use] == 2, net.k[use], net.j[use])
     pairs = np.unique(np.sort(np.stack([a, b], 1), axis=1), axis=0)
-    ax.add_collection(LineCollection(xy[pairs], colors="0.8", linewidths=0.5, zorder=1))
+    ax.add_collection(mcoll.LineCollection(xy[pairs], colors="0.8", linewidths=0.5, zorder=1))
 
 
 def _lines(ax, net, xy: np.ndarray) -> None:
@@ -72,7 +72,7 @@ def _ellipses(ax, net, an, pts, xy: np.ndarray, f: float) -> float:
     ey = k * mag * (A * np.cos(t) * np.sin(T) + B * np.sin(t) * np.cos(T))
     seg = np.stack([xy[pts, 0, None] + ex / f, xy[pts, 1, None] + ey / f], -1)
     if large:
-        ax.add_collection(LineCollection(seg, colors="C1", linewidths=0.9, zorder=2))
+        ax.add_collection(mcoll.LineCollection(seg, colors="C1", linewidths=0.9, zorder=2))
     else:
         for s_ in seg:
             ax.plot(s_[:, 0], s_[:, 1], color="C1", lw=0.9, zorder=2)

@@ -6,10 +6,10 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib.ticker
 import numpy as np
 
 from sim.mc.storage import read_table
+from sim.report.mpl import ticker
 from sim.report.plotting import draw, place_legend, plt, save
 from sim.studies.wolf.model import ls_map
 
@@ -164,8 +164,8 @@ def degree_figure(out: Path) -> None:
         degs = sorted(set(d["degree"].tolist()))
         ax.set_xticks(degs)
         ax.set_xlim(min(degs) - 0.3, max(degs) + 0.3)
-        ax.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
-        ax.yaxis.set_minor_formatter(matplotlib.ticker.ScalarFormatter())
+        ax.yaxis.set_major_formatter(ticker.ScalarFormatter())
+        ax.yaxis.set_minor_formatter(ticker.ScalarFormatter())
     axs[0, 0].set_ylabel("median rms (µm): dashed fit data, solid independent plate")
     for ax in axs[0]:
         place_legend(ax, fontsize=8)
@@ -195,8 +195,8 @@ def readings_figure(out: Path) -> None:
             )
         ax.set_xscale("log")
         ax.set_xticks(sorted(set(r["readings"].tolist())))
-        ax.xaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
-        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.xaxis.set_major_formatter(ticker.ScalarFormatter())
+        ax.xaxis.set_minor_formatter(ticker.NullFormatter())
         ax.set_xlabel("readings per point")
         ax.set_title(f"approach: {appr.replace('_', ' ')}")
     axs[0].set_ylabel("rms per coordinate (µm)")

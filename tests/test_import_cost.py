@@ -1,0 +1,38 @@
+"""What a process pays before it does anything: the suite's modules load without matplotlib,
+scipy.stats or numba (about 0.5 s, 0.5 s and 1 s of CPU each), which a process loads only when
+it draws a figure (sim.report.mpl), explores a region (its Sobol design) or compiles a kernel
+(sim.lsq.compile). A `sim check`, a `--no-figures` run, a pool or Dask worker and every
+re-run of `make verify` start faster for it; a test run starts dozens of such processes."""
+
+import subprocess
+import sys
+
+from conftest import ROOT
+
+from sim.studies import MODULES
+
+HEAVY = ("matplotlib", "scipy.stats", "numba")
+
+
+def test_importing_every_study_and_door_loads_no_heavy_module():
+    mods = ["sim.cli", "sim.batch", "sim.api", "sim.report.verify", "sim.report.markdown"]
+    mods += [f"{m}.run" for m in sorted(set(MODULES.values()))]
+    code = "import importlib, sys\n"
+    code += f"for m in {mods!r}: importlib.import_module(m)\n"
+    code += f"print(' '.join(h for h in {HEAVY!r} if h in sys.modules))"
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == [], f"loaded on import: {r.stdout.strip()}"
+
+
+def test_the_first_figure_sets_the_backend_and_style():
+    code = (
+        "from sim.report import mpl\n"
+        "from sim.report.plotting import plt\n"
+        "fig, ax = plt.subplots()\n"
+        "import matplotlib\n"
+        "print(matplotlib.get_backend(), matplotlib.rcParams['font.size'])\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.lower().split() == ["agg", "9.0"], r.stdout
