@@ -55,14 +55,19 @@ def test_batch_and_verify_stop_their_children_with_one_function(monkeypatch):
     assert sim.report.verify.rerun.stop_children is children.stop_children
     old = {s: signal.getsignal(s) for s in (signal.SIGINT, *children.STOP_SIGNALS)}
     # one child ends on SIGTERM, one ignores it (killed after the grace), one fills its pipe
-    stubborn = "import signal, time; signal.signal(signal.SIGTERM, signal.SIG_IGN); time.sleep(30)"
+    stubborn = (
+        "import signal, time; signal.signal(signal.SIGTERM, signal.SIG_IGN); "
+        "print('ready', flush=True); time.sleep(30)"
+    )
     chatty = "import sys, time; sys.stdout.write('x' * 10**6); sys.stdout.flush(); time.sleep(30)"
     procs = [
         subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"]),
-        subprocess.Popen([sys.executable, "-c", stubborn]),
+        subprocess.Popen([sys.executable, "-c", stubborn], stdout=subprocess.PIPE),
         subprocess.Popen([sys.executable, "-c", chatty], stdout=subprocess.PIPE),
     ]
-    time.sleep(0.3)
+    # the stubborn child ignores SIGTERM only once it says so (a loaded machine starts Python
+    # slowly); the others end on SIGTERM at any moment of their start
+    assert procs[1].stdout.readline().strip() == b"ready"
     called = []
     try:
         t = time.monotonic()
