@@ -183,6 +183,20 @@ def table1_sigma_stats(sig_um: np.ndarray) -> dict[str, np.ndarray]:
     }
 
 
+def table1_statement_evidence(cof: np.ndarray, s0_um: np.ndarray) -> dict[str, np.ndarray]:
+    """The evidence of :data:`TABLE1`'s four point-sigma statements at ``N`` input vectors,
+    by statement id, from the cofactors ``(N, 25, 2)`` (:func:`table1_cofactors`) and sigma0
+    ``(N,)`` (um): the 50 sigmas as printed (:func:`table1_sigma_stats`), and every sigma /
+    sigma0 for "somewhat smaller than the rms error of closure"."""
+    st = table1_sigma_stats(np.asarray(s0_um, float)[:, None, None] * cof)
+    return {
+        _T1 + "share_1p1_1p3": st["share"],
+        _T1 + "points_ge_1p45": st["count"],
+        _T1 + "max_um": st["max"],
+        _T1 + "below_closure": cof.reshape(len(cof), -1),
+    }
+
+
 def grid_of_extent(k: int, half_extent_mm) -> np.ndarray:
     """k x k grids reaching +-half_extent_mm ``(G, k*k, 2)``."""
     e = np.atleast_1d(np.asarray(half_extent_mm, float))

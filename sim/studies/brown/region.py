@@ -123,19 +123,7 @@ def table1_model(x: dict) -> dict:
     return {
         SCALE.id: scale_evidence(P, B.thetas(o, b)),
         "brown.table1_closure.rms_um": s0,
-        **_sigma_evidence(cof, s0),
-    }
-
-
-def _sigma_evidence(cof: np.ndarray, s0: np.ndarray) -> dict:
-    """The four point-sigma statements' evidence from the cofactors ``(N, 25, 2)`` and sigma0
-    ``(N,)`` (um): the 50 sigmas as printed (:func:`sim.instruments.ranges.brown.table1_sigma_stats`)."""
-    st = B.table1_sigma_stats(s0[:, None, None] * cof)
-    return {
-        T1 + "share_1p1_1p3": st["share"],
-        T1 + "points_ge_1p45": st["count"],
-        T1 + "max_um": st["max"],
-        T1 + "below_closure": cof.reshape(len(cof), -1),
+        **B.table1_statement_evidence(cof, s0),
     }
 
 
@@ -167,7 +155,7 @@ def table1_stations(o: np.ndarray, b: np.ndarray) -> np.ndarray:
     preds = [printed[c] for c in T1_PREDICTIONS[:3]]  # below_closure: no sigma0, above
     some = np.zeros(len(j), bool)
     for s0 in np.arange(lo, hi + SIGMA0_STEP_UM / 2, SIGMA0_STEP_UM):
-        ev = _sigma_evidence(cof, np.full(len(j), s0))
+        ev = B.table1_statement_evidence(cof, np.full(len(j), s0))
         some |= (evaluate(preds, ev, len(j)) != FAILS).all(axis=1)
     out[:] = False
     out[j[some]] = True

@@ -131,7 +131,6 @@ ZEISS_READS = Statement(
 #: one declaration (:data:`sim.instruments.ranges.brown.TABLE1`, whose zones brown_table1's
 #: claim rows take too): the closure bounds sigma0 (:data:`SIGMA0`), the four statements about
 #: the 50 printed point sigmas (:data:`TABLE1`) are constraints
-_T1 = "brown.table1_point_sigma."
 _PRINTED = {s.id: s for s in parse_declaration(B.TABLE1)[1]}
 _CLOSURE = _PRINTED.pop("brown.table1_closure.rms_um")
 #: Table 1's printed closure, 1.6 um at its rounding: the range of sigma0 (the closure is a
@@ -156,13 +155,7 @@ def table1_evidence(o, b, s0, alpha_mm: float = B.ALPHA_MM) -> dict:
     :func:`sim.instruments.ranges.brown.table1_sigma_stats`, as brown_table1's)."""
     o, b, s0 = (np.asarray(v, float) for v in (o, b, s0))
     cof = B.table1_cofactors(o, b, alpha_mm)  # (N, 25, 2)
-    st = B.table1_sigma_stats(s0[:, None, None] * cof)
-    return {
-        _T1 + "share_1p1_1p3": st["share"],
-        _T1 + "points_ge_1p45": st["count"],
-        _T1 + "max_um": st["max"],
-        _T1 + "below_closure": cof.reshape(len(o), -1),
-    }
+    return B.table1_statement_evidence(cof, s0)
 
 
 def _comparator_inputs():
