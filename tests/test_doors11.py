@@ -1,0 +1,92 @@
+"""The classes of the tenth sweep of bad inputs (issue 26, doors11), one case each; each
+failed on the code before its fix.
+
+* a key given twice, once as a quoted dotted key and once in a table (``"plate.grid" = 3``
+  and ``[plate] grid = 4``, in the study or in its ``[sweep]``): the later silently won; now
+  refused naming the key (:func:`sim.mc.config.flatten`, :func:`sim.mc.sweep.read_sweep`);
+* a sweep range whose ends are too far apart (``{start = -1.7e308, stop = 1.7e308, num =
+  3}``) printed NumPy's overflow warnings before the one-line error;
+* ``python -m benchmarks`` with bad arguments: argparse's two-line usage errors; ``--out``
+  a file or FIFO failed after a minute of work with a traceback, ``--out ''`` wrote into the
+  working directory, ``--out`` a study's results directory mixed the bench's files into it;
+  ``--rerun-files`` empty, a directory or broken TOML ended in a traceback; ``--only rerun
+  --no-rerun`` measured nothing and exited 0; ``--rerun-files`` without the rerun section
+  was ignored.
+"""
+
+import contextlib
+import warnings
+from pathlib import Path
+
+import pytest
+
+from benchmarks import cli as bench
+from sim.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+TABLE1 = (ROOT / "studies" / "brown_table1.toml").read_text()
+
+
+def _one_line(capsys, rc, *needles):
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "\n" not in err and "Traceback" not in err, (rc, err)
+    assert all(n in err for n in needles), err
+    return err
+
+
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        ('"plate.grid" = 3\n' + TABLE1, "plate.grid: is given twice"),
+        (TABLE1 + '\n[sweep]\n"plate.grid" = [3]\n[sweep.plate]\ngrid = [4]\n', "sweep.plate.grid"),
+    ],
+)
+def test_a_key_given_twice_is_refused_naming_it(tmp_path, capsys, text, key):
+    f = tmp_path / "twice.toml"
+    f.write_text(text)
+    _one_line(capsys, main(["check", str(f)]), key, "given twice")
+
+
+def test_an_overflowing_sweep_range_is_one_line_without_warnings(tmp_path, capsys):
+    f = tmp_path / "wide.toml"
+    f.write_text(
+        TABLE1
+        + '\n[sweep]\n"errors.setting_sigma_um" = {start = -1.7e308, stop = 1.7e308, num = 3}\n'
+    )
+    with _no_warnings():
+        rc = main(["check", str(f)])
+    _one_line(capsys, rc, "sweep.errors.setting_sigma_um", "not finite")
+
+
+@contextlib.contextmanager
+def _no_warnings():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        yield
+
+
+def test_bench_bad_arguments_are_one_line_before_any_work(tmp_path, capsys):
+    (tmp_path / "a.toml").write_text("x = \n")
+    (tmp_path / "res").mkdir()
+    (tmp_path / "res" / "claims.parquet").write_text("")
+    (tmp_path / "file").write_text("")
+    out = ["--out", str(tmp_path / "b")]
+    cases = [
+        (["--only", "rerun", "--no-rerun", *out], "nothing to measure"),
+        (["--only", "brown", "--rerun-files", "x/*.toml", *out], "--rerun-files: the rerun"),
+        (["--only", "brown", "--out", ""], "--out: is empty"),
+        (["--only", "brown", "--out", str(tmp_path / "file")], "not a directory"),
+        (["--only", "brown", "--out", str(tmp_path / "file" / "x")], "not a writable directory"),
+        (["--only", "brown", "--out", str(tmp_path / "res")], "a study's results directory"),
+        (["--only", "rerun", "--rerun-files", "", *out], "--rerun-files: is empty"),
+        (["--only", "rerun", "--rerun-files", str(tmp_path), *out], "is not a study file"),
+        (["--only", "rerun", "--rerun-files", str(tmp_path / "a.toml"), *out], "not a readable"),
+    ]
+    for argv, needle in cases:
+        _one_line(capsys, bench.main(argv), needle)
+    with pytest.raises(SystemExit) as e:
+        bench.main(["--only", "nosuch"])
+    _one_line(capsys, e.value.code, "benchmarks: error: argument --only", "--help")
+    assert not (tmp_path / "b").exists() and sorted(
+        p.name for p in (tmp_path / "res").iterdir()
+    ) == ["claims.parquet"]
