@@ -15,6 +15,8 @@ failed on the code before its fix.
 """
 
 import contextlib
+import subprocess
+import sys
 import warnings
 from pathlib import Path
 
@@ -90,3 +92,30 @@ def test_bench_bad_arguments_are_one_line_before_any_work(tmp_path, capsys):
     assert not (tmp_path / "b").exists() and sorted(
         p.name for p in (tmp_path / "res").iterdir()
     ) == ["claims.parquet"]
+
+
+def test_ctrl_c_while_an_entry_point_loads_is_one_line_and_exit_130():
+    """Ctrl-C in the second or two in which ``sim``, ``python -m sim.batch`` or ``python -m
+    sim.report.verify`` import the suite printed a KeyboardInterrupt traceback from whichever
+    import ran; the entry points now guard their imports (:func:`sim.threads.interrupt_while_loading`)."""
+    code = (
+        "import os, signal, time\n"
+        "from sim.threads import interrupt_while_loading\n"
+        "interrupt_while_loading('sim')\n"
+        "os.kill(os.getpid(), signal.SIGINT)\n"
+        "time.sleep(30)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 130 and done.stderr == "sim: interrupted\n", done
+
+
+def test_the_entry_points_hand_ctrl_c_back_once_loaded():
+    for mod in ("sim.__main__", "sim.batch", "sim.report.verify"):  # none runs its main
+        code = (
+            f"import signal, sys\nsys.argv = ['-m']\nimport {mod}\n"
+            "assert signal.getsignal(signal.SIGINT) is signal.default_int_handler\n"
+        )
+        done = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, timeout=120
+        )
+        assert done.returncode == 0, (mod, done.stderr[-500:])
