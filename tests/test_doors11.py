@@ -119,3 +119,14 @@ def test_the_entry_points_hand_ctrl_c_back_once_loaded():
             [sys.executable, "-c", code], capture_output=True, text=True, timeout=120
         )
         assert done.returncode == 0, (mod, done.stderr[-500:])
+
+
+def test_a_refused_sweep_of_a_list_valued_key_is_one_line(tmp_path, capsys):
+    """Every cell of a sweep of a list-valued key (``plate.points``) refused: the message
+    collected the distinct values in a dict and ended in ``TypeError: unhashable type``."""
+    f = tmp_path / "points.toml"
+    f.write_text(
+        TABLE1 + '\n[sweep]\n"plate.points" = [[[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]]]\n'
+        '"plate.pattern" = ["list"]\n'
+    )
+    _one_line(capsys, main(["check", str(f)]), "sweep.plate.points: every cell failed", "4 points")

@@ -196,6 +196,14 @@ def cell_config(study, cfg: Mapping[str, Any], cell: Mapping[str, Any], seed: in
     return ccfg
 
 
+def _distinct(vs: list) -> list:
+    """The distinct values in order (a list-valued key's values are lists: not hashable)."""
+    seen: dict[str, Any] = {}
+    for v in vs:
+        seen.setdefault(repr(v), v)
+    return list(seen.values())
+
+
 def _shown(keys: list[str], cell: Mapping[str, Any]) -> str:
     return ", ".join(f"{k} = {cell[k]!r}" for k in keys)
 
@@ -228,7 +236,7 @@ def refused_cells(
             bad[i] = str(e)
             named.add(e.key)
     if cells and len(bad) == len(cells):
-        values = {k: list(dict.fromkeys(c[k] for c in cells)) for k in keys}
+        values = {k: _distinct([c[k] for c in cells]) for k in keys}
         culprit = keys if len(keys) == 1 else [k for k in keys if k in named]
         key = f"sweep.{culprit[0]}" if len(culprit) == 1 else "sweep"
         shown = "; ".join(f"{k} = {v!r}" for k, v in values.items())[:300]
