@@ -20,10 +20,14 @@ import sys
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from benchmarks import cli as bench
 from sim.cli import main
+from sim.mc.storage import write_table
+from sim.report.plotting import checking_figures
+from sim.report.sweep import fig_sweep
 
 ROOT = Path(__file__).resolve().parent.parent
 TABLE1 = (ROOT / "studies" / "brown_table1.toml").read_text()
@@ -130,3 +134,38 @@ def test_a_refused_sweep_of_a_list_valued_key_is_one_line(tmp_path, capsys):
         '"plate.pattern" = ["list"]\n'
     )
     _one_line(capsys, main(["check", str(f)]), "sweep.plate.points: every cell failed", "4 points")
+
+
+def test_sweep_png_of_list_values_keeps_its_axes(tmp_path, monkeypatch):
+    """A sweep of ``plate.points`` (list values) drew its legend labels whole, crowding the
+    axes to nothing (matplotlib: "axes sizes collapsed to zero"), and put a text first key's
+    cells at their row numbers; now the labels are shortened and each distinct value of a
+    first key that is not a number has one place, its tick labelled with the value."""
+    pts = [repr([[float(i), 0.0], [0.0, 10.0 * i], [5.0, 5.0], [50.0, 50.0]]) for i in (1, 2)]
+    v = np.array([3.0, 3.0, 2.5, 2.6])
+    cols = {
+        "cell": [0, 1, 2, 3],
+        "replicate": [0, 0, 0, 0],
+        "label": [f"cell{i:04d}_r0" for i in range(4)],
+        "seed": [1, 2, 3, 4],
+        "feasible": [True, True, True, False],
+        "reason": ["", "", "", "bad"],
+        "plate.pattern": ["list", "grid", "list", "grid"],
+        "plate.points": [pts[0], pts[0], pts[1], pts[1]],
+        "brown.closure_um": v,
+        "brown.closure_um:lo": v - 0.1,
+        "brown.closure_um:hi": v + 0.1,
+    }
+    path = tmp_path / "sweep.parquet"
+    write_table(
+        path, cols, {"study": "brown_table1", "sweep_keys": ["plate.pattern", "plate.points"]}
+    )
+    with _no_warnings(), checking_figures() as found:
+        fig_sweep(path, tmp_path / "sweep.png")
+    assert found == {"sweep.png": []}
+    figs = []
+    monkeypatch.setattr("sim.report.sweep.save", lambda fig, png: figs.append(fig))
+    fig_sweep(path, tmp_path / "sweep.png")
+    (ax,) = figs[0].axes
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["'list'", "'grid'"]
+    assert all(len(t.get_text()) <= 40 for t in ax.get_legend().get_texts())
