@@ -234,6 +234,9 @@ def main(argv=None) -> int:
     except (FileNotFoundError, RuntimeError, _ArgError) as e:
         print(f"benchmarks: error: {e}".splitlines()[0], file=sys.stderr)
         return 2
+    except OSError as e:  # a failing write (a full disk, ulimit -f): one line, no traceback
+        print(f"benchmarks: error: writing under {a.out}: {e}".splitlines()[0], file=sys.stderr)
+        return 2
     if "bench.parquet" in tables:
         b = tables["bench.parquet"]
         case, tps = np.array(b["case"]), np.array(b["trials_per_s"])

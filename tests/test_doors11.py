@@ -169,3 +169,15 @@ def test_sweep_png_of_list_values_keeps_its_axes(tmp_path, monkeypatch):
     (ax,) = figs[0].axes
     assert [t.get_text() for t in ax.get_xticklabels()] == ["'list'", "'grid'"]
     assert all(len(t.get_text()) <= 40 for t in ax.get_legend().get_texts())
+
+
+def test_bench_a_failing_write_is_one_line(tmp_path, monkeypatch, capsys):
+    """A write that fails (``ulimit -f``: "File too large") ended in an OSError traceback."""
+
+    def full(*a, **k):
+        raise OSError(27, "File too large")
+
+    monkeypatch.setattr(bench, "engine_rows", lambda quick: {"case": ["x"]})
+    monkeypatch.setattr(bench, "write_table", full)
+    rc = bench.main(["--quick", "--only", "engines", "--out", str(tmp_path / "b")])
+    _one_line(capsys, rc, "benchmarks: error: writing under", "File too large")
