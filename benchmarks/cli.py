@@ -14,6 +14,7 @@ rerun times say nothing about the 90 s target.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 import tomllib
@@ -127,8 +128,57 @@ def _csv(kind, choices=None):
     return parse
 
 
+class _ArgError(Exception):
+    """A bad argument, found before anything is measured (one line, exit 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with the suite's one-line errors (``sim``'s style), exit 2."""
+
+    def error(self, message: str):
+        print(f"benchmarks: error: {message} (see {self.prog} --help)", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def _check_args(a: argparse.Namespace, sections: tuple[str, ...]) -> None:
+    """Refuse, before anything is measured, what would fail after minutes of work or be
+    ignored: nothing to measure, rerun options without the rerun section, an --out that is
+    empty, not a directory, a study's results directory or cannot be written, and rerun files
+    that are not readable TOML study files."""
+    if not sections:
+        raise _ArgError("--only/--no-rerun: nothing to measure (the only section is left out)")
+    if "rerun" not in sections:
+        given = [
+            n
+            for n, v in (("--rerun-files", a.rerun_files), ("--rerun-workers", a.rerun_workers))
+            if v is not None
+        ]
+        if given:
+            raise _ArgError(f"{given[0]}: the rerun section is not measured (--only/--no-rerun)")
+    if not a.out.strip():
+        raise _ArgError("--out: is empty (give a directory)")
+    out = Path(a.out)
+    if out.exists() and not out.is_dir():
+        raise _ArgError(f"--out: {out} exists and is not a directory")
+    if any((out / f).exists() for f in ("claims.parquet", "sweep.parquet", "run.json")):
+        raise _ArgError(f"--out: {out} is a study's results directory (give another)")
+    base = next(p for p in (out.absolute(), *out.absolute().parents) if p.exists())
+    if not base.is_dir() or not os.access(base, os.W_OK | os.X_OK):
+        raise _ArgError(f"--out: cannot write {out} ({base} is not a writable directory)")
+    if "rerun" in sections:
+        if a.rerun_files is not None and not a.rerun_files.strip():
+            raise _ArgError("--rerun-files: is empty (give a glob, e.g. studies/*.toml)")
+        for f in study_files(a.rerun_files or "studies/*.toml"):
+            try:
+                study = tomllib.loads(f.read_text()).get("study") if f.is_file() else None
+            except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
+                raise _ArgError(f"--rerun-files: {f}: not a readable TOML file ({e})") from None
+            if not isinstance(study, str):
+                raise _ArgError(f"--rerun-files: {f} is not a study file (no study = ...)")
+
+
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(
+    ap = _Parser(
         prog="python -m benchmarks",
         description="Benchmark of the batched solvers and of make rerun (see README, Benchmark)",
     )
@@ -155,13 +205,13 @@ def main(argv=None) -> int:
     )
     ap.add_argument(
         "--rerun-files",
-        default="studies/*.toml",
+        default=None,
         help="study files of the rerun rows (default studies/*.toml)",
     )
     ap.add_argument(
         "--rerun-workers",
         type=_csv(int),
-        default=(1, 2),
+        default=None,
         help="worker counts of the rerun rows (default 1,2)",
     )
     ap.add_argument("--million-child", type=int, help=argparse.SUPPRESS)
@@ -173,9 +223,19 @@ def main(argv=None) -> int:
         return 0
     sections = tuple(s for s in a.only if a.rerun or s != "rerun")
     try:
-        tables = run(Path(a.out), a.quick, sections, a.rerun_files, a.rerun_workers)
-    except (FileNotFoundError, RuntimeError) as e:
+        _check_args(a, sections)
+        tables = run(
+            Path(a.out),
+            a.quick,
+            sections,
+            a.rerun_files or "studies/*.toml",
+            a.rerun_workers or (1, 2),
+        )
+    except (FileNotFoundError, RuntimeError, _ArgError) as e:
         print(f"benchmarks: error: {e}".splitlines()[0], file=sys.stderr)
+        return 2
+    except OSError as e:  # a failing write (a full disk, ulimit -f): one line, no traceback
+        print(f"benchmarks: error: writing under {a.out}: {e}".splitlines()[0], file=sys.stderr)
         return 2
     if "bench.parquet" in tables:
         b = tables["bench.parquet"]

@@ -4,8 +4,9 @@ an unwritable config directory kept quiet, then the command line."""
 import logging
 import sys
 
-from sim.threads import single_threaded_blas
+from sim.threads import interrupt_while_loading, single_threaded_blas
 
+loaded = interrupt_while_loading("sim")  # Ctrl-C during the imports: one line, exit 130
 single_threaded_blas()  # before NumPy loads (sim.cli imports it)
 
 
@@ -24,6 +25,8 @@ class _CacheDirNotes(logging.Filter):
 logging.getLogger("matplotlib").addFilter(_CacheDirNotes())  # before matplotlib loads
 
 from sim.cli import main  # noqa: E402
+
+loaded()
 
 if __name__ == "__main__":
     sys.exit(main())

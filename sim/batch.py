@@ -34,8 +34,9 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from sim.threads import single_threaded_blas
+from sim.threads import interrupt_while_loading, single_threaded_blas
 
+_loaded = interrupt_while_loading("sim.batch")  # Ctrl-C during the imports: one line, exit 130
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 
 from sim.cli import __doc__ as cli_doc  # noqa: E402
@@ -47,6 +48,8 @@ from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.storage import regular_text  # noqa: E402
+
+_loaded()
 
 __all__ = ["SLOW_FIRST", "order", "run_all", "main"]
 

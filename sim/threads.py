@@ -6,6 +6,8 @@ before anything imports NumPy; the environment of the caller wins.
 """
 
 import os
+import signal
+import threading
 
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
@@ -13,3 +15,23 @@ BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THR
 def single_threaded_blas() -> None:
     for v in BLAS_THREAD_VARIABLES:
         os.environ.setdefault(v, "1")
+
+
+def interrupt_while_loading(prog: str):
+    """Ctrl-C while an entry point imports the suite (a second or two): one line
+    ``<prog>: interrupted`` and exit 130, as later, not a traceback from whichever import
+    was running (nothing has been written yet). Returns the function that puts Python's own
+    handler back once the command handles Ctrl-C itself; a SIGINT the caller ignores (a
+    background job) stays ignored."""
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
+    ):
+        return lambda: None
+
+    def handler(signum, frame):
+        os.write(2, f"{prog}: interrupted\n".encode())
+        os._exit(130)
+
+    signal.signal(signal.SIGINT, handler)
+    return lambda: signal.signal(signal.SIGINT, signal.default_int_handler)

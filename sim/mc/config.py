@@ -167,8 +167,16 @@ def flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in d.items():
         key = f"{prefix}{k}"
+        if key in out:  # "a.b" = 1 and [a] b = 2: the same key twice, the later would win
+            raise ConfigError(key, "is given twice (as a quoted dotted key and in a table)")
         if isinstance(v, dict) and v:
-            out.update(flatten(v, key + "."))
+            inner = flatten(v, key + ".")
+            twice = [k2 for k2 in inner if k2 in out]
+            if twice:
+                raise ConfigError(
+                    twice[0], "is given twice (as a quoted dotted key and in a table)"
+                )
+            out.update(inner)
         elif isinstance(v, dict):  # an empty table: a section, or a value given as {} (validate)
             out[key] = _EmptyTable()
         else:

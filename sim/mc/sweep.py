@@ -67,10 +67,15 @@ def _flatten_sweep(d: Mapping, prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in d.items():
         key = f"{prefix}{k}"
-        if isinstance(v, dict) and not _is_range(v):
-            out.update(_flatten_sweep(v, key + "."))
-        else:
-            out[key] = v
+        inner = (
+            _flatten_sweep(v, key + ".") if isinstance(v, dict) and not _is_range(v) else {key: v}
+        )
+        for k2, v2 in inner.items():
+            if k2 in out:  # "a.b" = [..] and [sweep.a] b = [..]: the same key twice
+                raise ConfigError(
+                    f"sweep.{k2}", "is given twice (as a quoted dotted key and in a table)"
+                )
+            out[k2] = v2
     return out
 
 
@@ -121,7 +126,8 @@ def _values(key: str, v: Any) -> list:
                 raise ConfigError(
                     f"sweep.{key}", f"num must be an integer from 1 to {MAX_CELLS} (got {n!r})"
                 )
-            out = np.linspace(a, b, n)
+            with np.errstate(all="ignore"):  # b - a overflowing: refused below, not warned
+                out = np.linspace(a, b, n)
         elif "step" in v:
             s = _finite(key, "step", v["step"])
             if s == 0 or (b - a) / s < 0:
@@ -135,7 +141,8 @@ def _values(key: str, v: Any) -> list:
                     f"step {s!r} gives more than {MAX_CELLS} values from {a!r} to {b!r}",
                 )
             k = int(math.floor(count + 1e-9))
-            out = a + s * np.arange(k + 1)
+            with np.errstate(all="ignore"):
+                out = a + s * np.arange(k + 1)
         else:
             raise ConfigError(f"sweep.{key}", "a range needs num or step")
         if not np.isfinite(out).all():
@@ -189,6 +196,14 @@ def cell_config(study, cfg: Mapping[str, Any], cell: Mapping[str, Any], seed: in
     return ccfg
 
 
+def _distinct(vs: list) -> list:
+    """The distinct values in order (a list-valued key's values are lists: not hashable)."""
+    seen: dict[str, Any] = {}
+    for v in vs:
+        seen.setdefault(repr(v), v)
+    return list(seen.values())
+
+
 def _shown(keys: list[str], cell: Mapping[str, Any]) -> str:
     return ", ".join(f"{k} = {cell[k]!r}" for k in keys)
 
@@ -221,7 +236,7 @@ def refused_cells(
             bad[i] = str(e)
             named.add(e.key)
     if cells and len(bad) == len(cells):
-        values = {k: list(dict.fromkeys(c[k] for c in cells)) for k in keys}
+        values = {k: _distinct([c[k] for c in cells]) for k in keys}
         culprit = keys if len(keys) == 1 else [k for k in keys if k in named]
         key = f"sweep.{culprit[0]}" if len(culprit) == 1 else "sweep"
         shown = "; ".join(f"{k} = {v!r}" for k, v in values.items())[:300]

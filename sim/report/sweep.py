@@ -56,20 +56,29 @@ def _column(t: dict, name: str) -> np.ndarray:
     return np.array([np.nan if a is None else a for a in t[name]], float)
 
 
+def _short(text: str, n: int = 40) -> str:
+    """A legend or tick label of at most ``n`` characters (a list-valued key's values would
+    crowd the axes out of the figure)."""
+    return text if len(text) <= n else text[: n - 1] + "\u2026"
+
+
 def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     """Each claim's value (with its 95 % interval) against the first swept key, one line per
     combination of the other keys; infeasible cells marked by a red band. Proportions (by
     their names, values in [0, 1]) are drawn with their intervals clipped to [0, 1]; tick
-    labels say the numbers (no offset). Drawn from the rows of ``sweep.parquet`` alone."""
+    labels say the numbers (no offset). A first key whose values are not numbers (text, lists)
+    is drawn at one place per distinct value, its ticks labelled with the values; long
+    labels are shortened. Drawn from the rows of ``sweep.parquet`` alone."""
 
     t = read_table(path).to_pydict()
     keys = read_provenance(path).get("sweep_keys", [])
     claims = _claim_columns(t, keys)[:max_panels]
     if not keys or not claims:
         return None
-    x = np.array(
-        [float(v) if isinstance(v, (int, float)) else i for i, v in enumerate(t[keys[0]])], float
-    )
+    first = t[keys[0]]
+    numeric = all(isinstance(v, (int, float)) for v in first)
+    ticks = list(dict.fromkeys(repr(v) for v in first))  # text, list values: one place each
+    x = np.array([float(v) for v in first] if numeric else [ticks.index(repr(v)) for v in first])
     other = [tuple(t[k][i] for k in keys[1:]) for i in range(len(x))]
     feas = np.array(t["feasible"], bool)
     ncol = min(3, len(claims))
@@ -89,7 +98,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         for n, grp in enumerate(dict.fromkeys(other)):
             sel = np.array([o == grp for o in other]) & feas
             o = np.argsort(x[sel])
-            lab = ", ".join(f"{k}={g}" for k, g in zip(keys[1:], grp)) or None
+            lab = _short(", ".join(f"{k}={g}" for k, g in zip(keys[1:], grp))) or None
             ax.errorbar(
                 x[sel][o],
                 v[sel][o],
@@ -108,6 +117,8 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             ) > 0.5 else None
         readable_limits(ax, "y")
         ax.ticklabel_format(axis="both", useOffset=False, style="plain")
+        if not numeric:
+            ax.set_xticks(range(len(ticks)), [_short(v, 16) for v in ticks], fontsize=7)
         ax.set_title(c, fontsize=8, wrap=True)
         ax.set_xlabel(xlabel, fontsize=8)
         ax.set_ylabel(_y_label(c, prop), fontsize=8)

@@ -30,9 +30,17 @@ line and exit 2; a failed comparison exit 1. ``--scratch`` replaces only what th
 there (a directory with its ``run.json``); anything else is refused, never deleted.
 """
 
-from sim.report.verify.cli import main
-from sim.report.verify.rerun import markdown, rerun_study, study_dirs, verify, write_record
-from sim.report.verify.rules import (
+import sys
+
+from sim.threads import interrupt_while_loading
+
+# python -m sim.report.verify imports this package first (sys.argv[0] is "-m" meanwhile):
+# Ctrl-C during its imports is one line and exit 130 (sim.report.verify.__main__)
+_loaded = interrupt_while_loading("sim verify") if sys.argv[:1] == ["-m"] else (lambda: None)
+
+from sim.report.verify.cli import main  # noqa: E402
+from sim.report.verify.rerun import markdown, rerun_study, study_dirs, verify, write_record  # noqa: E402
+from sim.report.verify.rules import (  # noqa: E402
     DEFAULT_ATOL,
     DEFAULT_RTOL,
     Comparison,
@@ -40,6 +48,8 @@ from sim.report.verify.rules import (
     compare_dirs,
     compare_tables,
 )
+
+_loaded()
 
 __all__ = [
     "compare_dirs",
