@@ -401,6 +401,12 @@ def _main(argv: list[str]) -> int:
         # cell table; a file nested too deep to read (a run.json of 100,000 brackets)
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)
         return 2
+    except Exception as e:  # noqa: BLE001 - a bug outside a run (check, show, report, loading):
+        if os.environ.get("SIM_DEBUG"):  # one line as docs/cli.md promises, the traceback on
+            raise  # request
+        what = f"{type(e).__name__}: {e}".splitlines()[0]
+        print(f"sim: internal error: {what} (SIM_DEBUG=1 shows where)", file=sys.stderr)
+        return INTERNAL
     return 1
 
 

@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 from benchmarks import cli as bench
+from sim import cli
 from sim.cli import main
 from sim.mc.storage import write_table
 from sim.report.plotting import checking_figures
@@ -181,3 +182,21 @@ def test_bench_a_failing_write_is_one_line(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(bench, "write_table", full)
     rc = bench.main(["--quick", "--only", "engines", "--out", str(tmp_path / "b")])
     _one_line(capsys, rc, "benchmarks: error: writing under", "File too large")
+
+
+def test_a_bug_outside_a_run_is_one_line_and_exit_3(monkeypatch, capsys):
+    """A TypeError raised by ``sim check`` itself (not bad input, not inside a run) was a raw
+    traceback with exit 1; docs/cli.md promises one line and exit 3 (SIM_DEBUG=1: the
+    traceback)."""
+
+    def broken(args):
+        raise TypeError("unhashable type: 'list'")
+
+    monkeypatch.setattr(cli, "_check", broken)
+    monkeypatch.delenv("SIM_DEBUG", raising=False)
+    assert cli.main(["check", str(ROOT / "studies" / "brown_table1.toml")]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "internal error: TypeError: unhashable" in err[0], err
+    monkeypatch.setenv("SIM_DEBUG", "1")
+    with pytest.raises(TypeError):
+        cli.main(["check", str(ROOT / "studies" / "brown_table1.toml")])
