@@ -200,3 +200,13 @@ def test_a_bug_outside_a_run_is_one_line_and_exit_3(monkeypatch, capsys):
     monkeypatch.setenv("SIM_DEBUG", "1")
     with pytest.raises(TypeError):
         cli.main(["check", str(ROOT / "studies" / "brown_table1.toml")])
+
+
+def test_a_plate_region_too_small_to_hold_a_point_is_refused(capsys):
+    """region.plate_points = 8 passed check, and the plates part then held no point of Table 1's
+    region (about 3 % of the box): its rows came out undecidable naming Table 1's statements as
+    conflicting. At least 256 points (about 6 in the region)."""
+    f = str(ROOT / "studies" / "brown_design.toml")
+    assert main(["check", f, "--set", "region.plate_points=8"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "region.plate_points" in err[0] and ">= 256" in err[0], err

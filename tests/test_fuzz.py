@@ -70,7 +70,7 @@ SMALL = {
         "bayes.steps": 100,
         "region.points": 256,
         "region.rounds": 1,
-        "region.plate_points": 8,
+        "region.plate_points": 256,
     },
     "gridplate_two_plates": {
         "trials": 8,
