@@ -210,3 +210,15 @@ def test_a_plate_region_too_small_to_hold_a_point_is_refused(capsys):
     assert main(["check", f, "--set", "region.plate_points=8"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "region.plate_points" in err[0] and ">= 256" in err[0], err
+
+
+def test_an_output_name_too_long_for_its_staging_directory_is_refused(tmp_path, capsys):
+    """A study file (so a results directory) named with 247 or more characters passed the
+    checks, then failed naming the run's staging directory ``.<name>.partial``: the names the
+    run works with next to ``--out`` must fit the file system's name limit."""
+    out = tmp_path / ("a" * 250)
+    f = str(ROOT / "studies" / "brown_table1.toml")
+    assert main(["run", f, "--out", str(out), "--trials", "40", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--out" in err[0] and "shorter" in err[0], err
+    assert list(tmp_path.iterdir()) == []  # nothing made

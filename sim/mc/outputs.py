@@ -47,12 +47,38 @@ def name_problem(text: str) -> str | None:
     return None
 
 
+def _name_max(d: Path) -> int:
+    """The file system's longest file name (bytes) in ``d`` or its nearest existing parent."""
+    for p in (d, *d.parents):
+        if p.is_dir():
+            try:
+                return os.pathconf(p, "PC_NAME_MAX")
+            except (OSError, ValueError):
+                break
+    return 255
+
+
+def _check_name_length(out: Path, shown: str) -> None:
+    """The run works next to ``out`` in ``.<name>.partial`` and swaps the old results through
+    ``.<name>.old.<pid>``: both names must fit the file system (a study file name of 247
+    characters passed, then failed naming the staging directory)."""
+    longest = len(f".{out.name}.old.{os.getpid()}".encode("utf-8", "surrogateescape"))
+    limit = _name_max(out.parent)
+    if longest > limit:
+        raise ConfigError(
+            "--out",
+            f"{shown}: its name needs {longest} bytes with the run's staging suffix, over the "
+            f"file system's {limit}: choose a shorter --out (or study file name)",
+        )
+
+
 def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
     """Refuse an output path the suite did not write (with or without ``--overwrite``) and,
     without ``--overwrite``, results of a different config or code version."""
 
     if not out.name or out == out.parent:
         raise ConfigError("--out", f"{shown} is not a directory the suite can write into")
+    _check_name_length(out, shown)
     _check_not_nested(out, shown)
     if out.is_symlink():
         raise ConfigError("--out", f"{shown} is a symbolic link; sim never replaces it")
