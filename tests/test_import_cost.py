@@ -1,5 +1,5 @@
 """What a process pays before it does anything: the suite's modules load without matplotlib,
-scipy.stats or numba (about 0.5 s, 0.5 s and 1 s of CPU each), which a process loads only when
+scipy.stats or numba (about 0.5 s, 0.5 s and 0.3 s of CPU each, measured), which a process loads only when
 it draws a figure (sim.report.mpl), explores a region (its Sobol design) or compiles a kernel
 (sim.lsq.compile). A `sim check`, a `--no-figures` run, a pool or Dask worker and every
 re-run of `make verify` start faster for it; a test run starts dozens of such processes."""
