@@ -39,9 +39,9 @@ from sim.threads import interrupt_while_loading, single_threaded_blas
 _loaded = interrupt_while_loading("sim.batch")  # Ctrl-C during the imports: one line, exit 130
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 
-from sim.cli import __doc__ as cli_doc  # noqa: E402
+from sim.cli import DOC as cli_doc  # noqa: E402
 from sim.cli import check_run_args, load_run  # noqa: E402
-from sim.cli_args import OnceParser  # noqa: E402
+from sim.cli_args import OnceParser, module_doc  # noqa: E402
 from sim.cli_args import parser as run_parser  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, stop_children  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
@@ -278,7 +278,9 @@ def _main(argv: list[str]) -> int:
     if "--" in argv:
         i = argv.index("--")
         argv, run_args = argv[:i], argv[i + 1 :]
-    ap = _Parser(prog="python -m sim.batch", description=__doc__.splitlines()[0])
+    ap = _Parser(
+        prog="python -m sim.batch", description=module_doc(__doc__, __file__).partition("\n")[0]
+    )
     ap.add_argument("files", nargs="+", help="study files")
     ap.add_argument("--jobs", type=int, default=2, help="studies run at a time (default 2)")
     ap.add_argument("--results", default="results", help="results directory (default results)")

@@ -30,7 +30,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.cli_args import parser
+from sim.cli_args import module_doc, parser
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
@@ -43,6 +43,9 @@ from sim.report.run_summary import run_markdown, terminal_summary, terminal_tabl
 from sim.studies import get_study, load_study
 
 __all__ = ["main", "check_run_args"]
+
+#: the usage text of ``sim`` (the module docstring, also under ``python -OO``)
+DOC = module_doc(__doc__, __file__)
 
 #: exit code of an internal error (a bug, not bad input): one line, traceback with SIM_DEBUG=1
 INTERNAL = 3
@@ -333,7 +336,7 @@ def main(argv: list[str] | None = None) -> int:
     old = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
     try:
         if not argv:  # usage, not an error message
-            parser(__doc__).print_help()
+            parser(DOC).print_help()
             return 2
         return _main(argv)
     except BrokenPipeError:  # sim check ... | head: the reader left, nothing to say
@@ -352,7 +355,7 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str]) -> int:
     args = None
     try:
-        args = parser(__doc__).parse_args(argv)
+        args = parser(DOC).parse_args(argv)
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")

@@ -10,6 +10,7 @@ after that, every read is a dictionary lookup in the imported module.
 from __future__ import annotations
 
 import importlib
+import os
 import threading
 from types import ModuleType
 from typing import Any
@@ -31,11 +32,18 @@ _done: list[bool] = []
 
 
 def _setup() -> None:
-    """Agg backend and :data:`STYLE`, once per process, before any matplotlib module loads."""
+    """Agg backend and :data:`STYLE`, once per process, before any matplotlib module loads.
+    The user's ``MPLBACKEND`` is set aside while matplotlib loads (and put back): the suite
+    draws only PNG files through Agg, and a value matplotlib does not know (``nosuch``)
+    failed a run at its first figure, after every trial was computed."""
     with _ready:
         if not _done:
-            import matplotlib  # heavy: loaded here, on a figure's first use
-
+            backend = os.environ.pop("MPLBACKEND", None)
+            try:
+                import matplotlib  # heavy: loaded here, on a figure's first use
+            finally:
+                if backend is not None:
+                    os.environ["MPLBACKEND"] = backend
             matplotlib.use("Agg")
             matplotlib.rcParams.update(STYLE)
             _done.append(True)
