@@ -6,15 +6,24 @@ a new user's first hour), one case each; each failed on the code before its fix.
   it is now read from the source (:func:`sim.cli_args.module_doc`);
 * ``MPLBACKEND`` naming a backend matplotlib does not know: a run computed every trial,
   then failed at its first figure; the suite draws PNG files through Agg only, so the
-  variable is set aside while matplotlib loads (:mod:`sim.report.mpl`).
+  variable is set aside while matplotlib loads (:mod:`sim.report.mpl`);
+* a study file saved by a Windows editor with a UTF-8 signature (BOM) was "malformed TOML
+  at line 1, column 1"; it is read (the signature is no part of the text), and a UTF-16
+  file says it is not UTF-8 (:func:`sim.mc.config.read_toml`).
 """
 
 import os
 import subprocess
 import sys
+from pathlib import Path
+
+import pytest
 
 from sim import batch, cli
 from sim.cli_args import module_doc
+from sim.mc.config import ConfigError, read_toml
+
+STUDY = Path(__file__).resolve().parent.parent / "studies" / "network_plate.toml"
 
 
 def _python(*args, env=None):
@@ -45,3 +54,12 @@ def test_an_unknown_MPLBACKEND_does_not_stop_the_figures():
     p = _python("-c", code, env={"MPLBACKEND": "nosuch"})
     assert p.returncode == 0, p.stderr
     assert p.stdout.split() == ["agg", "nosuch"]  # drawn through Agg; the variable put back
+
+
+def test_a_study_file_with_a_byte_order_mark_is_read(tmp_path):
+    text = STUDY.read_text(encoding="utf-8")
+    (tmp_path / "bom.toml").write_bytes(b"\xef\xbb\xbf" + text.encode())
+    (tmp_path / "u16.toml").write_bytes(text.encode("utf-16"))
+    assert read_toml(tmp_path / "bom.toml") == read_toml(STUDY)
+    with pytest.raises(ConfigError, match=r"u16.toml: not UTF-8 text \(.*UTF-16"):
+        read_toml(tmp_path / "u16.toml")

@@ -14,6 +14,7 @@ error amplitude); the report lists them so nobody mistakes them for predictions.
 
 from __future__ import annotations
 
+import codecs
 import difflib
 import math
 import tomllib
@@ -265,10 +266,16 @@ def read_toml(path: str | Path) -> dict[str, Any]:
             raise ConfigError(
                 None, f"{p}: over {MAX_STUDY_BYTES // 1024**2} MiB, too large for a study file"
             )
-        with p.open("rb") as fh:
-            doc = tomllib.load(fh)
+        data = p.read_bytes()
+        if data.startswith(codecs.BOM_UTF8):  # a Windows editor's UTF-8 signature: not TOML,
+            data = data[len(codecs.BOM_UTF8) :]  # and no part of the text; it was refused
+        if b"\x00" in data:  # as malformed TOML at line 1, column 1 (doors12)
+            raise ConfigError(None, f"{p}: not UTF-8 text (it holds NUL bytes: UTF-16 or binary)")
+        doc = tomllib.loads(data.decode("utf-8"))
         refuse_big_ints("", doc)
         return doc
+    except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again
+        raise
     except tomllib.TOMLDecodeError as e:
         raise ConfigError(None, f"{p}: malformed TOML: {e}") from None
     except RecursionError:
