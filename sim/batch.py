@@ -324,8 +324,9 @@ def _main(argv: list[str]) -> int:
     if not 1 <= args.jobs <= 64:
         print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
         return 2
+    log = _Stdout()
     try:
-        done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only)
+        done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only, log)
     except KeyboardInterrupt:  # the runs were stopped and cleaned up
         print(
             "sim.batch: interrupted; the same command again resumes the unfinished runs",
@@ -335,7 +336,31 @@ def _main(argv: list[str]) -> int:
     if args.timings is not None:
         Path(args.timings).write_text(json.dumps(done), encoding="utf-8")
     failed = [v[0] for v in done.values() if v[0] != 0]
+    if log.error is not None and not isinstance(log.error, BrokenPipeError):
+        print(f"sim.batch: standard output: {log.error.strerror or log.error}", file=sys.stderr)
+        return (failed[0] if failed[0] > 0 else 1) if failed else 2
     return (failed[0] if failed[0] > 0 else 1) if failed else 0
+
+
+class _Stdout:
+    """``print`` to standard output for :func:`run_all`'s lines, which keeps the first failed
+    write (``> /dev/full``; ``| head -1``, a broken pipe) instead of raising it in a run's
+    thread: that was a traceback while the other runs went on; now every run ends, the
+    timings are written and the driver ends with one line (a broken pipe: quietly)."""
+
+    def __init__(self) -> None:
+        self.error: OSError | None = None
+
+    def __call__(self, text: str) -> None:
+        if self.error is None:
+            try:
+                print(text, flush=True)
+            except OSError as e:
+                self.error = e
+                try:  # what is left in the buffer is dropped, not retried at exit
+                    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+                except (OSError, ValueError):
+                    pass
 
 
 if __name__ == "__main__":

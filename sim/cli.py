@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import linecache
 import os
 import re
 import signal
@@ -315,6 +316,20 @@ def _cwd_exists() -> bool:
     return True
 
 
+def _stdout_failed(e: OSError) -> bool:
+    """Whether ``e`` came from printing to standard output (``sim check > /dev/full``): such
+    a write fails without a file name, and the line said only "No space left on device"
+    (after a run's results had been written). Judged by the innermost line it was raised
+    on: a ``print`` to standard output, or ``sys.stdout`` itself."""
+    tb = e.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    if tb is None:
+        return False
+    line = linecache.getline(tb.tb_frame.f_code.co_filename, tb.tb_lineno)
+    return ("print(" in line and "file=" not in line) or "sys.stdout" in line
+
+
 def _why(e: OSError) -> str:
     """The reason of an OSError in words: its strerror, or (pyarrow raises
     ``FileNotFoundError(path)`` without one) the name of its kind."""
@@ -390,6 +405,8 @@ def _main(argv: list[str]) -> int:
             name = e.args[0]  # pyarrow's FileNotFoundError(path)
         if not name and not _cwd_exists():
             name = "the working directory (it was deleted)"
+        if not name and _stdout_failed(e):
+            name = "standard output"
         print(f"sim: error: {_why(e)}: {name}".rstrip(": "), file=sys.stderr)
         return 2
     except UnicodeEncodeError as e:  # a text the terminal's encoding cannot show (ascii)

@@ -9,9 +9,14 @@ a new user's first hour), one case each; each failed on the code before its fix.
   variable is set aside while matplotlib loads (:mod:`sim.report.mpl`);
 * a study file saved by a Windows editor with a UTF-8 signature (BOM) was "malformed TOML
   at line 1, column 1"; it is read (the signature is no part of the text), and a UTF-16
-  file says it is not UTF-8 (:func:`sim.mc.config.read_toml`).
+  file says it is not UTF-8 (:func:`sim.mc.config.read_toml`);
+* standard output that cannot be written (``> /dev/full``): ``sim`` said only "No space
+  left on device", and ``python -m sim.batch`` ended in a traceback from a run's thread; now
+  one line naming standard output, exit 2 (:func:`sim.cli._stdout_failed`,
+  :class:`sim.batch._Stdout`).
 """
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -63,3 +68,37 @@ def test_a_study_file_with_a_byte_order_mark_is_read(tmp_path):
     assert read_toml(tmp_path / "bom.toml") == read_toml(STUDY)
     with pytest.raises(ConfigError, match=r"u16.toml: not UTF-8 text \(.*UTF-16"):
         read_toml(tmp_path / "u16.toml")
+
+
+@contextlib.contextmanager
+def full_stdout():
+    """Standard output on /dev/full (set inside the test: capsys replaces sys.stdout)."""
+    full = open("/dev/full", "w", buffering=1)  # noqa: SIM115 - closed below
+    try:
+        with pytest.MonkeyPatch.context() as m:
+            m.setattr(sys, "stdout", full)
+            yield
+    finally:
+        with contextlib.suppress(OSError):  # what is left fails to flush, as it should
+            full.close()
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_a_full_standard_output_is_named(capsys):
+    with full_stdout():
+        assert cli.main(["check", str(STUDY)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "sim: error: No space left on device: standard output", err
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_a_full_standard_output_ends_a_batch_in_one_line(capsys, monkeypatch):
+    def run_all(files, results, jobs, run_args, stale_only, log):
+        log("network_plate: results in ...")
+        return {"network_plate": (0, 1.0, 0.0)}
+
+    monkeypatch.setattr(batch, "run_all", run_all)
+    with full_stdout():
+        assert batch.main([str(STUDY), "--results", "/nonexistent/r"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "sim.batch: standard output: No space left on device", err
