@@ -13,11 +13,17 @@ a new user's first hour), one case each; each failed on the code before its fix.
 * standard output that cannot be written (``> /dev/full``): ``sim`` said only "No space
   left on device", and ``python -m sim.batch`` ended in a traceback from a run's thread; now
   one line naming standard output, exit 2 (:func:`sim.cli._stdout_failed`,
-  :class:`sim.batch._Stdout`).
+  :class:`sim.batch._Stdout`);
+* a results directory copied into another study's results (a user's copy): re-running
+  that study kept the copy but dropped its ``run.json``, so the copy was no longer results
+  (``sim.mc.outputs._foreign`` took every ``run.json`` for the run's own);
+* ``python -m sim.report.verify --results DIR`` from a directory without ``studies/``
+  reported every study as FAILED (exit 1, and recorded so): now one line, exit 2.
 """
 
 import contextlib
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -27,6 +33,7 @@ import pytest
 from sim import batch, cli
 from sim.cli_args import module_doc
 from sim.mc.config import ConfigError, read_toml
+from sim.report.verify import main as verify_main
 
 STUDY = Path(__file__).resolve().parent.parent / "studies" / "network_plate.toml"
 
@@ -102,3 +109,21 @@ def test_a_full_standard_output_ends_a_batch_in_one_line(capsys, monkeypatch):
         assert batch.main([str(STUDY), "--results", "/nonexistent/r"]) == 2
     err = capsys.readouterr().err.strip()
     assert err == "sim.batch: standard output: No space left on device", err
+
+
+def test_a_results_copy_inside_results_keeps_its_run_json(tmp_path, capsys):
+    out = tmp_path / "r"
+    run = ["run", str(STUDY), "--trials", "40", "--quiet", "--no-figures", "--out", str(out)]
+    assert cli.main(run) == 0
+    shutil.copytree(out, tmp_path / "copy")
+    shutil.move(tmp_path / "copy", out / "copy")  # the user's copy of results, inside results
+    before = sorted(p.relative_to(out / "copy") for p in (out / "copy").rglob("*"))
+    assert cli.main([*run, "--overwrite", "--seed", "2"]) == 0, capsys.readouterr().err
+    assert sorted(p.relative_to(out / "copy") for p in (out / "copy").rglob("*")) == before
+
+
+def test_verify_outside_the_project_is_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert verify_main(["--results", str(tmp_path), "--no-record"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "no studies/ directory" in err, err

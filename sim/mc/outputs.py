@@ -315,7 +315,7 @@ def _foreign(out: Path) -> list[str]:
         r = Path(root)
         for n in files + [d for d in dirs if (r / d).is_symlink()]:
             f = (r / n).relative_to(out).as_posix()
-            if f not in mine and n not in ("run.json", LOCK):
+            if f not in mine and f not in ("run.json", LOCK):  # its own, not a copy's inside
                 keep.append(f)
         if r != out and not dirs and not files:
             keep.append(r.relative_to(out).as_posix() + "/")

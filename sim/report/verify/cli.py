@@ -84,6 +84,11 @@ def _check_args(a) -> None:
         raise VerifyError("--set: only with --trials (a re-run with other inputs is not a check)")
     if a.no_rerun and not a.scratch:
         raise VerifyError("--no-rerun: needs --scratch (the directory of the re-runs)")
+    if not a.no_rerun and not Path("studies").is_dir():  # run elsewhere, every study "FAILED"
+        raise VerifyError(
+            f"no studies/ directory in {Path.cwd()}: the re-runs read their study files from "
+            "studies/; run from the project's root"
+        )
     for s in a.set:
         if "=" not in s:
             raise VerifyError(f"--set: {s!r} is not KEY=VALUE")
