@@ -18,7 +18,10 @@ a new user's first hour), one case each; each failed on the code before its fix.
   that study kept the copy but dropped its ``run.json``, so the copy was no longer results
   (``sim.mc.outputs._foreign`` took every ``run.json`` for the run's own);
 * ``python -m sim.report.verify --results DIR`` from a directory without ``studies/``
-  reported every study as FAILED (exit 1, and recorded so): now one line, exit 2.
+  reported every study as FAILED (exit 1, and recorded so): now one line, exit 2;
+* ``--out`` naming another study's results said "holds results of a different config; use
+  --overwrite", and --overwrite then replaced brown_table1's results with a network's: the
+  message names the other study (:func:`sim.mc.outputs._differs`).
 """
 
 import contextlib
@@ -127,3 +130,13 @@ def test_verify_outside_the_project_is_one_line(tmp_path, capsys, monkeypatch):
     assert verify_main(["--results", str(tmp_path), "--no-record"]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "no studies/ directory" in err, err
+
+
+def test_another_studys_results_are_named_as_such(tmp_path, capsys):
+    out = tmp_path / "r"
+    out.mkdir()
+    shutil.copy(STUDY.parent.parent / "results" / "brown_table1" / "run.json", out / "run.json")
+    assert cli.main(["run", str(STUDY), "--trials", "40", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "holds results of another study ('brown_table1'; this run is 'network')" in err, err
+    assert "\n" not in err

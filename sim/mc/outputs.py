@@ -101,12 +101,21 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
         return
     if _same(old, record) or overwrite:
         return
-    why = (
-        "a different config"
-        if old.get("config") != record["config"]
-        else "a different code version"
+    raise ConfigError(
+        "--out", f"{shown} holds results of {_differs(old, record)}; use --overwrite to replace it"
     )
-    raise ConfigError("--out", f"{shown} holds results of {why}; use --overwrite to replace it")
+
+
+def _differs(old: dict, record: dict) -> str:
+    """How the run record ``old`` differs from this run's: another study is named (it was
+    "a different config", and --overwrite then replaced brown_table1's results with a
+    network's), else a different config or code version."""
+    mine = record["config"].get("study")
+    theirs = old.get("config", {}).get("study") if isinstance(old.get("config"), dict) else None
+    if theirs != mine:
+        return f"another study ({theirs!r}; this run is {mine!r})"
+    same = old.get("config") == record["config"]
+    return "a different code version" if same else "a different config"
 
 
 def _check_not_nested(out: Path, shown: str) -> None:
@@ -206,14 +215,9 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
         elif old is None or old.get("failed") or overwrite:
             _clear(stage)  # ours (locked, a record or a lock file), and not resumable
         else:
-            why = (
-                "a different config"
-                if old.get("config") != record["config"]
-                else "a different code version"
-            )
             raise ConfigError(
                 "--out",
-                f"{stage} holds an unfinished run of {why}; run that "
+                f"{stage} holds an unfinished run of {_differs(old, record)}; run that "
                 "command again to finish it, or use --overwrite to replace it",
             )
         for tmp in stage.rglob("*.tmp"):  # a write cut short by a kill
