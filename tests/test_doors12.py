@@ -21,7 +21,10 @@ a new user's first hour), one case each; each failed on the code before its fix.
   reported every study as FAILED (exit 1, and recorded so): now one line, exit 2;
 * ``--out`` naming another study's results said "holds results of a different config; use
   --overwrite", and --overwrite then replaced brown_table1's results with a network's: the
-  message names the other study (:func:`sim.mc.outputs._differs`).
+  message names the other study (:func:`sim.mc.outputs._differs`);
+* a name the figure font cannot draw (``network.name = "日本"``): matplotlib printed two
+  warning lines per character and draw; now one note naming the figure and the characters
+  (:func:`sim.report.plotting.save`).
 """
 
 import contextlib
@@ -36,6 +39,8 @@ import pytest
 from sim import batch, cli
 from sim.cli_args import module_doc
 from sim.mc.config import ConfigError, read_toml
+from sim.report.mpl import pyplot as plt
+from sim.report.plotting import save
 from sim.report.verify import main as verify_main
 
 STUDY = Path(__file__).resolve().parent.parent / "studies" / "network_plate.toml"
@@ -140,3 +145,12 @@ def test_another_studys_results_are_named_as_such(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "holds results of another study ('brown_table1'; this run is 'network')" in err, err
     assert "\n" not in err
+
+
+def test_characters_the_font_lacks_are_one_note(tmp_path, capsys):
+    fig = plt.figure()
+    fig.suptitle("日本 plate")
+    save(fig, tmp_path / "f.png")
+    err = capsys.readouterr().err.strip()
+    assert err == "sim: note: f.png: its font has no glyph for '日本' (drawn as boxes)", err
+    assert (tmp_path / "f.png").stat().st_size > 0
