@@ -34,9 +34,11 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from sim.threads import interrupt_while_loading, single_threaded_blas
+from sim.threads import interrupt_while_loading, refuse_bad_environment, single_threaded_blas
 
 _loaded = interrupt_while_loading("sim.batch")  # Ctrl-C during the imports: one line, exit 130
+if __name__ == "__main__":
+    refuse_bad_environment("sim.batch")  # a variable NumPy cannot load with: one line, exit 2
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 
 from sim.cli import DOC as cli_doc  # noqa: E402

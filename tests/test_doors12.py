@@ -24,7 +24,10 @@ a new user's first hour), one case each; each failed on the code before its fix.
   message names the other study (:func:`sim.mc.outputs._differs`);
 * a name the figure font cannot draw (``network.name = "日本"``): matplotlib printed two
   warning lines per character and draw; now one note naming the figure and the characters
-  (:func:`sim.report.plotting.save`).
+  (:func:`sim.report.plotting.save`);
+* ``SOURCE_DATE_EPOCH`` that is not an integer: every entry point ended in a traceback from
+  ``numpy.f2py`` while loading SciPy; now one line naming the variable, exit 2
+  (:func:`sim.threads.refuse_bad_environment`).
 """
 
 import contextlib
@@ -154,3 +157,10 @@ def test_characters_the_font_lacks_are_one_note(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err == "sim: note: f.png: its font has no glyph for '日本' (drawn as boxes)", err
     assert (tmp_path / "f.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("module", ["sim", "sim.batch", "sim.report.verify", "benchmarks"])
+def test_a_source_date_epoch_numpy_cannot_read_is_one_line(module):
+    p = _python("-m", module, "--help", env={"SOURCE_DATE_EPOCH": "garbage"})
+    err = p.stderr.strip()
+    assert p.returncode == 2 and "\n" not in err and "SOURCE_DATE_EPOCH" in err, err
