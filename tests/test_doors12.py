@@ -27,7 +27,12 @@ a new user's first hour), one case each; each failed on the code before its fix.
   (:func:`sim.report.plotting.save`);
 * ``SOURCE_DATE_EPOCH`` that is not an integer: every entry point ended in a traceback from
   ``numpy.f2py`` while loading SciPy; now one line naming the variable, exit 2
-  (:func:`sim.threads.refuse_bad_environment`).
+  (:func:`sim.threads.refuse_bad_environment`);
+* ``--out=~/x`` (the shell expands no ``~`` after ``=``) made a directory named ``~`` in
+  the working directory and said "results in ~/x/"; such a path is refused, naming why
+  (:func:`sim.mc.outputs.name_problem`);
+* a study file given as a directory or a pipe (``cat x.toml | sim check /dev/stdin``) was
+  "no such study file"; it is named for what it is (:func:`sim.mc.config.read_toml`).
 """
 
 import contextlib
@@ -164,3 +169,21 @@ def test_a_source_date_epoch_numpy_cannot_read_is_one_line(module):
     p = _python("-m", module, "--help", env={"SOURCE_DATE_EPOCH": "garbage"})
     err = p.stderr.strip()
     assert p.returncode == 2 and "\n" not in err and "SOURCE_DATE_EPOCH" in err, err
+
+
+def test_an_unexpanded_tilde_is_refused(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["run", str(STUDY), "--trials", "40", "--out=~/x"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("sim: error: --out: starts with '~'") and "\n" not in err, err
+    assert batch.main([str(STUDY), "--results=~/r"]) == 2
+    assert "--results: starts with '~'" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_study_file_that_is_a_directory_or_a_pipe_is_named(tmp_path):
+    with pytest.raises(ConfigError, match="is a directory, not a study file"):
+        read_toml(tmp_path)
+    os.mkfifo(tmp_path / "fifo.toml")
+    with pytest.raises(ConfigError, match="not a regular file"):
+        read_toml(tmp_path / "fifo.toml")

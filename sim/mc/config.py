@@ -259,6 +259,10 @@ MAX_STUDY_BYTES = 16 * 1024**2
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML study file; a missing, oversized or malformed file is a ConfigError."""
     p = Path(path)
+    if p.is_dir():  # both were "no such study file", of a file that is there
+        raise ConfigError(None, f"{p}: is a directory, not a study file")
+    if p.exists() and not p.is_file():  # a pipe (cat x.toml | sim check /dev/stdin), a device
+        raise ConfigError(None, f"{p}: not a regular file (a pipe or a device): name the file")
     if not p.is_file():
         raise ConfigError(None, f"{p}: no such study file")
     try:

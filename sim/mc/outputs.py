@@ -34,16 +34,21 @@ __all__ = [
 
 def name_problem(text: str) -> str | None:
     """Why a path given on the command line cannot name a file of the suite, in a few words
-    (None: it can): empty or blank, a control character or a line break, or bytes that are
-    not UTF-8 text (a Latin-1 name, or any non-ASCII name in a C locale without UTF-8 mode,
-    which Python keeps as surrogate escapes; the suite writes every path it records as UTF-8,
-    so such a run would fail at its end)."""
+    (None: it can): empty or blank, a control character or a line break, a leading ``~``
+    the shell left unexpanded, or bytes that are not UTF-8 text (a Latin-1 name, or any
+    non-ASCII name in a C locale without UTF-8 mode, which Python keeps as surrogate escapes;
+    the suite writes every path it records as UTF-8, so such a run would fail at its end)."""
     if not text.strip():
         return "is empty"
     if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text):
         return "contains a control character or a line break"
     if any(unicodedata.category(c) == "Cs" for c in text):
         return "contains bytes that are not UTF-8 text (a non-UTF-8 name or locale)"
+    if text.startswith("~"):  # --out=~/x: the shell expands no ~ after "=", and a directory
+        return (  # named "~" was made here, which "rm -rf ~" would then mistake for home
+            "starts with '~', which the shell did not expand (it does not after '='): use "
+            "$HOME, or a space for the '=' (./~ names a file that starts with ~)"
+        )
     return None
 
 
