@@ -32,7 +32,9 @@ a new user's first hour), one case each; each failed on the code before its fix.
   the working directory and said "results in ~/x/"; such a path is refused, naming why
   (:func:`sim.mc.outputs.name_problem`);
 * a study file given as a directory or a pipe (``cat x.toml | sim check /dev/stdin``) was
-  "no such study file"; it is named for what it is (:func:`sim.mc.config.read_toml`).
+  "no such study file"; it is named for what it is (:func:`sim.mc.config.read_toml`);
+* a key in another case (``--set TRIALS=40``) was "unknown key" with no guess
+  (:func:`sim.mc.config.did_you_mean`).
 """
 
 import contextlib
@@ -187,3 +189,9 @@ def test_a_study_file_that_is_a_directory_or_a_pipe_is_named(tmp_path):
     os.mkfifo(tmp_path / "fifo.toml")
     with pytest.raises(ConfigError, match="not a regular file"):
         read_toml(tmp_path / "fifo.toml")
+
+
+def test_a_key_in_another_case_gets_its_guess(capsys):
+    assert cli.main(["check", str(STUDY), "--set", "TRIALS=40"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "sim: error: TRIALS: unknown key (did you mean trials?)", err

@@ -190,11 +190,12 @@ def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
     unit suffix (``comparator.beta`` -> ``comparator.beta_mm``), the same last part under
     another table, or the closest spellings (difflib)."""
     names = list(schema)
+    same_case = [s for s in names if s.lower() == key.lower()]  # TRIALS: no guess before
     suffixed = [s for s in names if s.startswith(key + "_") and "." not in s[len(key) :]]
     last = key.split(".")[-1]
     same_last = [s for s in names if s.split(".")[-1] == last]
     close = difflib.get_close_matches(key, names, n=n, cutoff=0.75)
-    return list(dict.fromkeys(suffixed + same_last + close))[:n]
+    return list(dict.fromkeys(same_case + suffixed + same_last + close))[:n]
 
 
 def validate(
