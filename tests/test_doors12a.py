@@ -5,11 +5,17 @@ each failed on the code before its fix.
   over the chunks (brown_table1, brown_dilution, the network kind) passed ``sim check`` and
   stopped only at the end, after every trial; it is now refused when the study is loaded,
   naming ``chunk`` (or ``trials``). The studies that never call the jackknife still run with 2.
+* ``sim show`` / ``sim report`` on a table with a column dropped or retyped by hand said "a
+  table under DIR is not as sim wrote it" without naming the file (the error came from the
+  code reading a column); the reader now names the file (relative to DIR) and the column.
 """
 
 import re
+import shutil
 from pathlib import Path
 
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 
 from sim.cli import main
@@ -70,3 +76,33 @@ def test_one_chunk_short_is_refused_at_check_and_the_limit_passes(study, capsys)
             load_study(f, [f"trials={(need - 1) * chunk}", f"chunk={chunk}"])
         with pytest.raises(ConfigError, match=f"^trials: .*at least {need} trials"):
             load_study(f, [f"trials={need - 1}", "chunk=1"])
+
+
+@pytest.mark.parametrize(
+    "damage, what",
+    [
+        (lambda t: t.drop_columns(["fit_rms_um"]), "has no column 'fit_rms_um'"),
+        (
+            lambda t: t.set_column(
+                t.schema.get_field_index("fit_rms_um"),
+                "fit_rms_um",
+                t.column("fit_rms_um").cast(pa.string()),
+            ),
+            "column 'fit_rms_um'",
+        ),
+    ],
+    ids=["dropped", "retyped"],
+)
+def test_show_and_report_name_the_damaged_table_and_its_column(tmp_path, capsys, damage, what):
+    res = tmp_path / "res"
+    d = res / "wolf_polynomial"
+    shutil.copytree(ROOT / "results" / "wolf_polynomial", d, ignore=shutil.ignore_patterns("*.png"))
+    assert main(["show", str(d), "--markdown"]) == 0  # as sim wrote it: shown
+    capsys.readouterr()
+    f = d / "degree.parquet"
+    pq.write_table(damage(pq.read_table(f)), f)
+    _one_line(capsys, main(["show", str(d), "--markdown"]), "degree.parquet under", what)
+    _one_line(
+        capsys, main(["report", "--results", str(res)]), "wolf_polynomial/degree.parquet", what
+    )
+    assert not (res / "REPORT.md").exists()
