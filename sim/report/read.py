@@ -5,7 +5,7 @@ The report is built from the tables alone, so a table dropped, replaced or edite
 :func:`columns` and :func:`records` return the table as ``{column: values}`` or as rows, as
 ``pyarrow``'s ``to_pydict`` / ``to_pylist`` do, but:
 
-* a file that cannot be read raises :class:`TableError` naming the file;
+* a file that is not a Parquet table raises :class:`TableError` naming the file;
 * a column the report asks for and the table lacks raises :class:`TableError` naming the file
   and the column;
 * every column read is remembered (:func:`last_read`), so an error the report code raises
@@ -67,9 +67,11 @@ class Row(Columns):
 
 
 def _read(path: Path) -> pa.Table:
+    """The table; a file that is there but not Parquet raises :class:`TableError` (a missing
+    or unreadable one raises the OSError, which the command reports with its reason)."""
     try:
         return read_table(path)
-    except (OSError, pa.ArrowException) as e:
+    except pa.ArrowException as e:
         raise TableError(path, f"cannot be read ({str(e).splitlines()[0][:200]})") from None
 
 
