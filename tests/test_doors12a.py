@@ -8,21 +8,29 @@ each failed on the code before its fix.
 * ``sim show`` / ``sim report`` on a table with a column dropped or retyped by hand said "a
   table under DIR is not as sim wrote it" without naming the file (the error came from the
   code reading a column); the reader now names the file (relative to DIR) and the column.
+* ``sim/mc/estimate.py`` counted brown_design's largest ``design.grids`` as a Monte-Carlo chunk
+  of every part, and refused ``design.grids = [.., 29]`` as 254 GiB; each part is now counted
+  with its own geometry, the design grid as the analytic stack it is.
 """
 
 import re
 import shutil
+import tracemalloc
 from pathlib import Path
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
 from sim.cli import main
 from sim.mc.config import ConfigError
+from sim.mc.estimate import check_limits, estimate
 from sim.mc.registry import MODULES
 from sim.mc.runner import MIN_CHUNKS
 from sim.studies import load_study
+from sim.studies.design.cells import geometry_eval, plate_setup
+from sim.studies.design.chunks import design_chunk
 
 ROOT = Path(__file__).resolve().parent.parent
 #: one shipped study file per study kind
@@ -106,3 +114,55 @@ def test_show_and_report_name_the_damaged_table_and_its_column(tmp_path, capsys,
         capsys, main(["report", "--results", str(res)]), "wolf_polynomial/degree.parquet", what
     )
     assert not (res / "REPORT.md").exists()
+
+
+# --- brown_design's estimate: each part with its own geometry ----------------------------------
+
+
+def _design_cfg(*over):
+    return load_study(ROOT / "studies" / "brown_design.toml", list(over))[1]
+
+
+def test_the_design_grid_is_counted_as_the_analytic_stack_it_is():
+    """``design.grids = [.., 29]`` was refused as 254 GiB: the largest design grid was counted
+    as a chunk of 500 Monte-Carlo trials seen from the most positions. The design grid is
+    analytic: one (offsets x betas, 2n, 2n) cofactor stack per grid."""
+    est = estimate(_design_cfg("design.grids=[3, 4, 5, 6, 29]"))
+    check_limits(est)  # about 1.7 GiB, under the default 8 GiB
+    assert "29 x 29 points" in est.largest and est.bytes < 2 * 2**30
+    # a design grid really too big for the memory limit is still refused, naming the part
+    betas = "design.beta_mm=[0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]"
+    with pytest.raises(ConfigError, match=r"over the 8 GiB limit .*80 offset x beta geometries"):
+        check_limits(estimate(_design_cfg("design.grids=[5, 30]", betas)))
+
+
+def test_the_design_estimate_covers_what_the_analytic_grid_allocates():
+    """The estimate of the design grid's part is at least the peak that
+    :func:`sim.studies.design.cells.geometry_eval` allocates (tracemalloc), and not far above
+    it (a model, not a bound a run could exceed)."""
+    cfg = _design_cfg("design.grids=[5, 10]", "design.positions=[4]", "chunk=20")
+    est = estimate(cfg)
+    assert "10 x 10 points" in est.largest
+    tracemalloc.start()
+    try:
+        geometry_eval(cfg, 4, 10, 90.0, cfg["design.offsets_mm"], cfg["design.beta_mm"])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak <= est.bytes <= 2 * peak, (peak, est.bytes)
+
+
+def test_the_design_estimate_covers_what_a_monte_carlo_chunk_allocates():
+    """The paper's plate in chunks of 500 (the study file): the estimate is at least the peak
+    of one chunk of :func:`sim.studies.design.chunks.design_chunk`."""
+    cfg = _design_cfg()
+    est = estimate(cfg)
+    assert est.largest == "the Monte-Carlo check on the paper's plate"
+    pts, th = plate_setup(cfg, 4, 5, 90.0, 17.0, 1.0)
+    tracemalloc.start()
+    try:
+        design_chunk(pts, th, 1.0, np.random.default_rng(5), cfg["chunk"])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak <= est.bytes <= 8 * peak, (peak, est.bytes)
