@@ -11,6 +11,9 @@ each failed on the code before its fix.
 * ``sim/mc/estimate.py`` counted brown_design's largest ``design.grids`` as a Monte-Carlo chunk
   of every part, and refused ``design.grids = [.., 29]`` as 254 GiB; each part is now counted
   with its own geometry, the design grid as the analytic stack it is.
+* ``sim/mc/outputs.py``'s name-length check spelled the staging and swap directories' names
+  again; they are now made by one helper each (:func:`sim.mc.outputs.stage_dir`,
+  :func:`sim.mc.outputs.swap_dir`), which the run and the check both use.
 """
 
 import re
@@ -24,6 +27,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from sim.cli import main
+from sim.mc import outputs
 from sim.mc.config import ConfigError
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.registry import MODULES
@@ -166,3 +170,28 @@ def test_the_design_estimate_covers_what_a_monte_carlo_chunk_allocates():
     finally:
         tracemalloc.stop()
     assert peak <= est.bytes <= 8 * peak, (peak, est.bytes)
+
+
+# --- the staging names next to --out are made in one place -------------------------------------
+
+
+def test_the_name_check_measures_the_names_the_run_makes(tmp_path, monkeypatch):
+    """The name-length check and the run take the staging and swap names from the same
+    helpers: an ``--out`` whose longer one is one byte over the file system's limit is
+    refused, one at the limit passes; nothing is made."""
+    limit = 255
+    monkeypatch.setattr(outputs, "_name_max", lambda d: limit)
+    rec = {"config": {"study": "brown_table1"}}
+    r = tmp_path / "r"  # the bytes the longer name adds to a name: the pid's digits decide
+    extra = max(len(outputs.stage_dir(r).name), len(outputs.swap_dir(r).name)) - 1
+    for over in (1, 0):
+        out = tmp_path / ("r" * (limit + over - extra))
+        names = [outputs.stage_dir(out).name, outputs.swap_dir(out).name]
+        assert names[0] == f".{out.name}.partial" and names[1].startswith(f".{out.name}.old.")
+        assert max(len(n) for n in names) == limit + over
+        if over:
+            with pytest.raises(ConfigError, match="^--out: .*over the file system's 255"):
+                outputs.check_out(out, str(out), rec, overwrite=False)
+        else:
+            outputs.check_out(out, str(out), rec, overwrite=False)
+    assert list(tmp_path.iterdir()) == []
