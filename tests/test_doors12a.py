@@ -14,6 +14,9 @@ each failed on the code before its fix.
 * ``sim/mc/outputs.py``'s name-length check spelled the staging and swap directories' names
   again; they are now made by one helper each (:func:`sim.mc.outputs.stage_dir`,
   :func:`sim.mc.outputs.swap_dir`), which the run and the check both use.
+* brown_design's plates region: a corner of Zeiss points 13 mm from a station, under beta's
+  14.5 mm, is outside the region (Table 1's statements fail there), so no reading off the arm
+  is ever simulated; the test says why.
 """
 
 import re
@@ -26,7 +29,9 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from sim.claims.inference import FAILS, evaluate
 from sim.cli import main
+from sim.instruments.ranges import brown as B
 from sim.mc import outputs
 from sim.mc.config import ConfigError
 from sim.mc.estimate import check_limits, estimate
@@ -35,6 +40,8 @@ from sim.mc.runner import MIN_CHUNKS
 from sim.studies import load_study
 from sim.studies.design.cells import geometry_eval, plate_setup
 from sim.studies.design.chunks import design_chunk
+from sim.studies.design.external import zeiss_points
+from sim.studies.design.region import SIGMA0, TABLE1, ZEISS, table1_evidence
 
 ROOT = Path(__file__).resolve().parent.parent
 #: one shipped study file per study kind
@@ -195,3 +202,34 @@ def test_the_name_check_measures_the_names_the_run_makes(tmp_path, monkeypatch):
         else:
             outputs.check_out(out, str(out), rec, overwrite=False)
     assert list(tmp_path.iterdir()) == []
+
+
+# --- brown_design's plates region: every Zeiss reading is on the arm --------------------------
+
+
+def test_table1_keeps_the_plates_region_off_the_arms_unreachable_corner():
+    """Zeiss points at +-110 mm with stations 0.5 mm out are 13 mm from a station, under
+    beta's 14.5 mm maximum: a reading ``sqrt(d^2 - beta^2) - alpha`` there would be
+    imaginary or negative. The plates region never reaches that corner: plates are simulated
+    only where Table 1's printed statements hold, and they fail at every station offset the
+    corner needs. The Zeiss stand-in lies on the 1 cm lattice within +-110 mm (its half extent
+    is at most 115 mm), so the nearest point is at least ``d = 12.5 + o`` mm from a station
+    ``o`` mm outside the 245 mm format, and a reading needs ``d^2 >= beta^2 + alpha^2``: with
+    beta <= 14.5 mm, only ``o < sqrt(14.5^2 + alpha^2) - 12.5`` (2.01 mm at alpha 0.5 mm) can
+    miss the arm."""
+    cfg = _design_cfg()
+    assert np.abs(zeiss_points(cfg, ZEISS.high)).max() <= 110.0
+    alpha = cfg["comparator.alpha_mm"]
+    corner = np.hypot(B.SCALE_WIDTH_MM / 2, alpha) - (B.FORMAT_MM / 2 - 110.0)
+    assert 2.0 < corner < 2.1
+    o, b, s0 = (
+        a.ravel()
+        for a in np.meshgrid(
+            np.linspace(0.5, corner, 26),
+            np.linspace(0.0, B.SCALE_WIDTH_MM / 2, 30),
+            np.linspace(SIGMA0.low, SIGMA0.high, 5),
+            indexing="ij",
+        )
+    )
+    verdicts = evaluate(TABLE1, table1_evidence(o, b, s0, alpha), len(o))
+    assert (verdicts == FAILS).any(axis=1).all()  # no such point is in the region
