@@ -19,7 +19,7 @@ from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
 from sim.report.glance import by_paper, number, opening
 from sim.report.papers import paper_name
-from sim.report.read import records
+from sim.report.read import forget, records
 from sim.report.run_summary import headline_rows, write_run_readme
 from sim.report.tables import fmt, md_table
 from sim.report.verify import markdown as reproducibility_markdown
@@ -260,6 +260,7 @@ _RULES = (
 
 
 def _entry(d: Path, get_study: Callable) -> tuple:
+    forget()
     study, prov, claims = _claims_of(d, get_study)
     c = verdict_counts(claims)
     nr = d / "not_reproduced.parquet"

@@ -24,7 +24,7 @@ import pyarrow as pa
 
 from sim.mc.storage import read_table
 
-__all__ = ["TableError", "columns", "records", "last_read", "damaged_message"]
+__all__ = ["TableError", "columns", "records", "last_read", "forget", "damaged_message"]
 
 _LAST = threading.local()  # the (file, column) last read by this thread's report
 
@@ -44,6 +44,12 @@ def _note(path: Path, key: str) -> None:
 def last_read() -> tuple[Path, str] | None:
     """The ``(file, column)`` this thread's report read last, or None."""
     return getattr(_LAST, "where", None)
+
+
+def forget() -> None:
+    """Start a directory's report: no column read yet (an error before the first is not
+    blamed on another directory's table)."""
+    _LAST.where = None
 
 
 class Columns(dict):

@@ -17,7 +17,7 @@ from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.papers import paper_name
-from sim.report.read import columns, records
+from sim.report.read import columns, forget, records
 from sim.report.sweep import sweep_markdown
 from sim.report.tables import fmt
 
@@ -159,6 +159,7 @@ def run_markdown(out: Path, get_study: Callable) -> str:
     counts, the region line, then the study's own report section (claims, tables, figures:
     links relative to the directory) or the sweep's table."""
     out = Path(out)
+    forget()
     kind = _kind_of(out)
     src = out / ("claims.parquet" if kind == "study" else "sweep.parquet")
     prov = read_provenance(src)
