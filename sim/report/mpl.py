@@ -26,19 +26,20 @@ STYLE = {
     "svg.hashsalt": "sim",
 }
 
-_ready = threading.Lock()
-_done: list[bool] = []
+_lock = threading.Lock()  # brown_design draws its figures from threads
+_set_up = False
 
 
 def _setup() -> None:
     """Agg backend and :data:`STYLE`, once per process, before any matplotlib module loads."""
-    with _ready:
-        if not _done:
+    global _set_up
+    with _lock:
+        if not _set_up:
             import matplotlib  # heavy: loaded here, on a figure's first use
 
             matplotlib.use("Agg")
             matplotlib.rcParams.update(STYLE)
-            _done.append(True)
+            _set_up = True
 
 
 class lazy:
