@@ -40,6 +40,7 @@ from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
 from sim.report.markdown import write_report
+from sim.report.read import damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.studies import get_study, load_study
 
@@ -229,9 +230,8 @@ def _show(args) -> int:
 
 def _not_as_written(d: Path, e: Exception) -> str:
     """show and report read the Parquet tables only: one that fails to read as its study's
-    table was replaced or edited by hand."""
-    why = f"{type(e).__name__}: {e}".splitlines()[0][:240]
-    return f"a table under {d} is not as sim wrote it ({why}); run its study again"
+    table was replaced or edited by hand (named with its column by the reader)."""
+    return damaged_message(d, e)
 
 
 def _check_claims(f: Path) -> None:

@@ -22,7 +22,7 @@ import numpy as np
 
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
-from sim.mc.outputs import check_out, drop_stage, prepare_stage, publish, seal
+from sim.mc.outputs import check_out, drop_stage, prepare_stage, publish, seal, stage_dir
 from sim.mc.runner import ChunkStore, RunContext, make_executor
 from sim.mc.storage import (
     code_hash,
@@ -143,7 +143,7 @@ def execute(
         **({} if figures else {"figures": False}),
     }
     check_out(out, shown, record, overwrite)
-    stage = out.parent / f".{out.name}.partial"
+    stage = stage_dir(out)
     try:
         ex = make_executor(executor, workers, scheduler)
     except (RuntimeError, OSError, TimeoutError, ValueError, TypeError) as e:

@@ -117,9 +117,10 @@ def tiny_run(tmp_path_factory):
     (and every ``pytest -n`` process: a directory of the session's base, a lock per run, a
     failure recorded once). Without options, every figure's layout check and facts are
     written to ``<dir>.figures.jsonl`` (``SIM_FIGURE_CHECK``, :func:`sim.report.plotting.save`:
-    the check runs after the PNG is written and leaves it as it is). ``elsewhere=True``: on 2
-    workers on another numerical path (:data:`ELSEWHERE`) and without figures (``--no-figures``:
-    its tables are compared, and the figures are drawn by the run on the usual path).
+    the check runs after the PNG is written and leaves it as it is). With options, and with
+    ``elsewhere=True`` (on 2 workers on another numerical path, :data:`ELSEWHERE`), the run
+    draws no figures (``--no-figures``): its tables are compared, and the figures are drawn by
+    the plain run.
     READ ONLY: a test that edits a file copies it first."""
     base = tmp_path_factory.getbasetemp()
     cache = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "tiny-runs"
@@ -133,8 +134,9 @@ def tiny_run(tmp_path_factory):
         env = dict(os.environ)
         if elsewhere:
             env.update(ELSEWHERE)
+        if elsewhere or options:  # tables only: the figures are the plain run's
             options = (*options, "--no-figures")
-        elif not options:
+        else:
             env.update(SIM_FIGURE_CHECK=str(cache / f"{key}.figures.jsonl"))
         with open(cache / f"{key}.lock", "w") as lock:
             fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes

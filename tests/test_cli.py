@@ -244,7 +244,7 @@ def test_an_empty_directory_and_our_own_results_are_replaced(tmp_path):
         (["--workers", "0"], "--workers"),
         (["--scheduler", "not an address", "--executor", "dask"], "--scheduler"),
         (["--scheduler", "tcp://127.0.0.1:8786"], "needs --executor dask"),
-        (["--trials", "20", "--set", "chunk=20"], "at least 2 chunks"),
+        (["--trials", "20", "--set", "chunk=20"], "need at least 20"),
         (["--max-memory-gb", "nan"], "--max-memory-gb"),
         (["--bogus"], "unrecognized arguments"),
     ],

@@ -1,7 +1,9 @@
 """Staleness per study: a study's code hash covers the modules it imports, and only those."""
 
+import ast
 from pathlib import Path
 
+from sim.mc import codehash
 from sim.mc.codehash import study_files
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -83,3 +85,23 @@ def test_import_lines_are_read_in_every_form(tmp_path, monkeypatch):
         "sim.mc",
         "sim.mc.storage",
     }
+
+
+def test_the_statement_walk_finds_every_import_node():
+    """``_statements`` (the code hash's import finder) yields the import nodes ``ast.walk``
+    finds, in every file of ``sim/`` and in a module that imports in every kind of block."""
+    nested = (
+        "import sim.a\ndef f():\n    import sim.b\nclass C:\n    def g(self):\n"
+        "        from sim import c\nif x:\n    pass\nelse:\n    import sim.d\n"
+        "try:\n    pass\nexcept E:\n    import sim.e\nfinally:\n    import sim.f\n"
+        "for i in y:\n    pass\nelse:\n    import sim.g\nwith z:\n    import sim.h\n"
+        "match v:\n    case 1:\n        import sim.i\n"
+    )
+    sources = [nested] + [p.read_text() for p in (ROOT / "sim").rglob("*.py")]
+    for src in sources:
+        tree = ast.parse(src)
+        kinds = (ast.Import, ast.ImportFrom)
+        walked = [n for n in ast.walk(tree) if isinstance(n, kinds)]
+        ours = [n for n in codehash._statements(tree.body) if isinstance(n, kinds)]
+        assert {id(n) for n in ours} == {id(n) for n in walked}
+    assert len([n for n in ast.walk(ast.parse(nested)) if isinstance(n, ast.Import)]) == 8

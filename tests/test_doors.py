@@ -54,7 +54,7 @@ def test_load_names_a_bad_study_file_argument(bad):
     ],
 )
 def test_run_names_a_bad_argument(tmp_path, kw, key):
-    st = sim.load(STUDY, trials=20, chunk=10)
+    st = sim.load(STUDY, trials=20, chunk=1)
     with pytest.raises(ConfigError, match=f"^{key}"):
         st.run(**({"out": tmp_path / "o"} | kw))
     assert not (tmp_path / "o").exists()

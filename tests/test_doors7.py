@@ -72,7 +72,7 @@ def test_api_trials_picks_the_chunk_as_sim_run_trials_does(capsys):
     MIN_CHUNKS chunks); ``sim.load(f, trials=40)`` and ``.run(trials=40)`` refused it."""
     assert sim.load(NETWORK, trials=40).config["chunk"] == 2
     assert sim.load(NETWORK, trials=400).config["chunk"] == 20
-    assert sim.load(NETWORK, trials=40, chunk=4).config["chunk"] == 4
+    assert sim.load(NETWORK, trials=40, chunk=1).config["chunk"] == 1
     assert sim.load(NETWORK, trials=4000).config["chunk"] == 100  # the file's, small enough
     assert main(["check", str(NETWORK), "--set", "trials=40"]) == 0
     assert "\nchunk = 2 " in capsys.readouterr().out

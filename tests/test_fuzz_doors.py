@@ -38,7 +38,7 @@ BAD = {
 @pytest.mark.parametrize("case", range(CASES))
 def test_api_arguments(tmp_path, case):
     rng = np.random.default_rng([20261126, case])
-    st = sim.load(STUDY, trials=20, chunk=10)
+    st = sim.load(STUDY, trials=20, chunk=1)
     key = sorted(BAD)[rng.integers(len(BAD))]
     value = BAD[key][rng.integers(len(BAD[key]))]
     kw = {"out": tmp_path / "o", key: value}

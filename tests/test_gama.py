@@ -383,7 +383,7 @@ def test_sim_check_on_a_fifo_is_one_line_not_a_hang(tmp_path):
     os.mkfifo(fifo)
     study_file = tmp_path / "s.toml"
     study_file.write_text(
-        f'study = "network"\ntrials = 200\nchunk = 50\n[network]\ngama_xml = "{fifo}"\n'
+        f'study = "network"\ntrials = 200\nchunk = 10\n[network]\ngama_xml = "{fifo}"\n'
     )
     r = subprocess.run(
         [sys.executable, "-m", "sim", "check", str(study_file)],
@@ -402,7 +402,7 @@ def test_an_edited_gama_file_changes_the_resolved_config(tmp_path):
     path.write_text((DATA / "two_sets.xml").read_text())
     study_file = tmp_path / "s.toml"
     study_file.write_text(
-        f'study = "network"\ntrials = 200\nchunk = 50\n[network]\ngama_xml = "{path}"\n'
+        f'study = "network"\ntrials = 200\nchunk = 10\n[network]\ngama_xml = "{path}"\n'
     )
     _, c1 = load_study(study_file)
     assert len(c1["network.gama_sha256"]) == 64
@@ -586,7 +586,7 @@ def test_fuzzed_gama_files_give_a_network_or_one_config_error(case, tmp_path):
     base = tmp_path / "s.toml"
     path = tmp_path / "m.xml"
     base.write_text(
-        f'study = "network"\ntrials = 200\nchunk = 50\n[network]\ngama_xml = "{path}"\n'
+        f'study = "network"\ntrials = 200\nchunk = 10\n[network]\ngama_xml = "{path}"\n'
     )
     outcomes = {"ok": 0, "refused": 0}
     for _ in range(60):

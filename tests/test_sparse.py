@@ -43,7 +43,7 @@ def trilateration(tmp_path, n=6, kind="inner", extra=""):
     """A jittered n x n trilateration grid, 8 nearest neighbours, in ``kind`` datum."""
     f = tmp_path / "tri.toml"
     f.write_text(
-        'study = "network"\ntrials = 40\nchunk = 20\nseed = 5\n[network]\n'
+        'study = "network"\ntrials = 40\nchunk = 2\nseed = 5\n[network]\n'
         f'random = [ {{ prefix = "P", n = {n * n}, half_extent_mm = 5000.0 }} ]\n'
         'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 8, '
         'sigma_mm = 1.0 }, { kind = "direction", from = "P1*", to = "P*", nearest = 4, '
@@ -271,7 +271,7 @@ def test_the_issue_network_that_counts_refused_now_checks(tmp_path):
     nearest applied): it checks, on the sparse path."""
     f = tmp_path / "g.toml"
     f.write_text(
-        'study = "network"\ntrials = 40\nchunk = 20\n[network]\n'
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\n'
         'grids = [ { prefix = "P", nx = 20, ny = 20, spacing_mm = 1000.0 } ]\n'
         'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 8, '
         'sigma_mm = 1.0 } ]\n[datum]\nkind = "inner"\n'
@@ -320,7 +320,7 @@ def test_the_estimate_counts_nonzeros_and_bounds_a_network_by_memory(tmp_path, m
         check_limits(estimate(big))
     f = tmp_path / "huge.toml"
     f.write_text(
-        'study = "network"\ntrials = 4\nchunk = 2\n[network]\n'
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\n'
         'grids = [ { prefix = "P", nx = 100000, ny = 100000, spacing_mm = 1.0 } ]\n'
         'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 4, '
         "sigma_mm = 1.0 } ]\n"
@@ -343,7 +343,7 @@ def test_large_network_keeps_the_datum_semantics_on_the_sparse_path(tmp_path, mo
     bound). The redundancy numbers ``1 - a' Q a`` (``a' Q a`` at most 1) take the same bound."""
     f = tmp_path / "dir.toml"
     f.write_text(
-        'study = "network"\ntrials = 40\nchunk = 20\nseed = 3\n[network]\n'
+        'study = "network"\ntrials = 40\nchunk = 2\nseed = 3\n[network]\n'
         'points = [ { name = "F", x_mm = 0.0, y_mm = 0.0, role = "fixed" } ]\n'
         'random = [ { prefix = "P", n = 225, half_extent_mm = 20000.0 } ]\n'
         'generate = [ { kind = "direction", from = "*", to = "*", nearest = 6, '

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import ast
 import hashlib
+from collections.abc import Iterator
 from functools import lru_cache
 from pathlib import Path
 
@@ -54,6 +55,16 @@ def _module_name(f: Path) -> str:
     return ".".join(parts)
 
 
+def _statements(body: list) -> Iterator[ast.AST]:
+    """Every statement of ``body`` and of the blocks nested in it (functions, classes, ``if``,
+    ``try``, ``with``, loops, ``match``): an import is a statement, so this finds every import
+    node ``ast.walk`` would, without visiting the expressions (most of a module's nodes)."""
+    for node in body:
+        yield node
+        for block in ("body", "orelse", "finalbody", "handlers", "cases"):
+            yield from _statements(getattr(node, block, None) or [])
+
+
 def _imports(f: Path) -> set[str]:
     """Absolute names of the ``sim`` modules ``f`` imports (``from . import x`` included, and
     imports inside functions): every ``import`` node of the parsed source."""
@@ -61,7 +72,7 @@ def _imports(f: Path) -> set[str]:
     if f.name != "__init__.py":
         pkg = pkg[:-1]
     out: set[str] = set()
-    for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"), str(f))):
+    for node in _statements(ast.parse(f.read_text(encoding="utf-8"), str(f)).body):
         if isinstance(node, ast.Import):
             out.update(a.name for a in node.names)
         elif isinstance(node, ast.ImportFrom):

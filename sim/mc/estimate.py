@@ -53,6 +53,7 @@ class Estimate:
     unknowns: int  # unknowns of the largest adjustment
     bytes: float  # largest working set of one chunk, bytes
     cells: int = 1  # sweep cells x replicates
+    largest: str = ""  # the part whose chunk (or analytic stack) needs ``bytes``, if named
 
     def describe(self, workers: int = 1) -> str:
         """One line: trials, adjustments, unknowns and the memory of ``workers`` processes."""
@@ -113,7 +114,27 @@ def _brown(c: Mapping) -> tuple:
     return T, T * per + analytic, max(U, 2 * n_an + 7), b
 
 
+#: float64 values a brown_design Monte-Carlo chunk holds per range of a trial (measured with
+#: tracemalloc: about 30-100 for the P-position solver and 50-100 for the 4-station one)
+DESIGN_RANGE_VALUES = 128
+#: copies of the (geometries, 2n, 2n) cofactor stack the analytic design grid holds at its
+#: peak (measured: 4.07 x for grids of 10 and 15 points per side, any number of positions)
+DESIGN_COFACTOR_COPIES = 5.0
+
+
+def _design_mc(ch: float, P: float, n: float) -> float:
+    """Bytes of one Monte-Carlo chunk of ``ch`` trials of ``n`` points seen from ``P``
+    positions: the per-range arrays of every trial, and the (2n, 2n) inner-datum matrix and
+    its product, once per chunk."""
+    return ch * P * n * DESIGN_RANGE_VALUES * F8 + 2 * (2 * n) ** 2 * F8
+
+
 def _design(c: Mapping) -> tuple:
+    """brown_design, each part with its own geometry: the Monte-Carlo check, the error budget
+    and the posterior on the paper's plate (``paper.positions`` x ``paper.grid``), the
+    coverage on 4 stations over ``coverage.grids`` and ``datum.grid``; the design grid
+    (``design.*``) is analytic, one (geometries, 2n, 2n) cofactor stack per grid, the
+    geometries its offsets x betas, not a chunk of trials."""
     lists = [
         c.get(f"design.{k}", [1])
         for k in (
@@ -127,7 +148,7 @@ def _design(c: Mapping) -> tuple:
         )
     ]
     cells = math.prod(max(len(v), 1) for v in lists)
-    P, G = _max(c.get("design.positions"), 4), _max(c.get("design.grids"), 5)
+    G = _max(c.get("design.grids"), 5)
     n = G * G
     U = 2 * n + 7
     T, ch = c["trials"], min(c["chunk"], c["trials"])
@@ -141,9 +162,19 @@ def _design(c: Mapping) -> tuple:
     bayes = c.get("bayes.walkers", 0) * c.get("bayes.steps", 0) * 2
     trials = T + cov_T + sw_T + budget
     adj = cells * 3 + T * 3 + cov_T * 2 + sw_T * 2 + budget + bayes
-    nc = max(_max(c.get("coverage.grids"), 5) ** 2, c.get("datum.grid", 5) ** 2, n)
-    b = ch * P * nc * (2 * nc + 7) * F8 * COPIES
-    return trials, adj, max(U, 2 * int(nc) + 7), b
+    n_paper = c.get("paper.grid", 5) ** 2
+    nc = max(_max(c.get("coverage.grids"), 5) ** 2, c.get("datum.grid", 5) ** 2)
+    geometries = _n(c.get("design.offsets_mm", [1])) * _n(c.get("design.beta_mm", [1]))
+    parts = {
+        "the Monte-Carlo check on the paper's plate": _design_mc(
+            ch, c.get("paper.positions", 4), n_paper
+        ),
+        "the coverage": _design_mc(ch, 4, nc),
+        f"the analytic design grid ({int(geometries)} offset x beta geometries of {int(G)} x "
+        f"{int(G)} points)": DESIGN_COFACTOR_COPIES * geometries * (2 * n) ** 2 * F8,
+    }
+    what = max(parts, key=parts.get)
+    return trials, adj, max(U, 2 * int(max(nc, n_paper)) + 7), parts[what], what
 
 
 def _gridplate(c: Mapping) -> tuple:
@@ -361,13 +392,14 @@ ESTIMATORS: dict[str, Callable[[Mapping], tuple]] = {
 
 
 def _one(cfg: Mapping) -> tuple:
+    """``(trials, adjustments, unknowns, bytes, the part needing the bytes or "")``."""
     fn = ESTIMATORS.get(cfg.get("study"), _generic)
     try:
-        t, a, u, b = fn(cfg)
+        t, a, u, b, *what = fn(cfg)
     except (TypeError, ValueError, KeyError, OverflowError, ZeroDivisionError):
-        t, a, u, b = _generic(cfg)
+        t, a, u, b, *what = _generic(cfg)
     fix = lambda x: x if isinstance(x, (int, float)) and not math.isnan(x) else math.inf  # noqa: E731
-    return fix(t), fix(a), fix(u), fix(b)
+    return fix(t), fix(a), fix(u), fix(b), (what or [""])[0]
 
 
 def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> Estimate:
@@ -381,9 +413,11 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
     T = sum(p[0] for p in parts) * reps
     A = sum(p[1] for p in parts) * reps
     U = max(p[2] for p in parts)
-    B = max(p[3] for p in parts)
+    B, what = max((p[3], p[4]) for p in parts)
     big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
-    return Estimate(str(cfg.get("study")), big(T), float(A), big(U), float(B), len(cfgs) * reps)
+    return Estimate(
+        str(cfg.get("study")), big(T), float(A), big(U), float(B), len(cfgs) * reps, what
+    )
 
 
 def _limit(given: float | None, env: str, default: float, key: str) -> float:
@@ -417,8 +451,9 @@ def check_limits(
         raise ConfigError(
             None,
             f"{est.study}: the run needs {est.describe(workers)}, over the "
-            f"{mem:g} GiB limit (--max-memory-gb or SIM_MAX_MEMORY_GB); reduce "
-            "chunk, trials or the sizes in the study file",
+            f"{mem:g} GiB limit (--max-memory-gb or SIM_MAX_MEMORY_GB)"
+            + (f", most of it for {est.largest}" if est.largest else "")
+            + "; reduce chunk, trials or the sizes in the study file",
         )
     if not est.adjustments <= adj:
         raise ConfigError(

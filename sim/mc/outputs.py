@@ -29,6 +29,8 @@ __all__ = [
     "publish",
     "damaged_chunks",
     "name_problem",
+    "stage_dir",
+    "swap_dir",
 ]
 
 
@@ -63,11 +65,27 @@ def _name_max(d: Path) -> int:
     return 255
 
 
+STAGE_SUFFIX = ".partial"
+
+
+def stage_dir(out: Path) -> Path:
+    """The run's staging directory next to ``out``: ``.<name>.partial`` (resumed after a kill)."""
+    return out.parent / f".{out.name}{STAGE_SUFFIX}"
+
+
+def swap_dir(out: Path) -> Path:
+    """Where :func:`publish` moves the old results of ``out`` while it swaps the new ones in:
+    ``.<name>.old.<pid>``."""
+    return out.parent / f".{out.name}.old.{os.getpid()}"
+
+
 def _check_name_length(out: Path, shown: str) -> None:
-    """The run works next to ``out`` in ``.<name>.partial`` and swaps the old results through
-    ``.<name>.old.<pid>``: both names must fit the file system (a study file name of 247
+    """The run works next to ``out`` in :func:`stage_dir` and swaps the old results through
+    :func:`swap_dir`: both names must fit the file system (a study file name of 247
     characters passed, then failed naming the staging directory)."""
-    longest = len(f".{out.name}.old.{os.getpid()}".encode("utf-8", "surrogateescape"))
+    longest = max(
+        len(d.name.encode("utf-8", "surrogateescape")) for d in (stage_dir(out), swap_dir(out))
+    )
     limit = _name_max(out.parent)
     if longest > limit:
         raise ConfigError(
@@ -130,7 +148,7 @@ def _check_not_nested(out: Path, shown: str) -> None:
     for up in out.parents:
         if up == up.parent:
             break
-        if (up / "run.json").is_file() or up.name.endswith(".partial") or up.name == "trials":
+        if (up / "run.json").is_file() or up.name.endswith(STAGE_SUFFIX) or up.name == "trials":
             raise ConfigError(
                 "--out",
                 f"{shown} lies inside {up}, which belongs to another run; choose a directory "
@@ -383,7 +401,7 @@ def publish(stage: Path, out: Path) -> None:
         )
     for f in keep:
         _carry(out / f, stage / f)
-    old = out.parent / f".{out.name}.old.{os.getpid()}"
+    old = swap_dir(out)
     if out.exists():
         os.replace(out, old)
     os.replace(stage, out)

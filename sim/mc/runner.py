@@ -38,7 +38,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.lsq import distributions as D
-from sim.mc.config import StudyError
+from sim.mc.config import ConfigError, StudyError
 from sim.mc.executors import InProcess, make_executor
 from sim.mc.progress import Progress
 from sim.mc.storage import atomic_path, config_hash
@@ -51,6 +51,7 @@ __all__ = [
     "make_executor",
     "jackknife",
     "require_finite",
+    "require_chunks",
     "MIN_CHUNKS",
 ]
 
@@ -77,6 +78,28 @@ def require_finite(name: str, array, part: str, key: str | None = None) -> np.nd
             f"NaN or infinite){hint}"
         )
     return a
+
+
+def require_chunks(cfg: Mapping, need: int = MIN_CHUNKS, use: str = "jackknife intervals") -> None:
+    """Refuse, at load time, a config whose ``trials`` in chunks of ``chunk`` give fewer than
+    ``need`` chunks (:class:`sim.mc.config.ConfigError`, one line naming ``chunk``, or
+    ``trials`` when no chunk size can give enough). A study whose results call
+    :func:`jackknife` on the chunks of its ``trials``/``chunk`` run calls it from its schema's
+    ``check`` (brown_table1, brown_dilution, network): without it a run of too few chunks
+    computed every trial and then failed in :func:`jackknife`. ``need >= 2``."""
+    trials, chunk = cfg["trials"], cfg["chunk"]
+    have = -(-trials // chunk)
+    if have >= need:
+        return
+    if trials < need:  # chunk = 1 gives `trials` chunks: only more trials help
+        fix = f"give at least {need} trials (one per chunk)"
+    else:  # the largest chunk c with ceil(trials / c) >= need
+        fix = f"make chunk at most {-(-trials // (need - 1)) - 1}"
+    raise ConfigError(
+        "trials" if trials < need else "chunk",
+        f"{trials:,} trials in chunks of {chunk:,} give {have} chunk{'s' * (have != 1)}; "
+        f"this study's {use} are taken over chunks and need at least {need}: {fix}",
+    )
 
 
 @dataclass(frozen=True)

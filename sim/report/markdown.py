@@ -19,6 +19,7 @@ from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
 from sim.report.glance import by_paper, number, opening
 from sim.report.papers import paper_name
+from sim.report.read import forget, records
 from sim.report.run_summary import headline_rows, write_run_readme
 from sim.report.tables import fmt, md_table
 from sim.report.verify import markdown as reproducibility_markdown
@@ -74,7 +75,7 @@ def claims_markdown(path: Path) -> str:
     for (rounding widened by the claim's tolerance), the simulated value, its 95 % interval
     (``plates``: the spread of a one-plate statistic, with ``p`` the probability of a plate at
     least as extreme as the paper's), the verdict and its kind."""
-    t = read_table(path).to_pylist()
+    t = records(path)
     rows = []
     for r in t:
         if r["verdict"] == "not comparable":
@@ -111,7 +112,7 @@ def claims_markdown(path: Path) -> str:
     )
     nr = Path(path).with_name("not_reproduced.parquet")
     if nr.is_file():
-        n = read_table(nr).to_pylist()
+        n = records(nr)
         if n:
             out += "\n\nPrinted numbers not reproduced:\n\n" + md_table(
                 ["source", "printed", "why not"], [[x["source"], x["printed"], x["why"]] for x in n]
@@ -228,7 +229,7 @@ def _claims_of(d: Path, get_study: Callable):
     f = d / "claims.parquet"
     try:
         prov = read_provenance(f) or {}
-        claims = read_table(f).to_pylist()
+        claims = records(f)
     except (OSError, ValueError, pa.ArrowException) as e:
         raise ConfigError("--results", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
     if "study" not in prov or (claims and not {"claim", "verdict"} <= set(claims[0])):
@@ -259,6 +260,7 @@ _RULES = (
 
 
 def _entry(d: Path, get_study: Callable) -> tuple:
+    forget()
     study, prov, claims = _claims_of(d, get_study)
     c = verdict_counts(claims)
     nr = d / "not_reproduced.parquet"

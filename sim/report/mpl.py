@@ -27,8 +27,8 @@ STYLE = {
     "svg.hashsalt": "sim",
 }
 
-_ready = threading.Lock()
-_done: list[bool] = []
+_lock = threading.Lock()  # brown_design draws its figures from threads
+_set_up = False
 
 
 def _setup() -> None:
@@ -36,8 +36,9 @@ def _setup() -> None:
     The user's ``MPLBACKEND`` is set aside while matplotlib loads (and put back): the suite
     draws only PNG files through Agg, and a value matplotlib does not know (``nosuch``)
     failed a run at its first figure, after every trial was computed."""
-    with _ready:
-        if not _done:
+    global _set_up
+    with _lock:
+        if not _set_up:
             backend = os.environ.pop("MPLBACKEND", None)
             try:
                 import matplotlib  # heavy: loaded here, on a figure's first use
@@ -46,7 +47,7 @@ def _setup() -> None:
                     os.environ["MPLBACKEND"] = backend
             matplotlib.use("Agg")
             matplotlib.rcParams.update(STYLE)
-            _done.append(True)
+            _set_up = True
 
 
 class lazy:

@@ -180,8 +180,9 @@ def layout_problems(fig) -> list[str]:
       over markers or cut off, tiny fonts, ASCII units, tick labels with too many digits,
       comb histograms, pale or look-alike legend colours.
 
-    Empty when the figure reads cleanly. Draws the figure once (no file is written)."""
-    fig.canvas.draw()
+    Empty when the figure reads cleanly. Lays the figure out once, without rasterising it (no
+    file is written: every check reads the artists' boxes, not pixels)."""
+    fig.draw_without_rendering()
     renderer = fig.canvas.get_renderer()
     drawn = _texts(fig, renderer)
     texts = [(w, t.get_window_extent(renderer), r) for w, t, r in drawn]

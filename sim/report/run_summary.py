@@ -17,6 +17,7 @@ from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.papers import paper_name
+from sim.report.read import columns, forget, records
 from sim.report.sweep import sweep_markdown
 from sim.report.tables import fmt
 
@@ -102,11 +103,11 @@ def terminal_summary(out: Path, n: int = 5, shown: str | None = None) -> str:
     (under ``shown``, the directory as the user named it, if given)."""
     out = Path(out)
     if _kind_of(out) == "sweep":
-        t = read_table(out / "sweep.parquet").to_pydict()
+        t = columns(out / "sweep.parquet")
         ok = sum(bool(f) for f in t.get("feasible", []))
         lines = [f"sweep: {ok} of {len(t.get('feasible', []))} cells ran"]
     else:
-        claims = read_table(out / "claims.parquet").to_pylist()
+        claims = records(out / "claims.parquet")
         lines = [verdict_line(claims)]
         for r in headline_rows(claims, n):
             ci = _interval(r)
@@ -125,13 +126,13 @@ def terminal_table(out: Path, width: int = 100) -> str:
     interval, verdict), then the counts; a sweep directory as its cells."""
     out = Path(out)
     if _kind_of(out) == "sweep":
-        t = read_table(out / "sweep.parquet").to_pydict()
+        t = columns(out / "sweep.parquet")
         rows = [
             [t["label"][i], "yes" if t["feasible"][i] else f"no: {t['reason'][i]}"]
             for i in range(len(t["label"]))
         ]
         return _text_table(["cell", "feasible"], rows, width)
-    claims = read_table(out / "claims.parquet").to_pylist()
+    claims = records(out / "claims.parquet")
     rows = [[r["claim"], _value_text(r), _interval(r), r["verdict"]] for r in claims]
     table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
     return table + "\n\n" + verdict_line(claims)
@@ -158,6 +159,7 @@ def run_markdown(out: Path, get_study: Callable) -> str:
     counts, the region line, then the study's own report section (claims, tables, figures:
     links relative to the directory) or the sweep's table."""
     out = Path(out)
+    forget()
     kind = _kind_of(out)
     src = out / ("claims.parquet" if kind == "study" else "sweep.parquet")
     prov = read_provenance(src)
@@ -175,7 +177,7 @@ def run_markdown(out: Path, get_study: Callable) -> str:
     if kind == "sweep":
         body = sweep_markdown(out, ".")
     else:
-        claims = read_table(src).to_pylist()
+        claims = records(src)
         head += [f"**Verdicts:** {verdict_line(claims)}.", ""]
         if (reg := region_line(out)) is not None:
             head += [reg[0].upper() + reg[1:] + ".", ""]

@@ -33,8 +33,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from sim.mc.storage import read_provenance, read_table
+from sim.mc.storage import read_provenance
 from sim.report.markdown import claims_markdown, inputs_markdown
+from sim.report.read import columns, records
 from sim.report.tables import fmt, md_table
 
 __all__ = [
@@ -53,13 +54,15 @@ __all__ = [
 
 
 def table(out: Path, name: str) -> dict[str, list]:
-    """The columns of ``out/name`` (a Parquet table the study wrote)."""
-    return read_table(Path(out) / name).to_pydict()
+    """The columns of ``out/name`` (a Parquet table the study wrote); a missing file or
+    column raises :class:`sim.report.read.TableError` naming it."""
+    return columns(Path(out) / name)
 
 
 def rows(out: Path, name: str) -> list[dict[str, Any]]:
-    """The rows of ``out/name`` (a Parquet table the study wrote)."""
-    return read_table(Path(out) / name).to_pylist()
+    """The rows of ``out/name`` (a Parquet table the study wrote); a missing file or column
+    raises :class:`sim.report.read.TableError` naming it."""
+    return records(Path(out) / name)
 
 
 def config(out: Path) -> dict[str, Any]:

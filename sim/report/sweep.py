@@ -8,8 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.mc.storage import read_provenance, read_table
+from sim.mc.storage import read_provenance
 from sim.report.plotting import place_legend, plt, readable_limits, save
+from sim.report.read import columns
 from sim.report.tables import fmt, md_table
 
 __all__ = ["fig_sweep", "sweep_markdown"]
@@ -70,7 +71,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     is drawn at one place per distinct value, its ticks labelled with the values; long
     labels are shortened. Drawn from the rows of ``sweep.parquet`` alone."""
 
-    t = read_table(path).to_pydict()
+    t = columns(path)
     keys = read_provenance(path).get("sweep_keys", [])
     claims = _claim_columns(t, keys)[:max_panels]
     if not keys or not claims:
@@ -133,7 +134,7 @@ def sweep_markdown(out: Path, name: str | None = None) -> str:
     """Markdown for a sweep directory from ``sweep.parquet`` alone: the cells with their
     feasibility and claim values, and the figure (for ``sim report``)."""
 
-    t = read_table(Path(out) / "sweep.parquet").to_pydict()
+    t = columns(Path(out) / "sweep.parquet")
     keys = read_provenance(Path(out) / "sweep.parquet").get("sweep_keys", [])
     claims = _claim_columns(t, keys)
     rows = [

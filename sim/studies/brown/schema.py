@@ -12,7 +12,7 @@ from sim.instruments.ranges import multilateration as ml
 from sim.instruments.ranges import positions as po
 from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
 from sim.mc.config import COMMON, ConfigError, Field
-from sim.mc.runner import chunk_rng
+from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
 from sim.mc.schema_helpers import count, counts, positive, real
 from sim.studies.brown.values import thetas
 
@@ -25,6 +25,12 @@ MIN_RANGE_SIGMA_UM = 1e-6
 
 BASE = {
     **COMMON,
+    "chunk": count(
+        200,
+        f"trials per chunk (the jackknife intervals are over chunks: >= {MIN_CHUNKS} chunks)",
+        lo=1,
+        hi=1_000_000,
+    ),
     "plate.format_mm": real(245.0, "side of the square plate format", lo=1.0, unit="mm"),
     "plate.pattern": Field("grid", "str", "point pattern", choices=("grid", "random", "list")),
     "plate.grid": count(5, "points per side of the grid pattern", lo=2, hi=200),
@@ -188,7 +194,9 @@ def check_extents(cfg: dict) -> None:
 
 def check(cfg: dict) -> None:
     """Cross-key rules: a range sigma the model can divide by, points inside the format,
-    enough points, no duplicates/collinearity, every range on the scale."""
+    enough points, no duplicates/collinearity, every range on the scale, and the chunks the
+    Monte-Carlo agreement rows' jackknife intervals need (:func:`sim.studies.brown.core.MC.jack`:
+    at least :data:`sim.mc.runner.MIN_CHUNKS`)."""
     if range_sigma_um(cfg) < MIN_RANGE_SIGMA_UM:
         # (tenth sweep) errors.setting_sigma_um = 5e-324 without a comparator error passed
         # check; the run's ratios to the range sigma were NaN, its claims not finite
@@ -254,6 +262,7 @@ def check(cfg: dict) -> None:
                 f"reads 0 to {reach:g} mm (move the stations in, or use alpha)",
             )
     check_pivot(cfg, key, pts)
+    require_chunks(cfg)
 
 
 def pivot_rcond(pts: np.ndarray, theta: np.ndarray) -> float:

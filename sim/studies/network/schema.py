@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from sim.mc.config import COMMON, ConfigError, Field
+from sim.mc.runner import MIN_CHUNKS, require_chunks
 from sim.studies.network.analysis import (
     check_inner,
     estimated_points,
@@ -135,7 +136,11 @@ SCHEMA = {
 }
 SCHEMA["trials"] = Field(2000, "int", "Monte-Carlo trials", lo=2, hi=10_000_000)
 SCHEMA["chunk"] = Field(
-    100, "int", "trials per chunk (intervals are over chunks: >= 2 chunks)", lo=1, hi=100_000
+    100,
+    "int",
+    f"trials per chunk (the jackknife intervals are over chunks: >= {MIN_CHUNKS} chunks)",
+    lo=1,
+    hi=100_000,
 )
 
 
@@ -156,15 +161,11 @@ def _check_compare(net, full: dict, fix: list, sparse: bool) -> None:
 def check(cfg: dict) -> None:
     """Cross-key rules: the network builds (every observation well defined), its datum covers
     every rank defect and is not near-singular, something is estimated, the chunk fits in
-    memory (on the sparse path for a large network), the run has at least two chunks and
+    memory (on the sparse path for a large network), the run has the chunks its jackknife
+    intervals need (:data:`sim.mc.runner.MIN_CHUNKS`) and
     ``output.inner_over`` can fix the defects. Records the sha256 of ``network.gama_xml`` in
     ``network.gama_sha256``."""
-    if cfg["trials"] < 2 * cfg["chunk"]:
-        raise ConfigError(
-            "chunk",
-            f"{cfg['trials']} trials in chunks of {cfg['chunk']} give "
-            "fewer than 2 chunks: the intervals are taken over chunks",
-        )
+    require_chunks(cfg)  # estimates.py and tables.py: jackknife intervals over the chunks
     _digest(cfg)
     full = merge_gama(cfg)
     net = build(full)

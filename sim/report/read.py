@@ -1,0 +1,116 @@
+"""Reading a results directory's Parquet tables for ``sim show`` and ``sim report``.
+
+The report is built from the tables alone, so a table dropped, replaced or edited by hand
+(a column removed or renamed, a column's type changed) is found while the report reads it.
+:func:`columns` and :func:`records` return the table as ``{column: values}`` or as rows, as
+``pyarrow``'s ``to_pydict`` / ``to_pylist`` do, but:
+
+* a file that is not a Parquet table raises :class:`TableError` naming the file;
+* a column the report asks for and the table lacks raises :class:`TableError` naming the file
+  and the column;
+* every column read is remembered (:func:`last_read`), so an error the report code raises
+  on a column's values (a number column retyped as text: ``Unknown format code 'f' for
+  object of type 'str'``) is named with the file and column it was reading
+  (:func:`damaged_message`).
+"""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+
+from sim.mc.storage import read_table
+
+__all__ = ["TableError", "columns", "records", "last_read", "forget", "damaged_message"]
+
+_LAST = threading.local()  # the (file, column) last read by this thread's report
+
+
+class TableError(ValueError):
+    """One table is not as sim wrote it: ``path`` the file, ``what`` the problem."""
+
+    def __init__(self, path: Path, what: str):
+        self.path, self.what = Path(path), what
+        super().__init__(f"{path}: {what}")
+
+
+def _note(path: Path, key: str) -> None:
+    _LAST.where = (path, key)
+
+
+def last_read() -> tuple[Path, str] | None:
+    """The ``(file, column)`` this thread's report read last, or None."""
+    return getattr(_LAST, "where", None)
+
+
+def forget() -> None:
+    """Start a directory's report: no column read yet (an error before the first is not
+    blamed on another directory's table)."""
+    _LAST.where = None
+
+
+class Columns(dict):
+    """``{column: values}`` of one table; a missing column raises :class:`TableError`."""
+
+    def __init__(self, path: Path, data: dict):
+        super().__init__(data)
+        self.path = path
+
+    def __getitem__(self, key):
+        value = super().__getitem__(key)
+        _note(self.path, key)
+        return value
+
+    def __missing__(self, key):
+        raise TableError(self.path, f"has no column {key!r}")
+
+
+class Row(Columns):
+    """One row of a table, ``{column: value}``; a missing column raises :class:`TableError`."""
+
+
+def _read(path: Path) -> pa.Table:
+    """The table; a file that is there but not Parquet raises :class:`TableError` (a missing
+    or unreadable one raises the OSError, which the command reports with its reason)."""
+    try:
+        return read_table(path)
+    except pa.ArrowException as e:
+        raise TableError(path, f"cannot be read ({str(e).splitlines()[0][:200]})") from None
+
+
+def columns(path: str | Path) -> dict[str, list]:
+    """The columns of the table at ``path`` (``to_pydict``), checked as the module says."""
+    path = Path(path)
+    return Columns(path, _read(path).to_pydict())
+
+
+def records(path: str | Path) -> list[dict[str, Any]]:
+    """The rows of the table at ``path`` (``to_pylist``), checked as the module says."""
+    path = Path(path)
+    return [Row(path, r) for r in _read(path).to_pylist()]
+
+
+def _under(path: Path, root: Path) -> str | None:
+    """``path`` relative to ``root``, or None when it is not under it."""
+    try:
+        return str(Path(path).resolve().relative_to(Path(root).resolve()))
+    except (OSError, ValueError):
+        return None
+
+
+def damaged_message(root: Path, e: Exception) -> str:
+    """One line for ``sim show`` / ``sim report`` when reading the tables under ``root``
+    failed with ``e``: the file (relative to ``root``) and what is wrong with it -- the
+    column it lacks, or the column being read when the report failed on its values."""
+    why = f"{type(e).__name__}: {e}".splitlines()[0][:240]
+    lr = last_read()
+    if isinstance(e, TableError):
+        where, why = _under(e.path, root) or str(e.path), e.what
+    elif lr is not None and _under(lr[0], root) is not None:  # (not a stale one elsewhere)
+        where, why = _under(lr[0], root), f"column {lr[1]!r}: {why}"
+    else:
+        return f"a table under {root} is not as sim wrote it ({why}); run its study again"
+    return f"{where} under {root} is not as sim wrote it ({why}); run its study again"
