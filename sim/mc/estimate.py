@@ -8,6 +8,16 @@ order-of-magnitude model of the study's arrays (observations x unknowns x trials
 with a safety factor for copies), meant to stop a run that would hang or be killed for want
 of memory, not to predict its time.
 
+The work is counted in adjustments. The unit, :data:`ADJUSTMENT_S` seconds of one core of the
+2-core reference machine, is one adjustment of the kind the Monte-Carlo parts solve (a third of
+a trial of brown_design's check on the paper's plate, 57 unknowns). A part whose one step costs
+far more than that unit is counted in adjustment-equivalents (its measured seconds over
+:data:`ADJUSTMENT_S`): brown_design's analytic design grid, whose cofactor of an n-point grid
+costs ~(2n)^3 per geometry (~k^6 for a k x k grid, :func:`design_grid_equivalents`). Such an
+analytic part runs before the first progress bar and cannot be resumed, so it may take at most
+:data:`ANALYTIC_SHARE` of the work limit (by default about 25 s on one core); over that the
+run stops naming the key that sets its size (``design.grids``) and its minutes.
+
 Limits: ``--max-memory-gb`` (env ``SIM_MAX_MEMORY_GB``, default 8 GiB: a third of a 24 GiB
 machine) and ``--max-adjustments`` (env ``SIM_MAX_ADJUSTMENTS``, default 5e8: hours on two
 cores). A run over a limit stops at once with the estimate in the message (exit 2). Sweeps are
@@ -35,12 +45,23 @@ __all__ = [
     "MAX_CELLS",
     "DEFAULT_MAX_MEMORY_GB",
     "DEFAULT_MAX_ADJUSTMENTS",
+    "ADJUSTMENT_S",
+    "ANALYTIC_SHARE",
+    "design_grid_equivalents",
 ]
 
 DEFAULT_MAX_MEMORY_GB = 8.0
 DEFAULT_MAX_ADJUSTMENTS = 5e8
 F8 = 8.0  # bytes of a float64
 COPIES = 6.0  # working copies of the largest array (residuals, Jacobian, ...)
+#: CPU seconds of the unit adjustment on one core of the 2-core reference machine (one BLAS
+#: thread, best of 5 rounds of 500 trials): a third of a trial of brown_design's Monte-Carlo
+#: check on the paper's plate (P-position solver, 4 positions x 25 points, 57 unknowns),
+#: counted as 3 adjustments. The default limit of 5e8 is then about 7 hours on one core.
+ADJUSTMENT_S = 5.1e-5
+#: an analytic part (no progress bar, nothing to resume) may take at most this share of the
+#: work limit: 5e5 adjustment-equivalents, about 25 s on one core, at the default 5e8
+ANALYTIC_SHARE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -54,14 +75,24 @@ class Estimate:
     bytes: float  # largest working set of one chunk, bytes
     cells: int = 1  # sweep cells x replicates
     largest: str = ""  # the part whose chunk (or analytic stack) needs ``bytes``, if named
+    analytic: float = 0.0  # adjustment-equivalents of the largest analytic part (one cell)
+    analytic_key: str = ""  # the key that sets that part's size (``design.grids``)
+    analytic_part: str = ""  # that part, named
 
     def describe(self, workers: int = 1) -> str:
-        """One line: trials, adjustments, unknowns and the memory of ``workers`` processes."""
+        """One line: trials, adjustments (analytic parts in adjustment-equivalents, each
+        :data:`ADJUSTMENT_S` s of one core), unknowns and the memory of ``workers``
+        processes."""
         if isinstance(workers, bool) or not isinstance(workers, Integral) or workers < 1:
             raise ConfigError("workers", f"must be a whole number >= 1 (got {workers!r})")
         cells = f" in {self.cells} sweep cells" if self.cells > 1 else ""
+        eq = (
+            f" (with {self.analytic:.3g} adjustment-equivalents of analytic work)"
+            if self.analytic >= 1
+            else ""
+        )
         return (
-            f"{self.trials:,} trials{cells}, about {self.adjustments:.3g} adjustments of up "
+            f"{self.trials:,} trials{cells}, about {self.adjustments:.3g} adjustments{eq} of up "
             f"to {self.unknowns:,} unknowns, about {_gib(self.bytes * max(workers, 1))} of "
             "memory"
         )
@@ -122,6 +153,30 @@ DESIGN_RANGE_VALUES = 128
 DESIGN_COFACTOR_COPIES = 5.0
 
 
+#: CPU seconds of one geometry of the analytic design grid (both models' (2n, 2n) cofactors in
+#: the inner datum, :func:`sim.studies.design.cells.geometry_eval`) of n points: a (2n)^3 +
+#: b (2n)^2, fitted (relative least squares) to serial timings on the reference machine at
+#: k = 10, 14, 18, 22, 26 and 29 points a side, 3, 4 and 8 positions (the same within 2 %),
+#: the study's 8 offsets x 2 betas; every timing within 9 % of the law. From 10 to 29 points
+#: a side the time grows as k^5.45 (k^6.03 from 18 on: the cube dominates); 29 x 29 takes
+#: 0.60-0.65 s a geometry, about 2 minutes for the study's 4 positions x 3 extents.
+DESIGN_CUBE_S = 1.11e-10
+DESIGN_SQUARE_S = 2.41e-8
+
+
+def design_grid_equivalents(
+    grids, positions: float = 1, extents: float = 1, geometries: float = 1
+) -> float:
+    """Adjustment-equivalents (:data:`ADJUSTMENT_S` s each) of brown_design's analytic design
+    grid: every grid of ``grids`` (points per side) for each of ``positions`` x ``extents``,
+    ``geometries`` (offsets x betas) batched, at :data:`DESIGN_CUBE_S` (2n)^3 +
+    :data:`DESIGN_SQUARE_S` (2n)^2 seconds a geometry, n = k^2."""
+    per = sum(
+        DESIGN_CUBE_S * (2.0 * k * k) ** 3 + DESIGN_SQUARE_S * (2.0 * k * k) ** 2 for k in grids
+    )
+    return positions * extents * geometries * per / ADJUSTMENT_S
+
+
 def _design_mc(ch: float, P: float, n: float) -> float:
     """Bytes of one Monte-Carlo chunk of ``ch`` trials of ``n`` points seen from ``P``
     positions: the per-range arrays of every trial, and the (2n, 2n) inner-datum matrix and
@@ -165,6 +220,16 @@ def _design(c: Mapping) -> tuple:
     n_paper = c.get("paper.grid", 5) ** 2
     nc = max(_max(c.get("coverage.grids"), 5) ** 2, c.get("datum.grid", 5) ** 2)
     geometries = _n(c.get("design.offsets_mm", [1])) * _n(c.get("design.beta_mm", [1]))
+    grids = [float(k) for k in c.get("design.grids", [5])]
+    PE = _n(c.get("design.positions", [1])) * _n(c.get("design.extents_mm", [1]))
+    eq = design_grid_equivalents(grids, PE, 1, geometries)
+    adj += eq
+    analytic = (
+        eq,
+        "design.grids",
+        f"the analytic design grid ({len(grids)} grids up to {int(G)} x {int(G)} points, each "
+        f"for {int(PE)} positions x extents and {int(geometries)} offset x beta geometries)",
+    )
     parts = {
         "the Monte-Carlo check on the paper's plate": _design_mc(
             ch, c.get("paper.positions", 4), n_paper
@@ -174,7 +239,7 @@ def _design(c: Mapping) -> tuple:
         f"{int(G)} points)": DESIGN_COFACTOR_COPIES * geometries * (2 * n) ** 2 * F8,
     }
     what = max(parts, key=parts.get)
-    return trials, adj, max(U, 2 * int(max(nc, n_paper)) + 7), parts[what], what
+    return trials, adj, max(U, 2 * int(max(nc, n_paper)) + 7), parts[what], what, analytic
 
 
 def _gridplate(c: Mapping) -> tuple:
@@ -392,14 +457,17 @@ ESTIMATORS: dict[str, Callable[[Mapping], tuple]] = {
 
 
 def _one(cfg: Mapping) -> tuple:
-    """``(trials, adjustments, unknowns, bytes, the part needing the bytes or "")``."""
+    """``(trials, adjustments, unknowns, bytes, the part needing the bytes or "", (analytic
+    adjustment-equivalents, key, part))``; an estimator may leave out the last two."""
     fn = ESTIMATORS.get(cfg.get("study"), _generic)
     try:
-        t, a, u, b, *what = fn(cfg)
+        t, a, u, b, *rest = fn(cfg)
     except (TypeError, ValueError, KeyError, OverflowError, ZeroDivisionError):
-        t, a, u, b, *what = _generic(cfg)
+        t, a, u, b, *rest = _generic(cfg)
     fix = lambda x: x if isinstance(x, (int, float)) and not math.isnan(x) else math.inf  # noqa: E731
-    return fix(t), fix(a), fix(u), fix(b), (what or [""])[0]
+    what = rest[0] if rest else ""
+    eq, key, part = rest[1] if len(rest) > 1 else (0.0, "", "")
+    return fix(t), fix(a), fix(u), fix(b), what, (fix(eq), key, part)
 
 
 def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> Estimate:
@@ -414,9 +482,19 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
     A = sum(p[1] for p in parts) * reps
     U = max(p[2] for p in parts)
     B, what = max((p[3], p[4]) for p in parts)
+    eq, key, part = max((p[5] for p in parts), key=lambda x: x[0])  # one cell's, not the sum
     big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
     return Estimate(
-        str(cfg.get("study")), big(T), float(A), big(U), float(B), len(cfgs) * reps, what
+        str(cfg.get("study")),
+        big(T),
+        float(A),
+        big(U),
+        float(B),
+        len(cfgs) * reps,
+        what,
+        float(eq),
+        key,
+        part,
     )
 
 
@@ -441,7 +519,9 @@ def check_limits(
     max_adjustments: float | None = None,
     workers: int = 1,
 ) -> None:
-    """Stop (ConfigError, one line with the estimate) a run over the memory or work limit."""
+    """Stop (ConfigError, one line with the estimate) a run over the memory or work limit, or
+    whose analytic part would run silently for more than :data:`ANALYTIC_SHARE` of the work
+    limit (named by its key, in minutes on the reference machine)."""
     mem = _limit(max_memory_gb, "SIM_MAX_MEMORY_GB", DEFAULT_MAX_MEMORY_GB, "--max-memory-gb")
     adj = _limit(
         max_adjustments, "SIM_MAX_ADJUSTMENTS", DEFAULT_MAX_ADJUSTMENTS, "--max-adjustments"
@@ -462,3 +542,20 @@ def check_limits(
             f"limit of {adj:.3g} adjustments (--max-adjustments or "
             "SIM_MAX_ADJUSTMENTS); reduce trials or the lists in the study file",
         )
+    if not est.analytic <= adj * ANALYTIC_SHARE:
+        raise ConfigError(
+            est.analytic_key or None,
+            f"{est.study}: {est.analytic_part or 'an analytic part'} needs about "
+            f"{est.analytic:.3g} adjustment-equivalents, about "
+            f"{_minutes(est.analytic * ADJUSTMENT_S)} of one core of the reference machine "
+            f"before the first progress bar, over the {adj * ANALYTIC_SHARE:.3g} an analytic "
+            f"part may take ({ANALYTIC_SHARE:g} of the limit of {adj:.3g} adjustments, "
+            "--max-adjustments or SIM_MAX_ADJUSTMENTS); use fewer points per side or fewer "
+            "positions, extents, offsets or betas, or raise the limit",
+        )
+
+
+def _minutes(s: float) -> str:
+    if not math.isfinite(s):
+        return "forever"
+    return f"{s / 60:.2g} min" if s < 3600 * 10 else f"{s / 3600:.3g} h"
