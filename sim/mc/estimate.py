@@ -13,7 +13,10 @@ The work is counted in adjustments. The unit, :data:`ADJUSTMENT_S` seconds of on
 a trial of brown_design's check on the paper's plate, 57 unknowns). A part whose one step costs
 far more than that unit is counted in adjustment-equivalents (its measured seconds over
 :data:`ADJUSTMENT_S`): brown_design's analytic design grid, whose cofactor of an n-point grid
-costs ~(2n)^3 per geometry (~k^6 for a k x k grid, :func:`design_grid_equivalents`). Such an
+costs ~(2n)^3 per geometry (~k^6 for a k x k grid, :func:`design_grid_equivalents`); a dense
+adjustment larger than the unit (Wolf's polynomial fit, the network's dense path) as m U^2 +
+U^3 against the unit's (:func:`_dense`); an Agnard block adjustment per model of its block
+(:data:`AGNARD_MODEL_UNITS`). Each was measured on the reference machine. Such an
 analytic part runs before the first progress bar and cannot be resumed, so it may take at most
 :data:`ANALYTIC_SHARE` of the work limit (by default about 25 s on one core); over that the
 run stops naming the key that sets its size (``design.grids``) and its minutes.
