@@ -7,6 +7,10 @@ now counts the design grid in adjustment-equivalents (:func:`sim.mc.estimate.
 design_grid_equivalents`, a law fitted to serial timings on the reference machine), and an
 analytic part may take at most :data:`sim.mc.estimate.ANALYTIC_SHARE` of the work limit.
 
+The same blind spot in the other studies (an adjustment much larger than the unit while the
+count stays the same) is fixed for Wolf's polynomial fit, the network's dense path and Agnard's
+block adjustment; each weight is checked against one measured run (within a factor 3).
+
 No test here is timed: the law's constants are the measurements (see the constants'
 comments); the tests pin its shape and the refusal.
 """
@@ -147,6 +151,17 @@ def test_a_dense_adjustment_larger_than_the_unit_counts_in_proportion(tmp_path):
     ]
     big = estimate(load_study(wolf, [*tiny, *fine])[1])
     assert small.adjustments < 2e3 and 1.5e6 / 3 < big.adjustments < 1.5e6 * 3
+    # 200,000 trials of that fit (about a day of one core) are refused; they passed before
+    many = [
+        f"trials={200_000}",
+        "chunk=10",
+        "unprinted.trials=10",
+        "trade.trials=10",
+        *tiny[4:],
+        *fine,
+    ]
+    with pytest.raises(ConfigError, match="over the limit of 5e\\+08 adjustments"):
+        check_limits(estimate(load_study(wolf, many)[1]))
     plate = (ROOT / "studies" / "network_plate.toml").read_text()
     f13 = tmp_path / "n13.toml"
     f13.write_text(plate.replace("nx = 5, ny = 5", "nx = 13, ny = 13").replace('"G13"', '"G85"'))
