@@ -15,6 +15,7 @@ executors, and the rule that nothing the suite did not write is ever replaced.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import tempfile
 from dataclasses import dataclass, field
@@ -102,6 +103,7 @@ class StudyHandle:
     config: dict = field(repr=False)
     overrides: dict = field(default_factory=dict, repr=False)
     sweep: dict = field(default_factory=dict, repr=False)
+    file_sha256: str = field(default="", repr=False)
 
     @property
     def name(self) -> str:
@@ -113,6 +115,7 @@ class StudyHandle:
 
     def replace(self, **overrides) -> "StudyHandle":
         """A new handle with more overrides."""
+        _unchanged(self)
         return load(self.path, **{**self.overrides, **{_key(k): v for k, v in overrides.items()}})
 
     def run(
@@ -139,6 +142,7 @@ class StudyHandle:
         for name, v in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures)):
             if not isinstance(v, bool):
                 raise ConfigError(name, f"must be True or False (got {v!r})")
+        _unchanged(self)
         h = (
             self
             if trials is None and seed is None
@@ -171,6 +175,22 @@ class StudyHandle:
             figures=figures,
         )
         return Results(out, h.name)
+
+
+def _sha256(path: Path) -> str:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return ""
+
+
+def _unchanged(h: StudyHandle) -> None:
+    """A handle runs the file it loaded: its config is that file's, and ``replace`` or
+    ``run(trials=...)`` read the file again, so an edited (or deleted) file would give one
+    handle two configs. Refused, as an edited ``network.gama_xml`` is."""
+    if h.file_sha256 and _sha256(h.path) != h.file_sha256:
+        state = "has changed" if h.path.is_file() else "is gone"
+        raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
 
 
 def _check_owner(p: Path, study: str) -> None:
@@ -250,5 +270,9 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
         if not _key(k).strip(".").strip() or not k.isprintable():
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
     vals = {_key(k): _plain(v) for k, v in overrides.items()}
+    sha = _sha256(study_file)
     study, cfg = _load_picking_chunk(study_file, vals)
-    return StudyHandle(study_file, study, cfg, vals, read_sweep(study_file, study.schema))
+    sweep = read_sweep(study_file, study.schema)
+    if _sha256(study_file) != sha:  # written to while it was read: which version is this?
+        raise ConfigError("study_file", f"{study_file} changed while it was loaded: load it again")
+    return StudyHandle(study_file, study, cfg, vals, sweep, sha)

@@ -294,12 +294,34 @@ def _conditioned(net, an, key: str) -> None:
         )
 
 
+def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
+    """A network of full rank whose normals the engine still finds singular: the sigmas
+    make it so (e.g. weighted coordinates a million times looser than the differences
+    between them). Name the weakest unknown and the range of the sigmas."""
+    _, sv, vt = np.linalg.svd(A, full_matrices=False)
+    par = int(free[int(np.argmax(np.abs(vt[-1])))])
+    what = (
+        f"point {net.names[par // 2]!r} ({'xy'[par % 2]})"
+        if par < 2 * net.n
+        else net.parameter_names()[par - 2 * net.n]
+    )
+    raise ConfigError(
+        key,
+        f"the network is near-singular from its weights: {what} is nearly undetermined "
+        f"(the normal matrix's condition number is {(sv[0] / sv[-1]) ** 2:.3g}, too large "
+        "to solve in double precision): bring the observations' sigmas closer together, "
+        "or fix points",
+    )
+
+
 def _defect(net, dt, key: str) -> None:
     free = dt.free_index(net.q)
     _, J = computed(net, net.theta_true()[None], jac=True)
     A = J[0][:, free] / net.sigma[:, None]
     sv = np.linalg.svd(A, compute_uv=False)
     rank = int((sv > sv[0] * 1e-10).sum()) if sv.size else 0
+    if sv.size and rank == len(free):
+        _weights(net, A, free, key)
     C = dt.constraint_matrix(net.theta_true()[None])
     c = 0 if C is None else C.shape[-1]
     raise ConfigError(

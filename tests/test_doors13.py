@@ -1,0 +1,80 @@
+"""The classes of the twelfth sweep of bad inputs (issue 26, doors13), one case each; each
+failed on the code before its fix.
+
+* a network whose sigmas alone make the normals singular (weighted coordinates of 1 m
+  beside coordinate differences of 2 um) was refused blaming "a rank defect of 0 ... that
+  the datum does not cover"; now it names the weakest unknown and the condition number;
+* a distance whose own ``bias_mm`` makes it read a negative length passed ``sim check``
+  (``constant_mm`` doing the same was refused); an angle with a gross bias (200,000 arcsec)
+  passed and its run's error blamed ``solver.max_iter``; now the error names the bias;
+* a ``sim.load`` handle whose study file was edited (or deleted) afterwards: ``run()`` ran
+  the config of load time, ``run(trials=...)`` and ``replace`` the edited file, so one
+  handle gave two configs without a word; now refused naming ``study_file``.
+"""
+
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim.cli import main
+from sim.mc.config import ConfigError
+from sim.studies import load_study
+from sim.studies.network.definition import build
+from sim.studies.network.run import _biased
+
+ROOT = Path(__file__).resolve().parent.parent
+PLATE = str(ROOT / "studies" / "network_plate.toml")
+FIELD = ROOT / "studies" / "network_testfield.toml"
+
+
+def _one_line(capsys, rc, *needles):
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "\n" not in err and "Traceback" not in err, (rc, err)
+    assert all(n in err for n in needles), err
+    return err
+
+
+def test_a_network_singular_from_its_weights_names_the_unknown_not_a_rank_defect(capsys):
+    grid = '[{prefix="G",nx=5,ny=5,spacing_mm=40.0,role="observed",sigma_mm=1e3}]'
+    err = _one_line(
+        capsys, main(["check", PLATE, "--set", f"network.grids={grid}"]), "from its weights"
+    )
+    assert "point 'G" in err and "rank defect" not in err
+
+
+def test_a_bias_that_makes_a_distance_negative_is_refused_at_check(capsys):
+    obs = '[{kind="distance",from="N6",to="N7",sigma_mm=1.0,bias_mm=-30000}]'
+    _one_line(
+        capsys,
+        main(["check", str(FIELD), "--set", f"network.observations={obs}"]),
+        "network.observations",
+        "'N6' to 'N7'",
+        "bias_mm",
+    )
+
+
+def test_a_gross_angle_bias_is_named_when_the_run_does_not_converge():
+    obs = [{"kind": "angle", "at": "N6", "from": "N5", "to": "N7", "sigma_arcsec": 2.0}]
+    _, cfg = load_study(FIELD, values={"network.observations": obs})
+    assert _biased(build(cfg)) == ""  # no bias: the run's own message stands
+    _, cfg = load_study(FIELD, values={"network.observations": [{**obs[0], "bias_arcsec": 2e5}]})
+    msg = _biased(build(cfg))
+    assert msg.startswith("network.observations:") and "200000 arcsec" in msg
+    assert "angle at 'N6' from 'N5' to 'N7'" in msg
+
+
+@pytest.mark.parametrize("edit", ["change", "delete"])
+def test_a_handle_refuses_its_study_file_edited_since_load(tmp_path, edit):
+    f = tmp_path / "t.toml"
+    f.write_text(FIELD.read_text())
+    h = sim.load(f, trials=200)
+    h.replace(seed=3)  # unchanged: fine
+    if edit == "change":
+        f.write_text(FIELD.read_text().replace("seed = 14", "seed = 15"))
+    else:
+        f.unlink()
+    for call in (lambda: h.run(out=tmp_path / "o"), lambda: h.replace(seed=3)):
+        with pytest.raises(ConfigError, match="study_file: .* since sim.load"):
+            call()
+    assert not (tmp_path / "o").exists()
