@@ -9,17 +9,26 @@ failed on the code before its fix.
   passed and its run's error blamed ``solver.max_iter``; now the error names the bias;
 * a ``sim.load`` handle whose study file was edited (or deleted) afterwards: ``run()`` ran
   the config of load time, ``run(trials=...)`` and ``replace`` the edited file, so one
-  handle gave two configs without a word; now refused naming ``study_file``.
+  handle gave two configs without a word; now refused naming ``study_file``;
+* a GNU Gama d-m-s value with 60.00 seconds (gama-local reads it; its own test data
+  ``zoltan-test_2d_dms.gkf`` holds "187-33-60.00") was refused as garbage;
+* agnard with ``snoop.max_reject = 0`` (legal: no data snooping) decided "digital pugging
+  removes no pass point" as holds, though no point could be removed; and with the fewest
+  paired blocks (``table1.trials = 2``) the row's note stated a share of 780 %.
 """
 
+import re
 from pathlib import Path
+from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 import sim
 from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.studies import load_study
+from sim.studies.agnard.decide import REJECTED, _zeros, without_snooping
 from sim.studies.network.definition import build
 from sim.studies.network.run import _biased
 
@@ -78,3 +87,33 @@ def test_a_handle_refuses_its_study_file_edited_since_load(tmp_path, edit):
         with pytest.raises(ConfigError, match="study_file: .* since sim.load"):
             call()
     assert not (tmp_path / "o").exists()
+
+
+def test_without_snooping_the_rejection_row_is_undecidable_not_holds():
+    row = {"claim": REJECTED, "kind": "prediction", "outcome": "holds", "verdict": "holds"}
+    row = {**row, "holds": True, "note": "n"}
+    other = {**row, "claim": "agnard.other"}
+    (r, o) = without_snooping({"snoop.max_reject": 0}, [row, other])
+    assert (r["verdict"], r["outcome"], r["holds"]) == ("undecidable", "undecidable", None)
+    assert "snoop.max_reject = 0" in r["note"] and o == other
+    assert without_snooping({"snoop.max_reject": 25}, [row]) == [row]
+
+
+def test_the_rejection_note_never_states_a_share_over_100_percent():
+    ev = {"share_zero": np.array([1.0, 1.0]), "share_zero_high": np.array([1.0, 1.0])}
+    note = _zeros(SimpleNamespace(outputs={REJECTED: ev}), REJECTED, 2)  # 2 pairs: the least
+    shares = [float(x) for x in re.findall(r"([\d.e+]+) %", note)]
+    assert shares and max(shares) <= 100, note
+
+
+def test_a_dms_value_of_60_seconds_is_read_as_gama_local_reads_it(tmp_path, capsys):
+    src = (ROOT / "tests" / "data" / "gama" / "user_dms.xml").read_text()
+    m = re.search(r'val="(\d+)-(\d+)-([\d.]+)"', src)
+    assert m, "the reference file has a d-m-s value"
+    f = tmp_path / "n.xml"
+    f.write_text(src.replace(m.group(0), f'val="{m.group(1)}-{m.group(2)}-60.00"', 1))
+    study = tmp_path / "s.toml"
+    study.write_text(f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{f}"\n')
+    assert main(["check", str(study)]) == 0, capsys.readouterr().err
+    f.write_text(src.replace(m.group(0), f'val="{m.group(1)}-{m.group(2)}-60.01"', 1))
+    _one_line(capsys, main(["check", str(study)]), "seconds at most 60")
