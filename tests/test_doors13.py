@@ -30,6 +30,7 @@ from sim.mc.config import ConfigError
 from sim.studies import load_study
 from sim.studies.agnard.decide import REJECTED, _zeros, without_snooping
 from sim.studies.network.definition import build
+from sim.studies.network.gama import merge_gama
 from sim.studies.network.run import _biased
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -117,3 +118,16 @@ def test_a_dms_value_of_60_seconds_is_read_as_gama_local_reads_it(tmp_path, caps
     assert main(["check", str(study)]) == 0, capsys.readouterr().err
     f.write_text(src.replace(m.group(0), f'val="{m.group(1)}-{m.group(2)}-60.01"', 1))
     _one_line(capsys, main(["check", str(study)]), "seconds at most 60")
+
+
+def test_a_free_gama_file_with_xy_points_is_read_in_their_inner_datum(tmp_path, capsys):
+    """The suite's own export of a free network (``adj="XY"``, no fixed point) imported
+    again, the study saying nothing of the datum: gama-local adjusts it in the inner datum
+    over those points, and so does the study (it refused: "rank defect of 3")."""
+    xml = ROOT / "tests" / "data" / "gama" / "directions_free.xml"
+    study = tmp_path / "s.toml"
+    study.write_text(f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{xml}"\n')
+    assert main(["check", str(study)]) == 0, capsys.readouterr().err
+    _, cfg = load_study(study)
+    full = merge_gama(cfg)
+    assert full["datum.kind"] == "inner" and full["datum.points"] == ["P1", "P2", "P3"]

@@ -125,7 +125,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
         "gama_xml": export(net, full, out / "network.xml"),
         "gama_input": import_note(cfg),
     }
-    write_summary(out, net, an, cfg, facts, est, prov)
+    write_summary(out, net, an, full, facts, est, prov)  # full: the datum as read
     a95 = K95 * ellipse(an.cov[pts])[0]
     network_claims(out, prov, an, est, cfg, design_figures(net, an, a95, dil, est))
     draw(
