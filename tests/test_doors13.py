@@ -131,3 +131,38 @@ def test_a_free_gama_file_with_xy_points_is_read_in_their_inner_datum(tmp_path, 
     _, cfg = load_study(study)
     full = merge_gama(cfg)
     assert full["datum.kind"] == "inner" and full["datum.points"] == ["P1", "P2", "P3"]
+
+
+@pytest.mark.parametrize(
+    "sets, words",
+    [
+        (  # two blocks of points, one of them tied to the fixed points by no observation
+            [
+                'network.grids=[{prefix="N",nx=15,ny=10,spacing_m=1.0,origin_m=[2.0,2.0]},'
+                '{prefix="M",nx=15,ny=10,spacing_m=1.0,origin_m=[60.0,60.0]}]',
+                'network.points=[{name="A",x_m=0.0,y_m=0.0,role="fixed"},'
+                '{name="B",x_m=0.0,y_m=1.0,role="fixed"},{name="C",x_m=1.0,y_m=0.0,role="fixed"}]',
+                'network.generate=[{kind="distance",from="*",to="*",nearest=4,sigma_mm=1.0},'
+                '{kind="direction",from="*",to="*",nearest=3,sigma_arcsec=1.0}]',
+            ],
+            "points 'M1', 'M2', 'M3' and 147 more are tied to the datum by no observation",
+        ),
+        (  # a line of points seen by distances along it only: no y
+            [
+                'network.grids=[{prefix="N",nx=400,ny=1,spacing_m=1.0,origin_m=[2.0,0.0]}]',
+                'network.generate=[{kind="distance",from="*",to="*",nearest=2,sigma_mm=1.0}]',
+                'network.points=[{name="A",x_m=0.0,y_m=0.0,role="fixed"},'
+                '{name="B",x_m=1.0,y_m=5.0,role="fixed"}]',
+            ],
+            "(y) is determined by no observation (399 such unknowns)",
+        ),
+    ],
+)
+def test_a_large_singular_network_names_its_loose_points(capsys, sets, words):
+    """On the sparse path (400 unknowns and more) a singular network said only "the normal
+    equations are singular": now it names the loose points."""
+    base = ["network.observations=[]", "compare.fix=[]", "output.inner_over=[]"]
+    args = ["check", str(FIELD)]
+    for s in base + sets:
+        args += ["--set", s]
+    _one_line(capsys, main(args), "datum.kind", words)

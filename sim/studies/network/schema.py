@@ -23,6 +23,7 @@ from sim.studies.network.analysis import (
 from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.model import computed, datum, defect_basis, use_sparse
+from sim.studies.network.singular import singular_cause
 from sim.studies.network.sparse_analysis import chunk_bytes, pre_analysis, variances
 
 __all__ = ["SCHEMA", "check"]
@@ -191,7 +192,12 @@ def check(cfg: dict) -> None:
     an = pre_analysis(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
         if sparse:
-            raise ConfigError("datum.kind", f"{an.factor.message}: fix points or change the datum")
+            cause = singular_cause(net, full, dt.free_index(net.q))
+            raise ConfigError(
+                "datum.kind",
+                f"{an.factor.message}{': ' + cause if cause else ''}: fix points or change "
+                "the datum",
+            )
         _defect(net, dt, "datum.kind")
     _conditioned(net, an, "datum.kind")
     if not estimated_points(net, an):
