@@ -14,10 +14,15 @@ failed on the code before its fix.
   ``zoltan-test_2d_dms.gkf`` holds "187-33-60.00") was refused as garbage;
 * agnard with ``snoop.max_reject = 0`` (legal: no data snooping) decided "digital pugging
   removes no pass point" as holds, though no point could be removed; and with the fewest
-  paired blocks (``table1.trials = 2``) the row's note stated a share of 780 %.
+  paired blocks (``table1.trials = 2``) the row's note stated a share of 780 %;
+* the suite's own GNU Gama export of a free network (``adj="XY"``) read back was refused;
+* a large (sparse-path) singular network named no point;
+* ``make verify --study`` naming a sweep's results said there were none; results it could
+  not re-run (no study file in studies/) printed "0 files; largest relative deviation 0".
 """
 
 import re
+import shutil
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -27,6 +32,7 @@ import pytest
 import sim
 from sim.cli import main
 from sim.mc.config import ConfigError
+from sim.report.verify.cli import main as verify_main
 from sim.studies import load_study
 from sim.studies.agnard.decide import REJECTED, _zeros, without_snooping
 from sim.studies.network.definition import build
@@ -166,3 +172,31 @@ def test_a_large_singular_network_names_its_loose_points(capsys, sets, words):
     for s in base + sets:
         args += ["--set", s]
     _one_line(capsys, main(args), "datum.kind", words)
+
+
+def _results_with(tmp_path, name: str) -> Path:
+    res = tmp_path / "res"
+    shutil.copytree(ROOT / "results" / "network_plate", res / name, ignore=_no_trials)
+    return res
+
+
+def _no_trials(d, names):
+    return ["trials"] if "trials" in names else []
+
+
+def test_verify_names_a_sweeps_results_as_a_sweep_not_as_missing(tmp_path, capsys):
+    res = _results_with(tmp_path, "network_plate")
+    (res / "sw").mkdir()
+    (res / "sw" / "sweep.parquet").write_bytes(b"")
+    rc = verify_main(["--results", str(res), "--study", "sw", "--no-record"])
+    _one_line(capsys, rc, "--study", "holds a sweep's results")
+
+
+def test_verify_states_no_deviation_when_it_compared_nothing(tmp_path, capsys):
+    """Results of a study file outside studies/ cannot be re-run: "FAILED; 0 files; largest
+    relative deviation 0" read as a comparison made; now it says nothing was compared."""
+    res = _results_with(tmp_path, "mine")
+    rc = verify_main(["--results", str(res), "--study", "mine", "--no-record"])
+    out = capsys.readouterr().out
+    assert rc == 1 and "mine: FAILED; nothing compared" in out and "deviation" not in out
+    assert "no study file" in out
