@@ -105,6 +105,9 @@ class StudyHandle:
     sweep: dict = field(default_factory=dict, repr=False)
     file_sha256: str = field(default="", repr=False)
 
+    def __hash__(self) -> int:  # the dataclass's would hash the config dict: TypeError
+        return hash((self.path, self.file_sha256, repr(sorted(self.overrides.items()))))
+
     @property
     def name(self) -> str:
         return self.config["study"]
@@ -234,9 +237,14 @@ def _check_int(name: str, v: Any) -> None:
 
 def _plain(v: Any) -> Any:
     """A NumPy scalar or array as the Python value a study file would hold (``np.int64(40)``
-    is ``40``), so that it is validated like one; anything else as given."""
+    is ``40``), also inside lists and tables (``[{"sigma_mm": np.float32(1.0)}]``), so that
+    it is validated like one; anything else as given."""
     if isinstance(v, (np.generic, np.ndarray)):
         return v.tolist()
+    if isinstance(v, (list, tuple)):
+        return type(v)(_plain(x) for x in v)
+    if isinstance(v, dict):
+        return {k: _plain(x) for k, x in v.items()}
     return v
 
 

@@ -200,3 +200,15 @@ def test_verify_states_no_deviation_when_it_compared_nothing(tmp_path, capsys):
     out = capsys.readouterr().out
     assert rc == 1 and "mine: FAILED; nothing compared" in out and "deviation" not in out
     assert "no study file" in out
+
+
+def test_a_handle_is_hashable_and_numpy_values_nested_in_tables_are_plain():
+    """``hash(handle)`` (a set of handles, a cache key) raised the dataclass's TypeError on
+    its config dict; a NumPy scalar inside a list of tables was refused as "must be a finite
+    number (got np.float32(1.0))"."""
+    a, b, c = (sim.load(FIELD, trials=t) for t in (200, 200, 300))
+    assert hash(a) == hash(b) and len({a, b, c}) == 2
+    gen = sim.load(FIELD, trials=200).config["network.generate"]
+    gen = [{**g, "sigma_mm": np.float32(g["sigma_mm"])} if "sigma_mm" in g else g for g in gen]
+    h = sim.load(FIELD, trials=200, **{"network.generate": gen})
+    assert h.config["network.generate"][0]["sigma_mm"] == 1.0
