@@ -212,3 +212,16 @@ def test_a_handle_is_hashable_and_numpy_values_nested_in_tables_are_plain():
     gen = [{**g, "sigma_mm": np.float32(g["sigma_mm"])} if "sigma_mm" in g else g for g in gen]
     h = sim.load(FIELD, trials=200, **{"network.generate": gen})
     assert h.config["network.generate"][0]["sigma_mm"] == 1.0
+
+
+def test_a_defect_between_the_distance_constant_and_scale_names_their_keys(capsys):
+    """Distances all of one length cannot separate an estimated additive constant from an
+    estimated scale: the error blamed datum.kind and advised fixing points."""
+    gen = (
+        'network.generate=[{kind="distance",from="N*",to="N*",nearest=2,sigma_mm=1.0},'
+        '{kind="direction",from=["A","B","C","D"],to="*",sigma_arcsec=1.0}]'
+    )
+    args = ["check", str(FIELD), "--set", gen, "--set", "network.estimate_scale=true"]
+    args += ["--set", "network.estimate_constant=true"]
+    err = _one_line(capsys, main(args), "network.estimate_constant", "constant and the scale")
+    assert "datum.kind" not in err

@@ -320,6 +320,26 @@ def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
     )
 
 
+def _parameters(net, A: np.ndarray, free: np.ndarray, rank: int) -> None:
+    """A rank defect among the distances' constant and scale (and orientations) alone, no
+    coordinate in it: no datum covers it, so name the keys that estimate them."""
+    _, _, vt = np.linalg.svd(A, full_matrices=False)
+    w = (vt[rank:] ** 2).sum(axis=0)
+    involved = free[w > 1e-6 * w.max()]
+    if involved.min() < 2 * net.n:
+        return  # coordinates move: a datum defect, the caller's message
+    names = [net.parameter_names()[g - 2 * net.n] for g in involved]
+    pairs = (("network.estimate_constant", net.i_constant), ("network.estimate_scale", net.i_scale))
+    keys = [k for k, g in pairs if g in involved]
+    raise ConfigError(
+        keys[0] if keys else "network.observations",
+        f"the {' and the '.join(names)} cannot be told apart by these observations (a rank "
+        f"defect of {len(free) - rank} among them, no coordinate in it: no datum covers it): "
+        + ("estimate fewer of them, or " if keys else "")
+        + "add observations of other lengths or directions",
+    )
+
+
 def _defect(net, dt, key: str) -> None:
     free = dt.free_index(net.q)
     _, J = computed(net, net.theta_true()[None], jac=True)
@@ -328,6 +348,8 @@ def _defect(net, dt, key: str) -> None:
     rank = int((sv > sv[0] * 1e-10).sum()) if sv.size else 0
     if sv.size and rank == len(free):
         _weights(net, A, free, key)
+    if sv.size and rank < len(free):
+        _parameters(net, A, free, rank)
     C = dt.constraint_matrix(net.theta_true()[None])
     c = 0 if C is None else C.shape[-1]
     raise ConfigError(
