@@ -97,6 +97,11 @@ def _check_args(a) -> None:
 def _print(comps: list[Comparison]) -> None:
     for c in comps:
         status = "ok" if c.ok else "FAILED"
+        if not c.files and c.failures:  # nothing compared: no deviation to state
+            print(f"{c.study}: FAILED; nothing compared")
+            for f in c.failures[:20]:
+                print(f"  {f}")
+            continue
         print(
             f"{c.study}: {status}; {c.files} files; largest relative deviation "
             f"{c.max_rel:.2g}; largest deviation/tolerance {c.max_ratio:.2g} ({c.worst})"
