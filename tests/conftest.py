@@ -11,6 +11,7 @@ import re
 import resource
 import subprocess
 import sys
+import threading
 import tomllib
 from pathlib import Path
 
@@ -109,6 +110,41 @@ def tiny_command(name: str, out: Path, workers: int = 1, *extra: str) -> list[st
 ELSEWHERE = {"OPENBLAS_CORETYPE": "Sandybridge", "SIM_NO_JIT": "1"}
 
 
+def tiny_cache(base: Path) -> Path:
+    """The directory of the session's shared tiny runs: under the controller's base temporary
+    directory, which every ``pytest -n`` process shares (a worker's base lies inside it)."""
+    cache = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "tiny-runs"
+    cache.mkdir(exist_ok=True)
+    return cache
+
+
+def shared_tiny_run(cache: Path, name: str, *options: str, elsewhere: bool = False) -> Path:
+    """The shared tiny run of ``studies/<name>.toml`` with ``options`` in ``cache``, made by
+    the first process that asks for it (a lock per run; a failure recorded once): see
+    :func:`tiny_run`."""
+    key = "_".join([name, *(o.strip("-").replace("=", "-") for o in options)])
+    key = f"{key}-elsewhere" if elsewhere else key
+    assert re.fullmatch(r"[\w.-]+", key), f"options {options} make no directory name"
+    out, failed = cache / key, cache / f"{key}.failed"
+    env = dict(os.environ)
+    if elsewhere:
+        env.update(ELSEWHERE)
+    if elsewhere or options:  # tables only: the figures are the plain run's
+        options = (*options, "--no-figures")
+    else:
+        env.update(SIM_FIGURE_CHECK=str(cache / f"{key}.figures.jsonl"))
+    with open(cache / f"{key}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        if not out.exists() and not failed.exists():
+            cmd = tiny_command(name, out, 2 if elsewhere else 1, *options)
+            r = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+            if r.returncode != 0:
+                failed.write_text(f"exit {r.returncode}\n{r.stderr[-3000:]}")
+    if failed.exists():
+        pytest.fail(f"the shared tiny run {key} failed: {failed.read_text()}")
+    return out
+
+
 @pytest.fixture(scope="session")
 def tiny_run(tmp_path_factory):
     """``tiny_run(name, *options)``: the output directory of ``studies/<name>.toml`` run at
@@ -122,33 +158,44 @@ def tiny_run(tmp_path_factory):
     draws no figures (``--no-figures``): its tables are compared, and the figures are drawn by
     the plain run.
     READ ONLY: a test that edits a file copies it first."""
-    base = tmp_path_factory.getbasetemp()
-    cache = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "tiny-runs"
-    cache.mkdir(exist_ok=True)
+    cache = tiny_cache(tmp_path_factory.getbasetemp())
 
     def run(name: str, *options: str, elsewhere: bool = False) -> Path:
-        key = "_".join([name, *(o.strip("-").replace("=", "-") for o in options)])
-        key = f"{key}-elsewhere" if elsewhere else key
-        assert re.fullmatch(r"[\w.-]+", key), f"options {options} make no directory name"
-        out, failed = cache / key, cache / f"{key}.failed"
-        env = dict(os.environ)
-        if elsewhere:
-            env.update(ELSEWHERE)
-        if elsewhere or options:  # tables only: the figures are the plain run's
-            options = (*options, "--no-figures")
-        else:
-            env.update(SIM_FIGURE_CHECK=str(cache / f"{key}.figures.jsonl"))
-        with open(cache / f"{key}.lock", "w") as lock:
-            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
-            if not out.exists() and not failed.exists():
-                cmd = tiny_command(name, out, 2 if elsewhere else 1, *options)
-                r = subprocess.run(
-                    cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=600
-                )
-                if r.returncode != 0:
-                    failed.write_text(f"exit {r.returncode}\n{r.stderr[-3000:]}")
-        if failed.exists():
-            pytest.fail(f"the shared tiny run {key} failed: {failed.read_text()}")
-        return out
+        return shared_tiny_run(cache, name, *options, elsewhere=elsewhere)
 
     return run
+
+
+#: the shared tiny runs that compile the suite's numba kernels (on a fresh clone no kernel is
+#: in numba's cache yet): Brown's multilateration kernel (about 11 s of CPU), Wolf's error
+#: field and polynomial fit, Agnard's group kernels. ``make test`` (``pytest -n``, the whole
+#: suite) makes them first, two lines side by side in its controlling process, so that each
+#: kernel is compiled once, and not by several processes that start before its cache is
+#: written. The test processes start meanwhile and wait for a run they need (its lock).
+FIRST_RUNS = (("brown_table1", "brown_design"), ("wolf_polynomial", "agnard_block"))
+_FIRST: list = []
+
+
+def pytest_sessionstart(session):
+    config = session.config
+    whole = config.args_source is pytest.Config.ArgsSource.TESTPATHS
+    if hasattr(config, "workerinput") or not whole or not config.getoption("numprocesses", 0):
+        return
+    cache = tiny_cache(config._tmp_path_factory.getbasetemp())
+
+    def make(names):
+        for name in names:
+            try:
+                shared_tiny_run(cache, name)
+            except BaseException:  # recorded in <run>.failed; the test that needs it says so
+                pass
+
+    for names in FIRST_RUNS:
+        t = threading.Thread(target=make, args=(names,), daemon=True)
+        t.start()
+        _FIRST.append(t)
+
+
+def pytest_sessionfinish(session):
+    for t in _FIRST:
+        t.join()
