@@ -3,6 +3,7 @@ model block adjustment (reduced normals), data snooping, study config and a tiny
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -366,12 +367,14 @@ def _tiny_overrides():
 
 
 @pytest.fixture(scope="module")
-def tiny_run(tmp_path_factory):
-    from sim.studies import RunContext
+def tiny_run(tiny_run):
+    """The session's shared tiny run of agnard_block (conftest.py: its tables are read here,
+    its figures were checked as they were drawn), with the study and its config."""
+    from sim.mc.storage import read_provenance
 
-    out = tmp_path_factory.mktemp("agnard_tiny")
     study, cfg = load_study(STUDY, _tiny_overrides(), trials=4)
-    study.run(cfg, out, RunContext(quiet=True))
+    out = tiny_run("agnard_block")
+    assert read_provenance(out / "claims.parquet")["config"] == json.loads(json.dumps(cfg))
     return study, cfg, out
 
 

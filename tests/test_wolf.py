@@ -357,27 +357,13 @@ def test_cells_share_instruments_and_default_cell_equals_main():
     assert np.mean(cells["s.repeat.rms_x_um"]) < 0.7 * np.mean(cells["d.repeat.rms_x_um"])
 
 
-def test_study_runs_and_reports(tmp_path):
+def test_study_runs_and_reports(tiny_run):
+    """The session's shared tiny run of wolf_polynomial (tests/data/tiny/wolf_polynomial.txt:
+    its figures were checked as they were drawn): every claim scored once, the paper's errata
+    recomputed from the transcribed coordinates, the region rows by their points' rule."""
     from sim.mc.storage import read_table
-    from sim.studies import RunContext
 
-    cfg = {
-        "study": "wolf_polynomial",
-        **_cfg(
-            **{
-                "trade.degrees": [1, 3],
-                "trade.spacings_mm": [20.0, 50.0],
-                "trade.n_sets": [1, 3],
-                "trade.readings": [1, 3],
-                "trade.pointing_sigmas_um": [7.0],
-                "trade.ages_weeks": [0.0, 52.0],
-                "trade.drift_fractions": [0.5],
-                "region.points": 4,
-                "region.rounds": 0,
-            }
-        ),
-    }
-    wolf.run(cfg, tmp_path, RunContext(quiet=True))
+    tmp_path = tiny_run("wolf_polynomial")
     claims = read_table(tmp_path / "claims.parquet").to_pydict()
     by = {c: i for i, c in enumerate(claims["claim"])}
     from sim.studies.wolf.claims import load_book
