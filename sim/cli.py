@@ -34,7 +34,7 @@ from sim.cli_args import parser
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
-from sim.mc.outputs import name_problem
+from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
@@ -287,7 +287,7 @@ def _report(results: Path) -> int:
     user's with none gets no REPORT.md written into it)."""
     if results.is_dir() and not any(
         (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
-        for d in results.iterdir()
+        for d in results_dirs(results)
     ):
         raise ConfigError(
             "--results", f"no study results in {results} (no */claims.parquet): nothing to report"

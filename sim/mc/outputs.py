@@ -68,6 +68,14 @@ def stage_dir(out: Path) -> Path:
     return out.parent / f".{out.name}{STAGE_SUFFIX}"
 
 
+def results_dirs(results: Path) -> list[Path]:
+    """The entries directly under ``results`` that may hold a study's results: every one but
+    a run's hidden working directories (its staging :func:`stage_dir`, ``.<name>.partial``,
+    and :func:`swap_dir`, ``.<name>.old.<pid>``), which hold unfinished or replaced results
+    (``sim report`` listed an interrupted run's staging directory as a study of its own)."""
+    return [p for p in Path(results).iterdir() if not p.name.startswith(".")]
+
+
 def swap_dir(out: Path) -> Path:
     """Where :func:`publish` moves the old results of ``out`` while it swaps the new ones in:
     ``.<name>.old.<pid>``."""
