@@ -18,7 +18,14 @@ The command line is :mod:`benchmarks.cli`. Nothing here is study code (:mod:`sim
 
 from __future__ import annotations
 
-from benchmarks.cli import main
-from benchmarks.timing import cpu_time, numpy_path
+import sys
+
+from sim.threads import refuse_bad_environment
+
+if sys.argv[:1] == ["-m"]:  # python -m benchmarks, while this package loads (as sim.report.verify)
+    refuse_bad_environment("benchmarks")  # a variable NumPy cannot load with: one line, exit 2
+
+from benchmarks.cli import main  # noqa: E402
+from benchmarks.timing import cpu_time, numpy_path  # noqa: E402
 
 __all__ = ["main", "cpu_time", "numpy_path"]

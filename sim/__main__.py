@@ -4,9 +4,10 @@ an unwritable config directory kept quiet, then the command line."""
 import logging
 import sys
 
-from sim.threads import interrupt_while_loading, single_threaded_blas
+from sim.threads import interrupt_while_loading, refuse_bad_environment, single_threaded_blas
 
 loaded = interrupt_while_loading("sim")  # Ctrl-C during the imports: one line, exit 130
+refuse_bad_environment("sim")  # a variable NumPy cannot load with: one line, exit 2
 single_threaded_blas()  # before NumPy loads (sim.cli imports it)
 
 

@@ -15,6 +15,7 @@ executors, and the rule that nothing the suite did not write is ever replaced.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import tempfile
 from dataclasses import dataclass, field
@@ -102,6 +103,10 @@ class StudyHandle:
     config: dict = field(repr=False)
     overrides: dict = field(default_factory=dict, repr=False)
     sweep: dict = field(default_factory=dict, repr=False)
+    file_sha256: str = field(default="", repr=False)
+
+    def __hash__(self) -> int:  # the dataclass's would hash the config dict: TypeError
+        return hash((self.path, self.file_sha256, repr(sorted(self.overrides.items()))))
 
     @property
     def name(self) -> str:
@@ -113,6 +118,7 @@ class StudyHandle:
 
     def replace(self, **overrides) -> "StudyHandle":
         """A new handle with more overrides."""
+        _unchanged(self)
         return load(self.path, **{**self.overrides, **{_key(k): v for k, v in overrides.items()}})
 
     def run(
@@ -139,6 +145,7 @@ class StudyHandle:
         for name, v in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures)):
             if not isinstance(v, bool):
                 raise ConfigError(name, f"must be True or False (got {v!r})")
+        _unchanged(self)
         h = (
             self
             if trials is None and seed is None
@@ -171,6 +178,22 @@ class StudyHandle:
             figures=figures,
         )
         return Results(out, h.name)
+
+
+def _sha256(path: Path) -> str:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return ""
+
+
+def _unchanged(h: StudyHandle) -> None:
+    """A handle runs the file it loaded: its config is that file's, and ``replace`` or
+    ``run(trials=...)`` read the file again, so an edited (or deleted) file would give one
+    handle two configs. Refused, as an edited ``network.gama_xml`` is."""
+    if h.file_sha256 and _sha256(h.path) != h.file_sha256:
+        state = "has changed" if h.path.is_file() else "is gone"
+        raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
 
 
 def _check_owner(p: Path, study: str) -> None:
@@ -214,9 +237,14 @@ def _check_int(name: str, v: Any) -> None:
 
 def _plain(v: Any) -> Any:
     """A NumPy scalar or array as the Python value a study file would hold (``np.int64(40)``
-    is ``40``), so that it is validated like one; anything else as given."""
+    is ``40``), also inside lists and tables (``[{"sigma_mm": np.float32(1.0)}]``), so that
+    it is validated like one; anything else as given."""
     if isinstance(v, (np.generic, np.ndarray)):
         return v.tolist()
+    if isinstance(v, (list, tuple)):
+        return type(v)(_plain(x) for x in v)
+    if isinstance(v, dict):
+        return {k: _plain(x) for k, x in v.items()}
     return v
 
 
@@ -250,5 +278,9 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
         if not _key(k).strip(".").strip() or not k.isprintable():
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
     vals = {_key(k): _plain(v) for k, v in overrides.items()}
+    sha = _sha256(study_file)
     study, cfg = _load_picking_chunk(study_file, vals)
-    return StudyHandle(study_file, study, cfg, vals, read_sweep(study_file, study.schema))
+    sweep = read_sweep(study_file, study.schema)
+    if _sha256(study_file) != sha:  # written to while it was read: which version is this?
+        raise ConfigError("study_file", f"{study_file} changed while it was loaded: load it again")
+    return StudyHandle(study_file, study, cfg, vals, sweep, sha)

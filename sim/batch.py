@@ -34,14 +34,16 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from sim.threads import interrupt_while_loading, single_threaded_blas
+from sim.threads import interrupt_while_loading, refuse_bad_environment, single_threaded_blas
 
 _loaded = interrupt_while_loading("sim.batch")  # Ctrl-C during the imports: one line, exit 130
+if __name__ == "__main__":
+    refuse_bad_environment("sim.batch")  # a variable NumPy cannot load with: one line, exit 2
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 
-from sim.cli import __doc__ as cli_doc  # noqa: E402
+from sim.cli import DOC as cli_doc  # noqa: E402
 from sim.cli import check_run_args, load_run  # noqa: E402
-from sim.cli_args import OnceParser  # noqa: E402
+from sim.cli_args import OnceParser, module_doc  # noqa: E402
 from sim.cli_args import parser as run_parser  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, stop_children  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
@@ -278,7 +280,9 @@ def _main(argv: list[str]) -> int:
     if "--" in argv:
         i = argv.index("--")
         argv, run_args = argv[:i], argv[i + 1 :]
-    ap = _Parser(prog="python -m sim.batch", description=__doc__.splitlines()[0])
+    ap = _Parser(
+        prog="python -m sim.batch", description=module_doc(__doc__, __file__).partition("\n")[0]
+    )
     ap.add_argument("files", nargs="+", help="study files")
     ap.add_argument("--jobs", type=int, default=2, help="studies run at a time (default 2)")
     ap.add_argument("--results", default="results", help="results directory (default results)")
@@ -322,8 +326,9 @@ def _main(argv: list[str]) -> int:
     if not 1 <= args.jobs <= 64:
         print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
         return 2
+    log = _Stdout()
     try:
-        done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only)
+        done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only, log)
     except KeyboardInterrupt:  # the runs were stopped and cleaned up
         print(
             "sim.batch: interrupted; the same command again resumes the unfinished runs",
@@ -333,7 +338,31 @@ def _main(argv: list[str]) -> int:
     if args.timings is not None:
         Path(args.timings).write_text(json.dumps(done), encoding="utf-8")
     failed = [v[0] for v in done.values() if v[0] != 0]
+    if log.error is not None and not isinstance(log.error, BrokenPipeError):
+        print(f"sim.batch: standard output: {log.error.strerror or log.error}", file=sys.stderr)
+        return (failed[0] if failed[0] > 0 else 1) if failed else 2
     return (failed[0] if failed[0] > 0 else 1) if failed else 0
+
+
+class _Stdout:
+    """``print`` to standard output for :func:`run_all`'s lines, which keeps the first failed
+    write (``> /dev/full``; ``| head -1``, a broken pipe) instead of raising it in a run's
+    thread: that was a traceback while the other runs went on; now every run ends, the
+    timings are written and the driver ends with one line (a broken pipe: quietly)."""
+
+    def __init__(self) -> None:
+        self.error: OSError | None = None
+
+    def __call__(self, text: str) -> None:
+        if self.error is None:
+            try:
+                print(text, flush=True)
+            except OSError as e:
+                self.error = e
+                try:  # what is left in the buffer is dropped, not retried at exit
+                    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+                except (OSError, ValueError):
+                    pass
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import linecache
 import os
 import re
 import signal
@@ -30,7 +31,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.cli_args import parser
+from sim.cli_args import module_doc, parser
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
@@ -44,6 +45,9 @@ from sim.report.run_summary import run_markdown, terminal_summary, terminal_tabl
 from sim.studies import get_study, load_study
 
 __all__ = ["main", "check_run_args"]
+
+#: the usage text of ``sim`` (the module docstring, also under ``python -OO``)
+DOC = module_doc(__doc__, __file__)
 
 #: exit code of an internal error (a bug, not bad input): one line, traceback with SIM_DEBUG=1
 INTERNAL = 3
@@ -312,6 +316,20 @@ def _cwd_exists() -> bool:
     return True
 
 
+def _stdout_failed(e: OSError) -> bool:
+    """Whether ``e`` came from printing to standard output (``sim check > /dev/full``): such
+    a write fails without a file name, and the line said only "No space left on device"
+    (after a run's results had been written). Judged by the innermost line it was raised
+    on: a ``print`` to standard output, or ``sys.stdout`` itself."""
+    tb = e.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    if tb is None:
+        return False
+    line = linecache.getline(tb.tb_frame.f_code.co_filename, tb.tb_lineno)
+    return ("print(" in line and "file=" not in line) or "sys.stdout" in line
+
+
 def _why(e: OSError) -> str:
     """The reason of an OSError in words: its strerror, or (pyarrow raises
     ``FileNotFoundError(path)`` without one) the name of its kind."""
@@ -333,7 +351,7 @@ def main(argv: list[str] | None = None) -> int:
     old = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
     try:
         if not argv:  # usage, not an error message
-            parser(__doc__).print_help()
+            parser(DOC).print_help()
             return 2
         return _main(argv)
     except BrokenPipeError:  # sim check ... | head: the reader left, nothing to say
@@ -352,7 +370,7 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str]) -> int:
     args = None
     try:
-        args = parser(__doc__).parse_args(argv)
+        args = parser(DOC).parse_args(argv)
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
@@ -387,6 +405,8 @@ def _main(argv: list[str]) -> int:
             name = e.args[0]  # pyarrow's FileNotFoundError(path)
         if not name and not _cwd_exists():
             name = "the working directory (it was deleted)"
+        if not name and _stdout_failed(e):
+            name = "standard output"
         print(f"sim: error: {_why(e)}: {name}".rstrip(": "), file=sys.stderr)
         return 2
     except UnicodeEncodeError as e:  # a text the terminal's encoding cannot show (ascii)

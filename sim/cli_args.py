@@ -4,12 +4,14 @@ and its options, with one-line errors (exit 2 through :func:`sim.cli.main`)."""
 from __future__ import annotations
 
 import argparse
+import ast
 from importlib import metadata
+from pathlib import Path
 
 from sim.mc.config import ConfigError
 from sim.mc.runner import MIN_CHUNKS
 
-__all__ = ["OnceParser", "parser"]
+__all__ = ["OnceParser", "module_doc", "parser"]
 
 
 class _Once(argparse.Action):
@@ -50,6 +52,19 @@ class _Parser(OnceParser):
 
     def error(self, message: str):
         raise ConfigError(None, f"{self.prog}: {message} (see {self.prog} --help)")
+
+
+def module_doc(doc: str | None, path: str) -> str:
+    """A module's docstring ``doc``, or, under ``python -OO`` (which strips docstrings, so
+    ``doc`` is None and ``sim`` ended in an AttributeError), the same text read from the
+    module's source ``path``; "" when neither can be had."""
+    if doc is not None:
+        return doc
+    try:
+        tree = ast.parse(Path(path).read_text(encoding="utf-8"))
+    except (OSError, SyntaxError, ValueError):
+        return ""
+    return ast.get_docstring(tree, clean=False) or ""
 
 
 def _version() -> str:

@@ -7,6 +7,7 @@ before anything imports NumPy; the environment of the caller wins.
 
 import os
 import signal
+import sys
 import threading
 
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
@@ -35,3 +36,21 @@ def interrupt_while_loading(prog: str):
 
     signal.signal(signal.SIGINT, handler)
     return lambda: signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+def refuse_bad_environment(prog: str) -> None:
+    """Exit 2 with one line when the environment holds a value that breaks loading NumPy or
+    SciPy: ``SOURCE_DATE_EPOCH`` that is not an integer ended every command in a traceback
+    from ``numpy.f2py`` (imported by ``scipy.sparse``). Called by the entry points before
+    anything imports NumPy."""
+    v = os.environ.get("SOURCE_DATE_EPOCH")
+    if v is None:
+        return
+    try:
+        int(v)  # as numpy.f2py reads it
+    except ValueError:
+        sys.stderr.write(
+            f"{prog}: error: SOURCE_DATE_EPOCH: must be an integer, seconds since 1970 "
+            f"(got {v!r}); NumPy reads it while loading\n"
+        )
+        sys.exit(2)

@@ -14,6 +14,7 @@ error amplitude); the report lists them so nobody mistakes them for predictions.
 
 from __future__ import annotations
 
+import codecs
 import difflib
 import math
 import tomllib
@@ -189,11 +190,12 @@ def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
     unit suffix (``comparator.beta`` -> ``comparator.beta_mm``), the same last part under
     another table, or the closest spellings (difflib)."""
     names = list(schema)
+    same_case = [s for s in names if s.lower() == key.lower()]  # TRIALS: no guess before
     suffixed = [s for s in names if s.startswith(key + "_") and "." not in s[len(key) :]]
     last = key.split(".")[-1]
     same_last = [s for s in names if s.split(".")[-1] == last]
     close = difflib.get_close_matches(key, names, n=n, cutoff=0.75)
-    return list(dict.fromkeys(suffixed + same_last + close))[:n]
+    return list(dict.fromkeys(same_case + suffixed + same_last + close))[:n]
 
 
 def validate(
@@ -258,6 +260,10 @@ MAX_STUDY_BYTES = 16 * 1024**2
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML study file; a missing, oversized or malformed file is a ConfigError."""
     p = Path(path)
+    if p.is_dir():  # both were "no such study file", of a file that is there
+        raise ConfigError(None, f"{p}: is a directory, not a study file")
+    if p.exists() and not p.is_file():  # a pipe (cat x.toml | sim check /dev/stdin), a device
+        raise ConfigError(None, f"{p}: not a regular file (a pipe or a device): name the file")
     if not p.is_file():
         raise ConfigError(None, f"{p}: no such study file")
     try:
@@ -265,10 +271,16 @@ def read_toml(path: str | Path) -> dict[str, Any]:
             raise ConfigError(
                 None, f"{p}: over {MAX_STUDY_BYTES // 1024**2} MiB, too large for a study file"
             )
-        with p.open("rb") as fh:
-            doc = tomllib.load(fh)
+        data = p.read_bytes()
+        if data.startswith(codecs.BOM_UTF8):  # a Windows editor's UTF-8 signature: not TOML,
+            data = data[len(codecs.BOM_UTF8) :]  # and no part of the text; it was refused
+        if b"\x00" in data:  # as malformed TOML at line 1, column 1 (doors12)
+            raise ConfigError(None, f"{p}: not UTF-8 text (it holds NUL bytes: UTF-16 or binary)")
+        doc = tomllib.loads(data.decode("utf-8"))
         refuse_big_ints("", doc)
         return doc
+    except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again
+        raise
     except tomllib.TOMLDecodeError as e:
         raise ConfigError(None, f"{p}: malformed TOML: {e}") from None
     except RecursionError:

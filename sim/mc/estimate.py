@@ -8,6 +8,19 @@ order-of-magnitude model of the study's arrays (observations x unknowns x trials
 with a safety factor for copies), meant to stop a run that would hang or be killed for want
 of memory, not to predict its time.
 
+The work is counted in adjustments. The unit, :data:`ADJUSTMENT_S` seconds of one core of the
+2-core reference machine, is one adjustment of the kind the Monte-Carlo parts solve (a third of
+a trial of brown_design's check on the paper's plate, 57 unknowns). A part whose one step costs
+far more than that unit is counted in adjustment-equivalents (its measured seconds over
+:data:`ADJUSTMENT_S`): brown_design's analytic design grid, whose cofactor of an n-point grid
+costs ~(2n)^3 per geometry (~k^6 for a k x k grid, :func:`design_grid_equivalents`); a dense
+adjustment larger than the unit (Wolf's polynomial fit, the network's dense path) as m U^2 +
+U^3 against the unit's (:func:`sim.mc.workunits.dense_units`); an Agnard block adjustment per model of its block
+(:data:`AGNARD_MODEL_UNITS`). Each was measured on the reference machine. Such an
+analytic part runs before the first progress bar and cannot be resumed, so it may take at most
+:data:`ANALYTIC_SHARE` of the work limit (by default about 25 s on one core); over that the
+run stops naming the key that sets its size (``design.grids``) and its minutes.
+
 Limits: ``--max-memory-gb`` (env ``SIM_MAX_MEMORY_GB``, default 8 GiB: a third of a 24 GiB
 machine) and ``--max-adjustments`` (env ``SIM_MAX_ADJUSTMENTS``, default 5e8: hours on two
 cores). A run over a limit stops at once with the estimate in the message (exit 2). Sweeps are
@@ -27,6 +40,15 @@ from typing import Any, Callable, Mapping
 from sim.lsq.size import SPARSE_MIN_UNKNOWNS
 from sim.mc.config import ConfigError
 from sim.mc.sweep import MAX_CELLS, expand
+from sim.mc.workunits import (
+    ADJUSTMENT_S,
+    F8,
+    design_grid_equivalents,
+)
+from sim.mc.workunits import dense_units as _dense
+from sim.mc.workunits import design_estimate as _design
+from sim.mc.workunits import max_of as _max
+from sim.mc.workunits import n_of as _n
 
 __all__ = [
     "Estimate",
@@ -35,12 +57,17 @@ __all__ = [
     "MAX_CELLS",
     "DEFAULT_MAX_MEMORY_GB",
     "DEFAULT_MAX_ADJUSTMENTS",
+    "ADJUSTMENT_S",
+    "ANALYTIC_SHARE",
+    "design_grid_equivalents",
 ]
 
 DEFAULT_MAX_MEMORY_GB = 8.0
 DEFAULT_MAX_ADJUSTMENTS = 5e8
-F8 = 8.0  # bytes of a float64
 COPIES = 6.0  # working copies of the largest array (residuals, Jacobian, ...)
+#: an analytic part (no progress bar, nothing to resume) may take at most this share of the
+#: work limit: 5e5 adjustment-equivalents, about 25 s on one core, at the default 5e8
+ANALYTIC_SHARE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -54,14 +81,24 @@ class Estimate:
     bytes: float  # largest working set of one chunk, bytes
     cells: int = 1  # sweep cells x replicates
     largest: str = ""  # the part whose chunk (or analytic stack) needs ``bytes``, if named
+    analytic: float = 0.0  # adjustment-equivalents of the largest analytic part (one cell)
+    analytic_key: str = ""  # the key that sets that part's size (``design.grids``)
+    analytic_part: str = ""  # that part, named
 
     def describe(self, workers: int = 1) -> str:
-        """One line: trials, adjustments, unknowns and the memory of ``workers`` processes."""
+        """One line: trials, adjustments (analytic parts in adjustment-equivalents, each
+        :data:`ADJUSTMENT_S` s of one core), unknowns and the memory of ``workers``
+        processes."""
         if isinstance(workers, bool) or not isinstance(workers, Integral) or workers < 1:
             raise ConfigError("workers", f"must be a whole number >= 1 (got {workers!r})")
         cells = f" in {self.cells} sweep cells" if self.cells > 1 else ""
+        eq = (
+            f" (with {self.analytic:.3g} adjustment-equivalents of analytic work)"
+            if self.analytic >= 1
+            else ""
+        )
         return (
-            f"{self.trials:,} trials{cells}, about {self.adjustments:.3g} adjustments of up "
+            f"{self.trials:,} trials{cells}, about {self.adjustments:.3g} adjustments{eq} of up "
             f"to {self.unknowns:,} unknowns, about {_gib(self.bytes * max(workers, 1))} of "
             "memory"
         )
@@ -69,17 +106,6 @@ class Estimate:
 
 def _gib(b: float) -> str:
     return f"{b / 2**30:.3g} GiB" if b >= 2**27 else f"{b / 2**20:.3g} MiB"
-
-
-def _n(v: Any) -> float:
-    try:
-        return float(len(v)) if isinstance(v, (list, tuple)) else float(v)
-    except (TypeError, ValueError):
-        return 0.0
-
-
-def _max(v, default=0.0) -> float:
-    return max((float(x) for x in v), default=default) if isinstance(v, (list, tuple)) else default
 
 
 def _min(v, default=1.0) -> float:
@@ -112,69 +138,6 @@ def _brown(c: Mapping) -> tuple:
     )
     b = max(ch * 4 * n * U * F8, 4 * n_an * 7 * F8 * 3) * COPIES
     return T, T * per + analytic, max(U, 2 * n_an + 7), b
-
-
-#: float64 values a brown_design Monte-Carlo chunk holds per range of a trial (measured with
-#: tracemalloc: about 30-100 for the P-position solver and 50-100 for the 4-station one)
-DESIGN_RANGE_VALUES = 128
-#: copies of the (geometries, 2n, 2n) cofactor stack the analytic design grid holds at its
-#: peak (measured: 4.07 x for grids of 10 and 15 points per side, any number of positions)
-DESIGN_COFACTOR_COPIES = 5.0
-
-
-def _design_mc(ch: float, P: float, n: float) -> float:
-    """Bytes of one Monte-Carlo chunk of ``ch`` trials of ``n`` points seen from ``P``
-    positions: the per-range arrays of every trial, and the (2n, 2n) inner-datum matrix and
-    its product, once per chunk."""
-    return ch * P * n * DESIGN_RANGE_VALUES * F8 + 2 * (2 * n) ** 2 * F8
-
-
-def _design(c: Mapping) -> tuple:
-    """brown_design, each part with its own geometry: the Monte-Carlo check, the error budget
-    and the posterior on the paper's plate (``paper.positions`` x ``paper.grid``), the
-    coverage on 4 stations over ``coverage.grids`` and ``datum.grid``; the design grid
-    (``design.*``) is analytic, one (geometries, 2n, 2n) cofactor stack per grid, the
-    geometries its offsets x betas, not a chunk of trials."""
-    lists = [
-        c.get(f"design.{k}", [1])
-        for k in (
-            "positions",
-            "offsets_mm",
-            "grids",
-            "extents_mm",
-            "settings",
-            "setting_sigma_um",
-            "beta_mm",
-        )
-    ]
-    cells = math.prod(max(len(v), 1) for v in lists)
-    G = _max(c.get("design.grids"), 5)
-    n = G * G
-    U = 2 * n + 7
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
-    cov_T = c.get("coverage.trials", 0)
-    sw_T = c.get("coverage.sweep_trials", 0) * (
-        _n(c.get("coverage.noise_um", []))
-        + _n(c.get("coverage.grids", []))
-        + _n(c.get("coverage.betas_mm", []))
-    )
-    budget = 6 * c.get("budget.max_trials", 0)
-    bayes = c.get("bayes.walkers", 0) * c.get("bayes.steps", 0) * 2
-    trials = T + cov_T + sw_T + budget
-    adj = cells * 3 + T * 3 + cov_T * 2 + sw_T * 2 + budget + bayes
-    n_paper = c.get("paper.grid", 5) ** 2
-    nc = max(_max(c.get("coverage.grids"), 5) ** 2, c.get("datum.grid", 5) ** 2)
-    geometries = _n(c.get("design.offsets_mm", [1])) * _n(c.get("design.beta_mm", [1]))
-    parts = {
-        "the Monte-Carlo check on the paper's plate": _design_mc(
-            ch, c.get("paper.positions", 4), n_paper
-        ),
-        "the coverage": _design_mc(ch, 4, nc),
-        f"the analytic design grid ({int(geometries)} offset x beta geometries of {int(G)} x "
-        f"{int(G)} points)": DESIGN_COFACTOR_COPIES * geometries * (2 * n) ** 2 * F8,
-    }
-    what = max(parts, key=parts.get)
-    return trials, adj, max(U, 2 * int(max(nc, n_paper)) + 7), parts[what], what
 
 
 def _gridplate(c: Mapping) -> tuple:
@@ -245,8 +208,12 @@ def _wolf(c: Mapping) -> tuple:
         )
     )
     trials = T + Tt * (_n(c.get("trade.spacings_mm", [])) + rd_cells + 1) + Tu
+    # each adjustment fits the pooled sets' points (x and y) with U (or Ut) unknowns
+    w, wt = _dense(2 * n * sets, U), _dense(2 * nt * nsets, Ut)
     adj = (
-        T * (sets + 2) + Tt * (deg_cells + rd_cells * (sets + 2) + ages) + Tu * u_cells * (sets + 2)
+        T * (sets + 2) * w
+        + Tt * (deg_cells + rd_cells * (sets + 2) + ages) * wt
+        + Tu * u_cells * (sets + 2) * w
     )
     b = (
         max(
@@ -258,6 +225,13 @@ def _wolf(c: Mapping) -> tuple:
         * COPIES
     )
     return trials, adj, max(U, Ut), b
+
+
+#: unit adjustments one block adjustment costs per model of the block (its reduced normals are
+#: 7 x 7 blocks coupled to a few neighbours: the work grows with the models). Measured from
+#: tiny runs' CPU time (20 trials, 3,800 counted adjustments): 2 x 8 models 43 units an
+#: adjustment, 4 x 25 models 350 (8x the time for 6x the models, the same count before)
+AGNARD_MODEL_UNITS = 3.5
 
 
 def _agnard(c: Mapping) -> tuple:
@@ -277,11 +251,12 @@ def _agnard(c: Mapping) -> tuple:
     sT, s_cells = c.get("sweep.trials", 0), _n(c.get("sweep.five_inset", []))  # swept layout
     trials = T + tT * (dp + rc) + bT * len(sizes) + sT * s_cells
     snoop = 1 + c.get("snoop.max_reject", 0)
+    w, wt = AGNARD_MODEL_UNITS * M, AGNARD_MODEL_UNITS * Mt  # unit adjustments a block solve
     adj = (
-        T * (3 + layouts) * snoop
-        + tT * (2 * dp + rc) * snoop
-        + bT * len(sizes) * 2
-        + sT * s_cells * 3 * snoop
+        T * (3 + layouts) * snoop * w
+        + tT * (2 * dp + rc) * snoop * w
+        + bT * len(sizes) * 2 * wt
+        + sT * s_cells * 3 * snoop * w
     )
     # reduced normal equations of the models (7 x 7 blocks coupled through the points); the
     # block-size trade-off bounds its chunk by the pair blocks (4e6 floats)
@@ -369,9 +344,11 @@ def _network(c: Mapping) -> tuple:
         s = 6.0  # Jacobian slots of a distance or direction row
         nnz_l = m * s * s * max(math.log2(max(U, 2)), 1.0) / 3 + 4 * U
         b = 3 * F8 * (ch * m * (s + 3) + 3 * ch * U) + 3 * 16 * nnz_l
+        w = 1.0  # the sparse path: its work grows with the factor's nonzeros, as its memory
     else:
         b = ch * m * (U + 1) * F8 * COPIES
-    return T, T + 2, int(U), b
+        w = _dense(m, U)  # the dense path: m U^2 + U^3 a trial
+    return T, T * w + 2, int(U), b
 
 
 def _generic(c: Mapping) -> tuple:
@@ -392,14 +369,17 @@ ESTIMATORS: dict[str, Callable[[Mapping], tuple]] = {
 
 
 def _one(cfg: Mapping) -> tuple:
-    """``(trials, adjustments, unknowns, bytes, the part needing the bytes or "")``."""
+    """``(trials, adjustments, unknowns, bytes, the part needing the bytes or "", (analytic
+    adjustment-equivalents, key, part))``; an estimator may leave out the last two."""
     fn = ESTIMATORS.get(cfg.get("study"), _generic)
     try:
-        t, a, u, b, *what = fn(cfg)
+        t, a, u, b, *rest = fn(cfg)
     except (TypeError, ValueError, KeyError, OverflowError, ZeroDivisionError):
-        t, a, u, b, *what = _generic(cfg)
+        t, a, u, b, *rest = _generic(cfg)
     fix = lambda x: x if isinstance(x, (int, float)) and not math.isnan(x) else math.inf  # noqa: E731
-    return fix(t), fix(a), fix(u), fix(b), (what or [""])[0]
+    what = rest[0] if rest else ""
+    eq, key, part = rest[1] if len(rest) > 1 else (0.0, "", "")
+    return fix(t), fix(a), fix(u), fix(b), what, (fix(eq), key, part)
 
 
 def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> Estimate:
@@ -414,9 +394,19 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
     A = sum(p[1] for p in parts) * reps
     U = max(p[2] for p in parts)
     B, what = max((p[3], p[4]) for p in parts)
+    eq, key, part = max((p[5] for p in parts), key=lambda x: x[0])  # one cell's, not the sum
     big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
     return Estimate(
-        str(cfg.get("study")), big(T), float(A), big(U), float(B), len(cfgs) * reps, what
+        str(cfg.get("study")),
+        big(T),
+        float(A),
+        big(U),
+        float(B),
+        len(cfgs) * reps,
+        what,
+        float(eq),
+        key,
+        part,
     )
 
 
@@ -441,7 +431,9 @@ def check_limits(
     max_adjustments: float | None = None,
     workers: int = 1,
 ) -> None:
-    """Stop (ConfigError, one line with the estimate) a run over the memory or work limit."""
+    """Stop (ConfigError, one line with the estimate) a run over the memory or work limit, or
+    whose analytic part would run silently for more than :data:`ANALYTIC_SHARE` of the work
+    limit (named by its key, in minutes on the reference machine)."""
     mem = _limit(max_memory_gb, "SIM_MAX_MEMORY_GB", DEFAULT_MAX_MEMORY_GB, "--max-memory-gb")
     adj = _limit(
         max_adjustments, "SIM_MAX_ADJUSTMENTS", DEFAULT_MAX_ADJUSTMENTS, "--max-adjustments"
@@ -462,3 +454,20 @@ def check_limits(
             f"limit of {adj:.3g} adjustments (--max-adjustments or "
             "SIM_MAX_ADJUSTMENTS); reduce trials or the lists in the study file",
         )
+    if not est.analytic <= adj * ANALYTIC_SHARE:
+        raise ConfigError(
+            est.analytic_key or None,
+            f"{est.study}: {est.analytic_part or 'an analytic part'} needs about "
+            f"{est.analytic:.3g} adjustment-equivalents, about "
+            f"{_minutes(est.analytic * ADJUSTMENT_S)} of one core of the reference machine "
+            f"before the first progress bar, over the {adj * ANALYTIC_SHARE:.3g} an analytic "
+            f"part may take ({ANALYTIC_SHARE:g} of the limit of {adj:.3g} adjustments, "
+            "--max-adjustments or SIM_MAX_ADJUSTMENTS); use fewer points per side or fewer "
+            "positions, extents, offsets or betas, or raise the limit",
+        )
+
+
+def _minutes(s: float) -> str:
+    if not math.isfinite(s):
+        return "forever"
+    return f"{s / 60:.2g} min" if s < 3600 * 10 else f"{s / 3600:.3g} h"

@@ -36,16 +36,21 @@ __all__ = [
 
 def name_problem(text: str) -> str | None:
     """Why a path given on the command line cannot name a file of the suite, in a few words
-    (None: it can): empty or blank, a control character or a line break, or bytes that are
-    not UTF-8 text (a Latin-1 name, or any non-ASCII name in a C locale without UTF-8 mode,
-    which Python keeps as surrogate escapes; the suite writes every path it records as UTF-8,
-    so such a run would fail at its end)."""
+    (None: it can): empty or blank, a control character or a line break, a leading ``~``
+    the shell left unexpanded, or bytes that are not UTF-8 text (a Latin-1 name, or any
+    non-ASCII name in a C locale without UTF-8 mode, which Python keeps as surrogate escapes;
+    the suite writes every path it records as UTF-8, so such a run would fail at its end)."""
     if not text.strip():
         return "is empty"
     if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text):
         return "contains a control character or a line break"
     if any(unicodedata.category(c) == "Cs" for c in text):
         return "contains bytes that are not UTF-8 text (a non-UTF-8 name or locale)"
+    if text.startswith("~"):  # --out=~/x: the shell expands no ~ after "=", and a directory
+        return (  # named "~" was made here, which "rm -rf ~" would then mistake for home
+            "starts with '~', which the shell did not expand (it does not after '='): use "
+            "$HOME, or a space for the '=' (./~ names a file that starts with ~)"
+        )
     return None
 
 
@@ -127,12 +132,21 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
         return
     if _same(old, record) or overwrite:
         return
-    why = (
-        "a different config"
-        if old.get("config") != record["config"]
-        else "a different code version"
+    raise ConfigError(
+        "--out", f"{shown} holds results of {_differs(old, record)}; use --overwrite to replace it"
     )
-    raise ConfigError("--out", f"{shown} holds results of {why}; use --overwrite to replace it")
+
+
+def _differs(old: dict, record: dict) -> str:
+    """How the run record ``old`` differs from this run's: another study is named (it was
+    "a different config", and --overwrite then replaced brown_table1's results with a
+    network's), else a different config or code version."""
+    mine = record["config"].get("study")
+    theirs = old.get("config", {}).get("study") if isinstance(old.get("config"), dict) else None
+    if theirs != mine:
+        return f"another study ({theirs!r}; this run is {mine!r})"
+    same = old.get("config") == record["config"]
+    return "a different code version" if same else "a different config"
 
 
 def _check_not_nested(out: Path, shown: str) -> None:
@@ -232,14 +246,9 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
         elif old is None or old.get("failed") or overwrite:
             _clear(stage)  # ours (locked, a record or a lock file), and not resumable
         else:
-            why = (
-                "a different config"
-                if old.get("config") != record["config"]
-                else "a different code version"
-            )
             raise ConfigError(
                 "--out",
-                f"{stage} holds an unfinished run of {why}; run that "
+                f"{stage} holds an unfinished run of {_differs(old, record)}; run that "
                 "command again to finish it, or use --overwrite to replace it",
             )
         for tmp in stage.rglob("*.tmp"):  # a write cut short by a kill
@@ -344,7 +353,7 @@ def _foreign(out: Path) -> list[str]:
         r = Path(root)
         for n in files + [d for d in dirs if (r / d).is_symlink()]:
             f = (r / n).relative_to(out).as_posix()
-            if f not in mine and n not in ("run.json", LOCK):
+            if f not in mine and f not in ("run.json", LOCK):  # its own, not a copy's inside
                 keep.append(f)
         if r != out and not dirs and not files:
             keep.append(r.relative_to(out).as_posix() + "/")

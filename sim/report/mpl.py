@@ -10,6 +10,7 @@ after that, every read is a dictionary lookup in the imported module.
 from __future__ import annotations
 
 import importlib
+import os
 import threading
 from types import ModuleType
 from typing import Any
@@ -31,12 +32,19 @@ _set_up = False
 
 
 def _setup() -> None:
-    """Agg backend and :data:`STYLE`, once per process, before any matplotlib module loads."""
+    """Agg backend and :data:`STYLE`, once per process, before any matplotlib module loads.
+    The user's ``MPLBACKEND`` is set aside while matplotlib loads (and put back): the suite
+    draws only PNG files through Agg, and a value matplotlib does not know (``nosuch``)
+    failed a run at its first figure, after every trial was computed."""
     global _set_up
     with _lock:
         if not _set_up:
-            import matplotlib  # heavy: loaded here, on a figure's first use
-
+            backend = os.environ.pop("MPLBACKEND", None)
+            try:
+                import matplotlib  # heavy: loaded here, on a figure's first use
+            finally:
+                if backend is not None:
+                    os.environ["MPLBACKEND"] = backend
             matplotlib.use("Agg")
             matplotlib.rcParams.update(STYLE)
             _set_up = True

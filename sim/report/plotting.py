@@ -8,7 +8,9 @@ from __future__ import annotations
 import json
 import os
 import re
+import sys
 import threading
+import warnings
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable, Iterator, Sequence
@@ -262,6 +264,29 @@ def without_figures() -> Iterator[None]:
             _SKIP.clear()
 
 
+#: matplotlib's warning for a character its font cannot draw (a network named "日本")
+_GLYPH = re.compile(r"Glyph (\d+) .*missing from font")
+
+
+def _glyph_note(path: Path, caught: list) -> None:
+    """One line for the characters of a figure that its font could not draw (they are boxes
+    in the PNG), instead of matplotlib's two lines per character and draw; any other warning
+    is shown as it was."""
+    missing = []
+    for w in caught:
+        m = _GLYPH.match(str(w.message))
+        if m is None:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+        elif chr(int(m.group(1))) not in missing:
+            missing.append(chr(int(m.group(1))))
+    if missing:
+        print(
+            f"sim: note: {path.name}: its font has no glyph for {''.join(missing)!r} "
+            "(drawn as boxes)",
+            file=sys.stderr,
+        )
+
+
 def save(fig, path: str | Path) -> Path:
     """Save ``fig`` as PNG without a timestamp or version stamp, then close it. Inside
     :func:`checking_figures` (or with ``SIM_FIGURE_CHECK`` set) the saved figure is then
@@ -272,8 +297,10 @@ def save(fig, path: str | Path) -> Path:
     if _SKIP.is_set():  # a run without figures (:func:`without_figures`)
         plt.close(fig)
         return path
-    with atomic_path(path) as tmp:
+    with atomic_path(path) as tmp, warnings.catch_warnings(record=True) as caught:
+        warnings.filterwarnings("always", _GLYPH.pattern, UserWarning)
         fig.savefig(tmp, format="png", metadata={"Software": None}, bbox_inches="tight")
+    _glyph_note(path, caught)
     if _RECORDER is not None:
         _RECORDER(path, fig)
     elif os.environ.get("SIM_FIGURE_CHECK"):  # the same check in a `sim run` process (tests)

@@ -32,11 +32,13 @@ there (a directory with its ``run.json``); anything else is refused, never delet
 
 import sys
 
-from sim.threads import interrupt_while_loading
+from sim.threads import interrupt_while_loading, refuse_bad_environment
 
 # python -m sim.report.verify imports this package first (sys.argv[0] is "-m" meanwhile):
 # Ctrl-C during its imports is one line and exit 130 (sim.report.verify.__main__)
 _loaded = interrupt_while_loading("sim verify") if sys.argv[:1] == ["-m"] else (lambda: None)
+if sys.argv[:1] == ["-m"]:
+    refuse_bad_environment("sim verify")  # a variable NumPy cannot load with: one line, exit 2
 
 from sim.report.verify.cli import main  # noqa: E402
 from sim.report.verify.rerun import markdown, rerun_study, study_dirs, verify, write_record  # noqa: E402

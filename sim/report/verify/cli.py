@@ -84,6 +84,11 @@ def _check_args(a) -> None:
         raise VerifyError("--set: only with --trials (a re-run with other inputs is not a check)")
     if a.no_rerun and not a.scratch:
         raise VerifyError("--no-rerun: needs --scratch (the directory of the re-runs)")
+    if not a.no_rerun and not Path("studies").is_dir():  # run elsewhere, every study "FAILED"
+        raise VerifyError(
+            f"no studies/ directory in {Path.cwd()}: the re-runs read their study files from "
+            "studies/; run from the project's root"
+        )
     for s in a.set:
         if "=" not in s:
             raise VerifyError(f"--set: {s!r} is not KEY=VALUE")
@@ -92,6 +97,11 @@ def _check_args(a) -> None:
 def _print(comps: list[Comparison]) -> None:
     for c in comps:
         status = "ok" if c.ok else "FAILED"
+        if not c.files and c.failures:  # nothing compared: no deviation to state
+            print(f"{c.study}: FAILED; nothing compared")
+            for f in c.failures[:20]:
+                print(f"  {f}")
+            continue
         print(
             f"{c.study}: {status}; {c.files} files; largest relative deviation "
             f"{c.max_rel:.2g}; largest deviation/tolerance {c.max_ratio:.2g} ({c.worst})"

@@ -58,6 +58,12 @@ def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path,
     if only:
         names = {n for d, s in found for n in (s, d.name)}
         unknown = [s for s in only if s not in names]
+        sweeps = [s for s in unknown if (results / s / "sweep.parquet").is_file()]
+        if sweeps:  # not "no results": results verify cannot compare
+            raise VerifyError(
+                f"--study: {results / sweeps[0]} holds a sweep's results (sweep.parquet): "
+                "verify re-runs single studies; re-run the sweep with sim run to compare"
+            )
         if unknown:
             raise VerifyError(
                 f"--study: no results of {', '.join(map(repr, unknown))} in {results} "

@@ -313,8 +313,9 @@ def rejection_rows(
         "agnard.pass_rejections.mechanical_pct": plates(
             sh,
             (
-                f"share of the {n_pass} pass points removed under mechanical pugging (no gross "
-                f"errors at pugging.gross_rate {cfg['pugging.gross_rate']:g}; hole transfer "
+                f"share of the {n_pass} pass points removed under mechanical pugging ("
+                f"{'no gross errors' if not cfg['pugging.gross_rate'] else 'gross errors'} at "
+                f"pugging.gross_rate {cfg['pugging.gross_rate']:g}; hole transfer "
                 f"{cfg['pugging.transfer_um']:g} um, re-centring {cfg['pugging.recentre_px']:g} px "
                 f"per photo: unprinted, set so the share matches the paper: an input); {_where(ref(book, 'agnard.pass_rejections.mechanical_pct'), sh)}; "
                 f"mean share against the re-centring error: {sens}"

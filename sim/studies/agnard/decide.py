@@ -236,7 +236,7 @@ def _zeros(region, cid: str, k: int) -> str:
         f"its interval at least {100 * hi.min():.2g} %: the row fails at a vector only where "
         f"that end is under 2.5 % (a block losing none rarer than one in forty), which "
         f"{k} pairs cannot show: with none of them losing none it still reaches about "
-        f"{100 * z_box(k) * np.sqrt(f0 * (1 - f0) / k):.2g} %"
+        f"{100 * min(1.0, z_box(k) * np.sqrt(f0 * (1 - f0) / k)):.2g} %"  # a share: <= 100 %
     )
 
 
@@ -322,3 +322,27 @@ def _findings(region: Region) -> Region:
     finding row of :data:`~.claims.WITHOUT_CENTRES` that of its prediction there."""
     region.outputs.update({f: region.outputs[c] for c, f in WITHOUT_CENTRES.items()})
     return region
+
+
+def without_snooping(cfg: dict, rows: list[dict]) -> list[dict]:
+    """With ``snoop.max_reject = 0`` no pass point can be removed, so the rejection row
+    (the paper: digital pugging removes none) would hold by construction, not by the
+    simulation: it is undecidable, saying why."""
+    if cfg["snoop.max_reject"]:
+        return rows
+    why = (
+        "undecidable: snoop.max_reject = 0 (no data snooping), so no block can lose a pass "
+        "point and the count is 0 by construction, not by the simulated measurement"
+    )
+    return [
+        {
+            **r,
+            "outcome": "undecidable",
+            "verdict": "undecidable",
+            "holds": None,
+            "note": f"{why}; {r['note']}",
+        }
+        if r["claim"] == REJECTED and r["kind"] == "prediction"
+        else r
+        for r in rows
+    ]

@@ -305,7 +305,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     regions = (layout, preds5, stats5, scanner, sstats)
     rows = dc.over_joint(cfg, book, rows, regions, five, prov, out)
     ctrl_idx = _region_layouts(block, insets, prov, out)
-    write_claims(out / "claims.parquet", rows, prov, book)
+    write_claims(out / "claims.parquet", dc.without_snooping(cfg, rows), prov, book)
     draw(
         [
             (fg.fig_tradeoffs, (scan_t, lay_t, size_t, out / "tradeoffs.png")),

@@ -324,14 +324,24 @@ def _check_offset(beta: float, names, xy, kind, i, j) -> None:
         )
 
 
-def _check_readings(cfg: dict, beta: float, names, xy, kind, i, j) -> None:
-    """Every distance reads a positive length: ``(1 + s) sqrt(d^2 - beta^2) - alpha > 0``."""
+def _check_readings(cfg: dict, beta: float, names, xy, kind, i, j, bias) -> None:
+    """Every distance reads a positive length: ``(1 + s) sqrt(d^2 - beta^2) - alpha > 0``,
+    and with its own ``bias_mm`` added too."""
     rows_d = np.flatnonzero(kind == 0)
     if not rows_d.size:
         return
     d = np.hypot(*(xy[j[rows_d]] - xy[i[rows_d]]).T)
     f = 1.0 + 1e-6 * cfg["network.scale_ppm"]
     read = f * np.sqrt(np.maximum(d * d - beta * beta, 0.0)) - cfg["network.constant_mm"]
+    biased = read + bias[rows_d]
+    if read.min() > 0 and biased.min() <= 0:
+        r = rows_d[int(np.argmin(biased))]
+        raise ConfigError(
+            "network.observations",
+            f"the distance from {names[i[r]]!r} to {names[j[r]]!r} would read "
+            f"{biased.min():.6g} mm with its bias_mm of {bias[r]:g}: a reading is a "
+            "positive length",
+        )
     if read.min() <= 0:
         r = rows_d[int(np.argmin(read))]
         raise ConfigError(
@@ -357,7 +367,7 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
     oset, stations = _orientation_sets(cfg, names, kind, i)
     beta = cfg["network.offset_mm"]
     _check_offset(beta, names, xy, kind, i, j)
-    _check_readings(cfg, beta, names, xy, kind, i, j)
+    _check_readings(cfg, beta, names, xy, kind, i, j, bias.astype(float))
     return Network(
         title("network.name", cfg["network.name"]),
         tuple(names),

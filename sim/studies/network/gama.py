@@ -80,6 +80,11 @@ def merge_gama(cfg: dict) -> dict:
     }
     if rec["datum.points"] and not cfg["datum.points"]:
         out["datum.points"] = rec["datum.points"]
+    fixed = any(p.get("role") == "fixed" for p in rec["network.points"])
+    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and not fixed:
+        # a free network with adj="XY" points: gama-local adjusts it in the inner datum over
+        # them, as the suite's own export writes it (its round trip), so the study does too
+        out["datum.kind"] = "inner"
     return out
 
 

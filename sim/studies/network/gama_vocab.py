@@ -161,8 +161,10 @@ class _File:
             raise self.err(e, "missing", attr)
         if _DMS.match(v):
             d, m, s = v.lstrip("+-").split("-")
-            if int(m) >= 60 or float(s) >= 60:
-                raise self.err(e, f"{v!r}: minutes and seconds must be below 60", attr)
+            # seconds of 60.00 are a value rounded up (gama-local reads them, and its own
+            # test data holds "187-33-60.00"); more is garbage
+            if int(m) >= 60 or float(s) > 60:
+                raise self.err(e, f"{v!r}: minutes must be below 60 and seconds at most 60", attr)
             return True
         self.num(e, attr)
         return False

@@ -110,7 +110,10 @@ def run(cfg: dict, out: Path, ctx) -> None:
     held = [net.names[a] for a in range(net.n) if net.role[a] != 1 and a not in pts]
     C = dt.constraint_matrix(net.theta_true()[None])
     sim = _mc(net, an, C, pts, cfg, ctx)
-    est = mc_estimates(an, pts, sim)
+    try:
+        est = mc_estimates(an, pts, sim)
+    except StudyError as e:
+        raise StudyError(_biased(net) or str(e)) from None
     dil = _dilution(net, an, full, cfg, pts)
     write_points(out, net, an, pts, est, dil, prov)
     write_parameters(out, net, an, sim, est.n_ok, prov)
@@ -122,7 +125,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
         "gama_xml": export(net, full, out / "network.xml"),
         "gama_input": import_note(cfg),
     }
-    write_summary(out, net, an, cfg, facts, est, prov)
+    write_summary(out, net, an, full, facts, est, prov)  # full: the datum as read
     a95 = K95 * ellipse(an.cov[pts])[0]
     network_claims(out, prov, an, est, cfg, design_figures(net, an, a95, dil, est))
     draw(
@@ -130,4 +133,25 @@ def run(cfg: dict, out: Path, ctx) -> None:
             (network_figure, (net, an, pts, out / "network.png")),
             (reliability_figure, (net, an, out / "reliability.png")),
         ]
+    )
+
+
+def _biased(net: Network) -> str:
+    """The message for a run that did not converge when an observation carries a bias (a
+    gross error unknown to the adjustment): name the largest, in its sigmas; "" when none
+    has a bias."""
+    if not np.any(net.bias):
+        return ""
+    r = int(np.argmax(np.abs(net.bias) / net.sigma))
+    ang = int(net.kind[r]) in (1, 2)
+    unit, f = ("arcsec", 648000 / np.pi) if ang else ("mm", 1.0)
+    kind = ("distance", "direction", "angle", "dx", "dy", "x", "y")[int(net.kind[r])]
+    what = f"the {kind} at {net.names[net.i[r]]!r}"
+    what += f" from {net.names[net.j[r]]!r}" if net.kind[r] == 2 else ""
+    to = net.k[r] if net.kind[r] == 2 else net.j[r]
+    what += f" to {net.names[to]!r}" if to >= 0 else ""
+    return (
+        "network.observations: fewer than two chunks have converged trials: the bias of "
+        f"{net.bias[r] * f:g} {unit} on {what} is a gross error the adjustment cannot absorb "
+        "(a bias is unknown to it): make it smaller"
     )

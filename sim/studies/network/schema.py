@@ -24,6 +24,7 @@ from sim.studies.network.analysis import (
 from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.model import computed, datum, defect_basis, use_sparse
+from sim.studies.network.singular import singular_cause
 from sim.studies.network.sparse_analysis import chunk_bytes, pre_analysis, variances
 
 __all__ = ["SCHEMA", "check"]
@@ -192,7 +193,12 @@ def check(cfg: dict) -> None:
     an = pre_analysis(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
         if sparse:
-            raise ConfigError("datum.kind", f"{an.factor.message}: fix points or change the datum")
+            cause = singular_cause(net, full, dt.free_index(net.q))
+            raise ConfigError(
+                "datum.kind",
+                f"{an.factor.message}{': ' + cause if cause else ''}: fix points or change "
+                "the datum",
+            )
         _defect(net, dt, "datum.kind")
     _conditioned(net, an, "datum.kind")
     if not estimated_points(net, an):
@@ -295,12 +301,56 @@ def _conditioned(net, an, key: str) -> None:
         )
 
 
+def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
+    """A network of full rank whose normals the engine still finds singular: the sigmas
+    make it so (e.g. weighted coordinates a million times looser than the differences
+    between them). Name the weakest unknown and the range of the sigmas."""
+    _, sv, vt = np.linalg.svd(A, full_matrices=False)
+    par = int(free[int(np.argmax(np.abs(vt[-1])))])
+    what = (
+        f"point {net.names[par // 2]!r} ({'xy'[par % 2]})"
+        if par < 2 * net.n
+        else net.parameter_names()[par - 2 * net.n]
+    )
+    raise ConfigError(
+        key,
+        f"the network is near-singular from its weights: {what} is nearly undetermined "
+        f"(the normal matrix's condition number is {(sv[0] / sv[-1]) ** 2:.3g}, too large "
+        "to solve in double precision): bring the observations' sigmas closer together, "
+        "or fix points",
+    )
+
+
+def _parameters(net, A: np.ndarray, free: np.ndarray, rank: int) -> None:
+    """A rank defect among the distances' constant and scale (and orientations) alone, no
+    coordinate in it: no datum covers it, so name the keys that estimate them."""
+    _, _, vt = np.linalg.svd(A, full_matrices=False)
+    w = (vt[rank:] ** 2).sum(axis=0)
+    involved = free[w > 1e-6 * w.max()]
+    if involved.min() < 2 * net.n:
+        return  # coordinates move: a datum defect, the caller's message
+    names = [net.parameter_names()[g - 2 * net.n] for g in involved]
+    pairs = (("network.estimate_constant", net.i_constant), ("network.estimate_scale", net.i_scale))
+    keys = [k for k, g in pairs if g in involved]
+    raise ConfigError(
+        keys[0] if keys else "network.observations",
+        f"the {' and the '.join(names)} cannot be told apart by these observations (a rank "
+        f"defect of {len(free) - rank} among them, no coordinate in it: no datum covers it): "
+        + ("estimate fewer of them, or " if keys else "")
+        + "add observations of other lengths or directions",
+    )
+
+
 def _defect(net, dt, key: str) -> None:
     free = dt.free_index(net.q)
     _, J = computed(net, net.theta_true()[None], jac=True)
     A = J[0][:, free] / net.sigma[:, None]
     sv = np.linalg.svd(A, compute_uv=False)
     rank = int((sv > sv[0] * 1e-10).sum()) if sv.size else 0
+    if sv.size and rank == len(free):
+        _weights(net, A, free, key)
+    if sv.size and rank < len(free):
+        _parameters(net, A, free, rank)
     C = dt.constraint_matrix(net.theta_true()[None])
     c = 0 if C is None else C.shape[-1]
     raise ConfigError(

@@ -1,0 +1,157 @@
+"""What one adjustment costs, measured, for the work estimate (:mod:`sim.mc.estimate`).
+
+The unit (:data:`ADJUSTMENT_S` s of one core of the 2-core reference machine) is one
+adjustment of the kind the Monte-Carlo parts solve; :func:`dense_units` weighs a dense
+adjustment larger than the unit (m U^2 + U^3 against the unit's); brown_design's analytic
+design grid is counted in adjustment-equivalents by a cost law fitted to serial timings
+(:func:`design_grid_equivalents`, ~(2n)^3 a geometry, ~k^6 for a k x k grid), and
+:func:`design_estimate` is brown_design's estimator (Brown 1968, seed ``004``). Sizes are in
+points and unknowns, times in seconds, memory in bytes.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+__all__ = [
+    "ADJUSTMENT_S",
+    "F8",
+    "UNIT_WORK",
+    "n_of",
+    "max_of",
+    "dense_units",
+    "design_grid_equivalents",
+    "design_chunk_bytes",
+    "design_estimate",
+]
+
+F8 = 8.0  # bytes of a float64
+
+#: CPU seconds of the unit adjustment on one core of the 2-core reference machine (one BLAS
+#: thread, best of 5 rounds of 500 trials): a third of a trial of brown_design's Monte-Carlo
+#: check on the paper's plate (P-position solver, 4 positions x 25 points, 57 unknowns),
+#: counted as 3 adjustments. The default limit of 5e8 is then about 7 hours on one core.
+ADJUSTMENT_S = 5.1e-5
+
+
+def n_of(v: Any) -> float:
+    try:
+        return float(len(v)) if isinstance(v, (list, tuple)) else float(v)
+    except (TypeError, ValueError):
+        return 0.0
+
+
+def max_of(v, default=0.0) -> float:
+    return max((float(x) for x in v), default=default) if isinstance(v, (list, tuple)) else default
+
+
+#: the unit adjustment's dense work: normal equations m U^2 and their factor U^3 of its 100
+#: ranges and 57 unknowns (:data:`ADJUSTMENT_S`)
+UNIT_WORK = 100.0 * 57**2 + 57.0**3
+
+
+def dense_units(m: float, U: float) -> float:
+    """Unit adjustments one dense adjustment of ``m`` observations and ``U`` unknowns costs
+    (m U^2 + U^3 against :data:`UNIT_WORK`), at least 1: an adjustment no larger than the
+    unit counts as one, as every adjustment did before; a larger one in proportion (Wolf's
+    polynomial fit at 1 mm spacing and degree 8: 1,900 units by this model, 1,200 measured
+    from a run's CPU time)."""
+    return max(1.0, (m * U * U + U**3) / UNIT_WORK)
+
+
+#: float64 values a brown_design Monte-Carlo chunk holds per range of a trial (measured with
+#: tracemalloc: about 30-100 for the P-position solver and 50-100 for the 4-station one)
+DESIGN_RANGE_VALUES = 128
+#: copies of the (geometries, 2n, 2n) cofactor stack the analytic design grid holds at its
+#: peak (measured: 4.07 x for grids of 10 and 15 points per side, any number of positions)
+DESIGN_COFACTOR_COPIES = 5.0
+
+
+#: CPU seconds of one geometry of the analytic design grid (both models' (2n, 2n) cofactors in
+#: the inner datum, :func:`sim.studies.design.cells.geometry_eval`) of n points: a (2n)^3 +
+#: b (2n)^2, fitted (relative least squares) to serial timings on the reference machine at
+#: k = 10, 14, 18, 22, 26 and 29 points a side, 3, 4 and 8 positions (the same within 2 %),
+#: the study's 8 offsets x 2 betas; every timing within 9 % of the law. From 10 to 29 points
+#: a side the time grows as k^5.45 (k^6.03 from 18 on: the cube dominates); 29 x 29 takes
+#: 0.60-0.65 s a geometry, about 2 minutes for the study's 4 positions x 3 extents.
+DESIGN_CUBE_S = 1.11e-10
+DESIGN_SQUARE_S = 2.41e-8
+
+
+def design_grid_equivalents(
+    grids, positions: float = 1, extents: float = 1, geometries: float = 1
+) -> float:
+    """Adjustment-equivalents (:data:`ADJUSTMENT_S` s each) of brown_design's analytic design
+    grid: every grid of ``grids`` (points per side) for each of ``positions`` x ``extents``,
+    ``geometries`` (offsets x betas) batched, at :data:`DESIGN_CUBE_S` (2n)^3 +
+    :data:`DESIGN_SQUARE_S` (2n)^2 seconds a geometry, n = k^2."""
+    per = sum(
+        DESIGN_CUBE_S * (2.0 * k * k) ** 3 + DESIGN_SQUARE_S * (2.0 * k * k) ** 2 for k in grids
+    )
+    return positions * extents * geometries * per / ADJUSTMENT_S
+
+
+def design_chunk_bytes(ch: float, P: float, n: float) -> float:
+    """Bytes of one Monte-Carlo chunk of ``ch`` trials of ``n`` points seen from ``P``
+    positions: the per-range arrays of every trial, and the (2n, 2n) inner-datum matrix and
+    its product, once per chunk."""
+    return ch * P * n * DESIGN_RANGE_VALUES * F8 + 2 * (2 * n) ** 2 * F8
+
+
+def design_estimate(c: Mapping) -> tuple:
+    """brown_design, each part with its own geometry: the Monte-Carlo check, the error budget
+    and the posterior on the paper's plate (``paper.positions`` x ``paper.grid``), the
+    coverage on 4 stations over ``coverage.grids`` and ``datum.grid``; the design grid
+    (``design.*``) is analytic, one (geometries, 2n, 2n) cofactor stack per grid, the
+    geometries its offsets x betas, not a chunk of trials."""
+    lists = [
+        c.get(f"design.{k}", [1])
+        for k in (
+            "positions",
+            "offsets_mm",
+            "grids",
+            "extents_mm",
+            "settings",
+            "setting_sigma_um",
+            "beta_mm",
+        )
+    ]
+    cells = math.prod(max(len(v), 1) for v in lists)
+    G = max_of(c.get("design.grids"), 5)
+    n = G * G
+    U = 2 * n + 7
+    T, ch = c["trials"], min(c["chunk"], c["trials"])
+    cov_T = c.get("coverage.trials", 0)
+    sw_T = c.get("coverage.sweep_trials", 0) * (
+        n_of(c.get("coverage.noise_um", []))
+        + n_of(c.get("coverage.grids", []))
+        + n_of(c.get("coverage.betas_mm", []))
+    )
+    budget = 6 * c.get("budget.max_trials", 0)
+    bayes = c.get("bayes.walkers", 0) * c.get("bayes.steps", 0) * 2
+    trials = T + cov_T + sw_T + budget
+    adj = cells * 3 + T * 3 + cov_T * 2 + sw_T * 2 + budget + bayes
+    n_paper = c.get("paper.grid", 5) ** 2
+    nc = max(max_of(c.get("coverage.grids"), 5) ** 2, c.get("datum.grid", 5) ** 2)
+    geometries = n_of(c.get("design.offsets_mm", [1])) * n_of(c.get("design.beta_mm", [1]))
+    grids = [float(k) for k in c.get("design.grids", [5])]
+    PE = n_of(c.get("design.positions", [1])) * n_of(c.get("design.extents_mm", [1]))
+    eq = design_grid_equivalents(grids, PE, 1, geometries)
+    adj += eq
+    analytic = (
+        eq,
+        "design.grids",
+        f"the analytic design grid ({len(grids)} grids up to {int(G)} x {int(G)} points, each "
+        f"for {int(PE)} positions x extents and {int(geometries)} offset x beta geometries)",
+    )
+    parts = {
+        "the Monte-Carlo check on the paper's plate": design_chunk_bytes(
+            ch, c.get("paper.positions", 4), n_paper
+        ),
+        "the coverage": design_chunk_bytes(ch, 4, nc),
+        f"the analytic design grid ({int(geometries)} offset x beta geometries of {int(G)} x "
+        f"{int(G)} points)": DESIGN_COFACTOR_COPIES * geometries * (2 * n) ** 2 * F8,
+    }
+    what = max(parts, key=parts.get)
+    return trials, adj, max(U, 2 * int(max(nc, n_paper)) + 7), parts[what], what, analytic

@@ -1,0 +1,81 @@
+"""What makes a large network's normals singular, named for ``sim check``.
+
+The sparse path (:mod:`sim.studies.network.sparse_analysis`) factorises the normals once and,
+when they are singular, knows only that a pivot failed. A user needs the point: this module
+looks for the two usual causes, cheaply at any size (linear in the observations):
+
+* an unknown no observation determines (a zero diagonal of the normals: a point whose only
+  sights are distances along one line, say);
+* a part of the network tied to the datum by no observation (a connected component of the
+  graph of points and observations that holds no fixed or observed point, and no inner-datum
+  point): the nearest-neighbour observations of a random network leave such islands.
+
+Units: those of the network (mm, rad); no model of its own.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from sim.studies.network.definition import Network
+from sim.studies.network.model import jacobian_sparse, pattern
+
+__all__ = ["singular_cause"]
+
+
+def _unobserved(net: Network, free: np.ndarray) -> str:
+    cols = pattern(net)
+    _, vals = jacobian_sparse(net, net.theta_true()[None])
+    w = np.where(cols >= 0, (vals[0] / net.sigma[:, None]) ** 2, 0.0)
+    diag = np.zeros(net.q + 1)
+    np.add.at(diag, np.where(cols >= 0, cols, net.q), w)
+    zero = [g for g in free if not diag[g] > 0]
+    if not zero:
+        return ""
+    g = int(zero[0])
+    what = (
+        f"point {net.names[g // 2]!r} ({'xy'[g % 2]})"
+        if g < 2 * net.n
+        else net.parameter_names()[g - 2 * net.n]
+    )
+    return f"{what} is determined by no observation ({len(zero)} such unknowns)"
+
+
+def _islands(net: Network, cfg: dict) -> str:
+    n = net.n
+    anchored = net.role != 0
+    inner = cfg["datum.kind"] == "inner"
+    a, b = [net.i], [np.where(net.j >= 0, net.j, net.i)]
+    a.append(net.i)
+    b.append(np.where(net.k >= 0, net.k, net.i))
+    a.append(np.flatnonzero(anchored))
+    b.append(np.full(int(anchored.sum()), n))  # node n: the datum
+    a, b = np.concatenate(a), np.concatenate(b)
+    graph = coo_matrix((np.ones(a.size), (a, b)), shape=(n + 1, n + 1))
+    _, label = connected_components(graph, directed=False)
+    loose = label[:n] != label[n]
+    if inner and loose.any():  # the inner datum holds one part: the largest loose one
+        loose &= label[:n] != np.bincount(label[:n][loose]).argmax()
+    loose = np.flatnonzero(loose)
+    if not loose.size:
+        return ""
+    parts = np.unique(label[loose])
+    sizes = [int((label[:n] == p).sum()) for p in parts]
+    part = parts[int(np.argmin(sizes))]
+    names = [net.names[p] for p in np.flatnonzero(label[:n] == part)]
+    shown = ", ".join(repr(x) for x in names[:3]) + (
+        f" and {len(names) - 3} more" if len(names) > 3 else ""
+    )
+    return (
+        f"points {shown} are tied to the datum by no observation ({len(parts)} such "
+        f"part{'s' if len(parts) > 1 else ''} of the network, {loose.size} points in all)"
+    )
+
+
+def singular_cause(net: Network, cfg: dict, free: np.ndarray) -> str:
+    """The first cause found of singular normals (see the module doc), or ""."""
+    if cfg["datum.kind"] == "constraints":
+        return _unobserved(net, free)
+    return _unobserved(net, free) or _islands(net, cfg)
