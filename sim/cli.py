@@ -43,6 +43,7 @@ from sim.report.markdown import write_report
 from sim.report.read import damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.studies import get_study, load_study
+from sim.threads import interrupted
 
 __all__ = ["main", "check_run_args"]
 
@@ -422,6 +423,9 @@ def _main(argv: list[str]) -> int:
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)
         return 2
     except Exception as e:  # noqa: BLE001 - a bug outside a run (check, show, report, loading):
+        if interrupted(e):  # Ctrl-C inside an import: ImportError from the KeyboardInterrupt
+            print("sim: interrupted", file=sys.stderr)
+            return 130
         if os.environ.get("SIM_DEBUG"):  # one line as docs/cli.md promises, the traceback on
             raise  # request
         what = f"{type(e).__name__}: {e}".splitlines()[0]

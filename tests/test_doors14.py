@@ -9,7 +9,10 @@ failed on the code before its fix.
 * a run into an earlier results directory interrupted while it copied the user's files into
   its staging directory (:func:`sim.mc.outputs.publish`): every later run into it refused,
   naming the user's own file as one the run writes (the copies had been recorded as the run's
-  files when the resumed run sealed its staging directory).
+  files when the resumed run sealed its staging directory);
+* Ctrl-C while a run imported a module on first use (a SciPy extension raises ImportError
+  from the KeyboardInterrupt): exit 3 and "the run failed", not an interruption
+  (:func:`sim.threads.interrupted`).
 """
 
 from __future__ import annotations
@@ -18,8 +21,9 @@ import json
 import shutil
 from pathlib import Path
 
+from sim import cli
 from sim.cli import main
-from sim.mc import outputs
+from sim.mc import outputs, runner
 from sim.report.verify.rerun import study_dirs
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -81,3 +85,28 @@ def test_a_run_cut_short_while_keeping_the_users_files_is_resumed(tmp_path, monk
     files = json.loads((out / "run.json").read_text())["files"]
     assert "notes.txt" not in files and "big.dat" not in files and "claims.parquet" in files
     assert sorted(p.name for p in tmp_path.iterdir()) == ["np"]
+
+
+def _import_cut_short(*args, **kwargs):
+    """What a pybind11 module of SciPy's raises when Ctrl-C lands while it initialises."""
+    try:
+        raise KeyboardInterrupt
+    except KeyboardInterrupt as k:
+        raise ImportError("initialization failed") from k
+
+
+def test_ctrl_c_inside_an_import_is_an_interruption(tmp_path, monkeypatch, capsys):
+    """Ctrl-C while a run imported a module on first use (Wolf's region, SciPy's qmc) ended
+    as ``sim: error: wolf_polynomial: the run failed in ...explore_region: ImportError:
+    initialization failed`` and exit 3 (a bug), not as an interruption: exit 130, one line."""
+    f = str(ROOT / "studies" / "network_plate.toml")
+    out = tmp_path / "np"
+    monkeypatch.setattr(runner.RunContext, "progress_bar", _import_cut_short)
+    cmd = ["run", f, "--out", str(out), "--quiet", "--no-figures", "--set", "trials=40"]
+    assert main([*cmd, "--set", "chunk=2"]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("sim: interrupted"), err
+    monkeypatch.setattr(cli, "_check", _import_cut_short)  # outside a run: the same
+    assert main(["check", f]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["sim: interrupted"], err
