@@ -35,7 +35,7 @@ from sim.cli_args import module_doc, parser
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
-from sim.mc.outputs import name_problem
+from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
@@ -43,6 +43,7 @@ from sim.report.markdown import write_report
 from sim.report.read import damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.studies import get_study, load_study
+from sim.threads import interrupted
 
 __all__ = ["main", "check_run_args"]
 
@@ -291,7 +292,7 @@ def _report(results: Path) -> int:
     user's with none gets no REPORT.md written into it)."""
     if results.is_dir() and not any(
         (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
-        for d in results.iterdir()
+        for d in results_dirs(results)
     ):
         raise ConfigError(
             "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
@@ -422,6 +423,9 @@ def _main(argv: list[str]) -> int:
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)
         return 2
     except Exception as e:  # noqa: BLE001 - a bug outside a run (check, show, report, loading):
+        if interrupted(e):  # Ctrl-C inside an import: ImportError from the KeyboardInterrupt
+            print("sim: interrupted", file=sys.stderr)
+            return 130
         if os.environ.get("SIM_DEBUG"):  # one line as docs/cli.md promises, the traceback on
             raise  # request
         what = f"{type(e).__name__}: {e}".splitlines()[0]

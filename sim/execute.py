@@ -34,6 +34,7 @@ from sim.mc.storage import (
 from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cells, refused_note
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
+from sim.threads import interrupted
 
 __all__ = ["execute", "run_sweep", "check_sweep"]
 
@@ -169,12 +170,14 @@ def execute(
                 run_sweep(study, cfg, sweep, stage, ctx) if sweep else study.run(cfg, stage, ctx)
         except (ConfigError, StudyError):
             raise
-        except (ArithmeticError, ValueError, MemoryError) as e:  # numbers the model cannot take
-            raise _numeric_failure(e, study, cfg) from None
         except (OSError, KeyboardInterrupt, SystemExit):
             raise
-        except Exception as e:  # noqa: BLE001 - a bug: one line, the traceback on request
-            if os.environ.get("SIM_DEBUG"):
+        except Exception as e:
+            if interrupted(e):  # Ctrl-C inside an import (or a library that wraps it)
+                raise KeyboardInterrupt from None
+            if isinstance(e, (ArithmeticError, ValueError, MemoryError)):  # numbers the model
+                raise _numeric_failure(e, study, cfg) from None  # cannot take
+            if os.environ.get("SIM_DEBUG"):  # a bug: one line, the traceback on request
                 raise
             err = _numeric_failure(e, study, cfg)
             err.internal = True

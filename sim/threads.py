@@ -18,6 +18,20 @@ def single_threaded_blas() -> None:
         os.environ.setdefault(v, "1")
 
 
+def interrupted(e: BaseException | None) -> bool:
+    """Whether ``e`` comes of Ctrl-C (or SIGTERM, raised as one): an extension module whose
+    initialisation is interrupted (pybind11's, as SciPy's modules imported on first use) raises
+    ``ImportError: initialization failed`` from the KeyboardInterrupt, which a run reported as
+    its own failure (exit 3) instead of an interruption (exit 130)."""
+    seen = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return False
+
+
 def interrupt_while_loading(prog: str):
     """Ctrl-C while an entry point imports the suite (a second or two): one line
     ``<prog>: interrupted`` and exit 130, as later, not a traceback from whichever import

@@ -73,6 +73,14 @@ def stage_dir(out: Path) -> Path:
     return out.parent / f".{out.name}{STAGE_SUFFIX}"
 
 
+def results_dirs(results: Path) -> list[Path]:
+    """The entries directly under ``results`` that may hold a study's results: every one but
+    a run's hidden working directories (its staging :func:`stage_dir`, ``.<name>.partial``,
+    and :func:`swap_dir`, ``.<name>.old.<pid>``), which hold unfinished or replaced results
+    (``sim report`` listed an interrupted run's staging directory as a study of its own)."""
+    return [p for p in Path(results).iterdir() if not p.name.startswith(".")]
+
+
 def swap_dir(out: Path) -> Path:
     """Where :func:`publish` moves the old results of ``out`` while it swaps the new ones in:
     ``.<name>.old.<pid>``."""
@@ -245,7 +253,8 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
             )
         for tmp in stage.rglob("*.tmp"):  # a write cut short by a kill
             tmp.unlink(missing_ok=True)
-        write_record(stage, record)
+        carried = (read_record(stage) or {}).get("carried")  # see publish()
+        write_record(stage, {**record, "carried": carried} if carried else record)
     except BaseException:
         drop_stage(stage, lock)
         raise
@@ -281,9 +290,11 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
     if store is not None:
         for p in store.strays():
             p.unlink()
-    files = _files(stage)
+    rec = read_record(stage)
+    carried = set(rec.get("carried") or [])  # the user's files a publish copied in: not ours
+    files = [f for f in _files(stage) if f not in carried]
     chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
-    write_record(stage, {**read_record(stage), "files": files, "chunk_sha256": chunks})
+    write_record(stage, {**rec, "files": files, "chunk_sha256": chunks})
 
 
 def damaged_chunks(out: Path) -> str | None:
@@ -392,6 +403,11 @@ def publish(stage: Path, out: Path) -> None:
     for tmp in stage.rglob("*.tmp"):
         tmp.unlink(missing_ok=True)
     keep = _foreign(out) if out.is_dir() else []
+    rec = read_record(stage)
+    for f in set(rec.get("carried") or []) & set(keep):  # copied by a publish cut short
+        q = stage / f
+        if (q.is_symlink() or q.exists()) and not q.is_dir():
+            q.unlink()  # (the user's own is still in out): copied again below
     clash = [c for f in keep if (c := _clash(stage, f))]
     if clash:
         raise ConfigError(
@@ -399,6 +415,8 @@ def publish(stage: Path, out: Path) -> None:
             f"{out / clash[0]} was not written by sim but the new run writes a file of that "
             "name; move it away and run again",
         )
+    if keep:  # named before copying: a resume after a kill here knows the copies for copies
+        write_record(stage, {**rec, "carried": keep})
     for f in keep:
         _carry(out / f, stage / f)
     old = swap_dir(out)

@@ -14,6 +14,7 @@ import pyarrow as pa
 
 from sim.claims.rules import PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
+from sim.mc.outputs import results_dirs
 from sim.mc.storage import atomic_path, read_provenance, read_table
 from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
@@ -285,12 +286,12 @@ def build_report(results: Path, get_study: Callable) -> str:
         raise ConfigError("--results", f"{results} is not a results directory")
     entries = [
         _entry(d, get_study)
-        for d in sorted(p for p in results.iterdir() if (p / "claims.parquet").is_file())
+        for d in sorted(p for p in results_dirs(results) if (p / "claims.parquet").is_file())
     ]
     entries.sort(key=lambda e: (e[0], e[1]))
     sweeps = sorted(
         p.name
-        for p in results.iterdir()
+        for p in results_dirs(results)
         if (p / "sweep.parquet").is_file() and not (p / "claims.parquet").is_file()
     )
     head = (
@@ -349,7 +350,7 @@ def write_report(results: Path, get_study: Callable) -> Path:
             "--results", f"{out} was not written by sim report; sim never replaces it"
         )
     text = MARK + "\n" + build_report(results, get_study)
-    for d in sorted(results.iterdir()):
+    for d in sorted(results_dirs(results)):
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             write_run_readme(d, get_study)
     with atomic_path(out) as tmp:

@@ -13,6 +13,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.mc.children import stop_children
+from sim.mc.outputs import results_dirs
 from sim.mc.storage import read_provenance, read_record, versions, write_table
 from sim.report.tables import fmt, md_table
 from sim.report.verify.rules import DEFAULT_RTOL, Comparison, VerifyError, compare_dirs
@@ -46,7 +47,7 @@ def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path,
     if not results.is_dir():
         raise VerifyError(f"--results: {results} is not a directory")
     found = []
-    for d in sorted(p for p in results.iterdir() if (p / "claims.parquet").is_file()):
+    for d in sorted(p for p in results_dirs(results) if (p / "claims.parquet").is_file()):
         try:
             study = read_provenance(d / "claims.parquet").get("study") or d.name
         except (OSError, pa.ArrowException, ValueError):
@@ -276,7 +277,9 @@ def _committed_on(results: Path) -> str:
     """Which machine, numerical path and versions produced the committed results (from the
     provenance of the studies' claims tables), as a sentence."""
     seen = set()
-    for p in sorted(results.glob("*/claims.parquet")):
+    for p in sorted(d / "claims.parquet" for d in results_dirs(results)):
+        if not p.is_file():
+            continue
         try:
             prov = read_provenance(p)
         except (OSError, pa.ArrowException, ValueError):
