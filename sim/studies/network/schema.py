@@ -287,12 +287,7 @@ def _conditioned(net, an, key: str) -> None:
     vif = q_ii * n_ii
     if not np.all(np.isfinite(vif)) or vif.max() > MAX_INFLATION:
         g = int(np.argmax(np.where(np.isfinite(vif), vif, np.inf)))
-        par = int(an.free[g])
-        what = (
-            f"point {net.names[par // 2]!r} ({'xy'[par % 2]})"
-            if par < 2 * net.n
-            else net.parameter_names()[par - 2 * net.n]
-        )
+        what = _unknown(net, int(an.free[g]))
         raise ConfigError(
             key,
             f"the network is near-singular: {what} is determined {vif[g]:.3g} times worse "
@@ -301,17 +296,20 @@ def _conditioned(net, an, key: str) -> None:
         )
 
 
+def _unknown(net, par: int) -> str:
+    """The unknown of column ``par`` for a message: a point's coordinate (``point 'P1' (x)``)
+    or the name of a network parameter (a scale, a constant, an orientation)."""
+    if par < 2 * net.n:
+        return f"point {net.names[par // 2]!r} ({'xy'[par % 2]})"
+    return net.parameter_names()[par - 2 * net.n]
+
+
 def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
     """A network of full rank whose normals the engine still finds singular: the sigmas
     make it so (e.g. weighted coordinates a million times looser than the differences
     between them). Name the weakest unknown and the range of the sigmas."""
     _, sv, vt = np.linalg.svd(A, full_matrices=False)
-    par = int(free[int(np.argmax(np.abs(vt[-1])))])
-    what = (
-        f"point {net.names[par // 2]!r} ({'xy'[par % 2]})"
-        if par < 2 * net.n
-        else net.parameter_names()[par - 2 * net.n]
-    )
+    what = _unknown(net, int(free[int(np.argmax(np.abs(vt[-1])))]))
     raise ConfigError(
         key,
         f"the network is near-singular from its weights: {what} is nearly undetermined "
