@@ -14,7 +14,7 @@ import pytest
 from scipy import sparse
 
 from sim.lsq import sparse as lsq_sparse
-from sim.mc import estimate as estimate_module
+from sim.mc import network_size
 from sim.mc.config import ConfigError
 from sim.mc.estimate import check_limits, estimate
 from sim.studies import load_study
@@ -313,7 +313,7 @@ def test_the_estimate_counts_nonzeros_and_bounds_a_network_by_memory(tmp_path, m
     # a set larger than NAME_SAMPLE is matched through evenly spaced names: close to the
     # exact count (the declared 2,500-point grid through 500 of its names)
     exact = est.bytes
-    monkeypatch.setattr(estimate_module, "NAME_SAMPLE", 500)
+    monkeypatch.setattr(network_size, "NAME_SAMPLE", 500)
     assert estimate(cfg).bytes == pytest.approx(exact, rel=0.02)
     big = {**cfg, "network.grids": [{**cfg["network.grids"][0], "nx": 3000, "ny": 3000}]}
     with pytest.raises(ConfigError, match="GiB"):

@@ -29,19 +29,18 @@ bounded too: at most :data:`MAX_CELLS` cells times replicates.
 
 from __future__ import annotations
 
-import fnmatch
 import math
 import os
-import re
 from dataclasses import dataclass
 from numbers import Integral
 from typing import Any, Callable, Mapping
 
-from sim.lsq.size import SPARSE_MIN_UNKNOWNS
 from sim.mc.config import ConfigError
+from sim.mc.network_size import network_estimate as _network
 from sim.mc.sweep import MAX_CELLS, expand
 from sim.mc.workunits import (
     ADJUSTMENT_S,
+    COPIES,
     F8,
     design_grid_equivalents,
 )
@@ -64,7 +63,6 @@ __all__ = [
 
 DEFAULT_MAX_MEMORY_GB = 8.0
 DEFAULT_MAX_ADJUSTMENTS = 5e8
-COPIES = 6.0  # working copies of the largest array (residuals, Jacobian, ...)
 #: an analytic part (no progress bar, nothing to resume) may take at most this share of the
 #: work limit: 5e5 adjustment-equivalents, about 25 s on one core, at the default 5e8
 ANALYTIC_SHARE = 1e-3
@@ -267,88 +265,6 @@ def _agnard(c: Mapping) -> tuple:
         2 * (ch_t * (7 * Mt) ** 2 * F8 + 4e6 * F8),
     )
     return trials, adj, int(max(U, Ut)), b
-
-
-#: unknowns from which the network kind takes the sparse path (the engine's size rule)
-NETWORK_SPARSE_FROM = SPARSE_MIN_UNKNOWNS
-
-
-#: a set of more points than this is matched against a pattern through this many evenly
-#: spaced names (each standing for its share of the set): the estimate of a network of
-#: millions of points takes a fraction of a second, not a minute of name matching
-NAME_SAMPLE = 20_000
-
-
-def _network_names(c: Mapping) -> list[tuple[list[str], float]]:
-    """The point names a network config declares, as ``(names, weight)`` groups: the listed
-    points (weight 1), then each grid and random set by prefix (``P1`` ... ``Pk``): all its
-    names when there are at most :data:`NAME_SAMPLE`, else that many evenly spaced ones, each
-    of weight k / NAME_SAMPLE."""
-    groups = [
-        ([str(p.get("name", "")) for p in c.get("network.points", []) if isinstance(p, dict)], 1.0)
-    ]
-    for key, count in (("network.grids", ("nx", "ny")), ("network.random", ("n",))):
-        for rec in c.get(key, []):
-            if not isinstance(rec, dict):
-                continue
-            k = math.prod(int(rec.get(f, 1)) for f in count)
-            pre = rec.get("prefix", "")
-            if k <= NAME_SAMPLE:
-                groups.append(([f"{pre}{b + 1}" for b in range(k)], 1.0))
-            else:
-                picks = dict.fromkeys(
-                    round(1 + i * (k - 1) / (NAME_SAMPLE - 1)) for i in range(NAME_SAMPLE)
-                )
-                groups.append(([f"{pre}{b}" for b in picks], k / len(picks)))
-    return groups
-
-
-def _network(c: Mapping) -> tuple:
-    """A network: points and observations counted from the declaration (patterns matched
-    against the names; ``nearest`` bounds each generated set), then the memory of the path
-    the size takes -- the sparse one counts nonzeros (Jacobian slots per observation, the
-    factor ~ nnz(N) log2(unknowns) / 3, its selected inverse), the dense one trials x
-    observations x unknowns."""
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
-    gama = c.get("network.gama_xml", "")
-    if gama:  # an imported file: about 80 bytes per observation, 4 observations a point
-        m = os.path.getsize(gama) / 80 if os.path.isfile(gama) else 1e3
-        n = m / 4
-    else:
-        groups = _network_names(c)
-        n = sum(len(names) * w for names, w in groups)
-
-        def count(pats) -> float:
-            pats = [pats] if isinstance(pats, str) else list(pats or [])
-            rx = [re.compile(fnmatch.translate(str(p))).match for p in pats]  # = fnmatchcase
-            return sum(w * sum(1 for nm in names if any(m(nm) for m in rx)) for names, w in groups)
-
-        m = float(len(c.get("network.observations", [])))
-        for g in c.get("network.generate", []):
-            if isinstance(g, dict):
-                k = int(g.get("nearest", 0) or 0)
-                fr = count(g.get("from", []))
-                m += fr * (k if k else count(g.get("to", [])))
-        m += 2 * sum(
-            rec.get("role") == "observed"
-            for rec in c.get("network.points", [])
-            if isinstance(rec, dict)
-        )
-        m += 2 * sum(
-            math.prod(int(rec.get(f, 1)) for f in ("nx", "ny"))
-            for rec in c.get("network.grids", [])
-            if isinstance(rec, dict) and rec.get("role") == "observed"
-        )
-    U = 2 * n + n / 4 + 2  # coordinates, orientations (at most a quarter), constant, scale
-    if U >= NETWORK_SPARSE_FROM:
-        s = 6.0  # Jacobian slots of a distance or direction row
-        nnz_l = m * s * s * max(math.log2(max(U, 2)), 1.0) / 3 + 4 * U
-        b = 3 * F8 * (ch * m * (s + 3) + 3 * ch * U) + 3 * 16 * nnz_l
-        w = 1.0  # the sparse path: its work grows with the factor's nonzeros, as its memory
-    else:
-        b = ch * m * (U + 1) * F8 * COPIES
-        w = _dense(m, U)  # the dense path: m U^2 + U^3 a trial
-    return T, T * w + 2, int(U), b
 
 
 def _generic(c: Mapping) -> tuple:

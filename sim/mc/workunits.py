@@ -17,6 +17,7 @@ from typing import Any, Mapping
 __all__ = [
     "ADJUSTMENT_S",
     "F8",
+    "COPIES",
     "UNIT_WORK",
     "n_of",
     "max_of",
@@ -27,6 +28,7 @@ __all__ = [
 ]
 
 F8 = 8.0  # bytes of a float64
+COPIES = 6.0  # working copies of the largest array (residuals, Jacobian, ...)
 
 #: CPU seconds of the unit adjustment on one core of the 2-core reference machine (one BLAS
 #: thread, best of 5 rounds of 500 trials): a third of a trial of brown_design's Monte-Carlo
