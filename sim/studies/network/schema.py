@@ -324,9 +324,11 @@ def _parameters(net, A: np.ndarray, free: np.ndarray, rank: int) -> None:
     coordinate in it: no datum covers it, so name the keys that estimate them."""
     _, _, vt = np.linalg.svd(A, full_matrices=False)
     w = (vt[rank:] ** 2).sum(axis=0)
-    involved = free[w > 1e-6 * w.max()]
-    if involved.min() < 2 * net.n:
-        return  # coordinates move: a datum defect, the caller's message
+    involved = free[w > 1e-6 * w.max()] if w.size else free[:0]
+    if not involved.size or involved.min() < 2 * net.n:
+        # coordinates move (a datum defect), or fewer observations than unknowns (the
+        # reduced SVD holds no null space to look at): the caller's message
+        return
     names = [net.parameter_names()[g - 2 * net.n] for g in involved]
     pairs = (("network.estimate_constant", net.i_constant), ("network.estimate_scale", net.i_scale))
     keys = [k for k, g in pairs if g in involved]

@@ -25,7 +25,13 @@ T3_NUM = ("x_dba_mm", "y_dba_mm", "x_pg2_mm", "y_pg2_mm", "dx_printed_mm", "dy_p
 
 def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> dict:
     p = Path(path)
-    if not p.is_file():
+    if not str(p).isprintable():  # a line break would split the one-line message
+        raise ConfigError(key, f"is not a file name: it holds a control character ({str(p)!r})")
+    try:
+        is_file = p.is_file()
+    except OSError as e:  # a name too long: pathlib raises what it does not take for "absent"
+        raise ConfigError(key, f"cannot read {str(p)[:80]}...: {e.strerror}") from None
+    if not is_file:
         raise ConfigError(key, f"no such file: {p}")
     try:
         with open(p, newline="", encoding="utf-8") as fh:
