@@ -203,8 +203,9 @@ class _File:
 def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
     """The bytes of ``path``: a regular file of at most :data:`MAX_BYTES` (else one line)."""
     path = Path(path)
-    if "\0" in str(path):
-        raise ConfigError(key, f"{str(path)!r} holds a NUL character: not a path")
+    if not str(path).isprintable():  # NUL, or a line break that would split the one line
+        what = "a NUL character" if "\0" in str(path) else "a control character"
+        raise ConfigError(key, f"{str(path)!r} holds {what}: not a path")
     try:
         st = os.stat(path)
     except OSError as e:

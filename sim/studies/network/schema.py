@@ -159,6 +159,18 @@ def _check_compare(net, full: dict, fix: list, sparse: bool) -> None:
         _defect(net, datum(net, full, tuple(extra)), "compare.fix")
 
 
+def _build(full: dict):
+    """``build(full)``; a point or observation read from ``network.gama_xml`` that the network
+    refuses is named by that key and the file, not by keys the study file does not hold."""
+    try:
+        return build(full)
+    except ConfigError as e:
+        gama = full.get("network.gama_xml")
+        if not gama or not str(e.key or "").startswith(("network.points", "network.observations")):
+            raise
+        raise ConfigError("network.gama_xml", f"{gama}: {str(e)[len(e.key) + 2 :]}") from None
+
+
 def check(cfg: dict) -> None:
     """Cross-key rules: the network builds (every observation well defined), its datum covers
     every rank defect and is not near-singular, something is estimated, the chunk fits in
@@ -169,7 +181,7 @@ def check(cfg: dict) -> None:
     require_chunks(cfg)  # estimates.py and tables.py: jackknife intervals over the chunks
     _digest(cfg)
     full = merge_gama(cfg)
-    net = build(full)
+    net = _build(full)
     sparse = use_sparse(net)
     nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
     if nbytes > MAX_CHUNK_BYTES:
@@ -192,12 +204,15 @@ def check(cfg: dict) -> None:
         check_inner(net, inner_defect(net), pts, "datum.points")
     an = pre_analysis(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
-        if sparse:
-            cause = singular_cause(net, full, dt.free_index(net.q))
+        # dense too: name the point no observation reaches (docs/network.md), unless nothing
+        # holds the network at all (then the rank defect and its advice say it better)
+        held = sparse or full["datum.kind"] != "fixed" or np.any(net.role != 0)
+        cause = singular_cause(net, full, dt.free_index(net.q)) if held else ""
+        if sparse or cause:
+            what = an.factor.message if sparse else "the normal matrix is singular"
             raise ConfigError(
                 "datum.kind",
-                f"{an.factor.message}{': ' + cause if cause else ''}: fix points or change "
-                "the datum",
+                f"{what}{': ' + cause if cause else ''}: fix points or change the datum",
             )
         _defect(net, dt, "datum.kind")
     _conditioned(net, an, "datum.kind")
