@@ -245,6 +245,12 @@ def _check_claims(f: Path) -> None:
         raise ConfigError("DIR", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
     if "study" not in prov or not {"claim", "verdict"} <= set(names):
         raise ConfigError("DIR", f"{f} is not a claims table written by sim")
+    run = (read_record(f.parent) or {}).get("config")
+    owner = run.get("study") if isinstance(run, dict) else None
+    if isinstance(owner, str) and prov["study"] != owner:  # another study's table, copied in
+        raise ConfigError(
+            "DIR", f"{f} is a table of {prov['study']!r}, not of this run's {owner!r} (run.json)"
+        )
 
 
 def _n(x: float) -> str:

@@ -17,11 +17,15 @@ before its fix.
   sparse path does (:func:`sim.studies.network.schema.check`);
 * a point or observation of a ``network.gama_xml`` file that the network refuses (a sight to
   itself: gama-local reads it) was named by ``network.observations``, a key the study file
-  does not hold, and not by the file (:func:`sim.studies.network.schema._build`).
+  does not hold, and not by the file (:func:`sim.studies.network.schema._build`);
+* ``sim show`` printed another study's claims table copied into a results directory as this
+  run's, exit 0 (docs/cli.md: a table replaced by hand is one line naming the directory;
+  :func:`sim.cli._check_claims`).
 """
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -96,3 +100,12 @@ def test_a_table_file_name_the_file_system_refuses_is_one_line_naming_the_key(va
         sim.load(str(ROOT / "studies/wolf_polynomial.toml"), **{"table3.file": value})
     assert e.value.key == "table3.file" and words in str(e.value), str(e.value)
     assert "\n" not in str(e.value)
+
+
+def test_sim_show_refuses_another_studys_claims_copied_in(tmp_path, capsys):
+    d = tmp_path / "brown_table1"
+    shutil.copytree(ROOT / "results/brown_table1", d)
+    shutil.copy(ROOT / "results/network_brown/claims.parquet", d / "claims.parquet")
+    assert main(["show", str(d)]) == 2
+    err = capsys.readouterr().err
+    assert "a table of 'network'" in err and err.count("\n") == 1, err
