@@ -20,7 +20,15 @@ before its fix.
   does not hold, and not by the file (:func:`sim.studies.network.schema._build`);
 * ``sim show`` printed another study's claims table copied into a results directory as this
   run's, exit 0 (docs/cli.md: a table replaced by hand is one line naming the directory;
-  :func:`sim.cli._check_claims`).
+  :func:`sim.cli._check_claims`);
+* a ``network.gama_xml`` file without a fixed point and with ``adj="XY"`` points is adjusted
+  in the inner datum (docs/gama.md), but ``sim check`` and the run record showed the study
+  file's ``datum.kind = 'fixed'`` (:func:`sim.studies.network.schema.check`).
+
+Sentences of the documentation found false and corrected: docs/cli.md and docs/python.md
+("picks the largest chunk": ``--trials`` keeps the file's chunk when it gives 20 chunks);
+docs/network.md (a decimal angle in a gama-local file is gon, not degrees; ``<vectors>`` are
+read, not refused).
 """
 
 from __future__ import annotations
@@ -109,3 +117,16 @@ def test_sim_show_refuses_another_studys_claims_copied_in(tmp_path, capsys):
     assert main(["show", str(d)]) == 2
     err = capsys.readouterr().err
     assert "a table of 'network'" in err and err.count("\n") == 1, err
+
+
+def test_a_free_gama_file_resolves_the_inner_datum_it_is_adjusted_in(tmp_path, capsys):
+    xml = tmp_path / "free.xml"  # adj="XY" and no fixed point: the inner datum (docs/gama.md)
+    text = (ROOT / "tests/data/gama/user_defaults.xml").read_text()
+    xml.write_text(text.replace('fix="xy"', 'adj="XY"'))
+    study = tmp_path / "s.toml"
+    study.write_text(
+        f'study = "network"\ntrials = 200\nchunk = 10\n[network]\ngama_xml = "{xml}"\n'
+    )
+    assert sim.load(str(study)).config["datum.kind"] == "inner"
+    assert main(["check", str(study)]) == 0
+    assert "datum.kind = 'inner'" in capsys.readouterr().out

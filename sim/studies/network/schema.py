@@ -181,6 +181,7 @@ def check(cfg: dict) -> None:
     require_chunks(cfg)  # estimates.py and tables.py: jackknife intervals over the chunks
     _digest(cfg)
     full = merge_gama(cfg)
+    cfg["datum.kind"] = full["datum.kind"]  # a free gama-local file's inner datum, resolved
     net = _build(full)
     sparse = use_sparse(net)
     nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
