@@ -23,7 +23,9 @@ before its fix.
   :func:`sim.cli._check_claims`);
 * a ``network.gama_xml`` file without a fixed point and with ``adj="XY"`` points is adjusted
   in the inner datum (docs/gama.md), but ``sim check`` and the run record showed the study
-  file's ``datum.kind = 'fixed'`` (:func:`sim.studies.network.schema.check`).
+  file's ``datum.kind = 'fixed'`` (:func:`sim.studies.network.schema.check`);
+* Brown's closure note said "1.7 um per setting (double) and the comparator's 1.1 um" whatever
+  ``errors.*`` said (:func:`sim.studies.brown.claims._closure`).
 
 Sentences of the documentation found false and corrected: docs/cli.md and docs/python.md
 ("picks the largest chunk": ``--trials`` keeps the file's chunk when it gives 20 chunks);
@@ -36,10 +38,12 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import sim
 from sim.cli import main
+from sim.studies.brown.claims import _closure
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -130,3 +134,14 @@ def test_a_free_gama_file_resolves_the_inner_datum_it_is_adjusted_in(tmp_path, c
     assert sim.load(str(study)).config["datum.kind"] == "inner"
     assert main(["check", str(study)]) == 0
     assert "datum.kind = 'inner'" in capsys.readouterr().out
+
+
+def test_brown_closure_note_states_the_configured_settings():
+    """At errors.settings = 1 and a 3 um setting the note said "1.7 um per setting (double)"."""
+    cfg = {"errors.settings": 1, "errors.setting_sigma_um": 3.0, "errors.comparator_sigma_um": 1.1}
+    s0 = np.linspace(1.5, 2.5, 40)
+    note = _closure(cfg, s0, 3.2)["brown.table1_closure.rms_um"].note
+    assert "3 um per setting (single) and the comparator's 1.1 um" in note, note
+    cfg.update({"errors.settings": 2, "errors.setting_sigma_um": 1.7})
+    note = _closure(cfg, s0, 1.6)["brown.table1_closure.rms_um"].note
+    assert "1.7 um per setting (double) and the comparator's 1.1 um" in note, note

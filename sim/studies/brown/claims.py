@@ -181,12 +181,15 @@ def _closure(cfg, s0, sr) -> dict[str, Sim]:
     """The closure rows of Table 1: sigma0 over plates, its typical range, the setting sigma."""
     q25, q75 = np.percentile(s0, [25, 75])
     inside = float(np.mean((s0 >= 1.45) & (s0 < 2.05)))
+    n = cfg["errors.settings"]  # the inputs as configured (the paper's: 1.7 um, double, 1.1 um)
+    word = {1: "single", 2: "double"}.get(n, f"{n} settings")
     return {
         "brown.table1_closure.rms_um": plates(
             s0,
             f"a-posteriori sigma0 of one plate over {len(s0)} simulated plates; its expectation is "
-            f"the range sigma {sr:.2f} um built from 1.7 um per setting (double) and the comparator's "
-            "1.1 um, which the paper derived from this 1.6: agreement by construction",
+            f"the range sigma {sr:.2f} um built from {cfg['errors.setting_sigma_um']:g} um per "
+            f"setting ({word}) and the comparator's {cfg['errors.comparator_sigma_um']:g} um, "
+            "which the paper derived from this 1.6: agreement by construction",
         ),
         "brown.table1_closure.typical_range_um": Sim(
             float(q25),
