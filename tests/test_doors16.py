@@ -25,7 +25,9 @@ before its fix.
   in the inner datum (docs/gama.md), but ``sim check`` and the run record showed the study
   file's ``datum.kind = 'fixed'`` (:func:`sim.studies.network.schema.check`);
 * Brown's closure note said "1.7 um per setting (double) and the comparator's 1.1 um" whatever
-  ``errors.*`` said (:func:`sim.studies.brown.claims._closure`).
+  ``errors.*`` said (:func:`sim.studies.brown.claims._closure`);
+* explicit ``datum.constraints`` that leave a rank defect (a coefficient of 1e-300: legal, but
+  no constraint) were blamed on ``datum.kind`` (the earlier class was NaN or inf there).
 
 Sentences of the documentation found false and corrected: docs/cli.md and docs/python.md
 ("picks the largest chunk": ``--trials`` keeps the file's chunk when it gives 20 chunks);
@@ -145,3 +147,11 @@ def test_brown_closure_note_states_the_configured_settings():
     cfg.update({"errors.settings": 2, "errors.setting_sigma_um": 1.7})
     note = _closure(cfg, s0, 1.6)["brown.table1_closure.rms_um"].note
     assert "1.7 um per setting (double) and the comparator's 1.1 um" in note, note
+
+
+def test_constraints_that_leave_a_defect_are_named(capsys):
+    tiny = '[{"S1.x" = 1e-300}, {"S3.x" = 1.0}, {"S4.y" = 1.0, "S2.y" = 1.0}]'
+    study = str(ROOT / "studies/network_brown.toml")
+    assert main(["check", study, "--set", f"datum.constraints={tiny}"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("sim: error: datum.constraints: ") and "rank defect of 3" in err, err

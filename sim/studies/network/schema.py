@@ -215,7 +215,10 @@ def check(cfg: dict) -> None:
                 "datum.kind",
                 f"{what}{': ' + cause if cause else ''}: fix points or change the datum",
             )
-        _defect(net, dt, "datum.kind")
+        # explicit constraints that leave a defect (one of coefficient 1e-300, say) are theirs
+        _defect(
+            net, dt, "datum.constraints" if full["datum.kind"] == "constraints" else "datum.kind"
+        )
     _conditioned(net, an, "datum.kind")
     if not estimated_points(net, an):
         raise ConfigError(
