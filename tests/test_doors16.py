@@ -27,7 +27,10 @@ before its fix.
 * Brown's closure note said "1.7 um per setting (double) and the comparator's 1.1 um" whatever
   ``errors.*`` said (:func:`sim.studies.brown.claims._closure`);
 * explicit ``datum.constraints`` that leave a rank defect (a coefficient of 1e-300: legal, but
-  no constraint) were blamed on ``datum.kind`` (the earlier class was NaN or inf there).
+  no constraint) were blamed on ``datum.kind`` (the earlier class was NaN or inf there);
+* brown_design's chi-square false-alarm self-checks compared the rate of a test run at
+  ``coverage.alpha`` with the book's 5 %: at any other legal level (0.01, 1e-12) the
+  self-check "failed" (:func:`sim.studies.design.claims._at_level`).
 
 Sentences of the documentation found false and corrected: docs/cli.md and docs/python.md
 ("picks the largest chunk": ``--trials`` keeps the file's chunk when it gives 20 chunks);
@@ -46,6 +49,7 @@ import pytest
 import sim
 from sim.cli import main
 from sim.studies.brown.claims import _closure
+from sim.studies.design import claims as design_claims
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -155,3 +159,17 @@ def test_constraints_that_leave_a_defect_are_named(capsys):
     assert main(["check", study, "--set", f"datum.constraints={tiny}"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("sim: error: datum.constraints: ") and "rank defect of 3" in err, err
+
+
+def test_brown_design_false_alarm_is_checked_at_the_configured_level():
+    """The chi-square test ran at coverage.alpha, its rate was checked against 5 % (a self-check
+    that failed at any other legal level)."""
+    book = design_claims.load_book()
+    design_claims._at_level(book, 0.01)
+    s = book.spec("coverage.pivot.false_alarm")
+    assert s["ref"] == 0.01 and s["tol"] == pytest.approx(0.002)
+    book = design_claims.load_book()
+    design_claims._at_level(book, 0.05)
+    assert book.spec("coverage.affine.false_alarm") == design_claims.load_book().spec(
+        "coverage.affine.false_alarm"
+    )

@@ -270,9 +270,20 @@ def _twoplate(tp: dict | None) -> dict[str, Sim | None]:
     }
 
 
+def _at_level(book: ClaimBook, alpha: float) -> None:
+    """The chi-square test runs at ``coverage.alpha``: its false-alarm rate is checked against
+    that level (the book states the default 5 %, tolerance 1 point), not against 5 %."""
+    for m in ("pivot", "affine"):
+        cid = f"coverage.{m}.false_alarm"
+        s = book.spec(cid)
+        if s["ref"] != alpha:
+            book.specs[cid] = {**s, "ref": alpha, "tol": s["tol"] * alpha / s["ref"]}
+
+
 def score_all(book: ClaimBook, cfg: dict, R: dict) -> list[dict]:
     """The rows of brown_design not decided over the region (the EXTERNAL rows come from
     :mod:`.region`; ``R["external"]`` is at the labelled example)."""
+    _at_level(book, cfg["coverage.alpha"])
     table = {
         **_operation(cfg, R),
         **_budget(R),
