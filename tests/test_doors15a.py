@@ -12,10 +12,11 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from oneline import one_line
-from scipy import stats
+from scipy import sparse, stats
 from scipy.special import gammaln
 
 from sim.cli import main
+from sim.lsq.sparse import factorize
 from sim.mc.config import ConfigError, shown
 from sim.mc.runner import jackknife
 from sim.studies import load_study
@@ -104,3 +105,44 @@ def test_the_sigma_ratio_is_unbiased_at_40_trials_and_its_interval_covers_1():
     assert abs(new[:, 0].mean() - 1) < 4 * se, (new[:, 0].mean(), se)
     assert abs(old[:, 0].mean() - c4) < 4 * se and 1 - old[:, 0].mean() > 10 * se
     assert int(((old[:, 1] <= 1) & (old[:, 2] >= 1)).sum()) < covers - 10  # the bias showed
+
+
+def _chain(n: int = 200) -> list[str]:
+    """``--set`` values of a chain of ``n`` points between two fixed ends on the x axis, each
+    off the line by up to 1 mm, seen by the distances to its two nearest neighbours only."""
+    rng = np.random.default_rng(3)
+    pts = [
+        '{name="A",x_m=0.0,y_m=0.0,role="fixed"}',
+        f'{{name="B",x_m={n + 1}.0,y_m=0.0,role="fixed"}}',
+    ]
+    pts += [
+        f'{{name="P{i}",x_m={i}.0,y_m={rng.uniform(-1e-3, 1e-3):.6f}}}' for i in range(1, n + 1)
+    ]
+    gen = '[{kind="distance",from="*",to="*",nearest=2,sigma_mm=1.0}]'
+    sets = [f"network.points=[{','.join(pts)}]", "network.grids=[]", f"network.generate={gen}"]
+    sets += ["network.observations=[]", "compare.fix=[]", "output.inner_over=[]"]
+    return [a for v in sets for a in ("--set", v)]
+
+
+def test_a_long_chain_nearly_in_line_names_its_weak_point_on_the_sparse_path(capsys):
+    err = one_line(capsys, main(["check", str(FIELD), *_chain()]), "datum.kind", "singular")
+    assert re.search(r"point 'P\d+' \(y\) is nearly undetermined", err), err
+
+
+@pytest.mark.parametrize("eps, words", [(0.0, "exactly zero pivot"), (1e-13, "scaled pivot")])
+def test_the_sparse_factor_names_the_unknown_of_its_failed_pivot(eps, words):
+    """Unit normals of 500 unknowns with one pair coupled to (nearly) one: the pivot fails
+    on one of the two, in the order of the free unknowns, also with a datum defect held out."""
+    p, a, b = 500, 123, 321
+    N = sparse.lil_matrix(sparse.identity(p))
+    N[a, b] = N[b, a] = 1.0 - eps
+    f = factorize(sparse.csc_matrix(N))
+    assert not f.ok and words in f.message and f.weak in (a, b), (f.message, f.weak)
+    # a defect in front (two unknowns seen only by their sum), one of them held as the datum:
+    # the pivot's unknown is still given among all the free ones
+    Nd = sparse.block_diag([np.ones((2, 2)), N], format="csc")
+    G = np.zeros((p + 2, 1))
+    G[:2, 0] = [1.0, -1.0]
+    f = factorize(Nd, G, G)
+    assert not f.ok and words in f.message and f.weak in (a + 2, b + 2), (f.message, f.weak)
+    assert factorize(sparse.identity(p, format="csc")).weak == -1  # a regular factor names none
