@@ -6,6 +6,8 @@ failed on the code before its fix.
 """
 
 import re
+import subprocess
+import sys
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -65,6 +67,14 @@ def test_a_huge_number_on_any_integer_key_gets_a_short_message(path):
 def test_a_huge_set_override_gets_a_short_message(capsys, setting, needle):
     err = one_line(capsys, main(["check", str(FIELD), "--set", setting]), needle)
     assert not LONG.search(err) and len(err) < 300, err
+
+
+def test_a_huge_nearest_is_every_target_in_the_work_estimate_too(capsys):
+    """``nearest = 1e300`` builds every target (the build takes the smaller count); the work
+    estimate multiplied by it and refused "9.06e+301 adjustments" naming no key."""
+    gen = '[{kind="distance",from="*",to="*",nearest=1e300,sigma_mm=1.0}]'
+    assert main(["check", str(FIELD), "--set", f"network.generate={gen}"]) == 0
+    assert "about 2e+03 adjustments" in capsys.readouterr().out
 
 
 def _chunk_sums(rng, sig, trials=40, chunk=2):
@@ -146,3 +156,20 @@ def test_the_sparse_factor_names_the_unknown_of_its_failed_pivot(eps, words):
     f = factorize(Nd, G, G)
     assert not f.ok and words in f.message and f.weak in (a + 2, b + 2), (f.message, f.weak)
     assert factorize(sparse.identity(p, format="csc")).weak == -1  # a regular factor names none
+
+
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP", "SIGINT"])
+def test_a_stop_signal_while_sim_loads_is_one_line_and_exit_130(sig):
+    code = (
+        "import os, signal, time\n"
+        "from sim.threads import interrupt_while_loading\n"
+        "loaded = interrupt_while_loading('sim')\n"
+        "h = signal.getsignal(signal.SIGTERM)\n"
+        "loaded()\n"
+        "assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL is not h\n"
+        "interrupt_while_loading('sim')\n"
+        f"os.kill(os.getpid(), signal.{sig})\n"
+        "time.sleep(30)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 130 and done.stderr == "sim: interrupted\n", done
