@@ -1,7 +1,8 @@
 """Monte-Carlo estimates of a network study from the runner's per-chunk sums: the point sigmas
 with jackknife intervals over chunks, their ratio to the analytic sigmas (the root of the
 mean variance ratio: unbiased at any number of trials), the coverage of the analytic 95 %
-ellipses and the false-alarm rate of the global test (Wilson intervals from the counts). Coordinates and sigmas in mm. Every estimate is ``(value, lo, hi)``.
+ellipses and the false-alarm rate of the global test (Wilson intervals from the counts).
+Coordinates and sigmas in mm. Every estimate is ``(value, lo, hi)``.
 """
 
 from __future__ import annotations
@@ -31,11 +32,10 @@ def sigma_ratio(s_mc: np.ndarray, an_sig: np.ndarray) -> float:
     variance ratios is 1 in expectation when the analytic sigmas are right, whatever the
     number of trials; its root is biased only by the spread of that mean (by about minus an
     eighth of its variance: 1e-6 at 40 trials of 5,000 independent coordinates).
-    The sample standard deviation is biased low by Gurland and Tripathi's factor ``c4(n)``
+    The sample standard deviation is biased low, by the factor ``c4(n)`` for normal errors
     (0.9936 at n = 40), which a mean of ``s / sigma`` over many coordinates keeps while its
-    interval shrinks: at 40 trials network_gridplate_2500's interval left out 1. Correcting
-    by ``c4`` would need the converged count of every chunk and assumes normal errors; the
-    variances need neither."""
+    interval shrinks: at 40 trials network_gridplate_2500's interval left out 1. Dividing
+    by ``c4`` would hold for normal errors only; the variances are unbiased for any."""
     return float(np.sqrt(np.mean((s_mc / an_sig) ** 2)))
 
 
@@ -45,9 +45,9 @@ class McEstimates:
 
     n_ok : converged trials per chunk; an_sig : the analytic sigmas (mm); s_mc, s_lo, s_hi : the
     Monte-Carlo sigmas and their 95 % interval (mm); ratio : MC / analytic sigma (the root of
-    the mean variance ratio, :func:`sigma_ratio`); cover :
-    per point, the share inside its 95 % ellipse; cover_mean : its mean over points; alarm :
-    the rejection rate of the global test. The last four as ``(value, lo, hi)`` arrays."""
+    the mean variance ratio, :func:`sigma_ratio`); cover : per point, the share inside its
+    95 % ellipse; cover_mean : its mean over points; alarm : the rejection rate of the global
+    test. The last four as ``(value, lo, hi)`` arrays."""
 
     n_ok: np.ndarray
     an_sig: np.ndarray
