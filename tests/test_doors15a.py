@@ -180,3 +180,31 @@ def test_a_stop_signal_while_sim_loads_is_one_line_and_exit_130(sig):
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.returncode == 130 and done.stderr == "sim: interrupted\n", done
+
+
+def test_ctrl_c_while_the_pool_forks_is_not_lost():
+    """An interrupt raised in the parent's at-fork hook (where a real Ctrl-C lands now and
+    then) was swallowed; now it reaches the caller as KeyboardInterrupt, and the workers take
+    signals again (a SIGTERM still ends them)."""
+    code = (
+        "import os, signal, sys\n"
+        "from sim.mc.executors import _Pool\n"
+        "os.register_at_fork(after_in_parent=lambda: os.kill(os.getpid(), signal.SIGINT))\n"
+        "try:\n"
+        "    _Pool(1)\n"
+        "except KeyboardInterrupt:\n"
+        "    sys.exit(130)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 130 and "Exception ignored" not in done.stderr, done
+    code = (
+        "import signal\n"
+        "from sim.mc.executors import _Pool\n"
+        "p = _Pool(1)\n"
+        "assert p.start_method != 'fork' or not signal.pthread_sigmask(signal.SIG_BLOCK, [])\n"
+        "f = p.pool.submit(signal.pthread_sigmask, signal.SIG_BLOCK, [])\n"
+        "assert not f.result(timeout=30), f.result()\n"
+        "p.close(kill=True)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr[-800:]
