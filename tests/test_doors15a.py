@@ -42,8 +42,10 @@ def test_shown_shortens_only_numbers_longer_than_64_bits():
     assert shown(2**63 - 1) == "9223372036854775807"  # a legal seed stays whole
     assert shown(10**300) == "1e+300" and shown(-(10**30)) == "-1e+30"
     assert shown(10**400) == "a 401-digit number" and shown(1.5) == "1.5"
+    assert shown(-(10**5000)) == "a negative number of over 4000 digits"
     msg = str(ConfigError("k", f"{10**40} at /tmp/{10**25}/x and 0.{10**30}"))
     assert msg.startswith("k: 1e+40 at /tmp/1") and f"0.{10**30}" in msg  # paths, decimals kept
+    assert str(ConfigError("k", "x " + "7" * 5000)) == "k: x a 5000-digit number"  # > 4300
 
 
 @pytest.mark.parametrize("path", KINDS, ids=lambda p: p.stem)

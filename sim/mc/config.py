@@ -45,19 +45,30 @@ def shown(v: Any) -> str:
     or "a 401-digit number" beyond a float's range): 1e300 given for an integer key is the
     integer 10**300 (301 digits), which no one line should print."""
     if isinstance(v, int) and not isinstance(v, bool):
-        digits = len(str(abs(v))) if abs(v) < 10**4000 else 4001
+        if abs(v) >= 10**4000:  # str() reads at most 4300 digits
+            return f"a {'negative ' if v < 0 else ''}number of over 4000 digits"
+        digits = len(str(abs(v)))
         if digits <= LONG_DIGITS:
             return repr(v)
         try:
             return f"{float(v):g}"
         except OverflowError:
-            return f"{'-' if v < 0 else ''}a {digits}-digit number"
+            return f"a {'negative ' if v < 0 else ''}{digits}-digit number"
     return repr(v)
 
 
 def _shorten(message: str) -> str:
-    """Every run of more than 19 digits in ``message`` shortened as :func:`shown` does."""
-    return _LONG_RUN.sub(lambda m: shown(int(m.group(0))), message)
+    """Every run of more than 19 digits in ``message`` shortened as :func:`shown` does (one
+    beyond a float's range counted, not converted: Python reads at most 4300 digits)."""
+
+    def short(m: re.Match) -> str:
+        t = m.group(0)
+        digits = len(t.lstrip("-"))
+        if digits > 308:
+            return f"a {'negative ' if t.startswith('-') else ''}{digits}-digit number"
+        return shown(int(t))
+
+    return _LONG_RUN.sub(short, message)
 
 
 class ConfigError(ValueError):
