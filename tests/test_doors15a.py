@@ -210,3 +210,19 @@ def test_ctrl_c_while_the_pool_forks_is_not_lost():
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr[-800:]
+
+
+def test_ctrl_c_in_the_first_import_of_sim_is_one_line():
+    code = (
+        "import os, signal, sys\n"
+        "assert 'logging' not in sys.modules\n"
+        "class Hook:\n"
+        "    def find_spec(self, name, path=None, target=None):\n"
+        "        if name == 'logging':\n"
+        "            os.kill(os.getpid(), signal.SIGINT)\n"
+        "sys.meta_path.insert(0, Hook())\n"
+        "sys.argv = ['sim']\n"
+        "import sim.__main__\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 130 and done.stderr == "sim: interrupted\n", done
