@@ -6,15 +6,13 @@ failed on the code before its fix.
 """
 
 import re
-import subprocess
-import sys
 import tomllib
 from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from oneline import one_line
+from oneline import one_line, python_lines
 from scipy import sparse, stats
 from scipy.special import gammaln
 
@@ -169,60 +167,56 @@ def test_the_sparse_factor_names_the_unknown_of_its_failed_pivot(eps, words):
 
 @pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP", "SIGINT"])
 def test_a_stop_signal_while_sim_loads_is_one_line_and_exit_130(sig):
-    code = (
-        "import os, signal, time\n"
-        "from sim.threads import interrupt_while_loading\n"
-        "loaded = interrupt_while_loading('sim')\n"
-        "h = signal.getsignal(signal.SIGTERM)\n"
-        "loaded()\n"
-        "assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL is not h\n"
-        "interrupt_while_loading('sim')\n"
-        f"os.kill(os.getpid(), signal.{sig})\n"
-        "time.sleep(30)\n"
+    done = python_lines(
+        "import os, signal, time",
+        "from sim.threads import interrupt_while_loading",
+        "loaded = interrupt_while_loading('sim')",
+        "h = signal.getsignal(signal.SIGTERM)",
+        "loaded()",
+        "assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL is not h",
+        "interrupt_while_loading('sim')",
+        f"os.kill(os.getpid(), signal.{sig})",
+        "time.sleep(30)",
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.returncode == 130 and done.stderr == "sim: interrupted\n", done
 
 
 def test_ctrl_c_while_the_pool_forks_is_not_lost():
     """An interrupt raised in the parent's at-fork hook (where a real Ctrl-C lands now and
-    then) was swallowed; now it reaches the caller as KeyboardInterrupt, and the workers take
-    signals again (a SIGTERM still ends them)."""
-    code = (
-        "import os, signal, sys\n"
-        "from sim.mc.executors import _Pool\n"
-        "os.register_at_fork(after_in_parent=lambda: os.kill(os.getpid(), signal.SIGINT))\n"
-        "try:\n"
-        "    _Pool(1)\n"
-        "except KeyboardInterrupt:\n"
-        "    sys.exit(130)\n"
+    then) was swallowed; now it reaches the caller as KeyboardInterrupt; the workers block no signal (a SIGTERM
+    from the pool's close still ends them)."""
+    done = python_lines(
+        "import os, signal, sys",
+        "from sim.mc.executors import _Pool",
+        "os.register_at_fork(after_in_parent=lambda: os.kill(os.getpid(), signal.SIGINT))",
+        "try:",
+        "    _Pool(1)",
+        "except KeyboardInterrupt:",
+        "    sys.exit(130)",
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.returncode == 130 and "Exception ignored" not in done.stderr, done
-    code = (
-        "import signal\n"
-        "from sim.mc.executors import _Pool\n"
-        "p = _Pool(1)\n"
-        "assert p.start_method != 'fork' or not signal.pthread_sigmask(signal.SIG_BLOCK, [])\n"
-        "f = p.pool.submit(signal.pthread_sigmask, signal.SIG_BLOCK, [])\n"
-        "assert not f.result(timeout=30), f.result()\n"
-        "p.close(kill=True)\n"
+    done = python_lines(
+        "import signal",
+        "from sim.mc.executors import _Pool",
+        "p = _Pool(1)",
+        "assert p.start_method != 'fork' or not signal.pthread_sigmask(signal.SIG_BLOCK, [])",
+        "f = p.pool.submit(signal.pthread_sigmask, signal.SIG_BLOCK, [])",
+        "assert not f.result(timeout=30), f.result()",
+        "p.close(kill=True)",
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr[-800:]
 
 
 def test_ctrl_c_in_the_first_import_of_sim_is_one_line():
-    code = (
-        "import os, signal, sys\n"
-        "assert 'logging' not in sys.modules\n"
-        "class Hook:\n"
-        "    def find_spec(self, name, path=None, target=None):\n"
-        "        if name == 'logging':\n"
-        "            os.kill(os.getpid(), signal.SIGINT)\n"
-        "sys.meta_path.insert(0, Hook())\n"
-        "sys.argv = ['sim']\n"
-        "import sim.__main__\n"
+    done = python_lines(
+        "import os, signal, sys",
+        "assert 'logging' not in sys.modules",
+        "class Hook:",
+        "    def find_spec(self, name, path=None, target=None):",
+        "        if name == 'logging':",
+        "            os.kill(os.getpid(), signal.SIGINT)",
+        "sys.meta_path.insert(0, Hook())",
+        "sys.argv = ['sim']",
+        "import sim.__main__",
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.returncode == 130 and done.stderr == "sim: interrupted\n", done
