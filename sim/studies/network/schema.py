@@ -193,7 +193,8 @@ def check(cfg: dict) -> None:
     an = pre_analysis(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
         if sparse:
-            cause = singular_cause(net, full, dt.free_index(net.q))
+            free = dt.free_index(net.q)
+            cause = singular_cause(net, full, free) or _pivot(net, an.factor, free)
             raise ConfigError(
                 "datum.kind",
                 f"{an.factor.message}{': ' + cause if cause else ''}: fix points or change "
@@ -302,6 +303,17 @@ def _unknown(net, par: int) -> str:
     if par < 2 * net.n:
         return f"point {net.names[par // 2]!r} ({'xy'[par % 2]})"
     return net.parameter_names()[par - 2 * net.n]
+
+
+def _pivot(net, factor, free: np.ndarray) -> str:
+    """The unknown at the sparse factor's failed pivot (:attr:`sim.lsq.sparse.Factor.weak`),
+    named as the dense path names its weakest one; "" when the factor names none."""
+    if factor is None or factor.weak < 0:
+        return ""
+    return (
+        f"{_unknown(net, int(free[factor.weak]))} is nearly undetermined (the smallest pivot "
+        "of the normals falls on it; points nearly on one line, or too few observations)"
+    )
 
 
 def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
