@@ -61,6 +61,12 @@ def test_points_needed_is_the_fewest_points_whose_bound_is_small_enough(share, l
     assert share_bound(k, level) <= share < share_bound(k - 1, level) if k > 1 else True
 
 
+@pytest.mark.parametrize("k", [1, 5, 29])
+def test_points_needed_counts_a_bound_equal_to_the_share_as_enough(k):
+    assert points_needed(share_bound(k), 0.95) == k  # "at most" the share, not "under"
+    assert points_needed(0.96, 0.95) == 1  # one point already bounds it under 95 %
+
+
 @pytest.mark.parametrize("share, level", [(0.0, 0.95), (1.0, 0.95), (0.1, 0.0), (0.1, 1.0)])
 def test_points_needed_refuses_a_share_or_level_outside_0_1(share, level):
     with pytest.raises(ValueError, match="0 < share < 1"):
