@@ -1,12 +1,13 @@
 """``python -m sim`` and the ``sim`` command: BLAS single-threaded, matplotlib's notes about
 an unwritable config directory kept quiet, then the command line."""
 
-import logging
-import sys
-
 from sim.threads import interrupt_while_loading, refuse_bad_environment, single_threaded_blas
 
 loaded = interrupt_while_loading("sim")  # Ctrl-C during the imports: one line, exit 130
+
+import logging  # noqa: E402 - after the guard: Ctrl-C in this import was a traceback
+import sys  # noqa: E402
+
 refuse_bad_environment("sim")  # a variable NumPy cannot load with: one line, exit 2
 single_threaded_blas()  # before NumPy loads (sim.cli imports it)
 

@@ -11,6 +11,12 @@ import sys
 import threading
 
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+#: the signals an entry point takes over while it loads, with their default handlers
+LOADING_SIGNALS = (
+    ("SIGINT", signal.default_int_handler),
+    ("SIGTERM", signal.SIG_DFL),
+    ("SIGHUP", signal.SIG_DFL),
+)
 
 
 def single_threaded_blas() -> None:
@@ -33,23 +39,31 @@ def interrupted(e: BaseException | None) -> bool:
 
 
 def interrupt_while_loading(prog: str):
-    """Ctrl-C while an entry point imports the suite (a second or two): one line
-    ``<prog>: interrupted`` and exit 130, as later, not a traceback from whichever import
-    was running (nothing has been written yet). Returns the function that puts Python's own
-    handler back once the command handles Ctrl-C itself; a SIGINT the caller ignores (a
-    background job) stays ignored."""
-    if (
-        threading.current_thread() is not threading.main_thread()
-        or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
-    ):
+    """Ctrl-C (or SIGTERM, SIGHUP) while an entry point imports the suite (a second or two):
+    one line ``<prog>: interrupted`` and exit 130, as later, not a traceback from whichever
+    import was running nor a silent death by SIGTERM (nothing has been written yet). Returns
+    the function that puts the default handlers back once the command handles the signals
+    itself; a signal the caller ignores (SIGINT of a background job, SIGHUP under nohup)
+    stays ignored."""
+    if threading.current_thread() is not threading.main_thread():
         return lambda: None
 
     def handler(signum, frame):
         os.write(2, f"{prog}: interrupted\n".encode())
         os._exit(130)
 
-    signal.signal(signal.SIGINT, handler)
-    return lambda: signal.signal(signal.SIGINT, signal.default_int_handler)
+    taken = []
+    for name, default in LOADING_SIGNALS:
+        s = getattr(signal, name, None)
+        if s is not None and signal.getsignal(s) is default:
+            signal.signal(s, handler)
+            taken.append((s, default))
+
+    def restore() -> None:
+        for s, default in taken:
+            signal.signal(s, default)
+
+    return restore
 
 
 def refuse_bad_environment(prog: str) -> None:

@@ -9,6 +9,7 @@ import fcntl
 import os
 import re
 import resource
+import signal
 import subprocess
 import sys
 import threading
@@ -20,6 +21,13 @@ import pytest
 from sim.threads import single_threaded_blas
 
 single_threaded_blas()
+
+# A shell without job control starts a background job (`make test &`, a CI step's `&`) with
+# SIGINT ignored, and every child inherits that: the tests of what a command does on Ctrl-C
+# (a terminal's foreground process) would then see a SIGINT the caller ignores. The tests run
+# as from a terminal, however they were started.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 #: SIM_TEST_CPU_LOG=FILE: append each test's CPU seconds (its process and the subprocesses it
 #: waited for, setup and teardown included) to FILE as "nodeid<TAB>seconds". CPU time, not
@@ -34,6 +42,27 @@ def _cpu_s() -> float:
         resource.getrusage(resource.RUSAGE_CHILDREN),
     )
     return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+#: the handlers a test must give back: a test process whose SIGINT is left ignored passes that
+#: on to every child it starts, and a later test of Ctrl-C in a child then fails
+SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+@pytest.fixture(autouse=True)
+def _gives_signal_handlers_back():
+    """Every test leaves the process's signal handlers as it found them (a command called in
+    process restores its own); one that does not fails, naming the signal, and they are put
+    back so that the tests after it are not affected."""
+    before = {s: signal.getsignal(s) for s in SIGNALS}
+    yield
+    changed = [s for s in SIGNALS if signal.getsignal(s) is not before[s]]
+    for s in changed:
+        signal.signal(s, before[s])
+    if changed:
+        pytest.fail(
+            f"the test left the handler of {', '.join(signal.Signals(s).name for s in changed)} changed"
+        )
 
 
 @pytest.hookimpl(hookwrapper=True)

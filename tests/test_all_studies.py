@@ -1,11 +1,14 @@
 """Every study through the runner: a run on 1 worker and a run on 2 local workers that is killed
-with SIGKILL after its first chunks and then resumed on a Dask cluster with 2 workers give the
+with SIGKILL after its first chunks and then resumed on a Dask cluster give the
 same tables and trials (issue 12; the second run without figures, ``--no-figures``). So every study shows that the chunks of 2 local pool workers, those of
 Dask workers and those of the in-process run are the same, and that a killed run resumes (even
 on another executor) to the files of an uninterrupted one.
 
-The Dask cluster is one for the module (a scheduler address given with ``--scheduler``); the
-path where ``--executor dask`` starts its own LocalCluster is tested in ``test_runner.py``.
+The Dask cluster is one for the module (a scheduler address given with ``--scheduler``), with
+one worker process: the chunks it computes come from a fresh process, not a fork, which is what
+this module shows for every study; the path where ``--executor dask`` starts its own
+LocalCluster of 2 workers is tested in ``test_runner.py``. (A second worker here cost the
+module about 7 s of CPU, its imports and kernels loaded twice per study.)
 
 Each study provides ``tests/data/tiny/<study>.txt``: one ``KEY=VALUE`` override per line for a
 run of a few seconds with at least two chunks. The uninterrupted 1-worker run is the session's
@@ -89,12 +92,15 @@ CLUSTER = """
 import sys
 import dask
 from dask.distributed import LocalCluster
-# no statistical profiler (100 samples a second of every task) and slower monitors: the
-# cluster idles between the studies, and its CPU is the test's
+# no statistical profiler (100 samples a second of every task), slower monitors and event-loop
+# ticks, no work stealing (one worker): the cluster idles between the studies, and its CPU is
+# the test's (idle, 0.4 s of CPU in 40 s instead of 1.7 s)
 dask.config.set({"distributed.worker.profile.enabled": False,
                  "distributed.admin.system-monitor.interval": "5s",
-                 "distributed.worker.memory.monitor-interval": "5s"})
-with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                 "distributed.worker.memory.monitor-interval": "5s",
+                 "distributed.admin.tick.interval": "500ms",
+                 "distributed.scheduler.work-stealing": False})
+with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                   dashboard_address=None) as cluster:
     print(cluster.scheduler_address, flush=True)
     sys.stdin.read()                     # until the test module closes our stdin
@@ -103,7 +109,7 @@ with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
 
 @pytest.fixture(scope="module")
 def scheduler():
-    """A Dask LocalCluster with 2 single-threaded worker processes, shared by the studies. It
+    """A Dask LocalCluster with 1 single-threaded worker process, shared by the studies. It
     lives in a process of its own, so nothing the test process does (forks, signals) reaches
     its workers."""
     pytest.importorskip("dask.distributed")

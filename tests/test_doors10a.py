@@ -17,17 +17,12 @@ each failed on the code before its fix.
 
 from pathlib import Path
 
+from oneline import one_line
+
 from sim.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 DESIGN = ROOT / "studies" / "brown_design.toml"
-
-
-def _one_line(capsys, rc, *needles):
-    err = capsys.readouterr().err.strip()
-    assert rc == 2 and "\n" not in err and "Traceback" not in err, (rc, err)
-    assert all(n in err for n in needles), err
-    return err
 
 
 def test_brown_design_at_its_allowed_edges_is_refused_on_load_naming_the_key(capsys):
@@ -40,7 +35,7 @@ def test_brown_design_at_its_allowed_edges_is_refused_on_load_naming_the_key(cap
         ("zeiss.points=3", "zeiss.points: 3 points in 4 positions", "at least 4 points"),
     ]
     for setting, *needles in cases:
-        _one_line(capsys, main(["check", str(DESIGN), "--set", setting]), *needles)
+        one_line(capsys, main(["check", str(DESIGN), "--set", setting]), *needles)
     # just inside: alpha below the region's 29.64 mm shortest reading, the noise at 1 % of 45 mm
     for setting in ("comparator.alpha_mm=29.6", "coverage.sigma_um=450"):
         assert main(["check", str(DESIGN), "--set", setting]) == 0, setting
@@ -49,10 +44,10 @@ def test_brown_design_at_its_allowed_edges_is_refused_on_load_naming_the_key(cap
 def test_a_sweep_of_only_refused_cells_is_refused_by_check_and_run(tmp_path, capsys):
     f = tmp_path / "s.toml"
     f.write_text(DESIGN.read_text() + '\n[sweep]\n"comparator.alpha_mm" = [49.5, 50.0]\n')
-    err = _one_line(capsys, main(["check", str(f)]), "sweep.comparator.alpha_mm: every cell")
+    err = one_line(capsys, main(["check", str(f)]), "sweep.comparator.alpha_mm: every cell")
     assert "(2 of 2)" in err and "[49.5, 50.0]" in err and "negative range" in err
     out = tmp_path / "o"
-    _one_line(capsys, main(["run", str(f), "--out", str(out)]), "sweep.comparator.alpha_mm")
+    one_line(capsys, main(["run", str(f), "--out", str(out)]), "sweep.comparator.alpha_mm")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]  # nothing was started
     # one refused cell of two: named once, the check passes (the run records it, not runs it)
     f.write_text(DESIGN.read_text() + '\n[sweep]\n"comparator.alpha_mm" = [0.5, 50.0]\n')

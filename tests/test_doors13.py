@@ -32,6 +32,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from oneline import one_line
 
 import sim
 from sim.cli import main
@@ -49,16 +50,9 @@ PLATE = str(ROOT / "studies" / "network_plate.toml")
 FIELD = ROOT / "studies" / "network_testfield.toml"
 
 
-def _one_line(capsys, rc, *needles):
-    err = capsys.readouterr().err.strip()
-    assert rc == 2 and "\n" not in err and "Traceback" not in err, (rc, err)
-    assert all(n in err for n in needles), err
-    return err
-
-
 def test_a_network_singular_from_its_weights_names_the_unknown_not_a_rank_defect(capsys):
     grid = '[{prefix="G",nx=5,ny=5,spacing_mm=40.0,role="observed",sigma_mm=1e3}]'
-    err = _one_line(
+    err = one_line(
         capsys, main(["check", PLATE, "--set", f"network.grids={grid}"]), "from its weights"
     )
     assert "point 'G" in err and "rank defect" not in err
@@ -66,7 +60,7 @@ def test_a_network_singular_from_its_weights_names_the_unknown_not_a_rank_defect
 
 def test_a_bias_that_makes_a_distance_negative_is_refused_at_check(capsys):
     obs = '[{kind="distance",from="N6",to="N7",sigma_mm=1.0,bias_mm=-30000}]'
-    _one_line(
+    one_line(
         capsys,
         main(["check", str(FIELD), "--set", f"network.observations={obs}"]),
         "network.observations",
@@ -128,7 +122,7 @@ def test_a_dms_value_of_60_seconds_is_read_as_gama_local_reads_it(tmp_path, caps
     study.write_text(f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{f}"\n')
     assert main(["check", str(study)]) == 0, capsys.readouterr().err
     f.write_text(src.replace(m.group(0), f'val="{m.group(1)}-{m.group(2)}-60.01"', 1))
-    _one_line(capsys, main(["check", str(study)]), "seconds at most 60")
+    one_line(capsys, main(["check", str(study)]), "seconds at most 60")
 
 
 def test_a_free_gama_file_with_xy_points_is_read_in_their_inner_datum(tmp_path, capsys):
@@ -176,7 +170,7 @@ def test_a_large_singular_network_names_its_loose_points(capsys, sets, words):
     args = ["check", str(FIELD)]
     for s in base + sets:
         args += ["--set", s]
-    _one_line(capsys, main(args), "datum.kind", words)
+    one_line(capsys, main(args), "datum.kind", words)
 
 
 def _results_with(tmp_path, name: str) -> Path:
@@ -194,7 +188,7 @@ def test_verify_names_a_sweeps_results_as_a_sweep_not_as_missing(tmp_path, capsy
     (res / "sw").mkdir()
     (res / "sw" / "sweep.parquet").write_bytes(b"")
     rc = verify_main(["--results", str(res), "--study", "sw", "--no-record"])
-    _one_line(capsys, rc, "--study", "holds a sweep's results")
+    one_line(capsys, rc, "--study", "holds a sweep's results")
 
 
 def test_verify_states_no_deviation_when_it_compared_nothing(tmp_path, capsys):
@@ -228,7 +222,7 @@ def test_a_defect_between_the_distance_constant_and_scale_names_their_keys(capsy
     )
     args = ["check", str(FIELD), "--set", gen, "--set", "network.estimate_scale=true"]
     args += ["--set", "network.estimate_constant=true"]
-    err = _one_line(capsys, main(args), "network.estimate_constant", "constant and the scale")
+    err = one_line(capsys, main(args), "network.estimate_constant", "constant and the scale")
     assert "datum.kind" not in err
 
 

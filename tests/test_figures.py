@@ -14,6 +14,7 @@ import pytest
 
 from benchmarks.figures import brown_figure, engines_figure
 from sim.mc.storage import read_table, write_table
+from sim.report import region as region_figures
 from sim.report.plotting import (
     checking_figures,
     hist_bins,
@@ -21,6 +22,7 @@ from sim.report.plotting import (
     place_legend,
     plt,
     times_ten,
+    without_figures,
 )
 from sim.report.sweep import fig_sweep
 from sim.studies import MODULES
@@ -103,6 +105,24 @@ def test_sweep_png_reads_cleanly(tmp_path):
         fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png")
     assert found == {"sweep.png": []}
     assert (tmp_path / "sweep.png").stat().st_size > 10_000
+
+
+def test_a_run_without_figures_builds_none(tmp_path, monkeypatch):
+    """``--no-figures``: the figure functions called outside :func:`draw` (the region's, the
+    sweep's) return before they build a figure; building one only to close it unsaved cost
+    every such run pyplot's import and a layout."""
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a figure was built in a run without figures")
+
+    _sweep_table(tmp_path / "sweep.parquet")
+    monkeypatch.setattr(plt._load(), "subplots", refuse)  # the module the lazy name loads
+    with without_figures():
+        assert fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png") is None
+        region_figures.fig_region(None, tmp_path / "region.png")
+    assert not (tmp_path / "sweep.png").exists() and not (tmp_path / "region.png").exists()
+    with pytest.raises(AssertionError, match="was built"):  # outside, the figure is built
+        fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png")
 
 
 def test_sweep_png_clips_proportions_and_keeps_red_for_infeasible(tmp_path, monkeypatch):

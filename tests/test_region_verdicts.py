@@ -20,8 +20,10 @@ A_UP = Statement("a_up", (4.0, 4.0), "upper", decimals=0)  # a <= 4.5
 @pytest.mark.parametrize(
     "counts, verdict",
     [
-        ((10, 10, 0), "holds"),
-        ((10, 0, 10), "fails"),
+        ((40, 40, 0), "holds"),  # 29 points or more (sim.claims.region.REGION_MIN_POINTS)
+        ((40, 0, 40), "fails"),
+        ((10, 10, 0), "inconclusive"),  # too few points (tests/test_region_rule.py)
+        ((10, 0, 10), "inconclusive"),
         ((10, 9, 1), "depends"),
         ((10, 1, 9), "depends"),
         ((10, 1, 1), "depends"),  # both sides, undecided between

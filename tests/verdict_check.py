@@ -9,16 +9,25 @@ from pathlib import Path
 
 from sim.mc.storage import read_table
 
+#: the fewest region points a holds / fails needs: 1 - 0.05**(1/29) = 9.8 % is the first
+#: 95 % bound on the disagreeing share at most 10 % (1 - 0.05**(1/28) = 10.1 %)
+MIN_POINTS = 29
+
 
 def region_verdict(outcomes) -> str:
     """The rule of docs/verdict-rules.md 'Over a region', written out here independently of
-    sim.claims.region: holds / fails at every point, undecidable when no point decides it,
-    depends where it holds at some points and fails at others, 'holds or undecided' ('fails
-    or undecided') where it holds (fails) at some points and is undecided at the rest. ``None`` or "" marks a row of another part of the region table."""
-    s = {o for o in outcomes if o}
+    sim.claims.region: holds / fails at every point (inconclusive at fewer than 29 points),
+    undecidable when no point decides it, depends where it holds at some points and fails at
+    others, 'holds or undecided' ('fails or undecided') where it holds (fails) at some points
+    and is undecided at the rest. ``None`` or "" marks a row of another part of the region
+    table."""
+    pts = [o for o in outcomes if o]
+    s = set(pts)
     assert s <= {"holds", "fails", "undecided"}, s
     if not s:  # an empty region decides nothing
         return "undecidable"
+    if s in ({"holds"}, {"fails"}) and len(pts) < MIN_POINTS:
+        return "inconclusive"
     if s == {"holds"}:
         return "holds"
     if s == {"fails"}:

@@ -15,12 +15,31 @@ FAILS / UNDECIDED by the decision zone of :class:`~sim.claims.inference.Statemen
                   rest: no feasible input confirms it (it is never shown to hold);
 * **undecidable** no point of the region decides it (its interval covers values on both sides
                   of the zone everywhere), or the region is empty; ``note`` says what would
-                  decide it (the statement's ``decide`` text, or the conflicting statements).
+                  decide it (the statement's ``decide`` text, or the conflicting statements);
+* **inconclusive** it holds (fails) at every point, but the region was sampled at fewer than
+                  :data:`REGION_MIN_POINTS` accepted points: too few to say it holds (fails)
+                  over the region (the sample-size rule below; the word the claims layer
+                  uses for an interval that cannot exclude the alternative,
+                  :mod:`sim.claims.rules`).
 
 The rule in one line: the verdict names the set of per-point outcomes over the region
 ({holds}, {fails}, {holds, fails[, undecided]}, {holds, undecided}, {fails, undecided},
 {undecided}); "depends" is kept for a prediction that really turns on the inputs (it holds
 somewhere *and* fails somewhere). See :func:`region_verdict`.
+
+The sample-size rule (issues 26/28 follow-up). "holds at all k points" says little when k is
+small: read the k accepted points as k independent draws from the region (the exploration's
+design measure: a scrambled Sobol design, denser at the boundary after refinement), if the
+prediction fails on a share q of the region, all k points hold with probability
+``(1 - q)**k``; the exact one-sided 95 % upper bound on q is therefore
+``1 - 0.05**(1/k)`` (:func:`share_bound`; the Clopper-Pearson bound for 0 of k, about 3/k,
+"the rule of three"). A region verdict **holds** or **fails** needs
+``k >= REGION_MIN_POINTS`` accepted points, the smallest k whose bound is at most
+:data:`REGION_SHARE` (10 %: k = 29); with fewer it is **inconclusive**, and the note says
+"region sampled at k points, ...: a region verdict needs 29 (bounds the share where it fails
+under 10 %)". A held (failed) row's note states its bound: "holds at all 35 points of the
+region (fails on under 8.2 % of it, 95 %)". "depends" needs no minimum: a point on each
+side proves it. The two constants are one rule for every study (no per-study setting).
 
 Nominal input values have no place in these verdicts; they survive only as labelled examples
 in figures. :func:`region_table` gives the rows of ``consistent_region.parquet``.
@@ -45,6 +64,13 @@ __all__ = [
     "REGION_VERDICTS",
     "region_verdict",
     "OUTCOME_NAMES",
+    "REGION_LEVEL",
+    "REGION_SHARE",
+    "REGION_MIN_POINTS",
+    "share_bound",
+    "points_needed",
+    "too_few_note",
+    "bound_phrase",
 ]
 
 REGION_VERDICTS = (
@@ -54,8 +80,14 @@ REGION_VERDICTS = (
     "holds or undecided",
     "fails or undecided",
     "undecidable",
+    "inconclusive",
 )
 OUTCOME_NAMES = {HOLDS: "holds", FAILS: "fails", UNDECIDED: "undecided"}
+#: the confidence of the bound on the disagreeing share of a region verdict
+REGION_LEVEL = 0.95
+#: the largest share of the region where a "holds" ("fails") region verdict may be wrong
+#: (bounded at REGION_LEVEL)
+REGION_SHARE = 0.10
 
 
 @dataclass(frozen=True)
@@ -82,18 +114,72 @@ class RegionVerdict:
         return self.verdict + (f" ({self.note})" if self.note else "")
 
 
-def region_verdict(n_points: int, n_holds: int, n_fails: int) -> str:
+def share_bound(k: int, level: float = REGION_LEVEL) -> float:
+    """The exact one-sided ``level`` upper bound on the share of the region where a
+    prediction disagrees, when it agrees at all ``k`` accepted points (read as independent
+    draws): ``1 - (1 - level)**(1/k)``, the q with ``(1 - q)**k = 1 - level`` (the
+    Clopper-Pearson bound for 0 of k; about 3/k at 95 %). 1 for k = 0 (nothing sampled)."""
+    if k <= 0:
+        return 1.0
+    return 1.0 - (1.0 - level) ** (1.0 / k)
+
+
+def points_needed(share: float = REGION_SHARE, level: float = REGION_LEVEL) -> int:
+    """The fewest accepted points whose :func:`share_bound` is at most ``share`` (0 < share
+    < 1): 29 for 10 % at 95 %."""
+    if not 0 < share < 1 or not 0 < level < 1:
+        raise ValueError(f"need 0 < share < 1 and 0 < level < 1, not {share!r}, {level!r}")
+    k = 1
+    while share_bound(k, level) > share:  # exact, no rounding of log(1 - level) / log(1 - share)
+        k += 1
+    return k
+
+
+#: the fewest accepted region points a "holds" or "fails" region verdict needs (29)
+REGION_MIN_POINTS = points_needed(REGION_SHARE, REGION_LEVEL)
+
+
+def region_verdict(
+    n_points: int, n_holds: int, n_fails: int, min_points: int = REGION_MIN_POINTS
+) -> str:
     """The region verdict from the counts of accepted points where a prediction holds and
-    fails (the rest are undecided): the rule of the module doc, in one place."""
+    fails (the rest are undecided): the rule of the module doc, in one place. "holds" and
+    "fails" need ``n_points >= min_points``; with fewer they are "inconclusive"."""
     if n_points <= 0 or n_holds + n_fails == 0:
         return "undecidable"
-    if n_holds == n_points:
-        return "holds"
-    if n_fails == n_points:
-        return "fails"
+    if n_holds == n_points or n_fails == n_points:
+        if n_points < min_points:
+            return "inconclusive"
+        return "holds" if n_holds == n_points else "fails"
     if n_holds and n_fails:
         return "depends"
     return "holds or undecided" if n_holds else "fails or undecided"
+
+
+def _pct(share: float) -> str:
+    return f"{100 * share:.2g} %"
+
+
+def too_few_note(n_points: int, side: str) -> str:
+    """Why a prediction that ``side`` ("holds" / "fails") at all ``n_points`` accepted
+    points is inconclusive over the region (fewer than :data:`REGION_MIN_POINTS`)."""
+    other = "fails" if side == "holds" else "holds"
+    return (
+        f"region sampled at {n_points} points, {side} at all of them: a region verdict needs "
+        f"{REGION_MIN_POINTS} (bounds the share where it {other} under {_pct(REGION_SHARE)}, "
+        f"{_pct(REGION_LEVEL)})"
+    )
+
+
+def bound_phrase(rv: RegionVerdict) -> str:
+    """The region-verdict phrase of a claims row that holds (fails) at every accepted point,
+    with its :func:`share_bound`: "holds at all 35 points of the region (fails on under
+    8.2 % of it, 95 %)"."""
+    other = "fails" if rv.verdict == "holds" else "holds"
+    return (
+        f"{rv.verdict} at all {rv.n_points} points of the region ({other} on under "
+        f"{_pct(share_bound(rv.n_points))} of it, {_pct(REGION_LEVEL)})"
+    )
 
 
 def statement_of(book, cid: str, form: str | None = None) -> Statement:
@@ -151,6 +237,8 @@ def decide_over(
     v = region_verdict(n, nh, nf)
     if v in ("holds", "fails"):
         note = ""
+    elif v == "inconclusive":
+        note = too_few_note(n, "holds" if nh else "fails")
     elif v == "undecidable":
         note = spec.decide or "no input of the region decides it"
     else:
@@ -183,7 +271,8 @@ def region_row(book, cid: str, rv: RegionVerdict, values, note: str = "") -> dic
     """The claims row of prediction ``cid`` decided over the region: ``value``/``value_high``
     and the interval are the smallest and largest value over the region's points
     (``interval = "region"``), ``outcome``/``verdict`` the region verdict (holds / fails /
-    depends / undecidable), and the note says where it holds and fails."""
+    depends / ... / inconclusive), and the note says where it holds and fails (a held or
+    failed row with the bound on the share of the region where it is wrong)."""
     v = np.asarray(values, float)
     v = v[np.isfinite(v)]
     lo, hi = (float(v.min()), float(v.max())) if v.size else (np.nan, np.nan)
@@ -193,8 +282,9 @@ def region_row(book, cid: str, rv: RegionVerdict, values, note: str = "") -> dic
         row = book.score(cid, 0.0, (0.0, 0.0), "exact")
         row.update(value_high=hi)
     where = {
-        "holds": f"holds at all {rv.n_points} points of the region",
-        "fails": f"fails at all {rv.n_points} points of the region",
+        "holds": bound_phrase(rv),
+        "fails": bound_phrase(rv),
+        "inconclusive": f"inconclusive: {rv.note}",
         "depends": f"holds for {rv.holds_where}; fails for {rv.fails_where} ({rv.note})",
         "holds or undecided": (
             f"holds for {rv.holds_where}, fails nowhere in the region, undecided at the rest "

@@ -19,7 +19,8 @@ slots of a row (``-1``: unused) and ``vals`` ``(..., m, s)`` the derivatives. We
   scaled singularity rule of the sparse path: a pivot of the unit-diagonal normals at or below
   ``rcond`` (or not finite) -- the pivots bound the smallest eigenvalue from above, so what the
   dense rule (:func:`sim.lsq.normals.scaled_rcond`) refuses with a pivot that small is
-  refused here too;
+  refused here too; the factor then names the unknown of its smallest pivot (``weak``; for an
+  exactly zero pivot, which SuperLU does not locate, from the normals shifted by ``rcond``);
 * :meth:`Factor.solve` -- a block of right-hand sides ``(p, T)`` in one pass of compiled
   triangular solves (:mod:`sim.lsq.selinv`);
 * :meth:`Factor.entries` -- any entries of the cofactor matrix in the datum that lie in the
@@ -130,6 +131,7 @@ class Factor:
     D: np.ndarray  # pivots
     ok: bool
     message: str = ""
+    weak: int = -1  # not ok from a pivot: the free unknown (position) of the smallest one
     C: np.ndarray | None = None  # (p, c) constraints C' dx = 0
     P: np.ndarray | None = None  # (p, c): x = y - P C' y restores them
     terms: list = field(default_factory=list)  # [(Lm, Rm)]: Q += Lm Rm' (low rank)
@@ -209,10 +211,40 @@ def _order_out(G: np.ndarray) -> np.ndarray:
     return np.sort(piv[: G.shape[1]])
 
 
-def _fail(p: int, msg: str) -> Factor:
+def _fail(p: int, msg: str, weak: int = -1) -> Factor:
     e = np.zeros(0)
     z = np.zeros(1, np.int64)
-    return Factor(p, np.zeros(0, int), np.zeros(0, int), e, z, z[:0], e, e, False, msg)
+    return Factor(p, np.zeros(0, int), np.zeros(0, int), e, z, z[:0], e, e, False, msg, weak)
+
+
+def _splu(Ns: sparse.csc_matrix):
+    """SuperLU's ``L D L'`` of the unit-diagonal normals (symmetric mode, no pivoting)."""
+    return splu(
+        Ns,
+        permc_spec="MMD_AT_PLUS_A",
+        diag_pivot_thresh=0.0,
+        options={"SymmetricMode": True},
+    )
+
+
+def _smallest_pivot(lu, D: np.ndarray) -> int:
+    """The unknown (position in the factorised normals) of the smallest pivot in ``D`` (a
+    non-finite one first): where the elimination met the weak direction. ``perm_c`` puts
+    column ``i`` at position ``perm_c[i]``."""
+    j = int(np.argmin(np.where(np.isfinite(D), D, -np.inf)))
+    return int(np.flatnonzero(np.asarray(lu.perm_c) == j)[0])
+
+
+def _zero_pivot(Ns: sparse.csc_matrix, rcond: float) -> int:
+    """The unknown of an exactly zero pivot (SuperLU names none): the normals shifted by
+    ``rcond`` on their unit diagonal are positive definite, and their smallest pivot (about
+    ``rcond``) falls on an unknown of the singular direction; -1 if that fails too. One
+    more factorisation of the same pattern: the cost of the first, no dense matrix."""
+    try:
+        lu = _splu(sparse.csc_matrix(Ns + rcond * sparse.identity(Ns.shape[0], format="csc")))
+    except RuntimeError:  # pragma: no cover - a shifted positive semi-definite matrix is regular
+        return -1
+    return _smallest_pivot(lu, lu.U.diagonal())
 
 
 def factorize(
@@ -224,7 +256,8 @@ def factorize(
     """Factorise the normals ``N`` (p, p) once: see the module doc. ``G`` (p, d): the null
     space of ``N`` (the datum defect; None or d = 0: ``N`` regular); ``C`` (p, c): the datum
     constraints ``C' x = 0`` (with a defect, ``c = d`` and ``C' G`` regular). A factor that
-    is not ``ok`` carries its one-line ``message``."""
+    is not ``ok`` carries its one-line ``message`` (and, failed at a pivot, the ``weak``
+    unknown)."""
     N = sparse.csc_matrix(N)
     p = N.shape[0]
     d = 0 if G is None else G.shape[1]
@@ -244,14 +277,14 @@ def factorize(
     Ns = sparse.csc_matrix(Nr, copy=True)  # scaled in place: explicit zeros stay
     Ns.data *= s[Ns.indices] * np.repeat(s, np.diff(Ns.indptr))
     try:
-        lu = splu(
-            Ns,
-            permc_spec="MMD_AT_PLUS_A",
-            diag_pivot_thresh=0.0,
-            options={"SymmetricMode": True},
-        )
+        lu = _splu(Ns)
     except RuntimeError:
-        return _fail(p, "the normal equations are singular (an exactly zero pivot)")
+        weak = _zero_pivot(Ns, rcond)
+        return _fail(
+            p,
+            "the normal equations are singular (an exactly zero pivot)",
+            int(keep[weak]) if weak >= 0 else -1,
+        )
     if not np.array_equal(lu.perm_r, lu.perm_c):  # pragma: no cover - SPD keeps the diagonal
         return _fail(p, "the normal equations are not positive definite (pivoting needed)")
     D = lu.U.diagonal().copy()
@@ -260,6 +293,7 @@ def factorize(
             p,
             f"the normal equations are singular (a scaled pivot of {D.min(initial=0.0):.3g}"
             f" is not above rcond {rcond:g})",
+            int(keep[_smallest_pivot(lu, D)]),
         )
     L = sparse.tril(lu.L, k=-1, format="csc")
     L.sort_indices()

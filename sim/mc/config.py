@@ -17,6 +17,7 @@ from __future__ import annotations
 import codecs
 import difflib
 import math
+import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,15 +31,52 @@ __all__ = [
     "validate",
     "check_chunks",
     "did_you_mean",
+    "shown",
 ]
+
+#: digits of an integer above which a message shows it shortened (a 64-bit one has 19 digits)
+LONG_DIGITS = 19
+#: a run of more digits than that in a message, not part of a word, a path or a decimal
+_LONG_RUN = re.compile(r"(?<![\w./])-?\d{%d,}(?![\w./])" % (LONG_DIGITS + 1))
+
+
+def shown(v: Any) -> str:
+    """``repr(v)`` for a message, with an integer of more than 19 digits shortened (``1e+300``,
+    or "a 401-digit number" beyond a float's range): 1e300 given for an integer key is the
+    integer 10**300 (301 digits), which no one line should print."""
+    if isinstance(v, int) and not isinstance(v, bool):
+        if abs(v) >= 10**4000:  # str() reads at most 4300 digits
+            return f"a {'negative ' if v < 0 else ''}number of over 4000 digits"
+        digits = len(str(abs(v)))
+        if digits <= LONG_DIGITS:
+            return repr(v)
+        try:
+            return f"{float(v):g}"
+        except OverflowError:
+            return f"a {'negative ' if v < 0 else ''}{digits}-digit number"
+    return repr(v)
+
+
+def _shorten(message: str) -> str:
+    """Every run of more than 19 digits in ``message`` shortened as :func:`shown` does (one
+    beyond a float's range counted, not converted: Python reads at most 4300 digits)."""
+
+    def short(m: re.Match) -> str:
+        t = m.group(0)
+        digits = len(t.lstrip("-"))
+        if digits > 308:
+            return f"a {'negative ' if t.startswith('-') else ''}{digits}-digit number"
+        return shown(int(t))
+
+    return _LONG_RUN.sub(short, message)
 
 
 class ConfigError(ValueError):
     """A bad study configuration. ``str(err)`` is one line naming the key."""
 
     def __init__(self, key: str | None, message: str):
-        self.key = key
-        super().__init__(f"{key}: {message}" if key else message)
+        self.key = key  # a number of hundreds of digits is shortened in any message
+        super().__init__(_shorten(f"{key}: {message}" if key else message))
 
 
 class StudyError(RuntimeError):
@@ -86,7 +124,7 @@ def refuse_big_ints(key: str, v: Any) -> None:
     while todo:
         k, x = todo.pop()
         if isinstance(x, int) and not isinstance(x, bool) and not -INT64 <= x < INT64:
-            digits = len(str(abs(x))) if abs(x) < 10**4000 else "over 4000"
+            digits = len(str(abs(x))) if abs(x) < 10**4000 else "over 4000"  # str(): < 4300
             raise ConfigError(k, f"an integer of {digits} digits is outside TOML's 64-bit range")
         if isinstance(x, Mapping):
             todo += [(f"{k}.{n}" if k else str(n), y) for n, y in x.items()]
@@ -96,26 +134,28 @@ def refuse_big_ints(key: str, v: Any) -> None:
 
 def _num(key: str, v: Any, want_int: bool) -> float | int:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise ConfigError(key, f"must be {'an integer' if want_int else 'a number'} (got {v!r})")
+        raise ConfigError(
+            key, f"must be {'an integer' if want_int else 'a number'} (got {shown(v)[:60]})"
+        )
     refuse_big_ints(key, v)
+    if not math.isfinite(v):
+        raise ConfigError(key, f"must be finite (got {v!r})")
     if want_int and not isinstance(v, int):
         if float(v).is_integer():
             v = int(v)
         else:
             raise ConfigError(key, f"must be an integer (got {v!r})")
-    if not math.isfinite(v):
-        raise ConfigError(key, f"must be finite (got {v!r})")
     return v if want_int else float(v)
 
 
 def _bounds(key: str, f: Field, v: float) -> None:
     if f.lo is not None:
         if f.lo_open and not v > f.lo:
-            raise ConfigError(key, f"must be > {f.lo:g} (got {v!r})")
+            raise ConfigError(key, f"must be > {f.lo:g} (got {shown(v)})")
         if not f.lo_open and not v >= f.lo:
-            raise ConfigError(key, f"must be >= {f.lo:g} (got {v!r})")
+            raise ConfigError(key, f"must be >= {f.lo:g} (got {shown(v)})")
     if f.hi is not None and not v <= f.hi:
-        raise ConfigError(key, f"must be <= {f.hi:g} (got {v!r})")
+        raise ConfigError(key, f"must be <= {f.hi:g} (got {shown(v)})")
 
 
 def check_value(key: str, f: Field, v: Any) -> Any:
@@ -124,6 +164,7 @@ def check_value(key: str, f: Field, v: Any) -> Any:
     if k in ("int", "float"):
         v = _num(key, v, k == "int")
         _bounds(key, f, v)
+        refuse_big_ints(key, v)  # 1e300 for an unbounded integer key: 10**300, not TOML's
         return v
     if k == "bool":
         if not isinstance(v, bool):

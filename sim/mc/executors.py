@@ -45,6 +45,7 @@ def _worker_init(ppid: int | None) -> None:
     which ends when the run's process does."""
     if ppid is None:
         ppid = os.getppid()
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)  # held by the forking parent (_Pool)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if sys.platform.startswith("linux"):
@@ -74,6 +75,10 @@ def _start_method() -> str | None:
     return "forkserver" if "forkserver" in methods else "spawn"
 
 
+#: the signals that stop a run, held while a pool forks its workers (see :class:`_Pool`)
+_STOPS = {signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", signal.SIGTERM)}
+
+
 def _ready() -> int:
     return os.getpid()
 
@@ -93,7 +98,17 @@ class _Pool:
             initargs=(None if method == "forkserver" else os.getpid(),),
         )
         self.start_method = method or multiprocessing.get_start_method()
-        for f in [self.pool.submit(_ready) for _ in range(workers)]:
+        # Ctrl-C or SIGTERM in the at-fork hooks of a fork (logging's lock release) is
+        # "Exception ignored" by Python: the run went on to exit 0 (doors15a). Held over the
+        # forks, a stop signal is delivered here after them; the workers unblock it first thing
+        held = self.start_method == "fork"
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS) if held else None
+        try:
+            ready = [self.pool.submit(_ready) for _ in range(workers)]
+        finally:
+            if held:
+                signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for f in ready:
             f.result()  # every worker forked now (a fork pool starts them all at once)
 
     def run(self, fn, seed, part, jobs):

@@ -76,8 +76,8 @@ def network_estimate(c: Mapping) -> tuple:
         for g in c.get("network.generate", []):
             if isinstance(g, dict):
                 k = int(g.get("nearest", 0) or 0)
-                fr = count(g.get("from", []))
-                m += fr * (k if k else count(g.get("to", [])))
+                fr, to = count(g.get("from", [])), count(g.get("to", []))
+                m += fr * (min(k, to) if k else to)  # nearest=1e300: every target, not 1e300
         m += 2 * sum(
             rec.get("role") == "observed"
             for rec in c.get("network.points", [])

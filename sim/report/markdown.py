@@ -12,6 +12,7 @@ from typing import Callable
 
 import pyarrow as pa
 
+from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
 from sim.claims.rules import PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
@@ -254,7 +255,10 @@ _RULES = (
     "**holds** or **fails** when it does so everywhere in the region, **depends** when it "
     "holds in one part and fails in another, **holds or undecided** (**fails or undecided**) "
     "when it holds (fails) in one part, the opposite nowhere and is undecided at the rest, "
-    "and is **undecidable** when no input of the region decides it. A paper check whose recomputation from the paper's own printed data "
+    "and is **undecidable** when no input of the region decides it; a region sampled at "
+    f"fewer than {REGION_MIN_POINTS} accepted points leaves an everywhere-holding (-failing) "
+    f"prediction **inconclusive** ({REGION_MIN_POINTS} points bound the share of the region "
+    f"where it is wrong under {100 * REGION_SHARE:g} %, {100 * REGION_LEVEL:g} %). A paper check whose recomputation from the paper's own printed data "
     "fails is an **erratum**. Numbers are printed at the precision their interval supports "
     "(two significant digits of its half-width).\n\n"
 )

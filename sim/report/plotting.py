@@ -31,6 +31,7 @@ __all__ = [
     "layout_problems",
     "checking_figures",
     "without_figures",
+    "figures_off",
     "figure_facts",
     "hist_bins",
     "UNITLESS",
@@ -262,6 +263,13 @@ def without_figures() -> Iterator[None]:
     finally:
         if not was:
             _SKIP.clear()
+
+
+def figures_off() -> bool:
+    """True inside :func:`without_figures`: a figure function called outside :func:`draw`
+    returns before it builds anything (building a figure only to close it unsaved would
+    import pyplot and lay out every panel for nothing)."""
+    return _SKIP.is_set()
 
 
 #: matplotlib's warning for a character its font cannot draw (a network named "日本")

@@ -14,7 +14,7 @@ import numpy as np
 
 from sim.claims.inference import Region
 from sim.report.papers import paper_name
-from sim.report.plotting import plt, save
+from sim.report.plotting import figures_off, plt, save
 
 __all__ = ["fig_region", "reader_label", "LABELS"]
 
@@ -74,7 +74,10 @@ def fig_region(
 
     boundary : ``{(x input, y input): f}``, a hardware limit ``y = f(x)`` drawn as a line.
     nominal : the configured values, drawn as a star (an example, not a verdict).
+    Nothing is built in a run without figures (:func:`~sim.report.plotting.figures_off`).
     """
+    if figures_off():
+        return
     free = [i for i in region.inputs if i.high > i.low]
     pairs = list(combinations(free, 2))
     n = max(len(pairs), 1)

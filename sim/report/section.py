@@ -33,6 +33,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from sim.claims.region import REGION_MIN_POINTS
 from sim.mc.storage import read_provenance
 from sim.report.markdown import claims_markdown, inputs_markdown
 from sim.report.read import columns, records
@@ -142,7 +143,9 @@ def _region_how(design: str, values: str) -> str:
         f"The unprinted inputs are explored jointly (`sim.claims.inference`: {design}; "
         f"{values}). The region holds the input "
         "vectors that the hardware and the printed inputs allow; a prediction *holds* or "
-        "*fails* over all of it, else *depends* (holds in one part, fails in another; where "
+        f"*fails* over all of it (at {REGION_MIN_POINTS} or more of its points, else "
+        "*inconclusive*), else "
+        "*depends* (holds in one part, fails in another; where "
         "is given), *holds or undecided* / *fails or undecided* (one side nowhere) or "
         "*undecidable* "
         "(`consistent_region.parquet`, `region_inputs.parquet`)."

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.mc.storage import read_provenance
-from sim.report.plotting import place_legend, plt, readable_limits, save
+from sim.report.plotting import figures_off, place_legend, plt, readable_limits, save
 from sim.report.read import columns
 from sim.report.tables import fmt, md_table
 
@@ -69,8 +69,10 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     their names, values in [0, 1]) are drawn with their intervals clipped to [0, 1]; tick
     labels say the numbers (no offset). A first key whose values are not numbers (text, lists)
     is drawn at one place per distinct value, its ticks labelled with the values; long
-    labels are shortened. Drawn from the rows of ``sweep.parquet`` alone."""
-
+    labels are shortened. Drawn from the rows of ``sweep.parquet`` alone; nothing in a run
+    without figures."""
+    if figures_off():
+        return None
     t = columns(path)
     keys = read_provenance(path).get("sweep_keys", [])
     claims = _claim_columns(t, keys)[:max_panels]

@@ -327,7 +327,8 @@ def _findings(region: Region) -> Region:
 def without_snooping(cfg: dict, rows: list[dict]) -> list[dict]:
     """With ``snoop.max_reject = 0`` no pass point can be removed, so the rejection row
     (the paper: digital pugging removes none) would hold by construction, not by the
-    simulation: it is undecidable, saying why."""
+    simulation: it is undecidable, saying why (the region verdict the count would have had,
+    "holds at all ... points", is dropped from the note: :func:`_how_of`)."""
     if cfg["snoop.max_reject"]:
         return rows
     why = (
@@ -340,9 +341,16 @@ def without_snooping(cfg: dict, rows: list[dict]) -> list[dict]:
             "outcome": "undecidable",
             "verdict": "undecidable",
             "holds": None,
-            "note": f"{why}; {r['note']}",
+            "note": f"{why}; {_how_of(r['note'])}",
         }
         if r["claim"] == REJECTED and r["kind"] == "prediction"
         else r
         for r in rows
     ]
+
+
+def _how_of(note: str) -> str:
+    """A row's note over the scanner's vectors without its leading region verdict (how it was
+    decided onwards, :data:`~.leads.HOW`)."""
+    i = note.find(HOW[2:])
+    return note[i:] if i >= 0 else note

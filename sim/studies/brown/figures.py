@@ -13,7 +13,7 @@ from sim.claims.intervals import std_rel_se
 from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
 from sim.mc.storage import read_provenance, read_table
-from sim.report.plotting import hist_bins, place_legend, plt, save
+from sim.report.plotting import figures_off, hist_bins, place_legend, plt, save
 from sim.report.region import reader_label
 from sim.studies.brown.schema import MODEL_NAMES
 from sim.studies.brown.values import pooled
@@ -174,7 +174,10 @@ def fig_region(out: Path, pairs, path):
     """Pairwise projections of the consistent region (grey: inputs the hardware and the
     constraining statements allow; green: where every prediction holds together), the declared
     hardware box (dotted) and the scale's limit (dashed); the configured geometry as a labelled
-    example (star). The legend is the figure's, below the panels."""
+    example (star). The legend is the figure's, below the panels. Nothing is built in a run
+    without figures."""
+    if figures_off():
+        return
     reg = read_table(out / "consistent_region.parquet").to_pydict()
     ins = {r["input"]: r for r in read_table(out / "region_inputs.parquet").to_pylist()}
     cfg = read_provenance(out / "claims.parquet")["config"]

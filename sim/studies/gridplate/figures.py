@@ -10,7 +10,7 @@ import numpy as np
 
 from sim.instruments import gridplate as gp
 from sim.instruments import transforms2d as t2
-from sim.report.plotting import hist_bins, place_legend, plain_log, plt, save
+from sim.report.plotting import figures_off, hist_bins, place_legend, plain_log, plt, save
 from sim.studies.gridplate.model import PARAMS, truth_rows
 from sim.studies.gridplate.schema import UM
 
@@ -46,8 +46,21 @@ def _arrows(ax, g, v, qs, **kw):
 def fig_residuals(cfg: dict, sim: dict, path: Path) -> dict:
     """Residual vectors of one calibration (plate 1): affine with the grid fixed, and the
     combined adjustment's comparator and grid residuals at the re-weighted ratio. Returns
-    the drawn vectors (mm, µm) as table columns."""
+    the drawn vectors (mm, µm) as table columns (also in a run without figures, which draws
+    nothing)."""
     g, fa, vc, vg, rw = _residual_fits(cfg, sim)
+    cols = {
+        "x_mm": g[:, 0],
+        "y_mm": g[:, 1],
+        "aff_vx_um": fa.residuals[0, :, 0] / UM,
+        "aff_vy_um": fa.residuals[0, :, 1] / UM,
+        "comb_vx_um": vc[:, 0] / UM,
+        "comb_vy_um": vc[:, 1] / UM,
+        "grid_vx_um": vg[0, :, 0] / UM,
+        "grid_vy_um": vg[1, :, 1] / UM,
+    }
+    if figures_off():
+        return cols
     fig, axs = plt.subplots(1, 2, figsize=(10, 5.4), layout="constrained")
     qs = 2 * UM / (cfg["plate.spacing_mm"] / 4)  # 2 µm drawn as a quarter spacing
     for ax in axs:
@@ -64,16 +77,7 @@ def fig_residuals(cfg: dict, sim: dict, path: Path) -> dict:
     for ax, qq in zip(axs, (q, q2)):
         ax.quiverkey(qq, 0.85, 1.02, 2 * UM, "2 µm", labelpos="E", coordinates="axes")
     save(fig, path)
-    return {
-        "x_mm": g[:, 0],
-        "y_mm": g[:, 1],
-        "aff_vx_um": fa.residuals[0, :, 0] / UM,
-        "aff_vy_um": fa.residuals[0, :, 1] / UM,
-        "comb_vx_um": vc[:, 0] / UM,
-        "comb_vy_um": vc[:, 1] / UM,
-        "grid_vx_um": vg[0, :, 0] / UM,
-        "grid_vy_um": vg[1, :, 1] / UM,
-    }
+    return cols
 
 
 def fig_params(cfg: dict, res: dict, path: Path) -> None:

@@ -44,7 +44,7 @@ def _self_checks(alpha: float, dof: int) -> list[tuple[str, str, float, float]]:
     return [
         (
             "network.mc_agreement.mean_ratio",
-            "Monte-Carlo sigma / analytic sigma (mean over coordinates)",
+            "Monte-Carlo sigma / analytic sigma (root of the mean variance ratio over coordinates)",
             1.0,
             0.05,
         ),

@@ -208,7 +208,10 @@ def check(cfg: dict) -> None:
         # dense too: name the point no observation reaches (docs/network.md), unless nothing
         # holds the network at all (then the rank defect and its advice say it better)
         held = sparse or full["datum.kind"] != "fixed" or np.any(net.role != 0)
-        cause = singular_cause(net, full, dt.free_index(net.q)) if held else ""
+        free = dt.free_index(net.q)
+        cause = singular_cause(net, full, free) if held else ""
+        if sparse and not cause:
+            cause = _pivot(net, an.factor, free)
         if sparse or cause:
             what = an.factor.message if sparse else "the normal matrix is singular"
             raise ConfigError(
@@ -321,6 +324,17 @@ def _unknown(net, par: int) -> str:
     if par < 2 * net.n:
         return f"point {net.names[par // 2]!r} ({'xy'[par % 2]})"
     return net.parameter_names()[par - 2 * net.n]
+
+
+def _pivot(net, factor, free: np.ndarray) -> str:
+    """The unknown at the sparse factor's failed pivot (:attr:`sim.lsq.sparse.Factor.weak`),
+    named as the dense path names its weakest one; "" when the factor names none."""
+    if factor is None or factor.weak < 0:
+        return ""
+    return (
+        f"{_unknown(net, int(free[factor.weak]))} is nearly undetermined (the smallest pivot "
+        "of the normals falls on it; points nearly on one line, or too few observations)"
+    )
 
 
 def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
