@@ -43,7 +43,7 @@ from sim.report.markdown import write_report
 from sim.report.read import damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.studies import get_study, load_study
-from sim.threads import interrupted
+from sim.threads import interrupted, memory_words, short_of_memory
 
 __all__ = ["main", "check_run_args"]
 
@@ -401,6 +401,9 @@ def _main(argv: list[str]) -> int:
     except BrokenPipeError:
         raise
     except OSError as e:  # a failing write (full disk, vanished directory): one line, no traceback
+        if short_of_memory(e):  # ulimit -v: a library loaded on first use could not be mapped
+            print(f"sim: error: {memory_words(e)}", file=sys.stderr)
+            return 2
         name = getattr(e, "filename", "") or ""
         if not name and not e.strerror and len(e.args) == 1 and isinstance(e.args[0], str):
             name = e.args[0]  # pyarrow's FileNotFoundError(path)
@@ -420,12 +423,18 @@ def _main(argv: list[str]) -> int:
         return 2
     except (ArithmeticError, ValueError, MemoryError, RecursionError) as e:  # e.g. a sweep
         # cell table; a file nested too deep to read (a run.json of 100,000 brackets)
+        if short_of_memory(e):
+            print(f"sim: error: {memory_words(e)}", file=sys.stderr)
+            return 2
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)
         return 2
     except Exception as e:  # noqa: BLE001 - a bug outside a run (check, show, report, loading):
         if interrupted(e):  # Ctrl-C inside an import: ImportError from the KeyboardInterrupt
             print("sim: interrupted", file=sys.stderr)
             return 130
+        if short_of_memory(e):  # an ImportError: a library that could not be mapped
+            print(f"sim: error: {memory_words(e)}", file=sys.stderr)
+            return 2
         if os.environ.get("SIM_DEBUG"):  # one line as docs/cli.md promises, the traceback on
             raise  # request
         what = f"{type(e).__name__}: {e}".splitlines()[0]

@@ -6,6 +6,7 @@ before anything imports NumPy; the environment of the caller wins.
 """
 
 import os
+import resource
 import signal
 import sys
 import threading
@@ -37,19 +38,68 @@ def interrupt_while_loading(prog: str):
     ``<prog>: interrupted`` and exit 130, as later, not a traceback from whichever import
     was running (nothing has been written yet). Returns the function that puts Python's own
     handler back once the command handles Ctrl-C itself; a SIGINT the caller ignores (a
-    background job) stays ignored."""
-    if (
-        threading.current_thread() is not threading.main_thread()
-        or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
-    ):
-        return lambda: None
+    background job) stays ignored. Until then a library that cannot be loaded for want of
+    memory (``ulimit -v``) ends the command with one line "not enough memory ..." and exit 2,
+    not a traceback (or a crash while Python shuts down)."""
+    hook = sys.excepthook
 
-    def handler(signum, frame):
-        os.write(2, f"{prog}: interrupted\n".encode())
-        os._exit(130)
+    def short(kind, e, tb):  # ulimit -v: a library that cannot be mapped, not a traceback
+        if not short_of_memory(e):
+            return hook(kind, e, tb)
+        os.write(2, f"{prog}: error: {memory_words(e)}\n".encode())
+        os._exit(2)  # not Python's finalisation: short of memory, it may crash (SIGSEGV)
 
-    signal.signal(signal.SIGINT, handler)
-    return lambda: signal.signal(signal.SIGINT, signal.default_int_handler)
+    sys.excepthook = short
+
+    def loaded():
+        sys.excepthook = hook
+        if own:
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+
+    own = (
+        threading.current_thread() is threading.main_thread()
+        and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    )
+    if own:
+
+        def handler(signum, frame):
+            os.write(2, f"{prog}: interrupted\n".encode())
+            os._exit(130)
+
+        signal.signal(signal.SIGINT, handler)
+    return loaded
+
+
+#: what the loader and llvmlite say of a library they cannot map into memory (ulimit -v)
+_MAP_WORDS = ("failed to map segment", "cannot allocate memory", "could not find/load shared")
+
+
+def short_of_memory(e: BaseException | None) -> bool:
+    """Whether ``e`` (or an exception it came from) says the process ran out of address space:
+    a MemoryError, or, under a limit of address space (``ulimit -v``), a shared library that
+    could not be mapped (an ImportError or OSError that blamed the library itself)."""
+    limited = resource.getrlimit(resource.RLIMIT_AS)[0] != resource.RLIM_INFINITY
+    seen = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, MemoryError):
+            return True
+        text = str(e).lower()
+        if isinstance(e, (ImportError, OSError)) and any(w in text for w in _MAP_WORDS):
+            return limited or "cannot allocate memory" in text
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return False
+
+
+def memory_words(e: BaseException | None = None) -> str:
+    """The one line's words for :func:`short_of_memory`: what could not be had (a library, or
+    NumPy's "Unable to allocate ..."), and the limit if one is set."""
+    cap = resource.getrlimit(resource.RLIMIT_AS)[0]
+    limit = f" (ulimit -v is {cap // 1024} kB)" if cap != resource.RLIM_INFINITY else ""
+    what = "to load the suite and its libraries"
+    if isinstance(e, MemoryError) and str(e):
+        what = f"for the run: {str(e).splitlines()[0][:200]}"
+    return f"not enough memory {what}{limit}"
 
 
 def refuse_bad_environment(prog: str) -> None:

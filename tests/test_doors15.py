@@ -15,11 +15,12 @@ from __future__ import annotations
 
 import resource
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
-from sim import batch
+from sim import batch, cli, threads
 from sim.mc import executors
 from sim.mc.storage import atomic_path
 
@@ -67,3 +68,43 @@ def test_dask_is_not_started_under_too_few_open_files(monkeypatch):
     with pytest.raises(RuntimeError, match="needs at least 64 open files, and ulimit -n is 40"):
         executors.make_executor("dask", 2, None)
     assert not started
+
+
+def test_a_library_that_cannot_be_mapped_ends_in_one_line_not_a_traceback(tmp_path):
+    """``ulimit -v``: a library imported while an entry point loads cannot be mapped
+    (ImportError "failed to map segment from shared object", or a MemoryError), which was a
+    traceback and then a crash (SIGSEGV) as Python shut down."""
+    code = (
+        "from sim.threads import interrupt_while_loading\n"
+        "interrupt_while_loading('sim')\n"
+        "raise ImportError('/x/_sparsetools.so: failed to map segment from shared object')\n"
+    )
+    limit = 64 * 2**30  # a limit of address space, far above what this needs
+
+    def cap():
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+
+    got = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, preexec_fn=cap, cwd=ROOT
+    )
+    assert got.returncode == 2, got.stderr
+    assert (
+        got.stderr
+        == f"sim: error: not enough memory to load the suite and its libraries (ulimit -v is {limit // 1024} kB)\n"
+    )
+
+
+def test_a_library_loaded_in_a_run_short_of_memory_is_named_as_such(monkeypatch, capsys):
+    """llvmlite, loaded when the first kernel compiles, says "Could not find/load shared object
+    file" when it cannot be mapped: that was the one line, blaming a missing file."""
+
+    def no_room(args):
+        raise OSError("Could not find/load shared object file 'libllvmlite.so' from resource")
+
+    monkeypatch.setattr(cli, "_check", no_room)
+    monkeypatch.setattr(threads.resource, "getrlimit", lambda what: (2**29, 2**29))
+    assert cli.main(["check", str(ROOT / "studies" / "salsig_encoders.toml")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "sim: error: not enough memory to load the suite and its libraries (ulimit -v is 524288 kB)"
+    ]
