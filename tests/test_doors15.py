@@ -21,8 +21,8 @@ from pathlib import Path
 import pytest
 
 from sim import batch, cli, threads
-from sim.mc import executors
-from sim.mc.storage import atomic_path
+from sim.mc import executors, outputs
+from sim.mc.storage import atomic_path, read_record, write_record
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -108,3 +108,22 @@ def test_a_library_loaded_in_a_run_short_of_memory_is_named_as_such(monkeypatch,
     assert err == [
         "sim: error: not enough memory to load the suite and its libraries (ulimit -v is 524288 kB)"
     ]
+
+
+def test_old_results_that_cannot_be_removed_are_named(tmp_path, monkeypatch, capsys):
+    """``--overwrite`` by a user who may replace the results directory (its parent is
+    writable) but not remove what is in it: the run ended with exit 0 and left the old results
+    in a hidden ``.<name>.old.<pid>`` without a word."""
+    out, stage = tmp_path / "res", tmp_path / ".res.partial"
+    for d, seed in ((out, 1), (stage, 2)):
+        (d / "trials").mkdir(parents=True)
+        write_record(d, {"config": {"seed": seed}, "code_hash": "x", "files": []})
+    (out / "trials" / "chunk-000000.parquet").write_bytes(b"old")
+    monkeypatch.setattr(outputs.shutil, "rmtree", lambda p, ignore_errors=False: None)
+    outputs.publish(stage, out)
+    assert read_record(out)["config"] == {"seed": 2}
+    err = capsys.readouterr().err.strip().splitlines()
+    old = outputs.swap_dir(out)
+    assert old.is_dir() and len(err) == 1
+    assert err[0].startswith(f"sim: note: the replaced results are kept in {old} (")
+    assert "chunk-000000.parquet could not be removed" in err[0]
