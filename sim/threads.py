@@ -102,11 +102,29 @@ def memory_words(e: BaseException | None = None) -> str:
     return f"not enough memory {what}{limit}"
 
 
+#: address space (kB) below which no command starts: the suite's libraries (NumPy, SciPy,
+#: pyarrow, numba's LLVM) map about 700 MB before any work; under a limit just above that,
+#: OpenBLAS retried each failed allocation inside SuperLU and a small network ran for hours
+MIN_ADDRESS_SPACE_KB = 1024 * 1024
+
+
+def _refuse_small_address_space(prog: str) -> None:
+    cap = resource.getrlimit(resource.RLIMIT_AS)[0]
+    if cap != resource.RLIM_INFINITY and cap // 1024 < MIN_ADDRESS_SPACE_KB:
+        sys.stderr.write(
+            f"{prog}: error: not enough memory: ulimit -v is {cap // 1024} kB, and the suite "
+            f"needs at least {MIN_ADDRESS_SPACE_KB} kB of address space (its libraries map "
+            "about 700 MB)\n"
+        )
+        sys.exit(2)
+
+
 def refuse_bad_environment(prog: str) -> None:
     """Exit 2 with one line when the environment holds a value that breaks loading NumPy or
     SciPy: ``SOURCE_DATE_EPOCH`` that is not an integer ended every command in a traceback
     from ``numpy.f2py`` (imported by ``scipy.sparse``). Called by the entry points before
     anything imports NumPy."""
+    _refuse_small_address_space(prog)
     v = os.environ.get("SOURCE_DATE_EPOCH")
     if v is None:
         return

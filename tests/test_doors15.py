@@ -127,3 +127,19 @@ def test_old_results_that_cannot_be_removed_are_named(tmp_path, monkeypatch, cap
     assert old.is_dir() and len(err) == 1
     assert err[0].startswith(f"sim: note: the replaced results are kept in {old} (")
     assert "chunk-000000.parquet could not be removed" in err[0]
+
+
+def test_a_command_under_too_small_an_address_space_does_not_start():
+    """``ulimit -v 500000``: a small network study ran for hours (OpenBLAS retried every
+    failed allocation inside SuperLU); the entry points now refuse to start below 1 GiB."""
+    code = "from sim.threads import refuse_bad_environment\nrefuse_bad_environment('sim')\n"
+
+    def cap():
+        resource.setrlimit(resource.RLIMIT_AS, (500_000 * 1024, 500_000 * 1024))
+
+    got = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, preexec_fn=cap, cwd=ROOT
+    )
+    assert got.returncode == 2
+    assert got.stderr.startswith("sim: error: not enough memory: ulimit -v is 500000 kB")
+    assert len(got.stderr.splitlines()) == 1
