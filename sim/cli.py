@@ -343,13 +343,23 @@ def _why(e: OSError) -> str:
     return str(e) or type(e).__name__
 
 
+#: signals that end a command as Ctrl-C does; SIGXCPU: the soft CPU limit (``ulimit -S -t``),
+#: which killed a run with "CPU time limit exceeded" and no line of its own
+_STOPS = (signal.SIGTERM, signal.SIGHUP, signal.SIGXCPU)
+_cpu_limit = []  # set when SIGXCPU ended the command: its one line says why
+
+
 def _on_sigterm(signum, frame):
+    if signum == signal.SIGXCPU:  # sent again every second: once is enough (the cleanup runs)
+        signal.signal(signal.SIGXCPU, signal.SIG_IGN)
+        _cpu_limit.append(signum)
     raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    old = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
+    old = {s: signal.getsignal(s) for s in _STOPS}
+    _cpu_limit.clear()
     try:
         if not argv:  # usage, not an error message
             parser(DOC).print_help()
@@ -375,7 +385,7 @@ def _main(argv: list[str]) -> int:
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
-        for s in (signal.SIGTERM, signal.SIGHUP):  # clean up like Ctrl-C (nohup: ignored): a
+        for s in _STOPS:  # clean up like Ctrl-C (nohup: ignored): a
             if signal.getsignal(s) is signal.SIG_DFL:  # run's stage, report's temporary files
                 signal.signal(s, _on_sigterm)
         if args.cmd == "run":
@@ -396,7 +406,9 @@ def _main(argv: list[str]) -> int:
         return INTERNAL if getattr(e, "internal", False) else 2
     except KeyboardInterrupt:
         again = "; run the same command again to finish the missing chunks"
-        print(f"sim: interrupted{again if args and args.cmd == 'run' else ''}", file=sys.stderr)
+        why = " by the CPU time limit (ulimit -t)" if _cpu_limit else ""
+        again = again if args and args.cmd == "run" else ""
+        print(f"sim: interrupted{why}{again}", file=sys.stderr)
         return 130
     except BrokenPipeError:
         raise

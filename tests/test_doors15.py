@@ -13,7 +13,9 @@ each failed on the code before its fix.
 
 from __future__ import annotations
 
+import os
 import resource
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -143,3 +145,21 @@ def test_a_command_under_too_small_an_address_space_does_not_start():
     assert got.returncode == 2
     assert got.stderr.startswith("sim: error: not enough memory: ulimit -v is 500000 kB")
     assert len(got.stderr.splitlines()) == 1
+
+
+def test_the_soft_cpu_limit_ends_a_command_in_one_line(monkeypatch, capsys):
+    """``ulimit -S -t``: SIGXCPU killed a run ("CPU time limit exceeded", exit 152) with no line
+    of its own; it now ends as Ctrl-C does, naming the limit (the chunks finished are kept)."""
+
+    def busy(args):
+        os.kill(os.getpid(), signal.SIGXCPU)
+        for _ in range(10**7):  # the handler runs between two bytecodes
+            pass
+        raise AssertionError("SIGXCPU was not handled")
+
+    before = signal.getsignal(signal.SIGXCPU)
+    monkeypatch.setattr(cli, "_check", busy)
+    assert cli.main(["check", str(ROOT / "studies" / "salsig_encoders.toml")]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["sim: interrupted by the CPU time limit (ulimit -t)"]
+    assert signal.getsignal(signal.SIGXCPU) == before  # in-process callers get theirs back
