@@ -163,3 +163,19 @@ def test_the_soft_cpu_limit_ends_a_command_in_one_line(monkeypatch, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["sim: interrupted by the CPU time limit (ulimit -t)"]
     assert signal.getsignal(signal.SIGXCPU) == before  # in-process callers get theirs back
+
+
+@pytest.mark.parametrize("var", ["FUZZ_CASES=0", "FUZZ_CASES=-1", "FUZZ_CASES=abc", "FUZZ_SEED=x"])
+def test_make_fuzz_refuses_a_count_that_fuzzes_nothing(var):
+    """``make fuzz FUZZ_CASES=0`` (or -1) fuzzed nothing and passed; ``FUZZ_CASES=abc`` was a
+    pytest collection error. Checked before pytest starts (``-o`` keeps the venv's stamp)."""
+    got = subprocess.run(
+        ["make", "-s", "-o", ".venv/.installed", "fuzz", var],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert got.returncode == 2
+    name = var.split("=")[0]
+    assert got.stderr.splitlines()[0].startswith(f"make fuzz: {name} must be a whole number")
