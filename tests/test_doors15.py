@@ -23,7 +23,7 @@ from pathlib import Path
 import pytest
 
 from sim import batch, cli, threads
-from sim.mc import executors, outputs
+from sim.mc import executors, outputs, storage
 from sim.mc.storage import atomic_path, read_record, write_record
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -179,3 +179,19 @@ def test_make_fuzz_refuses_a_count_that_fuzzes_nothing(var):
     assert got.returncode == 2
     name = var.split("=")[0]
     assert got.stderr.splitlines()[0].startswith(f"make fuzz: {name} must be a whole number")
+
+
+def test_a_git_that_prints_bytes_not_utf8_is_no_commit(tmp_path, monkeypatch):
+    """A ``git`` on PATH that prints bytes not UTF-8 (a wrapper; a Latin-1 file name with
+    ``core.quotePath=false``) ended every run in "UnicodeDecodeError", exit 2; its words
+    (not a commit hash) were the recorded commit otherwise."""
+    fake = tmp_path / "git"
+    fake.write_text("#!/bin/sh\nprintf '\\377\\376 not a commit\\n'\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("PATH", f"{tmp_path}{os.pathsep}{os.environ['PATH']}")
+    storage.git_commit.cache_clear()
+    try:
+        assert storage.git_commit("salsig_encoders") == "unknown"
+        assert storage.git_commit() == "unknown"
+    finally:
+        storage.git_commit.cache_clear()

@@ -75,19 +75,23 @@ def git_commit(study: str | None = None) -> str:
             cwd=root,
             capture_output=True,
             text=True,
+            errors="replace",  # a file name git prints in Latin-1, a wrapper's bytes
             timeout=10,
         )
-        if head.returncode != 0 or not head.stdout.strip():
-            return "unknown"
+        if head.returncode != 0 or not re.fullmatch(
+            r"[0-9a-f]{40}|[0-9a-f]{64}", head.stdout.strip()
+        ):
+            return "unknown"  # no commit, or not what git prints (a wrapper's words)
         dirty = subprocess.run(
             ["git", "status", "--porcelain", "--", *paths],
             cwd=root,
             capture_output=True,
             text=True,
+            errors="replace",  # a file name git prints in Latin-1, a wrapper's bytes
             timeout=10,
         ).stdout.strip()
         return head.stdout.strip() + ("-dirty" if dirty else "")
-    except (OSError, subprocess.SubprocessError):
+    except (OSError, subprocess.SubprocessError, ValueError):
         return "unknown"
 
 
