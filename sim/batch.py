@@ -138,9 +138,17 @@ def run_all(
         with starting:
             if stop.is_set():
                 return f.stem, None, 0.0, t - t0
-            proc = subprocess.Popen(
-                cmd, stdout=subprocess.PIPE if jobs > 1 else None, stderr=subprocess.PIPE, text=True
-            )
+            try:
+                proc = subprocess.Popen(
+                    cmd,
+                    stdout=subprocess.PIPE if jobs > 1 else None,
+                    stderr=subprocess.PIPE,
+                    text=True,
+                )
+            except OSError as e:  # no process or pipe to be had (ulimit -n, -u): one line
+                why = e.strerror or str(e)
+                print(f"sim.batch: {f.name}: cannot start its run: {why}", file=sys.stderr)
+                return f.stem, 2, time.perf_counter() - t, t - t0
             procs.append(proc)
         with proc:
             stdout, stderr = proc.communicate()
@@ -336,7 +344,11 @@ def _main(argv: list[str]) -> int:
         )
         return 130
     if args.timings is not None:
-        Path(args.timings).write_text(json.dumps(done), encoding="utf-8")
+        try:
+            Path(args.timings).write_text(json.dumps(done), encoding="utf-8")
+        except OSError as e:  # a full disk, ulimit -f: the runs stand, their timings do not
+            print(f"sim.batch: --timings: {e.strerror or e}: {args.timings}", file=sys.stderr)
+            return 2
     failed = [v[0] for v in done.values() if v[0] != 0]
     if log.error is not None and not isinstance(log.error, BrokenPipeError):
         print(f"sim.batch: standard output: {log.error.strerror or log.error}", file=sys.stderr)

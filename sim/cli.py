@@ -43,7 +43,7 @@ from sim.report.markdown import write_report
 from sim.report.read import damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.studies import get_study, load_study
-from sim.threads import interrupted
+from sim.threads import interrupted, memory_words, short_of_memory
 
 __all__ = ["main", "check_run_args"]
 
@@ -349,13 +349,23 @@ def _why(e: OSError) -> str:
     return str(e) or type(e).__name__
 
 
+#: signals that end a command as Ctrl-C does; SIGXCPU: the soft CPU limit (``ulimit -S -t``),
+#: which killed a run with "CPU time limit exceeded" and no line of its own
+_STOPS = (signal.SIGTERM, signal.SIGHUP, signal.SIGXCPU)
+_cpu_limit = []  # set when SIGXCPU ended the command: its one line says why
+
+
 def _on_sigterm(signum, frame):
+    if signum == signal.SIGXCPU:  # sent again every second: once is enough (the cleanup runs)
+        signal.signal(signal.SIGXCPU, signal.SIG_IGN)
+        _cpu_limit.append(signum)
     raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    old = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
+    old = {s: signal.getsignal(s) for s in _STOPS}
+    _cpu_limit.clear()
     try:
         if not argv:  # usage, not an error message
             parser(DOC).print_help()
@@ -381,7 +391,7 @@ def _main(argv: list[str]) -> int:
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
-        for s in (signal.SIGTERM, signal.SIGHUP):  # clean up like Ctrl-C (nohup: ignored): a
+        for s in _STOPS:  # clean up like Ctrl-C (nohup: ignored): a
             if signal.getsignal(s) is signal.SIG_DFL:  # run's stage, report's temporary files
                 signal.signal(s, _on_sigterm)
         if args.cmd == "run":
@@ -402,11 +412,16 @@ def _main(argv: list[str]) -> int:
         return INTERNAL if getattr(e, "internal", False) else 2
     except KeyboardInterrupt:
         again = "; run the same command again to finish the missing chunks"
-        print(f"sim: interrupted{again if args and args.cmd == 'run' else ''}", file=sys.stderr)
+        why = " by the CPU time limit (ulimit -t)" if _cpu_limit else ""
+        again = again if args and args.cmd == "run" else ""
+        print(f"sim: interrupted{why}{again}", file=sys.stderr)
         return 130
     except BrokenPipeError:
         raise
     except OSError as e:  # a failing write (full disk, vanished directory): one line, no traceback
+        if short_of_memory(e):  # ulimit -v: a library loaded on first use could not be mapped
+            print(f"sim: error: {memory_words(e)}", file=sys.stderr)
+            return 2
         name = getattr(e, "filename", "") or ""
         if not name and not e.strerror and len(e.args) == 1 and isinstance(e.args[0], str):
             name = e.args[0]  # pyarrow's FileNotFoundError(path)
@@ -426,12 +441,18 @@ def _main(argv: list[str]) -> int:
         return 2
     except (ArithmeticError, ValueError, MemoryError, RecursionError) as e:  # e.g. a sweep
         # cell table; a file nested too deep to read (a run.json of 100,000 brackets)
+        if short_of_memory(e):
+            print(f"sim: error: {memory_words(e)}", file=sys.stderr)
+            return 2
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)
         return 2
     except Exception as e:  # noqa: BLE001 - a bug outside a run (check, show, report, loading):
         if interrupted(e):  # Ctrl-C inside an import: ImportError from the KeyboardInterrupt
             print("sim: interrupted", file=sys.stderr)
             return 130
+        if short_of_memory(e):  # an ImportError: a library that could not be mapped
+            print(f"sim: error: {memory_words(e)}", file=sys.stderr)
+            return 2
         if os.environ.get("SIM_DEBUG"):  # one line as docs/cli.md promises, the traceback on
             raise  # request
         what = f"{type(e).__name__}: {e}".splitlines()[0]

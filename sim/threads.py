@@ -6,6 +6,7 @@ before anything imports NumPy; the environment of the caller wins.
 """
 
 import os
+import resource
 import signal
 import sys
 import threading
@@ -44,26 +45,86 @@ def interrupt_while_loading(prog: str):
     import was running nor a silent death by SIGTERM (nothing has been written yet). Returns
     the function that puts the default handlers back once the command handles the signals
     itself; a signal the caller ignores (SIGINT of a background job, SIGHUP under nohup)
-    stays ignored."""
-    if threading.current_thread() is not threading.main_thread():
-        return lambda: None
+    stays ignored. Until then a library that cannot be loaded for want of memory
+    (``ulimit -v``) ends the command with one line "not enough memory ..." and exit 2, not a
+    traceback (or a crash while Python shuts down)."""
+    hook = sys.excepthook
+
+    def short(kind, e, tb):  # ulimit -v: a library that cannot be mapped, not a traceback
+        if not short_of_memory(e):
+            return hook(kind, e, tb)
+        os.write(2, f"{prog}: error: {memory_words(e)}\n".encode())
+        os._exit(2)  # not Python's finalisation: short of memory, it may crash (SIGSEGV)
+
+    sys.excepthook = short
 
     def handler(signum, frame):
         os.write(2, f"{prog}: interrupted\n".encode())
         os._exit(130)
 
     taken = []
-    for name, default in LOADING_SIGNALS:
-        s = getattr(signal, name, None)
-        if s is not None and signal.getsignal(s) is default:
-            signal.signal(s, handler)
-            taken.append((s, default))
+    if threading.current_thread() is threading.main_thread():
+        for name, default in LOADING_SIGNALS:
+            s = getattr(signal, name, None)
+            if s is not None and signal.getsignal(s) is default:
+                signal.signal(s, handler)
+                taken.append((s, default))
 
     def restore() -> None:
+        sys.excepthook = hook
         for s, default in taken:
             signal.signal(s, default)
 
     return restore
+
+
+#: what the loader and llvmlite say of a library they cannot map into memory (ulimit -v)
+_MAP_WORDS = ("failed to map segment", "cannot allocate memory", "could not find/load shared")
+
+
+def short_of_memory(e: BaseException | None) -> bool:
+    """Whether ``e`` (or an exception it came from) says the process ran out of address space:
+    a MemoryError, or, under a limit of address space (``ulimit -v``), a shared library that
+    could not be mapped (an ImportError or OSError that blamed the library itself)."""
+    limited = resource.getrlimit(resource.RLIMIT_AS)[0] != resource.RLIM_INFINITY
+    seen = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, MemoryError):
+            return True
+        text = str(e).lower()
+        if isinstance(e, (ImportError, OSError)) and any(w in text for w in _MAP_WORDS):
+            return limited or "cannot allocate memory" in text
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return False
+
+
+def memory_words(e: BaseException | None = None) -> str:
+    """The one line's words for :func:`short_of_memory`: what could not be had (a library, or
+    NumPy's "Unable to allocate ..."), and the limit if one is set."""
+    cap = resource.getrlimit(resource.RLIMIT_AS)[0]
+    limit = f" (ulimit -v is {cap // 1024} kB)" if cap != resource.RLIM_INFINITY else ""
+    what = "to load the suite and its libraries"
+    if isinstance(e, MemoryError) and str(e):
+        what = f"for the run: {str(e).splitlines()[0][:200]}"
+    return f"not enough memory {what}{limit}"
+
+
+#: address space (kB) below which no command starts: the suite's libraries (NumPy, SciPy,
+#: pyarrow, numba's LLVM) map about 700 MB before any work; under a limit just above that,
+#: OpenBLAS retried each failed allocation inside SuperLU and a small network ran for hours
+MIN_ADDRESS_SPACE_KB = 1024 * 1024
+
+
+def _refuse_small_address_space(prog: str) -> None:
+    cap = resource.getrlimit(resource.RLIMIT_AS)[0]
+    if cap != resource.RLIM_INFINITY and cap // 1024 < MIN_ADDRESS_SPACE_KB:
+        sys.stderr.write(
+            f"{prog}: error: not enough memory: ulimit -v is {cap // 1024} kB, and the suite "
+            f"needs at least {MIN_ADDRESS_SPACE_KB} kB of address space (its libraries map "
+            "about 700 MB)\n"
+        )
+        sys.exit(2)
 
 
 def refuse_bad_environment(prog: str) -> None:
@@ -71,6 +132,7 @@ def refuse_bad_environment(prog: str) -> None:
     SciPy: ``SOURCE_DATE_EPOCH`` that is not an integer ended every command in a traceback
     from ``numpy.f2py`` (imported by ``scipy.sparse``). Called by the entry points before
     anything imports NumPy."""
+    _refuse_small_address_space(prog)
     v = os.environ.get("SOURCE_DATE_EPOCH")
     if v is None:
         return

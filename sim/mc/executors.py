@@ -7,6 +7,7 @@ from __future__ import annotations
 import logging
 import multiprocessing
 import os
+import resource
 import signal
 import sys
 import threading
@@ -147,6 +148,7 @@ class _Dask:
         if scheduler:
             self.client = Client(scheduler, timeout="10s")
         else:
+            _enough_files(workers)
             try:
                 self.cluster = LocalCluster(
                     n_workers=max(workers, 1),
@@ -180,6 +182,23 @@ class _Dask:
             self.client.close(timeout=5)
         if self.cluster is not None:
             end_dask_clusters()
+
+
+#: open files a LocalCluster needs per worker (pipes, sockets, its nanny): measured with
+#: ``ulimit -n``, 2 workers hang past 100 s at 40 files, fail with tracebacks at 32 and run at 64
+DASK_FILES_PER_WORKER = 32
+
+
+def _enough_files(workers: int) -> None:
+    """Refuse (one line) to start a LocalCluster under a limit of open files it cannot start
+    in: it would not fail but retry for minutes, printing tracebacks of its monitors."""
+    need = DASK_FILES_PER_WORKER * max(workers, 2)
+    soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
+    if soft != resource.RLIM_INFINITY and soft < need:
+        raise RuntimeError(
+            f"a LocalCluster of {max(workers, 1)} workers needs at least {need} open files, "
+            f"and ulimit -n is {soft} (raise it, or use --executor local)"
+        )
 
 
 def end_dask_clusters() -> None:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
+import sys
 import unicodedata
 from pathlib import Path
 
@@ -425,3 +426,10 @@ def publish(stage: Path, out: Path) -> None:
     os.replace(stage, out)
     (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
     shutil.rmtree(old, ignore_errors=True)
+    if old.exists() or old.is_symlink():  # a file or directory of the old results that this
+        # user may not remove: they are not lost, but say where (a hidden directory)
+        left = next(iter(sorted(old.rglob("*"), key=lambda q: -len(q.parts))), old)
+        print(
+            f"sim: note: the replaced results are kept in {old} ({left} could not be removed)",
+            file=sys.stderr,
+        )

@@ -14,6 +14,7 @@ import hashlib
 import json
 import os
 import platform
+import re
 import stat
 import subprocess
 import sys
@@ -74,19 +75,23 @@ def git_commit(study: str | None = None) -> str:
             cwd=root,
             capture_output=True,
             text=True,
+            errors="replace",  # a file name git prints in Latin-1, a wrapper's bytes
             timeout=10,
         )
-        if head.returncode != 0 or not head.stdout.strip():
-            return "unknown"
+        if head.returncode != 0 or not re.fullmatch(
+            r"[0-9a-f]{40}|[0-9a-f]{64}", head.stdout.strip()
+        ):
+            return "unknown"  # no commit, or not what git prints (a wrapper's words)
         dirty = subprocess.run(
             ["git", "status", "--porcelain", "--", *paths],
             cwd=root,
             capture_output=True,
             text=True,
+            errors="replace",  # a file name git prints in Latin-1, a wrapper's bytes
             timeout=10,
         ).stdout.strip()
         return head.stdout.strip() + ("-dirty" if dirty else "")
-    except (OSError, subprocess.SubprocessError):
+    except (OSError, subprocess.SubprocessError, ValueError):
         return "unknown"
 
 
@@ -177,6 +182,23 @@ class atomic_path:
                 raise
         else:
             self.tmp.unlink(missing_ok=True)
+            if isinstance(exc, OSError) and not exc.filename:
+                # a failing write (ulimit -f: EFBIG, a full disk) says only "File too large";
+                # pyarrow's says "Error writing bytes to file. Detail: [errno 27] ...": name
+                # the file it was writing
+                raise _named(exc, self.path) from None
+
+
+def _named(e: OSError, path: Path) -> OSError:
+    """``e`` again, with the file it was writing as its file name (its errno and words kept;
+    pyarrow's "... Detail: [errno N] words" read as errno N and its words)."""
+    num, words = e.errno, e.strerror
+    m = re.search(r"\[errno (\d+)\] (.+)$", str(e))
+    if m:
+        num, words = num or int(m.group(1)), m.group(2)
+    named = OSError(num or 0, words or str(e) or type(e).__name__, str(path))
+    named.__traceback__ = e.__traceback__
+    return named
 
 
 class NonFiniteError(ValueError):
