@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import linecache
 import os
 import re
 import signal
@@ -32,6 +31,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.cli_args import module_doc, parser
+from sim.cli_errors import cwd_exists, os_reason, stdout_failed
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
@@ -315,40 +315,6 @@ def _report(results: Path) -> int:
     return 0
 
 
-def _cwd_exists() -> bool:
-    try:
-        os.getcwd()
-    except OSError:
-        return False
-    return True
-
-
-def _stdout_failed(e: OSError) -> bool:
-    """Whether ``e`` came from printing to standard output (``sim check > /dev/full``): such
-    a write fails without a file name, and the line said only "No space left on device"
-    (after a run's results had been written). Judged by the innermost line it was raised
-    on: a ``print`` to standard output, or ``sys.stdout`` itself."""
-    tb = e.__traceback__
-    while tb is not None and tb.tb_next is not None:
-        tb = tb.tb_next
-    if tb is None:
-        return False
-    line = linecache.getline(tb.tb_frame.f_code.co_filename, tb.tb_lineno)
-    return ("print(" in line and "file=" not in line) or "sys.stdout" in line
-
-
-def _why(e: OSError) -> str:
-    """The reason of an OSError in words: its strerror, or (pyarrow raises
-    ``FileNotFoundError(path)`` without one) the name of its kind."""
-    if e.strerror:
-        return e.strerror
-    if isinstance(e, FileNotFoundError):
-        return "No such file or directory"
-    if len(e.args) == 1 and isinstance(e.args[0], str):  # OSError(path): the path is all
-        return type(e).__name__
-    return str(e) or type(e).__name__
-
-
 #: signals that end a command as Ctrl-C does; SIGXCPU: the soft CPU limit (``ulimit -S -t``),
 #: which killed a run with "CPU time limit exceeded" and no line of its own
 _STOPS = (signal.SIGTERM, signal.SIGHUP, signal.SIGXCPU)
@@ -425,11 +391,11 @@ def _main(argv: list[str]) -> int:
         name = getattr(e, "filename", "") or ""
         if not name and not e.strerror and len(e.args) == 1 and isinstance(e.args[0], str):
             name = e.args[0]  # pyarrow's FileNotFoundError(path)
-        if not name and not _cwd_exists():
+        if not name and not cwd_exists():
             name = "the working directory (it was deleted)"
-        if not name and _stdout_failed(e):
+        if not name and stdout_failed(e):
             name = "standard output"
-        print(f"sim: error: {_why(e)}: {name}".rstrip(": "), file=sys.stderr)
+        print(f"sim: error: {os_reason(e)}: {name}".rstrip(": "), file=sys.stderr)
         return 2
     except UnicodeEncodeError as e:  # a text the terminal's encoding cannot show (ascii)
         what = ascii(e.object[e.start : e.end]) if isinstance(e.object, str) else "a character"

@@ -310,6 +310,8 @@ def test_claims_tables_state_their_interval_methods(tmp_path):
     assert prov["study"] == "t"
     iv = prov["intervals"]
     assert iv["level"] == 0.95 and iv["min_chunks"] == 20 and iv["one_plate_p_fail"] == 0.05
+    # the region verdicts' sample-size rule: 29 points bound the disagreeing share under 10 %
+    assert (iv["region_min_points"], iv["region_share"], iv["region_level"]) == (29, 0.10, 0.95)
     assert set(iv["methods"]) == {
         "mean",
         "sd",
