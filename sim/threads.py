@@ -128,10 +128,11 @@ def _refuse_small_address_space(prog: str) -> None:
 
 
 def refuse_bad_environment(prog: str) -> None:
-    """Exit 2 with one line when the environment holds a value that breaks loading NumPy or
-    SciPy: ``SOURCE_DATE_EPOCH`` that is not an integer ended every command in a traceback
-    from ``numpy.f2py`` (imported by ``scipy.sparse``). Called by the entry points before
-    anything imports NumPy."""
+    """Exit 2 with one line when the environment cannot load the suite: an address-space
+    limit under :data:`MIN_ADDRESS_SPACE_KB` (``ulimit -v``), or a value that breaks loading
+    NumPy or SciPy (``SOURCE_DATE_EPOCH`` that is not an integer ended every command in a
+    traceback from ``numpy.f2py``, imported by ``scipy.sparse``). Called by the entry points
+    before anything imports NumPy."""
     _refuse_small_address_space(prog)
     v = os.environ.get("SOURCE_DATE_EPOCH")
     if v is None:

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from oneline import one_line
 
 from benchmarks import cli as bench
 from sim import cli
@@ -34,13 +35,6 @@ ROOT = Path(__file__).resolve().parent.parent
 TABLE1 = (ROOT / "studies" / "brown_table1.toml").read_text()
 
 
-def _one_line(capsys, rc, *needles):
-    err = capsys.readouterr().err.strip()
-    assert rc == 2 and "\n" not in err and "Traceback" not in err, (rc, err)
-    assert all(n in err for n in needles), err
-    return err
-
-
 @pytest.mark.parametrize(
     "text, key",
     [
@@ -51,7 +45,7 @@ def _one_line(capsys, rc, *needles):
 def test_a_key_given_twice_is_refused_naming_it(tmp_path, capsys, text, key):
     f = tmp_path / "twice.toml"
     f.write_text(text)
-    _one_line(capsys, main(["check", str(f)]), key, "given twice")
+    one_line(capsys, main(["check", str(f)]), key, "given twice")
 
 
 def test_an_overflowing_sweep_range_is_one_line_without_warnings(tmp_path, capsys):
@@ -62,7 +56,7 @@ def test_an_overflowing_sweep_range_is_one_line_without_warnings(tmp_path, capsy
     )
     with _no_warnings():
         rc = main(["check", str(f)])
-    _one_line(capsys, rc, "sweep.errors.setting_sigma_um", "not finite")
+    one_line(capsys, rc, "sweep.errors.setting_sigma_um", "not finite")
 
 
 @contextlib.contextmanager
@@ -90,10 +84,10 @@ def test_bench_bad_arguments_are_one_line_before_any_work(tmp_path, capsys):
         (["--only", "rerun", "--rerun-files", str(tmp_path / "a.toml"), *out], "not a readable"),
     ]
     for argv, needle in cases:
-        _one_line(capsys, bench.main(argv), needle)
+        one_line(capsys, bench.main(argv), needle)
     with pytest.raises(SystemExit) as e:
         bench.main(["--only", "nosuch"])
-    _one_line(capsys, e.value.code, "benchmarks: error: argument --only", "--help")
+    one_line(capsys, e.value.code, "benchmarks: error: argument --only", "--help")
     assert not (tmp_path / "b").exists() and sorted(
         p.name for p in (tmp_path / "res").iterdir()
     ) == ["claims.parquet"]
@@ -126,7 +120,7 @@ def test_the_entry_points_hand_ctrl_c_back_once_loaded():
         assert done.returncode == 0, (mod, done.stderr[-500:])
 
 
-def test_a_refused_sweep_of_a_list_valued_key_is_one_line(tmp_path, capsys):
+def test_a_refused_sweep_of_a_list_valued_key_isone_line(tmp_path, capsys):
     """Every cell of a sweep of a list-valued key (``plate.points``) refused: the message
     collected the distinct values in a dict and ended in ``TypeError: unhashable type``."""
     f = tmp_path / "points.toml"
@@ -134,7 +128,7 @@ def test_a_refused_sweep_of_a_list_valued_key_is_one_line(tmp_path, capsys):
         TABLE1 + '\n[sweep]\n"plate.points" = [[[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]]]\n'
         '"plate.pattern" = ["list"]\n'
     )
-    _one_line(capsys, main(["check", str(f)]), "sweep.plate.points: every cell failed", "4 points")
+    one_line(capsys, main(["check", str(f)]), "sweep.plate.points: every cell failed", "4 points")
 
 
 def test_sweep_png_of_list_values_keeps_its_axes(tmp_path, monkeypatch):
@@ -172,7 +166,7 @@ def test_sweep_png_of_list_values_keeps_its_axes(tmp_path, monkeypatch):
     assert all(len(t.get_text()) <= 40 for t in ax.get_legend().get_texts())
 
 
-def test_bench_a_failing_write_is_one_line(tmp_path, monkeypatch, capsys):
+def test_bench_a_failing_write_isone_line(tmp_path, monkeypatch, capsys):
     """A write that fails (``ulimit -f``: "File too large") ended in an OSError traceback."""
 
     def full(*a, **k):
@@ -181,7 +175,7 @@ def test_bench_a_failing_write_is_one_line(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(bench, "engine_rows", lambda quick: {"case": ["x"]})
     monkeypatch.setattr(bench, "write_table", full)
     rc = bench.main(["--quick", "--only", "engines", "--out", str(tmp_path / "b")])
-    _one_line(capsys, rc, "benchmarks: error: writing under", "File too large")
+    one_line(capsys, rc, "benchmarks: error: writing under", "File too large")
 
 
 def test_a_bug_outside_a_run_is_one_line_and_exit_3(monkeypatch, capsys):

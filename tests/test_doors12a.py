@@ -28,6 +28,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
+from oneline import one_line
 
 from sim.claims.inference import FAILS, evaluate
 from sim.cli import main
@@ -59,12 +60,6 @@ FILES = {
 JACKKNIFE_CALL = re.compile(r"\bjackknife\(|\.jack\(")
 
 
-def _one_line(capsys, rc, *needles):
-    err = capsys.readouterr().err.strip()
-    assert rc == 2 and "\n" not in err and "Traceback" not in err, (rc, err)
-    assert all(n in err for n in needles), err
-
-
 def _uses_jackknife(study: str) -> bool:
     """Whether the study's own package calls the chunk jackknife (its source, not a list)."""
     pkg = ROOT / Path(*MODULES[study].split("."))
@@ -86,7 +81,7 @@ def test_one_chunk_short_is_refused_at_check_and_the_limit_passes(study, capsys)
     f = str(ROOT / "studies" / f"{FILES[study]}.toml")
     chunk = 3
     short = ["--set", f"trials={(need - 1) * chunk}", "--set", f"chunk={chunk}"]
-    _one_line(capsys, main(["check", f, *short]), "chunk", "trials", "at least")
+    one_line(capsys, main(["check", f, *short]), "chunk", "trials", "at least")
     limit = ["--set", f"trials={need * chunk - 1}", "--set", f"chunk={chunk}"]
     assert main(["check", f, *limit]) == 0, capsys.readouterr().err
     assert f"\nchunk = {chunk} " in capsys.readouterr().out
@@ -120,8 +115,8 @@ def test_show_and_report_name_the_damaged_table_and_its_column(tmp_path, capsys,
     capsys.readouterr()
     f = d / "degree.parquet"
     pq.write_table(damage(pq.read_table(f)), f)
-    _one_line(capsys, main(["show", str(d), "--markdown"]), "degree.parquet under", what)
-    _one_line(
+    one_line(capsys, main(["show", str(d), "--markdown"]), "degree.parquet under", what)
+    one_line(
         capsys, main(["report", "--results", str(res)]), "wolf_polynomial/degree.parquet", what
     )
     assert not (res / "REPORT.md").exists()
