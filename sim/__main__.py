@@ -26,9 +26,16 @@ class _CacheDirNotes(logging.Filter):
 
 logging.getLogger("matplotlib").addFilter(_CacheDirNotes())  # before matplotlib loads
 
-from sim.cli import main  # noqa: E402
+from sim.cli import main as command  # noqa: E402
+from sim.stops import run_program  # noqa: E402
 
-loaded()
+
+def main() -> int:
+    """The ``sim`` program (``python -m sim``, the ``sim`` script): the command line, and a
+    stop signal after it returned ends the process with its exit code (:mod:`sim.stops`)."""
+    return run_program("sim", command, loaded)
+
 
 if __name__ == "__main__":
     sys.exit(main())
+loaded()  # imported (the sim script, the tests): the default handlers until main runs

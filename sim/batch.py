@@ -50,8 +50,10 @@ from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.storage import regular_text  # noqa: E402
+from sim.stops import check_interrupt, keep_lost_interrupts, run_program  # noqa: E402
 
-_loaded()
+if __name__ != "__main__":  # imported: the default handlers (the program: run_program's)
+    _loaded()
 
 __all__ = ["SLOW_FIRST", "order", "run_all", "main"]
 
@@ -167,6 +169,7 @@ def run_all(
     try:
         for stem, code, wall, start in pool.map(one, todo):
             out[stem] = (code, wall, start)
+            check_interrupt()  # one Python dropped (a C callback): the other runs end too
     except KeyboardInterrupt:
         stop_children(procs, first=lambda: _set(stop, starting))
         pool.shutdown(wait=True, cancel_futures=True)
@@ -273,10 +276,20 @@ def _timings_problem(path: str) -> str | None:
     return None
 
 
+#: the driver's line when it was interrupted
+INTERRUPTED = "sim.batch: interrupted; the same command again resumes the unfinished runs"
+
+
 def main(argv: list[str] | None = None) -> int:
     old = {s: signal.getsignal(s) for s in (signal.SIGINT, *STOP_SIGNALS)}
     try:
-        return _main(list(sys.argv[1:] if argv is None else argv))
+        with keep_lost_interrupts():  # Ctrl-C that Python drops in a C callback: kept
+            code = _main(list(sys.argv[1:] if argv is None else argv))
+            check_interrupt()  # and never exit 0 after one
+            return code
+    except KeyboardInterrupt:
+        print(INTERRUPTED, file=sys.stderr)
+        return 130
     finally:  # in-process callers (the tests) get their handlers back
         for s, h in old.items():
             if h is not None:
@@ -337,11 +350,9 @@ def _main(argv: list[str]) -> int:
     log = _Stdout()
     try:
         done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only, log)
+        check_interrupt()  # before the timings are written
     except KeyboardInterrupt:  # the runs were stopped and cleaned up
-        print(
-            "sim.batch: interrupted; the same command again resumes the unfinished runs",
-            file=sys.stderr,
-        )
+        print(INTERRUPTED, file=sys.stderr)
         return 130
     if args.timings is not None:
         try:
@@ -377,5 +388,5 @@ class _Stdout:
                     pass
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # a signal after main returned: its exit code stands
+    sys.exit(run_program("sim.batch", main, _loaded))

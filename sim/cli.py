@@ -42,6 +42,7 @@ from sim.mc.sweep import read_sweep
 from sim.report.markdown import write_report
 from sim.report.read import damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
+from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.studies import get_study, load_study
 from sim.threads import interrupted, memory_words, short_of_memory
 
@@ -196,6 +197,7 @@ def _run(args) -> int:
         max_adjustments=args.max_adjustments,
         figures=not args.no_figures,
     )
+    check_interrupt()  # dropped by Python since the results were published: not exit 0
     try:
         write_run_readme(out, get_study)
         summary = terminal_summary(out, shown=shown)
@@ -336,7 +338,8 @@ def main(argv: list[str] | None = None) -> int:
         if not argv:  # usage, not an error message
             parser(DOC).print_help()
             return 2
-        return _main(argv)
+        with keep_lost_interrupts():  # Ctrl-C that Python drops in a C callback: kept
+            return _main(argv)
     except BrokenPipeError:  # sim check ... | head: the reader left, nothing to say
         try:
             devnull = os.open(os.devnull, os.O_WRONLY)
@@ -360,19 +363,9 @@ def _main(argv: list[str]) -> int:
         for s in _STOPS:  # clean up like Ctrl-C (nohup: ignored): a
             if signal.getsignal(s) is signal.SIG_DFL:  # run's stage, report's temporary files
                 signal.signal(s, _on_sigterm)
-        if args.cmd == "run":
-            return _run(args)
-        if args.cmd == "check":
-            return _check(args)
-        if args.cmd == "show":
-            return _show(args)
-        if args.cmd == "report":
-            if name_problem(args.results):
-                why = name_problem(args.results)
-                raise ConfigError(
-                    "--results", f"not a directory name: {why} (got {args.results!r})"
-                )
-            return _report(Path(args.results))
+        code = _command(args)
+        check_interrupt()  # an interrupt Python dropped (a C callback) never ends in exit 0
+        return code
     except (ConfigError, StudyError) as e:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)
         return INTERNAL if getattr(e, "internal", False) else 2
@@ -424,6 +417,20 @@ def _main(argv: list[str]) -> int:
         what = f"{type(e).__name__}: {e}".splitlines()[0]
         print(f"sim: internal error: {what} (SIM_DEBUG=1 shows where)", file=sys.stderr)
         return INTERNAL
+
+
+def _command(args) -> int:
+    if args.cmd == "run":
+        return _run(args)
+    if args.cmd == "check":
+        return _check(args)
+    if args.cmd == "show":
+        return _show(args)
+    if args.cmd == "report":
+        if name_problem(args.results):
+            why = name_problem(args.results)
+            raise ConfigError("--results", f"not a directory name: {why} (got {args.results!r})")
+        return _report(Path(args.results))
     return 1
 
 

@@ -34,6 +34,7 @@ from sim.mc.storage import (
 from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cells, refused_note
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
+from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted
 
 __all__ = ["execute", "run_sweep", "check_sweep"]
@@ -108,6 +109,7 @@ def _hint(msg: str, kind: str, schema) -> str:
     return ""
 
 
+@keep_lost_interrupts()  # every door: Ctrl-C that Python drops in a C callback is kept
 def execute(
     study,
     cfg: dict,
@@ -168,6 +170,7 @@ def execute(
         try:
             with ctx.progress_bar(cfg["study"]), nullcontext() if figures else without_figures():
                 run_sweep(study, cfg, sweep, stage, ctx) if sweep else study.run(cfg, stage, ctx)
+            check_interrupt()  # dropped by Python after the last chunk: the stage is kept
         except (ConfigError, StudyError):
             raise
         except (OSError, KeyboardInterrupt, SystemExit):
@@ -192,6 +195,7 @@ def execute(
         raise
     ex.close()
     try:
+        check_interrupt()  # not published: an interrupted run never looks finished
         check_out(out, shown, record, True)  # again, under the lock: still ours or absent
         seal(stage, ctx.store)
         publish(stage, out)

@@ -44,8 +44,8 @@ def interrupt_while_loading(prog: str):
     one line ``<prog>: interrupted`` and exit 130, as later, not a traceback from whichever
     import was running nor a silent death by SIGTERM (nothing has been written yet). Returns
     the function that puts the default handlers back once the command handles the signals
-    itself; a signal the caller ignores (SIGINT of a background job, SIGHUP under nohup)
-    stays ignored. Until then a library that cannot be loaded for want of memory
+    itself (or a handler of the caller's: ``restore(then=handler)``); a signal the caller
+    ignores (SIGINT of a background job, SIGHUP under nohup) stays ignored. Until then a library that cannot be loaded for want of memory
     (``ulimit -v``) ends the command with one line "not enough memory ..." and exit 2, not a
     traceback (or a crash while Python shuts down)."""
     hook = sys.excepthook
@@ -70,10 +70,13 @@ def interrupt_while_loading(prog: str):
                 signal.signal(s, handler)
                 taken.append((s, default))
 
-    def restore() -> None:
+    def restore(then=None) -> list:
+        """Put back the default handlers (or ``then``, the handler of the command's phase,
+        :func:`sim.stops.run_program`); returns the signals it handles."""
         sys.excepthook = hook
         for s, default in taken:
-            signal.signal(s, default)
+            signal.signal(s, default if then is None else then)
+        return [s for s, _ in taken]
 
     return restore
 

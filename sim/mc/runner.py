@@ -43,6 +43,7 @@ from sim.mc.executors import InProcess, make_executor
 from sim.mc.progress import Progress
 from sim.mc.storage import atomic_path, config_hash
 from sim.mc.streams import chunk_rng
+from sim.stops import check_interrupt
 
 __all__ = [
     "chunk_rng",
@@ -262,6 +263,7 @@ def run_chunks(
         else Progress(trials, label, quiet=quiet, chunks=len(sizes))
     ) as bar:
         bar.update(done_trials, len(results))
+        check_interrupt()  # an interrupt Python dropped (a C callback) stops the run here,
         for k, n, out in executor.run(fn, seed, part, todo):
             if store is not None:
                 store.save(part, k, n, out, seed)
@@ -269,6 +271,7 @@ def run_chunks(
                 out = {key: v for key, v in out.items() if not key.startswith(ROWS)}
             results[k] = out
             bar.update(n, 1)
+            check_interrupt()  # or once the chunk it came in is saved
     keys = results[0].keys() if results else []
     return {
         key: np.concatenate([results[k][key] for k in range(len(sizes))], axis=0) for key in keys

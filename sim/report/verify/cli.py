@@ -12,6 +12,7 @@ from pathlib import Path
 from sim.mc.outputs import name_problem
 from sim.report.verify.rerun import verify, write_record
 from sim.report.verify.rules import Comparison, VerifyError
+from sim.stops import check_interrupt, keep_lost_interrupts
 
 __all__ = ["main"]
 
@@ -112,6 +113,10 @@ def _print(comps: list[Comparison]) -> None:
             print(f"  not compared (rows depend on the trials): {', '.join(c.not_compared)}")
 
 
+#: the command's line when it was interrupted
+INTERRUPTED = "sim verify: interrupted; the re-run was stopped"
+
+
 def _interrupt(signum, frame):
     raise KeyboardInterrupt
 
@@ -123,7 +128,13 @@ def main(argv: list[str] | None = None) -> int:
         if old[s] is signal.SIG_DFL:
             signal.signal(s, _interrupt)
     try:
-        return _main(argv)
+        with keep_lost_interrupts():  # Ctrl-C that Python drops in a C callback: kept
+            code = _main(argv)
+            check_interrupt()  # and never exit 0 after one
+            return code
+    except KeyboardInterrupt:
+        print(INTERRUPTED, file=sys.stderr)
+        return 130
     finally:
         for s, h in old.items():
             if h is not None:
@@ -147,11 +158,12 @@ def _main(argv: list[str] | None) -> int:
                 extra=extra,
                 mode=mode,
             )
+        check_interrupt()  # before the comparisons are printed and recorded
     except VerifyError as e:
         print(f"sim verify: error: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("sim verify: interrupted; the re-run was stopped", file=sys.stderr)
+        print(INTERRUPTED, file=sys.stderr)
         return 130
     _print(comps)
     if not a.no_record and mode == "full" and not a.study:

@@ -1,0 +1,132 @@
+"""Stop signals in the two places where Python would drop them or die of them.
+
+**An interrupt Python cannot raise.** The commands turn Ctrl-C and SIGTERM into
+``KeyboardInterrupt``; raised inside a C callback (numba's ``_raw_object_cache_notify``, any
+``ctypes`` callback), an at-fork hook or a ``__del__``, Python cannot hand it to the caller: it
+printed "Exception ignored in: ... KeyboardInterrupt", dropped it, and the run went on to exit 0.
+While :func:`keep_lost_interrupts` is open (every command, and :func:`sim.execute.execute` for
+every door), such an interrupt is recorded silently instead, and the next check point,
+:func:`check_interrupt`, raises it: the chunk loop of the Monte-Carlo runner at each chunk, a
+run before it publishes its results, a command before it returns its exit code.
+
+**A signal after the command ended.** Once a command has returned its exit code, the program
+still shuts Python down (atexit callbacks, then the teardown of NumPy, SciPy, numba and
+pyarrow: a few tenths of a second), and Python resets its handlers to the defaults on the way:
+Ctrl-C there killed ``sim run --workers 2`` by SIGINT (exit -2, no line) after it had printed
+its results, or printed a traceback from an atexit callback. :func:`run_program` ends the
+program with the command's own exit code then: the command's work is done and its output is
+complete, so there is nothing left to stop or to resume (a run's results are published, its
+line printed); a signal there ends the process at once with that code, and is ignored during
+Python's last teardown (so it cannot turn a finished run into a death by signal).
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import signal
+import sys
+from contextlib import contextmanager
+
+__all__ = ["keep_lost_interrupts", "check_interrupt", "run_program"]
+
+#: interrupts recorded by the hook of :func:`keep_lost_interrupts`, not yet raised
+_lost: list[str] = []
+#: how many :func:`keep_lost_interrupts` are open (the outermost forgets a pending interrupt)
+_open: list[int] = [0]
+
+
+def _recording(previous):
+    def hook(u) -> None:
+        if isinstance(u.exc_type, type) and issubclass(u.exc_type, KeyboardInterrupt):
+            _lost.append(str(u.err_msg or "an interrupt Python could not raise"))
+            return  # silently: the command says "interrupted" in its own one line
+        previous(u)
+
+    hook.records_interrupts = True
+    return hook
+
+
+@contextmanager
+def keep_lost_interrupts():
+    """While open, an unraisable ``KeyboardInterrupt`` is recorded (not printed) for
+    :func:`check_interrupt`; every other unraisable exception goes to the hook that was there
+    before, which is put back on the way out."""
+    previous = sys.unraisablehook
+    sys.unraisablehook = _recording(previous)
+    _open[0] += 1
+    try:
+        yield
+    finally:
+        sys.unraisablehook = previous
+        _open[0] -= 1
+        if _open[0] == 0:
+            _lost.clear()  # not raised by now: the command ended otherwise (its own line)
+
+
+def check_interrupt() -> None:
+    """Raise ``KeyboardInterrupt`` if an interrupt was dropped by Python since the last check
+    (see :func:`keep_lost_interrupts`); it is raised once."""
+    if _lost:
+        _lost.clear()
+        raise KeyboardInterrupt
+
+
+#: the exit code of the program once its command has returned (see :func:`run_program`)
+_ended: list[int] = []
+#: the signals whose handler is :func:`_program_handler` (the caller left them at the default)
+_taken: list[int] = []
+
+
+def _program_handler(signum, frame):
+    """A stop signal to a program of the suite: while its command runs, ``KeyboardInterrupt``
+    (as Ctrl-C's default handler, and the commands' SIGTERM handlers, raise it); once the
+    command has returned, the end of the process with the command's exit code."""
+    if not _ended:
+        raise KeyboardInterrupt
+    for f in (sys.stdout, sys.stderr):
+        try:
+            f.flush()
+        except Exception:  # noqa: BLE001 - a closed or broken stream: nothing more to say
+            pass
+    os._exit(_ended[0])
+
+
+def _ignore_during_teardown() -> None:
+    """The last atexit callback (registered before any library's): Python's teardown that
+    follows resets the handlers to the defaults, under which a signal kills the process."""
+    if _ended:
+        for s in _taken:
+            signal.signal(s, signal.SIG_IGN)
+
+
+atexit.register(_ignore_during_teardown)
+
+
+def _exit_status(code) -> int:
+    """The status ``sys.exit(code)`` ends the process with."""
+    if code is None:
+        return 0
+    return code if isinstance(code, int) else 1
+
+
+def run_program(prog: str, main, loaded) -> int:
+    """Run ``main()`` (a command's ``main``) as the program ``prog`` and return its exit code
+    for ``sys.exit``. ``loaded``: what :func:`sim.threads.interrupt_while_loading` returned;
+    the stop signals it took over (those the caller left at their defaults) get
+    :func:`_program_handler`, so a signal after ``main`` returned ends the process with
+    ``main``'s code (see the module's docstring); one that lands as ``main`` returns gives
+    ``<prog>: interrupted`` and 130."""
+    _taken[:] = loaded(then=_program_handler)
+    try:
+        try:
+            code = main()
+        except SystemExit as e:  # argparse's --help: its code stands as well
+            _ended[:] = [_exit_status(e.code)]
+            raise
+        _ended[:] = [_exit_status(code)]
+    except KeyboardInterrupt:
+        _ended[:] = [130]
+        os.write(2, f"{prog}: interrupted\n".encode())
+        code = 130
+    return code
