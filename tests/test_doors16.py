@@ -92,7 +92,8 @@ def test_a_free_point_no_observation_reaches_is_named(tmp_path):
     study.write_text(NETWORK)
     with pytest.raises(sim.ConfigError) as e:
         sim.load(str(study))
-    assert "point 'Q' (x) is determined by no observation" in str(e.value), str(e.value)
+    assert e.value.key == "network.points", str(e.value)
+    assert "point 'Q' is declared in the study file but no observation reaches it" in str(e.value)
 
 
 def test_an_observation_of_a_gama_file_is_refused_naming_the_file(tmp_path):

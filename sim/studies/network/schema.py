@@ -24,7 +24,7 @@ from sim.studies.network.analysis import (
 from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.model import computed, datum, defect_basis, use_sparse
-from sim.studies.network.singular import singular_cause
+from sim.studies.network.singular import singular_cause, unreached, unreached_message
 from sim.studies.network.sparse_analysis import chunk_bytes, pre_analysis, variances
 
 __all__ = ["SCHEMA", "check"]
@@ -197,31 +197,14 @@ def check(cfg: dict) -> None:
     if cfg["datum.points"] and cfg["datum.kind"] != "inner":
         raise ConfigError("datum.points", "only with datum.kind = inner (it has no effect here)")
     _no_effect(net, full)
+    lone = _unreached_free(net, full)
     dt = datum(net, full)
-    if full["datum.kind"] == "constraints":
-        _minimal(net, dt)
-    if full["datum.kind"] == "inner":
-        pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
-        check_inner(net, inner_defect(net), pts, "datum.points")
-    an = pre_analysis(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
-    if not an.ok:
-        # dense too: name the point no observation reaches (docs/network.md), unless nothing
-        # holds the network at all (then the rank defect and its advice say it better)
-        held = sparse or full["datum.kind"] != "fixed" or np.any(net.role != 0)
-        free = dt.free_index(net.q)
-        cause = singular_cause(net, full, free) if held else ""
-        if sparse and not cause:
-            cause = _pivot(net, an.factor, free)
-        if sparse or cause:
-            what = an.factor.message if sparse else "the normal matrix is singular"
-            raise ConfigError(
-                "datum.kind",
-                f"{what}{': ' + cause if cause else ''}: fix points or change the datum",
-            )
-        # explicit constraints that leave a defect (one of coefficient 1e-300, say) are theirs
-        _defect(
-            net, dt, "datum.constraints" if full["datum.kind"] == "constraints" else "datum.kind"
-        )
+    try:
+        an = _held(net, full, dt, sparse)
+    except ConfigError as e:  # a fixed point nothing observes holds nothing: the cause, named
+        if not lone.size:
+            raise
+        raise ConfigError(_where(full)[0], unreached_message(net, lone, _where(full)[1])) from e
     _conditioned(net, an, "datum.kind")
     if not estimated_points(net, an):
         raise ConfigError(
@@ -239,6 +222,54 @@ def check(cfg: dict) -> None:
     if cfg["output.inner_over"]:
         pts = match_points(net, "output.inner_over", cfg["output.inner_over"])
         check_inner(net, inner_defect(net), pts, "output.inner_over")
+
+
+def _where(full: dict) -> tuple[str, str]:
+    """The key and the words that say where the network's points are declared."""
+    gama = full.get("network.gama_xml")
+    return ("network.gama_xml", gama) if gama else ("network.points", "the study file")
+
+
+def _unreached_free(net, full: dict) -> np.ndarray:
+    """Refuse a free point that no observation reaches (its position cannot be estimated,
+    whatever the datum); return the fixed ones, which hold nothing in place (they only matter
+    when the datum then leaves a defect: gama-local files often list unused control points)."""
+    lone = unreached(net)
+    free = lone[net.role[lone] != 1]
+    if free.size:
+        key, where = _where(full)
+        raise ConfigError(key, unreached_message(net, free, where))
+    return lone
+
+
+def _held(net, full: dict, dt, sparse: bool):
+    """The pre-analysis of a network its datum holds: the datum's own checks (minimal
+    constraints, inner-datum points), then the normals; a defect is refused naming its cause
+    where it can be found."""
+    if full["datum.kind"] == "constraints":
+        _minimal(net, dt)
+    if full["datum.kind"] == "inner":
+        pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
+        check_inner(net, inner_defect(net), pts, "datum.points")
+    an = pre_analysis(net, dt, full["reliability.alpha0"], full["reliability.power"])
+    if not an.ok:
+        # dense too: name the point no observation reaches (docs/network.md), unless nothing
+        # holds the network at all (then the rank defect and its advice say it better)
+        held = sparse or full["datum.kind"] != "fixed" or np.any(net.role != 0)
+        free = dt.free_index(net.q)
+        cause = singular_cause(net, full, free) if held else ""
+        if sparse and not cause:
+            cause = _pivot(net, an.factor, free)
+        if sparse or cause:
+            what = an.factor.message if sparse else "the normal matrix is singular"
+            raise ConfigError(
+                "datum.kind",
+                f"{what}{': ' + cause if cause else ''}: fix points or change the datum",
+            )
+        # explicit constraints that leave a defect (one of coefficient 1e-300, say) are theirs
+        kind = full["datum.kind"]
+        _defect(net, dt, "datum.constraints" if kind == "constraints" else "datum.kind", kind)
+    return an
 
 
 def _no_effect(net, cfg: dict) -> None:
@@ -374,7 +405,15 @@ def _parameters(net, A: np.ndarray, free: np.ndarray, rank: int) -> None:
     )
 
 
-def _defect(net, dt, key: str) -> None:
+#: what to do about a rank defect the datum leaves, by datum kind (never the datum it has)
+_DEFECT_ADVICE = {
+    "fixed": "fix points, add observations, or use datum.kind = inner",
+    "constraints": "add constraints or observations, or use datum.kind = inner",
+    "inner": "add observations that tie every point to the rest, or fix points",
+}
+
+
+def _defect(net, dt, key: str, kind: str = "fixed") -> None:
     free = dt.free_index(net.q)
     _, J = computed(net, net.theta_true()[None], jac=True)
     A = J[0][:, free] / net.sigma[:, None]
@@ -390,5 +429,5 @@ def _defect(net, dt, key: str) -> None:
         key,
         f"the network has a rank defect of {len(free) - rank} ({len(free)} "
         f"unknowns, rank {rank}) that the datum ({c} constraints) does not cover: "
-        "fix points, add observations, or use datum.kind = inner",
+        + _DEFECT_ADVICE.get(kind, _DEFECT_ADVICE["fixed"]),
     )

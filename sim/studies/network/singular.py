@@ -22,7 +22,7 @@ from scipy.sparse.csgraph import connected_components
 from sim.studies.network.definition import Network
 from sim.studies.network.model import jacobian_sparse, pattern
 
-__all__ = ["singular_cause"]
+__all__ = ["singular_cause", "unreached", "unreached_message"]
 
 
 def _unobserved(net: Network, free: np.ndarray) -> str:
@@ -79,3 +79,32 @@ def singular_cause(net: Network, cfg: dict, free: np.ndarray) -> str:
     if cfg["datum.kind"] == "constraints":
         return _unobserved(net, free)
     return _unobserved(net, free) or _islands(net, cfg)
+
+
+def unreached(net: Network) -> np.ndarray:
+    """The points no observation reaches (neither station, target nor sight of one, and no
+    observed coordinate), in the network's order."""
+    seen = np.zeros(net.n, bool)
+    for a in (net.i, net.j, net.k):
+        seen[a[a >= 0]] = True
+    return np.flatnonzero(~seen)
+
+
+def unreached_message(net: Network, points: np.ndarray, where: str) -> str:
+    """One line naming the declared ``points`` no observation reaches (``where``: the file or
+    key that declares them): a free one's position cannot be estimated, a fixed one holds
+    nothing of the network in place."""
+    fixed = bool(np.all(net.role[points] == 1))
+    names = ", ".join(repr(net.names[p]) for p in points[:3])
+    more = f" and {len(points) - 3} more" if len(points) > 3 else ""
+    one = len(points) == 1
+    what = f"{'fixed ' if fixed else ''}point{'' if one else 's'} {names}{more}"
+    verb = "is" if one else "are"
+    it = "it" if one else "them"
+    if fixed:
+        why = f"{'it holds' if one else 'they hold'} nothing of the network in place"
+        fix = f"observe {it}, or hold the network by points it observes"
+    else:
+        why = f"{'its position' if one else 'their positions'} cannot be estimated"
+        fix = f"observe {it} or remove {it}"
+    return f"{what} {verb} declared in {where} but no observation reaches {it}: {why}; {fix}"
