@@ -45,6 +45,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from oneline import one_line
 
 import sim
 from sim.cli import main
@@ -61,12 +62,24 @@ def test_a_network_with_fewer_observations_than_unknowns_names_the_datum(tmp_pat
         .read_text()
         .replace('role = "fixed"', 'role = "free"')
     )
+    # every point reached by one of two angles (8 unknowns): the rank defect, named
+    sets = {
+        "network.generate": [],
+        "network.grids": [],
+        "compare.fix": [],
+        "output.inner_over": [],
+        "network.observations": [
+            {"kind": "angle", "at": "A", "from": "B", "to": "C", "sigma_arcsec": 2.0},
+            {"kind": "angle", "at": "D", "from": "C", "to": "A", "sigma_arcsec": 2.0},
+        ],
+    }
     with pytest.raises(sim.ConfigError) as e:
-        sim.load(str(study), **{"network.generate": []})
-    assert e.value.key == "datum.kind" and "rank defect of" in str(e.value), str(e.value)
-    assert main(["check", str(study), "--set", "network.generate=[]"]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("sim: error: datum.kind: ") and err.count("\n") == 1, err
+        sim.load(str(study), **sets)
+    assert e.value.key == "datum.kind" and "rank defect of 6" in str(e.value), str(e.value)
+    # the points that no observation reaches (the file's one angle reaches three): named
+    err = one_line(capsys, main(["check", str(study), "--set", "network.generate=[]"]))
+    assert err.startswith("sim: error: network.points: points 'A', 'B', 'C' and 10 more"), err
+    assert "no observation reaches them" in err, err
 
 
 def test_a_gama_file_name_with_a_line_break_is_one_line():
