@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+from oneline import SIM_ERROR, one_line
 
 import sim
 from sim.cli import main
@@ -126,13 +127,6 @@ def test_the_gama_stdev_range_is_the_studys_in_its_unit(tmp_path):
     _refused(_gama(tmp_path, DIST, DIST.replace('stdev="2.0"', 'stdev="2e9"')), "<distance>")
 
 
-def _one_line(capsys, code: int, *words: str) -> str:
-    err = capsys.readouterr().err
-    assert code == 2 and err.count("\n") == 1 and err.startswith("sim: error: "), err
-    assert "Traceback" not in err and all(w in err for w in words), err
-    return err
-
-
 def test_an_integer_outside_64_bits_is_named(tmp_path, capsys):
     big = 10**400
     with pytest.raises(ConfigError, match="^trials: .*64-bit"):
@@ -144,11 +138,15 @@ def test_an_integer_outside_64_bits_is_named(tmp_path, capsys):
             'kind = "fixed"', f'kind = "constraints"\nconstraints = [ {{ "N1.x" = {2**70} }} ]'
         )
     )
-    _one_line(capsys, main(["check", str(f)]), "datum.constraints", "64-bit")
+    one_line(capsys, main(["check", str(f)]), "datum.constraints", "64-bit", prefix=SIM_ERROR)
     f.write_text(text + f'[sweep]\n"network.scale_ppm" = {{ start = 0, stop = {big}, step = 1 }}\n')
-    _one_line(capsys, main(["check", str(f)]), "sweep.network.scale_ppm.stop", "64-bit")
+    one_line(
+        capsys, main(["check", str(f)]), "sweep.network.scale_ppm.stop", "64-bit", prefix=SIM_ERROR
+    )
     f.write_text(text.replace("trials = 2000", "trials = " + "9" * 5000))
-    _one_line(capsys, main(["check", str(f)]), "s.toml", "malformed TOML", "4300 digits")
+    one_line(
+        capsys, main(["check", str(f)]), "s.toml", "malformed TOML", "4300 digits", prefix=SIM_ERROR
+    )
 
 
 def test_api_arguments_of_a_wrong_type_are_named(tmp_path):
@@ -190,7 +188,12 @@ def test_an_override_of_a_swept_key_is_refused(tmp_path, capsys):
     f.write_text(NETWORK.read_text() + '[sweep]\n"network.scale_ppm" = [0.0, 10.0]\n')
     with pytest.raises(ConfigError, match="^network.scale_ppm: is swept"):
         sim.load(f, network__scale_ppm=5.0)
-    _one_line(capsys, main(["check", str(f), "--set", "network.scale_ppm=5"]), "is swept")
+    one_line(
+        capsys,
+        main(["check", str(f), "--set", "network.scale_ppm=5"]),
+        "is swept",
+        prefix=SIM_ERROR,
+    )
     assert sim.load(f, network__constant_mm=0.1).sweep == {"network.scale_ppm": [0.0, 10.0]}
 
 
@@ -209,7 +212,7 @@ def test_a_record_nested_too_deeply_is_not_a_record(tmp_path):
 
 def test_stations_so_far_out_that_ranges_overflow_are_named(capsys):
     argv = ["check", str(BROWN), "--set", "comparator.station_offset_mm=1e308"]
-    _one_line(capsys, main(argv), "comparator.station_offset_mm", "overflow")
+    one_line(capsys, main(argv), "comparator.station_offset_mm", "overflow", prefix=SIM_ERROR)
 
 
 @pytest.mark.parametrize("key", ["network.gama_xml", "network.gama_sha256"])
@@ -221,7 +224,7 @@ def test_the_gama_file_is_not_swept(tmp_path, capsys, key):
         f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{xml}"\n'
         f'[datum]\nkind = "inner"\n[sweep]\n"{key}" = ["{xml}", "{xml}"]\n'
     )
-    _one_line(capsys, main(["check", str(f)]), f"sweep.{key}", "cannot be swept")
+    one_line(capsys, main(["check", str(f)]), f"sweep.{key}", "cannot be swept", prefix=SIM_ERROR)
 
 
 @pytest.mark.parametrize(
@@ -235,4 +238,10 @@ def test_the_gama_file_is_not_swept(tmp_path, capsys, key):
 def test_a_single_observation_names_the_field_matching_many(tmp_path, capsys, obs, key):
     f = tmp_path / "s.toml"
     f.write_text(NETWORK.read_text().replace("observations = [", f"observations = [ {obs},"))
-    _one_line(capsys, main(["check", str(f)]), f"network.observations[0].{key}", "matches")
+    one_line(
+        capsys,
+        main(["check", str(f)]),
+        f"network.observations[0].{key}",
+        "matches",
+        prefix=SIM_ERROR,
+    )

@@ -28,6 +28,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
+from oneline import SIM_ERROR, VERIFY_ERROR, one_line
 
 import sim
 from sim import ConfigError
@@ -58,19 +59,18 @@ constraints = [ { "A.x" = COEF }, { "A.y" = 1.0 }, { "B.y" = 1.0 } ]
 """
 
 
-def _one_line(capsys, code: int, *names: str) -> str:
-    err = capsys.readouterr().err
-    assert code == 2 and err.count("\n") == 1 and err.startswith("sim: error: "), err
-    assert "Traceback" not in err and all(n in err for n in names), err
-    return err
-
-
 @pytest.mark.parametrize(
     "value, key",
     [("40\nchunk=2", "trials"), ("40\rseed=3", "trials"), ("[3,\n5]", "dilution.grids")],
 )
 def test_a_set_value_is_one_line(capsys, value, key):
-    _one_line(capsys, main(["check", str(BROWN), "--set", f"{key}={value}"]), key, "one line")
+    one_line(
+        capsys,
+        main(["check", str(BROWN), "--set", f"{key}={value}"]),
+        key,
+        "one line",
+        prefix=SIM_ERROR,
+    )
 
 
 @pytest.mark.parametrize(
@@ -79,17 +79,28 @@ def test_a_set_value_is_one_line(capsys, value, key):
 def test_an_empty_table_is_not_a_value(tmp_path, capsys, text, key):
     f = tmp_path / "s.toml"
     f.write_text('study = "brown_table1"\n' + text)
-    _one_line(capsys, main(["check", str(f)]), key, "{}")
+    one_line(capsys, main(["check", str(f)]), key, "{}", prefix=SIM_ERROR)
     f.write_text('study = "brown_table1"\n[plate]\n[errors]\nsettings = 2\n')  # empty section
     assert main(["check", str(f)]) == 0
     capsys.readouterr()
-    _one_line(capsys, main(["check", str(BROWN), "--set", "plate={}"]), "plate", "unknown key")
+    one_line(
+        capsys,
+        main(["check", str(BROWN), "--set", "plate={}"]),
+        "plate",
+        "unknown key",
+        prefix=SIM_ERROR,
+    )
 
 
 def test_report_refuses_a_directory_without_study_results(tmp_path, capsys):
     (tmp_path / "mine").mkdir()
     (tmp_path / "mine" / "notes.txt").write_text("mine\n")
-    _one_line(capsys, main(["report", "--results", str(tmp_path / "mine")]), "no study results")
+    one_line(
+        capsys,
+        main(["report", "--results", str(tmp_path / "mine")]),
+        "no study results",
+        prefix=SIM_ERROR,
+    )
     assert [p.name for p in (tmp_path / "mine").iterdir()] == ["notes.txt"]
 
 
@@ -97,7 +108,7 @@ def test_report_refuses_a_directory_without_study_results(tmp_path, capsys):
 def test_an_all_zero_datum_constraint_is_named(tmp_path, capsys, coef):
     f = tmp_path / "n.toml"
     f.write_text(NETWORK.replace("COEF", coef))
-    _one_line(capsys, main(["check", str(f)]), "datum.constraints[0]", "zero")
+    one_line(capsys, main(["check", str(f)]), "datum.constraints[0]", "zero", prefix=SIM_ERROR)
     f.write_text(NETWORK.replace("COEF", "1.0"))
     assert main(["check", str(f)]) == 0
 
@@ -114,9 +125,7 @@ def test_verify_no_rerun_without_the_reruns_records_nothing(tmp_path, capsys):
     res = _results(tmp_path)
     (tmp_path / "scratch").mkdir()
     argv = ["--results", str(res), "--scratch", str(tmp_path / "scratch"), "--no-rerun"]
-    assert verify_main(argv) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "no re-run of brown_table1" in err
+    one_line(capsys, verify_main(argv), "no re-run of brown_table1", prefix=VERIFY_ERROR)
     assert sorted(p.name for p in res.iterdir()) == ["brown_table1"]  # no record written
 
 
@@ -134,9 +143,9 @@ def test_show_names_a_claims_table_that_is_not_ours(tmp_path, capsys):
     d = tmp_path / "r"
     d.mkdir()
     pq.write_table(pa.table({"a": [1, 2]}), d / "claims.parquet")
-    _one_line(capsys, main(["show", str(d)]), "not a claims table")
+    one_line(capsys, main(["show", str(d)]), "not a claims table", prefix=SIM_ERROR)
     (d / "claims.parquet").write_bytes(b"PAR1 truncated")
-    _one_line(capsys, main(["show", str(d)]), "cannot be read")
+    one_line(capsys, main(["show", str(d)]), "cannot be read", prefix=SIM_ERROR)
 
 
 @pytest.mark.parametrize(
@@ -154,9 +163,9 @@ def test_batch_refuses_in_one_line_before_running(tmp_path, capsys, argv, words)
         str(tmp_path) if a == "DIR" else str(tmp_path / "mine.txt") if a == "MINE" else a
         for a in argv
     ]
-    assert batch_main([*argv, "--results", str(tmp_path / "r")]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and words in err and err.startswith("sim.batch: "), err
+    one_line(
+        capsys, batch_main([*argv, "--results", str(tmp_path / "r")]), words, prefix="sim.batch: "
+    )
     assert not (tmp_path / "r").exists() and (tmp_path / "mine.txt").read_text() == "mine\n"
 
 
@@ -180,18 +189,23 @@ C_PT = '{ name = "C", x_mm = 400.0, y_mm = 700.0 }'
 def test_names_are_one_printable_line_without_patterns(tmp_path, capsys, old, new, key):
     f = tmp_path / "n.toml"
     f.write_text(THIRD.replace(old, new))
-    _one_line(capsys, main(["check", str(f)]), key)
+    one_line(capsys, main(["check", str(f)]), key, prefix=SIM_ERROR)
 
 
 def test_a_deeply_nested_or_huge_study_file_is_one_line(tmp_path, capsys):
     deep = "[" * 50_000 + "]" * 50_000
-    _one_line(capsys, main(["check", str(BROWN), "--set", f"dilution.grids={deep}"]), "nested")
+    one_line(
+        capsys,
+        main(["check", str(BROWN), "--set", f"dilution.grids={deep}"]),
+        "nested",
+        prefix=SIM_ERROR,
+    )
     f = tmp_path / "s.toml"
     f.write_text(f"trials = {deep}\n")
-    _one_line(capsys, main(["check", str(f)]), "s.toml", "nested")
+    one_line(capsys, main(["check", str(f)]), "s.toml", "nested", prefix=SIM_ERROR)
     with f.open("wb") as fh:  # sparse: 17 MiB of nothing, never read
         fh.truncate(17 * 1024**2)
-    _one_line(capsys, main(["check", str(f)]), "s.toml", "MiB")
+    one_line(capsys, main(["check", str(f)]), "s.toml", "MiB", prefix=SIM_ERROR)
 
 
 def test_show_and_report_name_a_table_replaced_by_hand(tmp_path, capsys):
@@ -200,8 +214,13 @@ def test_show_and_report_name_a_table_replaced_by_hand(tmp_path, capsys):
     capsys.readouterr()
     before = (d / "README.md").read_bytes()
     (d / "summary.parquet").write_bytes((d / "datums.parquet").read_bytes())
-    _one_line(capsys, main(["show", str(d), "--markdown"]), "not as sim wrote it")
-    _one_line(capsys, main(["report", "--results", str(d.parent)]), "not as sim wrote it")
+    one_line(capsys, main(["show", str(d), "--markdown"]), "not as sim wrote it", prefix=SIM_ERROR)
+    one_line(
+        capsys,
+        main(["report", "--results", str(d.parent)]),
+        "not as sim wrote it",
+        prefix=SIM_ERROR,
+    )
     assert (d / "README.md").read_bytes() == before and not (d.parent / "REPORT.md").exists()
 
 
@@ -213,7 +232,13 @@ def _net(tmp_path: Path, text: str = THIRD) -> Path:
 
 def test_an_output_path_with_a_control_character_is_refused(tmp_path, capsys):
     out = str(tmp_path / "a\nb")
-    _one_line(capsys, main(["run", str(BROWN), "--out", out]), "--out", "control character")
+    one_line(
+        capsys,
+        main(["run", str(BROWN), "--out", out]),
+        "--out",
+        "control character",
+        prefix=SIM_ERROR,
+    )
     with pytest.raises(ConfigError, match="out"):
         sim.load(BROWN, trials=40, chunk=2).run(out=out)
     assert list(tmp_path.iterdir()) == []
@@ -228,7 +253,7 @@ def test_a_key_without_effect_or_object_is_refused(tmp_path, capsys, extra, key)
     text = text.replace('"B", x_mm', '"B", role = "fixed", x_mm') + '[datum]\nkind = "fixed"\n'
     assert main(["check", str(_net(tmp_path, text))]) == 0
     capsys.readouterr()
-    _one_line(capsys, main(["check", str(_net(tmp_path, text + extra))]), key)
+    one_line(capsys, main(["check", str(_net(tmp_path, text + extra))]), key, prefix=SIM_ERROR)
 
 
 GAMA = ROOT / "tests" / "data" / "gama" / "one_fixed.xml"
@@ -249,7 +274,7 @@ def test_a_gama_value_out_of_range_names_the_file_and_element(tmp_path, capsys, 
     f = _net(
         tmp_path, f'study = "network"\n[network]\ngama_xml = "{xml}"\n[datum]\nkind = "inner"\n'
     )
-    _one_line(capsys, main(["check", str(f)]), "n.xml", *words)
+    one_line(capsys, main(["check", str(f)]), "n.xml", *words, prefix=SIM_ERROR)
 
 
 @pytest.mark.parametrize(
@@ -265,7 +290,7 @@ def test_weights_stay_in_range_after_settings_and_bias(tmp_path, capsys, field, 
     if "direction" in field:
         obs = obs.replace('kind = "distance", ', "").replace("sigma_mm", "sigma_arcsec")
     f = _net(tmp_path, THIRD.replace("[datum]", obs + "\n[datum]"))
-    _one_line(capsys, main(["check", str(f)]), f"network.observations[0].{key}")
+    one_line(capsys, main(["check", str(f)]), f"network.observations[0].{key}", prefix=SIM_ERROR)
 
 
 def test_a_failing_run_in_a_batch_names_its_study_file(tmp_path):
@@ -306,7 +331,7 @@ def test_an_empty_results_directory_name_is_not_the_working_directory(
     assert "--results" in capsys.readouterr().err
     assert verify_main(["--results", "", "--no-record"]) == 2
     assert "--results" in capsys.readouterr().err
-    _one_line(capsys, main(["report", "--results", ""]), "--results")
+    one_line(capsys, main(["report", "--results", ""]), "--results", prefix=SIM_ERROR)
     assert list(tmp_path.iterdir()) == []
 
 
@@ -339,17 +364,24 @@ def test_a_network_key_without_effect_is_named(tmp_path, capsys, old, new, key):
     the datum (a constant or scale to estimate in a network without distances)."""
     assert old in FIXED and main(["check", str(_net(tmp_path, FIXED))]) == 0
     capsys.readouterr()
-    _one_line(capsys, main(["check", str(_net(tmp_path, FIXED.replace(old, new, 1)))]), key)
+    one_line(
+        capsys,
+        main(["check", str(_net(tmp_path, FIXED.replace(old, new, 1)))]),
+        key,
+        prefix=SIM_ERROR,
+    )
 
 
 def test_an_empty_dir_or_a_deleted_working_directory_is_named(tmp_path, capsys, monkeypatch):
     """``sim show ""`` read the working directory; a deleted one gave a bare OSError text."""
-    _one_line(capsys, main(["show", ""]), "DIR", "not a directory name")
+    one_line(capsys, main(["show", ""]), "DIR", "not a directory name", prefix=SIM_ERROR)
     gone = tmp_path / "gone"
     gone.mkdir()
     monkeypatch.chdir(gone)
     gone.rmdir()
-    _one_line(capsys, main(["run", str(BROWN), "--out", "out"]), "working directory")
+    one_line(
+        capsys, main(["run", str(BROWN), "--out", "out"]), "working directory", prefix=SIM_ERROR
+    )
 
 
 def test_trials_pick_the_chunk_when_the_files_chunk_is_too_large(tmp_path, capsys):
@@ -401,15 +433,26 @@ def test_api_paths_keys_and_results_are_checked(tmp_path):
 def test_a_swept_value_its_key_refuses_is_refused_by_check(tmp_path, capsys, sweep, key):
     """``sim check`` passed a sweep whose every cell then failed at run time."""
     f = _net(tmp_path, THIRD + f'[sweep]\n"network.offset_mm" = {sweep}\n')
-    _one_line(capsys, main(["check", str(f)]), "sweep.network.offset_mm", key)
+    one_line(capsys, main(["check", str(f)]), "sweep.network.offset_mm", key, prefix=SIM_ERROR)
 
 
 def test_a_run_of_too_many_chunk_files_is_refused_before_it_starts(tmp_path, capsys):
     """Two million trials in chunks of one ran for hours, writing a file per chunk."""
     argv = ["--set", "trials=2000000", "--set", "chunk=1"]
-    _one_line(capsys, main(["check", str(_net(tmp_path)), *argv]), "chunk", "at most 100,000")
+    one_line(
+        capsys,
+        main(["check", str(_net(tmp_path)), *argv]),
+        "chunk",
+        "at most 100,000",
+        prefix=SIM_ERROR,
+    )
     out = tmp_path / "o"
-    _one_line(capsys, main(["run", str(_net(tmp_path)), *argv, "--out", str(out)]), "chunk files")
+    one_line(
+        capsys,
+        main(["run", str(_net(tmp_path)), *argv, "--out", str(out)]),
+        "chunk files",
+        prefix=SIM_ERROR,
+    )
     assert not out.exists()
 
 
@@ -429,7 +472,7 @@ def test_a_run_record_listing_its_files_wrongly_is_named_not_a_traceback(tmp_pat
     (out / "run.json").write_text(json.dumps({**rec, "files": 3}))
     capsys.readouterr()
     argv = ["run", str(_net(tmp_path)), "--out", str(out), "--quiet", "--overwrite", "--seed", "7"]
-    _one_line(capsys, main(argv), "run.json", "does not list the files")
+    one_line(capsys, main(argv), "run.json", "does not list the files", prefix=SIM_ERROR)
     assert json.loads((out / "run.json").read_text())["files"] == 3  # nothing replaced
 
 

@@ -20,6 +20,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 from conftest import ELSEWHERE, tiny_overrides
+from oneline import VERIFY_ERROR, one_line
 
 import sim
 from sim.batch import is_current
@@ -166,21 +167,22 @@ def test_a_bad_declaration_is_refused_naming_the_column(tmp_path, tol, match):
 # --- the command line: one line for a bad request, nothing deleted that the suite did not write
 
 
-def _one_line(capsys, argv, code):
-    assert verify_main(argv) == code
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("sim verify: error:"), err
-    return err[0]
-
-
 def test_unknown_study_and_empty_results_are_one_line(capsys, tmp_path, two_runs):
     results = tmp_path / "results"
     shutil.copytree(two_runs / "committed", results / "brown_table1")
-    assert "nosuch" in _one_line(capsys, ["--results", str(results), "--study", "nosuch"], 2)
+    assert "nosuch" in one_line(
+        capsys, verify_main(["--results", str(results), "--study", "nosuch"]), prefix=VERIFY_ERROR
+    )
     (tmp_path / "empty").mkdir()
-    assert "no study results" in _one_line(capsys, ["--results", str(tmp_path / "empty")], 2)
-    assert "--workers" in _one_line(capsys, ["--results", str(results), "--workers", "0"], 2)
-    assert "error" in _one_line(capsys, ["--results", str(results), "--bogus"], 2)
+    assert "no study results" in one_line(
+        capsys, verify_main(["--results", str(tmp_path / "empty")]), prefix=VERIFY_ERROR
+    )
+    assert "--workers" in one_line(
+        capsys, verify_main(["--results", str(results), "--workers", "0"]), prefix=VERIFY_ERROR
+    )
+    assert "error" in one_line(
+        capsys, verify_main(["--results", str(results), "--bogus"]), prefix=VERIFY_ERROR
+    )
 
 
 def test_a_truncated_file_is_one_failure_line(capsys, tmp_path, two_runs):
@@ -202,22 +204,36 @@ def test_scratch_keeps_what_the_suite_did_not_write(capsys, tmp_path, two_runs):
     mine = scratch / "brown_table1" / "notes.txt"  # the user's directory named like a study
     mine.parent.mkdir(parents=True)
     mine.write_text("mine")
-    line = _one_line(capsys, ["--results", str(results), "--scratch", str(scratch)], 2)
+    line = one_line(
+        capsys,
+        verify_main(["--results", str(results), "--scratch", str(scratch)]),
+        prefix=VERIFY_ERROR,
+    )
     assert "not a results directory of the suite" in line and mine.read_text() == "mine"
     before = sorted(p.name for p in (results / "brown_table1").iterdir())
-    line = _one_line(capsys, ["--results", str(results), "--scratch", str(results)], 2)
+    line = one_line(
+        capsys,
+        verify_main(["--results", str(results), "--scratch", str(results)]),
+        prefix=VERIFY_ERROR,
+    )
     assert "inside) the committed results" in line
     assert sorted(p.name for p in (results / "brown_table1").iterdir()) == before
     # an earlier re-run (its run.json) with the user's note in it: refused too, note kept
     shutil.copytree(two_runs / "rerun", scratch / "brown_table1", dirs_exist_ok=True)
-    line = _one_line(capsys, ["--results", str(results), "--scratch", str(scratch)], 2)
+    line = one_line(
+        capsys,
+        verify_main(["--results", str(results), "--scratch", str(scratch)]),
+        prefix=VERIFY_ERROR,
+    )
     assert "'notes.txt', which the suite did not write" in line and mine.read_text() == "mine"
     # without it, the earlier re-run is replaced (the same tiny run: every column compared)
     mine.unlink()
     tiny = tiny_overrides("brown_table1")
     assert tiny[:4] == ["--set", "trials=40", "--set", "chunk=2"]
     argv = ["--results", str(results), "--scratch", str(scratch), "--trials", "40", *tiny[2:]]
-    assert "--trials: must be at least 400" in _one_line(capsys, argv, 2)  # too few
+    assert "--trials: must be at least 400" in one_line(
+        capsys, verify_main(argv), prefix=VERIFY_ERROR
+    )  # too few
     argv[argv.index("40")] = "400"
     argv[argv.index("chunk=2")] = "chunk=20"  # a key given twice by --set is refused
     assert verify_main([*argv, "--study", "brown_table1"]) == 0
