@@ -197,6 +197,7 @@ def _run(args) -> int:
         max_adjustments=args.max_adjustments,
         figures=not args.no_figures,
     )
+    args.published = shown  # an interrupt from now on finds the results written
     check_interrupt()  # dropped by Python since the results were published: not exit 0
     try:
         write_run_readme(out, get_study)
@@ -373,6 +374,8 @@ def _main(argv: list[str]) -> int:
         again = "; run the same command again to finish the missing chunks"
         why = " by the CPU time limit (ulimit -t)" if _cpu_limit else ""
         again = again if args and args.cmd == "run" else ""
+        if getattr(args, "published", None):  # nothing is missing: say where the results are
+            again = f" after the results were written to {args.published}/"
         print(f"sim: interrupted{why}{again}", file=sys.stderr)
         return 130
     except BrokenPipeError:

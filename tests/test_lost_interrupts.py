@@ -112,7 +112,9 @@ def test_an_interrupt_dropped_after_the_last_chunk_is_not_published(tmp_path, mo
 def test_an_interrupt_dropped_after_publishing_is_not_exit_0(tmp_path, monkeypatch, capsys):
     readme = cli.write_run_readme
     monkeypatch.setattr(cli, "write_run_readme", lambda *a: (_drop_an_interrupt(), readme(*a)))
-    _interrupted(capsys, main(["run", PLATE, "--out", str(tmp_path / "np"), *RUN]))
+    err = _interrupted(capsys, main(["run", PLATE, "--out", str(tmp_path / "np"), *RUN]))
+    assert err == f"sim: interrupted after the results were written to {tmp_path / 'np'}/", err
+    assert (tmp_path / "np" / "claims.parquet").is_file()  # published, complete
     monkeypatch.setattr(cli, "_check", lambda args: (_drop_an_interrupt(), 0)[1])
     _interrupted(capsys, main(["check", PLATE]))  # any command
 
