@@ -67,6 +67,7 @@ from scipy import special
 from scipy.spatial import cKDTree
 
 from sim.claims.declaration import FORMS, Input, Statement, load_declaration, parse_declaration
+from sim.lsq.sobol import sobol_base2
 
 __all__ = [
     "Input",
@@ -281,13 +282,8 @@ def explore(
     d = max(len(free), 1)
     m = int(math.ceil(math.log2(n)))
     u = np.full((2**m, len(inputs)), 0.5)
-    if free:
-        # scipy.stats costs about 0.5 s of CPU to import, in every process that imports the
-        # suite (a `sim check`, a pool worker); only an exploration needs it
-        from scipy.stats import qmc
-
-        sob = qmc.Sobol(d=len(free), scramble=True, seed=rng)
-        u[:, free] = sob.random_base2(m)
+    if free:  # scipy.stats.qmc.Sobol's points, without importing scipy.stats
+        u[:, free] = sobol_base2(len(free), m, rng)
     h0 = (2**m) ** (-1.0 / d)
     h = h0
     x = _scale(inputs, u)

@@ -371,17 +371,37 @@ def place_legend(ax, *args, **kw):
     right. Call it once the axes' data and limits are final."""
     if _SKIP.is_set():  # no figure will be saved: no layout pass to place it
         return ax.legend(*args, **kw)
-    fig = ax.figure
-    fig.draw_without_rendering()  # the layout and text extents, no pixels
-    renderer = fig.canvas.get_renderer()
+    ax.figure.draw_without_rendering()  # the layout and text extents, no pixels
+    return _place(ax, args, kw)[0]
+
+
+def place_legends(axes, **kw) -> None:
+    """:func:`place_legend` on each of ``axes`` (of one figure, every panel drawn): one layout
+    pass for them all (a pass per legend cost about a second each on a sweep's 12 panels), and
+    a new one after a legend placed outside its axes (that legend moves the panels)."""
+    laid_out = _SKIP.is_set()
+    for ax in axes:
+        if _SKIP.is_set():
+            ax.legend(**kw)
+            continue
+        if not laid_out:
+            ax.figure.draw_without_rendering()
+        laid_out = _place(ax, (), dict(kw))[1]
+
+
+def _place(ax, args, kw):
+    """The legend of ``ax`` at the first free place inside (``(legend, True)``) or outside on
+    the right (``(legend, False)``); the figure's layout is current."""
+    renderer = ax.figure.canvas.get_renderer()
     pts = data_points(ax)
     kw.setdefault("fontsize", 7)
     for loc in _INSIDE:
         leg = ax.legend(*args, loc=loc, **kw)
         box = leg.get_window_extent(renderer)
         if not points_inside(pts, box, shrink=-4.0):  # with 4 px to spare
-            return leg
-    return ax.legend(*args, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, **kw)
+            return leg, True
+    leg = ax.legend(*args, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, **kw)
+    return leg, False
 
 
 def readable_limits(ax, axis: str = "y", rel: float = 1e-3) -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.mc.storage import read_provenance
-from sim.report.plotting import figures_off, place_legend, plt, readable_limits, save
+from sim.report.plotting import figures_off, place_legends, plt, readable_limits, save
 from sim.report.read import columns
 from sim.report.tables import fmt, md_table
 
@@ -125,10 +125,10 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         ax.set_title(c, fontsize=8, wrap=True)
         ax.set_xlabel(xlabel, fontsize=8)
         ax.set_ylabel(_y_label(c, prop), fontsize=8)
-        if other[0]:
-            place_legend(ax)
     for ax in axs.ravel()[len(claims) :]:
         ax.axis("off")
+    if other[0]:  # once every panel is drawn: the layout is final
+        place_legends(axs.ravel()[: len(claims)])
     return save(fig, png)
 
 
