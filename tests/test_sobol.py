@@ -47,6 +47,20 @@ def test_the_direction_numbers_start_as_joe_and_kuo_print_them():
     assert list(m[1, :6]) == [1, 3, 5, 15, 17, 51]
 
 
+def test_without_the_direction_numbers_file_scipy_makes_the_points(monkeypatch, tmp_path):
+    """A SciPy that keeps its direction numbers elsewhere: the same points, from SciPy."""
+    from sim.lsq import sobol
+
+    monkeypatch.setattr(sobol, "_NUMBERS", tmp_path / "missing.npz")
+    sobol.direction_numbers.cache_clear()
+    try:
+        a = sobol_base2(4, 5, np.random.default_rng(9))
+    finally:
+        sobol.direction_numbers.cache_clear()
+    b = qmc.Sobol(d=4, scramble=True, rng=np.random.default_rng(9)).random_base2(5)
+    assert np.array_equal(a, b)
+
+
 def test_bad_sizes_are_refused():
     with pytest.raises(ValueError, match="d >= 1"):
         sobol_base2(0, 3, np.random.default_rng(0))

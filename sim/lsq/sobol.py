@@ -79,7 +79,13 @@ def sobol_base2(d: int, m: int, rng: np.random.Generator) -> np.ndarray:
     ``(2**m, d)`` array in [0, 1); the first point is the digital shift itself."""
     if not 1 <= d or not 0 <= m <= BITS:
         raise ValueError(f"sobol: need d >= 1 and 0 <= m <= {BITS} (got d={d}, m={m})")
-    v, shift = _scrambled(direction_numbers(d), rng.spawn(1)[0])
+    try:
+        v = direction_numbers(d)
+    except OSError:  # a SciPy that keeps its direction numbers elsewhere: its own generator
+        from scipy.stats import qmc
+
+        return qmc.Sobol(d=d, scramble=True, rng=rng).random_base2(m)
+    v, shift = _scrambled(v, rng.spawn(1)[0])
     i = np.arange(2**m, dtype=np.uint64)
     gray = i ^ (i >> np.uint64(1))  # point i XORs the numbers of the bits set in gray(i)
     q = np.broadcast_to(shift, (2**m, d)).copy()
