@@ -80,10 +80,11 @@ def merge_gama(cfg: dict) -> dict:
     }
     if rec["datum.points"] and not cfg["datum.points"]:
         out["datum.points"] = rec["datum.points"]
-    fixed = any(p.get("role") == "fixed" for p in rec["network.points"])
-    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and not fixed:
-        # a free network with adj="XY" points: gama-local adjusts it in the inner datum over
-        # them, as the suite's own export writes it (its round trip), so the study does too
+    if rec["datum.points"] and cfg["datum.kind"] == "fixed":
+        # adj="XY" points: gama-local removes the defect its fixed points leave (all of it in
+        # a free network, the rotation about one fixed point) over them, as the suite's own
+        # export of an inner datum writes it (its round trip), so the study does too; with
+        # fixed points that leave no defect the inner datum adds no constraint
         out["datum.kind"] = "inner"
     return out
 
