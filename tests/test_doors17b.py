@@ -22,6 +22,10 @@ each; each failed on the code before its fix. The harness that found them (about
   1e5) were estimated as the study's defaults and started; gridplate's, agnard's and wolf's
   regions are now counted (measured: a gridplate region point 0.85 ms plus 1.25 us a draw),
   and such runs are refused at once with the estimate;
+* ``sim show`` and ``sim report`` printed a claims table edited by hand to hold a verdict sim
+  never writes (one with a line break split every row of the table and of ``REPORT.md``), and
+  ``sim report`` on a table whose provenance names the study by a number said "study: unknown
+  study 5" naming no file (:func:`sim.report.read.claims_damage`).
 """
 
 from __future__ import annotations
@@ -29,11 +33,15 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
+from oneline import one_line
 
 from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.mc.estimate import ADJUSTMENT_S, CHUNK_UNITS, check_limits, estimate
+from sim.mc.storage import read_provenance
 from sim.studies import load_study
 from sim.studies.network.analysis import analyse
 from sim.studies.network.definition import build
@@ -111,3 +119,31 @@ def test_a_gridplate_region_counts_as_measured():
     big = estimate(load_study(path, ["region.points=4096", "region.rounds=0"])[1])
     seconds = (big.adjustments - base.adjustments) * ADJUSTMENT_S
     assert 8.8 / 3 < seconds < 8.8 * 3, seconds
+
+
+def test_a_claims_table_with_a_verdict_sim_never_writes_is_refused(tmp_path, capsys):
+    out = tmp_path / "R" / "tf"
+    study = str(ROOT / "studies" / "network_testfield.toml")
+    tiny = ["--trials", "40", "--chunk", "2", "--no-figures", "--quiet"]
+    assert main(["run", study, "--out", str(out), *tiny]) == 0, capsys.readouterr().err
+    f = out / "claims.parquet"
+    good = pq.read_table(f)
+    meta = good.schema.metadata
+    at = good.column_names.index("verdict")
+    bad = good.set_column(at, "verdict", pa.array(["maybe\nsecond line"] * good.num_rows))
+    pq.write_table(bad.replace_schema_metadata(meta), f)
+    capsys.readouterr()
+    one_line(capsys, main(["show", str(out)]), "claims.parquet", "'maybe\\nsecond line'")
+    one_line(capsys, main(["report", "--results", str(out.parent)]), "claims.parquet", "verdict")
+    assert not (out.parent / "REPORT.md").exists()
+    prov = {**read_provenance(f), "study": 5}  # a study named by a number: name the file
+    pq.write_table(good.replace_schema_metadata({**meta, b"sim.provenance": _json(prov)}), f)
+    one_line(capsys, main(["report", "--results", str(out.parent)]), "claims.parquet", "no study")
+    pq.write_table(good, f)  # the table as written reads again
+    assert main(["show", str(out)]) == 0 and main(["report", "--results", str(out.parent)]) == 0
+
+
+def _json(obj) -> bytes:
+    import json
+
+    return json.dumps(obj).encode()
