@@ -25,7 +25,10 @@ each; each failed on the code before its fix. The harness that found them (about
 * ``sim show`` and ``sim report`` printed a claims table edited by hand to hold a verdict sim
   never writes (one with a line break split every row of the table and of ``REPORT.md``), and
   ``sim report`` on a table whose provenance names the study by a number said "study: unknown
-  study 5" naming no file (:func:`sim.report.read.claims_damage`).
+  study 5" naming no file (:func:`sim.report.read.claims_damage`);
+* ``sim.load(f, **{"datum.kind": "fixed"}, datum__kind="inner")`` (one key in both of the
+  API's spellings) kept one value and dropped the other without a word, as ``--set`` twice
+  did before the eighth sweep (:func:`sim.api._keyed`).
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ import pyarrow.parquet as pq
 import pytest
 from oneline import one_line
 
+import sim
 from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.mc.estimate import ADJUSTMENT_S, CHUNK_UNITS, check_limits, estimate
@@ -147,3 +151,17 @@ def _json(obj) -> bytes:
     import json
 
     return json.dumps(obj).encode()
+
+
+def test_a_key_given_in_both_spellings_of_the_api_is_refused():
+    study = ROOT / "studies" / "network_testfield.toml"
+    both = {"datum.kind": "fixed", "datum__kind": "inner"}
+    for call in (
+        lambda: sim.load(study, **both),
+        lambda: sim.load(study, trials=40, chunk=2).replace(**both),
+    ):
+        with pytest.raises(sim.ConfigError, match="datum.kind: given twice"):
+            call()
+    # one spelling replaces an earlier override, as replace() is for
+    h = sim.load(study, trials=40, chunk=2, datum__kind="fixed").replace(**{"datum.kind": "inner"})
+    assert h.config["datum.kind"] == "inner"
