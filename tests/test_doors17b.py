@@ -7,8 +7,8 @@ each; each failed on the code before its fix. The harness that found them (about
 * the suite's own export of an inner datum with one fixed point (``adj="XY"`` beside
   ``fix="xy"``, as ``tests/data/gama/one_fixed.xml``, which gama-local adjusts with defect 1)
   read back was refused ("a rank defect of 1 ... that the datum does not cover"): the
-  ``adj="XY"`` points made the datum inner only in a file without a fixed point
-  (:func:`sim.studies.network.gama.merge_gama`);
+  ``adj="XY"`` points made the datum inner only in a file without a fixed point; now in a
+  file of fewer than two (:func:`sim.studies.network.gama.merge_gama`);
 * the work estimate was not honest at real size: a trial of a network on the sparse path
   counted one unit adjustment whatever its size (a 100 x 100 grid plate's trial costs 12 ms,
   237 units: 1e5 trials, 20 hours of CPU, were estimated at 5 minutes, never over the limit),
@@ -74,6 +74,13 @@ def test_an_exported_inner_datum_with_one_fixed_point_reads_back(tmp_path, capsy
     _, net0, an0 = _analysed(load_study(GAMA / "one_fixed.toml")[1])
     assert list(net.names) == list(net0.names)
     np.testing.assert_allclose(an.cov, an0.cov, rtol=1e-9, atol=1e-15)
+    # two fixed points leave no defect: an adj="XY" point beside them keeps the fixed datum
+    two = tmp_path / "two.xml"
+    text = (GAMA / "two_sets.xml").read_text()
+    assert text.count('adj="xy"') == 2
+    two.write_text(text.replace('adj="xy"', 'adj="XY"', 1))
+    study.write_text(study.read_text().replace(str(GAMA / "one_fixed.xml"), str(two)))
+    assert merge_gama(load_study(study)[1])["datum.kind"] == "fixed"
 
 
 def _plate(nx: int, trials: int, chunk: int) -> dict:
