@@ -28,7 +28,10 @@ each; each failed on the code before its fix. The harness that found them (about
   study 5" naming no file (:func:`sim.report.read.claims_damage`);
 * ``sim.load(f, **{"datum.kind": "fixed"}, datum__kind="inner")`` (one key in both of the
   API's spellings) kept one value and dropped the other without a word, as ``--set`` twice
-  did before the eighth sweep (:func:`sim.api._keyed`).
+  did before the eighth sweep (:func:`sim.api._keyed`);
+* ``sim report`` on a network's results whose ``summary.parquet`` was emptied by hand blamed
+  another file ("claims.parquet ... column 'verdict': IndexError"), and one with its row doubled
+  reported the first row as the run's (:func:`sim.studies.network.report.report`).
 """
 
 from __future__ import annotations
@@ -132,7 +135,7 @@ def test_a_gridplate_region_counts_as_measured():
     assert 8.8 / 3 < seconds < 8.8 * 3, seconds
 
 
-def test_a_claims_table_with_a_verdict_sim_never_writes_is_refused(tmp_path, capsys):
+def test_a_claims_or_summary_table_edited_by_hand_is_one_line_naming_it(tmp_path, capsys):
     out = tmp_path / "R" / "tf"
     study = str(ROOT / "studies" / "network_testfield.toml")
     tiny = ["--trials", "40", "--chunk", "2", "--no-figures", "--quiet"]
@@ -152,6 +155,13 @@ def test_a_claims_table_with_a_verdict_sim_never_writes_is_refused(tmp_path, cap
     one_line(capsys, main(["report", "--results", str(out.parent)]), "claims.parquet", "no study")
     pq.write_table(good, f)  # the table as written reads again
     assert main(["show", str(out)]) == 0 and main(["report", "--results", str(out.parent)]) == 0
+    # the summary table emptied or doubled: the line names it, not the table read before it
+    summary = out / "summary.parquet"
+    one = pq.read_table(summary)
+    for bad in (one.slice(0, 0), pa.concat_tables([one, one])):
+        pq.write_table(bad.replace_schema_metadata(one.schema.metadata), summary)
+        rows = f"has {bad.num_rows} rows, not one"
+        one_line(capsys, main(["report", "--results", str(out.parent)]), "summary.parquet", rows)
 
 
 def _json(obj) -> bytes:
