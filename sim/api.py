@@ -42,6 +42,19 @@ def _key(k: str) -> str:
     return k.replace("__", ".")
 
 
+def _keyed(overrides: dict) -> dict:
+    """``overrides`` by their dotted keys; a key given twice (``**{"datum.kind": ...}`` beside
+    ``datum__kind=...``) is refused, as ``--set`` twice is: one value would be dropped."""
+    out: dict = {}
+    seen: dict = {}
+    for k, v in overrides.items():
+        d = _key(k) if isinstance(k, str) else k
+        if d in out:
+            raise ConfigError(d, f"given twice ({seen[d]!r} and {k!r}): one value would be dropped")
+        out[d], seen[d] = v, k
+    return out
+
+
 @dataclass(frozen=True)
 class Results:
     """A finished run's directory; tables are read from its Parquet files."""
@@ -119,7 +132,7 @@ class StudyHandle:
     def replace(self, **overrides) -> "StudyHandle":
         """A new handle with more overrides."""
         _unchanged(self)
-        return load(self.path, **{**self.overrides, **{_key(k): v for k, v in overrides.items()}})
+        return load(self.path, **{**self.overrides, **_keyed(overrides)})
 
     def run(
         self,
@@ -277,7 +290,7 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     for k in overrides:
         if not _key(k).strip(".").strip() or not k.isprintable():
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
-    vals = {_key(k): _plain(v) for k, v in overrides.items()}
+    vals = {k: _plain(v) for k, v in _keyed(overrides).items()}
     sha = _sha256(study_file)
     study, cfg = _load_picking_chunk(study_file, vals)
     sweep = read_sweep(study_file, study.schema)

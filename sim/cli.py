@@ -40,7 +40,7 @@ from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
 from sim.report.markdown import write_report
-from sim.report.read import damaged_message
+from sim.report.read import claims_damage, damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.studies import get_study, load_study
@@ -248,6 +248,13 @@ def _check_claims(f: Path) -> None:
         raise ConfigError("DIR", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
     if "study" not in prov or not {"claim", "verdict"} <= set(names):
         raise ConfigError("DIR", f"{f} is not a claims table written by sim")
+    try:
+        verdicts = pq.read_table(f, columns=["verdict"]).column("verdict").to_pylist()
+    except (OSError, ValueError, pa.ArrowException) as e:
+        raise ConfigError("DIR", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+    damage = claims_damage(prov, verdicts)
+    if damage:
+        raise ConfigError("DIR", f"{f} is not a claims table written by sim: {damage}")
     run = (read_record(f.parent) or {}).get("config")
     owner = run.get("study") if isinstance(run, dict) else None
     if isinstance(owner, str) and prov["study"] != owner:  # another study's table, copied in

@@ -82,7 +82,7 @@ def test_a_huge_nearest_is_every_target_in_the_work_estimate_too(capsys):
     estimate multiplied by it and refused "9.06e+301 adjustments" naming no key."""
     gen = '[{kind="distance",from="*",to="*",nearest=1e300,sigma_mm=1.0}]'
     assert main(["check", str(FIELD), "--set", f"network.generate={gen}"]) == 0
-    assert "about 2e+03 adjustments" in capsys.readouterr().out
+    assert "about 4e+03 adjustments" in capsys.readouterr().out  # 2,000 trials, 20 chunks
 
 
 def _chunk_sums(rng, sig, trials=40, chunk=2):

@@ -58,9 +58,15 @@ __all__ = [
     "DEFAULT_MAX_ADJUSTMENTS",
     "ADJUSTMENT_S",
     "ANALYTIC_SHARE",
+    "CHUNK_UNITS",
     "design_grid_equivalents",
 ]
 
+#: unit adjustments a chunk costs besides its trials (its streams, tables and its file
+#: written and read back): 6 ms of CPU, measured on a 13-unknown network in chunks of 1
+#: against chunks of 100 (2,000 trials). 100,000 chunks of one trial are about ten minutes,
+#: which a count of trials alone took for five seconds
+CHUNK_UNITS = 100.0
 DEFAULT_MAX_MEMORY_GB = 8.0
 DEFAULT_MAX_ADJUSTMENTS = 5e8
 #: an analytic part (no progress bar, nothing to resume) may take at most this share of the
@@ -145,7 +151,13 @@ def _gridplate(c: Mapping) -> tuple:
     per = 3 + _n(c.get("analysis.ratios", [])) + _n(c.get("analysis.stated_sigmas_um", []))
     U = 2 * N + 3
     b = ch * (P * N * L * 2 + P * N * 2 * 4 * 3) * F8 * COPIES * 4
-    return T, T * per, U, b
+    # the region: region.points input vectors, each round up to 4x as many at its boundary;
+    # each vector draws region.draws calibrations (measured 0.85 ms + 1.25 us a draw) and
+    # counts the iterations of region.iter_calibrations calibrations (a row of each plate each)
+    pts = c.get("region.points", 0) * (1 + 4 * c.get("region.rounds", 0))
+    draw_s = 0.85e-3 + 1.25e-6 * c.get("region.draws", 0)
+    region = pts * (draw_s / ADJUSTMENT_S + c.get("region.iter_calibrations", 0) * 2 * P)
+    return T, T * per + region, U, b
 
 
 def _salsig(c: Mapping) -> tuple:
@@ -208,10 +220,13 @@ def _wolf(c: Mapping) -> tuple:
     trials = T + Tt * (_n(c.get("trade.spacings_mm", [])) + rd_cells + 1) + Tu
     # each adjustment fits the pooled sets' points (x and y) with U (or Ut) unknowns
     w, wt = _dense(2 * n * sets, U), _dense(2 * nt * nsets, Ut)
+    # the region: each input vector (region.points, a quarter more each round) is one cell
+    # of the unprinted inputs' experiment on unprinted.trials instruments
+    r_pts = c.get("region.points", 0) * (1 + c.get("region.rounds", 0) / 4)
     adj = (
         T * (sets + 2) * w
         + Tt * (deg_cells + rd_cells * (sets + 2) + ages) * wt
-        + Tu * u_cells * (sets + 2) * w
+        + Tu * (u_cells + r_pts) * (sets + 2) * w
     )
     b = (
         max(
@@ -250,11 +265,15 @@ def _agnard(c: Mapping) -> tuple:
     trials = T + tT * (dp + rc) + bT * len(sizes) + sT * s_cells
     snoop = 1 + c.get("snoop.max_reject", 0)
     w, wt = AGNARD_MODEL_UNITS * M, AGNARD_MODEL_UNITS * Mt  # unit adjustments a block solve
+    # the region: region.trials blocks adjusted once per layout of region.points, without
+    # and with the projection centres
+    rT, r_pts = c.get("region.trials", 0), c.get("region.points", 0)
     adj = (
         T * (3 + layouts) * snoop * w
         + tT * (2 * dp + rc) * snoop * w
         + bT * len(sizes) * 2 * wt
         + sT * s_cells * 3 * snoop * w
+        + rT * r_pts * 2 * snoop * w
     )
     # reduced normal equations of the models (7 x 7 blocks coupled through the points); the
     # block-size trade-off bounds its chunk by the pair blocks (4e6 floats)
@@ -293,9 +312,19 @@ def _one(cfg: Mapping) -> tuple:
     except (TypeError, ValueError, KeyError, OverflowError, ZeroDivisionError):
         t, a, u, b, *rest = _generic(cfg)
     fix = lambda x: x if isinstance(x, (int, float)) and not math.isnan(x) else math.inf  # noqa: E731
+    a = fix(a) + _chunk_units(cfg, fix(t))
     what = rest[0] if rest else ""
     eq, key, part = rest[1] if len(rest) > 1 else (0.0, "", "")
-    return fix(t), fix(a), fix(u), fix(b), what, (fix(eq), key, part)
+    return fix(t), a, fix(u), fix(b), what, (fix(eq), key, part)
+
+
+def _chunk_units(cfg: Mapping, trials: float) -> float:
+    """:data:`CHUNK_UNITS` for each chunk of the run's ``trials`` (every part's, in chunks of
+    the study's ``chunk``): the cost of a run of many small chunks."""
+    ch = cfg.get("chunk", 1)
+    if isinstance(ch, bool) or not isinstance(ch, (int, float)) or not ch >= 1:
+        return 0.0
+    return math.ceil(trials / ch) * CHUNK_UNITS if math.isfinite(trials) else math.inf
 
 
 def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> Estimate:

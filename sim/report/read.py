@@ -22,9 +22,22 @@ from typing import Any
 
 import pyarrow as pa
 
+from sim.claims.region import REGION_VERDICTS
+from sim.claims.rules import VERDICTS
 from sim.mc.storage import read_table
 
-__all__ = ["TableError", "columns", "records", "last_read", "forget", "damaged_message"]
+__all__ = [
+    "TableError",
+    "columns",
+    "records",
+    "last_read",
+    "forget",
+    "damaged_message",
+    "claims_damage",
+]
+
+#: every verdict a claims table of the suite holds
+KNOWN_VERDICTS = frozenset(VERDICTS) | frozenset(REGION_VERDICTS)
 
 _LAST = threading.local()  # the (file, column) last read by this thread's report
 
@@ -114,3 +127,15 @@ def damaged_message(root: Path, e: Exception) -> str:
     else:
         return f"a table under {root} is not as sim wrote it ({why}); run its study again"
     return f"{where} under {root} is not as sim wrote it ({why}); run its study again"
+
+
+def claims_damage(prov: dict, verdicts: list) -> str | None:
+    """What makes a claims table (its provenance, its ``verdict`` column) one the suite did not
+    write, or None: a study that is not a name, or a verdict outside the suite's vocabulary
+    (a table edited by hand: a made-up verdict, a line break that would split a row)."""
+    if not isinstance(prov.get("study"), str):
+        return f"its provenance names no study ({prov.get('study')!r:.40})"
+    for v in verdicts:
+        if v not in KNOWN_VERDICTS:
+            return f"it holds the verdict {v!r:.40}, which sim never writes"
+    return None

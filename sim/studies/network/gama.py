@@ -80,10 +80,12 @@ def merge_gama(cfg: dict) -> dict:
     }
     if rec["datum.points"] and not cfg["datum.points"]:
         out["datum.points"] = rec["datum.points"]
-    fixed = any(p.get("role") == "fixed" for p in rec["network.points"])
-    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and not fixed:
-        # a free network with adj="XY" points: gama-local adjusts it in the inner datum over
-        # them, as the suite's own export writes it (its round trip), so the study does too
+    fixed = sum(p.get("role") == "fixed" for p in rec["network.points"])
+    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and fixed < 2:
+        # adj="XY" points: gama-local removes the defect its fixed points leave over them (all
+        # of it in a free network, the rotation about a single fixed point), as the suite's
+        # own export of an inner datum writes it (its round trip), so the study does too; two
+        # fixed points or more leave no defect, and the datum stays fixed
         out["datum.kind"] = "inner"
     return out
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sim.report.read import TableError
 from sim.report.section import section, table
 from sim.report.tables import fmt, md_table
 
@@ -158,6 +159,9 @@ def report(out: Path) -> str:
     other parameters, datums, figures."""
     out = Path(out)
     s = table(out, "summary.parquet")
+    rows = {len(v) for v in s.values()}
+    if rows != {1}:  # emptied or doubled by hand: its row would be another's, or an IndexError
+        raise TableError(out / "summary.parquet", f"has {min(rows, default=0)} rows, not one")
     s = {k: v[0] for k, v in s.items()}
     p, o = table(out, "points.parquet"), table(out, "observations.parquet")
     return section(
