@@ -1,0 +1,106 @@
+"""The classes of the sweep doors17a (issue 26: the process environment, streams and
+invocation contexts a user's shell or notebook brings), one case each; each failed on the
+code before its fix.
+
+* a run of the Python API in a user's process took matplotlib over: ``matplotlib.use("Agg")``
+  switched the caller's pyplot backend (closing every figure the caller had open) and the
+  suite's style stayed in the caller's ``rcParams`` (a notebook's next plot in 9 pt with a
+  grid); the suite now draws on Agg canvases of its own without pyplot, and
+  :func:`sim.report.mpl.kept` puts the caller's ``rcParams`` back (the PNGs are the same);
+* a network whose point names are not ASCII, run under a locale that is not UTF-8 (``LC_ALL=C``
+  with ``PYTHONUTF8=0``, or a Latin-1 locale), computed every trial and then failed writing
+  ``network.xml`` (UnicodeEncodeError; under Latin-1 it would write an XML file in Latin-1
+  without saying so): the file is written in UTF-8 (:func:`sim.studies.network.gama.write_gama`),
+  as is every text file the suite writes;
+* ``python -m sim.batch`` and ``make verify`` read their child runs' output in the locale's
+  encoding, not the one the child writes in (``PYTHONIOENCODING=utf-16``: every character of a
+  run's error line came out with NULs between): :func:`sim.mc.children.child_text`;
+* 50,000 options (``--set`` or ``--study``) kept ``sim``, ``python -m sim.batch`` and ``make
+  verify`` busy for minutes (argparse's time grows with their square) before "unknown key":
+  at most :data:`sim.mc.argv.MAX_OPTIONS` are read (:class:`sim.mc.argv.BoundedParser`).
+"""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from oneline import one_line, python_lines
+
+import sim.batch
+from sim.cli import main
+from sim.mc.argv import MAX_OPTIONS
+from sim.report.verify import main as verify_main
+
+ROOT = Path(__file__).resolve().parent.parent
+STUDY = ROOT / "studies" / "network_plate.toml"
+SMALL = ["--trials", "40", "--chunk", "2"]
+
+
+def test_an_api_run_leaves_the_callers_matplotlib_alone(tmp_path):
+    p = python_lines(
+        "import matplotlib",
+        "matplotlib.use('svg')",
+        "import matplotlib.pyplot as plt",
+        "plt.rcParams['font.size'] = 14.0",
+        "mine = plt.figure()",
+        "import sim",
+        f"sim.load({str(STUDY)!r}, trials=40, chunk=2).run(out={str(tmp_path / 'api')!r})",
+        "print(matplotlib.get_backend(), plt.get_fignums(), plt.rcParams['font.size'],",
+        "      plt.rcParams['axes.grid'])",
+    )
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.split() == ["svg", "[1]", "14.0", "False"], p.stdout
+    cli = subprocess.run(
+        [sys.executable, "-m", "sim", "run", str(STUDY), *SMALL, "--out", str(tmp_path / "cli")],
+        capture_output=True,
+        text=True,
+    )
+    assert cli.returncode == 0, cli.stderr
+    for png in ("network.png", "reliability.png"):  # drawn as sim run draws them
+        assert (tmp_path / "api" / png).read_bytes() == (tmp_path / "cli" / png).read_bytes()
+
+
+def test_a_network_of_non_ascii_names_runs_in_a_locale_that_is_not_utf8(tmp_path):
+    text = STUDY.read_text(encoding="utf-8").replace('"G', '"É')
+    assert "É13" in text
+    study = tmp_path / "names.toml"
+    study.write_text(text, encoding="utf-8")
+    env = {**os.environ, "LC_ALL": "C", "PYTHONUTF8": "0", "PYTHONCOERCECLOCALE": "0"}
+    out = tmp_path / "o"
+    p = subprocess.run(
+        [sys.executable, "-m", "sim", "run", str(study), *SMALL, "--no-figures", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        env=env,
+    )
+    assert p.returncode == 0, p.stderr
+    assert '<point id="É1"' in (out / "network.xml").read_bytes().decode("utf-8")
+
+
+def test_batch_reads_its_runs_lines_in_the_encoding_they_are_written_in(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(STUDY.read_text(encoding="utf-8") + "nosuch = 1\n", encoding="utf-8")
+    p = subprocess.run(
+        [sys.executable, "-m", "sim.batch", str(bad), "--", *SMALL],
+        capture_output=True,
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONIOENCODING": "utf-16"},
+    )
+    err = p.stderr.decode("utf-16").strip()
+    assert p.returncode == 2 and "\n" not in err and "\x00" not in err, (p.returncode, err)
+    assert err.startswith("bad.toml") and "nosuch: unknown key" in err, err
+
+
+def test_too_many_options_are_refused_before_argparse_reads_them(capsys):
+    def sets(n):
+        return [x for i in range(n) for x in ("--set", f"a{i}=1")]
+
+    one_line(
+        capsys, main(["check", str(STUDY), *sets(MAX_OPTIONS + 1)]), f"at most {MAX_OPTIONS:,}"
+    )
+    one_line(capsys, sim.batch.main([str(STUDY), "--", *sets(MAX_OPTIONS + 1)]), f"{MAX_OPTIONS:,}")
+    studies = [x for i in range(MAX_OPTIONS + 1) for x in ("--study", f"a{i}")]
+    one_line(capsys, verify_main(studies), f"at most {MAX_OPTIONS:,}")
+    # at the bound, the options are read (and the first unknown key named)
+    one_line(capsys, main(["check", str(STUDY), *sets(MAX_OPTIONS)]), "a0: unknown key")
