@@ -25,6 +25,7 @@ import os
 import re
 import signal
 import sys
+import threading
 from pathlib import Path
 
 import pyarrow as pa
@@ -330,7 +331,10 @@ def _on_sigterm(signum, frame):
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    old = {s: signal.getsignal(s) for s in _STOPS}
+    # signal handlers are the main thread's to set: main() called from another thread (a
+    # notebook's worker, a test runner) ended in "ValueError: signal only works in main thread"
+    mine = threading.current_thread() is threading.main_thread()
+    old = {s: signal.getsignal(s) for s in _STOPS} if mine else {}
     _cpu_limit.clear()
     try:
         if not argv:  # usage, not an error message
@@ -357,9 +361,9 @@ def _main(argv: list[str]) -> int:
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
-        for s in _STOPS:  # clean up like Ctrl-C (nohup: ignored): a
-            if signal.getsignal(s) is signal.SIG_DFL:  # run's stage, report's temporary files
-                signal.signal(s, _on_sigterm)
+        for s in _STOPS if threading.current_thread() is threading.main_thread() else ():
+            if signal.getsignal(s) is signal.SIG_DFL:  # clean up like Ctrl-C (nohup: ignored):
+                signal.signal(s, _on_sigterm)  # a run's stage, report's temporary files
         if args.cmd == "run":
             return _run(args)
         if args.cmd == "check":

@@ -23,6 +23,7 @@ code before its fix.
 import os
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 from oneline import one_line, python_lines
@@ -104,3 +105,20 @@ def test_too_many_options_are_refused_before_argparse_reads_them(capsys):
     one_line(capsys, verify_main(studies), f"at most {MAX_OPTIONS:,}")
     # at the bound, the options are read (and the first unknown key named)
     one_line(capsys, main(["check", str(STUDY), *sets(MAX_OPTIONS)]), "a0: unknown key")
+
+
+def test_the_command_line_runs_in_a_thread_that_is_not_the_main_one(capsys):
+    # main() from a notebook's or a test runner's thread: "sim: error: ValueError: signal
+    # only works in main thread", and the same ValueError again from restoring the handlers
+    done = {}
+
+    def check():
+        try:
+            done["rc"] = main(["check", str(STUDY)])
+        except BaseException as e:  # noqa: BLE001 - what the thread met is the finding
+            done["rc"] = repr(e)
+
+    t = threading.Thread(target=check)
+    t.start()
+    t.join()
+    assert done["rc"] == 0, (done, capsys.readouterr().err)
