@@ -47,12 +47,17 @@ def interrupt_while_loading(prog: str):
     itself; a signal the caller ignores (SIGINT of a background job, SIGHUP under nohup)
     stays ignored. Until then a library that cannot be loaded for want of memory
     (``ulimit -v``) ends the command with one line "not enough memory ..." and exit 2, not a
-    traceback (or a crash while Python shuts down)."""
+    traceback (or a crash while Python shuts down); a library that is missing, or shadowed by
+    a file of its name on the path, is one line naming it (:func:`import_words`), exit 2."""
     hook = sys.excepthook
 
     def short(kind, e, tb):  # ulimit -v: a library that cannot be mapped, not a traceback
         if not short_of_memory(e):
-            return hook(kind, e, tb)
+            words = import_words(e)
+            if words is None:
+                return hook(kind, e, tb)
+            os.write(2, f"{prog}: error: {words}\n".encode(errors="replace"))
+            os._exit(2)
         os.write(2, f"{prog}: error: {memory_words(e)}\n".encode())
         os._exit(2)  # not Python's finalisation: short of memory, it may crash (SIGSEGV)
 
@@ -76,6 +81,29 @@ def interrupt_while_loading(prog: str):
             signal.signal(s, default)
 
     return restore
+
+
+def import_words(e: BaseException | None) -> str | None:
+    """The one line for a library the suite cannot import while an entry point loads, or None
+    if ``e`` is no ImportError: a file of the library's name ahead of it on the path (an empty
+    ``tqdm.py`` or ``pyarrow.py`` in ``PYTHONPATH`` or the working directory) is named as the
+    cause; a library missing altogether (the suite run by a Python it was not installed
+    into) says so. Both ended in a traceback."""
+    if not isinstance(e, ImportError) or interrupted(e):  # Ctrl-C inside an import
+        return None
+    name = (e.name or "").split(".")[0]
+    module = sys.modules.get(name)
+    where = getattr(module, "__file__", None) or getattr(e, "path", None)
+    first = (str(e).splitlines() or [type(e).__name__])[0][:300]
+    if where and not str(where).startswith((sys.prefix, sys.base_prefix)) and name != "sim":
+        return (
+            f"cannot load {name}: {first}; {where} shadows the library of that name "
+            "(PYTHONPATH or the working directory): rename it or leave that directory"
+        )
+    return (
+        f"cannot load {name or 'a library'}: {first}; run the suite with the Python it was "
+        f"installed into (make venv; .venv/bin/sim), not {sys.executable}"
+    )
 
 
 #: what the loader and llvmlite say of a library they cannot map into memory (ulimit -v)

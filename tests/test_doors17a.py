@@ -122,3 +122,25 @@ def test_the_command_line_runs_in_a_thread_that_is_not_the_main_one(capsys):
     t.start()
     t.join()
     assert done["rc"] == 0, (done, capsys.readouterr().err)
+
+
+def test_a_library_shadowed_or_missing_at_load_is_one_line(tmp_path):
+    # an empty tqdm.py on PYTHONPATH (or in the working directory): a traceback ending in
+    # "cannot import name 'tqdm' from 'tqdm' (.../tqdm.py)"
+    (tmp_path / "tqdm.py").write_text("", encoding="utf-8")
+    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    for args in (["-m", "sim", "check", str(STUDY)], ["-m", "sim.batch", str(STUDY)]):
+        p = subprocess.run([sys.executable, *args], capture_output=True, text=True, env=env)
+        err = p.stderr.strip()
+        assert p.returncode == 2 and "\n" not in err and "Traceback" not in err, (args, err)
+        assert f"{tmp_path / 'tqdm.py'} shadows the library" in err, err
+    # a Python the suite is not installed into: "No module named ..." named in one line
+    p = python_lines(
+        "import sys",
+        "from sim.threads import import_words",
+        "print(import_words(ModuleNotFoundError(\"No module named 'pyarrow'\", name='pyarrow')))",
+        "print(import_words(ValueError('x')))",
+    )
+    lines = p.stdout.splitlines()
+    assert lines[0].startswith("cannot load pyarrow: No module named 'pyarrow'; run the suite")
+    assert lines[1] == "None"
