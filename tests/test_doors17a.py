@@ -17,7 +17,16 @@ code before its fix.
   run's error line came out with NULs between): :func:`sim.mc.children.child_text`;
 * 50,000 options (``--set`` or ``--study``) kept ``sim``, ``python -m sim.batch`` and ``make
   verify`` busy for minutes (argparse's time grows with their square) before "unknown key":
-  at most :data:`sim.mc.argv.MAX_OPTIONS` are read (:class:`sim.mc.argv.BoundedParser`).
+  at most :data:`sim.mc.argv.MAX_OPTIONS` are read (:class:`sim.mc.argv.BoundedParser`);
+* ``sim.cli.main`` called from a thread that is not the main one (a notebook's worker) ended
+  in "ValueError: signal only works in main thread": it sets signal handlers in the main
+  thread only;
+* a library missing (``python3 -m sim`` with a Python the suite is not installed into) or
+  shadowed (an empty ``tqdm.py`` or ``pyarrow.py`` on ``PYTHONPATH`` or in the working
+  directory) while an entry point loads ended in a traceback: one line naming the file that
+  shadows it, or the Python (:func:`sim.threads.import_words`);
+* a ``--set`` value the locale could not decode (``LC_ALL=C`` without UTF-8 mode, or Latin-1
+  bytes) was refused as "must be printable on one line"; now as bytes that are not UTF-8.
 """
 
 import os
@@ -26,11 +35,13 @@ import sys
 import threading
 from pathlib import Path
 
+import pytest
 from oneline import one_line, python_lines
 
 import sim.batch
 from sim.cli import main
 from sim.mc.argv import MAX_OPTIONS
+from sim.mc.config import ConfigError, parse_override
 from sim.report.verify import main as verify_main
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -144,3 +155,11 @@ def test_a_library_shadowed_or_missing_at_load_is_one_line(tmp_path):
     lines = p.stdout.splitlines()
     assert lines[0].startswith("cannot load pyarrow: No module named 'pyarrow'; run the suite")
     assert lines[1] == "None"
+
+
+def test_a_set_value_the_locale_could_not_decode_is_named_as_such():
+    # LC_ALL=C without UTF-8 mode: --set network.name="café" reached the schema as
+    # 'caf\udcc3\udca9' and was refused as "must be printable on one line"
+    with pytest.raises(ConfigError, match="network.name: --set holds bytes that are not UTF-8"):
+        parse_override('network.name="caf\udcc3\udca9"')
+    assert parse_override('network.name="café"') == ("network.name", "café")
