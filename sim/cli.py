@@ -361,6 +361,8 @@ def _main(argv: list[str]) -> int:
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
+        if args.cmd in ("check", "show") and sys.stdout is None:  # >&-: print() wrote nowhere
+            raise ConfigError(None, "standard output is closed (>&-): nothing to print to")
         for s in _STOPS if threading.current_thread() is threading.main_thread() else ():
             if signal.getsignal(s) is signal.SIG_DFL:  # clean up like Ctrl-C (nohup: ignored):
                 signal.signal(s, _on_sigterm)  # a run's stage, report's temporary files

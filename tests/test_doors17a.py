@@ -163,3 +163,18 @@ def test_a_set_value_the_locale_could_not_decode_is_named_as_such():
     with pytest.raises(ConfigError, match="network.name: --set holds bytes that are not UTF-8"):
         parse_override('network.name="caf\udcc3\udca9"')
     assert parse_override('network.name="café"') == ("network.name", "café")
+
+
+def test_check_and_show_with_standard_output_closed_say_so():
+    # sim check STUDY >&- printed nowhere and exited 0: what was asked for went nowhere
+    for args in (["check", str(STUDY)], ["show", str(ROOT / "results" / "network_plate")]):
+        p = subprocess.run(
+            [sys.executable, "-m", "sim", *args],
+            stderr=subprocess.PIPE,
+            text=True,
+            preexec_fn=lambda: os.close(1),  # noqa: PLW1509 - the shell's >&-
+        )
+        err = p.stderr.strip()
+        assert p.returncode == 2 and err == (
+            "sim: error: standard output is closed (>&-): nothing to print to"
+        ), (args, p.returncode, err)
