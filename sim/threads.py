@@ -10,6 +10,7 @@ import resource
 import signal
 import sys
 import threading
+import time
 
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 #: the signals an entry point takes over while it loads, with their default handlers
@@ -162,14 +163,32 @@ def refuse_bad_environment(prog: str) -> None:
     traceback from ``numpy.f2py``, imported by ``scipy.sparse``). Called by the entry points
     before anything imports NumPy."""
     _refuse_small_address_space(prog)
+    _refuse_bad_tqdm_variables(prog)
     v = os.environ.get("SOURCE_DATE_EPOCH")
     if v is None:
         return
     try:
-        int(v)  # as numpy.f2py reads it
-    except ValueError:
+        time.gmtime(int(v))  # as numpy.f2py reads it (99999999999999999999: OverflowError)
+    except (ValueError, OverflowError, OSError):
         sys.stderr.write(
             f"{prog}: error: SOURCE_DATE_EPOCH: must be an integer, seconds since 1970 "
-            f"(got {v!r}); NumPy reads it while loading\n"
+            f"within the system's dates (got {v[:40]!r}); NumPy reads it while loading\n"
+        )
+        sys.exit(2)
+
+
+def _refuse_bad_tqdm_variables(prog: str) -> None:
+    """tqdm (the progress bar) reads ``TQDM_<option>`` variables while it is imported and
+    converts each to its option's type: ``TQDM_NCOLS=abc`` ended every command in a
+    traceback from ``tqdm.utils``. Imported here only when such a variable is set."""
+    given = sorted(k for k in os.environ if k.upper().startswith("TQDM_"))
+    if not given:
+        return
+    try:
+        import tqdm  # noqa: F401 - its import reads the variables
+    except (ValueError, TypeError) as e:
+        sys.stderr.write(
+            f"{prog}: error: {', '.join(given)}: tqdm cannot read "
+            f"{'it' if len(given) == 1 else 'them'} ({str(e).splitlines()[0][:200]})\n"
         )
         sys.exit(2)

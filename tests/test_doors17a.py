@@ -26,7 +26,12 @@ code before its fix.
   directory) while an entry point loads ended in a traceback: one line naming the file that
   shadows it, or the Python (:func:`sim.threads.import_words`);
 * a ``--set`` value the locale could not decode (``LC_ALL=C`` without UTF-8 mode, or Latin-1
-  bytes) was refused as "must be printable on one line"; now as bytes that are not UTF-8.
+  bytes) was refused as "must be printable on one line"; now as bytes that are not UTF-8;
+* ``sim check`` or ``sim show`` with standard output closed (``>&-``) printed nowhere and
+  exited 0;
+* ``TQDM_NCOLS=abc`` (any ``TQDM_`` variable tqdm cannot convert) and a ``SOURCE_DATE_EPOCH``
+  beyond the system's dates ended every entry point in a traceback while loading
+  (:func:`sim.threads.refuse_bad_environment`).
 """
 
 import os
@@ -178,3 +183,21 @@ def test_check_and_show_with_standard_output_closed_say_so():
         assert p.returncode == 2 and err == (
             "sim: error: standard output is closed (>&-): nothing to print to"
         ), (args, p.returncode, err)
+
+
+def test_variables_a_library_reads_while_loading_are_one_line():
+    # TQDM_NCOLS=abc: a traceback from tqdm.utils at import; SOURCE_DATE_EPOCH beyond the
+    # system's dates: "OverflowError: timestamp out of range" from numpy.f2py
+    cases = [
+        ({"TQDM_NCOLS": "abc"}, "sim: error: TQDM_NCOLS: tqdm cannot read it"),
+        ({"SOURCE_DATE_EPOCH": "9" * 20}, "sim: error: SOURCE_DATE_EPOCH: must be an integer"),
+    ]
+    for env, start in cases:
+        p = subprocess.run(
+            [sys.executable, "-m", "sim", "check", str(STUDY)],
+            capture_output=True,
+            text=True,
+            env={**os.environ, **env},
+        )
+        err = p.stderr.strip()
+        assert p.returncode == 2 and "\n" not in err and err.startswith(start), (env, err)
