@@ -31,7 +31,10 @@ code before its fix.
   exited 0;
 * ``TQDM_NCOLS=abc`` (any ``TQDM_`` variable tqdm cannot convert) and a ``SOURCE_DATE_EPOCH``
   beyond the system's dates ended every entry point in a traceback while loading
-  (:func:`sim.threads.refuse_bad_environment`).
+  (:func:`sim.threads.refuse_bad_environment`);
+* ``run(workers=2)`` of the Python API inside a worker of the caller's ``multiprocessing.Pool``
+  (a daemonic process) ended in multiprocessing's bare AssertionError: one line saying to use
+  one worker (:func:`sim.mc.executors._may_start_processes`).
 """
 
 import os
@@ -201,3 +204,24 @@ def test_variables_a_library_reads_while_loading_are_one_line():
         )
         err = p.stderr.strip()
         assert p.returncode == 2 and "\n" not in err and err.startswith(start), (env, err)
+
+
+def test_workers_from_a_daemonic_process_are_one_line_and_nothing_written(tmp_path):
+    # run(workers=2) inside a worker of the caller's multiprocessing.Pool: multiprocessing's
+    # bare "AssertionError: daemonic processes are not allowed to have children"
+    out = tmp_path / "o"
+    p = python_lines(
+        "from multiprocessing import get_context",
+        "import sim",
+        "def f(_):",
+        "    try:",
+        f"        sim.load({str(STUDY)!r}, trials=40, chunk=2).run(out={str(out)!r}, workers=2)",
+        "    except sim.ConfigError as e:",
+        "        return str(e)",
+        "if __name__ == '__main__':",
+        "    with get_context('fork').Pool(1) as pool:",
+        "        print(pool.map(f, [0])[0])",
+    )
+    assert p.returncode == 0, p.stderr
+    assert "from a daemonic process" in p.stdout and "use 1 worker" in p.stdout, p.stdout
+    assert list(tmp_path.iterdir()) == []

@@ -84,6 +84,17 @@ def _ready() -> int:
     return os.getpid()
 
 
+def _may_start_processes(what: str) -> None:
+    """Refuse (one line) to start worker processes from a daemonic process (a worker of the
+    caller's ``multiprocessing.Pool``), which multiprocessing forbids: ``run(workers=2)`` there
+    ended in its bare "AssertionError: daemonic processes are not allowed to have children"."""
+    if multiprocessing.current_process().daemon:
+        raise RuntimeError(
+            f"{what} from a daemonic process (a worker of a multiprocessing Pool), which may "
+            "start no processes: use 1 worker here (the results are the same)"
+        )
+
+
 class _Pool:
     """A local process pool (``concurrent.futures``); its workers die with the parent. They
     are all started here, while the caller is the only thread that needs to exist (see
@@ -91,6 +102,7 @@ class _Pool:
     own (the parts of ``brown_design``, figures drawn in this process)."""
 
     def __init__(self, workers: int):
+        _may_start_processes(f"{workers} worker processes")
         method = _start_method()
         self.pool = ProcessPoolExecutor(
             max_workers=workers,
@@ -148,6 +160,7 @@ class _Dask:
         if scheduler:
             self.client = Client(scheduler, timeout="10s")
         else:
+            _may_start_processes("a LocalCluster")
             _enough_files(workers)
             try:
                 self.cluster = LocalCluster(
