@@ -44,7 +44,7 @@ from sim.report.markdown import write_report
 from sim.report.read import damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.studies import get_study, load_study
-from sim.threads import interrupted, memory_words, short_of_memory
+from sim.threads import interrupted, memory_words, shadowed, short_of_memory
 
 __all__ = ["main", "check_run_args"]
 
@@ -424,6 +424,9 @@ def _main(argv: list[str]) -> int:
             return 130
         if short_of_memory(e):  # an ImportError: a library that could not be mapped
             print(f"sim: error: {memory_words(e)}", file=sys.stderr)
+            return 2
+        if (words := shadowed(e)) is not None:  # a user's tomllib.py: not a bug of ours
+            print(f"sim: error: {words}", file=sys.stderr)
             return 2
         if os.environ.get("SIM_DEBUG"):  # one line as docs/cli.md promises, the traceback on
             raise  # request

@@ -6,11 +6,13 @@ before anything imports NumPy; the environment of the caller wins.
 """
 
 import os
+import re
 import resource
 import signal
 import sys
 import threading
 import time
+import types
 
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 #: the signals an entry point takes over while it loads, with their default handlers
@@ -86,25 +88,57 @@ def interrupt_while_loading(prog: str):
 
 def import_words(e: BaseException | None) -> str | None:
     """The one line for a library the suite cannot import while an entry point loads, or None
-    if ``e`` is no ImportError: a file of the library's name ahead of it on the path (an empty
-    ``tqdm.py`` or ``pyarrow.py`` in ``PYTHONPATH`` or the working directory) is named as the
-    cause; a library missing altogether (the suite run by a Python it was not installed
-    into) says so. Both ended in a traceback."""
-    if not isinstance(e, ImportError) or interrupted(e):  # Ctrl-C inside an import
+    if ``e`` is neither an ImportError nor a shadowed module (:func:`shadowed`): a file of the
+    library's name ahead of it on the path (an empty ``tqdm.py`` or ``numpy.py`` in
+    ``PYTHONPATH`` or the working directory) is named as the cause; a library missing
+    altogether (the suite run by a Python it was not installed into) says so. Both ended in a
+    traceback."""
+    if e is None or interrupted(e):  # Ctrl-C inside an import
+        return None
+    first = (str(e).splitlines() or [type(e).__name__])[0][:300]
+    words = shadowed(e)
+    if words is not None:
+        return f"cannot load the suite: {first}; {words}"
+    if not isinstance(e, ImportError):
         return None
     name = (e.name or "").split(".")[0]
-    module = sys.modules.get(name)
-    where = getattr(module, "__file__", None) or getattr(e, "path", None)
-    first = (str(e).splitlines() or [type(e).__name__])[0][:300]
-    if where and not str(where).startswith((sys.prefix, sys.base_prefix)) and name != "sim":
-        return (
-            f"cannot load {name}: {first}; {where} shadows the library of that name "
-            "(PYTHONPATH or the working directory): rename it or leave that directory"
-        )
     return (
         f"cannot load {name or 'a library'}: {first}; run the suite with the Python it was "
         f"installed into (make venv; .venv/bin/sim), not {sys.executable}"
     )
+
+
+def _installed(path: str) -> bool:
+    """Whether ``path`` is part of this Python's installation or of the suite itself."""
+    suite = os.path.dirname(os.path.abspath(__file__))
+    return path.startswith((sys.prefix, sys.base_prefix, suite + os.sep))
+
+
+def shadowed(e: BaseException | None) -> str | None:
+    """Words naming a file of the user's that shadows a library (``tomllib.py``,
+    ``matplotlib.py``, an empty ``numba/`` directory on ``PYTHONPATH`` or in the working
+    directory), if ``e`` (or an exception it came from) is an ImportError of that library or
+    an AttributeError read from that module; else None. Such a file ended a command in an
+    "internal error" (exit 3) or a traceback, wherever the library was first used."""
+    seen = set()
+    while e is not None and id(e) not in seen:
+        seen.add(id(e))
+        module = getattr(e, "obj", None) if isinstance(e, AttributeError) else None
+        said = re.match(r"module '([\w.]+)' has no attribute", str(e))  # from C (pyarrow)
+        if module is None and isinstance(e, AttributeError) and said:
+            module = sys.modules.get(said.group(1))
+        if isinstance(e, ImportError):
+            module = sys.modules.get((e.name or "").split(".")[0])
+        if isinstance(module, types.ModuleType):
+            where = getattr(module, "__file__", None)
+            where = where or next(iter(getattr(module, "__path__", None) or ()), None)
+            if where and not _installed(str(where)):
+                return (
+                    f"{where} shadows the library {module.__name__} (PYTHONPATH or the working "
+                    "directory): rename it or leave that directory"
+                )
+        e = e.__cause__ or e.__context__
+    return None
 
 
 #: what the loader and llvmlite say of a library they cannot map into memory (ulimit -v)

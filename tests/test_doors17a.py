@@ -22,9 +22,11 @@ code before its fix.
   in "ValueError: signal only works in main thread": it sets signal handlers in the main
   thread only;
 * a library missing (``python3 -m sim`` with a Python the suite is not installed into) or
-  shadowed (an empty ``tqdm.py`` or ``pyarrow.py`` on ``PYTHONPATH`` or in the working
-  directory) while an entry point loads ended in a traceback: one line naming the file that
-  shadows it, or the Python (:func:`sim.threads.import_words`);
+  shadowed (an empty ``tqdm.py``, ``numpy.py`` or ``pyarrow.py`` on ``PYTHONPATH`` or in the
+  working directory) while an entry point loads ended in a traceback, and one first used later
+  (``tomllib.py`` in ``sim check``, ``matplotlib.py`` after every trial) in an "internal
+  error", exit 3: one line naming the file that shadows it, or the Python, exit 2
+  (:func:`sim.threads.import_words`, :func:`sim.threads.shadowed`);
 * a ``--set`` value the locale could not decode (``LC_ALL=C`` without UTF-8 mode, or Latin-1
   bytes) was refused as "must be printable on one line"; now as bytes that are not UTF-8;
 * ``sim check`` or ``sim show`` with standard output closed (``>&-``) printed nowhere and
@@ -143,16 +145,27 @@ def test_the_command_line_runs_in_a_thread_that_is_not_the_main_one(capsys):
     assert done["rc"] == 0, (done, capsys.readouterr().err)
 
 
-def test_a_library_shadowed_or_missing_at_load_is_one_line(tmp_path):
-    # an empty tqdm.py on PYTHONPATH (or in the working directory): a traceback ending in
-    # "cannot import name 'tqdm' from 'tqdm' (.../tqdm.py)"
-    (tmp_path / "tqdm.py").write_text("", encoding="utf-8")
-    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
-    for args in (["-m", "sim", "check", str(STUDY)], ["-m", "sim.batch", str(STUDY)]):
+def test_a_library_shadowed_or_missing_is_one_line(tmp_path):
+    # a file of a library's name on PYTHONPATH (or in the working directory): a traceback at
+    # load (tqdm.py: "cannot import name 'tqdm'"; numpy.py: pyarrow's AttributeError), an
+    # "internal error" exit 3 in sim check (tomllib.py) or after every trial (matplotlib.py)
+    out = str(tmp_path / "o")
+    cases = [
+        ("tqdm", ["-m", "sim", "check", str(STUDY)]),
+        ("tqdm", ["-m", "sim.batch", str(STUDY)]),
+        ("numpy", ["-m", "sim", "check", str(STUDY)]),
+        ("tomllib", ["-m", "sim", "check", str(STUDY)]),
+        ("matplotlib", ["-m", "sim", "run", str(STUDY), *SMALL, "--quiet", "--out", out]),
+    ]
+    for name, args in cases:
+        shadow = tmp_path / name
+        shadow.mkdir(exist_ok=True)
+        (shadow / f"{name}.py").write_text("", encoding="utf-8")
+        env = {**os.environ, "PYTHONPATH": str(shadow)}
         p = subprocess.run([sys.executable, *args], capture_output=True, text=True, env=env)
         err = p.stderr.strip()
         assert p.returncode == 2 and "\n" not in err and "Traceback" not in err, (args, err)
-        assert f"{tmp_path / 'tqdm.py'} shadows the library" in err, err
+        assert f"{shadow / name}.py shadows the library {name}" in err, err
     # a Python the suite is not installed into: "No module named ..." named in one line
     p = python_lines(
         "import sys",
