@@ -112,34 +112,56 @@ def _rectangle(*args: Any, **kw: Any):
     return Rectangle(*args, **kw)
 
 
+_runs: list = []  # the runs inside :func:`kept` in this process (threads of the API)
+_restore: list = []  # what puts the caller's rcParams back when the last of them ends
+
+
 @contextlib.contextmanager
 def kept() -> Iterator[None]:
     """The caller's ``rcParams`` as they were before, whatever the suite set inside (a run of
     the Python API in a user's process: :data:`STYLE` is the suite's, not the user's next
     plot's). Inside, the suite's figures are drawn in :data:`STYLE` over matplotlib's
-    defaults, whatever the caller had set, so a PNG is the same as ``sim run``'s."""
-    global _set_up
-    if "matplotlib" not in sys.modules:  # nothing of the user's to keep, nor to set aside
-        try:
-            yield
-        finally:
-            m = sys.modules.get("matplotlib")
-            if m is not None and _set_up:  # loaded inside: leave matplotlib's defaults
-                with _lock:
-                    m.rcParams.update({k: m.rcParamsDefault[k] for k in STYLE})
-                    _set_up = False
-        return
-    import matplotlib
-
-    ours = {k: v for k, v in matplotlib.rcParamsDefault.items() if k != "backend"}
+    defaults, whatever the caller had set, so a PNG is the same as ``sim run``'s. Runs in
+    several threads at once share one such state, put back when the last of them ends."""
     with _lock:
-        _set_up = True  # the style is set here, for the run only
+        _runs.append(None)
+        if len(_runs) == 1:
+            _restore[:] = [_take_over()]
     try:
-        with matplotlib.rc_context({**ours, **STYLE}):
-            yield
+        yield
     finally:
         with _lock:
-            _set_up = False
+            _runs.pop()
+            if not _runs:
+                _restore.pop()()
+
+
+def _take_over():
+    """Set the suite's style (if matplotlib is loaded; else :func:`_setup` sets it on the first
+    figure) and return the function that puts the caller's state back. Under :data:`_lock`."""
+    global _set_up
+    m = sys.modules.get("matplotlib")
+    if m is None:  # nothing of the caller's to keep: after the run, matplotlib's defaults
+
+        def back() -> None:
+            global _set_up
+            loaded = sys.modules.get("matplotlib")
+            if loaded is not None and _set_up:
+                loaded.rcParams.update({k: loaded.rcParamsDefault[k] for k in STYLE})
+                _set_up = False
+
+        return back
+    ours = {k: v for k, v in m.rcParamsDefault.items() if k != "backend"}
+    context = m.rc_context({**ours, **STYLE})
+    context.__enter__()
+    _set_up = True  # the style is set here, for the runs only
+
+    def back() -> None:
+        global _set_up
+        context.__exit__(None, None, None)
+        _set_up = False
+
+    return back
 
 
 class lazy:
