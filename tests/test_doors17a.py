@@ -36,7 +36,11 @@ code before its fix.
   (:func:`sim.threads.refuse_bad_environment`);
 * ``run(workers=2)`` of the Python API inside a worker of the caller's ``multiprocessing.Pool``
   (a daemonic process) ended in multiprocessing's bare AssertionError: one line saying to use
-  one worker (:func:`sim.mc.executors._may_start_processes`).
+  one worker (:func:`sim.mc.executors._may_start_processes`);
+* ``--workers 2`` (or ``run(workers=2)``) in a process whose start method is ``forkserver``
+  (set by the caller, and Python 3.14's default on Linux) failed at once: the pool's workers,
+  children of the fork server, took the run's process for their dead parent and quit
+  (:class:`sim.mc.executors._Pool`).
 """
 
 import os
@@ -238,3 +242,20 @@ def test_workers_from_a_daemonic_process_are_one_line_and_nothing_written(tmp_pa
     assert p.returncode == 0, p.stderr
     assert "from a daemonic process" in p.stdout and "use 1 worker" in p.stdout, p.stdout
     assert list(tmp_path.iterdir()) == []
+
+
+def test_workers_start_under_the_callers_forkserver_method(tmp_path):
+    # multiprocessing.set_start_method("forkserver") (Python 3.14's default on Linux): the
+    # workers, children of the fork server, took their parent for dead and quit at once:
+    # "cannot start the local executor: A process in the process pool was terminated abruptly"
+    p = python_lines(
+        "import multiprocessing as mp",
+        "import sim",
+        "if __name__ == '__main__':",
+        "    mp.set_start_method('forkserver', force=True)",
+        f"    st = sim.load({str(STUDY)!r}, trials=40, chunk=2)",
+        f"    two = st.run(out={str(tmp_path / 'two')!r}, workers=2, figures=False)",
+        f"    one = st.run(out={str(tmp_path / 'one')!r}, figures=False)",
+        "    print(two.claims().select(['value']).equals(one.claims().select(['value'])))",
+    )
+    assert p.returncode == 0 and p.stdout.split() == ["True"], (p.stdout, p.stderr)

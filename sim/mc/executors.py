@@ -104,13 +104,16 @@ class _Pool:
     def __init__(self, workers: int):
         _may_start_processes(f"{workers} worker processes")
         method = _start_method()
+        # the method the workers start by: ours, or the caller's (``set_start_method``; the
+        # default of Python 3.14 on Linux) -- a forkserver's workers are its children, not
+        # ours: given our pid they took their parent for dead and quit ("terminated abruptly")
+        self.start_method = method or multiprocessing.get_start_method()
         self.pool = ProcessPoolExecutor(
             max_workers=workers,
             mp_context=multiprocessing.get_context(method) if method else None,
             initializer=_worker_init,
-            initargs=(None if method == "forkserver" else os.getpid(),),
+            initargs=(None if self.start_method == "forkserver" else os.getpid(),),
         )
-        self.start_method = method or multiprocessing.get_start_method()
         # Ctrl-C or SIGTERM in the at-fork hooks of a fork (logging's lock release) is
         # "Exception ignored" by Python: the run went on to exit 0 (doors15a). Held over the
         # forks, a stop signal is delivered here after them; the workers unblock it first thing
