@@ -29,6 +29,7 @@ from benchmarks.figures import brown_figure, engines_figure
 from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
 from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
+from sim.mc.argv import BoundedParser
 from sim.mc.storage import provenance, write_table
 
 __all__ = ["main", "run"]
@@ -132,7 +133,7 @@ class _ArgError(Exception):
     """A bad argument, found before anything is measured (one line, exit 2)."""
 
 
-class _Parser(argparse.ArgumentParser):
+class _Parser(BoundedParser):
     """argparse with the suite's one-line errors (``sim``'s style), exit 2."""
 
     def error(self, message: str):

@@ -33,6 +33,7 @@ from sim.mc.outputs import damaged_chunks
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import read_provenance
 from sim.mc.sweep import read_sweep
+from sim.report.mpl import kept
 from sim.studies import load_study
 
 __all__ = ["load", "StudyHandle", "Results"]
@@ -177,19 +178,20 @@ class StudyHandle:
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
         out = _absolute("out", out)
-        execute(
-            h.study,
-            h.config,
-            h.sweep,
-            out,
-            str(out),
-            executor=executor,
-            workers=workers,
-            scheduler=scheduler,
-            overwrite=overwrite,
-            quiet=quiet,
-            figures=figures,
-        )
+        with kept():  # the caller's matplotlib settings as they were (a notebook's)
+            execute(
+                h.study,
+                h.config,
+                h.sweep,
+                out,
+                str(out),
+                executor=executor,
+                workers=workers,
+                scheduler=scheduler,
+                overwrite=overwrite,
+                quiet=quiet,
+                figures=figures,
+            )
         return Results(out, h.name)
 
 

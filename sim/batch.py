@@ -45,7 +45,7 @@ from sim.cli import DOC as cli_doc  # noqa: E402
 from sim.cli import check_run_args, load_run  # noqa: E402
 from sim.cli_args import OnceParser, module_doc  # noqa: E402
 from sim.cli_args import parser as run_parser  # noqa: E402
-from sim.mc.children import STOP_SIGNALS, stop_children  # noqa: E402
+from sim.mc.children import STOP_SIGNALS, child_text, stop_children  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
 from sim.mc.config import ConfigError, StudyError  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
@@ -145,7 +145,7 @@ def run_all(
                     cmd,
                     stdout=subprocess.PIPE if jobs > 1 else None,
                     stderr=subprocess.PIPE,
-                    text=True,
+                    **child_text(),  # the child's encoding, which is the driver's
                 )
             except OSError as e:  # no process or pipe to be had (ulimit -n, -u): one line
                 why = e.strerror or str(e)

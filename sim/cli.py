@@ -25,6 +25,7 @@ import os
 import re
 import signal
 import sys
+import threading
 from pathlib import Path
 
 import pyarrow as pa
@@ -44,7 +45,7 @@ from sim.report.read import claims_damage, damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.studies import get_study, load_study
-from sim.threads import interrupted, memory_words, short_of_memory
+from sim.threads import interrupted, memory_words, shadowed, short_of_memory
 
 __all__ = ["main", "check_run_args"]
 
@@ -340,7 +341,10 @@ def _on_sigterm(signum, frame):
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    old = {s: signal.getsignal(s) for s in _STOPS}
+    # signal handlers are the main thread's to set: main() called from another thread (a
+    # notebook's worker, a test runner) ended in "ValueError: signal only works in main thread"
+    mine = threading.current_thread() is threading.main_thread()
+    old = {s: signal.getsignal(s) for s in _STOPS} if mine else {}
     _cpu_limit.clear()
     try:
         if not argv:  # usage, not an error message
@@ -368,9 +372,11 @@ def _main(argv: list[str]) -> int:
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
-        for s in _STOPS:  # clean up like Ctrl-C (nohup: ignored): a
-            if signal.getsignal(s) is signal.SIG_DFL:  # run's stage, report's temporary files
-                signal.signal(s, _on_sigterm)
+        if args.cmd in ("check", "show") and sys.stdout is None:  # >&-: print() wrote nowhere
+            raise ConfigError(None, "standard output is closed (>&-): nothing to print to")
+        for s in _STOPS if threading.current_thread() is threading.main_thread() else ():
+            if signal.getsignal(s) is signal.SIG_DFL:  # clean up like Ctrl-C (nohup: ignored):
+                signal.signal(s, _on_sigterm)  # a run's stage, report's temporary files
         code = _command(args)
         check_interrupt()  # an interrupt Python dropped (a C callback) never ends in exit 0
         return code
@@ -421,6 +427,9 @@ def _main(argv: list[str]) -> int:
             return 130
         if short_of_memory(e):  # an ImportError: a library that could not be mapped
             print(f"sim: error: {memory_words(e)}", file=sys.stderr)
+            return 2
+        if (words := shadowed(e)) is not None:  # a user's tomllib.py: not a bug of ours
+            print(f"sim: error: {words}", file=sys.stderr)
             return 2
         if os.environ.get("SIM_DEBUG"):  # one line as docs/cli.md promises, the traceback on
             raise  # request

@@ -8,6 +8,7 @@ import ast
 from importlib import metadata
 from pathlib import Path
 
+from sim.mc.argv import BoundedParser
 from sim.mc.config import ConfigError
 from sim.mc.runner import MIN_CHUNKS
 
@@ -34,8 +35,9 @@ class _Once(argparse.Action):
 ONCE = frozenset({"--out", "--trials", "--chunk", "--seed", "--results", "--timings"})
 
 
-class OnceParser(argparse.ArgumentParser):
-    """argparse where an option of :data:`ONCE` may be given once."""
+class OnceParser(BoundedParser):
+    """argparse where an option of :data:`ONCE` may be given once, and at most
+    :data:`sim.mc.argv.MAX_OPTIONS` options are read."""
 
     def add_argument(self, *args, **kwargs):
         if args and args[0] in ONCE and "action" not in kwargs:

@@ -35,7 +35,7 @@ from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cel
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
 from sim.stops import check_interrupt, keep_lost_interrupts
-from sim.threads import interrupted
+from sim.threads import interrupted, shadowed
 
 __all__ = ["execute", "run_sweep", "check_sweep"]
 
@@ -180,6 +180,8 @@ def execute(
                 raise KeyboardInterrupt from None
             if isinstance(e, (ArithmeticError, ValueError, MemoryError)):  # numbers the model
                 raise _numeric_failure(e, study, cfg) from None  # cannot take
+            if (words := shadowed(e)) is not None:  # a user's matplotlib.py: not our bug
+                raise StudyError(f"{cfg['study']}: {words}") from None
             if os.environ.get("SIM_DEBUG"):  # a bug: one line, the traceback on request
                 raise
             err = _numeric_failure(e, study, cfg)

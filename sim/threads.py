@@ -6,10 +6,13 @@ before anything imports NumPy; the environment of the caller wins.
 """
 
 import os
+import re
 import resource
 import signal
 import sys
 import threading
+import time
+import types
 
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 #: the signals an entry point takes over while it loads, with their default handlers
@@ -47,12 +50,17 @@ def interrupt_while_loading(prog: str):
     itself (or a handler of the caller's: ``restore(then=handler)``); a signal the caller
     ignores (SIGINT of a background job, SIGHUP under nohup) stays ignored. Until then a library that cannot be loaded for want of memory
     (``ulimit -v``) ends the command with one line "not enough memory ..." and exit 2, not a
-    traceback (or a crash while Python shuts down)."""
+    traceback (or a crash while Python shuts down); a library that is missing, or shadowed by
+    a file of its name on the path, is one line naming it (:func:`import_words`), exit 2."""
     hook = sys.excepthook
 
     def short(kind, e, tb):  # ulimit -v: a library that cannot be mapped, not a traceback
         if not short_of_memory(e):
-            return hook(kind, e, tb)
+            words = import_words(e)
+            if words is None:
+                return hook(kind, e, tb)
+            os.write(2, f"{prog}: error: {words}\n".encode(errors="replace"))
+            os._exit(2)
         os.write(2, f"{prog}: error: {memory_words(e)}\n".encode())
         os._exit(2)  # not Python's finalisation: short of memory, it may crash (SIGSEGV)
 
@@ -79,6 +87,61 @@ def interrupt_while_loading(prog: str):
         return [s for s, _ in taken]
 
     return restore
+
+
+def import_words(e: BaseException | None) -> str | None:
+    """The one line for a library the suite cannot import while an entry point loads, or None
+    if ``e`` is neither an ImportError nor a shadowed module (:func:`shadowed`): a file of the
+    library's name ahead of it on the path (an empty ``tqdm.py`` or ``numpy.py`` in
+    ``PYTHONPATH`` or the working directory) is named as the cause; a library missing
+    altogether (the suite run by a Python it was not installed into) says so. Both ended in a
+    traceback."""
+    if e is None or interrupted(e):  # Ctrl-C inside an import
+        return None
+    first = (str(e).splitlines() or [type(e).__name__])[0][:300]
+    words = shadowed(e)
+    if words is not None:
+        return f"cannot load the suite: {first}; {words}"
+    if not isinstance(e, ImportError):
+        return None
+    name = (e.name or "").split(".")[0]
+    return (
+        f"cannot load {name or 'a library'}: {first}; run the suite with the Python it was "
+        f"installed into (make venv; .venv/bin/sim), not {sys.executable}"
+    )
+
+
+def _installed(path: str) -> bool:
+    """Whether ``path`` is part of this Python's installation or of the suite itself."""
+    suite = os.path.dirname(os.path.abspath(__file__))
+    return path.startswith((sys.prefix, sys.base_prefix, suite + os.sep))
+
+
+def shadowed(e: BaseException | None) -> str | None:
+    """Words naming a file of the user's that shadows a library (``tomllib.py``,
+    ``matplotlib.py``, an empty ``numba/`` directory on ``PYTHONPATH`` or in the working
+    directory), if ``e`` (or an exception it came from) is an ImportError of that library or
+    an AttributeError read from that module; else None. Such a file ended a command in an
+    "internal error" (exit 3) or a traceback, wherever the library was first used."""
+    seen = set()
+    while e is not None and id(e) not in seen:
+        seen.add(id(e))
+        module = getattr(e, "obj", None) if isinstance(e, AttributeError) else None
+        said = re.match(r"module '([\w.]+)' has no attribute", str(e))  # from C (pyarrow)
+        if module is None and isinstance(e, AttributeError) and said:
+            module = sys.modules.get(said.group(1))
+        if isinstance(e, ImportError):
+            module = sys.modules.get((e.name or "").split(".")[0])
+        if isinstance(module, types.ModuleType):
+            where = getattr(module, "__file__", None)
+            where = where or next(iter(getattr(module, "__path__", None) or ()), None)
+            if where and not _installed(str(where)):
+                return (
+                    f"{where} shadows the library {module.__name__} (PYTHONPATH or the working "
+                    "directory): rename it or leave that directory"
+                )
+        e = e.__cause__ or e.__context__
+    return None
 
 
 #: what the loader and llvmlite say of a library they cannot map into memory (ulimit -v)
@@ -137,14 +200,32 @@ def refuse_bad_environment(prog: str) -> None:
     traceback from ``numpy.f2py``, imported by ``scipy.sparse``). Called by the entry points
     before anything imports NumPy."""
     _refuse_small_address_space(prog)
+    _refuse_bad_tqdm_variables(prog)
     v = os.environ.get("SOURCE_DATE_EPOCH")
     if v is None:
         return
     try:
-        int(v)  # as numpy.f2py reads it
-    except ValueError:
+        time.gmtime(int(v))  # as numpy.f2py reads it (99999999999999999999: OverflowError)
+    except (ValueError, OverflowError, OSError):
         sys.stderr.write(
             f"{prog}: error: SOURCE_DATE_EPOCH: must be an integer, seconds since 1970 "
-            f"(got {v!r}); NumPy reads it while loading\n"
+            f"within the system's dates (got {v[:40]!r}); NumPy reads it while loading\n"
+        )
+        sys.exit(2)
+
+
+def _refuse_bad_tqdm_variables(prog: str) -> None:
+    """tqdm (the progress bar) reads ``TQDM_<option>`` variables while it is imported and
+    converts each to its option's type: ``TQDM_NCOLS=abc`` ended every command in a
+    traceback from ``tqdm.utils``. Imported here only when such a variable is set."""
+    given = sorted(k for k in os.environ if k.upper().startswith("TQDM_"))
+    if not given:
+        return
+    try:
+        import tqdm  # noqa: F401 - its import reads the variables
+    except (ValueError, TypeError) as e:
+        sys.stderr.write(
+            f"{prog}: error: {', '.join(given)}: tqdm cannot read "
+            f"{'it' if len(given) == 1 else 'them'} ({str(e).splitlines()[0][:200]})\n"
         )
         sys.exit(2)

@@ -12,15 +12,25 @@ from __future__ import annotations
 
 import signal
 import subprocess
+import sys
 from collections.abc import Callable, Iterable
 
-__all__ = ["STOP_SIGNALS", "GRACE_S", "stop_children"]
+__all__ = ["STOP_SIGNALS", "GRACE_S", "stop_children", "child_text"]
 
 #: the signals that end a driver (and each of its runs) as Ctrl-C does
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
 
 #: seconds an interrupted child run has to clean up before it is killed
 GRACE_S = 30
+
+
+def child_text() -> dict:
+    """How a driver reads the text a child run prints: in the encoding of the driver's own
+    standard error, which the child (same environment, same locale) writes too. Python's
+    default, the locale's encoding, is another one under ``PYTHONIOENCODING`` (``utf-16``:
+    every character came out with NULs between), and a byte that is not text is replaced,
+    not a traceback in a reader thread."""
+    return {"encoding": getattr(sys.stderr, "encoding", None) or "utf-8", "errors": "replace"}
 
 
 def stop_children(

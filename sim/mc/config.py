@@ -283,6 +283,10 @@ def parse_override(text: str) -> tuple[str, Any]:
         raise ConfigError(None, f"--set needs key=value (got {text!r})")
     if any(c in val for c in "\n\r\0"):  # one value: a line break would smuggle in more keys
         raise ConfigError(key, f"--set value must be one line (got {val!r})")
+    if any("\udc80" <= c <= "\udcff" for c in text):  # bytes the locale could not decode
+        raise ConfigError(  # (LC_ALL=C without UTF-8 mode: "é" was "must be printable")
+            key or None, "--set holds bytes that are not UTF-8 text (a non-UTF-8 locale or value)"
+        )
     try:
         doc = tomllib.loads(f"v = {val.strip()}")
     except tomllib.TOMLDecodeError:

@@ -84,6 +84,17 @@ def _ready() -> int:
     return os.getpid()
 
 
+def _may_start_processes(what: str) -> None:
+    """Refuse (one line) to start worker processes from a daemonic process (a worker of the
+    caller's ``multiprocessing.Pool``), which multiprocessing forbids: ``run(workers=2)`` there
+    ended in its bare "AssertionError: daemonic processes are not allowed to have children"."""
+    if multiprocessing.current_process().daemon:
+        raise RuntimeError(
+            f"{what} from a daemonic process (a worker of a multiprocessing Pool), which may "
+            "start no processes: use 1 worker here (the results are the same)"
+        )
+
+
 class _Pool:
     """A local process pool (``concurrent.futures``); its workers die with the parent. They
     are all started here, while the caller is the only thread that needs to exist (see
@@ -91,14 +102,18 @@ class _Pool:
     own (the parts of ``brown_design``, figures drawn in this process)."""
 
     def __init__(self, workers: int):
+        _may_start_processes(f"{workers} worker processes")
         method = _start_method()
+        # the method the workers start by: ours, or the caller's (``set_start_method``; the
+        # default of Python 3.14 on Linux) -- a forkserver's workers are its children, not
+        # ours: given our pid they took their parent for dead and quit ("terminated abruptly")
+        self.start_method = method or multiprocessing.get_start_method()
         self.pool = ProcessPoolExecutor(
             max_workers=workers,
             mp_context=multiprocessing.get_context(method) if method else None,
             initializer=_worker_init,
-            initargs=(None if method == "forkserver" else os.getpid(),),
+            initargs=(None if self.start_method == "forkserver" else os.getpid(),),
         )
-        self.start_method = method or multiprocessing.get_start_method()
         # Ctrl-C or SIGTERM in the at-fork hooks of a fork (logging's lock release) is
         # "Exception ignored" by Python: the run went on to exit 0 (doors15a). Held over the
         # forks, a stop signal is delivered here after them; the workers unblock it first thing
@@ -148,6 +163,7 @@ class _Dask:
         if scheduler:
             self.client = Client(scheduler, timeout="10s")
         else:
+            _may_start_processes("a LocalCluster")
             _enough_files(workers)
             try:
                 self.cluster = LocalCluster(

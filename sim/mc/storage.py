@@ -74,7 +74,7 @@ def git_commit(study: str | None = None) -> str:
             ["git", "log", "-1", "--format=%H", "--", *paths],
             cwd=root,
             capture_output=True,
-            text=True,
+            encoding="utf-8",  # not the locale's (git prints hashes; -X warn_default_encoding)
             errors="replace",  # a file name git prints in Latin-1, a wrapper's bytes
             timeout=10,
         )
@@ -86,7 +86,7 @@ def git_commit(study: str | None = None) -> str:
             ["git", "status", "--porcelain", "--", *paths],
             cwd=root,
             capture_output=True,
-            text=True,
+            encoding="utf-8",  # not the locale's (git prints hashes; -X warn_default_encoding)
             errors="replace",  # a file name git prints in Latin-1, a wrapper's bytes
             timeout=10,
         ).stdout.strip()

@@ -3,19 +3,28 @@
 A process that draws no figure (``sim check``, ``sim show``, a run with ``--no-figures``, a
 pool or Dask worker, ``make verify``'s re-runs) never pays for importing matplotlib, about
 0.5 s of CPU per process. The first attribute read from :data:`pyplot` (or any other module
-here) sets the Agg backend and the suite's style (:data:`STYLE`), then imports the module;
-after that, every read is a dictionary lookup in the imported module.
+here) imports matplotlib and sets the suite's style (:data:`STYLE`); after that, every read
+is a dictionary lookup in the imported module.
+
+The suite's figures never go through ``matplotlib.pyplot``: :data:`pyplot` is the part of it
+the suite uses (``subplots``, ``figure``, ``close``, ``Rectangle``), built on
+``matplotlib.figure.Figure`` with an Agg canvas of its own. Called from the Python API inside
+a user's notebook or script, a run so leaves the user's backend and open figures alone
+(``matplotlib.use("Agg")`` switched the caller's pyplot to Agg and closed every figure it had
+open), and :func:`kept` puts the user's ``rcParams`` back after the run.
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
+import sys
 import threading
-from types import ModuleType
-from typing import Any
+from types import ModuleType, SimpleNamespace
+from typing import Any, Iterator
 
-__all__ = ["pyplot", "ticker", "collections", "lazy", "STYLE"]
+__all__ = ["pyplot", "ticker", "collections", "lazy", "STYLE", "kept"]
 
 #: the suite's figure style: deterministic PNGs (no hash salt from the run), small fonts
 STYLE = {
@@ -32,10 +41,11 @@ _set_up = False
 
 
 def _setup() -> None:
-    """Agg backend and :data:`STYLE`, once per process, before any matplotlib module loads.
-    The user's ``MPLBACKEND`` is set aside while matplotlib loads (and put back): the suite
-    draws only PNG files through Agg, and a value matplotlib does not know (``nosuch``)
-    failed a run at its first figure, after every trial was computed."""
+    """:data:`STYLE`, once per process, before any matplotlib module loads. The user's
+    ``MPLBACKEND`` is set aside while matplotlib loads (and put back): the suite draws only
+    PNG files through an Agg canvas of its own, and a value matplotlib does not know
+    (``nosuch``) failed a run at its first figure, after every trial was computed. A value it
+    knows stays the backend of the caller's own pyplot. No backend is chosen here."""
     global _set_up
     with _lock:
         if not _set_up:
@@ -45,9 +55,113 @@ def _setup() -> None:
             finally:
                 if backend is not None:
                     os.environ["MPLBACKEND"] = backend
-            matplotlib.use("Agg")
+            if backend and matplotlib.rcParams._get_backend_or_none() is None:
+                with contextlib.suppress(ValueError):  # nosuch: the suite draws through Agg
+                    matplotlib.rcParams["backend"] = backend
             matplotlib.rcParams.update(STYLE)
             _set_up = True
+
+
+def _figure(**kw: Any):
+    """``pyplot.figure(**kw)`` without pyplot: a Figure on an Agg canvas of its own, in no
+    figure list of pyplot's (so never shown, and left to the garbage collector)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(**kw)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _subplots(
+    nrows: int = 1,
+    ncols: int = 1,
+    *,
+    sharex=False,
+    sharey=False,
+    squeeze=True,
+    width_ratios=None,
+    height_ratios=None,
+    subplot_kw=None,
+    gridspec_kw=None,
+    **fig_kw,
+):
+    """``pyplot.subplots(...)`` without pyplot (:func:`_figure`)."""
+    fig = _figure(**fig_kw)
+    axs = fig.subplots(
+        nrows,
+        ncols,
+        sharex=sharex,
+        sharey=sharey,
+        squeeze=squeeze,
+        width_ratios=width_ratios,
+        height_ratios=height_ratios,
+        subplot_kw=subplot_kw,
+        gridspec_kw=gridspec_kw,
+    )
+    return fig, axs
+
+
+def _close(fig: Any = None) -> None:
+    """``pyplot.close``: a figure of :func:`_figure` is in no list; nothing to do."""
+
+
+def _rectangle(*args: Any, **kw: Any):
+    from matplotlib.patches import Rectangle
+
+    return Rectangle(*args, **kw)
+
+
+_runs: list = []  # the runs inside :func:`kept` in this process (threads of the API)
+_restore: list = []  # what puts the caller's rcParams back when the last of them ends
+
+
+@contextlib.contextmanager
+def kept() -> Iterator[None]:
+    """The caller's ``rcParams`` as they were before, whatever the suite set inside (a run of
+    the Python API in a user's process: :data:`STYLE` is the suite's, not the user's next
+    plot's). Inside, the suite's figures are drawn in :data:`STYLE` over matplotlib's
+    defaults, whatever the caller had set, so a PNG is the same as ``sim run``'s. Runs in
+    several threads at once share one such state, put back when the last of them ends."""
+    with _lock:
+        _runs.append(None)
+        if len(_runs) == 1:
+            _restore[:] = [_take_over()]
+    try:
+        yield
+    finally:
+        with _lock:
+            _runs.pop()
+            if not _runs:
+                _restore.pop()()
+
+
+def _take_over():
+    """Set the suite's style (if matplotlib is loaded; else :func:`_setup` sets it on the first
+    figure) and return the function that puts the caller's state back. Under :data:`_lock`."""
+    global _set_up
+    m = sys.modules.get("matplotlib")
+    if m is None:  # nothing of the caller's to keep: after the run, matplotlib's defaults
+
+        def back() -> None:
+            global _set_up
+            loaded = sys.modules.get("matplotlib")
+            if loaded is not None and _set_up:
+                loaded.rcParams.update({k: loaded.rcParamsDefault[k] for k in STYLE})
+                _set_up = False
+
+        return back
+    ours = {k: v for k, v in m.rcParamsDefault.items() if k != "backend"}
+    context = m.rc_context({**ours, **STYLE})
+    context.__enter__()
+    _set_up = True  # the style is set here, for the runs only
+
+    def back() -> None:
+        global _set_up
+        context.__exit__(None, None, None)
+        _set_up = False
+
+    return back
 
 
 class lazy:
@@ -73,8 +187,24 @@ class lazy:
         return f"<lazy {self._name}>"
 
 
-#: ``matplotlib.pyplot``
-pyplot = lazy("matplotlib.pyplot")
+class _Pyplot:
+    """The part of ``matplotlib.pyplot`` the suite uses, without pyplot's global state; the
+    first use loads matplotlib (:func:`_setup`)."""
+
+    def _load(self) -> SimpleNamespace:
+        _setup()
+        return _PYPLOT
+
+    def __getattr__(self, attr: str) -> Any:
+        return getattr(self._load(), attr)
+
+    def __repr__(self) -> str:
+        return "<the suite's pyplot: subplots, figure, close, Rectangle>"
+
+
+_PYPLOT = SimpleNamespace(subplots=_subplots, figure=_figure, close=_close, Rectangle=_rectangle)
+#: ``matplotlib.pyplot``'s ``subplots``, ``figure``, ``close`` and ``Rectangle``, without pyplot
+pyplot = _Pyplot()
 #: ``matplotlib.ticker``
 ticker = lazy("matplotlib.ticker")
 #: ``matplotlib.collections``

@@ -9,6 +9,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from sim.mc.argv import BoundedParser
 from sim.mc.outputs import name_problem
 from sim.report.verify.rerun import verify, write_record
 from sim.report.verify.rules import Comparison, VerifyError
@@ -24,7 +25,7 @@ DESCRIPTION = (
 # --- command line -----------------------------------------------------------------------------
 
 
-class _Parser(argparse.ArgumentParser):
+class _Parser(BoundedParser):
     def error(self, message: str):  # one line, exit 2 (main prints it)
         raise VerifyError(message)
 

@@ -268,7 +268,10 @@ def write_gama(net: Network, path: str | Path, inner: tuple | list = ()) -> Path
     _vectors(net, po, pairs, val)
     ET.indent(root)
     path = Path(path)
-    path.write_text('<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n")
+    # UTF-8, as an XML file without an encoding declaration is read, whatever the locale (a
+    # point named "É1" under LC_ALL=C without UTF-8 mode: UnicodeEncodeError after every trial)
+    text = '<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+    path.write_text(text, encoding="utf-8")
     return path
 
 
