@@ -29,7 +29,6 @@ import threading
 from pathlib import Path
 
 import pyarrow as pa
-import pyarrow.parquet as pq
 
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, os_reason, stdout_failed
@@ -38,10 +37,10 @@ from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.runner import MIN_CHUNKS
-from sim.mc.storage import code_hash, read_provenance, read_record
+from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import read_sweep
 from sim.report.markdown import write_report
-from sim.report.read import claims_damage, damaged_message
+from sim.report.read import check_claims_table, damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.studies import get_study, load_study
@@ -221,7 +220,7 @@ def _show(args) -> int:
         d = Path("results") / args.dir
     if not d.is_dir():
         raise ConfigError("DIR", f"{args.dir} is not a directory")
-    _check_claims(d / "claims.parquet")
+    check_claims_table(d / "claims.parquet", "DIR")
     try:
         text = run_markdown(d, get_study) if args.markdown else terminal_table(d)
     except ConfigError:
@@ -237,31 +236,6 @@ def _not_as_written(d: Path, e: Exception) -> str:
     """show and report read the Parquet tables only: one that fails to read as its study's
     table was replaced or edited by hand (named with its column by the reader)."""
     return damaged_message(d, e)
-
-
-def _check_claims(f: Path) -> None:
-    """A results directory's claims table must be one the suite wrote (one line if not)."""
-    if not f.is_file():
-        return
-    try:
-        prov, names = read_provenance(f), pq.read_schema(f).names
-    except (OSError, ValueError, pa.ArrowException) as e:
-        raise ConfigError("DIR", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
-    if "study" not in prov or not {"claim", "verdict"} <= set(names):
-        raise ConfigError("DIR", f"{f} is not a claims table written by sim")
-    try:
-        verdicts = pq.read_table(f, columns=["verdict"]).column("verdict").to_pylist()
-    except (OSError, ValueError, pa.ArrowException) as e:
-        raise ConfigError("DIR", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
-    damage = claims_damage(prov, verdicts)
-    if damage:
-        raise ConfigError("DIR", f"{f} is not a claims table written by sim: {damage}")
-    run = (read_record(f.parent) or {}).get("config")
-    owner = run.get("study") if isinstance(run, dict) else None
-    if isinstance(owner, str) and prov["study"] != owner:  # another study's table, copied in
-        raise ConfigError(
-            "DIR", f"{f} is a table of {prov['study']!r}, not of this run's {owner!r} (run.json)"
-        )
 
 
 def _n(x: float) -> str:

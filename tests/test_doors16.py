@@ -20,7 +20,7 @@ before its fix.
   does not hold, and not by the file (:func:`sim.studies.network.schema._build`);
 * ``sim show`` printed another study's claims table copied into a results directory as this
   run's, exit 0 (docs/cli.md: a table replaced by hand is one line naming the directory;
-  :func:`sim.cli._check_claims`);
+  :func:`sim.report.read.check_claims_table`);
 * a ``network.gama_xml`` file without a fixed point and with ``adj="XY"`` points is adjusted
   in the inner datum (docs/gama.md), but ``sim check`` and the run record showed the study
   file's ``datum.kind = 'fixed'`` (:func:`sim.studies.network.schema.check`);

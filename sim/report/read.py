@@ -21,12 +21,15 @@ from pathlib import Path
 from typing import Any
 
 import pyarrow as pa
+import pyarrow.parquet as pq
 
 from sim.claims.region import REGION_VERDICTS
 from sim.claims.rules import VERDICTS
-from sim.mc.storage import read_table
+from sim.mc.config import ConfigError
+from sim.mc.storage import read_provenance, read_record, read_table
 
 __all__ = [
+    "check_claims_table",
     "TableError",
     "columns",
     "records",
@@ -139,3 +142,30 @@ def claims_damage(prov: dict, verdicts: list) -> str | None:
         if v not in KNOWN_VERDICTS:
             return f"it holds the verdict {v!r:.40}, which sim never writes"
     return None
+
+
+def check_claims_table(f: Path, key: str) -> None:
+    """A results directory's claims table ``f`` must be one the suite wrote, of the study its
+    ``run.json`` names (a :class:`ConfigError` for ``key``, naming the file, if not; nothing
+    when there is no table)."""
+    if not f.is_file():
+        return
+    try:
+        prov, names = read_provenance(f), pq.read_schema(f).names
+    except (OSError, ValueError, pa.ArrowException) as e:
+        raise ConfigError(key, f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+    if "study" not in prov or not {"claim", "verdict"} <= set(names):
+        raise ConfigError(key, f"{f} is not a claims table written by sim")
+    try:
+        verdicts = pq.read_table(f, columns=["verdict"]).column("verdict").to_pylist()
+    except (OSError, ValueError, pa.ArrowException) as e:
+        raise ConfigError(key, f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+    damage = claims_damage(prov, verdicts)
+    if damage:
+        raise ConfigError(key, f"{f} is not a claims table written by sim: {damage}")
+    run = (read_record(f.parent) or {}).get("config")
+    owner = run.get("study") if isinstance(run, dict) else None
+    if isinstance(owner, str) and prov["study"] != owner:  # another study's table, copied in
+        raise ConfigError(
+            key, f"{f} is a table of {prov['study']!r}, not of this run's {owner!r} (run.json)"
+        )
