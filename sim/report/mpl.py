@@ -73,33 +73,22 @@ def _figure(**kw: Any):
     return fig
 
 
-def _subplots(
-    nrows: int = 1,
-    ncols: int = 1,
-    *,
-    sharex=False,
-    sharey=False,
-    squeeze=True,
-    width_ratios=None,
-    height_ratios=None,
-    subplot_kw=None,
-    gridspec_kw=None,
-    **fig_kw,
-):
+#: the keywords of ``pyplot.subplots`` that go to ``Figure.subplots``; the rest make the figure
+_GRID = (
+    "sharex",
+    "sharey",
+    "squeeze",
+    "width_ratios",
+    "height_ratios",
+    "subplot_kw",
+    "gridspec_kw",
+)
+
+
+def _subplots(nrows: int = 1, ncols: int = 1, **kw: Any):
     """``pyplot.subplots(...)`` without pyplot (:func:`_figure`)."""
-    fig = _figure(**fig_kw)
-    axs = fig.subplots(
-        nrows,
-        ncols,
-        sharex=sharex,
-        sharey=sharey,
-        squeeze=squeeze,
-        width_ratios=width_ratios,
-        height_ratios=height_ratios,
-        subplot_kw=subplot_kw,
-        gridspec_kw=gridspec_kw,
-    )
-    return fig, axs
+    fig = _figure(**{k: v for k, v in kw.items() if k not in _GRID})
+    return fig, fig.subplots(nrows, ncols, **{k: v for k, v in kw.items() if k in _GRID})
 
 
 def _close(fig: Any = None) -> None:
