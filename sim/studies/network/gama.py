@@ -80,10 +80,12 @@ def merge_gama(cfg: dict) -> dict:
     }
     if rec["datum.points"] and not cfg["datum.points"]:
         out["datum.points"] = rec["datum.points"]
-    fixed = any(p.get("role") == "fixed" for p in rec["network.points"])
-    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and not fixed:
-        # a free network with adj="XY" points: gama-local adjusts it in the inner datum over
-        # them, as the suite's own export writes it (its round trip), so the study does too
+    fixed = sum(p.get("role") == "fixed" for p in rec["network.points"])
+    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and fixed <= 1:
+        # adj="XY" points and a defect the fixed points leave (all of them in a free network,
+        # the rotation and scale about one fixed point): gama-local removes it by inner
+        # constraints over them, as the suite's own export writes such a network (its round
+        # trip), so the study does too; two fixed points leave no defect
         out["datum.kind"] = "inner"
     return out
 

@@ -1,0 +1,94 @@
+"""The classes of the sweep doors17c (issue 26: a new user's realistic mistakes in the first
+hour, with README.md and docs/*.md open), one case each; each failed on the code before its
+fix.
+
+* a point typed with one coordinate in metres and the other in millimetres (``x_m = 0.15,
+  y_mm = 120.0``: the README's network edited by hand) was accepted, the point silently a
+  thousand times off in one axis (docs/network.md: one unit per field); the same for a grid's
+  ``spacing_m`` with ``origin_mm`` and a random set's ``half_extent_m`` with ``center_mm``
+  (:func:`sim.studies.network.validate.one_unit`);
+* a ``network.gama_xml`` file with one ``fix="xy"`` point and ``adj="XY"`` points (which
+  gama-local adjusts, and which the suite's own export writes for an inner datum with one
+  fixed point: ``tests/data/gama/one_fixed.xml``), read with the study file of docs/gama.md,
+  was refused with "a rank defect of 1 ... that the datum (0 constraints) does not cover"
+  (:func:`sim.studies.network.gama.merge_gama`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from oneline import one_line
+
+import sim
+from sim.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+GAMA = ROOT / "tests" / "data" / "gama"
+
+README_NET = """study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+           { name = "B", x_mm = 400.0, y_mm = 0.0, role = "fixed" },
+           { name = "C", x_mm = 400.0, y_mm = 300.0, role = "fixed" },
+           { name = "D", x_mm = 0.0, y_mm = 300.0, role = "fixed" },
+           { name = "P", x_mm = 150.0, y_mm = 120.0 } ]
+generate = [ { kind = "distance", from = ["A", "B", "C", "D"], to = "P", sigma_mm = 0.002 },
+             { kind = "direction", from = ["A", "B", "C", "D"], to = "*", sigma_arcsec = 2.0 } ]
+"""
+
+
+@pytest.mark.parametrize(
+    ("edit", "needles"),
+    [
+        (("x_mm = 150.0", "x_m = 0.15"), ("network.points[4].x_m", "y_mm", "one unit")),
+        (
+            (
+                "[network]\n",
+                '[network]\ngrids = [ { prefix = "N", nx = 2, ny = 2, '
+                "spacing_m = 0.02, origin_mm = [100.0, 100.0] } ]\n",
+            ),
+            ("network.grids[0].spacing_m", "origin_mm", "one unit"),
+        ),
+        (
+            (
+                "[network]\n",
+                '[network]\nrandom = [ { prefix = "R", n = 3, '
+                "half_extent_mm = 50.0, center_m = [0.2, 0.15] } ]\n",
+            ),
+            ("network.random[0].center_m", "half_extent_mm", "one unit"),
+        ),
+    ],
+)
+def test_a_point_with_metres_and_millimetres_is_refused(tmp_path, capsys, edit, needles):
+    study = tmp_path / "net.toml"
+    study.write_text(README_NET.replace(*edit))
+    one_line(capsys, main(["check", str(study)]), *needles)
+    ok = tmp_path / "ok.toml"  # one unit per point, either one: accepted
+    ok.write_text(README_NET.replace("x_mm = 150.0, y_mm = 120.0", "x_m = 0.15, y_m = 0.12"))
+    assert main(["check", str(ok)]) == 0
+
+
+def test_a_gama_file_with_one_fixed_point_and_xy_points_is_read_as_gama_local_reads_it(
+    tmp_path, monkeypatch
+):
+    study = tmp_path / "g.toml"
+    xml = (GAMA / "one_fixed.xml").as_posix()
+    study.write_text(f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{xml}"\n')
+    st = sim.load(study)
+    assert st.config["datum.kind"] == "inner"
+    a = st.run().table("points").to_pydict()
+    b = sim.load(GAMA / "one_fixed.toml", trials=40, chunk=2).run().table("points").to_pydict()
+    assert a["point"] == b["point"] == ["B", "C", "D"]
+    for k in ("sigma_x_mm", "sigma_y_mm"):  # the same precision as the hand-written study
+        np.testing.assert_allclose(a[k], b[k], rtol=1e-9)
+    # two fixed points leave no defect: adj="XY" then changes nothing (the fixed datum)
+    tf = (GAMA / "testfield.xml").read_text().replace('adj="xy"', 'adj="XY"', 1)
+    (tmp_path / "tf.xml").write_text(tf)
+    study.write_text('study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "tf.xml"\n')
+    monkeypatch.chdir(tmp_path)
+    assert sim.load(study).config["datum.kind"] == "fixed"
