@@ -73,6 +73,8 @@ class Results:
             raise ConfigError("table", f"must be a table name such as 'claims' (got {name!r})")
         self._check_dir()
         p = self.path / (name if name == "trials" else f"{name}.parquet")
+        if not p.exists() and not self.names():  # not "no table 'claims'; it has " (none)
+            raise ConfigError("path", f"{self.path} is not a results directory (no tables)")
         if not p.exists():
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
@@ -164,20 +166,35 @@ class StudyHandle:
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
         out = _absolute("out", out)
-        execute(
-            h.study,
-            h.config,
-            h.sweep,
-            out,
-            str(out),
-            executor=executor,
-            workers=workers,
-            scheduler=scheduler,
-            overwrite=overwrite,
-            quiet=quiet,
-            figures=figures,
-        )
+        try:
+            execute(
+                h.study,
+                h.config,
+                h.sweep,
+                out,
+                str(out),
+                executor=executor,
+                workers=workers,
+                scheduler=scheduler,
+                overwrite=overwrite,
+                quiet=quiet,
+                figures=figures,
+            )
+        except ConfigError as e:
+            if e.key != "--out":
+                raise
+            raise _api_words(e) from None
         return Results(out, h.name)
+
+
+def _api_words(e: ConfigError) -> ConfigError:
+    """An output-directory refusal in the API's words: the argument is ``out`` and the way to
+    replace is ``overwrite=True`` (the command line's ``--out``/``--overwrite`` name nothing
+    a caller of ``run()`` can pass)."""
+    msg = str(e).removeprefix("--out: ")
+    for cli, api in (("--overwrite", "overwrite=True"), ("--out", "out")):
+        msg = msg.replace(cli, api)
+    return ConfigError("out", msg)
 
 
 def _sha256(path: Path) -> str:

@@ -11,7 +11,13 @@ fix.
   gama-local adjusts, and which the suite's own export writes for an inner datum with one
   fixed point: ``tests/data/gama/one_fixed.xml``), read with the study file of docs/gama.md,
   was refused with "a rank defect of 1 ... that the datum (0 constraints) does not cover"
-  (:func:`sim.studies.network.gama.merge_gama`).
+  (:func:`sim.studies.network.gama.merge_gama`);
+* ``st.run(out=...)`` into a directory it may not use answered in the command line's words
+  ("--out: ... use --overwrite to replace it"), naming an option a caller of ``run()`` cannot
+  pass: the API names ``out`` and ``overwrite=True`` (:func:`sim.api._api_words`);
+* ``sim.Results("studies", "network").claims()`` (a directory that holds no results) said
+  "network has no table 'claims'; it has " and an empty list, not that the directory is not
+  a results directory (:meth:`sim.api.Results.table`).
 """
 
 from __future__ import annotations
@@ -92,3 +98,24 @@ def test_a_gama_file_with_one_fixed_point_and_xy_points_is_read_as_gama_local_re
     study.write_text('study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "tf.xml"\n')
     monkeypatch.chdir(tmp_path)
     assert sim.load(study).config["datum.kind"] == "fixed"
+
+
+def test_the_api_names_its_own_arguments_for_an_output_directory_it_refuses(tmp_path):
+    net = tmp_path / "net.toml"
+    net.write_text(README_NET)
+    st = sim.load(net)
+    st.run(out=tmp_path / "o")
+    brown = sim.load(ROOT / "studies" / "brown_table1.toml", trials=40, chunk=2)
+    with pytest.raises(sim.ConfigError) as e:
+        brown.run(out=tmp_path / "o")
+    assert str(e.value).startswith("out: ") and "overwrite=True" in str(e.value)
+    assert "--" not in str(e.value)
+    with pytest.raises(sim.ConfigError, match=r"^out: .*choose another out\)$"):
+        st.run(out=net)
+    assert net.read_text() == README_NET and (tmp_path / "o" / "run.json").is_file()
+
+
+def test_results_of_a_directory_without_tables_names_the_directory(tmp_path):
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(sim.ConfigError, match=r"^path: .* is not a results directory"):
+        sim.Results(tmp_path, "network").claims()
