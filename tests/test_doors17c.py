@@ -17,7 +17,11 @@ fix.
   pass: the API names ``out`` and ``overwrite=True`` (:func:`sim.api._api_words`);
 * ``sim.Results("studies", "network").claims()`` (a directory that holds no results) said
   "network has no table 'claims'; it has " and an empty list, not that the directory is not
-  a results directory (:meth:`sim.api.Results.table`).
+  a results directory (:meth:`sim.api.Results.table`);
+* ``python -m sim.batch --results FILE`` (a file, or a dangling link, where the results
+  directory goes) started every run, each failing with "--out: cannot write to FILE: Not a
+  directory", one line per study naming an option the command line did not hold
+  (:func:`sim.batch.main`).
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ import pytest
 from oneline import one_line
 
 import sim
+from sim.batch import main as batch
 from sim.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -119,3 +124,18 @@ def test_results_of_a_directory_without_tables_names_the_directory(tmp_path):
     (tmp_path / "notes.txt").write_text("mine")
     with pytest.raises(sim.ConfigError, match=r"^path: .* is not a results directory"):
         sim.Results(tmp_path, "network").claims()
+
+
+@pytest.mark.parametrize("kind", ["file", "dangling link"])
+def test_batch_results_that_is_not_a_directory_is_one_line_before_any_run(tmp_path, capsys, kind):
+    net = tmp_path / "net.toml"
+    net.write_text(README_NET)
+    res = tmp_path / "res"
+    if kind == "file":
+        res.write_text("mine")
+    else:
+        res.symlink_to(tmp_path / "nowhere")
+    rc = batch(["--results", str(res), str(net), "--", "--no-figures"])
+    one_line(capsys, rc, "sim.batch: --results: ", "is not a directory")
+    assert not (tmp_path / "nowhere").exists()
+    assert kind != "file" or res.read_text() == "mine"
