@@ -21,7 +21,10 @@ fix.
 * ``python -m sim.batch --results FILE`` (a file, or a dangling link, where the results
   directory goes) started every run, each failing with "--out: cannot write to FILE: Not a
   directory", one line per study naming an option the command line did not hold
-  (:func:`sim.batch.main`).
+  (:func:`sim.batch.main`);
+* a mistyped option where an argument is still missing (``sim --verison``, ``sim check
+  --hlep``) was answered "the following arguments are required: COMMAND" (or ``study``),
+  naming what the user did not do wrong and not the option (:class:`sim.cli_args._Parser`).
 """
 
 from __future__ import annotations
@@ -139,3 +142,16 @@ def test_batch_results_that_is_not_a_directory_is_one_line_before_any_run(tmp_pa
     one_line(capsys, rc, "sim.batch: --results: ", "is not a directory")
     assert not (tmp_path / "nowhere").exists()
     assert kind != "file" or res.read_text() == "mine"
+
+
+@pytest.mark.parametrize(
+    ("argv", "needles"),
+    [
+        (["--verison"], ("sim: unrecognized arguments: --verison",)),
+        (["check", "--hlep"], ("sim check: unrecognized arguments: --hlep",)),
+        (["run", "--trails=40"], ("sim run: unrecognized arguments: --trails=40",)),
+        (["run", "--no-figures"], ("sim run: the following arguments are required: study",)),
+    ],
+)
+def test_a_mistyped_option_is_named_before_a_missing_argument(capsys, argv, needles):
+    one_line(capsys, main(argv), *needles)
