@@ -24,7 +24,10 @@ fix.
   (:func:`sim.batch.main`);
 * a mistyped option where an argument is still missing (``sim --verison``, ``sim check
   --hlep``) was answered "the following arguments are required: COMMAND" (or ``study``),
-  naming what the user did not do wrong and not the option (:class:`sim.cli_args._Parser`).
+  naming what the user did not do wrong and not the option (:class:`sim.cli_args._Parser`);
+* ``--set “plate.grid=4”`` (typographic quotes pasted from a web page) answered
+  "“plate.grid: unknown key (did you mean plate.grid?)", a guess that reads as the key
+  given; the quote is named (:func:`sim.mc.config.validate`).
 """
 
 from __future__ import annotations
@@ -155,3 +158,9 @@ def test_batch_results_that_is_not_a_directory_is_one_line_before_any_run(tmp_pa
 )
 def test_a_mistyped_option_is_named_before_a_missing_argument(capsys, argv, needles):
     one_line(capsys, main(argv), *needles)
+
+
+def test_a_key_with_a_typographic_quote_names_the_quote(capsys):
+    brown = str(ROOT / "studies" / "brown_table1.toml")
+    line = one_line(capsys, main(["check", brown, "--set", "\u201cplate.grid=4\u201d"]))
+    assert "typographic quote \u201c" in line and "did you mean" not in line

@@ -239,6 +239,10 @@ def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
     return list(dict.fromkeys(same_case + suffixed + same_last + close))[:n]
 
 
+#: quotes an editor or a web page puts where a plain " or ' was typed (“plate.grid=4”)
+TYPOGRAPHIC = "\u201c\u201d\u2018\u2019\u201e\u00ab\u00bb"
+
+
 def validate(
     raw: Mapping[str, Any], schema: Mapping[str, Field], check: Callable[[dict], None] | None = None
 ) -> dict[str, Any]:
@@ -261,6 +265,10 @@ def validate(
         if key not in schema:
             near = did_you_mean(key, schema)
             hint = f" (did you mean {' or '.join(near)}?)" if near else ""
+            curly = [c for c in key if c in TYPOGRAPHIC]
+            if curly:  # --set “plate.grid=4” pasted from a web page or a word processor:
+                # "did you mean plate.grid?" alone reads as the same key
+                hint = f' (it holds the typographic quote {curly[0]}: type a plain " or none)'
             raise ConfigError(key, f"unknown key{hint}")
     cfg = {}
     for key, f in schema.items():
