@@ -27,7 +27,9 @@ fix.
   naming what the user did not do wrong and not the option (:class:`sim.cli_args._Parser`);
 * ``--set “plate.grid=4”`` (typographic quotes pasted from a web page) answered
   "“plate.grid: unknown key (did you mean plate.grid?)", a guess that reads as the key
-  given; the quote is named (:func:`sim.mc.config.validate`).
+  given; the quote is named (:func:`sim.mc.config.validate`); so is one in a study file
+  (``study = “network”``: "malformed TOML: Invalid value (at line 1, column 9)" alone,
+  :func:`sim.mc.config.read_toml`).
 """
 
 from __future__ import annotations
@@ -164,3 +166,20 @@ def test_a_key_with_a_typographic_quote_names_the_quote(capsys):
     brown = str(ROOT / "studies" / "brown_table1.toml")
     line = one_line(capsys, main(["check", brown, "--set", "\u201cplate.grid=4\u201d"]))
     assert "typographic quote \u201c" in line and "did you mean" not in line
+
+
+def test_a_study_file_with_typographic_quotes_names_the_quote(tmp_path, capsys):
+    study = tmp_path / "net.toml"
+    study.write_text(
+        README_NET.replace('y_mm = 0.0, role = "fixed"', "y_mm = 0.0, role = \u201cfixed\u201d"),
+        encoding="utf-8",
+    )
+    one_line(
+        capsys,
+        main(["check", str(study)]),
+        "malformed TOML",
+        "at line 5",
+        "typographic quote \u201c",
+    )
+    study.write_text(README_NET.replace("trials = 40", "trials = "), encoding="utf-8")
+    assert "typographic" not in one_line(capsys, main(["check", str(study)]), "malformed TOML")

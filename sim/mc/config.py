@@ -331,7 +331,12 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again
         raise
     except tomllib.TOMLDecodeError as e:
-        raise ConfigError(None, f"{p}: malformed TOML: {e}") from None
+        at = re.search(r"at line (\d+)", str(e))  # tomllib before 3.14: in the text only
+        n = int(at.group(1)) if at else 0
+        line = data.decode("utf-8").splitlines()[n - 1 : n] if n else []
+        curly = [c for c in "".join(line) if c in TYPOGRAPHIC]  # a word processor's quotes
+        hint = f' (the typographic quote {curly[0]} is no TOML quote: type ")' if curly else ""
+        raise ConfigError(None, f"{p}: malformed TOML: {e}{hint}") from None
     except RecursionError:
         raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None
     except UnicodeDecodeError:
