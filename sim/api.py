@@ -27,7 +27,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.execute import execute
-from sim.mc.config import ConfigError
+from sim.mc.config import ConfigError, study_file_hint
 from sim.mc.estimate import estimate
 from sim.mc.outputs import damaged_chunks
 from sim.mc.runner import MIN_CHUNKS
@@ -287,7 +287,9 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
     if not Path(study_file).is_file():
-        raise ConfigError("study_file", f"{study_file} is not a study file")
+        raise ConfigError(
+            "study_file", f"{study_file} is not a study file{study_file_hint(study_file)}"
+        )
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the
     # working directory may have changed since (it would read another file of that name)
     study_file = _absolute("study_file", study_file)

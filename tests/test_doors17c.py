@@ -29,11 +29,16 @@ fix.
   "“plate.grid: unknown key (did you mean plate.grid?)", a guess that reads as the key
   given; the quote is named (:func:`sim.mc.config.validate`); so is one in a study file
   (``study = “network”``: "malformed TOML: Invalid value (at line 1, column 9)" alone,
-  :func:`sim.mc.config.read_toml`).
+  :func:`sim.mc.config.read_toml`);
+* the study named as a new user names it (``sim check brown_table1``, ``studies/brown_table1``
+  without ``.toml``, ``studies\\brown_table1.toml`` from Windows, ``sim.load("brown_table1")``)
+  was "no such study file" with no way on; the file that exists is suggested
+  (:func:`sim.mc.config.study_file_hint`).
 """
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -183,3 +188,16 @@ def test_a_study_file_with_typographic_quotes_names_the_quote(tmp_path, capsys):
     )
     study.write_text(README_NET.replace("trials = 40", "trials = "), encoding="utf-8")
     assert "typographic" not in one_line(capsys, main(["check", str(study)]), "malformed TOML")
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["brown_table1", "brown_table1.toml", "studies/brown_table1", "studies\\brown_table1.toml"],
+)
+def test_a_study_named_without_its_path_suggests_the_file(capsys, monkeypatch, name):
+    monkeypatch.chdir(ROOT)
+    hint = "(did you mean studies/brown_table1.toml?)"
+    one_line(capsys, main(["check", name]), "no such study file", hint)
+    with pytest.raises(sim.ConfigError, match=r"^study_file: .*" + re.escape(hint)):
+        sim.load(name)
+    assert one_line(capsys, main(["check", "nosuch"])).endswith("nosuch: no such study file")

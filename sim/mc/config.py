@@ -306,6 +306,15 @@ def parse_override(text: str) -> tuple[str, Any]:
 MAX_STUDY_BYTES = 16 * 1024**2
 
 
+def study_file_hint(p: str | Path) -> str:
+    """`` (did you mean studies/brown_table1.toml?)`` for a study file named the way a new
+    user names it: without ``.toml``, without ``studies/``, or with Windows backslashes."""
+    text = str(p).replace("\\", "/")
+    tries = [text, f"{text}.toml", f"studies/{text}", f"studies/{text}.toml"]
+    hit = next((t for t in tries if t != str(p) and Path(t).is_file()), None)
+    return f" (did you mean {hit}?)" if hit else ""
+
+
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML study file; a missing, oversized or malformed file is a ConfigError."""
     p = Path(path)
@@ -314,7 +323,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     if p.exists() and not p.is_file():  # a pipe (cat x.toml | sim check /dev/stdin), a device
         raise ConfigError(None, f"{p}: not a regular file (a pipe or a device): name the file")
     if not p.is_file():
-        raise ConfigError(None, f"{p}: no such study file")
+        raise ConfigError(None, f"{p}: no such study file{study_file_hint(p)}")
     try:
         if p.stat().st_size > MAX_STUDY_BYTES:
             raise ConfigError(
