@@ -33,7 +33,8 @@ fix.
 * the study named as a new user names it (``sim check brown_table1``, ``studies/brown_table1``
   without ``.toml``, ``studies\\brown_table1.toml`` from Windows, ``sim.load("brown_table1")``)
   was "no such study file" with no way on; the file that exists is suggested
-  (:func:`sim.mc.config.study_file_hint`).
+  (:func:`sim.mc.config.study_file_hint`); the same for a ``network.gama_xml`` path with
+  Windows backslashes (:func:`sim.studies.network.gama_vocab.read_bytes`).
 """
 
 from __future__ import annotations
@@ -201,3 +202,18 @@ def test_a_study_named_without_its_path_suggests_the_file(capsys, monkeypatch, n
     with pytest.raises(sim.ConfigError, match=r"^study_file: .*" + re.escape(hint)):
         sim.load(name)
     assert one_line(capsys, main(["check", "nosuch"])).endswith("nosuch: no such study file")
+
+
+def test_a_gama_path_with_backslashes_suggests_the_file(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    study = tmp_path / "g.toml"
+    study.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\n'
+        'gama_xml = "tests\\\\data\\\\gama\\\\one_fixed.xml"\n'
+    )
+    one_line(
+        capsys,
+        main(["check", str(study)]),
+        "network.gama_xml: cannot read tests\\data\\gama\\one_fixed.xml",
+        "(did you mean tests/data/gama/one_fixed.xml?)",
+    )
