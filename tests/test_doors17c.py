@@ -34,7 +34,9 @@ fix.
   without ``.toml``, ``studies\\brown_table1.toml`` from Windows, ``sim.load("brown_table1")``)
   was "no such study file" with no way on; the file that exists is suggested
   (:func:`sim.mc.config.study_file_hint`); the same for a ``network.gama_xml`` path with
-  Windows backslashes (:func:`sim.studies.network.gama_vocab.read_bytes`).
+  Windows backslashes (:func:`sim.studies.network.gama_vocab.read_bytes`);
+* a mistyped key of ``[sweep]`` (``network.nmae``) was "unknown key" with no guess, where the
+  same typo outside ``[sweep]`` is answered with one (:func:`sim.mc.sweep.expand`).
 """
 
 from __future__ import annotations
@@ -216,4 +218,14 @@ def test_a_gama_path_with_backslashes_suggests_the_file(tmp_path, capsys, monkey
         main(["check", str(study)]),
         "network.gama_xml: cannot read tests\\data\\gama\\one_fixed.xml",
         "(did you mean tests/data/gama/one_fixed.xml?)",
+    )
+
+
+def test_a_mistyped_sweep_key_is_answered_with_a_guess(tmp_path, capsys):
+    study = tmp_path / "s.toml"
+    study.write_text(README_NET + '[sweep]\nnetwork.nmae = ["a", "b"]\n')
+    one_line(
+        capsys,
+        main(["check", str(study)]),
+        "sweep.network.nmae: unknown key (did you mean sweep.network.name?)",
     )
