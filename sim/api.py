@@ -27,7 +27,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.execute import execute
-from sim.mc.config import ConfigError
+from sim.mc.config import ConfigError, study_file_hint
 from sim.mc.estimate import estimate
 from sim.mc.outputs import damaged_chunks
 from sim.mc.runner import MIN_CHUNKS
@@ -87,6 +87,8 @@ class Results:
             raise ConfigError("table", f"must be a table name such as 'claims' (got {name!r})")
         self._check_dir()
         p = self.path / (name if name == "trials" else f"{name}.parquet")
+        if not p.exists() and not self.names():  # not "no table 'claims'; it has " (none)
+            raise ConfigError("path", f"{self.path} is not a results directory (no tables)")
         if not p.exists():
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
@@ -179,20 +181,35 @@ class StudyHandle:
             raise ConfigError("out", "is empty: name an output directory")
         out = _absolute("out", out)
         with kept():  # the caller's matplotlib settings as they were (a notebook's)
-            execute(
-                h.study,
-                h.config,
-                h.sweep,
-                out,
-                str(out),
-                executor=executor,
-                workers=workers,
-                scheduler=scheduler,
-                overwrite=overwrite,
-                quiet=quiet,
-                figures=figures,
-            )
+            try:
+                execute(
+                    h.study,
+                    h.config,
+                    h.sweep,
+                    out,
+                    str(out),
+                    executor=executor,
+                    workers=workers,
+                    scheduler=scheduler,
+                    overwrite=overwrite,
+                    quiet=quiet,
+                    figures=figures,
+                )
+            except ConfigError as e:
+                if e.key != "--out":
+                    raise
+                raise _api_words(e) from None
         return Results(out, h.name)
+
+
+def _api_words(e: ConfigError) -> ConfigError:
+    """An output-directory refusal in the API's words: the argument is ``out`` and the way to
+    replace is ``overwrite=True`` (the command line's ``--out``/``--overwrite`` name nothing
+    a caller of ``run()`` can pass)."""
+    msg = str(e).removeprefix("--out: ")
+    for cli, api in (("--overwrite", "overwrite=True"), ("--out", "out")):
+        msg = msg.replace(cli, api)
+    return ConfigError("out", msg)
 
 
 def _sha256(path: Path) -> str:
@@ -285,7 +302,9 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
     if not Path(study_file).is_file():
-        raise ConfigError("study_file", f"{study_file} is not a study file")
+        raise ConfigError(
+            "study_file", f"{study_file} is not a study file{study_file_hint(study_file)}"
+        )
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the
     # working directory may have changed since (it would read another file of that name)
     study_file = _absolute("study_file", study_file)

@@ -320,6 +320,10 @@ def _main(argv: list[str]) -> int:
         why = name_problem(args.results)
         print(f"sim.batch: --results: {why} (got {args.results!r})", file=sys.stderr)
         return 2
+    if os.path.lexists(args.results) and not os.path.isdir(args.results):
+        # each run would name --out, an option this command line does not hold, one by one
+        print(f"sim.batch: --results: {args.results} is not a directory", file=sys.stderr)
+        return 2
     for name, v in [("FILE", f) for f in args.files] + [("--timings", args.timings)]:
         if v is not None and name_problem(v):
             print(f"sim.batch: {name}: {name_problem(v)} (got {v!r})", file=sys.stderr)

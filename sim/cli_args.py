@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import ast
+import sys
 from importlib import metadata
 from pathlib import Path
 
@@ -52,7 +53,24 @@ class OnceParser(BoundedParser):
 class _Parser(OnceParser):
     """argparse with one-line errors (exit 2 through :func:`main`, no usage dump)."""
 
+    def parse_known_args(self, args=None, namespace=None):
+        self.argv = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(args, namespace)
+
     def error(self, message: str):
+        if message.startswith("the following arguments are required"):
+            # `sim --verison`, `sim check --hlep`: the mistyped option, not the missing
+            # argument it left behind, is what the user must fix
+            known = self._option_string_actions
+            bad = [
+                a
+                for a in getattr(self, "argv", [])
+                if a.startswith("-")
+                and a != "-"
+                and not any(o.startswith(a.split("=")[0]) for o in known)
+            ]
+            if bad:
+                message = f"unrecognized arguments: {bad[0]}"
         raise ConfigError(None, f"{self.prog}: {message} (see {self.prog} --help)")
 
 

@@ -239,6 +239,10 @@ def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
     return list(dict.fromkeys(same_case + suffixed + same_last + close))[:n]
 
 
+#: quotes an editor or a web page puts where a plain " or ' was typed (“plate.grid=4”)
+TYPOGRAPHIC = "\u201c\u201d\u2018\u2019\u201e\u00ab\u00bb"
+
+
 def validate(
     raw: Mapping[str, Any], schema: Mapping[str, Field], check: Callable[[dict], None] | None = None
 ) -> dict[str, Any]:
@@ -261,6 +265,10 @@ def validate(
         if key not in schema:
             near = did_you_mean(key, schema)
             hint = f" (did you mean {' or '.join(near)}?)" if near else ""
+            curly = [c for c in key if c in TYPOGRAPHIC]
+            if curly:  # --set “plate.grid=4” pasted from a web page or a word processor:
+                # "did you mean plate.grid?" alone reads as the same key
+                hint = f' (it holds the typographic quote {curly[0]}: type a plain " or none)'
             raise ConfigError(key, f"unknown key{hint}")
     cfg = {}
     for key, f in schema.items():
@@ -302,6 +310,15 @@ def parse_override(text: str) -> tuple[str, Any]:
 MAX_STUDY_BYTES = 16 * 1024**2
 
 
+def study_file_hint(p: str | Path) -> str:
+    """`` (did you mean studies/brown_table1.toml?)`` for a study file named the way a new
+    user names it: without ``.toml``, without ``studies/``, or with Windows backslashes."""
+    text = str(p).replace("\\", "/")
+    tries = [text, f"{text}.toml", f"studies/{text}", f"studies/{text}.toml"]
+    hit = next((t for t in tries if t != str(p) and Path(t).is_file()), None)
+    return f" (did you mean {hit}?)" if hit else ""
+
+
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML study file; a missing, oversized or malformed file is a ConfigError."""
     p = Path(path)
@@ -310,7 +327,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     if p.exists() and not p.is_file():  # a pipe (cat x.toml | sim check /dev/stdin), a device
         raise ConfigError(None, f"{p}: not a regular file (a pipe or a device): name the file")
     if not p.is_file():
-        raise ConfigError(None, f"{p}: no such study file")
+        raise ConfigError(None, f"{p}: no such study file{study_file_hint(p)}")
     try:
         if p.stat().st_size > MAX_STUDY_BYTES:
             raise ConfigError(
@@ -327,7 +344,12 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again
         raise
     except tomllib.TOMLDecodeError as e:
-        raise ConfigError(None, f"{p}: malformed TOML: {e}") from None
+        at = re.search(r"at line (\d+)", str(e))  # tomllib before 3.14: in the text only
+        n = int(at.group(1)) if at else 0
+        line = data.decode("utf-8").splitlines()[n - 1 : n] if n else []
+        curly = [c for c in "".join(line) if c in TYPOGRAPHIC]  # a word processor's quotes
+        hint = f' (the typographic quote {curly[0]} is no TOML quote: type ")' if curly else ""
+        raise ConfigError(None, f"{p}: malformed TOML: {e}{hint}") from None
     except RecursionError:
         raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None
     except UnicodeDecodeError:

@@ -39,7 +39,15 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from sim.mc.config import ConfigError, Field, check_chunks, check_value, read_toml, validate
+from sim.mc.config import (
+    ConfigError,
+    Field,
+    check_chunks,
+    check_value,
+    did_you_mean,
+    read_toml,
+    validate,
+)
 from sim.mc.progress import Progress
 from sim.mc.runner import chunk_rng
 
@@ -170,7 +178,9 @@ def expand(table: Mapping[str, Any], schema: Mapping | None = None):
         if k in ("seed", "study"):
             raise ConfigError(f"sweep.{k}", "cannot be swept (use replicates for seeds)")
         if schema is not None and k not in schema:
-            raise ConfigError(f"sweep.{k}", "unknown key")
+            near = did_you_mean(k, schema)  # as an unknown key outside [sweep] is answered
+            hint = f" (did you mean {' or '.join(f'sweep.{n}' for n in near)}?)" if near else ""
+            raise ConfigError(f"sweep.{k}", f"unknown key{hint}")
         if schema is not None and getattr(schema[k], "sweep", None):
             raise ConfigError(f"sweep.{k}", f"cannot be swept: {schema[k].sweep}")
     vals = [_values(k, table[k]) for k in keys]

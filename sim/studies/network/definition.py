@@ -49,6 +49,7 @@ from sim.studies.network.validate import (
     _obs_common,
     _point_name,
     _role,
+    one_unit,
     title,
 )
 
@@ -136,6 +137,7 @@ def _listed_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
     for a, rec in enumerate(cfg["network.points"]):
         key = f"network.points[{a}]"
         _keys(key, rec, _p, {"name"})
+        one_unit(key, rec, ("x", "y"))
         r, s = _role(key, rec)
         _add(
             pts,
@@ -157,6 +159,7 @@ def _grid_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
     for a, rec in enumerate(cfg["network.grids"]):
         key = f"network.grids[{a}]"
         _keys(key, rec, _g | {"sigma_mm"}, {"prefix", "nx", "ny"})
+        one_unit(key, rec, ("spacing", "origin"))
         nx = _num(f"{key}.nx", rec["nx"], 1, integer=True)
         ny = _num(f"{key}.ny", rec["ny"], 1, integer=True)
         _fits(f"{key}.nx", len(pts[0]) + nx * ny, 0, f"{nx} x {ny} points")
@@ -177,6 +180,7 @@ def _random_points(cfg: dict, rng: np.random.Generator, pts: tuple[list, list, l
     for a, rec in enumerate(cfg["network.random"]):
         key = f"network.random[{a}]"
         _keys(key, rec, _r | {"sigma_mm"}, {"prefix", "n"})
+        one_unit(key, rec, ("half_extent", "center"))
         n = _num(f"{key}.n", rec["n"], 1, integer=True)
         _fits(f"{key}.n", len(pts[0]) + n, 0, f"{n} points")
         e = _mm(key, rec, "half_extent")

@@ -209,7 +209,9 @@ def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
     try:
         st = os.stat(path)
     except OSError as e:
-        raise ConfigError(key, f"cannot read {path}: {e.strerror}") from None
+        slash = str(path).replace("\\", "/")  # a Windows path pasted into the study file
+        hint = f" (did you mean {slash}?)" if slash != str(path) and Path(slash).is_file() else ""
+        raise ConfigError(key, f"cannot read {path}: {e.strerror}{hint}") from None
     if not stat.S_ISREG(st.st_mode):
         raise ConfigError(key, f"{path} is not a regular file")
     if st.st_size > MAX_BYTES:

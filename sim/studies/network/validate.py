@@ -133,6 +133,20 @@ def _role(key: str, rec: dict) -> tuple[int, float]:
     return ROLES.index(role), sig
 
 
+def one_unit(key: str, rec: dict, fields: tuple[str, str]) -> None:
+    """Refuse a record whose lengths mix metres and millimetres (``x_m`` with ``y_mm``, say):
+    a point typed with one key of each would silently be a thousand times off in one axis."""
+    for f in fields:
+        if f"{f}_mm" in rec and f"{f}_m" in rec:
+            raise ConfigError(f"{key}.{f}_m", f"give {f}_mm or {f}_m, not both")
+    m = [f"{f}_m" for f in fields if f"{f}_m" in rec]
+    mm = [f"{f}_mm" for f in fields if f"{f}_mm" in rec]
+    if m and mm:
+        raise ConfigError(
+            f"{key}.{m[0]}", f"in metres while {mm[0]} is in millimetres: give both in one unit"
+        )
+
+
 def _mm(key: str, rec: dict, field: str, required: bool = True, default=None):
     """``rec``'s ``field`` in mm, given as ``field_mm`` or as ``field_m`` (metres, for field
     networks), not both; a pair ``[x, y]`` when the default is one."""
