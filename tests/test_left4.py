@@ -6,6 +6,11 @@ before its fix.
   command lines checked the variables): tqdm is imported by a bar only, and ``sim.load`` (or a
   bar, if the variable is set later) refuses with one :class:`sim.ConfigError` naming the
   variable (:func:`sim.mc.progress.check_environment`);
+* a ``[sweep]`` of ``datum.kind`` over a GNU Gama file with ``adj="XY"`` points and fewer than
+  two fixed points ran its "fixed" cell in the inner datum while ``sweep.parquet`` labelled it
+  "fixed": the fallback is the default's only (:func:`sim.mc.config.given`); an explicit
+  ``fixed`` (file, ``--set``, API, sweep cell) is refused naming the key and the number of
+  fixed points, and the sweep records that cell as infeasible with the reason;
 """
 
 import os
@@ -13,8 +18,16 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pyarrow.parquet as pq
+import pytest
+from oneline import SIM_ERROR, one_line
+
+import sim
+from sim.cli import main
+
 ROOT = Path(__file__).resolve().parents[1]
 BROWN = ROOT / "studies" / "brown_table1.toml"
+GAMA = ROOT / "tests" / "data" / "gama"
 
 
 def _python(env: dict, *lines: str) -> subprocess.CompletedProcess:
@@ -71,3 +84,42 @@ def test_good_tqdm_variables_still_run():
         "print(type(h).__name__)",
     )
     assert p.returncode == 0 and p.stdout.strip() == "StudyHandle", p.stderr
+
+
+def _one_fixed(tmp_path, extra: str = "") -> Path:
+    study = tmp_path / "s.toml"
+    study.write_text(
+        f'study = "network"\ntrials = 40\nchunk = 2\n[network]\n'
+        f'gama_xml = "{GAMA / "one_fixed.xml"}"\n{extra}',
+        encoding="utf-8",
+    )
+    return study
+
+
+FIXED_WORDS = ("datum.kind", '"fixed" cannot hold', "one_fixed.xml has 1 fixed point")
+
+
+def test_an_explicit_fixed_datum_that_cannot_hold_is_refused_the_default_falls_back(
+    tmp_path, capsys
+):
+    study = _one_fixed(tmp_path)
+    assert main(["check", str(study)]) == 0  # the default: gama-local's inner datum
+    assert "datum.kind = 'inner'" in capsys.readouterr().out
+    rc = main(["check", str(study), "--set", "datum.kind=fixed"])
+    one_line(capsys, rc, *FIXED_WORDS, prefix=SIM_ERROR)
+    rc = main(["check", str(_one_fixed(tmp_path, '[datum]\nkind = "fixed"\n'))])
+    one_line(capsys, rc, *FIXED_WORDS, prefix=SIM_ERROR)
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(study, datum__kind="fixed")
+    assert str(e.value).startswith('datum.kind: "fixed" cannot hold'), e.value
+    assert sim.load(study, datum__kind="inner").config["datum.kind"] == "inner"
+
+
+def test_a_swept_fixed_datum_that_cannot_hold_is_not_run_under_its_label(tmp_path, capsys):
+    study = _one_fixed(tmp_path, '[sweep]\n"datum.kind" = ["fixed", "inner"]\n')
+    out = tmp_path / "o"
+    assert main(["run", str(study), "--quiet", "--out", str(out)]) == 0, capsys.readouterr().err
+    rows = pq.read_table(out / "sweep.parquet").to_pylist()
+    assert [r["datum.kind"] for r in rows] == ["fixed", "inner"]
+    assert [r["feasible"] for r in rows] == [False, True]
+    assert all(w in rows[0]["reason"] for w in FIXED_WORDS), rows[0]["reason"]

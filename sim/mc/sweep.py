@@ -200,7 +200,8 @@ def cell_config(study, cfg: Mapping[str, Any], cell: Mapping[str, Any], seed: in
     values and ``seed``, through the study's schema and ``check`` and the chunk rule (a
     :class:`ConfigError` naming the key when the study refuses it)."""
     base = {k: v for k, v in cfg.items() if k != "study"}
-    ccfg = validate({**base, **cell, "seed": seed}, study.schema, study.check)
+    # the cell's keys are the ones it sets: the base is resolved (its defaults already are)
+    ccfg = validate({**base, **cell, "seed": seed}, study.schema, study.check, frozenset(cell))
     ccfg = {"study": cfg["study"], **ccfg}
     check_chunks(ccfg)
     return ccfg
