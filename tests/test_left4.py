@@ -11,6 +11,10 @@ before its fix.
   "fixed": the fallback is the default's only (:func:`sim.mc.config.given`); an explicit
   ``fixed`` (file, ``--set``, API, sweep cell) is refused naming the key and the number of
   fixed points, and the sweep records that cell as infeasible with the reason;
+* ``python -m sim.batch a.toml b.toml -- --set nosuch=1`` printed one "unknown key" line per
+  study after starting each run: a key no study of the batch has is one line and exit 2 before
+  any run; a key only some lack is said once before the runs start
+  (:func:`sim.batch._unknown_sets`);
 """
 
 import os
@@ -23,6 +27,8 @@ import pytest
 from oneline import SIM_ERROR, one_line
 
 import sim
+from sim.batch import _unknown_sets
+from sim.batch import main as batch_main
 from sim.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -123,3 +129,21 @@ def test_a_swept_fixed_datum_that_cannot_hold_is_not_run_under_its_label(tmp_pat
     assert [r["datum.kind"] for r in rows] == ["fixed", "inner"]
     assert [r["feasible"] for r in rows] == [False, True]
     assert all(w in rows[0]["reason"] for w in FIXED_WORDS), rows[0]["reason"]
+
+
+def test_a_set_key_no_study_of_the_batch_has_is_one_line_before_any_run(tmp_path, capsys):
+    files = [str(BROWN), str(ROOT / "studies" / "network_plate.toml")]
+    res = tmp_path / "res"
+    for key in ("nosuch", "network.nosuch"):
+        rc = batch_main([*files, "--results", str(res), "--", "--set", f"{key}=1"])
+        line = one_line(capsys, rc, f"--set {key}: unknown key (no study of the batch has it)")
+        assert line.startswith("sim.batch: run options: "), line
+        assert not res.exists()  # refused before any run
+    rc = batch_main([*files, "--results", str(res), "--", "--set", "nosuch"])
+    one_line(capsys, rc, "--set needs key=value", prefix="sim.batch: run options: ")
+    # a key some studies have: no problem, one note naming those that lack it
+    why, note = _unknown_sets([Path(f) for f in files], ["--set", "plate.grid=4"])
+    assert why is None and note == (
+        "--set plate.grid: unknown to network_plate.toml (network), whose run will refuse it"
+    )
+    assert _unknown_sets([Path(f) for f in files], ["--set", "trials=40"]) == (None, None)
