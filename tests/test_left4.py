@@ -15,6 +15,9 @@ before its fix.
   study after starting each run: a key no study of the batch has is one line and exit 2 before
   any run; a key only some lack is said once before the runs start
   (:func:`sim.batch._unknown_sets`);
+* ``[sweep] trials = 40`` (one value, not a list) was read as a sweep of one cell: any swept
+  key given one value is refused with one short line naming ``sweep.<key>`` and showing the
+  list it takes;
 """
 
 import os
@@ -147,3 +150,25 @@ def test_a_set_key_no_study_of_the_batch_has_is_one_line_before_any_run(tmp_path
         "--set plate.grid: unknown to network_plate.toml (network), whose run will refuse it"
     )
     assert _unknown_sets([Path(f) for f in files], ["--set", "trials=40"]) == (None, None)
+
+
+@pytest.mark.parametrize(
+    "line, key, shown",
+    [
+        ("trials = 40", "sweep.trials", "trials = [40, 80]"),
+        ('"errors.settings" = 2', "sweep.errors.settings", '"errors.settings" = [2, 4]'),
+        ("[sweep.errors]\nbias_um = 0.5", "sweep.errors.bias_um", '"errors.bias_um" = [0.5, 1.0]'),
+    ],
+)
+def test_a_swept_key_given_one_value_is_refused_naming_it(tmp_path, capsys, line, key, shown):
+    study = tmp_path / "s.toml"
+    study.write_text(
+        f'study = "brown_table1"\ntrials = 40\nchunk = 2\n[sweep]\n{line}\n', encoding="utf-8"
+    )
+    for cmd in ("check", "run"):
+        rc = main([cmd, str(study), *(["--out", str(tmp_path / "o")] if cmd == "run" else [])])
+        got = one_line(capsys, rc, f"{key}: a sweep takes a list, e.g. {shown}", prefix=SIM_ERROR)
+        assert len(got) < 120, got
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(sim.ConfigError, match=f"^{key}: a sweep takes a list"):
+        sim.load(study)
