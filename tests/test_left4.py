@@ -18,6 +18,10 @@ before its fix.
 * ``[sweep] trials = 40`` (one value, not a list) was read as a sweep of one cell: any swept
   key given one value is refused with one short line naming ``sweep.<key>`` and showing the
   list it takes;
+* the work estimate left out the region parts of brown, brown_design and salsig (salsig's
+  ``region.trials`` at its bound asked for ~9 GiB and hours, and was estimated at seconds and
+  108 MiB), and counted agnard's about 30 times high: each is now measured
+  (:mod:`sim.mc.estimate`, :func:`sim.mc.workunits.design_estimate`);
 """
 
 import os
@@ -33,6 +37,8 @@ import sim
 from sim.batch import _unknown_sets
 from sim.batch import main as batch_main
 from sim.cli import main
+from sim.mc.estimate import ADJUSTMENT_S, check_limits, estimate
+from sim.studies import load_study
 
 ROOT = Path(__file__).resolve().parents[1]
 BROWN = ROOT / "studies" / "brown_table1.toml"
@@ -172,3 +178,78 @@ def test_a_swept_key_given_one_value_is_refused_naming_it(tmp_path, capsys, line
     assert not (tmp_path / "o").exists()
     with pytest.raises(sim.ConfigError, match=f"^{key}: a sweep takes a list"):
         sim.load(study)
+
+
+#: CPU seconds of the region part alone (one core, process_time around the region's function)
+#: between two sizes of its keys, measured for this estimate: the estimate's difference must
+#: be within 3x of them (the estimate is an order-of-magnitude model)
+REGION_SECONDS = [
+    (
+        "brown_table1",
+        {"region.points": 256, "region.rounds": 0},
+        {"region.points": 16384, "region.rounds": 8},
+        6.2,
+    ),
+    (
+        "brown_dilution",
+        {"region.points": 256, "region.rounds": 0},
+        {"region.points": 16384, "region.rounds": 8},
+        31.5,
+    ),
+    (
+        "brown_design",
+        {"region.points": 256, "region.rounds": 0},
+        {"region.points": 16384, "region.rounds": 8},
+        9.4,
+    ),
+    (
+        "brown_design",
+        {"region.plate_points": 256, "unprinted.plates": 100},
+        {"region.plate_points": 1024, "unprinted.plates": 400_000},
+        102.0,
+    ),
+    (
+        "salsig_encoders",
+        {"region.points": 16, "region.trials": 200},
+        {"region.points": 1024, "region.trials": 200},
+        7.6,
+    ),
+    (
+        "salsig_encoders",
+        {"region.points": 128, "region.trials": 200},
+        {"region.points": 128, "region.trials": 2000},
+        5.6,
+    ),
+    (
+        "agnard_block",
+        {"region.points": 4, "region.trials": 20},
+        {"region.points": 16, "region.trials": 600},
+        45.6,
+    ),
+]
+
+
+@pytest.mark.parametrize("study, small, big, seconds", REGION_SECONDS)
+def test_the_work_estimate_counts_each_region_part_as_measured(study, small, big, seconds):
+    path = ROOT / "studies" / f"{study}.toml"
+    a, b = (estimate(load_study(path, values=v)[1]).adjustments for v in (small, big))
+    est_s = (b - a) * ADJUSTMENT_S
+    assert seconds / 3 < est_s < seconds * 3, (study, big, est_s, seconds)
+
+
+def test_region_keys_at_their_bounds_are_refused_and_the_study_files_are_not():
+    for study in (
+        "brown_table1",
+        "brown_dilution",
+        "brown_design",
+        "salsig_encoders",
+        "agnard_block",
+    ):
+        check_limits(estimate(load_study(ROOT / "studies" / f"{study}.toml")[1]))
+    for study, bound, words in (
+        ("salsig_encoders", {"region.trials": 1_000_000}, "over the 8 GiB limit"),
+        ("agnard_block", {"region.points": 64, "region.trials": 1_000_000}, "over the limit of"),
+    ):
+        cfg = load_study(ROOT / "studies" / f"{study}.toml", values=bound)[1]
+        with pytest.raises(sim.ConfigError, match=words):
+            check_limits(estimate(cfg), max_memory_gb=8, max_adjustments=5e8)
