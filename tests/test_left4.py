@@ -22,6 +22,10 @@ before its fix.
   ``region.trials`` at its bound asked for ~9 GiB and hours, and was estimated at seconds and
   108 MiB), and counted agnard's about 30 times high: each is now measured
   (:mod:`sim.mc.estimate`, :func:`sim.mc.workunits.design_estimate`);
+* a relative ``network.gama_xml`` is read from the working directory (documented); run from
+  elsewhere, the file beside the study file was "cannot read x.xml: No such file" with no
+  hint: the line now names the working directory and the file that exists
+  (:func:`sim.studies._beside_the_study`);
 """
 
 import os
@@ -253,3 +257,33 @@ def test_region_keys_at_their_bounds_are_refused_and_the_study_files_are_not():
         cfg = load_study(ROOT / "studies" / f"{study}.toml", values=bound)[1]
         with pytest.raises(sim.ConfigError, match=words):
             check_limits(estimate(cfg), max_memory_gb=8, max_adjustments=5e8)
+
+
+def test_a_relative_gama_file_beside_the_study_is_named_when_run_from_elsewhere(
+    tmp_path, monkeypatch, capsys
+):
+    (tmp_path / "studies").mkdir()
+    (tmp_path / "studies" / "x.xml").write_bytes((GAMA / "one_fixed.xml").read_bytes())
+    study = tmp_path / "studies" / "x.toml"
+    study.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "x.xml"\n',
+        encoding="utf-8",
+    )
+    monkeypatch.chdir(tmp_path)
+    rc = main(["check", "studies/x.toml"])
+    one_line(
+        capsys,
+        rc,
+        f"network.gama_xml: x.xml not found in {tmp_path}",
+        "studies/x.xml exists: run from studies or give an absolute path",
+        prefix=SIM_ERROR,
+    )
+    with pytest.raises(sim.ConfigError, match="studies/x.xml exists"):
+        sim.load("studies/x.toml")
+    monkeypatch.chdir(tmp_path / "studies")  # the documented rule: the working directory
+    assert main(["check", "x.toml"]) == 0
+    capsys.readouterr()
+    # a path that exists nowhere keeps its plain line
+    monkeypatch.chdir(tmp_path)
+    rc = main(["check", "studies/x.toml", "--set", "network.gama_xml=nosuch.xml"])
+    one_line(capsys, rc, "cannot read nosuch.xml: No such file", prefix=SIM_ERROR)
