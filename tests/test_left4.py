@@ -26,6 +26,10 @@ before its fix.
   elsewhere, the file beside the study file was "cannot read x.xml: No such file" with no
   hint: the line now names the working directory and the file that exists
   (:func:`sim.studies._beside_the_study`);
+* ``sim run --out .`` (or ``..`` from a subdirectory) inside an earlier results directory
+  replaced the directory the shell was in and printed "results in ./" (the shell saw an empty,
+  deleted directory): an existing ``--out`` that holds the working directory is refused with
+  one line, before anything is written (:func:`sim.mc.outputs.check_out`);
 """
 
 import os
@@ -287,3 +291,23 @@ def test_a_relative_gama_file_beside_the_study_is_named_when_run_from_elsewhere(
     monkeypatch.chdir(tmp_path)
     rc = main(["check", "studies/x.toml", "--set", "network.gama_xml=nosuch.xml"])
     one_line(capsys, rc, "cannot read nosuch.xml: No such file", prefix=SIM_ERROR)
+
+
+def test_an_out_that_holds_the_working_directory_is_refused_and_left_alone(
+    tmp_path, monkeypatch, capsys
+):
+    out = tmp_path / "o"
+    argv = ["run", str(BROWN), "--trials", "40", "--quiet", "--no-figures"]
+    assert main([*argv, "--out", str(out)]) == 0
+    capsys.readouterr()
+    before = sorted(p.name for p in out.iterdir())
+    inode = out.stat().st_ino
+    (out / "trials").mkdir(exist_ok=True)
+    for cwd, given in ((out, "."), (out / "trials", ".."), (out / "trials", str(out))):
+        monkeypatch.chdir(cwd)
+        rc = main([*argv, "--overwrite", "--out", given])
+        one_line(capsys, rc, f"--out: {given} holds the working directory", prefix=SIM_ERROR)
+        assert out.stat().st_ino == inode and os.getcwd() == str(cwd)
+    assert sorted(p.name for p in out.iterdir()) == sorted(set(before) | {"trials"})
+    monkeypatch.chdir(tmp_path)  # from outside: replaced as ever
+    assert main([*argv, "--overwrite", "--out", "o"]) == 0
