@@ -311,3 +311,10 @@ def test_an_out_that_holds_the_working_directory_is_refused_and_left_alone(
     assert sorted(p.name for p in out.iterdir()) == sorted(set(before) | {"trials"})
     monkeypatch.chdir(tmp_path)  # from outside: replaced as ever
     assert main([*argv, "--overwrite", "--out", "o"]) == 0
+
+
+def test_the_plate_region_of_brown_design_counts_its_memory():
+    # measured: 211 MB more for 100,000 plates at one input vector (maxrss around the region)
+    path = ROOT / "studies" / "brown_design.toml"
+    est = estimate(load_study(path, values={"unprinted.plates": 100_000})[1])
+    assert 211e6 / 3 < est.bytes < 211e6 * 3 and "plate region" in est.largest, est
