@@ -30,6 +30,7 @@ from sim.execute import execute
 from sim.mc.config import ConfigError, study_file_hint
 from sim.mc.estimate import estimate
 from sim.mc.outputs import damaged_chunks
+from sim.mc.progress import check_environment
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import read_provenance
 from sim.mc.sweep import read_sweep
@@ -301,6 +302,7 @@ def _load_picking_chunk(study_file, vals: dict):
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
+    check_environment()  # TQDM_NCOLS=abc: refused here, not in the middle of a run
     if not Path(study_file).is_file():
         raise ConfigError(
             "study_file", f"{study_file} is not a study file{study_file_hint(study_file)}"

@@ -47,10 +47,11 @@ from sim.cli_args import OnceParser, module_doc  # noqa: E402
 from sim.cli_args import parser as run_parser  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_text, stop_children  # noqa: E402
 from sim.mc.codehash import study_code_hash  # noqa: E402
-from sim.mc.config import ConfigError, StudyError  # noqa: E402
+from sim.mc.config import ConfigError, StudyError, parse_override, read_toml  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.storage import regular_text  # noqa: E402
 from sim.stops import check_interrupt, keep_lost_interrupts, run_program  # noqa: E402
+from sim.studies import get_study  # noqa: E402
 
 if __name__ != "__main__":  # imported: the default handlers (the program: run_program's)
     _loaded()
@@ -239,6 +240,43 @@ def _run_options_problem(run_args: list[str]) -> str | None:
     return None
 
 
+def _unknown_sets(files: list[Path], run_args: list[str]) -> tuple[str | None, str | None]:
+    """``(problem, note)`` of the run options' ``--set`` keys against the studies of the batch
+    (each file's ``study``, its schema): a key no study has is a problem (exit 2 before any
+    run: each run would refuse it, one line per study); a key only some lack is a note said
+    once before the runs start (those runs refuse it). A file whose study cannot be read is
+    left to its run's own line."""
+    with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
+        sets = run_parser(cli_doc).parse_args(["run", "STUDY.toml", *run_args]).set or []
+    keys = []
+    for text in sets:
+        try:
+            key = parse_override(text)[0]
+        except ConfigError as e:  # "--set needs key=value (got 'bad')"
+            return str(e), None
+        keys.append(key)
+    schemas: dict[Path, tuple[str, set]] = {}
+    for f in files:
+        try:
+            name = read_toml(f).get("study")
+            schemas[f] = (name, set(get_study(name).schema))
+        except (ConfigError, OSError, ValueError, RecursionError):
+            continue
+    notes = []
+    for key in dict.fromkeys(keys):
+        lack = [f for f, (_, schema) in schemas.items() if key not in schema]
+        if not lack:
+            continue
+        if len(lack) == len(schemas):
+            many = "no study of the batch has it" if len(files) > 1 else "the study has no such key"
+            return f"--set {key}: unknown key ({many})", None
+        studies = ", ".join(f"{f.name} ({schemas[f][0]})" for f in lack)
+        notes.append(
+            f"--set {key}: unknown to {studies}, whose run{'s' * (len(lack) > 1)} will refuse it"
+        )
+    return None, "; ".join(notes) or None
+
+
 def _on_sigterm(signum, frame):
     raise KeyboardInterrupt
 
@@ -341,6 +379,10 @@ def _main(argv: list[str]) -> int:
     if why:
         print(f"sim.batch: run options: {why}", file=sys.stderr)
         return 2
+    why, note = _unknown_sets(files, run_args)
+    if why:
+        print(f"sim.batch: run options: {why}", file=sys.stderr)
+        return 2
     why = _timings_problem(args.timings) if args.timings is not None else None
     if why:
         print(f"sim.batch: --timings: {why}", file=sys.stderr)
@@ -351,6 +393,8 @@ def _main(argv: list[str]) -> int:
     if not 1 <= args.jobs <= 64:
         print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
         return 2
+    if note:  # once, not one line per run that refuses it
+        print(f"sim.batch: note: {note}", file=sys.stderr)
     log = _Stdout()
     try:
         done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only, log)

@@ -29,6 +29,7 @@ import threading
 from pathlib import Path
 
 import pyarrow as pa
+from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, os_reason, stdout_failed

@@ -5,6 +5,7 @@ so the entry points (:mod:`sim.__main__`, :mod:`sim.batch`) call :func:`single_t
 before anything imports NumPy; the environment of the caller wins.
 """
 
+import io
 import os
 import re
 import resource
@@ -214,18 +215,31 @@ def refuse_bad_environment(prog: str) -> None:
         sys.exit(2)
 
 
-def _refuse_bad_tqdm_variables(prog: str) -> None:
-    """tqdm (the progress bar) reads ``TQDM_<option>`` variables while it is imported and
-    converts each to its option's type: ``TQDM_NCOLS=abc`` ended every command in a
-    traceback from ``tqdm.utils``. Imported here only when such a variable is set."""
+def tqdm_variables_problem() -> str | None:
+    """What is wrong with the ``TQDM_<option>`` variables, or None. tqdm (the progress bar)
+    converts each to its option's type, some while it is imported (``TQDM_NCOLS=abc`` ended
+    every command, and ``import sim.api``, in a traceback from ``tqdm.utils``), some only when a
+    bar is drawn (``TQDM_LOCK_ARGS=x``): so a bar is drawn here, into memory. tqdm is imported
+    only when such a variable is set. The words name the variables, without the program."""
     given = sorted(k for k in os.environ if k.upper().startswith("TQDM_"))
     if not given:
-        return
+        return None
     try:
-        import tqdm  # noqa: F401 - its import reads the variables
-    except (ValueError, TypeError) as e:
-        sys.stderr.write(
-            f"{prog}: error: {', '.join(given)}: tqdm cannot read "
-            f"{'it' if len(given) == 1 else 'them'} ({str(e).splitlines()[0][:200]})\n"
+        from tqdm import tqdm  # its import reads the variables
+
+        sink = io.TextIOWrapper(io.BytesIO(), encoding="utf-8")
+        bar = tqdm(total=2, file=sink, disable=False, leave=False, mininterval=0)
+        bar.update(1)
+        bar.close()
+    except (ValueError, TypeError, KeyError, AttributeError, OverflowError) as e:
+        return (
+            f"{', '.join(given)}: tqdm cannot read "
+            f"{'it' if len(given) == 1 else 'them'} ({str(e).splitlines()[0][:200]})"
         )
+    return None
+
+
+def _refuse_bad_tqdm_variables(prog: str) -> None:
+    if (problem := tqdm_variables_problem()) is not None:
+        sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)

@@ -6,6 +6,7 @@ program run in a fresh Python, for what a test must not do to its own process.""
 import re
 import subprocess
 import sys
+from types import SimpleNamespace
 
 #: how the one line of the sim command and of make verify begin
 SIM_ERROR = "sim: error: "
@@ -26,6 +27,14 @@ def one_line(capsys, rc: int, *needles: str, prefix: str = "", code: int = 2) ->
     assert PROGRAM.match(line) and "Traceback" not in err, (rc, err)
     assert line.startswith(prefix) and all(n in line for n in needles), err
     return line.strip()
+
+
+def one_line_of(proc: subprocess.CompletedProcess, *needles: str, prefix: str = "", code=2):
+    """:func:`one_line` for a command run as a subprocess (its ``stderr`` captured as text):
+    the same checks on ``proc.returncode`` and ``proc.stderr``; the line is returned."""
+
+    captured = SimpleNamespace(readouterr=lambda: SimpleNamespace(out="", err=proc.stderr))
+    return one_line(captured, proc.returncode, *needles, prefix=prefix, code=code)
 
 
 def python_lines(*lines: str) -> subprocess.CompletedProcess:

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+from oneline import one_line
 
 from sim.cli import main
 from sim.mc.config import ConfigError, parse_override
@@ -68,9 +69,7 @@ def test_bad_config_names_the_key(tmp_path, body, key):
 def test_cli_bad_input_one_line_exit_2_no_output(tmp_path, capsys):
     p = write(tmp_path, BASE + "[plate]\ngird = 5\n")
     out = tmp_path / "res"
-    assert main(["run", str(p), "--out", str(out), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "plate.gird" in err[0]
+    one_line(capsys, main(["run", str(p), "--out", str(out), "--quiet"]), "plate.gird")
     assert not out.exists() and not list(tmp_path.glob(".res*"))
 
 
@@ -92,9 +91,7 @@ def test_cli_errors(tmp_path, capsys, args, needle):
         "unknown_study": write(tmp_path, 'study = "nope"\n', "u.toml"),
     }
     args = [a.format(**files) for a in args]
-    assert main(args + ["--out", str(tmp_path / "o"), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and needle in err[0]
+    one_line(capsys, main(args + ["--out", str(tmp_path / "o"), "--quiet"]), needle)
 
 
 def test_unwritable_output_directory(tmp_path, capsys):
@@ -102,9 +99,7 @@ def test_unwritable_output_directory(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("not a directory")
     p = write(tmp_path, BASE)
-    assert main(["run", str(p), "--out", str(blocker / "res"), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "--out" in err[0]
+    one_line(capsys, main(["run", str(p), "--out", str(blocker / "res"), "--quiet"]), "--out")
 
 
 def test_overrides_parse_toml_values():
@@ -205,9 +200,7 @@ def test_a_file_or_a_foreign_directory_is_never_replaced(tmp_path, capsys, overw
     d.mkdir()
     (d / "a.txt").write_text("mine too")
     for out, needle in ((f, "is a file"), (d, "no sim run record")):
-        assert _run(tmp_path, out, *overwrite) == 2
-        err = capsys.readouterr().err.strip().splitlines()
-        assert len(err) == 1 and needle in err[0]
+        one_line(capsys, _run(tmp_path, out, *overwrite), needle)
     assert f.read_text() == "mine" and (d / "a.txt").read_text() == "mine too"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["mine", "notes.txt", "ok.toml"]
 
@@ -254,9 +247,7 @@ def test_option_errors_are_one_line(tmp_path, capsys, args, needle):
     argv = ["run", str(p), "--quiet", *args]
     if "--out" not in args:
         argv += ["--out", str(tmp_path / "o")]
-    assert main(argv) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and needle in err[0], err
+    one_line(capsys, main(argv), needle)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.toml"]
 
 
@@ -274,9 +265,7 @@ def test_a_live_lock_stops_a_second_run_and_overwrite(tmp_path, capsys):
     (stage / "trials" / "half-written").write_text("x")
     try:
         for extra in ([], ["--overwrite"]):
-            assert _run(tmp_path, out, *extra) == 2
-            err = capsys.readouterr().err.strip().splitlines()
-            assert len(err) == 1 and f"pid {os.getpid()}" in err[0] and "running sim" in err[0]
+            one_line(capsys, _run(tmp_path, out, *extra), f"pid {os.getpid()}", "running sim")
         assert (stage / "trials" / "half-written").is_file() and not out.exists()
     finally:
         lock.release()
@@ -307,9 +296,11 @@ def test_a_failed_run_says_where_and_does_not_block_the_corrected_command(
 
     monkeypatch.setattr(studies, "get_study", failing)
     out = tmp_path / "res"
-    assert _run(tmp_path, out, "--set", "errors.settings=2") == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "LinAlgError: SVD did not converge" in err[0], err
+    one_line(
+        capsys,
+        _run(tmp_path, out, "--set", "errors.settings=2"),
+        "LinAlgError: SVD did not converge",
+    )
     assert (tmp_path / ".res.partial" / "run.json").is_file()  # kept: it holds a chunk
     monkeypatch.setattr(studies, "get_study", real)
     assert _run(tmp_path, out, "--set", "errors.settings=3") == 0  # corrected: replaces it

@@ -21,6 +21,8 @@ import json
 import shutil
 from pathlib import Path
 
+from oneline import one_line
+
 from sim import cli
 from sim.cli import main
 from sim.mc import outputs, runner
@@ -47,9 +49,7 @@ def test_an_interrupted_runs_staging_directory_is_no_study_of_the_report(
     shutil.rmtree(res / "network_brown")
     (res / "REPORT.md").unlink()
     capsys.readouterr()
-    assert main(["report", "--results", str(res)]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "no study results" in err[0], err
+    one_line(capsys, main(["report", "--results", str(res)]), "no study results")
     assert sorted(p.name for p in res.iterdir()) == [".network_brown.partial"]
 
 
@@ -103,10 +103,6 @@ def test_ctrl_c_inside_an_import_is_an_interruption(tmp_path, monkeypatch, capsy
     out = tmp_path / "np"
     monkeypatch.setattr(runner.RunContext, "progress_bar", _import_cut_short)
     cmd = ["run", f, "--out", str(out), "--quiet", "--no-figures", "--set", "trials=40"]
-    assert main([*cmd, "--set", "chunk=2"]) == 130
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("sim: interrupted"), err
+    one_line(capsys, main([*cmd, "--set", "chunk=2"]), prefix="sim: interrupted", code=130)
     monkeypatch.setattr(cli, "_check", _import_cut_short)  # outside a run: the same
-    assert main(["check", f]) == 130
-    err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["sim: interrupted"], err
+    assert one_line(capsys, main(["check", f]), code=130) == "sim: interrupted"

@@ -33,6 +33,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from oneline import one_line
 
 import sim
 from sim.batch import main as batch_main
@@ -82,10 +83,7 @@ def test_a_format_so_large_that_ranges_overflow_names_the_format(capsys):
     """Brown's stations stand half the format plus the offset from the centre; a format of
     1e300 mm was blamed on the 17 mm ``comparator.station_offset_mm``."""
     argv = ["check", str(ROOT / "studies" / "brown_table1.toml"), "--set", "plate.format_mm=1e300"]
-    assert main(argv) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.startswith("sim: error: plate.format_mm: ") and "overflow" in err
-    assert "\n" not in err
+    one_line(capsys, main(argv), "overflow", prefix="sim: error: plate.format_mm: ")
 
 
 @pytest.mark.parametrize(
@@ -99,17 +97,14 @@ def test_salsig_scales_that_overflow_are_refused_on_load(capsys, setting, key):
     """A comparator scale of 1e308 ran and recovered nonsense (SX 1000 digits); a z scale
     (and B8 scales) of 1e300 ran, printed a NumPy warning and failed after the run."""
     argv = ["check", str(ROOT / "studies" / "salsig_encoders.toml"), "--set", setting]
-    assert main(argv) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.startswith(f"sim: error: {key}: ") and "\n" not in err
+    one_line(capsys, main(argv), prefix=f"sim: error: {key}: ")
 
 
 def test_an_output_that_cannot_show_a_name_is_named(capsys, monkeypatch):
     """``PYTHONIOENCODING=ascii sim check`` of a network named 'café' said only
     "UnicodeEncodeError: 'ascii' codec can't encode ...", not that the output was the matter."""
     monkeypatch.setattr(sys, "stdout", io.TextIOWrapper(io.BytesIO(), encoding="ascii"))
-    assert main(["check", str(NETWORK), "--set", 'network.name="café"']) == 2
-    err = capsys.readouterr().err.strip()
+    err = one_line(capsys, main(["check", str(NETWORK), "--set", 'network.name="café"']))
     assert err == (
         "sim: error: the output (encoding ascii) cannot show '\\xe9': set PYTHONIOENCODING=utf-8"
     )
@@ -122,9 +117,7 @@ def test_a_key_given_by_its_option_and_by_set_is_refused(tmp_path, capsys, opts)
     """``sim run --trials 40 --set trials=60`` ran 40 trials without a word (and ``make
     verify --trials 400 --set trials=40`` dropped the user's --set the same way)."""
     argv = ["run", str(NETWORK), *opts, "--no-figures", "--quiet", "--out", str(tmp_path / "o")]
-    assert main(argv) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.startswith(f"sim: error: {opts[0]}: given twice") and "\n" not in err
+    one_line(capsys, main(argv), prefix=f"sim: error: {opts[0]}: given twice")
     assert not (tmp_path / "o").exists()
 
 
@@ -134,9 +127,8 @@ def test_batch_names_the_results_directory_two_files_would_share(tmp_path, capsy
         (tmp_path / d).mkdir()
         shutil.copy(NETWORK, tmp_path / d / "x.toml")
     files = [str(tmp_path / d / "x.toml") for d in "ab"]
-    assert batch_main(["--results", str(tmp_path / "out"), *files]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.endswith(f"would both write {tmp_path / 'out' / 'x'}") and "\n" not in err
+    err = one_line(capsys, batch_main(["--results", str(tmp_path / "out"), *files]))
+    assert err.endswith(f"would both write {tmp_path / 'out' / 'x'}"), err
 
 
 def test_a_user_directory_named_like_a_file_of_the_run_is_named(tmp_path, capsys):
@@ -149,10 +141,8 @@ def test_a_user_directory_named_like_a_file_of_the_run_is_named(tmp_path, capsys
     (d / "claims.parquet").mkdir()
     (d / "claims.parquet" / "notes.txt").write_text("mine")
     capsys.readouterr()
-    assert main([*run, "--overwrite", "--seed", "5"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.startswith(f"sim: error: --out: {d / 'claims.parquet'} was not written by sim")
-    assert "\n" not in err
+    prefix = f"sim: error: --out: {d / 'claims.parquet'} was not written by sim"
+    one_line(capsys, main([*run, "--overwrite", "--seed", "5"]), prefix=prefix)
     assert (d / "claims.parquet" / "notes.txt").read_text() == "mine"
 
 
@@ -164,6 +154,8 @@ def test_a_block_too_large_to_build_is_refused_before_it_is_built(capsys):
     block = ["block.strips=50", "block.models=200"]
     trade = ["tradeoff.block_strips=[50,1,1,1,1,1]", "tradeoff.block_models=[200,1,1,1,1,1]"]
     for key, sets in (("block.models", block), ("tradeoff.block_models", trade)):
-        assert main(["check", f, *(a for s in sets for a in ("--set", s))]) == 2
-        err = capsys.readouterr().err.strip().splitlines()
-        assert len(err) == 1 and f"{key}: a block of 50 x 200 = 10000 models" in err[0], err
+        one_line(
+            capsys,
+            main(["check", f, *(a for s in sets for a in ("--set", s))]),
+            f"{key}: a block of 50 x 200 = 10000 models",
+        )

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+from oneline import one_line
 
 from sim.cli import main
 from sim.mc.runner import ChunkStore, chunk_rng, jackknife, make_executor, run_chunks
@@ -154,11 +155,10 @@ def test_kill_9_then_same_command_finishes_missing_chunks(tmp_path, capsys):
             break
         time.sleep(0.05)
     second = main(cmd[3:] + ["--overwrite"])  # the same --out while the first one lives
-    err = capsys.readouterr().err.strip().splitlines()
     workers = _children(p.pid)
     os.kill(p.pid, signal.SIGKILL)
     p.wait()
-    assert second == 2 and len(err) == 1 and f"running sim (pid {p.pid})" in err[0], err
+    one_line(capsys, second, f"running sim (pid {p.pid})")
     done = len(list(stage.glob("chunk-*.parquet")))
     assert 3 <= done < 400, "the run finished before it could be killed; make it longer"
     assert not out.exists()  # nothing that looks complete
@@ -188,14 +188,8 @@ def test_full_disk_is_one_line_and_no_result(tmp_path, capsys, monkeypatch):
 
     monkeypatch.setattr(runner.pq, "write_table", full)
     out = tmp_path / "o"
-    assert (
-        main(
-            ["run", str(STUDY), "--out", str(out), "--trials", "20", "--quiet", "--set", "chunk=1"]
-        )
-        == 2
-    )
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "No space left" in err[0]
+    argv = ["run", str(STUDY), "--out", str(out), "--trials", "20", "--quiet", "--set", "chunk=1"]
+    one_line(capsys, main(argv), "No space left")
     assert not out.exists()
 
 
@@ -212,9 +206,7 @@ def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, 
     # a plain run of the degenerate cell is a one-line error, exit 2
     g = tmp_path / "g.toml"
     g.write_text(SMALL + "[plate]\ngrid = 2\n")
-    assert main(["run", str(g), "--out", str(tmp_path / "g"), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "singular" in err[0]
+    one_line(capsys, main(["run", str(g), "--out", str(tmp_path / "g"), "--quiet"]), "singular")
 
 
 # --- sweeps are bounded, estimates stop oversized runs, statistics are numbers -------------
@@ -237,9 +229,7 @@ def test_degenerate_cell_in_a_sweep_is_recorded_and_the_sweep_goes_on(tmp_path, 
 def test_sweep_cell_count_is_finite_and_bounded(tmp_path, capsys, sweep, needle):
     f = tmp_path / "s.toml"
     f.write_text(SMALL + f"[sweep]\n{sweep}\n")
-    assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and needle in err[0], err
+    one_line(capsys, main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]), needle)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
 
 
@@ -264,9 +254,12 @@ def test_dotted_range_syntax_and_sweep_chunks_carry_provenance(tmp_path):
 def test_a_sweep_whose_every_cell_fails_exits_2_with_the_reasons(tmp_path, capsys):
     f = tmp_path / "s.toml"
     f.write_text(SMALL + '[sweep]\n"plate.spacing_mm" = [80.0, 90.0]\n')
-    assert main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "every cell failed (2 of 2)" in err[0] and "plate" in err[0]
+    one_line(
+        capsys,
+        main(["run", str(f), "--out", str(tmp_path / "o"), "--quiet"]),
+        "every cell failed (2 of 2)",
+        "plate",
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
 
 
@@ -280,12 +273,10 @@ def test_the_estimate_stops_an_oversized_run_at_once(tmp_path, capsys, monkeypat
     big = estimate(cfg)
     assert big.unknowns == 2 * 200**2 + 7 and big.bytes > 1000 * small.bytes
     args = ["run", str(STUDY), "--out", str(tmp_path / "o"), "--quiet", "--set", "chunk=100"]
-    assert main(args + ["--max-memory-gb", "0.001"]) == 2
+    one_line(capsys, main(args + ["--max-memory-gb", "0.001"]), "GiB limit", "4,000 trials")
     monkeypatch.setenv("SIM_MAX_ADJUSTMENTS", "1000")
-    assert main(args) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 2 and "GiB limit" in err[0] and "adjustments" in err[1]
-    assert "4,000 trials" in err[0] and not (tmp_path / "o").exists()
+    one_line(capsys, main(args), "adjustments")
+    assert not (tmp_path / "o").exists()
 
 
 def test_require_finite_and_write_table_refuse_non_finite_statistics(tmp_path):

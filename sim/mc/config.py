@@ -243,13 +243,32 @@ def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
 TYPOGRAPHIC = "\u201c\u201d\u2018\u2019\u201e\u00ab\u00bb"
 
 
+class Resolved(dict):
+    """The dict :func:`validate` gives ``check``: ``given`` holds the keys the file, an option
+    or a sweep cell set, as against those left at their defaults (a study whose default
+    resolves by the input, as the network's ``datum.kind`` by an imported file, refuses an
+    explicit value that cannot hold instead of replacing it). A copy is a plain dict."""
+
+    given: frozenset = frozenset()
+
+
+def given(cfg: Mapping[str, Any], key: str) -> bool:
+    """Whether ``key`` was set (not its default) in ``cfg`` as :func:`validate` resolved it;
+    False for a plain dict (a configuration resolved before, whose check has run)."""
+    return key in getattr(cfg, "given", ())
+
+
 def validate(
-    raw: Mapping[str, Any], schema: Mapping[str, Field], check: Callable[[dict], None] | None = None
+    raw: Mapping[str, Any],
+    schema: Mapping[str, Field],
+    check: Callable[[dict], None] | None = None,
+    set_keys: frozenset | None = None,
 ) -> dict[str, Any]:
     """Resolve a flat ``{dotted: value}`` mapping against ``schema``.
 
     Unknown keys are errors; missing keys take their defaults. ``check`` receives the
-    resolved dict for cross-key rules and raises :class:`ConfigError` itself.
+    resolved dict (a :class:`Resolved` whose ``given`` is ``set_keys``, by default the keys of
+    ``raw``) for cross-key rules and raises :class:`ConfigError` itself.
     """
     raw = {
         k: v
@@ -270,7 +289,8 @@ def validate(
                 # "did you mean plate.grid?" alone reads as the same key
                 hint = f' (it holds the typographic quote {curly[0]}: type a plain " or none)'
             raise ConfigError(key, f"unknown key{hint}")
-    cfg = {}
+    cfg = Resolved()
+    cfg.given = frozenset(raw if set_keys is None else set_keys)
     for key, f in schema.items():
         v = raw.get(key, f.default)
         if v is None:

@@ -43,6 +43,7 @@ from sim.mc.workunits import (
     COPIES,
     F8,
     design_grid_equivalents,
+    region_points,
 )
 from sim.mc.workunits import dense_units as _dense
 from sim.mc.workunits import design_estimate as _design
@@ -141,7 +142,15 @@ def _brown(c: Mapping) -> tuple:
         len(grids) + _n(c.get("dilution.offsets_mm", [])) + _n(c.get("dilution.extents_mm", []))
     )
     b = max(ch * 4 * n * U * F8, 4 * n_an * 7 * F8 * 3) * COPIES
-    return T, T * per + analytic, max(U, 2 * n_an + 7), b
+    # the region, analytic cofactors at every input vector it evaluates (measured, one core:
+    # 16,384 points and 8 rounds, 49,152 vectors, 6.2 s for Table 1's region, 31.5 s for the
+    # Concept's, which adds the monotone curves over grids)
+    region = region_points(c) * (BROWN_REGION_UNITS.get(c.get("study"), 13.0))
+    return T, T * per + analytic + region, max(U, 2 * n_an + 7), b
+
+
+#: unit adjustments of one input vector of brown's region, by study (measured; see _brown)
+BROWN_REGION_UNITS = {"brown_table1": 2.5, "brown_dilution": 13.0}
 
 
 def _gridplate(c: Mapping) -> tuple:
@@ -174,7 +183,17 @@ def _salsig(c: Mapping) -> tuple:
     adj = 6 * T + 3 * cells * pT + 2 * relief
     n = max(marks, grid, pm, c.get("zscale.points", 9), c.get("vertical.control", 6) ** 2)
     b = ch * n * 2 * 6 * F8 * COPIES * 4
+    # the region: region.trials models at each of region.points input vectors, all of them in
+    # memory at once (measured, one core: 2.6 ms + 24 us a model a vector, 7.7 s for 1,024 x
+    # 200 and 6.5 s for 128 x 2,000; 617 MB for 100,000 models of up to 20 control points)
+    rT = c.get("region.trials", 0)
+    adj += c.get("region.points", 0) * (51.0 + 0.47 * rT)
+    b = max(b, rT * SALSIG_REGION_MODEL_BYTES)
     return trials, adj, 7, b
+
+
+#: bytes of one simulated model of salsig's region (6.2 kB measured, with copies' headroom)
+SALSIG_REGION_MODEL_BYTES = 1.0e4
 
 
 def _wolf(c: Mapping) -> tuple:
@@ -266,14 +285,16 @@ def _agnard(c: Mapping) -> tuple:
     snoop = 1 + c.get("snoop.max_reject", 0)
     w, wt = AGNARD_MODEL_UNITS * M, AGNARD_MODEL_UNITS * Mt  # unit adjustments a block solve
     # the region: region.trials blocks adjusted once per layout of region.points, without
-    # and with the projection centres
+    # and with the projection centres, snooping rejecting few points (measured, one core, on
+    # the 2 x 8 block: 4.3-4.9 ms a block and layout, 46.6 s for 16 x 600, about 95 units
+    # against 2 w = 112; counted with the snooping's maximum, it was 30 times high)
     rT, r_pts = c.get("region.trials", 0), c.get("region.points", 0)
     adj = (
         T * (3 + layouts) * snoop * w
         + tT * (2 * dp + rc) * snoop * w
         + bT * len(sizes) * 2 * wt
         + sT * s_cells * 3 * snoop * w
-        + rT * r_pts * 2 * snoop * w
+        + rT * r_pts * 2 * w
     )
     # reduced normal equations of the models (7 x 7 blocks coupled through the points); the
     # block-size trade-off bounds its chunk by the pair blocks (4e6 floats)

@@ -122,6 +122,16 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
             f"{shown} is a file, not a results directory; sim never "
             "replaces it (choose another --out)",
         )
+    try:  # the run replaces out: a shell inside it would be left in a deleted directory
+        cwd, o = Path(os.getcwd()).resolve(), out.resolve()
+    except (OSError, RuntimeError):
+        cwd = o = None
+    if cwd is not None and (cwd == o or o in cwd.parents):
+        raise ConfigError(
+            "--out",
+            f"{shown} holds the working directory, and the run replaces it (the shell would be "
+            f"left in a deleted directory): run from outside it (cd {o.parent})",
+        )
     old = read_record(out)
     if old is None:
         if any(out.iterdir()):

@@ -10,14 +10,23 @@ from __future__ import annotations
 
 import sys
 
-from tqdm import tqdm
+from sim.mc.config import ConfigError
+from sim.threads import tqdm_variables_problem
 
-__all__ = ["Progress"]
+__all__ = ["Progress", "check_environment"]
 
 _FORMAT = (
     "{desc} {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} trials "
     "[{elapsed}<{remaining}, {rate_fmt}{postfix}]"
 )
+
+
+def check_environment() -> None:
+    """Raise :class:`ConfigError` naming the ``TQDM_<option>`` variables tqdm cannot read.
+    tqdm is imported only by a bar (here or in :class:`Progress`), not by importing the suite:
+    ``import sim.api`` with ``TQDM_NCOLS=abc`` set ended in a traceback from ``tqdm.utils``."""
+    if (problem := tqdm_variables_problem()) is not None:
+        raise ConfigError(None, problem)
 
 
 class Progress:
@@ -38,6 +47,9 @@ class Progress:
         self.done = 0
         stream = stream if stream is not None else sys.stderr
         self.enabled = not quiet and hasattr(stream, "isatty") and stream.isatty()
+        check_environment()
+        from tqdm import tqdm
+
         self.bar = tqdm(
             total=self.total,
             desc=label,

@@ -158,7 +158,21 @@ def _values(key: str, v: Any) -> list:
         if all(isinstance(x, int) for x in (a, b, v.get("step", 0))) and "num" not in v:
             return [int(x) for x in out]
         return [float(x) for x in out]
-    return [v]
+    raise ConfigError(f"sweep.{key}", f"a sweep takes a list, e.g. {_example(key, v)} (got {v!r})")
+
+
+def _example(key: str, v: Any) -> str:
+    """``key = [v, ...]`` in TOML, the way to sweep a key given one value (``trials = 40`` was
+    read as a sweep of one cell)."""
+    name = key if key.replace("_", "").isalnum() else f'"{key}"'
+    if isinstance(v, int) and not isinstance(v, bool) and abs(v) < 2**52:
+        more = repr(2 * v or 1)
+    elif isinstance(v, float) and math.isfinite(v):
+        more = repr(2 * v or 1.0)
+    else:
+        more = "..."
+    first = f'"{v}"' if isinstance(v, str) and len(v) < 40 and '"' not in v else repr(v)[:40]
+    return f"{name} = [{str(v).lower() if isinstance(v, bool) else first}, {more}]"
 
 
 def expand(table: Mapping[str, Any], schema: Mapping | None = None):
@@ -200,7 +214,8 @@ def cell_config(study, cfg: Mapping[str, Any], cell: Mapping[str, Any], seed: in
     values and ``seed``, through the study's schema and ``check`` and the chunk rule (a
     :class:`ConfigError` naming the key when the study refuses it)."""
     base = {k: v for k, v in cfg.items() if k != "study"}
-    ccfg = validate({**base, **cell, "seed": seed}, study.schema, study.check)
+    # the cell's keys are the ones it sets: the base is resolved (its defaults already are)
+    ccfg = validate({**base, **cell, "seed": seed}, study.schema, study.check, frozenset(cell))
     ccfg = {"study": cfg["study"], **ccfg}
     check_chunks(ccfg)
     return ccfg

@@ -35,6 +35,15 @@ COPIES = 6.0  # working copies of the largest array (residuals, Jacobian, ...)
 #: check on the paper's plate (P-position solver, 4 positions x 25 points, 57 unknowns),
 #: counted as 3 adjustments. The default limit of 5e8 is then about 7 hours on one core.
 ADJUSTMENT_S = 5.1e-5
+#: points a region's boundary refinement adds at most each round
+#: (``sim.claims.inference.explore``'s ``max_new``)
+REGION_MAX_NEW = 4096
+
+
+def region_points(c: Mapping, n_key: str = "region.points", rounds_key: str = "region.rounds"):
+    """Input vectors a region evaluates at most: its Sobol design and, each refinement round,
+    up to :data:`REGION_MAX_NEW` more at its boundaries."""
+    return c.get(n_key, 0) + REGION_MAX_NEW * c.get(rounds_key, 0)
 
 
 def n_of(v: Any) -> float:
@@ -141,6 +150,12 @@ def design_estimate(c: Mapping) -> tuple:
     PE = n_of(c.get("design.positions", [1])) * n_of(c.get("design.extents_mm", [1]))
     eq = design_grid_equivalents(grids, PE, 1, geometries)
     adj += eq
+    # the regions (measured, one core): the tolerance region 0.19 ms an input vector (9.5 s
+    # for 16,384 points and 8 rounds, 49,152 vectors); the plate region 0.25 us a plate at each
+    # of region.plate_points vectors (102 s for 1,024 x 400,000 plates) and 0.5 ms a vector
+    adj += 3.8 * region_points(c) + c.get("region.plate_points", 0) * (
+        10.0 + 4.9e-3 * c.get("unprinted.plates", 0)
+    )
     analytic = (
         eq,
         "design.grids",
@@ -154,6 +169,8 @@ def design_estimate(c: Mapping) -> tuple:
         "the coverage": design_chunk_bytes(ch, 4, nc),
         f"the analytic design grid ({int(geometries)} offset x beta geometries of {int(G)} x "
         f"{int(G)} points)": DESIGN_COFACTOR_COPIES * geometries * (2 * n) ** 2 * F8,
+        # measured: 211 MB more for 100,000 plates at a vector, all of them held at once
+        "the plate region (unprinted.plates plates at once)": 2.2e3 * c.get("unprinted.plates", 0),
     }
     what = max(parts, key=parts.get)
     return trials, adj, max(U, 2 * int(max(nc, n_paper)) + 7), parts[what], what, analytic

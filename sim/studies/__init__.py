@@ -8,6 +8,7 @@ of ``results/REPORT.md`` built from those files alone.
 from __future__ import annotations
 
 import importlib
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -88,5 +89,30 @@ def load_study(
         flat["trials"] = trials
     if seed is not None:
         flat["seed"] = seed
-    cfg = validate(flat, study.schema, study.check)
+    try:
+        cfg = validate(flat, study.schema, study.check)
+    except ConfigError as e:
+        raise _beside_the_study(e, Path(path), flat) from None
     return study, {"study": name, **cfg}
+
+
+def _beside_the_study(e: ConfigError, path: Path, flat: Mapping[str, Any]) -> ConfigError:
+    """``e``, or, when it names a key whose value is a relative path that does not exist in
+    the working directory (against which such paths resolve, as documented) but does beside
+    the study file, one line saying so: run from there or give an absolute path."""
+    v = flat.get(e.key) if isinstance(e.key, str) else None
+    if not isinstance(v, str) or not v.strip() or os.path.isabs(v) or os.path.lexists(v):
+        return e
+    try:
+        beside = path.parent / v
+        if not beside.is_file():
+            return e
+        where = os.path.relpath(path.parent) if path.parent != Path(".") else "."
+        shown = os.path.relpath(beside)
+    except (OSError, ValueError):
+        return e
+    return ConfigError(
+        e.key,
+        f"{v} not found in {os.getcwd()} (a relative path is read from the working directory); "
+        f"{shown} exists: run from {where} or give an absolute path",
+    )

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.mc.config import ConfigError
+from sim.mc.config import ConfigError, given
 from sim.studies.network.definition import Network
 from sim.studies.network.gama_read import CC, NS, read_bytes, read_gama
 from sim.studies.network.model import computed
@@ -85,7 +85,16 @@ def merge_gama(cfg: dict) -> dict:
         # adj="XY" points: gama-local removes the defect its fixed points leave over them (all
         # of it in a free network, the rotation about a single fixed point), as the suite's
         # own export of an inner datum writes it (its round trip), so the study does too; two
-        # fixed points or more leave no defect, and the datum stays fixed
+        # fixed points or more leave no defect, and the datum stays fixed. A fixed datum the
+        # study asked for (the file, --set, a sweep cell) is refused: it would not be the one run
+        if given(cfg, "datum.kind"):
+            raise ConfigError(
+                "datum.kind",
+                f'"fixed" cannot hold: {Path(path).name} has {fixed} fixed '
+                f"point{'' if fixed == 1 else 's'} (a fixed datum needs two or more) and "
+                'adj="XY" points, which gama-local adjusts in the inner datum: set datum.kind '
+                '= "inner" (or leave it out: the default falls back to it)',
+            )
         out["datum.kind"] = "inner"
     return out
 
