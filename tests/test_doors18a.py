@@ -7,6 +7,10 @@ found them (``run.sh``, about 250 cases) lives outside the project.
   lock afterwards and replaced the first run's results at its end without ``--overwrite``:
   the output was checked before the lock, and checked again under it only as if
   ``--overwrite`` had been given (:func:`sim.execute.execute`);
+* an ``--overwrite`` whose old results hold a file it may not remove keeps them in
+  ``.<name>.old.<pid>``; in a container, where every command is the same pid, the next such
+  run failed after every trial with "sim: error: Directory not empty: OUT", and so did every
+  later run until the user found the hidden directory (:func:`sim.mc.outputs.publish`).
 """
 
 from __future__ import annotations
@@ -19,6 +23,8 @@ from oneline import SIM_ERROR, one_line
 
 from sim import execute
 from sim.cli import main
+from sim.mc import outputs
+from sim.mc.storage import read_record, write_record
 
 ROOT = Path(__file__).resolve().parent.parent
 PLATE = str(ROOT / "studies" / "network_plate.toml")
@@ -49,3 +55,30 @@ def test_a_run_published_while_another_starts_its_executor_is_not_replaced(
         if f.is_file():
             assert (out / f.relative_to(other)).read_bytes() == f.read_bytes()
     assert not (tmp_path / ".out.partial").exists()
+
+
+def test_old_results_left_by_a_run_of_the_same_pid_do_not_block_the_next(
+    tmp_path, monkeypatch, capsys
+):
+    """``--overwrite`` of results holding a file that cannot be removed keeps the old results
+    in ``.<name>.old.<pid>``; in a container every command is the same pid, and the next
+    ``--overwrite`` failed after every trial with "Directory not empty" (and so did every
+    run after it)."""
+    out, stage = tmp_path / "res", tmp_path / ".res.partial"
+    monkeypatch.setattr(outputs.shutil, "rmtree", lambda p, ignore_errors=False: None)
+    for seed in (1, 2, 3):
+        (stage / "trials").mkdir(parents=True)
+        chunk = "trials/chunk-000000.parquet"
+        write_record(stage, {"config": {"seed": seed}, "code_hash": "x", "files": [chunk]})
+        (stage / "trials" / "chunk-000000.parquet").write_bytes(b"%d" % seed)
+        outputs.publish(stage, out)
+        assert read_record(out)["config"] == {"seed": seed} and not stage.exists()
+    old = outputs.swap_dir(out)
+    kept = sorted(p.relative_to(old).as_posix() for p in old.rglob("chunk-*"))
+    assert kept == ["res.1/trials/chunk-000000.parquet", "trials/chunk-000000.parquet"]
+    assert (old / "trials" / "chunk-000000.parquet").read_bytes() == b"1"
+    assert (old / "res.1" / "trials" / "chunk-000000.parquet").read_bytes() == b"2"
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and err[1].startswith(
+        f"sim: note: the replaced results are kept in {old / 'res.1'} ("
+    )

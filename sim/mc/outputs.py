@@ -398,6 +398,22 @@ def _clash(stage: Path, f: str) -> str | None:
     return f if q.exists() or q.is_symlink() else None
 
 
+def _free_swap(out: Path) -> Path:
+    """Where :func:`publish` moves the old results: :func:`swap_dir`, or a new entry in it when
+    a run of the same pid (a container's) left old files there it could not remove."""
+    old = swap_dir(out)
+    if not (old.exists() or old.is_symlink()):
+        return old
+    if old.is_symlink() or not old.is_dir():
+        raise ConfigError(
+            "--out", f"{old} is in the way (not a directory sim left); move it away and run again"
+        )
+    k = 1
+    while (old / f"{out.name}.{k}").exists() or (old / f"{out.name}.{k}").is_symlink():
+        k += 1
+    return old / f"{out.name}.{k}"
+
+
 def publish(stage: Path, out: Path) -> None:
     """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
     files in ``out`` that the suite did not write."""
@@ -420,11 +436,13 @@ def publish(stage: Path, out: Path) -> None:
         write_record(stage, {**rec, "carried": keep})
     for f in keep:
         _carry(out / f, stage / f)
-    old = swap_dir(out)
-    if out.exists():
+    old = _free_swap(out) if out.exists() else None
+    if old is not None:
         os.replace(out, old)
     os.replace(stage, out)
     (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
+    if old is None:
+        return
     shutil.rmtree(old, ignore_errors=True)
     if old.exists() or old.is_symlink():  # a file or directory of the old results that this
         # user may not remove: they are not lost, but say where (a hidden directory)
