@@ -28,6 +28,7 @@ from sim.mc.storage import (
     code_hash,
     provenance,
     read_table,
+    umask_problem,
     versions,
     write_table,
 )
@@ -145,6 +146,8 @@ def execute(
         "versions": versions(),
         **({} if figures else {"figures": False}),
     }
+    if (why := umask_problem()) is not None:
+        raise ConfigError(None, why)
     check_out(out, shown, record, overwrite)
     stage = stage_dir(out)
     try:

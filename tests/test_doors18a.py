@@ -10,12 +10,18 @@ found them (``run.sh``, about 250 cases) lives outside the project.
 * an ``--overwrite`` whose old results hold a file it may not remove keeps them in
   ``.<name>.old.<pid>``; in a container, where every command is the same pid, the next such
   run failed after every trial with "sim: error: Directory not empty: OUT", and so did every
-  later run until the user found the hidden directory (:func:`sim.mc.outputs.publish`).
+  later run until the user found the hidden directory (:func:`sim.mc.outputs.publish`);
+* a umask that denies the owner (``umask 777``): ``sim run`` left a staging directory of mode
+  000 that blocked every later run of that ``--out``, ``--overwrite`` included ("Permission
+  denied: .../.lock"), and ``sim report`` replaced every README.md and REPORT.md by files no
+  one may read, with exit 0; both are refused in one line naming the umask
+  (:func:`sim.mc.storage.umask_problem`).
 """
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -82,3 +88,27 @@ def test_old_results_left_by_a_run_of_the_same_pid_do_not_block_the_next(
     assert len(err) == 2 and err[1].startswith(
         f"sim: note: the replaced results are kept in {old / 'res.1'} ("
     )
+
+
+def test_a_umask_that_denies_the_owner_is_refused_before_anything_is_made(tmp_path, capsys):
+    """``umask 777``: a run left a staging directory of mode 000 that every later run (with
+    ``--overwrite`` too) failed to lock, "Permission denied", until deleted by hand; ``sim
+    report`` replaced every README.md and REPORT.md by files of mode 000 with exit 0."""
+    res = tmp_path / "res"
+    assert main(["run", PLATE, *SMALL, "--out", str(res / "network_plate")]) == 0
+    assert main(["report", "--results", str(res)]) == 0
+    before = {p: p.stat().st_mode for p in res.rglob("*.md")}
+    capsys.readouterr()
+    old = os.umask(0o777)
+    try:
+        rc_run = main(["run", PLATE, *SMALL, "--out", str(tmp_path / "o")])
+        run_err = capsys.readouterr()
+        rc_report = main(["report", "--results", str(res)])
+    finally:
+        os.umask(old)
+    for rc, err in ((rc_run, run_err), (rc_report, capsys.readouterr())):
+        line = err.err.removesuffix("\n")
+        assert rc == 2 and "\n" not in line and "Traceback" not in err.err
+        assert line.startswith("sim: error: umask 0777 denies the owner access"), line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["res"]  # no .o.partial
+    assert {p: p.stat().st_mode for p in res.rglob("*.md")} == before

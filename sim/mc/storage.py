@@ -42,6 +42,7 @@ __all__ = [
     "read_provenance",
     "read_tolerances",
     "atomic_path",
+    "umask_problem",
     "read_record",
     "regular_text",
     "StageLock",
@@ -160,6 +161,26 @@ def _jsonable(o: Any) -> Any:
     if isinstance(o, Path):
         return str(o)
     raise TypeError(f"not JSON serialisable: {type(o)}")
+
+
+def umask_problem() -> str | None:
+    """Why the process's umask keeps the suite from its own files (None: it does not): one that
+    masks the owner's bits (``umask 777``: a staging directory of mode 000 that no later run
+    could enter, blocking it until deleted by hand; ``sim report`` replaced every README.md and
+    REPORT.md by files no one may read, with exit 0). Read from /proc (setting it to read it
+    would race other threads' files), else not judged."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            line = next((ln for ln in f if ln.startswith("Umask:")), "")
+        mask = int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        return None
+    if mask & 0o700 == 0:
+        return None
+    return (
+        f"umask {mask:04o} denies the owner access to the files the suite writes; run with a "
+        "umask such as 022 or 077"
+    )
 
 
 class atomic_path:
