@@ -15,7 +15,10 @@ found them (``run.sh``, about 250 cases) lives outside the project.
   000 that blocked every later run of that ``--out``, ``--overwrite`` included ("Permission
   denied: .../.lock"), and ``sim report`` replaced every README.md and REPORT.md by files no
   one may read, with exit 0; both are refused in one line naming the umask
-  (:func:`sim.mc.storage.umask_problem`).
+  (:func:`sim.mc.storage.umask_problem`);
+* a staging directory's ``.lock`` that is a symbolic or hard link to a file outside: taking
+  the lock truncated that file and wrote the run's pid into it (data loss outside the
+  output); a link or a FIFO there is now refused, naming it (:class:`sim.mc.storage.StageLock`).
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import os
 import shutil
 from pathlib import Path
 
+import pytest
 from oneline import SIM_ERROR, one_line
 
 from sim import execute
@@ -112,3 +116,20 @@ def test_a_umask_that_denies_the_owner_is_refused_before_anything_is_made(tmp_pa
         assert line.startswith("sim: error: umask 0777 denies the owner access"), line
     assert sorted(p.name for p in tmp_path.iterdir()) == ["res"]  # no .o.partial
     assert {p: p.stat().st_mode for p in res.rglob("*.md")} == before
+
+
+@pytest.mark.parametrize("kind", ["symlink", "hardlink", "fifo"])
+def test_a_lock_path_that_is_not_a_lock_file_is_never_written_through(tmp_path, capsys, kind):
+    """A staging directory whose ``.lock`` is a link to a file outside: taking the lock
+    truncated that file and wrote the run's pid into it (a user's notes replaced by "18156")."""
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes\n")
+    stage = tmp_path / ".o.partial"
+    stage.mkdir()
+    lock = stage / ".lock"
+    {"symlink": lambda: lock.symlink_to(notes), "hardlink": lambda: os.link(notes, lock)}.get(
+        kind, lambda: os.mkfifo(lock)
+    )()
+    rc = main(["run", PLATE, *SMALL, "--out", str(tmp_path / "o")])
+    one_line(capsys, rc, f"{lock} is not a lock file of sim", prefix=SIM_ERROR)
+    assert notes.read_text() == "my notes\n" and not (tmp_path / "o").exists()

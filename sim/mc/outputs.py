@@ -16,11 +16,12 @@ import os
 import shutil
 import sys
 import unicodedata
+from itertools import count
 from pathlib import Path
 
 from sim.mc.config import ConfigError
 from sim.mc.runner import ChunkStore
-from sim.mc.storage import LOCK, Locked, StageLock, read_record, write_record
+from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
     "check_out",
@@ -226,6 +227,10 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
             f"{shown} is being written by a running sim ({who}); wait "
             "for it to finish or choose another --out",
         ) from None
+    except NotALock as e:
+        raise ConfigError(
+            "--out", f"{e.path} is not a lock file of sim (a link or a pipe); move it away"
+        ) from None
     except OSError as e:
         raise ConfigError("--out", f"cannot write to {out.parent}: {e.strerror}") from None
     try:
@@ -402,16 +407,10 @@ def _free_swap(out: Path) -> Path:
     """Where :func:`publish` moves the old results: :func:`swap_dir`, or a new entry in it when
     a run of the same pid (a container's) left old files there it could not remove."""
     old = swap_dir(out)
-    if not (old.exists() or old.is_symlink()):
-        return old
-    if old.is_symlink() or not old.is_dir():
-        raise ConfigError(
-            "--out", f"{old} is in the way (not a directory sim left); move it away and run again"
-        )
-    k = 1
-    while (old / f"{out.name}.{k}").exists() or (old / f"{out.name}.{k}").is_symlink():
-        k += 1
-    return old / f"{out.name}.{k}"
+    if old.is_dir() and not old.is_symlink():
+        taken = {p.name for p in old.iterdir()}
+        return old / next(f"{out.name}.{k}" for k in count(1) if f"{out.name}.{k}" not in taken)
+    return old  # (anything else in the way: os.replace names it)
 
 
 def publish(stage: Path, out: Path) -> None:
