@@ -18,7 +18,10 @@ found them (``run.sh``, about 250 cases) lives outside the project.
   (:func:`sim.mc.storage.umask_problem`);
 * a staging directory's ``.lock`` that is a symbolic or hard link to a file outside: taking
   the lock truncated that file and wrote the run's pid into it (data loss outside the
-  output); a link or a FIFO there is now refused, naming it (:class:`sim.mc.storage.StageLock`).
+  output); a link or a FIFO there is now refused, naming it (:class:`sim.mc.storage.StageLock`);
+* ``--workers 2`` under ``ulimit -n 14``: the pool's second worker could not start, the run
+  printed its one line and then hung for good (the first worker waited for work, Python's
+  exit for it); the pool now ends the workers it started (:class:`sim.mc.executors._Pool`).
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from oneline import SIM_ERROR, one_line
+from oneline import SIM_ERROR, one_line, python_lines
 
 from sim import execute
 from sim.cli import main
@@ -133,3 +136,31 @@ def test_a_lock_path_that_is_not_a_lock_file_is_never_written_through(tmp_path, 
     rc = main(["run", PLATE, *SMALL, "--out", str(tmp_path / "o")])
     one_line(capsys, rc, f"{lock} is not a lock file of sim", prefix=SIM_ERROR)
     assert notes.read_text() == "my notes\n" and not (tmp_path / "o").exists()
+
+
+def test_a_process_pool_that_cannot_start_every_worker_ends(tmp_path):
+    """``ulimit -n 14`` with ``--workers 2``: the second worker could not start (no pipe), the
+    run printed its one line and then never ended: the first worker waited for work forever,
+    and Python's exit waited for it. Each open-file limit just above what the process holds
+    is tried in turn, so that the pool fails at each of its steps, the last one starting."""
+    done = python_lines(
+        "import gc, os, resource",
+        "from sim.mc.executors import make_executor",
+        "base = len(os.listdir('/proc/self/fd'))",
+        "hard = resource.getrlimit(resource.RLIMIT_NOFILE)[1]",
+        "failed = 0",
+        "for extra in range(0, 80, 4):",
+        "    resource.setrlimit(resource.RLIMIT_NOFILE, (base + extra, hard))",
+        "    try:",
+        "        ex = make_executor('local', 2, None)",
+        "    except OSError:",
+        "        failed += 1",
+        "        gc.collect()  # the failed pool's queues",
+        "        continue",
+        "    ex.close()",
+        "    break",
+        "print(failed, extra)",
+    )
+    assert done.returncode == 0, done.stderr
+    failed, extra = map(int, done.stdout.split())
+    assert failed >= 1 and extra < 76  # refused under the smaller limits, then started
