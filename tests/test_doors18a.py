@@ -21,7 +21,11 @@ found them (``run.sh``, about 250 cases) lives outside the project.
   output); a link or a FIFO there is now refused, naming it (:class:`sim.mc.storage.StageLock`);
 * ``--workers 2`` under ``ulimit -n 14``: the pool's second worker could not start, the run
   printed its one line and then hung for good (the first worker waited for work, Python's
-  exit for it); the pool now ends the workers it started (:class:`sim.mc.executors._Pool`).
+  exit for it); the pool now ends the workers it started (:class:`sim.mc.executors._Pool`);
+* the staging directory removed or moved away while a run works (``rm -rf .<out>.partial``,
+  or the working directory of a relative ``--out``): "internal error: AttributeError:
+  'NoneType' object has no attribute 'get'", exit 3; now one line naming it
+  (:func:`sim.mc.outputs.seal`).
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ from oneline import SIM_ERROR, one_line, python_lines
 from sim import execute
 from sim.cli import main
 from sim.mc import outputs
+from sim.mc.config import ConfigError
 from sim.mc.storage import read_record, write_record
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -164,3 +169,15 @@ def test_a_process_pool_that_cannot_start_every_worker_ends(tmp_path):
     assert done.returncode == 0, done.stderr
     failed, extra = map(int, done.stdout.split())
     assert failed >= 1 and extra < 76  # refused under the smaller limits, then started
+
+
+def test_a_staging_directory_removed_while_the_run_works_is_one_line(tmp_path):
+    """``rm -rf .<out>.partial`` (or ``mv``, or the working directory of a relative ``--out``
+    removed) while a run works: the chunks written after it made a new directory without a
+    run record, and the run ended in "internal error: AttributeError: 'NoneType' object has
+    no attribute 'get'" (exit 3)."""
+    stage = tmp_path / ".o.partial"
+    (stage / "trials" / "part-0").mkdir(parents=True)
+    (stage / "trials" / "part-0" / "chunk-000003.parquet").write_bytes(b"late")
+    with pytest.raises(ConfigError, match=r"^--out: .*\.o\.partial lost its run record"):
+        outputs.seal(stage, None)

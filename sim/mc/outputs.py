@@ -297,6 +297,8 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
         for p in store.strays():
             p.unlink()
     rec = read_record(stage)
+    if rec is None:  # the staging directory removed or moved away while the run worked
+        raise ConfigError("--out", f"{stage} lost its run record while the run worked; run again")
     carried = set(rec.get("carried") or [])  # the user's files a publish copied in: not ours
     files = [f for f in _files(stage) if f not in carried]
     chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
