@@ -38,7 +38,7 @@ from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.runner import MIN_CHUNKS
-from sim.mc.storage import code_hash, read_record
+from sim.mc.storage import code_hash, read_record, umask_problem
 from sim.mc.sweep import read_sweep
 from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, damaged_message
@@ -289,6 +289,8 @@ def _report(results: Path) -> int:
         raise ConfigError(
             "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
         )
+    if (why := umask_problem()) is not None:
+        raise ConfigError(None, why)
     try:
         text = write_report(results, get_study)
     except ConfigError:

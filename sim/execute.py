@@ -28,6 +28,7 @@ from sim.mc.storage import (
     code_hash,
     provenance,
     read_table,
+    umask_problem,
     versions,
     write_table,
 )
@@ -145,6 +146,8 @@ def execute(
         "versions": versions(),
         **({} if figures else {"figures": False}),
     }
+    if (why := umask_problem()) is not None:
+        raise ConfigError(None, why)
     check_out(out, shown, record, overwrite)
     stage = stage_dir(out)
     try:
@@ -156,6 +159,9 @@ def execute(
     lock = None
     try:
         lock, resumed = prepare_stage(stage, out, shown, record, overwrite)
+        # again, under the lock: another run may have published into out since the check
+        # above (a Dask cluster or a pool starting in between): its results are not ours
+        check_out(out, shown, record, overwrite)
         if not figures:  # figures of an earlier, killed attempt would pass for this run's
             for png in stage.rglob("*.png"):
                 png.unlink()
@@ -198,7 +204,7 @@ def execute(
     ex.close()
     try:
         check_interrupt()  # not published: an interrupted run never looks finished
-        check_out(out, shown, record, True)  # again, under the lock: still ours or absent
+        check_out(out, shown, record, overwrite)  # again, under the lock: ours or absent
         seal(stage, ctx.store)
         publish(stage, out)
     except BaseException:

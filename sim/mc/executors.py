@@ -120,12 +120,16 @@ class _Pool:
         held = self.start_method == "fork"
         old = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS) if held else None
         try:
-            ready = [self.pool.submit(_ready) for _ in range(workers)]
-        finally:
-            if held:
-                signal.pthread_sigmask(signal.SIG_SETMASK, old)
-        for f in ready:
-            f.result()  # every worker forked now (a fork pool starts them all at once)
+            try:
+                ready = [self.pool.submit(_ready) for _ in range(workers)]
+            finally:
+                if held:
+                    signal.pthread_sigmask(signal.SIG_SETMASK, old)
+            for f in ready:
+                f.result()  # every worker forked now (a fork pool starts them all at once)
+        except BaseException:  # a worker that could not start (ulimit -n: no pipe): the one
+            self.close(kill=True)  # started waited for work forever, and Python's exit on it
+            raise
 
     def run(self, fn, seed, part, jobs):
         futs = {self.pool.submit(_call_chunk, fn, seed, part, k, n): (k, n) for k, n in jobs}

@@ -16,11 +16,12 @@ import os
 import shutil
 import sys
 import unicodedata
+from itertools import count
 from pathlib import Path
 
 from sim.mc.config import ConfigError
 from sim.mc.runner import ChunkStore
-from sim.mc.storage import LOCK, Locked, StageLock, read_record, write_record
+from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
     "check_out",
@@ -236,6 +237,10 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
             f"{shown} is being written by a running sim ({who}); wait "
             "for it to finish or choose another --out",
         ) from None
+    except NotALock as e:
+        raise ConfigError(
+            "--out", f"{e.path} is not a lock file of sim (a link or a pipe); move it away"
+        ) from None
     except OSError as e:
         raise ConfigError("--out", f"cannot write to {out.parent}: {e.strerror}") from None
     try:
@@ -302,6 +307,8 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
         for p in store.strays():
             p.unlink()
     rec = read_record(stage)
+    if rec is None:  # the staging directory removed or moved away while the run worked
+        raise ConfigError("--out", f"{stage} lost its run record while the run worked; run again")
     carried = set(rec.get("carried") or [])  # the user's files a publish copied in: not ours
     files = [f for f in _files(stage) if f not in carried]
     chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
@@ -408,6 +415,16 @@ def _clash(stage: Path, f: str) -> str | None:
     return f if q.exists() or q.is_symlink() else None
 
 
+def _free_swap(out: Path) -> Path:
+    """Where :func:`publish` moves the old results: :func:`swap_dir`, or a new entry in it when
+    a run of the same pid (a container's) left old files there it could not remove."""
+    old = swap_dir(out)
+    if old.is_dir() and not old.is_symlink():
+        taken = {p.name for p in old.iterdir()}
+        return old / next(f"{out.name}.{k}" for k in count(1) if f"{out.name}.{k}" not in taken)
+    return old  # (anything else in the way: os.replace names it)
+
+
 def publish(stage: Path, out: Path) -> None:
     """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
     files in ``out`` that the suite did not write."""
@@ -430,11 +447,13 @@ def publish(stage: Path, out: Path) -> None:
         write_record(stage, {**rec, "carried": keep})
     for f in keep:
         _carry(out / f, stage / f)
-    old = swap_dir(out)
-    if out.exists():
+    old = _free_swap(out) if out.exists() else None
+    if old is not None:
         os.replace(out, old)
     os.replace(stage, out)
     (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
+    if old is None:
+        return
     shutil.rmtree(old, ignore_errors=True)
     if old.exists() or old.is_symlink():  # a file or directory of the old results that this
         # user may not remove: they are not lost, but say where (a hidden directory)

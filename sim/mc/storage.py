@@ -9,6 +9,7 @@ stored, so the same code and config give byte-identical files.
 
 from __future__ import annotations
 
+import errno
 import fcntl
 import hashlib
 import json
@@ -42,9 +43,11 @@ __all__ = [
     "read_provenance",
     "read_tolerances",
     "atomic_path",
+    "umask_problem",
     "read_record",
     "regular_text",
     "StageLock",
+    "NotALock",
     "NonFiniteError",
 ]
 
@@ -160,6 +163,26 @@ def _jsonable(o: Any) -> Any:
     if isinstance(o, Path):
         return str(o)
     raise TypeError(f"not JSON serialisable: {type(o)}")
+
+
+def umask_problem() -> str | None:
+    """Why the process's umask keeps the suite from its own files (None: it does not): one that
+    masks the owner's bits (``umask 777``: a staging directory of mode 000 that no later run
+    could enter, blocking it until deleted by hand; ``sim report`` replaced every README.md and
+    REPORT.md by files no one may read, with exit 0). Read from /proc (setting it to read it
+    would race other threads' files), else not judged."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            line = next((ln for ln in f if ln.startswith("Umask:")), "")
+        mask = int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        return None
+    if mask & 0o700 == 0:
+        return None
+    return (
+        f"umask {mask:04o} denies the owner access to the files the suite writes; run with a "
+        "umask such as 022 or 077"
+    )
 
 
 class atomic_path:
@@ -321,6 +344,15 @@ class Locked(RuntimeError):
         super().__init__(f"locked by pid {pid}")
 
 
+class NotALock(Exception):
+    """A staging directory's ``.lock`` that is not a lock file of the suite (a symbolic or hard
+    link to another file, a FIFO): locking wrote the pid through it, over a user's file."""
+
+    def __init__(self, path: Path):
+        super().__init__(str(path))
+        self.path = path
+
+
 class StageLock:
     """An exclusive ``flock`` on ``<stage>/.lock`` for the life of a run.
 
@@ -337,7 +369,17 @@ class StageLock:
     def acquire(self) -> "StageLock":
         self.created = not self.stage.exists()
         self.stage.mkdir(parents=True, exist_ok=True)
-        fd = os.open(self.stage / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        path = self.stage / LOCK  # written into: never through a link to another file
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
+        except OSError as e:
+            if e.errno == errno.ELOOP:  # a symbolic link
+                raise NotALock(path) from None
+            raise
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_nlink > 1:  # a FIFO, a hard link
+            os.close(fd)
+            raise NotALock(path)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
