@@ -13,16 +13,35 @@ STUDIES := $(basename $(notdir $(STUDY_FILES)))
 unexport PYTHONDONTWRITEBYTECODE
 
 .DEFAULT_GOAL := help
-.PHONY: help venv test reproduce rerun verify report bench clean fuzz mutation
+.PHONY: help venv test reproduce rerun verify report bench clean fuzz mutation venv-unusable
+
+# $(call q,TEXT): TEXT as one single-quoted shell word (a value with spaces or quotes stays one)
+q = '$(subst ','\'',$(1))'
+# $(call whole,NAME,MIN): stop with one line unless the variable NAME is a whole number >= MIN
+# (RUN_JOBS= or TEST_WORKERS=abc reached the command as a misread argument, or after the install)
+whole = @case $(call q,$($(1))) in ''|*[!0-9]*) false;; *) test $(call q,$($(1))) -ge $(2);; esac || \
+	{ printf 'make %s: %s must be a whole number of at least %s (got %s)\n' $@ $(1) $(2) $(call q,'$($(1))') >&2; exit 2; }
 
 help: ## list the targets
 	@grep -E '^[a-zA-Z_%/.-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/:.*## /\t/' | sort | \
 	  awk -F'\t' '{printf "  %-22s %s\n", $$1, $$2}'
 
-$(STAMP): pyproject.toml
-	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[dev]"
+# A .venv whose Python no longer starts (bin/python deleted, or the Python it was made from
+# removed or upgraded away) is made again from scratch, whatever its stamp says: `make venv`
+# repairs it (it printed ".venv/bin/python: No such file or directory" until `make clean`).
+PY_STARTS := $(shell $(PY) -S -c '' >/dev/null 2>&1 && echo yes)
+# $(call pip,ARGS): pip install ARGS, its output kept in PIP_LOG; a failure (no network, no index,
+# a Python the project does not support) is one line with pip's first error, exit 2 (it was
+# pip's dozen lines, the cause in the middle); the next `make venv` tries again
+PIP_LOG := $(VENV)/pip.log
+pip = @$(PY) -m pip install --quiet $(1) >> $(PIP_LOG) 2>&1 || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
+	"$$(grep -m1 -E '^ *ERROR' $(PIP_LOG) | sed -E 's/^ *ERROR: *//' || echo 'see its output')" >&2; exit 2; }
+
+$(STAMP): pyproject.toml $(if $(PY_STARTS),,venv-unusable)
+	$(PYTHON) -m venv $(if $(PY_STARTS),,--clear) $(VENV)
+	@echo "installing the project and its libraries into $(VENV) (pip; its output goes to $(PIP_LOG))"; : > $(PIP_LOG)
+	$(call pip,--upgrade pip)
+	$(call pip,-e ".[dev]")
 	@touch $@
 
 venv: $(STAMP) ## create the virtual environment and install the project
@@ -34,6 +53,7 @@ venv: $(STAMP) ## create the virtual environment and install the project
 TEST_WORKERS ?= 2
 
 test: $(STAMP) ## lint (ruff), the layer contracts (import-linter), then the test suite on TEST_WORKERS=2 processes
+	$(if $(filter auto logical,$(TEST_WORKERS)),,$(call whole,TEST_WORKERS,0))
 	$(VENV)/bin/ruff check sim tests benchmarks
 	$(VENV)/bin/ruff format --check sim tests benchmarks
 	$(VENV)/bin/lint-imports
@@ -52,7 +72,8 @@ fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=30
 MUTATION_WORKERS ?= 2
 
 mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (sim/claims/), run their tests, write docs/mutation.md
-	$(PY) -m pip install --quiet -e ".[dev,mutation]"
+	$(call whole,MUTATION_WORKERS,1)
+	$(call pip,-e ".[dev,mutation]")
 	rm -rf mutants
 	$(VENV)/bin/mutmut run --max-children $(MUTATION_WORKERS) > /dev/null
 	$(PY) tests/mutation_report.py
@@ -66,10 +87,12 @@ mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (s
 RUN_JOBS ?= 2
 
 reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md
+	$(call whole,RUN_JOBS,1)
 	$(PY) -m sim.batch --stale-only --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
 rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report
+	$(call whole,RUN_JOBS,1)
 	$(PY) -m sim.batch --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
@@ -89,7 +112,7 @@ BENCH_FLAGS ?=
 BENCH_OUT ?= results/bench
 
 bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/; BENCH_FLAGS=--quick: smoke)
-	$(PY) -m benchmarks --out $(BENCH_OUT) $(BENCH_FLAGS)
+	$(PY) -m benchmarks --out $(call q,$(BENCH_OUT)) $(BENCH_FLAGS)
 
 clean: ## remove the virtual environment and caches (results/ is kept)
 	rm -rf $(VENV) .pytest_cache sim.egg-info mutants

@@ -105,10 +105,28 @@ def import_words(e: BaseException | None) -> str | None:
     if not isinstance(e, ImportError):
         return None
     name = (e.name or "").split(".")[0]
+    if own_venv():  # `make venv` would do nothing here: its stamp is newer than pyproject.toml
+        return (
+            f"cannot load {name or 'a library'}: {first}; the suite's virtual environment "
+            f"{sys.prefix} lacks it: make clean venv installs it again (results/ is kept)"
+        )
     return (
         f"cannot load {name or 'a library'}: {first}; run the suite with the Python it was "
         f"installed into (make venv; .venv/bin/sim), not {sys.executable}"
     )
+
+
+def own_venv() -> bool:
+    """Whether this Python is the suite's own ``.venv`` (the one ``make venv`` makes beside
+    ``sim/``): a library missing there was removed from it, and running another Python would
+    not help (the message said "run the suite with the Python it was installed into (make venv;
+    .venv/bin/sim), not .venv/bin/python")."""
+    suite = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    venv = os.path.join(suite, ".venv")
+    try:
+        return sys.prefix != sys.base_prefix and os.path.samefile(sys.prefix, venv)
+    except OSError:
+        return False
 
 
 def _installed(path: str) -> bool:

@@ -1,0 +1,180 @@
+"""The classes of the sweep doors18c (issue 26: the make targets and the setup as a user calls
+them, and results that travel between machines), one case each; each failed on the code
+before its fix. The make cases run the project's Makefile with its install stamp taken as
+current (``make -o .venv/.installed``: nothing is installed) or a copy of it in a temporary
+directory with a stand-in Python, so they run no study and touch no network.
+
+* ``make reproduce RUN_JOBS=`` answered "argument --jobs: invalid int value:
+  'studies/agnard_block.toml'" (the empty value let the first study file take its place);
+  ``make test TEST_WORKERS=abc`` was pytest's four-line usage error; ``make mutation
+  MUTATION_WORKERS=abc`` installed the mutation extra first and then failed in mutmut's
+  usage: each is now one line naming the variable before anything runs (``whole`` in the
+  Makefile);
+* ``make bench BENCH_OUT="a b"`` split the directory into two arguments ("unrecognized
+  arguments: b"): the value is passed as one shell word;
+* a ``.venv`` whose Python no longer starts (``bin/python`` deleted, the Python it was made
+  from removed) stopped every target with ".venv/bin/python: No such file or directory", and
+  ``make venv`` did nothing (its stamp was newer than pyproject.toml) until ``make clean``:
+  such a ``.venv`` is made again;
+* pip failing in ``make venv`` (no network, no index) printed pip's dozen lines with the
+  cause in the middle; it is one line with pip's first error and the log's path, and the
+  next ``make venv`` tries again;
+* a library removed from the suite's own ``.venv`` was answered "run the suite with the Python
+  it was installed into (make venv; .venv/bin/sim), not .../.venv/bin/python": that is the
+  Python it was installed into, and ``make venv`` did nothing; the line now says the
+  environment lacks it and that ``make clean venv`` installs it again
+  (:func:`sim.threads.import_words`).
+"""
+
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from sim import threads
+
+ROOT = Path(__file__).resolve().parents[1]
+MAKE = shutil.which("make")
+pytestmark = pytest.mark.skipif(MAKE is None, reason="no make on this machine")
+
+
+def make(*args, cwd=ROOT, env=None):
+    """``make -s ARGS`` in ``cwd`` with the install stamp taken as current."""
+    return subprocess.run(
+        [MAKE, "-s", "--no-print-directory", "-o", ".venv/.installed", *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+    )
+
+
+def make_line(p: subprocess.CompletedProcess, *needles: str) -> str:
+    """Exit 2 and one line of ours on stderr, then only make's own "*** ... Error 2" line
+    (README: a failed target ends with it); the line is returned."""
+    lines = p.stderr.splitlines()
+    assert p.returncode == 2 and "Traceback" not in p.stderr, (p.returncode, p.stderr)
+    assert len(lines) == 2 and lines[1].startswith("make: *** ") and "Error 2" in lines[1], p.stderr
+    assert all(n in lines[0] for n in needles), lines[0]
+    return lines[0]
+
+
+@pytest.mark.parametrize(
+    ("target", "var", "value", "least"),
+    [
+        ("reproduce", "RUN_JOBS", "", 1),
+        ("rerun", "RUN_JOBS", "abc", 1),
+        ("reproduce", "RUN_JOBS", "a'b", 1),
+        ("test", "TEST_WORKERS", "abc", 0),
+        ("mutation", "MUTATION_WORKERS", "0", 1),
+    ],
+)
+def test_a_make_variable_that_is_not_a_whole_number_is_one_line_before_anything_runs(
+    target, var, value, least
+):
+    p = make(target, f"{var}={value}")
+    line = make_line(p, f"make {target}: {var} must be a whole number of at least {least}")
+    assert line.endswith(f"(got '{value}')"), line
+    assert p.stdout == ""  # nothing ran: no batch, no pytest, no pip
+
+
+def test_make_test_takes_auto_and_zero_workers():
+    for value in ("auto", "0"):
+        p = make("-n", "test", f"TEST_WORKERS={value}")
+        assert p.returncode == 0 and f"pytest -n {value} " in p.stdout, p.stdout + p.stderr
+
+
+def test_bench_out_with_a_space_and_a_quote_stays_one_argument():
+    out = "/tmp/my bench's dir"
+    p = make("-n", "bench", f"BENCH_OUT={out}", "BENCH_FLAGS=--quick")
+    assert p.returncode == 0, p.stderr
+    argv = shlex.split(p.stdout.strip().splitlines()[-1])
+    assert argv[argv.index("--out") + 1] == out and argv[-1] == "--quick", argv
+
+
+def fake_project(tmp_path: Path, python: str, pip_fails: bool = False) -> Path:
+    """A copy of the Makefile beside a pyproject.toml, a current stamp and ``.venv/bin/python``
+    pointing at ``python``; ``PYTHON`` for it is a stand-in whose ``-m venv`` only makes the
+    directory and its Python, and whose pip fails (as offline) when ``pip_fails``."""
+    d = tmp_path / "proj"
+    (d / ".venv" / "bin").mkdir(parents=True)
+    shutil.copy(ROOT / "Makefile", d / "Makefile")
+    (d / "pyproject.toml").write_text("[project]\nname = 'x'\n", encoding="utf-8")
+    fake = tmp_path / "fakepython"
+    fail = (
+        'echo "  ERROR: Could not find a version that satisfies the requirement setuptools>=61"\n'
+        'echo "  ERROR: No matching distribution found for setuptools>=61"; exit 1'
+    )
+    fake.write_text(
+        "#!/bin/sh\n"
+        'case "$*" in\n'
+        f'  *"-m pip"*) {fail if pip_fails else "exit 0"};;\n'
+        '  *"-m venv"*) echo "venv $*" >> "$(dirname "$0")/venv.log"\n'
+        '    ln -sfn "$0" .venv/bin/python; exit 0;;\n'
+        "esac\nexec " + shlex.quote(sys.executable) + ' "$@"\n',
+        encoding="utf-8",
+    )
+    fake.chmod(0o755)
+    (d / ".venv" / "bin" / "python").symlink_to(python)
+    stamp = d / ".venv" / ".installed"
+    stamp.touch()
+    os.utime(d / "pyproject.toml", (1_000_000_000, 1_000_000_000))  # older than the stamp
+    return d
+
+
+def run_make(d: Path, *args):
+    return subprocess.run(
+        [MAKE, "-s", "--no-print-directory", *args, f"PYTHON={d.parent / 'fakepython'}"],
+        cwd=d,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+
+
+def test_a_venv_whose_python_does_not_start_is_made_again(tmp_path):
+    # a dangling .venv/bin/python (the Python it was made from removed): made again, --clear
+    d = fake_project(tmp_path, "/nonexistent/python3")
+    p = run_make(d, "venv")
+    assert p.returncode == 0, p.stderr
+    assert "-m venv --clear .venv" in (tmp_path / "venv.log").read_text(encoding="utf-8")
+    # a .venv whose Python starts and whose stamp is current is left as it is
+    (tmp_path / "venv.log").unlink()
+    e = fake_project(tmp_path / "ok", str(tmp_path / "fakepython"))
+    p = run_make(e, "venv")
+    assert p.returncode == 0 and not (tmp_path / "ok" / "venv.log").exists(), p.stderr
+
+
+def test_pip_failing_in_make_venv_is_one_line_with_its_first_error(tmp_path):
+    d = fake_project(tmp_path, "/nonexistent/python3", pip_fails=True)
+    (d / ".venv" / "bin" / "python").unlink()
+    (d / ".venv" / "bin" / "python").symlink_to(tmp_path / "fakepython")
+    (d / ".venv" / ".installed").unlink()  # as a first install
+    p = run_make(d, "venv")
+    line = make_line(p, "make: pip could not install into .venv: ", "setuptools>=61")
+    assert "Could not find a version" in line and ".venv/pip.log" in line, line
+    assert "No matching distribution" in (d / ".venv" / "pip.log").read_text(encoding="utf-8")
+    assert not (d / ".venv" / ".installed").exists()  # the next make venv tries again
+
+
+def test_a_library_missing_from_the_suites_own_venv_says_how_to_install_it_again(
+    tmp_path, monkeypatch
+):
+    missing = ModuleNotFoundError("No module named 'pyarrow'", name="pyarrow")
+    (tmp_path / "sim").mkdir()
+    (tmp_path / ".venv").mkdir()
+    monkeypatch.setattr(threads, "__file__", str(tmp_path / "sim" / "threads.py"))
+    monkeypatch.setattr(sys, "prefix", str(tmp_path / ".venv"))
+    monkeypatch.setattr(sys, "base_prefix", "/usr")
+    words = threads.import_words(missing)
+    assert words.startswith("cannot load pyarrow: No module named 'pyarrow'; ")
+    assert f"virtual environment {tmp_path / '.venv'} lacks it: make clean venv" in words
+    assert "run the suite with the Python" not in words
+    # another Python (not the suite's .venv): as before, run the suite with its own
+    monkeypatch.setattr(sys, "prefix", str(tmp_path))
+    assert "run the suite with the Python it was installed into" in threads.import_words(missing)
