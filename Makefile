@@ -26,10 +26,15 @@ help: ## list the targets
 	@grep -E '^[a-zA-Z_%/.-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/:.*## /\t/' | sort | \
 	  awk -F'\t' '{printf "  %-22s %s\n", $$1, $$2}'
 
-# A .venv whose Python no longer starts (bin/python deleted, or the Python it was made from
-# removed or upgraded away) is made again from scratch, whatever its stamp says: `make venv`
-# repairs it (it printed ".venv/bin/python: No such file or directory" until `make clean`).
-PY_STARTS := $(shell $(PY) -S -c '' >/dev/null 2>&1 && echo yes)
+# A .venv that cannot serve this directory is made again from scratch, whatever its stamp says,
+# so that `make venv` repairs it (each needed `make clean` first): its Python no longer starts
+# (bin/python deleted, the Python it was made from removed: ".venv/bin/python: No such file or
+# directory"), is older than pyproject.toml's requires-python (a `make venv PYTHON=python3.10`
+# that failed), or the stamp names another directory (the project moved or copied with its
+# .venv, whose scripts start the old path's Python and code). The stamp holds the directory.
+VENV_USABLE := $(shell $(PY) -S -c 'import sys; sys.exit(sys.version_info < (3, 11))' >/dev/null 2>&1 && echo yes)
+MADE_IN := $(shell cat $(STAMP) 2>/dev/null)
+VENV_USABLE := $(and $(VENV_USABLE),$(if $(MADE_IN),$(if $(subst $(CURDIR),,$(MADE_IN)),,yes),yes))
 # $(call pip,ARGS): pip install ARGS, its output kept in PIP_LOG; a failure (no network, no index,
 # a Python the project does not support) is one line with pip's first error, exit 2 (it was
 # pip's dozen lines, the cause in the middle); the next `make venv` tries again
@@ -37,12 +42,12 @@ PIP_LOG := $(VENV)/pip.log
 pip = @$(PY) -m pip install --quiet $(1) >> $(PIP_LOG) 2>&1 || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
 	"$$(grep -m1 -E '^ *ERROR' $(PIP_LOG) | sed -E 's/^ *ERROR: *//' || echo 'see its output')" >&2; exit 2; }
 
-$(STAMP): pyproject.toml $(if $(PY_STARTS),,venv-unusable)
-	$(PYTHON) -m venv $(if $(PY_STARTS),,--clear) $(VENV)
+$(STAMP): pyproject.toml $(if $(VENV_USABLE),,venv-unusable)
+	$(PYTHON) -m venv $(if $(VENV_USABLE),,--clear) $(VENV)
 	@echo "installing the project and its libraries into $(VENV) (pip; its output goes to $(PIP_LOG))"; : > $(PIP_LOG)
 	$(call pip,--upgrade pip)
 	$(call pip,-e ".[dev]")
-	@touch $@
+	@echo '$(CURDIR)' > $@
 
 venv: $(STAMP) ## create the virtual environment and install the project
 

@@ -16,6 +16,14 @@ directory with a stand-in Python, so they run no study and touch no network.
   from removed) stopped every target with ".venv/bin/python: No such file or directory", and
   ``make venv`` did nothing (its stamp was newer than pyproject.toml) until ``make clean``:
   such a ``.venv`` is made again;
+* a ``.venv`` of a Python older than the project's ``requires-python`` (left by a failed
+  ``make venv PYTHON=python3.10``) or made for another directory (the project moved, or
+  copied with its ``.venv``: its scripts start the old path's Python and code) stayed as it
+  was, every later target failing in pip or in a "bad interpreter": made again too (the
+  stamp records the directory it was made for);
+* ``copy/.venv/bin/sim`` of a project copied with its ``.venv`` (``cp -a``) silently ran the
+  original's code in the copy; it is one line naming both and ``make clean venv``
+  (:func:`sim.threads.script_of_another_copy`);
 * pip failing in ``make venv`` (no network, no index) printed pip's dozen lines with the
   cause in the middle; it is one line with pip's first error and the log's path, and the
   next ``make venv`` tries again;
@@ -36,6 +44,7 @@ from pathlib import Path
 import pytest
 
 from sim import threads
+from tests.oneline import python_lines
 
 ROOT = Path(__file__).resolve().parents[1]
 MAKE = shutil.which("make")
@@ -148,6 +157,57 @@ def test_a_venv_whose_python_does_not_start_is_made_again(tmp_path):
     e = fake_project(tmp_path / "ok", str(tmp_path / "fakepython"))
     p = run_make(e, "venv")
     assert p.returncode == 0 and not (tmp_path / "ok" / "venv.log").exists(), p.stderr
+
+
+def test_a_venv_made_for_another_directory_or_an_older_python_is_made_again(tmp_path):
+    d = fake_project(tmp_path, str(tmp_path / "fakepython"))
+    stamp = d / ".venv" / ".installed"
+    stamp.write_text("/somewhere/else/proj\n", encoding="utf-8")  # moved or copied here
+    p = run_make(d, "venv")
+    assert p.returncode == 0, p.stderr
+    assert "-m venv --clear .venv" in (tmp_path / "venv.log").read_text(encoding="utf-8")
+    assert stamp.read_text(encoding="utf-8").strip() == str(d)  # the directory it serves
+    (tmp_path / "venv.log").unlink()
+    for made_in in (str(d), ""):  # made here, or an empty stamp of an older Makefile: kept
+        stamp.write_text(made_in, encoding="utf-8")
+        p = run_make(d, "venv")
+        assert p.returncode == 0 and not (tmp_path / "venv.log").exists(), (made_in, p.stderr)
+    # a Python older than requires-python (a failed make venv PYTHON=python3.10 left it)
+    old = tmp_path / "oldpython"
+    old.write_text('#!/bin/sh\ncase "$*" in *version_info*) exit 1;; esac\nexit 0\n')
+    old.chmod(0o755)
+    (d / ".venv" / "bin" / "python").unlink()
+    (d / ".venv" / "bin" / "python").symlink_to(old)
+    p = run_make(d, "venv")
+    assert p.returncode == 0, p.stderr
+    assert "-m venv --clear .venv" in (tmp_path / "venv.log").read_text(encoding="utf-8")
+
+
+def test_the_sim_script_of_a_copied_venv_refuses_to_run_the_originals_code(tmp_path):
+    copy = tmp_path / "copy"
+    (copy / "sim").mkdir(parents=True)
+    (copy / "sim" / "__init__.py").write_text("", encoding="utf-8")
+    (copy / ".venv" / "bin").mkdir(parents=True)
+    script = copy / ".venv" / "bin" / "sim"
+    p = python_lines(
+        "import sys",
+        f"sys.argv = [{str(script)!r}, '--version']",
+        "from sim.__main__ import main",
+        "sys.exit(main())",
+    )
+    err = p.stderr.strip()
+    assert p.returncode == 2 and "\n" not in err and "Traceback" not in err, err
+    assert err.startswith(f"sim: error: {script} runs the suite in {ROOT}, where its .venv"), err
+    assert f"make clean venv in {copy}" in err and p.stdout == "", err
+    # python -m sim in the copy (its own code), and a project's own script: nothing to say
+    for argv0 in (str(ROOT / "sim" / "__main__.py"), str(ROOT / ".venv" / "bin" / "sim")):
+        p = python_lines(
+            "import sys",
+            f"sys.argv = [{argv0!r}]",
+            "from sim.threads import script_of_another_copy",
+            "print(script_of_another_copy())",
+        )
+        assert p.stdout.strip() == "None", (argv0, p.stdout, p.stderr)
 
 
 def test_pip_failing_in_make_venv_is_one_line_with_its_first_error(tmp_path):
