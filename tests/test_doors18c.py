@@ -25,8 +25,11 @@ directory with a stand-in Python, so they run no study and touch no network.
   original's code in the copy; it is one line naming both and ``make clean venv``
   (:func:`sim.threads.script_of_another_copy`);
 * pip failing in ``make venv`` (no network, no index) printed pip's dozen lines with the
-  cause in the middle; it is one line with pip's first error and the log's path, and the
-  next ``make venv`` tries again;
+  cause in the middle; it is one line with pip's first error (or its last line: a pip that no
+  longer starts) and the log's path, and the next ``make venv`` tries again; an install
+  interrupted during pip's own upgrade left a pip that no longer imports, and every later
+  ``make venv`` failed in it: a ``.venv`` with this Makefile's pip log but no stamp is made
+  again from scratch (one of the user's own, without the log, is installed into as it is);
 * a library removed from the suite's own ``.venv`` was answered "run the suite with the Python
   it was installed into (make venv; .venv/bin/sim), not .../.venv/bin/python": that is the
   Python it was installed into, and ``make venv`` did nothing; the line now says the
@@ -106,6 +109,31 @@ def test_bench_out_with_a_space_and_a_quote_stays_one_argument():
     assert argv[argv.index("--out") + 1] == out and argv[-1] == "--quick", argv
 
 
+#: what pip prints without a network (its first error is the cause), and a pip left broken
+OFFLINE = [
+    "  ERROR: Could not find a version that satisfies the requirement setuptools>=61",
+    "  ERROR: No matching distribution found for setuptools>=61",
+]
+BROKEN = "ImportError: cannot import name 'open_rich_spinner' from 'pip._internal.cli.spinners'"
+
+
+def write_fake(fake: Path, pip_says: list[str] | None) -> None:
+    """A stand-in Python: ``-m pip`` prints ``pip_says`` and fails (succeeds when None),
+    ``-m venv`` logs its arguments and links ``.venv/bin/python`` to itself, anything else
+    is this Python."""
+    pip = "exit 0" if pip_says is None else "".join(f"echo {shlex.quote(x)}; " for x in pip_says)
+    fake.write_text(
+        "#!/bin/sh\n"
+        'case "$*" in\n'
+        f'  *"-m pip"*) {pip if pip_says is None else pip + "exit 1"};;\n'
+        '  *"-m venv"*) echo "venv $*" >> "$(dirname "$0")/venv.log"\n'
+        '    ln -sfn "$0" .venv/bin/python; exit 0;;\n'
+        "esac\nexec " + shlex.quote(sys.executable) + ' "$@"\n',
+        encoding="utf-8",
+    )
+    fake.chmod(0o755)
+
+
 def fake_project(tmp_path: Path, python: str, pip_fails: bool = False) -> Path:
     """A copy of the Makefile beside a pyproject.toml, a current stamp and ``.venv/bin/python``
     pointing at ``python``; ``PYTHON`` for it is a stand-in whose ``-m venv`` only makes the
@@ -114,21 +142,7 @@ def fake_project(tmp_path: Path, python: str, pip_fails: bool = False) -> Path:
     (d / ".venv" / "bin").mkdir(parents=True)
     shutil.copy(ROOT / "Makefile", d / "Makefile")
     (d / "pyproject.toml").write_text("[project]\nname = 'x'\n", encoding="utf-8")
-    fake = tmp_path / "fakepython"
-    fail = (
-        'echo "  ERROR: Could not find a version that satisfies the requirement setuptools>=61"\n'
-        'echo "  ERROR: No matching distribution found for setuptools>=61"; exit 1'
-    )
-    fake.write_text(
-        "#!/bin/sh\n"
-        'case "$*" in\n'
-        f'  *"-m pip"*) {fail if pip_fails else "exit 0"};;\n'
-        '  *"-m venv"*) echo "venv $*" >> "$(dirname "$0")/venv.log"\n'
-        '    ln -sfn "$0" .venv/bin/python; exit 0;;\n'
-        "esac\nexec " + shlex.quote(sys.executable) + ' "$@"\n',
-        encoding="utf-8",
-    )
-    fake.chmod(0o755)
+    write_fake(tmp_path / "fakepython", OFFLINE if pip_fails else None)
     (d / ".venv" / "bin" / "python").symlink_to(python)
     stamp = d / ".venv" / ".installed"
     stamp.touch()
@@ -210,6 +224,22 @@ def test_the_sim_script_of_a_copied_venv_refuses_to_run_the_originals_code(tmp_p
         assert p.stdout.strip() == "None", (argv0, p.stdout, p.stderr)
 
 
+def test_an_install_that_failed_or_was_stopped_starts_again_from_scratch(tmp_path):
+    d = fake_project(tmp_path, str(tmp_path / "fakepython"))
+    (d / ".venv" / ".installed").unlink()
+    (d / ".venv" / "pip.log").write_text("ImportError: cannot import name 'x'\n")
+    p = run_make(d, "venv")
+    assert p.returncode == 0, p.stderr
+    assert "-m venv --clear .venv" in (tmp_path / "venv.log").read_text(encoding="utf-8")
+    # a .venv of the user's own (no stamp, no log of this Makefile): installed into as it is
+    (tmp_path / "venv.log").unlink()
+    for f in ("pip.log", ".installed"):
+        (d / ".venv" / f).unlink()
+    p = run_make(d, "venv")
+    assert p.returncode == 0, p.stderr
+    assert "-m venv .venv" in (tmp_path / "venv.log").read_text(encoding="utf-8")
+
+
 def test_pip_failing_in_make_venv_is_one_line_with_its_first_error(tmp_path):
     d = fake_project(tmp_path, "/nonexistent/python3", pip_fails=True)
     (d / ".venv" / "bin" / "python").unlink()
@@ -220,6 +250,10 @@ def test_pip_failing_in_make_venv_is_one_line_with_its_first_error(tmp_path):
     assert "Could not find a version" in line and ".venv/pip.log" in line, line
     assert "No matching distribution" in (d / ".venv" / "pip.log").read_text(encoding="utf-8")
     assert not (d / ".venv" / ".installed").exists()  # the next make venv tries again
+    # a pip that does not start (a traceback, no ERROR line): its last line
+    write_fake(tmp_path / "fakepython", ["Traceback (most recent call last):", "  File x", BROKEN])
+    line = make_line(run_make(d, "venv"), "make: pip could not install into .venv: ")
+    assert line.startswith(f"make: pip could not install into .venv: {BROKEN} (all of its"), line
 
 
 def test_a_library_missing_from_the_suites_own_venv_says_how_to_install_it_again(
