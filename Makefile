@@ -32,12 +32,15 @@ help: ## list the targets
 # directory"), is older than pyproject.toml's requires-python (a `make venv PYTHON=python3.10`
 # that failed), or the stamp names another directory (the project moved or copied with its
 # .venv, whose scripts start the old path's Python and code). The stamp holds the directory.
-# A .venv with pip's log of this Makefile but no stamp is an install that failed or was
-# interrupted (a Ctrl-C during pip's own upgrade left a pip that no longer imports): made again
-# from scratch too. A .venv of the user's own (no log, no stamp) is installed into as it is.
+# An install that failed or was interrupted (a Ctrl-C during pip's own upgrade left a pip that
+# no longer imports; one during `venv --clear` half a .venv) leaves its mark INSTALLING beside
+# the .venv, which only a finished install removes: made again from scratch too. A .venv of
+# the user's own (no mark) is installed into as it is.
+INSTALLING := $(VENV).installing
 VENV_USABLE := $(shell $(PY) -S -c 'import sys; sys.exit(sys.version_info < (3, 11))' >/dev/null 2>&1 && echo yes)
 MADE_IN := $(shell cat $(STAMP) 2>/dev/null)
 VENV_USABLE := $(and $(VENV_USABLE),$(if $(MADE_IN),$(if $(subst $(CURDIR),,$(MADE_IN)),,yes),yes))
+VENV_USABLE := $(and $(VENV_USABLE),$(if $(wildcard $(INSTALLING)),,yes))
 # $(call pip,ARGS): pip install ARGS, its output kept in PIP_LOG; a failure (no network, no index,
 # a Python the project does not support) is one line with pip's first error (else its last
 # line: a pip that does not start), exit 2 (it was pip's dozen lines, the cause in the
@@ -47,11 +50,12 @@ pip = @$(PY) -m pip install --quiet $(1) >> $(PIP_LOG) 2>&1 || { printf 'make: p
 	"$$({ grep -m1 -E '^ *ERROR' $(PIP_LOG) || grep -v '^ *$$' $(PIP_LOG) | tail -1; } | sed -E 's/^ *(ERROR: *)?//')" >&2; exit 2; }
 
 $(STAMP): pyproject.toml $(if $(VENV_USABLE),,venv-unusable)
-	$(PYTHON) -m venv $(if $(and $(VENV_USABLE),$(or $(wildcard $(STAMP)),$(if $(wildcard $(PIP_LOG)),,yes))),,--clear) $(VENV)
+	@touch $(INSTALLING)
+	$(PYTHON) -m venv $(if $(VENV_USABLE),,--clear) $(VENV)
 	@echo "installing the project and its libraries into $(VENV) (pip; its output goes to $(PIP_LOG))"; : > $(PIP_LOG)
 	$(call pip,--upgrade pip)
 	$(call pip,-e ".[dev]")
-	@echo '$(CURDIR)' > $@
+	@echo '$(CURDIR)' > $@; rm -f $(INSTALLING)
 
 venv: $(STAMP) ## create the virtual environment and install the project
 

@@ -28,8 +28,12 @@ directory with a stand-in Python, so they run no study and touch no network.
   cause in the middle; it is one line with pip's first error (or its last line: a pip that no
   longer starts) and the log's path, and the next ``make venv`` tries again; an install
   interrupted during pip's own upgrade left a pip that no longer imports, and every later
-  ``make venv`` failed in it: a ``.venv`` with this Makefile's pip log but no stamp is made
-  again from scratch (one of the user's own, without the log, is installed into as it is);
+  ``make venv`` failed in it: an install that did not finish leaves ``.venv.installing``, and
+  the next one starts from scratch (a ``.venv`` of the user's own is installed into as it is);
+* ``make reproduce`` (``sim.batch --stale-only``) re-ran a study whose results were not
+  current without a word: results made by older code, copied from another machine or made
+  with other options ran for minutes with nothing printed (the runs are quiet side by side);
+  each is now named with the reason, one line per study (:func:`sim.batch.why_stale`);
 * a library removed from the suite's own ``.venv`` was answered "run the suite with the Python
   it was installed into (make venv; .venv/bin/sim), not .../.venv/bin/python": that is the
   Python it was installed into, and ``make venv`` did nothing; the line now says the
@@ -37,6 +41,7 @@ directory with a stand-in Python, so they run no study and touch no network.
   (:func:`sim.threads.import_words`).
 """
 
+import json
 import os
 import shlex
 import shutil
@@ -46,7 +51,9 @@ from pathlib import Path
 
 import pytest
 
+import sim.batch
 from sim import threads
+from sim.batch import why_stale
 from tests.oneline import python_lines
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -226,15 +233,15 @@ def test_the_sim_script_of_a_copied_venv_refuses_to_run_the_originals_code(tmp_p
 
 def test_an_install_that_failed_or_was_stopped_starts_again_from_scratch(tmp_path):
     d = fake_project(tmp_path, str(tmp_path / "fakepython"))
-    (d / ".venv" / ".installed").unlink()
-    (d / ".venv" / "pip.log").write_text("ImportError: cannot import name 'x'\n")
+    # the mark of an install that did not finish (pip failed, Ctrl-C, even inside venv --clear)
+    (d / ".venv.installing").touch()
     p = run_make(d, "venv")
     assert p.returncode == 0, p.stderr
     assert "-m venv --clear .venv" in (tmp_path / "venv.log").read_text(encoding="utf-8")
-    # a .venv of the user's own (no stamp, no log of this Makefile): installed into as it is
+    assert not (d / ".venv.installing").exists()  # removed by the install that finished
+    # a .venv of the user's own (no stamp, no mark of this Makefile): installed into as it is
     (tmp_path / "venv.log").unlink()
-    for f in ("pip.log", ".installed"):
-        (d / ".venv" / f).unlink()
+    (d / ".venv" / ".installed").unlink()
     p = run_make(d, "venv")
     assert p.returncode == 0, p.stderr
     assert "-m venv .venv" in (tmp_path / "venv.log").read_text(encoding="utf-8")
@@ -249,7 +256,8 @@ def test_pip_failing_in_make_venv_is_one_line_with_its_first_error(tmp_path):
     line = make_line(p, "make: pip could not install into .venv: ", "setuptools>=61")
     assert "Could not find a version" in line and ".venv/pip.log" in line, line
     assert "No matching distribution" in (d / ".venv" / "pip.log").read_text(encoding="utf-8")
-    assert not (d / ".venv" / ".installed").exists()  # the next make venv tries again
+    assert not (d / ".venv" / ".installed").exists()  # the next make venv tries again,
+    assert (d / ".venv.installing").exists()  # from scratch
     # a pip that does not start (a traceback, no ERROR line): its last line
     write_fake(tmp_path / "fakepython", ["Traceback (most recent call last):", "  File x", BROKEN])
     line = make_line(run_make(d, "venv"), "make: pip could not install into .venv: ")
@@ -259,16 +267,52 @@ def test_pip_failing_in_make_venv_is_one_line_with_its_first_error(tmp_path):
 def test_a_library_missing_from_the_suites_own_venv_says_how_to_install_it_again(
     tmp_path, monkeypatch
 ):
-    missing = ModuleNotFoundError("No module named 'pyarrow'", name="pyarrow")
+    # a name no module of this process has (a loaded pyarrow outside the patched prefix would
+    # read as a file shadowing it)
+    missing = ModuleNotFoundError("No module named 'pyarrowx'", name="pyarrowx")
     (tmp_path / "sim").mkdir()
     (tmp_path / ".venv").mkdir()
     monkeypatch.setattr(threads, "__file__", str(tmp_path / "sim" / "threads.py"))
     monkeypatch.setattr(sys, "prefix", str(tmp_path / ".venv"))
     monkeypatch.setattr(sys, "base_prefix", "/usr")
     words = threads.import_words(missing)
-    assert words.startswith("cannot load pyarrow: No module named 'pyarrow'; ")
+    assert words.startswith("cannot load pyarrowx: No module named 'pyarrowx'; ")
     assert f"virtual environment {tmp_path / '.venv'} lacks it: make clean venv" in words
     assert "run the suite with the Python" not in words
     # another Python (not the suite's .venv): as before, run the suite with its own
     monkeypatch.setattr(sys, "prefix", str(tmp_path))
     assert "run the suite with the Python it was installed into" in threads.import_words(missing)
+
+
+def test_stale_only_names_why_each_study_it_runs_is_out_of_date(tmp_path, capsys):
+    study = ROOT / "studies" / "network_plate.toml"
+    committed = json.loads((ROOT / "results" / "network_plate" / "run.json").read_text("utf-8"))
+    out = tmp_path / "r" / "network_plate"
+    assert why_stale(study, out) == "no results yet"
+    out.mkdir(parents=True)
+    assert why_stale(study, out) == "no run record (run.json)"
+
+    def record(**change):
+        (out / "run.json").write_text(json.dumps({**committed, **change}), encoding="utf-8")
+
+    record(code_hash="0" * 64)  # results made by older code (a clone a few commits back)
+    assert why_stale(study, out) == (
+        "made by other code than this (the code the study imports changed)"
+    )
+    record(config={**committed["config"], "seed": 99, "trials": 3})
+    assert why_stale(study, out) == "made with another config: seed, trials"
+    record(figures=False)
+    assert why_stale(study, out) == "made without figures"
+    # the batch says it, one line per study run, before the run's own line
+    record()
+    small = ["--trials", "40", "--chunk", "2", "--no-figures", "--quiet"]
+    assert (
+        sim.batch.main(["--stale-only", "--results", str(out.parent), str(study), "--", *small])
+        == 0
+    )
+    said = capsys.readouterr().out.splitlines()
+    assert (
+        said[0]
+        == "network_plate: out of date (made with another config: chunk, trials): running it"
+    ), said
+    assert json.loads((out / "run.json").read_text("utf-8"))["config"]["trials"] == 40
