@@ -34,6 +34,10 @@ directory with a stand-in Python, so they run no study and touch no network.
   current without a word: results made by older code, copied from another machine or made
   with other options ran for minutes with nothing printed (the runs are quiet side by side);
   each is now named with the reason, one line per study (:func:`sim.batch.why_stale`);
+* ``sim report`` on results whose directories were swapped by hand (``brown_table1/`` holding
+  brown_dilution's run and the other way round) labelled each study's claims, region and
+  link with the other's name without a word; each such directory is named in a note
+  (:func:`sim.report.glance.opening`);
 * a library removed from the suite's own ``.venv`` was answered "run the suite with the Python
   it was installed into (make venv; .venv/bin/sim), not .../.venv/bin/python": that is the
   Python it was installed into, and ``make venv`` did nothing; the line now says the
@@ -316,3 +320,24 @@ def test_stale_only_names_why_each_study_it_runs_is_out_of_date(tmp_path, capsys
         == "network_plate: out of date (made with another config: chunk, trials): running it"
     ), said
     assert json.loads((out / "run.json").read_text("utf-8"))["config"]["trials"] == 40
+
+
+def test_report_names_results_directories_swapped_by_hand(tmp_path, capsys):
+    from sim.cli import main
+
+    res = tmp_path / "R"
+    res.mkdir()
+    for a, b in (("brown_table1", "brown_dilution"), ("brown_dilution", "brown_table1")):
+        shutil.copytree(ROOT / "results" / a, res / b, ignore=shutil.ignore_patterns("trials"))
+    assert main(["report", "--results", str(res)]) == 0
+    text = (res / "REPORT.md").read_text(encoding="utf-8")
+    for name, holds in (("brown_table1", "brown_dilution"), ("brown_dilution", "brown_table1")):
+        assert (
+            f"- [{name}]({name}/README.md) holds the results of the study `{holds}` (its tables "
+            f"say so), not of `{name}`: a directory renamed or swapped by hand"
+        ) in text
+    # directories renamed to names no study has (as a variant, agnard_block_104): no note
+    (res / "brown_dilution").rename(res / "brown_t1")
+    (res / "brown_table1").rename(res / "brown_dil2")
+    assert main(["report", "--results", str(res)]) == 0
+    assert "holds the results" not in (res / "REPORT.md").read_text(encoding="utf-8")
