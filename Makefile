@@ -1,6 +1,12 @@
 # Reproduction of classic comparator/plotter calibration papers by Monte-Carlo simulation.
 # `make reproduce` and `make test` set everything up themselves (virtual environment, install).
 
+# every path below is relative to the project: `make -f path/to/Makefile` from elsewhere was
+# "No rule to make target 'pyproject.toml'"; say where to run it instead
+ifeq ($(wildcard pyproject.toml sim/__init__.py),)
+$(error $(lastword $(MAKEFILE_LIST)) runs in its own directory: make -C <its directory> $(or $(MAKECMDGOALS),help))
+endif
+
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python

@@ -12,6 +12,9 @@ directory with a stand-in Python, so they run no study and touch no network.
   Makefile);
 * ``make bench BENCH_OUT="a b"`` split the directory into two arguments ("unrecognized
   arguments: b"): the value is passed as one shell word;
+* ``make -f path/to/Makefile report`` from another directory was "No rule to make target
+  'pyproject.toml', needed by '.venv/.installed'" (every path in it is relative): one line
+  saying to run it in its own directory;
 * a ``.venv`` whose Python no longer starts (``bin/python`` deleted, the Python it was made
   from removed) stopped every target with ".venv/bin/python: No such file or directory", and
   ``make venv`` did nothing (its stamp was newer than pyproject.toml) until ``make clean``:
@@ -143,6 +146,22 @@ def write_fake(fake: Path, pip_says: list[str] | None) -> None:
         encoding="utf-8",
     )
     fake.chmod(0o755)
+
+
+def test_make_from_another_directory_says_where_to_run_it(tmp_path):
+    p = subprocess.run(
+        [MAKE, "-s", "-f", str(ROOT / "Makefile"), "report"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    err = p.stderr.strip()
+    assert p.returncode == 2 and "\n" not in err, err
+    assert err.endswith(
+        f"*** {ROOT / 'Makefile'} runs in its own directory: make -C <its directory> report.  Stop."
+    ), err
+    assert list(tmp_path.iterdir()) == []  # nothing made here
 
 
 def fake_project(tmp_path: Path, python: str, pip_fails: bool = False) -> Path:
