@@ -103,7 +103,7 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
         more = f" and {len(keys) - 3} more" if len(keys) > 3 else ""
         return f"made with another config: {', '.join(keys[:3])}{more}"
     if record.get("code_hash") != study_code_hash(cfg["study"]):
-        return "made by other code than this (the code the study imports changed)"
+        return "made by other code: the code the study imports changed since"
     return None
 
 

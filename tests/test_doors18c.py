@@ -319,9 +319,7 @@ def test_stale_only_names_why_each_study_it_runs_is_out_of_date(tmp_path, capsys
         (out / "run.json").write_text(json.dumps({**committed, **change}), encoding="utf-8")
 
     record(code_hash="0" * 64)  # results made by older code (a clone a few commits back)
-    assert why_stale(study, out) == (
-        "made by other code than this (the code the study imports changed)"
-    )
+    assert why_stale(study, out) == ("made by other code: the code the study imports changed since")
     record(config={**committed["config"], "seed": 99, "trials": 3})
     assert why_stale(study, out) == "made with another config: seed, trials"
     record(figures=False)
