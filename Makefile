@@ -41,7 +41,8 @@ help: ## list the targets
 # An install that failed or was interrupted (a Ctrl-C during pip's own upgrade left a pip that
 # no longer imports; one during `venv --clear` half a .venv) leaves its mark INSTALLING beside
 # the .venv, which only a finished install removes: made again from scratch too. A .venv of
-# the user's own (no mark) is installed into as it is.
+# the user's own (no mark) is installed into as it is. The mark holds venv's own output (a
+# PYTHON that is missing or cannot make one, python2.7: one line; Ctrl-C: no traceback).
 INSTALLING := $(VENV).installing
 VENV_USABLE := $(shell $(PY) -S -c 'import sys; sys.exit(sys.version_info < (3, 11))' >/dev/null 2>&1 && echo yes)
 MADE_IN := $(shell cat $(STAMP) 2>/dev/null)
@@ -56,9 +57,11 @@ pip = @$(PY) -m pip install --quiet $(1) >> $(PIP_LOG) 2>&1 || { printf 'make: p
 	"$$({ grep -m1 -E '^ *ERROR' $(PIP_LOG) || grep -v '^ *$$' $(PIP_LOG) | tail -1; } | sed -E 's/^ *(ERROR: *)?//')" >&2; exit 2; }
 
 $(STAMP): pyproject.toml $(if $(VENV_USABLE),,venv-unusable)
-	@touch $(INSTALLING)
-	$(PYTHON) -m venv $(if $(VENV_USABLE),,--clear) $(VENV)
-	@echo "installing the project and its libraries into $(VENV) (pip; its output goes to $(PIP_LOG))"; : > $(PIP_LOG)
+	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
+	@$(PYTHON) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) > $(INSTALLING) 2>&1 || { rc=$$?; \
+	  test $$rc -gt 128 && exit $$rc; printf 'make: %s -m venv could not make $(VENV): %s\n' $(call q,$(PYTHON)) \
+	  "$$(grep -v '^ *$$' $(INSTALLING) | tail -1)" >&2; exit 2; }
+	@: > $(PIP_LOG)
 	$(call pip,--upgrade pip)
 	$(call pip,-e ".[dev]")
 	@echo '$(CURDIR)' > $@; rm -f $(INSTALLING)

@@ -27,6 +27,9 @@ directory with a stand-in Python, so they run no study and touch no network.
 * ``copy/.venv/bin/sim`` of a project copied with its ``.venv`` (``cp -a``) silently ran the
   original's code in the copy; it is one line naming both and ``make clean venv``
   (:func:`sim.threads.script_of_another_copy`);
+* ``make venv PYTHON=python9`` (or a Python without ``venv``) was the shell's or Python's
+  line, and Ctrl-C during ``python -m venv`` printed its KeyboardInterrupt traceback: venv's
+  output goes to the install's mark, a failure is one line naming PYTHON;
 * pip failing in ``make venv`` (no network, no index) printed pip's dozen lines with the
   cause in the middle; it is one line with pip's first error (or its last line: a pip that no
   longer starts) and the log's path, and the next ``make venv`` tries again; an install
@@ -180,9 +183,10 @@ def fake_project(tmp_path: Path, python: str, pip_fails: bool = False) -> Path:
     return d
 
 
-def run_make(d: Path, *args):
+def run_make(d: Path, *args, python: str = ""):
+    python = python or str(d.parent / "fakepython")
     return subprocess.run(
-        [MAKE, "-s", "--no-print-directory", *args, f"PYTHON={d.parent / 'fakepython'}"],
+        [MAKE, "-s", "--no-print-directory", *args, f"PYTHON={python}"],
         cwd=d,
         capture_output=True,
         text=True,
@@ -252,6 +256,23 @@ def test_the_sim_script_of_a_copied_venv_refuses_to_run_the_originals_code(tmp_p
             "print(script_of_another_copy())",
         )
         assert p.stdout.strip() == "None", (argv0, p.stdout, p.stderr)
+
+
+def test_a_python_that_cannot_make_a_venv_is_one_line(tmp_path):
+    # make venv PYTHON=python9 (a typo), or a Python without the venv module (python2.7)
+    d = fake_project(tmp_path, "/nonexistent/python3")
+    old = tmp_path / "py27"
+    old.write_text('#!/bin/sh\necho "$0: No module named venv" >&2; exit 1\n', encoding="utf-8")
+    old.chmod(0o755)
+    for python, why in (
+        (str(tmp_path / "python9"), "not found"),
+        (str(old), "No module named venv"),
+    ):
+        line = make_line(
+            run_make(d, "venv", python=python), f"make: {python} -m venv could not make .venv: "
+        )
+        assert line.endswith(why), line
+        assert (d / ".venv.installing").exists()  # the next make venv starts from scratch
 
 
 def test_an_install_that_failed_or_was_stopped_starts_again_from_scratch(tmp_path):
