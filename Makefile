@@ -53,18 +53,22 @@ VENV_USABLE := $(and $(VENV_USABLE),$(if $(wildcard $(INSTALLING)),,yes))
 # line: a pip that does not start), exit 2 (it was pip's dozen lines, the cause in the
 # middle); the next `make venv` tries again
 PIP_LOG := $(VENV)/pip.log
-pip = @$(PY) -m pip install --quiet $(1) >> $(PIP_LOG) 2>&1 || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
+# Each install step holds the lock VENV_LOCK (where flock(1) exists): a pip still rolling back
+# after a Ctrl-C, or a second `make venv` at once, is waited for instead of racing the next
+# step ("venv --clear: Directory not empty", or a pip left without its modules)
+VENV_LOCK := $(if $(shell command -v flock 2>/dev/null),flock $(VENV).lock)
+pip = @$(VENV_LOCK) $(PY) -m pip install --quiet $(1) >> $(PIP_LOG) 2>&1 || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
 	"$$({ grep -m1 -E '^ *ERROR' $(PIP_LOG) || grep -v '^ *$$' $(PIP_LOG) | tail -1; } | sed -E 's/^ *(ERROR: *)?//')" >&2; exit 2; }
 
 $(STAMP): pyproject.toml $(if $(VENV_USABLE),,venv-unusable)
 	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
-	@$(PYTHON) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) > $(INSTALLING) 2>&1 || { rc=$$?; \
+	@$(VENV_LOCK) $(PYTHON) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) > $(INSTALLING) 2>&1 || { rc=$$?; \
 	  test $$rc -gt 128 && exit $$rc; printf 'make: %s -m venv could not make $(VENV): %s\n' $(call q,$(PYTHON)) \
 	  "$$(grep -v '^ *$$' $(INSTALLING) | tail -1)" >&2; exit 2; }
 	@: > $(PIP_LOG)
 	$(call pip,--upgrade pip)
 	$(call pip,-e ".[dev]")
-	@echo '$(CURDIR)' > $@; rm -f $(INSTALLING)
+	@echo '$(CURDIR)' > $@; rm -f $(INSTALLING) $(VENV).lock
 
 venv: $(STAMP) ## create the virtual environment and install the project
 
@@ -137,4 +141,4 @@ bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 a
 	$(PY) -m benchmarks --out $(call q,$(BENCH_OUT)) $(BENCH_FLAGS)
 
 clean: ## remove the virtual environment and caches (results/ is kept)
-	rm -rf $(VENV) .pytest_cache sim.egg-info mutants
+	rm -rf $(VENV) $(VENV).installing $(VENV).lock .pytest_cache sim.egg-info mutants

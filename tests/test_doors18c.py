@@ -27,6 +27,8 @@ directory with a stand-in Python, so they run no study and touch no network.
 * ``copy/.venv/bin/sim`` of a project copied with its ``.venv`` (``cp -a``) silently ran the
   original's code in the copy; it is one line naming both and ``make clean venv``
   (:func:`sim.threads.script_of_another_copy`);
+* each install step holds ``.venv.lock`` (flock): a pip still rolling back after Ctrl-C
+  raced the next make venv's ``venv --clear``;
 * ``make venv PYTHON=python9`` (or a Python without ``venv``) was the shell's or Python's
   line, and Ctrl-C during ``python -m venv`` printed its KeyboardInterrupt traceback: venv's
   output goes to the install's mark, a failure is one line naming PYTHON;
@@ -264,8 +266,9 @@ def test_a_python_that_cannot_make_a_venv_is_one_line(tmp_path):
     old = tmp_path / "py27"
     old.write_text('#!/bin/sh\necho "$0: No module named venv" >&2; exit 1\n', encoding="utf-8")
     old.chmod(0o755)
+    missing = "No such file or directory" if shutil.which("flock") else "not found"
     for python, why in (
-        (str(tmp_path / "python9"), "not found"),
+        (str(tmp_path / "python9"), missing),
         (str(old), "No module named venv"),
     ):
         line = make_line(
@@ -379,3 +382,13 @@ def test_report_names_results_directories_swapped_by_hand(tmp_path, capsys):
     (res / "brown_table1").rename(res / "brown_dil2")
     assert main(["report", "--results", str(res)]) == 0
     assert "holds the results" not in (res / "REPORT.md").read_text(encoding="utf-8")
+
+
+@pytest.mark.skipif(shutil.which("flock") is None, reason="no flock(1) here: steps unlocked")
+def test_the_install_steps_hold_a_lock(tmp_path):
+    # Ctrl-C during make venv, then make venv again at once: the first pip (still rolling
+    # back) and the second's venv --clear raced ("Directory not empty: 'setuptools'")
+    d = fake_project(tmp_path, "/nonexistent/python3")
+    p = run_make(d, "-n", "venv")
+    steps = [x for x in p.stdout.splitlines() if " -m venv --clear " in x or " -m pip in" in x]
+    assert len(steps) == 3 and all(x.startswith("flock .venv.lock ") for x in steps), p.stdout
