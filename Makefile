@@ -1,6 +1,12 @@
 # Reproduction of classic comparator/plotter calibration papers by Monte-Carlo simulation.
 # `make reproduce` and `make test` set everything up themselves (virtual environment, install).
 
+# every path below is relative to the project: `make -f path/to/Makefile` from elsewhere was
+# "No rule to make target 'pyproject.toml'"; say where to run it instead
+ifeq ($(wildcard pyproject.toml sim/__init__.py),)
+$(error $(lastword $(MAKEFILE_LIST)) runs in its own directory: make -C <its directory> $(or $(MAKECMDGOALS),help))
+endif
+
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -13,17 +19,56 @@ STUDIES := $(basename $(notdir $(STUDY_FILES)))
 unexport PYTHONDONTWRITEBYTECODE
 
 .DEFAULT_GOAL := help
-.PHONY: help venv test reproduce rerun verify report bench clean fuzz mutation
+.PHONY: help venv test reproduce rerun verify report bench clean fuzz mutation venv-unusable
+
+# $(call q,TEXT): TEXT as one single-quoted shell word (a value with spaces or quotes stays one)
+q = '$(subst ','\'',$(1))'
+# $(call whole,NAME,MIN): stop with one line unless the variable NAME is a whole number >= MIN
+# (RUN_JOBS= or TEST_WORKERS=abc reached the command as a misread argument, or after the install)
+whole = @case $(call q,$($(1))) in ''|*[!0-9]*) false;; *) test $(call q,$($(1))) -ge $(2);; esac || \
+	{ printf 'make %s: %s must be a whole number of at least %s (got %s)\n' $@ $(1) $(2) $(call q,'$($(1))') >&2; exit 2; }
 
 help: ## list the targets
 	@grep -E '^[a-zA-Z_%/.-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/:.*## /\t/' | sort | \
 	  awk -F'\t' '{printf "  %-22s %s\n", $$1, $$2}'
 
-$(STAMP): pyproject.toml
-	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[dev]"
-	@touch $@
+# A .venv that cannot serve this directory is made again from scratch, whatever its stamp says,
+# so that `make venv` repairs it (each needed `make clean` first): its Python no longer starts
+# (bin/python deleted, the Python it was made from removed: ".venv/bin/python: No such file or
+# directory"), is older than pyproject.toml's requires-python (a `make venv PYTHON=python3.10`
+# that failed), or the stamp names another directory (the project moved or copied with its
+# .venv, whose scripts start the old path's Python and code). The stamp holds the directory.
+# An install that failed or was interrupted (a Ctrl-C during pip's own upgrade left a pip that
+# no longer imports; one during `venv --clear` half a .venv) leaves its mark INSTALLING beside
+# the .venv, which only a finished install removes: made again from scratch too. A .venv of
+# the user's own (no mark) is installed into as it is. The mark holds venv's own output (a
+# PYTHON that is missing or cannot make one, python2.7: one line; Ctrl-C: no traceback).
+INSTALLING := $(VENV).installing
+VENV_USABLE := $(shell $(PY) -S -c 'import sys; sys.exit(sys.version_info < (3, 11))' >/dev/null 2>&1 && echo yes)
+MADE_IN := $(shell cat $(STAMP) 2>/dev/null)
+VENV_USABLE := $(and $(VENV_USABLE),$(if $(MADE_IN),$(if $(subst $(CURDIR),,$(MADE_IN)),,yes),yes))
+VENV_USABLE := $(and $(VENV_USABLE),$(if $(wildcard $(INSTALLING)),,yes))
+# $(call pip,ARGS): pip install ARGS, its output kept in PIP_LOG; a failure (no network, no index,
+# a Python the project does not support) is one line with pip's first error (else its last
+# line: a pip that does not start), exit 2 (it was pip's dozen lines, the cause in the
+# middle); the next `make venv` tries again
+PIP_LOG := $(VENV)/pip.log
+# Each install step holds the lock VENV_LOCK (where flock(1) exists): a pip still rolling back
+# after a Ctrl-C, or a second `make venv` at once, is waited for instead of racing the next
+# step ("venv --clear: Directory not empty", or a pip left without its modules)
+VENV_LOCK := $(if $(shell command -v flock 2>/dev/null),flock $(VENV).lock)
+pip = @$(VENV_LOCK) $(PY) -m pip install --quiet $(1) >> $(PIP_LOG) 2>&1 || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
+	"$$({ grep -m1 -E '^ *ERROR' $(PIP_LOG) || grep -v '^ *$$' $(PIP_LOG) | tail -1; } | sed -E 's/^ *(ERROR: *)?//')" >&2; exit 2; }
+
+$(STAMP): pyproject.toml $(if $(VENV_USABLE),,venv-unusable)
+	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
+	@$(VENV_LOCK) $(PYTHON) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) > $(INSTALLING) 2>&1 || { rc=$$?; \
+	  test $$rc -gt 128 && exit $$rc; printf 'make: %s -m venv could not make $(VENV): %s\n' $(call q,$(PYTHON)) \
+	  "$$(grep -v '^ *$$' $(INSTALLING) | tail -1)" >&2; exit 2; }
+	@: > $(PIP_LOG)
+	$(call pip,--upgrade pip)
+	$(call pip,-e ".[dev]")
+	@echo '$(CURDIR)' > $@; rm -f $(INSTALLING) $(VENV).lock
 
 venv: $(STAMP) ## create the virtual environment and install the project
 
@@ -34,6 +79,7 @@ venv: $(STAMP) ## create the virtual environment and install the project
 TEST_WORKERS ?= 2
 
 test: $(STAMP) ## lint (ruff), the layer contracts (import-linter), then the test suite on TEST_WORKERS=2 processes
+	$(if $(filter auto logical,$(TEST_WORKERS)),,$(call whole,TEST_WORKERS,0))
 	$(VENV)/bin/ruff check sim tests benchmarks
 	$(VENV)/bin/ruff format --check sim tests benchmarks
 	$(VENV)/bin/lint-imports
@@ -52,7 +98,8 @@ fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=30
 MUTATION_WORKERS ?= 2
 
 mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (sim/claims/), run their tests, write docs/mutation.md
-	$(PY) -m pip install --quiet -e ".[dev,mutation]"
+	$(call whole,MUTATION_WORKERS,1)
+	$(call pip,-e ".[dev,mutation]")
 	rm -rf mutants
 	$(VENV)/bin/mutmut run --max-children $(MUTATION_WORKERS) > /dev/null
 	$(PY) tests/mutation_report.py
@@ -66,10 +113,12 @@ mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (s
 RUN_JOBS ?= 2
 
 reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md
+	$(call whole,RUN_JOBS,1)
 	$(PY) -m sim.batch --stale-only --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
 rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report
+	$(call whole,RUN_JOBS,1)
 	$(PY) -m sim.batch --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
@@ -89,7 +138,7 @@ BENCH_FLAGS ?=
 BENCH_OUT ?= results/bench
 
 bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/; BENCH_FLAGS=--quick: smoke)
-	$(PY) -m benchmarks --out $(BENCH_OUT) $(BENCH_FLAGS)
+	$(PY) -m benchmarks --out $(call q,$(BENCH_OUT)) $(BENCH_FLAGS)
 
 clean: ## remove the virtual environment and caches (results/ is kept)
-	rm -rf $(VENV) .pytest_cache sim.egg-info mutants
+	rm -rf $(VENV) $(VENV).installing $(VENV).lock .pytest_cache sim.egg-info mutants

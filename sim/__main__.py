@@ -1,7 +1,12 @@
 """``python -m sim`` and the ``sim`` command: BLAS single-threaded, matplotlib's notes about
 an unwritable config directory kept quiet, then the command line."""
 
-from sim.threads import interrupt_while_loading, refuse_bad_environment, single_threaded_blas
+from sim.threads import (
+    interrupt_while_loading,
+    refuse_bad_environment,
+    script_of_another_copy,
+    single_threaded_blas,
+)
 
 loaded = interrupt_while_loading("sim")  # Ctrl-C during the imports: one line, exit 130
 
@@ -33,6 +38,10 @@ from sim.stops import run_program  # noqa: E402
 def main() -> int:
     """The ``sim`` program (``python -m sim``, the ``sim`` script): the command line, and a
     stop signal after it returned ends the process with its exit code (:mod:`sim.stops`)."""
+    words = script_of_another_copy()  # copy/.venv/bin/sim: the original's code, not the copy's
+    if words is not None:
+        print(f"sim: error: {words}", file=sys.stderr)
+        return 2
     return run_program("sim", command, loaded)
 
 

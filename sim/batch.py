@@ -14,7 +14,7 @@ the 20 % that keeps such machinery, issue 22, so it went). With ``J > 1`` the ru
 would overwrite each other); each study's line is printed when it ends. ``--stale-only``:
 only the studies whose results are not current (:func:`is_current`: their run record holds
 the config this run would resolve, run options included, and the current code), the others
-are reported up to date. A run that fails prints its own one-line message, which starts with the name of its study
+are reported up to date; each study run is named with the reason (:func:`why_stale`). A run that fails prints its own one-line message, which starts with the name of its study
 file; the others go on,
 and the exit code is that of the first failure (1 when a run was killed). A missing study
 file is bad input: one line, exit 2.
@@ -73,20 +73,39 @@ def is_current(study_file: str | Path, results: str | Path, run_args=()) -> bool
     """True when ``results/run.json`` records the config ``sim run STUDY_FILE RUN_ARGS``
     resolves (the study file with the run options' ``--set``, ``--trials``, ``--seed``,
     ``--chunk``) and the study's current code hash, and the run drew its figures (not
-    ``--no-figures``) unless ``run_args`` ask for none."""
+    ``--no-figures``) unless ``run_args`` ask for none (:func:`why_stale` says None)."""
+    return why_stale(study_file, results, run_args) is None
+
+
+def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str | None:
+    """Why ``results`` are not current for ``sim run STUDY_FILE RUN_ARGS`` (no results, a
+    config key that differs, the code changed since, no figures), in a few words; None when
+    they are (:func:`is_current`). ``--stale-only`` printed nothing for a study it re-ran,
+    so results made by older code or copied from elsewhere were re-run without a word."""
     try:
-        record = json.loads(regular_text(Path(results) / "run.json"))
+        text = regular_text(Path(results) / "run.json")
+    except OSError:
+        return "no results yet" if not Path(results).exists() else "no run record (run.json)"
+    try:
+        record = json.loads(text)
         with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
             args = run_parser(cli_doc).parse_args(["run", str(study_file), *run_args])
         _, cfg = load_run(args)
     except (OSError, ValueError, RecursionError, ConfigError, StudyError, SystemExit):
-        return False  # RecursionError: a run.json nested too deep to read
+        return "its run record or study file does not load"  # RecursionError: nested too deep
     if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
-        return False
+        return "its run record is not one"
     if record.get("figures") is False and not args.no_figures:  # sim run --no-figures
-        return False
-    want = study_code_hash(cfg["study"])
-    return record.get("config") == json.loads(json.dumps(cfg)) and record.get("code_hash") == want
+        return "made without figures"
+    want, have = json.loads(json.dumps(cfg)), record.get("config")
+    if have != want:
+        have = have if isinstance(have, dict) else {}
+        keys = sorted(k for k in {*want, *have} if want.get(k) != have.get(k))
+        more = f" and {len(keys) - 3} more" if len(keys) > 3 else ""
+        return f"made with another config: {', '.join(keys[:3])}{more}"
+    if record.get("code_hash") != study_code_hash(cfg["study"]):
+        return "made by other code: the code the study imports changed since"
+    return None
 
 
 def order(files: list[Path]) -> list[Path]:
@@ -114,8 +133,10 @@ def run_all(
     for f in order(files):
         if stale_only and is_current(f, results / f.stem, run_args):
             log(f"{f.stem}: up to date")
-        else:
-            todo.append(f)
+            continue
+        if stale_only:
+            log(f"{f.stem}: out of date ({why_stale(f, results / f.stem, run_args)}): running it")
+        todo.append(f)
     quiet = ["--quiet"] if jobs > 1 and "--quiet" not in run_args else []
 
     def argv(f: Path) -> list[str]:

@@ -106,10 +106,52 @@ def import_words(e: BaseException | None) -> str | None:
     if not isinstance(e, ImportError):
         return None
     name = (e.name or "").split(".")[0]
+    if own_venv():  # `make venv` would do nothing here: its stamp is newer than pyproject.toml
+        return (
+            f"cannot load {name or 'a library'}: {first}; the suite's virtual environment "
+            f"{sys.prefix} lacks it: make clean venv installs it again (results/ is kept)"
+        )
     return (
         f"cannot load {name or 'a library'}: {first}; run the suite with the Python it was "
         f"installed into (make venv; .venv/bin/sim), not {sys.executable}"
     )
+
+
+def script_of_another_copy() -> str | None:
+    """The words for the ``sim`` script of a ``.venv`` copied or moved with its project (``cp -a
+    project copy``): the script starts the suite where the ``.venv`` was made, so ``copy/.venv/
+    bin/sim`` silently ran the original's code (its edits, its code hash) in the copy; None
+    otherwise (``python -m sim`` runs the code of the working directory, as meant)."""
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    script = os.path.abspath(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    venv = os.path.dirname(os.path.dirname(script))
+    project = os.path.dirname(venv)
+    if os.path.basename(script) != "sim" or os.path.basename(venv) != ".venv":
+        return None
+    try:
+        if not os.path.isfile(os.path.join(project, "sim", "__init__.py")):
+            return None
+        if os.path.samefile(project, here):
+            return None
+    except OSError:
+        return None
+    return (
+        f"{script} runs the suite in {here}, where its .venv was made, not the one in "
+        f"{project}: a .venv cannot be copied or moved; make clean venv in {project} makes its own"
+    )
+
+
+def own_venv() -> bool:
+    """Whether this Python is the suite's own ``.venv`` (the one ``make venv`` makes beside
+    ``sim/``): a library missing there was removed from it, and running another Python would
+    not help (the message said "run the suite with the Python it was installed into (make venv;
+    .venv/bin/sim), not .venv/bin/python")."""
+    suite = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    venv = os.path.join(suite, ".venv")
+    try:
+        return sys.prefix != sys.base_prefix and os.path.samefile(sys.prefix, venv)
+    except OSError:
+        return False
 
 
 def _installed(path: str) -> bool:

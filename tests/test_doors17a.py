@@ -178,7 +178,8 @@ def test_a_library_shadowed_or_missing_is_one_line(tmp_path):
         "print(import_words(ValueError('x')))",
     )
     lines = p.stdout.splitlines()
-    assert lines[0].startswith("cannot load pyarrow: No module named 'pyarrow'; run the suite")
+    # doors18c: in the suite's own .venv the rest says to make it again (test_doors18c)
+    assert lines[0].startswith("cannot load pyarrow: No module named 'pyarrow'; ")
     assert lines[1] == "None"
 
 

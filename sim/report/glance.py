@@ -151,6 +151,15 @@ def opening(entries: list[tuple], results: Path) -> str:
     the same paper's study, counted apart) and the network studies (no paper)."""
     rows, notes, variants = [], [], []
     by_seed = by_paper(entries)
+    # a directory named as another study holds (results dirs swapped or renamed by hand): the
+    # report went by the directory's name, brown_dilution's claims shown as brown_table1's
+    names = {e[2].name for e in entries}
+    for _, name, study, _, _ in entries:
+        if name != study.name and name in names:
+            variants.append(
+                f"- [{name}]({name}/README.md) holds the results of the study `{study.name}` "
+                f"(its tables say so), not of `{name}`: a directory renamed or swapped by hand"
+            )
     for seed in sorted(s for s in by_seed if s):
         main, other = _main_and_variants(by_seed[seed])
         rows.append(_paper_row(seed, main))
