@@ -29,8 +29,8 @@ import pyarrow.parquet as pq
 from sim.execute import execute
 from sim.mc.config import ConfigError, study_file_hint
 from sim.mc.estimate import estimate
-from sim.mc.outputs import damaged_chunks
 from sim.mc.progress import check_environment
+from sim.mc.publish import damaged_chunks
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import read_provenance
 from sim.mc.sweep import read_sweep

@@ -22,7 +22,8 @@ import numpy as np
 
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
-from sim.mc.outputs import check_out, drop_stage, prepare_stage, publish, seal, stage_dir
+from sim.mc.outputs import check_out, drop_stage, prepare_stage, stage_dir
+from sim.mc.publish import publish, seal
 from sim.mc.runner import ChunkStore, RunContext, make_executor
 from sim.mc.storage import (
     code_hash,

@@ -16,7 +16,7 @@ a new user's first hour), one case each; each failed on the code before its fix.
   :class:`sim.batch._Stdout`);
 * a results directory copied into another study's results (a user's copy): re-running
   that study kept the copy but dropped its ``run.json``, so the copy was no longer results
-  (``sim.mc.outputs._foreign`` took every ``run.json`` for the run's own);
+  (``sim.mc.publish._foreign`` took every ``run.json`` for the run's own);
 * ``python -m sim.report.verify --results DIR`` from a directory without ``studies/``
   reported every study as FAILED (exit 1, and recorded so): now one line, exit 2;
 * ``--out`` naming another study's results said "holds results of a different config; use

@@ -7,7 +7,7 @@ failed on the code before its fix.
   to a README.md it then wrote into the staging directory), and ``make verify`` took it for a
   study to compare (:func:`sim.mc.outputs.results_dirs`);
 * a run into an earlier results directory interrupted while it copied the user's files into
-  its staging directory (:func:`sim.mc.outputs.publish`): every later run into it refused,
+  its staging directory (:func:`sim.mc.publish.publish`): every later run into it refused,
   naming the user's own file as one the run writes (the copies had been recorded as the run's
   files when the resumed run sealed its staging directory);
 * Ctrl-C while a run imported a module on first use (a SciPy extension raises ImportError
@@ -25,7 +25,8 @@ from oneline import one_line
 
 from sim import cli
 from sim.cli import main
-from sim.mc import outputs, runner
+from sim.mc import publish as publishing
+from sim.mc import runner
 from sim.report.verify.rerun import study_dirs
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -65,7 +66,7 @@ def test_a_run_cut_short_while_keeping_the_users_files_is_resumed(tmp_path, monk
     assert main(cmd) == 0
     (out / "notes.txt").write_text("mine")
     (out / "big.dat").write_bytes(b"\x01" * 1000)
-    carry = outputs._carry
+    carry = publishing._carry
     copied = []
 
     def cut_short(src, dst):  # the second copy is interrupted half way
@@ -74,9 +75,9 @@ def test_a_run_cut_short_while_keeping_the_users_files_is_resumed(tmp_path, monk
             raise KeyboardInterrupt
         copied.append(carry(src, dst))
 
-    monkeypatch.setattr(outputs, "_carry", cut_short)
+    monkeypatch.setattr(publishing, "_carry", cut_short)
     assert main([*cmd, "--overwrite"]) == 130
-    monkeypatch.setattr(outputs, "_carry", carry)
+    monkeypatch.setattr(publishing, "_carry", carry)
     assert len(list((tmp_path / ".np.partial").iterdir())) > 2  # a staging directory left
     capsys.readouterr()
     assert main(cmd) == 0, capsys.readouterr().err

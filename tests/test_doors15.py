@@ -25,6 +25,7 @@ from oneline import one_line, one_line_of
 
 from sim import batch, cli, threads
 from sim.mc import executors, outputs, storage
+from sim.mc import publish as publishing
 from sim.mc.storage import atomic_path, read_record, write_record
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -121,8 +122,8 @@ def test_old_results_that_cannot_be_removed_are_named(tmp_path, monkeypatch, cap
         (d / "trials").mkdir(parents=True)
         write_record(d, {"config": {"seed": seed}, "code_hash": "x", "files": []})
     (out / "trials" / "chunk-000000.parquet").write_bytes(b"old")
-    monkeypatch.setattr(outputs.shutil, "rmtree", lambda p, ignore_errors=False: None)
-    outputs.publish(stage, out)
+    monkeypatch.setattr(publishing.shutil, "rmtree", lambda p, ignore_errors=False: None)
+    publishing.publish(stage, out)
     assert read_record(out)["config"] == {"seed": 2}
     err = capsys.readouterr().err.strip().splitlines()
     old = outputs.swap_dir(out)

@@ -10,7 +10,7 @@ found them (``run.sh``, about 250 cases) lives outside the project.
 * an ``--overwrite`` whose old results hold a file it may not remove keeps them in
   ``.<name>.old.<pid>``; in a container, where every command is the same pid, the next such
   run failed after every trial with "sim: error: Directory not empty: OUT", and so did every
-  later run until the user found the hidden directory (:func:`sim.mc.outputs.publish`);
+  later run until the user found the hidden directory (:func:`sim.mc.publish.publish`);
 * a umask that denies the owner (``umask 777``): ``sim run`` left a staging directory of mode
   000 that blocked every later run of that ``--out``, ``--overwrite`` included ("Permission
   denied: .../.lock"), and ``sim report`` replaced every README.md and REPORT.md by files no
@@ -25,7 +25,7 @@ found them (``run.sh``, about 250 cases) lives outside the project.
 * the staging directory removed or moved away while a run works (``rm -rf .<out>.partial``,
   or the working directory of a relative ``--out``): "internal error: AttributeError:
   'NoneType' object has no attribute 'get'", exit 3; now one line naming it
-  (:func:`sim.mc.outputs.seal`).
+  (:func:`sim.mc.publish.seal`).
 """
 
 from __future__ import annotations
@@ -41,6 +41,7 @@ from oneline import SIM_ERROR, one_line, python_lines
 from sim import execute
 from sim.cli import main
 from sim.mc import outputs
+from sim.mc import publish as publishing
 from sim.mc.config import ConfigError
 from sim.mc.storage import read_record, write_record
 
@@ -83,13 +84,13 @@ def test_old_results_left_by_a_run_of_the_same_pid_do_not_block_the_next(
     ``--overwrite`` failed after every trial with "Directory not empty" (and so did every
     run after it)."""
     out, stage = tmp_path / "res", tmp_path / ".res.partial"
-    monkeypatch.setattr(outputs.shutil, "rmtree", lambda p, ignore_errors=False: None)
+    monkeypatch.setattr(publishing.shutil, "rmtree", lambda p, ignore_errors=False: None)
     for seed in (1, 2, 3):
         (stage / "trials").mkdir(parents=True)
         chunk = "trials/chunk-000000.parquet"
         write_record(stage, {"config": {"seed": seed}, "code_hash": "x", "files": [chunk]})
         (stage / "trials" / "chunk-000000.parquet").write_bytes(b"%d" % seed)
-        outputs.publish(stage, out)
+        publishing.publish(stage, out)
         assert read_record(out)["config"] == {"seed": seed} and not stage.exists()
     old = outputs.swap_dir(out)
     kept = sorted(p.relative_to(old).as_posix() for p in old.rglob("chunk-*"))
@@ -180,4 +181,4 @@ def test_a_staging_directory_removed_while_the_run_works_is_one_line(tmp_path):
     (stage / "trials" / "part-0").mkdir(parents=True)
     (stage / "trials" / "part-0" / "chunk-000003.parquet").write_bytes(b"late")
     with pytest.raises(ConfigError, match=r"^--out: .*\.o\.partial lost its run record"):
-        outputs.seal(stage, None)
+        publishing.seal(stage, None)

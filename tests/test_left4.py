@@ -14,7 +14,7 @@ before its fix.
 * ``python -m sim.batch a.toml b.toml -- --set nosuch=1`` printed one "unknown key" line per
   study after starting each run: a key no study of the batch has is one line and exit 2 before
   any run; a key only some lack is said once before the runs start
-  (:func:`sim.batch._unknown_sets`);
+  (:func:`sim.batch_checks._unknown_sets`);
 * ``[sweep] trials = 40`` (one value, not a list) was read as a sweep of one cell: any swept
   key given one value is refused with one short line naming ``sweep.<key>`` and showing the
   list it takes;
@@ -42,7 +42,7 @@ import pytest
 from oneline import SIM_ERROR, one_line
 
 import sim
-from sim.batch import _unknown_sets
+from sim.batch_checks import _unknown_sets
 from sim.batch import main as batch_main
 from sim.cli import main
 from sim.mc.estimate import ADJUSTMENT_S, check_limits, estimate

@@ -6,30 +6,23 @@ an earlier results directory (its ``run.json``), and not inside another run's di
 works in a locked staging directory ``.<out>.partial/`` (resumed after a kill, named when
 damaged) that replaces ``<out>`` only when everything succeeded, keeping the files there that
 the suite did not write. ``run.json`` records the config, the code hash, every file the run
-wrote and each chunk file's sha256.
+wrote and each chunk file's sha256 (sealing and publishing: :mod:`sim.mc.publish`).
 """
 
 from __future__ import annotations
 
-import hashlib
 import os
 import shutil
-import sys
 import unicodedata
-from itertools import count
 from pathlib import Path
 
 from sim.mc.config import ConfigError
-from sim.mc.runner import ChunkStore
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
     "check_out",
     "prepare_stage",
     "drop_stage",
-    "seal",
-    "publish",
-    "damaged_chunks",
     "name_problem",
     "stage_dir",
     "swap_dir",
@@ -288,177 +281,3 @@ def drop_stage(stage: Path, lock, reason: str | None = None) -> None:
             write_record(stage, {**rec, "failed": reason})
     finally:
         lock.release()
-
-
-def _files(d: Path) -> list[str]:
-    """The regular files under ``d`` (relative, POSIX), but the run record and the lock."""
-    return sorted(
-        p.relative_to(d).as_posix()
-        for p in d.rglob("*")
-        if p.is_file() and not p.is_symlink() and p.name not in ("run.json", LOCK)
-    )
-
-
-def seal(stage: Path, store: ChunkStore | None) -> None:
-    """Before publishing: drop chunk files this run neither wrote nor read (left over or copied
-    in), and record in ``run.json`` every file the run wrote and each chunk file's sha256, so
-    that a later run keeps a file it did not write and a reader can check a chunk's content."""
-    if store is not None:
-        for p in store.strays():
-            p.unlink()
-    rec = read_record(stage)
-    if rec is None:  # the staging directory removed or moved away while the run worked
-        raise ConfigError("--out", f"{stage} lost its run record while the run worked; run again")
-    carried = set(rec.get("carried") or [])  # the user's files a publish copied in: not ours
-    files = [f for f in _files(stage) if f not in carried]
-    chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
-    write_record(stage, {**rec, "files": files, "chunk_sha256": chunks})
-
-
-def damaged_chunks(out: Path) -> str | None:
-    """What is wrong with the per-trial chunk files of a finished results directory, against
-    the sha256 of each that its run recorded (``run.json`` ``chunk_sha256``), or None when
-    they are exactly the run's: a chunk missing, changed or added by hand. Chunks that cannot
-    be checked (no run record, or a record without their hashes: edited by hand, or written
-    before runs hashed their chunks) are refused too: unchecked trials are never read."""
-    rec = read_record(out)
-    if rec is None:
-        return f"{out / 'run.json'} is missing or not a run record, so the chunks cannot be checked"
-    want = rec.get("chunk_sha256")
-    if not isinstance(want, dict) or not all(isinstance(v, str) for v in want.values()):
-        return f"{out / 'run.json'} does not map the chunk files to their sha256 (edited by hand?)"
-    have = sorted(
-        p.relative_to(out).as_posix() for p in (out / "trials").rglob("*") if not p.is_dir()
-    )
-    for f in sorted(set(want) | set(have)):
-        if f not in have:
-            return f"{out / f} is missing; run the study again"
-        if f not in want:
-            # no run removes a file it did not write: re-running would not help
-            return f"{out / f} is not one of the run's chunk files (added by hand?): move it away"
-        if not (out / f).is_file() or (out / f).is_symlink() or _sha256(out / f) != want[f]:
-            return (
-                f"{out / f} is not the file the run wrote (its sha256 differs); run the study again"
-            )
-    return None
-
-
-def _sha256(p: Path) -> str:
-    h = hashlib.sha256()
-    with open(p, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
-def _foreign(out: Path) -> list[str]:
-    """Entries in an earlier results directory that its run did not write (a user's notes, a
-    symbolic link, a FIFO, an empty directory, given with a trailing ``/``): they are carried
-    into the new results. Results recorded before runs listed their files count as wholly
-    written by the suite."""
-    rec = read_record(out)
-    if not rec or "files" not in rec:
-        return []
-    if not isinstance(rec["files"], list) or not all(isinstance(f, str) for f in rec["files"]):
-        raise ConfigError(
-            "--out",
-            f"{out / 'run.json'} does not list the files its run wrote (edited by hand?): "
-            "move the directory away, or delete it, and run again",
-        )
-    mine = set(rec["files"])
-    keep = []
-    for root, dirs, files in os.walk(out):  # a link to a directory is an entry, not followed
-        r = Path(root)
-        for n in files + [d for d in dirs if (r / d).is_symlink()]:
-            f = (r / n).relative_to(out).as_posix()
-            if f not in mine and f not in ("run.json", LOCK):  # its own, not a copy's inside
-                keep.append(f)
-        if r != out and not dirs and not files:
-            keep.append(r.relative_to(out).as_posix() + "/")
-    return sorted(keep)
-
-
-def _carry(src: Path, dst: Path) -> None:
-    """Copy a user's entry ``src`` of an earlier results directory to ``dst`` as what it is: a
-    regular file's bytes, a symbolic link's target (not followed), an empty directory, and a
-    FIFO, socket or device by a hard link (never opened: a FIFO would block)."""
-    dst.parent.mkdir(parents=True, exist_ok=True)
-    if src.is_symlink():
-        os.symlink(os.readlink(src), dst)
-    elif src.is_dir():
-        dst.mkdir(exist_ok=True)
-    elif src.is_file():
-        shutil.copy2(src, dst)
-    else:
-        try:
-            os.link(src, dst, follow_symlinks=False)
-        except OSError as e:
-            raise ConfigError(
-                "--out",
-                f"{src} was not written by sim and cannot be kept ({e.strerror}); move it away "
-                "and run again",
-            ) from None
-
-
-def _clash(stage: Path, f: str) -> str | None:
-    """The part of the foreign file ``f`` (relative) that the new run's files in ``stage``
-    take: ``f`` itself, or a directory of its path that the run writes as a file (a user's
-    ``network.png/notes.txt``), else None."""
-    parts = Path(f).parts
-    for i in range(1, len(parts)):
-        q = stage.joinpath(*parts[:i])
-        if q.exists() and not q.is_dir():
-            return Path(*parts[:i]).as_posix()
-    q = stage / f
-    if f.endswith("/"):  # an empty directory: only a file of that name takes it
-        return f.rstrip("/") if q.exists() and not q.is_dir() else None
-    return f if q.exists() or q.is_symlink() else None
-
-
-def _free_swap(out: Path) -> Path:
-    """Where :func:`publish` moves the old results: :func:`swap_dir`, or a new entry in it when
-    a run of the same pid (a container's) left old files there it could not remove."""
-    old = swap_dir(out)
-    if old.is_dir() and not old.is_symlink():
-        taken = {p.name for p in old.iterdir()}
-        return old / next(f"{out.name}.{k}" for k in count(1) if f"{out.name}.{k}" not in taken)
-    return old  # (anything else in the way: os.replace names it)
-
-
-def publish(stage: Path, out: Path) -> None:
-    """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
-    files in ``out`` that the suite did not write."""
-    for tmp in stage.rglob("*.tmp"):
-        tmp.unlink(missing_ok=True)
-    keep = _foreign(out) if out.is_dir() else []
-    rec = read_record(stage)
-    for f in set(rec.get("carried") or []) & set(keep):  # copied by a publish cut short
-        q = stage / f
-        if (q.is_symlink() or q.exists()) and not q.is_dir():
-            q.unlink()  # (the user's own is still in out): copied again below
-    clash = [c for f in keep if (c := _clash(stage, f))]
-    if clash:
-        raise ConfigError(
-            "--out",
-            f"{out / clash[0]} was not written by sim but the new run writes a file of that "
-            "name; move it away and run again",
-        )
-    if keep:  # named before copying: a resume after a kill here knows the copies for copies
-        write_record(stage, {**rec, "carried": keep})
-    for f in keep:
-        _carry(out / f, stage / f)
-    old = _free_swap(out) if out.exists() else None
-    if old is not None:
-        os.replace(out, old)
-    os.replace(stage, out)
-    (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
-    if old is None:
-        return
-    shutil.rmtree(old, ignore_errors=True)
-    if old.exists() or old.is_symlink():  # a file or directory of the old results that this
-        # user may not remove: they are not lost, but say where (a hidden directory)
-        left = next(iter(sorted(old.rglob("*"), key=lambda q: -len(q.parts))), old)
-        print(
-            f"sim: note: the replaced results are kept in {old} ({left} could not be removed)",
-            file=sys.stderr,
-        )

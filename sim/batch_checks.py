@@ -1,0 +1,164 @@
+"""What ``python -m sim.batch`` checks before it starts any run, and whether a study's results
+are current (``--stale-only``, ``make verify``'s staleness rule).
+
+:func:`why_stale` reads the run record against the config ``sim run STUDY RUN_OPTIONS``
+resolves and the study's current code hash; the ``_..._problem`` checks run once before any
+study starts (a clash of two runs on one results directory, run options that every run would
+refuse, ``--set`` keys no study has, a timings file that is not the batch's).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+from pathlib import Path
+
+from sim.cli import DOC as cli_doc
+from sim.cli import check_run_args, load_run
+from sim.cli_args import parser as run_parser
+from sim.mc.codehash import study_code_hash
+from sim.mc.config import ConfigError, StudyError, parse_override, read_toml
+from sim.mc.storage import regular_text
+from sim.studies import get_study
+
+__all__ = ["is_current", "why_stale"]
+
+
+def is_current(study_file: str | Path, results: str | Path, run_args=()) -> bool:
+    """True when ``results/run.json`` records the config ``sim run STUDY_FILE RUN_ARGS``
+    resolves (the study file with the run options' ``--set``, ``--trials``, ``--seed``,
+    ``--chunk``) and the study's current code hash, and the run drew its figures (not
+    ``--no-figures``) unless ``run_args`` ask for none (:func:`why_stale` says None)."""
+    return why_stale(study_file, results, run_args) is None
+
+
+def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str | None:
+    """Why ``results`` are not current for ``sim run STUDY_FILE RUN_ARGS`` (no results, a
+    config key that differs, the code changed since, no figures), in a few words; None when
+    they are (:func:`is_current`). ``--stale-only`` printed nothing for a study it re-ran,
+    so results made by older code or copied from elsewhere were re-run without a word."""
+    try:
+        text = regular_text(Path(results) / "run.json")
+    except OSError:
+        return "no results yet" if not Path(results).exists() else "no run record (run.json)"
+    try:
+        record = json.loads(text)
+        with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
+            args = run_parser(cli_doc).parse_args(["run", str(study_file), *run_args])
+        _, cfg = load_run(args)
+    except (OSError, ValueError, RecursionError, ConfigError, StudyError, SystemExit):
+        return "its run record or study file does not load"  # RecursionError: nested too deep
+    if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
+        return "its run record is not one"
+    if record.get("figures") is False and not args.no_figures:  # sim run --no-figures
+        return "made without figures"
+    want, have = json.loads(json.dumps(cfg)), record.get("config")
+    if have != want:
+        have = have if isinstance(have, dict) else {}
+        keys = sorted(k for k in {*want, *have} if want.get(k) != have.get(k))
+        more = f" and {len(keys) - 3} more" if len(keys) > 3 else ""
+        return f"made with another config: {', '.join(keys[:3])}{more}"
+    if record.get("code_hash") != study_code_hash(cfg["study"]):
+        return "made by other code: the code the study imports changed since"
+    return None
+
+
+def _clashes(files: list[Path], run_args: list[str], results: str = "results") -> str | None:
+    """Why these runs cannot share one batch: two of them would write one results directory
+    (the same file twice, two files of one name), or a file's name is ``.toml`` or
+    ``...toml`` (its results would be <results> itself or its parent)."""
+    seen: dict[str, Path] = {}
+    for f in files:
+        if f.stem in ("", ".", ".."):
+            return f"{f}: a study file named like this would write <results>/{f.stem}"
+        if f.stem in seen:
+            same = f.resolve() == seen[f.stem].resolve()
+            return (
+                f"{f} is listed twice"
+                if same
+                else f"{seen[f.stem]} and {f} would both write {Path(results) / f.stem}"
+            )
+        seen[f.stem] = f
+    return None
+
+
+def _run_options_problem(run_args: list[str]) -> str | None:
+    """Why the run options cannot go to every run, checked once before any starts (as
+    ``sim run`` reads them, abbreviations included): a bad option or value, an ``--out``
+    (each study writes <results>/<file name>), or ``--help`` (each run would print its help
+    and exit 0 without running)."""
+    text = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(text), contextlib.redirect_stderr(text):
+            args = run_parser(cli_doc).parse_args(["run", "STUDY.toml", *run_args])
+        if args.out is not None:
+            return "--out cannot be a run option: each study writes <results>/<file name>"
+        check_run_args(args)
+    except SystemExit:
+        return f"{' '.join(run_args)!r} would print the help of sim run and run nothing"
+    except ConfigError as e:
+        return str(e).removeprefix("sim: ")
+    return None
+
+
+def _unknown_sets(files: list[Path], run_args: list[str]) -> tuple[str | None, str | None]:
+    """``(problem, note)`` of the run options' ``--set`` keys against the studies of the batch
+    (each file's ``study``, its schema): a key no study has is a problem (exit 2 before any
+    run: each run would refuse it, one line per study); a key only some lack is a note said
+    once before the runs start (those runs refuse it). A file whose study cannot be read is
+    left to its run's own line."""
+    with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
+        sets = run_parser(cli_doc).parse_args(["run", "STUDY.toml", *run_args]).set or []
+    keys = []
+    for text in sets:
+        try:
+            key = parse_override(text)[0]
+        except ConfigError as e:  # "--set needs key=value (got 'bad')"
+            return str(e), None
+        keys.append(key)
+    schemas: dict[Path, tuple[str, set]] = {}
+    for f in files:
+        try:
+            name = read_toml(f).get("study")
+            schemas[f] = (name, set(get_study(name).schema))
+        except (ConfigError, OSError, ValueError, RecursionError):
+            continue
+    notes = []
+    for key in dict.fromkeys(keys):
+        lack = [f for f, (_, schema) in schemas.items() if key not in schema]
+        if not lack:
+            continue
+        if len(lack) == len(schemas):
+            many = "no study of the batch has it" if len(files) > 1 else "the study has no such key"
+            return f"--set {key}: unknown key ({many})", None
+        studies = ", ".join(f"{f.name} ({schemas[f][0]})" for f in lack)
+        notes.append(
+            f"--set {key}: unknown to {studies}, whose run{'s' * (len(lack) > 1)} will refuse it"
+        )
+    return None, "; ".join(notes) or None
+
+
+def _timings_problem(path: str) -> str | None:
+    """Why the timings cannot be written to ``path`` (checked before anything runs): its
+    directory must be writable, and an existing file must be an earlier timings file (a
+    JSON object of lists), never a file of the user's."""
+    p = Path(path)
+    try:
+        parent = p.resolve().parent
+    except (OSError, RuntimeError) as e:  # a symlink loop
+        return f"{p} cannot be resolved: {e}"
+    if not parent.is_dir() or not os.access(parent, os.W_OK):
+        return f"cannot write into {parent}"
+    if p.is_symlink() or (p.exists() and not p.is_file()):
+        return f"{p} exists and is not a regular file"
+    if p.exists():
+        try:
+            old = json.loads(p.read_text(encoding="utf-8"))
+            ours = isinstance(old, dict) and all(isinstance(v, list) for v in old.values())
+        except (OSError, ValueError):
+            ours = False
+        if not ours:
+            return f"{p} exists and is not a timings file of sim.batch; sim never replaces it"
+    return None
