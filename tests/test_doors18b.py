@@ -17,6 +17,10 @@ with exit 0: is every output true?), one case each; each failed on the code befo
   analytic sigmas per unit range sigma: the self-check "Monte Carlo agrees with analytic"
   read 5.0 and failed for every model, a disagreement that was the suite's own units
   (:func:`sim.studies.brown.claims.score_dilution`; the committed run, at 1 um, is unchanged);
+* ``sim report`` over a directory of runs made with ``--set`` (``test.alpha=0.3``,
+  ``errors.setting_sigma_um=5``, 400 trials) printed their verdicts as those of the study
+  files' designs, without a word on what the runs changed; each such run is now named with the
+  keys it changed (:func:`sim.report.glance.design_notes`, :func:`sim.studies.design_config`);
 """
 
 from __future__ import annotations
@@ -79,3 +83,19 @@ def test_brown_dilution_compares_monte_carlo_with_analytic_at_the_range_sigma(tm
     for m in ("known", "stations", "pivot"):
         r = rows[f"brown.mc_agreement.{m}.mean_ratio"]
         assert r["ci_low"] < 1.0 < r["ci_high"] and r["outcome"] == "inconclusive", r
+
+
+def test_the_report_names_what_a_run_changed_from_its_study_file(tmp_path, capsys):
+    from sim.report.markdown import build_report
+    from sim.studies import design_config, get_study
+
+    out, f = tmp_path / "R" / "network_plate", str(ROOT / "studies" / "network_plate.toml")
+    sets = ["--set", "test.alpha=0.3", "--trials", "20", "--chunk", "1", "--no-figures"]
+    assert main(["run", f, "--out", str(out), *sets]) == 0, capsys.readouterr()
+    assert main(["report", "--results", str(out.parent)]) == 0, capsys.readouterr()
+    text = (out.parent / "REPORT.md").read_text()
+    line = next(ln for ln in text.splitlines() if "did not run the configuration" in ln)
+    assert "`test.alpha` = 0.300 (the file: 0.0500)" in line and "`trials` = 20" in line
+    # the committed results are the study files' designs: no such line
+    committed = build_report(ROOT / "results", get_study, design_config)
+    assert "did not run the configuration" not in committed
