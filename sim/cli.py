@@ -44,7 +44,7 @@ from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.stops import check_interrupt, keep_lost_interrupts
-from sim.studies import get_study, load_study
+from sim.studies import design_config, get_study, load_study
 from sim.threads import interrupted, memory_words, shadowed, short_of_memory
 
 __all__ = ["main", "check_run_args"]
@@ -292,7 +292,7 @@ def _report(results: Path) -> int:
     if (why := umask_problem()) is not None:
         raise ConfigError(None, why)
     try:
-        text = write_report(results, get_study)
+        text = write_report(results, get_study, design_config)
     except ConfigError:
         raise
     except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:

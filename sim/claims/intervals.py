@@ -134,9 +134,11 @@ def binomial_ci(k, n, level: float = LEVEL):
     denom = 2 * (n + z * z)
     centre = (2 * n * p + z * z) / denom
     half = z * np.sqrt(4 * n * p * (1 - p) + z * z) / denom
-    # rounding can carry the bounds a few ulp outside [0, 1] (k = n = 16: 1 + 2e-16)
-    lo = np.maximum(centre - half, 0.0)  # pragma: no mutate -- not seen below 0 for n <= 3000
-    return p, lo, np.minimum(centre + half, 1.0)
+    # rounding can carry the bounds a few ulp outside [0, 1] (k = n = 16: 1 + 2e-16), or
+    # inside it (k = n = 40: 1 - 1e-16, an interval that missed its own value 1): at k = 0
+    # and k = n the Wilson bound is exactly 0 and 1
+    lo = np.where(k == 0, 0.0, np.maximum(centre - half, 0.0))[()]  # [()]: a scalar stays one
+    return p, lo, np.where(k == n, 1.0, np.minimum(centre + half, 1.0))[()]
 
 
 def share_ci(x: np.ndarray, level: float = LEVEL) -> tuple[float, tuple[float, float]]:

@@ -89,4 +89,7 @@ def wilson_ci(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
     denom = 2 * (n + z * z)
     centre = (2 * n * p + z * z) / denom
     half = z * np.sqrt(4 * n * p * (1 - p) + z * z) / denom
-    return float(max(centre - half, 0.0)), float(min(centre + half, 1.0))
+    # at k = 0 and k = n the bound is exactly 0 and 1 (rounding gave 1 - 1e-16 at k = n = 40,
+    # an interval that missed its own value)
+    lo = 0.0 if k == 0 else max(centre - half, 0.0)
+    return float(lo), float(1.0 if k == n else min(centre + half, 1.0))

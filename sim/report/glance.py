@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Callable
 
 import pyarrow as pa
 
@@ -181,3 +182,27 @@ def opening(entries: list[tuple], results: Path) -> str:
         ["paper (studies)", "verdicts", "headline claims", "simulated [95%]", "verdict"], rows
     )
     return "\n".join(["## The verdicts at a glance", "", table, "", *variants, *notes, ""])
+
+
+def design_notes(entries: list[tuple], results: Path, design: Callable | None) -> list[str]:
+    """One line per results directory whose run changed the config of the study file it is
+    named after (``studies/<name>.toml``, ``design(name)``): the keys changed (at most six),
+    so that a ``--set`` run is not read as the paper's design."""
+    out = []
+    for _, name, *_ in entries:
+        base = design(name) if design is not None else None
+        if not base:
+            continue
+        mine = _config_of(results / name)
+        diff = [k for k in sorted(set(mine) | set(base)) if mine.get(k) != base.get(k)]
+        if not mine or not diff:
+            continue
+        what = ", ".join(
+            f"`{k}` = {fmt(mine.get(k))} (the file: {fmt(base.get(k))})" for k in diff[:6]
+        ) + (f", and {len(diff) - 6} more" if len(diff) > 6 else "")
+        out.append(
+            f"- [{name}]({name}/README.md) did not run the configuration of "
+            f"`studies/{name}.toml`: {what}. Its verdicts are about this run's configuration, "
+            "not the study file's design."
+        )
+    return out

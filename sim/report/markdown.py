@@ -19,7 +19,7 @@ from sim.mc.outputs import results_dirs
 from sim.mc.storage import atomic_path, read_provenance, read_table
 from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
-from sim.report.glance import by_paper, number, opening
+from sim.report.glance import by_paper, design_notes, number, opening
 from sim.report.papers import paper_name
 from sim.report.read import claims_damage, forget, records
 from sim.report.run_summary import headline_rows, write_run_readme
@@ -283,11 +283,12 @@ def _entry(d: Path, get_study: Callable) -> tuple:
     return (study.order, d.name, study, claims, row)
 
 
-def build_report(results: Path, get_study: Callable) -> str:
+def build_report(results: Path, get_study: Callable, design: Callable | None = None) -> str:
     """The suite's report over every results directory under ``results``: one screen of
     verdicts per paper, every headline claim, the counts per study, the rules, the
     reproducibility check, and links to each directory's README.md (the detail).
-    ``get_study(name)`` gives the registered study (title, seed file, order)."""
+    ``get_study(name)`` gives the registered study (title, seed file, order); ``design(name)``
+    the config of the study file a directory is named after (a run that changed it is said)."""
     results = Path(results)
     if not results.is_dir():
         raise ConfigError("--results", f"{results} is not a results directory")
@@ -317,6 +318,7 @@ def build_report(results: Path, get_study: Callable) -> str:
     return (
         head
         + opening(entries, results)
+        + "".join(line + "\n" for line in design_notes(entries, results, design))
         + "\n"
         + referee_summary(entries)
         + "\n### Counts per study\n\n"
@@ -346,7 +348,7 @@ def _ours(path: Path) -> bool:
     return first in (MARK, "# Reproducibility report")
 
 
-def write_report(results: Path, get_study: Callable) -> Path:
+def write_report(results: Path, get_study: Callable, design: Callable | None = None) -> Path:
     """Write each results directory's README.md (see
     :func:`sim.report.run_summary.write_run_readme`) and ``results/REPORT.md``; a REPORT.md
     there that the suite did not write is refused (one line naming it), never replaced."""
@@ -356,7 +358,7 @@ def write_report(results: Path, get_study: Callable) -> Path:
         raise ConfigError(
             "--results", f"{out} was not written by sim report; sim never replaces it"
         )
-    text = MARK + "\n" + build_report(results, get_study)
+    text = MARK + "\n" + build_report(results, get_study, design)
     for d in sorted(results_dirs(results)):
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             write_run_readme(d, get_study)

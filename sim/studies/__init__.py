@@ -18,7 +18,7 @@ from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
 from sim.mc.sweep import RESERVED, read_sweep
 
-__all__ = ["Study", "RunContext", "get_study", "load_study", "MODULES"]
+__all__ = ["Study", "RunContext", "design_config", "get_study", "load_study", "MODULES"]
 
 
 @dataclass(frozen=True)
@@ -116,3 +116,18 @@ def _beside_the_study(e: ConfigError, path: Path, flat: Mapping[str, Any]) -> Co
         f"{v} not found in {os.getcwd()} (a relative path is read from the working directory); "
         f"{shown} exists: run from {where} or give an absolute path",
     )
+
+
+#: the project's study files: a results directory named as one of them is that study's design
+STUDY_FILES = Path(__file__).resolve().parents[2] / "studies"
+
+
+def design_config(name: str) -> dict | None:
+    """The resolved config of the project's study file ``studies/<name>.toml`` (the design a
+    results directory of that name stands for), or None when there is none or it does not
+    load: ``sim report`` names what a run changed from it."""
+    f = STUDY_FILES / f"{name}.toml"
+    try:
+        return load_study(f)[1] if f.is_file() else None
+    except (ConfigError, OSError, ValueError):
+        return None

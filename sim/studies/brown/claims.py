@@ -22,7 +22,7 @@ from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import ConfigError
 from sim.mc.runner import chunk_rng
 from sim.studies.brown import values as V
-from sim.studies.brown.schema import MODEL_NAMES
+from sim.studies.brown.schema import MODEL_NAMES, range_sigma_um
 
 BOOK = Path(__file__).with_name("claims.toml")
 
@@ -172,8 +172,9 @@ def score_dilution(book, cfg, pts, theta, an, mc, sim, curve, extra, mono) -> li
         ),
         "brown.idealised.offset_for_085_mm": _idealised(cfg, pts),
     }
+    sr = range_sigma_um(cfg)  # an is per unit range sigma; the Monte Carlo is in um
     for i, m in enumerate(MODEL_NAMES):
-        table[f"brown.mc_agreement.{m}.mean_ratio"] = mc_agreement(mc, i, an[m], cfg["trials"])
+        table[f"brown.mc_agreement.{m}.mean_ratio"] = mc_agreement(mc, i, an[m] * sr, cfg["trials"])
     return claim_rows(book, table)
 
 
