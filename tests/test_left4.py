@@ -42,8 +42,8 @@ import pytest
 from oneline import SIM_ERROR, one_line
 
 import sim
-from sim.batch_checks import _unknown_sets
 from sim.batch import main as batch_main
+from sim.batch_checks import _unknown_sets
 from sim.cli import main
 from sim.mc.estimate import ADJUSTMENT_S, check_limits, estimate
 from sim.studies import load_study
