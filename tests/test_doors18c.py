@@ -73,15 +73,26 @@ MAKE = shutil.which("make")
 pytestmark = pytest.mark.skipif(MAKE is None, reason="no make on this machine")
 
 
+#: what an outer make (``make test`` runs pytest) passes down: the make under test would
+#: print its lines as ``make[1]:`` and take the outer one's flags
+OUTER_MAKE = ("MAKEFLAGS", "MAKELEVEL", "MFLAGS", "MAKEOVERRIDES", "MAKE_TERMOUT", "MAKE_TERMERR")
+
+
+def user_env(env=None) -> dict:
+    """``env`` (default: this process's) without what an outer make passes down."""
+    return {k: v for k, v in (os.environ if env is None else env).items() if k not in OUTER_MAKE}
+
+
 def make(*args, cwd=ROOT, env=None):
-    """``make -s ARGS`` in ``cwd`` with the install stamp taken as current."""
+    """``make -s ARGS`` in ``cwd`` with the install stamp taken as current, as a user's
+    make from a shell (not as a sub-make of the make that runs the tests)."""
     return subprocess.run(
         [MAKE, "-s", "--no-print-directory", "-o", ".venv/.installed", *args],
         cwd=cwd,
         capture_output=True,
         text=True,
         timeout=120,
-        env=env,
+        env=user_env(env),
     )
 
 
@@ -160,6 +171,7 @@ def test_make_from_another_directory_says_where_to_run_it(tmp_path):
         capture_output=True,
         text=True,
         timeout=60,
+        env=user_env(),
     )
     err = p.stderr.strip()
     assert p.returncode == 2 and "\n" not in err, err
@@ -193,6 +205,7 @@ def run_make(d: Path, *args, python: str = ""):
         capture_output=True,
         text=True,
         timeout=60,
+        env=user_env(),
     )
 
 
