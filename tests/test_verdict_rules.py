@@ -76,6 +76,14 @@ def test_an_exact_value_is_a_point_and_never_inconclusive():
         assert r["outcome"] == outcome and (r["ci_low"], r["ci_high"]) == (v, v)
 
 
+def test_an_exact_value_over_the_rounding_of_printed_inputs_is_decided_as_an_interval():
+    # a recomputation from printed digits (docs/verdict-rules.md): its range over their
+    # rounding straddling the zone edge cannot decide, inside holds, outside fails
+    for ci, outcome in (((2.5, 3.0), "inconclusive"), ((1.5, 2.5), "holds"), ((3.0, 3.5), "fails")):
+        r = one(form="value", ref=2, decimals=0, tol=0.25).score("c", sum(ci) / 2, ci, "exact")
+        assert (r["outcome"], r["interval"], r["ci_low"], r["ci_high"]) == (outcome, "exact", *ci)
+
+
 # --------------------------------------------------------------------------- bounds
 @pytest.mark.parametrize(
     "form, interval, outcome",
@@ -324,7 +332,7 @@ def test_claims_tables_state_their_interval_methods(tmp_path):
     assert iv["interval_column"] == {
         "ci": "a Monte-Carlo confidence interval (mean, sd, share, bootstrap or jackknife)",
         "spread": "the one-plate 2.5-97.5 % range over simulated plates",
-        "exact": "a deterministic value",
+        "exact": "a deterministic value (or its range over the rounding of printed inputs)",
         "region": "decided over the consistent region of unprinted inputs (sim.claims.region)",
     }
     assert pq.read_table(path).column("interval").to_pylist() == ["ci"]

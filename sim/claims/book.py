@@ -380,7 +380,7 @@ def interval_provenance() -> dict[str, Any]:
         "interval_column": {
             "ci": "a Monte-Carlo confidence interval (mean, sd, share, bootstrap or jackknife)",
             "spread": "the one-plate 2.5-97.5 % range over simulated plates",
-            "exact": "a deterministic value",
+            "exact": "a deterministic value (or its range over the rounding of printed inputs)",
             "region": "decided over the consistent region of unprinted inputs (sim.claims.region)",
         },
     }

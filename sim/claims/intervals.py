@@ -65,7 +65,10 @@ METHODS = {
         "of the paper's last printed decimal (plates on an edge count half; h = 0: "
         "2 min(q, 1-q), q the share below the paper's value)"
     ),
-    "exact": "a deterministic computation: the interval is the value itself",
+    "exact": (
+        "a deterministic computation: the interval is the value itself, or, recomputed from "
+        "the paper's printed numbers, its range over their rounding"
+    ),
 }
 
 

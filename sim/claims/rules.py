@@ -27,7 +27,9 @@ With ``I`` the simulated interval and ``Z`` the decision zone:
 * ``value``/``share``/``count``/``upper``/``lower``: **holds** iff ``I`` lies inside ``Z``;
   **fails** iff ``I`` and ``Z`` do not meet; otherwise **inconclusive** (the interval covers
   both values that agree and values that contradict the claim). An ``exact`` interval (a
-  deterministic computation) is a point, so it is never inconclusive.
+  deterministic computation) is a point, so it is never inconclusive, unless it is
+  recomputed from printed numbers and carries their rounding (``ci`` given: the range over
+  it), which is decided as any interval.
 * ``range``: **holds** iff every element's interval lies inside ``Z``; **fails** iff some
   element's interval lies wholly outside ``Z``; otherwise **inconclusive**.
 * ``one-plate``: with ``q`` the simulated probability of a plate at or below the paper's
