@@ -71,7 +71,16 @@ class _Parser(OnceParser):
             ]
             if bad:
                 message = f"unrecognized arguments: {bad[0]}"
-        raise ConfigError(None, f"{self.prog}: {message} (see {self.prog} --help)")
+        # the command's own parser names itself ("sim run: argument --trials: ..."); the top
+        # one reports what no command takes: its line already starts "sim: error:" (it said
+        # "sim: error: sim: unrecognized arguments"), and the help to see is the command's
+        head, helps = f"{self.prog}: ", self.prog
+        if " " not in self.prog:
+            head = ""
+            cmds = next((a.choices for a in self._actions if a.dest == "cmd"), {}) or {}
+            cmd = next((a for a in getattr(self, "argv", []) if a in cmds), None)
+            helps = f"{self.prog} {cmd}" if cmd else self.prog
+        raise ConfigError(None, f"{head}{message} (see {helps} --help)")
 
 
 def module_doc(doc: str | None, path: str) -> str:

@@ -305,3 +305,24 @@ def test_a_failed_run_says_where_and_does_not_block_the_corrected_command(
     monkeypatch.setattr(studies, "get_study", real)
     assert _run(tmp_path, out, "--set", "errors.settings=3") == 0  # corrected: replaces it
     assert not (tmp_path / ".res.partial").exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "line"),
+    [
+        (
+            ["check", "studies/wolf_polynomial.toml", "--trials", "20"],
+            "sim: error: unrecognized arguments: --trials 20 (see sim check --help)",
+        ),
+        (
+            ["show", "results/wolf_polynomial", "-x"],
+            "sim: error: unrecognized arguments: -x (see sim show --help)",
+        ),
+        (["--bogus"], "sim: error: unrecognized arguments: --bogus (see sim --help)"),
+    ],
+)
+def test_an_option_no_command_takes_names_the_program_once_and_the_commands_help(
+    capsys, argv, line
+):
+    # the top parser reported it as "sim: error: sim: unrecognized arguments: ... (see sim --help)"
+    assert one_line(capsys, main(argv)) == line
