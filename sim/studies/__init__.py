@@ -18,7 +18,15 @@ from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
 from sim.mc.sweep import RESERVED, read_sweep
 
-__all__ = ["Study", "RunContext", "design_config", "get_study", "load_study", "MODULES"]
+__all__ = [
+    "Study",
+    "data_check",
+    "RunContext",
+    "design_config",
+    "get_study",
+    "load_study",
+    "MODULES",
+]
 
 
 @dataclass(frozen=True)
@@ -31,6 +39,23 @@ class Study:
     report: Callable[[Path], str]
     check: Callable[[dict], None] | None = None
     order: int = 50  # position in REPORT.md
+    #: reads the study's claim book and region declarations (ConfigError naming the file and
+    #: the key or claim id), so that ``sim check`` and the start of a run refuse an edited
+    #: data file instead of the end of the run
+    data: Callable[[], None] | None = None
+
+
+def data_check(load_book: Callable[[], Any], *declarations: Path) -> Callable[[], None]:
+    """A :attr:`Study.data` that loads the claim book and each region declaration over it."""
+
+    def check() -> None:
+        from sim.claims.book_region import load_declaration
+
+        book = load_book()
+        for path in declarations:
+            load_declaration(path, book)
+
+    return check
 
 
 def get_study(name: str) -> Study:
@@ -77,6 +102,8 @@ def load_study(
     if name is None:
         raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
     study = get_study(name)
+    if study.data is not None:
+        study.data()
     swept = set(read_sweep(path)) - set(RESERVED) if "sweep" in doc else set()
     for text in overrides:
         key, value = parse_override(text)

@@ -1,0 +1,113 @@
+"""The classes of the sweep doors19b (issue 26: the suite's own data files edited by a user to
+try a variant of a paper study: the claim books and the region declarations), one case each;
+each failed on the code before its fix.
+
+* the claim book was read only when the run scored its claims, after the whole simulation: a
+  syntax error, a duplicate id or a bad form in ``claims.toml``, or a bound of ``region.toml``
+  reversed, passed ``sim check`` and ended the run minutes later; the study's ``data`` hook
+  (:func:`sim.studies.data_check`) reads the book and its region declarations when the study
+  file is loaded (``sim check``, the start of ``sim run``);
+* a claim the study scores removed or renamed ended the run in "KeyError ... is not declared"
+  (exit 3): one line naming the book and the claim id, exit 2;
+* ``decimals = "1"`` was a TypeError at scoring, ``decimals = 1.5`` and ``true`` and
+  ``ref = true`` (read as 1) and ``headline = "yes"`` were accepted, ``tol = inf`` made every
+  zone the whole line (every claim held), ``printed = 4.2`` in ``[[not_reproduced]]`` was an
+  ArrowTypeError, and ``claim = 5`` a TypeError: each is refused naming the key;
+* a region declaration's errors did not name the file (``inputs.relief_mm: high 0.5 < low
+  20.0`` reads as a key of the study file), and a claim listed twice, or both a constraint
+  and a prediction, was accepted.
+"""
+
+import pytest
+from oneline import one_line
+
+from sim import cli
+from sim.claims.book import ClaimBook
+from sim.claims.book_region import load_declaration
+from sim.mc.config import ConfigError
+from sim.studies import data_check
+from sim.studies.salsig import claims as salsig_claims
+from sim.studies.salsig.region import DECLARATION
+
+SALSIG = "studies/salsig_encoders.toml"
+GOOD = {
+    "id": "c",
+    "source": "s",
+    "paper": "p",
+    "kind": "prediction",
+    "form": "value",
+    "ref": 1.7,
+    "decimals": 1,
+    "tol": 0.0,
+}
+
+
+@pytest.mark.parametrize(
+    "edit, key",
+    [
+        ({"decimals": "1"}, "claim.decimals"),
+        ({"decimals": 1.5}, "claim.decimals"),
+        ({"decimals": True}, "claim.decimals"),
+        ({"decimals": -400}, "claim.decimals"),
+        ({"ref": True}, "claim.ref"),
+        ({"tol": float("inf")}, "claim.tol"),
+        ({"headline": "yes"}, "claim.headline"),
+    ],
+)
+def test_a_claims_printed_number_is_validated_naming_the_key(edit, key):
+    with pytest.raises(ConfigError, match=rf"^{key}: <b>: claim 1 \(c\): "):
+        ClaimBook([{**GOOD, **edit}], [], "<b>")
+    ClaimBook([GOOD], [], "<b>")  # the unedited row is a claim
+
+
+def test_a_not_reproduced_entry_and_the_claim_list_are_validated():
+    with pytest.raises(ConfigError, match=r"^not_reproduced: <b>: entry 1: .* are text$"):
+        ClaimBook([], [{"source": "s", "printed": 4.2, "why": "w"}], "<b>")
+    with pytest.raises(ConfigError, match=r"^claim: <b>: \[\[claim\]\] must be a list of tables"):
+        ClaimBook(5, [], "<b>")
+
+
+def test_a_scored_claim_missing_from_the_book_is_one_config_error():
+    with pytest.raises(ConfigError, match=r"^claim.id: <b>: claim 'x', which the study scores"):
+        ClaimBook([GOOD], [], "<b>").spec("x")
+
+
+def test_sim_check_reads_the_claim_book(tmp_path, monkeypatch, capsys):
+    book = tmp_path / "claims.toml"
+    text = salsig_claims.BOOK.read_text(encoding="utf-8")
+    monkeypatch.setattr(salsig_claims, "BOOK", book)
+    book.write_text(text + "\n[[claim]]\nid = \n", encoding="utf-8")
+    one_line(capsys, cli.main(["check", SALSIG]), str(book), "Invalid value")
+    first = text.index("decimals = ")
+    book.write_text(text[:first] + 'decimals = "3"\n' + text[first:].split("\n", 1)[1])
+    one_line(capsys, cli.main(["check", SALSIG]), str(book), "claim.decimals")
+    book.write_text(text, encoding="utf-8")  # the same book, read from elsewhere, is accepted
+    assert cli.main(["check", SALSIG]) == 0
+
+
+@pytest.mark.parametrize(
+    "old, new, needle",
+    [
+        ("low = 0.5\nhigh = 20.0", "low = 20.0\nhigh = 0.5", "inputs.relief_mm: high 0.5 < low"),
+        (
+            '"salsig.vertical_halved.dramatic_vertical",',
+            '"salsig.vertical_halved.rms_ratio",',
+            "'salsig.vertical_halved.rms_ratio' is listed twice",
+        ),
+        (
+            '"salsig.vertical_halved.dramatic_vertical",',
+            '"salsig.vertical_halved.dramatic_horizontal",',
+            "'salsig.vertical_halved.dramatic_horizontal' is listed twice",
+        ),
+    ],
+)
+def test_a_region_declaration_error_names_its_file(tmp_path, old, new, needle):
+    text = DECLARATION.read_text(encoding="utf-8")
+    assert old in text
+    region = tmp_path / "region.toml"
+    region.write_text(text.replace(old, new, 1), encoding="utf-8")
+    with pytest.raises(ConfigError) as e:
+        data_check(salsig_claims.load_book, region)()
+    assert str(e.value).startswith(f"{region}: ") and needle in str(e.value)
+    assert "\n" not in str(e.value)
+    load_declaration(DECLARATION, salsig_claims.load_book())  # the committed one is accepted
