@@ -111,3 +111,21 @@ def test_a_region_declaration_error_names_its_file(tmp_path, old, new, needle):
     assert str(e.value).startswith(f"{region}: ") and needle in str(e.value)
     assert "\n" not in str(e.value)
     load_declaration(DECLARATION, salsig_claims.load_book())  # the committed one is accepted
+
+
+def test_a_claim_book_or_region_saved_in_latin1_or_with_a_bom(tmp_path, monkeypatch, capsys):
+    """Latin-1 was "sim: error: UnicodeDecodeError: ..." naming no file (exit 3); a Windows
+    editor's BOM refused the unchanged book at line 1, column 1."""
+    book = tmp_path / "claims.toml"
+    text = salsig_claims.BOOK.read_text(encoding="utf-8")
+    monkeypatch.setattr(salsig_claims, "BOOK", book)
+    book.write_bytes(text.encode("utf-8") + "# café\n".encode("latin-1"))
+    one_line(capsys, cli.main(["check", SALSIG]), str(book), "not UTF-8 text")
+    book.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    assert cli.main(["check", SALSIG]) == 0
+    region = tmp_path / "region.toml"
+    region.write_bytes(DECLARATION.read_bytes() + "# café\n".encode("latin-1"))
+    with pytest.raises(ConfigError, match="region declaration is not UTF-8 text"):
+        data_check(salsig_claims.load_book, region)()
+    region.write_bytes(b"\xef\xbb\xbf" + DECLARATION.read_bytes())
+    data_check(salsig_claims.load_book, region)()

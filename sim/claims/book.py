@@ -22,6 +22,7 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
+from sim.claims.declaration import toml_text
 from sim.claims.intervals import LEVEL, METHODS, MIN_CHUNKS, plate_p, spread
 from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
 from sim.claims.rules import (
@@ -205,10 +206,11 @@ class ClaimBook:
     @classmethod
     def load(cls, path: str | Path) -> "ClaimBook":
         try:
-            with open(path, "rb") as f:
-                data = tomllib.load(f)
+            data = tomllib.loads(toml_text(Path(path)))
         except (OSError, tomllib.TOMLDecodeError) as e:
             raise ConfigError("claims", f"cannot read the claim book {path}: {e}") from None
+        except UnicodeDecodeError:  # an editor that saved it in Latin-1 or UTF-16
+            raise ConfigError("claims", f"the claim book {path} is not UTF-8 text") from None
         bad = set(data) - {"claim", "not_reproduced"}
         if bad:
             raise ConfigError(sorted(bad)[0], f"{path}: unknown table")
