@@ -25,9 +25,9 @@ from sim import cli
 from sim.claims.book import ClaimBook
 from sim.claims.book_region import load_declaration
 from sim.mc.config import ConfigError
-from sim.studies import data_check
+from sim.studies import data_check, load_study
 from sim.studies.salsig import claims as salsig_claims
-from sim.studies.salsig.region import DECLARATION
+from sim.studies.salsig.region import DECLARATION, nominal
 
 SALSIG = "studies/salsig_encoders.toml"
 GOOD = {
@@ -107,7 +107,7 @@ def test_a_region_declaration_error_names_its_file(tmp_path, old, new, needle):
     region = tmp_path / "region.toml"
     region.write_text(text.replace(old, new, 1), encoding="utf-8")
     with pytest.raises(ConfigError) as e:
-        data_check(salsig_claims.load_book, region)()
+        data_check(salsig_claims.load_book, region)({})
     assert str(e.value).startswith(f"{region}: ") and needle in str(e.value)
     assert "\n" not in str(e.value)
     load_declaration(DECLARATION, salsig_claims.load_book())  # the committed one is accepted
@@ -126,6 +126,27 @@ def test_a_claim_book_or_region_saved_in_latin1_or_with_a_bom(tmp_path, monkeypa
     region = tmp_path / "region.toml"
     region.write_bytes(DECLARATION.read_bytes() + "# café\n".encode("latin-1"))
     with pytest.raises(ConfigError, match="region declaration is not UTF-8 text"):
-        data_check(salsig_claims.load_book, region)()
+        data_check(salsig_claims.load_book, region)({})
     region.write_bytes(b"\xef\xbb\xbf" + DECLARATION.read_bytes())
-    data_check(salsig_claims.load_book, region)()
+    data_check(salsig_claims.load_book, region)({})
+
+
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        (("[inputs.relief_mm]", "[inputs.relief_m]"), "inputs.relief_mm: "),
+        (("", '\n[inputs.extra_mm]\nlow = 1.0\nhigh = 2.0\nwhy = "w"\n'), "inputs.extra_mm: "),
+    ],
+)
+def test_a_region_input_the_code_does_not_read_is_refused(tmp_path, edit, needle):
+    """An input renamed was "KeyError: 'relief_mm'" in the run's region part (exit 3); one
+    added was explored as a dimension no code reads."""
+    _, cfg = load_study(SALSIG)
+    text = DECLARATION.read_text(encoding="utf-8")
+    region = tmp_path / "region.toml"
+    old, new = edit
+    region.write_text(text.replace(old, new, 1) if old else text + new, encoding="utf-8")
+    with pytest.raises(ConfigError) as e:
+        data_check(salsig_claims.load_book, (region, nominal))(cfg)
+    assert str(e.value).startswith(needle) and str(region) in str(e.value)
+    data_check(salsig_claims.load_book, (DECLARATION, nominal))(cfg)

@@ -39,21 +39,40 @@ class Study:
     report: Callable[[Path], str]
     check: Callable[[dict], None] | None = None
     order: int = 50  # position in REPORT.md
-    #: reads the study's claim book and region declarations (ConfigError naming the file and
-    #: the key or claim id), so that ``sim check`` and the start of a run refuse an edited
-    #: data file instead of the end of the run
-    data: Callable[[], None] | None = None
+    #: reads the study's claim book and region declarations over the validated config
+    #: (ConfigError naming the file and the key or claim id), so that ``sim check`` and the
+    #: start of a run refuse an edited data file instead of the end of the run
+    data: Callable[[dict], None] | None = None
 
 
-def data_check(load_book: Callable[[], Any], *declarations: Path) -> Callable[[], None]:
-    """A :attr:`Study.data` that loads the claim book and each region declaration over it."""
+def data_check(
+    load_book: Callable[[], Any], *declarations: Path | tuple[Path, Callable[[dict], Any]]
+) -> Callable[[dict], None]:
+    """A :attr:`Study.data` that loads the claim book and each region declaration over it; a
+    declaration given with ``names(cfg)`` (the inputs the study's code reads) must declare
+    exactly those inputs (one renamed was a KeyError deep in the run, one added was explored
+    and read by no code)."""
 
-    def check() -> None:
+    def check(cfg: dict) -> None:
         from sim.claims.book_region import load_declaration
 
         book = load_book()
-        for path in declarations:
-            load_declaration(path, book)
+        for d in declarations:
+            path, names = d if isinstance(d, tuple) else (d, None)
+            dec = load_declaration(path, book)
+            if names is None:
+                continue
+            want, got = set(names(cfg)), {i.name for i in dec.inputs}
+            for name in sorted(want - got):
+                raise ConfigError(
+                    f"inputs.{name}", f"{path}: the study's code reads this input: declare it"
+                )
+            for name in sorted(got - want):
+                raise ConfigError(
+                    f"inputs.{name}",
+                    f"{path}: no code of the study reads this input (it reads "
+                    f"{', '.join(sorted(want))})",
+                )
 
     return check
 
@@ -102,8 +121,6 @@ def load_study(
     if name is None:
         raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
     study = get_study(name)
-    if study.data is not None:
-        study.data()
     swept = set(read_sweep(path)) - set(RESERVED) if "sweep" in doc else set()
     for text in overrides:
         key, value = parse_override(text)
@@ -120,6 +137,8 @@ def load_study(
         cfg = validate(flat, study.schema, study.check)
     except ConfigError as e:
         raise _beside_the_study(e, Path(path), flat) from None
+    if study.data is not None:
+        study.data(cfg)
     return study, {"study": name, **cfg}
 
 

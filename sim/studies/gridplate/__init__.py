@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from sim.studies import Study, data_check
 from sim.studies.gridplate.claims import load_book
-from sim.studies.gridplate.region import DECLARATION
+from sim.studies.gridplate.region import DECLARATION, nominal
 from sim.studies.gridplate.report import report
 from sim.studies.gridplate.run import run
 from sim.studies.gridplate.schema import SCHEMA, check
@@ -27,6 +27,6 @@ STUDIES = {
         report,
         check,
         order=20,
-        data=data_check(load_book, DECLARATION),
+        data=data_check(load_book, (DECLARATION, nominal)),
     ),
 }
