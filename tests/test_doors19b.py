@@ -27,6 +27,7 @@ from sim.claims.book_region import load_declaration
 from sim.mc.config import ConfigError
 from sim.studies import data_check, load_study
 from sim.studies.salsig import claims as salsig_claims
+from sim.studies.salsig import region as salsig_region
 from sim.studies.salsig.region import DECLARATION, nominal
 
 SALSIG = "studies/salsig_encoders.toml"
@@ -147,6 +148,29 @@ def test_a_region_input_the_code_does_not_read_is_refused(tmp_path, edit, needle
     old, new = edit
     region.write_text(text.replace(old, new, 1) if old else text + new, encoding="utf-8")
     with pytest.raises(ConfigError) as e:
-        data_check(salsig_claims.load_book, (region, nominal))(cfg)
+        data_check(salsig_claims.load_book, (region, nominal, {}))(cfg)
     assert str(e.value).startswith(needle) and str(region) in str(e.value)
-    data_check(salsig_claims.load_book, (DECLARATION, nominal))(cfg)
+    data_check(salsig_claims.load_book, (DECLARATION, nominal, {}))(cfg)
+
+
+@pytest.mark.parametrize(
+    "old, new, needle",
+    [
+        ("low = 10.0\nhigh = 200.0", "low = -10.0\nhigh = 200.0", "inputs.sigma_z_um.low: "),
+        ("low = 4\nhigh = 20", "low = 0\nhigh = 20", "inputs.control_1.low: "),
+        ("low = 0.5\nhigh = 20.0", "low = 0.5\nhigh = 1e300", "inputs.relief_mm.high: "),
+    ],
+)
+def test_a_region_range_keeps_the_bounds_of_the_key_it_sets(tmp_path, old, new, needle):
+    """A negative sigma, no control points or a relief of 1e300 mm were explored without a
+    word (the region verdicts over them, exit 0)."""
+    study, cfg = load_study(SALSIG)
+    keys = {**salsig_region._KEYS, "control_1": "vertical.control"}
+    text = DECLARATION.read_text(encoding="utf-8")
+    assert old in text
+    region = tmp_path / "region.toml"
+    region.write_text(text.replace(old, new, 1), encoding="utf-8")
+    with pytest.raises(ConfigError) as e:
+        data_check(salsig_claims.load_book, (region, nominal, keys))(cfg, study.schema)
+    assert str(e.value).startswith(needle) and "outside vertical." in str(e.value)
+    study.data(cfg, study.schema)  # the committed declaration keeps them

@@ -38,8 +38,8 @@ STUDIES = {
         order=50,
         data=data_check(
             load_book,
-            (DECLARATION, lambda cfg: (CENTRES, "five_inset_1")),
-            (SCANNER, lambda cfg: SCANNER_KEYS),
+            (DECLARATION, lambda cfg: (CENTRES, "five_inset_1"), {}),
+            (SCANNER, lambda cfg: SCANNER_KEYS, {}),
         ),
     )
 }

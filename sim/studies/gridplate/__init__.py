@@ -27,6 +27,17 @@ STUDIES = {
         report,
         check,
         order=20,
-        data=data_check(load_book, (DECLARATION, nominal)),
+        data=data_check(
+            load_book,
+            (
+                DECLARATION,
+                nominal,
+                {
+                    "grid_points_1": "plate.grid",
+                    "spacing_mm": "plate.spacing_mm",
+                    "grid_sigma_true_um": "grid.sigma_true_um",
+                },
+            ),
+        ),
     ),
 }

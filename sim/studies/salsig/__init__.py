@@ -16,7 +16,7 @@ from sim.studies.salsig.model import (  # noqa: F401
     simulate_vertical,
     simulate_zscale,
 )
-from sim.studies.salsig.region import DECLARATION, nominal
+from sim.studies.salsig.region import _KEYS, DECLARATION, nominal
 from sim.studies.salsig.report import report
 from sim.studies.salsig.run import run
 from sim.studies.salsig.schema import SCHEMA, check
@@ -33,6 +33,8 @@ STUDIES = {
         report,
         check,
         order=30,
-        data=data_check(load_book, (DECLARATION, nominal)),
+        data=data_check(
+            load_book, (DECLARATION, nominal, {**_KEYS, "control_1": "vertical.control"})
+        ),
     ),
 }

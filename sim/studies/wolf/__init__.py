@@ -24,7 +24,7 @@ from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk
 from sim.studies.wolf.claims import load_book
 from sim.studies.wolf.grid import grid_nodes, mid_cells, node_index
 from sim.studies.wolf.model import reading_error_rms
-from sim.studies.wolf.region import DECLARATION, nominal
+from sim.studies.wolf.region import CELL, DECLARATION, nominal
 from sim.studies.wolf.report import report
 from sim.studies.wolf.run import run
 from sim.studies.wolf.schema import SCHEMA, SEED
@@ -63,6 +63,8 @@ STUDIES = {
         report,
         check,
         order=40,
-        data=data_check(load_book, (DECLARATION, nominal)),
+        data=data_check(
+            load_book, (DECLARATION, nominal, {k: v for k, v in CELL.items() if "." in v})
+        ),
     ),
 }
