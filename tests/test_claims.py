@@ -120,7 +120,7 @@ def test_every_declared_claim_must_be_scored():
         [],
     )
     b.score("a", 1.0, interval="exact")
-    with pytest.raises(ValueError, match="not scored: b"):
+    with pytest.raises(ValueError, match="does not score: b"):
         b.check_complete()
 
 

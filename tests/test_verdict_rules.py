@@ -462,7 +462,10 @@ def test_load_reads_a_toml_book_and_names_what_is_wrong(tmp_path):
     b = ClaimBook.load(f)
     assert b.path == str(f) and list(b.specs) == ["c"] and len(b.not_reproduced) == 1
     assert b.spec("c")["kind"] == "finding"
-    with pytest.raises(KeyError, match=r"^\"claim 'x' is not declared in .*claims.toml\"$"):
+    with pytest.raises(
+        bk.ConfigError,
+        match=r"^claim.id: .*claims.toml: claim 'x', which the study scores, is not declared$",
+    ):
         b.spec("x")
     f.write_text("[[claim]]\nid = \n")
     with pytest.raises(bk.ConfigError) as e:
@@ -576,10 +579,14 @@ def test_write_claims_checks_the_book_and_writes_not_reproduced(tmp_path):
     nr = {"source": "s", "printed": "1.0", "why": "w"}
     specs = [{"id": i, "source": "s", "paper": "p", "kind": "finding"} for i in ("a", "b", "c")]
     b = ClaimBook(specs, [nr], "<t>")
-    with pytest.raises(ValueError, match=r"^<t>: declared claims not scored: a, b, c$"):
+    with pytest.raises(
+        ValueError, match=r"^claim.id: <t>: declared claims the study does not score: a, b, c$"
+    ):
         b.check_complete()
     rows = [b.score("a", 1.0, interval="exact"), b.score("c", 1.0, interval="exact")]
-    with pytest.raises(ValueError, match=r"^<t>: declared claims not scored: b$"):
+    with pytest.raises(
+        ValueError, match=r"^claim.id: <t>: declared claims the study does not score: b$"
+    ):
         write_claims(tmp_path / "claims.parquet", rows, {}, b)
     assert not (tmp_path / "claims.parquet").exists()
     rows.append(b.score("b", 2.0, (1.0, 3.0)))

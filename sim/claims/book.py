@@ -22,6 +22,7 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
+from sim.claims.declaration import toml_text
 from sim.claims.intervals import LEVEL, METHODS, MIN_CHUNKS, plate_p, spread
 from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
 from sim.claims.rules import (
@@ -85,6 +86,16 @@ CLAIM_TOLERANCES = {
     **{c: tl.exact() for c in ("outcome", "verdict", "holds")},
 }
 
+#: the most decimals a printed number carries here (a float has ~15 significant digits);
+#: negative: rounded to tens, hundreds (design's ``-2``)
+_MAX_DECIMALS = 12
+
+
+def _number(x: Any) -> bool:
+    """A TOML number: int or float, not a bool (``true`` is no printed value)."""
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
 _SPEC_KEYS = {"id", "source", "paper", "form", "ref", "decimals", "tol", "kind", "headline", "why"}
 
 
@@ -105,6 +116,9 @@ class ClaimBook:
     def __init__(self, specs: list[dict], not_reproduced: list[dict], path: str = "<claims>"):
         self.path = path
         self.specs: dict[str, dict] = {}
+        for key, items in (("claim", specs), ("not_reproduced", not_reproduced)):
+            if not isinstance(items, list) or not all(isinstance(s, dict) for s in items):
+                raise ConfigError(key, f"{path}: [[{key}]] must be a list of tables")
         for i, s in enumerate(specs):
             where = f"{path}: claim {i + 1}"
             bad = set(s) - _SPEC_KEYS
@@ -129,7 +143,7 @@ class ClaimBook:
                 ref = ref if isinstance(ref, list) else [ref, ref]
                 if (
                     len(ref) != 2
-                    or not all(isinstance(r, (int, float)) for r in ref)
+                    or not all(_number(r) for r in ref)
                     or not all(math.isfinite(r) for r in ref)
                     or ref[0] > ref[1]
                 ):
@@ -143,21 +157,48 @@ class ClaimBook:
                         f"{where} ({s['id']}): a range needs "
                         "[low, high], the other forms one number",
                     )
-                if not isinstance(s.get("tol"), (int, float)) or not s["tol"] >= 0:
+                if not _number(s.get("tol")) or not 0 <= s["tol"] < math.inf:
                     raise ConfigError(
-                        "claim.tol", f"{where} ({s['id']}): state the deciding half-width tol >= 0"
+                        "claim.tol",
+                        f"{where} ({s['id']}): state the deciding half-width tol >= 0",
+                    )
+                d = s.get("decimals", 0)
+                if (
+                    not isinstance(d, int)
+                    or isinstance(d, bool)
+                    or not -_MAX_DECIMALS <= d <= _MAX_DECIMALS
+                ):
+                    raise ConfigError(
+                        "claim.decimals",
+                        f"{where} ({s['id']}): decimals is the printed rounding, a whole number "
+                        f"-{_MAX_DECIMALS} to {_MAX_DECIMALS} (got {d!r})",
                     )
             elif s["kind"] in ("prediction", "paper-check"):
                 raise ConfigError(
                     "claim.ref",
                     f"{where} ({s['id']}): a {s['kind']} needs the paper's number (ref)",
                 )
+            if not isinstance(s.get("headline", False), bool):
+                raise ConfigError(
+                    "claim.headline", f"{where} ({s['id']}): headline is true or false"
+                )
+            for k in ("form", "decimals", "tol"):
+                if k in s and "ref" not in s:
+                    raise ConfigError(
+                        f"claim.{k}", f"{where} ({s['id']}): {k} without the paper's number (ref)"
+                    )
+            if not isinstance(s.get("why", ""), str):
+                raise ConfigError("claim.why", f"{where} ({s['id']}): why must be text")
             self.specs[s["id"]] = dict(s)
         self.not_reproduced = []
         for i, n in enumerate(not_reproduced):
-            if set(n) != {"source", "printed", "why"}:
+            if not isinstance(n, dict) or set(n) != {"source", "printed", "why"}:
                 raise ConfigError(
                     "not_reproduced", f"{path}: entry {i + 1} needs exactly source, printed and why"
+                )
+            if not all(isinstance(v, str) and v for v in n.values()):
+                raise ConfigError(
+                    "not_reproduced", f"{path}: entry {i + 1}: source, printed and why are text"
                 )
             self.not_reproduced.append(dict(n))
         self._scored: set[str] = set()
@@ -165,18 +206,21 @@ class ClaimBook:
     @classmethod
     def load(cls, path: str | Path) -> "ClaimBook":
         try:
-            with open(path, "rb") as f:
-                data = tomllib.load(f)
+            data = tomllib.loads(toml_text(Path(path)))
         except (OSError, tomllib.TOMLDecodeError) as e:
             raise ConfigError("claims", f"cannot read the claim book {path}: {e}") from None
+        except UnicodeDecodeError:  # an editor that saved it in Latin-1 or UTF-16
+            raise ConfigError("claims", f"the claim book {path} is not UTF-8 text") from None
         bad = set(data) - {"claim", "not_reproduced"}
         if bad:
             raise ConfigError(sorted(bad)[0], f"{path}: unknown table")
         return cls(data.get("claim", []), data.get("not_reproduced", []), str(path))
 
     def spec(self, cid: str) -> dict:
-        if cid not in self.specs:
-            raise KeyError(f"claim {cid!r} is not declared in {self.path}")
+        if cid not in self.specs:  # the book edited: a claim the study scores removed or renamed
+            raise ConfigError(
+                "claim.id", f"{self.path}: claim {cid!r}, which the study scores, is not declared"
+            )
         return self.specs[cid]
 
     def score(
@@ -292,7 +336,10 @@ class ClaimBook:
     def check_complete(self) -> None:
         missing = [c for c in self.specs if c not in self._scored]
         if missing:
-            raise ValueError(f"{self.path}: declared claims not scored: {', '.join(missing)}")
+            raise ConfigError(
+                "claim.id",
+                f"{self.path}: declared claims the study does not score: {', '.join(missing)}",
+            )
 
 
 def _finite(cid: str, x: np.ndarray, what: str) -> None:

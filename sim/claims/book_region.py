@@ -68,6 +68,17 @@ def load_declaration(path: str | Path, book: ClaimBook) -> Declaration:
     (hardware limits; the printed statements come from the book), and ``[explore]`` (``n``,
     ``rounds``, ``per_point``, ``draws``). Unknown keys and ids raise ConfigError naming them."""
     p = Path(path)
+    try:
+        return _load_declaration(p, book)
+    except ConfigError as e:  # name the file: the book's and the study file's keys look alike
+        if str(p) in str(e):
+            raise
+        err = ConfigError(None, f"{p}: {e}")
+        err.key = e.key
+        raise err from None
+
+
+def _load_declaration(p: Path, book: ClaimBook) -> Declaration:
     doc = read_toml(p, "region declaration")
     cons, preds = doc.pop("constraints", []), doc.pop("predictions", [])
     explore = doc.pop("explore", {})
@@ -79,6 +90,12 @@ def load_declaration(path: str | Path, book: ClaimBook) -> Declaration:
                 raise ConfigError(key, f"{i!r} is not a claim of {book.path}")
             if "ref" not in book.specs[i]:
                 raise ConfigError(key, f"{i!r} prints no number (no ref)")
+    if isinstance(cons, list) and isinstance(preds, list):
+        seen: set[str] = set()
+        for key, i in [("constraints", i) for i in cons] + [("predictions", i) for i in preds]:
+            if i in seen:  # constrains the region and is decided over it, or listed twice
+                raise ConfigError(key, f"{i!r} is listed twice (a claim is one or the other)")
+            seen.add(i)
     if not isinstance(explore, dict):
         raise ConfigError("explore", "must be a table")
     ex = {}

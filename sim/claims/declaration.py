@@ -158,8 +158,17 @@ def read_toml(path: str | Path, what: str) -> dict:
     """A TOML file's table; an unreadable or invalid file is one ConfigError naming it."""
     p = Path(path)
     try:
-        return tomllib.loads(p.read_text(encoding="utf-8"))
+        return tomllib.loads(toml_text(p))
     except OSError as e:
         raise ConfigError(str(p), f"cannot read the {what}: {e.strerror}") from None
+    except UnicodeDecodeError:  # an editor that saved it in Latin-1 or UTF-16
+        raise ConfigError(str(p), f"the {what} is not UTF-8 text") from None
     except tomllib.TOMLDecodeError as e:
         raise ConfigError(str(p), f"not valid TOML: {e}") from None
+
+
+def toml_text(p: Path) -> str:
+    """The text of a data file (claim book, region declaration) as a user's editor may save
+    it: UTF-8 with or without a Windows editor's signature (BOM), which is no part of the
+    text (the study files are read the same way: :func:`sim.mc.config.read_toml`)."""
+    return p.read_bytes().decode("utf-8").removeprefix("\ufeff")

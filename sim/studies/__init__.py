@@ -18,7 +18,15 @@ from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
 from sim.mc.sweep import RESERVED, read_sweep
 
-__all__ = ["Study", "RunContext", "design_config", "get_study", "load_study", "MODULES"]
+__all__ = [
+    "Study",
+    "data_check",
+    "RunContext",
+    "design_config",
+    "get_study",
+    "load_study",
+    "MODULES",
+]
 
 
 @dataclass(frozen=True)
@@ -31,6 +39,54 @@ class Study:
     report: Callable[[Path], str]
     check: Callable[[dict], None] | None = None
     order: int = 50  # position in REPORT.md
+    #: reads the study's claim book and region declarations over the validated config
+    #: (ConfigError naming the file and the key or claim id), so that ``sim check`` and the
+    #: start of a run refuse an edited data file instead of the end of the run
+    data: Callable[[dict, Mapping[str, Field]], None] | None = None
+
+
+def data_check(load_book: Callable[[], Any], *declarations: Any) -> Callable[..., None]:
+    """A :attr:`Study.data` that loads the claim book and each region declaration over it.
+    A declaration is a path, or ``(path, names, keys)``: ``names(cfg)`` the inputs the study's
+    code reads, which it must declare exactly (one renamed was a KeyError deep in the run,
+    one added was explored and read by no code), and ``keys`` the config key each input sets
+    unscaled, whose schema bounds its range must keep (a negative sigma was explored)."""
+
+    def check(cfg: dict, schema: Mapping[str, Field] | None = None) -> None:
+        from sim.claims.book_region import load_declaration
+
+        book = load_book()
+        for d in declarations:
+            path, names, keys = d if isinstance(d, tuple) else (d, None, {})
+            dec = load_declaration(path, book)
+            for i in dec.inputs:
+                f = (schema or {}).get(keys.get(i.name, ""))
+                if f is None:
+                    continue
+                for end, v in (("low", i.low), ("high", i.high)):
+                    if (f.lo is not None and (v < f.lo or (f.lo_open and v == f.lo))) or (
+                        f.hi is not None and v > f.hi
+                    ):
+                        raise ConfigError(
+                            f"inputs.{i.name}.{end}",
+                            f"{path}: {v:g} is outside {keys[i.name]}'s bounds "
+                            f"({'>' if f.lo_open else '>='} {f.lo}, <= {f.hi})",
+                        )
+            if names is None:
+                continue
+            want, got = set(names(cfg)), {i.name for i in dec.inputs}
+            for name in sorted(want - got):
+                raise ConfigError(
+                    f"inputs.{name}", f"{path}: the study's code reads this input: declare it"
+                )
+            for name in sorted(got - want):
+                raise ConfigError(
+                    f"inputs.{name}",
+                    f"{path}: no code of the study reads this input (it reads "
+                    f"{', '.join(sorted(want))})",
+                )
+
+    return check
 
 
 def get_study(name: str) -> Study:
@@ -93,6 +149,8 @@ def load_study(
         cfg = validate(flat, study.schema, study.check)
     except ConfigError as e:
         raise _beside_the_study(e, Path(path), flat) from None
+    if study.data is not None:
+        study.data(cfg, study.schema)
     return study, {"study": name, **cfg}
 
 

@@ -18,7 +18,9 @@ of blocks and its adjustments), :mod:`.run` (through the runner), ``claims.toml`
 
 from __future__ import annotations
 
-from sim.studies import Study
+from sim.studies import Study, data_check
+from sim.studies.agnard.claims import load_book
+from sim.studies.agnard.region import CENTRES, DECLARATION, SCANNER, SCANNER_KEYS
 from sim.studies.agnard.report import report
 from sim.studies.agnard.run import run
 from sim.studies.agnard.schema import NAME, SCHEMA, SEED, check
@@ -34,5 +36,10 @@ STUDIES = {
         report=report,
         check=check,
         order=50,
+        data=data_check(
+            load_book,
+            (DECLARATION, lambda cfg: (CENTRES, "five_inset_1"), {}),
+            (SCANNER, lambda cfg: SCANNER_KEYS, {}),
+        ),
     )
 }

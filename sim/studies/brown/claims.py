@@ -42,7 +42,10 @@ def full_book() -> ClaimBook:
         raise ConfigError(sorted(bad)[0], f"{BOOK}: unknown table")
     printed = B.TABLE1["statements"]
     specs = []
-    for s in data.get("claim", []):
+    claims = data.get("claim", [])
+    if not isinstance(claims, list) or not all(isinstance(s, dict) for s in claims):
+        raise ConfigError("claim", f"{BOOK}: [[claim]] must be a list of tables")
+    for s in claims:
         decl = printed.get(s.get("id"), {})
         again = [k for k in PRINTED_KEYS if k in decl and k in s]
         if again:

@@ -11,9 +11,10 @@ book), :mod:`.run`, :mod:`.figures`, :mod:`.report`.
 
 from __future__ import annotations
 
-from sim.studies import Study
+from sim.studies import Study, data_check
 from sim.studies.design.cells import geometry_eval, measuring_time, pareto_front, time_model
 from sim.studies.design.checks import check
+from sim.studies.design.claims import load_book
 from sim.studies.design.report import report
 from sim.studies.design.run import run
 from sim.studies.design.schema import SCHEMA, SEED
@@ -39,5 +40,6 @@ STUDIES = {
         report,
         check,
         order=12,
+        data=data_check(load_book),
     ),
 }

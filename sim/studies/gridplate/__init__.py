@@ -8,7 +8,9 @@ reduction), :mod:`.run` (the run), :mod:`.sweep` (unprinted inputs, consistent s
 
 from __future__ import annotations
 
-from sim.studies import Study
+from sim.studies import Study, data_check
+from sim.studies.gridplate.claims import load_book
+from sim.studies.gridplate.region import DECLARATION, nominal
 from sim.studies.gridplate.report import report
 from sim.studies.gridplate.run import run
 from sim.studies.gridplate.schema import SCHEMA, check
@@ -25,5 +27,17 @@ STUDIES = {
         report,
         check,
         order=20,
+        data=data_check(
+            load_book,
+            (
+                DECLARATION,
+                nominal,
+                {
+                    "grid_points_1": "plate.grid",
+                    "spacing_mm": "plate.spacing_mm",
+                    "grid_sigma_true_um": "grid.sigma_true_um",
+                },
+            ),
+        ),
     ),
 }

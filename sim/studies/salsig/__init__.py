@@ -8,13 +8,15 @@ consistent set), ``claims.toml`` + :mod:`.claims` (scoring), :mod:`.figures`, :m
 
 from __future__ import annotations
 
-from sim.studies import Study
+from sim.studies import Study, data_check
+from sim.studies.salsig.claims import load_book
 from sim.studies.salsig.model import (  # noqa: F401
     decompositions,
     simulate_chain,
     simulate_vertical,
     simulate_zscale,
 )
+from sim.studies.salsig.region import _KEYS, DECLARATION, nominal
 from sim.studies.salsig.report import report
 from sim.studies.salsig.run import run
 from sim.studies.salsig.schema import SCHEMA, check
@@ -31,5 +33,8 @@ STUDIES = {
         report,
         check,
         order=30,
+        data=data_check(
+            load_book, (DECLARATION, nominal, {**_KEYS, "control_1": "vertical.control"})
+        ),
     ),
 }

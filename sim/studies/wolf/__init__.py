@@ -18,11 +18,13 @@ Modules: :mod:`.schema` (the config's keys), :mod:`.checks` (cross-key rules),
 
 from __future__ import annotations
 
-from sim.studies import Study
+from sim.studies import Study, data_check
 from sim.studies.wolf.checks import check
 from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk
+from sim.studies.wolf.claims import load_book
 from sim.studies.wolf.grid import grid_nodes, mid_cells, node_index
 from sim.studies.wolf.model import reading_error_rms
+from sim.studies.wolf.region import CELL, DECLARATION, nominal
 from sim.studies.wolf.report import report
 from sim.studies.wolf.run import run
 from sim.studies.wolf.schema import SCHEMA, SEED
@@ -61,5 +63,8 @@ STUDIES = {
         report,
         check,
         order=40,
+        data=data_check(
+            load_book, (DECLARATION, nominal, {k: v for k, v in CELL.items() if "." in v})
+        ),
     ),
 }
