@@ -9,7 +9,12 @@ process at the k-th call of a chosen function, about 80 cases) lives outside the
   their run record last, and the next publish of that output removes such a directory of
   a process no longer alive (or of its own pid: a container's) when it still holds a run
   record or is empty; a directory of that name that holds neither is the user's and kept
-  (:func:`sim.mc.publish.publish`).
+  (:func:`sim.mc.publish.publish`);
+* a run killed after the old results went aside and before the new ones came in, then a run
+  of another config with ``--overwrite``: the staging directory (with the copy of the user's
+  file) was cleared, and the user's only file stayed in the hidden ``.<name>.old.<pid>``,
+  never named; it is now brought into the new results (or, when the new run writes a file
+  of its name, the directory is kept and named).
 """
 
 from __future__ import annotations
@@ -72,3 +77,34 @@ def test_a_run_killed_while_removing_the_replaced_results_leaves_nothing_after_t
     assert names == [".out.old.5", "out"], names
     assert (users / "notes.txt").read_text() == "keep"
     assert (out / "user.txt").read_text() == "mine"
+
+
+def test_a_run_killed_between_moving_the_old_results_aside_and_publishing_keeps_user_files(
+    tmp_path, monkeypatch, capsys
+):
+    """Killed after the old results went aside and before the new ones came in: ``out`` is
+    gone, the user's file is in the hidden old results (and a copy in the staging directory).
+    A run of another config with ``--overwrite`` then cleared the staging directory, copy
+    included, and left the only one in ``.out.old.<pid>`` for good, unnamed: now it is
+    brought into the new results and the leftover removed."""
+    out = tmp_path / "out"
+    assert main(["run", PLATE, *SMALL, "--seed", "7", "--out", str(out)]) == 0
+    (out / "user.txt").write_text("mine")
+    real = publishing.os.replace
+
+    def killed(src, dst, *a, **k):
+        real(src, dst, *a, **k)
+        if Path(src) == out:
+            raise _Killed
+
+    monkeypatch.setattr(publishing.os, "replace", killed)
+    with pytest.raises(_Killed):
+        main(["run", PLATE, *SMALL, "--overwrite", "--out", str(out)])
+    monkeypatch.setattr(publishing.os, "replace", real)
+    assert not out.exists() and (outputs.swap_dir(out) / "user.txt").is_file()
+    capsys.readouterr()
+    assert main(["run", PLATE, *SMALL, "--seed", "3", "--overwrite", "--out", str(out)]) == 0
+    assert "note" not in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    assert (out / "user.txt").read_text() == "mine"
+    assert read_record(out)["config"]["seed"] == 3

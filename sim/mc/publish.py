@@ -181,8 +181,9 @@ def _remove_record_last(old: Path) -> None:
 def _drop_stale_swaps(out: Path, mine: Path | None) -> None:
     """Remove the replaced results of ``out`` that an earlier run killed while publishing
     left behind (``.<name>.old.<pid>`` of a process no longer alive, or of this pid: a
-    container's): only a directory holding a run record, or an empty one; its user files
-    had been copied into the results it gave way to before it was moved aside."""
+    container's): only a directory holding a run record, or an empty one, and only when
+    every file of the user's in it is in ``out``: copied there before it was moved aside, or,
+    when a run of another config replaced the unfinished one, now (else it is named)."""
     pat = re.compile(re.escape(f".{out.name}.old.") + r"(\d+)")
     for d in out.parent.iterdir():
         m = pat.fullmatch(d.name)
@@ -191,9 +192,31 @@ def _drop_stale_swaps(out: Path, mine: Path | None) -> None:
         if int(m.group(1)) != os.getpid() and _alive(int(m.group(1))):
             continue  # another run may be removing it now
         if read_record(d) is not None:
+            lost: list[str] = []
+            try:
+                lost = [f for f in _foreign(d) if not _present(out / f)]
+                for f in lost:  # moved aside before the copies were published: bring them
+                    if _clash(out, f) is None:
+                        _carry(d / f, out / f)
+                lost = [f for f in lost if not _present(out / f)]
+            except ConfigError:  # its record does not say which files are the user's
+                lost = ["run.json"]
+            except OSError:  # kept, and named below
+                lost = [f for f in lost if not _present(out / f)] or ["run.json"]
+            if lost:
+                print(
+                    f"sim: note: {d} holds results replaced by a run that was killed, with "
+                    f"{d / lost[0]}, which is not in {out}: move what you need out of it",
+                    file=sys.stderr,
+                )
+                continue
             _remove_record_last(d)
         elif not any(d.iterdir()):
             d.rmdir()
+
+
+def _present(p: Path) -> bool:
+    return p.is_symlink() or p.exists()
 
 
 def _alive(pid: int) -> bool:
