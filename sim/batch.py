@@ -48,7 +48,7 @@ from sim.batch_checks import (  # noqa: E402
     why_stale,
 )
 from sim.cli_args import OnceParser, module_doc  # noqa: E402
-from sim.mc.children import STOP_SIGNALS, child_text, stop_children  # noqa: E402
+from sim.mc.children import STOP_SIGNALS, child_env, child_text, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.stops import check_interrupt, keep_lost_interrupts, run_program  # noqa: E402
 
@@ -127,6 +127,7 @@ def run_all(
                     cmd,
                     stdout=subprocess.PIPE if jobs > 1 else None,
                     stderr=subprocess.PIPE,
+                    env=child_env(),  # ends with the driver, even after kill -9
                     **child_text(),  # the child's encoding, which is the driver's
                 )
             except OSError as e:  # no process or pipe to be had (ulimit -n, -u): one line

@@ -14,12 +14,18 @@ process at the k-th call of a chosen function, about 80 cases) lives outside the
   of another config with ``--overwrite``: the staging directory (with the copy of the user's
   file) was cleared, and the user's only file stayed in the hidden ``.<name>.old.<pid>``,
   never named; it is now brought into the new results (or, when the new run writes a file
-  of its name, the directory is kept and named).
+  of its name, the directory is kept and named);
+* ``python -m sim.batch`` (and ``make verify``) killed with SIGKILL: its study runs ran on,
+  orphaned, holding their outputs' locks, and the same command run again was refused for
+  each ("being written by a running sim"); a child run now asks to be sent SIGTERM when its
+  driver dies (:func:`sim.mc.children.die_with_parent`) and ends as after Ctrl-C, its
+  staging directory resumable.
 """
 
 from __future__ import annotations
 
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -108,3 +114,38 @@ def test_a_run_killed_between_moving_the_old_results_aside_and_publishing_keeps_
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
     assert (out / "user.txt").read_text() == "mine"
     assert read_record(out)["config"]["seed"] == 3
+
+
+_CHILD = """
+import signal, sys, time
+from sim.mc.children import die_with_parent
+signal.signal(signal.SIGTERM, lambda *a: (print("stopped", flush=True), sys.exit(130)))
+print("ready" if die_with_parent() else "orphan", flush=True)
+time.sleep(60)
+"""
+
+_DRIVER = """
+import os, signal, subprocess, sys
+from sim.mc.children import child_env
+subprocess.Popen([sys.executable, "-c", sys.argv[1]], env=child_env())
+sys.stdin.readline()
+os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+def test_a_child_run_ends_when_its_driver_is_killed():
+    """The driver is killed with SIGKILL once its child is ready; the child is sent SIGTERM
+    (reading the shared pipe to its end waits for both: without the fix, 60 s and no
+    "stopped")."""
+    drv = subprocess.Popen(
+        [sys.executable, "-c", _DRIVER, _CHILD],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    assert drv.stdout.readline().strip() == "ready"
+    drv.stdin.write("\n")
+    drv.stdin.close()
+    assert drv.stdout.read().split() == ["stopped"]
+    assert drv.wait() == -9
