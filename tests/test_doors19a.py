@@ -19,16 +19,22 @@ process at the k-th call of a chosen function, about 80 cases) lives outside the
   orphaned, holding their outputs' locks, and the same command run again was refused for
   each ("being written by a running sim"); a child run now asks to be sent SIGTERM when its
   driver dies (:func:`sim.mc.children.die_with_parent`) and ends as after Ctrl-C, its
-  staging directory resumable.
+  staging directory resumable;
+* a worker of ``--workers 2`` killed (``kill -9``, the OOM killer): "sim: error: network: the
+  run failed in sim.studies.network.run._mc: BrokenProcessPool: ...", exit 3 (the study
+  blamed, as for a bug); now one line saying a worker ended abruptly and that the same
+  command resumes, exit 2 (:func:`sim.execute.execute`).
 """
 
 from __future__ import annotations
 
+import importlib
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from oneline import one_line
 
 from sim.cli import main
 from sim.mc import outputs
@@ -149,3 +155,27 @@ def test_a_child_run_ends_when_its_driver_is_killed():
     drv.stdin.close()
     assert drv.stdout.read().split() == ["stopped"]
     assert drv.wait() == -9
+
+
+def test_a_killed_worker_is_named_as_such_and_the_same_command_resumes(
+    tmp_path, monkeypatch, capsys
+):
+    from concurrent.futures.process import BrokenProcessPool
+
+    network_run = importlib.import_module("sim.studies.network.run")
+    real = network_run._mc
+
+    def broken(*a, **k):  # what the pool raises once a worker was killed
+        raise BrokenProcessPool("A process in the process pool was terminated abruptly")
+
+    out = tmp_path / "out"
+    cmd = ["run", PLATE, *SMALL, "--out", str(out)]
+    monkeypatch.setattr(network_run, "_mc", broken)
+    capsys.readouterr()
+    line = one_line(capsys, main(cmd), prefix="sim: error: network: a worker process of the run")
+    assert line.endswith(
+        "ended abruptly (killed, or out of memory?); the finished chunks are "
+        "kept: run the same command again to resume"
+    ), line
+    monkeypatch.setattr(network_run, "_mc", real)
+    assert main(cmd) == 0 and read_record(out) is not None
