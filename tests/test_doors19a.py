@@ -23,12 +23,17 @@ process at the k-th call of a chosen function, about 80 cases) lives outside the
 * a worker of ``--workers 2`` killed (``kill -9``, the OOM killer): "sim: error: network: the
   run failed in sim.studies.network.run._mc: BrokenProcessPool: ...", exit 3 (the study
   blamed, as for a bug); now one line saying a worker ended abruptly and that the same
-  command resumes, exit 2 (:func:`sim.execute.execute`).
+  command resumes, exit 2 (:func:`sim.execute.execute`);
+* ``sim report`` killed while writing a README.md or REPORT.md left ``.README.md.<pid>.tmp``
+  for good (the same command again did not remove it, and a re-run of the study carried it
+  into the new results as the user's file); a write now removes the temporaries of its file
+  that a dead process (or its own pid: a container's) left (:class:`sim.mc.storage.atomic_path`).
 """
 
 from __future__ import annotations
 
 import importlib
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -179,3 +184,18 @@ def test_a_killed_worker_is_named_as_such_and_the_same_command_resumes(
     ), line
     monkeypatch.setattr(network_run, "_mc", real)
     assert main(cmd) == 0 and read_record(out) is not None
+
+
+def test_a_temporary_left_by_a_killed_report_is_removed_by_the_next(tmp_path, capsys):
+    res = tmp_path / "res"
+    assert main(["run", PLATE, *SMALL, "--out", str(res / "network_plate")]) == 0
+    assert main(["report", "--results", str(res)]) == 0
+    dead = _dead_pid()
+    left = [res / f".REPORT.md.{dead}.tmp", res / "network_plate" / f".README.md.{dead}.tmp"]
+    live = res / f".REPORT.md.{os.getppid()}.tmp"  # a live writer's: kept
+    for p in (*left, live):
+        p.write_text("half a report")
+    before = (res / "REPORT.md").read_bytes()
+    assert main(["report", "--results", str(res)]) == 0
+    assert not any(p.exists() for p in left) and live.read_text() == "half a report"
+    assert (res / "REPORT.md").read_bytes() == before
