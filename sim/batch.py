@@ -140,6 +140,14 @@ def run_all(
         wall = time.perf_counter() - t
         if stop.is_set():  # interrupted: the driver says so in one line
             return f.stem, None, wall, t - t0
+        if proc.returncode < 0:  # killed by a signal (kill -9, the OOM killer): exit 1 and
+            try:  # not a word
+                why = signal.Signals(-proc.returncode).name
+            except ValueError:
+                why = f"signal {-proc.returncode}"
+            stderr = (
+                f"{stderr or ''}its run was killed ({why}); the same command again resumes it\n"
+            )
         named = _Named(sys.stderr, f.name)
         named.write(stderr)
         named.flush()

@@ -27,7 +27,10 @@ process at the k-th call of a chosen function, about 80 cases) lives outside the
 * ``sim report`` killed while writing a README.md or REPORT.md left ``.README.md.<pid>.tmp``
   for good (the same command again did not remove it, and a re-run of the study carried it
   into the new results as the user's file); a write now removes the temporaries of its file
-  that a dead process (or its own pid: a container's) left (:class:`sim.mc.storage.atomic_path`).
+  that a dead process (or its own pid: a container's) left (:class:`sim.mc.storage.atomic_path`);
+* one study run of ``python -m sim.batch`` killed (``kill -9``, the OOM killer): the batch
+  ended with exit 1 and not a word; it now says which run was killed, by what, and that the
+  same command resumes it (:func:`sim.batch.run_all`).
 """
 
 from __future__ import annotations
@@ -199,3 +202,22 @@ def test_a_temporary_left_by_a_killed_report_is_removed_by_the_next(tmp_path, ca
     assert main(["report", "--results", str(res)]) == 0
     assert not any(p.exists() for p in left) and live.read_text() == "half a report"
     assert (res / "REPORT.md").read_bytes() == before
+
+
+def test_a_batch_says_which_run_was_killed(tmp_path, monkeypatch, capsys):
+    from sim import batch
+
+    real = batch.subprocess.Popen
+    suicide = "import os, signal; os.kill(os.getpid(), signal.SIGKILL)"
+
+    def killed(cmd, *a, **k):  # the study's run, killed at its start
+        return real([sys.executable, "-c", suicide], *a, **k)
+
+    monkeypatch.setattr(batch.subprocess, "Popen", killed)
+    capsys.readouterr()
+    rc = batch.main(["--results", str(tmp_path / "res"), PLATE])
+    err = capsys.readouterr().err
+    assert rc != 0 and "Traceback" not in err
+    assert err.splitlines() == [
+        "network_plate.toml: its run was killed (SIGKILL); the same command again resumes it"
+    ], err
