@@ -32,12 +32,15 @@ class _CacheDirNotes(logging.Filter):
 logging.getLogger("matplotlib").addFilter(_CacheDirNotes())  # before matplotlib loads
 
 from sim.cli import main as command  # noqa: E402
+from sim.mc.children import die_with_parent  # noqa: E402
 from sim.stops import run_program  # noqa: E402
 
 
 def main() -> int:
     """The ``sim`` program (``python -m sim``, the ``sim`` script): the command line, and a
     stop signal after it returned ends the process with its exit code (:mod:`sim.stops`)."""
+    if not die_with_parent():  # a child of python -m sim.batch or make verify that died
+        return 130
     words = script_of_another_copy()  # copy/.venv/bin/sim: the original's code, not the copy's
     if words is not None:
         print(f"sim: error: {words}", file=sys.stderr)

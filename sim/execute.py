@@ -14,6 +14,7 @@ import logging
 import os
 import re
 import sys
+from concurrent.futures import BrokenExecutor
 from contextlib import nullcontext
 from pathlib import Path
 from typing import Any, Mapping
@@ -189,6 +190,12 @@ def execute(
                 raise _numeric_failure(e, study, cfg) from None  # cannot take
             if (words := shadowed(e)) is not None:  # a user's matplotlib.py: not our bug
                 raise StudyError(f"{cfg['study']}: {words}") from None
+            if isinstance(e, BrokenExecutor):  # a worker killed (kill -9, the OOM killer): the
+                raise StudyError(  # study part was blamed, exit 3 "internal error"
+                    f"{cfg['study']}: a worker process of the run ended abruptly (killed, or out "
+                    "of memory?); the finished chunks are kept: run the same command again to "
+                    "resume"
+                ) from None
             if os.environ.get("SIM_DEBUG"):  # a bug: one line, the traceback on request
                 raise
             err = _numeric_failure(e, study, cfg)

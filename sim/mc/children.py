@@ -10,18 +10,48 @@ resumable, its workers end) and waits for each, killing one still alive after
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
 from collections.abc import Callable, Iterable
 
-__all__ = ["STOP_SIGNALS", "GRACE_S", "stop_children", "child_text"]
+__all__ = ["STOP_SIGNALS", "GRACE_S", "stop_children", "child_text", "child_env", "die_with_parent"]
 
 #: the signals that end a driver (and each of its runs) as Ctrl-C does
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
 
 #: seconds an interrupted child run has to clean up before it is killed
 GRACE_S = 30
+
+
+#: the environment variable by which a driver asks its child runs to end with it
+PARENT_ENV = "SIM_STOP_WITH_PARENT"
+
+
+def child_env() -> dict:
+    """The environment of a child run: the driver's, plus its pid in :data:`PARENT_ENV`, so
+    that the child ends as after SIGTERM when the driver dies, even by ``kill -9`` (then
+    nobody would stop it: it ran on and held its output's lock, and the same command run
+    again was refused until it ended). Start the child from a thread that lives as long as
+    the child runs (Linux signals the child when the thread that started it ends)."""
+    return {**os.environ, PARENT_ENV: str(os.getpid())}
+
+
+def die_with_parent() -> bool:
+    """In a child run started with :func:`child_env`: be sent SIGTERM when the driver dies
+    (PR_SET_PDEATHSIG, Linux). False when the driver is gone already (the child should end
+    at once without a word: no one reads it)."""
+    want = os.environ.pop(PARENT_ENV, "")
+    if not want.isdigit() or not sys.platform.startswith("linux"):
+        return True
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        return True
+    return os.getppid() == int(want)
 
 
 def child_text() -> dict:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 import sys
 from itertools import count
@@ -160,6 +161,74 @@ def _free_swap(out: Path) -> Path:
     return old  # (anything else in the way: os.replace names it)
 
 
+def _remove_record_last(old: Path) -> None:
+    """Remove the replaced results ``old`` (what cannot be removed stays), its run record
+    last: a run killed while removing them leaves a directory that still names itself as
+    the suite's (or an empty one), which the next publish of that output removes."""
+    if old.is_dir() and not old.is_symlink():
+        try:
+            for p in old.iterdir():
+                if p.is_dir() and not p.is_symlink():
+                    shutil.rmtree(p, ignore_errors=True)
+                elif p.name != "run.json":
+                    p.unlink()
+            (old / "run.json").unlink(missing_ok=True)
+        except OSError:
+            pass  # what cannot be removed stays (publish names it)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def _drop_stale_swaps(out: Path, mine: Path | None) -> None:
+    """Remove the replaced results of ``out`` that an earlier run killed while publishing
+    left behind (``.<name>.old.<pid>`` of a process no longer alive, or of this pid: a
+    container's): only a directory holding a run record, or an empty one, and only when
+    every file of the user's in it is in ``out``: copied there before it was moved aside, or,
+    when a run of another config replaced the unfinished one, now (else it is named)."""
+    pat = re.compile(re.escape(f".{out.name}.old.") + r"(\d+)")
+    for d in out.parent.iterdir():
+        m = pat.fullmatch(d.name)
+        if not m or d == mine or d.is_symlink() or not d.is_dir():
+            continue
+        if int(m.group(1)) != os.getpid() and _alive(int(m.group(1))):
+            continue  # another run may be removing it now
+        if read_record(d) is not None:
+            lost: list[str] = []
+            try:
+                lost = [f for f in _foreign(d) if not _present(out / f)]
+                for f in lost:  # moved aside before the copies were published: bring them
+                    if _clash(out, f) is None:
+                        _carry(d / f, out / f)
+                lost = [f for f in lost if not _present(out / f)]
+            except ConfigError:  # its record does not say which files are the user's
+                lost = ["run.json"]
+            except OSError:  # kept, and named below
+                lost = [f for f in lost if not _present(out / f)] or ["run.json"]
+            if lost:
+                print(
+                    f"sim: note: {d} holds results replaced by a run that was killed, with "
+                    f"{d / lost[0]}, which is not in {out}: move what you need out of it",
+                    file=sys.stderr,
+                )
+                continue
+            _remove_record_last(d)
+        elif not any(d.iterdir()):
+            d.rmdir()
+
+
+def _present(p: Path) -> bool:
+    return p.is_symlink() or p.exists()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's process: alive
+        return True
+    return True
+
+
 def publish(stage: Path, out: Path) -> None:
     """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
     files in ``out`` that the suite did not write."""
@@ -187,9 +256,10 @@ def publish(stage: Path, out: Path) -> None:
         os.replace(out, old)
     os.replace(stage, out)
     (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
+    _drop_stale_swaps(out, old)
     if old is None:
         return
-    shutil.rmtree(old, ignore_errors=True)
+    _remove_record_last(old)
     if old.exists() or old.is_symlink():  # a file or directory of the old results that this
         # user may not remove: they are not lost, but say where (a hidden directory)
         left = next(iter(sorted(old.rglob("*"), key=lambda q: -len(q.parts))), old)

@@ -194,6 +194,7 @@ class atomic_path:
 
     def __enter__(self) -> Path:
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        _drop_stale_temporaries(self.path)
         return self.tmp
 
     def __exit__(self, exc_type, exc, tb) -> None:
@@ -222,6 +223,31 @@ def _named(e: OSError, path: Path) -> OSError:
     named = OSError(num or 0, words or str(e) or type(e).__name__, str(path))
     named.__traceback__ = e.__traceback__
     return named
+
+
+def _drop_stale_temporaries(path: Path) -> None:
+    """Remove the temporaries of ``path`` (``.<name>.<pid>.tmp``) that a process killed while
+    writing it left (``sim report`` killed during a README.md stayed so for good, and a
+    re-run carried it into the new results as the user's): those of a pid no longer alive,
+    or of this pid (a container's every command)."""
+    pat = re.compile(re.escape(f".{path.name}.") + r"(\d+)\.tmp")
+    try:
+        names = [n for n in os.listdir(path.parent) if pat.fullmatch(n)]
+    except OSError:
+        return
+    for n in names:
+        pid = int(pat.fullmatch(n).group(1))
+        if pid != os.getpid():
+            try:
+                os.kill(pid, 0)
+                continue  # a live process writing it
+            except ProcessLookupError:
+                pass
+            except OSError:
+                continue
+        p = path.parent / n
+        if p.is_file() and not p.is_symlink():
+            p.unlink(missing_ok=True)
 
 
 class NonFiniteError(ValueError):

@@ -12,7 +12,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.mc.children import child_text, stop_children
+from sim.mc.children import child_env, child_text, stop_children
 from sim.mc.outputs import results_dirs
 from sim.mc.storage import read_provenance, read_record, versions, write_table
 from sim.report.tables import fmt, md_table
@@ -119,7 +119,7 @@ def rerun_study(
     cmd += ["--no-figures"]
     cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else []), *extra]
     print(f"sim verify: re-running {d.name}", file=sys.stderr, flush=True)
-    with subprocess.Popen(cmd, stderr=subprocess.PIPE, **child_text()) as proc:
+    with subprocess.Popen(cmd, stderr=subprocess.PIPE, env=child_env(), **child_text()) as proc:
         try:
             _, err = proc.communicate()
         except KeyboardInterrupt:  # Ctrl-C reaches the re-run too, SIGTERM or SIGHUP only verify
