@@ -219,8 +219,9 @@ def _show(args) -> int:
     d = Path(args.dir)
     if not d.exists() and (Path("results") / args.dir).is_dir():
         d = Path("results") / args.dir
-    if not d.is_dir():
-        raise ConfigError("DIR", f"{args.dir} is not a directory")
+    if not d.is_dir():  # the name of a study's results is read under ./results too: say so
+        also = "" if d.is_absolute() or d.exists() else f" (nor is results/{args.dir})"
+        raise ConfigError("DIR", f"{args.dir} is not a directory{also}")
     check_claims_table(d / "claims.parquet", "DIR")
     try:
         text = run_markdown(d, get_study) if args.markdown else terminal_table(d)

@@ -326,3 +326,13 @@ def test_an_option_no_command_takes_names_the_program_once_and_the_commands_help
 ):
     # the top parser reported it as "sim: error: sim: unrecognized arguments: ... (see sim --help)"
     assert one_line(capsys, main(argv)) == line
+
+
+def test_show_names_both_places_a_study_name_is_looked_for(tmp_path, capsys, monkeypatch):
+    # `sim show nosuch` said only "nosuch is not a directory", though a name is also read as
+    # results/<name> (sim show --help)
+    monkeypatch.chdir(tmp_path)
+    line = one_line(capsys, main(["show", "nosuch"]))
+    assert line == "sim: error: DIR: nosuch is not a directory (nor is results/nosuch)"
+    line = one_line(capsys, main(["show", str(tmp_path / "nosuch")]))
+    assert line == f"sim: error: DIR: {tmp_path / 'nosuch'} is not a directory"
