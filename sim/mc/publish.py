@@ -21,7 +21,7 @@ from pathlib import Path
 from sim.mc.config import ConfigError
 from sim.mc.outputs import swap_dir
 from sim.mc.runner import ChunkStore
-from sim.mc.storage import LOCK, read_record, write_record
+from sim.mc.storage import LOCK, pid_alive, read_record, write_record
 
 __all__ = ["seal", "publish", "damaged_chunks"]
 
@@ -189,7 +189,7 @@ def _drop_stale_swaps(out: Path, mine: Path | None) -> None:
         m = pat.fullmatch(d.name)
         if not m or d == mine or d.is_symlink() or not d.is_dir():
             continue
-        if int(m.group(1)) != os.getpid() and _alive(int(m.group(1))):
+        if int(m.group(1)) != os.getpid() and pid_alive(int(m.group(1))):
             continue  # another run may be removing it now
         if read_record(d) is not None:
             lost: list[str] = []
@@ -217,16 +217,6 @@ def _drop_stale_swaps(out: Path, mine: Path | None) -> None:
 
 def _present(p: Path) -> bool:
     return p.is_symlink() or p.exists()
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:  # another user's process: alive
-        return True
-    return True
 
 
 def publish(stage: Path, out: Path) -> None:

@@ -225,6 +225,17 @@ def _named(e: OSError, path: Path) -> OSError:
     return named
 
 
+def pid_alive(pid: int) -> bool:
+    """Whether process ``pid`` exists (another user's process counts as alive)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # EPERM: someone else's
+        return True
+    return True
+
+
 def _drop_stale_temporaries(path: Path) -> None:
     """Remove the temporaries of ``path`` (``.<name>.<pid>.tmp``) that a process killed while
     writing it left (``sim report`` killed during a README.md stayed so for good, and a
@@ -237,14 +248,8 @@ def _drop_stale_temporaries(path: Path) -> None:
         return
     for n in names:
         pid = int(pat.fullmatch(n).group(1))
-        if pid != os.getpid():
-            try:
-                os.kill(pid, 0)
-                continue  # a live process writing it
-            except ProcessLookupError:
-                pass
-            except OSError:
-                continue
+        if pid != os.getpid() and pid_alive(pid):
+            continue  # a live process writing it
         p = path.parent / n
         if p.is_file() and not p.is_symlink():
             p.unlink(missing_ok=True)
