@@ -53,6 +53,8 @@ VENV_USABLE := $(and $(VENV_USABLE),$(if $(wildcard $(INSTALLING)),,yes))
 # line: a pip that does not start), exit 2 (it was pip's dozen lines, the cause in the
 # middle); the next `make venv` tries again
 PIP_LOG := $(VENV)/pip.log
+# a comma inside a $(call pip,...) argument ($(call) splits its arguments at commas)
+comma := ,
 # Each install step holds the lock VENV_LOCK (where flock(1) exists): a pip still rolling back
 # after a Ctrl-C, or a second `make venv` at once, is waited for instead of racing the next
 # step ("venv --clear: Directory not empty", or a pip left without its modules)
@@ -99,7 +101,7 @@ MUTATION_WORKERS ?= 2
 
 mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (sim/claims/), run their tests, write docs/mutation.md
 	$(call whole,MUTATION_WORKERS,1)
-	$(call pip,-e ".[dev,mutation]")
+	$(call pip,-e ".[dev$(comma)mutation]")
 	rm -rf mutants
 	$(VENV)/bin/mutmut run --max-children $(MUTATION_WORKERS) > /dev/null
 	$(PY) tests/mutation_report.py

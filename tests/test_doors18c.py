@@ -131,6 +131,23 @@ def test_make_test_takes_auto_and_zero_workers():
         assert p.returncode == 0 and f"pytest -n {value} " in p.stdout, p.stdout + p.stderr
 
 
+def phony_targets() -> list[str]:
+    """The Makefile's .PHONY targets (every command a user is told to run)."""
+    line = next(x for x in (ROOT / "Makefile").read_text().splitlines() if x.startswith(".PHONY:"))
+    return line.split(":", 1)[1].split()
+
+
+@pytest.mark.parametrize("target", [t for t in phony_targets() if t != "venv-unusable"])
+def test_every_make_target_is_commands_the_shell_can_parse(target):
+    """`make -n TARGET` prints what the target would run; each must be valid shell. A comma
+    inside ``$(call pip,-e ".[dev,mutation]")`` split the call's argument, and `make mutation`
+    died at once in "/bin/sh: Syntax error: Unterminated quoted string" (no test ran it)."""
+    p = make("-n", target)
+    assert p.returncode == 0, p.stderr
+    sh = subprocess.run(["sh", "-n"], input=p.stdout, capture_output=True, text=True, timeout=30)
+    assert sh.returncode == 0, (target, sh.stderr, p.stdout)
+
+
 def test_bench_out_with_a_space_and_a_quote_stays_one_argument():
     out = "/tmp/my bench's dir"
     p = make("-n", "bench", f"BENCH_OUT={out}", "BENCH_FLAGS=--quick")
