@@ -6,7 +6,9 @@ Sections (``--only``, default all): ``brown`` (``bench.parquet``, ``bench.png``:
 (``rerun.parquet``: :mod:`benchmarks.rerun`; ``--no-rerun`` leaves it out), engines and rerun
 drawn in ``engines.png``; ``README.md`` (:mod:`benchmarks.page`) names each compiled module and
 the row that keeps it; ``scaling`` (``scaling.parquet``, ``scaling.png``: the sparse path
-from 100 to 10,000 points and blocks of 10 to 200 models, :mod:`benchmarks.scaling`). ``--quick`` is a smoke run: small sizes, and the rerun rows with
+from 100 to 10,000 points and blocks of 10 to 200 models, :mod:`benchmarks.scaling`); ``store``
+(``store.parquet``: a chunk's kept arrays saved and loaded packed against ``.npz``,
+:mod:`benchmarks.store`). ``--quick`` is a smoke run: small sizes, and the rerun rows with
 the test suite's tiny configuration of each study (``tests/data/tiny/<study>.txt``), so its
 rerun times say nothing about the 90 s target.
 """
@@ -29,12 +31,13 @@ from benchmarks.figures import brown_figure, engines_figure
 from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
 from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
+from benchmarks.store import store_rows
 from sim.mc.argv import BoundedParser
 from sim.mc.storage import provenance, write_table
 
 __all__ = ["main", "run"]
 
-SECTIONS = ("brown", "engines", "studies", "rerun", "scaling")
+SECTIONS = ("brown", "engines", "studies", "rerun", "scaling", "store")
 TINY = Path(__file__).resolve().parent.parent / "tests" / "data" / "tiny"
 
 
@@ -98,6 +101,9 @@ def run(
         )
         scaling_figure(tables["scaling.parquet"], out / "scaling.png")
         print(f"benchmarks: scaling took {time.perf_counter() - t0:.0f} s", file=sys.stderr)
+    if "store" in sections:
+        tables["store.parquet"] = store_rows(quick)
+        write_table(out / "store.parquet", tables["store.parquet"], provenance(prov))
     if "engines" in sections or "rerun" in sections:
         engines_figure(
             tables.get("engines.parquet"), tables.get("rerun.parquet"), out / "engines.png"

@@ -24,7 +24,6 @@ Executors (:func:`make_executor`): in-process (default), a local process pool
 
 from __future__ import annotations
 
-import io
 import json
 import pickle
 import sys
@@ -40,6 +39,7 @@ import pyarrow.parquet as pq
 from sim.lsq import distributions as D
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.executors import InProcess, make_executor
+from sim.mc.packed import pack, unpack
 from sim.mc.progress import Progress
 from sim.mc.storage import atomic_path, config_hash
 from sim.mc.streams import chunk_rng
@@ -122,8 +122,6 @@ class ChunkStore:
     ) -> None:
         rows = {key[len(ROWS) :]: v for key, v in data.items() if key.startswith(ROWS)}
         kept = {key: v for key, v in data.items() if not key.startswith(ROWS)}
-        buf = io.BytesIO()
-        np.savez(buf, **kept)
         table = pa.table(
             {
                 "chunk": np.full(n, k, np.int32),
@@ -131,7 +129,7 @@ class ChunkStore:
                 **rows,
             }
         )
-        meta = {_ARRAYS: buf.getvalue(), b"n": str(n).encode()}
+        meta = {_ARRAYS: pack(kept), b"n": str(n).encode()}
         meta[_IDENTITY] = json.dumps(self._identity(part, k, n, seed), sort_keys=True).encode()
         if self.prov is not None:
             meta[b"sim.provenance"] = json.dumps(
@@ -175,8 +173,7 @@ class ChunkStore:
                 want["seed"] = ident.get("seed")
             if ident != want or table.num_rows != want["trials"]:
                 return None
-            with np.load(io.BytesIO(meta[_ARRAYS])) as z:
-                out = {key: z[key] for key in z.files}
+            out = unpack(meta[_ARRAYS])
         except (OSError, KeyError, ValueError, TypeError, pa.ArrowInvalid):
             return None  # unreadable or foreign: recompute it
         if keep_rows:
