@@ -50,6 +50,7 @@ from sim.batch_checks import (  # noqa: E402
 from sim.cli_args import OnceParser, module_doc  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
+from sim.mc.paths import link_problem  # noqa: E402
 from sim.stops import check_interrupt, keep_lost_interrupts, run_program  # noqa: E402
 
 if __name__ != "__main__":  # imported: the default handlers (the program: run_program's)
@@ -249,6 +250,9 @@ def _main(argv: list[str]) -> int:
         why = name_problem(args.results)
         print(f"sim.batch: --results: {why} (got {args.results!r})", file=sys.stderr)
         return 2
+    if why := link_problem(args.results):  # a loop: every run would fail on it, one by one
+        print(f"sim.batch: --results: {args.results} {why}", file=sys.stderr)
+        return 2
     if os.path.lexists(args.results) and not os.path.isdir(args.results):
         # each run would name --out, an option this command line does not hold, one by one
         print(f"sim.batch: --results: {args.results} is not a directory", file=sys.stderr)
@@ -260,7 +264,11 @@ def _main(argv: list[str]) -> int:
     files = [Path(f) for f in args.files]
     bad = [f for f in files if not f.is_file()]
     if bad:
-        print(f"sim.batch: no study file {bad[0]}", file=sys.stderr)
+        why = link_problem(bad[0])
+        print(
+            f"sim.batch: {bad[0]} {why}" if why else f"sim.batch: no study file {bad[0]}",
+            file=sys.stderr,
+        )
         return 2
     why = _clashes(files, run_args, args.results)
     if why:

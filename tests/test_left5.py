@@ -4,15 +4,28 @@ case each; each failed on the code before its fix.
 * ``network.xml`` was written in place: a symbolic link placed by hand under that name in a
   run's staging directory was written through (a file outside the output replaced by the
   export); it is now written as every other output, a temporary renamed over the name
-  (:func:`sim.studies.network.gama.write_gama`).
+  (:func:`sim.studies.network.gama.write_gama`);
+* a study file that is a loop of symbolic links read "no such study file" (pathlib takes the
+  system's "too many levels of symbolic links" for no file), of a name ``ls`` shows; so did a
+  results directory (``sim show``, ``sim report --results``, ``sim.batch --results``, ``make
+  verify --results``, ``sim.Results``), a batch's study file, ``sim.load``'s and a Wolf table
+  key's file. Each says it is, or goes through, a symbolic-link loop, or is a link to nothing
+  (:func:`sim.mc.paths.link_problem`).
 """
 
 from __future__ import annotations
 
 import importlib
+import re
 from pathlib import Path
 
+import pytest
+from oneline import one_line
+
+import sim
+from sim import batch
 from sim.cli import main
+from sim.report.verify import main as verify_main
 
 network_run = importlib.import_module("sim.studies.network.run")
 
@@ -43,3 +56,55 @@ def test_a_link_named_network_xml_in_the_staging_directory_is_not_written_throug
     assert notes.read_text() == "my notes\n"
     xml = tmp_path / "o" / "network.xml"
     assert not xml.is_symlink() and xml.read_text().startswith("<?xml")
+
+
+def _api(call):
+    """A door of the Python API as a command: its ConfigError as the one line of ``sim``."""
+
+    def door(argv):
+        try:
+            call(*argv)
+        except sim.ConfigError as e:
+            print(f"sim: error: {e}", file=__import__("sys").stderr)
+            return 2
+        return 0
+
+    return door
+
+
+WOLF = str(ROOT / "studies" / "wolf_polynomial.toml")
+DOORS = {
+    "sim check FILE": lambda p: main(["check", p]),
+    "sim run FILE": lambda p: main(["run", p, "--quiet"]),
+    "sim show DIR": lambda p: main(["show", p]),
+    "sim report --results": lambda p: main(["report", "--results", p]),
+    "sim.batch FILE": lambda p: batch.main([p]),
+    "sim.batch --results": lambda p: batch.main(["--results", p, PLATE]),
+    "make verify --results": lambda p: verify_main(["--results", p, "--no-record"]),
+    "sim.load": lambda p: _api(sim.load)([p]),
+    "sim.Results": lambda p: _api(lambda q: sim.Results(q, "network").names())([p]),
+    "wolf table1.file": lambda p: main(["check", WOLF, "--set", f"table1.file={p!r}"]),
+}
+
+
+@pytest.mark.parametrize("door", DOORS)
+@pytest.mark.parametrize("where", ["loop", "through", "dangling"])
+def test_a_symbolic_link_loop_is_named_not_taken_for_a_missing_file(
+    tmp_path, capsys, monkeypatch, door, where
+):
+    monkeypatch.chdir(tmp_path)  # sim show reads a bare name under ./results too
+    (tmp_path / "studies").mkdir()  # make verify runs in the project's root
+    ring = tmp_path / "ring"
+    ring.symlink_to(ring)
+    if where == "dangling":
+        ring = tmp_path / "link.toml"
+        ring.symlink_to(tmp_path / "gone")
+    path = ring / "x.toml" if where == "through" else ring
+    capsys.readouterr()
+    line = one_line(capsys, DOORS[door](str(path)), str(path))
+    want = {
+        "loop": f"{ring} is a symbolic-link loop",
+        "through": f"{path} goes through a symbolic-link loop ({ring})",
+        "dangling": f"{ring} is a symbolic link to {tmp_path / 'gone'}, which does not exist",
+    }[where]
+    assert want in re.sub(r": (is|goes) ", r" \1 ", line) and "no such" not in line, line

@@ -14,6 +14,7 @@ import pyarrow.parquet as pq
 
 from sim.mc.children import child_env, child_text, stop_children
 from sim.mc.outputs import results_dirs
+from sim.mc.paths import link_problem
 from sim.mc.storage import read_provenance, read_record, versions, write_table
 from sim.report.tables import fmt, md_table
 from sim.report.verify.rules import DEFAULT_RTOL, Comparison, VerifyError, compare_dirs
@@ -45,7 +46,7 @@ def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path,
     ``only`` (a study or its directory name); VerifyError for none or an unknown name."""
     results = Path(results)
     if not results.is_dir():
-        raise VerifyError(f"--results: {results} is not a directory")
+        raise VerifyError(f"--results: {results} {link_problem(results) or 'is not a directory'}")
     found = []
     for d in sorted(p for p in results_dirs(results) if (p / "claims.parquet").is_file()):
         try:
