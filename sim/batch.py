@@ -48,7 +48,7 @@ from sim.batch_checks import (  # noqa: E402
     why_stale,
 )
 from sim.cli_args import OnceParser, module_doc  # noqa: E402
-from sim.mc.children import STOP_SIGNALS, child_env, child_text, stop_children  # noqa: E402
+from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
 from sim.stops import check_interrupt, keep_lost_interrupts, run_program  # noqa: E402
@@ -141,14 +141,9 @@ def run_all(
         wall = time.perf_counter() - t
         if stop.is_set():  # interrupted: the driver says so in one line
             return f.stem, None, wall, t - t0
-        if proc.returncode < 0:  # killed by a signal (kill -9, the OOM killer): exit 1 and
-            try:  # not a word
-                why = signal.Signals(-proc.returncode).name
-            except ValueError:
-                why = f"signal {-proc.returncode}"
-            stderr = (
-                f"{stderr or ''}its run was killed ({why}); the same command again resumes it\n"
-            )
+        if proc.returncode < 0:  # killed by a signal (kill -9, the OOM killer): it said not a word
+            why = ended(proc.returncode)
+            stderr = f"{stderr or ''}its run {why}; the same command again resumes it\n"
         named = _Named(sys.stderr, f.name)
         named.write(stderr)
         named.flush()

@@ -10,13 +10,19 @@ case each; each failed on the code before its fix.
   results directory (``sim show``, ``sim report --results``, ``sim.batch --results``, ``make
   verify --results``, ``sim.Results``), a batch's study file, ``sim.load``'s and a Wolf table
   key's file. Each says it is, or goes through, a symbolic-link loop, or is a link to nothing
-  (:func:`sim.mc.paths.link_problem`).
+  (:func:`sim.mc.paths.link_problem`);
+* a child run killed by a signal read "exited with -9" (``make verify``'s re-run, the
+  benchmarks' runs and gama-local); every message that shows a child's return code now names
+  the signal, "was killed by SIGKILL" (:func:`sim.mc.children.ended`), as sim.batch did in
+  words of its own.
 """
 
 from __future__ import annotations
 
 import importlib
+import os
 import re
+import sys
 from pathlib import Path
 
 import pytest
@@ -25,7 +31,9 @@ from oneline import one_line
 import sim
 from sim import batch
 from sim.cli import main
+from sim.mc.children import ended
 from sim.report.verify import main as verify_main
+from sim.report.verify import rerun as verify_rerun
 
 network_run = importlib.import_module("sim.studies.network.run")
 
@@ -108,3 +116,33 @@ def test_a_symbolic_link_loop_is_named_not_taken_for_a_missing_file(
         "dangling": f"{ring} is a symbolic link to {tmp_path / 'gone'}, which does not exist",
     }[where]
     assert want in re.sub(r": (is|goes) ", r" \1 ", line) and "no such" not in line, line
+
+
+SUICIDE = "import os, signal; os.kill(os.getpid(), signal.SIGKILL)"
+
+
+def test_a_return_code_is_said_as_an_exit_or_the_signal_that_ended_the_child():
+    assert ended(0) == "exited with 0" and ended(3) == "exited with 3"
+    assert ended(-9) == "was killed by SIGKILL" and ended(-15) == "was killed by SIGTERM"
+    assert ended(-200) == "was killed by signal 200"  # no name: its number
+
+
+def test_a_verify_re_run_killed_by_a_signal_names_it(tmp_path, monkeypatch, capsys):
+    real = verify_rerun.subprocess.Popen
+
+    def killed(cmd, *a, **k):  # the study's re-run, killed at its start (kill -9, OOM)
+        return real([sys.executable, "-c", SUICIDE], *a, **k)
+
+    monkeypatch.setattr(verify_rerun.subprocess, "Popen", killed)
+    monkeypatch.chdir(ROOT)  # the re-run reads its study file from studies/
+    why = verify_rerun.rerun_study(
+        Path("results/network_plate"), "network", tmp_path / "x", False, 1, []
+    )
+    assert why == "the re-run was killed by SIGKILL", why
+
+
+def test_a_benchmark_run_killed_by_a_signal_names_it():
+    from benchmarks.studies import _run
+
+    with pytest.raises(RuntimeError, match=r"^bench: x failed \(it was killed by SIGKILL\): "):
+        _run([sys.executable, "-c", SUICIDE], dict(os.environ), "x")

@@ -12,7 +12,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.mc.children import child_env, child_text, stop_children
+from sim.mc.children import child_env, child_text, ended, stop_children
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.storage import read_provenance, read_record, versions, write_table
@@ -132,7 +132,7 @@ def rerun_study(
         # --out under --scratch): a request error, not a failed comparison to record
         raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
     sys.stderr.write(err)
-    return None if proc.returncode == 0 else f"the re-run exited with {proc.returncode}"
+    return None if proc.returncode == 0 else f"the re-run {ended(proc.returncode)}"
 
 
 def verify(
