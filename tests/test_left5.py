@@ -14,7 +14,14 @@ case each; each failed on the code before its fix.
 * a child run killed by a signal read "exited with -9" (``make verify``'s re-run, the
   benchmarks' runs and gama-local); every message that shows a child's return code now names
   the signal, "was killed by SIGKILL" (:func:`sim.mc.children.ended`), as sim.batch did in
-  words of its own.
+  words of its own;
+* a region input the code scales before it reaches a key (gridplate's
+  ``scale_diff_at_100mm_um``: 10 ppm per um, and the non-orthogonality in the configured
+  proportion), agnard's scanner inputs (set as they are, but given no key) and its five-point
+  inset (no key: its code's bounds) were explored past every bound (a scale difference of
+  1e5 ppm, a negative centring error, an inset whose outer points cross the block's middle):
+  each is refused at ``sim check`` naming the file, the input and the bound it breaks
+  (:func:`sim.studies.data_check`).
 """
 
 from __future__ import annotations
@@ -30,6 +37,7 @@ from oneline import one_line
 
 import sim
 from sim import batch
+from sim.claims import book_region
 from sim.cli import main
 from sim.mc.children import ended
 from sim.report.verify import main as verify_main
@@ -146,3 +154,80 @@ def test_a_benchmark_run_killed_by_a_signal_names_it():
 
     with pytest.raises(RuntimeError, match=r"^bench: x failed \(it was killed by SIGKILL\): "):
         _run([sys.executable, "-c", SUICIDE], dict(os.environ), "x")
+
+
+GRIDPLATE = str(ROOT / "studies" / "gridplate_two_plates.toml")
+AGNARD = str(ROOT / "studies" / "agnard_block.toml")
+REGIONS = ROOT / "sim" / "studies"
+
+
+@pytest.mark.parametrize(
+    "study, declaration, old, new, needle",
+    [
+        (
+            GRIDPLATE,
+            "gridplate/region.toml",
+            "low = 0.0\nhigh = 4.0",
+            "low = 0.0\nhigh = 2000.0",
+            "inputs.scale_diff_at_100mm_um.high: {path}: 2000 (20000 in "
+            "comparator.scale_diff_ppm) is outside comparator.scale_diff_ppm's bounds "
+            "(>= -10000.0, <= 10000.0)",
+        ),
+        (
+            AGNARD,
+            "agnard/scanner.toml",
+            "low = 2.0\nhigh = 230.0",
+            "low = 2.0\nhigh = 2300.0",
+            "inputs.wavelength_mm.high: {path}: 2300 is outside scan.wavelength_mm's bounds",
+        ),
+        (
+            AGNARD,
+            "agnard/scanner.toml",
+            'low = 0.0\nhigh = 0.5\nwhy = "the centring error of a grid',
+            'low = -0.1\nhigh = 0.5\nwhy = "the centring error of a grid',
+            "inputs.grid_sigma_px.low: {path}: -0.1 is outside scan.grid_sigma_px's bounds",
+        ),
+        (
+            AGNARD,
+            "agnard/region.toml",
+            "low = 0.0\nhigh = 0.45",
+            "low = 0.0\nhigh = 0.9",
+            "inputs.five_inset_1.high: {path}: 0.9 is outside the bounds its code takes "
+            "(>= 0.0, <= 0.5): beyond 0.5 the outer points cross",
+        ),
+    ],
+    ids=["gridplate scale difference", "agnard wavelength", "agnard grid sigma", "agnard inset"],
+)
+def test_a_region_range_keeps_the_bounds_of_where_its_input_goes(
+    tmp_path, monkeypatch, capsys, study, declaration, old, new, needle
+):
+    path = REGIONS / declaration
+    text = path.read_text(encoding="utf-8")
+    assert text.count(old) == 1
+    edited = tmp_path / path.name
+    edited.write_text(text.replace(old, new), encoding="utf-8")
+    real = book_region.load_declaration
+
+    def load(p, book):  # the study reads the edited declaration in place of its own
+        return real(edited if Path(p) == path else p, book)
+
+    monkeypatch.setattr(book_region, "load_declaration", load)
+    capsys.readouterr()
+    one_line(capsys, main(["check", study]), needle.format(path=path))
+    monkeypatch.setattr(book_region, "load_declaration", real)
+    assert main(["check", study]) == 0  # the committed declaration keeps them
+
+
+def test_the_non_orthogonality_a_scale_difference_carries_keeps_its_bound(capsys):
+    """The region sets the non-orthogonality in the configured proportion: a small configured
+    scale difference made the committed 4 um over 100 mm an angle of 15,200 arcsec."""
+    capsys.readouterr()
+    cmd = ["check", GRIDPLATE, "--set", "comparator.scale_diff_ppm=0.01"]
+    one_line(
+        capsys,
+        main(cmd),
+        "inputs.scale_diff_at_100mm_um.high: ",
+        "region.toml: 4 (15200 in comparator.nonorth_arcsec) is outside "
+        "comparator.nonorth_arcsec's bounds (>= -3600.0, <= 3600.0)",
+    )
+    assert main([*cmd[:-1], "comparator.scale_diff_ppm=1.0"]) == 0  # 152 arcsec
