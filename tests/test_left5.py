@@ -21,7 +21,13 @@ case each; each failed on the code before its fix.
   inset (no key: its code's bounds) were explored past every bound (a scale difference of
   1e5 ppm, a negative centring error, an inset whose outer points cross the block's middle):
   each is refused at ``sim check`` naming the file, the input and the bound it breaks
-  (:func:`sim.studies.data_check`).
+  (:func:`sim.studies.data_check`);
+* ``make venv PYTHON='py"thon'`` (a quote in a make variable) broke the shell line ("/bin/sh:
+  Syntax error: Unterminated quoted string", naming nothing), and ``py;x`` ran ``x``: PYTHON
+  is passed as one shell word, a failure one line naming PYTHON; the option variables
+  (RUN_FLAGS, VERIFY_FLAGS, BENCH_FLAGS: several words, passed on as they are) with a quote
+  left open are one line naming the variable before anything runs (``shellwords`` in the
+  Makefile).
 """
 
 from __future__ import annotations
@@ -29,11 +35,13 @@ from __future__ import annotations
 import importlib
 import os
 import re
+import shlex
 import sys
 from pathlib import Path
 
 import pytest
 from oneline import one_line
+from test_doors18c import MAKE, fake_project, make, make_line, run_make
 
 import sim
 from sim import batch
@@ -231,3 +239,41 @@ def test_the_non_orthogonality_a_scale_difference_carries_keeps_its_bound(capsys
         "comparator.nonorth_arcsec's bounds (>= -3600.0, <= 3600.0)",
     )
     assert main([*cmd[:-1], "comparator.scale_diff_ppm=1.0"]) == 0  # 152 arcsec
+
+
+needs_make = pytest.mark.skipif(MAKE is None, reason="no make on this machine")
+
+
+@needs_make
+@pytest.mark.parametrize("python", ['py"thon', "py'thon", "py thon", "py;touch injected"])
+def test_a_make_python_with_a_quote_or_a_space_is_one_word_and_one_line(tmp_path, python):
+    d = fake_project(tmp_path, "/nonexistent/python3")
+    line = make_line(run_make(d, "venv", python=python), f"make: PYTHON ({python}) could not ")
+    assert "Syntax error" not in line and not (d / "injected").exists(), line
+
+
+@needs_make
+@pytest.mark.parametrize(
+    ("target", "var", "value"),
+    [
+        ("reproduce", "RUN_FLAGS", '--set "x'),
+        ("rerun", "RUN_FLAGS", "--workers 1 '"),
+        ("verify", "VERIFY_FLAGS", '--study "brown_table1'),
+        ("bench", "BENCH_FLAGS", "--quick)"),
+    ],
+)
+def test_a_make_option_variable_the_shell_cannot_read_is_one_line_before_anything_runs(
+    target, var, value
+):
+    p = make(target, f"{var}={value}")
+    line = make_line(p, f"make {target}: {var} is not words the shell can read")
+    assert line.endswith(f"(got '{value}')") and p.stdout == "", (line, p.stdout)
+
+
+@needs_make
+def test_make_option_variables_with_quoted_words_pass_as_they_are():
+    flags = '--workers 1 --set "network.name=a b"'
+    p = make("-n", "reproduce", f"RUN_FLAGS={flags}")
+    assert p.returncode == 0, p.stderr
+    sh = [ln for ln in p.stdout.splitlines() if "sim.batch" in ln]
+    assert shlex.split(sh[0])[-4:] == ["--workers", "1", "--set", "network.name=a b"], sh
