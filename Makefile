@@ -27,6 +27,11 @@ q = '$(subst ','\'',$(1))'
 # (RUN_JOBS= or TEST_WORKERS=abc reached the command as a misread argument, or after the install)
 whole = @case $(call q,$($(1))) in ''|*[!0-9]*) false;; *) test $(call q,$($(1))) -ge $(2);; esac || \
 	{ printf 'make %s: %s must be a whole number of at least %s (got %s)\n' $@ $(1) $(2) $(call q,'$($(1))') >&2; exit 2; }
+# $(call shellwords,NAME): stop with one line unless the variable NAME (options passed on as they
+# are, several words) is words the shell can read: RUN_FLAGS='--set "x' broke the command line
+# ("/bin/sh: Syntax error: Unterminated quoted string", naming no variable)
+shellwords = @sh -nc $(call q,: $($(1))) 2>/dev/null || \
+	{ printf 'make %s: %s is not words the shell can read (a quote left open?) (got %s)\n' $@ $(1) $(call q,'$($(1))') >&2; exit 2; }
 
 help: ## list the targets
 	@grep -E '^[a-zA-Z_%/.-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/:.*## /\t/' | sort | \
@@ -64,8 +69,8 @@ pip = @$(VENV_LOCK) $(PY) -m pip install --quiet $(1) >> $(PIP_LOG) 2>&1 || { pr
 
 $(STAMP): pyproject.toml $(if $(VENV_USABLE),,venv-unusable)
 	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
-	@$(VENV_LOCK) $(PYTHON) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) > $(INSTALLING) 2>&1 || { rc=$$?; \
-	  test $$rc -gt 128 && exit $$rc; printf 'make: %s -m venv could not make $(VENV): %s\n' $(call q,$(PYTHON)) \
+	@$(VENV_LOCK) $(call q,$(PYTHON)) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) > $(INSTALLING) 2>&1 || { rc=$$?; \
+	  test $$rc -gt 128 && exit $$rc; printf 'make: PYTHON (%s) could not make $(VENV): %s\n' $(call q,$(PYTHON)) \
 	  "$$(grep -v '^ *$$' $(INSTALLING) | tail -1)" >&2; exit 2; }
 	@: > $(PIP_LOG)
 	$(call pip,--upgrade pip)
@@ -116,11 +121,13 @@ RUN_JOBS ?= 2
 
 reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md
 	$(call whole,RUN_JOBS,1)
+	$(call shellwords,RUN_FLAGS)
 	$(PY) -m sim.batch --stale-only --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
 rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report
 	$(call whole,RUN_JOBS,1)
+	$(call shellwords,RUN_FLAGS)
 	$(PY) -m sim.batch --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
@@ -128,6 +135,7 @@ rerun: $(STAMP) ## re-run every study even if its results are up to date, then t
 VERIFY_FLAGS ?=
 
 verify: $(STAMP) ## re-run every study into a scratch directory and compare with results/ (a rule per kind of column; VERIFY_FLAGS)
+	$(call shellwords,VERIFY_FLAGS)
 	$(PY) -m sim.report.verify --results results --workers 2 $(VERIFY_FLAGS)
 	$(PY) -m sim report --results results
 
@@ -140,6 +148,7 @@ BENCH_FLAGS ?=
 BENCH_OUT ?= results/bench
 
 bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/; BENCH_FLAGS=--quick: smoke)
+	$(call shellwords,BENCH_FLAGS)
 	$(PY) -m benchmarks --out $(call q,$(BENCH_OUT)) $(BENCH_FLAGS)
 
 clean: ## remove the virtual environment and caches (results/ is kept)

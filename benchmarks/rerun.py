@@ -24,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from sim.mc.children import ended
+
 __all__ = ["JOBS", "TARGET_S", "rerun_rows", "study_files"]
 
 #: issue 12: ``make rerun`` under 90 s on a 2-core machine (its ``RUN_FLAGS``: ``--workers 1``)
@@ -47,7 +49,7 @@ def _wall(cmd: list[str], what: str) -> float:
     wall = time.perf_counter() - t
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
-        raise RuntimeError(f"bench: {what} failed (exit {done.returncode}): {last}")
+        raise RuntimeError(f"bench: {what} failed (it {ended(done.returncode)}): {last}")
     return wall
 
 
@@ -131,11 +133,11 @@ def _batch(files, res, jobs, n, sets, timings: Path, offset: float) -> dict:
     done = subprocess.run(cmd, capture_output=True, text=True)
     if not timings.is_file():
         last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
-        raise RuntimeError(f"bench: sim.batch failed (exit {done.returncode}): {last}")
+        raise RuntimeError(f"bench: sim.batch failed (it {ended(done.returncode)}): {last}")
     out = json.loads(timings.read_text())
     timings.unlink()
     for k, (c, _, _) in out.items():
         if c != 0:
             last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
-            raise RuntimeError(f"bench: sim run of {k} failed (exit {c}): {last}")
+            raise RuntimeError(f"bench: sim run of {k} failed (it {ended(c)}): {last}")
     return {k: (c, w, s + offset) for k, (c, w, s) in out.items()}

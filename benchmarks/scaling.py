@@ -52,6 +52,7 @@ from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import make_block, select_control
 from sim.instruments.plates import grid_points
 from sim.lsq import distributions as D
+from sim.mc.children import ended
 from sim.mc.config import validate
 from sim.report.plotting import plt, save
 from sim.studies.network.definition import build
@@ -190,7 +191,7 @@ def _gama(gama: str, net, side: int, row: dict) -> str:
         except subprocess.TimeoutExpired:  # recorded as not measured (NaN)
             return f"not measured: over {GAMA_TIMEOUT_S} s"
         if r.returncode != 0:
-            return f"not measured: gama-local exit {r.returncode}"
+            return f"not measured: gama-local {ended(r.returncode)}"
         row["gama_s"] = time.perf_counter() - t2
     return ""
 

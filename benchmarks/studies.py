@@ -25,6 +25,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from sim.mc.children import ended
+
 __all__ = ["STUDIES", "KEEP_SHARE", "VARIANTS", "study_rows"]
 
 #: studies whose time decides a compiled path (the slowest of each family)
@@ -47,7 +49,7 @@ def _run(cmd: list[str], env: dict, what: str) -> tuple[float, float]:
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
-        raise RuntimeError(f"bench: {what} failed (exit {done.returncode}): {last}")
+        raise RuntimeError(f"bench: {what} failed (it {ended(done.returncode)}): {last}")
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return cpu, wall
 

@@ -29,6 +29,7 @@ import pyarrow.parquet as pq
 from sim.execute import execute
 from sim.mc.config import ConfigError, study_file_hint
 from sim.mc.estimate import estimate
+from sim.mc.paths import link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.runner import MIN_CHUNKS
@@ -74,7 +75,8 @@ class Results:
 
     def _check_dir(self) -> None:  # not "no table": the directory itself is wrong
         if not self.path.is_dir():
-            raise ConfigError("path", f"{self.path} is not a results directory")
+            why = link_problem(self.path) or "is not a results directory"
+            raise ConfigError("path", f"{self.path} {why}")
 
     def names(self) -> list[str]:
         """The tables of the run (``trials`` is the per-trial dataset, if any)."""
@@ -304,9 +306,8 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     _check_path("study_file", study_file)
     check_environment()  # TQDM_NCOLS=abc: refused here, not in the middle of a run
     if not Path(study_file).is_file():
-        raise ConfigError(
-            "study_file", f"{study_file} is not a study file{study_file_hint(study_file)}"
-        )
+        why = link_problem(study_file) or f"is not a study file{study_file_hint(study_file)}"
+        raise ConfigError("study_file", f"{study_file} {why}")
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the
     # working directory may have changed since (it would read another file of that name)
     study_file = _absolute("study_file", study_file)

@@ -48,8 +48,9 @@ from sim.batch_checks import (  # noqa: E402
     why_stale,
 )
 from sim.cli_args import OnceParser, module_doc  # noqa: E402
-from sim.mc.children import STOP_SIGNALS, child_env, child_text, stop_children  # noqa: E402
+from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
+from sim.mc.paths import link_problem  # noqa: E402
 from sim.stops import check_interrupt, keep_lost_interrupts, run_program  # noqa: E402
 
 if __name__ != "__main__":  # imported: the default handlers (the program: run_program's)
@@ -140,14 +141,9 @@ def run_all(
         wall = time.perf_counter() - t
         if stop.is_set():  # interrupted: the driver says so in one line
             return f.stem, None, wall, t - t0
-        if proc.returncode < 0:  # killed by a signal (kill -9, the OOM killer): exit 1 and
-            try:  # not a word
-                why = signal.Signals(-proc.returncode).name
-            except ValueError:
-                why = f"signal {-proc.returncode}"
-            stderr = (
-                f"{stderr or ''}its run was killed ({why}); the same command again resumes it\n"
-            )
+        if proc.returncode < 0:  # killed by a signal (kill -9, the OOM killer): it said not a word
+            why = ended(proc.returncode)
+            stderr = f"{stderr or ''}its run {why}; the same command again resumes it\n"
         named = _Named(sys.stderr, f.name)
         named.write(stderr)
         named.flush()
@@ -249,6 +245,9 @@ def _main(argv: list[str]) -> int:
         why = name_problem(args.results)
         print(f"sim.batch: --results: {why} (got {args.results!r})", file=sys.stderr)
         return 2
+    if why := link_problem(args.results):  # a loop: every run would fail on it, one by one
+        print(f"sim.batch: --results: {args.results} {why}", file=sys.stderr)
+        return 2
     if os.path.lexists(args.results) and not os.path.isdir(args.results):
         # each run would name --out, an option this command line does not hold, one by one
         print(f"sim.batch: --results: {args.results} is not a directory", file=sys.stderr)
@@ -260,7 +259,11 @@ def _main(argv: list[str]) -> int:
     files = [Path(f) for f in args.files]
     bad = [f for f in files if not f.is_file()]
     if bad:
-        print(f"sim.batch: no study file {bad[0]}", file=sys.stderr)
+        why = link_problem(bad[0])
+        print(
+            f"sim.batch: {bad[0]} {why}" if why else f"sim.batch: no study file {bad[0]}",
+            file=sys.stderr,
+        )
         return 2
     why = _clashes(files, run_args, args.results)
     if why:

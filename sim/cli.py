@@ -37,6 +37,7 @@ from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem, results_dirs
+from sim.mc.paths import link_problem
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_record, umask_problem
 from sim.mc.sweep import read_sweep
@@ -221,7 +222,8 @@ def _show(args) -> int:
         d = Path("results") / args.dir
     if not d.is_dir():  # the name of a study's results is read under ./results too: say so
         also = "" if d.is_absolute() or d.exists() else f" (nor is results/{args.dir})"
-        raise ConfigError("DIR", f"{args.dir} is not a directory{also}")
+        why = link_problem(d) or f"is not a directory{also}"
+        raise ConfigError("DIR", f"{args.dir} {why}")
     check_claims_table(d / "claims.parquet", "DIR")
     try:
         text = run_markdown(d, get_study) if args.markdown else terminal_table(d)

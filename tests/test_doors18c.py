@@ -302,7 +302,7 @@ def test_a_python_that_cannot_make_a_venv_is_one_line(tmp_path):
         (str(old), "No module named venv"),
     ):
         line = make_line(
-            run_make(d, "venv", python=python), f"make: {python} -m venv could not make .venv: "
+            run_make(d, "venv", python=python), f"make: PYTHON ({python}) could not make .venv: "
         )
         assert line.endswith(why), line
         assert (d / ".venv.installing").exists()  # the next make venv starts from scratch

@@ -219,5 +219,5 @@ def test_a_batch_says_which_run_was_killed(tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err
     assert rc != 0 and "Traceback" not in err
     assert err.splitlines() == [
-        "network_plate.toml: its run was killed (SIGKILL); the same command again resumes it"
+        "network_plate.toml: its run was killed by SIGKILL; the same command again resumes it"
     ], err

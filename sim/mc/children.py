@@ -16,7 +16,15 @@ import subprocess
 import sys
 from collections.abc import Callable, Iterable
 
-__all__ = ["STOP_SIGNALS", "GRACE_S", "stop_children", "child_text", "child_env", "die_with_parent"]
+__all__ = [
+    "STOP_SIGNALS",
+    "GRACE_S",
+    "stop_children",
+    "child_text",
+    "child_env",
+    "die_with_parent",
+    "ended",
+]
 
 #: the signals that end a driver (and each of its runs) as Ctrl-C does
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
@@ -52,6 +60,18 @@ def die_with_parent() -> bool:
     except (OSError, AttributeError):
         return True
     return os.getppid() == int(want)
+
+
+def ended(code: int) -> str:
+    """How a child process ended, from its return code, for a message: "exited with 1", or
+    "was killed by SIGKILL" (a negative code is the signal that ended it, as ``kill -9`` or
+    the OOM killer's: it read "exited with -9")."""
+    if code >= 0:
+        return f"exited with {code}"
+    try:
+        return f"was killed by {signal.Signals(-code).name}"
+    except ValueError:  # a real-time signal has no name
+        return f"was killed by signal {-code}"
 
 
 def child_text() -> dict:

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
+from sim.mc.paths import link_problem
+
 __all__ = [
     "ConfigError",
     "StudyError",
@@ -347,7 +349,8 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     if p.exists() and not p.is_file():  # a pipe (cat x.toml | sim check /dev/stdin), a device
         raise ConfigError(None, f"{p}: not a regular file (a pipe or a device): name the file")
     if not p.is_file():
-        raise ConfigError(None, f"{p}: no such study file{study_file_hint(p)}")
+        why = link_problem(p)  # a link loop was "no such study file", of a name that is there
+        raise ConfigError(None, f"{p}: {why or 'no such study file' + study_file_hint(p)}")
     try:
         if p.stat().st_size > MAX_STUDY_BYTES:
             raise ConfigError(

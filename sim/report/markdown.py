@@ -16,6 +16,7 @@ from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
 from sim.claims.rules import PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
+from sim.mc.paths import link_problem
 from sim.mc.storage import atomic_path, read_provenance, read_table
 from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
@@ -291,7 +292,8 @@ def build_report(results: Path, get_study: Callable, design: Callable | None = N
     the config of the study file a directory is named after (a run that changed it is said)."""
     results = Path(results)
     if not results.is_dir():
-        raise ConfigError("--results", f"{results} is not a results directory")
+        why = link_problem(results) or "is not a results directory"
+        raise ConfigError("--results", f"{results} {why}")
     entries = [
         _entry(d, get_study)
         for d in sorted(p for p in results_dirs(results) if (p / "claims.parquet").is_file())

@@ -49,8 +49,12 @@ def data_check(load_book: Callable[[], Any], *declarations: Any) -> Callable[...
     """A :attr:`Study.data` that loads the claim book and each region declaration over it.
     A declaration is a path, or ``(path, names, keys)``: ``names(cfg)`` the inputs the study's
     code reads, which it must declare exactly (one renamed was a KeyError deep in the run,
-    one added was explored and read by no code), and ``keys`` the config key each input sets
-    unscaled, whose schema bounds its range must keep (a negative sigma was explored)."""
+    one added was explored and read by no code), and ``keys`` where each input goes, whose
+    bounds its range must keep (a negative sigma was explored): a config key it sets as it is,
+    ``(key, factor)`` for a key it sets scaled (``factor`` a number or ``factor(cfg)``; 10 ppm
+    for 1 um over 100 mm: the range was checked against no bound), a :class:`Field` for an
+    input that reaches no key (the bounds its code takes), or a list of these (one input
+    setting two keys)."""
 
     def check(cfg: dict, schema: Mapping[str, Field] | None = None) -> None:
         from sim.claims.book_region import load_declaration
@@ -60,18 +64,10 @@ def data_check(load_book: Callable[[], Any], *declarations: Any) -> Callable[...
             path, names, keys = d if isinstance(d, tuple) else (d, None, {})
             dec = load_declaration(path, book)
             for i in dec.inputs:
-                f = (schema or {}).get(keys.get(i.name, ""))
-                if f is None:
-                    continue
                 for end, v in (("low", i.low), ("high", i.high)):
-                    if (f.lo is not None and (v < f.lo or (f.lo_open and v == f.lo))) or (
-                        f.hi is not None and v > f.hi
-                    ):
-                        raise ConfigError(
-                            f"inputs.{i.name}.{end}",
-                            f"{path}: {v:g} is outside {keys[i.name]}'s bounds "
-                            f"({'>' if f.lo_open else '>='} {f.lo}, <= {f.hi})",
-                        )
+                    why = _out_of_bounds(v, keys.get(i.name, []), cfg, schema or {})
+                    if why:
+                        raise ConfigError(f"inputs.{i.name}.{end}", f"{path}: {why}")
             if names is None:
                 continue
             want, got = set(names(cfg)), {i.name for i in dec.inputs}
@@ -87,6 +83,26 @@ def data_check(load_book: Callable[[], Any], *declarations: Any) -> Callable[...
                 )
 
     return check
+
+
+def _out_of_bounds(v: float, goes: Any, cfg: dict, schema: Mapping[str, Field]) -> str | None:
+    """Why the region input value ``v`` is outside the bounds of where it goes (``goes``: a
+    value of :func:`data_check`'s ``keys``), or None."""
+    for g in goes if isinstance(goes, list) else [goes]:
+        key, factor = g if isinstance(g, tuple) else (g, 1.0)
+        f = key if isinstance(key, Field) else schema.get(key) if isinstance(key, str) else None
+        if f is None:
+            continue
+        w = v * (factor(cfg) if callable(factor) else factor)
+        if (f.lo is not None and (w < f.lo or (f.lo_open and w == f.lo))) or (
+            f.hi is not None and w > f.hi
+        ):
+            bounds = f"({'>' if f.lo_open else '>='} {f.lo}, <= {f.hi})"
+            if isinstance(key, Field):
+                return f"{v:g} is outside the bounds its code takes {bounds}: {key.doc}"
+            scaled = "" if w == v else f" ({w:g} in {key})"
+            return f"{v:g}{scaled} is outside {key}'s bounds {bounds}"
+    return None
 
 
 def get_study(name: str) -> Study:

@@ -12,8 +12,9 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.mc.children import child_env, child_text, stop_children
+from sim.mc.children import child_env, child_text, ended, stop_children
 from sim.mc.outputs import results_dirs
+from sim.mc.paths import link_problem
 from sim.mc.storage import read_provenance, read_record, versions, write_table
 from sim.report.tables import fmt, md_table
 from sim.report.verify.rules import DEFAULT_RTOL, Comparison, VerifyError, compare_dirs
@@ -45,7 +46,7 @@ def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path,
     ``only`` (a study or its directory name); VerifyError for none or an unknown name."""
     results = Path(results)
     if not results.is_dir():
-        raise VerifyError(f"--results: {results} is not a directory")
+        raise VerifyError(f"--results: {results} {link_problem(results) or 'is not a directory'}")
     found = []
     for d in sorted(p for p in results_dirs(results) if (p / "claims.parquet").is_file()):
         try:
@@ -131,7 +132,7 @@ def rerun_study(
         # --out under --scratch): a request error, not a failed comparison to record
         raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
     sys.stderr.write(err)
-    return None if proc.returncode == 0 else f"the re-run exited with {proc.returncode}"
+    return None if proc.returncode == 0 else f"the re-run {ended(proc.returncode)}"
 
 
 def verify(

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from sim.studies import Study, data_check
 from sim.studies.agnard.claims import load_book
-from sim.studies.agnard.region import CENTRES, DECLARATION, SCANNER, SCANNER_KEYS
+from sim.studies.agnard.region import CENTRES, DECLARATION, INSET, SCANNER, SCANNER_KEYS
 from sim.studies.agnard.report import report
 from sim.studies.agnard.run import run
 from sim.studies.agnard.schema import NAME, SCHEMA, SEED, check
@@ -38,8 +38,8 @@ STUDIES = {
         order=50,
         data=data_check(
             load_book,
-            (DECLARATION, lambda cfg: (CENTRES, "five_inset_1"), {}),
-            (SCANNER, lambda cfg: SCANNER_KEYS, {}),
+            (DECLARATION, lambda cfg: (CENTRES, "five_inset_1"), {"five_inset_1": INSET}),
+            (SCANNER, lambda cfg: SCANNER_KEYS, SCANNER_KEYS),
         ),
     )
 }

@@ -48,6 +48,7 @@ from sim.claims.book import ClaimBook
 from sim.claims.book_region import load_declaration, plate_ref, sample_evidence
 from sim.claims.inference import Input, Region, explore
 from sim.instruments.block.layout import Block
+from sim.mc.config import Field
 from sim.mc.runner import chunk_rng
 from sim.studies.agnard import chunks as ch
 from sim.studies.agnard.paired import paired_evidence, paired_shift
@@ -65,6 +66,16 @@ SCANNER_KEYS = {
     "grid_sigma_px": "scan.grid_sigma_px",
     "fiducial_sigma_px": "scan.fiducial_sigma_px",
 }
+#: the bounds of the five-point layout's inset, which reaches no config key (its code,
+#: :func:`sim.studies.agnard.schema.five_targets`, takes them; :func:`sim.studies.data_check`)
+INSET = Field(
+    0.0,
+    "float",
+    "beyond 0.5 the outer points cross the block's middle (the layouts of 1 - inset again), "
+    "below 0 they leave the block (its corners again)",
+    lo=0.0,
+    hi=0.5,
+)
 #: the runner's stream of the scanner region's blocks (apart from every trade-off part) and
 #: of its design
 SCANNER_PART = 800

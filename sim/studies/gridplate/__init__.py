@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from sim.studies import Study, data_check
 from sim.studies.gridplate.claims import load_book
-from sim.studies.gridplate.region import DECLARATION, nominal
+from sim.studies.gridplate.region import DECLARATION, SCALE_DIFF_KEYS, nominal
 from sim.studies.gridplate.report import report
 from sim.studies.gridplate.run import run
 from sim.studies.gridplate.schema import SCHEMA, check
@@ -36,6 +36,7 @@ STUDIES = {
                     "grid_points_1": "plate.grid",
                     "spacing_mm": "plate.spacing_mm",
                     "grid_sigma_true_um": "grid.sigma_true_um",
+                    "scale_diff_at_100mm_um": SCALE_DIFF_KEYS,
                 },
             ),
         ),

@@ -67,12 +67,31 @@ def declaration(book: ClaimBook) -> Declaration:
     return load_declaration(DECLARATION, book)
 
 
+#: 1 um over 100 mm in ppm
+PPM_PER_UM = 10.0
+
+
+def _nonorth_per_um(cfg: dict) -> float:
+    """The non-orthogonality (arcsec) per um over 100 mm of scale difference: the configured
+    one's proportion, as :func:`point_cfg` sets it."""
+    base = cfg["comparator.scale_diff_ppm"]
+    return PPM_PER_UM * cfg["comparator.nonorth_arcsec"] / base if base else 0.0
+
+
+#: the keys ``scale_diff_at_100mm_um`` sets, scaled (their bounds keep its range:
+#: :func:`sim.studies.data_check`)
+SCALE_DIFF_KEYS = [
+    ("comparator.scale_diff_ppm", PPM_PER_UM),
+    ("comparator.nonorth_arcsec", _nonorth_per_um),
+]
+
+
 def point_cfg(cfg: dict, x: dict, i: int) -> dict:
     """The configuration at input vector ``i`` of ``x``."""
     c = dict(cfg)
     c["plate.grid"] = int(round(x["grid_points_1"][i]))
     c["plate.spacing_mm"] = float(x["spacing_mm"][i])
-    ppm = float(x["scale_diff_at_100mm_um"][i]) * 10.0  # 1 um over 100 mm = 10 ppm
+    ppm = float(x["scale_diff_at_100mm_um"][i]) * PPM_PER_UM
     base = cfg["comparator.scale_diff_ppm"]
     c["comparator.scale_diff_ppm"] = ppm
     c["comparator.nonorth_arcsec"] = cfg["comparator.nonorth_arcsec"] * ppm / base if base else 0.0
@@ -85,7 +104,7 @@ def nominal(cfg: dict) -> dict[str, float]:
     return {
         "grid_points_1": float(cfg["plate.grid"]),
         "spacing_mm": float(cfg["plate.spacing_mm"]),
-        "scale_diff_at_100mm_um": cfg["comparator.scale_diff_ppm"] / 10.0,
+        "scale_diff_at_100mm_um": cfg["comparator.scale_diff_ppm"] / PPM_PER_UM,
         "grid_sigma_true_um": float(cfg["grid.sigma_true_um"]),
     }
 

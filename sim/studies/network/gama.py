@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.mc.config import ConfigError, given
+from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network
 from sim.studies.network.gama_read import CC, NS, read_bytes, read_gama
 from sim.studies.network.model import computed
@@ -280,7 +281,8 @@ def write_gama(net: Network, path: str | Path, inner: tuple | list = ()) -> Path
     # UTF-8, as an XML file without an encoding declaration is read, whatever the locale (a
     # point named "É1" under LC_ALL=C without UTF-8 mode: UnicodeEncodeError after every trial)
     text = '<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n"
-    path.write_text(text, encoding="utf-8")
+    with atomic_path(path) as tmp:  # as every output: a link under this name is replaced,
+        tmp.write_text(text, encoding="utf-8")  # never written through
     return path
 
 

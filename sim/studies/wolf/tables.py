@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.mc.config import ConfigError
+from sim.mc.paths import link_problem
 
 STATS = ("max", "rms", "mean")
 T1_NUM = ("x_set1_mm", "x_set2_mm", "y_set1_mm", "y_set2_mm", "x_foster_mm", "y_foster_mm")
@@ -32,7 +33,7 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
     except OSError as e:  # a name too long: pathlib raises what it does not take for "absent"
         raise ConfigError(key, f"cannot read {str(p)[:80]}...: {e.strerror}") from None
     if not is_file:
-        raise ConfigError(key, f"no such file: {p}")
+        raise ConfigError(key, f"{p} {why}" if (why := link_problem(p)) else f"no such file: {p}")
     try:
         with open(p, newline="", encoding="utf-8") as fh:
             text = fh.read(2_000_000)
