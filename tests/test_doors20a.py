@@ -22,6 +22,9 @@ before its fix.
   ``tempfile.tempdir`` gone, or a file) ended in FileNotFoundError from ``tempfile``;
 * ``import sim.studies`` (every run) in a host process without ``sys.argv``, or with ``None``
   (an embedded Python), ended in a TypeError from ``sim.report.verify``;
+* two runs of the API in threads of the caller that overlap (one ends before the other) left the
+  suite's ``sys.unraisablehook`` in the caller's process for good: each put back the hook it had
+  found (:func:`sim.stops.keep_lost_interrupts` now counts);
 * a run with ``quiet=False`` while the caller's ``sys.stderr`` was a closed stream failed as
   "the run failed in sim.mc.progress: ValueError: I/O operation on closed file".
 """
@@ -39,6 +42,7 @@ from oneline import python_lines
 
 import sim
 from sim.mc.progress import Progress
+from sim.stops import keep_lost_interrupts
 
 ROOT = Path(__file__).resolve().parent.parent
 STUDY = ROOT / "studies" / "network_plate.toml"
@@ -131,3 +135,25 @@ def test_a_closed_stderr_is_no_terminal():
     with Progress(10, "x", quiet=False, stream=closed) as bar:
         bar.update(10)
     assert not bar.enabled
+
+
+def test_overlapping_runs_in_threads_put_the_callers_unraisable_hook_back():
+    mine = sys.unraisablehook
+    first, second = threading.Event(), threading.Event()
+
+    def a():  # opens first, closes first
+        with keep_lost_interrupts():
+            first.set()
+            second.wait(10)
+
+    def b():
+        first.wait(10)
+        with keep_lost_interrupts():
+            second.set()
+            ta.join(10)
+
+    ta, tb = threading.Thread(target=a), threading.Thread(target=b)
+    ta.start()
+    tb.start()
+    tb.join(10)
+    assert sys.unraisablehook is mine  # was the suite's recording hook, for good
