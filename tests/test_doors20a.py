@@ -25,6 +25,9 @@ before its fix.
 * two runs of the API in threads of the caller that overlap (one ends before the other) left the
   suite's ``sys.unraisablehook`` in the caller's process for good: each put back the hook it had
   found (:func:`sim.stops.keep_lost_interrupts` now counts);
+* an executor that could not start because its workers (Dask's spawn, a forkserver) ran the
+  caller's unguarded script again said only "Nanny failed to start": it asks for the main guard
+  (:func:`sim.mc.executors.script_words`);
 * a run with ``quiet=False`` while the caller's ``sys.stderr`` was a closed stream failed as
   "the run failed in sim.mc.progress: ValueError: I/O operation on closed file".
 """
@@ -35,12 +38,14 @@ import subprocess
 import sys
 import tempfile
 import threading
+import types
 from pathlib import Path
 
 import pytest
 from oneline import python_lines
 
 import sim
+from sim.mc.executors import script_words
 from sim.mc.progress import Progress
 from sim.stops import keep_lost_interrupts
 
@@ -157,3 +162,18 @@ def test_overlapping_runs_in_threads_put_the_callers_unraisable_hook_back():
     tb.start()
     tb.join(10)
     assert sys.unraisablehook is mine  # was the suite's recording hook, for good
+
+
+def test_an_executor_that_cannot_start_under_a_script_asks_for_the_main_guard(monkeypatch):
+    """Dask's workers (spawn) import the caller's script again: an unguarded one started its
+    run again there, and the run ended in "cannot start the dask executor: Nanny failed to
+    start", no cause named."""
+    script = types.ModuleType("__main__")
+    script.__file__ = "/home/me/analysis.py"
+    monkeypatch.setitem(sys.modules, "__main__", script)
+    words = script_words("dask", 1, None)
+    assert "analysis.py" in words and 'if __name__ == "__main__"' in words
+    assert script_words("dask", 1, "tcp://h:8786") == ""  # a scheduler's workers are not ours
+    assert script_words("local", 1, None) == ""  # no worker process
+    monkeypatch.delattr(script, "__file__")  # a notebook: nothing is imported again
+    assert script_words("dask", 1, None) == ""
