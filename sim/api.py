@@ -15,8 +15,10 @@ executors, and the rule that nothing the suite did not write is ever replaced.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
+import logging
 import os
 import tempfile
 from dataclasses import dataclass, field
@@ -211,7 +213,7 @@ class StudyHandle:
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
         out = _absolute("out", out)
-        with kept():  # the caller's matplotlib settings as they were (a notebook's)
+        with kept(), _loggers_kept():  # the caller's matplotlib and log levels as they were
             try:
                 execute(
                     h.study,
@@ -231,6 +233,30 @@ class StudyHandle:
                     raise
                 raise _api_words(e) from None
         return Results(out, h.name, _run_identity(out))
+
+
+#: the loggers a failed or interrupted Dask run silences (:func:`sim.execute._quiet_dask_logs`)
+_CHATTY = ("asyncio", "distributed", "tornado")
+
+
+@contextlib.contextmanager
+def _loggers_kept():
+    """The levels of the caller's loggers of :data:`_CHATTY` (and below) put back after the
+    run: an interrupted Dask run silences them for the cluster's closing chatter, which in a
+    user's process silenced the user's own ``asyncio`` errors for good. Loggers below them
+    that the run made (its cluster's) stay silenced."""
+    known = logging.root.manager.loggerDict
+    levels = {n: logging.getLogger(n).level for n in _CHATTY}  # NOTSET unless set
+    levels.update(
+        (n, lg.level)
+        for n, lg in list(known.items())
+        if n.split(".")[0] in _CHATTY and isinstance(lg, logging.Logger)
+    )
+    try:
+        yield
+    finally:
+        for n, level in levels.items():
+            logging.getLogger(n).setLevel(level)
 
 
 def _api_words(e: ConfigError) -> ConfigError:

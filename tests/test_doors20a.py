@@ -28,11 +28,14 @@ before its fix.
 * an executor that could not start because its workers (Dask's spawn, a forkserver) ran the
   caller's unguarded script again said only "Nanny failed to start": it asks for the main guard
   (:func:`sim.mc.executors.script_words`);
+* an interrupted Dask run of the API left the caller's ``asyncio``, ``distributed`` and ``tornado``
+  loggers silenced for good (:func:`sim.api._loggers_kept`);
 * a run with ``quiet=False`` while the caller's ``sys.stderr`` was a closed stream failed as
   "the run failed in sim.mc.progress: ValueError: I/O operation on closed file".
 """
 
 import io
+import logging
 import os
 import subprocess
 import sys
@@ -177,3 +180,24 @@ def test_an_executor_that_cannot_start_under_a_script_asks_for_the_main_guard(mo
     assert script_words("local", 1, None) == ""  # no worker process
     monkeypatch.delattr(script, "__file__")  # a notebook: nothing is imported again
     assert script_words("dask", 1, None) == ""
+
+
+def test_an_interrupted_run_puts_the_callers_log_levels_back(tmp_path, monkeypatch):
+    """An interrupted Dask run silences asyncio, distributed and tornado for the cluster's
+    closing chatter (:func:`sim.execute._quiet_dask_logs`): in the caller's process they stayed
+    silenced, the caller's own asyncio errors with them."""
+    import sim.api
+    from sim.execute import _quiet_dask_logs
+
+    def interrupted(*args, **kw):
+        _quiet_dask_logs()
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sim.api, "execute", interrupted)
+    mine = logging.getLogger("asyncio.mine")
+    mine.setLevel(logging.INFO)
+    before = logging.getLogger("asyncio").level
+    with pytest.raises(KeyboardInterrupt):
+        sim.load(STUDY, trials=40, chunk=2).run(out=tmp_path / "o")
+    assert logging.getLogger("asyncio").level == before and mine.level == logging.INFO
+    assert logging.getLogger("distributed").level < logging.CRITICAL
