@@ -15,7 +15,10 @@ executors, and the rule that nothing the suite did not write is ever replaced.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import json
+import logging
 import os
 import tempfile
 from dataclasses import dataclass, field
@@ -64,6 +67,8 @@ class Results:
 
     path: Path
     study: str
+    #: the identity of the run that returned these Results (:func:`_run_identity`; "": any)
+    run_sha256: str = field(default="", repr=False, compare=False)
 
     def __post_init__(self):  # Results("results/x", "x"): a str is taken as the path
         _check_path("path", self.path)
@@ -77,35 +82,55 @@ class Results:
         if not self.path.is_dir():
             why = link_problem(self.path) or "is not a results directory"
             raise ConfigError("path", f"{self.path} {why}")
+        if self.run_sha256 and _run_identity(self.path) not in ("", self.run_sha256):
+            raise ConfigError(  # its tables read silently as this run's (another seed's)
+                "path",
+                f"{self.path} holds another run than the one that returned these Results "
+                f"(run again into it since): read it with sim.Results(path, {self.study!r})",
+            )
+
+    def _dataset(self, name: str) -> bool:
+        """Whether ``name`` is the chunk dataset ``trials/``: ``chunks`` always, ``trials``
+        unless the study writes a table ``trials.parquet`` of its own (wolf, agnard,
+        gridplate), which that name reads (it was unreachable, and listed twice)."""
+        return name == "chunks" or (
+            name == "trials" and not (self.path / "trials.parquet").exists()
+        )
 
     def names(self) -> list[str]:
-        """The tables of the run (``trials`` is the per-trial dataset, if any)."""
+        """The tables of the run: each once; ``chunks`` is the per-trial chunk dataset (also
+        ``trials`` when the study writes no ``trials.parquet``)."""
         self._check_dir()
-        names = sorted(p.stem for p in self.path.glob("*.parquet"))
-        return names + (["trials"] if (self.path / "trials").is_dir() else [])
+        names = {p.stem for p in self.path.glob("*.parquet")}
+        if (self.path / "trials").is_dir():
+            names |= {"chunks", "trials"}
+        return sorted(names)
 
     def table(self, name: str) -> pa.Table:
-        """The table ``name`` (``claims``, ``points``, ..., or ``trials``) as a pyarrow Table."""
+        """The table ``name`` (``claims``, ``points``, ..., ``trials`` or ``chunks``) as a
+        pyarrow Table."""
         if not isinstance(name, str) or not name.isidentifier():
             raise ConfigError("table", f"must be a table name such as 'claims' (got {name!r})")
         self._check_dir()
-        p = self.path / (name if name == "trials" else f"{name}.parquet")
+        dataset = self._dataset(name)
+        p = self.path / ("trials" if dataset else f"{name}.parquet")
         if not p.exists() and not self.names():  # not "no table 'claims'; it has " (none)
             raise ConfigError("path", f"{self.path} is not a results directory (no tables)")
         if not p.exists():
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
             )
-        if name == "trials" and (bad := damaged_chunks(self.path)):
-            raise ConfigError("table", f"trials: {bad}")
-        if name != "trials" and not p.is_file():  # pyarrow reads a directory as a dataset
+        if dataset and (bad := damaged_chunks(self.path)):
+            raise ConfigError("table", f"{name}: {bad}")
+        if not dataset and not p.is_file():  # pyarrow reads a directory as a dataset
             raise ConfigError("table", f"{p} is not a file; run the study again")
         try:
             table = pq.read_table(p)
         except (OSError, pa.ArrowException) as e:
             raise ConfigError("table", f"{p} cannot be read ({type(e).__name__})") from None
-        if name != "trials":
+        if not dataset:
             _check_owner(p, self.study)
+        self._check_dir()  # replaced while it was read
         return table
 
     def claims(self) -> pa.Table:
@@ -178,12 +203,19 @@ class StudyHandle:
             )
         )
         if out is None:
-            base = Path(tempfile.mkdtemp(prefix=f"sim-{h.name}-"))
+            try:  # the caller's tempfile.tempdir (or TMPDIR) may be gone, a file, or full
+                base = Path(tempfile.mkdtemp(prefix=f"sim-{h.name}-"))
+            except OSError as e:
+                raise ConfigError(
+                    "out",
+                    f"is None, and no temporary directory can be made in "
+                    f"{tempfile.gettempdir()} ({e.strerror}): name an output directory",
+                ) from None
             out = base / h.name
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
         out = _absolute("out", out)
-        with kept():  # the caller's matplotlib settings as they were (a notebook's)
+        with kept(), _loggers_kept():  # the caller's matplotlib and log levels as they were
             try:
                 execute(
                     h.study,
@@ -202,7 +234,31 @@ class StudyHandle:
                 if e.key != "--out":
                     raise
                 raise _api_words(e) from None
-        return Results(out, h.name)
+        return Results(out, h.name, _run_identity(out))
+
+
+#: the loggers a failed or interrupted Dask run silences (:func:`sim.execute._quiet_dask_logs`)
+_CHATTY = ("asyncio", "distributed", "tornado")
+
+
+@contextlib.contextmanager
+def _loggers_kept():
+    """The levels of the caller's loggers of :data:`_CHATTY` (and below) put back after the
+    run: an interrupted Dask run silences them for the cluster's closing chatter, which in a
+    user's process silenced the user's own ``asyncio`` errors for good. Loggers below them
+    that the run made (its cluster's) stay silenced."""
+    known = logging.root.manager.loggerDict
+    levels = {n: logging.getLogger(n).level for n in _CHATTY}  # NOTSET unless set
+    levels.update(
+        (n, lg.level)
+        for n, lg in list(known.items())
+        if n.split(".")[0] in _CHATTY and isinstance(lg, logging.Logger)
+    )
+    try:
+        yield
+    finally:
+        for n, level in levels.items():
+            logging.getLogger(n).setLevel(level)
 
 
 def _api_words(e: ConfigError) -> ConfigError:
@@ -220,6 +276,18 @@ def _sha256(path: Path) -> str:
         return hashlib.sha256(path.read_bytes()).hexdigest()
     except OSError:
         return ""
+
+
+def _run_identity(out: Path) -> str:
+    """sha256 of the config and code hash ``out/run.json`` records: another run of the study
+    (another seed, another key) has another; "" when there is no such record (a damaged one
+    is refused by the reads themselves, naming ``run.json``)."""
+    try:
+        rec = json.loads((out / "run.json").read_text(encoding="utf-8"))
+        ident = [rec["config"], rec["code_hash"]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return ""
+    return hashlib.sha256(json.dumps(ident, sort_keys=True).encode()).hexdigest()
 
 
 def _unchanged(h: StudyHandle) -> None:

@@ -23,6 +23,7 @@ import numpy as np
 
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
+from sim.mc.executors import script_words
 from sim.mc.outputs import check_out, drop_stage, prepare_stage, stage_dir
 from sim.mc.publish import publish, seal
 from sim.mc.runner import ChunkStore, RunContext, make_executor
@@ -157,7 +158,8 @@ def execute(
     except (RuntimeError, OSError, TimeoutError, ValueError, TypeError) as e:
         key = "--scheduler" if scheduler else "--executor"
         msg = (str(e).strip().splitlines() or [type(e).__name__])[0]
-        raise ConfigError(key, f"cannot start the {executor} executor: {msg}") from None
+        words = script_words(executor, workers, scheduler)
+        raise ConfigError(key, f"cannot start the {executor} executor: {msg}{words}") from None
     lock = None
     try:
         lock, resumed = prepare_stage(stage, out, shown, record, overwrite)

@@ -26,6 +26,7 @@ import atexit
 import os
 import signal
 import sys
+import threading
 from contextlib import contextmanager
 
 __all__ = ["keep_lost_interrupts", "check_interrupt", "run_program"]
@@ -47,21 +48,31 @@ def _recording(previous):
     return hook
 
 
+#: the hook that was there before the outermost :func:`keep_lost_interrupts` opened
+_previous: list = []
+_guard = threading.Lock()
+
+
 @contextmanager
 def keep_lost_interrupts():
     """While open, an unraisable ``KeyboardInterrupt`` is recorded (not printed) for
     :func:`check_interrupt`; every other unraisable exception goes to the hook that was there
-    before, which is put back on the way out."""
-    previous = sys.unraisablehook
-    sys.unraisablehook = _recording(previous)
-    _open[0] += 1
+    before, which is put back when the last one open closes. Counted, not nested: runs of the
+    Python API in two threads of the caller's overlap (one ends before the other), and each
+    putting back the hook it found left the suite's hook in the caller's process for good."""
+    with _guard:
+        if _open[0] == 0:
+            _previous[:] = [sys.unraisablehook]
+            sys.unraisablehook = _recording(sys.unraisablehook)
+        _open[0] += 1
     try:
         yield
     finally:
-        sys.unraisablehook = previous
-        _open[0] -= 1
-        if _open[0] == 0:
-            _lost.clear()  # not raised by now: the command ended otherwise (its own line)
+        with _guard:
+            _open[0] -= 1
+            if _open[0] == 0:
+                sys.unraisablehook = _previous.pop()
+                _lost.clear()  # not raised by now: the command ended otherwise (its own line)
 
 
 def check_interrupt() -> None:

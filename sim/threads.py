@@ -123,7 +123,8 @@ def script_of_another_copy() -> str | None:
     bin/sim`` silently ran the original's code (its edits, its code hash) in the copy; None
     otherwise (``python -m sim`` runs the code of the working directory, as meant)."""
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    script = os.path.abspath(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    argv = getattr(sys, "argv", None) or [""]  # a host process may have none
+    script = os.path.abspath(argv[0]) if isinstance(argv[0], str) and argv[0] else ""
     venv = os.path.dirname(os.path.dirname(script))
     project = os.path.dirname(venv)
     if os.path.basename(script) != "sim" or os.path.basename(venv) != ".venv":

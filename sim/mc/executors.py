@@ -16,7 +16,7 @@ from contextlib import suppress
 
 from sim.mc.streams import call_chunk as _call_chunk
 
-__all__ = ["make_executor", "InProcess", "end_dask_clusters"]
+__all__ = ["make_executor", "InProcess", "end_dask_clusters", "script_words"]
 
 
 class InProcess:
@@ -242,6 +242,24 @@ def end_dask_clusters() -> None:
     for proc in multiprocessing.active_children():  # reaped, no zombies
         with suppress(Exception):
             proc.join(1)
+
+
+def script_words(kind: str, workers: int, scheduler: str | None) -> str:
+    """Why starting the executor may have failed when the caller is a script (the Python API):
+    workers started by ``spawn`` or ``forkserver`` (Dask's LocalCluster; a local pool in a
+    process with threads, or under the caller's start method) import the caller's script
+    again, and a script without ``if __name__ == "__main__":`` starts its run again there,
+    which multiprocessing refuses ("terminated abruptly", Dask's "Nanny failed to start"
+    with no cause). "" when that cannot be the cause."""
+    script = getattr(sys.modules.get("__main__"), "__file__", None)
+    if not script or scheduler or (kind == "local" and workers <= 1):
+        return ""
+    if kind == "local" and (_start_method() or multiprocessing.get_start_method()) == "fork":
+        return ""
+    return (
+        f" (its worker processes import {os.path.basename(script)} again: is the script's "
+        'code under if __name__ == "__main__":?)'
+    )
 
 
 def make_executor(kind: str = "local", workers: int = 1, scheduler: str | None = None):

@@ -29,6 +29,32 @@ def check_environment() -> None:
         raise ConfigError(None, problem)
 
 
+def _terminal(stream) -> bool:
+    """Whether ``stream`` is a terminal; a closed one (a notebook's ``sys.stderr`` replaced by
+    a closed ``StringIO``) is not: its ``isatty`` raised ValueError, which failed the run."""
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError, OSError):
+        return False
+
+
+_bar: list = []
+
+
+def _bar_class():
+    """tqdm without its monitor thread. tqdm starts one with its first bar (a disabled one
+    too) and leaves it running for the life of the process; in the process of a script of the
+    Python API it made the next ``run(workers=2)`` see a second thread and start its workers
+    by ``forkserver`` (:func:`sim.mc.executors._start_method`), which runs the caller's
+    script again in the fork server: a script without ``if __name__ == "__main__"`` started
+    a second run of its own into the same directory and the caller's run failed."""
+    if not _bar:
+        from tqdm import tqdm
+
+        _bar.append(type("Bar", (tqdm,), {"monitor_interval": 0}))
+    return _bar[0]
+
+
 class Progress:
     """``with Progress(total, label) as p: p.update(n)``; ``chunks`` > 0 adds ``chunk i/N``."""
 
@@ -46,11 +72,9 @@ class Progress:
         self.chunks_done = 0
         self.done = 0
         stream = stream if stream is not None else sys.stderr
-        self.enabled = not quiet and hasattr(stream, "isatty") and stream.isatty()
+        self.enabled = not quiet and _terminal(stream)
         check_environment()
-        from tqdm import tqdm
-
-        self.bar = tqdm(
+        self.bar = _bar_class()(
             total=self.total,
             desc=label,
             file=stream,

@@ -58,8 +58,15 @@ def _setup() -> None:
             if backend and matplotlib.rcParams._get_backend_or_none() is None:
                 with contextlib.suppress(ValueError):  # nosuch: the suite draws through Agg
                     matplotlib.rcParams["backend"] = backend
-            matplotlib.rcParams.update(STYLE)
+            matplotlib.rcParams.update({**_defaults(matplotlib), **STYLE})
             _set_up = True
+
+
+def _defaults(m: ModuleType) -> dict:
+    """matplotlib's own defaults, the backend aside: what the suite draws over, never a
+    ``matplotlibrc`` of the user's (in the working directory, ``MATPLOTLIBRC`` or
+    ``~/.config/matplotlib``), which changed every PNG of ``sim run`` and of the API."""
+    return {k: v for k, v in m.rcParamsDefault.items() if k != "backend"}
 
 
 def _figure(**kw: Any):
@@ -135,13 +142,14 @@ def _take_over():
         def back() -> None:
             global _set_up
             loaded = sys.modules.get("matplotlib")
-            if loaded is not None and _set_up:
-                loaded.rcParams.update({k: loaded.rcParamsDefault[k] for k in STYLE})
+            if loaded is not None and _set_up:  # as matplotlib loaded them (a matplotlibrc)
+                loaded.rcParams.update(
+                    {k: v for k, v in loaded.rcParamsOrig.items() if k != "backend"}
+                )
                 _set_up = False
 
         return back
-    ours = {k: v for k, v in m.rcParamsDefault.items() if k != "backend"}
-    context = m.rc_context({**ours, **STYLE})
+    context = m.rc_context({**_defaults(m), **STYLE})
     context.__enter__()
     _set_up = True  # the style is set here, for the runs only
 

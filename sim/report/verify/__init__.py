@@ -35,9 +35,11 @@ import sys
 from sim.threads import interrupt_while_loading, refuse_bad_environment
 
 # python -m sim.report.verify imports this package first (sys.argv[0] is "-m" meanwhile):
-# Ctrl-C during its imports is one line and exit 130 (sim.report.verify.__main__)
-_loaded = interrupt_while_loading("sim verify") if sys.argv[:1] == ["-m"] else (lambda: None)
-if sys.argv[:1] == ["-m"]:
+# Ctrl-C during its imports is one line and exit 130 (sim.report.verify.__main__). A host
+# process may have no sys.argv, or None (an embedded Python): every study imports this.
+_as_main = list(getattr(sys, "argv", None) or [])[:1] == ["-m"]
+_loaded = interrupt_while_loading("sim verify") if _as_main else (lambda: None)
+if _as_main:
     refuse_bad_environment("sim verify")  # a variable NumPy cannot load with: one line, exit 2
 
 from sim.report.verify.cli import main  # noqa: E402
