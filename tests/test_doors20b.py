@@ -5,12 +5,26 @@
   ``cells/<label>/trials/``, which the staging directory's chunk count did not look at, so
   Ctrl-C or SIGTERM found "no finished chunk" and deleted the whole staging directory (while
   saying "run the same command again to finish the missing chunks");
+* one value given twice in a swept key (``[1e-3, 0.001]``, ``[4, 4.0]`` of an integer key,
+  ``["grid", 'grid']``, ``[2, 2, 1]``) made two cells of one configuration with different
+  seeds: the table and the figure showed one setting with two results; it is refused naming
+  ``sweep.<key>`` and the value, and a value is recorded as its key reads it (``4``, not
+  ``4.0``, in ``sweep.parquet``);
 """
 
 from pathlib import Path
 
+import pytest
+from oneline import SIM_ERROR, one_line
+
 import sim.execute
 from sim.cli import main
+from sim.mc.config import ConfigError
+from sim.mc.sweep import expand
+from sim.studies import get_study
+
+ROOT = Path(__file__).resolve().parents[1]
+BROWN = ROOT / "studies" / "brown_table1.toml"
 
 NETWORK = """study = "network"
 trials = 40
@@ -58,3 +72,37 @@ def test_an_interrupted_sweep_keeps_its_finished_cells_and_resumes(tmp_path, cap
         q = out / p.relative_to(stage)
         assert q.stat().st_mtime_ns == t
     assert len(list(out.glob("cells/*/claims.parquet"))) == 3
+
+
+@pytest.mark.parametrize(
+    "sweep, key, shown",
+    [
+        ('"errors.bias_um" = [1e-3, 0.001]', "sweep.errors.bias_um", "(0.001)"),
+        ('"errors.settings" = [4, 4.0]', "sweep.errors.settings", "(4 and 4.0)"),
+        ('"plate.pattern" = ["grid", \'grid\']', "sweep.plate.pattern", "('grid')"),
+        ('"errors.settings" = [2, 2, 1]', "sweep.errors.settings", "(2)"),
+        (
+            '"plate.points" = [[[0, 0], [9, 0], [0, 9], [9, 9]], [[0.0, 0.0], [9.0, 0.0], '
+            "[0.0, 9.0], [9.0, 9.0]]]",
+            "sweep.plate.points",
+            "and",
+        ),
+    ],
+)
+def test_a_value_given_twice_in_a_sweep_is_refused(tmp_path, capsys, sweep, key, shown):
+    f = tmp_path / "s.toml"
+    f.write_text(BROWN.read_text() + "[sweep]\n" + sweep + "\n")
+    for cmd in ("check", "run"):
+        args = [cmd, str(f)] + (["--out", str(tmp_path / "out")] if cmd == "run" else [])
+        one_line(capsys, main(args), key, "twice", shown, "replicates", prefix=SIM_ERROR)
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_swept_value_is_recorded_as_its_key_reads_it():
+    schema = get_study("brown_table1").schema
+    _, cells, _, _ = expand({"errors.settings": [4.0, 5], "plate.spacing_mm": [40]}, schema)
+    assert [c["errors.settings"] for c in cells] == [4, 5]
+    assert all(type(c["errors.settings"]) is int for c in cells)
+    assert all(type(c["plate.spacing_mm"]) is float for c in cells)
+    with pytest.raises(ConfigError, match="twice"):  # without the schema too (the estimate)
+        expand({"errors.bias_um": [1e-3, 0.001]})
