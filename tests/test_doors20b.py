@@ -10,6 +10,8 @@
   seeds: the table and the figure showed one setting with two results; it is refused naming
   ``sweep.<key>`` and the value, and a value is recorded as its key reads it (``4``, not
   ``4.0``, in ``sweep.parquet``);
+* ``sim show`` of a sweep printed the cell labels and "yes" alone: which setting each cell
+  is, and where its claims are, was not said; each row now has the swept values.
 """
 
 from pathlib import Path
@@ -106,3 +108,21 @@ def test_a_swept_value_is_recorded_as_its_key_reads_it():
     assert all(type(c["plate.spacing_mm"]) is float for c in cells)
     with pytest.raises(ConfigError, match="twice"):  # without the schema too (the estimate)
         expand({"errors.bias_um": [1e-3, 0.001]})
+
+
+def test_show_of_a_sweep_names_each_cells_setting(tmp_path, capsys):
+    f = _study(tmp_path, '"network.scale_ppm" = [0.0, 25.0]\nreplicates = 2\n')
+    out = tmp_path / "out"
+    assert main(["run", str(f), "--out", str(out), "--quiet", "--no-figures"]) == 0
+    capsys.readouterr()
+    assert main(["show", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split() == ["cell", "network.scale_ppm", "feasible"]
+    rows = [ln.split() for ln in lines[2:6]]
+    assert rows == [
+        ["cell0000_r0", "0", "yes"],
+        ["cell0000_r1", "0", "yes"],
+        ["cell0001_r0", "25.0", "yes"],
+        ["cell0001_r1", "25.0", "yes"],
+    ]
+    assert f"sim show {out} --markdown" in lines[-1] and "4 of 4 cells ran" in lines[-1]
