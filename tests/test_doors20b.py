@@ -11,7 +11,10 @@
   ``sweep.<key>`` and the value, and a value is recorded as its key reads it (``4``, not
   ``4.0``, in ``sweep.parquet``);
 * ``sim show`` of a sweep printed the cell labels and "yes" alone: which setting each cell
-  is, and where its claims are, was not said; each row now has the swept values.
+  is, and where its claims are, was not said; each row now has the swept values;
+* a swept study was never current for ``sim.batch --stale-only`` (so ``make reproduce``):
+  its run record holds the ``[sweep]`` table beside the config, the staleness check compared
+  the config alone ("made with another config: sweep") and re-ran it every time.
 """
 
 from pathlib import Path
@@ -20,6 +23,7 @@ import pytest
 from oneline import SIM_ERROR, one_line
 
 import sim.execute
+from sim.batch import why_stale
 from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.mc.sweep import expand
@@ -126,3 +130,12 @@ def test_show_of_a_sweep_names_each_cells_setting(tmp_path, capsys):
         ["cell0001_r1", "25.0", "yes"],
     ]
     assert f"sim show {out} --markdown" in lines[-1] and "4 of 4 cells ran" in lines[-1]
+
+
+def test_a_swept_study_just_run_is_current_until_its_sweep_changes(tmp_path, capsys):
+    f = _study(tmp_path, '"network.scale_ppm" = [0.0, 25.0]\n')
+    out = tmp_path / "results" / "s"
+    assert main(["run", str(f), "--out", str(out), "--quiet"]) == 0
+    assert why_stale(f, out) is None
+    f.write_text(f.read_text().replace("25.0]", "30.0]"))
+    assert why_stale(f, out) == "made with another config: sweep"
