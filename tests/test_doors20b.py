@@ -14,7 +14,10 @@
   is, and where its claims are, was not said; each row now has the swept values;
 * a swept study was never current for ``sim.batch --stale-only`` (so ``make reproduce``):
   its run record holds the ``[sweep]`` table beside the config, the staleness check compared
-  the config alone ("made with another config: sweep") and re-ran it every time.
+  the config alone ("made with another config: sweep") and re-ran it every time;
+* ``make verify`` over results that hold only sweeps said "no study results in DIR (no
+  */claims.parquet)", as if they were lost, even with ``--study`` naming a sweep (whose own
+  message, "holds a sweep's results", was never reached); it names the sweeps.
 """
 
 from pathlib import Path
@@ -27,6 +30,7 @@ from sim.batch import why_stale
 from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.mc.sweep import expand
+from sim.report.verify import main as verify_main
 from sim.studies import get_study
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -139,3 +143,13 @@ def test_a_swept_study_just_run_is_current_until_its_sweep_changes(tmp_path, cap
     assert why_stale(f, out) is None
     f.write_text(f.read_text().replace("25.0]", "30.0]"))
     assert why_stale(f, out) == "made with another config: sweep"
+
+
+def test_verify_over_sweeps_alone_names_them(tmp_path, capsys):
+    res = tmp_path / "results"
+    for name in ("sw2", "sw1"):
+        (res / name).mkdir(parents=True)
+        (res / name / "sweep.parquet").write_bytes(b"")
+    for extra in ([], ["--study", "sw1"]):
+        rc = verify_main(["--results", str(res), "--no-record", *extra])
+        one_line(capsys, rc, "--results", "only sweeps' results (sw1, sw2", "sim run")
