@@ -17,7 +17,10 @@
   the config alone ("made with another config: sweep") and re-ran it every time;
 * ``make verify`` over results that hold only sweeps said "no study results in DIR (no
   */claims.parquet)", as if they were lost, even with ``--study`` naming a sweep (whose own
-  message, "holds a sweep's results", was never reached); it names the sweeps.
+  message, "holds a sweep's results", was never reached); it names the sweeps;
+* a claim with no finite value in any cell drew ``sweep.png``'s panel empty, on axes of
+  -0.04 to 0.04 (not the swept range), with a legend of series that were not there; it says
+  so in the panel, over the swept range.
 """
 
 from pathlib import Path
@@ -29,7 +32,9 @@ import sim.execute
 from sim.batch import why_stale
 from sim.cli import main
 from sim.mc.config import ConfigError
+from sim.mc.storage import write_table
 from sim.mc.sweep import expand
+from sim.report.sweep import fig_sweep
 from sim.report.verify import main as verify_main
 from sim.studies import get_study
 
@@ -153,3 +158,23 @@ def test_verify_over_sweeps_alone_names_them(tmp_path, capsys):
     for extra in ([], ["--study", "sw1"]):
         rc = verify_main(["--results", str(res), "--no-record", *extra])
         one_line(capsys, rc, "--results", "only sweeps' results (sw1, sw2", "sim run")
+
+
+def test_sweep_png_says_a_claim_has_no_finite_value(tmp_path, monkeypatch):
+    nan, cols = float("nan"), {"cell": [0, 0, 1, 1], "replicate": [0, 0, 0, 0]}
+    cols.update(label=["a", "b", "c", "d"], seed=[1, 2, 3, 4], feasible=[True] * 4)
+    cols.update({"reason": [""] * 4, "x_mm": [10.0, 10.0, 20.0, 20.0], "k": [1, 2, 1, 2]})
+    for c, v in (("gone_mm", [nan] * 4), ("kept_mm", [1.0, 2.0, 3.0, 4.0])):
+        cols.update({c: v, c + ":lo": [x - 0.1 for x in v], c + ":hi": [x + 0.1 for x in v]})
+    write_table(tmp_path / "sweep.parquet", cols, {"study": "network", "sweep_keys": ["x_mm", "k"]})
+    figs = []
+    monkeypatch.setattr("sim.report.sweep.save", lambda fig, png: figs.append(fig))
+    fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png")
+    (fig,) = figs
+    gone = next(a for a in fig.axes if a.get_title() == "gone_mm")
+    kept = next(a for a in fig.axes if a.get_title() == "kept_mm")
+    assert [t.get_text() for t in gone.texts] == ["no finite value in any cell"]
+    assert gone.get_legend() is None and kept.get_legend() is not None
+    lo, hi = gone.get_xlim()
+    assert lo <= 10.0 and hi >= 20.0 and hi - lo < 15.0  # the swept range, not -0.04..0.04
+    assert not kept.texts

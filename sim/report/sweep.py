@@ -93,6 +93,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     xlabel = f"{keys[0]} ({xunit or 'no unit'})" + (
         " - red band: infeasible" if (~feas).any() else ""
     )
+    empty: list = []  # panels of a claim without a finite value
     for ax, c in zip(axs.ravel(), claims):
         v, lo, hi = _column(t, c), _column(t, c + ":lo"), _column(t, c + ":hi")
         prop = _is_proportion(c, v)
@@ -114,6 +115,16 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             )
         for xi in x[~feas]:
             ax.axvline(xi, color="tab:red", alpha=0.3, lw=3)
+        if not np.isfinite(v[feas]).any():  # an empty panel of -0.04..0.04 on both axes, its
+            ax.text(  # legend naming series that are not there, read as a drawn result
+                0.5, 0.5, "no finite value in any cell", transform=ax.transAxes,
+                ha="center", va="center", fontsize=8,
+            )  # fmt: skip
+            if x.size and np.isfinite(x).all():
+                pad = max(abs(x.max() - x.min()) * 0.05, 0.5 if not numeric else 0.0) or 1.0
+                ax.set_xlim(x.min() - pad, x.max() + pad)
+            ax.set_yticks([])
+            empty.append(ax)
         if prop:
             ax.set_ylim(-0.02, 1.02) if np.nanmax(hi, initial=0) - np.nanmin(
                 lo, initial=1
@@ -128,7 +139,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     for ax in axs.ravel()[len(claims) :]:
         ax.axis("off")
     if other[0]:  # once every panel is drawn: the layout is final
-        place_legends(axs.ravel()[: len(claims)])
+        place_legends([a for a in axs.ravel()[: len(claims)] if a not in empty])
     return save(fig, png)
 
 
