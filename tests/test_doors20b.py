@@ -20,7 +20,10 @@
   message, "holds a sweep's results", was never reached); it names the sweeps;
 * a claim with no finite value in any cell drew ``sweep.png``'s panel empty, on axes of
   -0.04 to 0.04 (not the swept range), with a legend of series that were not there; it says
-  so in the panel, over the swept range.
+  so in the panel, over the swept range;
+* a sweep of three keys labelled its series with the whole dotted keys cut at 40 characters,
+  so two series read the same (``network.estimate_scale=False, solver.ma...`` twice): the
+  legend names the keys by their last part.
 """
 
 from pathlib import Path
@@ -178,3 +181,20 @@ def test_sweep_png_says_a_claim_has_no_finite_value(tmp_path, monkeypatch):
     lo, hi = gone.get_xlim()
     assert lo <= 10.0 and hi >= 20.0 and hi - lo < 15.0  # the swept range, not -0.04..0.04
     assert not kept.texts
+
+
+def test_sweep_png_legend_tells_every_series_apart(tmp_path, monkeypatch):
+    cols = {"cell": list(range(8)), "replicate": [0] * 8, "label": list("abcdefgh")}
+    cols.update(seed=list(range(8)), feasible=[True] * 8, reason=[""] * 8)
+    cols["network.scale_ppm"] = [0.0] * 4 + [20.0] * 4
+    cols["network.estimate_scale"] = [False, False, True, True] * 2
+    cols["solver.max_iter"] = [20, 5] * 4
+    cols.update({"v_mm": [1.0] * 8, "v_mm:lo": [0.9] * 8, "v_mm:hi": [1.1] * 8})
+    keys = ["network.scale_ppm", "network.estimate_scale", "solver.max_iter"]
+    write_table(tmp_path / "sweep.parquet", cols, {"study": "network", "sweep_keys": keys})
+    figs = []
+    monkeypatch.setattr("sim.report.sweep.save", lambda fig, png: figs.append(fig))
+    fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png")
+    labels = [t.get_text() for t in figs[0].axes[0].get_legend().get_texts()]
+    assert len(labels) == 4 and len(set(labels)) == 4, labels
+    assert "estimate_scale=False, max_iter=5" in labels

@@ -63,6 +63,15 @@ def _short(text: str, n: int = 40) -> str:
     return text if len(text) <= n else text[: n - 1] + "\u2026"
 
 
+def _legend_names(keys: list[str]) -> list[str]:
+    """The other swept keys as a legend names them: the last part of each dotted key when
+    those are distinct (``solver.max_iter`` -> ``max_iter``). A label of the whole keys cut
+    at 40 characters lost the key that told two series apart (``network.estimate_scale=
+    False, solver.ma...`` twice)."""
+    last = [k.rsplit(".", 1)[-1] for k in keys]
+    return last if len(set(last)) == len(last) else list(keys)
+
+
 def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     """Each claim's value (with its 95 % interval) against the first swept key, one line per
     combination of the other keys; infeasible cells marked by a red band. Proportions (by
@@ -94,6 +103,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         " - red band: infeasible" if (~feas).any() else ""
     )
     empty: list = []  # panels of a claim without a finite value
+    names = _legend_names(keys[1:])
     for ax, c in zip(axs.ravel(), claims):
         v, lo, hi = _column(t, c), _column(t, c + ":lo"), _column(t, c + ":hi")
         prop = _is_proportion(c, v)
@@ -102,7 +112,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         for n, grp in enumerate(dict.fromkeys(other)):
             sel = np.array([o == grp for o in other]) & feas
             o = np.argsort(x[sel])
-            lab = _short(", ".join(f"{k}={g}" for k, g in zip(keys[1:], grp))) or None
+            lab = _short(", ".join(f"{k}={_short(str(g), 16)}" for k, g in zip(names, grp))) or None
             ax.errorbar(
                 x[sel][o],
                 v[sel][o],
