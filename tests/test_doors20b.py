@@ -23,7 +23,9 @@
   so in the panel, over the swept range;
 * a sweep of three keys labelled its series with the whole dotted keys cut at 40 characters,
   so two series read the same (``network.estimate_scale=False, solver.ma...`` twice): the
-  legend names the keys by their last part.
+  legend names the keys by their last part;
+* a first swept key of 50 long text values drew 50 overlapping tick labels, each cut at its
+  end so that all read the same: at most 25, upright when many, shortened in the middle.
 """
 
 from pathlib import Path
@@ -198,3 +200,22 @@ def test_sweep_png_legend_tells_every_series_apart(tmp_path, monkeypatch):
     labels = [t.get_text() for t in figs[0].axes[0].get_legend().get_texts()]
     assert len(labels) == 4 and len(set(labels)) == 4, labels
     assert "estimate_scale=False, max_iter=5" in labels
+
+
+def test_sweep_png_ticks_of_many_long_values_are_distinct_and_few(tmp_path, monkeypatch):
+    n = 50
+    cols = {"cell": list(range(n)), "replicate": [0] * n, "label": [str(i) for i in range(n)]}
+    cols.update(seed=list(range(n)), feasible=[True] * n, reason=[""] * n)
+    cols["network.name"] = [f"a very long network name, variant {i:02d}" for i in range(n)]
+    cols.update({"v_mm": [1.0] * n, "v_mm:lo": [0.9] * n, "v_mm:hi": [1.1] * n})
+    write_table(
+        tmp_path / "sweep.parquet", cols, {"study": "network", "sweep_keys": ["network.name"]}
+    )
+    figs = []
+    monkeypatch.setattr("sim.report.sweep.save", lambda fig, png: figs.append(fig))
+    fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png")
+    ticks = figs[0].axes[0].get_xticklabels()
+    texts = [t.get_text() for t in ticks]
+    assert 10 <= len(texts) <= 25 and len(set(texts)) == len(texts), texts
+    assert all(len(t) <= 16 for t in texts) and texts[0].endswith("00'")
+    assert all(t.get_rotation() == 90 for t in ticks)

@@ -63,6 +63,15 @@ def _short(text: str, n: int = 40) -> str:
     return text if len(text) <= n else text[: n - 1] + "\u2026"
 
 
+def _middle(text: str, n: int) -> str:
+    """A tick label of at most ``n`` characters keeping both ends (values that differ only
+    at their end, ``variant 01`` and ``variant 02``, stay apart)."""
+    if len(text) <= n:
+        return text
+    head = (n - 1) // 2
+    return text[:head] + "\u2026" + text[len(text) - (n - 1 - head) :]
+
+
 def _legend_names(keys: list[str]) -> list[str]:
     """The other swept keys as a legend names them: the last part of each dotted key when
     those are distinct (``solver.max_iter`` -> ``max_iter``). A label of the whole keys cut
@@ -141,8 +150,11 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             ) > 0.5 else None
         readable_limits(ax, "y")
         ax.ticklabel_format(axis="both", useOffset=False, style="plain")
-        if not numeric:
-            ax.set_xticks(range(len(ticks)), [_short(v, 16) for v in ticks], fontsize=7)
+        if not numeric:  # at most 25 labels, upright when few: 50 overlapped in a smear, and
+            step = -(-len(ticks) // 25)  # cut at their ends they all read the same
+            pos = list(range(0, len(ticks), step))
+            shown = [_middle(ticks[i], 16) for i in pos]
+            ax.set_xticks(pos, shown, fontsize=7, rotation=90 if len(pos) > 6 else 0)
         ax.set_title(c, fontsize=8, wrap=True)
         ax.set_xlabel(xlabel, fontsize=8)
         ax.set_ylabel(_y_label(c, prop), fontsize=8)
