@@ -21,6 +21,7 @@ from sim.cli_args import parser as run_parser
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, parse_override, read_toml
 from sim.mc.storage import regular_text
+from sim.mc.sweep import read_sweep
 from sim.studies import get_study
 
 __all__ = ["is_current", "why_stale"]
@@ -47,14 +48,18 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
         record = json.loads(text)
         with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
             args = run_parser(cli_doc).parse_args(["run", str(study_file), *run_args])
-        _, cfg = load_run(args)
+        study, cfg = load_run(args)
+        sweep = read_sweep(study_file, study.schema)  # recorded with the config (execute):
     except (OSError, ValueError, RecursionError, ConfigError, StudyError, SystemExit):
         return "its run record or study file does not load"  # RecursionError: nested too deep
     if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
         return "its run record is not one"
     if record.get("figures") is False and not args.no_figures:  # sim run --no-figures
         return "made without figures"
-    want, have = json.loads(json.dumps(cfg)), record.get("config")
+    # the record holds the [sweep] table beside the config, as the run wrote it: without it
+    # a swept study was "made with another config: sweep" at once, and re-run every time
+    want = json.loads(json.dumps({**cfg, "sweep": sweep} if sweep else cfg))
+    have = record.get("config")
     if have != want:
         have = have if isinstance(have, dict) else {}
         keys = sorted(k for k in {*want, *have} if want.get(k) != have.get(k))

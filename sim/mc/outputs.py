@@ -171,14 +171,14 @@ def _check_not_nested(out: Path, shown: str) -> None:
 
 def _damage(stage: Path) -> str | None:
     """What is wrong with a staging directory's chunk store, if anything: a chunk path that is
-    not a regular file (a directory, a link)."""
-    t = stage / "trials"
-    if t.is_symlink() or (t.exists() and not t.is_dir()):
-        return f"{t} is not a directory"
-    if t.is_dir():
-        for p in sorted(t.rglob("*")):
-            if p.is_symlink() or (p.name.startswith("chunk-") and not p.is_file()):
-                return f"{p} is not a chunk file"
+    not a regular file (a directory, a link), in the run's store or in a sweep cell's."""
+    for t in _stores(stage):
+        if t.is_symlink() or (t.exists() and not t.is_dir()):
+            return f"{t} is not a directory"
+        if t.is_dir():
+            for p in sorted(t.rglob("*")):
+                if p.is_symlink() or (p.name.startswith("chunk-") and not p.is_file()):
+                    return f"{p} is not a chunk file"
     return None
 
 
@@ -198,9 +198,19 @@ def _clear(stage: Path) -> None:
             p.unlink()
 
 
+def _stores(stage: Path) -> list[Path]:
+    """The chunk stores of a staging directory: its ``trials/`` and, for a ``[sweep]``, each
+    cell's ``cells/<label>/trials/`` (an interrupted sweep's finished cells were counted as
+    no chunk at all, and its staging directory deleted: nothing to resume)."""
+    cells = stage / "cells"
+    inner = sorted(cells.glob("*/trials")) if cells.is_dir() and not cells.is_symlink() else []
+    return [stage / "trials", *inner]
+
+
 def _chunks(stage: Path) -> int:
-    t = stage / "trials"
-    return sum(1 for _ in t.rglob("chunk-*.parquet")) if t.is_dir() else 0
+    return sum(
+        sum(1 for _ in t.rglob("chunk-*.parquet")) if t.is_dir() else 0 for t in _stores(stage)
+    )
 
 
 def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: bool):

@@ -201,12 +201,39 @@ def expand(table: Mapping[str, Any], schema: Mapping | None = None):
     total = math.prod(len(v) for v in vals) * reps
     if total > MAX_CELLS:
         raise ConfigError("sweep", f"{total:,} cells x replicates (at most {MAX_CELLS:,})")
-    for k, vs in zip(keys, vals):  # a value its key refuses fails in every cell: refused here
-        if schema is not None and isinstance(schema[k], Field):
-            for v in vs:
+    for j, (k, raw) in enumerate(zip(keys, vals)):  # a value its key refuses fails in every
+        if schema is not None and isinstance(schema[k], Field):  # cell: refused here
+            vals[j] = [
                 check_value(f"sweep.{k}", schema[k], v.item() if isinstance(v, np.generic) else v)
+                for v in raw
+            ]  # as each cell reads it: 4.0 of an integer key is 4 (the table's column too)
+        _no_repeats(k, raw, vals[j])
     cells = [dict(zip(keys, combo)) for combo in itertools.product(*vals)]
     return keys, cells, reps, mode
+
+
+def _same(v: Any) -> Any:
+    """What makes two values of a key one value (``1e-3`` and ``0.001``; ``4`` and ``4.0``)."""
+    if isinstance(v, (int, float, np.number)) and not isinstance(v, (bool, np.bool_)):
+        return ("number", float(v))
+    return ("other", repr(v))
+
+
+def _no_repeats(key: str, raw: list, vs: list) -> None:
+    """A value given twice made two cells of one configuration, each with its own seed: the
+    table and the figure showed one setting with two results, as if two designs. ``raw``: the
+    values as written, ``vs``: as the key reads them."""
+    seen: dict = {}
+    for i, v in enumerate(vs):
+        j = seen.setdefault(_same(v), i)
+        if j != i:
+            a, b = repr(raw[j]), repr(raw[i])
+            twice = f"{a} and {b}" if a != b else a
+            raise ConfigError(
+                f"sweep.{key}",
+                f"gives one value twice ({twice[:120]}): each would be a cell of the same "
+                "configuration; for repetitions use replicates = 2",
+            )
 
 
 def cell_config(study, cfg: Mapping[str, Any], cell: Mapping[str, Any], seed: int) -> dict:

@@ -125,13 +125,23 @@ def terminal_table(out: Path, width: int = 100) -> str:
     """Every claim of a results directory as a plain-text table (claim, simulated, 95 %
     interval, verdict), then the counts; a sweep directory as its cells."""
     out = Path(out)
-    if _kind_of(out) == "sweep":
-        t = columns(out / "sweep.parquet")
+    if _kind_of(out) == "sweep":  # each cell with its swept values (cell0003_r0 alone named
+        t = columns(out / "sweep.parquet")  # no setting), and where its claims are
+        keys = [k for k in read_provenance(out / "sweep.parquet").get("sweep_keys", []) if k in t]
         rows = [
-            [t["label"][i], "yes" if t["feasible"][i] else f"no: {t['reason'][i]}"]
+            [
+                t["label"][i],
+                *[_cut(fmt(t[k][i]), 24) for k in keys],
+                "yes" if t["feasible"][i] else f"no: {t['reason'][i]}",
+            ]
             for i in range(len(t["label"]))
         ]
-        return _text_table(["cell", "feasible"], rows, width)
+        table = _text_table(["cell", *keys, "feasible"], rows, width)
+        ok = sum(bool(f) for f in t["feasible"])
+        return (
+            f"{table}\n\nsweep: {ok} of {len(rows)} cells ran; every claim of every cell: "
+            f"sim show {out} --markdown"
+        )
     claims = records(out / "claims.parquet")
     rows = [[r["claim"], _value_text(r), _interval(r), r["verdict"]] for r in claims]
     table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)

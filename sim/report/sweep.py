@@ -63,6 +63,24 @@ def _short(text: str, n: int = 40) -> str:
     return text if len(text) <= n else text[: n - 1] + "\u2026"
 
 
+def _middle(text: str, n: int) -> str:
+    """A tick label of at most ``n`` characters keeping both ends (values that differ only
+    at their end, ``variant 01`` and ``variant 02``, stay apart)."""
+    if len(text) <= n:
+        return text
+    head = (n - 1) // 2
+    return text[:head] + "\u2026" + text[len(text) - (n - 1 - head) :]
+
+
+def _legend_names(keys: list[str]) -> list[str]:
+    """The other swept keys as a legend names them: the last part of each dotted key when
+    those are distinct (``solver.max_iter`` -> ``max_iter``). A label of the whole keys cut
+    at 40 characters lost the key that told two series apart (``network.estimate_scale=
+    False, solver.ma...`` twice)."""
+    last = [k.rsplit(".", 1)[-1] for k in keys]
+    return last if len(set(last)) == len(last) else list(keys)
+
+
 def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     """Each claim's value (with its 95 % interval) against the first swept key, one line per
     combination of the other keys; infeasible cells marked by a red band. Proportions (by
@@ -93,6 +111,8 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     xlabel = f"{keys[0]} ({xunit or 'no unit'})" + (
         " - red band: infeasible" if (~feas).any() else ""
     )
+    empty: list = []  # panels of a claim without a finite value
+    names = _legend_names(keys[1:])
     for ax, c in zip(axs.ravel(), claims):
         v, lo, hi = _column(t, c), _column(t, c + ":lo"), _column(t, c + ":hi")
         prop = _is_proportion(c, v)
@@ -101,7 +121,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         for n, grp in enumerate(dict.fromkeys(other)):
             sel = np.array([o == grp for o in other]) & feas
             o = np.argsort(x[sel])
-            lab = _short(", ".join(f"{k}={g}" for k, g in zip(keys[1:], grp))) or None
+            lab = _short(", ".join(f"{k}={_short(str(g), 16)}" for k, g in zip(names, grp))) or None
             ax.errorbar(
                 x[sel][o],
                 v[sel][o],
@@ -114,21 +134,34 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             )
         for xi in x[~feas]:
             ax.axvline(xi, color="tab:red", alpha=0.3, lw=3)
+        if not np.isfinite(v[feas]).any():  # an empty panel of -0.04..0.04 on both axes, its
+            ax.text(  # legend naming series that are not there, read as a drawn result
+                0.5, 0.5, "no finite value in any cell", transform=ax.transAxes,
+                ha="center", va="center", fontsize=8,
+            )  # fmt: skip
+            if x.size and np.isfinite(x).all():
+                pad = max(abs(x.max() - x.min()) * 0.05, 0.5 if not numeric else 0.0) or 1.0
+                ax.set_xlim(x.min() - pad, x.max() + pad)
+            ax.set_yticks([])
+            empty.append(ax)
         if prop:
             ax.set_ylim(-0.02, 1.02) if np.nanmax(hi, initial=0) - np.nanmin(
                 lo, initial=1
             ) > 0.5 else None
         readable_limits(ax, "y")
         ax.ticklabel_format(axis="both", useOffset=False, style="plain")
-        if not numeric:
-            ax.set_xticks(range(len(ticks)), [_short(v, 16) for v in ticks], fontsize=7)
+        if not numeric:  # at most 25 labels, upright when few: 50 overlapped in a smear, and
+            step = -(-len(ticks) // 25)  # cut at their ends they all read the same
+            pos = list(range(0, len(ticks), step))
+            shown = [_middle(ticks[i], 16) for i in pos]
+            ax.set_xticks(pos, shown, fontsize=7, rotation=90 if len(pos) > 6 else 0)
         ax.set_title(c, fontsize=8, wrap=True)
         ax.set_xlabel(xlabel, fontsize=8)
         ax.set_ylabel(_y_label(c, prop), fontsize=8)
     for ax in axs.ravel()[len(claims) :]:
         ax.axis("off")
     if other[0]:  # once every panel is drawn: the layout is final
-        place_legends(axs.ravel()[: len(claims)])
+        place_legends([a for a in axs.ravel()[: len(claims)] if a not in empty])
     return save(fig, png)
 
 

@@ -55,6 +55,13 @@ def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path,
             study = d.name  # a damaged file: the comparison names it
         found.append((d, str(study)))
     if not found:
+        sweeps = sorted(p.name for p in results_dirs(results) if (p / "sweep.parquet").is_file())
+        if sweeps:  # "no study results" read as if the sweeps' runs were lost
+            raise VerifyError(
+                f"--results: {results} holds only sweeps' results ({', '.join(sweeps[:3])}"
+                f"{', ...' if len(sweeps) > 3 else ''}: sweep.parquet): verify re-runs single "
+                "studies; re-run a sweep with sim run to compare"
+            )
         raise VerifyError(f"--results: no study results in {results} (no */claims.parquet)")
     if only:
         names = {n for d, s in found for n in (s, d.name)}
