@@ -219,3 +219,27 @@ def test_sweep_png_ticks_of_many_long_values_are_distinct_and_few(tmp_path, monk
     assert 10 <= len(texts) <= 25 and len(set(texts)) == len(texts), texts
     assert all(len(t) <= 16 for t in texts) and texts[0].endswith("00'")
     assert all(t.get_rotation() == 90 for t in ticks)
+
+
+def test_sweep_png_draws_each_replicate_as_its_own_line(tmp_path, monkeypatch):
+    """With ``replicates = 2`` one line ran through both replicates of each setting, up and
+    down at every x value (a zig-zag read as noise in the design); each replicate is its own
+    line now, in its group's colour, the group named once."""
+    cols = {"cell": [0, 0, 1, 1, 2, 2, 3, 3], "replicate": [0, 1] * 4, "label": list("abcdefgh")}
+    cols.update(seed=list(range(8)), feasible=[True] * 8, reason=[""] * 8)
+    cols["x_mm"] = [1.0, 1.0, 2.0, 2.0] * 2
+    cols["k"] = [1] * 4 + [2] * 4
+    v = [1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5]
+    cols.update({"v_mm": v, "v_mm:lo": [a - 0.1 for a in v], "v_mm:hi": [a + 0.1 for a in v]})
+    write_table(tmp_path / "sweep.parquet", cols, {"study": "network", "sweep_keys": ["x_mm", "k"]})
+    figs = []
+    monkeypatch.setattr("sim.report.sweep.save", lambda fig, png: figs.append(fig))
+    fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png")
+    ax = figs[0].axes[0]
+    lines = [ln for ln in ax.get_lines() if ln.get_linestyle() == "-"]
+    assert len(lines) == 4  # two settings of k, two replicates each
+    for ln in lines:  # each line visits each x once, in order
+        assert list(ln.get_xdata()) == [1.0, 2.0], ln.get_xdata()
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels == ["k=1", "k=2"], labels
+    assert "2 replicates, a line each" in ax.get_xlabel()

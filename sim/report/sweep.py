@@ -4,6 +4,7 @@ every claim against the first swept key (``sweep.png``), and the table of cells.
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -101,6 +102,9 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     ticks = list(dict.fromkeys(repr(v) for v in first))  # text, list values: one place each
     x = np.array([float(v) for v in first] if numeric else [ticks.index(repr(v)) for v in first])
     other = [tuple(t[k][i] for k in keys[1:]) for i in range(len(x))]
+    # replicates (cells of one setting, other seeds): one line each, in their group's colour,
+    # named once; a line through all of them zig-zagged up and down at each x value
+    rep = np.asarray(t["replicate"] if "replicate" in t else np.zeros(len(x)), int)
     feas = np.array(t["feasible"], bool)
     ncol = min(3, len(claims))
     nrow = -(-len(claims) // ncol)
@@ -111,6 +115,8 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     xlabel = f"{keys[0]} ({xunit or 'no unit'})" + (
         " - red band: infeasible" if (~feas).any() else ""
     )
+    if rep.size and rep.max() > 0:
+        xlabel += f" - {rep.max() + 1} replicates, a line each"
     empty: list = []  # panels of a claim without a finite value
     names = _legend_names(keys[1:])
     for ax, c in zip(axs.ravel(), claims):
@@ -118,9 +124,9 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         prop = _is_proportion(c, v)
         if prop:
             lo, hi = np.clip(lo, 0.0, 1.0), np.clip(hi, 0.0, 1.0)
-        for n, grp in enumerate(dict.fromkeys(other)):
-            sel = np.array([o == grp for o in other]) & feas
-            o = np.argsort(x[sel])
+        for (n, grp), r in itertools.product(enumerate(dict.fromkeys(other)), np.unique(rep)):
+            sel = np.array([o == grp for o in other]) & feas & (rep == r)
+            o = np.argsort(x[sel], kind="stable")
             lab = _short(", ".join(f"{k}={_short(str(g), 16)}" for k, g in zip(names, grp))) or None
             ax.errorbar(
                 x[sel][o],
@@ -130,7 +136,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
                 ms=3,
                 capsize=2,
                 color=_COLOURS[n % len(_COLOURS)],
-                label=lab,
+                label=lab if r == rep.min() else None,
             )
         for xi in x[~feas]:
             ax.axvline(xi, color="tab:red", alpha=0.3, lw=3)
