@@ -37,6 +37,7 @@ import sim.execute
 from sim.batch import why_stale
 from sim.cli import main
 from sim.mc.config import ConfigError
+from sim.mc.estimate import CELL_UNITS, estimate
 from sim.mc.storage import write_table
 from sim.mc.sweep import expand
 from sim.report.sweep import fig_sweep
@@ -243,3 +244,23 @@ def test_sweep_png_draws_each_replicate_as_its_own_line(tmp_path, monkeypatch):
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
     assert labels == ["k=1", "k=2"], labels
     assert "2 replicates, a line each" in ax.get_xlabel()
+
+
+def test_a_sweep_counts_each_cells_own_cost_against_the_work_limit(tmp_path, capsys):
+    """10,000 cells of Brown's 4,000 trials were estimated at 4.7e8 adjustments (under the
+    5e8 limit) and ran for about 16 hours: each cell's claims, tables and README cost about a
+    second of CPU that the estimate left out. Counted (CELL_UNITS a cell), the sweep is
+    refused at once with the estimate."""
+    sweep = (
+        '"errors.settings" = [1, 2]\n'
+        '"plate.spacing_mm" = {start = 10, stop = 50, num = 50}\n'
+        '"errors.bias_um" = {start = 0, stop = 1, num = 100}\n'
+    )
+    f = tmp_path / "s.toml"
+    f.write_text(BROWN.read_text().replace("trials = ", "trials = 4000 #", 1) + "[sweep]\n" + sweep)
+    one_line(
+        capsys, main(["check", str(f)]), "10000 sweep cells", "over the limit", prefix=SIM_ERROR
+    )
+    base = estimate({"study": "network", "trials": 40, "chunk": 2})
+    swept = estimate({"study": "network", "trials": 40, "chunk": 2}, {"trials": [40, 40.0 + 1]})
+    assert swept.adjustments >= base.adjustments + 2 * CELL_UNITS

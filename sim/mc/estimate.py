@@ -60,6 +60,7 @@ __all__ = [
     "ADJUSTMENT_S",
     "ANALYTIC_SHARE",
     "CHUNK_UNITS",
+    "CELL_UNITS",
     "design_grid_equivalents",
 ]
 
@@ -68,6 +69,11 @@ __all__ = [
 #: against chunks of 100 (2,000 trials). 100,000 chunks of one trial are about ten minutes,
 #: which a count of trials alone took for five seconds
 CHUNK_UNITS = 100.0
+#: unit adjustments a sweep cell costs besides its trials (its config, claims, tables and
+#: README): about 0.8 s of CPU, measured on network_plate at 40 trials in chunks of 2, one
+#: cell against eight (0.96 s a cell on the loaded 2-core machine). Without it 10,000 cells
+#: of 4,000 trials were estimated at 4.7e8 (under the limit) and measured at about 16 hours
+CELL_UNITS = 1.5e4
 DEFAULT_MAX_MEMORY_GB = 8.0
 DEFAULT_MAX_ADJUSTMENTS = 5e8
 #: an analytic part (no progress bar, nothing to resume) may take at most this share of the
@@ -357,7 +363,7 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
         cfgs = [{**cfg, **cell} for cell in cells]
     parts = [_one(c) for c in cfgs]
     T = sum(p[0] for p in parts) * reps
-    A = sum(p[1] for p in parts) * reps
+    A = sum(p[1] for p in parts) * reps + (len(cfgs) * reps * CELL_UNITS if sweep else 0.0)
     U = max(p[2] for p in parts)
     B, what = max((p[3], p[4]) for p in parts)
     eq, key, part = max((p[5] for p in parts), key=lambda x: x[0])  # one cell's, not the sum
