@@ -41,6 +41,7 @@ from sim.mc.paths import link_problem
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_record, umask_problem
 from sim.mc.sweep import read_sweep
+from sim.mc.toml_text import toml_value
 from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, damaged_message
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
@@ -269,13 +270,13 @@ def _check(args) -> int:
     for k, v in cfg.items():
         f = study.schema.get(k)
         if f is None:
-            print(f"{k} = {v!r}")
+            print(f"{k} = {toml_value(v)}")
             continue
         unit = f.unit or ""
         notes = "; ".join(
             x for x in (unit and f"unit {unit}", _bounds(f), "paper input" if f.input else "") if x
         )
-        print(f"{k} = {v!r}  # {f.doc}" + (f" ({notes})" if notes else ""))
+        print(f"{k} = {toml_value(v)}  # {f.doc}" + (f" ({notes})" if notes else ""))
     if sweep:
         print(f"# [sweep] {', '.join(sweep)}")
     print(f"# work: {est.describe()}")

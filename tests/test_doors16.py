@@ -153,7 +153,7 @@ def test_a_free_gama_file_resolves_the_inner_datum_it_is_adjusted_in(tmp_path, c
     )
     assert sim.load(str(study)).config["datum.kind"] == "inner"
     assert main(["check", str(study)]) == 0
-    assert "datum.kind = 'inner'" in capsys.readouterr().out
+    assert 'datum.kind = "inner"' in capsys.readouterr().out
 
 
 def test_brown_closure_note_states_the_configured_settings():

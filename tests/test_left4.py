@@ -127,7 +127,7 @@ def test_an_explicit_fixed_datum_that_cannot_hold_is_refused_the_default_falls_b
 ):
     study = _one_fixed(tmp_path)
     assert main(["check", str(study)]) == 0  # the default: gama-local's inner datum
-    assert "datum.kind = 'inner'" in capsys.readouterr().out
+    assert 'datum.kind = "inner"' in capsys.readouterr().out
     rc = main(["check", str(study), "--set", "datum.kind=fixed"])
     one_line(capsys, rc, *FIXED_WORDS, prefix=SIM_ERROR)
     rc = main(["check", str(_one_fixed(tmp_path, '[datum]\nkind = "fixed"\n'))])

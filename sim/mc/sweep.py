@@ -50,6 +50,7 @@ from sim.mc.config import (
 )
 from sim.mc.progress import Progress
 from sim.mc.runner import chunk_rng
+from sim.mc.toml_text import toml_value
 
 __all__ = [
     "SWEEP_KEY",
@@ -257,7 +258,7 @@ def _distinct(vs: list) -> list:
 
 
 def _shown(keys: list[str], cell: Mapping[str, Any]) -> str:
-    return ", ".join(f"{k} = {cell[k]!r}" for k in keys)
+    return ", ".join(f"{k} = {toml_value(cell[k])}" for k in keys)
 
 
 #: seconds ``sim check`` / ``sim run`` spend validating a sweep's cells before it runs (a
