@@ -264,3 +264,18 @@ def test_a_sweep_counts_each_cells_own_cost_against_the_work_limit(tmp_path, cap
     base = estimate({"study": "network", "trials": 40, "chunk": 2})
     swept = estimate({"study": "network", "trials": 40, "chunk": 2}, {"trials": [40, 40.0 + 1]})
     assert swept.adjustments >= base.adjustments + 2 * CELL_UNITS
+
+
+def test_verify_says_which_sweeps_it_did_not_verify(tmp_path, capsys):
+    """Results holding studies and sweeps: the sweeps were skipped without a word, and the
+    run read as if everything in the directory had been verified."""
+    res = tmp_path / "results"
+    for name, table in (("one", "claims.parquet"), ("sw1", "sweep.parquet")):
+        (res / name).mkdir(parents=True)
+        (res / name / table).write_bytes(b"")
+    rc = verify_main(
+        ["--results", str(res), "--scratch", str(tmp_path / "s"), "--no-rerun", "--no-record"]
+    )
+    err = capsys.readouterr().err.splitlines()
+    assert rc == 2 and err[0].startswith("sim verify: not verified: sw1 (sweeps"), err
+    assert "no re-run of one" in err[1], err

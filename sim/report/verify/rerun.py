@@ -158,6 +158,13 @@ def verify(
     if scratch.exists() and not scratch.is_dir():
         raise VerifyError(f"--scratch: {scratch} is not a directory")
     todo = study_dirs(results, only)
+    sweeps = sorted(p.name for p in results_dirs(results) if (p / "sweep.parquet").is_file())
+    if sweeps and not only:  # skipped without a word, they read as verified
+        print(
+            f"sim verify: not verified: {', '.join(sweeps[:5])}{', ...' if len(sweeps) > 5 else ''}"
+            " (sweeps: verify re-runs single studies; re-run a sweep with sim run to compare)",
+            file=sys.stderr,
+        )
     try:
         inside = scratch.resolve() == Path(results).resolve() or Path(results).resolve() in (
             scratch.resolve().parents
