@@ -38,6 +38,7 @@ __all__ = [
     "point_cov_in",
     "in_datum",
     "inner_defect",
+    "held_defect",
     "check_inner",
     "match_points",
     "estimated_points",
@@ -118,6 +119,17 @@ def inner_defect(net: Network) -> np.ndarray:
     extra = [net.i_constant] * net.estimate_constant + [net.i_scale] * net.estimate_scale
     free = np.concatenate([np.arange(2 * net.n), orient, extra]).astype(int)
     return defect_basis(net, free)[: 2 * net.n]
+
+
+def held_defect(net: Network, free: np.ndarray) -> np.ndarray:
+    """Coordinate rows ``(2n, d)`` of the datum defects the free unknowns ``free`` leave, the
+    fixed points held (one fixed point: the rotation, and scale, about it): what inner
+    constraints over a datum's points must remove (a held point's rows are zero)."""
+    G = defect_basis(net, free)
+    H = np.zeros((2 * net.n, G.shape[1]))
+    coord = free < 2 * net.n
+    H[free[coord]] = G[coord]
+    return H
 
 
 def match_points(net: Network, key: str, pats) -> list[int]:
