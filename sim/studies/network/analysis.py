@@ -17,7 +17,6 @@ tables in mm. Seeds: Baarda's reliability theory as used for comparator networks
 
 from __future__ import annotations
 
-import fnmatch
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,6 +27,7 @@ from sim.lsq.datum import s_matrix, s_transform
 from sim.mc.config import ConfigError
 from sim.studies.network.definition import Network
 from sim.studies.network.model import NetworkModel, defect_basis, simulate
+from sim.studies.network.validate import name_index, select
 
 __all__ = [
     "Analytic",
@@ -38,6 +38,7 @@ __all__ = [
     "point_cov_in",
     "in_datum",
     "inner_defect",
+    "held_defect",
     "check_inner",
     "match_points",
     "estimated_points",
@@ -120,16 +121,21 @@ def inner_defect(net: Network) -> np.ndarray:
     return defect_basis(net, free)[: 2 * net.n]
 
 
+def held_defect(net: Network, free: np.ndarray) -> np.ndarray:
+    """Coordinate rows ``(2n, d)`` of the datum defects the free unknowns ``free`` leave, the
+    fixed points held (one fixed point: the rotation, and scale, about it): what inner
+    constraints over a datum's points must remove (a held point's rows are zero)."""
+    G = defect_basis(net, free)
+    H = np.zeros((2 * net.n, G.shape[1]))
+    coord = free < 2 * net.n
+    H[free[coord]] = G[coord]
+    return H
+
+
 def match_points(net: Network, key: str, pats) -> list[int]:
     """Indices of the points matching any of the name patterns (one set; each pattern must
     match a point)."""
-    out: list[int] = []
-    for p in pats:
-        hit = [a for a, nm in enumerate(net.names) if fnmatch.fnmatchcase(nm, p)]
-        if not hit:
-            raise ConfigError(key, f"no point matches {p!r}")
-        out += [h for h in hit if h not in out]
-    return out
+    return select(key, pats, net.names, name_index(net.names), "no point matches")
 
 
 def datum_weights(net: Network, points: list[int]) -> np.ndarray:

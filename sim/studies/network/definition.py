@@ -49,6 +49,7 @@ from sim.studies.network.validate import (
     _obs_common,
     _point_name,
     _role,
+    name_index,
     one_unit,
     title,
 )
@@ -246,13 +247,14 @@ def _targets(xy: np.ndarray, fr: list[int], to: list[int], k: int) -> list[list[
 def _listed_obs(cfg: dict, names: list[str]) -> list[tuple]:
     """The rows ``(kind, i, j, k, sigma, bias)`` of ``network.observations``, one each."""
     rows: list[tuple] = []
+    index = name_index(names)
     for a, rec in enumerate(cfg["network.observations"]):
         key = f"network.observations[{a}]"
         _keys(key, rec, _OBS - {"nearest"}, {"kind", "to"})
         code, sig, bias = _obs_common(key, rec)
         if code == 2:
             _keys(key, rec, _OBS, {"at", "from"})
-            at, bs, fs = (_match(f"{key}.{f}", rec[f], names) for f in ("at", "from", "to"))
+            at, bs, fs = (_match(f"{key}.{f}", rec[f], names, index) for f in ("at", "from", "to"))
             _one_each(key, {"at": at, "from": bs, "to": fs})
             rows.append((code, at[0], bs[0], fs[0], sig, bias))
             continue
@@ -260,7 +262,7 @@ def _listed_obs(cfg: dict, names: list[str]) -> list[tuple]:
             raise ConfigError(f"{key}.from", "missing")
         if "at" in rec:
             raise ConfigError(f"{key}.at", f"only an angle has 'at' (this is a {KINDS[code]})")
-        fr, to = (_match(f"{key}.{f}", rec[f], names) for f in ("from", "to"))
+        fr, to = (_match(f"{key}.{f}", rec[f], names, index) for f in ("from", "to"))
         _one_each(key, {"from": fr, "to": to})
         rows.append((code, fr[0], to[0], -1, sig, bias))
     return rows
@@ -282,6 +284,7 @@ def _one_each(key: str, matched: dict) -> None:
 def _generated_obs(cfg: dict, names: list[str], xy: np.ndarray, rows: list[tuple]) -> None:
     """Append the rows of ``network.generate`` (every ``from`` to every, or the nearest,
     ``to``), refusing a set that would not fit the memory limit before it is made."""
+    index = name_index(names)
     for a, rec in enumerate(cfg["network.generate"]):
         key = f"network.generate[{a}]"
         _keys(key, rec, _OBS - {"at", "set"}, {"kind", "from", "to"})
@@ -290,7 +293,7 @@ def _generated_obs(cfg: dict, names: list[str], xy: np.ndarray, rows: list[tuple
             raise ConfigError(
                 f"{key}.kind", "angles are declared one by one (network.observations)"
             )
-        fr, to = (_match(f"{key}.{f}", rec[f], names) for f in ("from", "to"))
+        fr, to = (_match(f"{key}.{f}", rec[f], names, index) for f in ("from", "to"))
         k = _num(f"{key}.nearest", rec.get("nearest", 0), 0, integer=True)
         per = min(k, len(to)) if k else len(to)
         _fits(key, len(names), len(rows) + len(fr) * per, f"{len(fr)} x {per} observations")

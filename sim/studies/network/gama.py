@@ -25,7 +25,6 @@ Import: :mod:`sim.studies.network.gama_read` (``network.gama_xml``).
 
 from __future__ import annotations
 
-import fnmatch
 import hashlib
 import math
 import xml.etree.ElementTree as ET
@@ -38,6 +37,7 @@ from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network
 from sim.studies.network.gama_read import CC, NS, read_bytes, read_gama
 from sim.studies.network.model import computed
+from sim.studies.network.validate import hits, name_index
 
 __all__ = ["read_gama", "write_gama", "merge_gama", "export", "gama_digest", "import_note"]
 
@@ -288,12 +288,9 @@ def write_gama(net: Network, path: str | Path, inner: tuple | list = ()) -> Path
 
 def inner_points(net: Network, cfg: dict) -> list[int]:
     """Indices of the estimated points of ``datum.points`` (default: all)."""
-    pats = cfg["datum.points"] or ["*"]
-    return [
-        a
-        for a, nm in enumerate(net.names)
-        if net.role[a] != 1 and any(fnmatch.fnmatchcase(nm, p) for p in pats)
-    ]
+    index = name_index(net.names)
+    sel = {a for p in cfg["datum.points"] or ["*"] for a in hits(p, net.names, index)}
+    return [a for a in range(net.n) if net.role[a] != 1 and a in sel]
 
 
 def export(net: Network, cfg: dict, path: str | Path) -> str:

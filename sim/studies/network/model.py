@@ -12,8 +12,6 @@ inner constraints over chosen points, or a user's minimal constraints. Seed pape
 
 from __future__ import annotations
 
-import fnmatch
-
 import numpy as np
 
 from sim import lsq
@@ -21,6 +19,7 @@ from sim.lsq import sparse as lsq_sparse
 from sim.lsq.size import SPARSE_MIN_UNKNOWNS
 from sim.mc.config import ConfigError
 from sim.studies.network.definition import Network
+from sim.studies.network.validate import hits, name_index
 
 __all__ = [
     "NetworkModel",
@@ -314,8 +313,9 @@ def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
     # inner constraints over the chosen points, for the defects the network really has
     pats = cfg["datum.points"] or ["*"]
     sel = np.zeros(net.n, bool)
+    index = name_index(net.names)
     for p in pats:
-        sel |= np.array([fnmatch.fnmatchcase(nm, p) for nm in net.names])
+        sel[hits(p, net.names, index)] = True
     if not sel.any():
         raise ConfigError("datum.points", f"no point matches {pats}")
     G = defect_basis(net, free)

@@ -11,14 +11,13 @@ network in ``gama-local`` XML when it has that form) and the figures.
 
 from __future__ import annotations
 
-import fnmatch
 from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 from sim.lsq import distributions as D
-from sim.mc.config import ConfigError, StudyError
+from sim.mc.config import StudyError
 from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance
 from sim.report.plotting import draw
@@ -39,19 +38,14 @@ from sim.studies.network.tables import (
     write_points,
     write_summary,
 )
+from sim.studies.network.validate import name_index, select
 
 __all__ = ["run", "compare_points"]
 
 
 def compare_points(net: Network, cfg: dict) -> list[int]:
     """The points ``compare.fix`` names (patterns), each once, in the order named."""
-    out: list[int] = []
-    for p in cfg["compare.fix"]:
-        hit = [a for a, nm in enumerate(net.names) if fnmatch.fnmatchcase(nm, p)]
-        if not hit:
-            raise ConfigError("compare.fix", f"no point named {p!r}")
-        out += [h for h in hit if h not in out]
-    return out
+    return select("compare.fix", cfg["compare.fix"], net.names, name_index(net.names))
 
 
 def _rms_sigma(cov: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ from sim.mc.runner import MIN_CHUNKS, require_chunks
 from sim.studies.network.analysis import (
     check_inner,
     estimated_points,
+    held_defect,
     inner_defect,
     match_points,
 )
@@ -249,8 +250,10 @@ def _held(net, full: dict, dt, sparse: bool):
     if full["datum.kind"] == "constraints":
         _minimal(net, dt)
     if full["datum.kind"] == "inner":
+        # the defect the datum leaves (one fixed point: the rotation about it), not every
+        # defect of the network with no point held
         pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
-        check_inner(net, inner_defect(net), pts, "datum.points")
+        check_inner(net, held_defect(net, dt.free_index(net.q)), pts, "datum.points")
     an = pre_analysis(net, dt, full["reliability.alpha0"], full["reliability.power"])
     if not an.ok:
         # dense too: name the point no observation reaches (docs/network.md), unless nothing
