@@ -175,3 +175,52 @@ def test_an_exported_inner_datum_of_many_points_is_matched_by_name(tmp_path, mon
     assert full2["datum.points"] == [f"P{k}" for k in range(1, n + 1)]
     export(build(full2), full2, tmp_path / "again_out.xml")
     assert len(calls) < 10 * n, len(calls)
+
+
+# --- the words of a datum that cannot fix the defects ----------------------------------------
+
+FREE_SQUARE = """study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [
+  { name = "A", x_mm = 0.0, y_mm = 0.0 }, { name = "B", x_mm = 300.0, y_mm = 0.0 },
+  { name = "C", x_mm = 250.0, y_mm = 280.0 }, { name = "D", x_mm = -20.0, y_mm = 260.0 },
+]
+generate = [ { kind = "%s", from = "*", to = "*", sigma_%s = 1.0 } ]
+[datum]
+kind = "inner"
+points = ["A"]
+"""
+
+
+@pytest.mark.parametrize(
+    ("kind", "unit", "words"),
+    [
+        ("distance", "mm", "3 datum defects (two translations and a rotation)"),
+        ("direction", "arcsec", "4 datum defects (two translations and a rotation, and a scale"),
+    ],
+)
+def test_a_datum_that_cannot_fix_the_defects_names_them(tmp_path, capsys, kind, unit, words):
+    """The line listed "(translation, rotation, scale)" for any count: a network with lengths
+    has no scale defect, and a fixed point leaves only the rotation (and scale) about it."""
+    st = tmp_path / "s.toml"
+    st.write_text(FREE_SQUARE % (kind, unit))
+    assert main(["check", str(st)]) == 2
+    err = capsys.readouterr().err
+    assert "the points A cannot fix the network's " + words in err, err
+
+
+def test_the_defects_left_by_a_fixed_point_are_a_rotation_and_scale_about_it(tmp_path, capsys):
+    st = tmp_path / "s.toml"
+    held = FREE_SQUARE.replace(
+        'y_mm = 0.0 }, { name = "B"', 'y_mm = 0.0, role = "fixed" }, { name = "B"'
+    )
+    for kind, unit, words in (
+        ("distance", "mm", "1 datum defect (a rotation about the fixed points)"),
+        ("direction", "arcsec", "2 datum defects (a rotation and a scale about the fixed points)"),
+    ):
+        st.write_text(held % (kind, unit))
+        assert main(["check", str(st)]) == 2
+        err = capsys.readouterr().err
+        assert "the points A cannot fix the network's " + words in err, err

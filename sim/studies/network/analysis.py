@@ -154,11 +154,26 @@ def check_inner(net: Network, H: np.ndarray, points: list[int], key: str) -> Non
     ev = np.linalg.eigvalsh((H.T * w) @ H)
     if ev.min() <= 1e-10 * max(np.linalg.eigvalsh(H.T @ H).max(), 1e-300):
         names = ", ".join(net.names[a] for a in points[:5]) + (" ..." if len(points) > 5 else "")
+        d = H.shape[1]
         raise ConfigError(
             key,
-            f"the points {names} cannot fix the network's {H.shape[1]} datum defects "
-            "(translation, rotation, scale): choose more points, not all on one line",
+            f"the points {names} cannot fix the network's {d} datum defect{'s' * (d != 1)} "
+            f"({defect_words(H)}): choose more points, not all on one line",
         )
+
+
+def defect_words(H: np.ndarray) -> str:
+    """What the datum defects ``H`` (rows of :func:`held_defect`) are, in words: with no point
+    held two translations, a rotation and, without a length, a scale; with points held (their
+    rows zero) a rotation and a scale about them. It said "translation, rotation, scale" for
+    any count, also for the one rotation left by a fixed point."""
+    d = H.shape[1]
+    held = bool((~H.reshape(-1, 2 * d).any(axis=1)).any()) if H.size else False
+    if not held and d in (3, 4):
+        return "two translations and a rotation" + (", and a scale: no length" if d == 4 else "")
+    if held and d in (1, 2):
+        return "a rotation" + (" and a scale" if d == 2 else "") + " about the fixed points"
+    return f"{d} motions of the whole network"
 
 
 def in_datum(net: Network, an: Analytic, points: list[int]) -> np.ndarray:
