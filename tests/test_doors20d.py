@@ -34,7 +34,7 @@ from sim.cli import main
 from sim.studies import load_study
 from sim.studies.network.analysis import analyse
 from sim.studies.network.definition import build
-from sim.studies.network.gama import export, merge_gama
+from sim.studies.network.gama import export, import_note, merge_gama
 from sim.studies.network.model import datum
 
 NS = "http://www.gnu.org/software/gama/gama-local"
@@ -224,3 +224,50 @@ def test_the_defects_left_by_a_fixed_point_are_a_rotation_and_scale_about_it(tmp
         assert main(["check", str(st)]) == 2
         err = capsys.readouterr().err
         assert "the points A cannot fix the network's " + words in err, err
+
+
+# --- frames turned from ne (13 of Gama's 33 example files are axes-xy="sw") -----------------
+
+
+def turned(axes: str) -> tuple[str, np.ndarray]:
+    """FIXED_CONSTRAINED's square in the frame ``axes`` and the rotation R (ne -> axes)."""
+    R = {"es": [[0, 1], [-1, 0]], "sw": [[-1, 0], [0, -1]], "wn": [[0, -1], [1, 0]]}[axes]
+    R = np.array(R, float)
+    xy = {k: tuple(float(c) for c in R @ np.array(v)) for k, v in SQUARE.items()}
+    pts = "\n".join(
+        f'<point id="{k}" x="{x!r}" y="{y!r}" {"fix" if k == "A" else "adj"}="'
+        f'{"xy" if k in "ACD" else "XY"}"/>'
+        for k, (x, y) in xy.items()
+    )
+    xml = gama_xml(pts, obs_of(SQUARE)).replace('axes-xy="ne"', f'axes-xy="{axes}"')
+    return xml, R
+
+
+@pytest.mark.parametrize("axes", ["es", "sw", "wn"])
+def test_a_frame_turned_from_ne_is_read_with_the_same_observation_equations(tmp_path, axes):
+    """``axes-xy="sw"`` (and es, wn) was refused: only 'ne'. They are ne turned by 90, 180,
+    270 degrees (bearings still run clockwise from +x to +y), so the network is the same and
+    each point's covariance is ne's turned: R C R'."""
+    ne = ours(study_of(tmp_path, FIXED_CONSTRAINED, "ne"))
+    xml, R = turned(axes)
+    st = study_of(tmp_path, xml, axes)
+    net, an = ours(st)
+    scale = np.abs(ne[1].cov).max()  # rounding of the two solutions: 1e-11 of it
+    for a in range(net.n):
+        np.testing.assert_allclose(an.cov[a], R @ ne[1].cov[a] @ R.T, rtol=0, atol=1e-9 * scale)
+    assert f"axes-xy = '{axes}'" in import_note(load_study(st)[1])
+
+
+@needs_gama
+def test_a_sw_frame_agrees_with_gama_local(tmp_path):
+    xml, _ = turned("sw")
+    st = study_of(tmp_path, xml, "sw")
+    agree_with_gama(st, tmp_path / "sw.xml")
+
+
+@pytest.mark.parametrize("axes", ["en", "nw", "se", "ws"])
+def test_a_right_handed_frame_is_refused_naming_it(tmp_path, capsys, axes):
+    st = study_of(tmp_path, FIXED_CONSTRAINED.replace('axes-xy="ne"', f'axes-xy="{axes}"'))
+    assert main(["check", str(st)]) == 2
+    err = capsys.readouterr().err
+    assert f"'{axes}' is a right-handed frame" in err and "axes-xy" in err, err

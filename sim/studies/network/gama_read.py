@@ -243,6 +243,16 @@ def _vectors(f: _File, e, out: list) -> None:
         out.append({"kind": "dy", "from": fr, "to": to, "sigma_mm": math.sqrt(var[3 * a + 1])})
 
 
+#: gama-local's left-handed frames (x to y clockwise, as bearings run): ne and its turns by
+#: 90, 180 and 270 degrees read as ne (the observation equations are the same in each)
+TURNS = {
+    "ne": "x north, y east",
+    "es": "x east, y south: ne turned 90 degrees",
+    "sw": "x south, y west: ne turned 180 degrees",
+    "wn": "x west, y north: ne turned 270 degrees",
+}
+
+
 def _network(f: _File, data: bytes):
     """The ``<network>`` element of the file's bytes, its root and attributes checked."""
     key, path = f.key, f.path
@@ -259,8 +269,13 @@ def _network(f: _File, data: bytes):
     if len(nets) != 1:
         raise f.err(root, f"{len(nets)} <network> elements (need one)")
     net = nets[0]
-    if net.get("axes-xy", "ne").strip() != "ne":
-        raise f.err(net, f"{net.get('axes-xy')!r}: only 'ne' is supported", "axes-xy")
+    if net.get("axes-xy", "ne").strip() not in TURNS:
+        raise f.err(
+            net,
+            f"{net.get('axes-xy')!r} is a right-handed frame (bearings run from +y to +x): "
+            "only 'ne' and its turns 'es', 'sw', 'wn' are supported",
+            "axes-xy",
+        )
     if net.get("angles", "left-handed").strip() != "left-handed":
         raise f.err(net, "only left-handed angles are supported", "angles")
     if net.get("epoch") is not None:
@@ -316,6 +331,12 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         )
     net = _network(f, data)
     note = _parameters(f, [e for e in net if _tag(e) == "parameters"])
+    axes = net.get("axes-xy", "ne").strip()
+    if axes != "ne":
+        note += (
+            f"; axes-xy = {axes!r} ({TURNS[axes]}): ne turned, so every bearing, distance and "
+            "angle is the same; coordinates and covariances are in the file's frame"
+        )
     pos = [e for e in net if _tag(e) == "points-observations"]
     if len(pos) != 1:
         raise f.err(net, f"{len(pos)} <points-observations> elements (need one)")
