@@ -37,6 +37,26 @@ NOTES = {
         )
         for k in (13, 15)
     },
+    "sim.claims.intervals.x_binomial_ci__mutmut_50": (
+        "equivalent: the lower bound's np.where(k == 0, 0.0, ...) dropped; at k = 0 the Wilson "
+        "lower bound centre - half is computed as fl(z*z)/denom - fl(z*sqrt(fl(z*z)))/denom, "
+        "and sqrt(fl(z*z)) == z in IEEE arithmetic, so it is exactly 0.0 for every n and "
+        "level (checked for n = 1..2000 at seven levels). The where keeps the bound exact "
+        "should the formula change; tests/test_claim_book_checks.py pins lo == 0 at k = 0."
+    ),
+    "sim.claims.intervals.x_binomial_ci__mutmut_78": (
+        "equivalent: np.minimum(centre + half, 2.0) for 1.0; the clamp only acts where "
+        "centre + half > 1, which is at k = n only (rounding: k = n = 16 gives 1 + 2e-16), "
+        "where np.where(k == n, 1.0, ...) sets the bound to 1 anyway; for k < n the upper "
+        "bound stays <= 1 (checked for every k < n <= 2000 at seven levels and at k = n - 1 "
+        "for n = 10 .. 1e18)."
+    ),
+    "sim.claims.book.xǁClaimBookǁ__init____mutmut_159": (
+        "equivalent: the default of an omitted decimals, 1 for 0, feeds only the range check "
+        "-12 <= d <= 12, which both pass; the claim's spec keeps no decimals key (scoring "
+        "reads an omitted decimals as an exact reference), as "
+        "tests/test_claim_book_checks.py checks."
+    ),
     **{
         f"sim.claims.inference.x__evidence__mutmut_{k}": (
             "equivalent: the value array without the float dtype; it is used only as the "
