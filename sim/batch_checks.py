@@ -43,6 +43,8 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
         text = regular_text(Path(results) / "run.json")
     except OSError:
         return "no results yet" if not Path(results).exists() else "no run record (run.json)"
+    except UnicodeDecodeError:  # bytes of another tool: a traceback of make reproduce
+        return "its run record is not one (run.json is not UTF-8 text)"
     try:
         record = json.loads(text)
         with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
