@@ -35,6 +35,7 @@ from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import read_provenance
 from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
+from sim.report.read import mixed_run
 from sim.studies import load_study
 
 __all__ = ["load", "StudyHandle", "Results"]
@@ -104,6 +105,8 @@ class Results:
             raise ConfigError("table", f"{p} cannot be read ({type(e).__name__})") from None
         if name != "trials":
             _check_owner(p, self.study)
+            if (mixed := mixed_run(self.path, [p.name])) is not None:  # copied from another run
+                raise ConfigError("table", mixed)
         return table
 
     def claims(self) -> pa.Table:

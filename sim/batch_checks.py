@@ -21,6 +21,8 @@ from sim.cli_args import parser as run_parser
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, parse_override, read_toml
 from sim.mc.storage import regular_text
+from sim.mc.sweep import read_sweep
+from sim.report.read import mixed_table
 from sim.studies import get_study
 
 __all__ = ["is_current", "why_stale"]
@@ -49,14 +51,16 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
         record = json.loads(text)
         with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
             args = run_parser(cli_doc).parse_args(["run", str(study_file), *run_args])
-        _, cfg = load_run(args)
+        study, cfg = load_run(args)
+        sweep = read_sweep(args.study, study.schema)  # a sweep's record holds it (sim run)
     except (OSError, ValueError, RecursionError, ConfigError, StudyError, SystemExit):
         return "its run record or study file does not load"  # RecursionError: nested too deep
     if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
         return "its run record is not one"
     if record.get("figures") is False and not args.no_figures:  # sim run --no-figures
         return "made without figures"
-    want, have = json.loads(json.dumps(cfg)), record.get("config")
+    want = json.loads(json.dumps({**cfg, "sweep": sweep} if sweep else cfg))
+    have = record.get("config")
     if have != want:
         have = have if isinstance(have, dict) else {}
         keys = sorted(k for k in {*want, *have} if want.get(k) != have.get(k))
@@ -64,7 +68,10 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
         return f"made with another config: {', '.join(keys[:3])}{more}"
     if record.get("code_hash") != study_code_hash(cfg["study"]):
         return "made by other code: the code the study imports changed since"
-    return None
+    # a table copied in from another run (two results directories merged by hand, or one
+    # rewritten by a tool that drops its provenance) beside this run's record: not current
+    mixed = mixed_table(Path(results), missing_ok=False)
+    return None if mixed is None else f"{mixed[0].name} is not of the run of run.json: {mixed[1]}"
 
 
 def _clashes(files: list[Path], run_args: list[str], results: str = "results") -> str | None:
