@@ -12,6 +12,8 @@ results directories merged by hand), one case each; each failed on the code befo
   whose provenance is not the run record's is named (:func:`sim.report.read.mixed_run`);
 * a claims table with a claim listed twice (two tables concatenated) or with no row was read
   as it was: every count doubled, a headline claim listed twice, or "0 claims";
+* the claims table of an older version (results/ of an old clone: no `verdict` column) was
+  "not a claims table written by sim": the line says it is an older version's;
 * an unfinished run of another code version (an older clone's staging directory) was refused
   with "run that command again to finish it", which this version cannot: the line says so;
 * ``--stale-only`` called a sweep's results out of date whatever they were ("made with another
@@ -145,3 +147,14 @@ def test_an_unfinished_run_of_another_code_version_is_not_said_to_finish(
     rc = main(["run", str(BROWN), "--out", str(tmp_path / "a"), "--quiet", *tiny])
     line = one_line(capsys, rc, "a different code version", "cannot finish it", "--overwrite")
     assert "run that command again" not in line and (stage / chunk).is_file()
+
+
+def test_an_older_versions_claims_table_is_named_as_such(tmp_path, capsys):
+    d = tmp_path / "brown_table1"  # results/ of an old clone: a 'holds' column, no 'verdict'
+    d.mkdir()
+    prov = json.dumps({"study": "brown_table1", "config": {"study": "brown_table1"}}).encode()
+    t = pa.table({"claim": ["brown.x"], "value": [1.0], "holds": [True]})
+    pq.write_table(t.replace_schema_metadata({b"sim.provenance": prov}), d / "claims.parquet")
+    one_line(capsys, main(["show", str(d)]), "an older version's table", "run its study again")
+    rc = main(["report", "--results", str(tmp_path)])
+    one_line(capsys, rc, "an older version's table", "no 'verdict' column")

@@ -39,6 +39,7 @@ __all__ = [
     "claims_damage",
     "mixed_run",
     "mixed_table",
+    "older",
 ]
 
 #: every verdict a claims table of the suite holds
@@ -155,6 +156,16 @@ def claims_damage(prov: dict, verdicts: list, claims: list | None = None) -> str
     return None
 
 
+def older(prov: dict, names) -> str:
+    """``: ...`` for a claims table of an older version of the suite (its provenance names the
+    study, but it has no ``verdict`` column: the results/ of an old clone), else ``""``."""
+    if isinstance(prov, dict) and isinstance(prov.get("study"), str) and "holds" in names:
+        return (
+            " of this version: an older version's table (no 'verdict' column); run its study again"
+        )
+    return ""
+
+
 def check_claims_table(f: Path, key: str) -> None:
     """A results directory's claims table ``f`` must be one the suite wrote, of the study its
     ``run.json`` names (a :class:`ConfigError` for ``key``, naming the file, if not; nothing
@@ -166,7 +177,7 @@ def check_claims_table(f: Path, key: str) -> None:
     except (OSError, ValueError, pa.ArrowException) as e:
         raise ConfigError(key, f"{f} cannot be read: {str(e).splitlines()[0]}") from None
     if "study" not in prov or not {"claim", "verdict"} <= set(names):
-        raise ConfigError(key, f"{f} is not a claims table written by sim")
+        raise ConfigError(key, f"{f} is not a claims table written by sim{older(prov, names)}")
     try:
         cols = pq.read_table(f, columns=["claim", "verdict"])
         verdicts, claims = cols.column("verdict").to_pylist(), cols.column("claim").to_pylist()
