@@ -39,6 +39,7 @@ from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import read_provenance
 from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
+from sim.report.read import mixed_run
 from sim.studies import load_study
 
 __all__ = ["load", "StudyHandle", "Results"]
@@ -130,6 +131,8 @@ class Results:
             raise ConfigError("table", f"{p} cannot be read ({type(e).__name__})") from None
         if not dataset:
             _check_owner(p, self.study)
+            if (mixed := mixed_run(self.path, [p.name])) is not None:  # copied from another run
+                raise ConfigError("table", mixed)
         self._check_dir()  # replaced while it was read
         return table
 

@@ -22,6 +22,7 @@ from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, parse_override, read_toml
 from sim.mc.storage import regular_text
 from sim.mc.sweep import read_sweep
+from sim.report.read import mixed_table
 from sim.studies import get_study
 
 __all__ = ["is_current", "why_stale"]
@@ -44,6 +45,8 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
         text = regular_text(Path(results) / "run.json")
     except OSError:
         return "no results yet" if not Path(results).exists() else "no run record (run.json)"
+    except UnicodeDecodeError:  # bytes of another tool: a traceback of make reproduce
+        return "its run record is not one (run.json is not UTF-8 text)"
     try:
         record = json.loads(text)
         with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
@@ -67,7 +70,10 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
         return f"made with another config: {', '.join(keys[:3])}{more}"
     if record.get("code_hash") != study_code_hash(cfg["study"]):
         return "made by other code: the code the study imports changed since"
-    return None
+    # a table copied in from another run (two results directories merged by hand, or one
+    # rewritten by a tool that drops its provenance) beside this run's record: not current
+    mixed = mixed_table(Path(results), missing_ok=False)
+    return None if mixed is None else f"{mixed[0].name} is not of the run of run.json: {mixed[1]}"
 
 
 def _clashes(files: list[Path], run_args: list[str], results: str = "results") -> str | None:

@@ -265,10 +265,15 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
         elif old is None or old.get("failed") or overwrite:
             _clear(stage)  # ours (locked, a record or a lock file), and not resumable
         else:
+            how = _differs(old, record)
+            finish = (  # another code version: only that version can finish it, not this one
+                "this version of the suite cannot finish it; "
+                if how == "a different code version"
+                else "run that command again to finish it, or "
+            )
             raise ConfigError(
                 "--out",
-                f"{stage} holds an unfinished run of {_differs(old, record)}; run that "
-                "command again to finish it, or use --overwrite to replace it",
+                f"{stage} holds an unfinished run of {how}; {finish}use --overwrite to replace it",
             )
         for tmp in stage.rglob("*.tmp"):  # a write cut short by a kill
             tmp.unlink(missing_ok=True)

@@ -22,7 +22,7 @@ from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
 from sim.report.glance import by_paper, design_notes, number, opening
 from sim.report.papers import paper_name
-from sim.report.read import claims_damage, forget, records
+from sim.report.read import claims_damage, forget, mixed_run, older, records
 from sim.report.run_summary import headline_rows, write_run_readme
 from sim.report.tables import fmt, md_table
 from sim.report.verify import markdown as reproducibility_markdown
@@ -236,10 +236,15 @@ def _claims_of(d: Path, get_study: Callable):
     except (OSError, ValueError, pa.ArrowException) as e:
         raise ConfigError("--results", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
     if "study" not in prov or (claims and not {"claim", "verdict"} <= set(claims[0])):
-        raise ConfigError("--results", f"{f} is not a claims table written by sim")
-    damage = claims_damage(prov, [r["verdict"] for r in claims])
+        names = claims[0] if claims else ()
+        raise ConfigError(
+            "--results", f"{f} is not a claims table written by sim{older(prov, names)}"
+        )
+    damage = claims_damage(prov, [r["verdict"] for r in claims], [r["claim"] for r in claims])
     if damage:
         raise ConfigError("--results", f"{f} is not a claims table written by sim: {damage}")
+    if (mixed := mixed_run(d)) is not None:
+        raise ConfigError("--results", mixed)
     return get_study(prov["study"]), prov, claims
 
 

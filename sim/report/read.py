@@ -37,6 +37,9 @@ __all__ = [
     "forget",
     "damaged_message",
     "claims_damage",
+    "mixed_run",
+    "mixed_table",
+    "older",
 ]
 
 #: every verdict a claims table of the suite holds
@@ -132,16 +135,35 @@ def damaged_message(root: Path, e: Exception) -> str:
     return f"{where} under {root} is not as sim wrote it ({why}); run its study again"
 
 
-def claims_damage(prov: dict, verdicts: list) -> str | None:
-    """What makes a claims table (its provenance, its ``verdict`` column) one the suite did not
-    write, or None: a study that is not a name, or a verdict outside the suite's vocabulary
-    (a table edited by hand: a made-up verdict, a line break that would split a row)."""
+def claims_damage(prov: dict, verdicts: list, claims: list | None = None) -> str | None:
+    """What makes a claims table (its provenance, its ``verdict`` and ``claim`` columns) one
+    the suite did not write, or None: a study that is not a name, no row (every study scores
+    its claim book), a claim listed twice (two tables concatenated: every count doubled), or a
+    verdict outside the suite's vocabulary (a table edited by hand: a made-up verdict, a line
+    break that would split a row)."""
     if not isinstance(prov.get("study"), str):
         return f"its provenance names no study ({prov.get('study')!r:.40})"
+    if not verdicts:
+        return "it holds no claim"
+    seen: set = set()
+    for c in claims or ():
+        if c in seen:
+            return f"it lists the claim {c!r:.60} twice"
+        seen.add(c)
     for v in verdicts:
         if v not in KNOWN_VERDICTS:
             return f"it holds the verdict {v!r:.40}, which sim never writes"
     return None
+
+
+def older(prov: dict, names) -> str:
+    """``: ...`` for a claims table of an older version of the suite (its provenance names the
+    study, but it has no ``verdict`` column: the results/ of an old clone), else ``""``."""
+    if isinstance(prov, dict) and isinstance(prov.get("study"), str) and "holds" in names:
+        return (
+            " of this version: an older version's table (no 'verdict' column); run its study again"
+        )
+    return ""
 
 
 def check_claims_table(f: Path, key: str) -> None:
@@ -155,12 +177,13 @@ def check_claims_table(f: Path, key: str) -> None:
     except (OSError, ValueError, pa.ArrowException) as e:
         raise ConfigError(key, f"{f} cannot be read: {str(e).splitlines()[0]}") from None
     if "study" not in prov or not {"claim", "verdict"} <= set(names):
-        raise ConfigError(key, f"{f} is not a claims table written by sim")
+        raise ConfigError(key, f"{f} is not a claims table written by sim{older(prov, names)}")
     try:
-        verdicts = pq.read_table(f, columns=["verdict"]).column("verdict").to_pylist()
+        cols = pq.read_table(f, columns=["claim", "verdict"])
+        verdicts, claims = cols.column("verdict").to_pylist(), cols.column("claim").to_pylist()
     except (OSError, ValueError, pa.ArrowException) as e:
         raise ConfigError(key, f"{f} cannot be read: {str(e).splitlines()[0]}") from None
-    damage = claims_damage(prov, verdicts)
+    damage = claims_damage(prov, verdicts, claims)
     if damage:
         raise ConfigError(key, f"{f} is not a claims table written by sim: {damage}")
     run = (read_record(f.parent) or {}).get("config")
@@ -169,3 +192,65 @@ def check_claims_table(f: Path, key: str) -> None:
         raise ConfigError(
             key, f"{f} is a table of {prov['study']!r}, not of this run's {owner!r} (run.json)"
         )
+    if (mixed := mixed_run(f.parent)) is not None:
+        raise ConfigError(key, mixed)
+
+
+def _other_run(prov: Any, record: dict) -> str | None:
+    """How a table's provenance differs from the run record's config and code, or None."""
+    if not isinstance(prov, dict) or not prov:
+        return "it carries no provenance"
+    if "config" not in prov or "code_hash" not in prov:
+        return "its provenance records no config and code hash: an older version's table"
+    mine, theirs = prov["config"], record.get("config")
+    if isinstance(mine, dict) and prov.get("sweep"):  # a sweep's table: its record adds the sweep
+        mine = {**mine, "sweep": prov["sweep"]}
+    if mine != theirs:
+        mine, theirs = (x if isinstance(x, dict) else {} for x in (mine, theirs))
+        keys = sorted(k for k in {*mine, *theirs} if mine.get(k) != theirs.get(k))
+        more = f" and {len(keys) - 3} more" if len(keys) > 3 else ""
+        return f"made with another config: {', '.join(map(str, keys[:3]))}{more}"
+    if prov["code_hash"] != record.get("code_hash"):
+        code = f"{prov['code_hash']!s:.20}, run.json's {record.get('code_hash')!s:.20}"
+        return f"made by other code: code hash {code}"
+    return None
+
+
+def mixed_table(
+    d: Path, names: list[str] | None = None, missing_ok: bool = True
+) -> tuple[Path, str] | None:
+    """The first table of the results directory ``d`` (``names``: only these, e.g.
+    ``["points.parquet"]``) that is not of the run its ``run.json`` records, and how
+    (:func:`mixed_run`); None when every one is."""
+    record = read_record(d)
+    if record is None:  # no run record: nothing to check against
+        return None
+    for p in sorted(Path(d) / n for n in names) if names else sorted(Path(d).glob("*.parquet")):
+        if not p.is_file():
+            continue
+        try:
+            prov = read_provenance(p)
+        except (OSError, ValueError, pa.ArrowException):
+            continue  # not Parquet: its reader names it
+        why = _other_run(prov, record)
+        if why is not None and not (missing_ok and not prov):
+            return p, why
+    return None
+
+
+def mixed_run(d: Path, names: list[str] | None = None, missing_ok: bool = True) -> str | None:
+    """Why the tables of the results directory ``d`` are not all of the run its ``run.json``
+    records (one line), or None. Every table the suite writes carries the config and code hash
+    of its run (its provenance), so a table copied in from another run -- an older version's
+    results, another config's, two results directories merged by hand -- is named here, never
+    read as this run's verdicts (``sim show``, ``sim report``, ``Results.table``) nor called
+    current (``--stale-only``). A table with no provenance at all (rewritten by a tool that
+    drops schema metadata) is passed when ``missing_ok`` (its numbers are read and checked as
+    they are); a directory without a run record has nothing to check against (None)."""
+    found = mixed_table(d, names, missing_ok)
+    if found is None:
+        return None
+    return (
+        f"{found[0]} is not a table of the run its run.json records ({found[1]}): the "
+        "directory mixes results of two runs; run its study again"
+    )
