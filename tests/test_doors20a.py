@@ -50,6 +50,7 @@ from oneline import python_lines
 import sim
 from sim.mc.executors import script_words
 from sim.mc.progress import Progress
+from sim.mc.storage import read_provenance
 from sim.stops import keep_lost_interrupts
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -107,9 +108,8 @@ def test_results_of_a_run_replaced_by_another_are_refused(tmp_path):
 def test_a_studys_own_trials_table_is_read_and_the_chunks_are_named_chunks(tmp_path):
     res = sim.load(STUDY, trials=40, chunk=2).run(out=tmp_path / "o", figures=False)
     assert res.table("trials").num_rows == 40 == res.table("chunks").num_rows
-    sim.write_table(
-        tmp_path / "o" / "trials.parquet", {"trial": list(range(5))}, {"study": "network"}
-    )
+    prov = read_provenance(tmp_path / "o" / "claims.parquet")  # written by the run (wolf's is)
+    sim.write_table(tmp_path / "o" / "trials.parquet", {"trial": list(range(5))}, prov)
     names = sim.Results(tmp_path / "o", "network").names()
     assert len(names) == len(set(names)) and {"trials", "chunks"} <= set(names), names
     own = sim.Results(tmp_path / "o", "network")
