@@ -32,7 +32,7 @@ import pyarrow as pa
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
 from sim.cli_args import module_doc, parser
-from sim.cli_errors import cwd_exists, os_reason, stdout_failed
+from sim.cli_errors import cwd_exists, not_as_written, os_reason, stdout_failed
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
@@ -43,7 +43,7 @@ from sim.mc.storage import code_hash, read_record, umask_problem
 from sim.mc.sweep import read_sweep
 from sim.mc.toml_text import toml_value
 from sim.report.markdown import write_report
-from sim.report.read import check_claims_table, damaged_message
+from sim.report.read import check_claims_table
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.studies import design_config, get_study, load_study
@@ -231,16 +231,10 @@ def _show(args) -> int:
     except ConfigError:
         raise
     except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
-        raise ConfigError("DIR", _not_as_written(d, e)) from None
+        raise ConfigError("DIR", not_as_written(d, e)) from None
     print(text, end="")
     print("" if args.markdown else "\n", end="")
     return 0
-
-
-def _not_as_written(d: Path, e: Exception) -> str:
-    """show and report read the Parquet tables only: one that fails to read as its study's
-    table was replaced or edited by hand (named with its column by the reader)."""
-    return damaged_message(d, e)
 
 
 def _n(x: float) -> str:
@@ -302,7 +296,7 @@ def _report(results: Path) -> int:
     except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
         # report reads the Parquet tables only: one that fails here was not written as it is
         # by sim (a table replaced or edited by hand)
-        raise ConfigError("--results", _not_as_written(results, e)) from None
+        raise ConfigError("--results", not_as_written(results, e)) from None
     print(text)
     return 0
 

@@ -1,11 +1,19 @@
 """How the command line tells an operating-system error in its one line: whether standard
 output itself failed (``sim check > /dev/full``), whether the working directory is gone, and the
-reason of an OSError in words (pyarrow raises some without one)."""
+reason of an OSError in words (pyarrow raises some without one); and why a results directory
+could not be read by show or report (a table not as sim wrote it, or results of another
+version of the suite's code)."""
 
 import linecache
 import os
+from pathlib import Path
 
-__all__ = ["cwd_exists", "stdout_failed", "os_reason"]
+from sim.mc.codehash import study_code_hash
+from sim.mc.outputs import results_dirs
+from sim.mc.storage import read_record
+from sim.report.read import damaged_message
+
+__all__ = ["cwd_exists", "stdout_failed", "os_reason", "not_as_written", "other_code"]
 
 
 def cwd_exists() -> bool:
@@ -40,3 +48,31 @@ def os_reason(e: OSError) -> str:
     if len(e.args) == 1 and isinstance(e.args[0], str):  # OSError(path): the path is all
         return type(e).__name__
     return str(e) or type(e).__name__
+
+
+def not_as_written(d: Path, e: Exception) -> str:
+    """show and report read the Parquet tables only: one that fails to read as its study's
+    table was replaced or edited by hand (named with its column by the reader), or was
+    written by another version of the suite (results of an older clone: then said so)."""
+    older = other_code(d)
+    if older:
+        return (
+            f"{older} was made by another version of the suite's code, which this version "
+            f"cannot read ({type(e).__name__}: {str(e)[:80]}): run its study again "
+            "(make reproduce re-runs what is stale)"
+        )
+    return damaged_message(d, e)
+
+
+def other_code(d: Path) -> str | None:
+    """The first results directory at or under ``d`` whose run record names a study whose
+    code has changed since (its ``code_hash`` is not this suite's), or None."""
+    for r in [d, *results_dirs(d)] if d.is_dir() else []:
+        rec = read_record(r)
+        study = rec.get("config", {}).get("study") if rec else None
+        try:
+            if isinstance(study, str) and rec["code_hash"] != study_code_hash(study):
+                return str(r)
+        except (KeyError, ValueError, OSError, ImportError):  # an unknown study: not ours
+            continue
+    return None

@@ -158,3 +158,29 @@ def test_an_older_versions_claims_table_is_named_as_such(tmp_path, capsys):
     one_line(capsys, main(["show", str(d)]), "an older version's table", "run its study again")
     rc = main(["report", "--results", str(tmp_path)])
     one_line(capsys, rc, "an older version's table", "no 'verdict' column")
+
+
+def test_results_of_an_older_version_that_the_report_cannot_read_say_so(tiny_run, tmp_path, capsys):
+    """Results of an older clone (their config without a key this version reads) ended in
+    "a table ... is not as sim wrote it (KeyError: 'region.trials'); run its study again", as
+    if edited by hand: the run record's code hash names another version of the code."""
+    d = tmp_path / "results" / "salsig_encoders"
+    shutil.copytree(tiny_run("salsig_encoders"), d)
+
+    def older(cfg: dict) -> None:
+        del cfg["region.trials"]  # salsig's report names it (its region's simulated models)
+
+    def older_prov(prov):
+        older(prov["config"])
+        prov["code_hash"] = "0" * 16
+
+    for p in d.glob("*.parquet"):
+        _rewrite(p, older_prov)
+    rec = json.loads((d / "run.json").read_text())
+    older(rec["config"])
+    rec["code_hash"] = "0" * 16
+    (d / "run.json").write_text(json.dumps(rec))
+    rc = main(["report", "--results", str(d.parent)])
+    err = capsys.readouterr().err
+    assert rc == 2 and "made by another version of the suite's code" in err, err
+    assert "make reproduce" in err and len(err.splitlines()) == 1, err
