@@ -20,6 +20,7 @@ each failed on the code before its fix.
 
 import pytest
 from oneline import one_line
+from test_claim_book_checks import GOOD  # a claim every rule accepts
 
 from sim import cli
 from sim.claims.book import ClaimBook
@@ -31,16 +32,6 @@ from sim.studies.salsig import region as salsig_region
 from sim.studies.salsig.region import DECLARATION, nominal
 
 SALSIG = "studies/salsig_encoders.toml"
-GOOD = {
-    "id": "c",
-    "source": "s",
-    "paper": "p",
-    "kind": "prediction",
-    "form": "value",
-    "ref": 1.7,
-    "decimals": 1,
-    "tol": 0.0,
-}
 
 
 @pytest.mark.parametrize(
