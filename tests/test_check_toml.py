@@ -9,6 +9,7 @@ import math
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sim.cli import main
@@ -54,6 +55,16 @@ def test_a_value_comes_back_from_its_toml_text(value):
     assert back == value and type(back) is type(value)
     if isinstance(value, float):
         assert math.copysign(1, back) == math.copysign(1, value)
+
+
+def test_numpy_values_are_written_as_the_numbers_they_hold():
+    v = {"f": np.float64(1.5), "i": np.int64(-3), "b": np.bool_(True), "a": np.arange(3.0)}
+    assert tomllib.loads(f"k = {toml_value(v)}")["k"] == {
+        "f": 1.5,
+        "i": -3,
+        "b": True,
+        "a": [0.0, 1.0, 2.0],
+    }
 
 
 def test_nan_and_a_tuple_and_what_toml_cannot_hold():

@@ -15,6 +15,8 @@ import math
 import re
 from typing import Any
 
+import numpy as np
+
 __all__ = ["toml_value", "toml_key"]
 
 _BARE = re.compile(r"[A-Za-z0-9_-]+")
@@ -27,15 +29,20 @@ def toml_key(key: str) -> str:
 
 def toml_value(v: Any) -> str:
     """``v`` (a value of a resolved config: bool, int, float, str, list/tuple, dict) as TOML;
-    ``TypeError`` for anything else (``None`` has no TOML form)."""
+    ``TypeError`` for anything else (``None`` has no TOML form). A NumPy scalar is written as
+    the Python number it holds (``repr`` of ``np.float64(1.5)`` is not TOML)."""
+    if isinstance(v, np.generic):
+        v = v.item()
+    if isinstance(v, np.ndarray):
+        v = v.tolist()
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, int):
-        return str(v)
+        return str(int(v))
     if isinstance(v, float):
         if math.isnan(v):
             return "nan"
-        return repr(v) if math.isfinite(v) else ("inf" if v > 0 else "-inf")
+        return repr(float(v)) if math.isfinite(v) else ("inf" if v > 0 else "-inf")
     if isinstance(v, str):  # DEL must be escaped in TOML, not in JSON
         return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007f")
     if isinstance(v, (list, tuple)):
