@@ -214,9 +214,9 @@ def memory_words(e: BaseException | None = None) -> str:
     NumPy's "Unable to allocate ..."), and the limit if one is set."""
     cap = resource.getrlimit(resource.RLIMIT_AS)[0]
     limit = f" (ulimit -v is {cap // 1024} kB)" if cap != resource.RLIM_INFINITY else ""
-    what = "to load the suite and its libraries"
-    if isinstance(e, MemoryError) and str(e):
-        what = f"for the run: {str(e).splitlines()[0][:200]}"
+    what = "to load the suite and its libraries"  # a library that could not be mapped
+    if isinstance(e, MemoryError):  # the command's own work (a run, a huge table to show):
+        what = "for this command" + (f": {str(e).splitlines()[0][:200]}" if str(e) else "")
     return f"not enough memory {what}{limit}"
 
 

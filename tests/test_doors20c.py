@@ -184,3 +184,18 @@ def test_results_of_an_older_version_that_the_report_cannot_read_say_so(tiny_run
     err = capsys.readouterr().err
     assert rc == 2 and "made by another version of the suite's code" in err, err
     assert "make reproduce" in err and len(err.splitlines()) == 1, err
+
+
+def test_a_table_too_large_for_memory_is_not_blamed_on_loading_the_libraries(
+    tiny_run, tmp_path, capsys, monkeypatch
+):
+    """A claims table of a million rows under ``ulimit -v``: pyarrow's bare MemoryError read
+    "not enough memory to load the suite and its libraries", though they had loaded."""
+    d = _copy(tiny_run, tmp_path)
+
+    def huge(*a, **k):
+        raise MemoryError()
+
+    monkeypatch.setattr("sim.cli.terminal_table", huge)
+    err = one_line(capsys, main(["show", str(d)]), "not enough memory for this command")
+    assert "load the suite" not in err
