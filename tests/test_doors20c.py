@@ -199,3 +199,23 @@ def test_a_table_too_large_for_memory_is_not_blamed_on_loading_the_libraries(
     monkeypatch.setattr("sim.cli.terminal_table", huge)
     err = one_line(capsys, main(["show", str(d)]), "not enough memory for this command")
     assert "load the suite" not in err
+
+
+def test_verify_says_when_the_committed_results_were_made_by_other_code(tiny_run, tmp_path):
+    """Only the code differs (an older clone's results): the FAILED line listed deviations
+    and did not say the committed results were stale."""
+    d = _copy(tiny_run, tmp_path)
+    for p in d.glob("*.parquet"):
+        _rewrite(p, lambda prov: prov.update(code_hash="0" * 16))
+    rec = json.loads((d / "run.json").read_text())
+    rec["code_hash"] = "0" * 16
+    (d / "run.json").write_text(json.dumps(rec))
+    t = pq.read_table(d / "points.parquet")
+    col = next(n for n in t.column_names if pa.types.is_floating(t.schema.field(n).type))
+    moved = pa.array([x * 1.5 + 1.0 for x in t.column(col).to_pylist()])
+    _rewrite(d / "points.parquet", table=t.set_column(t.column_names.index(col), col, moved))
+    scratch = tmp_path / "scratch"
+    shutil.copytree(tiny_run("brown_table1"), scratch / "brown_table1")
+    [comp] = verify(d.parent, scratch, rerun=False)
+    assert not comp.ok and "made by other code (code hash 0000000000000000" in comp.failures[0]
+    assert len(comp.failures) > 1  # the deviations follow

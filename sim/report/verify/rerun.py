@@ -205,8 +205,24 @@ def verify(
             c.failures.append(stale)
             out.append(c)
             continue
-        out.append(compare_dirs(d, target, d.name, mode))
+        comp = compare_dirs(d, target, d.name, mode)
+        if not comp.ok and (older := _other_code(d, target)):  # why, before the deviations
+            comp.failures.insert(0, older)
+        out.append(comp)
     return out
+
+
+def _other_code(d: Path, target: Path) -> str | None:
+    """That the committed results ``d`` were made by other code than the re-run ``target``
+    (their run records' code hashes differ), or None: deviations are then expected of stale
+    results, and the FAILED line listed them without saying so."""
+    a, b = read_record(d), read_record(target)
+    if not (a and b) or a.get("code_hash") == b.get("code_hash"):
+        return None
+    return (
+        f"the committed results were made by other code (code hash {a.get('code_hash')}, this "
+        f"version's {b.get('code_hash')}): they are stale; run make reproduce, then verify"
+    )
 
 
 def _other_config(d: Path, target: Path) -> str | None:
