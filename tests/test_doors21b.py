@@ -1,0 +1,72 @@
+"""The classes of the sweep doors21b (every number a reader sees of a claim, traced to its
+table), one case each on a hand-made claims row; each failed on the code before its fix.
+
+* a Monte-Carlo value and interval below 1e-9 (a self-check's residual, a tiny bias) printed as
+  ``0.000000000 [0.000000000, 0.000000000]`` in README.md, ``sim show`` and REPORT.md's first
+  screen, and a decision zone of such a size as ``≤ 0.000000000``: the decimals were capped at
+  nine (:func:`sim.report.claimtext.decimals_for`, :func:`sim.report.tables.fmt`), so a nonzero
+  value read as zero and its interval as of zero width. They print in significant digits now.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from sim.report.claimtext import interval_text, ref_text, sim_text
+from sim.report.glance import _sig3
+from sim.report.tables import fmt
+
+NUM = re.compile(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
+
+
+def _row(**kw) -> dict:
+    r = dict(
+        claim="x.tiny",
+        verdict="holds",
+        interval="ci",
+        form="upper",
+        value=1.23e-11,
+        value_high=math.nan,
+        ci_low=1.20e-11,
+        ci_high=1.26e-11,
+        zone_low=math.nan,
+        zone_high=3.0e-11,
+        p_plate=None,
+        headline=True,
+    )
+    r.update(kw)
+    return r
+
+
+def _numbers(text: str) -> list[float]:
+    return [float(t) for t in NUM.findall(text)]
+
+
+def test_a_tiny_monte_carlo_value_and_its_interval_print_as_what_they_are():
+    r = _row()
+    for text, want in (
+        (sim_text(r), [r["value"]]),
+        (interval_text(r), [r["ci_low"], r["ci_high"]]),
+        (_sig3(r), [r["value"], r["ci_low"], r["ci_high"]]),
+        (ref_text(r), [r["zone_high"]]),
+    ):
+        got = _numbers(text)
+        assert len(got) == len(want), text
+        for g, w in zip(got, want):
+            assert g != 0 and abs(g - w) <= 0.01 * abs(w), (text, w)
+    lo, hi = _numbers(interval_text(r))
+    assert lo < hi  # the interval does not read as of zero width
+
+
+def test_a_value_far_above_its_tiny_interval_keeps_its_decimals_in_fixed_notation():
+    r = _row(value=5.0, ci_low=5 - 1e-11, ci_high=5 + 1e-11, zone_high=6.0)
+    lo, hi = _numbers(interval_text(r))
+    assert lo < 5 < hi and sim_text(r).startswith("5.0000000000")
+
+
+def test_fmt_never_prints_a_nonzero_number_as_zero():
+    for x in (1.234e-12, -4.5e-10, 7e-300):
+        text = fmt(x)
+        assert float(text) != 0 and abs(float(text) - x) <= 0.01 * abs(x), text
+    assert fmt(3.13e-5) == "0.0000313"  # what the shipped results print is unchanged
