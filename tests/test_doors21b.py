@@ -5,7 +5,11 @@ table), one case each on a hand-made claims row; each failed on the code before 
   ``0.000000000 [0.000000000, 0.000000000]`` in README.md, ``sim show`` and REPORT.md's first
   screen, and a decision zone of such a size as ``≤ 0.000000000``: the decimals were capped at
   nine (:func:`sim.report.claimtext.decimals_for`, :func:`sim.report.tables.fmt`), so a nonzero
-  value read as zero and its interval as of zero width. They print in significant digits now.
+  value read as zero and its interval as of zero width. They print in significant digits now;
+* REPORT.md's *Every headline claim* printed a variant run's rows (``agnard_block_104``, every
+  verdict ``finding``) under the same claim names as the main run's, told apart only by the
+  link target, and the study's title twice: a variant's rows now name their directory and say
+  they are not counted.
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ NUM = re.compile(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 def _row(**kw) -> dict:
     r = dict(
         claim="x.tiny",
+        paper="a sentence of the paper",
         verdict="holds",
         interval="ci",
         form="upper",
@@ -70,3 +75,25 @@ def test_fmt_never_prints_a_nonzero_number_as_zero():
         text = fmt(x)
         assert float(text) != 0 and abs(float(text) - x) <= 0.01 * abs(x), text
     assert fmt(3.13e-5) == "0.0000313"  # what the shipped results print is unchanged
+
+
+def test_a_variant_runs_headline_rows_in_report_md_say_whose_they_are():
+    """REPORT.md's *Every headline claim* printed ``agnard_block_104``'s rows (verdict
+    ``finding``) under the same claim names as ``agnard_block``'s (``undecidable``...), told
+    apart only by a link target, and the paper's study title twice."""
+    from types import SimpleNamespace
+
+    from sim.report.markdown import referee_summary
+
+    study = SimpleNamespace(name="blk", title="The block", seed_file="agnard.toml")
+    main = [_row(claim="blk.headline", verdict="undecidable")]
+    variant = [_row(claim="blk.headline", verdict="finding")]
+    md = referee_summary(
+        [(None, "blk", study, main, None), (None, "blk_104", study, variant, None)]
+    )
+    rows = [line for line in md.splitlines() if line.startswith("| [`blk.headline`]")]
+    assert len(rows) == 2
+    main_row, variant_row = rows
+    assert "(blk/README.md) |" in main_row and "undecidable" in main_row
+    assert "(blk_104/README.md) (`blk_104`, not counted) |" in variant_row
+    assert md.count("The block") == 1

@@ -17,7 +17,7 @@ from sim.report.papers import paper_name
 from sim.report.run_summary import headline_rows, region_line, verdict_line
 from sim.report.tables import fmt, md_table
 
-__all__ = ["opening", "by_paper", "number", "VERDICT_TEXT"]
+__all__ = ["opening", "by_paper", "main_and_variants", "number", "VERDICT_TEXT"]
 
 
 VERDICT_TEXT = {
@@ -92,7 +92,7 @@ def by_paper(entries: list[tuple]) -> dict[str, list]:
     return by_seed
 
 
-def _main_and_variants(studies: list[tuple]) -> tuple[list, list]:
+def main_and_variants(studies: list[tuple]) -> tuple[list, list]:
     """The studies of one paper split into its main runs (one per registered study, the
     directory named as the study first) and the variants (another run of a study already
     shown, e.g. ``agnard_block_104``: the same study at a real block's size)."""
@@ -162,7 +162,7 @@ def opening(entries: list[tuple], results: Path) -> str:
                 f"(its tables say so), not of `{name}`: a directory renamed or swapped by hand"
             )
     for seed in sorted(s for s in by_seed if s):
-        main, other = _main_and_variants(by_seed[seed])
+        main, other = main_and_variants(by_seed[seed])
         rows.append(_paper_row(seed, main))
         for name, study, claims in other:
             variants.append(_variant_note(results, name, study, claims, study.name))
