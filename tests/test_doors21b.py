@@ -9,7 +9,10 @@ table), one case each on a hand-made claims row; each failed on the code before 
 * REPORT.md's *Every headline claim* printed a variant run's rows (``agnard_block_104``, every
   verdict ``finding``) under the same claim names as the main run's, told apart only by the
   link target, and the study's title twice: a variant's rows now name their directory and say
-  they are not counted.
+  they are not counted;
+* REPORT.md's first screen printed an exact value at 3 significant digits even where they
+  cross an edge of the decision zone (1.4999 against ``≥ 1.5``, verdict fails, read "1.50"):
+  it keeps the digits README.md prints there.
 """
 
 from __future__ import annotations
@@ -97,3 +100,13 @@ def test_a_variant_runs_headline_rows_in_report_md_say_whose_they_are():
     assert "(blk/README.md) |" in main_row and "undecidable" in main_row
     assert "(blk_104/README.md) (`blk_104`, not counted) |" in variant_row
     assert md.count("The block") == 1
+
+
+def test_report_md_first_screen_keeps_an_exact_value_on_its_side_of_the_zone():
+    """An exact 1.4999 against ``≥ 1.5`` (verdict fails) read "1.50" on REPORT.md's first
+    screen, while README.md and ``sim show`` print 1.4999."""
+    r = _row(interval="exact", verdict="fails", form="lower", value=1.4999, zone_low=1.5)
+    r.update(ci_low=1.4999, ci_high=1.4999, zone_high=math.nan)
+    assert float(_sig3(r)) < 1.5 and _sig3(r) == sim_text(r) == "1.4999"
+    r.update(value=-59.2, zone_low=-59.25, zone_high=-59.15, form="value", verdict="holds")
+    assert _sig3(r) == "-59.2"  # 3 significant digits where they stay on their side

@@ -9,7 +9,7 @@ import math
 
 from sim.report.tables import fmt
 
-__all__ = ["decimals_for", "fmt_at", "ref_text", "sim_text", "interval_text"]
+__all__ = ["decimals_for", "fmt_at", "ref_text", "sim_text", "interval_text", "exact_text"]
 
 
 def ref_text(r) -> str:
@@ -68,6 +68,9 @@ def _exact(x, r=None) -> str:
         if all((y < b) == (x < b) and (y > b) == (x > b) for b in edges):
             return text
     return f"{x:.10g}"
+
+
+exact_text = _exact
 
 
 def sim_text(r) -> str:

@@ -12,7 +12,7 @@ from typing import Callable
 import pyarrow as pa
 
 from sim.mc.storage import read_provenance
-from sim.report.claimtext import decimals_for, fmt_at
+from sim.report.claimtext import decimals_for, exact_text, fmt_at
 from sim.report.papers import paper_name
 from sim.report.run_summary import headline_rows, region_line, verdict_line
 from sim.report.tables import fmt, md_table
@@ -67,6 +67,24 @@ def _num(x, dec: int | None) -> str:
     return fmt_at(x, three if dec is None else min(dec, three))
 
 
+def _on_its_side(x, text: str, r: dict) -> str:
+    """``text`` (``x`` at 3 significant digits), or the digits that keep it on its side of
+    each edge of the claim's decision zone where 3 do not (an exact 1.4999 against ``≥ 1.5``
+    read "1.50" and *fails*; README.md prints 1.4999)."""
+    try:
+        y = float(text)
+    except ValueError:
+        return text
+    for b in (number(r.get("zone_low")), number(r.get("zone_high"))):
+        if (
+            isinstance(b, (int, float))
+            and math.isfinite(b)
+            and ((y < b) != (x < b) or (y > b) != (x > b))
+        ):
+            return exact_text(x, r)
+    return text
+
+
 def _sig3(r: dict) -> str:
     """A claim's simulated value at the precision its interval supports, at most 3
     significant digits (a range over a region as low–high); its 95 % interval after it
@@ -75,10 +93,11 @@ def _sig3(r: dict) -> str:
         return ""
     lo, hi = number(r.get("ci_low")), number(r.get("ci_high"))
     dec = decimals_for(lo, hi) if r["interval"] != "exact" else None
-    v = _num(r["value"], dec)
+    num = _num if r["interval"] != "exact" else lambda x, d: _on_its_side(x, _num(x, d), r)
+    v = num(r["value"], dec)
     vh = number(r.get("value_high"))
     if vh is not None and vh != r["value"]:
-        v += f"–{_num(vh, dec)}"
+        v += f"–{num(vh, dec)}"
     same = (lo, hi) == (r["value"], vh) or lo == hi
     if r["interval"] != "exact" and lo is not None and not same:
         v += f" [{_num(lo, dec)}, {_num(hi, dec)}]"
