@@ -12,7 +12,11 @@ table), one case each on a hand-made claims row; each failed on the code before 
   they are not counted;
 * REPORT.md's first screen printed an exact value at 3 significant digits even where they
   cross an edge of the decision zone (1.4999 against ``≥ 1.5``, verdict fails, read "1.50"):
-  it keeps the digits README.md prints there.
+  it keeps the digits README.md prints there;
+* the count line of REPORT.md's first screen, README.md and ``sim show`` counted a paper-check
+  that holds (the paper's own arithmetic) as ``holds`` (Wolf & Pearsall: "47 holds", none of
+  them a prediction) while *Counts per study* said ``paper consistent``; that table in turn
+  counted an inconclusive paper-check as ``paper consistent``.
 """
 
 from __future__ import annotations
@@ -110,3 +114,32 @@ def test_report_md_first_screen_keeps_an_exact_value_on_its_side_of_the_zone():
     assert float(_sig3(r)) < 1.5 and _sig3(r) == sim_text(r) == "1.4999"
     r.update(value=-59.2, zone_low=-59.25, zone_high=-59.15, form="value", verdict="holds")
     assert _sig3(r) == "-59.2"  # 3 significant digits where they stay on their side
+
+
+def test_a_paper_check_is_counted_alike_on_the_first_screen_and_in_the_counts_per_study():
+    """REPORT.md's first screen (and README.md's and ``sim show``'s count line) counted a
+    paper-check that holds (the paper's own arithmetic) as ``holds``: Wolf & Pearsall read
+    "47 holds" though none of its predictions holds, while *Counts per study* read holds 0,
+    paper consistent 47; and that table counted a paper-check the simulation left
+    inconclusive (gridplate_two_plates, 2) as ``paper consistent``."""
+    from sim.report.markdown import verdict_counts
+    from sim.report.run_summary import verdict_line
+
+    claims = [
+        {"kind": "prediction", "verdict": "fails"},
+        {"kind": "paper-check", "verdict": "holds"},
+        {"kind": "paper-check", "verdict": "holds"},
+        {"kind": "paper-check", "verdict": "inconclusive"},
+        {"kind": "paper-check", "verdict": "erratum"},
+    ]
+    assert verdict_line(claims) == (
+        "5 claims: 1 fails, 1 inconclusive, 1 erratum, 2 paper consistent"
+    )
+    c = verdict_counts(claims)
+    assert (c["holds"], c["fails"], c["inconclusive"], c["erratum"], c["paper ok"]) == (
+        0,
+        1,
+        1,
+        1,
+        2,
+    )

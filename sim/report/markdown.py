@@ -143,8 +143,8 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
         v, k = r["verdict"], r["kind"]
         if k == "prediction":
             c[v if v in PREDICTION_VERDICTS else "finding"] += 1
-        elif k == "paper-check":
-            c["erratum" if v == "erratum" else "paper ok"] += 1
+        elif k == "paper-check":  # a check the simulation cannot settle is not "consistent"
+            c["erratum" if v == "erratum" else "paper ok" if v == "holds" else v] += 1
         elif k == "self-check":
             c["self-check"] += 1
             c["self-check failed"] += r.get("outcome") == "fails"
