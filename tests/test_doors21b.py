@@ -16,7 +16,10 @@ table), one case each on a hand-made claims row; each failed on the code before 
 * the count line of REPORT.md's first screen, README.md and ``sim show`` counted a paper-check
   that holds (the paper's own arithmetic) as ``holds`` (Wolf & Pearsall: "47 holds", none of
   them a prediction) while *Counts per study* said ``paper consistent``; that table in turn
-  counted an inconclusive paper-check as ``paper consistent``.
+  counted an inconclusive paper-check as ``paper consistent``;
+* the region line pooled a region of parts (brown_design: "2289 accepted input vectors")
+  while the verdicts count the points of their part ("holds at all 2261 points"): it gives
+  each part's count.
 """
 
 from __future__ import annotations
@@ -142,4 +145,25 @@ def test_a_paper_check_is_counted_alike_on_the_first_screen_and_in_the_counts_pe
         1,
         1,
         2,
+    )
+
+
+def test_the_region_line_counts_each_part_of_a_region_of_parts(tmp_path):
+    """brown_design's region has two parts (tolerances 2261 vectors, plates 28): REPORT.md's
+    first screen read "2289 accepted input vectors" and README.md's verdicts "holds at all
+    2261 points of the region", with nothing to tie the two numbers together."""
+    from sim.mc.storage import write_table
+    from sim.report.run_summary import region_line
+
+    write_table(
+        tmp_path / "consistent_region.parquet",
+        {
+            "offset_mm": [1.0, 2.0, 4.0],
+            "confirmed": [True, True, True],
+            "part": ["tolerances", "tolerances", "plates"],
+        },
+        {"study": "brown_design"},
+    )
+    assert region_line(tmp_path) == (
+        "consistent region: 3 accepted input vectors (tolerances 2, plates 1; offset_mm 1.00–4.00)"
     )

@@ -93,6 +93,10 @@ def region_line(out: Path) -> str | None:
         if vals:
             lo, hi = min(vals), max(vals)
             parts.append(f"{name} {fmt(lo)}" + ("" if lo == hi else f"–{fmt(hi)}"))
+    if "part" in t.column_names:  # a region of parts: say how many vectors each part holds,
+        # as the verdicts say "holds at all 2261 points" of their part, not of the 2289
+        n = Counter(t.column("part").to_pylist())
+        parts.insert(0, ", ".join(f"{k} {v}" for k, v in n.items()))
     where = f" ({'; '.join(parts)})" if parts else ""
     return f"consistent region: {t.num_rows} accepted input vectors{where}"
 
