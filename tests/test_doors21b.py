@@ -19,7 +19,9 @@ table), one case each on a hand-made claims row; each failed on the code before 
   counted an inconclusive paper-check as ``paper consistent``;
 * the region line pooled a region of parts (brown_design: "2289 accepted input vectors")
   while the verdicts count the points of their part ("holds at all 2261 points"): it gives
-  each part's count.
+  each part's count;
+* a value of 0 read "0" on the first screen and "0.00" in README.md ("0–1.00" against
+  "0.00–1.00"); a region's range of no width read "2.00–2.00".
 """
 
 from __future__ import annotations
@@ -167,3 +169,13 @@ def test_the_region_line_counts_each_part_of_a_region_of_parts(tmp_path):
     assert region_line(tmp_path) == (
         "consistent region: 3 accepted input vectors (tolerances 2, plates 1; offset_mm 1.00–4.00)"
     )
+
+
+def test_the_same_interval_reads_the_same_on_the_first_screen_and_in_readme():
+    """twoplate.weight_ratio.reweight_trials (0 to 1 over a region) read "0–1.00" on REPORT.md's
+    first screen and "0.00–1.00" in README.md; a region over which the value does not move
+    read "2.00–2.00"."""
+    r = _row(interval="region", value=0.0, value_high=1.0, ci_low=0.0, ci_high=1.0)
+    assert _sig3(r) == sim_text(r) == "0.00–1.00"
+    r = _row(interval="region", value=2.0, value_high=2.0, ci_low=2.0, ci_high=2.0)
+    assert sim_text(r) == "2.00"

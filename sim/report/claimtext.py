@@ -77,13 +77,13 @@ def sim_text(r) -> str:
     if r["interval"] == "exact":
         val = _exact(r["value"], r)
         vh = r.get("value_high")
-        if vh is not None and math.isfinite(vh):
+        if vh is not None and math.isfinite(vh) and vh != r["value"]:
             val += f"–{_exact(vh, r)}"
         return val
     dec = decimals_for(r.get("ci_low"), r.get("ci_high"))
     val = fmt_at(r["value"], dec)
     vh = r.get("value_high")
-    if vh is not None and math.isfinite(vh):
+    if vh is not None and math.isfinite(vh) and vh != r["value"]:  # not "2.00–2.00"
         val += f"–{fmt_at(vh, dec)}"
     return val
 

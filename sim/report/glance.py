@@ -61,8 +61,8 @@ def _num(x, dec: int | None) -> str:
         return fmt(x)
     if float(x).is_integer() and abs(x) < 1e6 and not dec:
         return str(int(x))
-    if x == 0:
-        return "0"
+    if x == 0:  # at the interval's decimals, as README.md prints it ("0.00–1.00", not "0–1.00")
+        return fmt_at(0.0, dec) if dec else "0"
     three = 2 - math.floor(math.log10(abs(x)))  # decimals of 3 significant digits
     return fmt_at(x, three if dec is None else min(dec, three))
 
