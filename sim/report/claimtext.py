@@ -9,7 +9,7 @@ import math
 
 from sim.report.tables import fmt
 
-__all__ = ["decimals_for", "fmt_at", "ref_text", "sim_text", "interval_text"]
+__all__ = ["decimals_for", "fmt_at", "ref_text", "sim_text", "interval_text", "exact_text"]
 
 
 def ref_text(r) -> str:
@@ -29,13 +29,14 @@ def ref_text(r) -> str:
 
 def decimals_for(lo, hi) -> int | None:
     """Decimal places an interval ``[lo, hi]`` supports: two significant digits of its
-    half-width (negative: tens, hundreds...); None for a missing or zero-width interval."""
+    half-width (negative: tens, hundreds...; more than nine: printed by :func:`fmt_at` in
+    significant digits); None for a missing or zero-width interval."""
     if lo is None or hi is None:
         return None
     w = (float(hi) - float(lo)) / 2
     if not math.isfinite(w) or w <= 0:
         return None
-    return min(9, 1 - math.floor(math.log10(w)))
+    return 1 - math.floor(math.log10(w))
 
 
 def fmt_at(x, dec: int | None, digits: int = 3) -> str:
@@ -45,6 +46,8 @@ def fmt_at(x, dec: int | None, digits: int = 3) -> str:
         return fmt(x, digits)
     if dec <= 0:
         return f"{round(float(x), dec):.0f}"
+    if dec > 9 and x != 0 and abs(x) < 1e-4:  # 1.23e-11 at those decimals, never 0.000000000
+        return f"{float(x):.{max(0, dec + math.floor(math.log10(abs(x))))}e}"
     return f"{float(x):.{dec}f}"
 
 
@@ -67,17 +70,20 @@ def _exact(x, r=None) -> str:
     return f"{x:.10g}"
 
 
+exact_text = _exact
+
+
 def sim_text(r) -> str:
     if r["interval"] == "exact":
         val = _exact(r["value"], r)
         vh = r.get("value_high")
-        if vh is not None and math.isfinite(vh):
+        if vh is not None and math.isfinite(vh) and vh != r["value"]:
             val += f"–{_exact(vh, r)}"
         return val
     dec = decimals_for(r.get("ci_low"), r.get("ci_high"))
     val = fmt_at(r["value"], dec)
     vh = r.get("value_high")
-    if vh is not None and math.isfinite(vh):
+    if vh is not None and math.isfinite(vh) and vh != r["value"]:  # not "2.00–2.00"
         val += f"–{fmt_at(vh, dec)}"
     return val
 

@@ -12,12 +12,12 @@ from typing import Callable
 import pyarrow as pa
 
 from sim.mc.storage import read_provenance
-from sim.report.claimtext import decimals_for, fmt_at
+from sim.report.claimtext import decimals_for, exact_text, fmt_at
 from sim.report.papers import paper_name
 from sim.report.run_summary import headline_rows, region_line, verdict_line
 from sim.report.tables import fmt, md_table
 
-__all__ = ["opening", "by_paper", "number", "VERDICT_TEXT"]
+__all__ = ["opening", "by_paper", "main_and_variants", "number", "VERDICT_TEXT"]
 
 
 VERDICT_TEXT = {
@@ -61,10 +61,28 @@ def _num(x, dec: int | None) -> str:
         return fmt(x)
     if float(x).is_integer() and abs(x) < 1e6 and not dec:
         return str(int(x))
-    if x == 0:
-        return "0"
+    if x == 0:  # at the interval's decimals, as README.md prints it ("0.00–1.00", not "0–1.00")
+        return fmt_at(0.0, dec) if dec else "0"
     three = 2 - math.floor(math.log10(abs(x)))  # decimals of 3 significant digits
     return fmt_at(x, three if dec is None else min(dec, three))
+
+
+def _on_its_side(x, text: str, r: dict) -> str:
+    """``text`` (``x`` at 3 significant digits), or the digits that keep it on its side of
+    each edge of the claim's decision zone where 3 do not (an exact 1.4999 against ``≥ 1.5``
+    read "1.50" and *fails*; README.md prints 1.4999)."""
+    try:
+        y = float(text)
+    except ValueError:
+        return text
+    for b in (number(r.get("zone_low")), number(r.get("zone_high"))):
+        if (
+            isinstance(b, (int, float))
+            and math.isfinite(b)
+            and ((y < b) != (x < b) or (y > b) != (x > b))
+        ):
+            return exact_text(x, r)
+    return text
 
 
 def _sig3(r: dict) -> str:
@@ -75,10 +93,11 @@ def _sig3(r: dict) -> str:
         return ""
     lo, hi = number(r.get("ci_low")), number(r.get("ci_high"))
     dec = decimals_for(lo, hi) if r["interval"] != "exact" else None
-    v = _num(r["value"], dec)
+    num = _num if r["interval"] != "exact" else lambda x, d: _on_its_side(x, _num(x, d), r)
+    v = num(r["value"], dec)
     vh = number(r.get("value_high"))
     if vh is not None and vh != r["value"]:
-        v += f"–{_num(vh, dec)}"
+        v += f"–{num(vh, dec)}"
     same = (lo, hi) == (r["value"], vh) or lo == hi
     if r["interval"] != "exact" and lo is not None and not same:
         v += f" [{_num(lo, dec)}, {_num(hi, dec)}]"
@@ -92,7 +111,7 @@ def by_paper(entries: list[tuple]) -> dict[str, list]:
     return by_seed
 
 
-def _main_and_variants(studies: list[tuple]) -> tuple[list, list]:
+def main_and_variants(studies: list[tuple]) -> tuple[list, list]:
     """The studies of one paper split into its main runs (one per registered study, the
     directory named as the study first) and the variants (another run of a study already
     shown, e.g. ``agnard_block_104``: the same study at a real block's size)."""
@@ -162,7 +181,7 @@ def opening(entries: list[tuple], results: Path) -> str:
                 f"(its tables say so), not of `{name}`: a directory renamed or swapped by hand"
             )
     for seed in sorted(s for s in by_seed if s):
-        main, other = _main_and_variants(by_seed[seed])
+        main, other = main_and_variants(by_seed[seed])
         rows.append(_paper_row(seed, main))
         for name, study, claims in other:
             variants.append(_variant_note(results, name, study, claims, study.name))

@@ -20,7 +20,7 @@ from sim.mc.paths import link_problem
 from sim.mc.storage import atomic_path, read_provenance, read_table
 from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
-from sim.report.glance import by_paper, design_notes, number, opening
+from sim.report.glance import by_paper, design_notes, main_and_variants, number, opening
 from sim.report.papers import paper_name
 from sim.report.read import claims_damage, forget, mixed_run, older, records
 from sim.report.run_summary import headline_rows, write_run_readme
@@ -143,8 +143,8 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
         v, k = r["verdict"], r["kind"]
         if k == "prediction":
             c[v if v in PREDICTION_VERDICTS else "finding"] += 1
-        elif k == "paper-check":
-            c["erratum" if v == "erratum" else "paper ok"] += 1
+        elif k == "paper-check":  # a check the simulation cannot settle is not "consistent"
+            c["erratum" if v == "erratum" else "paper ok" if v == "holds" else v] += 1
         elif k == "self-check":
             c["self-check"] += 1
             c["self-check failed"] += r.get("outcome") == "fails"
@@ -192,12 +192,15 @@ def referee_summary(entries: list[tuple]) -> str:
     ]
     for seed in sorted(s for s in by_seed if s):
         rows = []
-        for name, study, claims in by_seed[seed]:
+        main, variants = main_and_variants(by_seed[seed])
+        for name, study, claims in main + variants:
+            # a variant run's rows carry the claims' names of the main run: say whose they are
+            also = "" if not any(name == v[0] for v in variants) else f" (`{name}`, not counted)"
             for r in headline_rows(claims):
                 nc = r["verdict"] == "not comparable"
                 rows.append(
                     [
-                        f"[`{r['claim']}`]({name}/README.md)",
+                        f"[`{r['claim']}`]({name}/README.md){also}",
                         r["paper"],
                         ref_text(r),
                         "" if nc else sim_text(r),
@@ -205,7 +208,7 @@ def referee_summary(entries: list[tuple]) -> str:
                         _VERDICT_TEXT.get(r["verdict"], r["verdict"]),
                     ]
                 )
-        titles = "; ".join(study.title for _, study, _ in by_seed[seed])
+        titles = "; ".join(dict.fromkeys(study.title for _, study, _ in main))
         parts.append(f"**{paper_name(seed, full=True)}** ({titles})\n")
         parts.append(
             md_table(

@@ -23,7 +23,9 @@ def fmt(x, digits: int = 3) -> str:
             return "0"
         mag = math.floor(math.log10(abs(x)))
         dec = max(0, digits - 1 - mag)
-        return f"{x:.{min(dec, 9)}f}"
+        if dec > 9:  # nine decimals would print a nonzero 1e-11 as 0.000000000
+            return f"{x:.{digits - 1}e}"
+        return f"{x:.{dec}f}"
     return str(x)
 
 
