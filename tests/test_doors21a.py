@@ -1,0 +1,65 @@
+"""The classes of the sweep doors21a (issue 26: the advice at the end of a refusal, followed
+literally), one case each; each failed on the code before its fix.
+
+* a network whose normals are singular because an unknown is determined by no observation, or
+  a part of it is tied to the datum by none, was refused "...: fix points or change the
+  datum"; changing the datum cannot hold either (``datum.kind = inner`` gave the same refusal
+  again, explicit constraints are refused as more than the datum defect): the advice now names
+  what does, fixing points or adding observations;
+* a network with fixed points whose rank defect is more than the datum defect (a part of it
+  held by one fixed point of its own, free to turn about it) was told "... or use datum.kind =
+  inner"; the inner datum covers only the network's own defect and was refused in turn ("add
+  observations ..., or fix points"): the advice no longer names the inner datum there.
+"""
+
+from sim.cli import main
+from tests.oneline import SIM_ERROR, one_line
+
+HEAD = 'study = "network"\ntrials = 40\nchunk = 2\nseed = 1\n[network]\nname = "n"\n'
+
+
+def _pt(name, x, y, fixed):
+    role = ', role = "fixed"' if fixed else ""
+    return f'{{ name = "{name}", x_mm = {x}, y_mm = {y}{role} }}'
+
+
+def _study(tmp_path, fixed: str, obs: str, gen: str = "", kind: str = "fixed"):
+    xy = {"A": (0.0, 0.0), "B": (100.0, 0.0), "C": (50.0, 80.0)}
+    xy |= {"D": (500.0, 500.0), "E": (600.0, 500.0), "F": (550.0, 600.0)}
+    pts = ", ".join(_pt(n, *p, n in fixed) for n, p in xy.items() if n in obs + gen + fixed)
+    p = tmp_path / f"net_{fixed}_{kind}.toml"
+    text = HEAD + f"points = [ {pts} ]\nobservations = [ {obs} ]\n"
+    text += f"generate = [ {gen} ]\n" if gen else ""
+    p.write_text(text + f'[datum]\nkind = "{kind}"\n')
+    return str(p)
+
+
+def _d(a, b):
+    return f'{{ kind = "distance", from = "{a}", to = "{b}", sigma_mm = 0.01 }}'
+
+
+def test_unobserved_unknown_is_not_told_to_change_the_datum(tmp_path, capsys):
+    obs = ", ".join([_d("A", "C"), _d("B", "C"), _d("D", "E")])  # D.y, E.y: no observation
+    line = one_line(capsys, main(["check", _study(tmp_path, "AB", obs)]), prefix=SIM_ERROR)
+    assert "determined by no observation" in line and line.endswith(
+        "fix points or add observations"
+    )
+    # the datum it used to advise gives the same refusal: the advice no longer names it
+    again = one_line(capsys, main(["check", _study(tmp_path, "AB", obs, kind="inner")]))
+    assert "determined by no observation" in again and "change the datum" not in again
+    # the advice followed: the points fixed, the check passes
+    assert main(["check", _study(tmp_path, "ABDE", obs)]) == 0
+
+
+def test_a_part_turning_about_its_own_fixed_point_is_not_told_to_use_the_inner_datum(
+    tmp_path, capsys
+):
+    obs = ", ".join([_d("A", "C"), _d("B", "C")])
+    tri = '["D", "E", "F"]'
+    gen = f'{{ kind = "distance", from = {tri}, to = {tri}, sigma_mm = 0.01 }}'
+    line = one_line(capsys, main(["check", _study(tmp_path, "ABD", obs, gen)]), "rank defect")
+    assert "datum.kind = inner" not in line and line.endswith("or fix points"), line
+    inner = one_line(capsys, main(["check", _study(tmp_path, "ABD", obs, gen, kind="inner")]))
+    assert "rank defect" in inner  # the inner datum does not hold it: the advice was wrong
+    assert main(["check", _study(tmp_path, "ABDE", obs, gen)]) == 0
+    capsys.readouterr()
