@@ -63,3 +63,27 @@ def test_a_part_turning_about_its_own_fixed_point_is_not_told_to_use_the_inner_d
     assert "rank defect" in inner  # the inner datum does not hold it: the advice was wrong
     assert main(["check", _study(tmp_path, "ABDE", obs, gen)]) == 0
     capsys.readouterr()
+
+
+def test_api_limit_refusal_names_what_run_takes(tmp_path, monkeypatch):
+    """``run()`` refused by a work limit said "(--max-adjustments or SIM_MAX_ADJUSTMENTS)", an
+    option it does not take; it names the environment variable, and setting it lets the run
+    through."""
+    import pytest
+
+    import sim
+    from sim.mc.config import ConfigError
+
+    h = sim.load("studies/network_plate.toml").replace(trials=40, chunk=2)
+    for var, small, option in (
+        ("SIM_MAX_ADJUSTMENTS", "10", "--max-adjustments"),
+        ("SIM_MAX_MEMORY_GB", "1e-9", "--max-memory-gb"),
+    ):
+        monkeypatch.setenv(var, small)
+        with pytest.raises(ConfigError) as e:
+            h.run(out=tmp_path / "a", figures=False)
+        assert option not in str(e.value) and f"the environment variable {var}" in str(e.value)
+        assert "\n" not in str(e.value) and not (tmp_path / "a").exists()
+        monkeypatch.delenv(var)
+    monkeypatch.setenv("SIM_MAX_ADJUSTMENTS", "1e6")  # the advice followed
+    assert (h.run(out=tmp_path / "a", figures=False).path / "run.json").is_file()
