@@ -9,7 +9,12 @@ literally), one case each; each failed on the code before its fix.
 * a network with fixed points whose rank defect is more than the datum defect (a part of it
   held by one fixed point of its own, free to turn about it) was told "... or use datum.kind =
   inner"; the inner datum covers only the network's own defect and was refused in turn ("add
-  observations ..., or fix points"): the advice no longer names the inner datum there.
+  observations ..., or fix points"): the advice no longer names the inner datum there;
+* ``run()`` refused by a work limit named ``--max-adjustments``/``--max-memory-gb``, options it
+  does not take: it names the environment variable;
+* too few trials for the chunks asked for were told "give at least 20 trials (one per chunk)";
+  followed with the chunk kept (``--chunk 2``, or ``chunk = 2`` in the file), 20 trials in
+  chunks of 2 were refused again ("make chunk at most 1"): the advice gives both numbers.
 """
 
 from sim.cli import main
@@ -87,3 +92,12 @@ def test_api_limit_refusal_names_what_run_takes(tmp_path, monkeypatch):
         monkeypatch.delenv(var)
     monkeypatch.setenv("SIM_MAX_ADJUSTMENTS", "1e6")  # the advice followed
     assert (h.run(out=tmp_path / "a", figures=False).path / "run.json").is_file()
+
+
+def test_too_few_trials_advice_followed_with_either_chunk(capsys):
+    p = "studies/network_plate.toml"
+    line = one_line(capsys, main(["check", p, "--set", "trials=10", "--set", "chunk=2"]))
+    assert line.endswith("give at least 20 trials in chunks of 1, or 40 in chunks of 2"), line
+    for trials, chunk in (("20", "1"), ("40", "2")):  # each half of the advice, literally
+        assert main(["check", p, "--set", f"trials={trials}", "--set", f"chunk={chunk}"]) == 0
+    capsys.readouterr()
