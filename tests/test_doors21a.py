@@ -14,7 +14,9 @@ literally), one case each; each failed on the code before its fix.
   does not take: it names the environment variable;
 * too few trials for the chunks asked for were told "give at least 20 trials (one per chunk)";
   followed with the chunk kept (``--chunk 2``, or ``chunk = 2`` in the file), 20 trials in
-  chunks of 2 were refused again ("make chunk at most 1"): the advice gives both numbers.
+  chunks of 2 were refused again ("make chunk at most 1"): the advice gives both numbers;
+* too many chunk files were told "make chunk larger": a chunk of 2 for 10,000,000 trials was
+  refused again; the advice names the smallest chunk accepted.
 """
 
 from sim.cli import main
@@ -100,4 +102,13 @@ def test_too_few_trials_advice_followed_with_either_chunk(capsys):
     assert line.endswith("give at least 20 trials in chunks of 1, or 40 in chunks of 2"), line
     for trials, chunk in (("20", "1"), ("40", "2")):  # each half of the advice, literally
         assert main(["check", p, "--set", f"trials={trials}", "--set", f"chunk={chunk}"]) == 0
+    capsys.readouterr()
+
+
+def test_too_many_chunks_advice_names_the_smallest_chunk(capsys):
+    p, trials = "studies/network_plate.toml", "trials=9999999"
+    line = one_line(capsys, main(["check", p, "--set", trials, "--set", "chunk=2"]), "chunk files")
+    assert line.endswith("make chunk at least 100"), line
+    assert main(["check", p, "--set", trials, "--set", "chunk=100"]) == 0  # followed literally
+    assert main(["check", p, "--set", trials, "--set", "chunk=99"]) == 2  # and it is the least
     capsys.readouterr()
