@@ -234,7 +234,7 @@ class StudyHandle:
                     figures=figures,
                 )
             except ConfigError as e:
-                if e.key != "--out":
+                if e.key != "--out" and not any(cli in str(e) for cli, _ in _LIMITS):
                     raise
                 raise _api_words(e) from None
         return Results(out, h.name, _run_identity(out))
@@ -267,11 +267,24 @@ def _loggers_kept():
 def _api_words(e: ConfigError) -> ConfigError:
     """An output-directory refusal in the API's words: the argument is ``out`` and the way to
     replace is ``overwrite=True`` (the command line's ``--out``/``--overwrite`` name nothing
-    a caller of ``run()`` can pass)."""
+    a caller of ``run()`` can pass); a work limit's, the environment variable (:data:`_LIMITS`)."""
+    if e.key != "--out":  # a work limit: run() takes no option for it, the environment does
+        msg = str(e).removeprefix(f"{e.key}: " if e.key else "")
+        for cli, api in _LIMITS:
+            msg = msg.replace(cli, api)
+        return ConfigError(e.key, msg)
     msg = str(e).removeprefix("--out: ")
     for cli, api in (("--overwrite", "overwrite=True"), ("--out", "out")):
         msg = msg.replace(cli, api)
     return ConfigError("out", msg)
+
+
+#: the command line's limit options in a refusal, and what a caller of ``run()`` sets instead
+#: (it said "--max-adjustments or SIM_MAX_ADJUSTMENTS": an option ``run()`` does not take)
+_LIMITS = (
+    ("--max-adjustments or SIM_MAX_ADJUSTMENTS", "the environment variable SIM_MAX_ADJUSTMENTS"),
+    ("--max-memory-gb or SIM_MAX_MEMORY_GB", "the environment variable SIM_MAX_MEMORY_GB"),
+)
 
 
 def _sha256(path: Path) -> str:

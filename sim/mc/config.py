@@ -401,7 +401,7 @@ def check_chunks(cfg: Mapping[str, Any]) -> None:
             "chunk",
             f"{cfg['trials']:,} trials in chunks of {cfg['chunk']:,} make "
             f"{-(-cfg['trials'] // cfg['chunk']):,} chunk files (at most {MAX_CHUNKS:,}): "
-            "make chunk larger",
+            f"make chunk at least {-(-cfg['trials'] // MAX_CHUNKS):,}",  # "larger": 2 was refused
         )
 
 

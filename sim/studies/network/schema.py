@@ -261,14 +261,15 @@ def _held(net, full: dict, dt, sparse: bool):
         held = sparse or full["datum.kind"] != "fixed" or np.any(net.role != 0)
         free = dt.free_index(net.q)
         cause = singular_cause(net, full, free) if held else ""
+        # an unknown no observation reaches, or a part tied to the datum by none: no datum
+        # holds it (inner or constraints cover only the network's own defect), so the advice
+        # names what does ("or change the datum" gave the same refusal again)
+        fix = "fix points or add observations" if cause else "fix points or change the datum"
         if sparse and not cause:
             cause = _pivot(net, an.factor, free)
         if sparse or cause:
             what = an.factor.message if sparse else "the normal matrix is singular"
-            raise ConfigError(
-                "datum.kind",
-                f"{what}{': ' + cause if cause else ''}: fix points or change the datum",
-            )
+            raise ConfigError("datum.kind", f"{what}{': ' + cause if cause else ''}: {fix}")
         # explicit constraints that leave a defect (one of coefficient 1e-300, say) are theirs
         kind = full["datum.kind"]
         _defect(net, dt, "datum.constraints" if kind == "constraints" else "datum.kind", kind)
@@ -428,9 +429,11 @@ def _defect(net, dt, key: str, kind: str = "fixed") -> None:
         _parameters(net, A, free, rank)
     C = dt.constraint_matrix(net.theta_true()[None])
     c = 0 if C is None else C.shape[-1]
+    advice = _DEFECT_ADVICE.get(kind, _DEFECT_ADVICE["fixed"])
+    if len(free) - rank > defect_basis(net, free).shape[1]:  # more than a datum can hold
+        advice = _DEFECT_ADVICE["inner"]  # (inner or constraints: the same refusal again)
     raise ConfigError(
         key,
         f"the network has a rank defect of {len(free) - rank} ({len(free)} "
-        f"unknowns, rank {rank}) that the datum ({c} constraints) does not cover: "
-        + _DEFECT_ADVICE.get(kind, _DEFECT_ADVICE["fixed"]),
+        f"unknowns, rank {rank}) that the datum ({c} constraints) does not cover: " + advice,
     )
