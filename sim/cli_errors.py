@@ -54,14 +54,14 @@ def not_as_written(d: Path, e: Exception) -> str:
     """show and report read the Parquet tables only: one that fails to read as its study's
     table was replaced or edited by hand (named with its column by the reader), or was
     written by another version of the suite (results of an older clone: then said so)."""
+    msg = damaged_message(d, e)
     older = other_code(d)
-    if older:
-        return (
-            f"{older} was made by another version of the suite's code, which this version "
-            f"cannot read ({type(e).__name__}: {str(e)[:80]}): run its study again "
-            "(make reproduce re-runs what is stale)"
+    if older:  # the likely cause: a table this version reads as it writes it now
+        msg += (
+            f" ({older} was made by another version of the suite's code: make reproduce "
+            "re-runs what is stale)"
         )
-    return damaged_message(d, e)
+    return msg
 
 
 def other_code(d: Path) -> str | None:
