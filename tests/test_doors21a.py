@@ -19,9 +19,12 @@ literally), one case each; each failed on the code before its fix.
   refused again; the advice names the smallest chunk accepted.
 """
 
+from pathlib import Path
+
 from sim.cli import main
 from tests.oneline import SIM_ERROR, one_line
 
+ROOT = Path(__file__).resolve().parents[1]
 HEAD = 'study = "network"\ntrials = 40\nchunk = 2\nseed = 1\n[network]\nname = "n"\n'
 
 
@@ -112,3 +115,21 @@ def test_too_many_chunks_advice_names_the_smallest_chunk(capsys):
     assert main(["check", p, "--set", trials, "--set", "chunk=100"]) == 0  # followed literally
     assert main(["check", p, "--set", trials, "--set", "chunk=99"]) == 2  # and it is the least
     capsys.readouterr()
+
+
+def test_an_unfinished_run_of_another_config_names_the_values_to_finish_it(tmp_path, capsys):
+    """ "holds an unfinished run of a different config; run that command again to finish it"
+    named neither the command nor what differs: the keys, the unfinished run's values and
+    this run's are named now, so the run can be finished (or replaced with --overwrite)."""
+    study = tmp_path / "s.toml"
+    study.write_text((ROOT / "studies" / "network_plate.toml").read_text())
+    out = tmp_path / "o"
+    assert main(["run", str(study), "--out", str(out), "--trials", "40", "--chunk", "2",
+                 "--no-figures"]) == 0  # fmt: skip
+    capsys.readouterr()
+    (out / "run.json").replace(tmp_path / "record.json")
+    out.rename(tmp_path / ".o.partial")  # as a run stopped before it published
+    (tmp_path / "record.json").replace(tmp_path / ".o.partial" / "run.json")
+    rc = main(["run", str(study), "--out", str(out), "--trials", "60", "--chunk", "2"])
+    one_line(capsys, rc, "unfinished run of a different config: trials = 40 (this run 60)",
+             "run again with its values", "--overwrite", prefix=SIM_ERROR)  # fmt: skip

@@ -150,8 +150,14 @@ def _differs(old: dict, record: dict) -> str:
     theirs = old.get("config", {}).get("study") if isinstance(old.get("config"), dict) else None
     if theirs != mine:
         return f"another study ({theirs!r}; this run is {mine!r})"
-    same = old.get("config") == record["config"]
-    return "a different code version" if same else "a different config"
+    ca, cb = old.get("config"), record["config"]
+    if not isinstance(ca, dict):
+        return "a different config"
+    if ca == cb:
+        return "a different code version"
+    keys = sorted(k for k in set(ca) | set(cb) if ca.get(k) != cb.get(k))
+    shown = ", ".join(f"{k} = {ca.get(k)!r:.40} (this run {cb.get(k)!r:.40})" for k in keys[:3])
+    return f"a different config: {shown}{' ...' if len(keys) > 3 else ''}"
 
 
 def _check_not_nested(out: Path, shown: str) -> None:
@@ -269,7 +275,7 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
             finish = (  # another code version: only that version can finish it, not this one
                 "this version of the suite cannot finish it; "
                 if how == "a different code version"
-                else "run that command again to finish it, or "
+                else "run again with its values to finish it, or "
             )
             raise ConfigError(
                 "--out",
