@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import json
 import logging
 import os
 import tempfile
@@ -36,7 +35,7 @@ from sim.mc.paths import link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.runner import MIN_CHUNKS
-from sim.mc.storage import read_provenance
+from sim.mc.storage import config_hash, read_provenance, read_record
 from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
@@ -295,15 +294,12 @@ def _sha256(path: Path) -> str:
 
 
 def _run_identity(out: Path) -> str:
-    """sha256 of the config and code hash ``out/run.json`` records: another run of the study
-    (another seed, another key) has another; "" when there is no such record (a damaged one
-    is refused by the reads themselves, naming ``run.json``)."""
-    try:
-        rec = json.loads((out / "run.json").read_text(encoding="utf-8"))
-        ident = [rec["config"], rec["code_hash"]]
-    except (OSError, ValueError, KeyError, TypeError):
-        return ""
-    return hashlib.sha256(json.dumps(ident, sort_keys=True).encode()).hexdigest()
+    """The config hash (:func:`sim.mc.storage.config_hash`) of the config and code hash
+    ``out/run.json`` records: another run of the study (another seed, another key) has
+    another; "" when there is no such record (a damaged one is refused by the reads
+    themselves, naming ``run.json``)."""
+    rec = read_record(out)
+    return config_hash(rec["config"], rec["code_hash"]) if rec else ""
 
 
 def _unchanged(h: StudyHandle) -> None:

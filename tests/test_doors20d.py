@@ -21,7 +21,6 @@ outside the project. The tests that run ``gama-local`` skip without it (``$GAMA_
 from __future__ import annotations
 
 import math
-import os
 import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -30,6 +29,7 @@ import numpy as np
 import pytest
 
 import sim.studies.network.validate as validate
+from benchmarks.scaling import gama_local
 from sim.cli import main
 from sim.studies import load_study
 from sim.studies.network.analysis import analyse
@@ -39,11 +39,6 @@ from sim.studies.network.model import datum
 
 NS = "http://www.gnu.org/software/gama/gama-local"
 ONS = "{http://www.gnu.org/software/gama/gama-local-adjustment}"
-
-
-def gama_local() -> str | None:
-    p = os.environ.get("GAMA_LOCAL") or "/tmp/gama-build/gama-local"
-    return p if os.path.isfile(p) and os.access(p, os.X_OK) else None
 
 
 needs_gama = pytest.mark.skipif(gama_local() is None, reason="no gama-local on this machine")
