@@ -54,7 +54,10 @@ from sim.studies.network.validate import (
     title,
 )
 
-__all__ = ["Network", "build", "KINDS", "ARCSEC"]
+__all__ = ["Network", "build", "KINDS", "ARCSEC", "COORDINATE_MAX_MM"]
+
+#: no plane coordinate on the earth is farther from its grid's origin (mm: 100,000 km)
+COORDINATE_MAX_MM = 1e11
 
 
 @dataclass(frozen=True)
@@ -84,6 +87,14 @@ class Network:
     offset_mm: float = 0.0
     scale_ppm: float = 0.0
     estimate_scale: bool = False
+    origin_mm: tuple = (0.0, 0.0)
+
+    @property
+    def xy_mm(self) -> np.ndarray:
+        """(n, 2) coordinates as the study gave them (mm): ``xy`` is taken from ``origin_mm``,
+        a whole kilometre near the network's centre, so that a national grid's millions of
+        metres do not cost the simulated readings their last digits."""
+        return self.xy + np.asarray(self.origin_mm)
 
     @property
     def n(self) -> int:
@@ -208,15 +219,27 @@ def _points(cfg: dict, rng: np.random.Generator):
     if dup:
         raise ConfigError("network.points", f"duplicate point name {dup[0]!r}")
     xy = np.array(pts[1], float)
-    scale = np.abs(xy).max()
-    if scale > 1e9:
-        far = names[int(np.argmax(np.abs(xy).max(axis=1)))]
+    span = float(np.ptp(xy, axis=0).max())
+    if span > 1e9:
         raise ConfigError(
             "network.points",
-            f"point {far!r} at {scale:.3g} mm: over 1000 km, "
-            "out of range for double-precision adjustment at the um level",
+            f"the network spans {span / 1e6:.4g} km: over 1000 km, out of range for a plane "
+            "network (the earth's curvature) and for double-precision adjustment at the um level",
+        )
+    far = int(np.argmax(np.abs(xy).max(axis=1)))
+    if np.abs(xy[far]).max() > COORDINATE_MAX_MM:
+        raise ConfigError(
+            "network.points",
+            f"point {names[far]!r} at {np.abs(xy[far]).max() / 1e6:.4g} km from the origin: "
+            f"over {COORDINATE_MAX_MM / 1e6:,.0f} km, not a plane coordinate on the earth",
         )
     return names, xy, np.array(pts[2]), np.array(pts[3])
+
+
+def _origin(xy: np.ndarray) -> np.ndarray:
+    """The whole kilometre (mm) nearest the centre of the points' extent: 0 for a plate or a
+    field network about the origin, the grid's offset for national grid coordinates."""
+    return np.round((xy.min(axis=0) + xy.max(axis=0)) / 2 / 1e6) * 1e6
 
 
 def _targets(xy: np.ndarray, fr: list[int], to: list[int], k: int) -> list[list[int]]:
@@ -363,6 +386,8 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
     if rng is None:
         rng = np.random.default_rng(np.random.SeedSequence(cfg["seed"], spawn_key=(99,)))
     names, xy, role, csig = _points(cfg, rng)
+    origin = _origin(xy)
+    xy = xy - origin
     rows = _listed_obs(cfg, names)
     _generated_obs(cfg, names, xy, rows)
     for a in np.flatnonzero(role == 2):
@@ -393,4 +418,5 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
         beta,
         cfg["network.scale_ppm"],
         cfg["network.estimate_scale"],
+        (float(origin[0]), float(origin[1])),
     )

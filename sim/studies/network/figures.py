@@ -88,7 +88,7 @@ def network_figure(net, an, pts, path: Path) -> Path:
     """Points (fixed as triangles), observation lines, 95 % ellipses magnified to be seen;
     axes in metres for a field network and in mm for a plate (:func:`natural_unit`)."""
     unit, f = natural_unit(net.xy)
-    xy = net.xy / f
+    xy = net.xy_mm / f
     fig, ax = plt.subplots(figsize=(6.5, 6.0), layout="constrained")
     large = net.m > LARGE
     _lines(ax, net, xy)

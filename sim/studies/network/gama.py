@@ -207,7 +207,7 @@ def _points(net: Network, po: ET.Element, inner: set[int], pairs: bool) -> None:
     """One ``<point>`` per point (m): fixed ones ``fix``, estimated ones ``adj`` (``XY`` in
     the inner datum); with coordinate-difference vectors every point also gets z = 0 (fixed)."""
     for a, nm in enumerate(net.names):
-        attr = {"id": nm, "x": _fmt(net.xy[a, 0] / 1000), "y": _fmt(net.xy[a, 1] / 1000)}
+        attr = {"id": nm, "x": _fmt(net.xy_mm[a, 0] / 1000), "y": _fmt(net.xy_mm[a, 1] / 1000)}
         if net.role[a] == 1:
             attr["fix"] = "xyz" if pairs else "xy"
         else:
@@ -230,7 +230,11 @@ def _coordinates(net: Network, po: ET.Element) -> None:
         ET.SubElement(
             c,
             "point",
-            {"id": net.names[a], "x": _fmt(net.xy[a, 0] / 1000), "y": _fmt(net.xy[a, 1] / 1000)},
+            {
+                "id": net.names[a],
+                "x": _fmt(net.xy_mm[a, 0] / 1000),
+                "y": _fmt(net.xy_mm[a, 1] / 1000),
+            },
         )
     sig = {int(a): s for a, s in zip(net.i[net.kind == 5], net.sigma[net.kind == 5])}
     cm = ET.SubElement(c, "cov-mat", {"dim": str(2 * obs_pts.size), "band": "0"})

@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.mc.config import ConfigError
-from sim.studies.network.definition import ARCSEC
+from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
 from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes
 from sim.studies.network.validate import SIGMA_RANGE
 
@@ -139,8 +139,8 @@ def _point(f: _File, e, points: dict, datum: dict) -> None:
     if e.get("x") is not None or e.get("y") is not None:
         xy = (f.num(e, "x") * 1000, f.num(e, "y") * 1000)
         for ax, v in zip("xy", xy):
-            if not abs(v) <= 1e9:  # the study's own range (1000 km), named by the element
-                raise f.err(e, f"{v / 1000:g} m: over 1000 km, out of range", ax)
+            if not abs(v) <= COORDINATE_MAX_MM:  # no coordinate on the earth, by the element
+                raise f.err(e, f"{v / 1000:g} m: over 100,000 km, out of range", ax)
         if "x_mm" in rec and (rec["x_mm"], rec["y_mm"]) != xy:
             raise f.err(e, f"point {pid!r} declared twice with different coordinates", "x")
         rec["x_mm"], rec["y_mm"] = xy

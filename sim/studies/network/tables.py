@@ -64,8 +64,8 @@ def write_points(
         out / "points.parquet",
         {
             "point": [net.names[a] for a in pts],
-            "x_mm": net.xy[pts, 0],
-            "y_mm": net.xy[pts, 1],
+            "x_mm": net.xy_mm[pts, 0],
+            "y_mm": net.xy_mm[pts, 1],
             "role": [("free", "fixed", "observed")[net.role[a]] for a in pts],
             "sigma_x_mm": est.an_sig[0::2],
             "sigma_y_mm": est.an_sig[1::2],
