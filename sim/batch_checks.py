@@ -20,6 +20,7 @@ from sim.cli import check_run_args, load_run
 from sim.cli_args import parser as run_parser
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, parse_override, read_toml
+from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
 from sim.mc.sweep import read_sweep
 from sim.report.read import mixed_table
@@ -38,9 +39,10 @@ def is_current(study_file: str | Path, results: str | Path, run_args=()) -> bool
 
 def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str | None:
     """Why ``results`` are not current for ``sim run STUDY_FILE RUN_ARGS`` (no results, a
-    config key that differs, the code changed since, no figures), in a few words; None when
-    they are (:func:`is_current`). ``--stale-only`` printed nothing for a study it re-ran,
-    so results made by older code or copied from elsewhere were re-run without a word."""
+    config key that differs, the code changed since, no figures or one replaced by hand), in
+    a few words; None when they are (:func:`is_current`). ``--stale-only`` printed nothing
+    for a study it re-ran, so results made by older code or copied from elsewhere were re-run
+    without a word."""
     try:
         text = regular_text(Path(results) / "run.json")
     except OSError:
@@ -73,7 +75,9 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
     # a table copied in from another run (two results directories merged by hand, or one
     # rewritten by a tool that drops its provenance) beside this run's record: not current
     mixed = mixed_table(Path(results), missing_ok=False)
-    return None if mixed is None else f"{mixed[0].name} is not of the run of run.json: {mixed[1]}"
+    if mixed is not None:
+        return f"{mixed[0].name} is not of the run of run.json: {mixed[1]}"
+    return changed_figure(Path(results))  # a figure replaced by hand: drawn again
 
 
 def _clashes(files: list[Path], run_args: list[str], results: str = "results") -> str | None:

@@ -1,8 +1,9 @@
 """Sealing and publishing a finished run's staging directory (:mod:`sim.mc.outputs` checks
 the output and keeps the staging directory).
 
-:func:`seal` records in ``run.json`` every file the run wrote and each chunk file's sha256
-(:func:`damaged_chunks` checks a finished directory against them); :func:`publish` replaces
+:func:`seal` records in ``run.json`` every file the run wrote and each chunk file's and
+figure's sha256 (:func:`damaged_chunks` and :func:`changed_figure` check a finished directory
+against them); :func:`publish` replaces
 ``<out>`` by the staging directory, carrying over every entry of the old results that the
 suite did not write (a user's notes, links, FIFOs: copied as what they are, never opened),
 and refuses when the new run writes a file of a carried entry's name.
@@ -23,7 +24,7 @@ from sim.mc.outputs import swap_dir
 from sim.mc.runner import ChunkStore
 from sim.mc.storage import LOCK, pid_alive, read_record, write_record
 
-__all__ = ["seal", "publish", "damaged_chunks"]
+__all__ = ["seal", "publish", "damaged_chunks", "changed_figure"]
 
 
 def _files(d: Path) -> list[str]:
@@ -48,7 +49,27 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
     carried = set(rec.get("carried") or [])  # the user's files a publish copied in: not ours
     files = [f for f in _files(stage) if f not in carried]
     chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
-    write_record(stage, {**rec, "files": files, "chunk_sha256": chunks})
+    figures = {f: _sha256(stage / f) for f in files if f.endswith(".png")}
+    write_record(stage, {**rec, "files": files, "chunk_sha256": chunks, "figure_sha256": figures})
+
+
+def changed_figure(out: Path) -> str | None:
+    """Which figure of a finished results directory is not the one its run drew (missing, or
+    its sha256 differs from the run record's ``figure_sha256``: replaced or edited by hand),
+    in a few words, or None. A report embeds the figures as they are: a hand-made picture
+    beside the run's tables was read as the run's. Results of runs that recorded no figure
+    hashes (older versions) are not checked."""
+    rec = read_record(out)
+    want = rec.get("figure_sha256") if rec else None
+    if not isinstance(want, dict):
+        return None
+    for f, h in sorted(want.items()):
+        p = out / f
+        if not p.is_file() or p.is_symlink():
+            return f"{p} is missing (the run drew it)"
+        if not isinstance(h, str) or _sha256(p) != h:
+            return f"{p} is not the figure its run drew (its sha256 differs: replaced by hand?)"
+    return None
 
 
 def damaged_chunks(out: Path) -> str | None:

@@ -26,6 +26,7 @@ import pyarrow.parquet as pq
 from sim.claims.region import REGION_VERDICTS
 from sim.claims.rules import VERDICTS
 from sim.mc.config import ConfigError
+from sim.mc.publish import changed_figure
 from sim.mc.storage import read_provenance, read_record, read_table
 
 __all__ = [
@@ -246,10 +247,12 @@ def mixed_run(d: Path, names: list[str] | None = None, missing_ok: bool = True) 
     read as this run's verdicts (``sim show``, ``sim report``, ``Results.table``) nor called
     current (``--stale-only``). A table with no provenance at all (rewritten by a tool that
     drops schema metadata) is passed when ``missing_ok`` (its numbers are read and checked as
-    they are); a directory without a run record has nothing to check against (None)."""
+    they are); a directory without a run record has nothing to check against (None). Without
+    ``names`` its figures are checked too (:func:`~sim.mc.publish.changed_figure`)."""
     found = mixed_table(d, names, missing_ok)
     if found is None:
-        return None
+        figure = None if names else changed_figure(Path(d))
+        return None if figure is None else f"{figure}: run its study again"
     return (
         f"{found[0]} is not a table of the run its run.json records ({found[1]}): the "
         "directory mixes results of two runs; run its study again"

@@ -1,0 +1,66 @@
+"""A figure replaced by hand (issue 26: doors20c left it unnoticed). ``run.json`` recorded
+every table's provenance and every chunk's sha256, but nothing of the figures: a PNG drawn by
+hand (or copied from another run) beside the run's tables was embedded in the study's README
+and in REPORT.md as the run's, and ``--stale-only`` called the results current. The run now
+records each figure's sha256 (:func:`sim.mc.publish.seal`), and every reader of a whole
+results directory checks them (:func:`sim.mc.publish.changed_figure`)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from sim.batch_checks import why_stale
+from sim.cli import main
+from sim.mc.publish import _sha256, changed_figure
+from tests.oneline import one_line
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture
+def plate(tiny_run, tmp_path) -> Path:
+    """A copy of the tiny network_plate run (its figures drawn) under ``tmp_path/results``."""
+    d = tmp_path / "results" / "network_plate"
+    shutil.copytree(tiny_run("network_plate"), d)
+    return d
+
+
+def test_the_run_records_the_sha256_of_every_figure_it_drew(plate):
+    rec = json.loads((plate / "run.json").read_text())
+    pngs = sorted(p.name for p in plate.glob("*.png"))
+    assert pngs and sorted(rec["figure_sha256"]) == pngs
+    assert all(rec["figure_sha256"][f] == _sha256(plate / f) for f in pngs)
+    assert changed_figure(plate) is None
+
+
+def test_a_figure_replaced_by_hand_is_named_by_show_and_report(plate, capsys):
+    fig = sorted(plate.glob("*.png"))[0]
+    fig.write_bytes(fig.read_bytes() + b"\0")  # one byte more: another picture
+    assert str(fig) in changed_figure(plate)
+    one_line(capsys, main(["show", str(plate)]), fig.name, "not the figure its run drew")
+    rc = main(["report", "--results", str(plate.parent)])
+    one_line(capsys, rc, fig.name, "not the figure its run drew", "run its study again")
+
+
+def test_a_figure_removed_by_hand_is_named(plate, capsys):
+    fig = sorted(plate.glob("*.png"))[-1]
+    fig.unlink()
+    one_line(capsys, main(["show", str(plate)]), fig.name, "is missing")
+
+
+def test_stale_only_re_runs_results_with_a_figure_replaced_by_hand(plate, tiny_run):
+    """``--stale-only`` called such results current: now it names the figure."""
+    study = plate.parent / "network_plate.toml"
+    run = json.loads((plate / "run.json").read_text())
+    cfg = run["config"]
+    src = (ROOT / "studies" / "network_plate.toml").read_text()
+    src = src.replace("trials = 2000", f"trials = {cfg['trials']}")
+    study.write_text(src.replace("chunk = 100", f"chunk = {cfg['chunk']}"))
+    assert why_stale(study, plate) is None
+    fig = sorted(plate.glob("*.png"))[0]
+    fig.write_bytes(b"\x89PNG not the run's")
+    assert "not the figure its run drew" in why_stale(study, plate)
