@@ -32,7 +32,7 @@ import pyarrow as pa
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
 from sim.cli_args import module_doc, parser
-from sim.cli_errors import cwd_exists, not_as_written, os_reason, stdout_failed
+from sim.cli_errors import cwd_exists, not_as_written, os_reason, other_code, stdout_failed
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
@@ -234,6 +234,12 @@ def _show(args) -> int:
         raise ConfigError("DIR", not_as_written(d, e)) from None
     print(text, end="")
     print("" if args.markdown else "\n", end="")
+    if older := other_code(d):  # verdicts of code since changed: read as current otherwise
+        print(
+            f"sim: note: {older} was made by another version of the suite's code (its study's "
+            "code changed since): make reproduce re-runs what is stale",
+            file=sys.stderr,
+        )
     return 0
 
 

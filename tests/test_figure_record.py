@@ -64,3 +64,16 @@ def test_stale_only_re_runs_results_with_a_figure_replaced_by_hand(plate, tiny_r
     fig = sorted(plate.glob("*.png"))[0]
     fig.write_bytes(b"\x89PNG not the run's")
     assert "not the figure its run drew" in why_stale(study, plate)
+
+
+def test_show_notes_results_made_by_code_that_changed_since(plate, capsys, monkeypatch):
+    """Results of an older checkout that still load were shown without a word (doors20c): the
+    verdicts of code since changed read as current. Now a note follows the table."""
+    assert main(["show", str(plate)]) == 0
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr("sim.cli_errors.study_code_hash", lambda study: "another")
+    assert main(["show", str(plate)]) == 0
+    out, err = capsys.readouterr()
+    assert " claims: " in out  # the table as before, the note after it
+    assert err.count("\n") == 1 and err.startswith("sim: note: ") and str(plate) in err
+    assert "another version" in err and "make reproduce" in err
