@@ -125,7 +125,7 @@ def claims_markdown(path: Path) -> str:
 
 def verdict_counts(claims: list[dict]) -> dict[str, int]:
     """Counts per class: predictions by verdict, errata, inputs, self-checks (and how many of
-    them failed their own rule), findings, not comparable."""
+    them failed their own rule, or could not decide it), findings, not comparable."""
     c = {
         k: 0
         for k in (
@@ -135,6 +135,7 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
             "input",
             "self-check",
             "self-check failed",
+            "self-check undecided",
             "finding",
             "not comparable",
         )
@@ -148,6 +149,7 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
         elif k == "self-check":
             c["self-check"] += 1
             c["self-check failed"] += r.get("outcome") == "fails"
+            c["self-check undecided"] += r.get("outcome") not in (None, "holds", "fails")
         else:
             c[k] += 1
     return c
@@ -284,9 +286,10 @@ def _entry(d: Path, get_study: Callable) -> tuple:
     n_nr = read_table(nr).num_rows if nr.is_file() else 0
     row = [f"[{d.name}]({d.name}/README.md): {study.title}", paper_name(study.seed_file) or "—"]
     row += [c[k] for k, _ in _COUNT_COLS]
-    if c["self-check failed"]:
+    apart = [f"{c[f'self-check {w}']} {w}" for w in ("failed", "undecided") if c[f"self-check {w}"]]
+    if apart:  # counted as self-checks, but not ones that held their own rule
         row[2 + [k for k, _ in _COUNT_COLS].index("self-check")] = (
-            f"{c['self-check']} ({c['self-check failed']} failed)"
+            f"{c['self-check']} ({', '.join(apart)})"
         )
     row += [n_nr, prov.get("git_commit", "")[:12]]
     return (study.order, d.name, study, claims, row)

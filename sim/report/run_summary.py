@@ -41,6 +41,8 @@ VERDICT_ORDER = (
     "not comparable",
     "input",
     "self-check",
+    "self-check failed",
+    "self-check undecided",
     "finding",
 )
 
@@ -56,16 +58,22 @@ def _kind_of(out: Path) -> str:
     )
 
 
+def _counted_as(r: dict) -> str:
+    """The heading a claim row is counted under in a verdict line."""
+    if r.get("kind") == "paper-check" and r["verdict"] == "holds":
+        return "paper consistent"
+    if r.get("kind") == "self-check" and r.get("outcome") not in (None, "holds"):
+        return "self-check failed" if r["outcome"] == "fails" else "self-check undecided"
+    return r["verdict"]
+
+
 def verdict_line(claims: list[dict]) -> str:
     """``"14 claims: 6 holds, 2 fails, ..."`` (every verdict value, in :data:`VERDICT_ORDER`);
     a paper-check that holds (the paper's own arithmetic) counts as ``paper consistent``, as in
-    REPORT.md's counts per study, not as a prediction that holds."""
-    c = Counter(
-        "paper consistent"
-        if r.get("kind") == "paper-check" and r["verdict"] == "holds"
-        else r["verdict"]
-        for r in claims
-    )
+    REPORT.md's counts per study, not as a prediction that holds; a self-check that did not
+    hold its own rule counts apart (``self-check failed``, ``self-check undecided``: as in
+    REPORT.md), not as one that did."""
+    c = Counter(_counted_as(r) for r in claims)
     order = [v for v in VERDICT_ORDER if c[v]] + sorted(v for v in c if v not in VERDICT_ORDER)
     return f"{len(claims)} claims: " + ", ".join(f"{c[v]} {v}" for v in order)
 
