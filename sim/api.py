@@ -63,7 +63,8 @@ def _keyed(overrides: dict) -> dict:
 
 @dataclass(frozen=True)
 class Results:
-    """A finished run's directory; tables are read from its Parquet files."""
+    """A finished run's directory (a relative ``path`` is taken from the current directory
+    when the Results is made); tables are read from its Parquet files."""
 
     path: Path
     study: str
@@ -76,7 +77,13 @@ class Results:
             raise ConfigError(
                 "study", f"must be a study name such as 'network' (got {self.study!r})"
             )
-        object.__setattr__(self, "path", Path(self.path))
+        try:  # taken where it was named: a later os.chdir read another directory's tables
+            where = Path(self.path).absolute()
+        except OSError:  # the current directory was removed: a relative path names nothing
+            raise ConfigError(
+                "path", f"{self.path} is relative and the current directory no longer exists"
+            ) from None
+        object.__setattr__(self, "path", where)
 
     def _check_dir(self) -> None:  # not "no table": the directory itself is wrong
         if not self.path.is_dir():

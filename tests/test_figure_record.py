@@ -77,3 +77,29 @@ def test_show_notes_results_made_by_code_that_changed_since(plate, capsys, monke
     assert " claims: " in out  # the table as before, the note after it
     assert err.count("\n") == 1 and err.startswith("sim: note: ") and str(plate) in err
     assert "another version" in err and "make reproduce" in err
+
+
+def test_results_of_a_relative_path_stay_where_they_were_named(plate, monkeypatch, tmp_path):
+    """``sim.Results("network_plate", ...)`` followed a later ``os.chdir``: the same object
+    read another directory's tables (doors20a). The path is taken when it is named."""
+    import sim
+
+    monkeypatch.chdir(plate.parent)
+    res = sim.Results("network_plate", "network")
+    assert res.path == plate
+    elsewhere = tmp_path / "elsewhere" / "network_plate"
+    elsewhere.mkdir(parents=True)
+    monkeypatch.chdir(elsewhere.parent)
+    assert res.table("claims").num_rows > 0  # still the run's, not "no tables"
+
+
+def test_results_of_a_relative_path_in_a_removed_directory_is_one_line(tmp_path, monkeypatch):
+    import sim
+    from sim.mc.config import ConfigError
+
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    with pytest.raises(ConfigError, match="current directory no longer exists"):
+        sim.Results("network_plate", "network")
