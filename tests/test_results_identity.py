@@ -1,9 +1,14 @@
-"""A figure replaced by hand (issue 26: doors20c left it unnoticed). ``run.json`` recorded
+"""What a results directory is, as its readers take it (issue 26: doors20c and doors20a left
+these): its figures, the code that made it, the directory a relative path names.
+
+A figure replaced by hand. ``run.json`` recorded
 every table's provenance and every chunk's sha256, but nothing of the figures: a PNG drawn by
 hand (or copied from another run) beside the run's tables was embedded in the study's README
 and in REPORT.md as the run's, and ``--stale-only`` called the results current. The run now
 records each figure's sha256 (:func:`sim.mc.publish.seal`), and every reader of a whole
-results directory checks them (:func:`sim.mc.publish.changed_figure`)."""
+results directory checks them (:func:`sim.mc.publish.changed_figure`). Results of code that
+changed since are noted by ``sim show``; ``sim.Results`` of a relative path stays where it
+was named."""
 
 from __future__ import annotations
 
