@@ -372,3 +372,41 @@ def test_the_mistyped_key_of_cli_md_is_refused_with_its_guess():
     )
     line = one_line_of(r)
     assert line == "sim: error: comparator.beta: unknown key (did you mean comparator.beta_mm?)"
+
+
+STATED = re.compile(
+    r"`([a-z_0-9]+(?:\.[a-z_0-9]+)+)` = (-?[\d.]+(?:e-?\d+)?)|`([a-z_0-9]+(?:\.[a-z_0-9]+)+) = (-?[\d.]+(?:e-?\d+)?)`"
+)
+
+
+def test_every_value_the_docs_state_for_a_key_is_a_study_files():
+    """``the same `table1.trials` = 48 blocks``, ``(`table1.rounds = 0`: ...)``: a value a page
+    states for a key is the value of that key in a study file (the agnard page said the
+    scanner's vectors were 16 where `table1.points` had been raised to 32)."""
+    wrong = []
+    stated = 0
+    for page in prose_pages():
+        text = page.read_text()
+        for m in STATED.finditer(text):
+            key, value = (m.group(1), m.group(2)) if m.group(1) else (m.group(3), m.group(4))
+            have = [c[key] for c in configs().values() if key in c]
+            if not have:
+                continue  # not a key (test_every_dotted_name_...)
+            stated += 1
+            if not any(float(v) == float(value) for v in have if isinstance(v, (int, float))):
+                line = text[: m.start()].count("\n") + 1
+                wrong.append(f"{page.relative_to(ROOT)}:{line}: {key} = {value}, files: {have}")
+    assert stated >= 4
+    assert not wrong, "values the docs state that no study file has:\n" + "\n".join(wrong)
+
+
+def test_the_agnard_page_counts_the_scanner_vectors_the_run_explores():
+    """The scanner region and the joint design: `table1.points` vectors (scanner_region.parquet
+    rows), two joint points per vector (joint_region.parquet rows)."""
+    n = configs()["agnard_block"]["table1.points"]
+    res = ROOT / "results" / "agnard_block"
+    assert pq.read_metadata(res / "scanner_region.parquet").num_rows == n
+    assert pq.read_metadata(res / "joint_region.parquet").num_rows == 2 * n
+    text = (ROOT / "docs" / "papers" / "agnard-nolette-gagnon.md").read_text()
+    assert f"every explored vector (`table1.points` = {n}" in text
+    assert f"{2 * n} joint points, {n} with\nthe centres" in text
