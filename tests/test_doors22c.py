@@ -458,3 +458,20 @@ def test_the_sparse_page_measures_are_the_committed_bench_rows():
         assert _num(c[2]) == r["points"] and _num(c[3]) == r["unknowns"]
         for cell, col in zip(c[6:9], ("analytic_s", "mc_s_per_trial", "peak_mib")):
             assert close(cell, r[col]), (c, col, r[col])
+
+
+def test_the_batch_help_states_the_run_options_cli_md_documents():
+    """docs/cli.md: in ``python -m sim.batch`` "the run options after ``--`` are read once, as
+    ``sim run`` reads them"; its --help showed ``files [files ...]`` and no such part (and RST
+    quotes, ``make reproduce``); ``sim check --help`` gave no meaning for ``--set``."""
+    assert "run options after `--`" in " ".join((ROOT / "docs" / "cli.md").read_text().split())
+    r = subprocess.run(
+        [sys.executable, "-m", "sim.batch", "-h"], capture_output=True, text=True, cwd=ROOT
+    )
+    words = " ".join(r.stdout.split())
+    assert "[-- RUN_OPTIONS]" in words and "so --out is refused" in words, r.stdout
+    assert "``" not in r.stdout
+    r = subprocess.run(
+        [sys.executable, "-m", "sim", "check", "-h"], capture_output=True, text=True, cwd=ROOT
+    )
+    assert re.search(r"--set KEY=VALUE\s+override a config key", r.stdout), r.stdout
