@@ -475,3 +475,14 @@ def test_the_batch_help_states_the_run_options_cli_md_documents():
         [sys.executable, "-m", "sim", "check", "-h"], capture_output=True, text=True, cwd=ROOT
     )
     assert re.search(r"--set KEY=VALUE\s+override a config key", r.stdout), r.stdout
+
+
+def test_every_make_variable_a_user_may_set_is_named_by_make_help():
+    """The Makefile's ``VAR ?= default`` knobs (RUN_JOBS, RUN_FLAGS, MUTATION_WORKERS,
+    BENCH_OUT, PYTHON) were named by no page and not by ``make help``."""
+    text = (ROOT / "Makefile").read_text()
+    knobs = re.findall(r"^([A-Z][A-Z_]*) *\?=", text, re.M)
+    assert len(knobs) >= 6
+    helps = " ".join(re.findall(r"^[\w.-]+:.*## (.*)$", text, re.M))
+    missing = [k for k in knobs if k not in helps]
+    assert not missing, f"make help names no {missing}"
