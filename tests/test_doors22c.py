@@ -486,3 +486,29 @@ def test_every_make_variable_a_user_may_set_is_named_by_make_help():
     helps = " ".join(re.findall(r"^[\w.-]+:.*## (.*)$", text, re.M))
     missing = [k for k in knobs if k not in helps]
     assert not missing, f"make help names no {missing}"
+
+
+def test_what_the_docs_say_of_the_gama_local_export(tmp_path):
+    """README.md said every run exports its network as ``network.xml``, and docs/network.md
+    that the export refuses the additive constant, the offset, the scale and ``dx``/``dy``:
+    a network with biases is not exported (the summary says why), while a known constant and
+    offset (network_brown) and ``dx``/``dy`` pairs (network_plate) are."""
+    res = ROOT / "results"
+    brown = configs()["network_brown"]
+    assert brown["network.constant_mm"] != 0 and brown["network.offset_mm"] != 0
+    assert (res / "network_brown" / "network.xml").is_file()
+    assert "<vec " in (res / "network_plate" / "network.xml").read_text()
+    words = " ".join((ROOT / "docs" / "network.md").read_text().split())
+    assert "refuses biases, the additive constant, the offset" not in words
+    assert "every run exports its network" not in " ".join((ROOT / "README.md").read_text().split())
+
+    readme = (ROOT / "README.md").read_text()
+    toml = re.search(r"```toml\n(# my_network\.toml.*?)```", readme, re.S).group(1)
+    biased = toml.replace("sigma_mm = 0.002 }", "sigma_mm = 0.002, bias_mm = 0.001 }")
+    assert biased != toml
+    f = tmp_path / "my_network.toml"
+    f.write_text(biased)
+    out = sim.load(f, trials=40, chunk=2).run(out=tmp_path / "out", figures=False).path
+    assert not (out / "network.xml").exists()
+    why = pq.read_table(out / "summary.parquet").column("gama_xml").to_pylist()[0]
+    assert why.startswith("not exported") and "bias" in why, why
