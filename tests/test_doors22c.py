@@ -512,3 +512,41 @@ def test_what_the_docs_say_of_the_gama_local_export(tmp_path):
     assert not (out / "network.xml").exists()
     why = pq.read_table(out / "summary.parquet").column("gama_xml").to_pylist()[0]
     assert why.startswith("not exported") and "bias" in why, why
+
+
+@pytest.mark.parametrize(
+    "override, key",
+    [
+        (
+            {
+                "network.generate": [
+                    {"kind": "distance", "from": ["A", "B"], "to": "N*", "sigma_mm": 1.0},
+                    {
+                        "kind": "distance",
+                        "from": ["C"],
+                        "to": "N*",
+                        "sigma_mm": 1.0,
+                        "bias_mm": -2e5,
+                    },
+                ]
+            },
+            "network.generate[1].bias_mm",
+        ),
+        (
+            {
+                "network.observations": [
+                    {"kind": "distance", "from": "A", "to": "N1", "sigma_mm": 1.0},
+                    {"kind": "distance", "from": "A", "to": "N2", "sigma_mm": 1.0, "bias_mm": -2e5},
+                ]
+            },
+            "network.observations[1].bias_mm",
+        ),
+    ],
+)
+def test_a_bias_that_reads_a_negative_length_names_its_key(override, key):
+    """docs/network.md: "A bad network ... gives one line naming the key", and "a distance
+    whose `bias_mm` would make it read a negative length is refused by `sim check`": it was
+    refused naming ``network.observations`` also for a bias of ``network.generate[1]``."""
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(ROOT / "studies" / "network_testfield.toml", **override)
+    assert str(e.value).startswith(f"{key}: the distance from"), str(e.value)
