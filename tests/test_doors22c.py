@@ -550,3 +550,22 @@ def test_a_bias_that_reads_a_negative_length_names_its_key(override, key):
     with pytest.raises(sim.ConfigError) as e:
         sim.load(ROOT / "studies" / "network_testfield.toml", **override)
     assert str(e.value).startswith(f"{key}: the distance from"), str(e.value)
+
+
+def test_the_settings_bound_network_md_states():
+    """docs/network.md: "at most 1,000,000 settings": 1,000,000 is accepted, 1,000,001 refused,
+    and the line says the number (it read "1e+06 readings ...: over 1e+06", a bound broken
+    by an equal number)."""
+    f = ROOT / "studies" / "network_testfield.toml"
+    assert "at most 1,000,000 settings" in " ".join(
+        (ROOT / "docs" / "network.md").read_text().split()
+    )
+
+    def angle(n):
+        o = {"kind": "angle", "at": "N6", "from": "N5", "to": "N7", "sigma_arcsec": 1.0}
+        return {"network.observations": [{**o, "settings": n}]}
+
+    sim.load(f, **angle(1_000_000))
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(f, **angle(1_000_001))
+    assert "1,000,001 readings of sigma 1 arcsec: over 1,000,000" in str(e.value), str(e.value)
