@@ -569,3 +569,20 @@ def test_the_settings_bound_network_md_states():
     with pytest.raises(sim.ConfigError) as e:
         sim.load(f, **angle(1_000_001))
     assert "1,000,001 readings of sigma 1 arcsec: over 1,000,000" in str(e.value), str(e.value)
+
+
+def test_the_studies_study_code_md_names_as_users_of_the_run_steps():
+    """docs/study-code.md names the studies that use ``run_part`` and ``over_region`` (it
+    named brown_design for both, which uses only ``run_part``, and left out agnard_block)."""
+    text = " ".join((ROOT / "docs" / "study-code.md").read_text().split())
+    pkg = {"gridplate_two_plates": "gridplate", "salsig_encoders": "salsig"}
+    pkg |= {"wolf_polynomial": "wolf", "brown_design": "design", "agnard_block": "agnard"}
+    for helper in ("run_part", "over_region"):
+        said = re.search(rf"`{helper}` (?:is used )?by ((?:`\w+`(?:, | and )?)+)", text).group(1)
+        named = set(re.findall(r"`(\w+)`", said))
+        users = set()
+        for study, d in pkg.items():
+            src = "".join(f.read_text() for f in (ROOT / "sim" / "studies" / d).glob("*.py"))
+            if re.search(rf"from sim\.studies\.run_steps import [^\n]*\b{helper}\b", src):
+                users.add(study)
+        assert named == users, (helper, named, users)
