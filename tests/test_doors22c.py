@@ -586,3 +586,41 @@ def test_the_studies_study_code_md_names_as_users_of_the_run_steps():
             if re.search(rf"from sim\.studies\.run_steps import [^\n]*\b{helper}\b", src):
                 users.add(study)
         assert named == users, (helper, named, users)
+
+
+def _sets_of(path: Path) -> dict[str, set[str]]:
+    """The literal string sets assigned by name in a module (``_p = {"name", ...}``)."""
+    import ast
+
+    out = {}
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Assign) and isinstance(node.value, ast.Set):
+            vals = {e.value for e in node.value.elts if isinstance(e, ast.Constant)}
+            for t in node.targets:
+                if isinstance(t, ast.Name):
+                    out[t.id] = vals
+    return out
+
+
+def test_sim_check_names_every_field_a_network_record_accepts():
+    """``sim check`` "prints every key with its meaning": a network record's description
+    listed ``{name, x_mm, y_mm, role, sigma_mm}`` while the metre forms (``x_m``) and a
+    direction's ``set`` are accepted too."""
+    net = ROOT / "sim" / "studies" / "network"
+    sets = _sets_of(net / "definition.py") | _sets_of(net / "validate.py")
+    obs = sets["_OBS"]
+    accepted = {
+        "network.points": sets["_p"],
+        "network.grids": sets["_g"] | {"sigma_mm"},
+        "network.random": sets["_r"] | {"sigma_mm"},
+        "network.observations": obs - {"nearest"},
+        "network.generate": obs - {"at", "set"},
+    }
+    from sim.studies.network.schema import SCHEMA
+
+    for key, fields in accepted.items():
+        doc = SCHEMA[key].doc
+        listed = set(re.findall(r"[a-z_]+\*?", doc.split("{")[1].split("}")[0]))
+        for f in fields:
+            ok = f in listed or any(x.endswith("*") and f.startswith(x[:-1]) for x in listed)
+            assert ok, f"{key}: the validator accepts {f!r}, sim check's meaning lists {listed}"
