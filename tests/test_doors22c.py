@@ -643,3 +643,17 @@ def test_every_sim_load_of_a_docstring_example_loads(monkeypatch):
             exec(code, {"sim": sim})
         except sim.ConfigError as e:
             raise AssertionError(f"{where}: {code}: {e}") from None
+
+
+def test_outputs_md_names_every_key_of_a_run_record():
+    """docs/outputs.md's ``run.json`` entry names each key a run records (it gave the config
+    and the code hash, with a stray "run.," and no ``versions``)."""
+    import json
+
+    text = (ROOT / "docs" / "outputs.md").read_text()
+    entry = text.split("- `run.json`:")[1].split("\n- ")[0]
+    for d in (ROOT / "results").iterdir():
+        if (d / "run.json").is_file():
+            for k in json.loads((d / "run.json").read_text()):
+                assert f"`{k}`" in entry, (d.name, k)
+    assert "`figures`" in entry or '"figures": false' in entry
