@@ -657,3 +657,17 @@ def test_outputs_md_names_every_key_of_a_run_record():
             for k in json.loads((d / "run.json").read_text()):
                 assert f"`{k}`" in entry, (d.name, k)
     assert "`figures`" in entry or '"figures": false' in entry
+
+
+def test_every_paper_page_names_its_studies_config_sections():
+    """docs/index.md: "One page per paper, with its studies, their models, keys and outputs":
+    the Ohio State, Wolf, Salsig and Agnard pages named almost none of their studies' keys
+    (``comparator.*``, ``field.*``, ``b8.*``, ``block.*``, ...)."""
+    assert "their models, keys and outputs" in (ROOT / "docs" / "index.md").read_text()
+    for page, studies in PAPER_STUDIES.items():
+        text = (ROOT / "docs" / "papers" / page).read_text()
+        sections = {
+            k.split(".")[0] for s in studies if s in configs() for k in configs()[s] if "." in k
+        }
+        missing = sorted(s for s in sections if f"`{s}." not in text)
+        assert not missing, f"{page} names no key of {missing}"
