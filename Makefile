@@ -77,7 +77,7 @@ $(STAMP): pyproject.toml $(if $(VENV_USABLE),,venv-unusable)
 	$(call pip,-e ".[dev]")
 	@echo '$(CURDIR)' > $@; rm -f $(INSTALLING) $(VENV).lock
 
-venv: $(STAMP) ## create the virtual environment and install the project
+venv: $(STAMP) ## create the virtual environment and install the project (with PYTHON=python3, 3.11 or later)
 
 # The test files run side by side on TEST_WORKERS processes (pytest-xdist), a file on one process
 # (its module fixtures, such as the shared Dask cluster, start once); TEST_WORKERS=0: one process.
@@ -104,7 +104,7 @@ fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=30
 # not part of `make test`: about 10-20 minutes on 2 cores. Writes docs/mutation.md.
 MUTATION_WORKERS ?= 2
 
-mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (sim/claims/), run their tests, write docs/mutation.md
+mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (sim/claims/), run their tests, write docs/mutation.md (MUTATION_WORKERS=2)
 	$(call whole,MUTATION_WORKERS,1)
 	$(call pip,-e ".[dev$(comma)mutation]")
 	rm -rf mutants
@@ -119,13 +119,13 @@ mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (s
 # fast as two of two workers each and without their pools (results/bench/rerun.parquet).
 RUN_JOBS ?= 2
 
-reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md
+reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, each with RUN_FLAGS="--workers 1": sim run options)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
 	$(PY) -m sim.batch --stale-only --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
-rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report
+rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report (RUN_JOBS, RUN_FLAGS)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
 	$(PY) -m sim.batch --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
@@ -139,7 +139,7 @@ verify: $(STAMP) ## re-run every study into a scratch directory and compare with
 	$(PY) -m sim.report.verify --results results --workers 2 $(VERIFY_FLAGS)
 	$(PY) -m sim report --results results
 
-report: $(STAMP) ## rebuild results/REPORT.md from the Parquet files alone
+report: $(STAMP) ## rebuild results/REPORT.md and every results/<study>/README.md from the Parquet files alone
 	$(PY) -m sim report --results results
 
 # BENCH_FLAGS: e.g. "--quick" (a smoke run: small sizes, tiny study configurations),
@@ -147,7 +147,7 @@ report: $(STAMP) ## rebuild results/REPORT.md from the Parquet files alone
 BENCH_FLAGS ?=
 BENCH_OUT ?= results/bench
 
-bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/; BENCH_FLAGS=--quick: smoke)
+bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/, or BENCH_OUT; BENCH_FLAGS=--quick: smoke)
 	$(call shellwords,BENCH_FLAGS)
 	$(PY) -m benchmarks --out $(call q,$(BENCH_OUT)) $(BENCH_FLAGS)
 

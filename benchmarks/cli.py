@@ -187,7 +187,7 @@ def _check_args(a: argparse.Namespace, sections: tuple[str, ...]) -> None:
 def main(argv=None) -> int:
     ap = _Parser(
         prog="python -m benchmarks",
-        description="Benchmark of the batched solvers and of make rerun (see README, Benchmark)",
+        description="Benchmark of the batched solvers and of make rerun (see docs/benchmark.md)",
     )
     ap.add_argument(
         "--out", default="results/bench", help="output directory (default results/bench)"

@@ -1,7 +1,7 @@
 """The Python API: load a study, override keys, run it, read its tables.
 
 >>> import sim
->>> st = sim.load("studies/brown_table1.toml", trials=400, chunk=100, **{"errors.settings": 3})
+>>> st = sim.load("studies/brown_table1.toml", trials=400, chunk=20, **{"errors.settings": 3})
 >>> res = st.run(workers=2)                     # a fresh temporary directory unless out=...
 >>> res.claims().to_pylist()[0]["claim"]        # pyarrow tables
 >>> res.table("points").column("sigma_x_um")

@@ -199,7 +199,14 @@ def parser(doc: str) -> argparse.ArgumentParser:
         "resolved value, meaning, unit and bounds, then the work the run would do.",
     )
     c.add_argument("study", help="study file, e.g. studies/brown_dilution.toml")
-    c.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    c.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a config key as sim run --set does (repeatable); --set trials=N shows "
+        "the chunk sim run --trials N would pick",
+    )
     rep = sub.add_parser(
         "report",
         help="rebuild results/REPORT.md and each results/<study>/README.md from the Parquet files",

@@ -304,10 +304,12 @@ def _one_each(key: str, matched: dict) -> None:
             )
 
 
-def _generated_obs(cfg: dict, names: list[str], xy: np.ndarray, rows: list[tuple]) -> None:
+def _generated_obs(cfg: dict, names: list[str], xy: np.ndarray, rows: list[tuple]) -> list[int]:
     """Append the rows of ``network.generate`` (every ``from`` to every, or the nearest,
-    ``to``), refusing a set that would not fit the memory limit before it is made."""
+    ``to``), refusing a set that would not fit the memory limit before it is made. Returns
+    the end of each entry's rows (a row's entry, for a message that names its key)."""
     index = name_index(names)
+    ends = []
     for a, rec in enumerate(cfg["network.generate"]):
         key = f"network.generate[{a}]"
         _keys(key, rec, _OBS - {"at", "set"}, {"kind", "from", "to"})
@@ -325,6 +327,8 @@ def _generated_obs(cfg: dict, names: list[str], xy: np.ndarray, rows: list[tuple
             rows += [(code, s, t, -1, sig, bias) for t in tgt]
         if len(rows) == before:
             raise ConfigError(key, "generates no observation: no 'to' point other than 'from'")
+        ends.append(len(rows))
+    return ends
 
 
 def _orientation_sets(cfg: dict, names, kind, i) -> tuple[np.ndarray, tuple[str, ...]]:
@@ -354,9 +358,18 @@ def _check_offset(beta: float, names, xy, kind, i, j) -> None:
         )
 
 
-def _check_readings(cfg: dict, beta: float, names, xy, kind, i, j, bias) -> None:
+def _source(cfg: dict, ends: list[int], r: int) -> str:
+    """The key that declares row ``r``: ``network.observations[a]`` (listed first), else
+    ``network.generate[a]`` (``ends``: where each entry's rows end)."""
+    n = len(cfg["network.observations"])
+    if r < n:
+        return f"network.observations[{r}]"
+    return f"network.generate[{int(np.searchsorted(ends, r, side='right'))}]"
+
+
+def _check_readings(cfg: dict, beta: float, names, xy, kind, i, j, bias, ends) -> None:
     """Every distance reads a positive length: ``(1 + s) sqrt(d^2 - beta^2) - alpha > 0``,
-    and with its own ``bias_mm`` added too."""
+    and with its own ``bias_mm`` added too (named by the key that declares it)."""
     rows_d = np.flatnonzero(kind == 0)
     if not rows_d.size:
         return
@@ -367,7 +380,7 @@ def _check_readings(cfg: dict, beta: float, names, xy, kind, i, j, bias) -> None
     if read.min() > 0 and biased.min() <= 0:
         r = rows_d[int(np.argmin(biased))]
         raise ConfigError(
-            "network.observations",
+            f"{_source(cfg, ends, int(r))}.bias_mm",
             f"the distance from {names[i[r]]!r} to {names[j[r]]!r} would read "
             f"{biased.min():.6g} mm with its bias_mm of {bias[r]:g}: a reading is a "
             "positive length",
@@ -389,7 +402,7 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
     origin = _origin(xy)
     xy = xy - origin
     rows = _listed_obs(cfg, names)
-    _generated_obs(cfg, names, xy, rows)
+    ends = _generated_obs(cfg, names, xy, rows)
     for a in np.flatnonzero(role == 2):
         rows += [(5, a, -1, -1, csig[a], 0.0), (6, a, -1, -1, csig[a], 0.0)]
     if not rows:
@@ -399,7 +412,7 @@ def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
     oset, stations = _orientation_sets(cfg, names, kind, i)
     beta = cfg["network.offset_mm"]
     _check_offset(beta, names, xy, kind, i, j)
-    _check_readings(cfg, beta, names, xy, kind, i, j, bias.astype(float))
+    _check_readings(cfg, beta, names, xy, kind, i, j, bias.astype(float), ends)
     return Network(
         title("network.name", cfg["network.name"]),
         tuple(names),

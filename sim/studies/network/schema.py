@@ -52,21 +52,23 @@ SCHEMA = {
         "file makes the results stale (if given, the file must still have it)",
         sweep="it is the sha256 of the one network.gama_xml file",
     ),
-    "network.points": Field([], "records", "points {name, x_mm, y_mm, role, sigma_mm}"),
+    "network.points": Field([], "records", "points {name, x_mm | x_m, y_mm | y_m, role, sigma_mm}"),
     "network.grids": Field(
-        [], "records", "grids {prefix, nx, ny, spacing_mm, origin_mm, role, sigma_mm}"
+        [],
+        "records",
+        "grids {prefix, nx, ny, spacing_mm | spacing_m, origin_mm | origin_m, role, sigma_mm}",
     ),
     "network.random": Field(
         [],
         "records",
-        "random points {prefix, n, half_extent_mm, center_mm, "
+        "random points {prefix, n, half_extent_mm | half_extent_m, center_mm | center_m, "
         "role, sigma_mm}, drawn once from the seed",
     ),
     "network.observations": Field(
         [],
         "records",
         "single observations {kind, from, to, at, "
-        "sigma_mm | sigma_arcsec, settings, bias_mm | bias_arcsec}",
+        "sigma_mm | sigma_arcsec, settings, bias_mm | bias_arcsec, set}",
     ),
     "network.generate": Field(
         [],

@@ -245,7 +245,7 @@ def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
     if not settings <= MAX_SETTINGS or not lo <= sig / math.sqrt(settings):
         raise ConfigError(
             f"{key}.settings",
-            f"{settings:g} readings of sigma {sig:g} {unit}: over {MAX_SETTINGS:g} or an "
+            f"{int(settings):,} readings of sigma {sig:g} {unit}: over {MAX_SETTINGS:,} or an "
             f"averaged sigma under {lo:g} {unit}",
         )
     bias = _num(f"{key}.bias_{unit}", rec.get(f"bias_{unit}", 0.0))
