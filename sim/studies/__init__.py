@@ -163,8 +163,8 @@ def load_study(
         flat["seed"] = seed
     try:
         cfg = validate(flat, study.schema, study.check)
-    except ConfigError as e:
-        raise _beside_the_study(e, Path(path), flat) from None
+    except ConfigError as e:  # a key the study has not (``include = "x.toml"``) is not a path
+        raise (_beside_the_study(e, Path(path), flat) if e.key in study.schema else e) from None
     if study.data is not None:
         study.data(cfg, study.schema)
     return study, {"study": name, **cfg}

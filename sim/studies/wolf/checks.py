@@ -6,6 +6,7 @@ Coordinates in mm."""
 
 from __future__ import annotations
 
+import filecmp
 from pathlib import Path
 
 import numpy as np
@@ -45,8 +46,29 @@ def _grid_ok(cfg, spacing, key):
 
 
 def table_path(cfg: dict, key: str) -> Path:
+    """The file ``cfg[key]`` names: a relative path is read from the project root, never from
+    the working directory. A file of that relative path in the working directory (a study
+    author's own copy, ``studies/data/wolf_table1.csv`` edited in a directory of theirs, or
+    ``my_table.csv`` beside their study) was silently passed over for the project's (or named
+    "no such file" under the root): a path whose file here differs from the root's (or that
+    the root lacks) is refused, one line naming the key."""
     p = Path(cfg[key])
-    return p if p.is_absolute() else ROOT / p
+    if p.is_absolute():
+        return p
+    here = Path.cwd() / p
+    try:  # a copy of the same bytes reads the same: only another file is refused
+        other = here.is_file() and not (
+            (ROOT / p).is_file() and filecmp.cmp(here, ROOT / p, shallow=False)
+        )
+    except OSError:  # unreadable here or under the root: the reader names the root's
+        other = False
+    require(
+        not other,
+        key,
+        f"{p} is read from the project root {ROOT}, not from the working directory "
+        f"{Path.cwd()}, which holds another file of that path: give its absolute path",
+    )
+    return ROOT / p
 
 
 def _grids(cfg: dict) -> np.ndarray:
