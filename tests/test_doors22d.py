@@ -135,3 +135,19 @@ def test_an_include_of_another_study_file_is_an_unknown_key(tmp_path, monkeypatc
     monkeypatch.chdir(tmp_path)
     with pytest.raises(ConfigError, match=rf"^{key}: unknown key"):
         load_study(f)
+
+
+def test_wolfs_tables_contents_are_part_of_its_config(tmp_path):
+    """An edited Table 1 (the author's own coordinates) left the config, and so
+    ``--stale-only``, ``make verify`` and a resume, as they were: the results stayed
+    "up to date". The sha256 of each table is recorded in the config on load."""
+    own = tmp_path / "t1.csv"
+    shutil.copy(ROOT / "studies" / "data" / "wolf_table1.csv", own)
+    wolf = ROOT / "studies" / "wolf_polynomial.toml"
+    _, before = load_study(wolf, values={"table1.file": str(own)})
+    own.write_text(own.read_text().replace("59.080", "59.090"))
+    _, after = load_study(wolf, values={"table1.file": str(own)})
+    differ = sorted(k for k in before if before[k] != after[k])
+    assert differ == ["table1.sha256"]
+    with pytest.raises(ConfigError, match=r"^table1.sha256: .* has changed"):
+        load_study(wolf, values={"table1.file": str(own), "table1.sha256": before["table1.sha256"]})

@@ -7,15 +7,17 @@ Coordinates in mm."""
 from __future__ import annotations
 
 import filecmp
+import hashlib
 from pathlib import Path
 
 import numpy as np
 
+from sim.mc.config import ConfigError
 from sim.mc.schema_helpers import require
 from sim.studies.wolf import tables
 from sim.studies.wolf.grid import grid_nodes, mid_cells, node_index
 
-__all__ = ["MAX_CHUNK_CELLS", "ROOT", "check", "table_path"]
+__all__ = ["MAX_CHUNK_CELLS", "ROOT", "check", "table_digest", "table_path"]
 
 #: the repository root: table files are given relative to it
 ROOT = Path(__file__).resolve().parents[3]
@@ -151,3 +153,26 @@ def check(cfg: dict) -> None:
     _chunk_work(cfg, g)
     tables.load_table1(table_path(cfg, "table1.file"), "table1.file")
     tables.load_table3(table_path(cfg, "table3.file"), "table3.file")
+    for t in ("table1", "table3"):
+        cfg[f"{t}.sha256"] = table_digest(cfg, t)
+
+
+def table_digest(cfg: dict, t: str) -> str:
+    """The sha256 of the file ``cfg["<t>.file"]`` names, which must be ``cfg["<t>.sha256"]``
+    when that is given (recorded at load): the config, and so the staleness of the results
+    (``--stale-only``, ``make verify``, a resumed run, the API's handle), holds the table's
+    contents, not only its path. An edited table was "up to date"."""
+    key = f"{t}.sha256"
+    path = table_path(cfg, f"{t}.file")
+    try:
+        sha = hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError as e:
+        raise ConfigError(f"{t}.file", f"{path}: {e.strerror or e}") from None
+    have = cfg.get(key)
+    require(
+        not have or have == sha,
+        key,
+        f"{path} has changed since the study was loaded (sha256 {sha[:12]}..., recorded "
+        f"{str(have)[:12]}...): load the study again",
+    )
+    return sha
