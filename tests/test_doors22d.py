@@ -151,3 +151,35 @@ def test_wolfs_tables_contents_are_part_of_its_config(tmp_path):
     assert differ == ["table1.sha256"]
     with pytest.raises(ConfigError, match=r"^table1.sha256: .* has changed"):
         load_study(wolf, values={"table1.file": str(own), "table1.sha256": before["table1.sha256"]})
+
+
+def test_a_scale_too_short_for_any_offset_says_so_not_a_negative_bound():
+    """``scale.graduated_mm = 200`` (an author's shorter comparator) was refused with "at most
+    -32.8 mm fits a +-90 mm grid": no offset fits, and the line now says that and what to
+    change."""
+    design = ROOT / "studies" / "brown_design.toml"
+    with pytest.raises(
+        ConfigError, match=r"^paper.offset_mm: .*\(no offset fits a \+-90 mm grid: "
+    ) as e:
+        load_study(design, values={"scale.graduated_mm": 200.0})
+    assert "-3" not in str(e.value) and "scale.graduated_mm" in str(e.value)
+    with pytest.raises(ConfigError, match=r"\(at most 33.6 mm fits a \+-90 mm grid\)$"):
+        load_study(design, values={"paper.offset_mm": 80.0})
+
+
+def test_wolfs_table_beside_the_study_is_not_said_to_be_read_from_the_working_directory(
+    tmp_path, monkeypatch, capsys
+):
+    """A ``table1.file`` beside the study file was answered "not found in <cwd> (a relative
+    path is read from the working directory) ...: run from studies": the hint of
+    ``network.gama_xml``; run from there, the table was still not read (the project root is
+    where it is read from). The line names the file under the root it looked for."""
+    (tmp_path / "studies").mkdir()
+    shutil.copy(ROOT / "studies" / "data" / "wolf_table1.csv", tmp_path / "studies" / "t1.csv")
+    f = tmp_path / "studies" / "wolf.toml"
+    f.write_text('study = "wolf_polynomial"\n[table1]\nfile = "t1.csv"\n')
+    monkeypatch.chdir(tmp_path)
+    line = one_line(capsys, cli.main(["check", str(f)]), "table1.file", prefix=SIM_ERROR)
+    assert (
+        str(ROOT / "t1.csv") in line and "working directory" not in line and "run from" not in line
+    )

@@ -163,8 +163,11 @@ def load_study(
         flat["seed"] = seed
     try:
         cfg = validate(flat, study.schema, study.check)
-    except ConfigError as e:  # a key the study has not (``include = "x.toml"``) is not a path
-        raise (_beside_the_study(e, Path(path), flat) if e.key in study.schema else e) from None
+    except ConfigError as e:  # a key the study has not (``include = "x.toml"``) is not a path,
+        # and one read from the repository root (Wolf's tables) says so itself
+        field = study.schema.get(e.key) if isinstance(e.key, str) else None
+        cwd = field is not None and "repository root" not in field.doc
+        raise (_beside_the_study(e, Path(path), flat) if cwd else e) from None
     if study.data is not None:
         study.data(cfg, study.schema)
     return study, {"study": name, **cfg}
