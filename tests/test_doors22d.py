@@ -20,7 +20,14 @@ case each; each failed on the code before its fix.
   that differs from the root's is refused naming the key (:func:`sim.studies.wolf.checks.table_path`);
 * ``include = "base.toml"`` (a key no study has, whose value is a file beside the study) was
   answered "base.toml not found in ... run from studies or give an absolute path", as if
-  include were supported from another directory: it is ``include: unknown key``.
+  include were supported from another directory: it is ``include: unknown key``;
+* an edited Wolf table left the config as it was (``--stale-only``: up to date): its sha256
+  is part of the config (``table1.sha256``, ``table3.sha256``);
+* a Wolf table beside the study file got ``network.gama_xml``'s hint "read from the working
+  directory: run from studies", where it was still not read;
+* ``scale.graduated_mm = 200`` in brown_design: "at most -32.8 mm fits": no offset fits;
+* point layouts given only under ``[sweep]``: "a network needs at least two points", without
+  saying that the file's own values are checked first, the swept key at its default.
 """
 
 from __future__ import annotations
@@ -183,3 +190,21 @@ def test_wolfs_table_beside_the_study_is_not_said_to_be_read_from_the_working_di
     assert (
         str(ROOT / "t1.csv") in line and "working directory" not in line and "run from" not in line
     )
+
+
+def test_a_key_given_only_in_the_sweep_is_named_when_the_files_own_values_fail(tmp_path):
+    """Two point layouts of an author's network given only under ``[sweep]`` were refused
+    "network.points: a network needs at least two points": the file's own values are checked
+    first as a study of their own, where the swept key takes its default. The line says so."""
+    layout = NET[NET.index("points = ") : NET.index("generate = ")].removeprefix("points = ")
+    body = NET.replace(f"points = {layout}", "")
+    other = layout.strip().replace("x_mm = 150.0", "x_mm = 350.0")  # P moved
+    f = tmp_path / "layouts.toml"
+    f.write_text(f'{body}[sweep]\n"network.points" = [{layout.strip()}, {other}]\n')
+    with pytest.raises(ConfigError, match=r"^network.points: a network needs at least two") as e:
+        load_study(f)
+    assert "network.points is swept but not given there" in str(e.value)
+    g = tmp_path / "given.toml"  # given outside [sweep] too: it loads
+    g.write_text(f'{NET}[sweep]\n"network.points" = [{layout.strip()}, {other}]\n')
+    assert cli.main(["check", str(g)]) == 0
+    assert load_study(g)[1]["network.points"][3]["name"] == "P"
