@@ -131,7 +131,8 @@ rerun: $(STAMP) ## re-run every study even if its results are up to date, then t
 	$(PY) -m sim.batch --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
-# VERIFY_FLAGS: e.g. "--study brown_table1", "--scratch DIR" (see python -m sim.report.verify -h)
+# VERIFY_FLAGS: e.g. "--study brown_table1", "--scratch DIR" (see python -m sim.report.verify -h;
+# results of your own study files: python -m sim.report.verify --results DIR --studies DIR)
 VERIFY_FLAGS ?=
 
 verify: $(STAMP) ## re-run every study into a scratch directory and compare with results/ (a rule per kind of column; VERIFY_FLAGS)

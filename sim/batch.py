@@ -41,6 +41,7 @@ single_threaded_blas()  # before NumPy loads (the study modules import it)
 
 from sim.batch_checks import (  # noqa: E402
     _clashes,
+    _replaces_project_results,
     _run_options_problem,
     _timings_problem,
     _unknown_sets,
@@ -247,6 +248,9 @@ def _main(argv: list[str]) -> int:
     except _BadArgs as e:
         print(f"sim.batch: {e} (see python -m sim.batch --help)", file=sys.stderr)
         return 2
+    if not 1 <= args.jobs <= 64:  # an option of the command line, before its files
+        print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
+        return 2
     if name_problem(args.results):
         why = name_problem(args.results)
         print(f"sim.batch: --results: {why} (got {args.results!r})", file=sys.stderr)
@@ -287,12 +291,13 @@ def _main(argv: list[str]) -> int:
     if why:
         print(f"sim.batch: --timings: {why}", file=sys.stderr)
         return 2
+    for f in files:
+        if why := _replaces_project_results(f, Path(args.results)):
+            print(f"sim.batch: {why}", file=sys.stderr)
+            return 2
     for s in STOP_SIGNALS:
         if signal.getsignal(s) is signal.SIG_DFL:
             signal.signal(s, _on_sigterm)  # end the runs as Ctrl-C does
-    if not 1 <= args.jobs <= 64:
-        print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
-        return 2
     if note:  # once, not one line per run that refuses it
         print(f"sim.batch: note: {note}", file=sys.stderr)
     log = _Stdout()

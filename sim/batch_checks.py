@@ -99,6 +99,26 @@ def _clashes(files: list[Path], run_args: list[str], results: str = "results") -
     return None
 
 
+def _replaces_project_results(f: Path, results: Path) -> str | None:
+    """Why the run of ``f`` would replace the results of the project's own study file of its
+    name (``results/<stem>``, made from ``studies/<stem>.toml`` of the working directory) with
+    the results of another file of that name (a study author's own ``brown_table1.toml``):
+    each run is ``--overwrite``, and the committed results were silently replaced."""
+    own = Path("studies") / f"{f.stem}.toml"
+    try:
+        target = (results / f.stem).resolve()
+        if target != (Path("results") / f.stem).resolve() or not own.is_file():
+            return None
+        if f.resolve() == own.resolve():
+            return None
+    except (OSError, RuntimeError):  # a loop: the run names it
+        return None
+    return (
+        f"{f} would replace {results / f.stem}, the results of the project's {own} "
+        "(another file of that name): give your own --results DIR"
+    )
+
+
 def _run_options_problem(run_args: list[str]) -> str | None:
     """Why the run options cannot go to every run, checked once before any starts (as
     ``sim run`` reads them, abbreviations included): a bad option or value, an ``--out``

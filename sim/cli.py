@@ -145,12 +145,15 @@ def _differs(old: dict, record: dict) -> str:
     return "the code changed since they were made"
 
 
-def _default_out(cfg: dict, sweep: dict, name: str) -> tuple[Path, str, bool]:
-    """Without --out: ``results/<name>`` (``name`` the study file's, where ``make reproduce``
+def _default_out(cfg: dict, sweep: dict, path: Path) -> tuple[Path, str, bool]:
+    """Without --out: ``results/<name>`` (``name`` the study file ``path``'s, where ``make reproduce``
     writes it, or the study kind's when only that exists) when it holds this very run (config and code) or does not exist, else
     ``scratch/<name>-<config hash>`` (said on standard error). Returns ``(absolute path,
     shown path, overwrite)``; a scratch directory is replaced freely. (By the study kind,
-    ``studies/network_brown.toml`` wrote into a new ``results/network/``.)"""
+    ``studies/network_brown.toml`` wrote into a new ``results/network/``.) In the project's
+    root a new ``results/<name>`` is made for its ``studies/<name>.toml`` only: an author's
+    ``my_net.toml`` went into the committed results, REPORT.md and ``make verify``."""
+    name = path.stem
     if not (Path("results") / name).exists() and (Path("results") / cfg["study"]).exists():
         name = cfg["study"]  # a copy of a study file under another name
     committed = Path("results") / name
@@ -159,6 +162,14 @@ def _default_out(cfg: dict, sweep: dict, name: str) -> tuple[Path, str, bool]:
         "code_hash": code_hash(cfg["study"]),
     }
     old = read_record(committed)
+    if not committed.exists() and not _project_file(path, name):
+        scratch = Path("scratch") / f"{name}-{_config_tag(record)}"
+        print(
+            f"sim: {path} is not the project's studies/{name}.toml: writing to {scratch}/ "
+            "(--out DIR to choose; results/ holds the project's studies)",
+            file=sys.stderr,
+        )
+        return Path(os.path.abspath(scratch)), str(scratch), True
     if not committed.exists() or (
         old is not None
         and old.get("config") == record["config"]
@@ -175,13 +186,23 @@ def _default_out(cfg: dict, sweep: dict, name: str) -> tuple[Path, str, bool]:
     return Path(os.path.abspath(scratch)), str(scratch), True
 
 
+def _project_file(path: Path, name: str) -> bool:
+    """Whether ``path`` may make ``results/<name>``: it is ``studies/<name>.toml``, or the
+    working directory is no project's root (no ``studies/``: its ``results/`` is the user's)."""
+    own = Path("studies") / f"{name}.toml"
+    try:
+        return not Path("studies").is_dir() or path.resolve() == own.resolve()
+    except (OSError, RuntimeError):
+        return False
+
+
 def _run(args) -> int:
     out = check_run_args(args)
     study, cfg = load_run(args)
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
     overwrite = args.overwrite
     if out is None:
-        out, shown, scratch = _default_out(cfg, sweep, Path(args.study).stem)
+        out, shown, scratch = _default_out(cfg, sweep, Path(args.study))
         overwrite = overwrite or scratch
     else:
         shown = args.out

@@ -163,11 +163,29 @@ def load_study(
         flat["seed"] = seed
     try:
         cfg = validate(flat, study.schema, study.check)
-    except ConfigError as e:
-        raise _beside_the_study(e, Path(path), flat) from None
+    except ConfigError as e:  # a key the study has not (``include = "x.toml"``) is not a path,
+        # and one read from the repository root (Wolf's tables) says so itself
+        field = study.schema.get(e.key) if isinstance(e.key, str) else None
+        cwd = field is not None and "repository root" not in field.doc
+        raise _unswept(_beside_the_study(e, Path(path), flat) if cwd else e, swept, flat) from None
     if study.data is not None:
         study.data(cfg, study.schema)
     return study, {"study": name, **cfg}
+
+
+def _unswept(e: ConfigError, swept: set[str], flat: Mapping[str, Any]) -> ConfigError:
+    """``e``, saying so when a swept key is not given outside ``[sweep]``: the file's own
+    values are validated first, as a study of their own, so a network whose points are given
+    only as the sweep's layouts was refused "a network needs at least two points"."""
+    missing = sorted(k for k in swept if k not in flat)
+    if not missing:
+        return e
+    return ConfigError(
+        e.key,
+        f"{str(e).removeprefix(f'{e.key}: ')} (the values outside [sweep] are checked first, "
+        f"as a study of their own: {', '.join(missing)} is swept but not given there, so it "
+        "takes its default; give it one of the swept values too)",
+    )
 
 
 def _beside_the_study(e: ConfigError, path: Path, flat: Mapping[str, Any]) -> ConfigError:

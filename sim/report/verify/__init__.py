@@ -1,7 +1,8 @@
 """Reproducibility verified, not promised: re-run the studies and compare with committed results.
 
 ``python -m sim.report.verify`` (``make verify``) re-runs every study of a results directory
-(its study file in ``studies/``) into a scratch directory and compares, file by file and column
+(its study file in ``studies/``, or in ``--studies DIR`` for the results of study files
+kept elsewhere) into a scratch directory and compares, file by file and column
 by column, the Parquet tables there with the committed ones, each column by the rule declared
 with it for the kind of number it holds (:mod:`sim.mc.tolerance`; docs/reproducibility.md):
 

@@ -43,6 +43,11 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--scratch", help="where to re-run (default: a temporary directory, removed after)"
     )
+    p.add_argument(
+        "--studies",
+        default="studies",
+        help="the study files of the results, DIR/<results directory>.toml (default: studies)",
+    )
     p.add_argument("--workers", type=int, default=1, help="workers of each re-run")
     p.add_argument("--study", action="append", help="only this study (repeatable)")
     p.add_argument(
@@ -69,7 +74,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _check_args(a) -> None:
-    for name, v in (("--results", a.results), ("--scratch", a.scratch)):
+    for name, v in (("--results", a.results), ("--scratch", a.scratch), ("--studies", a.studies)):
         why = None if v is None else name_problem(v)
         if why:
             raise VerifyError(f"{name}: {why} (got {v!r})")
@@ -86,10 +91,12 @@ def _check_args(a) -> None:
         raise VerifyError("--set: only with --trials (a re-run with other inputs is not a check)")
     if a.no_rerun and not a.scratch:
         raise VerifyError("--no-rerun: needs --scratch (the directory of the re-runs)")
-    if not a.no_rerun and not Path("studies").is_dir():  # run elsewhere, every study "FAILED"
+    if not a.no_rerun and a.studies != "studies" and not Path(a.studies).is_dir():
+        raise VerifyError(f"--studies: {a.studies} is not a directory")
+    if not a.no_rerun and not Path(a.studies).is_dir():  # run elsewhere, every study "FAILED"
         raise VerifyError(
             f"no studies/ directory in {Path.cwd()}: the re-runs read their study files from "
-            "studies/; run from the project's root"
+            "studies/; run from the project's root (or name their directory with --studies)"
         )
     for s in a.set:
         if "=" not in s:
@@ -158,6 +165,7 @@ def _main(argv: list[str] | None) -> int:
                 rerun=not a.no_rerun,
                 extra=extra,
                 mode=mode,
+                studies=Path(a.studies),
             )
         check_interrupt()  # before the comparisons are printed and recorded
     except VerifyError as e:

@@ -20,7 +20,7 @@ from sim.report.read import mixed_run
 from sim.report.tables import fmt, md_table
 from sim.report.verify.rules import DEFAULT_RTOL, Comparison, VerifyError, compare_dirs
 
-__all__ = ["study_dirs", "rerun_study", "verify", "write_record", "markdown"]
+__all__ = ["study_dirs", "study_file", "rerun_study", "verify", "write_record", "markdown"]
 
 
 # --- re-running -------------------------------------------------------------------------------
@@ -113,16 +113,31 @@ def _ours(p: Path) -> bool:
     return p.name == "run.json" or p.suffix in (".parquet", ".png", ".xml")
 
 
+def study_file(d: Path, study: str, studies: Path = Path("studies")) -> Path:
+    """The study file that made the results ``d`` of ``study``: ``studies/<d.name>.toml`` (a
+    study kind with several files, ``network_*``, is named by its directory), else
+    ``studies/<study>.toml``."""
+    sf = studies / f"{d.name}.toml"
+    return sf if sf.is_file() else studies / f"{study}.toml"
+
+
 def rerun_study(
-    d: Path, study: str, target: Path, overwrite: bool, workers: int, extra: list[str]
+    d: Path,
+    study: str,
+    target: Path,
+    overwrite: bool,
+    workers: int,
+    extra: list[str],
+    studies: Path = Path("studies"),
 ) -> str | None:
-    """Run the study of committed results ``d`` into ``target``; the failure, or None."""
-    studies_dir = Path("studies")
-    # a study kind with several example files (network_*) is named by its directory
-    sf = studies_dir / f"{d.name}.toml"
-    sf = sf if sf.is_file() else studies_dir / f"{study}.toml"
+    """Run the study of committed results ``d`` into ``target`` from its file in ``studies``;
+    the failure, or None."""
+    sf = study_file(d, study, studies)
     if not sf.is_file():
-        return f"no study file {studies_dir / (d.name + '.toml')} to re-run"
+        return (
+            f"no study file {studies / (d.name + '.toml')} to re-run (results of study files "
+            "kept elsewhere: name their directory with --studies)"
+        )
     # the comparison reads tables only: no figures drawn (half of some studies' time)
     cmd = [sys.executable, "-m", "sim", "run", str(sf), "--out", str(target), "--quiet"]
     cmd += ["--no-figures"]
@@ -151,10 +166,12 @@ def verify(
     rerun: bool = True,
     extra: list[str] | None = None,
     mode: str = "full",
+    studies: Path = Path("studies"),
 ) -> list[Comparison]:
     """Re-run each study with committed results into ``scratch`` and compare (``rerun=False``:
     compare with what ``scratch`` holds). ``extra``: further ``sim run`` arguments (``--trials
-    N``, ``--set K=V``); ``mode``: ``full``, or ``mc`` for a re-run with fewer trials."""
+    N``, ``--set K=V``); ``mode``: ``full``, or ``mc`` for a re-run with fewer trials;
+    ``studies``: the directory of the study files (:func:`study_file`)."""
     scratch = Path(scratch)
     if scratch.exists() and not scratch.is_dir():
         raise VerifyError(f"--scratch: {scratch} is not a directory")
@@ -193,13 +210,14 @@ def verify(
             continue
         if rerun:
             overwrite = replace[d]
-            why = rerun_study(d, study, target, overwrite, workers, extra or [])
+            why = rerun_study(d, study, target, overwrite, workers, extra or [], Path(studies))
             if why:
                 c = Comparison(d.name)
                 c.failures.append(why)
                 out.append(c)
                 continue
-        stale = _other_config(d, target) if mode == "full" else None
+        sf = study_file(d, study, Path(studies)) if rerun else None
+        stale = _other_config(d, target, sf) if mode == "full" else None
         if stale:  # not a reproduction failure of these numbers: results of another input
             c = Comparison(d.name)
             c.failures.append(stale)
@@ -225,10 +243,12 @@ def _other_code(d: Path, target: Path) -> str | None:
     )
 
 
-def _other_config(d: Path, target: Path) -> str | None:
-    """Why the committed results ``d`` cannot be compared with the re-run ``target``: their
-    run records hold different configs (results left by a run with other options, or stale
-    against the study file), so numbers that differ would be no failure to reproduce."""
+def _other_config(d: Path, target: Path, sf: Path | None = None) -> str | None:
+    """Why the committed results ``d`` cannot be compared with the re-run ``target`` (of the
+    study file ``sf``): their run records hold different configs (results left by a run with
+    other options, stale against the study file, or made from another file of its name: a
+    study author's own ``brown_table1.toml`` re-run as the project's), so numbers that differ
+    would be no failure to reproduce."""
     a, b = read_record(d), read_record(target)
     if not isinstance(a, dict) or not isinstance(b, dict) or "config" not in a:
         return None  # no record to tell: the comparison decides
@@ -236,9 +256,15 @@ def _other_config(d: Path, target: Path) -> str | None:
     if not isinstance(ca, dict) or not isinstance(cb, dict) or ca == cb:
         return None
     keys = sorted(k for k in set(ca) | set(cb) if ca.get(k) != cb.get(k))
+    why = "they are stale or were made with other options"
+    if sf is not None:  # re-run from a file of ours: the results may be of a file of theirs
+        why = (
+            f"they are stale, were made with other options, or from another study file than "
+            f"{sf} (name its directory with --studies)"
+        )
     return (
         f"the committed results are of another config than the re-run (keys {', '.join(keys)}): "
-        "they are stale or were made with other options; run make reproduce, then verify"
+        f"{why}; run make reproduce, then verify"
     )
 
 

@@ -86,6 +86,15 @@ def check(cfg: dict) -> None:
     _check_paper_solvable(cfg)
 
 
+def _fits(hmax: float, what: str = "") -> str:
+    """Which station offsets fit ``what``: "at most 32.8 mm fits", or, when none does (a
+    scale too short for the grid: it read "at most -32.8 mm fits"), that none fits and what
+    to change."""
+    if hmax < 0:
+        return f"no offset fits{what}: lengthen scale.graduated_mm or shrink the grid"
+    return f"at most {hmax:.1f} mm fits{what}"
+
+
 def _check_geometry(cfg: dict) -> None:
     """The paper's, the datum's and the Zeiss geometry fit the format and the hardware."""
     half = cfg["plate.format_mm"] / 2
@@ -98,19 +107,19 @@ def _check_geometry(cfg: dict) -> None:
     )
     require(datum_ext <= half, "datum.spacing_mm", "the datum grid leaves the format")
     hmax = max_offset_mm(cfg, cfg["paper.extent_mm"])
+    grid = f" a +-{cfg['paper.extent_mm']:g} mm grid"
     require(
         cfg["paper.offset_mm"] <= hmax + 1e-9,
         "paper.offset_mm",
         f"the paper's design must fit its hardware: at {cfg['paper.offset_mm']:g} mm the "
-        f"longest range exceeds the scale plus micrometer (at most {hmax:.1f} mm fits a +-"
-        f"{cfg['paper.extent_mm']:g} mm grid)",
+        f"longest range exceeds the scale plus micrometer ({_fits(hmax, grid)})",
     )
     dmax = max_offset_mm(cfg, datum_ext)
     require(
         cfg["datum.offset_mm"] <= dmax + 1e-9,
         "datum.offset_mm",
         f"the datum geometry must be buildable: at {cfg['datum.offset_mm']:g} mm its "
-        f"longest range exceeds the scale plus micrometer (at most {dmax:.1f} mm fits)",
+        f"longest range exceeds the scale plus micrometer ({_fits(dmax)})",
     )
     P, n = cfg["paper.positions"], cfg["zeiss.points"]
     dof = P * n - 2 * n - (2 * P + 2) + 3  # readings - unknowns (the rigid fit fixes 3)

@@ -6,15 +6,18 @@ Coordinates in mm."""
 
 from __future__ import annotations
 
+import filecmp
+import hashlib
 from pathlib import Path
 
 import numpy as np
 
+from sim.mc.config import ConfigError
 from sim.mc.schema_helpers import require
 from sim.studies.wolf import tables
 from sim.studies.wolf.grid import grid_nodes, mid_cells, node_index
 
-__all__ = ["MAX_CHUNK_CELLS", "ROOT", "check", "table_path"]
+__all__ = ["MAX_CHUNK_CELLS", "ROOT", "check", "table_digest", "table_path"]
 
 #: the repository root: table files are given relative to it
 ROOT = Path(__file__).resolve().parents[3]
@@ -45,8 +48,29 @@ def _grid_ok(cfg, spacing, key):
 
 
 def table_path(cfg: dict, key: str) -> Path:
+    """The file ``cfg[key]`` names: a relative path is read from the project root, never from
+    the working directory. A file of that relative path in the working directory (a study
+    author's own copy, ``studies/data/wolf_table1.csv`` edited in a directory of theirs, or
+    ``my_table.csv`` beside their study) was silently passed over for the project's (or named
+    "no such file" under the root): a path whose file here differs from the root's (or that
+    the root lacks) is refused, one line naming the key."""
     p = Path(cfg[key])
-    return p if p.is_absolute() else ROOT / p
+    if p.is_absolute():
+        return p
+    here = Path.cwd() / p
+    try:  # a copy of the same bytes reads the same: only another file is refused
+        other = here.is_file() and not (
+            (ROOT / p).is_file() and filecmp.cmp(here, ROOT / p, shallow=False)
+        )
+    except OSError:  # unreadable here or under the root: the reader names the root's
+        other = False
+    require(
+        not other,
+        key,
+        f"{p} is read from the project root {ROOT}, not from the working directory "
+        f"{Path.cwd()}, which holds another file of that path: give its absolute path",
+    )
+    return ROOT / p
 
 
 def _grids(cfg: dict) -> np.ndarray:
@@ -129,3 +153,26 @@ def check(cfg: dict) -> None:
     _chunk_work(cfg, g)
     tables.load_table1(table_path(cfg, "table1.file"), "table1.file")
     tables.load_table3(table_path(cfg, "table3.file"), "table3.file")
+    for t in ("table1", "table3"):
+        cfg[f"{t}.sha256"] = table_digest(cfg, t)
+
+
+def table_digest(cfg: dict, t: str) -> str:
+    """The sha256 of the file ``cfg["<t>.file"]`` names, which must be ``cfg["<t>.sha256"]``
+    when that is given (recorded at load): the config, and so the staleness of the results
+    (``--stale-only``, ``make verify``, a resumed run, the API's handle), holds the table's
+    contents, not only its path. An edited table was "up to date"."""
+    key = f"{t}.sha256"
+    path = table_path(cfg, f"{t}.file")
+    try:
+        sha = hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError as e:
+        raise ConfigError(f"{t}.file", f"{path}: {e.strerror or e}") from None
+    have = cfg.get(key)
+    require(
+        not have or have == sha,
+        key,
+        f"{path} has changed since the study was loaded (sha256 {sha[:12]}..., recorded "
+        f"{str(have)[:12]}...): load the study again",
+    )
+    return sha

@@ -232,12 +232,24 @@ SCHEMA = {
         "studies/data/wolf_table1.csv",
         "str",
         "transcription of Tables 1 and 2 (relative to the repository root)",
+        sweep="its contents are recorded in table1.sha256: write one study file per table",
     ),
     "table3.file": Field(
         "studies/data/wolf_table3.csv",
         "str",
         "transcription of Table 3 (relative to the repository root)",
+        sweep="its contents are recorded in table3.sha256: write one study file per table",
     ),
+    **{
+        f"{t}.sha256": Field(
+            "",
+            "str",
+            f"sha256 of the {t}.file's contents, filled in on load so that an edited table "
+            "makes the results stale (if given, the file must still have it)",
+            sweep=f"it is the sha256 of the one {t}.file",
+        )
+        for t in ("table1", "table3")
+    },
     "mono.sigma_um": real(
         1.5,
         "error of one monocomparator coordinate (H. Dell Foster, "
