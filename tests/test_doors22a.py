@@ -12,8 +12,11 @@ the project. The tests that run ``gama-local`` skip without it (``$GAMA_LOCAL``,
   covariance with a pivot tolerance of 1e-8 times the cluster's FIRST variance, so a station
   whose first direction has a variance over 1e8 times a later one's (1000 arcsec before
   0.05 arcsec), or a vector of sigma 10 m beside the export's dz variance of 1 mm^2, was
-  written as a file gama-local cannot read; the export now puts the least variance first
-  where the order would fail (files that passed are written byte for byte as before).
+  written as a file gama-local cannot read; and it tests each cluster again, at the
+  adjustment, over the observations it keeps (without the lone direction of a set): a
+  station whose lone direction came before an angle of 1e8 times a distance's variance
+  failed there ("CovMat::cholDec ... not positive definite"). The export now writes such a
+  cluster in ascending variance (files that passed are written byte for byte as before).
 """
 
 from __future__ import annotations
@@ -121,7 +124,30 @@ generate = [ { kind = "distance", from = ["A", "B"], to = ["C", "D"], sigma_mm =
 """
 )
 
-CASES = {"directions": DIRECTIONS, "vectors": VECTORS, "coordinates": COORDINATES}
+#: at A a lone direction (1 arcsec: 9.5 cc^2) before an angle of 30 arcsec (8,573 cc^2) and a
+#: distance of 0.001 mm: the file's order passes (1e-6 / 9.5), but gama-local adjusts without
+#: the lone direction (its orientation absorbs it), and then 1e-6 / 8,573 does not
+LONE = (
+    'study = "network"\ntrials = 40\nchunk = 2\n[network]\n'
+    + POINTS % ("", "")
+    + """
+observations = [
+  { kind = "direction", from = "A", to = "C", sigma_arcsec = 1.0 },
+  { kind = "angle", at = "A", from = "B", to = "D", sigma_arcsec = 30.0 },
+  { kind = "distance", from = "A", to = "C", sigma_mm = 0.001 },
+  { kind = "distance", from = "A", to = "D", sigma_mm = 0.001 },
+]
+generate = [ { kind = "distance", from = "B", to = ["C", "D"], sigma_mm = 1.0 },
+             { kind = "direction", from = "B", to = "*", sigma_arcsec = 1.0 } ]
+"""
+)
+
+CASES = {
+    "directions": DIRECTIONS,
+    "vectors": VECTORS,
+    "coordinates": COORDINATES,
+    "lone direction": LONE,
+}
 
 
 @pytest.mark.parametrize("case", list(CASES))
@@ -134,6 +160,11 @@ def test_every_exported_cluster_passes_gama_locals_pivot_test(case, tmp_path):
     note = export(net, full, xml)
     assert not note.startswith("not exported"), note
     for var in clusters(xml):
+        assert all(v > 1e-8 * var[0] for v in var[1:]), var
+    # and over the observations gama-local adjusts: without the lone direction of a set
+    for o in ET.parse(xml).getroot().iter(NS + "obs"):
+        dirs = [e for e in o if e.tag == NS + "direction"]
+        var = [float(e.get("stdev")) ** 2 for e in o if not (len(dirs) == 1 and e in dirs)]
         assert all(v > 1e-8 * var[0] for v in var[1:]), var
 
 

@@ -17,7 +17,7 @@ the design, the same precision. ``val`` is the error-free value.
 Refused with one line (gama-local cannot express them): an estimated additive constant or
 scale, observation biases, a ``dx`` without its ``dy`` (a vector has both), a ``dy`` whose
 variance is at or below 1e-8 of every ``dx``'s (:func:`_least_first`: a cluster whose order
-would fail gama-local's pivot test gets its least variance first).
+would fail gama-local's pivot test is written in ascending variance).
 ``datum.kind = "constraints"`` is written as the free network in the inner datum over all its
 points (:func:`export`, which says so): its precision is this study's moved by an
 S-transformation (``output.inner_over``).
@@ -184,20 +184,24 @@ def _obs_sets(net: Network, po, val: np.ndarray) -> None:
             if not g:
                 continue
             o = ET.SubElement(po, "obs", {"from": net.names[a]})
-            for r in _least_first(g, [_variance(net, int(r)) for r in g]):
+            lone = [r for r in g if net.kind[r] == 1]
+            lone = tuple(lone) if len(lone) == 1 else ()
+            for r in _least_first(g, [_variance(net, int(r)) for r in g], lone):
                 _one(net, o, int(r), val[r])
 
 
-def _least_first(items: list, var: list) -> list:
-    """``items`` as they are, or with the one of least variance moved first when gama-local
-    would refuse them: it factorises each cluster's covariance with a pivot tolerance of
-    1e-8 times its first variance, so a cluster whose first variance is over 1e8 times a
-    later one is "not positive definite" (a direction of 1000 arcsec before one of 0.05);
-    from the least, every pivot passes."""
-    if _passes(var):
+def _least_first(items: list, var: list, passive: tuple = ()) -> list:
+    """``items`` as they are, or in ascending variance when gama-local would refuse them: it
+    factorises each cluster's covariance with a pivot tolerance of 1e-8 times its first
+    variance, so a cluster whose first variance is over 1e8 times a later one is "not
+    positive definite" (a direction of 1000 arcsec before one of 0.05), when it reads the
+    file and again over the observations it adjusts (without ``passive`` ones: the lone
+    direction of a set, which its orientation absorbs). In ascending order the first of any
+    part is its least, and every pivot passes."""
+    active = [v for it, v in zip(items, var) if it not in passive]
+    if _passes(var) and (not active or _passes(active)):
         return items
-    b = int(np.argmin(var))
-    return [items[b]] + items[:b] + items[b + 1 :]
+    return [items[b] for b in np.argsort(var, kind="stable")]
 
 
 def _passes(var: list) -> bool:
