@@ -15,7 +15,9 @@ equivalent stdev ``sigma s / ((1 + scale) d)`` (``s = sqrt(d^2 - beta^2)``): the
 the design, the same precision. ``val`` is the error-free value.
 
 Refused with one line (gama-local cannot express them): an estimated additive constant or
-scale, observation biases, a ``dx`` without its ``dy`` (a vector has both).
+scale, observation biases, a ``dx`` without its ``dy`` (a vector has both), a ``dy`` whose
+variance is at or below 1e-8 of every ``dx``'s (:func:`_least_first`: a cluster whose order
+would fail gama-local's pivot test is written in ascending variance).
 ``datum.kind = "constraints"`` is written as the free network in the inner datum over all its
 points (:func:`export`, which says so): its precision is this study's moved by an
 S-transformation (``output.inner_over``).
@@ -144,6 +146,23 @@ def _vector_pairs(net: Network) -> list[tuple[int, int]]:
     return pairs
 
 
+def _expressible(net: Network, pairs: list) -> None:
+    """A vector's dx comes first in its ``<vec>``: a dy whose variance is at or below 1e-8
+    of the least dx variance fails gama-local's pivot tolerance (:func:`_least_first`)."""
+    if not pairs:
+        return
+    least = min(float(net.sigma[rx]) for rx, _ in pairs)
+    for rx, ry in pairs:
+        if net.sigma[ry] ** 2 <= 1e-8 * least**2:
+            raise ConfigError(
+                "network.observations",
+                f"the dy from {net.names[net.i[ry]]!r} to {net.names[net.j[ry]]!r} "
+                f"(sigma {net.sigma[ry]:g} mm) is under 1e-4 of every dx's sigma (least "
+                f"{least:g} mm): gama-local refuses such a vector covariance as not "
+                "positive definite",
+            )
+
+
 def _distance_sigma(net: Network, r: int) -> float:
     """The stdev of a plain distance with the same design row as row ``r`` (known offset,
     constant and scale folded in)."""
@@ -165,8 +184,34 @@ def _obs_sets(net: Network, po, val: np.ndarray) -> None:
             if not g:
                 continue
             o = ET.SubElement(po, "obs", {"from": net.names[a]})
-            for r in g:
+            lone = [r for r in g if net.kind[r] == 1]
+            lone = tuple(lone) if len(lone) == 1 else ()
+            for r in _least_first(g, [_variance(net, int(r)) for r in g], lone):
                 _one(net, o, int(r), val[r])
+
+
+def _least_first(items: list, var: list, passive: tuple = ()) -> list:
+    """``items`` as they are, or in ascending variance when gama-local would refuse them: it
+    factorises each cluster's covariance with a pivot tolerance of 1e-8 times its first
+    variance, so a cluster whose first variance is over 1e8 times a later one is "not
+    positive definite" (a direction of 1000 arcsec before one of 0.05), when it reads the
+    file and again over the observations it adjusts (without ``passive`` ones: the lone
+    direction of a set, which its orientation absorbs). In ascending order the first of any
+    part is its least, and every pivot passes."""
+    active = [v for it, v in zip(items, var) if it not in passive]
+    if _passes(var) and (not active or _passes(active)):
+        return items
+    return [items[b] for b in np.argsort(var, kind="stable")]
+
+
+def _passes(var: list) -> bool:
+    """gama-local's pivot test of a diagonal covariance: every variance over 1e-8 the first."""
+    return all(v > 1e-8 * var[0] for v in var[1:])
+
+
+def _variance(net: Network, r: int) -> float:
+    """The variance row ``r`` is exported with (mm^2 or cc^2)."""
+    return _distance_sigma(net, r) ** 2 if net.kind[r] == 0 else (net.sigma[r] / CC) ** 2
 
 
 def _one(net: Network, o, r: int, v: float) -> None:
@@ -225,6 +270,8 @@ def _coordinates(net: Network, po: ET.Element) -> None:
     obs_pts = np.flatnonzero(net.role == 2)
     if not obs_pts.size:
         return
+    sig = {int(a): s for a, s in zip(net.i[net.kind == 5], net.sigma[net.kind == 5])}
+    obs_pts = _least_first(list(obs_pts), [sig[int(a)] ** 2 for a in obs_pts])
     c = ET.SubElement(po, "coordinates")
     for a in obs_pts:
         ET.SubElement(
@@ -236,16 +283,23 @@ def _coordinates(net: Network, po: ET.Element) -> None:
                 "y": _fmt(net.xy_mm[a, 1] / 1000),
             },
         )
-    sig = {int(a): s for a, s in zip(net.i[net.kind == 5], net.sigma[net.kind == 5])}
-    cm = ET.SubElement(c, "cov-mat", {"dim": str(2 * obs_pts.size), "band": "0"})
+    cm = ET.SubElement(c, "cov-mat", {"dim": str(2 * len(obs_pts)), "band": "0"})
     cm.text = " ".join(_fmt(sig[int(a)] ** 2) for a in obs_pts for _ in (0, 1))
 
 
 def _vectors(net: Network, po: ET.Element, pairs: list, val: np.ndarray) -> None:
     """The coordinate-difference pairs as 3-D ``<vec>`` (m, dz = 0) with their diagonal
-    covariance matrix (mm^2; the z variance 1)."""
+    covariance matrix (mm^2; the dz variance 1, or, where gama-local would refuse that
+    cluster (:func:`_least_first`), the dx's, with the vector of least dx variance first: a
+    dz between fixed heights changes nothing but a degree of freedom)."""
     if not pairs:
         return
+    var = [float(net.sigma[r]) ** 2 for rx, ry in pairs for r in (rx, ry)]
+    dz = [1.0] * len(pairs)
+    if not _passes([x for a in range(len(pairs)) for x in (*var[2 * a : 2 * a + 2], 1.0)]):
+        b = int(np.argmin([net.sigma[rx] for rx, _ in pairs]))
+        pairs = [pairs[b]] + pairs[:b] + pairs[b + 1 :]
+        dz = [float(net.sigma[rx]) ** 2 for rx, _ in pairs]
     v = ET.SubElement(po, "vectors")
     for rx, ry in pairs:
         ET.SubElement(
@@ -261,7 +315,8 @@ def _vectors(net: Network, po: ET.Element, pairs: list, val: np.ndarray) -> None
         )
     cm = ET.SubElement(v, "cov-mat", {"dim": str(3 * len(pairs)), "band": "0"})
     cm.text = " ".join(
-        f"{_fmt(net.sigma[rx] ** 2)} {_fmt(net.sigma[ry] ** 2)} 1.0" for rx, ry in pairs
+        f"{_fmt(net.sigma[rx] ** 2)} {_fmt(net.sigma[ry] ** 2)} {_fmt(z)}"
+        for (rx, ry), z in zip(pairs, dz)
     )
 
 
@@ -270,6 +325,7 @@ def write_gama(net: Network, path: str | Path, inner: tuple | list = ()) -> Path
     refused); ``inner``: indices of the points of an inner datum (``adj="XY"``)."""
     _refuse(net)
     pairs = _vector_pairs(net)
+    _expressible(net, pairs)
     val = computed(net, net.theta_true()[None])[0]
     root = ET.Element("gama-local", xmlns=NS)
     nw = ET.SubElement(root, "network", {"axes-xy": "ne", "angles": "left-handed"})
