@@ -14,9 +14,10 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.config import ConfigError, Field, flatten, parse_override, read_toml, validate
+from sim.mc.read_when import refuse_unread, unread
 from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
-from sim.mc.sweep import RESERVED, read_sweep
+from sim.mc.sweep import RESERVED, expand, read_sweep
 
 __all__ = [
     "Study",
@@ -25,6 +26,7 @@ __all__ = [
     "design_config",
     "get_study",
     "load_study",
+    "unread_keys",
     "MODULES",
 ]
 
@@ -43,6 +45,19 @@ class Study:
     #: (ConfigError naming the file and the key or claim id), so that ``sim check`` and the
     #: start of a run refuse an edited data file instead of the end of the run
     data: Callable[[dict, Mapping[str, Field]], None] | None = None
+    #: the keys the resolved config does not read by a condition no ``read_when`` of the schema
+    #: can say (the network's keys of the distances, in a network without one), each with why
+    unread: Callable[[dict], Mapping[str, str]] | None = None
+
+
+def unread_keys(study: Study, cfg: Mapping[str, Any]) -> dict[str, str]:
+    """The keys of ``study`` that the resolved ``cfg`` does not read, each with why: by the
+    schema's ``read_when`` (:func:`sim.mc.read_when.unread`) and the study's own
+    :attr:`Study.unread`."""
+    out = unread(study.schema, cfg)
+    if study.unread is not None:
+        out.update(study.unread(dict(cfg)))
+    return out
 
 
 def data_check(load_book: Callable[[], Any], *declarations: Any) -> Callable[..., None]:
@@ -149,7 +164,8 @@ def load_study(
     if name is None:
         raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
     study = get_study(name)
-    swept = set(read_sweep(path)) - set(RESERVED) if "sweep" in doc else set()
+    table = read_sweep(path) if "sweep" in doc else {}
+    swept = set(table) - set(RESERVED)
     for text in overrides:
         key, value = parse_override(text)
         _overridable(key, swept)
@@ -165,9 +181,21 @@ def load_study(
         cfg = validate(flat, study.schema, study.check)
     except ConfigError as e:
         raise _beside_the_study(e, Path(path), flat) from None
+    refuse_unread(study.schema, cfg, flat, _cells(table, study.schema))
     if study.data is not None:
         study.data(cfg, study.schema)
     return study, {"study": name, **cfg}
+
+
+def _cells(table: Mapping[str, Any], schema: Mapping[str, Field]) -> list[dict] | None:
+    """The cells of a study file's sweep ``table`` (None without one, or when the table is
+    refused: the sweep's own check names why, after the load)."""
+    if not table:
+        return None
+    try:
+        return expand(table, schema)[1]
+    except ConfigError:
+        return None
 
 
 def _beside_the_study(e: ConfigError, path: Path, flat: Mapping[str, Any]) -> ConfigError:
