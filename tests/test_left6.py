@@ -8,6 +8,11 @@ each; each failed on the code before its fix.
   where it is not read is refused at load, one line naming the key, the switch and its value;
   a sweep is judged over its cells. The network refuses the keys of the distances in a
   network without one (a condition of its observations, not of a switch);
+* a claim removed from a claim book was caught at the end of the run (the study scores an id
+  the book no longer declares): the ids the study's code names as literals (120 of the 334
+  scored ids) are read from its package's source and checked against the book when the file is
+  loaded (``sim check``, the start of ``sim run``; :mod:`sim.studies.scored_ids`); the ids the
+  code builds (f-strings over loops, a transcribed table's rows) are still caught at the end;
 """
 
 from __future__ import annotations
@@ -23,6 +28,8 @@ from sim.mc.config import ConfigError, check_value
 from sim.mc.read_when import When
 from sim.mc.registry import MODULES
 from sim.studies import get_study, load_study
+from sim.studies.salsig import claims as salsig_claims
+from sim.studies.scored_ids import check_literal_ids
 
 ROOT = Path(__file__).resolve().parent.parent
 DILUTION = ROOT / "studies" / "brown_dilution.toml"
@@ -31,6 +38,7 @@ AGNARD = ROOT / "studies" / "agnard_block.toml"
 PLATE = ROOT / "studies" / "network_plate.toml"  # dx, dy and observed coordinates: no distance
 FIELD = ROOT / "studies" / "network_testfield.toml"  # distances and directions, fixed datum
 GAMA_XML = ROOT / "tests" / "data" / "gama" / "one_fixed.xml"
+SALSIG = ROOT / "studies" / "salsig_encoders.toml"
 
 
 # ------------------------------------------------------------------ 1. keys a study never reads
@@ -204,3 +212,55 @@ def test_the_check_listing_comments_out_what_the_configuration_does_not_read(cap
     assert main(["check", str(PLATE)]) == 0
     out = capsys.readouterr().out
     assert "# network.constant_mm = 0.0  # " in out and "the network has none" in out
+
+
+# ----------------------------------------------------------- 2. a claim removed from the book
+
+
+def _without(text: str, cid: str) -> str:
+    """The claim book ``text`` without the ``[[claim]]`` table of ``cid``."""
+    parts = text.split("[[claim]]")
+    kept = [p for p in parts[1:] if f'id = "{cid}"' not in p]
+    assert len(kept) == len(parts) - 2, cid  # exactly one table removed
+    return "[[claim]]".join([parts[0], *kept])
+
+
+@pytest.mark.parametrize("cid", ["salsig.recovery.SX", "salsig.vertical_halved.rms_ratio"])
+def test_a_claim_the_code_names_removed_from_the_book_is_refused_by_sim_check(
+    tmp_path, monkeypatch, capsys, cid
+):
+    book = tmp_path / "claims.toml"
+    book.write_text(_without(salsig_claims.BOOK.read_text(encoding="utf-8"), cid))
+    monkeypatch.setattr(salsig_claims, "BOOK", book)
+    one_line(
+        capsys,
+        main(["check", str(SALSIG)]),
+        f"claim.id: {book}: claim '{cid}', which the study scores (",
+        "is not declared",
+        prefix=SIM_ERROR,
+    )
+
+
+def test_the_check_of_the_named_ids_reads_the_package_not_the_book_directory(tmp_path):
+    """A book read from elsewhere (a user's copy) is checked against the study's own code."""
+    package = Path(salsig_claims.__file__).parent
+    book = salsig_claims.load_book()
+    check_literal_ids(book, package)  # the shipped book declares every id the code names
+    del book.specs["salsig.recovery.SY"]
+    with pytest.raises(ConfigError, match=r"claim 'salsig.recovery.SY', .* \(claims.py\)"):
+        check_literal_ids(book, package)
+    check_literal_ids(book, tmp_path)  # no code there: nothing named
+
+
+def test_the_two_studies_of_one_book_check_only_the_ids_each_scores(tmp_path, monkeypatch):
+    """brown_dilution and brown_table1 split one book: a Table 1 claim removed is refused by
+    brown_table1, not by brown_dilution (whose code never scores it)."""
+    from sim.studies.brown import claims as brown_claims
+
+    cid = "brown.table1_closure.rms_um"
+    book = tmp_path / "claims.toml"
+    book.write_text(_without(brown_claims.BOOK.read_text(encoding="utf-8"), cid))
+    monkeypatch.setattr(brown_claims, "BOOK", book)
+    load_study(DILUTION)
+    with pytest.raises(ConfigError, match=f"claim '{cid}', which the study scores"):
+        load_study(TABLE1)

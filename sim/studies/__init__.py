@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -18,6 +19,7 @@ from sim.mc.read_when import refuse_unread, unread
 from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
 from sim.mc.sweep import RESERVED, expand, read_sweep
+from sim.studies.scored_ids import check_literal_ids
 
 __all__ = [
     "Study",
@@ -60,7 +62,9 @@ def unread_keys(study: Study, cfg: Mapping[str, Any]) -> dict[str, str]:
     return out
 
 
-def data_check(load_book: Callable[[], Any], *declarations: Any) -> Callable[..., None]:
+def data_check(
+    load_book: Callable[[], Any], *declarations: Any, scores: Callable[[str], bool] | None = None
+) -> Callable[..., None]:
     """A :attr:`Study.data` that loads the claim book and each region declaration over it.
     A declaration is a path, or ``(path, names, keys)``: ``names(cfg)`` the inputs the study's
     code reads, which it must declare exactly (one renamed was a KeyError deep in the run,
@@ -69,12 +73,16 @@ def data_check(load_book: Callable[[], Any], *declarations: Any) -> Callable[...
     ``(key, factor)`` for a key it sets scaled (``factor`` a number or ``factor(cfg)``; 10 ppm
     for 1 um over 100 mm: the range was checked against no bound), a :class:`Field` for an
     input that reaches no key (the bounds its code takes), or a list of these (one input
-    setting two keys)."""
+    setting two keys). The claim ids the study's code names as literals must be declared in
+    the book (:mod:`sim.studies.scored_ids`; ``scores``: which of them this study scores)."""
+
+    package = Path(sys.modules[load_book.__module__].__file__).parent  # the study's code
 
     def check(cfg: dict, schema: Mapping[str, Field] | None = None) -> None:
         from sim.claims.book_region import load_declaration
 
         book = load_book()
+        check_literal_ids(book, package, schema or {}, scores)  # a claim its code names
         for d in declarations:
             path, names, keys = d if isinstance(d, tuple) else (d, None, {})
             dec = load_declaration(path, book)
