@@ -13,6 +13,10 @@ each; each failed on the code before its fix.
   scored ids) are read from its package's source and checked against the book when the file is
   loaded (``sim check``, the start of ``sim run``; :mod:`sim.studies.scored_ids`); the ids the
   code builds (f-strings over loops, a transcribed table's rows) are still caught at the end;
+* a network with a group of points tied to nothing under ``datum.kind = "constraints"`` was
+  refused blaming "a datum defect of 0" (the fixed points hold the rest: the count of the
+  constraints was blamed), or "a rank defect of 6" when no point is held; the group is named
+  and said to be tied to nothing, and the advice, followed, loads.
 """
 
 from __future__ import annotations
@@ -264,3 +268,65 @@ def test_the_two_studies_of_one_book_check_only_the_ids_each_scores(tmp_path, mo
     load_study(DILUTION)
     with pytest.raises(ConfigError, match=f"claim '{cid}', which the study scores"):
         load_study(TABLE1)
+
+
+# ------------------------------------------- 3. a group tied to nothing under minimal constraints
+
+ISLAND = """study = "network"
+trials = 40
+chunk = 2
+seed = 1
+
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+  { name = "B", x_mm = 100.0, y_mm = 0.0, role = "fixed" }, { name = "C", x_mm = 50.0, y_mm = 80.0 },
+  { name = "D", x_mm = 500.0, y_mm = 500.0 }, { name = "E", x_mm = 600.0, y_mm = 500.0 } ]
+observations = [ { kind = "distance", from = "A", to = "C", sigma_mm = 0.01 },
+  { kind = "distance", from = "B", to = "C", sigma_mm = 0.01 },
+  { kind = "distance", from = "D", to = "E", sigma_mm = 0.01 } ]
+[datum]
+kind = "constraints"
+constraints = [ { "D.x" = 1.0 }, { "D.y" = 1.0 }, { "E.y" = 1.0 } ]
+"""
+
+
+def test_a_group_tied_to_nothing_under_constraints_is_named(tmp_path, capsys):
+    f = tmp_path / "island.toml"
+    f.write_text(ISLAND)
+    line = one_line(
+        capsys,
+        main(["check", str(f)]),
+        "datum.constraints: points 'D', 'E' are tied to the datum by no observation",
+        "cannot hold such a part",
+        prefix=SIM_ERROR,
+    )
+    assert "minimal constraints are as many as the defect" not in line, line
+    # the advice followed: fix two of its points, the fixed datum without constraints
+    fixed = ISLAND.replace("y_mm = 500.0 }", 'y_mm = 500.0, role = "fixed" }')
+    fixed = fixed.replace('kind = "constraints"', 'kind = "fixed"').split("constraints = ")[0]
+    f.write_text(fixed)
+    assert main(["check", str(f)]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+
+
+def test_the_part_the_constraints_do_not_name_is_the_one_tied_to_nothing(tmp_path, capsys):
+    """No point held: the constraints hold the part they name (D, E, F); the other part is
+    named, where "a rank defect of 6" was said."""
+    f = tmp_path / "parts.toml"
+    text = ISLAND.replace(', role = "fixed"', "").replace(
+        "observations = [",
+        'observations = [ { kind = "distance", from = "A", to = "B", sigma_mm = 0.01 },\n'
+        '  { kind = "distance", from = "E", to = "F", sigma_mm = 0.01 },\n'
+        '  { kind = "distance", from = "D", to = "F", sigma_mm = 0.01 },',
+    )
+    text = text.replace(
+        '{ name = "E", x_mm = 600.0, y_mm = 500.0 } ]',
+        '{ name = "E", x_mm = 600.0, y_mm = 500.0 }, { name = "F", x_mm = 550.0, y_mm = 580.0 } ]',
+    )
+    f.write_text(text)
+    one_line(
+        capsys,
+        main(["check", str(f)]),
+        "points 'A', 'B', 'C' are tied to the datum by no observation",
+        prefix=SIM_ERROR,
+    )

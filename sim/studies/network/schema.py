@@ -27,7 +27,12 @@ from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.keys import SCHEMA
 from sim.studies.network.model import computed, datum, defect_basis, use_sparse
-from sim.studies.network.singular import singular_cause, unreached, unreached_message
+from sim.studies.network.singular import (
+    loose_part,
+    singular_cause,
+    unreached,
+    unreached_message,
+)
 from sim.studies.network.sparse_analysis import chunk_bytes, pre_analysis, variances
 
 __all__ = ["SCHEMA", "check", "unread"]
@@ -138,7 +143,7 @@ def _held(net, full: dict, dt, sparse: bool):
     constraints, inner-datum points), then the normals; a defect is refused naming its cause
     where it can be found."""
     if full["datum.kind"] == "constraints":
-        _minimal(net, dt)
+        _minimal(net, dt, full)
     if full["datum.kind"] == "inner":
         # the defect the datum leaves (one fixed point: the rotation about it), not every
         # defect of the network with no point held
@@ -211,11 +216,21 @@ def unread(cfg: dict) -> dict[str, str]:
     return {} if np.any(net.kind == 0) else dict.fromkeys(DISTANCE_KEYS, NO_DISTANCES)
 
 
-def _minimal(net, dt) -> None:
+def _minimal(net, dt, full: dict) -> None:
     """``datum.constraints`` are minimal: no more of them than the network's datum defects
-    (a further one would hold an estimable quantity and bend the network)."""
+    (a further one would hold an estimable quantity and bend the network). A part of the
+    network tied to nothing has a defect of its own, which they do not hold: it is named
+    (it was "a datum defect of 0", of a network whose fixed points hold its datum)."""
     c = dt.n_constraints()
     d = defect_basis(net, dt.free_index(net.q)).shape[1]
+    loose = loose_part(net, full) if c > d == 0 else ""
+    if loose and d == 0:  # (with a defect to hold, c > d is the count, named below)
+        raise ConfigError(
+            "datum.constraints",
+            f"{loose}; the fixed points hold the rest (a datum defect of 0) and minimal "
+            "constraints cannot hold such a part: add observations that tie it to the rest, "
+            'or fix two of its points, and use datum.kind = "fixed" without constraints',
+        )
     if c > d:
         raise ConfigError(
             "datum.constraints",
