@@ -261,7 +261,8 @@ def _check(args) -> int:
     check_limits(est)  # the limits sim run applies (SIM_MAX_MEMORY_GB, SIM_MAX_ADJUSTMENTS)
     check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
-    skip = unread_keys(study, cfg)  # listed commented out: set, they would be refused
+    # listed commented out (set, they would be refused); one a sweep's cells read is kept
+    skip = {k: w for k, w in unread_keys(study, cfg).items() if cfg[k] == study.schema[k].default}
     for k, v in cfg.items():
         f = study.schema.get(k)
         if f is None:

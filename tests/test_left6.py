@@ -105,10 +105,11 @@ def test_a_key_of_the_file_is_judged_over_the_cells_that_set_its_switch(tmp_path
         "plate.n_random: is not read when plate.pattern = 'grid' or 'list' in every cell",
         prefix=SIM_ERROR,
     )
-    # a cell that reads it: the sweep is accepted (its grid cell runs the default grid)
+    # a cell that reads it: the sweep is accepted (its grid cell runs the default grid), and
+    # the listing keeps the value its random cells read (not commented out as unread)
     f.write_text(text + '[sweep]\n"plate.pattern" = ["grid", "random"]\n')
     assert main(["check", str(f)]) == 0, capsys.readouterr().err
-    capsys.readouterr()
+    assert "\nplate.n_random = 30  # " in capsys.readouterr().out
 
 
 def test_an_optional_part_switched_off_does_not_read_its_keys(capsys):
