@@ -71,9 +71,9 @@ def unless(field: Field, switch: str, *values: Any, says: str = "") -> Field:
 
 
 def unread(schema: Mapping[str, Field], cfg: Mapping[str, Any]) -> dict[str, str]:
-    """The keys of ``schema`` that the resolved ``cfg`` does not read, each with why (``plate.pattern
-    = 'grid'``): ``sim check`` lists them commented out (each holds its default: set, it would be
-    refused)."""
+    """The keys of ``schema`` that the resolved ``cfg`` does not read, each with why
+    (``plate.pattern = 'grid'``): ``sim check`` lists those at their default commented out (set,
+    one would be refused, unless a sweep's cells read it)."""
     out = {}
     for key, f in schema.items():
         w = getattr(f, "read_when", None)
