@@ -46,7 +46,7 @@ from sim.report.markdown import write_report
 from sim.report.read import check_claims_table
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
 from sim.stops import check_interrupt, keep_lost_interrupts
-from sim.studies import design_config, get_study, load_study
+from sim.studies import design_config, get_study, load_study, unread_keys
 from sim.threads import interrupted, memory_words, shadowed, short_of_memory
 
 __all__ = ["main", "check_run_args"]
@@ -288,6 +288,8 @@ def _check(args) -> int:
     check_limits(est)  # the limits sim run applies (SIM_MAX_MEMORY_GB, SIM_MAX_ADJUSTMENTS)
     check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
+    # listed commented out (set, they would be refused); one a sweep's cells read is kept
+    skip = {k: w for k, w in unread_keys(study, cfg).items() if cfg[k] == study.schema[k].default}
     for k, v in cfg.items():
         f = study.schema.get(k)
         if f is None:
@@ -295,9 +297,17 @@ def _check(args) -> int:
             continue
         unit = f.unit or ""
         notes = "; ".join(
-            x for x in (unit and f"unit {unit}", _bounds(f), "paper input" if f.input else "") if x
+            x
+            for x in (
+                unit and f"unit {unit}",
+                _bounds(f),
+                "paper input" if f.input else "",
+                k in skip and f"not read: {skip[k]}",
+            )
+            if x
         )
-        print(f"{k} = {toml_value(v)}  # {f.doc}" + (f" ({notes})" if notes else ""))
+        line = f"{k} = {toml_value(v)}  # {f.doc}" + (f" ({notes})" if notes else "")
+        print(f"# {line}" if k in skip else line)
     if sweep:
         print(f"# [sweep] {', '.join(sweep)}")
     print(f"# work: {est.describe()}")

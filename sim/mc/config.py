@@ -99,6 +99,8 @@ class Field:
     min_len : minimum length of lists.
     input : the value was set to match a paper (reported as *input*).
     sweep : the key may be swept (``[sweep]``); None, or the reason it may not.
+    read_when : None (always read), or when the study reads the key (a
+        :class:`sim.mc.read_when.When`): a key set where it is not read is refused.
     """
 
     default: Any
@@ -112,6 +114,7 @@ class Field:
     input: bool = False
     unit: str = ""
     sweep: str | None = None
+    read_when: Any = None
 
 
 #: TOML's integers are 64-bit ("an integer that cannot be represented losslessly is an

@@ -9,14 +9,17 @@ from __future__ import annotations
 
 import importlib
 import os
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.config import ConfigError, Field, flatten, parse_override, read_toml, validate
+from sim.mc.read_when import refuse_unread, unread
 from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
-from sim.mc.sweep import RESERVED, read_sweep
+from sim.mc.sweep import RESERVED, expand, read_sweep
+from sim.studies.scored_ids import check_literal_ids
 
 __all__ = [
     "Study",
@@ -25,6 +28,7 @@ __all__ = [
     "design_config",
     "get_study",
     "load_study",
+    "unread_keys",
     "MODULES",
 ]
 
@@ -43,9 +47,24 @@ class Study:
     #: (ConfigError naming the file and the key or claim id), so that ``sim check`` and the
     #: start of a run refuse an edited data file instead of the end of the run
     data: Callable[[dict, Mapping[str, Field]], None] | None = None
+    #: the keys the resolved config does not read by a condition no ``read_when`` of the schema
+    #: can say (the network's keys of the distances, in a network without one), each with why
+    unread: Callable[[dict], Mapping[str, str]] | None = None
 
 
-def data_check(load_book: Callable[[], Any], *declarations: Any) -> Callable[..., None]:
+def unread_keys(study: Study, cfg: Mapping[str, Any]) -> dict[str, str]:
+    """The keys of ``study`` that the resolved ``cfg`` does not read, each with why: by the
+    schema's ``read_when`` (:func:`sim.mc.read_when.unread`) and the study's own
+    :attr:`Study.unread`."""
+    out = unread(study.schema, cfg)
+    if study.unread is not None:
+        out.update(study.unread(dict(cfg)))
+    return out
+
+
+def data_check(
+    load_book: Callable[[], Any], *declarations: Any, scores: Callable[[str], bool] | None = None
+) -> Callable[..., None]:
     """A :attr:`Study.data` that loads the claim book and each region declaration over it.
     A declaration is a path, or ``(path, names, keys)``: ``names(cfg)`` the inputs the study's
     code reads, which it must declare exactly (one renamed was a KeyError deep in the run,
@@ -54,12 +73,16 @@ def data_check(load_book: Callable[[], Any], *declarations: Any) -> Callable[...
     ``(key, factor)`` for a key it sets scaled (``factor`` a number or ``factor(cfg)``; 10 ppm
     for 1 um over 100 mm: the range was checked against no bound), a :class:`Field` for an
     input that reaches no key (the bounds its code takes), or a list of these (one input
-    setting two keys)."""
+    setting two keys). The claim ids the study's code names as literals must be declared in
+    the book (:mod:`sim.studies.scored_ids`; ``scores``: which of them this study scores)."""
+
+    package = Path(sys.modules[load_book.__module__].__file__).parent  # the study's code
 
     def check(cfg: dict, schema: Mapping[str, Field] | None = None) -> None:
         from sim.claims.book_region import load_declaration
 
         book = load_book()
+        check_literal_ids(book, package, schema or {}, scores)  # a claim its code names
         for d in declarations:
             path, names, keys = d if isinstance(d, tuple) else (d, None, {})
             dec = load_declaration(path, book)
@@ -149,7 +172,8 @@ def load_study(
     if name is None:
         raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
     study = get_study(name)
-    swept = set(read_sweep(path)) - set(RESERVED) if "sweep" in doc else set()
+    table = read_sweep(path) if "sweep" in doc else {}
+    swept = set(table) - set(RESERVED)
     for text in overrides:
         key, value = parse_override(text)
         _overridable(key, swept)
@@ -168,6 +192,7 @@ def load_study(
         field = study.schema.get(e.key) if isinstance(e.key, str) else None
         cwd = field is not None and "repository root" not in field.doc
         raise _unswept(_beside_the_study(e, Path(path), flat) if cwd else e, swept, flat) from None
+    refuse_unread(study.schema, cfg, flat, _cells(table, study.schema))
     if study.data is not None:
         study.data(cfg, study.schema)
     return study, {"study": name, **cfg}
@@ -186,6 +211,17 @@ def _unswept(e: ConfigError, swept: set[str], flat: Mapping[str, Any]) -> Config
         f"as a study of their own: {', '.join(missing)} is swept but not given there, so it "
         "takes its default; give it one of the swept values too)",
     )
+
+
+def _cells(table: Mapping[str, Any], schema: Mapping[str, Field]) -> list[dict] | None:
+    """The cells of a study file's sweep ``table`` (None without one, or when the table is
+    refused: the sweep's own check names why, after the load)."""
+    if not table:
+        return None
+    try:
+        return expand(table, schema)[1]
+    except ConfigError:
+        return None
 
 
 def _beside_the_study(e: ConfigError, path: Path, flat: Mapping[str, Any]) -> ConfigError:

@@ -13,6 +13,7 @@ import numpy as np
 from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import CONTROL_PATTERNS, Block, control_targets, make_block
 from sim.mc.config import COMMON, ConfigError, Field
+from sim.mc.read_when import unless
 from sim.mc.schema_helpers import count, counts, positive, real, reals
 
 SEED = "003_5ce730a990a7ebc5.txt"
@@ -102,8 +103,17 @@ SCHEMA = {
         0.0,
         1.0,
     ),
-    "pugging.gross_px": reals(
-        [2.0, 6.0], "mechanical: range of a missed hole's error", 0.0, 1000.0, min_len=2, unit="px"
+    "pugging.gross_px": unless(
+        reals(
+            [2.0, 6.0],
+            "mechanical: range of a missed hole's error",
+            0.0,
+            1000.0,
+            min_len=2,
+            unit="px",
+        ),
+        "pugging.gross_rate",
+        0.0,
     ),
     "weights.pass": real(
         0.1, "weight of model points (paper: 0.1; at least 1e-6 of it)", lo=1e-7, input=True

@@ -16,7 +16,7 @@ reports. Coordinates in mm, standard deviations in um.
 from __future__ import annotations
 
 from sim.studies import Study, data_check
-from sim.studies.brown.claims import load_book
+from sim.studies.brown.claims import load_book, scored_by
 from sim.studies.brown.report import report_dilution, report_table1
 from sim.studies.brown.run import run_dilution, run_table1
 from sim.studies.brown.schema import DILUTION, SEED, TABLE1, check
@@ -31,7 +31,7 @@ STUDIES = {
         report_dilution,
         check,
         order=10,
-        data=data_check(lambda: load_book("brown_dilution")),
+        data=data_check(lambda: load_book("brown_dilution"), scores=scored_by("brown_dilution")),
     ),
     "brown_table1": Study(
         "brown_table1",
@@ -42,6 +42,6 @@ STUDIES = {
         report_table1,
         check,
         order=11,
-        data=data_check(lambda: load_book("brown_table1")),
+        data=data_check(lambda: load_book("brown_table1"), scores=scored_by("brown_table1")),
     ),
 }

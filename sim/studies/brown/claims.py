@@ -9,6 +9,7 @@ self-checks of Monte Carlo against the analytic covariance. Seed paper 004 (Brow
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 from scipy import optimize
@@ -62,9 +63,15 @@ def load_book(study: str) -> ClaimBook:
     *Results* section for ``brown_table1``, the rest for ``brown_dilution``."""
     full = full_book()
     t1 = study == "brown_table1"
-    specs = [s for cid, s in full.specs.items() if cid.startswith("brown.table1") == t1]
+    specs = [s for cid, s in full.specs.items() if scored_by(study)(cid)]
     nr = [n for n in full.not_reproduced if ("Results" in n["source"]) == t1]
     return ClaimBook(specs, nr, str(BOOK))
+
+
+def scored_by(study: str) -> Callable[[str], bool]:
+    """Whether ``study`` scores the claim id (the book's split of :func:`load_book`)."""
+    t1 = study == "brown_table1"
+    return lambda cid: cid.startswith("brown.table1") == t1
 
 
 def _pt(pts, j) -> str:

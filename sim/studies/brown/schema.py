@@ -12,6 +12,7 @@ from sim.instruments.ranges import multilateration as ml
 from sim.instruments.ranges import positions as po
 from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
 from sim.mc.config import COMMON, ConfigError, Field
+from sim.mc.read_when import when
 from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
 from sim.mc.schema_helpers import count, counts, positive, real
 from sim.studies.brown.values import thetas
@@ -23,6 +24,17 @@ MIN_RANGE_SIGMA_UM = 1e-6
 
 # ----------------------------------------------------------------------------- configuration
 
+
+def _grid(f: Field) -> Field:
+    """A key of the grid pattern: read only when ``plate.pattern = "grid"``."""
+    return when(f, "plate.pattern", "grid")
+
+
+def _random(f: Field) -> Field:
+    """A key of the random pattern: read only when ``plate.pattern = "random"``."""
+    return when(f, "plate.pattern", "random")
+
+
 BASE = {
     **COMMON,
     "chunk": count(
@@ -33,17 +45,24 @@ BASE = {
     ),
     "plate.format_mm": real(245.0, "side of the square plate format", lo=1.0, unit="mm"),
     "plate.pattern": Field("grid", "str", "point pattern", choices=("grid", "random", "list")),
-    "plate.grid": count(5, "points per side of the grid pattern", lo=2, hi=200),
-    "plate.spacing_mm": positive(
-        45.0,
-        "grid spacing (Table 1: 45 mm; the Concept section prints no layout, its extent is swept)",
-        unit="mm",
+    "plate.grid": _grid(count(5, "points per side of the grid pattern", lo=2, hi=200)),
+    "plate.spacing_mm": _grid(
+        positive(
+            45.0,
+            "grid spacing (Table 1: 45 mm; the Concept section prints no layout, its extent is "
+            "swept)",
+            unit="mm",
+        )
     ),
-    "plate.n_random": count(25, "number of points of the random pattern", lo=3, hi=100000),
-    "plate.random_half_extent_mm": positive(
-        110.0, "random points lie in |x|,|y| <= this", unit="mm"
+    "plate.n_random": _random(count(25, "number of points of the random pattern", lo=3, hi=100000)),
+    "plate.random_half_extent_mm": _random(
+        positive(110.0, "random points lie in |x|,|y| <= this", unit="mm")
     ),
-    "plate.points": Field([], "points", "explicit point list [[x, y], ...] for pattern 'list'"),
+    "plate.points": when(
+        Field([], "points", "explicit point list [[x, y], ...] for pattern 'list'"),
+        "plate.pattern",
+        "list",
+    ),
     "comparator.station_offset_mm": positive(
         17.0,
         "distance of the stations outside the midsides of the format; the paper "
@@ -127,7 +146,7 @@ DILUTION = {
 TABLE1 = {
     **BASE,
     "trials": count(4000, "Monte-Carlo trials", lo=2, hi=100_000_000),
-    "plate.spacing_mm": positive(45.0, "grid spacing (paper: 45 mm)", unit="mm", input=True),
+    "plate.spacing_mm": _grid(positive(45.0, "grid spacing (paper: 45 mm)", unit="mm", input=True)),
     "errors.setting_sigma_um": positive(
         1.7, "one setting (paper: 1.7 um)", hi=1e4, unit="um", input=True
     ),

@@ -22,7 +22,7 @@ from __future__ import annotations
 from sim.studies import Study
 from sim.studies.network.report import report
 from sim.studies.network.run import run
-from sim.studies.network.schema import SCHEMA, check
+from sim.studies.network.schema import SCHEMA, check, unread
 
 STUDIES = {
     "network": Study(
@@ -34,5 +34,6 @@ STUDIES = {
         report,
         check,
         order=90,
+        unread=unread,
     ),
 }

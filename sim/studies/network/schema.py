@@ -1,4 +1,5 @@
-"""Configuration schema of the ``network`` study kind (a user's network as data).
+"""The cross-key rules of the ``network`` study kind (a user's network as data); its keys are
+:mod:`sim.studies.network.keys` (``SCHEMA``, re-exported here).
 
 Coordinates and distance sigmas in mm, angular sigmas in arcsec. The network itself
 (``network.points``, ``grids``, ``random``, ``observations``, ``generate``) is a list of
@@ -13,8 +14,8 @@ import math
 
 import numpy as np
 
-from sim.mc.config import COMMON, ConfigError, Field
-from sim.mc.runner import MIN_CHUNKS, require_chunks
+from sim.mc.config import ConfigError, given
+from sim.mc.runner import require_chunks
 from sim.studies.network.analysis import (
     check_inner,
     estimated_points,
@@ -24,128 +25,20 @@ from sim.studies.network.analysis import (
 )
 from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
+from sim.studies.network.keys import SCHEMA
 from sim.studies.network.model import computed, datum, defect_basis, use_sparse
-from sim.studies.network.singular import singular_cause, unreached, unreached_message
+from sim.studies.network.singular import (
+    loose_part,
+    singular_cause,
+    unreached,
+    unreached_message,
+)
 from sim.studies.network.sparse_analysis import chunk_bytes, pre_analysis, variances
 
-__all__ = ["SCHEMA", "check"]
+__all__ = ["SCHEMA", "check", "unread"]
 
 #: bytes of one chunk's dense Jacobians above which a configuration is refused
 MAX_CHUNK_BYTES = 2 * 1024**3
-
-SCHEMA = {
-    **COMMON,
-    "network.name": Field("network", "str", "name of the network (report title)"),
-    "network.gama_xml": Field(
-        "",
-        "str",
-        "read the points and observations from this "
-        "gama-local XML file instead (a path relative to the working "
-        "directory, or absolute)",
-        sweep="each file is a network with its own sha256 (network.gama_sha256): "
-        "write one study file per network",
-    ),
-    "network.gama_sha256": Field(
-        "",
-        "str",
-        "sha256 of the network.gama_xml file's contents, filled in on load so that an edited "
-        "file makes the results stale (if given, the file must still have it)",
-        sweep="it is the sha256 of the one network.gama_xml file",
-    ),
-    "network.points": Field([], "records", "points {name, x_mm | x_m, y_mm | y_m, role, sigma_mm}"),
-    "network.grids": Field(
-        [],
-        "records",
-        "grids {prefix, nx, ny, spacing_mm | spacing_m, origin_mm | origin_m, role, sigma_mm}",
-    ),
-    "network.random": Field(
-        [],
-        "records",
-        "random points {prefix, n, half_extent_mm | half_extent_m, center_mm | center_m, "
-        "role, sigma_mm}, drawn once from the seed",
-    ),
-    "network.observations": Field(
-        [],
-        "records",
-        "single observations {kind, from, to, at, "
-        "sigma_mm | sigma_arcsec, settings, bias_mm | bias_arcsec, set}",
-    ),
-    "network.generate": Field(
-        [],
-        "records",
-        "generated observations {kind, from, to, nearest, "
-        "sigma_*, settings, bias_*}: every 'from' point to every 'to' point",
-    ),
-    "network.constant_mm": Field(
-        0.0,
-        "float",
-        "true additive constant of every distance (Brown's alpha)",
-        lo=-1e6,
-        hi=1e6,
-        unit="mm",
-    ),
-    "network.estimate_constant": Field(False, "bool", "estimate the additive constant"),
-    "network.offset_mm": Field(
-        0.0,
-        "float",
-        "known perpendicular offset of every distance (Brown's beta): reads sqrt(d^2 - beta^2)",
-        lo=0.0,
-        hi=1e6,
-        unit="mm",
-    ),
-    "network.scale_ppm": Field(
-        0.0,
-        "float",
-        "true scale error of every distance: reads (1 + s) times the distance",
-        lo=-1e5,
-        hi=1e5,
-        unit="ppm",
-    ),
-    "network.estimate_scale": Field(False, "bool", "estimate the scale error of the distances"),
-    "datum.kind": Field(
-        "fixed",
-        "str",
-        "fixed points, inner constraints over datum.points, or explicit minimal constraints",
-        choices=("fixed", "inner", "constraints"),
-    ),
-    "datum.points": Field(
-        [], "list[str]", "name patterns of the inner-constraint points (default: all)"
-    ),
-    "datum.constraints": Field(
-        [], "records", 'minimal constraints, each {"P.x" = coef, ...}: sum of coef x correction = 0'
-    ),
-    "output.inner_over": Field(
-        [],
-        "list[str]",
-        "also state the point precision in the inner "
-        "datum over these name patterns (S-transformation)",
-    ),
-    "compare.fix": Field(
-        [],
-        "list[str]",
-        "a second parameterisation with these points known: "
-        "the dilution of every other point between the two",
-    ),
-    "reliability.alpha0": Field(
-        0.001, "float", "significance level of Baarda's w-test", lo=1e-12, hi=0.5
-    ),
-    "reliability.power": Field(0.80, "float", "power of the w-test (MDB)", lo=0.05, hi=0.9999),
-    "test.alpha": Field(
-        0.05, "float", "significance level of the global (chi-square) test", lo=1e-6, hi=0.5
-    ),
-    "solver.tol_mm": Field(
-        1e-9, "float", "convergence on the corrections", lo=1e-15, hi=1.0, lo_open=True, unit="mm"
-    ),
-    "solver.max_iter": Field(20, "int", "Gauss-Newton iteration limit", lo=1, hi=200),
-}
-SCHEMA["trials"] = Field(2000, "int", "Monte-Carlo trials", lo=2, hi=10_000_000)
-SCHEMA["chunk"] = Field(
-    100,
-    "int",
-    f"trials per chunk (the jackknife intervals are over chunks: >= {MIN_CHUNKS} chunks)",
-    lo=1,
-    hi=100_000,
-)
 
 
 def _check_compare(net, full: dict, fix: list, sparse: bool) -> None:
@@ -199,7 +92,7 @@ def check(cfg: dict) -> None:
         raise ConfigError("network.points", "every point is fixed: nothing to estimate")
     if cfg["datum.points"] and cfg["datum.kind"] != "inner":
         raise ConfigError("datum.points", "only with datum.kind = inner (it has no effect here)")
-    _no_effect(net, full)
+    _no_effect(net, full, cfg)
     lone = _unreached_free(net, full)
     dt = datum(net, full)
     try:
@@ -250,7 +143,7 @@ def _held(net, full: dict, dt, sparse: bool):
     constraints, inner-datum points), then the normals; a defect is refused naming its cause
     where it can be found."""
     if full["datum.kind"] == "constraints":
-        _minimal(net, dt)
+        _minimal(net, dt, full)
     if full["datum.kind"] == "inner":
         # the defect the datum leaves (one fixed point: the rotation about it), not every
         # defect of the network with no point held
@@ -278,26 +171,66 @@ def _held(net, full: dict, dt, sparse: bool):
     return an
 
 
-def _no_effect(net, cfg: dict) -> None:
+#: keys of the distances alone (their true constant, offset and scale, and whether to estimate
+#: the constant and the scale): set in a network without a distance, they are read by nothing
+DISTANCE_KEYS = (
+    "network.constant_mm",
+    "network.offset_mm",
+    "network.scale_ppm",
+    "network.estimate_constant",
+    "network.estimate_scale",
+)
+
+
+def _no_effect(net, cfg: dict, asked: dict) -> None:
     """Keys that would do nothing, or be blamed on the datum: constraints without
-    ``datum.kind = constraints``, an additive constant or scale to estimate without a distance."""
+    ``datum.kind = constraints``, an additive constant or scale to estimate without a distance,
+    and any key of the distances that ``asked`` (the configuration as the user set it:
+    :func:`sim.mc.config.given`) sets in a network without one (the network's condition of
+    :mod:`sim.mc.read_when`: it depends on the observations, not on a switch)."""
     if cfg["datum.constraints"] and cfg["datum.kind"] != "constraints":
         raise ConfigError(
             "datum.constraints", "only with datum.kind = constraints (it has no effect here)"
         )
+    if np.any(net.kind == 0):
+        return
     for what, key in (("constant", "estimate_constant"), ("scale error", "estimate_scale")):
-        if cfg[f"network.{key}"] and not np.any(net.kind == 0):
+        if cfg[f"network.{key}"]:
             raise ConfigError(
                 f"network.{key}",
                 f"the {what} of the distances cannot be estimated: the network has no distances",
             )
+    for key in DISTANCE_KEYS:
+        if given(asked, key):
+            raise ConfigError(key, f"is not read: {NO_DISTANCES}")
 
 
-def _minimal(net, dt) -> None:
+#: why the keys of the distances are not read in a network without one
+NO_DISTANCES = "it applies to distances and the network has none"
+
+
+def unread(cfg: dict) -> dict[str, str]:
+    """The keys of the distances, in a network without one (:attr:`sim.studies.Study.unread`:
+    ``sim check`` lists them commented out); ``{}`` otherwise."""
+    net = _build(merge_gama(cfg))
+    return {} if np.any(net.kind == 0) else dict.fromkeys(DISTANCE_KEYS, NO_DISTANCES)
+
+
+def _minimal(net, dt, full: dict) -> None:
     """``datum.constraints`` are minimal: no more of them than the network's datum defects
-    (a further one would hold an estimable quantity and bend the network)."""
+    (a further one would hold an estimable quantity and bend the network). A part of the
+    network tied to nothing has a defect of its own, which they do not hold: it is named
+    (it was "a datum defect of 0", of a network whose fixed points hold its datum)."""
     c = dt.n_constraints()
     d = defect_basis(net, dt.free_index(net.q)).shape[1]
+    loose = loose_part(net, full) if c > d == 0 else ""
+    if loose and d == 0:  # (with a defect to hold, c > d is the count, named below)
+        raise ConfigError(
+            "datum.constraints",
+            f"{loose}; the fixed points hold the rest (a datum defect of 0) and minimal "
+            "constraints cannot hold such a part: add observations that tie it to the rest, "
+            'or fix two of its points, and use datum.kind = "fixed" without constraints',
+        )
     if c > d:
         raise ConfigError(
             "datum.constraints",

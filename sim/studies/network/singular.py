@@ -8,7 +8,8 @@ looks for the two usual causes, cheaply at any size (linear in the observations)
   sights are distances along one line, say);
 * a part of the network tied to the datum by no observation (a connected component of the
   graph of points and observations that holds no fixed or observed point, and no inner-datum
-  point): the nearest-neighbour observations of a random network leave such islands.
+  point, nor, in a network with no point held, a point of ``datum.constraints``): the
+  nearest-neighbour observations of a random network leave such islands.
 
 Units: those of the network (mm, rad); no model of its own.
 """
@@ -22,7 +23,7 @@ from scipy.sparse.csgraph import connected_components
 from sim.studies.network.definition import Network
 from sim.studies.network.model import jacobian_sparse, pattern
 
-__all__ = ["singular_cause", "unreached", "unreached_message"]
+__all__ = ["singular_cause", "loose_part", "unreached", "unreached_message"]
 
 
 def _unobserved(net: Network, free: np.ndarray) -> str:
@@ -43,10 +44,17 @@ def _unobserved(net: Network, free: np.ndarray) -> str:
     return f"{what} is determined by no observation ({len(zero)} such unknowns)"
 
 
+def _constrained(net: Network, cfg: dict) -> np.ndarray:
+    """The points ``datum.constraints`` name (their coefficients hold the part they lie in)."""
+    names = {k.rsplit(".", 1)[0] for rec in cfg["datum.constraints"] for k in rec}
+    return np.array([i for i, x in enumerate(net.names) if x in names], int)
+
+
 def _islands(net: Network, cfg: dict) -> str:
     n = net.n
     anchored = net.role != 0
     inner = cfg["datum.kind"] == "inner"
+    held = cfg["datum.kind"] == "constraints" and not anchored.any()
     a, b = [net.i], [np.where(net.j >= 0, net.j, net.i)]
     a.append(net.i)
     b.append(np.where(net.k >= 0, net.k, net.i))
@@ -58,6 +66,8 @@ def _islands(net: Network, cfg: dict) -> str:
     loose = label[:n] != label[n]
     if inner and loose.any():  # the inner datum holds one part: the largest loose one
         loose &= label[:n] != np.bincount(label[:n][loose]).argmax()
+    if held:  # minimal constraints of a network with no point held hold the parts they name
+        loose &= ~np.isin(label[:n], label[_constrained(net, cfg)])
     loose = np.flatnonzero(loose)
     if not loose.size:
         return ""
@@ -76,9 +86,13 @@ def _islands(net: Network, cfg: dict) -> str:
 
 def singular_cause(net: Network, cfg: dict, free: np.ndarray) -> str:
     """The first cause found of singular normals (see the module doc), or ""."""
-    if cfg["datum.kind"] == "constraints":
-        return _unobserved(net, free)
     return _unobserved(net, free) or _islands(net, cfg)
+
+
+def loose_part(net: Network, cfg: dict) -> str:
+    """A part of the network tied to the datum by no observation, named (see the module
+    doc), or "": minimal constraints hold the network's datum defect, not a part's own."""
+    return _islands(net, cfg)
 
 
 def unreached(net: Network) -> np.ndarray:
