@@ -128,7 +128,11 @@ def rerun_study(
     cmd += ["--no-figures"]
     cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else []), *extra]
     print(f"sim verify: re-running {d.name}", file=sys.stderr, flush=True)
-    with subprocess.Popen(cmd, stderr=subprocess.PIPE, env=child_env(), **child_text()) as proc:
+    # its standard output is not verify's: the re-run's "results in /tmp/sim-verify-.../" named
+    # a directory removed at exit, between verify's own lines, and a full or closed standard
+    # output of verify's failed the re-run itself
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.PIPE}
+    with subprocess.Popen(cmd, **quiet, env=child_env(), **child_text()) as proc:
         try:
             _, err = proc.communicate()
         except KeyboardInterrupt:  # Ctrl-C reaches the re-run too, SIGTERM or SIGHUP only verify

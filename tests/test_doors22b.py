@@ -1,0 +1,104 @@
+"""The classes of the sweep doors22b (every command's output as other programs and terminals
+consume it: pipes, a full disk, closed streams, a terminal of no size), one case each; each
+failed on the code before its fix.
+
+* standard output that fails only when Python flushes it at exit (a user's default: block
+  buffered, ``PYTHONUNBUFFERED`` unset; the earlier tests wrote through a line-buffered file):
+  ``sim check STUDY > /dev/full``, ``sim show DIR > /dev/full``, ``--help > /dev/full`` of every
+  program and ``make verify > /dev/full`` printed Python's "Exception ignored in: <_io.TextIOWrapper
+  name='<stdout>'> OSError: [Errno 28]" and exited 120; a reader that left (``| head -1``)
+  printed the same with BrokenPipeError. Now one line naming standard output and exit 2, or
+  (a reader that left) nothing and 141 (:func:`sim.stops.flush_stdout`);
+"""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from oneline import one_line_of
+
+ROOT = Path(__file__).resolve().parent.parent
+STUDY = ROOT / "studies" / "network_plate.toml"
+FULL = Path("/dev/full")
+
+
+def _env() -> dict:
+    """The environment of a user's shell: standard output block-buffered."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+    env["PYTHONIOENCODING"] = "utf-8"
+    return env
+
+
+def _into_full(*argv: str) -> subprocess.CompletedProcess:
+    with open(FULL, "w") as full:
+        return subprocess.run(
+            [sys.executable, *argv],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=_env(),
+            cwd=ROOT,
+        )
+
+
+def _into_left_pipe(*argv: str) -> subprocess.CompletedProcess:
+    """``argv`` with its standard output a pipe whose reader has left (``| head -c 0``)."""
+    r, w = os.pipe()
+    os.close(r)
+    try:
+        return subprocess.run(
+            [sys.executable, *argv],
+            stdout=w,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=_env(),
+            cwd=ROOT,
+        )
+    finally:
+        os.close(w)
+
+
+SMALL_OUTPUTS = [
+    ("-m", "sim", "check", str(STUDY)),
+    ("-m", "sim", "show", str(ROOT / "results" / "network_plate")),
+    ("-m", "sim", "--help"),
+    ("-m", "sim", "--version"),
+    ("-m", "sim.batch", "--help"),
+    ("-m", "sim.report.verify", "--help"),
+    ("-m", "benchmarks", "--help"),
+]
+
+
+@pytest.mark.skipif(not FULL.exists(), reason="needs /dev/full")
+@pytest.mark.parametrize("argv", SMALL_OUTPUTS, ids=lambda a: " ".join(a[1:3]))
+def test_a_full_standard_output_flushed_at_exit_is_one_line(argv):
+    if "show" in argv and not (ROOT / "results" / "network_plate" / "claims.parquet").is_file():
+        pytest.skip("needs the committed results of network_plate")
+    p = _into_full(*argv)
+    line = one_line_of(p, "No space left on device", "standard output")
+    assert "Exception ignored" not in line
+
+
+@pytest.mark.parametrize("argv", SMALL_OUTPUTS, ids=lambda a: " ".join(a[1:3]))
+def test_a_reader_that_left_ends_the_output_quietly(argv):
+    if "show" in argv and not (ROOT / "results" / "network_plate" / "claims.parquet").is_file():
+        pytest.skip("needs the committed results of network_plate")
+    p = _into_left_pipe(*argv)
+    assert (p.returncode, p.stderr) == (141, ""), (p.returncode, p.stderr)
+
+
+def test_verify_prints_only_its_own_lines(tmp_path):
+    """``make verify``'s standard output held each re-run's own "network: results in
+    /tmp/sim-verify-.../network_plate/" (a directory removed when verify ends) between its
+    comparison lines, and a full standard output failed the re-runs themselves."""
+    if not (ROOT / "results" / "network_plate" / "claims.parquet").is_file():
+        pytest.skip("needs the committed results of network_plate")
+    argv = ["-m", "sim.report.verify", "--results", "results", "--study", "network_plate"]
+    argv += ["--trials", "400", "--workers", "1", "--scratch", str(tmp_path / "s")]
+    p = subprocess.run(
+        [sys.executable, *argv], capture_output=True, text=True, env=_env(), cwd=ROOT
+    )
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.startswith("network_plate: ok; ") and p.stdout.count("\n") == 1, p.stdout
