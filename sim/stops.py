@@ -29,7 +29,13 @@ import sys
 import threading
 from contextlib import contextmanager
 
-__all__ = ["keep_lost_interrupts", "check_interrupt", "run_program", "flush_stdout"]
+__all__ = [
+    "keep_lost_interrupts",
+    "check_interrupt",
+    "run_program",
+    "flush_stdout",
+    "stdout_unwritten",
+]
 
 #: interrupts recorded by the hook of :func:`keep_lost_interrupts`, not yet raised
 _lost: list[str] = []
@@ -121,6 +127,18 @@ def _exit_status(code) -> int:
     return code if isinstance(code, int) else 1
 
 
+#: a failed write to standard output that its writer could not raise (see stdout_unwritten)
+_unwritten: list[OSError] = []
+
+
+def stdout_unwritten(e: OSError) -> None:
+    """Record ``e``, a write to standard output that failed where it is dropped (argparse
+    drops an OSError of its ``--help`` and ``--version``: under ``PYTHONUNBUFFERED=1``, as in
+    many containers, ``sim --help > /dev/full`` ended silently with exit 0), for
+    :func:`flush_stdout` to say."""
+    _unwritten[:] = [e]
+
+
 def flush_stdout(prog: str, code: int) -> int:
     """Flush standard output now, while a failure can still be said, and return the exit code
     to end with. Standard output to a file or a pipe is block-buffered: what a command printed
@@ -133,6 +151,8 @@ def flush_stdout(prog: str, code: int) -> int:
     try:
         if out is None:  # >&-: print() wrote nowhere
             return code
+        if _unwritten:  # a write that failed where it could not be raised (argparse's --help)
+            raise _unwritten.pop()
         out.flush()
         return code
     except ValueError:  # closed by the caller (the API's host): nothing left to write

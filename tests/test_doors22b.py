@@ -8,7 +8,11 @@ failed on the code before its fix.
   program and ``make verify > /dev/full`` printed Python's "Exception ignored in: <_io.TextIOWrapper
   name='<stdout>'> OSError: [Errno 28]" and exited 120; a reader that left (``| head -1``)
   printed the same with BrokenPipeError. Now one line naming standard output and exit 2, or
-  (a reader that left) nothing and 141 (:func:`sim.stops.flush_stdout`);
+  (a reader that left) nothing and 141 (:func:`sim.stops.flush_stdout`); with
+  ``PYTHONUNBUFFERED=1`` argparse dropped the failed write of ``--help``: exit 0, no word
+  (:class:`sim.mc.argv.BoundedParser`);
+* ``make verify``'s standard output held its re-runs' "results in /tmp/sim-verify-.../" lines
+  (a directory removed at its end) between its own (:func:`sim.report.verify.rerun.rerun_study`);
 """
 
 import os
@@ -24,21 +28,21 @@ STUDY = ROOT / "studies" / "network_plate.toml"
 FULL = Path("/dev/full")
 
 
-def _env() -> dict:
+def _env(**more: str) -> dict:
     """The environment of a user's shell: standard output block-buffered."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
     env["PYTHONIOENCODING"] = "utf-8"
-    return env
+    return {**env, **more}
 
 
-def _into_full(*argv: str) -> subprocess.CompletedProcess:
+def _into_full(*argv: str, **env: str) -> subprocess.CompletedProcess:
     with open(FULL, "w") as full:
         return subprocess.run(
             [sys.executable, *argv],
             stdout=full,
             stderr=subprocess.PIPE,
             text=True,
-            env=_env(),
+            env=_env(**env),
             cwd=ROOT,
         )
 
@@ -79,6 +83,14 @@ def test_a_full_standard_output_flushed_at_exit_is_one_line(argv):
     p = _into_full(*argv)
     line = one_line_of(p, "No space left on device", "standard output")
     assert "Exception ignored" not in line
+
+
+@pytest.mark.skipif(not FULL.exists(), reason="needs /dev/full")
+@pytest.mark.parametrize("prog", ["sim", "sim.batch", "sim.report.verify", "benchmarks"])
+def test_help_into_a_full_output_unbuffered_is_one_line(prog):
+    """argparse drops an OSError of its --help: with PYTHONUNBUFFERED=1 (many containers) every
+    program's ``--help > /dev/full`` ended with exit 0 and no word."""
+    one_line_of(_into_full("-m", prog, "--help", PYTHONUNBUFFERED="1"), "standard output")
 
 
 @pytest.mark.parametrize("argv", SMALL_OUTPUTS, ids=lambda a: " ".join(a[1:3]))
