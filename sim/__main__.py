@@ -32,6 +32,7 @@ class _CacheDirNotes(logging.Filter):
 logging.getLogger("matplotlib").addFilter(_CacheDirNotes())  # before matplotlib loads
 
 from sim.cli import main as command  # noqa: E402
+from sim.ends import finish  # noqa: E402
 from sim.mc.children import die_with_parent  # noqa: E402
 from sim.stops import run_program  # noqa: E402
 
@@ -45,7 +46,7 @@ def main() -> int:
     if words is not None:
         print(f"sim: error: {words}", file=sys.stderr)
         return 2
-    return run_program("sim", command, loaded)
+    return finish("sim", lambda: run_program("sim", command, loaded))  # stdout flushed: sim.ends
 
 
 if __name__ == "__main__":

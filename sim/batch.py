@@ -48,6 +48,7 @@ from sim.batch_checks import (  # noqa: E402
     why_stale,
 )
 from sim.cli_args import OnceParser, module_doc  # noqa: E402
+from sim.ends import finish  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
@@ -331,4 +332,4 @@ class _Stdout:
 
 
 if __name__ == "__main__":  # a signal after main returned: its exit code stands
-    sys.exit(run_program("sim.batch", main, _loaded))
+    sys.exit(finish("sim.batch", lambda: run_program("sim.batch", main, _loaded)))

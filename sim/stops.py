@@ -29,13 +29,7 @@ import sys
 import threading
 from contextlib import contextmanager
 
-__all__ = [
-    "keep_lost_interrupts",
-    "check_interrupt",
-    "run_program",
-    "flush_stdout",
-    "stdout_unwritten",
-]
+__all__ = ["keep_lost_interrupts", "check_interrupt", "run_program"]
 
 #: interrupts recorded by the hook of :func:`keep_lost_interrupts`, not yet raised
 _lost: list[str] = []
@@ -127,51 +121,6 @@ def _exit_status(code) -> int:
     return code if isinstance(code, int) else 1
 
 
-#: a failed write to standard output that its writer could not raise (see stdout_unwritten)
-_unwritten: list[OSError] = []
-
-
-def stdout_unwritten(e: OSError) -> None:
-    """Record ``e``, a write to standard output that failed where it is dropped (argparse
-    drops an OSError of its ``--help`` and ``--version``: under ``PYTHONUNBUFFERED=1``, as in
-    many containers, ``sim --help > /dev/full`` ended silently with exit 0), for
-    :func:`flush_stdout` to say."""
-    _unwritten[:] = [e]
-
-
-def flush_stdout(prog: str, code: int) -> int:
-    """Flush standard output now, while a failure can still be said, and return the exit code
-    to end with. Standard output to a file or a pipe is block-buffered: what a command printed
-    last (``sim check``'s whole listing, ``--help``) was written only when Python flushed it at
-    exit, where a full disk (``> /dev/full``) or a reader that left (``| head -1``) was
-    Python's "Exception ignored in: <_io.TextIOWrapper name='<stdout>'>" and exit 120. Now a
-    failed write is one line naming standard output and exit 2, a reader that left nothing
-    and 141 (as a program killed by SIGPIPE); ``code`` stands when it already says a failure."""
-    out = sys.stdout
-    try:
-        if out is None:  # >&-: print() wrote nowhere
-            return code
-        if _unwritten:  # a write that failed where it could not be raised (argparse's --help)
-            raise _unwritten.pop()
-        out.flush()
-        return code
-    except ValueError:  # closed by the caller (the API's host): nothing left to write
-        return code
-    except OSError as e:
-        try:  # what is left in the buffer is dropped, not tried again at exit
-            os.dup2(os.open(os.devnull, os.O_WRONLY), out.fileno())
-        except (OSError, ValueError):
-            pass
-        if isinstance(e, BrokenPipeError):
-            return code or 141
-        try:
-            why = e.strerror or type(e).__name__
-            print(f"{prog}: error: {why}: standard output", file=sys.stderr, flush=True)
-        except (OSError, ValueError, AttributeError):  # standard error gone as well
-            pass
-        return code or 2
-
-
 def run_program(prog: str, main, loaded) -> int:
     """Run ``main()`` (a command's ``main``) as the program ``prog`` and return its exit code
     for ``sys.exit``. ``loaded``: what :func:`sim.threads.interrupt_while_loading` returned;
@@ -184,13 +133,9 @@ def run_program(prog: str, main, loaded) -> int:
         try:
             code = main()
         except SystemExit as e:  # argparse's --help: its code stands as well
-            status = _exit_status(e.code)
-            _ended[:] = [flush_stdout(prog, status)]
-            if _ended[0] != status:
-                return _ended[0]
+            _ended[:] = [_exit_status(e.code)]
             raise
-        code = flush_stdout(prog, _exit_status(code))
-        _ended[:] = [code]
+        _ended[:] = [_exit_status(code)]
     except KeyboardInterrupt:
         _ended[:] = [130]
         os.write(2, f"{prog}: interrupted\n".encode())

@@ -8,7 +8,7 @@ failed on the code before its fix.
   program and ``make verify > /dev/full`` printed Python's "Exception ignored in: <_io.TextIOWrapper
   name='<stdout>'> OSError: [Errno 28]" and exited 120; a reader that left (``| head -1``)
   printed the same with BrokenPipeError. Now one line naming standard output and exit 2, or
-  (a reader that left) nothing and 141 (:func:`sim.stops.flush_stdout`); with
+  (a reader that left) nothing and 141 (:func:`sim.ends.flush_stdout`); with
   ``PYTHONUNBUFFERED=1`` argparse dropped the failed write of ``--help``: exit 0, no word
   (:class:`sim.mc.argv.BoundedParser`);
 * ``make verify``'s standard output held its re-runs' "results in /tmp/sim-verify-.../" lines

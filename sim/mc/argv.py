@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from sim.stops import stdout_unwritten
+from sim.ends import stdout_unwritten
 
 __all__ = ["MAX_OPTIONS", "BoundedParser"]
 
@@ -36,7 +36,7 @@ class BoundedParser(argparse.ArgumentParser):
     def _print_message(self, message, file=None):
         """argparse's, which dropped a failed write (``--help > /dev/full`` with unbuffered
         output: exit 0 and no word); one to standard output is kept for the program's end
-        (:func:`sim.stops.flush_stdout`: one line naming it, exit 2)."""
+        (:func:`sim.ends.flush_stdout`: one line naming it, exit 2)."""
         if not message:
             return
         file = file or sys.stderr
