@@ -11,6 +11,10 @@ failed on the code before its fix.
   (a reader that left) nothing and 141 (:func:`sim.ends.flush_stdout`); with
   ``PYTHONUNBUFFERED=1`` argparse dropped the failed write of ``--help``: exit 0, no word
   (:class:`sim.mc.argv.BoundedParser`);
+* ``sim run ... --out DIR > DIR/log.txt`` over earlier results in DIR: the user's log was
+  carried into the new results as a copy made before the run printed a word, and the run's
+  lines went into the old file, removed with the old results: an empty log and exit 0. A
+  user's regular file is now carried by a hard link, the same file (:func:`sim.mc.publish._carry`);
 * ``make verify``'s standard output held its re-runs' "results in /tmp/sim-verify-.../" lines
   (a directory removed at its end) between its own (:func:`sim.report.verify.rerun.rerun_study`);
 """
@@ -114,3 +118,25 @@ def test_verify_prints_only_its_own_lines(tmp_path):
     )
     assert p.returncode == 0, p.stderr
     assert p.stdout.startswith("network_plate: ok; ") and p.stdout.count("\n") == 1, p.stdout
+
+
+def test_output_redirected_into_the_results_directory_is_kept(tmp_path):
+    """``sim run ... --out DIR > DIR/log.txt`` over an earlier run into DIR: the user's log was
+    carried into the new results as a copy made before the run printed a word, and what it
+    printed went into the old file, removed with the old results: an empty log, exit 0."""
+    out = tmp_path / "o"
+    run = [sys.executable, "-m", "sim", "run", str(STUDY), "--no-figures", "--out", str(out)]
+    first = subprocess.run([*run, "--trials", "40"], capture_output=True, env=_env(), cwd=ROOT)
+    assert first.returncode == 0, first.stderr
+    for trials in ("40", "60"):  # the same run again, and one of another config
+        with open(out / "log.txt", "w") as log:
+            p = subprocess.run(
+                [*run, "--trials", trials, "--overwrite"],
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                env=_env(),
+                cwd=ROOT,
+            )
+        text = (out / "log.txt").read_text()
+        assert p.returncode == 0, text
+        assert f"results in {out}/" in text, (trials, text)
