@@ -127,7 +127,10 @@ def run_all(
             try:
                 proc = subprocess.Popen(
                     cmd,
-                    stdout=subprocess.PIPE if jobs > 1 else None,
+                    # its lines reach standard output through the driver's log, --jobs 1 too
+                    # (where a full or closed one was a line per run, and a reader that left
+                    # the exit code of the first run's, not the driver's)
+                    stdout=subprocess.PIPE,
                     stderr=subprocess.PIPE,
                     env=child_env(),  # ends with the driver, even after kill -9
                     **child_text(),  # the child's encoding, which is the driver's
@@ -148,7 +151,7 @@ def run_all(
         named = _Named(sys.stderr, f.name)
         named.write(stderr)
         named.flush()
-        if jobs > 1 and stdout:
+        if stdout:
             log(stdout.rstrip())
         return f.stem, proc.returncode, wall, t - t0
 
@@ -307,6 +310,8 @@ def _main(argv: list[str]) -> int:
     if log.error is not None and not isinstance(log.error, BrokenPipeError):
         print(f"sim.batch: standard output: {log.error.strerror or log.error}", file=sys.stderr)
         return (failed[0] if failed[0] > 0 else 1) if failed else 2
+    if log.error is not None and not failed:  # a reader that left (| head -1): as sim does
+        return 141
     return (failed[0] if failed[0] > 0 else 1) if failed else 0
 
 

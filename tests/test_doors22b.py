@@ -15,6 +15,10 @@ failed on the code before its fix.
   carried into the new results as a copy made before the run printed a word, and the run's
   lines went into the old file, removed with the old results: an empty log and exit 0. A
   user's regular file is now carried by a hard link, the same file (:func:`sim.mc.publish._carry`);
+* ``python -m sim.batch --jobs 1`` passed its standard output to the runs: a full one was a
+  line per run, and a reader that left ended the batch with the first run's 141, where
+  ``--jobs 2`` said a full output once and ended with 0 on a reader that left; both now as
+  ``sim``: one line, or quietly 141 (:func:`sim.batch.run_all`, :func:`sim.batch.main`);
 * ``make verify``'s standard output held its re-runs' "results in /tmp/sim-verify-.../" lines
   (a directory removed at its end) between its own (:func:`sim.report.verify.rerun.rerun_study`);
 """
@@ -140,3 +144,24 @@ def test_output_redirected_into_the_results_directory_is_kept(tmp_path):
         text = (out / "log.txt").read_text()
         assert p.returncode == 0, text
         assert f"results in {out}/" in text, (trials, text)
+
+
+@pytest.mark.skipif(not FULL.exists(), reason="needs /dev/full")
+def test_batch_of_one_job_says_a_full_output_once(tmp_path):
+    """``python -m sim.batch --jobs 1`` passed its standard output to the runs: a full one was
+    one line per run (each run's own), where ``--jobs 2`` says it once for the driver."""
+    files = [str(STUDY), str(ROOT / "studies" / "network_testfield.toml")]
+    argv = ["-m", "sim.batch", *files, "--jobs", "1", "--results", str(tmp_path / "r")]
+    p = _into_full(*argv, "--", "--trials", "40", "--no-figures")
+    assert one_line_of(p) == "sim.batch: standard output: No space left on device"
+    assert (tmp_path / "r" / "network_testfield" / "run.json").is_file()
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_batch_whose_reader_left_ends_as_sim_does(tmp_path, jobs):
+    """A reader that left (``| head -c 0``): ``--jobs 1`` ended with the first run's 141,
+    ``--jobs 2`` with 0; both as ``sim``: quietly, 141."""
+    argv = ["-m", "sim.batch", str(STUDY), "--jobs", jobs, "--results", str(tmp_path / "r")]
+    p = _into_left_pipe(*argv, "--", "--trials", "40", "--no-figures")
+    assert (p.returncode, p.stderr) == (141, ""), (p.returncode, p.stderr)
+    assert (tmp_path / "r" / "network_plate" / "run.json").is_file()
