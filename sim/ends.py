@@ -17,7 +17,7 @@ from __future__ import annotations
 import os
 import sys
 
-__all__ = ["finish", "flush_stdout", "stdout_unwritten"]
+__all__ = ["finish", "flush_stdout", "stdout_failed", "stdout_unwritten"]
 
 #: a failed write to standard output that its writer could not raise (see stdout_unwritten)
 _unwritten: list[OSError] = []
@@ -43,18 +43,25 @@ def flush_stdout(prog: str, code: int) -> int:
     except ValueError:  # closed by the caller: nothing left to write
         return code
     except OSError as e:
-        try:  # what is left in the buffer is dropped, not tried again at exit
-            os.dup2(os.open(os.devnull, os.O_WRONLY), out.fileno())
-        except (OSError, ValueError):
-            pass
-        if isinstance(e, BrokenPipeError):
-            return code or 141
-        try:
-            why = e.strerror or type(e).__name__
-            print(f"{prog}: error: {why}: standard output", file=sys.stderr, flush=True)
-        except (OSError, ValueError, AttributeError):  # standard error gone as well
-            pass
-        return code or 2
+        return stdout_failed(prog, e, code)
+
+
+def stdout_failed(prog: str, e: OSError, code: int) -> int:
+    """The exit code after ``e``, a failed write to standard output, and its one line (none
+    for a reader that left: 141); ``code`` stands when it already says a failure. What is
+    left in the buffer is dropped, not tried again at exit."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
+    if isinstance(e, BrokenPipeError):
+        return code or 141
+    try:
+        why = e.strerror or type(e).__name__
+        print(f"{prog}: error: {why}: standard output", file=sys.stderr, flush=True)
+    except (OSError, ValueError, AttributeError):  # standard error gone as well
+        pass
+    return code or 2
 
 
 def finish(prog: str, main) -> int:

@@ -19,6 +19,9 @@ failed on the code before its fix.
   line per run, and a reader that left ended the batch with the first run's 141, where
   ``--jobs 2`` said a full output once and ended with 0 on a reader that left; both now as
   ``sim``: one line, or quietly 141 (:func:`sim.batch.run_all`, :func:`sim.batch.main`);
+* ``make verify`` that failed broadly prints ~30 KB: into a full disk or to a reader that left
+  it was a traceback from ``print``, and its record was not written
+  (:func:`sim.report.verify.cli._main`, :func:`sim.ends.stdout_failed`);
 * ``make verify``'s standard output held its re-runs' "results in /tmp/sim-verify-.../" lines
   (a directory removed at its end) between its own (:func:`sim.report.verify.rerun.rerun_study`);
 """
@@ -29,7 +32,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from oneline import one_line_of
+from oneline import one_line, one_line_of
 
 ROOT = Path(__file__).resolve().parent.parent
 STUDY = ROOT / "studies" / "network_plate.toml"
@@ -165,3 +168,44 @@ def test_batch_whose_reader_left_ends_as_sim_does(tmp_path, jobs):
     p = _into_left_pipe(*argv, "--", "--trials", "40", "--no-figures")
     assert (p.returncode, p.stderr) == (141, ""), (p.returncode, p.stderr)
     assert (tmp_path / "r" / "network_plate" / "run.json").is_file()
+
+
+def _failed_comparisons(*args, **kwargs):
+    """What verify found, as a broad failure does: 20 lines for each of 12 studies (~30 KB)."""
+    from sim.report.verify.rules import Comparison
+
+    lines = [f"points.parquet:col{j}: deviation beyond its tolerance {'.' * 80}" for j in range(20)]
+    return [Comparison(study=f"s{i}", files=3, max_ratio=9.0, failures=lines) for i in range(12)]
+
+
+@pytest.mark.skipif(not FULL.exists(), reason="needs /dev/full")
+@pytest.mark.parametrize("reader_left", [False, True])
+def test_verify_long_output_that_cannot_be_written(tmp_path, capsys, monkeypatch, reader_left):
+    """A verify that failed broadly prints ~30 KB: into a full disk or to a reader that left it
+    was a traceback from ``print`` (exit 1 by the traceback), before the record was written."""
+    from sim.report.verify import cli as verify_cli
+
+    monkeypatch.setattr(verify_cli, "verify", _failed_comparisons)
+    monkeypatch.setattr(verify_cli, "write_record", lambda results, comps: written.append(comps))
+    written: list = []
+    if reader_left:
+        r, w = os.pipe()
+        os.close(r)
+        out = os.fdopen(w, "w", buffering=1024)
+    else:
+        out = open(FULL, "w", buffering=1024)  # noqa: SIM115 - closed below
+    try:
+        monkeypatch.setattr(sys, "stdout", out)
+        rc = verify_cli.main(["--results", str(ROOT / "results"), "--scratch", str(tmp_path)])
+    finally:
+        monkeypatch.undo()
+        try:
+            out.close()
+        except OSError:
+            pass
+    assert written, "the record was not written"
+    if reader_left:
+        assert (rc, capsys.readouterr().err) == (1, "")
+    else:
+        line = one_line(capsys, rc, "standard output", code=1)
+        assert line == "sim verify: error: No space left on device: standard output"
