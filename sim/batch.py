@@ -102,11 +102,12 @@ def run_all(
     quiet = ["--quiet"] if jobs > 1 and "--quiet" not in run_args else []
 
     def argv(f: Path) -> list[str]:
+        # a name that begins with "-" (--results=-r, ./-x.toml) is a value, never an option:
+        # sim run read "--out -r/x" as an --out without its value
         return [
             "run",
-            str(f),
-            "--out",
-            str(results / f.stem),
+            str(f) if not str(f).startswith("-") else f"./{f}",
+            f"--out={results / f.stem}",
             "--overwrite",
             *run_args,
             *quiet,

@@ -19,6 +19,10 @@ failed on the code before its fix.
   line per run, and a reader that left ended the batch with the first run's 141, where
   ``--jobs 2`` said a full output once and ended with 0 on a reader that left; both now as
   ``sim``: one line, or quietly 141 (:func:`sim.batch.run_all`, :func:`sim.batch.main`);
+* a directory name that begins with "-" (``python -m sim.batch --results=-r``, ``make verify``
+  ``--scratch=-s``) reached each run as ``--out -r/<study>``, which sim run read as an option
+  ("argument --out: expected one argument"); ``--out -`` and ``--timings -`` made a directory
+  and a file named "-" where "-" reads as standard output: refused by name;
 * ``make verify`` that failed broadly prints ~30 KB: into a full disk or to a reader that left
   it was a traceback from ``print``, and its record was not written
   (:func:`sim.report.verify.cli._main`, :func:`sim.ends.stdout_failed`);
@@ -209,3 +213,38 @@ def test_verify_long_output_that_cannot_be_written(tmp_path, capsys, monkeypatch
     else:
         line = one_line(capsys, rc, "standard output", code=1)
         assert line == "sim verify: error: No space left on device: standard output"
+
+
+def test_a_directory_name_that_begins_with_a_dash_reaches_the_runs(tmp_path):
+    """``python -m sim.batch --results=-r`` (and ``make verify`` ``--scratch=-s``) handed each
+    run ``--out -r/<study>``, which sim run read as an option: "argument --out: expected one
+    argument", naming an option the user never gave."""
+    argv = ["-m", "sim.batch", str(STUDY), "--results=-r", "--", "--trials", "40", "--no-figures"]
+    p = subprocess.run(
+        [sys.executable, *argv], capture_output=True, text=True, env=_env(), cwd=tmp_path
+    )
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "-r" / "network_plate" / "run.json").is_file()
+    if not (ROOT / "results" / "network_plate" / "claims.parquet").is_file():
+        return
+    for d in ("studies", "results"):
+        (tmp_path / d).symlink_to(ROOT / d)
+    argv = ["-m", "sim.report.verify", "--results", "results", "--study", "network_plate"]
+    argv += ["--trials", "400", "--workers", "1", "--scratch=-s"]
+    p = subprocess.run(
+        [sys.executable, *argv], capture_output=True, text=True, env=_env(), cwd=tmp_path
+    )
+    assert p.returncode == 0 and p.stdout.startswith("network_plate: ok; "), p.stderr
+
+
+def test_a_dash_for_an_output_is_not_taken_as_a_name(tmp_path, capsys, monkeypatch):
+    """``--out -`` made a results directory named "-" and ``--timings -`` a file named "-" (in
+    the working directory), where many programs read "-" as standard output."""
+    from sim import batch, cli
+
+    monkeypatch.chdir(tmp_path)
+    run = ["run", str(STUDY), "--trials", "40", "--no-figures", "--out", "-"]
+    one_line(capsys, cli.main(run), "'-' is not standard output", prefix="sim: error: --out: ")
+    argv = [str(STUDY), "--stale-only", "--results", str(tmp_path / "r"), "--timings", "-"]
+    one_line(capsys, batch.main(argv), "'-' is not standard output", prefix="sim.batch: --timings")
+    assert not (tmp_path / "-").exists()

@@ -124,7 +124,8 @@ def rerun_study(
     if not sf.is_file():
         return f"no study file {studies_dir / (d.name + '.toml')} to re-run"
     # the comparison reads tables only: no figures drawn (half of some studies' time)
-    cmd = [sys.executable, "-m", "sim", "run", str(sf), "--out", str(target), "--quiet"]
+    # --out=DIR: a --scratch that begins with "-" is a value, not an option of sim run's
+    cmd = [sys.executable, "-m", "sim", "run", str(sf), f"--out={target}", "--quiet"]
     cmd += ["--no-figures"]
     cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else []), *extra]
     print(f"sim verify: re-running {d.name}", file=sys.stderr, flush=True)
