@@ -1,6 +1,7 @@
 """``python -m sim`` and the ``sim`` command: BLAS single-threaded, matplotlib's notes about
 an unwritable config directory kept quiet, then the command line."""
 
+from sim.ends import open_standard_streams
 from sim.threads import (
     interrupt_while_loading,
     refuse_bad_environment,
@@ -8,6 +9,7 @@ from sim.threads import (
     single_threaded_blas,
 )
 
+open_standard_streams()  # 2>&-: before any file takes its descriptor
 loaded = interrupt_while_loading("sim")  # Ctrl-C during the imports: one line, exit 130
 
 import logging  # noqa: E402 - after the guard: Ctrl-C in this import was a traceback

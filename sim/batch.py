@@ -34,6 +34,10 @@ from pathlib import Path
 
 from sim.threads import interrupt_while_loading, refuse_bad_environment, single_threaded_blas
 
+if __name__ == "__main__":  # 2>&-: before any file takes its descriptor (sim.ends)
+    from sim.ends import open_standard_streams
+
+    open_standard_streams()
 _loaded = interrupt_while_loading("sim.batch")  # Ctrl-C during the imports: one line, exit 130
 if __name__ == "__main__":
     refuse_bad_environment("sim.batch")  # a variable NumPy cannot load with: one line, exit 2

@@ -17,7 +17,7 @@ from __future__ import annotations
 import os
 import sys
 
-__all__ = ["finish", "flush_stdout", "stdout_failed", "stdout_unwritten"]
+__all__ = ["finish", "flush_stdout", "stdout_failed", "stdout_unwritten", "open_standard_streams"]
 
 #: a failed write to standard output that its writer could not raise (see stdout_unwritten)
 _unwritten: list[OSError] = []
@@ -74,3 +74,29 @@ def finish(prog: str, main) -> int:
             raise
         code = e.code
     return flush_stdout(prog, code or 0)
+
+
+def open_standard_streams() -> None:
+    """A standard stream closed when the program starts (``2>&-``, ``>&-``, ``<&-``) is opened
+    on the null device. Python leaves ``sys.stderr`` None then, and ``print(..., file=
+    sys.stderr)`` writes to standard *output*: ``sim check STUDY --set trials=-1 2>&- >
+    saved.toml`` wrote its error line into saved.toml, and ``python -m sim.batch 2>&-`` ended
+    with exit 1 and no timings after its runs (``sys.stderr.write`` of a run's lines). And the
+    lowest free descriptor goes to the next file opened (the run's lock file became descriptor
+    1 or 2). Standard error now writes nowhere, as asked; ``sys.stdout`` stays None (``sim
+    check`` and ``sim show`` refuse to print nowhere), its descriptor taken by the null device."""
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+            continue
+        except OSError:
+            pass
+        try:
+            null = os.open(os.devnull, os.O_RDWR)
+            if null != fd:
+                os.dup2(null, fd)
+                os.close(null)
+        except OSError:  # no descriptor to be had: left as it was
+            continue
+        if fd == 2 and sys.stderr is None:
+            sys.stderr = open(2, "w", encoding="utf-8", errors="backslashreplace", closefd=False)  # noqa: SIM115

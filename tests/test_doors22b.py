@@ -23,6 +23,9 @@ failed on the code before its fix.
   ``--scratch=-s``) reached each run as ``--out -r/<study>``, which sim run read as an option
   ("argument --out: expected one argument"); ``--out -`` and ``--timings -`` made a directory
   and a file named "-" where "-" reads as standard output: refused by name;
+* standard error closed (``2>&-``): Python's ``print(..., file=sys.stderr)`` wrote to standard
+  output (an error line into a saved ``sim check`` listing), and ``python -m sim.batch`` ended
+  with exit 1 and no timings after its runs (:func:`sim.ends.open_standard_streams`);
 * ``make verify`` that failed broadly prints ~30 KB: into a full disk or to a reader that left
   it was a traceback from ``print``, and its record was not written
   (:func:`sim.report.verify.cli._main`, :func:`sim.ends.stdout_failed`);
@@ -248,3 +251,29 @@ def test_a_dash_for_an_output_is_not_taken_as_a_name(tmp_path, capsys, monkeypat
     argv = [str(STUDY), "--stale-only", "--results", str(tmp_path / "r"), "--timings", "-"]
     one_line(capsys, batch.main(argv), "'-' is not standard output", prefix="sim.batch: --timings")
     assert not (tmp_path / "-").exists()
+
+
+def _closed_stderr(*argv: str, cwd=ROOT) -> subprocess.CompletedProcess:
+    """``argv`` run with its standard error closed (``2>&-``)."""
+    script = '"$0" "$@" 2>&-'
+    return subprocess.run(
+        ["sh", "-c", script, sys.executable, *argv],
+        capture_output=True,
+        text=True,
+        env=_env(),
+        cwd=cwd,
+    )
+
+
+def test_a_closed_standard_error_keeps_errors_out_of_standard_output(tmp_path):
+    """With standard error closed Python leaves ``sys.stderr`` None, and ``print(...,
+    file=sys.stderr)`` wrote to standard output: ``sim check STUDY --set trials=-1 2>&- >
+    saved.toml`` put its error line into the saved listing; ``python -m sim.batch 2>&-``
+    ended with exit 1 and no timings after its runs had finished."""
+    p = _closed_stderr("-m", "sim", "check", str(STUDY), "--set", "trials=-1")
+    assert (p.returncode, p.stdout) == (2, ""), (p.returncode, p.stdout)
+    timings = tmp_path / "t.json"
+    argv = ["-m", "sim.batch", str(STUDY), "--results", str(tmp_path / "r")]
+    argv += ["--timings", str(timings), "--", "--trials", "40", "--no-figures"]
+    p = _closed_stderr(*argv)
+    assert p.returncode == 0 and timings.is_file(), (p.returncode, p.stdout)

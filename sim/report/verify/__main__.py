@@ -2,8 +2,10 @@
 
 import sys
 
+from sim.ends import open_standard_streams  # noqa: E402
 from sim.threads import interrupt_while_loading
 
+open_standard_streams()  # 2>&-: before any file takes its descriptor
 loaded = interrupt_while_loading("sim verify")  # Ctrl-C during the imports: one line, exit 130
 from sim.ends import finish  # noqa: E402
 from sim.report.verify.cli import main  # noqa: E402
