@@ -156,8 +156,7 @@ def peak_memory(out: Path, trials: int, chunk: int) -> tuple[float, float]:
             str(trials),
             "--chunk",
             str(chunk),
-            "--out",
-            str(out),
+            f"--out={out}",  # an --out that begins with "-" is its value, not an option
         ],
         check=True,
         capture_output=True,

@@ -1,6 +1,7 @@
 """``python -m sim`` and the ``sim`` command: BLAS single-threaded, matplotlib's notes about
 an unwritable config directory kept quiet, then the command line."""
 
+from sim.ends import open_standard_streams
 from sim.threads import (
     interrupt_while_loading,
     refuse_bad_environment,
@@ -8,6 +9,7 @@ from sim.threads import (
     single_threaded_blas,
 )
 
+open_standard_streams()  # 2>&-: before any file takes its descriptor
 loaded = interrupt_while_loading("sim")  # Ctrl-C during the imports: one line, exit 130
 
 import logging  # noqa: E402 - after the guard: Ctrl-C in this import was a traceback
@@ -32,6 +34,7 @@ class _CacheDirNotes(logging.Filter):
 logging.getLogger("matplotlib").addFilter(_CacheDirNotes())  # before matplotlib loads
 
 from sim.cli import main as command  # noqa: E402
+from sim.ends import finish  # noqa: E402
 from sim.mc.children import die_with_parent  # noqa: E402
 from sim.stops import run_program  # noqa: E402
 
@@ -45,7 +48,7 @@ def main() -> int:
     if words is not None:
         print(f"sim: error: {words}", file=sys.stderr)
         return 2
-    return run_program("sim", command, loaded)
+    return finish("sim", lambda: run_program("sim", command, loaded))  # stdout flushed: sim.ends
 
 
 if __name__ == "__main__":

@@ -34,6 +34,10 @@ from pathlib import Path
 
 from sim.threads import interrupt_while_loading, refuse_bad_environment, single_threaded_blas
 
+if __name__ == "__main__":  # 2>&-: before any file takes its descriptor (sim.ends)
+    from sim.ends import open_standard_streams
+
+    open_standard_streams()
 _loaded = interrupt_while_loading("sim.batch")  # Ctrl-C during the imports: one line, exit 130
 if __name__ == "__main__":
     refuse_bad_environment("sim.batch")  # a variable NumPy cannot load with: one line, exit 2
@@ -49,6 +53,7 @@ from sim.batch_checks import (  # noqa: E402
     why_stale,
 )
 from sim.cli_args import OnceParser, module_doc  # noqa: E402
+from sim.ends import finish  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
@@ -102,11 +107,12 @@ def run_all(
     quiet = ["--quiet"] if jobs > 1 and "--quiet" not in run_args else []
 
     def argv(f: Path) -> list[str]:
+        # a name that begins with "-" (--results=-r, ./-x.toml) is a value, never an option:
+        # sim run read "--out -r/x" as an --out without its value
         return [
             "run",
-            str(f),
-            "--out",
-            str(results / f.stem),
+            str(f) if not str(f).startswith("-") else f"./{f}",
+            f"--out={results / f.stem}",
             "--overwrite",
             *run_args,
             *quiet,
@@ -127,7 +133,10 @@ def run_all(
             try:
                 proc = subprocess.Popen(
                     cmd,
-                    stdout=subprocess.PIPE if jobs > 1 else None,
+                    # its lines reach standard output through the driver's log, --jobs 1 too
+                    # (where a full or closed one was a line per run, and a reader that left
+                    # the exit code of the first run's, not the driver's)
+                    stdout=subprocess.PIPE,
                     stderr=subprocess.PIPE,
                     env=child_env(),  # ends with the driver, even after kill -9
                     **child_text(),  # the child's encoding, which is the driver's
@@ -148,7 +157,7 @@ def run_all(
         named = _Named(sys.stderr, f.name)
         named.write(stderr)
         named.flush()
-        if jobs > 1 and stdout:
+        if stdout:
             log(stdout.rstrip())
         return f.stem, proc.returncode, wall, t - t0
 
@@ -317,6 +326,8 @@ def _main(argv: list[str]) -> int:
     if log.error is not None and not isinstance(log.error, BrokenPipeError):
         print(f"sim.batch: standard output: {log.error.strerror or log.error}", file=sys.stderr)
         return (failed[0] if failed[0] > 0 else 1) if failed else 2
+    if log.error is not None and not failed:  # a reader that left (| head -1): as sim does
+        return 141
     return (failed[0] if failed[0] > 0 else 1) if failed else 0
 
 
@@ -342,4 +353,4 @@ class _Stdout:
 
 
 if __name__ == "__main__":  # a signal after main returned: its exit code stands
-    sys.exit(run_program("sim.batch", main, _loaded))
+    sys.exit(finish("sim.batch", lambda: run_program("sim.batch", main, _loaded)))

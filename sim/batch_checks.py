@@ -179,6 +179,8 @@ def _timings_problem(path: str) -> str | None:
     """Why the timings cannot be written to ``path`` (checked before anything runs): its
     directory must be writable, and an existing file must be an earlier timings file (a
     JSON object of lists), never a file of the user's."""
+    if path == "-":  # read as standard output by many programs: here it named a file "-"
+        return "'-' is not standard output here: name a file (./- for a file named '-')"
     p = Path(path)
     try:
         parent = p.resolve().parent

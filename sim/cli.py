@@ -81,6 +81,10 @@ def check_run_args(args) -> Path:
     if args.out is not None:
         if not args.out.strip():
             raise ConfigError("--out", "is empty: name an output directory")
+        if args.out == "-":  # read as standard output by many programs: it made a directory "-"
+            raise ConfigError(
+                "--out", "'-' is not standard output here: name a directory (./- for one named '-')"
+            )
         why = name_problem(args.out)
         if why:
             raise ConfigError("--out", f"{why} (got {args.out!r})")

@@ -12,6 +12,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from sim.ends import stdout_unwritten
+
 __all__ = ["MAX_OPTIONS", "BoundedParser"]
 
 #: options (arguments starting with "-") one command line may hold
@@ -30,3 +32,16 @@ class BoundedParser(argparse.ArgumentParser):
                 "or pass them to the Python API)"
             )
         return super().parse_known_args(args, namespace)
+
+    def _print_message(self, message, file=None):
+        """argparse's, which dropped a failed write (``--help > /dev/full`` with unbuffered
+        output: exit 0 and no word); one to standard output is kept for the program's end
+        (:func:`sim.ends.flush_stdout`: one line naming it, exit 2)."""
+        if not message:
+            return
+        file = file or sys.stderr
+        try:
+            file.write(message)
+        except (AttributeError, OSError) as e:  # a closed or gone stream: as argparse did
+            if isinstance(e, OSError) and file is sys.stdout:
+                stdout_unwritten(e)

@@ -137,15 +137,21 @@ def _foreign(out: Path) -> list[str]:
 
 def _carry(src: Path, dst: Path) -> None:
     """Copy a user's entry ``src`` of an earlier results directory to ``dst`` as what it is: a
-    regular file's bytes, a symbolic link's target (not followed), an empty directory, and a
-    FIFO, socket or device by a hard link (never opened: a FIFO would block)."""
+    regular file by a hard link (the same file: a log the command itself is writing, ``sim run
+    ... --out DIR > DIR/log.txt``, was copied before the run printed a word and its lines went
+    into the old file, removed with the old results), else its bytes; a symbolic link's
+    target (not followed), an empty directory, and a FIFO, socket or device by a hard link
+    (never opened: a FIFO would block)."""
     dst.parent.mkdir(parents=True, exist_ok=True)
     if src.is_symlink():
         os.symlink(os.readlink(src), dst)
     elif src.is_dir():
         dst.mkdir(exist_ok=True)
     elif src.is_file():
-        shutil.copy2(src, dst)
+        try:
+            os.link(src, dst, follow_symlinks=False)
+        except OSError:  # another user's file (protected_hardlinks), a mount: its bytes
+            shutil.copy2(src, dst)
     else:
         try:
             os.link(src, dst, follow_symlinks=False)

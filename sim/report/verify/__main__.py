@@ -2,10 +2,13 @@
 
 import sys
 
+from sim.ends import open_standard_streams  # noqa: E402
 from sim.threads import interrupt_while_loading
 
+open_standard_streams()  # 2>&-: before any file takes its descriptor
 loaded = interrupt_while_loading("sim verify")  # Ctrl-C during the imports: one line, exit 130
+from sim.ends import finish  # noqa: E402
 from sim.report.verify.cli import main  # noqa: E402
 from sim.stops import run_program  # noqa: E402
 
-sys.exit(run_program("sim verify", main, loaded))  # a late signal: the command's code stands
+sys.exit(finish("sim verify", lambda: run_program("sim verify", main, loaded)))  # sim.ends

@@ -9,6 +9,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from sim.ends import stdout_failed
 from sim.mc.argv import BoundedParser
 from sim.mc.outputs import name_problem
 from sim.report.verify.rerun import verify, write_record
@@ -174,7 +175,14 @@ def _main(argv: list[str] | None) -> int:
     except KeyboardInterrupt:
         print(INTERRUPTED, file=sys.stderr)
         return 130
-    _print(comps)
+    try:  # a long output (20 lines a failed study) into a full disk or a reader that left
+        _print(comps)  # was a traceback here, and the record below was not written
+        unprinted = None
+    except OSError as e:
+        unprinted = e
+    code = 0 if all(c.ok for c in comps) else 1
+    if unprinted is not None:
+        code = stdout_failed("sim verify", unprinted, code)
     if not a.no_record and mode == "full" and not a.study:
         try:
             write_record(Path(a.results), comps)
@@ -182,4 +190,4 @@ def _main(argv: list[str] | None) -> int:
             where = Path(a.results) / "reproducibility.parquet"
             print(f"sim verify: error: cannot write {where}: {e.strerror or e}", file=sys.stderr)
             return 2
-    return 0 if all(c.ok for c in comps) else 1
+    return code

@@ -139,11 +139,16 @@ def rerun_study(
             "kept elsewhere: name their directory with --studies)"
         )
     # the comparison reads tables only: no figures drawn (half of some studies' time)
-    cmd = [sys.executable, "-m", "sim", "run", str(sf), "--out", str(target), "--quiet"]
+    # --out=DIR: a --scratch that begins with "-" is a value, not an option of sim run's
+    cmd = [sys.executable, "-m", "sim", "run", str(sf), f"--out={target}", "--quiet"]
     cmd += ["--no-figures"]
     cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else []), *extra]
     print(f"sim verify: re-running {d.name}", file=sys.stderr, flush=True)
-    with subprocess.Popen(cmd, stderr=subprocess.PIPE, env=child_env(), **child_text()) as proc:
+    # its standard output is not verify's: the re-run's "results in /tmp/sim-verify-.../" named
+    # a directory removed at exit, between verify's own lines, and a full or closed standard
+    # output of verify's failed the re-run itself
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.PIPE}
+    with subprocess.Popen(cmd, **quiet, env=child_env(), **child_text()) as proc:
         try:
             _, err = proc.communicate()
         except KeyboardInterrupt:  # Ctrl-C reaches the re-run too, SIGTERM or SIGHUP only verify

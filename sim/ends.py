@@ -1,0 +1,102 @@
+"""How a program of the suite ends: its standard output flushed while a failure can still be
+said in one line.
+
+Standard output to a file or a pipe is block-buffered: what a command printed last (``sim
+check``'s whole listing, ``--help``, ``make verify``'s comparisons) was written only when Python
+flushed it at exit, where a full disk (``> /dev/full``) or a reader that left (``| head -1``)
+was Python's "Exception ignored in: <_io.TextIOWrapper name='<stdout>'>" and exit 120. And
+argparse drops an OSError of its own write (``--help > /dev/full`` under ``PYTHONUNBUFFERED=1``,
+as in many containers, ended silently with exit 0). :func:`finish` runs a program's main and
+flushes: a failed write is one line naming standard output and exit 2, a reader that left
+nothing and 141 (as a program killed by SIGPIPE). Outside the studies' code (and its hash):
+only the programs' entry points use it.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+__all__ = ["finish", "flush_stdout", "stdout_failed", "stdout_unwritten", "open_standard_streams"]
+
+#: a failed write to standard output that its writer could not raise (see stdout_unwritten)
+_unwritten: list[OSError] = []
+
+
+def stdout_unwritten(e: OSError) -> None:
+    """Record ``e``, a write to standard output that failed where it is dropped (argparse's
+    ``--help`` and ``--version``), for :func:`flush_stdout` to say."""
+    _unwritten[:] = [e]
+
+
+def flush_stdout(prog: str, code: int) -> int:
+    """Flush standard output now and return the exit code to end with (see the module's
+    docstring); ``code`` stands when it already says a failure."""
+    out = sys.stdout
+    try:
+        if out is None:  # >&-: print() wrote nowhere
+            return code
+        if _unwritten:  # a write that failed where it could not be raised (argparse's --help)
+            raise _unwritten.pop()
+        out.flush()
+        return code
+    except ValueError:  # closed by the caller: nothing left to write
+        return code
+    except OSError as e:
+        return stdout_failed(prog, e, code)
+
+
+def stdout_failed(prog: str, e: OSError, code: int) -> int:
+    """The exit code after ``e``, a failed write to standard output, and its one line (none
+    for a reader that left: 141); ``code`` stands when it already says a failure. What is
+    left in the buffer is dropped, not tried again at exit."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
+    if isinstance(e, BrokenPipeError):
+        return code or 141
+    try:
+        why = e.strerror or type(e).__name__
+        print(f"{prog}: error: {why}: standard output", file=sys.stderr, flush=True)
+    except (OSError, ValueError, AttributeError):  # standard error gone as well
+        pass
+    return code or 2
+
+
+def finish(prog: str, main) -> int:
+    """``main()``'s exit code (a ``SystemExit`` of argparse's ``--help`` included) after
+    :func:`flush_stdout`, for ``sys.exit``."""
+    try:
+        code = main()
+    except SystemExit as e:
+        if not (e.code is None or isinstance(e.code, int)):  # a message: Python prints it
+            raise
+        code = e.code
+    return flush_stdout(prog, code or 0)
+
+
+def open_standard_streams() -> None:
+    """A standard stream closed when the program starts (``2>&-``, ``>&-``, ``<&-``) is opened
+    on the null device. Python leaves ``sys.stderr`` None then, and ``print(..., file=
+    sys.stderr)`` writes to standard *output*: ``sim check STUDY --set trials=-1 2>&- >
+    saved.toml`` wrote its error line into saved.toml, and ``python -m sim.batch 2>&-`` ended
+    with exit 1 and no timings after its runs (``sys.stderr.write`` of a run's lines). And the
+    lowest free descriptor goes to the next file opened (the run's lock file became descriptor
+    1 or 2). Standard error now writes nowhere, as asked; ``sys.stdout`` stays None (``sim
+    check`` and ``sim show`` refuse to print nowhere), its descriptor taken by the null device."""
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+            continue
+        except OSError:
+            pass
+        try:
+            null = os.open(os.devnull, os.O_RDWR)
+            if null != fd:
+                os.dup2(null, fd)
+                os.close(null)
+        except OSError:  # no descriptor to be had: left as it was
+            continue
+        if fd == 2 and sys.stderr is None:
+            sys.stderr = open(2, "w", encoding="utf-8", errors="backslashreplace", closefd=False)  # noqa: SIM115
