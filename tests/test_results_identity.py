@@ -51,10 +51,17 @@ def test_a_figure_replaced_by_hand_is_named_by_show_and_report(plate, capsys):
     one_line(capsys, rc, fig.name, "not the figure its run drew", "run its study again")
 
 
-def test_a_figure_removed_by_hand_is_named(plate, capsys):
+def test_a_figure_removed_is_seen_missing_and_drawn_again_by_stale_only(plate, capsys):
+    """A figure deleted (to save room) is seen missing by a reader: ``sim show`` prints the
+    tables; ``--stale-only`` re-runs the study to draw it again. A figure read through a
+    symbolic link to the run's own bytes is the run's."""
     fig = sorted(plate.glob("*.png"))[-1]
-    fig.unlink()
-    one_line(capsys, main(["show", str(plate)]), fig.name, "is missing")
+    keep = plate.parent / "kept.png"
+    fig.rename(keep)
+    assert main(["show", str(plate)]) == 0 and capsys.readouterr().err == ""
+    assert "is missing (the run drew it)" in changed_figure(plate)
+    fig.symlink_to(keep)
+    assert changed_figure(plate) is None
 
 
 def test_stale_only_re_runs_results_with_a_figure_replaced_by_hand(plate, tiny_run):

@@ -53,11 +53,12 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
     write_record(stage, {**rec, "files": files, "chunk_sha256": chunks, "figure_sha256": figures})
 
 
-def changed_figure(out: Path) -> str | None:
-    """Which figure of a finished results directory is not the one its run drew (missing, or
-    its sha256 differs from the run record's ``figure_sha256``: replaced or edited by hand),
-    in a few words, or None. A report embeds the figures as they are: a hand-made picture
-    beside the run's tables was read as the run's. Results of runs that recorded no figure
+def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
+    """Which figure of a finished results directory is not the one its run drew (its sha256,
+    read through a symbolic link, differs from the run record's ``figure_sha256``: replaced
+    or edited by hand; or missing, unless ``missing_ok``), in a few words, or None. A report
+    embeds the figures as they are: a hand-made picture beside the run's tables was read as
+    the run's, where a missing one is seen missing. Results of runs that recorded no figure
     hashes (older versions) are not checked."""
     rec = read_record(out)
     want = rec.get("figure_sha256") if rec else None
@@ -65,7 +66,9 @@ def changed_figure(out: Path) -> str | None:
         return None
     for f, h in sorted(want.items()):
         p = out / f
-        if not p.is_file() or p.is_symlink():
+        if not p.is_file():
+            if missing_ok:
+                continue
             return f"{p} is missing (the run drew it)"
         if not isinstance(h, str) or _sha256(p) != h:
             return f"{p} is not the figure its run drew (its sha256 differs: replaced by hand?)"
