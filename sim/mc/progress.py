@@ -8,6 +8,8 @@ so logs and CI output stay clean. A run shares one bar over all its parts (see
 
 from __future__ import annotations
 
+import io
+import os
 import sys
 
 from sim.mc.config import ConfigError
@@ -37,6 +39,19 @@ def _terminal(stream) -> bool:
     except (AttributeError, ValueError, OSError):
         return False
 
+
+def _columns(stream) -> int | None:
+    """The width of the terminal ``stream`` is (0 for a pseudo-terminal whose size was never
+    set), or None where it cannot be asked."""
+    try:
+        return os.get_terminal_size(stream.fileno()).columns
+    except (AttributeError, ValueError, OSError, io.UnsupportedOperation):
+        return None
+
+
+#: the bar's width where the terminal gives none (0 columns: tqdm drew no bar at all) and
+#: the widest it is drawn (at 2,000 columns each redraw was a line of 5.8 kB)
+DEFAULT_COLUMNS, MAX_COLUMNS = 80, 200
 
 _bar: list = []
 
@@ -72,8 +87,13 @@ class Progress:
         self.chunks_done = 0
         self.done = 0
         stream = stream if stream is not None else sys.stderr
-        self.enabled = not quiet and _terminal(stream)
+        # a terminal that cannot move the cursor back (TERM=dumb: an editor's shell buffer)
+        # would show every redraw: no bar there
+        self.enabled = not quiet and _terminal(stream) and os.environ.get("TERM") != "dumb"
         check_environment()
+        cols = _columns(stream) if self.enabled else None
+        fixed = cols is not None and not 0 < cols <= MAX_COLUMNS
+        width = (min(cols, MAX_COLUMNS) or DEFAULT_COLUMNS) if fixed else None
         self.bar = _bar_class()(
             total=self.total,
             desc=label,
@@ -83,7 +103,8 @@ class Progress:
             unit=" trials",
             bar_format=_FORMAT,
             leave=False,
-            dynamic_ncols=True,
+            ncols=width,
+            dynamic_ncols=not fixed,
         )
 
     def __enter__(self) -> "Progress":

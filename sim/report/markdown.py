@@ -34,41 +34,9 @@ __all__ = [
     "md_table",
     "inputs_markdown",
     "number",
-    "consistent_rows",
-    "consistent_sets_sentence",
     "verdict_counts",
     "referee_summary",
 ]
-
-
-def consistent_rows(cons: dict) -> list[list]:
-    """Rows ``[input, claim, kind, where it holds]`` of a ``consistent_set.parquet`` table
-    (one-input sweeps: the range of values where each claim, and all together, hold)."""
-    rows = []
-    for i, c in enumerate(cons["claim"]):
-        lo, hi = number(cons["holds_low"][i]), number(cons["holds_high"][i])
-        where = "nowhere" if lo is None else f"{fmt(lo)} - {fmt(hi)}"
-        if lo is not None and cons["n_holds"][i] != cons["n_values"][i]:
-            where += f" ({cons['n_holds'][i]} of {cons['n_values'][i]} values)"
-        rows.append(
-            [cons["input"][i], "**all claims**" if c == "ALL" else f"`{c}`", cons["kind"][i], where]
-        )
-    return rows
-
-
-def consistent_sets_sentence(cons: dict) -> str:
-    """'Consistent sets: ...' -- per swept input, the values where all claims hold together
-    (the ``ALL`` rows of a ``consistent_set.parquet`` table), or that they conflict."""
-    parts = []
-    for i, c in enumerate(cons["claim"]):
-        if c != "ALL":
-            continue
-        lo, hi = number(cons["holds_low"][i]), number(cons["holds_high"][i])
-        parts.append(
-            f"`{cons['input'][i]}` "
-            + ("none: the claims conflict" if lo is None else f"{fmt(lo)} - {fmt(hi)}")
-        )
-    return "Consistent sets: " + "; ".join(parts) + "."
 
 
 def claims_markdown(path: Path) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -29,8 +30,16 @@ def fmt(x, digits: int = 3) -> str:
     return str(x)
 
 
+def _cell(s) -> str:
+    """A table cell's text: a pipe escaped (``\\|``), and the backslashes just before it
+    doubled, so that a name ending in a backslash (``P\\``) does not escape the pipe's
+    escape and split the row into one cell more (GitHub reads ``\\\\|`` as a backslash and a
+    cell's end); a line break made a space."""
+    s = re.sub(r"(\\*)\|", lambda m: m[1] * 2 + "\\|", str(s))
+    return s.replace("\n", " ")
+
+
 def md_table(header: list[str], rows: list[list]) -> str:
-    esc = lambda s: str(s).replace("|", "\\|").replace("\n", " ")  # noqa: E731
     out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    out += ["| " + " | ".join(esc(c) for c in r) + " |" for r in rows]
+    out += ["| " + " | ".join(_cell(c) for c in r) + " |" for r in rows]
     return "\n".join(out)
