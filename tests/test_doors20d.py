@@ -67,10 +67,13 @@ def ours(study: Path):
 
 
 def gama_cov(src: Path) -> dict:
-    """gama-local's point covariances (mm^2) by point name, from its XML output."""
+    """gama-local's point covariances (mm^2) by point name, from its XML output; fails with
+    its error descriptions where it adjusted nothing."""
     out = src.with_suffix(".out.xml")
     subprocess.run([gama_local(), str(src), "--xml", str(out)], check=True, capture_output=True)
-    coords = ET.parse(out).getroot().find(ONS + "coordinates")
+    root = ET.parse(out).getroot()
+    coords = root.find(ONS + "coordinates")
+    assert coords is not None, [d.text for d in root.iter(ONS + "description")]
     names = []
     for p in coords.find(ONS + "adjusted"):
         pid = p.find(ONS + "id").text.strip()

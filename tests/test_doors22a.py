@@ -21,7 +21,6 @@ the project. The tests that run ``gama-local`` skip without it (``$GAMA_LOCAL``,
 
 from __future__ import annotations
 
-import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -34,6 +33,7 @@ from sim.studies.network.analysis import analyse
 from sim.studies.network.definition import build
 from sim.studies.network.gama import export, merge_gama
 from sim.studies.network.model import datum
+from tests.test_doors20d import gama_cov
 
 NS = "{http://www.gnu.org/software/gama/gama-local}"
 ONS = "{http://www.gnu.org/software/gama/gama-local-adjustment}"
@@ -58,28 +58,6 @@ def clusters(xml: Path) -> list[list[float]]:
         elif tag in ("coordinates", "vectors"):
             out.append([float(v) for v in e.find(NS + "cov-mat").text.split()])
     return out
-
-
-def gama_cov(src: Path) -> dict:
-    """gama-local's point covariances (mm^2) by name; fails with its error description."""
-    out = src.with_suffix(".out.xml")
-    subprocess.run([gama_local(), str(src), "--xml", str(out)], check=True, capture_output=True)
-    root = ET.parse(out).getroot()
-    coords = root.find(ONS + "coordinates")
-    errs = [d.text for d in root.iter(ONS + "description")]
-    assert coords is not None, errs
-    names = []
-    for p in coords.find(ONS + "adjusted"):
-        pid = p.find(ONS + "id").text.strip()
-        names += [pid for c in "xyXY" if p.find(ONS + c) is not None]
-    cm = coords.find(ONS + "cov-mat")
-    dim, band = int(cm.find(ONS + "dim").text), int(cm.find(ONS + "band").text)
-    vals = iter(float(f.text) for f in cm.findall(ONS + "flt"))
-    cov = np.zeros((dim, dim))
-    for r in range(dim):
-        for c in range(r, min(dim, r + band + 1)):
-            cov[r, c] = cov[c, r] = next(vals)
-    return {nm: cov[2 * a : 2 * a + 2, 2 * a : 2 * a + 2] for a, nm in enumerate(names[::2])}
 
 
 # --- the export's clusters pass gama-local's pivot test --------------------------------------
