@@ -28,25 +28,22 @@ import sys
 import threading
 from pathlib import Path
 
-import pyarrow as pa
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
 from sim.cli_args import module_doc, parser
-from sim.cli_errors import cwd_exists, not_as_written, os_reason, other_code, stdout_failed
+from sim.cli_errors import cwd_exists, os_reason, stdout_failed
+from sim.cli_read import report, show
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
-from sim.mc.outputs import name_problem, results_dirs
-from sim.mc.paths import link_problem
+from sim.mc.outputs import name_problem
 from sim.mc.runner import MIN_CHUNKS
-from sim.mc.storage import code_hash, read_record, umask_problem
+from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import read_sweep
 from sim.mc.toml_text import toml_value
-from sim.report.markdown import write_report
-from sim.report.read import check_claims_table
-from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
+from sim.report.run_summary import terminal_summary, write_run_readme
 from sim.stops import check_interrupt, keep_lost_interrupts
-from sim.studies import design_config, get_study, load_study, unread_keys
+from sim.studies import get_study, load_study, unread_keys
 from sim.threads import interrupted, memory_words, shadowed, short_of_memory
 
 __all__ = ["main", "check_run_args"]
@@ -238,36 +235,6 @@ def _run(args) -> int:
     return 0
 
 
-def _show(args) -> int:
-    if name_problem(args.dir):
-        raise ConfigError(
-            "DIR", f"not a directory name: {name_problem(args.dir)} (got {args.dir!r})"
-        )
-    d = Path(args.dir)
-    if not d.exists() and (Path("results") / args.dir).is_dir():
-        d = Path("results") / args.dir
-    if not d.is_dir():  # the name of a study's results is read under ./results too: say so
-        also = "" if d.is_absolute() or d.exists() else f" (nor is results/{args.dir})"
-        why = link_problem(d) or f"is not a directory{also}"
-        raise ConfigError("DIR", f"{args.dir} {why}")
-    check_claims_table(d / "claims.parquet", "DIR")
-    try:
-        text = run_markdown(d, get_study) if args.markdown else terminal_table(d)
-    except ConfigError:
-        raise
-    except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
-        raise ConfigError("DIR", not_as_written(d, e)) from None
-    print(text, end="")
-    print("" if args.markdown else "\n", end="")
-    if older := other_code(d):  # verdicts of code since changed: read as current otherwise
-        print(
-            f"sim: note: {older} was made by another version of the suite's code (its study's "
-            "code changed since): make reproduce re-runs what is stale",
-            file=sys.stderr,
-        )
-    return 0
-
-
 def _n(x: float) -> str:
     return f"{int(x):_}" if float(x).is_integer() and abs(x) < 1e16 else f"{x:g}"
 
@@ -315,30 +282,6 @@ def _check(args) -> int:
     if sweep:
         print(f"# [sweep] {', '.join(sweep)}")
     print(f"# work: {est.describe()}")
-    return 0
-
-
-def _report(results: Path) -> int:
-    """``sim report``: only over a directory that holds study results (a directory of the
-    user's with none gets no REPORT.md written into it)."""
-    if results.is_dir() and not any(
-        (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
-        for d in results_dirs(results)
-    ):
-        raise ConfigError(
-            "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
-        )
-    if (why := umask_problem()) is not None:
-        raise ConfigError(None, why)
-    try:
-        text = write_report(results, get_study, design_config)
-    except ConfigError:
-        raise
-    except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
-        # report reads the Parquet tables only: one that fails here was not written as it is
-        # by sim (a table replaced or edited by hand)
-        raise ConfigError("--results", not_as_written(results, e)) from None
-    print(text)
     return 0
 
 
@@ -460,12 +403,12 @@ def _command(args) -> int:
     if args.cmd == "check":
         return _check(args)
     if args.cmd == "show":
-        return _show(args)
+        return show(args)
     if args.cmd == "report":
         if name_problem(args.results):
             why = name_problem(args.results)
             raise ConfigError("--results", f"not a directory name: {why} (got {args.results!r})")
-        return _report(Path(args.results))
+        return report(Path(args.results))
     return 1
 
 

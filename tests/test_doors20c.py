@@ -196,7 +196,7 @@ def test_a_table_too_large_for_memory_is_not_blamed_on_loading_the_libraries(
     def huge(*a, **k):
         raise MemoryError()
 
-    monkeypatch.setattr("sim.cli.terminal_table", huge)
+    monkeypatch.setattr("sim.cli_read.terminal_table", huge)
     err = one_line(capsys, main(["show", str(d)]), "not enough memory for this command")
     assert "load the suite" not in err
 

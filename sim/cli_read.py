@@ -1,0 +1,78 @@
+"""The commands of ``sim`` that read finished results: ``sim show DIR`` (one results
+directory as a table, or its README.md) and ``sim report`` (REPORT.md and every study's
+README.md). They read the Parquet tables only; a table that does not read as its study wrote
+it is one line naming it (:func:`sim.cli_errors.not_as_written`)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pyarrow as pa
+
+from sim.cli_errors import not_as_written, other_code
+from sim.mc.config import ConfigError
+from sim.mc.outputs import name_problem, results_dirs
+from sim.mc.paths import link_problem
+from sim.mc.storage import umask_problem
+from sim.report.markdown import write_report
+from sim.report.read import check_claims_table
+from sim.report.run_summary import run_markdown, terminal_table
+from sim.studies import design_config, get_study
+
+__all__ = ["show", "report"]
+
+
+def show(args) -> int:
+    """``sim show DIR``: the results directory's claims (``--markdown``: its README.md)."""
+    if name_problem(args.dir):
+        raise ConfigError(
+            "DIR", f"not a directory name: {name_problem(args.dir)} (got {args.dir!r})"
+        )
+    d = Path(args.dir)
+    if not d.exists() and (Path("results") / args.dir).is_dir():
+        d = Path("results") / args.dir
+    if not d.is_dir():  # the name of a study's results is read under ./results too: say so
+        also = "" if d.is_absolute() or d.exists() else f" (nor is results/{args.dir})"
+        why = link_problem(d) or f"is not a directory{also}"
+        raise ConfigError("DIR", f"{args.dir} {why}")
+    check_claims_table(d / "claims.parquet", "DIR")
+    try:
+        text = run_markdown(d, get_study) if args.markdown else terminal_table(d)
+    except ConfigError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
+        raise ConfigError("DIR", not_as_written(d, e)) from None
+    print(text, end="")
+    print("" if args.markdown else "\n", end="")
+    if older := other_code(d):  # verdicts of code since changed: read as current otherwise
+        print(
+            f"sim: note: {older} was made by another version of the suite's code (its study's "
+            "code changed since): make reproduce re-runs what is stale",
+            file=sys.stderr,
+        )
+    return 0
+
+
+def report(results: Path) -> int:
+    """``sim report``: only over a directory that holds study results (a directory of the
+    user's with none gets no REPORT.md written into it)."""
+    if results.is_dir() and not any(
+        (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
+        for d in results_dirs(results)
+    ):
+        raise ConfigError(
+            "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
+        )
+    if (why := umask_problem()) is not None:
+        raise ConfigError(None, why)
+    try:
+        text = write_report(results, get_study, design_config)
+    except ConfigError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
+        # report reads the Parquet tables only: one that fails here was not written as it is
+        # by sim (a table replaced or edited by hand)
+        raise ConfigError("--results", not_as_written(results, e)) from None
+    print(text)
+    return 0
