@@ -38,10 +38,11 @@ from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
+from sim.mc.read_when import read_in_a_cell
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_record, umask_problem
-from sim.mc.sweep import read_sweep
-from sim.mc.toml_text import toml_value
+from sim.mc.sweep import expand, read_sweep
+from sim.mc.toml_text import toml_key, toml_value
 from sim.report.markdown import write_report
 from sim.report.read import check_claims_table
 from sim.report.run_summary import run_markdown, terminal_summary, terminal_table, write_run_readme
@@ -293,7 +294,12 @@ def _check(args) -> int:
     check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
     # listed commented out (set, they would be refused); one a sweep's cells read is kept
-    skip = {k: w for k, w in unread_keys(study, cfg).items() if cfg[k] == study.schema[k].default}
+    cells = expand(sweep)[1] if sweep else []
+    skip = {
+        k: w
+        for k, w in unread_keys(study, cfg).items()
+        if not read_in_a_cell(study.schema[k], cfg, cells)
+    }
     for k, v in cfg.items():
         f = study.schema.get(k)
         if f is None:
@@ -312,8 +318,10 @@ def _check(args) -> int:
         )
         line = f"{k} = {toml_value(v)}  # {f.doc}" + (f" ({notes})" if notes else "")
         print(f"# {line}" if k in skip else line)
-    if sweep:
-        print(f"# [sweep] {', '.join(sweep)}")
+    if sweep:  # as the file gives it: the listing saved is the same study, sweep and all
+        print("[sweep]")
+        for k, v in sweep.items():
+            print(f"{toml_key(k)} = {toml_value(v)}")
     print(f"# work: {est.describe()}")
     return 0
 
