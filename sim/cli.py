@@ -37,10 +37,11 @@ from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem
+from sim.mc.read_when import read_in_a_cell
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_record
-from sim.mc.sweep import read_sweep
-from sim.mc.toml_text import toml_value
+from sim.mc.sweep import expand, read_sweep
+from sim.mc.toml_text import toml_key, toml_value
 from sim.report.run_summary import terminal_summary, write_run_readme
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.studies import get_study, load_study, unread_keys
@@ -260,7 +261,12 @@ def _check(args) -> int:
     check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
     # listed commented out (set, they would be refused); one a sweep's cells read is kept
-    skip = {k: w for k, w in unread_keys(study, cfg).items() if cfg[k] == study.schema[k].default}
+    cells = expand(sweep)[1] if sweep else []
+    skip = {
+        k: w
+        for k, w in unread_keys(study, cfg).items()
+        if not read_in_a_cell(study.schema[k], cfg, cells)
+    }
     for k, v in cfg.items():
         f = study.schema.get(k)
         if f is None:
@@ -279,8 +285,10 @@ def _check(args) -> int:
         )
         line = f"{k} = {toml_value(v)}  # {f.doc}" + (f" ({notes})" if notes else "")
         print(f"# {line}" if k in skip else line)
-    if sweep:
-        print(f"# [sweep] {', '.join(sweep)}")
+    if sweep:  # as the file gives it: the listing saved is the same study, sweep and all
+        print("[sweep]")
+        for k, v in sweep.items():
+            print(f"{toml_key(k)} = {toml_value(v)}")
     print(f"# work: {est.describe()}")
     return 0
 

@@ -22,7 +22,7 @@ from typing import Any, Iterable, Mapping
 
 from sim.mc.config import ConfigError, Field
 
-__all__ = ["When", "when", "unless", "unread", "refuse_unread"]
+__all__ = ["When", "when", "unless", "unread", "read_in_a_cell", "refuse_unread"]
 
 
 @dataclass(frozen=True)
@@ -80,6 +80,13 @@ def unread(schema: Mapping[str, Field], cfg: Mapping[str, Any]) -> dict[str, str
         if w is not None and not w.reads(cfg.get(w.switch)):
             out[key] = f"{w.switch} = {_shown(cfg.get(w.switch))}"
     return out
+
+
+def read_in_a_cell(field: Field, cfg: Mapping[str, Any], cells: list[Mapping[str, Any]]) -> bool:
+    """Whether some cell of a sweep over ``cfg`` (``cells``: each cell's ``{key: value}``)
+    reads the key of ``field``, which ``cfg`` does not read: ``sim check`` lists it as set."""
+    w = getattr(field, "read_when", None)
+    return w is not None and any(w.reads(c.get(w.switch, cfg.get(w.switch))) for c in cells)
 
 
 def refuse_unread(

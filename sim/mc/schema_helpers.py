@@ -24,7 +24,7 @@ from typing import Any
 
 from sim.mc.config import ConfigError, Field
 
-__all__ = ["count", "real", "positive", "level", "reals", "counts", "require"]
+__all__ = ["count", "real", "positive", "level", "reals", "counts", "require", "recorded_sha256"]
 
 
 def count(default: int, doc: str, lo: int, hi: int | None = None, *, input: bool = False) -> Field:
@@ -94,3 +94,22 @@ def require(ok: Any, key: str, message: str) -> None:
     """A cross-key rule: :class:`ConfigError` ``"<key>: <message>"`` unless ``ok``."""
     if not ok:
         raise ConfigError(key, message)
+
+
+def recorded_sha256(key: str, have: Any) -> str:
+    """The sha256 a study file records for a file it reads (``key``: ``table1.sha256``,
+    ``network.gama_sha256``), lower-cased (``sha256sum`` prints lower case; an upper-case copy
+    of the same digest was refused as "the file has changed"), ``""`` when not given; a value
+    that is no sha256 at all is refused saying so (it was "has changed since the study was
+    loaded (recorded abc...)")."""
+    if not have:
+        return ""
+    if (
+        not isinstance(have, str)
+        or len(have) != 64
+        or any(c not in "0123456789abcdef" for c in have.lower())
+    ):
+        raise ConfigError(
+            key, "is not a sha256 (64 hexadecimal digits): leave it out, it is filled in on load"
+        )
+    return have.lower()

@@ -192,10 +192,33 @@ def load_study(
         field = study.schema.get(e.key) if isinstance(e.key, str) else None
         cwd = field is not None and "repository root" not in field.doc
         raise _unswept(_beside_the_study(e, Path(path), flat) if cwd else e, swept, flat) from None
-    refuse_unread(study.schema, cfg, flat, _cells(table, study.schema))
+    refuse_unread(
+        study.schema,
+        cfg,
+        _asked(study.schema, flat, overrides, values),
+        _cells(table, study.schema),
+    )
     if study.data is not None:
         study.data(cfg, study.schema)
     return study, {"study": name, **cfg}
+
+
+def _asked(
+    schema: Mapping[str, Field], flat: Mapping[str, Any], overrides: Any, values: Any
+) -> set[str]:
+    """The keys of ``flat`` whose being unread is refused: every key an override (``--set``,
+    the Python API) sets, and every key of the file but those whose switch an override sets.
+    Switching the file's pattern (``--set plate.pattern=random`` on a file with ``grid = 5``)
+    leaves the file's keys of the other pattern unread by the user's choice: refusing them
+    ("leave it out") asked for an edit of the file no option can make."""
+    over = {parse_override(t)[0] for t in overrides} | set(values or {})
+    return {
+        k
+        for k in flat
+        if k in over
+        or (w := getattr(schema.get(k), "read_when", None)) is None
+        or w.switch not in over
+    }
 
 
 def _unswept(e: ConfigError, swept: set[str], flat: Mapping[str, Any]) -> ConfigError:

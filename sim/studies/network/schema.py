@@ -16,6 +16,7 @@ import numpy as np
 
 from sim.mc.config import ConfigError, given
 from sim.mc.runner import require_chunks
+from sim.mc.schema_helpers import recorded_sha256
 from sim.studies.network.analysis import (
     check_inner,
     estimated_points,
@@ -90,8 +91,6 @@ def check(cfg: dict) -> None:
         )
     if not np.any(net.role != 1):
         raise ConfigError("network.points", "every point is fixed: nothing to estimate")
-    if cfg["datum.points"] and cfg["datum.kind"] != "inner":
-        raise ConfigError("datum.points", "only with datum.kind = inner (it has no effect here)")
     _no_effect(net, full, cfg)
     lone = _unreached_free(net, full)
     dt = datum(net, full)
@@ -183,15 +182,11 @@ DISTANCE_KEYS = (
 
 
 def _no_effect(net, cfg: dict, asked: dict) -> None:
-    """Keys that would do nothing, or be blamed on the datum: constraints without
-    ``datum.kind = constraints``, an additive constant or scale to estimate without a distance,
+    """Keys that would do nothing, or be blamed on the datum: an additive constant or scale to
+    estimate without a distance,
     and any key of the distances that ``asked`` (the configuration as the user set it:
     :func:`sim.mc.config.given`) sets in a network without one (the network's condition of
     :mod:`sim.mc.read_when`: it depends on the observations, not on a switch)."""
-    if cfg["datum.constraints"] and cfg["datum.kind"] != "constraints":
-        raise ConfigError(
-            "datum.constraints", "only with datum.kind = constraints (it has no effect here)"
-        )
     if np.any(net.kind == 0):
         return
     for what, key in (("constant", "estimate_constant"), ("scale error", "estimate_scale")):
@@ -240,7 +235,8 @@ def _minimal(net, dt, full: dict) -> None:
 
 
 def _digest(cfg: dict) -> None:
-    path, have = cfg["network.gama_xml"], cfg["network.gama_sha256"]
+    path = cfg["network.gama_xml"]
+    have = recorded_sha256("network.gama_sha256", cfg["network.gama_sha256"])
     if not path:
         if have:
             raise ConfigError("network.gama_sha256", "only with network.gama_xml")

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.mc.config import ConfigError
-from sim.mc.schema_helpers import require
+from sim.mc.schema_helpers import recorded_sha256, require
 from sim.studies.wolf import tables
 from sim.studies.wolf.grid import grid_nodes, mid_cells, node_index
 
@@ -168,7 +168,7 @@ def table_digest(cfg: dict, t: str) -> str:
         sha = hashlib.sha256(path.read_bytes()).hexdigest()
     except OSError as e:
         raise ConfigError(f"{t}.file", f"{path}: {e.strerror or e}") from None
-    have = cfg.get(key)
+    have = recorded_sha256(key, cfg.get(key))
     require(
         not have or have == sha,
         key,
