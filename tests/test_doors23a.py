@@ -131,3 +131,27 @@ def test_a_recorded_sha256_in_upper_case_is_the_same_digest(capsys):
     other = ("0" if sha[0] != "0" else "1") + sha[1:]
     with pytest.raises(ConfigError, match="has changed since the study was loaded"):
         load_study(WOLF, [f'table1.sha256="{other}"'])
+
+
+def test_a_key_the_files_own_values_do_not_read_says_they_are_checked_first(tmp_path, capsys):
+    """doors23a left it: ``network.constant_mm`` with ``network.generate`` swept between
+    directions alone (the file's own value) and distances read "is not read: the network has
+    none", of a network that one cell has: the line now says the values outside [sweep] are
+    checked first, as a study of their own, and what to give there."""
+    dirs = '[ { kind = "direction", from = ["A", "B", "C"], to = "*", sigma_arcsec = 2.0 } ]'
+    dist = '[ { kind = "distance", from = ["A", "B", "C"], to = "*", sigma_mm = 0.002 } ]'
+    text = NETWORK.replace("KIND", 'kind = "fixed"').replace('points = ["A", "B", "C"]\n', "")
+    head, rest = text.split("generate = ", 1)
+    rest = rest.split("\n[datum]", 1)[1]
+    f = tmp_path / "net.toml"
+    f.write_text(
+        f"{head}constant_mm = 0.5\ngenerate = {dirs}\n[datum]{rest}"
+        f'[sweep]\n"network.generate" = [{dirs}, {dist}]\n'
+    )
+    one_line(
+        capsys,
+        main(["check", str(f)]),
+        "network.constant_mm",
+        "checked first, as a study of their own, with network.generate as given there",
+        prefix=SIM_ERROR,
+    )

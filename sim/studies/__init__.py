@@ -224,10 +224,19 @@ def _asked(
 def _unswept(e: ConfigError, swept: set[str], flat: Mapping[str, Any]) -> ConfigError:
     """``e``, saying so when a swept key is not given outside ``[sweep]``: the file's own
     values are validated first, as a study of their own, so a network whose points are given
-    only as the sweep's layouts was refused "a network needs at least two points"."""
+    only as the sweep's layouts was refused "a network needs at least two points"; a key
+    refused by those values alone, that a cell would read (``network.constant_mm`` where the
+    file's own observations have no distance), says so too."""
     missing = sorted(k for k in swept if k not in flat)
     if not missing:
-        return e
+        if not swept or e.key in swept:
+            return e
+        return ConfigError(  # a key that one cell reads, refused by the file's own values
+            e.key,
+            f"{str(e).removeprefix(f'{e.key}: ')} (the values outside [sweep] are checked "
+            f"first, as a study of their own, with {', '.join(sorted(swept))} as given there: "
+            "give there values under which it holds)",
+        )
     return ConfigError(
         e.key,
         f"{str(e).removeprefix(f'{e.key}: ')} (the values outside [sweep] are checked first, "
