@@ -155,3 +155,16 @@ def test_a_key_the_files_own_values_do_not_read_says_they_are_checked_first(tmp_
         "checked first, as a study of their own, with network.generate as given there",
         prefix=SIM_ERROR,
     )
+
+
+@pytest.mark.parametrize("what", ["directory", "fifo", "device"])
+def test_a_table_path_that_is_no_regular_file_is_named_so(tmp_path, capsys, what):
+    """doors23a left it: ``table1.file`` naming a directory, a FIFO or ``/dev/zero`` read "no
+    such file" of a path that exists."""
+    import os
+
+    p = {"directory": tmp_path, "device": Path("/dev/zero"), "fifo": tmp_path / "t.csv"}[what]
+    if what == "fifo":
+        os.mkfifo(p)
+    rc = main(["check", str(WOLF), "--set", f"table1.file={str(p)!r}"])
+    one_line(capsys, rc, "table1.file", "is not a regular file", prefix=SIM_ERROR)

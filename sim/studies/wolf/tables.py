@@ -33,7 +33,11 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
     except OSError as e:  # a name too long: pathlib raises what it does not take for "absent"
         raise ConfigError(key, f"cannot read {str(p)[:80]}...: {e.strerror}") from None
     if not is_file:
-        raise ConfigError(key, f"{p} {why}" if (why := link_problem(p)) else f"no such file: {p}")
+        if why := link_problem(p):
+            raise ConfigError(key, f"{p} {why}")
+        if p.exists():  # a directory, a FIFO, a device: never opened (a FIFO would block)
+            raise ConfigError(key, f"{p} is not a regular file: expected the CSV transcription")
+        raise ConfigError(key, f"no such file: {p}")
     try:
         with open(p, newline="", encoding="utf-8") as fh:
             text = fh.read(2_000_000)
