@@ -65,12 +65,22 @@ def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
     if not isinstance(want, dict):
         return None
     for f, h in sorted(want.items()):
+        # a name the run could not have written (absolute, "..", not a PNG): the record was
+        # edited, and its path would read a file outside the results (/proc/self/mem)
+        if f.startswith("/") or ".." in f.split("/") or not f.endswith(".png") or "\0" in f:
+            return (
+                f"{out / 'run.json'} names a figure outside its directory: {f!r} (edited by hand?)"
+            )
         p = out / f
         if not p.is_file():
             if missing_ok:
                 continue
             return f"{p} is missing (the run drew it)"
-        if not isinstance(h, str) or _sha256(p) != h:
+        try:
+            same = isinstance(h, str) and _sha256(p) == h
+        except OSError as e:  # a read that fails (EIO) has no file name of its own to say
+            return f"{p} cannot be read ({e.strerror or type(e).__name__})"
+        if not same:
             return f"{p} is not the figure its run drew (its sha256 differs: replaced by hand?)"
     return None
 
