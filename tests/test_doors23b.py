@@ -62,3 +62,47 @@ def test_a_figure_that_cannot_be_read_is_named(run_dir, capsys):
     one_line(
         capsys, main(["show", str(run_dir)]), "network.png", "cannot be read", prefix=SIM_ERROR
     )
+
+
+# A report embeds a figure only when it is the one the run drew (``sim.mc.publish.drawn``): a
+# PNG put by hand beside the tables of a ``--no-figures`` run, or in place of a sweep's
+# ``sweep.png`` (whose directory sim show checks nothing of), was shown as the run's figure.
+
+
+def test_a_png_put_beside_a_no_figures_run_is_not_shown_as_the_run_s(run_dir):
+    from sim.report.section import figure
+
+    rec = json.loads((run_dir / "run.json").read_text())
+    (run_dir / "run.json").write_text(json.dumps({**rec, "figures": False, "figure_sha256": {}}))
+    assert (run_dir / "network.png").is_file()  # the user's picture, of that name
+    assert "not drawn by this run" in figure(run_dir, "network.png", "network")
+    _figures(run_dir, rec["figure_sha256"])  # the run's own: shown
+    assert figure(run_dir, "network.png", "network").startswith("![network]")
+
+
+SWEEP = """study = "network"
+trials = 40
+chunk = 2
+seed = 1
+[network]
+grids = [ { prefix = "G", nx = 3, ny = 3, spacing_mm = 40.0, role = "observed", sigma_mm = 0.0012 } ]
+generate = [ { kind = "dx", from = "G5", to = "G*", sigma_mm = 0.002 },
+             { kind = "dy", from = "G5", to = "G*", sigma_mm = 0.002 } ]
+[datum]
+kind = "fixed"
+[sweep]
+"network.grids" = [
+  [{ prefix = "G", nx = 3, ny = 3, spacing_mm = 40.0, role = "observed", sigma_mm = 0.0012 }],
+  [{ prefix = "G", nx = 3, ny = 3, spacing_mm = 60.0, role = "observed", sigma_mm = 0.0012 }] ]
+"""
+
+
+def test_a_sweep_png_replaced_by_hand_is_not_shown_as_the_run_s(tmp_path, run_dir, capsys):
+    from sim.report.sweep import sweep_markdown
+
+    (tmp_path / "sw.toml").write_text(SWEEP)
+    out = tmp_path / "sw"
+    assert main(["run", str(tmp_path / "sw.toml"), "--out", str(out), "--quiet"]) == 0
+    assert "sweep.png" in sweep_markdown(out, "sw")
+    shutil.copyfile(run_dir / "network.png", out / "sweep.png")  # another picture
+    assert "sweep.png" not in sweep_markdown(out, "sw")
