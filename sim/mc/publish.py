@@ -24,7 +24,7 @@ from sim.mc.outputs import swap_dir
 from sim.mc.runner import ChunkStore
 from sim.mc.storage import LOCK, pid_alive, read_record, write_record
 
-__all__ = ["seal", "publish", "damaged_chunks", "changed_figure"]
+__all__ = ["seal", "publish", "damaged_chunks", "changed_figure", "drawn"]
 
 
 def _files(d: Path) -> list[str]:
@@ -65,14 +65,42 @@ def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
     if not isinstance(want, dict):
         return None
     for f, h in sorted(want.items()):
+        # a name the run could not have written (absolute, "..", not a PNG): the record was
+        # edited, and its path would read a file outside the results (/proc/self/mem)
+        if f.startswith("/") or ".." in f.split("/") or not f.endswith(".png") or "\0" in f:
+            return (
+                f"{out / 'run.json'} names a figure outside its directory: {f!r} (edited by hand?)"
+            )
         p = out / f
         if not p.is_file():
             if missing_ok:
                 continue
             return f"{p} is missing (the run drew it)"
-        if not isinstance(h, str) or _sha256(p) != h:
+        try:
+            same = isinstance(h, str) and _sha256(p) == h
+        except OSError as e:  # a read that fails (EIO) has no file name of its own to say
+            return f"{p} cannot be read ({e.strerror or type(e).__name__})"
+        if not same:
             return f"{p} is not the figure its run drew (its sha256 differs: replaced by hand?)"
     return None
+
+
+def drawn(out: Path, name: str) -> bool:
+    """Whether ``out/name`` is a figure the run of ``out`` drew, for a report to embed: a file
+    there, and one its run record lists in ``figure_sha256`` (a PNG put beside the tables of
+    a ``--no-figures`` run was embedded as the run's), with the sha256 recorded there (a
+    sweep's ``sweep.png`` replaced by hand was embedded too). Results of runs that recorded no figure hashes (older
+    versions, or a run still being written) embed what is there."""
+    rec = read_record(out)
+    want = rec.get("figure_sha256") if rec else None
+    if not (out / name).is_file():
+        return False
+    if not isinstance(want, dict):
+        return True
+    try:  # and of the run's bytes: a sweep's directory is checked by nothing else
+        return isinstance(want.get(name), str) and _sha256(out / name) == want[name]
+    except OSError:
+        return False
 
 
 def damaged_chunks(out: Path) -> str | None:

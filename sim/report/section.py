@@ -34,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from sim.claims.region import REGION_MIN_POINTS
+from sim.mc.publish import drawn
 from sim.mc.storage import read_provenance
 from sim.report.markdown import claims_markdown, inputs_markdown
 from sim.report.read import columns, records
@@ -76,6 +77,8 @@ def figure(out: Path, file: str, alt: str) -> str:
     so when the run drew no figures (``sim run --no-figures``)."""
     if not (Path(out) / file).is_file():
         return f"*{alt}: not drawn (`{file}` is missing: a run with `--no-figures`?)*"
+    if not drawn(Path(out), file):  # put there by hand: not the run's figure
+        return f"*{alt}: not drawn by this run (`{file}` is not the figure its run.json records)*"
     return f"![{alt}]({Path(out).name}/{file})"
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sim.mc.publish import drawn
 from sim.mc.storage import read_provenance
 from sim.report.plotting import figures_off, place_legends, plt, readable_limits, save
 from sim.report.read import columns
@@ -189,6 +190,6 @@ def sweep_markdown(out: Path, name: str | None = None) -> str:
         for i in range(len(t["cell"]))
     ]
     txt = md_table(["cell", *keys, "seed", "feasible", *[f"`{c}`" for c in claims]], rows)
-    if (Path(out) / "sweep.png").is_file():
+    if drawn(Path(out), "sweep.png"):
         txt += f"\n\n![sweep]({name or Path(out).name}/sweep.png)"
     return txt
