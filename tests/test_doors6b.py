@@ -48,7 +48,7 @@ import pytest
 from oneline import one_line
 
 import sim.__main__  # noqa: F401 - the sim command's set-up (its log filter)
-from sim import batch, cli, execute
+from sim import batch, cli_read, execute
 from sim.cli import main
 from sim.mc.storage import write_table
 from sim.report.verify import main as verify_main
@@ -229,7 +229,7 @@ def test_a_signal_to_report_cleans_up_with_one_line(tmp_path, capsys, monkeypatc
         finally:
             tmp.unlink()
 
-    monkeypatch.setattr(cli, "write_report", write_report)
+    monkeypatch.setattr(cli_read, "write_report", write_report)
     t = time.monotonic()
     code = main(["report", "--results", str(d.parent)])
     err = capsys.readouterr().err
