@@ -31,8 +31,9 @@ from pathlib import Path
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
 from sim.cli_args import module_doc, parser
-from sim.cli_errors import cwd_exists, os_reason, stdout_failed
+from sim.cli_errors import cwd_exists, from_stdout, os_reason
 from sim.cli_read import report, show
+from sim.ends import stdout_failed
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
@@ -319,13 +320,8 @@ def main(argv: list[str] | None = None) -> int:
             return 2
         with keep_lost_interrupts():  # Ctrl-C that Python drops in a C callback: kept
             return _main(argv)
-    except BrokenPipeError:  # sim check ... | head: the reader left, nothing to say
-        try:
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, sys.stdout.fileno())
-        except (OSError, ValueError):
-            pass
-        return 141
+    except BrokenPipeError as e:  # sim check ... | head: the reader left, nothing to say
+        return stdout_failed("sim", e, 0)
     finally:  # in-process callers (the tests, the API) get their handlers back
         for s, h in old.items():
             if h is not None:
@@ -369,7 +365,7 @@ def _main(argv: list[str]) -> int:
             name = e.args[0]  # pyarrow's FileNotFoundError(path)
         if not name and not cwd_exists():
             name = "the working directory (it was deleted)"
-        if not name and stdout_failed(e):
+        if not name and from_stdout(e):
             name = "standard output"
         print(f"sim: error: {os_reason(e)}: {name}".rstrip(": "), file=sys.stderr)
         return 2

@@ -13,7 +13,7 @@ from sim.mc.outputs import results_dirs
 from sim.mc.storage import read_record
 from sim.report.read import damaged_message
 
-__all__ = ["cwd_exists", "stdout_failed", "os_reason", "not_as_written", "other_code"]
+__all__ = ["cwd_exists", "from_stdout", "os_reason", "not_as_written", "other_code"]
 
 
 def cwd_exists() -> bool:
@@ -24,7 +24,7 @@ def cwd_exists() -> bool:
     return True
 
 
-def stdout_failed(e: OSError) -> bool:
+def from_stdout(e: OSError) -> bool:
     """Whether ``e`` came from printing to standard output (``sim check > /dev/full``): such
     a write fails without a file name, and the line said only "No space left on device"
     (after a run's results had been written). Judged by the innermost line it was raised

@@ -12,7 +12,7 @@ a new user's first hour), one case each; each failed on the code before its fix.
   file says it is not UTF-8 (:func:`sim.mc.config.read_toml`);
 * standard output that cannot be written (``> /dev/full``): ``sim`` said only "No space
   left on device", and ``python -m sim.batch`` ended in a traceback from a run's thread; now
-  one line naming standard output, exit 2 (:func:`sim.cli_errors.stdout_failed`,
+  one line naming standard output, exit 2 (:func:`sim.cli_errors.from_stdout`,
   :class:`sim.batch._Stdout`);
 * a results directory copied into another study's results (a user's copy): re-running
   that study kept the copy but dropped its ``run.json``, so the copy was no longer results

@@ -53,6 +53,20 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
     write_record(stage, {**rec, "files": files, "chunk_sha256": chunks, "figure_sha256": figures})
 
 
+def _recorded_figures(out: Path) -> dict | None:
+    """The run record's ``figure_sha256`` of ``out``, or None (no record, or one of a version
+    that recorded no figure hashes: its figures are not checked)."""
+    rec = read_record(out)
+    want = rec.get("figure_sha256") if rec else None
+    return want if isinstance(want, dict) else None
+
+
+def _run_drew(p: Path, sha256) -> bool:
+    """Whether the file ``p`` (read through a link) has the recorded ``sha256``; OSError
+    where it cannot be read."""
+    return isinstance(sha256, str) and _sha256(p) == sha256
+
+
 def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
     """Which figure of a finished results directory is not the one its run drew (its sha256,
     read through a symbolic link, differs from the run record's ``figure_sha256``: replaced
@@ -60,11 +74,7 @@ def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
     embeds the figures as they are: a hand-made picture beside the run's tables was read as
     the run's, where a missing one is seen missing. Results of runs that recorded no figure
     hashes (older versions) are not checked."""
-    rec = read_record(out)
-    want = rec.get("figure_sha256") if rec else None
-    if not isinstance(want, dict):
-        return None
-    for f, h in sorted(want.items()):
+    for f, h in sorted((_recorded_figures(out) or {}).items()):
         # a name the run could not have written (absolute, "..", not a PNG): the record was
         # edited, and its path would read a file outside the results (/proc/self/mem)
         if f.startswith("/") or ".." in f.split("/") or not f.endswith(".png") or "\0" in f:
@@ -77,7 +87,7 @@ def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
                 continue
             return f"{p} is missing (the run drew it)"
         try:
-            same = isinstance(h, str) and _sha256(p) == h
+            same = _run_drew(p, h)
         except OSError as e:  # a read that fails (EIO) has no file name of its own to say
             return f"{p} cannot be read ({e.strerror or type(e).__name__})"
         if not same:
@@ -87,18 +97,17 @@ def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
 
 def drawn(out: Path, name: str) -> bool:
     """Whether ``out/name`` is a figure the run of ``out`` drew, for a report to embed: a file
-    there, and one its run record lists in ``figure_sha256`` (a PNG put beside the tables of
-    a ``--no-figures`` run was embedded as the run's), with the sha256 recorded there (a
-    sweep's ``sweep.png`` replaced by hand was embedded too). Results of runs that recorded no figure hashes (older
-    versions, or a run still being written) embed what is there."""
-    rec = read_record(out)
-    want = rec.get("figure_sha256") if rec else None
+    there that its run record lists in ``figure_sha256`` with the sha256 recorded there (a PNG
+    put beside the tables of a ``--no-figures`` run, or a sweep's ``sweep.png`` replaced by
+    hand, was embedded as the run's). Results of runs that recorded no figure hashes (older
+    versions) embed what is there."""
     if not (out / name).is_file():
         return False
-    if not isinstance(want, dict):
+    want = _recorded_figures(out)
+    if want is None:
         return True
-    try:  # and of the run's bytes: a sweep's directory is checked by nothing else
-        return isinstance(want.get(name), str) and _sha256(out / name) == want[name]
+    try:
+        return _run_drew(out / name, want.get(name))
     except OSError:
         return False
 

@@ -64,11 +64,11 @@ def check_literal_ids(
     scores: Callable[[str], bool] | None = None,
 ) -> None:
     """Refuse ``book`` (a :class:`sim.claims.book.ClaimBook`) when the code of the study
-    ``package`` (its directory) names a claim id the book does not declare (in a group of the book's ids; not
-    one of the study's config ``keys``, ``bayes.chains``, nor a file name, ``bayes.parquet``,
-    nor the start of a declared id,
-    ``"agnard.table1.ratio_" + ...``). ``scores``: which of the
-    package's ids this study scores (two studies sharing a package and a book split it)."""
+    ``package`` (its directory) names a claim id the book does not declare: a literal in a
+    group of the book's ids that is not one of the study's config ``keys`` (``bayes.chains``),
+    a file name (``bayes.parquet``) or the start of a declared id (``"agnard.table1.ratio_" +
+    ...``). ``scores``: which of the package's ids this study scores (two studies sharing a
+    package and a book split it)."""
     declared = set(book.specs)
     groups = {c.rsplit(".", 1)[0] for c in declared}
     keys = set(keys)
