@@ -328,6 +328,18 @@ def main(argv: list[str] | None = None) -> int:
                 signal.signal(s, h)
 
 
+def _interrupted_line(args) -> str:
+    """The one line of an interrupted command: a run says how to finish it (its finished
+    chunks are kept), or where its results are when they were written before the interrupt."""
+    why = " by the CPU time limit (ulimit -t)" if _cpu_limit else ""
+    again = ""
+    if args is not None and getattr(args, "cmd", None) == "run":
+        again = "; run the same command again to finish the missing chunks"
+    if getattr(args, "published", None):  # nothing is missing: say where the results are
+        again = f" after the results were written to {args.published}/"
+    return f"sim: interrupted{why}{again}"
+
+
 def _main(argv: list[str]) -> int:
     args = None
     try:
@@ -347,12 +359,7 @@ def _main(argv: list[str]) -> int:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)
         return INTERNAL if getattr(e, "internal", False) else 2
     except KeyboardInterrupt:
-        again = "; run the same command again to finish the missing chunks"
-        why = " by the CPU time limit (ulimit -t)" if _cpu_limit else ""
-        again = again if args and args.cmd == "run" else ""
-        if getattr(args, "published", None):  # nothing is missing: say where the results are
-            again = f" after the results were written to {args.published}/"
-        print(f"sim: interrupted{why}{again}", file=sys.stderr)
+        print(_interrupted_line(args), file=sys.stderr)
         return 130
     except BrokenPipeError:
         raise
@@ -385,8 +392,8 @@ def _main(argv: list[str]) -> int:
         print(f"sim: error: {type(e).__name__}: {e}".splitlines()[0], file=sys.stderr)
         return 2
     except Exception as e:  # noqa: BLE001 - a bug outside a run (check, show, report, loading):
-        if interrupted(e):  # Ctrl-C inside an import: ImportError from the KeyboardInterrupt
-            print("sim: interrupted", file=sys.stderr)
+        if interrupted(e):  # Ctrl-C inside an import: ImportError from the KeyboardInterrupt;
+            print(_interrupted_line(args), file=sys.stderr)  # a second one in a run's clean-up
             return 130
         if short_of_memory(e):  # an ImportError: a library that could not be mapped
             print(f"sim: error: {memory_words(e)}", file=sys.stderr)

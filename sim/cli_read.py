@@ -16,7 +16,7 @@ from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.storage import umask_problem
 from sim.report.markdown import write_report
-from sim.report.read import check_claims_table
+from sim.report.read import check_claims_table, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
 from sim.studies import design_config, get_study
 
@@ -37,6 +37,8 @@ def show(args) -> int:
         why = link_problem(d) or f"is not a directory{also}"
         raise ConfigError("DIR", f"{args.dir} {why}")
     check_claims_table(d / "claims.parquet", "DIR")
+    if (sweep := _sweep_of(d)) is not None and (mixed := mixed_run(sweep)) is not None:
+        raise ConfigError("DIR", mixed)  # a cell's figure replaced by hand: its sweep's record
     try:
         text = run_markdown(d, get_study) if args.markdown else terminal_table(d)
     except ConfigError:
@@ -52,6 +54,19 @@ def show(args) -> int:
             file=sys.stderr,
         )
     return 0
+
+
+def _sweep_of(d: Path) -> Path | None:
+    """The sweep directory whose run record covers ``d`` (a sweep's own directory, which has
+    no claims table of its own, or one of its ``cells/<label>/``, which has no run record), or
+    None: a sweep records the sha256 of every cell's figures in its one ``run.json``."""
+    if (d / "sweep.parquet").is_file() and not (d / "claims.parquet").is_file():
+        return d
+    up = d.resolve().parent
+    if up.name == "cells" and (up.parent / "sweep.parquet").is_file():
+        if not (d / "run.json").exists():
+            return up.parent
+    return None
 
 
 def report(results: Path) -> int:

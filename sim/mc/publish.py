@@ -61,10 +61,18 @@ def _recorded_figures(out: Path) -> dict | None:
     return want if isinstance(want, dict) else None
 
 
+#: bytes beyond any figure a run draws (the largest shipped one is 0.4 MB; a 20,000-point
+#: network's a few MB): a file this large is not the run's figure, and is not read through
+#: (a link to a disk image made ``sim show`` hash gigabytes before its first line)
+FIGURE_BYTES = 64 << 20
+
+
 def _run_drew(p: Path, sha256) -> bool:
     """Whether the file ``p`` (read through a link) has the recorded ``sha256``; OSError
-    where it cannot be read."""
-    return isinstance(sha256, str) and _sha256(p) == sha256
+    where it cannot be read. A file larger than :data:`FIGURE_BYTES` is not read."""
+    if not isinstance(sha256, str) or p.stat().st_size > FIGURE_BYTES:
+        return False
+    return _sha256(p) == sha256
 
 
 def changed_figure(out: Path, missing_ok: bool = False) -> str | None:

@@ -172,7 +172,7 @@ def load_study(
     if name is None:
         raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
     study = get_study(name)
-    table = read_sweep(path) if "sweep" in doc else {}
+    table = read_sweep(path, study.schema) if "sweep" in doc else {}  # unknown keys first
     swept = set(table) - set(RESERVED)
     for text in overrides:
         key, value = parse_override(text)
