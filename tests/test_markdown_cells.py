@@ -39,3 +39,25 @@ def test_a_cell_with_pipes_and_backslashes_is_one_cell_read_back_as_written(name
     assert len(cells) == 2 and cells[1] == "0.1", row
     if "|" in name:  # the cell's own escapes read back as the name (a backslash before a
         assert cells[0] == name, row  # pipe doubled; other backslashes are left as written
+
+
+# A name that reads as HTML outside a code span (doors22b left it): a point ``<D>`` vanished
+# from a README's table (GitHub drops an unknown tag) and ``&lt;`` showed as ``<``; the
+# suite's own ``<br>`` and every code span stay as written.
+@pytest.mark.parametrize(
+    ("text", "written"),
+    [
+        ("<D>", "&lt;D>"),
+        ("</x>", "&lt;/x>"),
+        ("<!-- c -->", "&lt;!-- c -->"),
+        ("&lt;", "&amp;lt;"),
+        ("&#60;", "&amp;#60;"),
+        ("`<D>` and <D>", "`<D>` and &lt;D>"),
+        ("`a`<br>`b`", "`a`<br>`b`"),
+        ("B&L Macroscope", "B&L Macroscope"),
+        ("x < y", "x < y"),
+        ("``a ` <D>``", "``a ` <D>``"),
+    ],
+)
+def test_a_name_that_reads_as_html_is_escaped_outside_code_spans(text, written):
+    assert md_table(["point"], [[text]]).splitlines()[2] == f"| {written} |"
