@@ -240,6 +240,9 @@ class StudyHandle:
                     figures=figures,
                 )
             except ConfigError as e:
+                if e.key in _ARGUMENTS:  # the command line's option: the argument of run()
+                    msg = str(e).removeprefix(f"{e.key}: ")
+                    raise ConfigError(_ARGUMENTS[e.key], msg) from None
                 if e.key != "--out" and not any(cli in str(e) for cli, _ in _LIMITS):
                     raise
                 raise _api_words(e) from None
@@ -284,6 +287,9 @@ def _api_words(e: ConfigError) -> ConfigError:
         msg = msg.replace(cli, api)
     return ConfigError("out", msg)
 
+
+#: the command line's options a refusal names, and the argument of ``run()`` each is
+_ARGUMENTS = {"--executor": "executor", "--workers": "workers", "--scheduler": "scheduler"}
 
 #: the command line's limit options in a refusal, and what a caller of ``run()`` sets instead
 #: (it said "--max-adjustments or SIM_MAX_ADJUSTMENTS": an option ``run()`` does not take)

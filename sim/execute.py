@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import multiprocessing
 import os
 import re
 import sys
@@ -113,6 +114,17 @@ def _hint(msg: str, kind: str, schema) -> str:
     return ""
 
 
+def _not_in_a_starting_worker() -> None:
+    """A worker process that ``spawn`` or ``forkserver`` is starting imports the caller's
+    script again (as ``__mp_main__``); a script without ``if __name__ == "__main__":`` starts
+    its run again there. That process ends here, silently (its parent, whose executor then
+    fails to start, says why in one line: :func:`sim.mc.executors.script_words`): each worker
+    printed multiprocessing's "bootstrapping phase" traceback, and under Dask each started a
+    cluster of its own, about 250 lines of tracebacks before the parent's one line."""
+    if getattr(multiprocessing.current_process(), "_inheriting", False):
+        os._exit(1)
+
+
 @keep_lost_interrupts()  # every door: Ctrl-C that Python drops in a C callback is kept
 def execute(
     study,
@@ -137,6 +149,7 @@ def execute(
     as up to date). Raises ConfigError/StudyError (one line) on any failure. Returns the
     run's :class:`sim.mc.estimate.Estimate`."""
 
+    _not_in_a_starting_worker()
     shown = shown or str(out)
     _check_options(executor, workers, scheduler)
     check_chunks(cfg)

@@ -14,6 +14,8 @@ earlier sweeps left (issue 26):
 import json
 import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -114,3 +116,33 @@ def test_a_sweep_key_the_study_does_not_have_is_named_first(tmp_path, capsys):
     f.write_text(text + '\n[sweep]\n"network.grids.0.nx" = [4, 5]\n')
     line = one_line(capsys, main(["check", str(f)]), "sweep.network.grids.0.nx", "unknown key")
     assert "takes its default" not in line
+
+
+UNGUARDED = """\
+import multiprocessing as mp
+import sys
+
+if mp.get_start_method(allow_none=True) is None:  # the worker has its parent's: spawn
+    mp.set_start_method("spawn")
+import sim
+
+try:  # no if __name__ == "__main__": each worker imports this file again
+    sim.load({study!r}).run(out={out!r}, workers=2, trials=200)
+except sim.ConfigError as e:
+    print(e, file=sys.stderr)
+    sys.exit(2)
+"""
+
+
+def test_a_script_without_a_main_guard_gets_one_line_and_no_worker_tracebacks(tmp_path):
+    script = tmp_path / "unguarded.py"
+    study = str(ROOT / "studies" / "network_plate.toml")
+    script.write_text(UNGUARDED.format(study=study, out=str(tmp_path / "out")))
+    p = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=300, cwd=tmp_path
+    )
+    # each worker printed multiprocessing's "bootstrapping phase" traceback before this line
+    assert p.returncode == 2 and p.stderr.count("\n") == 1, p.stderr
+    assert p.stderr.startswith("executor: cannot start the local executor"), p.stderr
+    assert 'unguarded.py again: is the script\'s code under if __name__ == "__main__"' in p.stderr
+    assert not (tmp_path / "out").exists()
