@@ -5,6 +5,10 @@
    ``brown.table1_closure.dof`` 25 against the book's 43 and counted "1 self-check failed",
    and its predictions stayed tests of the paper. A self-check that must hold on any setup
    (gridplate's ``closed_form``) still fails on any.
+2. The claim ids a study's code builds (214 of 334: an f-string over a loop, a table's rows)
+   were checked against its book only at the end of the run; each study now lists them from
+   its resolved config (``sim.studies.claim_ids``) and ``sim check`` holds them against the
+   book both ways.
 """
 
 from __future__ import annotations
@@ -13,6 +17,7 @@ from pathlib import Path
 
 import pyarrow.parquet as pq
 import pytest
+from oneline import one_line
 
 from sim.claims.book import ClaimBook, write_claims
 from sim.claims.rules import NOT_APPLICABLE, VERDICTS, off_paper
@@ -20,9 +25,16 @@ from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.report.markdown import verdict_counts
 from sim.report.run_summary import verdict_line
+from sim.studies import claim_ids, load_study
+from sim.studies.agnard import claims as agnard_claims
+from sim.studies.brown import claims as brown_claims
 from sim.studies.brown.claims import full_book
+from sim.studies.design import claims as design_claims
+from sim.studies.gridplate import claims as gridplate_claims
 from sim.studies.network.claims import _book as network_book
 from sim.studies.network.claims import _self_checks as network_checks
+from sim.studies.salsig import claims as salsig_claims
+from sim.studies.wolf import claims as wolf_claims
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = ROOT / "sim" / "studies"
@@ -195,3 +207,76 @@ def test_brown_table1_on_a_4_by_4_grid_is_off_the_papers_setup(tmp_path, capsys)
     assert "self-check not applicable" in capsys.readouterr().out
     readme = (out / "README.md").read_text()
     assert "| not applicable (fails) |" in readme
+
+
+# ------------------------------------------------------ 2. the claim ids a study's run will score
+#: the study files whose shipped results hold the claims their run scored
+SHIPPED = sorted(
+    f.stem
+    for f in (ROOT / "studies").glob("*.toml")
+    if (ROOT / "results" / f.stem / "claims.parquet").is_file()
+)
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_each_study_lists_the_ids_its_shipped_run_scored(name):
+    """The listing (from the resolved config, no trial run) is the claims column of the
+    study's committed results: every id once, none missing, none more."""
+    study, cfg = load_study(ROOT / "studies" / f"{name}.toml")
+    ids = claim_ids(study, cfg)
+    shipped = pq.read_table(ROOT / "results" / name / "claims.parquet").column("claim")
+    if study.name == "network":  # its book is built by its code from the same lists
+        assert ids is None
+        return
+    assert ids is not None and len(ids) == len(set(ids))
+    assert sorted(ids) == sorted(shipped.to_pylist())
+
+
+def _edited(text: str, cid: str, new: str | None = None) -> str:
+    """The claim book ``text`` without the ``[[claim]]`` table of ``cid``, or with a copy of
+    it declared as ``new``."""
+    parts = text.split("[[claim]]")
+    (hit,) = [p for p in parts[1:] if f'id = "{cid}"' in p]
+    if new is not None:
+        return text + "\n[[claim]]" + hit.replace(f'id = "{cid}"', f'id = "{new}"')
+    return "[[claim]]".join([parts[0], *(p for p in parts[1:] if p is not hit)])
+
+
+#: (study file, the module holding its BOOK, a claim id the study's code builds)
+BUILT = [
+    ("wolf_polynomial", wolf_claims, "wolf.table1.p003.max_x_um"),
+    ("wolf_polynomial", wolf_claims, "wolf.table2_check.p005.set2.rms_y_um"),
+    ("agnard_block", agnard_claims, "agnard.table1.ratio_check_y"),
+    ("agnard_block", agnard_claims, "agnard.input.control_5_check_n"),
+    ("gridplate_two_plates", gridplate_claims, "twoplate.beyond.coverage_S2_wpri"),
+    ("brown_design", design_claims, "bayes.brown_agreement.alpha"),
+    ("salsig_encoders", salsig_claims, "salsig.decompose_b8.E"),
+    ("brown_table1", brown_claims, "brown.table1_point_sigma.together"),
+    ("brown_dilution", brown_claims, "brown.mc_agreement.pivot.mean_ratio"),
+]
+
+
+@pytest.mark.parametrize("name, module, cid", BUILT)
+def test_a_built_claim_removed_from_the_book_is_refused_by_sim_check(
+    tmp_path, monkeypatch, capsys, name, module, cid
+):
+    book = tmp_path / "claims.toml"
+    book.write_text(_edited(module.BOOK.read_text(encoding="utf-8"), cid))
+    monkeypatch.setattr(module, "BOOK", book)
+    rc = main(["check", str(ROOT / "studies" / f"{name}.toml")])
+    one_line(capsys, rc, f"claim '{cid}', which the study scores, is not declared", str(book))
+
+
+@pytest.mark.parametrize(
+    "cid, new",
+    [
+        ("wolf.table1.p003.max_x_um", "wolf.table1.p007.max_x_um"),  # a plate Table 1 lacks
+        ("wolf.before.max_x_um", "wolf.before.median_x_um"),  # a statistic nobody computes
+    ],
+)
+def test_a_claim_no_code_scores_is_refused_by_sim_check(tmp_path, monkeypatch, capsys, cid, new):
+    book = tmp_path / "claims.toml"
+    book.write_text(_edited(wolf_claims.BOOK.read_text(encoding="utf-8"), cid, new))
+    monkeypatch.setattr(wolf_claims, "BOOK", book)
+    rc = main(["check", str(ROOT / "studies" / "wolf_polynomial.toml")])
+    one_line(capsys, rc, f"declared claims the study does not score: {new}", str(book))
