@@ -9,6 +9,8 @@
    were checked against its book only at the end of the run; each study now lists them from
    its resolved config (``sim.studies.claim_ids``) and ``sim check`` holds them against the
    book both ways.
+3. ``Study.run(chunk=...)`` and every other argument the Python API does not take ended in
+   Python's own TypeError; it is one ConfigError line naming the argument and the ones taken.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import pyarrow.parquet as pq
 import pytest
 from oneline import one_line
 
+import sim
 from sim.claims.book import ClaimBook, write_claims
 from sim.claims.rules import NOT_APPLICABLE, VERDICTS, off_paper
 from sim.cli import main
@@ -280,3 +283,48 @@ def test_a_claim_no_code_scores_is_refused_by_sim_check(tmp_path, monkeypatch, c
     monkeypatch.setattr(wolf_claims, "BOOK", book)
     rc = main(["check", str(ROOT / "studies" / "wolf_polynomial.toml")])
     one_line(capsys, rc, f"declared claims the study does not score: {new}", str(book))
+
+
+# ------------------------------------------------ 3. an argument the Python API does not take
+@pytest.fixture(scope="module")
+def handle():
+    return sim.load(ROOT / "studies" / "brown_table1.toml", trials=40, chunk=2)
+
+
+RESULTS = ROOT / "results" / "brown_table1"
+
+
+@pytest.mark.parametrize(
+    "call, key, needles",
+    [
+        (lambda h: h.run(chunk=5), "chunk", ["run() takes no argument 'chunk'", "replace()"]),
+        (lambda h: h.run(plate__grid=4), "plate__grid", ["plate.grid is a config key"]),
+        (lambda h: h.run(workerz=2), "workerz", ["(it takes out, executor, workers, trials"]),
+        (lambda h: h.run("o", "local", 1, None, None, "x"), "StudyHandle.run()", ["at most 5"]),
+        (lambda h: h.run("o", out="p"), "out", ["was given out twice"]),
+        (lambda h: h.estimate(1), "StudyHandle.estimate()", ["no positional argument"]),
+        (lambda h: h.replace(1), "StudyHandle.replace()", ["config keys by name"]),
+        (lambda h: sim.load(), "study_file", ["missing: load() needs it"]),
+        (lambda h: sim.load("a", "b", trials=4), "load()", ["at most 1 positional"]),
+        (lambda h: sim.Results(RESULTS, name="x"), "name", ["Results() takes no argument"]),
+        (lambda h: sim.Results(RESULTS), "study", ["missing: Results() needs it"]),
+        (
+            lambda h: sim.Results(RESULTS, "brown_table1").table("claims", columns=["claim"]),
+            "columns",
+            ["Results.table() takes no argument 'columns' (it takes name)"],
+        ),
+        (lambda h: sim.Results(RESULTS, "brown_table1").claims(True), "Results.claims()", []),
+    ],
+)
+def test_an_argument_the_api_does_not_take_is_one_config_error_line(handle, call, key, needles):
+    with pytest.raises(ConfigError) as e:
+        call(handle)
+    assert e.value.key == key and "\n" not in str(e.value)
+    assert all(n in str(e.value) for n in needles), str(e.value)
+
+
+def test_the_api_still_takes_its_own_arguments(handle):
+    assert handle.replace(trials=60).config["trials"] == 60 and handle.estimate() is not None
+    r = sim.Results(path=RESULTS, study="brown_table1")
+    assert r.table(name="claims").num_rows == r.claims().num_rows > 0
+    assert "claims" in r.names()
