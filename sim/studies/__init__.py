@@ -116,9 +116,9 @@ def data_check(
 
     def listed(book: Any, cfg: dict) -> list[str]:
         """The ids the code builds (``scored``) and the declared ones it names as literals."""
-        built = list(scored(cfg, book))  # type: ignore[misc]
-        named = [c for c in named_ids(book, package, scores) if c not in set(built)]
-        return built + named
+        built = list(scored(cfg, book))  # type: ignore[misc]  (only called when given)
+        kept = set(built)
+        return built + [c for c in named_ids(book, package, scores) if c not in kept]
 
     check.scored = None if scored is None else lambda cfg: listed(load_book(), cfg)
     return check
