@@ -28,6 +28,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from sim.api_args import arguments as _arguments
 from sim.execute import execute
 from sim.mc.config import ConfigError, study_file_hint
 from sim.mc.estimate import estimate
@@ -104,6 +105,7 @@ class Results:
             name == "trials" and not (self.path / "trials.parquet").exists()
         )
 
+    @_arguments
     def names(self) -> list[str]:
         """The tables of the run: each once; ``chunks`` is the per-trial chunk dataset (also
         ``trials`` when the study writes no ``trials.parquet``)."""
@@ -113,6 +115,7 @@ class Results:
             names |= {"chunks", "trials"}
         return sorted(names)
 
+    @_arguments
     def table(self, name: str) -> pa.Table:
         """The table ``name`` (``claims``, ``points``, ..., ``trials`` or ``chunks``) as a
         pyarrow Table."""
@@ -142,9 +145,13 @@ class Results:
         self._check_dir()  # replaced while it was read
         return table
 
+    @_arguments
     def claims(self) -> pa.Table:
         """The claims table: each paper claim beside the simulated value and its verdict."""
         return self.table("claims")
+
+
+Results.__init__ = _arguments(Results.__init__)  # type: ignore[method-assign]
 
 
 @dataclass(frozen=True)
@@ -165,15 +172,18 @@ class StudyHandle:
     def name(self) -> str:
         return self.config["study"]
 
+    @_arguments
     def estimate(self):
         """Work and memory of a run (:class:`sim.mc.estimate.Estimate`)."""
         return estimate(self.config, self.sweep)
 
+    @_arguments
     def replace(self, **overrides) -> "StudyHandle":
         """A new handle with more overrides."""
         _unchanged(self)
         return load(self.path, **{**self.overrides, **_keyed(overrides)})
 
+    @_arguments
     def run(
         self,
         out: str | os.PathLike | None = None,
@@ -394,6 +404,7 @@ def _load_picking_chunk(study_file, vals: dict):
     return study, cfg
 
 
+@_arguments
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)

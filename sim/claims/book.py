@@ -96,7 +96,7 @@ def _number(x: Any) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
-_SPEC_KEYS = {"id", "source", "paper", "form", "ref", "decimals", "tol", "kind", "headline", "why"}
+_SPEC_KEYS = {*"id source paper form ref decimals tol kind headline why paper_setup".split()}
 
 
 # --------------------------------------------------------------------------- claim books
@@ -109,6 +109,8 @@ class ClaimBook:
     rounding; omit for an exact reference) and ``tol`` (the half-width beyond the rounding that
     decides; 0 lets the rounding alone decide). ``headline = true`` puts the claim in the
     report's referee summary; ``why`` is the reason of a ``not comparable`` row.
+    ``paper_setup = true`` marks a ``self-check`` whose reference is a number of the paper's
+    setup, not one every setup gives (:func:`sim.claims.rules.off_paper`).
     Each ``[[not_reproduced]]`` has ``source``, ``printed`` and ``why``.
     The study scores every declared claim exactly once (:meth:`check_complete`).
     """
@@ -187,6 +189,15 @@ class ClaimBook:
                     raise ConfigError(
                         f"claim.{k}", f"{where} ({s['id']}): {k} without the paper's number (ref)"
                     )
+            if not isinstance(s.get("paper_setup", False), bool):
+                raise ConfigError("claim.paper_setup", f"{where} ({s['id']}): true or false")
+            if s.get("paper_setup") and (s["kind"] != "self-check" or "ref" not in s):
+                what = f"not a {s['kind']}" if s["kind"] != "self-check" else "this has none"
+                raise ConfigError(
+                    "claim.paper_setup",
+                    f"{where} ({s['id']}): marks a self-check whose ref is the paper's "
+                    f"setup's, {what}",
+                )
             if not isinstance(s.get("why", ""), str):
                 raise ConfigError("claim.why", f"{where} ({s['id']}): why must be text")
             self.specs[s["id"]] = dict(s)
@@ -215,6 +226,10 @@ class ClaimBook:
         if bad:
             raise ConfigError(sorted(bad)[0], f"{path}: unknown table")
         return cls(data.get("claim", []), data.get("not_reproduced", []), str(path))
+
+    @property
+    def paper_setup(self) -> frozenset[str]:  # the self-checks of the paper's setup
+        return frozenset(c for c, s in self.specs.items() if s.get("paper_setup"))
 
     def spec(self, cid: str) -> dict:
         if cid not in self.specs:  # the book edited: a claim the study scores removed or renamed
@@ -405,7 +420,7 @@ def write_claims(
             {c: [n[c] for n in nr] for c in NOT_REPRODUCED_COLUMNS},
             prov,
         )
-    rows = off_paper(rows)
+    rows = off_paper(rows, book.paper_setup if book is not None else ())
     cols = {c: [_null(r[c]) for r in rows] for c in CLAIM_COLUMNS}
     return write_table(
         path, cols, {**prov, "intervals": interval_provenance()}, tolerances=CLAIM_TOLERANCES

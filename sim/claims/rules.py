@@ -60,6 +60,15 @@ an ``input`` row with an exact value (a configuration value the paper prints) fa
 rule, the run simulates another setup (e.g. a larger block): :func:`off_paper` keeps every
 prediction's ``outcome`` but makes its ``verdict`` a **finding** (about that setup, not the
 paper) and names the differing inputs in the note.
+
+A self-check whose reference is a number of the paper's setup, not one every setup gives
+(``paper_setup = true`` in the claim book: Brown's 43 degrees of freedom are 2(25) - 7 of the
+paper's 25 points), is **not applicable** on a run off that setup: its ``outcome`` is kept
+(the rule's result against the paper's number), its ``verdict`` is ``not applicable``, and it
+is counted apart, never as a failed self-check. An exact one that fails its rule is itself a
+differing printed input (its value is computed from the run's setup alone), so it makes the
+run off the paper's setup as an exact ``input`` row does. A self-check without the flag (an
+identity, Monte Carlo against analytic) must hold on any setup and is decided as ever.
 """
 
 from __future__ import annotations
@@ -79,6 +88,7 @@ __all__ = [
     "verdict_of",
     "holds_of",
     "off_paper",
+    "NOT_APPLICABLE",
 ]
 
 FORMS = ("value", "share", "count", "upper", "lower", "range", "one-plate")
@@ -93,7 +103,17 @@ PREDICTION_VERDICTS = (
     "fails or undecided",
     "undecidable",
 )
-VERDICTS = (*PREDICTION_VERDICTS, "erratum", "input", "self-check", "finding", "not comparable")
+VERDICTS = (
+    *PREDICTION_VERDICTS,
+    "erratum",
+    "input",
+    "self-check",
+    "finding",
+    "not comparable",
+    "not applicable",
+)
+#: the verdict of a ``paper_setup`` self-check on a run off the paper's setup (:func:`off_paper`)
+NOT_APPLICABLE = "not applicable"
 #: the probability of a plate at least as extreme below which a one-plate claim fails
 P_FAIL = 0.05
 
@@ -157,15 +177,22 @@ def holds_of(verdict: str):  # depends / undecidable (over a region, sim.claims.
     return {"holds": True, "fails": False, "erratum": False}.get(verdict)
 
 
-def off_paper(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
+def off_paper(
+    rows: Iterable[dict[str, Any]], paper_setup: Iterable[str] = ()
+) -> list[dict[str, Any]]:
     """The rows of a run, with every prediction a **finding** when the run's printed inputs
-    differ from the paper's (an exact ``input`` row that fails its rule); see the module doc.
-    Rows of a run on the paper's setup come back unchanged."""
+    differ from the paper's (an exact ``input`` row, or an exact self-check of ``paper_setup``,
+    that fails its rule), and every self-check of ``paper_setup`` (the ids whose reference is
+    the paper's setup) **not applicable** then; see the module doc. Rows of a run on the
+    paper's setup come back unchanged."""
     rows = list(rows)
+    setup = set(paper_setup)
     bad = [
         r["claim"]
         for r in rows
-        if r["kind"] == "input" and r["interval"] == "exact" and r["outcome"] == "fails"
+        if (r["kind"] == "input" or (r["kind"] == "self-check" and r["claim"] in setup))
+        and r["interval"] == "exact"
+        and r["outcome"] == "fails"
     ]
     if not bad:
         return rows
@@ -174,10 +201,17 @@ def off_paper(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
         + ", ".join(bad)
         + "), so the rule's outcome ({}) is a finding about this run's setup"
     )
+    aside = (
+        "not applicable: its reference is a number of the paper's setup, and this run's printed inputs "
+        "differ from the paper's (" + ", ".join(bad) + "); against that number the rule gives: {}"
+    )
     out = []
     for r in rows:
         if r["kind"] == "prediction" and r["verdict"] != "finding":
             note = why.format(r["outcome"]) + ("; " + r["note"] if r["note"] else "")
             r = {**r, "verdict": "finding", "holds": None, "note": note}
+        elif r["kind"] == "self-check" and r["claim"] in setup:
+            note = aside.format(r["outcome"]) + ("; " + r["note"] if r["note"] else "")
+            r = {**r, "verdict": NOT_APPLICABLE, "holds": None, "note": note}
         out.append(r)
     return out

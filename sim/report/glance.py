@@ -33,6 +33,7 @@ VERDICT_TEXT = {
     "self-check": "self-check",
     "finding": "finding",
     "not comparable": "not comparable",
+    "not applicable": "not applicable",
 }
 
 

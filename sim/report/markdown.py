@@ -13,7 +13,7 @@ from typing import Callable
 import pyarrow as pa
 
 from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
-from sim.claims.rules import PREDICTION_VERDICTS
+from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
@@ -93,7 +93,8 @@ def claims_markdown(path: Path) -> str:
 
 def verdict_counts(claims: list[dict]) -> dict[str, int]:
     """Counts per class: predictions by verdict, errata, inputs, self-checks (and how many of
-    them failed their own rule, or could not decide it), findings, not comparable."""
+    them failed their own rule, or could not decide it, or were not applicable: a reference of
+    the paper's setup on a run off it), findings, not comparable."""
     c = {
         k: 0
         for k in (
@@ -104,6 +105,7 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
             "self-check",
             "self-check failed",
             "self-check undecided",
+            "self-check not applicable",
             "finding",
             "not comparable",
         )
@@ -116,6 +118,9 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
             c["erratum" if v == "erratum" else "paper ok" if v == "holds" else v] += 1
         elif k == "self-check":
             c["self-check"] += 1
+            if v == NOT_APPLICABLE:  # its outcome is against the paper's setup, not this run's
+                c["self-check not applicable"] += 1
+                continue
             c["self-check failed"] += r.get("outcome") == "fails"
             c["self-check undecided"] += r.get("outcome") not in (None, "holds", "fails")
         else:
@@ -254,7 +259,11 @@ def _entry(d: Path, get_study: Callable) -> tuple:
     n_nr = read_table(nr).num_rows if nr.is_file() else 0
     row = [f"[{d.name}]({d.name}/README.md): {study.title}", paper_name(study.seed_file) or "—"]
     row += [c[k] for k, _ in _COUNT_COLS]
-    apart = [f"{c[f'self-check {w}']} {w}" for w in ("failed", "undecided") if c[f"self-check {w}"]]
+    apart = [
+        f"{c[f'self-check {w}']} {w}"
+        for w in ("failed", "undecided", "not applicable")
+        if c[f"self-check {w}"]
+    ]
     if apart:  # counted as self-checks, but not ones that held their own rule
         row[2 + [k for k, _ in _COUNT_COLS].index("self-check")] = (
             f"{c['self-check']} ({', '.join(apart)})"

@@ -12,7 +12,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Callable
 
-from sim.claims.rules import PREDICTION_VERDICTS
+from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
 from sim.report.claimtext import interval_text, sim_text
@@ -43,6 +43,7 @@ VERDICT_ORDER = (
     "self-check",
     "self-check failed",
     "self-check undecided",
+    "self-check not applicable",
     "finding",
 )
 
@@ -62,6 +63,8 @@ def _counted_as(r: dict) -> str:
     """The heading a claim row is counted under in a verdict line."""
     if r.get("kind") == "paper-check" and r["verdict"] == "holds":
         return "paper consistent"
+    if r.get("kind") == "self-check" and r["verdict"] == NOT_APPLICABLE:
+        return "self-check not applicable"  # off the paper's setup: its outcome is not this run's
     if r.get("kind") == "self-check" and r.get("outcome") not in (None, "holds"):
         return "self-check failed" if r["outcome"] == "fails" else "self-check undecided"
     return r["verdict"]
@@ -72,7 +75,8 @@ def verdict_line(claims: list[dict]) -> str:
     a paper-check that holds (the paper's own arithmetic) counts as ``paper consistent``, as in
     REPORT.md's counts per study, not as a prediction that holds; a self-check that did not
     hold its own rule counts apart (``self-check failed``, ``self-check undecided``: as in
-    REPORT.md), not as one that did."""
+    REPORT.md), not as one that did, and one whose reference is the paper's setup's on a run
+    off it apart again (``self-check not applicable``), not as a failed one."""
     c = Counter(_counted_as(r) for r in claims)
     order = [v for v in VERDICT_ORDER if c[v]] + sorted(v for v in c if v not in VERDICT_ORDER)
     return f"{len(claims)} claims: " + ", ".join(f"{c[v]} {v}" for v in order)

@@ -19,7 +19,7 @@ from sim.mc.read_when import refuse_unread, unread
 from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
 from sim.mc.sweep import RESERVED, expand, read_sweep
-from sim.studies.scored_ids import check_literal_ids
+from sim.studies.scored_ids import check_literal_ids, check_scored, named_ids
 
 __all__ = [
     "Study",
@@ -28,6 +28,7 @@ __all__ = [
     "design_config",
     "get_study",
     "load_study",
+    "claim_ids",
     "unread_keys",
     "MODULES",
 ]
@@ -63,7 +64,10 @@ def unread_keys(study: Study, cfg: Mapping[str, Any]) -> dict[str, str]:
 
 
 def data_check(
-    load_book: Callable[[], Any], *declarations: Any, scores: Callable[[str], bool] | None = None
+    load_book: Callable[[], Any],
+    *declarations: Any,
+    scores: Callable[[str], bool] | None = None,
+    scored: Callable[[dict, Any], Any] | None = None,
 ) -> Callable[..., None]:
     """A :attr:`Study.data` that loads the claim book and each region declaration over it.
     A declaration is a path, or ``(path, names, keys)``: ``names(cfg)`` the inputs the study's
@@ -74,7 +78,10 @@ def data_check(
     for 1 um over 100 mm: the range was checked against no bound), a :class:`Field` for an
     input that reaches no key (the bounds its code takes), or a list of these (one input
     setting two keys). The claim ids the study's code names as literals must be declared in
-    the book (:mod:`sim.studies.scored_ids`; ``scores``: which of them this study scores)."""
+    the book (:mod:`sim.studies.scored_ids`; ``scores``: which of them this study scores), and
+    ``scored(cfg, book)``, the ids the run of ``cfg`` builds (with the declared ones the code
+    names: every id it scores), exactly the ones the book declares
+    (:func:`sim.studies.scored_ids.check_scored`)."""
 
     package = Path(sys.modules[load_book.__module__].__file__).parent  # the study's code
 
@@ -83,6 +90,8 @@ def data_check(
 
         book = load_book()
         check_literal_ids(book, package, schema or {}, scores)  # a claim its code names
+        if scored is not None:  # and every claim its run scores, as the run will build it
+            check_scored(book, listed(book, cfg))
         for d in declarations:
             path, names, keys = d if isinstance(d, tuple) else (d, None, {})
             dec = load_declaration(path, book)
@@ -105,7 +114,22 @@ def data_check(
                     f"{', '.join(sorted(want))})",
                 )
 
+    def listed(book: Any, cfg: dict) -> list[str]:
+        """The ids the code builds (``scored``) and the declared ones it names as literals."""
+        built = list(scored(cfg, book))  # type: ignore[misc]  (only called when given)
+        kept = set(built)
+        return built + [c for c in named_ids(book, package, scores) if c not in kept]
+
+    check.scored = None if scored is None else lambda cfg: listed(load_book(), cfg)
     return check
+
+
+def claim_ids(study: Study, cfg: Mapping[str, Any]) -> list[str] | None:
+    """Every claim id the run of ``study`` at the resolved ``cfg`` scores, listed without
+    running a trial (the ``scored`` of its :func:`data_check`), or None for a study that does
+    not list them (the network kind: its book is built by its code, nothing to edit)."""
+    listing = getattr(study.data, "scored", None)
+    return None if listing is None else listing(dict(cfg))
 
 
 def _out_of_bounds(v: float, goes: Any, cfg: dict, schema: Mapping[str, Field]) -> str | None:

@@ -7,8 +7,12 @@ run, after the whole simulation. The ids the code writes out as string literals
 package's source, statically (nothing is imported or run), so that ``sim check`` and the start
 of ``sim run`` refuse such a book naming the claim and the file that scores it.
 
-Left to the end of the run: the ids the code builds (an f-string over a loop, a transcribed
-table's rows); the ids of a region declaration are checked by :mod:`sim.claims.book_region`.
+The ids the code builds (an f-string over a loop, a transcribed table's rows) are listed by
+the study itself, from its resolved config and without running a trial (``scored`` of
+:func:`sim.studies.data_check`), and :func:`check_scored` holds that list against the book
+both ways: a listed id the book does not declare, and a declared id nobody scores, are
+refused at load as they would be at the end of the run. The ids of a region declaration are
+checked by :mod:`sim.claims.book_region`.
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ from typing import Callable, Iterable
 
 from sim.mc.config import ConfigError
 
-__all__ = ["literal_ids", "check_literal_ids"]
+__all__ = ["literal_ids", "check_literal_ids", "check_scored", "named_ids"]
 
 #: a claim id: dotted words (``salsig.recovery.SX``)
 _ID = re.compile(r"[A-Za-z]\w*(?:\.\w+)+")
@@ -80,3 +84,27 @@ def check_literal_ids(
                 "claim.id",
                 f"{book.path}: claim {cid!r}, which the study scores ({name}), is not declared",
             )
+
+
+def named_ids(book, package: Path, scores: Callable[[str], bool] | None = None) -> list[str]:
+    """The declared ids of ``book`` that the code of ``package`` names as literals (and this
+    study scores, ``scores``), in the book's order."""
+    named = literal_ids(package, {c.rsplit(".", 1)[0] for c in book.specs})
+    return [c for c in book.specs if c in named and (scores is None or scores(c))]
+
+
+def check_scored(book, ids: Iterable[str]) -> None:
+    """Refuse ``book`` (a :class:`sim.claims.book.ClaimBook`) unless ``ids``, the claims the
+    study's run scores (listed from its config), are exactly the ones it declares: the two
+    errors the end of the run gives (:meth:`~sim.claims.book.ClaimBook.spec`,
+    :meth:`~sim.claims.book.ClaimBook.check_complete`), at load."""
+    ids = list(ids)
+    for cid in ids:
+        book.spec(cid)  # a claim the study scores, not declared: named with the book
+    listed = set(ids)
+    missing = [c for c in book.specs if c not in listed]
+    if missing:
+        raise ConfigError(
+            "claim.id",
+            f"{book.path}: declared claims the study does not score: {', '.join(missing)}",
+        )

@@ -19,7 +19,7 @@ of blocks and its adjustments), :mod:`.run` (through the runner), ``claims.toml`
 from __future__ import annotations
 
 from sim.studies import Study, data_check
-from sim.studies.agnard.claims import load_book
+from sim.studies.agnard.claims import load_book, scored_ids
 from sim.studies.agnard.region import CENTRES, DECLARATION, INSET, SCANNER, SCANNER_KEYS
 from sim.studies.agnard.report import report
 from sim.studies.agnard.run import run
@@ -40,6 +40,7 @@ STUDIES = {
             load_book,
             (DECLARATION, lambda cfg: (CENTRES, "five_inset_1"), {"five_inset_1": INSET}),
             (SCANNER, lambda cfg: SCANNER_KEYS, SCANNER_KEYS),
+            scored=scored_ids,
         ),
     )
 }

@@ -53,6 +53,29 @@ def _where(p: float, x: np.ndarray) -> str:
     return f"{100 * np.mean(np.asarray(x) < p):.0f} % of the simulated blocks lie below the paper's value"
 
 
+def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
+    """The ids :func:`claim_rows` builds: the scanner's gains (:func:`scanner_rows`), the
+    book's inputs that are config keys and the control counts (:func:`input_rows`), Tables
+    2-3 with their acceptance rows and families (:func:`tables23_rows`, :data:`JOINT`), the
+    first pass (:func:`first_pass_rows`) and Table 1 (:func:`table1_rows`)."""
+    blocks, pre = ("control_5", "control_21"), "agnard.input."
+    return [
+        *(f"agnard.scanner.gain_{d:.0f}dpi_pct" for d in (300.0, 600.0)),
+        *(c for c in book.specs if c.startswith(pre) and c[len(pre) :] in cfg),
+        *(f"{pre}{b}{n}_n" for b in blocks for n in ("", "_check")),
+        *(f"agnard.{b}.{w}_{c}_cm" for b in blocks for w in ("ctrl", "check") for c in AXES),
+        *(f"agnard.max_residual.{b}_{c}_cm" for b in blocks for c in ("xy", "z")),
+        *JOINT.values(),
+        *(f"agnard.first_pass.pass_{q}_cm" for q in ("xy", "z")),
+        *(
+            f"agnard.table1.{tag}_{w}_{c}{unit}"
+            for w in ("ctrl", "check")
+            for c in ("x", "y")
+            for tag, unit in (("with", "_m"), ("without", "_m"), ("ratio", ""))
+        ),
+    ]
+
+
 def scanner_rows(scan_t: dict) -> dict[str, Sim]:
     rows = {}
     dpi = np.asarray(scan_t["dpi"])

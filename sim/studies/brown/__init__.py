@@ -17,9 +17,21 @@ from __future__ import annotations
 
 from sim.studies import Study, data_check
 from sim.studies.brown.claims import load_book, scored_by
+from sim.studies.brown.region import T1_JOINT, T1_PREDICTIONS
 from sim.studies.brown.report import report_dilution, report_table1
 from sim.studies.brown.run import run_dilution, run_table1
-from sim.studies.brown.schema import DILUTION, SEED, TABLE1, check
+from sim.studies.brown.schema import DILUTION, MODEL_NAMES, SEED, TABLE1, check
+
+
+def _dilution_ids(cfg: dict, book) -> list[str]:
+    """The ids brown_dilution builds (:func:`.claims.score_dilution`)."""
+    return [f"brown.mc_agreement.{m}.mean_ratio" for m in MODEL_NAMES]
+
+
+def _table1_ids(cfg: dict, book) -> list[str]:
+    """The ids brown_table1 builds: Table 1's statements over the region (:mod:`.region`)."""
+    return [*T1_PREDICTIONS, T1_JOINT]
+
 
 STUDIES = {
     "brown_dilution": Study(
@@ -31,7 +43,11 @@ STUDIES = {
         report_dilution,
         check,
         order=10,
-        data=data_check(lambda: load_book("brown_dilution"), scores=scored_by("brown_dilution")),
+        data=data_check(
+            lambda: load_book("brown_dilution"),
+            scores=scored_by("brown_dilution"),
+            scored=_dilution_ids,
+        ),
     ),
     "brown_table1": Study(
         "brown_table1",
@@ -42,6 +58,8 @@ STUDIES = {
         report_table1,
         check,
         order=11,
-        data=data_check(lambda: load_book("brown_table1"), scores=scored_by("brown_table1")),
+        data=data_check(
+            lambda: load_book("brown_table1"), scores=scored_by("brown_table1"), scored=_table1_ids
+        ),
     ),
 }

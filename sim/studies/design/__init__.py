@@ -14,7 +14,7 @@ from __future__ import annotations
 from sim.studies import Study, data_check
 from sim.studies.design.cells import geometry_eval, measuring_time, pareto_front, time_model
 from sim.studies.design.checks import check
-from sim.studies.design.claims import load_book
+from sim.studies.design.claims import load_book, scored_ids
 from sim.studies.design.report import report
 from sim.studies.design.run import run
 from sim.studies.design.schema import SCHEMA, SEED
@@ -40,6 +40,6 @@ STUDIES = {
         report,
         check,
         order=12,
-        data=data_check(load_book),
+        data=data_check(load_book, scored=scored_ids),
     ),
 }

@@ -12,6 +12,7 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.table import Sim, claim_rows, exact, mc, plates
+from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import StudyError
 from sim.studies.design.errbudget import BUDGET_ROWS
 
@@ -100,6 +101,26 @@ DESIGN_CLAIMS = (
     "brown.design.max_offset_paper_grid_mm",
     "brown.design.max_offset_dilution_grid_mm",
 )
+
+
+def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
+    """The ids :func:`score_all` builds: the budget's sources (:func:`_budget`), the datum
+    rows (:func:`_design`), the coverages (:func:`_coverage`) and the posterior's parameters
+    (:func:`_bayes`, :data:`sim.instruments.ranges.multilateration.PARAM_NAMES`)."""
+    return [
+        *(f"brown.budget.{name}_um" for name in BUDGET_CLAIMS),
+        *(
+            f"brown.datum.{lab}.{m}_pct"
+            for m in ("stations", "pivot")
+            for lab in ("brown", "invariant", "corners")
+        ),
+        *(
+            f"coverage.{m}.{key}"
+            for m in ("pivot", "affine")
+            for key in ("coverage_known", "coverage_f", "false_alarm", "sigma0_over_c4")
+        ),
+        *(f"bayes.brown_agreement.{nm.rsplit('_', 1)[0]}" for nm in ml.PARAM_NAMES),
+    ]
 
 
 def _operation(cfg: dict, R: dict) -> dict[str, Sim]:

@@ -9,7 +9,7 @@ reduction), :mod:`.run` (the run), :mod:`.sweep` (unprinted inputs, consistent s
 from __future__ import annotations
 
 from sim.studies import Study, data_check
-from sim.studies.gridplate.claims import load_book
+from sim.studies.gridplate.claims import load_book, scored_ids
 from sim.studies.gridplate.region import DECLARATION, SCALE_DIFF_KEYS, nominal
 from sim.studies.gridplate.report import report
 from sim.studies.gridplate.run import run
@@ -39,6 +39,7 @@ STUDIES = {
                     "scale_diff_at_100mm_um": SCALE_DIFF_KEYS,
                 },
             ),
+            scored=scored_ids,
         ),
     ),
 }

@@ -272,6 +272,20 @@ def _self_checks(cfg: dict, res: dict) -> dict[str, Sim]:
     }
 
 
+def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
+    """The ids :func:`score` builds: bias and spread of S, S', eps with the grid fixed
+    (:func:`_beyond`: one ``grid fixed`` row of ``beyond.parquet`` each) and their coverages
+    (:func:`_coverage`)."""
+    return [
+        *(f"twoplate.beyond.fixed.{w}_{k}" for k in PARAMS for w in ("bias", "sd")),
+        *(
+            f"twoplate.beyond.coverage_{k}_{tag}"
+            for k in PARAMS
+            for tag in ("fixed_pri", "fixed_post", "wpri", "wpost")
+        ),
+    ]
+
+
 def _beyond(beyond: dict) -> dict[str, Sim]:
     """Bias and spread of S, S', eps with the grid fixed (rows of ``beyond.parquet``)."""
     table = {}

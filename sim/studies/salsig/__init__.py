@@ -9,7 +9,7 @@ consistent set), ``claims.toml`` + :mod:`.claims` (scoring), :mod:`.figures`, :m
 from __future__ import annotations
 
 from sim.studies import Study, data_check
-from sim.studies.salsig.claims import load_book
+from sim.studies.salsig.claims import load_book, scored_ids
 from sim.studies.salsig.model import (  # noqa: F401
     decompositions,
     simulate_chain,
@@ -34,7 +34,9 @@ STUDIES = {
         check,
         order=30,
         data=data_check(
-            load_book, (DECLARATION, nominal, {**_KEYS, "control_1": "vertical.control"})
+            load_book,
+            (DECLARATION, nominal, {**_KEYS, "control_1": "vertical.control"}),
+            scored=scored_ids,
         ),
     ),
 }

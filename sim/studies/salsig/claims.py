@@ -56,6 +56,15 @@ def marks_layout() -> dict:
     return {"spacing_mm": float(math.hypot(a, b)), "placement_rms_mm": rms, "extent_mm": ext}
 
 
+def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
+    """The ids :func:`score` builds: SX, SY, E of FIG. 2 (the grid) and FIG. 3 (the B8) from
+    :func:`_decompositions`, and the vertical rms before and after the correction."""
+    return [
+        *(f"salsig.decompose_{f}.{q}" for f in ("grid", "b8") for q in ("SX", "SY", "E")),
+        *(f"salsig.vertical_halved.rms_z_{tag}_um" for tag in ("before", "after")),
+    ]
+
+
 def _decompositions(dec: dict) -> dict[str, Sim]:
     """SX, SY, E of FIG. 2 and FIG. 3 recomputed from the printed A-F (``dec``: the rows of
     ``decompositions.parquet``)."""

@@ -21,7 +21,7 @@ from __future__ import annotations
 from sim.studies import Study, data_check
 from sim.studies.wolf.checks import check
 from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk
-from sim.studies.wolf.claims import load_book
+from sim.studies.wolf.claims import load_book, scored_ids
 from sim.studies.wolf.grid import grid_nodes, mid_cells, node_index
 from sim.studies.wolf.model import reading_error_rms
 from sim.studies.wolf.region import CELL, DECLARATION, nominal
@@ -64,7 +64,9 @@ STUDIES = {
         check,
         order=40,
         data=data_check(
-            load_book, (DECLARATION, nominal, {k: v for k, v in CELL.items() if "." in v})
+            load_book,
+            (DECLARATION, nominal, {k: v for k, v in CELL.items() if "." in v}),
+            scored=scored_ids,
         ),
     ),
 }

@@ -137,6 +137,43 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
     )
 
 
+def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
+    """The ids :func:`rows` scores, from the constants it loops over (no trial run, no table
+    read: the tables' plates and photographs are named here, their rows only selected): the
+    book's simulated rows whose statistic the experiment gives, the two families, the
+    paper-checks of Tables 1-3, the plate statistics and the cubic."""
+    stats = {f"{s}_{ax}_um" for s in STATS for ax in AXES}
+    return [
+        *(c for c in book.specs if stat_key(c) is not None and c.rsplit(".", 1)[1] in stats),
+        HEADLINE,
+        JOINT,
+        *(f"wolf.table1.p{p}.{s}_{ax}_um" for p in ("003", "005") for s in STATS for ax in AXES),
+        *(
+            f"wolf.table2_check.p{p}.set{st}.{s}_{ax}_um"
+            for p in ("003", "005")
+            for ax in AXES
+            for st in (1, 2)
+            for s in STATS
+        ),
+        *(f"wolf.table2_check.overall_{s}_um" for s in STATS),
+        *(
+            f"wolf.table3_check.p{p}.{s}_{ax}_um"
+            for p in ("501", "505")
+            for ax in AXES
+            for s in STATS
+        ),
+        "wolf.summary.mean_range_check",
+        *(
+            f"wolf.{pre}.{s}_{ax}_um"
+            for pre in ("check_after", "plate_after", "plate_before")
+            for s in ("max", "rms")
+            for ax in AXES
+        ),
+        *(f"wolf.before_{k}.rms_{ax}_um" for k in ("similarity", "affine") for ax in AXES),
+        CUBIC,
+    ]
+
+
 def _table_checks(t1: dict, t3: dict) -> dict[str, Sim]:
     """Paper-check rows: the summary lines recomputed from the paper's own printed data
     (Tables 1, 2 and 3, then the range of every recomputed mean line)."""

@@ -1,0 +1,75 @@
+"""The Python API's arguments checked as its config keys are: an argument a function of
+:mod:`sim.api` does not take, one given twice, too many or one missing is one
+:class:`sim.mc.config.ConfigError` line naming it and the ones the function takes, not
+Python's ``TypeError``."""
+
+from __future__ import annotations
+
+import functools
+import inspect
+
+from sim.mc.config import ConfigError
+
+__all__ = ["arguments"]
+
+
+def _key(k: str) -> str:
+    return k.replace("__", ".")
+
+
+def arguments(fn):
+    """``fn`` refusing an argument it does not take with one ConfigError line that names the
+    argument and the ones it takes (Python's TypeError named the function only: ``run()
+    got an unexpected keyword argument 'chunk'``); a config key given to ``run()`` is pointed
+    to ``sim.load()`` and ``replace()``."""
+    sig = inspect.signature(fn)
+    P = inspect.Parameter
+    method = next(iter(sig.parameters), "") == "self"
+    params = list(sig.parameters.values())[method:]
+    named = [p for p in params if p.kind not in (P.VAR_POSITIONAL, P.VAR_KEYWORD)]
+    positional = [p.name for p in named if p.kind != P.KEYWORD_ONLY]
+    parts = [", ".join(p.name for p in named)] if named else []
+    parts += ["config keys by name"] if any(p.kind == P.VAR_KEYWORD for p in params) else []
+    takes = " and ".join(parts) or "no argument"
+    known = None if any(p.kind == P.VAR_KEYWORD for p in params) else {p.name for p in named}
+    what = f"{fn.__qualname__.removesuffix('.__init__')}()"
+
+    def refusal(args: tuple, kwargs: dict) -> ConfigError:
+        for k in kwargs:
+            if known is not None and k not in known:
+                cfg = getattr(args[0], "config", None) if method and args else None
+                hint = (
+                    f"; {_key(k)} is a config key: give it to sim.load() or replace()"
+                    if isinstance(cfg, dict) and _key(k) in cfg
+                    else ""
+                )
+                return ConfigError(k, f"{what} takes no argument {k!r} (it takes {takes}){hint}")
+        given = args[method:]
+        for name in positional[: len(given)]:
+            if name in kwargs:
+                return ConfigError(name, f"{what} was given {name} twice")
+        if len(given) > len(positional):
+            at_most = (
+                f"at most {len(positional)} positional ({', '.join(positional)})"
+                if positional
+                else "no positional argument"
+            )
+            return ConfigError(what, f"takes {at_most}, got {len(given)} (it takes {takes})")
+        missing = [
+            p.name
+            for i, p in enumerate(named)
+            if p.default is P.empty and p.name not in kwargs and i >= len(given)
+        ]
+        return ConfigError(
+            missing[0] if missing else what, f"missing: {what} needs it (it takes {takes})"
+        )
+
+    @functools.wraps(fn)
+    def checked(*args, **kwargs):
+        try:
+            sig.bind(*args, **kwargs)
+        except TypeError:
+            raise refusal(args, kwargs) from None
+        return fn(*args, **kwargs)
+
+    return checked
