@@ -121,9 +121,9 @@ def test_an_exact_paper_setup_self_check_that_fails_is_itself_a_differing_input(
 @pytest.mark.parametrize(
     "spec, needle",
     [
-        ({"kind": "prediction", "form": "value", "ref": 1.0}, "not a prediction"),
-        ({"kind": "input", "form": "value", "ref": 1.0}, "not a input"),
-        ({"kind": "self-check"}, "this has none"),
+        ({"kind": "prediction", "form": "value", "ref": 1.0}, "only on a self-check"),
+        ({"kind": "input", "form": "value", "ref": 1.0}, "only on a self-check"),
+        ({"kind": "self-check"}, "with the paper's number (ref)"),
         (
             {"kind": "self-check", "form": "value", "ref": 1.0, "paper_setup": "yes"},
             "true or false",

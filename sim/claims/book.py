@@ -189,15 +189,10 @@ class ClaimBook:
                     raise ConfigError(
                         f"claim.{k}", f"{where} ({s['id']}): {k} without the paper's number (ref)"
                     )
-            if not isinstance(s.get("paper_setup", False), bool):
-                raise ConfigError("claim.paper_setup", f"{where} ({s['id']}): true or false")
-            if s.get("paper_setup") and (s["kind"] != "self-check" or "ref" not in s):
-                what = f"not a {s['kind']}" if s["kind"] != "self-check" else "this has none"
-                raise ConfigError(
-                    "claim.paper_setup",
-                    f"{where} ({s['id']}): marks a self-check whose ref is the paper's "
-                    f"setup's, {what}",
-                )
+            ps = s.get("paper_setup", False)  # true: a self-check's ref is the paper setup's
+            if not isinstance(ps, bool) or ps and (s["kind"] != "self-check" or "ref" not in s):
+                why = "true or false, true only on a self-check with the paper's number (ref)"
+                raise ConfigError("claim.paper_setup", f"{where} ({s['id']}): {why}")
             if not isinstance(s.get("why", ""), str):
                 raise ConfigError("claim.why", f"{where} ({s['id']}): why must be text")
             self.specs[s["id"]] = dict(s)
