@@ -1,0 +1,53 @@
+"""The classes of the sweep doors24d (issue 26: the seven paper studies' numbers checked three
+ways on designs a user would try with --set and [sweep]), one case each; each failed on the
+code before its fix. The harness that found them (an independent numpy recomputation of
+Brown's point cofactors for every model and layout, the Monte-Carlo spread against the
+analytic sigmas within chi-square bounds, every sigma times k, a sweep cell against the single
+run, and every claim row's outcome recomputed from its interval and zone by
+docs/verdict-rules.md) lives outside the project.
+
+* a claim about a resolution left out of ``tradeoff.dpis`` was scored as an exact 0 % gain:
+  ``agnard_block`` with ``--set "tradeoff.dpis=[600.0]"`` wrote
+  ``agnard.scanner.gain_300dpi_pct`` = 0 with the interval [0, 0], and the report read
+  "Calibration gains 0 % at 300 DPI and 5.6 % at 600 DPI ... (the 600 DPI gain's interval
+  lies above the 300 DPI one)": a comparison with a number nothing simulated. The row is now
+  absent (a declared claim this run does not produce) and the report says which resolution
+  the list lacks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sim.studies.agnard.claims import scanner_rows
+from sim.studies.agnard.report import _table1_line
+
+GAIN = "agnard.scanner.gain_{}dpi_pct"
+
+
+def _scan(dpis):
+    n = len(dpis)
+    return {
+        "dpi": np.repeat(np.asarray(dpis, float), 2),
+        "calibration": np.array(["raw", "corrected"] * n),
+        "gain_xy_pct": np.tile([0.0, 5.5], n),
+        "gain_xy_pct_se": np.tile([0.0, 0.5], n),
+        "trials": np.full(2 * n, 40),
+    }
+
+
+def test_a_resolution_not_simulated_has_no_gain_row():
+    rows = scanner_rows(_scan([600.0]))
+    assert rows[GAIN.format(300)] is None
+    assert rows[GAIN.format(600)].value == 5.5
+    both = scanner_rows(_scan([300.0, 600.0]))
+    assert both[GAIN.format(300)].value == 5.5 and both[GAIN.format(300)].ci[0] < 5.5
+
+
+def test_the_report_does_not_compare_a_gain_nothing_simulated():
+    g6 = {"value": 5.6, "ci_low": 4.5, "ci_high": 6.6}
+    line = _table1_line({GAIN.format(600): g6})
+    assert "lacks 300 DPI" in line and "0 % at 300" not in line and "lies above" not in line
+    g3 = {"value": 1.0, "ci_low": 0.5, "ci_high": 1.5}
+    line = _table1_line({GAIN.format(300): g3, GAIN.format(600): g6})
+    assert "1.0 % at 300 DPI and 5.6 % at 600 DPI" in line and "lies above" in line
