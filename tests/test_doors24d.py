@@ -13,14 +13,22 @@ docs/verdict-rules.md) lives outside the project.
   lies above the 300 DPI one)": a comparison with a number nothing simulated. The row is now
   absent (a declared claim this run does not produce) and the report says which resolution
   the list lacks.
+* ``brown_design``'s coverage and false-alarm rates took the interval v +- 1.96 sqrt(v(1-v)/N)
+  (docs/verdict-rules.md: a proportion gets the Wilson interval, never a normal one):
+  ``--set coverage.trials=10`` gave ``coverage.affine.false_alarm`` = 0 with the interval
+  [-6e-7, 6e-7], outcome "fails" against the zone [0.04, 0.06] (0 false alarms in 10 trials
+  cannot exclude 5 %: Wilson [0, 0.28], inconclusive), and coverages of 0.93 with intervals
+  up to 1.09. They now take the Wilson interval over the trials.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy import stats
 
 from sim.studies.agnard.claims import scanner_rows
 from sim.studies.agnard.report import _table1_line
+from sim.studies.design.claims import _coverage
 
 GAIN = "agnard.scanner.gain_{}dpi_pct"
 
@@ -51,3 +59,37 @@ def test_the_report_does_not_compare_a_gain_nothing_simulated():
     g3 = {"value": 1.0, "ci_low": 0.5, "ci_high": 1.5}
     line = _table1_line({GAIN.format(300): g3, GAIN.format(600): g6})
     assert "1.0 % at 300 DPI and 5.6 % at 600 DPI" in line and "lies above" in line
+
+
+def _cov_table(false_alarm, coverage, trials=10):
+    two = lambda v: [v, v]  # noqa: E731
+    return {
+        "coverage": {
+            "model": ["pivot", "affine"],
+            "scenario": two("nominal"),
+            "trials": two(trials),
+            "nonconverged": two(0),
+            "grid": two(5),
+            "dof": two(43),
+            "coverage_known": two(coverage),
+            "coverage_f": two(coverage),
+            "false_alarm": two(false_alarm),
+            "s0_ratio": two(1.0),
+            "s0_ratio_se": two(0.01),
+            "s0_expected": two(0.99),
+            "s0sq_ratio": two(1.0),
+        }
+    }
+
+
+def test_brown_design_rates_take_the_wilson_interval():
+    t = _coverage(_cov_table(0.0, 0.932))
+    fa, cov = t["coverage.affine.false_alarm"], t["coverage.pivot.coverage_known"]
+    wilson = stats.binomtest(0, 10).proportion_ci(0.95, "wilson")
+    assert fa.value == 0.0 and fa.ci[0] == 0.0
+    assert np.isclose(fa.ci[1], wilson.high, rtol=1e-9)  # 0.28: 0 of 10 cannot exclude 5 %
+    assert 0.0 <= cov.ci[0] < 0.932 < cov.ci[1] <= 1.0
+    w = stats.binomtest(3, 20).proportion_ci(0.95, "wilson")
+    fa = _coverage(_cov_table(0.15, 1.0, trials=20))["coverage.pivot.false_alarm"]
+    assert np.allclose(fa.ci, (w.low, w.high), rtol=1e-9)
+    assert _coverage(_cov_table(0.15, 1.0, trials=20))["coverage.pivot.coverage_f"].ci[1] == 1.0
