@@ -19,6 +19,12 @@ docs/verdict-rules.md) lives outside the project.
   [-6e-7, 6e-7], outcome "fails" against the zone [0.04, 0.06] (0 false alarms in 10 trials
   cannot exclude 5 %: Wilson [0, 0.28], inconclusive), and coverages of 0.93 with intervals
   up to 1.09. They now take the Wilson interval over the trials.
+* ``wolf_polynomial``'s ``wolf.degree.cubic_excess_pct`` ("the cubic's excess over the best
+  degree tried") compared the cubic with itself when the other degrees could not be
+  estimated on the grid: ``--set plate.spacing_mm=25.0 --set "trade.spacings_mm=[25.0]"
+  --set "trade.degrees=[3,4,5]"`` gave 0 % with the interval [0, 0] ("mean rms by degree: 3:
+  5.29 um"). Such a run now has no row (nothing was compared), as a trade-off without another
+  degree has none.
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ from scipy import stats
 from sim.studies.agnard.claims import scanner_rows
 from sim.studies.agnard.report import _table1_line
 from sim.studies.design.claims import _coverage
+from sim.studies.wolf.claims import _cubic_excess
 
 GAIN = "agnard.scanner.gain_{}dpi_pct"
 
@@ -93,3 +100,20 @@ def test_brown_design_rates_take_the_wilson_interval():
     fa = _coverage(_cov_table(0.15, 1.0, trials=20))["coverage.pivot.false_alarm"]
     assert np.allclose(fa.ci, (w.low, w.high), rtol=1e-9)
     assert _coverage(_cov_table(0.15, 1.0, trials=20))["coverage.pivot.coverage_f"].ci[1] == 1.0
+
+
+def _degt(rms4):
+    t = 20
+    return {
+        "spacing_mm": np.full(2 * t, 25.0),
+        "n_sets": np.full(2 * t, 3),
+        "degree": np.repeat([3, 4], t),
+        "check_rms_um": np.concatenate([np.linspace(5.0, 6.0, t), np.full(t, rms4)]),
+    }
+
+
+def test_wolf_cubic_is_not_compared_with_itself():
+    cfg = {"plate.spacing_mm": 25.0, "calib.n_sets": 3, "seed": 1, "trade.trials": 20}
+    assert _cubic_excess(cfg, _degt(np.nan)) is None  # degree 4 not estimable: cubic alone
+    both = _cubic_excess(cfg, _degt(5.0))
+    assert both.value > 0 and both.ci[1] > both.ci[0]  # 5.5 against 5.0: a real comparison
