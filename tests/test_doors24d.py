@@ -25,6 +25,10 @@ docs/verdict-rules.md) lives outside the project.
   --set "trade.degrees=[3,4,5]"`` gave 0 % with the interval [0, 0] ("mean rms by degree: 3:
   5.29 um"). Such a run now has no row (nothing was compared), as a trade-off without another
   degree has none.
+* ``gridplate_two_plates`` left the calibrations without a positive re-weighting fixed point
+  out of the comparator sigma's spread and the grid share without a word (``--set
+  plate.grid=3``: 31 of 200), and said "both plates" of one plate or four. The notes now say
+  how many were left out, and which plates are pooled.
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ from scipy import stats
 from sim.studies.agnard.claims import scanner_rows
 from sim.studies.agnard.report import _table1_line
 from sim.studies.design.claims import _coverage
+from sim.studies.gridplate import claims as gridplate_claims
 from sim.studies.wolf.claims import _cubic_excess
 
 GAIN = "agnard.scanner.gain_{}dpi_pct"
@@ -117,3 +122,24 @@ def test_wolf_cubic_is_not_compared_with_itself():
     assert _cubic_excess(cfg, _degt(np.nan)) is None  # degree 4 not estimable: cubic alone
     both = _cubic_excess(cfg, _degt(5.0))
     assert both.value > 0 and both.ci[1] > both.ci[0]  # 5.5 against 5.0: a real comparison
+
+
+def test_gridplate_notes_say_what_was_left_out_and_which_plates():
+    rng = np.random.default_rng(5)
+    comp = rng.normal(1.2, 0.1, 40)
+    comp[:6] = np.nan
+    res = {"gn_iterations": np.full(40, 2), "comp_sigma_um": comp, "aff_sigma_um": comp + 0.2}
+    res["sim_sigma_um"] = comp + 0.3
+    cfg = {
+        "comparator.coord_sigma_um": 1.2,
+        "readings.count": 4,
+        "readings.sigma_um": 1.5,
+        "analysis.iter_tol_um": 0.001,
+        "plate.count": 1,
+    }
+    rows = gridplate_claims._comparator(gridplate_claims.load_book(), cfg, res)
+    note = rows["twoplate.comparator_sigma.sigma_um"].note
+    assert "6 of 40 calibrations had no positive fixed point" in note and "both" not in note
+    assert "on the plate pooled" in note
+    share = gridplate_claims._shares(res)["twoplate.similarity_vs_affine.grid_share_linear_um"]
+    assert "6 of 40" in share.note
