@@ -29,6 +29,12 @@ docs/verdict-rules.md) lives outside the project.
   out of the comparator sigma's spread and the grid share without a word (``--set
   plate.grid=3``: 31 of 200), and said "both plates" of one plate or four. The notes now say
   how many were left out, and which plates are pooled.
+* ``wolf_polynomial`` run off the paper's calibration (``--set calib.degree=1``: a linear
+  correction, not the paper's ten-term cubic; or one reading, one set) still decided the
+  paper's predictions ("fails or undecided" on "after correction 5 um rms"), against the rule
+  that a prediction tests the paper only on a run whose printed inputs are the paper's: the
+  printed inputs were listed as not reproduced, with no exact input row to fail. They are now
+  exact input rows (``wolf.input.*``), and such a run's predictions are findings.
 """
 
 from __future__ import annotations
@@ -36,10 +42,14 @@ from __future__ import annotations
 import numpy as np
 from scipy import stats
 
+from sim.claims.rules import off_paper
+from sim.claims.table import claim_rows, exact
+from sim.studies import load_study
 from sim.studies.agnard.claims import scanner_rows
 from sim.studies.agnard.report import _table1_line
 from sim.studies.design.claims import _coverage
 from sim.studies.gridplate import claims as gridplate_claims
+from sim.studies.wolf import claims as wolf_claims
 from sim.studies.wolf.claims import _cubic_excess
 
 GAIN = "agnard.scanner.gain_{}dpi_pct"
@@ -143,3 +153,19 @@ def test_gridplate_notes_say_what_was_left_out_and_which_plates():
     assert "on the plate pooled" in note
     share = gridplate_claims._shares(res)["twoplate.similarity_vs_affine.grid_share_linear_um"]
     assert "6 of 40" in share.note
+
+
+def test_wolf_off_the_papers_calibration_is_not_a_test_of_it():
+    book = wolf_claims.load_book()
+    cfg = load_study("studies/wolf_polynomial.toml")[1]
+    ids = [f"wolf.input.{k}" for k in wolf_claims.PRINTED_INPUTS]
+    assert {"wolf.input.calib.degree", "wolf.input.reading.n", "wolf.input.calib.n_sets"} <= set(
+        ids
+    )
+    shipped = claim_rows(book, {i: exact(float(cfg[i[len("wolf.input.") :]])) for i in ids})
+    assert [r["outcome"] for r in shipped] == ["holds"] * len(ids)  # the study file is the paper's
+    pred = {"claim": "p", "kind": "prediction", "verdict": "holds", "outcome": "holds", "note": ""}
+    assert off_paper([*shipped, pred])[-1]["verdict"] == "holds"
+    linear = claim_rows(wolf_claims.load_book(), {"wolf.input.calib.degree": exact(1.0)})
+    assert linear[0]["outcome"] == "fails"
+    assert off_paper([*linear, pred])[-1]["verdict"] == "finding"

@@ -31,6 +31,9 @@ SIMULATED = {
 HEADLINE = "wolf.headline.mean_vs_mono_um"
 #: the cubic against the other degrees of the trade-off
 CUBIC = "wolf.degree.cubic_excess_pct"
+#: the printed inputs of the calibration, scored as exact ``input`` rows: a run that changes one
+#: is not a test of the paper (sim.claims.rules.off_paper makes its predictions findings)
+PRINTED_INPUTS = ("reading.n", "calib.n_sets", "calib.degree", "plate.spacing_mm", "reduce.ab_mm")
 #: Table 2 decided as one statement (Holm over its 24 one-plate rows)
 JOINT = "wolf.table2.joint_holm"
 
@@ -132,6 +135,10 @@ def rows(cfg: dict, main: dict, t1: dict, t3: dict, degt: dict, book: ClaimBook)
                 **_table_checks(t1, t3),
                 **_plate_stats(main, T),
                 CUBIC: _cubic_excess(cfg, degt),
+                **{
+                    f"wolf.input.{k}": exact(float(cfg[k]), "the configuration")
+                    for k in PRINTED_INPUTS
+                },
             },
         )
     )
