@@ -83,8 +83,8 @@ def scanner_rows(scan_t: dict) -> dict[str, Sim]:
     for d in (300.0, 600.0):
         cid = f"agnard.scanner.gain_{d:.0f}dpi_pct"
         i = np.flatnonzero((dpi == d) & (cal == "corrected"))
-        if i.size == 0:
-            rows[cid] = exact(0.0, f"{d:g} DPI not in tradeoff.dpis: not simulated in this run")
+        if i.size == 0:  # not in tradeoff.dpis: nothing simulated, no row (not a 0 % gain)
+            rows[cid] = None
             continue
         rows[cid] = mc(
             scan_t["gain_xy_pct"][i[0]],

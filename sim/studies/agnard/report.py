@@ -58,12 +58,23 @@ def anisotropy_text(c: dict, out: Path, cfg: dict) -> str:
 
 
 def _table1_line(c: dict) -> str:
-    g3, g6 = c["agnard.scanner.gain_300dpi_pct"], c["agnard.scanner.gain_600dpi_pct"]
+    lead = (
+        "- *Table 1* (not comparable: no input of the simulated scanner, peaking at the "
+        "paper's +-20 / +-40 um, reproduces it; see the scanner region above). "
+    )
+    g3, g6 = c.get("agnard.scanner.gain_300dpi_pct"), c.get("agnard.scanner.gain_600dpi_pct")
+    if g3 is None or g6 is None:  # a resolution not in tradeoff.dpis: not simulated
+        given = [f"{fmt(g['value'], 2)} % at {d} DPI" for d, g in ((300, g3), (600, g6)) if g]
+        return (
+            lead
+            + (f"Calibration gain {given[0]} in check-point XY rms; " if given else "")
+            + "tradeoff.dpis lacks "
+            + " and ".join(f"{d} DPI" for d, g in ((300, g3), (600, g6)) if g is None)
+            + ", so the two gains are not compared."
+        )
     apart = g6["ci_low"] > g3["ci_high"]
     return (
-        "- *Table 1* (not comparable: no input of the simulated scanner, peaking at the "
-        "paper's +-20 / +-40 um, reproduces it; see the scanner region above). Calibration gains "
-        f"{fmt(g3['value'], 2)} % at 300 "
+        lead + f"Calibration gains {fmt(g3['value'], 2)} % at 300 "
         f"DPI and {fmt(g6['value'], 2)} % at 600 DPI in check-point XY rms"
         + (
             " (the 600 DPI gain's interval lies above the 300 DPI one)."

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
+from sim.claims.intervals import binomial_ci
 from sim.claims.table import Sim, claim_rows, exact, mc, plates
 from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import StudyError
@@ -230,12 +231,17 @@ def _coverage(R: dict) -> dict[str, Sim]:
             )
         for key in ("coverage_known", "coverage_f", "false_alarm"):
             v = c[key][i]
-            se = math.sqrt(max(v * (1 - v), 1e-12) / N)  # per-trial averages: conservative
-            table[f"coverage.{m}.{key}"] = mc(
+            # a proportion: the Wilson interval over the N trials (the false alarms are
+            # counts; a coverage is a per-trial average over points, for which N is
+            # conservative), never v +- 1.96 se, which left [0, 1] and shrank to [0, 0]
+            # when no trial rejected (docs/verdict-rules.md, "Rules about sizes")
+            k = min(max(round(v * N) if key == "false_alarm" else v * N, 0.0), N)
+            _, lo, hi = binomial_ci(k, N)
+            table[f"coverage.{m}.{key}"] = Sim(
                 v,
-                se,
-                f"empirical rate over {N} trials x {c['grid'][i] ** 2} "
-                f"points; binomial interval over trials",
+                (float(lo), float(hi)),
+                note=f"empirical rate over {N} trials x {c['grid'][i] ** 2} "
+                f"points; Wilson interval over trials",
             )
         table[f"coverage.{m}.sigma0_over_c4"] = mc(
             c["s0_ratio"][i] / c["s0_expected"][i],

@@ -48,6 +48,22 @@ def _finite(x, what: str, key: str) -> np.ndarray:
     return f
 
 
+def _left_out(x) -> str:
+    """What a note says of the calibrations :func:`_finite` left out (nothing if none)."""
+    n = int(np.sum(~np.isfinite(np.asarray(x, float))))
+    return (
+        f" {n} of {np.size(x)} calibrations had no positive fixed point and are left out."
+        if n
+        else ""
+    )
+
+
+def _pooled(cfg: dict) -> str:
+    """Which plates a pooled s0 covers (the paper's two, or the configured count)."""
+    P = cfg["plate.count"]
+    return "both plates" if P == 2 else ("the plate" if P == 1 else f"all {P} plates")
+
+
 def _readings(cfg: dict, res: dict) -> dict[str, Sim]:
     """The precision of one reading (from the repeated readings) and the stated grid sigma."""
     L, N, P = cfg["readings.count"], cfg["plate.grid"] ** 2, cfg["plate.count"]
@@ -73,7 +89,7 @@ def _weighting(cfg: dict, res: dict) -> dict[str, Sim]:
         "twoplate.weight_ratio.grid_sigma_1to3_um": plates(
             res["grid_sigma_1to3_um"],
             "grid sigma implied by the weights, s0/sqrt(P_cx), P_x:P_cx = 1:3, "
-            "x' and y' of both plates pooled; expectation sqrt((sx'^2 + sg^2)/(1 + "
+            f"x' and y' of {_pooled(cfg)} pooled; expectation sqrt((sx'^2 + sg^2)/(1 + "
             f"P_cx)) = {math.sqrt((sx**2 + sgt**2) / 4):.3f} um from the "
             "simulated comparator and grid sigmas.",
         )
@@ -136,8 +152,9 @@ def _comparator(book: ClaimBook, cfg: dict, res: dict) -> dict[str, Sim]:
         ),
         "twoplate.comparator_sigma.sigma_um": plates(
             comp,
-            f"s0 (P_x = 1) of the re-weighted combined adjustment, x' and y' on both "
-            f"plates pooled; the truth is an input ({sx:g} um).",
+            f"s0 (P_x = 1) of the re-weighted combined adjustment, x' and y' on "
+            f"{_pooled(cfg)} pooled; the truth is an input ({sx:g} um)."
+            + _left_out(res["comp_sigma_um"]),
         ),
         "twoplate.comparator_sigma.mean_of_L": exact(
             best,
@@ -239,7 +256,7 @@ def _shares(res: dict) -> dict[str, Sim]:
         "twoplate.similarity_vs_affine.grid_share_linear_um": plates(
             _finite(aff - res["comp_sigma_um"], "the grid share", "grid.sigma_stated_um"),
             "affine sigma (grid fixed) minus the re-weighted comparator sigma per "
-            "calibration (linear), against the printed value.",
+            "calibration (linear), against the printed value." + _left_out(res["comp_sigma_um"]),
         ),
     }
 
