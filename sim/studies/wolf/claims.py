@@ -148,7 +148,7 @@ def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
     """The ids :func:`rows` scores, from the constants it loops over (no trial run, no table
     read: the tables' plates and photographs are named here, their rows only selected): the
     book's simulated rows whose statistic the experiment gives, the two families, the
-    paper-checks of Tables 1-3, the plate statistics and the cubic."""
+    paper-checks of Tables 1-3, the plate statistics, the cubic and the printed inputs."""
     stats = {f"{s}_{ax}_um" for s in STATS for ax in AXES}
     return [
         *(c for c in book.specs if stat_key(c) is not None and c.rsplit(".", 1)[1] in stats),
@@ -178,6 +178,7 @@ def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
         ),
         *(f"wolf.before_{k}.rms_{ax}_um" for k in ("similarity", "affine") for ax in AXES),
         CUBIC,
+        *(f"wolf.input.{k}" for k in PRINTED_INPUTS),
     ]
 
 
