@@ -166,3 +166,46 @@ def test_a_file_that_cannot_be_written_is_named_not_its_temporary(tmp_path):
             raise PermissionError(errno.EACCES, "Permission denied", str(tmp))
     assert caught.value.filename == str(target)
     assert list(tmp_path.iterdir()) == []
+
+
+def _unreadable(monkeypatch, module, name: str, d: Path) -> None:
+    """``module.name`` (a reader of the directory ``d``) as on another user's directory of
+    mode 0700: Permission denied (root reads every directory, so the test says it)."""
+
+    def refuse(*args, **kwargs):
+        raise PermissionError(errno.EACCES, "Permission denied", str(d))
+
+    monkeypatch.setattr(module, name, refuse)
+
+
+def test_another_users_unreadable_results_are_one_line_in_the_cli_and_the_api(
+    tmp_path, monkeypatch, capsys
+):
+    """``--out`` of another user's results made under ``umask 077``: ``sim run`` said
+    "Permission denied: OUT" and the Python API raised PermissionError from the output check
+    (every refusal of ``run()`` is a ConfigError naming ``out``)."""
+    import sim
+    from sim.mc import outputs
+
+    out = tmp_path / "theirs"
+    out.mkdir()
+    (out / "run.json").write_text("{}")
+    _unreadable(monkeypatch, outputs, "read_record", out)
+    rc = main(["run", PLATE, *SMALL, "--overwrite", "--out", str(out)])
+    one_line(capsys, rc, f"--out: {out} cannot be read (Permission denied", prefix=SIM_ERROR)
+    handle = sim.load(PLATE, trials=40, chunk=2)
+    with pytest.raises(sim.ConfigError, match="out: .* cannot be read"):
+        handle.run(out=out, overwrite=True, quiet=True, figures=False)
+
+
+def test_verify_with_a_scratch_directory_of_another_user_is_one_line(tmp_path, monkeypatch, capsys):
+    """``make verify VERIFY_FLAGS="--scratch DIR"`` where ``DIR/<study>`` is another user's
+    (mode 0700): a traceback ending "PermissionError: [Errno 13] Permission denied"."""
+    from sim.report.verify import cli, rerun
+
+    _unreadable(monkeypatch, rerun, "_target", tmp_path / "network_plate")
+    argv = ["--results", str(ROOT / "results"), "--study", "network_plate"]
+    rc = cli.main([*argv, "--trials", "400", "--scratch", str(tmp_path)])
+    one_line(
+        capsys, rc, f"Permission denied: {tmp_path / 'network_plate'}", prefix="sim verify: error: "
+    )

@@ -130,9 +130,15 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
             f"{shown} holds the working directory, and the run replaces it (the shell would be "
             f"left in a deleted directory): run from outside it (cd {o.parent})",
         )
-    old = read_record(out)
+    try:  # another user's directory (umask 077): the API raised PermissionError here
+        old = read_record(out)
+        filled = any(out.iterdir())
+    except OSError as e:
+        raise ConfigError(
+            "--out", f"{shown} cannot be read ({e.strerror}; another user's?): choose another --out"
+        ) from None
     if old is None:
-        if any(out.iterdir()):
+        if filled:
             raise ConfigError(
                 "--out",
                 f"{shown} holds files but no sim run record (run.json); "
