@@ -28,6 +28,7 @@ without privileges:
 from __future__ import annotations
 
 import errno
+import logging
 import os
 import subprocess
 import sys
@@ -209,3 +210,46 @@ def test_verify_with_a_scratch_directory_of_another_user_is_one_line(tmp_path, m
     one_line(
         capsys, rc, f"Permission denied: {tmp_path / 'network_plate'}", prefix="sim verify: error: "
     )
+
+
+def _kernel_of_the_full_disk_test(a, b):  # a kernel of its own (compiled once per key)
+    return a - b
+
+
+def test_a_kernel_runs_when_numba_cannot_write_its_cache(monkeypatch):
+    """A read-only clone with ``HOME`` on a full disk: numba's cache index could not be
+    written and brown_table1 ended "sim: error: No space left on device", naming nothing."""
+    pytest.importorskip("numba")
+    from numba.core import caching
+
+    from sim.lsq import compile as compiling
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.delenv("SIM_NO_JIT", raising=False)
+    monkeypatch.setattr(caching.Cache, "save_overload", full)
+    monkeypatch.setattr(compiling, "_kernels", {})
+    monkeypatch.setattr(compiling, "_callers", {})
+    assert compiling.compiled(_kernel_of_the_full_disk_test)(5.0, 2.0) == 3.0
+
+
+def test_a_full_home_is_not_reported_by_the_sim_command():
+    """``HOME`` on a full disk: ``sim run`` printed matplotlib's "Could not save font_manager
+    cache [Errno 28] No space left on device" (from its font_manager logger, which the
+    filter on the "matplotlib" logger does not see) before its results, exit 0."""
+    import sim.__main__  # noqa: F401 - the sim command's filters
+
+    log = logging.getLogger("matplotlib.font_manager")
+    rec = log.makeRecord(
+        log.name,
+        logging.WARNING,
+        __file__,
+        1,
+        "Could not save font_manager cache %s",
+        (OSError(28, "No space left on device"),),
+        None,
+    )
+    assert not log.filter(rec)
+    other = log.makeRecord(log.name, logging.WARNING, __file__, 1, "findfont: %s", ("x",), None)
+    assert log.filter(other)

@@ -126,4 +126,15 @@ class _Writable:
         self.dispatcher = dispatcher
 
     def __call__(self, *args):
-        return self.dispatcher(*(_writable(a) for a in args))
+        args = tuple(_writable(a) for a in args)
+        try:
+            return self.dispatcher(*args)
+        except OSError:  # a kernel does no I/O: numba's disk cache could not be written (a
+            # full or read-only HOME: "No space left on device" ended the run); without it
+            from numba.core.caching import NullCache
+
+            if isinstance(getattr(self.dispatcher, "_cache", None), (NullCache, type(None))):
+                raise
+            for d in _kernels.values():  # every kernel (and helper) of the process uncached
+                d._cache = NullCache()
+            return self.dispatcher(*args)
