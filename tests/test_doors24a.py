@@ -253,3 +253,22 @@ def test_a_full_home_is_not_reported_by_the_sim_command():
     assert not log.filter(rec)
     other = log.makeRecord(log.name, logging.WARNING, __file__, 1, "findfont: %s", ("x",), None)
     assert log.filter(other)
+
+
+def test_a_study_file_that_may_not_be_read_is_one_line_in_the_api(tmp_path, monkeypatch):
+    """A colleague's study file of mode 0600: ``sim.load`` raised PermissionError from
+    pathlib (every refusal of ``load()`` is a ConfigError naming the file)."""
+    import sim
+
+    mine = tmp_path / "mine.toml"
+    mine.write_bytes(Path(PLATE).read_bytes())
+    real = Path.read_bytes
+
+    def refuse(self):
+        if self == mine:  # root reads every file: the test says it
+            raise PermissionError(errno.EACCES, "Permission denied", str(self))
+        return real(self)
+
+    monkeypatch.setattr(Path, "read_bytes", refuse)
+    with pytest.raises(sim.ConfigError, match=f"{mine}: cannot read the study file \\(Permission"):
+        sim.load(mine)
