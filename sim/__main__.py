@@ -25,13 +25,19 @@ class _CacheDirNotes(logging.Filter):
     removed at exit, and a run is as good as any other; two lines of advice on every run
     (a read-only HOME, a container) are not the command's to print."""
 
-    WORDS = ("mkdir -p failed for path", "is not a writable directory", "temporary cache directory")
+    WORDS = (
+        "mkdir -p failed for path",
+        "is not a writable directory",
+        "temporary cache directory",
+        "Could not save font_manager cache",  # a full HOME: the cache is made again next time
+    )
 
     def filter(self, record: logging.LogRecord) -> bool:
         return not any(w in str(record.msg) for w in self.WORDS)
 
 
-logging.getLogger("matplotlib").addFilter(_CacheDirNotes())  # before matplotlib loads
+for _name in ("matplotlib", "matplotlib.font_manager"):  # before matplotlib loads (a logger's
+    logging.getLogger(_name).addFilter(_CacheDirNotes())  # filter sees its own records only)
 
 from sim.cli import main as command  # noqa: E402
 from sim.ends import finish  # noqa: E402

@@ -80,7 +80,11 @@ def compiled(fn, reassociate: bool = False, helpers=(), **consts):
 
     ``consts`` (e.g. block sizes ``P_TERMS``, ``W``) are frozen into its globals as
     compile-time constants (numba treats globals as such), which lets the compiler unroll and
-    vectorise the small loops; each variant is compiled under its own name. ``helpers``:
+    vectorise the small loops; each variant is compiled under its own name. Where numba
+    finds no directory to cache in (a read-only clone, another user's checkout, with no
+    writable ``HOME``, ``XDG_CACHE_HOME`` or ``NUMBA_CACHE_DIR``: "cannot cache function ...
+    no locator available", exit 3 before this fallback) it is compiled uncached, once per
+    process, the same machine code. ``helpers``:
     functions ``fn`` calls by their global name, compiled here (without ``reassociate``) and
     bound in its globals. ``reassociate``: compile ``fn`` with :data:`REASSOCIATE`. Every
     kernel has ``error_model="numpy"``: a division by zero gives inf or NaN, as in NumPy,
@@ -98,7 +102,12 @@ def compiled(fn, reassociate: bool = False, helpers=(), **consts):
         f = types.FunctionType(fn.__code__, glb, name, fn.__defaults__, fn.__closure__)
         f.__qualname__ = name
         opts = {"fastmath": set(REASSOCIATE)} if reassociate else {}
-        _kernels[key] = njit(cache=True, error_model="numpy", **opts)(f)
+        try:
+            _kernels[key] = njit(cache=True, error_model="numpy", **opts)(f)
+        except RuntimeError as e:  # no place to cache in: compiled for this process alone
+            if "no locator available" not in str(e):
+                raise
+            _kernels[key] = njit(cache=False, error_model="numpy", **opts)(f)
         _callers[key] = _Writable(_kernels[key])
     return _callers[key]
 
@@ -117,4 +126,15 @@ class _Writable:
         self.dispatcher = dispatcher
 
     def __call__(self, *args):
-        return self.dispatcher(*(_writable(a) for a in args))
+        args = tuple(_writable(a) for a in args)
+        try:
+            return self.dispatcher(*args)
+        except OSError:  # a kernel does no I/O: numba's disk cache could not be written (a
+            # full or read-only HOME: "No space left on device" ended the run); without it
+            from numba.core.caching import NullCache
+
+            if isinstance(getattr(self.dispatcher, "_cache", None), (NullCache, type(None))):
+                raise
+            for d in _kernels.values():  # every kernel (and helper) of the process uncached
+                d._cache = NullCache()
+            return self.dispatcher(*args)

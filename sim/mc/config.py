@@ -382,6 +382,8 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         raise ConfigError(None, f"{p}: not UTF-8 text") from None
     except ValueError as e:  # an integer of over 4300 digits (Python's int-from-text limit)
         raise ConfigError(None, f"{p}: malformed TOML: {str(e).split(';')[0]}") from None
+    except OSError as e:  # another user's file (mode 0600): the API raised PermissionError
+        raise ConfigError(None, f"{p}: cannot read the study file ({e.strerror or e})") from None
 
 
 #: most chunks of one run (each is a file of the trials dataset, read back by every resume)

@@ -11,8 +11,12 @@ wrote and each chunk file's sha256 (sealing and publishing: :mod:`sim.mc.publish
 
 from __future__ import annotations
 
+import errno
+import fcntl
 import os
+import pwd
 import shutil
+import stat
 import unicodedata
 from pathlib import Path
 
@@ -126,19 +130,54 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
             f"{shown} holds the working directory, and the run replaces it (the shell would be "
             f"left in a deleted directory): run from outside it (cd {o.parent})",
         )
-    old = read_record(out)
+    try:  # another user's directory (umask 077): the API raised PermissionError here
+        old = read_record(out)
+        filled = any(out.iterdir())
+    except OSError as e:
+        raise ConfigError(
+            "--out", f"{shown} cannot be read ({e.strerror}; another user's?): choose another --out"
+        ) from None
     if old is None:
-        if any(out.iterdir()):
+        if filled:
             raise ConfigError(
                 "--out",
                 f"{shown} holds files but no sim run record (run.json); "
                 "sim never replaces it, with or without --overwrite",
             )
+        _check_replaceable(out, shown)
         return
     if _same(old, record) or overwrite:
+        _check_replaceable(out, shown)
         return
     raise ConfigError(
         "--out", f"{shown} holds results of {_differs(old, record)}; use --overwrite to replace it"
+    )
+
+
+def _check_replaceable(out: Path, shown: str) -> None:
+    """Refuse, before any work, an existing ``out`` that this user may not replace at the
+    run's end (a rename in its parent): a parent not writable by this user, or one with the
+    sticky bit (``/tmp``, a shared results folder) when neither ``out`` nor the parent is this
+    user's. The run of another user's results computed every chunk, then ended "Operation not
+    permitted: OUT" and left its staging directory beside them."""
+    parent = out.parent
+    try:
+        st = parent.stat()
+        owner = out.stat().st_uid
+    except OSError:
+        return  # (what cannot be read is named where it is read)
+    me = os.geteuid()
+    ids = os.access in os.supports_effective_ids
+    if not os.access(parent, os.W_OK | os.X_OK, effective_ids=ids):
+        why = f"you may not write in {parent}"
+    elif st.st_mode & stat.S_ISVTX and me != 0 and me not in (owner, st.st_uid):
+        why = f"it is {_owner(out)}'s, and {parent} has the sticky bit: only they may rename it"
+    else:
+        return
+    raise ConfigError(
+        "--out",
+        f"{shown} cannot be replaced by this run ({why}; a run replaces its output directory at "
+        "its end): choose another --out",
     )
 
 
@@ -251,7 +290,7 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
             "--out", f"{e.path} is not a lock file of sim (a link or a pipe); move it away"
         ) from None
     except OSError as e:
-        raise ConfigError("--out", f"cannot write to {out.parent}: {e.strerror}") from None
+        raise ConfigError("--out", _not_lockable(stage, out, shown, e)) from None
     try:
         damage = _damage(stage) if stage.is_dir() else None
         if damage is not None:
@@ -289,6 +328,63 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
         drop_stage(stage, lock)
         raise
     return lock, resumed
+
+
+def _owner(p: Path) -> str:
+    """The user who owns ``p``, by name where the system knows it (else ``uid N``)."""
+    try:
+        uid = p.lstat().st_uid
+    except OSError:
+        return "another user"
+    try:
+        return pwd.getpwuid(uid).pw_name
+    except (KeyError, OverflowError):
+        return f"uid {uid}"
+
+
+def _holder(lock: Path) -> tuple[bool, int | None]:
+    """Whether a process holds the lock ``lock`` that this user may not write (another user's
+    run), and its pid: the lock is tested through a read-only descriptor (a shared lock,
+    dropped at once; never through a link)."""
+    try:
+        fd = os.open(lock, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return False, None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return False, None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            try:
+                return True, int(os.read(fd, 32).decode().strip() or 0) or None
+            except (OSError, ValueError):
+                return True, None
+        return False, None
+    finally:
+        os.close(fd)
+
+
+def _not_lockable(stage: Path, out: Path, shown: str, e: OSError) -> str:
+    """Why the staging directory could not be locked, in words: another user's run writing
+    it now, or another user's unfinished run (its staging directory or lock file not ours to
+    write: it was "cannot write to <parent>: Permission denied", naming the wrong directory
+    and no process), else the directory that could not be written."""
+    if e.errno in (errno.EACCES, errno.EPERM) and stage.is_dir() and not stage.is_symlink():
+        held, pid = _holder(stage / LOCK)
+        if held:
+            who = f"pid {pid}" if pid else "another process"
+            return (
+                f"{shown} is being written by a running sim ({who} of user "
+                f"{_owner(stage / LOCK)}); "
+                "wait for it to finish or choose another --out"
+            )
+        return (
+            f"{stage} holds an unfinished run of another user ({_owner(stage)}) that you may "
+            f"not write in ({e.strerror}): ask them to finish or remove it, or choose another "
+            "--out"
+        )
+    return f"cannot write to {out.parent}: {e.strerror}"
 
 
 def drop_stage(stage: Path, lock, reason: str | None = None) -> None:

@@ -201,15 +201,16 @@ class atomic_path:
         if exc_type is None:
             try:
                 os.replace(self.tmp, self.path)
-            except OSError:  # e.g. a directory where the file goes: leave no temporary behind
-                self.tmp.unlink(missing_ok=True)
-                raise
+            except OSError as e:  # e.g. a directory where the file goes: leave no temporary
+                self.tmp.unlink(missing_ok=True)  # behind, and name the file, not it
+                raise _named(e, self.path) from None
         else:
             self.tmp.unlink(missing_ok=True)
-            if isinstance(exc, OSError) and not exc.filename:
+            if isinstance(exc, OSError) and exc.filename in (None, "", str(self.tmp)):
                 # a failing write (ulimit -f: EFBIG, a full disk) says only "File too large";
                 # pyarrow's says "Error writing bytes to file. Detail: [errno 27] ...": name
-                # the file it was writing
+                # the file it was writing (not the temporary, ".README.md.9762.tmp", a name
+                # the user never saw: a directory of another user's, read-only)
                 raise _named(exc, self.path) from None
 
 
@@ -400,9 +401,11 @@ class StageLock:
     def acquire(self) -> "StageLock":
         self.created = not self.stage.exists()
         self.stage.mkdir(parents=True, exist_ok=True)
-        path = self.stage / LOCK  # written into: never through a link to another file
+        # written into: never through a link to another file; its mode is the umask's, as for
+        # every file of a run (0o644 kept a group's other members from resuming their runs)
+        path = self.stage / LOCK
         try:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o666)
         except OSError as e:
             if e.errno == errno.ELOOP:  # a symbolic link
                 raise NotALock(path) from None

@@ -172,6 +172,10 @@ def _main(argv: list[str] | None) -> int:
     except VerifyError as e:
         print(f"sim verify: error: {e}", file=sys.stderr)
         return 2
+    except OSError as e:  # a --scratch or results of another user's that may not be read:
+        where = f": {e.filename}" if e.filename else ""  # it was a traceback
+        print(f"sim verify: error: {e.strerror or e}{where}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print(INTERRUPTED, file=sys.stderr)
         return 130
