@@ -7,7 +7,7 @@ import re
 
 import numpy as np
 
-__all__ = ["fmt", "md_table"]
+__all__ = ["fmt", "md_table", "md_text", "md_code", "Md"]
 
 
 def fmt(x, digits: int = 3) -> str:
@@ -30,11 +30,48 @@ def fmt(x, digits: int = 3) -> str:
     return str(x)
 
 
+class Md(str):
+    """Text already in Markdown form (:func:`md_text`): :func:`md_table` writes it as it is."""
+
+
+#: what Markdown or HTML reads as markup in a line of text: emphasis, code, links, tags,
+#: entities, strike-through, a table's pipe, and the backslash that escapes them
+_ACTIVE = re.compile(r"[\\`*_\[\]<>&~|]")
+
+
+def md_text(s) -> Md:
+    """A user's text (a point or network name) as Markdown that shows it as written
+    (doors24c): a point named ``<b>`` or ``&amp;`` was HTML in the README (bold for the rest
+    of the cell, an ``&``), ``*a*`` italic, a backtick opened code. Each such character is
+    escaped with a backslash; an underscore inside a word (``P_1``) cannot mark emphasis and
+    is left as it is."""
+    s = str(s).replace("\n", " ")
+
+    def esc(m: re.Match) -> str:
+        a, b = m.start(), m.end()
+        inner = 0 < a and b < len(s) and s[a - 1].isalnum() and s[b].isalnum()
+        return m[0] if m[0] == "_" and inner else "\\" + m[0]
+
+    return Md(_ACTIVE.sub(esc, s))
+
+
+def md_code(s) -> str:
+    """``s`` as an inline code span that shows it as written: fenced by more backticks than
+    any run inside it (a name with a backtick ended a one-backtick span early)."""
+    s = str(s).replace("\n", " ")
+    if "`" not in s:
+        return f"`{s}`"
+    fence = "`" * (max(len(r) for r in re.findall(r"`+", s)) + 1)
+    return f"{fence} {s} {fence}"
+
+
 def _cell(s) -> str:
     """A table cell's text: a pipe escaped (``\\|``), and the backslashes just before it
     doubled, so that a name ending in a backslash (``P\\``) does not escape the pipe's
     escape and split the row into one cell more (GitHub reads ``\\\\|`` as a backslash and a
-    cell's end); a line break made a space."""
+    cell's end); a line break made a space. :class:`Md` text is written as it is."""
+    if isinstance(s, Md):
+        return str(s)
     s = re.sub(r"(\\*)\|", lambda m: m[1] * 2 + "\\|", str(s))
     return s.replace("\n", " ")
 
