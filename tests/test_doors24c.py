@@ -232,3 +232,18 @@ def test_wolfs_table_with_a_decimal_comma_is_refused_not_shifted(tmp_path):
     p.write_text(text.replace(row, row.replace("33.221", "33,221", 1)), encoding="utf-8")
     with pytest.raises(ConfigError, match=r"data row 2 has 10 cells for the header's 9"):
         load_table1(p)
+
+
+def test_a_path_in_another_unicode_form_than_the_files_name_is_named(tmp_path, capsys):
+    """``café.xml`` typed precomposed (NFC) for a file saved decomposed (NFD, as macOS writes
+    names) is another name to Linux: it was "no such file" of a name ``ls`` shows alike."""
+    nfc, nfd = "caf\u00e9", "cafe\u0301"
+    (tmp_path / f"{nfd}.xml").write_bytes(TWO_SETS.read_bytes())
+    (tmp_path / f"{nfd}.toml").write_bytes(BROWN.read_bytes())
+    (tmp_path / f"{nfd}.csv").write_bytes(TABLE1.read_bytes())
+    why = "its name in another Unicode form (U+0065 U+0301 against U+00E9)"
+    one_line(capsys, cli.main(["check", str(tmp_path / f"{nfc}.toml")]), why)
+    with pytest.raises(ConfigError, match=re.escape(why)):
+        read_gama(tmp_path / f"{nfc}.xml")
+    with pytest.raises(ConfigError, match=re.escape(why)):
+        load_table1(tmp_path / f"{nfc}.csv")

@@ -14,6 +14,7 @@ import stat
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.paths import link_problem
 from sim.studies.network.validate import _point_name
 
 __all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes", "ws", "words"]
@@ -229,6 +230,8 @@ def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
     except OSError as e:
         slash = str(path).replace("\\", "/")  # a Windows path pasted into the study file
         hint = f" (did you mean {slash}?)" if slash != str(path) and Path(slash).is_file() else ""
+        if why := link_problem(path):  # a loop of links, a name of another Unicode form
+            raise ConfigError(key, f"cannot read {path}: it {why}") from None
         raise ConfigError(key, f"cannot read {path}: {e.strerror}{hint}") from None
     if not stat.S_ISREG(st.st_mode):
         raise ConfigError(key, f"{path} is not a regular file")
