@@ -186,15 +186,15 @@ def _shown(md: str) -> str:
     out, k = "", 0
     while k < len(md):
         c = md[k]
-        if c == "\\" and k + 1 < len(md) and md[k + 1] in "\\`*_[]<>&~|":
+        if c == "\\" and k + 1 < len(md) and md[k + 1] in "\\`*_[]<>&~|$":
             out, k = out + md[k + 1], k + 2
             continue
-        assert c not in "`*[]<>&~|\\", (md, k)  # unescaped: read as markup
+        assert c not in "`*[]<>&~|$\\", (md, k)  # unescaped: read as markup
         out, k = out + c, k + 1
     return out
 
 
-@pytest.mark.parametrize("name", ["<b>&amp;", "*x*", "a`b", "_P_", "A\\|B", "P_1", "É😀"])
+@pytest.mark.parametrize("name", ["<b>&amp;", "*x*", "a`b", "_P_", "A\\|B", "P_1", "É😀", "$x$"])
 def test_a_users_name_in_markdown_shows_as_written(name):
     assert _shown(md_text(name)) == name
     row = md_table(["point"], [[md_text(name)]]).splitlines()[2]
@@ -247,3 +247,20 @@ def test_a_path_in_another_unicode_form_than_the_files_name_is_named(tmp_path, c
         read_gama(tmp_path / f"{nfc}.xml")
     with pytest.raises(ConfigError, match=re.escape(why)):
         load_table1(tmp_path / f"{nfc}.csv")
+
+
+def test_a_network_name_with_dollars_is_drawn_as_written(tmp_path, capsys):
+    """matplotlib reads text between two ``$`` as mathtext: ``net $\\alpha$`` was titled
+    "net α", and ``$\\foo{$`` failed the run at its figure, after every trial (exit 2)."""
+    from matplotlib.text import Text
+
+    from sim.studies.network.figures import literal
+
+    name = "net $\\foo{$ $\\alpha$ a\\$b"
+    assert Text()._preprocess_math(literal(name)) == (name, False)  # no math, as written
+    p = tmp_path / "dollar.toml"
+    p.write_text(
+        NET.format(a="A", b="B", c="B").replace("[network]", f"[network]\nname = '{name}'")
+    )
+    assert cli.main(["run", str(p), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert (tmp_path / "o" / "network.png").is_file()

@@ -35,8 +35,8 @@ class Md(str):
 
 
 #: what Markdown or HTML reads as markup in a line of text: emphasis, code, links, tags,
-#: entities, strike-through, a table's pipe, and the backslash that escapes them
-_ACTIVE = re.compile(r"[\\`*_\[\]<>&~|]")
+#: entities, strike-through, a table's pipe, GitHub's math (``$``), and the backslash
+_ACTIVE = re.compile(r"[\\`*_\[\]<>&~|$]")
 
 
 def md_text(s) -> Md:
