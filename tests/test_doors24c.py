@@ -264,3 +264,17 @@ def test_a_network_name_with_dollars_is_drawn_as_written(tmp_path, capsys):
     )
     assert cli.main(["run", str(p), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     assert (tmp_path / "o" / "network.png").is_file()
+
+
+def test_report_links_a_results_directory_of_any_name(tmp_path, capsys):
+    """``[my net (v2)*](my net (v2)*/README.md)`` was no link (a space ends a link's target)
+    and its star began emphasis; the committed names are written as they were."""
+    import shutil
+
+    shutil.copytree(ROOT / "results" / "network_plate", tmp_path / "my net (v2)*")
+    shutil.copytree(ROOT / "results" / "network_plate", tmp_path / "network_plate")
+    assert cli.main(["report", "--results", str(tmp_path)]) == 0
+    capsys.readouterr()
+    text = (tmp_path / "REPORT.md").read_text(encoding="utf-8")
+    assert "[my net (v2)\\*](my%20net%20%28v2%29%2A/README.md)" in text
+    assert "(my net" not in text and "[network_plate](network_plate/README.md)" in text

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import math
 import re
+from urllib.parse import quote
 
 import numpy as np
 
-__all__ = ["fmt", "md_table", "md_text", "md_code", "Md"]
+__all__ = ["fmt", "md_table", "md_text", "md_code", "md_link", "md_href", "Md"]
 
 
 def fmt(x, digits: int = 3) -> str:
@@ -63,6 +64,18 @@ def md_code(s) -> str:
         return f"`{s}`"
     fence = "`" * (max(len(r) for r in re.findall(r"`+", s)) + 1)
     return f"{fence} {s} {fence}"
+
+
+def md_href(name: str, leaf: str = "README.md") -> str:
+    """The link target ``name/leaf``, percent-encoded: a results directory named
+    ``my net (v2)`` was no link in REPORT.md (a space ends a link's target)."""
+    return quote(f"{name}/{leaf}")
+
+
+def md_link(name: str, leaf: str = "README.md") -> Md:
+    """``[name](name/leaf)``: the name shown as written (:func:`md_text`), the target encoded
+    (:func:`md_href`); a plain name (``brown_table1``) is written as it was."""
+    return Md(f"[{md_text(name)}]({md_href(name, leaf)})")
 
 
 def _cell(s) -> str:
