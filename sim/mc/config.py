@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
+from sim.mc.lookalike import char_name, note
 from sim.mc.paths import link_problem
 
 __all__ = [
@@ -74,11 +75,14 @@ def _shorten(message: str) -> str:
 
 
 class ConfigError(ValueError):
-    """A bad study configuration. ``str(err)`` is one line naming the key."""
+    """A bad study configuration. ``str(err)`` is one line naming the key; a character in it
+    that looks like an ASCII one but is not (a Cyrillic letter in a key, a full-width digit)
+    is named (:func:`sim.mc.lookalike.note`): the message quoted text that looked right."""
 
     def __init__(self, key: str | None, message: str):
         self.key = key  # a number of hundreds of digits is shortened in any message
-        super().__init__(_shorten(f"{key}: {message}" if key else message))
+        text = f"{key}: {message}" if key else message
+        super().__init__(_shorten(text + note(text)))
 
 
 class StudyError(RuntimeError):
@@ -344,6 +348,20 @@ def study_file_hint(p: str | Path) -> str:
     return f" (did you mean {hit}?)" if hit else ""
 
 
+def _char_hint(line: str, col: int) -> str:
+    """What the character at ``col`` (1-based) of a malformed TOML ``line`` is, when nothing
+    shows it: a line ended by a lone CR (classic Mac OS), or a character that is not ASCII --
+    invisible (a second byte-order mark, a zero-width or no-break space) or drawn as ASCII (a
+    Cyrillic letter in a key): "at line 6, column 4" of ``triаls = 5`` pointed at nothing
+    the user could see."""
+    c = line[col - 1 : col]
+    if c == "\r" and line[col : col + 1] != "":  # tomllib's line ends at "\n" only
+        return " (a lone CR ends the line, as classic Mac OS saved text: save it with LF ends)"
+    if c and not c.isascii():
+        return f" (the character there is {c!r}, {char_name(c)})"
+    return ""
+
+
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML study file; a missing, oversized or malformed file is a ConfigError."""
     p = Path(path)
@@ -370,16 +388,23 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again
         raise
     except tomllib.TOMLDecodeError as e:
-        at = re.search(r"at line (\d+)", str(e))  # tomllib before 3.14: in the text only
-        n = int(at.group(1)) if at else 0
-        line = data.decode("utf-8").splitlines()[n - 1 : n] if n else []
-        curly = [c for c in "".join(line) if c in TYPOGRAPHIC]  # a word processor's quotes
+        at = re.search(r"at line (\d+), column (\d+)", str(e))  # before 3.14: in the text only
+        n, col = (int(at.group(1)), int(at.group(2))) if at else (0, 0)
+        line = "".join(data.decode("utf-8").split("\n")[n - 1 : n] if n else [])  # as tomllib
+        curly = [c for c in line if c in TYPOGRAPHIC]  # a word processor's quotes
         hint = f' (the typographic quote {curly[0]} is no TOML quote: type ")' if curly else ""
-        raise ConfigError(None, f"{p}: malformed TOML: {e}{hint}") from None
+        raise ConfigError(
+            None, f"{p}: malformed TOML: {e}{hint or _char_hint(line, col)}"
+        ) from None
     except RecursionError:
         raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None
-    except UnicodeDecodeError:
-        raise ConfigError(None, f"{p}: not UTF-8 text") from None
+    except UnicodeDecodeError as e:  # where, and the likely encoding (it was "not UTF-8 text")
+        line = data[: e.start].count(b"\n") + 1
+        raise ConfigError(
+            None,
+            f"{p}: not UTF-8 text (byte 0x{data[e.start]:02x} at line {line}: saved as Latin-1 "
+            "or Windows-1252? save it as UTF-8)",
+        ) from None
     except ValueError as e:  # an integer of over 4300 digits (Python's int-from-text limit)
         raise ConfigError(None, f"{p}: malformed TOML: {str(e).split(';')[0]}") from None
     except OSError as e:  # another user's file (mode 0600): the API raised PermissionError

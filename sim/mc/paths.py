@@ -3,14 +3,20 @@
 pathlib's ``is_file``, ``is_dir`` and ``exists`` read a loop of links (the system's "too many
 levels of symbolic links") as no file at all: a study file that is such a loop read "no such
 study file", of a name ``ls`` shows. Each door that finds a path missing asks
-:func:`link_problem` first, and says what is in the way.
+:func:`link_problem` first, and says what is in the way. So is a name in another Unicode form
+than the file's (doors24c): ``café.xml`` typed precomposed (NFC) for a file saved decomposed
+(NFD, as macOS writes names) is another name to Linux, and was "no such file" of a name
+``ls`` shows alike.
 """
 
 from __future__ import annotations
 
 import errno
 import os
+import unicodedata
 from pathlib import Path
+
+from sim.mc.lookalike import differs
 
 __all__ = ["link_problem"]
 
@@ -28,7 +34,29 @@ def link_problem(p: str | os.PathLike) -> str | None:
     if _errno(p) == errno.ENOENT and os.path.islink(p):
         to = os.readlink(p)
         return f"is a symbolic link to {to if to.isprintable() else repr(to)}, which does not exist"
+    if _errno(p) == errno.ENOENT:
+        return _other_form(Path(p))
     return None
+
+
+def _other_form(q: Path) -> str | None:
+    """`` is not there; '...' is, its name in another Unicode form (...)`` for the first missing
+    part of ``q`` whose directory holds a name that differs from it in normalisation only."""
+    a = next((a for a in (*reversed(q.parents), q) if not os.path.lexists(a)), None)
+    if a is None or not a.name:
+        return None
+    want = unicodedata.normalize("NFC", a.name)
+    try:
+        names = os.listdir(a.parent)
+    except (OSError, ValueError):
+        return None
+    hit = next((n for n in names if n != a.name and unicodedata.normalize("NFC", n) == want), None)
+    if hit is None:
+        return None
+    return (
+        f"is not there; {str(a.parent / hit)!r} is, its name in another Unicode form "
+        f"({differs(hit, a.name)}): give the name as the file has it"
+    )
 
 
 def _errno(p: str | os.PathLike) -> int | None:

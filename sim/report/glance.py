@@ -15,7 +15,7 @@ from sim.mc.storage import read_provenance
 from sim.report.claimtext import decimals_for, exact_text, fmt_at
 from sim.report.papers import paper_name
 from sim.report.run_summary import headline_rows, region_line, verdict_line
-from sim.report.tables import fmt, md_table
+from sim.report.tables import Md, fmt, md_link, md_table
 
 __all__ = ["opening", "by_paper", "main_and_variants", "number", "VERDICT_TEXT"]
 
@@ -142,7 +142,7 @@ def _variant_note(results: Path, name: str, study, claims: list, of: str) -> str
         ", ..." if len(diff) > 4 else ""
     )
     return (
-        f"- [{name}]({name}/README.md) is the study `{of}` again at another configuration"
+        f"- {md_link(name)} is the study `{of}` again at another configuration"
         + (f" ({what})" if what else "")
         + f": {verdict_line(claims).split(': ', 1)[1]}; not counted in the row above."
     )
@@ -151,7 +151,7 @@ def _variant_note(results: Path, name: str, study, claims: list, of: str) -> str
 def _paper_row(seed: str, studies: list[tuple]) -> list[str]:
     """One row: the paper and its studies (linked), the counts, three headline claims with
     their values and verdicts (one per line of the cell)."""
-    links = ", ".join(f"[{name}]({name}/README.md)" for name, _, _ in studies)
+    links = Md(", ".join(md_link(name) for name, _, _ in studies))
     counts = verdict_line([r for _, _, c in studies for r in c]).split(": ", 1)[1]
     picks = [r for _, r in _headline_pick(studies)]
     if not picks:
@@ -178,7 +178,7 @@ def opening(entries: list[tuple], results: Path) -> str:
     for _, name, study, _, _ in entries:
         if name != study.name and name in names:
             variants.append(
-                f"- [{name}]({name}/README.md) holds the results of the study `{study.name}` "
+                f"- {md_link(name)} holds the results of the study `{study.name}` "
                 f"(its tables say so), not of `{name}`: a directory renamed or swapped by hand"
             )
     for seed in sorted(s for s in by_seed if s):
@@ -194,8 +194,7 @@ def opening(entries: list[tuple], results: Path) -> str:
         notes.append(
             "- Network studies (a declared network, no paper): "
             + "; ".join(
-                f"[{name}]({name}/README.md) {verdict_line(c).split(': ', 1)[1]}"
-                for name, _, c in nets
+                f"{md_link(name)} {verdict_line(c).split(': ', 1)[1]}" for name, _, c in nets
             )
         )
     table = md_table(
@@ -221,7 +220,7 @@ def design_notes(entries: list[tuple], results: Path, design: Callable | None) -
             f"`{k}` = {fmt(mine.get(k))} (the file: {fmt(base.get(k))})" for k in diff[:6]
         ) + (f", and {len(diff) - 6} more" if len(diff) > 6 else "")
         out.append(
-            f"- [{name}]({name}/README.md) did not run the configuration of "
+            f"- {md_link(name)} did not run the configuration of "
             f"`studies/{name}.toml`: {what}. Its verdicts are about this run's configuration, "
             "not the study file's design."
         )

@@ -24,7 +24,7 @@ from sim.report.glance import by_paper, design_notes, main_and_variants, number,
 from sim.report.papers import paper_name
 from sim.report.read import claims_damage, forget, mixed_run, older, records
 from sim.report.run_summary import headline_rows, write_run_readme
-from sim.report.tables import fmt, md_table
+from sim.report.tables import Md, fmt, md_href, md_link, md_table
 from sim.report.verify import markdown as reproducibility_markdown
 
 __all__ = [
@@ -175,7 +175,7 @@ def referee_summary(entries: list[tuple]) -> str:
                 nc = r["verdict"] == "not comparable"
                 rows.append(
                     [
-                        f"[`{r['claim']}`]({name}/README.md){also}",
+                        f"[`{r['claim']}`]({md_href(name)}){also}",
                         r["paper"],
                         ref_text(r),
                         "" if nc else sim_text(r),
@@ -257,7 +257,7 @@ def _entry(d: Path, get_study: Callable) -> tuple:
     c = verdict_counts(claims)
     nr = d / "not_reproduced.parquet"
     n_nr = read_table(nr).num_rows if nr.is_file() else 0
-    row = [f"[{d.name}]({d.name}/README.md): {study.title}", paper_name(study.seed_file) or "—"]
+    row = [Md(f"{md_link(d.name)}: {study.title}"), paper_name(study.seed_file) or "—"]
     row += [c[k] for k, _ in _COUNT_COLS]
     apart = [
         f"{c[f'self-check {w}']} {w}"
@@ -303,8 +303,8 @@ def build_report(results: Path, get_study: Callable, design: Callable | None = N
         [e[4] for e in entries],
     )
     repro = reproducibility_markdown(results)
-    details = [f"- [{e[1]}]({e[1]}/README.md): {e[2].title}" for e in entries]
-    details += [f"- [{s}]({s}/README.md): a sweep" for s in sweeps]
+    details = [f"- {md_link(e[1])}: {e[2].title}" for e in entries]
+    details += [f"- {md_link(s)}: a sweep" for s in sweeps]
     return (
         head
         + opening(entries, results)

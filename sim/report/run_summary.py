@@ -19,7 +19,7 @@ from sim.report.claimtext import interval_text, sim_text
 from sim.report.papers import paper_name
 from sim.report.read import columns, forget, records
 from sim.report.sweep import sweep_markdown
-from sim.report.tables import fmt
+from sim.report.tables import fmt, md_code, md_text
 
 __all__ = [
     "VERDICT_ORDER",
@@ -200,12 +200,12 @@ def run_markdown(out: Path, get_study: Callable) -> str:
     study = get_study(prov["study"])
     paper = paper_name(study.seed_file, full=True)
     head = [
-        f"# {out.name}: {study.title}",
+        f"# {md_text(out.name)}: {study.title}",  # a directory name of the user's
         "",
         f"Study `{prov['study']}`"
         + (f", seed paper: {paper}." if paper else " (a declared network, no seed paper).")
         + " Written by `sim run` from this directory's Parquet files "
-        f"(`sim show {out.name}` prints it again).",
+        f"({md_code(f'sim show {out.name}')} prints it again).",
         "",
     ]
     if kind == "sweep":

@@ -49,6 +49,7 @@ from sim.studies.network.validate import (
     _obs_common,
     _point_name,
     _role,
+    distinct_looks,
     name_index,
     one_unit,
     title,
@@ -218,6 +219,7 @@ def _points(cfg: dict, rng: np.random.Generator):
     dup = sorted(x for x, c in Counter(names).items() if c > 1)
     if dup:
         raise ConfigError("network.points", f"duplicate point name {dup[0]!r}")
+    distinct_looks("network.points", names)
     xy = np.array(pts[1], float)
     span = float(np.ptp(xy, axis=0).max())
     if span > 1e9:

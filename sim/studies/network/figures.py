@@ -84,6 +84,13 @@ def _times(mag: float) -> str:
     return f"×{mag:.0f}" if mag >= 100 else f"×{mag:.3g}"
 
 
+def literal(text: str) -> str:
+    """A user's text for matplotlib, drawn as written (doors24c): text between two ``$`` is
+    mathtext there, so a network named ``net $\\alpha$`` was titled "net α", and one named
+    ``$\\foo{$`` failed the run at its figure, after every trial. Each ``$`` is escaped."""
+    return text.replace("$", r"\$")
+
+
 def network_figure(net, an, pts, path: Path) -> Path:
     """Points (fixed as triangles), observation lines, 95 % ellipses magnified to be seen;
     axes in metres for a field network and in mm for a plate (:func:`natural_unit`)."""
@@ -102,7 +109,7 @@ def network_figure(net, an, pts, path: Path) -> Path:
     ax.set_aspect("equal")
     ax.set_xlabel(f"x ({unit})")
     ax.set_ylabel(f"y ({unit})")
-    ax.set_title(f"{net.name}: {net.n} points, {net.m} observations")
+    ax.set_title(f"{literal(net.name)}: {net.n} points, {net.m} observations")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2, fontsize=8)
     return save(fig, path)
 

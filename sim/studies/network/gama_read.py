@@ -46,8 +46,9 @@ import numpy as np
 
 from sim.mc.config import ConfigError
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
-from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes
-from sim.studies.network.validate import SIGMA_RANGE
+from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
+from sim.studies.network.gama_vocab import words as _words
+from sim.studies.network.validate import SIGMA_RANGE, looks_like
 
 __all__ = ["read_gama", "read_bytes", "MAX_BYTES", "CC", "NS"]
 
@@ -61,7 +62,7 @@ def _cov(f: _File, cm, n: int) -> np.ndarray:
     dim, band = int(dim), int(band)
     if dim != n:
         raise f.err(cm, f"dim {dim} for {n} observations", "dim")
-    words = (cm.text or "").split()
+    words = _words(cm.text)
     need = dim * (band + 1) - band * (band + 1) // 2
     if len(words) != need:
         raise f.err(cm, f"{len(words)} numbers for dim {dim}, band {band} (need {need})")
@@ -88,7 +89,7 @@ def _cov(f: _File, cm, n: int) -> np.ndarray:
 
 def _defaults(f: _File, po) -> dict:
     d = {}
-    words = (po.get("distance-stdev") or "").split()
+    words = _words(po.get("distance-stdev"))
     if len(words) > 3:
         raise f.err(po, "takes 'a [b [c]]' (a + b D^c mm, D in km)", "distance-stdev")
     for w in words:
@@ -130,7 +131,7 @@ def _stdev(f: _File, o, default, var: float | None) -> float:
 
 def _point(f: _File, e, points: dict, datum: dict) -> None:
     pid = f.name(e, "id")
-    fix, adj = e.get("fix", "").strip(), e.get("adj", "").strip()
+    fix, adj = ws(e.get("fix", "")), ws(e.get("adj", ""))
     if "z" in adj.lower():
         raise f.err(e, f"adj={adj!r}: height unknowns are not supported (2-D networks)", "adj")
     if fix and adj and "xy" in fix.lower() and "xy" in adj.lower():
@@ -269,14 +270,14 @@ def _network(f: _File, data: bytes):
     if len(nets) != 1:
         raise f.err(root, f"{len(nets)} <network> elements (need one)")
     net = nets[0]
-    if net.get("axes-xy", "ne").strip() not in TURNS:
+    if ws(net.get("axes-xy", "ne")) not in TURNS:
         raise f.err(
             net,
             f"{net.get('axes-xy')!r} is a right-handed frame (bearings run from +y to +x): "
             "only 'ne' and its turns 'es', 'sw', 'wn' are supported",
             "axes-xy",
         )
-    if net.get("angles", "left-handed").strip() != "left-handed":
+    if ws(net.get("angles", "left-handed")) != "left-handed":
         raise f.err(net, "only left-handed angles are supported", "angles")
     if net.get("epoch") is not None:
         f.num(net, "epoch")
@@ -309,8 +310,9 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
     for rec in obs:
         for fld in ("from", "to", "at"):
             if fld in rec and rec[fld] not in points:
+                like = looks_like(rec[fld], points)  # Cyrillic А for A, decomposed É
                 raise ConfigError(
-                    key, f"{path}: <{rec['kind']}> {fld}={rec[fld]!r}: no such <point>"
+                    key, f"{path}: <{rec['kind']}> {fld}={rec[fld]!r}: no such <point>{like}"
                 )
 
 
@@ -331,7 +333,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         )
     net = _network(f, data)
     note = _parameters(f, [e for e in net if _tag(e) == "parameters"])
-    axes = net.get("axes-xy", "ne").strip()
+    axes = ws(net.get("axes-xy", "ne"))
     if axes != "ne":
         note += (
             f"; axes-xy = {axes!r} ({TURNS[axes]}): ne turned, so every bearing, distance and "
@@ -386,7 +388,7 @@ def _parameters(f: _File, pars: list) -> str:
                 raise f.err(p, f"{c:g} must be an integer >= -1", "cov-band")
         if p.get("latitude") is not None:
             f.angle(p, "latitude")
-    act = "aposteriori" if p is None else p.get("sigma-act", "aposteriori").strip()
+    act = "aposteriori" if p is None else ws(p.get("sigma-act", "aposteriori"))
     if act == "apriori":
         return "sigma-act = apriori, as this study: the stdevs are the observations' sigmas"
     return (

@@ -14,9 +14,10 @@ import stat
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.paths import link_problem
 from sim.studies.network.validate import _point_name
 
-__all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes"]
+__all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes", "ws", "words"]
 
 NS = "http://www.gnu.org/software/gama/gama-local"
 CC = math.pi / 200 / 10000  # one centesimal second in rad
@@ -26,6 +27,24 @@ MAX_BYTES = 16 * 1024**2
 #: would also take Arabic-Indic or full-width digits)
 _NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$", re.ASCII)
 _DMS = re.compile(r"^[+-]?\d+-\d+-\d+(\.\d*)?([eE][+-]?\d+)?$", re.ASCII)
+#: the white space XML (and gama-local) trims around a value and splits a list at: Python's
+#: ``strip()`` and ``split()`` also take a no-break space and the other Unicode spaces, so an id
+#: ``"A\u00a0"`` was the point ``A`` here and another point in gama-local (doors24c)
+XML_WS = " \t\r\n"
+_WS_RUN = re.compile(r"[ \t\r\n]+")
+
+
+def ws(v: str) -> str:
+    """``v`` without the XML white space around it (a no-break space stays, as in gama-local)."""
+    return v.strip(XML_WS)
+
+
+def words(v: str | None) -> list[str]:
+    """The words of a list value (a ``<cov-mat>``'s numbers, ``distance-stdev``), split at XML
+    white space only."""
+    return [w for w in _WS_RUN.split(ws(v or "")) if w]
+
+
 _XYZ = ("xy", "XY", "z", "Z", "xyz", "XYZ", "XYz", "xyZ")
 #: gama-local's vocabulary: element -> its attributes
 VOCAB = {
@@ -136,7 +155,7 @@ class _File:
             if default is None:
                 raise self.err(e, "missing", attr)
             return default
-        if not _NUM.match(v.strip()):
+        if not _NUM.match(ws(v)):
             raise self.err(e, f"{v!r} is not a number", attr)
         x = float(v)
         if not math.isfinite(x):
@@ -147,16 +166,16 @@ class _File:
 
     def name(self, e, attr: str, default: str | None = None) -> str:
         v = e.get(attr, default)
-        if v is None or not v.strip():
+        if v is None or not ws(v):
             raise self.err(e, "missing point name", attr)
         try:
-            return _point_name(attr, v.strip())
+            return _point_name(attr, ws(v))
         except ConfigError as err:
             raise self.err(e, str(err).split(": ", 1)[1], attr) from None
 
     def angle(self, e, attr: str = "val") -> bool:
         """Check an angular value; True when it is d-m-s (degrees), False for gon."""
-        v = (e.get(attr) or "").strip()
+        v = ws(e.get(attr) or "")
         if not v:
             raise self.err(e, "missing", attr)
         if _DMS.match(v):
@@ -196,7 +215,7 @@ class _File:
                 if a not in VOCAB[t]:
                     raise self.err(e, "unknown attribute", a)
                 ch = _CHOICES.get((t, a))
-                if ch and v.strip() not in ch:
+                if ch and ws(v) not in ch:
                     raise self.err(e, f"{v!r} is not one of {', '.join(ch)}", a)
 
 
@@ -211,6 +230,8 @@ def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
     except OSError as e:
         slash = str(path).replace("\\", "/")  # a Windows path pasted into the study file
         hint = f" (did you mean {slash}?)" if slash != str(path) and Path(slash).is_file() else ""
+        if why := link_problem(path):  # a loop of links, a name of another Unicode form
+            raise ConfigError(key, f"cannot read {path}: it {why}") from None
         raise ConfigError(key, f"cannot read {path}: {e.strerror}{hint}") from None
     if not stat.S_ISREG(st.st_mode):
         raise ConfigError(key, f"{path} is not a regular file")

@@ -10,7 +10,7 @@ import numpy as np
 
 from sim.report.read import TableError
 from sim.report.section import section, table
-from sim.report.tables import fmt, md_table
+from sim.report.tables import fmt, md_code, md_table, md_text
 
 __all__ = ["report"]
 
@@ -19,19 +19,19 @@ def _summary(s: dict, p: dict, o: dict) -> str:
     r = np.array(o["redundancy"], float)
     worst = int(np.argmax(p["ellipse95_a_mm"]))
     return (
-        f"Network **{s['network']}**: {s['points']} points, {s['observations']} observations, "
+        f"Network **{md_text(s['network'])}**: {s['points']} points, {s['observations']} observations, "
         f"{s['unknowns']} unknowns, datum `{s['datum']}` ({s['datum_constraints']} "
         f"constraints), {s['dof']} degrees of freedom. {s['converged']} of {s['trials']} "
         f"simulated adjustments converged. The sum of the redundancy numbers is "
-        f"{fmt(s['redundancy_sum'], 6)}. Largest 95 % ellipse: point `{p['point'][worst]}`, "
+        f"{fmt(s['redundancy_sum'], 6)}. Largest 95 % ellipse: point {md_code(p['point'][worst])}, "
         f"semi-axes {fmt(p['ellipse95_a_mm'][worst])} x {fmt(p['ellipse95_b_mm'][worst])} mm. "
         f"Redundancy numbers range from {fmt(float(r.min()))} to {fmt(float(r.max()))}; "
         f"{int(np.sum(~np.array(o['controlled'])))} observations are uncontrolled (r = 0). "
-        f"gama-local XML: {s['gama_xml']}."
-        + (f" Read from {s['gama_input']}." if s.get("gama_input") else "")
+        f"gama-local XML: {md_text(s['gama_xml'])}."
+        + (f" Read from {md_text(s['gama_input'])}." if s.get("gama_input") else "")
         + (
             f" Points held in part by the datum constraints (singular 2 x 2 covariance, not "
-            f"listed): {s['held_by_datum']}."
+            f"listed): {md_text(s['held_by_datum'])}."
             if s["held_by_datum"]
             else ""
         )
@@ -60,7 +60,7 @@ def _points(s: dict, p: dict) -> list[str]:
     """The point table (the 15 largest ellipses of a network over 30 points)."""
     rows = [
         [
-            p["point"][a],
+            md_text(p["point"][a]),
             fmt(p["sigma_x_mm"][a]),
             fmt(p["sigma_y_mm"][a]),
             _mc(p, "mc_sigma_x_mm", a),
@@ -101,9 +101,9 @@ def _weakest(o: dict) -> list[str]:
             [
                 [
                     o["kind"][a],
-                    o["at"][a],
-                    o["from"][a],
-                    o["to"][a],
+                    md_text(o["at"][a] or ""),
+                    md_text(o["from"][a] or ""),
+                    md_text(o["to"][a] or ""),
                     fmt(o["redundancy"][a]),
                     _mdb(o, a),
                     fmt(o["external_max_mm"][a]),
@@ -127,7 +127,7 @@ def _parameters(out: Path) -> list[str]:
             ["parameter", "unit", "true", "sigma", "MC sigma [95 %]", "MC mean error [95 %]"],
             [
                 [
-                    g["parameter"][a],
+                    md_text(g["parameter"][a]),
                     g["unit"][a],
                     fmt(g["true"][a]),
                     fmt(g["sigma"][a]),
@@ -148,7 +148,7 @@ def _datums(out: Path) -> list[str]:
         sx = [v for v, n in zip(d["sigma_x_mm"], d["datum"]) if n == name]
         sy = [v for v, n in zip(d["sigma_y_mm"], d["datum"]) if n == name]
         lines.append(
-            f"In the datum *{name}* (S-transformation) the point sigmas range "
+            f"In the datum *{md_text(name)}* (S-transformation) the point sigmas range "
             f"from {fmt(min(sx + sy))} to {fmt(max(sx + sy))} mm."
         )
     return ["\n".join(lines)] if lines else []

@@ -15,6 +15,7 @@ import numpy as np
 
 from sim.mc.config import ConfigError
 from sim.mc.estimate import DEFAULT_MAX_MEMORY_GB, _limit
+from sim.mc.lookalike import differs, skeleton
 
 __all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE", "MAX_NAME", "MAX_TITLE", "title"]
 
@@ -166,6 +167,29 @@ def _mm(key: str, rec: dict, field: str, required: bool = True, default=None):
     return _num(f"{key}.{name}", v) * f
 
 
+def distinct_looks(key: str, names) -> None:
+    """Refuse two point names that look the same (doors24c): ``A`` and Cyrillic ``А``, a
+    precomposed ``É`` and ``E`` + U+0301, ``P1`` and full-width ``Ｐ1`` were two points
+    that every table, figure and exported file then printed alike -- one point split in two,
+    silently, where an observation or a pattern named the other."""
+    seen: dict[str, str] = {}
+    for nm in names:
+        other = seen.setdefault(skeleton(nm), nm)
+        if other != nm:
+            raise ConfigError(
+                key,
+                f"point names {other!r} and {nm!r} look the same ({differs(other, nm)}): "
+                "name them apart, or write both alike",
+            )
+
+
+def looks_like(p: str, names) -> str:
+    """`` (the network has 'А', ...)`` for a name not found that looks like a point's."""
+    sk = skeleton(p)
+    hit = next((nm for nm in names if skeleton(nm) == sk), None)
+    return "" if hit is None else f" (a point {hit!r} looks the same: {differs(hit, p)} here)"
+
+
 def name_index(names) -> dict[str, int]:
     """``{name: index}`` of a network's point names (unique), for :func:`hits`."""
     return {nm: a for a, nm in enumerate(names)}
@@ -190,7 +214,7 @@ def select(key: str, pats, names, index: dict[str, int], what: str = "no point n
     for p in pats:
         hit = hits(p, names, index)
         if not hit:
-            raise ConfigError(key, f"{what} {p!r}")
+            raise ConfigError(key, f"{what} {p!r}{looks_like(p, names)}")
         out += [h for h in hit if h not in seen]
         seen.update(hit)
     return out

@@ -39,7 +39,7 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
             raise ConfigError(key, f"{p} is not a regular file: expected the CSV transcription")
         raise ConfigError(key, f"no such file: {p}")
     try:
-        with open(p, newline="", encoding="utf-8") as fh:
+        with open(p, newline="", encoding="utf-8-sig") as fh:  # Excel's "CSV UTF-8" signature
             text = fh.read(2_000_000)
     except UnicodeDecodeError:
         raise ConfigError(
@@ -65,6 +65,12 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
         )
     out: dict[str, list] = {c: [] for c in cols}
     for i, r in enumerate(rows, start=1):
+        if None in r:  # more cells than the header: every value after a decimal comma moved
+            raise ConfigError(
+                key,
+                f"{p}: data row {i} has {len(r) - 1 + len(r[None])} cells for the header's "
+                f"{len(r) - 1} (a decimal comma? numbers take a point: 33.221)",
+            )
         try:
             out[groups].append(str(r[groups]).strip())
             out["point"].append(int(r["point"]))
