@@ -89,3 +89,26 @@ def test_a_network_too_large_at_one_trial_is_not_told_to_use_a_smaller_chunk(tmp
         schema.check(cfg)
     assert e.value.key == "network"
     assert "smaller chunk" not in str(e.value) and "a chunk of one trial too" in str(e.value)
+
+
+def test_a_dense_networks_figure_draws_ellipses_apart(tmp_path, monkeypatch):
+    """A 60 x 60 grid (3,600 points): ellipses at no more than SIDE x SIDE points, each apart
+    from the next, and markers smaller than a sparse network's (a 142 x 142 grid was a blue
+    square with its 20,164 ellipses 1 pt across underneath)."""
+    from sim.studies.network import figures
+    from sim.studies.network.sparse_analysis import analyse_sparse
+
+    cfg = _grid(tmp_path, 60)
+    net = build(cfg)
+    an = analyse_sparse(net, datum(net, cfg), 0.001, 0.8)
+    seen = {}
+    monkeypatch.setattr(figures, "save", lambda fig, path: seen.setdefault("fig", fig) and path)
+    figures.network_figure(net, an, np.arange(net.n), tmp_path / "n.png")
+    ax = seen["fig"].axes[0]
+    lines = [c for c in ax.collections if hasattr(c, "get_segments")]
+    ell = [c for c in lines if len(c.get_segments()) and len(c.get_segments()[0]) == 61]
+    assert len(ell) == 1 and len(ell[0].get_segments()) <= 50**2  # figures.SIDE
+    dots = [c for c in ax.collections if c.get_label() == "estimated point"]
+    assert dots and float(dots[0].get_sizes()[0]) < 2
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any(f"of the {net.n:,} points" in t for t in labels), labels
