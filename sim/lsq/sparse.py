@@ -62,6 +62,7 @@ __all__ = [
     "factorize",
     "gauss_newton_shared",
     "factor_nonzeros",
+    "normals_nonzeros",
 ]
 
 
@@ -106,6 +107,18 @@ def normals(cols, vals, w, free, q, pairs=None) -> sparse.csc_matrix:
         v = np.concatenate([v, np.zeros(2 * len(pp))])
     p = len(free)
     return sparse.csc_matrix((v, (r, c)), shape=(p, p))
+
+
+def normals_nonzeros(cols: np.ndarray, q: int) -> int:
+    """Nonzeros of ``N = A' W A`` (both triangles, as :func:`normals` holds them) of a Jacobian
+    pattern ``cols`` (m, s) over ``q`` globals (-1: unused slot): the distinct pairs of
+    columns the rows join. Not the rows' slot pairs ``m s^2``: a regular network joins each
+    pair of points from both ends, and unused slots join nothing (a nearest-8 trilateration
+    grid of 10,000 points: 3.6e5 nonzeros, ``m s^2`` = 2.9e6)."""
+    cols = np.asarray(cols, np.int64)
+    r, c = cols[:, :, None], cols[:, None, :]
+    code = (r * (q + 1) + c)[(r >= 0) & (c >= 0)]
+    return int(np.unique(code).size)
 
 
 def factor_nonzeros(p: int, nnz_n: int) -> float:

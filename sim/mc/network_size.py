@@ -96,11 +96,17 @@ def network_estimate(c: Mapping) -> tuple:
     U = 2 * n + n / 4 + 2  # coordinates, orientations (at most a quarter), constant, scale
     if U >= NETWORK_SPARSE_FROM:
         s = 6.0  # Jacobian slots of a distance or direction row
-        nnz_l = m * s * s * max(math.log2(max(U, 2)), 1.0) / 3 + 4 * U
+        # N's nonzeros: the pairs of unknowns a row joins, 8 a row (a pair of points, as most
+        # are seen from both ends, or a direction's point and orientation) and a 2 x 2 block a
+        # point, not the rows' slot pairs m s^2 (measured, nearest-8 trilateration grids of
+        # 10,000 and 50,000 points: 4.5 m; m s^2 made the factor 11 times its real size)
+        lg = max(math.log2(max(U, 2)), 1.0)
+        nnz_l = (8 * m + 2 * U) * lg / 3 + 4 * U
         b = 3 * F8 * (ch * m * (s + 3) + 3 * ch * U) + 3 * 16 * nnz_l
         # the sparse path: a trial's work grows with the factor's nonzeros, as its memory
-        # (one unit per SPARSE_NNZ_PER_UNIT of them; it was one unit whatever the size)
-        w = max(1.0, nnz_l / SPARSE_NNZ_PER_UNIT)
+        # (one unit per SPARSE_NNZ_PER_UNIT of them; it was one unit whatever the size),
+        # counted from the slot pairs m s^2 the unit was measured with
+        w = max(1.0, (m * s * s * lg / 3 + 4 * U) / SPARSE_NNZ_PER_UNIT)
     else:
         b = ch * m * (U + 1) * F8 * COPIES
         w = _dense(m, U)  # the dense path: m U^2 + U^3 a trial

@@ -83,11 +83,18 @@ def check(cfg: dict) -> None:
     sparse = use_sparse(net)
     nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
     if nbytes > MAX_CHUNK_BYTES:
+        one = chunk_bytes(net, 1) if sparse else net.m * (net.q + 1) * 8
         raise ConfigError(
-            "chunk",
+            "chunk" if one <= MAX_CHUNK_BYTES else "network",
             f"a chunk of {cfg['chunk']} trials needs about "
             f"{nbytes / 1024**3:.1f} GiB ({net.m} observations x "
-            f"{net.q} unknowns{', sparse' if sparse else ''}); use a smaller chunk",
+            f"{net.q} unknowns{', sparse' if sparse else ''}); "
+            + (
+                "use a smaller chunk"
+                if one <= MAX_CHUNK_BYTES
+                else f"a chunk of one trial too ({one / 1024**3:.1f} GiB, over "
+                f"{MAX_CHUNK_BYTES / 1024**3:g} GiB): use fewer points or observations"
+            ),
         )
     if not np.any(net.role != 1):
         raise ConfigError("network.points", "every point is fixed: nothing to estimate")
