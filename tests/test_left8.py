@@ -59,6 +59,7 @@ from sim.claims.rules import off_paper, printed_differs
 from sim.cli import main
 from sim.mc.config import Field
 from sim.mc.schema_helpers import count, printed
+from sim.mc.storage import read_provenance
 from sim.studies import get_study, load_study
 from sim.studies.brown.schema import TABLE1
 
@@ -262,3 +263,27 @@ def test_another_papers_study_off_its_printed_setup_scores_findings(tmp_path):
     preds = [r for r in rows if r["kind"] == "prediction"]
     assert preds and all(r["verdict"] == "finding" for r in preds)
     assert all("(analysis.ratio_start = 3 (paper: 2))" in r["note"] for r in preds)
+
+
+@pytest.mark.parametrize("claims", sorted((ROOT / "results").glob("*/claims.parquet")))
+def test_every_shipped_result_was_run_on_the_papers_printed_setup(claims):
+    """The runs shipped in results/ keep every verdict: their recorded configuration differs
+    from the paper's in no printed key (agnard_block_104 is off the paper's setup by its exact
+    input rows, as before)."""
+    cfg = read_provenance(claims)["config"]
+    assert printed_differs(get_study(cfg["study"]).schema, cfg) == []
+
+
+def test_sim_check_says_before_the_run_that_it_is_off_the_papers_setup(capsys):
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    assert main(["check", study, "--set", "plate.spacing_mm=30"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    spacing = next(x for x in out if x.startswith("plate.spacing_mm = 30.0"))
+    assert "printed by the paper: another value is off its setup" in spacing
+    assert out[-2] == (
+        "# off the paper's setup (plate.spacing_mm = 30 (paper: 45)): its predictions will be "
+        "findings"
+    )
+    assert out[-1].startswith("# work: ")
+    assert main(["check", study]) == 0
+    assert "off the paper's setup" not in capsys.readouterr().out
