@@ -49,6 +49,9 @@ verdict stands; no claim book gained a row.
 
 from __future__ import annotations
 
+import ast
+import inspect
+import sys
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -287,3 +290,22 @@ def test_sim_check_says_before_the_run_that_it_is_off_the_papers_setup(capsys):
     assert out[-1].startswith("# work: ")
     assert main(["check", study]) == 0
     assert "off the paper's setup" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", sorted(SURVEY))
+def test_each_papers_study_gives_write_claims_its_schema(name):
+    """Each paper study's run hands its own schema to write_claims (read from the run's source:
+    a study that left it out would score any printed key's change as the paper's)."""
+    study = get_study(name)
+    module = sys.modules[study.run.__module__]
+    tree = ast.parse(inspect.getsource(module))
+    fn = next(
+        n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) and n.name == study.run.__name__
+    )
+    calls = [
+        c
+        for c in ast.walk(fn)
+        if isinstance(c, ast.Call) and getattr(c.func, "id", None) == "write_claims"
+    ]
+    assert len(calls) == 1 and len(calls[0].args) == 5
+    assert getattr(module, calls[0].args[4].id) is study.schema
