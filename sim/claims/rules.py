@@ -182,11 +182,11 @@ def holds_of(verdict: str):  # depends / undecidable (over a region, sim.claims.
     return {"holds": True, "fails": False, "erratum": False}.get(verdict)
 
 
-def _shown(v: Any) -> str:
+def _shown(v: Any) -> str:  # 12 digits: a printed 12.700082809 and a change in its 7th show
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_shown(x) for x in v) + "]"
     if isinstance(v, float):
-        return f"{v:g}"
+        return f"{v:.12g}"
     return repr(v) if isinstance(v, str) else str(v)
 
 
