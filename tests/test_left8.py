@@ -7,7 +7,8 @@ the paper. A key whose default is a number the paper prints for its own setup is
 ``printed`` in the study's schema (:func:`sim.mc.schema_helpers.printed`); a run whose value
 differs is off the paper's setup (:func:`sim.claims.rules.printed_differs`, applied by
 :func:`sim.claims.book.write_claims` with the study's schema): predictions are findings, a
-``paper_setup`` self-check is not applicable, the note names the key, its value and the paper's.
+``paper_setup`` self-check is not applicable, the note names the key, its value and the paper's;
+``sim check`` marks the printed keys and says so before the run.
 
 The survey (:data:`SURVEY`: every paper study's keys that a user can change with ``--set`` or
 ``[sweep]``, read against its seed):
