@@ -30,6 +30,7 @@ from pathlib import Path
 
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
+from sim.claims.rules import printed_differs
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
 from sim.cli_read import report, show
@@ -280,6 +281,7 @@ def _check(args) -> int:
                 unit and f"unit {unit}",
                 _bounds(f),
                 "paper input" if f.input else "",
+                f.printed and "printed by the paper: another value is off its setup",
                 k in skip and f"not read: {skip[k]}",
             )
             if x
@@ -290,6 +292,9 @@ def _check(args) -> int:
         print("[sweep]")
         for k, v in sweep.items():
             print(f"{toml_key(k)} = {toml_value(v)}")
+    off = printed_differs(study.schema, cfg)
+    if off:  # said before the run: its predictions will be findings (sim.claims.rules)
+        print(f"# off the paper's setup ({', '.join(off)}): its predictions will be findings")
     print(f"# work: {est.describe()}")
     return 0
 

@@ -33,6 +33,7 @@ from sim.claims.rules import (
     decide,
     holds_of,
     off_paper,
+    printed_differs,
     verdict_of,
     zone,
 )
@@ -402,10 +403,15 @@ def _row(
 
 
 def write_claims(
-    path, rows: Iterable[Mapping[str, Any]], prov: Mapping[str, Any], book: ClaimBook | None = None
+    path,
+    rows: Iterable[Mapping[str, Any]],
+    prov: Mapping[str, Any],
+    book: ClaimBook | None = None,
+    schema: Mapping[str, Any] | None = None,
 ):
     """Write ``claims.parquet`` (and, with a book, ``not_reproduced.parquet`` beside it).
-    With a book, every declared claim must have been scored."""
+    With a book, every declared claim must have been scored; with the study's ``schema``, a
+    ``printed`` key that differs in ``prov["config"]`` makes the run off the paper's setup."""
     rows = list(rows)
     if book is not None:
         book.check_complete()
@@ -415,7 +421,8 @@ def write_claims(
             {c: [n[c] for n in nr] for c in NOT_REPRODUCED_COLUMNS},
             prov,
         )
-    rows = off_paper(rows, book.paper_setup if book is not None else ())
+    differs = printed_differs(schema, prov.get("config") or {}) if schema is not None else []
+    rows = off_paper(rows, book.paper_setup if book is not None else (), differs)
     cols = {c: [_null(r[c]) for r in rows] for c in CLAIM_COLUMNS}
     return write_table(
         path, cols, {**prov, "intervals": interval_provenance()}, tolerances=CLAIM_TOLERANCES

@@ -59,7 +59,11 @@ A prediction is a test of the paper only on a run whose printed inputs are the p
 an ``input`` row with an exact value (a configuration value the paper prints) fails its own
 rule, the run simulates another setup (e.g. a larger block): :func:`off_paper` keeps every
 prediction's ``outcome`` but makes its ``verdict`` a **finding** (about that setup, not the
-paper) and names the differing inputs in the note.
+paper) and names the differing inputs in the note. A configuration key of the study's schema
+marked ``printed`` (:func:`sim.mc.schema_helpers.printed`: its default is the paper's own
+number, e.g. brown_table1's 5 x 5 grid at 45 mm) whose resolved value differs is such an
+input too (:func:`printed_differs`): a run on another plate is off the paper's setup without
+any row of its own failing.
 
 A self-check whose reference is a number of the paper's setup, not one every setup gives
 (``paper_setup = true`` in the claim book: Brown's 43 degrees of freedom are 2(25) - 7 of the
@@ -74,7 +78,7 @@ identity, Monte Carlo against analytic) must hold on any setup and is decided as
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable
+from typing import Any, Iterable, Mapping
 
 import numpy as np
 
@@ -88,6 +92,7 @@ __all__ = [
     "verdict_of",
     "holds_of",
     "off_paper",
+    "printed_differs",
     "NOT_APPLICABLE",
 ]
 
@@ -177,14 +182,35 @@ def holds_of(verdict: str):  # depends / undecidable (over a region, sim.claims.
     return {"holds": True, "fails": False, "erratum": False}.get(verdict)
 
 
+def _shown(v: Any) -> str:  # 12 digits: a printed 12.700082809 and a change in its 7th show
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_shown(x) for x in v) + "]"
+    if isinstance(v, float):
+        return f"{v:.12g}"
+    return repr(v) if isinstance(v, str) else str(v)
+
+
+def printed_differs(schema: Mapping[str, Any], cfg: Mapping[str, Any]) -> list[str]:
+    """The keys of ``schema`` marked ``printed`` (their default is the paper's own number)
+    whose value in the resolved ``cfg`` differs, each as ``"key = value (paper: default)"``,
+    in the schema's order; ``[]`` on the paper's setup. A key the configuration leaves out
+    (one not read under its switch) has its default."""
+    out = []
+    for k, f in schema.items():
+        if getattr(f, "printed", False) and cfg.get(k, f.default) != f.default:
+            out.append(f"{k} = {_shown(cfg[k])} (paper: {_shown(f.default)})")
+    return out
+
+
 def off_paper(
-    rows: Iterable[dict[str, Any]], paper_setup: Iterable[str] = ()
+    rows: Iterable[dict[str, Any]], paper_setup: Iterable[str] = (), differs: Iterable[str] = ()
 ) -> list[dict[str, Any]]:
     """The rows of a run, with every prediction a **finding** when the run's printed inputs
     differ from the paper's (an exact ``input`` row, or an exact self-check of ``paper_setup``,
-    that fails its rule), and every self-check of ``paper_setup`` (the ids whose reference is
-    the paper's setup) **not applicable** then; see the module doc. Rows of a run on the
-    paper's setup come back unchanged."""
+    that fails its rule, or a ``printed`` configuration key named in ``differs``, from
+    :func:`printed_differs`), and every self-check of ``paper_setup`` (the ids whose
+    reference is the paper's setup) **not applicable** then; see the module doc. Rows of a
+    run on the paper's setup come back unchanged."""
     rows = list(rows)
     setup = set(paper_setup)
     bad = [
@@ -193,7 +219,7 @@ def off_paper(
         if (r["kind"] == "input" or (r["kind"] == "self-check" and r["claim"] in setup))
         and r["interval"] == "exact"
         and r["outcome"] == "fails"
-    ]
+    ] + list(differs)
     if not bad:
         return rows
     why = (

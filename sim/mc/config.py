@@ -102,6 +102,10 @@ class Field:
     choices : allowed values for strings (and elements of string lists).
     min_len : minimum length of lists.
     input : the value was set to match a paper (reported as *input*).
+    printed : the default is a value the paper prints for its own setup (its design: the
+        plate, the grid, counts, printed error levels); a run with another value is off the
+        paper's setup and its predictions are findings (:func:`sim.claims.rules.off_paper`;
+        written with :func:`sim.mc.schema_helpers.printed`).
     sweep : the key may be swept (``[sweep]``); None, or the reason it may not.
     read_when : None (always read), or when the study reads the key (a
         :class:`sim.mc.read_when.When`): a key set where it is not read is refused.
@@ -119,6 +123,7 @@ class Field:
     unit: str = ""
     sweep: str | None = None
     read_when: Any = None
+    printed: bool = False
 
 
 #: TOML's integers are 64-bit ("an integer that cannot be represented losslessly is an

@@ -10,6 +10,8 @@ its keys are one of a few kinds, written here once:
 * :func:`positive` -- a number ``> 0`` (a standard deviation, a scale), at most ``hi``;
 * :func:`level` -- the level of a two-sided test, in ``(0, 0.5]``;
 * :func:`reals`, :func:`counts` -- lists of those (the values a sweep visits);
+* :func:`printed` -- marks a key whose default is a value the paper prints for its own setup
+  (a run with another value is off the paper's setup: :func:`sim.claims.rules.off_paper`);
 * :func:`require` -- a cross-key rule of a study's ``check``: :class:`ConfigError` naming the
   key when it does not hold.
 
@@ -20,11 +22,22 @@ would spell out (equal field by field), so validation and the report are unchang
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from sim.mc.config import ConfigError, Field
 
-__all__ = ["count", "real", "positive", "level", "reals", "counts", "require", "recorded_sha256"]
+__all__ = [
+    "count",
+    "real",
+    "positive",
+    "level",
+    "reals",
+    "counts",
+    "printed",
+    "require",
+    "recorded_sha256",
+]
 
 
 def count(default: int, doc: str, lo: int, hi: int | None = None, *, input: bool = False) -> Field:
@@ -88,6 +101,14 @@ def counts(
 ) -> Field:
     """A list of at least ``min_len`` integers, each in ``[lo, hi]``."""
     return Field(default, "list[int]", doc, lo=lo, hi=hi, min_len=min_len)
+
+
+def printed(f: Field) -> Field:
+    """``f`` marked as a value the paper prints for its own setup (its default is the paper's
+    number): a run whose resolved value differs is off the paper's setup, and its predictions
+    are findings (:func:`sim.claims.rules.printed_differs`, applied by
+    :func:`sim.claims.book.write_claims`)."""
+    return dataclasses.replace(f, printed=True)
 
 
 def require(ok: Any, key: str, message: str) -> None:

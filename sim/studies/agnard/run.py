@@ -33,7 +33,7 @@ from sim.studies.agnard import chunks as ch
 from sim.studies.agnard import decide as dc
 from sim.studies.agnard import figures as fg
 from sim.studies.agnard.claims import claim_rows, load_book
-from sim.studies.agnard.schema import NAME, block_of, five_control
+from sim.studies.agnard.schema import NAME, SCHEMA, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
 
 
@@ -305,7 +305,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     regions = (layout, preds5, stats5, scanner, sstats)
     rows = dc.over_joint(cfg, book, rows, regions, five, prov, out)
     ctrl_idx = _region_layouts(block, insets, prov, out)
-    write_claims(out / "claims.parquet", dc.without_snooping(cfg, rows), prov, book)
+    write_claims(out / "claims.parquet", dc.without_snooping(cfg, rows), prov, book, SCHEMA)
     draw(
         [
             (fg.fig_tradeoffs, (scan_t, lay_t, size_t, out / "tradeoffs.png")),

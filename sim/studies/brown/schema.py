@@ -14,7 +14,7 @@ from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import when
 from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
-from sim.mc.schema_helpers import count, counts, positive, real
+from sim.mc.schema_helpers import count, counts, positive, printed, real
 from sim.studies.brown.values import thetas
 
 SEED = "004_f5bd9e86c308241f.txt"
@@ -43,7 +43,12 @@ BASE = {
         lo=1,
         hi=1_000_000,
     ),
-    "plate.format_mm": real(245.0, "side of the square plate format", lo=1.0, unit="mm"),
+    # printed(...): the paper's own number (seed 004: "245 X 245 mm", "graduated ... over a
+    # length of 261 mm", the micrometer's "at most one millimeter"); another value is another
+    # instrument, and the run is off the paper's setup (sim.claims.rules.printed_differs)
+    "plate.format_mm": printed(
+        real(245.0, "side of the square plate format (paper: 245 mm)", lo=1.0, unit="mm")
+    ),
     "plate.pattern": Field("grid", "str", "point pattern", choices=("grid", "random", "list")),
     "plate.grid": _grid(count(5, "points per side of the grid pattern", lo=2, hi=200)),
     "plate.spacing_mm": _grid(
@@ -77,15 +82,17 @@ BASE = {
     "comparator.beta_mm": real(
         1.0, "tangential pivot offset beta (true value)", lo=0.0, hi=50.0, unit="mm"
     ),
-    "comparator.scale_length_mm": real(
-        261.0,
-        "graduated length of the scale (paper: 261 mm); every range must fit on "
-        "it plus the micrometer travel. 0 = not enforced (an idealised comparator)",
-        lo=0.0,
-        unit="mm",
+    "comparator.scale_length_mm": printed(
+        real(
+            261.0,
+            "graduated length of the scale (paper: 261 mm); every range must fit on "
+            "it plus the micrometer travel. 0 = not enforced (an idealised comparator)",
+            lo=0.0,
+            unit="mm",
+        )
     ),
-    "comparator.micrometer_mm": real(
-        1.0, "micrometer travel added to the scale (paper: at most 1 mm)", lo=0.0, unit="mm"
+    "comparator.micrometer_mm": printed(
+        real(1.0, "micrometer travel added to the scale (paper: at most 1 mm)", lo=0.0, unit="mm")
     ),
     "errors.setting_sigma_um": positive(
         1.0, "standard deviation of one setting", hi=1e4, unit="um"
@@ -143,21 +150,31 @@ DILUTION = {
     ),
 }
 
+#: Table 1's plate and settings as printed (seed 004, Results: "a 5 X 5 array of PUG points
+#: evenly spaced at 45 mm", "double settings", "an individual setting ... 1.7 microns", the
+#: comparator's "1.1 microns"): a run with another plate (another grid, spacing or pattern,
+#: 25 random points included) or other settings is off the paper's setup (printed)
 TABLE1 = {
     **BASE,
     "trials": count(4000, "Monte-Carlo trials", lo=2, hi=100_000_000),
-    "plate.spacing_mm": _grid(positive(45.0, "grid spacing (paper: 45 mm)", unit="mm", input=True)),
-    "errors.setting_sigma_um": positive(
-        1.7, "one setting (paper: 1.7 um)", hi=1e4, unit="um", input=True
+    "plate.pattern": printed(BASE["plate.pattern"]),
+    "plate.grid": printed(BASE["plate.grid"]),
+    "plate.spacing_mm": printed(
+        _grid(positive(45.0, "grid spacing (paper: 45 mm)", unit="mm", input=True))
     ),
-    "errors.settings": count(2, "double settings (paper)", lo=1, hi=100, input=True),
-    "errors.comparator_sigma_um": real(
-        1.1,
-        "comparator contribution (paper: about 1.1 um)",
-        lo=0.0,
-        hi=1e4,
-        unit="um",
-        input=True,
+    "errors.setting_sigma_um": printed(
+        positive(1.7, "one setting (paper: 1.7 um)", hi=1e4, unit="um", input=True)
+    ),
+    "errors.settings": printed(count(2, "double settings (paper)", lo=1, hi=100, input=True)),
+    "errors.comparator_sigma_um": printed(
+        real(
+            1.1,
+            "comparator contribution (paper: about 1.1 um)",
+            lo=0.0,
+            hi=1e4,
+            unit="um",
+            input=True,
+        )
     ),
 }
 

@@ -41,6 +41,7 @@ from sim.studies.design.external import external_at
 from sim.studies.design.formal import coverage_analysis
 from sim.studies.design.parts import side_by_side
 from sim.studies.design.posterior import bayes_analysis, twoplate_analysis
+from sim.studies.design.schema import SCHEMA
 from sim.studies.run_steps import run_part
 
 __all__ = ["run"]
@@ -311,4 +312,4 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         print(f"brown_design: bayes.twoplate_ratio skipped: {why}")
     write_table(out / "consistent_region.parquet", region_table, prov)
     write_table(out / "region_inputs.parquet", region_inputs, prov)
-    write_claims(out / "claims.parquet", rows, prov, book)
+    write_claims(out / "claims.parquet", rows, prov, book, SCHEMA)

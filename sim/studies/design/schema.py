@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from sim.instruments.ranges import brown as B
 from sim.mc.config import COMMON
-from sim.mc.schema_helpers import count, counts, level, positive, real, reals
+from sim.mc.schema_helpers import count, counts, level, positive, printed, real, reals
 
 __all__ = ["SEED", "SCHEMA", "MAX_CELLS", "MAX_POINTS", "BETA_MAX_MM"]
 
@@ -341,3 +341,39 @@ SCHEMA = {
         hi=10.0,
     ),
 }
+
+#: the keys whose default is a number the paper prints for its own comparator and Table 1
+#: (seed 004: the format, the scale and micrometer, the comparator's 1.1 um, the timed plate,
+#: Table 1's plate and settings, the error budget's printed sources, the Zeiss grid, the
+#: operation's offsets, the calibration's tolerances): a run with another value is off the
+#: paper's setup, its predictions findings (sim.claims.rules.printed_differs). Not marked:
+#: the design space explored (design.*, coverage.*), the labelled examples of unprinted
+#: inputs (offsets, beta, pitch, the Zeiss layout, time.pass_min), brown_dilution's example
+#: geometry (datum.*)
+PRINTED = (
+    "plate.format_mm",
+    "scale.graduated_mm",
+    "scale.micrometer_mm",
+    "comparator.sigma_um",
+    "time.images",
+    "time.single_min",
+    "time.double_min",
+    "paper.positions",
+    "paper.grid",
+    "paper.extent_mm",
+    "paper.settings",
+    "paper.setting_sigma_um",
+    "budget.graduation_um",
+    "budget.scale_spec_um",
+    "budget.screw_um",
+    "budget.drum_periodic_um",
+    "budget.wobble_um",
+    "budget.sphericity_um",
+    "zeiss.points",
+    "zeiss.grid_sigma_um",
+    "operation.lateral_offset_um",
+    "operation.gap_um",
+    "calibration.accuracy_um",
+    "calibration.drum_dividing_arcsec",
+)
+SCHEMA.update({k: printed(SCHEMA[k]) for k in PRINTED})

@@ -21,6 +21,7 @@ from sim.studies.gridplate import figures as F
 from sim.studies.gridplate.claims import beyond_table, score
 from sim.studies.gridplate.model import PARAMS, chunk, simulate
 from sim.studies.gridplate.region import IT, explore_region, iteration_note, nominal
+from sim.studies.gridplate.schema import SCHEMA
 from sim.studies.run_steps import over_region, run_part, spread_note
 
 
@@ -183,4 +184,4 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_table(
         out / "example_plate.parquet", F.fig_residuals(cfg, ex, out / "residuals.png"), prov
     )
-    write_claims(out / "claims.parquet", rows, prov, book)
+    write_claims(out / "claims.parquet", rows, prov, book, SCHEMA)

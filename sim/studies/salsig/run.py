@@ -29,6 +29,7 @@ from sim.studies.salsig.model import (
     vertical_chunk,
 )
 from sim.studies.salsig.region import RATIO, explore_region, nominal
+from sim.studies.salsig.schema import SCHEMA
 
 #: ``make verify`` (:mod:`sim.mc.tolerance`): E and SX - SY are small differences of numbers of
 #: order pi and 12.7, so their rounding is absolute: 1e3 eps of what they are computed from
@@ -130,4 +131,4 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         title="seed 002: the vertical test's unprinted inputs (constrained by 'cut roughly in half')",
         nominal=nominal(cfg),
     )
-    write_claims(out / "claims.parquet", rows, prov, book)
+    write_claims(out / "claims.parquet", rows, prov, book, SCHEMA)

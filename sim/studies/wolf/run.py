@@ -36,6 +36,7 @@ from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk, s
 from sim.studies.wolf.grid import grid_nodes
 from sim.studies.wolf.model import field_spec, reading_error_rms
 from sim.studies.wolf.region import explore_region, nominal
+from sim.studies.wolf.schema import SCHEMA
 
 APPROACHES = ("one_side", "random")
 
@@ -173,7 +174,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     _stability(cfg, out, prov, ctx)
     t1, t3 = _paper_tables(cfg, out, prov)
     rows = over_region(book, region, preds, cl.rows(cfg, main, t1, t3, degt, book), example_note)
-    write_claims(out / "claims.parquet", rows, prov, book)
+    write_claims(out / "claims.parquet", rows, prov, book, SCHEMA)
     _region_figure(cfg, out, region)
     figures.figures(cfg, out)
 
