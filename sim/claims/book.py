@@ -23,12 +23,11 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from sim.claims.declaration import toml_text
-from sim.claims.intervals import LEVEL, METHODS, MIN_CHUNKS, plate_p, spread
-from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
+from sim.claims.intervals import plate_p, spread
+from sim.claims.provenance import interval_provenance
 from sim.claims.rules import (
     FORMS,
     KINDS,
-    P_FAIL,
     VERDICTS,
     decide,
     holds_of,
@@ -427,27 +426,6 @@ def write_claims(
     return write_table(
         path, cols, {**prov, "intervals": interval_provenance()}, tolerances=CLAIM_TOLERANCES
     )
-
-
-def interval_provenance() -> dict[str, Any]:
-    """How every interval and verdict of a claims table was made, for its provenance: the
-    interval methods (:data:`sim.claims.intervals.METHODS`) and the decision thresholds,
-    with the sample-size rule of region verdicts (:mod:`sim.claims.region`)."""
-    return {
-        "level": LEVEL,
-        "methods": dict(METHODS),
-        "min_chunks": MIN_CHUNKS,
-        "one_plate_p_fail": P_FAIL,
-        "region_min_points": REGION_MIN_POINTS,
-        "region_share": REGION_SHARE,
-        "region_level": REGION_LEVEL,
-        "interval_column": {
-            "ci": "a Monte-Carlo confidence interval (mean, sd, share, bootstrap or jackknife)",
-            "spread": "the one-plate 2.5-97.5 % range over simulated plates",
-            "exact": "a deterministic value (or its range over the rounding of printed inputs)",
-            "region": "decided over the consistent region of unprinted inputs (sim.claims.region)",
-        },
-    }
 
 
 def _null(x):
