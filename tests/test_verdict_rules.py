@@ -12,8 +12,9 @@ import pytest
 
 from sim.claims import book as bk
 from sim.claims import rules
-from sim.claims.book import P_FAIL, ClaimBook, decide, write_claims
+from sim.claims.book import ClaimBook, decide, write_claims
 from sim.claims.inference import FAILS, HOLDS, UNDECIDED, Statement, status
+from sim.claims.rules import P_FAIL
 from sim.mc.storage import read_provenance
 
 ROOT = Path(__file__).resolve().parent.parent
