@@ -109,3 +109,20 @@ def test_a_plain_directory_name_is_printed_as_it_was():
     root = Path(__file__).resolve().parents[1]
     text = (root / "results" / "network_plate" / "README.md").read_text(encoding="utf-8")
     assert "(`sim show network_plate` prints it again)" in text
+
+
+def test_out_beside_a_results_directory_of_another_unicode_form_is_refused(tmp_path, capsys):
+    """``--out café`` (NFC) beside the results ``café`` (NFD, as macOS writes names) made a
+    second results directory that ``ls`` and REPORT.md show alike."""
+    p = tmp_path / "net.toml"
+    p.write_text(NET.format(a="C", b="D"), encoding="utf-8")
+    nfd, nfc = tmp_path / "cafe\u0301", tmp_path / "caf\u00e9"
+    assert cli.main(["run", str(p), "--out", str(nfd), "--quiet", "--no-figures"]) == 0
+    capsys.readouterr()
+    rc = cli.main(["run", str(p), "--out", str(nfc), "--quiet", "--no-figures"])
+    one_line(capsys, rc, "--out", "another Unicode form", "U+0065 U+0301 against U+00E9")
+    assert not nfc.exists() and sorted(x.name for x in tmp_path.iterdir()) == [
+        "cafe\u0301",
+        "net.toml",
+    ]
+    assert cli.main(["run", str(p), "--out", str(nfd), "--quiet", "--no-figures"]) == 0

@@ -21,6 +21,7 @@ import unicodedata
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.paths import link_problem
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
@@ -112,7 +113,9 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
     _check_not_nested(out, shown)
     if out.is_symlink():
         raise ConfigError("--out", f"{shown} is a symbolic link; sim never replaces it")
-    if not out.exists():
+    if not out.exists():  # café typed beside a café of the other Unicode form (doors25a):
+        if (why := link_problem(out)) is not None:  # two results directories printed alike
+            raise ConfigError("--out", f"{shown} {why}")
         return
     if not out.is_dir():
         raise ConfigError(
