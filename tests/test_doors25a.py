@@ -126,3 +126,34 @@ def test_out_beside_a_results_directory_of_another_unicode_form_is_refused(tmp_p
         "net.toml",
     ]
     assert cli.main(["run", str(p), "--out", str(nfd), "--quiet", "--no-figures"]) == 0
+
+
+def test_a_lock_file_that_is_a_directory_is_named(tmp_path, capsys):
+    """It was "cannot write to <the parent>: Is a directory", naming the wrong path."""
+    p = tmp_path / "net.toml"
+    p.write_text(NET.format(a="C", b="D"), encoding="utf-8")
+    (tmp_path / ".o.partial" / ".lock").mkdir(parents=True)
+    rc = cli.main(["run", str(p), "--out", str(tmp_path / "o"), "--quiet", "--no-figures"])
+    line = one_line(capsys, rc, "--out", ".o.partial/.lock is not a lock file of sim")
+    assert "Is a directory" not in line
+
+
+@pytest.mark.parametrize("lock", [True, False])
+def test_a_staging_directory_of_ones_own_that_cannot_be_written_is_not_another_users(
+    tmp_path, lock
+):
+    """A user's own lock file (or staging directory) made read-only was "an unfinished run
+    of another user (<the user>)". (The run itself cannot be made to fail so as root: the
+    error is given.)"""
+    import errno
+
+    from sim.mc import outputs
+
+    stage = tmp_path / ".o.partial"
+    stage.mkdir()
+    if lock:
+        (stage / ".lock").write_text("1\n")
+    e = PermissionError(errno.EACCES, "Permission denied")
+    why = outputs._not_lockable(stage, tmp_path / "o", "o", e)
+    assert "another user" not in why
+    assert why.startswith(f"{stage / '.lock' if lock else stage} is yours"), why

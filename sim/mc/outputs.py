@@ -290,7 +290,8 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
         ) from None
     except NotALock as e:
         raise ConfigError(
-            "--out", f"{e.path} is not a lock file of sim (a link or a pipe); move it away"
+            "--out",
+            f"{e.path} is not a lock file of sim (a link, a pipe or a directory); move it away",
         ) from None
     except OSError as e:
         raise ConfigError("--out", _not_lockable(stage, out, shown, e)) from None
@@ -345,6 +346,13 @@ def _owner(p: Path) -> str:
         return f"uid {uid}"
 
 
+def _uid(p: Path) -> int | None:
+    try:
+        return p.lstat().st_uid
+    except OSError:
+        return None
+
+
 def _holder(lock: Path) -> tuple[bool, int | None]:
     """Whether a process holds the lock ``lock`` that this user may not write (another user's
     run), and its pid: the lock is tested through a read-only descriptor (a shared lock,
@@ -381,6 +389,12 @@ def _not_lockable(stage: Path, out: Path, shown: str, e: OSError) -> str:
                 f"{shown} is being written by a running sim ({who} of user "
                 f"{_owner(stage / LOCK)}); "
                 "wait for it to finish or choose another --out"
+            )
+        me, lock = os.geteuid(), _uid(stage / LOCK)
+        if _uid(stage) == me and lock in (me, None):  # doors25a: it was "another user (me)"
+            what = stage / LOCK if lock is not None else stage  # made read-only by its owner
+            return (
+                f"{what} is yours but cannot be written ({e.strerror}): chmod u+w it or remove it"
             )
         return (
             f"{stage} holds an unfinished run of another user ({_owner(stage)}) that you may "
