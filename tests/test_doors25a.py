@@ -157,3 +157,14 @@ def test_a_staging_directory_of_ones_own_that_cannot_be_written_is_not_another_u
     why = outputs._not_lockable(stage, tmp_path / "o", "o", e)
     assert "another user" not in why
     assert why.startswith(f"{stage / '.lock' if lock else stage} is yours"), why
+
+
+def test_a_gridplate_variant_of_one_plate_is_written_in_the_singular():
+    from sim.studies import load_study
+    from sim.studies.gridplate.report import _intro
+
+    root = Path(__file__).resolve().parents[1]
+    _, cfg = load_study(root / "studies" / "gridplate_two_plates.toml", values={"plate.count": 1})
+    assert "with 1 grid plate of 5 x 5" in _intro(cfg)
+    cfg["plate.count"] = 2
+    assert "with 2 grid plates of 5 x 5" in _intro(cfg)
