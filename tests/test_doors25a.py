@@ -168,3 +168,11 @@ def test_a_gridplate_variant_of_one_plate_is_written_in_the_singular():
     assert "with 1 grid plate of 5 x 5" in _intro(cfg)
     cfg["plate.count"] = 2
     assert "with 2 grid plates of 5 x 5" in _intro(cfg)
+
+
+def test_a_table_given_a_value_names_its_keys(capsys):
+    """``--set plate=4`` was "plate: unknown key" of a study whose file has a [plate]."""
+    brown = str(Path(__file__).resolve().parents[1] / "studies" / "brown_table1.toml")
+    rc = cli.main(["check", brown, "--set", "plate=4"])
+    one_line(capsys, rc, "plate: unknown key (plate is a table: give one of its keys, plate.")
+    one_line(capsys, cli.main(["check", brown, "--set", "plat=4"]), "plat: unknown key")
