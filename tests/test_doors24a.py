@@ -127,6 +127,7 @@ def test_another_users_unfinished_run_is_named_with_its_owner(tmp_path, monkeypa
     stage = tmp_path / ".o.partial"
     StageLock(stage).acquire().release()
     _not_ours(monkeypatch, stage / LOCK)
+    monkeypatch.setattr(os, "geteuid", lambda: os.getuid() + 4242)  # and owned by another
     rc = main(["run", PLATE, *SMALL, "--out", str(tmp_path / "o")])
     one_line(
         capsys,

@@ -38,6 +38,7 @@ from sim.claims.rules import (
 )
 from sim.mc import tolerance as tl
 from sim.mc.config import ConfigError, StudyError
+from sim.mc.lookalike import alike
 from sim.mc.storage import write_table
 
 __all__ = [
@@ -228,9 +229,8 @@ class ClaimBook:
 
     def spec(self, cid: str) -> dict:
         if cid not in self.specs:  # the book edited: a claim the study scores removed or renamed
-            raise ConfigError(
-                "claim.id", f"{self.path}: claim {cid!r}, which the study scores, is not declared"
-            )
+            why = f"claim {cid!r}, which the study scores, is not declared{alike(cid, self.specs)}"
+            raise ConfigError("claim.id", f"{self.path}: {why}")
         return self.specs[cid]
 
     def score(

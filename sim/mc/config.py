@@ -298,6 +298,8 @@ def validate(
         if key not in schema:
             near = did_you_mean(key, schema)
             hint = f" (did you mean {' or '.join(near)}?)" if near else ""
+            if inner := [s for s in schema if s.startswith(f"{key}.")][:3]:  # --set plate=4
+                hint = f" ({key} is a table: give one of its keys, {', '.join(inner)}, ...)"
             curly = [c for c in key if c in TYPOGRAPHIC]
             if curly:  # --set “plate.grid=4” pasted from a web page or a word processor:
                 # "did you mean plate.grid?" alone reads as the same key

@@ -21,6 +21,7 @@ import unicodedata
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.paths import link_problem
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
@@ -112,7 +113,9 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
     _check_not_nested(out, shown)
     if out.is_symlink():
         raise ConfigError("--out", f"{shown} is a symbolic link; sim never replaces it")
-    if not out.exists():
+    if not out.exists():  # café typed beside a café of the other Unicode form (doors25a):
+        if (why := link_problem(out)) is not None:  # two results directories printed alike
+            raise ConfigError("--out", f"{shown} {why}")
         return
     if not out.is_dir():
         raise ConfigError(
@@ -287,7 +290,8 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
         ) from None
     except NotALock as e:
         raise ConfigError(
-            "--out", f"{e.path} is not a lock file of sim (a link or a pipe); move it away"
+            "--out",
+            f"{e.path} is not a lock file of sim (a link, a pipe or a directory); move it away",
         ) from None
     except OSError as e:
         raise ConfigError("--out", _not_lockable(stage, out, shown, e)) from None
@@ -342,6 +346,13 @@ def _owner(p: Path) -> str:
         return f"uid {uid}"
 
 
+def _uid(p: Path) -> int | None:
+    try:
+        return p.lstat().st_uid
+    except OSError:
+        return None
+
+
 def _holder(lock: Path) -> tuple[bool, int | None]:
     """Whether a process holds the lock ``lock`` that this user may not write (another user's
     run), and its pid: the lock is tested through a read-only descriptor (a shared lock,
@@ -378,6 +389,12 @@ def _not_lockable(stage: Path, out: Path, shown: str, e: OSError) -> str:
                 f"{shown} is being written by a running sim ({who} of user "
                 f"{_owner(stage / LOCK)}); "
                 "wait for it to finish or choose another --out"
+            )
+        me, lock = os.geteuid(), _uid(stage / LOCK)
+        if _uid(stage) == me and lock in (me, None):  # doors25a: it was "another user (me)"
+            what = stage / LOCK if lock is not None else stage  # made read-only by its owner
+            return (
+                f"{what} is yours but cannot be written ({e.strerror}): chmod u+w it or remove it"
             )
         return (
             f"{stage} holds an unfinished run of another user ({_owner(stage)}) that you may "

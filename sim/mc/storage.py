@@ -407,8 +407,8 @@ class StageLock:
         try:
             fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o666)
         except OSError as e:
-            if e.errno == errno.ELOOP:  # a symbolic link
-                raise NotALock(path) from None
+            if e.errno in (errno.ELOOP, errno.EISDIR):  # a symbolic link, a directory (doors25a:
+                raise NotALock(path) from None  # "cannot write to <the parent>: Is a directory")
             raise
         st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode) or st.st_nlink > 1:  # a FIFO, a hard link

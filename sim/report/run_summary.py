@@ -8,6 +8,7 @@ A directory is a study run (``claims.parquet``) or a ``[sweep]`` run (``sweep.pa
 from __future__ import annotations
 
 import math
+import shlex
 from collections import Counter
 from pathlib import Path
 from typing import Callable
@@ -164,7 +165,7 @@ def terminal_table(out: Path, width: int = 100) -> str:
         ok = sum(bool(f) for f in t["feasible"])
         return (
             f"{table}\n\nsweep: {ok} of {len(rows)} cells ran; every claim of every cell: "
-            f"sim show {out} --markdown"
+            f"sim show {shlex.quote(str(out))} --markdown"  # a command to paste (doors25a)
         )
     claims = records(out / "claims.parquet")
     rows = [[r["claim"], _value_text(r), _interval(r), r["verdict"]] for r in claims]
@@ -205,7 +206,7 @@ def run_markdown(out: Path, get_study: Callable) -> str:
         f"Study `{prov['study']}`"
         + (f", seed paper: {paper}." if paper else " (a declared network, no seed paper).")
         + " Written by `sim run` from this directory's Parquet files "
-        f"({md_code(f'sim show {out.name}')} prints it again).",
+        f"({md_code(f'sim show {shlex.quote(out.name)}')} prints it again).",
         "",
     ]
     if kind == "sweep":

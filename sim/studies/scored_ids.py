@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Callable, Iterable
 
 from sim.mc.config import ConfigError
+from sim.mc.lookalike import alike
 
 __all__ = ["literal_ids", "check_literal_ids", "check_scored", "named_ids"]
 
@@ -82,7 +83,8 @@ def check_literal_ids(
         if not any(d.startswith(cid) for d in declared):
             raise ConfigError(
                 "claim.id",
-                f"{book.path}: claim {cid!r}, which the study scores ({name}), is not declared",
+                f"{book.path}: claim {cid!r}, which the study scores ({name}), is not declared"
+                + alike(cid, declared),
             )
 
 

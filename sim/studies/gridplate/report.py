@@ -27,9 +27,9 @@ _MODEL = (
 
 
 def _intro(cfg: dict) -> str:
-    k = cfg["plate.grid"]
-    return (
-        f"Simulated calibrations of a comparator with {cfg['plate.count']} grid plates of "
+    k, n = cfg["plate.grid"], cfg["plate.count"]
+    return (  # plate.count = 1: "1 grid plates" (doors25a)
+        f"Simulated calibrations of a comparator with {n} grid plate{'s' * (n != 1)} of "
         f"{k} x {k} points at {cfg['plate.spacing_mm']:g} mm, each on its carrier with "
         f"|kappa| <= {cfg['plate.kappa_deg']:g} deg, {cfg['readings.count']} readings per point "
         f"of {cfg['readings.sigma_um']:g} um, a mean comparator coordinate of "
