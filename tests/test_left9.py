@@ -142,8 +142,11 @@ class _Tty(io.StringIO):
 def test_a_phase_shows_on_a_terminal_and_is_erased(monkeypatch):
     monkeypatch.delenv("TERM", raising=False)
     s = _Tty()
-    with progress.phase("network: factorising", True, quiet=False, stream=s):
-        assert s.getvalue() == "network: factorising ..."
+    with progress.phase("network: tables", True, quiet=False, stream=s):
+        assert s.getvalue().endswith("\x1b[Knetwork: tables ...")
+        with progress.phase("network: factorising", True, quiet=False, stream=s):
+            assert s.getvalue().endswith("\x1b[Knetwork: factorising ...")
+        assert s.getvalue().endswith("\x1b[Knetwork: tables ...")  # the outer step again
     assert s.getvalue().endswith("\r\x1b[K")
     for kw in ({"quiet": True}, {"show": False, "quiet": False}):  # --quiet; a small network
         s = _Tty()

@@ -136,6 +136,20 @@ def set_quiet(quiet: bool) -> None:
     _QUIET[0] = bool(quiet)
 
 
+#: the phases shown now, outermost first (a step inside another replaces its line, and the
+#: outer one's comes back when it ends)
+_SHOWN: list = []
+
+
+def _show(stream, text: str) -> bool:
+    try:
+        stream.write("\r\x1b[K" + text)
+        stream.flush()
+        return True
+    except (OSError, ValueError):
+        return False
+
+
 @contextmanager
 def phase(label: str, show: bool = True, quiet: bool | None = None, stream=None):
     """Show ``label ...`` on standard error while the block runs, erased when it ends: the
@@ -148,18 +162,13 @@ def phase(label: str, show: bool = True, quiet: bool | None = None, stream=None)
     on = show and not quiet and _terminal(stream) and os.environ.get("TERM") != "dumb"
     if on:
         cols = _columns(stream) or DEFAULT_COLUMNS
-        text = f"{label} ..."[: max(min(cols, MAX_COLUMNS) - 1, 1)]
-        try:
-            stream.write(text)
-            stream.flush()
-        except (OSError, ValueError):
-            on = False
+        on = _show(stream, f"{label} ..."[: max(min(cols, MAX_COLUMNS) - 1, 1)])
+    if on:
+        _SHOWN.append((stream, f"{label} ..."[: max(min(cols, MAX_COLUMNS) - 1, 1)]))
     try:
         yield
     finally:
         if on:
-            try:
-                stream.write("\r\x1b[K")
-                stream.flush()
-            except (OSError, ValueError):
-                pass
+            _SHOWN.pop()
+            back = [t for st, t in _SHOWN if st is stream]
+            _show(stream, back[-1] if back else "")
