@@ -44,6 +44,9 @@ NNZ_PER_ROW = {"distance": 4.5, "direction": 8.5, "angle": 12.0, "dx": 1.0, "dy"
 SPARSE_NNZ_PER_UNIT = 1.0e4
 SPARSE_ROWS_PER_UNIT = 2.5e3
 SPARSE_SETUP_UNITS_PER_NNZ = 0.04
+#: unit adjustments per observation of the outputs, once a run (the tables, the figures, the
+#: gama-local export): measured, a 10,000-point trilateration grid (80,000 distances), 9.5 s
+OUTPUT_UNITS_PER_ROW = 2.5
 #: a dense network adjustment's iteration, in unit adjustments: DENSE_ITERATION_UNITS (the
 #: batch's steps, amortised over a chunk) plus m U over DENSE_ROWS_COLS_PER_UNIT (the Jacobian
 #: and the trial's tables) plus m U^2 + U^3 over DENSE_WORK_PER_UNIT (the normals and their
@@ -124,7 +127,7 @@ def network_estimate(c: Mapping) -> tuple:
     """A network's ``(trials, adjustments, unknowns, bytes)``: on the sparse path each
     iteration of a trial one solve with the factor (:data:`SPARSE_NNZ_PER_UNIT`) and one pass
     over the rows (:data:`SPARSE_ROWS_PER_UNIT`), one pass more after the last step, and the
-    pre-analysis once (:data:`SPARSE_SETUP_UNITS_PER_NNZ`); its memory the Jacobian slots of a
+    pre-analysis once (:data:`SPARSE_SETUP_UNITS_PER_NNZ`) and the outputs (:data:`OUTPUT_UNITS_PER_ROW`); its memory the Jacobian slots of a
     chunk and the factor with its selected inverse. On the dense path each iteration
     a constant, m U and m U^2 + U^3 (:data:`DENSE_WORK_PER_UNIT`), its memory trials x observations x
     unknowns."""
@@ -145,7 +148,7 @@ def network_estimate(c: Mapping) -> tuple:
             + (m * U * U + U**3) / DENSE_WORK_PER_UNIT
         )
         setup = 0.0
-    return T, T * w + setup + 2, int(U), b
+    return T, T * w + setup + OUTPUT_UNITS_PER_ROW * m + 2, int(U), b
 
 
 def _declared(c: Mapping) -> tuple[float, float, float, float, bool]:
