@@ -39,6 +39,7 @@ from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem
+from sim.mc.progress import set_quiet
 from sim.mc.read_when import read_in_a_cell
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_record
@@ -110,6 +111,7 @@ def load_run(args):
     """The study and its resolved config, as ``sim run`` (or ``check``) with the parsed
     ``args`` resolves them. ``--trials`` (or ``--set trials=``) without a chunk
     size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it."""
+    set_quiet(getattr(args, "quiet", False))  # the check of a large network shows its steps
     overrides = list(args.set) + ([f"chunk={args.chunk}"] if args.chunk is not None else [])
     given = _keys_set(args.set)
     for opt, key in (("--trials", "trials"), ("--seed", "seed"), ("--chunk", "chunk")):

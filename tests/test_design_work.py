@@ -173,7 +173,10 @@ def test_a_dense_adjustment_larger_than_the_unit_counts_in_proportion(tmp_path):
         estimate(load_study(f, over)[1]) for f in (ROOT / "studies" / "network_plate.toml", f13)
     )
     chunks = 400 / 20 * CHUNK_UNITS
-    assert n5.adjustments - chunks < 500 and 2.7e5 / 3 < n13.adjustments - chunks < 2.7e5 * 3
+    # measured (CPU, single-threaded BLAS): the 5 x 5 plate 12.5 units a trial (it was
+    # counted 1), the 13 x 13 one 883 (two iterations each, tests/test_left9.py)
+    assert 5e3 / 3 < n5.adjustments - chunks < 5e3 * 3
+    assert 3.5e5 / 3 < n13.adjustments - chunks < 3.5e5 * 3
     for f in sorted((ROOT / "studies").glob("*.toml")):
         check_limits(estimate(load_study(f)[1]))
 

@@ -9,22 +9,54 @@ import fnmatch
 import math
 import os
 import re
-from typing import Mapping
+from typing import Mapping, NamedTuple
 
 from sim.lsq.size import SPARSE_MIN_UNKNOWNS
+from sim.lsq.sparse import factor_nonzeros
 from sim.mc.workunits import COPIES, F8
-from sim.mc.workunits import dense_units as _dense
 
-__all__ = ["network_estimate", "NAME_SAMPLE", "NETWORK_SPARSE_FROM"]
+__all__ = ["network_estimate", "network_counts", "Counts", "NAME_SAMPLE", "NETWORK_SPARSE_FROM"]
 
 
 #: unknowns from which the network kind takes the sparse path (the engine's size rule)
 NETWORK_SPARSE_FROM = SPARSE_MIN_UNKNOWNS
-#: nonzeros of the sparse factor (as :func:`network_estimate` counts them) worth one unit
-#: adjustment of a trial's work. Measured (CPU of 400 against 40 trials, chunk 20): the
-#: 50 x 50 grid plate of ``studies/network_gridplate_2500.toml`` (3.8e6 nonzeros) 1.9 ms a
-#: trial, 37 units; a 100 x 100 grid plate (1.7e7) 12 ms, 237 units
-SPARSE_NNZ_PER_UNIT = 1e5
+#: Gauss-Newton iterations a trial takes, counted by the run (``rows.iterations``; fixed
+#: seeds, 2 mm / 1 arcsec networks of 16 to 50,176 points): on the sparse path, whose one
+#: factor of the nominal normals serves every iteration, one for observations linear in the
+#: unknowns (coordinate differences and coordinates: the first step is the solution) and three
+#: with a distance, direction or angle; on the dense path, re-linearised at each step, two
+#: (the step and the one that confirms it) and three with a non-linear kind
+SPARSE_ITERATIONS = {False: 1, True: 3}
+DENSE_ITERATIONS = {False: 2, True: 3}
+#: the observation kinds not linear in the unknowns
+NONLINEAR_KINDS = ("distance", "direction", "angle")
+#: nonzeros of the normals ``N`` (both triangles) a row of each kind adds: the distinct pairs
+#: of unknowns it joins, a pair of points seen from both ends counted once (measured with
+#: :func:`sim.lsq.sparse.normals_nonzeros`: a nearest-8 trilateration grid 4.5 a distance; a
+#: coordinate difference joins two unknowns, 1 a row; a direction adds its station's
+#: orientation, an angle a third point); each point adds its 2 x 2 block
+NNZ_PER_ROW = {"distance": 4.5, "direction": 8.5, "angle": 12.0, "dx": 1.0, "dy": 1.0}
+#: unit adjustments of the sparse path's work (measured, CPU of 20 to 40 trials after a
+#: warm-up chunk, 1,024 to 10,000 points): one iteration of a trial solves with the factor,
+#: ~5e-9 s a nonzero (:func:`sim.lsq.sparse.factor_nonzeros`), and evaluates the residuals
+#: and gradient, ~2e-8 s a row, once more after the last step; the pre-analysis (factor,
+#: selected inverse, reliability) ~2e-6 s a factor nonzero (4 s at 10,000 points)
+SPARSE_NNZ_PER_UNIT = 1.0e4
+SPARSE_ROWS_PER_UNIT = 2.5e3
+SPARSE_SETUP_UNITS_PER_NNZ = 0.04
+#: unit adjustments per observation of the outputs, once a run (the tables, the figures, the
+#: gama-local export): measured, a 10,000-point trilateration grid (80,000 distances), 9.5 s
+OUTPUT_UNITS_PER_ROW = 2.5
+#: a dense network adjustment's iteration, in unit adjustments: DENSE_ITERATION_UNITS (the
+#: batch's steps, amortised over a chunk) plus m U over DENSE_ROWS_COLS_PER_UNIT (the Jacobian
+#: and the trial's tables) plus m U^2 + U^3 over DENSE_WORK_PER_UNIT (the normals and their
+#: solve). Measured with single-threaded BLAS, as ``sim`` runs: 4 points (11 x 13, chunk
+#: 5,000) 0.4 an iteration; the test field (133 x 38) 3.4; Brown's comparator (100 x 60) 9.7;
+#: a 13 x 13 plate (674 x 340) 441; a 196-point trilateration grid (1,568 x 394) 930. It was
+#: one unit a trial whatever the size: the test field's 100,000 trials took 4 times that
+DENSE_ITERATION_UNITS = 0.5
+DENSE_ROWS_COLS_PER_UNIT = 2.0e3
+DENSE_WORK_PER_UNIT = 2.8e5
 
 
 #: a set of more points than this is matched against a pattern through this many evenly
@@ -57,57 +89,104 @@ def _network_names(c: Mapping) -> list[tuple[list[str], float]]:
     return groups
 
 
-def network_estimate(c: Mapping) -> tuple:
-    """A network: points and observations counted from the declaration (patterns matched
-    against the names; ``nearest`` bounds each generated set), then the memory of the path
-    the size takes -- the sparse one counts nonzeros (Jacobian slots per observation, the
-    factor ~ nnz(N) log2(unknowns) / 3, its selected inverse), the dense one trials x
-    observations x unknowns."""
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
+class Counts(NamedTuple):
+    """What a network run does, counted from its declaration: ``unknowns`` (the engine's q),
+    ``rows`` (observations), ``sparse`` (the path), ``iterations`` (a trial's Gauss-Newton
+    steps), ``factor_nnz`` (the sparse factor's nonzeros, 0 on the dense path)."""
+
+    unknowns: float
+    rows: float
+    sparse: bool
+    iterations: int
+    factor_nnz: float
+
+
+def network_counts(c: Mapping) -> Counts:
+    """:class:`Counts` of the network ``c`` declares (points and observations counted from
+    the declaration, patterns matched against the names, ``nearest`` bounding each generated
+    set; an imported ``network.gama_xml`` by its size): the path its unknowns take (the
+    engine's rule), a trial's iterations (:data:`SPARSE_ITERATIONS`,
+    :data:`DENSE_ITERATIONS`, at most ``solver.max_iter``) and on the sparse path the
+    factor's nonzeros from the normals' (:data:`NNZ_PER_ROW`,
+    :func:`sim.lsq.sparse.factor_nonzeros`)."""
     gama = c.get("network.gama_xml", "")
     if gama:  # an imported file: about 80 bytes per observation, 4 observations a point
         m = os.path.getsize(gama) / 80 if os.path.isfile(gama) else 1e3
-        n = m / 4
+        n, orient, nnz_rows, nonlinear = m / 4, m / 16, 6.0 * m, True
     else:
-        groups = _network_names(c)
-        n = sum(len(names) * w for names, w in groups)
-
-        def count(pats) -> float:
-            pats = [pats] if isinstance(pats, str) else list(pats or [])
-            rx = [re.compile(fnmatch.translate(str(p))).match for p in pats]  # = fnmatchcase
-            return sum(w * sum(1 for nm in names if any(m(nm) for m in rx)) for names, w in groups)
-
-        m = float(len(c.get("network.observations", [])))
-        for g in c.get("network.generate", []):
-            if isinstance(g, dict):
-                k = int(g.get("nearest", 0) or 0)
-                fr, to = count(g.get("from", [])), count(g.get("to", []))
-                m += fr * (min(k, to) if k else to)  # nearest=1e300: every target, not 1e300
-        m += 2 * sum(
-            rec.get("role") == "observed"
-            for rec in c.get("network.points", [])
-            if isinstance(rec, dict)
-        )
-        m += 2 * sum(
-            math.prod(int(rec.get(f, 1)) for f in ("nx", "ny"))
-            for rec in c.get("network.grids", [])
-            if isinstance(rec, dict) and rec.get("role") == "observed"
-        )
-    U = 2 * n + n / 4 + 2  # coordinates, orientations (at most a quarter), constant, scale
+        n, m, orient, nnz_rows, nonlinear = _declared(c)
+    U = 2 * n + orient + 2  # coordinates, orientations, constant, scale
+    cap = max(int(c.get("solver.max_iter", 50) or 1), 1)
     if U >= NETWORK_SPARSE_FROM:
+        nnz_l = factor_nonzeros(int(U), int(nnz_rows + 2 * U))
+        return Counts(U, m, True, min(SPARSE_ITERATIONS[nonlinear], cap), nnz_l)
+    return Counts(U, m, False, min(DENSE_ITERATIONS[nonlinear], cap), 0.0)
+
+
+def network_estimate(c: Mapping) -> tuple:
+    """A network's ``(trials, adjustments, unknowns, bytes)``: on the sparse path each
+    iteration of a trial one solve with the factor (:data:`SPARSE_NNZ_PER_UNIT`) and one pass
+    over the rows (:data:`SPARSE_ROWS_PER_UNIT`), one pass more after the last step, and the
+    pre-analysis once (:data:`SPARSE_SETUP_UNITS_PER_NNZ`) and the outputs (:data:`OUTPUT_UNITS_PER_ROW`); its memory the Jacobian slots of a
+    chunk and the factor with its selected inverse. On the dense path each iteration
+    a constant, m U and m U^2 + U^3 (:data:`DENSE_WORK_PER_UNIT`), its memory trials x observations x
+    unknowns."""
+    T, ch = c["trials"], min(c["chunk"], c["trials"])
+    k = network_counts(c)
+    U, m, it, nnz_l = k.unknowns, k.rows, k.iterations, k.factor_nnz
+    if k.sparse:
         s = 6.0  # Jacobian slots of a distance or direction row
-        # N's nonzeros: the pairs of unknowns a row joins, 8 a row (a pair of points, as most
-        # are seen from both ends, or a direction's point and orientation) and a 2 x 2 block a
-        # point, not the rows' slot pairs m s^2 (measured, nearest-8 trilateration grids of
-        # 10,000 and 50,000 points: 4.5 m; m s^2 made the factor 11 times its real size)
-        lg = max(math.log2(max(U, 2)), 1.0)
-        nnz_l = (8 * m + 2 * U) * lg / 3 + 4 * U
         b = 3 * F8 * (ch * m * (s + 3) + 3 * ch * U) + 3 * 16 * nnz_l
-        # the sparse path: a trial's work grows with the factor's nonzeros, as its memory
-        # (one unit per SPARSE_NNZ_PER_UNIT of them; it was one unit whatever the size),
-        # counted from the slot pairs m s^2 the unit was measured with
-        w = max(1.0, (m * s * s * lg / 3 + 4 * U) / SPARSE_NNZ_PER_UNIT)
+        rows = m / SPARSE_ROWS_PER_UNIT
+        w = it * (nnz_l / SPARSE_NNZ_PER_UNIT + rows) + rows
+        setup = SPARSE_SETUP_UNITS_PER_NNZ * nnz_l
     else:
         b = ch * m * (U + 1) * F8 * COPIES
-        w = _dense(m, U)  # the dense path: m U^2 + U^3 a trial
-    return T, T * w + 2, int(U), b
+        w = it * (
+            DENSE_ITERATION_UNITS
+            + m * U / DENSE_ROWS_COLS_PER_UNIT
+            + (m * U * U + U**3) / DENSE_WORK_PER_UNIT
+        )
+        setup = 0.0
+    return T, T * w + setup + OUTPUT_UNITS_PER_ROW * m + 2, int(U), b
+
+
+def _declared(c: Mapping) -> tuple[float, float, float, float, bool]:
+    """``(points, observations, orientation unknowns, N's nonzeros of the rows, any
+    non-linear kind)`` counted from a declared network."""
+    groups = _network_names(c)
+    n = sum(len(names) * w for names, w in groups)
+
+    def count(pats) -> float:
+        pats = [pats] if isinstance(pats, str) else list(pats or [])
+        rx = [re.compile(fnmatch.translate(str(p))).match for p in pats]  # = fnmatchcase
+        return sum(w * sum(1 for nm in names if any(m(nm) for m in rx)) for names, w in groups)
+
+    obs = [o for o in c.get("network.observations", []) if isinstance(o, dict)]
+    rows = {k: 0.0 for k in NNZ_PER_ROW}
+    for o in obs:
+        rows[o.get("kind")] = rows.get(o.get("kind"), 0.0) + 1
+    orient = len(
+        {(o.get("at", o.get("from")), o.get("set")) for o in obs if o.get("kind") == "direction"}
+    )
+    for g in c.get("network.generate", []):
+        if isinstance(g, dict):
+            k = int(g.get("nearest", 0) or 0)
+            fr, to = count(g.get("from", [])), count(g.get("to", []))
+            r = fr * (min(k, to) if k else to)  # nearest=1e300: every target, not 1e300
+            rows[g.get("kind")] = rows.get(g.get("kind"), 0.0) + r
+            orient += fr if g.get("kind") == "direction" else 0
+    m = sum(rows.values())
+    m += 2 * sum(
+        rec.get("role") == "observed"
+        for rec in c.get("network.points", [])
+        if isinstance(rec, dict)
+    )
+    m += 2 * sum(
+        math.prod(int(rec.get(f, 1)) for f in ("nx", "ny"))
+        for rec in c.get("network.grids", [])
+        if isinstance(rec, dict) and rec.get("role") == "observed"
+    )
+    nnz_rows = sum(NNZ_PER_ROW.get(k, 8.0) * v for k, v in rows.items())
+    nonlinear = any(rows.get(k, 0) > 0 for k in NONLINEAR_KINDS)
+    return n, m, min(orient, n), nnz_rows, nonlinear

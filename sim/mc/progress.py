@@ -11,11 +11,12 @@ from __future__ import annotations
 import io
 import os
 import sys
+from contextlib import contextmanager
 
 from sim.mc.config import ConfigError
 from sim.threads import tqdm_variables_problem
 
-__all__ = ["Progress", "check_environment"]
+__all__ = ["Progress", "check_environment", "phase", "set_quiet"]
 
 _FORMAT = (
     "{desc} {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} trials "
@@ -123,3 +124,51 @@ class Progress:
         if self.chunks:
             self.bar.set_postfix_str(f"chunk {self.chunks_done}/{self.chunks}", refresh=False)
         self.bar.update(int(n))
+
+
+#: whether the command runs with ``--quiet`` (set by the entry point before a study file is
+#: checked: the check of a large network factorises it, before any run context exists)
+_QUIET = [False]
+
+
+def set_quiet(quiet: bool) -> None:
+    """Silence (or not) the setup phases :func:`phase` shows for the rest of the process."""
+    _QUIET[0] = bool(quiet)
+
+
+#: the phases shown now, outermost first (a step inside another replaces its line, and the
+#: outer one's comes back when it ends)
+_SHOWN: list = []
+
+
+def _show(stream, text: str) -> bool:
+    try:
+        stream.write("\r\x1b[K" + text)
+        stream.flush()
+        return True
+    except (OSError, ValueError):
+        return False
+
+
+@contextmanager
+def phase(label: str, show: bool = True, quiet: bool | None = None, stream=None):
+    """Show ``label ...`` on standard error while the block runs, erased when it ends: the
+    steps before a run's first progress bar (building, checking, factorising a network of
+    tens of thousands of points takes a minute). Shown only where the bar would be (a terminal
+    that can move the cursor, not ``quiet``: the argument, else :func:`set_quiet`'s) and when
+    ``show`` (the caller's estimate says the step takes more than a couple of seconds)."""
+    stream = stream if stream is not None else sys.stderr
+    quiet = _QUIET[0] if quiet is None else quiet
+    on = show and not quiet and _terminal(stream) and os.environ.get("TERM") != "dumb"
+    if on:
+        cols = _columns(stream) or DEFAULT_COLUMNS
+        on = _show(stream, f"{label} ..."[: max(min(cols, MAX_COLUMNS) - 1, 1)])
+    if on:
+        _SHOWN.append((stream, f"{label} ..."[: max(min(cols, MAX_COLUMNS) - 1, 1)]))
+    try:
+        yield
+    finally:
+        if on:
+            _SHOWN.pop()
+            back = [t for st, t in _SHOWN if st is stream]
+            _show(stream, back[-1] if back else "")

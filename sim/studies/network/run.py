@@ -18,6 +18,7 @@ import numpy as np
 
 from sim.lsq import distributions as D
 from sim.mc.config import StudyError
+from sim.mc.progress import phase
 from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance
 from sim.report.plotting import draw
@@ -28,7 +29,13 @@ from sim.studies.network.estimates import mc_estimates
 from sim.studies.network.figures import network_figure, reliability_figure
 from sim.studies.network.gama import export, import_note, merge_gama
 from sim.studies.network.model import datum
-from sim.studies.network.sparse_analysis import SparseAnalytic, mc_chunk_sparse, pre_analysis
+from sim.studies.network.sparse_analysis import (
+    SparseAnalytic,
+    mc_chunk_sparse,
+    pre_analysis,
+    shows_phases,
+    shows_phases_of,
+)
 from sim.studies.network.tables import (
     K95,
     parameter_indices,
@@ -94,7 +101,10 @@ def run(cfg: dict, out: Path, ctx) -> None:
     the gama-local export and the figures."""
     out = Path(out)
     full = merge_gama(cfg)
-    net = build(full)
+    quiet = True if getattr(ctx, "quiet", False) else None  # else --quiet as the command set it
+    with phase("network: building", shows_phases_of(cfg), quiet):
+        net = build(full)
+    show = shows_phases(net.q)
     dt = datum(net, full)
     an = pre_analysis(net, dt, cfg["reliability.alpha0"], cfg["reliability.power"])
     if not an.ok:
@@ -108,6 +118,12 @@ def run(cfg: dict, out: Path, ctx) -> None:
         est = mc_estimates(an, pts, sim)
     except StudyError as e:
         raise StudyError(_biased(net) or str(e)) from None
+    with phase("network: tables and figures", show, quiet):
+        _outputs(out, cfg, full, net, an, dt, C, pts, held, sim, est, prov)
+
+
+def _outputs(out, cfg, full, net, an, dt, C, pts, held, sim, est, prov) -> None:
+    """The compared parameterisation, the tables, the claims, the export and the figures."""
     dil = _dilution(net, an, full, cfg, pts)
     write_points(out, net, an, pts, est, dil, prov)
     write_parameters(out, net, an, sim, est.n_ok, prov)

@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from sim.mc.config import ConfigError, given
+from sim.mc.progress import phase
 from sim.mc.runner import require_chunks
 from sim.mc.schema_helpers import recorded_sha256
 from sim.studies.network.analysis import (
@@ -34,7 +35,12 @@ from sim.studies.network.singular import (
     unreached,
     unreached_message,
 )
-from sim.studies.network.sparse_analysis import chunk_bytes, pre_analysis, variances
+from sim.studies.network.sparse_analysis import (
+    chunk_bytes,
+    pre_analysis,
+    shows_phases_of,
+    variances,
+)
 
 __all__ = ["SCHEMA", "check", "unread"]
 
@@ -79,7 +85,8 @@ def check(cfg: dict) -> None:
     _digest(cfg)
     full = merge_gama(cfg)
     cfg["datum.kind"] = full["datum.kind"]  # a free gama-local file's inner datum, resolved
-    net = _build(full)
+    with phase("network: building", shows_phases_of(full)):
+        net = _build(full)
     sparse = use_sparse(net)
     nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
     if nbytes > MAX_CHUNK_BYTES:
