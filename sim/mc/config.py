@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from sim.mc.lookalike import char_name, note
+from sim.mc.lookalike import note, toml_char_hint
 from sim.mc.paths import link_problem
 
 __all__ = [
@@ -355,20 +355,6 @@ def study_file_hint(p: str | Path) -> str:
     return f" (did you mean {hit}?)" if hit else ""
 
 
-def _char_hint(line: str, col: int) -> str:
-    """What the character at ``col`` (1-based) of a malformed TOML ``line`` is, when nothing
-    shows it: a line ended by a lone CR (classic Mac OS), or a character that is not ASCII --
-    invisible (a second byte-order mark, a zero-width or no-break space) or drawn as ASCII (a
-    Cyrillic letter in a key): "at line 6, column 4" of ``triаls = 5`` pointed at nothing
-    the user could see."""
-    c = line[col - 1 : col]
-    if c == "\r" and line[col : col + 1] != "":  # tomllib's line ends at "\n" only
-        return " (a lone CR ends the line, as classic Mac OS saved text: save it with LF ends)"
-    if c and not c.isascii():
-        return f" (the character there is {c!r}, {char_name(c)})"
-    return ""
-
-
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML study file; a missing, oversized or malformed file is a ConfigError."""
     p = Path(path)
@@ -401,7 +387,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         curly = [c for c in line if c in TYPOGRAPHIC]  # a word processor's quotes
         hint = f' (the typographic quote {curly[0]} is no TOML quote: type ")' if curly else ""
         raise ConfigError(
-            None, f"{p}: malformed TOML: {e}{hint or _char_hint(line, col)}"
+            None, f"{p}: malformed TOML: {e}{hint or toml_char_hint(line, col)}"
         ) from None
     except RecursionError:
         raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None

@@ -14,7 +14,7 @@ from __future__ import annotations
 import re
 import unicodedata
 
-__all__ = ["note", "skeleton", "differs", "char_name", "alike"]
+__all__ = ["note", "skeleton", "differs", "char_name", "alike", "toml_char_hint"]
 
 #: Cyrillic and Greek letters drawn as a Latin letter, and the letter they look like
 #: (doors25a: and the Armenian, Cherokee and Latin letters drawn as one, Greek small ones)
@@ -86,3 +86,17 @@ def alike(name: str, names) -> str:
     return (
         "" if hit is None else f" (declared is {hit!r}, which looks the same: {differs(hit, name)})"
     )
+
+
+def toml_char_hint(line: str, col: int) -> str:
+    """What the character at ``col`` (1-based) of a malformed TOML ``line`` is, when nothing
+    shows it: a line ended by a lone CR (classic Mac OS), or a character that is not ASCII --
+    invisible (a second byte-order mark, a zero-width or no-break space) or drawn as ASCII (a
+    Cyrillic letter in a key): "at line 6, column 4" of ``triаls = 5`` pointed at nothing
+    the user could see."""
+    c = line[col - 1 : col]
+    if c == "\r" and line[col : col + 1] != "":  # tomllib's line ends at "\n" only
+        return " (a lone CR ends the line, as classic Mac OS saved text: save it with LF ends)"
+    if c and not c.isascii():
+        return f" (the character there is {c!r}, {char_name(c)})"
+    return ""
