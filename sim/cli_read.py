@@ -5,6 +5,7 @@ it is one line naming it (:func:`sim.cli_errors.not_as_written`)."""
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -33,8 +34,13 @@ def show(args) -> int:
     if not d.exists() and (Path("results") / args.dir).is_dir():
         d = Path("results") / args.dir
     if not d.is_dir():  # the name of a study's results is read under ./results too: say so
-        also = "" if d.is_absolute() or d.exists() else f" (nor is results/{args.dir})"
-        why = link_problem(d) or f"is not a directory{also}"
+        what = "is not a directory" if os.path.lexists(d) else "does not exist"
+        also = (
+            ""
+            if d.is_absolute() or d.exists()
+            else f" (nor is there a directory results/{args.dir})"
+        )
+        why = link_problem(d) or f"{what}{also}"
         raise ConfigError("DIR", f"{args.dir} {why}")
     check_claims_table(d / "claims.parquet", "DIR")
     if (sweep := _sweep_of(d)) is not None and (mixed := mixed_run(sweep)) is not None:

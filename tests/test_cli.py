@@ -333,6 +333,8 @@ def test_show_names_both_places_a_study_name_is_looked_for(tmp_path, capsys, mon
     # results/<name> (sim show --help)
     monkeypatch.chdir(tmp_path)
     line = one_line(capsys, main(["show", "nosuch"]))
-    assert line == "sim: error: DIR: nosuch is not a directory (nor is results/nosuch)"
+    assert (
+        line == "sim: error: DIR: nosuch does not exist (nor is there a directory results/nosuch)"
+    )
     line = one_line(capsys, main(["show", str(tmp_path / "nosuch")]))
-    assert line == f"sim: error: DIR: {tmp_path / 'nosuch'} is not a directory"
+    assert line == f"sim: error: DIR: {tmp_path / 'nosuch'} does not exist"
