@@ -155,7 +155,7 @@ def run_all(
             why = ended(proc.returncode)
             stderr = f"{stderr or ''}its run {why}; the same command again resumes it\n"
         named = _Named(sys.stderr, f.name)
-        named.write(stderr)
+        named.write(_in_batch_words(stderr))
         named.flush()
         if stdout:
             log(stdout.rstrip())
@@ -173,6 +173,15 @@ def run_all(
         raise
     pool.shutdown()
     return out
+
+
+def _in_batch_words(text: str | None) -> str | None:
+    """A run's refusal of its ``--out`` in the words of the batch's command line: the user
+    gave ``--results`` (each study writes ``<results>/<file name>``), not ``--out``."""
+    if not text:
+        return text
+    text = text.replace("sim: error: --out: ", "sim: error: --results: ")
+    return text.replace("choose another --out", "choose another --results")
 
 
 def _set(stop: threading.Event, starting: threading.Lock) -> None:

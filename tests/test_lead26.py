@@ -1,0 +1,27 @@
+"""Door classes the lead fixed in the session of 2026-11-28 (05:48 UTC), from the items the
+earlier sweeps left (issue 26):
+
+* ``python -m sim.batch --results DIR`` relayed a run's refusal of its output directory in the
+  run's own words, "--out: ... (choose another --out)": the batch has no ``--out`` (it refuses
+  one), the user gave ``--results``.
+"""
+
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_a_batch_names_its_results_option_not_the_run_s_out(tmp_path):
+    res = tmp_path / "res"
+    res.mkdir()
+    (res / "network_plate").write_text("the user's file\n")  # where the study's results go
+    study = ROOT / "studies" / "network_plate.toml"
+    cmd = [sys.executable, "-m", "sim.batch", "--results", str(res), str(study)]
+    p = subprocess.run([*cmd, "--", "--trials", "40"], capture_output=True, text=True, cwd=ROOT)
+    lines = p.stderr.splitlines()
+    assert p.returncode == 2 and len(lines) == 1 and "Traceback" not in p.stderr, p.stderr
+    assert lines[0].startswith("network_plate.toml: sim: error: --results: "), lines
+    assert "choose another --results" in lines[0] and "--out" not in lines[0], lines
+    assert (res / "network_plate").read_text() == "the user's file\n"
