@@ -57,7 +57,13 @@ from sim.ends import finish  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
-from sim.stops import check_interrupt, keep_lost_interrupts, run_program  # noqa: E402
+from sim.stops import (  # noqa: E402
+    check_interrupt,
+    exit_status,
+    in_main_thread,
+    keep_lost_interrupts,
+    run_program,
+)
 
 if __name__ != "__main__":  # imported: the default handlers (the program: run_program's)
     _loaded()
@@ -225,7 +231,8 @@ INTERRUPTED = "sim.batch: interrupted; the same command again resumes the unfini
 
 
 def main(argv: list[str] | None = None) -> int:
-    old = {s: signal.getsignal(s) for s in (signal.SIGINT, *STOP_SIGNALS)}
+    signals = (signal.SIGINT, *STOP_SIGNALS) if in_main_thread() else ()
+    old = {s: signal.getsignal(s) for s in signals}
     try:
         with keep_lost_interrupts():  # Ctrl-C that Python drops in a C callback: kept
             code = _main(list(sys.argv[1:] if argv is None else argv))
@@ -263,6 +270,8 @@ def _main(argv: list[str]) -> int:
     ap.add_argument("--timings", help="write {study: [exit code, wall s, start s]} (JSON) here")
     try:
         args = ap.parse_args(argv)
+    except SystemExit as e:  # --help: printed; an in-process caller (a notebook) goes on
+        return exit_status(e)
     except _BadArgs as e:
         print(f"sim.batch: {e} (see python -m sim.batch --help)", file=sys.stderr)
         return 2
@@ -313,7 +322,7 @@ def _main(argv: list[str]) -> int:
         if why := _replaces_project_results(f, Path(args.results)):
             print(f"sim.batch: {why}", file=sys.stderr)
             return 2
-    for s in STOP_SIGNALS:
+    for s in STOP_SIGNALS if in_main_thread() else ():
         if signal.getsignal(s) is signal.SIG_DFL:
             signal.signal(s, _on_sigterm)  # end the runs as Ctrl-C does
     if note:  # once, not one line per run that refuses it

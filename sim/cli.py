@@ -25,7 +25,6 @@ import os
 import re
 import signal
 import sys
-import threading
 from pathlib import Path
 
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
@@ -46,7 +45,7 @@ from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
 from sim.report.run_summary import terminal_summary, write_run_readme
-from sim.stops import check_interrupt, keep_lost_interrupts
+from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
 from sim.studies import get_study, load_study, unread_keys
 from sim.threads import interrupted, memory_words, shadowed, short_of_memory
 
@@ -318,8 +317,7 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     # signal handlers are the main thread's to set: main() called from another thread (a
     # notebook's worker, a test runner) ended in "ValueError: signal only works in main thread"
-    mine = threading.current_thread() is threading.main_thread()
-    old = {s: signal.getsignal(s) for s in _STOPS} if mine else {}
+    old = {s: signal.getsignal(s) for s in _STOPS} if in_main_thread() else {}
     _cpu_limit.clear()
     try:
         if not argv:  # usage, not an error message
@@ -350,13 +348,16 @@ def _interrupted_line(args) -> str:
 def _main(argv: list[str]) -> int:
     args = None
     try:
-        args = parser(DOC).parse_args(argv)
+        try:
+            args = parser(DOC).parse_args(argv)
+        except SystemExit as e:  # --help, --version: printed; the caller (a notebook) goes on
+            return exit_status(e)
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
         if args.cmd in ("check", "show") and sys.stdout is None:  # >&-: print() wrote nowhere
             raise ConfigError(None, "standard output is closed (>&-): nothing to print to")
-        for s in _STOPS if threading.current_thread() is threading.main_thread() else ():
+        for s in _STOPS if in_main_thread() else ():
             if signal.getsignal(s) is signal.SIG_DFL:  # clean up like Ctrl-C (nohup: ignored):
                 signal.signal(s, _on_sigterm)  # a run's stage, report's temporary files
         code = _command(args)

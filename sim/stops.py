@@ -29,7 +29,13 @@ import sys
 import threading
 from contextlib import contextmanager
 
-__all__ = ["keep_lost_interrupts", "check_interrupt", "run_program"]
+__all__ = [
+    "keep_lost_interrupts",
+    "check_interrupt",
+    "run_program",
+    "in_main_thread",
+    "exit_status",
+]
 
 #: interrupts recorded by the hook of :func:`keep_lost_interrupts`, not yet raised
 _lost: list[str] = []
@@ -112,6 +118,19 @@ def _ignore_during_teardown() -> None:
 
 
 atexit.register(_ignore_during_teardown)
+
+
+def in_main_thread() -> bool:
+    """Whether this thread may set signal handlers (Python lets only the main thread): a
+    command's ``main`` called from a thread of the caller's (a notebook's background job)
+    ended in "ValueError: signal only works in main thread" when it set or put them back."""
+    return threading.current_thread() is threading.main_thread()
+
+
+def exit_status(e: SystemExit) -> int:
+    """The exit code of argparse's ``--help`` or ``--version`` (a ``SystemExit``), which a
+    command's ``main`` returns: called in a notebook, it raised SystemExit into the caller."""
+    return _exit_status(e.code)
 
 
 def _exit_status(code) -> int:

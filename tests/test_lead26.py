@@ -8,6 +8,7 @@ earlier sweeps left (issue 26):
 
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -25,3 +26,32 @@ def test_a_batch_names_its_results_option_not_the_run_s_out(tmp_path):
     assert lines[0].startswith("network_plate.toml: sim: error: --results: "), lines
     assert "choose another --results" in lines[0] and "--out" not in lines[0], lines
     assert (res / "network_plate").read_text() == "the user's file\n"
+
+
+def test_the_commands_main_returns_help_s_code_and_runs_in_a_thread(tmp_path, capsys):
+    """``sim.cli.main``, ``sim.batch.main`` and ``sim.report.verify.cli.main`` called in a
+    notebook: ``--help``/``--version`` raised SystemExit into the caller (the kernel showed an
+    error), and the batch and verify mains called from a thread of the caller's ended in
+    "ValueError: signal only works in main thread" (they set and put back signal handlers)."""
+    import sim.batch as batch
+    import sim.report.verify.cli as verify
+    from sim.cli import main
+
+    for m, argv in ((main, ["--help"]), (main, ["--version"]), (main, ["show", "--help"])):
+        assert m(argv) == 0
+    assert batch.main(["--help"]) == 0 and verify.main(["--help"]) == 0
+    capsys.readouterr()
+    got = {}
+    study = str(ROOT / "studies" / "network_plate.toml")
+
+    def in_a_thread():
+        got["batch"] = batch.main(["--results", str(tmp_path / "nosuch" / "x"), "-x.toml"])
+        got["verify"] = verify.main(["--results", str(tmp_path / "nosuch")])
+        got["check"] = main(["check", study])
+
+    t = threading.Thread(target=in_a_thread)
+    t.start()
+    t.join()
+    err = capsys.readouterr().err
+    assert got == {"batch": 2, "verify": 2, "check": 0}, (got, err)
+    assert "Traceback" not in err and "signal only works" not in err, err

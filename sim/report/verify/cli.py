@@ -14,7 +14,7 @@ from sim.mc.argv import BoundedParser
 from sim.mc.outputs import name_problem
 from sim.report.verify.rerun import verify, write_record
 from sim.report.verify.rules import Comparison, VerifyError
-from sim.stops import check_interrupt, keep_lost_interrupts
+from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
 
 __all__ = ["main"]
 
@@ -131,7 +131,7 @@ def _interrupt(signum, frame):
 
 
 def main(argv: list[str] | None = None) -> int:
-    signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP) if in_main_thread() else ()
     old = {s: signal.getsignal(s) for s in signals}
     for s in signals[1:]:  # end the re-run and clean up as Ctrl-C does
         if old[s] is signal.SIG_DFL:
@@ -152,7 +152,10 @@ def main(argv: list[str] | None = None) -> int:
 
 def _main(argv: list[str] | None) -> int:
     try:
-        a = _parser().parse_args(argv)
+        try:
+            a = _parser().parse_args(argv)
+        except SystemExit as e:  # --help (or argparse's own error): an in-process caller goes on
+            return exit_status(e)
         _check_args(a)
         extra = [] if a.trials is None else ["--trials", str(a.trials)]
         extra += [x for s in a.set for x in ("--set", s)]
