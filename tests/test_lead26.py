@@ -55,3 +55,26 @@ def test_the_commands_main_returns_help_s_code_and_runs_in_a_thread(tmp_path, ca
     err = capsys.readouterr().err
     assert got == {"batch": 2, "verify": 2, "check": 0}, (got, err)
     assert "Traceback" not in err and "signal only works" not in err, err
+
+
+def test_a_bar_asked_for_is_drawn_in_a_jupyter_notebook():
+    """The API's ``run(quiet=False)`` in a notebook drew no bar (a kernel's output stream is
+    no terminal), though its front end redraws a line ended by a carriage return; a stream of
+    any other kind that is no terminal (a log file, a StringIO) still gets nothing."""
+    import io
+
+    from sim.mc.progress import Progress
+
+    class OutStream(io.StringIO):  # as ipykernel's, by its module
+        __module__ = "ipykernel.iostream"
+
+    for stream, quiet, drawn in (
+        (OutStream(), False, True),
+        (OutStream(), True, False),
+        (io.StringIO(), False, False),
+    ):
+        with Progress(400, "network", quiet=quiet, stream=stream, min_interval=0) as p:
+            p.update(200)
+            p.update(200)
+        text = stream.getvalue()
+        assert ("200/400 trials" in text) == drawn and ("\r" in text) == drawn, (quiet, text)

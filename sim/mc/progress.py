@@ -1,7 +1,7 @@
 """The progress bar (tqdm): trials done, trials per second, time left.
 
-Drawn on standard error only when it is a terminal (and not ``quiet``); silent otherwise,
-so logs and CI output stay clean. A run shares one bar over all its parts (see
+Drawn on standard error only when it is a terminal or a Jupyter notebook's output (and not
+``quiet``); silent otherwise, so logs and CI output stay clean. A run shares one bar over all its parts (see
 :class:`sim.studies.RunContext`), whose total comes from the run's estimate
 (:mod:`sim.mc.estimate`).
 """
@@ -39,6 +39,13 @@ def _terminal(stream) -> bool:
         return bool(stream.isatty())
     except (AttributeError, ValueError, OSError):
         return False
+
+
+def _notebook(stream) -> bool:
+    """Whether ``stream`` is a Jupyter kernel's (ipykernel's ``OutStream``): not a terminal,
+    but its front end redraws a line ended by a carriage return, so a bar asked for there
+    (the API's ``run(quiet=False)``) is drawn; it drew nothing, a long run with no sign."""
+    return type(stream).__module__.startswith("ipykernel.")
 
 
 def _columns(stream) -> int | None:
@@ -90,11 +97,13 @@ class Progress:
         stream = stream if stream is not None else sys.stderr
         # a terminal that cannot move the cursor back (TERM=dumb: an editor's shell buffer)
         # would show every redraw: no bar there
-        self.enabled = not quiet and _terminal(stream) and os.environ.get("TERM") != "dumb"
+        notebook = not quiet and _notebook(stream)
+        terminal = not quiet and _terminal(stream) and os.environ.get("TERM") != "dumb"
+        self.enabled = terminal or notebook
         check_environment()
-        cols = _columns(stream) if self.enabled else None
-        fixed = cols is not None and not 0 < cols <= MAX_COLUMNS
-        width = (min(cols, MAX_COLUMNS) or DEFAULT_COLUMNS) if fixed else None
+        cols = _columns(stream) if terminal else None
+        fixed = notebook or (cols is not None and not 0 < cols <= MAX_COLUMNS)
+        width = (min(cols or 0, MAX_COLUMNS) or DEFAULT_COLUMNS) if fixed else None
         self.bar = _bar_class()(
             total=self.total,
             desc=label,
