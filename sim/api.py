@@ -161,7 +161,7 @@ class StudyHandle:
     path: Path
     study: Any = field(repr=False)
     config: dict = field(repr=False)
-    overrides: dict = field(default_factory=dict, repr=False)
+    overrides: dict = field(default_factory=dict)  # shown: two handles of one file differ
     sweep: dict = field(default_factory=dict, repr=False)
     file_sha256: str = field(default="", repr=False)
 

@@ -78,3 +78,14 @@ def test_a_bar_asked_for_is_drawn_in_a_jupyter_notebook():
             p.update(200)
         text = stream.getvalue()
         assert ("200/400 trials" in text) == drawn and ("\r" in text) == drawn, (quiet, text)
+
+
+def test_a_handle_shows_its_overrides():
+    """A notebook shows a handle by its repr: two handles of one file with other overrides
+    (``trials=200``, ``datum__kind="inner"``) looked alike, ``StudyHandle(path=...)``."""
+    import sim
+
+    study = ROOT / "studies" / "network_plate.toml"
+    plain, other = sim.load(study), sim.load(study, trials=200, datum__kind="inner")
+    assert repr(plain) != repr(other)
+    assert "'trials': 200" in repr(other) and "'datum.kind': 'inner'" in repr(other)
