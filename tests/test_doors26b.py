@@ -5,7 +5,7 @@ held to its double-precision spacing, so a point far from the network's origin w
 near that spacing scattered by its rounding, and the run published Monte-Carlo sigmas,
 coverages and false-alarm rates of cancellation noise with exit 0 (two clusters 60 km apart,
 sigmas 1e-9 mm: coverage of the 95 % ellipse 73 %, global test 10 % at alpha 5 %), or, further
-out, blamed ``solver.max_iter``. Such a network is now refused before its Monte Carlo, naming
+out, blamed ``solver.max_iter``. Such a network is now refused by ``sim check`` and before its Monte Carlo, naming
 the point, its distance from the origin and the rounding."""
 
 from __future__ import annotations
@@ -53,8 +53,10 @@ def test_a_point_whose_sigma_its_rounding_swamps_is_refused_naming_the_magnitude
     """60 km between the clusters (30 km from the origin, a spacing of 3.7e-9 mm) and sigmas
     of 1e-9 mm: exit 0 with a coverage of 73 % before; now one line, exit 2."""
     st = clusters(tmp_path, 6e7, 1e-9)
+    what = ("network.points", "'PC'", "30 km from the network's origin", "rounds")
+    one_line(capsys, main(["check", str(st)]), *what)
     rc = main(["run", str(st), "--out", str(tmp_path / "out")])
-    one_line(capsys, rc, "network.points", "'PC'", "30 km from the network's origin", "rounds")
+    one_line(capsys, rc, *what)
     assert not (tmp_path / "out" / "points.parquet").exists()
 
 

@@ -7,8 +7,8 @@ analytic sigma is not well above that spacing scatters by its rounding as much a
 readings: the Monte-Carlo sigmas, the ellipse coverage and the global test then measure
 cancellation noise (a cluster 60 km from the origin with sigmas of 1e-9 mm covered 73 % in
 its 95 % ellipse), and further out the adjustment no longer converges at all. The pre-analysis
-itself is exact there (it is translation invariant to 1e-12), so the network is refused before
-its Monte Carlo, naming the point, its distance from the origin and the rounding.
+itself is exact there (it is translation invariant to 1e-12), so the network is refused by ``sim check``
+and before its Monte Carlo, naming the point, its distance from the origin and the rounding.
 
 Units: those of the network (mm).
 """
@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.mc.config import StudyError
+from sim.mc.config import ConfigError
 from sim.studies.network.definition import Network
 
 __all__ = ["ROUNDING_SHARE", "check_rounding"]
@@ -43,9 +43,10 @@ def check_rounding(net: Network, cov: np.ndarray, pts: list[int]) -> None:
         return
     a = int(p[worst])
     far = float(np.abs(net.xy[a]).max())
-    raise StudyError(
-        f"network.points: point {net.names[a]!r} lies {far / 1e6:.4g} km from the network's "
+    raise ConfigError(
+        "network.points",
+        f"point {net.names[a]!r} lies {far / 1e6:.4g} km from the network's "
         f"origin, where double precision rounds a coordinate to {spacing[worst]:.2g} mm, over "
         f"{ROUNDING_SHARE:g} of its smallest sigma ({smallest[worst]:.2g} mm): the Monte Carlo "
-        "would measure the rounding; make the smallest sigmas larger or the network smaller"
+        "would measure the rounding; make the smallest sigmas larger or the network smaller",
     )

@@ -29,6 +29,7 @@ from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.keys import SCHEMA
 from sim.studies.network.model import computed, datum, defect_basis, use_sparse
+from sim.studies.network.rounding import check_rounding
 from sim.studies.network.singular import (
     loose_part,
     singular_cause,
@@ -181,6 +182,7 @@ def _held(net, full: dict, dt, sparse: bool):
         # explicit constraints that leave a defect (one of coefficient 1e-300, say) are theirs
         kind = full["datum.kind"]
         _defect(net, dt, "datum.constraints" if kind == "constraints" else "datum.kind", kind)
+    check_rounding(net, an.cov, estimated_points(net, an))
     return an
 
 
