@@ -29,6 +29,7 @@ from sim.studies.network.estimates import mc_estimates
 from sim.studies.network.figures import network_figure, reliability_figure
 from sim.studies.network.gama import export, import_note, merge_gama
 from sim.studies.network.model import datum
+from sim.studies.network.rounding import check_rounding
 from sim.studies.network.sparse_analysis import (
     SparseAnalytic,
     mc_chunk_sparse,
@@ -111,6 +112,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
         raise StudyError("datum.kind: the normal equations are singular in this datum")
     prov = provenance(cfg)
     pts = estimated_points(net, an)
+    check_rounding(net, an.cov, pts)
     held = [net.names[a] for a in range(net.n) if net.role[a] != 1 and a not in pts]
     C = dt.constraint_matrix(net.theta_true()[None])
     sim = _mc(net, an, C, pts, cfg, ctx)

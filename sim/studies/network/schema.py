@@ -29,6 +29,7 @@ from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.keys import SCHEMA
 from sim.studies.network.model import computed, datum, defect_basis, use_sparse
+from sim.studies.network.rounding import check_rounding
 from sim.studies.network.singular import (
     loose_part,
     singular_cause,
@@ -181,6 +182,7 @@ def _held(net, full: dict, dt, sparse: bool):
         # explicit constraints that leave a defect (one of coefficient 1e-300, say) are theirs
         kind = full["datum.kind"]
         _defect(net, dt, "datum.constraints" if kind == "constraints" else "datum.kind", kind)
+    check_rounding(net, an.cov, estimated_points(net, an))
     return an
 
 
@@ -362,11 +364,23 @@ _DEFECT_ADVICE = {
 }
 
 
+def _equilibrated(A: np.ndarray) -> np.ndarray:
+    """``A`` with unit rows, then unit columns (zero ones left zero): the same rank, without
+    the spread of the weights. A sight of 1e-6 mm weighs 1e22 times a 100 m one; its rows
+    pushed seven honest singular values below the relative tolerance, so a network of full
+    rank held by four fixed points read as a rank defect of 12 the datum does not cover."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.linalg.norm(A, axis=1)
+        B = A / np.where(r > 0, r, 1.0)[:, None]
+        c = np.linalg.norm(B, axis=0)
+        return B / np.where(c > 0, c, 1.0)
+
+
 def _defect(net, dt, key: str, kind: str = "fixed") -> None:
     free = dt.free_index(net.q)
     _, J = computed(net, net.theta_true()[None], jac=True)
     A = J[0][:, free] / net.sigma[:, None]
-    sv = np.linalg.svd(A, compute_uv=False)
+    sv = np.linalg.svd(_equilibrated(A), compute_uv=False)
     rank = int((sv > sv[0] * 1e-10).sum()) if sv.size else 0
     if sv.size and rank == len(free):
         _weights(net, A, free, key)
