@@ -76,3 +76,31 @@ def test_dependencies_paragraph_names_every_package_declared_and_imported():
     imported = {PROVIDER.get(m, m) for m in _imported()}
     assert imported - named == set(), f"imported, not named: {imported - named}"
     assert named - declared - imported == set(), "named but neither declared nor imported"
+
+
+def test_benchmark_page_quotes_the_committed_bench_record():
+    """docs/benchmark.md's paragraph on the compiled rows quotes results/bench/: it gave an
+    older round's numbers (network_gradient 25.4x, agnard_block 29.8 s against 51.5 s, 42 %)
+    beside a record of 16.8x and 53.9 s against 107.6 s (50 %)."""
+    import pyarrow.parquet as pq
+
+    page = (ROOT / "docs" / "benchmark.md").read_text(encoding="utf-8")
+    start = page.index("The committed record (`results/bench/`")
+    para = page[start : page.index("\n\n", start)]
+    engines = {
+        r["engine"]: r["compiled_vs_numpy"]
+        for r in pq.read_table(ROOT / "results" / "bench" / "engines.parquet").to_pylist()
+    }
+    pairs = dict(re.findall(r"`(\w+)`,?\s+(\d+\.\d)x", para))
+    assert {"selinv", "sparse_solve", "network_gradient", "block_sparse", "block"} <= set(pairs)
+    for row, x in pairs.items():
+        assert f"{engines[row]:.1f}" == x, f"{row}: the page says {x}x, the record {engines[row]}"
+    studies = {
+        (r["study"], r["variant"]): r["cpu_s"]
+        for r in pq.read_table(ROOT / "results" / "bench" / "studies.parquet").to_pylist()
+    }
+    m = re.search(r"took (\d+\.\d) s of CPU\s+compiled\s+against (\d+\.\d) s", para)
+    c, n = studies[("agnard_block", "compiled")], studies[("agnard_block", "numpy")]
+    assert m and (m.group(1), m.group(2)) == (f"{c:.1f}", f"{n:.1f}"), para
+    saved = re.search(r"a saving of (\d+) %", para)
+    assert saved and int(saved.group(1)) == round(100 * (1 - c / n))
