@@ -104,3 +104,24 @@ def test_benchmark_page_quotes_the_committed_bench_record():
     assert m and (m.group(1), m.group(2)) == (f"{c:.1f}", f"{n:.1f}"), para
     saved = re.search(r"a saving of (\d+) %", para)
     assert saved and int(saved.group(1)) == round(100 * (1 - c / n))
+
+
+def _significant(cell: str) -> int:
+    digits = cell.lstrip("-").replace(".", "").lstrip("0")
+    return len(digits) if digits else 1
+
+
+def test_opening_screen_digits_as_the_overview_says():
+    """docs/verdicts.md said the opening screen of REPORT.md "uses 3 significant digits"; it
+    prints at the interval's decimals, capped at 3 (sim.report.glance._num): wolf's headline
+    is 0.04–0.72. The page says "at most 3", and no cell of the screen has more."""
+    page = (ROOT / "docs" / "verdicts.md").read_text(encoding="utf-8")
+    assert re.search(r"opening screen of `REPORT.md` uses at\s+most 3 significant digits", page)
+    report = (ROOT / "results" / "REPORT.md").read_text(encoding="utf-8")
+    screen = report[report.index("## The verdicts at a glance") : report.index("\n- ")]
+    rows = [r.split(" | ") for r in screen.splitlines() if r.startswith("| **")]
+    assert rows
+    cells = [c for r in rows for cell in r[3].split("<br>") for c in cell.split("–")]
+    counts = [_significant(c.strip()) for c in cells]
+    assert max(counts) <= 3, cells
+    assert min(counts) < 3, "the page's example of fewer digits is gone: reword it"
