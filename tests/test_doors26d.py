@@ -5,6 +5,10 @@ when the code moves, held to the code they describe.
   command (``make: *** [Makefile:N: verify] Error 1``): a line added to the recipe above it
   (the ``shellwords`` check of VERIFY_FLAGS) moved the command to the next line, and the page
   named the check's line.
+- ``sim run --executor dask`` under too few open files (``ulimit -n 50``) is refused before any
+  worker starts, in one line that gives the limit without the hint about a script's missing
+  ``if __name__ == "__main__":`` (it blamed ``__main__.py`` of ``python -m sim``), and says
+  "1 worker" (it said "1 workers"); docs/cli.md gives the count the code asks (64 at least).
 - docs/architecture.md's "Dependencies and why" names every package the project declares
   (pyproject.toml: dependencies and every extra) and every library outside the standard
   library that ``sim/`` and ``benchmarks/`` import: ruff, import-linter, mutmut and psutil
@@ -13,11 +17,15 @@ when the code moves, held to the code they describe.
 
 import ast
 import re
+import resource
+import subprocess
 import sys
 import tomllib
 from pathlib import Path
 
+import pytest
 from conftest import ROOT
+from oneline import one_line_of
 
 #: import name -> the package that provides it, where the two differ
 PROVIDER = {"distributed": "dask", "importlinter": "import-linter"}
@@ -125,3 +133,32 @@ def test_opening_screen_digits_as_the_overview_says():
     counts = [_significant(c.strip()) for c in cells]
     assert max(counts) <= 3, cells
     assert min(counts) < 3, "the page's example of fewer digits is gone: reword it"
+
+
+def test_dask_refused_under_few_open_files_names_the_limit_only(tmp_path):
+    pytest.importorskip("dask.distributed")
+
+    def few_files():
+        resource.setrlimit(resource.RLIMIT_NOFILE, (50, 50))
+
+    proc = subprocess.run(
+        [sys.executable, "-m", "sim", "run", str(ROOT / "studies" / "network_plate.toml")]
+        + ["--trials", "40", "--executor", "dask", "--workers", "1", "--quiet"]
+        + ["--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
+        preexec_fn=few_files,
+    )
+    line = one_line_of(proc, "--executor", "a LocalCluster of 1 worker needs at least 64", "50")
+    assert "__main__" not in line and "script" not in line
+    assert not (tmp_path / "out").exists()
+    page = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
+    from sim.mc.executors import DASK_FILES_PER_WORKER
+
+    floor = 2 * DASK_FILES_PER_WORKER
+    assert re.search(
+        rf"needs at least {DASK_FILES_PER_WORKER} open files a worker and at least {floor}",
+        page,
+    ), "docs/cli.md states the open files --executor dask needs"

@@ -16,7 +16,7 @@ from contextlib import suppress
 
 from sim.mc.streams import call_chunk as _call_chunk
 
-__all__ = ["make_executor", "InProcess", "end_dask_clusters", "script_words"]
+__all__ = ["make_executor", "InProcess", "end_dask_clusters", "script_words", "StartRefused"]
 
 
 class InProcess:
@@ -209,15 +209,21 @@ class _Dask:
 DASK_FILES_PER_WORKER = 32
 
 
+class StartRefused(RuntimeError):
+    """The executor was refused before any worker process started (a limit it cannot start
+    under): no script was imported again, so :func:`script_words` does not apply."""
+
+
 def _enough_files(workers: int) -> None:
     """Refuse (one line) to start a LocalCluster under a limit of open files it cannot start
     in: it would not fail but retry for minutes, printing tracebacks of its monitors."""
     need = DASK_FILES_PER_WORKER * max(workers, 2)
     soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
     if soft != resource.RLIM_INFINITY and soft < need:
-        raise RuntimeError(
-            f"a LocalCluster of {max(workers, 1)} workers needs at least {need} open files, "
-            f"and ulimit -n is {soft} (raise it, or use --executor local)"
+        n = max(workers, 1)
+        raise StartRefused(
+            f"a LocalCluster of {n} worker{'s' if n > 1 else ''} needs at least {need} open "
+            f"files, and ulimit -n is {soft} (raise it, or use --executor local)"
         )
 
 
