@@ -162,3 +162,29 @@ def test_dask_refused_under_few_open_files_names_the_limit_only(tmp_path):
         rf"needs at least {DASK_FILES_PER_WORKER} open files a worker and at least {floor}",
         page,
     ), "docs/cli.md states the open files --executor dask needs"
+
+
+def test_no_main_guard_hint_for_the_suites_own_command(monkeypatch):
+    """The hint about a script's missing main guard is for a caller's script, never for
+    ``python -m sim`` or the ``sim`` script (it said "its worker processes import
+    __main__.py again" of sim's own guarded entry)."""
+    import types
+
+    import sim.__main__ as entry
+    from sim.mc.executors import script_words
+
+    for spec_name in ("sim.__main__", "sim.batch", "sim.report.verify"):
+        mod = types.ModuleType("__main__")
+        mod.__file__ = "/x/sim/__main__.py"
+        mod.__spec__ = types.SimpleNamespace(name=spec_name)
+        monkeypatch.setitem(sys.modules, "__main__", mod)
+        assert script_words("dask", 2, None) == "", spec_name
+    console = types.ModuleType("__main__")  # .venv/bin/sim: from sim.__main__ import main
+    console.__file__ = "/x/.venv/bin/sim"
+    console.main = entry.main
+    monkeypatch.setitem(sys.modules, "__main__", console)
+    assert script_words("dask", 2, None) == ""
+    mine = types.ModuleType("__main__")
+    mine.__file__ = "/home/me/analysis.py"
+    monkeypatch.setitem(sys.modules, "__main__", mine)
+    assert "analysis.py" in script_words("dask", 2, None)

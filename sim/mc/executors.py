@@ -250,6 +250,15 @@ def end_dask_clusters() -> None:
             proc.join(1)
 
 
+def _suite_entry(main) -> bool:
+    """Whether the process's ``__main__`` is the suite's own command (``python -m sim``, the
+    ``sim`` script), whose code is guarded: no script of the caller's is imported again."""
+    spec = getattr(main, "__spec__", None)
+    if spec is not None and (spec.name == "sim" or spec.name.startswith("sim.")):
+        return True
+    return getattr(getattr(main, "main", None), "__module__", None) == "sim.__main__"
+
+
 def script_words(kind: str, workers: int, scheduler: str | None) -> str:
     """Why starting the executor may have failed when the caller is a script (the Python API):
     workers started by ``spawn`` or ``forkserver`` (Dask's LocalCluster; a local pool in a
@@ -257,8 +266,9 @@ def script_words(kind: str, workers: int, scheduler: str | None) -> str:
     again, and a script without ``if __name__ == "__main__":`` starts its run again there,
     which multiprocessing refuses ("terminated abruptly", Dask's "Nanny failed to start"
     with no cause). "" when that cannot be the cause."""
-    script = getattr(sys.modules.get("__main__"), "__file__", None)
-    if not script or scheduler or (kind == "local" and workers <= 1):
+    main = sys.modules.get("__main__")
+    script = getattr(main, "__file__", None)
+    if not script or scheduler or (kind == "local" and workers <= 1) or _suite_entry(main):
         return ""
     if kind == "local" and (_start_method() or multiprocessing.get_start_method()) == "fork":
         return ""
