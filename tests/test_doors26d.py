@@ -188,3 +188,18 @@ def test_no_main_guard_hint_for_the_suites_own_command(monkeypatch):
     mine.__file__ = "/home/me/analysis.py"
     monkeypatch.setitem(sys.modules, "__main__", mine)
     assert "analysis.py" in script_words("dask", 2, None)
+
+
+def test_docs_index_links_every_page():
+    """The README calls docs/index.md "every page"; it left out paper-regions.md and
+    study-code.md."""
+    index = (ROOT / "docs" / "index.md").read_text(encoding="utf-8")
+    linked = {m for m in re.findall(r"\]\(([^)#]+\.md)(?:#[^)]*)?\)", index)}
+    pages = {
+        str(p.relative_to(ROOT / "docs"))
+        for p in (ROOT / "docs").rglob("*.md")
+        if p.name != "index.md"
+    }
+    assert pages - linked == set(), f"pages docs/index.md does not link: {pages - linked}"
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert "[docs/index.md](docs/index.md): every page" in readme
