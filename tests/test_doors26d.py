@@ -203,3 +203,23 @@ def test_docs_index_links_every_page():
     assert pages - linked == set(), f"pages docs/index.md does not link: {pages - linked}"
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     assert "[docs/index.md](docs/index.md): every page" in readme
+
+
+def test_report_states_the_one_plate_rule_the_code_applies():
+    """REPORT.md's rules said a one-plate claim fails "when fewer than 5 % of simulated plates
+    are at least as extreme"; the rule's p is two-sided (sim.claims.intervals.plate_p: twice
+    the rarer side's share), so 3 % of plates beyond the paper's value on one side (p = 0.06)
+    does not fail. The text now says 2.5 % on the paper's side, from P_FAIL."""
+    import numpy as np
+
+    from sim.claims.intervals import plate_p
+    from sim.claims.rules import P_FAIL, decide
+    from sim.report.markdown import _RULES
+
+    plates = np.arange(1, 101, dtype=float)  # 3 of 100 plates above 97.5
+    p = plate_p(plates, 97.5)
+    assert p == 0.06
+    assert decide("one-plate", (3.0, 98.0), (0.0, 200.0), p_plate=p) != "fails"
+    one_side = re.search(r"fewer than ([\d.]+) % of\s+simulated plates are as extreme", _RULES)
+    assert one_side and float(one_side.group(1)) == 100 * P_FAIL / 2, _RULES
+    assert "two-sided" in (ROOT / "docs" / "verdicts.md").read_text(encoding="utf-8")
