@@ -24,7 +24,7 @@ import numpy as np
 
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
-from sim.mc.executors import script_words
+from sim.mc.executors import StartRefused, script_words
 from sim.mc.outputs import check_out, drop_stage, prepare_stage, stage_dir
 from sim.mc.publish import publish, seal
 from sim.mc.runner import ChunkStore, RunContext, make_executor
@@ -171,7 +171,8 @@ def execute(
     except (RuntimeError, OSError, TimeoutError, ValueError, TypeError) as e:
         key = "--scheduler" if scheduler else "--executor"
         msg = (str(e).strip().splitlines() or [type(e).__name__])[0]
-        words = script_words(executor, workers, scheduler)
+        # a refusal before any worker started is not a script's missing main guard
+        words = "" if isinstance(e, StartRefused) else script_words(executor, workers, scheduler)
         raise ConfigError(key, f"cannot start the {executor} executor: {msg}{words}") from None
     lock = None
     try:

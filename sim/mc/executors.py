@@ -16,7 +16,7 @@ from contextlib import suppress
 
 from sim.mc.streams import call_chunk as _call_chunk
 
-__all__ = ["make_executor", "InProcess", "end_dask_clusters", "script_words"]
+__all__ = ["make_executor", "InProcess", "end_dask_clusters", "script_words", "StartRefused"]
 
 
 class InProcess:
@@ -209,15 +209,21 @@ class _Dask:
 DASK_FILES_PER_WORKER = 32
 
 
+class StartRefused(RuntimeError):
+    """The executor was refused before any worker process started (a limit it cannot start
+    under): no script was imported again, so :func:`script_words` does not apply."""
+
+
 def _enough_files(workers: int) -> None:
     """Refuse (one line) to start a LocalCluster under a limit of open files it cannot start
     in: it would not fail but retry for minutes, printing tracebacks of its monitors."""
     need = DASK_FILES_PER_WORKER * max(workers, 2)
     soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
     if soft != resource.RLIM_INFINITY and soft < need:
-        raise RuntimeError(
-            f"a LocalCluster of {max(workers, 1)} workers needs at least {need} open files, "
-            f"and ulimit -n is {soft} (raise it, or use --executor local)"
+        n = max(workers, 1)
+        raise StartRefused(
+            f"a LocalCluster of {n} worker{'s' if n > 1 else ''} needs at least {need} open "
+            f"files, and ulimit -n is {soft} (raise it, or use --executor local)"
         )
 
 
@@ -244,6 +250,15 @@ def end_dask_clusters() -> None:
             proc.join(1)
 
 
+def _suite_entry(main) -> bool:
+    """Whether the process's ``__main__`` is the suite's own command (``python -m sim``, the
+    ``sim`` script), whose code is guarded: no script of the caller's is imported again."""
+    spec = getattr(main, "__spec__", None)
+    if spec is not None and (spec.name == "sim" or spec.name.startswith("sim.")):
+        return True
+    return getattr(getattr(main, "main", None), "__module__", None) == "sim.__main__"
+
+
 def script_words(kind: str, workers: int, scheduler: str | None) -> str:
     """Why starting the executor may have failed when the caller is a script (the Python API):
     workers started by ``spawn`` or ``forkserver`` (Dask's LocalCluster; a local pool in a
@@ -251,8 +266,9 @@ def script_words(kind: str, workers: int, scheduler: str | None) -> str:
     again, and a script without ``if __name__ == "__main__":`` starts its run again there,
     which multiprocessing refuses ("terminated abruptly", Dask's "Nanny failed to start"
     with no cause). "" when that cannot be the cause."""
-    script = getattr(sys.modules.get("__main__"), "__file__", None)
-    if not script or scheduler or (kind == "local" and workers <= 1):
+    main = sys.modules.get("__main__")
+    script = getattr(main, "__file__", None)
+    if not script or scheduler or (kind == "local" and workers <= 1) or _suite_entry(main):
         return ""
     if kind == "local" and (_start_method() or multiprocessing.get_start_method()) == "fork":
         return ""

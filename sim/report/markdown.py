@@ -13,7 +13,7 @@ from typing import Callable
 import pyarrow as pa
 
 from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
-from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
+from sim.claims.rules import NOT_APPLICABLE, P_FAIL, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
@@ -235,9 +235,11 @@ _RULES = (
     "meet, and is **inconclusive** otherwise (the interval covers both agreeing and "
     'contradicting values). A *range* ("from 5 to 15 %") holds when every element\'s '
     "interval lies inside it and fails when some element's interval lies wholly outside. "
-    "A *one-plate* statistic (the paper's one plate) fails when fewer than 5 % of "
-    "simulated plates are at least as extreme (`p < 0.05`) and holds when, besides, the "
-    "central 95 % of simulated plates lies inside the zone. A prediction decided over a "
+    "A *one-plate* statistic (the paper's one plate) fails when its two-sided `p` is below "
+    f"{P_FAIL:g}: fewer than {100 * P_FAIL / 2:g} % of simulated plates are as extreme as the "
+    "paper's on its side (every value that prints as the paper's number counted), and holds "
+    "when, besides, the central 95 % of simulated plates lies inside the zone. A prediction "
+    "decided over a "
     "study's consistent region (the unprinted inputs the paper's statements leave) "
     "**holds** or **fails** when it does so everywhere in the region, **depends** when it "
     "holds in one part and fails in another, **holds or undecided** (**fails or undecided**) "
