@@ -1,6 +1,9 @@
 """Door classes the lead fixed in the session of 2026-11-28 (05:48 UTC), from the items the
 earlier sweeps left (issue 26):
 
+* a Brown plate point no farther from a station than the tangential offset beta (its range
+  sqrt(d^2 - beta^2) - alpha undefined) was accepted by ``sim check`` (every trial failed at
+  run time, after a NumPy warning) or blamed on a singular normal matrix or on the scale;
 * ``python -m sim.batch --results DIR`` relayed a run's refusal of its output directory in the
   run's own words, "--out: ... (choose another --out)": the batch has no ``--out`` (it refuses
   one), the user gave ``--results``.
@@ -10,6 +13,10 @@ import subprocess
 import sys
 import threading
 from pathlib import Path
+
+import pytest
+
+from tests.oneline import SIM_ERROR, one_line
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -89,3 +96,27 @@ def test_a_handle_shows_its_overrides():
     plain, other = sim.load(study), sim.load(study, trials=200, datum__kind="inner")
     assert repr(plain) != repr(other)
     assert "'trials': 200" in repr(other) and "'datum.kind': 'inner'" in repr(other)
+
+
+@pytest.mark.parametrize(
+    "points, scale, needle",
+    [
+        ("[[0,122.3],[10,-20],[-30,40],[50,50],[-60,-70]]", 0, "point 1 (0, 122.3) mm lies 0.7 mm"),
+        ("[[0,122],[10,-20],[-30,40],[50,50],[-60,-70]]", 0, "point 1 (0, 122) mm lies 1 mm"),
+        ("[[10,-20],[-30,40],[0.3,122.5],[50,50],[-60,-70]]", 261, "point 3 (0.3, 122.5)"),
+    ],
+)
+def test_a_brown_point_within_beta_of_a_station_is_named(points, scale, needle, capsys):
+    from sim.cli import main
+
+    sets = {
+        "plate.pattern": "list",
+        "plate.points": points,
+        "comparator.station_offset_mm": 0.5,  # the stations 0.5 mm outside the format
+        "comparator.beta_mm": 1,
+        "comparator.scale_length_mm": scale,
+    }
+    argv = ["check", str(ROOT / "studies" / "brown_table1.toml")]
+    argv += [a for k, v in sets.items() for a in ("--set", f"{k}={v}")]
+    line = one_line(capsys, main(argv), SIM_ERROR + "plate.points: ", needle)
+    assert "station 1 (0, 123)" in line and "beta = 1 mm" in line, line

@@ -280,6 +280,7 @@ def check(cfg: dict) -> None:
         raise ConfigError(
             key, "all points are collinear: the station coordinates cannot be recovered"
         )
+    _within_beta(cfg, key, pts)
     if cfg["comparator.scale_length_mm"] > 0:
         _, theta = setup(cfg)
         r = ml.ranges(pts[None], theta[None])
@@ -299,6 +300,26 @@ def check(cfg: dict) -> None:
             )
     check_pivot(cfg, key, pts)
     require_chunks(cfg)
+
+
+def _within_beta(cfg: dict, key: str, pts: np.ndarray) -> None:
+    """A point no farther from a station than the tangential offset beta has no range
+    (r = sqrt(d^2 - beta^2) - alpha): it was accepted (or blamed on a singular normal matrix,
+    or on the scale) and every trial failed at run time after a NumPy warning."""
+    _, theta = setup(cfg)
+    st = ml.stations(theta)  # (4, 2) mm
+    d2 = ((pts[:, None, :] - st[None, :, :]) ** 2).sum(-1)  # (n, 4) mm^2
+    beta = cfg["comparator.beta_mm"]
+    bad = np.argwhere(d2 <= beta**2)
+    if len(bad):
+        i, j = bad[0]
+        raise ConfigError(
+            key,
+            f"point {i + 1} ({pts[i, 0]:g}, {pts[i, 1]:g}) mm lies {np.sqrt(d2[i, j]):.3g} mm "
+            f"from station {j + 1} ({st[j, 0]:g}, {st[j, 1]:g}), within the tangential pivot "
+            f"offset beta = {beta:g} mm: its range is undefined (move the point, or the "
+            "stations out: comparator.station_offset_mm)",
+        )
 
 
 def pivot_rcond(pts: np.ndarray, theta: np.ndarray) -> float:
