@@ -17,6 +17,13 @@ def _key(k: str) -> str:
     return k.replace("__", ".")
 
 
+#: where a user gets the object a method is called on
+_MADE_BY = {
+    "Results": "the Results run() returned, or sim.Results(path, study)",
+    "StudyHandle": "the handle sim.load(...) returned",
+}
+
+
 def arguments(fn):
     """``fn`` refusing an argument it does not take with one ConfigError line that names the
     argument and the ones it takes (Python's TypeError named the function only: ``run()
@@ -34,7 +41,13 @@ def arguments(fn):
     known = None if any(p.kind == P.VAR_KEYWORD for p in params) else {p.name for p in named}
     what = f"{fn.__qualname__.removesuffix('.__init__')}()"
 
+    owner = fn.__qualname__.rpartition(".")[0].removesuffix(".__init__")
+
     def refusal(args: tuple, kwargs: dict) -> ConfigError:
+        if method and not (args and any(c.__qualname__ == owner for c in type(args[0]).__mro__)):
+            # Results.claims() on the class: "missing: ... needs it (it takes no argument)"
+            made = _MADE_BY.get(owner, "an instance")
+            return ConfigError(what, f"is called on the class {owner}: call it on {made}")
         for k in kwargs:
             if known is not None and k not in known:
                 cfg = getattr(args[0], "config", None) if method and args else None

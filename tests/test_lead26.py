@@ -120,3 +120,21 @@ def test_a_brown_point_within_beta_of_a_station_is_named(points, scale, needle, 
     argv += [a for k, v in sets.items() for a in ("--set", f"{k}={v}")]
     line = one_line(capsys, main(argv), SIM_ERROR + "plate.points: ", needle)
     assert "station 1 (0, 123)" in line and "beta = 1 mm" in line, line
+
+
+def test_a_method_called_on_the_class_says_so():
+    """``sim.Results.claims()`` (the class, not an instance) said "missing: Results.claims()
+    needs it (it takes no argument)": Python's missing ``self`` in the API's argument words."""
+    import sim
+    from sim.mc.config import ConfigError
+
+    for call, needle in (
+        (lambda: sim.Results.claims(), "call it on the Results run() returned"),
+        (lambda: sim.Results.table("claims"), "sim.Results(path, study)"),
+        (lambda: sim.api.StudyHandle.run(), "the handle sim.load(...) returned"),
+    ):
+        with pytest.raises(ConfigError) as e:
+            call()
+        assert "is called on the class" in str(e.value) and needle in str(e.value), e.value
+    with pytest.raises(ConfigError, match="missing"):  # on an instance: the argument's words
+        sim.Results(ROOT / "results" / "network_plate", "network").table()
