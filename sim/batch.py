@@ -271,7 +271,7 @@ def _main(argv: list[str]) -> int:
     try:
         args = ap.parse_args(argv)
     except SystemExit as e:  # --help: printed; an in-process caller (a notebook) goes on
-        return exit_status(e)
+        return exit_status(e.code)
     except _BadArgs as e:
         print(f"sim.batch: {e} (see python -m sim.batch --help)", file=sys.stderr)
         return 2

@@ -351,7 +351,7 @@ def _main(argv: list[str]) -> int:
         try:
             args = parser(DOC).parse_args(argv)
         except SystemExit as e:  # --help, --version: printed; the caller (a notebook) goes on
-            return exit_status(e)
+            return exit_status(e.code)
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")

@@ -127,14 +127,10 @@ def in_main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
-def exit_status(e: SystemExit) -> int:
-    """The exit code of argparse's ``--help`` or ``--version`` (a ``SystemExit``), which a
-    command's ``main`` returns: called in a notebook, it raised SystemExit into the caller."""
-    return _exit_status(e.code)
-
-
-def _exit_status(code) -> int:
-    """The status ``sys.exit(code)`` ends the process with."""
+def exit_status(code) -> int:
+    """The status ``sys.exit(code)`` ends the process with: also what a command's ``main``
+    returns for argparse's ``--help`` or ``--version`` (``SystemExit(e.code)``), since a
+    ``main`` called in a notebook raised SystemExit into the caller."""
     if code is None:
         return 0
     return code if isinstance(code, int) else 1
@@ -152,9 +148,9 @@ def run_program(prog: str, main, loaded) -> int:
         try:
             code = main()
         except SystemExit as e:  # argparse's --help: its code stands as well
-            _ended[:] = [_exit_status(e.code)]
+            _ended[:] = [exit_status(e.code)]
             raise
-        _ended[:] = [_exit_status(code)]
+        _ended[:] = [exit_status(code)]
     except KeyboardInterrupt:
         _ended[:] = [130]
         os.write(2, f"{prog}: interrupted\n".encode())

@@ -155,7 +155,7 @@ def _main(argv: list[str] | None) -> int:
         try:
             a = _parser().parse_args(argv)
         except SystemExit as e:  # --help (or argparse's own error): an in-process caller goes on
-            return exit_status(e)
+            return exit_status(e.code)
         _check_args(a)
         extra = [] if a.trials is None else ["--trials", str(a.trials)]
         extra += [x for s in a.set for x in ("--set", s)]

@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from sim.lsq.normals import RCOND, scaled_rcond
 from sim.mc.config import ConfigError, given
 from sim.mc.progress import phase
 from sim.mc.runner import require_chunks
@@ -325,12 +326,13 @@ def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
     between them). Name the weakest unknown and the range of the sigmas."""
     _, sv, vt = np.linalg.svd(A, full_matrices=False)
     what = _unknown(net, int(free[int(np.argmax(np.abs(vt[-1])))]))
+    rc = float(scaled_rcond(A.T @ A))
     raise ConfigError(
         key,
         f"the network is near-singular from its weights: {what} is nearly undetermined "
-        f"(the normal matrix's condition number is {(sv[0] / sv[-1]) ** 2:.3g}, too large "
-        "to solve in double precision): bring the observations' sigmas closer together, "
-        "or fix points",
+        f"(the normal matrix scaled to unit diagonal has a reciprocal condition number of "
+        f"{rc:.2g}, under the engine's limit of {RCOND:g}, more than ten digits lost): "
+        "bring the observations' sigmas closer together, or fix points",
     )
 
 
