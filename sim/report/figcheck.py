@@ -185,11 +185,14 @@ def _comb_problems(i: int, ax) -> list[str]:
 
 
 def _handle_colour(h):
+    if isinstance(h, _container.ErrorbarContainer) and h.lines[0] is not None:
+        h = h.lines[0]  # an error-bar series: its data line (a sweep's series were skipped)
     if isinstance(h, _lines.Line2D):
         c = h.get_color()
         if h.get_linestyle() in ("None", "") and h.get_markerfacecolor() != "none":
             c = h.get_markerfacecolor()  # a marker alone: its face, else its edge
-        return _colors.to_rgba(c, h.get_alpha()), (h.get_marker(), h.get_linestyle())
+        hollow = _colors.same_color(h.get_markerfacecolor(), "white")
+        return _colors.to_rgba(c, h.get_alpha()), (h.get_marker(), h.get_linestyle(), hollow)
     if isinstance(h, mcoll.PathCollection) and len(h.get_facecolors()):
         return _colors.to_rgba(h.get_facecolors()[0], h.get_alpha()), ("scatter", "")
     return None, None
@@ -200,8 +203,10 @@ def _colour_problems(i: int, ax) -> list[str]:
     if leg is None or not leg.get_visible():
         return []
     probs, seen = [], []
+    drawn = dict(zip(*reversed(ax.get_legend_handles_labels())))  # label -> the series
     for h, t in zip(leg.legend_handles, leg.get_texts()):
-        rgba, style = _handle_colour(h)
+        rgba, style = _handle_colour(drawn.get(t.get_text(), h))  # an error bar's proxy
+        # in the legend is its bars' LineCollection: the series itself has the colour
         if rgba is None:
             continue
         a = rgba[3]

@@ -31,6 +31,31 @@ _PROPORTION = ("coverage", "false_alarm", "share", "rate", "proportion", "fracti
 #: series colours: the default cycle without red, which marks infeasible cells
 _COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink"]
 _COLOURS += ["tab:gray", "tab:olive", "tab:cyan"]
+#: after every colour, the next series change marker and line (the tenth series was drawn
+#: exactly as the first: two legend entries alike, their lines told apart by nothing)
+_STYLES = [("o", "-"), ("s", "--"), ("^", ":"), ("D", "-."), ("v", (0, (5, 1, 1, 1, 1, 1)))]
+
+
+def _style(n: int) -> dict:
+    """Colour, marker and line of series ``n``: distinct for 45 series, then repeating (past
+    the colours, hollow markers: a legend's short handle hides a dashed line)."""
+    k = (n // len(_COLOURS)) % len(_STYLES)
+    marker, line = _STYLES[k]
+    style = {"color": _COLOURS[n % len(_COLOURS)], "marker": marker, "linestyle": line}
+    return style | ({"markerfacecolor": "white"} if k else {})  # hollow: told apart in a legend
+
+
+def _value_texts(values) -> dict:
+    """Each value of a swept key (by its ``repr``) as a legend shows it: floats with the fewest significant
+    digits (at least 4) that keep every value apart (a range's 0.031111111111111112 was cut
+    to "0.0311111111111..."), anything else as ``str``."""
+    vals = {repr(v): v for v in values}  # by repr: a list-valued key's values are lists
+    floats = {k: v for k, v in vals.items() if isinstance(v, float)}
+    for digits in range(4, 18):
+        shown = {k: f"{v:.{digits}g}" for k, v in floats.items()}
+        if len(set(shown.values())) == len(shown):
+            break
+    return {k: shown[k] if k in floats else str(v) for k, v in vals.items()}
 
 
 def unit_of(name: str) -> str:
@@ -120,6 +145,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         xlabel += f" - {rep.max() + 1} replicates, a line each"
     empty: list = []  # panels of a claim without a finite value
     names = _legend_names(keys[1:])
+    shown = [_value_texts(t[k]) for k in keys[1:]]
     for ax, c in zip(axs.ravel(), claims):
         v, lo, hi = _column(t, c), _column(t, c + ":lo"), _column(t, c + ":hi")
         prop = _is_proportion(c, v)
@@ -128,16 +154,15 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         for (n, grp), r in itertools.product(enumerate(dict.fromkeys(other)), np.unique(rep)):
             sel = np.array([o == grp for o in other]) & feas & (rep == r)
             o = np.argsort(x[sel], kind="stable")
-            lab = _short(", ".join(f"{k}={_short(str(g), 16)}" for k, g in zip(names, grp))) or None
+            lab = ", ".join(f"{k}={_short(s[repr(g)], 16)}" for k, g, s in zip(names, grp, shown))
             ax.errorbar(
                 x[sel][o],
                 v[sel][o],
                 yerr=[np.maximum(v[sel][o] - lo[sel][o], 0), np.maximum(hi[sel][o] - v[sel][o], 0)],
-                fmt="o-",
                 ms=3,
                 capsize=2,
-                color=_COLOURS[n % len(_COLOURS)],
-                label=lab if r == rep.min() else None,
+                label=(_short(lab) or None) if r == rep.min() else None,
+                **_style(n),
             )
         for xi in x[~feas]:
             ax.axvline(xi, color="tab:red", alpha=0.3, lw=3)
@@ -168,7 +193,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     for ax in axs.ravel()[len(claims) :]:
         ax.axis("off")
     if other[0]:  # once every panel is drawn: the layout is final
-        place_legends([a for a in axs.ravel()[: len(claims)] if a not in empty])
+        place_legends([a for a in axs.ravel()[: len(claims)] if a not in empty], handlelength=3)
     return save(fig, png)
 
 
