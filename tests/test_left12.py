@@ -6,6 +6,22 @@
    many, an adjustment where only one method found a fixed point counts as a difference of 1
    (it fails), and with fewer than 29 compared (the region rule's count: 29 bound the share
    where an identity fails under 10 %, 95 %) the row is undecided, never holds.
+2. gridplate_two_plates on one plate (``--set plate.count=1``). Which claims need two plates,
+   read against seed 001: none of the book's statements does. Each is about one observation
+   (the precision 1.5 um), one adjustment of x' or y' ("one or two trials" of the
+   re-weighting, "two or three iterations", the 1:3 weighting's 0.7 and ratio 3, the
+   comparator's 1.2) or one fit's residual sigma by the paper's own divisors over the N points
+   of a plate (the similarity's 2N - 4: 1.65, the affine's 2N - 6: 1.5, their linear shares
+   0.15 and 0.3); a one-plate calibration has each of these. The paper counts plates only in
+   the precision's divisor, "4N because x, y coordinates are measured in two plates": how two
+   plates pool, not what is claimed. So the study has a meaning on one plate (a calibration
+   of the same procedure on another setup) and is not refused; what keeps it from deciding
+   the paper's claims is that ``plate.count`` is a printed key (left8): every prediction is a
+   finding naming it, the inputs stay inputs, the self-checks are the run's own, and the
+   paper-checks recompute the paper's printed numbers whatever the run (equal to the shipped
+   run's). What was wrong on one plate were the notes: "two plates pooled" of the similarity
+   and affine fits, and the precision's "sqrt(sum sigma_i^2 / 4N) ... on 1 plates ... the
+   paper's '4N' is the divisor", where the run's divisor is 2N.
 """
 
 from __future__ import annotations
@@ -16,6 +32,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from sim.claims.rules import PREDICTION_VERDICTS
 from sim.claims.table import claim_rows
 from sim.cli import main
 from sim.studies.gridplate import claims as gridplate_claims
@@ -117,3 +134,50 @@ def test_a_run_comparing_20_adjustments_leaves_the_closed_form_check_undecided(t
     assert row["outcome"] == "inconclusive" and row["ci_high"] == 1.0
     assert "over the 20 of 20 sampled adjustments" in row["note"]
     assert "self-check undecided" in (out / "README.md").read_text()
+
+
+# ------------------------------------------------------------- 2. gridplate on one plate
+def test_gridplate_on_one_plate_decides_no_claim_of_the_paper_and_says_one_plate(tmp_path):
+    out = tmp_path / "gp1"
+    study = str(ROOT / "studies" / "gridplate_two_plates.toml")
+    sets = _tiny("gridplate_two_plates", "trials=200", "chunk=10", "plate.count=1")
+    assert main(["run", study, "--out", str(out), *sets]) == 0
+    rows = {r["claim"]: r for r in pq.read_table(out / "claims.parquet").to_pylist()}
+    shipped = ROOT / "results" / "gridplate_two_plates" / "claims.parquet"
+    paper = {r["claim"]: r for r in pq.read_table(shipped).to_pylist()}
+    for cid, r in rows.items():
+        if r["kind"] == "prediction":
+            assert r["verdict"] == "finding" and "(plate.count = 1 (paper: 2))" in r["note"], cid
+        elif r["kind"] == "paper-check":  # the paper's own numbers, not this run's
+            p = paper[cid]
+            assert (r["value"], r["ci_low"], r["ci_high"], r["verdict"]) == (
+                p["value"],
+                p["ci_low"],
+                p["ci_high"],
+                p["verdict"],
+            ), cid
+        else:
+            assert r["verdict"] == r["kind"] not in PREDICTION_VERDICTS, cid
+        assert "two plates pooled" not in r["note"] and "1 plates" not in r["note"], cid
+    note = rows["twoplate.precision.reading_sigma_um"]["note"]
+    assert note.startswith("sigma = sqrt(sum sigma_i^2 / 2N) from 4 readings of 25 points on 1 ")
+    assert "the paper's divisor 4N is for its two plates" in note
+    cfg = {"comparator.scale_diff_ppm": 15.0, "comparator.nonorth_arcsec": 3.8, "plate.count": 1}
+    res = {"sim_sigma_um": np.full(10, 1.6), "aff_sigma_um": np.full(10, 1.5)}
+    book = gridplate_claims.load_book()
+    for n, said in ((1, "grid fixed, one plate"), (2, "grid fixed, two plates pooled")):
+        fits = gridplate_claims._fits(book, {**cfg, "plate.count": n}, res)
+        assert all(said in s.note for s in fits.values())  # the fits' notes before the region
+    assert "x' and y' on the plate pooled" in rows["twoplate.comparator_sigma.sigma_um"]["note"]
+
+
+def test_the_two_plate_notes_are_the_papers_words_unchanged():
+    """On the paper's two plates the notes read as shipped (no results row changes)."""
+    shipped = ROOT / "results" / "gridplate_two_plates" / "claims.parquet"
+    rows = {r["claim"]: r for r in pq.read_table(shipped).to_pylist()}
+    cfg = {"readings.count": 4, "plate.grid": 5, "plate.count": 2, "readings.sigma_um": 1.5}
+    cfg["grid.sigma_stated_um"] = 0.7
+    res = {"sigma_obs_um": np.full(10, 1.5)}
+    sims = gridplate_claims._readings(cfg, res)
+    cid = "twoplate.precision.reading_sigma_um"
+    assert sims[cid].note == rows[cid]["note"]
