@@ -22,6 +22,16 @@
    run's). What was wrong on one plate were the notes: "two plates pooled" of the similarity
    and affine fits, and the precision's "sqrt(sum sigma_i^2 / 4N) ... on 1 plates ... the
    paper's '4N' is the divisor", where the run's divisor is 2N.
+3. brown_table1 off the paper's design (``--set plate.spacing_mm=30``): its five Table 1
+   predictions are decided over the region of (station offset, beta, sigma0) on Table 1's own
+   plate and the built comparator (:mod:`sim.studies.brown.region` reads only the run's seed
+   and region sizes), not on the run's plate or trials, so they ARE the paper's verdicts: they
+   were relabelled "finding" with a note about "this run's setup". They now keep their verdicts
+   (equal to the run on the paper's plate), the note says they were decided on the paper's own
+   setup, independent of the run's design, and ``sim check`` says so before the run. The same
+   holds for brown_dilution's five Concept rows (decided over the region on the paper's
+   format and scale). The degrees of freedom self-check (a number of the run's plate) stays
+   not applicable; the shipped runs are on the paper's setup, so no shipped verdict changes.
 """
 
 from __future__ import annotations
@@ -181,3 +191,56 @@ def test_the_two_plate_notes_are_the_papers_words_unchanged():
     sims = gridplate_claims._readings(cfg, res)
     cid = "twoplate.precision.reading_sigma_um"
     assert sims[cid].note == rows[cid]["note"]
+
+
+# ------------------------------------------------------------- 3. Brown's region rows off design
+REGION_COLUMNS = ("value", "value_high", "ci_low", "ci_high", "outcome", "verdict", "holds")
+
+
+@pytest.mark.parametrize(
+    "name, change, named",
+    [
+        ("brown_table1", "plate.spacing_mm=30", "plate.spacing_mm = 30 (paper: 45)"),
+        ("brown_dilution", "plate.format_mm=250", "plate.format_mm = 250 (paper: 245)"),
+    ],
+)
+def test_brown_region_rows_off_the_design_are_the_papers_verdicts(
+    tmp_path, tiny_run, name, change, named
+):
+    from sim.studies import get_study
+
+    paper = {r["claim"]: r for r in pq.read_table(tiny_run(name) / "claims.parquet").to_pylist()}
+    out = tmp_path / name
+    sets = _tiny(name, change)
+    assert main(["run", str(ROOT / "studies" / f"{name}.toml"), "--out", str(out), *sets]) == 0
+    rows = {r["claim"]: r for r in pq.read_table(out / "claims.parquet").to_pylist()}
+    kept = get_study(name).paper_design
+    assert len(kept) == 5 and kept <= set(rows)
+    for cid in kept:
+        r, p = rows[cid], paper[cid]
+        assert r["kind"] == "prediction" and r["interval"] == "region"
+        assert [r[c] for c in REGION_COLUMNS] == [p[c] for c in REGION_COLUMNS], cid
+        assert r["verdict"] != "finding"
+        assert r["note"] == (
+            "the paper's verdict: decided on the paper's own setup, independent of this run's "
+            f"design, whose printed inputs differ ({named}); " + p["note"]
+        )
+    others = [r for c, r in rows.items() if r["kind"] == "prediction" and c not in kept]
+    assert all(r["verdict"] == "finding" and f"({named})" in r["note"] for r in others)
+    assert bool(others) == (name == "brown_dilution")  # brown_table1's predictions: all five
+    if name == "brown_table1":
+        assert rows["brown.table1_closure.dof"]["verdict"] == "not applicable"
+
+
+def test_sim_check_says_which_predictions_stay_the_papers(capsys):
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    assert main(["check", study, "--set", "plate.spacing_mm=30"]) == 0
+    assert capsys.readouterr().out.splitlines()[-2] == (
+        "# off the paper's setup (plate.spacing_mm = 30 (paper: 45)): its predictions will be "
+        "findings, but the 5 it decides on the paper's own setup, which stay the paper's verdicts"
+    )
+    study = str(ROOT / "studies" / "gridplate_two_plates.toml")
+    assert main(["check", study, "--set", "plate.count=1"]) == 0
+    assert capsys.readouterr().out.splitlines()[-2] == (
+        "# off the paper's setup (plate.count = 1 (paper: 2)): its predictions will be findings"
+    )
