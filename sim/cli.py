@@ -293,7 +293,7 @@ def _check(args) -> int:
         print("[sweep]")
         for k, v in sweep.items():
             print(f"{toml_key(k)} = {toml_value(v)}")
-    off = printed_differs(study.schema, cfg)
+    off = printed_differs(study.schema, cfg, study.as_printed)
     if off:  # said before the run: its predictions will be findings (sim.claims.rules)
         kept = len(study.paper_design)
         but = (

@@ -32,6 +32,11 @@
    holds for brown_dilution's five Concept rows (decided over the region on the paper's
    format and scale). The degrees of freedom self-check (a number of the run's plate) stays
    not applicable; the shipped runs are on the paper's setup, so no shipped verdict changes.
+4. brown_table1 with ``plate.pattern = "list"`` of exactly Table 1's 25 points was off the
+   paper's setup by the key's spelling ("plate.pattern = 'list' (paper: 'grid')"). The
+   resolved geometry decides now (:func:`sim.studies.brown.schema.as_printed`): a list that is
+   Table 1's 25 points, in any order, each within 1 nm (``PAPER_PLATE_TOL_MM``), is the
+   paper's plate; a point 1 um off, one missing or doubled, or the plate shifted is not.
 """
 
 from __future__ import annotations
@@ -244,3 +249,53 @@ def test_sim_check_says_which_predictions_stay_the_papers(capsys):
     assert capsys.readouterr().out.splitlines()[-2] == (
         "# off the paper's setup (plate.count = 1 (paper: 2)): its predictions will be findings"
     )
+
+
+# ------------------------------------------------------------- 4. the paper's plate as a list
+def _paper_points() -> np.ndarray:
+    from sim.instruments.plates import grid_points
+
+    return grid_points(5, 45.0)
+
+
+def _listed(pts) -> dict:
+    from sim.mc.config import validate
+    from sim.studies.brown.schema import TABLE1
+
+    return validate({"plate.pattern": "list", "plate.points": np.asarray(pts).tolist()}, TABLE1)
+
+
+def _differs(pts) -> list[str]:
+    from sim.claims.rules import printed_differs
+    from sim.studies import get_study
+
+    study = get_study("brown_table1")
+    return printed_differs(study.schema, _listed(pts), study.as_printed)
+
+
+def test_the_papers_25_points_as_a_list_are_the_papers_plate():
+    p = _paper_points()
+    shuffled = p[np.random.default_rng(4).permutation(25)]
+    assert _differs(p) == [] and _differs(shuffled) == []
+    assert _differs(shuffled + 4e-7) == []  # within the nanometre: the same points
+    off = "plate.pattern = 'list' (paper: 'grid')"
+    moved = p.copy()
+    moved[7, 0] += 1e-3  # one point a micron off
+    twice = p.copy()
+    twice[3] = p[4]  # one point doubled, one missing
+    for pts in (moved, twice, p[:24], p + 1.0, p * 30 / 45):
+        assert _differs(pts) == [off]
+
+
+def test_brown_table1_on_the_papers_points_as_a_list_is_on_the_papers_setup(tmp_path, capsys):
+    pts = _paper_points()[::-1].tolist()  # another order
+    sets = _tiny("brown_table1", 'plate.pattern="list"', f"plate.points={pts}")
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    assert main(["check", study, *sets]) == 0
+    assert "off the paper's setup" not in capsys.readouterr().out
+    out = tmp_path / "bt1"
+    assert main(["run", study, "--out", str(out), *sets]) == 0
+    rows = {r["claim"]: r for r in pq.read_table(out / "claims.parquet").to_pylist()}
+    dof = rows["brown.table1_closure.dof"]
+    assert (dof["value"], dof["verdict"]) == (43.0, "self-check")
+    assert not any("printed inputs differ" in r["note"] for r in rows.values())

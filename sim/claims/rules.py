@@ -84,7 +84,7 @@ passes these ids to :func:`sim.claims.book.write_claims` as ``paper_design``).
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -196,11 +196,18 @@ def _shown(v: Any) -> str:  # 12 digits: a printed 12.700082809 and a change in 
     return repr(v) if isinstance(v, str) else str(v)
 
 
-def printed_differs(schema: Mapping[str, Any], cfg: Mapping[str, Any]) -> list[str]:
+def printed_differs(
+    schema: Mapping[str, Any],
+    cfg: Mapping[str, Any],
+    as_printed: Callable[[dict], Mapping[str, Any]] | None = None,
+) -> list[str]:
     """The keys of ``schema`` marked ``printed`` (their default is the paper's own number)
     whose value in the resolved ``cfg`` differs, each as ``"key = value (paper: default)"``,
     in the schema's order; ``[]`` on the paper's setup. A key the configuration leaves out
-    (one not read under its switch) has its default."""
+    (one not read under its switch) has its default. ``as_printed``: the study's spelling of
+    ``cfg`` in the paper's keys where it resolves to the paper's setup by another spelling
+    (brown's list of exactly Table 1's 25 points, :func:`sim.studies.brown.schema.as_printed`)."""
+    cfg = as_printed(dict(cfg)) if as_printed is not None else cfg
     out = []
     for k, f in schema.items():
         if getattr(f, "printed", False) and cfg.get(k, f.default) != f.default:

@@ -55,6 +55,9 @@ class Study:
     #: (brown's region rows): on a run off the paper's setup they stay the paper's verdicts
     #: (its run passes them to write_claims; ``sim check`` says so)
     paper_design: frozenset[str] = frozenset()
+    #: the config spelled in the paper's printed keys where another spelling resolves to the
+    #: paper's setup (brown_table1's list of Table 1's 25 points); None: as it is
+    as_printed: Callable[[dict], dict] | None = None
 
 
 def unread_keys(study: Study, cfg: Mapping[str, Any]) -> dict[str, str]:

@@ -25,7 +25,7 @@ from sim.studies.brown.region import (
 )
 from sim.studies.brown.report import report_dilution, report_table1
 from sim.studies.brown.run import run_dilution, run_table1
-from sim.studies.brown.schema import DILUTION, MODEL_NAMES, SEED, TABLE1, check
+from sim.studies.brown.schema import DILUTION, MODEL_NAMES, SEED, TABLE1, as_printed, check
 
 
 def _dilution_ids(cfg: dict, book) -> list[str]:
@@ -68,5 +68,6 @@ STUDIES = {
             lambda: load_book("brown_table1"), scores=scored_by("brown_table1"), scored=_table1_ids
         ),
         paper_design=TABLE1_ON_PAPER,
+        as_printed=as_printed,
     ),
 }
