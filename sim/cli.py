@@ -293,9 +293,15 @@ def _check(args) -> int:
         print("[sweep]")
         for k, v in sweep.items():
             print(f"{toml_key(k)} = {toml_value(v)}")
-    off = printed_differs(study.schema, cfg)
+    off = printed_differs(study.schema, cfg, study.as_printed)
     if off:  # said before the run: its predictions will be findings (sim.claims.rules)
-        print(f"# off the paper's setup ({', '.join(off)}): its predictions will be findings")
+        kept = len(study.paper_design)
+        but = (
+            f", but the {kept} it decides on the paper's own setup, which stay the paper's verdicts"
+            if kept
+            else ""
+        )
+        print(f"# off the paper's setup ({', '.join(off)}): its predictions will be findings{but}")
     print(f"# work: {est.describe()}")
     return 0
 

@@ -203,9 +203,10 @@ def test_brown_table1_on_a_4_by_4_grid_is_off_the_papers_setup(tmp_path, capsys)
     dof = rows["brown.table1_closure.dof"]
     assert (dof["value"], dof["outcome"], dof["verdict"]) == (25.0, "fails", "not applicable")
     preds = [r for r in rows.values() if r["kind"] == "prediction"]
-    assert preds and all(r["verdict"] == "finding" for r in preds)
-    # the note names the failed self-check and the printed key that differs (left8)
-    named = "(brown.table1_closure.dof, plate.grid = 4 (paper: 5))"
+    # Table 1's predictions are decided on the paper's own plate: they keep the paper's
+    # verdicts (left12); the note names the failed self-check and the printed key (left8)
+    assert preds and all(r["verdict"] != "finding" for r in preds)
+    named = "whose printed inputs differ (brown.table1_closure.dof, plate.grid = 4 (paper: 5))"
     assert all(named in r["note"] for r in preds)
     line = verdict_line(list(rows.values()))
     assert "1 self-check not applicable" in line and "self-check failed" not in line

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import tomllib
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -407,10 +407,17 @@ def write_claims(
     prov: Mapping[str, Any],
     book: ClaimBook | None = None,
     schema: Mapping[str, Any] | None = None,
+    *,
+    paper_design: Iterable[str] = (),
+    as_printed: Callable[[dict], Mapping[str, Any]] | None = None,
 ):
     """Write ``claims.parquet`` (and, with a book, ``not_reproduced.parquet`` beside it).
     With a book, every declared claim must have been scored; with the study's ``schema``, a
-    ``printed`` key that differs in ``prov["config"]`` makes the run off the paper's setup."""
+    ``printed`` key that differs in ``prov["config"]`` makes the run off the paper's setup.
+    ``paper_design``: the predictions decided on the paper's own setup whatever the run's
+    design, which keep their verdicts there (:func:`sim.claims.rules.off_paper`);
+    ``as_printed``: the study's spelling of a config in the paper's keys
+    (:func:`sim.claims.rules.printed_differs`)."""
     rows = list(rows)
     if book is not None:
         book.check_complete()
@@ -420,8 +427,10 @@ def write_claims(
             {c: [n[c] for n in nr] for c in NOT_REPRODUCED_COLUMNS},
             prov,
         )
-    differs = printed_differs(schema, prov.get("config") or {}) if schema is not None else []
-    rows = off_paper(rows, book.paper_setup if book is not None else (), differs)
+    cfg = prov.get("config") or {}
+    differs = printed_differs(schema, cfg, as_printed) if schema is not None else []
+    setup = book.paper_setup if book is not None else ()
+    rows = off_paper(rows, setup, differs, paper_design)
     cols = {c: [_null(r[c]) for r in rows] for c in CLAIM_COLUMNS}
     return write_table(
         path, cols, {**prov, "intervals": interval_provenance()}, tolerances=CLAIM_TOLERANCES

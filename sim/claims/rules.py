@@ -73,12 +73,18 @@ is counted apart, never as a failed self-check. An exact one that fails its rule
 differing printed input (its value is computed from the run's setup alone), so it makes the
 run off the paper's setup as an exact ``input`` row does. A self-check without the flag (an
 identity, Monte Carlo against analytic) must hold on any setup and is decided as ever.
+
+A prediction the study decides on the paper's own setup whatever the run's design (Brown's
+Table 1 and Concept rows, decided over the region on Table 1's plate and the built
+comparator, which read no key of the run's design) is no finding about the run's setup: it
+keeps its verdict, the paper's, on a run off the setup, and its note says so (the study
+passes these ids to :func:`sim.claims.book.write_claims` as ``paper_design``).
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -190,11 +196,18 @@ def _shown(v: Any) -> str:  # 12 digits: a printed 12.700082809 and a change in 
     return repr(v) if isinstance(v, str) else str(v)
 
 
-def printed_differs(schema: Mapping[str, Any], cfg: Mapping[str, Any]) -> list[str]:
+def printed_differs(
+    schema: Mapping[str, Any],
+    cfg: Mapping[str, Any],
+    as_printed: Callable[[dict], Mapping[str, Any]] | None = None,
+) -> list[str]:
     """The keys of ``schema`` marked ``printed`` (their default is the paper's own number)
     whose value in the resolved ``cfg`` differs, each as ``"key = value (paper: default)"``,
     in the schema's order; ``[]`` on the paper's setup. A key the configuration leaves out
-    (one not read under its switch) has its default."""
+    (one not read under its switch) has its default. ``as_printed``: the study's spelling of
+    ``cfg`` in the paper's keys where it resolves to the paper's setup by another spelling
+    (brown's list of exactly Table 1's 25 points, :func:`sim.studies.brown.schema.as_printed`)."""
+    cfg = as_printed(dict(cfg)) if as_printed is not None else cfg
     out = []
     for k, f in schema.items():
         if getattr(f, "printed", False) and cfg.get(k, f.default) != f.default:
@@ -203,16 +216,22 @@ def printed_differs(schema: Mapping[str, Any], cfg: Mapping[str, Any]) -> list[s
 
 
 def off_paper(
-    rows: Iterable[dict[str, Any]], paper_setup: Iterable[str] = (), differs: Iterable[str] = ()
+    rows: Iterable[dict[str, Any]],
+    paper_setup: Iterable[str] = (),
+    differs: Iterable[str] = (),
+    paper_design: Iterable[str] = (),
 ) -> list[dict[str, Any]]:
     """The rows of a run, with every prediction a **finding** when the run's printed inputs
     differ from the paper's (an exact ``input`` row, or an exact self-check of ``paper_setup``,
     that fails its rule, or a ``printed`` configuration key named in ``differs``, from
     :func:`printed_differs`), and every self-check of ``paper_setup`` (the ids whose
-    reference is the paper's setup) **not applicable** then; see the module doc. Rows of a
-    run on the paper's setup come back unchanged."""
+    reference is the paper's setup) **not applicable** then; see the module doc. A prediction
+    of ``paper_design`` (the ids the study decides on the paper's own setup whatever the run's
+    design: Brown's region rows, on Table 1's plate and the built comparator) keeps its
+    verdict, the paper's, and its note says so. Rows of a run on the paper's setup come back
+    unchanged."""
     rows = list(rows)
-    setup = set(paper_setup)
+    setup, design = set(paper_setup), set(paper_design)
     bad = [
         r["claim"]
         for r in rows
@@ -231,9 +250,15 @@ def off_paper(
         "not applicable: its reference is a number of the paper's setup, and this run's printed inputs "
         "differ from the paper's (" + ", ".join(bad) + "); against that number the rule gives: {}"
     )
+    kept = (
+        "the paper's verdict: decided on the paper's own setup, independent of this run's "
+        "design, whose printed inputs differ (" + ", ".join(bad) + ")"
+    )
     out = []
     for r in rows:
-        if r["kind"] == "prediction" and r["verdict"] != "finding":
+        if r["kind"] == "prediction" and r["claim"] in design:
+            r = {**r, "note": kept + ("; " + r["note"] if r["note"] else "")}
+        elif r["kind"] == "prediction" and r["verdict"] != "finding":
             note = why.format(r["outcome"]) + ("; " + r["note"] if r["note"] else "")
             r = {**r, "verdict": "finding", "holds": None, "note": note}
         elif r["kind"] == "self-check" and r["claim"] in setup:

@@ -51,6 +51,13 @@ class Study:
     #: the keys the resolved config does not read by a condition no ``read_when`` of the schema
     #: can say (the network's keys of the distances, in a network without one), each with why
     unread: Callable[[dict], Mapping[str, str]] | None = None
+    #: the predictions the study decides on the paper's own setup whatever the run's design
+    #: (brown's region rows): on a run off the paper's setup they stay the paper's verdicts
+    #: (its run passes them to write_claims; ``sim check`` says so)
+    paper_design: frozenset[str] = frozenset()
+    #: the config spelled in the paper's printed keys where another spelling resolves to the
+    #: paper's setup (brown_table1's list of Table 1's 25 points); None: as it is
+    as_printed: Callable[[dict], dict] | None = None
 
 
 def unread_keys(study: Study, cfg: Mapping[str, Any]) -> dict[str, str]:

@@ -17,10 +17,15 @@ from __future__ import annotations
 
 from sim.studies import Study, data_check
 from sim.studies.brown.claims import load_book, scored_by
-from sim.studies.brown.region import T1_JOINT, T1_PREDICTIONS
+from sim.studies.brown.region import (
+    CONCEPT_ON_PAPER,
+    T1_JOINT,
+    T1_PREDICTIONS,
+    TABLE1_ON_PAPER,
+)
 from sim.studies.brown.report import report_dilution, report_table1
 from sim.studies.brown.run import run_dilution, run_table1
-from sim.studies.brown.schema import DILUTION, MODEL_NAMES, SEED, TABLE1, check
+from sim.studies.brown.schema import DILUTION, MODEL_NAMES, SEED, TABLE1, as_printed, check
 
 
 def _dilution_ids(cfg: dict, book) -> list[str]:
@@ -48,6 +53,7 @@ STUDIES = {
             scores=scored_by("brown_dilution"),
             scored=_dilution_ids,
         ),
+        paper_design=CONCEPT_ON_PAPER,
     ),
     "brown_table1": Study(
         "brown_table1",
@@ -61,5 +67,7 @@ STUDIES = {
         data=data_check(
             lambda: load_book("brown_table1"), scores=scored_by("brown_table1"), scored=_table1_ids
         ),
+        paper_design=TABLE1_ON_PAPER,
+        as_printed=as_printed,
     ),
 }

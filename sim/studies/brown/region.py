@@ -76,6 +76,12 @@ CONCEPT_PREDICTIONS = (
     "brown.pivot_extra_dilution.typical_pct",
     "brown.dilution_falls_with_points.monotone",
 )
+#: the predictions decided over a region on the paper's own setup (Table 1's plate, the
+#: built comparator's format and scale: :mod:`sim.instruments.ranges.brown`), which read no key
+#: of the run's design (only its seed and region sizes): on a run off the paper's setup they
+#: stay the paper's verdicts (:func:`sim.claims.rules.off_paper`)
+TABLE1_ON_PAPER = frozenset((*T1_PREDICTIONS, T1_JOINT))
+CONCEPT_ON_PAPER = frozenset(CONCEPT_PREDICTIONS)
 #: points per side of the format's edge at which "points near the edges" are evaluated
 EDGE_POINTS = 25
 #: grids of the "more points, less dilution" prediction over the region (same extent)

@@ -20,7 +20,14 @@ from sim.studies.brown import region as RG
 from sim.studies.brown import values as V
 from sim.studies.brown.claims import load_book, score_dilution, score_table1
 from sim.studies.brown.core import MC, analytic_sigma, points_table, run_mc
-from sim.studies.brown.schema import DILUTION, MODEL_NAMES, TABLE1, range_sigma_um, setup
+from sim.studies.brown.schema import (
+    DILUTION,
+    MODEL_NAMES,
+    TABLE1,
+    as_printed,
+    range_sigma_um,
+    setup,
+)
 
 
 def _common(cfg, ctx, **kw):
@@ -79,7 +86,9 @@ def run_dilution(cfg: dict, out: Path, ctx: RunContext) -> None:
     rows = score_dilution(book, cfg, pts, theta, unit, mc, sim, curve, extra, mono)
     reg, preds, verdicts = RG.concept_region(cfg, book)
     rows += _write_region(out, prov, book, reg, preds, verdicts, RG.CONCEPT_NOTES)
-    write_claims(out / "claims.parquet", rows, prov, book, DILUTION)
+    write_claims(
+        out / "claims.parquet", rows, prov, book, DILUTION, paper_design=RG.CONCEPT_ON_PAPER
+    )
     F.fig_region(out, RG.CONCEPT_PAIRS, out / "consistent_region.png")
 
 
@@ -115,5 +124,13 @@ def run_table1(cfg: dict, out: Path, ctx: RunContext) -> None:
     draw([(F.fig_table1, (cfg, pts, theta, an["pivot"], t1, out / "table1.png"))])
     reg, preds, verdicts = RG.table1_region(cfg, book)
     rows += _write_region(out, prov, book, reg, preds, verdicts, RG.TABLE1_NOTES)
-    write_claims(out / "claims.parquet", rows, prov, book, TABLE1)
+    write_claims(
+        out / "claims.parquet",
+        rows,
+        prov,
+        book,
+        TABLE1,
+        paper_design=RG.TABLE1_ON_PAPER,
+        as_printed=as_printed,
+    )
     F.fig_region(out, RG.TABLE1_PAIRS, out / "consistent_region.png")

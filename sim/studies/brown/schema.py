@@ -179,6 +179,31 @@ TABLE1 = {
 }
 
 
+#: how far (mm, in x and in y) a listed point may lie from a point of Table 1's plate and
+#: still be it: a nanometre, far below the paper's whole-millimetre coordinates and its
+#: micron-level sigmas, so only the floating-point spelling of the same point passes
+PAPER_PLATE_TOL_MM = 1e-6
+
+
+def as_printed(cfg: dict) -> dict:
+    """``cfg`` with a ``plate.pattern = "list"`` of exactly Table 1's 25 points (in any order,
+    each within :data:`PAPER_PLATE_TOL_MM`) spelled as the paper's grid (pattern, grid and
+    spacing of :data:`TABLE1`): the points the run uses, not the key's spelling, decide
+    whether its plate is the paper's (:func:`sim.claims.rules.printed_differs`). Any other
+    config comes back as it is."""
+    if cfg.get("plate.pattern") != "list":
+        return cfg
+    paper = {k: TABLE1[k].default for k in ("plate.pattern", "plate.grid", "plate.spacing_mm")}
+    ref = pattern_points("grid", grid=paper["plate.grid"], spacing_mm=paper["plate.spacing_mm"])
+    pts = np.asarray(cfg.get("plate.points") or [], float).reshape(-1, 2)
+    if pts.shape != ref.shape:
+        return cfg
+    near = np.abs(pts[:, None, :] - ref[None, :, :]).max(axis=2) <= PAPER_PLATE_TOL_MM
+    if (near.sum(axis=0) == 1).all() and (near.sum(axis=1) == 1).all():  # one to one
+        return {**cfg, **paper}
+    return cfg
+
+
 def range_sigma_um(cfg: dict) -> float:
     """sigma of one (averaged) range: sqrt(setting^2 / settings + comparator^2), um."""
     return float(

@@ -9,7 +9,8 @@ reduction), :mod:`.run` (the run), :mod:`.sweep` (unprinted inputs, consistent s
 from __future__ import annotations
 
 from sim.studies import Study, data_check
-from sim.studies.gridplate.claims import load_book, scored_ids
+from sim.studies.gridplate.beyond import scored_ids
+from sim.studies.gridplate.claims import load_book
 from sim.studies.gridplate.region import DECLARATION, SCALE_DIFF_KEYS, nominal
 from sim.studies.gridplate.report import report
 from sim.studies.gridplate.run import run

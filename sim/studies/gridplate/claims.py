@@ -13,12 +13,12 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook
-from sim.claims.intervals import mean_ci, share_ci, std_ci
+from sim.claims.intervals import share_ci
+from sim.claims.region import REGION_MIN_POINTS, share_bound
 from sim.claims.table import Sim, claim_rows, exact, plates
-from sim.instruments import transforms2d as t2
 from sim.lsq import distributions as D
 from sim.mc.config import StudyError
-from sim.studies.gridplate.model import PARAM_LABEL, PARAMS
+from sim.studies.gridplate.beyond import beyond_rows, coverage_rows
 
 BOOK = Path(__file__).with_name("claims.toml")
 
@@ -64,16 +64,31 @@ def _pooled(cfg: dict) -> str:
     return "both plates" if P == 2 else ("the plate" if P == 1 else f"all {P} plates")
 
 
+def _count(P: int) -> str:
+    return "1 plate" if P == 1 else f"{P} plates"
+
+
+def _fit_pool(cfg: dict) -> str:
+    """What a fit's sigma pools: "two plates pooled" (the paper's), one plate alone, or P."""
+    P = cfg["plate.count"]
+    return "two plates pooled" if P == 2 else ("one plate" if P == 1 else f"{P} plates pooled")
+
+
 def _readings(cfg: dict, res: dict) -> dict[str, Sim]:
     """The precision of one reading (from the repeated readings) and the stated grid sigma."""
     L, N, P = cfg["readings.count"], cfg["plate.grid"] ** 2, cfg["plate.count"]
     return {
         "twoplate.precision.reading_sigma_um": plates(
             res["sigma_obs_um"],
-            f"sigma = sqrt(sum sigma_i^2 / 4N) from {L} readings of {N} points on {P} "
-            f"plates; the reading sigma is an input ({cfg['readings.sigma_um']:g} um), so "
-            f"this shows the estimator's spread ({2 * P * N * (L - 1)} degrees of "
-            "freedom; the paper's '4N' is the divisor).",
+            f"sigma = sqrt(sum sigma_i^2 / {2 * P if P != 2 else 4}N) from {L} readings of {N} "
+            f"points on {_count(P)}; the reading sigma is an input "
+            f"({cfg['readings.sigma_um']:g} um), so this shows the estimator's spread "
+            f"({2 * P * N * (L - 1)} degrees of freedom; "
+            + (
+                "the paper's '4N' is the divisor)."
+                if P == 2
+                else "the paper's divisor 4N is for its two plates)."
+            ),
         ),
         "twoplate.grid.stated_sigma_um": exact(
             cfg["grid.sigma_stated_um"], "the stated (certificate) grid sigma of the simulation"
@@ -177,15 +192,15 @@ def _fits(book: ClaimBook, cfg: dict, res: dict) -> dict[str, Sim]:
     return {
         "twoplate.similarity_vs_affine.similarity_sigma_um": plates(
             res["sim_sigma_um"],
-            f"sqrt(sum(vx^2+vy^2)/(2N-4)) of a similarity fit, grid fixed, two plates "
-            f"pooled; the comparator's scale difference ({cfg['comparator.scale_diff_ppm']:g}"
+            f"sqrt(sum(vx^2+vy^2)/(2N-4)) of a similarity fit, grid fixed, {_fit_pool(cfg)}; "
+            f"the comparator's scale difference ({cfg['comparator.scale_diff_ppm']:g}"
             f' ppm) and non-orthogonality ({cfg["comparator.nonorth_arcsec"]:g}") are not '
             "printed: an example; the region (consistent_region.parquet) decides this row.",
         ),
         "twoplate.similarity_vs_affine.affine_sigma_um": plates(
             res["aff_sigma_um"],
-            "sqrt(sum(vx^2+vy^2)/(2N-6)) of the affine fit, grid fixed, two plates "
-            "pooled, against the printed 1.5 (the paper's 1.2 and 0.7 support "
+            f"sqrt(sum(vx^2+vy^2)/(2N-6)) of the affine fit, grid fixed, {_fit_pool(cfg)}, "
+            "against the printed 1.5 (the paper's 1.2 and 0.7 support "
             f"{math.hypot(r1p2, r0p7):.2f}: "
             "paper_check.affine_from_comparator_and_grid).",
         ),
@@ -261,11 +276,44 @@ def _shares(res: dict) -> dict[str, Sim]:
     }
 
 
+def _closed_form(res: dict) -> Sim:
+    """The closed-form re-weighting fixed point against the iterated one, over the sampled
+    adjustments: the largest relative difference of the ratios where both found a positive
+    fixed point, 1 where only one of them found one (a ratio against none). An identity
+    checked on k adjustments bounds the share where it fails only by ``1 - 0.05^(1/k)``
+    (:func:`sim.claims.region.share_bound`): with fewer than ``REGION_MIN_POINTS`` (29, under
+    10 %) compared and none disagreeing, the interval reaches 1 (an adjustment not compared
+    may differ as much as a ratio from none) and the rule gives inconclusive, never holds."""
+    ok = np.asarray(res["closed_form_ok"], bool).ravel()
+    one = np.asarray(res["closed_form_one"], bool).ravel()
+    rel = np.asarray(res["closed_form_rel"], float).ravel()
+    k, d = int(ok.sum()), int(one.sum())
+    cfmax = float(rel[ok | one].max()) if k + d else 0.0
+    note = (
+        f"largest relative difference between sim.instruments.gridplate.reweight (iterated) "
+        f"and the closed-form fixed point s_w^2/sg^2 - (A^2 + B^2) used for all trials, over "
+        f"the {k} of {ok.size} sampled adjustments where both found a positive fixed point"
+    )
+    if d:
+        note += f"; in {d} only one of them found one (counted as a difference of 1)"
+    rest = ok.size - k - d
+    if rest:
+        note += f"; {rest} where neither found one"
+    if d or k >= REGION_MIN_POINTS:
+        return exact(cfmax, note + ".")
+    return Sim(
+        cfmax,
+        (cfmax, 1.0),
+        note=note + f": a self-check needs {REGION_MIN_POINTS} compared (bounding the share where "
+        f"it fails under 10 %, 95 %; {k} bound it only under {100 * share_bound(k):.2g} %), so "
+        "the interval reaches 1 (an adjustment not compared may differ as much as a ratio from "
+        "none) and it is undecided; raise analysis.iter_sample or trials.",
+    )
+
+
 def _self_checks(cfg: dict, res: dict) -> dict[str, Sim]:
     """The closed-form re-weighting against the iterated one, and the affine sigma's Monte
     Carlo against its chi-square distribution."""
-    cf = res["closed_form_rel"][res["closed_form_ok"].astype(bool)]
-    cfmax = float(cf.max()) if cf.size else 0.0
     N, P = cfg["plate.grid"] ** 2, cfg["plate.count"]
     sx, sgt = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
     nu = P * (2 * N - 6)
@@ -273,12 +321,7 @@ def _self_checks(cfg: dict, res: dict) -> dict[str, Sim]:
     a_med = sw * math.sqrt(D.chi2_ppf(0.5, nu) / nu)
     med, (lo, hi) = quantile_ci(res["aff_sigma_um"], 0.5)
     return {
-        "twoplate.self_check.closed_form": exact(
-            cfmax,
-            f"largest relative difference over {cf.size} adjustments between "
-            "sim.instruments.gridplate.reweight (iterated) and the closed-form fixed point "
-            "s_w^2/sg^2 - (A^2 + B^2) used for all trials.",
-        ),
+        "twoplate.self_check.closed_form": _closed_form(res),
         "twoplate.self_check.affine_sigma_analytic": Sim(
             med / a_med - 1,
             (lo / a_med - 1, hi / a_med - 1),
@@ -287,70 +330,6 @@ def _self_checks(cfg: dict, res: dict) -> dict[str, Sim]:
             "(consistent_region.parquet) uses these chi-square distributions.",
         ),
     }
-
-
-def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
-    """The ids :func:`score` builds: bias and spread of S, S', eps with the grid fixed
-    (:func:`_beyond`: one ``grid fixed`` row of ``beyond.parquet`` each) and their coverages
-    (:func:`_coverage`)."""
-    return [
-        *(f"twoplate.beyond.fixed.{w}_{k}" for k in PARAMS for w in ("bias", "sd")),
-        *(
-            f"twoplate.beyond.coverage_{k}_{tag}"
-            for k in PARAMS
-            for tag in ("fixed_pri", "fixed_post", "wpri", "wpost")
-        ),
-    ]
-
-
-def _beyond(beyond: dict) -> dict[str, Sim]:
-    """Bias and spread of S, S', eps with the grid fixed (rows of ``beyond.parquet``)."""
-    table = {}
-    for i in range(len(beyond["param"])):
-        if not beyond["method"][i].startswith("grid fixed"):
-            continue
-        k = {"S": "S", "S'": "S2", "eps": "eps"}[beyond["param"][i]]
-        u = beyond["unit"][i]
-        table[f"twoplate.beyond.fixed.bias_{k}"] = Sim(
-            beyond["bias"][i],
-            (beyond["bias_lo"][i], beyond["bias_hi"][i]),
-            note=f"mean error of {beyond['param'][i]} ({u}), grid fixed (the weighted "
-            "adjustment gives the same estimates to first order)",
-        )
-        table[f"twoplate.beyond.fixed.sd_{k}"] = Sim(
-            beyond["sd"][i],
-            (beyond["sd_lo"][i], beyond["sd_hi"][i]),
-            note=f"standard deviation of {beyond['param'][i]} over plates ({u}), "
-            "chi-square interval",
-        )
-    return table
-
-
-def _coverage(cfg: dict, res: dict, j_true: int) -> dict[str, Sim]:
-    """Coverage of the nominal 95 % intervals of S, S', eps: grid fixed (a-priori and
-    a-posteriori sigma) and weighted at the ratio nearest the true one."""
-    table = {}
-    for k in PARAMS:
-        for tag, key, lab in (
-            ("fixed_pri", f"{k}_cov_fixed_pri", "grid fixed, a-priori comparator sigma"),
-            ("fixed_post", f"{k}_cov_fixed_post", "grid fixed, a-posteriori s0"),
-            (
-                "wpri",
-                f"{k}_cov_wpri_r{j_true}",
-                "weighted at the ratio nearest the true one, a-priori sigma",
-            ),
-            ("wpost", f"{k}_cov_wpost_r{j_true}", "weighted, a-posteriori s0"),
-        ):
-            m, ci = share_ci(res[key])
-            table[f"twoplate.beyond.coverage_{k}_{tag}"] = Sim(
-                m,
-                ci,
-                note=f"share of plates whose interval {PARAM_LABEL[k]} +- 1.96 sd "
-                f"contains the truth; {lab}"
-                + (f" (1:{cfg['analysis.ratios'][j_true]:g})" if tag.startswith("w") else "")
-                + ".",
-            )
-    return table
 
 
 def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], ClaimBook]:
@@ -366,49 +345,7 @@ def score(cfg: dict, res: dict, beyond: dict, cov: dict) -> tuple[list[dict], Cl
         **_paper_checks(book),
         **_shares(res),
         **_self_checks(cfg, res),
-        **_beyond(beyond),
-        **_coverage(cfg, res, cov["j_true"]),
+        **beyond_rows(beyond),
+        **coverage_rows(cfg, res, cov["j_true"]),
     }
     return claim_rows(book, table), book
-
-
-def beyond_table(res: dict, ratios: list, j_true: int) -> dict:
-    """Bias and spread of S, S', eps (grid fixed and weighted at the ratio nearest the truth)."""
-    conv = {"S": 1e6, "S2": 1e6, "eps": 1 / t2.ARCSEC}
-    b = {
-        k: []
-        for k in (
-            "param",
-            "method",
-            "bias",
-            "bias_lo",
-            "bias_hi",
-            "sd",
-            "sd_lo",
-            "sd_hi",
-            "stated_sd_rms",
-            "unit",
-        )
-    }
-    for k in PARAMS:
-        for meth, key, sdkey in (
-            ("grid fixed (affine)", f"{k}_err_fixed_pri", f"{k}_sd_fixed_post"),
-            (f"grid weighted 1:{ratios[j_true]:g}", f"{k}_err_fixed_pri", f"{k}_sd_w_r{j_true}"),
-        ):
-            e = np.asarray(res[key], float).ravel() * conv[k]
-            m, (lo, hi) = mean_ci(e)
-            s, slo, shi = std_ci(e)
-            for col, v in (
-                ("param", PARAM_LABEL[k]),
-                ("method", meth),
-                ("bias", m),
-                ("bias_lo", lo),
-                ("bias_hi", hi),
-                ("sd", float(s)),
-                ("sd_lo", float(slo)),
-                ("sd_hi", float(shi)),
-                ("stated_sd_rms", float(np.sqrt(np.mean(np.asarray(res[sdkey]) ** 2)) * conv[k])),
-                ("unit", "arcsec" if k == "eps" else "ppm"),
-            ):
-                b[col].append(v)
-    return b

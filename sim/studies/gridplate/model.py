@@ -215,8 +215,9 @@ def _reweighting(cfg: dict, sw2: np.ndarray, kk: np.ndarray, N: int, n: int, P: 
 
 def _iterated(cfg: dict, mean: np.ndarray, g: np.ndarray, closed: np.ndarray) -> dict:
     """The iterated combined adjustment (:func:`sim.instruments.gridplate.reweight`) on a
-    sample of adjustments: check of the closed form, pass rate after re-weighting,
-    Gauss-Newton iterations."""
+    sample of adjustments: check of the closed form (``closed_form_ok``: both methods found a
+    positive fixed point and their ratios are compared; ``closed_form_one``: only one of them
+    found one), pass rate after re-weighting, Gauss-Newton iterations."""
     sg = cfg["grid.sigma_stated_um"] * UM
     comp2 = np.concatenate([mean[..., 0], mean[..., 1]], 0)[: cfg["analysis.iter_sample"]]
     g2 = np.concatenate([g, g], 0)[: cfg["analysis.iter_sample"]]
@@ -224,11 +225,15 @@ def _iterated(cfg: dict, mean: np.ndarray, g: np.ndarray, closed: np.ndarray) ->
     start = cfg["analysis.ratio_start"]
     rw = gp.reweight(comp2, g2, sg, ratio0=float(start), alpha=cfg["analysis.alpha"])
     cf = np.concatenate([closed[:, 0], closed[:, 1]])[:m]
-    good = np.isfinite(rw["ratio"]) & (cf > 0)
-    r_it = np.where(np.isfinite(rw["ratio"]), rw["ratio"], start)
-    return {
-        "closed_form_rel": np.abs(np.where(good, rw["ratio"] / np.where(good, cf, 1.0) - 1, 0.0)),
+    found = np.isfinite(rw["ratio"])
+    good = found & (cf > 0)  # both found a positive fixed point: their ratios compared
+    one = found != (cf > 0)  # one method found a fixed point, the other none: they disagree
+    r_it = np.where(found, rw["ratio"], start)
+    rel = np.abs(np.where(good, rw["ratio"] / np.where(good, cf, 1.0) - 1, 0.0))
+    return {  # a disagreement is a relative difference of 1 (a ratio against none)
+        "closed_form_rel": np.where(one, 1.0, rel),
         "closed_form_ok": good,
+        "closed_form_one": one,
         "passes_rw": rw["passes"],
         "gn_iterations": iterations(comp2, g2, r_it, cfg["analysis.iter_tol_um"] * UM),
     }

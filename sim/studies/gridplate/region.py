@@ -275,7 +275,8 @@ def iteration_note(cfg: dict, region: Region, example: np.ndarray) -> str:
         "Gauss-Newton solves of the combined adjustment until the largest correction is below "
         f"{cfg['analysis.iter_tol_um']:g} um (the converging solve counts), counted at each "
         f"region point on {per} adjustments ({C} simulated calibration{'s' if C > 1 else ''} x "
-        f"{cfg['plate.count']} plates x rows x' and y') at the re-weighted "
+        f"{cfg['plate.count']} plate{'s' if cfg['plate.count'] > 1 else ''} x rows x' and y') "
+        "at the re-weighted "
         "ratio; a point holds when every count lies in 2-3, fails when none does; counts over "
         f"the region {tally(c)}; at the configured inputs (an example): counts {tally(example)}"
     )

@@ -18,7 +18,8 @@ from sim.report.plotting import draw
 from sim.report.region import fig_region
 from sim.studies import RunContext
 from sim.studies.gridplate import figures as F
-from sim.studies.gridplate.claims import beyond_table, score
+from sim.studies.gridplate.beyond import beyond_table
+from sim.studies.gridplate.claims import score
 from sim.studies.gridplate.model import PARAMS, chunk, simulate
 from sim.studies.gridplate.region import IT, explore_region, iteration_note, nominal
 from sim.studies.gridplate.schema import SCHEMA
