@@ -20,13 +20,20 @@ harness found:
 
 from __future__ import annotations
 
+import itertools
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 import pytest
+from oneline import one_line
 from test_doors20d import gama_cov, needs_gama, ours, study_of
+
+from sim.cli import main
+from sim.studies import load_study
+from sim.studies.network.definition import build
+from sim.studies.network.gama import export, import_note, merge_gama
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "tests/data/gama"
@@ -126,3 +133,113 @@ def test_gama_local_adjusts_the_same_network_in_every_frame(tmp_path, case):
         if not consistent(axes, angles) and off > 1e-3:  # the internal frame is visible
             with pytest.raises(AssertionError):
                 assert_same(raw, want, 1e-6)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_every_frame_is_read_with_the_ne_covariance_mapped_into_it(tmp_path, case):
+    """All 16 combinations are read (the right-handed frames and angles were refused): each
+    point's covariance in the file's frame is ne's mapped, M C M' (the normals are the same
+    up to the sign of rows), and the report's note names the frame and, for angles against
+    it, what that changes."""
+    ne = suite_cov(tmp_path, (DATA / f"{case}.xml").read_text(), "ne")
+    for axes, angles in COMBOS:
+        xml = reframe(DATA / f"{case}.xml", axes, angles)
+        m = frame(axes)
+        got = suite_cov(tmp_path, xml, f"{axes}_{angles}")
+        assert_same(got, {k: m @ c @ m.T for k, c in ne.items()}, 1e-9)
+        note = import_note(load_study(tmp_path / f"{axes}_{angles}.toml")[1])
+        if (axes, angles) == ("ne", "left-handed"):
+            assert "axes-xy" not in note, note
+        else:
+            assert f"axes-xy = '{axes}'" in note and f"{angles} angles" in note, note
+            assert ("against its angles" in note) != consistent(axes, angles), note
+
+
+@needs_gama
+@pytest.mark.parametrize("case", CASES)
+def test_the_suite_agrees_with_gama_local_on_every_frame(tmp_path, case):
+    """Each of the 16 files, read by the suite and adjusted by gama-local: the covariances in
+    the file's frame agree (gama-local's internal frame undone, :func:`file_frame`)."""
+    for axes, angles in COMBOS:
+        src = tmp_path / f"{axes}_{angles}.xml"
+        xml = reframe(DATA / f"{case}.xml", axes, angles)
+        mine = suite_cov(tmp_path, xml, f"{axes}_{angles}")
+        assert_same(mine, file_frame(gama_cov(src), axes, angles), 1e-6)
+
+
+def _exported(tmp_path: Path, case: str, axes: str, angles: str):
+    """The file ``case`` in the frame, imported, and the suite's export of it: the run's
+    covariances and the export's path."""
+    name = f"{axes}_{angles}"
+    study_of(tmp_path, reframe(DATA / f"{case}.xml", axes, angles), name)
+    full = merge_gama(load_study(tmp_path / f"{name}.toml")[1])
+    net, an = ours(tmp_path / f"{name}.toml")
+    out = tmp_path / f"{name}.export.xml"
+    note = export(build(full), full, out)
+    assert not note.startswith("not exported"), note
+    cov = {nm: an.cov[a] for a, nm in enumerate(net.names) if net.role[a] != 1}
+    return cov, out
+
+
+def _angular(path: Path) -> tuple[dict, dict]:
+    """The file's direction sets ``{(station, n-th set there): {target: val}}`` and angles
+    ``{(station, bs, fs): val}`` (gon)."""
+    root = ET.parse(path).getroot()
+    sets: dict = {}
+    angs: dict = {}
+    for o in root.iter(f"{{{NS}}}obs"):
+        st = o.get("from")
+        d = {e.get("to"): float(e.get("val")) for e in o if e.tag == f"{{{NS}}}direction"}
+        if d:
+            sets[(st, sum(k[0] == st for k in sets))] = d
+        for e in o.iter(f"{{{NS}}}angle"):
+            angs[(st, e.get("bs"), e.get("fs"))] = float(e.get("val"))
+    return sets, angs
+
+
+def _gon_apart(a: float, b: float) -> float:
+    return abs((a - b + 200) % 400 - 200)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_the_export_of_an_imported_file_is_written_in_its_frame(tmp_path, case):
+    """network.xml of a run on a file in any frame keeps that file's axes-xy and angles (it
+    was labelled ne: the same numbers in another frame, a mirror image of the network for a
+    right-handed one), its angles and, up to each set's orientation, its directions (their
+    sign changed where the angles run against the frame); read back, it has the run's
+    covariances."""
+    for axes, angles in COMBOS:
+        cov, out = _exported(tmp_path, case, axes, angles)
+        net = ET.parse(out).getroot().find(f"{{{NS}}}network")
+        assert (net.get("axes-xy"), net.get("angles")) == (axes, angles)
+        sets, angs = _angular(tmp_path / f"{axes}_{angles}.xml")
+        got_sets, got_angs = _angular(out)
+        assert angs.keys() == got_angs.keys()
+        for k, v in angs.items():
+            assert _gon_apart(got_angs[k], v) < 1e-9, (k, v, got_angs[k])
+        assert sets.keys() == got_sets.keys()
+        for k, d in sets.items():
+            assert d.keys() == got_sets[k].keys()
+            shift = [(got_sets[k][t] - v) % 400 for t, v in d.items()]
+            assert all(_gon_apart(x, shift[0]) < 1e-9 for x in shift), (k, shift)
+        back = suite_cov(tmp_path, out.read_text(), f"back_{axes}_{angles}")
+        assert_same(back, cov, 1e-9)
+
+
+@needs_gama
+def test_gama_local_on_the_export_agrees_with_the_run(tmp_path):
+    for case, (axes, angles) in itertools.product(CASES, COMBOS):
+        (tmp_path / case).mkdir(exist_ok=True)
+        cov, out = _exported(tmp_path / case, case, axes, angles)
+        assert_same(file_frame(gama_cov(out), axes, angles), cov, 1e-6)
+
+
+@pytest.mark.parametrize(
+    "attr,value", [("axes-xy", "xy"), ("axes-xy", "NE"), ("angles", "clockwise")]
+)
+def test_a_frame_outside_gama_locals_vocabulary_is_refused_naming_it(tmp_path, capsys, attr, value):
+    xml = reframe(DATA / "two_sets.xml", "ne", "left-handed")
+    old = 'axes-xy="ne"' if attr == "axes-xy" else 'angles="left-handed"'
+    assert old in xml
+    st = study_of(tmp_path, xml.replace(old, f'{attr}="{value}"'))
+    one_line(capsys, main(["check", str(st)]), f"'{value}' is not one of", f"'{attr}'")
