@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -30,8 +31,10 @@ import pytest
 from oneline import one_line
 from test_doors20d import gama_cov, needs_gama, ours, study_of
 
+from benchmarks.scaling import gama_local
 from sim.cli import main
 from sim.studies import load_study
+from sim.studies.network.analysis import bearing_deg, ellipse
 from sim.studies.network.definition import build
 from sim.studies.network.gama import export, import_note, merge_gama
 
@@ -243,3 +246,41 @@ def test_a_frame_outside_gama_locals_vocabulary_is_refused_naming_it(tmp_path, c
     assert old in xml
     st = study_of(tmp_path, xml.replace(old, f'{attr}="{value}"'))
     one_line(capsys, main(["check", str(st)]), f"'{value}' is not one of", f"'{attr}'")
+
+
+def gama_ellipses(src: Path) -> dict:
+    """gama-local's text output's mean error ellipses: ``{point: (a mm, b mm, alpha gon)}``
+    (printed to 0.1)."""
+    out = src.with_suffix(".txt")
+    subprocess.run([gama_local(), str(src), "--text", str(out)], check=True, capture_output=True)
+    lines = out.read_text().splitlines()
+    at = next(n for n, t in enumerate(lines) if t.startswith("Mean errors and parameters"))
+    at = next(n for n in range(at, len(lines)) if lines[n].startswith("====")) + 2
+    rows = {}
+    for t in lines[at:]:
+        if not t.strip():
+            break
+        w = t.split()
+        rows[w[0]] = (float(w[3]), float(w[4]), float(w[5]))
+    return rows
+
+
+@needs_gama
+def test_the_ellipses_bearings_run_from_x_towards_y_against_inconsistent_angles(tmp_path):
+    """gama-local's ellipse bearing alpha runs from +x in the sense of the file's angles; the
+    suite's (``ellipse_bearing_deg``) from +x towards +y: the same where frame and angles
+    agree, alpha = -bearing (mod 200 gon) where they do not. The semi-axes are the same."""
+    for axes, angles in COMBOS:
+        name = f"{axes}_{angles}"
+        net, an = ours(study_of(tmp_path, reframe(DATA / "two_sets.xml", axes, angles), name))
+        est = [a for a in range(net.n) if net.role[a] != 1]
+        a, b, _ = ellipse(an.cov[est])
+        bearing, _ = bearing_deg(an.cov[est])
+        got = gama_ellipses(tmp_path / f"{name}.xml")
+        assert sorted(got) == sorted(net.names[p] for p in est)
+        for n, p in enumerate(est):
+            ga, gb, alpha = got[net.names[p]]
+            assert abs(ga - a[n]) <= 0.051 and abs(gb - b[n]) <= 0.051
+            mine = bearing[n] / 0.9 * (1 if consistent(axes, angles) else -1)
+            assert abs((alpha - mine + 100) % 200 - 100) <= 0.051, (name, alpha, mine)
+            assert 5 < abs((alpha + mine + 100) % 200 - 100)  # the other sense is far off
