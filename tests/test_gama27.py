@@ -16,6 +16,10 @@ harness found:
   writes its XML ``<cov-mat>`` in that internal frame: cov(x, y) there has the opposite sign
   of the file's frame, in which it writes the adjusted coordinates. Its text output's ellipse
   bearing alpha runs from +x in the sense of the file's angles in every combination.
+
+So the reader accepts all 16 (it refused the right-handed frames en, nw, se, ws and
+right-handed angles), with covariances in the file's frame, and the export of an imported
+network is written in the frame it was read in (it was labelled ne).
 """
 
 from __future__ import annotations
