@@ -263,9 +263,5 @@ def test_a_sw_frame_agrees_with_gama_local(tmp_path):
     agree_with_gama(st, tmp_path / "sw.xml")
 
 
-@pytest.mark.parametrize("axes", ["en", "nw", "se", "ws"])
-def test_a_right_handed_frame_is_refused_naming_it(tmp_path, capsys, axes):
-    st = study_of(tmp_path, FIXED_CONSTRAINED.replace('axes-xy="ne"', f'axes-xy="{axes}"'))
-    assert main(["check", str(st)]) == 2
-    err = capsys.readouterr().err
-    assert f"'{axes}' is a right-handed frame" in err and "axes-xy" in err, err
+# the right-handed frames (en, nw, se, ws) and angles, refused here, are read since brief G27:
+# tests/test_gama27.py

@@ -315,7 +315,7 @@ def test_aposteriori_files_are_read_with_the_apriori_convention_stated(tmp_path)
 BAD = [
     ('<parameters sigma-apr="1" sigma-act="apriori" />', '<parameters angles="deg" />', "angles"),
     ('<network axes-xy="ne" angles="left-handed">', '<network angles="400">', "angles"),
-    ('<network axes-xy="ne" angles="left-handed">', '<network axes-xy="en">', "axes-xy"),
+    ('<network axes-xy="ne" angles="left-handed">', '<network axes-xy="xy">', "axes-xy"),
     ('x="150.0"', 'x="1abc"', "'1abc' is not a number"),
     ('x="150.0"', 'x="1_000"', "not a number"),
     ('x="150.0"', 'x="nan"', "not a number"),

@@ -2,7 +2,9 @@
 
 Export (``network.xml``, written by every network run when the network has that form):
 ``<network axes-xy="ne">`` (left-handed angles, gama-local's default: x north, y east,
-bearings clockwise from x, as this suite's bearings from +x towards +y) with
+bearings clockwise from x, as this suite's bearings from +x towards +y; a network imported from
+a gama-local file is written in that file's ``axes-xy`` and ``angles``, its coordinates as
+read, directions and angles negated where the angles run against the frame) with
 ``<parameters sigma-apr="1" sigma-act="apriori"/>`` (a precision study: the stdevs are the
 observations' sigmas); points in metres, ``fix="xy"`` (fixed), ``adj="xy"`` (free or
 observed), ``adj="XY"`` on the points of an inner datum; directions grouped one ``<obs>`` per
@@ -37,13 +39,15 @@ import numpy as np
 from sim.mc.config import ConfigError, given
 from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network
-from sim.studies.network.gama_read import CC, NS, read_bytes, read_gama
+from sim.studies.network.gama_read import CC, NS, consistent, read_bytes, read_gama
 from sim.studies.network.model import computed
 from sim.studies.network.validate import hits, name_index
 
 __all__ = ["read_gama", "write_gama", "merge_gama", "export", "gama_digest", "import_note"]
 
 _GON = math.pi / 200
+#: gama-local's default frame, the suite's own: x north, y east, angles clockwise
+NE = ("ne", "left-handed")
 
 
 def gama_digest(path: str | Path, key: str = "network.gama_xml") -> str:
@@ -80,6 +84,7 @@ def merge_gama(cfg: dict) -> dict:
         **cfg,
         "network.points": rec["network.points"],
         "network.observations": rec["network.observations"],
+        "network.gama_frame": rec["frame"],  # the export writes the frame it was read in
     }
     if rec["datum.points"] and not cfg["datum.points"]:
         out["datum.points"] = rec["datum.points"]
@@ -327,15 +332,19 @@ def _vectors(net: Network, po: ET.Element, pairs: list, val: np.ndarray) -> None
     )
 
 
-def write_gama(net: Network, path: str | Path, inner: tuple | list = ()) -> Path:
+def write_gama(net: Network, path: str | Path, inner: tuple | list = (), frame: tuple = NE) -> Path:
     """Write ``net`` as ``gama-local`` XML (see the module doc for the mapping and what is
-    refused); ``inner``: indices of the points of an inner datum (``adj="XY"``)."""
+    refused); ``inner``: indices of the points of an inner datum (``adj="XY"``); ``frame``:
+    ``(axes-xy, angles)``, the coordinates' frame (as read from a gama-local file): the
+    directions and angles change sign where the angles run against the frame."""
     _refuse(net)
     pairs = _vector_pairs(net)
     _expressible(net, pairs)
     val = computed(net, net.theta_true()[None])[0]
+    if not consistent(*frame):  # from +x towards -y: an angle's or direction's value negated
+        val = np.where(np.isin(net.kind, (1, 2)), -val, val)
     root = ET.Element("gama-local", xmlns=NS)
-    nw = ET.SubElement(root, "network", {"axes-xy": "ne", "angles": "left-handed"})
+    nw = ET.SubElement(root, "network", {"axes-xy": frame[0], "angles": frame[1]})
     ET.SubElement(nw, "description").text = net.name
     ET.SubElement(nw, "parameters", {"sigma-apr": "1", "sigma-act": "apriori"})
     po = ET.SubElement(nw, "points-observations")
@@ -364,12 +373,13 @@ def export(net: Network, cfg: dict, path: str | Path) -> str:
     """Write ``network.xml`` in the datum of ``cfg``; returns the sentence for the summary
     (the file name, what was changed to say it in gama-local, or why it was not written)."""
     kind = cfg["datum.kind"]
+    frame = tuple(cfg.get("network.gama_frame", NE))  # an imported file's frame, else ne
     try:
         if kind == "fixed":
-            write_gama(net, path)
+            write_gama(net, path, frame=frame)
             return Path(path).name
         pts = [a for a in range(net.n) if net.role[a] != 1]
-        write_gama(net, path, inner_points(net, cfg) if kind == "inner" else pts)
+        write_gama(net, path, inner_points(net, cfg) if kind == "inner" else pts, frame)
     except ConfigError as e:
         return f"not exported: {e}"
     if kind == "inner":

@@ -7,7 +7,14 @@ names the file, the element and the attribute. Only a regular file of at most
 :data:`MAX_BYTES` is read (a FIFO or a device is refused before it is opened).
 
 What maps to what (2-D, ``axes-xy = "ne"``, left-handed angles: x north, y east, bearings
-clockwise from x -- this suite's x, y and bearings from +x towards +y):
+clockwise from x -- this suite's x, y and bearings from +x towards +y). Every frame
+``gama-local`` reads is read (``axes-xy``: ne, es, sw, wn and the right-handed en, nw, se, ws;
+``angles``: left- or right-handed), its coordinates as they are: the suite's bearings run from
++x towards +y, which is the file's convention when frame and angles have the same handedness;
+when they do not, each direction and angle of the file is the suite's with its sign changed,
+a change of sign of its design row (and of the orientation unknown) that leaves the normals,
+hence every covariance, unchanged. Covariances are in the file's frame (``note`` names it;
+tests/test_gama27.py compares all 16 combinations with ``gama-local``).
 
 * ``<point id x y fix="xy">`` -> role ``fixed``; ``adj="xy"`` -> ``free``; ``adj="XY"`` ->
   free and a datum point of the inner constraints (``datum.points``); metres -> mm. A ``z``
@@ -29,10 +36,10 @@ clockwise from x -- this suite's x, y and bearings from +x towards +y):
   when the file asks for ``sigma-act = "aposteriori"`` (``gama-local``'s default).
 
 Refused with one line: heights and 3-D data (``z-angle``, ``s-distance``,
-``height-differences``, free heights), azimuths, other axes orientations, right-handed angles,
-correlated covariance blocks. The observed values (``val``) are checked as numbers but not
-used otherwise: the simulation draws readings from the points' coordinates, which every point
-must therefore have.
+``height-differences``, free heights), azimuths, an ``axes-xy`` or ``angles`` outside
+``gama-local``'s vocabulary, correlated covariance blocks. The observed values (``val``) are
+checked as numbers but not used otherwise: the simulation draws readings from the points'
+coordinates, which every point must therefore have.
 """
 
 from __future__ import annotations
@@ -244,14 +251,42 @@ def _vectors(f: _File, e, out: list) -> None:
         out.append({"kind": "dy", "from": fr, "to": to, "sigma_mm": math.sqrt(var[3 * a + 1])})
 
 
-#: gama-local's left-handed frames (x to y clockwise, as bearings run): ne and its turns by
-#: 90, 180 and 270 degrees read as ne (the observation equations are the same in each)
-TURNS = {
+#: gama-local's frames (``axes-xy``): the left-handed ones (x to y clockwise) are ne and its
+#: turns by 90, 180 and 270 degrees, the right-handed ones their mirror images
+FRAMES = {
     "ne": "x north, y east",
     "es": "x east, y south: ne turned 90 degrees",
     "sw": "x south, y west: ne turned 180 degrees",
     "wn": "x west, y north: ne turned 270 degrees",
+    "en": "x east, y north: right-handed",
+    "nw": "x north, y west: right-handed",
+    "se": "x south, y east: right-handed",
+    "ws": "x west, y south: right-handed",
 }
+LEFT_HANDED = ("ne", "es", "sw", "wn")
+
+
+def consistent(axes: str, angles: str) -> bool:
+    """The frame and the angles have the same handedness: a direction is a bearing from +x
+    towards +y (minus its orientation), as this suite's; otherwise from +x towards -y."""
+    return (axes in LEFT_HANDED) == (angles == "left-handed")
+
+
+def frame_note(axes: str, angles: str) -> str:
+    """What the report says of a file's frame (``""`` for gama-local's default, ne with
+    left-handed angles)."""
+    if (axes, angles) == ("ne", "left-handed"):
+        return ""
+    note = (
+        f"; axes-xy = {axes!r} ({FRAMES[axes]}), {angles} angles: coordinates and covariances "
+        "are in the file's frame, ellipse bearings from +x towards +y"
+    )
+    if consistent(axes, angles):
+        return note + " (the sense of its angles)"
+    return note + (
+        " (against its angles, which run from +x towards -y: each direction and angle only "
+        "changes sign, which leaves every covariance unchanged)"
+    )
 
 
 def _network(f: _File, data: bytes):
@@ -270,15 +305,6 @@ def _network(f: _File, data: bytes):
     if len(nets) != 1:
         raise f.err(root, f"{len(nets)} <network> elements (need one)")
     net = nets[0]
-    if ws(net.get("axes-xy", "ne")) not in TURNS:
-        raise f.err(
-            net,
-            f"{net.get('axes-xy')!r} is a right-handed frame (bearings run from +y to +x): "
-            "only 'ne' and its turns 'es', 'sw', 'wn' are supported",
-            "axes-xy",
-        )
-    if ws(net.get("angles", "left-handed")) != "left-handed":
-        raise f.err(net, "only left-handed angles are supported", "angles")
     if net.get("epoch") is not None:
         f.num(net, "epoch")
     return net
@@ -318,8 +344,9 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
 
 def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | None = None) -> dict:
     """Points and observations of a ``gama-local`` XML file as study records:
-    ``{"network.points", "network.observations", "datum.points", "note"}`` (``note``: the
-    ``<parameters>`` convention used, one sentence). ``sha256``: the digest the study recorded
+    ``{"network.points", "network.observations", "datum.points", "note", "frame"}`` (``note``:
+    the ``<parameters>`` convention used and the frame, one sentence; ``frame``: ``(axes-xy,
+    angles)``). ``sha256``: the digest the study recorded
     on load; bytes of another digest (the file edited since) are refused, so a run never
     simulates a network other than the one its config names."""
     path = Path(path)
@@ -333,12 +360,9 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         )
     net = _network(f, data)
     note = _parameters(f, [e for e in net if _tag(e) == "parameters"])
-    axes = ws(net.get("axes-xy", "ne"))
-    if axes != "ne":
-        note += (
-            f"; axes-xy = {axes!r} ({TURNS[axes]}): ne turned, so every bearing, distance and "
-            "angle is the same; coordinates and covariances are in the file's frame"
-        )
+    axes = ws(net.get("axes-xy", "ne"))  # gama-local's vocabulary, checked in _network
+    angles = ws(net.get("angles", "left-handed"))
+    note += frame_note(axes, angles)
     pos = [e for e in net if _tag(e) == "points-observations"]
     if len(pos) != 1:
         raise f.err(net, f"{len(pos)} <points-observations> elements (need one)")
@@ -367,6 +391,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         "network.observations": obs,
         "datum.points": list(datum),
         "note": note,
+        "frame": (axes, angles),
     }
 
 
