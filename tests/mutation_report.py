@@ -57,6 +57,25 @@ NOTES = {
         "reads an omitted decimals as an exact reference), as "
         "tests/test_claim_book_checks.py checks."
     ),
+    "sim.claims.rules.x__shown__mutmut_9": (
+        "equivalent: repr for str() on every value that is no float, list or string; a "
+        "validated configuration value is then an int, a bool, None or a records table (a "
+        "dict), whose repr and str are the same text (sim.mc.config.check_value); a string is "
+        "shown quoted either way, which tests/test_rules_off_paper.py pins."
+    ),
+    "sim.claims.rules.x_printed_differs__mutmut_5": (
+        "equivalent: getattr's default None for False; both are false, so a field without a "
+        "printed attribute is not printed either way."
+    ),
+    **{
+        f"sim.claims.rules.x_printed_differs__mutmut_{k}": (
+            "equivalent: getattr's default (dropped, or True for False) is read only for a "
+            "schema value without a printed attribute; every value of every study schema is a "
+            "sim.mc.config.Field, whose printed defaults to False (checked over the 15 schema "
+            "tables of sim/studies/*/schema.py; sim.cli reads f.printed directly)."
+        )
+        for k in (8, 11)
+    },
     **{
         f"sim.claims.inference.x__evidence__mutmut_{k}": (
             "equivalent: the value array without the float dtype; it is used only as the "
