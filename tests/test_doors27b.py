@@ -20,9 +20,13 @@ from pathlib import Path
 
 import pytest
 
+import sim.mc.publish as publish_mod
+from sim.mc.outputs import stage_dir
+from sim.mc.publish import publish
+from sim.mc.storage import read_record, write_record
 from tests.test_doors18c import MAKE, fake_project, user_env
 
-pytestmark = pytest.mark.skipif(
+needs_make = pytest.mark.skipif(
     MAKE is None or shutil.which("flock") is None or not Path("/proc/locks").exists(),
     reason="needs make, flock(1) and /proc/locks",
 )
@@ -35,6 +39,7 @@ def _waiters(path: Path) -> int:
     return sum(1 for x in lines if "->" in x and x.split()[-3].endswith(f":{ino}"))
 
 
+@needs_make
 def test_a_second_make_venv_that_waited_for_the_first_leaves_its_install_alone(tmp_path):
     d = fake_project(tmp_path, "/nonexistent/python3")  # a fresh clone: no usable .venv yet
     (d / ".venv" / ".installed").unlink()
@@ -68,6 +73,7 @@ def test_a_second_make_venv_that_waited_for_the_first_leaves_its_install_alone(t
     assert lock.exists()  # the lock file stays: a third make would lock a new one
 
 
+@needs_make
 def test_one_make_venv_alone_installs_and_writes_its_stamp(tmp_path):
     # the stamp is now written by the last pip step, under its lock
     d = fake_project(tmp_path, "/nonexistent/python3")
@@ -84,3 +90,83 @@ def test_one_make_venv_alone_installs_and_writes_its_stamp(tmp_path):
     assert "-m venv --clear .venv" in (tmp_path / "venv.log").read_text(encoding="utf-8")
     assert (d / ".venv" / ".installed").read_text(encoding="utf-8") == f"{d}\n"
     assert not (d / ".venv.installing").exists()
+
+
+# * ``sim report``, ``sim show`` or ``make verify`` in a second terminal while ``make
+#   reproduce`` publishes a study: the old results were moved aside and the new ones moved in
+#   by two renames, so for an instant the study had no directory (a loop of 300 publishes
+#   against a process looking for it: absent 59 times of 72,617); a README.md written into it
+#   then would have made an empty directory there. Now the two are swapped in one step
+#   (renameat2 RENAME_EXCHANGE; the two renames where the system has no such call).
+
+
+def _published(root: Path, text: str) -> Path:
+    """``root/X`` published from a staging directory holding one table of ``text``."""
+    out = root / "X"
+    stage = stage_dir(out)
+    stage.mkdir(parents=True)
+    write_record(stage, {"config": {"study": "x"}, "code_hash": "h", "files": ["t.txt"]})
+    (stage / "t.txt").write_text(text, encoding="utf-8")
+    publish(stage, out)
+    return out
+
+
+@pytest.mark.parametrize("swap", [True, False])
+def test_a_published_study_never_lacks_its_directory(tmp_path, monkeypatch, swap):
+    if swap and getattr(publish_mod._libc(), "renameat2", None) is None:
+        pytest.skip("no renameat2 here: the two renames are the fallback")
+    out = _published(tmp_path, "old")
+    (out / "notes.md").write_text("mine", encoding="utf-8")  # the user's: carried over
+    real, seen = os.replace, []
+
+    def replace(a, b):
+        real(a, b)
+        seen.append(out.is_dir())  # what another process looking at the study would see
+
+    monkeypatch.setattr(os, "replace", replace)
+    if not swap:  # a file system without the call: as before
+        monkeypatch.setattr(publish_mod, "_exchange", lambda a, b: False)
+    _published(tmp_path, "new")
+    monkeypatch.undo()
+    assert (out / "t.txt").read_text(encoding="utf-8") == "new"
+    assert (out / "notes.md").read_text(encoding="utf-8") == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["X"]  # nothing left beside it
+    if swap:
+        assert seen and all(seen), seen
+    else:
+        assert False in seen  # the instant the fallback still has
+
+
+class _Killed(BaseException):
+    """A kill at one point of a run (no handler of the suite catches it)."""
+
+
+def test_a_run_killed_right_after_the_swap_loses_nothing(tmp_path, monkeypatch, capsys):
+    # killed between the swap and moving the old results (now at the staging path) aside:
+    # the new results are in place with the user's file; the next run clears the old ones
+    from sim.cli import main
+
+    plate = str(Path(__file__).resolve().parents[1] / "studies" / "network_plate.toml")
+    small = ["--trials", "40", "--chunk", "2", "--no-figures", "--quiet"]
+    out = tmp_path / "out"
+    assert main(["run", plate, *small, "--seed", "7", "--out", str(out)]) == 0
+    (out / "user.txt").write_text("mine", encoding="utf-8")
+    real = publish_mod._exchange
+
+    def killed(a, b):
+        if not real(a, b):
+            pytest.skip("no renameat2 here")
+        raise _Killed  # (as kill -9: nothing after the swap ran)
+
+    monkeypatch.setattr(publish_mod, "_exchange", killed)
+    with pytest.raises(_Killed):
+        main(["run", plate, *small, "--seed", "8", "--overwrite", "--out", str(out)])
+    monkeypatch.undo()
+    assert read_record(out)["config"]["seed"] == 8
+    assert (out / "user.txt").read_text(encoding="utf-8") == "mine"
+    capsys.readouterr()
+    assert main(["run", plate, *small, "--seed", "3", "--overwrite", "--out", str(out)]) == 0
+    assert "note" not in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    assert (out / "user.txt").read_text(encoding="utf-8") == "mine"
+    assert read_record(out)["config"]["seed"] == 3
