@@ -170,3 +170,27 @@ def test_a_run_killed_right_after_the_swap_loses_nothing(tmp_path, monkeypatch, 
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
     assert (out / "user.txt").read_text(encoding="utf-8") == "mine"
     assert read_record(out)["config"]["seed"] == 3
+
+
+# * ``sim run --out A`` in one terminal and ``sim run --out A/B`` in another while the first
+#   works (``A`` not made yet: the first run works in ``.A.partial``): the second made ``A``,
+#   and the first computed every chunk, then refused to replace it ("holds files but no sim
+#   run record"). Now the second is refused at once: it lies inside the output of a run that
+#   is running or unfinished.
+
+
+def test_an_out_inside_the_output_of_a_run_still_working_is_refused(tmp_path, capsys):
+    from sim.cli import main
+    from sim.mc.storage import StageLock
+    from tests.oneline import SIM_ERROR, one_line
+
+    plate = str(Path(__file__).resolve().parents[1] / "studies" / "network_plate.toml")
+    small = ["--trials", "40", "--chunk", "2", "--no-figures", "--quiet"]
+    first = tmp_path / "A"
+    lock = StageLock(stage_dir(first)).acquire()  # the first run, working
+    try:
+        rc = main(["run", plate, *small, "--out", str(first / "B")])
+        one_line(capsys, rc, f"lies inside {first}, the output of a run", prefix=SIM_ERROR)
+        assert not first.exists()  # nothing made where the first run will publish
+    finally:
+        lock.release()
