@@ -194,3 +194,37 @@ def test_an_out_inside_the_output_of_a_run_still_working_is_refused(tmp_path, ca
         assert not first.exists()  # nothing made where the first run will publish
     finally:
         lock.release()
+
+
+# * ``sim report`` in one terminal while ``make reproduce`` publishes a study in another: the
+#   report read some of the study's tables before the new results came in and the rest after
+#   (or all before), and, ending last, left a REPORT.md of results no longer there. Now a report
+#   whose directories changed while it read them reads them again.
+
+
+def test_a_report_that_read_a_study_while_it_was_replaced_reads_it_again(tmp_path, monkeypatch):
+    import sim.report.markdown as md
+    from sim.cli import main
+
+    plate = str(Path(__file__).resolve().parents[1] / "studies" / "network_plate.toml")
+    small = ["--trials", "40", "--chunk", "2", "--no-figures", "--quiet"]
+    res, new = tmp_path / "R", tmp_path / "new"
+    assert main(["run", plate, *small, "--seed", "7", "--out", str(res / "network_plate")]) == 0
+    assert main(["run", plate, *small, "--seed", "8", "--out", str(new / "network_plate")]) == 0
+    real, swapped = md._entry, []
+
+    def entry(d, get_study):
+        got = real(d, get_study)
+        if not swapped:  # the other terminal's run publishes right after the report read it
+            os.rename(res / "network_plate", tmp_path / "old")
+            os.rename(new / "network_plate", res / "network_plate")
+            swapped.append(d)
+        return got
+
+    monkeypatch.setattr(md, "_entry", entry)
+    assert main(["report", "--results", str(res)]) == 0
+    monkeypatch.undo()
+    assert swapped
+    text = (res / "REPORT.md").read_text(encoding="utf-8")
+    assert main(["report", "--results", str(res)]) == 0  # the report of what is there now
+    assert text == (res / "REPORT.md").read_text(encoding="utf-8")
