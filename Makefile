@@ -62,20 +62,33 @@ PIP_LOG := $(VENV)/pip.log
 comma := ,
 # Each install step holds the lock VENV_LOCK (where flock(1) exists): a pip still rolling back
 # after a Ctrl-C, or a second `make venv` at once, is waited for instead of racing the next
-# step ("venv --clear: Directory not empty", or a pip left without its modules)
+# step ("venv --clear: Directory not empty", or a pip left without its modules). The lock file
+# stays (removed while another make waited on it, a third make locked a new file beside it).
 VENV_LOCK := $(if $(shell command -v flock 2>/dev/null),flock $(VENV).lock)
-pip = @$(VENV_LOCK) $(PY) -m pip install --quiet $(1) >> $(PIP_LOG) 2>&1 || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
+# A step of the install checks, under the lock, whether another make finished the install while
+# this one waited (two terminals or `make -j` on a fresh clone: `make venv` and `make test`):
+# the stamp is now current, and it was not when this make started. It then does nothing: its
+# `venv --clear` wiped the finished .venv while the other make went on to run the tests in it
+# ("No such file or directory: .venv/bin/ruff"). The last pip step writes the stamp under the
+# same lock, so no step of another make runs between the install and its stamp.
+INSTALLED_NOW = test -f $(STAMP) && test $(STAMP) -nt pyproject.toml && \
+	test "$$(cat $(STAMP))" = $(call q,$(CURDIR)) && test ! -e $(INSTALLING)
+INSTALLED_AT_START := $(and $(VENV_USABLE),$(MADE_IN),$(shell test $(STAMP) -nt pyproject.toml && echo yes))
+# $(call locked,SCRIPT,SKIP): a prefix that runs the command after it as "$$@" in the shell
+# SCRIPT under the lock; SKIP (the stamp's steps): nothing when another make installed meanwhile
+locked = $(VENV_LOCK) sh -c $(call q,$(if $(and $(2),$(if $(INSTALLED_AT_START),,yes)),$(INSTALLED_NOW) && exit 0;) $(1)) sh
+# $(call pip,ARGS[,SKIP,THEN]): pip install ARGS under the lock, then the shell command THEN
+pip = @$(call locked,"$$@" >> $(PIP_LOG) 2>&1 || exit; $(3),$(2)) $(PY) -m pip install --quiet $(1) || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
 	"$$({ grep -m1 -E '^ *ERROR' $(PIP_LOG) || grep -v '^ *$$' $(PIP_LOG) | tail -1; } | sed -E 's/^ *(ERROR: *)?//')" >&2; exit 2; }
 
 $(STAMP): pyproject.toml $(if $(VENV_USABLE),,venv-unusable)
 	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
-	@$(VENV_LOCK) $(call q,$(PYTHON)) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) > $(INSTALLING) 2>&1 || { rc=$$?; \
+	@$(call locked,"$$@" > $(INSTALLING) 2>&1,skip) $(call q,$(PYTHON)) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) || { rc=$$?; \
 	  test $$rc -gt 128 && exit $$rc; printf 'make: PYTHON (%s) could not make $(VENV): %s\n' $(call q,$(PYTHON)) \
 	  "$$(grep -v '^ *$$' $(INSTALLING) | tail -1)" >&2; exit 2; }
-	@: > $(PIP_LOG)
-	$(call pip,--upgrade pip)
-	$(call pip,-e ".[dev]")
-	@echo '$(CURDIR)' > $@; rm -f $(INSTALLING) $(VENV).lock
+	@test -e $(INSTALLING) || exit 0; : > $(PIP_LOG)
+	$(call pip,--upgrade pip,skip)
+	$(call pip,-e ".[dev]",skip,echo $(call q,$(CURDIR)) > $(STAMP) && rm -f $(INSTALLING))
 
 venv: $(STAMP) ## create the virtual environment and install the project (with PYTHON=python3, 3.11 or later)
 

@@ -205,7 +205,8 @@ def _differs(old: dict, record: dict) -> str:
 def _check_not_nested(out: Path, shown: str) -> None:
     """Refuse an output directory inside another run's results or staging directory (its
     ``run.json``, its ``.partial`` staging directory or its ``trials/`` dataset): a re-run of
-    that study would replace it, and chunk files there would join that run's trials."""
+    that study would replace it, and chunk files there would join that run's trials. So is
+    one inside the output of a run still working (its staging directory beside it)."""
     for up in out.parents:
         if up == up.parent:
             break
@@ -214,6 +215,12 @@ def _check_not_nested(out: Path, shown: str) -> None:
                 "--out",
                 f"{shown} lies inside {up}, which belongs to another run; choose a directory "
                 "outside every results directory",
+            )
+        if (s := stage_dir(up)).is_dir() and not s.is_symlink():  # a run writing up (doors27b):
+            raise ConfigError(  # it computed every chunk, then refused to replace up (this run
+                "--out",  # had made it, "holds files but no sim run record")
+                f"{shown} lies inside {up}, the output of a run that is running or unfinished "
+                f"({s}); choose a directory outside every results directory",
             )
 
 

@@ -11,6 +11,8 @@ and refuses when the new run writes a file of a carried entry's name.
 
 from __future__ import annotations
 
+import ctypes
+import errno
 import hashlib
 import os
 import re
@@ -294,6 +296,36 @@ def _present(p: Path) -> bool:
     return p.is_symlink() or p.exists()
 
 
+#: renameat2(2)'s flag that swaps two paths in one step (Linux 3.15, glibc 2.28)
+_RENAME_EXCHANGE, _AT_FDCWD = 2, -100
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap the directories ``a`` and ``b`` in one step where the system can (False: it
+    cannot, and nothing was done). Moving the old results aside and the new ones in by two
+    renames left ``out`` absent for an instant, in which ``sim report`` or ``make verify`` in
+    another terminal found no results of that study (and a README.md written into it then
+    made an empty directory in its place, which the second rename could not replace)."""
+    fn = getattr(_libc(), "renameat2", None)
+    if fn is None:
+        return False
+    fn.argtypes = (ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint)
+    enc = [os.fsencode(str(p)) for p in (a, b)]
+    if fn(_AT_FDCWD, enc[0], _AT_FDCWD, enc[1], _RENAME_EXCHANGE) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP, errno.EPERM):
+        return False  # an older kernel, a file system without it (a FUSE mount, NFS)
+    raise OSError(err, os.strerror(err), str(b))
+
+
+def _libc():
+    try:
+        return ctypes.CDLL(None, use_errno=True)
+    except OSError:
+        return None
+
+
 def publish(stage: Path, out: Path) -> None:
     """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
     files in ``out`` that the suite did not write."""
@@ -317,9 +349,13 @@ def publish(stage: Path, out: Path) -> None:
     for f in keep:
         _carry(out / f, stage / f)
     old = _free_swap(out) if out.exists() else None
-    if old is not None:
+    if old is None:
+        os.replace(stage, out)
+    elif _exchange(stage, out):  # out now holds the new results, stage the old ones
+        os.replace(stage, old)
+    else:
         os.replace(out, old)
-    os.replace(stage, out)
+        os.replace(stage, out)
     (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
     _drop_stale_swaps(out, old)
     if old is None:

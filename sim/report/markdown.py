@@ -340,6 +340,39 @@ def _ours(path: Path) -> bool:
     return first in (MARK, "# Reproducibility report")
 
 
+def _dirs(results: Path) -> dict[str, int]:
+    """Each results directory's inode: a run that published one meanwhile gave it a new one."""
+    out = {}
+    try:
+        dirs = results_dirs(results)
+    except OSError:
+        return out
+    for d in dirs:
+        try:
+            out[d.name] = d.stat().st_ino
+        except OSError:
+            out[d.name] = -1
+    return out
+
+
+def _settled(results: Path, build: Callable, tries: int = 3):
+    """``build()``, done again when a run published a study while it read the directories
+    (``make reproduce`` in another terminal): the report took the tables of two runs as one
+    (or named one of them as another run's table beside a run.json). A failure while the
+    directories moved is read again too; after ``tries``, the last outcome stands."""
+    for k in range(tries):
+        before = _dirs(results)
+        try:
+            value = build()
+        except (ConfigError, OSError):
+            if k + 1 < tries and _dirs(results) != before:
+                continue
+            raise
+        if _dirs(results) == before:
+            return value
+    return value
+
+
 def write_report(results: Path, get_study: Callable, design: Callable | None = None) -> Path:
     """Write each results directory's README.md (see
     :func:`sim.report.run_summary.write_run_readme`) and ``results/REPORT.md``; a REPORT.md
@@ -350,10 +383,10 @@ def write_report(results: Path, get_study: Callable, design: Callable | None = N
         raise ConfigError(
             "--results", f"{out} was not written by sim report; sim never replaces it"
         )
-    text = MARK + "\n" + build_report(results, get_study, design)
+    text = MARK + "\n" + _settled(results, lambda: build_report(results, get_study, design))
     for d in sorted(results_dirs(results)):
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
-            write_run_readme(d, get_study)
+            _settled(results, lambda d=d: write_run_readme(d, get_study))
     with atomic_path(out) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return out
