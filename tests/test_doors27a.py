@@ -6,7 +6,10 @@ for labels, counts and intervals. Each class found is pinned here.
 * A solver limit that no trial can meet (``solver.max_iter = 1``, or 2 for Brown's pivot
   model, which starts at alpha = beta = 0; any tolerance) passed ``sim check``; the run
   computed every chunk and only then refused ("only 0 trials converged"). Brown's check now
-  adjusts a few probe plates of the run's error model and refuses naming the key."""
+  adjusts a few probe plates of the run's error model and refuses naming the key.
+* A cross-key refusal named a key the designer had not changed: gridplate's 1 % bound on the
+  comparator's scale difference and non-orthogonality together named ``scale_diff_ppm`` for
+  ``nonorth_arcsec = 3600``; it now names the larger part, with both parts."""
 
 from __future__ import annotations
 
@@ -38,3 +41,25 @@ def test_brown_solver_limit_the_trials_meet_is_accepted(capsys):
     assert main(["check", study, "--set", "solver.max_iter=3"]) == 0
     assert main(["check", study, "--set", "solver.max_iter=2", "--set", "solver.tol_mm=1e-3"]) == 0
     capsys.readouterr()
+
+
+@pytest.mark.parametrize(
+    ("sets", "key"),
+    [
+        (["comparator.nonorth_arcsec=3600", "readings.count=2"], "comparator.nonorth_arcsec"),
+        (
+            ["comparator.scale_diff_ppm=-9000", "comparator.nonorth_arcsec=900"],
+            "comparator.scale_diff_ppm",
+        ),
+        (
+            ["comparator.scale_diff_ppm=2000", "comparator.nonorth_arcsec=-1800"],
+            "comparator.nonorth_arcsec",
+        ),
+    ],
+)
+def test_gridplate_systematic_bound_names_the_larger_part(capsys, sets, key):
+    argv = ["check", str(ROOT / "studies" / "gridplate_two_plates.toml")]
+    for s in sets:
+        argv += ["--set", s]
+    line = one_line(capsys, main(argv), "exceed 1 %")
+    assert line.startswith(f"sim: error: {key}: "), line
