@@ -5,8 +5,10 @@ for labels, counts and intervals. Each class found is pinned here.
 
 * A solver limit that no trial can meet (``solver.max_iter = 1``, or 2 for Brown's pivot
   model, which starts at alpha = beta = 0; any tolerance) passed ``sim check``; the run
-  computed every chunk and only then refused ("only 0 trials converged"). Brown's check now
-  adjusts a few probe plates of the run's error model and refuses naming the key.
+  computed every chunk and only then refused (Brown: "only 0 trials converged"; the network
+  kind: "fewer than two chunks have converged trials"). Both checks now adjust a few probe
+  trials of the run's error model from a stream of their own and refuse naming the key,
+  when the same trials converge with the key's default (else the limit is not the cause).
 * A cross-key refusal named a key the designer had not changed: gridplate's 1 % bound on the
   comparator's scale difference and non-orthogonality together named ``scale_diff_ppm`` for
   ``nonorth_arcsec = 3600``; it now names the larger part, with both parts."""
@@ -63,3 +65,14 @@ def test_gridplate_systematic_bound_names_the_larger_part(capsys, sets, key):
         argv += ["--set", s]
     line = one_line(capsys, main(argv), "exceed 1 %")
     assert line.startswith(f"sim: error: {key}: "), line
+
+
+@pytest.mark.parametrize("study", ["network_plate", "network_brown"])
+def test_network_solver_limit_no_trial_meets_is_refused_at_check(capsys, study):
+    argv = ["check", str(ROOT / "studies" / f"{study}.toml"), "--set", "solver.max_iter=1"]
+    line = one_line(capsys, main(argv), "solver.max_iter", "probe")
+    assert "1 iteration to solver.tol_mm = 1e-09" in line, line
+    # two iterations do, and a tolerance as large as the noise lets one do
+    assert main([*argv[:-1], "solver.max_iter=2"]) == 0
+    assert main([*argv, "--set", "solver.tol_mm=1"]) == 0
+    capsys.readouterr()

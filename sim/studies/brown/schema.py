@@ -331,9 +331,15 @@ def check_solver(cfg: dict, pts: np.ndarray) -> None:
         bias_um=cfg["errors.bias_um"],
     )
     tol, limit = cfg["solver.tol_mm"], cfg["solver.max_iter"]
+
+    def status(m: str, max_iter: int) -> np.ndarray:
+        t0 = start_theta(theta, m)
+        return ml.adjust(obs, m, t0, tol_mm=tol, max_iter=max_iter, engine="numpy").status
+
     for m in MODEL_NAMES:
-        res = ml.adjust(obs, m, start_theta(theta, m), tol_mm=tol, max_iter=limit, engine="numpy")
-        if np.all(res.status == 1):
+        # the limit is the cause only when the same plates converge with the key's default
+        default = BASE["solver.max_iter"].default
+        if np.all(status(m, limit) == 1) and np.any(status(m, default) == 0):
             raise ConfigError(
                 "solver.max_iter",
                 f"{limit} iteration{'s' * (limit > 1)} to solver.tol_mm = {tol:g}: none of "
