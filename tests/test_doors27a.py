@@ -63,7 +63,7 @@ def test_gridplate_systematic_bound_names_the_larger_part(capsys, sets, key):
     argv = ["check", str(ROOT / "studies" / "gridplate_two_plates.toml")]
     for s in sets:
         argv += ["--set", s]
-    line = one_line(capsys, main(argv), "exceed 1 %")
+    line = one_line(capsys, main(argv), "over 1 %")
     assert line.startswith(f"sim: error: {key}: "), line
 
 

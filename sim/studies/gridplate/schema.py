@@ -172,9 +172,9 @@ def check(cfg: dict) -> None:
     require(
         scale + nonorth <= 0.01,
         "comparator.scale_diff_ppm" if scale >= nonorth else "comparator.nonorth_arcsec",
-        f"scale difference ({scale * 100:.3g} %) and non-orthogonality ({nonorth * 100:.3g} %) "
-        "together exceed 1 % (the decomposition is linearised about a near-identity "
-        "comparator)",
+        f"scale difference {scale * 100:.3g} % plus non-orthogonality {nonorth * 100:.3g} % "
+        f"is {(scale + nonorth) * 100:.4g} %, over 1 % (the decomposition is linearised about "
+        "a near-identity comparator)",
     )
     require(
         sc * UM <= 0.01 * extent,
