@@ -344,7 +344,8 @@ def check_solver(cfg: dict, pts: np.ndarray) -> None:
                 "solver.max_iter",
                 f"{limit} iteration{'s' * (limit > 1)} to solver.tol_mm = {tol:g}: none of "
                 f"{PROBE_TRIALS} probe plates of the {m} model converged, so no trial would "
-                f"(every chunk computed, then refused): raise solver.max_iter (or tol_mm)",
+                "(the run would compute every chunk, then refuse): raise solver.max_iter (or "
+                "tol_mm)",
             )
 
 

@@ -58,7 +58,7 @@ def probe_solver(net: Network, an, C, pts, cfg: dict) -> None:
         raise ConfigError(
             "solver.max_iter",
             f"{limit} iteration{'s' * (limit > 1)} to solver.tol_mm = {cfg['solver.tol_mm']:g}: "
-            f"none of {PROBE_TRIALS} probe trials converged, so no trial would (every chunk "
-            "computed, then refused): raise solver.max_iter (the first correction from the "
-            "true coordinates is the noise itself), or tol_mm",
+            f"none of {PROBE_TRIALS} probe trials converged, so no trial would (the run would "
+            "compute every chunk, then refuse): raise solver.max_iter (the first correction "
+            "from the true coordinates is the noise itself), or tol_mm",
         )
