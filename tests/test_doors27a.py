@@ -11,7 +11,11 @@ for labels, counts and intervals. Each class found is pinned here.
   when the same trials converge with the key's default (else the limit is not the cause).
 * A cross-key refusal named a key the designer had not changed: gridplate's 1 % bound on the
   comparator's scale difference and non-orthogonality together named ``scale_diff_ppm`` for
-  ``nonorth_arcsec = 3600``; it now names the larger part, with both parts."""
+  ``nonorth_arcsec = 3600``; it now names the larger part, with both parts.
+* A swept value one ulp from the paper's printed number (``{start = 1.1, stop = 2.3, step =
+  0.6}`` gives 1.7000000000000002 for Brown's 1.7 um setting) made the cell off the paper's
+  setup, every prediction a finding, its note "errors.setting_sigma_um = 1.7 (paper: 1.7)":
+  a printed value now differs when it shows differently (12 significant digits)."""
 
 from __future__ import annotations
 
@@ -76,3 +80,23 @@ def test_network_solver_limit_no_trial_meets_is_refused_at_check(capsys, study):
     assert main([*argv[:-1], "solver.max_iter=2"]) == 0
     assert main([*argv, "--set", "solver.tol_mm=1"]) == 0
     capsys.readouterr()
+
+
+def test_a_value_one_ulp_from_the_papers_is_the_papers(capsys):
+    # a swept range {start = 1.1, stop = 2.3, step = 0.6} gives 1.1 + 0.6 = 1.7000000000000002:
+    # that cell was off the paper's setup, every prediction a finding, its note
+    # "errors.setting_sigma_um = 1.7 (paper: 1.7)"
+    from sim.claims.rules import printed_differs
+    from sim.mc.sweep import _values
+    from sim.studies.brown.schema import TABLE1
+
+    swept = _values("errors.setting_sigma_um", {"start": 1.1, "stop": 2.3, "step": 0.6})
+    assert swept[1] != 1.7 and f"{swept[1]:.12g}" == "1.7"
+    cfg = {k: f.default for k, f in TABLE1.items()}
+    assert printed_differs(TABLE1, {**cfg, "errors.setting_sigma_um": swept[1]}) == []
+    assert printed_differs(TABLE1, {**cfg, "errors.setting_sigma_um": 1.7000001}) == [
+        "errors.setting_sigma_um = 1.7000001 (paper: 1.7)"
+    ]
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    assert main(["check", study, "--set", f"errors.setting_sigma_um={swept[1]!r}"]) == 0
+    assert "off the paper's setup" not in capsys.readouterr().out

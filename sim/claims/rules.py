@@ -194,10 +194,12 @@ def printed_differs(schema: Mapping[str, Any], cfg: Mapping[str, Any]) -> list[s
     """The keys of ``schema`` marked ``printed`` (their default is the paper's own number)
     whose value in the resolved ``cfg`` differs, each as ``"key = value (paper: default)"``,
     in the schema's order; ``[]`` on the paper's setup. A key the configuration leaves out
-    (one not read under its switch) has its default."""
+    (one not read under its switch) has its default. A value differs when it shows differently
+    (12 significant digits): a swept 1.1 + 0.6 = 1.7000000000000002 is the paper's 1.7, and
+    made the run off the paper's setup with the note "1.7 (paper: 1.7)"."""
     out = []
     for k, f in schema.items():
-        if getattr(f, "printed", False) and cfg.get(k, f.default) != f.default:
+        if getattr(f, "printed", False) and _shown(cfg.get(k, f.default)) != _shown(f.default):
             out.append(f"{k} = {_shown(cfg[k])} (paper: {_shown(f.default)})")
     return out
 
