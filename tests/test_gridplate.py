@@ -148,7 +148,7 @@ def test_bad_config_names_the_key(tmp_path):
     [
         ("grid.sigma_stated_um=1e-9", "grid.sigma_stated_um"),  # no re-weighting ratio passes
         ("grid.sigma_stated_um=5.0", "grid.sigma_stated_um"),  # no positive fixed point
-        ("comparator.nonorth_arcsec=3000.0", "comparator.scale_diff_ppm"),
+        ("comparator.nonorth_arcsec=3000.0", "comparator.nonorth_arcsec"),  # the larger part
         ("chunk=100000", "chunk"),
     ],
 )

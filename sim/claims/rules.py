@@ -206,11 +206,14 @@ def printed_differs(
     in the schema's order; ``[]`` on the paper's setup. A key the configuration leaves out
     (one not read under its switch) has its default. ``as_printed``: the study's spelling of
     ``cfg`` in the paper's keys where it resolves to the paper's setup by another spelling
-    (brown's list of exactly Table 1's 25 points, :func:`sim.studies.brown.schema.as_printed`)."""
+    (brown's list of exactly Table 1's 25 points, :func:`sim.studies.brown.schema.as_printed`).
+    A value differs when it shows differently (12 significant digits): a swept 1.1 + 0.6 =
+    1.7000000000000002 is the paper's 1.7, and made the run off the paper's setup with the
+    note "1.7 (paper: 1.7)"."""
     cfg = as_printed(dict(cfg)) if as_printed is not None else cfg
     out = []
     for k, f in schema.items():
-        if getattr(f, "printed", False) and cfg.get(k, f.default) != f.default:
+        if getattr(f, "printed", False) and _shown(cfg.get(k, f.default)) != _shown(f.default):
             out.append(f"{k} = {_shown(cfg[k])} (paper: {_shown(f.default)})")
     return out
 

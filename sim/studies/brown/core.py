@@ -14,20 +14,13 @@ from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import StudyError
 from sim.mc.runner import jackknife, run_chunks
 from sim.studies import RunContext
-from sim.studies.brown.schema import MODEL_NAMES
+from sim.studies.brown.schema import MODEL_NAMES, start_theta
 
 
 def analytic_sigma(pts: np.ndarray, theta: np.ndarray, model: str, sigma_um: float = 1.0):
     """Per-point sigma_x, sigma_y (um) at the true values, shape (n, 2)."""
     Q = ml.covariance(pts[None], theta[None], model)[0][0]
     return sigma_um * np.sqrt(np.stack([Q[:, 0, 0], Q[:, 1, 1]], axis=1))
-
-
-def start_theta(theta: np.ndarray, model: str) -> np.ndarray:
-    """Initial globals: the design (true) stations; alpha and beta^2 start at 0 when free."""
-    t0 = theta.copy()
-    t0[5 + (model == "alpha") : ml.MODELS[model]] = 0.0
-    return t0
 
 
 SIM_KEYS = (

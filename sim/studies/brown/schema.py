@@ -324,7 +324,54 @@ def check(cfg: dict) -> None:
                 f"reads 0 to {reach:g} mm (move the stations in, or use alpha)",
             )
     check_pivot(cfg, key, pts)
+    check_solver(cfg, pts)
     require_chunks(cfg)
+
+
+#: trials of the solver probe (:func:`check_solver`), drawn from a fixed stream of their own,
+#: run when ``solver.max_iter`` is at most PROBE_MAX_ITER (the models converge in 2 to 4)
+PROBE_TRIALS, PROBE_SEED, PROBE_MAX_ITER = 16, 27, 8
+
+
+def check_solver(cfg: dict, pts: np.ndarray) -> None:
+    """The solver limits can be met: ``PROBE_TRIALS`` plates of the run's error model (a fixed
+    stream, not the run's) adjusted with each model from the run's start values. When no
+    probe plate of a model converges within ``solver.max_iter`` (status 1, the iteration
+    limit), no trial of the run would either: the run computed every chunk and then
+    refused (``solver.max_iter = 1``, or 2 for the pivot model, which starts at alpha =
+    beta = 0). Run only for a small limit (``PROBE_MAX_ITER``): a 100 x 100 plate's probe
+    takes seconds."""
+    if cfg["solver.max_iter"] > PROBE_MAX_ITER:
+        return
+    _, theta = setup(cfg)
+    if not np.all(np.isfinite(ml.ranges(pts[None], theta[None]))):
+        return  # the scale check names the overflow when the scale is enforced
+    obs = ml.simulate_ranges(
+        np.broadcast_to(pts, (PROBE_TRIALS,) + pts.shape),
+        np.broadcast_to(theta, (PROBE_TRIALS, 7)),
+        np.random.default_rng(PROBE_SEED),
+        setting_sigma_um=cfg["errors.setting_sigma_um"],
+        settings=cfg["errors.settings"],
+        comparator_sigma_um=cfg["errors.comparator_sigma_um"],
+        bias_um=cfg["errors.bias_um"],
+    )
+    tol, limit = cfg["solver.tol_mm"], cfg["solver.max_iter"]
+
+    def status(m: str, max_iter: int) -> np.ndarray:
+        t0 = start_theta(theta, m)
+        return ml.adjust(obs, m, t0, tol_mm=tol, max_iter=max_iter, engine="numpy").status
+
+    for m in MODEL_NAMES:
+        # the limit is the cause only when the same plates converge with the key's default
+        default = BASE["solver.max_iter"].default
+        if np.all(status(m, limit) == 1) and np.any(status(m, default) == 0):
+            raise ConfigError(
+                "solver.max_iter",
+                f"{limit} iteration{'s' * (limit > 1)} to solver.tol_mm = {tol:g}: none of "
+                f"{PROBE_TRIALS} probe plates of the {m} model converged, so no trial would "
+                "(the run would compute every chunk, then refuse): raise solver.max_iter (or "
+                "tol_mm)",
+            )
 
 
 def _within_beta(cfg: dict, key: str, pts: np.ndarray) -> None:
@@ -386,6 +433,13 @@ def check_pivot(cfg: dict, key: str, pts: np.ndarray) -> None:
                 f"matrix is singular (scaled reciprocal condition {rc:.2g}, the adjustment "
                 f"needs > {RCOND:g})",
             )
+
+
+def start_theta(theta: np.ndarray, model: str) -> np.ndarray:
+    """Initial globals: the design (true) stations; alpha and beta^2 start at 0 when free."""
+    t0 = theta.copy()
+    t0[5 + (model == "alpha") : ml.MODELS[model]] = 0.0
+    return t0
 
 
 def setup(cfg: dict):

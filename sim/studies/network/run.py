@@ -11,35 +11,31 @@ network in ``gama-local`` XML when it has that form) and the figures.
 
 from __future__ import annotations
 
-from functools import partial
 from pathlib import Path
 
 import numpy as np
 
-from sim.lsq import distributions as D
 from sim.mc.config import StudyError
 from sim.mc.progress import phase
 from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance
 from sim.report.plotting import draw
-from sim.studies.network.analysis import ellipse, estimated_points, mc_chunk
+from sim.studies.network.analysis import ellipse, estimated_points
 from sim.studies.network.claims import design_figures, network_claims
 from sim.studies.network.definition import Network, build
 from sim.studies.network.estimates import mc_estimates
 from sim.studies.network.figures import network_figure, reliability_figure
 from sim.studies.network.gama import export, import_note, merge_gama
 from sim.studies.network.model import datum
+from sim.studies.network.probe import chunk_fn
 from sim.studies.network.rounding import check_rounding
 from sim.studies.network.sparse_analysis import (
-    SparseAnalytic,
-    mc_chunk_sparse,
     pre_analysis,
     shows_phases,
     shows_phases_of,
 )
 from sim.studies.network.tables import (
     K95,
-    parameter_indices,
     write_datums,
     write_observations,
     write_parameters,
@@ -76,22 +72,7 @@ def _dilution(net: Network, an, full: dict, cfg: dict, pts: list[int]) -> np.nda
 
 
 def _mc(net, an, C, pts, cfg, ctx):
-    crit = float(D.chi2_ppf(1 - cfg["test.alpha"], an.dof))
-    cov_inv = np.linalg.inv(an.cov[pts])
-    common = dict(
-        net=net,
-        free=an.free,
-        cov_inv=cov_inv,
-        pts=np.asarray(pts),
-        crit=crit,
-        tol=cfg["solver.tol_mm"],
-        max_iter=cfg["solver.max_iter"],
-        par=parameter_indices(net, an),
-    )
-    if isinstance(an, SparseAnalytic):  # one factor for every trial and iteration
-        fn = partial(mc_chunk_sparse, fac=an.factor, dof=an.dof, **common)
-    else:
-        fn = partial(mc_chunk, C=None if C is None else C[0], **common)
+    fn = chunk_fn(net, an, C, pts, cfg)
     return run_chunks(
         fn, cfg["trials"], cfg["seed"], cfg["chunk"], part=0, label=cfg["study"], ctx=ctx
     )

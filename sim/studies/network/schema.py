@@ -30,6 +30,7 @@ from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.keys import SCHEMA
 from sim.studies.network.model import computed, datum, defect_basis, use_sparse
+from sim.studies.network.probe import probe_solver
 from sim.studies.network.rounding import check_rounding
 from sim.studies.network.singular import (
     loose_part,
@@ -128,6 +129,8 @@ def check(cfg: dict) -> None:
             f"{len(an.free)} unknowns leave {an.dof} degrees of freedom: add "
             "observations",
         )
+    pts = estimated_points(net, an)
+    probe_solver(net, an, dt.constraint_matrix(net.theta_true()[None]), pts, cfg)
     if cfg["compare.fix"]:
         _check_compare(net, full, cfg["compare.fix"], sparse)
     if cfg["output.inner_over"]:

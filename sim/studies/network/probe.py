@@ -1,0 +1,64 @@
+"""The Monte Carlo's chunk function of a network, and the solver probe ``sim check`` runs
+with it: a few trials from a fixed stream of their own (not the run's), refused when none
+converges within ``solver.max_iter`` (status 1, the iteration limit). ``solver.max_iter = 1``
+was accepted, every chunk computed, and the run then refused ("fewer than two chunks have
+converged trials"): the first correction from the true coordinates is the noise itself, so
+a trial converges at the earliest in the second iteration."""
+
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+
+from sim.lsq import distributions as D
+from sim.mc.config import ConfigError
+from sim.studies.network.analysis import mc_chunk
+from sim.studies.network.definition import Network
+from sim.studies.network.keys import SCHEMA
+from sim.studies.network.sparse_analysis import SparseAnalytic, mc_chunk_sparse
+from sim.studies.network.tables import parameter_indices
+
+#: trials of the probe, their stream, and the largest limit it is run for (the adjustments
+#: converge in 1 to 4 iterations; a larger limit needs no probe)
+PROBE_TRIALS, PROBE_SEED, PROBE_MAX_ITER = 16, 27, 8
+
+
+def chunk_fn(net: Network, an, C, pts, cfg: dict):
+    """The function of one chunk (rng, n) -> outputs that the run's Monte Carlo calls."""
+    crit = float(D.chi2_ppf(1 - cfg["test.alpha"], an.dof))
+    common = dict(
+        net=net,
+        free=an.free,
+        cov_inv=np.linalg.inv(an.cov[pts]),
+        pts=np.asarray(pts),
+        crit=crit,
+        tol=cfg["solver.tol_mm"],
+        max_iter=cfg["solver.max_iter"],
+        par=parameter_indices(net, an),
+    )
+    if isinstance(an, SparseAnalytic):  # one factor for every trial and iteration
+        return partial(mc_chunk_sparse, fac=an.factor, dof=an.dof, **common)
+    return partial(mc_chunk, C=None if C is None else C[0], **common)
+
+
+def probe_solver(net: Network, an, C, pts, cfg: dict) -> None:
+    """Refuse a solver limit no probe trial meets, naming ``solver.max_iter``."""
+    limit = cfg["solver.max_iter"]
+    if limit > PROBE_MAX_ITER:
+        return
+
+    def statuses(max_iter: int) -> np.ndarray:
+        fn = chunk_fn(net, an, C, pts, {**cfg, "solver.max_iter": max_iter})
+        return fn(np.random.default_rng(PROBE_SEED), PROBE_TRIALS)["rows.status"]
+
+    # the limit is the cause only when the same trials converge with the key's default (a
+    # gross bias that no limit helps is named by the run: network.observations)
+    if np.all(statuses(limit) == 1) and np.any(statuses(SCHEMA["solver.max_iter"].default) == 0):
+        raise ConfigError(
+            "solver.max_iter",
+            f"{limit} iteration{'s' * (limit > 1)} to solver.tol_mm = {cfg['solver.tol_mm']:g}: "
+            f"none of {PROBE_TRIALS} probe trials converged, so no trial would (the run would "
+            "compute every chunk, then refuse): raise solver.max_iter (the first correction "
+            "from the true coordinates is the noise itself), or tol_mm",
+        )
