@@ -57,6 +57,7 @@ from sim.ends import finish  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
+from sim.mc.storage import atomic_path  # noqa: E402
 from sim.stops import (  # noqa: E402
     check_interrupt,
     exit_status,
@@ -336,7 +337,8 @@ def _main(argv: list[str]) -> int:
         return 130
     if args.timings is not None:
         try:
-            Path(args.timings).write_text(json.dumps(done), encoding="utf-8")
+            with atomic_path(args.timings) as tmp:  # a write cut short (a full disk, ulimit
+                tmp.write_text(json.dumps(done), encoding="utf-8")  # -f) keeps the earlier file
         except OSError as e:  # a full disk, ulimit -f: the runs stand, their timings do not
             print(f"sim.batch: --timings: {e.strerror or e}: {args.timings}", file=sys.stderr)
             return 2

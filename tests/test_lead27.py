@@ -7,7 +7,9 @@ code before its fix.
   :data:`sim.lsq.normals.RCOND`), and the line now states that rule and its number;
 * a sweep's figure with ten values of its second key drew the tenth series exactly as the
   first (nine colours, one marker and line) and labelled a range's values
-  ``alpha=0.0311111111111...``; the figure check skipped error-bar series, so it passed.
+  ``alpha=0.0311111111111...``; the figure check skipped error-bar series, so it passed;
+* ``sim.batch --timings F`` wrote F in place: a write cut short left a truncated file that
+  every later batch refused as not its own (doors27b left it).
 """
 
 import re
@@ -73,3 +75,32 @@ def test_the_figure_check_sees_two_error_bar_series_drawn_alike():
     ax.legend()
     assert any("'a' and 'b' look alike" in p for p in layout_problems(fig))
     plt.close(fig)
+
+
+_CUT_SHORT = """
+import resource, signal, sys
+import sim.batch as b
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG
+resource.setrlimit(resource.RLIMIT_FSIZE, (2000, 2000))
+b.run_all = lambda *a, **k: {f"study{i:03d}": [0, 1.5, 2.5] for i in range(300)}
+sys.exit(b.main([sys.argv[1], "--results", sys.argv[2], "--timings", sys.argv[3]]))
+"""
+
+
+def test_a_timings_file_cut_short_keeps_the_earlier_one(tmp_path):
+    """``--timings`` was written in place: a write cut short (a full disk, ``ulimit -f``) left a
+    truncated file, which every later batch then refused as "not a timings file of
+    sim.batch; sim never replaces it". The runs are stubbed (nothing else is written)."""
+    import json
+    import subprocess
+    import sys
+
+    timings = tmp_path / "timings.json"
+    timings.write_text(json.dumps({"earlier": [0, 1.0, 0.0]}), encoding="utf-8")
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    args = [sys.executable, "-c", _CUT_SHORT, study, str(tmp_path / "res"), str(timings)]
+    p = subprocess.run(args, capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.count("\n") == 1 and "--timings" in p.stderr and "Traceback" not in p.stderr
+    assert json.loads(timings.read_text(encoding="utf-8")) == {"earlier": [0, 1.0, 0.0]}
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["timings.json"]
