@@ -28,6 +28,10 @@ single_threaded_blas()
 # as from a terminal, however they were started.
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+# The same for SIGHUP under `nohup make test`: the commands keep a SIGHUP their caller ignores
+# ignored (as they should), and the tests of what a closed terminal does saw no signal at all.
+if signal.getsignal(signal.SIGHUP) is signal.SIG_IGN:
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
 
 #: SIM_TEST_CPU_LOG=FILE: append each test's CPU seconds (its process and the subprocesses it
 #: waited for, setup and teardown included) to FILE as "nodeid<TAB>seconds". CPU time, not
