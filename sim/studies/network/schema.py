@@ -118,7 +118,8 @@ def check(cfg: dict) -> None:
             raise
         raise ConfigError(_where(full)[0], unreached_message(net, lone, _where(full)[1])) from e
     _conditioned(net, an, "datum.kind")
-    if not estimated_points(net, an):
+    pts = estimated_points(net, an)
+    if not pts:
         raise ConfigError(
             "network.points", "no estimated point has a regular covariance: nothing to estimate"
         )
@@ -129,7 +130,6 @@ def check(cfg: dict) -> None:
             f"{len(an.free)} unknowns leave {an.dof} degrees of freedom: add "
             "observations",
         )
-    pts = estimated_points(net, an)
     probe_solver(net, an, dt.constraint_matrix(net.theta_true()[None]), pts, cfg)
     if cfg["compare.fix"]:
         _check_compare(net, full, cfg["compare.fix"], sparse)
