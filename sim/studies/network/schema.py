@@ -326,8 +326,9 @@ def _pivot(net, factor, free: np.ndarray) -> str:
 def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
     """A network of full rank whose normals the engine still finds singular: the sigmas
     make it so (e.g. weighted coordinates a million times looser than the differences
-    between them). Name the weakest unknown and the range of the sigmas."""
-    _, sv, vt = np.linalg.svd(A, full_matrices=False)
+    between them). Name the weakest unknown and the reciprocal condition number of the
+    normals scaled to unit diagonal, under the engine's limit :data:`RCOND`."""
+    vt = np.linalg.svd(A, full_matrices=False)[2]
     what = _unknown(net, int(free[int(np.argmax(np.abs(vt[-1])))]))
     rc = float(scaled_rcond(A.T @ A))
     raise ConfigError(
