@@ -358,6 +358,7 @@ def check_solver(cfg: dict, pts: np.ndarray) -> None:
         bias_um=cfg["errors.bias_um"],
     )
     tol, limit = cfg["solver.tol_mm"], cfg["solver.max_iter"]
+    default = BASE["solver.max_iter"].default
 
     def status(m: str, max_iter: int) -> np.ndarray:
         t0 = start_theta(theta, m)
@@ -365,7 +366,6 @@ def check_solver(cfg: dict, pts: np.ndarray) -> None:
 
     for m in MODEL_NAMES:
         # the limit is the cause only when the same plates converge with the key's default
-        default = BASE["solver.max_iter"].default
         if np.all(status(m, limit) == 1) and np.any(status(m, default) == 0):
             raise ConfigError(
                 "solver.max_iter",
