@@ -64,7 +64,7 @@ SCHEMA = {
 }
 
 
-def _write(tmp_path, config, *, schema=SCHEMA, with_book=True):
+def _write(tmp_path, config, *, schema=SCHEMA, with_book=True, **kw):
     b = ClaimBook([dict(s) for s in SPECS], [], "<t>")
     rows = [
         b.score("w.grid", 5, interval="exact"),  # no row of the run fails its rule
@@ -73,7 +73,7 @@ def _write(tmp_path, config, *, schema=SCHEMA, with_book=True):
     ]
     prov = {"study": "t"} if config is None else {"study": "t", "config": config}
     path = tmp_path / "claims.parquet"
-    write_claims(path, rows, prov, b if with_book else None, schema)
+    write_claims(path, rows, prov, b if with_book else None, schema, **kw)
     return pq.read_table(path).to_pydict()
 
 
@@ -103,3 +103,14 @@ def test_without_the_book_the_printed_key_still_makes_predictions_findings(tmp_p
 def test_without_the_schema_the_config_is_not_compared(tmp_path):
     t = _write(tmp_path, {"plate.n": 4}, schema=None)
     assert t["verdict"] == ["input", "self-check", "holds"]
+
+
+def test_write_claims_passes_the_studys_paper_design_and_spelling_on(tmp_path):
+    # paper_design: the prediction keeps its verdict off the setup, the note says why
+    t = _write(tmp_path, {"plate.n": 4}, paper_design=["w.pred"])
+    assert t["verdict"] == ["input", NOT_APPLICABLE, "holds"] and t["holds"][2] is True
+    assert t["note"][2].startswith("the paper's verdict: decided on the paper's own setup")
+    # as_printed: the study's spelling of the paper's setup is the paper's
+    four_is_five = lambda cfg: {**cfg, "plate.n": 5} if cfg.get("plate.n") == 4 else cfg  # noqa: E731
+    t = _write(tmp_path, {"plate.n": 4}, as_printed=four_is_five)
+    assert t["verdict"] == ["input", "self-check", "holds"] and t["note"] == ["", "", ""]

@@ -2,6 +2,8 @@
 (a configuration value the paper prints) fails its rule, every prediction of the run is a
 finding about that setup, its outcome kept; on the paper's setup nothing changes."""
 
+import math
+
 import pyarrow.parquet as pq
 import pytest
 
@@ -242,3 +244,54 @@ def test_each_differing_printed_key_is_named_with_its_value_and_the_papers_in_sc
 def test_a_change_in_the_seventh_digit_shows():
     (line,) = printed_differs(SCHEMA, {"plate.spacing_mm": 45.0000001})
     assert line == "plate.spacing_mm = 45.0000001 (paper: 45)"
+
+
+def test_a_value_one_ulp_from_the_papers_is_the_papers():
+    # a swept 1.1 + 0.6 = 1.7000000000000002: 12 significant digits decide, not the float
+    assert printed_differs(SCHEMA, {"plate.spacing_mm": math.nextafter(45.0, 46.0)}) == []
+    assert printed_differs(SCHEMA, {"plate.xs": [1.0, 2.5 + 1e-15]}) == []
+
+
+def test_the_studys_spelling_of_the_papers_setup_is_the_papers():
+    # as_printed (brown's list of Table 1's points, spelled as its grid) is applied to a copy
+    def spelled(cfg):
+        cfg["plate.design"] = "grid" if cfg["plate.design"] == "list" else cfg["plate.design"]
+        return cfg
+
+    cfg = {"plate.design": "list"}
+    assert printed_differs(SCHEMA, cfg, spelled) == []
+    assert cfg == {"plate.design": "list"}
+    assert printed_differs(SCHEMA, cfg) == ["plate.design = 'list' (paper: 'grid')"]
+    assert printed_differs(SCHEMA, {"plate.design": "random"}, spelled) == [
+        "plate.design = 'random' (paper: 'grid')"
+    ]
+
+
+# ------------------------------------------------------------ predictions on the paper's design
+# docs/verdict-rules.md: a prediction the study decides on the paper's own setup whatever the
+# run's design (paper_design: Brown's region rows) keeps its verdict on a run off the setup,
+# its note saying so before its own; every other row is treated as without it.
+KEPT = (
+    "the paper's verdict: decided on the paper's own setup, independent of this run's design, "
+    "whose printed inputs differ (u.grid)"
+)
+
+
+def test_off_the_setup_a_paper_design_prediction_keeps_its_verdict():
+    b, rows = _setup_rows(4, 43, 1.0)  # the grid differs from the paper's
+    own = [{**r, "note": "over 300 points"} if r["claim"] == "u.pred" else r for r in rows]
+    for given, note in ((rows, KEPT), (own, KEPT + "; over 300 points")):
+        out = off_paper(given, b.paper_setup, (), ["u.pred", "u.dof"])
+        _same_columns(out, given)
+        pred = out[4]
+        assert (pred["verdict"], pred["outcome"], pred["holds"]) == ("holds", "holds", True)
+        assert pred["note"] == note
+        # a self-check among the ids is no prediction: still not applicable
+        assert out[1]["verdict"] == NOT_APPLICABLE
+    assert rows[4]["verdict"] == "holds" and rows[4]["note"] == ""  # the input is not modified
+    assert off_paper(rows, b.paper_setup)[4]["verdict"] == "finding"  # without the id
+
+
+def test_on_the_setup_a_paper_design_prediction_is_unchanged():
+    b, rows = _setup_rows(5, 43, 1.0)
+    assert off_paper(rows, b.paper_setup, (), ["u.pred"]) == rows

@@ -54,12 +54,19 @@ __all__ = [
     "require_finite",
     "require_chunks",
     "MIN_CHUNKS",
+    "PROBE_TRIALS",
+    "PROBE_SEED",
+    "PROBE_MAX_ITER",
 ]
 
 #: the fewest chunks a jackknife interval is computed from: with C chunks the interval's
 #: standard error has C - 1 degrees of freedom, and below about 20 it is itself too uncertain
 #: to decide a claim on (the issue-25 run of 2 chunks gave a proportion's interval [0.07, 0.07])
 MIN_CHUNKS = 20
+#: a study's solver probe at load time (brown's check_solver, the network's probe_solver):
+#: PROBE_TRIALS trials from a fixed stream of their own (PROBE_SEED, not the run's), run when
+#: ``solver.max_iter`` is at most PROBE_MAX_ITER (their adjustments converge in 1 to 4)
+PROBE_TRIALS, PROBE_SEED, PROBE_MAX_ITER = 16, 27, 8
 ROWS = "rows."
 _ARRAYS = b"sim.arrays"
 _IDENTITY = b"sim.chunk"  # a chunk file's identity, checked when it is read back

@@ -355,17 +355,21 @@ def _dirs(results: Path) -> dict[str, int]:
     return out
 
 
-def _settled(results: Path, build: Callable, tries: int = 3):
+#: how many times :func:`_settled` reads the results directories at most
+_READS = 3
+
+
+def _settled(results: Path, build: Callable):
     """``build()``, done again when a run published a study while it read the directories
     (``make reproduce`` in another terminal): the report took the tables of two runs as one
     (or named one of them as another run's table beside a run.json). A failure while the
-    directories moved is read again too; after ``tries``, the last outcome stands."""
-    for k in range(tries):
+    directories moved is read again too; after ``_READS`` reads, the last outcome stands."""
+    for k in range(_READS):
         before = _dirs(results)
         try:
             value = build()
         except (ConfigError, OSError):
-            if k + 1 < tries and _dirs(results) != before:
+            if k + 1 < _READS and _dirs(results) != before:
                 continue
             raise
         if _dirs(results) == before:

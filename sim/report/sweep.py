@@ -46,9 +46,9 @@ def _style(n: int) -> dict:
 
 
 def _value_texts(values) -> dict:
-    """Each value of a swept key (by its ``repr``) as a legend shows it: floats with the fewest significant
-    digits (at least 4) that keep every value apart (a range's 0.031111111111111112 was cut
-    to "0.0311111111111..."), anything else as ``str``."""
+    """Each value of a swept key (by its ``repr``) as a legend shows it: floats with the
+    fewest significant digits (at least 4) that keep every value apart (a range's
+    0.031111111111111112 was cut to "0.0311111111111..."), anything else as ``str``."""
     vals = {repr(v): v for v in values}  # by repr: a list-valued key's values are lists
     floats = {k: v for k, v in vals.items() if isinstance(v, float)}
     for digits in range(4, 18):

@@ -14,7 +14,8 @@ from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import StudyError
 from sim.mc.runner import jackknife, run_chunks
 from sim.studies import RunContext
-from sim.studies.brown.schema import MODEL_NAMES, start_theta
+from sim.studies.brown.schema import MODEL_NAMES
+from sim.studies.brown.values import start_theta
 
 
 def analytic_sigma(pts: np.ndarray, theta: np.ndarray, model: str, sigma_um: float = 1.0):

@@ -13,9 +13,16 @@ from sim.instruments.ranges import positions as po
 from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import when
-from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
+from sim.mc.runner import (
+    MIN_CHUNKS,
+    PROBE_MAX_ITER,
+    PROBE_SEED,
+    PROBE_TRIALS,
+    chunk_rng,
+    require_chunks,
+)
 from sim.mc.schema_helpers import count, counts, positive, printed, real
-from sim.studies.brown.values import thetas
+from sim.studies.brown.values import start_theta, thetas
 
 SEED = "004_f5bd9e86c308241f.txt"
 MODEL_NAMES = ("known", "stations", "pivot")
@@ -328,11 +335,6 @@ def check(cfg: dict) -> None:
     require_chunks(cfg)
 
 
-#: trials of the solver probe (:func:`check_solver`), drawn from a fixed stream of their own,
-#: run when ``solver.max_iter`` is at most PROBE_MAX_ITER (the models converge in 2 to 4)
-PROBE_TRIALS, PROBE_SEED, PROBE_MAX_ITER = 16, 27, 8
-
-
 def check_solver(cfg: dict, pts: np.ndarray) -> None:
     """The solver limits can be met: ``PROBE_TRIALS`` plates of the run's error model (a fixed
     stream, not the run's) adjusted with each model from the run's start values. When no
@@ -356,6 +358,7 @@ def check_solver(cfg: dict, pts: np.ndarray) -> None:
         bias_um=cfg["errors.bias_um"],
     )
     tol, limit = cfg["solver.tol_mm"], cfg["solver.max_iter"]
+    default = BASE["solver.max_iter"].default
 
     def status(m: str, max_iter: int) -> np.ndarray:
         t0 = start_theta(theta, m)
@@ -363,7 +366,6 @@ def check_solver(cfg: dict, pts: np.ndarray) -> None:
 
     for m in MODEL_NAMES:
         # the limit is the cause only when the same plates converge with the key's default
-        default = BASE["solver.max_iter"].default
         if np.all(status(m, limit) == 1) and np.any(status(m, default) == 0):
             raise ConfigError(
                 "solver.max_iter",
@@ -433,13 +435,6 @@ def check_pivot(cfg: dict, key: str, pts: np.ndarray) -> None:
                 f"matrix is singular (scaled reciprocal condition {rc:.2g}, the adjustment "
                 f"needs > {RCOND:g})",
             )
-
-
-def start_theta(theta: np.ndarray, model: str) -> np.ndarray:
-    """Initial globals: the design (true) stations; alpha and beta^2 start at 0 when free."""
-    t0 = theta.copy()
-    t0[5 + (model == "alpha") : ml.MODELS[model]] = 0.0
-    return t0
 
 
 def setup(cfg: dict):

@@ -36,6 +36,13 @@ def thetas(format_mm: float, offsets, alpha_mm: float, beta_mm: float) -> np.nda
     )
 
 
+def start_theta(theta: np.ndarray, model: str) -> np.ndarray:
+    """Initial globals: the design (true) stations; alpha and beta^2 start at 0 when free."""
+    t0 = theta.copy()
+    t0[5 + (model == "alpha") : ml.MODELS[model]] = 0.0
+    return t0
+
+
 def dilution_curve(
     format_mm: float, grids, half_extent, offsets, alpha_mm=0.0, beta_mm=0.0, pivot: bool = True
 ):

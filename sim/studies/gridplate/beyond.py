@@ -14,9 +14,9 @@ from sim.studies.gridplate.model import PARAM_LABEL, PARAMS
 
 
 def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
-    """The ids :func:`score` builds: bias and spread of S, S', eps with the grid fixed
-    (:func:`beyond_rows`: one ``grid fixed`` row of ``beyond.parquet`` each) and their coverages
-    (:func:`coverage_rows`)."""
+    """The ids :func:`sim.studies.gridplate.claims.score` builds from this module's rows: bias
+    and spread of S, S', eps with the grid fixed (:func:`beyond_rows`: one ``grid fixed`` row
+    of ``beyond.parquet`` each) and their coverages (:func:`coverage_rows`)."""
     return [
         *(f"twoplate.beyond.fixed.{w}_{k}" for k in PARAMS for w in ("bias", "sd")),
         *(

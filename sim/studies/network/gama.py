@@ -39,15 +39,13 @@ import numpy as np
 from sim.mc.config import ConfigError, given
 from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network
-from sim.studies.network.gama_read import CC, NS, consistent, read_bytes, read_gama
+from sim.studies.network.gama_read import CC, NE, NS, consistent, read_bytes, read_gama
 from sim.studies.network.model import computed
 from sim.studies.network.validate import hits, name_index
 
 __all__ = ["read_gama", "write_gama", "merge_gama", "export", "gama_digest", "import_note"]
 
 _GON = math.pi / 200
-#: gama-local's default frame, the suite's own: x north, y east, angles clockwise
-NE = ("ne", "left-handed")
 
 
 def gama_digest(path: str | Path, key: str = "network.gama_xml") -> str:

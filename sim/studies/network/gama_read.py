@@ -264,6 +264,8 @@ FRAMES = {
     "ws": "x west, y south: right-handed",
 }
 LEFT_HANDED = ("ne", "es", "sw", "wn")
+#: gama-local's default frame, the suite's own: (axes-xy, angles), x north, y east, clockwise
+NE = ("ne", "left-handed")
 
 
 def consistent(axes: str, angles: str) -> bool:
@@ -275,7 +277,7 @@ def consistent(axes: str, angles: str) -> bool:
 def frame_note(axes: str, angles: str) -> str:
     """What the report says of a file's frame (``""`` for gama-local's default, ne with
     left-handed angles)."""
-    if (axes, angles) == ("ne", "left-handed"):
+    if (axes, angles) == NE:
         return ""
     note = (
         f"; axes-xy = {axes!r} ({FRAMES[axes]}), {angles} angles: coordinates and covariances "
@@ -360,8 +362,8 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         )
     net = _network(f, data)
     note = _parameters(f, [e for e in net if _tag(e) == "parameters"])
-    axes = ws(net.get("axes-xy", "ne"))  # gama-local's vocabulary, checked in _network
-    angles = ws(net.get("angles", "left-handed"))
+    axes = ws(net.get("axes-xy", NE[0]))  # gama-local's vocabulary, checked in _network
+    angles = ws(net.get("angles", NE[1]))
     note += frame_note(axes, angles)
     pos = [e for e in net if _tag(e) == "points-observations"]
     if len(pos) != 1:

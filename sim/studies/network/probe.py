@@ -13,15 +13,12 @@ import numpy as np
 
 from sim.lsq import distributions as D
 from sim.mc.config import ConfigError
+from sim.mc.runner import PROBE_MAX_ITER, PROBE_SEED, PROBE_TRIALS
 from sim.studies.network.analysis import mc_chunk
 from sim.studies.network.definition import Network
 from sim.studies.network.keys import SCHEMA
 from sim.studies.network.sparse_analysis import SparseAnalytic, mc_chunk_sparse
 from sim.studies.network.tables import parameter_indices
-
-#: trials of the probe, their stream, and the largest limit it is run for (the adjustments
-#: converge in 1 to 4 iterations; a larger limit needs no probe)
-PROBE_TRIALS, PROBE_SEED, PROBE_MAX_ITER = 16, 27, 8
 
 
 def chunk_fn(net: Network, an, C, pts, cfg: dict):

@@ -118,7 +118,8 @@ def check(cfg: dict) -> None:
             raise
         raise ConfigError(_where(full)[0], unreached_message(net, lone, _where(full)[1])) from e
     _conditioned(net, an, "datum.kind")
-    if not estimated_points(net, an):
+    pts = estimated_points(net, an)
+    if not pts:
         raise ConfigError(
             "network.points", "no estimated point has a regular covariance: nothing to estimate"
         )
@@ -129,7 +130,6 @@ def check(cfg: dict) -> None:
             f"{len(an.free)} unknowns leave {an.dof} degrees of freedom: add "
             "observations",
         )
-    pts = estimated_points(net, an)
     probe_solver(net, an, dt.constraint_matrix(net.theta_true()[None]), pts, cfg)
     if cfg["compare.fix"]:
         _check_compare(net, full, cfg["compare.fix"], sparse)
@@ -326,8 +326,9 @@ def _pivot(net, factor, free: np.ndarray) -> str:
 def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
     """A network of full rank whose normals the engine still finds singular: the sigmas
     make it so (e.g. weighted coordinates a million times looser than the differences
-    between them). Name the weakest unknown and the range of the sigmas."""
-    _, sv, vt = np.linalg.svd(A, full_matrices=False)
+    between them). Name the weakest unknown and the reciprocal condition number of the
+    normals scaled to unit diagonal, under the engine's limit :data:`RCOND`."""
+    vt = np.linalg.svd(A, full_matrices=False)[2]
     what = _unknown(net, int(free[int(np.argmax(np.abs(vt[-1])))]))
     rc = float(scaled_rcond(A.T @ A))
     raise ConfigError(
