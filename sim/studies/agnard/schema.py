@@ -15,6 +15,7 @@ from sim.instruments.block.layout import CONTROL_PATTERNS, Block, control_target
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import unless
 from sim.mc.schema_helpers import count, counts, positive, printed, real, reals
+from sim.studies.agnard.datum import check_datum
 
 SEED = "003_5ce730a990a7ebc5.txt"
 NAME = "agnard_block"
@@ -253,6 +254,7 @@ def check(cfg: dict) -> None:
             "the block has no pass points (no point seen by two "
             "models): raise block.pass_rows or the overlaps",
         )
+    check_datum(cfg, block, {k: SCHEMA[k].default for k in SCHEMA if k.startswith("weights.")})
     pairs = int((np.bincount(block.obs_point).astype(np.int64) ** 2).sum())
     if cfg["chunk"] * pairs * 49 * 8 > 2e9:
         raise ConfigError(
