@@ -79,3 +79,24 @@ def test_the_check_refuses_exactly_what_the_engine_flags_singular(chunk):
     status, (ok, rc) = _status(chunk, "corners", 1e-4)
     assert ok and rc is None
     assert (status == 0).all(), status
+
+
+BROWN = "studies/brown_table1.toml"
+
+
+@pytest.mark.parametrize(
+    "setting, key",
+    [
+        ("plate.spacing_mm=60", "plate.spacing_mm"),
+        ("plate.format_mm=300", "plate.format_mm"),
+        ("comparator.station_offset_mm=45.0", "comparator.station_offset_mm"),
+        ("comparator.scale_length_mm=200", "comparator.scale_length_mm"),
+    ],
+)
+def test_the_brown_scale_refusal_names_the_key_the_user_changed(capsys, setting, key):
+    """The refusal "ranges run ... move the stations in, or use alpha" named
+    comparator.scale_length_mm whatever pushed a range off the scale."""
+    rc = main(["check", BROWN, "--set", setting])
+    line = one_line(capsys, rc, "ranges run from", "comparator.scale_length_mm", prefix=SIM_ERROR)
+    assert line.startswith(f"{SIM_ERROR}{key}: "), line
+    assert line.endswith(f"changed from their paper or nominal values: {key}"), line
