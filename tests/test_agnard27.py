@@ -34,7 +34,9 @@ STUDY = "studies/agnard_block.toml"
 )
 def test_a_control_weight_near_zero_is_refused_by_check(capsys, key, needle):
     rc = main(["check", STUDY, "--set", f"{key}=1e-12"])
-    line = one_line(capsys, rc, key, needle, f"engine's limit {RCOND:g}", prefix=SIM_ERROR)
+    line = one_line(
+        capsys, rc, key, needle, f"engine's singularity limit {RCOND:g}", prefix=SIM_ERROR
+    )
     limit = float(line.rsplit("keep the ratio above about ", 1)[1])
     # the limit named is the engine's: between the refused 1e-11 and the paper's ratios
     assert 1e-11 < limit < 1e-6, line
@@ -100,3 +102,10 @@ def test_the_brown_scale_refusal_names_the_key_the_user_changed(capsys, setting,
     line = one_line(capsys, rc, "ranges run from", "comparator.scale_length_mm", prefix=SIM_ERROR)
     assert line.startswith(f"{SIM_ERROR}{key}: "), line
     assert line.endswith(f"changed from their paper or nominal values: {key}"), line
+
+
+def test_the_regions_five_point_layouts_are_checked_too(capsys):
+    """At 3e-8 times the pass weight the configured layouts pass the rule but the region's
+    five-point layout with its outer points moved in (inset 0.45, region.toml) does not."""
+    rc = main(["check", STUDY, "--set", "weights.control_xy=3e-9"])
+    one_line(capsys, rc, "weights.control_xy", "five-point layout, inset 0.45", prefix=SIM_ERROR)
