@@ -11,10 +11,17 @@ from __future__ import annotations
 import numpy as np
 
 from sim.instruments.block import scanner as sc
-from sim.instruments.block.layout import CONTROL_PATTERNS, Block, control_targets, make_block
+from sim.instruments.block.layout import (
+    CONTROL_PATTERNS,
+    Block,
+    control_targets,
+    make_block,
+    select_control,
+)
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import unless
 from sim.mc.schema_helpers import count, counts, positive, printed, real, reals
+from sim.studies.agnard.datum import check_datum, region_insets
 
 SEED = "003_5ce730a990a7ebc5.txt"
 NAME = "agnard_block"
@@ -253,6 +260,12 @@ def check(cfg: dict) -> None:
             "the block has no pass points (no point seen by two "
             "models): raise block.pass_rows or the overlaps",
         )
+    names = [cfg["control.table1"], cfg["control.few"], cfg["control.many"]]
+    layouts = {n: select_control(block, n) for n in dict.fromkeys(names + cfg["tradeoff.layouts"])}
+    for u in region_insets():  # the region's five-point layouts (region.toml)
+        layouts[f"the region's five-point layout, inset {u:g}"] = five_control(block, u)
+    paper = {k: SCHEMA[k].default for k in SCHEMA if k.startswith("weights.")}
+    check_datum(cfg, block, paper, layouts)
     pairs = int((np.bincount(block.obs_point).astype(np.int64) ** 2).sum())
     if cfg["chunk"] * pairs * 49 * 8 > 2e9:
         raise ConfigError(

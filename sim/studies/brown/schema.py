@@ -22,6 +22,7 @@ from sim.mc.runner import (
     require_chunks,
 )
 from sim.mc.schema_helpers import count, counts, positive, printed, real
+from sim.studies.brown.range_keys import moved_from_paper
 from sim.studies.brown.values import start_theta, thetas
 
 SEED = "004_f5bd9e86c308241f.txt"
@@ -325,10 +326,17 @@ def check(cfg: dict) -> None:
             )
         reach = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
         if r.max() > reach or r.min() < 0:
+            moved = moved_from_paper(cfg, key, {k: f.default for k, f in BASE.items()})
             raise ConfigError(
-                "comparator.scale_length_mm",
+                moved[0] if moved else "comparator.scale_length_mm",
                 f"ranges run from {r.min():.1f} to {r.max():.1f} mm but the scale "
-                f"reads 0 to {reach:g} mm (move the stations in, or use alpha)",
+                f"(comparator.scale_length_mm + comparator.micrometer_mm) reads 0 to "
+                f"{reach:g} mm (move the stations in, or use alpha)"
+                + (
+                    f"; changed from their paper or nominal values: {', '.join(moved)}"
+                    if moved
+                    else ""
+                ),
             )
     check_pivot(cfg, key, pts)
     check_solver(cfg, pts)
