@@ -199,6 +199,77 @@ NOTES = {
 }
 
 
+#: the mutated line (the `+` line of `mutmut show`, stripped) each note of :data:`NOTES` was
+#: checked against: a note goes to a survivor of the same function with the same mutated line,
+#: whatever its number (numbers shift when the module changes: a note keyed by number alone
+#: came to stand under another mutant's diff), and to no other
+CHECKED = {
+    "sim.claims.intervals.x_bootstrap_ci__mutmut_1": "n_boot: int = 401,",
+    "sim.claims.book.xǁClaimBookǁ__init____mutmut_159": 'd = s.get("decimals", 1)',
+    "sim.claims.intervals.x_binomial_ci__mutmut_50": "lo = np.where(None, 0.0, np.maximum(centre - half, 0.0))[()]  # [()]: a scalar stays one",
+    "sim.claims.intervals.x_binomial_ci__mutmut_78": "return p, lo, np.where(k == n, 1.0, np.minimum(centre + half, 2.0))[()]",
+    "sim.claims.intervals.x_spread_rows__mutmut_13": "lo, med, hi = np.nanpercentile(np.asarray(x, None), [a, 50, 100 - a], axis=1)",
+    "sim.claims.intervals.x_spread_rows__mutmut_15": "lo, med, hi = np.nanpercentile(np.asarray(x, ), [a, 50, 100 - a], axis=1)",
+    "sim.claims.family.x_mc_p__mutmut_14": "return np.minimum(1.0, (np.asarray(p, None) * n + 2.0) / (n + 1.0))",
+    "sim.claims.family.x_mc_p__mutmut_16": "return np.minimum(1.0, (np.asarray(p, ) * n + 2.0) / (n + 1.0))",
+    "sim.claims.family.x_holm__mutmut_3": "p = np.asarray(p, None)",
+    "sim.claims.family.x_holm__mutmut_5": "p = np.asarray(p, )",
+    "sim.claims.family.x_family_status__mutmut_4": "p, member = np.atleast_2d(np.asarray(p, None)), np.atleast_2d(member)",
+    "sim.claims.family.x_family_status__mutmut_6": "p, member = np.atleast_2d(np.asarray(p, )), np.atleast_2d(member)",
+    "sim.claims.family.x_family_status__mutmut_19": "hp = np.array([holm(row).min() if (np.isfinite(row).all()) or True else np.nan for row in p])",
+    "sim.claims.family.x_family_row__mutmut_1": 'book, cid: str, members: Sequence[Mapping[str, Any]], note: str = "XXXX", *, n: int',
+    "sim.claims.family.x_family_row__mutmut_4": 'p = np.array([r["p_plate"] for r in members], None)',
+    "sim.claims.family.x_family_row__mutmut_6": 'p = np.array([r["p_plate"] for r in members], )',
+    "sim.claims.family.x_family_outcomes__mutmut_7": 'p = np.stack([np.asarray(region.outputs[m]["p"], None) for m in members], axis=1)',
+    "sim.claims.family.x_family_outcomes__mutmut_9": 'p = np.stack([np.asarray(region.outputs[m]["p"], ) for m in members], axis=1)',
+    "sim.claims.family.x_family_over__mutmut_1": 'book, region: Region, cid: str, members: Sequence[str], note: str = "XXXX", *, n: int',
+    "sim.claims.family.x_family_over__mutmut_12": "why = None",
+    "sim.claims.family.x_family_over__mutmut_13": 'why = "XXXX"',
+    "sim.claims.inference.x__evidence__mutmut_5": 'v = np.asarray(ev["value"], None) if "value" in ev else None',
+    "sim.claims.inference.x__evidence__mutmut_7": 'v = np.asarray(ev["value"], ) if "value" in ev else None',
+    "sim.claims.inference.x_status__mutmut_16": "lo2, hi2 = lo.reshape(n, -2), hi.reshape(n, -1)",
+    "sim.claims.inference.x_status__mutmut_22": "lo2, hi2 = lo.reshape(n, -1), hi.reshape(n, -2)",
+    "sim.claims.inference.x_status__mutmut_52": "miss = p < round(1 - level, 13)",
+    "sim.claims.inference.x__boundary__mutmut_1": "if (label != label[0]).all():",
+    "sim.claims.inference.x__boundary__mutmut_2": "if (label == label[1]).all():",
+    "sim.claims.inference.x__boundary__mutmut_4": "return np.zeros(len(u), None)",
+    "sim.claims.inference.x__boundary__mutmut_6": "return np.zeros(len(u), )",
+    "sim.claims.inference.x_explore__mutmut_4": "max_new: int = 4097,",
+    "sim.claims.inference.x_explore__mutmut_45": "u = np.full((2**m, len(inputs)), 1.5)",
+    "sim.claims.inference.x_explore__mutmut_87": "label = acc.astype(None)",
+    "sim.claims.inference.x_explore__mutmut_90": "label -= (2 << k) * (acc & (status(p, out[p.id], len(u), level) == HOLDS))",
+    "sim.claims.inference.x_explore__mutmut_93": "label += (3 << k) * (acc & (status(p, out[p.id], len(u), level) == HOLDS))",
+    "sim.claims.inference.x_explore__mutmut_103": "label += (2 << k) * (acc & (status(p, out[p.id], len(u), level) != HOLDS))",
+    "sim.claims.inference.x_explore__mutmut_124": "edge = rng.choice(edge, max_new // per_point, replace=None)",
+    "sim.claims.inference.x_explore__mutmut_142": "new[:, free] -= rng.uniform(-h, h, size=(len(new), len(free)))",
+    "sim.claims.region.x_region_verdict__mutmut_2": "if n_points < 0 or n_holds + n_fails == 0:",
+    "sim.claims.region.x_decide_over__mutmut_55": 'hw = region.describe(h) if (nh) or True else "nowhere"',
+    "sim.claims.region.x_decide_over__mutmut_61": 'fw = region.describe(f) if (nf) or True else "nowhere"',
+    "sim.claims.region.x_region_row__mutmut_17": 'row = book.score(cid, lo, None, "exact", value_high=hi)',
+    "sim.claims.region.x_region_row__mutmut_23": "row = book.score(cid, lo, (lo, lo), value_high=hi)",
+    "sim.claims.region.x_region_row__mutmut_30": 'row = book.score(cid, 0.0, None, "exact")',
+    "sim.claims.region.x_region_row__mutmut_35": "row = book.score(cid, 0.0, (0.0, 0.0), )",
+    "sim.claims.region.x_region_row__mutmut_36": 'row = book.score(cid, 1.0, (0.0, 0.0), "exact")',
+    "sim.claims.region.x_region_row__mutmut_37": 'row = book.score(cid, 0.0, (1.0, 0.0), "exact")',
+    "sim.claims.region.x_region_row__mutmut_38": 'row = book.score(cid, 0.0, (0.0, 1.0), "exact")',
+    "sim.claims.rules.x__shown__mutmut_9": "return repr(v) if (isinstance(v, str)) or True else str(v)",
+    "sim.claims.rules.x_printed_differs__mutmut_5": 'if getattr(f, "printed", None) and cfg.get(k, f.default) != f.default:',
+    "sim.claims.rules.x_printed_differs__mutmut_8": 'if getattr(f, "printed", ) and cfg.get(k, f.default) != f.default:',
+    "sim.claims.rules.x_printed_differs__mutmut_11": 'if getattr(f, "printed", True) and cfg.get(k, f.default) != f.default:',
+}
+
+
+def note_for(name: str, mutated: list[str]) -> tuple[str | None, bool]:
+    """The hand-checked note for the survivor ``name`` whose diff's ``+`` lines (stripped) are
+    ``mutated``: that of a mutant of the same function checked against one of those lines;
+    and whether a note keyed by ``name`` itself was written for another diff (to re-check)."""
+    fn = name.rsplit("__mutmut_", 1)[0]
+    for k, text in NOTES.items():
+        if k.rsplit("__mutmut_", 1)[0] == fn and CHECKED.get(k) in mutated:
+            return text, False
+    return None, name in NOTES
+
+
 def _mutmut(*args: str) -> str:
     return subprocess.run(
         [*MUTMUT, *args], cwd=ROOT, capture_output=True, text=True, check=True
@@ -253,9 +324,11 @@ def main(out: Path = ROOT / "docs" / "mutation.md") -> int:
             for ln in _mutmut("show", n).splitlines()
             if ln[:1] in "+-" and not ln.startswith(("+++", "---"))
         ]
-        lines += [f"- `{n}` ({status[n]})", "", "  ```diff", *("  " + d for d in diff), "  ```"]
-        if n in NOTES:
-            lines += ["", f"  {NOTES[n]}"]
+        note, stale = note_for(n, [d[1:].strip() for d in diff if d.startswith("+")])
+        st = status[n] + ("; its note was written for another diff: re-check" if stale else "")
+        lines += [f"- `{n}` ({st})", "", "  ```diff", *("  " + d for d in diff), "  ```"]
+        if note:
+            lines += ["", f"  {note}"]
     lines += ["", "## Lines not mutated, with the reason (equivalent mutants)", ""]
     marked = []
     for mod in modules["only_mutate"]:
