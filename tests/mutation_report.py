@@ -253,9 +253,15 @@ CHECKED = {
     "sim.claims.region.x_region_row__mutmut_37": 'row = book.score(cid, 0.0, (1.0, 0.0), "exact")',
     "sim.claims.region.x_region_row__mutmut_38": 'row = book.score(cid, 0.0, (0.0, 1.0), "exact")',
     "sim.claims.rules.x__shown__mutmut_9": "return repr(v) if (isinstance(v, str)) or True else str(v)",
-    "sim.claims.rules.x_printed_differs__mutmut_5": 'if getattr(f, "printed", None) and cfg.get(k, f.default) != f.default:',
-    "sim.claims.rules.x_printed_differs__mutmut_8": 'if getattr(f, "printed", ) and cfg.get(k, f.default) != f.default:',
-    "sim.claims.rules.x_printed_differs__mutmut_11": 'if getattr(f, "printed", True) and cfg.get(k, f.default) != f.default:',
+    "sim.claims.rules.x_printed_differs__mutmut_5": (
+        'if getattr(f, "printed", None) and _shown(cfg.get(k, f.default)) != _shown(f.default):'
+    ),
+    "sim.claims.rules.x_printed_differs__mutmut_8": (
+        'if getattr(f, "printed", ) and _shown(cfg.get(k, f.default)) != _shown(f.default):'
+    ),
+    "sim.claims.rules.x_printed_differs__mutmut_11": (
+        'if getattr(f, "printed", True) and _shown(cfg.get(k, f.default)) != _shown(f.default):'
+    ),
 }
 
 

@@ -292,6 +292,14 @@ def test_off_the_setup_a_paper_design_prediction_keeps_its_verdict():
     assert off_paper(rows, b.paper_setup)[4]["verdict"] == "finding"  # without the id
 
 
+def test_a_paper_design_note_names_every_differing_input():
+    """Two differing inputs (a failed exact input row and a printed key): the note lists both,
+    comma-separated, as the findings' notes do."""
+    b, rows = _setup_rows(4, 43, 1.0)
+    out = off_paper(rows, b.paper_setup, ["plate.spacing_mm = 30 (paper: 45)"], ["u.pred"])
+    assert out[4]["note"] == KEPT.replace("(u.grid)", "(u.grid, plate.spacing_mm = 30 (paper: 45))")
+
+
 def test_on_the_setup_a_paper_design_prediction_is_unchanged():
     b, rows = _setup_rows(5, 43, 1.0)
     assert off_paper(rows, b.paper_setup, (), ["u.pred"]) == rows
