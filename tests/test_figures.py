@@ -273,7 +273,7 @@ def test_bench_figures_read_cleanly(tmp_path):
 
 
 def test_checking_a_figure_leaves_its_png_unchanged(tiny_run, tmp_path):
-    """The layout check draws a figure once more (at the screen's resolution); it runs after
+    """The layout check draws a figure once more (at the PNG's resolution); it runs after
     the PNG is written, so a checked run writes the same bytes as a plain one (wolf's vectors
     and Table 1 figures, whose constrained layouts settled elsewhere when drawn twice)."""
     shared = tiny_run("wolf_polynomial")

@@ -299,8 +299,10 @@ def save(fig, path: str | Path) -> Path:
     """Save ``fig`` as PNG without a timestamp or version stamp, then close it. Inside
     :func:`checking_figures` (or with ``SIM_FIGURE_CHECK`` set) the saved figure is then
     checked by :func:`layout_problems`: after the file is written, since the check draws the
-    figure at the screen's resolution and a layout drawn twice can settle elsewhere (the PNG
-    is the same with the check on or off)."""
+    figure once more and a layout drawn twice can settle elsewhere (the PNG is the same with
+    the check on or off). The check, :func:`place_legend` and the PNG share one resolution
+    (the style's ``figure.dpi`` is its ``savefig.dpi``), so the boxes the check measures are
+    the PNG's."""
     path = Path(path)
     if _SKIP.is_set():  # a run without figures (:func:`without_figures`)
         plt.close(fig)
