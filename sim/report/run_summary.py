@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import shlex
+import unicodedata
 from collections import Counter
 from pathlib import Path
 from typing import Callable
@@ -174,19 +175,46 @@ def terminal_table(out: Path, width: int = 100) -> str:
 
 
 def _text_table(header: list[str], rows: list[list], width: int) -> str:
+    """Columns aligned by the width a terminal gives each character (:func:`_cols`): a
+    network's or a swept value's CJK name takes two columns, an accent none."""
     cols = list(zip(header, *rows)) if rows else [(h,) for h in header]
-    w = [max(len(str(c)) for c in col) for col in cols]
+    w = [max(_cols(str(c)) for c in col) for col in cols]
     if sum(w) + 2 * (len(w) - 1) > width and len(w) > 1:  # shorten the first column
         w[0] = max(12, width - sum(w[1:]) - 2 * (len(w) - 1))
 
     def line(cells):
-        return "  ".join(_cut(str(c), w[i]).ljust(w[i]) for i, c in enumerate(cells)).rstrip()
+        return "  ".join(_pad(_cut(str(c), w[i]), w[i]) for i, c in enumerate(cells)).rstrip()
 
     return "\n".join([line(header), line(["-" * x for x in w])] + [line(r) for r in rows])
 
 
+def _cols(s: str) -> int:
+    """Terminal columns of ``s``: East Asian wide and full-width characters two, combining
+    marks and zero-width characters none, every other character one."""
+    return sum(
+        0
+        if unicodedata.combining(ch) or unicodedata.category(ch) in ("Mn", "Me", "Cf")
+        else 2
+        if unicodedata.east_asian_width(ch) in ("W", "F")
+        else 1
+        for ch in s
+    )
+
+
+def _pad(s: str, n: int) -> str:
+    return s + " " * max(n - _cols(s), 0)
+
+
 def _cut(s: str, n: int) -> str:
-    return s if len(s) <= n else s[: max(n - 3, 0)] + "..."
+    """``s`` in at most ``n`` terminal columns, ``...`` ending a shortened one."""
+    if _cols(s) <= n:
+        return s
+    out, room = "", max(n - 3, 0)
+    for ch in s:
+        if _cols(out + ch) > room:
+            break
+        out += ch
+    return out + "..."
 
 
 def run_markdown(out: Path, get_study: Callable) -> str:
