@@ -5,15 +5,23 @@
    25 points, which the run (and the check's own last line) treats as the paper's plate
    (:func:`sim.studies.brown.schema.as_printed`). The note now says the value spells the
    paper's setup another way; a list that is not Table 1's keeps the old note.
+2. brown's ``check_solver`` and the network's ``probe_solver`` refused a solver limit no trial
+   meets by one rule in two wordings ("probe plates of the pivot model ... (or tol_mm)",
+   "probe trials ... (the first correction ...), or tol_mm", without the network). One
+   helper below both, :func:`sim.mc.runner.probe_limit`, words it once, naming the key and
+   the model the trials adjust with.
 """
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from sim.cli import main
+from tests.oneline import SIM_ERROR, one_line
 
 ROOT = Path(__file__).resolve().parents[1]
 OFF = "printed by the paper: another value is off its setup"
@@ -44,3 +52,48 @@ def test_the_check_note_on_the_papers_points_as_a_list_agrees_with_the_run(capsy
     lines, out = _listing(capsys, moved)
     assert OFF in lines["plate.pattern"], lines["plate.pattern"]
     assert out[-2].startswith("# off the paper's setup (plate.pattern = 'list' (paper: 'grid'))")
+
+
+# ------------------------------------------------------------- 2. one wording of the probe
+#: the one wording, with the limit, the tolerance and the model as groups
+PROBE = re.compile(
+    re.escape(SIM_ERROR)
+    + r"solver\.max_iter: (\d+) iterations? to solver\.tol_mm = (\S+): none of 16 probe trials "
+    r"of the (.+) converged, so no trial would \(the run would compute every chunk, then "
+    r"refuse\): raise solver\.max_iter \(or solver\.tol_mm\)"
+)
+
+
+@pytest.mark.parametrize(
+    "study, limit, model",
+    [
+        ("brown_table1", 1, "known model"),
+        ("brown_dilution", 2, "pivot model"),
+        ("network_plate", 1, "'grid plate' network"),
+        ("network_brown", 1, "network"),
+    ],
+)
+def test_the_solver_probes_refuse_in_one_wording_naming_the_key_and_the_model(
+    capsys, study, limit, model
+):
+    argv = ["check", str(ROOT / "studies" / f"{study}.toml"), "--set", f"solver.max_iter={limit}"]
+    line = one_line(capsys, main(argv), "solver.max_iter", prefix=SIM_ERROR)
+    m = PROBE.fullmatch(line)
+    assert m, line
+    assert m[1] == str(limit) and m[3].endswith(model), line
+
+
+def test_the_probe_helper_refuses_only_when_the_limit_is_the_cause():
+    from sim.mc.config import ConfigError
+    from sim.mc.runner import PROBE_MAX_ITER, probe_limit
+
+    def statuses(at_limit, at_default):
+        return lambda n: np.array(at_limit if n < 50 else at_default)
+
+    cfg = {"solver.max_iter": 2, "solver.tol_mm": 1e-9}
+    with pytest.raises(ConfigError, match="of the pivot model converged"):
+        probe_limit(cfg, statuses([1, 1], [0, 1]), 50, "pivot model")
+    probe_limit(cfg, statuses([1, 0], [0, 0]), 50, "pivot model")  # one converges: accepted
+    probe_limit(cfg, statuses([1, 1], [1, 2]), 50, "pivot model")  # not the limit's fault
+    high = {**cfg, "solver.max_iter": PROBE_MAX_ITER + 1}  # not probed at all
+    probe_limit(high, lambda n: pytest.fail("probed"), 50, "pivot model")
