@@ -10,6 +10,9 @@
    "probe trials ... (the first correction ...), or tol_mm", without the network). One
    helper below both, :func:`sim.mc.runner.probe_limit`, words it once, naming the key and
    the model the trials adjust with.
+3. The Makefile's comment on its ``pip`` macro said ``$(call pip,ARGS)``: the macro takes
+   ``ARGS[,SKIP,THEN]`` (the lock's skip and a command after the install). Every comment that
+   spells a call of it now names the arguments its definition reads.
 """
 
 from __future__ import annotations
@@ -97,3 +100,19 @@ def test_the_probe_helper_refuses_only_when_the_limit_is_the_cause():
     probe_limit(cfg, statuses([1, 1], [1, 2]), 50, "pivot model")  # not the limit's fault
     high = {**cfg, "solver.max_iter": PROBE_MAX_ITER + 1}  # not probed at all
     probe_limit(high, lambda n: pytest.fail("probed"), 50, "pivot model")
+
+
+# ------------------------------------------------------------- 3. the pip macro's comment
+def test_the_makefiles_comments_on_pip_name_the_arguments_it_reads():
+    text = (ROOT / "Makefile").read_text(encoding="utf-8")
+    body = re.search(r"^pip = (.*(?:\\\n.*)*)", text, re.M)[1]
+    reads = max(int(n) for n in re.findall(r"\$\((\d)\)", body))
+    said = [
+        ln
+        for ln in text.splitlines()
+        if ln.startswith("#") and re.search(r"\$\(call pip,[A-Z]", ln)
+    ]
+    assert said and reads == 3, (said, reads)
+    for ln in said:
+        args = re.search(r"\$\(call pip,([^)]*)\)", ln)[1]
+        assert len(re.findall(r"[A-Z]+", args)) == reads, ln
