@@ -13,6 +13,13 @@
 3. The Makefile's comment on its ``pip`` macro said ``$(call pip,ARGS)``: the macro takes
    ``ARGS[,SKIP,THEN]`` (the lock's skip and a command after the install). Every comment that
    spells a call of it now names the arguments its definition reads.
+4. agnard_block with a control weight between the engine's singular limit (refused by
+   ``sim check``, agnard27) and about 1e-5 of the pass weight: some trials stop at the
+   iteration limit, and only the README's "every adjustment converged: no" said so. The
+   closing summary of ``sim run`` and ``sim show`` now say, under the verdict counts, how
+   many trials had an adjustment that did not converge, of each adjustment
+   (:func:`sim.report.run_summary.converged_line`, from ``trials.parquet``); nothing is said
+   when every one converged (the shipped runs), and no table changes.
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pyarrow.parquet as pq
 import pytest
 
 from sim.cli import main
@@ -116,3 +124,52 @@ def test_the_makefiles_comments_on_pip_name_the_arguments_it_reads():
     for ln in said:
         args = re.search(r"\$\(call pip,([^)]*)\)", ln)[1]
         assert len(re.findall(r"[A-Z]+", args)) == reads, ln
+
+
+# ------------------------------------------------------------- 4. trials stopped at the limit
+def _summary_of(capsys, d: Path) -> tuple[str, str]:
+    from sim.report.run_summary import terminal_summary
+
+    assert main(["show", str(d)]) == 0
+    return terminal_summary(d), capsys.readouterr().out
+
+
+def test_the_summary_says_how_many_trials_did_not_converge(tmp_path, capsys):
+    """A copy of the shipped agnard_block results with two trials' adjustments marked not
+    converged: both summaries count them; the shipped results (every one converged) say
+    nothing."""
+    import shutil
+
+    shipped = ROOT / "results" / "agnard_block"
+    for text in _summary_of(capsys, shipped):
+        assert "not converged" not in text
+    d = tmp_path / "agnard_block"
+    shutil.copytree(shipped, d)
+    t = pq.read_table(d / "trials.parquet")
+    n = t.num_rows
+    for col, bad in (("layout_five.converged", [3, 7]), ("layout_corners.converged", [7])):
+        v = np.ones(n, bool)
+        v[bad] = False
+        t = t.set_column(t.schema.get_field_index(col), col, [v])
+    pq.write_table(t, d / "trials.parquet")
+    said = f"not converged: 2 of {n:,} trials in some adjustment (layout_five 2, layout_corners 1)"
+    summary, shown = _summary_of(capsys, d)
+    assert summary.splitlines()[1].startswith(said), summary
+    assert shown.splitlines()[-1].startswith(said), shown
+
+
+def test_a_run_whose_trials_stop_at_the_limit_says_so(tmp_path, capsys):
+    """At a control weight of 3e-6 times the pass weight (the datum check passes it) one of
+    the four tiny trials stops at the iteration limit in the 5-control and corner layouts."""
+    lines = (ROOT / "tests" / "data" / "tiny" / "agnard_block.txt").read_text().split()
+    sets = [x for kv in lines for x in ("--set", kv)]
+    sets += ["--set", "weights.control_xy=3e-7", "--set", "weights.control_z=2e-7"]
+    out = tmp_path / "ag"
+    assert main(["run", str(ROOT / "studies" / "agnard_block.toml"), "--out", str(out), *sets]) == 0
+    said = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("not converged")]
+    conv = pq.read_table(out / "trials.parquet").to_pydict()
+    bad = {k: v.count(False) for k, v in conv.items() if k.endswith(".converged")}
+    some = sum(not all(v) for v in zip(*(conv[k] for k in bad)))
+    assert some >= 1 and len(said) == 1, (bad, said)
+    assert said[0].startswith(f"not converged: {some} of 4 trials in some adjustment ("), said
+    assert "every adjustment converged: no" in (out / "README.md").read_text()
