@@ -20,6 +20,14 @@
    many trials had an adjustment that did not converge, of each adjustment
    (:func:`sim.report.run_summary.converged_line`, from ``trials.parquet``); nothing is said
    when every one converged (the shipped runs), and no table changes.
+5. gridplate_two_plates on one plate (``--set plate.count=1``): its consistent region is
+   inferred from the paper's comparator sigma 1.2 um and 1:3 weighting's 0.7 um, which the
+   paper measured on two plates, read as one plate's statistics; the region rows (already
+   findings there, ``plate.count`` being printed) did not say so. docs/verdict-rules.md gives
+   "not applicable" to a self-check of the paper's setup only, so a prediction off the
+   paper's setup stays a finding: each region row's note now says its region is inferred
+   from two-plate statements applied to the run's one plate, naming them. The shipped
+   (two-plate) rows are unchanged.
 """
 
 from __future__ import annotations
@@ -173,3 +181,41 @@ def test_a_run_whose_trials_stop_at_the_limit_says_so(tmp_path, capsys):
     assert some >= 1 and len(said) == 1, (bad, said)
     assert said[0].startswith(f"not converged: {some} of 4 trials in some adjustment ("), said
     assert "every adjustment converged: no" in (out / "README.md").read_text()
+
+
+# ------------------------------------------------------------- 5. gridplate's region on one plate
+TWO_PLATE = (
+    "region inferred from statements the paper measured on two plates "
+    "(twoplate.comparator_sigma.sigma_um = 1.2, twoplate.weight_ratio.grid_sigma_1to3_um = 0.7) "
+    "applied to one plate"
+)
+
+
+def test_gridplate_region_rows_on_one_plate_say_the_region_is_from_two_plate_statements(
+    tmp_path,
+):
+    out = tmp_path / "gp1"
+    lines = (ROOT / "tests" / "data" / "tiny" / "gridplate_two_plates.txt").read_text().split()
+    lines = [kv for kv in lines if kv.split("=")[0] not in ("trials", "chunk")]
+    lines += ["trials=200", "chunk=10", "plate.count=1"]
+    sets = [x for kv in lines for x in ("--set", kv)]
+    study = str(ROOT / "studies" / "gridplate_two_plates.toml")
+    assert main(["run", study, "--out", str(out), *sets]) == 0
+    rows = pq.read_table(out / "claims.parquet").to_pylist()
+    region = [r for r in rows if r["interval"] == "region"]
+    assert len(region) == 7, [r["claim"] for r in region]
+    for r in region:
+        assert TWO_PLATE in r["note"], (r["claim"], r["note"])
+        assert r["verdict"] != "holds" and r["verdict"] != "fails", r  # findings, or undecidable
+    assert not any(TWO_PLATE in r["note"] for r in rows if r["interval"] != "region")
+
+
+def test_gridplate_region_rows_on_two_plates_are_as_shipped():
+    from sim.studies.gridplate.region import plates_basis
+
+    shipped = ROOT / "results" / "gridplate_two_plates" / "claims.parquet"
+    rows = pq.read_table(shipped).to_pylist()
+    assert not any("measured on two plates" in r["note"] for r in rows)
+    assert plates_basis({"plate.count": 2}) == ""
+    three = plates_basis({"plate.count": 3})
+    assert three == TWO_PLATE.replace("one plate", "3 plates") + "; ", three
