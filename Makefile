@@ -53,10 +53,9 @@ VENV_USABLE := $(shell $(PY) -S -c 'import sys; sys.exit(sys.version_info < (3, 
 MADE_IN := $(shell cat $(STAMP) 2>/dev/null)
 VENV_USABLE := $(and $(VENV_USABLE),$(if $(MADE_IN),$(if $(subst $(CURDIR),,$(MADE_IN)),,yes),yes))
 VENV_USABLE := $(and $(VENV_USABLE),$(if $(wildcard $(INSTALLING)),,yes))
-# $(call pip,ARGS): pip install ARGS, its output kept in PIP_LOG; a failure (no network, no index,
-# a Python the project does not support) is one line with pip's first error (else its last
-# line: a pip that does not start), exit 2 (it was pip's dozen lines, the cause in the
-# middle); the next `make venv` tries again
+# pip (its arguments: at its definition below): its output kept in PIP_LOG; a failure (no network,
+# no index, a Python the project does not support) is one line with pip's first error (else its
+# last line: a pip that does not start), exit 2 (not pip's dozen lines); `make venv` tries again
 PIP_LOG := $(VENV)/pip.log
 # a comma inside a $(call pip,...) argument ($(call) splits its arguments at commas)
 comma := ,
@@ -77,7 +76,8 @@ INSTALLED_AT_START := $(and $(VENV_USABLE),$(MADE_IN),$(shell test $(STAMP) -nt 
 # $(call locked,SCRIPT,SKIP): a prefix that runs the command after it as "$$@" in the shell
 # SCRIPT under the lock; SKIP (the stamp's steps): nothing when another make installed meanwhile
 locked = $(VENV_LOCK) sh -c $(call q,$(if $(and $(2),$(if $(INSTALLED_AT_START),,yes)),$(INSTALLED_NOW) && exit 0;) $(1)) sh
-# $(call pip,ARGS[,SKIP,THEN]): pip install ARGS under the lock, then the shell command THEN
+# $(call pip,ARGS[,SKIP,THEN]): pip install ARGS under the lock; SKIP non-empty (the stamp's steps):
+# nothing when another make installed meanwhile; THEN: a shell command run, still locked, on success
 pip = @$(call locked,"$$@" >> $(PIP_LOG) 2>&1 || exit; $(3),$(2)) $(PY) -m pip install --quiet $(1) || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
 	"$$({ grep -m1 -E '^ *ERROR' $(PIP_LOG) || grep -v '^ *$$' $(PIP_LOG) | tail -1; } | sed -E 's/^ *(ERROR: *)?//')" >&2; exit 2; }
 

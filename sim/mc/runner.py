@@ -57,6 +57,7 @@ __all__ = [
     "PROBE_TRIALS",
     "PROBE_SEED",
     "PROBE_MAX_ITER",
+    "probe_limit",
 ]
 
 #: the fewest chunks a jackknife interval is computed from: with C chunks the interval's
@@ -110,6 +111,28 @@ def require_chunks(cfg: Mapping, need: int = MIN_CHUNKS, use: str = "jackknife i
         f"{trials:,} trials in chunks of {chunk:,} give {have} chunk{'s' * (have != 1)}; "
         f"this study's {use} are taken over chunks and need at least {need}: {fix}",
     )
+
+
+def probe_limit(cfg: Mapping, statuses: Callable[[int], np.ndarray], default: int, model: str):
+    """Refuse, at load time, a ``solver.max_iter`` no trial of the run can meet (the run
+    computed every chunk, then refused): ``statuses(max_iter)`` gives the solver statuses of
+    the study's :data:`PROBE_TRIALS` probe trials (a stream of :data:`PROBE_SEED`, not the
+    run's) adjusted within ``max_iter`` iterations (1: the iteration limit, 0: converged).
+    The limit is the cause only when none converges within it and the same trials converge
+    at the key's ``default`` (a gross bias no limit helps is named elsewhere); probed only at
+    a limit of at most :data:`PROBE_MAX_ITER`. One wording for every study (brown's
+    ``check_solver``, the network's ``probe_solver``), naming the key and ``model`` (what
+    the trials adjust with: "pivot model", "'grid plate' network")."""
+    limit, tol = cfg["solver.max_iter"], cfg["solver.tol_mm"]
+    if limit > PROBE_MAX_ITER or not np.all(statuses(limit) == 1):
+        return
+    if np.any(statuses(default) == 0):
+        raise ConfigError(
+            "solver.max_iter",
+            f"{limit} iteration{'s' * (limit > 1)} to solver.tol_mm = {tol:g}: none of "
+            f"{PROBE_TRIALS} probe trials of the {model} converged, so no trial would (the run "
+            "would compute every chunk, then refuse): raise solver.max_iter (or solver.tol_mm)",
+        )
 
 
 @dataclass(frozen=True)

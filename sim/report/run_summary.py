@@ -14,6 +14,9 @@ from collections import Counter
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
+import pyarrow.parquet as pq
+
 from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
@@ -29,6 +32,7 @@ __all__ = [
     "headline_rows",
     "region_line",
     "terminal_summary",
+    "converged_line",
     "terminal_table",
     "run_markdown",
     "write_run_readme",
@@ -115,6 +119,33 @@ def region_line(out: Path) -> str | None:
     return f"consistent region: {t.num_rows} accepted input vectors{where}"
 
 
+def converged_line(out: Path) -> str | None:
+    """One line when some Monte-Carlo trial of the directory (``trials.parquet``'s
+    ``<adjustment>.converged`` columns: agnard_block's) has an adjustment that did not
+    converge: how many of the trials, and of each adjustment, left as the solver stopped
+    (the iteration limit, or flagged singular). Said only in the README's "every adjustment
+    converged: no" before (a control weight between the engine's singular limit and about
+    1e-5 of the pass weight: some trials stop at the limit); None when every one converged."""
+    p = Path(out) / "trials.parquet"
+    if not p.is_file():
+        return None
+    names = [c for c in pq.read_schema(p).names if c.endswith(".converged")]
+    if not names:
+        return None
+    t = pq.read_table(p, columns=names)
+    bad = {c: ~np.asarray(t.column(c).to_numpy(zero_copy_only=False), bool) for c in names}
+    some = np.any(list(bad.values()), axis=0)
+    if not some.any():
+        return None
+    each = ", ".join(
+        f"{c.removesuffix('.converged')} {int(b.sum())}" for c, b in bad.items() if b.any()
+    )
+    return (
+        f"not converged: {int(some.sum()):,} of {t.num_rows:,} trials in some adjustment "
+        f"({each}), their values as the solver left them (at its iteration limit, or singular)"
+    )
+
+
 def _value_text(r: dict) -> str:
     return "" if r["verdict"] == "not comparable" else sim_text(r)
 
@@ -135,6 +166,8 @@ def terminal_summary(out: Path, n: int = 5, shown: str | None = None) -> str:
     else:
         claims = records(out / "claims.parquet")
         lines = [verdict_line(claims)]
+        if (conv := converged_line(out)) is not None:
+            lines.append(conv)
         for r in headline_rows(claims, n):
             ci = _interval(r)
             lines.append(
@@ -171,7 +204,8 @@ def terminal_table(out: Path, width: int = 100) -> str:
     claims = records(out / "claims.parquet")
     rows = [[r["claim"], _value_text(r), _interval(r), r["verdict"]] for r in claims]
     table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
-    return table + "\n\n" + verdict_line(claims)
+    conv = converged_line(out)
+    return table + "\n\n" + verdict_line(claims) + ("" if conv is None else f"\n{conv}")
 
 
 def _text_table(header: list[str], rows: list[list], width: int) -> str:

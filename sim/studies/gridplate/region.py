@@ -54,7 +54,7 @@ from sim.studies.gridplate.model import (
     simulate,
     truth_rows,
 )
-from sim.studies.gridplate.schema import UM
+from sim.studies.gridplate.schema import SCHEMA, UM
 
 DECLARATION = Path(__file__).with_name("region.toml")
 #: the statistic behind each claim id (keys of :func:`draws`)
@@ -258,6 +258,31 @@ def explore_region(
         max_new=4 * cfg["region.points"],
     )
     return region, dec.predictions
+
+
+def plates_basis(cfg: dict, book: ClaimBook | None = None) -> str:
+    """The clause a region row's note begins with on a run of other than the paper's two
+    plates (``plate.count``, printed): the region is inferred from the paper's printed
+    statements (the constraints of ``region.toml``: the comparator sigma 1.2 um and the 1:3
+    weighting's 0.7 um), which the paper measured on its two plates, applied to the run's
+    plates as their statistics (:func:`draws` pools ``plate.count`` plates). Such rows are
+    findings already (the printed key differs; ``docs/verdict-rules.md`` gives "not
+    applicable" to a self-check only); the note says what their region rests on. "" on two
+    plates (the shipped rows unchanged)."""
+    P = cfg["plate.count"]
+    if P == SCHEMA["plate.count"].default:
+        return ""
+    book = book if book is not None else ClaimBook.load(Path(__file__).with_name("claims.toml"))
+    printed = ", ".join(
+        f"{s.id} = {book.spec(s.id)['ref']:g}"
+        for s in declaration(book).statements
+        if s.id in book.specs
+    )
+    plates = "one plate" if P == 1 else f"{P} plates"
+    return (
+        f"region inferred from statements the paper measured on two plates ({printed}) "
+        f"applied to {plates}; "
+    )
 
 
 def iteration_note(cfg: dict, region: Region, example: np.ndarray) -> str:

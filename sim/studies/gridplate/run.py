@@ -21,7 +21,7 @@ from sim.studies.gridplate import figures as F
 from sim.studies.gridplate.beyond import beyond_table
 from sim.studies.gridplate.claims import score
 from sim.studies.gridplate.model import PARAMS, chunk, simulate
-from sim.studies.gridplate.region import IT, explore_region, iteration_note, nominal
+from sim.studies.gridplate.region import IT, explore_region, iteration_note, nominal, plates_basis
 from sim.studies.gridplate.schema import SCHEMA
 from sim.studies.run_steps import over_region, run_part, spread_note
 
@@ -62,7 +62,11 @@ def decide_over_region(
     def note(row: dict) -> str:
         return it_note if row["claim"] == IT else spread(row)
 
-    return over_region(book, region, preds, rows, note)
+    basis = plates_basis(cfg, book)  # off the paper's two plates: what the region rests on
+    return [
+        {**r, "note": basis + r["note"]} if basis and r["claim"] in preds else r
+        for r in over_region(book, region, preds, rows, note)
+    ]
 
 
 def trials_table(res: dict) -> dict[str, np.ndarray]:

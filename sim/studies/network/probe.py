@@ -12,8 +12,7 @@ from functools import partial
 import numpy as np
 
 from sim.lsq import distributions as D
-from sim.mc.config import ConfigError
-from sim.mc.runner import PROBE_MAX_ITER, PROBE_SEED, PROBE_TRIALS
+from sim.mc.runner import PROBE_SEED, PROBE_TRIALS, probe_limit
 from sim.studies.network.analysis import mc_chunk
 from sim.studies.network.definition import Network
 from sim.studies.network.keys import SCHEMA
@@ -40,22 +39,11 @@ def chunk_fn(net: Network, an, C, pts, cfg: dict):
 
 
 def probe_solver(net: Network, an, C, pts, cfg: dict) -> None:
-    """Refuse a solver limit no probe trial meets, naming ``solver.max_iter``."""
-    limit = cfg["solver.max_iter"]
-    if limit > PROBE_MAX_ITER:
-        return
+    """Refuse a solver limit no probe trial meets, naming ``solver.max_iter`` and the network
+    (:func:`sim.mc.runner.probe_limit`)."""
 
     def statuses(max_iter: int) -> np.ndarray:
         fn = chunk_fn(net, an, C, pts, {**cfg, "solver.max_iter": max_iter})
         return fn(np.random.default_rng(PROBE_SEED), PROBE_TRIALS)["rows.status"]
 
-    # the limit is the cause only when the same trials converge with the key's default (a
-    # gross bias that no limit helps is named by the run: network.observations)
-    if np.all(statuses(limit) == 1) and np.any(statuses(SCHEMA["solver.max_iter"].default) == 0):
-        raise ConfigError(
-            "solver.max_iter",
-            f"{limit} iteration{'s' * (limit > 1)} to solver.tol_mm = {cfg['solver.tol_mm']:g}: "
-            f"none of {PROBE_TRIALS} probe trials converged, so no trial would (the run would "
-            "compute every chunk, then refuse): raise solver.max_iter (the first correction "
-            "from the true coordinates is the noise itself), or tol_mm",
-        )
+    probe_limit(cfg, statuses, SCHEMA["solver.max_iter"].default, f"{net.name!r} network")
