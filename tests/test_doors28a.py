@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -64,3 +65,61 @@ def test_a_pyproject_edited_with_an_older_time_than_the_stamp_is_installed(tmp_p
     os.utime(d / "pyproject.toml", (1_000_000_000, 1_000_000_000))  # older than the stamp
     p = run_make(d, "venv")
     assert p.returncode == 2 and "pip could not install" in p.stderr, p.stderr  # it tried
+
+
+# * ``--out`` naming a mount point (an empty file system mounted for the results, a bind
+#   mount): accepted, every chunk computed, then "Device or resource busy" when the run
+#   replaced it, its staging directory left on the file system above. Refused at once now.
+# * ``--out lnk/x`` with ``lnk`` a symbolic link into another run's ``trials/`` (or its
+#   results directory), or a relative ``--out`` from a shell inside them (``cd lnk``): the
+#   check that an output lies in no other run's directory read the path's names only, so the
+#   run wrote its results into that dataset, which then failed its own check ("not one of
+#   the run's chunk files"). The directories the system reaches through the links are
+#   checked too.
+
+
+def _unshare_works() -> bool:
+    if shutil.which("unshare") is None:
+        return False
+    p = subprocess.run(["unshare", "-Urm", "true"], capture_output=True)
+    return p.returncode == 0
+
+
+@pytest.mark.skipif(not _unshare_works(), reason="needs unshare -Urm (a mount namespace)")
+@pytest.mark.parametrize("how", ["tmpfs", "bind"])
+def test_out_naming_a_mount_point_is_refused_before_the_run(tmp_path, how):
+    mp = tmp_path / "mnt"
+    mp.mkdir()
+    (tmp_path / "src").mkdir()
+    mount = "mount -t tmpfs tmpfs" if how == "tmpfs" else f"mount --bind {tmp_path / 'src'}"
+    study = ROOT / "studies" / "brown_table1.toml"
+    run = f"{sys.executable} -m sim run {study} --trials 40 --no-figures --quiet --out {mp}"
+    script = f'{mount} "$1" && exec {run}'
+    p = subprocess.run(
+        ["unshare", "-Urm", "sh", "-c", script, "sh", str(mp)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    err = p.stderr.strip()
+    assert p.returncode == 2 and "\n" not in err, err
+    assert err.startswith("sim: error: --out:") and "is a mount point" in err, err
+    assert not (tmp_path / ".mnt.partial").exists()  # refused before any work
+
+
+def test_out_through_a_link_into_another_runs_trials_is_refused(tmp_path, capsys, monkeypatch):
+    from sim.cli import main
+    from tests.oneline import one_line
+
+    run = tmp_path / "run"
+    (run / "trials" / "part-0").mkdir(parents=True)
+    (run / "run.json").write_text("{}", encoding="utf-8")
+    (tmp_path / "lnk").symlink_to(run / "trials" / "part-0")
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    argv = ["run", study, "--trials", "40", "--no-figures", "--quiet", "--out"]
+    for out in (tmp_path / "lnk" / "x",):
+        one_line(capsys, main([*argv, str(out)]), "--out", "lies inside", str(run))
+    monkeypatch.chdir(tmp_path / "lnk")  # a shell in the link: cd lnk; sim run ... --out x
+    one_line(capsys, main([*argv, "x"]), "--out", "lies inside", str(run / "trials"))
+    assert sorted(p.name for p in (run / "trials" / "part-0").iterdir()) == []

@@ -21,7 +21,7 @@ import unicodedata
 from pathlib import Path
 
 from sim.mc.config import ConfigError
-from sim.mc.paths import link_problem
+from sim.mc.paths import link_problem, mount_point
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
@@ -123,6 +123,12 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
             f"{shown} is a file, not a results directory; sim never "
             "replaces it (choose another --out)",
         )
+    if mount_point(out):  # renamed at the run's end: EBUSY after every chunk was computed
+        raise ConfigError(
+            "--out",
+            f"{shown} is a mount point, which the system does not let a run replace at its end: "
+            "choose a directory inside it",
+        )
     try:  # the run replaces out: a shell inside it would be left in a deleted directory
         cwd, o = Path(os.getcwd()).resolve(), out.resolve()
     except (OSError, RuntimeError):
@@ -206,10 +212,16 @@ def _check_not_nested(out: Path, shown: str) -> None:
     """Refuse an output directory inside another run's results or staging directory (its
     ``run.json``, its ``.partial`` staging directory or its ``trials/`` dataset): a re-run of
     that study would replace it, and chunk files there would join that run's trials. So is
-    one inside the output of a run still working (its staging directory beside it)."""
-    for up in out.parents:
-        if up == up.parent:
-            break
+    one inside the output of a run still working (its staging directory beside it). The
+    directories are those the path names and those the system reaches through its links
+    (``--out lnk/x`` with ``lnk`` a link into a run's ``trials/``)."""
+    try:
+        real = Path(os.path.realpath(out.parent))
+    except (OSError, ValueError):
+        real = out.parent
+    for up in dict.fromkeys([*out.parents, real, *real.parents]):
+        if up == up.parent:  # the root, or "." of a relative path (its real path follows)
+            continue
         if (up / "run.json").is_file() or up.name.endswith(STAGE_SUFFIX) or up.name == "trials":
             raise ConfigError(
                 "--out",

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from sim.mc.lookalike import differs
 
-__all__ = ["link_problem"]
+__all__ = ["link_problem", "mount_point"]
 
 
 def link_problem(p: str | os.PathLike) -> str | None:
@@ -68,3 +68,19 @@ def _errno(p: str | os.PathLike) -> int | None:
     except ValueError:
         return None
     return None
+
+
+def mount_point(p: str | os.PathLike) -> bool:
+    """Whether the directory ``p`` is a mount point (a file system of its own mounted there,
+    or a bind mount of a directory of the same one, which ``os.path.ismount`` does not see):
+    the system refuses to rename it (EBUSY), so it cannot be a run's output directory."""
+    if os.path.ismount(p):
+        return True
+    try:
+        real = os.fsencode(os.path.realpath(p))
+        with open("/proc/self/mountinfo", "rb") as f:  # field 5: the mount point, octal-escaped
+            points = {ln.split()[4] for ln in f if len(ln.split()) > 4}
+    except (OSError, ValueError):
+        return False
+    esc = b"".join(b"\\%03o" % c if c in b" \t\n\\" else bytes([c]) for c in real)
+    return esc in points
