@@ -123,3 +123,31 @@ def test_out_through_a_link_into_another_runs_trials_is_refused(tmp_path, capsys
     monkeypatch.chdir(tmp_path / "lnk")  # a shell in the link: cd lnk; sim run ... --out x
     one_line(capsys, main([*argv, "x"]), "--out", "lies inside", str(run / "trials"))
     assert sorted(p.name for p in (run / "trials" / "part-0").iterdir()) == []
+
+
+# * ``--out lnk/../y`` (a ``..`` after a symbolic link, as ``ls`` and every other program read
+#   it: the parent of the link's target) was made absolute by its letters (``./y``): the run
+#   wrote ``./y``, said "results in lnk/../y" (where ``ls`` then found nothing), and with
+#   ``--overwrite`` replaced a ``./y`` the user had not named. ``sim run`` and the Python API
+#   now resolve such a path as the system does.
+
+
+@pytest.mark.parametrize("door", ["cli", "api"])
+def test_out_with_dotdot_after_a_link_is_where_the_system_says(tmp_path, capsys, door):
+    import sim
+    from sim.cli import main
+    from tests.oneline import one_line
+
+    (tmp_path / "far" / "sub").mkdir(parents=True)
+    (tmp_path / "lnk").symlink_to(tmp_path / "far" / "sub")
+    (tmp_path / "far" / "y").write_text("the user's file", encoding="utf-8")  # lnk/../y
+    study = ROOT / "studies" / "brown_table1.toml"
+    out = str(tmp_path / "lnk" / ".." / "y")
+    if door == "cli":
+        rc = main(["run", str(study), "--trials", "40", "--no-figures", "--quiet", "--out", out])
+        one_line(capsys, rc, "--out", "is a file, not a results directory")
+    else:
+        with pytest.raises(sim.ConfigError, match="is a file, not a results directory"):
+            sim.load(study, trials=40).run(out=out, figures=False)
+    assert not (tmp_path / "y").exists()  # nothing written where lnk/.. reads by its letters
+    assert (tmp_path / "far" / "y").read_text(encoding="utf-8") == "the user's file"

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from sim.mc.lookalike import differs
 
-__all__ = ["link_problem", "mount_point"]
+__all__ = ["absolute", "link_problem", "mount_point"]
 
 
 def link_problem(p: str | os.PathLike) -> str | None:
@@ -84,3 +84,19 @@ def mount_point(p: str | os.PathLike) -> bool:
         return False
     esc = b"".join(b"\\%03o" % c if c in b" \t\n\\" else bytes([c]) for c in real)
     return esc in points
+
+
+def absolute(p: str | os.PathLike) -> Path:
+    """``p`` made absolute against the working directory as the system resolves it: a ``..``
+    after a symbolic link is the parent of the link's target (``os.path.abspath`` drops
+    ``lnk/..`` by its letters: ``--out lnk/../y`` wrote ``./y`` while the run said "results
+    in lnk/../y", a path where ``ls`` finds nothing, and ``--overwrite`` replaced a ``./y``
+    the user had not named). The last name is kept as given (a link there is the caller's
+    to refuse); OSError where the working directory is gone."""
+    a = os.path.join(os.getcwd(), os.fspath(p))
+    if ".." not in Path(a).parts:
+        return Path(os.path.normpath(a))  # ("." and doubled or trailing slashes only)
+    head, tail = os.path.split(a.rstrip("/"))
+    if tail in ("..", "."):
+        return Path(os.path.realpath(a))
+    return Path(os.path.realpath(head)) / tail
