@@ -151,3 +151,31 @@ def test_out_with_dotdot_after_a_link_is_where_the_system_says(tmp_path, capsys,
             sim.load(study, trials=40).run(out=out, figures=False)
     assert not (tmp_path / "y").exists()  # nothing written where lnk/.. reads by its letters
     assert (tmp_path / "far" / "y").read_text(encoding="utf-8") == "the user's file"
+
+
+# * A file system mounted inside an earlier results directory (a disk or a tmpfs in
+#   ``results/x/data``): the run copied its files into the new results, moved the mount aside
+#   with the old results and emptied it while removing them (the user's files deleted from
+#   their own file system, the mount left under a hidden ``.x.old.<pid>``). Refused at once.
+
+
+@pytest.mark.skipif(not _unshare_works(), reason="needs unshare -Urm (a mount namespace)")
+def test_out_holding_a_mount_point_is_refused_before_the_run(tmp_path):
+    out = tmp_path / "res"
+    (out / "data").mkdir(parents=True)
+    record = '{"config": {"study": "brown_table1"}, "code_hash": "0", "files": ["t.txt"]}'
+    (out / "run.json").write_text(record, encoding="utf-8")  # an earlier run's results
+    study = ROOT / "studies" / "brown_table1.toml"
+    run = f"{sys.executable} -m sim run {study} --trials 40 --no-figures --quiet --overwrite"
+    script = f'mount -t tmpfs tmpfs "$1/data" && echo mine > "$1/data/f" && exec {run} --out "$1"'
+    p = subprocess.run(
+        ["unshare", "-Urm", "sh", "-c", script, "sh", str(out)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    err = p.stderr.strip()
+    assert p.returncode == 2 and "\n" not in err, err
+    assert err.startswith("sim: error: --out:") and f"holds a mount point, {out / 'data'}" in err
+    assert not (tmp_path / ".res.partial").exists()  # refused before any work

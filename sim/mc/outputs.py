@@ -21,7 +21,7 @@ import unicodedata
 from pathlib import Path
 
 from sim.mc.config import ConfigError
-from sim.mc.paths import link_problem, mount_point
+from sim.mc.paths import link_problem, mount_point, mounts_under
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
@@ -146,6 +146,12 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
         raise ConfigError(
             "--out", f"{shown} cannot be read ({e.strerror}; another user's?): choose another --out"
         ) from None
+    if old is not None and (mounts := mounts_under(out)):
+        raise ConfigError(
+            "--out",
+            f"{shown} holds a mount point, {mounts[0]}: the run replaces its output directory, "
+            "which would move that file system aside and empty it; unmount it or move it away",
+        )
     if old is None:
         if filled:
             raise ConfigError(

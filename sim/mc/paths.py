@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import unicodedata
 from pathlib import Path
 
 from sim.mc.lookalike import differs
 
-__all__ = ["absolute", "link_problem", "mount_point"]
+__all__ = ["absolute", "link_problem", "mount_point", "mounts_under"]
 
 
 def link_problem(p: str | os.PathLike) -> str | None:
@@ -74,16 +75,32 @@ def mount_point(p: str | os.PathLike) -> bool:
     """Whether the directory ``p`` is a mount point (a file system of its own mounted there,
     or a bind mount of a directory of the same one, which ``os.path.ismount`` does not see):
     the system refuses to rename it (EBUSY), so it cannot be a run's output directory."""
-    if os.path.ismount(p):
-        return True
+    return os.path.ismount(p) or os.path.realpath(p) in _mount_points()
+
+
+def mounts_under(p: str | os.PathLike) -> list[str]:
+    """The mount points inside the directory ``p`` (a disk or a tmpfs mounted in a results
+    directory): a run that replaced ``p`` moved them aside with the old results, and emptied
+    them while removing those (a copy of their files went into the new results)."""
+    real = os.path.realpath(p).rstrip("/") + "/"
+    return sorted(m for m in _mount_points() if m.startswith(real))
+
+
+def _mount_points() -> set[str]:
+    """Every mount point this process sees (``/proc/self/mountinfo``, its fifth field, with
+    the octal escapes of a space, tab, line break and backslash undone); empty where the
+    system has no such file."""
     try:
-        real = os.fsencode(os.path.realpath(p))
-        with open("/proc/self/mountinfo", "rb") as f:  # field 5: the mount point, octal-escaped
-            points = {ln.split()[4] for ln in f if len(ln.split()) > 4}
-    except (OSError, ValueError):
-        return False
-    esc = b"".join(b"\\%03o" % c if c in b" \t\n\\" else bytes([c]) for c in real)
-    return esc in points
+        with open("/proc/self/mountinfo", "rb") as f:
+            fields = [ln.split() for ln in f]
+    except OSError:
+        return set()
+    unescape = re.compile(rb"\\([0-7]{3})")
+    return {
+        os.fsdecode(unescape.sub(lambda m: bytes([int(m.group(1), 8)]), x[4]))
+        for x in fields
+        if len(x) > 4
+    }
 
 
 def absolute(p: str | os.PathLike) -> Path:
