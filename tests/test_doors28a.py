@@ -179,3 +179,52 @@ def test_out_holding_a_mount_point_is_refused_before_the_run(tmp_path):
     assert p.returncode == 2 and "\n" not in err, err
     assert err.startswith("sim: error: --out:") and f"holds a mount point, {out / 'data'}" in err
     assert not (tmp_path / ".res.partial").exists()  # refused before any work
+
+
+# * A results directory of an overlay's lower layer (the project baked into a container's
+#   image, ``make reproduce`` run in the container): the kernel renames no such directory
+#   ("Invalid cross-device link", EXDEV, for the swap and for the two renames), so the run
+#   computed every chunk and failed at its end, and again at each try. It is now removed
+#   (what the user put there copied into the new results first) and the new results renamed
+#   in its place.
+
+_OVERLAY_PUBLISH = """
+import sys
+from pathlib import Path
+from sim.mc.outputs import stage_dir
+from sim.mc.publish import publish
+from sim.mc.storage import read_record, write_record
+out = Path(sys.argv[1]) / "X"
+stage = stage_dir(out)
+stage.mkdir()
+write_record(stage, {"config": {"study": "x"}, "code_hash": "h", "files": ["t.txt"]})
+(stage / "t.txt").write_text("new", encoding="utf-8")
+publish(stage, out)
+print((out / "t.txt").read_text(), (out / "notes.md").read_text(), read_record(out)["files"])
+print(sorted(p.name for p in out.parent.iterdir()))
+"""
+
+
+@pytest.mark.skipif(not _unshare_works(), reason="needs unshare -Urm (a mount namespace)")
+def test_results_of_an_overlays_lower_layer_are_replaced(tmp_path):
+    lower, upper, work, merged = (tmp_path / n for n in ("lower", "upper", "work", "merged"))
+    for d in (upper, work, merged):
+        d.mkdir()
+    (lower / "X" / "trials").mkdir(parents=True)  # the image's results, with a note of the user
+    record = '{"config": {"study": "x"}, "code_hash": "g", "files": ["t.txt"]}'
+    (lower / "X" / "run.json").write_text(record, encoding="utf-8")
+    (lower / "X" / "t.txt").write_text("old", encoding="utf-8")
+    (lower / "X" / "notes.md").write_text("mine", encoding="utf-8")
+    opts = f"lowerdir={lower},upperdir={upper},workdir={work},userxattr"
+    script = f'mount -t overlay overlay -o {opts} "$1" || exit 99; exec "$2" -c "$3" "$1"'
+    p = subprocess.run(
+        ["unshare", "-Urm", "sh", "-c", script, "sh", merged, sys.executable, _OVERLAY_PUBLISH],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    if p.returncode == 99:
+        pytest.skip(f"no overlay mount here: {p.stderr.strip()}")
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.splitlines() == ["new mine ['t.txt']", "['X']"], p.stdout

@@ -314,8 +314,9 @@ def _exchange(a: Path, b: Path) -> bool:
     if fn(_AT_FDCWD, enc[0], _AT_FDCWD, enc[1], _RENAME_EXCHANGE) == 0:
         return True
     err = ctypes.get_errno()
-    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP, errno.EPERM):
-        return False  # an older kernel, a file system without it (a FUSE mount, NFS)
+    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP, errno.EPERM, errno.EXDEV):
+        return False  # an older kernel, a file system without it (a FUSE mount, NFS; EXDEV:
+        # an overlay, whose directories of a lower layer cannot be renamed)
     raise OSError(err, os.strerror(err), str(b))
 
 
@@ -354,7 +355,17 @@ def publish(stage: Path, out: Path) -> None:
     elif _exchange(stage, out):  # out now holds the new results, stage the old ones
         os.replace(stage, old)
     else:
-        os.replace(out, old)
+        try:
+            os.replace(out, old)
+        except OSError as e:
+            if e.errno != errno.EXDEV:
+                raise
+            # out cannot be renamed: a directory of an overlay's lower layer (the project in a
+            # container's image: "Invalid cross-device link" after every chunk was computed,
+            # at each try). Removed instead: what the user put there is copied in the staging
+            # directory, and a kill now leaves that finished run to be published by the next.
+            _remove_record_last(out)
+            old = None
         os.replace(stage, out)
     (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
     _drop_stale_swaps(out, old)
