@@ -228,3 +228,39 @@ def test_results_of_an_overlays_lower_layer_are_replaced(tmp_path):
         pytest.skip(f"no overlay mount here: {p.stderr.strip()}")
     assert p.returncode == 0, p.stderr
     assert p.stdout.splitlines() == ["new mine ['t.txt']", "['X']"], p.stdout
+
+
+# * ``sim report`` over results on a read-only file system (a read-only mount of a clone or
+#   of a colleague's results) ended "Read-only file system: .../.README.md.<pid>.tmp", a
+#   name the user never saw: removing the temporary that was never made fails with EROFS
+#   there, and that error replaced the one naming README.md.
+
+_READ_ONLY_WRITE = """
+import sys
+from pathlib import Path
+from sim.mc.storage import atomic_path
+ro = Path(sys.argv[1])
+try:
+    with atomic_path(ro / "README.md") as tmp:
+        tmp.write_text("x", encoding="utf-8")
+except OSError as e:
+    print(e.errno, e.filename)
+"""
+
+
+@pytest.mark.skipif(not _unshare_works(), reason="needs unshare -Urm (a mount namespace)")
+def test_a_write_on_a_read_only_file_system_names_the_file(tmp_path):
+    import errno
+
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    script = 'mount -t tmpfs -o ro tmpfs "$1" || exit 99; exec "$2" -c "$3" "$1"'
+    p = subprocess.run(
+        ["unshare", "-Urm", "sh", "-c", script, "sh", ro, sys.executable, _READ_ONLY_WRITE],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() == f"{errno.EROFS} {ro / 'README.md'}", p.stdout

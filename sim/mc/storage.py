@@ -202,16 +202,25 @@ class atomic_path:
             try:
                 os.replace(self.tmp, self.path)
             except OSError as e:  # e.g. a directory where the file goes: leave no temporary
-                self.tmp.unlink(missing_ok=True)  # behind, and name the file, not it
+                self._drop_tmp()  # behind, and name the file, not it
                 raise _named(e, self.path) from None
         else:
-            self.tmp.unlink(missing_ok=True)
+            self._drop_tmp()
             if isinstance(exc, OSError) and exc.filename in (None, "", str(self.tmp)):
                 # a failing write (ulimit -f: EFBIG, a full disk) says only "File too large";
                 # pyarrow's says "Error writing bytes to file. Detail: [errno 27] ...": name
                 # the file it was writing (not the temporary, ".README.md.9762.tmp", a name
                 # the user never saw: a directory of another user's, read-only)
                 raise _named(exc, self.path) from None
+
+    def _drop_tmp(self) -> None:
+        """Remove the temporary if it is there: on a read-only file system unlink fails with
+        EROFS even for a name that does not exist, and ``sim report`` over a read-only
+        results directory ended naming ``.README.md.<pid>.tmp``, not the README.md."""
+        try:
+            self.tmp.unlink(missing_ok=True)
+        except OSError:
+            pass
 
 
 def _named(e: OSError, path: Path) -> OSError:
@@ -253,7 +262,10 @@ def _drop_stale_temporaries(path: Path) -> None:
             continue  # a live process writing it
         p = path.parent / n
         if p.is_file() and not p.is_symlink():
-            p.unlink(missing_ok=True)
+            try:
+                p.unlink(missing_ok=True)
+            except OSError:  # (a read-only file system: it stays, and the write names the file)
+                pass
 
 
 class NonFiniteError(ValueError):
