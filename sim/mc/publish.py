@@ -23,6 +23,7 @@ from pathlib import Path
 
 from sim.mc.config import ConfigError
 from sim.mc.outputs import swap_dir
+from sim.mc.paths import mounts_under
 from sim.mc.runner import ChunkStore
 from sim.mc.storage import LOCK, pid_alive, read_record, write_record
 
@@ -358,7 +359,7 @@ def publish(stage: Path, out: Path) -> None:
         try:
             os.replace(out, old)
         except OSError as e:
-            if e.errno != errno.EXDEV:
+            if e.errno != errno.EXDEV or mounts_under(out):  # (never empty a mount in it)
                 raise
             # out cannot be renamed: a directory of an overlay's lower layer (the project in a
             # container's image: "Invalid cross-device link" after every chunk was computed,
