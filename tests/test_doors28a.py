@@ -264,3 +264,21 @@ def test_a_write_on_a_read_only_file_system_names_the_file(tmp_path):
     )
     assert p.returncode == 0, p.stderr
     assert p.stdout.strip() == f"{errno.EROFS} {ro / 'README.md'}", p.stdout
+
+
+# * A folder of the user's named ``trials`` (``~/trials/run1``, or a home reached through a
+#   link to ``/data/trials/u``, now that the links are followed) was taken for another run's
+#   chunk store, and every ``--out`` inside it refused. A run's ``trials/`` holds its
+#   ``part-<p>/`` folders; that is what is refused.
+
+
+def test_a_folder_of_the_users_named_trials_is_not_a_runs_dataset(tmp_path):
+    from sim.mc.config import ConfigError
+    from sim.mc.outputs import check_out
+
+    record = {"config": {"study": "brown_table1"}, "code_hash": "0"}
+    (tmp_path / "trials").mkdir()
+    check_out(tmp_path / "trials" / "run1", "run1", record, False)  # no error: the user's
+    (tmp_path / "trials" / "part-0").mkdir()  # a run's chunk store (its run.json gone)
+    with pytest.raises(ConfigError, match="lies inside"):
+        check_out(tmp_path / "trials" / "run1", "run1", record, False)
