@@ -256,6 +256,20 @@ def _remove_record_last(old: Path) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
+def _remove_in_place(out: Path) -> None:
+    """Remove the results ``out`` that cannot be moved aside, their run record last and only
+    when everything else is gone (an error names what could not be removed): a run killed
+    meanwhile leaves results that still name themselves as the suite's, which the next
+    publish removes, never a directory of files without a record, which no run replaces."""
+    for p in out.iterdir():
+        if p.is_dir() and not p.is_symlink():
+            shutil.rmtree(p)
+        elif p.name != "run.json":
+            p.unlink()
+    (out / "run.json").unlink(missing_ok=True)
+    out.rmdir()
+
+
 def _drop_stale_swaps(out: Path, mine: Path | None) -> None:
     """Remove the replaced results of ``out`` that an earlier run killed while publishing
     left behind (``.<name>.old.<pid>`` of a process no longer alive, or of this pid: a
@@ -365,7 +379,7 @@ def publish(stage: Path, out: Path) -> None:
             # container's image: "Invalid cross-device link" after every chunk was computed,
             # at each try). Removed instead: what the user put there is copied in the staging
             # directory, and a kill now leaves that finished run to be published by the next.
-            _remove_record_last(out)
+            _remove_in_place(out)
             old = None
         os.replace(stage, out)
     (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
