@@ -282,3 +282,30 @@ def test_a_folder_of_the_users_named_trials_is_not_a_runs_dataset(tmp_path):
     (tmp_path / "trials" / "part-0").mkdir()  # a run's chunk store (its run.json gone)
     with pytest.raises(ConfigError, match="lies inside"):
         check_out(tmp_path / "trials" / "run1", "run1", record, False)
+
+
+# * A results folder on a file system that cannot lock files (an NFS mount whose lock service
+#   is down: flock fails with ENOLCK) was "cannot write to <folder>: No locks available"
+#   (the folder can be written), and left an empty staging directory there. It now says the
+#   folder cannot hold a lock, and leaves nothing.
+
+
+def test_a_file_system_that_cannot_lock_is_named_and_left_clean(tmp_path, capsys, monkeypatch):
+    import errno
+    import fcntl
+    import types
+
+    import sim.mc.storage as storage
+    from sim.cli import main
+    from tests.oneline import one_line
+
+    def flock(fd, op):
+        raise OSError(errno.ENOLCK, os.strerror(errno.ENOLCK))
+
+    fake = types.SimpleNamespace(flock=flock, LOCK_EX=fcntl.LOCK_EX, LOCK_NB=fcntl.LOCK_NB)
+    monkeypatch.setattr(storage, "fcntl", fake)
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    out = tmp_path / "o"
+    rc = main(["run", study, "--trials", "40", "--no-figures", "--quiet", "--out", str(out)])
+    one_line(capsys, rc, f"cannot lock a file in {tmp_path}", os.strerror(errno.ENOLCK))
+    assert sorted(tmp_path.iterdir()) == []  # no staging directory left

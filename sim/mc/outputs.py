@@ -325,6 +325,8 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
             f"{e.path} is not a lock file of sim (a link, a pipe or a directory); move it away",
         ) from None
     except OSError as e:
+        if lock.created:  # made by this call, holding only its lock file: no litter left
+            shutil.rmtree(stage, ignore_errors=True)
         raise ConfigError("--out", _not_lockable(stage, out, shown, e)) from None
     try:
         damage = _damage(stage) if stage.is_dir() else None
@@ -432,7 +434,8 @@ def _not_lockable(stage: Path, out: Path, shown: str, e: OSError) -> str:
             f"not write in ({e.strerror}): ask them to finish or remove it, or choose another "
             "--out"
         )
-    return f"cannot write to {out.parent}: {e.strerror}"
+    nolock = e.errno in (errno.ENOLCK, errno.ENOTSUP, errno.ENOSYS)  # NFS without its lockd
+    return f"cannot {'lock a file in' if nolock else 'write to'} {out.parent}: {e.strerror}"
 
 
 def drop_stage(stage: Path, lock, reason: str | None = None) -> None:

@@ -435,6 +435,9 @@ class StageLock:
                 pid = None
             os.close(fd)
             raise Locked(pid) from None
+        except OSError:  # a file system that cannot lock (ENOLCK: NFS without its lock service)
+            os.close(fd)
+            raise
         os.ftruncate(fd, 0)
         os.write(fd, f"{os.getpid()}\n".encode())
         self.fd = fd
