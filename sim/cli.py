@@ -234,7 +234,7 @@ def _run(args) -> int:
         summary = terminal_summary(out, shown=shown)
     except (OSError, ValueError, KeyError) as e:  # the results stand; only their summary failed
         summary = f"(no summary: {type(e).__name__}: {e})".splitlines()[0]
-    print(f"{cfg['study']}: results in {shown}/")
+    print(f"{cfg['study']}: results in {shown.rstrip('/')}/")  # (--out DIR/: not DIR//)
     if not args.quiet:
         print(summary)
     return 0

@@ -309,3 +309,16 @@ def test_a_file_system_that_cannot_lock_is_named_and_left_clean(tmp_path, capsys
     rc = main(["run", study, "--trials", "40", "--no-figures", "--quiet", "--out", str(out)])
     one_line(capsys, rc, f"cannot lock a file in {tmp_path}", os.strerror(errno.ENOLCK))
     assert sorted(tmp_path.iterdir()) == []  # no staging directory left
+
+
+# * ``--out DIR/`` (a shell completes a directory with its slash) ended "results in DIR//".
+
+
+def test_out_with_a_trailing_slash_is_named_once_slashed(tmp_path, capsys):
+    from sim.cli import main
+
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    out = f"{tmp_path / 'o'}//"
+    assert main(["run", study, "--trials", "40", "--no-figures", "--quiet", "--out", out]) == 0
+    assert capsys.readouterr().out == f"brown_table1: results in {tmp_path / 'o'}/\n"
+    assert (tmp_path / "o" / "run.json").is_file()
