@@ -322,3 +322,34 @@ def test_out_with_a_trailing_slash_is_named_once_slashed(tmp_path, capsys):
     assert main(["run", study, "--trials", "40", "--no-figures", "--quiet", "--out", out]) == 0
     assert capsys.readouterr().out == f"brown_table1: results in {tmp_path / 'o'}/\n"
     assert (tmp_path / "o" / "run.json").is_file()
+
+
+# * ``make verify`` with its scratch directory on a file system that is full (or a write cut
+#   short by ``ulimit -f``): the re-run's "No space left on device" was recorded as a failed
+#   reproduction ("brown_table1: FAILED; nothing compared", exit 1, and a FAILED row in
+#   reproducibility.parquet without --no-record); with --trials it was "the re-run refused
+#   its options". Now one line naming the system's error, exit 2.
+
+
+@pytest.mark.parametrize("extra", [[], ["--trials", "400"]])
+def test_verify_whose_rerun_cannot_write_is_not_a_failed_reproduction(tmp_path, extra):
+    import resource
+
+    def small_files():  # (in the verify process and the re-run it starts)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1024, resource.RLIM_INFINITY))
+
+    cmd = [sys.executable, "-m", "sim.report.verify", "--results", str(ROOT / "results")]
+    cmd += ["--studies", str(ROOT / "studies"), "--study", "brown_table1", "--no-record"]
+    cmd += ["--scratch", str(tmp_path / "scr"), *extra]
+    p = subprocess.run(
+        cmd,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        preexec_fn=small_files,
+    )
+    lines = [ln for ln in p.stderr.splitlines() if not ln.startswith("sim verify: re-running")]
+    assert p.returncode == 2 and len(lines) == 1, p.stderr
+    assert lines[0].startswith("sim verify: error: brown_table1: the re-run could not run here:")
+    assert "File too large" in lines[0], lines[0]
