@@ -9,6 +9,7 @@ stored, so the same code and config give byte-identical files.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import fcntl
 import hashlib
@@ -214,13 +215,10 @@ class atomic_path:
                 raise _named(exc, self.path) from None
 
     def _drop_tmp(self) -> None:
-        """Remove the temporary if it is there: on a read-only file system unlink fails with
-        EROFS even for a name that does not exist, and ``sim report`` over a read-only
-        results directory ended naming ``.README.md.<pid>.tmp``, not the README.md."""
-        try:
+        """Remove the temporary if it is there (on a read-only file system unlink fails with
+        EROFS even for a name that is not: that error named ``.README.md.<pid>.tmp``)."""
+        with contextlib.suppress(OSError):
             self.tmp.unlink(missing_ok=True)
-        except OSError:
-            pass
 
 
 def _named(e: OSError, path: Path) -> OSError:
@@ -262,10 +260,8 @@ def _drop_stale_temporaries(path: Path) -> None:
             continue  # a live process writing it
         p = path.parent / n
         if p.is_file() and not p.is_symlink():
-            try:
+            with contextlib.suppress(OSError):  # (read-only: it stays; the write names the file)
                 p.unlink(missing_ok=True)
-            except OSError:  # (a read-only file system: it stays, and the write names the file)
-                pass
 
 
 class NonFiniteError(ValueError):
