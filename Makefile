@@ -19,7 +19,7 @@ STUDIES := $(basename $(notdir $(STUDY_FILES)))
 unexport PYTHONDONTWRITEBYTECODE
 
 .DEFAULT_GOAL := help
-.PHONY: help venv test reproduce rerun verify report bench clean fuzz mutation venv-unusable
+.PHONY: help venv test reproduce rerun verify report bench clean fuzz mutation venv-unusable pyproject-changed
 
 # $(call q,TEXT): TEXT as one single-quoted shell word (a value with spaces or quotes stays one)
 q = '$(subst ','\'',$(1))'
@@ -42,7 +42,12 @@ help: ## list the targets
 # (bin/python deleted, the Python it was made from removed: ".venv/bin/python: No such file or
 # directory"), is older than pyproject.toml's requires-python (a `make venv PYTHON=python3.10`
 # that failed), or the stamp names another directory (the project moved or copied with its
-# .venv, whose scripts start the old path's Python and code). The stamp holds the directory.
+# .venv, whose scripts start the old path's Python and code). The stamp holds the directory,
+# then the checksum of the pyproject.toml installed: whether it changed since is decided by its
+# content, not by file times (a pyproject.toml dated in the future, by clock skew or a copy
+# from a machine whose clock is ahead, made every target install again, and fail offline, until
+# the clock caught up; one edited while the clock stood behind the stamp's was not installed).
+# A stamp of an older Makefile (the directory alone) is judged by its time, as before.
 # An install that failed or was interrupted (a Ctrl-C during pip's own upgrade left a pip that
 # no longer imports; one during `venv --clear` half a .venv) leaves its mark INSTALLING beside
 # the .venv, which only a finished install removes: made again from scratch too. A .venv of
@@ -50,7 +55,11 @@ help: ## list the targets
 # PYTHON that is missing or cannot make one, python2.7: one line; Ctrl-C: no traceback).
 INSTALLING := $(VENV).installing
 VENV_USABLE := $(shell $(PY) -S -c 'import sys; sys.exit(sys.version_info < (3, 11))' >/dev/null 2>&1 && echo yes)
-MADE_IN := $(shell cat $(STAMP) 2>/dev/null)
+MADE_IN := $(shell sed -n 1p $(STAMP) 2>/dev/null)
+MADE_FROM := $(shell sed -n 2p $(STAMP) 2>/dev/null)
+PYPROJECT_SUM := $(shell cksum < pyproject.toml | tr ' ' -)
+# nothing when the stamp's checksum is pyproject.toml's, pyproject.toml when it records none
+PYPROJECT_DEP := $(if $(MADE_FROM),$(if $(filter $(PYPROJECT_SUM),$(MADE_FROM)),,pyproject-changed),pyproject.toml)
 VENV_USABLE := $(and $(VENV_USABLE),$(if $(MADE_IN),$(if $(subst $(CURDIR),,$(MADE_IN)),,yes),yes))
 VENV_USABLE := $(and $(VENV_USABLE),$(if $(wildcard $(INSTALLING)),,yes))
 # pip (its arguments: at its definition below): its output kept in PIP_LOG; a failure (no network,
@@ -70,9 +79,9 @@ VENV_LOCK := $(if $(shell command -v flock 2>/dev/null),flock $(VENV).lock)
 # `venv --clear` wiped the finished .venv while the other make went on to run the tests in it
 # ("No such file or directory: .venv/bin/ruff"). The last pip step writes the stamp under the
 # same lock, so no step of another make runs between the install and its stamp.
-INSTALLED_NOW = test -f $(STAMP) && test $(STAMP) -nt pyproject.toml && \
-	test "$$(cat $(STAMP))" = $(call q,$(CURDIR)) && test ! -e $(INSTALLING)
-INSTALLED_AT_START := $(and $(VENV_USABLE),$(MADE_IN),$(shell test $(STAMP) -nt pyproject.toml && echo yes))
+INSTALLED_NOW = test -f $(STAMP) && test "$$(sed -n 2p $(STAMP))" = $(PYPROJECT_SUM) && \
+	test "$$(sed -n 1p $(STAMP))" = $(call q,$(CURDIR)) && test ! -e $(INSTALLING)
+INSTALLED_AT_START := $(and $(VENV_USABLE),$(MADE_IN),$(if $(PYPROJECT_DEP),,yes))
 # $(call locked,SCRIPT,SKIP): a prefix that runs the command after it as "$$@" in the shell
 # SCRIPT under the lock; SKIP (the stamp's steps): nothing when another make installed meanwhile
 locked = $(VENV_LOCK) sh -c $(call q,$(if $(and $(2),$(if $(INSTALLED_AT_START),,yes)),$(INSTALLED_NOW) && exit 0;) $(1)) sh
@@ -81,14 +90,14 @@ locked = $(VENV_LOCK) sh -c $(call q,$(if $(and $(2),$(if $(INSTALLED_AT_START),
 pip = @$(call locked,"$$@" >> $(PIP_LOG) 2>&1 || exit; $(3),$(2)) $(PY) -m pip install --quiet $(1) || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
 	"$$({ grep -m1 -E '^ *ERROR' $(PIP_LOG) || grep -v '^ *$$' $(PIP_LOG) | tail -1; } | sed -E 's/^ *(ERROR: *)?//')" >&2; exit 2; }
 
-$(STAMP): pyproject.toml $(if $(VENV_USABLE),,venv-unusable)
+$(STAMP): $(PYPROJECT_DEP) $(if $(VENV_USABLE),,venv-unusable)
 	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
 	@$(call locked,"$$@" > $(INSTALLING) 2>&1,skip) $(call q,$(PYTHON)) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) || { rc=$$?; \
 	  test $$rc -gt 128 && exit $$rc; printf 'make: PYTHON (%s) could not make $(VENV): %s\n' $(call q,$(PYTHON)) \
 	  "$$(grep -v '^ *$$' $(INSTALLING) | tail -1)" >&2; exit 2; }
 	@test -e $(INSTALLING) || exit 0; : > $(PIP_LOG)
 	$(call pip,--upgrade pip,skip)
-	$(call pip,-e ".[dev]",skip,echo $(call q,$(CURDIR)) > $(STAMP) && rm -f $(INSTALLING))
+	$(call pip,-e ".[dev]",skip,printf '%s\n%s\n' $(call q,$(CURDIR)) $(PYPROJECT_SUM) > $(STAMP) && rm -f $(INSTALLING))
 
 venv: $(STAMP) ## create the virtual environment and install the project (with PYTHON=python3, 3.11 or later)
 

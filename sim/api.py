@@ -32,7 +32,7 @@ from sim.api_args import arguments as _arguments
 from sim.execute import execute
 from sim.mc.config import ConfigError, study_file_hint
 from sim.mc.estimate import estimate
-from sim.mc.paths import link_problem
+from sim.mc.paths import absolute, link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.runner import MIN_CHUNKS
@@ -361,7 +361,7 @@ def _absolute(name: str, v: str | os.PathLike) -> Path:
     """``v`` made absolute against the working directory, which may have been deleted (then
     one line naming the argument, not pathlib's FileNotFoundError)."""
     try:
-        return Path(os.path.abspath(v))
+        return absolute(v)
     except OSError as e:
         raise ConfigError(
             name, f"{os.fspath(v)} is relative, but the working directory is gone ({e.strerror})"

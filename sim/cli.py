@@ -38,6 +38,7 @@ from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem
+from sim.mc.paths import absolute
 from sim.mc.progress import set_quiet
 from sim.mc.read_when import read_in_a_cell
 from sim.mc.runner import MIN_CHUNKS
@@ -88,7 +89,7 @@ def check_run_args(args) -> Path:
         why = name_problem(args.out)
         if why:
             raise ConfigError("--out", f"{why} (got {args.out!r})")
-    return Path(os.path.abspath(args.out)) if args.out else None
+    return absolute(args.out) if args.out else None
 
 
 def _keys_set(overrides: list[str]) -> set[str]:
@@ -233,7 +234,7 @@ def _run(args) -> int:
         summary = terminal_summary(out, shown=shown)
     except (OSError, ValueError, KeyError) as e:  # the results stand; only their summary failed
         summary = f"(no summary: {type(e).__name__}: {e})".splitlines()[0]
-    print(f"{cfg['study']}: results in {shown}/")
+    print(f"{cfg['study']}: results in {shown.rstrip('/')}/")  # (--out DIR/: not DIR//)
     if not args.quiet:
         print(summary)
     return 0

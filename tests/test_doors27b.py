@@ -25,6 +25,7 @@ from sim.mc.outputs import stage_dir
 from sim.mc.publish import publish
 from sim.mc.storage import read_record, write_record
 from tests.test_doors18c import MAKE, fake_project, user_env
+from tests.test_doors28a import stamp_text
 
 needs_make = pytest.mark.skipif(
     MAKE is None or shutil.which("flock") is None or not Path("/proc/locks").exists(),
@@ -61,7 +62,7 @@ def test_a_second_make_venv_that_waited_for_the_first_leaves_its_install_alone(t
         # the first make ends its install: a working .venv and its stamp, then the lock
         (d / ".venv" / "bin" / "python").unlink()
         (d / ".venv" / "bin" / "python").symlink_to(tmp_path / "fakepython")
-        (d / ".venv" / ".installed").write_text(f"{d}\n", encoding="utf-8")
+        (d / ".venv" / ".installed").write_text(stamp_text(d), encoding="utf-8")
     finally:
         os.close(fd)
     out, err = second.communicate(timeout=60)
@@ -69,7 +70,7 @@ def test_a_second_make_venv_that_waited_for_the_first_leaves_its_install_alone(t
     # no venv --clear over the finished install, and no mark of an unfinished one left
     assert not (tmp_path / "venv.log").exists(), (tmp_path / "venv.log").read_text("utf-8")
     assert not (d / ".venv.installing").exists()
-    assert (d / ".venv" / ".installed").read_text(encoding="utf-8") == f"{d}\n"
+    assert (d / ".venv" / ".installed").read_text(encoding="utf-8") == stamp_text(d)
     assert lock.exists()  # the lock file stays: a third make would lock a new one
 
 
@@ -88,7 +89,7 @@ def test_one_make_venv_alone_installs_and_writes_its_stamp(tmp_path):
     )
     assert p.returncode == 0, p.stderr
     assert "-m venv --clear .venv" in (tmp_path / "venv.log").read_text(encoding="utf-8")
-    assert (d / ".venv" / ".installed").read_text(encoding="utf-8") == f"{d}\n"
+    assert (d / ".venv" / ".installed").read_text(encoding="utf-8") == stamp_text(d)
     assert not (d / ".venv.installing").exists()
 
 

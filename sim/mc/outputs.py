@@ -21,7 +21,7 @@ import unicodedata
 from pathlib import Path
 
 from sim.mc.config import ConfigError
-from sim.mc.paths import link_problem
+from sim.mc.paths import link_problem, mount_point, mounts_under
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
@@ -123,6 +123,12 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
             f"{shown} is a file, not a results directory; sim never "
             "replaces it (choose another --out)",
         )
+    if mount_point(out):  # renamed at the run's end: EBUSY after every chunk was computed
+        raise ConfigError(
+            "--out",
+            f"{shown} is a mount point, which the system does not let a run replace at its end: "
+            "choose a directory inside it",
+        )
     try:  # the run replaces out: a shell inside it would be left in a deleted directory
         cwd, o = Path(os.getcwd()).resolve(), out.resolve()
     except (OSError, RuntimeError):
@@ -140,6 +146,12 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
         raise ConfigError(
             "--out", f"{shown} cannot be read ({e.strerror}; another user's?): choose another --out"
         ) from None
+    if old is not None and (mounts := mounts_under(out)):
+        raise ConfigError(
+            "--out",
+            f"{shown} holds a mount point, {mounts[0]}: the run replaces its output directory, "
+            "which would move that file system aside and empty it; unmount it or move it away",
+        )
     if old is None:
         if filled:
             raise ConfigError(
@@ -206,11 +218,17 @@ def _check_not_nested(out: Path, shown: str) -> None:
     """Refuse an output directory inside another run's results or staging directory (its
     ``run.json``, its ``.partial`` staging directory or its ``trials/`` dataset): a re-run of
     that study would replace it, and chunk files there would join that run's trials. So is
-    one inside the output of a run still working (its staging directory beside it)."""
-    for up in out.parents:
-        if up == up.parent:
-            break
-        if (up / "run.json").is_file() or up.name.endswith(STAGE_SUFFIX) or up.name == "trials":
+    one inside the output of a run still working (its staging directory beside it). The
+    directories are those the path names and those the system reaches through its links
+    (``--out lnk/x`` with ``lnk`` a link into a run's ``trials/``)."""
+    try:
+        real = Path(os.path.realpath(out.parent))
+    except (OSError, ValueError):
+        real = out.parent
+    for up in dict.fromkeys([*out.parents, real, *real.parents]):
+        if up == up.parent:  # the root, or "." of a relative path (its real path follows)
+            continue
+        if (up / "run.json").is_file() or up.name.endswith(STAGE_SUFFIX) or _dataset(up):
             raise ConfigError(
                 "--out",
                 f"{shown} lies inside {up}, which belongs to another run; choose a directory "
@@ -222,6 +240,12 @@ def _check_not_nested(out: Path, shown: str) -> None:
                 f"{shown} lies inside {up}, the output of a run that is running or unfinished "
                 f"({s}); choose a directory outside every results directory",
             )
+
+
+def _dataset(d: Path) -> bool:
+    """Whether ``d`` is a run's chunk store: ``trials/`` holding ``part-<p>/`` (a folder of the
+    user's named ``trials``, ``~/trials/run1``, is not another run's)."""
+    return d.name == "trials" and any(d.glob("part-*"))
 
 
 def _damage(stage: Path) -> str | None:
@@ -301,6 +325,8 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
             f"{e.path} is not a lock file of sim (a link, a pipe or a directory); move it away",
         ) from None
     except OSError as e:
+        if lock.created:  # made by this call, holding only its lock file: no litter left
+            shutil.rmtree(stage, ignore_errors=True)
         raise ConfigError("--out", _not_lockable(stage, out, shown, e)) from None
     try:
         damage = _damage(stage) if stage.is_dir() else None
@@ -408,7 +434,8 @@ def _not_lockable(stage: Path, out: Path, shown: str, e: OSError) -> str:
             f"not write in ({e.strerror}): ask them to finish or remove it, or choose another "
             "--out"
         )
-    return f"cannot write to {out.parent}: {e.strerror}"
+    nolock = e.errno in (errno.ENOLCK, errno.ENOTSUP, errno.ENOSYS)  # NFS without its lockd
+    return f"cannot {'lock a file in' if nolock else 'write to'} {out.parent}: {e.strerror}"
 
 
 def drop_stage(stage: Path, lock, reason: str | None = None) -> None:

@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import unicodedata
 from pathlib import Path
 
 from sim.mc.lookalike import differs
 
-__all__ = ["link_problem"]
+__all__ = ["absolute", "link_problem", "mount_point", "mounts_under"]
 
 
 def link_problem(p: str | os.PathLike) -> str | None:
@@ -68,3 +69,51 @@ def _errno(p: str | os.PathLike) -> int | None:
     except ValueError:
         return None
     return None
+
+
+def mount_point(p: str | os.PathLike) -> bool:
+    """Whether the directory ``p`` is a mount point (a file system of its own mounted there,
+    or a bind mount of a directory of the same one, which ``os.path.ismount`` does not see):
+    the system refuses to rename it (EBUSY), so it cannot be a run's output directory."""
+    return os.path.ismount(p) or os.path.realpath(p) in _mount_points()
+
+
+def mounts_under(p: str | os.PathLike) -> list[str]:
+    """The mount points inside the directory ``p`` (a disk or a tmpfs mounted in a results
+    directory): a run that replaced ``p`` moved them aside with the old results, and emptied
+    them while removing those (a copy of their files went into the new results)."""
+    real = os.path.realpath(p).rstrip("/") + "/"
+    return sorted(m for m in _mount_points() if m.startswith(real))
+
+
+def _mount_points() -> set[str]:
+    """Every mount point this process sees (``/proc/self/mountinfo``, its fifth field, with
+    the octal escapes of a space, tab, line break and backslash undone); empty where the
+    system has no such file."""
+    try:
+        with open("/proc/self/mountinfo", "rb") as f:
+            fields = [ln.split() for ln in f]
+    except OSError:
+        return set()
+    unescape = re.compile(rb"\\([0-7]{3})")
+    return {
+        os.fsdecode(unescape.sub(lambda m: bytes([int(m.group(1), 8)]), x[4]))
+        for x in fields
+        if len(x) > 4
+    }
+
+
+def absolute(p: str | os.PathLike) -> Path:
+    """``p`` made absolute against the working directory as the system resolves it: a ``..``
+    after a symbolic link is the parent of the link's target (``os.path.abspath`` drops
+    ``lnk/..`` by its letters: ``--out lnk/../y`` wrote ``./y`` while the run said "results
+    in lnk/../y", a path where ``ls`` finds nothing, and ``--overwrite`` replaced a ``./y``
+    the user had not named). The last name is kept as given (a link there is the caller's
+    to refuse); OSError where the working directory is gone."""
+    a = os.path.join(os.getcwd(), os.fspath(p))
+    if ".." not in Path(a).parts:
+        return Path(os.path.normpath(a))  # ("." and doubled or trailing slashes only)
+    head, tail = os.path.split(a.rstrip("/"))
+    if tail in ("..", "."):
+        return Path(os.path.realpath(a))
+    return Path(os.path.realpath(head)) / tail

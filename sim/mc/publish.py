@@ -23,6 +23,7 @@ from pathlib import Path
 
 from sim.mc.config import ConfigError
 from sim.mc.outputs import swap_dir
+from sim.mc.paths import mounts_under
 from sim.mc.runner import ChunkStore
 from sim.mc.storage import LOCK, pid_alive, read_record, write_record
 
@@ -255,6 +256,20 @@ def _remove_record_last(old: Path) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
+def _remove_in_place(out: Path) -> None:
+    """Remove the results ``out`` that cannot be moved aside, their run record last and only
+    when everything else is gone (an error names what could not be removed): a run killed
+    meanwhile leaves results that still name themselves as the suite's, which the next
+    publish removes, never a directory of files without a record, which no run replaces."""
+    for p in out.iterdir():
+        if p.is_dir() and not p.is_symlink():
+            shutil.rmtree(p)
+        elif p.name != "run.json":
+            p.unlink()
+    (out / "run.json").unlink(missing_ok=True)
+    out.rmdir()
+
+
 def _drop_stale_swaps(out: Path, mine: Path | None) -> None:
     """Remove the replaced results of ``out`` that an earlier run killed while publishing
     left behind (``.<name>.old.<pid>`` of a process no longer alive, or of this pid: a
@@ -314,8 +329,9 @@ def _exchange(a: Path, b: Path) -> bool:
     if fn(_AT_FDCWD, enc[0], _AT_FDCWD, enc[1], _RENAME_EXCHANGE) == 0:
         return True
     err = ctypes.get_errno()
-    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP, errno.EPERM):
-        return False  # an older kernel, a file system without it (a FUSE mount, NFS)
+    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP, errno.EPERM, errno.EXDEV):
+        return False  # an older kernel, a file system without it (a FUSE mount, NFS; EXDEV:
+        # an overlay, whose directories of a lower layer cannot be renamed)
     raise OSError(err, os.strerror(err), str(b))
 
 
@@ -354,7 +370,17 @@ def publish(stage: Path, out: Path) -> None:
     elif _exchange(stage, out):  # out now holds the new results, stage the old ones
         os.replace(stage, old)
     else:
-        os.replace(out, old)
+        try:
+            os.replace(out, old)
+        except OSError as e:
+            if e.errno != errno.EXDEV or mounts_under(out):  # (never empty a mount in it)
+                raise
+            # out cannot be renamed: a directory of an overlay's lower layer (the project in a
+            # container's image: "Invalid cross-device link" after every chunk was computed,
+            # at each try). Removed instead: what the user put there is copied in the staging
+            # directory, and a kill now leaves that finished run to be published by the next.
+            _remove_in_place(out)
+            old = None
         os.replace(stage, out)
     (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
     _drop_stale_swaps(out, old)

@@ -9,6 +9,7 @@ stored, so the same code and config give byte-identical files.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import fcntl
 import hashlib
@@ -202,16 +203,22 @@ class atomic_path:
             try:
                 os.replace(self.tmp, self.path)
             except OSError as e:  # e.g. a directory where the file goes: leave no temporary
-                self.tmp.unlink(missing_ok=True)  # behind, and name the file, not it
+                self._drop_tmp()  # behind, and name the file, not it
                 raise _named(e, self.path) from None
         else:
-            self.tmp.unlink(missing_ok=True)
+            self._drop_tmp()
             if isinstance(exc, OSError) and exc.filename in (None, "", str(self.tmp)):
                 # a failing write (ulimit -f: EFBIG, a full disk) says only "File too large";
                 # pyarrow's says "Error writing bytes to file. Detail: [errno 27] ...": name
                 # the file it was writing (not the temporary, ".README.md.9762.tmp", a name
                 # the user never saw: a directory of another user's, read-only)
                 raise _named(exc, self.path) from None
+
+    def _drop_tmp(self) -> None:
+        """Remove the temporary if it is there (on a read-only file system unlink fails with
+        EROFS even for a name that is not: that error named ``.README.md.<pid>.tmp``)."""
+        with contextlib.suppress(OSError):
+            self.tmp.unlink(missing_ok=True)
 
 
 def _named(e: OSError, path: Path) -> OSError:
@@ -253,7 +260,8 @@ def _drop_stale_temporaries(path: Path) -> None:
             continue  # a live process writing it
         p = path.parent / n
         if p.is_file() and not p.is_symlink():
-            p.unlink(missing_ok=True)
+            with contextlib.suppress(OSError):  # (read-only: it stays; the write names the file)
+                p.unlink(missing_ok=True)
 
 
 class NonFiniteError(ValueError):
@@ -423,6 +431,9 @@ class StageLock:
                 pid = None
             os.close(fd)
             raise Locked(pid) from None
+        except OSError:  # a file system that cannot lock (ENOLCK: NFS without its lock service)
+            os.close(fd)
+            raise
         os.ftruncate(fd, 0)
         os.write(fd, f"{os.getpid()}\n".encode())
         self.fd = fd

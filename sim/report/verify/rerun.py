@@ -3,6 +3,7 @@ wrote there is ever replaced), the reproducibility record and the report's secti
 
 from __future__ import annotations
 
+import errno
 import os
 import platform
 import subprocess
@@ -155,12 +156,30 @@ def rerun_study(
             stop_children([proc], drain=True)  # as Ctrl-C does, without a word of its own
             raise
     lines = [ln for ln in err.splitlines() if ln.strip()]
+    if proc.returncode == 2 and lines and _system_error(lines[-1]):
+        # a scratch directory full or read-only, memory short: this machine's, not a failed
+        # reproduction (it was recorded as one, "FAILED; nothing compared", exit 1; with
+        # --trials it was "the re-run refused its options")
+        raise VerifyError(f"{d.name}: the re-run could not run here: {lines[-1]}")
     if proc.returncode == 2 and lines and (extra or lines[-1].startswith("sim: error: --")):
         # the re-run refused the options verify passed (--trials, --set, --workers, the
         # --out under --scratch): a request error, not a failed comparison to record
         raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
     sys.stderr.write(err)
     return None if proc.returncode == 0 else f"the re-run {ended(proc.returncode)}"
+
+
+#: the words of every errno, as a failing write or read of the re-run begins its line
+_STRERRORS = {os.strerror(n) for n in errno.errorcode}
+
+
+def _system_error(line: str) -> bool:
+    """Whether the re-run's error line is the system's (``sim: error: No space left on device:
+    PATH``, or not enough memory), not the study's or its options'."""
+    text = line.removeprefix("sim: error: ")
+    return text != line and (
+        text.startswith("not enough memory") or text.split(": ", 1)[0] in _STRERRORS
+    )
 
 
 def verify(
