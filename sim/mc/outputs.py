@@ -21,7 +21,7 @@ import unicodedata
 from pathlib import Path
 
 from sim.mc.config import ConfigError
-from sim.mc.paths import link_problem, mount_point, mounts_under
+from sim.mc.paths import is_chunk_store, link_problem, mount_point, mounts_under
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
@@ -228,7 +228,7 @@ def _check_not_nested(out: Path, shown: str) -> None:
     for up in dict.fromkeys([*out.parents, real, *real.parents]):
         if up == up.parent:  # the root, or "." of a relative path (its real path follows)
             continue
-        if (up / "run.json").is_file() or up.name.endswith(STAGE_SUFFIX) or _dataset(up):
+        if (up / "run.json").is_file() or up.name.endswith(STAGE_SUFFIX) or is_chunk_store(up):
             raise ConfigError(
                 "--out",
                 f"{shown} lies inside {up}, which belongs to another run; choose a directory "
@@ -240,12 +240,6 @@ def _check_not_nested(out: Path, shown: str) -> None:
                 f"{shown} lies inside {up}, the output of a run that is running or unfinished "
                 f"({s}); choose a directory outside every results directory",
             )
-
-
-def _dataset(d: Path) -> bool:
-    """Whether ``d`` is a run's chunk store: ``trials/`` holding ``part-<p>/`` (a folder of the
-    user's named ``trials``, ``~/trials/run1``, is not another run's)."""
-    return d.name == "trials" and any(d.glob("part-*"))
 
 
 def _damage(stage: Path) -> str | None:

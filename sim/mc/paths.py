@@ -19,7 +19,7 @@ from pathlib import Path
 
 from sim.mc.lookalike import differs
 
-__all__ = ["absolute", "link_problem", "mount_point", "mounts_under"]
+__all__ = ["absolute", "is_chunk_store", "link_problem", "mount_point", "mounts_under"]
 
 
 def link_problem(p: str | os.PathLike) -> str | None:
@@ -117,3 +117,9 @@ def absolute(p: str | os.PathLike) -> Path:
     if tail in ("..", "."):
         return Path(os.path.realpath(a))
     return Path(os.path.realpath(head)) / tail
+
+
+def is_chunk_store(d: Path) -> bool:
+    """Whether ``d`` is a run's chunk store: ``trials/`` holding ``part-<p>/`` (a folder of the
+    user's named ``trials``, ``~/trials/run1``, is not another run's)."""
+    return d.name == "trials" and any(d.glob("part-*"))
