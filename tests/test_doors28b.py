@@ -1,0 +1,100 @@
+"""The classes of the sweep doors28b (a study author porting study files between kinds, and a
+batch of many study files), one case each; each failed on the code before its fix.
+
+* A study file copied from another study with ``study`` changed (``brown_dilution.toml`` as
+  ``gridplate_two_plates``, a network file as ``brown_table1``, Brown's keys under a network's
+  ``[sweep]``, brown_dilution's key set by ``--set`` on brown_table1) was refused
+  ``plate.format_mm: unknown key``, with a guess from the new study's own keys (``did you
+  mean block.format_mm?``, agnard's own key): nothing named the study whose key it is, nor
+  how many more of the file's keys were that study's (:mod:`sim.studies.ported`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from sim.cli import main
+from tests.oneline import SIM_ERROR, one_line
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDIES = ROOT / "studies"
+
+
+def _ported(tmp_path: Path, source: str, kind: str, extra: str = "") -> str:
+    """``studies/<source>.toml`` copied with ``study = "<kind>"`` (and ``extra`` appended)."""
+    text = (STUDIES / f"{source}.toml").read_text(encoding="utf-8")
+    lines = [f'study = "{kind}"' if s.startswith("study = ") else s for s in text.splitlines()]
+    path = tmp_path / f"{source}_as_{kind}.toml"
+    path.write_text("\n".join(lines) + "\n" + extra, encoding="utf-8")
+    return str(path)
+
+
+@pytest.mark.parametrize(
+    ("source", "kind", "needles"),
+    [
+        (
+            "brown_dilution",
+            "gridplate_two_plates",
+            ["plate.format_mm: unknown key of the study gridplate_two_plates", "brown_dilution"],
+        ),
+        ("brown_dilution", "agnard_block", ["plate.format_mm", "of brown_dilution that"]),
+        ("network_plate", "brown_table1", ["network.name", "a key of network", "4 keys"]),
+        ("brown_design", "brown_table1", ["scale.graduated_mm", "a key of brown_design"]),
+        ("gridplate_two_plates", "wolf_polynomial", ["plate.grid", "gridplate_two_plates"]),
+    ],
+)
+def test_a_file_ported_from_another_study_names_whose_keys_it_holds(
+    capsys, tmp_path, source, kind, needles
+):
+    path = _ported(tmp_path, source, kind)
+    line = one_line(capsys, main(["check", path]), *needles, prefix=SIM_ERROR)
+    assert "did you mean" not in line, line  # no guess from the new study's own keys
+
+
+def test_a_ported_file_counts_the_other_studys_keys(capsys, tmp_path):
+    path = _ported(tmp_path, "brown_dilution", "gridplate_two_plates")
+    line = one_line(capsys, main(["check", path]), "brown_dilution", prefix=SIM_ERROR)
+    # every key of the file that gridplate_two_plates has not is brown_dilution's
+    assert "the file holds 14 keys of brown_dilution" in line and "11 more" in line, line
+
+
+def test_a_sweep_of_another_studys_key_is_named_with_that_study(capsys, tmp_path):
+    path = _ported(
+        tmp_path, "network_plate", "network", '[sweep]\n"plate.spacing_mm" = [35.0, 45.0]\n'
+    )
+    one_line(
+        capsys,
+        main(["check", path]),
+        "sweep.plate.spacing_mm: unknown key of the study network",
+        "brown_dilution",
+        prefix=SIM_ERROR,
+    )
+
+
+def test_an_override_of_another_studys_key_names_that_study_alone(capsys):
+    argv = ["check", str(STUDIES / "brown_table1.toml"), "--set", "dilution.grids=[3,4]"]
+    line = one_line(capsys, main(argv), "dilution.grids", "a key of brown_dilution")
+    assert "the file holds" not in line, line  # the key is the override's, not the file's
+
+
+def test_a_key_of_no_study_keeps_its_guess(capsys):
+    argv = ["check", str(STUDIES / "brown_table1.toml"), "--set", "plate.gird=4"]
+    line = one_line(capsys, main(argv), "plate.gird: unknown key (did you mean plate.grid?)")
+    assert "a key of" not in line, line
+
+
+def test_a_file_of_a_study_whose_keys_the_other_reads_still_loads(capsys, tmp_path):
+    # brown_table1's keys are all brown_dilution's: the port is legitimate
+    path = _ported(tmp_path, "brown_table1", "brown_dilution")
+    assert main(["check", path]) == 0
+    assert "brown_dilution" in capsys.readouterr().out
+
+
+def test_the_python_api_names_the_other_studys_key_too(tmp_path):
+    import sim
+
+    path = _ported(tmp_path, "network_plate", "brown_table1")
+    with pytest.raises(sim.ConfigError, match=r"network\.name: .*a key of network"):
+        sim.load(path, trials=40)
