@@ -7,10 +7,17 @@ batch of many study files), one case each; each failed on the code before its fi
   ``plate.format_mm: unknown key``, with a guess from the new study's own keys (``did you
   mean block.format_mm?``, agnard's own key): nothing named the study whose key it is, nor
   how many more of the file's keys were that study's (:mod:`sim.studies.ported`).
+* A study file of one study named as another's (``mine/brown_table1.toml`` holding
+  ``study = "brown_dilution"``, run by ``sim.batch --results R``): ``sim report --results R``
+  compared the run's config with ``studies/brown_table1.toml``'s, key by key, "did not run the
+  configuration of studies/brown_table1.toml: `checks.bias_shift_um` = 100 (the file: )" for
+  every key of the other study; it now says whose run the directory holds
+  (:func:`sim.report.glance.design_notes`).
 """
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -98,3 +105,12 @@ def test_the_python_api_names_the_other_studys_key_too(tmp_path):
     path = _ported(tmp_path, "network_plate", "brown_table1")
     with pytest.raises(sim.ConfigError, match=r"network\.name: .*a key of network"):
         sim.load(path, trials=40)
+
+
+def test_a_results_directory_named_as_another_study_is_not_compared_key_by_key(capsys, tmp_path):
+    shutil.copytree(ROOT / "results" / "brown_dilution", tmp_path / "brown_table1")
+    assert main(["report", "--results", str(tmp_path)]) == 0
+    capsys.readouterr()
+    text = (tmp_path / "REPORT.md").read_text(encoding="utf-8")
+    assert "(the file: )" not in text and "did not run the configuration" not in text
+    assert "holds a run of the study `brown_dilution`, not of `studies/brown_table1.toml`" in text
