@@ -13,6 +13,13 @@ batch of many study files), one case each; each failed on the code before its fi
   configuration of studies/brown_table1.toml: `checks.bias_shift_um` = 100 (the file: )" for
   every key of the other study; it now says whose run the directory holds
   (:func:`sim.report.glance.design_notes`).
+* ``python -m sim.batch`` over many files: a file whose run would refuse its config (a ported
+  file, a bad value, a study that does not exist) was found only when its run started, after
+  the others had run (hours in ``make reproduce``); it is now resolved before any run, every
+  such file named, one line each, exit 2 (:func:`sim.batch_checks._configs_problems`). Of
+  several missing files or clashes only the first was named; a directory was "no study
+  file", and a shell pattern that matched nothing said nothing of it
+  (:func:`sim.batch_checks._file_problem`, :func:`sim.batch_checks._clashes`).
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ from pathlib import Path
 
 import pytest
 
+from sim import batch
 from sim.cli import main
 from tests.oneline import SIM_ERROR, one_line
 
@@ -114,3 +122,59 @@ def test_a_results_directory_named_as_another_study_is_not_compared_key_by_key(c
     text = (tmp_path / "REPORT.md").read_text(encoding="utf-8")
     assert "(the file: )" not in text and "did not run the configuration" not in text
     assert "holds a run of the study `brown_dilution`, not of `studies/brown_table1.toml`" in text
+
+
+def _lines(capsys) -> list[str]:
+    """Standard error's lines since the last read, each one a line of the batch driver."""
+    err = capsys.readouterr().err
+    lines = err.splitlines()
+    assert err.endswith("\n") and "Traceback" not in err, err
+    assert all(line.startswith("sim.batch: ") for line in lines), err
+    return lines
+
+
+def test_a_batch_names_every_broken_file_before_any_run(capsys, tmp_path):
+    good = tmp_path / "good.toml"
+    good.write_text((STUDIES / "network_plate.toml").read_text(encoding="utf-8"))
+    files = [
+        good,
+        Path(_ported(tmp_path, "brown_dilution", "gridplate_two_plates")),
+        Path(_ported(tmp_path, "network_plate", "brown_table1")),
+        tmp_path / "nosuch_study.toml",
+        tmp_path / "typo.toml",
+    ]
+    files[3].write_text('study = "nosuch"\n')
+    files[4].write_text(good.read_text().replace("seed = 1", "seed = -1"))
+    results = tmp_path / "R"
+    rc = batch.main(["--results", str(results), *map(str, files), "--", "--trials", "40"])
+    lines = _lines(capsys)
+    assert rc == 2 and len(lines) == 4, lines
+    for f, needle in zip(
+        files[1:], ["plate.format_mm: unknown key", "network.name", "study: unknown", "seed"]
+    ):
+        assert any(line.startswith(f"sim.batch: {f}: ") and needle in line for line in lines), (
+            f,
+            lines,
+        )
+    assert not results.exists()  # no run started, the good file's neither
+
+
+def test_a_batch_names_every_missing_file_and_every_clash(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "d").mkdir()
+    (tmp_path / "d" / "a.toml").write_text((STUDIES / "network_plate.toml").read_text())
+    (tmp_path / "a.toml").write_text((STUDIES / "network_plate.toml").read_text())
+    (tmp_path / "b.toml").write_text((STUDIES / "network_plate.toml").read_text())
+    argv = ["a.toml", "nope1.toml", "d", "no*.toml", "nope2.toml", "d/a.toml", "b.toml", "./b.toml"]
+    assert batch.main(argv) == 2
+    lines = _lines(capsys)
+    assert lines == [
+        "sim.batch: no study file nope1.toml",
+        "sim.batch: d: is a directory, not a study file (name its files: d/*.toml)",
+        "sim.batch: no study file no*.toml (a pattern that matched no file: the shell passed "
+        "it on as it is)",
+        "sim.batch: no study file nope2.toml",
+        "sim.batch: a.toml and d/a.toml would both write results/a",
+        "sim.batch: b.toml is listed twice",
+    ], lines
+    assert not (tmp_path / "results").exists()
