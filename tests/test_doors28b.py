@@ -178,3 +178,15 @@ def test_a_batch_names_every_missing_file_and_every_clash(capsys, tmp_path, monk
         "sim.batch: b.toml is listed twice",
     ], lines
     assert not (tmp_path / "results").exists()
+
+
+def test_a_batch_names_a_pipe_as_no_regular_file(capsys, tmp_path):
+    import os
+
+    os.mkfifo(tmp_path / "pipe.toml")  # there, but no study file: was "no study file"
+    assert batch.main([str(tmp_path / "pipe.toml"), "/dev/null"]) == 2
+    assert _lines(capsys) == [
+        f"sim.batch: {tmp_path / 'pipe.toml'}: not a regular file (a pipe or a device): name "
+        "the study file",
+        "sim.batch: /dev/null: not a regular file (a pipe or a device): name the study file",
+    ]
