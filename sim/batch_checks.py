@@ -21,6 +21,7 @@ from sim.cli import check_run_args, load_run
 from sim.cli_args import parser as run_parser
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
+from sim.mc.estimate import check_limits, estimate
 from sim.mc.paths import link_problem
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
@@ -134,7 +135,8 @@ def _file_problem(f: Path) -> str | None:
 def _configs_problems(files: list[Path], run_args: list[str]) -> tuple[list[str], dict]:
     """``(lines, loaded)``: one line for each study file whose run would refuse its config
     (``sim run FILE RUN_ARGS`` resolves it here, before any run starts: a study file ported
-    from another study, a bad key or value, a bad ``[sweep]``), every such file named, and
+    from another study, a bad key or value, a bad ``[sweep]``, a run over the memory or work
+    limits), every such file named, and
     ``{file: (args, study, cfg, sweep)}`` of the others (``--stale-only`` reads them). One
     broken file among many ran the others first, for hours in ``make reproduce``, and was
     named only when its turn came. A ``--set`` key a study has not is left out of its check
@@ -151,6 +153,8 @@ def _configs_problems(files: list[Path], run_args: list[str]) -> tuple[list[str]
             study, cfg = load_run(args)
             check_chunks(cfg)
             sweep = read_sweep(f, study.schema)
+            est = estimate(cfg, sweep)  # the limits its run applies (sim check's too)
+            check_limits(est, args.max_memory_gb, args.max_adjustments, args.workers)
         except (ConfigError, StudyError) as e:  # a line that names the file already: as it is
             lines.append(str(e) if str(e).startswith(f"{f}: ") else f"{f}: {e}")
             continue

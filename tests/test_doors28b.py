@@ -19,7 +19,8 @@ batch of many study files), one case each; each failed on the code before its fi
   such file named, one line each, exit 2 (:func:`sim.batch_checks._configs_problems`). Of
   several missing files or clashes only the first was named; a directory was "no study
   file", and a shell pattern that matched nothing said nothing of it
-  (:func:`sim.batch_checks._file_problem`, :func:`sim.batch_checks._clashes`).
+  (:func:`sim.batch_checks._file_problem`, :func:`sim.batch_checks._clashes`); a run over the
+  memory or work limit is refused with them.
 """
 
 from __future__ import annotations
@@ -190,3 +191,17 @@ def test_a_batch_names_a_pipe_as_no_regular_file(capsys, tmp_path):
         "the study file",
         "sim.batch: /dev/null: not a regular file (a pipe or a device): name the study file",
     ]
+
+
+def test_a_batch_refuses_a_run_over_the_work_limit_before_any_run(capsys, tmp_path):
+    good = tmp_path / "good.toml"
+    good.write_text((STUDIES / "network_plate.toml").read_text(encoding="utf-8"))
+    big = tmp_path / "big.toml"  # a run its own start refuses, after the others had run
+    big.write_text(good.read_text().replace("trials = 2000", "trials = 1000000"))
+    big.write_text(big.read_text().replace("chunk = 100", "chunk = 10000"))
+    results = tmp_path / "R"  # about 9e6 adjustments, the good file's 2e4
+    argv = ["--results", str(results), str(good), str(big), "--", "--max-adjustments", "1e6"]
+    assert batch.main(argv) == 2
+    (line,) = _lines(capsys)
+    assert line.startswith(f"sim.batch: {big}: network: the run needs") and "limit" in line
+    assert not results.exists()
