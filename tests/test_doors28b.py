@@ -6,7 +6,10 @@ batch of many study files), one case each; each failed on the code before its fi
   ``[sweep]``, brown_dilution's key set by ``--set`` on brown_table1) was refused
   ``plate.format_mm: unknown key``, with a guess from the new study's own keys (``did you
   mean block.format_mm?``, agnard's own key): nothing named the study whose key it is, nor
-  how many more of the file's keys were that study's (:mod:`sim.studies.ported`).
+  how many more of the file's keys were that study's (:mod:`sim.studies.ported`). A
+  ``kind = "gridplate_two_plates"`` written to switch the study was answered "did you mean
+  datum.kind?" (the network's datum); a file whose ``study`` line was deleted is told which
+  studies its keys fit.
 * A study file of one study named as another's (``mine/brown_table1.toml`` holding
   ``study = "brown_dilution"``, run by ``sim.batch --results R``): ``sim report --results R``
   compared the run's config with ``studies/brown_table1.toml``'s, key by key, "did not run the
@@ -123,6 +126,30 @@ def test_a_results_directory_named_as_another_study_is_not_compared_key_by_key(c
     text = (tmp_path / "REPORT.md").read_text(encoding="utf-8")
     assert "(the file: )" not in text and "did not run the configuration" not in text
     assert "holds a run of the study `brown_dilution`, not of `studies/brown_table1.toml`" in text
+
+
+def test_kind_written_for_study_says_how_a_file_names_its_study(capsys, tmp_path):
+    path = tmp_path / "kind.toml"
+    text = (STUDIES / "network_plate.toml").read_text(encoding="utf-8")
+    path.write_text('kind = "gridplate_two_plates"\n' + text, encoding="utf-8")
+    line = one_line(capsys, main(["check", str(path)]), 'write study = "gridplate_two_plates"')
+    assert line.startswith(f"{SIM_ERROR}kind: unknown key") and "datum.kind" not in line, line
+
+
+def test_a_file_without_study_is_told_which_studies_its_keys_fit(capsys, tmp_path):
+    path = tmp_path / "nostudy.toml"
+    text = (STUDIES / "brown_table1.toml").read_text(encoding="utf-8")
+    path.write_text(text.replace('study = "brown_table1"', ""), encoding="utf-8")
+    one_line(
+        capsys,
+        main(["check", str(path)]),
+        "study: missing",
+        "every key of the file is a key of brown_dilution, brown_table1",
+        prefix=SIM_ERROR,
+    )
+    path.write_text("trials = 40\n", encoding="utf-8")  # keys of every study: no list
+    line = one_line(capsys, main(["check", str(path)]), "study: missing")
+    assert "every key" not in line, line
 
 
 def _lines(capsys) -> list[str]:

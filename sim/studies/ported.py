@@ -47,11 +47,20 @@ def foreign_key(e: ConfigError, path: str | os.PathLike) -> ConfigError:
     that other studies have (a ``sweep.`` key too), one line naming those studies and, when
     the key is the file's own (not an override's), how many of the file's keys (and swept
     keys) are the likeliest one's, the first few by name."""
+    if e.key == "study" and "missing" in str(e):
+        return _missing_study(e, path)
     if not isinstance(e.key, str) or not str(e).startswith(f"{e.key}: unknown key"):
         return e
     try:
         doc = read_toml(path)
         name = doc.get("study")
+        value = doc.get(e.key)
+        if isinstance(value, str) and value in MODULES and value != name:  # kind = "network"
+            return ConfigError(
+                e.key,
+                f'unknown key: a study file names its study by study = "..." alone (this '
+                f'file\'s is {name}; for {value}, write study = "{value}" and leave {e.key} out)',
+            )
         schema = get_study(name).schema
         keys = list(flatten({k: v for k, v in doc.items() if k not in ("study", "sweep")}))
         try:
@@ -78,3 +87,21 @@ def foreign_key(e: ConfigError, path: str | os.PathLike) -> ConfigError:
             "study keeps that study's keys: leave them out)"
         )
     return ConfigError(e.key, text)
+
+
+def _missing_study(e: ConfigError, path: str | os.PathLike) -> ConfigError:
+    """``e`` (a file without ``study``), with the studies whose keys hold every key of the
+    file (the line was deleted, or ``kind = ...`` written for it), when there are any."""
+    try:
+        doc = read_toml(path)
+    except (ConfigError, OSError):
+        return e
+    common = ("trials", "seed", "chunk")  # every study's: they tell none apart
+    keys = [k for k in flatten({k: v for k, v in doc.items() if k != "sweep"}) if k not in common]
+    fits = [s for s, sch in _schemas("").items() if keys and all(k in sch for k in keys)]
+    if not fits or len(fits) > SHOWN:
+        return e
+    return ConfigError(
+        "study",
+        f"{str(e).removeprefix('study: ')}; every key of the file is a key of {', '.join(fits)}",
+    )
