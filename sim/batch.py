@@ -319,7 +319,7 @@ def _main(argv: list[str]) -> int:
     if why:
         print(f"sim.batch: run options: {why}", file=sys.stderr)
         return 2
-    bad, loaded = _configs_problems(files, run_args)  # before any run: every file named
+    bad, loaded = _configs_problems(files, run_args, Path(args.results))  # every file named
     for why in bad:
         print(f"sim.batch: {why}", file=sys.stderr)
     if bad:

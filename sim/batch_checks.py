@@ -22,6 +22,7 @@ from sim.cli_args import parser as run_parser
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
 from sim.mc.estimate import check_limits, estimate
+from sim.mc.outputs import check_out
 from sim.mc.paths import link_problem
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
@@ -132,11 +133,14 @@ def _file_problem(f: Path) -> str | None:
     return f"no study file {f}"
 
 
-def _configs_problems(files: list[Path], run_args: list[str]) -> tuple[list[str], dict]:
+def _configs_problems(
+    files: list[Path], run_args: list[str], results: Path | None = None
+) -> tuple[list[str], dict]:
     """``(lines, loaded)``: one line for each study file whose run would refuse its config
     (``sim run FILE RUN_ARGS`` resolves it here, before any run starts: a study file ported
     from another study, a bad key or value, a bad ``[sweep]``, a run over the memory or work
-    limits), every such file named, and
+    limits, a ``<results>/<file name>`` its run refuses to replace: a file, a foreign
+    directory, a link), every such file named, and
     ``{file: (args, study, cfg, sweep)}`` of the others (``--stale-only`` reads them). One
     broken file among many ran the others first, for hours in ``make reproduce``, and was
     named only when its turn came. A ``--set`` key a study has not is left out of its check
@@ -155,7 +159,15 @@ def _configs_problems(files: list[Path], run_args: list[str]) -> tuple[list[str]
             sweep = read_sweep(f, study.schema)
             est = estimate(cfg, sweep)  # the limits its run applies (sim check's too)
             check_limits(est, args.max_memory_gb, args.max_adjustments, args.workers)
-        except (ConfigError, StudyError) as e:  # a line that names the file already: as it is
+            if results is not None:  # each run is --overwrite: the record is not compared
+                out = results / f.stem
+                record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
+                check_out(Path(os.path.abspath(out)), str(out), record, True)
+        except ConfigError as e:  # a line that names the file already: as it is
+            e = _out_in_batch_words(e)
+            lines.append(str(e) if str(e).startswith(f"{f}: ") else f"{f}: {e}")
+            continue
+        except StudyError as e:
             lines.append(str(e) if str(e).startswith(f"{f}: ") else f"{f}: {e}")
             continue
         except RecursionError:  # nested too deeply for the parser: its run says so
@@ -164,6 +176,17 @@ def _configs_problems(files: list[Path], run_args: list[str]) -> tuple[list[str]
         if args.set == (base.set or []):  # the run's own config (not one without a --set)
             loaded[f] = (args, study, cfg, sweep)
     return lines, loaded
+
+
+def _out_in_batch_words(e: ConfigError) -> ConfigError:
+    """``e``, a refusal of a run's ``--out`` in the words of the batch's command line, whose
+    ``--results`` chose it (as the batch says its runs' refusals)."""
+    if e.key != "--out":
+        return e
+    text = (
+        str(e).removeprefix("--out: ").replace("choose another --out", "choose another --results")
+    )
+    return ConfigError("--results", text)
 
 
 def _replaces_project_results(f: Path, results: Path) -> str | None:

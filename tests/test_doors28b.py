@@ -232,3 +232,27 @@ def test_a_batch_refuses_a_run_over_the_work_limit_before_any_run(capsys, tmp_pa
     (line,) = _lines(capsys)
     assert line.startswith(f"sim.batch: {big}: network: the run needs") and "limit" in line
     assert not results.exists()
+
+
+def test_a_batch_refuses_results_its_runs_would_not_replace_before_any_run(capsys, tmp_path):
+    files = []
+    for name in ("a", "b", "c", "d"):
+        files.append(tmp_path / f"{name}.toml")
+        files[-1].write_text((STUDIES / "network_plate.toml").read_text(encoding="utf-8"))
+    results = tmp_path / "R"
+    results.mkdir()
+    (results / "b").symlink_to(tmp_path)  # each run refused it, after the others had run
+    (results / "c").write_text("mine")
+    (results / "d").mkdir()
+    (results / "d" / "notes.txt").write_text("mine")
+    assert batch.main(["--results", str(results), *map(str, files), "--", "--trials", "40"]) == 2
+    lines = _lines(capsys)
+    assert len(lines) == 3, lines
+    for name, needle in (("b", "symbolic link"), ("c", "is a file"), ("d", "no sim run record")):
+        assert any(
+            line.startswith(f"sim.batch: {tmp_path / name}.toml: --results: {results / name} ")
+            and needle in line
+            for line in lines
+        ), (name, lines)
+    assert sorted(p.name for p in results.iterdir()) == ["b", "c", "d"]  # a was not run
+    assert (results / "d" / "notes.txt").read_text() == "mine"
