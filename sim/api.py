@@ -41,6 +41,7 @@ from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
 from sim.studies import load_study
+from sim.studies.ported import foreign_key
 
 __all__ = ["load", "StudyHandle", "Results"]
 
@@ -389,13 +390,13 @@ def _plain(v: Any) -> Any:
 def _load_picking_chunk(study_file, vals: dict):
     """``load_study``; ``trials`` without ``chunk`` picks the largest chunk giving at least
     MIN_CHUNKS chunks, as ``sim run --trials`` does (same config, same results)."""
-    if "trials" not in vals or "chunk" in vals:
-        return load_study(study_file, values=vals)
     try:
+        if "trials" not in vals or "chunk" in vals:
+            return load_study(study_file, values=vals)
         study, cfg = load_study(study_file, values=vals)
     except ConfigError as e:
-        if e.key != "chunk":
-            raise
+        if e.key != "chunk" or "trials" not in vals or "chunk" in vals:
+            raise foreign_key(e, study_file) from None  # a key of another study: whose
         # the file's chunk is too large for the trials asked for
         _, cfg = load_study(study_file, values={**vals, "chunk": 1})
         return load_study(study_file, values={**vals, "chunk": max(1, cfg["trials"] // MIN_CHUNKS)})

@@ -16,8 +16,11 @@ only the studies whose results are not current (:func:`is_current`: their run re
 the config this run would resolve, run options included, and the current code), the others
 are reported up to date; each study run is named with the reason (:func:`why_stale`). A run that fails prints its own one-line message, which starts with the name of its study
 file; the others go on,
-and the exit code is that of the first failure (1 when a run was killed). A missing study
-file is bad input: one line, exit 2.
+and the exit code is that of the first failure (1 when a run was killed). Bad input is
+refused before any run starts, exit 2, one line for each bad file (every one named): a file
+that is missing or a directory, two runs into one results directory, and a study file whose
+config its run would refuse (resolved here with the run options, as ``sim run`` resolves it:
+a file ported from another study, a bad value).
 """
 
 from __future__ import annotations
@@ -45,6 +48,8 @@ single_threaded_blas()  # before NumPy loads (the study modules import it)
 
 from sim.batch_checks import (  # noqa: E402
     _clashes,
+    _configs_problems,
+    _file_problem,
     _replaces_project_results,
     _run_options_problem,
     _timings_problem,
@@ -97,19 +102,24 @@ def run_all(
     stale_only=False,
     log=print,
     extra=None,
+    loaded=None,
 ) -> dict[str, tuple[int, float, float]]:
     """Run every study file of ``files`` into ``results/<stem>``, ``jobs`` at a time, with
     ``run_args`` (and ``extra[stem]``, more arguments of one study's run). ``log`` gets the
     up-to-date lines and, for runs side by side, each run's output when it ends. Returns
     ``{stem: (exit code, wall seconds, start in seconds after the first start)}`` of the runs
-    made (up-to-date studies are left out)."""
+    made (up-to-date studies are left out). ``loaded``: ``{file: (args, study, cfg, sweep)}``
+    of the files the batch resolved before (:func:`sim.batch_checks._configs_problems`),
+    which ``--stale-only`` does not resolve again."""
     todo = []
     for f in order(files):
-        if stale_only and is_current(f, results / f.stem, run_args):
+        done = (loaded or {}).get(f)
+        if stale_only and is_current(f, results / f.stem, run_args, done):
             log(f"{f.stem}: up to date")
             continue
         if stale_only:
-            log(f"{f.stem}: out of date ({why_stale(f, results / f.stem, run_args)}): running it")
+            why = why_stale(f, results / f.stem, run_args, done)
+            log(f"{f.stem}: out of date ({why}): running it")
         todo.append(f)
     quiet = ["--quiet"] if jobs > 1 and "--quiet" not in run_args else []
 
@@ -295,17 +305,11 @@ def _main(argv: list[str]) -> int:
             print(f"sim.batch: {name}: {name_problem(v)} (got {v!r})", file=sys.stderr)
             return 2
     files = [Path(f) for f in args.files]
-    bad = [f for f in files if not f.is_file()]
-    if bad:
-        why = link_problem(bad[0])
-        print(
-            f"sim.batch: {bad[0]} {why}" if why else f"sim.batch: no study file {bad[0]}",
-            file=sys.stderr,
-        )
-        return 2
-    why = _clashes(files, run_args, args.results)
-    if why:
+    bad = [why for f in files if (why := _file_problem(f))]  # every one, not the first only
+    bad += _clashes([f for f in files if not _file_problem(f)], run_args, args.results)
+    for why in bad:
         print(f"sim.batch: {why}", file=sys.stderr)
+    if bad:
         return 2
     why = _run_options_problem(run_args)
     if why:
@@ -314,6 +318,11 @@ def _main(argv: list[str]) -> int:
     why, note = _unknown_sets(files, run_args)
     if why:
         print(f"sim.batch: run options: {why}", file=sys.stderr)
+        return 2
+    bad, loaded = _configs_problems(files, run_args, Path(args.results))  # every file named
+    for why in bad:
+        print(f"sim.batch: {why}", file=sys.stderr)
+    if bad:
         return 2
     why = _timings_problem(args.timings) if args.timings is not None else None
     if why:
@@ -330,7 +339,9 @@ def _main(argv: list[str]) -> int:
         print(f"sim.batch: note: {note}", file=sys.stderr)
     log = _Stdout()
     try:
-        done = run_all(files, Path(args.results), args.jobs, run_args, args.stale_only, log)
+        done = run_all(
+            files, Path(args.results), args.jobs, run_args, args.stale_only, log, loaded=loaded
+        )
         check_interrupt()  # before the timings are written
     except KeyboardInterrupt:  # the runs were stopped and cleaned up
         print(INTERRUPTED, file=sys.stderr)

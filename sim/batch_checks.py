@@ -10,6 +10,7 @@ refuse, ``--set`` keys no study has, a timings file that is not the batch's).
 from __future__ import annotations
 
 import contextlib
+import copy
 import io
 import json
 import os
@@ -19,7 +20,10 @@ from sim.cli import DOC as cli_doc
 from sim.cli import check_run_args, load_run
 from sim.cli_args import parser as run_parser
 from sim.mc.codehash import study_code_hash
-from sim.mc.config import ConfigError, StudyError, parse_override, read_toml
+from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
+from sim.mc.estimate import check_limits, estimate
+from sim.mc.outputs import check_out
+from sim.mc.paths import link_problem
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
 from sim.mc.sweep import read_sweep
@@ -29,15 +33,19 @@ from sim.studies import get_study
 __all__ = ["is_current", "why_stale"]
 
 
-def is_current(study_file: str | Path, results: str | Path, run_args=()) -> bool:
+def is_current(
+    study_file: str | Path, results: str | Path, run_args=(), loaded: tuple | None = None
+) -> bool:
     """True when ``results/run.json`` records the config ``sim run STUDY_FILE RUN_ARGS``
     resolves (the study file with the run options' ``--set``, ``--trials``, ``--seed``,
     ``--chunk``) and the study's current code hash, and the run drew its figures (not
     ``--no-figures``) unless ``run_args`` ask for none (:func:`why_stale` says None)."""
-    return why_stale(study_file, results, run_args) is None
+    return why_stale(study_file, results, run_args, loaded) is None
 
 
-def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str | None:
+def why_stale(
+    study_file: str | Path, results: str | Path, run_args=(), loaded: tuple | None = None
+) -> str | None:
     """Why ``results`` are not current for ``sim run STUDY_FILE RUN_ARGS`` (no results, a
     config key that differs, the code changed since, no figures or one replaced by hand), in
     a few words; None when they are (:func:`is_current`). ``--stale-only`` printed nothing
@@ -51,10 +59,13 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
         return "its run record is not one (run.json is not UTF-8 text)"
     try:
         record = json.loads(text)
-        with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
-            args = run_parser(cli_doc).parse_args(["run", str(study_file), *run_args])
-        study, cfg = load_run(args)
-        sweep = read_sweep(study_file, study.schema)  # recorded with the config (execute):
+        if loaded is not None:  # the batch resolved it already (_configs_problems)
+            args, study, cfg, sweep = loaded
+        else:
+            with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
+                args = run_parser(cli_doc).parse_args(["run", str(study_file), *run_args])
+            study, cfg = load_run(args)
+            sweep = read_sweep(study_file, study.schema)  # recorded with the config (execute):
     except (OSError, ValueError, RecursionError, ConfigError, StudyError, SystemExit):
         return "its run record or study file does not load"  # RecursionError: nested too deep
     if not isinstance(record, dict):  # run.json edited into another JSON shape: not current
@@ -80,23 +91,102 @@ def why_stale(study_file: str | Path, results: str | Path, run_args=()) -> str |
     return changed_figure(Path(results))  # a figure replaced by hand: drawn again
 
 
-def _clashes(files: list[Path], run_args: list[str], results: str = "results") -> str | None:
-    """Why these runs cannot share one batch: two of them would write one results directory
-    (the same file twice, two files of one name), or a file's name is ``.toml`` or
-    ``...toml`` (its results would be <results> itself or its parent)."""
+def _clashes(files: list[Path], run_args: list[str], results: str = "results") -> list[str]:
+    """Why these runs cannot share one batch, one line each (every clash, not only the
+    first: a batch of many files was refused one clash at a time): two of them would write
+    one results directory (the same file twice, two files of one name), or a file's name is
+    ``.toml`` or ``...toml`` (its results would be <results> itself or its parent)."""
     seen: dict[str, Path] = {}
+    out = []
     for f in files:
         if f.stem in ("", ".", ".."):
-            return f"{f}: a study file named like this would write <results>/{f.stem}"
-        if f.stem in seen:
+            out.append(f"{f}: a study file named like this would write <results>/{f.stem}")
+        elif f.stem in seen:
             same = f.resolve() == seen[f.stem].resolve()
-            return (
+            out.append(
                 f"{f} is listed twice"
                 if same
                 else f"{seen[f.stem]} and {f} would both write {Path(results) / f.stem}"
             )
-        seen[f.stem] = f
-    return None
+        else:
+            seen[f.stem] = f
+    return out
+
+
+def _file_problem(f: Path) -> str | None:
+    """Why ``f`` names no study file (one line, the path first), or None: a directory (``sim
+    check`` said so; the batch said "no study file"), a link that leads nowhere, a pipe or a
+    device (also "no study file"), a shell pattern that matched no file (the shell passes it
+    on as it is), or nothing there."""
+    if f.is_file():
+        return None
+    if f.is_dir():
+        return f"{f}: is a directory, not a study file (name its files: {f}/*.toml)"
+    if why := link_problem(f):
+        return f"{f} {why}"
+    if f.exists():  # a FIFO, a device (/dev/null): there, but no study file
+        return f"{f}: not a regular file (a pipe or a device): name the study file"
+    if any(c in str(f) for c in "*?[") and not f.exists():
+        return (
+            f"no study file {f} (a pattern that matched no file: the shell passed it on as it is)"
+        )
+    return f"no study file {f}"
+
+
+def _configs_problems(
+    files: list[Path], run_args: list[str], results: Path | None = None
+) -> tuple[list[str], dict]:
+    """``(lines, loaded)``: one line for each study file whose run would refuse its config
+    (``sim run FILE RUN_ARGS`` resolves it here, before any run starts: a study file ported
+    from another study, a bad key or value, a bad ``[sweep]``, a run over the memory or work
+    limits, a ``<results>/<file name>`` its run refuses to replace: a file, a foreign
+    directory, a link), every such file named, and
+    ``{file: (args, study, cfg, sweep)}`` of the others (``--stale-only`` reads them). One
+    broken file among many ran the others first, for hours in ``make reproduce``, and was
+    named only when its turn came. A ``--set`` key a study has not is left out of its check
+    (:func:`_unknown_sets` says it once; that run refuses it)."""
+    with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
+        base = run_parser(cli_doc).parse_args(["run", "STUDY.toml", *run_args])
+    lines, loaded = [], {}
+    for f in files:
+        args = copy.copy(base)
+        args.study, args.quiet = str(f), True
+        try:
+            schema = get_study(read_toml(f).get("study")).schema
+            args.set = [t for t in base.set or [] if parse_override(t)[0] in schema]
+            study, cfg = load_run(args)
+            check_chunks(cfg)
+            sweep = read_sweep(f, study.schema)
+            est = estimate(cfg, sweep)  # the limits its run applies (sim check's too)
+            check_limits(est, args.max_memory_gb, args.max_adjustments, args.workers)
+            if results is not None:  # each run is --overwrite: the record is not compared
+                out = results / f.stem
+                record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
+                check_out(Path(os.path.abspath(out)), str(out), record, True)
+        except ConfigError as e:  # a line that names the file already: as it is
+            e = _out_in_batch_words(e)
+            lines.append(str(e) if str(e).startswith(f"{f}: ") else f"{f}: {e}")
+            continue
+        except StudyError as e:
+            lines.append(str(e) if str(e).startswith(f"{f}: ") else f"{f}: {e}")
+            continue
+        except RecursionError:  # nested too deeply for the parser: its run says so
+            lines.append(f"{f}: malformed TOML: nested too deeply")
+            continue
+        if args.set == (base.set or []):  # the run's own config (not one without a --set)
+            loaded[f] = (args, study, cfg, sweep)
+    return lines, loaded
+
+
+def _out_in_batch_words(e: ConfigError) -> ConfigError:
+    """``e``, a refusal of a run's ``--out`` in the words of the batch's command line, whose
+    ``--results`` chose it (as the batch says its runs' refusals)."""
+    if e.key != "--out":
+        return e
+    text = (
+        str(e).removeprefix("--out: ").replace("choose another --out", "choose another --results")
+    )
+    return ConfigError("--results", text)
 
 
 def _replaces_project_results(f: Path, results: Path) -> str | None:

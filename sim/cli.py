@@ -48,6 +48,7 @@ from sim.mc.toml_text import toml_key, toml_value
 from sim.report.run_summary import terminal_summary, write_run_readme
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
 from sim.studies import get_study, load_study, unread_keys
+from sim.studies.ported import foreign_key
 from sim.threads import interrupted, memory_words, shadowed, short_of_memory
 
 __all__ = ["main", "check_run_args"]
@@ -122,7 +123,7 @@ def load_run(args):
         study, cfg = load_study(args.study, overrides, args.trials, args.seed)
     except ConfigError as e:
         if not (e.key == "chunk" and trials_given and args.chunk is None and "chunk" not in given):
-            raise
+            raise foreign_key(e, args.study) from None  # a key of another study: whose
         # the file's chunk is too large for the trials asked for: --trials picks the chunk
         _, cfg = load_study(args.study, [*overrides, "chunk=1"], args.trials, args.seed)
         overrides = [*overrides, f"chunk={max(1, cfg['trials'] // MIN_CHUNKS)}"]

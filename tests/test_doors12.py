@@ -119,7 +119,7 @@ def test_a_full_standard_output_is_named(capsys):
 
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
 def test_a_full_standard_output_ends_a_batch_in_one_line(capsys, monkeypatch):
-    def run_all(files, results, jobs, run_args, stale_only, log):
+    def run_all(files, results, jobs, run_args, stale_only, log, **_):
         log("network_plate: results in ...")
         return {"network_plate": (0, 1.0, 0.0)}
 

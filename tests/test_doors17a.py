@@ -105,17 +105,18 @@ def test_a_network_of_non_ascii_names_runs_in_a_locale_that_is_not_utf8(tmp_path
 
 
 def test_batch_reads_its_runs_lines_in_the_encoding_they_are_written_in(tmp_path):
-    bad = tmp_path / "bad.toml"
-    bad.write_text(STUDY.read_text(encoding="utf-8") + "nosuch = 1\n", encoding="utf-8")
-    p = subprocess.run(
+    bad = tmp_path / "bad.toml"  # its run refuses the umask (a bad config, or a results
+    bad.write_text(STUDY.read_text(encoding="utf-8"), encoding="utf-8")  # directory it would
+    p = subprocess.run(  # not replace, the driver refuses itself: tests/test_doors28b.py)
         [sys.executable, "-m", "sim.batch", str(bad), "--", *SMALL],
         capture_output=True,
         cwd=tmp_path,
         env={**os.environ, "PYTHONIOENCODING": "utf-16"},
+        preexec_fn=lambda: os.umask(0o277),
     )
     err = p.stderr.decode("utf-16").strip()
     assert p.returncode == 2 and "\n" not in err and "\x00" not in err, (p.returncode, err)
-    assert err.startswith("bad.toml") and "nosuch: unknown key" in err, err
+    assert err.startswith("bad.toml: sim: error: umask 0277") and "denies" in err, err
 
 
 def test_too_many_options_are_refused_before_argparse_reads_them(capsys):

@@ -208,9 +208,17 @@ def design_notes(entries: list[tuple], results: Path, design: Callable | None) -
     named after (``studies/<name>.toml``, ``design(name)``): the keys changed (at most six),
     so that a ``--set`` run is not read as the paper's design."""
     out = []
-    for _, name, *_ in entries:
+    for _, name, study, *_ in entries:
         base = design(name) if design is not None else None
         if not base:
+            continue
+        if base.get("study") != study.name:  # a study file of another study named like it:
+            # its keys were compared with the other study's ("(the file: )" for each)
+            out.append(
+                f"- {md_link(name)} holds a run of the study `{study.name}`, not of "
+                f"`studies/{name}.toml` (the study `{base.get('study')}`): a study file of "
+                f"`{study.name}` named `{name}.toml`. Its verdicts are `{study.name}`'s."
+            )
             continue
         mine = _config_of(results / name)
         diff = [k for k in sorted(set(mine) | set(base)) if mine.get(k) != base.get(k)]
