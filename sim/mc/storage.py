@@ -202,16 +202,25 @@ class atomic_path:
             try:
                 os.replace(self.tmp, self.path)
             except OSError as e:  # e.g. a directory where the file goes: leave no temporary
-                self.tmp.unlink(missing_ok=True)  # behind, and name the file, not it
+                _unlink_quietly(self.tmp)  # behind, and name the file, not it
                 raise _named(e, self.path) from None
         else:
-            self.tmp.unlink(missing_ok=True)
+            _unlink_quietly(self.tmp)
             if isinstance(exc, OSError) and exc.filename in (None, "", str(self.tmp)):
                 # a failing write (ulimit -f: EFBIG, a full disk) says only "File too large";
                 # pyarrow's says "Error writing bytes to file. Detail: [errno 27] ...": name
                 # the file it was writing (not the temporary, ".README.md.9762.tmp", a name
                 # the user never saw: a directory of another user's, read-only)
                 raise _named(exc, self.path) from None
+
+
+def _unlink_quietly(p: Path) -> None:
+    """Remove the temporary ``p`` if there: on a read-only mount removing a file never made
+    fails with EROFS, which replaced the error reported (it named ``.README.md.9762.tmp``)."""
+    try:
+        p.unlink(missing_ok=True)
+    except OSError:
+        pass  # nothing was made there (or it cannot be removed either)
 
 
 def _named(e: OSError, path: Path) -> OSError:
