@@ -10,6 +10,18 @@ were all right already.
   results/agnard_block/.README.md.22149.tmp", a file the user never saw: removing the
   temporary that could not be made failed too there (EROFS, not ENOENT), and that error
   replaced the one being reported (:class:`sim.mc.storage.atomic_path`).
+* the reproducibility record did not say which results it checked: a study re-run after
+  ``make verify`` (``make reproduce`` after an edit, at a newer commit, or in another terminal
+  while verify ran), its results replaced by a copy or removed, still read "within tolerance:
+  yes" in the report's *Reproducibility* section (the committed REPORT.md said so of every
+  study re-run the day after its record). The record now holds the sha256 of the tables each
+  comparison read, and the section says which results are not the ones checked
+  (:func:`sim.report.verify.record.markdown`).
+* ``make verify`` during a ``make reproduce`` that publishes new results of the study it is
+  comparing: the tables read before the publish were of the old run, the rest of the new one,
+  and the FAILED line listed deviations that no re-run had (not "stale"); the comparison is
+  now made again when the directory changed while it read it
+  (:func:`sim.report.verify.rerun._settled`). The test publishes between two tables.
 """
 
 import errno
@@ -20,7 +32,12 @@ from pathlib import Path
 
 from oneline import SIM_ERROR, one_line
 
+import sim.report.verify.rules as rules
 from sim.cli import main
+from sim.mc.outputs import stage_dir
+from sim.mc.publish import publish
+from sim.report.verify import main as verify_main
+from sim.report.verify import markdown
 
 
 def _read_only(monkeypatch, top: Path) -> None:
@@ -59,3 +76,60 @@ def test_sim_report_on_a_read_only_mount_names_the_readme_not_its_temporary(
     assert line.endswith(str(results / "network_plate" / "README.md")), line
     assert ".tmp" not in line
     assert {p: p.read_bytes() for p in results.rglob("*") if p.is_file()} == before
+
+
+def _results_and_rerun(tmp_path: Path, tiny_run) -> tuple[Path, Path]:
+    """``results/network_plate`` (committed) and ``scratch/network_plate`` (its re-run)."""
+    results, scratch = tmp_path / "results", tmp_path / "scratch"
+    for d in (results, scratch):
+        shutil.copytree(tiny_run("network_plate"), d / "network_plate")
+    return results, scratch
+
+
+def _row(text: str, study: str) -> str:
+    return next(ln for ln in text.splitlines() if ln.startswith(f"| {study} |"))
+
+
+def test_the_report_does_not_call_results_replaced_after_verify_verified(
+    tiny_run, tmp_path, capsys
+):
+    results, scratch = _results_and_rerun(tmp_path, tiny_run)
+    args = ["--results", str(results), "--scratch", str(scratch), "--no-rerun"]
+    assert verify_main(args) == 0
+    capsys.readouterr()
+    assert _row(markdown(results), "network_plate").endswith("| yes |  |")
+    shutil.rmtree(results / "network_plate")  # make reproduce after the study file was edited
+    shutil.copytree(tiny_run("network_plate", "--set", "seed=5"), results / "network_plate")
+    text = markdown(results)
+    row = _row(text, "network_plate")
+    assert "| yes |" not in row and "not checked now" in row and "changed" in row, row
+    assert "run make verify again" in text
+    shutil.rmtree(results / "network_plate")  # a copy of the results without this study
+    shutil.copytree(tiny_run("network_plate"), results / "network_plate_copy")
+    text = markdown(results)
+    assert "no longer there" in _row(text, "network_plate")
+    assert "Not checked: network_plate_copy" in text
+
+
+def test_verify_compares_again_when_a_run_publishes_while_it_reads(
+    tiny_run, tmp_path, monkeypatch, capsys
+):
+    results, scratch = _results_and_rerun(tmp_path, tiny_run)
+    out = results / "network_plate"
+    stage = stage_dir(out)  # make reproduce's run of the edited study file, finished
+    shutil.copytree(tiny_run("network_plate", "--set", "seed=5"), stage)
+    real, read = rules.compare_tables, []
+
+    def compare_tables(a, b, cmp, mode="full"):
+        real(a, b, cmp, mode)
+        read.append(a.name)
+        if len(read) == 1:  # between the first table and the second: the run publishes
+            publish(stage, out)
+
+    monkeypatch.setattr(rules, "compare_tables", compare_tables)
+    rc = verify_main(["--results", str(results), "--scratch", str(scratch), "--no-rerun"])
+    text = capsys.readouterr().out
+    assert rc == 1 and len(read) > 1 and not stage.exists()
+    assert text.startswith("network_plate: FAILED; nothing compared\n"), text
+    assert "another config than the re-run (keys seed)" in text and "allowed" not in text, text
+    assert "not checked now" not in _row(markdown(results), "network_plate")
