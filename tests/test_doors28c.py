@@ -22,6 +22,10 @@ were all right already.
   and the FAILED line listed deviations that no re-run had (not "stale"); the comparison is
   now made again when the directory changed while it read it
   (:func:`sim.report.verify.rerun._settled`). The test publishes between two tables.
+* ``make verify`` whose comparison failed (exit 1) wrote the failure into the record but left
+  REPORT.md as it was: it went on showing the previous check's "yes" for results that had
+  just failed (the report step ran only after a success). A failed comparison now rebuilds
+  the report before make stops; a refused request (2) or an interrupt (130) does not.
 """
 
 import errno
@@ -30,6 +34,7 @@ import pathlib
 import shutil
 from pathlib import Path
 
+import pytest
 from oneline import SIM_ERROR, one_line
 
 import sim.report.verify.rules as rules
@@ -38,6 +43,7 @@ from sim.mc.outputs import stage_dir
 from sim.mc.publish import publish
 from sim.report.verify import main as verify_main
 from sim.report.verify import markdown
+from tests.test_doors18c import MAKE, fake_project, run_make
 
 
 def _read_only(monkeypatch, top: Path) -> None:
@@ -133,3 +139,20 @@ def test_verify_compares_again_when_a_run_publishes_while_it_reads(
     assert text.startswith("network_plate: FAILED; nothing compared\n"), text
     assert "another config than the re-run (keys seed)" in text and "allowed" not in text, text
     assert "not checked now" not in _row(markdown(results), "network_plate")
+
+
+@pytest.mark.skipif(MAKE is None, reason="no make on this machine")
+@pytest.mark.parametrize("code, report", [(0, True), (1, True), (2, False), (130, False)])
+def test_a_failed_comparison_of_make_verify_rebuilds_the_report(tmp_path, code, report):
+    log, fake = tmp_path / "calls.log", tmp_path / "python"
+    fake.write_text(  # a Python whose verify ends with the code, every other command with 0
+        f'#!/bin/sh\necho "$*" >> {log}\ncase "$*" in *sim.report.verify*) exit {code};; esac\n',
+        encoding="utf-8",
+    )
+    fake.chmod(0o755)
+    p = run_make(fake_project(tmp_path, str(fake)), "verify")
+    calls = [ln for ln in log.read_text(encoding="utf-8").splitlines() if ln.startswith("-m ")]
+    verify, rebuild = "-m sim.report.verify --results results --workers 2", "-m sim report"
+    assert calls == [verify, *([f"{rebuild} --results results"] if report else [])], calls
+    assert p.returncode == (0 if code == 0 else 2), p.stderr
+    assert code == 0 or f"verify] Error {code}" in p.stderr, p.stderr
