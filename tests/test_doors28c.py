@@ -26,12 +26,19 @@ were all right already.
   REPORT.md as it was: it went on showing the previous check's "yes" for results that had
   just failed (the report step ran only after a success). A failed comparison now rebuilds
   the report before make stops; a refused request (2) or an interrupt (130) does not.
+* a clone made with ``core.autocrlf=true`` (Git for Windows' default) checked every text file
+  out with CRLF line ends: each study's code hash (the bytes of its modules) and the sha256 of
+  Wolf's tables changed, so every committed result was "made by other code" (``make
+  reproduce`` re-ran them all on a fresh clone) and ``make verify`` failed wolf_polynomial as
+  "of another config (keys table1.sha256, table3.sha256)". ``.gitattributes`` now checks text
+  out with LF whatever the setting.
 """
 
 import errno
 import os
 import pathlib
 import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -44,6 +51,8 @@ from sim.mc.publish import publish
 from sim.report.verify import main as verify_main
 from sim.report.verify import markdown
 from tests.test_doors18c import MAKE, fake_project, run_make
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def _read_only(monkeypatch, top: Path) -> None:
@@ -156,3 +165,35 @@ def test_a_failed_comparison_of_make_verify_rebuilds_the_report(tmp_path, code, 
     assert calls == [verify, *([f"{rebuild} --results results"] if report else [])], calls
     assert p.returncode == (0 if code == 0 else 2), p.stderr
     assert code == 0 or f"verify] Error {code}" in p.stderr, p.stderr
+
+
+#: one committed file of each kind a study's staleness or a comparison reads: code, a study
+#: file, a data file it hashes, a run record, a table, a figure, a page
+KINDS = [
+    "sim/mc/codehash.py",
+    "studies/wolf_polynomial.toml",
+    "studies/data/wolf_table1.csv",
+    "results/brown_table1/run.json",
+    "results/brown_table1/claims.parquet",
+    "results/brown_table1/table1.png",
+    "README.md",
+]
+
+
+@pytest.mark.skipif(shutil.which("git") is None, reason="needs git")
+def test_a_clone_made_with_autocrlf_holds_every_file_as_committed(tmp_path):
+    env = {**os.environ, "GIT_CONFIG_GLOBAL": os.devnull, "GIT_CONFIG_NOSYSTEM": "1"}
+    env |= {k: "t" for k in ("GIT_AUTHOR_NAME", "GIT_COMMITTER_NAME")}
+    env |= {k: "t@t" for k in ("GIT_AUTHOR_EMAIL", "GIT_COMMITTER_EMAIL")}
+    src, dst = tmp_path / "src", tmp_path / "clone"
+    for f in [*KINDS, ".gitattributes"]:
+        if (ROOT / f).is_file():  # (before the fix there was no .gitattributes)
+            (src / f).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(ROOT / f, src / f)
+    for cmd in (["init", "-q", str(src)], ["-C", str(src), "add", "-A"]):
+        subprocess.run(["git", *cmd], env=env, check=True, capture_output=True)
+    subprocess.run(["git", "-C", str(src), "commit", "-qm", "x"], env=env, check=True)
+    clone = ["git", "-c", "core.autocrlf=true", "clone", "-q", str(src), str(dst)]
+    subprocess.run(clone, env=env, check=True, capture_output=True)
+    changed = [f for f in KINDS if (dst / f).read_bytes() != (ROOT / f).read_bytes()]
+    assert changed == [], f"checked out otherwise than committed: {changed}"
