@@ -32,6 +32,11 @@ were all right already.
   reproduce`` re-ran them all on a fresh clone) and ``make verify`` failed wolf_polynomial as
   "of another config (keys table1.sha256, table3.sha256)". ``.gitattributes`` now checks text
   out with LF whatever the setting.
+* a committed claims table rewritten without its Parquet metadata (pandas, or pyarrow
+  without ``schema.metadata``) passed ``make verify`` ("ok", its numbers matched, and the
+  record said so) while ``sim show`` and ``sim report`` refused it as "not a claims table
+  written by sim" (make verify's own report step then failed): verify now refuses what they
+  refuse, naming the file (:func:`sim.report.verify.rerun._not_as_written`).
 """
 
 import errno
@@ -41,6 +46,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import pyarrow.parquet as pq
 import pytest
 from oneline import SIM_ERROR, one_line
 
@@ -197,3 +203,17 @@ def test_a_clone_made_with_autocrlf_holds_every_file_as_committed(tmp_path):
     subprocess.run(clone, env=env, check=True, capture_output=True)
     changed = [f for f in KINDS if (dst / f).read_bytes() != (ROOT / f).read_bytes()]
     assert changed == [], f"checked out otherwise than committed: {changed}"
+
+
+def test_verify_refuses_a_claims_table_that_lost_its_metadata_as_the_report_does(
+    tiny_run, tmp_path, capsys
+):
+    results, scratch = _results_and_rerun(tmp_path, tiny_run)
+    f = results / "network_plate" / "claims.parquet"
+    pq.write_table(pq.read_table(f).replace_schema_metadata(None), f)  # another tool's copy
+    args = ["--results", str(results), "--scratch", str(scratch), "--no-rerun", "--no-record"]
+    rc = verify_main(args)
+    out = capsys.readouterr().out
+    assert rc == 1 and out.startswith("network_plate: FAILED; nothing compared\n"), out
+    assert f"{f} is not a claims table written by sim" in out, out
+    one_line(capsys, main(["report", "--results", str(results)]), f"{f} is not a claims table")

@@ -12,10 +12,11 @@ from pathlib import Path
 import pyarrow as pa
 
 from sim.mc.children import child_env, child_text, ended, stop_children
+from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.storage import read_provenance, read_record
-from sim.report.read import mixed_run
+from sim.report.read import check_claims_table
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
 
 __all__ = ["study_dirs", "study_file", "rerun_study", "verify"]
@@ -189,7 +190,7 @@ def verify(
     out = []
     for d, study in todo:
         target = scratch / d.name
-        mixed = mixed_run(d)  # tables of two runs: no reproduction of one run to check
+        mixed = _not_as_written(d)  # tables of two runs (...): no run's reproduction to check
         if mixed:
             c = Comparison(d.name)
             c.failures.append(mixed)
@@ -246,7 +247,7 @@ def _judge(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
     runs, results of another config, else every table by its rules (and, when one fails,
     whether the results were made by other code)."""
     comp = Comparison(d.name)
-    why = mixed_run(d) or (_other_config(d, target, sf) if mode == "full" else None)
+    why = _not_as_written(d) or (_other_config(d, target, sf) if mode == "full" else None)
     if why:  # not a reproduction failure of these numbers: results of another input
         comp.failures.append(why)
         return comp
@@ -254,6 +255,18 @@ def _judge(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
     if not comp.ok and (older := _other_code(d, target)):  # why, before the deviations
         comp.failures.insert(0, older)
     return comp
+
+
+def _not_as_written(d: Path) -> str | None:
+    """Why ``sim show`` and ``sim report`` would refuse the committed results ``d`` (a claims
+    table without its provenance, as a tool that drops Parquet metadata rewrites it; an older
+    version's; another study's; tables of two runs), or None. Verify called such results ok
+    when their numbers matched, and make verify's report step then refused them."""
+    try:
+        check_claims_table(d / "claims.parquet", None)
+    except ConfigError as e:
+        return f"{e}"
+    return None
 
 
 def _other_code(d: Path, target: Path) -> str | None:
