@@ -154,12 +154,14 @@ rerun: $(STAMP) ## re-run every study even if its results are up to date, then t
 	$(PY) -m sim report --results results
 
 # VERIFY_FLAGS: e.g. "--study brown_table1", "--scratch DIR" (see python -m sim.report.verify -h;
-# results of your own study files: python -m sim.report.verify --results DIR --studies DIR)
+# results of your own study files: python -m sim.report.verify --results DIR --studies DIR).
+# A failed comparison (exit 1) rebuilds the report too: REPORT.md showed the record before it
 VERIFY_FLAGS ?=
 
 verify: $(STAMP) ## re-run every study into a scratch directory and compare with results/ (a rule per kind of column; VERIFY_FLAGS)
 	$(call shellwords,VERIFY_FLAGS)
-	$(PY) -m sim.report.verify --results results --workers 2 $(VERIFY_FLAGS)
+	$(PY) -m sim.report.verify --results results --workers 2 $(VERIFY_FLAGS) || { rc=$$?; \
+	  [ $$rc -ne 1 ] || $(PY) -m sim report --results results; exit $$rc; }
 	$(PY) -m sim report --results results
 
 report: $(STAMP) ## rebuild results/REPORT.md and every results/<study>/README.md from the Parquet files alone

@@ -44,7 +44,8 @@ if _as_main:
     refuse_bad_environment("sim verify")  # a variable NumPy cannot load with: one line, exit 2
 
 from sim.report.verify.cli import main  # noqa: E402
-from sim.report.verify.rerun import markdown, rerun_study, study_dirs, verify, write_record  # noqa: E402
+from sim.report.verify.record import markdown, write_record  # noqa: E402
+from sim.report.verify.rerun import rerun_study, study_dirs, verify  # noqa: E402
 from sim.report.verify.rules import (  # noqa: E402
     DEFAULT_ATOL,
     DEFAULT_RTOL,

@@ -12,7 +12,8 @@ from pathlib import Path
 from sim.ends import stdout_failed
 from sim.mc.argv import BoundedParser
 from sim.mc.outputs import name_problem
-from sim.report.verify.rerun import verify, write_record
+from sim.report.verify.record import write_record
+from sim.report.verify.rerun import verify
 from sim.report.verify.rules import Comparison, VerifyError
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
 

@@ -1,46 +1,29 @@
 """Re-running the studies of a results directory into a scratch directory (only what the suite
-wrote there is ever replaced), the reproducibility record and the report's section."""
+wrote there is ever replaced) and comparing them with it (the record and the report's section:
+:mod:`sim.report.verify.record`)."""
 
 from __future__ import annotations
 
 import errno
 import os
-import platform
 import subprocess
 import sys
 from pathlib import Path
 
 import pyarrow as pa
-import pyarrow.parquet as pq
 
 from sim.mc.children import child_env, child_text, ended, stop_children
+from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
-from sim.mc.storage import read_provenance, read_record, versions, write_table
-from sim.report.read import mixed_run
-from sim.report.tables import fmt, md_table
-from sim.report.verify.rules import DEFAULT_RTOL, Comparison, VerifyError, compare_dirs
+from sim.mc.storage import read_provenance, read_record
+from sim.report.read import check_claims_table
+from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
 
-__all__ = ["study_dirs", "study_file", "rerun_study", "verify", "write_record", "markdown"]
+__all__ = ["study_dirs", "study_file", "rerun_study", "verify"]
 
 
 # --- re-running -------------------------------------------------------------------------------
-
-
-def _machine() -> dict:
-    return {
-        "machine": platform.machine(),
-        "system": platform.system(),
-        "processor": platform.processor() or platform.machine(),
-        "cpus": os.cpu_count(),
-        **(
-            {"openblas_coretype": os.environ["OPENBLAS_CORETYPE"]}
-            if "OPENBLAS_CORETYPE" in os.environ
-            else {}
-        ),
-        **({"sim_no_jit": os.environ["SIM_NO_JIT"]} if os.environ.get("SIM_NO_JIT") else {}),
-        **versions(),
-    }
 
 
 def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path, str]]:
@@ -226,7 +209,7 @@ def verify(
     out = []
     for d, study in todo:
         target = scratch / d.name
-        mixed = mixed_run(d)  # tables of two runs: no reproduction of one run to check
+        mixed = _not_as_written(d)  # tables of two runs (...): no run's reproduction to check
         if mixed:
             c = Comparison(d.name)
             c.failures.append(mixed)
@@ -241,17 +224,68 @@ def verify(
                 out.append(c)
                 continue
         sf = study_file(d, study, Path(studies)) if rerun else None
-        stale = _other_config(d, target, sf) if mode == "full" else None
-        if stale:  # not a reproduction failure of these numbers: results of another input
-            c = Comparison(d.name)
-            c.failures.append(stale)
-            out.append(c)
-            continue
-        comp = compare_dirs(d, target, d.name, mode)
-        if not comp.ok and (older := _other_code(d, target)):  # why, before the deviations
-            comp.failures.insert(0, older)
-        out.append(comp)
+        out.append(_settled(d, target, sf, mode))
     return out
+
+
+#: how many times a comparison is made again when the committed results change while it reads
+SETTLE = 3
+
+
+def _settled(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
+    """:func:`_judge` of the committed results ``d``, made again when they changed while it
+    read them: a ``make reproduce`` in another terminal that published new results of the
+    study between its first table and its last (or after their run record was read) made a
+    comparison of two runs' tables, a FAILED line of deviations that no re-run had."""
+    for _ in range(SETTLE):
+        before = _state(d)
+        comp = _judge(d, target, sf, mode)
+        if _state(d) == before:
+            comp.tables = before[-1]
+            return comp
+    comp = Comparison(d.name)
+    comp.failures.append(
+        f"{d} changed while verify read it, {SETTLE} times (a run publishing its results "
+        "there?): verify it when that run has ended"
+    )
+    return comp
+
+
+def _state(d: Path) -> tuple:
+    """What :func:`_settled` compares before and after: the directory (a publish swaps in
+    another) and its tables' content (:func:`tables_digest`)."""
+    try:
+        st = os.stat(d)
+    except OSError:
+        return (None, None, None)
+    return (st.st_dev, st.st_ino, tables_digest(d))
+
+
+def _judge(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
+    """The comparison of the committed results ``d`` with the re-run ``target``: tables of two
+    runs, results of another config, else every table by its rules (and, when one fails,
+    whether the results were made by other code)."""
+    comp = Comparison(d.name)
+    why = _not_as_written(d) or (_other_config(d, target, sf) if mode == "full" else None)
+    if why:  # not a reproduction failure of these numbers: results of another input
+        comp.failures.append(why)
+        return comp
+    comp = compare_dirs(d, target, d.name, mode)
+    if not comp.ok and (older := _other_code(d, target)):  # why, before the deviations
+        comp.failures.insert(0, older)
+    return comp
+
+
+def _not_as_written(d: Path) -> str | None:
+    """Why ``sim show`` and ``sim report`` would refuse the committed results ``d`` (a claims
+    table without its provenance, as a tool that drops Parquet metadata rewrites it; an older
+    version's; another study's; tables of two runs), or None. Verify called such results ok
+    when their numbers matched, and make verify's report step then refused them."""
+    try:
+        check_claims_table(d / "claims.parquet", None)
+    except ConfigError as e:
+        return f"{e}"
+    return None
 
 
 def _other_code(d: Path, target: Path) -> str | None:
@@ -290,95 +324,3 @@ def _other_config(d: Path, target: Path, sf: Path | None = None) -> str | None:
         f"the committed results are of another config than the re-run (keys {', '.join(keys)}): "
         f"{why}; run make reproduce, then verify"
     )
-
-
-# --- the record and the report ----------------------------------------------------------------
-
-
-def write_record(results: Path, comps: list[Comparison]) -> Path:
-    cols = {
-        "study": [c.study for c in comps],
-        "files": [c.files for c in comps],
-        "max_rel_dev": [c.max_rel for c in comps],
-        "max_dev_over_tol": [c.max_ratio for c in comps],
-        "worst": [c.worst for c in comps],
-        "failures": [len(c.failures) for c in comps],
-        "first_failure": [c.failures[0] if c.failures else "" for c in comps],
-        "text_columns_changed": [", ".join(c.text_changes) for c in comps],
-        "ok": [c.ok for c in comps],
-    }
-    return write_table(
-        Path(results) / "reproducibility.parquet", cols, {"study": "verify", "machine": _machine()}
-    )
-
-
-def markdown(results: Path) -> str:
-    """The report's *Reproducibility* section from ``reproducibility.parquet`` (empty if none)."""
-    p = Path(results) / "reproducibility.parquet"
-    if not p.is_file():
-        return ""
-    t = pq.read_table(p).to_pylist()
-    m = read_provenance(p).get("machine", {})
-    ver = ", ".join(
-        f"{k} {v}" for k, v in m.items() if k not in ("machine", "system", "processor", "cpus")
-    )
-    made = _committed_on(Path(results))
-    rows = [
-        [
-            r["study"],
-            r["files"],
-            fmt(r["max_rel_dev"], 2),
-            fmt(r["max_dev_over_tol"], 2),
-            f"`{r['worst']}`" if r["worst"] else "",
-            "yes" if r["ok"] else f"**no**: {r['first_failure']}",
-            r["text_columns_changed"],
-        ]
-        for r in t
-    ]
-    return (
-        "## Reproducibility\n\n"
-        f"`make verify` re-ran every study into a scratch directory on {m.get('system', '?')} "
-        f"{m.get('machine', '?')} ({m.get('cpus', '?')} CPUs; {ver}) and compared each "
-        "Parquet column with the committed one by the rule declared for the kind of number it "
-        "holds (docs/reproducibility.md): exact for labels, counts and decisions; within the "
-        f"bound of its conditioning for arithmetic (by default {DEFAULT_RTOL:g} relative); "
-        "within a fraction of its Monte-Carlo standard error for a Monte-Carlo statistic and "
-        "its Monte-Carlo interval for a chain's output; modulo the period for an angle. A "
-        f"changed verdict fails. {made}\n\n"
-        + md_table(
-            [
-                "study",
-                "files",
-                "largest relative deviation",
-                "largest deviation / tolerance",
-                "where",
-                "within tolerance",
-                "text columns that differ",
-            ],
-            rows,
-        )
-        + "\n"
-    )
-
-
-def _committed_on(results: Path) -> str:
-    """Which machine, numerical path and versions produced the committed results (from the
-    provenance of the studies' claims tables), as a sentence."""
-    seen = set()
-    for p in sorted(d / "claims.parquet" for d in results_dirs(results)):
-        if not p.is_file():
-            continue
-        try:
-            prov = read_provenance(p)
-        except (OSError, pa.ArrowException, ValueError):
-            continue
-        n, v = prov.get("numerics") or {}, prov.get("versions") or {}
-        where = (
-            " ".join(str(n[k]) for k in ("system", "machine") if k in n) or "an unrecorded machine"
-        )
-        path = ", ".join(f"{k}={n[k]}" for k in ("OPENBLAS_CORETYPE", "SIM_NO_JIT") if k in n)
-        ver = ", ".join(f"{k} {x}" for k, x in sorted(v.items()))
-        seen.add(f"{where}{f' ({path})' if path else ''} with {ver}" if ver else where)
-    if not seen:
-        return ""
-    return "The committed results were made on " + "; and on ".join(sorted(seen)) + "."

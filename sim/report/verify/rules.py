@@ -4,6 +4,7 @@ column, each by the rule declared with it for the kind of number it holds
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -17,6 +18,7 @@ from sim.mc.storage import read_provenance, read_tolerances
 __all__ = [
     "compare_dirs",
     "compare_tables",
+    "tables_digest",
     "DEFAULT_RTOL",
     "DEFAULT_ATOL",
     "Comparison",
@@ -47,6 +49,7 @@ class Comparison:
     failures: list[str] = field(default_factory=list)
     text_changes: list[str] = field(default_factory=list)
     not_compared: list[str] = field(default_factory=list)  # at the MC level: not comparable
+    tables: str | None = None  # the committed tables compared (:func:`tables_digest`)
 
     @property
     def ok(self) -> bool:
@@ -228,6 +231,21 @@ def compare_tables(a: Path, b: Path, cmp: Comparison, mode: str = "full") -> Non
 def _at_mc_level(spec: dict) -> bool:
     """Compared against a run with fewer trials: analytic columns, MC statistics, chains."""
     return bool(spec.get("analytic")) or spec["kind"] in ("mc", "chain")
+
+
+def tables_digest(d: Path) -> str | None:
+    """The sha256 of the tables a comparison reads in the results ``d`` (every ``*.parquet``
+    but :data:`SKIP`, by name and content), or None when ``d`` or a table cannot be read: what
+    the reproducibility record says it checked, so that results re-run, copied in or edited
+    since are not shown as verified. Content only: a copy (``cp``, ``tar``, a clone) keeps it."""
+    h = hashlib.sha256()
+    try:
+        for p in sorted(q for q in Path(d).glob("*.parquet") if q.name not in SKIP):
+            h.update(p.name.encode("utf-8", "surrogateescape") + b"\0")
+            h.update(hashlib.sha256(p.read_bytes()).digest())
+    except OSError:
+        return None
+    return h.hexdigest()
 
 
 def compare_dirs(

@@ -1,0 +1,171 @@
+"""The reproducibility record of ``make verify`` (``<results>/reproducibility.parquet``: per
+study the comparison and the tables it checked) and the report's *Reproducibility* section."""
+
+from __future__ import annotations
+
+import os
+import platform
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from sim.mc.outputs import results_dirs
+from sim.mc.storage import read_provenance, versions, write_table
+from sim.report.tables import fmt, md_table
+from sim.report.verify.rules import DEFAULT_RTOL, Comparison, tables_digest
+
+__all__ = ["write_record", "markdown"]
+
+
+def _machine() -> dict:
+    return {
+        "machine": platform.machine(),
+        "system": platform.system(),
+        "processor": platform.processor() or platform.machine(),
+        "cpus": os.cpu_count(),
+        **(
+            {"openblas_coretype": os.environ["OPENBLAS_CORETYPE"]}
+            if "OPENBLAS_CORETYPE" in os.environ
+            else {}
+        ),
+        **({"sim_no_jit": os.environ["SIM_NO_JIT"]} if os.environ.get("SIM_NO_JIT") else {}),
+        **versions(),
+    }
+
+
+def write_record(results: Path, comps: list[Comparison]) -> Path:
+    cols = {
+        "study": [c.study for c in comps],
+        "files": [c.files for c in comps],
+        "max_rel_dev": [c.max_rel for c in comps],
+        "max_dev_over_tol": [c.max_ratio for c in comps],
+        "worst": [c.worst for c in comps],
+        "failures": [len(c.failures) for c in comps],
+        "first_failure": [c.failures[0] if c.failures else "" for c in comps],
+        "text_columns_changed": [", ".join(c.text_changes) for c in comps],
+        "ok": [c.ok for c in comps],
+        "tables_sha256": [c.tables or "" for c in comps],  # what was checked: markdown()
+    }
+    return write_table(
+        Path(results) / "reproducibility.parquet", cols, {"study": "verify", "machine": _machine()}
+    )
+
+
+def markdown(results: Path) -> str:
+    """The report's *Reproducibility* section from ``reproducibility.parquet`` (empty if none)."""
+    p = Path(results) / "reproducibility.parquet"
+    if not p.is_file():
+        return ""
+    t = pq.read_table(p).to_pylist()
+    m = read_provenance(p).get("machine", {})
+    since = _checked_since(Path(results), t)
+    ver = ", ".join(
+        f"{k} {v}" for k, v in m.items() if k not in ("machine", "system", "processor", "cpus")
+    )
+    made = _committed_on(Path(results))
+    rows = [
+        [
+            r["study"],
+            r["files"],
+            fmt(r["max_rel_dev"], 2),
+            fmt(r["max_dev_over_tol"], 2),
+            f"`{r['worst']}`" if r["worst"] else "",
+            since.get(r["study"]) or ("yes" if r["ok"] else f"**no**: {r['first_failure']}"),
+            r["text_columns_changed"],
+        ]
+        for r in t
+    ]
+    made += _not_checked(Path(results), t, since)
+    return (
+        "## Reproducibility\n\n"
+        f"`make verify` re-ran every study into a scratch directory on {m.get('system', '?')} "
+        f"{m.get('machine', '?')} ({m.get('cpus', '?')} CPUs; {ver}) and compared each "
+        "Parquet column with the committed one by the rule declared for the kind of number it "
+        "holds (docs/reproducibility.md): exact for labels, counts and decisions; within the "
+        f"bound of its conditioning for arithmetic (by default {DEFAULT_RTOL:g} relative); "
+        "within a fraction of its Monte-Carlo standard error for a Monte-Carlo statistic and "
+        "its Monte-Carlo interval for a chain's output; modulo the period for an angle. A "
+        f"changed verdict fails. {made}\n\n"
+        + md_table(
+            [
+                "study",
+                "files",
+                "largest relative deviation",
+                "largest deviation / tolerance",
+                "where",
+                "within tolerance",
+                "text columns that differ",
+            ],
+            rows,
+        )
+        + "\n"
+    )
+
+
+def _checked_since(results: Path, rows: list[dict]) -> dict[str, str]:
+    """Per study of the record whose results are no longer the tables it checked (their
+    :func:`tables_digest` differs: re-run by make reproduce since, in another terminal while
+    verify ran, or copied in or edited by hand; or removed), what the report says instead of
+    its verdict. A record that did not say what it checked (an older version's) is taken as
+    it is."""
+    out = {}
+    for r in rows:
+        want, name = r.get("tables_sha256"), str(r.get("study"))
+        if not want or name in ("", ".", "..") or "/" in name:  # (a record edited by hand)
+            continue
+        d = results / name
+        if not (d / "claims.parquet").is_file():
+            out[r["study"]] = "**not checked now**: these results are no longer there"
+        elif tables_digest(d) != want:
+            out[r["study"]] = "**not checked now**: its tables changed after this check"
+    return out
+
+
+def _not_checked(results: Path, rows: list[dict], since: dict) -> str:
+    """The sentences that say which results the record does not vouch for: those changed
+    since (:func:`_checked_since`), studies with results but no row, and every study when the
+    record does not say which tables it checked."""
+    out = ""
+    if since:
+        out += (
+            f" The results of {len(since)} of these studies are not the ones checked (their "
+            "tables were re-run, replaced or edited since): run make verify again."
+        )
+    recorded = {str(r.get("study")) for r in rows}
+    new = sorted(
+        d.name
+        for d in results_dirs(results)
+        if (d / "claims.parquet").is_file() and d.name not in recorded
+    )
+    if new:
+        out += f" Not checked: {', '.join(new)} (no row in the record)."
+    if rows and not any(r.get("tables_sha256") for r in rows):
+        out += (
+            " This record does not say which tables it checked (an older version wrote it): "
+            "results re-run after it read as checked here; run make verify again."
+        )
+    return out
+
+
+def _committed_on(results: Path) -> str:
+    """Which machine, numerical path and versions produced the committed results (from the
+    provenance of the studies' claims tables), as a sentence."""
+    seen = set()
+    for p in sorted(d / "claims.parquet" for d in results_dirs(results)):
+        if not p.is_file():
+            continue
+        try:
+            prov = read_provenance(p)
+        except (OSError, pa.ArrowException, ValueError):
+            continue
+        n, v = prov.get("numerics") or {}, prov.get("versions") or {}
+        where = (
+            " ".join(str(n[k]) for k in ("system", "machine") if k in n) or "an unrecorded machine"
+        )
+        path = ", ".join(f"{k}={n[k]}" for k in ("OPENBLAS_CORETYPE", "SIM_NO_JIT") if k in n)
+        ver = ", ".join(f"{k} {x}" for k, x in sorted(v.items()))
+        seen.add(f"{where}{f' ({path})' if path else ''} with {ver}" if ver else where)
+    if not seen:
+        return ""
+    return "The committed results were made on " + "; and on ".join(sorted(seen)) + "."
