@@ -113,12 +113,11 @@ def run_all(
     which ``--stale-only`` does not resolve again."""
     todo = []
     for f in order(files):
-        done = (loaded or {}).get(f)
-        if stale_only and is_current(f, results / f.stem, run_args, done):
-            log(f"{f.stem}: up to date")
-            continue
-        if stale_only:
-            why = why_stale(f, results / f.stem, run_args, done)
+        if stale_only:  # is_current's question, asked once
+            why = why_stale(f, results / f.stem, run_args, (loaded or {}).get(f))
+            if why is None:
+                log(f"{f.stem}: up to date")
+                continue
             log(f"{f.stem}: out of date ({why}): running it")
         todo.append(f)
     quiet = ["--quiet"] if jobs > 1 and "--quiet" not in run_args else []
@@ -305,8 +304,9 @@ def _main(argv: list[str]) -> int:
             print(f"sim.batch: {name}: {name_problem(v)} (got {v!r})", file=sys.stderr)
             return 2
     files = [Path(f) for f in args.files]
-    bad = [why for f in files if (why := _file_problem(f))]  # every one, not the first only
-    bad += _clashes([f for f in files if not _file_problem(f)], run_args, args.results)
+    problems = [_file_problem(f) for f in files]
+    bad = [why for why in problems if why]  # every one, not the first only
+    bad += _clashes([f for f, why in zip(files, problems) if not why], run_args, args.results)
     for why in bad:
         print(f"sim.batch: {why}", file=sys.stderr)
     if bad:

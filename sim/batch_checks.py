@@ -33,14 +33,12 @@ from sim.studies import get_study
 __all__ = ["is_current", "why_stale"]
 
 
-def is_current(
-    study_file: str | Path, results: str | Path, run_args=(), loaded: tuple | None = None
-) -> bool:
+def is_current(study_file: str | Path, results: str | Path, run_args=()) -> bool:
     """True when ``results/run.json`` records the config ``sim run STUDY_FILE RUN_ARGS``
     resolves (the study file with the run options' ``--set``, ``--trials``, ``--seed``,
     ``--chunk``) and the study's current code hash, and the run drew its figures (not
     ``--no-figures``) unless ``run_args`` ask for none (:func:`why_stale` says None)."""
-    return why_stale(study_file, results, run_args, loaded) is None
+    return why_stale(study_file, results, run_args) is None
 
 
 def why_stale(
@@ -50,7 +48,8 @@ def why_stale(
     config key that differs, the code changed since, no figures or one replaced by hand), in
     a few words; None when they are (:func:`is_current`). ``--stale-only`` printed nothing
     for a study it re-ran, so results made by older code or copied from elsewhere were re-run
-    without a word."""
+    without a word. ``loaded``: the file's ``(args, study, cfg, sweep)`` as the batch resolved
+    them before any run (:func:`_configs_problems`), not resolved again."""
     try:
         text = regular_text(Path(results) / "run.json")
     except OSError:
@@ -126,7 +125,7 @@ def _file_problem(f: Path) -> str | None:
         return f"{f} {why}"
     if f.exists():  # a FIFO, a device (/dev/null): there, but no study file
         return f"{f}: not a regular file (a pipe or a device): name the study file"
-    if any(c in str(f) for c in "*?[") and not f.exists():
+    if any(c in str(f) for c in "*?["):
         return (
             f"no study file {f} (a pattern that matched no file: the shell passed it on as it is)"
         )
@@ -134,7 +133,7 @@ def _file_problem(f: Path) -> str | None:
 
 
 def _configs_problems(
-    files: list[Path], run_args: list[str], results: Path | None = None
+    files: list[Path], run_args: list[str], results: Path
 ) -> tuple[list[str], dict]:
     """``(lines, loaded)``: one line for each study file whose run would refuse its config
     (``sim run FILE RUN_ARGS`` resolves it here, before any run starts: a study file ported
@@ -159,10 +158,9 @@ def _configs_problems(
             sweep = read_sweep(f, study.schema)
             est = estimate(cfg, sweep)  # the limits its run applies (sim check's too)
             check_limits(est, args.max_memory_gb, args.max_adjustments, args.workers)
-            if results is not None:  # each run is --overwrite: the record is not compared
-                out = results / f.stem
-                record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
-                check_out(Path(os.path.abspath(out)), str(out), record, True)
+            out = results / f.stem  # each run is --overwrite: the record is not compared
+            record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
+            check_out(Path(os.path.abspath(out)), str(out), record, True)
         except ConfigError as e:  # a line that names the file already: as it is
             e = _out_in_batch_words(e)
             lines.append(str(e) if str(e).startswith(f"{f}: ") else f"{f}: {e}")

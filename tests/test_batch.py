@@ -87,13 +87,15 @@ def test_side_by_side_equals_one_after_the_other(tmp_path, monkeypatch):
 def test_stale_only_skips_the_current_studies(tmp_path, monkeypatch):
     fa, sa = _tiny(tmp_path, "network_testfield.toml")
     fb, _ = _tiny(tmp_path, "brown_table1.toml")
-    monkeypatch.setattr(batch, "is_current", lambda f, res, *_: Path(f).stem == fb.stem)
+    current = {fb.stem: None, fa.stem: "no results yet"}  # why_stale's None: current
+    monkeypatch.setattr(batch, "why_stale", lambda f, res, *_: current[Path(f).stem])
     logged = []
     done = batch.run_all(
         [fa, fb], tmp_path / "r", 2, [], stale_only=True, log=logged.append, extra={fa.stem: sa}
     )
     assert list(done) == [fa.stem] and done[fa.stem][0] == 0
     assert f"{fb.stem}: up to date" in logged
+    assert f"{fa.stem}: out of date (no results yet): running it" in logged
     assert not (tmp_path / "r" / fb.stem).exists()
 
 
