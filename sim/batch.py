@@ -50,6 +50,7 @@ from sim.batch_checks import (  # noqa: E402
     _clashes,
     _configs_problems,
     _file_problem,
+    _in_batch_words,
     _replaces_project_results,
     _run_options_problem,
     _timings_problem,
@@ -189,15 +190,6 @@ def run_all(
         raise
     pool.shutdown()
     return out
-
-
-def _in_batch_words(text: str | None) -> str | None:
-    """A run's refusal of its ``--out`` in the words of the batch's command line: the user
-    gave ``--results`` (each study writes ``<results>/<file name>``), not ``--out``."""
-    if not text:
-        return text
-    text = text.replace("sim: error: --out: ", "sim: error: --results: ")
-    return text.replace("choose another --out", "choose another --results")
 
 
 def _set(stop: threading.Event, starting: threading.Lock) -> None:

@@ -23,7 +23,7 @@ from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import check_out
-from sim.mc.paths import link_problem
+from sim.mc.paths import absolute, link_problem
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
 from sim.mc.sweep import read_sweep
@@ -160,7 +160,7 @@ def _configs_problems(
             check_limits(est, args.max_memory_gb, args.max_adjustments, args.workers)
             out = results / f.stem  # each run is --overwrite: the record is not compared
             record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
-            check_out(Path(os.path.abspath(out)), str(out), record, True)
+            check_out(absolute(out), str(out), record, True)  # (as sim run: check_run_args)
         except ConfigError as e:  # a line that names the file already: as it is
             e = _out_in_batch_words(e)
             lines.append(str(e) if str(e).startswith(f"{f}: ") else f"{f}: {e}")
@@ -176,15 +176,21 @@ def _configs_problems(
     return lines, loaded
 
 
+def _in_batch_words(text: str | None) -> str | None:
+    """A run's refusal of its ``--out`` in the words of the batch's command line: the user
+    gave ``--results`` (each study writes ``<results>/<file name>``), not ``--out``."""
+    if not text:
+        return text
+    text = text.replace("sim: error: --out: ", "sim: error: --results: ")
+    return text.replace("choose another --out", "choose another --results")
+
+
 def _out_in_batch_words(e: ConfigError) -> ConfigError:
-    """``e``, a refusal of a run's ``--out`` in the words of the batch's command line, whose
-    ``--results`` chose it (as the batch says its runs' refusals)."""
+    """``e``, a refusal of a run's ``--out`` found before the run, in the batch's words
+    (:func:`_in_batch_words`, as the batch says its runs' own refusals)."""
     if e.key != "--out":
         return e
-    text = (
-        str(e).removeprefix("--out: ").replace("choose another --out", "choose another --results")
-    )
-    return ConfigError("--results", text)
+    return ConfigError("--results", _in_batch_words(str(e).removeprefix("--out: ")))
 
 
 def _replaces_project_results(f: Path, results: Path) -> str | None:
