@@ -211,17 +211,13 @@ def verify(
         target = scratch / d.name
         mixed = _not_as_written(d)  # tables of two runs (...): no run's reproduction to check
         if mixed:
-            c = Comparison(d.name)
-            c.failures.append(mixed)
-            out.append(c)
+            out.append(Comparison(d.name, failures=[mixed]))
             continue
         if rerun:
             overwrite = replace[d]
             why = rerun_study(d, study, target, overwrite, workers, extra or [], Path(studies))
             if why:
-                c = Comparison(d.name)
-                c.failures.append(why)
-                out.append(c)
+                out.append(Comparison(d.name, failures=[why]))
                 continue
         sf = study_file(d, study, Path(studies)) if rerun else None
         out.append(_settled(d, target, sf, mode))
@@ -243,12 +239,13 @@ def _settled(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
         if _state(d) == before:
             comp.tables = before[-1]
             return comp
-    comp = Comparison(d.name)
-    comp.failures.append(
-        f"{d} changed while verify read it, {SETTLE} times (a run publishing its results "
-        "there?): verify it when that run has ended"
+    return Comparison(
+        d.name,
+        failures=[
+            f"{d} changed while verify read it, {SETTLE} times (a run publishing its results "
+            "there?): verify it when that run has ended"
+        ],
     )
-    return comp
 
 
 def _state(d: Path) -> tuple:
@@ -265,11 +262,9 @@ def _judge(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
     """The comparison of the committed results ``d`` with the re-run ``target``: tables of two
     runs, results of another config, else every table by its rules (and, when one fails,
     whether the results were made by other code)."""
-    comp = Comparison(d.name)
     why = _not_as_written(d) or (_other_config(d, target, sf) if mode == "full" else None)
     if why:  # not a reproduction failure of these numbers: results of another input
-        comp.failures.append(why)
-        return comp
+        return Comparison(d.name, failures=[why])
     comp = compare_dirs(d, target, d.name, mode)
     if not comp.ok and (older := _other_code(d, target)):  # why, before the deviations
         comp.failures.insert(0, older)
