@@ -61,8 +61,7 @@ def why_stale(
         if loaded is not None:  # the batch resolved it already (_configs_problems)
             args, study, cfg, sweep = loaded
         else:
-            with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
-                args = run_parser(cli_doc).parse_args(["run", str(study_file), *run_args])
+            args = _parsed(run_args, study_file)
             study, cfg = load_run(args)
             sweep = read_sweep(study_file, study.schema)  # recorded with the config (execute):
     except (OSError, ValueError, RecursionError, ConfigError, StudyError, SystemExit):
@@ -144,8 +143,7 @@ def _configs_problems(
     broken file among many ran the others first, for hours in ``make reproduce``, and was
     named only when its turn came. A ``--set`` key a study has not is left out of its check
     (:func:`_unknown_sets` says it once; that run refuses it)."""
-    with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
-        base = run_parser(cli_doc).parse_args(["run", "STUDY.toml", *run_args])
+    base = _parsed(run_args)
     lines, loaded = [], {}
     for f in files:
         args = copy.copy(base)
@@ -213,6 +211,13 @@ def _replaces_project_results(f: Path, results: Path) -> str | None:
     )
 
 
+def _parsed(run_args, study: str | Path = "STUDY.toml"):
+    """``sim run STUDY RUN_ARGS`` as its parser reads it, its messages kept quiet: the batch
+    checked the options first (:func:`_run_options_problem` says what is wrong with them)."""
+    with contextlib.redirect_stderr(io.StringIO()):
+        return run_parser(cli_doc).parse_args(["run", str(study), *run_args])
+
+
 def _run_options_problem(run_args: list[str]) -> str | None:
     """Why the run options cannot go to every run, checked once before any starts (as
     ``sim run`` reads them, abbreviations included): a bad option or value, an ``--out``
@@ -238,8 +243,7 @@ def _unknown_sets(files: list[Path], run_args: list[str]) -> tuple[str | None, s
     run: each run would refuse it, one line per study); a key only some lack is a note said
     once before the runs start (those runs refuse it). A file whose study cannot be read is
     left to its run's own line."""
-    with contextlib.redirect_stderr(io.StringIO()):  # bad options: _run_options_problem
-        sets = run_parser(cli_doc).parse_args(["run", "STUDY.toml", *run_args]).set or []
+    sets = _parsed(run_args).set or []
     keys = []
     for text in sets:
         try:
