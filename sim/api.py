@@ -390,17 +390,16 @@ def _plain(v: Any) -> Any:
 def _load_picking_chunk(study_file, vals: dict):
     """``load_study``; ``trials`` without ``chunk`` picks the largest chunk giving at least
     MIN_CHUNKS chunks, as ``sim run --trials`` does (same config, same results)."""
+    picks = "trials" in vals and "chunk" not in vals
     try:
-        if "trials" not in vals or "chunk" in vals:
-            return load_study(study_file, values=vals)
         study, cfg = load_study(study_file, values=vals)
     except ConfigError as e:
-        if e.key != "chunk" or "trials" not in vals or "chunk" in vals:
+        if e.key != "chunk" or not picks:
             raise foreign_key(e, study_file) from None  # a key of another study: whose
         # the file's chunk is too large for the trials asked for
         _, cfg = load_study(study_file, values={**vals, "chunk": 1})
         return load_study(study_file, values={**vals, "chunk": max(1, cfg["trials"] // MIN_CHUNKS)})
-    if "chunk" in cfg and cfg["chunk"] > (chunk := max(1, cfg["trials"] // MIN_CHUNKS)):
+    if picks and "chunk" in cfg and cfg["chunk"] > (chunk := max(1, cfg["trials"] // MIN_CHUNKS)):
         study, cfg = load_study(study_file, values={**vals, "chunk": chunk})
     return study, cfg
 

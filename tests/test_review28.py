@@ -1,5 +1,5 @@
-"""Review of the session of 2026-11-28 (brief R28): what the batch's checks before any run
-resolve, resolved as the run resolves it.
+"""Review of the session of 2026-11-28 (brief R28): a config or an output directory resolved
+before a run (the batch's checks, the Python API) is the one the run resolves.
 
 * ``python -m sim.batch --results lnk/..`` (a ``..`` after a symbolic link): each run reads its
   ``--out lnk/../<file name>`` as the system does (:func:`sim.mc.paths.absolute`, doors28a),
@@ -11,6 +11,8 @@ resolve, resolved as the run resolves it.
 from __future__ import annotations
 
 from pathlib import Path
+
+import pytest
 
 from sim.batch_checks import _configs_problems
 
@@ -31,3 +33,27 @@ def test_the_batch_checks_the_results_directory_its_run_writes(tmp_path, monkeyp
     ], lines
     assert loaded == {}
     assert (tmp_path / "far" / "a").read_text(encoding="utf-8") == "the user's file"
+
+
+# * ``sim.load`` resolves ``trials`` (without ``chunk``) to the chunk ``sim run --trials``
+#   picks, with or without a chunk error of the file's own chunk, and keeps a given chunk
+#   (sim.api._load_picking_chunk, whose conditions doors28b wrote twice).
+
+
+@pytest.mark.parametrize(
+    "vals, argv",
+    [
+        ({"trials": 400}, ["--trials", "400"]),  # the file's chunk 200: two chunks, cut to 20
+        ({"trials": 100}, ["--trials", "100"]),  # fewer trials than a chunk: the chunk error path
+        ({"trials": 400, "chunk": 20}, ["--trials", "400", "--chunk", "20"]),  # given: kept
+        ({"seed": 5}, ["--seed", "5"]),  # no trials: the file's chunk
+    ],
+)
+def test_the_api_resolves_the_config_sim_run_resolves(vals, argv):
+    import sim
+    from sim.cli import DOC, load_run
+    from sim.cli_args import parser
+
+    study = ROOT / "studies" / "brown_table1.toml"
+    _, cfg = load_run(parser(DOC).parse_args(["run", str(study), *argv]))
+    assert sim.load(study, **vals).config == cfg
