@@ -159,12 +159,9 @@ def _configs_problems(
             out = results / f.stem  # each run is --overwrite: the record is not compared
             record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
             check_out(absolute(out), str(out), record, True)  # (as sim run: check_run_args)
-        except ConfigError as e:  # a line that names the file already: as it is
-            e = _out_in_batch_words(e)
-            lines.append(str(e) if str(e).startswith(f"{f}: ") else f"{f}: {e}")
-            continue
-        except StudyError as e:
-            lines.append(str(e) if str(e).startswith(f"{f}: ") else f"{f}: {e}")
+        except (ConfigError, StudyError) as e:  # a line that names the file already: as it is
+            text = str(_out_in_batch_words(e) if isinstance(e, ConfigError) else e)
+            lines.append(text if text.startswith(f"{f}: ") else f"{f}: {text}")
             continue
         except RecursionError:  # nested too deeply for the parser: its run says so
             lines.append(f"{f}: malformed TOML: nested too deeply")
