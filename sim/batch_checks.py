@@ -19,6 +19,7 @@ from pathlib import Path
 from sim.cli import DOC as cli_doc
 from sim.cli import check_run_args, load_run
 from sim.cli_args import parser as run_parser
+from sim.cli_errors import cwd_exists
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
 from sim.mc.estimate import check_limits, estimate
@@ -142,7 +143,10 @@ def _configs_problems(
     ``{file: (args, study, cfg, sweep)}`` of the others (``--stale-only`` reads them). One
     broken file among many ran the others first, for hours in ``make reproduce``, and was
     named only when its turn came. A ``--set`` key a study has not is left out of its check
-    (:func:`_unknown_sets` says it once; that run refuses it)."""
+    (:func:`_unknown_sets` says it once; that run refuses it). A working directory that was
+    deleted is one line for all (as ``sim run`` says it)."""
+    if not cwd_exists():  # each run resolves its --out against it, and would refuse
+        return ["No such file or directory: the working directory (it was deleted)"], {}
     base = _parsed(run_args)
     lines, loaded = [], {}
     for f in files:

@@ -57,3 +57,23 @@ def test_the_api_resolves_the_config_sim_run_resolves(vals, argv):
     study = ROOT / "studies" / "brown_table1.toml"
     _, cfg = load_run(parser(DOC).parse_args(["run", str(study), *argv]))
     assert sim.load(study, **vals).config == cfg
+
+
+def test_a_batch_from_a_deleted_working_directory_is_one_line(tmp_path, monkeypatch, capsys):
+    """Each run resolves its ``--out`` against the working directory (sim.mc.paths.absolute)
+    and refuses when it is gone; the batch's check before the runs ended in a traceback
+    (FileNotFoundError of os.getcwd) with the default, relative ``--results``."""
+    from sim import batch
+
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    study = str(ROOT / "studies" / "network_plate.toml")
+    for results in ([], ["--results", str(tmp_path / "R")]):
+        assert batch.main([*results, study, "--", "--trials", "40"]) == 2
+        err = capsys.readouterr().err
+        assert err == (
+            "sim.batch: No such file or directory: the working directory (it was deleted)\n"
+        ), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
