@@ -25,9 +25,11 @@ all, and no verdict (a smaller run may be inconclusive where the full one decide
 ``SIM_NO_JIT=1``, another worker count): the environment passes to the re-runs.
 
 A full comparison of every study is written to ``<results>/reproducibility.parquet`` (one row
-per study, with the machine and package versions in the provenance) for the report's
-*Reproducibility* section. A bad option, an unknown study or an empty results directory is one
-line and exit 2; a failed comparison exit 1. ``--scratch`` replaces only what the suite wrote
+per study, with the sha256 of the tables it read, and the machine and package versions in the
+provenance: :mod:`sim.report.verify.record`) for the report's *Reproducibility* section, which
+marks results changed since as not checked now. A bad option, an unknown study, an empty
+results directory or a re-run this machine cannot run (its scratch directory full or read-only,
+memory short) is one line and exit 2; a failed comparison exit 1. ``--scratch`` replaces only what the suite wrote
 there (a directory with its ``run.json``); anything else is refused, never deleted.
 """
 
