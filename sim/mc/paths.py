@@ -7,6 +7,10 @@ study file", of a name ``ls`` shows. Each door that finds a path missing asks
 than the file's (doors24c): ``café.xml`` typed precomposed (NFC) for a file saved decomposed
 (NFD, as macOS writes names) is another name to Linux, and was "no such file" of a name
 ``ls`` shows alike.
+
+Beside it, what the system makes of an output path: :func:`absolute` (``..`` after a link is
+the link target's parent), :func:`mount_point` and :func:`mounts_under` (a directory a run
+cannot rename, or would empty), :func:`is_chunk_store` (another run's ``trials/``).
 """
 
 from __future__ import annotations

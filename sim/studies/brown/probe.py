@@ -18,10 +18,11 @@ __all__ = ["check_solver"]
 
 def check_solver(cfg: dict, pts: np.ndarray, theta: np.ndarray, models, default: int) -> None:
     """The solver limits can be met: ``PROBE_TRIALS`` plates of the run's error model (a fixed
-    stream, not the run's) adjusted with each model from the run's start values, refused by
-    :func:`sim.mc.runner.probe_limit` (``solver.max_iter = 1``, or 2 for the pivot model,
-    which starts at alpha = beta = 0, passed and the run refused after every chunk). Run only
-    for a small limit (``PROBE_MAX_ITER``): a 100 x 100 plate's probe takes seconds.
+    stream, not the run's) adjusted with each model from the run's start values; a limit no
+    probe plate meets is refused by :func:`sim.mc.runner.probe_limit`. Before this check,
+    ``solver.max_iter = 1`` (or 2 for the pivot model, which starts at alpha = beta = 0) passed
+    ``sim check`` and the run refused only after computing every chunk. Run only for a small
+    limit (``PROBE_MAX_ITER``): a 100 x 100 plate's probe takes seconds.
     ``theta``: the run's true globals (7,); ``models``: the models the run adjusts with;
     ``default``: the key's default limit."""
     if cfg["solver.max_iter"] > PROBE_MAX_ITER:
