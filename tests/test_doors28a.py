@@ -85,6 +85,18 @@ def _unshare_works() -> bool:
     return p.returncode == 0
 
 
+def _unshared(script: str, *args, timeout: float = 600) -> subprocess.CompletedProcess:
+    """``sh -c script sh args...`` as root of a user and mount namespace of its own (its
+    mounts vanish with it), from the project's root."""
+    return subprocess.run(
+        ["unshare", "-Urm", "sh", "-c", script, "sh", *map(str, args)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
 @pytest.mark.skipif(not _unshare_works(), reason="needs unshare -Urm (a mount namespace)")
 @pytest.mark.parametrize("how", ["tmpfs", "bind"])
 def test_out_naming_a_mount_point_is_refused_before_the_run(tmp_path, how):
@@ -95,13 +107,7 @@ def test_out_naming_a_mount_point_is_refused_before_the_run(tmp_path, how):
     study = ROOT / "studies" / "brown_table1.toml"
     run = f"{sys.executable} -m sim run {study} --trials 40 --no-figures --quiet --out {mp}"
     script = f'{mount} "$1" && exec {run}'
-    p = subprocess.run(
-        ["unshare", "-Urm", "sh", "-c", script, "sh", str(mp)],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
+    p = _unshared(script, mp)
     err = p.stderr.strip()
     assert p.returncode == 2 and "\n" not in err, err
     assert err.startswith("sim: error: --out:") and "is a mount point" in err, err
@@ -168,13 +174,7 @@ def test_out_holding_a_mount_point_is_refused_before_the_run(tmp_path):
     study = ROOT / "studies" / "brown_table1.toml"
     run = f"{sys.executable} -m sim run {study} --trials 40 --no-figures --quiet --overwrite"
     script = f'mount -t tmpfs tmpfs "$1/data" && echo mine > "$1/data/f" && exec {run} --out "$1"'
-    p = subprocess.run(
-        ["unshare", "-Urm", "sh", "-c", script, "sh", str(out)],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
+    p = _unshared(script, out)
     err = p.stderr.strip()
     assert p.returncode == 2 and "\n" not in err, err
     assert err.startswith("sim: error: --out:") and f"holds a mount point, {out / 'data'}" in err
@@ -217,13 +217,7 @@ def test_results_of_an_overlays_lower_layer_are_replaced(tmp_path):
     (lower / "X" / "notes.md").write_text("mine", encoding="utf-8")
     opts = f"lowerdir={lower},upperdir={upper},workdir={work},userxattr"
     script = f'mount -t overlay overlay -o {opts} "$1" || exit 99; exec "$2" -c "$3" "$1"'
-    p = subprocess.run(
-        ["unshare", "-Urm", "sh", "-c", script, "sh", merged, sys.executable, _OVERLAY_PUBLISH],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    p = _unshared(script, merged, sys.executable, _OVERLAY_PUBLISH, timeout=120)
     if p.returncode == 99:
         pytest.skip(f"no overlay mount here: {p.stderr.strip()}")
     assert p.returncode == 0, p.stderr
@@ -255,13 +249,7 @@ def test_a_write_on_a_read_only_file_system_names_the_file(tmp_path):
     ro = tmp_path / "ro"
     ro.mkdir()
     script = 'mount -t tmpfs -o ro tmpfs "$1" || exit 99; exec "$2" -c "$3" "$1"'
-    p = subprocess.run(
-        ["unshare", "-Urm", "sh", "-c", script, "sh", ro, sys.executable, _READ_ONLY_WRITE],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    p = _unshared(script, ro, sys.executable, _READ_ONLY_WRITE, timeout=120)
     assert p.returncode == 0, p.stderr
     assert p.stdout.strip() == f"{errno.EROFS} {ro / 'README.md'}", p.stdout
 
