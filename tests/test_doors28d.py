@@ -14,12 +14,24 @@ user who upgrades), one case each; each failed on the code before its fix.
 The other 36 distinct versions of the shipped study files (``git log -- studies/``) run, or
 are refused by a key whose bound or rule changed, one line naming it (``region.plate_points:
 must be >= 256``, a ``pugging.gross_px`` no longer read at ``gross_rate = 0``).
+
+* ``sim report --results`` over the results tree of an older commit (``git archive a9e864d9
+  results``: ``sim show`` reads each directory, with its note) said of agnard_block's claims
+  table that it "is not as sim wrote it (... KeyError ...); run its study again" and then
+  named another directory (network_testfield, the first listed) as made by another version:
+  a hand edit blamed for what an older version wrote, and the wrong study named. The line now
+  says the table's own directory was made by another version of the suite's code
+  (:func:`sim.cli_errors.not_as_written`). Results of older commits were otherwise read
+  right: ``sim show`` with its note, ``sim report`` of the day before's tree.
 """
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
+import pyarrow.compute as pc
+import pyarrow.parquet as pq
 import pytest
 
 import sim
@@ -29,7 +41,8 @@ from sim.studies import get_study
 from sim.studies.retired import RETIRED
 from tests.oneline import SIM_ERROR, one_line
 
-STUDIES = Path(__file__).resolve().parents[1] / "studies"
+ROOT = Path(__file__).resolve().parents[1]
+STUDIES = ROOT / "studies"
 
 
 def _old_file(tmp_path: Path, name: str, extra: str, top: bool = False) -> Path:
@@ -104,3 +117,33 @@ def test_the_table_of_retired_keys_names_no_key_a_study_reads_now():
     for f in STUDIES.glob("*.toml"):  # no shipped file holds one
         doc = read_toml(f)
         assert not set(flatten(doc)) & set(RETIRED.get(doc["study"], {})), f
+
+
+def _older_tree(tmp_path: Path) -> Path:
+    """Committed results of two studies, agnard_block's claims table without the rows of a
+    claim this version's book scores (as a version before that claim wrote it)."""
+    root = tmp_path / "results"
+    for name in ("agnard_block", "brown_table1"):
+        shutil.copytree(ROOT / "results" / name, root / name)
+    f = root / "agnard_block" / "claims.parquet"
+    t = pq.read_table(f)  # (its metadata kept: the provenance of the run)
+    pq.write_table(t.filter(pc.invert(pc.starts_with(t["claim"], "agnard.control_21"))), f)
+    return root
+
+
+def test_report_over_an_older_versions_results_says_so_of_the_tables_own_study(
+    tmp_path, capsys, monkeypatch
+):
+    root = _older_tree(tmp_path)
+    line = one_line(capsys, main(["report", "--results", str(root)]), "agnard_block/claims")
+    assert "not as sim wrote it" in line and "another version" not in line  # a hand edit
+    monkeypatch.setattr("sim.cli_errors.study_code_hash", lambda study: "f" * 16)  # upgraded
+    line = one_line(
+        capsys,
+        main(["report", "--results", str(root)]),
+        "agnard_block/claims.parquet under",
+        "was made by another version of the suite's code",
+        "make reproduce re-runs what is stale",
+        prefix=SIM_ERROR,
+    )
+    assert "not as sim wrote it" not in line and "brown_table1" not in line, line
