@@ -11,7 +11,7 @@ from pathlib import Path
 from sim.mc.codehash import study_code_hash
 from sim.mc.outputs import results_dirs
 from sim.mc.storage import read_record
-from sim.report.read import damaged_message
+from sim.report.read import TableError, damaged_message, last_read
 
 __all__ = ["cwd_exists", "from_stdout", "os_reason", "not_as_written", "other_code"]
 
@@ -53,8 +53,15 @@ def os_reason(e: OSError) -> str:
 def not_as_written(d: Path, e: Exception) -> str:
     """show and report read the Parquet tables only: one that fails to read as its study's
     table was replaced or edited by hand (named with its column by the reader), or was
-    written by another version of the suite (results of an older clone: then said so)."""
+    written by another version of the suite (results of an older clone: then said so, of the
+    failing table's own results directory when its run record says so)."""
     msg = damaged_message(d, e)
+    own = _table_dir(d, e)
+    if own is not None and other_code(own) == str(own):  # the table's own run is older:
+        # it is as that version wrote it ("not as sim wrote it" blamed a hand edit)
+        return msg.replace(
+            "is not as sim wrote it (", "was made by another version of the suite's code ("
+        ).replace("; run its study again", ": make reproduce re-runs what is stale")
     older = other_code(d)
     if older:  # the likely cause: a table this version reads as it writes it now
         msg += (
@@ -62,6 +69,20 @@ def not_as_written(d: Path, e: Exception) -> str:
             "re-runs what is stale)"
         )
     return msg
+
+
+def _table_dir(d: Path, e: Exception) -> Path | None:
+    """The results directory (``d`` or one directly under it) of the table whose reading
+    failed with ``e``, or None when no table is named."""
+    lr = last_read()
+    f = e.path if isinstance(e, TableError) else (lr[0] if lr else None)
+    if f is None:
+        return None
+    try:
+        parts = Path(f).resolve().relative_to(Path(d).resolve()).parts
+    except (ValueError, OSError):
+        return None
+    return Path(d) / parts[0] if len(parts) > 1 and (Path(d) / parts[0]).is_dir() else Path(d)
 
 
 def other_code(d: Path) -> str | None:

@@ -22,6 +22,7 @@ from sim.mc.config import ConfigError, flatten, read_toml
 from sim.mc.registry import MODULES
 from sim.mc.sweep import read_sweep
 from sim.studies import get_study
+from sim.studies.retired import retired_note
 
 __all__ = ["foreign_key"]
 
@@ -69,6 +70,12 @@ def foreign_key(e: ConfigError, path: str | os.PathLike) -> ConfigError:
             pass
     except (ConfigError, OSError):  # the file as the load read it: nothing else to say
         return e
+    if note := retired_note(name, e.key):  # a file kept from an older version of the suite
+        old = [k for k in dict.fromkeys(keys) if retired_note(name, k)]
+        more = f" and {len(old) - SHOWN} more" if len(old) > SHOWN else ""
+        if len(old) > 1:
+            note += f" (the file holds {len(old)} such keys: {', '.join(old[:SHOWN])}{more})"
+        return ConfigError(e.key, note)
     key = e.key.removeprefix("sweep.")
     schemas = _schemas(name)
     owners = [s for s, sch in schemas.items() if key in sch]
