@@ -30,13 +30,14 @@ import pyarrow.parquet as pq
 
 from sim.api_args import arguments as _arguments
 from sim.execute import execute
-from sim.mc.config import ConfigError, study_file_hint
+from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
 from sim.mc.paths import absolute, link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import config_hash, read_provenance, read_record
+from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
@@ -409,9 +410,8 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
     check_environment()  # TQDM_NCOLS=abc: refused here, not in the middle of a run
-    if not Path(study_file).is_file():
-        why = link_problem(study_file) or f"is not a study file{study_file_hint(study_file)}"
-        raise ConfigError("study_file", f"{study_file} {why}")
+    if why := study_file_problem(study_file):  # sim check's own check of a file
+        raise ConfigError("study_file", why)
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the
     # working directory may have changed since (it would read another file of that name)
     study_file = _absolute("study_file", study_file)

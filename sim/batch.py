@@ -49,7 +49,6 @@ single_threaded_blas()  # before NumPy loads (the study modules import it)
 from sim.batch_checks import (  # noqa: E402
     _clashes,
     _configs_problems,
-    _file_problem,
     _in_batch_words,
     _replaces_project_results,
     _run_options_problem,
@@ -64,6 +63,7 @@ from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_chi
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
 from sim.mc.storage import atomic_path  # noqa: E402
+from sim.mc.study_file import study_file_problem  # noqa: E402
 from sim.stops import (  # noqa: E402
     check_interrupt,
     exit_status,
@@ -296,7 +296,7 @@ def _main(argv: list[str]) -> int:
             print(f"sim.batch: {name}: {name_problem(v)} (got {v!r})", file=sys.stderr)
             return 2
     files = [Path(f) for f in args.files]
-    problems = [_file_problem(f) for f in files]
+    problems = [study_file_problem(f) for f in files]  # sim check's own check of a file
     bad = [why for why in problems if why]  # every one, not the first only
     bad += _clashes([f for f, why in zip(files, problems) if not why], run_args, args.results)
     for why in bad:

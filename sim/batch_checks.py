@@ -24,7 +24,7 @@ from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import check_out
-from sim.mc.paths import absolute, link_problem
+from sim.mc.paths import absolute
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
 from sim.mc.sweep import read_sweep
@@ -110,26 +110,6 @@ def _clashes(files: list[Path], run_args: list[str], results: str = "results") -
         else:
             seen[f.stem] = f
     return out
-
-
-def _file_problem(f: Path) -> str | None:
-    """Why ``f`` names no study file (one line, the path first), or None: a directory (``sim
-    check`` said so; the batch said "no study file"), a link that leads nowhere, a pipe or a
-    device (also "no study file"), a shell pattern that matched no file (the shell passes it
-    on as it is), or nothing there."""
-    if f.is_file():
-        return None
-    if f.is_dir():
-        return f"{f}: is a directory, not a study file (name its files: {f}/*.toml)"
-    if why := link_problem(f):
-        return f"{f} {why}"
-    if f.exists():  # a FIFO, a device (/dev/null): there, but no study file
-        return f"{f}: not a regular file (a pipe or a device): name the study file"
-    if any(c in str(f) for c in "*?["):
-        return (
-            f"no study file {f} (a pattern that matched no file: the shell passed it on as it is)"
-        )
-    return f"no study file {f}"
 
 
 def _configs_problems(

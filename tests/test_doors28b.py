@@ -22,7 +22,7 @@ batch of many study files), one case each; each failed on the code before its fi
   such file named, one line each, exit 2 (:func:`sim.batch_checks._configs_problems`). Of
   several missing files or clashes only the first was named; a directory was "no study
   file", and a shell pattern that matched nothing said nothing of it
-  (:func:`sim.batch_checks._file_problem`, :func:`sim.batch_checks._clashes`); a run over the
+  (:func:`sim.mc.study_file.study_file_problem`, :func:`sim.batch_checks._clashes`); a run over the
   memory or work limit is refused with them.
 """
 
@@ -197,11 +197,11 @@ def test_a_batch_names_every_missing_file_and_every_clash(capsys, tmp_path, monk
     assert batch.main(argv) == 2
     lines = _lines(capsys)
     assert lines == [
-        "sim.batch: no study file nope1.toml",
-        "sim.batch: d: is a directory, not a study file (name its files: d/*.toml)",
-        "sim.batch: no study file no*.toml (a pattern that matched no file: the shell passed "
-        "it on as it is)",
-        "sim.batch: no study file nope2.toml",
+        "sim.batch: nope1.toml: no such study file",
+        "sim.batch: d: is a directory, not a study file (its study files are d/*.toml)",
+        "sim.batch: no*.toml: no such study file (a pattern that matched no file: the shell "
+        "passed it on as it is)",
+        "sim.batch: nope2.toml: no such study file",
         "sim.batch: a.toml and d/a.toml would both write results/a",
         "sim.batch: b.toml is listed twice",
     ], lines

@@ -184,7 +184,7 @@ def test_a_signal_after_sim_returned_leaves_its_exit_code(tmp_path, when, sig):
 @pytest.mark.parametrize(
     "argv, line",
     [
-        (["sim.batch", "nosuch.toml"], "sim.batch: no study file nosuch.toml\n"),
+        (["sim.batch", "nosuch.toml"], "sim.batch: nosuch.toml: no such study file\n"),
         (["sim.report.verify", "--workers", "0"], "sim verify: error: --workers: must be"),
     ],
 )

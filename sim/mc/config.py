@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.lookalike import note, toml_char_hint
-from sim.mc.paths import link_problem
+from sim.mc.study_file import study_file_problem
 
 __all__ = [
     "ConfigError",
@@ -342,34 +342,12 @@ def parse_override(text: str) -> tuple[str, Any]:
     return key, doc["v"]
 
 
-#: largest study file read (bytes): a study file is a page of keys, not data
-MAX_STUDY_BYTES = 16 * 1024**2
-
-
-def study_file_hint(p: str | Path) -> str:
-    """`` (did you mean studies/brown_table1.toml?)`` for a study file named the way a new
-    user names it: without ``.toml``, without ``studies/``, or with Windows backslashes."""
-    text = str(p).replace("\\", "/")
-    tries = [text, f"{text}.toml", f"studies/{text}", f"studies/{text}.toml"]
-    hit = next((t for t in tries if t != str(p) and Path(t).is_file()), None)
-    return f" (did you mean {hit}?)" if hit else ""
-
-
 def read_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML study file; a missing, oversized or malformed file is a ConfigError."""
     p = Path(path)
-    if p.is_dir():  # both were "no such study file", of a file that is there
-        raise ConfigError(None, f"{p}: is a directory, not a study file")
-    if p.exists() and not p.is_file():  # a pipe (cat x.toml | sim check /dev/stdin), a device
-        raise ConfigError(None, f"{p}: not a regular file (a pipe or a device): name the file")
-    if not p.is_file():
-        why = link_problem(p)  # a link loop was "no such study file", of a name that is there
-        raise ConfigError(None, f"{p}: {why or 'no such study file' + study_file_hint(p)}")
+    if why := study_file_problem(p):  # the one check (the batch's too, before any run)
+        raise ConfigError(None, why)
     try:
-        if p.stat().st_size > MAX_STUDY_BYTES:
-            raise ConfigError(
-                None, f"{p}: over {MAX_STUDY_BYTES // 1024**2} MiB, too large for a study file"
-            )
         data = p.read_bytes()
         if data.startswith(codecs.BOM_UTF8):  # a Windows editor's UTF-8 signature: not TOML,
             data = data[len(codecs.BOM_UTF8) :]  # and no part of the text; it was refused

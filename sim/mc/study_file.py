@@ -1,0 +1,57 @@
+"""Whether a path can be read as a study file: the one check of ``sim check``/``sim run``
+(:func:`sim.mc.config.read_toml`), ``python -m sim.batch`` before any run, and ``sim.load``.
+
+The batch had its own near-copy of these checks in other words ("no study file x.toml"
+beside read_toml's "x.toml: no such study file", a pattern hint the command line lacked,
+no size limit until the file's config was read): one check, one wording, the path first.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from sim.mc.paths import link_problem
+
+__all__ = ["MAX_STUDY_BYTES", "study_file_hint", "study_file_problem"]
+
+#: largest study file read (bytes): a study file is a page of keys, not data
+MAX_STUDY_BYTES = 16 * 1024**2
+
+
+def study_file_hint(p: str | Path) -> str:
+    """`` (did you mean studies/brown_table1.toml?)`` for a study file named the way a new
+    user names it: without ``.toml``, without ``studies/``, or with Windows backslashes."""
+    text = str(p).replace("\\", "/")
+    tries = [text, f"{text}.toml", f"studies/{text}", f"studies/{text}.toml"]
+    hit = next((t for t in tries if t != str(p) and Path(t).is_file()), None)
+    return f" (did you mean {hit}?)" if hit else ""
+
+
+def study_file_problem(p: str | Path) -> str | None:
+    """Why ``p`` cannot be read as a study file, one line that starts with the path, or None:
+    a directory, a pipe or a device (opening a FIFO nobody writes to blocks), a link that
+    leads nowhere or loops, a shell pattern that matched no file (the shell passes it on as
+    it is), nothing there (with the file meant, when a near name is one), or a file over
+    :data:`MAX_STUDY_BYTES`. A file that cannot be read is said when it is read."""
+    p = Path(p)
+    if p.is_dir():  # both were "no such study file", of a file that is there
+        return f"{p}: is a directory, not a study file (its study files are {p}/*.toml)"
+    if p.exists() and not p.is_file():  # a pipe (cat x.toml | sim check /dev/stdin), a device
+        return f"{p}: not a regular file (a pipe or a device): name the study file"
+    if not p.is_file():
+        if why := link_problem(p):  # a link loop was "no such study file", of a name there
+            return f"{p}: {why}"
+        if any(c in str(p) for c in "*?["):
+            return (
+                f"{p}: no such study file (a pattern that matched no file: the shell passed "
+                "it on as it is)"
+            )
+        return f"{p}: no such study file{study_file_hint(p)}"
+    try:
+        size = os.stat(p).st_size
+    except OSError:  # gone since, or a directory of the path not searchable: said on reading
+        return None
+    if size > MAX_STUDY_BYTES:
+        return f"{p}: over {MAX_STUDY_BYTES // 1024**2} MiB, too large for a study file"
+    return None

@@ -1,0 +1,84 @@
+"""The items issue 26's last note left open (review28's, doors28b's, doors28c's and doors28d's;
+brief L14).
+
+1. ``python -m sim.batch`` checked its files before any run with a near-copy of
+   :func:`sim.mc.config.read_toml`'s checks in other words ("no study file x.toml" beside
+   ``sim check``'s "x.toml: no such study file", no "did you mean studies/x.toml?", a
+   pattern hint ``sim check`` lacked) and ``sim.load`` with a third ("x is not a study
+   file"). One check, :func:`sim.mc.study_file.study_file_problem`, words every refusal of a
+   path once; the three doors say its line after their own prefix.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim import batch
+from sim.cli import main
+from sim.mc.config import ConfigError
+from tests.oneline import SIM_ERROR, one_line
+
+ROOT = Path(__file__).resolve().parents[1]
+PLATE = ROOT / "studies" / "network_plate.toml"
+
+
+# ------------------------------------------------------------- 1. one check of a study file
+def _bad_path(tmp_path: Path, kind: str) -> str:
+    """A path of ``kind`` that names no readable study file (the working directory is
+    ``tmp_path``, which holds ``studies/net.toml``)."""
+    if kind == "directory":
+        (tmp_path / "d").mkdir()
+        return "d"
+    if kind == "fifo":
+        os.mkfifo(tmp_path / "pipe.toml")
+        return "pipe.toml"
+    if kind == "device":
+        return "/dev/null"
+    if kind == "loop":
+        (tmp_path / "ring").symlink_to(tmp_path / "ring")
+        return "ring"
+    if kind == "dangling":
+        (tmp_path / "link.toml").symlink_to(tmp_path / "gone")
+        return "link.toml"
+    if kind == "huge":  # a sparse file over the size limit
+        with open(tmp_path / "huge.toml", "wb") as f:
+            f.truncate(17 * 1024**2)
+        return "huge.toml"
+    return {"missing": "nosuch.toml", "near": "net", "pattern": "no*.toml"}[kind]
+
+
+KINDS = ["directory", "fifo", "device", "loop", "dangling", "huge", "missing", "near", "pattern"]
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_the_batch_sim_check_and_the_api_refuse_a_path_in_one_wording(
+    tmp_path, monkeypatch, capsys, kind
+):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "studies").mkdir()
+    (tmp_path / "studies" / "net.toml").write_text(PLATE.read_text(encoding="utf-8"))
+    path = _bad_path(tmp_path, kind)
+    line = one_line(capsys, main(["check", path]), prefix=SIM_ERROR)
+    why = line.removeprefix(SIM_ERROR)
+    assert why.startswith(f"{path}: "), why
+    assert one_line(capsys, batch.main([path])) == f"sim.batch: {why}"
+    with pytest.raises(ConfigError) as e:
+        sim.load(path)
+    assert str(e.value) == f"study_file: {why}"
+    want = {
+        "directory": "is a directory, not a study file (its study files are d/*.toml)",
+        "fifo": "not a regular file (a pipe or a device)",
+        "device": "not a regular file (a pipe or a device)",
+        "loop": "is a symbolic-link loop",
+        "dangling": "is a symbolic link to",
+        "huge": "over 16 MiB, too large for a study file",
+        "missing": "no such study file",
+        "near": "no such study file (did you mean studies/net.toml?)",
+        "pattern": "no such study file (a pattern that matched no file",
+    }[kind]
+    assert want in why, why
+    assert not (tmp_path / "results").exists()
