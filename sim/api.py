@@ -35,14 +35,12 @@ from sim.mc.estimate import estimate
 from sim.mc.paths import absolute, link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
-from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import config_hash, read_provenance, read_record
 from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
-from sim.studies import load_study
-from sim.studies.ported import foreign_key
+from sim.studies.picking import load_picking_chunk
 
 __all__ = ["load", "StudyHandle", "Results"]
 
@@ -388,23 +386,6 @@ def _plain(v: Any) -> Any:
     return v
 
 
-def _load_picking_chunk(study_file, vals: dict):
-    """``load_study``; ``trials`` without ``chunk`` picks the largest chunk giving at least
-    MIN_CHUNKS chunks, as ``sim run --trials`` does (same config, same results)."""
-    picks = "trials" in vals and "chunk" not in vals
-    try:
-        study, cfg = load_study(study_file, values=vals)
-    except ConfigError as e:
-        if e.key != "chunk" or not picks:
-            raise foreign_key(e, study_file) from None  # a key of another study: whose
-        # the file's chunk is too large for the trials asked for
-        _, cfg = load_study(study_file, values={**vals, "chunk": 1})
-        return load_study(study_file, values={**vals, "chunk": max(1, cfg["trials"] // MIN_CHUNKS)})
-    if picks and "chunk" in cfg and cfg["chunk"] > (chunk := max(1, cfg["trials"] // MIN_CHUNKS)):
-        study, cfg = load_study(study_file, values={**vals, "chunk": chunk})
-    return study, cfg
-
-
 @_arguments
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
@@ -420,7 +401,8 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
     vals = {k: _plain(v) for k, v in _keyed(overrides).items()}
     sha = _sha256(study_file)
-    study, cfg = _load_picking_chunk(study_file, vals)
+    picks = "trials" in vals and "chunk" not in vals  # sim run --trials's chunk
+    study, cfg = load_picking_chunk(study_file, picks, values=vals)
     sweep = read_sweep(study_file, study.schema)
     if _sha256(study_file) != sha:  # written to while it was read: which version is this?
         raise ConfigError("study_file", f"{study_file} changed while it was loaded: load it again")

@@ -41,14 +41,13 @@ from sim.mc.outputs import name_problem
 from sim.mc.paths import absolute
 from sim.mc.progress import set_quiet
 from sim.mc.read_when import read_in_a_cell
-from sim.mc.runner import MIN_CHUNKS
 from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
 from sim.report.run_summary import terminal_summary, write_run_readme
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
-from sim.studies import get_study, load_study, unread_keys
-from sim.studies.ported import foreign_key
+from sim.studies import get_study, unread_keys
+from sim.studies.picking import load_picking_chunk
 from sim.threads import interrupted, memory_words, shadowed, short_of_memory
 
 __all__ = ["main", "check_run_args"]
@@ -111,30 +110,17 @@ def _keys_set(overrides: list[str]) -> set[str]:
 def load_run(args):
     """The study and its resolved config, as ``sim run`` (or ``check``) with the parsed
     ``args`` resolves them. ``--trials`` (or ``--set trials=``) without a chunk
-    size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it."""
+    size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it
+    (:func:`sim.studies.picking.load_picking_chunk`, :func:`sim.load`'s rule too)."""
     set_quiet(getattr(args, "quiet", False))  # the check of a large network shows its steps
     overrides = list(args.set) + ([f"chunk={args.chunk}"] if args.chunk is not None else [])
     given = _keys_set(args.set)
     for opt, key in (("--trials", "trials"), ("--seed", "seed"), ("--chunk", "chunk")):
         if getattr(args, key) is not None and key in given:  # one would be dropped silently
             raise ConfigError(opt, f"given twice, as {opt} and as --set {key}=: give one")
-    trials_given = args.trials is not None or "trials" in given
-    try:
-        study, cfg = load_study(args.study, overrides, args.trials, args.seed)
-    except ConfigError as e:
-        if not (e.key == "chunk" and trials_given and args.chunk is None and "chunk" not in given):
-            raise foreign_key(e, args.study) from None  # a key of another study: whose
-        # the file's chunk is too large for the trials asked for: --trials picks the chunk
-        _, cfg = load_study(args.study, [*overrides, "chunk=1"], args.trials, args.seed)
-        overrides = [*overrides, f"chunk={max(1, cfg['trials'] // MIN_CHUNKS)}"]
-        study, cfg = load_study(args.study, overrides, args.trials, args.seed)
-    if trials_given and args.chunk is None and "chunk" not in given and "chunk" in cfg:
-        chunk = max(1, cfg["trials"] // MIN_CHUNKS)
-        if cfg["chunk"] > chunk:
-            study, cfg = load_study(
-                args.study, [*overrides, f"chunk={chunk}"], args.trials, args.seed
-            )
-    return study, cfg
+    trials = args.trials is not None or "trials" in given
+    picks = trials and args.chunk is None and "chunk" not in given  # --trials's chunk
+    return load_picking_chunk(args.study, picks, overrides, args.trials, args.seed)
 
 
 def _config_tag(record: dict) -> str:

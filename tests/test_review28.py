@@ -37,7 +37,7 @@ def test_the_batch_checks_the_results_directory_its_run_writes(tmp_path, monkeyp
 
 # * ``sim.load`` resolves ``trials`` (without ``chunk``) to the chunk ``sim run --trials``
 #   picks, with or without a chunk error of the file's own chunk, and keeps a given chunk
-#   (sim.api._load_picking_chunk, whose conditions doors28b wrote twice).
+#   (sim.studies.picking.load_picking_chunk, sim run's rule too; doors28b wrote it twice).
 
 
 @pytest.mark.parametrize(
