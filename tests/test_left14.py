@@ -7,6 +7,14 @@ brief L14).
    pattern hint ``sim check`` lacked) and ``sim.load`` with a third ("x is not a study
    file"). One check, :func:`sim.mc.study_file.study_file_problem`, words every refusal of a
    path once; the three doors say its line after their own prefix.
+2. (a refactor: tests/test_review28.py holds it) the chunk ``--trials`` picks is one helper,
+   :func:`sim.studies.picking.load_picking_chunk`, for ``sim run`` and ``sim.load``.
+3. ``make verify``'s record (``reproducibility.parquet``) named the machine and numerical
+   path by a copy of :func:`sim.mc.storage.numerics` under keys of its own
+   (``openblas_coretype``; an empty ``OPENBLAS_CORETYPE``, which OpenBLAS takes as unset,
+   recorded as set), so the report's *Reproducibility* section and its "committed results
+   were made on ... (OPENBLAS_CORETYPE=...)" named one variable two ways. The record now
+   holds :func:`sim.mc.storage.numerics` as every run does.
 """
 
 from __future__ import annotations
@@ -82,3 +90,24 @@ def test_the_batch_sim_check_and_the_api_refuse_a_path_in_one_wording(
     }[kind]
     assert want in why, why
     assert not (tmp_path / "results").exists()
+
+
+# ------------------------------------------------------------- 3. one record of the numerics
+@pytest.mark.parametrize("coretype", ["Haswell", ""])
+def test_the_verify_record_names_the_numerical_path_as_every_run_does(
+    tmp_path, monkeypatch, coretype
+):
+    from sim.mc.storage import numerics, read_provenance
+    from sim.report.verify import markdown, write_record
+    from sim.report.verify.rules import Comparison
+
+    monkeypatch.setenv("OPENBLAS_CORETYPE", coretype)
+    monkeypatch.setenv("SIM_NO_JIT", "1")
+    run = numerics()  # what a run records in its tables' provenance
+    assert run["SIM_NO_JIT"] == "1" and run.get("OPENBLAS_CORETYPE") == (coretype or None)
+    machine = read_provenance(write_record(tmp_path, [Comparison("x", files=1)]))["machine"]
+    assert {k: v for k, v in machine.items() if k in run or k.isupper()} == run, machine
+    text = markdown(tmp_path)
+    assert "SIM_NO_JIT=1" in text and "sim_no_jit" not in text, text
+    assert ("OPENBLAS_CORETYPE=Haswell" in text) == bool(coretype), text
+    assert "openblas_coretype" not in text, text

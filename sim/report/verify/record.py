@@ -11,7 +11,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.mc.outputs import results_dirs
-from sim.mc.storage import read_provenance, versions, write_table
+from sim.mc.storage import numerics, read_provenance, versions, write_table
 from sim.report.tables import fmt, md_table
 from sim.report.verify.rules import DEFAULT_RTOL, Comparison, tables_digest
 
@@ -19,17 +19,15 @@ __all__ = ["write_record", "markdown"]
 
 
 def _machine() -> dict:
+    """The machine and numerical path of the re-runs, as every run records its own
+    (:func:`sim.mc.storage.numerics`, under the same keys: the record named them
+    ``openblas_coretype``/``sim_no_jit`` in a copy of its own, and recorded an empty
+    ``OPENBLAS_CORETYPE`` that OpenBLAS takes as unset), with the processor, the CPU count
+    and the package versions."""
     return {
-        "machine": platform.machine(),
-        "system": platform.system(),
+        **numerics(),
         "processor": platform.processor() or platform.machine(),
         "cpus": os.cpu_count(),
-        **(
-            {"openblas_coretype": os.environ["OPENBLAS_CORETYPE"]}
-            if "OPENBLAS_CORETYPE" in os.environ
-            else {}
-        ),
-        **({"sim_no_jit": os.environ["SIM_NO_JIT"]} if os.environ.get("SIM_NO_JIT") else {}),
         **versions(),
     }
 
@@ -60,8 +58,10 @@ def markdown(results: Path) -> str:
     t = pq.read_table(p).to_pylist()
     m = read_provenance(p).get("machine", {})
     since = _checked_since(Path(results), t)
-    ver = ", ".join(
-        f"{k} {v}" for k, v in m.items() if k not in ("machine", "system", "processor", "cpus")
+    ver = ", ".join(  # a variable of the numerical path as it is set (OPENBLAS_CORETYPE=...)
+        f"{k}={v}" if k.isupper() else f"{k} {v}"
+        for k, v in m.items()
+        if k not in ("machine", "system", "processor", "cpus")
     )
     made = _committed_on(Path(results))
     rows = [
