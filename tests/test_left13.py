@@ -79,7 +79,7 @@ PROBE = re.compile(
     re.escape(SIM_ERROR)
     + r"solver\.max_iter: (\d+) iterations? to solver\.tol_mm = (\S+): none of 16 probe trials "
     r"of the (.+) converged, so no trial would \(the run would compute every chunk, then "
-    r"refuse\): raise solver\.max_iter \(or solver\.tol_mm\)"
+    r"refuse\): raise solver\.max_iter \(or solver\.tol_mm\)(?:; (.+))?"
 )
 
 
@@ -100,6 +100,7 @@ def test_the_solver_probes_refuse_in_one_wording_naming_the_key_and_the_model(
     m = PROBE.fullmatch(line)
     assert m, line
     assert m[1] == str(limit) and m[3].endswith(model), line
+    assert (m[4] is not None) == model.endswith("network"), line  # its hint: tests/test_left14
 
 
 def test_the_probe_helper_refuses_only_when_the_limit_is_the_cause():

@@ -15,6 +15,11 @@ brief L14).
    recorded as set), so the report's *Reproducibility* section and its "committed results
    were made on ... (OPENBLAS_CORETYPE=...)" named one variable two ways. The record now
    holds :func:`sim.mc.storage.numerics` as every run does.
+4. The network's refusal of a ``solver.max_iter`` no probe trial meets lost, when its wording
+   became the common one (:func:`sim.mc.runner.probe_limit`, left13), what the network said of
+   it: the first correction from the true coordinates is the noise itself, so a trial
+   converges in its second iteration at the earliest. The common line now ends with what a
+   model knows of it (the network's, not Brown's models').
 """
 
 from __future__ import annotations
@@ -111,3 +116,23 @@ def test_the_verify_record_names_the_numerical_path_as_every_run_does(
     assert "SIM_NO_JIT=1" in text and "sim_no_jit" not in text, text
     assert ("OPENBLAS_CORETYPE=Haswell" in text) == bool(coretype), text
     assert "openblas_coretype" not in text, text
+
+
+# ------------------------------------------------------------- 4. the network's probe hint
+@pytest.mark.parametrize(
+    "study, limit, hint",
+    [("network_plate", 1, True), ("network_brown", 1, True), ("brown_table1", 1, False)],
+)
+def test_the_networks_solver_refusal_says_why_one_iteration_never_converges(
+    capsys, study, limit, hint
+):
+    argv = ["check", str(ROOT / "studies" / f"{study}.toml"), "--set", f"solver.max_iter={limit}"]
+    line = one_line(
+        capsys, main(argv), "solver.max_iter", "raise solver.max_iter", prefix=SIM_ERROR
+    )
+    said = "the first correction from the true coordinates is the noise itself, so a trial "
+    assert (said in line) == hint, line
+    assert line.endswith("second iteration at the earliest") == hint, line
+    if hint:  # and the limit it points to is met: two iterations pass the probe
+        argv[-1] = "solver.max_iter=2"
+        assert main(argv) == 0, capsys.readouterr().err

@@ -113,7 +113,9 @@ def require_chunks(cfg: Mapping, need: int = MIN_CHUNKS, use: str = "jackknife i
     )
 
 
-def probe_limit(cfg: Mapping, statuses: Callable[[int], np.ndarray], default: int, model: str):
+def probe_limit(
+    cfg: Mapping, statuses: Callable[[int], np.ndarray], default: int, model: str, why: str = ""
+):
     """Refuse, at load time, a ``solver.max_iter`` no trial of the run can meet (the run
     computed every chunk, then refused): ``statuses(max_iter)`` gives the solver statuses of
     the study's :data:`PROBE_TRIALS` probe trials (a stream of :data:`PROBE_SEED`, not the
@@ -122,7 +124,9 @@ def probe_limit(cfg: Mapping, statuses: Callable[[int], np.ndarray], default: in
     at the key's ``default`` (a gross bias no limit helps is named elsewhere); probed only at
     a limit of at most :data:`PROBE_MAX_ITER`. One wording for every study (brown's
     ``check_solver``, the network's ``probe_solver``), naming the key and ``model`` (what
-    the trials adjust with: "pivot model", "'grid plate' network")."""
+    the trials adjust with: "pivot model", "'grid plate' network"); ``why``: what the model
+    knows of the iterations a trial needs, said after the common words (the network's: its
+    first correction is the noise itself)."""
     limit, tol = cfg["solver.max_iter"], cfg["solver.tol_mm"]
     if limit > PROBE_MAX_ITER or not np.all(statuses(limit) == 1):
         return
@@ -131,7 +135,8 @@ def probe_limit(cfg: Mapping, statuses: Callable[[int], np.ndarray], default: in
             "solver.max_iter",
             f"{limit} iteration{'s' * (limit > 1)} to solver.tol_mm = {tol:g}: none of "
             f"{PROBE_TRIALS} probe trials of the {model} converged, so no trial would (the run "
-            "would compute every chunk, then refuse): raise solver.max_iter (or solver.tol_mm)",
+            "would compute every chunk, then refuse): raise solver.max_iter (or solver.tol_mm)"
+            + (f"; {why}" if why else ""),
         )
 
 
