@@ -35,7 +35,7 @@ from sim.cli_errors import cwd_exists, from_stdout, os_reason
 from sim.cli_read import report, show
 from sim.ends import stdout_failed
 from sim.execute import check_sweep, execute
-from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
+from sim.mc.config import ConfigError, StudyError, check_chunks, config_changes, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem
 from sim.mc.paths import absolute
@@ -130,11 +130,11 @@ def _config_tag(record: dict) -> str:
 
 def _differs(old: dict, record: dict) -> str:
     """What differs between a committed run record and this run's, in a few words."""
-    a, b = old.get("config") or {}, record["config"]
-    keys = [k for k in dict.fromkeys([*a, *b]) if a.get(k) != b.get(k)]
-    if keys:
-        shown = ", ".join(f"{k} {a.get(k)!r} -> {b.get(k)!r}" for k in keys[:3])
-        return f"its config differs ({shown}{', ...' if len(keys) > 3 else ''})"
+    a, b = old.get("config"), record["config"]
+    if not isinstance(a, dict):  # a record edited by hand
+        return "its config differs"
+    if a != b:  # the keys, as --out's refusal names them (sim.mc.outputs)
+        return f"its config differs ({config_changes(a, b)})"
     return "the code changed since they were made"
 
 

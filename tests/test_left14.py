@@ -20,10 +20,16 @@ brief L14).
    it: the first correction from the true coordinates is the noise itself, so a trial
    converges in its second iteration at the earliest. The common line now ends with what a
    model knows of it (the network's, not Brown's models').
+5. A results directory of an older version whose config held a key retired since
+   (:mod:`sim.studies.retired`) was refused by ``sim run --out`` as "a different config:
+   sweep.trials = 40 (this run None)", as if this run had set the key to None (and ``sim run``
+   without ``--out`` said "sweep.trials 40 -> None", its own copy of the comparison). One
+   function, :func:`sim.mc.config.config_changes`, says a key either side lacks as such.
 """
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -136,3 +142,24 @@ def test_the_networks_solver_refusal_says_why_one_iteration_never_converges(
     if hint:  # and the limit it points to is met: two iterations pass the probe
         argv[-1] = "solver.max_iter=2"
         assert main(argv) == 0, capsys.readouterr().err
+
+
+# ------------------------------------------------------------- 5. a key one config lacks
+def test_a_key_of_an_older_config_is_not_said_as_none_in_this_run(tmp_path, capsys):
+    from sim.cli import DOC, _differs, load_run
+    from sim.cli_args import parser
+
+    argv = ["run", str(PLATE), "--trials", "40", "--out", str(tmp_path / "old")]
+    _, cfg = load_run(parser(DOC).parse_args(argv))
+    old = {k: v for k, v in cfg.items() if k != "seed"}  # a key added since
+    old["sweep.trials"] = 40  # a key of an older version, retired since
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / "run.json").write_text(
+        json.dumps({"config": old, "code_hash": "x", "files": []}), encoding="utf-8"
+    )
+    line = one_line(capsys, main(argv), "--out", "holds results of a different config")
+    for said in (line, _differs({"config": old}, {"config": cfg})):
+        assert "None" not in said, said
+        assert "sweep.trials = 40 (no such key in this run's config)" in said, said
+        assert f"seed: not in that config (this run {cfg['seed']})" in said, said
+    assert sorted(p.name for p in (tmp_path / "old").iterdir()) == ["run.json"]

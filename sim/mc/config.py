@@ -28,6 +28,7 @@ from sim.mc.study_file import study_file_problem
 
 __all__ = [
     "ConfigError",
+    "config_changes",
     "StudyError",
     "Field",
     "parse_override",
@@ -380,6 +381,23 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         raise ConfigError(None, f"{p}: malformed TOML: {str(e).split(';')[0]}") from None
     except OSError as e:  # another user's file (mode 0600): the API raised PermissionError
         raise ConfigError(None, f"{p}: cannot read the study file ({e.strerror or e})") from None
+
+
+def config_changes(old: Mapping[str, Any], new: Mapping[str, Any], shown: int = 3) -> str:
+    """The keys whose values differ between a recorded config ``old`` and this run's ``new``
+    (sorted), the first ``shown`` as ``key = OLD (this run NEW)`` and `` ...`` after them. A
+    key one side lacks says so: a key an older version read and retired since was
+    ``key = 40 (this run None)``, as if this run had set it to None."""
+    keys = sorted(k for k in {*old, *new} if k not in old or k not in new or old[k] != new[k])
+
+    def one(k: str) -> str:
+        if k not in new:
+            return f"{k} = {old[k]!r:.40} (no such key in this run's config)"
+        if k not in old:
+            return f"{k}: not in that config (this run {new[k]!r:.40})"
+        return f"{k} = {old[k]!r:.40} (this run {new[k]!r:.40})"
+
+    return ", ".join(map(one, keys[:shown])) + (" ..." if len(keys) > shown else "")
 
 
 #: most chunks of one run (each is a file of the trials dataset, read back by every resume)

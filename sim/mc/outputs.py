@@ -20,7 +20,7 @@ import stat
 import unicodedata
 from pathlib import Path
 
-from sim.mc.config import ConfigError
+from sim.mc.config import ConfigError, config_changes
 from sim.mc.paths import is_chunk_store, link_problem, mount_point, mounts_under
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
@@ -209,9 +209,7 @@ def _differs(old: dict, record: dict) -> str:
         return "a different config"
     if ca == cb:
         return "a different code version"
-    keys = sorted(k for k in set(ca) | set(cb) if ca.get(k) != cb.get(k))
-    shown = ", ".join(f"{k} = {ca.get(k)!r:.40} (this run {cb.get(k)!r:.40})" for k in keys[:3])
-    return f"a different config: {shown}{' ...' if len(keys) > 3 else ''}"
+    return f"a different config: {config_changes(ca, cb)}"
 
 
 def _check_not_nested(out: Path, shown: str) -> None:
