@@ -16,7 +16,8 @@ only the studies whose results are not current (:func:`is_current`: their run re
 the config this run would resolve, run options included, and the current code), the others
 are reported up to date; each study run is named with the reason (:func:`why_stale`). A run that fails prints its own one-line message, which starts with the name of its study
 file; the others go on,
-and the exit code is that of the first failure (1 when a run was killed). Bad input is
+and the exit code is that of the first failure (1 when a run was killed). After the last run one
+line on standard output says how many ran and which failed (:func:`summary`). Bad input is
 refused before any run starts, exit 2, one line for each bad file (every one named): a file
 that is missing or a directory, two runs into one results directory, and a study file whose
 config its run would refuse (resolved here with the run options, as ``sim run`` resolves it:
@@ -75,7 +76,7 @@ from sim.stops import (  # noqa: E402
 if __name__ != "__main__":  # imported: the default handlers (the program: run_program's)
     _loaded()
 
-__all__ = ["SLOW_FIRST", "order", "run_all", "main", "is_current", "why_stale"]
+__all__ = ["SLOW_FIRST", "order", "run_all", "main", "summary", "is_current", "why_stale"]
 
 #: the studies that take longest (``make bench``'s rerun rows), started first in this order
 SLOW_FIRST = (
@@ -346,12 +347,33 @@ def _main(argv: list[str]) -> int:
             print(f"sim.batch: --timings: {e.strerror or e}: {args.timings}", file=sys.stderr)
             return 2
     failed = [v[0] for v in done.values() if v[0] != 0]
+    code = (failed[0] if failed[0] > 0 else 1) if failed else 0
+    log(summary(files, done, code))
     if log.error is not None and not isinstance(log.error, BrokenPipeError):
         print(f"sim.batch: standard output: {log.error.strerror or log.error}", file=sys.stderr)
         return (failed[0] if failed[0] > 0 else 1) if failed else 2
     if log.error is not None and not failed:  # a reader that left (| head -1): as sim does
         return 141
-    return (failed[0] if failed[0] > 0 else 1) if failed else 0
+    return code
+
+
+def summary(files: list[Path], done: dict[str, tuple[int, float, float]], code: int) -> str:
+    """The batch's closing line, after its last run: how many runs were made and, with
+    ``--stale-only``, how many studies were up to date; when a run failed, how many and which
+    (the study files' names) and the batch's exit code. A batch of many studies ended with the
+    last run's own lines, and a failure among them was found by scrolling back."""
+    up = len(files) - len(done)
+    current = f", {up} up to date" if up else ""
+    runs = f"{len(done)} run{'s' * (len(done) != 1)}"
+    bad = [f.name for f in files if f.stem in done and done[f.stem][0] != 0]
+    if not bad:
+        return (
+            f"sim.batch: {runs} done{current}" if done else f"sim.batch: {up} up to date, none run"
+        )
+    return (
+        f"sim.batch: {runs}, {len(done) - len(bad)} done, {len(bad)} failed "
+        f"({', '.join(bad)}){current}; exit {code}"
+    )
 
 
 class _Stdout:

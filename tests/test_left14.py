@@ -25,6 +25,11 @@ brief L14).
    sweep.trials = 40 (this run None)", as if this run had set the key to None (and ``sim run``
    without ``--out`` said "sweep.trials 40 -> None", its own copy of the comparison). One
    function, :func:`sim.mc.config.config_changes`, says a key either side lacks as such.
+6. ``python -m sim.batch`` (``make reproduce``) ended with the last run's own lines: a failed
+   run among 17 was found by scrolling back. After the last run it now prints one line on
+   standard output (:func:`sim.batch.summary`): ``sim.batch: 17 runs done`` (and ``, N up to
+   date`` with ``--stale-only``), or ``sim.batch: 17 runs, 16 done, 1 failed
+   (brown_table1.toml); exit 1``.
 """
 
 from __future__ import annotations
@@ -163,3 +168,42 @@ def test_a_key_of_an_older_config_is_not_said_as_none_in_this_run(tmp_path, caps
         assert "sweep.trials = 40 (no such key in this run's config)" in said, said
         assert f"seed: not in that config (this run {cfg['seed']})" in said, said
     assert sorted(p.name for p in (tmp_path / "old").iterdir()) == ["run.json"]
+
+
+# ------------------------------------------------------------- 6. the batch's closing line
+def test_the_batch_ends_with_one_line_of_what_ran(tmp_path, capsys):
+    f = tmp_path / "net.toml"
+    f.write_text(PLATE.read_text(encoding="utf-8"))
+    argv = ["--results", str(tmp_path / "R"), str(f), "--", "--trials", "40", "--no-figures"]
+    assert batch.main(argv) == 0
+    out, err = capsys.readouterr()
+    assert out.splitlines()[-1] == "sim.batch: 1 run done" and err == "", (out, err)
+    assert batch.main(["--stale-only", *argv]) == 0
+    out, err = capsys.readouterr()
+    assert out.splitlines() == ["net: up to date", "sim.batch: 1 up to date, none run"], out
+
+
+def test_the_batch_summary_names_the_failed_runs_and_the_exit_code(tmp_path, capsys, monkeypatch):
+    files = []
+    for name in ("a", "b", "c", "d"):
+        files.append(tmp_path / f"{name}.toml")
+        files[-1].write_text(PLATE.read_text(encoding="utf-8"))
+    codes = {"a": (0, 1.0, 0.0), "b": (2, 1.0, 0.0), "c": (-9, 1.0, 0.0)}  # d: up to date
+
+    def run_all(files, results, jobs, run_args, stale_only, log, **_):
+        return codes
+
+    monkeypatch.setattr(batch, "run_all", run_all)
+    argv = ["--stale-only", "--results", str(tmp_path / "R"), *map(str, files)]
+    assert batch.main(argv) == 2
+    assert capsys.readouterr().out.splitlines() == [
+        "sim.batch: 3 runs, 1 done, 2 failed (b.toml, c.toml), 1 up to date; exit 2"
+    ]
+    codes.update(b=(0, 1.0, 0.0))
+    assert batch.main(argv) == 1  # a run killed by a signal: exit 1
+    assert capsys.readouterr().out == (
+        "sim.batch: 3 runs, 2 done, 1 failed (c.toml), 1 up to date; exit 1\n"
+    )
+    codes.update(c=(0, 1.0, 0.0))
+    assert batch.main(argv) == 0
+    assert capsys.readouterr().out == "sim.batch: 3 runs done, 1 up to date\n"
