@@ -19,7 +19,7 @@ from sim.mc.storage import umask_problem
 from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
-from sim.studies import design_config, get_study
+from sim.studies import STUDY_FILES, design_config, get_study
 
 __all__ = ["show", "report"]
 
@@ -88,7 +88,7 @@ def report(results: Path) -> int:
     if (why := umask_problem()) is not None:
         raise ConfigError(None, why)
     try:
-        text = write_report(results, get_study, design_config)
+        text = write_report(results, get_study, design_config, project_studies(results))
     except ConfigError:
         raise
     except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
@@ -97,3 +97,16 @@ def report(results: Path) -> int:
         raise ConfigError("--results", not_as_written(results, e)) from None
     print(text)
     return 0
+
+
+def project_studies(results: Path) -> list[Path]:
+    """The project's study files (``studies/*.toml`` of the suite's own checkout) when
+    ``results`` is the project's own ``results/`` (what ``make reproduce`` writes), else none:
+    a results directory of the user's holds the studies they chose to run (``--studies``),
+    and the report names no study file it lacks."""
+    try:
+        if Path(results).resolve() != (STUDY_FILES.parent / "results").resolve():
+            return []
+        return sorted(STUDY_FILES.glob("*.toml"))
+    except (OSError, RuntimeError):  # a loop: the report names it
+        return []

@@ -30,6 +30,11 @@ brief L14).
    standard output (:func:`sim.batch.summary`): ``sim.batch: 17 runs done`` (and ``, N up to
    date`` with ``--stale-only``), or ``sim.batch: 17 runs, 16 done, 1 failed
    (brown_table1.toml); exit 1``.
+7. ``sim report`` over the project's own ``results/`` left out, without a word, a study file
+   of ``studies/`` that had no results directory there (a paper's studies partly run read as
+   the whole of it). The report now names such files below its opening screen
+   (:func:`sim.cli_read.project_studies`); over a results directory of the user's (their own
+   subset of studies) it says nothing of them.
 """
 
 from __future__ import annotations
@@ -207,3 +212,32 @@ def test_the_batch_summary_names_the_failed_runs_and_the_exit_code(tmp_path, cap
     codes.update(c=(0, 1.0, 0.0))
     assert batch.main(argv) == 0
     assert capsys.readouterr().out == "sim.batch: 3 runs done, 1 up to date\n"
+
+
+# ------------------------------------------------------------- 7. studies the report lacks
+def test_the_report_over_the_projects_results_names_study_files_without_results(
+    tmp_path, capsys, monkeypatch
+):
+    import shutil
+
+    from sim import cli_read
+
+    project = tmp_path / "project"
+    (project / "studies").mkdir(parents=True)
+    for name in ("network_plate", "network_brown", "network_testfield"):
+        shutil.copy(ROOT / "studies" / f"{name}.toml", project / "studies")
+    shutil.copytree(ROOT / "results" / "network_plate", project / "results" / "network_plate")
+    monkeypatch.setattr(cli_read, "STUDY_FILES", project / "studies")
+    shutil.copytree(project / "results", tmp_path / "mine")  # a directory of the user's
+    absent = "No results here for `studies/network_brown.toml`, `studies/network_testfield.toml`"
+    for results, said in ((project / "results", True), (tmp_path / "mine", False)):
+        assert main(["report", "--results", str(results)]) == 0, capsys.readouterr().err
+        capsys.readouterr()
+        text = (results / "REPORT.md").read_text(encoding="utf-8")
+        assert (absent in text) == said, text[:3000]
+        assert ("`studies/network_plate.toml`" in text) is False  # it has results
+    (project / "studies" / "network_brown.toml").unlink()
+    (project / "studies" / "network_testfield.toml").unlink()
+    assert main(["report", "--results", str(project / "results")]) == 0
+    text = (project / "results" / "REPORT.md").read_text(encoding="utf-8")
+    assert "No results here" not in text  # every study file has its results: nothing said

@@ -274,12 +274,17 @@ def _entry(d: Path, get_study: Callable) -> tuple:
     return (study.order, d.name, study, claims, row)
 
 
-def build_report(results: Path, get_study: Callable, design: Callable | None = None) -> str:
+def build_report(
+    results: Path, get_study: Callable, design: Callable | None = None, studies=()
+) -> str:
     """The suite's report over every results directory under ``results``: one screen of
     verdicts per paper, every headline claim, the counts per study, the rules, the
     reproducibility check, and links to each directory's README.md (the detail).
     ``get_study(name)`` gives the registered study (title, seed file, order); ``design(name)``
-    the config of the study file a directory is named after (a run that changed it is said)."""
+    the config of the study file a directory is named after (a run that changed it is said);
+    ``studies``: the study files ``results`` should hold (the project's ``studies/*.toml``
+    for the project's own ``results/``), those without results named below the opening
+    screen (a paper's study left out read as the whole of it)."""
     results = Path(results)
     if not results.is_dir():
         why = link_problem(results) or "is not a results directory"
@@ -311,6 +316,7 @@ def build_report(results: Path, get_study: Callable, design: Callable | None = N
         head
         + opening(entries, results)
         + "".join(line + "\n" for line in design_notes(entries, results, design))
+        + _absent({e[1] for e in entries} | set(sweeps), studies)
         + "\n"
         + referee_summary(entries)
         + "\n### Counts per study\n\n"
@@ -321,6 +327,18 @@ def build_report(results: Path, get_study: Callable, design: Callable | None = N
         + "\n## The studies in detail\n\n"
         + "\n".join(details)
         + "\n"
+    )
+
+
+def _absent(have: set[str], studies) -> str:
+    """The line naming the study files of ``studies`` that have no results directory among
+    ``have`` ("" when every one has): the report leaves them out."""
+    absent = [f"`studies/{Path(f).name}`" for f in studies if Path(f).stem not in have]
+    if not absent:
+        return ""
+    return (
+        f"- No results here for {', '.join(absent)}: this report leaves "
+        f"{'them' if len(absent) > 1 else 'it'} out (`make reproduce` runs what is missing).\n"
     )
 
 
@@ -377,17 +395,22 @@ def _settled(results: Path, build: Callable):
     return value
 
 
-def write_report(results: Path, get_study: Callable, design: Callable | None = None) -> Path:
+def write_report(
+    results: Path, get_study: Callable, design: Callable | None = None, studies=()
+) -> Path:
     """Write each results directory's README.md (see
-    :func:`sim.report.run_summary.write_run_readme`) and ``results/REPORT.md``; a REPORT.md
-    there that the suite did not write is refused (one line naming it), never replaced."""
+    :func:`sim.report.run_summary.write_run_readme`) and ``results/REPORT.md``
+    (:func:`build_report`); a REPORT.md there that the suite did not write is refused (one
+    line naming it), never replaced."""
     results = Path(results)
     out = results / "REPORT.md"
     if out.is_symlink() or (out.exists() and not _ours(out)):
         raise ConfigError(
             "--results", f"{out} was not written by sim report; sim never replaces it"
         )
-    text = MARK + "\n" + _settled(results, lambda: build_report(results, get_study, design))
+    text = (
+        MARK + "\n" + _settled(results, lambda: build_report(results, get_study, design, studies))
+    )
     for d in sorted(results_dirs(results)):
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             _settled(results, lambda d=d: write_run_readme(d, get_study))
