@@ -13,8 +13,8 @@ from pathlib import Path
 import pyarrow.parquet as pq
 import pytest
 
-from sim.cli import MIN_CHUNKS, main
-from sim.mc.runner import make_executor
+from sim.cli import main
+from sim.mc.runner import MIN_CHUNKS, make_executor
 from sim.mc.storage import write_table
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.run_summary import region_line, verdict_line

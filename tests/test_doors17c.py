@@ -33,7 +33,7 @@ fix.
 * the study named as a new user names it (``sim check brown_table1``, ``studies/brown_table1``
   without ``.toml``, ``studies\\brown_table1.toml`` from Windows, ``sim.load("brown_table1")``)
   was "no such study file" with no way on; the file that exists is suggested
-  (:func:`sim.mc.config.study_file_hint`); the same for a ``network.gama_xml`` path with
+  (:func:`sim.mc.study_file.study_file_hint`); the same for a ``network.gama_xml`` path with
   Windows backslashes (:func:`sim.studies.network.gama_vocab.read_bytes`);
 * a mistyped key of ``[sweep]`` (``network.nmae``) was "unknown key" with no guess, where the
   same typo outside ``[sweep]`` is answered with one (:func:`sim.mc.sweep.expand`).
