@@ -149,7 +149,7 @@ def test_a_different_run_goes_to_scratch_and_leaves_results_alone(tmp_path, caps
     capsys.readouterr()
     assert main(["run", str(study), "--seed", "5", "--quiet", "--no-figures"]) == 0
     err = capsys.readouterr().err
-    assert "writing to scratch/brown_table1-" in err and "seed 20261122 -> 5" in err
+    assert "writing to scratch/brown_table1-" in err and "seed = 20261122 (this run 5)" in err
     assert (committed / "run.json").read_text() == before
     (scratch,) = Path("scratch").iterdir()
     assert json.loads((scratch / "run.json").read_text())["config"]["seed"] == 5
