@@ -351,7 +351,7 @@ def _main(argv: list[str]) -> int:
     log(summary(files, done, code))
     if log.error is not None and not isinstance(log.error, BrokenPipeError):
         print(f"sim.batch: standard output: {log.error.strerror or log.error}", file=sys.stderr)
-        return (failed[0] if failed[0] > 0 else 1) if failed else 2
+        return code if failed else 2
     if log.error is not None and not failed:  # a reader that left (| head -1): as sim does
         return 141
     return code
