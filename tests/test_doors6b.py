@@ -221,7 +221,7 @@ def test_a_signal_to_report_cleans_up_with_one_line(tmp_path, capsys, monkeypatc
     shutil.copytree(ROOT / "results" / "network_testfield", d)
     tmp = d / ".README.md.tmp"
 
-    def write_report(results, get_study, design=None):  # killed while a file is half written
+    def write_report(results, get_study, design=None, studies=()):  # killed half written
         try:
             tmp.write_text("half")
             os.kill(os.getpid(), signal.SIGTERM)
