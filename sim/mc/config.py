@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.lookalike import note, toml_char_hint
+from sim.mc.numtext import number_text, unsigned_zeros
 from sim.mc.paths import link_problem
 
 __all__ = [
@@ -148,9 +149,10 @@ def refuse_big_ints(key: str, v: Any) -> None:
 
 def _num(key: str, v: Any, want_int: bool) -> float | int:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise ConfigError(
-            key, f"must be {'an integer' if want_int else 'a number'} (got {shown(v)[:60]})"
-        )
+        what = "an integer" if want_int else "a number"
+        if isinstance(v, str) and (n := number_text(v)):  # --set x=.5: TOML read a string
+            raise ConfigError(key, f"must be {what} (got the text {v[:60]!r}: write {n})")
+        raise ConfigError(key, f"must be {what} (got {shown(v)[:60]})")
     refuse_big_ints(key, v)
     if not math.isfinite(v):
         raise ConfigError(key, f"must be finite (got {v!r})")
@@ -295,6 +297,12 @@ def validate(
     }  # an empty section of the file ([compare] with nothing in it) says nothing
     for key in raw:
         refuse_big_ints(key, raw[key])  # an API value, or a --set one
+    for key in raw:  # -0.0 is 0.0
+        try:
+            raw[key] = unsigned_zeros(raw[key])
+        except RecursionError:
+            raise ConfigError(key, "is nested too deeply") from None
+    for key in raw:
         if key not in schema:
             near = did_you_mean(key, schema)
             hint = f" (did you mean {' or '.join(near)}?)" if near else ""

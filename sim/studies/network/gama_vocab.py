@@ -157,7 +157,7 @@ class _File:
             return default
         if not _NUM.match(ws(v)):
             raise self.err(e, f"{v!r} is not a number", attr)
-        x = float(v)
+        x = float(v) + 0.0  # "-0" is 0.0 (atan2 tells -0.0 apart: other results)
         if not math.isfinite(x):
             raise self.err(e, f"{v!r} is out of range", attr)
         if lo is not None and x <= lo:
