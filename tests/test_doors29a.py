@@ -15,6 +15,9 @@ each; each failed on the code before its fix.
   ``Decimal``/``IntEnum`` trials): ``run()`` now validates them as the config keys;
 * a -0.0 (a point at ``y_mm = -0.0``, a gama-local ``y="-0"``) gave a network other results
   than 0.0 (atan2 of -0.0) and the config another hash: the sign of a zero is dropped;
+* a float of a study file, a ``--set`` or a sweep whose digits no double holds was read as
+  something else: ``bias_um = 1e-400`` as 0 without a word (a network coordinate too), and
+  ``1e400`` "must be finite (got inf)"; now each is refused naming the key and the digits;
 * ``--set comparator.beta_mm=.5`` (or ``5.``, ``07``, ``0x1p3``, a quoted ``"400"``) said
   "must be a number (got '.5')" of what reads as a number: now it says how to write it.
 """
@@ -140,3 +143,45 @@ def test_a_negative_zero_is_zero_in_the_config_and_a_gama_file(tmp_path):
 def test_a_set_value_that_spells_a_number_says_how_to_write_it(capsys, value, write):
     args = ["check", BROWN, "--set", f"comparator.beta_mm={value}"]
     one_line(capsys, main(args), "comparator.beta_mm: must be a number (got the text", write)
+
+
+@pytest.mark.parametrize(
+    ("where", "text", "key", "words"),
+    [
+        ("file", "bias_um = 1e-400", "errors.bias_um", "1e-400 is too small for a 64-bit float"),
+        ("set", "errors.bias_um=-1e400", "errors.bias_um", "-1e400 is beyond a 64-bit float"),
+        ("sweep", "errors.bias_um = [1e-400, 1.0]", "sweep.errors.bias_um", "1e-400 is too"),
+        ("network", "x_mm = 1e-4_00", "network.points", "1e-4_00 is too small"),
+    ],
+)
+def test_digits_no_double_holds_are_refused_not_read_as_zero(
+    tmp_path, capsys, where, text, key, words
+):
+    study = tmp_path / "study.toml"
+    args = ["check", str(study)]
+    if where == "network":
+        study.write_text(
+            'study = "network"\ntrials = 40\nchunk = 2\n[network]\npoints = [\n'
+            + "".join(
+                f'{{ name = "{n}", {x}, y_mm = {y}, role = "fixed" }},\n'
+                for n, x, y in [
+                    ("A", "x_mm = 0.0", 0),
+                    ("B", "x_mm = 400.0", 0),
+                    ("C", "x_mm = 0", 300),
+                ]
+            )
+            + f'{{ name = "P", {text}, y_mm = 120.0 }} ]\n'
+            + 'generate = [ { kind = "distance", from = ["A", "B", "C"], to = "P", sigma_mm = 0.002 } ]\n'
+        )
+    else:
+        body = Path(BROWN).read_text().replace("trials = 4000", "trials = 40")
+        body = body.replace("chunk = 200", "chunk = 2")
+        if where == "file":
+            assert "bias_um = 0.0" in body
+            body = body.replace("bias_um = 0.0", text)
+        if where == "sweep":
+            body += f"\n[sweep]\n{text}\n"
+        if where == "set":
+            args += ["--set", text]
+        study.write_text(body)
+    one_line(capsys, main(args), f"{key}: {words}")

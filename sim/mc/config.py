@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.lookalike import note, toml_char_hint
-from sim.mc.numtext import number_text, unsigned_zeros
+from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.paths import link_problem
 
 __all__ = [
@@ -302,6 +302,8 @@ def validate(
             raw[key] = unsigned_zeros(raw[key])
         except RecursionError:
             raise ConfigError(key, "is nested too deeply") from None
+        except UnheldError as e:  # 1e-400: not 0, silently
+            raise ConfigError(key, str(e)) from None
     for key in raw:
         if key not in schema:
             near = did_you_mean(key, schema)
@@ -340,7 +342,7 @@ def parse_override(text: str) -> tuple[str, Any]:
             key or None, "--set holds bytes that are not UTF-8 text (a non-UTF-8 locale or value)"
         )
     try:
-        doc = tomllib.loads(f"v = {val.strip()}")
+        doc = tomllib.loads(f"v = {val.strip()}", parse_float=toml_float)
     except tomllib.TOMLDecodeError:
         return key, val.strip()
     except RecursionError:
@@ -383,7 +385,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
             data = data[len(codecs.BOM_UTF8) :]  # and no part of the text; it was refused
         if b"\x00" in data:  # as malformed TOML at line 1, column 1 (doors12)
             raise ConfigError(None, f"{p}: not UTF-8 text (it holds NUL bytes: UTF-16 or binary)")
-        doc = tomllib.loads(data.decode("utf-8"))
+        doc = tomllib.loads(data.decode("utf-8"), parse_float=toml_float)
         refuse_big_ints("", doc)
         return doc
     except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again
