@@ -185,3 +185,13 @@ def test_digits_no_double_holds_are_refused_not_read_as_zero(
             args += ["--set", text]
         study.write_text(body)
     one_line(capsys, main(args), f"{key}: {words}")
+
+
+def test_a_gama_value_no_double_holds_is_refused_naming_the_attribute(tmp_path, capsys):
+    gama = (ROOT / "tests" / "data" / "gama" / "one_fixed.xml").read_text()
+    assert 'id="B" x="250.0"' in gama
+    (tmp_path / "net.xml").write_text(gama.replace('id="B" x="250.0"', 'id="B" x="1e-400"'))
+    study = tmp_path / "net.toml"
+    study.write_text(f'study = "network"\n[network]\ngama_xml = "{tmp_path}/net.xml"\n')
+    line = one_line(capsys, main(["check", str(study)]), "network.gama_xml", "attribute 'x'")
+    assert "1e-400 is too small for a 64-bit float" in line
