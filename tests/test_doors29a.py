@@ -18,6 +18,8 @@ each; each failed on the code before its fix.
 * a float of a study file, a ``--set`` or a sweep whose digits no double holds was read as
   something else: ``bias_um = 1e-400`` as 0 without a word (a network coordinate too), and
   ``1e400`` "must be finite (got inf)"; now each is refused naming the key and the digits;
+* a sweep range's ``num = 3.0`` was refused ("num must be an integer") where ``trials = 3.0``
+  is the count 3: now it is the count;
 * ``--set comparator.beta_mm=.5`` (or ``5.``, ``07``, ``0x1p3``, a quoted ``"400"``) said
   "must be a number (got '.5')" of what reads as a number: now it says how to write it.
 """
@@ -195,3 +197,17 @@ def test_a_gama_value_no_double_holds_is_refused_naming_the_attribute(tmp_path, 
     study.write_text(f'study = "network"\n[network]\ngama_xml = "{tmp_path}/net.xml"\n')
     line = one_line(capsys, main(["check", str(study)]), "network.gama_xml", "attribute 'x'")
     assert "1e-400 is too small for a 64-bit float" in line
+
+
+def test_a_sweep_range_num_written_as_a_float_is_the_count(tmp_path, capsys):
+    body = Path(BROWN).read_text().replace("trials = 4000", "trials = 40")
+    study = tmp_path / "brown_table1.toml"
+    cells = []
+    for num in ("3", "3.0"):
+        study.write_text(
+            body.replace("chunk = 200", "chunk = 2")
+            + f"\n[sweep]\nerrors.settings = {{start = 1, stop = 3, num = {num}}}\n"
+        )
+        assert main(["check", str(study)]) == 0, capsys.readouterr().err
+        cells += [ln for ln in capsys.readouterr().out.splitlines() if "sweep cells" in ln]
+    assert len(cells) == 2 and cells[0] == cells[1] and "in 3 sweep cells" in cells[0]

@@ -139,6 +139,8 @@ def _values(key: str, v: Any) -> list:
             raise ConfigError(f"sweep.{key}", "give num or step, not both")
         if "num" in v:
             n = v["num"]
+            if isinstance(n, float) and n.is_integer() and abs(n) <= MAX_CELLS:
+                n = int(n)  # num = 1e3 or 3.0: the count, as trials = 1e3 is
             if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_CELLS:
                 raise ConfigError(
                     f"sweep.{key}", f"num must be an integer from 1 to {MAX_CELLS} (got {n!r})"
