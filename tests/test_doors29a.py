@@ -211,3 +211,32 @@ def test_a_sweep_range_num_written_as_a_float_is_the_count(tmp_path, capsys):
         assert main(["check", str(study)]) == 0, capsys.readouterr().err
         cells += [ln for ln in capsys.readouterr().out.splitlines() if "sweep cells" in ln]
     assert len(cells) == 2 and cells[0] == cells[1] and "in 3 sweep cells" in cells[0]
+
+
+@pytest.mark.parametrize(
+    ("file", "old", "new", "words"),
+    [
+        (
+            "user_dms.xml",
+            '<cov-mat dim="4" band="0">9.0',
+            '<cov-mat dim="4" band="0">1e-400',
+            "<cov-mat>",
+        ),
+        (
+            "user_defaults.xml",
+            'distance-stdev="2 3 1"',
+            'distance-stdev="1e-400 3 1"',
+            "distance-stdev",
+        ),
+    ],
+)
+def test_gama_variances_and_stdev_words_no_double_holds_are_named(
+    tmp_path, capsys, file, old, new, words
+):
+    gama = (ROOT / "tests" / "data" / "gama" / file).read_text()
+    assert old in gama
+    (tmp_path / "net.xml").write_text(gama.replace(old, new))
+    study = tmp_path / "net.toml"
+    study.write_text(f'study = "network"\n[network]\ngama_xml = "{tmp_path}/net.xml"\n')
+    line = one_line(capsys, main(["check", str(study)]), "network.gama_xml", words)
+    assert "1e-400 is too small for a 64-bit float" in line
