@@ -15,7 +15,8 @@ each; each failed on the code before its fix.
   ``Decimal``/``IntEnum`` trials): ``run()`` now validates them as the config keys;
 * a -0.0 (a point at ``y_mm = -0.0``, a gama-local ``y="-0"``) gave a network other results
   than 0.0 (atan2 of -0.0) and the config another hash: the sign of a zero is dropped;
-* a float of a study file, a ``--set`` or a sweep whose digits no double holds was read as
+* a float of a study file, a ``--set``, a sweep or a GNU Gama file (an attribute, a
+  ``<cov-mat>`` variance, a ``distance-stdev`` word) whose digits no double holds was read as
   something else: ``bias_um = 1e-400`` as 0 without a word (a network coordinate too), and
   ``1e400`` "must be finite (got inf)"; now each is refused naming the key and the digits;
 * a sweep range's ``num = 3.0`` was refused ("num must be an integer") where ``trials = 3.0``
