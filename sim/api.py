@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -35,6 +34,7 @@ from sim.mc.estimate import estimate
 from sim.mc.paths import absolute, link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
+from sim.mc.pyvalue import as_config_value
 from sim.mc.storage import config_hash, read_provenance, read_record
 from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
@@ -201,10 +201,7 @@ class StudyHandle:
         :class:`Results`. ``executor``: ``local`` (a process pool when ``workers > 1``) or
         ``dask``. Output is identical for every executor and worker count. ``figures=False``:
         no PNG is drawn (``sim run --no-figures``), the tables are the same."""
-        _check_path("out", out, none_ok=True)
-        for name, v in (("trials", trials), ("seed", seed)):
-            if v is not None:
-                _check_int(name, v)
+        _check_path("out", out, none_ok=True)  # trials, seed: validated as the config keys
         for name, v in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures)):
             if not isinstance(v, bool):
                 raise ConfigError(name, f"must be True or False (got {v!r})")
@@ -368,24 +365,6 @@ def _absolute(name: str, v: str | os.PathLike) -> Path:
         ) from None
 
 
-def _check_int(name: str, v: Any) -> None:
-    if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
-        raise ConfigError(name, f"must be an integer (got {v!r})")
-
-
-def _plain(v: Any) -> Any:
-    """A NumPy scalar or array as the Python value a study file would hold (``np.int64(40)``
-    is ``40``), also inside lists and tables (``[{"sigma_mm": np.float32(1.0)}]``), so that
-    it is validated like one; anything else as given."""
-    if isinstance(v, (np.generic, np.ndarray)):
-        return v.tolist()
-    if isinstance(v, (list, tuple)):
-        return type(v)(_plain(x) for x in v)
-    if isinstance(v, dict):
-        return {k: _plain(x) for k, x in v.items()}
-    return v
-
-
 @_arguments
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
@@ -399,7 +378,9 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     for k in overrides:
         if not _key(k).strip(".").strip() or not k.isprintable():
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
-    vals = {k: _plain(v) for k, v in _keyed(overrides).items()}
+    # each value as a study file would hold it (sim.mc.pyvalue): np.int64(40) is 40, a tuple
+    # a list, Decimal("0.1") 0.1, an IntEnum member its int: validated and hashed like one
+    vals = {k: as_config_value(str(k), v) for k, v in _keyed(overrides).items()}
     sha = _sha256(study_file)
     picks = "trials" in vals and "chunk" not in vals  # sim run --trials's chunk
     study, cfg = load_picking_chunk(study_file, picks, values=vals)

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.lookalike import note, toml_char_hint
+from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.study_file import study_file_problem
 
 __all__ = [
@@ -149,9 +150,10 @@ def refuse_big_ints(key: str, v: Any) -> None:
 
 def _num(key: str, v: Any, want_int: bool) -> float | int:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise ConfigError(
-            key, f"must be {'an integer' if want_int else 'a number'} (got {shown(v)[:60]})"
-        )
+        what = "an integer" if want_int else "a number"
+        if isinstance(v, str) and (n := number_text(v)):  # --set x=.5: TOML read a string
+            raise ConfigError(key, f"must be {what} (got the text {v[:60]!r}: write {n})")
+        raise ConfigError(key, f"must be {what} (got {shown(v)[:60]})")
     refuse_big_ints(key, v)
     if not math.isfinite(v):
         raise ConfigError(key, f"must be finite (got {v!r})")
@@ -296,6 +298,14 @@ def validate(
     }  # an empty section of the file ([compare] with nothing in it) says nothing
     for key in raw:
         refuse_big_ints(key, raw[key])  # an API value, or a --set one
+    for key in raw:  # -0.0 is 0.0
+        try:
+            raw[key] = unsigned_zeros(raw[key])
+        except RecursionError:
+            raise ConfigError(key, "is nested too deeply") from None
+        except UnheldError as e:  # 1e-400: not 0, silently
+            raise ConfigError(key, str(e)) from None
+    for key in raw:
         if key not in schema:
             near = did_you_mean(key, schema)
             hint = f" (did you mean {' or '.join(near)}?)" if near else ""
@@ -333,7 +343,7 @@ def parse_override(text: str) -> tuple[str, Any]:
             key or None, "--set holds bytes that are not UTF-8 text (a non-UTF-8 locale or value)"
         )
     try:
-        doc = tomllib.loads(f"v = {val.strip()}")
+        doc = tomllib.loads(f"v = {val.strip()}", parse_float=toml_float)
     except tomllib.TOMLDecodeError:
         return key, val.strip()
     except RecursionError:
@@ -354,7 +364,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
             data = data[len(codecs.BOM_UTF8) :]  # and no part of the text; it was refused
         if b"\x00" in data:  # as malformed TOML at line 1, column 1 (doors12)
             raise ConfigError(None, f"{p}: not UTF-8 text (it holds NUL bytes: UTF-16 or binary)")
-        doc = tomllib.loads(data.decode("utf-8"))
+        doc = tomllib.loads(data.decode("utf-8"), parse_float=toml_float)
         refuse_big_ints("", doc)
         return doc
     except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again

@@ -48,6 +48,7 @@ from sim.mc.config import (
     read_toml,
     validate,
 )
+from sim.mc.numtext import UnheldError, unsigned_zeros
 from sim.mc.progress import Progress
 from sim.mc.runner import chunk_rng
 from sim.mc.toml_text import toml_value
@@ -96,6 +97,13 @@ def read_sweep(path: str | Path, schema: Mapping | None = None) -> dict[str, Any
     if not isinstance(sw, dict):
         raise ConfigError("sweep", "must be a table")
     flat = _flatten_sweep(sw)
+    for k, v in flat.items():  # -0.0 is 0.0; 1e-400 refused, not a cell of 0 (sim.mc.numtext)
+        try:
+            flat[k] = unsigned_zeros(v)
+        except UnheldError as e:
+            raise ConfigError(f"sweep.{k}", str(e)) from None
+        except RecursionError:
+            raise ConfigError(f"sweep.{k}", "is nested too deeply") from None
     if "sweep" in doc and not flat:
         raise ConfigError("sweep", "is empty: give at least one key to sweep")
     if flat and schema is not None:
@@ -131,6 +139,8 @@ def _values(key: str, v: Any) -> list:
             raise ConfigError(f"sweep.{key}", "give num or step, not both")
         if "num" in v:
             n = v["num"]
+            if isinstance(n, float) and n.is_integer() and abs(n) <= MAX_CELLS:
+                n = int(n)  # num = 1e3 or 3.0: the count, as trials = 1e3 is
             if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_CELLS:
                 raise ConfigError(
                     f"sweep.{key}", f"num must be an integer from 1 to {MAX_CELLS} (got {n!r})"

@@ -14,6 +14,7 @@ import stat
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.numtext import UnheldError, toml_float, unsigned_zeros
 from sim.mc.paths import link_problem
 from sim.studies.network.validate import _point_name
 
@@ -157,9 +158,10 @@ class _File:
             return default
         if not _NUM.match(ws(v)):
             raise self.err(e, f"{v!r} is not a number", attr)
-        x = float(v)
-        if not math.isfinite(x):
-            raise self.err(e, f"{v!r} is out of range", attr)
+        try:  # "-0" is 0.0 (atan2 tells -0.0 apart: other results); 1e-400 not 0, silently
+            x = unsigned_zeros(toml_float(ws(v)))
+        except UnheldError as why:
+            raise self.err(e, str(why), attr) from None
         if lo is not None and x <= lo:
             raise self.err(e, f"{v!r} must be > {lo:g}", attr)
         return x

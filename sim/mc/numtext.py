@@ -1,0 +1,75 @@
+"""Readings of numbers in a config value, for :mod:`sim.mc.config`: the number a string spells
+in a form TOML does not read (its message says how to write it); every -0.0 in a value made
+0.0 (the sign of a zero means nothing in any key); and a TOML float whose digits no double
+holds (``1e-400``, which tomllib reads as 0, ``1e400`` as inf) kept apart to be refused."""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Any
+
+__all__ = ["number_text", "unsigned_zeros", "toml_float", "UnheldError"]
+
+
+class UnheldError(ValueError):
+    """A float of a study file or ``--set`` that no double holds (its message says which)."""
+
+
+class _Unheld(float):
+    """What tomllib read for digits no double holds (0.0 or inf), with the digits."""
+
+    text = ""
+
+
+def toml_float(text: str) -> float:
+    """tomllib's ``parse_float``: ``float(text)``, but digits that are no zero read as 0 (an
+    underflow, ``1e-400``) or that are finite read as inf (``1e400``) are kept apart
+    (refused by :func:`unsigned_zeros`, naming the key): 1e-400 was a bias of 0, silently,
+    and 1e400 "must be finite (got inf)" of a finite number."""
+    x = float(text)
+    if x != 0 and not math.isinf(x) or math.isnan(x) or "inf" in text:
+        return x
+    if x == 0 and not any(c in "123456789" for c in re.split("[eE]", text)[0]):
+        return x  # a zero written as one
+    out = _Unheld(x)
+    out.text = text
+    return out
+
+
+def number_text(text: str) -> str:
+    """The number ``text`` spells in a form TOML does not read (``.5``, ``5.``, ``07``,
+    ``0x1p3``, ``Infinity``) or as a quoted string (``"400"``), written as TOML writes it
+    (``0.5``); "" when it spells no finite number."""
+    t = text.strip()
+    if not t or len(t) > 100:
+        return ""
+    for read in (lambda s: int(s, 0), int, float, float.fromhex):
+        try:
+            x = read(t)
+        except ValueError:
+            continue
+        return repr(x) if math.isfinite(x) else ""
+    return ""
+
+
+def unsigned_zeros(v: Any) -> Any:
+    """``v`` with every -0.0 in it (in lists and tables too) made 0.0: a point at
+    ``y_mm = -0.0`` gave a network other results than at ``0.0`` (in the 14th digit: atan2
+    of -0.0), and its config another hash. RecursionError when nested too deeply;
+    :class:`UnheldError` for digits no double holds (:func:`toml_float`)."""
+    if isinstance(v, _Unheld):
+        raise UnheldError(
+            f"{v.text} is beyond a 64-bit float's range"
+            if math.isinf(v)
+            else f"{v.text} is too small for a 64-bit float (it would be read as 0)"
+        )
+    if isinstance(v, float):
+        return v + 0.0  # -0.0 + 0.0 is 0.0
+    if isinstance(v, list):
+        return [unsigned_zeros(x) for x in v]
+    if isinstance(v, tuple):
+        return tuple(unsigned_zeros(x) for x in v)
+    if isinstance(v, dict) and v:  # an empty one is kept as it is (config's _EmptyTable)
+        return {k: unsigned_zeros(x) for k, x in v.items()}
+    return v

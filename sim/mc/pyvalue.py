@@ -1,0 +1,117 @@
+"""A Python value given for a config key (``sim.load(..., **overrides)``) as the value a study
+file would hold, so that it is validated, recorded and hashed like one.
+
+A Python caller holds numbers of many types; a study file holds TOML's four: bool, a 64-bit
+integer, a double and a string, in lists and tables. Each value is read as the number it is:
+
+* any integer (``np.int64(7)``, an ``IntEnum`` member, an ``int`` subclass) is the ``int``;
+* a ``Fraction`` with denominator 1 and a ``Decimal`` written without a point or an exponent
+  (``Decimal("400")``) are that ``int``; others are the double nearest them, as TOML reads
+  the same digits (``Decimal("0.1")`` is ``0.1``); one beyond a double's range, or so small it
+  would be read as 0, is refused naming the key;
+* a NumPy float is the decimal number it prints: ``np.float32(0.1)`` is ``0.1`` (not its
+  binary value ``0.10000000149011612``), as the same digits typed into a study file would be;
+  ``np.longdouble`` is the double nearest it; a ``float`` subclass is the ``float``;
+* a NumPy array, a tuple and a list are lists (at any depth: ``plate.points`` as a tuple of
+  tuples or an ``(n, 2)`` array), a 0-d array its element, a mapping a table;
+* ``np.bool_`` is ``bool``; ``np.str_`` and a ``str`` subclass are ``str``.
+
+Anything else (a complex number, a date, ``None``) is passed on as given and refused by the
+key's validation with one line naming the type expected. A bool stays a bool (refused where
+a number is meant: ``True`` is not the trial count 1).
+"""
+
+from __future__ import annotations
+
+import decimal
+import numbers
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from sim.mc.config import ConfigError, refuse_big_ints
+
+__all__ = ["as_config_value"]
+
+#: most digits of an integral Decimal converted to an int (any over 19 is refused anyway)
+_MAX_DIGITS = 4000
+
+
+def _decimal(key: str, v: decimal.Decimal) -> Any:
+    if v.is_nan():  # sNaN: float() raises; NaN is refused by the key ("must be finite")
+        return float("nan")
+    if v.is_infinite():
+        return float(v)
+    text = str(v)
+    if "E" not in text and "." not in text:  # written as an integer: the int
+        if len(text.lstrip("-")) > _MAX_DIGITS:
+            raise ConfigError(key, f"an integer of over {_MAX_DIGITS} digits is not a config value")
+        return int(v)
+    return _nearest(key, v, float(v))
+
+
+def _nearest(key: str, v: Any, x: float) -> float:
+    """``x``, the double nearest the finite non-double ``v``; refused when ``v`` is beyond a
+    double's range (``x`` infinite) or so small that ``x`` is 0."""
+    if x in (float("inf"), float("-inf")):
+        raise ConfigError(key, f"{v!r} is beyond a 64-bit float's range")
+    if x == 0 and v != 0:
+        raise ConfigError(key, f"{v!r} is too small for a 64-bit float (it would be read as 0)")
+    return x
+
+
+def _scalar(key: str, v: Any) -> Any:
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, numbers.Integral):  # int subclasses, IntEnum, NumPy integers
+        return int(v)
+    if isinstance(v, np.floating):  # the decimal number it prints (float32(0.1) is 0.1)
+        return float(str(v))
+    if isinstance(v, float):
+        return float(v)
+    if isinstance(v, numbers.Rational):  # Fraction
+        if v.denominator == 1:
+            return int(v.numerator)
+        try:
+            x = float(v)
+        except OverflowError:
+            x = float("inf") if v > 0 else float("-inf")
+        return _nearest(key, v, x)
+    if isinstance(v, decimal.Decimal):
+        return _decimal(key, v)
+    if isinstance(v, numbers.Real):  # another library's real number
+        return _nearest(key, v, float(v))
+    if isinstance(v, str):  # np.str_, a str subclass (a StrEnum member)
+        return str.__str__(v)
+    if isinstance(v, np.generic):  # datetime64 and the like: refused by the key, as Python's
+        return v.item()
+    return v
+
+
+def as_config_value(key: str, v: Any) -> Any:
+    """``v`` as a study file would hold it (module docstring); ConfigError naming ``key`` for
+    a number no double can hold or a value nested too deeply."""
+    try:
+        return _convert(key, v)
+    except RecursionError:
+        raise ConfigError(key, "is nested too deeply") from None
+
+
+def _convert(key: str, v: Any) -> Any:
+    if isinstance(v, np.ndarray):
+        if v.ndim == 0:
+            return _convert(key, v[()])
+        if v.dtype.kind in "iub" or v.dtype == np.float64:
+            return v.tolist()
+        return [_convert(key, x) for x in v]
+    if isinstance(v, (list, tuple)):
+        return [_convert(key, x) for x in v]
+    if isinstance(v, Mapping):
+        out = {}
+        for k, x in v.items():
+            name = _scalar(key, k) if isinstance(k, str) else k
+            out[name] = _convert(f"{key}.{name}", x)
+        return out
+    refuse_big_ints(key, v)  # before int() of a 10**400 IntEnum or Fraction
+    return _scalar(key, v)
