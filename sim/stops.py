@@ -29,8 +29,6 @@ import sys
 import threading
 from contextlib import contextmanager
 
-from sim.threads import drop_half_imported
-
 __all__ = [
     "keep_lost_interrupts",
     "check_interrupt",
@@ -67,9 +65,7 @@ def keep_lost_interrupts():
     :func:`check_interrupt`; every other unraisable exception goes to the hook that was there
     before, which is put back when the last one open closes. Counted, not nested: runs of the
     Python API in two threads of the caller's overlap (one ends before the other), and each
-    putting back the hook it found left the suite's hook in the caller's process for good.
-    A command that fails or is interrupted leaves no half-imported library behind
-    (:func:`sim.threads.drop_half_imported`): the next command in the process loads it again."""
+    putting back the hook it found left the suite's hook in the caller's process for good."""
     with _guard:
         if _open[0] == 0:
             _previous[:] = [sys.unraisablehook]
@@ -77,9 +73,6 @@ def keep_lost_interrupts():
         _open[0] += 1
     try:
         yield
-    except BaseException:
-        drop_half_imported()  # Ctrl-C in matplotlib's or numba's first import: not poisoned
-        raise
     finally:
         with _guard:
             _open[0] -= 1

@@ -43,28 +43,6 @@ def interrupted(e: BaseException | None) -> bool:
     return False
 
 
-def drop_half_imported() -> list[str]:
-    """Remove from ``sys.modules`` every module left behind by an import that failed half-way
-    (Ctrl-C while a run imports matplotlib or numba on first use, about a second): Python
-    removes the package whose code was interrupted, but not its submodules already loaded,
-    which keep the half-made package (``matplotlib.rcsetup`` bound to a ``matplotlib`` without
-    ``get_data_path``). The next import of the package ran its code again over them, and in a
-    long-lived process (a notebook) every later run failed ("module 'matplotlib' has no
-    attribute '_docstring'", numba's "partially initialized module 'numba.core.types'")
-    until the process was restarted. A module left behind is one whose parent package is not
-    in ``sys.modules`` (a process holds none otherwise); the next import loads them afresh.
-    Returns their names."""
-    mods = sys.modules
-    gone = [
-        n
-        for n in list(mods)
-        if "." in n and any(n.rsplit(".", k)[0] not in mods for k in range(1, n.count(".") + 1))
-    ]
-    for n in gone:
-        mods.pop(n, None)
-    return gone
-
-
 def interrupt_while_loading(prog: str):
     """Ctrl-C (or SIGTERM, SIGHUP) while an entry point imports the suite (a second or two):
     one line ``<prog>: interrupted`` and exit 130, as later, not a traceback from whichever

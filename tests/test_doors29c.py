@@ -8,7 +8,7 @@ interrupted), one case each; each failed on the code before its fix.
   sim.studies.brown.figures._fig: AttributeError: module 'matplotlib' has no attribute
   '_docstring'"; numba's "partially initialized module 'numba.core.types'") until the kernel
   was restarted. A failed or interrupted command now drops them
-  (:func:`sim.threads.drop_half_imported`), and the next run imports the library afresh.
+  (:func:`sim.execute.drop_half_imported`), and the next run imports the library afresh.
 * ``run(out=None)`` that was refused (``workers=999``, a work limit) left an empty
   ``$TMPDIR/sim-<study>-XXXX/`` behind, one per call; an interrupted one left its staging
   directory there, finished chunks and all, under a name the caller was never told (so
