@@ -28,6 +28,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.api_args import arguments as _arguments
+from sim.api_state import anonymous_dir, check_state, state_sha256
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
@@ -164,6 +165,8 @@ class StudyHandle:
     overrides: dict = field(default_factory=dict)  # shown: two handles of one file differ
     sweep: dict = field(default_factory=dict, repr=False)
     file_sha256: str = field(default="", repr=False)
+    #: :func:`sim.api_state.state_sha256` of config, overrides and sweep as loaded ("": none)
+    state_sha256: str = field(default="", repr=False)
 
     def __hash__(self) -> int:  # the dataclass's would hash the config dict: TypeError
         return hash((self.path, self.file_sha256, repr(sorted(self.overrides.items()))))
@@ -175,6 +178,7 @@ class StudyHandle:
     @_arguments
     def estimate(self):
         """Work and memory of a run (:class:`sim.mc.estimate.Estimate`)."""
+        check_state(self)
         return estimate(self.config, self.sweep)
 
     @_arguments
@@ -218,6 +222,7 @@ class StudyHandle:
                 },
             )
         )
+        base = None  # the temporary directory made for this run (out=None)
         if out is None:
             try:  # the caller's tempfile.tempdir (or TMPDIR) may be gone, a file, or full
                 base = Path(tempfile.mkdtemp(prefix=f"sim-{h.name}-"))
@@ -231,7 +236,9 @@ class StudyHandle:
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
         out = _absolute("out", out)
-        with kept(), _loggers_kept():  # the caller's matplotlib and log levels as they were
+        # the caller's matplotlib and log levels as they were; a failed run's temporary
+        # directory removed, or named when it keeps finished chunks
+        with kept(), _loggers_kept(), anonymous_dir(base, out):
             try:
                 execute(
                     h.study,
@@ -325,7 +332,9 @@ def _run_identity(out: Path) -> str:
 def _unchanged(h: StudyHandle) -> None:
     """A handle runs the file it loaded: its config is that file's, and ``replace`` or
     ``run(trials=...)`` read the file again, so an edited (or deleted) file would give one
-    handle two configs. Refused, as an edited ``network.gama_xml`` is."""
+    handle two configs. Refused, as an edited ``network.gama_xml`` is; so is a config changed
+    in place (:func:`sim.api_state.check_state`)."""
+    check_state(h)
     if h.file_sha256 and _sha256(h.path) != h.file_sha256:
         state = "has changed" if h.path.is_file() else "is gone"
         raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
@@ -387,4 +396,4 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     sweep = read_sweep(study_file, study.schema)
     if _sha256(study_file) != sha:  # written to while it was read: which version is this?
         raise ConfigError("study_file", f"{study_file} changed while it was loaded: load it again")
-    return StudyHandle(study_file, study, cfg, vals, sweep, sha)
+    return StudyHandle(study_file, study, cfg, vals, sweep, sha, state_sha256(cfg, vals, sweep))

@@ -10,6 +10,7 @@ kill and replaces ``<out>`` only when everything succeeded, a ``[sweep]`` over t
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import multiprocessing
 import os
@@ -42,7 +43,7 @@ from sim.report.sweep import fig_sweep
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
-__all__ = ["execute", "run_sweep", "check_sweep"]
+__all__ = ["execute", "run_sweep", "check_sweep", "drop_half_imported"]
 
 
 #: a Dask scheduler address: tcp://HOST:PORT (or another Dask protocol)
@@ -125,6 +126,44 @@ def _not_in_a_starting_worker() -> None:
         os._exit(1)
 
 
+def drop_half_imported() -> list[str]:
+    """Remove from ``sys.modules`` every module left behind by an import that failed half-way
+    (Ctrl-C while a run imports matplotlib or numba on first use, about a second): Python
+    removes the package whose code was interrupted, but not its submodules already loaded,
+    which keep the half-made package (``matplotlib.rcsetup`` bound to a ``matplotlib`` without
+    ``get_data_path``). The next import of the package ran its code again over them, and in a
+    long-lived process (a notebook) every later run failed ("module 'matplotlib' has no
+    attribute '_docstring'", numba's "module 'numba' has no attribute 'core'") until the
+    process was restarted. A module left behind is one whose parent package is not in
+    ``sys.modules`` (a process holds none otherwise); the next import loads them afresh.
+    (Here, not in :mod:`sim.stops`: that module is part of every study's code hash.)"""
+    mods = sys.modules
+    gone = [
+        n
+        for n in list(mods)
+        if "." in n and any(n.rsplit(".", k)[0] not in mods for k in range(1, n.count(".") + 1))
+    ]
+    for n in gone:
+        mods.pop(n, None)
+    return gone
+
+
+def _no_half_imports(fn):
+    """``fn`` leaving no half-imported library behind when it fails or is interrupted
+    (:func:`drop_half_imported`): the next run in the process imports it again."""
+
+    @functools.wraps(fn)
+    def wrapped(*args, **kwargs):
+        try:
+            return fn(*args, **kwargs)
+        except BaseException:
+            drop_half_imported()
+            raise
+
+    return wrapped
+
+
+@_no_half_imports  # every door: Ctrl-C in matplotlib's or numba's first import poisons nothing
 @keep_lost_interrupts()  # every door: Ctrl-C that Python drops in a C callback is kept
 def execute(
     study,
