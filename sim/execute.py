@@ -176,7 +176,7 @@ def execute(
         raise ConfigError(key, f"cannot start the {executor} executor: {msg}{words}") from None
     lock = None
     try:
-        lock, resumed = prepare_stage(stage, out, shown, record, overwrite)
+        lock, resumed, dropped = prepare_stage(stage, out, shown, record, overwrite)
         # again, under the lock: another run may have published into out since the check
         # above (a Dask cluster or a pool starting in between): its results are not ours
         check_out(out, shown, record, overwrite)
@@ -185,6 +185,11 @@ def execute(
                 png.unlink()
         if resumed:
             print(f"sim: resuming {cfg['study']}: {resumed} finished chunks found", file=sys.stderr)
+        if dropped:  # not resumed: another version's chunks are not mixed with this one's
+            print(
+                f"sim: starting {cfg['study']} over: {dropped} is replaced, not resumed",
+                file=sys.stderr,
+            )
         ctx = RunContext(
             quiet=quiet,
             executor=ex,

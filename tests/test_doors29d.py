@@ -10,16 +10,29 @@ failed on the code before its fix.
   had read ("wolf_polynomial/claims.parquet ... is not as sim wrote it (column 'kind':
   KeyError: 'study'); run its study again"): now one line naming the record
   (:func:`sim.report.verify.record.markdown`).
+* a run killed under older code, the code pulled, then ``make reproduce`` (``sim.batch``, whose
+  runs are ``--overwrite``) or ``sim run --overwrite``: the older version's chunks were dropped
+  and the run started over without a word (a long agnard_block run lost, the user not told
+  why). Its chunks are still never mixed with this version's (their identity holds the code
+  hash), and a run without --overwrite still refuses, naming the code version; with it, one
+  line says what is replaced: "sim: starting agnard_block over: its unfinished run of a
+  different code version (48 chunks) is replaced, not resumed"
+  (:func:`sim.mc.outputs.prepare_stage`).
 """
 
+import json
 import shutil
+import subprocess
 from pathlib import Path
 
 import pyarrow as pa
 import pyarrow.parquet as pq
-from oneline import SIM_ERROR, one_line
+from conftest import tiny_command
+from oneline import SIM_ERROR, one_line, one_line_of
 
 from sim.cli import main
+from sim.mc.outputs import stage_dir
+from sim.mc.storage import read_provenance, read_record
 from sim.report.verify import main as verify_main
 from sim.report.verify import markdown
 
@@ -75,3 +88,25 @@ def test_a_record_that_is_not_one_is_named_not_a_study_table(tiny_run, tmp_path,
         rc = main(["report", "--results", str(results)])
         line = one_line(capsys, rc, str(rec), why, "make verify writes it again", prefix=SIM_ERROR)
         assert "claims.parquet" not in line and "run its study again" not in line, line
+
+
+def test_an_older_versions_unfinished_run_is_not_resumed_and_says_so(tiny_run, tmp_path):
+    src, out = tiny_run("brown_table1"), tmp_path / "brown_table1"
+    stage = stage_dir(out)  # its run killed under older code: the same config, its chunks
+    shutil.copytree(src / "trials", stage / "trials")
+    rec = json.loads((src / "run.json").read_text(encoding="utf-8"))
+    (stage / "run.json").write_text(json.dumps({**rec, "code_hash": "0123456789abcdef"}))
+    n = sum(1 for _ in (stage / "trials").rglob("chunk-*.parquet"))
+    cmd = tiny_command("brown_table1", out)
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    one_line_of(
+        p, "unfinished run of a different code version", "cannot finish it", prefix=SIM_ERROR
+    )
+    assert not out.exists() and (stage / "trials").is_dir()
+    p = subprocess.run(cmd + ["--overwrite"], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    said = f"starting brown_table1 over: its unfinished run of a different code version ({n} "
+    assert said in p.stderr and "not resumed" in p.stderr and "resuming" not in p.stderr, p.stderr
+    code = read_record(out)["code_hash"]
+    chunks = sorted((out / "trials").rglob("chunk-*.parquet"))
+    assert chunks and all(read_provenance(c)["code_hash"] == code for c in chunks)
