@@ -287,9 +287,7 @@ def _chunks(stage: Path) -> int:
 
 
 def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: bool):
-    """Lock the staging directory and make it hold ``record``. Returns ``(lock, resumed,
-    dropped)``: the chunks resumed, and what --overwrite replaced (an unfinished run of older
-    code or another config: a make reproduce after a pull started over without a word)."""
+    """Lock the staging directory and make it hold ``record``. Returns ``(lock, resumed)``."""
 
     if stage.is_symlink() or (stage.exists() and not stage.is_dir()):
         raise ConfigError(
@@ -335,14 +333,12 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
                 )
             _clear(stage)
         old = read_record(stage)
-        resumed, dropped = 0, None
+        resumed = 0
         if old is not None and _same(old, record) and not old.get("failed"):
             resumed = _chunks(stage)
         elif old is not None and _same(old, record):
             resumed = _chunks(stage)  # a failed run of the same command: try again, resume
         elif old is None or old.get("failed") or overwrite:
-            if old is not None and not old.get("failed") and (n := _chunks(stage)):
-                dropped = f"its unfinished run of {_differs(old, record)} ({n} chunks)"
             _clear(stage)  # ours (locked, a record or a lock file), and not resumable
         else:
             how = _differs(old, record)
@@ -362,7 +358,7 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
     except BaseException:
         drop_stage(stage, lock)
         raise
-    return lock, resumed, dropped
+    return lock, resumed
 
 
 def _owner(p: Path) -> str:
