@@ -18,6 +18,12 @@ failed on the code before its fix.
   line says what is replaced: "sim: starting agnard_block over: its unfinished run of a
   different code version (48 chunks) is replaced, not resumed"
   (:func:`sim.mc.outputs.prepare_stage`).
+* results of an older version kept after a pull, which lack a table this version reads
+  (``brown_dilution`` of e48edaac~1: no ``region_inputs.parquet``): ``sim report`` and ``sim show
+  --markdown`` said only "No such file or directory: .../region_inputs.parquet"; now the
+  directory is named as made by another version of the code, and make reproduce as the remedy
+  (:func:`sim.cli_errors.older_lacks`); a table removed by hand from this version's run is
+  still the plain line.
 """
 
 import json
@@ -30,6 +36,7 @@ import pyarrow.parquet as pq
 from conftest import tiny_command
 from oneline import SIM_ERROR, one_line, one_line_of
 
+import sim.cli_errors as cli_errors
 from sim.cli import main
 from sim.mc.outputs import stage_dir
 from sim.mc.storage import read_provenance, read_record
@@ -110,3 +117,21 @@ def test_an_older_versions_unfinished_run_is_not_resumed_and_says_so(tiny_run, t
     code = read_record(out)["code_hash"]
     chunks = sorted((out / "trials").rglob("chunk-*.parquet"))
     assert chunks and all(read_provenance(c)["code_hash"] == code for c in chunks)
+
+
+def test_results_of_an_older_version_without_a_table_this_one_reads(
+    tiny_run, tmp_path, capsys, monkeypatch
+):
+    results = tmp_path / "results"
+    d = results / "brown_dilution"  # as a version before region_inputs.parquet wrote it
+    shutil.copytree(tiny_run("brown_dilution"), d)
+    (d / "region_inputs.parquet").unlink()
+    rc = main(["report", "--results", str(results)])  # this version's run, removed by hand
+    line = one_line(capsys, rc, "No such file or directory", "region_inputs.parquet")
+    assert "another version" not in line, line
+    monkeypatch.setattr(cli_errors, "study_code_hash", lambda study: "0123456789abcdef")
+    said = ("brown_dilution was made by another version", "has no region_inputs.parquet")
+    rc = main(["report", "--results", str(results)])  # the code pulled since
+    one_line(capsys, rc, *said, "make reproduce re-runs", prefix=SIM_ERROR)
+    rc = main(["show", "--markdown", str(d)])
+    one_line(capsys, rc, *said, prefix=SIM_ERROR)
