@@ -24,6 +24,10 @@ failed on the code before its fix.
   directory is named as made by another version of the code, and make reproduce as the remedy
   (:func:`sim.cli_errors.older_lacks`); a table removed by hand from this version's run is
   still the plain line.
+* ``make verify`` over such results (brown_table1 of e48edaac~1, whose run wrote a table named
+  ``sweep.parquet`` beside its claims) said "not verified: brown_table1 (sweeps: verify re-runs
+  single studies ...)" and then compared it all the same: a study's results are not a sweep's
+  (:func:`sim.report.verify.rerun.verify`, as ``sim report`` already told them apart).
 """
 
 import json
@@ -135,3 +139,16 @@ def test_results_of_an_older_version_without_a_table_this_one_reads(
     one_line(capsys, rc, *said, "make reproduce re-runs", prefix=SIM_ERROR)
     rc = main(["show", "--markdown", str(d)])
     one_line(capsys, rc, *said, prefix=SIM_ERROR)
+
+
+def test_verify_does_not_call_a_study_with_an_older_sweep_table_a_sweep(tiny_run, tmp_path, capsys):
+    results, scratch = tmp_path / "results", tmp_path / "scratch"
+    for d in (results, scratch):
+        shutil.copytree(tiny_run("network_plate"), d / "network_plate")
+    shutil.copy(
+        results / "network_plate" / "claims.parquet", results / "network_plate" / "sweep.parquet"
+    )
+    rc = verify_main(["--results", str(results), "--scratch", str(scratch), "--no-rerun"])
+    out, err = capsys.readouterr()
+    assert rc == 1 and "sweep.parquet: only in the committed results" in out, (out, err)
+    assert "not verified" not in err and "sweeps" not in err, err
