@@ -13,7 +13,7 @@ from sim.mc.outputs import results_dirs
 from sim.mc.storage import read_record
 from sim.report.read import TableError, damaged_message, last_read
 
-__all__ = ["cwd_exists", "from_stdout", "os_reason", "not_as_written", "other_code"]
+__all__ = ["cwd_exists", "from_stdout", "os_reason", "not_as_written", "older_lacks", "other_code"]
 
 
 def cwd_exists() -> bool:
@@ -69,6 +69,27 @@ def not_as_written(d: Path, e: Exception) -> str:
             "re-runs what is stale)"
         )
     return msg
+
+
+def older_lacks(d: Path, e: FileNotFoundError) -> str | None:
+    """The line for a table this version reads that is missing from results ``d`` (or one
+    directly under it) made by another version of the suite's code, which did not write it
+    (``sim report`` over an older clone's results said only "No such file or directory:
+    .../brown_dilution/region_inputs.parquet"); None otherwise (a table removed by hand)."""
+    name = e.filename or (e.args[0] if len(e.args) == 1 else None)  # pyarrow's: the path only
+    if not isinstance(name, str) or not name:
+        return None
+    try:
+        parts = Path(name).resolve().relative_to(Path(d).resolve()).parts
+    except (ValueError, OSError):
+        return None
+    own = Path(d) / parts[0] if len(parts) > 1 else Path(d)
+    if other_code(own) != str(own):
+        return None
+    return (
+        f"{own} was made by another version of the suite's code (it has no {parts[-1]}, which "
+        "this version reads): make reproduce re-runs what is stale"
+    )
 
 
 def _table_dir(d: Path, e: Exception) -> Path | None:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
-from sim.cli_errors import not_as_written, other_code
+from sim.cli_errors import not_as_written, older_lacks, other_code
 from sim.mc.config import ConfigError
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
@@ -51,6 +51,10 @@ def show(args) -> int:
         raise
     except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
         raise ConfigError("DIR", not_as_written(d, e)) from None
+    except FileNotFoundError as e:
+        if (why := older_lacks(d, e)) is None:
+            raise
+        raise ConfigError("DIR", why) from None
     print(text, end="")
     print("" if args.markdown else "\n", end="")
     if older := other_code(d):  # verdicts of code since changed: read as current otherwise
@@ -95,6 +99,10 @@ def report(results: Path) -> int:
         # report reads the Parquet tables only: one that fails here was not written as it is
         # by sim (a table replaced or edited by hand)
         raise ConfigError("--results", not_as_written(results, e)) from None
+    except FileNotFoundError as e:
+        if (why := older_lacks(results, e)) is None:
+            raise
+        raise ConfigError("--results", why) from None
     print(text)
     return 0
 

@@ -32,6 +32,7 @@ from sim.mc.runner import ChunkStore, RunContext, make_executor
 from sim.mc.storage import (
     code_hash,
     provenance,
+    read_record,
     read_table,
     umask_problem,
     versions,
@@ -215,6 +216,7 @@ def execute(
         raise ConfigError(key, f"cannot start the {executor} executor: {msg}{words}") from None
     lock = None
     try:
+        dropped = _replaced(stage, record) if overwrite else None
         lock, resumed = prepare_stage(stage, out, shown, record, overwrite)
         # again, under the lock: another run may have published into out since the check
         # above (a Dask cluster or a pool starting in between): its results are not ours
@@ -224,6 +226,11 @@ def execute(
                 png.unlink()
         if resumed:
             print(f"sim: resuming {cfg['study']}: {resumed} finished chunks found", file=sys.stderr)
+        if dropped:  # not resumed: another version's chunks are not mixed with this one's
+            print(
+                f"sim: starting {cfg['study']} over: {dropped} is replaced, not resumed",
+                file=sys.stderr,
+            )
         ctx = RunContext(
             quiet=quiet,
             executor=ex,
@@ -275,6 +282,30 @@ def execute(
         raise
     lock.release()
     return est
+
+
+def _replaced(stage: Path, record: dict) -> str | None:
+    """What ``--overwrite`` replaces in the staging directory ``stage`` instead of resuming
+    it: an unfinished run of other code (killed, the code pulled since) or of another config
+    with its chunks (``make reproduce`` after a pull started it over without a word; its chunks
+    are never mixed with this run's). Read before the lock, for the message only."""
+    try:
+        old = read_record(stage) if stage.is_dir() and not stage.is_symlink() else None
+        n = sum(1 for _ in stage.rglob("chunk-*.parquet")) if old else 0
+    except OSError:
+        return None
+    if (
+        not n
+        or old.get("failed")
+        or (old["config"], old["code_hash"])
+        == (
+            record["config"],
+            record["code_hash"],
+        )
+    ):
+        return None
+    how = "a different code version" if old["config"] == record["config"] else "another config"
+    return f"its unfinished run of {how} ({n} chunks)"
 
 
 def _quiet_dask_logs() -> None:

@@ -10,6 +10,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.storage import numerics, read_provenance, versions, write_table
 from sim.report.tables import fmt, md_table
@@ -55,9 +56,9 @@ def markdown(results: Path) -> str:
     p = Path(results) / "reproducibility.parquet"
     if not p.is_file():
         return ""
-    t = pq.read_table(p).to_pylist()
-    m = read_provenance(p).get("machine", {})
+    t, m = _read(p)
     since = _checked_since(Path(results), t)
+    older = not any(r.get("tables_sha256") for r in t)
     ver = ", ".join(  # a variable of the numerical path as it is set (OPENBLAS_CORETYPE=...)
         f"{k}={v}" if k.isupper() else f"{k} {v}"
         for k, v in m.items()
@@ -71,7 +72,7 @@ def markdown(results: Path) -> str:
             fmt(r["max_rel_dev"], 2),
             fmt(r["max_dev_over_tol"], 2),
             f"`{r['worst']}`" if r["worst"] else "",
-            since.get(r["study"]) or ("yes" if r["ok"] else f"**no**: {r['first_failure']}"),
+            since.get(r["study"]) or _verdict(r, older),
             r["text_columns_changed"],
         ]
         for r in t
@@ -101,6 +102,49 @@ def markdown(results: Path) -> str:
         )
         + "\n"
     )
+
+
+#: the columns of every record written so far (0a43b332 on; ``tables_sha256`` since 9d90f3a7)
+_COLUMNS = ("study", "files", "max_rel_dev", "max_dev_over_tol", "worst", "first_failure")
+_COLUMNS += ("text_columns_changed", "ok")
+
+
+def _read(p: Path) -> tuple[list[dict], dict]:
+    """The rows and the machine of the record ``p``; one that is not a record of make verify
+    (truncated, or another table in its place) is a :class:`ConfigError` naming it (the
+    report blamed the last study table it had read: "wolf_polynomial/claims.parquet ... is
+    not as sim wrote it (column 'kind': KeyError: 'study'); run its study again")."""
+    try:
+        t = pq.read_table(p)
+        m = read_provenance(p).get("machine", {})
+        lacks = [c for c in _COLUMNS if c not in t.column_names]
+        why = f"it has no column {lacks[0]!r}" if lacks else None
+        why = why or (None if isinstance(m, dict) else "its provenance names no machine")
+    except (pa.ArrowException, ValueError, AttributeError) as e:
+        why = f"{type(e).__name__}: {str(e).splitlines()[0][:160]}"
+    if why is not None:
+        raise ConfigError(
+            "--results",
+            f"{p} is not a record of make verify ({why}): make verify writes it again "
+            "(or remove it)",
+        )
+    return t.to_pylist(), m
+
+
+def _verdict(r: dict, older: bool) -> str:
+    """A row's *within tolerance* cell: yes or no, of the tables the row names by their hash.
+    A row that names none vouches for no tables there now: a record of an older version
+    (``older``: before ``tables_sha256``; it read "yes" for results re-run at any commit
+    since), or a check that could not read the tables."""
+    said = "yes" if r["ok"] else f"no: {r['first_failure']}"
+    if r.get("tables_sha256"):
+        return said if r["ok"] else f"**{said[:2]}**{said[2:]}"
+    who = (
+        "checked by an older version, which did not record the tables"
+        if older
+        else ("the check did not record the tables")
+    )
+    return f"**not checked now**: {who} (it said {said})"
 
 
 def _checked_since(results: Path, rows: list[dict]) -> dict[str, str]:
@@ -143,7 +187,7 @@ def _not_checked(results: Path, rows: list[dict], since: dict) -> str:
     if rows and not any(r.get("tables_sha256") for r in rows):
         out += (
             " This record does not say which tables it checked (an older version wrote it): "
-            "results re-run after it read as checked here; run make verify again."
+            "none of these results is shown as checked; run make verify again."
         )
     return out
 

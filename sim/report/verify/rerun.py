@@ -183,7 +183,11 @@ def verify(
     if scratch.exists() and not scratch.is_dir():
         raise VerifyError(f"--scratch: {scratch} is not a directory")
     todo = study_dirs(results, only)
-    sweeps = sorted(p.name for p in results_dirs(results) if (p / "sweep.parquet").is_file())
+    sweeps = sorted(  # (a study's results with an older version's sweep.parquet are not one)
+        p.name
+        for p in results_dirs(results)
+        if (p / "sweep.parquet").is_file() and not (p / "claims.parquet").is_file()
+    )
     if sweeps and not only:  # skipped without a word, they read as verified
         print(
             f"sim verify: not verified: {', '.join(sweeps[:5])}{', ...' if len(sweeps) > 5 else ''}"
