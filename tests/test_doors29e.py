@@ -9,17 +9,25 @@ turn, by an OSError or a kill), one case each; each failed on the code before it
   user's). The README is now written into the sealed staging directory, so the results
   directory is the old complete one or the new complete one, and a failure is one line naming
   the file, exit 2, the finished chunks kept for the same command to resume.
+* After the new results were swapped into place (renameat2), an error moving the old ones
+  aside (EIO: k=70 of ``--overwrite`` over earlier results) or removing the lock file from the
+  published results (k=71) ended the run in exit 2 naming a path, with its results published;
+  the first left the old results in the staging directory, where they blocked the next run
+  without ``--overwrite`` as "an unfinished run of a different config". The old results are
+  now removed where they are, and a lock file that cannot be removed is left: exit 0.
 """
 
 from __future__ import annotations
 
 import errno
 import json
+import os
 
 import sim.report.run_summary as run_summary
 from sim.cli import main
 from sim.mc import publish as publish_mod
 from sim.mc.outputs import stage_dir
+from sim.mc.storage import LOCK
 from tests.oneline import SIM_ERROR, one_line
 
 RUN = ["run", "studies/brown_table1.toml", "--trials", "40", "--chunk", "2", "--quiet"]
@@ -83,3 +91,40 @@ def test_a_users_readme_is_kept_over_a_rerun(tmp_path, capsys):
     assert "README.md" not in json.loads((out / "run.json").read_text())["files"]
     assert main([*RUN, "--out", str(out)]) == 0  # and again: still the user's
     assert (out / "README.md").read_text() == "my own notes\n"
+
+
+def _failing(monkeypatch, name, when):
+    """``os.<name>`` raising EIO for the paths ``when(*args)`` picks (the others pass)."""
+    real = getattr(os, name)
+
+    def call(*a, **k):
+        if when(*map(str, a[:2])):
+            raise OSError(errno.EIO, "Input/output error", str(a[0]))
+        return real(*a, **k)
+
+    monkeypatch.setattr(os, name, call)
+
+
+def test_old_results_that_cannot_be_moved_aside_do_not_fail_the_published_run(
+    tmp_path, monkeypatch, capsys
+):
+    out = tmp_path / "X"
+    assert main([*RUN, "--seed", "7", "--out", str(out)]) == 0
+    _failing(monkeypatch, "replace", lambda a, b="": a == str(stage_dir(out)) and ".old." in b)
+    assert main([*RUN, "--out", str(out), "--overwrite"]) == 0
+    monkeypatch.undo()
+    assert json.loads((out / "run.json").read_text())["config"]["seed"] != 7
+    assert not stage_dir(out).exists() and not (out / LOCK).exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["X"]
+    assert main([*RUN, "--out", str(out)]) == 0  # the next run without --overwrite
+
+
+def test_a_lock_file_that_cannot_be_removed_does_not_fail_the_published_run(
+    tmp_path, monkeypatch, capsys
+):
+    out = tmp_path / "X"
+    _failing(monkeypatch, "unlink", lambda a, b="": a == str(out / LOCK))
+    assert main([*RUN, "--out", str(out)]) == 0
+    monkeypatch.undo()
+    assert (out / "claims.parquet").is_file() and not stage_dir(out).exists()
+    assert main([*RUN, "--out", str(out)]) == 0  # and it does not stand in the next run's way
