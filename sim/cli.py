@@ -213,11 +213,11 @@ def _run(args) -> int:
         max_memory_gb=args.max_memory_gb,
         max_adjustments=args.max_adjustments,
         figures=not args.no_figures,
+        readme=lambda stage, name: write_run_readme(stage, get_study, name, final=out),
     )
     args.published = shown  # an interrupt from now on finds the results written
     check_interrupt()  # dropped by Python since the results were published: not exit 0
-    try:
-        write_run_readme(out, get_study)
+    try:  # (its README.md was written before the results were published)
         summary = terminal_summary(out, shown=shown)
     except (OSError, ValueError, KeyError) as e:  # the results stand; only their summary failed
         summary = f"(no summary: {type(e).__name__}: {e})".splitlines()[0]

@@ -19,7 +19,7 @@ import sys
 from concurrent.futures import BrokenExecutor
 from contextlib import nullcontext
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import numpy as np
 
@@ -181,13 +181,17 @@ def execute(
     max_memory_gb: float | None = None,
     max_adjustments: float | None = None,
     figures: bool = True,
+    readme: Callable[[Path, str], Any] | None = None,
 ):
     """Run a validated study config (and its sweep) into ``out`` (absolute): estimate and
     limits, output checks, executor, locked staging directory, the run, and the final
     replacement of ``out``. ``figures=False``: no figure is drawn (the tables are the same;
     ``run.json`` says ``"figures": false``, so ``make reproduce`` does not take the results
-    as up to date). Raises ConfigError/StudyError (one line) on any failure. Returns the
-    run's :class:`sim.mc.estimate.Estimate`."""
+    as up to date). ``readme(stage, name)``: writes the run's README.md into the sealed
+    staging directory before it replaces ``out`` (``sim run``; written after, a failure or a
+    kill there left the new results without it, or with a ``run.json`` that did not list it,
+    and exit 0). Raises ConfigError/StudyError (one line) on any failure. Returns the run's
+    :class:`sim.mc.estimate.Estimate`."""
 
     _not_in_a_starting_worker()
     shown = shown or str(out)
@@ -276,6 +280,8 @@ def execute(
         check_interrupt()  # not published: an interrupted run never looks finished
         check_out(out, shown, record, overwrite)  # again, under the lock: ours or absent
         seal(stage, ctx.store)
+        if readme is not None:
+            readme(stage, out.name)
         publish(stage, out)
     except BaseException:
         drop_stage(stage, lock)

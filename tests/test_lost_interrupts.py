@@ -3,7 +3,7 @@
 * A Ctrl-C or SIGTERM (raised as ``KeyboardInterrupt``) inside a C callback, as numba's
   ``_raw_object_cache_notify``, was printed as "Exception ignored in: ... KeyboardInterrupt" and
   dropped: the run went on and exited 0. The tests drop one the same way, from a real ``ctypes``
-  callback, at a chosen point of a run: a chunk, the pool's close, the run's README; and in
+  callback, at a chosen point of a run: a chunk, the pool's close, the run's summary; and in
   ``sim.batch``, ``make verify`` and the Python API.
 * A stop signal after a command returned its exit code (while Python shuts down) killed the
   program by the signal (exit -2 or -15, no line) or printed a traceback of an atexit callback.
@@ -110,8 +110,10 @@ def test_an_interrupt_dropped_after_the_last_chunk_is_not_published(tmp_path, mo
 
 
 def test_an_interrupt_dropped_after_publishing_is_not_exit_0(tmp_path, monkeypatch, capsys):
-    readme = cli.write_run_readme
-    monkeypatch.setattr(cli, "write_run_readme", lambda *a: (_drop_an_interrupt(), readme(*a)))
+    summary = cli.terminal_summary  # the first step after publishing (the README is before)
+    monkeypatch.setattr(
+        cli, "terminal_summary", lambda *a, **k: (_drop_an_interrupt(), summary(*a, **k))[1]
+    )
     err = _interrupted(capsys, main(["run", PLATE, "--out", str(tmp_path / "np"), *RUN]))
     assert err == f"sim: interrupted after the results were written to {tmp_path / 'np'}/", err
     assert (tmp_path / "np" / "claims.parquet").is_file()  # published, complete

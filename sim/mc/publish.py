@@ -11,6 +11,7 @@ and refuses when the new run writes a file of a carried entry's name.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import errno
 import hashlib
@@ -368,7 +369,12 @@ def publish(stage: Path, out: Path) -> None:
     if old is None:
         os.replace(stage, out)
     elif _exchange(stage, out):  # out now holds the new results, stage the old ones
-        os.replace(stage, old)
+        try:
+            os.replace(stage, old)
+        except OSError:  # (EIO) the new results are published: the old ones are removed
+            old = stage  # where they are, below (an error here ended the published run in
+            # exit 2, and left them as an unfinished run of another config that blocked the
+            # next run without --overwrite)
     else:
         try:
             os.replace(out, old)
@@ -382,7 +388,8 @@ def publish(stage: Path, out: Path) -> None:
             _remove_in_place(out)
             old = None
         os.replace(stage, out)
-    (out / LOCK).unlink(missing_ok=True)  # we still hold it through the open descriptor
+    with contextlib.suppress(OSError):  # (EIO, EACCES: a published run does not fail for it;
+        (out / LOCK).unlink(missing_ok=True)  # the next run ignores it) we still hold it
     _drop_stale_swaps(out, old)
     if old is None:
         return

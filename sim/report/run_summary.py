@@ -251,11 +251,13 @@ def _cut(s: str, n: int) -> str:
     return out + "..."
 
 
-def run_markdown(out: Path, get_study: Callable) -> str:
+def run_markdown(out: Path, get_study: Callable, name: str | None = None) -> str:
     """The README.md of one results directory: what ran (study, paper, config), the verdict
     counts, the region line, then the study's own report section (claims, tables, figures:
-    links relative to the directory) or the sweep's table."""
+    links relative to the directory) or the sweep's table. ``name``: the directory's name in
+    its title (a run writes the README in its staging directory, ``.<name>.partial``)."""
     out = Path(out)
+    name = name or out.name
     forget()
     kind = _kind_of(out)
     src = out / ("claims.parquet" if kind == "study" else "sweep.parquet")
@@ -263,12 +265,12 @@ def run_markdown(out: Path, get_study: Callable) -> str:
     study = get_study(prov["study"])
     paper = paper_name(study.seed_file, full=True)
     head = [
-        f"# {md_text(out.name)}: {study.title}",  # a directory name of the user's
+        f"# {md_text(name)}: {study.title}",  # a directory name of the user's
         "",
         f"Study `{prov['study']}`"
         + (f", seed paper: {paper}." if paper else " (a declared network, no seed paper).")
         + " Written by `sim run` from this directory's Parquet files "
-        f"({md_code(f'sim show {shlex.quote(out.name)}')} prints it again).",
+        f"({md_code(f'sim show {shlex.quote(name)}')} prints it again).",
         "",
     ]
     if kind == "sweep":
@@ -301,16 +303,32 @@ def _ours(path: Path) -> bool:
         return False
 
 
-def write_run_readme(out: Path, get_study: Callable) -> Path | None:
-    """Write ``out/README.md`` (see :func:`run_markdown`) atomically and list it among the
-    files the run wrote (``run.json``, so a later run into the directory replaces it rather
-    than keeping it as the user's). A README.md the suite did not write (no mark) is left as
-    it is: returns None then, else the path."""
+def _user_readme(path: Path) -> bool:
+    return path.is_symlink() or (path.exists() and not _ours(path))
+
+
+def write_run_readme(
+    out: Path, get_study: Callable, name: str | None = None, final: Path | None = None
+) -> Path | None:
+    """Write ``out/README.md`` (see :func:`run_markdown`; ``name``: the directory's name in
+    it) atomically and list it among the files the run wrote (``run.json``, so a later run
+    into the directory replaces it rather than keeping it as the user's). A README.md the
+    suite did not write (no mark) is left as it is: returns None then, else the path.
+    ``final``: the results directory that ``out``, a run's staging directory, replaces; a
+    README.md of the user's there is kept as well (carried into the new results), and none is
+    written."""
     out = Path(out)
     path = out / "README.md"
     if path.is_symlink() or (path.exists() and not _ours(path)):
         return None
-    text = README_MARK + "\n" + run_markdown(out, get_study)
+    if final is not None and _user_readme(Path(final) / "README.md"):
+        if path.exists():  # ours, of an earlier attempt: it would take the user's place
+            path.unlink()
+            rec = read_record(out)
+            if rec is not None and "README.md" in (rec.get("files") or []):
+                write_record(out, {**rec, "files": [f for f in rec["files"] if f != "README.md"]})
+        return None
+    text = README_MARK + "\n" + run_markdown(out, get_study, name)
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     rec = read_record(out)
