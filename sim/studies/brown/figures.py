@@ -130,7 +130,8 @@ def fig_mc_vs_analytic(cols, n_trials, path):
 
 def fig_table1(cfg, pts, theta, an_pivot, t1, path):
     """Table 1 of Brown 1968 against simulated plates: the rms closure σ0, the share of the
-    50 σ printing 1.1-1.3 µm, and the analytic σ over the plate (pivot model)."""
+    run's 2n σ (x and y of its n points: 50 on the paper's 5 x 5 plate) printing 1.1-1.3 µm,
+    and the analytic σ over the plate (pivot model)."""
     fig, axs = _fig(1, 3, 15, 4.8)
     a0, a1, a2 = axs[0]
     _plate_axes(a2, cfg, theta, "analytic σ, pivot model")
@@ -146,7 +147,7 @@ def fig_table1(cfg, pts, theta, an_pivot, t1, path):
     share = np.asarray(t1["share_1p1_1p3"], float) * 100
     a1.hist(share, bins=hist_bins(np.round(share, 6), 25), color="tab:green", alpha=0.8)
     a1.axvline(80, color="tab:red", ls="--", label="paper: 80 %")
-    a1.set_xlabel("share of the 50 σ printing 1.1–1.3 µm (%)")
+    a1.set_xlabel(f"share of the {2 * len(pts)} σ printing 1.1–1.3 µm (%)")
     a1.set_ylabel("simulated plates")
     a1.set_title("printed σ in 1.1–1.3 µm")
     place_legend(a1, fontsize=8)
