@@ -1,0 +1,116 @@
+"""The classes of the sweep doors29b (brief D29b: the command line as argparse parses it, in
+``sim``, ``python -m sim.batch``, ``make verify`` and ``python -m benchmarks``):
+
+* an abbreviated option (``--tri 40`` for ``--trials``, ``--no-fig``, ``--stale`` for
+  ``--stale-only``, ``sim --vers``) was taken without a word: a command line of a script or a
+  Makefile that breaks the day an option of the same prefix is added (``--o`` already matches
+  ``--out`` and ``--overwrite``); now one line naming the option it abbreviates;
+* a mistyped command or choice (``sim rn``, ``--executor daks``) or option (``--trails``) was
+  named with no guess at what was meant;
+* ``make verify`` (``python -m sim.report.verify``) took ``--trials 400 --trials 800``,
+  ``--scratch A --scratch B`` and ``--studies A --studies B`` with the last value, as ``sim``
+  did before the ``ONCE`` options; a key given twice by its ``--set`` went to every re-run,
+  each of which refused it in turn (a "FAILED" study for each) instead of one line at once.
+"""
+
+from __future__ import annotations
+
+import pytest
+from conftest import ROOT
+from oneline import SIM_ERROR, VERIFY_ERROR, one_line
+
+import sim.batch
+from benchmarks import cli as bench_cli
+from sim.cli import DOC, main
+from sim.cli_args import parser
+from sim.report.verify.cli import _parser as verify_parser
+from sim.report.verify.cli import main as verify_main
+
+BROWN = str(ROOT / "studies" / "brown_table1.toml")
+
+
+def _bench(argv: list[str]) -> int:
+    try:
+        return bench_cli.main(argv)
+    except SystemExit as e:
+        return e.code
+
+
+@pytest.mark.parametrize(
+    "program, argv, meant",
+    [
+        (main, ["run", BROWN, "--tri", "40", "--quiet", "--no-figures"], "--trials"),
+        (main, ["run", BROWN, "--trials", "40", "--quiet", "--no-fig"], "--no-figures"),
+        (main, ["run", BROWN, "--o", "OUT"], "--out or --overwrite"),
+        (main, ["check", BROWN, "--se", "seed=1"], "--set"),
+        (main, ["--vers"], "--version"),
+        (sim.batch.main, ["--stale", BROWN], "--stale-only"),
+        (sim.batch.main, [BROWN, "--", "--trials", "40", "--no-fig"], "--no-figures"),
+        (verify_main, ["--stu", "brown_table1"], "--studies or --study"),
+        (_bench, ["--qui"], "--quick"),
+    ],
+)
+def test_an_abbreviated_option_is_refused_naming_the_option(tmp_path, capsys, program, argv, meant):
+    argv = [a.replace("OUT", str(tmp_path / "o")) for a in argv]
+    if program is sim.batch.main:
+        argv = ["--results", str(tmp_path / "r"), *argv]
+    if program is main and argv[0] == "run" and "--o" not in argv:
+        argv += ["--out", str(tmp_path / "o")]
+    line = one_line(capsys, program(argv), f"did you mean {meant}?", "not abbreviated")
+    assert "unrecognized arguments" in line, line
+    assert list(tmp_path.iterdir()) == []  # nothing was run
+
+
+def test_an_option_by_its_whole_name_with_equals_is_still_read():
+    a = parser(DOC).parse_args(["run", BROWN, "--out=X", "--trials=40", "--set=seed=1"])
+    assert (a.out, a.trials, a.set) == ("X", 40, ["seed=1"])
+    v = verify_parser().parse_args(["--results=R", "--study=brown_table1", "--trials=400"])
+    assert (v.results, v.study, v.trials) == ("R", ["brown_table1"], 400)
+
+
+@pytest.mark.parametrize(
+    "argv, guess",
+    [
+        (["rn", BROWN], "did you mean run?"),
+        (["chek", BROWN], "did you mean check?"),
+        (["run", BROWN, "--executor", "daks"], "did you mean dask?"),
+        (["run", BROWN, "--trails", "40"], "did you mean --trials?"),
+        (["--verison"], "did you mean --version?"),
+    ],
+)
+def test_a_mistyped_command_choice_or_option_gets_a_guess(capsys, argv, guess):
+    line = one_line(capsys, main(argv), guess, prefix=SIM_ERROR)
+    assert "not abbreviated" not in line  # a typo, not a prefix
+
+
+def test_a_word_like_no_command_gets_no_guess(capsys):
+    line = one_line(capsys, main(["zzzz"]), "invalid choice: 'zzzz'", prefix=SIM_ERROR)
+    assert "did you mean" not in line
+
+
+@pytest.mark.parametrize(
+    "argv, opt",
+    [
+        (["--trials", "400", "--trials", "800"], "--trials"),
+        (["--scratch", "A", "--scratch", "B"], "--scratch"),
+        (["--studies", "A", "--studies", "B"], "--studies"),
+    ],
+)
+def test_verify_refuses_an_option_given_twice(tmp_path, capsys, argv, opt):
+    argv = [str(tmp_path / a) if a in "AB" else a for a in argv]
+    one_line(capsys, verify_main(argv), f"argument {opt}: given twice", prefix=VERIFY_ERROR)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_verify_refuses_a_key_given_twice_by_set_before_any_rerun(tmp_path, capsys):
+    scratch = tmp_path / "s"
+    argv = ["--scratch", str(scratch), "--study", "brown_table1", "--trials", "400"]
+    argv += ["--set", "seed=1", "--set", "seed = 2"]
+    one_line(capsys, verify_main(argv), "seed: given twice by --set", prefix=VERIFY_ERROR)
+    assert not scratch.exists()  # refused before the re-run, not by it
+
+
+def test_verify_results_may_be_given_again_as_make_verify_does():
+    # the Makefile runs `python -m sim.report.verify --results results ... $(VERIFY_FLAGS)`
+    a = verify_parser().parse_args(["--results", "results", "--workers", "2", "--results", "R"])
+    assert a.results == "R"
