@@ -10,7 +10,10 @@
 * ``make verify`` (``python -m sim.report.verify``) took ``--trials 400 --trials 800``,
   ``--scratch A --scratch B`` and ``--studies A --studies B`` with the last value, as ``sim``
   did before the ``ONCE`` options; a key given twice by its ``--set`` went to every re-run,
-  each of which refused it in turn (a "FAILED" study for each) instead of one line at once.
+  each of which refused it in turn (a "FAILED" study for each) instead of one line at once;
+* a variable on make's command line that the Makefile does not read, named like one it does
+  (``make verify STUDY=brown_table1``, ``make reproduce JOBS=4``, ``make test PYTEST_ARGS=-x``),
+  was dropped: every study re-run, 2 at a time, every test; now one line naming what to write.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from __future__ import annotations
 import pytest
 from conftest import ROOT
 from oneline import SIM_ERROR, VERIFY_ERROR, one_line
+from test_doors18c import MAKE, fake_project, run_make
 
 import sim.batch
 from benchmarks import cli as bench_cli
@@ -114,3 +118,43 @@ def test_verify_results_may_be_given_again_as_make_verify_does():
     # the Makefile runs `python -m sim.report.verify --results results ... $(VERIFY_FLAGS)`
     a = verify_parser().parse_args(["--results", "results", "--workers", "2", "--results", "R"])
     assert a.results == "R"
+
+
+@pytest.mark.skipif(MAKE is None, reason="no make on this machine")
+@pytest.mark.parametrize(
+    "target, setting, instead",
+    [
+        ("verify", "STUDY=brown_table1", 'VERIFY_FLAGS="--study NAME"'),
+        ("verify", "STUDIES=brown_table1", 'VERIFY_FLAGS="--study NAME --study NAME2"'),
+        ("reproduce", "JOBS=4", "RUN_JOBS=N"),
+        ("test", "WORKERS=1", "TEST_WORKERS=N"),
+        ("reproduce", "TRIALS=40", 'RUN_FLAGS="--trials N"'),
+        ("reproduce", "SEED=7", 'RUN_FLAGS="--seed N"'),
+        ("verify", "FLAGS=--study x", "VERIFY_FLAGS"),
+        ("test", "PYTEST_ARGS=-x", "PYTEST_ADDOPTS"),
+    ],
+)
+def test_make_names_a_setting_it_does_not_read_before_any_command(
+    tmp_path, target, setting, instead
+):
+    log, fake = tmp_path / "calls.log", tmp_path / "python"
+    fake.write_text(f'#!/bin/sh\necho "$*" >> {log}\n', encoding="utf-8")
+    fake.chmod(0o755)
+    d = fake_project(tmp_path, str(fake))
+    p = run_make(d, target, setting)
+    err = p.stderr.removesuffix("\n")
+    name = setting.split("=")[0]
+    assert p.returncode == 2 and "\n" not in err, p.stderr
+    assert f"{name} is not a setting of this Makefile; " in err and instead in err, err
+    assert not log.exists()  # nothing ran
+
+
+@pytest.mark.skipif(MAKE is None, reason="no make on this machine")
+def test_make_leaves_such_a_name_in_the_environment_alone(tmp_path, monkeypatch):
+    log, fake = tmp_path / "calls.log", tmp_path / "python"
+    fake.write_text(f'#!/bin/sh\necho "$*" >> {log}\n', encoding="utf-8")
+    fake.chmod(0o755)
+    d = fake_project(tmp_path, str(fake))
+    monkeypatch.setenv("JOBS", "4")  # a shell's own JOBS, not meant for make
+    p = run_make(d, "report")
+    assert p.returncode == 0 and "-m sim report --results results" in log.read_text(), p.stderr
