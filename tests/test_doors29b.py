@@ -18,6 +18,9 @@
 
 from __future__ import annotations
 
+import argparse
+import re
+
 import pytest
 from conftest import ROOT
 from oneline import SIM_ERROR, VERIFY_ERROR, one_line
@@ -158,3 +161,35 @@ def test_make_leaves_such_a_name_in_the_environment_alone(tmp_path, monkeypatch)
     monkeypatch.setenv("JOBS", "4")  # a shell's own JOBS, not meant for make
     p = run_make(d, "report")
     assert p.returncode == 0 and "-m sim report --results results" in log.read_text(), p.stderr
+
+
+def _options(p: argparse.ArgumentParser) -> list[tuple[str, ...]]:
+    """The long options of ``p`` and of its commands that ``--help`` shows, each with its
+    other names (``--rerun``/``--no-rerun``)."""
+    found = []
+    for a in p._actions:
+        if isinstance(a, argparse._SubParsersAction):
+            for sub in a.choices.values():
+                found += _options(sub)
+        elif a.help != argparse.SUPPRESS and "--help" not in a.option_strings:
+            found.append(tuple(o for o in a.option_strings if o.startswith("--")))
+    return found
+
+
+def test_every_option_of_every_command_line_is_named_in_the_docs(monkeypatch):
+    """``make verify``'s ``--no-record`` was named by its ``--help`` alone."""
+    seen = {}
+    for program in (sim.batch.main, bench_cli.main):  # their parsers are built in main
+        monkeypatch.setattr(
+            argparse.ArgumentParser,
+            "parse_args",
+            lambda self, *a, program=program, **k: seen.setdefault(program, self) and 1 / 0,
+        )
+        with pytest.raises(ZeroDivisionError):
+            program(["x"])
+    parsers = [parser(DOC), verify_parser(), *seen.values()]
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    text = "\n".join(p.read_text(encoding="utf-8") for p in pages)
+    named = set(re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", text))
+    missing = sorted(o for p in parsers for o in _options(p) if o and not named & set(o))
+    assert len(parsers) == 4 and not missing, missing
