@@ -7,6 +7,20 @@ ifeq ($(wildcard pyproject.toml sim/__init__.py),)
 $(error $(lastword $(MAKEFILE_LIST)) runs in its own directory: make -C <its directory> $(or $(MAKECMDGOALS),help))
 endif
 
+# A variable on make's command line that this Makefile does not read but is named like what it
+# reads was dropped without a word: `make verify STUDY=brown_table1` re-ran every study,
+# `make reproduce JOBS=4` ran 2 at a time, `make test PYTEST_ARGS=-x` ran every test. One line
+# naming what to write instead, exit 2 (set in the environment such a name is left alone).
+not_read = $(if $(filter command line,$(origin $(1))),$(error make: $(1) is not a setting of this Makefile; $(2)))
+$(call not_read,STUDY,make verify VERIFY_FLAGS="--study NAME" re-runs one study)
+$(call not_read,STUDIES,make verify VERIFY_FLAGS="--study NAME --study NAME2" re-runs those studies)
+$(call not_read,JOBS,RUN_JOBS=N runs N studies at a time (make reproduce and make rerun))
+$(call not_read,WORKERS,TEST_WORKERS=N (make test) or MUTATION_WORKERS=N or RUN_FLAGS="--workers N")
+$(call not_read,TRIALS,RUN_FLAGS="--trials N" (make reproduce and make rerun) or VERIFY_FLAGS="--trials N")
+$(call not_read,SEED,RUN_FLAGS="--seed N" (make reproduce and make rerun) or FUZZ_SEED=N (make fuzz))
+$(call not_read,FLAGS,RUN_FLAGS or VERIFY_FLAGS or BENCH_FLAGS: the options of the target's command)
+$(call not_read,PYTEST_ARGS,PYTEST_ADDOPTS="..." passes options to pytest (make test))
+
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python

@@ -142,7 +142,7 @@ class _ArgError(Exception):
 class _Parser(BoundedParser):
     """argparse with the suite's one-line errors (``sim``'s style), exit 2."""
 
-    def error(self, message: str):
+    def refuse(self, message: str):
         print(f"benchmarks: error: {message} (see {self.prog} --help)", file=sys.stderr)
         raise SystemExit(2)
 

@@ -58,8 +58,9 @@ from sim.batch_checks import (  # noqa: E402
     is_current,
     why_stale,
 )
-from sim.cli_args import OnceParser, module_doc  # noqa: E402
+from sim.cli_args import module_doc  # noqa: E402
 from sim.ends import finish  # noqa: E402
+from sim.mc.argv import OnceParser  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
@@ -225,7 +226,7 @@ class _BadArgs(ValueError):
 
 
 class _Parser(OnceParser):
-    def error(self, message: str):  # one line, exit 2 (main prints it)
+    def refuse(self, message: str):  # one line, exit 2 (main prints it)
         raise _BadArgs(message)
 
 

@@ -5,72 +5,31 @@ from __future__ import annotations
 
 import argparse
 import ast
-import sys
 from importlib import metadata
 from pathlib import Path
 
-from sim.mc.argv import BoundedParser
+from sim.mc.argv import OnceParser
 from sim.mc.config import ConfigError
 from sim.mc.runner import MIN_CHUNKS
 
-__all__ = ["OnceParser", "module_doc", "parser"]
-
-
-class _Once(argparse.Action):
-    """Store an option's value and refuse a second one: ``--trials 40 --trials 60`` (or
-    ``--out A --out B``, ``--results A --results B``) ran with the last and dropped the first
-    without a word, as ``--set seed=3 --set seed=4`` did before the eighth sweep."""
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        given = parser.__dict__.setdefault("given_once", set())
-        if self.dest in given:
-            parser.error(f"argument {'/'.join(self.option_strings)}: given twice: give one value")
-        given.add(self.dest)
-        setattr(namespace, self.dest, values)
-
-
-#: the options that decide what is computed or where it is written: given twice, one value
-#: would be dropped. The others (``--workers``, ``--executor``, ``--jobs``, the limits) change
-#: no number; a later one wins, as in argparse, so a default put first can be overridden
-#: (tests/conftest.py's ``--workers 1 ... --workers 2``, the Makefile's ``VERIFY_FLAGS``)
-ONCE = frozenset({"--out", "--trials", "--chunk", "--seed", "--results", "--timings"})
-
-
-class OnceParser(BoundedParser):
-    """argparse where an option of :data:`ONCE` may be given once, and at most
-    :data:`sim.mc.argv.MAX_OPTIONS` options are read."""
-
-    def add_argument(self, *args, **kwargs):
-        if args and args[0] in ONCE and "action" not in kwargs:
-            kwargs["action"] = _Once
-        return super().add_argument(*args, **kwargs)
-
-    def parse_known_args(self, args=None, namespace=None):
-        self.given_once = set()  # each parse starts afresh (a parser may be used again)
-        return super().parse_known_args(args, namespace)
+__all__ = ["module_doc", "parser"]
 
 
 class _Parser(OnceParser):
     """argparse with one-line errors (exit 2 through :func:`main`, no usage dump)."""
 
-    def parse_known_args(self, args=None, namespace=None):
-        self.argv = list(sys.argv[1:] if args is None else args)
-        return super().parse_known_args(args, namespace)
-
-    def error(self, message: str):
+    def refuse(self, message: str):
         if message.startswith("the following arguments are required"):
             # `sim --verison`, `sim check --hlep`: the mistyped option, not the missing
             # argument it left behind, is what the user must fix
             known = self._option_string_actions
             bad = [
                 a
-                for a in getattr(self, "argv", [])
-                if a.startswith("-")
-                and a != "-"
-                and not any(o.startswith(a.split("=")[0]) for o in known)
+                for a in getattr(self, "given", [])
+                if a.startswith("-") and a != "-" and a.split("=")[0] not in known
             ]
             if bad:
-                message = f"unrecognized arguments: {bad[0]}"
+                message = self.explain(f"unrecognized arguments: {bad[0]}")
         # the command's own parser names itself ("sim run: argument --trials: ..."); the top
         # one reports what no command takes: its line already starts "sim: error:" (it said
         # "sim: error: sim: unrecognized arguments"), and the help to see is the command's
@@ -78,7 +37,7 @@ class _Parser(OnceParser):
         if " " not in self.prog:
             head = ""
             cmds = next((a.choices for a in self._actions if a.dest == "cmd"), {}) or {}
-            cmd = next((a for a in getattr(self, "argv", []) if a in cmds), None)
+            cmd = next((a for a in getattr(self, "given", []) if a in cmds), None)
             helps = f"{self.prog} {cmd}" if cmd else self.prog
         raise ConfigError(None, f"{head}{message} (see {helps} --help)")
 

@@ -161,7 +161,12 @@ def test_batch_results_that_is_not_a_directory_is_one_line_before_any_run(tmp_pa
 @pytest.mark.parametrize(
     ("argv", "needles"),
     [
-        (["--verison"], ("sim: error: unrecognized arguments: --verison (see sim --help)",)),
+        (
+            ["--verison"],
+            (
+                "sim: error: unrecognized arguments: --verison (did you mean --version?) (see sim --help)",
+            ),
+        ),
         (["check", "--hlep"], ("sim check: unrecognized arguments: --hlep",)),
         (["run", "--trails=40"], ("sim run: unrecognized arguments: --trails=40",)),
         (["run", "--no-figures"], ("sim run: the following arguments are required: study",)),

@@ -42,7 +42,7 @@ def test_an_option_given_twice_is_refused_not_dropped(capsys):
         (main, ["run", study, "--seed", "1", "--seed", "1"], "--seed"),
         (main, ["report", "--results", "a", "--results", "b"], "--results"),
         (sim.batch.main, ["--results", "a", "--results", "b", study], "--results"),
-        (sim.batch.main, [study, "--", "--out", "a", "--ou", "b"], "--out"),
+        (sim.batch.main, [study, "--", "--out", "a", "--out", "b"], "--out"),
     ]
     for fn, argv, opt in cases:
         assert fn(argv) == 2, argv

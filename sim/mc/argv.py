@@ -1,37 +1,107 @@
 """The argparse base of every command line (``sim``, ``python -m sim.batch``, ``make verify``,
-``python -m benchmarks``): a bound on the options one command line may hold.
+``python -m benchmarks``): a bound on the options one command line may hold, options never
+abbreviated, an option that decides a result given once, and a guess at a mistyped option
+or command.
 
 argparse's time grows with the square of the options given (it looks for the next option
 among all of them, once per option): 50,000 ``--set`` ran for over three minutes before
 "unknown key", and 50,000 ``--study`` kept ``make verify`` busy as long. A study has a few
 hundred keys at most, and a study file holds any number of them.
+
+argparse takes any unambiguous prefix of an option (``--tri 40`` for ``--trials``, ``--stale``
+for ``--stale-only``, ``sim --vers``) without a word: such a command line, in a script or a
+Makefile, breaks the day an option of the same prefix is added (``--o`` already matches both
+``--out`` and ``--overwrite``). Options are read by their whole name;
+a prefix is refused naming the option it abbreviates.
 """
 
 from __future__ import annotations
 
 import argparse
+import difflib
+import re
 import sys
 
 from sim.ends import stdout_unwritten
 
-__all__ = ["MAX_OPTIONS", "BoundedParser"]
+__all__ = ["MAX_OPTIONS", "ONCE", "BoundedParser", "OnceParser"]
 
 #: options (arguments starting with "-") one command line may hold
 MAX_OPTIONS = 2000
 
+#: the options that decide what is computed, read or written: given twice, one value would be
+#: dropped. The others (``--workers``, ``--executor``, ``--jobs``, the limits) change no
+#: number; a later one wins, as in argparse, so a default put first can be overridden
+#: (tests/conftest.py's ``--workers 1 ... --workers 2``, the Makefile's ``VERIFY_FLAGS``)
+ONCE = frozenset(
+    {"--out", "--trials", "--chunk", "--seed", "--results", "--timings", "--scratch", "--studies"}
+)
+
+
+def _guess(word: str, names) -> str:
+    """`` (did you mean NAME?)`` for a mistyped ``word`` among ``names``: the names it is a
+    prefix of first (an abbreviation), else the closest one; "" when none is close."""
+    names = sorted(set(names))
+    longer = [n for n in names if n.startswith(word) and n != word]
+    if longer:
+        said = " or ".join(longer[:3])
+        return f" (did you mean {said}? options are not abbreviated)"
+    close = difflib.get_close_matches(word, names, n=1, cutoff=0.6)
+    return f" (did you mean {close[0]}?)" if close else ""
+
 
 class BoundedParser(argparse.ArgumentParser):
-    """argparse that reads at most :data:`MAX_OPTIONS` options; more is ``self.error``."""
+    """argparse that reads at most :data:`MAX_OPTIONS` options, takes no abbreviation of an
+    option, and adds a guess to a mistyped option or choice; its one-line refusal is
+    :meth:`refuse` (argparse's own ``error`` by default)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)  # the commands' parsers too (add_parser)
+        super().__init__(*args, **kwargs)
 
     def parse_known_args(self, args=None, namespace=None):
         given = sys.argv[1:] if args is None else args
-        n = sum(1 for a in given if str(a).startswith("-"))
+        self.given = [str(a) for a in given]
+        n = sum(1 for a in self.given if a.startswith("-"))
         if n > MAX_OPTIONS:
             self.error(
                 f"{n:,} options: at most {MAX_OPTIONS:,} (write the keys into a study file, "
                 "or pass them to the Python API)"
             )
         return super().parse_known_args(args, namespace)
+
+    def options(self) -> set[str]:
+        """Every option string of this parser and of the command named in the arguments
+        being read (``sim run ... --tri``: the options of ``run``)."""
+        known = set(self._option_string_actions)
+        for a in self._actions:
+            if isinstance(a, argparse._SubParsersAction):
+                cmd = next((w for w in getattr(self, "given", []) if w in a.choices), None)
+                if cmd is not None:
+                    known |= set(a.choices[cmd]._option_string_actions)
+        return known
+
+    def explain(self, message: str) -> str:
+        """argparse's ``message`` with a guess at what was meant: an abbreviated or mistyped
+        option (``--tri``: ``--trials``), a mistyped command or choice (``sim rn``: ``run``)."""
+        m = re.match(r"unrecognized arguments: (.*)", message)
+        if m:
+            bad = next((w for w in m.group(1).split(" ") if w.startswith("-") and w != "-"), None)
+            if bad is not None:
+                return message + _guess(bad.split("=")[0], self.options())
+        m = re.search(r"invalid choice: '(.*?)' \(choose from (.*)\)$", message)
+        if m:
+            close = difflib.get_close_matches(m.group(1), re.findall(r"'([^']*)'", m.group(2)), 1)
+            if close:
+                return f"{message} (did you mean {close[0]}?)"
+        return message
+
+    def error(self, message: str):
+        self.refuse(self.explain(message))
+
+    def refuse(self, message: str):
+        """One line naming the problem (a subclass raises its own error)."""
+        super().error(message)
 
     def _print_message(self, message, file=None):
         """argparse's, which dropped a failed write (``--help > /dev/full`` with unbuffered
@@ -45,3 +115,29 @@ class BoundedParser(argparse.ArgumentParser):
         except (AttributeError, OSError) as e:  # a closed or gone stream: as argparse did
             if isinstance(e, OSError) and file is sys.stdout:
                 stdout_unwritten(e)
+
+
+class _Once(argparse.Action):
+    """Store an option's value and refuse a second one: ``--trials 40 --trials 60`` (or
+    ``--out A --out B``, ``--results A --results B``) ran with the last and dropped the first
+    without a word, as ``--set seed=3 --set seed=4`` did before the eighth sweep."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = parser.__dict__.setdefault("given_once", set())
+        if self.dest in given:
+            parser.error(f"argument {'/'.join(self.option_strings)}: given twice: give one value")
+        given.add(self.dest)
+        setattr(namespace, self.dest, values)
+
+
+class OnceParser(BoundedParser):
+    """:class:`BoundedParser` where an option of :data:`ONCE` may be given once."""
+
+    def add_argument(self, *args, **kwargs):
+        if args and args[0] in ONCE and "action" not in kwargs:
+            kwargs["action"] = _Once
+        return super().add_argument(*args, **kwargs)
+
+    def parse_known_args(self, args=None, namespace=None):
+        self.given_once = set()  # each parse starts afresh (a parser may be used again)
+        return super().parse_known_args(args, namespace)

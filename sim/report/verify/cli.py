@@ -10,7 +10,8 @@ import tempfile
 from pathlib import Path
 
 from sim.ends import stdout_failed
-from sim.mc.argv import BoundedParser
+from sim.mc.argv import OnceParser
+from sim.mc.config import ConfigError, parse_override
 from sim.mc.outputs import name_problem
 from sim.report.verify.record import write_record
 from sim.report.verify.rerun import verify
@@ -27,8 +28,8 @@ DESCRIPTION = (
 # --- command line -----------------------------------------------------------------------------
 
 
-class _Parser(BoundedParser):
-    def error(self, message: str):  # one line, exit 2 (main prints it)
+class _Parser(OnceParser):
+    def refuse(self, message: str):  # one line, exit 2 (main prints it)
         raise VerifyError(message)
 
 
@@ -41,7 +42,14 @@ MIN_TRIALS = 400
 
 def _parser() -> argparse.ArgumentParser:
     p = _Parser(prog="python -m sim.report.verify", description=DESCRIPTION)
-    p.add_argument("--results", default="results", help="the committed results (default: results)")
+    # --results, unlike the other paths, may be given again: make verify passes --results
+    # results before VERIFY_FLAGS (the last wins, as before)
+    p.add_argument(
+        "--results",
+        action="store",
+        default="results",
+        help="the committed results (default: results)",
+    )
     p.add_argument(
         "--scratch", help="where to re-run (default: a temporary directory, removed after)"
     )
@@ -100,9 +108,17 @@ def _check_args(a) -> None:
             f"no studies/ directory in {Path.cwd()}: the re-runs read their study files from "
             "studies/; run from the project's root (or name their directory with --studies)"
         )
+    keys = set()
     for s in a.set:
         if "=" not in s:
             raise VerifyError(f"--set: {s!r} is not KEY=VALUE")
+        try:
+            key = parse_override(s)[0]
+        except ConfigError as e:
+            raise VerifyError(f"--set: {e}" if e.key else str(e)) from None
+        if key in keys:  # each re-run refused it, one by one after the runs before it
+            raise VerifyError(f"--set: {key}: given twice by --set: give one value")
+        keys.add(key)
 
 
 def _print(comps: list[Comparison]) -> None:
