@@ -44,3 +44,8 @@ def test_table1_figure_counts_the_runs_sigmas(monkeypatch):
     F.fig_table1({}, pts, None, np.full((16, 2), 1.2), t1, None)
     labels = [ax.get_xlabel() for ax in seen[0].axes]
     assert "share of the 32 σ printing 1.1–1.3 µm (%)" in labels
+
+
+def test_table1_intro_on_the_papers_plate_says_it_once(monkeypatch):
+    text = _intro(monkeypatch)
+    assert text.startswith("The paper's production test: a 5 x 5 array at 45 mm, 2 settings")

@@ -99,8 +99,10 @@ def _plate(cfg: dict) -> str:
 def _table1_intro(out: Path) -> str:
     prov = config(out)
     cfg = prov["config"]
+    paper, run = "a 5 x 5 array at 45 mm", _plate(cfg)
+    plate = run if run == paper else f"({paper}); this run: {run}"
     return (
-        f"The paper's production test (a 5 x 5 array at 45 mm); this run: {_plate(cfg)}, "
+        f"The paper's production test{':' if run == paper else ''} {plate}, "
         f"{cfg['errors.settings']} settings of {cfg['errors.setting_sigma_um']:g} um each and "
         f"{cfg['errors.comparator_sigma_um']:g} um from the comparator (range sigma "
         f"{prov['range_sigma_um']:.2f} um), reduced with the `pivot` model (2n + 7 unknowns). "
