@@ -277,7 +277,9 @@ def _main(argv: list[str]) -> int:
     except SystemExit as e:  # --help: printed; an in-process caller (a notebook) goes on
         return exit_status(e.code)
     except _BadArgs as e:
-        print(f"sim.batch: {e} (see python -m sim.batch --help)", file=sys.stderr)
+        after = [a for a in run_args if a.endswith(".toml")]  # a study file among sim run's options
+        hint = f"; study files come before --, not after it ({after[0]})" if after else ""
+        print(f"sim.batch: {e}{hint} (see python -m sim.batch --help)", file=sys.stderr)
         return 2
     if not 1 <= args.jobs <= 64:  # an option of the command line, before its files
         print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)

@@ -193,3 +193,10 @@ def test_every_option_of_every_command_line_is_named_in_the_docs(monkeypatch):
     named = set(re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", text))
     missing = sorted(o for p in parsers for o in _options(p) if o and not named & set(o))
     assert len(parsers) == 4 and not missing, missing
+
+
+def test_a_batch_with_its_study_files_after_the_separator_says_so(capsys):
+    """``python -m sim.batch --results X -- a.toml`` said only "the following arguments are
+    required: files": what follows ``--`` is sim run's options, so the file was never seen."""
+    rc = sim.batch.main(["--results", "X", "--", BROWN])
+    one_line(capsys, rc, "required: files", "study files come before --", "brown_table1.toml")
