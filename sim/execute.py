@@ -26,7 +26,7 @@ import numpy as np
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.executors import StartRefused, script_words
-from sim.mc.outputs import check_out, drop_stage, prepare_stage, stage_dir
+from sim.mc.outputs import _chunks, _differs, _same, check_out, drop_stage, prepare_stage, stage_dir
 from sim.mc.publish import publish, seal
 from sim.mc.runner import ChunkStore, RunContext, make_executor
 from sim.mc.storage import (
@@ -294,24 +294,16 @@ def _replaced(stage: Path, record: dict) -> str | None:
     """What ``--overwrite`` replaces in the staging directory ``stage`` instead of resuming
     it: an unfinished run of other code (killed, the code pulled since) or of another config
     with its chunks (``make reproduce`` after a pull started it over without a word; its chunks
-    are never mixed with this run's). Read before the lock, for the message only."""
+    are never mixed with this run's). Read before the lock, for the message only, with the
+    staging rules' own tests (:mod:`sim.mc.outputs`: the same run, its chunks, how it differs)."""
     try:
         old = read_record(stage) if stage.is_dir() and not stage.is_symlink() else None
-        n = sum(1 for _ in stage.rglob("chunk-*.parquet")) if old else 0
+        n = _chunks(stage) if old else 0
     except OSError:
         return None
-    if (
-        not n
-        or old.get("failed")
-        or (old["config"], old["code_hash"])
-        == (
-            record["config"],
-            record["code_hash"],
-        )
-    ):
+    if not n or old.get("failed") or _same(old, record):
         return None
-    how = "a different code version" if old["config"] == record["config"] else "another config"
-    return f"its unfinished run of {how} ({n} chunks)"
+    return f"its unfinished run of {_differs(old, record)} ({n} chunks)"
 
 
 def _quiet_dask_logs() -> None:
