@@ -28,6 +28,7 @@ from benchmarks import studies
 from benchmarks.brown import brown_rows, million, peak_rss_mib
 from benchmarks.engines import engine_rows
 from benchmarks.figures import brown_figure, engines_figure
+from benchmarks.outdir import not_written_here
 from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
 from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
@@ -169,6 +170,14 @@ def _check_args(a: argparse.Namespace, sections: tuple[str, ...]) -> None:
         raise _ArgError(f"--out: {out} exists and is not a directory")
     if any((out / f).exists() for f in ("claims.parquet", "sweep.parquet", "run.json")):
         raise _ArgError(f"--out: {out} is a study's results directory (give another)")
+    if out.is_dir() and next(out.glob("*/claims.parquet"), None) is not None:
+        raise _ArgError(f"--out: {out} holds studies' results directories (give {out / 'bench'})")
+    foreign = not_written_here(out)
+    if foreign:
+        raise _ArgError(
+            f"--out: {out / foreign} was not written by the benchmark, which would replace it"
+            " (give a new directory, or one make bench wrote)"
+        )
     base = next(p for p in (out.absolute(), *out.absolute().parents) if p.exists())
     if not base.is_dir() or not os.access(base, os.W_OK | os.X_OK):
         raise _ArgError(f"--out: cannot write {out} ({base} is not a writable directory)")

@@ -13,7 +13,9 @@ import numpy as np
 from benchmarks.engines import KEEP_RATIO
 from benchmarks.studies import KEEP_SHARE
 
-__all__ = ["write_page", "STUDY_OF"]
+__all__ = ["HEADING", "STUDY_OF", "write_page"]
+
+HEADING = "# Benchmark: compiled code and the rows that keep it"
 
 #: compiled modules whose engine row falls below KEEP_RATIO and the study that decides them
 STUDY_OF = {"sim.lsq.group_kernel, sim.lsq.group_kernel_solve": "agnard_block"}
@@ -63,7 +65,7 @@ def _engines_table(eng) -> list[str]:
 def write_page(path: Path, eng, studies, quick: bool) -> None:
     """Write the page from the columns of ``engines.parquet`` and ``studies.parquet`` (either
     None when not measured in this run)."""
-    out = ["# Benchmark: compiled code and the rows that keep it", ""]
+    out = [HEADING, ""]
     out += [
         "Written by `make bench` (`python -m benchmarks`, "
         + ("`--quick`: smoke sizes, the numbers say nothing" if quick else "full size")
