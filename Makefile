@@ -12,14 +12,27 @@ endif
 # `make reproduce JOBS=4` ran 2 at a time, `make test PYTEST_ARGS=-x` ran every test. One line
 # naming what to write instead, exit 2 (set in the environment such a name is left alone).
 not_read = $(if $(filter command line,$(origin $(1))),$(error make: $(1) is not a setting of this Makefile; $(2)))
-$(call not_read,STUDY,make verify VERIFY_FLAGS="--study NAME" re-runs one study)
-$(call not_read,STUDIES,make verify VERIFY_FLAGS="--study NAME --study NAME2" re-runs those studies)
-$(call not_read,JOBS,RUN_JOBS=N runs N studies at a time (make reproduce and make rerun))
-$(call not_read,WORKERS,TEST_WORKERS=N (make test) or MUTATION_WORKERS=N or RUN_FLAGS="--workers N")
-$(call not_read,TRIALS,RUN_FLAGS="--trials N" (make reproduce and make rerun) or VERIFY_FLAGS="--trials N")
-$(call not_read,SEED,RUN_FLAGS="--seed N" (make reproduce and make rerun) or FUZZ_SEED=N (make fuzz))
-$(call not_read,FLAGS,RUN_FLAGS or VERIFY_FLAGS or BENCH_FLAGS: the options of the target's command)
-$(call not_read,PYTEST_ARGS,PYTEST_ADDOPTS="..." passes options to pytest (make test))
+# $(call not_read_any,NAMES,TEXT): not_read of each of NAMES, the spellings a user tries for a
+# setting (singular or plural, without its prefix, in lower case: `make test workers=1`)
+not_read_any = $(foreach n_,$(1),$(call not_read,$(n_),$(2)))
+$(call not_read_any,STUDY study,make verify VERIFY_FLAGS="--study NAME" re-runs one study)
+$(call not_read_any,STUDIES studies,make verify VERIFY_FLAGS="--study NAME --study NAME2" re-runs those studies)
+$(call not_read_any,JOBS JOB RUN_JOB jobs run_jobs,RUN_JOBS=N runs N studies at a time (make reproduce and make rerun))
+$(call not_read_any,WORKERS WORKER workers,TEST_WORKERS=N (make test) or MUTATION_WORKERS=N or RUN_FLAGS="--workers N")
+$(call not_read_any,TEST_WORKER test_workers,TEST_WORKERS=N runs the tests in N processes (make test))
+$(call not_read_any,MUTATION_WORKER mutation_workers,MUTATION_WORKERS=N (make mutation))
+$(call not_read_any,TRIALS TRIAL trials,RUN_FLAGS="--trials N" (make reproduce and make rerun) or VERIFY_FLAGS="--trials N")
+$(call not_read_any,SEED SEEDS seed,RUN_FLAGS="--seed N" (make reproduce and make rerun) or FUZZ_SEED=N (make fuzz))
+$(call not_read_any,FUZZ_SEEDS fuzz_seed,FUZZ_SEED=N (make fuzz))
+$(call not_read_any,CASES FUZZ_CASE cases fuzz_cases,FUZZ_CASES=N (make fuzz))
+$(call not_read_any,SAVE fuzz_save save,FUZZ_SAVE=DIR (make fuzz))
+$(call not_read_any,FLAGS ARGS flags args,RUN_FLAGS or VERIFY_FLAGS or BENCH_FLAGS: the options of the target's command)
+$(call not_read_any,RUN_FLAG RUN_ARGS run_flags,RUN_FLAGS="..." (make reproduce and make rerun))
+$(call not_read_any,VERIFY_FLAG VERIFY_ARGS verify_flags,VERIFY_FLAGS="..." (make verify))
+$(call not_read_any,BENCH_FLAG BENCH_ARGS bench_flags,BENCH_FLAGS="..." (make bench))
+$(call not_read_any,OUT BENCH_DIR out bench_out,BENCH_OUT=DIR (make bench))
+$(call not_read_any,PYTEST_ARGS PYTEST_FLAGS PYTEST_OPTS,PYTEST_ADDOPTS="..." passes options to pytest (make test))
+$(call not_read_any,PY python,PYTHON=python3.X chooses the Python of the virtual environment (make venv))
 
 PYTHON ?= python3
 VENV   := .venv
@@ -188,6 +201,7 @@ BENCH_OUT ?= results/bench
 
 bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/, or BENCH_OUT; BENCH_FLAGS=--quick: smoke)
 	$(call shellwords,BENCH_FLAGS)
+	$(if $(filter --out --out=%,$(BENCH_FLAGS)),@echo 'make bench: BENCH_FLAGS holds --out: give the directory as BENCH_OUT=DIR' >&2; exit 2)
 	$(PY) -m benchmarks --out $(call q,$(BENCH_OUT)) $(BENCH_FLAGS)
 
 clean: ## remove the virtual environment and caches (results/ is kept)

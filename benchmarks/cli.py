@@ -33,7 +33,7 @@ from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
 from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
 from benchmarks.store import store_rows
-from sim.mc.argv import BoundedParser
+from sim.mc.argv import ONCE, OnceParser
 from sim.mc.storage import provenance, write_table
 
 __all__ = ["main", "run"]
@@ -140,8 +140,12 @@ class _ArgError(Exception):
     """A bad argument, found before anything is measured (one line, exit 2)."""
 
 
-class _Parser(BoundedParser):
-    """argparse with the suite's one-line errors (``sim``'s style), exit 2."""
+class _Parser(OnceParser):
+    """argparse with the suite's one-line errors (``sim``'s style), exit 2; ``--out``,
+    ``--only``, ``--rerun-files`` and ``--rerun-workers`` given once (a second one was taken
+    and the first dropped without a word: ``--out A --out B`` wrote into B alone)."""
+
+    once = ONCE | {"--only", "--rerun-files", "--rerun-workers"}
 
     def refuse(self, message: str):
         print(f"benchmarks: error: {message} (see {self.prog} --help)", file=sys.stderr)

@@ -8,7 +8,7 @@ import ast
 from importlib import metadata
 from pathlib import Path
 
-from sim.mc.argv import OnceParser
+from sim.mc.argv import OnceParser, integer
 from sim.mc.config import ConfigError
 from sim.mc.runner import MIN_CHUNKS
 
@@ -78,12 +78,12 @@ def _run_parser(sub) -> None:
     )
     r.add_argument(
         "--trials",
-        type=int,
+        type=integer,
         help=f"number of Monte-Carlo trials; also picks a chunk size giving at least "
         f"{MIN_CHUNKS} chunks unless --chunk or chunk= is given",
     )
-    r.add_argument("--chunk", type=int, help="trials per chunk (the intervals are over chunks)")
-    r.add_argument("--seed", type=int, help="override the root seed")
+    r.add_argument("--chunk", type=integer, help="trials per chunk (the intervals are over chunks)")
+    r.add_argument("--seed", type=integer, help="override the root seed")
     r.add_argument(
         "--set",
         action="append",

@@ -233,7 +233,7 @@ def test_an_empty_directory_and_our_own_results_are_replaced(tmp_path):
     "args, needle",
     [
         (["--out", ""], "--out: is empty"),
-        (["--trials", "2.5"], "invalid int value: '2.5'"),
+        (["--trials", "2.5"], "argument --trials: must be an integer (got 2.5)"),
         (["--workers", "0"], "--workers"),
         (["--scheduler", "not an address", "--executor", "dask"], "--scheduler"),
         (["--scheduler", "tcp://127.0.0.1:8786"], "needs --executor dask"),

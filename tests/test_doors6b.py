@@ -174,7 +174,7 @@ def test_an_unwritable_matplotlib_config_directory_is_not_reported():
         (["--ou", "X"], "--out"),
         (["--help"], "help"),
         (["--workers", "0"], "--workers"),
-        (["--trials", "1e3"], "--trials"),
+        (["--trials", "1000.5"], "--trials"),  # 1e3 is 1000 (left15), as --set reads it
     ],
 )
 def test_batch_reads_the_run_options_before_any_run(tmp_path, capsys, opts, words):

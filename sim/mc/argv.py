@@ -23,8 +23,9 @@ import re
 import sys
 
 from sim.ends import stdout_unwritten
+from sim.mc.config import ConfigError, Field, parse_override, validate
 
-__all__ = ["MAX_OPTIONS", "ONCE", "BoundedParser", "OnceParser"]
+__all__ = ["MAX_OPTIONS", "ONCE", "BoundedParser", "OnceParser", "integer"]
 
 #: options (arguments starting with "-") one command line may hold
 MAX_OPTIONS = 2000
@@ -36,6 +37,19 @@ MAX_OPTIONS = 2000
 ONCE = frozenset(
     {"--out", "--trials", "--chunk", "--seed", "--results", "--timings", "--scratch", "--studies"}
 )
+
+
+def integer(text: str) -> int:
+    """argparse's ``type`` of an option that sets an integer key (``--trials``, ``--chunk``,
+    ``--seed``; ``make verify``'s ``--trials``): the value read as ``--set KEY=VALUE`` reads
+    it (TOML), so a float without a fraction is that integer (``1e3``, ``1000.0``: 1000), and
+    anything else is refused in ``--set``'s words (``must be an integer (got 1000.5)``).
+    ``--trials 1e3`` was refused ("invalid int value") while ``--set trials=1e3`` and
+    ``sim.load(..., trials=1e3)`` ran 1000 trials."""
+    try:
+        return validate({"v": parse_override(f"v={text}")[1]}, {"v": Field(0, "int", "")})["v"]
+    except ConfigError as e:
+        raise argparse.ArgumentTypeError(str(e).removeprefix("v: ")) from None
 
 
 def _guess(word: str, names) -> str:
@@ -131,10 +145,13 @@ class _Once(argparse.Action):
 
 
 class OnceParser(BoundedParser):
-    """:class:`BoundedParser` where an option of :data:`ONCE` may be given once."""
+    """:class:`BoundedParser` where an option of :attr:`once` (:data:`ONCE` unless a
+    subclass names more) may be given once."""
+
+    once: frozenset = ONCE
 
     def add_argument(self, *args, **kwargs):
-        if args and args[0] in ONCE and "action" not in kwargs:
+        if args and args[0] in self.once and "action" not in kwargs:
             kwargs["action"] = _Once
         return super().add_argument(*args, **kwargs)
 

@@ -40,11 +40,13 @@ def toml_float(text: str) -> float:
 def number_text(text: str) -> str:
     """The number ``text`` spells in a form TOML does not read (``.5``, ``5.``, ``07``,
     ``0x1p3``, ``Infinity``) or as a quoted string (``"400"``), written as TOML writes it
-    (``0.5``); "" when it spells no finite number."""
+    (``0.5``); "" when it spells no finite number (a hexadecimal float only with its ``0x``:
+    ``--set trials=abc`` was told to "write 2748.0")."""
     t = text.strip()
     if not t or len(t) > 100:
         return ""
-    for read in (lambda s: int(s, 0), int, float, float.fromhex):
+    hexa = t.lstrip("+-")[:2].lower() == "0x"  # fromhex reads "abc" (2748.0) or "add" too
+    for read in (lambda s: int(s, 0), int, float, *([float.fromhex] if hexa else [])):
         try:
             x = read(t)
         except ValueError:

@@ -418,25 +418,25 @@ class StageLock:
             if e.errno in (errno.ELOOP, errno.EISDIR):  # a symbolic link, a directory (doors25a:
                 raise NotALock(path) from None  # "cannot write to <the parent>: Is a directory")
             raise
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode) or st.st_nlink > 1:  # a FIFO, a hard link
-            os.close(fd)
-            raise NotALock(path)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
+        self.fd = fd  # recorded before flock: an interrupt (Ctrl-C) after it, before this
+        try:  # assignment, kept the lock for the process's life (a notebook's sim.load)
+            st = os.fstat(fd)
+            if not stat.S_ISREG(st.st_mode) or st.st_nlink > 1:  # a FIFO, a hard link
+                raise NotALock(path)
             try:
-                pid = int(os.read(fd, 32).decode().strip() or 0) or None
-            except (OSError, ValueError):
-                pid = None
-            os.close(fd)
-            raise Locked(pid) from None
-        except OSError:  # a file system that cannot lock (ENOLCK: NFS without its lock service)
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                try:
+                    pid = int(os.read(fd, 32).decode().strip() or 0) or None
+                except (OSError, ValueError):
+                    pid = None
+                raise Locked(pid) from None
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()}\n".encode())
+        except BaseException:  # also an OSError: ENOLCK (NFS without its lock service)
+            self.fd = None
             os.close(fd)
             raise
-        os.ftruncate(fd, 0)
-        os.write(fd, f"{os.getpid()}\n".encode())
-        self.fd = fd
         return self
 
     def release(self, unlink: Path | None = None) -> None:

@@ -310,13 +310,15 @@ def build_report(
         [e[4] for e in entries],
     )
     repro = reproducibility_markdown(results)
-    details = [f"- {md_link(e[1])}: {e[2].title}" for e in entries]
-    details += [f"- {md_link(s)}: a sweep" for s in sweeps]
+    lost = _no_file({e[1] for e in entries} | set(sweeps), studies)
+    details = [f"- {md_link(e[1])}: {e[2].title}{lost.get(e[1], '')}" for e in entries]
+    details += [f"- {md_link(s)}: a sweep{lost.get(s, '')}" for s in sweeps]
     return (
         head
         + opening(entries, results)
         + "".join(line + "\n" for line in design_notes(entries, results, design))
         + _absent({e[1] for e in entries} | set(sweeps), studies)
+        + "".join(f"- `{d}`{why}\n" for d, why in lost.items())
         + "\n"
         + referee_summary(entries)
         + "\n### Counts per study\n\n"
@@ -328,6 +330,18 @@ def build_report(
         + "\n".join(details)
         + "\n"
     )
+
+
+def _no_file(have: set[str], studies) -> dict[str, str]:
+    """For each results directory among ``have`` without its study file among ``studies``
+    (the project's ``studies/*.toml``; none for a results directory of the user's, whose
+    files may be anywhere), the words that mark it: it was shown like any other."""
+    names = {Path(f).stem for f in studies}
+    return {
+        d: f" (no study file `studies/{d}.toml`: these results cannot be re-run)"
+        for d in sorted(have)
+        if studies and d not in names
+    }
 
 
 def _absent(have: set[str], studies) -> str:

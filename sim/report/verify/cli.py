@@ -10,7 +10,7 @@ import tempfile
 from pathlib import Path
 
 from sim.ends import stdout_failed
-from sim.mc.argv import OnceParser
+from sim.mc.argv import OnceParser, integer
 from sim.mc.config import ConfigError, parse_override
 from sim.mc.outputs import name_problem
 from sim.report.verify.record import write_record
@@ -67,7 +67,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--trials",
-        type=int,
+        type=integer,
         help="re-run with this many trials and compare at the Monte-Carlo level",
     )
     p.add_argument(

@@ -14,6 +14,8 @@ from sim.report.plotting import draw, place_legend, plt, save
 from sim.studies.wolf.model import ls_map
 
 _UM_PER_MM = 2.5  # vector plots: 1 mm of plot = 2.5 µm of discrepancy (50 µm = 20 mm)
+#: the scale of the Table 1 plot, as its title says it: 10 µm of discrepancy drawn as 20 mm
+_TABLE1_KEY_UM, _TABLE1_KEY_MM = 10.0, 20.0
 
 
 def _quiver(ax, x, y, dx, dy, title, key_um=20.0, um_per_mm=_UM_PER_MM):
@@ -236,9 +238,9 @@ def table1_figure(out: Path) -> None:
             t["y_set1_mm"][m],
             t["dx_sets_um"][m],
             t["dy_sets_um"][m],
-            f"plate {plate}: Set 1 - Set 2 (Table 1, 10 µm = 20 mm)",
-            10.0,
-            0.5,
+            f"plate {plate}: Set 1 - Set 2 (Table 1, {_TABLE1_KEY_UM:g} µm = {_TABLE1_KEY_MM:g} mm)",
+            _TABLE1_KEY_UM,
+            _TABLE1_KEY_UM / _TABLE1_KEY_MM,
         )
         for x, y, p in zip(t["x_set1_mm"][m], t["y_set1_mm"][m], t["point"][m]):
             ax.annotate(str(p), (x, y), textcoords="offset points", xytext=(3, -8), fontsize=7)
