@@ -135,6 +135,14 @@ def test_verify_results_may_be_given_again_as_make_verify_does():
         ("reproduce", "SEED=7", 'RUN_FLAGS="--seed N"'),
         ("verify", "FLAGS=--study x", "VERIFY_FLAGS"),
         ("test", "PYTEST_ARGS=-x", "PYTEST_ADDOPTS"),
+        # left15: other spellings of the documented settings (see test_left15)
+        ("reproduce", "jobs=4", "RUN_JOBS=N"),
+        ("reproduce", "RUN_JOB=4", "RUN_JOBS=N"),
+        ("test", "test_workers=1", "TEST_WORKERS=N"),
+        ("bench", "OUT=/tmp/x", "BENCH_OUT=DIR"),
+        ("fuzz", "FUZZ_CASE=5", "FUZZ_CASES=N"),
+        ("verify", "VERIFY_ARGS=--study x", 'VERIFY_FLAGS="..."'),
+        ("venv", "PY=python3", "PYTHON=python3.X"),
     ],
 )
 def test_make_names_a_setting_it_does_not_read_before_any_command(

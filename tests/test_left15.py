@@ -201,30 +201,8 @@ def test_every_settings_likely_spellings_are_named():
     assert not _named() & settings  # no setting is refused
 
 
-@pytest.mark.skipif(MAKE is None, reason="no make on this machine")
-@pytest.mark.parametrize(
-    "target, setting, instead",
-    [
-        ("reproduce", "jobs=4", "RUN_JOBS=N"),
-        ("reproduce", "RUN_JOB=4", "RUN_JOBS=N"),
-        ("test", "test_workers=1", "TEST_WORKERS=N"),
-        ("bench", "OUT=/tmp/x", "BENCH_OUT=DIR"),
-        ("fuzz", "FUZZ_CASE=5", "FUZZ_CASES=N"),
-        ("verify", "VERIFY_ARGS=--study x", 'VERIFY_FLAGS="..."'),
-        ("venv", "PY=python3", "PYTHON=python3.X"),
-    ],
-)
-def test_make_names_another_spelling_of_a_setting(tmp_path, target, setting, instead):
-    log, fake = tmp_path / "calls.log", tmp_path / "python"
-    fake.write_text(f'#!/bin/sh\necho "$*" >> {log}\n', encoding="utf-8")
-    fake.chmod(0o755)
-    d = fake_project(tmp_path, str(fake))
-    p = run_make(d, target, setting)
-    err = p.stderr.removesuffix("\n")
-    name = setting.split("=")[0]
-    assert p.returncode == 2 and "\n" not in err, p.stderr
-    assert f"{name} is not a setting of this Makefile; " in err and instead in err, err
-    assert not log.exists()  # nothing ran
+# the other spellings refused before any command: cases of
+# test_doors29b.test_make_names_a_setting_it_does_not_read_before_any_command
 
 
 # ------------------------------------------------------------- 7. results without a study file
