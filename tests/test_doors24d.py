@@ -67,10 +67,10 @@ def _scan(dpis):
 
 
 def test_a_resolution_not_simulated_has_no_gain_row():
-    rows = scanner_rows(_scan([600.0]))
+    rows = scanner_rows(_scan([600.0]), 21)
     assert rows[GAIN.format(300)] is None
     assert rows[GAIN.format(600)].value == 5.5
-    both = scanner_rows(_scan([300.0, 600.0]))
+    both = scanner_rows(_scan([300.0, 600.0]), 21)
     assert both[GAIN.format(300)].value == 5.5 and both[GAIN.format(300)].ci[0] < 5.5
 
 

@@ -76,7 +76,9 @@ def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
     ]
 
 
-def scanner_rows(scan_t: dict) -> dict[str, Sim]:
+def scanner_rows(scan_t: dict, n_many: int) -> dict[str, Sim]:
+    """The calibration's gains at 300 and 600 DPI, on the ``n_many`` control points of the
+    ``control.many`` pass (the paper's 21)."""
     rows = {}
     dpi = np.asarray(scan_t["dpi"])
     cal = np.asarray(scan_t["calibration"])
@@ -90,7 +92,7 @@ def scanner_rows(scan_t: dict) -> dict[str, Sim]:
             scan_t["gain_xy_pct"][i[0]],
             scan_t["gain_xy_pct_se"][i[0]],
             f"reduction of the check-point XY rms by the grid calibration at {d:g} DPI "
-            f"(21 control; mean over {scan_t['trials'][i[0]]} blocks of the per-block relative "
+            f"({n_many} control; mean over {scan_t['trials'][i[0]]} blocks of the per-block relative "
             "gain, the same measurements with and without; 95 % confidence interval)",
         )
     return rows
@@ -396,7 +398,7 @@ def claim_rows(
     """Every claim of the book, scored once (Table 1 over the ``scanner`` region, with the
     per-vector statistics ``scanner_stats``)."""
     table = {
-        **scanner_rows(scan_t),
+        **scanner_rows(scan_t, len(c21)),
         **input_rows(book, cfg, block, c5, c21),
         **budget_rows(book, cfg),
         **tables23_rows(book, cfg, block, sim, c5, c21),

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sim.instruments.ranges import brown as B
 from sim.report.section import config, figure, region_lead, section, table
 from sim.report.tables import fmt, md_table
 from sim.studies.design.schema import SCHEMA
@@ -59,7 +60,7 @@ def _lead(out: Path, cfg: dict) -> list[str]:
             "simulated plates per input vector that Table 1's statements leave in the region, "
             "whose noise enters the decision",
         ),
-        "The comparator bounds the region: its 261 + 1 mm scale must read Table 1's plate, "
+        f"The comparator bounds the region: {_scale_words(cfg)} must read Table 1's plate, "
         "and the Zeiss points for the Zeiss rows (figure: brown_table1's region). The "
         "tolerances and the plate comparisons are the built comparator's, the instrument "
         "that measured Table 1, so both parts also ask Table 1's printed statements to hold "
@@ -67,6 +68,30 @@ def _lead(out: Path, cfg: dict) -> list[str]:
         "the closure): they are decided where Table 1 puts the stations (fifth reading), and "
         "the plates are drawn with each point's closure sigma0 as their range sigma.",
     ]
+
+
+def _scale_words(cfg: dict) -> str:
+    """The scale the region's hardware statement reads: the built comparator's 261 + 1 mm
+    (:mod:`sim.instruments.ranges.brown`), whatever ``scale.*`` says; said so where the run's
+    scale differs (it bounds the design trade-off only)."""
+    paper = f"{B.SCALE_MM:g} + {B.MICROMETER_MM:g} mm scale"
+    run = (cfg["scale.graduated_mm"], cfg["scale.micrometer_mm"])
+    if run == (B.SCALE_MM, B.MICROMETER_MM):
+        return f"its {paper}"
+    return (
+        f"the paper's {paper} (the built comparator's, whatever scale.graduated_mm and "
+        f"scale.micrometer_mm say: this run's {run[0]:g} + {run[1]:g} mm bounds the design "
+        "trade-off only)"
+    )
+
+
+def _time_words(cfg: dict) -> str:
+    """The measuring times the trade-off is scaled to (``time.*``), the paper's or the run's."""
+    keys = ("time.single_min", "time.double_min", "time.images")
+    words = "{:g} and {:g} minutes for {:g} images"
+    run = words.format(*(cfg[k] for k in keys))
+    paper = words.format(*(SCHEMA[k].default for k in keys))
+    return f"the paper's {paper}" if run == paper else f"{run} (the paper's: {paper})"
 
 
 _INTRO = (
@@ -144,7 +169,7 @@ def _tradeoff(out: Path, cfg: dict) -> list[str]:
         "### Design trade-off",
         f"{len(ok)} cells, {int(ok.sum())} feasible; infeasible cells stay in `design.parquet` "
         "with the reason (" + ", ".join(f"{k}: {v}" for k, v in reasons.items()) + "). "
-        f"Measuring time: the paper's 60 and 90 minutes for 30 images, with "
+        f"Measuring time: {_time_words(cfg)}, with "
         f"{fmt(cfg['time.pass_min'])} min per plate position (not printed; a labelled example).",
         md_table(list(_DESIGN_COLS), _columns(d, tuple(_DESIGN_COLS.values()), pf)),
         f"The paper's design: {fmt(d['time_min'][jp])} min, worst sigma "

@@ -280,7 +280,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     # the unprinted inputs explored jointly (.region): the tolerances analytic, the external
     # comparisons on a small design of plates
     parts = {"tolerances": DR.tolerance_region(cfg, book), "plates": DR.plates_region(cfg, book)}
-    region_rows, region_table, region_inputs = DR.region_rows(book, parts)
+    region_rows, region_table, region_inputs = DR.region_rows(book, parts, cfg)
     R["design"] = _design(cfg, cols)
     R["time"] = (
         measuring_time(cfg, 4, cfg["time.images"], 1),

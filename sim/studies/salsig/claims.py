@@ -16,6 +16,7 @@ from sim.claims.intervals import share_ci, spread, std_ci
 from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.instruments import transforms2d as t2
 from sim.studies.salsig import printed as pr
+from sim.studies.salsig.wording import correction, level_text
 
 BOOK = Path(__file__).with_name("claims.toml")
 
@@ -169,7 +170,7 @@ def _recovery(cfg: dict, rec: dict) -> dict[str, Sim]:
             m,
             ci,
             note=f"share of simulated calibrations in which {what} "
-            f"differs from zero at the {100 * (1 - cfg['analysis.alpha']):g} % level "
+            f"differs from zero at the {level_text(cfg)} level "
             f"({design}); see power.png.",
         )
     for cid, key in (
@@ -202,7 +203,9 @@ def _zscale(cfg: dict, zs: dict) -> dict[str, Sim]:
             (float(sp[0]), float(sp[1])),
             "spread",
             note=f"standard error of S from the fit, um/digit ({cfg['zscale.points'] - 2} "
-            f"degrees of freedom); the 12.5 against 12.7 difference is {200 / m:.0f} of them.",
+            f"degrees of freedom); the {cfg['zscale.s_mm_per_digit']:g} against "
+            f"{cfg['b8.sx_mm_per_digit']:.4g} difference is "
+            f"{abs(cfg['b8.sx_mm_per_digit'] - cfg['zscale.s_mm_per_digit']) * 1e3 / m:.0f} of them.",
         ),
     }
 
@@ -216,7 +219,7 @@ def _vertical(book: ClaimBook, cfg: dict, vt: dict) -> dict[str, Sim]:
     table = {
         "salsig.vertical_halved.rms_ratio": plates(
             vt["ratio"],
-            f"rms vertical residual after / before multiplying z by 12.500/12.700, "
+            f"rms vertical residual after / before multiplying z by {correction(cfg)}, "
             f"7-parameter conformal fit per model; {vdesc}. The spread over models is the "
             "'one plate' question: the paper's data were some models.",
         )

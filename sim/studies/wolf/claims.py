@@ -17,6 +17,7 @@ from sim.claims.intervals import bootstrap_ci
 from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.mc.runner import chunk_rng
 from sim.studies.wolf.tables import STATS, recomputation, summary
+from sim.studies.wolf.wording import polynomial
 
 BOOK = Path(__file__).with_name("claims.toml")
 AXES = ("x", "y")
@@ -72,7 +73,8 @@ def _simulated_notes(cfg: dict) -> dict[str, str]:
         f"reduction; distribution over {T} simulated instruments. The field "
         "amplitudes (field.*) were chosen so these look like the paper's; "
         "these rows constrain the consistent region (consistent_region.parquet)",
-        "wolf.after.": f"residuals of the ten-term cubic fitted to the {S} pooled sets; "
+        "wolf.after.": f"residuals of the {polynomial(cfg['calib.degree'], True)} fitted to "
+        f"the {S} pooled sets; "
         f"distribution over {T} instruments",
         "wolf.repeatability.": f"{cfg['repeat.n_points']} points of a simulated P-30 photograph "
         f"read {cfg['repeat.gap_weeks']:g} week(s) apart, each set "
