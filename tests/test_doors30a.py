@@ -264,3 +264,28 @@ def test_design_region_notes_are_the_runs_zeiss_grid_and_accuracy():
     assert "25-point stand-in layout" in notes and "the grid's 0.5 um" in notes
     assert "= the accuracy (2 um)" in notes
     assert "33" not in notes and "0.8" not in notes
+
+
+def test_wolf_repeatability_photograph_is_the_runs_format():
+    """repeat.format_mm = [120, 90]: the repeatability rows' note said 'a simulated P-30
+    photograph' (the paper's 150 x 100 mm); it names the run's format."""
+    import sim.studies.wolf.claims as C
+    from sim.studies.wolf.schema import SCHEMA
+
+    cfg = {k: f.default for k, f in SCHEMA.items() if hasattr(f, "default")}
+    note = C._simulated_notes({**cfg, "repeat.format_mm": [120.0, 90.0]})["wolf.repeatability."]
+    assert "points of a simulated 120 x 90 mm photograph" in note
+    assert "simulated P-30 photograph" in C._simulated_notes(cfg)["wolf.repeatability."]
+
+
+def test_agnard_scanner_peaks_are_the_runs():
+    """scan.max_y_um = 30: every simulated scanner field peaks at the run's +-20 / +-30 um
+    (simulate.py), but the scanner region's lead and the Table 1 line said 'the printed
+    +-20 / +-40 um peaks' / 'peaking at the paper's +-20 / +-40 um'."""
+    from sim.studies.agnard.leads import peaks
+
+    R = import_module("sim.studies.agnard.report")
+    cfg = {"scan.max_x_um": 20.0, "scan.max_y_um": 30.0}
+    assert peaks(cfg) == "this run's +-20 / +-30 um peaks (printed: +-20 / +-40 um)"
+    assert "scaled to this run's +-20 / +-30 um peaks" in R._table1_line({}, cfg)
+    assert peaks({**cfg, "scan.max_y_um": 40.0}) == "the printed +-20 / +-40 um peaks"

@@ -14,7 +14,7 @@ from sim.lsq import distributions as D
 from sim.report.markdown import fmt, md_table
 from sim.report.section import config, rows, section, table
 from sim.studies.agnard.claims import WITHOUT_CENTRES
-from sim.studies.agnard.leads import five_lead, scanner_lead
+from sim.studies.agnard.leads import five_lead, peaks, scanner_lead
 from sim.studies.agnard.schema import SCHEMA
 
 __all__ = ["anisotropy_text", "findings", "model_choices", "report"]
@@ -57,10 +57,10 @@ def anisotropy_text(c: dict, out: Path, cfg: dict) -> str:
     )
 
 
-def _table1_line(c: dict) -> str:
+def _table1_line(c: dict, cfg: dict) -> str:
     lead = (
-        "- *Table 1* (not comparable: no input of the simulated scanner, peaking at the "
-        "paper's +-20 / +-40 um, reproduces it; see the scanner region above). "
+        "- *Table 1* (not comparable: no input of the simulated scanner, scaled to "
+        f"{peaks(cfg)}, reproduces it; see the scanner region above). "
     )
     g3, g6 = c.get("agnard.scanner.gain_300dpi_pct"), c.get("agnard.scanner.gain_600dpi_pct")
     if g3 is None or g6 is None:  # a resolution not in tradeoff.dpis: not simulated
@@ -181,7 +181,7 @@ def findings(out: Path) -> str:
     errata = [k for k, r in c.items() if r["verdict"] == "erratum"]
     return "\n".join(
         [
-            _table1_line(c),
+            _table1_line(c, cfg),
             *_claim_lines(c),
             _rejection_line(c, out),
             anisotropy_text(c, out, cfg),
@@ -416,7 +416,7 @@ def report(out: Path) -> str:
     cfg = config(out)["config"]
     return section(
         out,
-        lead=[*five_lead(out, cfg), *scanner_lead(out)],
+        lead=[*five_lead(out, cfg), *scanner_lead(out, cfg)],
         intro=[_block_text(cfg, out), model_choices(out), "**Findings.**\n" + findings(out)],
         schema=SCHEMA,
         body=[

@@ -17,7 +17,7 @@ from sim.claims.intervals import bootstrap_ci
 from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.mc.runner import chunk_rng
 from sim.studies.wolf.tables import STATS, recomputation, summary
-from sim.studies.wolf.wording import polynomial
+from sim.studies.wolf.wording import photograph, polynomial
 
 BOOK = Path(__file__).with_name("claims.toml")
 AXES = ("x", "y")
@@ -76,7 +76,8 @@ def _simulated_notes(cfg: dict) -> dict[str, str]:
         "wolf.after.": f"residuals of the {polynomial(cfg['calib.degree'], True)} fitted to "
         f"the {S} pooled sets; "
         f"distribution over {T} instruments",
-        "wolf.repeatability.": f"{cfg['repeat.n_points']} points of a simulated P-30 photograph "
+        "wolf.repeatability.": f"{cfg['repeat.n_points']} points of a simulated "
+        f"{photograph(cfg['repeat.format_mm'])} photograph "
         f"read {cfg['repeat.gap_weeks']:g} week(s) apart, each set "
         "corrected and fitted to its four fiducials; the default pointing "
         "sigma was chosen from these; they constrain the consistent region",

@@ -1,6 +1,7 @@
-"""How the texts of ``wolf_polynomial`` name the run's correction polynomial (``calib.degree``):
-the paper's ten-term cubic at degree 3, the run's own otherwise (a six-term quadratic at 2),
-never the paper's where the run changed it."""
+"""How the texts of ``wolf_polynomial`` name the run's correction polynomial (``calib.degree``:
+the paper's ten-term cubic at degree 3, the run's own otherwise, a six-term quadratic at 2)
+and its photograph (``repeat.format_mm``: the paper's P-30 at 150 x 100 mm), never the paper's
+where the run changed it."""
 
 from __future__ import annotations
 
@@ -21,3 +22,13 @@ def polynomial(degree: int, counted: bool = False) -> str:
         return name
     n = terms(int(degree))
     return f"{_WORDS.get(n, n)}-term {name}"
+
+
+#: the P-30 phototheodolite's format (mm), the paper's photographs of Tables 1 and 2
+P30_MM = (150.0, 100.0)
+
+
+def photograph(format_mm) -> str:
+    """``"P-30"`` for the paper's 150 x 100 mm format, else ``"120 x 90 mm"``."""
+    w, h = (float(v) for v in format_mm)
+    return "P-30" if (w, h) == P30_MM else f"{w:g} x {h:g} mm"
