@@ -153,7 +153,8 @@ def _agnard_layout(monkeypatch, R, many: int, few: int) -> None:
 def test_agnard_counts_the_runs_many_point_control(monkeypatch):
     """A 2 x 6 block over 120 points: the 'full' layout has 15 control points, but the
     scanner trade-off's figure title and table heading, the layout figure's legend and the
-    gain rows' notes said 21 (the paper's); they count the run's."""
+    gain rows' notes said 21 (the paper's); they count the run's (the committed
+    agnard_block_104's 4 x 26 block has 105, its README said '(21 control')."""
     import sim.studies.agnard.figures as F
 
     R = import_module("sim.studies.agnard.report")
