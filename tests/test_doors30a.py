@@ -290,3 +290,16 @@ def test_agnard_scanner_peaks_are_the_runs():
     assert peaks(cfg) == "this run's +-20 / +-30 um peaks (printed: +-20 / +-40 um)"
     assert "scaled to this run's +-20 / +-30 um peaks" in R._table1_line({}, cfg)
     assert peaks({**cfg, "scan.max_y_um": 40.0}) == "the printed +-20 / +-40 um peaks"
+
+
+def test_design_datum_geometry_is_named_the_runs():
+    """datum.grid = 4: the datum rows and the scale-length note computed on the run's
+    +-67.5 mm grid but called it brown_dilution's (a 5 x 5 grid at +-90 mm)."""
+    from sim.studies.design.run import _scale_length
+    from sim.studies.design.schema import SCHEMA, datum_geometry
+
+    cfg = {k: f.default for k, f in SCHEMA.items() if hasattr(f, "default")}
+    assert datum_geometry(cfg) == "brown_dilution's"
+    cfg["datum.grid"] = 4
+    note = _scale_length(cfg)["brown.design.max_offset_dilution_grid_mm"][1]
+    assert note.startswith("the same for the run's datum.* +-67.5 mm grid")

@@ -12,12 +12,12 @@ import numpy as np
 from sim.instruments.ranges import brown as B
 from sim.report.section import config, figure, region_lead, section, table
 from sim.report.tables import fmt, md_table
-from sim.studies.design.schema import SCHEMA
+from sim.studies.design.schema import SCHEMA, datum_geometry
 
 __all__ = ["report"]
 
 
-def _datum_findings(V, VH, feas_note):
+def _datum_findings(V, VH, feas_note, whose: str):
     g = lambda k: (V.get(k, np.nan), VH.get(k, np.nan))  # noqa: E731
     (bl, bh), (il, ih), (cl, ch) = (
         g(f"brown.datum.{d}.stations_pct") for d in ("brown", "invariant", "corners")
@@ -28,7 +28,7 @@ def _datum_findings(V, VH, feas_note):
     )
     return (
         f"* *Datum of the dilution* (findings, not scored against Brown's sentence): in "
-        f"Brown's datum the `stations` dilution of brown_dilution's geometry is "
+        f"Brown's datum the `stations` dilution of {whose} geometry is "
         f"{bl:.1f}-{bh:.1f} %; after the S-transformation to inner constraints over the points "
         f"it is {il:.1f}-{ih:.1f} %, after a similarity onto the four corners {cl:.1f}-{ch:.1f} %. "
         f"So {100 * (1 - ih / bh):.0f} % of the largest and {100 * (1 - il / bl):.0f} % of the "
@@ -102,7 +102,7 @@ _INTRO = (
 )
 
 
-def _findings(out: Path) -> str:
+def _findings(out: Path, cfg: dict) -> str:
     """The findings bullets: datum of the dilution, scale length, design, error budget."""
     cl = table(out, "claims.parquet")
     V = dict(zip(cl["claim"], cl["value"]))
@@ -117,11 +117,11 @@ def _findings(out: Path) -> str:
         "range does not fit on the scale plus micrometer; the rows are findings.)"
     )
     bullets = [
-        _datum_findings(V, VH, feas_note),
+        _datum_findings(V, VH, feas_note, datum_geometry(cfg)),
         f"* *Scale length.* With every range on the scale plus micrometer the stations can stand "
         f"at most {fmt(V.get('brown.design.max_offset_paper_grid_mm'))} mm outside the midsides "
         f"for Table 1's grid and {fmt(V.get('brown.design.max_offset_dilution_grid_mm'))} mm "
-        "for brown_dilution's. Verdicts use feasible designs only.",
+        f"for {datum_geometry(cfg)} grid. Verdicts use feasible designs only.",
         f"* *Design.* {N.get('brown.design.paper_on_front_same_points', '')}.",
         f"* *Error budget.* Setting error alone {fmt(bud.get('setting'))} um rms after a rigid "
         f"fit; calibrated scale {fmt(bud.get('scale'))} um, uncalibrated scale at its "
@@ -305,7 +305,7 @@ def report(out: Path) -> str:
     return section(
         out,
         lead=_lead(out, cfg),
-        intro=[_INTRO, _findings(out)],
+        intro=[_INTRO, _findings(out, cfg)],
         schema=SCHEMA,
         body=[
             *_tradeoff(out, cfg),

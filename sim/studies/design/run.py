@@ -41,7 +41,7 @@ from sim.studies.design.external import external_at
 from sim.studies.design.formal import coverage_analysis
 from sim.studies.design.parts import side_by_side
 from sim.studies.design.posterior import bayes_analysis, twoplate_analysis
-from sim.studies.design.schema import SCHEMA
+from sim.studies.design.schema import SCHEMA, datum_geometry
 from sim.studies.run_steps import run_part
 
 __all__ = ["run"]
@@ -111,7 +111,7 @@ def _scale_length(cfg) -> dict:
         "brown.design.max_offset_dilution_grid_mm": (
             max_offset_mm(cfg, ext_d),
             (
-                f"the same for brown_dilution's +-{ext_d:g} mm grid (its station offset is "
+                f"the same for {datum_geometry(cfg)} +-{ext_d:g} mm grid (its station offset is "
                 f"{cfg['datum.offset_mm']:g} mm)"
             ),
         ),
