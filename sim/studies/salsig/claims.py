@@ -16,7 +16,7 @@ from sim.claims.intervals import share_ci, spread, std_ci
 from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.instruments import transforms2d as t2
 from sim.studies.salsig import printed as pr
-from sim.studies.salsig.wording import correction, level_text
+from sim.studies.salsig.wording import b8_printed, correction, level_text, sigma_set
 
 BOOK = Path(__file__).with_name("claims.toml")
 
@@ -137,11 +137,12 @@ def _recovery(cfg: dict, rec: dict) -> dict[str, Sim]:
         f"{cfg['marks.grid'] ** 2} marks, B8 error {cfg['b8.sigma_um']:g} um, comparator "
         f"{cfg['comparator.sigma_um']:g} um"
     )
+    truth = "printed FIG. 3" if b8_printed(cfg) else "run's b8.*"
     table = {
         cid: plates(
             rec[key],
             f"recovered over simulated calibrations ({design}); the truth is the "
-            "printed FIG. 3 value (input), so this shows the spread of one calibration: "
+            f"{truth} value (input), so this shows the spread of one calibration: "
             f"sd {np.std(rec[key], ddof=1):.3g}.",
         )
         for cid, key in (
@@ -154,12 +155,12 @@ def _recovery(cfg: dict, rec: dict) -> dict[str, Sim]:
         rec["s0_fig3_digits"],
         "a-posteriori unit-weight error of the B8 -> grid affine in the units of "
         "the observed system X2 (B8 digits), as the program's residuals VX2, VY2 "
-        f"are ({design}); b8.sigma_um is not printed: set to reproduce the .002 (an input).",
+        f"are ({design}); {sigma_set(cfg, 'b8.sigma_um', '.002')}.",
     )
     table["salsig.recovery.s0_fig2_mm"] = plates(
         rec["s0_fig2_mm"],
         "unit-weight error of the comparator -> grid affine (mm); "
-        "comparator.sigma_um is not printed: set to reproduce the .003 (an input).",
+        f"{sigma_set(cfg, 'comparator.sigma_um', '.003')}.",
     )
     for cid, key, what in (
         ("salsig.recovery.power_E", "detect_E", "E"),

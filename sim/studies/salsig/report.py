@@ -8,9 +8,8 @@ from pathlib import Path
 
 from sim.report.section import config, errata, figure, region_lead, rows, section, table
 from sim.report.tables import fmt, md_table
-from sim.studies.salsig.printed import FIG3_PRINTED
 from sim.studies.salsig.schema import SCHEMA
-from sim.studies.salsig.wording import correction, level_text
+from sim.studies.salsig.wording import b8_printed, correction, level_text
 
 _CONVENTIONS = (
     "**Conventions.** Salsig's program prints the affine `X1 = A X2 + B Y2 + C`, "
@@ -41,9 +40,8 @@ def _chain(cfg: dict) -> str:
 
 
 def _as_printed(cfg: dict) -> str:
-    """ ", as printed in FIG. 3" where the run's B8 affine is the paper's, else ""."""
-    run = (cfg["b8.sx_mm_per_digit"], cfg["b8.sy_mm_per_digit"], cfg["b8.e_arcsec"])
-    return ", as printed in FIG. 3" if run == FIG3_PRINTED else ""
+    """The words ", as printed in FIG. 3" where the run's B8 affine is the paper's."""
+    return ", as printed in FIG. 3" if b8_printed(cfg) else ""
 
 
 def _power(out: Path, cfg: dict) -> list[str]:
