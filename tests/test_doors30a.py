@@ -322,3 +322,22 @@ def test_salsig_recovery_notes_name_the_runs_truth_and_sigmas():
     note3 = rows["salsig.recovery.s0_fig3_digits"].note
     assert "b8.sigma_um is not printed: this run's 20 um (the default 25 reproduces" in note3
     assert "set to reproduce the .003" in rows["salsig.recovery.s0_fig2_mm"].note
+
+
+def test_agnard_recentring_is_not_said_to_match_when_the_run_changed_it(monkeypatch):
+    """pugging.recentre_px = 0.7: the mechanical rejection row and the report said the
+    unprinted re-centring error 'is set so the share matches' the paper's; the run's is not."""
+    from sim.studies.agnard.schema import SCHEMA, recentre_words
+
+    cfg = {"pugging.recentre_px": 0.7}
+    assert recentre_words(cfg).startswith("unprinted: this run's 0.7 px, the default 0.5 px")
+    default = {"pugging.recentre_px": SCHEMA["pugging.recentre_px"].default}
+    assert recentre_words(default) == "unprinted, set so the share matches the paper: an input"
+    R = import_module("sim.studies.agnard.report")
+    monkeypatch.setattr(
+        R, "table", lambda out, name: {"recentre_px": [0.7], "mean_share_pct": [20.0]}
+    )
+    row = {"value": 1.0, "value_high": None, "verdict": "finding"}
+    c = {"agnard.pass_rejections.digital": row, "agnard.pass_rejections.mechanical_pct": row}
+    line = R._rejection_line(c, Path("/nonexistent"), cfg)
+    assert "(the re-centring error unprinted: this run's 0.7 px" in line

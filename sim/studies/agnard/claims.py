@@ -19,7 +19,7 @@ from sim.claims.table import Sim, exact, mc, plates
 from sim.claims.table import claim_rows as table_rows
 from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import Block
-from sim.studies.agnard.schema import model_sigmas, pixel_ground_m
+from sim.studies.agnard.schema import model_sigmas, pixel_ground_m, recentre_words
 from sim.studies.agnard.table1_rows import table1_rows
 
 BOOK = Path(__file__).with_name("claims.toml")
@@ -342,7 +342,7 @@ def rejection_rows(
                 f"{'no gross errors' if not cfg['pugging.gross_rate'] else 'gross errors'} at "
                 f"pugging.gross_rate {cfg['pugging.gross_rate']:g}; hole transfer "
                 f"{cfg['pugging.transfer_um']:g} um, re-centring {cfg['pugging.recentre_px']:g} px "
-                f"per photo: unprinted, set so the share matches the paper: an input); {_where(ref(book, 'agnard.pass_rejections.mechanical_pct'), sh)}; "
+                f"per photo: {recentre_words(cfg)}); {_where(ref(book, 'agnard.pass_rejections.mechanical_pct'), sh)}; "
                 f"mean share against the re-centring error: {sens}"
             ),
         ),

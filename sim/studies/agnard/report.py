@@ -15,7 +15,7 @@ from sim.report.markdown import fmt, md_table
 from sim.report.section import config, rows, section, table
 from sim.studies.agnard.claims import WITHOUT_CENTRES
 from sim.studies.agnard.leads import five_lead, peaks, scanner_lead
-from sim.studies.agnard.schema import SCHEMA
+from sim.studies.agnard.schema import SCHEMA, recentre_words
 
 __all__ = ["anisotropy_text", "findings", "model_choices", "report"]
 
@@ -146,7 +146,7 @@ def _claim_lines(c: dict) -> list[str]:
     ]
 
 
-def _rejection_line(c: dict, out: Path) -> str:
+def _rejection_line(c: dict, out: Path, cfg: dict) -> str:
     """Digital and mechanical pass-point rejections, and the re-centring sensitivity."""
     pt = table(out, "tradeoff_pugging.parquet")
     sens = ", ".join(
@@ -169,7 +169,7 @@ def _rejection_line(c: dict, out: Path) -> str:
         f"{_span(dig)} pass points per block{over} "
         f"(*{dig['verdict']}*); mechanical pugging "
         f"{fmt(mech['value'])} % "
-        "(an input: the unprinted re-centring error is set so the share matches), mean "
+        f"(the re-centring error {recentre_words(cfg)}), mean "
         f"share against that re-centring error: {sens}."
     )
 
@@ -183,7 +183,7 @@ def findings(out: Path) -> str:
         [
             _table1_line(c, cfg),
             *_claim_lines(c),
-            _rejection_line(c, out),
+            _rejection_line(c, out, cfg),
             anisotropy_text(c, out, cfg),
             f"- *Errata* (paper-checks the paper's own printed data contradict): {len(errata)}: "
             + (", ".join(e.replace("agnard.", "") for e in errata) or "none")
