@@ -279,6 +279,19 @@ def test_wolf_repeatability_photograph_is_the_runs_format():
     assert "simulated P-30 photograph" in C._simulated_notes(cfg)["wolf.repeatability."]
 
 
+def test_wolf_before_rows_do_not_claim_the_runs_amplitudes_were_fitted():
+    """field.stress_um = 20: the 'before' rows' note said the field amplitudes 'were chosen
+    so these look like the paper's' (true of the defaults only); it names the changed keys."""
+    import sim.studies.wolf.claims as C
+    from sim.studies.wolf.schema import SCHEMA
+
+    cfg = {k: f.default for k, f in SCHEMA.items() if hasattr(f, "default")}
+    note = C._simulated_notes({**cfg, "field.stress_um": 20.0})["wolf.before."]
+    assert "This run's field amplitudes differ from the defaults" in note
+    assert "(field.stress_um)" in note
+    assert "were chosen so these look" in C._simulated_notes(cfg)["wolf.before."]
+
+
 def test_agnard_scanner_peaks_are_the_runs():
     """scan.max_y_um = 30: every simulated scanner field peaks at the run's +-20 / +-30 um
     (simulate.py), but the scanner region's lead and the Table 1 line said 'the printed

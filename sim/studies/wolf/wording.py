@@ -5,6 +5,8 @@ where the run changed it."""
 
 from __future__ import annotations
 
+from sim.studies.wolf.schema import SCHEMA
+
 _NAMES = {1: "linear polynomial", 2: "quadratic", 3: "cubic", 4: "quartic", 5: "quintic"}
 _WORDS = {3: "three", 6: "six", 10: "ten", 15: "fifteen", 21: "twenty-one"}
 
@@ -32,3 +34,16 @@ def photograph(format_mm) -> str:
     """``"P-30"`` for the paper's 150 x 100 mm format, else ``"120 x 90 mm"``."""
     w, h = (float(v) for v in format_mm)
     return "P-30" if (w, h) == P30_MM else f"{w:g} x {h:g} mm"
+
+
+def amplitudes(cfg: dict) -> str:
+    """How the field amplitudes (``field.*_um``) came about: the defaults were chosen so the
+    'before' rows look like the paper's; a run with other amplitudes says so."""
+    keys = [k for k in SCHEMA if k.startswith("field.") and k.endswith("_um")]
+    changed = [k for k in keys if cfg[k] != SCHEMA[k].default]
+    if not changed:
+        return "The field amplitudes (field.*) were chosen so these look like the paper's"
+    return (
+        f"This run's field amplitudes differ from the defaults chosen so these look like the "
+        f"paper's ({', '.join(changed)})"
+    )
