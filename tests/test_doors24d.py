@@ -53,6 +53,7 @@ from sim.studies.wolf import claims as wolf_claims
 from sim.studies.wolf.claims import _cubic_excess
 
 GAIN = "agnard.scanner.gain_{}dpi_pct"
+CFG = {"scan.max_x_um": 20.0, "scan.max_y_um": 40.0}
 
 
 def _scan(dpis):
@@ -67,19 +68,19 @@ def _scan(dpis):
 
 
 def test_a_resolution_not_simulated_has_no_gain_row():
-    rows = scanner_rows(_scan([600.0]))
+    rows = scanner_rows(_scan([600.0]), 21)
     assert rows[GAIN.format(300)] is None
     assert rows[GAIN.format(600)].value == 5.5
-    both = scanner_rows(_scan([300.0, 600.0]))
+    both = scanner_rows(_scan([300.0, 600.0]), 21)
     assert both[GAIN.format(300)].value == 5.5 and both[GAIN.format(300)].ci[0] < 5.5
 
 
 def test_the_report_does_not_compare_a_gain_nothing_simulated():
     g6 = {"value": 5.6, "ci_low": 4.5, "ci_high": 6.6}
-    line = _table1_line({GAIN.format(600): g6})
+    line = _table1_line({GAIN.format(600): g6}, CFG)
     assert "lacks 300 DPI" in line and "0 % at 300" not in line and "lies above" not in line
     g3 = {"value": 1.0, "ci_low": 0.5, "ci_high": 1.5}
-    line = _table1_line({GAIN.format(300): g3, GAIN.format(600): g6})
+    line = _table1_line({GAIN.format(300): g3, GAIN.format(600): g6}, CFG)
     assert "1.0 % at 300 DPI and 5.6 % at 600 DPI" in line and "lies above" in line
 
 

@@ -282,8 +282,9 @@ def test_checking_a_figure_leaves_its_png_unchanged(tiny_run, tmp_path):
         d.mkdir()
         for f in shared.glob("*.parquet"):
             (d / f.name).symlink_to(f)
+    cfg = json.loads((shared / "run.json").read_text())["config"]
     for name, draw_it in (
-        ("vectors.png", wolf_figures.vectors_figure),
+        ("vectors.png", lambda d: wolf_figures.vectors_figure(cfg, d)),
         ("table1_real.png", wolf_figures.table1_figure),
     ):
         draw_it(plain)

@@ -91,6 +91,8 @@ def sim_text(r) -> str:
 def interval_text(r) -> str:
     if r["interval"] == "exact":
         return "exact"
+    if r.get("ci_low") is None and r.get("ci_high") is None:
+        return "—"  # a region row with no point to take values from (not "[, ]")
     dec = decimals_for(r.get("ci_low"), r.get("ci_high"))
     out = f"[{fmt_at(r['ci_low'], dec)}, {fmt_at(r['ci_high'], dec)}]" + (
         " plates" if r["interval"] == "spread" else ""

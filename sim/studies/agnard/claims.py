@@ -19,7 +19,7 @@ from sim.claims.table import Sim, exact, mc, plates
 from sim.claims.table import claim_rows as table_rows
 from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import Block
-from sim.studies.agnard.schema import model_sigmas, pixel_ground_m
+from sim.studies.agnard.schema import model_sigmas, pixel_ground_m, recentre_words
 from sim.studies.agnard.table1_rows import table1_rows
 
 BOOK = Path(__file__).with_name("claims.toml")
@@ -76,7 +76,9 @@ def scored_ids(cfg: dict, book: ClaimBook) -> list[str]:
     ]
 
 
-def scanner_rows(scan_t: dict) -> dict[str, Sim]:
+def scanner_rows(scan_t: dict, n_many: int) -> dict[str, Sim]:
+    """The calibration's gains at 300 and 600 DPI, on the ``n_many`` control points of the
+    ``control.many`` pass (the paper's 21)."""
     rows = {}
     dpi = np.asarray(scan_t["dpi"])
     cal = np.asarray(scan_t["calibration"])
@@ -90,7 +92,7 @@ def scanner_rows(scan_t: dict) -> dict[str, Sim]:
             scan_t["gain_xy_pct"][i[0]],
             scan_t["gain_xy_pct_se"][i[0]],
             f"reduction of the check-point XY rms by the grid calibration at {d:g} DPI "
-            f"(21 control; mean over {scan_t['trials'][i[0]]} blocks of the per-block relative "
+            f"({n_many} control; mean over {scan_t['trials'][i[0]]} blocks of the per-block relative "
             "gain, the same measurements with and without; 95 % confidence interval)",
         )
     return rows
@@ -340,7 +342,7 @@ def rejection_rows(
                 f"{'no gross errors' if not cfg['pugging.gross_rate'] else 'gross errors'} at "
                 f"pugging.gross_rate {cfg['pugging.gross_rate']:g}; hole transfer "
                 f"{cfg['pugging.transfer_um']:g} um, re-centring {cfg['pugging.recentre_px']:g} px "
-                f"per photo: unprinted, set so the share matches the paper: an input); {_where(ref(book, 'agnard.pass_rejections.mechanical_pct'), sh)}; "
+                f"per photo: {recentre_words(cfg)}); {_where(ref(book, 'agnard.pass_rejections.mechanical_pct'), sh)}; "
                 f"mean share against the re-centring error: {sens}"
             ),
         ),
@@ -396,7 +398,7 @@ def claim_rows(
     """Every claim of the book, scored once (Table 1 over the ``scanner`` region, with the
     per-vector statistics ``scanner_stats``)."""
     table = {
-        **scanner_rows(scan_t),
+        **scanner_rows(scan_t, len(c21)),
         **input_rows(book, cfg, block, c5, c21),
         **budget_rows(book, cfg),
         **tables23_rows(book, cfg, block, sim, c5, c21),

@@ -80,7 +80,13 @@ def fig_layout(block: Block, ctrl5, ctrl21, path: Path, sweep_ctrl=(), insets=()
     _stereo_areas(ax, block)
     P = block.points
     chk = np.setdiff1d(np.arange(block.n_ground), ctrl21)
-    ax.plot(*P[chk, :2].T, ".", color="0.45", ms=4, label=f"check ({chk.size} with 21 control)")
+    ax.plot(
+        *P[chk, :2].T,
+        ".",
+        color="0.45",
+        ms=4,
+        label=f"check ({chk.size} with {ctrl21.size} control)",
+    )
     npass = int(block.is_pass.sum())
     ax.plot(*P[block.is_pass, :2].T, "x", color="tab:green", ms=5, label=f"pass points ({npass})")
     ax.plot(
@@ -152,7 +158,7 @@ def fig_residuals(vec: dict, path: Path) -> None:
     save(fig, path)
 
 
-def _scan_panel(ax, scan_t: dict) -> None:
+def _scan_panel(ax, scan_t: dict, n_many: int) -> None:
     dpi = np.asarray(scan_t["dpi"])
     for cal, mk in (("raw", "o--"), ("corrected", "s-")):
         sel = np.asarray(scan_t["calibration"]) == cal
@@ -171,7 +177,7 @@ def _scan_panel(ax, scan_t: dict) -> None:
     ax.minorticks_off()
     ax.set_xlabel("scan resolution (DPI)")
     ax.set_ylabel("rms error at check points (m)")
-    ax.set_title("scanner resolution and calibration (21 control)")
+    ax.set_title(f"scanner resolution and calibration ({n_many} control)")
 
 
 def _layout_panel(ax, lay_t: dict) -> None:
@@ -223,11 +229,12 @@ def _size_panel(ax, size_t: dict) -> None:
         )
 
 
-def fig_tradeoffs(scan_t: dict, lay_t: dict, size_t: dict, path: Path) -> None:
+def fig_tradeoffs(scan_t: dict, lay_t: dict, size_t: dict, n_many: int, path: Path) -> None:
     """The trade-offs (rms errors in m, with their Monte-Carlo standard errors): scanner
-    resolution and calibration, control layout, block size."""
+    resolution and calibration (on the ``n_many`` control points of ``control.many``), control
+    layout, block size."""
     fig, axs = plt.subplots(1, 3, figsize=(15, 4.6), layout="constrained")
-    _scan_panel(axs[0], scan_t)
+    _scan_panel(axs[0], scan_t, n_many)
     _layout_panel(axs[1], lay_t)
     _size_panel(axs[2], size_t)
     for ax in axs:

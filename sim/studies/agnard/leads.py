@@ -12,6 +12,7 @@ from pathlib import Path
 
 from sim.report.markdown import fmt, md_table
 from sim.report.section import figure, region_lead, rows, table
+from sim.studies.agnard.schema import SCHEMA
 
 __all__ = ["five_lead", "scanner_lead", "HOW"]
 
@@ -57,15 +58,31 @@ def five_lead(out: Path, cfg: dict) -> list[str]:
     return [lead, figure(out, "consistent_region.png", "consistent region")]
 
 
-def scanner_lead(out: Path) -> list[str]:
+def peaks(cfg: dict) -> str:
+    """The peaks every simulated scanner field is scaled to (``scan.max_*_um``): "the printed
+    +-20 / +-40 um peaks", or the run's with the paper's beside them."""
+    keys = ("scan.max_x_um", "scan.max_y_um")
+    run = "+-{:g} / +-{:g} um".format(*(cfg[k] for k in keys))
+    paper = "+-{:g} / +-{:g} um".format(*(SCHEMA[k].default for k in keys))
+    return (
+        f"the printed {paper} peaks"
+        if run == paper
+        else f"this run's {run} peaks (printed: {paper})"
+    )
+
+
+def scanner_lead(out: Path, cfg: dict) -> list[str]:
     """The scanner region's section and figure (none for results written before the scanner
     region existed)."""
     if not (out / "scanner_region.parquet").is_file():
         return []
-    return [_scanner_region(out), figure(out, "scanner_region.png", "scanner region under Table 1")]
+    return [
+        _scanner_region(out, cfg),
+        figure(out, "scanner_region.png", "scanner region under Table 1"),
+    ]
 
 
-def _scanner_region(out: Path) -> str:
+def _scanner_region(out: Path, cfg: dict) -> str:
     """The scanner's unprinted inputs under Table 1 (``scanner_region*.parquet``): per input its
     possible range, what Table 1 leaves, the design's resolution; then the conflicts."""
     inp = rows(out, "scanner_region_inputs.parquet")
@@ -100,7 +117,7 @@ def _scanner_region(out: Path) -> str:
         [
             f"**Scanner region under Table 1** (`scanner_region.parquet`, {n} vectors explored "
             "jointly, each adjusting the same simulated blocks without and with the grid "
-            "correction; every field scaled to the printed +-20 / +-40 um peaks): " + verdict,
+            f"correction; every field scaled to {peaks(cfg)}): " + verdict,
             "",
             md_table(["input", "possible", "left by Table 1", "resolution", "why"], body),
         ]

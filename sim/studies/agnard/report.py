@@ -14,8 +14,8 @@ from sim.lsq import distributions as D
 from sim.report.markdown import fmt, md_table
 from sim.report.section import config, rows, section, table
 from sim.studies.agnard.claims import WITHOUT_CENTRES
-from sim.studies.agnard.leads import five_lead, scanner_lead
-from sim.studies.agnard.schema import SCHEMA
+from sim.studies.agnard.leads import five_lead, peaks, scanner_lead
+from sim.studies.agnard.schema import SCHEMA, recentre_words
 
 __all__ = ["anisotropy_text", "findings", "model_choices", "report"]
 
@@ -57,10 +57,10 @@ def anisotropy_text(c: dict, out: Path, cfg: dict) -> str:
     )
 
 
-def _table1_line(c: dict) -> str:
+def _table1_line(c: dict, cfg: dict) -> str:
     lead = (
-        "- *Table 1* (not comparable: no input of the simulated scanner, peaking at the "
-        "paper's +-20 / +-40 um, reproduces it; see the scanner region above). "
+        "- *Table 1* (not comparable: no input of the simulated scanner, scaled to "
+        f"{peaks(cfg)}, reproduces it; see the scanner region above). "
     )
     g3, g6 = c.get("agnard.scanner.gain_300dpi_pct"), c.get("agnard.scanner.gain_600dpi_pct")
     if g3 is None or g6 is None:  # a resolution not in tradeoff.dpis: not simulated
@@ -146,7 +146,7 @@ def _claim_lines(c: dict) -> list[str]:
     ]
 
 
-def _rejection_line(c: dict, out: Path) -> str:
+def _rejection_line(c: dict, out: Path, cfg: dict) -> str:
     """Digital and mechanical pass-point rejections, and the re-centring sensitivity."""
     pt = table(out, "tradeoff_pugging.parquet")
     sens = ", ".join(
@@ -169,7 +169,7 @@ def _rejection_line(c: dict, out: Path) -> str:
         f"{_span(dig)} pass points per block{over} "
         f"(*{dig['verdict']}*); mechanical pugging "
         f"{fmt(mech['value'])} % "
-        "(an input: the unprinted re-centring error is set so the share matches), mean "
+        f"(the re-centring error {recentre_words(cfg)}), mean "
         f"share against that re-centring error: {sens}."
     )
 
@@ -181,9 +181,9 @@ def findings(out: Path) -> str:
     errata = [k for k, r in c.items() if r["verdict"] == "erratum"]
     return "\n".join(
         [
-            _table1_line(c),
+            _table1_line(c, cfg),
             *_claim_lines(c),
-            _rejection_line(c, out),
+            _rejection_line(c, out, cfg),
             anisotropy_text(c, out, cfg),
             f"- *Errata* (paper-checks the paper's own printed data contradict): {len(errata)}: "
             + (", ".join(e.replace("agnard.", "") for e in errata) or "none")
@@ -264,14 +264,15 @@ def _adjustment_choice(cfg: dict, prov: dict, out: Path) -> str:
         "batched over trials for small blocks and as a sparse matrix from "
         f"{prov.get('sparse_from_models')} models up (the largest block "
         f"of the size trade-off has {max(bt['n_models'])} models); Gauss-Newton to 0.01 mm. "
-        "Weights as "
-        f"in the paper: control {cfg['weights.control_xy']:g} (XY) and "
+        f"Weights{_as_in_paper(cfg)}: control {cfg['weights.control_xy']:g} (XY) and "
         f"{cfg['weights.control_z']:g} (Z) against {cfg['weights.pass']:g} on model points; the "
         f"first pass {cfg['weights.first_pass_control']:g} on control against "
         f"{cfg['weights.first_pass_pass']:g}. Control coordinates carry "
         f"{100 * cfg['measure.control_sigma_m']:g} cm survey error. The seed's Figures 4-5 "
-        f"(control layouts) are lost: the 21-point pass uses the '{cfg['control.many']}' layout "
-        f"and the 5-point pass the '{cfg['control.few']}' layout (see the block figure); the "
+        f"(control layouts) are lost: the paper's 21-point pass uses the '{cfg['control.many']}' "
+        f"layout ({_n_many(out)} points in this block) and its 5-point pass the "
+        f"'{cfg['control.few']}' layout ({_n_many(out, 'control_few')} points; see the block "
+        "figure); the "
         "five-point layout is explored in the consistent region above."
     )
 
@@ -312,6 +313,19 @@ def _se(r: dict, q: str) -> str:
     return f"{fmt(r[q])} ± {fmt(r[q + '_se'], 2)}"
 
 
+def _n_many(out: Path, kind: str = "control_many") -> int:
+    """Control points of the ``control.many`` pass (the paper's 21; ``kind="control_few"``:
+    of the ``control.few`` pass, the paper's 5), from ``layout.parquet``."""
+    kinds = np.asarray(table(out, "layout.parquet")["kind"])
+    return int(np.isin(kinds, (kind, "control_both")).sum())
+
+
+def _as_in_paper(cfg: dict) -> str:
+    """ " as in the paper" where every ``weights.*`` key is the paper's, else ""."""
+    keys = [k for k in SCHEMA if k.startswith("weights.")]
+    return " as in the paper" if all(cfg[k] == SCHEMA[k].default for k in keys) else ""
+
+
 def _scanner_table(out: Path) -> list[str]:
     """Trade-off of scan resolution and calibration (``tradeoff_scanner.parquet``)."""
     body = [
@@ -331,12 +345,13 @@ def _scanner_table(out: Path) -> list[str]:
     header = ["DPI", "calibration", "trials", "check XY (m)", "check Z (m)"]
     header += ["control XY (m)", "control Z (m)", "XY gain of calibration (%)"]
     return [
-        "**Trade-off: scan resolution and calibration** (21 control, mean rms over trials ± s.e.):",
+        f"**Trade-off: scan resolution and calibration** ({_n_many(out)} control, mean rms over "
+        "trials ± s.e.):",
         md_table(header, body),
     ]
 
 
-def _layout_table(out: Path) -> list[str]:
+def _layout_table(out: Path, cfg: dict) -> list[str]:
     """Trade-off of the control layout (``tradeoff_control.parquet``)."""
     header = ["layout", "control", "check XY (m)", "check Z (m)", "control XY (m)", "control Z (m)"]
     body = [
@@ -351,7 +366,8 @@ def _layout_table(out: Path) -> list[str]:
         for r in rows(out, "tradeoff_control.parquet")
     ]
     return [
-        "**Trade-off: control layout** (600 DPI calibrated, same trials as the claims):",
+        f"**Trade-off: control layout** ({cfg['scan.dpi']:g} DPI calibrated, same trials as the "
+        "claims):",
         md_table(header, body),
     ]
 
@@ -400,12 +416,12 @@ def report(out: Path) -> str:
     cfg = config(out)["config"]
     return section(
         out,
-        lead=[*five_lead(out, cfg), *scanner_lead(out)],
+        lead=[*five_lead(out, cfg), *scanner_lead(out, cfg)],
         intro=[_block_text(cfg, out), model_choices(out), "**Findings.**\n" + findings(out)],
         schema=SCHEMA,
         body=[
             *_scanner_table(out),
-            *_layout_table(out),
+            *_layout_table(out, cfg),
             *_block_table(out, cfg),
             *_pugging_table(out),
         ],

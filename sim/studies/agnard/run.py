@@ -308,7 +308,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     write_claims(out / "claims.parquet", dc.without_snooping(cfg, rows), prov, book, SCHEMA)
     draw(
         [
-            (fg.fig_tradeoffs, (scan_t, lay_t, size_t, out / "tradeoffs.png")),
+            (fg.fig_tradeoffs, (scan_t, lay_t, size_t, c21.size, out / "tradeoffs.png")),
             (fg.fig_layout, (block, c5, c21, out / "block_layout.png", ctrl_idx, insets)),
         ]
     )

@@ -364,3 +364,16 @@ def nearest_points(block: Block, targets: np.ndarray) -> np.ndarray:
 
 def five_control(block: Block, inset: float) -> np.ndarray:
     return nearest_points(block, five_targets(block, inset))
+
+
+def recentre_words(cfg: dict) -> str:
+    """Why ``pugging.recentre_px`` (unprinted) has its value: the default is set so the share
+    of pass points mechanical pugging removes matches the paper's; a run with another value
+    says so rather than claim the match."""
+    key = "pugging.recentre_px"
+    if cfg[key] == SCHEMA[key].default:
+        return "unprinted, set so the share matches the paper: an input"
+    return (
+        f"unprinted: this run's {cfg[key]:g} px, the default {SCHEMA[key].default:g} px is set "
+        "so the share matches the paper"
+    )

@@ -61,7 +61,7 @@ EXTERNAL = {
     "brown.results.zeiss_discrepancy_um": (
         lambda e: {"samples": e["zeiss_rms"]},
         lambda e: (
-            "33-point stand-in layout (1 cm intersections drawn from the seed), Table 1's "
+            "stand-in layout of zeiss.points 1 cm intersections (drawn from the seed), Table 1's "
             "error model plus the grid's stated error, linearised"
         ),
     ),
@@ -128,7 +128,10 @@ def _operation(cfg: dict, R: dict) -> dict[str, Sim]:
     """Calibration and operation: the axis tilt, the paper's arithmetic, the time model."""
     return {
         "brown.calibration.axis_tilt_deg": exact(
-            R["external"]["axis_tilt_deg"], "atan(accuracy / gap) at the larger printed gap"
+            R["external"]["axis_tilt_deg"],
+            f"atan(accuracy / gap) at {cfg['calibration.accuracy_um']:g} um over the gap "
+            f"operation.gap_um = {cfg['operation.gap_um']:g} um (the paper's larger printed gap "
+            "is 100 um, the worst case)",
         ),
         "brown.calibration.scale_combined_um": exact(
             math.hypot(0.5, 0.2), "recomputed from the paper's 0.5 and 0.2 micron"
@@ -147,10 +150,12 @@ def _operation(cfg: dict, R: dict) -> dict[str, Sim]:
             cfg["paper.positions"] * 2, "positions x 2 settings"
         ),
         "brown.operation.single_settings_min": exact(
-            R["time"][0], "the time model at 30 images, 4 positions, single settings"
+            R["time"][0],
+            f"the time model at {cfg['time.images']} images, 4 positions, single settings",
         ),
         "brown.operation.double_settings_min": exact(
-            R["time"][1], "the time model at 30 images, 4 positions, double settings"
+            R["time"][1],
+            f"the time model at {cfg['time.images']} images, 4 positions, double settings",
         ),
     }
 

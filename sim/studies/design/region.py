@@ -271,19 +271,25 @@ def plates_region(cfg: dict, book):
     return reg, preds, {p.id: decide_over(reg, p) for p in preds}
 
 
-_NOTES = {
-    TOLERANCES[0]: "d^2 / (2 r_min) at the plate's shortest range",
-    TOLERANCES[1]: "lateral offset d with d^2 / (2 r_min) = the accuracy (1 um)",
-    TOLERANCES[2]: "the dividing error as a fraction of one turn of the screw",
-    PLATES[0]: (
-        "one plate's rms discrepancy with a two-screw comparator of error two_screw_sigma_um "
-        "per coordinate added, after translation and rotation; central half of the plates of "
-        "Table 1's plate at the stations and closure sigma0_um where Table 1's statements hold"
-    ),
-    PLATES[1]: "33-point stand-in layout within the half extent, plus the grid's 0.8 um, at "
-    "the stations and closure where Table 1's statements hold",
-    PLATES[2]: "the comparator's part of the Zeiss comparison alone",
-}
+def _notes(cfg: dict) -> dict[str, str]:
+    """How each prediction is computed, with the run's Zeiss points and grid sigma
+    (``zeiss.*``) and the accuracy its tolerances are stated for (``calibration.accuracy_um``)."""
+    return {
+        TOLERANCES[0]: "d^2 / (2 r_min) at the plate's shortest range",
+        TOLERANCES[1]: "lateral offset d with d^2 / (2 r_min) = the accuracy "
+        f"({cfg['calibration.accuracy_um']:g} um)",
+        TOLERANCES[2]: "the dividing error as a fraction of one turn of the screw",
+        PLATES[0]: (
+            "one plate's rms discrepancy with a two-screw comparator of error "
+            "two_screw_sigma_um per coordinate added, after translation and rotation; central "
+            "half of the plates of Table 1's plate at the stations and closure sigma0_um where "
+            "Table 1's statements hold"
+        ),
+        PLATES[1]: f"{cfg['zeiss.points']}-point stand-in layout within the half extent, plus "
+        f"the grid's {cfg['zeiss.grid_sigma_um']:g} um, at the stations and closure where "
+        "Table 1's statements hold",
+        PLATES[2]: "the comparator's part of the Zeiss comparison alone",
+    }
 
 
 def decided_by(reg, pred: Statement, name: str) -> str:
@@ -312,12 +318,12 @@ def decided_by(reg, pred: Statement, name: str) -> str:
 _DECIDED_BY = {PLATES[0]: TWO_SCREW.name}
 
 
-def region_rows(book, parts) -> tuple[list[dict], dict, dict]:
+def region_rows(book, parts, cfg: dict) -> tuple[list[dict], dict, dict]:
     """Claim rows of every part's predictions, ``consistent_region.parquet`` (the parts'
     tables stacked, ``part`` naming each; an input a part does not have is NaN) and
     ``region_inputs.parquet`` (per part and input: the declared range, the region's
     projection, where every prediction of the part holds, the resolution)."""
-    rows, tables, ins = [], [], {k: [] for k in _INPUT_COLS}
+    rows, tables, ins, notes = [], [], {k: [] for k in _INPUT_COLS}, _notes(cfg)
     for name, (reg, preds, verdicts) in parts.items():
         where = f" (part '{name}': " + ", ".join(i.name for i in reg.inputs) + ")"
         for p in preds:
@@ -334,7 +340,7 @@ def region_rows(book, parts) -> tuple[list[dict], dict, dict]:
                     verdicts[p.id],
                     v[reg.accepted],
                     (decided_by(reg, p, _DECIDED_BY[p.id]) if p.id in _DECIDED_BY else "")
-                    + _NOTES[p.id]
+                    + notes[p.id]
                     + where,
                 )
             )

@@ -9,14 +9,15 @@ from pathlib import Path
 
 import numpy as np
 
+from sim.instruments.ranges import brown as B
 from sim.report.section import config, figure, region_lead, section, table
 from sim.report.tables import fmt, md_table
-from sim.studies.design.schema import SCHEMA
+from sim.studies.design.schema import SCHEMA, datum_geometry
 
 __all__ = ["report"]
 
 
-def _datum_findings(V, VH, feas_note):
+def _datum_findings(V, VH, feas_note, whose: str):
     g = lambda k: (V.get(k, np.nan), VH.get(k, np.nan))  # noqa: E731
     (bl, bh), (il, ih), (cl, ch) = (
         g(f"brown.datum.{d}.stations_pct") for d in ("brown", "invariant", "corners")
@@ -27,7 +28,7 @@ def _datum_findings(V, VH, feas_note):
     )
     return (
         f"* *Datum of the dilution* (findings, not scored against Brown's sentence): in "
-        f"Brown's datum the `stations` dilution of brown_dilution's geometry is "
+        f"Brown's datum the `stations` dilution of {whose} geometry is "
         f"{bl:.1f}-{bh:.1f} %; after the S-transformation to inner constraints over the points "
         f"it is {il:.1f}-{ih:.1f} %, after a similarity onto the four corners {cl:.1f}-{ch:.1f} %. "
         f"So {100 * (1 - ih / bh):.0f} % of the largest and {100 * (1 - il / bl):.0f} % of the "
@@ -59,7 +60,7 @@ def _lead(out: Path, cfg: dict) -> list[str]:
             "simulated plates per input vector that Table 1's statements leave in the region, "
             "whose noise enters the decision",
         ),
-        "The comparator bounds the region: its 261 + 1 mm scale must read Table 1's plate, "
+        f"The comparator bounds the region: {_scale_words(cfg)} must read Table 1's plate, "
         "and the Zeiss points for the Zeiss rows (figure: brown_table1's region). The "
         "tolerances and the plate comparisons are the built comparator's, the instrument "
         "that measured Table 1, so both parts also ask Table 1's printed statements to hold "
@@ -67,6 +68,30 @@ def _lead(out: Path, cfg: dict) -> list[str]:
         "the closure): they are decided where Table 1 puts the stations (fifth reading), and "
         "the plates are drawn with each point's closure sigma0 as their range sigma.",
     ]
+
+
+def _scale_words(cfg: dict) -> str:
+    """The scale the region's hardware statement reads: the built comparator's 261 + 1 mm
+    (:mod:`sim.instruments.ranges.brown`), whatever ``scale.*`` says; said so where the run's
+    scale differs (it bounds the design trade-off only)."""
+    paper = f"{B.SCALE_MM:g} + {B.MICROMETER_MM:g} mm scale"
+    run = (cfg["scale.graduated_mm"], cfg["scale.micrometer_mm"])
+    if run == (B.SCALE_MM, B.MICROMETER_MM):
+        return f"its {paper}"
+    return (
+        f"the paper's {paper} (the built comparator's, whatever scale.graduated_mm and "
+        f"scale.micrometer_mm say: this run's {run[0]:g} + {run[1]:g} mm bounds the design "
+        "trade-off only)"
+    )
+
+
+def _time_words(cfg: dict) -> str:
+    """The measuring times the trade-off is scaled to (``time.*``), the paper's or the run's."""
+    keys = ("time.single_min", "time.double_min", "time.images")
+    words = "{:g} and {:g} minutes for {:g} images"
+    run = words.format(*(cfg[k] for k in keys))
+    paper = words.format(*(SCHEMA[k].default for k in keys))
+    return f"the paper's {paper}" if run == paper else f"{run} (the paper's: {paper})"
 
 
 _INTRO = (
@@ -77,7 +102,7 @@ _INTRO = (
 )
 
 
-def _findings(out: Path) -> str:
+def _findings(out: Path, cfg: dict) -> str:
     """The findings bullets: datum of the dilution, scale length, design, error budget."""
     cl = table(out, "claims.parquet")
     V = dict(zip(cl["claim"], cl["value"]))
@@ -92,11 +117,11 @@ def _findings(out: Path) -> str:
         "range does not fit on the scale plus micrometer; the rows are findings.)"
     )
     bullets = [
-        _datum_findings(V, VH, feas_note),
+        _datum_findings(V, VH, feas_note, datum_geometry(cfg)),
         f"* *Scale length.* With every range on the scale plus micrometer the stations can stand "
         f"at most {fmt(V.get('brown.design.max_offset_paper_grid_mm'))} mm outside the midsides "
         f"for Table 1's grid and {fmt(V.get('brown.design.max_offset_dilution_grid_mm'))} mm "
-        "for brown_dilution's. Verdicts use feasible designs only.",
+        f"for {datum_geometry(cfg)} grid. Verdicts use feasible designs only.",
         f"* *Design.* {N.get('brown.design.paper_on_front_same_points', '')}.",
         f"* *Error budget.* Setting error alone {fmt(bud.get('setting'))} um rms after a rigid "
         f"fit; calibrated scale {fmt(bud.get('scale'))} um, uncalibrated scale at its "
@@ -144,7 +169,7 @@ def _tradeoff(out: Path, cfg: dict) -> list[str]:
         "### Design trade-off",
         f"{len(ok)} cells, {int(ok.sum())} feasible; infeasible cells stay in `design.parquet` "
         "with the reason (" + ", ".join(f"{k}: {v}" for k, v in reasons.items()) + "). "
-        f"Measuring time: the paper's 60 and 90 minutes for 30 images, with "
+        f"Measuring time: {_time_words(cfg)}, with "
         f"{fmt(cfg['time.pass_min'])} min per plate position (not printed; a labelled example).",
         md_table(list(_DESIGN_COLS), _columns(d, tuple(_DESIGN_COLS.values()), pf)),
         f"The paper's design: {fmt(d['time_min'][jp])} min, worst sigma "
@@ -280,7 +305,7 @@ def report(out: Path) -> str:
     return section(
         out,
         lead=_lead(out, cfg),
-        intro=[_INTRO, _findings(out)],
+        intro=[_INTRO, _findings(out, cfg)],
         schema=SCHEMA,
         body=[
             *_tradeoff(out, cfg),

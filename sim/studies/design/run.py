@@ -41,7 +41,7 @@ from sim.studies.design.external import external_at
 from sim.studies.design.formal import coverage_analysis
 from sim.studies.design.parts import side_by_side
 from sim.studies.design.posterior import bayes_analysis, twoplate_analysis
-from sim.studies.design.schema import SCHEMA
+from sim.studies.design.schema import SCHEMA, datum_geometry
 from sim.studies.run_steps import run_part
 
 __all__ = ["run"]
@@ -111,7 +111,7 @@ def _scale_length(cfg) -> dict:
         "brown.design.max_offset_dilution_grid_mm": (
             max_offset_mm(cfg, ext_d),
             (
-                f"the same for brown_dilution's +-{ext_d:g} mm grid (its station offset is "
+                f"the same for {datum_geometry(cfg)} +-{ext_d:g} mm grid (its station offset is "
                 f"{cfg['datum.offset_mm']:g} mm)"
             ),
         ),
@@ -280,7 +280,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     # the unprinted inputs explored jointly (.region): the tolerances analytic, the external
     # comparisons on a small design of plates
     parts = {"tolerances": DR.tolerance_region(cfg, book), "plates": DR.plates_region(cfg, book)}
-    region_rows, region_table, region_inputs = DR.region_rows(book, parts)
+    region_rows, region_table, region_inputs = DR.region_rows(book, parts, cfg)
     R["design"] = _design(cfg, cols)
     R["time"] = (
         measuring_time(cfg, 4, cfg["time.images"], 1),

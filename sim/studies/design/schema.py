@@ -377,3 +377,11 @@ PRINTED = (
     "calibration.drum_dividing_arcsec",
 )
 SCHEMA.update({k: printed(SCHEMA[k]) for k in PRINTED})
+
+
+def datum_geometry(cfg: dict) -> str:
+    """Whose geometry the dilution's datum rows use: "brown_dilution's" where every
+    ``datum.*`` key is its default (brown_dilution's example), else "the run's datum.*"."""
+    keys = [k for k in SCHEMA if k.startswith("datum.")]
+    same = all(cfg[k] == SCHEMA[k].default for k in keys)
+    return "brown_dilution's" if same else "the run's datum.*"

@@ -179,7 +179,8 @@ def _comparator(book: ClaimBook, cfg: dict, res: dict) -> dict[str, Sim]:
             f"comparator sigma {r1p2:g} um of the means, as the paper's explanation needs; "
             f"the simulation adds a per-point comparator error of "
             f"{math.sqrt(max(sx**2 - cfg['readings.sigma_um'] ** 2 / L, 0)):.2f} um to make up "
-            f"the {r1p2:g}.",
+            f"its comparator sigma {sx:g} um (comparator.coord_sigma_um) from "
+            f"{cfg['readings.sigma_um']:g}/sqrt({L}).",
             ci=((r1p5 - h15) / math.sqrt(2), (r1p5 + h15) / math.sqrt(2)),
         ),
     }

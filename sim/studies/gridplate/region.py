@@ -303,5 +303,6 @@ def iteration_note(cfg: dict, region: Region, example: np.ndarray) -> str:
         f"{cfg['plate.count']} plate{'s' if cfg['plate.count'] > 1 else ''} x rows x' and y') "
         "at the re-weighted "
         "ratio; a point holds when every count lies in 2-3, fails when none does; counts over "
-        f"the region {tally(c)}; at the configured inputs (an example): counts {tally(example)}"
+        f"the region {tally(c) or 'none (no point of the region)'}; at the configured inputs "
+        f"(an example): counts {tally(example)}"
     )

@@ -83,10 +83,17 @@ def _points(s: dict, p: dict) -> list[str]:
     return [lead, md_table([*_POINT_HEADER, dil], rows)]
 
 
+def _finite(x) -> bool:
+    return x is not None and bool(np.isfinite(x))
+
+
 def _mdb(o: dict, a: int) -> str:
-    if o["mdb_mm"][a] is not None:
+    """The observation's minimal detectable bias in its unit: ``observations.parquet`` holds
+    NaN, not null, in the column of the other unit (an angle's ``mdb_mm``) and in both for
+    an uncontrolled observation."""
+    if _finite(o["mdb_mm"][a]):
         return f"{fmt(o['mdb_mm'][a])} mm"
-    if o["mdb_arcsec"][a] is not None:
+    if _finite(o["mdb_arcsec"][a]):
         return f"{fmt(o['mdb_arcsec'][a])} arcsec"
     return "uncontrolled"
 

@@ -16,6 +16,7 @@ from sim.claims.intervals import share_ci, spread, std_ci
 from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.instruments import transforms2d as t2
 from sim.studies.salsig import printed as pr
+from sim.studies.salsig.wording import b8_printed, correction, level_text, sigma_set
 
 BOOK = Path(__file__).with_name("claims.toml")
 
@@ -136,11 +137,12 @@ def _recovery(cfg: dict, rec: dict) -> dict[str, Sim]:
         f"{cfg['marks.grid'] ** 2} marks, B8 error {cfg['b8.sigma_um']:g} um, comparator "
         f"{cfg['comparator.sigma_um']:g} um"
     )
+    truth = "printed FIG. 3" if b8_printed(cfg) else "run's b8.*"
     table = {
         cid: plates(
             rec[key],
             f"recovered over simulated calibrations ({design}); the truth is the "
-            "printed FIG. 3 value (input), so this shows the spread of one calibration: "
+            f"{truth} value (input), so this shows the spread of one calibration: "
             f"sd {np.std(rec[key], ddof=1):.3g}.",
         )
         for cid, key in (
@@ -153,12 +155,12 @@ def _recovery(cfg: dict, rec: dict) -> dict[str, Sim]:
         rec["s0_fig3_digits"],
         "a-posteriori unit-weight error of the B8 -> grid affine in the units of "
         "the observed system X2 (B8 digits), as the program's residuals VX2, VY2 "
-        f"are ({design}); b8.sigma_um is not printed: set to reproduce the .002 (an input).",
+        f"are ({design}); {sigma_set(cfg, 'b8.sigma_um', '.002')}.",
     )
     table["salsig.recovery.s0_fig2_mm"] = plates(
         rec["s0_fig2_mm"],
         "unit-weight error of the comparator -> grid affine (mm); "
-        "comparator.sigma_um is not printed: set to reproduce the .003 (an input).",
+        f"{sigma_set(cfg, 'comparator.sigma_um', '.003')}.",
     )
     for cid, key, what in (
         ("salsig.recovery.power_E", "detect_E", "E"),
@@ -169,7 +171,7 @@ def _recovery(cfg: dict, rec: dict) -> dict[str, Sim]:
             m,
             ci,
             note=f"share of simulated calibrations in which {what} "
-            f"differs from zero at the {100 * (1 - cfg['analysis.alpha']):g} % level "
+            f"differs from zero at the {level_text(cfg)} level "
             f"({design}); see power.png.",
         )
     for cid, key in (
@@ -202,7 +204,9 @@ def _zscale(cfg: dict, zs: dict) -> dict[str, Sim]:
             (float(sp[0]), float(sp[1])),
             "spread",
             note=f"standard error of S from the fit, um/digit ({cfg['zscale.points'] - 2} "
-            f"degrees of freedom); the 12.5 against 12.7 difference is {200 / m:.0f} of them.",
+            f"degrees of freedom); the {cfg['zscale.s_mm_per_digit']:g} against "
+            f"{cfg['b8.sx_mm_per_digit']:.4g} difference is "
+            f"{abs(cfg['b8.sx_mm_per_digit'] - cfg['zscale.s_mm_per_digit']) * 1e3 / m:.0f} of them.",
         ),
     }
 
@@ -216,7 +220,7 @@ def _vertical(book: ClaimBook, cfg: dict, vt: dict) -> dict[str, Sim]:
     table = {
         "salsig.vertical_halved.rms_ratio": plates(
             vt["ratio"],
-            f"rms vertical residual after / before multiplying z by 12.500/12.700, "
+            f"rms vertical residual after / before multiplying z by {correction(cfg)}, "
             f"7-parameter conformal fit per model; {vdesc}. The spread over models is the "
             "'one plate' question: the paper's data were some models.",
         )

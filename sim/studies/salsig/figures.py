@@ -10,6 +10,7 @@ import numpy as np
 
 from sim.report.plotting import hist_bins, place_legend, plain_log, plt, save
 from sim.studies.salsig.schema import UM
+from sim.studies.salsig.wording import level_text
 
 
 def fig_residuals(ex: dict, cfg: dict, path: Path) -> None:
@@ -50,8 +51,8 @@ def fig_residuals(ex: dict, cfg: dict, path: Path) -> None:
 
 
 def fig_recovery(res: dict, cfg: dict, path: Path) -> None:
-    """The recovered B8 scales (in ppm of the true SX, so the 160 ppm SY - SX reads
-    directly) and non-perpendicularity E (arcsec) over the simulated calibrations."""
+    """The recovered B8 scales (in ppm of the true SX, so the true SY - SX, 153 ppm in the
+    paper's FIG. 3, reads directly) and non-perpendicularity E (arcsec) over the simulated calibrations."""
     fig, axs = plt.subplots(1, 3, figsize=(12, 4.0), layout="constrained")
     sx, sy = cfg["b8.sx_mm_per_digit"], cfg["b8.sy_mm_per_digit"]
     ppm = lambda v: (np.asarray(v, float) / sx - 1.0) * 1e6  # noqa: E731
@@ -78,12 +79,15 @@ def fig_recovery(res: dict, cfg: dict, path: Path) -> None:
     save(fig, path)
 
 
-def fig_power(sw: dict, path: Path) -> None:
+def fig_power(sw: dict, cfg: dict, path: Path) -> None:
+    """Detection power of E and SY - SX against the number of marks, per B8 sigma: the run's
+    true E and scale difference (``b8.*``) at its level ``analysis.alpha``."""
+    sx, sy = cfg["b8.sx_mm_per_digit"], cfg["b8.sy_mm_per_digit"]
     fig, axs = plt.subplots(1, 2, figsize=(11, 3.8), sharey=True, layout="constrained")
     sig = sorted(set(sw["sigma_um"]))
     for ax, key, title in (
-        (axs[0], "power_E", 'non-perpendicularity E = -59.2"'),
-        (axs[1], "power_scale", "scale difference SY - SX (0.016 %)"),
+        (axs[0], "power_E", f'non-perpendicularity E = {cfg["b8.e_arcsec"]:g}"'),
+        (axs[1], "power_scale", f"scale difference SY - SX ({100 * (sy - sx) / sx:.3g} %)"),
     ):
         for s in sig:
             idx = [i for i, v in enumerate(sw["sigma_um"]) if v == s]
@@ -96,7 +100,7 @@ def fig_power(sw: dict, path: Path) -> None:
         ax.axhline(0.95, color="k", lw=0.8)
         ax.set_xlabel("number of marks")
         ax.set_title(f"power to detect {title}")
-    axs[0].set_ylabel("detection rate at the 95 % level")
+    axs[0].set_ylabel(f"detection rate at the {level_text(cfg)} level")
     for ax in axs:
         place_legend(ax)
     save(fig, path)

@@ -9,6 +9,7 @@ from pathlib import Path
 from sim.report.section import config, errata, figure, region_lead, rows, section, table
 from sim.report.tables import fmt, md_table
 from sim.studies.salsig.schema import SCHEMA
+from sim.studies.salsig.wording import b8_printed, correction, level_text
 
 _CONVENTIONS = (
     "**Conventions.** Salsig's program prints the affine `X1 = A X2 + B Y2 + C`, "
@@ -28,21 +29,27 @@ def _chain(cfg: dict) -> str:
         f"{cfg['marks.grid']} x {cfg['marks.grid']} array over {cfg['marks.extent_mm']:g} mm, "
         f"scattered {cfg['marks.placement_sd_mm']:g} mm about nominal, tapped with a B8 error of "
         f"{cfg['b8.sigma_um']:g} um per coordinate; B8 readings = inverse of the true B8 affine "
-        "(SX, SY, E as printed in FIG. 3). Film on the comparator stage under the grid plate; "
+        f"(SX {cfg['b8.sx_mm_per_digit']:.12g}, SY {cfg['b8.sy_mm_per_digit']:.12g} mm/digit, "
+        f'E {cfg["b8.e_arcsec"]:g}"{_as_printed(cfg)}). Film on the comparator stage under the grid plate; '
         f"comparator readings of the {cfg['grid.points'] ** 2} intersections and the marks "
         f"through a FIG. 2-like affine, {cfg['comparator.sigma_um']:g} um per coordinate. Then "
         "the paper's two affines. The vertical test: stereomodels digitised with z at the z "
         "scale and x, y at the x scale, fitted to control by a 7-parameter conformal "
-        "transformation before and after the 12.500/12.700 correction."
+        f"transformation before and after the {correction(cfg)} correction."
     )
 
 
-def _power(out: Path) -> list[str]:
+def _as_printed(cfg: dict) -> str:
+    """The words ", as printed in FIG. 3" where the run's B8 affine is the paper's."""
+    return ", as printed in FIG. 3" if b8_printed(cfg) else ""
+
+
+def _power(out: Path, cfg: dict) -> list[str]:
     sw = table(out, "power.parquet")
     cols = ("n_marks", "sigma_um", "power_E", "power_scale", "sd_E_arcsec", "sd_scale_diff_ppm")
     return [
         "**Detection power against the design** (share of calibrations in which E, resp. "
-        "SX - SY, differs from zero at the 95 % level):",
+        f"SX - SY, differs from zero at the {level_text(cfg)} level):",
         md_table(
             ["marks", "B8 sigma (um)", "power E", "power SX-SY", 'sd E (")', "sd SX-SY (ppm)"],
             [[n, *(fmt(x) for x in rest)] for n, *rest in zip(*(sw[c] for c in cols))],
@@ -74,7 +81,7 @@ def report(out: Path) -> str:
         ],
         intro=[_CONVENTIONS, errata(claims), _chain(cfg)],
         schema=SCHEMA,
-        body=_power(out),
+        body=_power(out, cfg),
         figures=[
             ("residuals", "residuals.png"),
             ("recovery", "recovery.png"),

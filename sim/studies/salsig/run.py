@@ -107,7 +107,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     draw(
         [
             (F.fig_recovery, (rec, cfg, out / "recovery.png")),
-            (F.fig_power, (sw, out / "power.png")),
+            (F.fig_power, (sw, cfg, out / "power.png")),
         ]
     )
     region, preds = explore_region(cfg, book, chunk_rng(cfg["seed"], 900, 0))

@@ -17,6 +17,7 @@ from sim.claims.intervals import bootstrap_ci
 from sim.claims.table import Sim, claim_rows, exact, plates
 from sim.mc.runner import chunk_rng
 from sim.studies.wolf.tables import STATS, recomputation, summary
+from sim.studies.wolf.wording import amplitudes, photograph, polynomial
 
 BOOK = Path(__file__).with_name("claims.toml")
 AXES = ("x", "y")
@@ -69,12 +70,13 @@ def _simulated_notes(cfg: dict) -> dict[str, str]:
     T, S = cfg["trials"], cfg["calib.n_sets"]
     return {
         "wolf.before.": f"over the pooled {S} calibration sets after the non-redundant two-point "
-        f"reduction; distribution over {T} simulated instruments. The field "
-        "amplitudes (field.*) were chosen so these look like the paper's; "
+        f"reduction; distribution over {T} simulated instruments. {amplitudes(cfg)}; "
         "these rows constrain the consistent region (consistent_region.parquet)",
-        "wolf.after.": f"residuals of the ten-term cubic fitted to the {S} pooled sets; "
+        "wolf.after.": f"residuals of the {polynomial(cfg['calib.degree'], True)} fitted to "
+        f"the {S} pooled sets; "
         f"distribution over {T} instruments",
-        "wolf.repeatability.": f"{cfg['repeat.n_points']} points of a simulated P-30 photograph "
+        "wolf.repeatability.": f"{cfg['repeat.n_points']} points of a simulated "
+        f"{photograph(cfg['repeat.format_mm'])} photograph "
         f"read {cfg['repeat.gap_weeks']:g} week(s) apart, each set "
         "corrected and fitted to its four fiducials; the default pointing "
         "sigma was chosen from these; they constrain the consistent region",

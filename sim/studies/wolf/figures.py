@@ -12,8 +12,10 @@ from sim.mc.storage import read_table
 from sim.report.mpl import ticker
 from sim.report.plotting import draw, place_legend, plt, save
 from sim.studies.wolf.model import ls_map
+from sim.studies.wolf.wording import polynomial
 
 _UM_PER_MM = 2.5  # vector plots: 1 mm of plot = 2.5 µm of discrepancy (50 µm = 20 mm)
+_AFTER_UM_PER_MM = 1.0  # the corrected vectors drawn _UM_PER_MM / this times longer
 #: the scale of the Table 1 plot, as its title says it: 10 µm of discrepancy drawn as 20 mm
 _TABLE1_KEY_UM, _TABLE1_KEY_MM = 10.0, 20.0
 
@@ -55,7 +57,7 @@ def figures(cfg: dict, out: Path) -> None:
     draw(
         [
             (components_figure, (out,)),
-            (vectors_figure, (out,)),
+            (vectors_figure, (cfg, out)),
             (readings_figure, (out,)),
             (stability_figure, (cfg, out)),
             (degree_figure, (out,)),
@@ -64,7 +66,9 @@ def figures(cfg: dict, out: Path) -> None:
     )
 
 
-def vectors_figure(out: Path) -> None:
+def vectors_figure(cfg: dict, out: Path) -> None:
+    """Discrepancy vectors of one simulated instrument, before and after the run's
+    correction polynomial (``calib.degree``), one column per calibration set."""
     v = read_table(out / "vectors.parquet").to_pydict()
     v = {k: np.asarray(a) for k, a in v.items()}
     sets = np.unique(v["set"])
@@ -90,12 +94,14 @@ def vectors_figure(out: Path) -> None:
             v["y_mm"][m],
             v["dx_after_um"][m],
             v["dy_after_um"][m],
-            f"set {st}: after the cubic (rms {ra:.1f} µm, arrows ×2.5)",
+            f"set {st}: after the {polynomial(cfg['calib.degree'])} (rms {ra:.1f} µm, "
+            f"arrows ×{_UM_PER_MM / _AFTER_UM_PER_MM:g})",
             20.0,
-            1.0,
+            _AFTER_UM_PER_MM,
         )
+    dates = f"{len(sets)} date{'s' * (len(sets) != 1)}"
     fig.suptitle(
-        "Discrepancy vectors of one simulated instrument, three dates (cf. the paper's Figure 2)",
+        f"Discrepancy vectors of one simulated instrument, {dates} (cf. the paper's Figure 2)",
         fontsize=10,
     )
     save(fig, out / "vectors.png")
@@ -140,7 +146,7 @@ def components_figure(out: Path) -> None:
         "sum, less its best similarity\n(scale, rotation, shift are absorbed)",
     )
     fig.suptitle(
-        "Error-field components of one random draw at the default amplitudes (inputs); "
+        "Error-field components of one random draw at the configured amplitudes (inputs); "
         "each panel has its own arrow scale",
         fontsize=10,
     )

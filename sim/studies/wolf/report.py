@@ -26,6 +26,7 @@ from sim.report.section import (
     table,
 )
 from sim.studies.wolf.schema import SCHEMA
+from sim.studies.wolf.wording import polynomial
 
 __all__ = ["findings", "report"]
 
@@ -45,7 +46,8 @@ def findings(out: Path) -> list[str]:
     if "wolf.before.rms_x_um" in c:
         lines.append(
             f"- Before correction the simulated rms is {_med(c['wolf.before.rms_x_um'])} "
-            f"in x and {_med(c['wolf.before.rms_y_um'])} in y; after the cubic "
+            f"in x and {_med(c['wolf.before.rms_y_um'])} in y; after the "
+            f"{polynomial(config(out)['config']['calib.degree'])} "
             f"{_med(c['wolf.after.rms_x_um'])} and {_med(c['wolf.after.rms_y_um'])}; "
             "on an independent plate read later, corrected: "
             f"{_med(c['wolf.plate_after.rms_x_um'])} in x (uncorrected, after a "
@@ -101,7 +103,8 @@ def _model_text(cfg: dict, n_trials: int) -> str:
         f"drifts (AR(1), {cfg['field.drift_tau_weeks']:g} weeks) and each placement adds a "
         f"{cfg['field.restitution_um']:g} um restitution field. {cfg['calib.n_sets']} sets over "
         f"{cfg['calib.span_weeks']:g} weeks are reduced with the paper's non-redundant two-point "
-        "transformation and the cubic is fitted to the pooled sets. The Table 2 analogue compares "
+        f"transformation and the {polynomial(cfg['calib.degree'], True)} (degree "
+        f"{cfg['calib.degree']}) is fitted to the pooled sets. The Table 2 analogue compares "
         f"a photograph's corrected PG-2 coordinates with a monocomparator of "
         f"{cfg['mono.sigma_um']:g} um per coordinate (not printed; an example). {sizes}. The paper's "
         "numbers describe one instrument and one plate each, so most claims are *one-plate* "
@@ -347,7 +350,7 @@ def _readings_table(out: Path, r: dict, cfg: dict) -> list[str]:
     ]
 
 
-def _stability_table(out: Path, s: dict) -> list[str]:
+def _stability_table(out: Path, s: dict, cfg: dict) -> list[str]:
     """The stability trade-off (``stability.parquet``), and its figure."""
     srows = [
         [fmt(f), fmt(a), fmt(b), fmt(c), fmt(w)]
@@ -361,7 +364,8 @@ def _stability_table(out: Path, s: dict) -> list[str]:
     ]
     header = ["drifting share", "age (weeks)", "uncorrected", "corrected", "share helped"]
     return [
-        "Stability: calibration on the paper's sets, an independent plate read at a later age "
+        f"Stability: calibration on the run's {cfg['calib.n_sets']} sets "
+        f"({polynomial(cfg['calib.degree'])}), an independent plate read at a later age "
         "(median rms per coordinate, um; share of instruments where the correction helps):",
         md_table(header, srows),
         figure(out, "stability.png", "stability"),
@@ -385,5 +389,5 @@ def _tradeoffs(out: Path, cfg: dict) -> list[str]:
         _DRIFT_THEORY,
         *_degree_table(out, d, cfg),
         *_readings_table(out, r, cfg),
-        *_stability_table(out, s),
+        *_stability_table(out, s, cfg),
     ]
