@@ -55,13 +55,16 @@ def anonymous_dir(base: Path | None, out: Path):
     """Around a run into ``out`` inside ``base``, the temporary directory made for it
     (``None``: the caller named ``out``, nothing to do): on any failure or interrupt,
     ``base`` is removed if empty (the run's staging directory held no finished chunk and was
-    removed), else the exception gets a note naming ``out`` (its finished chunks resume)."""
+    removed), else the exception gets a note naming ``out`` (its finished chunks resume); a
+    ``base`` that is gone gets no note (it named a directory that is not there)."""
     try:
         yield
     except BaseException as e:
         if base is not None:
             try:
                 os.rmdir(base)  # only an empty directory: nothing the run kept is lost
+            except FileNotFoundError:  # removed under the run (a cleaner of /tmp): no chunk
+                pass  # is kept anywhere, and no out= resumes it
             except OSError:
                 e.add_note(
                     f"sim: the finished chunks are kept in {base}: "

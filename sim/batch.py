@@ -277,9 +277,10 @@ def _main(argv: list[str]) -> int:
     except SystemExit as e:  # --help: printed; an in-process caller (a notebook) goes on
         return exit_status(e.code)
     except _BadArgs as e:
-        after = [a for a in run_args if a.endswith(".toml")]  # a study file among sim run's options
-        hint = f"; study files come before --, not after it ({after[0]})" if after else ""
-        print(f"sim.batch: {e}{hint} (see python -m sim.batch --help)", file=sys.stderr)
+        print(
+            f"sim.batch: {e}{_files_after(str(e), run_args)} (see python -m sim.batch --help)",
+            file=sys.stderr,
+        )
         return 2
     if not 1 <= args.jobs <= 64:  # an option of the command line, before its files
         print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
@@ -358,6 +359,17 @@ def _main(argv: list[str]) -> int:
     if log.error is not None and not failed:  # a reader that left (| head -1): as sim does
         return 141
     return code
+
+
+def _files_after(message: str, run_args: list[str]) -> str:
+    """``; study files come before --, not after it (a.toml)`` when argparse's ``message``
+    says no study file was given and one is among sim run's options after ``--`` (a word of
+    its own, not an option's ``KEY=VALUE``); "" otherwise (a ``--set x=a.toml`` after a bad
+    ``--jobs`` is not a study file put in the wrong place)."""
+    if not message.startswith("the following arguments are required"):
+        return ""
+    after = [a for a in run_args if a.endswith(".toml") and not a.startswith("-") and "=" not in a]
+    return f"; study files come before --, not after it ({after[0]})" if after else ""
 
 
 def summary(files: list[Path], done: dict[str, tuple[int, float, float]], code: int) -> str:

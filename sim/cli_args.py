@@ -10,6 +10,7 @@ from pathlib import Path
 
 from sim.mc.argv import OnceParser, integer
 from sim.mc.config import ConfigError
+from sim.mc.numtext import UnheldError, float_text
 from sim.mc.runner import MIN_CHUNKS
 
 __all__ = ["module_doc", "parser"]
@@ -60,6 +61,17 @@ def _version() -> str:
         return metadata.version("sim")
     except metadata.PackageNotFoundError:  # a source tree that was never installed
         return "unknown"
+
+
+def _limit_value(text: str) -> float:
+    """A limit's number as argparse's ``float`` reads it, but digits no double holds named as
+    written (``--max-adjustments 1e-400`` was "must be a positive number (got 0.0)")."""
+    try:
+        return float_text(text)
+    except UnheldError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+    except ValueError:  # argparse's own words for type=float
+        raise argparse.ArgumentTypeError(f"invalid float value: {text!r}") from None
 
 
 def _run_parser(sub) -> None:
@@ -119,13 +131,13 @@ def _run_parser(sub) -> None:
     )
     r.add_argument(
         "--max-memory-gb",
-        type=float,
+        type=_limit_value,
         default=None,
         help="refuse a run whose estimated memory exceeds this (env SIM_MAX_MEMORY_GB)",
     )
     r.add_argument(
         "--max-adjustments",
-        type=float,
+        type=_limit_value,
         default=None,
         help="refuse a run with more least-squares adjustments than this (env SIM_MAX_ADJUSTMENTS)",
     )

@@ -19,7 +19,7 @@ import sys
 from concurrent.futures import BrokenExecutor
 from contextlib import nullcontext
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Collection, Mapping
 
 import numpy as np
 
@@ -127,22 +127,27 @@ def _not_in_a_starting_worker() -> None:
         os._exit(1)
 
 
-def drop_half_imported() -> list[str]:
-    """Remove from ``sys.modules`` every module left behind by an import that failed half-way
-    (Ctrl-C while a run imports matplotlib or numba on first use, about a second): Python
-    removes the package whose code was interrupted, but not its submodules already loaded,
-    which keep the half-made package (``matplotlib.rcsetup`` bound to a ``matplotlib`` without
+def drop_half_imported(before: Collection[str]) -> list[str]:
+    """Remove from ``sys.modules`` every module a failed or interrupted command imported
+    (not in ``before``, the names held when it started) whose import did not finish (Ctrl-C
+    while a run imports matplotlib or numba on first use, about a second): Python removes the
+    package whose code was interrupted, but not its submodules already loaded, which keep the
+    half-made package (``matplotlib.rcsetup`` bound to a ``matplotlib`` without
     ``get_data_path``). The next import of the package ran its code again over them, and in a
     long-lived process (a notebook) every later run failed ("module 'matplotlib' has no
     attribute '_docstring'", numba's "module 'numba' has no attribute 'core'") until the
-    process was restarted. A module left behind is one whose parent package is not in
-    ``sys.modules`` (a process holds none otherwise); the next import loads them afresh.
-    (Here, not in :mod:`sim.stops`: that module is part of every study's code hash.)"""
+    process was restarted. A module left behind is one whose parent package is no longer in
+    ``sys.modules``; the next import loads them afresh. A module of the caller's that was
+    there before the command (a stub put in ``sys.modules`` by hand, a test's mock) is left
+    alone, whatever its name. (Here, not in :mod:`sim.stops`: that module is part of every
+    study's code hash.)"""
     mods = sys.modules
     gone = [
         n
         for n in list(mods)
-        if "." in n and any(n.rsplit(".", k)[0] not in mods for k in range(1, n.count(".") + 1))
+        if "." in n
+        and n not in before
+        and any(n.rsplit(".", k)[0] not in mods for k in range(1, n.count(".") + 1))
     ]
     for n in gone:
         mods.pop(n, None)
@@ -151,14 +156,16 @@ def drop_half_imported() -> list[str]:
 
 def _no_half_imports(fn):
     """``fn`` leaving no half-imported library behind when it fails or is interrupted
-    (:func:`drop_half_imported`): the next run in the process imports it again."""
+    (:func:`drop_half_imported` of the modules it imported): the next run in the process
+    imports it again."""
 
     @functools.wraps(fn)
     def wrapped(*args, **kwargs):
+        before = set(sys.modules)
         try:
             return fn(*args, **kwargs)
         except BaseException:
-            drop_half_imported()
+            drop_half_imported(before)
             raise
 
     return wrapped

@@ -105,7 +105,9 @@ class BoundedParser(argparse.ArgumentParser):
                 return message + _guess(bad.split("=")[0], self.options())
         m = re.search(r"invalid choice: '(.*?)' \(choose from (.*)\)$", message)
         if m:
-            close = difflib.get_close_matches(m.group(1), re.findall(r"'([^']*)'", m.group(2)), 1)
+            # quoted ('run', 'check') up to Python 3.12.7, bare (run, check) since
+            choices = [c.strip().strip("'") for c in m.group(2).split(",")]
+            close = difflib.get_close_matches(m.group(1), choices, 1)
             if close:
                 return f"{message} (did you mean {close[0]}?)"
         return message

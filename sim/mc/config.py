@@ -151,7 +151,8 @@ def refuse_big_ints(key: str, v: Any) -> None:
 def _num(key: str, v: Any, want_int: bool) -> float | int:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         what = "an integer" if want_int else "a number"
-        if isinstance(v, str) and (n := number_text(v)):  # --set x=.5: TOML read a string
+        n = number_text(v) if isinstance(v, str) else ""  # --set x=.5: TOML read a string
+        if n and (not want_int or float(n).is_integer()):  # (no "write 0.5" for an integer)
             raise ConfigError(key, f"must be {what} (got the text {v[:60]!r}: write {n})")
         raise ConfigError(key, f"must be {what} (got {shown(v)[:60]})")
     refuse_big_ints(key, v)

@@ -37,6 +37,7 @@ from typing import Any, Callable, Mapping
 
 from sim.mc.config import ConfigError
 from sim.mc.network_size import network_estimate as _network
+from sim.mc.numtext import UnheldError, float_text
 from sim.mc.sweep import MAX_CELLS, expand
 from sim.mc.workunits import (
     ADJUSTMENT_S,
@@ -387,8 +388,10 @@ def _limit(given: float | None, env: str, default: float, key: str) -> float:
         txt = os.environ.get(env)
         if txt is None or not txt.strip():
             return default
-        try:  # ASCII digits, as --max-memory-gb reads them ('٨' was read as 8)
-            given = float(txt) if txt.isascii() else float("x")
+        try:  # ASCII digits, as --max-memory-gb reads them ('٨' was read as 8); 1e-400 is
+            given = float_text(txt) if txt.isascii() else float("x")  # no 0 (the digits said)
+        except UnheldError as e:
+            raise ConfigError(env, str(e)) from None
         except ValueError:
             raise ConfigError(env, f"must be a number (got {txt!r})") from None
         key = env

@@ -9,7 +9,7 @@ import math
 import re
 from typing import Any
 
-__all__ = ["number_text", "unsigned_zeros", "toml_float", "UnheldError"]
+__all__ = ["number_text", "unsigned_zeros", "toml_float", "float_text", "unheld", "UnheldError"]
 
 
 class UnheldError(ValueError):
@@ -28,13 +28,30 @@ def toml_float(text: str) -> float:
     (refused by :func:`unsigned_zeros`, naming the key): 1e-400 was a bias of 0, silently,
     and 1e400 "must be finite (got inf)" of a finite number."""
     x = float(text)
-    if x != 0 and not math.isinf(x) or math.isnan(x) or "inf" in text:
+    if x != 0 and not math.isinf(x) or math.isnan(x) or "inf" in text.lower():
         return x
     if x == 0 and not any(c in "123456789" for c in re.split("[eE]", text)[0]):
         return x  # a zero written as one
     out = _Unheld(x)
-    out.text = text
+    out.text = text.strip()
     return out
+
+
+def float_text(text: str) -> float:
+    """The number a text outside TOML spells (an environment variable, a command-line
+    option), as :func:`toml_float` reads it: ValueError when it spells none,
+    :class:`UnheldError` naming the digits when no double holds them (``1e-400`` was "must be
+    a positive number (got 0.0)", of digits that are no zero)."""
+    return unsigned_zeros(toml_float(text))
+
+
+def unheld(shown: str, x: float) -> str:
+    """The refusal of a number written ``shown`` that no double holds: ``x``, the double it
+    would be read as, is infinite (beyond the range) or 0 (too small). One wording for a
+    study file, ``--set``, a GNU Gama file and a Python value (:mod:`sim.mc.pyvalue`)."""
+    if math.isinf(x):
+        return f"{shown} is beyond a 64-bit float's range"
+    return f"{shown} is too small for a 64-bit float (it would be read as 0)"
 
 
 def number_text(text: str) -> str:
@@ -61,11 +78,7 @@ def unsigned_zeros(v: Any) -> Any:
     of -0.0), and its config another hash. RecursionError when nested too deeply;
     :class:`UnheldError` for digits no double holds (:func:`toml_float`)."""
     if isinstance(v, _Unheld):
-        raise UnheldError(
-            f"{v.text} is beyond a 64-bit float's range"
-            if math.isinf(v)
-            else f"{v.text} is too small for a 64-bit float (it would be read as 0)"
-        )
+        raise UnheldError(unheld(v.text, v))
     if isinstance(v, float):
         return v + 0.0  # -0.0 + 0.0 is 0.0
     if isinstance(v, list):

@@ -11,7 +11,8 @@ integer, a double and a string, in lists and tables. Each value is read as the n
   would be read as 0, is refused naming the key;
 * a NumPy float is the decimal number it prints: ``np.float32(0.1)`` is ``0.1`` (not its
   binary value ``0.10000000149011612``), as the same digits typed into a study file would be;
-  ``np.longdouble`` is the double nearest it; a ``float`` subclass is the ``float``;
+  ``np.longdouble`` is the double nearest it (refused as a ``Decimal`` is when
+  no double holds it: ``1e-4000``); a ``float`` subclass is the ``float``;
 * a NumPy array, a tuple and a list are lists (at any depth: ``plate.points`` as a tuple of
   tuples or an ``(n, 2)`` array), a 0-d array its element, a mapping a table;
 * ``np.bool_`` is ``bool``; ``np.str_`` and a ``str`` subclass are ``str``.
@@ -31,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from sim.mc.config import ConfigError, refuse_big_ints
+from sim.mc.numtext import unheld
 
 __all__ = ["as_config_value"]
 
@@ -54,10 +56,8 @@ def _decimal(key: str, v: decimal.Decimal) -> Any:
 def _nearest(key: str, v: Any, x: float) -> float:
     """``x``, the double nearest the finite non-double ``v``; refused when ``v`` is beyond a
     double's range (``x`` infinite) or so small that ``x`` is 0."""
-    if x in (float("inf"), float("-inf")):
-        raise ConfigError(key, f"{v!r} is beyond a 64-bit float's range")
-    if x == 0 and v != 0:
-        raise ConfigError(key, f"{v!r} is too small for a 64-bit float (it would be read as 0)")
+    if x in (float("inf"), float("-inf")) or (x == 0 and v != 0):
+        raise ConfigError(key, unheld(repr(v), x))  # the words of a study file's digits
     return x
 
 
@@ -66,8 +66,9 @@ def _scalar(key: str, v: Any) -> Any:
         return bool(v)
     if isinstance(v, numbers.Integral):  # int subclasses, IntEnum, NumPy integers
         return int(v)
-    if isinstance(v, np.floating):  # the decimal number it prints (float32(0.1) is 0.1)
-        return float(str(v))
+    if isinstance(v, np.floating):  # the decimal number it prints (float32(0.1) is 0.1);
+        x = float(str(v))  # a longdouble no double holds (1e-4000 was 0.0, silently) refused
+        return _nearest(key, v, x) if np.isfinite(v) else x
     if isinstance(v, float):
         return float(v)
     if isinstance(v, numbers.Rational):  # Fraction
