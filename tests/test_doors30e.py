@@ -15,6 +15,15 @@ lives outside the project.
   ``sim run``, interrupted and finished by the API ended without it too. ``run()`` now writes it
   as ``sim run`` does (:func:`sim.report.run_summary.write_run_readme`, into the sealed staging
   directory before the results are published).
+* a network's record written with a field at its default (``role = "free"``, ``settings =
+  1``, ``bias_mm = 0.0``, ``nearest = 0``, ``center_mm = [0, 0]``) or with an integer for a
+  float (``sigma_arcsec = 2``, ``x_mm = 400``, a constraint's ``1``) was another config of the
+  same network, with the same numbers: another config hash (another scratch directory, every
+  file's provenance and chunk other bytes), refused as "results of a different config" naming
+  a truncated ``network.points`` that showed no difference, or, the values comparing equal in
+  Python, run over the other spelling's results. The flat keys were resolved by their fields
+  already; the records are now written in one spelling once validated
+  (:func:`sim.studies.network.canonical.canonical`).
 
 What held (every file byte-identical, the README's directory name aside): 1 and 2 workers,
 the batch, every interruption resumed by any of the three doors, ``--chunk`` or ``--set
@@ -33,6 +42,7 @@ from pathlib import Path
 
 import sim
 from sim.cli import main
+from sim.mc.storage import code_hash, config_hash
 
 ROOT = Path(__file__).resolve().parent.parent
 STUDY = ROOT / "studies" / "brown_table1.toml"
@@ -56,3 +66,40 @@ def test_the_api_writes_the_directory_sim_run_writes(tmp_path):
     a, b = _files(cli), _files(api)
     assert sorted(a) == sorted(b), set(a) ^ set(b)
     assert [f for f in a if a[f] != b[f]] == []
+
+
+#: a small network of the README's kind, and the same network spelled otherwise
+NETWORK = """
+study = "network"
+trials = 200
+chunk = 10
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+           { name = "B", x_mm = 400.0, y_mm = 0.0, role = "fixed" },
+           { name = "C", x_mm = 400.0, y_mm = 300.0, role = "fixed" },
+           { name = "P", x_mm = 150.0, y_mm = 120.0 } ]
+generate = [ { kind = "distance", from = ["A", "B", "C"], to = "P", sigma_mm = 0.002 },
+             { kind = "direction", from = "*", to = "*", sigma_arcsec = 2.0, nearest = 2 } ]
+"""
+SPELLED = {
+    '{ name = "P", x_mm = 150.0, y_mm = 120.0 }': '{ name = "P", x_mm = 150, y_mm = 120.0, role = "free" }',
+    "sigma_mm = 0.002 }": "sigma_mm = 0.002, settings = 1, bias_mm = 0.0 }",
+    "sigma_arcsec = 2.0,": "sigma_arcsec = 2, settings = 1.0, bias_arcsec = 0,",
+    "nearest = 2 }": "nearest = 2.0 }",
+    "x_mm = 400.0, y_mm = 0.0": "x_mm = 400, y_mm = 0",
+}
+
+
+def test_a_network_spelled_otherwise_is_one_config(tmp_path):
+    """The same network with its records' fields at their defaults and integers for floats:
+    the same resolved config and config hash (as a flat key written ``0`` for ``0.0``)."""
+    text = NETWORK
+    for a, b in SPELLED.items():
+        assert a in text
+        text = text.replace(a, b)
+    (tmp_path / "a.toml").write_text(NETWORK)
+    (tmp_path / "b.toml").write_text(text)
+    a, b = (sim.load(tmp_path / f"{n}.toml").config for n in "ab")
+    code = code_hash("network")
+    assert config_hash(dict(b), code) == config_hash(dict(a), code)
+    assert "role" not in a["network.points"][3] and "settings" not in b["network.generate"][0]
