@@ -24,6 +24,10 @@ lives outside the project.
   Python, run over the other spelling's results. The flat keys were resolved by their fields
   already; the records are now written in one spelling once validated
   (:func:`sim.studies.network.canonical.canonical`).
+* a ``[sweep]`` table with its reserved entries at their defaults (``seed_mode = "spawn"``,
+  ``replicates = 1``) or an integer for a float key's values (``[35, 45]`` for ``[35.0,
+  45.0]``) was another config hash of the same cells (recorded as written in ``run.json`` and
+  every file's provenance); :func:`sim.mc.sweep.read_sweep` now gives the table in one spelling.
 
 What held (every file byte-identical, the README's directory name aside): 1 and 2 workers,
 the batch, every interruption resumed by any of the three doors, ``--chunk`` or ``--set
@@ -103,3 +107,19 @@ def test_a_network_spelled_otherwise_is_one_config(tmp_path):
     code = code_hash("network")
     assert config_hash(dict(b), code) == config_hash(dict(a), code)
     assert "role" not in a["network.points"][3] and "settings" not in b["network.generate"][0]
+
+
+def test_a_sweep_spelled_otherwise_is_one_config(tmp_path):
+    """The same sweep with ``seed_mode`` and ``replicates`` at their defaults and integers for
+    a float key: the same sweep table and config hash (as the ``--set`` runs of its cells)."""
+    base = 'study = "brown_table1"\ntrials = 200\nchunk = 10\n[sweep]\n'
+    (tmp_path / "a.toml").write_text(base + '"plate.spacing_mm" = [35.0, 45.0]\n')
+    (tmp_path / "b.toml").write_text(
+        base + '"plate.spacing_mm" = [35, 45]\nseed_mode = "spawn"\nreplicates = 1\n'
+    )
+    a, b = (sim.load(tmp_path / f"{n}.toml") for n in "ab")
+    code = code_hash("brown_table1")
+    assert b.sweep == {"plate.spacing_mm": [35.0, 45.0]}
+    assert config_hash({**b.config, "sweep": b.sweep}, code) == config_hash(
+        {**a.config, "sweep": a.sweep}, code
+    )
