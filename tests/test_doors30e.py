@@ -39,7 +39,13 @@ study file or to ``studies/``, a ``git clone`` at another path (a copy without `
 values (``seed_mode = "common"``: the study's seed; ``"spawn"``: ``--seed`` the cell's
 recorded seed; the chunks' provenance names the sweep and cell); a study file reordered,
 commented, written with inline tables, dotted keys, ``1_024``, ``4.5e1``, an integer for a
-float key, or listed by ``sim check`` and saved: the same config and config hash.
+float key, or listed by ``sim check`` and saved: the same config and config hash; ``--executor
+dask``; an interrupted sweep resumed by each door; figures drawn by the API in a process whose
+``rcParams`` were changed. Named, not a class: another ``chunk`` for the same trials draws other
+numbers (docs/cli.md now says so); a study file's ``trials`` (or a swept ``trials``) with a
+``chunk`` too large for it is refused naming ``chunk``, where ``--trials`` picks one; a key a
+configuration does not read, written at its default (``plate.n_random = 25`` on a grid), is
+refused as set (docs/cli.md).
 """
 
 from pathlib import Path
