@@ -41,6 +41,8 @@ from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
+from sim.report.run_summary import write_run_readme
+from sim.studies import get_study
 from sim.studies.picking import load_picking_chunk
 
 __all__ = ["load", "StudyHandle", "Results"]
@@ -202,9 +204,10 @@ class StudyHandle:
         figures: bool = True,
     ) -> Results:
         """Run the study into ``out`` (default: a new temporary directory) and return its
-        :class:`Results`. ``executor``: ``local`` (a process pool when ``workers > 1``) or
-        ``dask``. Output is identical for every executor and worker count. ``figures=False``:
-        no PNG is drawn (``sim run --no-figures``), the tables are the same."""
+        :class:`Results`: the directory ``sim run`` writes (its README.md too). ``executor``:
+        ``local`` (a process pool when ``workers > 1``) or ``dask``. Output is identical for
+        every executor and worker count. ``figures=False``: no PNG is drawn (``sim run
+        --no-figures``), the tables are the same."""
         _check_path("out", out, none_ok=True)  # trials, seed: validated as the config keys
         for name, v in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures)):
             if not isinstance(v, bool):
@@ -252,6 +255,8 @@ class StudyHandle:
                     overwrite=overwrite,
                     quiet=quiet,
                     figures=figures,
+                    # the README.md sim run writes: the same directory by either door
+                    readme=lambda stage, name: write_run_readme(stage, get_study, name, final=out),
                 )
             except ConfigError as e:
                 if e.key in _ARGUMENTS:  # the command line's option: the argument of run()

@@ -108,7 +108,25 @@ def read_sweep(path: str | Path, schema: Mapping | None = None) -> dict[str, Any
         raise ConfigError("sweep", "is empty: give at least one key to sweep")
     if flat and schema is not None:
         expand(flat, schema)
+        flat = _canonical(flat, schema)
     return flat
+
+
+def _canonical(flat: dict[str, Any], schema: Mapping) -> dict[str, Any]:
+    """A validated sweep table in one spelling, so that one sweep is one config hash: a
+    listed value as its key reads it (``35`` of a float key is ``35.0``), and the reserved
+    entries at their defaults (``replicates = 1``, ``seed_mode = "spawn"``) left out when a
+    key is swept (written, they made another hash of the same cells). A range stays as
+    written."""
+    keys = [k for k in flat if k not in RESERVED]
+    out: dict[str, Any] = {}
+    for k, v in flat.items():
+        if keys and (k, v) in (("replicates", 1), ("seed_mode", "spawn")):
+            continue
+        if k in keys and isinstance(v, list) and isinstance(schema.get(k), Field):
+            v = [check_value(f"sweep.{k}", schema[k], e) for e in v]
+        out[k] = v
+    return out
 
 
 def _is_range(v: Any) -> bool:

@@ -26,6 +26,7 @@ from sim.studies.network.analysis import (
     inner_defect,
     match_points,
 )
+from sim.studies.network.canonical import canonical
 from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.keys import SCHEMA
@@ -83,13 +84,15 @@ def check(cfg: dict) -> None:
     memory (on the sparse path for a large network), the run has the chunks its jackknife
     intervals need (:data:`sim.mc.runner.MIN_CHUNKS`) and
     ``output.inner_over`` can fix the defects. Records the sha256 of ``network.gama_xml`` in
-    ``network.gama_sha256``."""
+    ``network.gama_sha256``, and writes the network's records in their one spelling
+    (:func:`sim.studies.network.canonical.canonical`)."""
     require_chunks(cfg)  # estimates.py and tables.py: jackknife intervals over the chunks
     _digest(cfg)
     full = merge_gama(cfg)
     cfg["datum.kind"] = full["datum.kind"]  # a free gama-local file's inner datum, resolved
     with phase("network: building", shows_phases_of(full)):
         net = _build(full)
+    canonical(cfg)  # its records validated: one spelling, one config hash
     sparse = use_sparse(net)
     nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
     if nbytes > MAX_CHUNK_BYTES:
