@@ -20,7 +20,7 @@ import hashlib
 import logging
 import os
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -28,11 +28,13 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.api_args import arguments as _arguments
-from sim.api_state import anonymous_dir, check_state, state_sha256
+from sim.api_paths import absolute_path as _absolute
+from sim.api_paths import check_path as _check_path
+from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
-from sim.mc.paths import absolute, link_problem
+from sim.mc.paths import link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.pyvalue import as_config_value
@@ -41,6 +43,7 @@ from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
+from sim.studies import get_study
 from sim.studies.picking import load_picking_chunk
 
 __all__ = ["load", "StudyHandle", "Results"]
@@ -167,9 +170,19 @@ class StudyHandle:
     file_sha256: str = field(default="", repr=False)
     #: :func:`sim.api_state.state_sha256` of config, overrides and sweep as loaded ("": none)
     state_sha256: str = field(default="", repr=False)
+    #: the working directory of sim.load(), which a relative ``network.gama_xml`` is read from
+    cwd: str = field(default="", repr=False, compare=False)
 
     def __hash__(self) -> int:  # the dataclass's would hash the config dict: TypeError
         return hash((self.path, self.file_sha256, repr(sorted(self.overrides.items()))))
+
+    def __reduce__(self):  # pickled (a Pool's task): the study by its name, not its closures
+        state = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "study"}
+        try:
+            known = get_study(self.study.name) is self.study
+        except ConfigError:  # a study of the caller's own making: pickled as it is
+            known = False
+        return (_unpickled, (self.study.name if known else self.study, state))
 
     @property
     def name(self) -> str:
@@ -206,9 +219,9 @@ class StudyHandle:
         ``dask``. Output is identical for every executor and worker count. ``figures=False``:
         no PNG is drawn (``sim run --no-figures``), the tables are the same."""
         _check_path("out", out, none_ok=True)  # trials, seed: validated as the config keys
-        for name, v in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures)):
-            if not isinstance(v, bool):
-                raise ConfigError(name, f"must be True or False (got {v!r})")
+        overwrite, quiet, figures = (
+            _flag(*a) for a in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures))
+        )
         _unchanged(self)
         h = (
             self
@@ -329,12 +342,27 @@ def _run_identity(out: Path) -> str:
     return config_hash(rec["config"], rec["code_hash"]) if rec else ""
 
 
+def _flag(name: str, v: Any) -> bool:
+    """A flag of ``run()``: a bool, or a NumPy bool (``np.True_``, from a mask), as a config
+    key takes it (it was refused as "must be True or False (got np.True_)")."""
+    if not isinstance(b := as_config_value(name, v), bool):
+        raise ConfigError(name, f"must be True or False (got {v!r})")
+    return b
+
+
+def _unpickled(study: Any, state: dict) -> StudyHandle:
+    """A pickled :class:`StudyHandle` (:meth:`StudyHandle.__reduce__`) made again; ``study``
+    is a registered study's name, or the study."""
+    return StudyHandle(study=get_study(study) if isinstance(study, str) else study, **state)
+
+
 def _unchanged(h: StudyHandle) -> None:
     """A handle runs the file it loaded: its config is that file's, and ``replace`` or
     ``run(trials=...)`` read the file again, so an edited (or deleted) file would give one
     handle two configs. Refused, as an edited ``network.gama_xml`` is; so is a config changed
     in place (:func:`sim.api_state.check_state`)."""
     check_state(h)
+    check_cwd(h)
     if h.file_sha256 and _sha256(h.path) != h.file_sha256:
         state = "has changed" if h.path.is_file() else "is gone"
         raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
@@ -352,28 +380,6 @@ def _check_owner(p: Path, study: str) -> None:
         raise ConfigError("table", f"{p} is {whose}, not of {study!r}; run the study again")
 
 
-def _check_path(name: str, v: Any, none_ok: bool = False) -> None:
-    if v is None and none_ok:
-        return
-    try:  # an os.PathLike may give bytes, or (a broken one) neither str nor bytes
-        text = os.fspath(v) if isinstance(v, os.PathLike) else v
-    except TypeError:
-        text = None
-    if not isinstance(text, str) or not text.isprintable() or not text.strip():
-        raise ConfigError(name, f"must be a path (a str or os.PathLike of a str), got {v!r}")
-
-
-def _absolute(name: str, v: str | os.PathLike) -> Path:
-    """``v`` made absolute against the working directory, which may have been deleted (then
-    one line naming the argument, not pathlib's FileNotFoundError)."""
-    try:
-        return absolute(v)
-    except OSError as e:
-        raise ConfigError(
-            name, f"{os.fspath(v)} is relative, but the working directory is gone ({e.strerror})"
-        ) from None
-
-
 @_arguments
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
@@ -384,9 +390,13 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the
     # working directory may have changed since (it would read another file of that name)
     study_file = _absolute("study_file", study_file)
-    for k in overrides:
+    for k, v in overrides.items():
         if not _key(k).strip(".").strip() or not k.isprintable():
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
+        if v is None:  # it was "is required" of a key the study file gives
+            raise ConfigError(
+                _key(k), "is None, which no study file holds: leave it out for the file's value"
+            )
     # each value as a study file would hold it (sim.mc.pyvalue): np.int64(40) is 40, a tuple
     # a list, Decimal("0.1") 0.1, an IntEnum member its int: validated and hashed like one
     vals = {k: as_config_value(str(k), v) for k, v in _keyed(overrides).items()}
@@ -396,4 +406,5 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     sweep = read_sweep(study_file, study.schema)
     if _sha256(study_file) != sha:  # written to while it was read: which version is this?
         raise ConfigError("study_file", f"{study_file} changed while it was loaded: load it again")
-    return StudyHandle(study_file, study, cfg, vals, sweep, sha, state_sha256(cfg, vals, sweep))
+    state = state_sha256(cfg, vals, sweep)
+    return StudyHandle(study_file, study, cfg, vals, sweep, sha, state, working_dir())

@@ -14,7 +14,9 @@ integer, a double and a string, in lists and tables. Each value is read as the n
   ``np.longdouble`` is the double nearest it; a ``float`` subclass is the ``float``;
 * a NumPy array, a tuple and a list are lists (at any depth: ``plate.points`` as a tuple of
   tuples or an ``(n, 2)`` array), a 0-d array its element, a mapping a table;
-* ``np.bool_`` is ``bool``; ``np.str_`` and a ``str`` subclass are ``str``.
+* ``np.bool_`` is ``bool``; ``np.str_`` and a ``str`` subclass are ``str``;
+* an ``os.PathLike`` of a ``str`` (``pathlib.Path``) is that ``str``: a file key
+  (``network.gama_xml``) takes the path it is (it was refused as "must be a string").
 
 Anything else (a complex number, a date, ``None``) is passed on as given and refused by the
 key's validation with one line naming the type expected. A bool stays a bool (refused where
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import decimal
 import numbers
+import os
 from collections.abc import Mapping
 from typing import Any
 
@@ -86,6 +89,12 @@ def _scalar(key: str, v: Any) -> Any:
         return str.__str__(v)
     if isinstance(v, np.generic):  # datetime64 and the like: refused by the key, as Python's
         return v.item()
+    if isinstance(v, os.PathLike):  # Path("net.xml"); one of bytes is refused by the key
+        try:
+            text = os.fspath(v)
+        except TypeError:
+            return v
+        return str.__str__(text) if isinstance(text, str) else v
     return v
 
 
