@@ -114,7 +114,15 @@ class Results:
         """The tables of the run: each once; ``chunks`` is the per-trial chunk dataset (also
         ``trials`` when the study writes no ``trials.parquet``)."""
         self._check_dir()
-        names = {p.stem for p in self.path.glob("*.parquet")}
+        files = list(self.path.glob("*.parquet"))
+        names = {p.stem for p in files if _owner(p) == self.study}
+        if files and not names:  # another study's run: its tables, none of which table() reads
+            whose = sorted({repr(o) for p in files if isinstance(o := _owner(p), str)})
+            raise ConfigError(
+                "study",
+                f"{self.path} holds tables of {' and '.join(whose) or 'no study sim ran'}, "
+                f"not of {self.study!r}",
+            )
         if (self.path / "trials").is_dir():
             names |= {"chunks", "trials"}
         return sorted(names)
@@ -368,13 +376,18 @@ def _unchanged(h: StudyHandle) -> None:
         raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
 
 
-def _check_owner(p: Path, study: str) -> None:
-    """A table is ``study``'s: its provenance (written with every table) names the study."""
+def _owner(p: Path) -> Any:
+    """The study a table's provenance (written with every table) names (None: none)."""
     try:
         prov = read_provenance(p)
     except (OSError, ValueError, pa.ArrowException):
         prov = None
-    owner = prov.get("study") if isinstance(prov, dict) else None
+    return prov.get("study") if isinstance(prov, dict) else None
+
+
+def _check_owner(p: Path, study: str) -> None:
+    """A table is ``study``'s (:func:`_owner`)."""
+    owner = _owner(p)
     if owner != study:
         whose = f"a table of {owner!r}" if isinstance(owner, str) else "not a table sim wrote"
         raise ConfigError("table", f"{p} is {whose}, not of {study!r}; run the study again")

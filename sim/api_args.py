@@ -49,7 +49,7 @@ def arguments(fn):
             made = _MADE_BY.get(owner, "an instance")
             return ConfigError(what, f"is called on the class {owner}: call it on {made}")
         for k in kwargs:
-            if known is not None and k not in known:
+            if (known is not None and k not in known) or (method and k == "self"):
                 cfg = getattr(args[0], "config", None) if method and args else None
                 hint = (
                     f"; {_key(k)} is a config key: give it to sim.load() or replace()"

@@ -25,6 +25,10 @@ its fix.
   (:func:`sim.execute._this_process`);
 * ``run(quiet=np.True_)`` (a flag from a NumPy mask) was refused as "must be True or False
   (got np.True_)", where every config key takes a NumPy bool as the bool.
+* ``Results(path, study).names()`` of another study's results listed that study's tables,
+  each of which ``table()`` then refused: it refuses the directory, naming whose tables it
+  holds, and lists only the study's own;
+* ``replace(self=1)`` said "missing: StudyHandle.replace() needs it": ``self`` is no argument.
 
 Held (found right): ``Path``, an ``os.PathLike`` of the user's, a str subclass and
 ``np.str_`` for ``study_file``, ``out`` and ``sim.Results``; bytes paths refused in one line;
@@ -50,7 +54,7 @@ import pytest
 import sim
 from sim.mc.config import ConfigError
 from sim.mc.outputs import stage_dir
-from sim.mc.storage import StageLock
+from sim.mc.storage import StageLock, write_table
 
 ROOT = Path(__file__).resolve().parents[1]
 PLATE = str(ROOT / "studies" / "network_plate.toml")
@@ -165,3 +169,15 @@ def test_run_takes_numpy_bools_for_its_flags(tmp_path):
     with pytest.raises(ConfigError, match=r"^overwrite: must be True or False \(got 1\)"):
         sim.load(PLATE, **SMALL).run(overwrite=1)
     assert os.path.isdir(tmp_path / "o")
+
+
+def test_names_of_another_studys_results_are_refused(tmp_path):
+    write_table(tmp_path / "claims.parquet", {"claim": ["c"], "verdict": ["holds"]}, {"study": "x"})
+    assert sim.Results(tmp_path, "x").names() == ["claims"]
+    with pytest.raises(ConfigError, match=f"^study: {tmp_path} holds tables of 'x', not of 'y'$"):
+        sim.Results(tmp_path, "y").names()  # it listed x's tables, each then refused
+
+
+def test_self_as_a_keyword_is_no_argument():
+    with pytest.raises(ConfigError, match=r"^self: StudyHandle.replace\(\) takes no argument"):
+        sim.load(TABLE1).replace(self=1)  # it was "missing: StudyHandle.replace() needs it"
