@@ -403,16 +403,17 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the
     # working directory may have changed since (it would read another file of that name)
     study_file = _absolute("study_file", study_file)
-    for k, v in overrides.items():
+    for k in overrides:
         if not _key(k).strip(".").strip() or not k.isprintable():
             raise ConfigError(repr(k), "is not a config key (a dotted name such as 'trials')")
-        if v is None:  # it was "is required" of a key the study file gives
-            raise ConfigError(
-                _key(k), "is None, which no study file holds: leave it out for the file's value"
-            )
     # each value as a study file would hold it (sim.mc.pyvalue): np.int64(40) is 40, a tuple
     # a list, Decimal("0.1") 0.1, an IntEnum member its int: validated and hashed like one
     vals = {k: as_config_value(str(k), v) for k, v in _keyed(overrides).items()}
+    for k, v in vals.items():
+        if v is None:  # it was "is required" of a key the study file gives
+            raise ConfigError(
+                k, "is None, which no study file holds: leave it out for the file's value"
+            )
     sha = _sha256(study_file)
     picks = "trials" in vals and "chunk" not in vals  # sim run --trials's chunk
     study, cfg = load_picking_chunk(study_file, picks, values=vals)

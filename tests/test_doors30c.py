@@ -29,6 +29,12 @@ its fix.
   each of which ``table()`` then refused: it refuses the directory, naming whose tables it
   holds, and lists only the study's own;
 * ``replace(self=1)`` said "missing: StudyHandle.replace() needs it": ``self`` is no argument.
+* a pyarrow array or column (the suite's own tables: ``res.table("points").column(...)``)
+  where a list goes was refused in a message of twenty lines (its repr), and so was any
+  array-like of another library (a pandas Series); a pyarrow scalar was "must be a number
+  (got <pyarrow.DoubleScalar: 0.5>)". Each is now the list (the value) it holds
+  (:mod:`sim.mc.pyvalue`), and a refusal that quotes a many-line repr is one line
+  (:func:`sim.api_args.one_line`).
 
 Held (found right): ``Path``, an ``os.PathLike`` of the user's, a str subclass and
 ``np.str_`` for ``study_file``, ``out`` and ``sim.Results``; bytes paths refused in one line;
@@ -49,6 +55,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
 import pytest
 
 import sim
@@ -181,3 +188,29 @@ def test_names_of_another_studys_results_are_refused(tmp_path):
 def test_self_as_a_keyword_is_no_argument():
     with pytest.raises(ConfigError, match=r"^self: StudyHandle.replace\(\) takes no argument"):
         sim.load(TABLE1).replace(self=1)  # it was "missing: StudyHandle.replace() needs it"
+
+
+class _Rows:  # an array-like of another library, printed over lines (a pandas Series)
+    def __init__(self, rows, fails=False):
+        self.rows, self.fails = rows, fails
+
+    def __array__(self, dtype=None, copy=None):
+        if self.fails:
+            raise ValueError("cannot")
+        return np.array(self.rows)
+
+    def __repr__(self) -> str:
+        return "Rows(\n  ...\n)"
+
+
+def test_array_likes_are_lists_and_a_refusal_is_one_line():
+    pts = [[0.0, 0.0], [100.0, 0.0], [0.0, 100.0], [100.0, 100.0], [50.0, 50.0]]
+    for v in (pa.array(pts), pa.table({"p": pts}).column("p"), _Rows(pts)):
+        st = sim.load(TABLE1, plate__pattern="list", plate__points=v)
+        assert st.config["plate.points"] == pts
+    assert sim.load(TABLE1, trials=pa.scalar(40), chunk=2).config["trials"] == 40
+    with pytest.raises(ConfigError) as info:
+        sim.load(TABLE1, plate__pattern="list", plate__points=_Rows(pts, fails=True))
+    assert str(info.value) == "plate.points: must be a list (got Rows( ... ))"
+    with pytest.raises(ConfigError, match=r"^workers: .* \(got Rows\( \.\.\. \)\)$"):
+        sim.load(TABLE1).run(workers=_Rows(1))

@@ -13,7 +13,10 @@ integer, a double and a string, in lists and tables. Each value is read as the n
   binary value ``0.10000000149011612``), as the same digits typed into a study file would be;
   ``np.longdouble`` is the double nearest it; a ``float`` subclass is the ``float``;
 * a NumPy array, a tuple and a list are lists (at any depth: ``plate.points`` as a tuple of
-  tuples or an ``(n, 2)`` array), a 0-d array its element, a mapping a table;
+  tuples or an ``(n, 2)`` array), a 0-d array its element, a mapping a table; so are a
+  pyarrow array or column (the suite's own tables: ``res.table("points").column("x_mm")``)
+  and any other array-like (``__array__``: a pandas Series, a DataFrame as rows), whose
+  many-line repr a refusal quoted over many lines; a pyarrow scalar is its Python value;
 * ``np.bool_`` is ``bool``; ``np.str_`` and a ``str`` subclass are ``str``;
 * an ``os.PathLike`` of a ``str`` (``pathlib.Path``) is that ``str``: a file key
   (``network.gama_xml``) takes the path it is (it was refused as "must be a string").
@@ -32,6 +35,7 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+import pyarrow as pa
 
 from sim.mc.config import ConfigError, refuse_big_ints
 
@@ -108,6 +112,17 @@ def as_config_value(key: str, v: Any) -> Any:
 
 
 def _convert(key: str, v: Any) -> Any:
+    if isinstance(v, (pa.Array, pa.ChunkedArray)):
+        return _convert(key, v.to_pylist())
+    if isinstance(v, pa.Scalar):
+        return _convert(key, v.as_py())
+    if not isinstance(v, (np.ndarray, np.generic, str, bytes, Mapping)) and hasattr(
+        type(v), "__array__"
+    ):
+        try:
+            v = np.asarray(v)
+        except (TypeError, ValueError):  # refused by the key, naming its type
+            return v
     if isinstance(v, np.ndarray):
         if v.ndim == 0:
             return _convert(key, v[()])
