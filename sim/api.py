@@ -101,6 +101,14 @@ class Results:
                 f"(run again into it since): read it with sim.Results(path, {self.study!r})",
             )
 
+    def _within(self) -> str:
+        """``; <path>/<study> is its results directory: ...`` where ``path`` is a results root
+        (``sim.Results("results", "network")``, for ``results/network``), else ""."""
+        inner = self.path / self.study
+        if not any(inner.glob("*.parquet")):
+            return ""
+        return f"; {inner} holds the study's results: give that path"
+
     def _dataset(self, name: str) -> bool:
         """Whether ``name`` is the chunk dataset ``trials/``: ``chunks`` always, ``trials``
         unless the study writes a table ``trials.parquet`` of its own (wolf, agnard,
@@ -121,7 +129,7 @@ class Results:
             raise ConfigError(
                 "study",
                 f"{self.path} holds tables of {' and '.join(whose) or 'no study sim ran'}, "
-                f"not of {self.study!r}",
+                f"not of {self.study!r}{self._within()}",
             )
         if (self.path / "trials").is_dir():
             names |= {"chunks", "trials"}
@@ -137,7 +145,9 @@ class Results:
         dataset = self._dataset(name)
         p = self.path / ("trials" if dataset else f"{name}.parquet")
         if not p.exists() and not self.names():  # not "no table 'claims'; it has " (none)
-            raise ConfigError("path", f"{self.path} is not a results directory (no tables)")
+            raise ConfigError(
+                "path", f"{self.path} is not a results directory (no tables){self._within()}"
+            )
         if not p.exists():
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"

@@ -27,7 +27,8 @@ its fix.
   (got np.True_)", where every config key takes a NumPy bool as the bool.
 * ``Results(path, study).names()`` of another study's results listed that study's tables,
   each of which ``table()`` then refused: it refuses the directory, naming whose tables it
-  holds, and lists only the study's own;
+  holds (and ``<path>/<study>`` where ``path`` is a results root), and lists only the
+  study's own;
 * ``replace(self=1)`` said "missing: StudyHandle.replace() needs it": ``self`` is no argument.
 * a pyarrow array or column (the suite's own tables: ``res.table("points").column(...)``)
   where a list goes was refused in a message of twenty lines (its repr), and so was any
@@ -179,10 +180,13 @@ def test_run_takes_numpy_bools_for_its_flags(tmp_path):
 
 
 def test_names_of_another_studys_results_are_refused(tmp_path):
-    write_table(tmp_path / "claims.parquet", {"claim": ["c"], "verdict": ["holds"]}, {"study": "x"})
-    assert sim.Results(tmp_path, "x").names() == ["claims"]
-    with pytest.raises(ConfigError, match=f"^study: {tmp_path} holds tables of 'x', not of 'y'$"):
-        sim.Results(tmp_path, "y").names()  # it listed x's tables, each then refused
+    d = tmp_path / "x"
+    write_table(d / "claims.parquet", {"claim": ["c"], "verdict": ["holds"]}, {"study": "x"})
+    assert sim.Results(d, "x").names() == ["claims"]
+    with pytest.raises(ConfigError, match=f"^study: {d} holds tables of 'x', not of 'y'$"):
+        sim.Results(d, "y").names()  # it listed x's tables, each then refused
+    with pytest.raises(ConfigError, match=f"; {d} holds the study's results: give that path$"):
+        sim.Results(tmp_path, "x").claims()  # the results root, for its study's directory
 
 
 def test_self_as_a_keyword_is_no_argument():
