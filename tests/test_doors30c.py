@@ -36,6 +36,10 @@ its fix.
   (got <pyarrow.DoubleScalar: 0.5>)". Each is now the list (the value) it holds
   (:mod:`sim.mc.pyvalue`), and a refusal that quotes a many-line repr is one line
   (:func:`sim.api_args.one_line`).
+* a ``range``, a ``deque`` or ``d.keys()`` where a list goes was "must be a list (got
+  range(0, 3))"; a generator or ``zip`` "(got <zip object at 0x7f...>)", a set alike: a
+  sequence is now the list, and an iterator (read once) or a set (no order) is named as one
+  with what to give.
 
 Held (found right): ``Path``, an ``os.PathLike`` of the user's, a str subclass and
 ``np.str_`` for ``study_file``, ``out`` and ``sim.Results``; bytes paths refused in one line;
@@ -49,6 +53,7 @@ directories; a pickled handle run in a spawned and a forkserver pool.
 
 from __future__ import annotations
 
+import collections
 import multiprocessing
 import os
 import pickle
@@ -218,3 +223,18 @@ def test_array_likes_are_lists_and_a_refusal_is_one_line():
     assert str(info.value) == "plate.points: must be a list (got Rows( ... ))"
     with pytest.raises(ConfigError, match=r"^workers: .* \(got Rows\( \.\.\. \)\)$"):
         sim.load(TABLE1).run(workers=_Rows(1))
+
+
+def test_sequences_are_lists_and_iterators_or_sets_are_named():
+    names = {"G1": 1, "G5": 2}
+    for v in (collections.deque(["G1", "G5"]), names.keys(), range(0)):
+        st = sim.load(PLATE, datum__kind="inner", datum__points=v)
+        assert st.config["datum.points"] == list(v)
+    for v, words in (
+        ((n for n in names), r"an iterator, read once \(generator\)"),
+        (set(names), "a set"),
+    ):
+        with pytest.raises(ConfigError, match=f"^datum.points: is {words}.*: give a list"):
+            sim.load(PLATE, datum__points=v)  # "must be a list (got <generator object ...>)"
+    with pytest.raises(ConfigError, match="^datum.points: has 1000000000000 entries, over"):
+        sim.load(PLATE, datum__points=range(10**12))

@@ -17,6 +17,8 @@ integer, a double and a string, in lists and tables. Each value is read as the n
   pyarrow array or column (the suite's own tables: ``res.table("points").column("x_mm")``)
   and any other array-like (``__array__``: a pandas Series, a DataFrame as rows), whose
   many-line repr a refusal quoted over many lines; a pyarrow scalar is its Python value;
+* another sequence (a ``range``, a ``deque``, ``d.keys()``) is a list; an iterator (a generator, ``zip``,
+  ``map``: read once) and a set (no order) are refused, saying to give a list;
 * ``np.bool_`` is ``bool``; ``np.str_`` and a ``str`` subclass are ``str``;
 * an ``os.PathLike`` of a ``str`` (``pathlib.Path``) is that ``str``: a file key
   (``network.gama_xml``) takes the path it is (it was refused as "must be a string").
@@ -31,7 +33,7 @@ from __future__ import annotations
 import decimal
 import numbers
 import os
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping, MappingView, Sequence, Set
 from typing import Any
 
 import numpy as np
@@ -43,6 +45,8 @@ __all__ = ["as_config_value"]
 
 #: most digits of an integral Decimal converted to an int (any over 19 is refused anyway)
 _MAX_DIGITS = 4000
+#: most entries of a sequence other than a list or tuple (a ``range``) made a list
+_MAX_ITEMS = 10**6
 
 
 def _decimal(key: str, v: decimal.Decimal) -> Any:
@@ -131,6 +135,17 @@ def _convert(key: str, v: Any) -> Any:
         return [_convert(key, x) for x in v]
     if isinstance(v, (list, tuple)):
         return [_convert(key, x) for x in v]
+    if isinstance(v, MappingView) or (
+        isinstance(v, Sequence) and not isinstance(v, (str, bytes, bytearray, memoryview))
+    ):
+        if len(v) > _MAX_ITEMS:  # range(10**12) is no list to make
+            raise ConfigError(key, f"has {len(v)} entries, over {_MAX_ITEMS}")
+        return [_convert(key, x) for x in v]
+    if isinstance(v, (Iterator, Set)):  # refused by the key as "<zip object at 0x7f...>"
+        what = "a set, which has no order" if isinstance(v, Set) else "an iterator, read once"
+        raise ConfigError(
+            key, f"is {what} ({type(v).__name__}): give a list (list(...) or sorted(...))"
+        )
     if isinstance(v, Mapping):
         out = {}
         for k, x in v.items():
