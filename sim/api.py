@@ -20,7 +20,7 @@ import hashlib
 import logging
 import os
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -28,11 +28,13 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.api_args import arguments as _arguments
-from sim.api_state import anonymous_dir, check_state, state_sha256
+from sim.api_paths import absolute_path as _absolute
+from sim.api_paths import check_path as _check_path
+from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
-from sim.mc.paths import absolute, link_problem
+from sim.mc.paths import link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.pyvalue import as_config_value
@@ -100,6 +102,14 @@ class Results:
                 f"(run again into it since): read it with sim.Results(path, {self.study!r})",
             )
 
+    def _within(self) -> str:
+        """``; <path>/<study> is its results directory: ...`` where ``path`` is a results root
+        (``sim.Results("results", "network")``, for ``results/network``), else ""."""
+        inner = self.path / self.study
+        if not any(inner.glob("*.parquet")):
+            return ""
+        return f"; {inner} holds the study's results: give that path"
+
     def _dataset(self, name: str) -> bool:
         """Whether ``name`` is the chunk dataset ``trials/``: ``chunks`` always, ``trials``
         unless the study writes a table ``trials.parquet`` of its own (wolf, agnard,
@@ -113,7 +123,15 @@ class Results:
         """The tables of the run: each once; ``chunks`` is the per-trial chunk dataset (also
         ``trials`` when the study writes no ``trials.parquet``)."""
         self._check_dir()
-        names = {p.stem for p in self.path.glob("*.parquet")}
+        files = list(self.path.glob("*.parquet"))
+        names = {p.stem for p in files if _owner(p) == self.study}
+        if files and not names:  # another study's run: its tables, none of which table() reads
+            whose = sorted({repr(o) for p in files if isinstance(o := _owner(p), str)})
+            raise ConfigError(
+                "study",
+                f"{self.path} holds tables of {' and '.join(whose) or 'no study sim ran'}, "
+                f"not of {self.study!r}{self._within()}",
+            )
         if (self.path / "trials").is_dir():
             names |= {"chunks", "trials"}
         return sorted(names)
@@ -128,7 +146,9 @@ class Results:
         dataset = self._dataset(name)
         p = self.path / ("trials" if dataset else f"{name}.parquet")
         if not p.exists() and not self.names():  # not "no table 'claims'; it has " (none)
-            raise ConfigError("path", f"{self.path} is not a results directory (no tables)")
+            raise ConfigError(
+                "path", f"{self.path} is not a results directory (no tables){self._within()}"
+            )
         if not p.exists():
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
@@ -169,9 +189,19 @@ class StudyHandle:
     file_sha256: str = field(default="", repr=False)
     #: :func:`sim.api_state.state_sha256` of config, overrides and sweep as loaded ("": none)
     state_sha256: str = field(default="", repr=False)
+    #: the working directory of sim.load(), which a relative ``network.gama_xml`` is read from
+    cwd: str = field(default="", repr=False, compare=False)
 
     def __hash__(self) -> int:  # the dataclass's would hash the config dict: TypeError
         return hash((self.path, self.file_sha256, repr(sorted(self.overrides.items()))))
+
+    def __reduce__(self):  # pickled (a Pool's task): the study by its name, not its closures
+        state = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "study"}
+        try:
+            known = get_study(self.study.name) is self.study
+        except ConfigError:  # a study of the caller's own making: pickled as it is
+            known = False
+        return (_unpickled, (self.study.name if known else self.study, state))
 
     @property
     def name(self) -> str:
@@ -209,9 +239,9 @@ class StudyHandle:
         every executor and worker count. ``figures=False``: no PNG is drawn (``sim run
         --no-figures``), the tables are the same."""
         _check_path("out", out, none_ok=True)  # trials, seed: validated as the config keys
-        for name, v in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures)):
-            if not isinstance(v, bool):
-                raise ConfigError(name, f"must be True or False (got {v!r})")
+        overwrite, quiet, figures = (
+            _flag(*a) for a in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures))
+        )
         _unchanged(self)
         h = (
             self
@@ -334,49 +364,47 @@ def _run_identity(out: Path) -> str:
     return config_hash(rec["config"], rec["code_hash"]) if rec else ""
 
 
+def _flag(name: str, v: Any) -> bool:
+    """A flag of ``run()``: a bool, or a NumPy bool (``np.True_``, from a mask), as a config
+    key takes it (it was refused as "must be True or False (got np.True_)")."""
+    if not isinstance(b := as_config_value(name, v), bool):
+        raise ConfigError(name, f"must be True or False (got {v!r})")
+    return b
+
+
+def _unpickled(study: Any, state: dict) -> StudyHandle:
+    """A pickled :class:`StudyHandle` (:meth:`StudyHandle.__reduce__`) made again; ``study``
+    is a registered study's name, or the study."""
+    return StudyHandle(study=get_study(study) if isinstance(study, str) else study, **state)
+
+
 def _unchanged(h: StudyHandle) -> None:
     """A handle runs the file it loaded: its config is that file's, and ``replace`` or
     ``run(trials=...)`` read the file again, so an edited (or deleted) file would give one
     handle two configs. Refused, as an edited ``network.gama_xml`` is; so is a config changed
     in place (:func:`sim.api_state.check_state`)."""
     check_state(h)
+    check_cwd(h)
     if h.file_sha256 and _sha256(h.path) != h.file_sha256:
         state = "has changed" if h.path.is_file() else "is gone"
         raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
 
 
-def _check_owner(p: Path, study: str) -> None:
-    """A table is ``study``'s: its provenance (written with every table) names the study."""
+def _owner(p: Path) -> Any:
+    """The study a table's provenance (written with every table) names (None: none)."""
     try:
         prov = read_provenance(p)
     except (OSError, ValueError, pa.ArrowException):
         prov = None
-    owner = prov.get("study") if isinstance(prov, dict) else None
+    return prov.get("study") if isinstance(prov, dict) else None
+
+
+def _check_owner(p: Path, study: str) -> None:
+    """A table is ``study``'s (:func:`_owner`)."""
+    owner = _owner(p)
     if owner != study:
         whose = f"a table of {owner!r}" if isinstance(owner, str) else "not a table sim wrote"
         raise ConfigError("table", f"{p} is {whose}, not of {study!r}; run the study again")
-
-
-def _check_path(name: str, v: Any, none_ok: bool = False) -> None:
-    if v is None and none_ok:
-        return
-    try:  # an os.PathLike may give bytes, or (a broken one) neither str nor bytes
-        text = os.fspath(v) if isinstance(v, os.PathLike) else v
-    except TypeError:
-        text = None
-    if not isinstance(text, str) or not text.isprintable() or not text.strip():
-        raise ConfigError(name, f"must be a path (a str or os.PathLike of a str), got {v!r}")
-
-
-def _absolute(name: str, v: str | os.PathLike) -> Path:
-    """``v`` made absolute against the working directory, which may have been deleted (then
-    one line naming the argument, not pathlib's FileNotFoundError)."""
-    try:
-        return absolute(v)
-    except OSError as e:
-        raise ConfigError(
-            name, f"{os.fspath(v)} is relative, but the working directory is gone ({e.strerror})"
-        ) from None
 
 
 @_arguments
@@ -395,10 +423,16 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     # each value as a study file would hold it (sim.mc.pyvalue): np.int64(40) is 40, a tuple
     # a list, Decimal("0.1") 0.1, an IntEnum member its int: validated and hashed like one
     vals = {k: as_config_value(str(k), v) for k, v in _keyed(overrides).items()}
+    for k, v in vals.items():
+        if v is None:  # it was "is required" of a key the study file gives
+            raise ConfigError(
+                k, "is None, which no study file holds: leave it out for the file's value"
+            )
     sha = _sha256(study_file)
     picks = "trials" in vals and "chunk" not in vals  # sim run --trials's chunk
     study, cfg = load_picking_chunk(study_file, picks, values=vals)
     sweep = read_sweep(study_file, study.schema)
     if _sha256(study_file) != sha:  # written to while it was read: which version is this?
         raise ConfigError("study_file", f"{study_file} changed while it was loaded: load it again")
-    return StudyHandle(study_file, study, cfg, vals, sweep, sha, state_sha256(cfg, vals, sweep))
+    state = state_sha256(cfg, vals, sweep)
+    return StudyHandle(study_file, study, cfg, vals, sweep, sha, state, working_dir())

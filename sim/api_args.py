@@ -10,7 +10,7 @@ import inspect
 
 from sim.mc.config import ConfigError
 
-__all__ = ["arguments"]
+__all__ = ["arguments", "one_line"]
 
 
 def _key(k: str) -> str:
@@ -49,7 +49,7 @@ def arguments(fn):
             made = _MADE_BY.get(owner, "an instance")
             return ConfigError(what, f"is called on the class {owner}: call it on {made}")
         for k in kwargs:
-            if known is not None and k not in known:
+            if (known is not None and k not in known) or (method and k == "self"):
                 cfg = getattr(args[0], "config", None) if method and args else None
                 hint = (
                     f"; {_key(k)} is a config key: give it to sim.load() or replace()"
@@ -83,6 +83,20 @@ def arguments(fn):
             sig.bind(*args, **kwargs)
         except TypeError:
             raise refusal(args, kwargs) from None
-        return fn(*args, **kwargs)
+        try:
+            return fn(*args, **kwargs)
+        except ConfigError as e:
+            if len(str(e).splitlines()) < 2:
+                raise
+            raise one_line(e) from None
 
     return checked
+
+
+def one_line(e: ConfigError) -> ConfigError:
+    """``e`` in one line: a refusal that quotes a value of the caller's by its ``repr`` (an
+    object of a library whose repr spans lines, ``got Bad(\n...)``) spanned as many."""
+    flat = ConfigError(e.key, "")
+    flat.__dict__.update(e.__dict__)
+    flat.args = (" ".join(t.strip() for t in str(e).splitlines() if t.strip()),)
+    return flat

@@ -9,6 +9,8 @@ directory a run without ``out`` makes.
   other study's). :func:`state_sha256` is taken when the handle is made; a run, an estimate
   or ``replace`` refuses a handle whose state differs (:func:`check_state`), naming
   ``replace()``, the way to change a key.
+- A relative ``network.gama_xml`` is read from the working directory: a handle keeps the one
+  of :func:`sim.load` and refuses to run or ``replace`` in another (:func:`check_cwd`).
 - ``run(out=None)`` makes ``$TMPDIR/sim-<study>-XXXX/``; a run that failed or was interrupted
   left it behind, empty or holding a staging directory whose path the caller was never told
   (one per Ctrl-C or refused run: unreachable, never resumed, never removed).
@@ -27,7 +29,10 @@ from typing import Any
 
 from sim.mc.config import ConfigError
 
-__all__ = ["state_sha256", "check_state", "anonymous_dir"]
+__all__ = ["state_sha256", "check_state", "check_cwd", "working_dir", "anonymous_dir"]
+
+#: the config keys whose relative path is read from the working directory
+_FROM_CWD = ("network.gama_xml",)
 
 
 def state_sha256(config: dict, overrides: dict, sweep: dict) -> str:
@@ -48,6 +53,30 @@ def check_state(h: Any) -> None:
             "the handle's config, overrides or sweep were changed in place since sim.load() "
             "(unvalidated): use handle.replace(key=value), or sim.load() again",
         )
+
+
+def working_dir() -> str:
+    """The working directory ("" where it was removed)."""
+    try:
+        return os.getcwd()
+    except OSError:
+        return ""
+
+
+def check_cwd(h: Any) -> None:
+    """A relative path of :data:`_FROM_CWD` in ``h``'s config is read from the working
+    directory of :func:`sim.load`: after an ``os.chdir`` a run read another directory's file
+    of that name and said it "has changed since the study was loaded", and ``replace`` or
+    ``run(trials=...)`` loaded that other file's network without a word."""
+    now = working_dir()
+    for key in _FROM_CWD:
+        v = h.config.get(key)
+        if h.cwd and now != h.cwd and isinstance(v, str) and v and not os.path.isabs(v):
+            raise ConfigError(
+                key,
+                f"{v} is read from the working directory, {h.cwd} at sim.load() and "
+                f"{now or 'gone'} now: os.chdir back, or give {key} as an absolute path",
+            )
 
 
 @contextlib.contextmanager

@@ -228,7 +228,10 @@ def execute(
     lock = None
     try:
         dropped = _replaced(stage, record) if overwrite else None
-        lock, resumed = prepare_stage(stage, out, shown, record, overwrite)
+        try:
+            lock, resumed = prepare_stage(stage, out, shown, record, overwrite)
+        except ConfigError as e:
+            raise _this_process(e) from None
         # again, under the lock: another run may have published into out since the check
         # above (a Dask cluster or a pool starting in between): its results are not ours
         check_out(out, shown, record, overwrite)
@@ -295,6 +298,17 @@ def execute(
         raise
     lock.release()
     return est
+
+
+def _this_process(e: ConfigError) -> ConfigError:
+    """``e``, or when it names this process as the running sim that writes ``out`` (two runs
+    of the API in threads of one notebook), in words that say so: "(pid 9485)" named the
+    caller's own kernel as the process to wait for (or to kill)."""
+    me = f"(pid {os.getpid()})"
+    if me not in str(e):
+        return e
+    msg = str(e).removeprefix(f"{e.key}: ").replace(me, "(another run in this process: a thread)")
+    return ConfigError(e.key, msg)
 
 
 def _replaced(stage: Path, record: dict) -> str | None:

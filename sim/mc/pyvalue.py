@@ -14,8 +14,15 @@ integer, a double and a string, in lists and tables. Each value is read as the n
   ``np.longdouble`` is the double nearest it (refused as a ``Decimal`` is when
   no double holds it: ``1e-4000``); a ``float`` subclass is the ``float``;
 * a NumPy array, a tuple and a list are lists (at any depth: ``plate.points`` as a tuple of
-  tuples or an ``(n, 2)`` array), a 0-d array its element, a mapping a table;
-* ``np.bool_`` is ``bool``; ``np.str_`` and a ``str`` subclass are ``str``.
+  tuples or an ``(n, 2)`` array), a 0-d array its element, a mapping a table; so are a
+  pyarrow array or column (the suite's own tables: ``res.table("points").column("x_mm")``)
+  and any other array-like (``__array__``: a pandas Series, a DataFrame as rows), whose
+  many-line repr a refusal quoted over many lines; a pyarrow scalar is its Python value;
+* another sequence (a ``range``, a ``deque``, ``d.keys()``) is a list; an iterator (a generator, ``zip``,
+  ``map``: read once) and a set (no order) are refused, saying to give a list;
+* ``np.bool_`` is ``bool``; ``np.str_`` and a ``str`` subclass are ``str``;
+* an ``os.PathLike`` of a ``str`` (``pathlib.Path``) is that ``str``: a file key
+  (``network.gama_xml``) takes the path it is (it was refused as "must be a string").
 
 Anything else (a complex number, a date, ``None``) is passed on as given and refused by the
 key's validation with one line naming the type expected. A bool stays a bool (refused where
@@ -26,10 +33,12 @@ from __future__ import annotations
 
 import decimal
 import numbers
-from collections.abc import Mapping
+import os
+from collections.abc import Iterator, Mapping, MappingView, Sequence, Set
 from typing import Any
 
 import numpy as np
+import pyarrow as pa
 
 from sim.mc.config import ConfigError, refuse_big_ints
 from sim.mc.numtext import unheld
@@ -38,6 +47,8 @@ __all__ = ["as_config_value"]
 
 #: most digits of an integral Decimal converted to an int (any over 19 is refused anyway)
 _MAX_DIGITS = 4000
+#: most entries of a sequence other than a list or tuple (a ``range``) made a list
+_MAX_ITEMS = 10**6
 
 
 def _decimal(key: str, v: decimal.Decimal) -> Any:
@@ -87,6 +98,12 @@ def _scalar(key: str, v: Any) -> Any:
         return str.__str__(v)
     if isinstance(v, np.generic):  # datetime64 and the like: refused by the key, as Python's
         return v.item()
+    if isinstance(v, os.PathLike):  # Path("net.xml"); one of bytes is refused by the key
+        try:
+            text = os.fspath(v)
+        except TypeError:
+            return v
+        return str.__str__(text) if isinstance(text, str) else v
     return v
 
 
@@ -100,6 +117,17 @@ def as_config_value(key: str, v: Any) -> Any:
 
 
 def _convert(key: str, v: Any) -> Any:
+    if isinstance(v, (pa.Array, pa.ChunkedArray)):
+        return _convert(key, v.to_pylist())
+    if isinstance(v, pa.Scalar):
+        return _convert(key, v.as_py())
+    if not isinstance(v, (np.ndarray, np.generic, str, bytes, Mapping)) and hasattr(
+        type(v), "__array__"
+    ):
+        try:
+            v = np.asarray(v)
+        except (TypeError, ValueError):  # refused by the key, naming its type
+            return v
     if isinstance(v, np.ndarray):
         if v.ndim == 0:
             return _convert(key, v[()])
@@ -108,6 +136,17 @@ def _convert(key: str, v: Any) -> Any:
         return [_convert(key, x) for x in v]
     if isinstance(v, (list, tuple)):
         return [_convert(key, x) for x in v]
+    if isinstance(v, MappingView) or (
+        isinstance(v, Sequence) and not isinstance(v, (str, bytes, bytearray, memoryview))
+    ):
+        if len(v) > _MAX_ITEMS:  # range(10**12) is no list to make
+            raise ConfigError(key, f"has {len(v)} entries, over {_MAX_ITEMS}")
+        return [_convert(key, x) for x in v]
+    if isinstance(v, (Iterator, Set)):  # refused by the key as "<zip object at 0x7f...>"
+        what = "a set, which has no order" if isinstance(v, Set) else "an iterator, read once"
+        raise ConfigError(
+            key, f"is {what} ({type(v).__name__}): give a list (list(...) or sorted(...))"
+        )
     if isinstance(v, Mapping):
         out = {}
         for k, x in v.items():

@@ -1,0 +1,59 @@
+"""The paths a Python caller gives the API (``sim.load(study_file)``, ``run(out=...)``,
+``sim.Results(path, ...)``), checked as the command line checks its own.
+
+A path is a ``str`` or an ``os.PathLike`` of one (``pathlib.Path``, a str subclass), printable
+and not blank. Python expands neither ``~`` nor ``$HOME`` in a path (a shell does, on the
+command line): ``run(out="~/runs/x")`` made a directory named ``~`` in the working directory,
+which ``rm -rf ~`` would then mistake for home, and ``"$HOME/runs/x"`` one named ``$HOME``.
+A path that starts with ``~`` or names a variable of the environment (``$HOME``, ``${HOME}``)
+is refused, naming the argument and the function that expands it, unless a file of that
+very name exists (an earlier ``./~`` is the caller's to read).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from sim.mc.config import ConfigError
+from sim.mc.paths import absolute
+
+__all__ = ["check_path", "absolute_path"]
+
+
+def check_path(name: str, v: Any, none_ok: bool = False) -> None:
+    """``v`` is a path the API can take as argument ``name`` (module docstring)."""
+    if v is None and none_ok:
+        return
+    try:  # an os.PathLike may give bytes, or (a broken one) neither str nor bytes
+        text = os.fspath(v) if isinstance(v, os.PathLike) else v
+    except TypeError:
+        text = None
+    if not isinstance(text, str) or not text.isprintable() or not text.strip():
+        raise ConfigError(name, f"must be a path (a str or os.PathLike of a str), got {v!r}")
+    if os.path.lexists(text):
+        return
+    if text.startswith("~"):
+        raise ConfigError(
+            name,
+            f"{text} starts with '~', which Python does not expand: give "
+            f"os.path.expanduser({text!r}) (./~ names a file that starts with ~)",
+        )
+    if os.path.expandvars(text) != text:
+        raise ConfigError(
+            name,
+            f"{text} names an environment variable, which Python does not expand: give "
+            f"os.path.expandvars({text!r})",
+        )
+
+
+def absolute_path(name: str, v: str | os.PathLike) -> Path:
+    """``v`` made absolute against the working directory, which may have been deleted (then
+    one line naming the argument, not pathlib's FileNotFoundError)."""
+    try:
+        return absolute(v)
+    except OSError as e:
+        raise ConfigError(
+            name, f"{os.fspath(v)} is relative, but the working directory is gone ({e.strerror})"
+        ) from None
