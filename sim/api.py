@@ -138,7 +138,7 @@ class Results:
         try:
             table = pq.read_table(p)
         except (OSError, pa.ArrowException) as e:
-            raise ConfigError("table", f"{p} cannot be read ({type(e).__name__})") from None
+            raise ConfigError("table", f"{p} cannot be read ({_why(e)})") from None
         if not dataset:
             _check_owner(p, self.study)
             if (mixed := mixed_run(self.path, [p.name])) is not None:  # copied from another run
@@ -314,10 +314,15 @@ _LIMITS = (
 
 
 def _sha256(path: Path) -> str:
+    """The study file's sha256 ("": it is gone). A file that cannot be read (EACCES, EIO) is
+    one line saying so: it was taken for a file that "has changed since sim.load()" (or
+    "changed while it was loaded"), and a handle loaded then checked nothing."""
     try:
         return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
+    except FileNotFoundError:
         return ""
+    except OSError as e:
+        raise ConfigError("study_file", f"{path} cannot be read ({_why(e)})") from None
 
 
 def _run_identity(out: Path) -> str:
@@ -344,12 +349,22 @@ def _check_owner(p: Path, study: str) -> None:
     """A table is ``study``'s: its provenance (written with every table) names the study."""
     try:
         prov = read_provenance(p)
-    except (OSError, ValueError, pa.ArrowException):
+    except OSError as e:  # EIO, EACCES: it was "not a table sim wrote; run the study again"
+        raise ConfigError("table", f"{p} cannot be read ({_why(e)})") from None
+    except (ValueError, pa.ArrowException):
         prov = None
     owner = prov.get("study") if isinstance(prov, dict) else None
     if owner != study:
         whose = f"a table of {owner!r}" if isinstance(owner, str) else "not a table sim wrote"
         raise ConfigError("table", f"{p} is {whose}, not of {study!r}; run the study again")
+
+
+def _why(e: Exception) -> str:
+    """Why a file could not be read, in words: an OSError's reason (its kind when it has
+    none, as pyarrow's may not), else the kind of error."""
+    if isinstance(e, OSError) and e.strerror:
+        return e.strerror
+    return type(e).__name__
 
 
 def _check_path(name: str, v: Any, none_ok: bool = False) -> None:
