@@ -14,7 +14,6 @@ one line naming the file.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 from sim.mc.config import ConfigError
@@ -41,7 +40,7 @@ def replaced_results(stage: Path, out: Path) -> bool:
 
 def clear_replaced(stage: Path, out: Path, shown: str) -> None:
     """Remove the replaced results left in ``stage`` (:func:`replaced_results`; nothing
-    otherwise), saying so on standard error; refused (:class:`ConfigError`, one line) when a
+    otherwise), silently (as publishing would have); refused (:class:`ConfigError`, one line) when a
     file of the user's there is not in ``out``, or when they cannot be removed."""
     if not replaced_results(stage, out):
         return
@@ -61,6 +60,3 @@ def clear_replaced(stage: Path, out: Path, shown: str) -> None:
         raise ConfigError(
             "--out", f"{left}before removing them), and they cannot be removed: remove {stage}"
         )
-    print(
-        f"sim: note: removed the results that the last run into {shown} replaced", file=sys.stderr
-    )
