@@ -30,6 +30,7 @@ import pyarrow.parquet as pq
 from sim.api_args import arguments as _arguments
 from sim.api_paths import absolute_path as _absolute
 from sim.api_paths import check_path as _check_path
+from sim.api_paths import why_unread
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
@@ -160,7 +161,7 @@ class Results:
         try:
             table = pq.read_table(p)
         except (OSError, pa.ArrowException) as e:
-            raise ConfigError("table", f"{p} cannot be read ({type(e).__name__})") from None
+            raise ConfigError("table", f"{p} cannot be read ({why_unread(e)})") from None
         if not dataset:
             _check_owner(p, self.study)
             if (mixed := mixed_run(self.path, [p.name])) is not None:  # copied from another run
@@ -349,10 +350,15 @@ _LIMITS = (
 
 
 def _sha256(path: Path) -> str:
+    """The study file's sha256 ("": it is gone). A file that cannot be read (EACCES, EIO) is
+    one line saying so: it was taken for a file that "has changed since sim.load()" (or
+    "changed while it was loaded"), and a handle loaded then checked nothing."""
     try:
         return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
+    except FileNotFoundError:
         return ""
+    except OSError as e:
+        raise ConfigError("study_file", f"{path} cannot be read ({why_unread(e)})") from None
 
 
 def _run_identity(out: Path) -> str:
@@ -394,7 +400,9 @@ def _owner(p: Path) -> Any:
     """The study a table's provenance (written with every table) names (None: none)."""
     try:
         prov = read_provenance(p)
-    except (OSError, ValueError, pa.ArrowException):
+    except OSError as e:  # EIO, EACCES: it was "not a table sim wrote; run the study again"
+        raise ConfigError("table", f"{p} cannot be read ({why_unread(e)})") from None
+    except (ValueError, pa.ArrowException):
         prov = None
     return prov.get("study") if isinstance(prov, dict) else None
 

@@ -19,7 +19,7 @@ from typing import Any
 from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
 
-__all__ = ["check_path", "absolute_path"]
+__all__ = ["check_path", "absolute_path", "why_unread"]
 
 
 def check_path(name: str, v: Any, none_ok: bool = False) -> None:
@@ -57,3 +57,11 @@ def absolute_path(name: str, v: str | os.PathLike) -> Path:
         raise ConfigError(
             name, f"{os.fspath(v)} is relative, but the working directory is gone ({e.strerror})"
         ) from None
+
+
+def why_unread(e: Exception) -> str:
+    """Why a file could not be read, in words: an OSError's reason (its kind when it has
+    none, as pyarrow's may not), else the kind of error."""
+    if isinstance(e, OSError) and e.strerror:
+        return e.strerror
+    return type(e).__name__

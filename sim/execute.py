@@ -26,6 +26,7 @@ import numpy as np
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.executors import StartRefused, script_words
+from sim.mc.left_behind import clear_replaced
 from sim.mc.outputs import _chunks, _differs, _same, check_out, drop_stage, prepare_stage, stage_dir
 from sim.mc.publish import publish, seal
 from sim.mc.runner import ChunkStore, RunContext, make_executor
@@ -217,6 +218,7 @@ def execute(
         raise ConfigError(None, why)
     check_out(out, shown, record, overwrite)
     stage = stage_dir(out)
+    clear_replaced(stage, out, shown)  # a kill between publishing's two steps left them there
     try:
         ex = make_executor(executor, workers, scheduler)
     except (RuntimeError, OSError, TimeoutError, ValueError, TypeError) as e:

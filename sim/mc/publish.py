@@ -350,6 +350,10 @@ def publish(stage: Path, out: Path) -> None:
         tmp.unlink(missing_ok=True)
     keep = _foreign(out) if out.is_dir() else []
     rec = read_record(stage)
+    if rec is None:  # unreadable now (EIO), or removed: an AttributeError ended the run (exit 3)
+        raise ConfigError(
+            "--out", f"{stage / 'run.json'} cannot be read as the run's record; run again"
+        )
     for f in set(rec.get("carried") or []) & set(keep):  # copied by a publish cut short
         q = stage / f
         if (q.is_symlink() or q.exists()) and not q.is_dir():
@@ -361,8 +365,17 @@ def publish(stage: Path, out: Path) -> None:
             f"{out / clash[0]} was not written by sim but the new run writes a file of that "
             "name; move it away and run again",
         )
-    if keep:  # named before copying: a resume after a kill here knows the copies for copies
-        write_record(stage, {**rec, "carried": keep})
+    # named before copying: a resume after a kill here knows the copies for copies; and the
+    # results this run replaces, by their run record's sha256: a kill right after the swap
+    # below leaves them in the staging directory, where the next run must know them for what
+    # they are (:mod:`sim.mc.left_behind`), not for an unfinished run of another config
+    try:
+        replaced = _sha256(out / "run.json") if read_record(out) is not None else None
+    except OSError:  # (read a moment ago) a mark the run does without
+        replaced = None
+    if keep or replaced:
+        marks = {"carried": keep, "replaced": replaced}
+        write_record(stage, {**rec, **{k: v for k, v in marks.items() if v}})
     for f in keep:
         _carry(out / f, stage / f)
     old = _free_swap(out) if out.exists() else None
