@@ -254,7 +254,6 @@ def test_option_errors_are_one_line(tmp_path, capsys, args, needle):
 def test_a_live_lock_stops_a_second_run_and_overwrite(tmp_path, capsys):
     """A run holding the staging directory's lock: a second run into the same --out, with or
     without --overwrite, stops at once naming the holder, and removes nothing."""
-    import os
 
     from sim.mc.storage import StageLock
 
@@ -265,7 +264,7 @@ def test_a_live_lock_stops_a_second_run_and_overwrite(tmp_path, capsys):
     (stage / "trials" / "half-written").write_text("x")
     try:
         for extra in ([], ["--overwrite"]):
-            one_line(capsys, _run(tmp_path, out, *extra), f"pid {os.getpid()}", "running sim")
+            one_line(capsys, _run(tmp_path, out, *extra), "running sim", "in this process")
         assert (stage / "trials" / "half-written").is_file() and not out.exists()
     finally:
         lock.release()

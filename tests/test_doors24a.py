@@ -271,5 +271,5 @@ def test_a_study_file_that_may_not_be_read_is_one_line_in_the_api(tmp_path, monk
         return real(self)
 
     monkeypatch.setattr(Path, "read_bytes", refuse)
-    with pytest.raises(sim.ConfigError, match=f"{mine}: cannot read the study file \\(Permission"):
+    with pytest.raises(sim.ConfigError, match=f"{mine} cannot be read \\(Permission"):
         sim.load(mine)
