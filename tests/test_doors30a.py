@@ -47,6 +47,19 @@ def test_gridplate_per_point_error_makes_up_the_runs_comparator_sigma():
     assert "make up the 1.2" not in note
 
 
+def _two_sets_of_zero_vectors(monkeypatch, F):
+    """wolf's vectors table read by its figures: two calibration sets of two zero vectors."""
+    g = np.zeros(4)
+    vec = {"set": np.repeat([1, 2], 2), "x_mm": np.tile([0.0, 20.0], 2), "y_mm": g}
+    vec.update({k: g for k in ("dx_before_um", "dy_before_um", "dx_after_um", "dy_after_um")})
+
+    class _T:
+        def to_pydict(self):
+            return vec
+
+    monkeypatch.setattr(F, "read_table", lambda path: _T())
+
+
 def test_wolf_names_the_runs_polynomial_not_the_cubic(monkeypatch):
     """calib.degree = 2: the model text, the after-rows' note and the vectors figure said
     'the cubic' / 'ten-term cubic'; they name the run's six-term quadratic."""
@@ -61,15 +74,7 @@ def test_wolf_names_the_runs_polynomial_not_the_cubic(monkeypatch):
     assert "six-term quadratic (degree 2) is fitted" in R._model_text(cfg, 10)
     assert "residuals of the six-term quadratic" in C._simulated_notes(cfg)["wolf.after."]
     figs = _drawn(monkeypatch, F)
-    g = np.zeros(4)
-    vec = {"set": np.repeat([1, 2], 2), "x_mm": np.tile([0.0, 20.0], 2), "y_mm": g}
-    vec.update({k: g for k in ("dx_before_um", "dy_before_um", "dx_after_um", "dy_after_um")})
-
-    class _T:
-        def to_pydict(self):
-            return vec
-
-    monkeypatch.setattr(F, "read_table", lambda path: _T())
+    _two_sets_of_zero_vectors(monkeypatch, F)
     F.vectors_figure(cfg, Path("."))
     texts = _titles(figs[0])
     assert any("after the quadratic" in t for t in texts)
@@ -84,15 +89,7 @@ def test_wolf_counts_the_runs_calibration_sets(monkeypatch):
     R = import_module("sim.studies.wolf.report")
 
     figs = _drawn(monkeypatch, F)
-    g = np.zeros(4)
-    vec = {"set": np.repeat([1, 2], 2), "x_mm": np.tile([0.0, 20.0], 2), "y_mm": g}
-    vec.update({k: g for k in ("dx_before_um", "dy_before_um", "dx_after_um", "dy_after_um")})
-
-    class _T:
-        def to_pydict(self):
-            return vec
-
-    monkeypatch.setattr(F, "read_table", lambda path: _T())
+    _two_sets_of_zero_vectors(monkeypatch, F)
     F.vectors_figure({"calib.degree": 3}, Path("."))
     assert "2 dates" in figs[0]._suptitle.get_text()
     monkeypatch.setattr(R, "figure", lambda *a: "")

@@ -42,8 +42,8 @@ import pytest
 from conftest import ROOT
 from oneline import SIM_ERROR, one_line
 from test_doors18c import MAKE, fake_project, make_line, run_make
+from test_doors29b import _bench
 
-from benchmarks import cli as bench_cli
 from sim import cli_read
 from sim.cli import DOC, main
 from sim.cli_args import parser
@@ -81,11 +81,6 @@ def test_a_word_is_not_read_as_a_hexadecimal_number(capsys, text):
 
 
 # ------------------------------------------------------------- 3. benchmarks' once-options
-def _bench(argv: list[str]) -> int:
-    try:
-        return bench_cli.main(argv)
-    except SystemExit as e:
-        return e.code
 
 
 @pytest.mark.parametrize(
