@@ -52,6 +52,7 @@ from sim.studies.network.validate import (
     distinct_looks,
     name_index,
     one_unit,
+    positive_mm,
     title,
 )
 
@@ -176,9 +177,7 @@ def _grid_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
         nx = _num(f"{key}.nx", rec["nx"], 1, integer=True)
         ny = _num(f"{key}.ny", rec["ny"], 1, integer=True)
         _fits(f"{key}.nx", len(pts[0]) + nx * ny, 0, f"{nx} x {ny} points")
-        h = _mm(key, rec, "spacing")
-        if h <= 0:
-            raise ConfigError(f"{key}.spacing_mm", f"must be > 0 (got {h:g} mm)")
+        h = positive_mm(key, rec, "spacing")
         o = _mm(key, rec, "origin", False, [-(nx - 1) * h / 2, -(ny - 1) * h / 2])
         r, s = _role(key, rec)
         prefix = _point_name(f"{key}.prefix", rec["prefix"])
@@ -196,9 +195,7 @@ def _random_points(cfg: dict, rng: np.random.Generator, pts: tuple[list, list, l
         one_unit(key, rec, ("half_extent", "center"))
         n = _num(f"{key}.n", rec["n"], 1, integer=True)
         _fits(f"{key}.n", len(pts[0]) + n, 0, f"{n} points")
-        e = _mm(key, rec, "half_extent")
-        if e <= 0:
-            raise ConfigError(f"{key}.half_extent_mm", f"must be > 0 (got {e:g} mm)")
+        e = positive_mm(key, rec, "half_extent")
         c0 = _mm(key, rec, "center", False, [0.0, 0.0])
         r, s = _role(key, rec)
         prefix = _point_name(f"{key}.prefix", rec["prefix"])

@@ -167,6 +167,17 @@ def _mm(key: str, rec: dict, field: str, required: bool = True, default=None):
     return _num(f"{key}.{name}", v) * f
 
 
+def positive_mm(key: str, rec: dict, field: str) -> float:
+    """``rec``'s required length ``field`` in mm (as :func:`_mm`), refused unless > 0 naming
+    the key as written and its value in the unit written (``spacing_m = -25`` was refused
+    as ``spacing_mm: ... (got -25000 mm)``, a key the file does not have)."""
+    v = _mm(key, rec, field)
+    if v <= 0:
+        name, unit = (f"{field}_m", "m") if f"{field}_m" in rec else (f"{field}_mm", "mm")
+        raise ConfigError(f"{key}.{name}", f"must be > 0 (got {rec[name]:g} {unit})")
+    return v
+
+
 def distinct_looks(key: str, names) -> None:
     """Refuse two point names that look the same (doors24c): ``A`` and Cyrillic ``А``, a
     precomposed ``É`` and ``E`` + U+0301, ``P1`` and full-width ``Ｐ1`` were two points
