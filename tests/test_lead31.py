@@ -4,6 +4,7 @@ code before its fix."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -42,3 +43,31 @@ def test_a_field_networks_length_in_metres_is_refused_by_the_key_written(
     # does not have and a value it does not hold
     err = _refused(capsys, ["check", str(_edited(tmp_path, "network_testfield.toml", old, new))])
     assert words in err and "spacing_mm" not in err, err
+
+
+@pytest.mark.parametrize(
+    ("sec", "error"),
+    [
+        ("1e-400", "the seconds 1e-400 is too small for a 64-bit float"),
+        ("0.0e-400", None),  # a zero written as one is a zero
+        ("3e-5", None),  # before: "too many values to unpack", exit 3 (split at its "-")
+    ],
+)
+def test_dms_seconds_with_an_exponent_are_read_as_any_number_of_the_file(tmp_path, sec, error):
+    # before: "0-0-1e-400" and "0-0-3e-5" ended in a ValueError traceback (the d-m-s split
+    # at the exponent's minus); read as 0 once split, 1e-400 is refused naming its digits as
+    # every other number of a GNU Gama file that no double holds
+    from sim.mc.config import ConfigError
+    from sim.studies.network.gama_read import read_gama
+
+    src = (Path(__file__).parent / "data" / "gama" / "user_dms.xml").read_text()
+    m = re.search(r'val="(\d+)-(\d+)-([\d.]+)"', src)
+    assert m, "the reference file has a d-m-s value"
+    f = tmp_path / "n.xml"
+    f.write_text(src.replace(m.group(0), f'val="{m.group(1)}-{m.group(2)}-{sec}"', 1))
+    if error is None:
+        read_gama(f)
+        return
+    with pytest.raises(ConfigError) as e:
+        read_gama(f)
+    assert error in str(e.value) and "n.xml" in str(e.value) and "\n" not in str(e.value)
