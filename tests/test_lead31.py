@@ -71,3 +71,17 @@ def test_dms_seconds_with_an_exponent_are_read_as_any_number_of_the_file(tmp_pat
     with pytest.raises(ConfigError) as e:
         read_gama(f)
     assert error in str(e.value) and "n.xml" in str(e.value) and "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize(
+    ("option", "key", "bound"),
+    [("--trials", "trials", "1e+08"), ("--chunk", "chunk", "1e+06"), ("--seed", "seed", "9.22")],
+)
+def test_an_option_beyond_its_keys_bound_is_refused_as_set_refuses_it(capsys, option, key, bound):
+    # before: "--trials 1e30" said "an integer of 31 digits is outside TOML's 64-bit range"
+    # while "--set trials=1e30" said "trials: must be <= 1e+08 (got 1e+30)"
+    study = str(STUDIES / "brown_table1.toml")
+    by_set = _refused(capsys, ["check", study, "--set", f"{key}=1e30"])
+    by_option = _refused(capsys, ["run", study, option, "1e30", "--out", "unused"])
+    words = f"must be <= {bound}"
+    assert words in by_set and words in by_option and "(got 1e+30)" in by_option, by_option

@@ -23,7 +23,7 @@ import re
 import sys
 
 from sim.ends import stdout_unwritten
-from sim.mc.config import ConfigError, Field, parse_override, validate
+from sim.mc.config import COMMON, ConfigError, Field, parse_override, validate
 
 __all__ = ["MAX_OPTIONS", "ONCE", "BoundedParser", "OnceParser", "integer"]
 
@@ -39,17 +39,26 @@ ONCE = frozenset(
 )
 
 
-def integer(text: str) -> int:
-    """argparse's ``type`` of an option that sets an integer key (``--trials``, ``--chunk``,
-    ``--seed``; ``make verify``'s ``--trials``): the value read as ``--set KEY=VALUE`` reads
-    it (TOML), so a float without a fraction is that integer (``1e3``, ``1000.0``: 1000), and
-    anything else is refused in ``--set``'s words (``must be an integer (got 1000.5)``).
-    ``--trials 1e3`` was refused ("invalid int value") while ``--set trials=1e3`` and
-    ``sim.load(..., trials=1e3)`` ran 1000 trials."""
-    try:
-        return validate({"v": parse_override(f"v={text}")[1]}, {"v": Field(0, "int", "")})["v"]
-    except ConfigError as e:
-        raise argparse.ArgumentTypeError(str(e).removeprefix("v: ")) from None
+def integer(key: str):
+    """argparse's ``type`` of an option that sets the integer key ``key`` (``--trials``,
+    ``--chunk``, ``--seed``; ``make verify``'s ``--trials``): the value read as ``--set
+    KEY=VALUE`` reads it (TOML), so a float without a fraction is that integer (``1e3``,
+    ``1000.0``: 1000), and anything else is refused in ``--set``'s words (``must be an
+    integer (got 1000.5)``). ``--trials 1e3`` was refused ("invalid int value") while ``--set
+    trials=1e3`` and ``sim.load(..., trials=1e3)`` ran 1000 trials; above the key's bound it
+    is refused as ``--set`` refuses it (``--trials 1e30`` said "an integer of 31 digits is
+    outside TOML's 64-bit range", ``--set trials=1e30`` "must be <= 1e+08"). The key's lower
+    bound is left to the command (``make verify --trials`` asks for more)."""
+    field = Field(0, "int", "", hi=COMMON[key].hi)
+
+    def read(text: str) -> int:
+        try:
+            return validate({"v": parse_override(f"v={text}")[1]}, {"v": field})["v"]
+        except ConfigError as e:
+            raise argparse.ArgumentTypeError(str(e).removeprefix("v: ")) from None
+
+    read.__name__ = key  # argparse's "invalid trials value" should it ever say one
+    return read
 
 
 def _guess(word: str, names) -> str:
