@@ -12,12 +12,14 @@ very name exists (an earlier ``./~`` is the caller's to read).
 
 from __future__ import annotations
 
+import errno
 import os
 from pathlib import Path
 from typing import Any
 
 from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
+from sim.mc.storage import RECORD, config_hash, read_record, regular_text
 
 __all__ = ["check_path", "absolute_path", "why_unread"]
 
@@ -65,3 +67,23 @@ def why_unread(e: Exception) -> str:
     if isinstance(e, OSError) and e.strerror:
         return e.strerror
     return type(e).__name__
+
+
+def run_identity(out: Path) -> str:
+    """The config hash (:func:`sim.mc.storage.config_hash`) of the config and code hash
+    ``out/run.json`` records: another run of the study (another seed, another key) has
+    another; "" when there is no such record (a damaged one is refused by the reads
+    themselves, naming ``run.json``). A record the disk fails to read (EIO, EACCES) is
+    refused naming it: the check that the tables are still the run's was skipped, and
+    another run's tables read as this one's."""
+    rec = read_record(out)
+    if rec:
+        return config_hash(rec["config"], rec["code_hash"])
+    try:
+        regular_text(out / RECORD)
+    except OSError as e:
+        if e.errno is not None and e.errno != errno.ENOENT:  # not "none", not "not a file"
+            raise ConfigError("path", f"{out / RECORD} cannot be read ({why_unread(e)})") from None
+    except ValueError:  # not UTF-8: damaged, refused by the reads
+        pass
+    return ""

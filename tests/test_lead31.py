@@ -85,3 +85,28 @@ def test_an_option_beyond_its_keys_bound_is_refused_as_set_refuses_it(capsys, op
     by_option = _refused(capsys, ["run", study, option, "1e30", "--out", "unused"])
     words = f"must be <= {bound}"
     assert words in by_set and words in by_option and "(got 1e+30)" in by_option, by_option
+
+
+def test_results_whose_run_record_the_disk_fails_to_read_are_refused_naming_it(monkeypatch):
+    # before: an EIO reading run.json skipped the check that the directory still holds the
+    # run that returned these Results, and its tables were read as that run's
+    import errno
+    import pathlib
+
+    from sim import ConfigError
+    from sim.api import Results
+    from sim.api_paths import run_identity
+
+    out = STUDIES.parent / "results" / "brown_table1"
+    r = Results(out, "brown_table1", run_sha256=run_identity(out))
+    assert r.claims().num_rows > 0
+    read_text = pathlib.Path.read_text
+
+    def failing(self, *args, **kwargs):
+        if self.name == "run.json":
+            raise OSError(errno.EIO, "Input/output error")
+        return read_text(self, *args, **kwargs)
+
+    monkeypatch.setattr(pathlib.Path, "read_text", failing)
+    with pytest.raises(ConfigError, match=r"run\.json cannot be read \(Input/output error\)"):
+        r.claims()
