@@ -110,3 +110,34 @@ def test_results_whose_run_record_the_disk_fails_to_read_are_refused_naming_it(m
     monkeypatch.setattr(pathlib.Path, "read_text", failing)
     with pytest.raises(ConfigError, match=r"run\.json cannot be read \(Input/output error\)"):
         r.claims()
+
+
+def _quiet_refusal(capsys, args) -> str:
+    """The one line of a refusal given with no NumPy warning on the way."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        err = _refused(capsys, args)
+    assert not [w for w in seen if issubclass(w.category, RuntimeWarning)], seen[0].message
+    return err
+
+
+def test_a_control_weight_ratio_beyond_a_double_is_named_not_warned(capsys):
+    # before: "RuntimeWarning: overflow encountered in divide", then the line blamed the
+    # control "that weighs next to nothing" (1.7e308 "is inf times weights.pass")
+    study = str(STUDIES / "agnard_block.toml")
+    sets = ["weights.control_xy=1.7e308", "weights.control_z=1.7e308", "weights.pass=1e-7"]
+    err = _quiet_refusal(capsys, ["check", study, *[a for s in sets for a in ("--set", s)]])
+    assert "weights.control_xy: 1.7e+308 over weights.pass" in err, err
+    assert "beyond a 64-bit float" in err and "next to nothing" not in err, err
+
+
+def test_stations_so_far_out_that_ranges_overflow_are_refused_with_no_scale_enforced(capsys):
+    # before: with comparator.scale_length_mm = 0 (not enforced) `sim check` passed after a
+    # RuntimeWarning, and the run failed every trial ("only 0 trials converged")
+    study = str(STUDIES / "brown_table1.toml")
+    sets = ["comparator.station_offset_mm=1e200", "comparator.scale_length_mm=0"]
+    err = _quiet_refusal(capsys, ["check", study, *[a for s in sets for a in ("--set", s)]])
+    assert "comparator.station_offset_mm: stations 1e+200 mm" in err, err
+    assert "ranges overflow" in err, err

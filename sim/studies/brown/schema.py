@@ -308,16 +308,18 @@ def check(cfg: dict) -> None:
             key, "all points are collinear: the station coordinates cannot be recovered"
         )
     _within_beta(cfg, key, pts)
-    if cfg["comparator.scale_length_mm"] > 0:
-        _, theta = setup(cfg)
+    _, theta = setup(cfg)
+    with np.errstate(over="ignore", invalid="ignore"):  # named below, not warned
         r = ml.ranges(pts[None], theta[None])
-        if not np.all(np.isfinite(r)):  # the stations so far out that a range overflows
-            half, off = cfg["plate.format_mm"] / 2, cfg["comparator.station_offset_mm"]
-            raise ConfigError(  # the key of the larger part of the stations' distance
-                "plate.format_mm" if half >= off else "comparator.station_offset_mm",
-                f"stations {half + off:g} mm from the centre (half the {2 * half:g} mm format "
-                f"plus the {off:g} mm offset) are so far out that the ranges overflow",
-            )
+    if not np.all(np.isfinite(r)):  # the stations so far out that a range overflows (also
+        # with no scale length enforced: passed sim check, then every trial failed)
+        half, off = cfg["plate.format_mm"] / 2, cfg["comparator.station_offset_mm"]
+        raise ConfigError(  # the key of the larger part of the stations' distance
+            "plate.format_mm" if half >= off else "comparator.station_offset_mm",
+            f"stations {half + off:g} mm from the centre (half the {2 * half:g} mm format "
+            f"plus the {off:g} mm offset) are so far out that the ranges overflow",
+        )
+    if cfg["comparator.scale_length_mm"] > 0:
         reach = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
         if r.max() > reach or r.min() < 0:
             moved = moved_from_paper(cfg, key, {k: f.default for k, f in BASE.items()})
@@ -343,7 +345,8 @@ def _within_beta(cfg: dict, key: str, pts: np.ndarray) -> None:
     or on the scale) and every trial failed at run time after a NumPy warning."""
     _, theta = setup(cfg)
     st = ml.stations(theta)  # (4, 2) mm
-    d2 = ((pts[:, None, :] - st[None, :, :]) ** 2).sum(-1)  # (n, 4) mm^2
+    with np.errstate(over="ignore"):  # inf: the range check names stations that far out
+        d2 = ((pts[:, None, :] - st[None, :, :]) ** 2).sum(-1)  # (n, 4) mm^2
     beta = cfg["comparator.beta_mm"]
     bad = np.argwhere(d2 <= beta**2)
     if len(bad):
