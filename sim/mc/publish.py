@@ -404,9 +404,15 @@ def publish(stage: Path, out: Path) -> None:
     with contextlib.suppress(OSError):  # (EIO, EACCES: a published run does not fail for it;
         (out / LOCK).unlink(missing_ok=True)  # the next run ignores it) we still hold it
     _drop_stale_swaps(out, old)
+    if old is not None:
+        _remove_record_last(old)
+    if replaced and not (stage.exists() or stage.is_symlink()):  # the old results are no
+        # longer where the mark is looked for: dropped, so that a run made over identical
+        # results has the record of the same run made fresh (a kill before this keeps it)
+        with contextlib.suppress(OSError):
+            write_record(out, {**rec, **({"carried": keep} if keep else {})})
     if old is None:
         return
-    _remove_record_last(old)
     if old.exists() or old.is_symlink():  # a file or directory of the old results that this
         # user may not remove: they are not lost, but say where (a hidden directory)
         left = next(iter(sorted(old.rglob("*"), key=lambda q: -len(q.parts))), old)
