@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 import time
 import tomllib
@@ -35,6 +36,7 @@ from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
 from benchmarks.store import store_rows
 from sim.mc.argv import ONCE, OnceParser
 from sim.mc.storage import provenance, write_table
+from sim.stops import in_main_thread
 
 __all__ = ["main", "run"]
 
@@ -197,7 +199,38 @@ def _check_args(a: argparse.Namespace, sections: tuple[str, ...]) -> None:
                 raise _ArgError(f"--rerun-files: {f} is not a study file (no study = ...)")
 
 
+#: the line of an interrupted benchmark (Ctrl-C, SIGTERM, SIGHUP)
+INTERRUPTED = (
+    "benchmarks: interrupted; the sections that finished wrote their tables in --out "
+    "(its README.md was not rewritten)"
+)
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(argv=None) -> int:
+    """The benchmark; Ctrl-C, SIGTERM and SIGHUP end it with one line and exit 130, its
+    running ``sim run`` child stopped and its temporary directories removed (a SIGTERM killed
+    it silently, leaving both; Ctrl-C printed a traceback)."""
+    signals = (signal.SIGTERM, signal.SIGHUP) if in_main_thread() else ()
+    old = {s: signal.getsignal(s) for s in signals}
+    for s in signals:
+        if old[s] is signal.SIG_DFL:
+            signal.signal(s, _interrupt)
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        print(INTERRUPTED, file=sys.stderr)
+        return 130
+    finally:
+        for s, h in old.items():
+            if h is not None:
+                signal.signal(s, h)
+
+
+def _main(argv=None) -> int:
     ap = _Parser(
         prog="python -m benchmarks",
         description="Benchmark of the batched solvers and of make rerun (see docs/benchmark.md)",

@@ -141,3 +141,26 @@ def test_stations_so_far_out_that_ranges_overflow_are_refused_with_no_scale_enfo
     err = _quiet_refusal(capsys, ["check", study, *[a for s in sets for a in ("--set", s)]])
     assert "comparator.station_offset_mm: stations 1e+200 mm" in err, err
     assert "ranges overflow" in err, err
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM", "SIGHUP"])
+def test_a_stopped_benchmark_ends_in_one_line(tmp_path, sig):
+    # before: Ctrl-C printed a 34-line traceback (exit -2); SIGTERM and SIGHUP killed it
+    # silently, leaving its running `sim run` child and its temporary copy of the studies
+    import subprocess
+    import sys
+
+    code = (
+        "import signal, sys\n"
+        "from benchmarks import cli\n"
+        f"cli.run = lambda *a, **k: signal.raise_signal(signal.{sig})\n"
+        f"sys.exit(cli.main(['--quick', '--only', 'store', '--out', {str(tmp_path / 'b')!r}]))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], cwd=STUDIES.parent, capture_output=True, text=True
+    )
+    assert done.returncode == 130, (done.returncode, done.stderr)
+    assert done.stderr.strip() == (
+        "benchmarks: interrupted; the sections that finished wrote their tables in --out "
+        "(its README.md was not rewritten)"
+    )
