@@ -164,3 +164,22 @@ def test_a_stopped_benchmark_ends_in_one_line(tmp_path, sig):
         "benchmarks: interrupted; the sections that finished wrote their tables in --out "
         "(its README.md was not rewritten)"
     )
+
+
+def test_a_claims_table_with_a_claim_name_of_two_lines_is_not_shown_as_the_runs(tmp_path, capsys):
+    # before: `sim show` printed the claim 'a\nb' over two lines, splitting its row (a table
+    # edited by hand; a made-up verdict or a claim listed twice was already refused)
+    import shutil
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = tmp_path / "brown_table1"
+    shutil.copytree(STUDIES.parent / "results" / "brown_table1", out)
+    t = pq.read_table(out / "claims.parquet")
+    names = t.column("claim").to_pylist()
+    names[0] = "a\nb"
+    i = t.schema.get_field_index("claim")
+    pq.write_table(t.set_column(i, "claim", pa.array(names)), out / "claims.parquet")
+    err = _refused(capsys, ["show", str(out)])
+    assert "it holds the claim 'a\\nb', a name sim never writes" in err, err

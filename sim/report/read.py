@@ -139,15 +139,18 @@ def damaged_message(root: Path, e: Exception) -> str:
 def claims_damage(prov: dict, verdicts: list, claims: list | None = None) -> str | None:
     """What makes a claims table (its provenance, its ``verdict`` and ``claim`` columns) one
     the suite did not write, or None: a study that is not a name, no row (every study scores
-    its claim book), a claim listed twice (two tables concatenated: every count doubled), or a
-    verdict outside the suite's vocabulary (a table edited by hand: a made-up verdict, a line
-    break that would split a row)."""
+    its claim book), a claim that is no one-line name (a line break split ``sim show``'s
+    row), a claim listed twice (two tables concatenated: every count doubled), or a verdict
+    outside the suite's vocabulary (a table edited by hand: a made-up verdict, a line break
+    that would split a row)."""
     if not isinstance(prov.get("study"), str):
         return f"its provenance names no study ({prov.get('study')!r:.40})"
     if not verdicts:
         return "it holds no claim"
     seen: set = set()
     for c in claims or ():
+        if not isinstance(c, str) or not c.isprintable() or not c.strip():  # a line break
+            return f"it holds the claim {c!r:.60}, a name sim never writes"  # split a row
         if c in seen:
             return f"it lists the claim {c!r:.60} twice"
         seen.add(c)
