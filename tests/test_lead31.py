@@ -183,3 +183,27 @@ def test_a_claims_table_with_a_claim_name_of_two_lines_is_not_shown_as_the_runs(
     pq.write_table(t.set_column(i, "claim", pa.array(names)), out / "claims.parquet")
     err = _refused(capsys, ["show", str(out)])
     assert "it holds the claim 'a\\nb', a name sim never writes" in err, err
+
+
+def test_an_input_this_run_changed_is_not_listed_as_set_to_match_the_paper():
+    # before: `--set b8.sx_mm_per_digit=11` was listed under "Inputs set to match the paper
+    # (agreement with these is by construction)" as 11.0, and 12.702028129 was shown as 12.7
+    from sim.report.markdown import inputs_markdown
+    from sim.studies.salsig.schema import SCHEMA
+
+    cfg = {k: f.default for k, f in SCHEMA.items()}
+    assert "this run" not in inputs_markdown(cfg, SCHEMA)
+    assert "| 12.702028129 |" in inputs_markdown(cfg, SCHEMA)
+    text = inputs_markdown({**cfg, "b8.sx_mm_per_digit": 11.0}, SCHEMA)
+    assert "| 11.0 (this run; the paper's: 12.700082809) |" in text, text
+    assert "1 of them this run sets to another value" in text, text
+
+
+def test_salsigs_correction_factor_is_not_said_to_be_applied_as_printed():
+    # before: "the factor 12.500/12.700: applied in the simulation as printed", also in a run
+    # whose zscale.s_mm_per_digit and b8.sx_mm_per_digit are others
+    import tomllib
+
+    book = tomllib.loads((STUDIES.parent / "sim/studies/salsig/claims.toml").read_text())
+    (row,) = [r for r in book["not_reproduced"] if "12.500/12.700" in r["printed"]]
+    assert "as printed" not in row["why"] and "the run's own ratio" in row["why"], row

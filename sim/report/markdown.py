@@ -7,6 +7,7 @@ Markdown. Nothing here runs a simulation.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Callable
 
@@ -128,14 +129,37 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
     return c
 
 
+def _as_set(v) -> str:
+    """An input as the study file sets it (every digit: 12.702028129 was shown as 12.7)."""
+    if isinstance(v, float) and math.isfinite(v):
+        return repr(v)
+    return fmt(v)
+
+
 def inputs_markdown(cfg: dict, schema) -> str:
-    """List the config values marked as paper-matched inputs."""
-    rows = [[f"`{k}`", fmt(cfg.get(k)), f.doc] for k, f in schema.items() if f.input]
+    """List the config values marked as paper-matched inputs; one this run set to another
+    value than the paper's is marked so (it was listed as "set to match the paper")."""
+    rows, changed = [], 0
+    for k, f in schema.items():
+        if not f.input:
+            continue
+        v = cfg.get(k)
+        text = _as_set(v)
+        if v != f.default:
+            changed += 1
+            text += f" (this run; the paper's: {_as_set(f.default)})"
+        rows.append([f"`{k}`", text, f.doc])
     if not rows:
         return ""
+    but = (
+        f"; {changed} of them this run sets to another value, marked: there agreement is no "
+        "longer by construction"
+        if changed
+        else ""
+    )
     return (
         "Inputs set to match the paper (agreement with these is by construction, not a "
-        "prediction):\n\n" + md_table(["key", "value", "meaning"], rows)
+        f"prediction{but}):\n\n" + md_table(["key", "value", "meaning"], rows)
     )
 
 
