@@ -44,7 +44,7 @@ from sim.mc.read_when import read_in_a_cell
 from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
-from sim.report.run_summary import terminal_summary, write_run_readme
+from sim.report.run_summary import off_setup, terminal_summary, write_run_readme
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
 from sim.studies import get_study, unread_keys
 from sim.studies.picking import load_picking_chunk
@@ -290,13 +290,7 @@ def _check(args) -> int:
         for k, v in sweep.items():
             print(f"{toml_key(k)} = {toml_value(v)}")
     if off:  # said before the run: its predictions will be findings (sim.claims.rules)
-        kept = len(study.paper_design)
-        but = (
-            f", but the {kept} it decides on the paper's own setup, which stay the paper's verdicts"
-            if kept
-            else ""
-        )
-        print(f"# off the paper's setup ({', '.join(off)}): its predictions will be findings{but}")
+        print(f"# {off_setup(study, cfg, before=True)}")
     print(f"# work: {est.describe()}")
     return 0
 

@@ -207,3 +207,25 @@ def test_salsigs_correction_factor_is_not_said_to_be_applied_as_printed():
     book = tomllib.loads((STUDIES.parent / "sim/studies/salsig/claims.toml").read_text())
     (row,) = [r for r in book["not_reproduced"] if "12.500/12.700" in r["printed"]]
     assert "as printed" not in row["why"] and "the run's own ratio" in row["why"], row
+
+
+def test_a_runs_readme_says_at_its_top_that_it_is_off_the_papers_setup():
+    # before: only the claims' notes said that the run's printed inputs differ from the
+    # paper's; `sim check` said it in one line before the run
+    from types import SimpleNamespace
+
+    from sim.report.markdown import inputs_markdown
+    from sim.report.run_summary import off_setup
+    from sim.studies.salsig.schema import SCHEMA
+
+    cfg = {k: f.default for k, f in SCHEMA.items()}
+    study = SimpleNamespace(schema=SCHEMA, as_printed=None, paper_design=())
+    assert off_setup(study, cfg) == ""
+    line = off_setup(study, {**cfg, "zscale.s_mm_per_digit": 10.0})
+    assert line == (
+        "off the paper's setup (zscale.s_mm_per_digit = 10 (paper: 12.5)): its predictions "
+        "are findings"
+    ), line
+    # a value equal to the paper's as 12 digits show it is the paper's (1.1 + 0.6 is 1.7)
+    near = {**cfg, "b8.e_arcsec": -59.2 + 1e-14}
+    assert off_setup(study, near) == "" and "this run" not in inputs_markdown(near, SCHEMA)

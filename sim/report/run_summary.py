@@ -17,7 +17,7 @@ from typing import Callable
 import numpy as np
 import pyarrow.parquet as pq
 
-from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
+from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS, printed_differs
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
 from sim.report.claimtext import interval_text, sim_text
@@ -29,6 +29,7 @@ from sim.report.tables import fmt, md_code, md_text
 __all__ = [
     "VERDICT_ORDER",
     "verdict_line",
+    "off_setup",
     "headline_rows",
     "region_line",
     "terminal_summary",
@@ -278,10 +279,31 @@ def run_markdown(out: Path, get_study: Callable, name: str | None = None) -> str
     else:
         claims = records(src)
         head += [f"**Verdicts:** {verdict_line(claims)}.", ""]
+        rec = read_record(out)
+        if rec is not None and (off := off_setup(study, rec["config"])):
+            head += [f"**{off[0].upper()}{off[1:]}.**", ""]  # said once, at the top
         if (reg := region_line(out)) is not None:
             head += [reg[0].upper() + reg[1:] + ".", ""]
         body = study.report(out)
     return "\n".join(head) + "\n" + _relink(body, out.name) + "\n"
+
+
+def off_setup(study, cfg: dict, before: bool = False) -> str:
+    """``off the paper's setup (key = value (paper: default), ...): its predictions are
+    findings ...`` for a config whose printed inputs are not the paper's (``sim check`` says
+    it before the run, ``before``: "will be"; a run's README.md at its top: it said so only
+    in its claims' notes), else ``""``."""
+    off = printed_differs(study.schema, cfg, study.as_printed)
+    if not off:
+        return ""
+    kept = len(study.paper_design)
+    but = (
+        f", but the {kept} it decides on the paper's own setup, which stay the paper's verdicts"
+        if kept
+        else ""
+    )
+    verb = "will be" if before else "are"
+    return f"off the paper's setup ({', '.join(off)}): its predictions {verb} findings{but}"
 
 
 def _relink(body: str, name: str) -> str:
