@@ -138,8 +138,8 @@ def _study(tmp_path, region=True):
 
 
 class _Field:
-    def __init__(self, doc, inp):
-        self.doc, self.input = doc, inp
+    def __init__(self, doc, inp, default=4.0):
+        self.doc, self.input, self.default = doc, inp, default
 
 
 def test_section_keeps_the_order_and_leaves_out_empty_blocks(tmp_path):
@@ -159,7 +159,7 @@ def test_section_keeps_the_order_and_leaves_out_empty_blocks(tmp_path):
         txt.index("**Consistent region.** The predictions hold together for offset_mm 5.00–20.0"),
         txt.index("INTRO"),
         txt.index("| `t.a` |"),
-        txt.index("| `k` | 4.00 | the k of the paper |"),
+        txt.index("| `k` | 4.0 | the k of the paper |"),
         txt.index("BODY"),
         txt.index("![a figure](st/f.png)\n*b: not drawn (`g.png` is missing"),
     ]
