@@ -28,7 +28,7 @@ from benchmarks import studies
 from benchmarks.brown import brown_rows, million, peak_rss_mib
 from benchmarks.engines import engine_rows
 from benchmarks.figures import brown_figure, engines_figure
-from benchmarks.outdir import not_written_here
+from benchmarks.outdir import OutLock, not_written_here
 from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
 from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
@@ -238,19 +238,25 @@ def main(argv=None) -> int:
     ap.add_argument("--chunk", type=int, default=10000, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.million_child:
-        million(Path(a.out), a.million_child, a.chunk)
+        try:
+            million(Path(a.out), a.million_child, a.chunk)
+        except OSError as e:  # its parent names it (benchmarks.brown.peak_memory)
+            where = f": {e.filename}" if e.filename else ""
+            print(f"benchmarks: error: {e.strerror or e}{where}".splitlines()[0], file=sys.stderr)
+            return 2
         print(f"{peak_rss_mib():.1f}")
         return 0
     sections = tuple(s for s in a.only if a.rerun or s != "rerun")
     try:
         _check_args(a, sections)
-        tables = run(
-            Path(a.out),
-            a.quick,
-            sections,
-            a.rerun_files or "studies/*.toml",
-            a.rerun_workers or (1, 2),
-        )
+        with OutLock(Path(a.out)):  # a second benchmark into --out stops at once
+            tables = run(
+                Path(a.out),
+                a.quick,
+                sections,
+                a.rerun_files or "studies/*.toml",
+                a.rerun_workers or (1, 2),
+            )
     except (FileNotFoundError, RuntimeError, _ArgError) as e:
         print(f"benchmarks: error: {e}".splitlines()[0], file=sys.stderr)
         return 2

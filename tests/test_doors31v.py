@@ -1,0 +1,120 @@
+"""The classes of the sweep doors31v (brief V31: ``make verify``, ``python -m sim.batch``,
+``make bench`` and ``sim report`` under filesystem faults, each step failing in turn by EIO,
+ENOSPC or a kill, and run two at a time), one case each; each failed on the code before its
+fix.
+
+* The brown section's million-trial run (a child process writing its chunk store
+  ``million_trials.tmp`` under ``--out``) that failed (a full disk, EIO) or was killed (the OOM
+  killer, ``kill -9``) ended ``make bench`` in a ``CalledProcessError`` traceback, exit 1. It
+  is now one line naming how the child ended and, when it said why, the file.
+* That child killed while writing a chunk left the chunk's temporary
+  (``.chunk-000002.parquet.<pid>.tmp``) in the store, which every later ``make bench`` into
+  that ``--out`` refused as "not written by the benchmark" until it was removed by hand. The
+  store's own temporaries are now the benchmark's.
+* Two benchmarks into one ``--out`` at once both ran: each replaced the other's chunk store
+  (and resumed from its chunks, timing less work) and wrote their tables and figures over
+  each other's, a page of one run beside the tables of the other. ``--out`` is now locked
+  for the life of a benchmark (a ``flock`` on the directory, no file left in it): the second
+  stops at once in one line naming the first's pid.
+* ``make verify`` whose temporary scratch directory could not be removed at the end (an I/O
+  error on one of the re-runs' files) ended in exit 2 with "Input/output error:
+  claims.parquet" (a bare file name), its finished comparisons neither printed nor recorded
+  in ``reproducibility.parquet``. The check now stands: the comparisons are printed and
+  recorded and one note names the directory left behind.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from benchmarks import brown, cli
+from sim.cli import main as sim_main
+from sim.report.verify import main as verify_main
+from tests.oneline import one_line
+
+TINY = ["--set", "trials=40", "--set", "chunk=2", "--set", "region.points=256"]
+TINY += ["--set", "region.rounds=0"]
+
+
+def test_a_failing_million_trial_child_is_one_line(tmp_path):
+    (tmp_path / "million_trials.tmp").write_text("")  # its store cannot be made: ENOTDIR
+    with pytest.raises(RuntimeError) as e:  # before: CalledProcessError, a traceback
+        brown.peak_memory(tmp_path, 2000, 1000)
+    msg = str(e.value)
+    assert "\n" not in msg and "child process) exited with 2: Not a directory" in msg, msg
+    assert "million_trials.tmp" in msg
+
+
+def test_a_store_left_by_a_killed_child_does_not_block_the_next_benchmark(tmp_path, capsys):
+    part = tmp_path / "million_trials.tmp" / "part-0"
+    part.mkdir(parents=True)
+    (part / "chunk-000000.parquet").write_bytes(b"")
+    (part / ".chunk-000001.parquet.4242.tmp").write_bytes(b"")  # its chunk being written
+    # before: "--out: .../million_trials.tmp was not written by the benchmark", every time
+    assert cli.main(["--quick", "--only", "store", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "store.parquet").is_file()
+
+
+HOLD = """
+import fcntl, os, sys
+fd = os.open(sys.argv[1], os.O_RDONLY | os.O_DIRECTORY)
+fcntl.flock(fd, fcntl.LOCK_EX)  # as a benchmark writing into it holds it
+print("held", flush=True)
+sys.stdin.read()  # until the test closes the pipe
+"""
+
+
+def test_a_second_benchmark_into_the_same_out_is_refused_naming_the_first(tmp_path, capsys):
+    out = tmp_path / "bench"
+    out.mkdir()
+    with subprocess.Popen(
+        [sys.executable, "-c", HOLD, str(out)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    ) as first:
+        try:
+            assert first.stdout.readline() == "held\n"
+            rc = cli.main(["--quick", "--only", "store", "--out", str(out)])  # before: exit 0
+            one_line(capsys, rc, str(out), "another benchmark", f"(pid {first.pid})")
+            assert not (out / "store.parquet").exists()
+        finally:
+            first.stdin.close()
+    assert cli.main(["--quick", "--only", "store", "--out", str(out)]) == 0  # the lock is gone
+    assert sorted(p.name for p in out.iterdir()) == ["store.parquet"]  # no lock file left
+
+
+def test_a_scratch_directory_that_cannot_be_removed_leaves_the_check_standing(
+    tmp_path, monkeypatch, capsys
+):
+    studies, results = tmp_path / "studies", tmp_path / "results"
+    studies.mkdir()
+    assert sim_main(["check", "studies/brown_table1.toml", *TINY]) == 0
+    (studies / "brown_table1.toml").write_text(capsys.readouterr().out)
+    argv = ["run", str(studies / "brown_table1.toml"), "--quiet", "--no-figures"]
+    assert sim_main([*argv, "--out", str(results / "brown_table1")]) == 0
+    real, seen = os.unlink, []
+
+    def eio(path, *a, dir_fd=None, **k):  # the re-run's claims table, as rmtree removes it
+        if dir_fd is not None and str(path) == "claims.parquet" and not seen:
+            seen.append(path)
+            raise OSError(errno.EIO, "Input/output error", str(path))
+        return real(path, *a, dir_fd=dir_fd, **k)
+
+    monkeypatch.setattr(os, "unlink", eio)
+    rc = verify_main(["--results", str(results), "--studies", str(studies)])
+    monkeypatch.undo()
+    out, err = capsys.readouterr()
+    assert rc == 0 and "brown_table1: ok" in out, (rc, out, err)  # before: exit 2, nothing
+    assert (results / "reproducibility.parquet").is_file()
+    note = [ln for ln in err.splitlines() if "could not be removed" in ln]
+    assert len(note) == 1 and "Input/output error" in note[0], err
+    left = note[0].split("scratch directory ")[1].split(" could not")[0]
+    assert os.path.isdir(left) and os.path.basename(left).startswith("sim-verify-")
+    shutil.rmtree(left)
