@@ -16,6 +16,9 @@ fix.
   each other's, a page of one run beside the tables of the other. ``--out`` is now locked
   for the life of a benchmark (a ``flock`` on the directory, no file left in it): the second
   stops at once in one line naming the first's pid.
+* SIGTERM (or SIGHUP) to ``make bench`` ended it at once, exit 143 without a word, and left
+  its million-trial child running, writing into ``--out`` after the benchmark had ended (and
+  its lock with it). It now ends as Ctrl-C does: its children stopped, one line, exit 130.
 * ``make verify`` whose temporary scratch directory could not be removed at the end (an I/O
   error on one of the re-runs' files) ended in exit 2 with "Input/output error:
   claims.parquet" (a bare file name), its finished comparisons neither printed nor recorded
@@ -28,8 +31,11 @@ from __future__ import annotations
 import errno
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
+from pathlib import Path
 
 import pytest
 
@@ -88,6 +94,51 @@ def test_a_second_benchmark_into_the_same_out_is_refused_naming_the_first(tmp_pa
             first.stdin.close()
     assert cli.main(["--quick", "--only", "store", "--out", str(out)]) == 0  # the lock is gone
     assert sorted(p.name for p in out.iterdir()) == ["store.parquet"]  # no lock file left
+
+
+STOPPED = """
+import sys
+from benchmarks import brown, cli
+def rows(out, quick):  # the brown section's streamed run at once, long enough to be stopped
+    print("started", flush=True)
+    brown.peak_memory(out, 10**7, 10000)
+cli.brown_rows = rows
+sys.exit(cli.main(["--only", "brown", "--out", sys.argv[1]]))
+"""
+
+
+def _running_with(word: str) -> list[str]:
+    """The pids of live processes whose command line holds ``word``."""
+    pids = []
+    for p in Path("/proc").iterdir():
+        try:
+            if p.name.isdigit() and word.encode() in (p / "cmdline").read_bytes():
+                pids.append(p.name)
+        except OSError:
+            continue
+    return pids
+
+
+def test_sigterm_to_a_benchmark_stops_its_child_and_is_one_line(tmp_path):
+    out = tmp_path / "bench"
+    with subprocess.Popen(
+        [sys.executable, "-c", STOPPED, str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    ) as bench:
+        assert bench.stdout.readline() == "started\n"
+        deadline = time.monotonic() + 60
+        while not (out / "million_trials.tmp").exists():  # the child is writing its store
+            assert time.monotonic() < deadline and bench.poll() is None
+            time.sleep(0.02)
+        bench.send_signal(signal.SIGTERM)
+        _, err = bench.communicate(timeout=60)
+    left = _running_with(f"--out={out}")
+    for pid in left:  # (before the fix: the orphan)
+        os.kill(int(pid), signal.SIGKILL)
+    assert bench.returncode == 130 and err == "benchmarks: interrupted; nothing more was measured\n"
+    assert not left  # before: exit -15 (143), no line, the child writing on
 
 
 def test_a_scratch_directory_that_cannot_be_removed_leaves_the_check_standing(
