@@ -24,6 +24,11 @@ fix.
   claims.parquet" (a bare file name), its finished comparisons neither printed nor recorded
   in ``reproducibility.parquet``. The check now stands: the comparisons are printed and
   recorded and one note names the directory left behind.
+* A re-run of ``make verify`` ended by a signal of its own (the OOM killer, ``kill -9`` of
+  the re-run alone) was recorded as a failed reproduction: exit 1, and
+  ``reproducibility.parquet`` replaced by a record whose study read "no: the re-run was killed
+  by SIGKILL" (the report then showed results that had reproduced as not reproducing). It is
+  now one line naming the signal, exit 2, and the earlier record is kept.
 """
 
 from __future__ import annotations
@@ -42,6 +47,7 @@ import pytest
 from benchmarks import brown, cli
 from sim.cli import main as sim_main
 from sim.report.verify import main as verify_main
+from sim.report.verify import rerun as verify_rerun
 from tests.oneline import one_line
 
 TINY = ["--set", "trials=40", "--set", "chunk=2", "--set", "region.points=256"]
@@ -141,15 +147,22 @@ def test_sigterm_to_a_benchmark_stops_its_child_and_is_one_line(tmp_path):
     assert not left  # before: exit -15 (143), no line, the child writing on
 
 
-def test_a_scratch_directory_that_cannot_be_removed_leaves_the_check_standing(
-    tmp_path, monkeypatch, capsys
-):
+def _committed(tmp_path, capsys):
+    """``results/brown_table1`` of a tiny study file ``studies/brown_table1.toml`` (its
+    verify re-runs in a second or two)."""
     studies, results = tmp_path / "studies", tmp_path / "results"
     studies.mkdir()
     assert sim_main(["check", "studies/brown_table1.toml", *TINY]) == 0
     (studies / "brown_table1.toml").write_text(capsys.readouterr().out)
     argv = ["run", str(studies / "brown_table1.toml"), "--quiet", "--no-figures"]
     assert sim_main([*argv, "--out", str(results / "brown_table1")]) == 0
+    return studies, results
+
+
+def test_a_scratch_directory_that_cannot_be_removed_leaves_the_check_standing(
+    tmp_path, monkeypatch, capsys
+):
+    studies, results = _committed(tmp_path, capsys)
     real, seen = os.unlink, []
 
     def eio(path, *a, dir_fd=None, **k):  # the re-run's claims table, as rmtree removes it
@@ -169,3 +182,26 @@ def test_a_scratch_directory_that_cannot_be_removed_leaves_the_check_standing(
     left = note[0].split("scratch directory ")[1].split(" could not")[0]
     assert os.path.isdir(left) and os.path.basename(left).startswith("sim-verify-")
     shutil.rmtree(left)
+
+
+def test_a_re_run_killed_by_a_signal_is_not_recorded_as_a_failed_reproduction(
+    tmp_path, monkeypatch, capsys
+):
+    studies, results = _committed(tmp_path, capsys)
+    argv = ["--results", str(results), "--studies", str(studies)]
+    assert verify_main(argv) == 0
+    record = (results / "reproducibility.parquet").read_bytes()
+    capsys.readouterr()
+    real = verify_rerun.subprocess.Popen
+
+    def killed(cmd, *a, **k):  # the study's re-run, ended by the OOM killer
+        code = "import os, signal; os.kill(os.getpid(), signal.SIGKILL)"
+        return real([sys.executable, "-c", code], *a, **k)
+
+    monkeypatch.setattr(verify_rerun.subprocess, "Popen", killed)
+    rc = verify_main(argv)  # before: exit 1, "brown_table1: FAILED", and recorded so
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if not ln.startswith("sim verify: re-running")]
+    assert rc == 2 and len(lines) == 1 and "Traceback" not in err, (rc, err)
+    assert lines[0].startswith("sim verify: error: brown_table1: the re-run was killed by SIGKILL")
+    assert (results / "reproducibility.parquet").read_bytes() == record

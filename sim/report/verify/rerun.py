@@ -148,6 +148,14 @@ def rerun_study(
         # the re-run refused the options verify passed (--trials, --set, --workers, the
         # --out under --scratch): a request error, not a failed comparison to record
         raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
+    if proc.returncode < 0 or proc.returncode == 130:
+        # ended by a signal of its own (the OOM killer, a kill -9 or SIGTERM of the re-run
+        # alone): nothing was reproduced or not; it was recorded as a failed comparison ("no:
+        # the re-run was killed by SIGKILL"), over the record of the last check
+        raise VerifyError(
+            f"{d.name}: the re-run {ended(proc.returncode)} before it ended: nothing compared "
+            "or recorded (memory short? run verify again)"
+        )
     sys.stderr.write(err)
     return None if proc.returncode == 0 else f"the re-run {ended(proc.returncode)}"
 
