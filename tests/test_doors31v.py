@@ -29,6 +29,14 @@ fix.
   ``reproducibility.parquet`` replaced by a record whose study read "no: the re-run was killed
   by SIGKILL" (the report then showed results that had reproduced as not reproducing). It is
   now one line naming the signal, exit 2, and the earlier record is kept.
+* A re-run into ``--scratch`` that could not remove its lock file at its very end (an I/O
+  error: the run published, exit 0, the lock file left, as doors29e decided) left
+  ``DIR/<study>/.lock``, which every later ``make verify`` with that ``--scratch`` refused as
+  "holds '.lock', which the suite did not write" until it was removed by hand. The suite's
+  lock file is now the suite's.
+* A re-run whose ``--out`` under ``--scratch`` could not be made (a full disk: "sim: error:
+  --out: cannot write to DIR: No space left on device") was called "the re-run refused its
+  options"; it is now "the re-run could not run here", as the other errors of the system.
 """
 
 from __future__ import annotations
@@ -205,3 +213,20 @@ def test_a_re_run_killed_by_a_signal_is_not_recorded_as_a_failed_reproduction(
     assert rc == 2 and len(lines) == 1 and "Traceback" not in err, (rc, err)
     assert lines[0].startswith("sim verify: error: brown_table1: the re-run was killed by SIGKILL")
     assert (results / "reproducibility.parquet").read_bytes() == record
+
+
+def test_a_lock_file_left_in_an_earlier_re_run_does_not_block_the_next_verify(tmp_path, capsys):
+    studies, results = _committed(tmp_path, capsys)
+    argv = ["--results", str(results), "--studies", str(studies), "--no-record"]
+    argv += ["--scratch", str(tmp_path / "scratch")]
+    assert verify_main(argv) == 0
+    (tmp_path / "scratch" / "brown_table1" / ".lock").write_text("4242\n")  # (EIO at unlink)
+    capsys.readouterr()
+    assert verify_main(argv) == 0  # before: "holds '.lock', which the suite did not write"
+    assert "brown_table1: ok" in capsys.readouterr().out
+
+
+def test_a_scratch_that_cannot_be_written_is_the_machines_not_the_options():
+    line = "sim: error: --out: cannot write to /s/brown_table1: No space left on device"
+    assert verify_rerun._system_error(line)  # before: "the re-run refused its options"
+    assert not verify_rerun._system_error("sim: error: --out: must not be empty")

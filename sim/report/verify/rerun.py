@@ -16,7 +16,7 @@ from sim.mc.children import child_env, child_text, ended, stop_children
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
-from sim.mc.storage import read_provenance, read_record
+from sim.mc.storage import LOCK, read_provenance, read_record
 from sim.report.read import check_claims_table
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
 
@@ -94,6 +94,10 @@ def _ours(p: Path) -> bool:
         return False
     if p.is_dir():
         return p.name in ("trials", "cells")
+    # the lock file a run leaves in its results when it cannot remove it (an I/O error at its
+    # very end, the run published): every later verify into --scratch refused it as the user's
+    if p.name == LOCK:
+        return p.is_file()
     return p.name == "run.json" or p.suffix in (".parquet", ".png", ".xml")
 
 
@@ -169,7 +173,10 @@ def _system_error(line: str) -> bool:
     PATH``, or not enough memory), not the study's or its options'."""
     text = line.removeprefix("sim: error: ")
     return text != line and (
-        text.startswith("not enough memory") or text.split(": ", 1)[0] in _STRERRORS
+        text.startswith("not enough memory")
+        or text.split(": ", 1)[0] in _STRERRORS
+        # "--out: cannot write to DIR: No space left on device" (its --out under --scratch)
+        or (text.startswith("--out: cannot write") and text.rsplit(": ", 1)[-1] in _STRERRORS)
     )
 
 
