@@ -19,6 +19,10 @@ fix.
 * SIGTERM (or SIGHUP) to ``make bench`` ended it at once, exit 143 without a word, and left
   its million-trial child running, writing into ``--out`` after the benchmark had ended (and
   its lock with it). It now ends as Ctrl-C does: its children stopped, one line, exit 130.
+* The benchmark's page (``README.md``) was written in place: a write cut short (a full disk,
+  ``ulimit -f``) left a torn page where the finished one had been (and one cut within its
+  first line made every later ``make bench`` into that ``--out`` refuse it as not the
+  benchmark's). It is now written beside and renamed into place.
 * ``make verify`` whose temporary scratch directory could not be removed at the end (an I/O
   error on one of the re-runs' files) ended in exit 2 with "Input/output error:
   claims.parquet" (a bare file name), its finished comparisons neither printed nor recorded
@@ -53,6 +57,7 @@ from pathlib import Path
 import pytest
 
 from benchmarks import brown, cli
+from benchmarks.page import write_page
 from sim.cli import main as sim_main
 from sim.report.verify import main as verify_main
 from sim.report.verify import rerun as verify_rerun
@@ -113,6 +118,7 @@ def test_a_second_benchmark_into_the_same_out_is_refused_naming_the_first(tmp_pa
 STOPPED = """
 import sys
 from benchmarks import brown, cli
+from benchmarks.page import write_page
 def rows(out, quick):  # the brown section's streamed run at once, long enough to be stopped
     print("started", flush=True)
     brown.peak_memory(out, 10**7, 10000)
@@ -230,3 +236,27 @@ def test_a_scratch_that_cannot_be_written_is_the_machines_not_the_options():
     line = "sim: error: --out: cannot write to /s/brown_table1: No space left on device"
     assert verify_rerun._system_error(line)  # before: "the re-run refused its options"
     assert not verify_rerun._system_error("sim: error: --out: must not be empty")
+
+
+TORN = """
+import resource, signal, sys
+from pathlib import Path
+from benchmarks.page import write_page
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write over the limit fails with EFBIG
+resource.setrlimit(resource.RLIMIT_FSIZE, (256, resource.RLIM_INFINITY))
+try:
+    write_page(Path(sys.argv[1]), None, None, True)
+except OSError as e:
+    print("failed", e.errno)
+"""
+
+
+def test_a_page_cut_short_leaves_the_finished_one(tmp_path):
+    page = tmp_path / "README.md"
+    write_page(page, None, None, False)
+    before = page.read_bytes()
+    assert len(before) > 256
+    r = subprocess.run([sys.executable, "-c", TORN, str(page)], capture_output=True, text=True)
+    assert r.stdout == f"failed {errno.EFBIG}\n", (r.stdout, r.stderr)
+    assert page.read_bytes() == before  # before: its first 256 bytes
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["README.md"]
