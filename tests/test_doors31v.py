@@ -11,9 +11,10 @@ fix.
   (``.chunk-000002.parquet.<pid>.tmp``) in the store, which every later ``make bench`` into
   that ``--out`` refused as "not written by the benchmark" until it was removed by hand. The
   store's own temporaries are now the benchmark's.
-* Two benchmarks into one ``--out`` at once both ran: each replaced the other's chunk store
-  (and resumed from its chunks, timing less work) and wrote their tables and figures over
-  each other's, a page of one run beside the tables of the other. ``--out`` is now locked
+* Two benchmarks into one ``--out`` at once both ran: each could remove the other's chunk
+  store while it ran, or take its chunks as its own (the store resumes: timing less work),
+  and they wrote their tables and figures over each other's, a page of one run beside the
+  tables of the other. ``--out`` is now locked
   for the life of a benchmark (a ``flock`` on the directory, no file left in it): the second
   stops at once in one line naming the first's pid.
 * SIGTERM (or SIGHUP) to ``make bench`` ended it at once, exit 143 without a word, and left
