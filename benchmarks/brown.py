@@ -27,6 +27,7 @@ from scipy.optimize import least_squares
 from benchmarks.timing import cpu_time
 from sim.instruments.plates import grid_points, random_points
 from sim.instruments.ranges import multilateration as ml
+from sim.mc.children import ended
 from sim.mc.runner import ChunkStore, make_executor, run_chunks
 from sim.studies import RunContext
 
@@ -158,10 +159,16 @@ def peak_memory(out: Path, trials: int, chunk: int) -> tuple[float, float]:
             str(chunk),
             f"--out={out}",  # an --out that begins with "-" is its value, not an option
         ],
-        check=True,
         capture_output=True,
         text=True,
     )
+    if done.returncode != 0:  # its chunk store could not be written (a full disk), or it was
+        # killed (the OOM killer): a CalledProcessError traceback, exit 1
+        last = [ln for ln in done.stderr.splitlines() if ln.strip()][-1:]
+        why = f": {last[0].removeprefix('benchmarks: error: ')}" if last else ""
+        raise RuntimeError(
+            f"the {trials:,}-trial streamed run (a child process) {ended(done.returncode)}{why}"
+        )
     return float(done.stdout.split()[-1]), time.perf_counter() - t
 
 

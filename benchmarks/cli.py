@@ -29,7 +29,7 @@ from benchmarks import studies
 from benchmarks.brown import brown_rows, million, peak_rss_mib
 from benchmarks.engines import engine_rows
 from benchmarks.figures import brown_figure, engines_figure
-from benchmarks.outdir import not_written_here
+from benchmarks.outdir import OutLock, not_written_here
 from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
 from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
@@ -199,11 +199,8 @@ def _check_args(a: argparse.Namespace, sections: tuple[str, ...]) -> None:
                 raise _ArgError(f"--rerun-files: {f} is not a study file (no study = ...)")
 
 
-#: the line of an interrupted benchmark (Ctrl-C, SIGTERM, SIGHUP)
-INTERRUPTED = (
-    "benchmarks: interrupted; the sections that finished wrote their tables in --out "
-    "(its README.md was not rewritten)"
-)
+#: the benchmark's line when it was interrupted
+INTERRUPTED = "benchmarks: interrupted; nothing more was measured"
 
 
 def _interrupt(signum, frame):
@@ -211,12 +208,12 @@ def _interrupt(signum, frame):
 
 
 def main(argv=None) -> int:
-    """The benchmark; Ctrl-C, SIGTERM and SIGHUP end it with one line and exit 130, its
-    running ``sim run`` child stopped and its temporary directories removed (a SIGTERM killed
-    it silently, leaving both; Ctrl-C printed a traceback)."""
-    signals = (signal.SIGTERM, signal.SIGHUP) if in_main_thread() else ()
-    old = {s: signal.getsignal(s) for s in signals}
-    for s in signals:
+    """The benchmark; SIGTERM and SIGHUP end it as Ctrl-C does (its child processes stopped:
+    SIGTERM ended it at once, exit 143 without a word, and left its million-trial run
+    writing into ``--out``): one line, exit 130."""
+    stops = (signal.SIGTERM, signal.SIGHUP) if in_main_thread() else ()
+    old = {s: signal.getsignal(s) for s in stops}
+    for s in stops:
         if old[s] is signal.SIG_DFL:
             signal.signal(s, _interrupt)
     try:
@@ -230,7 +227,7 @@ def main(argv=None) -> int:
                 signal.signal(s, h)
 
 
-def _main(argv=None) -> int:
+def _main(argv) -> int:
     ap = _Parser(
         prog="python -m benchmarks",
         description="Benchmark of the batched solvers and of make rerun (see docs/benchmark.md)",
@@ -271,19 +268,25 @@ def _main(argv=None) -> int:
     ap.add_argument("--chunk", type=int, default=10000, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.million_child:
-        million(Path(a.out), a.million_child, a.chunk)
+        try:
+            million(Path(a.out), a.million_child, a.chunk)
+        except OSError as e:  # its parent names it (benchmarks.brown.peak_memory)
+            where = f": {e.filename}" if e.filename else ""
+            print(f"benchmarks: error: {e.strerror or e}{where}".splitlines()[0], file=sys.stderr)
+            return 2
         print(f"{peak_rss_mib():.1f}")
         return 0
     sections = tuple(s for s in a.only if a.rerun or s != "rerun")
     try:
         _check_args(a, sections)
-        tables = run(
-            Path(a.out),
-            a.quick,
-            sections,
-            a.rerun_files or "studies/*.toml",
-            a.rerun_workers or (1, 2),
-        )
+        with OutLock(Path(a.out)):  # a second benchmark into --out stops at once
+            tables = run(
+                Path(a.out),
+                a.quick,
+                sections,
+                a.rerun_files or "studies/*.toml",
+                a.rerun_workers or (1, 2),
+            )
     except (FileNotFoundError, RuntimeError, _ArgError) as e:
         print(f"benchmarks: error: {e}".splitlines()[0], file=sys.stderr)
         return 2

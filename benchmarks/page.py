@@ -12,6 +12,7 @@ import numpy as np
 
 from benchmarks.engines import KEEP_RATIO
 from benchmarks.studies import KEEP_SHARE
+from sim.mc.storage import atomic_path
 
 __all__ = ["HEADING", "STUDY_OF", "write_page"]
 
@@ -104,4 +105,5 @@ def write_page(path: Path, eng, studies, quick: bool) -> None:
             )
     else:
         out.append("Not measured in this run.")
-    Path(path).write_text("\n".join(out) + "\n")
+    with atomic_path(path) as tmp:  # a write cut short (a full disk) left a torn page in place
+        tmp.write_text("\n".join(out) + "\n", encoding="utf-8")  # of the finished one

@@ -151,10 +151,11 @@ def test_a_verify_re_run_killed_by_a_signal_names_it(tmp_path, monkeypatch, caps
 
     monkeypatch.setattr(verify_rerun.subprocess, "Popen", killed)
     monkeypatch.chdir(ROOT)  # the re-run reads its study file from studies/
-    why = verify_rerun.rerun_study(
-        Path("results/network_plate"), "network", tmp_path / "x", False, 1, []
-    )
-    assert why == "the re-run was killed by SIGKILL", why
+    # (since doors31v not a failed comparison to record: a request that could not run, exit 2)
+    with pytest.raises(verify_rerun.VerifyError, match="the re-run was killed by SIGKILL "):
+        verify_rerun.rerun_study(
+            Path("results/network_plate"), "network", tmp_path / "x", False, 1, []
+        )
 
 
 def test_a_benchmark_run_killed_by_a_signal_names_it():

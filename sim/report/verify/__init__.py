@@ -29,7 +29,7 @@ per study, with the sha256 of the tables it read, and the machine and package ve
 provenance: :mod:`sim.report.verify.record`) for the report's *Reproducibility* section, which
 marks results changed since as not checked now. A bad option, an unknown study, an empty
 results directory or a re-run this machine cannot run (its scratch directory full or read-only,
-memory short) is one line and exit 2; a failed comparison exit 1. ``--scratch`` replaces only what the suite wrote
+memory short, a re-run killed by a signal) is one line and exit 2; a failed comparison exit 1. ``--scratch`` replaces only what the suite wrote
 there (a directory with its ``run.json``); anything else is refused, never deleted.
 """
 

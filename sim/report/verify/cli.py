@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import signal
 import sys
 import tempfile
@@ -177,7 +178,8 @@ def _main(argv: list[str] | None) -> int:
         extra = [] if a.trials is None else ["--trials", str(a.trials)]
         extra += [x for s in a.set for x in ("--set", s)]
         mode = "full" if a.trials is None else "mc"
-        with tempfile.TemporaryDirectory(prefix="sim-verify-") as tmp:
+        tmp = None if a.scratch else tempfile.mkdtemp(prefix="sim-verify-")
+        try:
             comps = verify(
                 Path(a.results),
                 Path(a.scratch or tmp),
@@ -188,6 +190,8 @@ def _main(argv: list[str] | None) -> int:
                 mode=mode,
                 studies=Path(a.studies),
             )
+        finally:
+            left = _remove(tmp)
         check_interrupt()  # before the comparisons are printed and recorded
     except VerifyError as e:
         print(f"sim verify: error: {e}", file=sys.stderr)
@@ -214,4 +218,28 @@ def _main(argv: list[str] | None) -> int:
             where = Path(a.results) / "reproducibility.parquet"
             print(f"sim verify: error: cannot write {where}: {e.strerror or e}", file=sys.stderr)
             return 2
+    if left:
+        print(left, file=sys.stderr)
     return code
+
+
+def _remove(tmp: str | None) -> str | None:
+    """Remove the temporary scratch directory ``tmp`` of the re-runs; the note to print when
+    it could not be removed (an I/O error, a file in it made read-only), else None. A
+    finished check stands: the failure ended verify in exit 2 naming a bare file name
+    ("Input/output error: claims.parquet"), its comparisons neither printed nor recorded."""
+    if tmp is None:
+        return None
+    failed: list[str] = []
+
+    def note(fn, path, exc) -> None:  # (onexc of Python 3.12 on: the exception itself)
+        e = exc[1] if isinstance(exc, tuple) else exc
+        failed.append(f"{getattr(e, 'strerror', None) or e}: {path}")
+
+    shutil.rmtree(tmp, **{"onexc" if sys.version_info >= (3, 12) else "onerror": note})
+    if not failed or not os.path.lexists(tmp):
+        return None
+    return (
+        f"sim verify: note: its scratch directory {tmp} could not be removed ({failed[0]}): "
+        "remove it by hand"
+    )

@@ -16,7 +16,7 @@ from sim.mc.children import child_env, child_text, ended, stop_children
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
-from sim.mc.storage import read_provenance, read_record
+from sim.mc.storage import LOCK, read_provenance, read_record
 from sim.report.read import check_claims_table
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
 
@@ -94,6 +94,10 @@ def _ours(p: Path) -> bool:
         return False
     if p.is_dir():
         return p.name in ("trials", "cells")
+    # the lock file a run leaves in its results when it cannot remove it (an I/O error at its
+    # very end, the run published): every later verify into --scratch refused it as the user's
+    if p.name == LOCK:
+        return p.is_file()
     return p.name == "run.json" or p.suffix in (".parquet", ".png", ".xml")
 
 
@@ -148,6 +152,14 @@ def rerun_study(
         # the re-run refused the options verify passed (--trials, --set, --workers, the
         # --out under --scratch): a request error, not a failed comparison to record
         raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
+    if proc.returncode < 0 or proc.returncode == 130:
+        # ended by a signal of its own (the OOM killer, a kill -9 or SIGTERM of the re-run
+        # alone): nothing was reproduced or not; it was recorded as a failed comparison ("no:
+        # the re-run was killed by SIGKILL"), over the record of the last check
+        raise VerifyError(
+            f"{d.name}: the re-run {ended(proc.returncode)} before it ended: nothing compared "
+            "or recorded (memory short? run verify again)"
+        )
     sys.stderr.write(err)
     return None if proc.returncode == 0 else f"the re-run {ended(proc.returncode)}"
 
@@ -161,7 +173,10 @@ def _system_error(line: str) -> bool:
     PATH``, or not enough memory), not the study's or its options'."""
     text = line.removeprefix("sim: error: ")
     return text != line and (
-        text.startswith("not enough memory") or text.split(": ", 1)[0] in _STRERRORS
+        text.startswith("not enough memory")
+        or text.split(": ", 1)[0] in _STRERRORS
+        # "--out: cannot write to DIR: No space left on device" (its --out under --scratch)
+        or (text.startswith("--out: cannot write") and text.rsplit(": ", 1)[-1] in _STRERRORS)
     )
 
 
