@@ -226,3 +226,18 @@ def test_a_runs_readme_says_at_its_top_that_it_is_off_the_papers_setup():
     # a value equal to the paper's as 12 digits show it is the paper's (1.1 + 0.6 is 1.7)
     near = {**cfg, "b8.e_arcsec": -59.2 + 1e-14}
     assert off_setup(study, near) == "" and "this run" not in inputs_markdown(near, SCHEMA)
+
+
+def test_a_temporary_left_by_a_killed_writer_is_not_carried_as_the_users(tmp_path, capsys):
+    # before: `sim report` killed while writing README.md left `.README.md.<pid>.tmp`, and the
+    # next `sim run --overwrite` carried it into the new results as a file of the user's
+    out = tmp_path / "np"
+    run = ["run", str(STUDIES / "network_plate.toml"), "--trials", "40", "--chunk", "2"]
+    run += ["--out", str(out), "--quiet", "--no-figures"]
+    assert main(run) == 0
+    dead = 4_194_304 + 1_000  # above Linux's largest pid: no process has it
+    (out / f".README.md.{dead}.tmp").write_text("torn")
+    (out / f".notes.{dead}.tmp").write_text("mine")  # not a temporary of the suite's files
+    assert main([*run, "--overwrite"]) == 0, capsys.readouterr().err
+    left = sorted(p.name for p in out.iterdir() if p.name.endswith(".tmp"))
+    assert left == [f".notes.{dead}.tmp"], left

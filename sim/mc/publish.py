@@ -180,11 +180,26 @@ def _foreign(out: Path) -> list[str]:
         r = Path(root)
         for n in files + [d for d in dirs if (r / d).is_symlink()]:
             f = (r / n).relative_to(out).as_posix()
-            if f not in mine and f not in ("run.json", LOCK):  # its own, not a copy's inside
-                keep.append(f)
+            if f not in mine and f not in ("run.json", LOCK) and not _left_temporary(f, mine):
+                keep.append(f)  # (run.json, .lock: its own, not a copy's inside)
         if r != out and not dirs and not files:
             keep.append(r.relative_to(out).as_posix() + "/")
     return sorted(keep)
+
+
+#: the temporary of a file the suite writes (:class:`sim.mc.storage.atomic_path`)
+_TEMPORARY = re.compile(r"(.*/)?\.([^/]+)\.(\d+)\.tmp")
+
+
+def _left_temporary(f: str, mine: set) -> bool:
+    """Whether ``f`` is the temporary of one of the run's own files (``README.md``) that a
+    process killed while writing it left: not the user's, so not carried (``sim report``
+    killed mid-README, then ``sim run --overwrite``, carried ``.README.md.<pid>.tmp``)."""
+    m = _TEMPORARY.fullmatch(f)
+    if m is None or f"{m.group(1) or ''}{m.group(2)}" not in mine | {"run.json"}:
+        return False
+    pid = int(m.group(3))  # this pid's: a container's earlier command (as storage reads it)
+    return pid == os.getpid() or not pid_alive(pid)
 
 
 def _carry(src: Path, dst: Path) -> None:
