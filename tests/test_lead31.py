@@ -241,3 +241,15 @@ def test_a_temporary_left_by_a_killed_writer_is_not_carried_as_the_users(tmp_pat
     assert main([*run, "--overwrite"]) == 0, capsys.readouterr().err
     left = sorted(p.name for p in out.iterdir() if p.name.endswith(".tmp"))
     assert left == [f".notes.{dead}.tmp"], left
+
+
+def test_a_singular_pivot_model_is_blamed_on_the_stations_when_they_moved(capsys):
+    # before: stations 1e9 mm out (no scale enforced) were refused naming plate.grid, the
+    # paper's own 5 x 5 grid, which the paper's stations solve
+    study = str(STUDIES / "brown_table1.toml")
+    far = ["comparator.station_offset_mm=1e9", "comparator.scale_length_mm=0"]
+    err = _refused(capsys, ["check", study, *[a for s in far for a in ("--set", s)]])
+    assert err.startswith("sim: error: comparator.station_offset_mm: the pivot model"), err
+    # a 2 x 2 grid is singular from any stations: still its key
+    err = _refused(capsys, ["check", study, "--set", "plate.grid=2"])
+    assert err.startswith("sim: error: plate.grid: the pivot model"), err

@@ -378,14 +378,23 @@ def check_pivot(cfg: dict, key: str, pts: np.ndarray) -> None:
     the plate's extent."""
     _, theta = setup(cfg)
     if not np.all(np.isfinite(ml.ranges(pts[None], theta[None]))):
-        return  # the scale check names the overflow when the scale is enforced
+        return  # an overflow is named by the range check before this one
     rc = pivot_rcond(pts, theta)
     if not rc > RCOND:
+        moved = moved_from_paper(cfg, key, {k: f.default for k, f in BASE.items()})
+        blame = key  # the comparator's keys when the points are solved from the paper's
+        # stations (stations 1e9 mm out blamed the plate's grid)
+        if comp := [k for k in moved if k.startswith("comparator.")]:
+            paper = {**cfg, **{k: BASE[k].default for k in comp}}
+            blame = comp[-1] if pivot_rcond(pts, setup(paper)[1]) > RCOND else key
         raise ConfigError(
-            key,
+            blame,
             f"the pivot model (stations, alpha and beta free) cannot be solved at these "
             f"{len(pts)} points: its reduced normal matrix is singular (scaled reciprocal "
-            f"condition {rc:.2g}, the adjustment needs > {RCOND:g})",
+            f"condition {rc:.2g}, the adjustment needs > {RCOND:g})"
+            + (
+                f"; changed from their paper or nominal values: {', '.join(moved)}" if moved else ""
+            ),
         )
     ext = float(np.abs(pts).max())
     th = thetas(cfg["plate.format_mm"], cfg["comparator.station_offset_mm"], 0.0, 0.0)[0]
