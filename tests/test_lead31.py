@@ -253,3 +253,17 @@ def test_a_singular_pivot_model_is_blamed_on_the_stations_when_they_moved(capsys
     # a 2 x 2 grid is singular from any stations: still its key
     err = _refused(capsys, ["check", study, "--set", "plate.grid=2"])
     assert err.startswith("sim: error: plate.grid: the pivot model"), err
+
+
+@pytest.mark.parametrize(
+    ("given", "words"),
+    [
+        ("tests/data/gama/one_fixed.xml", "(it is a GNU Gama file, not a study file: a network"),
+        ("results/brown_table1/run.json", "(it is a results directory's run.json, not a study"),
+    ],
+)
+def test_a_file_of_another_kind_given_as_the_study_file_is_named(capsys, given, words):
+    # before: "malformed TOML: Invalid statement (at line 1, column 1)" alone for a new
+    # user's GNU Gama file or a results directory's run.json given to `sim run`
+    err = _refused(capsys, ["check", str(STUDIES.parent / given)])
+    assert "malformed TOML" in err and words in err, err

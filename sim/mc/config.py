@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.lookalike import note, toml_char_hint
+from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.study_file import study_file_problem
 
@@ -365,7 +366,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
             data = data[len(codecs.BOM_UTF8) :]  # and no part of the text; it was refused
         if b"\x00" in data:  # as malformed TOML at line 1, column 1 (doors12)
             raise ConfigError(None, f"{p}: not UTF-8 text (it holds NUL bytes: UTF-16 or binary)")
-        doc = tomllib.loads(data.decode("utf-8"), parse_float=toml_float)
+        doc = tomllib.loads(text := data.decode("utf-8"), parse_float=toml_float)
         refuse_big_ints("", doc)
         return doc
     except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again
@@ -377,7 +378,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         curly = [c for c in line if c in TYPOGRAPHIC]  # a word processor's quotes
         hint = f' (the typographic quote {curly[0]} is no TOML quote: type ")' if curly else ""
         raise ConfigError(
-            None, f"{p}: malformed TOML: {e}{hint or toml_char_hint(line, col)}"
+            None, f"{p}: malformed TOML: {e}{hint or kind_hint(text) or toml_char_hint(line, col)}"
         ) from None
     except RecursionError:
         raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None
