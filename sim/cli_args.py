@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import ast
+import re
 from importlib import metadata
 from pathlib import Path
 
@@ -31,6 +32,9 @@ class _Parser(OnceParser):
             ]
             if bad:
                 message = self.explain(f"unrecognized arguments: {bad[0]}")
+        extra = re.match(r"unrecognized arguments: (\S+\.toml)\b", message)
+        if extra:  # `sim run a.toml b.toml`: one study a command
+            message += " (one study file a command: python -m sim.batch runs many)"
         # the command's own parser names itself ("sim run: argument --trials: ..."); the top
         # one reports what no command takes: its line already starts "sim: error:" (it said
         # "sim: error: sim: unrecognized arguments"), and the help to see is the command's

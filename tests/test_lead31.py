@@ -267,3 +267,17 @@ def test_a_file_of_another_kind_given_as_the_study_file_is_named(capsys, given, 
     # user's GNU Gama file or a results directory's run.json given to `sim run`
     err = _refused(capsys, ["check", str(STUDIES.parent / given)])
     assert "malformed TOML" in err and words in err, err
+
+
+def test_a_quoted_pattern_of_study_files_is_not_said_to_match_none(capsys):
+    # before: `sim check 'studies/*.toml'` said "no such study file (a pattern that matched no
+    # file ...)" of a pattern that matches every study file (quoted, the shell left it)
+    err = _refused(capsys, ["check", str(STUDIES / "*.toml")])
+    assert "a pattern, not a study file (it matches" in err and "matched no file" not in err
+
+
+def test_two_study_files_to_one_command_are_told_of_the_batch(capsys):
+    # before: "unrecognized arguments: studies/brown_dilution.toml" alone
+    study = str(STUDIES / "brown_table1.toml")
+    err = _refused(capsys, ["run", study, str(STUDIES / "brown_dilution.toml")])
+    assert "brown_dilution.toml (one study file a command: python -m sim.batch runs many)" in err

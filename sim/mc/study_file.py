@@ -8,6 +8,7 @@ no size limit until the file's config was read): one check, one wording, the pat
 
 from __future__ import annotations
 
+import glob
 import os
 from pathlib import Path
 
@@ -43,6 +44,12 @@ def study_file_problem(p: str | Path) -> str | None:
         if why := link_problem(p):  # a link loop was "no such study file", of a name there
             return f"{p}: {why}"
         if any(c in str(p) for c in "*?["):
+            hits = len(glob.glob(str(p)))  # quoted, the shell passed on a pattern of files
+            if hits:
+                return (
+                    f"{p}: a pattern, not a study file (it matches {hits} files, which the "
+                    "shell did not expand: leave it unquoted, or name the files)"
+                )
             return (
                 f"{p}: no such study file (a pattern that matched no file: the shell passed "
                 "it on as it is)"
