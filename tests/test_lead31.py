@@ -185,7 +185,7 @@ def test_a_claims_table_with_a_claim_name_of_two_lines_is_not_shown_as_the_runs(
 def test_an_input_this_run_changed_is_not_listed_as_set_to_match_the_paper():
     # before: `--set b8.sx_mm_per_digit=11` was listed under "Inputs set to match the paper
     # (agreement with these is by construction)" as 11.0, and 12.702028129 was shown as 12.7
-    from sim.report.markdown import inputs_markdown
+    from sim.report.inputs import inputs_markdown
     from sim.studies.salsig.schema import SCHEMA
 
     cfg = {k: f.default for k, f in SCHEMA.items()}
@@ -211,7 +211,7 @@ def test_a_runs_readme_says_at_its_top_that_it_is_off_the_papers_setup():
     # paper's; `sim check` said it in one line before the run
     from types import SimpleNamespace
 
-    from sim.report.markdown import inputs_markdown
+    from sim.report.inputs import inputs_markdown
     from sim.report.run_summary import off_setup
     from sim.studies.salsig.schema import SCHEMA
 
@@ -281,3 +281,18 @@ def test_two_study_files_to_one_command_are_told_of_the_batch(capsys):
     study = str(STUDIES / "brown_table1.toml")
     err = _refused(capsys, ["run", study, str(STUDIES / "brown_dilution.toml")])
     assert "brown_dilution.toml (one study file a command: python -m sim.batch runs many)" in err
+
+
+def test_a_report_over_sweeps_only_prints_no_empty_tables(tmp_path, capsys):
+    # before: `sim report --results DIR` over a directory holding only a sweep wrote the
+    # verdict tables with a header and no row, and said its numbers came of `make reproduce`
+    study = tmp_path / "net_sweep.toml"
+    text = (STUDIES / "network_plate.toml").read_text(encoding="utf-8")
+    study.write_text(text + "\n[sweep]\nreplicates = 2\n", encoding="utf-8")
+    out = tmp_path / "r" / "net_sweep"
+    run = ["run", str(study), "--trials", "40", "--chunk", "2", "--out", str(out)]
+    assert main([*run, "--quiet", "--no-figures"]) == 0, capsys.readouterr().err
+    assert main(["report", "--results", str(tmp_path / "r")]) == 0, capsys.readouterr().err
+    report = (tmp_path / "r" / "REPORT.md").read_text(encoding="utf-8")
+    assert "No study results here, only sweeps" in report and "|---|" not in report, report
+    assert "(`sim run`)" in report and "make reproduce" not in report, report

@@ -7,7 +7,6 @@ Markdown. Nothing here runs a simulation.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Callable
 
@@ -33,7 +32,6 @@ __all__ = [
     "claims_markdown",
     "fmt",
     "md_table",
-    "inputs_markdown",
     "number",
     "verdict_counts",
     "referee_summary",
@@ -127,48 +125,6 @@ def verdict_counts(claims: list[dict]) -> dict[str, int]:
         else:
             c[k] += 1
     return c
-
-
-def _as_set(v) -> str:
-    """An input as the study file sets it (every digit: 12.702028129 was shown as 12.7)."""
-    if isinstance(v, float) and math.isfinite(v):
-        return repr(v)
-    return fmt(v)
-
-
-def _shown_differs(v, default) -> bool:
-    """Whether ``v`` is another value than ``default`` as 12 significant digits show them (a
-    swept 1.1 + 0.6 is the paper's 1.7, as :func:`sim.claims.rules.printed_differs` reads it)."""
-    if isinstance(v, float) and isinstance(default, (int, float)):
-        return f"{v:.12g}" != f"{float(default):.12g}"
-    return v != default
-
-
-def inputs_markdown(cfg: dict, schema) -> str:
-    """List the config values marked as paper-matched inputs; one this run set to another
-    value than the paper's is marked so (it was listed as "set to match the paper")."""
-    rows, changed = [], 0
-    for k, f in schema.items():
-        if not f.input:
-            continue
-        v = cfg.get(k)
-        text = _as_set(v)
-        if _shown_differs(v, f.default):
-            changed += 1
-            text += f" (this run; the paper's: {_as_set(f.default)})"
-        rows.append([f"`{k}`", text, f.doc])
-    if not rows:
-        return ""
-    but = (
-        f"; {changed} of them this run sets to another value, marked: there agreement is no "
-        "longer by construction"
-        if changed
-        else ""
-    )
-    return (
-        "Inputs set to match the paper (agreement with these is by construction, not a "
-        f"prediction{but}):\n\n" + md_table(["key", "value", "meaning"], rows)
-    )
 
 
 _COUNT_COLS = [
@@ -331,12 +287,19 @@ def build_report(
         for p in results_dirs(results)
         if (p / "sweep.parquet").is_file() and not (p / "claims.parquet").is_file()
     )
-    head = (
+    head = (  # a directory of the user's was made by `sim run`, not `make reproduce`
         "# Reproducibility report\n\n"
-        "Every number below was produced by a run of the code (`make reproduce`); paper values "
+        f"Every number below was produced by a run of the code "
+        f"(`{'make reproduce' if studies else 'sim run'}`); paper values "
         "appear only as the reference of a claim. Rebuilt from the Parquet files alone by "
         "`sim report`; each study's detail is its directory's README.md.\n\n"
     )
+    if not entries:  # sweeps only: no claim to count (its tables were printed empty)
+        return (
+            head
+            + "No study results here, only sweeps: each sweep's README.md has its cells.\n\n"
+            + "".join(f"- {md_link(s)}: a sweep\n" for s in sweeps)
+        )
     table = md_table(
         ["study", "paper"] + [t for _, t in _COUNT_COLS] + ["not reproduced", "code commit"],
         [e[4] for e in entries],

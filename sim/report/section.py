@@ -36,7 +36,8 @@ from typing import Any
 from sim.claims.region import REGION_MIN_POINTS
 from sim.mc.publish import drawn
 from sim.mc.storage import read_provenance
-from sim.report.markdown import claims_markdown, inputs_markdown
+from sim.report.inputs import inputs_markdown
+from sim.report.markdown import claims_markdown
 from sim.report.read import columns, records
 from sim.report.tables import fmt, md_table
 
