@@ -296,3 +296,22 @@ def test_a_report_over_sweeps_only_prints_no_empty_tables(tmp_path, capsys):
     report = (tmp_path / "r" / "REPORT.md").read_text(encoding="utf-8")
     assert "No study results here, only sweeps" in report and "|---|" not in report, report
     assert "(`sim run`)" in report and "make reproduce" not in report, report
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "words"),
+    [
+        (
+            'from = ["A", "B", "C", "D"], to = "N*", sigma_mm = 1.0',
+            'from = ["A", "A", "C", "D"], to = "N*", sigma_mm = 1.0',
+            "network.generate[0].from: 'A' is listed twice",
+        ),
+        ('fix = ["N1", "N12"]', 'fix = ["N1", "N1"]', "compare.fix: 'N1' is listed twice"),
+        ('inner_over = ["N*"]', 'inner_over = ["N*", "N*"]', "output.inner_over: 'N*' is listed"),
+    ],
+)
+def test_a_point_name_listed_twice_is_refused(tmp_path, capsys, old, new, words):
+    # before: `from = ["A", "A", "C", "D"]` (a typo for B) ran without B's sights, and
+    # `compare.fix = ["N1", "N1"]` compared with one point where two were meant
+    err = _refused(capsys, ["check", str(_edited(tmp_path, "network_testfield.toml", old, new))])
+    assert words in err, err

@@ -219,9 +219,13 @@ def hits(p: str, names, index: dict[str, int]) -> list[int]:
 
 def select(key: str, pats, names, index: dict[str, int], what: str = "no point named") -> list[int]:
     """Indices matched by any of ``pats``, each once, in the order matched; a pattern that
-    matches nothing is refused naming ``key``."""
+    matches nothing, or one listed twice (``["A", "A", "C"]``: a typo for ``B``, whose sights
+    were silently left out), is refused naming ``key``."""
     out: list[int] = []
     seen: set[int] = set()
+    twice = [p for i, p in enumerate(pats) if isinstance(p, str) and p in pats[:i]]
+    if twice:
+        raise ConfigError(key, f"{twice[0]!r} is listed twice")
     for p in pats:
         hit = hits(p, names, index)
         if not hit:
