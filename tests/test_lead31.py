@@ -315,3 +315,12 @@ def test_a_point_name_listed_twice_is_refused(tmp_path, capsys, old, new, words)
     # `compare.fix = ["N1", "N1"]` compared with one point where two were meant
     err = _refused(capsys, ["check", str(_edited(tmp_path, "network_testfield.toml", old, new))])
     assert words in err, err
+
+
+def test_a_sweep_given_as_an_override_is_told_where_sweeps_go(capsys):
+    # before: `--set sweep.plate.grid=[4,5]` on brown_table1 said "unknown key of the study
+    # brown_table1: a key of brown_dilution, gridplate_two_plates" of brown_table1's own key
+    study = str(STUDIES / "brown_table1.toml")
+    err = _refused(capsys, ["check", study, "--set", "sweep.plate.grid=[4,5]"])
+    assert "a sweep is not set by an override; write plate.grid in the study file's [sweep]" in err
+    assert "a key of" not in err, err
