@@ -13,6 +13,7 @@ import pyarrow as pa
 
 from sim.mc.storage import read_provenance
 from sim.report.claimtext import decimals_for, exact_text, fmt_at
+from sim.report.config_diff import changed_keys, changes_text
 from sim.report.papers import paper_name
 from sim.report.run_summary import headline_rows, region_line, verdict_line
 from sim.report.tables import Md, fmt, md_link, md_table
@@ -221,12 +222,9 @@ def design_notes(entries: list[tuple], results: Path, design: Callable | None) -
             )
             continue
         mine = _config_of(results / name)
-        diff = [k for k in sorted(set(mine) | set(base)) if mine.get(k) != base.get(k)]
-        if not mine or not diff:
+        if not mine or not changed_keys(mine, base):
             continue
-        what = ", ".join(
-            f"`{k}` = {fmt(mine.get(k))} (the file: {fmt(base.get(k))})" for k in diff[:6]
-        ) + (f", and {len(diff) - 6} more" if len(diff) > 6 else "")
+        what = changes_text(mine, base)
         out.append(
             f"- {md_link(name)} did not run the configuration of "
             f"`studies/{name}.toml`: {what}. Its verdicts are about this run's configuration, "

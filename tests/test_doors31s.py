@@ -1,0 +1,85 @@
+"""doors31s: what the suite shows about a run that is not the paper's default config.
+
+A run with ``--set``, ``--trials``, ``--seed`` or of an edited copy of a study file, read in
+its README.md, ``sim show`` (table and ``--markdown``), REPORT.md and claims.parquet: a
+sentence true only of the study file's design is silent nonsense there. Two classes: the run's
+README and ``sim show`` did not say the run changed its study file's config (REPORT.md did, but
+only for a directory named like a study file); the claim books' static text said an unprinted
+input "is set so that" the paper's number matches and "the row shows the setting reproduces the
+paper" (salsig, agnard), that the time model is calibrated to "the paper's 60 and 90 minutes"
+(brown_design) and spoke of "a 12.500/12.700 vertical scale error" (salsig), whatever the run's
+value of the key. The results directory is a copy of a committed one whose tables' provenance
+and run record say the overrides (no run), so the file stays fast."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import tomllib
+from pathlib import Path
+
+import pyarrow.parquet as pq
+
+from sim.cli import main
+
+REPO = Path(__file__).resolve().parents[1]
+CHANGED = {"trials": 40, "errors.comparator_sigma_um": 2.0}
+
+
+def _overridden(tmp_path: Path, name: str) -> Path:
+    """results/brown_table1 copied as ``name``, its tables and run record saying a run with
+    :data:`CHANGED` (what ``sim run ... --trials 40 --set errors.comparator_sigma_um=2`` records)."""
+    d = tmp_path / name
+    shutil.copytree(REPO / "results" / "brown_table1", d)
+    for p in d.glob("*.parquet"):
+        t = pq.read_table(p)
+        meta = dict(t.schema.metadata)
+        prov = json.loads(meta[b"sim.provenance"])
+        prov["config"].update(CHANGED)
+        meta[b"sim.provenance"] = json.dumps(prov).encode()
+        pq.write_table(t.replace_schema_metadata(meta), p)
+    rec = json.loads((d / "run.json").read_text())
+    rec["config"].update(CHANGED)
+    (d / "run.json").write_text(json.dumps(rec))
+    return d
+
+
+def test_a_runs_readme_and_sim_show_name_what_it_changed_from_its_study_file(tmp_path, capsys):
+    """`sim show` (both forms) of a run with --trials 40 --set errors.comparator_sigma_um=2 printed
+    the verdicts as the study file's: it names the keys, the run's and the file's values."""
+    d = _overridden(tmp_path, "mine")
+    file_cfg = tomllib.loads((REPO / "studies" / "brown_table1.toml").read_text())
+    for args in (["show", str(d)], ["show", str(d), "--markdown"]):
+        assert main(args) == 0
+        out = capsys.readouterr().out
+        assert "Not the configuration of `studies/brown_table1.toml`" in out
+        assert f"`trials` = 40 (the file: {file_cfg['trials']})" in out
+        assert "`errors.comparator_sigma_um` = 2.00 (the file: 1.10)" in out
+    # the committed results, the study file's config: no such line
+    assert main(["show", str(REPO / "results" / "brown_table1"), "--markdown"]) == 0
+    assert "Not the configuration" not in capsys.readouterr().out
+
+
+def _book_texts() -> list[str]:
+    out = []
+    for p in sorted((REPO / "sim" / "studies").glob("*/claims.toml")):
+        book = tomllib.loads(p.read_text(encoding="utf-8"))
+        for row in book.get("claim", []) + book.get("not_reproduced", []):
+            out += [row[k] for k in ("paper", "why", "printed") if isinstance(row.get(k), str)]
+    return out
+
+
+def test_claim_books_say_what_the_default_is_set_to_not_what_every_run_has():
+    """The books' static text is shown for every run: it said the unprinted inputs are set
+    to the paper's match (and the row shows it) and the time model is calibrated to the
+    paper's 60 and 90 minutes on runs that set other values. It now says the default does,
+    naming the key."""
+    stale = re.compile(
+        r"is not printed and is set|the row shows the setting|calibrated to the paper's"
+        r"|a 12\.500/12\.700"
+    )
+    texts = _book_texts()
+    assert not [t for t in texts if stale.search(t)]
+    for key in ("b8.sigma_um", "comparator.sigma_um", "pugging.recentre_px", "time.single_min"):
+        assert any(key in t and "default" in t for t in texts), key
