@@ -83,3 +83,15 @@ def test_claim_books_say_what_the_default_is_set_to_not_what_every_run_has():
     assert not [t for t in texts if stale.search(t)]
     for key in ("b8.sigma_um", "comparator.sigma_um", "pugging.recentre_px", "time.single_min"):
         assert any(key in t and "default" in t for t in texts), key
+
+
+def test_report_names_the_overrides_of_a_directory_not_named_like_a_study_file(tmp_path, capsys):
+    """REPORT.md named a run's changed keys only when its directory was named like a study
+    file (``--out .../brown_table1``); ``--out .../mine`` was read as the paper's design. It is
+    now compared with its study's file, in REPORT.md and in the README sim report rewrites."""
+    d = _overridden(tmp_path / "r", "mine")
+    assert main(["report", "--results", str(d.parent)]) == 0
+    capsys.readouterr()
+    report = (d.parent / "REPORT.md").read_text(encoding="utf-8")
+    assert "did not run the configuration of `studies/brown_table1.toml`: `errors." in report
+    assert "Not the configuration of `studies/brown_table1.toml`" in (d / "README.md").read_text()
