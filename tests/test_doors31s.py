@@ -95,3 +95,16 @@ def test_report_names_the_overrides_of_a_directory_not_named_like_a_study_file(t
     report = (d.parent / "REPORT.md").read_text(encoding="utf-8")
     assert "did not run the configuration of `studies/brown_table1.toml`: `errors." in report
     assert "Not the configuration of `studies/brown_table1.toml`" in (d / "README.md").read_text()
+
+
+def test_agnard_height_budget_note_says_the_runs_parallax_error_is_not_the_papers():
+    """The model_z_cm note said 'measure.parallax_px set from the paper's 22 cm' on a run
+    with --set measure.parallax_px=1 (44 cm): it names the run's value and the default's."""
+    import sim.studies.agnard.claims as C
+    from sim.studies.agnard.schema import SCHEMA
+
+    cfg = {k: f.default for k, f in SCHEMA.items()}
+    note = lambda c: C.budget_rows(C.load_book(), c)["agnard.budget.model_z_cm"].note  # noqa: E731
+    assert "(measure.parallax_px set from the paper's 22 cm)" in note(cfg)
+    off = note({**cfg, "measure.parallax_px": 1.0})
+    assert "this run's measure.parallax_px 1 px; the default 0.5 px is set from" in off
