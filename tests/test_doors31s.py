@@ -2,14 +2,15 @@
 
 A run with ``--set``, ``--trials``, ``--seed`` or of an edited copy of a study file, read in
 its README.md, ``sim show`` (table and ``--markdown``), REPORT.md and claims.parquet: a
-sentence true only of the study file's design is silent nonsense there. Two classes: the run's
-README and ``sim show`` did not say the run changed its study file's config (REPORT.md did, but
-only for a directory named like a study file); the claim books' static text said an unprinted
+sentence true only of the study file's design is silent nonsense there. Classes: the run's
+README and ``sim show`` did not say the run changed its study file's config, and REPORT.md said
+it only for a directory named like a study file; the claim books' static text said an unprinted
 input "is set so that" the paper's number matches and "the row shows the setting reproduces the
 paper" (salsig, agnard), that the time model is calibrated to "the paper's 60 and 90 minutes"
 (brown_design) and spoke of "a 12.500/12.700 vertical scale error" (salsig), whatever the run's
-value of the key. The results directory is a copy of a committed one whose tables' provenance
-and run record say the overrides (no run), so the file stays fast."""
+value of the key; two notes said the run's input was the paper's (agnard's parallax error,
+brown's setting sigma). The results directory is a copy of a committed one whose tables'
+provenance and run record say the overrides (no run), so the file stays fast."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ import shutil
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pyarrow.parquet as pq
 
 from sim.cli import main
@@ -108,3 +110,15 @@ def test_agnard_height_budget_note_says_the_runs_parallax_error_is_not_the_paper
     assert "(measure.parallax_px set from the paper's 22 cm)" in note(cfg)
     off = note({**cfg, "measure.parallax_px": 1.0})
     assert "this run's measure.parallax_px 1 px; the default 0.5 px is set from" in off
+
+
+def test_brown_setting_sigma_note_says_whose_setting_sigma_the_run_simulated():
+    """The table1_setting note said 'the simulated setting sigma is the paper's value' on a
+    run with --set errors.setting_sigma_um=3: it names the run's value and the paper's."""
+    import sim.studies.brown.claims as C
+
+    t1 = {"setting_sigma_um": np.linspace(1.5, 1.9, 50)}
+    cfg = {"errors.settings": 2, "errors.setting_sigma_um": 1.7}
+    assert "is 1.7 um, the paper's" in C._setting(cfg, t1).note
+    note = C._setting({**cfg, "errors.setting_sigma_um": 3.0}, t1).note
+    assert "is 3 um, this run's, not the paper's 1.7 um" in note
