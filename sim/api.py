@@ -46,7 +46,7 @@ from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
 from sim.report.run_summary import write_run_readme
-from sim.studies import get_study
+from sim.studies import design_config, get_study
 from sim.studies.picking import load_picking_chunk
 
 __all__ = ["load", "StudyHandle", "Results"]
@@ -288,7 +288,9 @@ class StudyHandle:
                     quiet=quiet,
                     figures=figures,
                     # the README.md sim run writes: the same directory by either door
-                    readme=lambda stage, name: write_run_readme(stage, get_study, name, final=out),
+                    readme=lambda stage, name: write_run_readme(
+                        stage, get_study, name, out, design_config
+                    ),
                 )
             except ConfigError as e:
                 if e.key in _ARGUMENTS:  # the command line's option: the argument of run()

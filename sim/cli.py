@@ -46,7 +46,7 @@ from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
 from sim.report.run_summary import off_setup, terminal_summary, write_run_readme
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
-from sim.studies import get_study, unread_keys
+from sim.studies import design_config, get_study, unread_keys
 from sim.studies.picking import load_picking_chunk
 from sim.threads import interrupted, memory_words, shadowed, short_of_memory
 
@@ -213,7 +213,7 @@ def _run(args) -> int:
         max_memory_gb=args.max_memory_gb,
         max_adjustments=args.max_adjustments,
         figures=not args.no_figures,
-        readme=lambda stage, name: write_run_readme(stage, get_study, name, final=out),
+        readme=lambda stage, name: write_run_readme(stage, get_study, name, out, design_config),
     )
     args.published = shown  # an interrupt from now on finds the results written
     check_interrupt()  # dropped by Python since the results were published: not exit 0

@@ -46,7 +46,11 @@ def show(args) -> int:
     if (sweep := _sweep_of(d)) is not None and (mixed := mixed_run(sweep)) is not None:
         raise ConfigError("DIR", mixed)  # a cell's figure replaced by hand: its sweep's record
     try:
-        text = run_markdown(d, get_study) if args.markdown else terminal_table(d)
+        text = (
+            run_markdown(d, get_study, design=design_config)
+            if args.markdown
+            else terminal_table(d, design=design_config)
+        )
     except ConfigError:
         raise
     except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:

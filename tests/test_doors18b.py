@@ -95,7 +95,7 @@ def test_the_report_names_what_a_run_changed_from_its_study_file(tmp_path, capsy
     assert main(["report", "--results", str(out.parent)]) == 0, capsys.readouterr()
     text = (out.parent / "REPORT.md").read_text()
     line = next(ln for ln in text.splitlines() if "did not run the configuration" in ln)
-    assert "`test.alpha` = 0.300 (the file: 0.0500)" in line and "`trials` = 20" in line
+    assert "`test.alpha` = 0.3 (the file: 0.05)" in line and "`trials` = 20" in line
     # the committed results are the study files' designs: no such line
     committed = build_report(ROOT / "results", get_study, design_config)
     assert "did not run the configuration" not in committed

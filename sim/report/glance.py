@@ -13,6 +13,7 @@ import pyarrow as pa
 
 from sim.mc.storage import read_provenance
 from sim.report.claimtext import decimals_for, exact_text, fmt_at
+from sim.report.config_diff import changed_keys, changes_text, design_of
 from sim.report.papers import paper_name
 from sim.report.run_summary import headline_rows, region_line, verdict_line
 from sim.report.tables import Md, fmt, md_link, md_table
@@ -204,16 +205,15 @@ def opening(entries: list[tuple], results: Path) -> str:
 
 
 def design_notes(entries: list[tuple], results: Path, design: Callable | None) -> list[str]:
-    """One line per results directory whose run changed the config of the study file it is
-    named after (``studies/<name>.toml``, ``design(name)``): the keys changed (at most six),
-    so that a ``--set`` run is not read as the paper's design."""
+    """One line per results directory whose run changed the config of the study file it
+    stands for (``studies/<name>.toml``, else ``studies/<study>.toml``: ``design(name)``, see
+    :func:`sim.report.config_diff.design_of`): the keys changed (at most six), so that a
+    ``--set`` run is not read as the paper's design."""
     out = []
     for _, name, study, *_ in entries:
         base = design(name) if design is not None else None
-        if not base:
-            continue
-        if base.get("study") != study.name:  # a study file of another study named like it:
-            # its keys were compared with the other study's ("(the file: )" for each)
+        if base and base.get("study") != study.name:  # a study file of another study named
+            # like it: its keys were compared with the other study's ("(the file: )" for each)
             out.append(
                 f"- {md_link(name)} holds a run of the study `{study.name}`, not of "
                 f"`studies/{name}.toml` (the study `{base.get('study')}`): a study file of "
@@ -221,15 +221,12 @@ def design_notes(entries: list[tuple], results: Path, design: Callable | None) -
             )
             continue
         mine = _config_of(results / name)
-        diff = [k for k in sorted(set(mine) | set(base)) if mine.get(k) != base.get(k)]
-        if not mine or not diff:
+        found = design_of(mine, name, design) if mine else None
+        if found is None or not changed_keys(mine, found[1]):
             continue
-        what = ", ".join(
-            f"`{k}` = {fmt(mine.get(k))} (the file: {fmt(base.get(k))})" for k in diff[:6]
-        ) + (f", and {len(diff) - 6} more" if len(diff) > 6 else "")
         out.append(
             f"- {md_link(name)} did not run the configuration of "
-            f"`studies/{name}.toml`: {what}. Its verdicts are about this run's configuration, "
-            "not the study file's design."
+            f"`{found[0]}`: {changes_text(mine, found[1])}. Its verdicts are about this run's "
+            "configuration, not the study file's design."
         )
     return out

@@ -8,10 +8,10 @@ import math
 
 from sim.report.tables import fmt, md_table
 
-__all__ = ["inputs_markdown"]
+__all__ = ["as_set", "inputs_markdown"]
 
 
-def _as_set(v) -> str:
+def as_set(v) -> str:
     """An input as the study file sets it (every digit: 12.702028129 was shown as 12.7)."""
     if isinstance(v, float) and math.isfinite(v):
         return repr(v)
@@ -34,10 +34,10 @@ def inputs_markdown(cfg: dict, schema) -> str:
         if not f.input:
             continue
         v = cfg.get(k)
-        text = _as_set(v)
+        text = as_set(v)
         if _shown_differs(v, f.default):
             changed += 1
-            text += f" (this run; the paper's: {_as_set(f.default)})"
+            text += f" (this run; the paper's: {as_set(f.default)})"
         rows.append([f"`{k}`", text, f.doc])
     if not rows:
         return ""

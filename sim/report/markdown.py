@@ -422,7 +422,7 @@ def write_report(
     )
     for d in sorted(results_dirs(results)):
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
-            _settled(results, lambda d=d: write_run_readme(d, get_study))
+            _settled(results, lambda d=d: write_run_readme(d, get_study, design=design))
     with atomic_path(out) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return out

@@ -21,6 +21,7 @@ from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS, printed_differ
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
 from sim.report.claimtext import interval_text, sim_text
+from sim.report.config_diff import config_line
 from sim.report.papers import paper_name
 from sim.report.read import columns, forget, records
 from sim.report.sweep import sweep_markdown
@@ -181,10 +182,14 @@ def terminal_summary(out: Path, n: int = 5, shown: str | None = None) -> str:
     return "\n".join(lines)
 
 
-def terminal_table(out: Path, width: int = 100) -> str:
+def terminal_table(out: Path, width: int = 100, design: Callable | None = None) -> str:
     """Every claim of a results directory as a plain-text table (claim, simulated, 95 %
-    interval, verdict), then the counts; a sweep directory as its cells."""
+    interval, verdict), then the counts; a sweep directory as its cells. ``design``: see
+    :func:`run_markdown` (what the run changed from its study file, a line at the end)."""
     out = Path(out)
+    cfg = read_provenance(out / ("claims.parquet" if _kind_of(out) == "study" else "sweep.parquet"))
+    changed = config_line(cfg.get("config") or {}, out.name, design)
+    tail = "" if changed is None else f"\n{changed}"
     if _kind_of(out) == "sweep":  # each cell with its swept values (cell0003_r0 alone named
         t = columns(out / "sweep.parquet")  # no setting), and where its claims are
         keys = [k for k in read_provenance(out / "sweep.parquet").get("sweep_keys", []) if k in t]
@@ -201,12 +206,12 @@ def terminal_table(out: Path, width: int = 100) -> str:
         return (
             f"{table}\n\nsweep: {ok} of {len(rows)} cells ran; every claim of every cell: "
             f"sim show {shlex.quote(str(out))} --markdown"  # a command to paste (doors25a)
-        )
+        ) + tail
     claims = records(out / "claims.parquet")
     rows = [[r["claim"], _value_text(r), _interval(r), r["verdict"]] for r in claims]
     table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
     conv = converged_line(out)
-    return table + "\n\n" + verdict_line(claims) + ("" if conv is None else f"\n{conv}")
+    return table + "\n\n" + verdict_line(claims) + ("" if conv is None else f"\n{conv}") + tail
 
 
 def _text_table(header: list[str], rows: list[list], width: int) -> str:
@@ -252,11 +257,15 @@ def _cut(s: str, n: int) -> str:
     return out + "..."
 
 
-def run_markdown(out: Path, get_study: Callable, name: str | None = None) -> str:
+def run_markdown(
+    out: Path, get_study: Callable, name: str | None = None, design: Callable | None = None
+) -> str:
     """The README.md of one results directory: what ran (study, paper, config), the verdict
     counts, the region line, then the study's own report section (claims, tables, figures:
     links relative to the directory) or the sweep's table. ``name``: the directory's name in
-    its title (a run writes the README in its staging directory, ``.<name>.partial``)."""
+    its title (a run writes the README in its staging directory, ``.<name>.partial``);
+    ``design``: a study file's config by its name (``sim.studies.design_config``), to name
+    what the run changed from it (:mod:`sim.report.config_diff`)."""
     out = Path(out)
     name = name or out.name
     forget()
@@ -274,14 +283,15 @@ def run_markdown(out: Path, get_study: Callable, name: str | None = None) -> str
         f"({md_code(f'sim show {shlex.quote(name)}')} prints it again).",
         "",
     ]
+    if (changed := config_line(prov.get("config") or {}, name, design)) is not None:
+        head += [f"**Configuration.** {changed}", ""]
     if kind == "sweep":
         body = sweep_markdown(out, ".")
     else:
         claims = records(src)
         head += [f"**Verdicts:** {verdict_line(claims)}.", ""]
-        rec = read_record(out)
-        if rec is not None and (off := off_setup(study, rec["config"])):
-            head += [f"**{off[0].upper()}{off[1:]}.**", ""]  # said once, at the top
+        if off := off_setup(study, prov.get("config") or {}):  # said once, at the top
+            head += [f"**{off[0].upper()}{off[1:]}.**", ""]
         if (reg := region_line(out)) is not None:
             head += [reg[0].upper() + reg[1:] + ".", ""]
         body = study.report(out)
@@ -330,7 +340,11 @@ def _user_readme(path: Path) -> bool:
 
 
 def write_run_readme(
-    out: Path, get_study: Callable, name: str | None = None, final: Path | None = None
+    out: Path,
+    get_study: Callable,
+    name: str | None = None,
+    final: Path | None = None,
+    design: Callable | None = None,
 ) -> Path | None:
     """Write ``out/README.md`` (see :func:`run_markdown`; ``name``: the directory's name in
     it) atomically and list it among the files the run wrote (``run.json``, so a later run
@@ -350,7 +364,7 @@ def write_run_readme(
             if rec is not None and "README.md" in (rec.get("files") or []):
                 write_record(out, {**rec, "files": [f for f in rec["files"] if f != "README.md"]})
         return None
-    text = README_MARK + "\n" + run_markdown(out, get_study, name)
+    text = README_MARK + "\n" + run_markdown(out, get_study, name, design)
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     rec = read_record(out)

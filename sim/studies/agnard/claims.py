@@ -19,7 +19,7 @@ from sim.claims.table import Sim, exact, mc, plates
 from sim.claims.table import claim_rows as table_rows
 from sim.instruments.block import scanner as sc
 from sim.instruments.block.layout import Block
-from sim.studies.agnard.schema import model_sigmas, pixel_ground_m, recentre_words
+from sim.studies.agnard.schema import model_sigmas, parallax_words, pixel_ground_m, recentre_words
 from sim.studies.agnard.table1_rows import table1_rows
 
 BOOK = Path(__file__).with_name("claims.toml")
@@ -162,7 +162,7 @@ def budget_rows(book: ClaimBook, cfg: dict) -> dict[str, Sim]:
             100 * sz,
             (
                 f"x-parallax setting error {cfg['measure.parallax_px']:g} px x f / b = "
-                f"{100 * sz:.2f} cm in height (measure.parallax_px set from the paper's 22 cm)"
+                f"{100 * sz:.2f} cm in height ({parallax_words(cfg)})"
             ),
         ),
     }

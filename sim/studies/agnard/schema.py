@@ -377,3 +377,12 @@ def recentre_words(cfg: dict) -> str:
         f"unprinted: this run's {cfg[key]:g} px, the default {SCHEMA[key].default:g} px is set "
         "so the share matches the paper"
     )
+
+
+def parallax_words(cfg: dict) -> str:
+    """Where ``measure.parallax_px`` comes from: the default is set from the paper's 22 cm in
+    height; a run with another value says so rather than claim it."""
+    key = "measure.parallax_px"
+    if cfg[key] == SCHEMA[key].default:
+        return f"{key} set from the paper's 22 cm"
+    return f"this run's {key} {cfg[key]:g} px; the default {SCHEMA[key].default:g} px is set from the paper's 22 cm"

@@ -23,7 +23,7 @@ from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import ConfigError
 from sim.mc.runner import chunk_rng
 from sim.studies.brown import values as V
-from sim.studies.brown.schema import MODEL_NAMES, range_sigma_um
+from sim.studies.brown.schema import MODEL_NAMES, TABLE1, range_sigma_um
 
 BOOK = Path(__file__).with_name("claims.toml")
 
@@ -218,10 +218,12 @@ def _closure(cfg, s0, sr) -> dict[str, Sim]:
 
 def _setting(cfg, t1) -> Sim:
     if cfg["errors.settings"] > 1:
+        run, paper = cfg["errors.setting_sigma_um"], TABLE1["errors.setting_sigma_um"].default
+        whose = "the paper's" if run == paper else f"this run's, not the paper's {paper:g} um"
         return plates(
             t1["setting_sigma_um"],
             "recovered per plate from the differences of the repeated "
-            "settings; the simulated setting sigma is the paper's value",
+            f"settings; the simulated setting sigma is {run:g} um, {whose}",
         )
     return exact(
         cfg["errors.setting_sigma_um"],

@@ -1,0 +1,63 @@
+"""What a run's config changed from a study file's: named in the run's README.md, by
+``sim show`` and in REPORT.md, so that a run with ``--set``, ``--trials`` or ``--seed`` (or of
+an edited copy of a study file) is not read as the study file's design.
+
+The reference is the project's study file the results stand for: ``studies/<dir>.toml`` when
+one of the run's study is named like the results directory, else ``studies/<study>.toml`` (the
+paper's design of the study); a study without such a file (the network kind) has none. The
+``design`` callable (``sim.studies.design_config``) resolves a file's config: the report layer
+reads no study file itself."""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Mapping
+
+from sim.report.inputs import as_set
+
+__all__ = ["changed_keys", "changes_text", "design_of", "config_line"]
+
+#: keys of a run's config that are not a setting of the study ([sweep]: the sweep's own table)
+_NOT_SETTINGS = {"sweep"}
+
+
+def changed_keys(mine: Mapping[str, Any], base: Mapping[str, Any]) -> list[str]:
+    """The keys whose value in ``mine`` is not the one in ``base`` (either may lack it)."""
+    keys = sorted((set(mine) | set(base)) - _NOT_SETTINGS)
+    return [k for k in keys if mine.get(k) != base.get(k)]
+
+
+def changes_text(mine: Mapping[str, Any], base: Mapping[str, Any], limit: int = 6) -> str:
+    """``"`k` = v (the file: w), ..., and N more"``: the first ``limit`` changed keys."""
+    diff = changed_keys(mine, base)
+    what = ", ".join(
+        f"`{k}` = {as_set(mine.get(k))} (the file: {as_set(base.get(k))})" for k in diff[:limit]
+    )
+    return what + (f", and {len(diff) - limit} more" if len(diff) > limit else "")
+
+
+def design_of(
+    cfg: Mapping[str, Any], name: str, design: Callable[[str], dict | None] | None
+) -> tuple[str, dict] | None:
+    """``(file name, its config)`` of the study file the results ``name`` of a run with ``cfg``
+    stand for (see the module docstring), or None."""
+    if design is None:
+        return None
+    for stem in (name, cfg.get("study")):
+        base = design(stem) if isinstance(stem, str) and stem else None
+        if base and base.get("study") == cfg.get("study"):
+            return f"studies/{stem}.toml", base
+    return None
+
+
+def config_line(
+    cfg: Mapping[str, Any], name: str, design: Callable[[str], dict | None] | None
+) -> str | None:
+    """One sentence naming what the run changed from its study file's config (at most six
+    keys), or None when it ran that config (or there is no such file)."""
+    found = design_of(cfg, name, design)
+    if found is None or not changed_keys(cfg, found[1]):
+        return None
+    return (
+        f"Not the configuration of `{found[0]}`: {changes_text(cfg, found[1])}. Its verdicts "
+        "and numbers are of this run's configuration, not of the study file's design."
+    )
