@@ -70,6 +70,12 @@ def foreign_key(e: ConfigError, path: str | os.PathLike) -> ConfigError:
             pass
     except (ConfigError, OSError):  # the file as the load read it: nothing else to say
         return e
+    if note := retired_note(name, e.key):  # a file kept from an older version of the suite
+        old = [k for k in dict.fromkeys(keys) if retired_note(name, k)]
+        more = f" and {len(old) - SHOWN} more" if len(old) > SHOWN else ""
+        if len(old) > 1:
+            note += f" (the file holds {len(old)} such keys: {', '.join(old[:SHOWN])}{more})"
+        return ConfigError(e.key, note)
     swept = e.key.removeprefix("sweep.")
     if swept != e.key and (swept in schema or swept in ("replicates", "seed_mode")):
         return ConfigError(  # --set sweep.plate.grid=[4,5]: "a key of brown_dilution" (sic)
@@ -77,12 +83,6 @@ def foreign_key(e: ConfigError, path: str | os.PathLike) -> ConfigError:
             f"unknown key: a sweep is not set by an override; write {swept} in the study "
             "file's [sweep] table",
         )
-    if note := retired_note(name, e.key):  # a file kept from an older version of the suite
-        old = [k for k in dict.fromkeys(keys) if retired_note(name, k)]
-        more = f" and {len(old) - SHOWN} more" if len(old) > SHOWN else ""
-        if len(old) > 1:
-            note += f" (the file holds {len(old)} such keys: {', '.join(old[:SHOWN])}{more})"
-        return ConfigError(e.key, note)
     key = e.key.removeprefix("sweep.")
     schemas = _schemas(name)
     owners = [s for s, sch in schemas.items() if key in sch]
