@@ -30,6 +30,7 @@ import pyarrow.parquet as pq
 from sim.api_args import arguments as _arguments
 from sim.api_paths import absolute_path as _absolute
 from sim.api_paths import check_path as _check_path
+from sim.api_paths import run_identity as _run_identity
 from sim.api_paths import why_unread
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.execute import execute
@@ -39,7 +40,7 @@ from sim.mc.paths import link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.pyvalue import as_config_value
-from sim.mc.storage import config_hash, read_provenance, read_record
+from sim.mc.storage import read_provenance
 from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
 from sim.report.mpl import kept
@@ -359,15 +360,6 @@ def _sha256(path: Path) -> str:
         return ""
     except OSError as e:
         raise ConfigError("study_file", f"{path} cannot be read ({why_unread(e)})") from None
-
-
-def _run_identity(out: Path) -> str:
-    """The config hash (:func:`sim.mc.storage.config_hash`) of the config and code hash
-    ``out/run.json`` records: another run of the study (another seed, another key) has
-    another; "" when there is no such record (a damaged one is refused by the reads
-    themselves, naming ``run.json``)."""
-    rec = read_record(out)
-    return config_hash(rec["config"], rec["code_hash"]) if rec else ""
 
 
 def _flag(name: str, v: Any) -> bool:

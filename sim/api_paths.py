@@ -12,12 +12,14 @@ very name exists (an earlier ``./~`` is the caller's to read).
 
 from __future__ import annotations
 
+import errno
 import os
 from pathlib import Path
 from typing import Any
 
 from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
+from sim.mc.storage import RECORD, config_hash, read_record, regular_text
 
 __all__ = ["check_path", "absolute_path", "why_unread"]
 
@@ -65,3 +67,21 @@ def why_unread(e: Exception) -> str:
     if isinstance(e, OSError) and e.strerror:
         return e.strerror
     return type(e).__name__
+
+
+def run_identity(out: Path) -> str:
+    """The config hash (:func:`sim.mc.storage.config_hash`) of the config and code hash
+    ``out/run.json`` records: another run of the study (another seed, another key) has
+    another; "" when there is no such record (a damaged one is refused by the reads
+    themselves, naming ``run.json``). A ``run.json`` there that cannot be read (EIO) is
+    refused, naming it: it was taken for none, and the check that ``out`` still holds the
+    run that returned the Results was skipped, silently."""
+    rec = read_record(out)
+    if rec is None:
+        try:
+            regular_text(out / RECORD)
+        except OSError as e:
+            if e.errno not in (None, errno.ENOENT, errno.ENOTDIR):
+                why = why_unread(e)
+                raise ConfigError("path", f"{out / RECORD} cannot be read ({why})") from None
+    return config_hash(rec["config"], rec["code_hash"]) if rec else ""

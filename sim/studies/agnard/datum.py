@@ -124,7 +124,15 @@ def check_datum(cfg: dict, block: Block, paper: dict, layouts: dict) -> None:
     rule = MARGIN * RCOND
     for kp, parts, lays in _weight_sets(cfg, layouts):
         wp = cfg[kp]
-        w_ctrl = np.sum([np.asarray(v, float) for v in parts.values()], axis=0) / wp
+        with np.errstate(over="ignore"):  # a ratio beyond a double: named below, not warned
+            w_ctrl = np.sum([np.asarray(v, float) for v in parts.values()], axis=0) / wp
+        if not np.all(np.isfinite(w_ctrl)):  # blamed on the weakest weight ("next to nothing")
+            big = max(parts, key=lambda k: cfg[k])
+            raise ConfigError(
+                big,
+                f"{cfg[big]:g} over {kp} ({wp:g}) is a weight ratio beyond a 64-bit float: "
+                "make it smaller",
+            )
         kc = min(parts, key=lambda k: cfg[k])  # the weakest control weight
         ratio = cfg[kc] / wp
         bad = []

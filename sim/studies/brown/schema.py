@@ -343,7 +343,8 @@ def _within_beta(cfg: dict, key: str, pts: np.ndarray) -> None:
     or on the scale) and every trial failed at run time after a NumPy warning."""
     _, theta = setup(cfg)
     st = ml.stations(theta)  # (4, 2) mm
-    d2 = ((pts[:, None, :] - st[None, :, :]) ** 2).sum(-1)  # (n, 4) mm^2
+    with np.errstate(over="ignore"):  # inf: the range check names stations that far out
+        d2 = ((pts[:, None, :] - st[None, :, :]) ** 2).sum(-1)  # (n, 4) mm^2
     beta = cfg["comparator.beta_mm"]
     bad = np.argwhere(d2 <= beta**2)
     if len(bad):

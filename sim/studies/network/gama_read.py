@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.mc.config import ConfigError
-from sim.mc.numtext import UnheldError, toml_float, unsigned_zeros
+from sim.mc.numtext import UnheldError, float_text
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
 from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
 from sim.studies.network.gama_vocab import words as _words
@@ -79,7 +79,7 @@ def _cov(f: _File, cm, n: int) -> np.ndarray:
         raise f.err(cm, f"{bad!r} is not a number")
     for w in words:  # 1e-400: not a variance of 0 ("must be positive"), 1e400 not inf
         try:
-            unsigned_zeros(toml_float(w))
+            float_text(w)
         except UnheldError as why:
             raise f.err(cm, str(why)) from None
     vals = iter(float(w) for w in words)
@@ -109,7 +109,7 @@ def _defaults(f: _File, po) -> dict:
         if not _NUM.match(w):
             raise f.err(po, f"{w!r} is not a number", "distance-stdev")
         try:  # 1e-400: not a of 0 mm, silently; 1e400: not "not a number"
-            unsigned_zeros(toml_float(w))
+            float_text(w)
         except UnheldError as why:
             raise f.err(po, str(why), "distance-stdev") from None
     abc = [float(w) for w in words] + [0.0, 0.0, 1.0][len(words) :]

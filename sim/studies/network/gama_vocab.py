@@ -14,7 +14,7 @@ import stat
 from pathlib import Path
 
 from sim.mc.config import ConfigError
-from sim.mc.numtext import UnheldError, toml_float, unsigned_zeros
+from sim.mc.numtext import UnheldError, float_text
 from sim.mc.paths import link_problem
 from sim.studies.network.validate import _point_name
 
@@ -159,7 +159,7 @@ class _File:
         if not _NUM.match(ws(v)):
             raise self.err(e, f"{v!r} is not a number", attr)
         try:  # "-0" is 0.0 (atan2 tells -0.0 apart: other results); 1e-400 not 0, silently
-            x = unsigned_zeros(toml_float(ws(v)))
+            x = float_text(ws(v))
         except UnheldError as why:
             raise self.err(e, str(why), attr) from None
         if lo is not None and x <= lo:
@@ -181,10 +181,14 @@ class _File:
         if not v:
             raise self.err(e, "missing", attr)
         if _DMS.match(v):
-            d, m, s = v.lstrip("+-").split("-")
+            d, m, s = v.lstrip("+-").split("-", 2)  # 0-0-1e-4: its seconds 1e-4
             # seconds of 60.00 are a value rounded up (gama-local reads them, and its own
             # test data holds "187-33-60.00"); more is garbage
-            if int(m) >= 60 or float(s) > 60:
+            try:  # 0-0-1e-400: not 0 seconds, silently
+                sec = float_text(s)
+            except UnheldError as why:
+                raise self.err(e, f"{v!r}: seconds {why}", attr) from None
+            if int(m) >= 60 or sec > 60:
                 raise self.err(e, f"{v!r}: minutes must be below 60 and seconds at most 60", attr)
             return True
         self.num(e, attr)
