@@ -90,12 +90,14 @@ def _run_parser(sub) -> None:
     )
     r.add_argument(
         "--trials",
-        type=integer,
+        type=integer("trials"),
         help=f"number of Monte-Carlo trials; also picks a chunk size giving at least "
         f"{MIN_CHUNKS} chunks unless --chunk or chunk= is given",
     )
-    r.add_argument("--chunk", type=integer, help="trials per chunk (the intervals are over chunks)")
-    r.add_argument("--seed", type=integer, help="override the root seed")
+    r.add_argument(
+        "--chunk", type=integer("chunk"), help="trials per chunk (the intervals are over chunks)"
+    )
+    r.add_argument("--seed", type=integer("seed"), help="override the root seed")
     r.add_argument(
         "--set",
         action="append",

@@ -15,6 +15,10 @@
    the Gama readers take such numbers through one helper, :func:`sim.mc.numtext.float_text`).
    And d-m-s seconds written with a negative exponent (``218-39-3.5e-1``) were split at its
    minus: "ValueError: too many values to unpack"; they are read.
+6. ``--trials 1e30`` was "an integer of 31 digits is outside TOML's 64-bit range" where
+   ``--set trials=1e30`` said "must be <= 1e+08 (got 1e+30)" (so ``--chunk``, ``--seed`` and
+   ``make verify``'s ``--trials``): an integer option now checks its value against its key's
+   own field (:func:`sim.mc.argv.integer`), in ``--set``'s words.
 """
 
 from __future__ import annotations
@@ -31,6 +35,8 @@ import sim
 from sim import api_paths
 from sim.cli import main
 from sim.mc import storage
+from sim.report.verify.cli import _parser as verify_parser
+from sim.report.verify.rules import VerifyError
 
 AGNARD = str(ROOT / "studies" / "agnard_block.toml")
 BROWN = str(ROOT / "studies" / "brown_table1.toml")
@@ -93,3 +99,16 @@ def test_a_gama_dms_angle_with_an_exponent_in_its_seconds_is_read(tmp_path, caps
     study = tmp_path / "net.toml"
     study.write_text(f'study = "network"\n[network]\ngama_xml = "{tmp_path}/net.xml"\n')
     assert main(["check", str(study)]) == 0, capsys.readouterr().err
+
+
+# ------------------------------------------------------------- 6. --trials 1e30 in --set's words
+@pytest.mark.parametrize("key", ["trials", "chunk", "seed"])
+def test_an_integer_option_beyond_its_bound_is_refused_in_set_words(capsys, key):
+    by_set = one_line(capsys, main(["check", BROWN, "--set", f"{key}=1e30"]), prefix=SIM_ERROR)
+    by_option = one_line(capsys, main(["run", BROWN, f"--{key}", "1e30"]), prefix=SIM_ERROR)
+    words = by_set.removeprefix(f"{SIM_ERROR}{key}: ")
+    assert words.startswith("must be <= ") and "(got 1e+30)" in words, by_set
+    assert f"argument --{key}: {words} (see sim run --help)" in by_option, by_option
+    with pytest.raises(VerifyError) as err:  # make verify's --trials reads its value so too
+        verify_parser().parse_args(["--trials", "1e30"])
+    assert str(err.value) == "argument --trials: must be <= 1e+08 (got 1e+30)"

@@ -21,9 +21,10 @@ import argparse
 import difflib
 import re
 import sys
+from collections.abc import Callable
 
 from sim.ends import stdout_unwritten
-from sim.mc.config import ConfigError, Field, parse_override, validate
+from sim.mc.config import COMMON, ConfigError, parse_override, validate
 
 __all__ = ["MAX_OPTIONS", "ONCE", "BoundedParser", "OnceParser", "integer"]
 
@@ -39,17 +40,25 @@ ONCE = frozenset(
 )
 
 
-def integer(text: str) -> int:
-    """argparse's ``type`` of an option that sets an integer key (``--trials``, ``--chunk``,
-    ``--seed``; ``make verify``'s ``--trials``): the value read as ``--set KEY=VALUE`` reads
-    it (TOML), so a float without a fraction is that integer (``1e3``, ``1000.0``: 1000), and
-    anything else is refused in ``--set``'s words (``must be an integer (got 1000.5)``).
+def integer(key: str) -> Callable[[str], int]:
+    """argparse's ``type`` of an option that sets the integer key ``key`` (``--trials``,
+    ``--chunk``, ``--seed``; ``make verify``'s ``--trials``): the value read as ``--set
+    KEY=VALUE`` reads it (TOML) and checked against the key's own field, so a float without a
+    fraction is that integer (``1e3``, ``1000.0``: 1000), and anything else is refused in
+    ``--set``'s words (``must be an integer (got 1000.5)``, ``must be <= 1e+08 (got 1e+30)``).
     ``--trials 1e3`` was refused ("invalid int value") while ``--set trials=1e3`` and
-    ``sim.load(..., trials=1e3)`` ran 1000 trials."""
-    try:
-        return validate({"v": parse_override(f"v={text}")[1]}, {"v": Field(0, "int", "")})["v"]
-    except ConfigError as e:
-        raise argparse.ArgumentTypeError(str(e).removeprefix("v: ")) from None
+    ``sim.load(..., trials=1e3)`` ran 1000 trials; ``--trials 1e30`` was "an integer of 31
+    digits is outside TOML's 64-bit range" where ``--set trials=1e30`` said its bound."""
+    field = COMMON[key]
+
+    def read(text: str) -> int:
+        try:
+            return validate({key: parse_override(f"{key}={text}")[1]}, {key: field})[key]
+        except ConfigError as e:
+            raise argparse.ArgumentTypeError(str(e).removeprefix(f"{key}: ")) from None
+
+    read.__name__ = key
+    return read
 
 
 def _guess(word: str, names) -> str:

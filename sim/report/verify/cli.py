@@ -67,7 +67,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--trials",
-        type=integer,
+        type=integer("trials"),
         help="re-run with this many trials and compare at the Monte-Carlo level",
     )
     p.add_argument(
