@@ -19,12 +19,21 @@
    ``--set trials=1e30`` said "must be <= 1e+08 (got 1e+30)" (so ``--chunk``, ``--seed`` and
    ``make verify``'s ``--trials``): an integer option now checks its value against its key's
    own field (:func:`sim.mc.argv.integer`), in ``--set``'s words.
+3. ``sim.load(...).run(out=None)`` killed outright (SIGKILL) left ``$TMPDIR/sim-<study>-XXXX/``
+   forever. The name now holds the process id, and a later ``run(out=None)`` of the study
+   removes the directories of dead processes it can prove are killed runs' (:mod:`sim.api_tmp`):
+   never a live process's, another user's, one holding finished results or chunks a failed
+   run named (marked), nor another study's.
 """
 
 from __future__ import annotations
 
 import errno
 import json
+import os
+import subprocess
+import sys
+import tempfile
 import warnings
 
 import pytest
@@ -32,7 +41,9 @@ from conftest import ROOT
 from oneline import SIM_ERROR, one_line
 
 import sim
+import sim.api
 from sim import api_paths
+from sim.api_tmp import KEPT
 from sim.cli import main
 from sim.mc import storage
 from sim.report.verify.cli import _parser as verify_parser
@@ -112,3 +123,42 @@ def test_an_integer_option_beyond_its_bound_is_refused_in_set_words(capsys, key)
     with pytest.raises(VerifyError) as err:  # make verify's --trials reads its value so too
         verify_parser().parse_args(["--trials", "1e30"])
     assert str(err.value) == "argument --trials: must be <= 1e+08 (got 1e+30)"
+
+
+# ------------------------------------------------------------- 3. a killed run's temp dir cleared
+def test_a_killed_runs_temporary_directory_is_cleared_by_the_next_run(tmp_path, monkeypatch):
+    gone = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    dead, live = int(gone.stdout), os.getpid()
+    made = {}
+    for tag, pid, study, inside in (
+        ("killed", dead, "brown_table1", ".staging/chunk-0.parquet"),
+        ("live", live, "brown_table1", ".staging/chunk-0.parquet"),
+        ("finished", dead, "brown_table1", "run.json"),
+        ("kept", dead, "brown_table1", None),
+        ("other", dead, "brown_dilution", ".staging/chunk-0.parquet"),
+    ):
+        d = tmp_path / f"sim-{study}-{pid}-{tag[:4]:_<8}"
+        (d / study / inside if inside else d / study).parent.mkdir(parents=True)
+        if inside:
+            (d / study / inside).write_text("x")
+        else:
+            (d / KEPT).write_text("x")
+        made[tag] = d
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+
+    def killed(*a, **k):
+        raise RuntimeError("stopped")
+
+    monkeypatch.setattr(sim.api, "execute", killed)
+    with pytest.raises(RuntimeError):
+        sim.load(BROWN).run(trials=40, workers=1)
+    assert not made["killed"].exists()
+    assert all(made[t].exists() for t in ("live", "finished", "kept", "other"))
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        made[t].name for t in ("live", "finished", "kept", "other")
+    )  # this run's own (empty) directory removed after its failure, as before
