@@ -33,6 +33,7 @@ from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
 from sim.api_paths import why_unread
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
+from sim.api_tmp import temp_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
@@ -260,7 +261,7 @@ class StudyHandle:
         base = None  # the temporary directory made for this run (out=None)
         if out is None:
             try:  # the caller's tempfile.tempdir (or TMPDIR) may be gone, a file, or full
-                base = Path(tempfile.mkdtemp(prefix=f"sim-{h.name}-"))
+                base = temp_dir(h.name)  # a killed run's removed first
             except OSError as e:
                 raise ConfigError(
                     "out",

@@ -15,7 +15,9 @@ directory a run without ``out`` makes.
   left it behind, empty or holding a staging directory whose path the caller was never told
   (one per Ctrl-C or refused run: unreachable, never resumed, never removed).
   :func:`anonymous_dir` removes it when it is empty, and otherwise (finished chunks, kept
-  for resumption) adds a note to the exception naming the ``out`` that resumes the run.
+  for resumption) adds a note to the exception naming the ``out`` that resumes the run (and
+  marks it :data:`sim.api_tmp.KEPT`). A run killed outright left it for good: a later
+  ``run(out=None)`` of the study removes it (:mod:`sim.api_tmp`).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ import os
 from pathlib import Path
 from typing import Any
 
+from sim.api_tmp import KEPT
 from sim.mc.config import ConfigError
 
 __all__ = ["state_sha256", "check_state", "check_cwd", "working_dir", "anonymous_dir"]
@@ -94,7 +97,9 @@ def anonymous_dir(base: Path | None, out: Path):
                 os.rmdir(base)  # only an empty directory: nothing the run kept is lost
             except FileNotFoundError:  # removed under the run (a cleaner of /tmp): no chunk
                 pass  # is kept anywhere, and no out= resumes it
-            except OSError:
+            except OSError:  # marked: a later run(out=None) never clears it (sim.api_tmp)
+                with contextlib.suppress(OSError):
+                    (base / KEPT).write_text("finished chunks a failed run named\n")
                 e.add_note(
                     f"sim: the finished chunks are kept in {base}: "
                     f"run(out={str(out)!r}) resumes the run"

@@ -1,0 +1,94 @@
+"""The temporary directory of ``run(out=None)``: ``$TMPDIR/sim-<study>-<pid>-XXXXXXXX/``.
+
+A run killed outright (SIGKILL, the out-of-memory killer) ran no cleanup: its directory, with
+a staging directory whose path the caller was never told, stayed in ``$TMPDIR`` forever. The
+process id in the name lets a later ``run(out=None)`` of the same study (:func:`temp_dir`)
+remove such a directory when it can prove it is one of those: a directory (not a link) of
+this user, named by this pattern, whose process is gone (``os.kill(pid, 0)``: no such
+process; a live one, this process, or another user's is never touched), whose ``.lock``
+files no one holds, that holds no finished results (``<study>/run.json``: a run that
+returned; its Results may still be read) and no chunks a failed run named in its exception
+(:data:`KEPT`, written by :func:`sim.api_state.anonymous_dir`: ``run(out=...)`` resumes
+them). Directories of other names (an older suite's, the user's) are never looked at.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import re
+import shutil
+import stat
+import tempfile
+from pathlib import Path
+
+from sim.mc.storage import LOCK, RECORD
+
+__all__ = ["KEPT", "temp_dir"]
+
+#: the marker of a temporary directory whose finished chunks a failed run named to the caller
+KEPT = ".sim-kept"
+
+
+def _alive(pid: int) -> bool:
+    """False only when no process ``pid`` exists (this process, another user's: alive)."""
+    if pid <= 0 or pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (OSError, OverflowError):  # PermissionError: another user's process
+        return True
+    return True
+
+
+def _locked(d: Path) -> bool:
+    """True when a ``.lock`` file under ``d`` is held (a run still writes there) or cannot
+    be tried."""
+    for top, dirs, files in os.walk(d):
+        dirs[:] = [n for n in dirs if not os.path.islink(os.path.join(top, n))]
+        if LOCK in files:
+            try:
+                fd = os.open(os.path.join(top, LOCK), os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+            except OSError:
+                return True
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                return True
+            finally:
+                os.close(fd)  # releases the lock just taken
+    return False
+
+
+def _clear_dead(tmp: Path, study: str) -> None:
+    """Remove the directories of killed runs of ``study`` in ``tmp`` (see the module doc);
+    anything unsure is left."""
+    name = re.compile(rf"sim-{re.escape(study)}-(\d+)-[a-z0-9_]{{8}}")
+    try:
+        names = os.listdir(tmp)
+    except OSError:
+        return
+    for n in names:
+        m = name.fullmatch(n)
+        if not m or _alive(int(m[1])):
+            continue
+        d = tmp / n
+        try:
+            st = os.lstat(d)
+            if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid():
+                continue
+            if os.path.lexists(d / study / RECORD) or os.path.lexists(d / KEPT) or _locked(d):
+                continue
+            shutil.rmtree(d)
+        except OSError:  # removed meanwhile, unreadable: left as it is
+            continue
+
+
+def temp_dir(study: str) -> Path:
+    """A new ``$TMPDIR/sim-<study>-<pid>-XXXXXXXX/`` for a run of ``study``, after the
+    directories of killed runs of it are cleared; OSError when none can be made."""
+    tmp = Path(tempfile.gettempdir())
+    _clear_dead(tmp, study)
+    return Path(tempfile.mkdtemp(prefix=f"sim-{study}-{os.getpid()}-"))
