@@ -22,6 +22,7 @@ import stat
 import tempfile
 from pathlib import Path
 
+from sim.mc.pids import pid_alive
 from sim.mc.storage import LOCK, RECORD
 
 __all__ = ["KEPT", "temp_dir"]
@@ -32,15 +33,7 @@ KEPT = ".sim-kept"
 
 def _alive(pid: int) -> bool:
     """False only when no process ``pid`` exists (this process, another user's: alive)."""
-    if pid <= 0 or pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (OSError, OverflowError):  # PermissionError: another user's process
-        return True
-    return True
+    return pid == os.getpid() or pid_alive(pid)
 
 
 def _locked(d: Path) -> bool:

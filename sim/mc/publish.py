@@ -25,8 +25,9 @@ from pathlib import Path
 from sim.mc.config import ConfigError
 from sim.mc.outputs import swap_dir
 from sim.mc.paths import mounts_under
+from sim.mc.pids import writer_gone
 from sim.mc.runner import ChunkStore
-from sim.mc.storage import LOCK, pid_alive, read_record, write_record
+from sim.mc.storage import LOCK, read_record, write_record
 
 __all__ = ["seal", "publish", "damaged_chunks", "changed_figure", "drawn"]
 
@@ -198,8 +199,7 @@ def _left_temporary(f: str, mine: set) -> bool:
     m = _TEMPORARY.fullmatch(f)
     if m is None or f"{m.group(1) or ''}{m.group(2)}" not in mine | {"run.json"}:
         return False
-    pid = int(m.group(3))  # this pid's: a container's earlier command (as storage reads it)
-    return pid == os.getpid() or not pid_alive(pid)
+    return writer_gone(int(m.group(3)))
 
 
 def _carry(src: Path, dst: Path) -> None:
@@ -297,7 +297,7 @@ def _drop_stale_swaps(out: Path, mine: Path | None) -> None:
         m = pat.fullmatch(d.name)
         if not m or d == mine or d.is_symlink() or not d.is_dir():
             continue
-        if int(m.group(1)) != os.getpid() and pid_alive(int(m.group(1))):
+        if not writer_gone(int(m.group(1))):
             continue  # another run may be removing it now
         if read_record(d) is not None:
             lost: list[str] = []

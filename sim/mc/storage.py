@@ -36,6 +36,7 @@ from sim.mc.codehash import (  # code no study result depends on
     study_code_hash,
     study_files,
 )
+from sim.mc.pids import writer_gone
 
 __all__ = [
     "provenance",
@@ -233,17 +234,6 @@ def _named(e: OSError, path: Path) -> OSError:
     return named
 
 
-def pid_alive(pid: int) -> bool:
-    """Whether process ``pid`` exists (another user's process counts as alive)."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:  # EPERM: someone else's
-        return True
-    return True
-
-
 def _drop_stale_temporaries(path: Path) -> None:
     """Remove the temporaries of ``path`` (``.<name>.<pid>.tmp``) that a process killed while
     writing it left (``sim report`` killed during a README.md stayed so for good, and a
@@ -255,8 +245,7 @@ def _drop_stale_temporaries(path: Path) -> None:
     except OSError:
         return
     for n in names:
-        pid = int(pat.fullmatch(n).group(1))
-        if pid != os.getpid() and pid_alive(pid):
+        if not writer_gone(int(pat.fullmatch(n).group(1))):
             continue  # a live process writing it
         p = path.parent / n
         if p.is_file() and not p.is_symlink():
