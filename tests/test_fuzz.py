@@ -3,7 +3,9 @@
 A seeded generator (``random.Random``) takes each study's file, shrinks it to a tiny run and
 mutates it: a key's value (wrong types, magnitudes from 1e-300 to 1e300, NaN and infinities,
 empty and huge lists, unicode, paths), the file's structure (unknown keys and studies,
-garbage, a ``[sweep]`` table with bad ranges) or the command line (``--trials``, ``--seed``,
+garbage, a ``[sweep]`` table with bad ranges; a well-formed key in the wrong place: written in
+table form with the key moved into another table or to the top level, its table an array of
+tables or declared twice, the key itself an array of tables) or the command line (``--trials``, ``--seed``,
 ``--workers``, ``--out``, ``--scheduler``). Every case runs ``sim run`` in a forked child
 (its own session, an address-space limit, a time bound) and must give exit 0 with finite
 results, or exit 2 with exactly one line on standard error and no traceback, and leave
@@ -212,6 +214,43 @@ def toml_doc(flat: dict, sweep: dict | None = None) -> str:
     return "\n".join(lines) + "\n"
 
 
+def toml_tables(flat: dict, moved: dict | None = None) -> list[str]:
+    """The document in table form (``[head]`` then ``leaf = value``), as an editor writes it;
+    ``moved`` maps a key to the table it is written in instead (``""``: the top level)."""
+    groups: dict[str, list[str]] = {}
+    for k, v in flat.items():
+        head, _, leaf = k.rpartition(".")
+        head = (moved or {}).get(k, head)
+        groups.setdefault(head, []).append(f"{leaf} = {toml_value(v)}")
+    lines = groups.pop("", [])
+    for head, body in groups.items():
+        lines += [f"[{head}]", *body]
+    return lines
+
+
+def relocate(rng: random.Random, flat: dict, schema: list[str]) -> tuple[bytes, str]:
+    """A well-formed key in the wrong place: moved into another table or to the top level,
+    its table given as an array of tables or declared twice, the key itself a table array."""
+    k = rng.choice([s for s in schema if "." in s and s in flat] or list(flat))
+    head, _, leaf = k.rpartition(".")
+    heads = sorted({s.rpartition(".")[0] for s in flat if "." in s} - {head})
+    what = rng.choice(["moved", "top", "aot_table", "dup_table", "aot_key"])
+    if what == "moved" and heads:
+        to = rng.choice(heads)
+        return "\n".join(toml_tables(flat, {k: to})).encode() + b"\n", f"{k} moved to [{to}]"
+    if what in ("moved", "top"):
+        return "\n".join(toml_tables(flat, {k: ""})).encode() + b"\n", f"{k} moved to the top"
+    lines = toml_tables(flat)
+    if what == "aot_key":
+        lines = toml_tables({x: v for x, v in flat.items() if x != k})
+        lines += [f"[[{k}]]", f"{leaf} = {toml_value(flat[k])}"]
+    elif head and what == "aot_table":
+        lines = [f"[[{head}]]" if ln == f"[{head}]" else ln for ln in lines]
+    elif head:  # the table declared twice (malformed TOML)
+        lines += [f"[{head}]", f"{leaf} = {toml_value(flat[k])}"]
+    return "\n".join(lines).encode() + b"\n", f"{what} {k}"
+
+
 def small(name: str) -> dict:
     """The tiny overrides the study's schema knows (study modules rename keys)."""
     schema = load_study(ROOT / "studies" / f"{name}.toml")[0].schema
@@ -256,7 +295,9 @@ def make_case(i: int):
     extra: list[str] = []
     sweep = None
     raw = None
-    kind = rng.choice(["value"] * 5 + ["two"] * 2 + ["set", "structure", "sweep", "option"])
+    kind = rng.choice(
+        ["value"] * 5 + ["two"] * 2 + ["set", "structure", "sweep", "option", "relocate"]
+    )
     if kind in ("value", "two"):
         keys = rng.sample(schema, 2 if kind == "two" else 1)
         for k in keys:
@@ -309,6 +350,8 @@ def make_case(i: int):
             flat[rng.choice(schema)] = {"a": 1}
         else:
             flat[rng.choice(schema)] = [1.0] * 100_000
+    elif kind == "relocate":
+        raw, desc = relocate(rng, flat, schema)
     elif kind == "sweep":
         k = rng.choice(schema)
         rngv = rng.choice(
