@@ -10,6 +10,11 @@ code before its fix.
   already been set". The suite's bars take a thread lock of their own
   (:func:`sim.mc.progress._bar_class`) and the method is read without fixing it
   (:func:`sim.mc.executors.process_start_method`).
+* In a process whose working directory was removed (a notebook started in a scratch
+  directory since deleted), ``sim.load`` of an absolute path, and ``run(out=...)`` of an
+  absolute one, were refused as "is relative, but the working directory is gone":
+  :func:`sim.mc.paths.absolute` joined every path to the working directory. An absolute path
+  runs; a relative one is still refused so.
 
 Held (found right, over 20 runs in one process, workers 1 and 2): open descriptors, threads,
 child processes, ``atexit`` callbacks, resident memory (about 1 MB a run, caches), signal
@@ -48,3 +53,29 @@ def test_a_run_leaves_the_start_method_unset(tmp_path):
         [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=300
     )
     assert p.stdout.split() == ["None", "None", "set"], p.stdout + p.stderr[-2000:]
+
+
+def test_an_absolute_path_runs_where_the_working_directory_is_gone(tmp_path):
+    """In a fresh Python whose working directory is removed: the absolute study file and
+    ``out`` run; a relative ``out`` is refused naming it."""
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    code = "\n".join(
+        [
+            "import os, sim",
+            f"os.chdir({str(gone)!r}); os.rmdir({str(gone)!r})",
+            f"st = sim.load({TABLE1!r}, trials=40, chunk=2)",
+            f"print(st.run(out={str(tmp_path / 'o')!r}, figures=False).claims().num_rows > 0)",
+            "try:",
+            "    st.run(out='rel', figures=False)",
+            "except sim.ConfigError as e:",
+            "    print(e)",
+        ]
+    )
+    p = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=300
+    )
+    assert p.stdout.splitlines() == [
+        "True",
+        "out: rel is relative, but the working directory is gone (No such file or directory)",
+    ], p.stdout + p.stderr[-2000:]
