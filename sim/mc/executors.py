@@ -61,6 +61,20 @@ def _worker_init(ppid: int | None) -> None:
     threading.Thread(target=_watch_parent, args=(ppid,), daemon=True).start()
 
 
+def process_start_method() -> str:
+    """The process's start method: the caller's (``set_start_method``) or the platform's
+    default, read without fixing it. ``multiprocessing.get_start_method()`` (and a pool or lock
+    made on the default context) fixes the default for the life of the process: after any run
+    of the Python API, the caller's own ``multiprocessing.set_start_method("spawn")`` failed
+    with "context has already been set"."""
+    return (
+        multiprocessing.get_start_method(allow_none=True)
+        or (
+            multiprocessing.get_all_start_methods()[0]  # the first is the default (documented)
+        )
+    )
+
+
 def _start_method() -> str | None:
     """How to start the pool's workers: the platform's default, except that a process with
     other threads running is never forked. A fork copies only the calling thread, so a lock
@@ -69,7 +83,7 @@ def _start_method() -> str | None:
     first import (seen with ``brown_design``, ``--workers 2`` and its figures drawn in threads). Then
     ``forkserver`` starts the workers from a clean single-threaded server instead."""
     methods = multiprocessing.get_all_start_methods()
-    if multiprocessing.get_start_method(allow_none=False) != "fork":
+    if process_start_method() != "fork":
         return None  # spawn (macOS, Windows) or a method the user chose: no fork hazard
     if threading.active_count() == 1:
         return "fork"
@@ -107,10 +121,10 @@ class _Pool:
         # the method the workers start by: ours, or the caller's (``set_start_method``; the
         # default of Python 3.14 on Linux) -- a forkserver's workers are its children, not
         # ours: given our pid they took their parent for dead and quit ("terminated abruptly")
-        self.start_method = method or multiprocessing.get_start_method()
-        self.pool = ProcessPoolExecutor(
+        self.start_method = method or process_start_method()
+        self.pool = ProcessPoolExecutor(  # a named context: the caller's default stays unset
             max_workers=workers,
-            mp_context=multiprocessing.get_context(method) if method else None,
+            mp_context=multiprocessing.get_context(self.start_method),
             initializer=_worker_init,
             initargs=(None if self.start_method == "forkserver" else os.getpid(),),
         )
@@ -270,7 +284,7 @@ def script_words(kind: str, workers: int, scheduler: str | None) -> str:
     script = getattr(main, "__file__", None)
     if not script or scheduler or (kind == "local" and workers <= 1) or _suite_entry(main):
         return ""
-    if kind == "local" and (_start_method() or multiprocessing.get_start_method()) == "fork":
+    if kind == "local" and (_start_method() or process_start_method()) == "fork":
         return ""
     return (
         f" (its worker processes import {os.path.basename(script)} again: is the script's "

@@ -113,8 +113,11 @@ def absolute(p: str | os.PathLike) -> Path:
     ``lnk/..`` by its letters: ``--out lnk/../y`` wrote ``./y`` while the run said "results
     in lnk/../y", a path where ``ls`` finds nothing, and ``--overwrite`` replaced a ``./y``
     the user had not named). The last name is kept as given (a link there is the caller's
-    to refuse); OSError where the working directory is gone."""
-    a = os.path.join(os.getcwd(), os.fspath(p))
+    to refuse); OSError where the working directory is gone and ``p`` is relative (an absolute
+    ``p`` is not joined to it: in a process whose directory was removed, ``sim.load`` of an
+    absolute path was refused as "relative, but the working directory is gone")."""
+    a = os.fspath(p)
+    a = a if os.path.isabs(a) else os.path.join(os.getcwd(), a)
     if ".." not in Path(a).parts:
         return Path(os.path.normpath(a))  # ("." and doubled or trailing slashes only)
     head, tail = os.path.split(a.rstrip("/"))

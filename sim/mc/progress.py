@@ -11,6 +11,7 @@ from __future__ import annotations
 import io
 import os
 import sys
+import threading
 from contextlib import contextmanager
 
 from sim.mc.config import ConfigError
@@ -70,11 +71,15 @@ def _bar_class():
     Python API it made the next ``run(workers=2)`` see a second thread and start its workers
     by ``forkserver`` (:func:`sim.mc.executors._start_method`), which runs the caller's
     script again in the fork server: a script without ``if __name__ == "__main__"`` started
-    a second run of its own into the same directory and the caller's run failed."""
+    a second run of its own into the same directory and the caller's run failed. Its lock is
+    a thread lock of its own: tqdm's default adds a ``multiprocessing.RLock``, whose making
+    fixes the process's start method, so that after any run the caller's own
+    ``multiprocessing.set_start_method("spawn")`` failed ("context has already been set");
+    the suite's bars are drawn by the run's process alone, never by its workers."""
     if not _bar:
         from tqdm import tqdm
 
-        _bar.append(type("Bar", (tqdm,), {"monitor_interval": 0}))
+        _bar.append(type("Bar", (tqdm,), {"monitor_interval": 0, "_lock": threading.RLock()}))
     return _bar[0]
 
 
