@@ -8,6 +8,8 @@ from __future__ import annotations
 import functools
 import inspect
 
+import numpy as np
+
 from sim.mc.config import ConfigError
 
 __all__ = ["arguments", "one_line"]
@@ -24,11 +26,16 @@ _MADE_BY = {
 }
 
 
+#: NumPy's default floating-point error handling, under which the studies are written
+NUMPY_DEFAULTS = {"divide": "warn", "over": "warn", "under": "ignore", "invalid": "warn"}
+
+
 def arguments(fn):
     """``fn`` refusing an argument it does not take with one ConfigError line that names the
     argument and the ones it takes (Python's TypeError named the function only: ``run()
     got an unexpected keyword argument 'chunk'``); a config key given to ``run()`` is pointed
-    to ``sim.load()`` and ``replace()``."""
+    to ``sim.load()`` and ``replace()``. It runs under NumPy's default error handling.
+    """
     sig = inspect.signature(fn)
     P = inspect.Parameter
     method = next(iter(sig.parameters), "") == "self"
@@ -83,8 +90,9 @@ def arguments(fn):
             sig.bind(*args, **kwargs)
         except TypeError:
             raise refusal(args, kwargs) from None
-        try:
-            return fn(*args, **kwargs)
+        try:  # under NumPy's default error handling, whatever the caller set (a notebook's
+            with np.errstate(**NUMPY_DEFAULTS):  # np.seterr(all="raise") made an underflow
+                return fn(*args, **kwargs)  # the suite ignores a FloatingPointError)
         except ConfigError as e:
             if len(str(e).splitlines()) < 2:
                 raise

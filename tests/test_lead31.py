@@ -324,3 +324,21 @@ def test_a_sweep_given_as_an_override_is_told_where_sweeps_go(capsys):
     err = _refused(capsys, ["check", study, "--set", "sweep.plate.grid=[4,5]"])
     assert "a sweep is not set by an override; write plate.grid in the study file's [sweep]" in err
     assert "a key of" not in err, err
+
+
+def test_the_api_runs_under_numpys_defaults_whatever_the_caller_set(tmp_path):
+    # before (doors31b's left item): a notebook's np.seterr(all="raise") made an underflow the
+    # suite ignores a raw FloatingPointError out of sim.load() (network_plate's rounding check)
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy as np, sim\n"
+        "np.seterr(all='raise')\n"
+        f"h = sim.load({str(STUDIES / 'network_plate.toml')!r}).replace(trials=40, chunk=2)\n"
+        f"h.run(out={str(tmp_path / 'o')!r}, quiet=True, figures=False)\n"
+        "print(sorted(set(np.geterr().values())))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-600:]
+    assert done.stdout.strip() == "['raise']", done.stdout  # the caller's own, put back
