@@ -25,8 +25,9 @@ CC = math.pi / 200 / 10000  # one centesimal second in rad
 #: largest gama-local file read (bytes)
 MAX_BYTES = 16 * 1024**2
 #: a number as gama-local's C parser reads it: ASCII digits only (Python's float and ``\d``
-#: would also take Arabic-Indic or full-width digits)
-_NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$", re.ASCII)
+#: would also take Arabic-Indic or full-width digits); one way to match each digit (``\d+\.?\d*``
+#: split a run of digits every way: a 10 MB attribute of digits ending in garbage hung, doors31y)
+_NUM = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$", re.ASCII)
 _DMS = re.compile(r"^[+-]?\d+-\d+-\d+(\.\d*)?([eE][+-]?\d+)?$", re.ASCII)
 #: the white space XML (and gama-local) trims around a value and splits a list at: Python's
 #: ``strip()`` and ``split()`` also take a no-break space and the other Unicode spaces, so an id
