@@ -342,3 +342,19 @@ def test_the_api_runs_under_numpys_defaults_whatever_the_caller_set(tmp_path):
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr[-600:]
     assert done.stdout.strip() == "['raise']", done.stdout  # the caller's own, put back
+
+
+def test_a_huge_bad_attribute_is_not_echoed_whole_into_the_one_line(tmp_path):
+    # before (doors31y's left item): a 1 MB garbage number was repeated whole in the refusal
+    from sim.mc.config import ConfigError
+    from sim.studies.network.gama_read import read_gama
+
+    src = (Path(__file__).parent / "data" / "gama" / "one_fixed.xml").read_text()
+    m = re.search(r'val="[^"]+"', src)
+    assert m
+    f = tmp_path / "n.xml"
+    f.write_text(src.replace(m.group(0), 'val="' + "9" * 1_000_000 + 'x"', 1))
+    with pytest.raises(ConfigError) as e:
+        read_gama(f)
+    line = str(e.value)
+    assert len(line) < 400 and "(1,000,001 characters) is not a number" in line, line[:400]

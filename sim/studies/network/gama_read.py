@@ -54,7 +54,17 @@ import numpy as np
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
-from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
+from sim.studies.network.gama_vocab import (
+    _NUM,
+    CC,
+    MAX_BYTES,
+    NS,
+    _File,
+    _tag,
+    read_bytes,
+    said,
+    ws,
+)
 from sim.studies.network.gama_vocab import words as _words
 from sim.studies.network.validate import SIGMA_RANGE, looks_like
 
@@ -76,7 +86,7 @@ def _cov(f: _File, cm, n: int) -> np.ndarray:
         raise f.err(cm, f"{len(words)} numbers for dim {dim}, band {band} (need {need})")
     if not all(_NUM.match(w) for w in words):
         bad = next(w for w in words if not _NUM.match(w))
-        raise f.err(cm, f"{bad!r} is not a number")
+        raise f.err(cm, f"{said(bad)} is not a number")
     for w in words:  # 1e-400: not a variance of 0 ("must be positive"), 1e400 not inf
         try:
             float_text(w)
@@ -107,7 +117,7 @@ def _defaults(f: _File, po) -> dict:
         raise f.err(po, "takes 'a [b [c]]' (a + b D^c mm, D in km)", "distance-stdev")
     for w in words:
         if not _NUM.match(w):
-            raise f.err(po, f"{w!r} is not a number", "distance-stdev")
+            raise f.err(po, f"{said(w)} is not a number", "distance-stdev")
         try:  # 1e-400: not a of 0 mm, silently; 1e400: not "not a number"
             float_text(w)
         except UnheldError as why:

@@ -36,6 +36,14 @@ XML_WS = " \t\r\n"
 _WS_RUN = re.compile(r"[ \t\r\n]+")
 
 
+def said(v: str, most: int = 40) -> str:
+    """``repr(v)`` for a message, cut to its first ``most`` characters with its length when
+    longer: a 10 MB attribute was echoed whole into the one-line refusal."""
+    if len(v) <= most:
+        return repr(v)
+    return f"{v[:most]!r}... ({len(v):,} characters)"
+
+
 def ws(v: str) -> str:
     """``v`` without the XML white space around it (a no-break space stays, as in gama-local)."""
     return v.strip(XML_WS)
@@ -158,13 +166,13 @@ class _File:
                 raise self.err(e, "missing", attr)
             return default
         if not _NUM.match(ws(v)):
-            raise self.err(e, f"{v!r} is not a number", attr)
+            raise self.err(e, f"{said(v)} is not a number", attr)
         try:  # "-0" is 0.0 (atan2 tells -0.0 apart: other results); 1e-400 not 0, silently
             x = float_text(ws(v))
         except UnheldError as why:
             raise self.err(e, str(why), attr) from None
         if lo is not None and x <= lo:
-            raise self.err(e, f"{v!r} must be > {lo:g}", attr)
+            raise self.err(e, f"{said(v)} must be > {lo:g}", attr)
         return x
 
     def name(self, e, attr: str, default: str | None = None) -> str:
@@ -186,11 +194,13 @@ class _File:
             try:  # seconds of 1e-400 are no 0 (or 1e400 no inf), as any number of the file
                 sec = float_text(s)
             except UnheldError as why:
-                raise self.err(e, f"{v!r}: the seconds {why}", attr) from None
+                raise self.err(e, f"{said(v)}: the seconds {why}", attr) from None
             # seconds of 60.00 are a value rounded up (gama-local reads them, and its own
             # test data holds "187-33-60.00"); more is garbage
             if int(m) >= 60 or sec > 60:
-                raise self.err(e, f"{v!r}: minutes must be below 60 and seconds at most 60", attr)
+                raise self.err(
+                    e, f"{said(v)}: minutes must be below 60 and seconds at most 60", attr
+                )
             return True
         self.num(e, attr)
         return False
@@ -223,7 +233,7 @@ class _File:
                     raise self.err(e, "unknown attribute", a)
                 ch = _CHOICES.get((t, a))
                 if ch and ws(v) not in ch:
-                    raise self.err(e, f"{v!r} is not one of {', '.join(ch)}", a)
+                    raise self.err(e, f"{said(v)} is not one of {', '.join(ch)}", a)
 
 
 def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
