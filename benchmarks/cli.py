@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import sys
 import time
 import tomllib
@@ -36,7 +35,7 @@ from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
 from benchmarks.store import store_rows
 from sim.mc.argv import ONCE, OnceParser
 from sim.mc.storage import provenance, write_table
-from sim.stops import in_main_thread
+from sim.stops import ended_as_ctrl_c
 
 __all__ = ["main", "run"]
 
@@ -203,28 +202,16 @@ def _check_args(a: argparse.Namespace, sections: tuple[str, ...]) -> None:
 INTERRUPTED = "benchmarks: interrupted; nothing more was measured"
 
 
-def _interrupt(signum, frame):
-    raise KeyboardInterrupt
-
-
 def main(argv=None) -> int:
     """The benchmark; SIGTERM and SIGHUP end it as Ctrl-C does (its child processes stopped:
     SIGTERM ended it at once, exit 143 without a word, and left its million-trial run
     writing into ``--out``): one line, exit 130."""
-    stops = (signal.SIGTERM, signal.SIGHUP) if in_main_thread() else ()
-    old = {s: signal.getsignal(s) for s in stops}
-    for s in stops:
-        if old[s] is signal.SIG_DFL:
-            signal.signal(s, _interrupt)
     try:
-        return _main(argv)
+        with ended_as_ctrl_c():
+            return _main(argv)
     except KeyboardInterrupt:
         print(INTERRUPTED, file=sys.stderr)
         return 130
-    finally:
-        for s, h in old.items():
-            if h is not None:
-                signal.signal(s, h)
 
 
 def _main(argv) -> int:

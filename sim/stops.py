@@ -35,6 +35,7 @@ __all__ = [
     "run_program",
     "in_main_thread",
     "exit_status",
+    "ended_as_ctrl_c",
 ]
 
 #: interrupts recorded by the hook of :func:`keep_lost_interrupts`, not yet raised
@@ -118,6 +119,30 @@ def _ignore_during_teardown() -> None:
 
 
 atexit.register(_ignore_during_teardown)
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+@contextmanager
+def ended_as_ctrl_c():
+    """While open, SIGTERM and SIGHUP (at their default handler) end the command as Ctrl-C
+    does, by KeyboardInterrupt: its children stopped and its temporaries removed (a SIGTERM
+    ended ``make bench`` at once, without a word, its child still writing). The handlers of
+    SIGINT, SIGTERM and SIGHUP are put back after (an in-process caller keeps its own); in
+    another thread than the main one nothing is set (Python lets only the main thread)."""
+    signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP) if in_main_thread() else ()
+    old = {s: signal.getsignal(s) for s in signals}
+    for s in signals[1:]:
+        if old[s] is signal.SIG_DFL:
+            signal.signal(s, _interrupt)
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            if h is not None:
+                signal.signal(s, h)
 
 
 def in_main_thread() -> bool:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import os
 import shutil
-import signal
 import sys
 import tempfile
 from pathlib import Path
@@ -17,7 +16,7 @@ from sim.mc.outputs import name_problem
 from sim.report.verify.record import write_record
 from sim.report.verify.rerun import verify
 from sim.report.verify.rules import Comparison, VerifyError
-from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
+from sim.stops import check_interrupt, ended_as_ctrl_c, exit_status, keep_lost_interrupts
 
 __all__ = ["main"]
 
@@ -144,28 +143,15 @@ def _print(comps: list[Comparison]) -> None:
 INTERRUPTED = "sim verify: interrupted; the re-run was stopped"
 
 
-def _interrupt(signum, frame):
-    raise KeyboardInterrupt
-
-
 def main(argv: list[str] | None = None) -> int:
-    signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP) if in_main_thread() else ()
-    old = {s: signal.getsignal(s) for s in signals}
-    for s in signals[1:]:  # end the re-run and clean up as Ctrl-C does
-        if old[s] is signal.SIG_DFL:
-            signal.signal(s, _interrupt)
     try:
-        with keep_lost_interrupts():  # Ctrl-C that Python drops in a C callback: kept
+        with ended_as_ctrl_c(), keep_lost_interrupts():  # Ctrl-C dropped in a C callback: kept
             code = _main(argv)
             check_interrupt()  # and never exit 0 after one
             return code
     except KeyboardInterrupt:
         print(INTERRUPTED, file=sys.stderr)
         return 130
-    finally:
-        for s, h in old.items():
-            if h is not None:
-                signal.signal(s, h)
 
 
 def _main(argv: list[str] | None) -> int:
