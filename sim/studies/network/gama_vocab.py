@@ -12,27 +12,36 @@ import os
 import re
 import stat
 from pathlib import Path
+from xml.parsers import expat
 
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, toml_float, unsigned_zeros
 from sim.mc.paths import link_problem
 from sim.studies.network.validate import _point_name
 
-__all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes", "ws", "words"]
+__all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes", "ws", "words", "said", "entity_declared"]
 
 NS = "http://www.gnu.org/software/gama/gama-local"
 CC = math.pi / 200 / 10000  # one centesimal second in rad
 #: largest gama-local file read (bytes)
 MAX_BYTES = 16 * 1024**2
 #: a number as gama-local's C parser reads it: ASCII digits only (Python's float and ``\d``
-#: would also take Arabic-Indic or full-width digits)
-_NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$", re.ASCII)
-_DMS = re.compile(r"^[+-]?\d+-\d+-\d+(\.\d*)?([eE][+-]?\d+)?$", re.ASCII)
+#: would also take Arabic-Indic or full-width digits); unambiguous, so linear in the value's
+#: length (``\d+\.?\d*`` backtracked quadratically: a 10 MB attribute of digits ending in a
+#: letter held the reader for hours, doors31x; possessive, so no backtracking at all)
+_NUM = re.compile(r"^[+-]?(\d++(\.\d*+)?|\.\d++)([eE][+-]?\d++)?$", re.ASCII)
+_DMS = re.compile(r"^[+-]?\d++-\d++-\d++(\.\d*+)?([eE][+-]?\d++)?$", re.ASCII)
 #: the white space XML (and gama-local) trims around a value and splits a list at: Python's
 #: ``strip()`` and ``split()`` also take a no-break space and the other Unicode spaces, so an id
 #: ``"A\u00a0"`` was the point ``A`` here and another point in gama-local (doors24c)
 XML_WS = " \t\r\n"
 _WS_RUN = re.compile(r"[ \t\r\n]+")
+
+
+def said(v: str, n: int = 19) -> str:
+    """``v`` quoted for a message, its first ``n`` characters when longer (a 10 MB attribute
+    made a 10 MB "one line", and scanning it for lookalike characters took seconds)."""
+    return repr(v) if len(v) <= n else f"{v[:n]!r}... ({len(v)} characters)"
 
 
 def ws(v: str) -> str:
@@ -147,7 +156,7 @@ class _File:
     def err(self, e, what: str, attr: str | None = None) -> ConfigError:
         where = f"<{_tag(e)}>" if attr is None else f"<{_tag(e)}> attribute {attr!r}"
         pid = e.get("id") or e.get("to")
-        at = f" ({'id' if e.get('id') else 'to'}={pid!r})" if pid and attr != "id" else ""
+        at = f" ({'id' if e.get('id') else 'to'}={said(pid)})" if pid and attr != "id" else ""
         return ConfigError(self.key, f"{self.path}: {where}{at}: {what}")
 
     def num(self, e, attr: str, default: float | None = None, lo: float | None = None) -> float:
@@ -157,13 +166,13 @@ class _File:
                 raise self.err(e, "missing", attr)
             return default
         if not _NUM.match(ws(v)):
-            raise self.err(e, f"{v!r} is not a number", attr)
+            raise self.err(e, f"{said(v)} is not a number", attr)
         try:  # "-0" is 0.0 (atan2 tells -0.0 apart: other results); 1e-400 not 0, silently
             x = unsigned_zeros(toml_float(ws(v)))
         except UnheldError as why:
             raise self.err(e, str(why), attr) from None
         if lo is not None and x <= lo:
-            raise self.err(e, f"{v!r} must be > {lo:g}", attr)
+            raise self.err(e, f"{said(v)} must be > {lo:g}", attr)
         return x
 
     def name(self, e, attr: str, default: str | None = None) -> str:
@@ -184,8 +193,10 @@ class _File:
             d, m, s = v.lstrip("+-").split("-")
             # seconds of 60.00 are a value rounded up (gama-local reads them, and its own
             # test data holds "187-33-60.00"); more is garbage
-            if int(m) >= 60 or float(s) > 60:
-                raise self.err(e, f"{v!r}: minutes must be below 60 and seconds at most 60", attr)
+            if float(m) >= 60 or float(s) > 60:  # int() of 5000 digits: ValueError
+                raise self.err(
+                    e, f"{said(v)}: minutes must be below 60 and seconds at most 60", attr
+                )
             return True
         self.num(e, attr)
         return False
@@ -218,7 +229,37 @@ class _File:
                     raise self.err(e, "unknown attribute", a)
                 ch = _CHOICES.get((t, a))
                 if ch and ws(v) not in ch:
-                    raise self.err(e, f"{v!r} is not one of {', '.join(ch)}", a)
+                    raise self.err(e, f"{said(v)} is not one of {', '.join(ch)}", a)
+
+
+class _Prolog(Exception):
+    """The first element: the prolog, where every declaration stands, is over."""
+
+
+def entity_declared(data: bytes) -> str | None:
+    """The name of the first entity the file's DOCTYPE declares (None: none). A gama-local file
+    needs none, and entities are how a file of a few kilobytes expands to gigabytes in the
+    parser ("billion laughs"; expat stops an amplification over 100, one just below it held
+    the reader at 50 times the file's size, doors31x) or names a local file or a URL (an
+    external entity: never read nor fetched here). Only the prolog is parsed: the scan stops
+    at the first element; a parse error is left to the reader, which names it."""
+    p = expat.ParserCreate()
+    found: list[str] = []
+
+    def entity(name, is_param, *_):
+        found.append(("%" if is_param else "&") + name + ";")
+        raise _Prolog
+
+    def element(*_):
+        raise _Prolog
+
+    p.EntityDeclHandler = entity
+    p.StartElementHandler = element
+    try:
+        p.Parse(data, True)
+    except (_Prolog, expat.ExpatError, ValueError, LookupError):
+        pass
+    return found[0] if found else None
 
 
 def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
