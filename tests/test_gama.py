@@ -610,7 +610,7 @@ LAUGHS = (
 @pytest.mark.parametrize(
     "text,msg",
     [
-        (LAUGHS, "is not XML"),
+        (LAUGHS, "declares the entity &a;"),  # refused before it expands (doors31x)
         ('<?xml version="1.0" encoding="foo"?><gama-local/>', "cannot be decoded"),
         ("", "is not XML"),
         ("<other/>", "not <gama-local>"),

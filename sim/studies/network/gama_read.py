@@ -53,18 +53,9 @@ import numpy as np
 
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
+from sim.studies.network import gama_vocab as vocab
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
-from sim.studies.network.gama_vocab import (
-    _NUM,
-    CC,
-    MAX_BYTES,
-    NS,
-    _File,
-    _tag,
-    read_bytes,
-    said,
-    ws,
-)
+from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
 from sim.studies.network.gama_vocab import words as _words
 from sim.studies.network.validate import SIGMA_RANGE, looks_like
 
@@ -86,7 +77,7 @@ def _cov(f: _File, cm, n: int) -> np.ndarray:
         raise f.err(cm, f"{len(words)} numbers for dim {dim}, band {band} (need {need})")
     if not all(_NUM.match(w) for w in words):
         bad = next(w for w in words if not _NUM.match(w))
-        raise f.err(cm, f"{said(bad)} is not a number")
+        raise f.err(cm, f"{vocab.said(bad)} is not a number")
     for w in words:  # 1e-400: not a variance of 0 ("must be positive"), 1e400 not inf
         try:
             float_text(w)
@@ -117,7 +108,7 @@ def _defaults(f: _File, po) -> dict:
         raise f.err(po, "takes 'a [b [c]]' (a + b D^c mm, D in km)", "distance-stdev")
     for w in words:
         if not _NUM.match(w):
-            raise f.err(po, f"{said(w)} is not a number", "distance-stdev")
+            raise f.err(po, f"{vocab.said(w)} is not a number", "distance-stdev")
         try:  # 1e-400: not a of 0 mm, silently; 1e400: not "not a number"
             float_text(w)
         except UnheldError as why:
@@ -251,7 +242,9 @@ def _coordinates(f: _File, e, coords: list) -> None:
     for a, p in enumerate(pts):
         vx, vy = var[2 * a], var[2 * a + 1]
         if not math.isclose(vx, vy, rel_tol=1e-9):
-            raise f.err(cms[0], f"point {p.get('id')!r}: observed x and y need one variance")
+            raise f.err(
+                cms[0], f"point {vocab.said(p.get('id') or '')}: observed x and y need one variance"
+            )
         pid = f.name(p, "id")
         f.num(p, "x"), f.num(p, "y")
         coords.append((pid, math.sqrt(vx)))
@@ -314,6 +307,12 @@ def frame_note(axes: str, angles: str) -> str:
 def _network(f: _File, data: bytes):
     """The ``<network>`` element of the file's bytes, its root and attributes checked."""
     key, path = f.key, f.path
+    if ent := vocab.entity_declared(data):
+        raise ConfigError(
+            key,
+            f"{path}: its <!DOCTYPE> declares the entity {ent}: entity declarations are not read "
+            "(a gama-local file needs none; write the values in place)",
+        )
     try:
         root = ET.fromstring(data)
     except ET.ParseError as e:

@@ -12,13 +12,14 @@ import os
 import re
 import stat
 from pathlib import Path
+from xml.parsers import expat
 
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
 from sim.mc.paths import link_problem
 from sim.studies.network.validate import _point_name
 
-__all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes", "ws", "words"]
+__all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes", "ws", "words", "said", "entity_declared"]
 
 NS = "http://www.gnu.org/software/gama/gama-local"
 CC = math.pi / 200 / 10000  # one centesimal second in rad
@@ -36,9 +37,10 @@ XML_WS = " \t\r\n"
 _WS_RUN = re.compile(r"[ \t\r\n]+")
 
 
-def said(v: str, most: int = 40) -> str:
+def said(v: str, most: int = 19) -> str:
     """``repr(v)`` for a message, cut to its first ``most`` characters with its length when
-    longer: a 10 MB attribute was echoed whole into the one-line refusal."""
+    longer: a 10 MB attribute was echoed whole into the one-line refusal (19: a longer run of
+    digits is shown as a float by every ConfigError, 40 nines as '1e+40')."""
     if len(v) <= most:
         return repr(v)
     return f"{v[:most]!r}... ({len(v):,} characters)"
@@ -156,7 +158,7 @@ class _File:
     def err(self, e, what: str, attr: str | None = None) -> ConfigError:
         where = f"<{_tag(e)}>" if attr is None else f"<{_tag(e)}> attribute {attr!r}"
         pid = e.get("id") or e.get("to")
-        at = f" ({'id' if e.get('id') else 'to'}={pid!r})" if pid and attr != "id" else ""
+        at = f" ({'id' if e.get('id') else 'to'}={said(pid)})" if pid and attr != "id" else ""
         return ConfigError(self.key, f"{self.path}: {where}{at}: {what}")
 
     def num(self, e, attr: str, default: float | None = None, lo: float | None = None) -> float:
@@ -197,7 +199,7 @@ class _File:
                 raise self.err(e, f"{said(v)}: the seconds {why}", attr) from None
             # seconds of 60.00 are a value rounded up (gama-local reads them, and its own
             # test data holds "187-33-60.00"); more is garbage
-            if int(m) >= 60 or sec > 60:
+            if float(m) >= 60 or sec > 60:  # int() of 5000 digits: ValueError
                 raise self.err(
                     e, f"{said(v)}: minutes must be below 60 and seconds at most 60", attr
                 )
@@ -234,6 +236,36 @@ class _File:
                 ch = _CHOICES.get((t, a))
                 if ch and ws(v) not in ch:
                     raise self.err(e, f"{said(v)} is not one of {', '.join(ch)}", a)
+
+
+class _Prolog(Exception):
+    """The first element: the prolog, where every declaration stands, is over."""
+
+
+def entity_declared(data: bytes) -> str | None:
+    """The name of the first entity the file's DOCTYPE declares (None: none). A gama-local file
+    needs none, and entities are how a file of a few kilobytes expands to gigabytes in the
+    parser ("billion laughs"; expat stops an amplification over 100, one just below it held
+    the reader at 50 times the file's size, doors31x) or names a local file or a URL (an
+    external entity: never read nor fetched here). Only the prolog is parsed: the scan stops
+    at the first element; a parse error is left to the reader, which names it."""
+    p = expat.ParserCreate()
+    found: list[str] = []
+
+    def entity(name, is_param, *_):
+        found.append(("%" if is_param else "&") + name + ";")
+        raise _Prolog
+
+    def element(*_):
+        raise _Prolog
+
+    p.EntityDeclHandler = entity
+    p.StartElementHandler = element
+    try:
+        p.Parse(data, True)
+    except (_Prolog, expat.ExpatError, ValueError, LookupError):
+        pass
+    return found[0] if found else None
 
 
 def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
