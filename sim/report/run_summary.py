@@ -130,7 +130,7 @@ def converged_line(out: Path) -> str | None:
     1e-5 of the pass weight: some trials stop at the limit); None when every one converged."""
     p = Path(out) / "trials.parquet"
     if not p.is_file():
-        return None
+        return _summary_converged(Path(out) / "summary.parquet")
     names = [c for c in pq.read_schema(p).names if c.endswith(".converged")]
     if not names:
         return None
@@ -145,6 +145,24 @@ def converged_line(out: Path) -> str | None:
     return (
         f"not converged: {int(some.sum()):,} of {t.num_rows:,} trials in some adjustment "
         f"({each}), their values as the solver left them (at its iteration limit, or singular)"
+    )
+
+
+def _summary_converged(p: Path) -> str | None:
+    """The line of a ``summary.parquet`` with ``trials`` and ``converged`` (the network
+    kind's): its Monte-Carlo estimates are of the converged trials alone, and a run of which
+    31 of 40 trials did not converge said so only in its README's summary sentence (lead32)."""
+    if not p.is_file() or not {"trials", "converged"} <= set(pq.read_schema(p).names):
+        return None
+    t = pq.read_table(p, columns=["trials", "converged"]).to_pylist()
+    if len(t) != 1 or not all(isinstance(v, int) for v in t[0].values()):
+        return None
+    n, ok = t[0]["trials"], t[0]["converged"]
+    if ok >= n:
+        return None
+    return (
+        f"not converged: {n - ok:,} of {n:,} trials, left out of the Monte-Carlo estimates "
+        f"(they are of the {ok:,} that converged)"
     )
 
 

@@ -12,10 +12,12 @@ from functools import partial
 import numpy as np
 
 from sim.lsq import distributions as D
+from sim.mc.config import ConfigError
 from sim.mc.runner import PROBE_SEED, PROBE_TRIALS, probe_limit
 from sim.studies.network.analysis import mc_chunk
 from sim.studies.network.definition import Network
 from sim.studies.network.keys import SCHEMA
+from sim.studies.network.linearity import biased, why_not_converged
 from sim.studies.network.sparse_analysis import SparseAnalytic, mc_chunk_sparse
 from sim.studies.network.tables import parameter_indices
 
@@ -46,10 +48,21 @@ def chunk_fn(net: Network, an, C, pts, cfg: dict):
 
 def probe_solver(net: Network, an, C, pts, cfg: dict) -> None:
     """Refuse a solver limit no probe trial meets, naming ``solver.max_iter`` and the network
-    (:func:`sim.mc.runner.probe_limit`)."""
+    (:func:`sim.mc.runner.probe_limit`); and a network none of whose probe trials converges
+    at any limit, naming a gross bias or the sight too short for its noise
+    (:mod:`sim.studies.network.linearity`): the run computed every chunk, then refused,
+    naming ``solver.max_iter``. The probe is 16 trials, a second on a 90,000-point network."""
+    seen: dict[int, np.ndarray] = {}
 
     def statuses(max_iter: int) -> np.ndarray:
-        fn = chunk_fn(net, an, C, pts, {**cfg, "solver.max_iter": max_iter})
-        return fn(np.random.default_rng(PROBE_SEED), PROBE_TRIALS)["rows.status"]
+        if max_iter not in seen:
+            fn = chunk_fn(net, an, C, pts, {**cfg, "solver.max_iter": max_iter})
+            seen[max_iter] = fn(np.random.default_rng(PROBE_SEED), PROBE_TRIALS)["rows.status"]
+        return seen[max_iter]
 
     probe_limit(cfg, statuses, SCHEMA["solver.max_iter"].default, f"{net.name!r} network", FIRST)
+    limit = cfg["solver.max_iter"]
+    if np.any(statuses(limit) == 0):
+        return
+    what = f"none of {PROBE_TRIALS} probe trials converged within solver.max_iter = {limit}"
+    raise ConfigError(*(biased(net, what) or why_not_converged(net, an.cov, cfg, what)))

@@ -26,6 +26,7 @@ from sim.studies.network.definition import Network, build
 from sim.studies.network.estimates import mc_estimates
 from sim.studies.network.figures import network_figure, reliability_figure
 from sim.studies.network.gama import export, import_note, merge_gama
+from sim.studies.network.linearity import biased, why_not_converged
 from sim.studies.network.model import datum
 from sim.studies.network.probe import chunk_fn
 from sim.studies.network.rounding import check_rounding
@@ -99,8 +100,10 @@ def run(cfg: dict, out: Path, ctx) -> None:
     sim = _mc(net, an, C, pts, cfg, ctx)
     try:
         est = mc_estimates(an, pts, sim)
-    except StudyError as e:
-        raise StudyError(_biased(net) or str(e)) from None
+    except StudyError:
+        what = "fewer than two chunks have converged trials"
+        key, msg = biased(net, what) or why_not_converged(net, an.cov, cfg, what)
+        raise StudyError(f"{key}: {msg}") from None
     with phase("network: tables and figures", show, quiet):
         _outputs(out, cfg, full, net, an, dt, C, pts, held, sim, est, prov)
 
@@ -126,25 +129,4 @@ def _outputs(out, cfg, full, net, an, dt, C, pts, held, sim, est, prov) -> None:
             (network_figure, (net, an, pts, out / "network.png")),
             (reliability_figure, (net, an, out / "reliability.png")),
         ]
-    )
-
-
-def _biased(net: Network) -> str:
-    """The message for a run that did not converge when an observation carries a bias (a
-    gross error unknown to the adjustment): name the largest, in its sigmas; "" when none
-    has a bias."""
-    if not np.any(net.bias):
-        return ""
-    r = int(np.argmax(np.abs(net.bias) / net.sigma))
-    ang = int(net.kind[r]) in (1, 2)
-    unit, f = ("arcsec", 648000 / np.pi) if ang else ("mm", 1.0)
-    kind = ("distance", "direction", "angle", "dx", "dy", "x", "y")[int(net.kind[r])]
-    what = f"the {kind} at {net.names[net.i[r]]!r}"
-    what += f" from {net.names[net.j[r]]!r}" if net.kind[r] == 2 else ""
-    to = net.k[r] if net.kind[r] == 2 else net.j[r]
-    what += f" to {net.names[to]!r}" if to >= 0 else ""
-    return (
-        "network.observations: fewer than two chunks have converged trials: the bias of "
-        f"{net.bias[r] * f:g} {unit} on {what} is a gross error the adjustment cannot absorb "
-        "(a bias is unknown to it): make it smaller"
     )
