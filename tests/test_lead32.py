@@ -74,3 +74,39 @@ def test_a_network_run_says_how_many_trials_did_not_converge(tmp_path, capsys):
     )
     assert main(["show", str(plate)]) == 0
     assert "not converged" not in capsys.readouterr().out
+
+
+def _plate(tmp_path: Path, side: int) -> Path:
+    """A side x side grid plate: observed coordinates and dx, dy from one point (4 slots)."""
+    p = tmp_path / "plate.toml"
+    grid = f'{{ prefix = "G", nx = {side}, ny = {side}, spacing_mm = 1.0, role = "observed", '
+    p.write_text(
+        f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngrids = [ {grid}'
+        'sigma_mm = 0.0012 } ]\ngenerate = [ { kind = "dx", from = "G1", to = "G*", '
+        'sigma_mm = 0.002 }, { kind = "dy", from = "G1", to = "G*", sigma_mm = 0.002 } ]\n'
+        '[datum]\nkind = "fixed"\n',
+        encoding="utf-8",
+    )
+    return p
+
+
+def test_a_network_whose_estimate_fits_the_memory_limit_is_not_refused_for_memory(
+    tmp_path, monkeypatch, capsys
+):
+    # before: a 300 x 300 plate, shown by `sim check` as "about 0.222 GiB of memory" (it took
+    # 0.49), was refused under SIM_MAX_MEMORY_GB=0.5 for "1 x 90000 observations need about
+    # 0.515 GiB", while `sim run --max-memory-gb 0.5` ran it: two models of one network. The
+    # early check of the declaration and the estimate now count one state, so a limit just
+    # over the estimate is met, and one under it refused, by the option and the variable alike
+    import sim
+
+    f = _plate(tmp_path, 60)
+    gib = sim.load(f).estimate().bytes / 2**30
+    monkeypatch.setenv("SIM_MAX_MEMORY_GB", f"{gib * 1.01:.6g}")
+    assert main(["check", str(f)]) == 0
+    capsys.readouterr()
+    monkeypatch.setenv("SIM_MAX_MEMORY_GB", f"{gib * 0.99:.6g}")
+    assert "over the" in _refused(capsys, ["check", str(f)])
+    monkeypatch.delenv("SIM_MAX_MEMORY_GB")
+    args = ["run", str(f), "--out", str(tmp_path / "o"), "--max-memory-gb", f"{gib * 0.99:.6g}"]
+    assert "over the" in _refused(capsys, args)

@@ -15,7 +15,15 @@ from sim.lsq.size import SPARSE_MIN_UNKNOWNS
 from sim.lsq.sparse import factor_nonzeros
 from sim.mc.workunits import COPIES, F8
 
-__all__ = ["network_estimate", "network_counts", "Counts", "NAME_SAMPLE", "NETWORK_SPARSE_FROM"]
+__all__ = [
+    "network_estimate",
+    "network_counts",
+    "Counts",
+    "NAME_SAMPLE",
+    "NETWORK_SPARSE_FROM",
+    "state_bytes",
+    "sparse_chunk_bytes",
+]
 
 
 #: unknowns from which the network kind takes the sparse path (the engine's size rule)
@@ -59,6 +67,46 @@ DENSE_ROWS_COLS_PER_UNIT = 2.0e3
 DENSE_WORK_PER_UNIT = 2.8e5
 
 
+#: bytes the sparse path holds besides a chunk's arrays and the factor (measured: peak RSS
+#: over a 300-point network's, dx/dy grids of 22,500 and 90,000 points and a 20,000-point
+#: trilateration, chunks of 2): per point its arrays and Python name; per slot pair of the
+#: Jacobian's rows (``m s^2``, s the pattern's width: 4 for coordinate differences and
+#: coordinates alone, 7 with a distance, direction or angle) the normal equations assembled
+#: from every row's slot pairs when the network is checked. The chunk model before counted a
+#: Jacobian per trial the sparse path never forms and no assembly: a 90,000-point plate was
+#: estimated at 0.22 GiB and took 0.49 GiB, a 2,500-point one 0.27 GiB for 0.04 GiB
+STATE_BYTES_PER_POINT = 2048
+STATE_BYTES_PER_SLOT_PAIR = 40
+#: bytes a trial of a chunk holds per observation and per unknown (its simulated readings,
+#: residuals and weights; its unknowns, gradient and step): measured 41 to 50 bytes per
+#: observation at 2,500 and 20,000 points, chunks of 10 to 200
+CHUNK_BYTES_PER_ROW, CHUNK_BYTES_PER_UNKNOWN = 48.0, 80.0
+
+
+def slot_width(nonlinear: bool) -> int:
+    """The Jacobian pattern's slots a row (the widest kind decides): 7 with a distance,
+    direction or angle (two points, an orientation, the constant and the scale), else 4."""
+    return 7 if nonlinear else 4
+
+
+def state_bytes(points: float, rows: float, nonlinear: bool = True) -> float:
+    """Bytes of a network's state on the sparse path (:data:`STATE_BYTES_PER_POINT`,
+    :data:`STATE_BYTES_PER_SLOT_PAIR`): what the early check of the declaration
+    (:func:`sim.studies.network.validate._fits`, every kind taken as non-linear) and the
+    run's estimate both count, so that no refusal states more than ``sim check`` shows."""
+    return points * STATE_BYTES_PER_POINT + rows * slot_width(nonlinear) ** 2 * (
+        STATE_BYTES_PER_SLOT_PAIR
+    )
+
+
+def sparse_chunk_bytes(chunk: float, rows: float, unknowns: float, factor_nnz: float) -> float:
+    """Bytes one Monte-Carlo chunk of the sparse path holds: its trials' arrays
+    (:data:`CHUNK_BYTES_PER_ROW`, :data:`CHUNK_BYTES_PER_UNKNOWN`) and the factor with its
+    selected inverse (three 16-byte entries a nonzero)."""
+    per_trial = rows * CHUNK_BYTES_PER_ROW + unknowns * CHUNK_BYTES_PER_UNKNOWN
+    return chunk * per_trial + 3 * 16 * factor_nnz
+
+
 #: a set of more points than this is matched against a pattern through this many evenly
 #: spaced names (each standing for its share of the set): the estimate of a network of
 #: millions of points takes a fraction of a second, not a minute of name matching
@@ -92,13 +140,16 @@ def _network_names(c: Mapping) -> list[tuple[list[str], float]]:
 class Counts(NamedTuple):
     """What a network run does, counted from its declaration: ``unknowns`` (the engine's q),
     ``rows`` (observations), ``sparse`` (the path), ``iterations`` (a trial's Gauss-Newton
-    steps), ``factor_nnz`` (the sparse factor's nonzeros, 0 on the dense path)."""
+    steps), ``factor_nnz`` (the sparse factor's nonzeros, 0 on the dense path), ``points``,
+    ``nonlinear`` (a distance, direction or angle among the rows)."""
 
     unknowns: float
     rows: float
     sparse: bool
     iterations: int
     factor_nnz: float
+    points: float = 0.0
+    nonlinear: bool = True
 
 
 def network_counts(c: Mapping) -> Counts:
@@ -119,8 +170,8 @@ def network_counts(c: Mapping) -> Counts:
     cap = max(int(c.get("solver.max_iter", 50) or 1), 1)
     if U >= NETWORK_SPARSE_FROM:
         nnz_l = factor_nonzeros(int(U), int(nnz_rows + 2 * U))
-        return Counts(U, m, True, min(SPARSE_ITERATIONS[nonlinear], cap), nnz_l)
-    return Counts(U, m, False, min(DENSE_ITERATIONS[nonlinear], cap), 0.0)
+        return Counts(U, m, True, min(SPARSE_ITERATIONS[nonlinear], cap), nnz_l, n, nonlinear)
+    return Counts(U, m, False, min(DENSE_ITERATIONS[nonlinear], cap), 0.0, n, nonlinear)
 
 
 def network_estimate(c: Mapping) -> tuple:
@@ -135,8 +186,8 @@ def network_estimate(c: Mapping) -> tuple:
     k = network_counts(c)
     U, m, it, nnz_l = k.unknowns, k.rows, k.iterations, k.factor_nnz
     if k.sparse:
-        s = 6.0  # Jacobian slots of a distance or direction row
-        b = 3 * F8 * (ch * m * (s + 3) + 3 * ch * U) + 3 * 16 * nnz_l
+        b = sparse_chunk_bytes(ch, m, U, nnz_l) + state_bytes(k.points, m, k.nonlinear)
+        b = max(b, state_bytes(k.points, m))  # never less than the declaration's check counts
         rows = m / SPARSE_ROWS_PER_UNIT
         w = it * (nnz_l / SPARSE_NNZ_PER_UNIT + rows) + rows
         setup = SPARSE_SETUP_UNITS_PER_NNZ * nnz_l

@@ -24,7 +24,7 @@ import numpy as np
 
 from sim import lsq
 from sim.lsq import sparse as lsq_sparse
-from sim.mc.network_size import network_counts
+from sim.mc.network_size import network_counts, sparse_chunk_bytes
 from sim.mc.progress import phase
 from sim.studies.network.analysis import (
     Analytic,
@@ -93,19 +93,16 @@ class SparseAnalytic(Analytic):
 
 
 def chunk_bytes(net: Network, chunk: int) -> float:
-    """Bytes one Monte-Carlo chunk of the sparse path holds at once: the Jacobian on its
-    pattern and the residuals (trials x observations x slots), the gradients and the
-    right-hand sides (trials x unknowns), the factor and its selected inverse (counted by
-    nonzeros), with a factor of three for copies. The factor's nonzeros follow from ``N``'s
-    own (the distinct pairs of estimated unknowns the rows join), not from the rows' slot
-    pairs, which counted a 10,000-point trilateration grid's factor 11 times too large and
-    refused a 50,000-point one at every chunk (it ran in 1.3 GiB)."""
+    """Bytes one Monte-Carlo chunk of the sparse path holds at once
+    (:func:`sim.mc.network_size.sparse_chunk_bytes`: the trials' readings, residuals and
+    steps, the factor and its selected inverse by nonzeros). The factor's nonzeros follow from
+    ``N``'s own (the distinct pairs of estimated unknowns the rows join), not from the rows'
+    slot pairs, which counted a 10,000-point trilateration grid's factor 11 times too large
+    and refused a 50,000-point one at every chunk (it ran in 1.3 GiB)."""
     cols = pattern(net)
-    s = cols.shape[1]
     held = [net.i_constant] * (not net.estimate_constant) + [net.i_scale] * (not net.estimate_scale)
     nnz_n = lsq_sparse.normals_nonzeros(np.where(np.isin(cols, held), -1, cols), net.q)
-    nnz_l = lsq_sparse.factor_nonzeros(net.q, nnz_n)
-    return 3.0 * 8 * (chunk * net.m * (s + 3) + 3 * chunk * net.q) + 3 * 16 * nnz_l
+    return sparse_chunk_bytes(chunk, net.m, net.q, lsq_sparse.factor_nonzeros(net.q, nnz_n))
 
 
 def _pairs(net: Network) -> np.ndarray:
