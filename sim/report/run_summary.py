@@ -150,8 +150,8 @@ def converged_line(out: Path) -> str | None:
 
 def _summary_converged(p: Path) -> str | None:
     """The line of a ``summary.parquet`` with ``trials`` and ``converged`` (the network
-    kind's): its Monte-Carlo estimates are of the converged trials alone, and a run of which
-    31 of 40 trials did not converge said so only in its README's summary sentence (lead32)."""
+    kind's): a run of which 31 of 40 trials did not converge said so only in its README's
+    summary sentence and its claims' notes (lead32)."""
     if not p.is_file() or not {"trials", "converged"} <= set(pq.read_schema(p).names):
         return None
     t = pq.read_table(p, columns=["trials", "converged"]).to_pylist()
@@ -161,8 +161,8 @@ def _summary_converged(p: Path) -> str | None:
     if ok >= n:
         return None
     return (
-        f"not converged: {n - ok:,} of {n:,} trials, left out of the Monte-Carlo estimates "
-        f"(they are of the {ok:,} that converged)"
+        f"not converged: {n - ok:,} of {n:,} trials (the claims' notes say how each "
+        "Monte-Carlo estimate takes them)"
     )
 
 
