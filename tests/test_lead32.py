@@ -20,7 +20,7 @@ def _refused(capsys, args) -> str:
 
 def _trilateration(tmp_path: Path, half_extent_mm: float) -> Path:
     """300 random points (600 unknowns: the sparse path), 8 nearest distances of 1 mm and
-    directions: a half extent of 1 m puts the closest pair 3 mm apart."""
+    directions: a half extent of 1 m puts the closest pair 6 mm apart."""
     p = tmp_path / "tri.toml"
     p.write_text(
         'study = "network"\ntrials = 40\nchunk = 2\nseed = 5\n[network]\n'
@@ -40,18 +40,18 @@ def test_a_network_too_far_from_linear_is_refused_at_check_naming_its_weakest_si
     # then refused naming solver.max_iter, which no limit helps (200 did not)
     err = _refused(capsys, ["check", str(_trilateration(tmp_path, 1000.0))])
     assert err.startswith("sim: error: network.generate: none of 16 probe trials converged"), err
-    assert "the distance from 'P82' to 'P150', is 3.006 mm long" in err, err
+    assert "the distance from 'P152' to 'P204', is 6.437 mm long" in err, err
     assert "place the points further apart" in err and "raise solver.max_iter" not in err
 
 
 def test_a_network_run_says_how_many_trials_did_not_converge(tmp_path, capsys):
-    # before: 36 of 40 trials left out of the estimates was said only in the README's
+    # before: 29 of 40 trials left out of the estimates was said only in the README's
     # summary sentence and the claims' notes; `sim run`'s closing lines and `sim show` said
     # nothing (docs/cli.md: "how many trials had an adjustment that did not converge")
     out = tmp_path / "out"
-    args = ["run", str(_trilateration(tmp_path, 5000.0)), "--out", str(out), "--no-figures"]
+    args = ["run", str(_trilateration(tmp_path, 8000.0)), "--out", str(out), "--no-figures"]
     assert main(args) == 0
-    line = "not converged: 36 of 40 trials (the claims' notes say how each Monte-Carlo"
+    line = "not converged: 29 of 40 trials (the claims' notes say how each Monte-Carlo"
     assert line in capsys.readouterr().out
     assert main(["show", str(out)]) == 0
     assert line in capsys.readouterr().out
@@ -119,11 +119,50 @@ def test_a_networks_shares_are_not_decided_on_the_trials_that_converged_alone(tm
     import pyarrow.parquet as pq
 
     out = tmp_path / "out"
-    f = str(_trilateration(tmp_path, 5000.0))
+    f = str(_trilateration(tmp_path, 8000.0))
     assert main(["run", f, "--out", str(out), "--no-figures", "--quiet"]) == 0
     rows = {r["claim"]: r for r in pq.read_table(out / "claims.parquet").to_pylist()}
     for claim in ("network.coverage95.mean", "network.global_test.false_alarm"):
         r = rows[claim]
-        assert r["ci_low"] < 0.2 and r["ci_high"] > 0.8, r
+        assert r["ci_low"] <= 11 / 40 and r["ci_high"] >= 29 / 40, r  # either outcome
         assert r["verdict"] == "self-check" and r["outcome"] == "inconclusive", r
-        assert "36 trials that did not converge" in r["note"], r["note"]
+        assert "29 trials that did not converge" in r["note"], r["note"]
+
+
+def _points_of(xml: Path) -> list[str]:
+    return [ln.strip() for ln in xml.read_text(encoding="utf-8").splitlines() if "<point " in ln]
+
+
+def test_a_random_networks_layout_is_one_network_across_seeds_and_sweep_cells(tmp_path, capsys):
+    # before: the layout was drawn from `seed`, so each cell of a sweep (its own seed, after
+    # the cells were validated at the study's) and each `--seed` drew another network: a sweep
+    # over a sigma compared networks of other geometries. network.layout_seed draws it now
+    f = tmp_path / "rsw.toml"
+    f.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\nseed = 5\n[network]\n'
+        'random = [ { prefix = "P", n = 30, half_extent_mm = 5000.0 } ]\n'
+        'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 6, '
+        'sigma_mm = 1.0 } ]\n[datum]\nkind = "inner"\n[sweep]\n'
+        '"network.generate" = [[{ kind = "distance", from = "P*", to = "P*", nearest = 6, '
+        'sigma_mm = 1.0 }], [{ kind = "distance", from = "P*", to = "P*", nearest = 6, '
+        "sigma_mm = 2.0 }]]\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "sweep"
+    assert main(["run", str(f), "--out", str(out), "--no-figures", "--quiet"]) == 0
+    a, b = (_points_of(out / "cells" / c / "network.xml") for c in ("cell0000_r0", "cell0001_r0"))
+    assert a == b and len(a) == 30
+    one = tmp_path / "one.toml"
+    one.write_text(f.read_text(encoding="utf-8").split("[sweep]")[0], encoding="utf-8")
+    runs = {}
+    for name, extra in (
+        ("s5", []),
+        ("s6", ["--seed", "6"]),
+        ("l2", ["--set", "network.layout_seed=2"]),
+    ):
+        o = tmp_path / name
+        assert main(["run", str(one), "--out", str(o), "--no-figures", "--quiet", *extra]) == 0
+        runs[name] = _points_of(o / "network.xml")
+    assert runs["s5"] == runs["s6"] == a  # another seed: other noise, the same network
+    assert runs["l2"] != a  # another layout seed: another network
+    capsys.readouterr()

@@ -394,9 +394,13 @@ def _check_readings(cfg: dict, beta: float, names, xy, kind, i, j, bias, ends) -
 
 
 def build(cfg: dict, rng: np.random.Generator | None = None) -> Network:
-    """The :class:`Network` of a validated study config (``rng``: the layout stream)."""
+    """The :class:`Network` of a validated study config (``rng``: the layout stream; by
+    default ``network.layout_seed``'s, never the run's ``seed``: a sweep's cells and
+    replicates, validated at the study's seed and run at their own, each drew another layout
+    of its random points, so a sweep over a sigma compared networks of other geometries)."""
     if rng is None:
-        rng = np.random.default_rng(np.random.SeedSequence(cfg["seed"], spawn_key=(99,)))
+        seed = cfg.get("network.layout_seed", 1)
+        rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(99,)))
     names, xy, role, csig = _points(cfg, rng)
     origin = _origin(xy)
     xy = xy - origin

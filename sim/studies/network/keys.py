@@ -61,8 +61,21 @@ SCHEMA = {
             [],
             "records",
             "random points {prefix, n, half_extent_mm | half_extent_m, center_mm | center_m, "
-            "role, sigma_mm}, drawn once from the seed",
+            "role, sigma_mm}, drawn once from network.layout_seed",
         )
+    ),
+    "network.layout_seed": unless(
+        Field(
+            1,
+            "int",
+            "seed of the random points' layout, apart from seed: --seed, replicates and "
+            "sweep cells draw new noise on one network (sweep this key to compare layouts)",
+            lo=0,
+            hi=2**63 - 1,
+        ),
+        "network.random",
+        [],
+        says="with random points (network.random)",
     ),
     "network.observations": _own(
         Field(
