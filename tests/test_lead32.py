@@ -166,3 +166,18 @@ def test_a_random_networks_layout_is_one_network_across_seeds_and_sweep_cells(tm
     assert runs["s5"] == runs["s6"] == a  # another seed: other noise, the same network
     assert runs["l2"] != a  # another layout seed: another network
     capsys.readouterr()
+
+
+def test_brown_s_random_plate_is_one_plate_across_seeds():
+    # the same class in Brown's studies: the random pattern was drawn from `seed`, so a sweep's
+    # cells and `--seed` measured other plates; plate.layout_seed draws it now
+    import numpy as np
+
+    import sim
+    from sim.studies.brown.schema import points_of
+
+    over = {"plate.pattern": "random", "plate.random_half_extent_mm": 100.0}
+    f = STUDIES / "brown_table1.toml"
+    a, b = (points_of(sim.load(f, seed=s, **over).config) for s in (5, 6))
+    c = points_of(sim.load(f, seed=5, plate__layout_seed=2, **over).config)
+    assert np.array_equal(a, b) and not np.array_equal(a, c)

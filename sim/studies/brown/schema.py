@@ -63,7 +63,16 @@ BASE = {
     ),
     "plate.n_random": _random(count(25, "number of points of the random pattern", lo=3, hi=100000)),
     "plate.random_half_extent_mm": _random(
-        positive(110.0, "random points lie in |x|,|y| <= this", unit="mm")
+        positive(100.0, "random points lie in |x|,|y| <= this", unit="mm")
+    ),
+    "plate.layout_seed": _random(
+        count(
+            1,
+            "seed of the random pattern's points, apart from seed: --seed, replicates and "
+            "sweep cells draw new noise on one plate (sweep this key to compare plates)",
+            lo=0,
+            hi=2**63 - 1,
+        )
     ),
     "plate.points": when(
         Field([], "points", "explicit point list [[x, y], ...] for pattern 'list'"),
@@ -217,7 +226,10 @@ def range_sigma_um(cfg: dict) -> float:
 
 
 def points_of(cfg: dict) -> np.ndarray:
-    """The plate's points (n, 2) mm; a random pattern is drawn once from stream part 99."""
+    """The plate's points (n, 2) mm; a random pattern is drawn once from stream part 99 of
+    ``plate.layout_seed``, never of the run's ``seed``: a sweep's cells (validated at the
+    study's seed, run at their own) and ``--seed`` each drew another plate, so a sweep over an
+    error compared plates of other layouts."""
     return pattern_points(
         cfg["plate.pattern"],
         grid=cfg["plate.grid"],
@@ -225,7 +237,7 @@ def points_of(cfg: dict) -> np.ndarray:
         n_random=cfg["plate.n_random"],
         half_extent_mm=cfg["plate.random_half_extent_mm"],
         points=cfg["plate.points"],
-        rng=chunk_rng(cfg["seed"], 99, 0),
+        rng=chunk_rng(cfg["plate.layout_seed"], 99, 0),
     )
 
 
