@@ -68,8 +68,8 @@ BASE = {
     "plate.layout_seed": _random(
         count(
             1,
-            "seed of the random pattern's points, apart from seed: --seed, replicates and "
-            "sweep cells draw new noise on one plate (sweep this key to compare plates)",
+            "seed of the random pattern's points, apart from seed: --seed, replicates and a "
+            "sweep's cells draw new noise on one plate (sweep this key to compare plates)",
             lo=0,
             hi=2**63 - 1,
         )

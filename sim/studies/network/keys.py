@@ -68,8 +68,8 @@ SCHEMA = {
         Field(
             1,
             "int",
-            "seed of the random points' layout, apart from seed: --seed, replicates and "
-            "sweep cells draw new noise on one network (sweep this key to compare layouts)",
+            "seed of the random points' layout, apart from seed: --seed, replicates and a "
+            "sweep's cells draw new noise on one network (sweep this key to compare layouts)",
             lo=0,
             hi=2**63 - 1,
         ),
