@@ -48,7 +48,11 @@ from sim.stops import run_program  # noqa: E402
 def main() -> int:
     """The ``sim`` program (``python -m sim``, the ``sim`` script): the command line, and a
     stop signal after it returned ends the process with its exit code (:mod:`sim.stops`)."""
-    if not die_with_parent():  # a child of python -m sim.batch or make verify that died
+    if (gone := die_with_parent()) is not None:  # a child of sim.batch or make verify that died
+        try:
+            print(f"sim: {gone}", file=sys.stderr)
+        except (OSError, ValueError):  # no one reads it: the driver died
+            pass
         return 130
     words = script_of_another_copy()  # copy/.venv/bin/sim: the original's code, not the copy's
     if words is not None:

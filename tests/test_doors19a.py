@@ -136,7 +136,7 @@ _CHILD = """
 import signal, sys, time
 from sim.mc.children import die_with_parent
 signal.signal(signal.SIGTERM, lambda *a: (print("stopped", flush=True), sys.exit(130)))
-print("ready" if die_with_parent() else "orphan", flush=True)
+print("ready" if die_with_parent() is None else "orphan", flush=True)
 time.sleep(60)
 """
 

@@ -181,3 +181,23 @@ def test_brown_s_random_plate_is_one_plate_across_seeds():
     a, b = (points_of(sim.load(f, seed=s, **over).config) for s in (5, 6))
     c = points_of(sim.load(f, seed=5, plate__layout_seed=2, **over).config)
     assert np.array_equal(a, b) and not np.array_equal(a, c)
+
+
+def test_a_drivers_variable_left_set_in_a_shell_is_named_not_a_silent_exit():
+    # before: SIM_STOP_WITH_PARENT (set by sim.batch and make verify for their runs) left set
+    # in a shell ended every `sim` command with status 130 and not a word
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "SIM_STOP_WITH_PARENT": "2"}
+    p = subprocess.run(
+        [sys.executable, "-m", "sim", "check", str(STUDIES / "wolf_polynomial.toml")],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert p.returncode == 130 and p.stdout == ""
+    assert p.stderr.startswith("sim: stopped: SIM_STOP_WITH_PARENT=2 names the program"), p.stderr
+    assert len(p.stderr.splitlines()) == 1

@@ -46,20 +46,26 @@ def child_env() -> dict:
     return {**os.environ, PARENT_ENV: str(os.getpid())}
 
 
-def die_with_parent() -> bool:
+def die_with_parent() -> str | None:
     """In a child run started with :func:`child_env`: be sent SIGTERM when the driver dies
-    (PR_SET_PDEATHSIG, Linux). False when the driver is gone already (the child should end
-    at once without a word: no one reads it)."""
+    (PR_SET_PDEATHSIG, Linux). None to go on; when the driver is gone already, why the child
+    ends at once (one line: the variable left set in a shell, ``export
+    SIM_STOP_WITH_PARENT=2``, ended every ``sim`` with status 130 and not a word)."""
     want = os.environ.pop(PARENT_ENV, "")
     if not want.isdigit() or not sys.platform.startswith("linux"):
-        return True
+        return None
     try:
         import ctypes
 
         ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG = 1
     except (OSError, AttributeError):
-        return True
-    return os.getppid() == int(want)
+        return None
+    if os.getppid() == int(want):
+        return None
+    return (
+        f"stopped: {PARENT_ENV}={want} names the program that started this run, and it has "
+        "ended (a driver's variable, left set in your shell? unset it)"
+    )
 
 
 def ended(code: int) -> str:
