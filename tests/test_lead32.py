@@ -201,3 +201,50 @@ def test_a_drivers_variable_left_set_in_a_shell_is_named_not_a_silent_exit():
     assert p.returncode == 130 and p.stdout == ""
     assert p.stderr.startswith("sim: stopped: SIM_STOP_WITH_PARENT=2 names the program"), p.stderr
     assert len(p.stderr.splitlines()) == 1
+
+
+def test_a_sweep_whose_first_key_is_text_and_has_a_second_key_draws_its_figure(tmp_path, capsys):
+    # before: the figure's second panel read the first panel's tick labels as the legend's
+    # texts: "the run failed in sim.execute.run_sweep: TypeError: string indices must be
+    # integers", exit 3, no results at all
+    f = tmp_path / "sw.toml"
+    f.write_text(
+        (STUDIES / "network_testfield.toml").read_text(encoding="utf-8")
+        + '\n[sweep]\n"datum.kind" = ["fixed", "inner"]\n"reliability.alpha0" = [0.001, 0.01]\n',
+        encoding="utf-8",
+    )
+    out = tmp_path / "out"
+    assert main(["run", str(f), "--trials", "40", "--out", str(out), "--quiet"]) == 0
+    assert (out / "sweep.png").is_file() and len(list((out / "cells").iterdir())) == 4
+
+
+def test_the_sweep_figure_labels_tiny_values_and_integer_keys_readably(tmp_path, monkeypatch):
+    # before: a claim zero but for rounding (Brown's bias invariance, 3e-13 mm) had every y
+    # label "0.000000000000000"; a swept integer (errors.settings, a layout seed) had ticks
+    # at 1.25 and 1.5 of it
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from sim.report import sweep as sweep_fig
+
+    t = pa.table(
+        {
+            "errors.settings": [1, 2, 3],
+            "replicate": [0, 0, 0],
+            "feasible": [True, True, True],
+            "a.tiny_mm": [2e-13, 5e-13, 3e-13],
+            "a.tiny_mm:lo": [2e-13, 5e-13, 3e-13],
+            "a.tiny_mm:hi": [2e-13, 5e-13, 3e-13],
+        }
+    )
+    meta = {b"sim.provenance": b'{"sweep_keys": ["errors.settings"]}'}
+    pq.write_table(t.replace_schema_metadata(meta), tmp_path / "sweep.parquet")
+    drawn = []
+    monkeypatch.setattr(sweep_fig, "save", lambda fig, png: drawn.append(fig) or png)
+    assert sweep_fig.fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png") is not None
+    ax = drawn[0].axes[0]
+    drawn[0].canvas.draw()
+    ys = [x.get_text() for x in ax.get_yticklabels() if x.get_text()]
+    assert len(set(ys)) == len(ys) > 1 and any("×10" in y for y in ys), ys
+    xs = [x.get_text() for x in ax.get_xticklabels() if x.get_text()]
+    assert xs and all(x.lstrip("−-").isdigit() for x in xs), xs

@@ -8,10 +8,18 @@ import itertools
 from pathlib import Path
 
 import numpy as np
+from matplotlib import ticker
 
 from sim.mc.publish import drawn
 from sim.mc.storage import read_provenance
-from sim.report.plotting import figures_off, place_legends, plt, readable_limits, save
+from sim.report.plotting import (
+    figures_off,
+    place_legends,
+    plt,
+    readable_limits,
+    save,
+    times_ten,
+)
 from sim.report.read import columns
 from sim.report.tables import fmt, md_table
 
@@ -125,6 +133,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         return None
     first = t[keys[0]]
     numeric = all(isinstance(v, (int, float)) for v in first)
+    whole = numeric and all(isinstance(v, int) and not isinstance(v, bool) for v in first)
     ticks = list(dict.fromkeys(repr(v) for v in first))  # text, list values: one place each
     x = np.array([float(v) for v in first] if numeric else [ticks.index(repr(v)) for v in first])
     other = [tuple(t[k][i] for k in keys[1:]) for i in range(len(x))]
@@ -182,11 +191,17 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             ) > 0.5 else None
         readable_limits(ax, "y")
         ax.ticklabel_format(axis="both", useOffset=False, style="plain")
+        _powers_when_tiny(ax)
+        if whole:  # an integer key (settings, a seed) at 1, 2, 3: no tick at 1.25 of it
+            ax.xaxis.set_major_locator(ticker.MaxNLocator(integer=True))
         if not numeric:  # at most 25 labels, upright when few: 50 overlapped in a smear, and
             step = -(-len(ticks) // 25)  # cut at their ends they all read the same
             pos = list(range(0, len(ticks), step))
-            shown = [_middle(ticks[i], 16) for i in pos]
-            ax.set_xticks(pos, shown, fontsize=7, rotation=90 if len(pos) > 6 else 0)
+            # (named apart from ``shown``, the other keys' texts the next panel's legend
+            # reads: a text first key and a second key failed the whole sweep at its
+            # second panel, "string indices must be integers")
+            at = [_middle(ticks[i], 16) for i in pos]
+            ax.set_xticks(pos, at, fontsize=7, rotation=90 if len(pos) > 6 else 0)
         ax.set_title(c, fontsize=8, wrap=True)
         ax.set_xlabel(xlabel, fontsize=8)
         ax.set_ylabel(_y_label(c, prop), fontsize=8)
@@ -195,6 +210,15 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     if other[0]:  # once every panel is drawn: the layout is final
         place_legends([a for a in axs.ravel()[: len(claims)] if a not in empty], handlelength=3)
     return save(fig, png)
+
+
+def _powers_when_tiny(ax) -> None:
+    """Tick labels of a y axis whose values all lie below 1e-3 in magnitude (a claim zero but
+    for rounding, 1e-16 mm) as ``2.0×10⁻¹⁷``: plain, every label of Brown's bias-invariance
+    panels read ``0.000000000000000``."""
+    lo, hi = ax.get_ylim()
+    if 0 < max(abs(lo), abs(hi)) < 1e-3:
+        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: times_ten(v, 2)))
 
 
 def sweep_markdown(out: Path, name: str | None = None) -> str:
