@@ -248,3 +248,12 @@ def test_the_sweep_figure_labels_tiny_values_and_integer_keys_readably(tmp_path,
     assert len(set(ys)) == len(ys) > 1 and any("×10" in y for y in ys), ys
     xs = [x.get_text() for x in ax.get_xticklabels() if x.get_text()]
     assert xs and all(x.lstrip("−-").isdigit() for x in xs), xs
+
+
+def test_readings_whose_average_is_too_precise_are_named_as_such(capsys):
+    # before: "1,000,000 readings of sigma 1e-09 mm: over 1,000,000 or an averaged sigma under
+    # 1e-09 mm", of a count that is not over 1,000,000
+    obs = '[{kind="distance",from="N6",to="N7",sigma_mm=1e-9,settings=1000000}]'
+    f = str(STUDIES / "network_testfield.toml")
+    err = _refused(capsys, ["check", f, "--set", f"network.observations={obs}"])
+    assert "average to sigma 1e-12 mm, under 1e-09 mm" in err and "over 1,000,000" not in err

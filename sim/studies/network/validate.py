@@ -281,11 +281,17 @@ def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
     if "set" in rec:
         _point_name(f"{key}.set", rec["set"])
     settings = _num(f"{key}.settings", rec.get("settings", 1), 1, integer=True)
-    if not settings <= MAX_SETTINGS or not lo <= sig / math.sqrt(settings):
+    if not settings <= MAX_SETTINGS:
         raise ConfigError(
             f"{key}.settings",
-            f"{int(settings):,} readings of sigma {sig:g} {unit}: over {MAX_SETTINGS:,} or an "
-            f"averaged sigma under {lo:g} {unit}",
+            f"{int(settings):,} readings of sigma {sig:g} {unit}: over {MAX_SETTINGS:,}",
+        )
+    if not lo <= sig / math.sqrt(settings):  # (said "over 1,000,000 or ..." of 1,000,000)
+        raise ConfigError(
+            f"{key}.settings",
+            f"{int(settings):,} readings of sigma {sig:g} {unit} average to sigma "
+            f"{sig / math.sqrt(settings):.3g} {unit}, under {lo:g} {unit}: its weight would "
+            "overflow",
         )
     bias = _num(f"{key}.bias_{unit}", rec.get(f"bias_{unit}", 0.0))
     if not abs(bias) <= hi:
