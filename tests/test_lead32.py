@@ -257,3 +257,17 @@ def test_readings_whose_average_is_too_precise_are_named_as_such(capsys):
     f = str(STUDIES / "network_testfield.toml")
     err = _refused(capsys, ["check", f, "--set", f"network.observations={obs}"])
     assert "average to sigma 1e-12 mm, under 1e-09 mm" in err and "over 1,000,000" not in err
+
+
+def test_a_value_equal_as_shown_is_not_named_a_change_by_any_of_the_three_rules():
+    # before: the Configuration line compared with `!=`: a swept 1.1 + 0.6 was named changed
+    # from 1.7 while the inputs table and the claims' off-setup note read it as 1.7
+    from sim.claims.rules import same_as_shown
+    from sim.report.config_diff import changed_keys
+
+    assert (
+        changed_keys({"a": 1.1 + 0.6, "b": 4, "c": [0.1 + 0.2]}, {"a": 1.7, "b": 4.0, "c": [0.3]})
+        == []
+    )
+    assert changed_keys({"a": 1.7001, "t": True}, {"a": 1.7, "t": 1}) == ["a", "t"]
+    assert same_as_shown({"x": 0.1 + 0.2}, {"x": 0.3}) and not same_as_shown("1", 1)

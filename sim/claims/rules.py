@@ -90,6 +90,7 @@ import numpy as np
 
 __all__ = [
     "FORMS",
+    "same_as_shown",
     "KINDS",
     "VERDICTS",
     "P_FAIL",
@@ -191,9 +192,19 @@ def holds_of(verdict: str):  # depends / undecidable (over a region, sim.claims.
 def _shown(v: Any) -> str:  # 12 digits: a printed 12.700082809 and a change in its 7th show
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_shown(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k!r}: {_shown(x)}" for k, x in v.items()) + "}"
     if isinstance(v, float):
         return f"{v:.12g}"
     return repr(v) if isinstance(v, str) else str(v)
+
+
+def same_as_shown(a: Any, b: Any) -> bool:
+    """Whether two config values are one value as 12 significant digits show them (a swept
+    1.1 + 0.6 = 1.7000000000000002 is 1.7; 4 and 4.0 are one; True and 1 are not): the one
+    rule of a run's README, ``sim show`` and the claims for "this run changed a value"
+    (the Configuration line compared with ``!=`` and named 1.7000000000000002 a change)."""
+    return _shown(a) == _shown(b)
 
 
 def printed_differs(
@@ -213,7 +224,7 @@ def printed_differs(
     cfg = as_printed(dict(cfg)) if as_printed is not None else cfg
     out = []
     for k, f in schema.items():
-        if getattr(f, "printed", False) and _shown(cfg.get(k, f.default)) != _shown(f.default):
+        if getattr(f, "printed", False) and not same_as_shown(cfg.get(k, f.default), f.default):
             out.append(f"{k} = {_shown(cfg[k])} (paper: {_shown(f.default)})")
     return out
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping
 
+from sim.claims.rules import same_as_shown
 from sim.report.inputs import as_set
 
 __all__ = ["changed_keys", "changes_text", "design_of", "config_line"]
@@ -21,9 +22,10 @@ _NOT_SETTINGS = {"sweep"}
 
 
 def changed_keys(mine: Mapping[str, Any], base: Mapping[str, Any]) -> list[str]:
-    """The keys whose value in ``mine`` is not the one in ``base`` (either may lack it)."""
+    """The keys whose value in ``mine`` is not the one in ``base`` (either may lack it), as
+    :func:`sim.claims.rules.same_as_shown` tells values apart."""
     keys = sorted((set(mine) | set(base)) - _NOT_SETTINGS)
-    return [k for k in keys if mine.get(k) != base.get(k)]
+    return [k for k in keys if not same_as_shown(mine.get(k), base.get(k))]
 
 
 def changes_text(mine: Mapping[str, Any], base: Mapping[str, Any], limit: int = 6) -> str:
