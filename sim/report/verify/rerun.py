@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -148,6 +149,13 @@ def rerun_study(
         # reproduction (it was recorded as one, "FAILED; nothing compared", exit 1; with
         # --trials it was "the re-run refused its options")
         raise VerifyError(f"{d.name}: the re-run could not run here: {lines[-1]}")
+    held = re.search(r"is being written by a running sim \(([^)]*)\)", lines[-1]) if lines else None
+    if proc.returncode == 2 and held:  # another verify re-runs into the same --scratch now:
+        # said "the re-run refused its options ... choose another --out", an option not given
+        raise VerifyError(
+            f"{d.name}: --scratch: {target} is being written by another run now ({held[1]}): "
+            "wait for it to finish, or give another --scratch"
+        )
     if proc.returncode == 2 and lines and (extra or lines[-1].startswith("sim: error: --")):
         # the re-run refused the options verify passed (--trials, --set, --workers, the
         # --out under --scratch): a request error, not a failed comparison to record
