@@ -271,6 +271,7 @@ def test_a_value_equal_as_shown_is_not_named_a_change_by_any_of_the_three_rules(
     )
     assert changed_keys({"a": 1.7001, "t": True}, {"a": 1.7, "t": 1}) == ["a", "t"]
     assert same_as_shown({"x": 0.1 + 0.2}, {"x": 0.3}) and not same_as_shown("1", 1)
+    assert same_as_shown([{"a": 1, "b": 2.0}], [{"b": 2, "a": 1}])  # a record's keys in any order
 
 
 def test_a_scratch_another_verify_writes_now_is_said_so(tmp_path, monkeypatch, capsys):

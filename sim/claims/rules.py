@@ -193,7 +193,7 @@ def _shown(v: Any) -> str:  # 12 digits: a printed 12.700082809 and a change in 
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_shown(x) for x in v) + "]"
     if isinstance(v, dict):
-        return "{" + ", ".join(f"{k!r}: {_shown(x)}" for k, x in v.items()) + "}"
+        return "{" + ", ".join(f"{k!r}: {_shown(v[k])}" for k in sorted(v, key=str)) + "}"
     if isinstance(v, float):
         return f"{v:.12g}"
     return repr(v) if isinstance(v, str) else str(v)
