@@ -302,3 +302,14 @@ def test_a_scratch_another_verify_writes_now_is_said_so(tmp_path, monkeypatch, c
     assert rc == 2 and len(err) == 1, err
     assert "is being written by another run now (pid 4242)" in err[0], err
     assert "give another --scratch" in err[0] and "--out" not in err[0], err
+
+
+def test_the_committed_results_are_of_their_study_files_configurations():
+    # the project's results are made from studies/<name>.toml as written: their READMEs carry
+    # no Configuration line (a rule comparing records by their keys' order named every
+    # network's records changed)
+    results = STUDIES.parent / "results"
+    named = [d for d in sorted(results.iterdir()) if (STUDIES / f"{d.name}.toml").is_file()]
+    assert len(named) >= 12
+    for d in named:
+        assert "**Configuration.**" not in (d / "README.md").read_text(encoding="utf-8"), d.name
