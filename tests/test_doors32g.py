@@ -23,6 +23,9 @@ name and value as written.
   handler compares names exactly) over bytes beyond ASCII was decoded by Python's
   codec, where ``gama-local`` reads the bytes as ISO-8859-1: a point ``И`` here was ``é`` there. Now refused in one line naming the encoding; an ASCII
   file under any declaration, and the encodings ``gama-local`` knows, are read.
+* ``<parameters language="en" encoding="utf-8">`` was read: those are options of
+  ``gama-local``'s command line, and its parser (and ``gama-local.xsd``) refuses them on
+  ``<parameters>``. Now an unknown attribute, one line.
 * A no-break space (U+00A0) as text between elements was taken for white space (Python's
   ``strip()``); ``gama-local`` refuses it (``isspace`` of the C locale): now refused.
 """
@@ -99,6 +102,12 @@ def test_a_foreign_prefixed_attribute_is_refused_in_one_line(tmp_path, capsys):
 )
 def test_a_keyword_with_white_space_around_is_refused(tmp_path, old, new, needles):
     _refused(tmp_path, SOURCE.replace(old, new, 1), *needles)
+
+
+@pytest.mark.parametrize("attr", ['language="en"', 'encoding="utf-8"'])
+def test_a_command_line_option_on_parameters_is_refused(tmp_path, attr):
+    xml = SOURCE.replace('<parameters sigma-apr="1"', f'<parameters {attr} sigma-apr="1"')
+    _refused(tmp_path, xml, "<parameters>", repr(attr.split("=")[0]), "unknown attribute")
 
 
 def test_numbers_with_white_space_around_are_still_read(tmp_path):

@@ -70,7 +70,8 @@ def words(v: str | None) -> list[str]:
 
 
 _XYZ = ("xy", "XY", "z", "Z", "xyz", "XYZ", "XYz", "xyZ")
-#: gama-local's vocabulary: element -> its attributes
+#: gama-local's vocabulary: element -> its attributes (``language`` and ``encoding`` are options
+#: of its command line, which its parser refuses on ``<parameters>``: unknown here too)
 VOCAB = {
     "gama-local": {"version"},
     "network": {"axes-xy", "angles", "epoch"},
@@ -82,8 +83,6 @@ VOCAB = {
         "sigma-act",
         "update-constrained-coordinates",
         "algorithm",
-        "language",
-        "encoding",
         "angles",
         "latitude",
         "ellipsoid",
@@ -142,8 +141,6 @@ _CHOICES = {
     ("parameters", "sigma-act"): ("aposteriori", "apriori"),
     ("parameters", "update-constrained-coordinates"): ("yes", "no"),
     ("parameters", "algorithm"): ("gso", "svd", "cholesky", "envelope"),
-    ("parameters", "language"): tuple("en ca cz du es fi fr hu ru ua zh".split()),
-    ("parameters", "encoding"): ("utf-8", "iso-8859-2", "iso-8859-2-flat", "cp-1250", "cp-1251"),
     ("parameters", "angles"): ("400", "360"),
     ("point", "fix"): _XYZ,
     ("point", "adj"): _XYZ,
