@@ -121,6 +121,13 @@ def _refuse(net: Network) -> None:
         )
     if net.estimate_scale:
         raise ConfigError("network.estimate_scale", "gama-local has no scale unknown")
+    # gama-local's PointID makes a run of spaces one space: "A  B" would be read as "A B"
+    if nm := next((nm for nm in net.names if "  " in nm), None):
+        raise ConfigError(
+            "network.points",
+            f"point {nm!r}: gama-local reads a run of spaces in an id as one space "
+            f"({' '.join(nm.split())!r}): name the point with single spaces",
+        )
 
 
 def _vector_pairs(net: Network) -> list[tuple[int, int]]:

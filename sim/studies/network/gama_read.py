@@ -319,6 +319,8 @@ def _network(f: _File, data: bytes):
         raise ConfigError(key, f"{path} is not XML: {e}") from None
     except (LookupError, ValueError) as e:  # an unknown encoding declared, undecodable bytes
         raise ConfigError(key, f"{path} cannot be decoded: {e}") from None
+    if why := vocab.raw_name_problem(data) or vocab.encoding_problem(data):  # as gama-local
+        raise ConfigError(key, f"{path}: {why}")
     if _tag(root) != "gama-local":
         raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
     f.vocab(root)

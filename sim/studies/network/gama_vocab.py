@@ -19,7 +19,19 @@ from sim.mc.numtext import UnheldError, float_text
 from sim.mc.paths import link_problem
 from sim.studies.network.validate import _point_name
 
-__all__ = ["NS", "CC", "MAX_BYTES", "VOCAB", "read_bytes", "ws", "words", "said", "entity_declared"]
+__all__ = [
+    "NS",
+    "CC",
+    "MAX_BYTES",
+    "VOCAB",
+    "read_bytes",
+    "ws",
+    "words",
+    "said",
+    "entity_declared",
+    "raw_name_problem",
+    "encoding_problem",
+]
 
 NS = "http://www.gnu.org/software/gama/gama-local"
 CC = math.pi / 200 / 10000  # one centesimal second in rad
@@ -58,7 +70,8 @@ def words(v: str | None) -> list[str]:
 
 
 _XYZ = ("xy", "XY", "z", "Z", "xyz", "XYZ", "XYz", "xyZ")
-#: gama-local's vocabulary: element -> its attributes
+#: gama-local's vocabulary: element -> its attributes (``language`` and ``encoding`` are options
+#: of its command line, which its parser refuses on ``<parameters>``: unknown here too)
 VOCAB = {
     "gama-local": {"version"},
     "network": {"axes-xy", "angles", "epoch"},
@@ -70,8 +83,6 @@ VOCAB = {
         "sigma-act",
         "update-constrained-coordinates",
         "algorithm",
-        "language",
-        "encoding",
         "angles",
         "latitude",
         "ellipsoid",
@@ -130,8 +141,6 @@ _CHOICES = {
     ("parameters", "sigma-act"): ("aposteriori", "apriori"),
     ("parameters", "update-constrained-coordinates"): ("yes", "no"),
     ("parameters", "algorithm"): ("gso", "svd", "cholesky", "envelope"),
-    ("parameters", "language"): tuple("en ca cz du es fi fr hu ru ua zh".split()),
-    ("parameters", "encoding"): ("utf-8", "iso-8859-2", "iso-8859-2-flat", "cp-1250", "cp-1251"),
     ("parameters", "angles"): ("400", "360"),
     ("point", "fix"): _XYZ,
     ("point", "adj"): _XYZ,
@@ -181,8 +190,11 @@ class _File:
         v = e.get(attr, default)
         if v is None or not ws(v):
             raise self.err(e, "missing point name", attr)
+        # gama-local's PointID trims the id and makes each run of white space one space:
+        # "A  B" and "A B" are one point there (two points here, read silently, doors32g)
+        v = " ".join(words(v))
         try:
-            return _point_name(attr, ws(v))
+            return _point_name(attr, v)
         except ConfigError as err:
             raise self.err(e, str(err).split(": ", 1)[1], attr) from None
 
@@ -222,10 +234,11 @@ class _File:
                 raise self.err(e, f"not supported: {_REFUSED[t]} (2-D networks only)")
             if t not in VOCAB:
                 raise self.err(e, "unknown element (not in gama-local's vocabulary)")
-            if t not in ("description", "cov-mat") and (e.text or "").strip():
-                raise self.err(e, f"unexpected text {e.text.strip()[:20]!r}")
-            if (e.tail or "").strip() and e is not root:
-                raise self.err(e, f"unexpected text {e.tail.strip()[:20]!r} after it")
+            # XML white space only: gama-local refuses a no-break space between elements
+            if t not in ("description", "cov-mat") and ws(e.text or ""):
+                raise self.err(e, f"unexpected text {ws(e.text)[:20]!r}")
+            if ws(e.tail or "") and e is not root:
+                raise self.err(e, f"unexpected text {ws(e.tail)[:20]!r} after it")
             for a, v in e.attrib.items():
                 if a.startswith("{" + NS + "}"):  # g:fix in gama-local's namespace: not fix
                     raise self.err(e, "an attribute with a namespace prefix: write it plainly", a)
@@ -234,7 +247,7 @@ class _File:
                 if a not in VOCAB[t]:
                     raise self.err(e, "unknown attribute", a)
                 ch = _CHOICES.get((t, a))
-                if ch and ws(v) not in ch:
+                if ch and v not in ch:  # gama-local compares the value as written: " ne" no
                     raise self.err(e, f"{said(v)} is not one of {', '.join(ch)}", a)
 
 
@@ -266,6 +279,75 @@ def entity_declared(data: bytes) -> str | None:
     except (_Prolog, expat.ExpatError, ValueError, LookupError):
         pass
     return found[0] if found else None
+
+
+#: the encodings gama-local decodes: expat's own (any case) and those of gama-local's handler
+#: (``encoding_unknown_handler.cpp``, compared exactly); any other name it reads as ISO-8859-1
+_EXPAT_ENC = ("utf-8", "utf-16", "iso-8859-1", "us-ascii")
+_GAMA_ENC = ("cp-1250", "windows-1250", "cp-1251", "windows-1251", "iso-8859-2")
+_DECL = re.compile(rb"^(?:\xef\xbb\xbf)?<\?xml[^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
+
+
+def encoding_problem(data: bytes) -> str | None:
+    """What makes gama-local read the file's characters otherwise than this reader, or None:
+    a declared encoding gama-local does not know (``koi8-r``, ``ISO-8859-2`` in capitals)
+    over bytes beyond ASCII, which gama-local reads as ISO-8859-1 (``\xe9`` is a point ``é``
+    there, ``И`` here in koi8-r; ``utf8`` fails here as not XML, Python's expat taking only
+    single-byte codecs)."""
+    m = _DECL.match(data[:1024])
+    if not m or data.isascii():
+        return None
+    enc = m.group(1).decode("ascii", "replace")
+    if enc.lower() in _EXPAT_ENC or enc in _GAMA_ENC:
+        return None
+    return (
+        f"<?xml encoding={said(enc)}?>: gama-local does not know this encoding and reads the "
+        "bytes beyond ASCII as ISO-8859-1, other characters than here: declare UTF-8 "
+        f"(or one of {', '.join(_EXPAT_ENC[1:] + _GAMA_ENC)})"
+    )
+
+
+class _Raw(Exception):
+    """The first name gama-local reads otherwise than a namespace-aware parser."""
+
+
+def raw_name_problem(data: bytes) -> str | None:
+    """What ``gama-local`` refuses in the file's names as written, or None. Its parser (expat
+    without namespace processing, ``gkfparser.cpp``) reads each name as it stands, where
+    ElementTree drops a prefix: ``<g:gama-local xmlns:g="...">`` is an unknown element there
+    (the same network here), an attribute of ``<gama-local>`` other than ``xmlns`` and
+    ``version`` (``xmlns:g``, ``xsi:schemaLocation``) is refused, and so is ``xmlns`` or any
+    prefixed attribute (``o:note``) of every other element, which reads its own attributes
+    only. A parse error is left to the reader, which names it."""
+    p = expat.ParserCreate()  # no namespace processing: names as gama-local sees them
+    p.ordered_attributes = True
+    depth = [0]
+
+    def start(name, attrs):
+        if ":" in name:
+            raise _Raw(
+                f"<{name}>: an element name with a namespace prefix (gama-local reads no "
+                f"prefix: write <{name.split(':', 1)[1]}>)"
+            )
+        names = attrs[0::2]
+        for a in names:
+            if depth[0] == 0 and a not in ("xmlns", "version"):
+                raise _Raw(f"<{name}> attribute {said(a)}: gama-local takes only xmlns and version")
+            if depth[0] and (a == "xmlns" or ":" in a):
+                raise _Raw(
+                    f"<{name}> attribute {said(a)}: gama-local refuses a namespace declaration "
+                    "or a prefixed attribute here (only <gama-local> takes xmlns)"
+                )
+        depth[0] += 1
+
+    p.StartElementHandler = start
+    try:
+        p.Parse(data, True)
+    except _Raw as why:
+        return str(why)
+    except (expat.ExpatError, ValueError, LookupError):
+        pass
+    return None
 
 
 def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
