@@ -42,7 +42,7 @@ from sim.mc.storage import (
 from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cells, refused_note
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
-from sim.stops import check_interrupt, keep_lost_interrupts
+from sim.stops import check_interrupt, held_stops, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
 __all__ = ["execute", "run_sweep", "check_sweep", "drop_half_imported"]
@@ -288,17 +288,23 @@ def execute(
             drop_stage(stage, lock, reason=str(e) if failed else None)
         raise
     ex.close()
+    published = False
     try:
         check_interrupt()  # not published: an interrupted run never looks finished
         check_out(out, shown, record, overwrite)  # again, under the lock: ours or absent
         seal(stage, ctx.store)
         if readme is not None:
             readme(stage, out.name)
-        publish(stage, out)
-    except BaseException:
-        drop_stage(stage, lock)
+        with held_stops():  # an interrupt between its renames: handled once they are done
+            publish(stage, out)
+            published = True
+            lock.release()
+    except BaseException as e:
+        if not published:
+            drop_stage(stage, lock)
+        elif isinstance(e, KeyboardInterrupt):  # the results stand: say where, not "resume"
+            e.published = shown
         raise
-    lock.release()
     return est
 
 
