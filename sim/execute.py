@@ -23,6 +23,7 @@ from typing import Any, Callable, Collection, Mapping
 
 import numpy as np
 
+from sim.held_stops import held_stops
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.executors import StartRefused, script_words
@@ -42,7 +43,7 @@ from sim.mc.storage import (
 from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cells, refused_note
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
-from sim.stops import check_interrupt, held_stops, keep_lost_interrupts
+from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
 __all__ = ["execute", "run_sweep", "check_sweep", "drop_half_imported"]

@@ -7,7 +7,7 @@ from threads, stale Results), one case each; each failed on the code before its 
   finish the missing chunks" although the new results were published and complete, and left
   the old results in a hidden directory (``.X.partial`` or ``.X.old.<pid>``) until a next run;
   the API's ``KeyboardInterrupt`` said nothing of them. A stop signal is now held while
-  publishing (:func:`sim.stops.held_stops`) and handled once it is done: exit 130 "interrupted
+  publishing (:func:`sim.held_stops.held_stops`) and handled once it is done: exit 130 "interrupted
   after the results were written to X/" (the API: a note saying so), nothing left beside.
 
 Held (found right; each phase by a child process that sends itself the signal from a patched
