@@ -88,11 +88,14 @@ def anonymous_dir(base: Path | None, out: Path):
     (``None``: the caller named ``out``, nothing to do): on any failure or interrupt,
     ``base`` is removed if empty (the run's staging directory held no finished chunk and was
     removed), else the exception gets a note naming ``out`` (its finished chunks resume); a
-    ``base`` that is gone gets no note (it named a directory that is not there)."""
+    ``base`` that is gone gets no note (it named a directory that is not there). Interrupted
+    once its results were published (:func:`sim.execute.execute`), the note says so."""
     try:
         yield
     except BaseException as e:
-        if base is not None:
+        if getattr(e, "published", None):  # interrupted as it published: the results stand
+            e.add_note(f"sim: the run's results were written to {out} before the interrupt")
+        elif base is not None:
             try:
                 os.rmdir(base)  # only an empty directory: nothing the run kept is lost
             except FileNotFoundError:  # removed under the run (a cleaner of /tmp): no chunk

@@ -361,7 +361,9 @@ def _main(argv: list[str]) -> int:
     except (ConfigError, StudyError) as e:
         print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)
         return INTERNAL if getattr(e, "internal", False) else 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:
+        if getattr(e, "published", None) and args is not None:  # as the run published
+            args.published = e.published
         print(_interrupted_line(args), file=sys.stderr)
         return 130
     except BrokenPipeError:

@@ -23,6 +23,7 @@ from typing import Any, Callable, Collection, Mapping
 
 import numpy as np
 
+from sim.held_stops import held_stops
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.executors import StartRefused, script_words
@@ -288,17 +289,23 @@ def execute(
             drop_stage(stage, lock, reason=str(e) if failed else None)
         raise
     ex.close()
+    published = False
     try:
         check_interrupt()  # not published: an interrupted run never looks finished
         check_out(out, shown, record, overwrite)  # again, under the lock: ours or absent
         seal(stage, ctx.store)
         if readme is not None:
             readme(stage, out.name)
-        publish(stage, out)
-    except BaseException:
-        drop_stage(stage, lock)
+        with held_stops():  # an interrupt between its renames: handled once they are done
+            publish(stage, out)
+            published = True
+            lock.release()
+    except BaseException as e:
+        if not published:
+            drop_stage(stage, lock)
+        elif isinstance(e, KeyboardInterrupt):  # the results stand: say where, not "resume"
+            e.published = shown
         raise
-    lock.release()
     return est
 
 
