@@ -313,3 +313,15 @@ def test_the_committed_results_are_of_their_study_files_configurations():
     assert len(named) >= 12
     for d in named:
         assert "**Configuration.**" not in (d / "README.md").read_text(encoding="utf-8"), d.name
+
+
+def test_a_small_bias_is_not_blamed_for_a_network_too_far_from_linear(tmp_path, capsys):
+    # before: any bias was named "a gross error the adjustment cannot absorb" when no probe
+    # trial converged, here 0.01 mm on distances of a network whose sights are 6 mm long
+    p = _trilateration(tmp_path, 1000.0)
+    text = p.read_text(encoding="utf-8").replace(
+        "sigma_mm = 1.0 },", "sigma_mm = 1.0, bias_mm = 0.01 },"
+    )
+    p.write_text(text, encoding="utf-8")
+    err = _refused(capsys, ["check", str(p)])
+    assert "weakest sight" in err and "bias" not in err, err
