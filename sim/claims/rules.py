@@ -88,6 +88,8 @@ from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
 
+from sim.mc.numtext import shown
+
 __all__ = [
     "FORMS",
     "KINDS",
@@ -188,14 +190,6 @@ def holds_of(verdict: str):  # depends / undecidable (over a region, sim.claims.
     return {"holds": True, "fails": False, "erratum": False}.get(verdict)
 
 
-def _shown(v: Any) -> str:  # 12 digits: a printed 12.700082809 and a change in its 7th show
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(_shown(x) for x in v) + "]"
-    if isinstance(v, float):
-        return f"{v:.12g}"
-    return repr(v) if isinstance(v, str) else str(v)
-
-
 def printed_differs(
     schema: Mapping[str, Any],
     cfg: Mapping[str, Any],
@@ -213,8 +207,8 @@ def printed_differs(
     cfg = as_printed(dict(cfg)) if as_printed is not None else cfg
     out = []
     for k, f in schema.items():
-        if getattr(f, "printed", False) and _shown(cfg.get(k, f.default)) != _shown(f.default):
-            out.append(f"{k} = {_shown(cfg[k])} (paper: {_shown(f.default)})")
+        if getattr(f, "printed", False) and shown(cfg.get(k, f.default)) != shown(f.default):
+            out.append(f"{k} = {shown(cfg[k])} (paper: {shown(f.default)})")
     return out
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+from sim.mc.numtext import shows_differently
 from sim.report.tables import fmt, md_table
 
 __all__ = ["as_set", "inputs_markdown"]
@@ -18,14 +19,6 @@ def as_set(v) -> str:
     return fmt(v)
 
 
-def _shown_differs(v, default) -> bool:
-    """Whether ``v`` is another value than ``default`` as 12 significant digits show them (a
-    swept 1.1 + 0.6 is the paper's 1.7, as :func:`sim.claims.rules.printed_differs` reads it)."""
-    if isinstance(v, float) and isinstance(default, (int, float)):
-        return f"{v:.12g}" != f"{float(default):.12g}"
-    return v != default
-
-
 def inputs_markdown(cfg: dict, schema) -> str:
     """List the config values marked as paper-matched inputs; one this run set to another
     value than the paper's is marked so (it was listed as "set to match the paper")."""
@@ -35,7 +28,7 @@ def inputs_markdown(cfg: dict, schema) -> str:
             continue
         v = cfg.get(k)
         text = as_set(v)
-        if _shown_differs(v, f.default):
+        if shows_differently(v, f.default):  # 12 digits: a swept 1.1 + 0.6 is 1.7
             changed += 1
             text += f" (this run; the paper's: {as_set(f.default)})"
         rows.append([f"`{k}`", text, f.doc])
