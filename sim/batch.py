@@ -58,6 +58,7 @@ from sim.batch_checks import (  # noqa: E402
     is_current,
     why_stale,
 )
+from sim.batch_timings import TimingsLock  # noqa: E402
 from sim.cli_args import module_doc  # noqa: E402
 from sim.ends import finish  # noqa: E402
 from sim.mc.argv import OnceParser, integer  # noqa: E402
@@ -321,9 +322,20 @@ def _main(argv: list[str]) -> int:
     if bad:
         return 2
     why = _timings_problem(args.timings) if args.timings is not None else None
+    lock = TimingsLock(args.timings) if args.timings is not None and not why else None
+    why = why or (lock.acquire() if lock else None)
     if why:
         print(f"sim.batch: --timings: {why}", file=sys.stderr)
         return 2
+    try:
+        return _run(args, files, run_args, note, loaded)
+    finally:
+        if lock:
+            lock.release()
+
+
+def _run(args, files: list[Path], run_args: list[str], note: str | None, loaded) -> int:
+    """Run the checked ``files`` and write their timings; the batch's exit code."""
     for f in files:
         if why := _replaces_project_results(f, Path(args.results)):
             print(f"sim.batch: {why}", file=sys.stderr)

@@ -14,6 +14,11 @@
 3. Two ``make verify`` given the same ``--scratch``: the second said "the re-run refused its
    options", naming the sim run's pid in its quoted line. It now says another verify (its
    pid) or a running sim (its pid) re-runs into that ``--scratch``, and names the directory.
+4. Two ``python -m sim.batch`` given the same ``--timings`` file each wrote their timings at
+   their end: the last write won, the other's studies were lost from the file without a word.
+   A batch now holds the file (:class:`sim.batch_timings.TimingsLock`, an ``flock`` on
+   ``.<name>.lock`` beside it); the second is refused before it runs anything, naming the
+   other's pid.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from conftest import ROOT
 from oneline import one_line
 
 from sim.batch import main as batch_main
+from sim.batch_timings import TimingsLock
 from sim.cli import DOC, main
 from sim.cli_args import parser
 from sim.mc.argv import most_workers
@@ -102,3 +108,30 @@ def test_a_scratch_a_running_sim_writes_is_named(tmp_path, capsys):
     assert line.startswith("sim verify: error: brown_table1: a running sim (pid "), line
     assert f"writes into the same --scratch {tmp_path} (brown_table1)" in line, line
     assert "refused its options" not in line, line
+
+
+# ------------------------------------------- 4. one batch at a time writes a --timings file
+def test_a_timings_file_another_batch_writes_is_refused_naming_its_pid(tmp_path, capsys):
+    timings = tmp_path / "t.json"
+    hold = (
+        "import sys\nfrom sim.batch_timings import TimingsLock\n"
+        f"assert TimingsLock({str(timings)!r}).acquire() is None\n"
+        "print('held', flush=True); sys.stdin.read()\n"
+    )
+    other = subprocess.Popen(
+        [sys.executable, "-c", hold], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert other.stdout.readline() == "held\n"
+        rc = batch_main(["--timings", str(timings), BROWN])
+    finally:
+        other.stdin.close()
+        other.wait()
+    one_line(capsys, rc, f"--timings: another sim.batch (pid {other.pid}) writes {timings}")
+    lock = TimingsLock(timings)  # the holder gone, the lock is free; released, no file left
+    assert lock.acquire() is None
+    lock.release()
+    assert sorted(tmp_path.iterdir()) == []
+    (tmp_path / ".t.json.lock").write_text("notes\n")  # a file of the user's of that name
+    assert "is not a lock file of sim.batch" in TimingsLock(timings).acquire()
+    assert (tmp_path / ".t.json.lock").read_text() == "notes\n"
