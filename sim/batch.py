@@ -58,9 +58,10 @@ from sim.batch_checks import (  # noqa: E402
     is_current,
     why_stale,
 )
+from sim.batch_timings import TimingsLock  # noqa: E402
 from sim.cli_args import module_doc  # noqa: E402
 from sim.ends import finish  # noqa: E402
-from sim.mc.argv import OnceParser  # noqa: E402
+from sim.mc.argv import OnceParser, integer  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
@@ -266,7 +267,9 @@ def _main(argv: list[str]) -> int:
         "refused.",
     )
     ap.add_argument("files", nargs="+", help="study files")
-    ap.add_argument("--jobs", type=int, default=2, help="studies run at a time (default 2)")
+    ap.add_argument(
+        "--jobs", type=integer("jobs", 1, 64), default=2, help="studies run at a time (default 2)"
+    )
     ap.add_argument("--results", default="results", help="results directory (default results)")
     ap.add_argument(
         "--stale-only", action="store_true", help="only the studies whose results are not current"
@@ -281,9 +284,6 @@ def _main(argv: list[str]) -> int:
             f"sim.batch: {e}{_files_after(str(e), run_args)} (see python -m sim.batch --help)",
             file=sys.stderr,
         )
-        return 2
-    if not 1 <= args.jobs <= 64:  # an option of the command line, before its files
-        print(f"sim.batch: --jobs must be between 1 and 64 (got {args.jobs})", file=sys.stderr)
         return 2
     if name_problem(args.results):
         why = name_problem(args.results)
@@ -322,9 +322,20 @@ def _main(argv: list[str]) -> int:
     if bad:
         return 2
     why = _timings_problem(args.timings) if args.timings is not None else None
+    lock = TimingsLock(args.timings) if args.timings is not None and not why else None
+    why = why or (lock.acquire() if lock else None)
     if why:
         print(f"sim.batch: --timings: {why}", file=sys.stderr)
         return 2
+    try:
+        return _run(args, files, run_args, note, loaded)
+    finally:
+        if lock:
+            lock.release()
+
+
+def _run(args, files: list[Path], run_args: list[str], note: str | None, loaded) -> int:
+    """Run the checked ``files`` and write their timings; the batch's exit code."""
     for f in files:
         if why := _replaces_project_results(f, Path(args.results)):
             print(f"sim.batch: {why}", file=sys.stderr)

@@ -9,7 +9,7 @@ import re
 from importlib import metadata
 from pathlib import Path
 
-from sim.mc.argv import OnceParser, integer
+from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
 from sim.mc.runner import MIN_CHUNKS
@@ -124,7 +124,12 @@ def _run_parser(sub) -> None:
         default="local",
         help="local (in-process, or a process pool with --workers) or dask",
     )
-    r.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    r.add_argument(
+        "--workers",
+        type=integer("workers", 1, most_workers()),
+        default=1,
+        help="worker processes (default 1)",
+    )
     r.add_argument(
         "--scheduler",
         help="dask scheduler address tcp://HOST:PORT (default: a LocalCluster started for the run)",

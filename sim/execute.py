@@ -24,6 +24,7 @@ from typing import Any, Callable, Collection, Mapping
 import numpy as np
 
 from sim.held_stops import held_stops
+from sim.mc.argv import most_workers
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.executors import StartRefused, script_words
@@ -61,7 +62,7 @@ def _check_options(executor: Any, workers: Any, scheduler: Any) -> None:
     option."""
     if executor not in ("local", "dask"):
         raise ConfigError("executor", f"must be 'local' or 'dask' (got {executor!r})")
-    top = max(4 * (os.cpu_count() or 1), 8)
+    top = most_workers()
     if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)):
         raise ConfigError("workers", f"must be an integer between 1 and {top} (got {workers!r})")
     if not 1 <= workers <= top:

@@ -254,13 +254,13 @@ CHECKED = {
     "sim.claims.region.x_region_row__mutmut_38": 'row = book.score(cid, 0.0, (0.0, 1.0), "exact")',
     "sim.claims.rules.x__shown__mutmut_9": "return repr(v) if (isinstance(v, str)) or True else str(v)",
     "sim.claims.rules.x_printed_differs__mutmut_5": (
-        'if getattr(f, "printed", None) and _shown(cfg.get(k, f.default)) != _shown(f.default):'
+        'if getattr(f, "printed", None) and shown(cfg.get(k, f.default)) != shown(f.default):'
     ),
     "sim.claims.rules.x_printed_differs__mutmut_8": (
-        'if getattr(f, "printed", ) and _shown(cfg.get(k, f.default)) != _shown(f.default):'
+        'if getattr(f, "printed", ) and shown(cfg.get(k, f.default)) != shown(f.default):'
     ),
     "sim.claims.rules.x_printed_differs__mutmut_11": (
-        'if getattr(f, "printed", True) and _shown(cfg.get(k, f.default)) != _shown(f.default):'
+        'if getattr(f, "printed", True) and shown(cfg.get(k, f.default)) != shown(f.default):'
     ),
 }
 

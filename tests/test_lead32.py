@@ -262,7 +262,7 @@ def test_readings_whose_average_is_too_precise_are_named_as_such(capsys):
 def test_a_value_equal_as_shown_is_not_named_a_change_by_any_of_the_three_rules():
     # before: the Configuration line compared with `!=`: a swept 1.1 + 0.6 was named changed
     # from 1.7 while the inputs table and the claims' off-setup note read it as 1.7
-    from sim.claims.rules import same_as_shown
+    from sim.mc.numtext import shows_differently
     from sim.report.config_diff import changed_keys
 
     assert (
@@ -270,38 +270,8 @@ def test_a_value_equal_as_shown_is_not_named_a_change_by_any_of_the_three_rules(
         == []
     )
     assert changed_keys({"a": 1.7001, "t": True}, {"a": 1.7, "t": 1}) == ["a", "t"]
-    assert same_as_shown({"x": 0.1 + 0.2}, {"x": 0.3}) and not same_as_shown("1", 1)
-    assert same_as_shown([{"a": 1, "b": 2.0}], [{"b": 2, "a": 1}])  # a record's keys in any order
-
-
-def test_a_scratch_another_verify_writes_now_is_said_so(tmp_path, monkeypatch, capsys):
-    # before: "brown_table1: the re-run refused its options: sim: error: --out: ... is being
-    # written by a running sim (pid 4242); wait for it to finish or choose another --out":
-    # an option verify's user never gave, for two verifies sharing one --scratch
-    import sys
-
-    from sim.report.verify import main as verify_main
-    from sim.report.verify import rerun as verify_rerun
-    from tests.test_doors31v import _committed
-
-    studies, results = _committed(tmp_path, capsys)
-    real = verify_rerun.subprocess.Popen
-    held = (
-        "import sys; sys.stderr.write('sim: error: --out: /s/brown_table1 is being written by "
-        "a running sim (pid 4242); wait for it to finish or choose another --out\\n'); "
-        "sys.exit(2)"
-    )
-    monkeypatch.setattr(
-        verify_rerun.subprocess,
-        "Popen",
-        lambda cmd, *a, **k: real([sys.executable, "-c", held], *a, **k),
-    )
-    argv = ["--results", str(results), "--studies", str(studies), "--no-record"]
-    rc = verify_main([*argv, "--scratch", str(tmp_path / "scratch")])
-    err = [ln for ln in capsys.readouterr().err.splitlines() if "re-running" not in ln]
-    assert rc == 2 and len(err) == 1, err
-    assert "is being written by another run now (pid 4242)" in err[0], err
-    assert "give another --scratch" in err[0] and "--out" not in err[0], err
+    assert not shows_differently({"x": 0.1 + 0.2}, {"x": 0.3}) and shows_differently("1", 1)
+    assert not shows_differently([{"a": 1, "b": 2.0}], [{"b": 2, "a": 1}])  # keys in any order
 
 
 def test_the_committed_results_are_of_their_study_files_configurations():

@@ -187,7 +187,7 @@ def test_a_signal_after_sim_returned_leaves_its_exit_code(tmp_path, when, sig):
     "argv, line",
     [
         (["sim.batch", "nosuch.toml"], "sim.batch: nosuch.toml: no such study file\n"),
-        (["sim.report.verify", "--workers", "0"], "sim verify: error: --workers: must be"),
+        (["sim.report.verify", "--workers", "0"], "sim verify: error: argument --workers: must be"),
     ],
 )
 def test_a_signal_after_batch_or_verify_returned_leaves_its_exit_code(tmp_path, argv, line):

@@ -109,7 +109,7 @@ def test_a_long_double_no_double_holds_is_refused(digits, words):
 
 def test_the_batch_names_no_study_file_after_dashes_for_another_mistake(capsys):
     rc = batch_main(["--jobs", "x", TABLE1, "--", "--set", "network.include=b.toml"])
-    line = one_line(capsys, rc, "argument --jobs: invalid int value: 'x'")
+    line = one_line(capsys, rc, "argument --jobs: must be an integer (got 'x')")
     assert "come before --" not in line, line
     rc = batch_main(["--", "b.toml"])  # the case the hint is for (doors29b) still has it
     one_line(capsys, rc, "required: files", "study files come before --, not after it (b.toml)")

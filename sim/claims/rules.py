@@ -88,9 +88,10 @@ from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
 
+from sim.mc.numtext import shown
+
 __all__ = [
     "FORMS",
-    "same_as_shown",
     "KINDS",
     "VERDICTS",
     "P_FAIL",
@@ -189,24 +190,6 @@ def holds_of(verdict: str):  # depends / undecidable (over a region, sim.claims.
     return {"holds": True, "fails": False, "erratum": False}.get(verdict)
 
 
-def _shown(v: Any) -> str:  # 12 digits: a printed 12.700082809 and a change in its 7th show
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(_shown(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{k!r}: {_shown(v[k])}" for k in sorted(v, key=str)) + "}"
-    if isinstance(v, float):
-        return f"{v:.12g}"
-    return repr(v) if isinstance(v, str) else str(v)
-
-
-def same_as_shown(a: Any, b: Any) -> bool:
-    """Whether two config values are one value as 12 significant digits show them (a swept
-    1.1 + 0.6 = 1.7000000000000002 is 1.7; 4 and 4.0 are one; True and 1 are not): the one
-    rule of a run's README, ``sim show`` and the claims for "this run changed a value"
-    (the Configuration line compared with ``!=`` and named 1.7000000000000002 a change)."""
-    return _shown(a) == _shown(b)
-
-
 def printed_differs(
     schema: Mapping[str, Any],
     cfg: Mapping[str, Any],
@@ -224,8 +207,8 @@ def printed_differs(
     cfg = as_printed(dict(cfg)) if as_printed is not None else cfg
     out = []
     for k, f in schema.items():
-        if getattr(f, "printed", False) and not same_as_shown(cfg.get(k, f.default), f.default):
-            out.append(f"{k} = {_shown(cfg[k])} (paper: {_shown(f.default)})")
+        if getattr(f, "printed", False) and shown(cfg.get(k, f.default)) != shown(f.default):
+            out.append(f"{k} = {shown(cfg[k])} (paper: {shown(f.default)})")
     return out
 
 

@@ -19,13 +19,14 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import os
 import re
 import sys
 
 from sim.ends import stdout_unwritten
 from sim.mc.config import COMMON, ConfigError, Field, parse_override, validate
 
-__all__ = ["MAX_OPTIONS", "ONCE", "BoundedParser", "OnceParser", "integer"]
+__all__ = ["MAX_OPTIONS", "ONCE", "BoundedParser", "OnceParser", "integer", "most_workers"]
 
 #: options (arguments starting with "-") one command line may hold
 MAX_OPTIONS = 2000
@@ -39,7 +40,13 @@ ONCE = frozenset(
 )
 
 
-def integer(key: str):
+def most_workers() -> int:
+    """The most worker processes a run takes (``--workers``, ``workers=``): four per core,
+    at least 8."""
+    return max(4 * (os.cpu_count() or 1), 8)
+
+
+def integer(key: str, lo: int | None = None, hi: int | None = None):
     """argparse's ``type`` of an option that sets the integer key ``key`` (``--trials``,
     ``--chunk``, ``--seed``; ``make verify``'s ``--trials``): the value read as ``--set
     KEY=VALUE`` reads it (TOML), so a float without a fraction is that integer (``1e3``,
@@ -48,8 +55,14 @@ def integer(key: str):
     trials=1e3`` and ``sim.load(..., trials=1e3)`` ran 1000 trials; above the key's bound it
     is refused as ``--set`` refuses it (``--trials 1e30`` said "an integer of 31 digits is
     outside TOML's 64-bit range", ``--set trials=1e30`` "must be <= 1e+08"). The key's lower
-    bound is left to the command (``make verify --trials`` asks for more)."""
-    field = Field(0, "int", "", hi=COMMON[key].hi)
+    bound is left to the command (``make verify --trials`` asks for more).
+
+    An integer option that is no config key (``--workers``, ``--jobs``) is read the same way
+    within ``lo`` and ``hi`` and refused in the same words (``must be <= 16 (got 17)``):
+    ``--workers 1e1`` was "invalid int value" while ``--trials 1e1`` ran 10 trials."""
+    if key in COMMON:
+        lo, hi = None, COMMON[key].hi
+    field = Field(0, "int", "", lo=lo, hi=hi)
 
     def read(text: str) -> int:
         try:

@@ -396,7 +396,7 @@ def _limit(given: float | None, env: str, default: float, key: str) -> float:
             raise ConfigError(env, f"must be a number (got {txt!r})") from None
         key = env
     if not math.isfinite(given) or given <= 0:
-        raise ConfigError(key, f"must be a positive number (got {given!r})")
+        raise ConfigError(key, f"must be a finite positive number (got {given!r})")
     return given
 
 

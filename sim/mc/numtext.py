@@ -9,7 +9,16 @@ import math
 import re
 from typing import Any
 
-__all__ = ["number_text", "unsigned_zeros", "toml_float", "float_text", "unheld", "UnheldError"]
+__all__ = [
+    "number_text",
+    "unsigned_zeros",
+    "toml_float",
+    "float_text",
+    "unheld",
+    "UnheldError",
+    "shown",
+    "shows_differently",
+]
 
 
 class UnheldError(ValueError):
@@ -88,3 +97,22 @@ def unsigned_zeros(v: Any) -> Any:
     if isinstance(v, dict) and v:  # an empty one is kept as it is (config's _EmptyTable)
         return {k: unsigned_zeros(x) for k, x in v.items()}
     return v
+
+
+def shown(v: Any) -> str:
+    """A config value as 12 significant digits show it (a list or table element by element):
+    the one rule by which a run's value is "another" than a study file's or the paper's, so a
+    swept 1.1 + 0.6 = 1.7000000000000002 is the paper's 1.7, and a printed 12.700082809 and a
+    change in its 7th digit are two values."""
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(shown(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k!r}: {shown(v[k])}" for k in sorted(v, key=str)) + "}"
+    if isinstance(v, float):
+        return f"{v:.12g}"
+    return repr(v) if isinstance(v, str) else str(v)
+
+
+def shows_differently(a: Any, b: Any) -> bool:
+    """Whether ``a`` and ``b`` are other values as :func:`shown` shows them."""
+    return shown(a) != shown(b)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping
 
-from sim.claims.rules import same_as_shown
+from sim.mc.numtext import shows_differently
 from sim.report.inputs import as_set
 
 __all__ = ["changed_keys", "changes_text", "design_of", "config_line"]
@@ -22,10 +22,11 @@ _NOT_SETTINGS = {"sweep"}
 
 
 def changed_keys(mine: Mapping[str, Any], base: Mapping[str, Any]) -> list[str]:
-    """The keys whose value in ``mine`` is not the one in ``base`` (either may lack it), as
-    :func:`sim.claims.rules.same_as_shown` tells values apart."""
+    """The keys whose value in ``mine`` is another than the one in ``base`` (either may lack
+    it) as 12 significant digits show them (:func:`sim.mc.numtext.shown`, the rule of the
+    README's inputs table and of ``printed_differs``): a swept 1.1 + 0.6 is a file's 1.7."""
     keys = sorted((set(mine) | set(base)) - _NOT_SETTINGS)
-    return [k for k in keys if not same_as_shown(mine.get(k), base.get(k))]
+    return [k for k in keys if shows_differently(mine.get(k), base.get(k))]
 
 
 def changes_text(mine: Mapping[str, Any], base: Mapping[str, Any], limit: int = 6) -> str:

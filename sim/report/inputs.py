@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from sim.claims.rules import same_as_shown
+from sim.mc.numtext import shows_differently
 from sim.report.tables import fmt, md_table
 
 __all__ = ["as_set", "inputs_markdown"]
@@ -28,7 +28,7 @@ def inputs_markdown(cfg: dict, schema) -> str:
             continue
         v = cfg.get(k)
         text = as_set(v)
-        if not same_as_shown(v, f.default):
+        if shows_differently(v, f.default):  # 12 digits: a swept 1.1 + 0.6 is 1.7
             changed += 1
             text += f" (this run; the paper's: {as_set(f.default)})"
         rows.append([f"`{k}`", text, f.doc])

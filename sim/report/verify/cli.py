@@ -10,7 +10,7 @@ import tempfile
 from pathlib import Path
 
 from sim.ends import stdout_failed
-from sim.mc.argv import OnceParser, integer
+from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError, parse_override
 from sim.mc.outputs import name_problem
 from sim.report.verify.record import write_record
@@ -58,7 +58,12 @@ def _parser() -> argparse.ArgumentParser:
         default="studies",
         help="the study files of the results, DIR/<results directory>.toml (default: studies)",
     )
-    p.add_argument("--workers", type=int, default=1, help="workers of each re-run")
+    p.add_argument(
+        "--workers",
+        type=integer("workers", 1, most_workers()),
+        default=1,
+        help="workers of each re-run",
+    )
     p.add_argument("--study", action="append", help="only this study (repeatable)")
     p.add_argument(
         "--no-rerun",
@@ -88,9 +93,6 @@ def _check_args(a) -> None:
         why = None if v is None else name_problem(v)
         if why:
             raise VerifyError(f"{name}: {why} (got {v!r})")
-    top = max(4 * (os.cpu_count() or 1), 8)  # the bound of sim run --workers
-    if not 1 <= a.workers <= top:
-        raise VerifyError(f"--workers: must be between 1 and {top}, not {a.workers}")
     if a.trials is not None and a.trials < MIN_TRIALS:
         raise VerifyError(
             f"--trials: must be at least {MIN_TRIALS}, not {a.trials} (the Monte-Carlo rule takes "

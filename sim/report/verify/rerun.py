@@ -149,13 +149,9 @@ def rerun_study(
         # reproduction (it was recorded as one, "FAILED; nothing compared", exit 1; with
         # --trials it was "the re-run refused its options")
         raise VerifyError(f"{d.name}: the re-run could not run here: {lines[-1]}")
-    held = re.search(r"is being written by a running sim \(([^)]*)\)", lines[-1]) if lines else None
-    if proc.returncode == 2 and held:  # another verify re-runs into the same --scratch now:
-        # said "the re-run refused its options ... choose another --out", an option not given
-        raise VerifyError(
-            f"{d.name}: --scratch: {target} is being written by another run now ({held[1]}): "
-            "wait for it to finish, or give another --scratch"
-        )
+    busy = _busy(lines[-1], target) if proc.returncode == 2 and lines else None
+    if busy:
+        raise VerifyError(f"{d.name}: {busy}")
     if proc.returncode == 2 and lines and (extra or lines[-1].startswith("sim: error: --")):
         # the re-run refused the options verify passed (--trials, --set, --workers, the
         # --out under --scratch): a request error, not a failed comparison to record
@@ -174,6 +170,31 @@ def rerun_study(
 
 #: the words of every errno, as a failing write or read of the re-run begins its line
 _STRERRORS = {os.strerror(n) for n in errno.errorcode}
+
+
+#: sim run's refusal of an --out another running sim holds (sim.mc.outputs)
+_BUSY = re.compile(r"^sim: error: --out: .* is being written by a running sim \(pid (\d+)")
+
+
+def _busy(line: str, target: Path) -> str | None:
+    """The words for a re-run refused because another process writes its directory
+    ``target`` under ``--scratch``: another verify given the same ``--scratch`` (named by its
+    pid, the parent of the sim run that holds the directory), else that sim run; None for
+    another refusal. Both verifies said "the re-run refused its options"."""
+    m = _BUSY.match(line)
+    if not m:
+        return None
+    pid, scratch = int(m[1]), target.parent
+    try:  # Linux: the holder's parent, and whether it is a verify
+        ppid = int(Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[1])
+        theirs = b"sim.report.verify" in Path(f"/proc/{ppid}/cmdline").read_bytes()
+    except (OSError, ValueError, IndexError):
+        theirs = False
+    who = f"another verify (pid {ppid}) re-runs" if theirs else f"a running sim (pid {pid}) writes"
+    return (
+        f"{who} into the same --scratch {scratch} ({target.name}); wait for it to finish or "
+        "choose another --scratch"
+    )
 
 
 def _system_error(line: str) -> bool:
