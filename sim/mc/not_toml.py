@@ -23,7 +23,7 @@ def kind_hint(text: str) -> str:
     if head.startswith("{"):
         try:
             doc = json.loads(text)
-        except ValueError:
+        except (ValueError, RecursionError):  # (RecursionError: nested too deeply for json)
             return " (it is JSON, not a study file: study files are TOML)"
         if isinstance(doc, dict) and "config" in doc and "code_hash" in doc:
             return (
