@@ -55,7 +55,10 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
     files = [f for f in _files(stage) if f not in carried]
     chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
     figures = {f: _sha256(stage / f) for f in files if f.endswith(".png")}
-    write_record(stage, {**rec, "files": files, "chunk_sha256": chunks, "figure_sha256": figures})
+    # the tables' too: make verify tells a table edited after its run from a failed re-run
+    tables = {f: _sha256(stage / f) for f in files if "/" not in f and f.endswith(".parquet")}
+    record = {**rec, "files": files, "chunk_sha256": chunks, "figure_sha256": figures}
+    write_record(stage, {**record, "table_sha256": tables})
 
 
 def _recorded_figures(out: Path) -> dict | None:

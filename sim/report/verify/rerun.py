@@ -5,6 +5,7 @@ wrote there is ever replaced) and comparing them with it (the record and the rep
 from __future__ import annotations
 
 import errno
+import hashlib
 import os
 import re
 import subprocess
@@ -316,7 +317,33 @@ def _judge(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
     comp = compare_dirs(d, target, d.name, mode)
     if not comp.ok and (older := _other_code(d, target)):  # why, before the deviations
         comp.failures.insert(0, older)
+    if not comp.ok and (edited := _edited(d)):  # the user's edit, not the code's failure
+        comp.failures.insert(0, edited)
     return comp
+
+
+def _edited(d: Path) -> str | None:
+    """The tables of the committed results ``d`` changed after their run wrote them (their
+    sha256 is not the one ``run.json`` records), or None: a verdict edited by hand, rows
+    reordered or duplicated were listed as deviations of a failed reproduction."""
+    rec = read_record(d) or {}
+    sums = rec.get("table_sha256")
+    if not isinstance(sums, dict):
+        return None  # an older version's record: the comparison decides
+    changed = []
+    for name, digest in sorted(sums.items()):
+        try:
+            if hashlib.sha256((d / str(name)).read_bytes()).hexdigest() != digest:
+                changed.append(str(name))
+        except OSError:
+            changed.append(str(name))
+    if not changed:
+        return None
+    return (
+        f"{', '.join(changed[:3])}{', ...' if len(changed) > 3 else ''} changed after the run "
+        "that wrote them (sha256 not the one in run.json: edited by hand or copied?): the "
+        "deviations below are of that change, not of the code; run make reproduce, then verify"
+    )
 
 
 def _not_as_written(d: Path) -> str | None:
