@@ -33,6 +33,13 @@ $(call not_read_any,BENCH_FLAG BENCH_ARGS bench_flags,BENCH_FLAGS="..." (make be
 $(call not_read_any,OUT BENCH_DIR out bench_out,BENCH_OUT=DIR (make bench))
 $(call not_read_any,PYTEST_ARGS PYTEST_FLAGS PYTEST_OPTS,PYTEST_ADDOPTS="..." passes options to pytest (make test))
 $(call not_read_any,PY python,PYTHON=python3.X chooses the Python of the virtual environment (make venv))
+# the settings spelt without their underscore or with a hyphen, in either case (`make verify
+# VERIFYFLAGS="--study NAME"` re-ran every study, `make test TESTWORKERS=0` ran 2 processes)
+lower = $(subst Z,z,$(subst Y,y,$(subst X,x,$(subst W,w,$(subst V,v,$(subst U,u,$(subst T,t,$(subst S,s,$(subst R,r,$(subst Q,q,$(subst P,p,$(subst O,o,$(subst N,n,$(subst M,m,$(subst L,l,$(subst K,k,$(subst J,j,$(subst I,i,$(subst H,h,$(subst G,g,$(subst F,f,$(subst E,e,$(subst D,d,$(subst C,c,$(subst B,b,$(subst A,a,$(1)))))))))))))))))))))))))))
+SETTINGS := PYTHON RUN_FLAGS RUN_JOBS TEST_WORKERS MUTATION_WORKERS VERIFY_FLAGS BENCH_FLAGS \
+  BENCH_OUT FUZZ_CASES FUZZ_SEED FUZZ_SAVE
+misspelt = $(filter-out $(1),$(sort $(subst _,,$(1)) $(subst _,-,$(1)) $(call lower,$(subst _,,$(1)) $(subst _,-,$(1)))))
+$(foreach s_,$(SETTINGS),$(call not_read_any,$(call misspelt,$(s_)),$(s_)="..." is the spelling))
 
 PYTHON ?= python3
 VENV   := .venv
