@@ -5,8 +5,11 @@ mutates it: a key's value (wrong types, magnitudes from 1e-300 to 1e300, NaN and
 empty and huge lists, unicode, paths), the file's structure (unknown keys and studies,
 garbage, a ``[sweep]`` table with bad ranges; a well-formed key in the wrong place: written in
 table form with the key moved into another table or to the top level, its table an array of
-tables or declared twice, the key itself an array of tables) or the command line (``--trials``, ``--seed``,
-``--workers``, ``--out``, ``--scheduler``). Every case runs ``sim run`` in a forked child
+tables or declared twice, the key itself an array of tables), its TOML type (a number as
+a string, a bool, a date or time, a table or array for a scalar, a mixed, empty or nested
+array, an integer beyond 64 bits, ``-0``, ``0x10``, ``1_000``; ``FUZZ_TYPE_WEIGHT`` sets its
+share) or the command line (``--trials``, ``--seed``, ``--workers``, ``--out``,
+``--scheduler``). Every case runs ``sim run`` in a forked child
 (its own session, an address-space limit, a time bound) and must give exit 0 with finite
 results, or exit 2 with exactly one line on standard error and no traceback, and leave
 nothing outside the output directory but, after a failed run, its staging directory.
@@ -188,7 +191,24 @@ LISTS = [
 ]
 
 
+class Raw(str):
+    """A TOML literal written as is (a date, ``0x10``, ``1_000``: values Python has no literal
+    for that round-trips through ``toml_value``)."""
+
+
+#: TYPE confusion: a number as a string, a bool, a date or time, a table or array for a scalar,
+#: mixed, empty and nested arrays, a 64-bit-overflowing integer, -0, 0x/0o/0b and 1_000 literals
+TYPED = [
+    *map(Raw, ['"6"', '"0.5"', "true", "1979-05-27", "07:32:00", "1979-05-27T07:32:00Z"]),
+    *map(Raw, ["1979-05-27 07:32:00.999999", "{a = 1}", "{}", '[1, "a"]', "[1, 2.0]", "[]"]),
+    *map(Raw, ["[[1], [2]]", "[[]]", "99999999999999999999", "-0", "0x10", "0o17", "0b101"]),
+    *map(Raw, ["1_000", "+inf", "-nan", "1e400", "[true, false]", "[1979-05-27]", "''"]),
+]
+
+
 def toml_value(v) -> str:
+    if isinstance(v, Raw):
+        return str(v)
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, int):
@@ -296,7 +316,10 @@ def make_case(i: int):
     sweep = None
     raw = None
     kind = rng.choice(
-        ["value"] * 5 + ["two"] * 2 + ["set", "structure", "sweep", "option", "relocate"]
+        ["value"] * 5
+        + ["two"] * 2
+        + ["set", "structure", "sweep", "option", "relocate"]
+        + ["type"] * int(os.environ.get("FUZZ_TYPE_WEIGHT", "2"))
     )
     if kind in ("value", "two"):
         keys = rng.sample(schema, 2 if kind == "two" else 1)
@@ -350,6 +373,17 @@ def make_case(i: int):
             flat[rng.choice(schema)] = {"a": 1}
         else:
             flat[rng.choice(schema)] = [1.0] * 100_000
+    elif kind == "type":  # a value of the wrong TOML type, or a list with one such element
+        k = rng.choice(schema)
+        old, lit = flat.get(k), rng.choice(TYPED)
+        if isinstance(old, list) and old and rng.random() < 0.5:
+            i = rng.randrange(len(old))
+            flat[k] = old[:i] + [lit] + old[i + 1 :]
+        elif isinstance(old, (int, float)) and rng.random() < 0.3:
+            flat[k] = Raw(json.dumps(str(old)))  # the right number as a string
+        else:
+            flat[k] = lit
+        desc = f"{k}={toml_value(flat[k])[:60]}"
     elif kind == "relocate":
         raw, desc = relocate(rng, flat, schema)
     elif kind == "sweep":

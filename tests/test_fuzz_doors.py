@@ -4,8 +4,12 @@ Each case asserts the promised class of behaviour: a bad argument is a ``ConfigE
 message starts with the argument's name (one line, nothing from pathlib or NumPy); a chunk
 store damaged between a kill and the resume (chunks truncated, swapped, duplicated, taken
 from another seed, left over beyond the run) resumes to results equal to a clean run's.
+``TYPED`` adds TYPE confusion to every argument (a date, a timedelta, a ``Decimal`` NaN, a
+complex, a bytearray, a set, a NumPy array, an integer beyond 64 bits).
 ``FUZZ_CASES`` sets the number of cases (``make fuzz`` raises it)."""
 
+import datetime
+import decimal
 import os
 import shutil
 from pathlib import Path
@@ -33,6 +37,19 @@ BAD = {
     "overwrite": ["yes", 1, None],
     "quiet": ["no", 0],
 }
+#: TYPE confusion: values of a type no argument takes (each refused by every argument)
+TYPED = [
+    datetime.date(2020, 1, 1),
+    datetime.timedelta(1),
+    decimal.Decimal("nan"),
+    complex(2, 0),
+    bytearray(b"1"),
+    {2},
+    np.array([2]),
+    -(2**70),
+]
+for _k in BAD:
+    BAD[_k] = BAD[_k] + TYPED
 
 
 @pytest.mark.parametrize("case", range(CASES))
