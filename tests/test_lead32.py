@@ -295,3 +295,19 @@ def test_a_small_bias_is_not_blamed_for_a_network_too_far_from_linear(tmp_path, 
     p.write_text(text, encoding="utf-8")
     err = _refused(capsys, ["check", str(p)])
     assert "weakest sight" in err and "bias" not in err, err
+
+
+def test_another_studys_results_under_a_name_are_said_to_be_so_by_verify(tmp_path, capsys):
+    # before: network_plate's results copied as brown_table1 were "of another config than the
+    # re-run (keys ...)", about 70 keys with `study` among them
+    from sim.report.verify import main as verify_main
+
+    R, S = tmp_path / "R" / "brown_table1", tmp_path / "S" / "brown_table1"
+    quiet = ["--quiet", "--no-figures", "--trials", "40"]
+    assert main(["run", str(STUDIES / "network_plate.toml"), "--out", str(R), *quiet]) == 0
+    assert main(["run", str(STUDIES / "brown_table1.toml"), "--out", str(S), *quiet]) == 0
+    capsys.readouterr()
+    argv = ["--results", str(R.parent), "--scratch", str(S.parent), "--no-rerun", "--no-record"]
+    assert verify_main(argv) == 1
+    text = " ".join(capsys.readouterr().out.split())
+    assert "are of the study 'network', not of 'brown_table1'" in text, text

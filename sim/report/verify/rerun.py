@@ -383,6 +383,13 @@ def _other_config(d: Path, target: Path, sf: Path | None = None) -> str | None:
     ca, cb = a.get("config"), b.get("config")
     if not isinstance(ca, dict) or not isinstance(cb, dict) or ca == cb:
         return None
+    if ca.get("study") != cb.get("study"):  # another study's results under this name: its
+        # ~70 keys were listed as "another config" with `study` among them
+        return (
+            f"the committed results are of the study {ca.get('study')!r}, not of "
+            f"{cb.get('study')!r} the re-run is (copied under this name?); run make reproduce, "
+            "then verify"
+        )
     keys = sorted(k for k in set(ca) | set(cb) if ca.get(k) != cb.get(k))
     why = "they are stale or were made with other options"
     if sf is not None:  # re-run from a file of ours: the results may be of a file of theirs
