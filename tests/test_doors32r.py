@@ -1,0 +1,40 @@
+"""R33, a fresh reading of the session's change of 2026-11-28/29 (issue 26): the network kind's
+runs of which few trials converge, through ``sim run``. Each test failed on the code before
+its fix."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from sim.cli import main
+
+
+def _trilateration(tmp_path: Path, half_extent_mm: float) -> Path:
+    """300 random points, 8 nearest distances of 1 mm and directions (tests/test_lead32.py's):
+    at a half extent of 7 m, 2 of 40 trials converge, in two chunks."""
+    p = tmp_path / "tri.toml"
+    p.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\nseed = 5\n[network]\n'
+        f'random = [ {{ prefix = "P", n = 300, half_extent_mm = {half_extent_mm} }} ]\n'
+        'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 8, sigma_mm = 1.0 },'
+        ' { kind = "direction", from = "P1*", to = "P*", nearest = 4, sigma_arcsec = 2.0 } ]\n'
+        '[datum]\nkind = "inner"\n',
+        encoding="utf-8",
+    )
+    return p
+
+
+def test_a_run_whose_jackknife_would_leave_one_converged_trial_names_the_network(
+    tmp_path, capsys
+):
+    # before: the converged trials lay in two chunks, so the estimates were formed; leaving
+    # out either chunk left one trial, whose sample sigma divided by zero: three numpy
+    # RuntimeWarnings on stderr, then "claim network.mc_agreement.mean_ratio: the simulated
+    # value is not finite", a claim named as the cause of a network that does not converge
+    f = _trilateration(tmp_path, 7000.0)
+    assert main(["run", str(f), "--out", str(tmp_path / "o"), "--no-figures", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("sim: error: network.generate: too few trials (the jackknife"), err
+    assert "converged from the true coordinates" in err and "weakest sight" in err, err
+    assert not (tmp_path / "o").exists()
