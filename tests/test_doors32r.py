@@ -38,3 +38,23 @@ def test_a_run_whose_jackknife_would_leave_one_converged_trial_names_the_network
     assert err.startswith("sim: error: network.generate: too few trials (the jackknife"), err
     assert "converged from the true coordinates" in err and "weakest sight" in err, err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_drivers_variable_of_a_non_ascii_digit_is_no_traceback():
+    # before: SIM_STOP_WITH_PARENT=² (a digit to str.isdigit) reached int(), and every `sim`
+    # command ended in a ValueError traceback, exit 1; a value that is no pid is ignored, as
+    # "yes" was
+    import os
+    import subprocess
+    import sys
+
+    study = Path(__file__).resolve().parents[1] / "studies" / "wolf_polynomial.toml"
+    env = {**os.environ, "SIM_STOP_WITH_PARENT": "\u00b2"}
+    p = subprocess.run(
+        [sys.executable, "-m", "sim", "check", str(study)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert p.returncode == 0 and p.stderr == "", p.stderr
