@@ -58,3 +58,21 @@ def test_a_drivers_variable_of_a_non_ascii_digit_is_no_traceback():
         timeout=120,
     )
     assert p.returncode == 0 and p.stderr == "", p.stderr
+
+
+def test_a_gross_bias_of_a_generated_set_names_network_generate(tmp_path, capsys):
+    # before: `sim check` refused it naming network.observations, a key the study did not set
+    p = tmp_path / "bias.toml"
+    p.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\n'
+        'grids = [ { prefix = "G", nx = 4, ny = 4, spacing_mm = 100.0 } ]\n'
+        'generate = [ { kind = "distance", from = "G*", to = "G*", nearest = 4, '
+        "sigma_mm = 0.01, bias_mm = 40.0 } ]\n"
+        '[datum]\nkind = "inner"\n',
+        encoding="utf-8",
+    )
+    assert main(["check", str(p)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("sim: error: network.generate: none of 16 probe trials"), err
+    assert "the bias of 40 mm" in err, err

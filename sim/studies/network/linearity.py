@@ -71,10 +71,11 @@ def why_not_converged(net: Network, cov: np.ndarray, cfg: dict, what: str) -> tu
     )
 
 
-def biased(net: Network, what: str) -> tuple[str, str] | None:
+def biased(net: Network, cfg: dict, what: str) -> tuple[str, str] | None:
     """``(key, message)`` for a network whose trials do not converge (``what``: which) when an
     observation carries a bias, a gross error unknown to the adjustment: the largest, in its
-    sigmas; None when none has a bias."""
+    sigmas, named by the key that declares it (a ``network.generate`` bias was named
+    ``network.observations``, a key the study did not set); None when none has a bias."""
     if not np.any(net.bias):
         return None
     r = int(np.argmax(np.abs(net.bias) / net.sigma))
@@ -84,7 +85,7 @@ def biased(net: Network, what: str) -> tuple[str, str] | None:
     obs += f" from {net.names[net.j[r]]!r}" if net.kind[r] == 2 else ""
     to = net.k[r] if net.kind[r] == 2 else net.j[r]
     obs += f" to {net.names[to]!r}" if to >= 0 else ""
-    return "network.observations", (
+    return _source(net, cfg, r), (
         f"{what}: the bias of {net.bias[r] * f:g} {unit} on {obs} is a gross error the "
         "adjustment cannot absorb (a bias is unknown to it): make it smaller"
     )

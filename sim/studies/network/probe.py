@@ -65,4 +65,4 @@ def probe_solver(net: Network, an, C, pts, cfg: dict) -> None:
     if np.any(statuses(limit) == 0):
         return
     what = f"none of {PROBE_TRIALS} probe trials converged within solver.max_iter = {limit}"
-    raise ConfigError(*(biased(net, what) or why_not_converged(net, an.cov, cfg, what)))
+    raise ConfigError(*(biased(net, cfg, what) or why_not_converged(net, an.cov, cfg, what)))

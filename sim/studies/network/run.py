@@ -102,7 +102,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
         est = mc_estimates(an, pts, sim)
     except StudyError:
         what = TOO_FEW
-        key, msg = biased(net, what) or why_not_converged(net, an.cov, cfg, what)
+        key, msg = biased(net, cfg, what) or why_not_converged(net, an.cov, cfg, what)
         raise StudyError(f"{key}: {msg}") from None
     with phase("network: tables and figures", show, quiet):
         _outputs(out, cfg, full, net, an, dt, C, pts, held, sim, est, prov)
