@@ -24,9 +24,7 @@ def _trilateration(tmp_path: Path, half_extent_mm: float) -> Path:
     return p
 
 
-def test_a_run_whose_jackknife_would_leave_one_converged_trial_names_the_network(
-    tmp_path, capsys
-):
+def test_a_run_whose_jackknife_would_leave_one_converged_trial_names_the_network(tmp_path, capsys):
     # before: the converged trials lay in two chunks, so the estimates were formed; leaving
     # out either chunk left one trial, whose sample sigma divided by zero: three numpy
     # RuntimeWarnings on stderr, then "claim network.mc_agreement.mean_ratio: the simulated
