@@ -74,3 +74,25 @@ def test_a_gross_bias_of_a_generated_set_names_network_generate(tmp_path, capsys
     assert len(err.splitlines()) == 1, err
     assert err.startswith("sim: error: network.generate: none of 16 probe trials"), err
     assert "the bias of 40 mm" in err, err
+
+
+def test_a_grid_prefix_with_two_spaces_is_named_as_the_grids_prefix(tmp_path):
+    # before: `sim run` wrote "gama-local XML: not exported: network.points: point 'A  B1'"
+    # into the README of a study that sets no network.points (its grid's prefix made the name)
+    from sim.studies import load_study
+    from sim.studies.network.definition import build
+    from sim.studies.network.gama import export, merge_gama
+
+    st = tmp_path / "s.toml"
+    st.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\n'
+        'grids = [ { prefix = "A  B", nx = 3, ny = 3, spacing_mm = 100.0 } ]\n'
+        'generate = [ { kind = "distance", from = "A*", to = "A*", nearest = 4, '
+        "sigma_mm = 0.01 } ]\n"
+        '[datum]\nkind = "inner"\n',
+        encoding="utf-8",
+    )
+    full = merge_gama(load_study(st)[1])
+    note = export(build(full), full, tmp_path / "n.xml")
+    assert note.startswith("not exported: network.grids[0].prefix: point 'A  B1'"), note
+    assert not (tmp_path / "n.xml").exists()
