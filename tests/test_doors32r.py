@@ -96,3 +96,24 @@ def test_a_grid_prefix_with_two_spaces_is_named_as_the_grids_prefix(tmp_path):
     note = export(build(full), full, tmp_path / "n.xml")
     assert note.startswith("not exported: network.grids[0].prefix: point 'A  B1'"), note
     assert not (tmp_path / "n.xml").exists()
+
+
+def test_a_bias_of_a_generated_set_is_named_by_network_generate_in_the_export_note(tmp_path):
+    # before: "not exported: network.observations: gama-local has no observation bias" of a
+    # study that sets no network.observations (the bias was network.generate's)
+    from sim.studies import load_study
+    from sim.studies.network.definition import build
+    from sim.studies.network.gama import export, merge_gama
+
+    st = tmp_path / "s.toml"
+    st.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\n'
+        'grids = [ { prefix = "G", nx = 3, ny = 3, spacing_mm = 100.0 } ]\n'
+        'generate = [ { kind = "distance", from = "G*", to = "G*", nearest = 4, '
+        "sigma_mm = 0.01, bias_mm = 0.001 } ]\n"
+        '[datum]\nkind = "inner"\n',
+        encoding="utf-8",
+    )
+    full = merge_gama(load_study(st)[1])
+    note = export(build(full), full, tmp_path / "n.xml")
+    assert note.startswith("not exported: network.generate: gama-local has no observation"), note

@@ -40,6 +40,7 @@ from sim.mc.config import ConfigError, given
 from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network
 from sim.studies.network.gama_read import CC, NE, NS, consistent, read_bytes, read_gama
+from sim.studies.network.linearity import row_key
 from sim.studies.network.model import computed
 from sim.studies.network.validate import hits, name_index
 
@@ -367,10 +368,17 @@ def inner_points(net: Network, cfg: dict) -> list[int]:
     return [a for a in range(net.n) if net.role[a] != 1 and a in sel]
 
 
-def _single_spaced(net: Network, cfg: dict) -> None:
-    """Refuse a point name with a run of spaces, which gama-local's PointID reads as one space
-    ("A  B" as "A B"), naming the key that declares it: a grid's or a random set's prefix, or
-    the point's record (it named ``network.points`` for a grid's points)."""
+def _keyed(net: Network, cfg: dict) -> None:
+    """Refuse what gama-local cannot take, naming the key of ``cfg`` that declares it (it
+    named ``network.observations`` for a bias of ``network.generate`` and ``network.points``
+    for a grid's points): a bias (:func:`sim.studies.network.linearity.row_key`); a point
+    name with a run of spaces, which gama-local's PointID reads as one space ("A  B" as
+    "A B"): a grid's or a random set's prefix, or the point's record."""
+    if np.any(net.bias != 0):
+        raise ConfigError(
+            row_key(net, cfg, int(np.flatnonzero(net.bias)[0])),
+            "gama-local has no observation bias: export a network without bias_*",
+        )
     nm = next((nm for nm in net.names if "  " in nm), None)
     if nm is None:
         return
@@ -394,7 +402,7 @@ def export(net: Network, cfg: dict, path: str | Path) -> str:
     kind = cfg["datum.kind"]
     frame = tuple(cfg.get("network.gama_frame", NE))  # an imported file's frame, else ne
     try:
-        _single_spaced(net, cfg)
+        _keyed(net, cfg)
         if kind == "fixed":
             write_gama(net, path, frame=frame)
             return Path(path).name
