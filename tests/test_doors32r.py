@@ -1,6 +1,9 @@
-"""R33, a fresh reading of the session's change of 2026-11-28/29 (issue 26): the network kind's
-runs of which few trials converge, through ``sim run``. Each test failed on the code before
-its fix."""
+"""R33, a fresh reading of the session's change of 2026-11-28/29 (issue 26), through ``sim run``,
+``sim check`` and the network's gama-local export: a run of which too few trials converge for
+the jackknife over chunks (numpy warnings, then a claim named as the cause); a driver's
+variable of a non-ASCII digit (a traceback); and three messages naming a key the study did
+not set (a ``network.generate`` bias at ``sim check`` and in the export note, a grid prefix's
+double space in the export note). Each test failed on the code before its fix."""
 
 from __future__ import annotations
 
