@@ -72,7 +72,7 @@ def test_a_bias_that_makes_a_distance_negative_is_refused_at_check(capsys):
 def test_a_gross_angle_bias_is_named_when_the_run_does_not_converge():
     obs = [{"kind": "angle", "at": "N6", "from": "N5", "to": "N7", "sigma_arcsec": 2.0}]
     _, cfg = load_study(FIELD, values={"network.observations": obs})
-    assert biased(build(cfg), "w") is None  # no bias: the run's own message stands
+    assert biased(build(cfg), cfg, "w") is None  # no bias: the run's own message stands
     # lead32: the solver probe refuses it when the file is loaded (the run computed every
     # chunk first), naming the bias as the run's message did
     with pytest.raises(ConfigError) as e:

@@ -52,7 +52,8 @@ def die_with_parent() -> str | None:
     ends at once (one line: the variable left set in a shell, ``export
     SIM_STOP_WITH_PARENT=2``, ended every ``sim`` with status 130 and not a word)."""
     want = os.environ.pop(PARENT_ENV, "")
-    if not want.isdigit() or not sys.platform.startswith("linux"):
+    # (ASCII digits: "²" is a digit to str.isdigit and a ValueError traceback to int)
+    if not (want.isascii() and want.isdigit()) or not sys.platform.startswith("linux"):
         return None
     try:
         import ctypes

@@ -40,6 +40,7 @@ from sim.mc.config import ConfigError, given
 from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network
 from sim.studies.network.gama_read import CC, NE, NS, consistent, read_bytes, read_gama
+from sim.studies.network.linearity import row_key
 from sim.studies.network.model import computed
 from sim.studies.network.validate import hits, name_index
 
@@ -121,13 +122,6 @@ def _refuse(net: Network) -> None:
         )
     if net.estimate_scale:
         raise ConfigError("network.estimate_scale", "gama-local has no scale unknown")
-    # gama-local's PointID makes a run of spaces one space: "A  B" would be read as "A B"
-    if nm := next((nm for nm in net.names if "  " in nm), None):
-        raise ConfigError(
-            "network.points",
-            f"point {nm!r}: gama-local reads a run of spaces in an id as one space "
-            f"({' '.join(nm.split())!r}): name the point with single spaces",
-        )
 
 
 def _vector_pairs(net: Network) -> list[tuple[int, int]]:
@@ -374,12 +368,41 @@ def inner_points(net: Network, cfg: dict) -> list[int]:
     return [a for a in range(net.n) if net.role[a] != 1 and a in sel]
 
 
+def _keyed(net: Network, cfg: dict) -> None:
+    """Refuse what gama-local cannot take, naming the key of ``cfg`` that declares it (it
+    named ``network.observations`` for a bias of ``network.generate`` and ``network.points``
+    for a grid's points): a bias (:func:`sim.studies.network.linearity.row_key`); a point
+    name with a run of spaces, which gama-local's PointID reads as one space ("A  B" as
+    "A B"): a grid's or a random set's prefix, or the point's record."""
+    if np.any(net.bias != 0):
+        raise ConfigError(
+            row_key(net, cfg, int(np.flatnonzero(net.bias)[0])),
+            "gama-local has no observation bias: export a network without bias_*",
+        )
+    nm = next((nm for nm in net.names if "  " in nm), None)
+    if nm is None:
+        return
+    key = "network.points"
+    for a, rec in enumerate(cfg.get("network.points") or []):
+        key = f"network.points[{a}].name" if rec.get("name") == nm else key
+    for src in ("network.grids", "network.random"):
+        for a, rec in enumerate(cfg.get(src) or []):
+            pre = str(rec.get("prefix", ""))
+            key = f"{src}[{a}].prefix" if nm[len(pre) :].isdigit() and nm.startswith(pre) else key
+    raise ConfigError(
+        key,
+        f"point {nm!r}: gama-local reads a run of spaces in an id as one space "
+        f"({' '.join(nm.split())!r}): name the point with single spaces",
+    )
+
+
 def export(net: Network, cfg: dict, path: str | Path) -> str:
     """Write ``network.xml`` in the datum of ``cfg``; returns the sentence for the summary
     (the file name, what was changed to say it in gama-local, or why it was not written)."""
     kind = cfg["datum.kind"]
     frame = tuple(cfg.get("network.gama_frame", NE))  # an imported file's frame, else ne
     try:
+        _keyed(net, cfg)
         if kind == "fixed":
             write_gama(net, path, frame=frame)
             return Path(path).name

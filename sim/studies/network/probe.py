@@ -72,5 +72,5 @@ def probe_solver(net: Network, an, C, pts, cfg: dict) -> None:
         clean = replace(net, bias=np.zeros_like(net.bias))
         fn = chunk_fn(clean, an, C, pts, {**cfg, "solver.max_iter": limit})
         if np.any(fn(np.random.default_rng(PROBE_SEED), PROBE_TRIALS)["rows.status"] == 0):
-            cause = biased(net, what)
+            cause = biased(net, cfg, what)
     raise ConfigError(*(cause or why_not_converged(net, an.cov, cfg, what)))

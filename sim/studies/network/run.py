@@ -23,7 +23,7 @@ from sim.report.plotting import draw
 from sim.studies.network.analysis import ellipse, estimated_points
 from sim.studies.network.claims import design_figures, network_claims
 from sim.studies.network.definition import Network, build
-from sim.studies.network.estimates import mc_estimates
+from sim.studies.network.estimates import TOO_FEW, mc_estimates
 from sim.studies.network.figures import network_figure, reliability_figure
 from sim.studies.network.gama import export, import_note, merge_gama
 from sim.studies.network.linearity import biased, why_not_converged
@@ -101,8 +101,8 @@ def run(cfg: dict, out: Path, ctx) -> None:
     try:
         est = mc_estimates(an, pts, sim)
     except StudyError:
-        what = "fewer than two chunks have converged trials"
-        key, msg = biased(net, what) or why_not_converged(net, an.cov, cfg, what)
+        what = TOO_FEW
+        key, msg = biased(net, cfg, what) or why_not_converged(net, an.cov, cfg, what)
         raise StudyError(f"{key}: {msg}") from None
     with phase("network: tables and figures", show, quiet):
         _outputs(out, cfg, full, net, an, dt, C, pts, held, sim, est, prov)
