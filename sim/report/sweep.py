@@ -8,10 +8,10 @@ import itertools
 from pathlib import Path
 
 import numpy as np
-from matplotlib import ticker
 
 from sim.mc.publish import drawn
 from sim.mc.storage import read_provenance
+from sim.report.mpl import ticker
 from sim.report.plotting import (
     figures_off,
     place_legends,

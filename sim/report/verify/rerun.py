@@ -315,10 +315,10 @@ def _judge(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
     if why:  # not a reproduction failure of these numbers: results of another input
         return Comparison(d.name, failures=[why])
     comp = compare_dirs(d, target, d.name, mode)
-    if not comp.ok and (older := _other_code(d, target)):  # why, before the deviations
-        comp.failures.insert(0, older)
     if not comp.ok and (edited := _edited(d)):  # the user's edit, not the code's failure
         comp.failures.insert(0, edited)
+    if not comp.ok and (older := _other_code(d, target)):  # why, before the deviations
+        comp.failures.insert(0, older)  # (first: stale results are made again, edits and all)
     return comp
 
 
