@@ -10,21 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from sim.cli import main
-
-
-def _trilateration(tmp_path: Path, half_extent_mm: float) -> Path:
-    """300 random points, 8 nearest distances of 1 mm and directions (tests/test_lead32.py's):
-    at a half extent of 7 m, 2 of 40 trials converge, in two chunks."""
-    p = tmp_path / "tri.toml"
-    p.write_text(
-        'study = "network"\ntrials = 40\nchunk = 2\nseed = 5\n[network]\n'
-        f'random = [ {{ prefix = "P", n = 300, half_extent_mm = {half_extent_mm} }} ]\n'
-        'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 8, sigma_mm = 1.0 },'
-        ' { kind = "direction", from = "P1*", to = "P*", nearest = 4, sigma_arcsec = 2.0 } ]\n'
-        '[datum]\nkind = "inner"\n',
-        encoding="utf-8",
-    )
-    return p
+from tests.test_lead32 import _trilateration  # 300 random points, 8 nearest distances
 
 
 def test_a_run_whose_jackknife_would_leave_one_converged_trial_names_the_network(tmp_path, capsys):
