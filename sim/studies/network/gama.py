@@ -376,7 +376,7 @@ def _keyed(net: Network, cfg: dict) -> None:
     "A B"): a grid's or a random set's prefix, or the point's record."""
     if np.any(net.bias != 0):
         raise ConfigError(
-            row_key(net, cfg, int(np.flatnonzero(net.bias)[0])),
+            row_key(cfg, int(np.flatnonzero(net.bias)[0])),
             "gama-local has no observation bias: export a network without bias_*",
         )
     nm = next((nm for nm in net.names if "  " in nm), None)

@@ -17,11 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from sim.studies.network.definition import Network
+from sim.studies.network.validate import KINDS
 
-__all__ = ["weakest_sight", "why_not_converged", "biased", "row_key", "KINDS"]
-
-#: the observation kinds by code (:class:`sim.studies.network.definition.Network`'s ``kind``)
-KINDS = ("distance", "direction", "angle", "dx", "dy", "x", "y")
+__all__ = ["weakest_sight", "why_not_converged", "biased", "row_key"]
 
 
 def weakest_sight(net: Network, cov: np.ndarray) -> tuple[int, int, int, float, float] | None:
@@ -44,7 +42,7 @@ def weakest_sight(net: Network, cov: np.ndarray) -> tuple[int, int, int, float, 
     return int(r[w]), int(a[w]), int(b[w]), float(d[w]), float(s[w])
 
 
-def row_key(net: Network, cfg: dict, r: int) -> str:
+def row_key(cfg: dict, r: int) -> str:
     """The key that declares row ``r`` of a network built from ``cfg``."""
     if cfg.get("network.gama_xml"):
         return "network.gama_xml"
@@ -63,7 +61,7 @@ def why_not_converged(net: Network, cov: np.ndarray, cfg: dict, what: str) -> tu
         sight = f"the angle at {net.names[a]!r}, its sight to {net.names[b]!r}"
     else:
         sight = f"the {KINDS[int(net.kind[r])]} from {net.names[a]!r} to {net.names[b]!r}"
-    return row_key(net, cfg, r), (
+    return row_key(cfg, r), (
         f"{what} from the true coordinates: the network is too far from linear for its noise; "
         f"its weakest sight, {sight}, is {d:.4g} mm long while the a-priori sigma of its ends is {s:.3g} mm ({100 * s / d:.3g} "
         "% of it): place the points further apart, leave such sights out, or make the "
@@ -85,7 +83,7 @@ def biased(net: Network, cfg: dict, what: str) -> tuple[str, str] | None:
     obs += f" from {net.names[net.j[r]]!r}" if net.kind[r] == 2 else ""
     to = net.k[r] if net.kind[r] == 2 else net.j[r]
     obs += f" to {net.names[to]!r}" if to >= 0 else ""
-    return row_key(net, cfg, r), (
+    return row_key(cfg, r), (
         f"{what}: the bias of {net.bias[r] * f:g} {unit} on {obs} is a gross error the "
         "adjustment cannot absorb (a bias is unknown to it): make it smaller"
     )
