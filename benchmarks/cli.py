@@ -132,6 +132,11 @@ def _csv(kind, choices=None):
                 f"{text!r}: expected a comma-separated subset of "
                 f"{', '.join(choices) if choices else '1 ... 64'}"
             )
+        twice = sorted({str(v) for v in vals if vals.count(v) > 1})
+        if twice:  # --rerun-workers 1,1 timed one setting twice: two rows of one key
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: {', '.join(twice)} given twice: give each once"
+            )
         return tuple(vals)
 
     return parse

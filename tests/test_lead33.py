@@ -1,9 +1,12 @@
 """The lead's own sweep of 2026-11-29 (issue 26): the network kind's refusals after a run
-whose trials do not converge. Each test failed on the code before its fix."""
+whose trials do not converge, and the benchmark's lists (a worker count given twice). Each test
+failed on the code before its fix."""
 
 from __future__ import annotations
 
 from pathlib import Path
+
+import pytest
 
 from sim.cli import main
 from tests.test_lead32 import _trilateration  # 300 random points, 8 nearest distances
@@ -38,3 +41,20 @@ def test_a_gross_bias_is_still_named_when_it_is_the_cause(tmp_path, capsys):
     assert main(["check", str(f)]) == 2
     err = capsys.readouterr().err.strip()
     assert "the bias of 40 mm on the distance" in err, err
+
+
+def test_a_bench_setting_given_twice_in_one_list_is_refused(tmp_path, capsys):
+    # before: `--rerun-workers 1,1` timed make rerun with one worker twice and wrote two rows
+    # of one key into rerun.parquet (and its figure), exit 0; `--only store,store` passed
+    from benchmarks import cli
+
+    for bad, named in (
+        (["--rerun-workers", "1,01"], "1 given twice"),
+        (["--only", "store,store"], "store given twice"),
+    ):
+        with pytest.raises(SystemExit) as e:
+            cli.main([*bad, "--quick", "--out", str(tmp_path / "b")])
+        assert e.value.code == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and named in err, err
+    assert not (tmp_path / "b").exists()
