@@ -109,12 +109,21 @@ def _table_dir(d: Path, e: Exception) -> Path | None:
 def other_code(d: Path) -> str | None:
     """The first results directory at or under ``d`` whose run record names a study whose
     code has changed since (its ``code_hash`` is not this suite's), or None."""
+    return next(iter(stale_dirs(d, first=True)), None)
+
+
+def stale_dirs(d: Path, first: bool = False) -> list[str]:
+    """The results directories at or under ``d`` made by another version of their study's
+    code (``first``: stop at the first)."""
+    found: list[str] = []
     for r in [d, *results_dirs(d)] if d.is_dir() else []:
         rec = read_record(r)
         study = rec.get("config", {}).get("study") if rec else None
         try:
             if isinstance(study, str) and rec["code_hash"] != study_code_hash(study):
-                return str(r)
+                found.append(str(r))
         except (KeyError, ValueError, OSError, ImportError):  # an unknown study: not ours
             continue
-    return None
+        if found and first:
+            break
+    return found

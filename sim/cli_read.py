@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
-from sim.cli_errors import not_as_written, older_lacks, other_code
+from sim.cli_errors import not_as_written, older_lacks, other_code, stale_dirs
 from sim.mc.config import ConfigError
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
@@ -108,6 +108,14 @@ def report(results: Path) -> int:
             raise
         raise ConfigError("--results", why) from None
     print(text)
+    if stale := stale_dirs(results):  # a report of verdicts since changed: read as current
+        names = ", ".join(sorted(Path(s).name for s in stale)[:4]) + (", ..." if len(stale) > 4 else "")
+        print(
+            f"sim: note: {len(stale)} of the reported results directories ({names}) were made by "
+            "another version of the suite's code (their study's code changed since): the report "
+            "gives their verdicts as they were; make reproduce re-runs what is stale",
+            file=sys.stderr,
+        )
     return 0
 
 

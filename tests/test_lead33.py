@@ -1,9 +1,11 @@
 """The lead's own sweep of 2026-11-29 (issue 26): the network kind's refusals after a run
-whose trials do not converge, and the benchmark's lists (a worker count given twice). Each test
-failed on the code before its fix."""
+whose trials do not converge; the benchmark's lists (a worker count given twice); ``sim report``
+over results of another version of the code (said by ``sim show``, not by the report). Each
+test failed on the code before its fix."""
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -58,3 +60,20 @@ def test_a_bench_setting_given_twice_in_one_list_is_refused(tmp_path, capsys):
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1 and named in err, err
     assert not (tmp_path / "b").exists()
+
+
+def test_sim_report_says_which_results_were_made_by_other_code(
+    tiny_run, tmp_path, capsys, monkeypatch
+):
+    # before: `sim show DIR` noted results made by another version of the study's code, while
+    # `sim report` rebuilt REPORT.md from them without a word (after a change of code, a
+    # report of the old verdicts read as current)
+    d = tmp_path / "results" / "salsig_encoders"
+    shutil.copytree(tiny_run("salsig_encoders"), d)
+    assert main(["report", "--results", str(d.parent)]) == 0
+    assert "note" not in capsys.readouterr().err
+    monkeypatch.setattr("sim.cli_errors.study_code_hash", lambda study: "0" * 16)
+    assert main(["report", "--results", str(d.parent)]) == 0
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert "1 of the reported results directories (salsig_encoders) were made by another" in err
