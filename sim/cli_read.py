@@ -109,11 +109,14 @@ def report(results: Path) -> int:
         raise ConfigError("--results", why) from None
     print(text)
     if stale := stale_dirs(results):  # a report of verdicts since changed: read as current
-        names = ", ".join(sorted(Path(s).name for s in stale)[:4]) + (", ..." if len(stale) > 4 else "")
+        names = ", ".join(sorted(Path(s).name for s in stale)[:4]) + (
+            ", ..." if len(stale) > 4 else ""
+        )
         print(
-            f"sim: note: {len(stale)} of the reported results directories ({names}) were made by "
-            "another version of the suite's code (their study's code changed since): the report "
-            "gives their verdicts as they were; make reproduce re-runs what is stale",
+            f"sim: note: {len(stale)} of the reported results directories ({names}) "
+            f"{'was' if len(stale) == 1 else 'were'} made by another version of the suite's code "
+            "(changed since the run): the report "
+            "gives the verdicts as they were; make reproduce re-runs what is stale",
             file=sys.stderr,
         )
     return 0

@@ -76,4 +76,15 @@ def test_sim_report_says_which_results_were_made_by_other_code(
     assert main(["report", "--results", str(d.parent)]) == 0
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1, err
-    assert "1 of the reported results directories (salsig_encoders) were made by another" in err
+    assert "1 of the reported results directories (salsig_encoders) was made by another" in err
+
+
+def test_the_report_says_how_many_trials_of_a_study_did_not_converge(tmp_path, capsys):
+    # before: `sim run` and `sim show` said "not converged: 29 of 40 trials", REPORT.md
+    # listed the study with "3 self-check undecided" and not a word of why
+    out = tmp_path / "r" / "tri"
+    args = ["run", str(_trilateration(tmp_path, 8000.0)), "--out", str(out), "--no-figures"]
+    assert main([*args, "--quiet"]) == 0
+    assert main(["report", "--results", str(out.parent)]) == 0
+    text = (out.parent / "REPORT.md").read_text(encoding="utf-8")
+    assert "(your own instrument as data). Not converged: 29 of 40 trials" in text, text

@@ -23,7 +23,7 @@ from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
 from sim.report.glance import by_paper, design_notes, main_and_variants, number, opening
 from sim.report.papers import paper_name
 from sim.report.read import claims_damage, forget, mixed_run, older, records
-from sim.report.run_summary import headline_rows, write_run_readme
+from sim.report.run_summary import converged_line, headline_rows, write_run_readme
 from sim.report.tables import Md, fmt, md_href, md_link, md_table
 from sim.report.verify import markdown as reproducibility_markdown
 
@@ -306,7 +306,11 @@ def build_report(
     )
     repro = reproducibility_markdown(results)
     lost = _no_file({e[1] for e in entries} | set(sweeps), studies)
-    details = [f"- {md_link(e[1])}: {e[2].title}{lost.get(e[1], '')}" for e in entries]
+    details = [  # the trials that did not converge: said by sim show, not here (lead33)
+        f"- {md_link(e[1])}: {e[2].title}{lost.get(e[1], '')}"
+        + (f". N{line[1:]}" if (line := converged_line(results / e[1])) else "")
+        for e in entries
+    ]
     details += [f"- {md_link(s)}: a sweep{lost.get(s, '')}" for s in sweeps]
     return (
         head
