@@ -1,7 +1,9 @@
-"""The lead's own sweep of 2026-11-29 (issue 26): the network kind's refusals after a run
-whose trials do not converge; the benchmark's lists (a worker count given twice); ``sim report``
-over results of another version of the code (said by ``sim show``, not by the report). Each
-test failed on the code before its fix."""
+"""The lead's own sweep of 2026-11-29 (issue 26): the network kind's refusal after a run
+whose trials do not converge (a bias named where it is not the cause); a w-test power not
+above its level (a negative MDB printed as a finding); the benchmark's lists (a worker count
+given twice); ``sim report`` over results of another version of the code, and over a study
+some of whose trials did not converge (said by ``sim show``, not by the report). Each test
+failed on the code before its fix."""
 
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from sim.cli import main
-from tests.test_lead32 import _trilateration  # 300 random points, 8 nearest distances
+from tests.test_lead32 import STUDIES, _trilateration  # 300 random points, 8 nearest distances
 
 
 def _with_bias(tmp_path: Path, half_extent_mm: float, bias_mm: float) -> Path:
@@ -88,3 +90,31 @@ def test_the_report_says_how_many_trials_of_a_study_did_not_converge(tmp_path, c
     assert main(["report", "--results", str(out.parent)]) == 0
     text = (out.parent / "REPORT.md").read_text(encoding="utf-8")
     assert "(your own instrument as data). Not converged: 29 of 40 trials" in text, text
+
+
+def test_a_w_test_power_not_above_its_level_is_refused(tmp_path, capsys):
+    # before: reliability.alpha0 = 0.5 with reliability.power = 0.05 printed the finding
+    # network.design.mdb_max_mm = -0.002325 (a negative minimal detectable bias), and 0.1 with
+    # 0.05 printed -1.6e-18 (Baarda's delta0 = z(1 - alpha0/2) + z(power) at or below zero)
+    f = STUDIES / "network_plate.toml"
+    for a0, pw in (("0.5", "0.05"), ("0.1", "0.05"), ("0.3", "0.3")):
+        args = [
+            "check",
+            str(f),
+            "--set",
+            f"reliability.alpha0={a0}",
+            "--set",
+            f"reliability.power={pw}",
+        ]
+        assert main(args) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1, err
+        assert err.startswith(
+            f"sim: error: reliability.power: {pw} is not above reliability.alpha0"
+        ), err
+    assert (
+        main(
+            ["check", str(f), "--set", "reliability.alpha0=0.3", "--set", "reliability.power=0.31"]
+        )
+        == 0
+    )

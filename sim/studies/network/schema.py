@@ -78,6 +78,21 @@ def _build(full: dict):
         raise ConfigError("network.gama_xml", f"{gama}: {str(e)[len(e.key) + 2 :]}") from None
 
 
+def _power(cfg: dict) -> None:
+    """The w-test's power above its level: a two-sided test of level alpha0 rejects with a
+    probability of at least alpha0 at any bias, so at a power no higher the minimal detectable
+    bias is no bias (Baarda's delta0 = z(1 - alpha0/2) + z(power) went to zero and below: an
+    MDB of -0.0023 mm was printed as a finding at alpha0 = 0.5, power = 0.05)."""
+    a0, pw = cfg["reliability.alpha0"], cfg["reliability.power"]
+    if pw <= a0:
+        raise ConfigError(
+            "reliability.power",
+            f"{pw:g} is not above reliability.alpha0 = {a0:g}: a w-test of level {a0:g} rejects "
+            f"with a probability of at least {a0:g} whatever the bias, so no bias is the "
+            "smallest it detects with that power; give a power above the level",
+        )
+
+
 def check(cfg: dict) -> None:
     """Cross-key rules: the network builds (every observation well defined), its datum covers
     every rank defect and is not near-singular, something is estimated, the chunk fits in
@@ -87,6 +102,7 @@ def check(cfg: dict) -> None:
     ``network.gama_sha256``, and writes the network's records in their one spelling
     (:func:`sim.studies.network.canonical.canonical`)."""
     require_chunks(cfg)  # estimates.py and tables.py: jackknife intervals over the chunks
+    _power(cfg)
     _digest(cfg)
     full = merge_gama(cfg)
     cfg["datum.kind"] = full["datum.kind"]  # a free gama-local file's inner datum, resolved
