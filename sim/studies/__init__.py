@@ -264,13 +264,13 @@ def _unswept(e: ConfigError, swept: set[str], flat: Mapping[str, Any]) -> Config
             return e
         return ConfigError(  # a key that one cell reads, refused by the file's own values
             e.key,
-            f"{str(e).removeprefix(f'{e.key}: ')} (the values outside [sweep] are checked "
+            f"{e.detail} (the values outside [sweep] are checked "
             f"first, as a study of their own, with {', '.join(sorted(swept))} as given there: "
             "give there values under which it holds)",
         )
     return ConfigError(
         e.key,
-        f"{str(e).removeprefix(f'{e.key}: ')} (the values outside [sweep] are checked first, "
+        f"{e.detail} (the values outside [sweep] are checked first, "
         f"as a study of their own: {', '.join(missing)} is swept but not given there, so it "
         "takes its default; give it one of the swept values too)",
     )

@@ -1,0 +1,116 @@
+"""Fuzz, seeds 3301.. and the doors fuzzer's new seeds (brief F33), and F32's left items; one
+case each, each failed on the code before its fix.
+
+* A TOML date or time where a key wants a number, a string or a list (``trials =
+  1979-05-27``, ``network.name = 07:32:00``, an element of a list, a ``--set`` value, a sweep
+  value, a network record's field, the study name) was quoted by Python's ``repr``: ``got
+  datetime.date(1979, 5, 27)``, or cut at 60 characters to ``datetime.datetime(1979, 5, 27, 7,
+  32, tzinfo=datetime.timezo``. It is now quoted as TOML wrote it (``got 1979-05-27``,
+  ``1979-05-27T07:32:00Z``): every date and time a study file or ``--set`` holds is given a
+  ``repr`` that is its TOML text when read (:func:`sim.mc.toml_dates.as_written`); an API
+  value (``sim.load(..., trials=datetime.date(2020, 1, 1))``) too.
+* A quoted key with white space or a character that does not print (``"trials " = 5``, a tab,
+  a zero-width space, ``--set "tri als=5"``) was named bare, ``trials : unknown key (did you
+  mean trials?)``, the space easy to miss and a zero-width space not seen at all; and the empty
+  key ``"" = 5`` was refused as ``unknown key``, naming no key. Such a key is now named in
+  double quotes with TOML's escapes (``"trials ": unknown key``, ``"tri\\u200bals"``, ``""``)
+  (:func:`sim.mc.message_text.key_text`).
+"""
+
+from __future__ import annotations
+
+import datetime
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim.cli import main
+from tests.oneline import SIM_ERROR, one_line
+
+ROOT = Path(__file__).resolve().parent.parent
+NET = """study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+           { name = "B", x_mm = 400.0, y_mm = 0.0, role = "fixed" },
+           { name = "P", x_mm = 150.0, y_mm = 120.0 } ]
+generate = [ { kind = "distance", from = ["A", "B"], to = "P", sigma_mm = 0.002 } ]
+"""
+
+
+@pytest.mark.parametrize(
+    "text, argv, needle",
+    [
+        (
+            'study = "brown_table1"\ntrials = 1979-05-27\n',
+            [],
+            "trials: must be an integer (got 1979-05-27)",
+        ),
+        (
+            'study = "brown_table1"\ntrials = 1979-05-27T07:32:00Z\n',
+            [],
+            "(got 1979-05-27T07:32:00Z)",
+        ),
+        (
+            'study = "brown_dilution"\n[dilution]\ngrids = [3, 1979-05-27 07:32:00.5]\n',
+            [],
+            "dilution.grids[1]: must be an integer (got 1979-05-27T07:32:00.500000)",
+        ),
+        ('study = "brown_table1"\n', ["--set", "trials=07:32:00"], "(got 07:32:00)"),
+        (
+            'study = "brown_table1"\n[sweep]\ntrials = [1979-05-27T07:32:00-07:00, 40]\n',
+            [],
+            "(got 1979-05-27T07:32:00-07:00)",
+        ),
+        (
+            NET.replace("x_mm = 150.0", "x_mm = 1979-05-27"),
+            [],
+            "x_mm: must be a finite number (got 1979-05-27)",
+        ),
+        ("study = 1979-05-27\n", [], "unknown study 1979-05-27;"),
+    ],
+)
+def test_a_toml_date_is_quoted_as_toml_wrote_it(tmp_path, capsys, text, argv, needle):
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    rc = main(["check", str(f), *argv])
+    line = one_line(capsys, rc, needle, prefix=SIM_ERROR)
+    assert "datetime" not in line, line
+    if not argv:  # the API reads the file the same way
+        with pytest.raises(sim.ConfigError) as e:
+            sim.load(f)
+        assert needle in str(e.value) and "datetime" not in str(e.value), e.value
+
+
+def test_an_api_date_is_quoted_as_toml_writes_it():
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(ROOT / "studies" / "brown_table1.toml", trials=datetime.date(2020, 1, 1))
+    assert "trials: must be an integer (got 2020-01-01)" in str(e.value), e.value
+
+
+@pytest.mark.parametrize(
+    "key, shown",
+    [
+        ('"trials "', '"trials ": unknown key (did you mean trials?)'),
+        ('"trials\\t"', '"trials\\t": unknown key'),
+        ('"tri\\u200bals"', '"tri\\u200bals": unknown key'),
+        ('""', '"": unknown key'),
+        ('plate."grid "', '"plate.grid ": unknown key (did you mean plate.grid?)'),
+    ],
+)
+def test_a_key_with_white_space_is_named_in_quotes(tmp_path, capsys, key, shown):
+    f = tmp_path / "s.toml"
+    f.write_text(f'study = "brown_table1"\n{key} = 5\n')
+    line = one_line(capsys, main(["check", str(f)]), prefix=SIM_ERROR)
+    assert line == SIM_ERROR + shown or line.startswith(SIM_ERROR + shown), line
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(f)
+    assert str(e.value).startswith(shown), e.value
+
+
+def test_a_set_key_with_white_space_is_named_in_quotes(capsys):
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    line = one_line(capsys, main(["check", study, "--set", "tri als=5"]), prefix=SIM_ERROR)
+    assert line.startswith(SIM_ERROR + '"tri als": unknown key'), line
