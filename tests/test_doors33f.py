@@ -15,6 +15,21 @@ case each, each failed on the code before its fix.
   key ``"" = 5`` was refused as ``unknown key``, naming no key. Such a key is now named in
   double quotes with TOML's escapes (``"trials ": unknown key``, ``"tri\\u200bals"``, ``""``)
   (:func:`sim.mc.message_text.key_text`).
+
+Found with the fuzzer's new mutation kind, KEY spelling (tests/fuzz_keys.py):
+
+* ``Study = "brown_table1"`` (or ``"study "``, a zero-width space, a Cyrillic letter) was
+  refused as ``study: missing: the file must say which study it is``, as if the file had no
+  such line; the line now says which key the file has instead (``the file has Study, not
+  that key``).
+* A key with a lookalike letter in its table's name (``papеr.positions``, a Cyrillic е) was
+  answered "did you mean design.positions or paper.positions?", the key of another table
+  first (the same last part); a key that looks the same (another case, white space, a
+  lookalike) now comes first (:func:`sim.mc.lookalike.looks`).
+* A datum constraint written with a bare dotted key, ``constraints = [ { P.x = 1.0 } ]``
+  (TOML reads it as a table ``P`` holding ``x``), was refused as ``'P' is not <point>.x or
+  <point>.y of a network point``, naming the point the user wrote with its axis; it now says
+  the key needs quotes (``write "P.x" = ... in quotes``).
 """
 
 from __future__ import annotations
@@ -114,3 +129,25 @@ def test_a_set_key_with_white_space_is_named_in_quotes(capsys):
     study = str(ROOT / "studies" / "brown_table1.toml")
     line = one_line(capsys, main(["check", study, "--set", "tri als=5"]), prefix=SIM_ERROR)
     assert line.startswith(SIM_ERROR + '"tri als": unknown key'), line
+
+
+@pytest.mark.parametrize("key", ["Study", '"study "', '"stu\\u200bdy"', '"ѕtudy"'])
+def test_the_study_key_misspelt_is_named(tmp_path, capsys, key):
+    f = tmp_path / "s.toml"
+    f.write_text(f'{key} = "brown_table1"\ntrials = 40\n')
+    line = one_line(capsys, main(["check", str(f)]), "study: missing", prefix=SIM_ERROR)
+    assert "the file has " in line and "not that key" in line, line
+
+
+def test_a_lookalike_table_name_is_answered_with_its_own_key(tmp_path, capsys):
+    f = tmp_path / "s.toml"
+    f.write_text('study = "brown_design"\n"papеr".positions = [4]\n')
+    line = one_line(capsys, main(["check", str(f)]), prefix=SIM_ERROR)
+    assert "(did you mean paper.positions" in line, line
+
+
+def test_a_bare_dotted_datum_constraint_says_to_quote_it(tmp_path, capsys):
+    f = tmp_path / "s.toml"
+    f.write_text(NET + '[datum]\nkind = "constraints"\nconstraints = [ { P.x = 1.0 } ]\n')
+    line = one_line(capsys, main(["check", str(f)]), "datum.constraints[0]", prefix=SIM_ERROR)
+    assert 'write "P.x" = ... in quotes' in line and "'P' is not" not in line, line

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from sim.mc.lookalike import note, toml_char_hint
+from sim.mc.lookalike import looks, note, toml_char_hint
 from sim.mc.message_text import key_text, shorten, shown
 from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
@@ -217,11 +217,13 @@ def flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
 
 
 def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
-    """The schema keys a mistyped ``key`` most likely meant (at most ``n``): the key with a
-    unit suffix (``comparator.beta`` -> ``comparator.beta_mm``), the same last part under
-    another table, or the closest spellings (difflib)."""
+    """The schema keys a mistyped ``key`` most likely meant (at most ``n``): the key that looks
+    the same (:func:`sim.mc.lookalike.looks`: another case, white space, a lookalike letter;
+    paper.positions with a Cyrillic a was "did you mean design.positions or paper.positions"),
+    the key with a unit suffix (``comparator.beta`` -> ``comparator.beta_mm``), the same last
+    part under another table, or the closest spellings (difflib)."""
     names = list(schema)
-    same_case = [s for s in names if s.lower() == key.lower()]  # TRIALS: no guess before
+    same_case = [s for s in names if looks(s) == looks(key)]  # TRIALS, "trials ", triаls
     suffixed = [s for s in names if s.startswith(key + "_") and "." not in s[len(key) :]]
     last = key.split(".")[-1]
     same_last = [s for s in names if s.split(".")[-1] == last]

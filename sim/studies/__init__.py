@@ -15,6 +15,8 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.config import ConfigError, Field, flatten, parse_override, read_toml, validate
+from sim.mc.lookalike import looks
+from sim.mc.message_text import key_text
 from sim.mc.read_when import refuse_unread, unread
 from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
@@ -201,7 +203,9 @@ def load_study(
     flat = flatten({k: v for k, v in doc.items() if k != "sweep"})  # [sweep]: sim.mc.sweep
     name = flat.pop("study", None)
     if name is None:
-        raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
+        raise ConfigError(
+            "study", f'missing: the file must say which study it is (study = "..."){_spelt(doc)}'
+        )
     study = get_study(name)
     table = read_sweep(path, study.schema) if "sweep" in doc else {}  # unknown keys first
     swept = set(table) - set(RESERVED)
@@ -232,6 +236,14 @@ def load_study(
     if study.data is not None:
         study.data(cfg, study.schema)
     return study, {"study": name, **cfg}
+
+
+def _spelt(doc: Mapping[str, Any]) -> str:
+    """`` (the file has "Study ": ...)`` for a top-level key of ``doc`` spelt like ``study`` in
+    another case, with white space, a character that does not print or a lookalike letter (it
+    read "study: missing" alone)."""
+    hit = next((k for k in doc if looks(k) == "study"), None)
+    return "" if hit is None else f"; the file has {key_text(hit)}, not that key"
 
 
 def _asked(

@@ -288,6 +288,13 @@ def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
         pos = {g: a for a, g in enumerate(free)}
         for b, rec in enumerate(recs):
             for name, coef in rec.items():
+                if isinstance(coef, dict) and coef:  # { P.x = 1.0 }: a table P to TOML
+                    pair = f"{name}.{next(iter(coef))}"
+                    raise ConfigError(
+                        f"datum.constraints[{b}]",
+                        f"{pair} without quotes is read by TOML as a table {name} with a key "
+                        f'{next(iter(coef))}: write "{pair}" = ... in quotes',
+                    )
                 g = _param_index(net, f"datum.constraints[{b}]", name)
                 if g not in pos:
                     if g // 2 in extra_fixed:
