@@ -14,7 +14,8 @@ case each, each failed on the code before its fix.
   mean trials?)``, the space easy to miss and a zero-width space not seen at all; and the empty
   key ``"" = 5`` was refused as ``unknown key``, naming no key. Such a key is now named in
   double quotes with TOML's escapes (``"trials ": unknown key``, ``"tri\\u200bals"``, ``""``)
-  (:func:`sim.mc.message_text.key_text`).
+  (:func:`sim.mc.message_text.key_text`); ``python -m sim.batch``'s own check of a run
+  option's ``--set`` key too.
 
 Found with the fuzzer's new mutation kind, KEY spelling (tests/fuzz_keys.py):
 
@@ -40,6 +41,7 @@ from pathlib import Path
 import pytest
 
 import sim
+from sim.batch import main as batch_main
 from sim.cli import main
 from tests.oneline import SIM_ERROR, one_line
 
@@ -125,10 +127,13 @@ def test_a_key_with_white_space_is_named_in_quotes(tmp_path, capsys, key, shown)
     assert str(e.value).startswith(shown), e.value
 
 
-def test_a_set_key_with_white_space_is_named_in_quotes(capsys):
+def test_a_set_key_with_white_space_is_named_in_quotes(tmp_path, capsys):
     study = str(ROOT / "studies" / "brown_table1.toml")
     line = one_line(capsys, main(["check", study, "--set", "tri als=5"]), prefix=SIM_ERROR)
     assert line.startswith(SIM_ERROR + '"tri als": unknown key'), line
+    rc = batch_main(["--results", str(tmp_path / "r"), study, "--", "--set", "tri\u200bals=5"])
+    line = one_line(capsys, rc, "sim.batch: ")
+    assert '--set "tri\\u200bals": unknown key' in line, line
 
 
 @pytest.mark.parametrize("key", ["Study", '"study "', '"stu\\u200bdy"', '"ѕtudy"'])
