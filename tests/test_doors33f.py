@@ -21,8 +21,11 @@ Found with the fuzzer's new mutation kind, KEY spelling (tests/fuzz_keys.py):
 
 * ``Study = "brown_table1"`` (or ``"study "``, a zero-width space, a Cyrillic letter) was
   refused as ``study: missing: the file must say which study it is``, as if the file had no
-  such line; the line now says which key the file has instead (``the file has Study, not
-  that key``).
+  such line (beside a ``study`` line: ``Study: unknown key``, no guess); ``[Sweep]`` (or
+  ``SWEEP.trials``) as ``Sweep.trials: unknown key (did you mean trials?)``, a guess that
+  sweeps nothing. Each is now named as not that word (``Study: is not study (a study file
+  names its study by study = "...", spelt so)``); and ``[sweep] Replicates = 2`` (no guess)
+  is answered "did you mean sweep.replicates?".
 * A key with a lookalike letter in its table's name (``papеr.positions``, a Cyrillic е) was
   answered "did you mean design.positions or paper.positions?", the key of another table
   first (the same last part); a key that looks the same (another case, white space, a
@@ -136,12 +139,25 @@ def test_a_set_key_with_white_space_is_named_in_quotes(tmp_path, capsys):
     assert '--set "tri\\u200bals": unknown key' in line, line
 
 
-@pytest.mark.parametrize("key", ["Study", '"study "', '"stu\\u200bdy"', '"ѕtudy"'])
-def test_the_study_key_misspelt_is_named(tmp_path, capsys, key):
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        ('Study = "brown_table1"\n', "Study: is not study (a study file names its study by"),
+        ('study = "brown_table1"\n"study " = "x"\n', '"study ": is not study'),
+        ('"stu\\u200bdy" = "brown_table1"\n', '"stu\\u200bdy": is not study'),
+        ('"ѕtudy" = "brown_table1"\n', "ѕtudy: is not study"),
+        ('study = "brown_table1"\n[Sweep]\ntrials = [40, 60]\n', "Sweep: is not sweep (the"),
+        ('study = "brown_table1"\nSWEEP.trials = [40, 60]\n', "SWEEP: is not sweep"),
+        (
+            'study = "brown_table1"\n[sweep]\nReplicates = 2\ntrials = [4000, 6000]\n',
+            "sweep.Replicates: unknown key (did you mean sweep.replicates?)",
+        ),
+    ],
+)
+def test_study_and_sweep_misspelt_are_named(tmp_path, capsys, text, needle):
     f = tmp_path / "s.toml"
-    f.write_text(f'{key} = "brown_table1"\ntrials = 40\n')
-    line = one_line(capsys, main(["check", str(f)]), "study: missing", prefix=SIM_ERROR)
-    assert "the file has " in line and "not that key" in line, line
+    f.write_text(text)
+    one_line(capsys, main(["check", str(f)]), SIM_ERROR + needle, prefix=SIM_ERROR)
 
 
 def test_a_lookalike_table_name_is_answered_with_its_own_key(tmp_path, capsys):

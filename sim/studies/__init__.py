@@ -16,7 +16,6 @@ from typing import Any, Callable, Mapping
 
 from sim.mc.config import ConfigError, Field, flatten, parse_override, read_toml, validate
 from sim.mc.lookalike import looks
-from sim.mc.message_text import key_text
 from sim.mc.read_when import refuse_unread, unread
 from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
@@ -184,6 +183,14 @@ def _overridable(key: str, swept: set) -> None:
         )
 
 
+#: the two top-level words of every study file, and what each is (a key of the file that looks
+#: like one, in another case or with white space, is refused saying so)
+_SPELT = {
+    "study": 'a study file names its study by study = "..."',
+    "sweep": "the table of swept keys is [sweep]",
+}
+
+
 def load_study(
     path: str | Path,
     overrides: list[str] | tuple = (),
@@ -200,12 +207,13 @@ def load_study(
     and ``cfg`` the resolved flat configuration (including ``study``).
     """
     doc = read_toml(path)
+    for k in doc:  # Study = "..." was "study: missing", [Sweep] trials = [...] "Sweep.trials:
+        if k not in _SPELT and looks(k) in _SPELT:  # unknown key (did you mean trials?)"
+            raise ConfigError(k, f"is not {looks(k)} ({_SPELT[looks(k)]}, spelt so)")
     flat = flatten({k: v for k, v in doc.items() if k != "sweep"})  # [sweep]: sim.mc.sweep
     name = flat.pop("study", None)
     if name is None:
-        raise ConfigError(
-            "study", f'missing: the file must say which study it is (study = "..."){_spelt(doc)}'
-        )
+        raise ConfigError("study", 'missing: the file must say which study it is (study = "...")')
     study = get_study(name)
     table = read_sweep(path, study.schema) if "sweep" in doc else {}  # unknown keys first
     swept = set(table) - set(RESERVED)
@@ -236,14 +244,6 @@ def load_study(
     if study.data is not None:
         study.data(cfg, study.schema)
     return study, {"study": name, **cfg}
-
-
-def _spelt(doc: Mapping[str, Any]) -> str:
-    """`` (the file has "Study ": ...)`` for a top-level key of ``doc`` spelt like ``study`` in
-    another case, with white space, a character that does not print or a lookalike letter (it
-    read "study: missing" alone)."""
-    hit = next((k for k in doc if looks(k) == "study"), None)
-    return "" if hit is None else f"; the file has {key_text(hit)}, not that key"
 
 
 def _asked(
