@@ -30,6 +30,9 @@ Found with the fuzzer's new mutation kind, KEY spelling (tests/fuzz_keys.py):
   answered "did you mean design.positions or paper.positions?", the key of another table
   first (the same last part); a key that looks the same (another case, white space, a
   lookalike) now comes first (:func:`sim.mc.lookalike.looks`).
+* A network record's field spelt in another case or with ``-`` (``Name``, ``x-mm``, ``"name "``)
+  was refused as ``network.points[3].Name: unknown field``, alone: the fields are nowhere
+  else on that line; it is now answered as an unknown key is ("did you mean name?").
 * A datum constraint written with a bare dotted key, ``constraints = [ { P.x = 1.0 } ]``
   (TOML reads it as a table ``P`` holding ``x``), was refused as ``'P' is not <point>.x or
   <point>.y of a network point``, naming the point the user wrote with its axis; it now says
@@ -172,3 +175,17 @@ def test_a_bare_dotted_datum_constraint_says_to_quote_it(tmp_path, capsys):
     f.write_text(NET + '[datum]\nkind = "constraints"\nconstraints = [ { P.x = 1.0 } ]\n')
     line = one_line(capsys, main(["check", str(f)]), "datum.constraints[0]", prefix=SIM_ERROR)
     assert 'write "P.x" = ... in quotes' in line and "'P' is not" not in line, line
+
+
+@pytest.mark.parametrize(
+    "old, new, needle",
+    [
+        ('name = "P"', 'Name = "P"', "points[2].Name: unknown field (did you mean name?)"),
+        ("x_mm = 150.0", "x-mm = 150.0", "points[2].x-mm: unknown field (did you mean x_mm?)"),
+        ('kind = "distance"', 'knd = "distance"', "(did you mean kind?)"),
+    ],
+)
+def test_a_misspelt_network_field_gets_a_guess(tmp_path, capsys, old, new, needle):
+    f = tmp_path / "s.toml"
+    f.write_text(NET.replace(old, new, 1))
+    one_line(capsys, main(["check", str(f)]), needle, prefix=SIM_ERROR)
