@@ -71,3 +71,72 @@ def respell(rng: random.Random, flat: dict, toml_value, toml_tables) -> tuple[st
     line = ".".join(map(_quoted, parts[:j] + [spelt] + parts[j + 1 :]))  # read stripped)
     doc = [f"{line} = {toml_value(flat[k])}" if x == k else ln for x, ln in zip(flat, lines)]
     return "\n".join(doc) + "\n", f"{how} {key_text(new)}", []
+
+
+#: a small network whose every key a case may respell: tables, record fields, constraint keys
+NETWORK = {
+    "study": "network",
+    "trials": 40,
+    "chunk": 2,
+    "network": {
+        "name": "spelt",
+        "points": [
+            {"name": "A", "x_mm": 0.0, "y_mm": 0.0},
+            {"name": "B", "x_mm": 400.0, "y_mm": 0.0},
+            {"name": "C", "x_mm": 400.0, "y_mm": 300.0, "role": "free"},
+            {"name": "P", "x_mm": 150.0, "y_mm": 120.0},
+        ],
+        "grids": [{"prefix": "G", "nx": 2, "ny": 2, "spacing_mm": 50.0}],
+        "generate": [
+            {"kind": "distance", "from": ["A", "B", "C"], "to": "*", "sigma_mm": 0.002},
+            {"kind": "direction", "from": "C", "to": "*", "sigma_arcsec": 2.0},
+        ],
+    },
+    "datum": {"kind": "constraints", "constraints": [{"A.x": 1.0}, {"A.y": 1.0}, {"B.y": 1.0}]},
+    "output": {"inner_over": ["G*"]},
+}
+
+
+def _inline(v, toml_value) -> str:
+    if isinstance(v, dict):
+        return (
+            "{ "
+            + ", ".join(f"{_quoted(k)} = {_inline(x, toml_value)}" for k, x in v.items())
+            + " }"
+        )
+    if isinstance(v, list):
+        return "[" + ", ".join(_inline(x, toml_value) for x in v) + "]"
+    return toml_value(v)
+
+
+def network_case(rng: random.Random, toml_value) -> tuple[str, str, list[str]]:
+    """``(document, description, needles)``: :data:`NETWORK` with one key spelt as no key is
+    (a table's name, a field of a record, a point's name in a constraint's key); the line
+    must hold one of ``needles`` (the part so spelt, as a key or a ``repr`` shows it)."""
+    doc = json.loads(json.dumps(NETWORK))
+    table = rng.choice(["network", "datum", "output", "points", "grids", "generate", "constraints"])
+    if table in ("network", "datum", "output"):
+        old = rng.choice([table, *doc[table]])
+        spelt, how = _respelt_part(rng, old)
+        if old == table:
+            doc[spelt] = doc.pop(table)
+        else:
+            doc[table] = {spelt if k == old else k: v for k, v in doc[table].items()}
+    else:
+        recs = doc["datum"]["constraints"] if table == "constraints" else doc["network"][table]
+        i = rng.randrange(len(recs))
+        old = rng.choice(list(recs[i]))
+        spelt, how = _respelt_part(rng, old)
+        recs[i] = {spelt if k == old else k: v for k, v in recs[i].items()}
+    lines = [
+        f"{_quoted(k)} = {_inline(v, toml_value)}"
+        for k, v in doc.items()
+        if not isinstance(v, dict)
+    ]
+    for head, body in ((k, v) for k, v in doc.items() if isinstance(v, dict)):
+        lines += [
+            f"[{_quoted(head)}]",
+            *(f"{_quoted(k)} = {_inline(v, toml_value)}" for k, v in body.items()),
+        ]
+    needles = [key_text(spelt).strip('"'), repr(spelt)[1:-1], spelt]
+    return "\n".join(lines) + "\n", f"network {table}: {how} {old} -> {spelt!r}", needles

@@ -36,7 +36,10 @@ Found with the fuzzer's new mutation kind, KEY spelling (tests/fuzz_keys.py):
 * A datum constraint written with a bare dotted key, ``constraints = [ { P.x = 1.0 } ]``
   (TOML reads it as a table ``P`` holding ``x``), was refused as ``'P' is not <point>.x or
   <point>.y of a network point``, naming the point the user wrote with its axis; it now says
-  the key needs quotes (``write "P.x" = ... in quotes``).
+  the key needs quotes (``write "P.x" = ... in quotes``). A constraint's key whose axis is
+  a lookalike (``"B.у"``, a Cyrillic у) or whose point is (``"А.x"``) was "is not <point>.x
+  or <point>.y of a network point", as if it were not written so; it now names the axis
+  (and its character) or the point (and the point that looks the same).
 """
 
 from __future__ import annotations
@@ -189,3 +192,19 @@ def test_a_misspelt_network_field_gets_a_guess(tmp_path, capsys, old, new, needl
     f = tmp_path / "s.toml"
     f.write_text(NET.replace(old, new, 1))
     one_line(capsys, main(["check", str(f)]), needle, prefix=SIM_ERROR)
+
+
+@pytest.mark.parametrize(
+    "spelt, needle",
+    [
+        ('"B.\\u0443"', "'B.у': the axis after its last dot must be x or y ('у', U+0443 CYRILLIC"),
+        (
+            '"\\u0410.x"',
+            "'А.x': 'А' is no point of the network (declared is 'A', which looks the same",
+        ),
+    ],
+)
+def test_a_lookalike_in_a_constraint_key_is_named(tmp_path, capsys, spelt, needle):
+    f = tmp_path / "s.toml"
+    f.write_text(NET + f'[datum]\nkind = "constraints"\nconstraints = [ {{ {spelt} = 1.0 }} ]\n')
+    one_line(capsys, main(["check", str(f)]), f"datum.constraints[0]: {needle}", prefix=SIM_ERROR)

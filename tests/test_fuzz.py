@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fuzz_keys import respell
+from fuzz_keys import network_case, respell
 
 from sim.cli import main
 from sim.mc.config import flatten
@@ -588,6 +588,22 @@ def test_fuzz(tmp_path):
     assert not failures, f"{len(failures)} of {CASES} fuzz cases broke the contract:\n" + "\n".join(
         failures
     )
+
+
+def test_fuzz_network_keys(tmp_path, capsys):
+    """KEY spelling in a small network (tests/fuzz_keys.py): a table's name, a record's field
+    or a constraint's point spelt as no key is; ``sim check`` must refuse each in one line
+    naming the key as written (4 cases per fuzz case: each is a check, not a run)."""
+    failures = []
+    for i in range(4 * CASES):
+        text, desc, needles = network_case(random.Random(SEED * 100_003 + 77_777 + i), toml_value)
+        f = tmp_path / "study.toml"
+        f.write_text(text)
+        rc = main(["check", str(f)])
+        err = capsys.readouterr().err.strip()
+        if rc != 2 or "\n" in err or not any(n in err for n in needles):
+            failures.append(f"case {i} ({desc}): exit {rc}: {err[-300:]}")
+    assert not failures, f"{len(failures)} of {4 * CASES}:\n" + "\n".join(failures)
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz
