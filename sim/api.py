@@ -295,7 +295,7 @@ class StudyHandle:
                 )
             except ConfigError as e:
                 if e.key in _ARGUMENTS:  # the command line's option: the argument of run()
-                    msg = str(e).removeprefix(f"{e.key}: ")
+                    msg = e.detail
                     raise ConfigError(_ARGUMENTS[e.key], msg) from None
                 if e.key != "--out" and not any(cli in str(e) for cli, _ in _LIMITS):
                     raise
@@ -332,7 +332,7 @@ def _api_words(e: ConfigError) -> ConfigError:
     replace is ``overwrite=True`` (the command line's ``--out``/``--overwrite`` name nothing
     a caller of ``run()`` can pass); a work limit's, the environment variable (:data:`_LIMITS`)."""
     if e.key != "--out":  # a work limit: run() takes no option for it, the environment does
-        msg = str(e).removeprefix(f"{e.key}: " if e.key else "")
+        msg = e.detail
         for cli, api in _LIMITS:
             msg = msg.replace(cli, api)
         return ConfigError(e.key, msg)

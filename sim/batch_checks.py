@@ -23,6 +23,7 @@ from sim.cli_errors import cwd_exists
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
 from sim.mc.estimate import check_limits, estimate
+from sim.mc.message_text import key_text
 from sim.mc.outputs import check_out
 from sim.mc.paths import absolute
 from sim.mc.publish import changed_figure
@@ -246,10 +247,10 @@ def _unknown_sets(files: list[Path], run_args: list[str]) -> tuple[str | None, s
             continue
         if len(lack) == len(schemas):
             many = "no study of the batch has it" if len(files) > 1 else "the study has no such key"
-            return f"--set {key}: unknown key ({many})", None
+            return f"--set {key_text(key)}: unknown key ({many})", None
         studies = ", ".join(f"{f.name} ({schemas[f][0]})" for f in lack)
         notes.append(
-            f"--set {key}: unknown to {studies}, whose run{'s' * (len(lack) > 1)} will refuse it"
+            f"--set {key_text(key)}: unknown to {studies}, whose run{'s' * (len(lack) > 1)} will refuse it"
         )
     return None, "; ".join(notes) or None
 

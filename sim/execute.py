@@ -317,7 +317,7 @@ def _this_process(e: ConfigError) -> ConfigError:
     me = f"(pid {os.getpid()})"
     if me not in str(e):
         return e
-    msg = str(e).removeprefix(f"{e.key}: ").replace(me, "(another run in this process: a thread)")
+    msg = e.detail.replace(me, "(another run in this process: a thread)")
     return ConfigError(e.key, msg)
 
 

@@ -8,7 +8,10 @@ table form with the key moved into another table or to the top level, its table 
 tables or declared twice, the key itself an array of tables), its TOML type (a number as
 a string, a bool, a date or time, a table or array for a scalar, a mixed, empty or nested
 array, an integer beyond 64 bits, ``-0``, ``0x10``, ``1_000``; ``FUZZ_TYPE_WEIGHT`` sets its
-share) or the command line (``--trials``, ``--seed``, ``--workers``, ``--out``,
+share), a key's spelling (another case, a lookalike letter, white space or an invisible
+character in a quoted key, ``-`` for ``_``, the key given twice through two spellings:
+tests/fuzz_keys.py; ``FUZZ_KEY_WEIGHT`` sets its share: such a case must be refused, naming
+the key as written) or the command line (``--trials``, ``--seed``, ``--workers``, ``--out``,
 ``--scheduler``). Every case runs ``sim run`` in a forked child
 (its own session, an address-space limit, a time bound) and must give exit 0 with finite
 results, or exit 2 with exactly one line on standard error and no traceback, and leave
@@ -35,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from fuzz_keys import network_case, respell
 
 from sim.cli import main
 from sim.mc.config import flatten
@@ -320,6 +324,7 @@ def make_case(i: int):
         + ["two"] * 2
         + ["set", "structure", "sweep", "option", "relocate"]
         + ["type"] * int(os.environ.get("FUZZ_TYPE_WEIGHT", "2"))
+        + ["key"] * int(os.environ.get("FUZZ_KEY_WEIGHT", "2"))
     )
     if kind in ("value", "two"):
         keys = rng.sample(schema, 2 if kind == "two" else 1)
@@ -386,6 +391,9 @@ def make_case(i: int):
         desc = f"{k}={toml_value(flat[k])[:60]}"
     elif kind == "relocate":
         raw, desc = relocate(rng, flat, schema)
+    elif kind == "key":  # the last word of desc: the key the refusal must name
+        text, desc, opts = respell(rng, flat, toml_value, toml_tables)
+        raw, extra = text.encode(), extra + opts
     elif kind == "sweep":
         k = rng.choice(schema)
         rngv = rng.choice(
@@ -538,6 +546,10 @@ def fuzz(n: int, tmp: Path) -> list[str]:
         study.write_bytes(raw if raw is not None else toml_doc(flat, sweep).encode())
         code, _, err, secs, argv = run_case(d, study, extra, TIMEOUT)
         bad = check_case(d, code, err, extra)
+        named = desc.rsplit(" ", 1)[-1]  # a misspelt key refused, named as written
+        if not bad and ": key: " in desc and (code != 2 or named not in err):
+            twice = desc.split(": key: ")[1].startswith("twice") and " line " in err  # TOML's
+            bad = None if twice else f"a misspelt key not refused naming {named}: exit {code}"
         if bad:
             where = study
             if save:
@@ -576,6 +588,22 @@ def test_fuzz(tmp_path):
     assert not failures, f"{len(failures)} of {CASES} fuzz cases broke the contract:\n" + "\n".join(
         failures
     )
+
+
+def test_fuzz_network_keys(tmp_path, capsys):
+    """KEY spelling in a small network (tests/fuzz_keys.py): a table's name, a record's field
+    or a constraint's point spelt as no key is; ``sim check`` must refuse each in one line
+    naming the key as written (4 cases per fuzz case: each is a check, not a run)."""
+    failures = []
+    for i in range(4 * CASES):
+        text, desc, needles = network_case(random.Random(SEED * 100_003 + 77_777 + i), toml_value)
+        f = tmp_path / "study.toml"
+        f.write_text(text)
+        rc = main(["check", str(f)])
+        err = capsys.readouterr().err.strip()
+        if rc != 2 or "\n" in err or not any(n in err for n in needles):
+            failures.append(f"case {i} ({desc}): exit {rc}: {err[-300:]}")
+    assert not failures, f"{len(failures)} of {4 * CASES}:\n" + "\n".join(failures)
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz

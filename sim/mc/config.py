@@ -23,10 +23,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from sim.mc.lookalike import note, toml_char_hint
+from sim.mc.lookalike import looks, note, toml_char_hint
+from sim.mc.message_text import key_text, shorten, shown
 from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.study_file import study_file_problem
+from sim.mc.toml_dates import as_written
 
 __all__ = [
     "ConfigError",
@@ -40,42 +42,6 @@ __all__ = [
     "shown",
 ]
 
-#: digits of an integer above which a message shows it shortened (a 64-bit one has 19 digits)
-LONG_DIGITS = 19
-#: a run of more digits than that in a message, not part of a word, a path or a decimal
-_LONG_RUN = re.compile(r"(?<![\w./])-?\d{%d,}(?![\w./])" % (LONG_DIGITS + 1))
-
-
-def shown(v: Any) -> str:
-    """``repr(v)`` for a message, with an integer of more than 19 digits shortened (``1e+300``,
-    or "a 401-digit number" beyond a float's range): 1e300 given for an integer key is the
-    integer 10**300 (301 digits), which no one line should print."""
-    if isinstance(v, int) and not isinstance(v, bool):
-        if abs(v) >= 10**4000:  # str() reads at most 4300 digits
-            return f"a {'negative ' if v < 0 else ''}number of over 4000 digits"
-        digits = len(str(abs(v)))
-        if digits <= LONG_DIGITS:
-            return repr(v)
-        try:
-            return f"{float(v):g}"
-        except OverflowError:
-            return f"a {'negative ' if v < 0 else ''}{digits}-digit number"
-    return repr(v)
-
-
-def _shorten(message: str) -> str:
-    """Every run of more than 19 digits in ``message`` shortened as :func:`shown` does (one
-    beyond a float's range counted, not converted: Python reads at most 4300 digits)."""
-
-    def short(m: re.Match) -> str:
-        t = m.group(0)
-        digits = len(t.lstrip("-"))
-        if digits > 308:
-            return f"a {'negative ' if t.startswith('-') else ''}{digits}-digit number"
-        return shown(int(t))
-
-    return _LONG_RUN.sub(short, message)
-
 
 class ConfigError(ValueError):
     """A bad study configuration. ``str(err)`` is one line naming the key; a character in it
@@ -84,8 +50,13 @@ class ConfigError(ValueError):
 
     def __init__(self, key: str | None, message: str):
         self.key = key  # a number of hundreds of digits is shortened in any message
-        text = f"{key}: {message}" if key else message
-        super().__init__(_shorten(text + note(text)))
+        text = f"{key_text(key)}: {message}" if key is not None else message
+        super().__init__(shorten(text + note(text)))
+
+    @property
+    def detail(self) -> str:
+        """The message without the key it names (to be said again of another key or door)."""
+        return str(self).removeprefix(f"{key_text(self.key)}: " if self.key is not None else "")
 
 
 class StudyError(RuntimeError):
@@ -246,11 +217,13 @@ def flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
 
 
 def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
-    """The schema keys a mistyped ``key`` most likely meant (at most ``n``): the key with a
-    unit suffix (``comparator.beta`` -> ``comparator.beta_mm``), the same last part under
-    another table, or the closest spellings (difflib)."""
+    """The schema keys a mistyped ``key`` most likely meant (at most ``n``): the key that looks
+    the same (:func:`sim.mc.lookalike.looks`: another case, white space, a lookalike letter;
+    paper.positions with a Cyrillic a was "did you mean design.positions or paper.positions"),
+    the key with a unit suffix (``comparator.beta`` -> ``comparator.beta_mm``), the same last
+    part under another table, or the closest spellings (difflib)."""
     names = list(schema)
-    same_case = [s for s in names if s.lower() == key.lower()]  # TRIALS: no guess before
+    same_case = [s for s in names if looks(s) == looks(key)]  # TRIALS, "trials ", triаls
     suffixed = [s for s in names if s.startswith(key + "_") and "." not in s[len(key) :]]
     last = key.split(".")[-1]
     same_last = [s for s in names if s.split(".")[-1] == last]
@@ -352,7 +325,7 @@ def parse_override(text: str) -> tuple[str, Any]:
         raise ConfigError(key, "--set value is nested too deeply") from None
     if list(doc) != ["v"]:
         raise ConfigError(key, f"--set value must be one TOML value (got {val!r})")
-    return key, doc["v"]
+    return key, as_written(doc["v"])  # a date quoted as TOML wrote it
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
@@ -368,7 +341,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
             raise ConfigError(None, f"{p}: not UTF-8 text (it holds NUL bytes: UTF-16 or binary)")
         doc = tomllib.loads(text := data.decode("utf-8"), parse_float=toml_float)
         refuse_big_ints("", doc)
-        return doc
+        return as_written(doc)  # a date or time quoted in a message as TOML wrote it
     except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again
         raise
     except tomllib.TOMLDecodeError as e:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import re
 import unicodedata
 
-__all__ = ["note", "skeleton", "differs", "char_name", "alike", "toml_char_hint"]
+__all__ = ["note", "skeleton", "looks", "differs", "char_name", "alike", "toml_char_hint"]
 
 #: Cyrillic and Greek letters drawn as a Latin letter, and the letter they look like
 #: (doors25a: and the Armenian, Cherokee and Latin letters drawn as one, Greek small ones)
@@ -36,6 +36,12 @@ def skeleton(text: str) -> str:
     """``text`` as it looks: NFKC-folded (full-width forms, ligatures, composed accents), with
     the Cyrillic and Greek letters that look Latin and the Unicode minus read as ASCII."""
     return unicodedata.normalize("NFKC", text).translate(_GLYPHS).translate(_SIGNS)
+
+
+def looks(text: str) -> str:
+    """``text`` as a reader sees it, in lower case: its :func:`skeleton` without white space and
+    characters that do not print (``"Tri\u200bals "`` looks like ``trials``)."""
+    return "".join(c for c in skeleton(text) if c.isprintable() and not c.isspace()).lower()
 
 
 def _lookalike(c: str, word: str) -> bool:

@@ -25,12 +25,14 @@ integer, a double and a string, in lists and tables. Each value is read as the n
   (``network.gama_xml``) takes the path it is (it was refused as "must be a string").
 
 Anything else (a complex number, a date, ``None``) is passed on as given and refused by the
-key's validation with one line naming the type expected. A bool stays a bool (refused where
+key's validation with one line naming the type expected (a date or time quoted as TOML writes
+it: ``2020-01-01``, not ``datetime.date(2020, 1, 1)``). A bool stays a bool (refused where
 a number is meant: ``True`` is not the trial count 1).
 """
 
 from __future__ import annotations
 
+import datetime
 import decimal
 import numbers
 import os
@@ -42,6 +44,7 @@ import pyarrow as pa
 
 from sim.mc.config import ConfigError, refuse_big_ints
 from sim.mc.numtext import unheld
+from sim.mc.toml_dates import as_written
 
 __all__ = ["as_config_value"]
 
@@ -97,7 +100,9 @@ def _scalar(key: str, v: Any) -> Any:
     if isinstance(v, str):  # np.str_, a str subclass (a StrEnum member)
         return str.__str__(v)
     if isinstance(v, np.generic):  # datetime64 and the like: refused by the key, as Python's
-        return v.item()
+        return as_written(v.item())
+    if isinstance(v, (datetime.date, datetime.time)):  # refused by the key, quoted as TOML
+        return as_written(v)  # writes it (2020-01-01), as a study file's date is
     if isinstance(v, os.PathLike):  # Path("net.xml"); one of bytes is refused by the key
         try:
             text = os.fspath(v)

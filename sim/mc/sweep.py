@@ -221,7 +221,7 @@ def expand(table: Mapping[str, Any], schema: Mapping | None = None):
         if k in ("seed", "study"):
             raise ConfigError(f"sweep.{k}", "cannot be swept (use replicates for seeds)")
         if schema is not None and k not in schema:
-            near = did_you_mean(k, schema)  # as an unknown key outside [sweep] is answered
+            near = did_you_mean(k, {**dict.fromkeys(RESERVED), **schema})  # Replicates too
             hint = f" (did you mean {' or '.join(f'sweep.{n}' for n in near)}?)" if near else ""
             raise ConfigError(f"sweep.{k}", f"unknown key{hint}")
         if schema is not None and getattr(schema[k], "sweep", None):

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.config import ConfigError, Field, flatten, parse_override, read_toml, validate
+from sim.mc.lookalike import looks
 from sim.mc.read_when import refuse_unread, unread
 from sim.mc.registry import MODULES
 from sim.mc.runner import RunContext
@@ -182,6 +183,14 @@ def _overridable(key: str, swept: set) -> None:
         )
 
 
+#: the two top-level words of every study file, and what each is (a key of the file that looks
+#: like one, in another case or with white space, is refused saying so)
+_SPELT = {
+    "study": 'a study file names its study by study = "..."',
+    "sweep": "the table of swept keys is [sweep]",
+}
+
+
 def load_study(
     path: str | Path,
     overrides: list[str] | tuple = (),
@@ -198,6 +207,9 @@ def load_study(
     and ``cfg`` the resolved flat configuration (including ``study``).
     """
     doc = read_toml(path)
+    for k in doc:  # Study = "..." was "study: missing", [Sweep] trials = [...] "Sweep.trials:
+        if k not in _SPELT and looks(k) in _SPELT:  # unknown key (did you mean trials?)"
+            raise ConfigError(k, f"is not {looks(k)} ({_SPELT[looks(k)]}, spelt so)")
     flat = flatten({k: v for k, v in doc.items() if k != "sweep"})  # [sweep]: sim.mc.sweep
     name = flat.pop("study", None)
     if name is None:
@@ -264,13 +276,13 @@ def _unswept(e: ConfigError, swept: set[str], flat: Mapping[str, Any]) -> Config
             return e
         return ConfigError(  # a key that one cell reads, refused by the file's own values
             e.key,
-            f"{str(e).removeprefix(f'{e.key}: ')} (the values outside [sweep] are checked "
+            f"{e.detail} (the values outside [sweep] are checked "
             f"first, as a study of their own, with {', '.join(sorted(swept))} as given there: "
             "give there values under which it holds)",
         )
     return ConfigError(
         e.key,
-        f"{str(e).removeprefix(f'{e.key}: ')} (the values outside [sweep] are checked first, "
+        f"{e.detail} (the values outside [sweep] are checked first, "
         f"as a study of their own: {', '.join(missing)} is swept but not given there, so it "
         "takes its default; give it one of the swept values too)",
     )

@@ -50,7 +50,7 @@ def foreign_key(e: ConfigError, path: str | os.PathLike) -> ConfigError:
     keys) are the likeliest one's, the first few by name."""
     if e.key == "study" and "missing" in str(e):
         return _missing_study(e, path)
-    if not isinstance(e.key, str) or not str(e).startswith(f"{e.key}: unknown key"):
+    if not isinstance(e.key, str) or not e.detail.startswith("unknown key"):
         return e
     try:
         doc = read_toml(path)

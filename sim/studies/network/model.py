@@ -18,6 +18,7 @@ from sim import lsq
 from sim.lsq import sparse as lsq_sparse
 from sim.lsq.size import SPARSE_MIN_UNKNOWNS
 from sim.mc.config import ConfigError
+from sim.mc.lookalike import alike, char_name
 from sim.studies.network.definition import Network
 from sim.studies.network.validate import hits, name_index
 
@@ -263,12 +264,22 @@ def defect_basis(net: Network, free: np.ndarray) -> np.ndarray:
 
 
 def _param_index(net: Network, key: str, name: str) -> int:
+    """The index of ``name`` (``"P.x"``) among the globals; refused naming what is wrong: no
+    axis, an axis that is not x or y (a Cyrillic у named), or no such point (the one that looks
+    the same named: ``"\ufeffA.x"`` was "is not <point>.x or <point>.y", as was ``"A.у"``)."""
+    pt, dot, ax = name.rpartition(".")
+    if not dot:
+        raise ConfigError(key, f"{name!r} is not <point>.x or <point>.y of a network point")
+    if ax not in ("x", "y"):
+        odd = next((f", {char_name(c)}" for c in ax if not c.isascii() or not c.isprintable()), "")
+        raise ConfigError(
+            key, f"{name!r}: the axis after its last dot must be x or y ({ax!r}{odd})"
+        )
     try:
-        pt, ax = name.rsplit(".", 1)
         return 2 * net.index(pt) + "xy".index(ax)
     except ValueError:
         raise ConfigError(
-            key, f"{name!r} is not <point>.x or <point>.y of a network point"
+            key, f"{name!r}: {pt!r} is no point of the network{alike(pt, net.names)}"
         ) from None
 
 
@@ -288,6 +299,13 @@ def datum(net: Network, cfg: dict, extra_fixed: tuple = ()) -> lsq.Datum:
         pos = {g: a for a, g in enumerate(free)}
         for b, rec in enumerate(recs):
             for name, coef in rec.items():
+                if isinstance(coef, dict) and coef:  # { P.x = 1.0 }: a table P to TOML
+                    pair = f"{name}.{next(iter(coef))}"
+                    raise ConfigError(
+                        f"datum.constraints[{b}]",
+                        f"{pair} without quotes is read by TOML as a table {name} with a key "
+                        f'{next(iter(coef))}: write "{pair}" = ... in quotes',
+                    )
                 g = _param_index(net, f"datum.constraints[{b}]", name)
                 if g not in pos:
                     if g // 2 in extra_fixed:

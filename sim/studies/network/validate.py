@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from sim.mc.config import ConfigError
+from sim.mc.config import ConfigError, did_you_mean
 from sim.mc.estimate import DEFAULT_MAX_MEMORY_GB, _limit
 from sim.mc.lookalike import differs, skeleton
 from sim.mc.network_size import state_bytes
@@ -107,8 +107,10 @@ def title(key: str, v) -> str:
 
 def _keys(key: str, rec: dict, allowed: set, required: set) -> None:
     bad = set(rec) - allowed
-    if bad:
-        raise ConfigError(f"{key}.{sorted(bad)[0]}", "unknown field")
+    if bad:  # Name, x-mm, "name ": a guess as for an unknown key (it was "unknown field" alone)
+        near = did_you_mean(sorted(bad)[0], dict.fromkeys(sorted(allowed)))
+        hint = f" (did you mean {' or '.join(near)}?)" if near else ""
+        raise ConfigError(f"{key}.{sorted(bad)[0]}", f"unknown field{hint}")
     miss = required - set(rec)
     if miss:
         raise ConfigError(f"{key}.{sorted(miss)[0]}", "missing")

@@ -1,0 +1,82 @@
+"""How a one-line message names a value and a key: an integer of hundreds of digits shortened,
+a key that holds white space or a character that does not print quoted.
+
+``shown``: 1e300 given for an integer key is the integer 10**300 (301 digits), which no one
+line should print. ``key_text``: a quoted key of a study file with a trailing space
+(``"trials " = 5``) was refused as ``trials : unknown key (did you mean trials?)``, the space
+easy to miss (a tab, a no-break space or a zero-width space not seen at all); such a key is
+named in double quotes, its white space other than a plain space and every character that
+does not print written as TOML escapes it (``"tri\\u200bals"``), and the empty key
+(``"" = 5``, which named no key) as ``""``.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+__all__ = ["LONG_DIGITS", "shown", "shorten", "key_text"]
+
+#: digits of an integer above which a message shows it shortened (a 64-bit one has 19 digits)
+LONG_DIGITS = 19
+#: a run of more digits than that in a message, not part of a word, a path or a decimal
+_LONG_RUN = re.compile(r"(?<![\w./])-?\d{%d,}(?![\w./])" % (LONG_DIGITS + 1))
+#: TOML's short escapes
+_ESCAPES = {
+    '"': '\\"',
+    "\\": "\\\\",
+    "\t": "\\t",
+    "\n": "\\n",
+    "\r": "\\r",
+    "\b": "\\b",
+    "\f": "\\f",
+}
+
+
+def shown(v: Any) -> str:
+    """``repr(v)`` for a message, with an integer of more than 19 digits shortened (``1e+300``,
+    or "a 401-digit number" beyond a float's range)."""
+    if isinstance(v, int) and not isinstance(v, bool):
+        if abs(v) >= 10**4000:  # str() reads at most 4300 digits
+            return f"a {'negative ' if v < 0 else ''}number of over 4000 digits"
+        digits = len(str(abs(v)))
+        if digits <= LONG_DIGITS:
+            return repr(v)
+        try:
+            return f"{float(v):g}"
+        except OverflowError:
+            return f"a {'negative ' if v < 0 else ''}{digits}-digit number"
+    return repr(v)
+
+
+def shorten(message: str) -> str:
+    """Every run of more than 19 digits in ``message`` shortened as :func:`shown` does (one
+    beyond a float's range counted, not converted: Python reads at most 4300 digits)."""
+
+    def short(m: re.Match) -> str:
+        t = m.group(0)
+        digits = len(t.lstrip("-"))
+        if digits > 308:
+            return f"a {'negative ' if t.startswith('-') else ''}{digits}-digit number"
+        return shown(int(t))
+
+    return _LONG_RUN.sub(short, message)
+
+
+def _plain(c: str) -> bool:
+    return c == " " or (c.isprintable() and not c.isspace())
+
+
+def key_text(key: str) -> str:
+    """``key`` as a message names it: as it is, or in double quotes with TOML's escapes when it
+    is empty or holds white space or a character that does not print."""
+    if not isinstance(key, str):
+        return str(key)
+    if key and all(c.isprintable() and not c.isspace() for c in key):
+        return key
+    esc = (
+        _ESCAPES.get(c)
+        or (c if _plain(c) else f"\\u{ord(c):04x}" if ord(c) < 0x10000 else f"\\U{ord(c):08x}")
+        for c in key
+    )
+    return '"' + "".join(esc) + '"'
