@@ -277,6 +277,9 @@ def _check(args) -> int:
             for x in (
                 unit and f"unit {unit}",
                 _bounds(f),
+                f.compared
+                and "settings compared: each once"
+                + ("" if f.kind == "list[str]" else ", read in increasing order"),
                 "paper input" if f.input else "",
                 f.printed and f"printed by the paper: {_PRINTED[k in spelled]}",
                 k in skip and f"not read: {skip[k]}",

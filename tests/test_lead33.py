@@ -1,6 +1,7 @@
 """The lead's own sweep of 2026-11-29 (issue 26): the network kind's refusal after a run
 whose trials do not converge (a bias named where it is not the cause); a w-test power not
-above its level (a negative MDB printed as a finding); the benchmark's lists (a worker count
+above its level (a negative MDB printed as a finding); a trade-off's list of settings with one twice (two rows
+of one setting) or out of order (a zigzag line); the benchmark's lists (a worker count
 given twice); ``sim report`` over results of another version of the code, and over a study
 some of whose trials did not converge (said by ``sim show``, not by the report). Each test
 failed on the code before its fix."""
@@ -118,3 +119,35 @@ def test_a_w_test_power_not_above_its_level_is_refused(tmp_path, capsys):
         )
         == 0
     )
+
+
+def test_a_list_of_settings_compared_takes_each_once_in_increasing_order(tmp_path, capsys):
+    # before: `power.marks = [3, 3, 5]` ran and wrote two rows of one setting (their values
+    # differed: two streams) into power.parquet, drawn as two lines of one label; `[7, 3, 5]`
+    # was drawn as a zigzag line (49, 9, 25 marks); every trade-off list of every study alike
+    f = STUDIES / "salsig_encoders.toml"
+    for bad, named in (("[3, 3, 5]", "3"), ("[5.0, 3, 5]", "5")):
+        assert main(["check", str(f), "--set", f"power.marks={bad}"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err == f"sim: error: power.marks: {named} is given twice: give each setting once", (
+            err
+        )
+    assert (
+        main(
+            [
+                "check",
+                str(STUDIES / "wolf_polynomial.toml"),
+                "--set",
+                "trade.drift_fractions=[0.5, 0.50]",
+            ]
+        )
+        == 2
+    )
+    assert "trade.drift_fractions: 0.5 is given twice" in capsys.readouterr().err
+    assert main(["check", str(f), "--set", "power.marks=[7, 3, 5]"]) == 0
+    out = capsys.readouterr().out
+    assert "power.marks = [3, 5, 7]  # " in out and "settings compared: each once" in out, out
+    # a list of names keeps its order (a table's rows), a name given twice is refused
+    layouts = 'tradeoff.layouts=["full", "corners", "full"]'
+    assert main(["check", str(STUDIES / "agnard_block.toml"), "--set", layouts]) == 2
+    assert "tradeoff.layouts: 'full' is given twice" in capsys.readouterr().err

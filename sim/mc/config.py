@@ -83,6 +83,8 @@ class Field:
     sweep : the key may be swept (``[sweep]``); None, or the reason it may not.
     read_when : None (always read), or when the study reads the key (a
         :class:`sim.mc.read_when.When`): a key set where it is not read is refused.
+    compared : the list is a set of settings compared (a row and a point of a trade-off
+        each): a value given twice is refused, and numbers are read in increasing order.
     """
 
     default: Any
@@ -98,6 +100,7 @@ class Field:
     sweep: str | None = None
     read_when: Any = None
     printed: bool = False
+    compared: bool = False
 
 
 #: TOML's integers are 64-bit ("an integer that cannot be represented losslessly is an
@@ -186,7 +189,12 @@ def check_value(key: str, f: Field, v: Any) -> Any:
             return out
         inner = k[5:-1]
         sub = Field(None, inner, f.doc, f.lo, f.hi, f.lo_open, f.choices)
-        return [check_value(f"{key}[{i}]", sub, e) for i, e in enumerate(v)]
+        vals = [check_value(f"{key}[{i}]", sub, e) for i, e in enumerate(v)]
+        if f.compared:  # [3, 3, 5] gave two rows of one setting, [7, 3, 5] a zigzag line
+            if twice := [x for i, x in enumerate(vals) if x in vals[:i]]:
+                raise ConfigError(key, f"{shown(twice[0])} is given twice: give each setting once")
+            return vals if inner == "str" else sorted(vals)
+        return vals
     raise AssertionError(f"unknown field kind {k}")  # programming error
 
 

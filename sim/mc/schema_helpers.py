@@ -34,6 +34,7 @@ __all__ = [
     "level",
     "reals",
     "counts",
+    "compared",
     "printed",
     "require",
     "recorded_sha256",
@@ -101,6 +102,13 @@ def counts(
 ) -> Field:
     """A list of at least ``min_len`` integers, each in ``[lo, hi]``."""
     return Field(default, "list[int]", doc, lo=lo, hi=hi, min_len=min_len)
+
+
+def compared(f: Field) -> Field:
+    """``f``, a list of settings a trade-off compares, marked as such: each given once (a value
+    twice gave two rows of one setting), numbers read in increasing order (``[7, 3, 5]`` was
+    drawn as a zigzag line): :func:`sim.mc.config.check_value`."""
+    return dataclasses.replace(f, compared=True)
 
 
 def printed(f: Field) -> Field:

@@ -20,7 +20,7 @@ from sim.instruments.block.layout import (
 )
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import unless
-from sim.mc.schema_helpers import count, counts, positive, printed, real, reals
+from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, reals
 from sim.studies.agnard.datum import check_datum, region_insets
 
 SEED = "003_5ce730a990a7ebc5.txt"
@@ -151,16 +151,20 @@ SCHEMA = {
         choices=("w", "tau"),
     ),
     "snoop.max_reject": count(25, "most pass points removed per block", 0, 1000),
-    "tradeoff.dpis": reals([300.0, 600.0, 1200.0], "scan resolutions compared", 50.0, 10000.0),
+    "tradeoff.dpis": compared(
+        reals([300.0, 600.0, 1200.0], "scan resolutions compared", 50.0, 10000.0)
+    ),
     "tradeoff.trials": count(
         150, "trials per scan resolution and per re-centring error", 2, 1_000_000
     ),
-    "tradeoff.layouts": Field(
-        list(CONTROL_PATTERNS),
-        "list[str]",
-        "control layouts compared",
-        choices=CONTROL_PATTERNS,
-        min_len=1,
+    "tradeoff.layouts": compared(
+        Field(
+            list(CONTROL_PATTERNS),
+            "list[str]",
+            "control layouts compared",
+            choices=CONTROL_PATTERNS,
+            min_len=1,
+        )
     ),
     "tradeoff.block_strips": counts([1, 2, 2, 3, 4, 4], "strips of the blocks compared", 1, 50),
     "tradeoff.block_models": counts(
@@ -169,12 +173,14 @@ SCHEMA = {
         1,
         200,
     ),
-    "tradeoff.recentre_px": reals(
-        [0.25, 0.5, 0.75],
-        "mechanical re-centring errors for the rejection sensitivity",
-        0.0,
-        20.0,
-        unit="px",
+    "tradeoff.recentre_px": compared(
+        reals(
+            [0.25, 0.5, 0.75],
+            "mechanical re-centring errors for the rejection sensitivity",
+            0.0,
+            20.0,
+            unit="px",
+        )
     ),
     "tradeoff.block_trials": count(30, "trials per block size", 2, 1_000_000),
     "tradeoff.block_control": Field(

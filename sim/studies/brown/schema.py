@@ -14,7 +14,7 @@ from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import when
 from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
-from sim.mc.schema_helpers import count, counts, positive, printed, real
+from sim.mc.schema_helpers import compared, count, counts, positive, printed, real
 from sim.studies.brown.probe import check_solver
 from sim.studies.brown.range_keys import moved_from_paper
 from sim.studies.brown.values import thetas
@@ -139,12 +139,14 @@ BASE = {
 DILUTION = {
     **BASE,
     "trials": count(4000, "Monte-Carlo trials", lo=2, hi=100_000_000),
-    "dilution.grids": counts(
-        [3, 4, 5, 7, 10, 14, 20],
-        "grid sizes (points per side, same extent) for dilution vs point count",
-        lo=2,
-        hi=200,
-        min_len=2,
+    "dilution.grids": compared(
+        counts(
+            [3, 4, 5, 7, 10, 14, 20],
+            "grid sizes (points per side, same extent) for dilution vs point count",
+            lo=2,
+            hi=200,
+            min_len=2,
+        )
     ),
     "idealised.half_extent_mm": positive(
         110.0,

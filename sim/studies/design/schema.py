@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from sim.instruments.ranges import brown as B
 from sim.mc.config import COMMON
-from sim.mc.schema_helpers import count, counts, level, positive, printed, real, reals
+from sim.mc.schema_helpers import compared, count, counts, level, positive, printed, real, reals
 
 __all__ = ["SEED", "SCHEMA", "MAX_CELLS", "MAX_POINTS", "BETA_MAX_MM"]
 
@@ -66,20 +66,31 @@ SCHEMA = {
         input=True,
     ),
     # design grid
-    "design.positions": counts([3, 4, 6, 8], "plate positions (stations)", lo=3, hi=24),
-    "design.offsets_mm": reals(
-        [5.0, 10.0, 17.0, 20.0, 30.0, 45.0, 60.0, 80.0],
-        "station offsets outside the midsides",
-        lo=0.0,
-        hi=1000.0,
-        lo_open=True,
-        unit="mm",
+    "design.positions": compared(counts([3, 4, 6, 8], "plate positions (stations)", lo=3, hi=24)),
+    "design.offsets_mm": compared(
+        reals(
+            [5.0, 10.0, 17.0, 20.0, 30.0, 45.0, 60.0, 80.0],
+            "station offsets outside the midsides",
+            lo=0.0,
+            hi=1000.0,
+            lo_open=True,
+            unit="mm",
+        )
     ),
-    "design.grids": counts([3, 4, 5, 6, 7], "points per side of the square grid", lo=2, hi=30),
-    "design.extents_mm": reals(
-        [70.0, 90.0, 110.0], "half extent of the grid", lo=0.0, hi=1000.0, lo_open=True, unit="mm"
+    "design.grids": compared(
+        counts([3, 4, 5, 6, 7], "points per side of the square grid", lo=2, hi=30)
     ),
-    "design.settings": counts([1, 2, 3], "settings per point and position", lo=1, hi=20),
+    "design.extents_mm": compared(
+        reals(
+            [70.0, 90.0, 110.0],
+            "half extent of the grid",
+            lo=0.0,
+            hi=1000.0,
+            lo_open=True,
+            unit="mm",
+        )
+    ),
+    "design.settings": compared(counts([1, 2, 3], "settings per point and position", lo=1, hi=20)),
     "design.setting_sigma_um": reals(
         [1.7, 0.5],
         "sigma of one setting (paper: 1.7 "
@@ -91,11 +102,13 @@ SCHEMA = {
         unit="um",
         input=True,
     ),
-    "design.beta_mm": reals(
-        [1.0, 5.0],
-        "tangential pivot offset beta (at most half the 29 mm scale's width: checked on load)",
-        lo=0.0,
-        unit="mm",
+    "design.beta_mm": compared(
+        reals(
+            [1.0, 5.0],
+            "tangential pivot offset beta (at most half the 29 mm scale's width: checked on load)",
+            lo=0.0,
+            unit="mm",
+        )
     ),
     # measuring time
     "time.images": count(30, "images of the timed plate (paper: 30)", lo=1, hi=10_000, input=True),
@@ -313,19 +326,23 @@ SCHEMA = {
         hi=1e5,
         unit="um",
     ),
-    "coverage.noise_um": reals(
-        [1.0, 300.0, 1000.0, 3000.0, 10000.0],
-        "range sigmas of the noise sweep",
-        lo=1e-6,
-        hi=1e5,
-        unit="um",
+    "coverage.noise_um": compared(
+        reals(
+            [1.0, 300.0, 1000.0, 3000.0, 10000.0],
+            "range sigmas of the noise sweep",
+            lo=1e-6,
+            hi=1e5,
+            unit="um",
+        )
     ),
-    "coverage.grids": counts([2, 3, 4, 5], "grids of the point-count sweep", lo=2, hi=20),
-    "coverage.betas_mm": reals(
-        [0.0, 0.003, 0.01, 0.03, 0.1, 1.0],
-        "betas of the beta sweep (at most half the 29 mm scale's width)",
-        lo=0.0,
-        unit="mm",
+    "coverage.grids": compared(counts([2, 3, 4, 5], "grids of the point-count sweep", lo=2, hi=20)),
+    "coverage.betas_mm": compared(
+        reals(
+            [0.0, 0.003, 0.01, 0.03, 0.1, 1.0],
+            "betas of the beta sweep (at most half the 29 mm scale's width)",
+            lo=0.0,
+            unit="mm",
+        )
     ),
     "coverage.alpha": level(0.05, "level of the global chi-square test"),
     # bayes

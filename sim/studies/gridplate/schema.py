@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.mc.config import COMMON
-from sim.mc.schema_helpers import count, level, positive, printed, real, reals, require
+from sim.mc.schema_helpers import compared, count, level, positive, printed, real, reals, require
 
 UM = 1e-3  # mm per um
 #: bytes per trial of the simulated readings (P plates, N points, L readings, 2 coords, 8 B)
@@ -69,19 +69,23 @@ SCHEMA = {
     "grid.sigma_stated_um": positive(
         0.7, "stated (certificate) grid sigma", hi=50.0, unit="um", input=True
     ),
-    "analysis.ratios": reals(
-        [0.25, 0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 30.0],
-        "weight ratios P_cx/P_x swept for coverage",
-        lo=1e-6,
-        hi=1e6,
+    "analysis.ratios": compared(
+        reals(
+            [0.25, 0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 30.0],
+            "weight ratios P_cx/P_x swept for coverage",
+            lo=1e-6,
+            hi=1e6,
+        )
     ),
-    "analysis.stated_sigmas_um": reals(
-        [0.2, 0.35, 0.5, 0.7, 0.9, 1.2, 1.6],
-        "stated grid sigmas for the chi-square rejection curve",
-        lo=0.0,
-        hi=50.0,
-        lo_open=True,
-        unit="um",
+    "analysis.stated_sigmas_um": compared(
+        reals(
+            [0.2, 0.35, 0.5, 0.7, 0.9, 1.2, 1.6],
+            "stated grid sigmas for the chi-square rejection curve",
+            lo=0.0,
+            hi=50.0,
+            lo_open=True,
+            unit="um",
+        )
     ),
     "analysis.alpha": level(0.05, "level of the two-sided chi-square test"),
     "analysis.ratio_start": real(

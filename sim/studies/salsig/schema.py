@@ -10,7 +10,17 @@ vertical test's are explored in the consistent region (:mod:`sim.studies.salsig.
 from __future__ import annotations
 
 from sim.mc.config import COMMON
-from sim.mc.schema_helpers import count, counts, level, positive, printed, real, reals, require
+from sim.mc.schema_helpers import (
+    compared,
+    count,
+    counts,
+    level,
+    positive,
+    printed,
+    real,
+    reals,
+    require,
+)
 
 UM = 1e-3
 
@@ -67,13 +77,17 @@ SCHEMA = {
     "grid.points": count(5, "grid intersections per side measured on the comparator", lo=2, hi=20),
     "grid.spacing_mm": real(50.0, "grid spacing (not printed)", lo=1.0, hi=100.0, unit="mm"),
     "analysis.alpha": level(0.05, "level of the detection tests"),
-    "power.marks": counts([3, 4, 5, 6, 7], "marks per side swept (same extent)", lo=2, hi=20),
-    "power.sigma_um": reals(
-        [2.0, 5.0, 10.0, 25.0, 50.0],
-        "B8 marking sigmas swept (um)",
-        lo=0.0,
-        lo_open=True,
-        unit="um",
+    "power.marks": compared(
+        counts([3, 4, 5, 6, 7], "marks per side swept (same extent)", lo=2, hi=20)
+    ),
+    "power.sigma_um": compared(
+        reals(
+            [2.0, 5.0, 10.0, 25.0, 50.0],
+            "B8 marking sigmas swept (um)",
+            lo=0.0,
+            lo_open=True,
+            unit="um",
+        )
     ),
     "power.trials": count(1000, "trials per sweep cell", lo=2, hi=1_000_000),
     "zscale.s_mm_per_digit": positive(

@@ -11,7 +11,7 @@ example.
 from __future__ import annotations
 
 from sim.mc.config import COMMON, Field
-from sim.mc.schema_helpers import count, counts, positive, printed, real, reals
+from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, reals
 
 __all__ = ["SCHEMA", "SEED"]
 
@@ -275,31 +275,39 @@ SCHEMA = {
     ),
     "region.rounds": count(1, "refinement rounds at the region's boundary", lo=0, hi=4),
     "trade.trials": count(400, "trials per cell of the design trade-offs", lo=2, hi=10_000_000),
-    "trade.degrees": counts([1, 2, 3, 4, 5], "polynomial degrees compared", lo=1, hi=8),
-    "trade.spacings_mm": reals(
-        [10.0, 20.0, 25.0, 50.0],
-        "grid spacings compared (each must divide ab)",
-        lo=0.0,
-        lo_open=True,
-        unit="mm",
+    "trade.degrees": compared(counts([1, 2, 3, 4, 5], "polynomial degrees compared", lo=1, hi=8)),
+    "trade.spacings_mm": compared(
+        reals(
+            [10.0, 20.0, 25.0, 50.0],
+            "grid spacings compared (each must divide ab)",
+            lo=0.0,
+            lo_open=True,
+            unit="mm",
+        )
     ),
-    "trade.n_sets": counts([1, 2, 3, 6], "numbers of pooled independent sets", lo=1, hi=50),
+    "trade.n_sets": compared(
+        counts([1, 2, 3, 6], "numbers of pooled independent sets", lo=1, hi=50)
+    ),
     "trade.check_points": count(
         100, "random independent points read in the same sets", lo=4, hi=10000
     ),
-    "trade.readings": counts([1, 2, 3, 5, 10], "readings per point compared", lo=1, hi=100),
-    "trade.pointing_sigmas_um": reals(
-        [2.0, 4.0, 7.0], "pointing sigmas compared", lo=0.0, hi=100.0, unit="um"
+    "trade.readings": compared(
+        counts([1, 2, 3, 5, 10], "readings per point compared", lo=1, hi=100)
     ),
-    "trade.ages_weeks": reals(
-        [0.0, 2.0, 4.0, 8.0, 13.0, 26.0, 52.0, 104.0, 208.0],
-        "ages of the calibration compared",
-        lo=0.0,
-        hi=5200.0,
-        unit="weeks",
+    "trade.pointing_sigmas_um": compared(
+        reals([2.0, 4.0, 7.0], "pointing sigmas compared", lo=0.0, hi=100.0, unit="um")
     ),
-    "trade.drift_fractions": reals(
-        [0.25, 0.5, 0.75, 1.0], "drifting shares of the field compared", lo=0.0, hi=1.0
+    "trade.ages_weeks": compared(
+        reals(
+            [0.0, 2.0, 4.0, 8.0, 13.0, 26.0, 52.0, 104.0, 208.0],
+            "ages of the calibration compared",
+            lo=0.0,
+            hi=5200.0,
+            unit="weeks",
+        )
+    ),
+    "trade.drift_fractions": compared(
+        reals([0.25, 0.5, 0.75, 1.0], "drifting shares of the field compared", lo=0.0, hi=1.0)
     ),
 }
 
