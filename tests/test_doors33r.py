@@ -11,6 +11,9 @@ defects); one case each, each failed on the code before its fix.
 * ``make verify``'s check of a table edited after its run read every name of ``run.json``'s
   ``table_sha256`` as it stood: a name with a NUL was a ValueError traceback (a FIFO's name
   would hang it). Only the names seal() writes are read, as regular files.
+* A committed table replaced by a pipe (``points.parquet`` a FIFO) hung ``make verify`` for
+  ever: the sha256 of the tables it reads (:func:`sim.report.verify.rules.tables_digest`)
+  and the comparison opened it and waited for a writer. It is named as no regular file.
 * A network run of which too few trials converged named any bias "a gross error the
   adjustment cannot absorb" (0.001 mm on distances of sigma 1 mm) where the network is too
   far from linear: the probe's rule (lead32) was not the run's. Both name a bias only when
@@ -26,13 +29,25 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from sim.cli import main
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
+
+
+@pytest.fixture(scope="module")
+def plate(tmp_path_factory) -> Path:
+    """network_plate's results of 40 trials, copied by each test that changes them."""
+    out = tmp_path_factory.mktemp("plate") / "network_plate"
+    args = ["--trials", "40", "--out", str(out), "--no-figures", "--quiet"]
+    assert main(["run", str(STUDIES / "network_plate.toml"), *args]) == 0
+    return out
 
 
 def _refused(capsys, args) -> str:
@@ -59,10 +74,9 @@ def test_a_parent_pid_variable_of_thousands_of_digits_is_one_line_not_a_tracebac
     assert len(p.stderr.splitlines()) == 1 and len(p.stderr) < 300
 
 
-def test_a_damaged_summary_or_trials_table_is_named_by_sim_show(tmp_path, capsys):
+def test_a_damaged_summary_or_trials_table_is_named_by_sim_show(plate, tmp_path, capsys):
     out = tmp_path / "plate"
-    args = ["--trials", "40", "--out", str(out), "--no-figures", "--quiet"]
-    assert main(["run", str(STUDIES / "network_plate.toml"), *args]) == 0
+    shutil.copytree(plate, out)
     (out / "summary.parquet").write_bytes(b"garbage")
     err = _refused(capsys, ["show", str(out)])
     assert "summary.parquet" in err and "claims.parquet" not in err, err
@@ -71,17 +85,15 @@ def test_a_damaged_summary_or_trials_table_is_named_by_sim_show(tmp_path, capsys
     assert "trials.parquet" in err and "claims.parquet" not in err, err
 
 
-def test_verify_reads_only_the_table_names_a_run_records(tmp_path, capsys):
+def test_verify_reads_only_the_table_names_a_run_records(plate, tmp_path, capsys):
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     from sim.report.verify import main as verify_main
 
     R, S = tmp_path / "R" / "network_plate", tmp_path / "S" / "network_plate"
-    args = ["--trials", "40", "--no-figures", "--quiet"]
-    assert main(["run", str(STUDIES / "network_plate.toml"), "--out", str(S), *args]) == 0
-    R.parent.mkdir()
-    subprocess.run(["cp", "-r", str(S), str(R)], check=True)
+    shutil.copytree(plate, S)
+    shutil.copytree(plate, R)
     t = pq.read_table(R / "summary.parquet")
     i = t.schema.get_field_index("redundancy_sum")
     t = t.set_column(i, "redundancy_sum", pa.array([v * 1.5 for v in t.column(i).to_pylist()]))
@@ -94,6 +106,23 @@ def test_verify_reads_only_the_table_names_a_run_records(tmp_path, capsys):
     assert verify_main(argv) == 1
     text = " ".join(capsys.readouterr().out.split())
     assert "summary.parquet changed after the run that wrote them" in text, text
+
+
+def test_a_committed_table_that_is_a_pipe_is_named_not_waited_on(plate, tmp_path):
+    R, S = tmp_path / "R" / "network_plate", tmp_path / "S" / "network_plate"
+    shutil.copytree(plate, S)
+    shutil.copytree(plate, R)
+    (R / "points.parquet").unlink()
+    os.mkfifo(R / "points.parquet")
+    argv = ["--results", str(R.parent), "--scratch", str(S.parent), "--no-rerun", "--no-record"]
+    p = subprocess.run(  # before: it waited for a writer of the pipe, for ever
+        [sys.executable, "-m", "sim.report.verify", *argv],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert p.returncode == 1, p.stderr
+    assert "points.parquet: the committed file is not a regular file" in p.stdout, p.stdout
 
 
 def test_a_tiny_bias_is_not_blamed_when_too_few_trials_of_the_run_converge(tmp_path, capsys):
