@@ -18,6 +18,10 @@ defects); one case each, each failed on the code before its fix.
   adjustment cannot absorb" (0.001 mm on distances of sigma 1 mm) where the network is too
   far from linear: the probe's rule (lead32) was not the run's. Both name a bias only when
   the probe trials converge more often without it.
+* ``python -m sim.batch --timings F``: a lock file ``.F.lock`` removed by hand while a batch
+  ran, a second batch took a new one; the first, ending, removed the second's, and a third
+  batch given ``F`` ran beside the second (the last to end overwrote the other's timings). A
+  batch removes the lock file only while it is still the one it holds.
 * A ``network.gama_xml`` that is no gama-local file at all (``<html lang="en">``) was refused
   for its root's attribute ("gama-local takes only xmlns and version"), not for its root.
 * The sweep figure's tiny y values (lead32: ``2.0×10⁻¹⁷``) were labelled at two digits
@@ -143,6 +147,28 @@ def test_a_tiny_bias_is_not_blamed_when_too_few_trials_of_the_run_converge(tmp_p
     err = _refused(capsys, args)
     assert "too few trials" in err and "weakest sight" in err, err
     assert "bias" not in err, err
+
+
+def test_a_batch_leaves_the_timings_lock_another_batch_took_after_its_was_removed(tmp_path, capsys):
+    from sim.batch import main as batch_main
+    from sim.batch_timings import TimingsLock
+
+    timings = tmp_path / "t.json"
+    first = TimingsLock(timings)
+    assert first.acquire() is None
+    first.lock.unlink()  # "a stale lock file": removed by hand while its batch runs
+    second = TimingsLock(timings)
+    assert second.acquire() is None
+    first.release()  # the first batch ends
+    try:
+        args = ["--timings", str(timings), "--results", str(tmp_path / "r")]
+        rc = batch_main([*args, str(STUDIES / "brown_table1.toml")])
+        err = capsys.readouterr().err
+        assert rc == 2 and len(err.splitlines()) == 1, err  # before: it ran beside the second
+        assert f"--timings: another sim.batch (pid {os.getpid()}) writes {timings}" in err, err
+    finally:
+        second.release()
+    assert sorted(tmp_path.iterdir()) == []
 
 
 def test_a_gama_xml_of_another_root_is_named_for_its_root(tmp_path, capsys):
