@@ -18,6 +18,9 @@ defects); one case each, each failed on the code before its fix.
   adjustment cannot absorb" (0.001 mm on distances of sigma 1 mm) where the network is too
   far from linear: the probe's rule (lead32) was not the run's. Both name a bias only when
   the probe trials converge more often without it.
+* The same refusal at ``solver.max_iter = 10`` of a network of which 11 of the 16 probe
+  trials converge within the default 20 (1 within 10, so ``sim check`` passed) said "place
+  the points further apart": it names ``solver.max_iter`` now, with both counts.
 * ``python -m sim.batch --timings F``: a lock file ``.F.lock`` removed by hand while a batch
   ran, a second batch took a new one; the first, ending, removed the second's, and a third
   batch given ``F`` ran beside the second (the last to end overwrote the other's timings). A
@@ -169,6 +172,23 @@ def test_a_batch_leaves_the_timings_lock_another_batch_took_after_its_was_remove
     finally:
         second.release()
     assert sorted(tmp_path.iterdir()) == []
+
+
+def test_a_run_of_too_few_converged_trials_at_a_low_limit_names_the_limit(tmp_path, capsys):
+    p = tmp_path / "tri.toml"
+    p.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\nseed = 5\n[network]\n'
+        'random = [ { prefix = "P", n = 300, half_extent_mm = 10000 } ]\n'
+        'generate = [ { kind = "distance", from = "P*", to = "P*", nearest = 8, sigma_mm = 1.0 },'
+        ' { kind = "direction", from = "P1*", to = "P*", nearest = 4, sigma_arcsec = 2.0 } ]\n'
+        '[datum]\nkind = "inner"\n[solver]\nmax_iter = 10\n',
+        encoding="utf-8",
+    )
+    args = ["run", str(p), "--out", str(tmp_path / "o"), "--no-figures", "--quiet"]
+    err = _refused(capsys, args)
+    assert err.startswith("sim: error: solver.max_iter: too few trials"), err
+    assert "1 of 16 probe trials converge within solver.max_iter = 10, 11 within" in err, err
+    assert "weakest sight" not in err, err
 
 
 def test_a_gama_xml_of_another_root_is_named_for_its_root(tmp_path, capsys):

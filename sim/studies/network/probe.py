@@ -79,16 +79,31 @@ def not_converged(
     net: Network, an, C, pts, cfg: dict, what: str, status: np.ndarray | None = None
 ) -> tuple[str, str]:
     """``(key, message)`` for a network whose trials do not converge (``what``: which), at
-    load time (none of the probe trials) or after the run (too few of its trials): a bias
-    (:func:`sim.studies.network.linearity.biased`) only when the probe trials converge more
-    often without the biases than with them (``status``: theirs with them, probed when not
-    given), else the sight too short for its noise
+    load time (none of the probe trials) or after the run (too few of its trials), by the
+    probe trials (``status``: their statuses as declared, probed when not given): a bias
+    (:func:`sim.studies.network.linearity.biased`) when they converge more often without the
+    biases; ``solver.max_iter`` when it is under the key's default and they converge more
+    often within the default; else the sight too short for its noise
     (:func:`sim.studies.network.linearity.why_not_converged`). A bias of 0.01 sigma was
-    named "a gross error" of a network too short for its noise: by the probe, and after the
-    run (which named any bias, 0.001 mm on a 1 mm distance, whatever the cause)."""
-    if np.any(net.bias):
-        status = _probe(net, an, C, pts, cfg) if status is None else status
-        clean = _probe(replace(net, bias=np.zeros_like(net.bias)), an, C, pts, cfg)
-        if np.count_nonzero(clean == 0) > np.count_nonzero(status == 0):
-            return biased(net, cfg, what)
+    named "a gross error" of a network too short for its noise (by the probe; after the run,
+    any bias, 0.001 mm on a 1 mm distance), and a run at ``solver.max_iter = 10`` of which 11
+    of the 16 probe trials converge within 20 was told to place its points further apart."""
+    ok = partial(_converged, net, an, C, pts, cfg)
+    n = int(np.count_nonzero(status == 0)) if status is not None else ok()
+    if np.any(net.bias) and ok(net=replace(net, bias=np.zeros_like(net.bias))) > n:
+        return biased(net, cfg, what)
+    limit, default = cfg["solver.max_iter"], SCHEMA["solver.max_iter"].default
+    if limit < default and (m := ok(max_iter=default)) > n:
+        return "solver.max_iter", (
+            f"{what}: {n} of {PROBE_TRIALS} probe trials converge within solver.max_iter = "
+            f"{limit}, {m} within the key's default {default}: raise solver.max_iter"
+        )
     return why_not_converged(net, an.cov, cfg, what)
+
+
+def _converged(net0: Network, an, C, pts, cfg: dict, net=None, max_iter=None) -> int:
+    """How many of the probe trials of ``net`` (else ``net0``) converge within ``max_iter``
+    (else ``cfg``'s ``solver.max_iter``)."""
+    limit = cfg["solver.max_iter"] if max_iter is None else max_iter
+    st = _probe(net0 if net is None else net, an, C, pts, {**cfg, "solver.max_iter": limit})
+    return int(np.count_nonzero(st == 0))
