@@ -76,12 +76,17 @@ class TimingsLock:
                 os.close(fd)
 
     def release(self) -> None:
-        """Remove the lock file and drop the lock."""
+        """Remove the lock file, when it is still the one this lock holds, and drop the lock.
+        (A lock file removed by hand while a batch ran, another batch took a new one: the
+        first, ending, removed the second's, and a third ran beside the second.)"""
         if self.fd is None:
             return
         try:
-            self.lock.unlink(missing_ok=True)
-        except OSError:  # a directory made read-only meanwhile: the lock file stays, unheld
+            ours = os.fstat(self.fd)
+            there = os.stat(self.lock, follow_symlinks=False)
+            if (there.st_dev, there.st_ino) == (ours.st_dev, ours.st_ino):
+                self.lock.unlink()
+        except OSError:  # gone, or a directory made read-only meanwhile: nothing to remove
             pass
         os.close(self.fd)
         self.fd = None

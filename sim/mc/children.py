@@ -61,10 +61,12 @@ def die_with_parent() -> str | None:
         ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG = 1
     except (OSError, AttributeError):
         return None
-    if os.getppid() == int(want):
+    # (compared as text: int() of over 4,300 digits is a ValueError traceback)
+    if want.lstrip("0") == str(os.getppid()):
         return None
+    said = want if len(want) <= 20 else f"{want[:20]}... ({len(want):,} digits)"
     return (
-        f"stopped: {PARENT_ENV}={want} names the program that started this run, and it has "
+        f"stopped: {PARENT_ENV}={said} names the program that started this run, and it has "
         "ended (a driver's variable, left set in your shell? unset it)"
     )
 

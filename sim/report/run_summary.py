@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
+import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS, printed_differs
@@ -23,7 +24,7 @@ from sim.mc.storage import atomic_path, read_provenance, read_record, read_table
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.config_diff import config_line
 from sim.report.papers import paper_name
-from sim.report.read import columns, forget, records
+from sim.report.read import TableError, columns, forget, records
 from sim.report.sweep import sweep_markdown
 from sim.report.tables import fmt, md_code, md_text
 
@@ -130,7 +131,16 @@ def converged_line(out: Path) -> str | None:
     1e-5 of the pass weight: some trials stop at the limit); None when every one converged."""
     p = Path(out) / "trials.parquet"
     if not p.is_file():
-        return _summary_converged(Path(out) / "summary.parquet")
+        p = Path(out) / "summary.parquet"
+    try:  # a table that is not Parquet is named as such (it was blamed on claims.parquet's
+        # column last read: "claims.parquet ... (column 'verdict': ArrowInvalid: ...)")
+        return _trials_converged(p) if p.name == "trials.parquet" else _summary_converged(p)
+    except pa.ArrowException as e:
+        raise TableError(p, f"cannot be read ({str(e).splitlines()[0][:200]})") from None
+
+
+def _trials_converged(p: Path) -> str | None:
+    """The line of a ``trials.parquet`` with ``<adjustment>.converged`` columns."""
     names = [c for c in pq.read_schema(p).names if c.endswith(".converged")]
     if not names:
         return None

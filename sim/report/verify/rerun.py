@@ -322,6 +322,18 @@ def _judge(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
     return comp
 
 
+#: the name of a table of a results directory's top level, as ``table_sha256`` records it
+_TABLE = re.compile(r"[^/\\\x00]+\.parquet")
+
+
+def _sha256(p: Path) -> str:
+    h = hashlib.sha256()
+    with open(p, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
 def _edited(d: Path) -> str | None:
     """The tables of the committed results ``d`` changed after their run wrote them (their
     sha256 is not the one ``run.json`` records), or None: a verdict edited by hand, rows
@@ -332,11 +344,17 @@ def _edited(d: Path) -> str | None:
         return None  # an older version's record: the comparison decides
     changed = []
     for name, digest in sorted(sums.items()):
+        # a table's name as seal() records it, read only as a regular file: a name of a
+        # run.json edited by hand was read as it stood ("x\0y": a ValueError traceback; a
+        # FIFO: a hang; "../..": a file outside the results)
+        if not _TABLE.fullmatch(name):
+            continue  # not a name seal() writes
+        p = d / name
         try:
-            if hashlib.sha256((d / str(name)).read_bytes()).hexdigest() != digest:
-                changed.append(str(name))
+            if not p.is_file() or p.is_symlink() or _sha256(p) != digest:
+                changed.append(name)
         except OSError:
-            changed.append(str(name))
+            changed.append(name)
     if not changed:
         return None
     return (

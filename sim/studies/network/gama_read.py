@@ -319,10 +319,11 @@ def _network(f: _File, data: bytes):
         raise ConfigError(key, f"{path} is not XML: {e}") from None
     except (LookupError, ValueError) as e:  # an unknown encoding declared, undecodable bytes
         raise ConfigError(key, f"{path} cannot be decoded: {e}") from None
+    if _tag(root) != "gama-local":  # first: an <html lang="en"> is no gama-local file at
+        # all (it was refused for its attribute, "gama-local takes only xmlns and version")
+        raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
     if why := vocab.raw_name_problem(data) or vocab.encoding_problem(data):  # as gama-local
         raise ConfigError(key, f"{path}: {why}")
-    if _tag(root) != "gama-local":
-        raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
     f.vocab(root)
     nets = [e for e in root if _tag(e) == "network"]
     if len(nets) != 1:

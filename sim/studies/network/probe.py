@@ -57,8 +57,7 @@ def probe_solver(net: Network, an, C, pts, cfg: dict) -> None:
 
     def statuses(max_iter: int) -> np.ndarray:
         if max_iter not in seen:
-            fn = chunk_fn(net, an, C, pts, {**cfg, "solver.max_iter": max_iter})
-            seen[max_iter] = fn(np.random.default_rng(PROBE_SEED), PROBE_TRIALS)["rows.status"]
+            seen[max_iter] = _probe(net, an, C, pts, {**cfg, "solver.max_iter": max_iter})
         return seen[max_iter]
 
     probe_limit(cfg, statuses, SCHEMA["solver.max_iter"].default, f"{net.name!r} network", FIRST)
@@ -66,20 +65,45 @@ def probe_solver(net: Network, an, C, pts, cfg: dict) -> None:
     if np.any(statuses(limit) == 0):
         return
     what = f"none of {PROBE_TRIALS} probe trials converged within solver.max_iter = {limit}"
-    raise ConfigError(*cause(net, an, C, pts, cfg, what))
+    raise ConfigError(*not_converged(net, an, C, pts, cfg, what, statuses(limit)))
 
 
-def cause(net: Network, an, C, pts, cfg: dict, what: str) -> tuple[str, str]:
-    """``(key, message)`` of a network whose trials do not converge (``what``: which): its
-    bias when more of the same probe trials (one stream, the same noise) converge without it
-    than with it, else the weakest sight. A bias of 0.01 sigma was named "a gross error" of a
-    network too short for its noise; shared by the probe and the run's own refusal after its
-    chunks, which named any bias first (a probe that passed had converged with it)."""
-    if np.any(net.bias):
-        n_ok = []
-        for b in (net, replace(net, bias=np.zeros_like(net.bias))):
-            out = chunk_fn(b, an, C, pts, cfg)(np.random.default_rng(PROBE_SEED), PROBE_TRIALS)
-            n_ok.append(int(np.sum(out["rows.status"] == 0)))
-        if n_ok[1] > n_ok[0]:
-            return biased(net, cfg, what)
+def _probe(net: Network, an, C, pts, cfg: dict) -> np.ndarray:
+    """The solver statuses of the :data:`PROBE_TRIALS` probe trials of ``net``."""
+    return chunk_fn(net, an, C, pts, cfg)(np.random.default_rng(PROBE_SEED), PROBE_TRIALS)[
+        "rows.status"
+    ]
+
+
+def not_converged(
+    net: Network, an, C, pts, cfg: dict, what: str, status: np.ndarray | None = None
+) -> tuple[str, str]:
+    """``(key, message)`` for a network whose trials do not converge (``what``: which), at
+    load time (none of the probe trials) or after the run (too few of its trials), by the
+    probe trials (``status``: their statuses as declared, probed when not given): a bias
+    (:func:`sim.studies.network.linearity.biased`) when they converge more often without the
+    biases; ``solver.max_iter`` when it is under the key's default and they converge more
+    often within the default; else the sight too short for its noise
+    (:func:`sim.studies.network.linearity.why_not_converged`). A bias of 0.01 sigma was
+    named "a gross error" of a network too short for its noise (by the probe; after the run,
+    any bias, 0.001 mm on a 1 mm distance), and a run at ``solver.max_iter = 10`` of which 11
+    of the 16 probe trials converge within 20 was told to place its points further apart."""
+    ok = partial(_converged, net, an, C, pts, cfg)
+    n = int(np.count_nonzero(status == 0)) if status is not None else ok()
+    if np.any(net.bias) and ok(net=replace(net, bias=np.zeros_like(net.bias))) > n:
+        return biased(net, cfg, what)
+    limit, default = cfg["solver.max_iter"], SCHEMA["solver.max_iter"].default
+    if limit < default and (m := ok(max_iter=default)) > n:
+        return "solver.max_iter", (
+            f"{what}: {n} of {PROBE_TRIALS} probe trials converge within solver.max_iter = "
+            f"{limit}, {m} within the key's default {default}: raise solver.max_iter"
+        )
     return why_not_converged(net, an.cov, cfg, what)
+
+
+def _converged(net0: Network, an, C, pts, cfg: dict, net=None, max_iter=None) -> int:
+    """How many of the probe trials of ``net`` (else ``net0``) converge within ``max_iter``
+    (else ``cfg``'s ``solver.max_iter``)."""
+    limit = cfg["solver.max_iter"] if max_iter is None else max_iter
+    st = _probe(net0 if net is None else net, an, C, pts, {**cfg, "solver.max_iter": limit})
+    return int(np.count_nonzero(st == 0))

@@ -27,7 +27,7 @@ from sim.studies.network.estimates import TOO_FEW, mc_estimates
 from sim.studies.network.figures import network_figure, reliability_figure
 from sim.studies.network.gama import export, import_note, merge_gama
 from sim.studies.network.model import datum
-from sim.studies.network.probe import cause, chunk_fn
+from sim.studies.network.probe import chunk_fn, not_converged
 from sim.studies.network.rounding import check_rounding
 from sim.studies.network.sparse_analysis import (
     pre_analysis,
@@ -100,8 +100,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
     try:
         est = mc_estimates(an, pts, sim)
     except StudyError:
-        what = TOO_FEW
-        key, msg = cause(net, an, C, pts, cfg, what)
+        key, msg = not_converged(net, an, C, pts, cfg, TOO_FEW)
         raise StudyError(f"{key}: {msg}") from None
     with phase("network: tables and figures", show, quiet):
         _outputs(out, cfg, full, net, an, dt, C, pts, held, sim, est, prov)
