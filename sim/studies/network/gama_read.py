@@ -307,19 +307,23 @@ def frame_note(axes: str, angles: str) -> str:
 def _network(f: _File, data: bytes):
     """The ``<network>`` element of the file's bytes, its root and attributes checked."""
     key, path = f.key, f.path
-    if ent := vocab.entity_declared(data):
+    try:  # the characters gama-local reads: its own encodings (cp-1250, ...) decoded as there
+        text = vocab.gama_text(data)
+    except vocab.EncodingProblem as why:
+        raise ConfigError(key, f"{path}: {why}") from None
+    if ent := vocab.entity_declared(text):
         raise ConfigError(
             key,
             f"{path}: its <!DOCTYPE> declares the entity {ent}: entity declarations are not read "
             "(a gama-local file needs none; write the values in place)",
         )
     try:
-        root = ET.fromstring(data)
+        root = ET.fromstring(text)
     except ET.ParseError as e:
         raise ConfigError(key, f"{path} is not XML: {e}") from None
     except (LookupError, ValueError) as e:  # an unknown encoding declared, undecodable bytes
         raise ConfigError(key, f"{path} cannot be decoded: {e}") from None
-    if why := vocab.raw_name_problem(data) or vocab.encoding_problem(data):  # as gama-local
+    if why := vocab.raw_name_problem(text):  # names as gama-local reads them
         raise ConfigError(key, f"{path}: {why}")
     if _tag(root) != "gama-local":
         raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
