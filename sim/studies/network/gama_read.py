@@ -156,7 +156,7 @@ def _point(f: _File, e, points: dict, datum: dict) -> None:
         raise f.err(e, f"point {pid!r} is both fixed and adjusted in xy", "fix")
     rec = points.setdefault(pid, {"name": pid})
     if e.get("x") is not None or e.get("y") is not None:
-        xy = (f.num(e, "x") * 1000, f.num(e, "y") * 1000)
+        xy = (f.mm(e, "x"), f.mm(e, "y"))
         for ax, v in zip("xy", xy):
             if not abs(v) <= COORDINATE_MAX_MM:  # no coordinate on the earth, by the element
                 raise f.err(e, f"{v / 1000:g} m: over 100,000 km, out of range", ax)

@@ -8,6 +8,7 @@ before it is opened). The parser: :mod:`sim.studies.network.gama_read`."""
 from __future__ import annotations
 
 import codecs
+import decimal
 import math
 import os
 import re
@@ -32,6 +33,7 @@ __all__ = [
     "entity_declared",
     "raw_name_problem",
     "gama_text",
+    "shifted",
     "EncodingProblem",
 ]
 
@@ -160,6 +162,13 @@ def _tag(e) -> str:
     return e.tag.split("}", 1)[-1] if isinstance(e.tag, str) else ""
 
 
+def shifted(text: str, places: int) -> decimal.Decimal:
+    """The decimal number ``text`` spells times ``10 ** places``, exactly (its digits kept,
+    its exponent moved: no rounding to a context's precision)."""
+    sign, digits, exp = decimal.Decimal(text).as_tuple()
+    return decimal.Decimal((sign, digits, exp + places))
+
+
 class _File:
     """Error helper: every message names the file, the element and the attribute."""
 
@@ -187,6 +196,13 @@ class _File:
         if lo is not None and x <= lo:
             raise self.err(e, f"{said(v)} must be > {lo:g}", attr)
         return x
+
+    def mm(self, e, attr: str) -> float:
+        """A coordinate of the file (metres) in millimetres: its decimal digits moved by three
+        places (``-256.034379`` is -256034.379 mm, where ``-256.034379 * 1000`` is
+        -256034.37900000002), so the export's coordinates read back to the last digit."""
+        self.num(e, attr)
+        return float(shifted(ws(e.get(attr)), 3)) + 0.0  # -0 is 0
 
     def name(self, e, attr: str, default: str | None = None) -> str:
         v = e.get(attr, default)
@@ -283,12 +299,10 @@ def entity_declared(data: bytes | str) -> str | None:
     return found[0] if found else None
 
 
-#: the encodings gama-local decodes: expat's own (any case; UTF-16 in a file of 8-bit bytes is
-#: refused by expat, there and here) and those of gama-local's handler
-#: (``encoding_unknown_handler.cpp``, names compared exactly: ``CP-1250`` is another name) with
-#: Python's codec and the bytes its table maps otherwise (cp1250: 0x80 to U+0080, not the euro
-#: sign, and its undefined bytes to themselves; cp1251: 0x98 to U+FFFD); any other name it reads
-#: as ISO-8859-1 (the handler's identity table)
+#: the encodings gama-local decodes: expat's own (any case) and its handler's (names compared
+#: exactly), by Python's codec and the bytes its table maps otherwise (cp1250: 0x80 to U+0080,
+#: not the euro sign, its undefined bytes to themselves; cp1251: 0x98 to U+FFFD); any other
+#: name it reads as ISO-8859-1 (``encoding_unknown_handler.cpp``: the identity table)
 _EXPAT_ENC = ("utf-8", "utf-16", "utf-16be", "utf-16le", "iso-8859-1", "us-ascii")
 _GAMA_ENC = {
     "cp-1250": "cp1250",
@@ -310,15 +324,13 @@ class EncodingProblem(ValueError):
 
 
 def _table(codec: str) -> dict[int, str]:
-    """gama-local's table of ``codec``'s bytes beyond ASCII, for ``str.translate`` of the
-    bytes read as ISO-8859-1."""
+    """gama-local's table of ``codec``'s bytes beyond ASCII (for ``str.translate``)."""
     own = _OWN.get(codec, {})
     return {b: own[b] if b in own else bytes([b]).decode(codec) for b in range(128, 256)}
 
 
 def _latin1(enc: str) -> bool:
-    """``enc`` is a Python name of ISO-8859-1 (``latin_1``, ``L1``): what gama-local reads
-    under a name it does not know, and what the name means."""
+    """``enc`` is a Python name of ISO-8859-1 (``latin_1``, ``L1``), as gama-local reads it."""
     try:
         return codecs.lookup(enc).name == "iso8859-1"
     except (LookupError, ValueError):
