@@ -17,6 +17,10 @@ every case below).
 * ``encoding="UTF8"`` over UTF-8 bytes was refused as "not XML: not well-formed (invalid
   token)", naming no encoding (gama-local reads the bytes as ISO-8859-1, other point names):
   now the line names the encoding and what to declare.
+* A file beginning with a processing instruction (``<?xml-stylesheet href="s.xsl"
+  encoding="koi8-r"?>``, no XML declaration) over UTF-8 bytes was refused as declaring
+  koi8-r: the declaration's pattern took ``<?xml-stylesheet`` for ``<?xml``. gama-local (and
+  Python's parser) read such a file as UTF-8; now read so.
 * A UTF-8 byte-order mark before ``encoding="iso-8859-1"`` was read silently in the
   declared encoding (``Dü`` became the point ``DÃ¼``, as gama-local reads it, not what the
   mark says): now refused, naming the mark and the declaration.
@@ -95,3 +99,10 @@ def test_an_exported_coordinate_reads_back_to_the_last_digit(tmp_path):
     assert 'x="0.125011"' in path.read_text()
     back = {p["name"]: p for p in read_gama(path)["network.points"]}
     assert back["C"]["x_mm"] == 125.011 and back["C"]["y_mm"] == 503.3
+
+
+def test_a_processing_instruction_declares_no_encoding(tmp_path):
+    path = tmp_path / "n.xml"
+    pi = '<?xml-stylesheet href="s.xsl" encoding="koi8-r"?>\n'
+    path.write_bytes((pi + BODY.replace('"D"', '"DÉ"')).encode())
+    assert "DÉ" in [p["name"] for p in read_gama(path)["network.points"]]

@@ -316,7 +316,8 @@ _OWN = {
     "cp1251": {0x98: "\ufffd"},
 }
 _BOM8 = b"\xef\xbb\xbf"
-_DECL = re.compile(rb"^(?:\xef\xbb\xbf)?<\?xml[^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
+#: the XML declaration's encoding (a ``<?xml-stylesheet encoding=...?>`` declares nothing)
+_DECL = re.compile(rb"^(?:\xef\xbb\xbf)?<\?xml[ \t\r\n][^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
 
 
 class EncodingProblem(ValueError):
@@ -324,8 +325,7 @@ class EncodingProblem(ValueError):
 
 
 def _table(codec: str) -> dict[int, str]:
-    """gama-local's table of ``codec``'s bytes beyond ASCII (for ``str.translate``)."""
-    own = _OWN.get(codec, {})
+    own = _OWN.get(codec, {})  # gama-local's table of the bytes beyond ASCII
     return {b: own[b] if b in own else bytes([b]).decode(codec) for b in range(128, 256)}
 
 
