@@ -21,6 +21,9 @@ every case below).
   encoding="koi8-r"?>``, no XML declaration) over UTF-8 bytes was refused as declaring
   koi8-r: the declaration's pattern took ``<?xml-stylesheet`` for ``<?xml``. gama-local (and
   Python's parser) read such a file as UTF-8; now read so.
+* ``encoding="windows-1250"`` was decoded by Python's codec, where gama-local's table differs:
+  the byte 0x80 was the point ``D€`` here (exit 0), ``D`` and U+0080 there; now decoded by
+  gama-local's table (such a name is then refused, naming the id, as not printable).
 * A UTF-8 byte-order mark before ``encoding="iso-8859-1"`` was read silently in the
   declared encoding (``Dü`` became the point ``DÃ¼``, as gama-local reads it, not what the
   mark says): now refused, naming the mark and the declaration.
@@ -75,6 +78,8 @@ def test_an_encoding_gama_local_reads_is_read_as_there(tmp_path, enc, name, read
     [
         ("UTF8", "Dé".encode(), b"", ("'UTF8'", "ISO-8859-1", "declare UTF-8")),
         ("iso-8859-1", "Dü".encode(), b"\xef\xbb\xbf", ("byte-order mark", "'iso-8859-1'")),
+        # gama-local's cp1250 table: 0x80 is U+0080, a control character, not Python's euro sign
+        ("windows-1250", b"D\x80", b"", ("<point>", "'id'", "'D\\x80'")),
     ],
 )
 def test_an_encoding_read_otherwise_is_one_line_naming_it(tmp_path, enc, name, bom, needles):
