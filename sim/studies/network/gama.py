@@ -40,6 +40,7 @@ from sim.mc.config import ConfigError, given
 from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network
 from sim.studies.network.gama_read import CC, NE, NS, consistent, read_bytes, read_gama
+from sim.studies.network.gama_vocab import shifted
 from sim.studies.network.linearity import row_key
 from sim.studies.network.model import computed
 from sim.studies.network.validate import hits, name_index
@@ -108,6 +109,19 @@ def merge_gama(cfg: dict) -> dict:
 
 def _fmt(x: float) -> str:
     return repr(float(x))
+
+
+def _metres(x_mm: float) -> str:
+    """A coordinate in mm written in metres: its shortest digits with the decimal point moved
+    by three places (-256034.379 mm is ``-256.034379``, where ``repr(x / 1000)`` wrote
+    ``-256.03437900000003``), so gama-local reads the metres the study meant and the import
+    reads back the same double (:meth:`sim.studies.network.gama_vocab._File.mm`)."""
+    d = shifted(repr(float(x_mm) + 0.0), -3)  # -0.0 written 0.0
+    if not -30 < d.adjusted() < 30:
+        return str(d)  # 1.5E-303: gama-local reads the exponent
+    t = format(d, "f")  # the shortest digits, written as repr writes a float: 250.0
+    t = t.rstrip("0") if "." in t else t + "."
+    return t + "0" if t.endswith(".") else t
 
 
 def _refuse(net: Network) -> None:
@@ -260,9 +274,9 @@ def _one(net: Network, o, r: int, v: float) -> None:
 def _points(net: Network, po: ET.Element, inner: set[int], pairs: bool) -> None:
     """One ``<point>`` per point (m): fixed ones ``fix``, estimated ones ``adj`` (``XY`` in
     the inner datum); with coordinate-difference vectors every point also gets z = 0 (fixed)."""
-    xy = net.xy_mm / 1000  # once: the property makes a new (n, 2) array at each call
+    xy = net.xy_mm  # once: the property makes a new (n, 2) array at each call
     for a, nm in enumerate(net.names):
-        attr = {"id": nm, "x": _fmt(xy[a, 0]), "y": _fmt(xy[a, 1])}
+        attr = {"id": nm, "x": _metres(xy[a, 0]), "y": _metres(xy[a, 1])}
         if net.role[a] == 1:
             attr["fix"] = "xyz" if pairs else "xy"
         else:
@@ -283,15 +297,15 @@ def _coordinates(net: Network, po: ET.Element) -> None:
     sig = {int(a): s for a, s in zip(net.i[net.kind == 5], net.sigma[net.kind == 5])}
     obs_pts = _least_first(list(obs_pts), [sig[int(a)] ** 2 for a in obs_pts])
     c = ET.SubElement(po, "coordinates")
-    xy = net.xy_mm / 1000
+    xy = net.xy_mm
     for a in obs_pts:
         ET.SubElement(
             c,
             "point",
             {
                 "id": net.names[a],
-                "x": _fmt(xy[a, 0]),
-                "y": _fmt(xy[a, 1]),
+                "x": _metres(xy[a, 0]),
+                "y": _metres(xy[a, 1]),
             },
         )
     cm = ET.SubElement(c, "cov-mat", {"dim": str(2 * len(obs_pts)), "band": "0"})

@@ -156,7 +156,7 @@ def _point(f: _File, e, points: dict, datum: dict) -> None:
         raise f.err(e, f"point {pid!r} is both fixed and adjusted in xy", "fix")
     rec = points.setdefault(pid, {"name": pid})
     if e.get("x") is not None or e.get("y") is not None:
-        xy = (f.num(e, "x") * 1000, f.num(e, "y") * 1000)
+        xy = (f.mm(e, "x"), f.mm(e, "y"))
         for ax, v in zip("xy", xy):
             if not abs(v) <= COORDINATE_MAX_MM:  # no coordinate on the earth, by the element
                 raise f.err(e, f"{v / 1000:g} m: over 100,000 km, out of range", ax)
@@ -307,22 +307,25 @@ def frame_note(axes: str, angles: str) -> str:
 def _network(f: _File, data: bytes):
     """The ``<network>`` element of the file's bytes, its root and attributes checked."""
     key, path = f.key, f.path
-    if ent := vocab.entity_declared(data):
+    try:  # the characters gama-local reads: its own encodings (cp-1250, ...) decoded as there
+        text = vocab.gama_text(data)
+    except vocab.EncodingProblem as why:
+        raise ConfigError(key, f"{path}: {why}") from None
+    if ent := vocab.entity_declared(text):
         raise ConfigError(
             key,
             f"{path}: its <!DOCTYPE> declares the entity {ent}: entity declarations are not read "
             "(a gama-local file needs none; write the values in place)",
         )
     try:
-        root = ET.fromstring(data)
+        root = ET.fromstring(text)
     except ET.ParseError as e:
         raise ConfigError(key, f"{path} is not XML: {e}") from None
     except (LookupError, ValueError) as e:  # an unknown encoding declared, undecodable bytes
         raise ConfigError(key, f"{path} cannot be decoded: {e}") from None
-    if _tag(root) != "gama-local":  # first: an <html lang="en"> is no gama-local file at
-        # all (it was refused for its attribute, "gama-local takes only xmlns and version")
+    if _tag(root) != "gama-local":  # first: an <html lang="en"> was refused for its attribute
         raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
-    if why := vocab.raw_name_problem(data) or vocab.encoding_problem(data):  # as gama-local
+    if why := vocab.raw_name_problem(text):  # names as gama-local reads them
         raise ConfigError(key, f"{path}: {why}")
     f.vocab(root)
     nets = [e for e in root if _tag(e) == "network"]

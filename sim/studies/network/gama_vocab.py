@@ -7,6 +7,8 @@ before it is opened). The parser: :mod:`sim.studies.network.gama_read`."""
 
 from __future__ import annotations
 
+import codecs
+import decimal
 import math
 import os
 import re
@@ -30,7 +32,9 @@ __all__ = [
     "said",
     "entity_declared",
     "raw_name_problem",
-    "encoding_problem",
+    "gama_text",
+    "shifted",
+    "EncodingProblem",
 ]
 
 NS = "http://www.gnu.org/software/gama/gama-local"
@@ -158,6 +162,13 @@ def _tag(e) -> str:
     return e.tag.split("}", 1)[-1] if isinstance(e.tag, str) else ""
 
 
+def shifted(text: str, places: int) -> decimal.Decimal:
+    """The decimal number ``text`` spells times ``10 ** places``, exactly (its digits kept,
+    its exponent moved: no rounding to a context's precision)."""
+    sign, digits, exp = decimal.Decimal(text).as_tuple()
+    return decimal.Decimal((sign, digits, exp + places))
+
+
 class _File:
     """Error helper: every message names the file, the element and the attribute."""
 
@@ -185,6 +196,13 @@ class _File:
         if lo is not None and x <= lo:
             raise self.err(e, f"{said(v)} must be > {lo:g}", attr)
         return x
+
+    def mm(self, e, attr: str) -> float:
+        """A coordinate of the file (metres) in millimetres: its decimal digits moved by three
+        places (``-256.034379`` is -256034.379 mm, where ``-256.034379 * 1000`` is
+        -256034.37900000002), so the export's coordinates read back to the last digit."""
+        self.num(e, attr)
+        return float(shifted(ws(e.get(attr)), 3)) + 0.0  # -0 is 0
 
     def name(self, e, attr: str, default: str | None = None) -> str:
         v = e.get(attr, default)
@@ -255,7 +273,7 @@ class _Prolog(Exception):
     """The first element: the prolog, where every declaration stands, is over."""
 
 
-def entity_declared(data: bytes) -> str | None:
+def entity_declared(data: bytes | str) -> str | None:
     """The name of the first entity the file's DOCTYPE declares (None: none). A gama-local file
     needs none, and entities are how a file of a few kilobytes expands to gigabytes in the
     parser ("billion laughs"; expat stops an amplification over 100, one just below it held
@@ -281,29 +299,78 @@ def entity_declared(data: bytes) -> str | None:
     return found[0] if found else None
 
 
-#: the encodings gama-local decodes: expat's own (any case) and those of gama-local's handler
-#: (``encoding_unknown_handler.cpp``, compared exactly); any other name it reads as ISO-8859-1
-_EXPAT_ENC = ("utf-8", "utf-16", "iso-8859-1", "us-ascii")
-_GAMA_ENC = ("cp-1250", "windows-1250", "cp-1251", "windows-1251", "iso-8859-2")
-_DECL = re.compile(rb"^(?:\xef\xbb\xbf)?<\?xml[^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
+#: the encodings gama-local decodes: expat's own (any case) and its handler's (names compared
+#: exactly), by Python's codec and the bytes its table maps otherwise (cp1250: 0x80 to U+0080,
+#: not the euro sign, its undefined bytes to themselves; cp1251: 0x98 to U+FFFD); any other
+#: name it reads as ISO-8859-1 (``encoding_unknown_handler.cpp``: the identity table)
+_EXPAT_ENC = ("utf-8", "utf-16", "utf-16be", "utf-16le", "iso-8859-1", "us-ascii")
+_GAMA_ENC = {
+    "cp-1250": "cp1250",
+    "windows-1250": "cp1250",
+    "cp-1251": "cp1251",
+    "windows-1251": "cp1251",
+    "iso-8859-2": "iso8859_2",
+}
+_OWN = {
+    "cp1250": {b: chr(b) for b in (0x80, 0x81, 0x83, 0x88, 0x90, 0x98)},
+    "cp1251": {0x98: "\ufffd"},
+}
+_BOM8 = b"\xef\xbb\xbf"
+#: the XML declaration's encoding (a ``<?xml-stylesheet encoding=...?>`` declares nothing)
+_DECL = re.compile(rb"^(?:\xef\xbb\xbf)?<\?xml[ \t\r\n][^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
 
 
-def encoding_problem(data: bytes) -> str | None:
-    """What makes gama-local read the file's characters otherwise than this reader, or None:
-    a declared encoding gama-local does not know (``koi8-r``, ``ISO-8859-2`` in capitals)
-    over bytes beyond ASCII, which gama-local reads as ISO-8859-1 (``\xe9`` is a point ``é``
-    there, ``И`` here in koi8-r; ``utf8`` fails here as not XML, Python's expat taking only
-    single-byte codecs)."""
+class EncodingProblem(ValueError):
+    """The file's bytes read as other characters in gama-local than here (the message says why)."""
+
+
+def _table(codec: str) -> dict[int, str]:
+    own = _OWN.get(codec, {})  # gama-local's table of the bytes beyond ASCII
+    return {b: own[b] if b in own else bytes([b]).decode(codec) for b in range(128, 256)}
+
+
+def _latin1(enc: str) -> bool:
+    """``enc`` is a Python name of ISO-8859-1 (``latin_1``, ``L1``), as gama-local reads it."""
+    try:
+        return codecs.lookup(enc).name == "iso8859-1"
+    except (LookupError, ValueError):
+        return False
+
+
+def gama_text(data: bytes) -> bytes | str:
+    """The file as ``gama-local`` reads its characters, for the XML parser: the bytes where
+    the parser decodes them as gama-local's (no declaration, expat's own encodings), else
+    the text decoded as gama-local decodes it: its own encodings (``cp-1250``, ...) by its
+    tables, any other name (``x-foo``, ``latin_1``) as ISO-8859-1, alike for a file of ASCII
+    bytes. Raises :class:`EncodingProblem` where that is not what the file means: a name of
+    another encoding (``koi8-r``, ``ISO-8859-2`` in capitals, ``UTF8``, ``CP1250``: Python's
+    codec would read other characters than gama-local, and the writer meant those) over bytes
+    beyond ASCII, or a UTF-8 byte-order mark before another declared encoding (gama-local
+    reads the bytes in the declared one: ``É`` of the UTF-8 the mark says is ``Ã‰`` there)."""
     m = _DECL.match(data[:1024])
-    if not m or data.isascii():
-        return None
+    if not m:
+        return data
     enc = m.group(1).decode("ascii", "replace")
-    if enc.lower() in _EXPAT_ENC or enc in _GAMA_ENC:
-        return None
-    return (
+    bom = data.startswith(_BOM8)
+    body = data[len(_BOM8) :] if bom else data
+    if bom and enc.lower() != "utf-8" and not body.isascii():
+        raise EncodingProblem(
+            f"a UTF-8 byte-order mark before <?xml encoding={said(enc)}?>: gama-local reads "
+            "the bytes beyond ASCII by the declaration, not as UTF-8 (an \u00c9 as \u00c3 and "
+            "another character): remove the mark or declare UTF-8"
+        )
+    if enc.lower() in _EXPAT_ENC:
+        return data
+    if body.isascii():  # no byte beyond ASCII: every name reads alike (gama-local's too)
+        return body.decode("ascii")
+    if enc in _GAMA_ENC:
+        return body.decode("latin-1").translate(_table(_GAMA_ENC[enc]))
+    if _latin1(enc):
+        return body.decode("latin-1")
+    raise EncodingProblem(
         f"<?xml encoding={said(enc)}?>: gama-local does not know this encoding and reads the "
         "bytes beyond ASCII as ISO-8859-1, other characters than here: declare UTF-8 "
-        f"(or one of {', '.join(_EXPAT_ENC[1:] + _GAMA_ENC)})"
+        f"(or one of {', '.join(('UTF-16', 'ISO-8859-1', 'US-ASCII', *_GAMA_ENC))})"
     )
 
 
@@ -311,7 +378,7 @@ class _Raw(Exception):
     """The first name gama-local reads otherwise than a namespace-aware parser."""
 
 
-def raw_name_problem(data: bytes) -> str | None:
+def raw_name_problem(data: bytes | str) -> str | None:
     """What ``gama-local`` refuses in the file's names as written, or None. Its parser (expat
     without namespace processing, ``gkfparser.cpp``) reads each name as it stands, where
     ElementTree drops a prefix: ``<g:gama-local xmlns:g="...">`` is an unknown element there
