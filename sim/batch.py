@@ -61,6 +61,7 @@ from sim.batch_checks import (  # noqa: E402
 from sim.batch_timings import TimingsLock  # noqa: E402
 from sim.cli_args import module_doc  # noqa: E402
 from sim.ends import finish  # noqa: E402
+from sim.held_stops import held_stops  # noqa: E402
 from sim.mc.argv import OnceParser, integer  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
@@ -354,10 +355,26 @@ def _run(args, files: list[Path], run_args: list[str], note: str | None, loaded)
     except KeyboardInterrupt:  # the runs were stopped and cleaned up
         print(INTERRUPTED, file=sys.stderr)
         return 130
+    written: list[str] = []
+    try:
+        return _finish(args, files, done, log, written)
+    except KeyboardInterrupt:  # it said "resumes the unfinished runs" of a batch with none
+        print(_ENDED + "".join(written), file=sys.stderr)
+        return 130
+
+
+#: the driver's line when interrupted after every run ended (writing the timings, the summary)
+_ENDED = "sim.batch: interrupted after every run ended"
+
+
+def _finish(args, files: list[Path], done: dict, log, written: list[str]) -> int:
+    """Write the timings of the ended runs ``done`` (an interrupt meanwhile is handled once
+    they are written: ``written`` then says so) and print the summary; the exit code."""
     if args.timings is not None:
         try:
-            with atomic_path(args.timings) as tmp:  # a write cut short (a full disk, ulimit
-                tmp.write_text(json.dumps(done), encoding="utf-8")  # -f) keeps the earlier file
+            with held_stops(), atomic_path(args.timings) as tmp:  # a write cut short (a full
+                tmp.write_text(json.dumps(done), encoding="utf-8")  # disk) keeps the earlier
+                written.append(f"; their timings were written to {args.timings}")
         except OSError as e:  # a full disk, ulimit -f: the runs stand, their timings do not
             print(f"sim.batch: --timings: {e.strerror or e}: {args.timings}", file=sys.stderr)
             return 2

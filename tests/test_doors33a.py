@@ -1,0 +1,171 @@
+"""The classes of the sweep doors33a (brief A33: interrupts placed per phase of ``sim report``,
+``python -m sim.batch`` and ``make verify``), one case each; each failed on the code before its
+fix. Each phase is reached by a patched function that sends the process the signal itself.
+
+* SIGINT or SIGTERM just before a file's rename (:class:`sim.mc.storage.atomic_path`: only an
+  OSError there removed the temporary) left ``.REPORT.md.<pid>.tmp`` in the results directory
+  after ``sim report`` (and ``.README.md.<pid>.tmp`` in a study's, a chunk's in a run's) until
+  a later write into it: the temporary now goes on any exception, which is raised as it was.
+* ``python -m sim.batch`` interrupted after every run ended, while it wrote ``--timings`` or its
+  summary, said "interrupted; the same command again resumes the unfinished runs" (there were
+  none) and left the timings file of an earlier batch as this one's: the timings are written
+  first (the signal handled once they are, as a run's publishing) and the line says so.
+* ``make verify`` interrupted after every re-run ended and was compared said "interrupted; the
+  re-run was stopped": while it printed the comparisons (the record is then not written: the
+  line says so), while it wrote ``reproducibility.parquet`` (now written first, then handled:
+  the line says it was recorded), and while it removed its temporary scratch directory, which
+  was left in the temporary directory for good (now removed first).
+
+Held (found right; each phase by a process sending itself SIGINT and SIGTERM, then the same
+command again): ``sim report`` while reading the tables, before and after each study's README.md
+and before a study's section (exit 130, one line; every file as before or as the report writes
+it, no temporary; the next report exit 0); ``python -m sim.batch`` between two studies and while
+a run publishes (the child's signal held by the run, the driver's line; the published results
+complete, the next study's ``.X.partial`` resumed by the same command; no child left, the
+``--timings`` lock removed); ``make verify`` during a re-run (before it starts, between chunks,
+while it publishes and writes its README: the re-run stopped, its staging directory under
+``--scratch`` resumed by the next verify, which ends ok) and while comparing (exit 130, nothing
+recorded, the temporary scratch removed).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import tempfile
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+import sim.batch
+import sim.report.verify.cli as verify_cli
+from sim.cli import main
+from sim.mc import storage
+from sim.report.verify.rules import Comparison
+
+ROOT = Path(__file__).resolve().parent.parent
+TABLE1 = str(ROOT / "studies" / "brown_table1.toml")
+RUN = ["run", TABLE1, "--trials", "40", "--chunk", "2", "--quiet", "--no-figures"]
+RUN += ["--set", "region.points=256", "--set", "region.rounds=0"]
+SIGNALS = [pytest.param(s, id=s.name) for s in (signal.SIGINT, signal.SIGTERM)]
+
+
+def _kill_me(sig) -> None:
+    os.kill(os.getpid(), sig)  # handled before the next line of Python runs
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    """A results directory with one small run of brown_table1 (copy it before writing)."""
+    res = tmp_path_factory.mktemp("res")
+    assert main([*RUN, "--out", str(res / "brown_table1")]) == 0
+    return res
+
+
+def _files(d: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(d)): p.read_bytes() for p in sorted(d.rglob("*")) if p.is_file()}
+
+
+@pytest.mark.parametrize("sig", SIGNALS)
+def test_an_interrupt_before_the_rename_of_report_md_leaves_no_temporary(
+    results, tmp_path, monkeypatch, capsys, sig
+):
+    res = tmp_path / "res"
+    shutil.copytree(results, res)
+    assert main(["report", "--results", str(res)]) == 0
+    before = _files(res)
+    real = os.replace
+
+    def replace(src, dst, *a, **k):
+        if Path(dst).name == "REPORT.md":
+            _kill_me(sig)
+        return real(src, dst, *a, **k)
+
+    monkeypatch.setattr(storage.os, "replace", replace)
+    capsys.readouterr()
+    rc = main(["report", "--results", str(res)])
+    assert (rc, capsys.readouterr().err) == (130, "sim: interrupted\n")
+    # before: .REPORT.md.<pid>.tmp stayed beside the REPORT.md it did not replace
+    assert _files(res) == before
+    monkeypatch.undo()
+    assert main(["report", "--results", str(res)]) == 0 and _files(res) == before
+
+
+def _batch_timings(tmp_path, monkeypatch, capsys, sig):
+    """python -m sim.batch whose runs ended (``run_all`` returns their timings) interrupted by
+    ``sig`` as it begins to write ``--timings``."""
+    timings = tmp_path / "t.json"
+    timings.write_text('{"an earlier batch": [0, 1.0, 0.0]}')
+    done = {"brown_table1": [0, 2.5, 0.0]}
+    monkeypatch.setattr(sim.batch, "run_all", lambda *a, **k: dict(done))
+    real = sim.batch.atomic_path
+
+    class interrupted(real):
+        def __enter__(self):
+            _kill_me(sig)
+            return super().__enter__()
+
+    monkeypatch.setattr(sim.batch, "atomic_path", interrupted)
+    rc = sim.batch.main([TABLE1, "--results", str(tmp_path / "r"), "--timings", str(timings)])
+    return rc, capsys.readouterr(), timings, done
+
+
+@pytest.mark.parametrize("sig", SIGNALS)
+def test_a_batch_interrupted_while_writing_its_timings_says_its_runs_ended(
+    tmp_path, monkeypatch, capsys, sig
+):
+    rc, out, timings, done = _batch_timings(tmp_path, monkeypatch, capsys, sig)
+    # before: "sim.batch: interrupted; the same command again resumes the unfinished runs",
+    # and t.json still the earlier batch's
+    words = f"sim.batch: interrupted after every run ended; their timings were written to {timings}"
+    assert (rc, out.err.strip()) == (130, words)
+    assert json.loads(timings.read_text()) == done
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.json"]  # no lock, no temporary
+
+
+def _verify(tmp_path, monkeypatch, sig, at: str, *options: str):
+    """``make verify`` whose re-runs ended and were compared (one study, ok), interrupted by
+    ``sig`` at ``at``: printing the comparisons, writing the record, removing its temporary
+    scratch directory."""
+    monkeypatch.chdir(ROOT)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+
+    def verify(results, scratch, **k):
+        (scratch / "brown_table1").mkdir()  # a re-run's results in the scratch directory
+        (scratch / "brown_table1" / "claims.parquet").write_bytes(b"")
+        return [Comparison("brown_table1", files=6)]
+
+    monkeypatch.setattr(verify_cli, "verify", verify)
+    for name in ("_print", "write_record"):
+        if name == at:
+            real = getattr(verify_cli, name)
+            monkeypatch.setattr(verify_cli, name, lambda *a, r=real: (_kill_me(sig), r(*a))[1])
+    if at == "rmtree":
+        real = shutil.rmtree
+        monkeypatch.setattr(
+            verify_cli.shutil, "rmtree", lambda *a, **k: (_kill_me(sig), real(*a, **k))
+        )
+    return verify_cli.main(["--results", str(tmp_path), *options])
+
+
+@pytest.mark.parametrize("sig", SIGNALS)
+@pytest.mark.parametrize(
+    "at,recorded", [("_print", False), ("write_record", True), ("rmtree", False)]
+)
+def test_verify_interrupted_after_its_comparisons_says_so(
+    tmp_path, monkeypatch, capsys, sig, at, recorded
+):
+    rc = _verify(tmp_path, monkeypatch, sig, at)
+    record = tmp_path / "reproducibility.parquet"
+    how = "were recorded" if recorded else "were not recorded"
+    # before: "sim verify: interrupted; the re-run was stopped", the record not written
+    words = f"sim verify: interrupted after the comparisons; they {how} in {record}"
+    assert (rc, capsys.readouterr().err.strip()) == (130, words)
+    assert record.exists() == recorded
+    if recorded:
+        assert pq.read_table(record).column("study").to_pylist() == ["brown_table1"]
+    assert list((tmp_path / "tmp").iterdir()) == []  # before: sim-verify-* left (at rmtree)
