@@ -10,6 +10,11 @@ fix. Each phase is reached by a patched function that sends the process the sign
   summary, said "interrupted; the same command again resumes the unfinished runs" (there were
   none) and left the timings file of an earlier batch as this one's: the timings are written
   first (the signal handled once they are, as a run's publishing) and the line says so.
+* ``python -m sim.batch`` sent SIGTERM while one of its runs published its results: the run
+  published them and said so ("interrupted after the results were written to X/"), but the
+  driver dropped the run's words and said only "interrupted; the same command again resumes
+  the unfinished runs", as if that run were unfinished: its line now names the study files
+  whose runs wrote their results.
 * ``make verify`` interrupted after every re-run ended and was compared said "interrupted; the
   re-run was stopped": while it printed the comparisons (the record is then not written: the
   line says so), while it wrote ``reproducibility.parquet`` (now written first, then handled:
@@ -20,9 +25,9 @@ Held (found right; each phase by a process sending itself SIGINT and SIGTERM, th
 command again): ``sim report`` while reading the tables, before and after each study's README.md
 and before a study's section (exit 130, one line; every file as before or as the report writes
 it, no temporary; the next report exit 0); ``python -m sim.batch`` between two studies and while
-a run publishes (the child's signal held by the run, the driver's line; the published results
-complete, the next study's ``.X.partial`` resumed by the same command; no child left, the
-``--timings`` lock removed); ``make verify`` during a re-run (before it starts, between chunks,
+a run of ``--jobs 2`` publishes while the other computes (the published results complete, the
+other's ``.X.partial`` resumed by the same command; no child left, the ``--timings`` lock
+removed); ``make verify`` during a re-run (before it starts, between chunks,
 while it publishes and writes its README: the re-run stopped, its staging directory under
 ``--scratch`` resumed by the next verify, which ends ok) and while comparing (exit 130, nothing
 recorded, the temporary scratch removed).
@@ -169,3 +174,40 @@ def test_verify_interrupted_after_its_comparisons_says_so(
     if recorded:
         assert pq.read_table(record).column("study").to_pylist() == ["brown_table1"]
     assert list((tmp_path / "tmp").iterdir()) == []  # before: sim-verify-* left (at rmtree)
+
+
+#: a batch's run that sends the driver SIGTERM as it publishes its results: the SIGTERM the
+#: driver passes on comes while it publishes (held until its results are published), or after
+#: (they are published, or the run has ended): in each case its results are written
+_CHILD = """import os, runpy, sys
+import sim.execute as ex
+real = ex.publish
+def publish(a, b):
+    os.kill(os.getppid(), 15)
+    return real(a, b)
+ex.publish = publish
+sys.argv = ["sim", *sys.argv[1:]]
+runpy.run_module("sim", run_name="__main__", alter_sys=True)
+"""
+
+
+def test_a_batch_interrupted_while_a_run_publishes_names_its_results(tmp_path, monkeypatch, capsys):
+    child, res = tmp_path / "child.py", tmp_path / "res"
+    child.write_text(_CHILD)
+    shutil.copy(TABLE1, tmp_path / "a.toml")
+    pids = []
+
+    class Popen(sim.batch.subprocess.Popen):  # the runs of the batch as _CHILD
+        def __init__(self, cmd, *a, **k):
+            super().__init__([cmd[0], str(child), *cmd[3:]], *a, **k)
+            pids.append(self.pid)
+
+    monkeypatch.setattr(sim.batch.subprocess, "Popen", Popen)
+    monkeypatch.chdir(ROOT)
+    rc = sim.batch.main([str(tmp_path / "a.toml"), "--results", str(res), "--", *RUN[2:]])
+    err = capsys.readouterr().err.strip()
+    # before: the line without the parenthesis, as if its run were unfinished
+    assert (rc, err) == (130, f"{sim.batch.INTERRUPTED} (the results of a.toml were written)")
+    assert sorted(p.name for p in res.iterdir()) == ["a"]  # complete, nothing beside
+    assert (res / "a" / "claims.parquet").is_file() and (res / "a" / "run.json").is_file()
+    assert len(pids) == 1 and not Path(f"/proc/{pids[0]}").exists()  # no child left
