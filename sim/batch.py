@@ -361,8 +361,8 @@ def _run(args, files: list[Path], run_args: list[str], note: str | None, loaded)
         check_interrupt()  # before the timings are written
     except KeyboardInterrupt as e:  # the runs were stopped and cleaned up
         w = getattr(e, "written", None)  # it said nothing of a run's results published meanwhile
-        done = f" (the results of {', '.join(w)} were written)" if w else ""
-        print(INTERRUPTED + done, file=sys.stderr)
+        named = f" (the results of {', '.join(w)} were written)" if w else ""
+        print(INTERRUPTED + named, file=sys.stderr)
         return 130
     written: list[str] = []
     try:
