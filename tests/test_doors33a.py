@@ -24,13 +24,13 @@ fix. Each phase is reached by a patched function that sends the process the sign
 Held (found right; each phase by a process sending itself SIGINT and SIGTERM, then the same
 command again): ``sim report`` while reading the tables, before and after each study's README.md
 and before a study's section (exit 130, one line; every file as before or as the report writes
-it, no temporary; the next report exit 0); ``python -m sim.batch`` between two studies and while
-a run of ``--jobs 2`` publishes while the other computes (the published results complete, the
-other's ``.X.partial`` resumed by the same command; no child left, the ``--timings`` lock
-removed); ``make verify`` during a re-run (before it starts, between chunks,
-while it publishes and writes its README: the re-run stopped, its staging directory under
-``--scratch`` resumed by the next verify, which ends ok) and while comparing (exit 130, nothing
-recorded, the temporary scratch removed).
+it, no temporary; the next report exit 0); ``python -m sim.batch`` between two studies of
+``--jobs 1`` and while a run of ``--jobs 2`` writes its README while the other computes (the
+ended run's results complete, the other's ``.X.partial`` resumed by the same command, which
+``--stale-only`` then reports up to date; no child left, the ``--timings`` lock removed);
+``make verify`` during a re-run (as it starts, while it publishes and writes its README: the
+re-run stopped, its staging directory under ``--scratch`` resumed by the next verify, which ends
+ok) and while comparing (exit 130, nothing recorded, the temporary scratch removed).
 """
 
 from __future__ import annotations
