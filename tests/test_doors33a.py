@@ -20,6 +20,12 @@ fix. Each phase is reached by a patched function that sends the process the sign
   line says so), while it wrote ``reproducibility.parquet`` (now written first, then handled:
   the line says it was recorded), and while it removed its temporary scratch directory, which
   was left in the temporary directory for good (now removed first).
+* SIGTERM to ``make`` of ``make verify`` (``timeout 1h make verify``, a CI job's limit) ended
+  make and its shell only: verify, orphaned, ran on with its re-run, printed its comparisons
+  after make had said "Terminated" and wrote the record into the results. The Makefile names
+  the shell to verify (``SIM_STOP_WITH_PARENT=$$``, as ``sim.batch`` names itself to its runs),
+  which ends as after SIGTERM when the shell does: its re-run stopped, its temporary scratch
+  removed, nothing recorded.
 
 Held (found right; each phase by a process sending itself SIGINT and SIGTERM, then the same
 command again): ``sim report`` while reading the tables, before and after each study's README.md
@@ -35,11 +41,15 @@ ok) and while comparing (exit 130, nothing recorded, the temporary scratch remov
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+import select
 import shutil
 import signal
+import subprocess
 import tempfile
+import time
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -211,3 +221,46 @@ def test_a_batch_interrupted_while_a_run_publishes_names_its_results(tmp_path, m
     assert sorted(p.name for p in res.iterdir()) == ["a"]  # complete, nothing beside
     assert (res / "a" / "claims.parquet").is_file() and (res / "a" / "run.json").is_file()
     assert len(pids) == 1 and not Path(f"/proc/{pids[0]}").exists()  # no child left
+
+
+def _read_until(fd: int, seconds: float, needle: bytes | None = None) -> tuple[bytes, bool]:
+    """What the pipe ``fd`` gives within ``seconds``: until ``needle`` is read, or until its end
+    (every process that holds it has ended); and whether that came in time."""
+    got, end = b"", time.monotonic() + seconds
+    while (left := end - time.monotonic()) > 0 and select.select([fd], [], [], left)[0]:
+        chunk = os.read(fd, 4096)
+        got += chunk
+        if not chunk or (needle is not None and needle in got):
+            return got, True
+    return got, False
+
+
+def test_sigterm_to_make_verify_ends_verify_and_its_re_run(results, tmp_path):
+    studies, res, tmp = tmp_path / "studies", tmp_path / "res", tmp_path / "tmp"
+    studies.mkdir(), tmp.mkdir()
+    shutil.copy(TABLE1, studies / "brown_table1.toml")  # 4000 trials: a re-run of seconds
+    shutil.copytree(results, res)
+    make = subprocess.Popen(
+        ["make", "-s", "-o", ".venv/.installed", "verify"]
+        + [f"VERIFY_FLAGS=--results {res} --studies {studies}"],
+        cwd=ROOT,
+        env={**os.environ, "TMPDIR": str(tmp)},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,  # (the test ends every process it started: its group)
+    )
+    try:
+        fd = make.stderr.fileno()
+        got, ok = _read_until(fd, 120, b"sim verify: re-running brown_table1\n")
+        assert ok, got
+        make.terminate()  # SIGTERM to make alone (`timeout 1h make verify`), which kills its shell
+        assert make.wait(timeout=60) != 0
+        rest, ended = _read_until(fd, 60)  # verify holds the pipe while it runs
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(make.pid, signal.SIGKILL)
+        make.stderr.close()
+    # before: verify ran on, orphaned, re-ran the study and wrote the record after make ended
+    assert ended, rest
+    assert verify_cli.INTERRUPTED in rest.decode().splitlines()
+    assert not (res / "reproducibility.parquet").exists() and list(tmp.iterdir()) == []
