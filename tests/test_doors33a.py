@@ -235,6 +235,7 @@ def _read_until(fd: int, seconds: float, needle: bytes | None = None) -> tuple[b
     return got, False
 
 
+@pytest.mark.skipif(shutil.which("make") is None, reason="no make on this machine")
 def test_sigterm_to_make_verify_ends_verify_and_its_re_run(results, tmp_path):
     studies, res, tmp = tmp_path / "studies", tmp_path / "res", tmp_path / "tmp"
     studies.mkdir(), tmp.mkdir()
