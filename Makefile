@@ -190,12 +190,14 @@ rerun: $(STAMP) ## re-run every study even if its results are up to date, then t
 # VERIFY_FLAGS: e.g. "--study brown_table1", "--scratch DIR" (see python -m sim.report.verify -h;
 # results of your own study files: python -m sim.report.verify --results DIR --studies DIR).
 # A failed comparison (exit 1) rebuilds the report too: REPORT.md showed the record before it
+# SIM_STOP_WITH_PARENT=$$$$ (the recipe's shell): SIGTERM to make ends that shell only, and
+# verify ran on, orphaned; it now ends with the shell (sim.mc.children.die_with_parent)
 VERIFY_FLAGS ?=
 
 verify: $(STAMP) ## re-run every study into a scratch directory and compare with results/ (a rule per kind of column; VERIFY_FLAGS)
 	$(call shellwords,VERIFY_FLAGS)
-	$(PY) -m sim.report.verify --results results --workers 2 $(VERIFY_FLAGS) || { rc=$$?; \
-	  [ $$rc -ne 1 ] || $(PY) -m sim report --results results; exit $$rc; }
+	SIM_STOP_WITH_PARENT=$$$$ $(PY) -m sim.report.verify --results results --workers 2 $(VERIFY_FLAGS) || { rc=$$?; \
+	  [ $$rc -ne 1 ] || SIM_STOP_WITH_PARENT=$$$$ $(PY) -m sim report --results results; exit $$rc; }
 	$(PY) -m sim report --results results
 
 report: $(STAMP) ## rebuild results/REPORT.md and every results/<study>/README.md from the Parquet files alone

@@ -50,6 +50,7 @@ single_threaded_blas()  # before NumPy loads (the study modules import it)
 from sim.batch_checks import (  # noqa: E402
     _clashes,
     _configs_problems,
+    _files_after,
     _in_batch_words,
     _replaces_project_results,
     _run_options_problem,
@@ -61,6 +62,7 @@ from sim.batch_checks import (  # noqa: E402
 from sim.batch_timings import TimingsLock  # noqa: E402
 from sim.cli_args import module_doc  # noqa: E402
 from sim.ends import finish  # noqa: E402
+from sim.held_stops import held_stops  # noqa: E402
 from sim.mc.argv import OnceParser, integer  # noqa: E402
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, ended, stop_children  # noqa: E402
 from sim.mc.outputs import name_problem  # noqa: E402
@@ -141,6 +143,7 @@ def run_all(
 
     t0 = time.perf_counter()
     procs: list[subprocess.Popen] = []
+    written: list[str] = []  # the study files whose runs published their results
     stop = threading.Event()  # set on an interrupt: start no more runs, print nothing of theirs
     starting = threading.Lock()
 
@@ -169,6 +172,8 @@ def run_all(
         with proc:
             stdout, stderr = proc.communicate()
         wall = time.perf_counter() - t
+        if proc.returncode == 0 or PUBLISHED in (stderr or ""):  # (interrupted as it published)
+            written.append(f.name)
         if stop.is_set():  # interrupted: the driver says so in one line
             return f.stem, None, wall, t - t0
         if proc.returncode < 0:  # killed by a signal (kill -9, the OOM killer): it said not a word
@@ -187,9 +192,10 @@ def run_all(
         for stem, code, wall, start in pool.map(one, todo):
             out[stem] = (code, wall, start)
             check_interrupt()  # one Python dropped (a C callback): the other runs end too
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:
         stop_children(procs, first=lambda: _set(stop, starting))
         pool.shutdown(wait=True, cancel_futures=True)
+        e.written = written  # for the driver's line: results replaced are not "unfinished"
         raise
     pool.shutdown()
     return out
@@ -233,6 +239,8 @@ class _Parser(OnceParser):
 
 #: the driver's line when it was interrupted
 INTERRUPTED = "sim.batch: interrupted; the same command again resumes the unfinished runs"
+#: what a run of ``sim run`` interrupted while it published its results says
+PUBLISHED = "interrupted after the results were written to"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -351,13 +359,31 @@ def _run(args, files: list[Path], run_args: list[str], note: str | None, loaded)
             files, Path(args.results), args.jobs, run_args, args.stale_only, log, loaded=loaded
         )
         check_interrupt()  # before the timings are written
-    except KeyboardInterrupt:  # the runs were stopped and cleaned up
-        print(INTERRUPTED, file=sys.stderr)
+    except KeyboardInterrupt as e:  # the runs were stopped and cleaned up
+        w = getattr(e, "written", None)  # it said nothing of a run's results published meanwhile
+        named = f" (the results of {', '.join(w)} were written)" if w else ""
+        print(INTERRUPTED + named, file=sys.stderr)
         return 130
+    written: list[str] = []
+    try:
+        return _finish(args, files, done, log, written)
+    except KeyboardInterrupt:  # it said "resumes the unfinished runs" of a batch with none
+        print(_ENDED + "".join(written), file=sys.stderr)
+        return 130
+
+
+#: the driver's line when interrupted after every run ended (writing the timings, the summary)
+_ENDED = "sim.batch: interrupted after every run ended"
+
+
+def _finish(args, files: list[Path], done: dict, log, written: list[str]) -> int:
+    """Write the timings of the ended runs ``done`` (an interrupt meanwhile is handled once
+    they are written: ``written`` then says so) and print the summary; the exit code."""
     if args.timings is not None:
         try:
-            with atomic_path(args.timings) as tmp:  # a write cut short (a full disk, ulimit
-                tmp.write_text(json.dumps(done), encoding="utf-8")  # -f) keeps the earlier file
+            with held_stops(), atomic_path(args.timings) as tmp:  # a write cut short (a full
+                tmp.write_text(json.dumps(done), encoding="utf-8")  # disk) keeps the earlier
+                written.append(f"; their timings were written to {args.timings}")
         except OSError as e:  # a full disk, ulimit -f: the runs stand, their timings do not
             print(f"sim.batch: --timings: {e.strerror or e}: {args.timings}", file=sys.stderr)
             return 2
@@ -370,17 +396,6 @@ def _run(args, files: list[Path], run_args: list[str], note: str | None, loaded)
     if log.error is not None and not failed:  # a reader that left (| head -1): as sim does
         return 141
     return code
-
-
-def _files_after(message: str, run_args: list[str]) -> str:
-    """``; study files come before --, not after it (a.toml)`` when argparse's ``message``
-    says no study file was given and one is among sim run's options after ``--`` (a word of
-    its own, not an option's ``KEY=VALUE``); "" otherwise (a ``--set x=a.toml`` after a bad
-    ``--jobs`` is not a study file put in the wrong place)."""
-    if not message.startswith("the following arguments are required"):
-        return ""
-    after = [a for a in run_args if a.endswith(".toml") and not a.startswith("-") and "=" not in a]
-    return f"; study files come before --, not after it ({after[0]})" if after else ""
 
 
 def summary(files: list[Path], done: dict[str, tuple[int, float, float]], code: int) -> str:

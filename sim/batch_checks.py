@@ -279,3 +279,14 @@ def _timings_problem(path: str) -> str | None:
         if not ours:
             return f"{p} exists and is not a timings file of sim.batch; sim never replaces it"
     return None
+
+
+def _files_after(message: str, run_args: list[str]) -> str:
+    """``; study files come before --, not after it (a.toml)`` when argparse's ``message``
+    says no study file was given and one is among sim run's options after ``--`` (a word of
+    its own, not an option's ``KEY=VALUE``); "" otherwise (a ``--set x=a.toml`` after a bad
+    ``--jobs`` is not a study file put in the wrong place)."""
+    if not message.startswith("the following arguments are required"):
+        return ""
+    after = [a for a in run_args if a.endswith(".toml") and not a.startswith("-") and "=" not in a]
+    return f"; study files come before --, not after it ({after[0]})" if after else ""

@@ -18,7 +18,9 @@ def held_stops():
     closing, by the handler that was there. Around publishing a run: the swap of the results
     directory and its clean-up are a few renames, and an interrupt between two of them left
     the new results published but the command saying "run the same command again to finish
-    the missing chunks" (exit 130), with the old results in a hidden directory. In another
+    the missing chunks" (exit 130), with the old results in a hidden directory. Also around
+    the drivers' last writes after their runs ended (``sim.batch``'s ``--timings``, ``make
+    verify``'s record and the removal of its temporary scratch directory). In another
     thread than the main one nothing is held (a signal is handled in the main thread)."""
     signals = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP) if in_main_thread() else ()
     old = {s: h for s in signals if callable(h := signal.getsignal(s))}

@@ -206,6 +206,9 @@ class atomic_path:
             except OSError as e:  # e.g. a directory where the file goes: leave no temporary
                 self._drop_tmp()  # behind, and name the file, not it
                 raise _named(e, self.path) from None
+            except BaseException:  # Ctrl-C or SIGTERM just before the rename: `sim report`
+                self._drop_tmp()  # left .REPORT.md.<pid>.tmp in the results until a next write
+                raise
         else:
             self._drop_tmp()
             if isinstance(exc, OSError) and exc.filename in (None, "", str(self.tmp)):

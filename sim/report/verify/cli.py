@@ -10,6 +10,7 @@ import tempfile
 from pathlib import Path
 
 from sim.ends import stdout_failed
+from sim.held_stops import held_stops
 from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError, parse_override
 from sim.mc.outputs import name_problem
@@ -157,6 +158,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str] | None) -> int:
+    comps = None
     try:
         try:
             a = _parser().parse_args(argv)
@@ -179,7 +181,8 @@ def _main(argv: list[str] | None) -> int:
                 studies=Path(a.studies),
             )
         finally:
-            left = _remove(tmp)
+            with held_stops():  # Ctrl-C while removing it left it (in /tmp) for good
+                left = _remove(tmp)
         check_interrupt()  # before the comparisons are printed and recorded
     except VerifyError as e:
         print(f"sim verify: error: {e}", file=sys.stderr)
@@ -189,8 +192,34 @@ def _main(argv: list[str] | None) -> int:
         print(f"sim verify: error: {e.strerror or e}{where}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(INTERRUPTED, file=sys.stderr)
+        print(INTERRUPTED if comps is None else _after(a, mode, []), file=sys.stderr)
         return 130
+    said: list[str] = []
+    try:
+        return _report(comps, _record_path(a, mode), left, said)
+    except KeyboardInterrupt:  # it said "the re-run was stopped" of re-runs that had ended
+        print(_after(a, mode, said), file=sys.stderr)
+        return 130
+
+
+def _record_path(a, mode: str) -> Path | None:
+    """Where the comparisons are recorded (None: not recorded, a part of them or by trials)."""
+    full = not a.no_record and mode == "full" and not a.study
+    return Path(a.results) / "reproducibility.parquet" if full else None
+
+
+def _after(a, mode: str, said: list[str]) -> str:
+    """The line of an interrupt after every re-run ended and was compared (``said``: that the
+    record was written, when it was)."""
+    where = _record_path(a, mode)
+    what = f"; they were not recorded in {where}" if where is not None else ""
+    return f"sim verify: interrupted after the comparisons{(said or [what])[-1]}"
+
+
+def _report(comps: list[Comparison], where: Path | None, left: str | None, said: list) -> int:
+    """Print the comparisons ``comps`` and record them in ``where`` (None: not recorded; an
+    interrupt while it is written is handled once it is, ``said`` then saying so); the exit
+    code."""
     try:  # a long output (20 lines a failed study) into a full disk or a reader that left
         _print(comps)  # was a traceback here, and the record below was not written
         unprinted = None
@@ -199,11 +228,12 @@ def _main(argv: list[str] | None) -> int:
     code = 0 if all(c.ok for c in comps) else 1
     if unprinted is not None:
         code = stdout_failed("sim verify", unprinted, code)
-    if not a.no_record and mode == "full" and not a.study:
+    if where is not None:
         try:
-            write_record(Path(a.results), comps)
+            with held_stops():
+                write_record(where.parent, comps)
+                said.append(f"; they were recorded in {where}")
         except OSError as e:  # e.g. a directory where the record goes: one line, no traceback
-            where = Path(a.results) / "reproducibility.parquet"
             print(f"sim verify: error: cannot write {where}: {e.strerror or e}", file=sys.stderr)
             return 2
     if left:
