@@ -8,6 +8,12 @@ seeds and verdicts), one case each; each failed on the code before its fix.
   longest range reads on the scale) moved with the seed. The same kind as lead32's random
   networks and plates: it is drawn from ``zeiss.layout_seed`` now (default 1967, the study
   file's seed, so the committed layout is the one it was).
+* A sweep's figure (``sweep.png``) drew every claim "with its 95 % interval" (docs/sweeps.md):
+  a one-plate claim's bars are the central 95 % of simulated plates (the spread of one
+  plate, not an interval of its value: two cells whose medians differ by many standard
+  errors had overlapping bars), and a region row's marker was the low end of its range over
+  the region, the bar the range. ``sweep.parquet`` now records each claim's interval kind
+  (``claim_intervals`` in its provenance) and each such panel says what its bars are.
 """
 
 from __future__ import annotations
@@ -15,6 +21,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+
+from sim.cli import main
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
 
@@ -32,3 +40,30 @@ def test_brown_design_zeiss_layout_is_one_layout_across_seeds():
     lat = np.stack(np.meshgrid(*[np.arange(-9, 10) * 10.0] * 2, indexing="ij"), -1)
     order = chunk_rng(1967, 90, 0).permutation(19 * 19)
     assert np.array_equal(a, lat.reshape(-1, 2)[np.sort(order[:33])])
+
+
+def test_a_sweep_figure_says_what_its_bars_are(tmp_path, monkeypatch):
+    from sim.mc.storage import read_provenance
+    from sim.report import sweep as sweep_fig
+
+    tiny = (STUDIES.parent / "tests" / "data" / "tiny" / "gridplate_two_plates.txt").read_text()
+    f = tmp_path / "sw.toml"
+    f.write_text(
+        'study = "gridplate_two_plates"\nseed = 3\n'
+        + "".join(f"{k.strip()} = {v.strip()}\n" for k, v in (x.split("=") for x in tiny.split()))
+        + '[sweep]\n"readings.count" = [4]\n',
+        encoding="utf-8",
+    )
+    out = tmp_path / "out"
+    assert main(["run", str(f), "--out", str(out), "--no-figures", "--quiet"]) == 0
+    kinds = read_provenance(out / "sweep.parquet")["claim_intervals"]
+    assert kinds["twoplate.precision.reading_sigma_um"] == ["spread"]
+    assert kinds["twoplate.combined.iterations"] == ["region"]
+    drawn = []
+    monkeypatch.setattr(sweep_fig, "save", lambda fig, png: drawn.append(fig) or png)
+    sweep_fig.fig_sweep(out / "sweep.parquet", out / "sweep.png")
+    titles = {a.get_title().split("\n")[0]: a.get_title() for a in drawn[0].axes}
+    plates = titles["twoplate.precision.reading_sigma_um"]
+    assert "bars: central 95 % of plates, not an interval of the value" in plates
+    assert "range over the region" in titles["twoplate.combined.iterations"]
+    assert "\n" not in titles["twoplate.grid.stated_sigma_um"]  # exact: no bars to explain
