@@ -14,6 +14,17 @@ seeds and verdicts), one case each; each failed on the code before its fix.
   errors had overlapping bars), and a region row's marker was the low end of its range over
   the region, the bar the range. ``sweep.parquet`` now records each claim's interval kind
   (``claim_intervals`` in its provenance) and each such panel says what its bars are.
+* A one-plate statistic over very few simulated plates was decided all the same: the plug-in
+  ``p = 2 k / n`` is 0 whenever every plate lies on one side of the paper's number, so 2 or
+  10 plates "failed" a claim (or a region's statement at a point) whose paper plate is
+  typical, and a spread of 2 plates "held". ``sim run studies/wolf_polynomial.toml --set
+  unprinted.trials=2`` (2 instruments per input vector) emptied the consistent region and
+  every region row's note blamed the paper: "no input is consistent with the printed
+  statements (conflicting: wolf.repeatability.p005.mean_x_um + ...)", exit 0 (at the
+  study's 400 the region holds points). A statistic over plates is now decided only over at
+  least ``MIN_PLATES = 40`` of them (with fewer, no plate on the paper's side still leaves the
+  Monte-Carlo test's p, ``2 (k + 1) / (n + 1)``, the families' ``mc_p``, at 0.05 or more):
+  fewer give inconclusive, saying so (over a region: undecided at that point).
 """
 
 from __future__ import annotations
@@ -67,3 +78,26 @@ def test_a_sweep_figure_says_what_its_bars_are(tmp_path, monkeypatch):
     assert "bars: central 95 % of plates, not an interval of the value" in plates
     assert "range over the region" in titles["twoplate.combined.iterations"]
     assert "\n" not in titles["twoplate.grid.stated_sigma_um"]  # exact: no bars to explain
+
+
+def test_a_statistic_over_too_few_plates_decides_nothing():
+    from sim.claims.book import ClaimBook
+    from sim.claims.book_region import sample_evidence
+    from sim.claims.inference import FAILS, UNDECIDED, Statement, status
+    from sim.claims.rules import MIN_PLATES
+
+    spec = {"source": "s", "paper": "p", "kind": "prediction", "form": "one-plate"}
+    spec |= {"ref": 1.0, "decimals": 1, "tol": 0.0}
+    far = np.linspace(2.0, 3.0, 400)  # every plate above the paper's 1.0: the plug-in p is 0
+    rows = {}
+    for n in (2, MIN_PLATES - 1, MIN_PLATES, 400):
+        book = ClaimBook([{"id": "c", **spec}], [], "<t>")
+        rows[n] = book.score("c", samples=far[:: max(1, 400 // n)][:n])
+    assert rows[2]["verdict"] == rows[MIN_PLATES - 1]["verdict"] == "inconclusive"
+    assert rows[2]["note"].startswith("inconclusive on 2 simulated plates: a verdict over plates")
+    assert rows[MIN_PLATES]["verdict"] == rows[400]["verdict"] == "fails"
+    # over a region: a point's statement on too few plates is undecided, not contradicted
+    st = Statement("c", (1.0, 1.0), "one-plate", 1, 0.0, "p", "s")
+    few, many = (sample_evidence(np.tile(far[:n], (3, 1)), 1.0, 0.05) for n in (10, 40))
+    assert list(status(st, few, 3)) == [UNDECIDED] * 3
+    assert list(status(st, many, 3)) == [FAILS] * 3
