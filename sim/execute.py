@@ -370,6 +370,7 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
 
     keys, cells, reps, mode = expand(table, study.schema)
     rows: list[dict[str, Any]] = []
+    kinds: dict[str, list[str]] = {}  # each claim's interval kinds over the cells (the figure's)
     for i, cell in enumerate(cells):
         for r in range(reps):
             seed = cell_seed(cfg["seed"], i, r, mode)
@@ -411,6 +412,9 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
                     row[c["claim"]] = c["value"]
                     row[c["claim"] + ":lo"] = c["ci_low"]
                     row[c["claim"] + ":hi"] = c["ci_high"]
+                    kinds.setdefault(c["claim"], [])
+                    if c["interval"] not in kinds[c["claim"]]:
+                        kinds[c["claim"]].append(c["interval"])
             rows.append(row)
     if rows and not any(r["feasible"] for r in rows):
         reasons = list(dict.fromkeys(r["reason"] for r in rows))
@@ -433,7 +437,7 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
     write_table(
         out / "sweep.parquet",
         cols,
-        provenance(cfg, sweep=dict(table), sweep_keys=keys, seed_mode=mode),
+        provenance(cfg, sweep=dict(table), sweep_keys=keys, seed_mode=mode, claim_intervals=kinds),
     )
     fig_sweep(out / "sweep.parquet", out / "sweep.png")
     return cols

@@ -28,6 +28,7 @@ from sim.claims.provenance import interval_provenance
 from sim.claims.rules import (
     FORMS,
     KINDS,
+    MIN_PLATES,
     VERDICTS,
     decide,
     holds_of,
@@ -297,9 +298,18 @@ class ClaimBook:
             rlo, rhi = rlo - half, rhi + half
             # a one-plate claim given no plates (e.g. an exact input) is decided as a value
             rule = "value" if form == "one-plate" and samples is None else form
+            n = None if samples is None else int(np.asarray(samples).size)
             outcome = decide(
-                rule, (float(ci[0]), float(ci[1])), (zlo, zhi), elems=elems, p_plate=p_plate
+                rule,
+                (float(ci[0]), float(ci[1])),
+                (zlo, zhi),
+                elems=elems,
+                p_plate=p_plate,
+                plates=n,
             )
+            if n is not None and n < MIN_PLATES:
+                few = f"inconclusive on {n} simulated plates: a verdict over plates needs {MIN_PLATES}"
+                note = f"{few}; {note}" if note else few
         verdict = verdict_of(s["kind"], outcome)
         if s["kind"] == "not comparable":
             note = (s.get("why", "") + " " + note).strip()

@@ -126,11 +126,12 @@ def sample_evidence(
     half: the book's one-plate rule (:func:`sim.claims.intervals.plate_p`), point by point."""
     x = np.asarray(x, float)
     med, lo, hi = spread_rows(x)
-    ev = {"value": med, "low": lo, "high": hi}
+    n = np.sum(np.isfinite(x), axis=1)
+    # ``plates``: fewer than MIN_PLATES decide nothing (sim.claims.inference.status)
+    ev = {"value": med, "low": lo, "high": hi, "plates": n}
     if ref is not None:
         if not h >= 0:
             raise ValueError(f"the rounding half-unit h must be >= 0, not {h!r}")
-        n = np.sum(np.isfinite(x), axis=1)
         below = np.sum(x < ref + h, axis=1) + 0.5 * np.sum(x == ref + h, axis=1)
         above = np.sum(x > ref - h, axis=1) + 0.5 * np.sum(x == ref - h, axis=1)
         ev["p"] = np.minimum(1.0, 2 * np.minimum(below, above) / np.maximum(n, 1))

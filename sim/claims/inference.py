@@ -67,6 +67,7 @@ from scipy import special
 from scipy.spatial import cKDTree
 
 from sim.claims.declaration import FORMS, Input, Statement, load_declaration, parse_declaration
+from sim.claims.rules import MIN_PLATES
 from sim.lsq.sobol import sobol_base2
 
 __all__ = [
@@ -95,18 +96,22 @@ def interval_from_se(value, se, level: float = 0.95) -> dict[str, np.ndarray]:
 
 
 def _evidence(sid: str, ev: Any, n: int):
-    """(low, high, p) with a leading point axis; low/high may carry an element axis."""
+    """(low, high, p, plates) with a leading point axis; low/high may carry an element axis;
+    ``plates`` (or None) the simulated plates per point behind a spread and its ``p``."""
+    plates = None
     if isinstance(ev, Mapping):
         v = np.asarray(ev["value"], float) if "value" in ev else None
         lo = np.asarray(ev.get("low", v), float)
         hi = np.asarray(ev.get("high", v), float)
         p = None if ev.get("p") is None else np.asarray(ev["p"], float)
+        if ev.get("plates") is not None:
+            plates = np.broadcast_to(np.asarray(ev["plates"]), (n,))
     else:
         lo = hi = np.asarray(ev, float)
         p = None
     if lo.shape[:1] != (n,) or hi.shape != lo.shape:
         raise ValueError(f"statement {sid}: evidence must have a leading axis of {n} points")
-    return lo, hi, p
+    return lo, hi, p, plates
 
 
 def status(st: Statement, ev: Any, n: int, level: float = 0.95) -> np.ndarray:
@@ -115,7 +120,7 @@ def status(st: Statement, ev: Any, n: int, level: float = 0.95) -> np.ndarray:
     fail test is ``p < 1 - level`` alone, replacing the interval's miss (the book's one-plate
     rule, :func:`sim.claims.rules.decide`): a spread wholly outside the zone is the raw p again
     and would undo any adjustment of ``p`` (the printed rounding, Holm's correction)."""
-    lo, hi, p = _evidence(st.id, ev, n)
+    lo, hi, p, plates = _evidence(st.id, ev, n)
     zl, zh = st.zone
     lo2, hi2 = lo.reshape(n, -1), hi.reshape(n, -1)
     nan = np.isnan(lo2).any(axis=1) | np.isnan(hi2).any(axis=1)
@@ -126,6 +131,8 @@ def status(st: Statement, ev: Any, n: int, level: float = 0.95) -> np.ndarray:
         miss = p < round(1 - level, 12)
     out = np.where(miss, FAILS, np.where(inside, HOLDS, UNDECIDED)).astype(np.int8)
     out[nan] = UNDECIDED
+    if plates is not None:  # too few plates to decide (sim.claims.rules.MIN_PLATES)
+        out[plates < MIN_PLATES] = UNDECIDED
     return out
 
 

@@ -8,7 +8,7 @@ from typing import Any
 
 from sim.claims.intervals import LEVEL, METHODS, MIN_CHUNKS
 from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
-from sim.claims.rules import P_FAIL
+from sim.claims.rules import MIN_PLATES, P_FAIL
 
 __all__ = ["interval_provenance"]
 
@@ -22,6 +22,7 @@ def interval_provenance() -> dict[str, Any]:
         "methods": dict(METHODS),
         "min_chunks": MIN_CHUNKS,
         "one_plate_p_fail": P_FAIL,
+        "one_plate_min_plates": MIN_PLATES,
         "region_min_points": REGION_MIN_POINTS,
         "region_share": REGION_SHARE,
         "region_level": REGION_LEVEL,

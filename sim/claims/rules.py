@@ -95,6 +95,7 @@ __all__ = [
     "KINDS",
     "VERDICTS",
     "P_FAIL",
+    "MIN_PLATES",
     "zone",
     "decide",
     "verdict_of",
@@ -129,6 +130,13 @@ VERDICTS = (
 NOT_APPLICABLE = "not applicable"
 #: the probability of a plate at least as extreme below which a one-plate claim fails
 P_FAIL = 0.05
+#: the fewest simulated plates a statistic over plates (a one-plate claim, a spread) is decided
+#: on: with fewer, even no plate on the paper's side leaves the Monte-Carlo test's p,
+#: 2 (k + 1) / (n + 1) (:func:`sim.claims.family.mc_p`), at 2 / (n + 1) >= 0.05: the plates
+#: cannot show the paper's plate rare (the plug-in 2 k / n is 0 whenever every plate lies on
+#: one side: 2 plates "failed" a claim whose paper plate is typical), nor their 2.5-97.5 %
+#: points the spread of one plate. Fewer: inconclusive (over a region: undecided there)
+MIN_PLATES = 40
 
 
 def zone(form: str, ref: tuple[float, float], half: float, tol: float) -> tuple[float, float]:
@@ -147,6 +155,7 @@ def decide(
     *,
     elems: tuple[np.ndarray, np.ndarray] | None = None,
     p_plate: float | None = None,
+    plates: int | None = None,
 ) -> str:
     """The outcome ``holds`` / ``fails`` / ``inconclusive`` of one claim (see the module doc).
 
@@ -155,9 +164,13 @@ def decide(
     zone : the decision zone (lo, hi), possibly half-infinite.
     elems : for ``range``, the per-element intervals ``(lo[k], hi[k])``.
     p_plate : for ``one-plate``, the probability of a plate at least as extreme.
+    plates : the number of simulated plates the interval (a spread) and ``p_plate`` come
+        from, if they do: fewer than :data:`MIN_PLATES` decide nothing (inconclusive).
     """
     if form not in FORMS:
         raise ValueError(f"form must be one of {', '.join(FORMS)}, not {form!r}")
+    if plates is not None and plates < MIN_PLATES:
+        return "inconclusive"
     zl, zh = zone
     if form == "range":
         if elems is None:

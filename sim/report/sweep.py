@@ -116,6 +116,27 @@ def _legend_names(keys: list[str]) -> list[str]:
     return last if len(set(last)) == len(last) else list(keys)
 
 
+#: what a panel's bars are, by the ``interval`` of the claim's rows (``sim.claims.book``): a
+#: one-plate claim's bars are the spread of one plate, not an interval of its value (two
+#: cells' bars overlapped where their medians differed by many standard errors), a region
+#: row's are its range over the region, its marker the range's low end
+_BARS = {
+    "ci": "",
+    "exact": "",
+    "spread": "bars: central 95 % of plates, not an interval of the value",
+    "region": "bars: range over the region, marker its low end",
+}
+
+
+def _bars(kinds) -> str:
+    """The panel's note on its bars, from the claim's interval kinds over the cells."""
+    kinds = list(kinds or ())
+    said = list(dict.fromkeys(_BARS.get(k, "") for k in kinds if _BARS.get(k, "")))
+    if said and "ci" in kinds:  # some cells a 95 % interval of the value, some not
+        said.insert(0, "bars: a 95 % interval in some cells")
+    return "; ".join(said)
+
+
 def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     """Each claim's value (with its 95 % interval) against the first swept key, one line per
     combination of the other keys; infeasible cells marked by a red band. Proportions (by
@@ -127,7 +148,9 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     if figures_off():
         return None
     t = columns(path)
-    keys = read_provenance(path).get("sweep_keys", [])
+    prov = read_provenance(path)
+    keys = prov.get("sweep_keys", [])
+    kinds = prov.get("claim_intervals") or {}
     claims = _claim_columns(t, keys)[:max_panels]
     if not keys or not claims:
         return None
@@ -202,7 +225,8 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             # second panel, "string indices must be integers")
             at = [_middle(ticks[i], 16) for i in pos]
             ax.set_xticks(pos, at, fontsize=7, rotation=90 if len(pos) > 6 else 0)
-        ax.set_title(c, fontsize=8, wrap=True)
+        note = _bars(kinds.get(c))
+        ax.set_title(c + (f"\n({note})" if note else ""), fontsize=8, wrap=True)
         ax.set_xlabel(xlabel, fontsize=8)
         ax.set_ylabel(_y_label(c, prop), fontsize=8)
     for ax in axs.ravel()[len(claims) :]:

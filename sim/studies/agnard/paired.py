@@ -213,7 +213,8 @@ def paired_evidence(
     out = {"value": ev["value"][:, mid], "low": ev["low"].min(1), "high": ev["high"].max(1)}
     if "p" in ev:
         out["p"] = ev["p"].max(1)
-    return {q: np.where(ok, a, np.nan) for q, a in out.items()}
+    out = {q: np.where(ok, a, np.nan) for q, a in out.items()}
+    return {**out, "plates": np.full(n, m)}  # the configured blocks behind every vector
 
 
 def variance_ratio(s_u: float, s_w: float, rho: float) -> float:

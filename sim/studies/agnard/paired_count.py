@@ -163,6 +163,7 @@ def count_evidence(base, c, v, ref: float | None = None, h: float = 0.0) -> dict
         "share_zero": s["F"][:, 0],
         "share_zero_low": lo[:, 0],
         "share_zero_high": hi[:, 0],
+        "plates": np.full(lo.shape[0], np.asarray(base).size),  # the configured blocks
     }
     if ref is not None:
         below = _g(hi, ref + h)  # the rarer side's share at its largest

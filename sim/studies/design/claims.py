@@ -61,7 +61,7 @@ EXTERNAL = {
     "brown.results.zeiss_discrepancy_um": (
         lambda e: {"samples": e["zeiss_rms"]},
         lambda e: (
-            "stand-in layout of zeiss.points 1 cm intersections (drawn from the seed), Table 1's "
+            "stand-in layout of zeiss.points 1 cm intersections (drawn from zeiss.layout_seed), Table 1's "
             "error model plus the grid's stated error, linearised"
         ),
     ),

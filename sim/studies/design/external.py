@@ -81,11 +81,13 @@ def tolerances(cfg: dict, r_min_mm: float, pitch_mm: float) -> dict:
 def zeiss_points(cfg: dict, half_extent_mm: float) -> np.ndarray:
     """Stand-in for the Zeiss grid's 33 calibrated intersections (layout not printed):
     ``zeiss.points`` distinct 1 cm lattice intersections within +-``half_extent_mm``, drawn
-    once from the run's seed (the same permutation stream for every extent)."""
+    once from ``zeiss.layout_seed`` (the same permutation stream for every extent), never from
+    the run's ``seed``: a layout is a design, and ``--seed`` or a sweep's cells (each its own
+    seed) drew another one, so a sweep over an error compared other layouts."""
     m = int(half_extent_mm // 10)
     ax = np.arange(-m, m + 1) * 10.0
     lat = np.stack(np.meshgrid(ax, ax, indexing="ij"), -1).reshape(-1, 2)
-    order = chunk_rng(cfg["seed"], 90, 0).permutation(len(lat))
+    order = chunk_rng(cfg["zeiss.layout_seed"], 90, 0).permutation(len(lat))
     return lat[np.sort(order[: cfg["zeiss.points"]])]
 
 

@@ -262,6 +262,14 @@ SCHEMA = {
         hi=1000.0,
         unit="mm",
     ),
+    "zeiss.layout_seed": count(
+        1967,
+        "seed of the stand-in layout's intersections, apart from seed: --seed, replicates and "
+        "a sweep's cells draw new plates on one layout (sweep this key to compare layouts; "
+        "1967 is the study file's seed, which drew it before)",
+        lo=0,
+        hi=2**63 - 1,
+    ),
     "operation.lateral_offset_um": real(
         100.0,
         "lateral offset of the image in the reticle (paper: as much as 100 um)",
