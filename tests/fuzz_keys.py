@@ -67,7 +67,7 @@ def respell(rng: random.Random, flat: dict, toml_value, toml_tables) -> tuple[st
     spelt, how = _respelt_part(rng, parts[j])
     new = ".".join(parts[:j] + [spelt] + parts[j + 1 :])
     if where < 0.35 and k != "study" and new.strip() != k:  # on the command line (its key is
-        return "\n".join(lines) + "\n", f"--set {how} {key_text(new)}", ["--set", f"{new}=1"]
+        return "\n".join(lines) + "\n", f"--set-{how} {key_text(new)}", ["--set", f"{new}=1"]
     line = ".".join(map(_quoted, parts[:j] + [spelt] + parts[j + 1 :]))  # read stripped)
     doc = [f"{line} = {toml_value(flat[k])}" if x == k else ln for x, ln in zip(flat, lines)]
     return "\n".join(doc) + "\n", f"{how} {key_text(new)}", []

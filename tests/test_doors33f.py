@@ -33,6 +33,10 @@ Found with the fuzzer's new mutation kind, KEY spelling (tests/fuzz_keys.py):
 * A network record's field spelt in another case or with ``-`` (``Name``, ``x-mm``, ``"name "``)
   was refused as ``network.points[3].Name: unknown field``, alone: the fields are nowhere
   else on that line; it is now answered as an unknown key is ("did you mean name?").
+* An option typed with a word processor's dash (``—trials 40``, an em dash for ``--``; an en
+  dash, a minus sign) or in capitals with its value (``--TRIALS=40``) was "unrecognized
+  arguments" without the guess ``--Trials 40`` gets; it now gets it, naming the dash
+  (``did you mean --trials? U+2014 EM DASH is no hyphen``).
 * A datum constraint written with a bare dotted key, ``constraints = [ { P.x = 1.0 } ]``
   (TOML reads it as a table ``P`` holding ``x``), was refused as ``'P' is not <point>.x or
   <point>.y of a network point``, naming the point the user wrote with its axis; it now says
@@ -208,3 +212,20 @@ def test_a_lookalike_in_a_constraint_key_is_named(tmp_path, capsys, spelt, needl
     f = tmp_path / "s.toml"
     f.write_text(NET + f'[datum]\nkind = "constraints"\nconstraints = [ {{ {spelt} = 1.0 }} ]\n')
     one_line(capsys, main(["check", str(f)]), f"datum.constraints[0]: {needle}", prefix=SIM_ERROR)
+
+
+@pytest.mark.parametrize(
+    "option, needle",
+    [
+        ("—trials", "(did you mean --trials? U+2014 EM DASH is no hyphen: type -)"),
+        ("–seed", "(did you mean --seed? U+2013 EN DASH is no hyphen: type -)"),
+        ("--TRIALS=40", "(did you mean --trials?)"),
+    ],
+)
+def test_an_option_with_a_typographic_dash_or_in_capitals_gets_a_guess(
+    tmp_path, capsys, option, needle
+):
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    rc = main(["run", study, "--out", str(tmp_path / "o"), option, *(["40"] * ("=" not in option))])
+    one_line(capsys, rc, "unrecognized arguments", needle, prefix=SIM_ERROR)
+    assert not (tmp_path / "o").exists()

@@ -546,7 +546,7 @@ def fuzz(n: int, tmp: Path) -> list[str]:
         study.write_bytes(raw if raw is not None else toml_doc(flat, sweep).encode())
         code, _, err, secs, argv = run_case(d, study, extra, TIMEOUT)
         bad = check_case(d, code, err, extra)
-        named = desc.rsplit(" ", 1)[-1]  # a misspelt key refused, named as written
+        named = desc.split(": key: ")[-1].split(" ", 1)[-1]  # a misspelt key: named as written
         if not bad and ": key: " in desc and (code != 2 or named not in err):
             twice = desc.split(": key: ")[1].startswith("twice") and " line " in err  # TOML's
             bad = None if twice else f"a misspelt key not refused naming {named}: exit {code}"

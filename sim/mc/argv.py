@@ -25,6 +25,7 @@ import sys
 
 from sim.ends import stdout_unwritten
 from sim.mc.config import COMMON, ConfigError, Field, parse_override, validate
+from sim.mc.lookalike import char_name, looks
 
 __all__ = ["MAX_OPTIONS", "ONCE", "BoundedParser", "OnceParser", "integer", "most_workers"]
 
@@ -74,10 +75,25 @@ def integer(key: str, lo: int | None = None, hi: int | None = None):
     return read
 
 
+#: dashes a word processor or a web page puts where ``--`` or ``-`` was typed (``—trials``)
+_DASHES = {"\u2014": "--", "\u2013": "--", "\u2015": "--", "\u2212": "-", "\u2010": "-"}
+_DASHES |= {"\u2011": "-", "\u2012": "-", "\ufe63": "-", "\uff0d": "-"}
+
+
 def _guess(word: str, names) -> str:
-    """`` (did you mean NAME?)`` for a mistyped ``word`` among ``names``: the names it is a
-    prefix of first (an abbreviation), else the closest one; "" when none is close."""
+    """`` (did you mean NAME?)`` for a mistyped ``word`` among ``names``: the name it is with
+    its dashes typed as hyphens (``—trials``, an em dash, was "unrecognized" without a guess)
+    or that looks the same (``--TRIALS=40``, no guess either) first, then the names it is a
+    prefix of (an abbreviation), else the closest one; "" when none is close."""
     names = sorted(set(names))
+    lead = len(word) - len(word.lstrip("-" + "".join(_DASHES)))
+    typed = "".join(_DASHES.get(c, c) for c in word[:lead]) + word[lead:]
+    same = [n for n in names if looks(n) == looks(typed) and n != word]
+    if same and typed != word:
+        dash = next(c for c in word if c in _DASHES)
+        return f" (did you mean {same[0]}? {char_name(dash)} is no hyphen: type -)"
+    if same:
+        return f" (did you mean {same[0]}?)"
     longer = [n for n in names if n.startswith(word) and n != word]
     if longer:
         said = " or ".join(longer[:3])
@@ -122,7 +138,8 @@ class BoundedParser(argparse.ArgumentParser):
         option (``--tri``: ``--trials``), a mistyped command or choice (``sim rn``: ``run``)."""
         m = re.match(r"unrecognized arguments: (.*)", message)
         if m:
-            bad = next((w for w in m.group(1).split(" ") if w.startswith("-") and w != "-"), None)
+            dash = ("-", *_DASHES)  # —trials too
+            bad = next((w for w in m.group(1).split(" ") if w.startswith(dash) and w != "-"), None)
             if bad is not None:
                 return message + _guess(bad.split("=")[0], self.options())
         m = re.search(r"invalid choice: '(.*?)' \(choose from (.*)\)$", message)
