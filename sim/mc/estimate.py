@@ -16,7 +16,7 @@ far more than that unit is counted in adjustment-equivalents (its measured secon
 costs ~(2n)^3 per geometry (~k^6 for a k x k grid, :func:`design_grid_equivalents`); a dense
 adjustment larger than the unit (Wolf's polynomial fit, the network's dense path) as m U^2 +
 U^3 against the unit's (:func:`sim.mc.workunits.dense_units`); an Agnard block adjustment per model of its block
-(:data:`AGNARD_MODEL_UNITS`). Each was measured on the reference machine. Such an
+(:data:`sim.mc.agnard_size.AGNARD_MODEL_UNITS`, with its points). Each was measured on the reference machine. Such an
 analytic part runs before the first progress bar and cannot be resumed, so it may take at most
 :data:`ANALYTIC_SHARE` of the work limit (by default about 25 s on one core); over that the
 run stops naming the key that sets its size (``design.grids``) and its minutes.
@@ -35,6 +35,8 @@ from dataclasses import dataclass
 from numbers import Integral
 from typing import Any, Callable, Mapping
 
+from sim.mc.agnard_size import agnard_estimate as _agnard
+from sim.mc.brown_size import brown_estimate as _brown
 from sim.mc.config import ConfigError
 from sim.mc.network_size import network_estimate as _network
 from sim.mc.numtext import UnheldError, float_text
@@ -44,7 +46,7 @@ from sim.mc.workunits import (
     COPIES,
     F8,
     design_grid_equivalents,
-    region_points,
+    grid_count,
 )
 from sim.mc.workunits import dense_units as _dense
 from sim.mc.workunits import design_estimate as _design
@@ -124,40 +126,7 @@ def _min(v, default=1.0) -> float:
     return min((float(x) for x in v), default=default) if isinstance(v, (list, tuple)) else default
 
 
-def _grid_count(span: float, step: float) -> float:
-    return math.floor(abs(span) / step) + 1 if step > 0 else math.inf
-
-
 # ---- one estimator per study kind: (trials, adjustments, unknowns, bytes) -------------------
-
-
-def _brown(c: Mapping) -> tuple:
-    pat = c.get("plate.pattern", "grid")
-    n = (
-        c.get("plate.grid", 5) ** 2
-        if pat == "grid"
-        else c.get("plate.n_random", 25)
-        if pat == "random"
-        else max(len(c.get("plate.points", [])), 1)
-    )
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
-    U = 2 * n + 7
-    per = 3 * (2 if "checks.bias_shift_um" in c else 1)
-    grids = c.get("dilution.grids", [])
-    n_an = max([n] + [g * g for g in grids])
-    analytic = 3 * (
-        len(grids) + _n(c.get("dilution.offsets_mm", [])) + _n(c.get("dilution.extents_mm", []))
-    )
-    b = max(ch * 4 * n * U * F8, 4 * n_an * 7 * F8 * 3) * COPIES
-    # the region, analytic cofactors at every input vector it evaluates (measured, one core:
-    # 16,384 points and 8 rounds, 49,152 vectors, 6.2 s for Table 1's region, 31.5 s for the
-    # Concept's, which adds the monotone curves over grids)
-    region = region_points(c) * (BROWN_REGION_UNITS.get(c.get("study"), 13.0))
-    return T, T * per + analytic + region, max(U, 2 * n_an + 7), b
-
-
-#: unit adjustments of one input vector of brown's region, by study (measured; see _brown)
-BROWN_REGION_UNITS = {"brown_table1": 2.5, "brown_dilution": 13.0}
 
 
 def _gridplate(c: Mapping) -> tuple:
@@ -210,7 +179,7 @@ def _wolf(c: Mapping) -> tuple:
     ay = area[3] - area[2] if len(area) >= 4 else 100.0
 
     def points(sp: float) -> float:
-        return _grid_count(ax, sp) * _grid_count(ay, sp)
+        return grid_count(ax, sp) * grid_count(ay, sp)
 
     d = c.get("calib.degree", 3)
     U = (d + 1) * (d + 2)
@@ -264,54 +233,6 @@ def _wolf(c: Mapping) -> tuple:
         * COPIES
     )
     return trials, adj, max(U, Ut), b
-
-
-#: unit adjustments one block adjustment costs per model of the block (its reduced normals are
-#: 7 x 7 blocks coupled to a few neighbours: the work grows with the models). Measured from
-#: tiny runs' CPU time (20 trials, 3,800 counted adjustments): 2 x 8 models 43 units an
-#: adjustment, 4 x 25 models 350 (8x the time for 6x the models, the same count before)
-AGNARD_MODEL_UNITS = 3.5
-
-
-def _agnard(c: Mapping) -> tuple:
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
-    M = c.get("block.strips", 2) * c.get("block.models", 8)
-    pts = c.get("block.ground_points", 178) + M * c.get("block.pass_rows", 4) * 3
-    U = 7 * M + 3 * pts
-    fmt, g = c.get("block.format_mm", 230.0), c.get("scan.grid_mm", 10.0)
-    scan_nodes = _grid_count(fmt, g) ** 2
-    sizes = list(zip(c.get("tradeoff.block_strips", []), c.get("tradeoff.block_models", [])))
-    Mt = max([S * Mo for S, Mo in sizes] + [M])
-    pts_t = pts * Mt / max(M, 1)
-    Ut = 7 * Mt + 3 * pts_t
-    layouts = _n(c.get("tradeoff.layouts", []))
-    tT, bT = c.get("tradeoff.trials", 0), c.get("tradeoff.block_trials", 0)
-    dp, rc = _n(c.get("tradeoff.dpis", [])), _n(c.get("tradeoff.recentre_px", []))
-    sT, s_cells = c.get("sweep.trials", 0), _n(c.get("sweep.five_inset", []))  # swept layout
-    trials = T + tT * (dp + rc) + bT * len(sizes) + sT * s_cells
-    snoop = 1 + c.get("snoop.max_reject", 0)
-    w, wt = AGNARD_MODEL_UNITS * M, AGNARD_MODEL_UNITS * Mt  # unit adjustments a block solve
-    # the region: region.trials blocks adjusted once per layout of region.points, without
-    # and with the projection centres, snooping rejecting few points (measured, one core, on
-    # the 2 x 8 block: 4.3-4.9 ms a block and layout, 46.6 s for 16 x 600, about 95 units
-    # against 2 w = 112; counted with the snooping's maximum, it was 30 times high)
-    rT, r_pts = c.get("region.trials", 0), c.get("region.points", 0)
-    adj = (
-        T * (3 + layouts) * snoop * w
-        + tT * (2 * dp + rc) * snoop * w
-        + bT * len(sizes) * 2 * wt
-        + sT * s_cells * 3 * snoop * w
-        + rT * r_pts * 2 * w
-    )
-    # reduced normal equations of the models (7 x 7 blocks coupled through the points); the
-    # block-size trade-off bounds its chunk by the pair blocks (4e6 floats)
-    npair = Mt * 40.0
-    ch_t = max(1.0, min(ch, bT or 1, 4e6 // (49 * npair)))
-    b = max(
-        COPIES * max(ch * (7 * M) ** 2 * F8, ch * scan_nodes * 2 * F8, ch * pts * M * 6 * F8),
-        2 * (ch_t * (7 * Mt) ** 2 * F8 + 4e6 * F8),
-    )
-    return trials, adj, int(max(U, Ut)), b
 
 
 def _generic(c: Mapping) -> tuple:
