@@ -20,6 +20,9 @@ Each study kind was pushed along its size keys (``sim run --set``, peak RSS by
 * brown_design's posteriors (``bayes.*``) were counted as 2 units a walker's step without
   the chains and with no memory: ``bayes.steps = 1e6`` passed ``sim check`` at 49 MiB for a
   run holding about 60 GiB of chains. Their chains now count in both.
+* salsig_encoders squared ``vertical.control``, a count of control points, as if it were
+  points a side, at 2,304 bytes a point and trial: 100 control points were refused at 21.5
+  GiB for a chunk of 30 MiB. Its chunk is now bytes a trial and a point of the most points.
 """
 
 from __future__ import annotations
@@ -137,3 +140,18 @@ def test_design_posteriors_count_their_chains():
     assert (many - four) * ADJUSTMENT_S >= 60 * 10 / 2  # 60 chains more, 10 s each
     post = (four - estimate(cfg).adjustments) * ADJUSTMENT_S  # 4,500 steps more: about 36 s
     assert 36 / 2 <= post <= 36 * 2, post
+
+
+def test_salsig_control_points_are_a_count_not_a_side():
+    from sim.studies.salsig.model import vertical_chunk
+
+    cfg = load_study(STUDIES / "salsig_encoders.toml", ["vertical.control=100"])[1]
+    est = estimate(cfg)
+    check_limits(est)  # refused at 21.5 GiB before, for a chunk of 30 MiB
+    tracemalloc.start()
+    try:
+        vertical_chunk(cfg, None, np.random.default_rng(3), cfg["chunk"])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak <= est.bytes <= 4 * peak, (peak, est.bytes)

@@ -157,8 +157,8 @@ def _salsig(c: Mapping) -> tuple:
     ) * sum(_n(v) for k, v in c.items() if k.startswith("consistency.") and isinstance(v, list))
     trials = 3 * T + cells * pT + relief
     adj = 6 * T + 3 * cells * pT + 2 * relief
-    n = max(marks, grid, pm, c.get("zscale.points", 9), c.get("vertical.control", 6) ** 2)
-    b = ch * n * 2 * 6 * F8 * COPIES * 4
+    n = max(marks, grid, pm, c.get("zscale.points", 9), c.get("vertical.control", 6))
+    b = ch * (SALSIG_TRIAL_BYTES + n * SALSIG_POINT_BYTES)
     # the region: region.trials models at each of region.points input vectors, all of them in
     # memory at once (measured, one core: 2.6 ms + 24 us a model a vector, 7.7 s for 1,024 x
     # 200 and 6.5 s for 128 x 2,000; 617 MB for 100,000 models of up to 20 control points)
@@ -168,6 +168,13 @@ def _salsig(c: Mapping) -> tuple:
     return trials, adj, 7, b
 
 
+#: bytes a trial of a salsig chunk holds, and per point (marks, grid intersections, elevations
+#: or control points, the most of them): measured with tracemalloc, chunks of 1,000, the
+#: calibration chain 34 kB a trial at the paper's 5 x 5 marks and 97 kB at 20 x 20, the
+#: vertical fit 30 kB at 100 control points. The model before, 2,304 bytes a point with
+#: ``vertical.control`` (a count of points) squared, refused 100 control points at 21.5 GiB for
+#: a chunk of 30 MiB
+SALSIG_TRIAL_BYTES, SALSIG_POINT_BYTES = 4.0e4, 200.0
 #: bytes of one simulated model of salsig's region (6.2 kB measured, with copies' headroom)
 SALSIG_REGION_MODEL_BYTES = 1.0e4
 
