@@ -23,6 +23,9 @@ Each study kind was pushed along its size keys (``sim run --set``, peak RSS by
 * salsig_encoders squared ``vertical.control``, a count of control points, as if it were
   points a side, at 2,304 bytes a point and trial: 100 control points were refused at 21.5
   GiB for a chunk of 30 MiB. Its chunk is now bytes a trial and a point of the most points.
+* wolf_polynomial counted a main trial as its fits' dense units: 6 units for 20 measured at
+  the paper's setup, 117 at ``reading.n = 100`` and 99 at ``check.n_points = 2000``. The
+  readings and the independent points now count, and the fits as measured.
 """
 
 from __future__ import annotations
@@ -155,3 +158,28 @@ def test_salsig_control_points_are_a_count_not_a_side():
     finally:
         tracemalloc.stop()
     assert peak <= est.bytes <= 4 * peak, (peak, est.bytes)
+
+
+@pytest.mark.parametrize(
+    "sets, measured",
+    [([], 20), (["reading.n=100"], 117), (["calib.n_sets=30", "trade.n_sets=[1, 2, 3, 30]"], 312)]
+    + [(["check.n_points=2000"], 99)],
+)
+def test_wolf_main_trial_counts_its_readings_sets_and_points(sets, measured):
+    cfg = load_study(STUDIES / "wolf_polynomial.toml", sets)[1]
+    a = estimate({**cfg, "trials": 2000}).adjustments
+    units = (estimate({**cfg, "trials": 4000}).adjustments - a) / 2000
+    assert measured / 2 <= units <= 2 * measured, units
+
+
+def test_wolf_main_trial_measured_at_100_readings():
+    from sim.studies.wolf.chunks import main_chunk
+
+    cfg = load_study(STUDIES / "wolf_polynomial.toml", ["reading.n=100", "chunk=20"])[1]
+    f = main_chunk(cfg)
+    f(np.random.default_rng(0), 2)
+    t = time.process_time()
+    f(np.random.default_rng(1), 20)
+    measured = (time.process_time() - t) / 20 / ADJUSTMENT_S
+    units = (estimate({**cfg, "trials": 4000}).adjustments - estimate(cfg).adjustments) / 2000
+    assert measured / 2 <= units <= 3 * measured, (units, measured)

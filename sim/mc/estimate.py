@@ -179,6 +179,21 @@ SALSIG_TRIAL_BYTES, SALSIG_POINT_BYTES = 4.0e4, 200.0
 SALSIG_REGION_MODEL_BYTES = 1.0e4
 
 
+#: the main experiment's trial, measured (one core, chunks of 100): its sets + 2 fits cost
+#: this many times their dense units (:func:`sim.mc.workunits.dense_units`); each simulated
+#: reading (points x sets x readings x 2 coordinates) :data:`WOLF_READING_UNITS` and each
+#: point of the independent plate :data:`WOLF_CHECK_UNITS`. From 20 units a trial at the
+#: paper's setup to 117 at ``reading.n = 100``, 312 at ``calib.n_sets = 30`` and 99 at
+#: ``check.n_points = 2000``; counted as the fits alone (6, 6, 101, 6) a run of a million
+#: trials at 100 readings was 20 times its estimate
+WOLF_FIT_FACTOR, WOLF_READING_UNITS, WOLF_CHECK_UNITS = 2.9, 2.5e-3, 0.04
+
+
+def wolf_draws(n: float, sets: float, rd: float, c: Mapping) -> float:
+    """Unit adjustments of a main trial's simulated readings and independent points."""
+    return WOLF_READING_UNITS * n * sets * rd * 2 + WOLF_CHECK_UNITS * c.get("check.n_points", 0)
+
+
 def _wolf(c: Mapping) -> tuple:
     T, ch = c["trials"], min(c["chunk"], c["trials"])
     area = c.get("plate.area_mm", [-100.0, 100.0, -40.0, 60.0])
@@ -226,7 +241,7 @@ def _wolf(c: Mapping) -> tuple:
     # of the unprinted inputs' experiment on unprinted.trials instruments
     r_pts = c.get("region.points", 0) * (1 + c.get("region.rounds", 0) / 4)
     adj = (
-        T * (sets + 2) * w
+        T * (WOLF_FIT_FACTOR * (sets + 2) * w + wolf_draws(n, sets, rd, c))
         + Tt * (deg_cells + rd_cells * (sets + 2) + ages) * wt
         + Tu * (u_cells + r_pts) * (sets + 2) * w
     )
