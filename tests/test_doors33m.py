@@ -26,6 +26,10 @@ Each study kind was pushed along its size keys (``sim run --set``, peak RSS by
 * wolf_polynomial counted a main trial as its fits' dense units: 6 units for 20 measured at
   the paper's setup, 117 at ``reading.n = 100`` and 99 at ``check.n_points = 2000``. The
   readings and the independent points now count, and the fits as measured.
+* gridplate_two_plates counted a trial as its adjustments whatever the plates and 384 bytes
+  a reading: 4 plates of 15 x 15 points read 50 times took 6.7 times the estimated time and
+  a fourteenth of the estimated memory (a chunk of 400 refused at 8 GiB for 0.6 GiB). Each
+  reading and point now counts as measured.
 """
 
 from __future__ import annotations
@@ -93,8 +97,8 @@ def test_brown_trial_work_grows_with_the_plate():
     base = estimate({**cfg, "trials": 10, "chunk": 10})
     more = estimate({**cfg, "trials": 20010, "chunk": 10})  # a trial's units, region aside
     units = (more.adjustments - base.adjustments) / 20000
-    measured = per_trial / ADJUSTMENT_S
-    assert measured / 2 <= units <= 3 * measured, (units, measured)
+    measured = per_trial / ADJUSTMENT_S  # CPU on a loaded machine: a third either way
+    assert measured / 3 <= units <= 3 * measured, (units, measured)
     # a million trials of a 200 x 200 plate (about 35 hours) are over the default work limit
     with pytest.raises(ConfigError, match="adjustments"):
         check_limits(estimate(_brown(200, trials=1_000_000, chunk=50_000)))
@@ -182,4 +186,26 @@ def test_wolf_main_trial_measured_at_100_readings():
     f(np.random.default_rng(1), 20)
     measured = (time.process_time() - t) / 20 / ADJUSTMENT_S
     units = (estimate({**cfg, "trials": 4000}).adjustments - estimate(cfg).adjustments) / 2000
-    assert measured / 2 <= units <= 3 * measured, (units, measured)
+    assert measured / 3 <= units <= 3 * measured, (units, measured)
+
+
+def test_gridplate_trial_counts_its_readings_and_points():
+    from sim.studies.gridplate.model import chunk
+
+    big = ["plate.grid=15", "plate.spacing_mm=10", "readings.count=50", "plate.count=4"]
+    cfg = load_study(STUDIES / "gridplate_two_plates.toml", [*big, "chunk=20"])[1]
+    chunk(cfg, np.random.default_rng(0), 2)
+    tracemalloc.start()
+    try:
+        t = time.process_time()
+        chunk(cfg, np.random.default_rng(1), 20)
+        measured = (time.process_time() - t) / 20 / ADJUSTMENT_S
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    est = estimate(cfg)
+    units = (estimate({**cfg, "trials": 2 * cfg["trials"]}).adjustments - est.adjustments) / (
+        cfg["trials"]
+    )
+    assert measured / 3 <= units <= 3 * measured, (units, measured)  # 20 before, 134 measured
+    assert peak <= est.bytes <= 3 * peak, (peak, est.bytes)  # 14 times the peak before

@@ -129,13 +129,25 @@ def _min(v, default=1.0) -> float:
 # ---- one estimator per study kind: (trials, adjustments, unknowns, bytes) -------------------
 
 
+#: gridplate_two_plates' trial, measured (one core, chunks of 100, tracemalloc): each reading
+#: (plates x points x readings) 0.002 units and 32 bytes, each plate's point 0.04 units and 300
+#: bytes besides the adjustments counted one a unit. From 10 units and 20 kB a trial at the
+#: study's 2 plates of 5 x 5 points read 4 times to 134 units and 1.5 MB at 4 plates of 15 x 15
+#: read 50 times: counted as the adjustments alone (20 units) and as 384 bytes a reading and
+#: 4,608 a point, the largest plates were 6.7 times over their estimate in time and 14 times
+#: under it in memory (a chunk of 400 refused at 8 GiB that holds 0.6 GiB)
+GP_READING_UNITS, GP_POINT_UNITS = 2e-3, 0.04
+GP_READING_BYTES, GP_POINT_BYTES = 32.0, 300.0
+
+
 def _gridplate(c: Mapping) -> tuple:
     N = c.get("plate.grid", 5) ** 2
     P, L = c.get("plate.count", 2), c.get("readings.count", 4)
     T, ch = c["trials"], min(c["chunk"], c["trials"])
     per = 3 + _n(c.get("analysis.ratios", [])) + _n(c.get("analysis.stated_sigmas_um", []))
     U = 2 * N + 3
-    b = ch * (P * N * L * 2 + P * N * 2 * 4 * 3) * F8 * COPIES * 4
+    per += GP_READING_UNITS * P * N * L + GP_POINT_UNITS * P * N
+    b = ch * (P * N * L * GP_READING_BYTES + P * N * GP_POINT_BYTES)
     # the region: region.points input vectors, each round up to 4x as many at its boundary;
     # each vector draws region.draws calibrations (measured 0.85 ms + 1.25 us a draw) and
     # counts the iterations of region.iter_calibrations calibrations (a row of each plate each)
@@ -179,14 +191,15 @@ SALSIG_TRIAL_BYTES, SALSIG_POINT_BYTES = 4.0e4, 200.0
 SALSIG_REGION_MODEL_BYTES = 1.0e4
 
 
-#: the main experiment's trial, measured (one core, chunks of 100): its sets + 2 fits cost
-#: this many times their dense units (:func:`sim.mc.workunits.dense_units`); each simulated
+#: the main experiment's trial, measured (one core, chunks of 100): each of its sets + 2 fits
+#: costs :data:`WOLF_FIT_UNITS` besides its dense units (:func:`sim.mc.workunits.dense_units`,
+#: within a factor 2 of a 20,301-point fit of degree 8: ``tests/test_design_work.py``); each simulated
 #: reading (points x sets x readings x 2 coordinates) :data:`WOLF_READING_UNITS` and each
 #: point of the independent plate :data:`WOLF_CHECK_UNITS`. From 20 units a trial at the
 #: paper's setup to 117 at ``reading.n = 100``, 312 at ``calib.n_sets = 30`` and 99 at
-#: ``check.n_points = 2000``; counted as the fits alone (6, 6, 101, 6) a run of a million
-#: trials at 100 readings was 20 times its estimate
-WOLF_FIT_FACTOR, WOLF_READING_UNITS, WOLF_CHECK_UNITS = 2.9, 2.5e-3, 0.04
+#: ``check.n_points = 2000`` (estimated 20, 117, 192 and 97); counted as the fits alone (6, 6,
+#: 101, 6) a run of a million trials at 100 readings was 20 times its estimate
+WOLF_FIT_UNITS, WOLF_READING_UNITS, WOLF_CHECK_UNITS = 1.9, 2.5e-3, 0.04
 
 
 def wolf_draws(n: float, sets: float, rd: float, c: Mapping) -> float:
@@ -241,7 +254,7 @@ def _wolf(c: Mapping) -> tuple:
     # of the unprinted inputs' experiment on unprinted.trials instruments
     r_pts = c.get("region.points", 0) * (1 + c.get("region.rounds", 0) / 4)
     adj = (
-        T * (WOLF_FIT_FACTOR * (sets + 2) * w + wolf_draws(n, sets, rd, c))
+        T * ((sets + 2) * (w + WOLF_FIT_UNITS) + wolf_draws(n, sets, rd, c))
         + Tt * (deg_cells + rd_cells * (sets + 2) + ages) * wt
         + Tu * (u_cells + r_pts) * (sets + 2) * w
     )
