@@ -30,6 +30,9 @@ Each study kind was pushed along its size keys (``sim run --set``, peak RSS by
   a reading: 4 plates of 15 x 15 points read 50 times took 6.7 times the estimated time and
   a fourteenth of the estimated memory (a chunk of 400 refused at 8 GiB for 0.6 GiB). Each
   reading and point now counts as measured.
+* a chunk of minutes said nothing: the progress bar moves once a chunk, and 50 trials of a 6 x
+  30 Agnard block (20 s each) left it at 0 % for 17 minutes. ``sim run`` now says before the
+  run when a chunk's estimate is over two minutes, and that a smaller ``--chunk`` shows more.
 """
 
 from __future__ import annotations
@@ -209,3 +212,29 @@ def test_gridplate_trial_counts_its_readings_and_points():
     )
     assert measured / 3 <= units <= 3 * measured, (units, measured)  # 20 before, 134 measured
     assert peak <= est.bytes <= 3 * peak, (peak, est.bytes)  # 14 times the peak before
+
+
+def test_a_chunk_of_minutes_is_said_before_the_run(tmp_path):
+    import subprocess
+    import sys
+
+    from sim.mc.estimate import chunk_note
+
+    for f in sorted(STUDIES.glob("*.toml")):  # the study files' chunks say nothing
+        cfg = load_study(f)[1]
+        assert chunk_note(estimate(cfg), cfg["chunk"]) == "", f.name
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("mine")  # refused after the note: no run
+    big = ["block.strips=6", "block.models=30", "block.ground_points=2000"]
+    r = subprocess.run(
+        [sys.executable, "-m", "sim", "run", str(STUDIES / "agnard_block.toml")]
+        + [a for s in big for a in ("--set", s)]
+        + ["--chunk", "20", "--max-memory-gb", "20", "--out", str(tmp_path / "mine")],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=120,
+    )
+    assert r.returncode == 2, r.stderr
+    note = [ln for ln in r.stderr.splitlines() if ln.startswith("sim: note: a chunk of 20")]
+    assert note and "min of one core" in note[0] and "--chunk" in note[0], r.stderr

@@ -64,6 +64,8 @@ __all__ = [
     "ANALYTIC_SHARE",
     "CHUNK_UNITS",
     "CELL_UNITS",
+    "CHUNK_NOTE_S",
+    "chunk_note",
     "design_grid_equivalents",
 ]
 
@@ -396,6 +398,28 @@ def check_limits(
             "--max-adjustments or SIM_MAX_ADJUSTMENTS); use fewer points per side or fewer "
             "positions, extents, offsets or betas, or raise the limit",
         )
+
+
+#: seconds of one core a chunk may take before the run says so: the progress bar moves once
+#: a chunk, and a chunk of 50 trials of a 6 x 30 Agnard block (20 s a trial) left it at 0 %
+#: for 17 minutes without a word
+CHUNK_NOTE_S = 120.0
+
+
+def chunk_note(est: Estimate, chunk: int) -> str:
+    """One line when a chunk of ``chunk`` trials (the run's average trial, every part's work
+    over its trials) takes more than :data:`CHUNK_NOTE_S` seconds of one core, else ``""``."""
+    if not est.trials >= 1 or not math.isfinite(est.adjustments):
+        return ""
+    n = min(chunk, est.trials)
+    s = est.adjustments / est.trials * n * ADJUSTMENT_S
+    if not s > CHUNK_NOTE_S:
+        return ""
+    return (
+        f"note: a chunk of {n:,} trials takes about {_minutes(s)} of one core of the reference "
+        "machine (estimate) and the progress bar moves once a chunk; a smaller --chunk shows "
+        "the progress more often"
+    )
 
 
 def _minutes(s: float) -> str:
