@@ -26,7 +26,7 @@ import numpy as np
 from sim.held_stops import held_stops
 from sim.mc.argv import most_workers
 from sim.mc.config import ConfigError, StudyError, check_chunks
-from sim.mc.estimate import check_limits, estimate
+from sim.mc.estimate import check_limits, chunk_note, estimate
 from sim.mc.executors import StartRefused, script_words
 from sim.mc.left_behind import clear_replaced
 from sim.mc.outputs import _chunks, _differs, _same, check_out, drop_stage, prepare_stage, stage_dir
@@ -210,6 +210,8 @@ def execute(
     est = estimate(cfg, sweep)
     check_limits(est, max_memory_gb, max_adjustments, workers)
     check_sweep(study, cfg, sweep, quiet)
+    if not quiet and (note := chunk_note(est, cfg["chunk"])):
+        print(f"sim: {note}", file=sys.stderr)
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
         "code_hash": code_hash(cfg["study"]),

@@ -153,7 +153,8 @@ def test_a_dense_adjustment_larger_than_the_unit_counts_in_proportion(tmp_path):
     big = estimate(load_study(wolf, [*tiny, *fine])[1])
     # the fits' units, less CHUNK_UNITS for each chunk (the same chunks in both)
     fits = lambda e: e.adjustments - math.ceil(e.trials / 10) * CHUNK_UNITS  # noqa: E731
-    assert fits(small) < 2e3 and 1.5e6 / 3 < fits(big) < 1.5e6 * 3
+    # the small run's 200 main trials: about 20 units each, measured (doors33m)
+    assert fits(small) < 1e4 and 1.5e6 / 3 < fits(big) < 1.5e6 * 3
     # 200,000 trials of that fit (about a day of one core) are refused; they passed before
     many = [
         f"trials={200_000}",

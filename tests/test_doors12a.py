@@ -148,7 +148,8 @@ def test_the_design_estimate_covers_what_the_analytic_grid_allocates():
     """The estimate of the design grid's part is at least the peak that
     :func:`sim.studies.design.cells.geometry_eval` allocates (tracemalloc), and not far above
     it (a model, not a bound a run could exceed)."""
-    cfg = _design_cfg("design.grids=[5, 10]", "design.positions=[4]", "chunk=20")
+    # the posteriors' shortest chains (doors33m counts their memory, 37 MiB at 500 steps)
+    cfg = _design_cfg("design.grids=[5, 10]", "design.positions=[4]", "chunk=20", "bayes.steps=100")
     est = estimate(cfg)
     assert "10 x 10 points" in est.largest
     tracemalloc.start()

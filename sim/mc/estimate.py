@@ -16,7 +16,7 @@ far more than that unit is counted in adjustment-equivalents (its measured secon
 costs ~(2n)^3 per geometry (~k^6 for a k x k grid, :func:`design_grid_equivalents`); a dense
 adjustment larger than the unit (Wolf's polynomial fit, the network's dense path) as m U^2 +
 U^3 against the unit's (:func:`sim.mc.workunits.dense_units`); an Agnard block adjustment per model of its block
-(:data:`AGNARD_MODEL_UNITS`). Each was measured on the reference machine. Such an
+(:data:`sim.mc.agnard_size.AGNARD_MODEL_UNITS`, with its points). Each was measured on the reference machine. Such an
 analytic part runs before the first progress bar and cannot be resumed, so it may take at most
 :data:`ANALYTIC_SHARE` of the work limit (by default about 25 s on one core); over that the
 run stops naming the key that sets its size (``design.grids``) and its minutes.
@@ -35,6 +35,8 @@ from dataclasses import dataclass
 from numbers import Integral
 from typing import Any, Callable, Mapping
 
+from sim.mc.agnard_size import agnard_estimate as _agnard
+from sim.mc.brown_size import brown_estimate as _brown
 from sim.mc.config import ConfigError
 from sim.mc.network_size import network_estimate as _network
 from sim.mc.numtext import UnheldError, float_text
@@ -44,7 +46,7 @@ from sim.mc.workunits import (
     COPIES,
     F8,
     design_grid_equivalents,
-    region_points,
+    grid_count,
 )
 from sim.mc.workunits import dense_units as _dense
 from sim.mc.workunits import design_estimate as _design
@@ -62,6 +64,8 @@ __all__ = [
     "ANALYTIC_SHARE",
     "CHUNK_UNITS",
     "CELL_UNITS",
+    "CHUNK_NOTE_S",
+    "chunk_note",
     "design_grid_equivalents",
 ]
 
@@ -124,40 +128,18 @@ def _min(v, default=1.0) -> float:
     return min((float(x) for x in v), default=default) if isinstance(v, (list, tuple)) else default
 
 
-def _grid_count(span: float, step: float) -> float:
-    return math.floor(abs(span) / step) + 1 if step > 0 else math.inf
-
-
 # ---- one estimator per study kind: (trials, adjustments, unknowns, bytes) -------------------
 
 
-def _brown(c: Mapping) -> tuple:
-    pat = c.get("plate.pattern", "grid")
-    n = (
-        c.get("plate.grid", 5) ** 2
-        if pat == "grid"
-        else c.get("plate.n_random", 25)
-        if pat == "random"
-        else max(len(c.get("plate.points", [])), 1)
-    )
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
-    U = 2 * n + 7
-    per = 3 * (2 if "checks.bias_shift_um" in c else 1)
-    grids = c.get("dilution.grids", [])
-    n_an = max([n] + [g * g for g in grids])
-    analytic = 3 * (
-        len(grids) + _n(c.get("dilution.offsets_mm", [])) + _n(c.get("dilution.extents_mm", []))
-    )
-    b = max(ch * 4 * n * U * F8, 4 * n_an * 7 * F8 * 3) * COPIES
-    # the region, analytic cofactors at every input vector it evaluates (measured, one core:
-    # 16,384 points and 8 rounds, 49,152 vectors, 6.2 s for Table 1's region, 31.5 s for the
-    # Concept's, which adds the monotone curves over grids)
-    region = region_points(c) * (BROWN_REGION_UNITS.get(c.get("study"), 13.0))
-    return T, T * per + analytic + region, max(U, 2 * n_an + 7), b
-
-
-#: unit adjustments of one input vector of brown's region, by study (measured; see _brown)
-BROWN_REGION_UNITS = {"brown_table1": 2.5, "brown_dilution": 13.0}
+#: gridplate_two_plates' trial, measured (one core, chunks of 100, tracemalloc): each reading
+#: (plates x points x readings) 0.002 units and 32 bytes, each plate's point 0.04 units and 300
+#: bytes besides the adjustments counted one a unit. From 10 units and 20 kB a trial at the
+#: study's 2 plates of 5 x 5 points read 4 times to 134 units and 1.5 MB at 4 plates of 15 x 15
+#: read 50 times: counted as the adjustments alone (20 units) and as 384 bytes a reading and
+#: 4,608 a point, the largest plates were 6.7 times over their estimate in time and 14 times
+#: under it in memory (a chunk of 400 refused at 8 GiB that holds 0.6 GiB)
+GP_READING_UNITS, GP_POINT_UNITS = 2e-3, 0.04
+GP_READING_BYTES, GP_POINT_BYTES = 32.0, 300.0
 
 
 def _gridplate(c: Mapping) -> tuple:
@@ -166,7 +148,8 @@ def _gridplate(c: Mapping) -> tuple:
     T, ch = c["trials"], min(c["chunk"], c["trials"])
     per = 3 + _n(c.get("analysis.ratios", [])) + _n(c.get("analysis.stated_sigmas_um", []))
     U = 2 * N + 3
-    b = ch * (P * N * L * 2 + P * N * 2 * 4 * 3) * F8 * COPIES * 4
+    per += GP_READING_UNITS * P * N * L + GP_POINT_UNITS * P * N
+    b = ch * (P * N * L * GP_READING_BYTES + P * N * GP_POINT_BYTES)
     # the region: region.points input vectors, each round up to 4x as many at its boundary;
     # each vector draws region.draws calibrations (measured 0.85 ms + 1.25 us a draw) and
     # counts the iterations of region.iter_calibrations calibrations (a row of each plate each)
@@ -188,8 +171,8 @@ def _salsig(c: Mapping) -> tuple:
     ) * sum(_n(v) for k, v in c.items() if k.startswith("consistency.") and isinstance(v, list))
     trials = 3 * T + cells * pT + relief
     adj = 6 * T + 3 * cells * pT + 2 * relief
-    n = max(marks, grid, pm, c.get("zscale.points", 9), c.get("vertical.control", 6) ** 2)
-    b = ch * n * 2 * 6 * F8 * COPIES * 4
+    n = max(marks, grid, pm, c.get("zscale.points", 9), c.get("vertical.control", 6))
+    b = ch * (SALSIG_TRIAL_BYTES + n * SALSIG_POINT_BYTES)
     # the region: region.trials models at each of region.points input vectors, all of them in
     # memory at once (measured, one core: 2.6 ms + 24 us a model a vector, 7.7 s for 1,024 x
     # 200 and 6.5 s for 128 x 2,000; 617 MB for 100,000 models of up to 20 control points)
@@ -199,8 +182,31 @@ def _salsig(c: Mapping) -> tuple:
     return trials, adj, 7, b
 
 
+#: bytes a trial of a salsig chunk holds, and per point (marks, grid intersections, elevations
+#: or control points, the most of them): measured with tracemalloc, chunks of 1,000, the
+#: calibration chain 34 kB a trial at the paper's 5 x 5 marks and 97 kB at 20 x 20, the
+#: vertical fit 30 kB at 100 control points. The model before, 2,304 bytes a point with
+#: ``vertical.control`` (a count of points) squared, refused 100 control points at 21.5 GiB for
+#: a chunk of 30 MiB
+SALSIG_TRIAL_BYTES, SALSIG_POINT_BYTES = 4.0e4, 200.0
 #: bytes of one simulated model of salsig's region (6.2 kB measured, with copies' headroom)
 SALSIG_REGION_MODEL_BYTES = 1.0e4
+
+
+#: the main experiment's trial, measured (one core, chunks of 100): each of its sets + 2 fits
+#: costs :data:`WOLF_FIT_UNITS` besides its dense units (:func:`sim.mc.workunits.dense_units`,
+#: within a factor 2 of a 20,301-point fit of degree 8: ``tests/test_design_work.py``); each simulated
+#: reading (points x sets x readings x 2 coordinates) :data:`WOLF_READING_UNITS` and each
+#: point of the independent plate :data:`WOLF_CHECK_UNITS`. From 20 units a trial at the
+#: paper's setup to 117 at ``reading.n = 100``, 312 at ``calib.n_sets = 30`` and 99 at
+#: ``check.n_points = 2000`` (estimated 20, 117, 192 and 97); counted as the fits alone (6, 6,
+#: 101, 6) a run of a million trials at 100 readings was 20 times its estimate
+WOLF_FIT_UNITS, WOLF_READING_UNITS, WOLF_CHECK_UNITS = 1.9, 2.5e-3, 0.04
+
+
+def wolf_draws(n: float, sets: float, rd: float, c: Mapping) -> float:
+    """Unit adjustments of a main trial's simulated readings and independent points."""
+    return WOLF_READING_UNITS * n * sets * rd * 2 + WOLF_CHECK_UNITS * c.get("check.n_points", 0)
 
 
 def _wolf(c: Mapping) -> tuple:
@@ -210,7 +216,7 @@ def _wolf(c: Mapping) -> tuple:
     ay = area[3] - area[2] if len(area) >= 4 else 100.0
 
     def points(sp: float) -> float:
-        return _grid_count(ax, sp) * _grid_count(ay, sp)
+        return grid_count(ax, sp) * grid_count(ay, sp)
 
     d = c.get("calib.degree", 3)
     U = (d + 1) * (d + 2)
@@ -250,7 +256,7 @@ def _wolf(c: Mapping) -> tuple:
     # of the unprinted inputs' experiment on unprinted.trials instruments
     r_pts = c.get("region.points", 0) * (1 + c.get("region.rounds", 0) / 4)
     adj = (
-        T * (sets + 2) * w
+        T * ((sets + 2) * (w + WOLF_FIT_UNITS) + wolf_draws(n, sets, rd, c))
         + Tt * (deg_cells + rd_cells * (sets + 2) + ages) * wt
         + Tu * (u_cells + r_pts) * (sets + 2) * w
     )
@@ -264,54 +270,6 @@ def _wolf(c: Mapping) -> tuple:
         * COPIES
     )
     return trials, adj, max(U, Ut), b
-
-
-#: unit adjustments one block adjustment costs per model of the block (its reduced normals are
-#: 7 x 7 blocks coupled to a few neighbours: the work grows with the models). Measured from
-#: tiny runs' CPU time (20 trials, 3,800 counted adjustments): 2 x 8 models 43 units an
-#: adjustment, 4 x 25 models 350 (8x the time for 6x the models, the same count before)
-AGNARD_MODEL_UNITS = 3.5
-
-
-def _agnard(c: Mapping) -> tuple:
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
-    M = c.get("block.strips", 2) * c.get("block.models", 8)
-    pts = c.get("block.ground_points", 178) + M * c.get("block.pass_rows", 4) * 3
-    U = 7 * M + 3 * pts
-    fmt, g = c.get("block.format_mm", 230.0), c.get("scan.grid_mm", 10.0)
-    scan_nodes = _grid_count(fmt, g) ** 2
-    sizes = list(zip(c.get("tradeoff.block_strips", []), c.get("tradeoff.block_models", [])))
-    Mt = max([S * Mo for S, Mo in sizes] + [M])
-    pts_t = pts * Mt / max(M, 1)
-    Ut = 7 * Mt + 3 * pts_t
-    layouts = _n(c.get("tradeoff.layouts", []))
-    tT, bT = c.get("tradeoff.trials", 0), c.get("tradeoff.block_trials", 0)
-    dp, rc = _n(c.get("tradeoff.dpis", [])), _n(c.get("tradeoff.recentre_px", []))
-    sT, s_cells = c.get("sweep.trials", 0), _n(c.get("sweep.five_inset", []))  # swept layout
-    trials = T + tT * (dp + rc) + bT * len(sizes) + sT * s_cells
-    snoop = 1 + c.get("snoop.max_reject", 0)
-    w, wt = AGNARD_MODEL_UNITS * M, AGNARD_MODEL_UNITS * Mt  # unit adjustments a block solve
-    # the region: region.trials blocks adjusted once per layout of region.points, without
-    # and with the projection centres, snooping rejecting few points (measured, one core, on
-    # the 2 x 8 block: 4.3-4.9 ms a block and layout, 46.6 s for 16 x 600, about 95 units
-    # against 2 w = 112; counted with the snooping's maximum, it was 30 times high)
-    rT, r_pts = c.get("region.trials", 0), c.get("region.points", 0)
-    adj = (
-        T * (3 + layouts) * snoop * w
-        + tT * (2 * dp + rc) * snoop * w
-        + bT * len(sizes) * 2 * wt
-        + sT * s_cells * 3 * snoop * w
-        + rT * r_pts * 2 * w
-    )
-    # reduced normal equations of the models (7 x 7 blocks coupled through the points); the
-    # block-size trade-off bounds its chunk by the pair blocks (4e6 floats)
-    npair = Mt * 40.0
-    ch_t = max(1.0, min(ch, bT or 1, 4e6 // (49 * npair)))
-    b = max(
-        COPIES * max(ch * (7 * M) ** 2 * F8, ch * scan_nodes * 2 * F8, ch * pts * M * 6 * F8),
-        2 * (ch_t * (7 * Mt) ** 2 * F8 + 4e6 * F8),
-    )
-    return trials, adj, int(max(U, Ut)), b
 
 
 def _generic(c: Mapping) -> tuple:
@@ -440,6 +398,28 @@ def check_limits(
             "--max-adjustments or SIM_MAX_ADJUSTMENTS); use fewer points per side or fewer "
             "positions, extents, offsets or betas, or raise the limit",
         )
+
+
+#: seconds of one core a chunk may take before the run says so: the progress bar moves once
+#: a chunk, and a chunk of 50 trials of a 6 x 30 Agnard block (20 s a trial) left it at 0 %
+#: for 17 minutes without a word
+CHUNK_NOTE_S = 120.0
+
+
+def chunk_note(est: Estimate, chunk: int) -> str:
+    """One line when a chunk of ``chunk`` trials (the run's average trial, every part's work
+    over its trials) takes more than :data:`CHUNK_NOTE_S` seconds of one core, else ``""``."""
+    if not est.trials >= 1 or not math.isfinite(est.adjustments):
+        return ""
+    n = min(chunk, est.trials)
+    s = est.adjustments / est.trials * n * ADJUSTMENT_S
+    if not s > CHUNK_NOTE_S:
+        return ""
+    return (
+        f"note: a chunk of {n:,} trials takes about {_minutes(s)} of one core of the reference "
+        "machine (estimate) and the progress bar moves once a chunk; a smaller --chunk shows "
+        "the progress more often"
+    )
 
 
 def _minutes(s: float) -> str:

@@ -20,6 +20,7 @@ __all__ = [
     "COPIES",
     "UNIT_WORK",
     "n_of",
+    "grid_count",
     "max_of",
     "dense_units",
     "design_grid_equivalents",
@@ -44,6 +45,11 @@ def region_points(c: Mapping, n_key: str = "region.points", rounds_key: str = "r
     """Input vectors a region evaluates at most: its Sobol design and, each refinement round,
     up to :data:`REGION_MAX_NEW` more at its boundaries."""
     return c.get(n_key, 0) + REGION_MAX_NEW * c.get(rounds_key, 0)
+
+
+def grid_count(span: float, step: float) -> float:
+    """Nodes of a grid of ``step`` over ``span`` (infinite for a step of 0 or less)."""
+    return math.floor(abs(span) / step) + 1 if step > 0 else math.inf
 
 
 def n_of(v: Any) -> float:
@@ -103,6 +109,19 @@ def design_grid_equivalents(
     return positions * extents * geometries * per / ADJUSTMENT_S
 
 
+#: unit adjustments of one walker's step of one chain, both posteriors (Brown's 7 globals
+#: and the two plates' twice as many steps of a cheaper posterior) together: measured, one
+#: core, 32 walkers x 5,000 steps x 4 chains, 20 s each. Counted as 2 a walker's step
+#: without the chains, the posteriors' time was 2.5 times the estimate at 4 chains and 40
+#: times at the 64 the schema allows
+BAYES_UNITS = 1.25
+#: bytes the posteriors hold a walker's step of a chain (every chain's samples kept, one
+#: chain's whole run with its autocorrelation's copies; measured 316 for Brown's and 514 at
+#: the two plates' peak, 32 walkers x 5,000 steps x 4 chains). Not counted, ``bayes.steps =
+#: 1e6`` passed ``sim check`` at 49 MiB for a run of about 60 GiB
+BAYES_BYTES = 600.0
+
+
 def design_chunk_bytes(ch: float, P: float, n: float) -> float:
     """Bytes of one Monte-Carlo chunk of ``ch`` trials of ``n`` points seen from ``P``
     positions: the per-range arrays of every trial, and the (2n, 2n) inner-datum matrix and
@@ -140,7 +159,8 @@ def design_estimate(c: Mapping) -> tuple:
         + n_of(c.get("coverage.betas_mm", []))
     )
     budget = 6 * c.get("budget.max_trials", 0)
-    bayes = c.get("bayes.walkers", 0) * c.get("bayes.steps", 0) * 2
+    walker_steps = c.get("bayes.walkers", 0) * c.get("bayes.steps", 0) * c.get("bayes.chains", 0)
+    bayes = BAYES_UNITS * walker_steps
     trials = T + cov_T + sw_T + budget
     adj = cells * 3 + T * 3 + cov_T * 2 + sw_T * 2 + budget + bayes
     n_paper = c.get("paper.grid", 5) ** 2
@@ -171,6 +191,8 @@ def design_estimate(c: Mapping) -> tuple:
         f"{int(G)} points)": DESIGN_COFACTOR_COPIES * geometries * (2 * n) ** 2 * F8,
         # measured: 211 MB more for 100,000 plates at a vector, all of them held at once
         "the plate region (unprinted.plates plates at once)": 2.2e3 * c.get("unprinted.plates", 0),
+        "the posteriors' chains (bayes.walkers x bayes.steps x bayes.chains)": BAYES_BYTES
+        * walker_steps,
     }
     what = max(parts, key=parts.get)
     return trials, adj, max(U, 2 * int(max(nc, n_paper)) + 7), parts[what], what, analytic
