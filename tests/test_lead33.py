@@ -3,7 +3,8 @@ bias kept (a tiny one is doors33r's, which the merge took); a w-test power not
 above its level (a negative MDB printed as a finding); a trade-off's list of settings with one twice (two rows
 of one setting) or out of order (a zigzag line); the benchmark's lists (a worker count
 given twice); ``sim report`` over results of another version of the code, and over a study
-some of whose trials did not converge (said by ``sim show``, not by the report). Each test
+some of whose trials did not converge (said by ``sim show``, not by the report); gridplate's
+second memory model. Each test
 failed on the code before its fix."""
 
 from __future__ import annotations
@@ -138,3 +139,18 @@ def test_a_list_of_settings_compared_takes_each_once_in_increasing_order(tmp_pat
     layouts = 'tradeoff.layouts=["full", "corners", "full"]'
     assert main(["check", str(STUDIES / "agnard_block.toml"), "--set", layouts]) == 2
     assert "tradeoff.layouts: 'full' is given twice" in capsys.readouterr().err
+
+
+def test_gridplates_chunk_check_uses_the_estimates_memory_model(capsys):
+    # before: gridplate's own chunk check counted 96 bytes a reading (a second memory model,
+    # 3 times the measured one: doors33m) and refused a chunk of 1,000 trials of 4 plates of
+    # 15 x 15 points read 50 times, "about 4.3 GB", that sim check's estimate put at 1.6 GiB
+    big = ["--set", "plate.count=4", "--set", "plate.grid=15", "--set", "readings.count=50"]
+    f = str(STUDIES / "gridplate_two_plates.toml")
+    assert main(["check", f, *big, "--set", "chunk=1000", "--set", "trials=20000"]) == 0
+    assert "about 1.59 GiB of memory" in capsys.readouterr().out
+    assert main(["check", f, *big, "--set", "chunk=5000", "--set", "trials=100000"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert (
+        err == "sim: error: chunk: a chunk of 5000 trials needs about 8.6 GB; use a smaller chunk"
+    )

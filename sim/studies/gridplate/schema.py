@@ -11,10 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 from sim.mc.config import COMMON
+from sim.mc.estimate import GP_POINT_BYTES, GP_READING_BYTES
 from sim.mc.schema_helpers import compared, count, level, positive, printed, real, reals, require
 
 UM = 1e-3  # mm per um
-#: bytes per trial of the simulated readings (P plates, N points, L readings, 2 coords, 8 B)
+#: bytes a chunk may hold (its readings and points: the estimate's measured model, one model)
 _MEM_LIMIT = 2e9
 
 SCHEMA = {
@@ -186,11 +187,11 @@ def check(cfg: dict) -> None:
         f"larger than 1 % of the grid extent {extent:g} mm: the adjustment's geometry is "
         "meaningless",
     )
-    n = cfg["plate.count"] * cfg["plate.grid"] ** 2 * cfg["readings.count"] * 2 * 8
+    pn = cfg["plate.count"] * cfg["plate.grid"] ** 2  # a second model said 3x the bytes (M33)
+    n = pn * (cfg["readings.count"] * GP_READING_BYTES + GP_POINT_BYTES)
     trials = min(cfg["chunk"], cfg["trials"])
     require(
-        n * trials * 6 <= _MEM_LIMIT,
+        n * trials <= _MEM_LIMIT,
         "chunk",
-        f"a chunk of {trials} trials needs about {n * trials * 6 / 1e9:.1f} GB; use a smaller "
-        "chunk",
+        f"a chunk of {trials} trials needs about {n * trials / 1e9:.1f} GB; use a smaller chunk",
     )
