@@ -1,11 +1,10 @@
-"""The lead's own sweep of 2026-11-29 (issue 26): the network kind's refusal of a gross
-bias kept (a tiny one is doors33r's, which the merge took); a w-test power not
-above its level (a negative MDB printed as a finding); a trade-off's list of settings with one twice (two rows
-of one setting) or out of order (a zigzag line); the benchmark's lists (a worker count
-given twice); ``sim report`` over results of another version of the code, and over a study
-some of whose trials did not converge (said by ``sim show``, not by the report); gridplate's
-second memory model. Each test
-failed on the code before its fix."""
+"""The lead's own sweep of 2026-11-29 (issue 26): the network kind's refusal of a gross bias kept
+(a tiny one is doors33r's, which the merge took); a w-test power not above its level (a
+negative MDB printed as a finding); a trade-off's list of settings with one twice (two rows of
+one setting) or out of order (a zigzag line); the benchmark's lists (a worker count given
+twice); ``sim report`` over results of another version of the code, and over a study some of
+whose trials did not converge (said by ``sim show``, not by the report); gridplate's second
+memory model. Each test failed on the code before its fix."""
 
 from __future__ import annotations
 
