@@ -9,6 +9,12 @@ failed on the code before its fix.
   directory there and each re-run refused its ``--out``. Both now refuse before any work,
   naming ``TMPDIR`` and its value (:func:`sim.api_tmp.temp_dir`,
   :func:`sim.report.verify.cli._main`).
+* standard error that cannot be written (``2>/dev/full``): the first note a command printed
+  raised, and the command stopped there: ``sim run mine/x.toml`` at its "writing to scratch/..."
+  note with exit 1 and no results, ``sim check`` of a bad key with exit 1 (not 2), ``make
+  verify`` with exit 1 (a failed comparison) at its first "re-running" line. A failed write to
+  standard error is now dropped (there is nowhere to say it) and the command runs on, ending
+  with its own code (:class:`sim.ends._Stderr`).
 
 Held (the harness, outside the project, ran every command: ``sim check``, ``run``, ``show``,
 ``report``, ``python -m sim.batch``, ``python -m sim.report.verify``, the API): a ``TMPDIR``
@@ -21,6 +27,10 @@ file, the earlier results intact, and the same command resumes once there is roo
 
 from __future__ import annotations
 
+import os
+import shutil
+import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -64,3 +74,22 @@ def test_verify_refuses_a_tmpdir_with_a_line_break_before_it_reruns(
     assert rc == 2 and "\n" not in err, err
     assert "TMPDIR" in err and "--scratch" in err, err
     assert calls == [] and list(broken_tmpdir.iterdir()) == []
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full on this system")
+def test_a_full_standard_error_neither_stops_a_run_nor_changes_an_exit_code(tmp_path):
+    (tmp_path / "studies").mkdir()  # a project of one's own: mine/ goes to scratch/, noted
+    (tmp_path / "mine").mkdir()
+    shutil.copy(TABLE1, tmp_path / "mine" / "brown_table1.toml")
+    sim_ = [sys.executable, "-m", "sim"]
+
+    def run(*args: str) -> int:
+        with open("/dev/full", "w") as full:
+            return subprocess.run(
+                [*sim_, *args], cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=full
+            ).returncode
+
+    assert run("check", "mine/brown_table1.toml", "--set", "trials=-1") == 2
+    run_ = ["run", "mine/brown_table1.toml", "--trials", "40", "--no-figures", "--quiet"]
+    assert run(*run_) == 0
+    assert len(list((tmp_path / "scratch").glob("brown_table1-*/run.json"))) == 1
