@@ -10,6 +10,10 @@ files no one holds, that holds no finished results (``<study>/run.json``: a run 
 returned; its Results may still be read) and no chunks a failed run named in its exception
 (:data:`KEPT`, written by :func:`sim.api_state.anonymous_dir`: ``run(out=...)`` resumes
 them). Directories of other names (an older suite's, the user's) are never looked at.
+
+A ``TMPDIR`` whose path the suite cannot record (a line break or another control character,
+bytes that are not UTF-8) is refused before the run, naming it: the run computed every chunk,
+then ``Results`` refused its own directory ("path: must be a path ...").
 """
 
 from __future__ import annotations
@@ -22,6 +26,8 @@ import stat
 import tempfile
 from pathlib import Path
 
+from sim.mc.config import ConfigError
+from sim.mc.outputs import name_problem
 from sim.mc.pids import pid_alive
 from sim.mc.storage import LOCK, RECORD
 
@@ -81,7 +87,14 @@ def _clear_dead(tmp: Path, study: str) -> None:
 
 def temp_dir(study: str) -> Path:
     """A new ``$TMPDIR/sim-<study>-<pid>-XXXXXXXX/`` for a run of ``study``, after the
-    directories of killed runs of it are cleared; OSError when none can be made."""
+    directories of killed runs of it are cleared; OSError when none can be made, ConfigError
+    naming ``out`` when its path cannot be recorded (module docstring)."""
     tmp = Path(tempfile.gettempdir())
+    if (why := name_problem(str(tmp))) is not None:
+        raise ConfigError(
+            "out",
+            f"is None, and the temporary directory {str(tmp)!r} (TMPDIR) {why}: "
+            "set TMPDIR, or name an output directory",
+        )
     _clear_dead(tmp, study)
     return Path(tempfile.mkdtemp(prefix=f"sim-{study}-{os.getpid()}-"))

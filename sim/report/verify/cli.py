@@ -168,6 +168,11 @@ def _main(argv: list[str] | None) -> int:
         extra = [] if a.trials is None else ["--trials", str(a.trials)]
         extra += [x for s in a.set for x in ("--set", s)]
         mode = "full" if a.trials is None else "mc"
+        if not a.scratch and (why := name_problem(tempfile.gettempdir())) is not None:
+            raise VerifyError(  # each re-run's --out would be refused (a line break in TMPDIR)
+                f"the temporary directory {tempfile.gettempdir()!r} (TMPDIR) {why}: "
+                "set TMPDIR, or give --scratch DIR"
+            )
         tmp = None if a.scratch else tempfile.mkdtemp(prefix="sim-verify-")
         try:
             comps = verify(
