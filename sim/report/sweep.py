@@ -4,6 +4,7 @@ every claim against the first swept key (``sweep.png``), and the table of cells.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from pathlib import Path
 
@@ -242,32 +243,39 @@ def _powers_when_tiny(ax) -> None:
     panels read ``0.000000000000000``."""
     lo, hi = ax.get_ylim()
     if 0 < max(abs(lo), abs(hi)) < 1e-3:
-        ax.yaxis.set_major_formatter(_PowersOfTen())
+        ax.yaxis.set_major_formatter(_powers_of_ten_class()())
 
 
-class _PowersOfTen(ticker.Formatter):
-    """:func:`times_ten` labels with the fewest digits (two at least) that say each tick's
-    value: at two, ticks 2.5e-17 apart read ``1.3×10⁻¹⁶`` at 1.25e-16, and ticks from 1.1e-16
-    to 1.3e-16 read ``1.1×10⁻¹⁶`` three times over."""
+@functools.cache
+def _powers_of_ten_class() -> type:
+    """The formatter's class, made at a figure's first use: a subclass of matplotlib's
+    ``Formatter`` at import loaded matplotlib with every door (tests/test_import_cost.py)."""
 
-    digits = 2
+    class _PowersOfTen(ticker.Formatter):
+        """:func:`times_ten` labels with the fewest digits (two at least) that say each tick's
+        value: at two, ticks 2.5e-17 apart read ``1.3×10⁻¹⁶`` at 1.25e-16, and ticks from 1.1e-16
+        to 1.3e-16 read ``1.1×10⁻¹⁶`` three times over."""
 
-    def set_locs(self, locs) -> None:
-        super().set_locs(locs)
-        v = np.asarray([x for x in locs if np.isfinite(x) and x != 0], float)
-        gaps = np.diff(np.unique(np.asarray(locs, float)))
-        step = float(gaps.min()) if gaps.size else 0.0
-        if not v.size or step <= 0:
-            self.digits = 2
-            return
-        scale = 10.0 ** np.floor(np.log10(np.abs(v)))
-        for d in range(2, 16):  # the rounded mantissas within a millionth of the tick step
-            if np.all(np.abs(np.round(v / scale, d - 1) - v / scale) * scale <= 1e-6 * step):
-                break
-        self.digits = d
+        digits = 2
 
-    def __call__(self, x, pos=None) -> str:
-        return times_ten(x, self.digits)
+        def set_locs(self, locs) -> None:
+            super().set_locs(locs)
+            v = np.asarray([x for x in locs if np.isfinite(x) and x != 0], float)
+            gaps = np.diff(np.unique(np.asarray(locs, float)))
+            step = float(gaps.min()) if gaps.size else 0.0
+            if not v.size or step <= 0:
+                self.digits = 2
+                return
+            scale = 10.0 ** np.floor(np.log10(np.abs(v)))
+            for d in range(2, 16):  # the rounded mantissas within a millionth of the tick step
+                if np.all(np.abs(np.round(v / scale, d - 1) - v / scale) * scale <= 1e-6 * step):
+                    break
+            self.digits = d
+
+        def __call__(self, x, pos=None) -> str:
+            return times_ten(x, self.digits)
+
+    return _PowersOfTen
 
 
 def sweep_markdown(out: Path, name: str | None = None) -> str:
