@@ -126,10 +126,13 @@ def _check_args(a) -> None:
 def _print(comps: list[Comparison]) -> None:
     for c in comps:
         status = "ok" if c.ok else "FAILED"
+        given = ", ".join(c.overrides)
         if not c.files and c.failures:  # nothing compared: no deviation to state
             print(f"{c.study}: FAILED; nothing compared")
             for f in c.failures[:20]:
                 print(f"  {f}")
+            if c.overrides and given not in c.failures[0]:
+                print(f"  re-run with the run's overrides: {given}")
             continue
         print(
             f"{c.study}: {status}; {c.files} files; largest relative deviation "
@@ -137,6 +140,8 @@ def _print(comps: list[Comparison]) -> None:
         )
         for f in c.failures[:20]:
             print(f"  {f}")
+        if c.overrides:  # results of a run off its study file's values, re-run with them
+            print(f"  {'reproduced' if c.ok else 're-run'} with the run's overrides: {given}")
         if c.not_compared:
             print(f"  not compared (rows depend on the trials): {', '.join(c.not_compared)}")
 
