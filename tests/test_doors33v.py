@@ -8,6 +8,9 @@ overrides), one case each; each failed on the code before its fix.
   written as TOML, sorted by key), and verify re-runs the study file with exactly them: "ok",
   deviation 0, "reproduced with the run's overrides: ...". A study file edited since the run
   is still another config, naming only the key the edit changed (it named every override too).
+* ``--trials N`` (the Monte-Carlo level) re-ran such results from the file as written with
+  verify's own values alone, comparing a grid of 4 points a side with the file's 5 without a
+  word; it now keeps the run's other overrides (its trials and chunk are verify's).
 * The Python API (``sim.load(path, key=value).run(trials=, seed=)``) and ``python -m sim.batch
   ... -- --set ...`` record the same overrides, byte for byte the ``run.json`` of ``sim run``
   with the same values given in another order.
@@ -103,6 +106,17 @@ def test_results_made_with_overrides_are_verified_with_them(made, tmp_path):
     assert out.returncode == 1, out.stdout + out.stderr
     assert "another config than the re-run with the run's overrides" in out.stdout
     assert "(keys comparator.beta_mm): they are stale against" in out.stdout
+
+
+def test_fewer_trials_keep_the_runs_other_overrides(made, tmp_path):
+    """``--trials 400`` (the Monte-Carlo level): the run's trials and chunk are verify's, its
+    other overrides the run's (they were dropped: a grid of 4 compared with the file's 5)."""
+    out = _verify(made / "R", "--scratch", tmp_path / "S", "--trials", "400")
+    assert out.returncode == 0, out.stdout + out.stderr
+    kept = "plate.grid=4, region.points=256, region.rounds=0, seed=7"
+    assert f"reproduced with the run's overrides: {kept}" in out.stdout
+    cfg = _rec(tmp_path / "S" / "brown_table1")["config"]
+    assert (cfg["plate.grid"], cfg["trials"], cfg["seed"]) == (4, 400, 7)
 
 
 def test_the_api_and_the_batch_record_what_sim_run_records(made, tmp_path):
