@@ -17,6 +17,10 @@ overrides), one case each; each failed on the code before its fix.
 * Overrides of TOML arrays of inline tables (a network's points), strings with quotes, spaces,
   brackets and an ``=``, and a ``network.gama_xml`` file round-trip exactly: the re-run's
   config is the run's, every table equal.
+* An override too long for a command line (a network's observations given to ``sim.load``,
+  over 128 KiB) made the re-run "Argument list too long", exit 2: such results could not be
+  verified. The re-run now reads such arguments from its standard input, and verify's line
+  shows each override cut to 100 characters.
 * A ``run.json`` whose overrides were edited by hand (an option such as ``--out=DIR``, text
   after a value, a key the config has not, a key twice, not a list) is not passed on to the
   re-run: the study fails in one line naming the entry and the file, and nothing is re-run.
@@ -175,6 +179,24 @@ def test_arrays_quoted_strings_and_a_gama_file_round_trip(tmp_path):
     assert elsewhere.returncode == 1, elsewhere.stdout + elsewhere.stderr
     assert "a file the run's overrides name is not here" in elsewhere.stdout
     assert "run verify where the run was made" in elsewhere.stdout
+
+
+def test_an_override_too_long_for_a_command_line_is_re_run(tmp_path):
+    """2,500 observations given to ``sim.load`` (150 kB of TOML, over Linux's 128 KiB an
+    argument): the re-run was "Argument list too long", exit 2; it now reads its arguments
+    from its standard input."""
+    pairs = [("A", "B"), ("B", "C"), ("C", "D"), ("A", "C"), ("B", "D")] * 500
+    obs = [{"kind": "distance", "from": a, "to": b, "sigma_mm": 2.0} for a, b in pairs]
+    one = ROOT / "tests" / "data" / "gama" / "one_fixed.toml"
+    sim.load(one, trials=40, network__observations=obs).run(
+        out=tmp_path / "R" / "one_fixed", figures=False
+    )
+    (long,) = [t for t in _rec(tmp_path / "R" / "one_fixed")["overrides"] if len(t) > 1 << 17]
+    out = _verify(tmp_path / "R", "--studies", one.parent, "--scratch", tmp_path / "S")
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "one_fixed: ok; 7 files; largest relative deviation 0;" in out.stdout
+    assert 'network.observations=[{ kind = "distance", from = "A", to = "B", s' in out.stdout
+    assert f"... ({len(long):,} characters), trials=40" in out.stdout  # a line, not 150 kB
 
 
 @pytest.mark.parametrize(

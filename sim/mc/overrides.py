@@ -25,7 +25,7 @@ from typing import Any
 from sim.mc.config import ConfigError, parse_override
 from sim.mc.toml_text import toml_value
 
-__all__ = ["recorded", "command_values", "replayable", "keys_of", "without"]
+__all__ = ["recorded", "command_values", "replayable", "keys_of", "without", "listed"]
 
 #: a config key as a study names it: dotted words
 _KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
@@ -42,6 +42,17 @@ def command_values(sets: list[str], **flags: Any) -> dict[str, Any]:
     out = dict(parse_override(t) for t in sets)
     out.update((k, v) for k, v in flags.items() if v is not None)
     return out
+
+
+#: the characters of an override shown in a line (a network's points run to megabytes)
+SHOWN = 100
+
+
+def listed(overrides: list[str]) -> str:
+    """``overrides`` for a line of text, each cut to :data:`SHOWN` characters."""
+    return ", ".join(
+        t if len(t) <= SHOWN else f"{t[: SHOWN - 30]}... ({len(t):,} characters)" for t in overrides
+    )
 
 
 def keys_of(overrides: list[str]) -> list[str]:

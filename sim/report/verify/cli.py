@@ -13,6 +13,7 @@ from sim.ends import stdout_failed
 from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError, parse_override
 from sim.mc.outputs import name_problem
+from sim.mc.overrides import listed
 from sim.report.verify.record import write_record
 from sim.report.verify.rerun import verify
 from sim.report.verify.rules import Comparison, VerifyError
@@ -126,7 +127,7 @@ def _check_args(a) -> None:
 def _print(comps: list[Comparison]) -> None:
     for c in comps:
         status = "ok" if c.ok else "FAILED"
-        given = ", ".join(c.overrides)
+        given = listed(c.overrides)
         if not c.files and c.failures:  # nothing compared: no deviation to state
             print(f"{c.study}: FAILED; nothing compared")
             for f in c.failures[:20]:

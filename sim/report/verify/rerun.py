@@ -7,7 +7,6 @@ from __future__ import annotations
 import errno
 import hashlib
 import os
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -17,10 +16,11 @@ import pyarrow as pa
 from sim.mc.children import child_env, child_text, ended, stop_children
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
-from sim.mc.overrides import keys_of, replayable, without
+from sim.mc.overrides import listed, replayable, without
 from sim.mc.paths import link_problem
 from sim.mc.storage import LOCK, read_provenance, read_record
 from sim.report.read import check_claims_table
+from sim.report.verify.child import busy_words, launcher, names_one_of, system_error
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
 
 __all__ = ["study_dirs", "study_file", "rerun_study", "verify"]
@@ -141,22 +141,25 @@ def rerun_study(
     # a directory removed at exit, between verify's own lines, and a full or closed standard
     # output of verify's failed the re-run itself
     quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.PIPE}
+    cmd, given = launcher(cmd)
+    if given is not None:
+        quiet["stdin"] = subprocess.PIPE
     with subprocess.Popen(cmd, **quiet, env=child_env(), **child_text()) as proc:
         try:
-            _, err = proc.communicate()
+            _, err = proc.communicate(given)
         except KeyboardInterrupt:  # Ctrl-C reaches the re-run too, SIGTERM or SIGHUP only verify
             stop_children([proc], drain=True)  # as Ctrl-C does, without a word of its own
             raise
     lines = [ln for ln in err.splitlines() if ln.strip()]
-    if proc.returncode == 2 and lines and _system_error(lines[-1]):
+    if proc.returncode == 2 and lines and system_error(lines[-1]):
         # a scratch directory full or read-only, memory short: this machine's, not a failed
         # reproduction (it was recorded as one, "FAILED; nothing compared", exit 1; with
         # --trials it was "the re-run refused its options")
         raise VerifyError(f"{d.name}: the re-run could not run here: {lines[-1]}")
-    busy = _busy(lines[-1], target) if proc.returncode == 2 and lines else None
+    busy = busy_words(lines[-1], target) if proc.returncode == 2 and lines else None
     if busy:
         raise VerifyError(f"{d.name}: {busy}")
-    if proc.returncode == 2 and lines and _names_one_of(lines[-1], overrides):
+    if proc.returncode == 2 and lines and names_one_of(lines[-1], overrides):
         # a key removed since, a value the file or the code refuses now (or edited by hand):
         # it was "the re-run exited with 2", or with --trials "the re-run refused its options"
         if os.strerror(errno.ENOENT) in lines[-1]:  # a file it names (network.gama_xml)
@@ -183,53 +186,6 @@ def rerun_study(
         )
     sys.stderr.write(err)
     return None if proc.returncode == 0 else f"the re-run {ended(proc.returncode)}"
-
-
-#: the words of every errno, as a failing write or read of the re-run begins its line
-_STRERRORS = {os.strerror(n) for n in errno.errorcode}
-
-
-#: sim run's refusal of an --out another running sim holds (sim.mc.outputs)
-_BUSY = re.compile(r"^sim: error: --out: .* is being written by a running sim \(pid (\d+)")
-
-
-def _busy(line: str, target: Path) -> str | None:
-    """The words for a re-run refused because another process writes its directory
-    ``target`` under ``--scratch``: another verify given the same ``--scratch`` (named by its
-    pid, the parent of the sim run that holds the directory), else that sim run; None for
-    another refusal. Both verifies said "the re-run refused its options"."""
-    m = _BUSY.match(line)
-    if not m:
-        return None
-    pid, scratch = int(m[1]), target.parent
-    try:  # Linux: the holder's parent, and whether it is a verify
-        ppid = int(Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[1])
-        theirs = b"sim.report.verify" in Path(f"/proc/{ppid}/cmdline").read_bytes()
-    except (OSError, ValueError, IndexError):
-        theirs = False
-    who = f"another verify (pid {ppid}) re-runs" if theirs else f"a running sim (pid {pid}) writes"
-    return (
-        f"{who} into the same --scratch {scratch} ({target.name}); wait for it to finish or "
-        "choose another --scratch"
-    )
-
-
-def _names_one_of(line: str, overrides: list[str] | tuple) -> bool:
-    """Whether the re-run's error line (``sim: error: KEY: ...``) names a key of ``overrides``."""
-    m = re.match(r"sim: error: ([^:\s]+): ", line)
-    return bool(m) and m[1] in keys_of(list(overrides))
-
-
-def _system_error(line: str) -> bool:
-    """Whether the re-run's error line is the system's (``sim: error: No space left on device:
-    PATH``, or not enough memory), not the study's or its options'."""
-    text = line.removeprefix("sim: error: ")
-    return text != line and (
-        text.startswith("not enough memory")
-        or text.split(": ", 1)[0] in _STRERRORS
-        # "--out: cannot write to DIR: No space left on device" (its --out under --scratch)
-        or (text.startswith("--out: cannot write") and text.rsplit(": ", 1)[-1] in _STRERRORS)
-    )
 
 
 def verify(
@@ -421,7 +377,7 @@ def _other_config(d: Path, target: Path, sf: Path | None = None, given=()) -> st
         )
     keys = sorted(k for k in set(ca) | set(cb) if ca.get(k) != cb.get(k))
     why = "they are stale or were made with other options"
-    rerun = f"the re-run with the run's overrides ({', '.join(given)})" if given else "the re-run"
+    rerun = f"the re-run with the run's overrides ({listed(given)})" if given else "the re-run"
     if sf is not None and given:  # its options are on record: the file is not what it was
         why = f"they are stale against {sf} (edited since the run?) or of another study file"
     elif sf is not None:  # re-run from a file of ours: the results may be of a file of theirs
