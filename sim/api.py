@@ -37,6 +37,7 @@ from sim.api_tmp import temp_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
+from sim.mc.overrides import recorded
 from sim.mc.paths import link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
@@ -292,6 +293,7 @@ class StudyHandle:
                     readme=lambda stage, name: write_run_readme(
                         stage, get_study, name, out, design_config
                     ),
+                    overrides=recorded(h.overrides),  # as sim run records its options
                 )
             except ConfigError as e:
                 if e.key in _ARGUMENTS:  # the command line's option: the argument of run()

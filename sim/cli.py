@@ -38,6 +38,7 @@ from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, config_changes, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem
+from sim.mc.overrides import command_values, recorded
 from sim.mc.paths import absolute
 from sim.mc.progress import set_quiet
 from sim.mc.read_when import read_in_a_cell
@@ -214,6 +215,9 @@ def _run(args) -> int:
         max_adjustments=args.max_adjustments,
         figures=not args.no_figures,
         readme=lambda stage, name: write_run_readme(stage, get_study, name, out, design_config),
+        overrides=recorded(
+            command_values(args.set, trials=args.trials, seed=args.seed, chunk=args.chunk)
+        ),
     )
     args.published = shown  # an interrupt from now on finds the results written
     check_interrupt()  # dropped by Python since the results were published: not exit 0

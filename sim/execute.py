@@ -192,6 +192,7 @@ def execute(
     max_adjustments: float | None = None,
     figures: bool = True,
     readme: Callable[[Path, str], Any] | None = None,
+    overrides: list[str] | None = None,
 ):
     """Run a validated study config (and its sweep) into ``out`` (absolute): estimate and
     limits, output checks, executor, locked staging directory, the run, and the final
@@ -200,7 +201,8 @@ def execute(
     as up to date). ``readme(stage, name)``: writes the run's README.md into the sealed
     staging directory before it replaces ``out`` (``sim run``; written after, a failure or a
     kill there left the new results without it, or with a ``run.json`` that did not list it,
-    and exit 0). Raises ConfigError/StudyError (one line) on any failure. Returns the run's
+    and exit 0). ``overrides``: the run's, as ``run.json`` records them (:mod:`sim.mc.overrides`).
+    Raises ConfigError/StudyError (one line) on any failure. Returns the run's
     :class:`sim.mc.estimate.Estimate`."""
 
     _not_in_a_starting_worker()
@@ -217,6 +219,7 @@ def execute(
         "code_hash": code_hash(cfg["study"]),
         "versions": versions(),
         **({} if figures else {"figures": False}),
+        **({"overrides": overrides} if overrides else {}),
     }
     if (why := umask_problem()) is not None:
         raise ConfigError(None, why)

@@ -235,8 +235,8 @@ def test_a_lock_file_left_in_an_earlier_re_run_does_not_block_the_next_verify(tm
 
 def test_a_scratch_that_cannot_be_written_is_the_machines_not_the_options():
     line = "sim: error: --out: cannot write to /s/brown_table1: No space left on device"
-    assert verify_rerun._system_error(line)  # before: "the re-run refused its options"
-    assert not verify_rerun._system_error("sim: error: --out: must not be empty")
+    assert verify_rerun.system_error(line)  # before: "the re-run refused its options"
+    assert not verify_rerun.system_error("sim: error: --out: must not be empty")
 
 
 TORN = """

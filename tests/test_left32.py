@@ -37,9 +37,9 @@ from sim.mc.argv import most_workers
 from sim.mc.outputs import stage_dir
 from sim.mc.storage import StageLock
 from sim.report.config_diff import changed_keys
+from sim.report.verify.child import busy_words
 from sim.report.verify.cli import _parser as verify_parser
 from sim.report.verify.cli import main as verify_main
-from sim.report.verify.rerun import _busy
 
 BROWN = str(ROOT / "studies" / "brown_table1.toml")
 
@@ -85,7 +85,7 @@ def test_a_scratch_another_verify_writes_is_named_with_its_pid(tmp_path):
         child = int(proc.stdout.readline())
         target = tmp_path / "brown_table1"
         line = f"sim: error: --out: {target} is being written by a running sim (pid {child}); wait"
-        said = _busy(line, target)
+        said = busy_words(line, target)
     finally:
         proc.stdin.close()
         proc.wait()
@@ -93,7 +93,7 @@ def test_a_scratch_another_verify_writes_is_named_with_its_pid(tmp_path):
         f"another verify (pid {proc.pid}) re-runs into the same --scratch {tmp_path} "
         "(brown_table1); wait for it to finish or choose another --scratch"
     )
-    assert _busy("sim: error: --trials: must be >= 1 (got 0)", target) is None
+    assert busy_words("sim: error: --trials: must be >= 1 (got 0)", target) is None
 
 
 def test_a_scratch_a_running_sim_writes_is_named(tmp_path, capsys):

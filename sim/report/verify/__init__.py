@@ -17,6 +17,11 @@ with it for the kind of number it holds (:mod:`sim.mc.tolerance`; docs/reproduci
 * other text columns: listed when they differ (notes format numbers), never a failure;
 * the set of files, their columns and row counts must be the same.
 
+Results made with overrides (``sim run --set``, ``--trials``, ``--seed``, ``--chunk``; the
+API's keys) are re-run with exactly those their ``run.json`` records (``overrides``;
+:mod:`sim.mc.overrides`, which passes on only ``--set KEY=VALUE`` of a key of the run's own
+config), so a study file edited since the run still gives another config.
+
 ``--trials N`` (with ``--set KEY=VALUE`` for other trial counts) re-runs with fewer trials and
 compares at the Monte-Carlo level: ``mc`` and ``chain`` columns within ``MC_K`` combined
 standard errors of the two runs, columns declared ``analytic`` by their rule, the rest not at

@@ -14,6 +14,7 @@ from sim.held_stops import held_stops
 from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError, parse_override
 from sim.mc.outputs import name_problem
+from sim.mc.overrides import listed
 from sim.report.verify.record import write_record
 from sim.report.verify.rerun import verify
 from sim.report.verify.rules import Comparison, VerifyError
@@ -127,10 +128,13 @@ def _check_args(a) -> None:
 def _print(comps: list[Comparison]) -> None:
     for c in comps:
         status = "ok" if c.ok else "FAILED"
+        given = listed(c.overrides)
         if not c.files and c.failures:  # nothing compared: no deviation to state
             print(f"{c.study}: FAILED; nothing compared")
             for f in c.failures[:20]:
                 print(f"  {f}")
+            if c.overrides and given not in c.failures[0]:
+                print(f"  re-run with the run's overrides: {given}")
             continue
         print(
             f"{c.study}: {status}; {c.files} files; largest relative deviation "
@@ -138,6 +142,8 @@ def _print(comps: list[Comparison]) -> None:
         )
         for f in c.failures[:20]:
             print(f"  {f}")
+        if c.overrides:  # results of a run off its study file's values, re-run with them
+            print(f"  {'reproduced' if c.ok else 're-run'} with the run's overrides: {given}")
         if c.not_compared:
             print(f"  not compared (rows depend on the trials): {', '.join(c.not_compared)}")
 

@@ -17,9 +17,11 @@ import pyarrow as pa
 from sim.mc.children import child_env, child_text, ended, stop_children
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
+from sim.mc.overrides import listed, replayable, without
 from sim.mc.paths import link_problem
 from sim.mc.storage import LOCK, read_provenance, read_record
 from sim.report.read import check_claims_table
+from sim.report.verify.child import busy_words, launcher, names_one_of, system_error
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
 
 __all__ = ["study_dirs", "study_file", "rerun_study", "verify"]
@@ -119,9 +121,10 @@ def rerun_study(
     workers: int,
     extra: list[str],
     studies: Path = Path("studies"),
+    overrides: list[str] | tuple = (),
 ) -> str | None:
-    """Run the study of committed results ``d`` into ``target`` from its file in ``studies``;
-    the failure, or None."""
+    """Run the study of committed results ``d`` into ``target`` from its file in ``studies``
+    with the run's ``overrides`` (:mod:`sim.mc.overrides`); the failure, or None."""
     sf = study_file(d, study, studies)
     if not sf.is_file():
         return (
@@ -132,27 +135,44 @@ def rerun_study(
     # --out=DIR: a --scratch that begins with "-" is a value, not an option of sim run's
     cmd = [sys.executable, "-m", "sim", "run", str(sf), f"--out={target}", "--quiet"]
     cmd += ["--no-figures"]
-    cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else []), *extra]
+    cmd += ["--workers", str(workers), *(["--overwrite"] if overwrite else [])]
+    cmd += [f"--set={t}" for t in overrides] + extra  # (each checked: replayable)
     print(f"sim verify: re-running {d.name}", file=sys.stderr, flush=True)
     # its standard output is not verify's: the re-run's "results in /tmp/sim-verify-.../" named
     # a directory removed at exit, between verify's own lines, and a full or closed standard
     # output of verify's failed the re-run itself
     quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.PIPE}
+    cmd, given = launcher(cmd)
+    if given is not None:
+        quiet["stdin"] = subprocess.PIPE
     with subprocess.Popen(cmd, **quiet, env=child_env(), **child_text()) as proc:
         try:
-            _, err = proc.communicate()
+            _, err = proc.communicate(given)
         except KeyboardInterrupt:  # Ctrl-C reaches the re-run too, SIGTERM or SIGHUP only verify
             stop_children([proc], drain=True)  # as Ctrl-C does, without a word of its own
             raise
     lines = [ln for ln in err.splitlines() if ln.strip()]
-    if proc.returncode == 2 and lines and _system_error(lines[-1]):
+    if proc.returncode == 2 and lines and system_error(lines[-1]):
         # a scratch directory full or read-only, memory short: this machine's, not a failed
         # reproduction (it was recorded as one, "FAILED; nothing compared", exit 1; with
         # --trials it was "the re-run refused its options")
         raise VerifyError(f"{d.name}: the re-run could not run here: {lines[-1]}")
-    busy = _busy(lines[-1], target) if proc.returncode == 2 and lines else None
+    busy = busy_words(lines[-1], target) if proc.returncode == 2 and lines else None
     if busy:
         raise VerifyError(f"{d.name}: {busy}")
+    if proc.returncode == 2 and lines and names_one_of(lines[-1], overrides):
+        # a key removed since, a value the file or the code refuses now (or edited by hand):
+        # it was "the re-run exited with 2", or with --trials "the re-run refused its options"
+        if os.strerror(errno.ENOENT) in lines[-1]:  # a file it names (network.gama_xml)
+            return (
+                f"a file the run's overrides name is not here ({lines[-1]}): a relative path "
+                "is read from the working directory; run verify where the run was made"
+            )
+        return (
+            f"the run's overrides no longer apply: the re-run of {sf} with them was refused "
+            f"({lines[-1]}): the study file or the code changed since the run (its results are "
+            "stale: run it again), or its run.json was edited"
+        )
     if proc.returncode == 2 and lines and (extra or lines[-1].startswith("sim: error: --")):
         # the re-run refused the options verify passed (--trials, --set, --workers, the
         # --out under --scratch): a request error, not a failed comparison to record
@@ -167,47 +187,6 @@ def rerun_study(
         )
     sys.stderr.write(err)
     return None if proc.returncode == 0 else f"the re-run {ended(proc.returncode)}"
-
-
-#: the words of every errno, as a failing write or read of the re-run begins its line
-_STRERRORS = {os.strerror(n) for n in errno.errorcode}
-
-
-#: sim run's refusal of an --out another running sim holds (sim.mc.outputs)
-_BUSY = re.compile(r"^sim: error: --out: .* is being written by a running sim \(pid (\d+)")
-
-
-def _busy(line: str, target: Path) -> str | None:
-    """The words for a re-run refused because another process writes its directory
-    ``target`` under ``--scratch``: another verify given the same ``--scratch`` (named by its
-    pid, the parent of the sim run that holds the directory), else that sim run; None for
-    another refusal. Both verifies said "the re-run refused its options"."""
-    m = _BUSY.match(line)
-    if not m:
-        return None
-    pid, scratch = int(m[1]), target.parent
-    try:  # Linux: the holder's parent, and whether it is a verify
-        ppid = int(Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[1])
-        theirs = b"sim.report.verify" in Path(f"/proc/{ppid}/cmdline").read_bytes()
-    except (OSError, ValueError, IndexError):
-        theirs = False
-    who = f"another verify (pid {ppid}) re-runs" if theirs else f"a running sim (pid {pid}) writes"
-    return (
-        f"{who} into the same --scratch {scratch} ({target.name}); wait for it to finish or "
-        "choose another --scratch"
-    )
-
-
-def _system_error(line: str) -> bool:
-    """Whether the re-run's error line is the system's (``sim: error: No space left on device:
-    PATH``, or not enough memory), not the study's or its options'."""
-    text = line.removeprefix("sim: error: ")
-    return text != line and (
-        text.startswith("not enough memory")
-        or text.split(": ", 1)[0] in _STRERRORS
-        # "--out: cannot write to DIR: No space left on device" (its --out under --scratch)
-        or (text.startswith("--out: cannot write") and text.rsplit(": ", 1)[-1] in _STRERRORS)
-    )
 
 
 def verify(
@@ -262,14 +241,21 @@ def verify(
         if mixed:
             out.append(Comparison(d.name, failures=[mixed]))
             continue
+        given: list[str] = []  # the run's overrides, re-run with it (sim.mc.overrides)
         if rerun:
-            overwrite = replace[d]
-            why = rerun_study(d, study, target, overwrite, workers, extra or [], Path(studies))
-            if why:
+            given, bad = replayable(read_record(d) or {})
+            if bad:  # never passed on: a run.json edited by hand adds no option to a re-run
+                why = f"{d / 'run.json'}: {bad} (edited by hand?): not re-run"
                 out.append(Comparison(d.name, failures=[why]))
                 continue
+            given = without(given, extra or [])
+            overwrite = replace[d]
+            why = rerun_study(d, study, target, overwrite, workers, extra or [], studies, given)
+            if why:
+                out.append(Comparison(d.name, failures=[why], overrides=given))
+                continue
         sf = study_file(d, study, Path(studies)) if rerun else None
-        out.append(_settled(d, target, sf, mode))
+        out.append(_settled(d, target, sf, mode, given))
     return out
 
 
@@ -277,16 +263,16 @@ def verify(
 SETTLE = 3
 
 
-def _settled(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
+def _settled(d: Path, target: Path, sf: Path | None, mode: str, given: list[str]) -> Comparison:
     """:func:`_judge` of the committed results ``d``, made again when they changed while it
     read them: a ``make reproduce`` in another terminal that published new results of the
     study between its first table and its last (or after their run record was read) made a
     comparison of two runs' tables, a FAILED line of deviations that no re-run had."""
     for _ in range(SETTLE):
         before = _state(d)
-        comp = _judge(d, target, sf, mode)
+        comp = _judge(d, target, sf, mode, given)
         if _state(d) == before:
-            comp.tables = before[-1]
+            comp.tables, comp.overrides = before[-1], given
             return comp
     return Comparison(
         d.name,
@@ -307,11 +293,11 @@ def _state(d: Path) -> tuple:
     return (st.st_dev, st.st_ino, tables_digest(d))
 
 
-def _judge(d: Path, target: Path, sf: Path | None, mode: str) -> Comparison:
+def _judge(d: Path, target: Path, sf: Path | None, mode: str, given: list[str]) -> Comparison:
     """The comparison of the committed results ``d`` with the re-run ``target``: tables of two
     runs, results of another config, else every table by its rules (and, when one fails,
     whether the results were made by other code)."""
-    why = _not_as_written(d) or (_other_config(d, target, sf) if mode == "full" else None)
+    why = _not_as_written(d) or (_other_config(d, target, sf, given) if mode == "full" else None)
     if why:  # not a reproduction failure of these numbers: results of another input
         return Comparison(d.name, failures=[why])
     comp = compare_dirs(d, target, d.name, mode)
@@ -389,12 +375,12 @@ def _other_code(d: Path, target: Path) -> str | None:
     )
 
 
-def _other_config(d: Path, target: Path, sf: Path | None = None) -> str | None:
+def _other_config(d: Path, target: Path, sf: Path | None = None, given=()) -> str | None:
     """Why the committed results ``d`` cannot be compared with the re-run ``target`` (of the
     study file ``sf``): their run records hold different configs (results left by a run with
     other options, stale against the study file, or made from another file of its name: a
     study author's own ``brown_table1.toml`` re-run as the project's), so numbers that differ
-    would be no failure to reproduce."""
+    would be no failure to reproduce. ``given``: the run's overrides the re-run was made with."""
     a, b = read_record(d), read_record(target)
     if not isinstance(a, dict) or not isinstance(b, dict) or "config" not in a:
         return None  # no record to tell: the comparison decides
@@ -410,12 +396,15 @@ def _other_config(d: Path, target: Path, sf: Path | None = None) -> str | None:
         )
     keys = sorted(k for k in set(ca) | set(cb) if ca.get(k) != cb.get(k))
     why = "they are stale or were made with other options"
-    if sf is not None:  # re-run from a file of ours: the results may be of a file of theirs
+    rerun = f"the re-run with the run's overrides ({listed(given)})" if given else "the re-run"
+    if sf is not None and given:  # its options are on record: the file is not what it was
+        why = f"they are stale against {sf} (edited since the run?) or of another study file"
+    elif sf is not None:  # re-run from a file of ours: the results may be of a file of theirs
         why = (
             f"they are stale, were made with other options, or from another study file than "
             f"{sf} (name its directory with --studies)"
         )
     return (
-        f"the committed results are of another config than the re-run (keys {', '.join(keys)}): "
+        f"the committed results are of another config than {rerun} (keys {', '.join(keys)}): "
         f"{why}; run make reproduce, then verify"
     )

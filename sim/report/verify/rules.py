@@ -50,6 +50,7 @@ class Comparison:
     text_changes: list[str] = field(default_factory=list)
     not_compared: list[str] = field(default_factory=list)  # at the MC level: not comparable
     tables: str | None = None  # the committed tables compared (:func:`tables_digest`)
+    overrides: list[str] = field(default_factory=list)  # the run's, re-run with (run.json)
 
     @property
     def ok(self) -> bool:

@@ -1,0 +1,87 @@
+"""The re-run's process of ``make verify``: how it is started (``python -m sim run`` with its
+arguments on its command line, or through its standard input when they are too long for one)
+and how its last error line reads (the system's error, another process writing its directory,
+a refusal of one of the run's recorded overrides)."""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+import re
+import sys
+from pathlib import Path
+
+from sim.mc.overrides import keys_of
+
+__all__ = ["launcher", "busy_words", "names_one_of", "system_error"]
+
+
+#: the longest argument, and all of them, that a re-run is given on its command line (Linux
+#: takes 128 KiB an argument): the overrides of a network's thousands of points given to
+#: ``sim.load`` made the re-run "Argument list too long" (exit 2: such results could not be
+#: verified); longer ones go to it through its standard input
+_ARG_BYTES = 1 << 16
+
+#: ``python -m sim`` with its arguments read as JSON from standard input
+_FROM_STDIN = (
+    "import json, runpy, sys; sys.argv[1:] = json.loads(sys.stdin.read()); "
+    "runpy.run_module('sim', run_name='__main__', alter_sys=True)"
+)
+
+
+def launcher(cmd: list[str]) -> tuple[list[str], str | None]:
+    """``cmd`` (``python -m sim run ...``) and None, or, when its arguments are too long for
+    a command line (:data:`_ARG_BYTES`), the same program reading them from its standard input
+    and that input (ASCII JSON: any encoding of the pipe reads it)."""
+    sizes = [len(a.encode("utf-8", "surrogateescape")) for a in cmd]
+    if max(sizes) < _ARG_BYTES and sum(sizes) < 4 * _ARG_BYTES:
+        return cmd, None
+    return [sys.executable, "-c", _FROM_STDIN], json.dumps(cmd[3:])
+
+
+#: the words of every errno, as a failing write or read of the re-run begins its line
+_STRERRORS = {os.strerror(n) for n in errno.errorcode}
+
+
+#: sim run's refusal of an --out another running sim holds (sim.mc.outputs)
+_BUSY = re.compile(r"^sim: error: --out: .* is being written by a running sim \(pid (\d+)")
+
+
+def busy_words(line: str, target: Path) -> str | None:
+    """The words for a re-run refused because another process writes its directory
+    ``target`` under ``--scratch``: another verify given the same ``--scratch`` (named by its
+    pid, the parent of the sim run that holds the directory), else that sim run; None for
+    another refusal. Both verifies said "the re-run refused its options"."""
+    m = _BUSY.match(line)
+    if not m:
+        return None
+    pid, scratch = int(m[1]), target.parent
+    try:  # Linux: the holder's parent, and whether it is a verify
+        ppid = int(Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[1])
+        theirs = b"sim.report.verify" in Path(f"/proc/{ppid}/cmdline").read_bytes()
+    except (OSError, ValueError, IndexError):
+        theirs = False
+    who = f"another verify (pid {ppid}) re-runs" if theirs else f"a running sim (pid {pid}) writes"
+    return (
+        f"{who} into the same --scratch {scratch} ({target.name}); wait for it to finish or "
+        "choose another --scratch"
+    )
+
+
+def names_one_of(line: str, overrides: list[str] | tuple) -> bool:
+    """Whether the re-run's error line (``sim: error: KEY: ...``) names a key of ``overrides``."""
+    m = re.match(r"sim: error: ([^:\s]+): ", line)
+    return bool(m) and m[1] in keys_of(list(overrides))
+
+
+def system_error(line: str) -> bool:
+    """Whether the re-run's error line is the system's (``sim: error: No space left on device:
+    PATH``, or not enough memory), not the study's or its options'."""
+    text = line.removeprefix("sim: error: ")
+    return text != line and (
+        text.startswith("not enough memory")
+        or text.split(": ", 1)[0] in _STRERRORS
+        # "--out: cannot write to DIR: No space left on device" (its --out under --scratch)
+        or (text.startswith("--out: cannot write") and text.rsplit(": ", 1)[-1] in _STRERRORS)
+    )
