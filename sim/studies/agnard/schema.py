@@ -75,7 +75,13 @@ SCHEMA = {
     "scan.grid_sigma_px": real(
         0.1, "centring error of a grid node on the scan", 0.0, 10.0, unit="px"
     ),
-    "scan.fiducial_mm": real(110.0, "corner fiducials at (+-d, +-d)", 10.0, 250.0, unit="mm"),
+    "scan.fiducial_mm": real(
+        110.0,
+        "corner fiducials at (+-d, +-d) (on the photo, at most half block.format_mm: checked on load)",
+        10.0,
+        250.0,
+        unit="mm",
+    ),
     "scan.fiducial_sigma_px": real(0.25, "centring error of a fiducial mark", 0.0, 10.0, unit="px"),
     "measure.pointing_px": positive(
         0.5,
@@ -232,6 +238,12 @@ def check(cfg: dict) -> None:
             "the base must be shorter than half the usable "
             "format (endlap over 50 %), or consecutive models share no points "
             "and the strip falls apart",
+        )
+    if cfg["scan.fiducial_mm"] > 0.5 * cfg["block.format_mm"]:
+        raise ConfigError(
+            "scan.fiducial_mm",
+            f"the corner fiducials at +-{cfg['scan.fiducial_mm']:g} mm lie off the "
+            f"{cfg['block.format_mm']:g} mm photo (block.format_mm): at most half the format",
         )
     if cfg["block.strips"] * cfg["block.models"] < 2:
         raise ConfigError("block.models", "a block needs at least two models")
