@@ -66,7 +66,7 @@ def test_a_figure_larger_than_any_the_run_draws_is_not_read(plate, monkeypatch, 
     def never(p):
         raise AssertionError(f"{p} was read")
 
-    monkeypatch.setattr(publish, "_sha256", never)
+    monkeypatch.setattr(publish, "file_sha256", never)
     assert "is not the figure its run drew" in changed_figure(plate)
     one_line(capsys, main(["show", str(plate)]), "network.png", "not the figure", prefix=SIM_ERROR)
 

@@ -20,7 +20,7 @@ import pytest
 
 from sim.batch_checks import why_stale
 from sim.cli import main
-from sim.mc.publish import _sha256, changed_figure
+from sim.mc.publish import changed_figure, file_sha256
 from tests.oneline import one_line
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -38,7 +38,7 @@ def test_the_run_records_the_sha256_of_every_figure_it_drew(plate):
     rec = json.loads((plate / "run.json").read_text())
     pngs = sorted(p.name for p in plate.glob("*.png"))
     assert pngs and sorted(rec["figure_sha256"]) == pngs
-    assert all(rec["figure_sha256"][f] == _sha256(plate / f) for f in pngs)
+    assert all(rec["figure_sha256"][f] == file_sha256(plate / f) for f in pngs)
     assert changed_figure(plate) is None
 
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from sim.mc.config import ConfigError
-from sim.mc.publish import _foreign, _present, _remove_record_last, _sha256
+from sim.mc.publish import _foreign, _present, _remove_record_last, file_sha256
 from sim.mc.storage import RECORD, read_record
 
 __all__ = ["replaced_results", "clear_replaced"]
@@ -33,7 +33,7 @@ def replaced_results(stage: Path, out: Path) -> bool:
     if not isinstance(want, str) or read_record(stage) is None:
         return False
     try:
-        return _sha256(stage / RECORD) == want
+        return file_sha256(stage / RECORD) == want
     except OSError:
         return False
 

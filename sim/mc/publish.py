@@ -29,7 +29,7 @@ from sim.mc.pids import writer_gone
 from sim.mc.runner import ChunkStore
 from sim.mc.storage import LOCK, read_record, write_record
 
-__all__ = ["seal", "publish", "damaged_chunks", "changed_figure", "drawn"]
+__all__ = ["seal", "publish", "damaged_chunks", "changed_figure", "drawn", "file_sha256"]
 
 
 def _files(d: Path) -> list[str]:
@@ -53,10 +53,10 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
         raise ConfigError("--out", f"{stage} lost its run record while the run worked; run again")
     carried = set(rec.get("carried") or [])  # the user's files a publish copied in: not ours
     files = [f for f in _files(stage) if f not in carried]
-    chunks = {f: _sha256(stage / f) for f in files if f.startswith("trials/")}
-    figures = {f: _sha256(stage / f) for f in files if f.endswith(".png")}
+    chunks = {f: file_sha256(stage / f) for f in files if f.startswith("trials/")}
+    figures = {f: file_sha256(stage / f) for f in files if f.endswith(".png")}
     # the tables' too: make verify tells a table edited after its run from a failed re-run
-    tables = {f: _sha256(stage / f) for f in files if "/" not in f and f.endswith(".parquet")}
+    tables = {f: file_sha256(stage / f) for f in files if "/" not in f and f.endswith(".parquet")}
     record = {**rec, "files": files, "chunk_sha256": chunks, "figure_sha256": figures}
     write_record(stage, {**record, "table_sha256": tables})
 
@@ -80,7 +80,7 @@ def _run_drew(p: Path, sha256) -> bool:
     where it cannot be read. A file larger than :data:`FIGURE_BYTES` is not read."""
     if not isinstance(sha256, str) or p.stat().st_size > FIGURE_BYTES:
         return False
-    return _sha256(p) == sha256
+    return file_sha256(p) == sha256
 
 
 def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
@@ -149,14 +149,15 @@ def damaged_chunks(out: Path) -> str | None:
         if f not in want:
             # no run removes a file it did not write: re-running would not help
             return f"{out / f} is not one of the run's chunk files (added by hand?): move it away"
-        if not (out / f).is_file() or (out / f).is_symlink() or _sha256(out / f) != want[f]:
+        if not (out / f).is_file() or (out / f).is_symlink() or file_sha256(out / f) != want[f]:
             return (
                 f"{out / f} is not the file the run wrote (its sha256 differs); run the study again"
             )
     return None
 
 
-def _sha256(p: Path) -> str:
+def file_sha256(p: Path) -> str:
+    """The sha256 of the file ``p``, read in blocks of 1 MiB."""
     h = hashlib.sha256()
     with open(p, "rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):
@@ -388,7 +389,7 @@ def publish(stage: Path, out: Path) -> None:
     # below leaves them in the staging directory, where the next run must know them for what
     # they are (:mod:`sim.mc.left_behind`), not for an unfinished run of another config
     try:
-        replaced = _sha256(out / "run.json") if read_record(out) is not None else None
+        replaced = file_sha256(out / "run.json") if read_record(out) is not None else None
     except OSError:  # (read a moment ago) a mark the run does without
         replaced = None
     if keep or replaced:

@@ -5,7 +5,6 @@ wrote there is ever replaced) and comparing them with it (the record and the rep
 from __future__ import annotations
 
 import errno
-import hashlib
 import os
 import re
 import subprocess
@@ -19,6 +18,7 @@ from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.overrides import listed, replayable, without
 from sim.mc.paths import link_problem
+from sim.mc.publish import file_sha256
 from sim.mc.storage import LOCK, read_provenance, read_record
 from sim.report.read import check_claims_table
 from sim.report.verify.child import busy_words, launcher, names_one_of, system_error
@@ -312,14 +312,6 @@ def _judge(d: Path, target: Path, sf: Path | None, mode: str, given: list[str]) 
 _TABLE = re.compile(r"[^/\\\x00]+\.parquet")
 
 
-def _sha256(p: Path) -> str:
-    h = hashlib.sha256()
-    with open(p, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def _edited(d: Path) -> str | None:
     """The tables of the committed results ``d`` changed after their run wrote them (their
     sha256 is not the one ``run.json`` records), or None: a verdict edited by hand, rows
@@ -337,7 +329,7 @@ def _edited(d: Path) -> str | None:
             continue  # not a name seal() writes
         p = d / name
         try:
-            if not p.is_file() or p.is_symlink() or _sha256(p) != digest:
+            if not p.is_file() or p.is_symlink() or file_sha256(p) != digest:
                 changed.append(name)
         except OSError:
             changed.append(name)
