@@ -153,3 +153,15 @@ def test_gridplates_chunk_check_uses_the_estimates_memory_model(capsys):
     assert (
         err == "sim: error: chunk: a chunk of 5000 trials needs about 8.6 GB; use a smaller chunk"
     )
+
+
+def test_wolfs_printed_approach_and_format_mark_a_run_off_the_papers_setup(capsys):
+    # before: the schema said the approach side and the P-30 format were "not in the text"
+    # (the paper: "always by approaching grid intersections from the lower right side",
+    # "100-by-150-mm format") and left them unmarked: a run from either side, or of another
+    # format, had its predictions scored as tests of the paper (S33's left item)
+    f = str(STUDIES / "wolf_polynomial.toml")
+    for setting in ("reading.approach=random", "repeat.format_mm=[120.0, 80.0]"):
+        assert main(["check", f, "--set", setting]) == 0
+        out = capsys.readouterr().out
+        assert f"# off the paper's setup ({setting.split('=')[0]} = " in out, out

@@ -319,8 +319,9 @@ SCHEMA = {
 #: Table 1's ten PUG marks): a run with another value is off the paper's setup, its
 #: predictions findings (sim.claims.rules.printed_differs). Not marked: the field amplitudes
 #: (set so that the simulated "before" discrepancies match the printed ones: Monte-Carlo
-#: inputs), the approach side and the P-30 format (not in the text), the unprinted inputs
-#: the region explores (region.toml) and the trade-offs' lists
+#: inputs), the unprinted inputs the region explores (region.toml) and the trade-offs' lists.
+#: The approach side ("always ... from the lower right side") and the P-30 photos' "100-by-150-
+#: mm format" are printed (they were said "not in the text" here and left unmarked: S33)
 PRINTED = (
     "plate.area_mm",
     "plate.spacing_mm",
@@ -332,5 +333,7 @@ PRINTED = (
     "calib.span_weeks",
     "calib.degree",
     "repeat.n_points",
+    "reading.approach",
+    "repeat.format_mm",
 )
 SCHEMA.update({k: printed(SCHEMA[k]) for k in PRINTED})
