@@ -31,9 +31,9 @@ The survey (:data:`SURVEY`: every paper study's keys that a user can change with
   geometry (``datum.*``).
 * wolf_polynomial (seed 000): the 100 x 200 mm area, the 20 mm quadrille, the grid's 1 um,
   line ab's 100 mm, the count's 4 um, three readings, three sets over a month, the cubic,
-  Table 1's ten marks. Not marked: the field amplitudes (set so that the simulated "before"
-  discrepancies match the printed ones), the approach side and the P-30 format (not in the
-  text), the region's inputs, the trade-offs' lists.
+  Table 1's ten marks, the approach from the lower right, the P-30's 100 by 150 mm format.
+  Not marked: the field amplitudes (set so that the simulated "before" discrepancies match
+  the printed ones), the region's inputs, the trade-offs' lists.
 * gridplate_two_plates (seed 001): two plates, the reading's 1.5 um, the comparator's 1.2 um,
   the stated 0.7 um, the first weighting 1:2. Not marked: grid, spacing, readings per point
   (not printed), the region's inputs, the sweeps.
@@ -122,6 +122,8 @@ SURVEY = {
         "calib.span_weeks",
         "calib.degree",
         "repeat.n_points",
+        "reading.approach",
+        "repeat.format_mm",
     },
     "gridplate_two_plates": {
         "plate.count",
