@@ -28,9 +28,9 @@ from sim.claims.provenance import interval_provenance
 from sim.claims.rules import (
     FORMS,
     KINDS,
-    MIN_PLATES,
     VERDICTS,
     decide,
+    few_plates,
     holds_of,
     off_paper,
     printed_differs,
@@ -299,16 +299,9 @@ class ClaimBook:
             # a one-plate claim given no plates (e.g. an exact input) is decided as a value
             rule = "value" if form == "one-plate" and samples is None else form
             n = None if samples is None else int(np.asarray(samples).size)
-            outcome = decide(
-                rule,
-                (float(ci[0]), float(ci[1])),
-                (zlo, zhi),
-                elems=elems,
-                p_plate=p_plate,
-                plates=n,
-            )
-            if n is not None and n < MIN_PLATES:
-                few = f"inconclusive on {n} simulated plates: a verdict over plates needs {MIN_PLATES}"
+            at = (float(ci[0]), float(ci[1]))
+            outcome = decide(rule, at, (zlo, zhi), elems=elems, p_plate=p_plate, plates=n)
+            if few := few_plates(n):
                 note = f"{few}; {note}" if note else few
         verdict = verdict_of(s["kind"], outcome)
         if s["kind"] == "not comparable":

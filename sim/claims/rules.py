@@ -96,6 +96,7 @@ __all__ = [
     "VERDICTS",
     "P_FAIL",
     "MIN_PLATES",
+    "few_plates",
     "zone",
     "decide",
     "verdict_of",
@@ -137,6 +138,14 @@ P_FAIL = 0.05
 #: one side: 2 plates "failed" a claim whose paper plate is typical), nor their 2.5-97.5 %
 #: points the spread of one plate. Fewer: inconclusive (over a region: undecided there)
 MIN_PLATES = 40
+
+
+def few_plates(n: int | None) -> str:
+    """What a claim's note says of a statistic over fewer than :data:`MIN_PLATES` simulated
+    plates (``""``: none given, or enough)."""
+    if n is None or n >= MIN_PLATES:
+        return ""
+    return f"inconclusive on {n} simulated plates: a verdict over plates needs {MIN_PLATES}"
 
 
 def zone(form: str, ref: tuple[float, float], half: float, tol: float) -> tuple[float, float]:
