@@ -170,7 +170,8 @@ def parser(doc: str) -> argparse.ArgumentParser:
         "show",
         help="print one results directory: its claims and verdicts",
         description="Print the claims of one results directory (a table; --markdown: its "
-        "README.md). DIR may also be a study name under results/.",
+        "README.md). DIR may also be a directory name under results/ or scratch/ (where a "
+        "run without --out writes), as its README.md names it.",
     )
     sh.add_argument("dir", metavar="DIR", help="a results directory, e.g. results/brown_table1")
     sh.add_argument("--markdown", action="store_true", help="print the directory's README.md")

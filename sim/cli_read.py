@@ -23,6 +23,10 @@ from sim.studies import STUDY_FILES, design_config, get_study
 
 __all__ = ["show", "report"]
 
+#: where ``sim show NAME`` looks for NAME when it is no directory here: the project's results
+#: and the scratch directories of its runs without ``--out``
+WHERE = (Path("results"), Path("scratch"))
+
 
 def show(args) -> int:
     """``sim show DIR``: the results directory's claims (``--markdown``: its README.md)."""
@@ -31,14 +35,16 @@ def show(args) -> int:
             "DIR", f"not a directory name: {name_problem(args.dir)} (got {args.dir!r})"
         )
     d = Path(args.dir)
-    if not d.exists() and (Path("results") / args.dir).is_dir():
-        d = Path("results") / args.dir
-    if not d.is_dir():  # the name of a study's results is read under ./results too: say so
+    # the name a README.md gives (`sim show NAME` prints it again) is read under ./results and
+    # ./scratch too, where sim run writes without --out (a scratch run's README named a
+    # command that said "does not exist" from the project's root)
+    d = next((b / d for b in WHERE if not d.exists() and (b / d).is_dir()), d)
+    if not d.is_dir():
         what = "is not a directory" if os.path.lexists(d) else "does not exist"
         also = (
             ""
             if d.is_absolute() or d.exists()
-            else f" (nor is there a directory results/{args.dir})"
+            else f" (nor is there a directory {' or '.join(f'{b}/{args.dir}' for b in WHERE)})"
         )
         why = link_problem(d) or f"{what}{also}"
         raise ConfigError("DIR", f"{args.dir} {why}")
