@@ -63,7 +63,9 @@ def test_an_option_typed_with_a_dash_before_the_file_names_the_dash(capsys, argv
 
 def test_a_batch_option_typed_with_a_dash_is_no_study_file(capsys, tmp_path):
     rc = batch.main(["--results", str(tmp_path / "r"), "\u2014jobs", "2", STUDY])
-    line = one_line(capsys, rc, "did you mean --jobs?", "EM DASH is no hyphen", prefix="sim.batch: ")
+    line = one_line(
+        capsys, rc, "did you mean --jobs?", "EM DASH is no hyphen", prefix="sim.batch: "
+    )
     assert "no such study file" not in line, line
 
 

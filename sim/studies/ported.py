@@ -62,7 +62,7 @@ def foreign_key(e: ConfigError, path: str | os.PathLike) -> ConfigError:
                 fix = f'for {value}, write study = "{value}" and {fix}'
             return ConfigError(
                 e.key,
-                "unknown key: a study file names its study by study = \"...\" alone "
+                'unknown key: a study file names its study by study = "..." alone '
                 f"(this file's is {name}; {fix})",
             )
         schema = get_study(name).schema
