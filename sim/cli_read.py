@@ -6,6 +6,7 @@ it is one line naming it (:func:`sim.cli_errors.not_as_written`)."""
 from __future__ import annotations
 
 import os
+import shlex
 import sys
 from pathlib import Path
 
@@ -96,6 +97,12 @@ def report(results: Path) -> int:
         (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
         for d in results_dirs(results)
     ):
+        if any((results / f).is_file() for f in ("claims.parquet", "sweep.parquet")):
+            raise ConfigError(  # "no */claims.parquet" of a directory that holds one
+                "--results",
+                f"{results} is one results directory, not a directory of them: give the "
+                f"directory that holds it (sim show {shlex.quote(str(results))} prints this one)",
+            )
         raise ConfigError(
             "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
         )

@@ -17,6 +17,9 @@ Each class was found false and fixed; each test fails on the code before its fix
   whose config is not the committed one (written to ``scratch/<name>-<hash>/``, the README's
   first run) that command said "does not exist (nor is there a directory results/NAME)" from
   the project's root, where the run was made. ``sim show`` now looks in ``scratch/`` too.
+* ``sim report --results DIR`` of one results directory (``--results /tmp/t1``, the docs'
+  ``--out``) said "no study results in DIR (no */claims.parquet)" of a directory that holds
+  ``claims.parquet``: it is now named as one results directory, not a directory of them.
 """
 
 from __future__ import annotations
@@ -97,3 +100,15 @@ def test_the_show_command_of_a_scratch_runs_readme_works_from_the_root(
     assert main(shlex.split(command)[1:]) == 0, capsys.readouterr().err
     assert "network.mc_agreement" in capsys.readouterr().out
     one_line(capsys, main(["show", "nosuch"]), "results/nosuch or scratch/nosuch")
+
+
+def test_report_of_one_results_directory_names_it_as_such(capsys, tmp_path):
+    (tmp_path / "net.toml").write_text(NET, encoding="utf-8")
+    out = tmp_path / "t1"
+    assert (
+        main(["run", str(tmp_path / "net.toml"), "--out", str(out), "--quiet", "--no-figures"]) == 0
+    )
+    capsys.readouterr()
+    line = one_line(capsys, main(["report", "--results", str(out)]), "is one results directory")
+    assert "no */claims.parquet" not in line and f"sim show {out}" in line, line
+    assert not (out / "REPORT.md").exists()
