@@ -20,6 +20,12 @@ Each class was found false and fixed; each test fails on the code before its fix
 * ``sim report --results DIR`` of one results directory (``--results /tmp/t1``, the docs'
   ``--out``) said "no study results in DIR (no */claims.parquet)" of a directory that holds
   ``claims.parquet``: it is now named as one results directory, not a directory of them.
+* docs/sweeps.md: "a key swept but not given there takes its default ..., and the one-line
+  error says so; give it one of the swept values too". It said so of every refusal of the
+  file's own values: docs/sweeps.md's own example with ``--set trials=1e30`` (or ``seed=-1``,
+  ``chunk=300``) was told to give ``errors.settings, plate.spacing_mm`` one of their swept
+  values, which refuses it all the same. The hint is now given only when a cell's swept
+  values change the refusal.
 """
 
 from __future__ import annotations
@@ -112,3 +118,28 @@ def test_report_of_one_results_directory_names_it_as_such(capsys, tmp_path):
     line = one_line(capsys, main(["report", "--results", str(out)]), "is one results directory")
     assert "no */claims.parquet" not in line and f"sim show {out}" in line, line
     assert not (out / "REPORT.md").exists()
+
+
+#: docs/sweeps.md's example, as written
+SWEEP = """# sweep_plate.toml: Brown's production test over the grid spacing and the settings
+study = "brown_table1"
+trials = 200
+chunk = 10
+[sweep]
+"plate.spacing_mm" = [35.0, 45.0]
+"errors.settings" = [1, 2]
+"""
+
+
+@pytest.mark.parametrize("override", ["trials=1e30", "seed=-1", "chunk=300"])
+def test_a_refusal_no_swept_value_helps_gives_no_sweep_hint(capsys, tmp_path, override):
+    path = tmp_path / "sweep_plate.toml"
+    path.write_text(SWEEP, encoding="utf-8")
+    key = override.split("=")[0]
+    line = one_line(capsys, main(["check", str(path), "--set", override]), prefix=SIM_ERROR + key)
+    assert "[sweep]" not in line and "swept" not in line, line
+    net = tmp_path / "net.toml"  # the hint where it helps: points given only as swept layouts
+    pts = NET.split("points = ")[1].split("generate")[0].strip()
+    text = NET.replace(f"points = {pts}", "") + f"[sweep]\n'network.points' = [{pts}]\n"
+    net.write_text(text, encoding="utf-8")
+    one_line(capsys, main(["check", str(net)]), "is swept but not given there")
