@@ -256,7 +256,7 @@ def _check(args) -> int:
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
     est = estimate(cfg, sweep)
-    check_limits(est)  # the limits sim run applies (SIM_MAX_MEMORY_GB, SIM_MAX_ADJUSTMENTS)
+    check_limits(est, args.max_memory_gb, args.max_adjustments)  # sim run's, at one worker
     check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
     # listed commented out (set, they would be refused); one a sweep's cells read is kept

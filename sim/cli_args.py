@@ -140,13 +140,19 @@ def _run_parser(sub) -> None:
         help="replace results of a different config or code version (only results "
         "directories the suite wrote are ever replaced)",
     )
-    r.add_argument(
+    _limit_options(r)
+
+
+def _limit_options(p) -> None:
+    """The limits of ``sim run``, which ``sim check`` applies too (its refusal over a limit
+    named ``--max-memory-gb``, an option it did not take)."""
+    p.add_argument(
         "--max-memory-gb",
         type=_limit_value,
         default=None,
         help="refuse a run whose estimated memory exceeds this (env SIM_MAX_MEMORY_GB)",
     )
-    r.add_argument(
+    p.add_argument(
         "--max-adjustments",
         type=_limit_value,
         default=None,
@@ -190,6 +196,7 @@ def parser(doc: str) -> argparse.ArgumentParser:
         help="override a config key as sim run --set does (repeatable); --set trials=N shows "
         "the chunk sim run --trials N would pick",
     )
+    _limit_options(c)
     rep = sub.add_parser(
         "report",
         help="rebuild results/REPORT.md and each results/<study>/README.md from the Parquet files",

@@ -26,6 +26,10 @@ Each class was found false and fixed; each test fails on the code before its fix
   ``chunk=300``) was told to give ``errors.settings, plate.spacing_mm`` one of their swept
   values, which refuses it all the same. The hint is now given only when a cell's swept
   values change the refusal.
+* docs/cli.md: "``sim check`` applies the memory and work limits ``sim run`` applies"; its
+  refusal over a limit says "(--max-memory-gb or SIM_MAX_MEMORY_GB)", but ``sim check`` took
+  neither option ("unrecognized arguments: --max-memory-gb"), so a run that ``sim run
+  --max-memory-gb 16`` makes could not be checked with the same limit. It takes both now.
 """
 
 from __future__ import annotations
@@ -143,3 +147,13 @@ def test_a_refusal_no_swept_value_helps_gives_no_sweep_hint(capsys, tmp_path, ov
     text = NET.replace(f"points = {pts}", "") + f"[sweep]\n'network.points' = [{pts}]\n"
     net.write_text(text, encoding="utf-8")
     one_line(capsys, main(["check", str(net)]), "is swept but not given there")
+
+
+def test_check_takes_the_limits_its_refusal_names(capsys, monkeypatch):
+    monkeypatch.setenv("SIM_MAX_MEMORY_GB", "0.001")  # the study needs about 6 MiB
+    line = one_line(capsys, main(["check", STUDY]), "(--max-memory-gb or SIM_MAX_MEMORY_GB)")
+    assert "over the 0.001 GiB limit" in line, line
+    assert main(["check", STUDY, "--max-memory-gb", "1"]) == 0, capsys.readouterr().err
+    assert "# work: 4,000 trials" in capsys.readouterr().out
+    monkeypatch.delenv("SIM_MAX_MEMORY_GB")
+    one_line(capsys, main(["check", STUDY, "--max-adjustments", "10"]), "--max-adjustments")
