@@ -30,6 +30,11 @@ Each class was found false and fixed; each test fails on the code before its fix
   refusal over a limit says "(--max-memory-gb or SIM_MAX_MEMORY_GB)", but ``sim check`` took
   neither option ("unrecognized arguments: --max-memory-gb"), so a run that ``sim run
   --max-memory-gb 16`` makes could not be checked with the same limit. It takes both now.
+* docs/cli.md: "a run over ``--max-memory-gb`` (``SIM_MAX_MEMORY_GB``, default 8) ... stops at
+  once". A network's size check at load read ``SIM_MAX_MEMORY_GB`` alone: ``sim run
+  --max-memory-gb 64`` of a network of 28 GiB was refused at 8 GiB, in ``sim run``, ``sim
+  check`` and ``python -m sim.batch -- --max-memory-gb 64`` alike. It takes the command's
+  option now (and ``sim.load`` names the environment variable, its only limit).
 """
 
 from __future__ import annotations
@@ -42,6 +47,7 @@ import pytest
 from conftest import ROOT
 from oneline import SIM_ERROR, one_line
 
+import sim
 from sim import batch
 from sim.cli import main
 
@@ -157,3 +163,16 @@ def test_check_takes_the_limits_its_refusal_names(capsys, monkeypatch):
     assert "# work: 4,000 trials" in capsys.readouterr().out
     monkeypatch.delenv("SIM_MAX_MEMORY_GB")
     one_line(capsys, main(["check", STUDY, "--max-adjustments", "10"]), "--max-adjustments")
+
+
+def test_a_networks_size_at_load_takes_the_commands_memory_limit(capsys, tmp_path, monkeypatch):
+    net = tmp_path / "net.toml"
+    net.write_text(NET, encoding="utf-8")
+    monkeypatch.setenv("SIM_MAX_MEMORY_GB", "1e-9")  # its state is some kB: over this
+    one_line(capsys, main(["check", str(net)]), "network.generate[0]", "GiB memory limit")
+    assert main(["check", str(net), "--max-memory-gb", "1"]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+    rc = batch.main(["--results", str(tmp_path / "r"), str(net), "--", "--max-memory-gb", "1"])
+    assert rc == 0 and (tmp_path / "r" / "net" / "claims.parquet").is_file(), capsys.readouterr()
+    with pytest.raises(sim.ConfigError, match=r"\(the environment variable SIM_MAX_MEMORY_GB\)"):
+        sim.load(net)
