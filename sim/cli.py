@@ -37,6 +37,7 @@ from sim.ends import stdout_failed
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, config_changes, parse_override
 from sim.mc.estimate import check_limits, estimate
+from sim.mc.memory_limit import memory_given
 from sim.mc.outputs import name_problem
 from sim.mc.overrides import command_values, recorded
 from sim.mc.paths import absolute
@@ -121,7 +122,8 @@ def load_run(args):
             raise ConfigError(opt, f"given twice, as {opt} and as --set {key}=: give one")
     trials = args.trials is not None or "trials" in given
     picks = trials and args.chunk is None and "chunk" not in given  # --trials's chunk
-    return load_picking_chunk(args.study, picks, overrides, args.trials, args.seed)
+    with memory_given(getattr(args, "max_memory_gb", None)):  # a network's size (sim.batch)
+        return load_picking_chunk(args.study, picks, overrides, args.trials, args.seed)
 
 
 def _config_tag(record: dict) -> str:
@@ -256,7 +258,7 @@ def _check(args) -> int:
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
     est = estimate(cfg, sweep)
-    check_limits(est)  # the limits sim run applies (SIM_MAX_MEMORY_GB, SIM_MAX_ADJUSTMENTS)
+    check_limits(est, args.max_memory_gb, args.max_adjustments)  # sim run's, at one worker
     check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
     # listed commented out (set, they would be refused); one a sweep's cells read is kept
@@ -421,6 +423,11 @@ def _main(argv: list[str]) -> int:
 
 
 def _command(args) -> int:
+    with memory_given(getattr(args, "max_memory_gb", None)):  # a network's size at load too
+        return _dispatch(args)
+
+
+def _dispatch(args) -> int:
     if args.cmd == "run":
         return _run(args)
     if args.cmd == "check":

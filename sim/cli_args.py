@@ -140,13 +140,19 @@ def _run_parser(sub) -> None:
         help="replace results of a different config or code version (only results "
         "directories the suite wrote are ever replaced)",
     )
-    r.add_argument(
+    _limit_options(r)
+
+
+def _limit_options(p) -> None:
+    """The limits of ``sim run``, which ``sim check`` applies too (its refusal over a limit
+    named ``--max-memory-gb``, an option it did not take)."""
+    p.add_argument(
         "--max-memory-gb",
         type=_limit_value,
         default=None,
         help="refuse a run whose estimated memory exceeds this (env SIM_MAX_MEMORY_GB)",
     )
-    r.add_argument(
+    p.add_argument(
         "--max-adjustments",
         type=_limit_value,
         default=None,
@@ -170,7 +176,8 @@ def parser(doc: str) -> argparse.ArgumentParser:
         "show",
         help="print one results directory: its claims and verdicts",
         description="Print the claims of one results directory (a table; --markdown: its "
-        "README.md). DIR may also be a study name under results/.",
+        "README.md). DIR may also be a directory name under results/ or scratch/ (where a "
+        "run without --out writes), as its README.md names it.",
     )
     sh.add_argument("dir", metavar="DIR", help="a results directory, e.g. results/brown_table1")
     sh.add_argument("--markdown", action="store_true", help="print the directory's README.md")
@@ -189,6 +196,7 @@ def parser(doc: str) -> argparse.ArgumentParser:
         help="override a config key as sim run --set does (repeatable); --set trials=N shows "
         "the chunk sim run --trials N would pick",
     )
+    _limit_options(c)
     rep = sub.add_parser(
         "report",
         help="rebuild results/REPORT.md and each results/<study>/README.md from the Parquet files",

@@ -6,6 +6,7 @@ it is one line naming it (:func:`sim.cli_errors.not_as_written`)."""
 from __future__ import annotations
 
 import os
+import shlex
 import sys
 from pathlib import Path
 
@@ -23,6 +24,10 @@ from sim.studies import STUDY_FILES, design_config, get_study
 
 __all__ = ["show", "report"]
 
+#: where ``sim show NAME`` looks for NAME when it is no directory here: the project's results
+#: and the scratch directories of its runs without ``--out``
+WHERE = (Path("results"), Path("scratch"))
+
 
 def show(args) -> int:
     """``sim show DIR``: the results directory's claims (``--markdown``: its README.md)."""
@@ -31,14 +36,16 @@ def show(args) -> int:
             "DIR", f"not a directory name: {name_problem(args.dir)} (got {args.dir!r})"
         )
     d = Path(args.dir)
-    if not d.exists() and (Path("results") / args.dir).is_dir():
-        d = Path("results") / args.dir
-    if not d.is_dir():  # the name of a study's results is read under ./results too: say so
+    # the name a README.md gives (`sim show NAME` prints it again) is read under ./results and
+    # ./scratch too, where sim run writes without --out (a scratch run's README named a
+    # command that said "does not exist" from the project's root)
+    d = next((b / d for b in WHERE if not d.exists() and (b / d).is_dir()), d)
+    if not d.is_dir():
         what = "is not a directory" if os.path.lexists(d) else "does not exist"
         also = (
             ""
             if d.is_absolute() or d.exists()
-            else f" (nor is there a directory results/{args.dir})"
+            else f" (nor is there a directory {' or '.join(f'{b}/{args.dir}' for b in WHERE)})"
         )
         why = link_problem(d) or f"{what}{also}"
         raise ConfigError("DIR", f"{args.dir} {why}")
@@ -90,6 +97,12 @@ def report(results: Path) -> int:
         (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
         for d in results_dirs(results)
     ):
+        if any((results / f).is_file() for f in ("claims.parquet", "sweep.parquet")):
+            raise ConfigError(  # "no */claims.parquet" of a directory that holds one
+                "--results",
+                f"{results} is one results directory, not a directory of them: give the "
+                f"directory that holds it (sim show {shlex.quote(str(results))} prints this one)",
+            )
         raise ConfigError(
             "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
         )

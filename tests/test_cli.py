@@ -333,7 +333,8 @@ def test_show_names_both_places_a_study_name_is_looked_for(tmp_path, capsys, mon
     monkeypatch.chdir(tmp_path)
     line = one_line(capsys, main(["show", "nosuch"]))
     assert (
-        line == "sim: error: DIR: nosuch does not exist (nor is there a directory results/nosuch)"
+        line == "sim: error: DIR: nosuch does not exist "
+        "(nor is there a directory results/nosuch or scratch/nosuch)"
     )
     line = one_line(capsys, main(["show", str(tmp_path / "nosuch")]))
     assert line == f"sim: error: DIR: {tmp_path / 'nosuch'} does not exist"

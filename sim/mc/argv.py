@@ -120,7 +120,21 @@ class BoundedParser(argparse.ArgumentParser):
                 f"{n:,} options: at most {MAX_OPTIONS:,} (write the keys into a study file, "
                 "or pass them to the Python API)"
             )
+        self._typed_dashes()
         return super().parse_known_args(args, namespace)
+
+    def _typed_dashes(self) -> None:
+        """Refuse an option typed with a dash that is no hyphen (``—trials``, an em dash)
+        wherever it stands: before the study file (``sim run —trials 40 a.toml``, ``sim show
+        —markdown DIR``) argparse took it for the file and refused "40 a.toml" without a
+        guess, and ``python -m sim.batch —jobs 2 a.toml`` called ``—jobs`` and ``2`` missing
+        study files. A word whose dashes typed as hyphens name no option of the command is
+        left to argparse (``./—x`` names a file that starts with a dash)."""
+        for word in self.given:
+            if word.startswith(tuple(_DASHES)):
+                guess = _guess(word.split("=")[0], self.options())
+                if "is no hyphen" in guess:
+                    self.refuse(f"unrecognized arguments: {word}{guess}")
 
     def options(self) -> set[str]:
         """Every option string of this parser and of the command named in the arguments

@@ -234,7 +234,8 @@ def load_study(
         # and one read from the repository root (Wolf's tables) says so itself
         field = study.schema.get(e.key) if isinstance(e.key, str) else None
         cwd = field is not None and "repository root" not in field.doc
-        raise _unswept(_beside_the_study(e, Path(path), flat) if cwd else e, swept, flat) from None
+        e = _beside_the_study(e, Path(path), flat) if cwd else e
+        raise _unswept(e, swept, flat, study, table) from None
     refuse_unread(
         study.schema,
         cfg,
@@ -264,16 +265,22 @@ def _asked(
     }
 
 
-def _unswept(e: ConfigError, swept: set[str], flat: Mapping[str, Any]) -> ConfigError:
+#: the cells :func:`_unswept` validates to tell whether the sweep bears on a refusal
+CELLS_TRIED = 8
+
+
+def _unswept(e: ConfigError, swept: set[str], flat: Mapping[str, Any], study, table) -> ConfigError:
     """``e``, saying so when a swept key is not given outside ``[sweep]``: the file's own
     values are validated first, as a study of their own, so a network whose points are given
     only as the sweep's layouts was refused "a network needs at least two points"; a key
     refused by those values alone, that a cell would read (``network.constant_mm`` where the
-    file's own observations have no distance), says so too."""
+    file's own observations have no distance), says so too. Only when a cell's swept values
+    change the refusal: ``trials = 1e30`` beside a sweep was told to give the swept keys one of
+    their values, which refuses it all the same."""
     missing = sorted(k for k in swept if k not in flat)
+    if not swept or (not missing and e.key in swept) or not _cell_bears(e, flat, study, table):
+        return e
     if not missing:
-        if not swept or e.key in swept:
-            return e
         return ConfigError(  # a key that one cell reads, refused by the file's own values
             e.key,
             f"{e.detail} (the values outside [sweep] are checked "
@@ -286,6 +293,19 @@ def _unswept(e: ConfigError, swept: set[str], flat: Mapping[str, Any]) -> Config
         f"as a study of their own: {', '.join(missing)} is swept but not given there, so it "
         "takes its default; give it one of the swept values too)",
     )
+
+
+def _cell_bears(e: ConfigError, flat: Mapping[str, Any], study, table) -> bool:
+    """Whether the file's values with a cell's swept values (one of the first
+    :data:`CELLS_TRIED`) are refused otherwise than ``e``, or not at all."""
+    for cell in (_cells(table, study.schema) or [])[:CELLS_TRIED]:
+        try:
+            validate({**flat, **cell}, study.schema, study.check)
+        except ConfigError as again:
+            if (again.key, again.detail) == (e.key, e.detail):
+                continue
+        return True
+    return False
 
 
 def _cells(table: Mapping[str, Any], schema: Mapping[str, Field]) -> list[dict] | None:

@@ -56,11 +56,14 @@ def foreign_key(e: ConfigError, path: str | os.PathLike) -> ConfigError:
         doc = read_toml(path)
         name = doc.get("study")
         value = doc.get(e.key)
-        if isinstance(value, str) and value in MODULES and value != name:  # kind = "network"
+        if isinstance(value, str) and value in MODULES:  # kind = "network"
+            fix = f"leave {e.key} out"  # beside study = "network": "did you mean datum.kind?"
+            if value != name:
+                fix = f'for {value}, write study = "{value}" and {fix}'
             return ConfigError(
                 e.key,
-                f'unknown key: a study file names its study by study = "..." alone (this '
-                f'file\'s is {name}; for {value}, write study = "{value}" and leave {e.key} out)',
+                'unknown key: a study file names its study by study = "..." alone '
+                f"(this file's is {name}; {fix})",
             )
         schema = get_study(name).schema
         keys = list(flatten({k: v for k, v in doc.items() if k not in ("study", "sweep")}))
@@ -110,6 +113,14 @@ def _missing_study(e: ConfigError, path: str | os.PathLike) -> ConfigError:
         doc = read_toml(path)
     except (ConfigError, OSError):
         return e
+    named = [(k, v) for k, v in doc.items() if isinstance(v, str) and v in MODULES]
+    if named:  # kind = "network" for study = "network": it fitted no study (kind is no key)
+        key, value = named[0]
+        return ConfigError(
+            "study",
+            f'missing: a study file names its study by study = "..." alone ({key} = '
+            f'"{value}": write study = "{value}" in its place)',
+        )
     common = ("trials", "seed", "chunk")  # every study's: they tell none apart
     keys = [k for k in flatten({k: v for k, v in doc.items() if k != "sweep"}) if k not in common]
     fits = [s for s, sch in _schemas("").items() if keys and all(k in sch for k in keys)]

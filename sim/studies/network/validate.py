@@ -14,8 +14,8 @@ import math
 import numpy as np
 
 from sim.mc.config import ConfigError, did_you_mean
-from sim.mc.estimate import DEFAULT_MAX_MEMORY_GB, _limit
 from sim.mc.lookalike import differs, skeleton
+from sim.mc.memory_limit import memory_limit_gb
 from sim.mc.network_size import state_bytes
 
 __all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE", "MAX_NAME", "MAX_TITLE", "title"]
@@ -31,8 +31,8 @@ SIGMA_RANGE = {"mm": (1e-9, 1e9), "arcsec": (1e-9, 1e6)}
 
 
 def _memory_limit() -> float:
-    """The memory limit in bytes (``SIM_MAX_MEMORY_GB``, else the default)."""
-    return _limit(None, "SIM_MAX_MEMORY_GB", DEFAULT_MAX_MEMORY_GB, "SIM_MAX_MEMORY_GB") * 2**30
+    """The memory limit in bytes (``--max-memory-gb``, ``SIM_MAX_MEMORY_GB``, the default)."""
+    return memory_limit_gb() * 2**30
 
 
 def _fits(key: str, points: float, obs: float, what: str) -> None:
@@ -48,7 +48,7 @@ def _fits(key: str, points: float, obs: float, what: str) -> None:
         raise ConfigError(
             key,
             f"{what} need about {need / 2**30:.3g} GiB, over the {lim / 2**30:g} GiB memory "
-            "limit (SIM_MAX_MEMORY_GB)",
+            "limit (--max-memory-gb or SIM_MAX_MEMORY_GB)",
         )
 
 
