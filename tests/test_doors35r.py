@@ -7,6 +7,14 @@ defects); one case each, each failed on the code before its fix.
   traceback while building the re-run's command line. Such an override is now refused as
   the other hand-edited ones are: the study fails in one line naming the entry and the
   file, and nothing is re-run.
+* ``sim.load(path, trials=np.timedelta64(40, "s"))`` was a TypeError traceback (NumPy counts a
+  timedelta64 as an integer, whose ``int()`` fails), and ``np.timedelta64(40, "ns")`` or
+  ``np.datetime64(40, "ns")`` (whose ``.item()`` is an int) ran 40 trials without a word; a
+  nearby input of last session's dates and times given to the API. Each is now refused naming
+  the key, as a date is (:func:`sim.mc.pyvalue.as_config_value`).
+* A pyarrow timestamp or duration in nanoseconds that are not whole microseconds (a scalar, an
+  array, a column) was a ValueError traceback of ``sim.load`` ("not safely convertible to
+  microseconds"): now one line naming the key and the value's type.
 """
 
 from __future__ import annotations
@@ -15,10 +23,16 @@ import json
 import shutil
 from pathlib import Path
 
+import numpy as np
+import pyarrow as pa
+import pytest
+
+import sim
 from sim.report.verify import main as verify_main
 
 ROOT = Path(__file__).resolve().parent.parent
 COMMITTED = ROOT / "results" / "brown_table1"
+BROWN = ROOT / "studies" / "brown_table1.toml"
 
 
 def _results(tmp_path: Path, overrides: list[str]) -> Path:
@@ -40,3 +54,36 @@ def test_an_override_with_a_lone_surrogate_is_not_passed_on(tmp_path, capsys):
     assert "its override 'plate.pattern=\"\\ud800\"' is not a value written as a run" in line
     assert "run.json" in line and "(edited by hand?): not re-run" in line
     assert "re-running" not in out.err and not (tmp_path / "S" / "brown_table1").exists()
+
+
+@pytest.mark.parametrize(
+    "value, words",
+    [
+        (np.timedelta64(40, "s"), "timedelta64(40,'s'))"),
+        (np.timedelta64(40, "ns"), "timedelta64(40,'ns'))"),
+        (np.datetime64(40, "ns"), "datetime64('1970-01-01T00:00:00.000000040'))"),
+        (np.datetime64(40, "D"), "(got 1970-02-10)"),  # (held: a date, as TOML writes it)
+    ],
+)
+def test_a_numpy_date_or_duration_is_no_trial_count(value, words):
+    # before: a TypeError traceback (seconds), or 40 trials (nanoseconds)
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(BROWN, trials=value)
+    line = str(e.value)
+    assert line.startswith("trials: must be an integer (got ") and line.endswith(words), line
+
+
+@pytest.mark.parametrize(
+    "value",
+    [
+        pa.scalar(40, type=pa.duration("ns")),
+        pa.scalar(40, type=pa.timestamp("ns")),
+        pa.chunked_array([pa.array([40], type=pa.duration("ns"))]),
+    ],
+    ids=["duration", "timestamp", "column"],
+)
+def test_a_pyarrow_nanosecond_value_is_refused_in_one_line(value):
+    with pytest.raises(sim.ConfigError) as e:  # before: ValueError, "not safely convertible"
+        sim.load(BROWN, trials=value)
+    assert str(e.value).startswith("trials: is a pyarrow "), str(e.value)
+    assert "[ns] value with no Python form: not a config value" in str(e.value)
