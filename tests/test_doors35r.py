@@ -15,6 +15,11 @@ defects); one case each, each failed on the code before its fix.
 * A pyarrow timestamp or duration in nanoseconds that are not whole microseconds (a scalar, an
   array, a column) was a ValueError traceback of ``sim.load`` ("not safely convertible to
   microseconds"): now one line naming the key and the value's type.
+* A network record given to the API with a key that is not a string (``{"name": "P", ...,
+  1: 2.0}``, which no study file can hold) was a TypeError traceback: last session's guess
+  of a misspelt field read the key as text (``normalize() argument 2 must be str``); with a
+  string key beside it, sorting the unknown fields failed; in ``datum.constraints`` it was an
+  AttributeError. A dict's keys must now be strings, refused naming the config key.
 """
 
 from __future__ import annotations
@@ -87,3 +92,35 @@ def test_a_pyarrow_nanosecond_value_is_refused_in_one_line(value):
         sim.load(BROWN, trials=value)
     assert str(e.value).startswith("trials: is a pyarrow "), str(e.value)
     assert "[ns] value with no Python form: not a config value" in str(e.value)
+
+
+NET = """study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+           { name = "B", x_mm = 400.0, y_mm = 0.0, role = "fixed" },
+           { name = "C", x_mm = 400.0, y_mm = 300.0, role = "fixed" },
+           { name = "P", x_mm = 150.0, y_mm = 120.0 } ]
+generate = [ { kind = "distance", from = ["A", "B", "C"], to = "P", sigma_mm = 0.002 } ]
+"""
+
+
+@pytest.mark.parametrize(
+    "key, value",
+    [
+        ("network.points", [{"name": "P", "x_mm": 150.0, "y_mm": 120.0, 1: 2.0}]),
+        ("network.points", [{"name": "P", "x_mm": 150.0, "y_mm": 120.0, 1: 2.0, "zz": 1}]),
+        ("datum.constraints", [{1: 1.0}]),
+    ],
+    ids=["int", "int-and-str", "constraint"],
+)
+def test_a_record_key_that_is_no_string_is_refused(tmp_path, key, value):
+    f = tmp_path / "net.toml"
+    f.write_text(NET, encoding="utf-8")
+    if key == "network.points":  # the file's three fixed pillars, then the record
+        value = [*sim.load(f).config["network.points"][:3], *value]
+    more = {"datum.kind": "constraints"} if key.startswith("datum") else {}
+    with pytest.raises(sim.ConfigError) as e:  # before: TypeError, AttributeError tracebacks
+        sim.load(f, **{key: value}, **more)
+    assert str(e.value) == f"{key}: a table's key must be a string (got 1)"

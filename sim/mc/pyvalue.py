@@ -166,7 +166,10 @@ def _convert(key: str, v: Any) -> Any:
     if isinstance(v, Mapping):
         out = {}
         for k, x in v.items():
-            name = _scalar(key, k) if isinstance(k, str) else k
+            if not isinstance(k, str):  # a study file's tables have names: {1: 2.0} in a
+                # network record was a TypeError traceback (its field guessed, or sorted)
+                raise ConfigError(key, f"a table's key must be a string (got {repr(k)[:60]})")
+            name = _scalar(key, k)
             out[name] = _convert(f"{key}.{name}", x)
         return out
     refuse_big_ints(key, v)  # before int() of a 10**400 IntEnum or Fraction
