@@ -20,6 +20,14 @@ defects); one case each, each failed on the code before its fix.
   of a misspelt field read the key as text (``normalize() argument 2 must be str``); with a
   string key beside it, sorting the unknown fields failed; in ``datum.constraints`` it was an
   AttributeError. A dict's keys must now be strings, refused naming the config key.
+* ``make verify`` of results made with an override the re-run now refuses in one of its
+  entries (``network.points``, refused as ``network.points[3].role: must be one of ...``: a
+  study file or code changed since the run, or a ``run.json`` edited) said only "the re-run
+  exited with 2" (the refusal on standard error, not in the study's lines), and with
+  ``--trials`` ended in exit 2 blaming verify's own options ("the re-run refused its
+  options"): only a refusal naming the override's key itself was known as the override's.
+  An entry or a field of an override's key is now the override's too ("the run's overrides
+  no longer apply ..."), as in 33v.
 """
 
 from __future__ import annotations
@@ -33,6 +41,7 @@ import pyarrow as pa
 import pytest
 
 import sim
+from sim.cli import main
 from sim.report.verify import main as verify_main
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -124,3 +133,31 @@ def test_a_record_key_that_is_no_string_is_refused(tmp_path, key, value):
     with pytest.raises(sim.ConfigError) as e:  # before: TypeError, AttributeError tracebacks
         sim.load(f, **{key: value}, **more)
     assert str(e.value) == f"{key}: a table's key must be a string (got 1)"
+
+
+def test_an_override_refused_in_one_of_its_entries_is_named(tmp_path, capsys):
+    studies, results = tmp_path / "studies", tmp_path / "R"
+    studies.mkdir()
+    (studies / "net.toml").write_text(NET, encoding="utf-8")
+    points = (
+        'network.points=[{ name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" }, '
+        '{ name = "B", x_mm = 400.0, y_mm = 0.0, role = "fixed" }, '
+        '{ name = "C", x_mm = 400.0, y_mm = 300.0, role = "fixed" }, '
+        '{ name = "P", x_mm = 160.0, y_mm = 120.0 }]'
+    )
+    run = ["run", str(studies / "net.toml"), "--set", points, "--out", str(results / "net")]
+    assert main([*run, "--no-figures", "--quiet"]) == 0
+    rec = json.loads((results / "net" / "run.json").read_text(encoding="utf-8"))
+    assert rec["overrides"] == [points]
+    # an entry the code (or the file) refuses now: a role it no longer takes
+    bad = points.replace("y_mm = 120.0 }", 'y_mm = 120.0, role = "fixd" }')
+    (results / "net" / "run.json").write_text(json.dumps({**rec, "overrides": [bad]}))
+    capsys.readouterr()
+    base = ["--results", str(results), "--studies", str(studies), "--no-record"]
+    for more in ([], ["--trials", "400"]):  # before: "exited with 2"; exit 2 with --trials
+        argv = [*base, "--scratch", str(tmp_path / f"S{len(more)}"), *more]
+        assert verify_main(argv) == 1
+        out = capsys.readouterr().out.splitlines()
+        assert out[0] == "net: FAILED; nothing compared", out
+        assert out[1].startswith("  the run's overrides no longer apply: the re-run of "), out
+        assert "(sim: error: network.points[3].role: must be one of free, fixed" in out[1], out
