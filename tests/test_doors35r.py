@@ -28,6 +28,13 @@ defects); one case each, each failed on the code before its fix.
   options"): only a refusal naming the override's key itself was known as the override's.
   An entry or a field of an override's key is now the override's too ("the run's overrides
   no longer apply ..."), as in 33v.
+* An option typed with a word processor's dash where argparse takes it for a file (``sim run
+  —trials 40 x.toml``: the study file; ``python -m sim.batch —jobs 2 x.toml``: two study
+  files) was answered "unrecognized arguments: 40 x.toml" (the study file named as the
+  unrecognized one), or "—jobs: no such study file" and "2: no such study file": lead33's
+  guess (``did you mean --trials? U+2014 EM DASH is no hyphen``) came only when argparse left
+  the word unrecognized. Such a word is now refused in one line with that guess wherever
+  it stands (:class:`sim.mc.argv.BoundedParser`).
 """
 
 from __future__ import annotations
@@ -161,3 +168,27 @@ def test_an_override_refused_in_one_of_its_entries_is_named(tmp_path, capsys):
         assert out[0] == "net: FAILED; nothing compared", out
         assert out[1].startswith("  the run's overrides no longer apply: the re-run of "), out
         assert "(sim: error: network.points[3].role: must be one of free, fixed" in out[1], out
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["run", "—trials", "40", str(BROWN)], "sim run: —trials: not an option (did you mean"),
+        (["check", "–set", "trials=40", str(BROWN)], "sim check: –set: not an option (did you"),
+        (["run", "—trials"], "sim run: —trials: not an option (did you mean --trials?"),
+    ],
+)
+def test_an_option_with_a_typographic_dash_taken_for_a_file_is_named(capsys, argv, words):
+    assert main(argv) == 2  # before: "unrecognized arguments: 40 ...", "no such study file"
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith(f"sim: error: {words}") and "DASH is no hyphen: type -)" in line, line
+
+
+def test_a_batch_option_with_a_typographic_dash_is_named(tmp_path, capsys):
+    from sim.batch import main as batch_main
+
+    argv = ["—jobs", "2", str(BROWN), "--results", str(tmp_path / "r")]
+    assert batch_main(argv) == 2  # before: two lines, "—jobs: no such study file", "2: ..."
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith("sim.batch: —jobs: not an option (did you mean --jobs? U+2014"), line
+    assert not (tmp_path / "r").exists()
