@@ -35,6 +35,10 @@ defects); one case each, each failed on the code before its fix.
   guess (``did you mean --trials? U+2014 EM DASH is no hyphen``) came only when argparse left
   the word unrecognized. Such a word is now refused in one line with that guess wherever
   it stands (:class:`sim.mc.argv.BoundedParser`).
+* (Older than the session, found beside it.) ``make verify --scratch DIR`` over an earlier
+  re-run whose ``run.json`` lists its files as no list of paths (``"files": 5``, edited by
+  hand) was a TypeError traceback; it is refused in one line naming the ``run.json``,
+  nothing replaced.
 """
 
 from __future__ import annotations
@@ -192,3 +196,17 @@ def test_a_batch_option_with_a_typographic_dash_is_named(tmp_path, capsys):
     (line,) = capsys.readouterr().err.splitlines()
     assert line.startswith("sim.batch: —jobs: not an option (did you mean --jobs? U+2014"), line
     assert not (tmp_path / "r").exists()
+
+
+@pytest.mark.parametrize("files", [5, [1, "claims.parquet"]], ids=["int", "int-entry"])
+def test_a_scratch_rerun_whose_file_list_is_no_list_is_refused(tmp_path, capsys, files):
+    results = _results(tmp_path, [])
+    old = tmp_path / "S" / "brown_table1"  # an earlier re-run under --scratch, edited
+    shutil.copytree(results / "brown_table1", old)
+    rec = json.loads((old / "run.json").read_text(encoding="utf-8"))
+    (old / "run.json").write_text(json.dumps({**rec, "files": files}), encoding="utf-8")
+    argv = ["--results", str(results), "--scratch", str(tmp_path / "S"), "--no-record"]
+    assert verify_main(argv) == 2  # before: TypeError / AttributeError traceback
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith(f"sim verify: error: --scratch: {old / 'run.json'} lists no files")
+    assert sorted(p.name for p in old.iterdir()) == sorted(p.name for p in results.glob("*/*"))
