@@ -188,6 +188,13 @@ def test_an_option_with_a_typographic_dash_taken_for_a_file_is_named(capsys, arg
     assert line.startswith(f"sim: error: {words}") and "DASH is no hyphen: type -)" in line, line
 
 
+def test_a_dashed_word_given_as_an_options_value_is_left_to_it(capsys):
+    # held: a --set value is its key's ("—trials: unknown key"), not an option's
+    assert main(["check", str(BROWN), "--set", "—trials=40"]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line == "sim: error: —trials: unknown key (did you mean trials?)", line
+
+
 def test_a_batch_option_with_a_typographic_dash_is_named(tmp_path, capsys):
     from sim.batch import main as batch_main
 

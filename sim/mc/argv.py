@@ -131,8 +131,12 @@ class BoundedParser(argparse.ArgumentParser):
         "unrecognized arguments: 40 x.toml", or "—jobs: no such study file" and "2: no such
         study file", the dash unnamed: lead33 named it only in a word left ``extras``
         (unrecognized), where :meth:`explain` still does."""
-        for word in self.given:
-            if word[:1] not in _DASHES or word in extras:
+        acts = self._acts()
+        for before, word in zip(["", *self.given], self.given):
+            if word == "--":  # the rest are values (sim.batch's run options: checked there)
+                return
+            takes = before in acts and acts[before].nargs != 0  # --set —x=1: its key's problem
+            if word[:1] not in _DASHES or word in extras or takes:
                 continue
             if "is no hyphen" in (guess := _guess(word.split("=")[0], self.options())):
                 self.error(f"{word}: not an option{guess}")
@@ -140,12 +144,16 @@ class BoundedParser(argparse.ArgumentParser):
     def options(self) -> set[str]:
         """Every option string of this parser and of the command named in the arguments
         being read (``sim run ... --tri``: the options of ``run``)."""
-        known = set(self._option_string_actions)
+        return set(self._acts())
+
+    def _acts(self) -> dict:
+        """The actions of :meth:`options`, by option string."""
+        known = dict(self._option_string_actions)
         for a in self._actions:
             if isinstance(a, argparse._SubParsersAction):
                 cmd = next((w for w in getattr(self, "given", []) if w in a.choices), None)
                 if cmd is not None:
-                    known |= set(a.choices[cmd]._option_string_actions)
+                    known.update(a.choices[cmd]._option_string_actions)
         return known
 
     def explain(self, message: str) -> str:
