@@ -120,31 +120,40 @@ class BoundedParser(argparse.ArgumentParser):
                 f"{n:,} options: at most {MAX_OPTIONS:,} (write the keys into a study file, "
                 "or pass them to the Python API)"
             )
-        self._typed_dashes()
-        return super().parse_known_args(args, namespace)
+        out = super().parse_known_args(args, namespace)
+        self._dashed(out[1])
+        return out
 
-    def _typed_dashes(self) -> None:
-        """Refuse an option typed with a dash that is no hyphen (``—trials``, an em dash)
-        wherever it stands: before the study file (``sim run —trials 40 a.toml``, ``sim show
-        —markdown DIR``) argparse took it for the file and refused "40 a.toml" without a
-        guess, and ``python -m sim.batch —jobs 2 a.toml`` called ``—jobs`` and ``2`` missing
-        study files. A word whose dashes typed as hyphens name no option of the command is
-        left to argparse (``./—x`` names a file that starts with a dash)."""
-        for word in self.given:
-            if word.startswith(tuple(_DASHES)):
-                guess = _guess(word.split("=")[0], self.options())
-                if "is no hyphen" in guess:
-                    self.refuse(f"unrecognized arguments: {word}{guess}")
+    def _dashed(self, extras: list) -> None:
+        """Refuse a word typed with a word processor's dash that spells an option of this
+        parser and that argparse took for a value (``sim run —trials 40 x.toml``: the study
+        file; ``python -m sim.batch —jobs 2 x.toml``: two study files). It said
+        "unrecognized arguments: 40 x.toml", or "—jobs: no such study file" and "2: no such
+        study file", the dash unnamed: lead33 named it only in a word left ``extras``
+        (unrecognized), where :meth:`explain` still does."""
+        acts = self._acts()
+        for before, word in zip(["", *self.given], self.given):
+            if word == "--":  # the rest are values (sim.batch's run options: checked there)
+                return
+            takes = before in acts and acts[before].nargs != 0  # --set —x=1: its key's problem
+            if word[:1] not in _DASHES or word in extras or takes:
+                continue
+            if "is no hyphen" in (guess := _guess(word.split("=")[0], self.options())):
+                self.error(f"{word}: not an option{guess}")
 
     def options(self) -> set[str]:
         """Every option string of this parser and of the command named in the arguments
         being read (``sim run ... --tri``: the options of ``run``)."""
-        known = set(self._option_string_actions)
+        return set(self._acts())
+
+    def _acts(self) -> dict:
+        """The actions of :meth:`options`, by option string."""
+        known = dict(self._option_string_actions)
         for a in self._actions:
             if isinstance(a, argparse._SubParsersAction):
                 cmd = next((w for w in getattr(self, "given", []) if w in a.choices), None)
                 if cmd is not None:
-                    known |= set(a.choices[cmd]._option_string_actions)
+                    known.update(a.choices[cmd]._option_string_actions)
         return known
 
     def explain(self, message: str) -> str:

@@ -97,6 +97,8 @@ def _problem(text: Any, config: Mapping[str, Any], seen: set[str]) -> str | None
     """Why ``text`` is no override :func:`replayable` passes on, or None."""
     if not isinstance(text, str) or "=" not in text:
         return "is not KEY=VALUE"
+    if not _utf8(text):  # a lone surrogate ("\ud800" in JSON): no argument of a command line
+        return "is not a value written as a run writes it (a character that is not UTF-8 text)"
     key = text.split("=", 1)[0]
     if not _KEY.fullmatch(key) or key not in config or key in ("study", "sweep"):
         return "does not set a key of its config"
@@ -109,3 +111,14 @@ def _problem(text: Any, config: Mapping[str, Any], seen: set[str]) -> str | None
     except (ConfigError, TypeError, ValueError, RecursionError):
         same = False
     return None if same else "is not a value written as a run writes it"
+
+
+def _utf8(text: str) -> bool:
+    """Whether ``text`` is UTF-8 text (no lone surrogate, which a run never records: its
+    re-run's command line, ``"\\ud800"`` of a ``run.json`` edited by hand, was a
+    UnicodeEncodeError traceback of ``make verify``)."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True

@@ -78,6 +78,12 @@ def _nearest(key: str, v: Any, x: float) -> float:
 def _scalar(key: str, v: Any) -> Any:
     if isinstance(v, (bool, np.bool_)):
         return bool(v)
+    if isinstance(v, (np.datetime64, np.timedelta64)):  # a date or a duration, no number:
+        # refused by the key. np.timedelta64 is a NumPy integer: int() of one in seconds was a
+        # TypeError traceback, and one in nanoseconds (as a datetime64's .item()) its count:
+        # trials=np.timedelta64(40, "ns") ran 40 trials
+        x = v.item()
+        return as_written(x) if isinstance(x, (datetime.date, datetime.time)) else v
     if isinstance(v, numbers.Integral):  # int subclasses, IntEnum, NumPy integers
         return int(v)
     if isinstance(v, np.floating):  # the decimal number it prints (float32(0.1) is 0.1);
@@ -122,10 +128,15 @@ def as_config_value(key: str, v: Any) -> Any:
 
 
 def _convert(key: str, v: Any) -> Any:
-    if isinstance(v, (pa.Array, pa.ChunkedArray)):
-        return _convert(key, v.to_pylist())
-    if isinstance(v, pa.Scalar):
-        return _convert(key, v.as_py())
+    if isinstance(v, (pa.Array, pa.ChunkedArray, pa.Scalar)):
+        try:
+            py = v.as_py() if isinstance(v, pa.Scalar) else v.to_pylist()
+        except (ValueError, pa.ArrowException):  # a timestamp or duration in ns (not whole
+            # microseconds) was a ValueError traceback; no key takes a date or a duration
+            raise ConfigError(
+                key, f"is a pyarrow {v.type} value with no Python form: not a config value"
+            ) from None
+        return _convert(key, py)
     if not isinstance(v, (np.ndarray, np.generic, str, bytes, Mapping)) and hasattr(
         type(v), "__array__"
     ):
@@ -155,7 +166,10 @@ def _convert(key: str, v: Any) -> Any:
     if isinstance(v, Mapping):
         out = {}
         for k, x in v.items():
-            name = _scalar(key, k) if isinstance(k, str) else k
+            if not isinstance(k, str):  # a study file's tables have names: {1: 2.0} in a
+                # network record was a TypeError traceback (its field guessed, or sorted)
+                raise ConfigError(key, f"a table's key must be a string (got {repr(k)[:60]})")
+            name = _scalar(key, k)
             out[name] = _convert(f"{key}.{name}", x)
         return out
     refuse_big_ints(key, v)  # before int() of a 10**400 IntEnum or Fraction

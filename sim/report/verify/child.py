@@ -70,9 +70,13 @@ def busy_words(line: str, target: Path) -> str | None:
 
 
 def names_one_of(line: str, overrides: list[str] | tuple) -> bool:
-    """Whether the re-run's error line (``sim: error: KEY: ...``) names a key of ``overrides``."""
+    """Whether the re-run's error line (``sim: error: KEY: ...``) names a key of ``overrides``,
+    or an entry or a field of one (``network.points[3].role`` of ``network.points``: it was
+    "the re-run exited with 2", and with ``--trials`` "the re-run refused its options")."""
     m = re.match(r"sim: error: ([^:\s]+): ", line)
-    return bool(m) and m[1] in keys_of(list(overrides))
+    return bool(m) and any(
+        m[1] == k or m[1].startswith((f"{k}[", f"{k}.")) for k in keys_of(list(overrides))
+    )
 
 
 def system_error(line: str) -> bool:

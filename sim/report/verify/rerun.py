@@ -78,7 +78,13 @@ def _target(scratch: Path, name: str) -> tuple[Path, bool]:
         return target, False
     record = read_record(target) if target.is_dir() and not target.is_symlink() else None
     if record is not None:
-        listed = {f.split("/")[0] for f in record.get("files", [])}  # what its run wrote
+        files = record.get("files")  # what its run wrote: a list of paths
+        if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
+            raise VerifyError(  # edited by hand ("files": 5 was a TypeError traceback)
+                f"--scratch: {target / 'run.json'} lists no files its run wrote (edited by "
+                "hand?): refusing to replace the directory; remove it or choose another --scratch"
+            )
+        listed = {f.split("/")[0] for f in files}
         foreign = [p.name for p in target.iterdir() if not _ours(p) and p.name not in listed]
         if foreign:
             raise VerifyError(
