@@ -29,6 +29,7 @@ from sim.mc.paths import absolute
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
 from sim.mc.sweep import read_sweep
+from sim.places import base
 from sim.report.read import mixed_table
 from sim.studies import get_study
 
@@ -178,10 +179,10 @@ def _replaces_project_results(f: Path, results: Path) -> str | None:
     name (``results/<stem>``, made from ``studies/<stem>.toml`` of the working directory) with
     the results of another file of that name (a study author's own ``brown_table1.toml``):
     each run is ``--overwrite``, and the committed results were silently replaced."""
-    own = Path("studies") / f"{f.stem}.toml"
+    own = base() / "studies" / f"{f.stem}.toml"  # the project's from a directory inside it
     try:
         target = (results / f.stem).resolve()
-        if target != (Path("results") / f.stem).resolve() or not own.is_file():
+        if target != (base() / "results" / f.stem).resolve() or not own.is_file():
             return None
         if f.resolve() == own.resolve():
             return None

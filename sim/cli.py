@@ -45,6 +45,7 @@ from sim.mc.read_when import read_in_a_cell
 from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
+from sim.places import base, shown_path
 from sim.report.run_summary import off_setup, terminal_summary, write_run_readme
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
 from sim.studies import design_config, get_study, unread_keys
@@ -146,46 +147,47 @@ def _default_out(cfg: dict, sweep: dict, path: Path) -> tuple[Path, str, bool]:
     shown path, overwrite)``; a scratch directory is replaced freely. (By the study kind,
     ``studies/network_brown.toml`` wrote into a new ``results/network/``.) In the project's
     root a new ``results/<name>`` is made for its ``studies/<name>.toml`` only: an author's
-    ``my_net.toml`` went into the committed results, REPORT.md and ``make verify``."""
-    name = path.stem
-    if not (Path("results") / name).exists() and (Path("results") / cfg["study"]).exists():
+    ``my_net.toml`` went into the committed results, REPORT.md and ``make verify``. Both are
+    the project's from a directory inside it (:func:`sim.places.base`: ``docs/results/<name>``
+    was made, or a ``run.json`` in a study's package that made its results stale)."""
+    name, at = path.stem, base()
+    if not (at / "results" / name).exists() and (at / "results" / cfg["study"]).exists():
         name = cfg["study"]  # a copy of a study file under another name
-    committed = Path("results") / name
+    committed = at / "results" / name
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
         "code_hash": code_hash(cfg["study"]),
     }
     old = read_record(committed)
-    if not committed.exists() and not _project_file(path, name):
-        scratch = Path("scratch") / f"{name}-{_config_tag(record)}"
+    scratch = at / "scratch" / f"{name}-{_config_tag(record)}"
+    if not committed.exists() and not _project_file(path, name, at):
         print(
-            f"sim: {path} is not the project's studies/{name}.toml: writing to {scratch}/ "
-            "(--out DIR to choose; results/ holds the project's studies)",
+            f"sim: {path} is not the project's studies/{name}.toml: writing to "
+            f"{shown_path(scratch)}/ (--out DIR to choose; results/ holds the project's studies)",
             file=sys.stderr,
         )
-        return Path(os.path.abspath(scratch)), str(scratch), True
+        return Path(os.path.abspath(scratch)), shown_path(scratch), True
     if not committed.exists() or (
         old is not None
         and old.get("config") == record["config"]
         and old.get("code_hash") == record["code_hash"]
     ):
-        return Path(os.path.abspath(committed)), str(committed), False
-    scratch = Path("scratch") / f"{name}-{_config_tag(record)}"
+        return Path(os.path.abspath(committed)), shown_path(committed), False
     why = _differs(old, record) if old is not None else "it is not a results directory of sim"
     print(
-        f"sim: {committed}/ holds the committed results and {why}: writing to {scratch}/ "
-        "(--out DIR to choose; make reproduce rewrites results/)",
+        f"sim: {shown_path(committed)}/ holds the committed results and {why}: writing to "
+        f"{shown_path(scratch)}/ (--out DIR to choose; make reproduce rewrites results/)",
         file=sys.stderr,
     )
-    return Path(os.path.abspath(scratch)), str(scratch), True
+    return Path(os.path.abspath(scratch)), shown_path(scratch), True
 
 
-def _project_file(path: Path, name: str) -> bool:
-    """Whether ``path`` may make ``results/<name>``: it is ``studies/<name>.toml``, or the
-    working directory is no project's root (no ``studies/``: its ``results/`` is the user's)."""
-    own = Path("studies") / f"{name}.toml"
+def _project_file(path: Path, name: str, at: Path) -> bool:
+    """Whether ``path`` may make ``results/<name>`` in ``at``: it is ``studies/<name>.toml``, or
+    ``at`` is no project's root (no ``studies/``: its ``results/`` is the user's)."""
+    own = at / "studies" / f"{name}.toml"
     try:
-        return not Path("studies").is_dir() or path.resolve() == own.resolve()
+        return not (at / "studies").is_dir() or path.resolve() == own.resolve()
     except (OSError, RuntimeError):
         return False
 
@@ -428,6 +430,8 @@ def _command(args) -> int:
     if args.cmd == "show":
         return show(args)
     if args.cmd == "report":
+        if args.results is None:  # from a directory inside the project (docs/): the project's
+            args.results = shown_path(base() / "results")
         if name_problem(args.results):
             why = name_problem(args.results)
             raise ConfigError("--results", f"not a directory name: {why} (got {args.results!r})")

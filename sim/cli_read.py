@@ -16,6 +16,7 @@ from sim.mc.config import ConfigError
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.storage import umask_problem
+from sim.places import base, shown_path
 from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
@@ -30,16 +31,12 @@ def show(args) -> int:
         raise ConfigError(
             "DIR", f"not a directory name: {name_problem(args.dir)} (got {args.dir!r})"
         )
-    d = Path(args.dir)
-    if not d.exists() and (Path("results") / args.dir).is_dir():
-        d = Path("results") / args.dir
+    d, under = Path(args.dir), Path(shown_path(base() / "results")) / args.dir
+    if not d.exists() and under.is_dir():  # the project's results/, from docs/ too
+        d = under
     if not d.is_dir():  # the name of a study's results is read under ./results too: say so
         what = "is not a directory" if os.path.lexists(d) else "does not exist"
-        also = (
-            ""
-            if d.is_absolute() or d.exists()
-            else f" (nor is there a directory results/{args.dir})"
-        )
+        also = "" if d.is_absolute() or d.exists() else f" (nor is there a directory {under})"
         why = link_problem(d) or f"{what}{also}"
         raise ConfigError("DIR", f"{args.dir} {why}")
     check_claims_table(d / "claims.parquet", "DIR")
@@ -86,6 +83,8 @@ def _sweep_of(d: Path) -> Path | None:
 def report(results: Path) -> int:
     """``sim report``: only over a directory that holds study results (a directory of the
     user's with none gets no REPORT.md written into it)."""
+    if not os.path.lexists(results):  # from / or $HOME: not "is not a results directory"
+        raise ConfigError("--results", f"{results} does not exist (in {os.getcwd()})")
     if results.is_dir() and not any(
         (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
         for d in results_dirs(results)

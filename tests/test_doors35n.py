@@ -1,0 +1,120 @@
+"""The classes of the sweep doors35n (brief N35: a new user's first hour, done carelessly:
+study files copied and run from other directories, commands run from a subdirectory of the
+project, from ``/`` and from ``$HOME``), one case each; each failed on the code before its fix.
+
+* ``sim run ../studies/brown_table1.toml`` from a directory inside the project (``docs/``,
+  ``studies/``, ``results/``) took its default output in that directory: it made
+  ``docs/results/brown_table1/`` (a results directory among the sources) and said "results in
+  results/brown_table1/", which the user read as the project's committed results; from
+  ``sim/studies/network/`` (reading the code) the run's ``run.json`` landed inside the study's
+  package, whose data files are part of its code hash, so every committed network result read
+  stale (``sim show``'s note; ``make reproduce`` re-ran them all). The defaults of ``sim run``
+  (``results/<name>``, ``scratch/<name>-<hash>``), ``sim report`` and ``python -m sim.batch``
+  (``--results``) are now the project's from any directory inside it, shown relative to the
+  working directory (:func:`sim.places.base`).
+* ``--out`` (or the API's ``out``) inside the suite's package ``sim/`` was accepted, with the
+  same stale code hash: refused in one line naming it (:func:`sim.places.check_not_in_code`).
+* ``sim report`` from a directory without ``results/`` (``/``, ``$HOME``) said "results is not
+  a results directory" of a directory that does not exist: it now says it does not exist, and
+  where it was looked for.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim.cli import _default_out
+from sim.studies import load_study
+
+ROOT = Path(__file__).resolve().parent.parent
+NET = ROOT / "studies" / "network_plate.toml"
+
+
+def _sim(*args, cwd):
+    return subprocess.run(
+        [sys.executable, "-m", "sim", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=300,
+    )
+
+
+def test_default_output_from_inside_the_project_is_the_projects(monkeypatch, capsys):
+    """From ``docs/`` a run of other values goes to the project's ``scratch/``, and one of
+    the committed config to the project's ``results/``, never to ``docs/results/``; from a
+    study's package likewise (nothing is run here: the default is only resolved)."""
+    _, cfg = load_study(NET, trials=40, overrides=["chunk=2"])
+    monkeypatch.chdir(ROOT / "docs")
+    out, shown, scratch = _default_out(cfg, {}, Path("../studies/network_plate.toml"))
+    assert out.parent == ROOT / "scratch" and out.name.startswith("network_plate-"), out
+    assert shown == f"../scratch/{out.name}" and scratch
+    assert "../results/network_plate/ holds the committed results" in capsys.readouterr().err
+    assert not (ROOT / "docs" / "results").exists()
+    _, cfg = load_study(NET)  # the committed config: its own results, as from the root
+    monkeypatch.chdir(ROOT / "sim" / "studies" / "network")
+    out, shown, scratch = _default_out(cfg, {}, NET)
+    assert (out, shown, scratch) == (
+        ROOT / "results" / "network_plate",
+        "../../../results/network_plate",
+        False,
+    )
+
+
+def test_batch_and_show_from_inside_the_project(tmp_path):
+    """From ``docs/``: ``python -m sim.batch`` of a file of the user's named like a project
+    study is refused before any run (it would replace ``../results/brown_table1``: it ran into
+    ``docs/results/``), and ``sim show brown_table1`` reads the project's results."""
+    mine = tmp_path / "brown_table1.toml"
+    mine.write_text((ROOT / "studies" / "brown_table1.toml").read_text() + "\n# mine\n")
+    r = subprocess.run(
+        [sys.executable, "-m", "sim.batch", str(mine), "--", "--trials", "40", "--no-figures"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT / "docs",
+        timeout=300,
+    )
+    assert r.returncode == 2 and "would replace ../results/brown_table1" in r.stderr, r
+    assert not (ROOT / "docs" / "results").exists()
+    r = _sim("show", "brown_table1", cwd=ROOT / "docs")
+    assert r.returncode == 0 and "brown.table1_closure.dof" in r.stdout, r
+
+
+def test_out_inside_the_suites_code_is_refused(tmp_path):
+    """``--out sim/studies/network/x`` and ``run(out=...)`` there: one line, nothing written."""
+    target = ROOT / "sim" / "studies" / "network" / "doors35n-out"
+    try:
+        r = _sim(
+            "run",
+            NET,
+            "--trials",
+            "40",
+            "--chunk",
+            "2",
+            "--quiet",
+            "--out",
+            "sim/studies/network/doors35n-out",
+            cwd=ROOT,
+        )
+        assert r.returncode == 2 and r.stdout == "", r
+        assert r.stderr.count("\n") == 1 and "lies inside the suite's code" in r.stderr, r.stderr
+        assert r.stderr.startswith("sim: error: --out: sim/studies/network/doors35n-out ")
+        with pytest.raises(sim.ConfigError, match="^out: .* lies inside the suite's code"):
+            sim.load(NET, trials=40, chunk=2).run(out=target, quiet=True)
+        assert not target.exists() and not target.with_name(".doors35n-out.partial").exists()
+    finally:  # before the fix the run wrote there: never leave it in the package
+        for p in (target, target.with_name(".doors35n-out.partial")):
+            if p.exists():
+                subprocess.run(["rm", "-rf", str(p)], check=False)
+
+
+def test_report_where_there_is_no_results_directory(tmp_path):
+    """``sim report`` in a directory of the user's without ``results/``: it does not exist."""
+    r = _sim("report", cwd=tmp_path)
+    assert r.returncode == 2, r
+    assert r.stderr == f"sim: error: --results: results does not exist (in {tmp_path})\n"
