@@ -12,6 +12,10 @@ project, from ``/`` and from ``$HOME``), one case each; each failed on the code 
   (``results/<name>``, ``scratch/<name>-<hash>``), ``sim report`` and ``python -m sim.batch``
   (``--results``) are now the project's from any directory inside it, shown relative to the
   working directory (:func:`sim.places.base`).
+* ``sim run studies/network_plate.toml --no-figures`` (the committed config, for speed)
+  replaced the committed results: their PNG files deleted (tracked files; the README shows
+  one of brown_dilution's), ``run.json`` saying ``"figures": false``, so ``make reproduce``
+  took them as stale. Such a run now goes to ``scratch/`` and says why.
 * ``--out`` (or the API's ``out``) inside the suite's package ``sim/`` was accepted, with the
   same stale code hash: refused in one line naming it (:func:`sim.places.check_not_in_code`).
 * ``sim report`` from a directory without ``results/`` (``/``, ``$HOME``) said "results is not
@@ -21,6 +25,8 @@ project, from ``/`` and from ``$HOME``), one case each; each failed on the code 
 
 from __future__ import annotations
 
+import contextlib
+import io
 import subprocess
 import sys
 from pathlib import Path
@@ -28,8 +34,8 @@ from pathlib import Path
 import pytest
 
 import sim
-from sim.cli import _default_out
-from sim.studies import load_study
+import sim.cli
+from sim.mc.config import ConfigError
 
 ROOT = Path(__file__).resolve().parent.parent
 NET = ROOT / "studies" / "network_plate.toml"
@@ -45,25 +51,46 @@ def _sim(*args, cwd):
     )
 
 
-def test_default_output_from_inside_the_project_is_the_projects(monkeypatch, capsys):
+def _run_goes_to(monkeypatch, cwd: Path, *argv: str) -> tuple[Path, str, str]:
+    """Where ``sim run ARGV`` in ``cwd`` would write (its ``out`` and the path it shows) and
+    its standard error; nothing is run (the run itself is stopped)."""
+    seen = {}
+
+    def stop(study, cfg, sweep, out, shown, **kw):
+        seen.update(out=out, shown=shown)
+        raise ConfigError(None, "stopped by the test")
+
+    monkeypatch.setattr(sim.cli, "execute", stop)
+    monkeypatch.chdir(cwd)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        assert sim.cli.main(["run", *argv, "--quiet"]) == 2
+    return seen["out"], seen["shown"], err.getvalue()
+
+
+def test_default_output_from_inside_the_project_is_the_projects(monkeypatch):
     """From ``docs/`` a run of other values goes to the project's ``scratch/``, and one of
     the committed config to the project's ``results/``, never to ``docs/results/``; from a
-    study's package likewise (nothing is run here: the default is only resolved)."""
-    _, cfg = load_study(NET, trials=40, overrides=["chunk=2"])
-    monkeypatch.chdir(ROOT / "docs")
-    out, shown, scratch = _default_out(cfg, {}, Path("../studies/network_plate.toml"))
-    assert out.parent == ROOT / "scratch" and out.name.startswith("network_plate-"), out
-    assert shown == f"../scratch/{out.name}" and scratch
-    assert "../results/network_plate/ holds the committed results" in capsys.readouterr().err
-    assert not (ROOT / "docs" / "results").exists()
-    _, cfg = load_study(NET)  # the committed config: its own results, as from the root
-    monkeypatch.chdir(ROOT / "sim" / "studies" / "network")
-    out, shown, scratch = _default_out(cfg, {}, NET)
-    assert (out, shown, scratch) == (
-        ROOT / "results" / "network_plate",
-        "../../../results/network_plate",
-        False,
+    study's package likewise."""
+    out, shown, err = _run_goes_to(
+        monkeypatch, ROOT / "docs", "../studies/network_plate.toml", "--trials", "40"
     )
+    assert out.parent == ROOT / "scratch" and out.name.startswith("network_plate-"), out
+    assert shown == f"../scratch/{out.name}", shown
+    assert "../results/network_plate/ holds the committed results" in err
+    out, shown, _ = _run_goes_to(monkeypatch, ROOT / "sim" / "studies" / "network", str(NET))
+    assert (out, shown) == (ROOT / "results" / "network_plate", "../../../results/network_plate")
+    assert not (ROOT / "docs" / "results").exists()
+
+
+def test_no_figures_never_replaces_committed_figures(monkeypatch):
+    """``sim run studies/network_plate.toml --no-figures``: the committed config, but its
+    figures would be deleted (and the results made stale): it goes to ``scratch/``."""
+    out, shown, err = _run_goes_to(monkeypatch, ROOT, str(NET), "--no-figures")
+    assert out.parent == ROOT / "scratch" and shown.startswith("scratch/network_plate-"), out
+    assert "its figures would be deleted by --no-figures" in err, err
+    out, _, _ = _run_goes_to(monkeypatch, ROOT, str(NET))  # with figures: the committed run
+    assert out == ROOT / "results" / "network_plate"
 
 
 def test_batch_and_show_from_inside_the_project(tmp_path):
