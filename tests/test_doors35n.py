@@ -18,6 +18,9 @@ project, from ``/`` and from ``$HOME``), one case each; each failed on the code 
   took them as stale. Such a run now goes to ``scratch/`` and says why.
 * ``--out`` (or the API's ``out``) inside the suite's package ``sim/`` was accepted, with the
   same stale code hash: refused in one line naming it (:func:`sim.places.check_not_in_code`).
+* A notebook keeps the ``Results`` of a run whose directory it then deleted (or a temporary
+  directory cleaned): reading them said "... is not a results directory" of what was one; it
+  now says the directory no longer exists, removed since the run.
 * ``sim report`` from a directory without ``results/`` (``/``, ``$HOME``) said "results is not
   a results directory" of a directory that does not exist: it now says it does not exist, and
   where it was looked for.
@@ -27,6 +30,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -145,3 +149,14 @@ def test_report_where_there_is_no_results_directory(tmp_path):
     r = _sim("report", cwd=tmp_path)
     assert r.returncode == 2, r
     assert r.stderr == f"sim: error: --results: results does not exist (in {tmp_path})\n"
+
+
+def test_results_of_a_run_whose_directory_was_deleted(tmp_path):
+    """A run's ``Results`` kept after its directory is removed: it no longer exists."""
+    res = sim.load(NET, trials=40, chunk=2).run(out=tmp_path / "o", quiet=True, figures=False)
+    assert res.claims().num_rows > 0
+    shutil.rmtree(tmp_path / "o")
+    for read in (res.claims, res.names):
+        with pytest.raises(sim.ConfigError) as e:
+            read()
+        assert str(e.value) == f"path: {tmp_path / 'o'} no longer exists (removed since the run)"
