@@ -39,7 +39,10 @@ import pytest
 
 import sim
 import sim.cli
+import sim.places
 from sim.mc.config import ConfigError
+from sim.mc.storage import code_hash
+from sim.studies import load_study
 
 ROOT = Path(__file__).resolve().parent.parent
 NET = ROOT / "studies" / "network_plate.toml"
@@ -72,6 +75,18 @@ def _run_goes_to(monkeypatch, cwd: Path, *argv: str) -> tuple[Path, str, str]:
     return seen["out"], seen["shown"], err.getvalue()
 
 
+def _committed_is_current(monkeypatch):
+    """``results/network_plate`` read as made by this very config and code (with figures),
+    whatever the checkout's results are (stale after a code change, before the re-run)."""
+    record = {"config": load_study(NET)[1], "code_hash": code_hash("network")}
+    real = sim.places.read_record
+    monkeypatch.setattr(
+        sim.places,
+        "read_record",
+        lambda d: record if Path(d).resolve() == ROOT / "results" / "network_plate" else real(d),
+    )
+
+
 def test_default_output_from_inside_the_project_is_the_projects(monkeypatch):
     """From ``docs/`` a run of other values goes to the project's ``scratch/``, and one of
     the committed config to the project's ``results/``, never to ``docs/results/``; from a
@@ -82,6 +97,7 @@ def test_default_output_from_inside_the_project_is_the_projects(monkeypatch):
     assert out.parent == ROOT / "scratch" and out.name.startswith("network_plate-"), out
     assert shown == f"../scratch/{out.name}", shown
     assert "../results/network_plate/ holds the committed results" in err
+    _committed_is_current(monkeypatch)
     out, shown, _ = _run_goes_to(monkeypatch, ROOT / "sim" / "studies" / "network", str(NET))
     assert (out, shown) == (ROOT / "results" / "network_plate", "../../../results/network_plate")
     assert not (ROOT / "docs" / "results").exists()
@@ -90,6 +106,7 @@ def test_default_output_from_inside_the_project_is_the_projects(monkeypatch):
 def test_no_figures_never_replaces_committed_figures(monkeypatch):
     """``sim run studies/network_plate.toml --no-figures``: the committed config, but its
     figures would be deleted (and the results made stale): it goes to ``scratch/``."""
+    _committed_is_current(monkeypatch)
     out, shown, err = _run_goes_to(monkeypatch, ROOT, str(NET), "--no-figures")
     assert out.parent == ROOT / "scratch" and shown.startswith("scratch/network_plate-"), out
     assert "its figures would be deleted by --no-figures" in err, err
