@@ -42,7 +42,7 @@ from sim.mc.storage import (
     write_table,
 )
 from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cells, refused_note
-from sim.places import check_not_in_code
+from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
 from sim.stops import check_interrupt, keep_lost_interrupts
@@ -223,7 +223,7 @@ def execute(
     }
     if (why := umask_problem()) is not None:
         raise ConfigError(None, why)
-    check_not_in_code(out, shown)  # its files would change a study's code hash
+    check_place(out, shown)  # not in sim/ (a study's code hash), not below a broken link
     check_out(out, shown, record, overwrite)
     stage = stage_dir(out)
     clear_replaced(stage, out, shown)  # a kill between publishing's two steps left them there

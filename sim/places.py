@@ -11,8 +11,8 @@
   the sources, said as ``results in results/<name>/``, which the user took for the project's
   own; inside a study's package its ``run.json`` changed that study's code hash, so every
   committed result of the study read stale and ``make reproduce`` re-ran them).
-* :func:`check_not_in_code`: an output directory inside the suite's package ``sim/`` is
-  refused (the data files of a study's package, ``.json`` and ``.toml`` among them, are part of
+* :func:`check_place`: an output directory inside the suite's package ``sim/`` is
+  refused, as is one below a symbolic link to nothing (the data files of a study's package, ``.json`` and ``.toml`` among them, are part of
   its code hash: a run's ``run.json`` there made the study's committed results stale).
 """
 
@@ -27,7 +27,7 @@ from pathlib import Path
 from sim.mc.config import ConfigError, config_changes
 from sim.mc.storage import code_hash, read_record
 
-__all__ = ["CODE", "PROJECT", "base", "check_not_in_code", "default_out", "shown_path"]
+__all__ = ["CODE", "PROJECT", "base", "check_place", "default_out", "shown_path"]
 
 #: the suite's package directory (``sim/``) and the checkout it lies in
 CODE = Path(__file__).resolve().parent
@@ -58,8 +58,17 @@ def shown_path(path: Path) -> str:
         return str(path)
 
 
-def check_not_in_code(out: Path, shown_as: str) -> None:
-    """Refuse ``out`` (absolute) inside the suite's package directory, one line naming it."""
+def check_place(out: Path, shown_as: str) -> None:
+    """Refuse ``out`` (absolute) inside the suite's package directory, or below a symbolic
+    link to nothing (a folder moved since: "cannot write to DIR: File exists"), one line."""
+    for up in reversed(out.parents):
+        if os.path.islink(up) and not os.path.exists(up):
+            to = os.readlink(up)
+            raise ConfigError(
+                "--out",
+                f"{shown_as}: {up} is a symbolic link to {to if to.isprintable() else repr(to)}, "
+                "which does not exist",
+            )
     try:
         real = Path(os.path.realpath(out))
     except (OSError, ValueError):

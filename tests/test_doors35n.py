@@ -17,7 +17,9 @@ project, from ``/`` and from ``$HOME``), one case each; each failed on the code 
   one of brown_dilution's), ``run.json`` saying ``"figures": false``, so ``make reproduce``
   took them as stale. Such a run now goes to ``scratch/`` and says why.
 * ``--out`` (or the API's ``out``) inside the suite's package ``sim/`` was accepted, with the
-  same stale code hash: refused in one line naming it (:func:`sim.places.check_not_in_code`).
+  same stale code hash: refused in one line naming it (:func:`sim.places.check_place`).
+* ``--out moved/x`` where ``moved`` is a symbolic link to a folder moved since said
+  "cannot write to moved: File exists": it now names the link and where it points.
 * A notebook keeps the ``Results`` of a run whose directory it then deleted (or a temporary
   directory cleaned): reading them said "... is not a results directory" of what was one; it
   now says the directory no longer exists, removed since the run.
@@ -159,6 +161,18 @@ def test_out_inside_the_suites_code_is_refused(tmp_path):
         for p in (target, target.with_name(".doors35n-out.partial")):
             if p.exists():
                 subprocess.run(["rm", "-rf", str(p)], check=False)
+
+
+def test_out_below_a_link_to_nothing(tmp_path):
+    """``--out lnk/x`` with ``lnk`` a symbolic link to a folder that was moved away."""
+    (tmp_path / "lnk").symlink_to("moved-away")
+    r = _sim("run", NET, "--trials", "40", "--quiet", "--out", "lnk/x", cwd=tmp_path)
+    assert r.returncode == 2 and r.stdout == "", r
+    assert r.stderr == (
+        f"sim: error: --out: lnk/x: {tmp_path / 'lnk'} is a symbolic link to moved-away, "
+        "which does not exist\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lnk"]
 
 
 def test_report_where_there_is_no_results_directory(tmp_path):
