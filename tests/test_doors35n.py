@@ -16,6 +16,11 @@ project, from ``/`` and from ``$HOME``), one case each; each failed on the code 
   replaced the committed results: their PNG files deleted (tracked files; the README shows
   one of brown_dilution's), ``run.json`` saying ``"figures": false``, so ``make reproduce``
   took them as stale. Such a run now goes to ``scratch/`` and says why.
+* ``python -m sim.batch mine/my_net.toml`` in the project's root (as the Makefile runs it)
+  made a new ``results/my_net`` among the committed results (listed in REPORT.md, never
+  checked by ``make verify``), which ``sim run`` of the same file never makes (it goes to
+  ``scratch/``): refused before any run, naming ``--results``, as a file named like a
+  project study already was.
 * ``--out`` (or the API's ``out``) inside the suite's package ``sim/`` was accepted, with the
   same stale code hash: refused in one line naming it (:func:`sim.places.check_place`).
 * ``--out moved/x`` where ``moved`` is a symbolic link to a folder moved since said
@@ -133,6 +138,25 @@ def test_batch_and_show_from_inside_the_project(tmp_path):
     assert not (ROOT / "docs" / "results").exists()
     r = _sim("show", "brown_table1", cwd=ROOT / "docs")
     assert r.returncode == 0 and "brown.table1_closure.dof" in r.stdout, r
+
+
+def test_batch_of_a_file_of_yours_into_the_projects_results(tmp_path):
+    """``python -m sim.batch mine/my_net.toml`` in the root: refused, nothing run or made."""
+    mine = tmp_path / "my_net_doors35n.toml"
+    mine.write_text(NET.read_text())
+    r = subprocess.run(
+        [sys.executable, "-m", "sim.batch", str(mine), "--", "--trials", "40", "--no-figures"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+    )
+    assert r.returncode == 2 and r.stdout == "", r
+    assert r.stderr == (
+        f"sim.batch: {mine} is not a study file of the project's studies: it would make a new "
+        "results/my_net_doors35n among the project's results: give your own --results DIR\n"
+    )
+    assert not (ROOT / "results" / "my_net_doors35n").exists()
 
 
 def test_out_inside_the_suites_code_is_refused(tmp_path):
