@@ -31,7 +31,7 @@ from sim.api_args import arguments as _arguments
 from sim.api_paths import absolute_path as _absolute
 from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
-from sim.api_paths import why_unread
+from sim.api_paths import why_not_a_dir, why_unread
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.api_tmp import temp_dir
 from sim.execute import execute
@@ -96,8 +96,8 @@ class Results:
         object.__setattr__(self, "path", where)
 
     def _check_dir(self) -> None:  # not "no table": the directory itself is wrong
-        if not self.path.is_dir():
-            why = link_problem(self.path) or "is not a results directory"
+        if not self.path.is_dir():  # a run's, deleted since, was "not a results directory"
+            why = link_problem(self.path) or why_not_a_dir(self.path, bool(self.run_sha256))
             raise ConfigError("path", f"{self.path} {why}")
         if self.run_sha256 and _run_identity(self.path) not in ("", self.run_sha256):
             raise ConfigError(  # its tables read silently as this run's (another seed's)

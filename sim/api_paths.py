@@ -21,7 +21,7 @@ from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
 from sim.mc.storage import RECORD, config_hash, read_record, regular_text
 
-__all__ = ["check_path", "absolute_path", "why_unread"]
+__all__ = ["check_path", "absolute_path", "why_not_a_dir", "why_unread"]
 
 
 def check_path(name: str, v: Any, none_ok: bool = False) -> None:
@@ -87,3 +87,11 @@ def run_identity(out: Path) -> str:
     except ValueError:  # not UTF-8: damaged, refused by the reads
         pass
     return ""
+
+
+def why_not_a_dir(path: Path, of_a_run: bool) -> str:
+    """Why ``path`` (a ``Results``' directory, not a directory) cannot be read: missing (a run's
+    results removed since the run, or a path that never was) or something else."""
+    if os.path.lexists(path):
+        return "is not a results directory"
+    return "no longer exists (removed since the run)" if of_a_run else "does not exist"

@@ -69,6 +69,7 @@ from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
 from sim.mc.storage import atomic_path  # noqa: E402
 from sim.mc.study_file import study_file_problem  # noqa: E402
+from sim.places import base, shown_path  # noqa: E402
 from sim.stops import (  # noqa: E402
     check_interrupt,
     exit_status,
@@ -278,7 +279,7 @@ def _main(argv: list[str]) -> int:
     ap.add_argument(
         "--jobs", type=integer("jobs", 1, 64), default=2, help="studies run at a time (default 2)"
     )
-    ap.add_argument("--results", default="results", help="results directory (default results)")
+    ap.add_argument("--results", help="results directory (default results, the project's)")
     ap.add_argument(
         "--stale-only", action="store_true", help="only the studies whose results are not current"
     )
@@ -293,6 +294,8 @@ def _main(argv: list[str]) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.results is None:  # from a directory inside the project (docs/): the project's
+        args.results = shown_path(base() / "results")
     if name_problem(args.results):
         why = name_problem(args.results)
         print(f"sim.batch: --results: {why} (got {args.results!r})", file=sys.stderr)

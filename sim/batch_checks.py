@@ -29,6 +29,7 @@ from sim.mc.paths import absolute
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
 from sim.mc.sweep import read_sweep
+from sim.places import base
 from sim.report.read import mixed_table
 from sim.studies import get_study
 
@@ -177,16 +178,24 @@ def _replaces_project_results(f: Path, results: Path) -> str | None:
     """Why the run of ``f`` would replace the results of the project's own study file of its
     name (``results/<stem>``, made from ``studies/<stem>.toml`` of the working directory) with
     the results of another file of that name (a study author's own ``brown_table1.toml``):
-    each run is ``--overwrite``, and the committed results were silently replaced."""
-    own = Path("studies") / f"{f.stem}.toml"
+    each run is ``--overwrite``, and the committed results were silently replaced. A file of
+    another name (``mine/my_net.toml``) made a new ``results/my_net`` among the project's
+    (in its REPORT.md, not checked by ``make verify``), which ``sim run`` never makes."""
+    at = base()  # the project's from a directory inside it
+    own = at / "studies" / f"{f.stem}.toml"
     try:
         target = (results / f.stem).resolve()
-        if target != (Path("results") / f.stem).resolve() or not own.is_file():
+        if target != (at / "results" / f.stem).resolve() or not (at / "studies").is_dir():
             return None
         if f.resolve() == own.resolve():
             return None
     except (OSError, RuntimeError):  # a loop: the run names it
         return None
+    if not own.is_file():
+        return (
+            f"{f} is not a study file of the project's {at / 'studies'}: it would make a new "
+            f"{results / f.stem} among the project's results: give your own --results DIR"
+        )
     return (
         f"{f} would replace {results / f.stem}, the results of the project's {own} "
         "(another file of that name): give your own --results DIR"

@@ -203,5 +203,7 @@ def parser(doc: str) -> argparse.ArgumentParser:
         description="Rebuild REPORT.md and each results directory's README.md from the "
         "Parquet files alone (nothing is run).",
     )
-    rep.add_argument("--results", default="results", help="the results directory (default results)")
+    rep.add_argument(
+        "--results", help="the results directory (default results, the project's from inside it)"
+    )
     return p

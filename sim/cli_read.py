@@ -17,6 +17,7 @@ from sim.mc.config import ConfigError
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.storage import umask_problem
+from sim.places import base, shown_path
 from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
@@ -36,16 +37,17 @@ def show(args) -> int:
             "DIR", f"not a directory name: {name_problem(args.dir)} (got {args.dir!r})"
         )
     d = Path(args.dir)
-    # the name a README.md gives (`sim show NAME` prints it again) is read under ./results and
-    # ./scratch too, where sim run writes without --out (a scratch run's README named a
-    # command that said "does not exist" from the project's root)
-    d = next((b / d for b in WHERE if not d.exists() and (b / d).is_dir()), d)
+    # the name a README.md gives (`sim show NAME` prints it again) is read under the project's
+    # results/ and scratch/ too (from docs/ as from the root), where sim run writes without
+    # --out (a scratch run's README named a command that said "does not exist" from the root)
+    where = [Path(shown_path(base() / b)) for b in WHERE]
+    d = next((b / d for b in where if not d.exists() and (b / d).is_dir()), d)
     if not d.is_dir():
         what = "is not a directory" if os.path.lexists(d) else "does not exist"
         also = (
             ""
             if d.is_absolute() or d.exists()
-            else f" (nor is there a directory {' or '.join(f'{b}/{args.dir}' for b in WHERE)})"
+            else f" (nor is there a directory {' or '.join(str(b / args.dir) for b in where)})"
         )
         why = link_problem(d) or f"{what}{also}"
         raise ConfigError("DIR", f"{args.dir} {why}")
@@ -93,6 +95,8 @@ def _sweep_of(d: Path) -> Path | None:
 def report(results: Path) -> int:
     """``sim report``: only over a directory that holds study results (a directory of the
     user's with none gets no REPORT.md written into it)."""
+    if not os.path.lexists(results):  # from / or $HOME: not "is not a results directory"
+        raise ConfigError("--results", f"{results} does not exist (in {os.getcwd()})")
     if results.is_dir() and not any(
         (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
         for d in results_dirs(results)

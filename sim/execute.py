@@ -42,6 +42,7 @@ from sim.mc.storage import (
     write_table,
 )
 from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cells, refused_note
+from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
 from sim.stops import check_interrupt, keep_lost_interrupts
@@ -58,8 +59,7 @@ _SCHEDULER = re.compile(
 
 
 def _check_options(executor: Any, workers: Any, scheduler: Any) -> None:
-    """The run options every door passes (``sim run``, the Python API): one line naming the
-    option."""
+    """The run options every door passes (``sim run``, the Python API): one line naming it."""
     if executor not in ("local", "dask"):
         raise ConfigError("executor", f"must be 'local' or 'dask' (got {executor!r})")
     top = most_workers()
@@ -223,6 +223,7 @@ def execute(
     }
     if (why := umask_problem()) is not None:
         raise ConfigError(None, why)
+    check_place(out, shown)  # not in sim/ (a study's code hash), not below a broken link
     check_out(out, shown, record, overwrite)
     stage = stage_dir(out)
     clear_replaced(stage, out, shown)  # a kill between publishing's two steps left them there

@@ -9,7 +9,7 @@ case each; each failed on the code before its fix.
 * ``sim run mine/my_net.toml`` without ``--out`` in the project's root wrote a new
   ``results/my_net/`` into the committed results (REPORT.md then listed it, ``make verify``
   failed on it), though the docs say only ``make reproduce``/``make rerun`` write there: it
-  goes to ``scratch/<name>-<hash>/`` and says so (:func:`sim.cli._default_out`);
+  goes to ``scratch/<name>-<hash>/`` and says so (:func:`sim.places.default_out`);
 * ``make verify`` over an author's own results directory re-ran the project's
   ``studies/<name>.toml`` (a variant named ``brown_table1`` was compared with the shipped
   study's full run, ``no study file studies/my_net.toml`` for a new one): ``--studies DIR``

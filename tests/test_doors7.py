@@ -62,9 +62,9 @@ def test_a_chunk_added_by_hand_is_named_with_a_remedy_that_works(tmp_path, capsy
 
 
 def test_results_of_a_missing_directory_name_the_path(tmp_path):
-    with pytest.raises(ConfigError, match=r"^path: .*nowhere is not a results directory"):
+    with pytest.raises(ConfigError, match=r"^path: .*nowhere does not exist$"):
         sim.Results(tmp_path / "nowhere", "network").claims()
-    with pytest.raises(ConfigError, match=r"^path: .*nowhere is not a results directory"):
+    with pytest.raises(ConfigError, match=r"^path: .*nowhere does not exist$"):
         sim.Results(tmp_path / "nowhere", "network").names()  # was []
 
 

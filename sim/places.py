@@ -1,0 +1,153 @@
+"""Where the suite's commands write when not told, and where they never write.
+
+* :func:`default_out`: where ``sim run`` writes without ``--out`` (the committed
+  ``results/<name>`` only for a run of the committed config, code and figures; else
+  ``scratch/<name>-<hash>``).
+* :func:`base`: the directory the command line's defaults are taken in (``sim run``'s
+  ``results/`` and ``scratch/``, ``sim report``'s and ``python -m sim.batch``'s ``--results``,
+  the study names ``sim show`` reads): the working directory, or the project's root when the
+  working directory lies inside the project below its root. Run from ``docs/``, ``studies/``
+  or ``sim/studies/network/``, a run made ``results/<name>`` there (a results directory among
+  the sources, said as ``results in results/<name>/``, which the user took for the project's
+  own; inside a study's package its ``run.json`` changed that study's code hash, so every
+  committed result of the study read stale and ``make reproduce`` re-ran them).
+* :func:`check_place`: an output directory inside the suite's package ``sim/`` is
+  refused, as is one below a symbolic link to nothing (the data files of a study's package, ``.json`` and ``.toml`` among them, are part of
+  its code hash: a run's ``run.json`` there made the study's committed results stale).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+from pathlib import Path
+
+from sim.mc.config import ConfigError, config_changes
+from sim.mc.storage import code_hash, read_record
+
+__all__ = ["CODE", "PROJECT", "base", "check_place", "default_out", "shown_path"]
+
+#: the suite's package directory (``sim/``) and the checkout it lies in
+CODE = Path(__file__).resolve().parent
+PROJECT = CODE.parent
+
+
+def _cwd() -> Path | None:
+    try:
+        return Path.cwd().resolve()
+    except (OSError, RuntimeError):  # the working directory was removed
+        return None
+
+
+def base() -> Path:
+    """``.``, or the project's root when the working directory lies inside the project's
+    checkout (its ``studies/`` beside ``sim/``) but is not its root."""
+    cwd = _cwd()
+    if cwd is None or cwd == PROJECT or not (PROJECT / "studies").is_dir():
+        return Path(".")
+    return PROJECT if cwd.is_relative_to(PROJECT) else Path(".")
+
+
+def shown_path(path: Path) -> str:
+    """``path`` as the user reads it: relative to the working directory."""
+    try:
+        return os.path.relpath(path)
+    except (OSError, ValueError):
+        return str(path)
+
+
+def check_place(out: Path, shown_as: str) -> None:
+    """Refuse ``out`` (absolute) inside the suite's package directory, or below a symbolic
+    link to nothing (a folder moved since: "cannot write to DIR: File exists"), one line."""
+    for up in reversed(out.parents):
+        if os.path.islink(up) and not os.path.exists(up):
+            to = os.readlink(up)
+            raise ConfigError(
+                "--out",
+                f"{shown_as}: {up} is a symbolic link to {to if to.isprintable() else repr(to)}, "
+                "which does not exist",
+            )
+    try:
+        real = Path(os.path.realpath(out))
+    except (OSError, ValueError):
+        real = out
+    if out.is_relative_to(CODE) or real.is_relative_to(CODE):
+        raise ConfigError(
+            "--out",
+            f"{shown_as} lies inside the suite's code {CODE} (the data files of a study's "
+            "package are part of its code hash: a run's files there would make its committed "
+            "results stale); choose a directory outside it",
+        )
+
+
+def _config_tag(record: dict) -> str:
+    text = json.dumps(record["config"], sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:8]
+
+
+def _differs(old: dict, record: dict) -> str:
+    """What differs between a committed run record and this run's, in a few words."""
+    a, b = old.get("config"), record["config"]
+    if not isinstance(a, dict):  # a record edited by hand
+        return "its config differs"
+    if a != b:  # the keys, as --out's refusal names them (sim.mc.outputs)
+        return f"its config differs ({config_changes(a, b)})"
+    return "the code changed since they were made"
+
+
+def default_out(cfg: dict, sweep: dict, path: Path, figures: bool = True) -> tuple[Path, str, bool]:
+    """Where ``sim run`` writes without --out: ``results/<name>`` (``name`` the study file
+    ``path``'s, where ``make reproduce`` writes it, or the study kind's when only that exists)
+    when it holds this very run (config and code) or does not exist, else
+    ``scratch/<name>-<config hash>`` (said on standard error). Returns ``(absolute path, shown
+    path, overwrite)``; a scratch directory is replaced freely. (By the study kind,
+    ``studies/network_brown.toml`` wrote into a new ``results/network/``.) In the project's
+    root a new ``results/<name>`` is made for its ``studies/<name>.toml`` only: an author's
+    ``my_net.toml`` went into the committed results, REPORT.md and ``make verify``. Both are
+    the project's from a directory inside it (:func:`base`). A run ``--no-figures`` never
+    replaces committed results that have figures: it deleted the committed PNG files (the
+    README's figure among them) and made the results stale for ``make reproduce``."""
+    name, at = path.stem, base()
+    if not (at / "results" / name).exists() and (at / "results" / cfg["study"]).exists():
+        name = cfg["study"]  # a copy of a study file under another name
+    committed = at / "results" / name
+    record = {
+        "config": {**cfg, "sweep": sweep} if sweep else cfg,
+        "code_hash": code_hash(cfg["study"]),
+    }
+    old = read_record(committed)
+    scratch = at / "scratch" / f"{name}-{_config_tag(record)}"
+    if not committed.exists() and not _project_file(path, name, at):
+        print(
+            f"sim: {path} is not the project's studies/{name}.toml: writing to "
+            f"{shown_path(scratch)}/ (--out DIR to choose; results/ holds the project's studies)",
+            file=sys.stderr,
+        )
+        return Path(os.path.abspath(scratch)), shown_path(scratch), True
+    same = (
+        old is not None
+        and old.get("config") == record["config"]
+        and old.get("code_hash") == record["code_hash"]
+    )
+    if not committed.exists() or (same and (figures or old.get("figures") is False)):
+        return Path(os.path.abspath(committed)), shown_path(committed), False
+    why = _differs(old, record) if old is not None else "it is not a results directory of sim"
+    why = "its figures would be deleted by --no-figures" if same else why
+    print(
+        f"sim: {shown_path(committed)}/ holds the committed results and {why}: writing to "
+        f"{shown_path(scratch)}/ (--out DIR to choose; make reproduce rewrites results/)",
+        file=sys.stderr,
+    )
+    return Path(os.path.abspath(scratch)), shown_path(scratch), True
+
+
+def _project_file(path: Path, name: str, at: Path) -> bool:
+    """Whether ``path`` may make ``results/<name>`` in ``at``: it is ``studies/<name>.toml``, or
+    ``at`` is no project's root (no ``studies/``: its ``results/`` is the user's)."""
+    own = at / "studies" / f"{name}.toml"
+    try:
+        return not (at / "studies").is_dir() or path.resolve() == own.resolve()
+    except (OSError, RuntimeError):
+        return False
