@@ -12,15 +12,14 @@ and exit code 2, never a traceback. What the suite did not write is never delete
 replaced: --out must be a new path, an empty directory, or a results directory of an
 earlier run (its run.json). A run works in a locked staging directory .<out>.partial/ that
 replaces <out> only when everything succeeded. Without --out a run writes into
-results/<study>/ only when its config and code are those of the committed results there;
+results/<study>/ only when it runs the study file as written (no --set, --trials, --seed,
+--chunk or --no-figures) and its config and code are those of the committed results there;
 any other run goes to scratch/<study>-<config hash>/ and says so (make reproduce and
 make rerun pass --out results/<study>).
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 import re
 import signal
@@ -32,17 +31,17 @@ from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing 
 from sim.claims.rules import printed_differs
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
+from sim.cli_out import default_out
 from sim.cli_read import report, show
 from sim.ends import stdout_failed
 from sim.execute import check_sweep, execute
-from sim.mc.config import ConfigError, StudyError, check_chunks, config_changes, parse_override
+from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.outputs import name_problem
-from sim.mc.overrides import command_values, recorded
+from sim.mc.overrides import command_values, listed, recorded
 from sim.mc.paths import absolute
 from sim.mc.progress import set_quiet
 from sim.mc.read_when import read_in_a_cell
-from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
 from sim.report.run_summary import off_setup, terminal_summary, write_run_readme
@@ -124,79 +123,16 @@ def load_run(args):
     return load_picking_chunk(args.study, picks, overrides, args.trials, args.seed)
 
 
-def _config_tag(record: dict) -> str:
-    text = json.dumps(record["config"], sort_keys=True, default=repr)
-    return hashlib.sha256(text.encode()).hexdigest()[:8]
-
-
-def _differs(old: dict, record: dict) -> str:
-    """What differs between a committed run record and this run's, in a few words."""
-    a, b = old.get("config"), record["config"]
-    if not isinstance(a, dict):  # a record edited by hand
-        return "its config differs"
-    if a != b:  # the keys, as --out's refusal names them (sim.mc.outputs)
-        return f"its config differs ({config_changes(a, b)})"
-    return "the code changed since they were made"
-
-
-def _default_out(cfg: dict, sweep: dict, path: Path) -> tuple[Path, str, bool]:
-    """Without --out: ``results/<name>`` (``name`` the study file ``path``'s, where ``make reproduce``
-    writes it, or the study kind's when only that exists) when it holds this very run (config and code) or does not exist, else
-    ``scratch/<name>-<config hash>`` (said on standard error). Returns ``(absolute path,
-    shown path, overwrite)``; a scratch directory is replaced freely. (By the study kind,
-    ``studies/network_brown.toml`` wrote into a new ``results/network/``.) In the project's
-    root a new ``results/<name>`` is made for its ``studies/<name>.toml`` only: an author's
-    ``my_net.toml`` went into the committed results, REPORT.md and ``make verify``."""
-    name = path.stem
-    if not (Path("results") / name).exists() and (Path("results") / cfg["study"]).exists():
-        name = cfg["study"]  # a copy of a study file under another name
-    committed = Path("results") / name
-    record = {
-        "config": {**cfg, "sweep": sweep} if sweep else cfg,
-        "code_hash": code_hash(cfg["study"]),
-    }
-    old = read_record(committed)
-    if not committed.exists() and not _project_file(path, name):
-        scratch = Path("scratch") / f"{name}-{_config_tag(record)}"
-        print(
-            f"sim: {path} is not the project's studies/{name}.toml: writing to {scratch}/ "
-            "(--out DIR to choose; results/ holds the project's studies)",
-            file=sys.stderr,
-        )
-        return Path(os.path.abspath(scratch)), str(scratch), True
-    if not committed.exists() or (
-        old is not None
-        and old.get("config") == record["config"]
-        and old.get("code_hash") == record["code_hash"]
-    ):
-        return Path(os.path.abspath(committed)), str(committed), False
-    scratch = Path("scratch") / f"{name}-{_config_tag(record)}"
-    why = _differs(old, record) if old is not None else "it is not a results directory of sim"
-    print(
-        f"sim: {committed}/ holds the committed results and {why}: writing to {scratch}/ "
-        "(--out DIR to choose; make reproduce rewrites results/)",
-        file=sys.stderr,
-    )
-    return Path(os.path.abspath(scratch)), str(scratch), True
-
-
-def _project_file(path: Path, name: str) -> bool:
-    """Whether ``path`` may make ``results/<name>``: it is ``studies/<name>.toml``, or the
-    working directory is no project's root (no ``studies/``: its ``results/`` is the user's)."""
-    own = Path("studies") / f"{name}.toml"
-    try:
-        return not Path("studies").is_dir() or path.resolve() == own.resolve()
-    except (OSError, RuntimeError):
-        return False
-
-
 def _run(args) -> int:
     out = check_run_args(args)
     study, cfg = load_run(args)
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
     overwrite = args.overwrite
+    overrides = recorded(
+        command_values(args.set, trials=args.trials, seed=args.seed, chunk=args.chunk)
+    )
     if out is None:
-        out, shown, scratch = _default_out(cfg, sweep, Path(args.study))
+        out, shown, scratch = default_out(cfg, sweep, Path(args.study), _off(overrides, args))
         overwrite = overwrite or scratch
     else:
         shown = args.out
@@ -215,9 +151,7 @@ def _run(args) -> int:
         max_adjustments=args.max_adjustments,
         figures=not args.no_figures,
         readme=lambda stage, name: write_run_readme(stage, get_study, name, out, design_config),
-        overrides=recorded(
-            command_values(args.set, trials=args.trials, seed=args.seed, chunk=args.chunk)
-        ),
+        overrides=overrides,
     )
     args.published = shown  # an interrupt from now on finds the results written
     check_interrupt()  # dropped by Python since the results were published: not exit 0
@@ -229,6 +163,14 @@ def _run(args) -> int:
     if not args.quiet:
         print(summary)
     return 0
+
+
+def _off(overrides: list[str], args) -> str | None:
+    """What makes a run other than its study file as written (the words of
+    :func:`sim.cli_out.default_out`), or None."""
+    what = [f"the overrides {listed(overrides)}"] if overrides else []
+    what += ["--no-figures"] if args.no_figures else []
+    return " and ".join(what) or None
 
 
 def _n(x: float) -> str:
