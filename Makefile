@@ -206,9 +206,10 @@ report: $(STAMP) ## rebuild results/REPORT.md and every results/<study>/README.m
 # BENCH_FLAGS: e.g. "--quick" (a smoke run: small sizes, tiny study configurations),
 # "--no-rerun" (leave out the make rerun rows), "--only engines"; see python -m benchmarks -h
 BENCH_FLAGS ?=
-BENCH_OUT ?= results/bench
+# a smoke run (--quick) never replaces the committed measurements of results/bench
+BENCH_OUT ?= $(if $(filter --quick,$(BENCH_FLAGS)),scratch/bench-quick,results/bench)
 
-bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/, or BENCH_OUT; BENCH_FLAGS=--quick: smoke)
+bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/, or BENCH_OUT; BENCH_FLAGS=--quick: smoke, into scratch/bench-quick/)
 	$(call shellwords,BENCH_FLAGS)
 	$(if $(filter --out --out=%,$(BENCH_FLAGS)),@echo 'make bench: BENCH_FLAGS holds --out: give the directory as BENCH_OUT=DIR' >&2; exit 2)
 	$(PY) -m benchmarks --out $(call q,$(BENCH_OUT)) $(BENCH_FLAGS)

@@ -21,7 +21,11 @@ line on standard output says how many ran and which failed (:func:`summary`). Ba
 refused before any run starts, exit 2, one line for each bad file (every one named): a file
 that is missing or a directory, two runs into one results directory, and a study file whose
 config its run would refuse (resolved here with the run options, as ``sim run`` resolves it:
-a file ported from another study, a bad value).
+a file ported from another study, a bad value). Without ``--results`` (the default
+``results/``, the project's study files as written), run options that set a key or
+``--no-figures``, and in the project's root a study file that is not ``studies/<name>.toml``,
+are refused naming ``--results`` (``sim run`` without ``--out`` sends such runs to
+``scratch/``; ``make reproduce`` and ``make rerun`` name ``--results results``).
 """
 
 from __future__ import annotations

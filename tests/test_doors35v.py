@@ -27,6 +27,10 @@ overrides, left-behind directories), one case each; each failed on the code befo
   results) for good: its directory is ``sim-verify-<pid>-XXXXXXXX`` with a marker holding
   that pid, and a later verify removes those of a dead verify (not one of a live process,
   without the marker, or of another name: :mod:`sim.report.verify.scratch`).
+* ``make bench BENCH_FLAGS=--quick`` (the docs' smoke run) replaced the committed full
+  measurements of ``results/bench`` (``BENCH_OUT``'s default) with its tiny sizes' numbers:
+  a smoke run goes to ``scratch/bench-quick`` by default (make and ``python -m benchmarks``),
+  and a directory holding a full benchmark's tables is refused to it, naming ``--out``.
 * ``python -m sim.batch`` interrupted while it checked its files said "interrupted; the same
   command again resumes the unfinished runs" of a batch that had started none: it says that
   nothing was run.
@@ -50,13 +54,16 @@ from pathlib import Path
 import pyarrow.parquet as pq
 import pytest
 from oneline import one_line
+from test_doors18c import make
 
 import sim.batch
+from benchmarks.cli import main as bench_main
 from sim import cli
 from sim.report.verify import main as verify_main
 from sim.report.verify.record import markdown
 from sim.report.verify.scratch import MARK
 
+ROOT = Path(__file__).resolve().parents[1]
 NET = """study = "network"
 trials = 40
 chunk = 2
@@ -201,3 +208,14 @@ def test_a_batch_interrupted_while_checking_its_files_says_nothing_ran(
     line = one_line(capsys, rc, code=130)
     assert line == "sim.batch: interrupted before any run started: nothing was run"
     assert not (project / "r").exists()
+
+
+def test_a_smoke_benchmark_leaves_the_committed_measurements(tmp_path, capsys):
+    full = tmp_path / "bench"
+    shutil.copytree(ROOT / "results" / "bench", full)
+    before = _files(full)
+    rc = bench_main(["--quick", "--only", "engines", "--out", str(full)])
+    one_line(capsys, rc, "holds the measurements of a full benchmark", "give another --out")
+    assert _files(full) == before  # before: engines.parquet, engines.png, README.md replaced
+    p = make("-n", "bench", "BENCH_FLAGS=--quick")
+    assert p.stdout.strip().endswith("--out 'scratch/bench-quick' --quick"), (p.stdout, p.stderr)
