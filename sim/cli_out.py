@@ -51,12 +51,19 @@ def default_out(
     None; else the words of what makes it another run, as "the overrides trials=40"), else
     ``scratch/<name>-<config hash>`` (said on standard error). Returns ``(absolute path, shown
     path, overwrite)``; a scratch directory is replaced freely. (By the study kind,
-    ``studies/network_brown.toml`` wrote into a new ``results/network/``.) In the project's
-    root a new ``results/<name>`` is made for its ``studies/<name>.toml`` only: an author's
-    ``my_net.toml`` went into the committed results, REPORT.md and ``make verify``."""
+    ``studies/network_brown.toml`` wrote into a new ``results/network/``; a new study file of
+    the project's, ``studies/brown_large.toml``, was sent to ``scratch/`` as "of another
+    config" than ``results/brown_table1``, where ``make reproduce`` writes
+    ``results/brown_large``.) In the project's root a new ``results/<name>`` is made for its
+    ``studies/<name>.toml`` only: an author's ``my_net.toml`` went into the committed results,
+    REPORT.md and ``make verify``."""
     name = path.stem
-    if not (Path("results") / name).exists() and (Path("results") / cfg["study"]).exists():
-        name = cfg["study"]  # a copy of a study file under another name
+    if (
+        not (Path("results") / name).exists()
+        and (Path("results") / cfg["study"]).exists()
+        and not (Path("studies").is_dir() and _project_file(path, name))
+    ):  # a copy of a study file under another name (not a new study file of the project's,
+        name = cfg["study"]  # whose results make reproduce writes into results/<its name>)
     committed = Path("results") / name
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,

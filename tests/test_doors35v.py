@@ -20,6 +20,11 @@ overrides, left-behind directories), one case each; each failed on the code befo
   ``results/my_net`` into the committed results, where ``sim run mine/my_net.toml`` goes to
   ``scratch/`` (doors22d): refused naming ``--results`` (with ``--results results`` it is
   written, as asked).
+* ``sim run studies/net_c.toml`` (a new study file of the project's, of the study kind
+  ``network`` whose ``results/network`` exists) went to ``scratch/network-<hash>/``, said to
+  be "of another config" than ``results/network``, where ``make reproduce`` writes
+  ``results/net_c``: it writes ``results/net_c`` too (a copy outside ``studies/`` is still
+  compared with the study kind's results).
 * ``make verify``'s record (``reproducibility.parquet``) did not say with which overrides
   each study was re-run: it has the column ``overrides`` (the run's, as its ``run.json``
   records them), and the report's *Reproducibility* section names them.
@@ -153,6 +158,18 @@ def test_a_batch_of_an_authors_file_needs_results_named(project, capsys):
     words = "mine/my_net.toml is not the project's studies/my_net.toml"
     one_line(capsys, rc, words, "give --results DIR", prefix="sim.batch: ")
     assert not (project / "results" / "my_net").exists()  # before: made, exit 0
+
+
+def test_a_new_study_file_of_the_project_runs_into_its_own_results(project, capsys):
+    shutil.copytree(project / "results" / "net_a", project / "results" / "network")
+    (project / "studies" / "network.toml").write_text(NET)
+    (project / "studies" / "net_c.toml").write_text(NET.replace("seed = 5", "seed = 9"))
+    assert cli.main(["run", "studies/net_c.toml", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert out == "network: results in results/net_c/\n", out  # before: scratch/network-...
+    assert (
+        json.loads((project / "results" / "net_c" / "run.json").read_text())["config"]["seed"] == 9
+    )
 
 
 def test_the_verify_record_names_the_overrides_of_each_run(project, capsys):
