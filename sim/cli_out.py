@@ -78,19 +78,19 @@ def default_out(
             file=sys.stderr,
         )
         return Path(os.path.abspath(scratch)), str(scratch), True
-    if off is not None:
+    if not committed.exists() or (
+        old is not None
+        and old.get("config") == record["config"]
+        and old.get("code_hash") == record["code_hash"]
+    ):
+        if off is None:
+            return Path(os.path.abspath(committed)), str(committed), False
         print(
             f"sim: a run with {off} is not {path} as written, whose results go to "
             f"{committed}/: writing to {scratch}/ (--out DIR to choose)",
             file=sys.stderr,
         )
         return Path(os.path.abspath(scratch)), str(scratch), True
-    if not committed.exists() or (
-        old is not None
-        and old.get("config") == record["config"]
-        and old.get("code_hash") == record["code_hash"]
-    ):
-        return Path(os.path.abspath(committed)), str(committed), False
     why = _differs(old, record) if old is not None else "it is not a results directory of sim"
     print(
         f"sim: {committed}/ holds the committed results and {why}: writing to {scratch}/ "
