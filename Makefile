@@ -178,13 +178,13 @@ RUN_JOBS ?= 2
 reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, each with RUN_FLAGS="--workers 1": sim run options)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
-	$(PY) -m sim.batch --stale-only --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
+	$(PY) -m sim.batch --stale-only --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
 rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report (RUN_JOBS, RUN_FLAGS)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
-	$(PY) -m sim.batch --jobs $(RUN_JOBS) $(STUDY_FILES) -- $(RUN_FLAGS)
+	$(PY) -m sim.batch --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)
 	$(PY) -m sim report --results results
 
 # VERIFY_FLAGS: e.g. "--study brown_table1", "--scratch DIR" (see python -m sim.report.verify -h;
@@ -206,9 +206,10 @@ report: $(STAMP) ## rebuild results/REPORT.md and every results/<study>/README.m
 # BENCH_FLAGS: e.g. "--quick" (a smoke run: small sizes, tiny study configurations),
 # "--no-rerun" (leave out the make rerun rows), "--only engines"; see python -m benchmarks -h
 BENCH_FLAGS ?=
-BENCH_OUT ?= results/bench
+# a smoke run (--quick) never replaces the committed measurements of results/bench
+BENCH_OUT ?= $(if $(filter --quick,$(BENCH_FLAGS)),scratch/bench-quick,results/bench)
 
-bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/, or BENCH_OUT; BENCH_FLAGS=--quick: smoke)
+bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 and 2 workers (results/bench/, or BENCH_OUT; BENCH_FLAGS=--quick: smoke, into scratch/bench-quick/)
 	$(call shellwords,BENCH_FLAGS)
 	$(if $(filter --out --out=%,$(BENCH_FLAGS)),@echo 'make bench: BENCH_FLAGS holds --out: give the directory as BENCH_OUT=DIR' >&2; exit 2)
 	$(PY) -m benchmarks --out $(call q,$(BENCH_OUT)) $(BENCH_FLAGS)

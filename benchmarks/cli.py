@@ -10,7 +10,10 @@ from 100 to 10,000 points and blocks of 10 to 200 models, :mod:`benchmarks.scali
 (``store.parquet``: a chunk's kept arrays saved and loaded packed against ``.npz``,
 :mod:`benchmarks.store`). ``--quick`` is a smoke run: small sizes, and the rerun rows with
 the test suite's tiny configuration of each study (``tests/data/tiny/<study>.txt``), so its
-rerun times say nothing about the 90 s target.
+rerun times say nothing about the 90 s target; without ``--out`` it writes
+``scratch/bench-quick`` (:data:`QUICK_OUT`), and a directory holding a full benchmark's tables
+(the committed ``results/bench``) is refused to it, naming ``--out``: a smoke run replaced the
+committed measurements.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ from benchmarks import studies
 from benchmarks.brown import brown_rows, million, peak_rss_mib
 from benchmarks.engines import engine_rows
 from benchmarks.figures import brown_figure, engines_figure
-from benchmarks.outdir import OutLock, not_written_here
+from benchmarks.outdir import OutLock, full_measurement, not_written_here
 from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
 from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
@@ -188,6 +191,11 @@ def _check_args(a: argparse.Namespace, sections: tuple[str, ...]) -> None:
             f"--out: {out / foreign} was not written by the benchmark, which would replace it"
             " (give a new directory, or one make bench wrote)"
         )
+    if a.quick and (full := full_measurement(out)) is not None:
+        raise _ArgError(
+            f"--out: {out} holds the measurements of a full benchmark ({full}), which a smoke "
+            "run (--quick) would replace: give another --out (make bench: BENCH_OUT=DIR)"
+        )
     base = next(p for p in (out.absolute(), *out.absolute().parents) if p.exists())
     if not base.is_dir() or not os.access(base, os.W_OK | os.X_OK):
         raise _ArgError(f"--out: cannot write {out} ({base} is not a writable directory)")
@@ -202,6 +210,10 @@ def _check_args(a: argparse.Namespace, sections: tuple[str, ...]) -> None:
             if not isinstance(study, str):
                 raise _ArgError(f"--rerun-files: {f} is not a study file (no study = ...)")
 
+
+#: where a smoke run (``--quick``) writes without ``--out``: the committed ``results/bench``
+#: holds a full benchmark's measurements (:func:`benchmarks.outdir.full_measurement`)
+QUICK_OUT = "scratch/bench-quick"
 
 #: the benchmark's line when it was interrupted
 INTERRUPTED = "benchmarks: interrupted; nothing more was measured"
@@ -225,7 +237,8 @@ def _main(argv) -> int:
         description="Benchmark of the batched solvers and of make rerun (see docs/benchmark.md)",
     )
     ap.add_argument(
-        "--out", default="results/bench", help="output directory (default results/bench)"
+        "--out",
+        help=f"output directory (default results/bench; with --quick {QUICK_OUT})",
     )
     ap.add_argument(
         "--quick",
@@ -259,6 +272,7 @@ def _main(argv) -> int:
     ap.add_argument("--million-child", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--chunk", type=int, default=10000, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    a.out = a.out if a.out is not None else QUICK_OUT if a.quick else "results/bench"
     if a.million_child:
         try:
             million(Path(a.out), a.million_child, a.chunk)

@@ -27,7 +27,7 @@ import pyarrow.parquet as pq
 
 from benchmarks.page import HEADING
 
-__all__ = ["WRITES", "OutLock", "not_written_here"]
+__all__ = ["WRITES", "OutLock", "full_measurement", "not_written_here"]
 
 TABLES = ("bench", "engines", "studies", "rerun", "scaling", "store")
 FIGURES = {"bench.png": "bench", "engines.png": "engines", "scaling.png": "scaling"}
@@ -39,13 +39,30 @@ WRITES = (*(f"{t}.parquet" for t in TABLES), *FIGURES, "README.md", STORE)
 _CHUNK = re.compile(r"chunk-\d+\.parquet|\.chunk-\d+\.parquet\.\d+\.tmp")
 
 
-def _bench_table(path: Path) -> bool:
+def _bench_config(path: Path) -> dict | None:
+    """The config a table of the benchmark records (``study``, ``quick``), or None."""
     try:
         meta = pq.read_schema(path).metadata or {}
         prov = json.loads(meta.get(b"sim.provenance", b"{}"))
     except (OSError, ValueError):
-        return False
-    return isinstance(prov, dict) and (prov.get("config") or {}).get("study") == "bench"
+        return None
+    config = prov.get("config") if isinstance(prov, dict) else None
+    return config if isinstance(config, dict) and config.get("study") == "bench" else None
+
+
+def _bench_table(path: Path) -> bool:
+    return _bench_config(path) is not None
+
+
+def full_measurement(out: Path) -> str | None:
+    """The name of the first table in ``out`` of a full benchmark (not ``--quick``), or None:
+    a smoke run replaced the committed measurements of ``results/bench`` (``make bench
+    BENCH_FLAGS=--quick``, whose ``BENCH_OUT`` is that by default) with its tiny sizes'."""
+    for t in TABLES:
+        config = _bench_config(out / f"{t}.parquet") if (out / f"{t}.parquet").is_file() else None
+        if config is not None and config.get("quick") is False:
+            return f"{t}.parquet"
+    return None
 
 
 def _bench_page(path: Path) -> bool:

@@ -18,7 +18,6 @@ then ``Results`` refused its own directory ("path: must be a path ...").
 
 from __future__ import annotations
 
-import fcntl
 import os
 import re
 import shutil
@@ -27,9 +26,10 @@ import tempfile
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.dead_dirs import lock_held
 from sim.mc.outputs import name_problem
 from sim.mc.pids import pid_alive
-from sim.mc.storage import LOCK, RECORD
+from sim.mc.storage import RECORD
 
 __all__ = ["KEPT", "temp_dir"]
 
@@ -40,25 +40,6 @@ KEPT = ".sim-kept"
 def _alive(pid: int) -> bool:
     """False only when no process ``pid`` exists (this process, another user's: alive)."""
     return pid == os.getpid() or pid_alive(pid)
-
-
-def _locked(d: Path) -> bool:
-    """True when a ``.lock`` file under ``d`` is held (a run still writes there) or cannot
-    be tried."""
-    for top, dirs, files in os.walk(d):
-        dirs[:] = [n for n in dirs if not os.path.islink(os.path.join(top, n))]
-        if LOCK in files:
-            try:
-                fd = os.open(os.path.join(top, LOCK), os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-            except OSError:
-                return True
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError:
-                return True
-            finally:
-                os.close(fd)  # releases the lock just taken
-    return False
 
 
 def _clear_dead(tmp: Path, study: str) -> None:
@@ -78,7 +59,7 @@ def _clear_dead(tmp: Path, study: str) -> None:
             st = os.lstat(d)
             if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid():
                 continue
-            if os.path.lexists(d / study / RECORD) or os.path.lexists(d / KEPT) or _locked(d):
+            if os.path.lexists(d / study / RECORD) or os.path.lexists(d / KEPT) or lock_held(d):
                 continue
             shutil.rmtree(d)
         except OSError:  # removed meanwhile, unreadable: left as it is

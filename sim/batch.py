@@ -21,7 +21,11 @@ line on standard output says how many ran and which failed (:func:`summary`). Ba
 refused before any run starts, exit 2, one line for each bad file (every one named): a file
 that is missing or a directory, two runs into one results directory, and a study file whose
 config its run would refuse (resolved here with the run options, as ``sim run`` resolves it:
-a file ported from another study, a bad value).
+a file ported from another study, a bad value). Without ``--results`` (the default
+``results/``, the project's study files as written), run options that set a key or
+``--no-figures``, and in the project's root a study file that is not ``studies/<name>.toml``,
+are refused naming ``--results`` (``sim run`` without ``--out`` sends such runs to
+``scratch/``; ``make reproduce`` and ``make rerun`` name ``--results results``).
 """
 
 from __future__ import annotations
@@ -50,6 +54,7 @@ single_threaded_blas()  # before NumPy loads (the study modules import it)
 from sim.batch_checks import (  # noqa: E402
     _clashes,
     _configs_problems,
+    _default_results_problem,
     _files_after,
     _in_batch_words,
     _replaces_project_results,
@@ -59,6 +64,7 @@ from sim.batch_checks import (  # noqa: E402
     is_current,
     why_stale,
 )
+from sim.batch_summary import _Stdout, summary  # noqa: E402
 from sim.batch_timings import TimingsLock  # noqa: E402
 from sim.cli_args import module_doc  # noqa: E402
 from sim.ends import finish  # noqa: E402
@@ -244,16 +250,23 @@ INTERRUPTED = "sim.batch: interrupted; the same command again resumes the unfini
 PUBLISHED = "interrupted after the results were written to"
 
 
+#: the driver's line when it was interrupted before its first run started (checking its files)
+NOTHING_RUN = "sim.batch: interrupted before any run started: nothing was run"
+
+
 def main(argv: list[str] | None = None) -> int:
     signals = (signal.SIGINT, *STOP_SIGNALS) if in_main_thread() else ()
     old = {s: signal.getsignal(s) for s in signals}
+    phase: list[str] = []  # "run": the runs started; "ended": every run ended
     try:
         with keep_lost_interrupts():  # Ctrl-C that Python drops in a C callback: kept
-            code = _main(list(sys.argv[1:] if argv is None else argv))
+            code = _main(list(sys.argv[1:] if argv is None else argv), phase)
+            phase.append("ended")
             check_interrupt()  # and never exit 0 after one
             return code
-    except KeyboardInterrupt:
-        print(INTERRUPTED, file=sys.stderr)
+    except KeyboardInterrupt:  # while it checked its files it said it "resumes the unfinished
+        said = {"run": INTERRUPTED, "ended": _ENDED}  # runs" of a batch that had started none
+        print(said.get(phase[-1], INTERRUPTED) if phase else NOTHING_RUN, file=sys.stderr)
         return 130
     finally:  # in-process callers (the tests) get their handlers back
         for s, h in old.items():
@@ -261,7 +274,7 @@ def main(argv: list[str] | None = None) -> int:
                 signal.signal(s, h)
 
 
-def _main(argv: list[str]) -> int:
+def _main(argv: list[str], phase: list[str]) -> int:
     run_args = []
     if "--" in argv:
         i = argv.index("--")
@@ -294,8 +307,8 @@ def _main(argv: list[str]) -> int:
             file=sys.stderr,
         )
         return 2
-    if args.results is None:  # from a directory inside the project (docs/): the project's
-        args.results = shown_path(base() / "results")
+    default = args.results is None  # the project's results/ (from docs/ too): the files as written
+    args.results = shown_path(base() / "results") if default else args.results
     if name_problem(args.results):
         why = name_problem(args.results)
         print(f"sim.batch: --results: {why} (got {args.results!r})", file=sys.stderr)
@@ -339,24 +352,29 @@ def _main(argv: list[str]) -> int:
         print(f"sim.batch: --timings: {why}", file=sys.stderr)
         return 2
     try:
-        return _run(args, files, run_args, note, loaded)
+        return _run(args, files, run_args, note, loaded, default, phase)
     finally:
         if lock:
             lock.release()
 
 
-def _run(args, files: list[Path], run_args: list[str], note: str | None, loaded) -> int:
-    """Run the checked ``files`` and write their timings; the batch's exit code."""
+def _run(args, files: list[Path], run_args: list[str], note, loaded, default, phase) -> int:
+    """Run the checked ``files`` and write their timings; the batch's exit code. ``default``:
+    no ``--results`` was given; ``phase``: told when the runs start and end (:func:`main`)."""
     for f in files:
         if why := _replaces_project_results(f, Path(args.results)):
             print(f"sim.batch: {why}", file=sys.stderr)
             return 2
+    if default and (why := _default_results_problem(files, run_args)):
+        print(f"sim.batch: {why}", file=sys.stderr)
+        return 2
     for s in STOP_SIGNALS if in_main_thread() else ():
         if signal.getsignal(s) is signal.SIG_DFL:
             signal.signal(s, _on_sigterm)  # end the runs as Ctrl-C does
     if note:  # once, not one line per run that refuses it
         print(f"sim.batch: note: {note}", file=sys.stderr)
     log = _Stdout()
+    phase.append("run")
     try:
         done = run_all(
             files, Path(args.results), args.jobs, run_args, args.stale_only, log, loaded=loaded
@@ -367,6 +385,7 @@ def _run(args, files: list[Path], run_args: list[str], note: str | None, loaded)
         named = f" (the results of {', '.join(w)} were written)" if w else ""
         print(INTERRUPTED + named, file=sys.stderr)
         return 130
+    phase.append("ended")
     written: list[str] = []
     try:
         return _finish(args, files, done, log, written)
@@ -399,46 +418,6 @@ def _finish(args, files: list[Path], done: dict, log, written: list[str]) -> int
     if log.error is not None and not failed:  # a reader that left (| head -1): as sim does
         return 141
     return code
-
-
-def summary(files: list[Path], done: dict[str, tuple[int, float, float]], code: int) -> str:
-    """The batch's closing line, after its last run: how many runs were made and, with
-    ``--stale-only``, how many studies were up to date; when a run failed, how many and which
-    (the study files' names) and the batch's exit code. A batch of many studies ended with the
-    last run's own lines, and a failure among them was found by scrolling back."""
-    up = len(files) - len(done)
-    current = f", {up} up to date" if up else ""
-    runs = f"{len(done)} run{'s' * (len(done) != 1)}"
-    bad = [f.name for f in files if f.stem in done and done[f.stem][0] != 0]
-    if not bad:
-        return (
-            f"sim.batch: {runs} done{current}" if done else f"sim.batch: {up} up to date, none run"
-        )
-    return (
-        f"sim.batch: {runs}, {len(done) - len(bad)} done, {len(bad)} failed "
-        f"({', '.join(bad)}){current}; exit {code}"
-    )
-
-
-class _Stdout:
-    """``print`` to standard output for :func:`run_all`'s lines, which keeps the first failed
-    write (``> /dev/full``; ``| head -1``, a broken pipe) instead of raising it in a run's
-    thread: that was a traceback while the other runs went on; now every run ends, the
-    timings are written and the driver ends with one line (a broken pipe: quietly)."""
-
-    def __init__(self) -> None:
-        self.error: OSError | None = None
-
-    def __call__(self, text: str) -> None:
-        if self.error is None:
-            try:
-                print(text, flush=True)
-            except OSError as e:
-                self.error = e
-                try:  # what is left in the buffer is dropped, not retried at exit
-                    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-                except (OSError, ValueError):
-                    pass
 
 
 if __name__ == "__main__":  # a signal after main returned: its exit code stands

@@ -12,7 +12,8 @@ and exit code 2, never a traceback. What the suite did not write is never delete
 replaced: --out must be a new path, an empty directory, or a results directory of an
 earlier run (its run.json). A run works in a locked staging directory .<out>.partial/ that
 replaces <out> only when everything succeeded. Without --out a run writes into
-results/<study>/ only when its config and code are those of the committed results there;
+results/<study>/ only when it runs the study file as written (no --set, --trials, --seed,
+--chunk or --no-figures) and its config and code are those of the committed results there;
 any other run goes to scratch/<study>-<config hash>/ and says so (make reproduce and
 make rerun pass --out results/<study>).
 """
@@ -37,7 +38,7 @@ from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.estimate import check_limits, estimate
 from sim.mc.memory_limit import memory_given
 from sim.mc.outputs import name_problem
-from sim.mc.overrides import command_values, recorded
+from sim.mc.overrides import command_values, listed, recorded
 from sim.mc.paths import absolute
 from sim.mc.progress import set_quiet
 from sim.mc.read_when import read_in_a_cell
@@ -129,8 +130,11 @@ def _run(args) -> int:
     study, cfg = load_run(args)
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
     overwrite = args.overwrite
+    overrides = recorded(
+        command_values(args.set, trials=args.trials, seed=args.seed, chunk=args.chunk)
+    )
     if out is None:
-        out, shown, scratch = default_out(cfg, sweep, Path(args.study), not args.no_figures)
+        out, shown, scratch = default_out(cfg, sweep, Path(args.study), _off(overrides, args))
         overwrite = overwrite or scratch
     else:
         shown = args.out
@@ -149,9 +153,7 @@ def _run(args) -> int:
         max_adjustments=args.max_adjustments,
         figures=not args.no_figures,
         readme=lambda stage, name: write_run_readme(stage, get_study, name, out, design_config),
-        overrides=recorded(
-            command_values(args.set, trials=args.trials, seed=args.seed, chunk=args.chunk)
-        ),
+        overrides=overrides,
     )
     args.published = shown  # an interrupt from now on finds the results written
     check_interrupt()  # dropped by Python since the results were published: not exit 0
@@ -163,6 +165,14 @@ def _run(args) -> int:
     if not args.quiet:
         print(summary)
     return 0
+
+
+def _off(overrides: list[str], args) -> str | None:
+    """What makes a run other than its study file as written (the words of
+    :func:`sim.places.default_out`), or None."""
+    what = [f"the overrides {listed(overrides)}"] if overrides else []
+    what += ["--no-figures"] if args.no_figures else []
+    return " and ".join(what) or None
 
 
 def _n(x: float) -> str:

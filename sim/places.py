@@ -97,21 +97,36 @@ def _differs(old: dict, record: dict) -> str:
     return "the code changed since they were made"
 
 
-def default_out(cfg: dict, sweep: dict, path: Path, figures: bool = True) -> tuple[Path, str, bool]:
+def default_out(
+    cfg: dict, sweep: dict, path: Path, off: str | None = None
+) -> tuple[Path, str, bool]:
     """Where ``sim run`` writes without --out: ``results/<name>`` (``name`` the study file
     ``path``'s, where ``make reproduce`` writes it, or the study kind's when only that exists)
-    when it holds this very run (config and code) or does not exist, else
-    ``scratch/<name>-<config hash>`` (said on standard error). Returns ``(absolute path, shown
-    path, overwrite)``; a scratch directory is replaced freely. (By the study kind,
-    ``studies/network_brown.toml`` wrote into a new ``results/network/``.) In the project's
-    root a new ``results/<name>`` is made for its ``studies/<name>.toml`` only: an author's
-    ``my_net.toml`` went into the committed results, REPORT.md and ``make verify``. Both are
-    the project's from a directory inside it (:func:`base`). A run ``--no-figures`` never
-    replaces committed results that have figures: it deleted the committed PNG files (the
-    README's figure among them) and made the results stale for ``make reproduce``."""
+    when it holds this very run (config and code) or does not exist, and the run is of the
+    file as written (``off``: None; else the words of what makes it another run, as "the
+    overrides trials=40" or "--no-figures"), else ``scratch/<name>-<config hash>`` (said on
+    standard error). Returns ``(absolute path, shown path, overwrite)``; a scratch directory
+    is replaced freely. Both are the project's from a directory inside it (:func:`base`).
+
+    A run with overrides wrote the committed results when its config happened to be theirs
+    (``--seed`` of the file's value, the override then recorded in ``run.json``) and whenever
+    ``results/<name>/`` did not exist (the user's experiment became the study's results, for
+    ``sim report``, ``REPORT.md`` and ``make verify``); ``--no-figures`` replaced them by
+    results without their figures (the committed PNG files deleted, the results stale for
+    ``make reproduce``). ``--out results/<name>`` (or ``make rerun RUN_FLAGS=...``) writes
+    there when asked. By the study kind, ``studies/network_brown.toml`` wrote into a new
+    ``results/network/``, and a new study file of the project's, ``studies/brown_large.toml``,
+    was sent to ``scratch/`` as "of another config" than ``results/brown_table1``, where
+    ``make reproduce`` writes ``results/brown_large``. In the project's root a new
+    ``results/<name>`` is made for its ``studies/<name>.toml`` only: an author's
+    ``my_net.toml`` went into the committed results, REPORT.md and ``make verify``."""
     name, at = path.stem, base()
-    if not (at / "results" / name).exists() and (at / "results" / cfg["study"]).exists():
-        name = cfg["study"]  # a copy of a study file under another name
+    if (
+        not (at / "results" / name).exists()
+        and (at / "results" / cfg["study"]).exists()
+        and not ((at / "studies").is_dir() and _project_file(path, name, at))
+    ):  # a copy of a study file under another name (not a new study file of the project's,
+        name = cfg["study"]  # whose results make reproduce writes into results/<its name>)
     committed = at / "results" / name
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
@@ -131,10 +146,16 @@ def default_out(cfg: dict, sweep: dict, path: Path, figures: bool = True) -> tup
         and old.get("config") == record["config"]
         and old.get("code_hash") == record["code_hash"]
     )
-    if not committed.exists() or (same and (figures or old.get("figures") is False)):
-        return Path(os.path.abspath(committed)), shown_path(committed), False
+    if not committed.exists() or same:
+        if off is None:
+            return Path(os.path.abspath(committed)), shown_path(committed), False
+        print(
+            f"sim: a run with {off} is not {path} as written, whose results go to "
+            f"{shown_path(committed)}/: writing to {shown_path(scratch)}/ (--out DIR to choose)",
+            file=sys.stderr,
+        )
+        return Path(os.path.abspath(scratch)), shown_path(scratch), True
     why = _differs(old, record) if old is not None else "it is not a results directory of sim"
-    why = "its figures would be deleted by --no-figures" if same else why
     print(
         f"sim: {shown_path(committed)}/ holds the committed results and {why}: writing to "
         f"{shown_path(scratch)}/ (--out DIR to choose; make reproduce rewrites results/)",

@@ -108,7 +108,7 @@ def test_batch_reads_its_runs_lines_in_the_encoding_they_are_written_in(tmp_path
     bad = tmp_path / "bad.toml"  # its run refuses the umask (a bad config, or a results
     bad.write_text(STUDY.read_text(encoding="utf-8"), encoding="utf-8")  # directory it would
     p = subprocess.run(  # not replace, the driver refuses itself: tests/test_doors28b.py)
-        [sys.executable, "-m", "sim.batch", str(bad), "--", *SMALL],
+        [sys.executable, "-m", "sim.batch", str(bad), "--results", "res", "--", *SMALL],
         capture_output=True,
         cwd=tmp_path,
         env={**os.environ, "PYTHONIOENCODING": "utf-16"},

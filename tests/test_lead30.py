@@ -14,7 +14,7 @@ from sim.mc.storage import provenance, write_table
 
 
 def _check(out):
-    ns = argparse.Namespace(out=str(out), rerun_files=None, rerun_workers=None)
+    ns = argparse.Namespace(out=str(out), rerun_files=None, rerun_workers=None, quick=False)
     cli._check_args(ns, ("store",))
 
 

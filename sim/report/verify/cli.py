@@ -18,6 +18,7 @@ from sim.mc.overrides import listed
 from sim.report.verify.record import write_record
 from sim.report.verify.rerun import verify
 from sim.report.verify.rules import Comparison, VerifyError
+from sim.report.verify.scratch import scratch_dir
 from sim.stops import check_interrupt, ended_as_ctrl_c, exit_status, keep_lost_interrupts
 
 __all__ = ["main"]
@@ -179,7 +180,7 @@ def _main(argv: list[str] | None) -> int:
                 f"the temporary directory {tempfile.gettempdir()!r} (TMPDIR) {why}: "
                 "set TMPDIR, or give --scratch DIR"
             )
-        tmp = None if a.scratch else tempfile.mkdtemp(prefix="sim-verify-")
+        tmp = None if a.scratch else scratch_dir()  # (those of killed verifies cleared)
         try:
             comps = verify(
                 Path(a.results),

@@ -12,6 +12,7 @@ import pyarrow.parquet as pq
 
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
+from sim.mc.overrides import listed
 from sim.mc.storage import numerics, read_provenance, versions, write_table
 from sim.report.tables import fmt, md_table
 from sim.report.verify.rules import DEFAULT_RTOL, Comparison, tables_digest
@@ -45,9 +46,14 @@ def write_record(results: Path, comps: list[Comparison]) -> Path:
         "text_columns_changed": [", ".join(c.text_changes) for c in comps],
         "ok": [c.ok for c in comps],
         "tables_sha256": [c.tables or "" for c in comps],  # what was checked: markdown()
+        # the overrides of the run each re-run was made with (its run.json's; none: the study
+        # file as written): the record said "yes" without saying of which config
+        "overrides": pa.array([list(c.overrides) for c in comps], pa.list_(pa.string())),
     }
     return write_table(
-        Path(results) / "reproducibility.parquet", cols, {"study": "verify", "machine": _machine()}
+        Path(results) / "reproducibility.parquet",
+        pa.table(cols),
+        {"study": "verify", "machine": _machine()},
     )
 
 
@@ -72,7 +78,7 @@ def markdown(results: Path) -> str:
             fmt(r["max_rel_dev"], 2),
             fmt(r["max_dev_over_tol"], 2),
             f"`{r['worst']}`" if r["worst"] else "",
-            since.get(r["study"]) or _verdict(r, older),
+            (since.get(r["study"]) or _verdict(r, older)) + _with(r.get("overrides")),
             r["text_columns_changed"],
         ]
         for r in t
@@ -145,6 +151,14 @@ def _verdict(r: dict, older: bool) -> str:
         else ("the check did not record the tables")
     )
     return f"**not checked now**: {who} (it said {said})"
+
+
+def _with(overrides) -> str:
+    """`` (re-run with the run's overrides: k=v, ...)`` for a row whose results were made with
+    overrides (a record of an older version has no such column: "")."""
+    if not overrides or not isinstance(overrides, list):
+        return ""
+    return f" (re-run with the run's overrides: {listed([str(t) for t in overrides])})"
 
 
 def _checked_since(results: Path, rows: list[dict]) -> dict[str, str]:
