@@ -208,9 +208,10 @@ def _default_results_problem(files: list[Path], run_args: list[str]) -> str | No
     what ``make reproduce`` makes of the project's study files as written: run options that
     make the runs other than the files (a key set, ``--no-figures``: ``make rerun`` writes the
     committed results with them when asked, by ``RUN_FLAGS``, whose Makefile line names
-    ``--results results``), or, in the project's root, a study file that is no
-    ``studies/<name>.toml`` (``sim run`` of each of these without ``--out`` goes to
-    ``scratch/``: :func:`sim.places.default_out`). None when it may."""
+    ``--results results``). ``sim run`` of each of these without ``--out`` goes to
+    ``scratch/`` (:func:`sim.places.default_out`); a study file that is no
+    ``studies/<name>.toml`` is refused by :func:`_replaces_project_results`. None when it
+    may."""
     args = _parsed(run_args)
     sets = recorded(command_values(args.set, trials=args.trials, seed=args.seed, chunk=args.chunk))
     off = [f"the overrides {listed(sets)}"] if sets else []
@@ -220,18 +221,6 @@ def _default_results_problem(files: list[Path], run_args: list[str]) -> str | No
             f"run options: a run with {' and '.join(off)} is not its study file as written, "
             "whose results the default results/ holds: give --results DIR (--results results "
             "to replace them)"
-        )
-    at = base()  # the project's from a directory inside it
-    if not (at / "studies").is_dir():  # no project's root: its results/ is the user's
-        return None
-    for f in files:
-        own = at / "studies" / f"{f.stem}.toml"
-        with contextlib.suppress(OSError, RuntimeError):  # (a loop: the run names it)
-            if own.is_file() and f.resolve() == own.resolve():
-                continue
-        return (
-            f"{f} is not the project's {own}: its results would go into the project's "
-            f"results/ (REPORT.md, make verify): give --results DIR"
         )
     return None
 

@@ -155,8 +155,8 @@ def test_a_batch_of_an_authors_file_needs_results_named(project, capsys):
     (project / "mine").mkdir()
     (project / "mine" / "my_net.toml").write_text(NET)
     rc = sim.batch.main(["mine/my_net.toml"])
-    words = "mine/my_net.toml is not the project's studies/my_net.toml"
-    one_line(capsys, rc, words, "give --results DIR", prefix="sim.batch: ")
+    words = "mine/my_net.toml is not a study file of the project's studies"
+    one_line(capsys, rc, words, "give your own --results DIR", prefix="sim.batch: ")
     assert not (project / "results" / "my_net").exists()  # before: made, exit 0
 
 
