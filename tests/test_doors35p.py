@@ -9,16 +9,29 @@ each failed on the code before its fix.
   rejected 19,000 times too often. The tolerance is now 2 points and at most 40 % of the level
   (:func:`sim.studies.network.claims.alarm_tol`; the committed runs at 5 % are unchanged): the
   zone is [6e-7, 1.4e-6] and the same run is inconclusive.
+* ``agnard_block``: ``tradeoff.centre_points`` (1 to 10,000) against the check points of the
+  blocks the block-size trade-off compares (``tradeoff.block_strips`` x
+  ``tradeoff.block_models``, ``tradeoff.block_control``): at 10,000 the 'centre' of every block
+  was all of its check points, and ``tradeoff_block.parquet`` and README.md printed the
+  accuracy "at the centre" as the same numbers as the whole block's (agnard_block_104: centre
+  XY 0.2192 m = all check XY 0.2192 m); a 1 x 1 block's default 10 were 10 of its 12. A centre
+  of more than half a compared block's check points is now refused on load, naming the block
+  and its count (:mod:`sim.studies.agnard.centre`).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 import sim
+from sim.cli import main
+from tests.oneline import SIM_ERROR, one_line
 
 ROOT = Path(__file__).resolve().parent.parent
 PLATE = ROOT / "studies" / "network_plate.toml"
+AGNARD = ROOT / "studies" / "agnard_block.toml"
 
 
 def _claim(res, cid: str) -> dict:
@@ -36,3 +49,17 @@ def test_false_alarm_zone_of_a_small_level_stays_a_probability(tmp_path):
     res = sim.load(PLATE, trials=40, chunk=2).run(out=tmp_path / "b", quiet=True, figures=False)
     row = _claim(res, "network.global_test.false_alarm")
     assert (row["zone_low"], row["zone_high"]) == (0.05 - 0.02, 0.05 + 0.02), row
+
+
+def test_a_centre_of_most_of_a_compared_block_is_refused(capsys):
+    argv = ["check", str(AGNARD), "--set", "tradeoff.centre_points=10000"]
+    line = one_line(capsys, main(argv), "tradeoff.centre_points", "2 x 4 block", prefix=SIM_ERROR)
+    assert "83 check points" in line and "at most 41" in line, line
+    tiny = ["--set", "tradeoff.block_strips=[1]", "--set", "tradeoff.block_models=[1]"]
+    one_line(capsys, main(["check", str(AGNARD), *tiny]), "12 check points", prefix=SIM_ERROR)
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(AGNARD, tradeoff__centre_points=42)
+    assert "tradeoff.centre_points" in str(e.value), e.value
+    # half of the smallest block's check points is still a centre
+    assert main(["check", str(AGNARD), "--set", "tradeoff.centre_points=41"]) == 0
+    capsys.readouterr()
