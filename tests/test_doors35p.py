@@ -17,6 +17,13 @@ each failed on the code before its fix.
   XY 0.2192 m = all check XY 0.2192 m); a 1 x 1 block's default 10 were 10 of its 12. A centre
   of more than half a compared block's check points is now refused on load, naming the block
   and its count (:mod:`sim.studies.agnard.centre`).
+* ``agnard_block``: ``snoop.max_reject = 0`` (no data snooping) with the mechanical-pugging row
+  ``agnard.pass_rejections.mechanical_pct``: no block can lose a pass point, so the share was
+  0 % by construction, whatever ``pugging.recentre_px``, and the row was decided against the
+  paper's 6.5 % ("input (fails)" at 40 plates: "100 % of the simulated blocks lie below the
+  paper's value"; agnard_block_104's committed row says so at 20). The digital row was already
+  undecidable for this reason; the mechanical one now is too, its note saying why
+  (:func:`sim.studies.agnard.decide.without_snooping`).
 """
 
 from __future__ import annotations
@@ -27,6 +34,7 @@ import pytest
 
 import sim
 from sim.cli import main
+from sim.studies.agnard.decide import without_snooping
 from tests.oneline import SIM_ERROR, one_line
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -63,3 +71,20 @@ def test_a_centre_of_most_of_a_compared_block_is_refused(capsys):
     # half of the smallest block's check points is still a centre
     assert main(["check", str(AGNARD), "--set", "tradeoff.centre_points=41"]) == 0
     capsys.readouterr()
+
+
+def test_the_mechanical_share_without_snooping_is_undecidable():
+    row = {  # the row a run at snoop.max_reject = 0 and 40 trials wrote (abridged)
+        "claim": "agnard.pass_rejections.mechanical_pct",
+        "kind": "input",
+        "value": 0.0,
+        "outcome": "fails",
+        "verdict": "input",
+        "holds": None,
+        "note": "share of the 76 pass points removed under mechanical pugging; 100 % of the "
+        "simulated blocks lie below the paper's value",
+    }
+    (out,) = without_snooping({"snoop.max_reject": 0}, [row])
+    assert out["outcome"] == "undecidable" and out["verdict"] == "input", out
+    assert out["note"].startswith("undecidable: snoop.max_reject = 0"), out["note"]
+    assert without_snooping({"snoop.max_reject": 25}, [row]) == [row]  # snooping: decided

@@ -48,6 +48,9 @@ __all__ = ["five_region", "scanner_region", "over_scanner", "over_joint"]
 #: how a region row undecided everywhere begins (sim.claims.region.region_row)
 UNDECIDABLE = "undecidable: no input of the region decides it"
 
+#: the share of pass points that mechanical pugging's snooping removes (:func:`without_snooping`)
+MECHANICAL = "agnard.pass_rejections.mechanical_pct"
+
 
 def five_region(cfg, block, book, runner, part, prov, out):
     """Explore the five-point layout (``region.toml``) at the configured scanner and write
@@ -325,10 +328,12 @@ def _findings(region: Region) -> Region:
 
 
 def without_snooping(cfg: dict, rows: list[dict]) -> list[dict]:
-    """With ``snoop.max_reject = 0`` no pass point can be removed, so the rejection row
-    (the paper: digital pugging removes none) would hold by construction, not by the
-    simulation: it is undecidable, saying why (the region verdict the count would have had,
-    "holds at all ... points", is dropped from the note: :func:`_how_of`)."""
+    """With ``snoop.max_reject = 0`` no pass point can be removed, so the rejection rows
+    would be decided by construction, not by the simulation: the digital row (the paper:
+    digital pugging removes none) would hold, the mechanical share (the paper: 6.5 %) is 0 %
+    whatever the re-centring error and would fail ("input (fails)" at 40 plates, every block
+    "below the paper's value"). Both are undecidable, saying why (the region verdict the count
+    would have had, "holds at all ... points", is dropped from the note: :func:`_how_of`)."""
     if cfg["snoop.max_reject"]:
         return rows
     why = (
@@ -344,6 +349,13 @@ def without_snooping(cfg: dict, rows: list[dict]) -> list[dict]:
             "note": f"{why}; {_how_of(r['note'])}",
         }
         if r["claim"] == REJECTED and r["kind"] == "prediction"
+        else {
+            **r,
+            "outcome": "undecidable",
+            "holds": None,
+            "note": f"{why.replace('the count', 'the share')}; {r['note']}",
+        }
+        if r["claim"] == MECHANICAL
         else r
         for r in rows
     ]
