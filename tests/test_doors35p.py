@@ -24,6 +24,10 @@ each failed on the code before its fix.
   paper's value"; agnard_block_104's committed row says so at 20). The digital row was already
   undecidable for this reason; the mechanical one now is too, its note saying why
   (:func:`sim.studies.agnard.decide.without_snooping`).
+* A network record's field of the other unit beside its own sigma (an angle's ``bias_mm``
+  beside ``sigma_arcsec``, a distance's ``bias_arcsec``) was named as the record's
+  ``sigma_mm`` (``sigma_arcsec``), a field it does not hold: "network.observations[0].sigma_mm:
+  a angle takes ...". The line now names the field given, and "an angle".
 """
 
 from __future__ import annotations
@@ -88,3 +92,18 @@ def test_the_mechanical_share_without_snooping_is_undecidable():
     assert out["outcome"] == "undecidable" and out["verdict"] == "input", out
     assert out["note"].startswith("undecidable: snoop.max_reject = 0"), out["note"]
     assert without_snooping({"snoop.max_reject": 25}, [row]) == [row]  # snooping: decided
+
+
+def test_a_field_of_the_other_unit_is_named_as_given(capsys):
+    net = ROOT / "studies" / "network_testfield.toml"
+    obs = (
+        '[{ kind = "angle", at = "N6", from = "N5", to = "N7", sigma_arcsec = 2.0, bias_mm = 1.0 }]'
+    )
+    argv = ["check", str(net), "--set", f"network.observations={obs}"]
+    line = one_line(
+        capsys, main(argv), "network.observations[0].bias_mm: an angle", prefix=SIM_ERROR
+    )
+    assert "sigma_mm" not in line.split(":")[1], line
+    gen = '[{ kind = "distance", from = "A", to = "N1", sigma_mm = 1.0, bias_arcsec = 1.0 }]'
+    argv = ["check", str(net), "--set", f"network.generate={gen}"]
+    one_line(capsys, main(argv), "network.generate[0].bias_arcsec: a distance", prefix=SIM_ERROR)

@@ -267,8 +267,10 @@ def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
         raise ConfigError(f"{key}.kind", f"must be one of {', '.join(KINDS[:5])} (got {kind!r})")
     code = KINDS.index(kind)
     unit, other = ("arcsec", "mm") if code in _ANGULAR else ("mm", "arcsec")
-    if f"sigma_{other}" in rec or f"bias_{other}" in rec:
-        raise ConfigError(f"{key}.sigma_{other}", f"a {kind} takes sigma_{unit} and bias_{unit}")
+    wrong = [f for f in (f"sigma_{other}", f"bias_{other}") if f in rec]
+    if wrong:  # the field given (an angle's bias_mm was named its sigma_mm)
+        a = "an" if kind[0] in "aeiou" else "a"
+        raise ConfigError(f"{key}.{wrong[0]}", f"{a} {kind} takes sigma_{unit} and bias_{unit}")
     if f"sigma_{unit}" not in rec:
         raise ConfigError(f"{key}.sigma_{unit}", "missing")
     sig = _num(f"{key}.sigma_{unit}", rec[f"sigma_{unit}"], 0.0, lo_open=True)
