@@ -28,6 +28,13 @@ each failed on the code before its fix.
   beside ``sigma_arcsec``, a distance's ``bias_arcsec``) was named as the record's
   ``sigma_mm`` (``sigma_arcsec``), a field it does not hold: "network.observations[0].sigma_mm:
   a angle takes ...". The line now names the field given, and "an angle".
+* ``datum.kind = "inner"`` (or ``constraints`` on other points) with ``compare.fix``: the
+  dilution divided a point's sigma in the inner datum over every point by its sigma with the
+  ``compare.fix`` points known, two datums: a free six-point network with two points known
+  printed dilutions of -45 % and a "largest dilution" finding of -30 %. The study's sigmas are
+  now S-transformed to the inner datum over the ``compare.fix`` points first when its datum is
+  not held by them (:func:`sim.studies.network.run._held_by`); the fixed datum and Brown's
+  constraints on the stations (held by the stations known) are compared as they were.
 """
 
 from __future__ import annotations
@@ -107,3 +114,37 @@ def test_a_field_of_the_other_unit_is_named_as_given(capsys):
     gen = '[{ kind = "distance", from = "A", to = "N1", sigma_mm = 1.0, bias_arcsec = 1.0 }]'
     argv = ["check", str(net), "--set", f"network.generate={gen}"]
     one_line(capsys, main(argv), "network.generate[0].bias_arcsec: a distance", prefix=SIM_ERROR)
+
+
+FREE = """study = "network"
+[network]
+name = "free"
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0 }, { name = "B", x_mm = 400.0, y_mm = 0.0 },
+           { name = "C", x_mm = 400.0, y_mm = 300.0 }, { name = "D", x_mm = 0.0, y_mm = 300.0 },
+           { name = "P", x_mm = 150.0, y_mm = 120.0 }, { name = "Q", x_mm = 250.0, y_mm = 200.0 } ]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.002 },
+             { kind = "direction", from = "*", to = "*", sigma_arcsec = 2.0 } ]
+[datum]
+kind = "inner"
+[compare]
+fix = ["A", "B"]
+"""
+
+
+def test_a_dilution_compares_sigmas_of_one_datum(tmp_path):
+    from sim.studies.network.definition import build
+    from sim.studies.network.model import datum
+    from sim.studies.network.run import _held_by
+
+    f = tmp_path / "free.toml"
+    f.write_text(FREE)
+    res = sim.load(f, trials=40, chunk=2).run(out=tmp_path / "o", quiet=True, figures=False)
+    dil = [d for d in res.table("points").column("dilution_pct").to_pylist() if d == d]
+    assert len(dil) == 4 and min(dil) >= 0, dil  # -45 % to -30 % in two datums
+    assert _claim(res, "network.design.dilution_max_pct")["value"] >= 0
+    # Brown's constraints on the stations are held by the stations known: compared as they are
+    cfg = dict(sim.load(ROOT / "studies" / "network_brown.toml").config)
+    net = build(cfg)
+    stations = [net.index(s) for s in ("S1", "S2", "S3", "S4")]
+    assert _held_by(net, datum(net, cfg), stations)
+    assert not _held_by(net, datum(net, cfg), stations[:3])
