@@ -35,6 +35,11 @@ each failed on the code before its fix.
   now S-transformed to the inner datum over the ``compare.fix`` points first when its datum is
   not held by them (:func:`sim.studies.network.run._held_by`); the fixed datum and Brown's
   constraints on the stations (held by the stations known) are compared as they were.
+* ``agnard_block``: ``snoop.max_reject = 0`` in the README's model choices: "Baarda's w-test
+  ... alpha = 0.001 two-sided, critical value 3.29; the worst pass point is removed and the
+  block re-adjusted until no |w| exceeds it" (agnard_block_104's committed README), of a run
+  that removes none. It now says there is no snooping, and that ``snoop.alpha`` and
+  ``snoop.test`` decide nothing (:func:`sim.studies.agnard.report._snooping_choice`).
 """
 
 from __future__ import annotations
@@ -148,3 +153,10 @@ def test_a_dilution_compares_sigmas_of_one_datum(tmp_path):
     stations = [net.index(s) for s in ("S1", "S2", "S3", "S4")]
     assert _held_by(net, datum(net, cfg), stations)
     assert not _held_by(net, datum(net, cfg), stations[:3])
+
+
+def test_a_run_without_snooping_says_it_removes_no_pass_point(capsys):
+    assert main(["show", "--markdown", str(ROOT / "results" / "agnard_block_104")]) == 0
+    text = capsys.readouterr().out
+    line = next(ln for ln in text.splitlines() if ln.startswith("- *Data snooping*"))
+    assert "none (snoop.max_reject = 0)" in line and "is removed and" not in line, line

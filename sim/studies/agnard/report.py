@@ -278,6 +278,11 @@ def _adjustment_choice(cfg: dict, prov: dict, out: Path) -> str:
 
 
 def _snooping_choice(cfg: dict, sxy: float, sz: float) -> str:
+    if not cfg["snoop.max_reject"]:  # it said "the worst pass point is removed ..."
+        return (
+            "- *Data snooping*: none (snoop.max_reject = 0): no pass point is removed, so "
+            "snoop.alpha and snoop.test decide nothing."
+        )
     crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
     return (
         f"- *Data snooping*: Baarda's w-test on each residual component, w = v / (sigma0 "
