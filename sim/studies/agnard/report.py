@@ -401,15 +401,18 @@ def _block_table(out: Path, cfg: dict) -> list[str]:
     ]
 
 
-def _pugging_table(out: Path) -> list[str]:
+def _pugging_table(out: Path, cfg: dict) -> list[str]:
     """Sensitivity of the pass-point rejections to the re-centring error."""
     body = [
         [fmt(r["recentre_px"]), r["trials"], _se(r, "mean_share_pct")]
         for r in rows(out, "tradeoff_pugging.parquet")
     ]
+    none = "; snoop.max_reject = 0: none is rejected, whatever the error" * (
+        not cfg["snoop.max_reject"]
+    )
     return [
         "**Sensitivity: mechanical re-centring error against pass-point rejections** "
-        "(no gross errors; the snooping weights are those of digital measurement):",
+        f"(no gross errors; the snooping weights are those of digital measurement{none}):",
         md_table(["re-centring (px)", "trials", "pass points rejected (%)"], body),
     ]
 
@@ -428,7 +431,7 @@ def report(out: Path) -> str:
             *_scanner_table(out),
             *_layout_table(out, cfg),
             *_block_table(out, cfg),
-            *_pugging_table(out),
+            *_pugging_table(out, cfg),
         ],
         figures=[
             ("scanner deformation", "scanner_field.png"),
