@@ -39,20 +39,26 @@ each failed on the code before its fix.
   ... alpha = 0.001 two-sided, critical value 3.29; the worst pass point is removed and the
   block re-adjusted until no |w| exceeds it" (agnard_block_104's committed README), of a run
   that removes none, and its table of the rejections against the re-centring error (0 % at
-  every error) did not say why. It now says there is no snooping, that ``snoop.alpha`` and
-  ``snoop.test`` decide nothing and that the table's rows are none by construction
-  (:mod:`sim.studies.agnard.report`).
+  every error) did not say why, and its findings printed "mechanical pugging 0 % (the
+  re-centring error unprinted, set so the share matches the paper)". It now says there is no
+  snooping, that ``snoop.alpha`` and ``snoop.test`` decide nothing and that the share and the
+  table's rows are none by construction (:mod:`sim.studies.agnard.report`).
+* The note of the digital-rejection row printed its shares with ``:.2g``: "the share of blocks
+  that lose none is 1e+02-1e+02 % ..., at least 1e+02 %" (agnard_block_104's committed
+  claims). A share of 100 % is now written 100 (:func:`sim.studies.agnard.decide._pct`).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 import sim
 from sim.cli import main
-from sim.studies.agnard.decide import without_snooping
+from sim.studies.agnard.decide import _zeros, without_snooping
 from tests.oneline import SIM_ERROR, one_line
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -164,3 +170,11 @@ def test_a_run_without_snooping_says_it_removes_no_pass_point(capsys):
     assert "none (snoop.max_reject = 0)" in line and "is removed and" not in line, line
     head = next(ln for ln in text.splitlines() if ln.startswith("**Sensitivity: mechanical"))
     assert "snoop.max_reject = 0: none is rejected" in head, head
+    line = next(ln for ln in text.splitlines() if ln.startswith("- *Pass-point rejection*"))
+    assert "set so the share matches" not in line and "none by construction" in line, line
+
+
+def test_a_share_of_all_blocks_is_written_100_percent():
+    ev = {"share_zero": np.array([1.0, 1.0]), "share_zero_high": np.array([1.0, 1.0])}
+    note = _zeros(SimpleNamespace(outputs={"r": ev}), "r", 4)
+    assert "is 100-100 %" in note and "at least 100 %" in note and "e+" not in note, note

@@ -234,13 +234,19 @@ def _zeros(region, cid: str, k: int) -> str:
     low = z < 0.1
     f0 = 1 / (k + 2)  # the smoothed share of a table with no zero (paired_count)
     return (
-        f"the share of blocks that lose none is {100 * z.min():.2g}-{100 * z.max():.2g} % "
+        f"the share of blocks that lose none is {_pct(z.min())}-{_pct(z.max())} % "
         f"over the vectors (under 10 % at {int(low.sum())} of {z.size}), the upper end of "
-        f"its interval at least {100 * hi.min():.2g} %: the row fails at a vector only where "
+        f"its interval at least {_pct(hi.min())} %: the row fails at a vector only where "
         f"that end is under 2.5 % (a block losing none rarer than one in forty), which "
         f"{k} pairs cannot show: with none of them losing none it still reaches about "
-        f"{100 * min(1.0, z_box(k) * np.sqrt(f0 * (1 - f0) / k)):.2g} %"  # a share: <= 100 %
+        f"{_pct(min(1.0, z_box(k) * np.sqrt(f0 * (1 - f0) / k)))} %"  # a share: <= 100 %
     )
+
+
+def _pct(share: float) -> str:
+    """A share as a percentage of two significant digits, 100 as 100 (``:.2g`` wrote 1e+02)."""
+    p = 100 * float(share)
+    return f"{p:.0f}" if abs(p) >= 99.5 else f"{p:.2g}"
 
 
 def _fresh(book) -> ClaimBook:

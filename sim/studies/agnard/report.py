@@ -169,8 +169,12 @@ def _rejection_line(c: dict, out: Path, cfg: dict) -> str:
         f"{_span(dig)} pass points per block{over} "
         f"(*{dig['verdict']}*); mechanical pugging "
         f"{fmt(mech['value'])} % "
-        f"(the re-centring error {recentre_words(cfg)}), mean "
-        f"share against that re-centring error: {sens}."
+        + (
+            f"(the re-centring error {recentre_words(cfg)}), mean "
+            if cfg["snoop.max_reject"]
+            else "(none by construction: snoop.max_reject = 0, no snooping), mean "
+        )
+        + f"share against that re-centring error: {sens}."
     )
 
 
