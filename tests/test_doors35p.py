@@ -14,9 +14,11 @@ each failed on the code before its fix.
   ``tradeoff.block_models``, ``tradeoff.block_control``): at 10,000 the 'centre' of every block
   was all of its check points, and ``tradeoff_block.parquet`` and README.md printed the
   accuracy "at the centre" as the same numbers as the whole block's (agnard_block_104: centre
-  XY 0.2192 m = all check XY 0.2192 m); a 1 x 1 block's default 10 were 10 of its 12. A centre
+  XY 0.2192 m = all check XY 0.2192 m); a 1 x 1 block's default 10 were 10 of its 12, and at
+  ``block.ground_points = 22`` the 1 x 8 block compared had no check point at all. A centre
   of more than half a compared block's check points is now refused on load, naming the block
-  and its count (:mod:`sim.studies.agnard.centre`).
+  and its count, and a compared block of fewer than 2 check points is named as such
+  (:mod:`sim.studies.agnard.centre`).
 * ``agnard_block``: ``snoop.max_reject = 0`` (no data snooping) with the mechanical-pugging row
   ``agnard.pass_rejections.mechanical_pct``: no block can lose a pass point, so the share was
   0 % by construction, whatever ``pugging.recentre_px``, and the row was decided against the
@@ -87,6 +89,9 @@ def test_a_centre_of_most_of_a_compared_block_is_refused(capsys):
     argv = ["check", str(AGNARD), "--set", "tradeoff.centre_points=10000"]
     line = one_line(capsys, main(argv), "tradeoff.centre_points", "2 x 4 block", prefix=SIM_ERROR)
     assert "83 check points" in line and "at most 41" in line, line
+    # a compared block left without check points is named as such, not given a centre of 0
+    argv = ["check", str(AGNARD), "--set", "block.ground_points=22"]
+    one_line(capsys, main(argv), "tradeoff.block_models", "has 0 check points", prefix=SIM_ERROR)
     tiny = ["--set", "tradeoff.block_strips=[1]", "--set", "tradeoff.block_models=[1]"]
     one_line(capsys, main(["check", str(AGNARD), *tiny]), "12 check points", prefix=SIM_ERROR)
     with pytest.raises(sim.ConfigError) as e:

@@ -4,7 +4,9 @@ at the main block's density of signalised points) and the rule on their 'centre'
 are at most half of its check points (the signalised points not in its
 ``tradeoff.block_control`` layout). At ``tradeoff.centre_points = 10000`` the 'centre' of every
 block compared was all of its check points, and its accuracy 'at the centre' the same numbers
-as the whole block's, printed in two columns of ``tradeoff_block.parquet`` and README.md."""
+as the whole block's, printed in two columns of ``tradeoff_block.parquet`` and README.md. A
+compared block of fewer than 2 check points (``block.ground_points = 22``: the 1 x 8 block's
+every point in its control) has no centre at all and is named as such."""
 
 from __future__ import annotations
 
@@ -51,6 +53,15 @@ def check_centre_points(cfg: dict, block: Block) -> None:
     values, d = tuple(cfg[x] for x in BLOCK_KEYS), ground_density(block)
     sizes = zip(cfg["tradeoff.block_strips"], cfg["tradeoff.block_models"])
     n, s, m = min((_check_points(values, s, m, d, control), s, m) for s, m in sizes)
+    if n < 2:  # no centre of at most half its check points: the block, not the centre
+        raise ConfigError(
+            "tradeoff.block_models",
+            f"the {s} x {m} block compared (tradeoff.block_strips, tradeoff.block_models) has "
+            f"{n} check points at the main block's density of signalised points "
+            f"(block.ground_points), the rest in its {control!r} control "
+            "(tradeoff.block_control): it needs at least 2 to state an accuracy at the centre; "
+            "compare larger blocks or raise block.ground_points",
+        )
     if 2 * k > n:  # the block of the fewest check points, so that the bound given is one
         raise ConfigError(
             "tradeoff.centre_points",
