@@ -48,6 +48,13 @@ each failed on the code before its fix.
 * The note of the digital-rejection row printed its shares with ``:.2g``: "the share of blocks
   that lose none is 1e+02-1e+02 % ..., at least 1e+02 %" (agnard_block_104's committed
   claims). A share of 100 % is now written 100 (:func:`sim.studies.agnard.decide._pct`).
+* A network's direction or angle ``sigma_arcsec`` up to 1e6 (277 degrees, within the weights'
+  range): its readings wrapped around the circle, so at 1e6 the global test's false-alarm
+  self-check "failed" (0 of 400 trials in [0, 0.0095]) and the orientations' Monte-Carlo
+  sigma (218,720 arcsec) fell short of the analytic 258,199: the suite's own checks failing
+  on a legal key. An angle's sigma now stops at 1e5 arcsec (27.8 degrees), in a study file
+  and in a ``gama-local`` file (:data:`sim.studies.network.validate.WRAPS`); a bias, a
+  constant offset, keeps its 1e6.
 """
 
 from __future__ import annotations
@@ -183,3 +190,13 @@ def test_a_share_of_all_blocks_is_written_100_percent():
     ev = {"share_zero": np.array([1.0, 1.0]), "share_zero_high": np.array([1.0, 1.0])}
     note = _zeros(SimpleNamespace(outputs={"r": ev}), "r", 4)
     assert "is 100-100 %" in note and "at least 100 %" in note and "e+" not in note, note
+
+
+def test_an_angle_sigma_that_wraps_around_the_circle_is_refused(capsys):
+    net = ROOT / "studies" / "network_testfield.toml"
+    obs = '[{ kind = "angle", at = "N6", from = "N5", to = "N7", sigma_arcsec = 1e6 }]'
+    argv = ["check", str(net), "--set", f"network.observations={obs}"]
+    one_line(capsys, main(argv), "sigma_arcsec", "wraps around the circle", prefix=SIM_ERROR)
+    ok = obs.replace("1e6", "1e5")
+    assert main(["check", str(net), "--set", f"network.observations={ok}"]) == 0
+    capsys.readouterr()
