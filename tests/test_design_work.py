@@ -195,6 +195,7 @@ def test_a_block_adjustment_counts_with_the_models_of_its_block():
         "tradeoff.dpis=[600.0]",
         "tradeoff.block_strips=[1]",
         "tradeoff.block_models=[3]",
+        "tradeoff.centre_points=1",  # the 1 x 3 block at 4 x 25's density has 2 check points
         "tradeoff.block_trials=2",
         "tradeoff.recentre_px=[0.5]",
         "region.trials=2",

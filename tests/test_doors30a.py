@@ -339,7 +339,7 @@ def test_agnard_recentring_is_not_said_to_match_when_the_run_changed_it(monkeypa
     unprinted re-centring error 'is set so the share matches' the paper's; the run's is not."""
     from sim.studies.agnard.schema import SCHEMA, recentre_words
 
-    cfg = {"pugging.recentre_px": 0.7}
+    cfg = {"pugging.recentre_px": 0.7, "snoop.max_reject": 25}  # snooping (doors35p)
     assert recentre_words(cfg).startswith("unprinted: this run's 0.7 px, the default 0.5 px")
     default = {"pugging.recentre_px": SCHEMA["pugging.recentre_px"].default}
     assert recentre_words(default) == "unprinted, set so the share matches the paper: an input"

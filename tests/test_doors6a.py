@@ -113,14 +113,15 @@ def test_a_nul_in_the_gama_path_is_named(tmp_path):
 
 
 def test_the_gama_stdev_range_is_the_studys_in_its_unit(tmp_path):
-    """A direction of 3e6 cc is 925,926 arcsec, within the study's 1e6 arcsec (what the
-    suite exports for sigma_arcsec = 1e6 is 3.09e6 cc): read. 3.3e6 cc (1.07e6 arcsec) and
-    a distance over 1e9 mm are refused, naming the element and the unit."""
-    ok = read_gama(_gama(tmp_path, DIR, DIR.replace("4.62962962962963", "3e6")))
+    """A direction of 3e5 cc is 97,200 arcsec, within the study's 1e5 arcsec (what the
+    suite exports for sigma_arcsec = 1e5 is 3.09e5 cc; 1e6 until doors35p): read. 3.3e5 cc
+    (106,920 arcsec) and a distance over 1e9 mm are refused, naming the element and the
+    unit."""
+    ok = read_gama(_gama(tmp_path, DIR, DIR.replace("4.62962962962963", "3e5")))
     sig = [o["sigma_arcsec"] for o in ok["network.observations"] if o["kind"] == "direction"]
-    assert max(sig) == pytest.approx(3e6 * 3240 / 10000, rel=1e-12)
+    assert max(sig) == pytest.approx(3e5 * 3240 / 10000, rel=1e-12)
     _refused(
-        _gama(tmp_path, DIR, DIR.replace("4.62962962962963", "3.3e6")),
+        _gama(tmp_path, DIR, DIR.replace("4.62962962962963", "3.3e5")),
         "<direction>",
         "'stdev'",
         "arcsec",

@@ -479,7 +479,7 @@ def _pts(**change):
                 ]
             },
             "network.observations[0].sigma_arcsec",
-            "over- or underflow",
+            "wraps around the circle",  # an angle's bound, 1e5 arcsec, is the tighter (doors35p)
         ),
         (
             {"network.offset_mm": 192094.0},

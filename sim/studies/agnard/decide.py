@@ -48,6 +48,9 @@ __all__ = ["five_region", "scanner_region", "over_scanner", "over_joint"]
 #: how a region row undecided everywhere begins (sim.claims.region.region_row)
 UNDECIDABLE = "undecidable: no input of the region decides it"
 
+#: the share of pass points that mechanical pugging's snooping removes (:func:`without_snooping`)
+MECHANICAL = "agnard.pass_rejections.mechanical_pct"
+
 
 def five_region(cfg, block, book, runner, part, prov, out):
     """Explore the five-point layout (``region.toml``) at the configured scanner and write
@@ -231,13 +234,19 @@ def _zeros(region, cid: str, k: int) -> str:
     low = z < 0.1
     f0 = 1 / (k + 2)  # the smoothed share of a table with no zero (paired_count)
     return (
-        f"the share of blocks that lose none is {100 * z.min():.2g}-{100 * z.max():.2g} % "
+        f"the share of blocks that lose none is {_pct(z.min())}-{_pct(z.max())} % "
         f"over the vectors (under 10 % at {int(low.sum())} of {z.size}), the upper end of "
-        f"its interval at least {100 * hi.min():.2g} %: the row fails at a vector only where "
+        f"its interval at least {_pct(hi.min())} %: the row fails at a vector only where "
         f"that end is under 2.5 % (a block losing none rarer than one in forty), which "
         f"{k} pairs cannot show: with none of them losing none it still reaches about "
-        f"{100 * min(1.0, z_box(k) * np.sqrt(f0 * (1 - f0) / k)):.2g} %"  # a share: <= 100 %
+        f"{_pct(min(1.0, z_box(k) * np.sqrt(f0 * (1 - f0) / k)))} %"  # a share: <= 100 %
     )
+
+
+def _pct(share: float) -> str:
+    """A share as a percentage of two significant digits, 100 as 100 (``:.2g`` wrote 1e+02)."""
+    p = 100 * float(share)
+    return f"{p:.0f}" if abs(p) >= 99.5 else f"{p:.2g}"
 
 
 def _fresh(book) -> ClaimBook:
@@ -325,10 +334,12 @@ def _findings(region: Region) -> Region:
 
 
 def without_snooping(cfg: dict, rows: list[dict]) -> list[dict]:
-    """With ``snoop.max_reject = 0`` no pass point can be removed, so the rejection row
-    (the paper: digital pugging removes none) would hold by construction, not by the
-    simulation: it is undecidable, saying why (the region verdict the count would have had,
-    "holds at all ... points", is dropped from the note: :func:`_how_of`)."""
+    """With ``snoop.max_reject = 0`` no pass point can be removed, so the rejection rows
+    would be decided by construction, not by the simulation: the digital row (the paper:
+    digital pugging removes none) would hold, the mechanical share (the paper: 6.5 %) is 0 %
+    whatever the re-centring error and would fail ("input (fails)" at 40 plates, every block
+    "below the paper's value"). Both are undecidable, saying why (the region verdict the count
+    would have had, "holds at all ... points", is dropped from the note: :func:`_how_of`)."""
     if cfg["snoop.max_reject"]:
         return rows
     why = (
@@ -344,6 +355,13 @@ def without_snooping(cfg: dict, rows: list[dict]) -> list[dict]:
             "note": f"{why}; {_how_of(r['note'])}",
         }
         if r["claim"] == REJECTED and r["kind"] == "prediction"
+        else {
+            **r,
+            "outcome": "undecidable",
+            "holds": None,
+            "note": f"{why.replace('the count', 'the share')}; {r['note']}",
+        }
+        if r["claim"] == MECHANICAL
         else r
         for r in rows
     ]

@@ -169,8 +169,12 @@ def _rejection_line(c: dict, out: Path, cfg: dict) -> str:
         f"{_span(dig)} pass points per block{over} "
         f"(*{dig['verdict']}*); mechanical pugging "
         f"{fmt(mech['value'])} % "
-        f"(the re-centring error {recentre_words(cfg)}), mean "
-        f"share against that re-centring error: {sens}."
+        + (
+            f"(the re-centring error {recentre_words(cfg)}), mean "
+            if cfg["snoop.max_reject"]
+            else "(none by construction: snoop.max_reject = 0, no snooping), mean "
+        )
+        + f"share against that re-centring error: {sens}."
     )
 
 
@@ -278,6 +282,11 @@ def _adjustment_choice(cfg: dict, prov: dict, out: Path) -> str:
 
 
 def _snooping_choice(cfg: dict, sxy: float, sz: float) -> str:
+    if not cfg["snoop.max_reject"]:  # it said "the worst pass point is removed ..."
+        return (
+            "- *Data snooping*: none (snoop.max_reject = 0): no pass point is removed, so "
+            "snoop.alpha and snoop.test decide nothing."
+        )
     crit = float(D.norm_ppf(1 - cfg["snoop.alpha"] / 2))
     return (
         f"- *Data snooping*: Baarda's w-test on each residual component, w = v / (sigma0 "
@@ -396,15 +405,18 @@ def _block_table(out: Path, cfg: dict) -> list[str]:
     ]
 
 
-def _pugging_table(out: Path) -> list[str]:
+def _pugging_table(out: Path, cfg: dict) -> list[str]:
     """Sensitivity of the pass-point rejections to the re-centring error."""
     body = [
         [fmt(r["recentre_px"]), r["trials"], _se(r, "mean_share_pct")]
         for r in rows(out, "tradeoff_pugging.parquet")
     ]
+    none = "; snoop.max_reject = 0: none is rejected, whatever the error" * (
+        not cfg["snoop.max_reject"]
+    )
     return [
         "**Sensitivity: mechanical re-centring error against pass-point rejections** "
-        "(no gross errors; the snooping weights are those of digital measurement):",
+        f"(no gross errors; the snooping weights are those of digital measurement{none}):",
         md_table(["re-centring (px)", "trials", "pass points rejected (%)"], body),
     ]
 
@@ -423,7 +435,7 @@ def report(out: Path) -> str:
             *_scanner_table(out),
             *_layout_table(out, cfg),
             *_block_table(out, cfg),
-            *_pugging_table(out),
+            *_pugging_table(out, cfg),
         ],
         figures=[
             ("scanner deformation", "scanner_field.png"),

@@ -32,6 +32,7 @@ from sim.studies import RunContext
 from sim.studies.agnard import chunks as ch
 from sim.studies.agnard import decide as dc
 from sim.studies.agnard import figures as fg
+from sim.studies.agnard.centre import ground_density
 from sim.studies.agnard.claims import claim_rows, load_book
 from sim.studies.agnard.schema import NAME, SCHEMA, block_of, five_control
 from sim.studies.agnard.simulate import centre_points
@@ -156,8 +157,7 @@ def _control_table(cfg, block, sim, prov, out):
 
 
 def _size_table(cfg, block, ctx, base, prov, out):
-    x0, x1, y0, y1 = block.extent()
-    density = block.n_ground / ((x1 - x0) * (y1 - y0) * 1e-6)
+    density = ground_density(block)
     t = {
         k: []
         for k in (

@@ -21,6 +21,7 @@ from sim.instruments.block.layout import (
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import unless
 from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, reals
+from sim.studies.agnard.centre import check_centre_points
 from sim.studies.agnard.datum import check_datum, region_insets
 
 SEED = "003_5ce730a990a7ebc5.txt"
@@ -193,7 +194,11 @@ SCHEMA = {
         "perimeter", "str", "control layout of the block-size runs", choices=CONTROL_PATTERNS
     ),
     "tradeoff.centre_points": count(
-        10, "check points nearest the block centre used for 'accuracy at the centre'", 1, 10_000
+        10,
+        "check points nearest the block centre used for 'accuracy at the centre' (at most half "
+        "the check points of each block compared: checked on load)",
+        1,
+        10_000,
     ),
     "region.trials": count(
         150, "simulated blocks per input vector of the region (region.toml)", 2, 1_000_000
@@ -278,6 +283,7 @@ def check(cfg: dict) -> None:
             "the block has no pass points (no point seen by two "
             "models): raise block.pass_rows or the overlaps",
         )
+    check_centre_points(cfg, block)
     names = [cfg["control.table1"], cfg["control.few"], cfg["control.many"]]
     layouts = {n: select_control(block, n) for n in dict.fromkeys(names + cfg["tradeoff.layouts"])}
     for u in region_insets():  # the region's five-point layouts (region.toml)

@@ -26,8 +26,16 @@ ARCSEC = math.pi / (180 * 3600)
 ROLES = ("free", "fixed", "observed")
 _ANGULAR = (1, 2)
 #: accepted ranges of the standard deviations: the weights 1 / sigma^2 stay far from
-#: overflow and underflow, and the normal equations within double precision
-SIGMA_RANGE = {"mm": (1e-9, 1e9), "arcsec": (1e-9, 1e6)}
+#: overflow and underflow, and the normal equations within double precision; an angle's at
+#: most 1e5 arcsec (27.8 degrees, a reading off by pi once in 1e10), see :data:`WRAPS`
+SIGMA_RANGE = {"mm": (1e-9, 1e9), "arcsec": (1e-9, 1e5)}
+#: why an angle's sigma stops at 1e5 arcsec: a direction of sigma 1e6 arcsec (277
+#: degrees, within the weights' range) drew readings that wrap around the circle, so the
+#: global test's false-alarm self-check failed (0 of 400 trials) and the orientations' Monte
+#: Carlo sigma disagreed with the analytic one: a Gaussian angle that spread is no reading
+WRAPS = "an angle that large wraps around the circle (at most 27.8 degrees)"
+#: the largest bias: a constant offset does not spread, so an angle's may pass 27.8 degrees
+BIAS_BOUND = {"mm": 1e9, "arcsec": 1e6}
 
 
 def _memory_limit() -> float:
@@ -267,16 +275,18 @@ def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
         raise ConfigError(f"{key}.kind", f"must be one of {', '.join(KINDS[:5])} (got {kind!r})")
     code = KINDS.index(kind)
     unit, other = ("arcsec", "mm") if code in _ANGULAR else ("mm", "arcsec")
-    if f"sigma_{other}" in rec or f"bias_{other}" in rec:
-        raise ConfigError(f"{key}.sigma_{other}", f"a {kind} takes sigma_{unit} and bias_{unit}")
+    wrong = [f for f in (f"sigma_{other}", f"bias_{other}") if f in rec]
+    if wrong:  # the field given (an angle's bias_mm was named its sigma_mm)
+        a = "an" if kind[0] in "aeiou" else "a"
+        raise ConfigError(f"{key}.{wrong[0]}", f"{a} {kind} takes sigma_{unit} and bias_{unit}")
     if f"sigma_{unit}" not in rec:
         raise ConfigError(f"{key}.sigma_{unit}", "missing")
     sig = _num(f"{key}.sigma_{unit}", rec[f"sigma_{unit}"], 0.0, lo_open=True)
     lo, hi = SIGMA_RANGE[unit]
     if not lo <= sig <= hi:
+        why = WRAPS if unit == "arcsec" and sig > hi else "its weight would over- or underflow"
         raise ConfigError(
-            f"{key}.sigma_{unit}",
-            f"{sig:g} is outside [{lo:g}, {hi:g}] {unit}: its weight would over- or underflow",
+            f"{key}.sigma_{unit}", f"{sig:g} is outside [{lo:g}, {hi:g}] {unit}: {why}"
         )
     if "set" in rec and code != 1:
         raise ConfigError(f"{key}.set", f"only a direction has an orientation set (a {kind})")
@@ -296,6 +306,7 @@ def _obs_common(key: str, rec: dict) -> tuple[int, float, float]:
             "overflow",
         )
     bias = _num(f"{key}.bias_{unit}", rec.get(f"bias_{unit}", 0.0))
+    hi = BIAS_BOUND[unit]
     if not abs(bias) <= hi:
         raise ConfigError(f"{key}.bias_{unit}", f"{bias:g} is outside [-{hi:g}, {hi:g}] {unit}")
     f = ARCSEC if code in _ANGULAR else 1.0
