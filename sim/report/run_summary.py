@@ -20,11 +20,12 @@ import pyarrow.parquet as pq
 
 from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS, printed_differs
 from sim.mc.config import ConfigError
-from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
+from sim.mc.storage import atomic_path, read_provenance, read_record, write_record
+from sim.mc.table_shape import kind
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.config_diff import config_line
 from sim.report.papers import paper_name
-from sim.report.read import TableError, columns, forget, records
+from sim.report.read import TableError, checked_table, columns, forget, records
 from sim.report.sweep import sweep_markdown
 from sim.report.tables import fmt, md_code, md_text
 
@@ -104,7 +105,7 @@ def region_line(out: Path) -> str | None:
     p = Path(out) / "consistent_region.parquet"
     if not p.is_file():
         return None
-    t = read_table(p)
+    t = checked_table(p)
     parts = []
     for name in t.column_names:
         if name == "confirmed" or name.endswith("__value"):
@@ -144,7 +145,11 @@ def _trials_converged(p: Path) -> str | None:
     names = [c for c in pq.read_schema(p).names if c.endswith(".converged")]
     if not names:
         return None
-    t = pq.read_table(p, columns=names)
+    t = checked_table(p).select(names)
+    for c in names:  # as text, "False" read as true (numpy): every trial converged
+        if not pa.types.is_boolean(t.column(c).type) or t.column(c).null_count:
+            what = f"{kind(t.column(c).type)}" + (", with nulls" if t.column(c).null_count else "")
+            raise TableError(p, f"column {c!r} is {what}, not a trial's true or false")
     bad = {c: ~np.asarray(t.column(c).to_numpy(zero_copy_only=False), bool) for c in names}
     some = np.any(list(bad.values()), axis=0)
     if not some.any():
@@ -164,9 +169,12 @@ def _summary_converged(p: Path) -> str | None:
     summary sentence and its claims' notes (lead32)."""
     if not p.is_file() or not {"trials", "converged"} <= set(pq.read_schema(p).names):
         return None
-    t = pq.read_table(p, columns=["trials", "converged"]).to_pylist()
-    if len(t) != 1 or not all(isinstance(v, int) for v in t[0].values()):
-        return None
+    t = checked_table(p).select(["trials", "converged"]).to_pylist()
+    if len(t) != 1:
+        raise TableError(p, f"has {len(t)} rows, not one")
+    for c, v in t[0].items():  # (a count as text or null: the line left out without a word)
+        if type(v) is not int:
+            raise TableError(p, f"column {c!r} holds {v!r:.40}, not a count of trials")
     n, ok = t[0]["trials"], t[0]["converged"]
     if ok >= n:
         return None
