@@ -31,10 +31,19 @@ each read by ``sim show``, ``sim show --markdown``, ``sim report``, ``sim.Result
 * ``make verify`` passed a committed number column rewritten as text (or true/false): the
   comparison took it for a text column whose changes are not failures. A column of another
   kind than the re-run's fails, naming the file and column.
+* ``make verify`` of a table whose tolerance declarations were edited (schema metadata
+  ``sim.tolerances`` not JSON, or a list) ended in a JSONDecodeError or TypeError traceback:
+  the table fails, naming the metadata.
+* ``sim report`` read a claims table whole (every row as Python objects) before checking it:
+  a table of a million rows (its rows repeated) took a minute to be named, and a claims table
+  whose provenance names another study than its ``run.json`` was read as that study's
+  results, and blamed on "another version of the suite's code" for the tables that study
+  has. It is checked as ``sim show`` checks it, first.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 from pathlib import Path
@@ -93,6 +102,11 @@ def test_a_column_retyped_by_hand_is_named_with_its_file_and_column(tiny_run, tm
     pq.write_table(t, f, row_group_size=1)
     assert main(["show", str(d), "--markdown"]) == 0
     assert sim.Results(d, "brown_table1").table("not_reproduced").num_rows > 0
+    record = json.loads((d / "run.json").read_text("utf-8"))  # a record edited into no shape
+    record["table_shape"]["not_reproduced.parquet"]["rows"] = 10**400  # (was printed whole)
+    (d / "run.json").write_text(json.dumps(record), "utf-8")
+    _edit(f, lambda t: _column(t, "source", [True] * t.num_rows))
+    assert main(["show", str(d), "--markdown"]) == 0 and len(capsys.readouterr().err) < 400
 
 
 @pytest.mark.parametrize(
@@ -193,3 +207,26 @@ def test_verify_fails_a_number_column_committed_as_text(tiny_run, tmp_path):
     assert not comp.ok and "points.parquet:sigma_x_um: string committed, double re-run" in str(
         comp.failures
     ), comp.failures
+
+
+def test_verify_names_tolerance_declarations_edited_by_hand(tiny_run, tmp_path):
+    d = _copy(tiny_run, tmp_path)
+    scratch = tmp_path / "scratch"
+    shutil.copytree(tiny_run("brown_table1"), scratch / "brown_table1")
+    f = d / "claims.parquet"
+    t = pq.read_table(f)
+    for raw in (b"{{", b"[1]"):
+        pq.write_table(t.replace_schema_metadata({**t.schema.metadata, b"sim.tolerances": raw}), f)
+        [comp] = verify(d.parent, scratch, rerun=False)  # was a traceback
+        assert not comp.ok and "'sim.tolerances'" in str(comp.failures), comp.failures
+
+
+def test_report_names_a_claims_table_of_another_study_than_its_run(tiny_run, tmp_path, capsys):
+    d = _copy(tiny_run, tmp_path)
+    f = d / "claims.parquet"
+    t = pq.read_table(f)
+    prov = json.loads(t.schema.metadata[b"sim.provenance"])
+    meta = {**t.schema.metadata, b"sim.provenance": json.dumps({**prov, "study": "brown_dilution"})}
+    pq.write_table(t.replace_schema_metadata(meta), f)
+    line = one_line(capsys, main(["report", "--results", str(d.parent)]), "claims.parquet")
+    assert "a table of 'brown_dilution', not of this run's 'brown_table1'" in line, line

@@ -103,15 +103,20 @@ def recorded_shape(path: str | Path) -> dict | None:
 def _is_shape(s: Any) -> bool:
     """Whether ``s`` is a shape as :func:`shape` makes it (a record edited into another form,
     or of a version that recorded none, is not one: its table is not checked)."""
-    if not isinstance(s, dict) or type(s.get("rows")) is not int:
+    if not isinstance(s, dict) or not _count_of(s.get("rows")):
         return False
     cols = s.get("columns")
     if not isinstance(cols, dict) or not all(isinstance(v, str) for v in cols.values()):
         return False
     return all(
-        isinstance(s.get(k, {}), dict) and all(type(v) is int for v in s.get(k, {}).values())
+        isinstance(s.get(k, {}), dict) and all(_count_of(v) for v in s.get(k, {}).values())
         for k in ("nulls", "nan", "inf")
     )
+
+
+def _count_of(v: Any) -> bool:
+    """A count a table can hold (an int of 10**400 in an edited record was printed whole)."""
+    return type(v) is int and 0 <= v < 2**63
 
 
 _WORDS = {"nulls": "null", "nan": "NaN", "inf": "infinite"}
@@ -139,7 +144,7 @@ def shape_problem(table: pa.Table, recorded: dict | None) -> str | None:
         if now["columns"][c] != k:
             return f"column {c!r} is {now['columns'][c]} where its run wrote {k}"
     if now["rows"] != recorded["rows"]:
-        return f"it holds {now['rows']:,} rows where its run wrote {recorded['rows']:,}"
+        return f"has {now['rows']:,} rows where its run wrote {recorded['rows']:,}"
     for what, word in _WORDS.items():
         have, had = now.get(what, {}), recorded.get(what, {})
         for c in want:

@@ -23,12 +23,9 @@ from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
 from sim.report.glance import by_paper, design_notes, main_and_variants, number, opening
 from sim.report.papers import paper_name
 from sim.report.read import (
-    TableError,
+    check_claims_table,
     checked_table,
-    claims_damage,
     forget,
-    mixed_run,
-    older,
     records,
 )
 from sim.report.run_summary import converged_line, headline_rows, write_run_readme
@@ -202,30 +199,16 @@ def referee_summary(entries: list[tuple]) -> str:
 
 def _claims_of(d: Path, get_study: Callable):
     """``(study, provenance, claim rows)`` of a results directory, or one line naming the file
-    when its ``claims.parquet`` is not a claims table written by the suite."""
+    when its ``claims.parquet`` is not a claims table its run wrote (as ``sim show`` checks it,
+    :func:`~sim.report.read.check_claims_table`: reading its two columns first, a table of a
+    million rows is named at once, and one of another study than its run.json's is named as
+    such, not read as that study's results)."""
     f = d / "claims.parquet"
+    check_claims_table(f, "--results")
     try:
-        prov = read_provenance(f) or {}
-        claims = records(f, shaped=False)  # its shape after what it holds and whose it is
+        return get_study(read_provenance(f)["study"]), read_provenance(f), records(f)
     except (OSError, ValueError, pa.ArrowException) as e:
         raise ConfigError("--results", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
-    if "study" not in prov or (claims and not {"claim", "verdict"} <= set(claims[0])):
-        names = claims[0] if claims else ()
-        raise ConfigError(
-            "--results", f"{f} is not a claims table written by sim{older(prov, names)}"
-        )
-    damage = claims_damage(prov, [r["verdict"] for r in claims], [r["claim"] for r in claims])
-    if damage:
-        raise ConfigError("--results", f"{f} is not a claims table written by sim: {damage}")
-    if (mixed := mixed_run(d)) is not None:
-        raise ConfigError("--results", mixed)
-    try:
-        checked_table(f)
-    except TableError as e:
-        raise ConfigError(
-            "--results", f"{f} is not the claims table its run wrote: {e.what}"
-        ) from None
-    return get_study(prov["study"]), prov, claims
 
 
 _RULES = (
