@@ -39,6 +39,9 @@ each read by ``sim show``, ``sim show --markdown``, ``sim report``, ``sim.Result
   whose provenance names another study than its ``run.json`` was read as that study's
   results, and blamed on "another version of the suite's code" for the tables that study
   has. It is checked as ``sim show`` checks it, first.
+* A sweep's ``sweep.parquet`` rewritten without its schema metadata was listed by ``sim show``
+  without the swept values of its cells (the keys are in its provenance), and ``--markdown``
+  said "a table under DIR is not as sim wrote it (KeyError: 'study')", naming no file.
 """
 
 from __future__ import annotations
@@ -230,3 +233,31 @@ def test_report_names_a_claims_table_of_another_study_than_its_run(tiny_run, tmp
     pq.write_table(t.replace_schema_metadata(meta), f)
     line = one_line(capsys, main(["report", "--results", str(d.parent)]), "claims.parquet")
     assert "a table of 'brown_dilution', not of this run's 'brown_table1'" in line, line
+
+
+SWEEP = """study = "network"
+trials = 40
+chunk = 2
+[network]
+name = "n"
+points = [
+  { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+  { name = "B", x_mm = 1000.0, y_mm = 0.0, role = "fixed" },
+  { name = "C", x_mm = 400.0, y_mm = 700.0 },
+]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
+[sweep]
+"network.scale_ppm" = [0.0, 10.0]
+"""
+
+
+def test_a_sweep_table_without_its_provenance_is_named(tmp_path, capsys):
+    f = tmp_path / "s.toml"
+    f.write_text(SWEEP, "utf-8")
+    out = tmp_path / "R" / "s"
+    assert main(["run", str(f), "--out", str(out), "--quiet", "--no-figures"]) == 0
+    assert main(["show", str(out)]) == 0 and "network.scale_ppm" in capsys.readouterr().out
+    p = out / "sweep.parquet"
+    pq.write_table(pq.read_table(p).replace_schema_metadata(None), p)
+    for args in (["show", str(out)], ["show", str(out), "--markdown"]):
+        one_line(capsys, main(args), "sweep.parquet under", "'sim.provenance'")

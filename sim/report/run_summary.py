@@ -223,12 +223,13 @@ def terminal_table(out: Path, width: int = 100, design: Callable | None = None) 
     interval, verdict), then the counts; a sweep directory as its cells. ``design``: see
     :func:`run_markdown` (what the run changed from its study file, a line at the end)."""
     out = Path(out)
-    cfg = read_provenance(out / ("claims.parquet" if _kind_of(out) == "study" else "sweep.parquet"))
+    study = _kind_of(out) == "study"
+    cfg = read_provenance(out / "claims.parquet") if study else _sweep_prov(out)
     changed = config_line(cfg.get("config") or {}, out.name, design)
     tail = "" if changed is None else f"\n{changed}"
     if _kind_of(out) == "sweep":  # each cell with its swept values (cell0003_r0 alone named
         t = columns(out / "sweep.parquet")  # no setting), and where its claims are
-        keys = [k for k in read_provenance(out / "sweep.parquet").get("sweep_keys", []) if k in t]
+        keys = [k for k in cfg["sweep_keys"] if k in t]
         rows = [
             [
                 t["label"][i],
@@ -248,6 +249,25 @@ def terminal_table(out: Path, width: int = 100, design: Callable | None = None) 
     table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
     conv = converged_line(out)
     return table + "\n\n" + verdict_line(claims) + ("" if conv is None else f"\n{conv}") + tail
+
+
+def _sweep_prov(out: Path) -> dict:
+    """The provenance of a sweep's ``sweep.parquet``; a :class:`TableError` naming it when it
+    names no study and swept keys (rewritten by a tool that drops schema metadata: its cells
+    were listed without their swept values, or "a table ... (KeyError: 'study')")."""
+    p = Path(out) / "sweep.parquet"
+    prov = read_provenance(p)
+    prov = prov if isinstance(prov, dict) else {}
+    keys = prov.get("sweep_keys")
+    if not isinstance(prov.get("study"), str) or not isinstance(keys, list):
+        raise TableError(
+            p,
+            "its provenance (schema metadata 'sim.provenance') names no study "
+            "and swept keys: rewritten by a tool?",
+        )
+    if not all(isinstance(k, str) for k in keys):
+        raise TableError(p, f"its provenance's swept keys are not names ({keys!r:.60})")
+    return prov
 
 
 def _text_table(header: list[str], rows: list[list], width: int) -> str:
@@ -307,7 +327,7 @@ def run_markdown(
     forget()
     kind = _kind_of(out)
     src = out / ("claims.parquet" if kind == "study" else "sweep.parquet")
-    prov = read_provenance(src)
+    prov = read_provenance(src) if kind == "study" else _sweep_prov(out)
     study = get_study(prov["study"])
     paper = paper_name(study.seed_file, full=True)
     head = [
