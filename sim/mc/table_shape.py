@@ -43,8 +43,10 @@ __all__ = [
 
 #: the key of the run record that holds every table's shape, by its path under the results
 SHAPE_KEY = "table_shape"
-#: the kinds of a number column (:func:`kind`; ``null``: a column of no value at all)
-NUMBERS = frozenset({"int", "double", "float", "halffloat", "null"})
+#: the kinds of a number column (:func:`kind`)
+NUMBERS = frozenset({"int", "double", "float", "halffloat"})
+#: what a number column may be (``null``: a column of no value at all, as pyarrow types it)
+_NUMBERISH = NUMBERS | {"null"}
 #: the tolerance kinds declared only with number columns (:mod:`sim.mc.tolerance`)
 _NUMBER_RULES = frozenset({"arithmetic", "axial", "circular", "mc", "chain"})
 
@@ -169,6 +171,6 @@ def declared_problem(table: pa.Table) -> str | None:
     for i, c in enumerate(table.column_names):
         spec = specs.get(c)
         k = kind(table.column(i).type)
-        if isinstance(spec, dict) and spec.get("kind") in _NUMBER_RULES and k not in NUMBERS:
+        if isinstance(spec, dict) and spec.get("kind") in _NUMBER_RULES and k not in _NUMBERISH:
             return f"column {c!r} is {k} where sim writes numbers"
     return None
