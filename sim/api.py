@@ -45,6 +45,7 @@ from sim.mc.pyvalue import as_config_value
 from sim.mc.storage import read_provenance
 from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
+from sim.mc.table_shape import recorded_shape, shape_problem
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
 from sim.report.run_summary import write_run_readme
@@ -169,6 +170,8 @@ class Results:
             _check_owner(p, self.study)
             if (mixed := mixed_run(self.path, [p.name])) is not None:  # copied from another run
                 raise ConfigError("table", mixed)
+            if (edit := shape_problem(table, recorded_shape(p))) is not None:  # edited by hand
+                raise ConfigError("table", f"{p} is not the table its run wrote: {edit}")
         self._check_dir()  # replaced while it was read
         return table
 

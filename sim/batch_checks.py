@@ -30,6 +30,7 @@ from sim.mc.paths import absolute
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
 from sim.mc.sweep import read_sweep
+from sim.mc.table_edits import edited_tables
 from sim.places import base
 from sim.report.read import mixed_table
 from sim.studies import get_study
@@ -90,7 +91,9 @@ def why_stale(
     mixed = mixed_table(Path(results), missing_ok=False)
     if mixed is not None:
         return f"{mixed[0].name} is not of the run of run.json: {mixed[1]}"
-    return changed_figure(Path(results))  # a figure replaced by hand: drawn again
+    if edited := edited_tables(Path(results)):  # a table edited by hand: made again, as a
+        return f"{edited[0]} changed after its run (sha256 not run.json's: edited by hand?)"
+    return changed_figure(Path(results))  # figure replaced by hand is drawn again
 
 
 def _clashes(files: list[Path], run_args: list[str], results: str = "results") -> list[str]:

@@ -11,7 +11,7 @@ from pathlib import Path
 from sim.mc.codehash import study_code_hash
 from sim.mc.outputs import results_dirs
 from sim.mc.storage import read_record
-from sim.report.read import TableError, damaged_message, last_read
+from sim.report.read import EditedTable, TableError, damaged_message, last_read
 
 __all__ = ["cwd_exists", "from_stdout", "os_reason", "not_as_written", "older_lacks", "other_code"]
 
@@ -56,6 +56,8 @@ def not_as_written(d: Path, e: Exception) -> str:
     written by another version of the suite (results of an older clone: then said so, of the
     failing table's own results directory when its run record says so)."""
     msg = damaged_message(d, e)
+    if isinstance(e, EditedTable):  # not its run's shape, which that run recorded: an edit
+        return msg
     own = _table_dir(d, e)
     if own is not None and other_code(own) == str(own):  # the table's own run is older:
         # it is as that version wrote it ("not as sim wrote it" blamed a hand edit)

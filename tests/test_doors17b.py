@@ -160,7 +160,7 @@ def test_a_claims_or_summary_table_edited_by_hand_is_one_line_naming_it(tmp_path
     one = pq.read_table(summary)
     for bad in (one.slice(0, 0), pa.concat_tables([one, one])):
         pq.write_table(bad.replace_schema_metadata(one.schema.metadata), summary)
-        rows = f"has {bad.num_rows} rows, not one"
+        rows = f"has {bad.num_rows} rows"  # (where its run wrote 1: run.json's table_shape)
         one_line(capsys, main(["report", "--results", str(out.parent)]), "summary.parquet", rows)
 
 

@@ -27,7 +27,8 @@ from sim.mc.outputs import swap_dir
 from sim.mc.paths import mounts_under
 from sim.mc.pids import writer_gone
 from sim.mc.runner import ChunkStore
-from sim.mc.storage import LOCK, read_record, write_record
+from sim.mc.storage import LOCK, read_record, read_table, write_record
+from sim.mc.table_shape import SHAPE_KEY, shape
 
 __all__ = ["seal", "publish", "damaged_chunks", "changed_figure", "drawn", "file_sha256"]
 
@@ -57,8 +58,15 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
     figures = {f: file_sha256(stage / f) for f in files if f.endswith(".png")}
     # the tables' too: make verify tells a table edited after its run from a failed re-run
     tables = {f: file_sha256(stage / f) for f in files if "/" not in f and f.endswith(".parquet")}
+    # and every table's shape (a sweep's cells' too): its readers tell a table edited by hand
+    shapes = {f: shape(read_table(stage / f)) for f in files if _a_table(f)}
     record = {**rec, "files": files, "chunk_sha256": chunks, "figure_sha256": figures}
-    write_record(stage, {**record, "table_sha256": tables})
+    write_record(stage, {**record, "table_sha256": tables, SHAPE_KEY: shapes})
+
+
+def _a_table(f: str) -> bool:
+    """A table of the results (not a chunk of the ``trials/`` dataset)."""
+    return f.endswith(".parquet") and "trials" not in f.split("/")[:-1]
 
 
 def _recorded_figures(out: Path) -> dict | None:

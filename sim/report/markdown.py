@@ -17,12 +17,17 @@ from sim.claims.rules import NOT_APPLICABLE, P_FAIL, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
-from sim.mc.storage import atomic_path, read_provenance, read_table
+from sim.mc.storage import atomic_path, read_provenance
 from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
 from sim.report.glance import by_paper, design_notes, main_and_variants, number, opening
 from sim.report.papers import paper_name
-from sim.report.read import claims_damage, forget, mixed_run, older, records
+from sim.report.read import (
+    check_claims_table,
+    checked_table,
+    forget,
+    records,
+)
 from sim.report.run_summary import converged_line, headline_rows, write_run_readme
 from sim.report.tables import Md, fmt, md_href, md_link, md_table
 from sim.report.verify import markdown as reproducibility_markdown
@@ -194,24 +199,16 @@ def referee_summary(entries: list[tuple]) -> str:
 
 def _claims_of(d: Path, get_study: Callable):
     """``(study, provenance, claim rows)`` of a results directory, or one line naming the file
-    when its ``claims.parquet`` is not a claims table written by the suite."""
+    when its ``claims.parquet`` is not a claims table its run wrote (as ``sim show`` checks it,
+    :func:`~sim.report.read.check_claims_table`: reading its two columns first, a table of a
+    million rows is named at once, and one of another study than its run.json's is named as
+    such, not read as that study's results)."""
     f = d / "claims.parquet"
+    check_claims_table(f, "--results")
     try:
-        prov = read_provenance(f) or {}
-        claims = records(f)
+        return get_study(read_provenance(f)["study"]), read_provenance(f), records(f)
     except (OSError, ValueError, pa.ArrowException) as e:
         raise ConfigError("--results", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
-    if "study" not in prov or (claims and not {"claim", "verdict"} <= set(claims[0])):
-        names = claims[0] if claims else ()
-        raise ConfigError(
-            "--results", f"{f} is not a claims table written by sim{older(prov, names)}"
-        )
-    damage = claims_damage(prov, [r["verdict"] for r in claims], [r["claim"] for r in claims])
-    if damage:
-        raise ConfigError("--results", f"{f} is not a claims table written by sim: {damage}")
-    if (mixed := mixed_run(d)) is not None:
-        raise ConfigError("--results", mixed)
-    return get_study(prov["study"]), prov, claims
 
 
 _RULES = (
@@ -246,7 +243,7 @@ def _entry(d: Path, get_study: Callable) -> tuple:
     study, prov, claims = _claims_of(d, get_study)
     c = verdict_counts(claims)
     nr = d / "not_reproduced.parquet"
-    n_nr = read_table(nr).num_rows if nr.is_file() else 0
+    n_nr = checked_table(nr).num_rows if nr.is_file() else 0
     row = [Md(f"{md_link(d.name)}: {study.title}"), paper_name(study.seed_file) or "—"]
     row += [c[k] for k, _ in _COUNT_COLS]
     apart = [

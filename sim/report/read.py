@@ -28,10 +28,13 @@ from sim.claims.rules import VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.publish import changed_figure
 from sim.mc.storage import read_provenance, read_record, read_table
+from sim.mc.table_shape import declared_problem, recorded_shape, shape_problem
 
 __all__ = [
     "check_claims_table",
+    "checked_table",
     "TableError",
+    "EditedTable",
     "columns",
     "records",
     "last_read",
@@ -57,8 +60,13 @@ class TableError(ValueError):
         super().__init__(f"{path}: {what}")
 
 
-def _note(path: Path, key: str) -> None:
-    _LAST.where = (path, key)
+class EditedTable(TableError):
+    """A table not of the shape its own run recorded: edited after that run, whatever version
+    of the suite's code made it (not a table an older version wrote otherwise)."""
+
+
+def _note(path: Path, key: str, record: int | None = None) -> None:
+    _LAST.where, _LAST.record = (path, key), record
 
 
 def last_read() -> tuple[Path, str] | None:
@@ -69,7 +77,7 @@ def last_read() -> tuple[Path, str] | None:
 def forget() -> None:
     """Start a directory's report: no column read yet (an error before the first is not
     blamed on another directory's table)."""
-    _LAST.where = None
+    _LAST.where, _LAST.record = None, None
 
 
 class Columns(dict):
@@ -87,30 +95,58 @@ class Columns(dict):
     def __missing__(self, key):
         raise TableError(self.path, f"has no column {key!r}")
 
+    def get(self, key, default=None):  # read and remembered as ``[key]`` is (not blamed on
+        return self[key] if key in self else default  # the column read before it)
+
 
 class Row(Columns):
-    """One row of a table, ``{column: value}``; a missing column raises :class:`TableError`."""
+    """One row of a table, ``{column: value}``, the table's ``index``-th (from 0); a missing
+    column raises :class:`TableError`. A value read is remembered with its row: an error on
+    it names the record, not only the column (a claims table's 15 rows hold one bad value)."""
+
+    def __init__(self, path: Path, data: dict, index: int):
+        super().__init__(path, data)
+        self.index = index
+
+    def __getitem__(self, key):
+        value = dict.__getitem__(self, key)
+        _note(self.path, key, self.index)
+        return value
 
 
-def _read(path: Path) -> pa.Table:
-    """The table; a file that is there but not Parquet raises :class:`TableError` (a missing
-    or unreadable one raises the OSError, which the command reports with its reason)."""
+def checked_table(path: str | Path, shaped: bool = True) -> pa.Table:
+    """The table at ``path``; a file that is there but not Parquet, or not of the shape its
+    run recorded (:func:`~sim.mc.table_shape.shape_problem`: a column retyped, renamed,
+    blanked, a row added by hand; ``shaped``), raises :class:`TableError` (a missing or
+    unreadable one raises the OSError, which the command reports with its reason). A table of
+    a run that recorded no shape (an older version's) is checked for what its columns declare
+    (:func:`~sim.mc.table_shape.declared_problem`: a number column as text)."""
+    path = Path(path)
     try:
-        return read_table(path)
+        table = read_table(path)
     except pa.ArrowException as e:
         raise TableError(path, f"cannot be read ({str(e).splitlines()[0][:200]})") from None
+    if not shaped:
+        return table
+    if (recorded := recorded_shape(path)) is None:  # an older version's run: what it declares
+        if (why := declared_problem(table)) is not None:
+            raise TableError(path, why)
+    elif (why := shape_problem(table, recorded)) is not None:
+        raise EditedTable(path, why)
+    return table
 
 
 def columns(path: str | Path) -> dict[str, list]:
     """The columns of the table at ``path`` (``to_pydict``), checked as the module says."""
     path = Path(path)
-    return Columns(path, _read(path).to_pydict())
+    return Columns(path, checked_table(path).to_pydict())
 
 
-def records(path: str | Path) -> list[dict[str, Any]]:
-    """The rows of the table at ``path`` (``to_pylist``), checked as the module says."""
+def records(path: str | Path, shaped: bool = True) -> list[dict[str, Any]]:
+    """The rows of the table at ``path`` (``to_pylist``), checked as the module says (its
+    shape only when ``shaped``: a claims table is first checked for what it holds)."""
     path = Path(path)
-    return [Row(path, r) for r in _read(path).to_pylist()]
+    return [Row(path, r, i) for i, r in enumerate(checked_table(path, shaped).to_pylist())]
 
 
 def _under(path: Path, root: Path) -> str | None:
@@ -130,7 +166,9 @@ def damaged_message(root: Path, e: Exception) -> str:
     if isinstance(e, TableError):
         where, why = _under(e.path, root) or str(e.path), e.what
     elif lr is not None and _under(lr[0], root) is not None:  # (not a stale one elsewhere)
-        where, why = _under(lr[0], root), f"column {lr[1]!r}: {why}"
+        at = getattr(_LAST, "record", None)
+        row = "" if at is None else f" of record {at} (from 0)"
+        where, why = _under(lr[0], root), f"column {lr[1]!r}{row}: {why}"
     else:
         return f"a table under {root} is not as sim wrote it ({why}); run its study again"
     return f"{where} under {root} is not as sim wrote it ({why}); run its study again"
@@ -161,13 +199,21 @@ def claims_damage(prov: dict, verdicts: list, claims: list | None = None) -> str
 
 
 def older(prov: dict, names) -> str:
-    """``: ...`` for a claims table of an older version of the suite (its provenance names the
-    study, but it has no ``verdict`` column: the results/ of an old clone), else ``""``."""
+    """What follows "is not a claims table written by sim" for a table with provenance ``prov``
+    and columns ``names``: `` of this version: ...`` for a claims table of an older version of
+    the suite (its provenance names the study, but it has no ``verdict`` column: the results/
+    of an old clone), else ``: ...`` naming what it lacks (its provenance, the study in it, the
+    ``claim`` or ``verdict`` column), or ``""``."""
     if isinstance(prov, dict) and isinstance(prov.get("study"), str) and "holds" in names:
         return (
             " of this version: an older version's table (no 'verdict' column); run its study again"
         )
-    return ""
+    if not prov:  # (the line named nothing: "... is not a claims table written by sim")
+        return ": it carries no provenance (schema metadata 'sim.provenance': rewritten by a tool?)"
+    if "study" not in prov:
+        return ": its provenance names no study"
+    lacks = sorted({"claim", "verdict"} - set(names))
+    return f": it has no column {lacks[0]!r}" if lacks else ""
 
 
 def check_claims_table(f: Path, key: str) -> None:
@@ -198,6 +244,10 @@ def check_claims_table(f: Path, key: str) -> None:
         )
     if (mixed := mixed_run(f.parent)) is not None:
         raise ConfigError(key, mixed)
+    try:  # (after the checks above: a table of another run is named as such, not by shape)
+        checked_table(f)
+    except TableError as e:
+        raise ConfigError(key, f"{f} is not the claims table its run wrote: {e.what}") from None
 
 
 def _other_run(prov: Any, record: dict) -> str | None:

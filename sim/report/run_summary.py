@@ -20,11 +20,12 @@ import pyarrow.parquet as pq
 
 from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS, printed_differs
 from sim.mc.config import ConfigError
-from sim.mc.storage import atomic_path, read_provenance, read_record, read_table, write_record
+from sim.mc.storage import atomic_path, read_provenance, read_record, write_record
+from sim.mc.table_shape import kind
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.config_diff import config_line
 from sim.report.papers import paper_name
-from sim.report.read import TableError, columns, forget, records
+from sim.report.read import TableError, checked_table, columns, forget, records
 from sim.report.sweep import sweep_markdown
 from sim.report.tables import fmt, md_code, md_text
 
@@ -104,7 +105,7 @@ def region_line(out: Path) -> str | None:
     p = Path(out) / "consistent_region.parquet"
     if not p.is_file():
         return None
-    t = read_table(p)
+    t = checked_table(p)
     parts = []
     for name in t.column_names:
         if name == "confirmed" or name.endswith("__value"):
@@ -144,7 +145,11 @@ def _trials_converged(p: Path) -> str | None:
     names = [c for c in pq.read_schema(p).names if c.endswith(".converged")]
     if not names:
         return None
-    t = pq.read_table(p, columns=names)
+    t = checked_table(p).select(names)
+    for c in names:  # as text, "False" read as true (numpy): every trial converged
+        if not pa.types.is_boolean(t.column(c).type) or t.column(c).null_count:
+            what = f"{kind(t.column(c).type)}" + (", with nulls" if t.column(c).null_count else "")
+            raise TableError(p, f"column {c!r} is {what}, not a trial's true or false")
     bad = {c: ~np.asarray(t.column(c).to_numpy(zero_copy_only=False), bool) for c in names}
     some = np.any(list(bad.values()), axis=0)
     if not some.any():
@@ -164,9 +169,12 @@ def _summary_converged(p: Path) -> str | None:
     summary sentence and its claims' notes (lead32)."""
     if not p.is_file() or not {"trials", "converged"} <= set(pq.read_schema(p).names):
         return None
-    t = pq.read_table(p, columns=["trials", "converged"]).to_pylist()
-    if len(t) != 1 or not all(isinstance(v, int) for v in t[0].values()):
-        return None
+    t = checked_table(p).select(["trials", "converged"]).to_pylist()
+    if len(t) != 1:
+        raise TableError(p, f"has {len(t)} rows, not one")
+    for c, v in t[0].items():  # (a count as text or null: the line left out without a word)
+        if type(v) is not int:
+            raise TableError(p, f"column {c!r} holds {v!r:.40}, not a count of trials")
     n, ok = t[0]["trials"], t[0]["converged"]
     if ok >= n:
         return None
@@ -215,12 +223,13 @@ def terminal_table(out: Path, width: int = 100, design: Callable | None = None) 
     interval, verdict), then the counts; a sweep directory as its cells. ``design``: see
     :func:`run_markdown` (what the run changed from its study file, a line at the end)."""
     out = Path(out)
-    cfg = read_provenance(out / ("claims.parquet" if _kind_of(out) == "study" else "sweep.parquet"))
+    study = _kind_of(out) == "study"
+    cfg = read_provenance(out / "claims.parquet") if study else _sweep_prov(out)
     changed = config_line(cfg.get("config") or {}, out.name, design)
     tail = "" if changed is None else f"\n{changed}"
     if _kind_of(out) == "sweep":  # each cell with its swept values (cell0003_r0 alone named
         t = columns(out / "sweep.parquet")  # no setting), and where its claims are
-        keys = [k for k in read_provenance(out / "sweep.parquet").get("sweep_keys", []) if k in t]
+        keys = [k for k in cfg["sweep_keys"] if k in t]
         rows = [
             [
                 t["label"][i],
@@ -240,6 +249,25 @@ def terminal_table(out: Path, width: int = 100, design: Callable | None = None) 
     table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
     conv = converged_line(out)
     return table + "\n\n" + verdict_line(claims) + ("" if conv is None else f"\n{conv}") + tail
+
+
+def _sweep_prov(out: Path) -> dict:
+    """The provenance of a sweep's ``sweep.parquet``; a :class:`TableError` naming it when it
+    names no study and swept keys (rewritten by a tool that drops schema metadata: its cells
+    were listed without their swept values, or "a table ... (KeyError: 'study')")."""
+    p = Path(out) / "sweep.parquet"
+    prov = read_provenance(p)
+    prov = prov if isinstance(prov, dict) else {}
+    keys = prov.get("sweep_keys")
+    if not isinstance(prov.get("study"), str) or not isinstance(keys, list):
+        raise TableError(
+            p,
+            "its provenance (schema metadata 'sim.provenance') names no study "
+            "and swept keys: rewritten by a tool?",
+        )
+    if not all(isinstance(k, str) for k in keys):
+        raise TableError(p, f"its provenance's swept keys are not names ({keys!r:.60})")
+    return prov
 
 
 def _text_table(header: list[str], rows: list[list], width: int) -> str:
@@ -299,7 +327,7 @@ def run_markdown(
     forget()
     kind = _kind_of(out)
     src = out / ("claims.parquet" if kind == "study" else "sweep.parquet")
-    prov = read_provenance(src)
+    prov = read_provenance(src) if kind == "study" else _sweep_prov(out)
     study = get_study(prov["study"])
     paper = paper_name(study.seed_file, full=True)
     head = [

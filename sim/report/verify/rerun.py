@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import errno
 import os
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -18,8 +17,8 @@ from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.overrides import listed, replayable, without
 from sim.mc.paths import link_problem
-from sim.mc.publish import file_sha256
 from sim.mc.storage import LOCK, read_provenance, read_record
+from sim.mc.table_edits import edited_tables
 from sim.report.read import check_claims_table
 from sim.report.verify.child import busy_words, launcher, names_one_of, system_error
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
@@ -314,31 +313,11 @@ def _judge(d: Path, target: Path, sf: Path | None, mode: str, given: list[str]) 
     return comp
 
 
-#: the name of a table of a results directory's top level, as ``table_sha256`` records it
-_TABLE = re.compile(r"[^/\\\x00]+\.parquet")
-
-
 def _edited(d: Path) -> str | None:
     """The tables of the committed results ``d`` changed after their run wrote them (their
     sha256 is not the one ``run.json`` records), or None: a verdict edited by hand, rows
     reordered or duplicated were listed as deviations of a failed reproduction."""
-    rec = read_record(d) or {}
-    sums = rec.get("table_sha256")
-    if not isinstance(sums, dict):
-        return None  # an older version's record: the comparison decides
-    changed = []
-    for name, digest in sorted(sums.items()):
-        # a table's name as seal() records it, read only as a regular file: a name of a
-        # run.json edited by hand was read as it stood ("x\0y": a ValueError traceback; a
-        # FIFO: a hang; "../..": a file outside the results)
-        if not _TABLE.fullmatch(name):
-            continue  # not a name seal() writes
-        p = d / name
-        try:
-            if not p.is_file() or p.is_symlink() or file_sha256(p) != digest:
-                changed.append(name)
-        except OSError:
-            changed.append(name)
+    changed = edited_tables(d)
     if not changed:
         return None
     return (

@@ -14,6 +14,7 @@ import pyarrow.parquet as pq
 
 from sim.mc import tolerance as tl
 from sim.mc.storage import read_provenance, read_tolerances
+from sim.mc.table_shape import NUMBERS, kind
 
 __all__ = [
     "compare_dirs",
@@ -70,11 +71,27 @@ def _legacy(prov: dict, fname: str) -> dict:
     return out
 
 
-def _specs(a: Path, b: Path) -> tuple[dict, dict]:
-    """The committed table's declarations (else the re-run's), and the re-run's own."""
-    sa, sb = read_tolerances(a), read_tolerances(b)
+def _specs(a: Path, b: Path, ta: pa.Table, tb: pa.Table) -> tuple[dict, dict]:
+    """The committed table's declarations (else the re-run's), and the re-run's own; a
+    ValueError naming the table whose declarations are not as sim writes them (its schema
+    metadata edited: not JSON, not an object of columns, a rule of no kind), which the
+    comparison read as they stood (a JSONDecodeError or TypeError traceback)."""
+    sa, sb = _declared(a, ta, "committed"), _declared(b, tb, "re-run")
     legacy = _legacy(read_provenance(a), a.name)
     return {**sb, **legacy, **sa}, sb
+
+
+def _declared(p: Path, t: pa.Table, side: str) -> dict:
+    try:
+        specs = read_tolerances(p)
+        if not isinstance(specs, dict) or not all(isinstance(v, dict) for v in specs.values()):
+            raise ValueError("not an object of column rules")
+        return tl.validate(specs, t)
+    except (ValueError, TypeError, RecursionError) as e:
+        raise ValueError(
+            f"{p.name}: the {side} table's tolerance declarations (schema metadata "
+            f"'sim.tolerances') are not as sim writes them ({str(e)[:120]})"
+        ) from None
 
 
 def _spec(specs: dict, name: str, col: str, t: pa.DataType) -> dict | None:
@@ -213,7 +230,11 @@ def compare_tables(a: Path, b: Path, cmp: Comparison, mode: str = "full") -> Non
         diff = sorted(set(ta.column_names) ^ set(tb.column_names)) or "their order"
         cmp.failures.append(f"{name}: columns differ ({diff})")
         return
-    specs, sb = _specs(a, b)
+    try:
+        specs, sb = _specs(a, b, ta, tb)
+    except ValueError as e:
+        cmp.failures.append(str(e))
+        return
     if ta.num_rows != tb.num_rows:
         if mode == "full":
             cmp.failures.append(f"{name}: {ta.num_rows} rows committed, {tb.num_rows} re-run")
@@ -222,6 +243,10 @@ def compare_tables(a: Path, b: Path, cmp: Comparison, mode: str = "full") -> Non
         return
     for c in ta.column_names:
         ca, cb = ta.column(c), tb.column(c)
+        ka, kb = kind(ca.type), kind(cb.type)
+        if ka != kb and not {ka, kb} <= NUMBERS:  # numbers as text, true/false: not compared
+            cmp.failures.append(f"{name}:{c}: {ka} committed, {kb} re-run")
+            continue
         spec = _spec(specs, name, c, ca.type)
         if mode == "mc" and spec is not None and not _at_mc_level(spec):
             continue

@@ -1,0 +1,176 @@
+"""The shape of each table a run wrote, recorded in its ``run.json`` (``table_shape``) and
+checked by every reader of the results (``sim show``, ``sim report``, ``Results.table``).
+
+A table edited by hand (with pandas, DuckDB, a spreadsheet's export) still parses, and the
+readers read it as the run's: a text column retyped as true/false printed ``True`` where the
+paper's source stood, a null printed ``None``, a number column written as text was printed as
+the text, a column renamed from ``_mm`` to ``_um`` was printed in the wrong unit, a row
+duplicated was counted twice. The shape of a table is what such edits change and a faithful
+rewrite (other row groups, dictionary encoding, a wider text type, another integer width)
+keeps:
+
+* its number of rows;
+* each column's name and kind (the Arrow type, with a dictionary read as its values, every
+  text type as ``string``, every integer width as ``int``);
+* per column, how many of its values are null, and per floating column how many are NaN and
+  how many infinite (a key column's value blanked or set to NaN by hand).
+
+:func:`shape_problem` says, in a few words naming the column, how a table differs from the
+shape its run recorded; results of a version that recorded none (or a record edited into
+another form) are not checked.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+import pyarrow.compute as pc
+
+from sim.mc import tolerance
+from sim.mc.storage import read_record
+
+__all__ = [
+    "SHAPE_KEY",
+    "NUMBERS",
+    "kind",
+    "shape",
+    "recorded_shape",
+    "shape_problem",
+    "declared_problem",
+]
+
+#: the key of the run record that holds every table's shape, by its path under the results
+SHAPE_KEY = "table_shape"
+#: the kinds of a number column (:func:`kind`)
+NUMBERS = frozenset({"int", "double", "float", "halffloat"})
+#: what a number column may be (``null``: a column of no value at all, as pyarrow types it)
+_NUMBERISH = NUMBERS | {"null"}
+#: the tolerance kinds declared only with number columns (:mod:`sim.mc.tolerance`)
+_NUMBER_RULES = frozenset({"arithmetic", "axial", "circular", "mc", "chain"})
+
+
+def kind(t: pa.DataType) -> str:
+    """A column's kind: its Arrow type, a dictionary as its values, every text type as
+    ``string``, every integer width as ``int``, a list by the kind of its items."""
+    if pa.types.is_dictionary(t):
+        return kind(t.value_type)
+    if pa.types.is_string(t) or pa.types.is_large_string(t):
+        return "string"
+    if pa.types.is_integer(t):
+        return "int"
+    if pa.types.is_list(t) or pa.types.is_large_list(t):
+        return f"list<{kind(t.value_type)}>"
+    return str(t)
+
+
+def _count(mask: Any) -> int:
+    return int(pc.sum(mask).as_py() or 0)
+
+
+def shape(table: pa.Table) -> dict:
+    """``{"rows": n, "columns": {name: kind}, "nulls"|"nan"|"inf": {name: count}}`` of a
+    table (the counts only where not zero)."""
+    cols: dict[str, str] = {}
+    counts: dict[str, dict[str, int]] = {"nulls": {}, "nan": {}, "inf": {}}
+    for i, name in enumerate(table.column_names):
+        col = table.column(i)
+        cols[name] = kind(col.type)
+        found = {"nulls": col.null_count}
+        if pa.types.is_floating(col.type):
+            found["nan"], found["inf"] = _count(pc.is_nan(col)), _count(pc.is_inf(col))
+        for what, k in found.items():
+            if k:
+                counts[what][name] = k
+    return {"rows": table.num_rows, "columns": cols, **{k: v for k, v in counts.items() if v}}
+
+
+def recorded_shape(path: str | Path) -> dict | None:
+    """The shape the run record of ``path``'s results directory recorded for it (a table of
+    a sweep's cell, ``cells/<label>/x.parquet``, is in the sweep's record), or None."""
+    path = Path(path)
+    spots = [(path.parent, path.name)]
+    if path.parent.parent.name == "cells":
+        spots.append((path.parent.parent.parent, f"cells/{path.parent.name}/{path.name}"))
+    for root, key in spots:
+        rec = read_record(root)
+        if rec is not None:
+            shapes = rec.get(SHAPE_KEY)
+            found = shapes.get(key) if isinstance(shapes, dict) else None
+            return found if _is_shape(found) else None
+    return None
+
+
+def _is_shape(s: Any) -> bool:
+    """Whether ``s`` is a shape as :func:`shape` makes it (a record edited into another form,
+    or of a version that recorded none, is not one: its table is not checked)."""
+    if not isinstance(s, dict) or not _count_of(s.get("rows")):
+        return False
+    cols = s.get("columns")
+    if not isinstance(cols, dict) or not all(isinstance(v, str) for v in cols.values()):
+        return False
+    return all(
+        isinstance(s.get(k, {}), dict) and all(_count_of(v) for v in s.get(k, {}).values())
+        for k in ("nulls", "nan", "inf")
+    )
+
+
+def _count_of(v: Any) -> bool:
+    """A count a table can hold (an int of 10**400 in an edited record was printed whole)."""
+    return type(v) is int and 0 <= v < 2**63
+
+
+_WORDS = {"nulls": "null", "nan": "NaN", "inf": "infinite"}
+
+
+def shape_problem(table: pa.Table, recorded: dict | None) -> str | None:
+    """How ``table`` differs from the shape its run ``recorded`` (a few words naming the
+    column: ``column 'x' is string where its run wrote double``), or None (the same, or
+    nothing recorded to check it against)."""
+    if not _is_shape(recorded):
+        return None
+    names = table.column_names
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        return f"it has the column {twice[0]!r} twice"
+    now, want = shape(table), recorded["columns"]
+    gone = [c for c in want if c not in now["columns"]]
+    new = [c for c in now["columns"] if c not in want]
+    if gone:
+        instead = f" (it has {new[0]!r} in its place: renamed by hand?)" if new else ""
+        return f"has no column {gone[0]!r}{instead}"
+    if new:
+        return f"column {new[0]!r} is not one its run wrote"
+    for c, k in want.items():
+        if now["columns"][c] != k:
+            return f"column {c!r} is {now['columns'][c]} where its run wrote {k}"
+    if now["rows"] != recorded["rows"]:
+        return f"has {now['rows']:,} rows where its run wrote {recorded['rows']:,}"
+    for what, word in _WORDS.items():
+        have, had = now.get(what, {}), recorded.get(what, {})
+        for c in want:
+            if have.get(c, 0) != had.get(c, 0):
+                return (
+                    f"column {c!r} holds {have.get(c, 0):,} {word} value(s) where its run "
+                    f"wrote {had.get(c, 0) or 'none'}"
+                )
+    return None
+
+
+def declared_problem(table: pa.Table) -> str | None:
+    """For a table whose run recorded no shape (an older version's results): a column declared
+    with a rule for numbers (its tolerance, :mod:`sim.mc.tolerance`) that holds no numbers
+    (retyped as text by hand), in a few words naming it, or None."""
+    try:
+        specs = tolerance.decode(table.schema.metadata)
+    except (ValueError, RecursionError):  # metadata edited into no JSON: not checked
+        return None
+    if not isinstance(specs, dict):
+        return None
+    for i, c in enumerate(table.column_names):
+        spec = specs.get(c)
+        k = kind(table.column(i).type)
+        if isinstance(spec, dict) and spec.get("kind") in _NUMBER_RULES and k not in _NUMBERISH:
+            return f"column {c!r} is {k} where sim writes numbers"
+    return None
