@@ -100,6 +100,7 @@ class Estimate:
     analytic: float = 0.0  # adjustment-equivalents of the largest analytic part (one cell)
     analytic_key: str = ""  # the key that sets that part's size (``design.grids``)
     analytic_part: str = ""  # that part, named
+    memory_keys: tuple = ()  # the keys that set ``bytes`` (the refusal names them), if known
 
     def describe(self, workers: int = 1) -> str:
         """One line: trials, adjustments (analytic parts in adjustment-equivalents, each
@@ -171,15 +172,23 @@ def _salsig(c: Mapping) -> tuple:
     ) * sum(_n(v) for k, v in c.items() if k.startswith("consistency.") and isinstance(v, list))
     trials = 3 * T + cells * pT + relief
     adj = 6 * T + 3 * cells * pT + 2 * relief
-    n = max(marks, grid, pm, c.get("zscale.points", 9), c.get("vertical.control", 6))
-    b = ch * (SALSIG_TRIAL_BYTES + n * SALSIG_POINT_BYTES)
+    counts = {
+        "marks.grid": marks,
+        "grid.points": grid,
+        "power.marks": pm,
+        "zscale.points": c.get("zscale.points", 9),
+        "vertical.control": c.get("vertical.control", 6),
+    }
+    most = max(counts, key=counts.get)  # the key of the most points
+    b = ch * (SALSIG_TRIAL_BYTES + counts[most] * SALSIG_POINT_BYTES)
     # the region: region.trials models at each of region.points input vectors, all of them in
     # memory at once (measured, one core: 2.6 ms + 24 us a model a vector, 7.7 s for 1,024 x
     # 200 and 6.5 s for 128 x 2,000; 617 MB for 100,000 models of up to 20 control points)
     rT = c.get("region.trials", 0)
     adj += c.get("region.points", 0) * (51.0 + 0.47 * rT)
-    b = max(b, rT * SALSIG_REGION_MODEL_BYTES)
-    return trials, adj, 7, b
+    if rT * SALSIG_REGION_MODEL_BYTES > b:  # the region's models, all at once
+        return trials, adj, 7, rT * SALSIG_REGION_MODEL_BYTES, "", (0.0, "", ""), ("region.trials",)
+    return trials, adj, 7, b, "", (0.0, "", ""), ("chunk", most)
 
 
 #: bytes a trial of a salsig chunk holds, and per point (marks, grid intersections, elevations
@@ -291,7 +300,8 @@ ESTIMATORS: dict[str, Callable[[Mapping], tuple]] = {
 
 def _one(cfg: Mapping) -> tuple:
     """``(trials, adjustments, unknowns, bytes, the part needing the bytes or "", (analytic
-    adjustment-equivalents, key, part))``; an estimator may leave out the last two."""
+    adjustment-equivalents, key, part), the keys that set the bytes)``; an estimator may leave
+    out the last three."""
     fn = ESTIMATORS.get(cfg.get("study"), _generic)
     try:
         t, a, u, b, *rest = fn(cfg)
@@ -301,7 +311,8 @@ def _one(cfg: Mapping) -> tuple:
     a = fix(a) + _chunk_units(cfg, fix(t))
     what = rest[0] if rest else ""
     eq, key, part = rest[1] if len(rest) > 1 else (0.0, "", "")
-    return fix(t), a, fix(u), fix(b), what, (fix(eq), key, part)
+    keys = tuple(rest[2]) if len(rest) > 2 else ()
+    return fix(t), a, fix(u), fix(b), what, (fix(eq), key, part), keys
 
 
 def _chunk_units(cfg: Mapping, trials: float) -> float:
@@ -324,7 +335,7 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
     T = sum(p[0] for p in parts) * reps
     A = sum(p[1] for p in parts) * reps + (len(cfgs) * reps * CELL_UNITS if sweep else 0.0)
     U = max(p[2] for p in parts)
-    B, what = max((p[3], p[4]) for p in parts)
+    B, what, mkeys = max((p[3], p[4], p[6]) for p in parts)
     eq, key, part = max((p[5] for p in parts), key=lambda x: x[0])  # one cell's, not the sum
     big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
     return Estimate(
@@ -338,6 +349,7 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
         float(eq),
         key,
         part,
+        mkeys,
     )
 
 
@@ -378,7 +390,7 @@ def check_limits(
             f"{est.study}: the run needs {est.describe(workers)}, over the "
             f"{mem:g} GiB limit (--max-memory-gb or SIM_MAX_MEMORY_GB)"
             + (f", most of it for {est.largest}" if est.largest else "")
-            + "; reduce chunk, trials or the sizes in the study file",
+            + f"; reduce {_either(est.memory_keys)}",
         )
     if not est.adjustments <= adj:
         raise ConfigError(
@@ -398,6 +410,14 @@ def check_limits(
             "--max-adjustments or SIM_MAX_ADJUSTMENTS); use fewer points per side or fewer "
             "positions, extents, offsets or betas, or raise the limit",
         )
+
+
+def _either(keys: tuple) -> str:
+    """The keys that set a run's memory, as advice (``chunk, trials or plate.grid``); without
+    them, the words that cover every study."""
+    if not keys:
+        return "chunk, trials or the sizes in the study file"
+    return keys[0] if len(keys) == 1 else f"{', '.join(keys[:-1])} or {keys[-1]}"
 
 
 #: seconds of one core a chunk may take before the run says so: the progress bar moves once
