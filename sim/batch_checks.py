@@ -22,7 +22,7 @@ from sim.cli_args import parser as run_parser
 from sim.cli_errors import cwd_exists
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
-from sim.mc.estimate import check_limits, estimate
+from sim.mc.estimate import GIVEN_MEMORY_GB, check_limits, estimate
 from sim.mc.message_text import key_text
 from sim.mc.outputs import check_out
 from sim.mc.paths import absolute
@@ -136,7 +136,11 @@ def _configs_problems(
         try:
             schema = get_study(read_toml(f).get("study")).schema
             args.set = [t for t in base.set or [] if parse_override(t)[0] in schema]
-            study, cfg = load_run(args)
+            given = GIVEN_MEMORY_GB.set(args.max_memory_gb)  # (a large network's check)
+            try:
+                study, cfg = load_run(args)
+            finally:
+                GIVEN_MEMORY_GB.reset(given)
             check_chunks(cfg)
             sweep = read_sweep(f, study.schema)
             est = estimate(cfg, sweep)  # the limits its run applies (sim check's too)

@@ -36,7 +36,7 @@ from sim.cli_read import report, show
 from sim.ends import stdout_failed
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, config_changes, parse_override
-from sim.mc.estimate import check_limits, estimate
+from sim.mc.estimate import GIVEN_MEMORY_GB, check_limits, estimate
 from sim.mc.outputs import name_problem
 from sim.mc.overrides import command_values, recorded
 from sim.mc.paths import absolute
@@ -192,7 +192,11 @@ def _project_file(path: Path, name: str) -> bool:
 
 def _run(args) -> int:
     out = check_run_args(args)
-    study, cfg = load_run(args)
+    given = GIVEN_MEMORY_GB.set(args.max_memory_gb)  # the limit of a large network's check
+    try:
+        study, cfg = load_run(args)
+    finally:
+        GIVEN_MEMORY_GB.reset(given)
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
     overwrite = args.overwrite
     if out is None:
@@ -298,7 +302,7 @@ def _check(args) -> int:
             print(f"{toml_key(k)} = {toml_value(v)}")
     if off:  # said before the run: its predictions will be findings (sim.claims.rules)
         print(f"# {off_setup(study, cfg, before=True)}")
-    print(f"# work: {est.describe()}")
+    print(f"# work: {est.describe()}; {est.core_time()}")
     return 0
 
 

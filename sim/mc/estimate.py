@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 import os
+from contextvars import ContextVar
 from dataclasses import dataclass
 from numbers import Integral
 from typing import Any, Callable, Mapping
@@ -40,6 +41,7 @@ from sim.mc.brown_size import brown_estimate as _brown
 from sim.mc.config import ConfigError
 from sim.mc.network_size import network_estimate as _network
 from sim.mc.numtext import UnheldError, float_text
+from sim.mc.salsig_size import salsig_estimate as _salsig
 from sim.mc.sweep import MAX_CELLS, expand
 from sim.mc.workunits import (
     ADJUSTMENT_S,
@@ -57,6 +59,8 @@ __all__ = [
     "Estimate",
     "estimate",
     "check_limits",
+    "memory_limit",
+    "GIVEN_MEMORY_GB",
     "MAX_CELLS",
     "DEFAULT_MAX_MEMORY_GB",
     "DEFAULT_MAX_ADJUSTMENTS",
@@ -80,6 +84,10 @@ CHUNK_UNITS = 100.0
 #: of 4,000 trials were estimated at 4.7e8 (under the limit) and measured at about 16 hours
 CELL_UNITS = 1.5e4
 DEFAULT_MAX_MEMORY_GB = 8.0
+#: ``sim run --max-memory-gb`` while the study loads: the checks a study makes before its
+#: arrays are built (a large network's) apply the limit the run was given, not only
+#: ``SIM_MAX_MEMORY_GB`` (:func:`memory_limit`)
+GIVEN_MEMORY_GB: ContextVar[float | None] = ContextVar("GIVEN_MEMORY_GB", default=None)
 DEFAULT_MAX_ADJUSTMENTS = 5e8
 #: an analytic part (no progress bar, nothing to resume) may take at most this share of the
 #: work limit: 5e5 adjustment-equivalents, about 25 s on one core, at the default 5e8
@@ -120,6 +128,13 @@ class Estimate:
             "memory"
         )
 
+    def core_time(self) -> str:
+        """The work as time: ``about 2.5 min of one core`` (:data:`ADJUSTMENT_S` seconds an
+        adjustment on the reference machine; seconds under a minute)."""
+        s = self.adjustments * ADJUSTMENT_S
+        t = f"{s:.2g} s" if math.isfinite(s) and s < 60 else _minutes(s)
+        return f"about {t} of one core of the reference machine"
+
 
 def _gib(b: float) -> str:
     return f"{b / 2**30:.3g} GiB" if b >= 2**27 else f"{b / 2**20:.3g} MiB"
@@ -158,48 +173,6 @@ def _gridplate(c: Mapping) -> tuple:
     draw_s = 0.85e-3 + 1.25e-6 * c.get("region.draws", 0)
     region = pts * (draw_s / ADJUSTMENT_S + c.get("region.iter_calibrations", 0) * 2 * P)
     return T, T * per + region, U, b
-
-
-def _salsig(c: Mapping) -> tuple:
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
-    marks = c.get("marks.grid", 5) ** 2
-    grid = c.get("grid.points", 5) ** 2
-    pm = _max(c.get("power.marks"), 5) ** 2
-    cells = _n(c.get("power.marks", [])) * _n(c.get("power.sigma_um", []))
-    pT = c.get("power.trials", 0)
-    relief = _n(c.get("vertical.relief_sweep_mm", [])) * min(T, 5000) + c.get(
-        "consistency.trials", 0
-    ) * sum(_n(v) for k, v in c.items() if k.startswith("consistency.") and isinstance(v, list))
-    trials = 3 * T + cells * pT + relief
-    adj = 6 * T + 3 * cells * pT + 2 * relief
-    counts = {
-        "marks.grid": marks,
-        "grid.points": grid,
-        "power.marks": pm,
-        "zscale.points": c.get("zscale.points", 9),
-        "vertical.control": c.get("vertical.control", 6),
-    }
-    most = max(counts, key=counts.get)  # the key of the most points
-    b = ch * (SALSIG_TRIAL_BYTES + counts[most] * SALSIG_POINT_BYTES)
-    # the region: region.trials models at each of region.points input vectors, all of them in
-    # memory at once (measured, one core: 2.6 ms + 24 us a model a vector, 7.7 s for 1,024 x
-    # 200 and 6.5 s for 128 x 2,000; 617 MB for 100,000 models of up to 20 control points)
-    rT = c.get("region.trials", 0)
-    adj += c.get("region.points", 0) * (51.0 + 0.47 * rT)
-    if rT * SALSIG_REGION_MODEL_BYTES > b:  # the region's models, all at once
-        return trials, adj, 7, rT * SALSIG_REGION_MODEL_BYTES, "", (0.0, "", ""), ("region.trials",)
-    return trials, adj, 7, b, "", (0.0, "", ""), ("chunk", most)
-
-
-#: bytes a trial of a salsig chunk holds, and per point (marks, grid intersections, elevations
-#: or control points, the most of them): measured with tracemalloc, chunks of 1,000, the
-#: calibration chain 34 kB a trial at the paper's 5 x 5 marks and 97 kB at 20 x 20, the
-#: vertical fit 30 kB at 100 control points. The model before, 2,304 bytes a point with
-#: ``vertical.control`` (a count of points) squared, refused 100 control points at 21.5 GiB for
-#: a chunk of 30 MiB
-SALSIG_TRIAL_BYTES, SALSIG_POINT_BYTES = 4.0e4, 200.0
-#: bytes of one simulated model of salsig's region (6.2 kB measured, with copies' headroom)
-SALSIG_REGION_MODEL_BYTES = 1.0e4
 
 
 #: the main experiment's trial, measured (one core, chunks of 100): each of its sets + 2 fits
@@ -368,6 +341,15 @@ def _limit(given: float | None, env: str, default: float, key: str) -> float:
     if not math.isfinite(given) or given <= 0:
         raise ConfigError(key, f"must be a finite positive number (got {given!r})")
     return given
+
+
+def memory_limit() -> float:
+    """The memory limit in bytes while a study loads: ``sim run --max-memory-gb``
+    (:data:`GIVEN_MEMORY_GB`), else ``SIM_MAX_MEMORY_GB``, else the default."""
+    mem = _limit(
+        GIVEN_MEMORY_GB.get(), "SIM_MAX_MEMORY_GB", DEFAULT_MAX_MEMORY_GB, "--max-memory-gb"
+    )
+    return mem * 2**30
 
 
 def check_limits(

@@ -14,9 +14,9 @@ import math
 import numpy as np
 
 from sim.mc.config import ConfigError, did_you_mean
-from sim.mc.estimate import DEFAULT_MAX_MEMORY_GB, _limit
+from sim.mc.estimate import memory_limit
 from sim.mc.lookalike import differs, skeleton
-from sim.mc.network_size import state_bytes
+from sim.mc.network_size import network_counts, network_estimate, state_bytes
 
 __all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE", "MAX_NAME", "MAX_TITLE", "title"]
 
@@ -31,8 +31,43 @@ SIGMA_RANGE = {"mm": (1e-9, 1e9), "arcsec": (1e-9, 1e6)}
 
 
 def _memory_limit() -> float:
-    """The memory limit in bytes (``SIM_MAX_MEMORY_GB``, else the default)."""
-    return _limit(None, "SIM_MAX_MEMORY_GB", DEFAULT_MAX_MEMORY_GB, "SIM_MAX_MEMORY_GB") * 2**30
+    """The memory limit in bytes (``sim run --max-memory-gb``, else ``SIM_MAX_MEMORY_GB``,
+    else the default: :func:`sim.mc.estimate.memory_limit`)."""
+    return memory_limit()
+
+
+def fits_estimate(cfg: dict) -> None:
+    """Refuse, before the network is built and its normals factorised (minutes and most of
+    the memory of a large one), a run whose estimate (:func:`sim.mc.network_size.
+    network_estimate`, the memory ``sim check`` shows) is over the memory limit, naming the
+    key that declares the network's size (``network.gama_xml`` and its file, else
+    ``network.generate``, ``network.grids``, ``network.random`` or ``network.points``). The
+    estimate was applied after the load: a 90,000-point network under
+    ``SIM_MAX_MEMORY_GB=2`` was built and factorised (two minutes, 1.35 GiB), then refused."""
+    try:
+        need, k = network_estimate(cfg)[3], network_counts(cfg)
+    except (TypeError, ValueError, KeyError, OverflowError, ZeroDivisionError, OSError):
+        return  # the build names what is wrong
+    lim = _memory_limit()
+    if need <= lim:
+        return
+    gama = cfg.get("network.gama_xml")
+    key = (
+        "network.gama_xml"
+        if gama
+        else next(
+            (f for f in ("network.generate", "network.grids", "network.random") if cfg.get(f)),
+            "network.points",
+        )
+    )
+    raise ConfigError(
+        key,
+        f"{gama + ': ' if gama else ''}a network of about {k.points:,.0f} points and "
+        f"{k.rows:,.0f} observations ({k.unknowns:,.0f} unknowns) needs about "
+        f"{need / 2**30:.3g} GiB with chunks of {min(cfg['chunk'], cfg['trials'])} trials "
+        f"(estimate), over the {lim / 2**30:g} GiB memory limit (--max-memory-gb or "
+        "SIM_MAX_MEMORY_GB): use fewer points or observations",
+    )
 
 
 def _fits(key: str, points: float, obs: float, what: str) -> None:
@@ -48,7 +83,7 @@ def _fits(key: str, points: float, obs: float, what: str) -> None:
         raise ConfigError(
             key,
             f"{what} need about {need / 2**30:.3g} GiB, over the {lim / 2**30:g} GiB memory "
-            "limit (SIM_MAX_MEMORY_GB)",
+            "limit (--max-memory-gb or SIM_MAX_MEMORY_GB)",
         )
 
 
