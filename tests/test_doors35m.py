@@ -156,6 +156,13 @@ def test_a_network_over_the_memory_limit_is_refused_before_it_is_built(
     args = ["run", str(st), "--out", str(tmp_path / "o"), "--max-memory-gb", f"{gib:.6g}"]
     one_line(capsys, main(args), "network.generate: ", *words)
     assert not (tmp_path / "o").exists()
+    # a gama-local file: named with its file, counted by its size (it is not read)
+    xml = tmp_path / "net.xml"
+    xml.write_text("<gama-local/>" + " " * 80_000)
+    st.write_text(f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{xml}"\n')
+    monkeypatch.setenv("SIM_MAX_MEMORY_GB", "0.001")
+    monkeypatch.setattr("sim.studies.network.schema.merge_gama", unbuilt)
+    one_line(capsys, main(["check", str(st)]), f"network.gama_xml: {xml}: ", "about 1,000 obs")
 
 
 def test_sim_check_says_the_work_as_time_of_one_core(capsys):

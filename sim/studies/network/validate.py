@@ -60,10 +60,12 @@ def fits_estimate(cfg: dict) -> None:
             "network.points",
         )
     )
+    what = f"a network of about {k.points:,.0f} points and {k.rows:,.0f} observations"
+    if gama:  # counted from the file's size, not read
+        what = f"{gama}: a gama-local file of about {k.rows:,.0f} observations by its size"
     raise ConfigError(
         key,
-        f"{gama + ': ' if gama else ''}a network of about {k.points:,.0f} points and "
-        f"{k.rows:,.0f} observations ({k.unknowns:,.0f} unknowns) needs about "
+        f"{what} ({k.unknowns:,.0f} unknowns) needs about "
         f"{need / 2**30:.3g} GiB with chunks of {min(cfg['chunk'], cfg['trials'])} trials "
         f"(estimate), over the {lim / 2**30:g} GiB memory limit (--max-memory-gb or "
         "SIM_MAX_MEMORY_GB): use fewer points or observations",
