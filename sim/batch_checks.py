@@ -141,7 +141,7 @@ def _configs_problems(
         try:
             schema = get_study(read_toml(f).get("study")).schema
             args.set = [t for t in base.set or [] if parse_override(t)[0] in schema]
-            study, cfg = load_run(args)
+            study, cfg = load_run(args)  # with its --max-memory-gb (a large network's check)
             check_chunks(cfg)
             sweep = read_sweep(f, study.schema)
             est = estimate(cfg, sweep)  # the limits its run applies (sim check's too)

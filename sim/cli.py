@@ -242,7 +242,7 @@ def _check(args) -> int:
             print(f"{toml_key(k)} = {toml_value(v)}")
     if off:  # said before the run: its predictions will be findings (sim.claims.rules)
         print(f"# {off_setup(study, cfg, before=True)}")
-    print(f"# work: {est.describe()}")
+    print(f"# work: {est.describe()}; {est.core_time()}")
     return 0
 
 

@@ -169,7 +169,7 @@ def test_a_networks_size_at_load_takes_the_commands_memory_limit(capsys, tmp_pat
     net = tmp_path / "net.toml"
     net.write_text(NET, encoding="utf-8")
     monkeypatch.setenv("SIM_MAX_MEMORY_GB", "1e-9")  # its state is some kB: over this
-    one_line(capsys, main(["check", str(net)]), "network.generate[0]", "GiB memory limit")
+    one_line(capsys, main(["check", str(net)]), "network.generate", "GiB memory limit")
     assert main(["check", str(net), "--max-memory-gb", "1"]) == 0, capsys.readouterr().err
     capsys.readouterr()
     rc = batch.main(["--results", str(tmp_path / "r"), str(net), "--", "--max-memory-gb", "1"])

@@ -308,16 +308,16 @@ def factorize(
             f" is not above rcond {rcond:g})",
             int(keep[_smallest_pivot(lu, D)]),
         )
-    L = sparse.tril(lu.L, k=-1, format="csc")
-    L.sort_indices()
-    perm = np.asarray(lu.perm_c, np.int64)
+    L, perm = lu.L, np.asarray(lu.perm_c, np.int64)  # L: unit lower, its diagonal too
+    del lu  # SuperLU's own L and U, as large as the factor, not held from here
     low = sparse.coo_matrix(Ns)
     use = perm[low.row] > perm[low.col]
     low = sparse.csc_matrix(
         (low.data[use], (perm[low.row[use]], perm[low.col[use]])), shape=Ns.shape
     )
+    del use, Ns, Nr
     low.sort_indices()
-    Lp, Li, Lx = selinv.filled(Ns.shape[0], low, L)
+    Lp, Li, Lx = selinv.filled(len(keep), low, L)
     f = Factor(p, keep, perm, s, Lp, Li, Lx, D, True)
     if c:
         _constrain(f, G if d else None, np.asarray(C, float), rcond)

@@ -56,6 +56,10 @@ BROWN_SUM_BYTES = 3 * 2 * 2 * F8 * 5
 BROWN_REGION_UNITS = {"brown_table1": 2.5, "brown_dilution": 13.0}
 
 
+#: the key that sets the plate's points, by ``plate.pattern``
+PLATE_KEYS = {"grid": "plate.grid", "random": "plate.n_random"}
+
+
 def plate_points(c: Mapping) -> float:
     """Points of the plate ``plate.pattern`` declares."""
     pat = c.get("plate.pattern", "grid")
@@ -66,6 +70,16 @@ def plate_points(c: Mapping) -> float:
     return max(len(c.get("plate.points", [])), 1)
 
 
+def _memory_keys(c: Mapping, n: float, n_an: float, chunk_b: float, curves_b: float) -> tuple:
+    """The keys that set a Brown run's memory: its chunk's (``chunk``, ``trials``: every
+    chunk's sums are kept, the plate's points and ``errors.settings``), or the analytic
+    curves' (``dilution.grids``, when a grid there has more points than the plate)."""
+    plate = PLATE_KEYS.get(c.get("plate.pattern", "grid"), "plate.points")
+    if curves_b > chunk_b:
+        return ("dilution.grids",) if n_an > n else (plate,)
+    return ("chunk", "trials", plate, "errors.settings")
+
+
 def brown_estimate(c: Mapping) -> tuple:
     """brown_dilution's or brown_table1's ``(trials, adjustments, unknowns, bytes)``: three
     model adjustments a trial (four with the bias check, :data:`BROWN_TABLE1_SOLVES` in
@@ -73,7 +87,8 @@ def brown_estimate(c: Mapping) -> tuple:
     :data:`BROWN_POINTS_PER_UNIT` units (at least one), the settings' draws, the analytic
     dilution curves (three a grid, offset and extent) and the region; the memory the larger
     of a chunk's arrays (:data:`BROWN_POINT_BYTES`, :data:`BROWN_SETTING_BYTES`) with every
-    chunk's sums (:data:`BROWN_SUM_BYTES`), and the analytic curves' point blocks."""
+    chunk's sums (:data:`BROWN_SUM_BYTES`), and the analytic curves' point blocks, with the
+    keys that set it (:func:`_memory_keys`)."""
     n = plate_points(c)
     T, ch = c["trials"], min(c["chunk"], c["trials"])
     L = c.get("errors.settings", 1)
@@ -91,6 +106,9 @@ def brown_estimate(c: Mapping) -> tuple:
     )
     point = BROWN_POINT_BYTES.get(c.get("study"), 1200.0) + L * BROWN_SETTING_BYTES
     chunks = math.ceil(T / max(ch, 1))
-    b = max(ch * n * point + chunks * n * BROWN_SUM_BYTES, 4 * n_an * 7 * F8 * 3 * COPIES)
+    chunk_b = ch * n * point + chunks * n * BROWN_SUM_BYTES
+    curves_b = 4 * n_an * 7 * F8 * 3 * COPIES
     region = region_points(c) * BROWN_REGION_UNITS.get(c.get("study"), 13.0)
-    return T, T * trial + analytic + region, max(U, 2 * n_an + 7), b
+    keys = _memory_keys(c, n, n_an, chunk_b, curves_b)
+    adj = T * trial + analytic + region
+    return T, adj, max(U, 2 * n_an + 7), max(chunk_b, curves_b), "", (0.0, "", ""), keys

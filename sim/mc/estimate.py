@@ -40,6 +40,7 @@ from sim.mc.brown_size import brown_estimate as _brown
 from sim.mc.config import ConfigError
 from sim.mc.network_size import network_estimate as _network
 from sim.mc.numtext import UnheldError, float_text
+from sim.mc.salsig_size import salsig_estimate as _salsig
 from sim.mc.sweep import MAX_CELLS, expand
 from sim.mc.workunits import (
     ADJUSTMENT_S,
@@ -100,6 +101,7 @@ class Estimate:
     analytic: float = 0.0  # adjustment-equivalents of the largest analytic part (one cell)
     analytic_key: str = ""  # the key that sets that part's size (``design.grids``)
     analytic_part: str = ""  # that part, named
+    memory_keys: tuple = ()  # the keys that set ``bytes`` (the refusal names them), if known
 
     def describe(self, workers: int = 1) -> str:
         """One line: trials, adjustments (analytic parts in adjustment-equivalents, each
@@ -118,6 +120,13 @@ class Estimate:
             f"to {self.unknowns:,} unknowns, about {_gib(self.bytes * max(workers, 1))} of "
             "memory"
         )
+
+    def core_time(self) -> str:
+        """The work as time: ``about 2.5 min of one core`` (:data:`ADJUSTMENT_S` seconds an
+        adjustment on the reference machine; seconds under a minute)."""
+        s = self.adjustments * ADJUSTMENT_S
+        t = f"{s:.2g} s" if math.isfinite(s) and s < 60 else _minutes(s)
+        return f"about {t} of one core of the reference machine"
 
 
 def _gib(b: float) -> str:
@@ -157,40 +166,6 @@ def _gridplate(c: Mapping) -> tuple:
     draw_s = 0.85e-3 + 1.25e-6 * c.get("region.draws", 0)
     region = pts * (draw_s / ADJUSTMENT_S + c.get("region.iter_calibrations", 0) * 2 * P)
     return T, T * per + region, U, b
-
-
-def _salsig(c: Mapping) -> tuple:
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
-    marks = c.get("marks.grid", 5) ** 2
-    grid = c.get("grid.points", 5) ** 2
-    pm = _max(c.get("power.marks"), 5) ** 2
-    cells = _n(c.get("power.marks", [])) * _n(c.get("power.sigma_um", []))
-    pT = c.get("power.trials", 0)
-    relief = _n(c.get("vertical.relief_sweep_mm", [])) * min(T, 5000) + c.get(
-        "consistency.trials", 0
-    ) * sum(_n(v) for k, v in c.items() if k.startswith("consistency.") and isinstance(v, list))
-    trials = 3 * T + cells * pT + relief
-    adj = 6 * T + 3 * cells * pT + 2 * relief
-    n = max(marks, grid, pm, c.get("zscale.points", 9), c.get("vertical.control", 6))
-    b = ch * (SALSIG_TRIAL_BYTES + n * SALSIG_POINT_BYTES)
-    # the region: region.trials models at each of region.points input vectors, all of them in
-    # memory at once (measured, one core: 2.6 ms + 24 us a model a vector, 7.7 s for 1,024 x
-    # 200 and 6.5 s for 128 x 2,000; 617 MB for 100,000 models of up to 20 control points)
-    rT = c.get("region.trials", 0)
-    adj += c.get("region.points", 0) * (51.0 + 0.47 * rT)
-    b = max(b, rT * SALSIG_REGION_MODEL_BYTES)
-    return trials, adj, 7, b
-
-
-#: bytes a trial of a salsig chunk holds, and per point (marks, grid intersections, elevations
-#: or control points, the most of them): measured with tracemalloc, chunks of 1,000, the
-#: calibration chain 34 kB a trial at the paper's 5 x 5 marks and 97 kB at 20 x 20, the
-#: vertical fit 30 kB at 100 control points. The model before, 2,304 bytes a point with
-#: ``vertical.control`` (a count of points) squared, refused 100 control points at 21.5 GiB for
-#: a chunk of 30 MiB
-SALSIG_TRIAL_BYTES, SALSIG_POINT_BYTES = 4.0e4, 200.0
-#: bytes of one simulated model of salsig's region (6.2 kB measured, with copies' headroom)
-SALSIG_REGION_MODEL_BYTES = 1.0e4
 
 
 #: the main experiment's trial, measured (one core, chunks of 100): each of its sets + 2 fits
@@ -291,7 +266,8 @@ ESTIMATORS: dict[str, Callable[[Mapping], tuple]] = {
 
 def _one(cfg: Mapping) -> tuple:
     """``(trials, adjustments, unknowns, bytes, the part needing the bytes or "", (analytic
-    adjustment-equivalents, key, part))``; an estimator may leave out the last two."""
+    adjustment-equivalents, key, part), the keys that set the bytes)``; an estimator may leave
+    out the last three."""
     fn = ESTIMATORS.get(cfg.get("study"), _generic)
     try:
         t, a, u, b, *rest = fn(cfg)
@@ -301,7 +277,8 @@ def _one(cfg: Mapping) -> tuple:
     a = fix(a) + _chunk_units(cfg, fix(t))
     what = rest[0] if rest else ""
     eq, key, part = rest[1] if len(rest) > 1 else (0.0, "", "")
-    return fix(t), a, fix(u), fix(b), what, (fix(eq), key, part)
+    keys = tuple(rest[2]) if len(rest) > 2 else ()
+    return fix(t), a, fix(u), fix(b), what, (fix(eq), key, part), keys
 
 
 def _chunk_units(cfg: Mapping, trials: float) -> float:
@@ -324,7 +301,7 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
     T = sum(p[0] for p in parts) * reps
     A = sum(p[1] for p in parts) * reps + (len(cfgs) * reps * CELL_UNITS if sweep else 0.0)
     U = max(p[2] for p in parts)
-    B, what = max((p[3], p[4]) for p in parts)
+    B, what, mkeys = max((p[3], p[4], p[6]) for p in parts)
     eq, key, part = max((p[5] for p in parts), key=lambda x: x[0])  # one cell's, not the sum
     big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
     return Estimate(
@@ -338,6 +315,7 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
         float(eq),
         key,
         part,
+        mkeys,
     )
 
 
@@ -378,7 +356,7 @@ def check_limits(
             f"{est.study}: the run needs {est.describe(workers)}, over the "
             f"{mem:g} GiB limit (--max-memory-gb or SIM_MAX_MEMORY_GB)"
             + (f", most of it for {est.largest}" if est.largest else "")
-            + "; reduce chunk, trials or the sizes in the study file",
+            + f"; reduce {_either(est.memory_keys)}",
         )
     if not est.adjustments <= adj:
         raise ConfigError(
@@ -398,6 +376,14 @@ def check_limits(
             "--max-adjustments or SIM_MAX_ADJUSTMENTS); use fewer points per side or fewer "
             "positions, extents, offsets or betas, or raise the limit",
         )
+
+
+def _either(keys: tuple) -> str:
+    """The keys that set a run's memory, as advice (``chunk, trials or plate.grid``); without
+    them, the words that cover every study."""
+    if not keys:
+        return "chunk, trials or the sizes in the study file"
+    return keys[0] if len(keys) == 1 else f"{', '.join(keys[:-1])} or {keys[-1]}"
 
 
 #: seconds of one core a chunk may take before the run says so: the progress bar moves once

@@ -45,6 +45,7 @@ from sim.studies.network.sparse_analysis import (
     shows_phases_of,
     variances,
 )
+from sim.studies.network.validate import fits_estimate
 
 __all__ = ["SCHEMA", "check", "unread"]
 
@@ -104,6 +105,7 @@ def check(cfg: dict) -> None:
     require_chunks(cfg)  # estimates.py and tables.py: jackknife intervals over the chunks
     _power(cfg)
     _digest(cfg)
+    fits_estimate(cfg)  # the run's memory, before the network is built and factorised
     full = merge_gama(cfg)
     cfg["datum.kind"] = full["datum.kind"]  # a free gama-local file's inner datum, resolved
     with phase("network: building", shows_phases_of(full)):

@@ -16,7 +16,7 @@ import numpy as np
 from sim.mc.config import ConfigError, did_you_mean
 from sim.mc.lookalike import differs, skeleton
 from sim.mc.memory_limit import memory_limit_gb
-from sim.mc.network_size import state_bytes
+from sim.mc.network_size import network_counts, network_estimate, state_bytes
 
 __all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE", "MAX_NAME", "MAX_TITLE", "title"]
 
@@ -41,6 +41,42 @@ BIAS_BOUND = {"mm": 1e9, "arcsec": 1e6}
 def _memory_limit() -> float:
     """The memory limit in bytes (``--max-memory-gb``, ``SIM_MAX_MEMORY_GB``, the default)."""
     return memory_limit_gb() * 2**30
+
+
+def fits_estimate(cfg: dict) -> None:
+    """Refuse, before the network is built and its normals factorised (minutes and most of
+    the memory of a large one), a run whose estimate (:func:`sim.mc.network_size.
+    network_estimate`, the memory ``sim check`` shows) is over the memory limit, naming the
+    key that declares the network's size (``network.gama_xml`` and its file, else
+    ``network.generate``, ``network.grids``, ``network.random`` or ``network.points``). The
+    estimate was applied after the load: a 90,000-point network under
+    ``SIM_MAX_MEMORY_GB=2`` was built and factorised (two minutes, 1.35 GiB), then refused."""
+    try:
+        need, k = network_estimate(cfg)[3], network_counts(cfg)
+    except (TypeError, ValueError, KeyError, OverflowError, ZeroDivisionError, OSError):
+        return  # the build names what is wrong
+    lim = _memory_limit()
+    if need <= lim:
+        return
+    gama = cfg.get("network.gama_xml")
+    key = (
+        "network.gama_xml"
+        if gama
+        else next(
+            (f for f in ("network.generate", "network.grids", "network.random") if cfg.get(f)),
+            "network.points",
+        )
+    )
+    what = f"a network of about {k.points:,.0f} points and {k.rows:,.0f} observations"
+    if gama:  # counted from the file's size, not read
+        what = f"{gama}: a gama-local file of about {k.rows:,.0f} observations by its size"
+    raise ConfigError(
+        key,
+        f"{what} ({k.unknowns:,.0f} unknowns) needs about "
+        f"{need / 2**30:.3g} GiB with chunks of {min(cfg['chunk'], cfg['trials'])} trials "
+        f"(estimate), over the {lim / 2**30:g} GiB memory limit (--max-memory-gb or "
+        "SIM_MAX_MEMORY_GB): use fewer points or observations",
+    )
 
 
 def _fits(key: str, points: float, obs: float, what: str) -> None:
