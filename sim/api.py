@@ -441,9 +441,7 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     try:
         study, cfg = load_picking_chunk(study_file, picks, values=vals)
     except ConfigError as e:  # a network over the memory limit at load: the environment's
-        if not any(cli in str(e) for cli, _ in _LIMITS):
-            raise
-        raise _api_words(e) from None
+        raise (_api_words(e) if any(c in str(e) for c, _ in _LIMITS) else e) from None
     sweep = read_sweep(study_file, study.schema)
     if _sha256(study_file) != sha:  # written to while it was read: which version is this?
         raise ConfigError("study_file", f"{study_file} changed while it was loaded: load it again")
