@@ -25,6 +25,7 @@ from typing import Any, Callable, Mapping
 
 from sim.mc.lookalike import looks, note, toml_char_hint
 from sim.mc.message_text import key_text, shorten, shown
+from sim.mc.toml_twice import twice_text
 from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.study_file import study_file_problem
@@ -106,6 +107,9 @@ class Field:
 #: TOML's integers are 64-bit ("an integer that cannot be represented losslessly is an
 #: error"); Python's tomllib and the API take any size, which overflowed float() and NumPy
 INT64 = 2**63
+#: below it every integer is a double: a float for an integer key from it on may be another
+#: integer than the one written (9007199254740993.0 reads 9007199254740992.0, 2**53)
+EXACT_INT = 2**53
 
 
 def refuse_big_ints(key: str, v: Any) -> None:
@@ -134,6 +138,12 @@ def _num(key: str, v: Any, want_int: bool) -> float | int:
     if not math.isfinite(v):
         raise ConfigError(key, f"must be finite (got {v!r})")
     if want_int and not isinstance(v, int):
+        if float(v).is_integer() and abs(v) >= EXACT_INT:  # seed = 9007199254740993.0 was
+            raise ConfigError(  # the seed 9007199254740992, silently
+                key,
+                f"must be an integer (got {v!r}, a float: from 2**53 = {EXACT_INT} on, a float "
+                "is not exact to the unit; write the integer without a point or an exponent)",
+            )
         if float(v).is_integer():
             v = int(v)
         else:
@@ -240,6 +250,8 @@ def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
 
 
 #: quotes an editor or a web page puts where a plain " or ' was typed (“plate.grid=4”)
+#: the white space TOML reads around a key and a value (a no-break space is none: a character)
+TOML_SPACE = " \t"
 TYPOGRAPHIC = "\u201c\u201d\u2018\u2019\u201e\u00ab\u00bb"
 
 
@@ -316,7 +328,8 @@ def parse_override(text: str) -> tuple[str, Any]:
     if "=" not in text:
         raise ConfigError(None, f"--set needs key=value (got {text!r})")
     key, val = text.split("=", 1)
-    key = key.strip()
+    key, val = key.strip(TOML_SPACE), val.strip(TOML_SPACE)  # as TOML reads white space: a
+    # no-break space is part of the key ("trials\u00a0" was read as trials) or the value
     if not key:
         raise ConfigError(None, f"--set needs key=value (got {text!r})")
     if any(c in val for c in "\n\r\0"):  # one value: a line break would smuggle in more keys
@@ -326,9 +339,9 @@ def parse_override(text: str) -> tuple[str, Any]:
             key or None, "--set holds bytes that are not UTF-8 text (a non-UTF-8 locale or value)"
         )
     try:
-        doc = tomllib.loads(f"v = {val.strip()}", parse_float=toml_float)
+        doc = tomllib.loads(f"v = {val}", parse_float=toml_float)
     except tomllib.TOMLDecodeError:
-        return key, val.strip()
+        return key, val
     except RecursionError:
         raise ConfigError(key, "--set value is nested too deeply") from None
     if list(doc) != ["v"]:
@@ -358,9 +371,9 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         line = "".join(data.decode("utf-8").split("\n")[n - 1 : n] if n else [])  # as tomllib
         curly = [c for c in line if c in TYPOGRAPHIC]  # a word processor's quotes
         hint = f' (the typographic quote {curly[0]} is no TOML quote: type ")' if curly else ""
-        raise ConfigError(
-            None, f"{p}: malformed TOML: {e}{hint or kind_hint(text) or toml_char_hint(line, col)}"
-        ) from None
+        hint = hint or kind_hint(text) or toml_char_hint(line, col)
+        twice = twice_text(text, str(e))  # the key given twice, named (tomllib names none)
+        raise ConfigError(None, f"{p}: malformed TOML: {twice or e}{hint}") from None
     except RecursionError:
         raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None
     except UnicodeDecodeError as e:  # where, and the likely encoding (it was "not UTF-8 text")

@@ -165,8 +165,36 @@ def _mm(key: str, rec: dict, field: str, required: bool = True, default=None):
     if isinstance(default, list):
         if not (isinstance(v, list) and len(v) == 2):
             raise ConfigError(f"{key}.{name}", "must be [x, y]")
-        return [_num(f"{key}.{name}", c) * f for c in v]
-    return _num(f"{key}.{name}", v) * f
+        return [_in_mm(f"{key}.{name}", _num(f"{key}.{name}", c), f) for c in v]
+    return _in_mm(f"{key}.{name}", _num(f"{key}.{name}", v), f)
+
+
+def _in_mm(key: str, v: float, f: float) -> float:
+    """``v`` times ``f`` (metres to mm), refused (naming ``key``) when that is no double."""
+    if not math.isfinite(v * f):  # x_m = 1e306: "the network spans inf km"
+        raise ConfigError(key, f"{v:g} m is beyond the largest 64-bit float in millimetres")
+    return v * f
+
+
+def reach(key: str, rec: dict, field: str, far: float) -> None:
+    """Refuse (naming ``field`` as written) a grid or random set whose extent ``far`` (mm)
+    is no finite double: a grid's spacing near the largest double made its points inf - inf
+    = NaN, which passed every check to an SVD that "did not converge"; a random set's half
+    extent, NumPy's "OverflowError: high - low range exceeds valid bounds"."""
+    if not math.isfinite(far):
+        name, unit = (f"{field}_m", "m") if f"{field}_m" in rec else (f"{field}_mm", "mm")
+        raise ConfigError(
+            f"{key}.{name}", f"{rec[name]:g} {unit} puts points beyond the largest 64-bit float"
+        )
+
+
+def finite_points(names: list[str], xy: np.ndarray) -> None:
+    """Refuse a point whose coordinates overflowed (an origin near the largest double)."""
+    bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
+    if bad.size:
+        raise ConfigError(
+            "network.points", f"point {names[bad[0]]!r} lies beyond the largest 64-bit float"
+        )
 
 
 def positive_mm(key: str, rec: dict, field: str) -> float:
