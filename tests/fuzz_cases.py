@@ -1,7 +1,8 @@
 """The fuzzer's cases (tests/test_fuzz.py): case ``i`` of seed ``FUZZ_SEED`` is one study's
 tiny file (tests/fuzz_values.py) with one mutation of a kind drawn by the seed: VALUE, two
 values, a ``--set``, STRUCTURE, a ``[sweep]``, an option, a key in the wrong place
-(``relocate``), TYPE, KEY spelling (tests/fuzz_keys.py), EDGE values (tests/fuzz_edges.py)."""
+(``relocate``), TYPE, KEY spelling (tests/fuzz_keys.py), EDGE values (tests/fuzz_edges.py), SHAPE
+(tests/fuzz_shapes.py)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import random
 
 from fuzz_edges import edge_case
 from fuzz_keys import respell
+from fuzz_shapes import shape_case
 from fuzz_values import (
     NAMES,
     NAN,
@@ -68,6 +70,7 @@ def make_case(i: int):
         + ["type"] * int(os.environ.get("FUZZ_TYPE_WEIGHT", "2"))
         + ["key"] * int(os.environ.get("FUZZ_KEY_WEIGHT", "2"))
         + ["edge"] * int(os.environ.get("FUZZ_EDGE_WEIGHT", "2"))
+        + ["shape"] * int(os.environ.get("FUZZ_SHAPE_WEIGHT", "1"))
     )
     if kind in ("value", "two"):
         keys = rng.sample(schema, 2 if kind == "two" else 1)
@@ -135,6 +138,9 @@ def make_case(i: int):
     elif kind == "edge":  # the description ends with the key a refusal must name, if beyond
         k, v, within = edge_case(rng, flat, fields)
         desc = f"{k} = {toml_value(v)[:60]}" + " beyond its bounds" * (within is False)
+    elif kind == "shape":  # the description ends "the same document" or the table named
+        text, desc = shape_case(rng, flat)
+        raw = text.encode()
     elif kind == "relocate":
         raw, desc = relocate(rng, flat, schema)
     elif kind == "key":  # the last word of desc: the key the refusal must name

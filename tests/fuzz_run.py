@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 from fuzz_cases import make_case
+from fuzz_shapes import SAME
 from fuzz_values import ROOT, toml_doc
 
 from sim.cli import main
@@ -151,6 +152,12 @@ def fuzz(n: int, tmp: Path) -> list[str]:
             and (code != 2 or key_text(edge) not in err)
         ):
             bad = f"a value beyond its bounds not refused naming {edge}: exit {code}"
+        if not bad and ": shape: " in desc:  # the same document runs; a table twice is named
+            shape = desc.split(": shape: ")[-1]
+            if shape.endswith(SAME) and code != 0:
+                bad = f"the same document in another shape not run: exit {code}"
+            elif not shape.endswith(SAME) and (code != 2 or shape.split()[-1] not in err):
+                bad = f"a table given twice not refused naming {shape.split()[-1]}: exit {code}"
         if bad:
             where = study
             if save:

@@ -17,7 +17,8 @@ F33's left items:
   11)``), and when the two differ in kind, how (``plate is given twice (a value, then a
   table)``) (:mod:`sim.mc.toml_twice`).
 
-Found with the fuzzer's new mutation kind, EDGE values (tests/fuzz_edges.py):
+Found with the fuzzer's new mutation kinds, EDGE values (tests/fuzz_edges.py) and SHAPE
+(tests/fuzz_shapes.py):
 
 * A float for an integer key from 2**53 on (``seed = 9007199254740993.0``; ``--seed``, the
   API) was taken as the integer the double holds, ``9007199254740992``: silently another
@@ -32,6 +33,13 @@ Found with the fuzzer's new mutation kind, EDGE values (tests/fuzz_edges.py):
   - low range exceeds valid bounds``; a point's ``x_m = 1e306`` was "the network spans inf
   km". Each now names its key (``network.grids[0].spacing_mm: 1.79769e+308 mm puts points
   beyond the largest 64-bit float``).
+* A study's name given as a table or an array (``study = { name = "brown_table1" }``,
+  ``[study]``, ``[[study]]``) was ``study: missing: the file must say which study it is`` (the
+  table flattened to ``study.name``), or ``unknown study [{'name': 'x'}]`` in Python's words;
+  it is now ``study: must name the study as a string, study = "..." (got a table)``.
+* A table header below an inline array (``[network.points.extra]`` after ``points = [ ... ]``)
+  was tomllib's ``Cannot declare ('network', 'points', 'extra') twice``; it is now
+  ``network.points is given twice (an array of tables, then a table)``.
 * A network grid too large by its ``ny`` (``nx = 5, ny = 900000000``) was refused naming
   ``network.grids[0].nx``; it now names the larger side.
 """
@@ -159,3 +167,22 @@ def test_a_brown_grid_spacing_that_merges_points_is_named(capsys):
 def test_a_network_length_beyond_a_double_is_named(tmp_path, capsys, old, new, needle):
     assert old in NET
     _check(tmp_path, capsys, NET.replace(old, new), needle)
+
+
+@pytest.mark.parametrize(
+    "text, what",
+    [
+        ('study = { name = "brown_table1" }\n', "a table"),
+        ("[study]\n", "a table"),
+        ('[[study]]\nname = "x"\n', "an array"),
+    ],
+)
+def test_a_study_name_given_as_a_table_is_named(tmp_path, capsys, text, what):
+    needle = f'study: must name the study as a string, study = "..." (got {what})'
+    _check(tmp_path, capsys, text, needle)
+
+
+def test_a_header_below_an_inline_array_is_named(tmp_path, capsys):
+    text = NET + "[network.points.extra]\nx = 1\n"
+    line = _check(tmp_path, capsys, text, "network.points is given twice (an array of tables, then")
+    assert "Cannot" not in line, line

@@ -15,7 +15,10 @@ tests/fuzz_keys.py; ``FUZZ_KEY_WEIGHT`` sets its share: such a case must be refu
 the key as written), a number at an EDGE (on its key's bound, one ulp inside or beyond it,
 ``-0.0``, a subnormal, ``2**53 + 1``, ``1e2`` for an integer key, a network record's number:
 tests/fuzz_edges.py; ``FUZZ_EDGE_WEIGHT`` sets its share: a value beyond the bounds must be
-refused naming its key) or the command line (``--trials``, ``--seed``, ``--workers``, ``--out``,
+refused naming its key), its SHAPE (a table written inline, records as an array of tables:
+the same document, which must run; a table given twice, by dotted keys and a header or inline
+and then more, the study's name as a table: refused naming it; tests/fuzz_shapes.py;
+``FUZZ_SHAPE_WEIGHT``) or the command line (``--trials``, ``--seed``, ``--workers``, ``--out``,
 ``--scheduler``). Every case runs ``sim run`` in a forked child
 (its own session, an address-space limit, a time bound) and must give exit 0 with finite
 results, or exit 2 with exactly one line on standard error and no traceback, and leave
@@ -37,7 +40,7 @@ import pytest
 from fuzz_cases import SEED
 from fuzz_keys import network_case
 from fuzz_run import fuzz
-from fuzz_values import NAMES, ROOT, small, toml_value
+from fuzz_values import NAMES, ROOT, base, small, toml_doc, toml_value
 
 from sim.cli import main
 from sim.studies import load_study
@@ -57,6 +60,17 @@ def test_fuzz_bases_run():
         assert sizes and all(cfg[k] == v for k, v in sizes.items()), name
         if "chunk" in cfg:  # a run needs two chunks (and a jackknife 20: brown in SMALL)
             assert cfg["trials"] >= 2 * cfg["chunk"], name
+
+
+def test_fuzz_bases_load_as_written(tmp_path):
+    """Every base written as the fuzzer writes it is a valid study file (a network's
+    constraint key ``"S1.x"`` written bare was a table ``S1``: every network case refused)."""
+    assert any(name.startswith("network") for name in NAMES)
+    for name in NAMES:
+        f = tmp_path / f"{name}.toml"
+        f.write_text(toml_doc(base(name)))
+        want = "network" if name.startswith("network") else name
+        assert load_study(f)[1]["study"] == want, name
 
 
 def test_fuzz(tmp_path):

@@ -25,11 +25,11 @@ from typing import Any, Callable, Mapping
 
 from sim.mc.lookalike import looks, note, toml_char_hint
 from sim.mc.message_text import key_text, shorten, shown
-from sim.mc.toml_twice import twice_text
 from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.study_file import study_file_problem
 from sim.mc.toml_dates import as_written
+from sim.mc.toml_twice import twice_text
 
 __all__ = [
     "ConfigError",

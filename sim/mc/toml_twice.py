@@ -82,6 +82,9 @@ def _named(text: str, reason: str, line: int, where: str) -> str | None:
     if target != path:
         second = "a table"  # dotted keys or a header below the key given before
     first = _kind(before, target)
+    while first is None and len(target) > 1 and named:  # [a.b.c] below an inline array a.b:
+        target = target[:-1]  # a.b given again, as a table
+        first, second = _kind(before, target), "a table"
     if first is None:  # a key inside the statement's own inline table: tomllib's words
         return None
     tables = ("a table", "an array of tables")
