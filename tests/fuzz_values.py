@@ -94,6 +94,10 @@ SMALL = {
         "tradeoff.block_trials": 4,
         "sweep.trials": 4,
         "sweep.five_inset": [0.0, 0.17],
+        "region.trials": 2,  # the regions' blocks: 2,400 and 1,536 of them, 50 s of CPU a run
+        "region.points": 2,
+        "table1.points": 2,
+        "table1.trials": 2,
     },
     # two network study files (the network kind: points, grids, generated and single
     # observations, a datum by constraints, a second parameterisation)
