@@ -138,17 +138,23 @@ def _num(key: str, v: Any, want_int: bool) -> float | int:
     if not math.isfinite(v):
         raise ConfigError(key, f"must be finite (got {v!r})")
     if want_int and not isinstance(v, int):
-        if float(v).is_integer() and abs(v) >= EXACT_INT:  # seed = 9007199254740993.0 was
-            raise ConfigError(  # the seed 9007199254740992, silently
-                key,
-                f"must be an integer (got {v!r}, a float: from 2**53 = {EXACT_INT} on, a float "
-                "is not exact to the unit; write the integer without a point or an exponent)",
-            )
         if float(v).is_integer():
             v = int(v)
         else:
             raise ConfigError(key, f"must be an integer (got {v!r})")
     return v if want_int else float(v)
+
+
+def _exact(key: str, given: Any) -> None:
+    """Refuse a float ``given`` for an integer key from 2**53 on, within the key's bounds
+    (beyond them, the bounds are the words): ``seed = 9007199254740993.0`` was the seed
+    9007199254740992, silently."""
+    if isinstance(given, float) and abs(given) >= EXACT_INT:
+        raise ConfigError(
+            key,
+            f"must be an integer (got {given!r}, a float: from 2**53 = {EXACT_INT} on, a float "
+            "is not exact to the unit; write the integer without a point or an exponent)",
+        )
 
 
 def _bounds(key: str, f: Field, v: float) -> None:
@@ -165,9 +171,11 @@ def check_value(key: str, f: Field, v: Any) -> Any:
     """Validate and normalise one value against its field; return the clean value."""
     k = f.kind
     if k in ("int", "float"):
-        v = _num(key, v, k == "int")
+        given, v = v, _num(key, v, k == "int")
         _bounds(key, f, v)
         refuse_big_ints(key, v)  # 1e300 for an unbounded integer key: 10**300, not TOML's
+        if k == "int":
+            _exact(key, given)
         return v
     if k == "bool":
         if not isinstance(v, bool):
