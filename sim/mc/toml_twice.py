@@ -27,15 +27,20 @@ _AT = re.compile(r"(.*) \(at line (\d+), column (\d+)\)", re.S)
 _NAMED = re.compile(r"Cannot (?:declare|redefine namespace|mutate immutable namespace) (\(.*?\))")
 #: a key no study file holds: where it lands is the table a statement is in
 _PROBE = "sim probe 5f0c"
-#: lines looked back for a statement's start (a longer multi-line value: tomllib's text)
-_BACK = 400
+#: lines looked back for a statement's start, characters read in all, and the largest file
+#: so read (a longer multi-line value, a larger file: tomllib's words, not a minute of parsing)
+_BACK, _BUDGET, _LARGEST = 400, 1_000_000, 256_000
 
 
 def twice_text(text: str, message: str) -> str | None:
     """``message`` (tomllib's, for ``text``) with the key given twice named, or None when it
     is no such message or the key cannot be told."""
     at = _AT.fullmatch(message)
-    if not at or not at.group(1).startswith(("Cannot ", "Duplicate inline table key")):
+    if (
+        len(text) > _LARGEST
+        or not at
+        or not at.group(1).startswith(("Cannot ", "Duplicate inline table key"))
+    ):
         return None
     reason, line = at.group(1), int(at.group(2))
     where = f" (at line {line}, column {at.group(3)})"
@@ -50,8 +55,11 @@ def _named(text: str, reason: str, line: int, where: str) -> str | None:
     starts = [0]
     for ln in lines:
         starts.append(starts[-1] + len(ln) + 1)
-    before = None
+    before, budget = None, _BUDGET
     for i in range(line - 1, max(-1, line - 1 - _BACK), -1):
+        budget -= starts[i]
+        if budget < 0:
+            return None
         try:
             before = tomllib.loads(text[: starts[i]])
             break
