@@ -107,6 +107,7 @@ def test_a_set_with_a_no_break_space_is_not_read_as_the_key(capsys, text, needle
         ("trials = 40\ntrials = 60\n", "trials is given twice (at line 3, column 12)"),
         ("[plate]\ngrid = 5\n[plate]\ngrid = 6\n", "plate is given twice (at line 4,"),
         ("[plate]\ngrid = 5\ngrid = 6\n", "plate.grid is given twice (at line 4,"),
+        ("[plate]\r\ngrid = 5\r\n[plate]\r\n", "plate is given twice (at line 4,"),
         ("plate = 5\n[plate]\ngrid = 5\n", "plate is given twice (a value, then a table)"),
         ("[[plate]]\ngrid = 5\n[plate]\n", "plate is given twice (an array of tables, then a"),
         ('"trials " = 1\n"trials " = 2\n', '"trials " is given twice'),

@@ -69,7 +69,7 @@ def _named(text: str, reason: str, line: int, where: str) -> str | None:
         return None
     stmt = lines[i].strip()
     if stmt.startswith("["):  # a header: its key is absolute
-        doc = tomllib.loads(lines[i])
+        doc = tomllib.loads(lines[i].rstrip("\r"))  # a CRLF file
         path, second = _path(doc), "an array of tables" if stmt.startswith("[[") else "a table"
     else:
         rel = _key_of(lines[i])
