@@ -17,7 +17,7 @@ fix (small sizes here, the measured ones in the docstrings).
   ``SIM_MAX_MEMORY_GB=0.4`` was built and factorised (0.47 GiB, over the limit it was
   refused for), a 90,000-point one took two minutes first. The check now refuses it before
   the network is built, with the estimate ``sim check`` shows, naming the key that declares
-  the network (``network.generate``; ``network.gama_xml`` and its file) and the limit.
+  the network (``network.grids``, the key holding its points; ``network.gama_xml`` and its file) and the limit.
 * ``sim check`` said a run's work in adjustments only, a unit no user knows: the time it
   takes is now said too (``about 2.5 min of one core of the reference machine`` for the
   90,000-point network's 40 trials, which took 107 s of CPU and 1.6 GiB, estimated 2.55 GiB;
@@ -151,10 +151,10 @@ def test_a_network_over_the_memory_limit_is_refused_before_it_is_built(
     monkeypatch.setattr("sim.studies.network.schema.build", unbuilt)
     monkeypatch.setenv("SIM_MAX_MEMORY_GB", f"{gib:.6g}")
     words = ("900 points and 7,200 observations", f"{need / 2**30:.3g} GiB", f"{gib:.6g} GiB")
-    one_line(capsys, main(["check", str(st)]), "network.generate: ", *words)
+    one_line(capsys, main(["check", str(st)]), "network.grids: ", *words)
     monkeypatch.delenv("SIM_MAX_MEMORY_GB")  # the run's own option, while it loads
     args = ["run", str(st), "--out", str(tmp_path / "o"), "--max-memory-gb", f"{gib:.6g}"]
-    one_line(capsys, main(args), "network.generate: ", *words)
+    one_line(capsys, main(args), "network.grids: ", *words)
     assert not (tmp_path / "o").exists()
     # a gama-local file: named with its file, counted by its size (it is not read)
     xml = tmp_path / "net.xml"

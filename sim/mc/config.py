@@ -29,6 +29,7 @@ from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.study_file import study_file_problem
 from sim.mc.toml_dates import as_written
+from sim.mc.toml_twice import twice_text
 
 __all__ = [
     "ConfigError",
@@ -106,6 +107,9 @@ class Field:
 #: TOML's integers are 64-bit ("an integer that cannot be represented losslessly is an
 #: error"); Python's tomllib and the API take any size, which overflowed float() and NumPy
 INT64 = 2**63
+#: below it every integer is a double: a float for an integer key from it on may be another
+#: integer than the one written (9007199254740993.0 reads 9007199254740992.0, 2**53)
+EXACT_INT = 2**53
 
 
 def refuse_big_ints(key: str, v: Any) -> None:
@@ -141,6 +145,18 @@ def _num(key: str, v: Any, want_int: bool) -> float | int:
     return v if want_int else float(v)
 
 
+def _exact(key: str, given: Any) -> None:
+    """Refuse a float ``given`` for an integer key from 2**53 on, within the key's bounds
+    (beyond them, the bounds are the words): ``seed = 9007199254740993.0`` was the seed
+    9007199254740992, silently."""
+    if isinstance(given, float) and abs(given) >= EXACT_INT:
+        raise ConfigError(
+            key,
+            f"must be an integer (got {given!r}, a float: from 2**53 = {EXACT_INT} on, a float "
+            "is not exact to the unit; write the integer without a point or an exponent)",
+        )
+
+
 def _bounds(key: str, f: Field, v: float) -> None:
     if f.lo is not None:
         if f.lo_open and not v > f.lo:
@@ -155,9 +171,11 @@ def check_value(key: str, f: Field, v: Any) -> Any:
     """Validate and normalise one value against its field; return the clean value."""
     k = f.kind
     if k in ("int", "float"):
-        v = _num(key, v, k == "int")
+        given, v = v, _num(key, v, k == "int")
         _bounds(key, f, v)
         refuse_big_ints(key, v)  # 1e300 for an unbounded integer key: 10**300, not TOML's
+        if k == "int":
+            _exact(key, given)
         return v
     if k == "bool":
         if not isinstance(v, bool):
@@ -240,6 +258,8 @@ def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
 
 
 #: quotes an editor or a web page puts where a plain " or ' was typed (“plate.grid=4”)
+#: the white space TOML reads around a key and a value (a no-break space is none: a character)
+TOML_SPACE = " \t"
 TYPOGRAPHIC = "\u201c\u201d\u2018\u2019\u201e\u00ab\u00bb"
 
 
@@ -316,7 +336,8 @@ def parse_override(text: str) -> tuple[str, Any]:
     if "=" not in text:
         raise ConfigError(None, f"--set needs key=value (got {text!r})")
     key, val = text.split("=", 1)
-    key = key.strip()
+    key, val = key.strip(TOML_SPACE), val.strip(TOML_SPACE)  # as TOML reads white space: a
+    # no-break space is part of the key ("trials\u00a0" was read as trials) or the value
     if not key:
         raise ConfigError(None, f"--set needs key=value (got {text!r})")
     if any(c in val for c in "\n\r\0"):  # one value: a line break would smuggle in more keys
@@ -326,9 +347,9 @@ def parse_override(text: str) -> tuple[str, Any]:
             key or None, "--set holds bytes that are not UTF-8 text (a non-UTF-8 locale or value)"
         )
     try:
-        doc = tomllib.loads(f"v = {val.strip()}", parse_float=toml_float)
+        doc = tomllib.loads(f"v = {val}", parse_float=toml_float)
     except tomllib.TOMLDecodeError:
-        return key, val.strip()
+        return key, val
     except RecursionError:
         raise ConfigError(key, "--set value is nested too deeply") from None
     if list(doc) != ["v"]:
@@ -358,9 +379,9 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         line = "".join(data.decode("utf-8").split("\n")[n - 1 : n] if n else [])  # as tomllib
         curly = [c for c in line if c in TYPOGRAPHIC]  # a word processor's quotes
         hint = f' (the typographic quote {curly[0]} is no TOML quote: type ")' if curly else ""
-        raise ConfigError(
-            None, f"{p}: malformed TOML: {e}{hint or kind_hint(text) or toml_char_hint(line, col)}"
-        ) from None
+        hint = hint or kind_hint(text) or toml_char_hint(line, col)
+        twice = twice_text(text, str(e))  # the key given twice, named (tomllib names none)
+        raise ConfigError(None, f"{p}: malformed TOML: {twice or e}{hint}") from None
     except RecursionError:
         raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None
     except UnicodeDecodeError as e:  # where, and the likely encoding (it was "not UTF-8 text")

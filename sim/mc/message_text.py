@@ -7,7 +7,7 @@ line should print. ``key_text``: a quoted key of a study file with a trailing sp
 easy to miss (a tab, a no-break space or a zero-width space not seen at all); such a key is
 named in double quotes, its white space other than a plain space and every character that
 does not print written as TOML escapes it (``"tri\\u200bals"``), and the empty key
-(``"" = 5``, which named no key) as ``""``.
+(``"" = 5``, which named no key) as ``""``, in a table too (``plate.""``: it was ``plate.``).
 """
 
 from __future__ import annotations
@@ -69,9 +69,14 @@ def _plain(c: str) -> bool:
 
 def key_text(key: str) -> str:
     """``key`` as a message names it: as it is, or in double quotes with TOML's escapes when it
-    is empty or holds white space or a character that does not print."""
+    is empty or holds white space or a character that does not print; a dotted key with an
+    empty part is named part by part, that part as ``""`` (``[plate] "" = 5``: ``plate.""``,
+    not ``plate.``)."""
     if not isinstance(key, str):
         return str(key)
+    parts = key.split(".")
+    if len(parts) > 1 and "" in parts:
+        return ".".join(map(key_text, parts))
     if key and all(c.isprintable() and not c.isspace() for c in key):
         return key
     esc = (

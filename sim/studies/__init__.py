@@ -161,6 +161,11 @@ def _out_of_bounds(v: float, goes: Any, cfg: dict, schema: Mapping[str, Field]) 
 
 
 def get_study(name: str) -> Study:
+    if isinstance(name, (dict, list)):  # study = { name = "..." } was "study: missing" (its
+        what = "a table" if isinstance(name, dict) else "an array"  # key study.name), and
+        raise ConfigError(  # [[study]] "unknown study [{'name': 'x'}]", Python's words
+            "study", f'must name the study as a string, study = "..." (got {what})'
+        )
     if not isinstance(name, str) or name not in MODULES:
         raise ConfigError("study", f"unknown study {name!r}; known: {', '.join(sorted(MODULES))}")
     try:
@@ -210,6 +215,8 @@ def load_study(
     for k in doc:  # Study = "..." was "study: missing", [Sweep] trials = [...] "Sweep.trials:
         if k not in _SPELT and looks(k) in _SPELT:  # unknown key (did you mean trials?)"
             raise ConfigError(k, f"is not {looks(k)} ({_SPELT[looks(k)]}, spelt so)")
+    if isinstance(doc.get("study"), (dict, list)):
+        get_study(doc["study"])  # refused there, not flattened to study.name
     flat = flatten({k: v for k, v in doc.items() if k != "sweep"})  # [sweep]: sim.mc.sweep
     name = flat.pop("study", None)
     if name is None:

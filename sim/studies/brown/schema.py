@@ -314,6 +314,12 @@ def check(cfg: dict) -> None:
     if np.any(np.abs(pts) > half):
         raise ConfigError(key, f"points outside the {cfg['plate.format_mm']:g} mm format")
     if len(np.unique(np.round(pts, 9), axis=0)) < n:
+        if cfg["plate.pattern"] == "grid":  # only a spacing below 1e-9 mm makes them (it was
+            raise ConfigError(  # "plate.grid: duplicate points", the key not changed)
+                "plate.spacing_mm",
+                f"{cfg['plate.spacing_mm']:g} mm puts points of the grid within 1e-09 mm of "
+                "each other: duplicate points",
+            )
         raise ConfigError(key, "duplicate points")
     c = pts - pts.mean(0)
     sv = np.linalg.svd(c, compute_uv=False)

@@ -50,9 +50,11 @@ from sim.studies.network.validate import (
     _point_name,
     _role,
     distinct_looks,
+    finite_points,
     name_index,
     one_unit,
     positive_mm,
+    reach,
     title,
 )
 
@@ -176,8 +178,10 @@ def _grid_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
         one_unit(key, rec, ("spacing", "origin"))
         nx = _num(f"{key}.nx", rec["nx"], 1, integer=True)
         ny = _num(f"{key}.ny", rec["ny"], 1, integer=True)
-        _fits(f"{key}.nx", len(pts[0]) + nx * ny, 0, f"{nx} x {ny} points")
+        big = f"{key}.{'nx' if nx >= ny else 'ny'}"  # the larger side (ny was named nx)
+        _fits(big, len(pts[0]) + nx * ny, 0, f"{nx} x {ny} points")
         h = positive_mm(key, rec, "spacing")
+        reach(key, rec, "spacing", (max(nx, ny) - 1) * h)
         o = _mm(key, rec, "origin", False, [-(nx - 1) * h / 2, -(ny - 1) * h / 2])
         r, s = _role(key, rec)
         prefix = _point_name(f"{key}.prefix", rec["prefix"])
@@ -196,6 +200,7 @@ def _random_points(cfg: dict, rng: np.random.Generator, pts: tuple[list, list, l
         n = _num(f"{key}.n", rec["n"], 1, integer=True)
         _fits(f"{key}.n", len(pts[0]) + n, 0, f"{n} points")
         e = positive_mm(key, rec, "half_extent")
+        reach(key, rec, "half_extent", 2 * e)
         c0 = _mm(key, rec, "center", False, [0.0, 0.0])
         r, s = _role(key, rec)
         prefix = _point_name(f"{key}.prefix", rec["prefix"])
@@ -218,6 +223,7 @@ def _points(cfg: dict, rng: np.random.Generator):
         raise ConfigError("network.points", f"duplicate point name {dup[0]!r}")
     distinct_looks("network.points", names)
     xy = np.array(pts[1], float)
+    finite_points(names, xy)
     span = float(np.ptp(xy, axis=0).max())
     if span > 1e9:
         raise ConfigError(

@@ -59,14 +59,7 @@ def fits_estimate(cfg: dict) -> None:
     if need <= lim:
         return
     gama = cfg.get("network.gama_xml")
-    key = (
-        "network.gama_xml"
-        if gama
-        else next(
-            (f for f in ("network.generate", "network.grids", "network.random") if cfg.get(f)),
-            "network.points",
-        )
-    )
+    key = "network.gama_xml" if gama else _size_key(cfg, k.points)
     what = f"a network of about {k.points:,.0f} points and {k.rows:,.0f} observations"
     if gama:  # counted from the file's size, not read
         what = f"{gama}: a gama-local file of about {k.rows:,.0f} observations by its size"
@@ -77,6 +70,22 @@ def fits_estimate(cfg: dict) -> None:
         f"(estimate), over the {lim / 2**30:g} GiB memory limit (--max-memory-gb or "
         "SIM_MAX_MEMORY_GB): use fewer points or observations",
     )
+
+
+def _size_key(cfg: dict, points: float) -> str:
+    """The key that sets a declared network's size: the grids or random points that hold most
+    of its points (a grid of 5 x 900,000,000 points was blamed on ``network.generate``, its
+    sights to the nearest points), else the sights generated, else the points listed."""
+    held = {
+        "network.grids": sum(
+            g.get("nx", 0) * g.get("ny", 0) for g in cfg.get("network.grids") or []
+        ),
+        "network.random": sum(r.get("n", 0) for r in cfg.get("network.random") or []),
+    }
+    key, most = max(held.items(), key=lambda kv: kv[1])
+    if most > points / 2:
+        return key
+    return "network.generate" if cfg.get("network.generate") else "network.points"
 
 
 def _fits(key: str, points: float, obs: float, what: str) -> None:
@@ -209,8 +218,36 @@ def _mm(key: str, rec: dict, field: str, required: bool = True, default=None):
     if isinstance(default, list):
         if not (isinstance(v, list) and len(v) == 2):
             raise ConfigError(f"{key}.{name}", "must be [x, y]")
-        return [_num(f"{key}.{name}", c) * f for c in v]
-    return _num(f"{key}.{name}", v) * f
+        return [_in_mm(f"{key}.{name}", _num(f"{key}.{name}", c), f) for c in v]
+    return _in_mm(f"{key}.{name}", _num(f"{key}.{name}", v), f)
+
+
+def _in_mm(key: str, v: float, f: float) -> float:
+    """``v`` times ``f`` (metres to mm), refused (naming ``key``) when that is no double."""
+    if not math.isfinite(v * f):  # x_m = 1e306: "the network spans inf km"
+        raise ConfigError(key, f"{v:g} m is beyond the largest 64-bit float in millimetres")
+    return v * f
+
+
+def reach(key: str, rec: dict, field: str, far: float) -> None:
+    """Refuse (naming ``field`` as written) a grid or random set whose extent ``far`` (mm)
+    is no finite double: a grid's spacing near the largest double made its points inf - inf
+    = NaN, which passed every check to an SVD that "did not converge"; a random set's half
+    extent, NumPy's "OverflowError: high - low range exceeds valid bounds"."""
+    if not math.isfinite(far):
+        name, unit = (f"{field}_m", "m") if f"{field}_m" in rec else (f"{field}_mm", "mm")
+        raise ConfigError(
+            f"{key}.{name}", f"{rec[name]:g} {unit} puts points beyond the largest 64-bit float"
+        )
+
+
+def finite_points(names: list[str], xy: np.ndarray) -> None:
+    """Refuse a point whose coordinates overflowed (an origin near the largest double)."""
+    bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
+    if bad.size:
+        raise ConfigError(
+            "network.points", f"point {names[bad[0]]!r} lies beyond the largest 64-bit float"
+        )
 
 
 def positive_mm(key: str, rec: dict, field: str) -> float:
