@@ -139,7 +139,8 @@ def _print(comps: list[Comparison]) -> None:
             continue
         print(
             f"{c.study}: {status}; {c.files} files; largest relative deviation "
-            f"{c.max_rel:.2g}; largest deviation/tolerance {c.max_ratio:.2g} ({c.worst})"
+            f"{c.max_rel:.2g}; largest deviation/tolerance {c.max_ratio:.2g}"
+            + (f" ({c.worst})" if c.worst else "")  # "0 ()" named no column: every one equal
         )
         for f in c.failures[:20]:
             print(f"  {f}")

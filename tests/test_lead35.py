@@ -1,0 +1,33 @@
+"""The lead's sweep of session 35 (issue 26): what the merges of its helpers' branches left.
+
+* ``make verify`` printed ``largest deviation/tolerance 0 ()`` for every study reproduced
+  exactly: the brackets name the file and column of the largest deviation, and with none
+  they named nothing (N35's left item). A study with a deviation keeps its column.
+* A network over the memory limit is refused before it is built (M35), naming the key that
+  holds most of its points: with grids beside sights generated to the nearest points, a grid
+  of 5 x 900,000,000 points was blamed on ``network.generate`` (F35's case at the merge).
+"""
+
+from __future__ import annotations
+
+from sim.report.verify.cli import _print
+from sim.report.verify.rules import Comparison
+from sim.studies.network.validate import _size_key
+
+
+def test_a_study_reproduced_exactly_names_no_empty_column(capsys):
+    _print([Comparison("net", files=7), Comparison("b", files=2, max_ratio=0.5, worst="t:x_um")])
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "net: ok; 7 files; largest relative deviation 0; largest deviation/tolerance 0"
+    assert out[1].endswith("largest deviation/tolerance 0.5 (t:x_um)"), out
+
+
+def test_a_networks_size_is_named_by_the_key_holding_its_points():
+    gen = [{"kind": "distance", "from": "G*", "to": "G*", "nearest": 8, "sigma_mm": 2.0}]
+    grid = {"network.grids": [{"prefix": "G", "nx": 5, "ny": 900_000_000}], "network.generate": gen}
+    assert _size_key(grid, 4_500_000_003) == "network.grids"
+    rnd = {"network.random": [{"prefix": "R", "n": 10**7}], "network.generate": gen}
+    assert _size_key(rnd, 10**7 + 3) == "network.random"
+    listed = {"network.grids": [{"prefix": "G", "nx": 2, "ny": 2}], "network.generate": gen}
+    assert _size_key(listed, 10**6) == "network.generate"  # the points are listed ones
+    assert _size_key({"network.generate": []}, 10**6) == "network.points"
