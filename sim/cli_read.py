@@ -40,13 +40,14 @@ def show(args) -> int:
     # the name a README.md gives (`sim show NAME` prints it again) is read under the project's
     # results/ and scratch/ too (from docs/ as from the root), where sim run writes without
     # --out (a scratch run's README named a command that said "does not exist" from the root)
-    where = [Path(shown_path(base() / b)) for b in WHERE]
+    # a name only (`sim show results/x` was told of results/results/x too)
+    where = [Path(shown_path(base() / b)) for b in WHERE] if len(d.parts) == 1 else []
     d = next((b / d for b in where if not d.exists() and (b / d).is_dir()), d)
     if not d.is_dir():
         what = "is not a directory" if os.path.lexists(d) else "does not exist"
         also = (
             ""
-            if d.is_absolute() or d.exists()
+            if d.is_absolute() or d.exists() or not where
             else f" (nor is there a directory {' or '.join(str(b / args.dir) for b in where)})"
         )
         why = link_problem(d) or f"{what}{also}"

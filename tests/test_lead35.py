@@ -3,6 +3,8 @@
 * ``make verify`` printed ``largest deviation/tolerance 0 ()`` for every study reproduced
   exactly: the brackets name the file and column of the largest deviation, and with none
   they named nothing (N35's left item). A study with a deviation keeps its column.
+* ``sim show results/x`` of a missing directory was told of ``results/results/x``: a path is
+  no study's name, looked for under results/ and scratch/ (N35's left item).
 * A network over the memory limit is refused before it is built (M35), naming the key that
   holds most of its points: with grids beside sights generated to the nearest points, a grid
   of 5 x 900,000,000 points was blamed on ``network.generate`` (F35's case at the merge).
@@ -31,3 +33,14 @@ def test_a_networks_size_is_named_by_the_key_holding_its_points():
     listed = {"network.grids": [{"prefix": "G", "nx": 2, "ny": 2}], "network.generate": gen}
     assert _size_key(listed, 10**6) == "network.generate"  # the points are listed ones
     assert _size_key({"network.generate": []}, 10**6) == "network.points"
+
+
+def test_show_of_a_path_is_not_looked_for_under_results(capsys):
+    # before: "results/nosuch does not exist (nor is there a directory results/results/nosuch
+    # or scratch/results/nosuch)": a path given is no study's name (N35's left item)
+    from sim.cli import main
+
+    assert main(["show", "results/nosuch"]) == 2
+    assert capsys.readouterr().err == "sim: error: DIR: results/nosuch does not exist\n"
+    assert main(["show", "nosuch"]) == 2
+    assert "(nor is there a directory results/nosuch or scratch/nosuch)" in capsys.readouterr().err
