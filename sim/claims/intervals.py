@@ -191,9 +191,16 @@ def spread(x: np.ndarray, level: float = LEVEL) -> tuple[float, tuple[float, flo
 
 def spread_rows(x: np.ndarray, level: float = LEVEL) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`spread` of every row of ``x`` ``(N, M)`` (NaN ignored): the median and the
-    central ``level`` range of each row, ``(median, low, high)``, each ``(N,)``."""
+    central ``level`` range of each row, ``(median, low, high)``, each ``(N,)``; NaN for a row
+    without a finite value (numpy's value, without its "All-NaN slice" warning on standard
+    error: gridplate's region at a point where no calibration has a re-weighting)."""
     a = _half(level) * 100
-    lo, med, hi = np.nanpercentile(np.asarray(x, float), [a, 50, 100 - a], axis=1)
+    x = np.asarray(x, float)
+    out = np.full((3, x.shape[0]), np.nan)
+    some = ~np.isnan(x).all(axis=1)
+    if some.any():
+        out[:, some] = np.nanpercentile(x[some], [a, 50, 100 - a], axis=1)
+    lo, med, hi = out
     return med, lo, hi
 
 
