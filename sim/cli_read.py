@@ -96,7 +96,8 @@ def _sweep_of(d: Path) -> Path | None:
 def report(results: Path) -> int:
     """``sim report``: only over a directory that holds study results (a directory of the
     user's with none gets no REPORT.md written into it)."""
-    if not os.path.lexists(results):  # from / or $HOME: not "is not a results directory"
+    # from / or $HOME: not "is not a results directory" (a link loop on the way: its words)
+    if not os.path.lexists(results) and not link_problem(results):
         raise ConfigError("--results", f"{results} does not exist (in {os.getcwd()})")
     if results.is_dir() and not any(
         (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
