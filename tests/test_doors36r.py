@@ -1,0 +1,50 @@
+"""A fresh reading of session 36's merges (sweep doors36r): each class was found through a
+real door and fixed; each test fails on the code before its fix:
+
+* the memory check of a network before it is built (``fits_estimate``, new this session)
+  counted a grid's ``nx = "3000"`` (text, not a number) as 3000 and, the estimate over the
+  limit, named the key of the most points by multiplying the raw values: ``"3000" * 3000`` a
+  string, summed with 0, a TypeError ("sim: internal error", exit 3) in ``sim check``,
+  ``sim run`` and ``sim.load``; a random set's ``n = "90000000"`` the same. The estimate is
+  now left to the build when a count is no number, which names the field ("must be a
+  finite number (got '3000')").
+"""
+
+from __future__ import annotations
+
+import pytest
+from oneline import SIM_ERROR, one_line
+
+import sim
+from sim.cli import main
+
+#: a network whose declared size is far over the 8 GiB default limit, a count given as text
+BIG = """study = "network"
+trials = 1000
+chunk = 50
+seed = 1
+
+[network]
+name = "big"
+{records}
+generate = [ {{ kind = "dx", from = "G*", to = "G*", nearest = 4, sigma_mm = 0.002 }} ]
+
+[datum]
+kind = "fixed"
+"""
+GRID = 'grids = [ { prefix = "G", nx = "3000", ny = 3000, spacing_mm = 10.0, role = "observed", sigma_mm = 0.0012 } ]'
+RANDOM = 'random = [ { prefix = "G", n = "90000000", half_extent_mm = 100.0, role = "observed", sigma_mm = 0.0012 } ]'
+
+
+@pytest.mark.parametrize(
+    ("records", "field"), [(GRID, "network.grids[0].nx"), (RANDOM, "network.random[0].n")]
+)
+def test_a_count_given_as_text_in_a_large_network_is_named(
+    capsys, tmp_path, monkeypatch, records, field
+):
+    monkeypatch.delenv("SIM_MAX_MEMORY_GB", raising=False)
+    path = tmp_path / "big.toml"
+    path.write_text(BIG.format(records=records), encoding="utf-8")
+    one_line(capsys, main(["check", str(path)]), field, "number", prefix=SIM_ERROR)
+    with pytest.raises(sim.ConfigError, match=field.replace("[", r"\[").replace("]", r"\]")):
+        sim.load(path)
