@@ -7,7 +7,9 @@ real door and fixed; each test fails on the code before its fix:
   string, summed with 0, a TypeError ("sim: internal error", exit 3) in ``sim check``,
   ``sim run`` and ``sim.load``; a random set's ``n = "90000000"`` the same. The estimate is
   now left to the build when a count is no number, which names the field ("must be a
-  finite number (got '3000')").
+  finite number (got '3000')"). A grid of ``nx = -3000, ny = -3000`` was refused as "a
+  network of about 9,000,000 points" (the product of two negative sides): it is now "nx:
+  must be >= 1".
 """
 
 from __future__ import annotations
@@ -33,18 +35,24 @@ generate = [ {{ kind = "dx", from = "G*", to = "G*", nearest = 4, sigma_mm = 0.0
 kind = "fixed"
 """
 GRID = 'grids = [ { prefix = "G", nx = "3000", ny = 3000, spacing_mm = 10.0, role = "observed", sigma_mm = 0.0012 } ]'
+NEGATIVE = GRID.replace('nx = "3000", ny = 3000', "nx = -3000, ny = -3000")
 RANDOM = 'random = [ { prefix = "G", n = "90000000", half_extent_mm = 100.0, role = "observed", sigma_mm = 0.0012 } ]'
 
 
 @pytest.mark.parametrize(
-    ("records", "field"), [(GRID, "network.grids[0].nx"), (RANDOM, "network.random[0].n")]
+    ("records", "field", "why"),
+    [
+        (GRID, "network.grids[0].nx", "number"),
+        (RANDOM, "network.random[0].n", "number"),
+        (NEGATIVE, "network.grids[0].nx", ">= 1"),
+    ],
 )
 def test_a_count_given_as_text_in_a_large_network_is_named(
-    capsys, tmp_path, monkeypatch, records, field
+    capsys, tmp_path, monkeypatch, records, field, why
 ):
     monkeypatch.delenv("SIM_MAX_MEMORY_GB", raising=False)
     path = tmp_path / "big.toml"
     path.write_text(BIG.format(records=records), encoding="utf-8")
-    one_line(capsys, main(["check", str(path)]), field, "number", prefix=SIM_ERROR)
+    one_line(capsys, main(["check", str(path)]), field, why, prefix=SIM_ERROR)
     with pytest.raises(sim.ConfigError, match=field.replace("[", r"\[").replace("]", r"\]")):
         sim.load(path)
