@@ -10,6 +10,11 @@ real door and fixed; each test fails on the code before its fix:
   finite number (got '3000')"). A grid of ``nx = -3000, ny = -3000`` was refused as "a
   network of about 9,000,000 points" (the product of two negative sides): it is now "nx:
   must be >= 1".
+* a study file giving a key twice names it ("trials is given twice (at line 4, column 13)",
+  toml_twice, new this session), except when the second is the file's last line with no line
+  break after it (an editor that writes none): tomllib says "(at end of document)", which the
+  reading did not match, and the line was tomllib's "Cannot overwrite a value (at end of
+  document)", no key named. It is named now, with its line.
 """
 
 from __future__ import annotations
@@ -55,4 +60,14 @@ def test_a_count_given_as_text_in_a_large_network_is_named(
     path.write_text(BIG.format(records=records), encoding="utf-8")
     one_line(capsys, main(["check", str(path)]), field, why, prefix=SIM_ERROR)
     with pytest.raises(sim.ConfigError, match=field.replace("[", r"\[").replace("]", r"\]")):
+        sim.load(path)
+
+
+def test_a_key_given_twice_on_the_last_line_without_a_line_break_is_named(capsys, tmp_path):
+    path = tmp_path / "twice.toml"
+    path.write_text('study = "brown"\ntrials = 400\nseed = 3\ntrials = 500', encoding="utf-8")
+    one_line(
+        capsys, main(["check", str(path)]), "trials is given twice (at line 4", prefix=SIM_ERROR
+    )
+    with pytest.raises(sim.ConfigError, match="trials is given twice"):
         sim.load(path)
