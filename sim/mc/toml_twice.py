@@ -4,6 +4,9 @@
 twice`` (a Python tuple) for a table given twice. The line is now ``trials is given twice (at
 line 3, column 11)``; when the two differ in kind, which they are (``plate is given twice (a
 value, then a table)``).
+A file whose last line, with no line break after it, gives the key again is told
+"(at end of document)" by tomllib, no line: named too (``trials is given twice (at line 4,
+the end of the file)``), no longer left as tomllib's words.
 
 The statement at fault is found by TOML itself: it begins at the last line start at or before
 the error's line whose text before it reads as TOML (a statement that spans lines, an array
@@ -24,6 +27,8 @@ from sim.mc.message_text import key_text
 __all__ = ["twice_text"]
 
 _AT = re.compile(r"(.*) \(at line (\d+), column (\d+)\)", re.S)
+#: the words of a file whose last statement, with no line break after it, is at fault
+_END = re.compile(r"(.*) \(at end of document\)", re.S)
 _NAMED = re.compile(r"Cannot (?:declare|redefine namespace|mutate immutable namespace) (\(.*?\))")
 #: a key no study file holds: where it lands is the table a statement is in
 _PROBE = "sim probe 5f0c"
@@ -35,15 +40,16 @@ _BACK, _BUDGET, _LARGEST = 400, 1_000_000, 256_000
 def twice_text(text: str, message: str) -> str | None:
     """``message`` (tomllib's, for ``text``) with the key given twice named, or None when it
     is no such message or the key cannot be told."""
-    at = _AT.fullmatch(message)
-    if (
-        len(text) > _LARGEST
-        or not at
-        or not at.group(1).startswith(("Cannot ", "Duplicate inline table key"))
-    ):
+    at, end = _AT.fullmatch(message), _END.fullmatch(message)
+    if at:
+        reason, line, where = at.group(1), int(at.group(2)), f" (at line {at[2]}, column {at[3]})"
+    elif end:  # the last statement, no line break after it: tomllib gives no line
+        line = text.count("\n") + 1
+        reason, where = end.group(1), f" (at line {line}, the end of the file)"
+    else:
         return None
-    reason, line = at.group(1), int(at.group(2))
-    where = f" (at line {line}, column {at.group(3)})"
+    if len(text) > _LARGEST or not reason.startswith(("Cannot ", "Duplicate inline table key")):
+        return None
     try:
         return _named(text, reason, line, where)
     except (tomllib.TOMLDecodeError, ValueError, SyntaxError, RecursionError, IndexError):

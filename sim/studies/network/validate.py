@@ -51,6 +51,8 @@ def fits_estimate(cfg: dict) -> None:
     ``network.generate``, ``network.grids``, ``network.random`` or ``network.points``). The
     estimate was applied after the load: a 90,000-point network under
     ``SIM_MAX_MEMORY_GB=2`` was built and factorised (two minutes, 1.35 GiB), then refused."""
+    if not _counts_typed(cfg):
+        return  # a count as text ("3000"), below 1, not whole: the build names its field
     try:
         need, k = network_estimate(cfg)[3], network_counts(cfg)
     except (TypeError, ValueError, KeyError, OverflowError, ZeroDivisionError, OSError):
@@ -70,6 +72,23 @@ def fits_estimate(cfg: dict) -> None:
         f"(estimate), over the {lim / 2**30:g} GiB memory limit (--max-memory-gb or "
         "SIM_MAX_MEMORY_GB): use fewer points or observations",
     )
+
+
+def _counts_typed(cfg: dict) -> bool:
+    """Whether every grid's ``nx``, ``ny`` and random set's ``n`` is a whole number of at least
+    1, as the build takes it: the estimate counted ``nx = "3000"`` as 3000 and
+    :func:`_size_key` multiplied the text, a TypeError traceback (exit 3); a grid of -3000 x
+    -3000 was refused as "a network of about 9,000,000 points", as was one of 3000.5 x 3000.
+    The build names such a field ("must be a finite number", "must be >= 1")."""
+    for key, fields in (("network.grids", ("nx", "ny")), ("network.random", ("n",))):
+        for rec in cfg.get(key) or []:
+            for f in fields if isinstance(rec, dict) else ():
+                v = rec.get(f, 1)
+                if isinstance(v, bool) or not isinstance(v, (int, float)):
+                    return False
+                if not (math.isfinite(v) and v >= 1 and float(v).is_integer()):
+                    return False
+    return True
 
 
 def _size_key(cfg: dict, points: float) -> str:
