@@ -80,6 +80,14 @@ def _counted_as(r: dict) -> str:
     return r["verdict"]
 
 
+def verdict_cell(r: dict) -> str:
+    """A claim's verdict as its row shows it: an input's or a self-check's own outcome in
+    brackets (``self-check (inconclusive)``), as README.md's table gives it and the counts
+    count it apart (``sim show`` said ``self-check`` of one its counts call undecided)."""
+    out = r.get("outcome") if r.get("kind") in ("input", "self-check") else None
+    return r["verdict"] + (f" ({out})" if out else "")
+
+
 def verdict_line(claims: list[dict]) -> str:
     """``"14 claims: 6 holds, 2 fails, ..."`` (every verdict value, in :data:`VERDICT_ORDER`);
     a paper-check that holds (the paper's own arithmetic) counts as ``paper consistent``, as in
@@ -245,7 +253,7 @@ def terminal_table(out: Path, width: int = 100, design: Callable | None = None) 
             f"sim show {shlex.quote(str(out))} --markdown"  # a command to paste (doors25a)
         ) + tail
     claims = records(out / "claims.parquet")
-    rows = [[r["claim"], _value_text(r), _interval(r), r["verdict"]] for r in claims]
+    rows = [[r["claim"], _value_text(r), _interval(r), verdict_cell(r)] for r in claims]
     table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
     conv = converged_line(out)
     return table + "\n\n" + verdict_line(claims) + ("" if conv is None else f"\n{conv}") + tail
