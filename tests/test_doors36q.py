@@ -9,10 +9,13 @@ the end of ``sim run``?), one case each; each failed on the code before its fix.
 * a run off the paper's setup (``--set errors.setting_sigma_um=3``): README.md says so at its
   top ("Off the paper's setup (...): its predictions are findings ..."), but ``sim show`` and
   the end of ``sim run`` printed the same verdicts without a word of it: both now give
-  README.md's line below their counts (:func:`sim.report.off_paper.off_note`).
+  README.md's line below their counts (:func:`sim.report.off_paper.off_note`), and
+  ``sim report``'s line on the run's configuration (REPORT.md) gives it too.
 """
 
 from __future__ import annotations
+
+import shutil
 
 from sim.cli import main
 from sim.report import run_summary
@@ -41,3 +44,17 @@ def test_show_and_the_end_of_a_run_say_a_run_is_off_the_papers_setup(tiny_run, c
     assert main(["show", str(d)]) == 0
     assert said in capsys.readouterr().out.splitlines()
     assert said in terminal_summary(d, get_study=get_study).splitlines()
+
+
+def test_report_says_a_run_is_off_the_papers_setup(tiny_run, tmp_path, capsys):
+    d = tiny_run("brown_table1", "--set=errors.setting_sigma_um=3.0")
+    said = next(ln for ln in (d / "README.md").read_text().splitlines() if "Off the paper" in ln)
+    shutil.copytree(d, tmp_path / "r" / "off")
+    assert main(["report", "--results", str(tmp_path / "r")]) == 0
+    capsys.readouterr()
+    line = next(
+        ln
+        for ln in (tmp_path / "r" / "REPORT.md").read_text().splitlines()
+        if ln.startswith("- [off]")
+    )
+    assert said.strip("*") in line
