@@ -158,7 +158,7 @@ def _run(args) -> int:
     args.published = shown  # an interrupt from now on finds the results written
     check_interrupt()  # dropped by Python since the results were published: not exit 0
     try:  # (its README.md was written before the results were published)
-        summary = terminal_summary(out, shown=shown)
+        summary = terminal_summary(out, shown=shown, get_study=get_study)
     except (OSError, ValueError, KeyError) as e:  # the results stand; only their summary failed
         summary = f"(no summary: {type(e).__name__}: {e})".splitlines()[0]
     print(f"{cfg['study']}: results in {shown.rstrip('/')}/")  # (--out DIR/: not DIR//)

@@ -59,7 +59,7 @@ def show(args) -> int:
         text = (
             run_markdown(d, get_study, design=design_config)
             if args.markdown
-            else terminal_table(d, design=design_config)
+            else terminal_table(d, design=design_config, get_study=get_study)
         )
     except ConfigError:
         raise

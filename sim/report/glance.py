@@ -14,6 +14,7 @@ import pyarrow as pa
 from sim.mc.storage import read_provenance
 from sim.report.claimtext import decimals_for, exact_text, fmt_at
 from sim.report.config_diff import changed_keys, changes_text, design_of
+from sim.report.off_paper import off_setup
 from sim.report.papers import paper_name
 from sim.report.run_summary import headline_rows, region_line, verdict_line
 from sim.report.tables import Md, fmt, md_link, md_table
@@ -224,9 +225,11 @@ def design_notes(entries: list[tuple], results: Path, design: Callable | None) -
         found = design_of(mine, name, design) if mine else None
         if found is None or not changed_keys(mine, found[1]):
             continue
+        off = off_setup(study, mine)  # README.md's and sim show's line (doors36q)
         out.append(
             f"- {md_link(name)} did not run the configuration of "
             f"`{found[0]}`: {changes_text(mine, found[1])}. Its verdicts are about this run's "
             "configuration, not the study file's design."
+            + (f" {off[:1].upper()}{off[1:]}." if off else "")
         )
     return out

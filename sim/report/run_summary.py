@@ -18,12 +18,13 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS, printed_differs
+from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, write_record
 from sim.mc.table_shape import kind
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.config_diff import config_line
+from sim.report.off_paper import off_note, off_setup
 from sim.report.papers import paper_name
 from sim.report.read import TableError, checked_table, columns, forget, records
 from sim.report.sweep import sweep_markdown
@@ -78,6 +79,14 @@ def _counted_as(r: dict) -> str:
     if r.get("kind") == "self-check" and r.get("outcome") not in (None, "holds"):
         return "self-check failed" if r["outcome"] == "fails" else "self-check undecided"
     return r["verdict"]
+
+
+def verdict_cell(r: dict) -> str:
+    """A claim's verdict as its row shows it: an input's or a self-check's own outcome in
+    brackets (``self-check (inconclusive)``), as README.md's table gives it and the counts
+    count it apart (``sim show`` said ``self-check`` of one its counts call undecided)."""
+    out = r.get("outcome") if r.get("kind") in ("input", "self-check") else None
+    return r["verdict"] + (f" ({out})" if out else "")
 
 
 def verdict_line(claims: list[dict]) -> str:
@@ -192,10 +201,11 @@ def _interval(r: dict) -> str:
     return "" if r["verdict"] == "not comparable" else interval_text(r)
 
 
-def terminal_summary(out: Path, n: int = 5, shown: str | None = None) -> str:
+def terminal_summary(out: Path, n: int = 5, shown: str | None = None, get_study=None) -> str:
     """The closing lines of a run: the verdict counts, up to ``n`` headline rows (value,
     95 % interval, verdict), the region line, and the path of the directory's README.md
-    (under ``shown``, the directory as the user named it, if given)."""
+    (under ``shown``, the directory as the user named it, if given); ``get_study`` given, a run
+    off the paper's setup says so as its README.md does (:func:`off_note`)."""
     out = Path(out)
     if _kind_of(out) == "sweep":
         t = columns(out / "sweep.parquet")
@@ -206,10 +216,13 @@ def terminal_summary(out: Path, n: int = 5, shown: str | None = None) -> str:
         lines = [verdict_line(claims)]
         if (conv := converged_line(out)) is not None:
             lines.append(conv)
+        lines += [off] if (off := off_note(out, get_study)) else []
         for r in headline_rows(claims, n):
             ci = _interval(r)
             lines.append(
-                f"  {r['claim']}: {_value_text(r)}" + (f" {ci}" if ci else "") + f" {r['verdict']}"
+                f"  {r['claim']}: {_value_text(r)}"
+                + (f" {ci}" if ci else "")
+                + f" {verdict_cell(r)}"
             )
         if (reg := region_line(out)) is not None:
             lines.append(reg)
@@ -218,10 +231,14 @@ def terminal_summary(out: Path, n: int = 5, shown: str | None = None) -> str:
     return "\n".join(lines)
 
 
-def terminal_table(out: Path, width: int = 100, design: Callable | None = None) -> str:
+def terminal_table(
+    out: Path, width: int = 100, design: Callable | None = None, get_study=None
+) -> str:
     """Every claim of a results directory as a plain-text table (claim, simulated, 95 %
     interval, verdict), then the counts; a sweep directory as its cells. ``design``: see
-    :func:`run_markdown` (what the run changed from its study file, a line at the end)."""
+    :func:`run_markdown` (what the run changed from its study file, a line at the end);
+    ``get_study``: the study's object by its name, to say a run off the paper's setup
+    (:func:`off_note`)."""
     out = Path(out)
     study = _kind_of(out) == "study"
     cfg = read_provenance(out / "claims.parquet") if study else _sweep_prov(out)
@@ -245,10 +262,12 @@ def terminal_table(out: Path, width: int = 100, design: Callable | None = None) 
             f"sim show {shlex.quote(str(out))} --markdown"  # a command to paste (doors25a)
         ) + tail
     claims = records(out / "claims.parquet")
-    rows = [[r["claim"], _value_text(r), _interval(r), r["verdict"]] for r in claims]
+    rows = [[r["claim"], _value_text(r), _interval(r), verdict_cell(r)] for r in claims]
     table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
     conv = converged_line(out)
-    return table + "\n\n" + verdict_line(claims) + ("" if conv is None else f"\n{conv}") + tail
+    off = off_note(out, get_study)
+    notes = "".join(f"\n{x}" for x in (conv, off) if x)
+    return table + "\n\n" + verdict_line(claims) + notes + tail
 
 
 def _sweep_prov(out: Path) -> dict:
@@ -352,24 +371,6 @@ def run_markdown(
             head += [reg[0].upper() + reg[1:] + ".", ""]
         body = study.report(out)
     return "\n".join(head) + "\n" + _relink(body, out.name) + "\n"
-
-
-def off_setup(study, cfg: dict, before: bool = False) -> str:
-    """``off the paper's setup (key = value (paper: default), ...): its predictions are
-    findings ...`` for a config whose printed inputs are not the paper's (``sim check`` says
-    it before the run, ``before``: "will be"; a run's README.md at its top: it said so only
-    in its claims' notes), else ``""``."""
-    off = printed_differs(study.schema, cfg, study.as_printed)
-    if not off:
-        return ""
-    kept = len(study.paper_design)
-    but = (
-        f", but the {kept} it decides on the paper's own setup, which stay the paper's verdicts"
-        if kept
-        else ""
-    )
-    verb = "will be" if before else "are"
-    return f"off the paper's setup ({', '.join(off)}): its predictions {verb} findings{but}"
 
 
 def _relink(body: str, name: str) -> str:

@@ -1,0 +1,42 @@
+"""The line on a run off the paper's setup (its printed inputs not the paper's): what
+README.md says at its top, ``sim check`` before the run, and ``sim show`` and the end of
+``sim run`` below their counts, in the same words."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+from sim.claims.rules import printed_differs
+from sim.mc.storage import read_provenance
+
+__all__ = ["off_setup", "off_note"]
+
+
+def off_setup(study, cfg: dict, before: bool = False) -> str:
+    """``off the paper's setup (key = value (paper: default), ...): its predictions are
+    findings ...`` for a config whose printed inputs are not the paper's (``sim check`` says
+    it before the run, ``before``: "will be"; a run's README.md at its top: it said so only
+    in its claims' notes), else ``""``."""
+    off = printed_differs(study.schema, cfg, study.as_printed)
+    if not off:
+        return ""
+    kept = len(study.paper_design)
+    but = (
+        f", but the {kept} it decides on the paper's own setup, which stay the paper's verdicts"
+        if kept
+        else ""
+    )
+    verb = "will be" if before else "are"
+    return f"off the paper's setup ({', '.join(off)}): its predictions {verb} findings{but}"
+
+
+def off_note(out: Path, get_study: Callable | None) -> str:
+    """README.md's line on a run off the paper's setup (:func:`off_setup`), for the doors that
+    print the same directory in a terminal (``sim show``, the end of ``sim run``: they said
+    nothing of it), or ``""`` (no ``get_study``, or on the paper's setup)."""
+    if get_study is None:
+        return ""
+    prov = read_provenance(Path(out) / "claims.parquet")
+    off = off_setup(get_study(prov["study"]), prov.get("config") or {})
+    return off[:1].upper() + off[1:]
