@@ -28,7 +28,7 @@ from sim.report.read import (
     forget,
     records,
 )
-from sim.report.run_summary import converged_line, headline_rows, write_run_readme
+from sim.report.run_summary import converged_line, headline_rows, verdict_cell, write_run_readme
 from sim.report.tables import Md, fmt, md_href, md_link, md_table
 from sim.report.verify import markdown as reproducibility_markdown
 
@@ -57,9 +57,8 @@ def claims_markdown(path: Path) -> str:
             sim, ci = "", ""
         else:
             sim, ci = sim_text(r), interval_text(r)
-        verdict = _VERDICT_TEXT.get(r["verdict"], r["verdict"])
-        if r["kind"] in ("input", "self-check") and r.get("outcome"):
-            verdict += f" ({r['outcome']})"
+        # the verdict in the words of sim show's table (an input's, a self-check's outcome)
+        verdict = verdict_cell({**r, "verdict": _VERDICT_TEXT.get(r["verdict"], r["verdict"])})
         rows.append(
             [
                 f"`{r['claim']}`",

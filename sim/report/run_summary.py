@@ -83,7 +83,7 @@ def _counted_as(r: dict) -> str:
 
 def verdict_cell(r: dict) -> str:
     """A claim's verdict as its row shows it: an input's or a self-check's own outcome in
-    brackets (``self-check (inconclusive)``), as README.md's table gives it and the counts
+    brackets (``self-check (inconclusive)``), in README.md's table (:mod:`.markdown`) too; the counts
     count it apart (``sim show`` said ``self-check`` of one its counts call undecided)."""
     out = r.get("outcome") if r.get("kind") in ("input", "self-check") else None
     return r["verdict"] + (f" ({out})" if out else "")
