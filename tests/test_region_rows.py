@@ -135,13 +135,15 @@ def test_decide_over_an_empty_region_names_the_conflicts():
     v = decide_over(r, Statement("b", (5.0, 5.0), "lower"))
     assert v == RegionVerdict(
         "b", "undecidable", 0, 0, 0, "nowhere", "nowhere",
-        "no input is consistent with the printed statements (conflicting: zero; a_up)",
+        "none of the 256 explored inputs is consistent with the printed statements"
+        " (conflicting: zero; a_up)",
     )  # fmt: skip
     # a minimal set of two statements that cannot hold together: "a + b" names both
     lo = Statement("a_up", (6.0, 6.0), "lower")  # a >= 6 with a <= 4.5 below
     r = region(A_UP, lo, rounds=0)
     assert decide_over(r, Statement("b", (5.0, 5.0), "lower")).note == (
-        "no input is consistent with the printed statements (conflicting: a_up + a_up)"
+        "none of the 256 explored inputs is consistent with the printed statements"
+        " (conflicting: a_up + a_up)"
     )
 
 

@@ -227,7 +227,8 @@ def decide_over(
         conf = "; ".join(" + ".join(c) for c in region.conflicts)
         return RegionVerdict(
             spec.id, "undecidable", 0, 0, 0, "nowhere", "nowhere",
-            f"no input is consistent with the printed statements (conflicting: {conf})",
+            f"none of the {acc.size} explored inputs is consistent with the printed statements"
+            f" (conflicting: {conf})",
         )  # fmt: skip
     o = outcomes(region, spec, evidence) if outcome is None else np.asarray(outcome)
     h, f = acc & (o == HOLDS), acc & (o == FAILS)
