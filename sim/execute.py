@@ -48,7 +48,7 @@ from sim.report.sweep import fig_sweep
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
-__all__ = ["execute", "run_sweep", "check_sweep", "drop_half_imported"]
+__all__ = ["execute", "run_sweep", "check_sweep", "sweep_limits", "drop_half_imported"]
 
 
 #: a Dask scheduler address: tcp://HOST:PORT (or another Dask protocol)
@@ -209,8 +209,7 @@ def execute(
     shown = shown or str(out)
     _check_options(executor, workers, scheduler)
     check_chunks(cfg)
-    est = estimate(cfg, sweep)
-    check_limits(est, max_memory_gb, max_adjustments, workers)
+    est = sweep_limits(study, cfg, sweep, max_memory_gb, max_adjustments, workers)
     check_sweep(study, cfg, sweep, quiet)
     if not quiet and (note := chunk_note(est, cfg["chunk"])):
         print(f"sim: {note}", file=sys.stderr)
@@ -355,6 +354,32 @@ def _quiet_dask_logs() -> None:
     ]
     for n in ("asyncio", "distributed", "tornado", *names):
         logging.getLogger(n).setLevel(logging.CRITICAL + 1)
+
+
+def sweep_limits(
+    study,
+    cfg: dict,
+    sweep: Mapping[str, Any],
+    max_memory_gb: float | None = None,
+    max_adjustments: float | None = None,
+    workers: int = 1,
+):
+    """The run's estimate (:func:`sim.mc.estimate.estimate`), checked against the limits
+    (``sim run``, ``sim check``, ``python -m sim.batch``). A sweep over a limit is estimated
+    again without the cells the study refuses (recorded infeasible, never run): a 150 x 150
+    plate outside the format, refused in its cell, made a sweep of it and a 5 x 5 plate "need
+    0.744 GiB" and refused it. A cell refused for the limit itself is named
+    (:func:`sim.mc.sweep.refused_cells`)."""
+    est = estimate(cfg, sweep)
+    try:
+        check_limits(est, max_memory_gb, max_adjustments, workers)
+    except ConfigError:
+        bad = refused_cells(study, cfg, sweep)[0] if sweep else None
+        if not bad:
+            raise
+        est = estimate(cfg, sweep, skip=bad)
+        check_limits(est, max_memory_gb, max_adjustments, workers)
+    return est
 
 
 def check_sweep(study, cfg: dict, sweep: Mapping[str, Any], quiet: bool = False) -> None:

@@ -42,6 +42,7 @@ import numpy as np
 from sim.mc.config import (
     ConfigError,
     Field,
+    LimitError,
     check_chunks,
     check_value,
     did_you_mean,
@@ -313,6 +314,11 @@ def refused_cells(
         checked += 1
         try:
             cell_config(study, cfg, cell, cfg["seed"])
+        except LimitError as e:  # this machine's limit, not the design's: the sweep is refused
+            key = e.key if e.key in keys else keys[0] if len(keys) == 1 else None
+            raise LimitError(
+                f"sweep.{key}" if key else "sweep", f"in the cell of {_shown(keys, cell)}: {e}"
+            ) from None
         except ConfigError as e:
             bad[i] = str(e)
             named.add(e.key)
