@@ -16,6 +16,11 @@ features, and P35's left items), one case each; each failed on the code before i
 * A sweep's table (its README.md, ``sim show --markdown``) gave a region row's value as the
   low end of its range over the region (``0.120`` where the cell's own README says
   ``0.12–0.92``): the range is given, as the cell's row gives it.
+* A cell whose run failed for the machine, not its configuration (a full disk, ``[Errno 28]``
+  writing its tables; memory; a worker killed) was recorded infeasible, "failed: [Errno 28]
+  No space left on device", and the sweep published with exit 0, the cell's results lost.
+  Such a failure now stops the sweep as it stops a single run, one line, the finished cells'
+  chunks kept: the same command resumes (:func:`sim.execute_sweep.not_the_cells`).
 * P35's left items: ``datum.kind = "inner"`` on a network whose fixed points already fix the
   datum ran the fixed datum, said ``datum `inner` (0 constraints)``, and ``datum.points``
   changed nothing: refused, naming the key (``datum.points`` when given). ``snoop.alpha`` and
@@ -31,6 +36,9 @@ refused for its design are named once and recorded.
 
 from __future__ import annotations
 
+import dataclasses
+import errno
+import importlib
 import textwrap
 
 import pytest
@@ -39,6 +47,7 @@ import sim
 from sim.cli import main
 from sim.mc.storage import write_table
 from sim.report.sweep import sweep_markdown
+from sim.studies import MODULES
 
 GRID = '{{ prefix = "G", nx = {n}, ny = {n}, spacing_mm = 40.0, role = "observed", sigma_mm = 0.0012 }}'
 
@@ -175,3 +184,38 @@ def test_snooping_keys_are_refused_without_snooping(tmp_path, key, value):
         sim.ConfigError, match=f"^snoop.{key}: is not read when snoop.max_reject = 0"
     ):
         sim.load(f)
+
+
+NETWORK = """\
+study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+           { name = "B", x_mm = 1000.0, y_mm = 0.0, role = "fixed" },
+           { name = "C", x_mm = 400.0, y_mm = 700.0 } ]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
+[sweep]
+"network.scale_ppm" = [0.0, 10.0]
+"""
+
+
+def test_a_full_disk_in_a_sweeps_cell_stops_the_run_resumably(tmp_path, capsys, monkeypatch):
+    mod = importlib.import_module(MODULES["network"])
+    real = mod.STUDIES["network"]
+
+    def full_disk(cfg, d, ctx):
+        if d.name.startswith("cell0001"):
+            raise OSError(errno.ENOSPC, "No space left on device", str(d / "claims.parquet"))
+        return real.run(cfg, d, ctx)
+
+    monkeypatch.setitem(mod.STUDIES, "network", dataclasses.replace(real, run=full_disk))
+    f, out = _file(tmp_path, "s.toml", NETWORK), tmp_path / "out"
+    cmd = ["run", str(f), "--out", str(out), "--quiet", "--no-figures"]
+    assert main(cmd) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "No space left on device" in err, err
+    assert not out.exists()
+    monkeypatch.setitem(mod.STUDIES, "network", real)
+    assert main(cmd) == 0
+    assert "resuming network: 20 finished chunks found" in capsys.readouterr().err
