@@ -21,6 +21,10 @@ features, and P35's left items), one case each; each failed on the code before i
   No space left on device", and the sweep published with exit 0, the cell's results lost.
   Such a failure now stops the sweep as it stops a single run, one line, the finished cells'
   chunks kept: the same command resumes (:func:`sim.execute_sweep.not_the_cells`).
+* A sweep of a printed key (``errors.settings = [1, 2]``) said nothing of its cells off the
+  paper's setup in its README.md, ``sim show`` or the end of ``sim run``, where ``sim show`` of
+  such a cell says its predictions are findings: the three now give one line naming the
+  cells off it (:func:`sim.report.off_paper.sweep_off_note`).
 * P35's left items: ``datum.kind = "inner"`` on a network whose fixed points already fix the
   datum ran the fixed datum, said ``datum `inner` (0 constraints)``, and ``datum.points``
   changed nothing: refused, naming the key (``datum.points`` when given). ``snoop.alpha`` and
@@ -40,15 +44,18 @@ import dataclasses
 import errno
 import importlib
 import textwrap
+from pathlib import Path
 
 import pytest
 
 import sim
 from sim.cli import main
 from sim.mc.storage import write_table
+from sim.report.run_summary import run_markdown, terminal_summary, terminal_table
 from sim.report.sweep import sweep_markdown
-from sim.studies import MODULES
+from sim.studies import MODULES, get_study
 
+ROOT = Path(__file__).resolve().parents[1]
 GRID = '{{ prefix = "G", nx = {n}, ny = {n}, spacing_mm = 40.0, role = "observed", sigma_mm = 0.0012 }}'
 
 
@@ -140,6 +147,30 @@ def test_a_sweeps_table_gives_a_region_rows_range(tmp_path):
     write_table(tmp_path / "sweep.parquet", cols, prov)
     text = sweep_markdown(tmp_path)
     assert "| 0.120–0.920 | 1.64 |" in text and "| 0.0400–0.920 | 1.65 |" in text, text
+
+
+def test_a_sweeps_doors_say_which_cells_are_off_the_papers_setup(tmp_path):
+    cfg = sim.load(ROOT / "studies" / "brown_table1.toml").config
+    cols = {
+        "cell": [0, 1],
+        "replicate": [0, 0],
+        "label": ["cell0000_r0", "cell0001_r0"],
+        "seed": [1, 2],
+        "feasible": [True, True],
+        "reason": ["", ""],
+        "errors.settings": [1, 2],
+    }
+    prov = {
+        "study": "brown_table1",
+        "config": cfg,
+        "sweep": {"errors.settings": [1, 2]},
+        "sweep_keys": ["errors.settings"],
+    }
+    write_table(tmp_path / "sweep.parquet", cols, prov)
+    said = "Off the paper's setup in 1 of 2 cells (cell0000: errors.settings = 1 (paper: 2))"
+    assert said in terminal_table(tmp_path, get_study=get_study)
+    assert said in terminal_summary(tmp_path, get_study=get_study)
+    assert said in run_markdown(tmp_path, get_study)
 
 
 INNER = """\
