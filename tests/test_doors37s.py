@@ -10,7 +10,7 @@ features, and P35's left items), one case each; each failed on the code before i
   ``network.grids`` with a 400 x 400 grid said "reduce chunk, trials or the sizes in the
   study file", a Brown sweep of ``plate.grid`` "reduce ... plate.grid" (the file's value, which
   the sweep overrides). The line now names the cell's swept values and ``sweep.<key>``; a
-  network cell refused by its size check (:class:`sim.mc.config.LimitError`, a limit of the
+  network cell refused by its size check (:class:`sim.mc.limit_error.LimitError`, a limit of the
   machine, not of the design) refuses the sweep naming ``sweep.network.grids`` and the cell,
   where it would have been recorded infeasible and the others run.
 * A sweep's table (its README.md, ``sim show --markdown``) gave a region row's value as the

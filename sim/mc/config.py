@@ -33,7 +33,6 @@ from sim.mc.toml_twice import twice_text
 
 __all__ = [
     "ConfigError",
-    "LimitError",
     "config_changes",
     "StudyError",
     "Field",
@@ -59,12 +58,6 @@ class ConfigError(ValueError):
     def detail(self) -> str:
         """The message without the key it names (to be said again of another key or door)."""
         return str(self).removeprefix(f"{key_text(self.key)}: " if self.key is not None else "")
-
-
-class LimitError(ConfigError):
-    """A configuration over a limit of the machine the command runs on (``--max-memory-gb``),
-    not of its design: a sweep's cell refused for it refuses the sweep, naming the cell
-    (recorded infeasible, its results would depend on the limit of the machine that ran it)."""
 
 
 class StudyError(RuntimeError):

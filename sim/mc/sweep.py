@@ -42,13 +42,13 @@ import numpy as np
 from sim.mc.config import (
     ConfigError,
     Field,
-    LimitError,
     check_chunks,
     check_value,
     did_you_mean,
     read_toml,
     validate,
 )
+from sim.mc.limit_error import LimitError
 from sim.mc.numtext import UnheldError, unsigned_zeros
 from sim.mc.progress import Progress
 from sim.mc.runner import chunk_rng

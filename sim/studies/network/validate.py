@@ -13,7 +13,8 @@ import math
 
 import numpy as np
 
-from sim.mc.config import ConfigError, LimitError, did_you_mean
+from sim.mc.config import ConfigError, did_you_mean
+from sim.mc.limit_error import LimitError
 from sim.mc.lookalike import differs, skeleton
 from sim.mc.memory_limit import memory_limit_gb
 from sim.mc.network_size import network_counts, network_estimate, state_bytes
