@@ -20,9 +20,9 @@ from sim.cli import DOC as cli_doc
 from sim.cli import check_run_args, load_run
 from sim.cli_args import parser as run_parser
 from sim.cli_errors import cwd_exists
+from sim.execute import sweep_limits
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
-from sim.mc.estimate import check_limits, estimate
 from sim.mc.message_text import key_text
 from sim.mc.outputs import check_out
 from sim.mc.overrides import command_values, listed, recorded
@@ -144,8 +144,8 @@ def _configs_problems(
             study, cfg = load_run(args)  # with its --max-memory-gb (a large network's check)
             check_chunks(cfg)
             sweep = read_sweep(f, study.schema)
-            est = estimate(cfg, sweep)  # the limits its run applies (sim check's too)
-            check_limits(est, args.max_memory_gb, args.max_adjustments, args.workers)
+            lim = args.max_memory_gb, args.max_adjustments, args.workers
+            sweep_limits(study, cfg, sweep, *lim)  # the limits its run applies (sim check's too)
             out = results / f.stem  # each run is --overwrite: the record is not compared
             record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
             check_out(absolute(out), str(out), record, True)  # (as sim run: check_run_args)

@@ -33,9 +33,8 @@ from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
 from sim.cli_read import report, show
 from sim.ends import stdout_failed
-from sim.execute import check_sweep, execute
+from sim.execute import check_sweep, execute, sweep_limits
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
-from sim.mc.estimate import check_limits, estimate
 from sim.mc.memory_limit import memory_given
 from sim.mc.outputs import name_problem
 from sim.mc.overrides import command_values, listed, recorded
@@ -199,8 +198,7 @@ def _check(args) -> int:
     study, cfg = load_run(args)
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
-    est = estimate(cfg, sweep)
-    check_limits(est, args.max_memory_gb, args.max_adjustments)  # sim run's, at one worker
+    est = sweep_limits(study, cfg, sweep, args.max_memory_gb, args.max_adjustments)  # at one worker
     check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
     # listed commented out (set, they would be refused); one a sweep's cells read is kept

@@ -23,10 +23,11 @@ from typing import Any, Callable, Collection, Mapping
 
 import numpy as np
 
+from sim.execute_sweep import check_sweep, not_the_cells, sweep_limits
 from sim.held_stops import held_stops
 from sim.mc.argv import most_workers
 from sim.mc.config import ConfigError, StudyError, check_chunks
-from sim.mc.estimate import check_limits, chunk_note, estimate
+from sim.mc.estimate import chunk_note
 from sim.mc.executors import StartRefused, script_words
 from sim.mc.left_behind import clear_replaced
 from sim.mc.outputs import _chunks, _differs, _same, check_out, drop_stage, prepare_stage, stage_dir
@@ -41,14 +42,14 @@ from sim.mc.storage import (
     versions,
     write_table,
 )
-from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cells, refused_note
+from sim.mc.sweep import cell_config, cell_label, cell_seed, expand
 from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
-__all__ = ["execute", "run_sweep", "check_sweep", "drop_half_imported"]
+__all__ = ["execute", "run_sweep", "check_sweep", "sweep_limits", "drop_half_imported"]
 
 
 #: a Dask scheduler address: tcp://HOST:PORT (or another Dask protocol)
@@ -209,8 +210,7 @@ def execute(
     shown = shown or str(out)
     _check_options(executor, workers, scheduler)
     check_chunks(cfg)
-    est = estimate(cfg, sweep)
-    check_limits(est, max_memory_gb, max_adjustments, workers)
+    est = sweep_limits(study, cfg, sweep, max_memory_gb, max_adjustments, workers)
     check_sweep(study, cfg, sweep, quiet)
     if not quiet and (note := chunk_note(est, cfg["chunk"])):
         print(f"sim: {note}", file=sys.stderr)
@@ -357,19 +357,6 @@ def _quiet_dask_logs() -> None:
         logging.getLogger(n).setLevel(logging.CRITICAL + 1)
 
 
-def check_sweep(study, cfg: dict, sweep: Mapping[str, Any], quiet: bool = False) -> None:
-    """Before anything runs (``sim run``, ``sim check``, the API, ``sim.batch``): a sweep in
-    which the study refuses every cell is refused (:class:`ConfigError` naming the swept key
-    and its values); the cells it refuses of a sweep that has others are named once on
-    standard error (:func:`sim.mc.sweep.refused_note`; they are recorded, not run), unless
-    ``quiet`` (``sweep.parquet`` records them with the reason)."""
-    if not sweep:
-        return
-    note = refused_note(sweep, *refused_cells(study, cfg, sweep))
-    if note and not quiet:
-        print(f"sim: {note}", file=sys.stderr)
-
-
 def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dict:
     """Run every cell of ``table`` for ``study`` from the resolved base ``cfg``; write
     ``out/sweep.parquet`` and ``out/cells/<label>/``. Returns the table's columns."""
@@ -410,6 +397,8 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
             except (KeyboardInterrupt, SystemExit):
                 raise
             except Exception as e:  # noqa: BLE001 - a failed cell is recorded, the sweep goes on
+                if not_the_cells(e):  # a full disk, a killed worker: the run stops, resumable
+                    raise
                 row.update(feasible=False, reason=f"failed: {e}".splitlines()[0])
                 rows.append(row)
                 continue

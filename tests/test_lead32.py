@@ -206,11 +206,12 @@ def test_a_drivers_variable_left_set_in_a_shell_is_named_not_a_silent_exit():
 def test_a_sweep_whose_first_key_is_text_and_has_a_second_key_draws_its_figure(tmp_path, capsys):
     # before: the figure's second panel read the first panel's tick labels as the legend's
     # texts: "the run failed in sim.execute.run_sweep: TypeError: string indices must be
-    # integers", exit 3, no results at all
+    # integers", exit 3, no results at all (swept: datum.kind = ["fixed", "inner"] until
+    # doors37s refused an inner datum the testfield's fixed pillars already hold)
     f = tmp_path / "sw.toml"
     f.write_text(
         (STUDIES / "network_testfield.toml").read_text(encoding="utf-8")
-        + '\n[sweep]\n"datum.kind" = ["fixed", "inner"]\n"reliability.alpha0" = [0.001, 0.01]\n',
+        + '\n[sweep]\n"network.name" = ["one", "two"]\n"reliability.alpha0" = [0.001, 0.01]\n',
         encoding="utf-8",
     )
     out = tmp_path / "out"

@@ -193,7 +193,7 @@ def test_gama_export_refuses_what_gama_local_cannot_say(tmp_path):
             "network.generate",
         ),
         ('network.observations=[{kind="distance", from="A", to="B", sigma_mm=-1.0}]', "sigma_mm"),
-        ('datum.kind="inner"', None),
+        ('datum.kind="inner"', "nothing to constrain"),  # fixed pillars: no defect (s37)
         ('network.observations=[{kind="bearing", from="A", to="B", sigma_mm=1.0}]', "kind"),
         (
             'network.points=[{name="A", x_mm=0.0, y_mm=0.0}, {name="A", x_mm=1.0, y_mm=0.0}]',
@@ -206,9 +206,6 @@ def test_bad_networks_are_one_line_errors(override, key, capsys):
     # test_cli.py)
     code = main(["check", str(ROOT / "studies/network_testfield.toml"), "--set", override])
     err = capsys.readouterr().err
-    if key is None:  # inner constraints over fixed pillars are still a valid datum
-        assert code == 0, err
-        return
     assert code == 2 and len(err.strip().splitlines()) == 1, err
     assert key in err and "Traceback" not in err
 

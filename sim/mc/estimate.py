@@ -33,7 +33,7 @@ import math
 import os
 from dataclasses import dataclass
 from numbers import Integral
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Container, Mapping
 
 from sim.mc.agnard_size import agnard_estimate as _agnard
 from sim.mc.brown_size import brown_estimate as _brown
@@ -42,6 +42,7 @@ from sim.mc.network_size import network_estimate as _network
 from sim.mc.numtext import UnheldError, float_text
 from sim.mc.salsig_size import salsig_estimate as _salsig
 from sim.mc.sweep import MAX_CELLS, expand
+from sim.mc.toml_text import toml_value
 from sim.mc.workunits import (
     ADJUSTMENT_S,
     COPIES,
@@ -102,6 +103,7 @@ class Estimate:
     analytic_key: str = ""  # the key that sets that part's size (``design.grids``)
     analytic_part: str = ""  # that part, named
     memory_keys: tuple = ()  # the keys that set ``bytes`` (the refusal names them), if known
+    cell: str = ""  # a sweep's: the swept values of the cell that needs ``bytes`` (if cells differ)
 
     def describe(self, workers: int = 1) -> str:
         """One line: trials, adjustments (analytic parts in adjustment-equivalents, each
@@ -290,18 +292,30 @@ def _chunk_units(cfg: Mapping, trials: float) -> float:
     return math.ceil(trials / ch) * CHUNK_UNITS if math.isfinite(trials) else math.inf
 
 
-def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> Estimate:
-    """The estimate of a run of ``cfg`` (and of every cell of its ``[sweep]`` table)."""
+def estimate(
+    cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None, skip: Container = ()
+) -> Estimate:
+    """The estimate of a run of ``cfg`` (and of every cell of its ``[sweep]`` table but those
+    of the indices ``skip``: cells the study refuses, recorded and never run)."""
     cfgs = [cfg]
     reps = 1
+    keys: list = []
+    cell = ""  # the swept values of the cell that needs ``B``, when cells differ in it
     if sweep:
-        _, cells, reps, _ = expand(sweep)
+        keys, cells, reps, _ = expand(sweep)
+        cells = [c for i, c in enumerate(cells) if i not in skip] or cells
         cfgs = [{**cfg, **cell} for cell in cells]
     parts = [_one(c) for c in cfgs]
     T = sum(p[0] for p in parts) * reps
     A = sum(p[1] for p in parts) * reps + (len(cfgs) * reps * CELL_UNITS if sweep else 0.0)
     U = max(p[2] for p in parts)
     B, what, mkeys = max((p[3], p[4], p[6]) for p in parts)
+    if sweep and B > min(p[3] for p in parts):  # the swept values that set it, named
+        at = next(c for c, p in zip(cells, parts) if p[3] == B)
+        cell = ", ".join(f"{k} = {toml_value(at[k])}"[:120] for k in keys)
+        mkeys = tuple(f"the values of sweep.{k}" if k in keys else k for k in mkeys) or tuple(
+            f"the values of sweep.{k}" for k in keys
+        )
     eq, key, part = max((p[5] for p in parts), key=lambda x: x[0])  # one cell's, not the sum
     big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
     return Estimate(
@@ -316,6 +330,7 @@ def estimate(cfg: Mapping[str, Any], sweep: Mapping[str, Any] | None = None) -> 
         key,
         part,
         mkeys,
+        cell,
     )
 
 
@@ -356,6 +371,7 @@ def check_limits(
             f"{est.study}: the run needs {est.describe(workers)}, over the "
             f"{mem:g} GiB limit (--max-memory-gb or SIM_MAX_MEMORY_GB)"
             + (f", most of it for {est.largest}" if est.largest else "")
+            + (f", in the sweep's cell of {est.cell}" if est.cell else "")
             + f"; reduce {_either(est.memory_keys)}",
         )
     if not est.adjustments <= adj:

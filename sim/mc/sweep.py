@@ -48,6 +48,7 @@ from sim.mc.config import (
     read_toml,
     validate,
 )
+from sim.mc.limit_error import LimitError
 from sim.mc.numtext import UnheldError, unsigned_zeros
 from sim.mc.progress import Progress
 from sim.mc.runner import chunk_rng
@@ -313,6 +314,11 @@ def refused_cells(
         checked += 1
         try:
             cell_config(study, cfg, cell, cfg["seed"])
+        except LimitError as e:  # this machine's limit, not the design's: the sweep is refused
+            key = e.key if e.key in keys else keys[0] if len(keys) == 1 else None
+            raise LimitError(
+                f"sweep.{key}" if key else "sweep", f"in the cell of {_shown(keys, cell)}: {e}"
+            ) from None
         except ConfigError as e:
             bad[i] = str(e)
             named.add(e.key)

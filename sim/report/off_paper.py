@@ -8,9 +8,11 @@ from pathlib import Path
 from typing import Callable
 
 from sim.claims.rules import printed_differs
+from sim.mc.config import ConfigError
 from sim.mc.storage import read_provenance
+from sim.mc.sweep import expand
 
-__all__ = ["off_setup", "off_note"]
+__all__ = ["off_setup", "off_note", "sweep_off_note"]
 
 
 def off_setup(study, cfg: dict, before: bool = False) -> str:
@@ -40,3 +42,32 @@ def off_note(out: Path, get_study: Callable | None) -> str:
     prov = read_provenance(Path(out) / "claims.parquet")
     off = off_setup(get_study(prov["study"]), prov.get("config") or {})
     return off[:1].upper() + off[1:]
+
+
+def sweep_off_note(out: Path, get_study: Callable | None) -> str:
+    """The line on a sweep's cells off the paper's setup (each cell's README-less results are
+    decided as :func:`off_setup` says), for its README.md, ``sim show`` and the end of ``sim
+    run``, or ``""``: a sweep of a printed key (``errors.settings = [1, 2]``) said nothing of
+    it, where ``sim show`` of its cell ``errors.settings = 1`` says its predictions are
+    findings."""
+    if get_study is None:
+        return ""
+    prov = read_provenance(Path(out) / "sweep.parquet")
+    cfg = prov.get("config") if isinstance(prov.get("config"), dict) else {}
+    try:
+        study = get_study(prov.get("study"))
+        cells = expand(prov.get("sweep") or {})[1]
+    except (ConfigError, TypeError, AttributeError):  # a provenance edited by hand: no line
+        return ""
+    off = [
+        (i, w)
+        for i, c in enumerate(cells)
+        if (w := printed_differs(study.schema, {**cfg, **c}, study.as_printed))
+    ]
+    if not off:
+        return ""
+    (i, words), more = off[0], " ..." if len(off) > 1 else ""
+    return (
+        f"Off the paper's setup in {len(off)} of {len(cells)} cells (cell{i:04d}: "
+        f"{', '.join(words)}{more}): their predictions are findings (sim show of a cell says which)"
+    )

@@ -24,7 +24,7 @@ from sim.mc.storage import atomic_path, read_provenance, read_record, write_reco
 from sim.mc.table_shape import kind
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.config_diff import config_line
-from sim.report.off_paper import off_note, off_setup
+from sim.report.off_paper import off_note, off_setup, sweep_off_note
 from sim.report.papers import paper_name
 from sim.report.read import TableError, checked_table, columns, forget, records
 from sim.report.sweep import sweep_markdown
@@ -211,6 +211,7 @@ def terminal_summary(out: Path, n: int = 5, shown: str | None = None, get_study=
         t = columns(out / "sweep.parquet")
         ok = sum(bool(f) for f in t.get("feasible", []))
         lines = [f"sweep: {ok} of {len(t.get('feasible', []))} cells ran"]
+        lines += [off] if (off := sweep_off_note(out, get_study)) else []
     else:
         claims = records(out / "claims.parquet")
         lines = [verdict_line(claims)]
@@ -257,10 +258,15 @@ def terminal_table(
         ]
         table = _text_table(["cell", *keys, "feasible"], rows, width)
         ok = sum(bool(f) for f in t["feasible"])
+        off = sweep_off_note(out, get_study)
         return (
-            f"{table}\n\nsweep: {ok} of {len(rows)} cells ran; every claim of every cell: "
-            f"sim show {shlex.quote(str(out))} --markdown"  # a command to paste (doors25a)
-        ) + tail
+            (
+                f"{table}\n\nsweep: {ok} of {len(rows)} cells ran; every claim of every cell: "
+                f"sim show {shlex.quote(str(out))} --markdown"  # a command to paste (doors25a)
+            )
+            + (f"\n{off}" if off else "")
+            + tail
+        )
     claims = records(out / "claims.parquet")
     rows = [[r["claim"], _value_text(r), _interval(r), verdict_cell(r)] for r in claims]
     table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
@@ -361,6 +367,8 @@ def run_markdown(
     if (changed := config_line(prov.get("config") or {}, name, design)) is not None:
         head += [f"**Configuration.** {changed}", ""]
     if kind == "sweep":
+        if off := sweep_off_note(out, get_study):  # said once, at the top
+            head += [f"**{off}.**", ""]
         body = sweep_markdown(out, ".")
     else:
         claims = records(src)

@@ -278,20 +278,36 @@ def _powers_of_ten_class() -> type:
     return _PowersOfTen
 
 
+def _value_cell(t: dict, claim: str, i: int, kinds) -> str:
+    """A claim's value in cell ``i``: a region row's (every cell's interval kind ``region``)
+    is its range over the region, ``0.12–0.92`` as the cell's own README gives it (the
+    table gave the range's low end alone, 0.120 in every cell of a sweep of an input the
+    region explores, as if it were the value)."""
+    lo, hi = t[claim][i], t[claim + ":hi"][i]
+    if list(kinds or ()) != ["region"] or fmt(hi) in ("", fmt(lo)) or fmt(lo) == "":
+        return fmt(lo)
+    return f"{fmt(lo)}–{fmt(hi)}"
+
+
 def sweep_markdown(out: Path, name: str | None = None) -> str:
     """Markdown for a sweep directory from ``sweep.parquet`` alone: the cells with their
     feasibility and claim values, and the figure (for ``sim report``)."""
 
     t = columns(Path(out) / "sweep.parquet")
-    keys = read_provenance(Path(out) / "sweep.parquet").get("sweep_keys", [])
+    prov = read_provenance(Path(out) / "sweep.parquet")
+    keys = prov.get("sweep_keys", [])
     claims = _claim_columns(t, keys)
+    kinds = prov.get("claim_intervals") or {}
     rows = [
         [
             t["label"][i],
             *[fmt(t[k][i]) for k in keys],
             t["seed"][i],
             "yes" if t["feasible"][i] else f"no: {t['reason'][i]}",
-            *[fmt(t[c][i]) for c in claims],
+            *[
+                _value_cell(t, c, i, kinds.get(c) if isinstance(kinds, dict) else None)
+                for c in claims
+            ],
         ]
         for i in range(len(t["cell"]))
     ]

@@ -149,13 +149,23 @@ SCHEMA = {
     "control.many": Field(
         "full", "str", "layout of the 21-control pass (Table 2 rows)", choices=CONTROL_PATTERNS
     ),
-    "snoop.alpha": real(0.001, "significance level of one w-test (two-sided)", 1e-09, 0.5),
-    "snoop.test": Field(
-        "w",
-        "str",
-        "w: Baarda's w-test with the a-priori sigma0; tau: Pope's "
-        "test with the block's a-posteriori sigma0",
-        choices=("w", "tau"),
+    # read only when the snooping removes points: at snoop.max_reject = 0 no test decides
+    # anything (the rejection rows are undecidable by construction: decide.without_snooping)
+    "snoop.alpha": unless(
+        real(0.001, "significance level of one w-test (two-sided)", 1e-09, 0.5),
+        "snoop.max_reject",
+        0,
+    ),
+    "snoop.test": unless(
+        Field(
+            "w",
+            "str",
+            "w: Baarda's w-test with the a-priori sigma0; tau: Pope's "
+            "test with the block's a-posteriori sigma0",
+            choices=("w", "tau"),
+        ),
+        "snoop.max_reject",
+        0,
     ),
     "snoop.max_reject": count(25, "most pass points removed per block", 0, 1000),
     "tradeoff.dpis": compared(

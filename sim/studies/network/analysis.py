@@ -40,6 +40,7 @@ __all__ = [
     "inner_defect",
     "held_defect",
     "check_inner",
+    "inner_left",
     "match_points",
     "estimated_points",
 ]
@@ -160,6 +161,24 @@ def check_inner(net: Network, H: np.ndarray, points: list[int], key: str) -> Non
             f"the points {names} cannot fix the network's {d} datum defect{'s' * (d != 1)} "
             f"({defect_words(H)}): choose more points, not all on one line",
         )
+
+
+def inner_left(net: Network, H: np.ndarray, key: str) -> None:
+    """Refuse an inner datum (``key``: ``datum.kind``, or ``datum.points`` when given) on a
+    network whose fixed points leave no defect ``H`` (:func:`held_defect`): its run was the
+    fixed datum's, said as ``datum `inner` (0 constraints)``, and ``datum.points`` changed
+    nothing (P35's left item)."""
+    if H.shape[1]:
+        return
+    fixed = [net.names[a] for a in np.flatnonzero(net.role == 1)]
+    names = ", ".join(fixed[:5]) + (" ..." if len(fixed) > 5 else "")
+    raise ConfigError(
+        key,
+        f'datum.kind = "inner" has nothing to constrain: the fixed points {names} already fix '
+        "the network's datum (no defect is left for inner constraints over datum.points, which "
+        'would change nothing): use datum.kind = "fixed" (output.inner_over states the '
+        "precision in an inner datum too)",
+    )
 
 
 def defect_words(H: np.ndarray) -> str:

@@ -24,6 +24,7 @@ from sim.studies.network.analysis import (
     estimated_points,
     held_defect,
     inner_defect,
+    inner_left,
     match_points,
 )
 from sim.studies.network.canonical import canonical
@@ -186,8 +187,11 @@ def _held(net, full: dict, dt, sparse: bool):
     if full["datum.kind"] == "inner":
         # the defect the datum leaves (one fixed point: the rotation about it), not every
         # defect of the network with no point held
+        H = held_defect(net, dt.free_index(net.q))
+        if not full.get("network.gama_xml"):  # (a gama-local file's datum is its own)
+            inner_left(net, H, "datum.points" if full["datum.points"] else "datum.kind")
         pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
-        check_inner(net, held_defect(net, dt.free_index(net.q)), pts, "datum.points")
+        check_inner(net, H, pts, "datum.points")
     an = pre_analysis(net, dt, full["reliability.alpha0"], full["reliability.power"])
     if not an.ok:
         # dense too: name the point no observation reaches (docs/network.md), unless nothing

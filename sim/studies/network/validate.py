@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from sim.mc.config import ConfigError, did_you_mean
+from sim.mc.limit_error import LimitError
 from sim.mc.lookalike import differs, skeleton
 from sim.mc.memory_limit import memory_limit_gb
 from sim.mc.network_size import network_counts, network_estimate, state_bytes
@@ -65,7 +66,7 @@ def fits_estimate(cfg: dict) -> None:
     what = f"a network of about {k.points:,.0f} points and {k.rows:,.0f} observations"
     if gama:  # counted from the file's size, not read
         what = f"{gama}: a gama-local file of about {k.rows:,.0f} observations by its size"
-    raise ConfigError(
+    raise LimitError(
         key,
         f"{what} ({k.unknowns:,.0f} unknowns) needs about "
         f"{need / 2**30:.3g} GiB with chunks of {min(cfg['chunk'], cfg['trials'])} trials "

@@ -1,0 +1,69 @@
+"""A sweep's checks outside its cells' runs (:mod:`sim.execute` runs them): its estimate
+against the limits (:func:`sweep_limits`, the cells the study refuses left out), the cells the
+study refuses named once (:func:`check_sweep`), and which failure of a cell is the machine's,
+not the cell's (:func:`not_the_cells`)."""
+
+from __future__ import annotations
+
+import sys
+from concurrent.futures import BrokenExecutor
+from typing import Any, Mapping
+
+from sim.mc.config import ConfigError
+from sim.mc.estimate import check_limits, estimate
+from sim.mc.sweep import refused_cells, refused_note
+from sim.threads import interrupted, shadowed
+
+__all__ = ["sweep_limits", "check_sweep", "not_the_cells"]
+
+
+def sweep_limits(
+    study,
+    cfg: dict,
+    sweep: Mapping[str, Any],
+    max_memory_gb: float | None = None,
+    max_adjustments: float | None = None,
+    workers: int = 1,
+):
+    """The run's estimate (:func:`sim.mc.estimate.estimate`), checked against the limits
+    (``sim run``, ``sim check``, ``python -m sim.batch``). A sweep over a limit is estimated
+    again without the cells the study refuses (recorded infeasible, never run): a 150 x 150
+    plate outside the format, refused in its cell, made a sweep of it and a 5 x 5 plate "need
+    0.744 GiB" and refused it. A cell refused for the limit itself is named
+    (:func:`sim.mc.sweep.refused_cells`)."""
+    est = estimate(cfg, sweep)
+    try:
+        check_limits(est, max_memory_gb, max_adjustments, workers)
+    except ConfigError:
+        bad = refused_cells(study, cfg, sweep)[0] if sweep else None
+        if not bad:
+            raise
+        est = estimate(cfg, sweep, skip=bad)
+        check_limits(est, max_memory_gb, max_adjustments, workers)
+    return est
+
+
+def not_the_cells(e: BaseException) -> bool:
+    """Whether a sweep cell's failure is the machine's, not its configuration's: a write cut
+    short (a full disk, ``ulimit -f``), memory, a worker killed, an interrupt inside a library,
+    a user's module shadowing one. Such a cell was recorded infeasible ("failed: [Errno 28]
+    No space left on device") and the sweep published with exit 0; it now stops the run as
+    it stops a single study's (one line; the finished chunks are kept for the same command)."""
+    return (
+        isinstance(e, (OSError, MemoryError, BrokenExecutor))
+        or interrupted(e)
+        or shadowed(e) is not None
+    )
+
+
+def check_sweep(study, cfg: dict, sweep: Mapping[str, Any], quiet: bool = False) -> None:
+    """Before anything runs (``sim run``, ``sim check``, the API, ``sim.batch``): a sweep in
+    which the study refuses every cell is refused (:class:`ConfigError` naming the swept key
+    and its values); the cells it refuses of a sweep that has others are named once on
+    standard error (:func:`sim.mc.sweep.refused_note`; they are recorded, not run), unless
+    ``quiet`` (``sweep.parquet`` records them with the reason)."""
+    if not sweep:
+        return
+    note = refused_note(sweep, *refused_cells(study, cfg, sweep))
+    if note and not quiet:
+        print(f"sim: {note}", file=sys.stderr)
