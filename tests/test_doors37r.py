@@ -8,6 +8,13 @@ real door and fixed; each test fails on the code before its fix:
   ``network.grids: ... use fewer points or observations``, and the 3,000 points alone fit in
   a few MiB. Observations over ``MANY_SIGHTS`` (50) a point now name the key that declares
   them, ``network.generate`` (``network.observations`` when those listed are most).
+* an option typed with a word processor's dash beside a hyphen (``sim run —-trials 40
+  x.toml``, ``python -m sim.batch –-jobs 2 x.toml``: what an editor makes of ``---`` or of
+  ``--`` typed after a dash) slipped past the check of session 36 (``_dashed``), which read
+  the dash as two hyphens, ``---trials``, no option: argparse took it for the study file and
+  the line said "unrecognized arguments: 40 x.toml", the dash unnamed (``sim.batch``: "no
+  such study file" of each word). A dash beside a hyphen is read as one or two hyphens too:
+  "—-trials: not an option (did you mean --trials? U+2014 EM DASH is no hyphen: type -)".
 """
 
 from __future__ import annotations
@@ -16,6 +23,7 @@ import pytest
 from oneline import SIM_ERROR, one_line
 
 import sim
+from sim.batch import main as batch_main
 from sim.cli import main
 
 #: a network of few points whose generated sights (every point to every point) are too many
@@ -46,3 +54,14 @@ def test_a_network_too_large_by_its_sights_names_them(capsys, tmp_path, monkeypa
     )
     with pytest.raises(sim.ConfigError, match=r"^network\.generate: "):
         sim.load(path)
+
+
+@pytest.mark.parametrize(
+    ("door", "argv", "needles"),
+    [
+        (main, ["run", "\u2014-trials", "40", "x.toml"], ("\u2014-trials", "--trials", "EM DASH")),
+        (batch_main, ["\u2013-jobs", "2", "x.toml"], ("\u2013-jobs", "--jobs", "EN DASH")),
+    ],
+)
+def test_an_option_typed_with_a_dash_beside_a_hyphen_is_named(capsys, door, argv, needles):
+    one_line(capsys, door(argv), *needles, "is no hyphen")
