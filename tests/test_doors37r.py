@@ -15,11 +15,17 @@ real door and fixed; each test fails on the code before its fix:
   the line said "unrecognized arguments: 40 x.toml", the dash unnamed (``sim.batch``: "no
   such study file" of each word). A dash beside a hyphen is read as one or two hyphens too:
   "—-trials: not an option (did you mean --trials? U+2014 EM DASH is no hyphen: type -)".
+* a masked value of NumPy (``np.ma.masked``, the element of a masked array or an astropy
+  table's column that holds none) given to ``sim.load`` or ``run()`` was refused as "trials:
+  is nested too deeply" (its ``v[()]`` is itself: the recursion's words); it is now "trials:
+  is masked (np.ma.masked, no value): give one, or leave the key out".
 """
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
+from conftest import ROOT
 from oneline import SIM_ERROR, one_line
 
 import sim
@@ -65,3 +71,9 @@ def test_a_network_too_large_by_its_sights_names_them(capsys, tmp_path, monkeypa
 )
 def test_an_option_typed_with_a_dash_beside_a_hyphen_is_named(capsys, door, argv, needles):
     one_line(capsys, door(argv), *needles, "is no hyphen")
+
+
+@pytest.mark.parametrize("value", [np.ma.masked, np.ma.array([400], mask=[True])[0]])
+def test_a_masked_value_is_refused_as_masked(value):
+    with pytest.raises(sim.ConfigError, match=r"^trials: is masked \(np\.ma\.masked, no value\)"):
+        sim.load(ROOT / "studies" / "brown_table1.toml", trials=value)
