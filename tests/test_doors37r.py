@@ -19,9 +19,18 @@ real door and fixed; each test fails on the code before its fix:
   table's column that holds none) given to ``sim.load`` or ``run()`` was refused as "trials:
   is nested too deeply" (its ``v[()]`` is itself: the recursion's words); it is now "trials:
   is masked (np.ma.masked, no value): give one, or leave the key out".
+* ``run(out=None)`` clears the temporary directories of killed runs of its study, named
+  ``$TMPDIR/sim-<study>-<pid>-XXXXXXXX``, by their name alone (and pid, owner, no results, no
+  lock): a directory of the user's named so, ``sim-brown_table1-2026-november`` (no process
+  2026), was removed with the notes it held. A run's directory now holds the marker
+  ``.sim-run`` (its pid), as ``make verify``'s holds ``.sim-verify``; one without it is left.
 """
 
 from __future__ import annotations
+
+import subprocess
+import sys
+import tempfile
 
 import numpy as np
 import pytest
@@ -29,6 +38,7 @@ from conftest import ROOT
 from oneline import SIM_ERROR, one_line
 
 import sim
+import sim.api
 from sim.batch import main as batch_main
 from sim.cli import main
 
@@ -77,3 +87,26 @@ def test_an_option_typed_with_a_dash_beside_a_hyphen_is_named(capsys, door, argv
 def test_a_masked_value_is_refused_as_masked(value):
     with pytest.raises(sim.ConfigError, match=r"^trials: is masked \(np\.ma\.masked, no value\)"):
         sim.load(ROOT / "studies" / "brown_table1.toml", trials=value)
+
+
+def test_a_users_directory_named_like_a_killed_runs_is_left(tmp_path, monkeypatch):
+    gone = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    pid = int(gone.stdout)  # no such process now
+    mine = tmp_path / f"sim-brown_table1-{pid}-november"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("the user's")
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+
+    def stopped(*a, **k):
+        raise RuntimeError("stopped")
+
+    monkeypatch.setattr(sim.api, "execute", stopped)
+    with pytest.raises(RuntimeError):
+        sim.load(ROOT / "studies" / "brown_table1.toml").run(trials=40)
+    assert (mine / "notes.txt").read_text() == "the user's"
+    assert [p.name for p in tmp_path.iterdir()] == [mine.name]  # the run's own: removed
