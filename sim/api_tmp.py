@@ -72,8 +72,8 @@ def _clear_dead(tmp: Path, study: str) -> None:
 
 def _marked(d: Path, pid: str) -> bool:
     """Whether ``d`` holds the marker a run writes (a regular file, its text ``pid``)."""
-    mark = d / MARK
-    return stat.S_ISREG(os.lstat(mark).st_mode) and mark.read_bytes()[:40] == pid.encode()
+    mark, st = d / MARK, os.lstat(d / MARK)
+    return stat.S_ISREG(st.st_mode) and st.st_size <= 20 and mark.read_bytes() == pid.encode()
 
 
 def temp_dir(study: str) -> Path:
