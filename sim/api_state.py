@@ -29,7 +29,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from sim.api_tmp import KEPT
+from sim.api_tmp import KEPT, MARK
 from sim.mc.config import ConfigError
 
 __all__ = ["state_sha256", "check_state", "check_cwd", "working_dir", "anonymous_dir"]
@@ -97,6 +97,7 @@ def anonymous_dir(base: Path | None, out: Path):
             e.add_note(f"sim: the run's results were written to {out} before the interrupt")
         elif base is not None:
             try:
+                (base / MARK).unlink(missing_ok=True)  # its marker (sim.api_tmp), then
                 os.rmdir(base)  # only an empty directory: nothing the run kept is lost
             except FileNotFoundError:  # removed under the run (a cleaner of /tmp): no chunk
                 pass  # is kept anywhere, and no out= resumes it

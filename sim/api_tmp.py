@@ -4,7 +4,9 @@ A run killed outright (SIGKILL, the out-of-memory killer) ran no cleanup: its di
 a staging directory whose path the caller was never told, stayed in ``$TMPDIR`` forever. The
 process id in the name lets a later ``run(out=None)`` of the same study (:func:`temp_dir`)
 remove such a directory when it can prove it is one of those: a directory (not a link) of
-this user, named by this pattern, whose process is gone (``os.kill(pid, 0)``: no such
+this user, named by this pattern, holding the marker :data:`MARK` whose text is the pid of
+its name (a directory of the user's named so, ``sim-network-2026-november``, was removed with
+what it held), whose process is gone (``os.kill(pid, 0)``: no such
 process; a live one, this process, or another user's is never touched), whose ``.lock``
 files no one holds, that holds no finished results (``<study>/run.json``: a run that
 returned; its Results may still be read) and no chunks a failed run named in its exception
@@ -31,10 +33,12 @@ from sim.mc.outputs import name_problem
 from sim.mc.pids import pid_alive
 from sim.mc.storage import RECORD
 
-__all__ = ["KEPT", "temp_dir"]
+__all__ = ["KEPT", "MARK", "temp_dir"]
 
 #: the marker of a temporary directory whose finished chunks a failed run named to the caller
 KEPT = ".sim-kept"
+#: the marker of a run's temporary directory: its text is the pid of the run that made it
+MARK = ".sim-run"
 
 
 def _alive(pid: int) -> bool:
@@ -57,13 +61,19 @@ def _clear_dead(tmp: Path, study: str) -> None:
         d = tmp / n
         try:
             st = os.lstat(d)
-            if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid():
+            if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid() or not _marked(d, m[1]):
                 continue
             if os.path.lexists(d / study / RECORD) or os.path.lexists(d / KEPT) or lock_held(d):
                 continue
             shutil.rmtree(d)
         except OSError:  # removed meanwhile, unreadable: left as it is
             continue
+
+
+def _marked(d: Path, pid: str) -> bool:
+    """Whether ``d`` holds the marker a run writes (a regular file, its text ``pid``)."""
+    mark, st = d / MARK, os.lstat(d / MARK)
+    return stat.S_ISREG(st.st_mode) and st.st_size <= 20 and mark.read_bytes() == pid.encode()
 
 
 def temp_dir(study: str) -> Path:
@@ -78,4 +88,10 @@ def temp_dir(study: str) -> Path:
             "set TMPDIR, or name an output directory",
         )
     _clear_dead(tmp, study)
-    return Path(tempfile.mkdtemp(prefix=f"sim-{study}-{os.getpid()}-"))
+    d = Path(tempfile.mkdtemp(prefix=f"sim-{study}-{os.getpid()}-"))
+    try:
+        (d / MARK).write_text(str(os.getpid()), encoding="ascii")
+    except BaseException:  # a full disk, Ctrl-C: not left behind unmarked
+        shutil.rmtree(d, ignore_errors=True)
+        raise
+    return d

@@ -20,7 +20,7 @@ from conftest import ROOT
 
 import sim
 import sim.api
-from sim.api_tmp import KEPT
+from sim.api_tmp import KEPT, MARK
 
 BROWN = str(ROOT / "studies" / "brown_table1.toml")
 
@@ -43,6 +43,7 @@ def test_a_killed_runs_temporary_directory_is_cleared_by_the_next_run(tmp_path, 
     ):
         d = tmp_path / f"sim-{study}-{pid}-{tag[:4]:_<8}"
         (d / study / inside if inside else d / study).parent.mkdir(parents=True)
+        (d / MARK).write_text(str(pid))  # each a run's (doors37r: the marker is needed too)
         if inside:
             (d / study / inside).write_text("x")
         else:

@@ -88,7 +88,9 @@ def _guess(word: str, names) -> str:
     names = sorted(set(names))
     lead = len(word) - len(word.lstrip("-" + "".join(_DASHES)))
     typed = "".join(_DASHES.get(c, c) for c in word[:lead]) + word[lead:]
-    same = [n for n in names if looks(n) == looks(typed) and n != word]
+    # a dash beside a hyphen (``—-trials``: "---trials") is one or two hyphens too
+    tries = {looks(typed)} | ({looks(h + word[lead:]) for h in ("-", "--")} if lead > 1 else set())
+    same = [n for n in names if looks(n) in tries and n != word]
     if same and typed != word:
         dash = next(c for c in word if c in _DASHES)
         return f" (did you mean {same[0]}? {char_name(dash)} is no hyphen: type -)"

@@ -145,6 +145,10 @@ def _convert(key: str, v: Any) -> Any:
         except (TypeError, ValueError):  # refused by the key, naming its type
             return v
     if isinstance(v, np.ndarray):
+        if v.ndim == 0 and np.ma.is_masked(v):  # np.ma.masked: v[()] is itself ("nested too
+            raise ConfigError(  # deeply", the recursion's words)
+                key, "is masked (np.ma.masked, no value): give one, or leave the key out"
+            )
         if v.ndim == 0:
             return _convert(key, v[()])
         if v.dtype.kind in "iub" or v.dtype == np.float64:

@@ -35,6 +35,8 @@ SIGMA_RANGE = {"mm": (1e-9, 1e9), "arcsec": (1e-9, 1e5)}
 #: global test's false-alarm self-check failed (0 of 400 trials) and the orientations' Monte
 #: Carlo sigma disagreed with the analytic one: a Gaussian angle that spread is no reading
 WRAPS = "an angle that large wraps around the circle (at most 27.8 degrees)"
+#: observations a point beyond which they set a network's size (``nearest = 4``: 4 a point)
+MANY_SIGHTS = 50
 #: the largest bias: a constant offset does not spread, so an angle's may pass 27.8 degrees
 BIAS_BOUND = {"mm": 1e9, "arcsec": 1e6}
 
@@ -62,7 +64,7 @@ def fits_estimate(cfg: dict) -> None:
     if need <= lim:
         return
     gama = cfg.get("network.gama_xml")
-    key = "network.gama_xml" if gama else _size_key(cfg, k.points)
+    key = "network.gama_xml" if gama else _size_key(cfg, k.points, k.rows)
     what = f"a network of about {k.points:,.0f} points and {k.rows:,.0f} observations"
     if gama:  # counted from the file's size, not read
         what = f"{gama}: a gama-local file of about {k.rows:,.0f} observations by its size"
@@ -92,10 +94,15 @@ def _counts_typed(cfg: dict) -> bool:
     return True
 
 
-def _size_key(cfg: dict, points: float) -> str:
-    """The key that sets a declared network's size: the grids or random points that hold most
-    of its points (a grid of 5 x 900,000,000 points was blamed on ``network.generate``, its
-    sights to the nearest points), else the sights generated, else the points listed."""
+def _size_key(cfg: dict, points: float, rows: float = 0.0) -> str:
+    """The key that sets a declared network's size: the observations when over :data:`MANY_SIGHTS`
+    a point (every point to every point, no ``nearest``: 3,000 points and 9,000,000 distances
+    were blamed on ``network.grids``), else the grids or random points that hold most of its
+    points (a grid of 5 x 900,000,000 points was blamed on ``network.generate``, its sights to
+    the nearest points), else the sights generated, else the points listed."""
+    if rows > MANY_SIGHTS * points:  # the sights, generated (or listed, when they are most)
+        listed = len(cfg.get("network.observations") or [])
+        return "network.generate" if rows - listed > listed else "network.observations"
     held = {
         "network.grids": sum(
             g.get("nx", 0) * g.get("ny", 0) for g in cfg.get("network.grids") or []
