@@ -1,0 +1,50 @@
+"""Last session's left items (doors37l), decided: each class through a real door, fixed; each
+test fails on the code before its fix:
+
+* a network whose generated points (``network.grids``, ``network.random``) failed a check of
+  the placed points (beyond 100,000 km from the origin, a duplicate name) named
+  ``network.points``, a key the file did not have: it names the grid's ``origin_mm`` (the
+  random set's ``center_mm``), or the set's ``prefix`` of a name given twice.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from oneline import SIM_ERROR, one_line
+
+import sim
+from sim.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+PLATE = (ROOT / "studies" / "network_plate.toml").read_text(encoding="utf-8")
+GRID = "spacing_mm = 40.0,"
+
+
+@pytest.mark.parametrize(
+    ("edit", "key", "why"),
+    [
+        ((GRID, GRID + " origin_mm = [2e11, 0.0],"), "network.grids[0].origin_mm", "100,000 km"),
+        (
+            (
+                'grids = [ { prefix = "G", nx = 5, ny = 5, spacing_mm = 40.0,',
+                'random = [ { prefix = "G", n = 25, half_extent_mm = 90.0, center_mm = [0, 2e11],',
+            ),
+            "network.random[0].center_mm",
+            "100,000 km",
+        ),
+        (
+            ("grids = [", 'points = [ { name = "G1", x_mm = 0.0, y_mm = 0.0 } ]\ngrids = ['),
+            "network.grids[0].prefix",
+            "duplicate point name 'G1'",
+        ),
+    ],
+)
+def test_a_generated_point_refused_names_the_key_that_placed_it(capsys, tmp_path, edit, key, why):
+    path = tmp_path / "net.toml"
+    path.write_text(PLATE.replace(*edit, 1), encoding="utf-8")
+    line = one_line(capsys, main(["check", str(path)]), why, prefix=SIM_ERROR + key + ":")
+    assert "network.points" not in line
+    with pytest.raises(sim.ConfigError, match="^" + key.replace("[", r"\[").replace("]", r"\]")):
+        sim.load(path)
