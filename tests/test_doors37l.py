@@ -4,17 +4,26 @@ test fails on the code before its fix:
 * a network whose generated points (``network.grids``, ``network.random``) failed a check of
   the placed points (beyond 100,000 km from the origin, a duplicate name) named
   ``network.points``, a key the file did not have: it names the grid's ``origin_mm`` (the
-  random set's ``center_mm``), or the set's ``prefix`` of a name given twice.
+  random set's ``center_mm``), or the set's ``prefix`` of a name given twice;
+* ``python -m sim.report.verify`` run from a directory inside the project (``docs/``) took
+  its default ``--results`` and ``--studies`` in the working directory ("no studies/ directory
+  in .../docs"), and ``python -m benchmarks`` its ``--out`` and ``--rerun-files`` ("no study
+  file matches studies/*.toml"; with ``--no-rerun`` it wrote ``docs/scratch/bench-quick``):
+  each now takes the project's, as ``sim run``, ``sim report`` and ``python -m sim.batch`` do
+  (:func:`sim.places.base`).
 """
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 import pytest
-from oneline import SIM_ERROR, one_line
+from oneline import SIM_ERROR, VERIFY_ERROR, one_line
 
+import benchmarks.cli
 import sim
+import sim.report.verify.cli
 from sim.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,3 +57,14 @@ def test_a_generated_point_refused_names_the_key_that_placed_it(capsys, tmp_path
     assert "network.points" not in line
     with pytest.raises(sim.ConfigError, match="^" + key.replace("[", r"\[").replace("]", r"\]")):
         sim.load(path)
+
+
+def test_verify_and_the_benchmark_from_inside_the_project_take_its_paths(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT / "docs")
+    rc = sim.report.verify.cli.main(["--study", "nosuch", "--no-record"])
+    one_line(capsys, rc, "no results of 'nosuch' in ../results", prefix=VERIFY_ERROR)
+    seen = []
+    monkeypatch.setattr(benchmarks.cli, "OutLock", lambda out: contextlib.nullcontext())
+    monkeypatch.setattr(benchmarks.cli, "run", lambda *a: seen.append(a) or {})
+    assert benchmarks.cli.main(["--quick", "--only", "rerun"]) == 0, capsys.readouterr().err
+    assert [(str(a[0]), a[3]) for a in seen] == [("../scratch/bench-quick", "../studies/*.toml")]
