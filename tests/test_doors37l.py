@@ -10,12 +10,18 @@ test fails on the code before its fix:
   in .../docs"), and ``python -m benchmarks`` its ``--out`` and ``--rerun-files`` ("no study
   file matches studies/*.toml"; with ``--no-rerun`` it wrote ``docs/scratch/bench-quick``):
   each now takes the project's, as ``sim run``, ``sim report`` and ``python -m sim.batch`` do
-  (:func:`sim.places.base`).
+  (:func:`sim.places.base`);
+* ``sim run studies/NAME.toml`` without ``--out``, where ``results/NAME`` is a symbolic link
+  (to the committed results kept on another disk, or to nothing), was refused as
+  "--out: results/NAME is a symbolic link; sim never replaces it", an option the command did
+  not hold: the run goes to ``scratch/NAME-<hash>/`` and says why, as for a file there or a
+  directory sim did not write.
 """
 
 from __future__ import annotations
 
 import contextlib
+import shutil
 from pathlib import Path
 
 import pytest
@@ -23,6 +29,7 @@ from oneline import SIM_ERROR, VERIFY_ERROR, one_line
 
 import benchmarks.cli
 import sim
+import sim.cli
 import sim.report.verify.cli
 from sim.cli import main
 
@@ -68,3 +75,21 @@ def test_verify_and_the_benchmark_from_inside_the_project_take_its_paths(capsys,
     monkeypatch.setattr(benchmarks.cli, "run", lambda *a: seen.append(a) or {})
     assert benchmarks.cli.main(["--quick", "--only", "rerun"]) == 0, capsys.readouterr().err
     assert [(str(a[0]), a[3]) for a in seen] == [("../scratch/bench-quick", "../studies/*.toml")]
+
+
+@pytest.mark.parametrize("to", ["../elsewhere", "../nothing"])
+def test_a_link_at_the_default_results_sends_the_run_to_scratch(capsys, tmp_path, monkeypatch, to):
+    (tmp_path / "studies").mkdir()
+    (tmp_path / "results").mkdir()
+    shutil.copytree(ROOT / "results" / "brown_table1", tmp_path / "elsewhere")  # its own run
+    text = (ROOT / "studies" / "brown_table1.toml").read_text(encoding="utf-8")
+    (tmp_path / "studies" / "brown_table1.toml").write_text(text, encoding="utf-8")
+    (tmp_path / "results" / "brown_table1").symlink_to(to)
+    monkeypatch.chdir(tmp_path)
+    seen = []
+    monkeypatch.setattr(sim.cli, "execute", lambda *a, **k: seen.append(a[4]))
+    assert main(["run", "studies/brown_table1.toml", "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert seen and seen[0].startswith("scratch/brown_table1-"), (seen, err)
+    assert "sim: results/brown_table1 is a symbolic link, which sim never replaces: " in err
+    assert "--out:" not in err
