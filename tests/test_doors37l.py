@@ -15,7 +15,11 @@ test fails on the code before its fix:
   (to the committed results kept on another disk, or to nothing), was refused as
   "--out: results/NAME is a symbolic link; sim never replaces it", an option the command did
   not hold: the run goes to ``scratch/NAME-<hash>/`` and says why, as for a file there or a
-  directory sim did not write.
+  directory sim did not write;
+* a wolf table given relative to the study file (``table1.file = "my_table.csv"`` beside
+  ``mine/wolf.toml``) is read from the project root, as the schema and the paper's page say;
+  its refusal was "no such file: <root>/my_table.csv", not saying why there: it now says a
+  relative path is read from the project root, not from the study file's directory.
 """
 
 from __future__ import annotations
@@ -93,3 +97,20 @@ def test_a_link_at_the_default_results_sends_the_run_to_scratch(capsys, tmp_path
     assert seen and seen[0].startswith("scratch/brown_table1-"), (seen, err)
     assert "sim: results/brown_table1 is a symbolic link, which sim never replaces: " in err
     assert "--out:" not in err
+
+
+def test_a_wolf_table_beside_its_study_file_is_refused_saying_where_it_was_looked_for(
+    capsys, tmp_path
+):
+    (tmp_path / "mine").mkdir()
+    shutil.copy(ROOT / "studies" / "data" / "wolf_table1.csv", tmp_path / "mine" / "t1.csv")
+    text = (ROOT / "studies" / "wolf_polynomial.toml").read_text(encoding="utf-8")
+    path = tmp_path / "mine" / "wolf.toml"
+    path.write_text(text.replace("studies/data/wolf_table1.csv", "t1.csv"), encoding="utf-8")
+    one_line(
+        capsys,
+        main(["check", str(path)]),
+        f"no such file: {ROOT / 't1.csv'} (a relative path is read from the project root, not "
+        "from the study file's directory",
+        prefix=SIM_ERROR + "table1.file: ",
+    )
