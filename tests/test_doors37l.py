@@ -19,12 +19,16 @@ test fails on the code before its fix:
 * a wolf table given relative to the study file (``table1.file = "my_table.csv"`` beside
   ``mine/wolf.toml``) is read from the project root, as the schema and the paper's page say;
   its refusal was "no such file: <root>/my_table.csv", not saying why there: it now says a
-  relative path is read from the project root, not from the study file's directory.
+  relative path is read from the project root, not from the study file's directory;
+* ``sim run studies/brown_tabel1.toml`` (a name mistyped) was "no such study file" with no
+  guess, where a mistyped key or option is answered "did you mean ...?": the study file of the
+  nearest name in that directory is named (``sim.load`` and ``python -m sim.batch`` too).
 """
 
 from __future__ import annotations
 
 import contextlib
+import re
 import shutil
 from pathlib import Path
 
@@ -114,3 +118,13 @@ def test_a_wolf_table_beside_its_study_file_is_refused_saying_where_it_was_looke
         "from the study file's directory",
         prefix=SIM_ERROR + "table1.file: ",
     )
+
+
+def test_a_mistyped_study_file_is_answered_with_the_near_name(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    want = "studies/brown_tabel1.toml: no such study file (did you mean studies/brown_table1.toml?)"
+    one_line(capsys, main(["run", "studies/brown_tabel1.toml"]), prefix=SIM_ERROR + want)
+    with pytest.raises(sim.ConfigError, match=re.escape(want)):
+        sim.load("studies/brown_tabel1.toml")
+    line = one_line(capsys, main(["check", "studies/nosuch.toml"]))
+    assert line == SIM_ERROR + "studies/nosuch.toml: no such study file"  # nothing near it

@@ -8,10 +8,13 @@ no size limit until the file's config was read): one check, one wording, the pat
 
 from __future__ import annotations
 
+import difflib
 import glob
+import itertools
 import os
 from pathlib import Path
 
+from sim.mc.lookalike import looks
 from sim.mc.paths import link_problem
 
 __all__ = ["MAX_STUDY_BYTES", "study_file_hint", "study_file_problem"]
@@ -26,7 +29,27 @@ def study_file_hint(p: str | Path) -> str:
     text = str(p).replace("\\", "/")
     tries = [text, f"{text}.toml", f"studies/{text}", f"studies/{text}.toml"]
     hit = next((t for t in tries if t != str(p) and Path(t).is_file()), None)
-    return f" (did you mean {hit}?)" if hit else ""
+    return f" (did you mean {hit or _near(Path(text))}?)" if hit or _near(Path(text)) else ""
+
+
+def _near(p: Path) -> str | None:
+    """The study file of a name near ``p``'s in its directory (and ``studies/`` for a bare
+    name): the one that looks the same (another case, a lookalike letter), else the closest
+    spelling (difflib, as a mistyped key or option is answered): ``studies/brown_tabel1.toml``
+    was "no such study file" without the ``studies/brown_table1.toml`` beside it (L37)."""
+    stem = p.name.removesuffix(".toml")
+    seen: dict[str, Path] = {}
+    for d in [p.parent] + ([Path("studies")] if p.parent == Path(".") else []):
+        try:
+            with os.scandir(d) as it:  # a few hundred names at most: not a whole disk
+                for e in itertools.islice(it, 2000):
+                    if e.name.endswith(".toml") and e.is_file():
+                        seen.setdefault(e.name.removesuffix(".toml"), d / e.name)
+        except OSError:
+            continue
+    same = [n for n in seen if looks(n) == looks(stem) and n != stem]
+    close = same or difflib.get_close_matches(stem, list(seen), n=1, cutoff=0.75)
+    return str(seen[close[0]]) if close else None
 
 
 def study_file_problem(p: str | Path) -> str | None:
