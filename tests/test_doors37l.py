@@ -22,7 +22,19 @@ test fails on the code before its fix:
   relative path is read from the project root, not from the study file's directory;
 * ``sim run studies/brown_tabel1.toml`` (a name mistyped) was "no such study file" with no
   guess, where a mistyped key or option is answered "did you mean ...?": the study file of the
-  nearest name in that directory is named (``sim.load`` and ``python -m sim.batch`` too).
+  nearest name in that directory is named (``sim.load`` and ``python -m sim.batch`` too);
+* ``--trials 1e3`` recorded ``trials=1000`` in ``run.json``'s overrides, and ``--set
+  trials=1e3`` (or the API's ``trials=1e3``) ``trials=1000.0``: one input, one config, two
+  records. A float the config reads as an integer is recorded as that integer;
+* ``run(trials=None)`` (or ``seed=None``) ran the handle's value where ``sim.load(f,
+  trials=None)`` is refused ("None is no value"): one rule for the API, ``run()`` refuses it
+  in the same words (``seed=None`` taken for "a random seed" gave the file's seed silently);
+* ``Results.names()`` left out a table of the run rewritten without its provenance (by a
+  tool) while ``table(name)`` refused it as "not a table sim wrote, not of 'brown_table1'":
+  it is listed (the run's ``run.json`` records it), and ``table()`` says it carries no
+  provenance, in ``sim show``'s words; and ``Results`` read results made by another version
+  of the suite's code without a word where ``sim show`` gives a note: reading a table warns
+  (``sim.StaleResultsWarning``) in the note's words.
 """
 
 from __future__ import annotations
@@ -32,13 +44,16 @@ import re
 import shutil
 from pathlib import Path
 
+import pyarrow.parquet as pq
 import pytest
 from oneline import SIM_ERROR, VERIFY_ERROR, one_line
 
 import benchmarks.cli
 import sim
+import sim.api
 import sim.cli
 import sim.report.verify.cli
+import sim.stale
 from sim.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -128,3 +143,56 @@ def test_a_mistyped_study_file_is_answered_with_the_near_name(capsys, monkeypatc
         sim.load("studies/brown_tabel1.toml")
     line = one_line(capsys, main(["check", "studies/nosuch.toml"]))
     assert line == SIM_ERROR + "studies/nosuch.toml: no such study file"  # nothing near it
+
+
+def test_a_float_count_is_recorded_as_the_integer_by_every_door(tmp_path, monkeypatch):
+    seen = []
+    keep = lambda *a, **k: seen.append(k["overrides"])  # noqa: E731
+    monkeypatch.setattr(sim.cli, "execute", keep)
+    monkeypatch.setattr(sim.api, "execute", keep)
+    brown = str(ROOT / "studies" / "brown_table1.toml")
+    for opts in (["--trials", "1e3"], ["--set", "trials=1e3"], ["--set", "trials=1000.0"]):
+        assert main(["run", brown, "--out", str(tmp_path / "o"), "--quiet", *opts]) == 0
+    sim.load(brown, trials=1e3).run(out=tmp_path / "a")
+    sim.load(brown).run(out=tmp_path / "b", trials=1000.0)
+    assert seen == [["trials=1000"]] * 5, seen
+
+
+def test_run_refuses_none_for_trials_and_seed_as_load_does(tmp_path, monkeypatch):
+    monkeypatch.setattr(sim.api, "execute", lambda *a, **k: None)
+    h = sim.load(ROOT / "studies" / "brown_table1.toml")
+    for key in ("trials", "seed"):
+        with pytest.raises(sim.ConfigError, match=f"^{key}: is None, which no study file holds"):
+            sim.load(h.path, **{key: None})
+        with pytest.raises(sim.ConfigError, match=f"^{key}: is None, which no study file holds"):
+            h.run(out=tmp_path / "o", **{key: None})
+
+
+def _copy_of_brown(tmp_path: Path) -> Path:
+    d = tmp_path / "brown_table1"
+    shutil.copytree(ROOT / "results" / "brown_table1", d, ignore=shutil.ignore_patterns("*.png"))
+    return d
+
+
+def test_results_list_a_table_without_provenance_and_say_why_it_is_refused(tmp_path):
+    d = _copy_of_brown(tmp_path)
+    table = pq.read_table(d / "points.parquet")
+    pq.write_table(table.replace_schema_metadata(None), d / "points.parquet")  # by a tool
+    res = sim.Results(d, "brown_table1")
+    assert "points" in res.names()
+    with pytest.raises(
+        sim.ConfigError,
+        match="points.parquet is not a table written by sim: it carries no provenance",
+    ):
+        res.table("points")
+
+
+def test_results_of_other_code_warn_in_the_words_of_sim_show(tmp_path, monkeypatch, capsys):
+    d = _copy_of_brown(tmp_path)
+    monkeypatch.setattr(sim.stale, "study_code_hash", lambda study: "0" * 16)  # code changed
+    assert main(["show", str(d)]) == 0
+    note = capsys.readouterr().err.strip().removeprefix(f"sim: note: {d} ")
+    assert note.startswith("was made by another version of the suite's code"), note
+    with pytest.warns(sim.StaleResultsWarning, match=re.escape(note)) as caught:
+        sim.Results(d, "brown_table1").claims()
+    assert caught[0].filename == __file__  # the caller's line, not the suite's
