@@ -143,6 +143,8 @@ def test_a_mistyped_study_file_is_answered_with_the_near_name(capsys, monkeypatc
         sim.load("studies/brown_tabel1.toml")
     line = one_line(capsys, main(["check", "studies/nosuch.toml"]))
     assert line == SIM_ERROR + "studies/nosuch.toml: no such study file"  # nothing near it
+    line = one_line(capsys, main(["check", "project.toml"]))  # pyproject.toml: not a study's
+    assert line == SIM_ERROR + "project.toml: no such study file"
 
 
 def test_a_float_count_is_recorded_as_the_integer_by_every_door(tmp_path, monkeypatch):

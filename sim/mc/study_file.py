@@ -12,6 +12,7 @@ import difflib
 import glob
 import itertools
 import os
+import re
 from pathlib import Path
 
 from sim.mc.lookalike import looks
@@ -48,8 +49,18 @@ def _near(p: Path) -> str | None:
         except OSError:
             continue
     same = [n for n in seen if looks(n) == looks(stem) and n != stem]
-    close = same or difflib.get_close_matches(stem, list(seen), n=1, cutoff=0.75)
-    return str(seen[close[0]]) if close else None
+    close = same + difflib.get_close_matches(stem, list(seen), n=3, cutoff=0.75)
+    return next((str(seen[n]) for n in close if _names_a_study(seen[n])), None)
+
+
+def _names_a_study(p: Path) -> bool:
+    """Whether ``p`` holds a top-level ``study = ...`` line (not ``pyproject.toml``)."""
+    try:
+        with open(p, "rb") as fh:
+            head = fh.read(65536)
+    except OSError:
+        return False
+    return re.search(rb"(?m)^[ \t]*study[ \t]*=", head) is not None
 
 
 def study_file_problem(p: str | Path) -> str | None:
