@@ -47,7 +47,7 @@ def check_owner(p: Path, study: str) -> None:
     if who is None:  # sim show's words of a claims table without it
         raise ConfigError(
             "table",
-            f"{p} is not a table written by sim: it carries no provenance (schema metadata "
+            f"{p} is not a table sim wrote: it carries no provenance (schema metadata "
             "'sim.provenance': rewritten by a tool?); run the study again",
         )
     if who != study:

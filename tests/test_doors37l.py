@@ -32,9 +32,9 @@ test fails on the code before its fix:
 * ``Results.names()`` left out a table of the run rewritten without its provenance (by a
   tool) while ``table(name)`` refused it as "not a table sim wrote, not of 'brown_table1'":
   it is listed (the run's ``run.json`` records it), and ``table()`` says it carries no
-  provenance, in ``sim show``'s words; and ``Results`` read results made by another version
-  of the suite's code without a word where ``sim show`` gives a note: reading a table warns
-  (``sim.StaleResultsWarning``) in the note's words.
+  provenance, as ``sim show`` says of a claims table; and ``Results`` read results made by
+  another version of the suite's code without a word where ``sim show`` gives a note: reading
+  a table warns (``sim.StaleResultsWarning``) in the note's words.
 """
 
 from __future__ import annotations
@@ -184,7 +184,7 @@ def test_results_list_a_table_without_provenance_and_say_why_it_is_refused(tmp_p
     assert "points" in res.names()
     with pytest.raises(
         sim.ConfigError,
-        match="points.parquet is not a table written by sim: it carries no provenance",
+        match="points.parquet is not a table sim wrote: it carries no provenance",
     ):
         res.table("points")
 
