@@ -38,6 +38,7 @@ from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
 from benchmarks.store import store_rows
 from sim.mc.argv import ONCE, OnceParser
 from sim.mc.storage import provenance, write_table
+from sim.places import base, shown_path
 from sim.stops import ended_as_ctrl_c
 
 __all__ = ["main", "run"]
@@ -202,7 +203,7 @@ def _check_args(a: argparse.Namespace, sections: tuple[str, ...]) -> None:
     if "rerun" in sections:
         if a.rerun_files is not None and not a.rerun_files.strip():
             raise _ArgError("--rerun-files: is empty (give a glob, e.g. studies/*.toml)")
-        for f in study_files(a.rerun_files or "studies/*.toml"):
+        for f in study_files(a.rerun_files or _ours("studies/*.toml")):
             try:
                 study = tomllib.loads(f.read_text()).get("study") if f.is_file() else None
             except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
@@ -217,6 +218,13 @@ QUICK_OUT = "scratch/bench-quick"
 
 #: the benchmark's line when it was interrupted
 INTERRUPTED = "benchmarks: interrupted; nothing more was measured"
+
+
+def _ours(path: str) -> str:
+    """A default path of the project's: from a directory inside it, its root's (:func:`sim.
+    places.base`: from ``docs/`` the benchmark wrote ``docs/scratch/bench-quick`` and found
+    no ``studies/*.toml``)."""
+    return shown_path(base() / path)
 
 
 def main(argv=None) -> int:
@@ -272,7 +280,8 @@ def _main(argv) -> int:
     ap.add_argument("--million-child", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--chunk", type=int, default=10000, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
-    a.out = a.out if a.out is not None else QUICK_OUT if a.quick else "results/bench"
+    # the project's results/ and studies/ from a directory inside it (docs/), as sim run's
+    a.out = a.out if a.out is not None else _ours(QUICK_OUT if a.quick else "results/bench")
     if a.million_child:
         try:
             million(Path(a.out), a.million_child, a.chunk)
@@ -290,7 +299,7 @@ def _main(argv) -> int:
                 Path(a.out),
                 a.quick,
                 sections,
-                a.rerun_files or "studies/*.toml",
+                a.rerun_files or _ours("studies/*.toml"),
                 a.rerun_workers or (1, 2),
             )
     except (FileNotFoundError, RuntimeError, _ArgError) as e:

@@ -13,6 +13,7 @@ _EXPORTS = {
     "load": "sim.api",
     "StudyHandle": "sim.api",
     "Results": "sim.api",
+    "StaleResultsWarning": "sim.api_tables",
     "ConfigError": "sim.mc.config",
     "StudyError": "sim.mc.config",
     "load_study": "sim.studies",

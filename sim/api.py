@@ -33,16 +33,18 @@ from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
 from sim.api_paths import why_not_a_dir, why_unread
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
+from sim.api_tables import check_owner as _check_owner
+from sim.api_tables import owner as _owner
+from sim.api_tables import run_tables, stale_warning
 from sim.api_tmp import temp_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
-from sim.mc.overrides import recorded
+from sim.mc.overrides import as_read, recorded
 from sim.mc.paths import link_problem
 from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.pyvalue import as_config_value
-from sim.mc.storage import read_provenance
 from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
 from sim.mc.table_shape import recorded_shape, shape_problem
@@ -53,6 +55,17 @@ from sim.studies import design_config, get_study
 from sim.studies.picking import load_picking_chunk
 
 __all__ = ["load", "StudyHandle", "Results"]
+
+
+class _Handles:
+    """``run()``'s ``trials`` and ``seed`` left out: the handle's (None is refused, as
+    ``sim.load(f, trials=None)`` is: ``run(trials=None)`` ran the handle's trials, L37)."""
+
+    def __repr__(self) -> str:
+        return "<the handle's>"
+
+
+HANDLES = _Handles()
 
 
 def _key(k: str) -> str:
@@ -128,8 +141,8 @@ class Results:
         """The tables of the run: each once; ``chunks`` is the per-trial chunk dataset (also
         ``trials`` when the study writes no ``trials.parquet``)."""
         self._check_dir()
-        files = list(self.path.glob("*.parquet"))
-        names = {p.stem for p in files if _owner(p) == self.study}
+        files, ran = list(self.path.glob("*.parquet")), run_tables(self.path, self.study)
+        names = {p.stem for p in files if p.name in ran or _owner(p) == self.study}
         if files and not names:  # another study's run: its tables, none of which table() reads
             whose = sorted({repr(o) for p in files if isinstance(o := _owner(p), str)})
             raise ConfigError(
@@ -173,6 +186,7 @@ class Results:
             if (edit := shape_problem(table, recorded_shape(p))) is not None:  # edited by hand
                 raise ConfigError("table", f"{p} is not the table its run wrote: {edit}")
         self._check_dir()  # replaced while it was read
+        stale_warning(self.path)  # sim show's note on results of another version's code
         return table
 
     @_arguments
@@ -232,8 +246,8 @@ class StudyHandle:
         out: str | os.PathLike | None = None,
         executor: str = "local",
         workers: int = 1,
-        trials: int | None = None,
-        seed: int | None = None,
+        trials: int = HANDLES,
+        seed: int = HANDLES,
         *,
         scheduler: str | None = None,
         overwrite: bool = False,
@@ -250,18 +264,12 @@ class StudyHandle:
             _flag(*a) for a in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures))
         )
         _unchanged(self)
-        h = (
-            self
-            if trials is None and seed is None
-            else load(
-                self.path,
-                **{
-                    **self.overrides,
-                    **({"trials": trials} if trials is not None else {}),
-                    **({"seed": seed} if seed is not None else {}),
-                },
+        given = {k: v for k, v in (("trials", trials), ("seed", seed)) if v is not HANDLES}
+        if (none := [k for k, v in given.items() if v is None]) != []:  # as sim.load refuses it
+            raise ConfigError(
+                none[0], "is None, which no study file holds: leave it out for the handle's value"
             )
-        )
+        h = load(self.path, **{**self.overrides, **given}) if given else self
         base = None  # the temporary directory made for this run (out=None)
         if out is None:
             try:  # the caller's tempfile.tempdir (or TMPDIR) may be gone, a file, or full
@@ -296,7 +304,7 @@ class StudyHandle:
                     readme=lambda stage, name: write_run_readme(
                         stage, get_study, name, out, design_config
                     ),
-                    overrides=recorded(h.overrides),  # as sim run records its options
+                    overrides=recorded(as_read(h.overrides, h.config)),  # as sim run's
                 )
             except ConfigError as e:
                 if e.key in _ARGUMENTS:  # the command line's option: the argument of run()
@@ -394,25 +402,6 @@ def _unchanged(h: StudyHandle) -> None:
     if h.file_sha256 and _sha256(h.path) != h.file_sha256:
         state = "has changed" if h.path.is_file() else "is gone"
         raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
-
-
-def _owner(p: Path) -> Any:
-    """The study a table's provenance (written with every table) names (None: none)."""
-    try:
-        prov = read_provenance(p)
-    except OSError as e:  # EIO, EACCES: it was "not a table sim wrote; run the study again"
-        raise ConfigError("table", f"{p} cannot be read ({why_unread(e)})") from None
-    except (ValueError, pa.ArrowException):
-        prov = None
-    return prov.get("study") if isinstance(prov, dict) else None
-
-
-def _check_owner(p: Path, study: str) -> None:
-    """A table is ``study``'s (:func:`_owner`)."""
-    owner = _owner(p)
-    if owner != study:
-        whose = f"a table of {owner!r}" if isinstance(owner, str) else "not a table sim wrote"
-        raise ConfigError("table", f"{p} is {whose}, not of {study!r}; run the study again")
 
 
 @_arguments

@@ -37,7 +37,7 @@ from sim.execute import check_sweep, execute, sweep_limits
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.memory_limit import memory_given
 from sim.mc.outputs import name_problem
-from sim.mc.overrides import command_values, listed, recorded
+from sim.mc.overrides import as_read, command_values, listed, recorded
 from sim.mc.paths import absolute
 from sim.mc.progress import set_quiet
 from sim.mc.read_when import read_in_a_cell
@@ -129,9 +129,8 @@ def _run(args) -> int:
     study, cfg = load_run(args)
     sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
     overwrite = args.overwrite
-    overrides = recorded(
-        command_values(args.set, trials=args.trials, seed=args.seed, chunk=args.chunk)
-    )
+    given = command_values(args.set, trials=args.trials, seed=args.seed, chunk=args.chunk)
+    overrides = recorded(as_read(given, cfg))  # --set trials=1e3 as --trials 1e3: trials=1000
     if out is None:
         out, shown, scratch = default_out(cfg, sweep, Path(args.study), _off(overrides, args))
         overwrite = overwrite or scratch

@@ -8,12 +8,10 @@ import linecache
 import os
 from pathlib import Path
 
-from sim.mc.codehash import study_code_hash
-from sim.mc.outputs import results_dirs
-from sim.mc.storage import read_record
 from sim.report.read import EditedTable, TableError, damaged_message, last_read
+from sim.stale import other_code
 
-__all__ = ["cwd_exists", "from_stdout", "os_reason", "not_as_written", "older_lacks", "other_code"]
+__all__ = ["cwd_exists", "from_stdout", "os_reason", "not_as_written", "older_lacks"]
 
 
 def cwd_exists() -> bool:
@@ -106,26 +104,3 @@ def _table_dir(d: Path, e: Exception) -> Path | None:
     except (ValueError, OSError):
         return None
     return Path(d) / parts[0] if len(parts) > 1 and (Path(d) / parts[0]).is_dir() else Path(d)
-
-
-def other_code(d: Path) -> str | None:
-    """The first results directory at or under ``d`` whose run record names a study whose
-    code has changed since (its ``code_hash`` is not this suite's), or None."""
-    return next(iter(stale_dirs(d, first=True)), None)
-
-
-def stale_dirs(d: Path, first: bool = False) -> list[str]:
-    """The results directories at or under ``d`` made by another version of their study's
-    code (``first``: stop at the first)."""
-    found: list[str] = []
-    for r in [d, *results_dirs(d)] if d.is_dir() else []:
-        rec = read_record(r)
-        study = rec.get("config", {}).get("study") if rec else None
-        try:
-            if isinstance(study, str) and rec["code_hash"] != study_code_hash(study):
-                found.append(str(r))
-        except (KeyError, ValueError, OSError, ImportError):  # an unknown study: not ours
-            continue
-        if found and first:
-            break
-    return found

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
-from sim.cli_errors import not_as_written, older_lacks, other_code, stale_dirs
+from sim.cli_errors import not_as_written, older_lacks
 from sim.mc.config import ConfigError
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
@@ -21,6 +21,7 @@ from sim.places import base, shown_path
 from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
+from sim.stale import other_code, stale_dirs
 from sim.studies import STUDY_FILES, design_config, get_study
 
 __all__ = ["show", "report"]

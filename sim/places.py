@@ -122,7 +122,7 @@ def default_out(
     ``my_net.toml`` went into the committed results, REPORT.md and ``make verify``."""
     name, at = path.stem, base()
     if (
-        not (at / "results" / name).exists()
+        not os.path.lexists(at / "results" / name)
         and (at / "results" / cfg["study"]).exists()
         and not ((at / "studies").is_dir() and _project_file(path, name, at))
     ):  # a copy of a study file under another name (not a new study file of the project's,
@@ -134,6 +134,13 @@ def default_out(
     }
     old = read_record(committed)
     scratch = at / "scratch" / f"{name}-{_config_tag(record)}"
+    if os.path.islink(committed):  # never replaced (sim.mc.outputs.check_out): it was
+        print(  # "--out: results/<name> is a symbolic link" of a command without --out
+            f"sim: {shown_path(committed)} is a symbolic link, which sim never replaces: "
+            f"writing to {shown_path(scratch)}/ (--out DIR to choose)",
+            file=sys.stderr,
+        )
+        return Path(os.path.abspath(scratch)), shown_path(scratch), True
     if not committed.exists() and not _project_file(path, name, at):
         print(
             f"sim: {path} is not the project's studies/{name}.toml: writing to "

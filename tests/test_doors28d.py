@@ -141,7 +141,7 @@ def test_report_over_an_older_versions_results_says_so_of_the_tables_own_study(
     root = _older_tree(tmp_path)
     line = one_line(capsys, main(["report", "--results", str(root)]), "agnard_block/claims")
     assert "not as sim wrote it" in line and "another version" not in line  # a hand edit
-    monkeypatch.setattr("sim.cli_errors.study_code_hash", lambda study: "f" * 16)  # upgraded
+    monkeypatch.setattr("sim.stale.study_code_hash", lambda study: "f" * 16)  # upgraded
     line = one_line(
         capsys,
         main(["report", "--results", str(root)]),

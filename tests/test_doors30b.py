@@ -107,7 +107,7 @@ def test_a_table_whose_provenance_cannot_be_read_is_named_with_the_reason(
     def eio(p):
         raise OSError(errno.EIO, "Input/output error", str(p))
 
-    monkeypatch.setattr("sim.api.read_provenance", eio)
+    monkeypatch.setattr("sim.api_tables.read_provenance", eio)
     with pytest.raises(sim.ConfigError, match=r"claims.parquet cannot be read \(Input/output"):
         res.claims()  # before: "is not a table sim wrote, not of 'brown_table1'; run ... again"
     monkeypatch.setattr("sim.api.pq.read_table", eio)

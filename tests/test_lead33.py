@@ -62,7 +62,7 @@ def test_sim_report_says_which_results_were_made_by_other_code(
     shutil.copytree(tiny_run("salsig_encoders"), d)
     assert main(["report", "--results", str(d.parent)]) == 0
     assert "note" not in capsys.readouterr().err
-    monkeypatch.setattr("sim.cli_errors.study_code_hash", lambda study: "0" * 16)
+    monkeypatch.setattr("sim.stale.study_code_hash", lambda study: "0" * 16)
     assert main(["report", "--results", str(d.parent)]) == 0
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1, err

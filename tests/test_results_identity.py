@@ -83,7 +83,7 @@ def test_show_notes_results_made_by_code_that_changed_since(plate, capsys, monke
     verdicts of code since changed read as current. Now a note follows the table."""
     assert main(["show", str(plate)]) == 0
     assert capsys.readouterr().err == ""
-    monkeypatch.setattr("sim.cli_errors.study_code_hash", lambda study: "another")
+    monkeypatch.setattr("sim.stale.study_code_hash", lambda study: "another")
     assert main(["show", str(plate)]) == 0
     out, err = capsys.readouterr()
     assert " claims: " in out  # the table as before, the note after it

@@ -25,7 +25,7 @@ from typing import Any
 from sim.mc.config import ConfigError, parse_override
 from sim.mc.toml_text import toml_value
 
-__all__ = ["recorded", "command_values", "replayable", "keys_of", "without", "listed"]
+__all__ = ["recorded", "as_read", "command_values", "replayable", "keys_of", "without", "listed"]
 
 #: a config key as a study names it: dotted words
 _KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
@@ -34,6 +34,22 @@ _KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
 def recorded(values: Mapping[str, Any]) -> list[str]:
     """The ``overrides`` of a run given ``values`` (``{dotted key: value as given}``)."""
     return [f"{k}={toml_value(v)}" for k, v in sorted(values.items())]
+
+
+def as_read(values: Mapping[str, Any], config: Mapping[str, Any]) -> dict[str, Any]:
+    """``values`` with each float that ``config`` (the run's, validated) reads as an integer
+    written as that integer, at any depth of a list: ``--trials 1e3`` recorded ``trials=1000``
+    and ``--set trials=1e3`` (or the API's ``trials=1e3``) ``trials=1000.0``, two records of
+    one input and one config (L37)."""
+    return {k: _as_read(v, config.get(k)) for k, v in values.items()}
+
+
+def _as_read(given: Any, read: Any) -> Any:
+    if isinstance(given, float) and type(read) is int and given == read:
+        return read
+    if isinstance(given, list) and isinstance(read, list) and len(given) == len(read):
+        return [_as_read(a, b) for a, b in zip(given, read)]
+    return given
 
 
 def command_values(sets: list[str], **flags: Any) -> dict[str, Any]:

@@ -8,10 +8,14 @@ no size limit until the file's config was read): one check, one wording, the pat
 
 from __future__ import annotations
 
+import difflib
 import glob
+import itertools
 import os
+import re
 from pathlib import Path
 
+from sim.mc.lookalike import looks
 from sim.mc.paths import link_problem
 
 __all__ = ["MAX_STUDY_BYTES", "study_file_hint", "study_file_problem"]
@@ -26,7 +30,37 @@ def study_file_hint(p: str | Path) -> str:
     text = str(p).replace("\\", "/")
     tries = [text, f"{text}.toml", f"studies/{text}", f"studies/{text}.toml"]
     hit = next((t for t in tries if t != str(p) and Path(t).is_file()), None)
-    return f" (did you mean {hit}?)" if hit else ""
+    return f" (did you mean {hit or _near(Path(text))}?)" if hit or _near(Path(text)) else ""
+
+
+def _near(p: Path) -> str | None:
+    """The study file of a name near ``p``'s in its directory (and ``studies/`` for a bare
+    name): the one that looks the same (another case, a lookalike letter), else the closest
+    spelling (difflib, as a mistyped key or option is answered): ``studies/brown_tabel1.toml``
+    was "no such study file" without the ``studies/brown_table1.toml`` beside it (L37)."""
+    stem = p.name.removesuffix(".toml")
+    seen: dict[str, Path] = {}
+    for d in [p.parent] + ([Path("studies")] if p.parent == Path(".") else []):
+        try:
+            with os.scandir(d) as it:  # a few hundred names at most: not a whole disk
+                for e in itertools.islice(it, 2000):
+                    if e.name.endswith(".toml") and e.is_file():
+                        seen.setdefault(e.name.removesuffix(".toml"), d / e.name)
+        except OSError:
+            continue
+    same = [n for n in seen if looks(n) == looks(stem) and n != stem]
+    close = same + difflib.get_close_matches(stem, list(seen), n=3, cutoff=0.75)
+    return next((str(seen[n]) for n in close if _names_a_study(seen[n])), None)
+
+
+def _names_a_study(p: Path) -> bool:
+    """Whether ``p`` holds a top-level ``study = ...`` line (not ``pyproject.toml``)."""
+    try:
+        with open(p, "rb") as fh:
+            head = fh.read(65536)
+    except OSError:
+        return False
+    return re.search(rb"(?m)^[ \t]*study[ \t]*=", head) is not None
 
 
 def study_file_problem(p: str | Path) -> str | None:

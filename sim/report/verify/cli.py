@@ -15,6 +15,7 @@ from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError, parse_override
 from sim.mc.outputs import name_problem
 from sim.mc.overrides import listed
+from sim.places import base, shown_path
 from sim.report.verify.record import write_record
 from sim.report.verify.rerun import verify
 from sim.report.verify.rules import Comparison, VerifyError
@@ -50,16 +51,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--results",
         action="store",
-        default="results",
-        help="the committed results (default: results)",
+        help="the committed results (default: results, the project's from inside it)",
     )
     p.add_argument(
         "--scratch", help="where to re-run (default: a temporary directory, removed after)"
     )
     p.add_argument(
         "--studies",
-        default="studies",
-        help="the study files of the results, DIR/<results directory>.toml (default: studies)",
+        help="the study files of the results, DIR/<results directory>.toml (default: studies, "
+        "the project's from inside it)",
     )
     p.add_argument(
         "--workers",
@@ -91,6 +91,15 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _defaults(a) -> None:
+    """``--results`` and ``--studies`` not given: the project's ``results/`` and ``studies/``
+    from a directory inside it (:func:`sim.places.base`, as ``sim run``, ``sim report`` and
+    ``python -m sim.batch`` take theirs): from ``docs/`` it refused, "no studies/ directory"."""
+    a.studies_given = a.studies is not None
+    a.results = shown_path(base() / "results") if a.results is None else a.results
+    a.studies = shown_path(base() / "studies") if a.studies is None else a.studies
+
+
 def _check_args(a) -> None:
     for name, v in (("--results", a.results), ("--scratch", a.scratch), ("--studies", a.studies)):
         why = None if v is None else name_problem(v)
@@ -106,7 +115,7 @@ def _check_args(a) -> None:
         raise VerifyError("--set: only with --trials (a re-run with other inputs is not a check)")
     if a.no_rerun and not a.scratch:
         raise VerifyError("--no-rerun: needs --scratch (the directory of the re-runs)")
-    if not a.no_rerun and a.studies != "studies" and not Path(a.studies).is_dir():
+    if not a.no_rerun and a.studies_given and not Path(a.studies).is_dir():
         raise VerifyError(f"--studies: {a.studies} is not a directory")
     if not a.no_rerun and not Path(a.studies).is_dir():  # run elsewhere, every study "FAILED"
         raise VerifyError(
@@ -172,6 +181,7 @@ def _main(argv: list[str] | None) -> int:
             a = _parser().parse_args(argv)
         except SystemExit as e:  # --help (or argparse's own error): an in-process caller goes on
             return exit_status(e.code)
+        _defaults(a)
         _check_args(a)
         extra = [] if a.trials is None else ["--trials", str(a.trials)]
         extra += [x for s in a.set for x in ("--set", s)]

@@ -29,13 +29,13 @@ plane system; bearings are measured from +x towards +y, as ``gama-local``'s ``ax
 
 from __future__ import annotations
 
-from collections import Counter
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from sim.mc.config import ConfigError
+from sim.studies.network.point_checks import COORDINATE_MAX_MM, check_points, placed_by
 from sim.studies.network.validate import (
     _OBS,
     ARCSEC,
@@ -49,8 +49,6 @@ from sim.studies.network.validate import (
     _obs_common,
     _point_name,
     _role,
-    distinct_looks,
-    finite_points,
     name_index,
     one_unit,
     positive_mm,
@@ -59,9 +57,6 @@ from sim.studies.network.validate import (
 )
 
 __all__ = ["Network", "build", "KINDS", "ARCSEC", "COORDINATE_MAX_MM"]
-
-#: no plane coordinate on the earth is farther from its grid's origin (mm: 100,000 km)
-COORDINATE_MAX_MM = 1e11
 
 
 @dataclass(frozen=True)
@@ -147,7 +142,7 @@ class Network:
         return np.concatenate([coords, orient, const, scale]).astype(int)
 
 
-def _listed_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
+def _listed_points(cfg: dict, pts: tuple) -> None:
     """Append ``network.points`` to ``pts`` (names, xy, role codes, coordinate sigmas)."""
     _p = {"name", "x_mm", "y_mm", "x_m", "y_m", "role", "sigma_mm"}
     for a, rec in enumerate(cfg["network.points"]):
@@ -161,15 +156,16 @@ def _listed_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
             [_mm(key, rec, "x"), _mm(key, rec, "y")],
             r,
             s,
+            key,
         )
 
 
-def _add(pts: tuple[list, list, list, list], name: str, xy: list, role: int, sig: float) -> None:
-    for col, v in zip(pts, (name, xy, role, sig)):
+def _add(pts: tuple, name: str, xy: list, role: int, sig: float, key: str) -> None:
+    for col, v in zip(pts, (name, xy, role, sig, key)):
         col.append(v)
 
 
-def _grid_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
+def _grid_points(cfg: dict, pts: tuple) -> None:
     """Append the points of ``network.grids`` (row by row, named prefix + 1-based index)."""
     _g = {"prefix", "nx", "ny", "spacing_mm", "spacing_m", "origin_mm", "origin_m", "role"}
     for a, rec in enumerate(cfg["network.grids"]):
@@ -184,13 +180,13 @@ def _grid_points(cfg: dict, pts: tuple[list, list, list, list]) -> None:
         reach(key, rec, "spacing", (max(nx, ny) - 1) * h)
         o = _mm(key, rec, "origin", False, [-(nx - 1) * h / 2, -(ny - 1) * h / 2])
         r, s = _role(key, rec)
-        prefix = _point_name(f"{key}.prefix", rec["prefix"])
+        prefix, at = _point_name(f"{key}.prefix", rec["prefix"]), placed_by(key, rec, "origin")
         for b in range(ny):
             for c in range(nx):
-                _add(pts, f"{prefix}{b * nx + c + 1}", [o[0] + c * h, o[1] + b * h], r, s)
+                _add(pts, f"{prefix}{b * nx + c + 1}", [o[0] + c * h, o[1] + b * h], r, s, at)
 
 
-def _random_points(cfg: dict, rng: np.random.Generator, pts: tuple[list, list, list, list]):
+def _random_points(cfg: dict, rng: np.random.Generator, pts: tuple):
     """Append the points of ``network.random`` (uniform in a square, from ``rng``)."""
     _r = {"prefix", "n", "half_extent_mm", "half_extent_m", "center_mm", "center_m", "role"}
     for a, rec in enumerate(cfg["network.random"]):
@@ -203,41 +199,20 @@ def _random_points(cfg: dict, rng: np.random.Generator, pts: tuple[list, list, l
         reach(key, rec, "half_extent", 2 * e)
         c0 = _mm(key, rec, "center", False, [0.0, 0.0])
         r, s = _role(key, rec)
-        prefix = _point_name(f"{key}.prefix", rec["prefix"])
+        prefix, at = _point_name(f"{key}.prefix", rec["prefix"]), placed_by(key, rec, "center")
         xy = rng.uniform(-e, e, (n, 2)) + np.array(c0)
         for b in range(n):
-            _add(pts, f"{prefix}{b + 1}", list(xy[b]), r, s)
+            _add(pts, f"{prefix}{b + 1}", list(xy[b]), r, s, at)
 
 
 def _points(cfg: dict, rng: np.random.Generator):
     """Names, coordinates (n, 2) mm, role codes and coordinate sigmas of every point."""
-    pts: tuple[list, list, list, list] = ([], [], [], [])
+    pts: tuple[list, ...] = ([], [], [], [], [])  # names, xy, roles, sigmas, the keys
     _listed_points(cfg, pts)
     _grid_points(cfg, pts)
     _random_points(cfg, rng, pts)
-    names = pts[0]
-    if len(names) < 2:
-        raise ConfigError("network.points", "a network needs at least two points")
-    dup = sorted(x for x, c in Counter(names).items() if c > 1)
-    if dup:
-        raise ConfigError("network.points", f"duplicate point name {dup[0]!r}")
-    distinct_looks("network.points", names)
-    xy = np.array(pts[1], float)
-    finite_points(names, xy)
-    span = float(np.ptp(xy, axis=0).max())
-    if span > 1e9:
-        raise ConfigError(
-            "network.points",
-            f"the network spans {span / 1e6:.4g} km: over 1000 km, out of range for a plane "
-            "network (the earth's curvature) and for double-precision adjustment at the um level",
-        )
-    far = int(np.argmax(np.abs(xy).max(axis=1)))
-    if np.abs(xy[far]).max() > COORDINATE_MAX_MM:
-        raise ConfigError(
-            "network.points",
-            f"point {names[far]!r} at {np.abs(xy[far]).max() / 1e6:.4g} km from the origin: "
-            f"over {COORDINATE_MAX_MM / 1e6:,.0f} km, not a plane coordinate on the earth",
-        )
+    names, xy = pts[0], np.array(pts[1], float)
+    check_points(names, xy, pts[4])
     return names, xy, np.array(pts[2]), np.array(pts[3])
 
 

@@ -268,15 +268,6 @@ def reach(key: str, rec: dict, field: str, far: float) -> None:
         )
 
 
-def finite_points(names: list[str], xy: np.ndarray) -> None:
-    """Refuse a point whose coordinates overflowed (an origin near the largest double)."""
-    bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
-    if bad.size:
-        raise ConfigError(
-            "network.points", f"point {names[bad[0]]!r} lies beyond the largest 64-bit float"
-        )
-
-
 def positive_mm(key: str, rec: dict, field: str) -> float:
     """``rec``'s required length ``field`` in mm (as :func:`_mm`), refused unless > 0 naming
     the key as written and its value in the unit written (``spacing_m = -25`` was refused

@@ -70,6 +70,17 @@ def table_path(cfg: dict, key: str) -> Path:
         f"{p} is read from the project root {ROOT}, not from the working directory "
         f"{Path.cwd()}, which holds another file of that path: give its absolute path",
     )
+    try:  # "no such file: ROOT/my.csv" of a file beside the study file said not why (L37)
+        (ROOT / p).lstat()
+    except FileNotFoundError:
+        require(
+            not str(p).isprintable(),  # a control character: the reader names it
+            key,
+            f"no such file: {ROOT / p} (a relative path is read from the project root, not "
+            "from the study file's directory: give the path from the root, or an absolute one)",
+        )
+    except OSError:  # a name too long, a directory not searchable: the reader names it
+        pass
     return ROOT / p
 
 

@@ -1,0 +1,81 @@
+"""Whose a results directory's tables are, for :class:`sim.Results`: the study a table's
+provenance names, the tables its run recorded (``run.json``), and the note ``sim show`` gives
+on results made by another version of the suite's code, which the API gave none of (L37).
+
+A table of the run rewritten without its provenance (by a tool) was left out of ``names()``
+while ``table(name)`` refused it: it is listed, as the run recorded it, and ``table()`` says
+it carries no provenance, in ``sim show``'s words."""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+
+from sim.api_paths import why_unread
+from sim.mc.config import ConfigError
+from sim.mc.storage import read_provenance, read_record
+from sim.stale import other_code
+
+#: the suite's package directory: a warning points at the first line of the caller's outside it
+_CODE = str(Path(__file__).resolve().parent) + "/"
+
+__all__ = ["StaleResultsWarning", "check_owner", "owner", "run_tables", "stale_warning"]
+
+
+class StaleResultsWarning(UserWarning):
+    """Results made by another version of their study's code (``make reproduce`` re-runs)."""
+
+
+def owner(p: Path) -> Any:
+    """The study a table's provenance (written with every table) names (None: none)."""
+    try:
+        prov = read_provenance(p)
+    except OSError as e:  # EIO, EACCES: it was "not a table sim wrote; run the study again"
+        raise ConfigError("table", f"{p} cannot be read ({why_unread(e)})") from None
+    except (ValueError, pa.ArrowException):
+        prov = None
+    return prov.get("study") if isinstance(prov, dict) else None
+
+
+def check_owner(p: Path, study: str) -> None:
+    """A table is ``study``'s (:func:`owner`)."""
+    who = owner(p)
+    if who is None:  # sim show's words of a claims table without it
+        raise ConfigError(
+            "table",
+            f"{p} is not a table sim wrote: it carries no provenance (schema metadata "
+            "'sim.provenance': rewritten by a tool?); run the study again",
+        )
+    if who != study:
+        whose = f"a table of {who!r}" if isinstance(who, str) else "not a table sim wrote"
+        raise ConfigError("table", f"{p} is {whose}, not of {study!r}; run the study again")
+
+
+def run_tables(d: Path, study: str) -> set[str]:
+    """The table files the run of ``study`` in ``d`` recorded in its ``run.json`` (none: no
+    record, or another study's)."""
+    rec = read_record(d)
+    config = rec.get("config") if isinstance(rec, dict) else None
+    tables = rec.get("table_sha256") if isinstance(config, dict) else None
+    if not isinstance(config, dict) or config.get("study") != study or not isinstance(tables, dict):
+        return set()
+    return {n for n in tables if isinstance(n, str) and "/" not in n}
+
+
+def stale_warning(d: Path) -> None:
+    """Warn (:class:`StaleResultsWarning`, once per place in the caller's code) when ``d``
+    was made by another version of its study's code, in ``sim show``'s words."""
+    if older := other_code(d):
+        level, f = 2, sys._getframe(1)  # the caller's line, not one of the suite's
+        while f is not None and f.f_code.co_filename.startswith(_CODE):
+            level, f = level + 1, f.f_back
+        warnings.warn(
+            f"{older} was made by another version of the suite's code (its study's code "
+            "changed since): make reproduce re-runs what is stale",
+            StaleResultsWarning,
+            stacklevel=level,
+        )

@@ -1,0 +1,36 @@
+"""Results made by another version of the suite's code: a run record (``run.json``) whose
+``code_hash`` is not its study's code hash now. ``sim show`` and ``sim report`` say so in a
+note, and so does the Python API's :class:`sim.Results` (a warning) when it reads a table."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from sim.mc.codehash import study_code_hash
+from sim.mc.outputs import results_dirs
+from sim.mc.storage import read_record
+
+__all__ = ["other_code", "stale_dirs"]
+
+
+def other_code(d: Path) -> str | None:
+    """The first results directory at or under ``d`` whose run record names a study whose
+    code has changed since (its ``code_hash`` is not this suite's), or None."""
+    return next(iter(stale_dirs(d, first=True)), None)
+
+
+def stale_dirs(d: Path, first: bool = False) -> list[str]:
+    """The results directories at or under ``d`` made by another version of their study's
+    code (``first``: stop at the first)."""
+    found: list[str] = []
+    for r in [d, *results_dirs(d)] if d.is_dir() else []:
+        rec = read_record(r)
+        study = rec.get("config", {}).get("study") if rec else None
+        try:
+            if isinstance(study, str) and rec["code_hash"] != study_code_hash(study):
+                found.append(str(r))
+        except (KeyError, ValueError, OSError, ImportError):  # an unknown study: not ours
+            continue
+        if found and first:
+            break
+    return found
