@@ -28,6 +28,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.api_args import arguments as _arguments
+from sim.api_args import count as _count
+from sim.api_args import flag
 from sim.api_paths import absolute_path as _absolute
 from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
@@ -111,7 +113,7 @@ class Results:
         """``; <path>/<study> is its results directory: ...`` where ``path`` is a results root
         (``sim.Results("results", "network")``, for ``results/network``), else ""."""
         inner = self.path / self.study
-        if not any(inner.glob("*.parquet")):
+        if not os.path.isdir(inner) or not any(inner.glob("*.parquet")):  # glob: ENAMETOOLONG
             return ""
         return f"; {inner} holds the study's results: give that path"
 
@@ -150,11 +152,12 @@ class Results:
         self._check_dir()
         dataset = self._dataset(name)
         p = self.path / ("trials" if dataset else f"{name}.parquet")
-        if not p.exists() and not self.names():  # not "no table 'claims'; it has " (none)
+        there = os.path.exists(p)  # a name too long for a file is none (pathlib's raised)
+        if not there and not self.names():  # not "no table 'claims'; it has " (none)
             raise ConfigError(
                 "path", f"{self.path} is not a results directory (no tables){self._within()}"
             )
-        if not p.exists():
+        if not there:
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
             )
@@ -246,8 +249,9 @@ class StudyHandle:
         every executor and worker count. ``figures=False``: no PNG is drawn (``sim run
         --no-figures``), the tables are the same."""
         _check_path("out", out, none_ok=True)  # trials, seed: validated as the config keys
+        workers = _count("workers", workers)  # np.array(2), Decimal("2"): 2, as trials reads
         overwrite, quiet, figures = (
-            _flag(*a) for a in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures))
+            flag(*a) for a in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures))
         )
         _unchanged(self)
         h = (
@@ -368,14 +372,6 @@ def _sha256(path: Path) -> str:
         return ""
     except OSError as e:
         raise ConfigError("study_file", f"{path} cannot be read ({why_unread(e)})") from None
-
-
-def _flag(name: str, v: Any) -> bool:
-    """A flag of ``run()``: a bool, or a NumPy bool (``np.True_``, from a mask), as a config
-    key takes it (it was refused as "must be True or False (got np.True_)")."""
-    if not isinstance(b := as_config_value(name, v), bool):
-        raise ConfigError(name, f"must be True or False (got {v!r})")
-    return b
 
 
 def _unpickled(study: Any, state: dict) -> StudyHandle:

@@ -21,7 +21,7 @@ from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
 from sim.mc.storage import RECORD, config_hash, read_record, regular_text
 
-__all__ = ["check_path", "absolute_path", "why_not_a_dir", "why_unread"]
+__all__ = ["check_path", "absolute_path", "too_long", "why_not_a_dir", "why_unread"]
 
 
 def check_path(name: str, v: Any, none_ok: bool = False) -> None:
@@ -32,8 +32,14 @@ def check_path(name: str, v: Any, none_ok: bool = False) -> None:
         text = os.fspath(v) if isinstance(v, os.PathLike) else v
     except TypeError:
         text = None
+    except Exception as e:  # a broken os.PathLike of the caller's: its ValueError passed
+        raise ConfigError(  # through the API as a traceback of the caller's own object
+            name, f"is not a path: os.fspath() of its {type(v).__name__} raised {_said(e)}"
+        ) from None
     if not isinstance(text, str) or not text.isprintable() or not text.strip():
         raise ConfigError(name, f"must be a path (a str or os.PathLike of a str), got {v!r}")
+    if (why := too_long(text)) is not None:
+        raise ConfigError(name, why)
     if os.path.lexists(text):
         return
     if text.startswith("~"):
@@ -48,6 +54,33 @@ def check_path(name: str, v: Any, none_ok: bool = False) -> None:
             f"{text} names an environment variable, which Python does not expand: give "
             f"os.path.expandvars({text!r})",
         )
+
+
+def _said(e: Exception) -> str:
+    """``ValueError: boom``: an exception of the caller's code in one line."""
+    text = " ".join(str(e).split())
+    return f"{type(e).__name__}: {text[:120]}" if text else type(e).__name__
+
+
+def too_long(text: str) -> str | None:
+    """Why the system cannot take the path ``text`` (a name in it over the file system's
+    limit, or the whole over the system's: ENAMETOOLONG), in one line that shows the path cut
+    short, or None. pathlib's ``exists``, ``is_dir`` and ``glob`` raise it where they read
+    "absent" for a name that is not there: ``sim.load("a" * 5000)``, ``run(out=...)`` and
+    ``sim.Results(path, ...)`` ended in pathlib's OSError with a traceback."""
+    try:
+        os.lstat(text)
+    except OSError as e:
+        if e.errno == errno.ENAMETOOLONG:
+            longest = max(len(part.encode("utf-8", "surrogateescape")) for part in text.split("/"))
+            shown = text if len(text) <= 80 else f"{text[:40]}...{text[-20:]}"
+            return (
+                f"{shown} is too long a path for the system ({e.strerror}: {len(text)} "
+                f"characters, its longest name {longest} bytes): give a shorter one"
+            )
+    except ValueError:  # an embedded NUL: refused as no path by the callers
+        pass
+    return None
 
 
 def absolute_path(name: str, v: str | os.PathLike) -> Path:

@@ -222,7 +222,7 @@ def test_array_likes_are_lists_and_a_refusal_is_one_line():
         sim.load(TABLE1, plate__pattern="list", plate__points=_Rows(pts, fails=True))
     assert str(info.value) == "plate.points: must be a list (got Rows( ... ))"
     with pytest.raises(ConfigError, match=r"^workers: .* \(got Rows\( \.\.\. \)\)$"):
-        sim.load(TABLE1).run(workers=_Rows(1))
+        sim.load(TABLE1).run(workers=_Rows(1, fails=True))  # an array-like of 1 is 1 (A37)
 
 
 def test_sequences_are_lists_and_iterators_or_sets_are_named():

@@ -1,0 +1,166 @@
+"""The classes of the sweep doors37a (brief A37: the Python API, every statement of
+docs/python.md tried as written, argument types not tried before, its objects' life), one case
+each; each failed on the code before its fix.
+
+* A path too long for the system (a name over the file system's 255 bytes, or the whole over
+  its limit: ``sim.load("a" * 5000)``, ``run(out="/tmp/<300 b>/<300 b>")``, ``sim.Results``
+  of such a path, of a study name or a table name of that length) ended in pathlib's
+  ``OSError: [Errno 36] File name too long`` with a traceback: pathlib's ``exists``,
+  ``is_dir`` and ``glob`` raise it where they read "absent" for a name that is not there
+  (:func:`sim.api_paths.too_long`); ``python -m sim.batch`` of such a study file or
+  ``--results`` too (a traceback, exit 1).
+* An ``os.PathLike`` of the caller's whose ``__fspath__`` raises (a ``ValueError`` of its
+  own; ``TypeError``, returning bytes or an int, was refused already) passed its exception
+  through ``sim.load``, ``run(out=...)`` and ``sim.Results`` as a traceback.
+* An ``executor`` whose ``__eq__`` raises (an object of the caller's) ran that ``__eq__`` in
+  ``executor not in ("local", "dask")``: its exception, a traceback (``workers``,
+  ``scheduler`` and the flags were refused in one line already).
+* ``run(workers=np.array(2))`` (a 0-d array), ``Decimal("2")``, ``Fraction(2)`` were refused
+  as "must be an integer between 1 and 8 (got array(2))", where ``trials`` and ``seed`` of
+  the same ``run()`` take each as the integer it is: a worker count is read as a config
+  key's number is.
+* A value whose ``__repr__`` raises, where the API refuses it (``trials=``, an element of
+  ``plate.points``, ``executor=``, ``out=``, ``sim.load``'s path, ``sim.Results``' path and
+  study, ``table()``): the refusal's line quotes it by its ``repr``, whose exception passed
+  through as a traceback naming nothing; it is now one line naming the argument
+  (:func:`sim.api_args._unshown`).
+* What the API returns and ``sim show`` prints for one directory differed without a word in
+  docs/python.md: ``res.claims()``'s ``verdict`` is ``input`` or ``not applicable`` where
+  ``sim show`` prints ``input (inconclusive)``, ``not applicable (holds)`` (the ``outcome``
+  column in brackets), and ``Results`` raise none of the notes ``sim show`` prints (results
+  of another code version, a run off the paper's setup); the page now says so.
+
+Held (found right): every example and statement of docs/python.md, from the project's root
+and (its relative study file refused in one line) from a fresh directory; bytes paths,
+``__fspath__`` returning bytes or an int, pathlib subclasses, ``np.str_``; NumPy scalars and
+0-d arrays for ``trials``, ``seed``, config keys and the flags; bools for integers;
+``Decimal``/``Fraction`` NaN, infinite, beyond and below a double; a ``MappingProxyType`` or a
+dict for a table key (refused naming its keys); generators and sets; self-referencing and
+deeply nested lists; values whose ``__eq__``/``__hash__`` raise (refused by the key); keys
+``comparator..beta_mm``, ``__trials``, ``trials__`` named as unknown; a handle whose study
+file was edited, whose ``config`` was changed in place, or made by ``dataclasses.replace``
+with another path.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from decimal import Decimal
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import sim
+
+ROOT = Path(__file__).resolve().parents[1]
+TABLE1 = str(ROOT / "studies" / "brown_table1.toml")
+RESULTS = str(ROOT / "results" / "brown_table1")
+
+
+@pytest.fixture(scope="module")
+def handle():
+    return sim.load(TABLE1, trials=20, chunk=1)
+
+
+def _refused(fn) -> str:
+    with pytest.raises(sim.ConfigError) as e:
+        fn()
+    assert "\n" not in str(e.value)
+    return str(e.value)
+
+
+def test_a_path_too_long_for_the_system_is_one_line(handle, tmp_path):
+    """Each path argument, a study name and a table name too long for the file system."""
+    deep = str(tmp_path / "/".join(["b" * 300] * 3))
+    assert _refused(lambda: sim.load("a" * 5000)).startswith("study_file: aaaa")
+    assert "too long a path" in _refused(lambda: sim.load("a" * 5000 + ".toml"))
+    assert "its longest name 300 bytes" in _refused(lambda: handle.run(out=deep))
+    assert _refused(lambda: sim.Results(deep, "brown_table1")).startswith("path: ")
+    res = sim.Results(RESULTS, "brown_table1")
+    assert "has no table" in _refused(lambda: res.table("c" * 300))
+    other = sim.Results(RESULTS, "b" * 300)
+    assert _refused(other.names).startswith("study: ")
+    p = subprocess.run(
+        [sys.executable, "-m", "sim.batch", "--results", deep, TABLE1],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
+    )
+    assert p.returncode == 2 and p.stderr.startswith("sim.batch: --results: "), p.stderr[-500:]
+    assert len(p.stderr.splitlines()) == 1
+
+
+def test_a_pathlike_whose_fspath_raises_is_one_line(handle):
+    """``__fspath__`` raising a ValueError of its own: refused naming the argument."""
+
+    class Broken:
+        def __fspath__(self):
+            raise ValueError("no path today")
+
+    msg = "is not a path: os.fspath() of its Broken raised ValueError: no path today"
+    assert _refused(lambda: sim.load(Broken())) == f"study_file: {msg}"
+    assert _refused(lambda: handle.run(out=Broken())) == f"out: {msg}"
+    assert _refused(lambda: sim.Results(Broken(), "brown_table1")) == f"path: {msg}"
+
+
+def test_an_executor_whose_eq_raises_is_one_line(handle, tmp_path):
+    """The caller's object as ``executor``: its ``__eq__`` is never run."""
+
+    class Odd:
+        def __eq__(self, other):
+            raise RuntimeError("eq")
+
+        __hash__ = object.__hash__
+
+        def __repr__(self):
+            return "Odd()"
+
+    msg = _refused(lambda: handle.run(out=tmp_path / "o", executor=Odd()))
+    assert msg == "executor: must be 'local' or 'dask' (got Odd())"
+
+
+@pytest.mark.parametrize("count", [np.array(99), Decimal("99"), Fraction(99, 1)])
+def test_workers_is_read_as_the_number_it_is(handle, tmp_path, count):
+    """Any integer type is the integer (refused here for its size, not its type: before any
+    work)."""
+    msg = _refused(lambda: handle.run(out=tmp_path / "o", workers=count))
+    assert msg.startswith("workers: must be between 1 and ") and msg.endswith("(got 99)")
+
+
+def test_a_value_whose_repr_raises_is_one_line(handle, tmp_path):
+    """A refusal that would quote the value names the argument instead."""
+
+    class Mute:
+        def __repr__(self):
+            raise RuntimeError("no repr")
+
+    for key, fn in [
+        ("trials", lambda: sim.load(TABLE1, trials=Mute())),
+        ("plate.points", lambda: sim.load(TABLE1, plate__points=[Mute()])),
+        ("executor", lambda: handle.run(out=tmp_path / "o", executor=Mute())),
+        ("out", lambda: handle.run(out=Mute())),
+        ("study_file", lambda: sim.load(Mute())),
+        ("study", lambda: sim.Results(RESULTS, Mute())),
+    ]:
+        msg = _refused(fn)
+        assert msg.startswith(f"{key}: cannot be quoted in a message: repr() of its "), msg
+
+
+def test_the_claims_table_and_sim_show_differ_as_the_docs_say():
+    """``res.claims()`` gives ``verdict`` and ``outcome`` apart where ``sim show`` prints an
+    input's or a self-check's ``verdict (outcome)``: docs/python.md said nothing of it, nor that
+    ``Results`` raise none of ``sim show``'s notes (stale code, off the paper's setup)."""
+    from sim.report.run_summary import verdict_cell
+
+    rows = sim.Results(RESULTS, "brown_table1").claims().to_pylist()
+    for r in rows:
+        cell = verdict_cell(r)
+        bracketed = r["kind"] in ("input", "self-check") and r["outcome"]
+        assert cell == (f"{r['verdict']} ({r['outcome']})" if bracketed else r["verdict"])
+    doc = " ".join((ROOT / "docs" / "python.md").read_text().split())
+    assert "its `outcome` column the rule's own outcome, which `sim show` and README.md" in doc
+    assert "which `sim show` notes on standard error) are read as they are" in doc
