@@ -31,9 +31,9 @@ from sim.api_args import arguments as _arguments
 from sim.api_args import count as _count
 from sim.api_args import flag
 from sim.api_paths import absolute_path as _absolute
+from sim.api_paths import cell_chunks, chunks_recorded, why_not_a_dir, why_unread
 from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
-from sim.api_paths import why_not_a_dir, why_unread
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.api_tmp import temp_dir
 from sim.execute import execute
@@ -139,7 +139,7 @@ class Results:
                 f"{self.path} holds tables of {' and '.join(whose) or 'no study sim ran'}, "
                 f"not of {self.study!r}{self._within()}",
             )
-        if (self.path / "trials").is_dir():
+        if (self.path / "trials").is_dir() and chunks_recorded(self.path):  # else unread
             names |= {"chunks", "trials"}
         return sorted(names)
 
@@ -162,7 +162,7 @@ class Results:
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
             )
         if dataset and (bad := damaged_chunks(self.path)):
-            raise ConfigError("table", f"{name}: {bad}")
+            raise ConfigError("table", f"{name}: {cell_chunks(self.path) or bad}")
         if not dataset and not p.is_file():  # pyarrow reads a directory as a dataset
             raise ConfigError("table", f"{p} is not a file; run the study again")
         try:

@@ -21,7 +21,15 @@ from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
 from sim.mc.storage import RECORD, config_hash, read_record, regular_text
 
-__all__ = ["check_path", "absolute_path", "too_long", "why_not_a_dir", "why_unread"]
+__all__ = [
+    "check_path",
+    "absolute_path",
+    "cell_chunks",
+    "chunks_recorded",
+    "too_long",
+    "why_not_a_dir",
+    "why_unread",
+]
 
 
 def check_path(name: str, v: Any, none_ok: bool = False) -> None:
@@ -128,3 +136,25 @@ def why_not_a_dir(path: Path, of_a_run: bool) -> str:
     if os.path.lexists(path):
         return "is not a results directory"
     return "no longer exists (removed since the run)" if of_a_run else "does not exist"
+
+
+def chunks_recorded(d: Path) -> bool:
+    """Whether the run record of ``d`` maps its chunk files to their sha256, the only chunks
+    ``Results.table("chunks")`` reads: a sweep's cell has no record of its own (its sweep's
+    records none of its chunks), and ``names()`` listed ``chunks`` and ``trials`` there, each
+    of which ``table()`` refused."""
+    rec = read_record(d)
+    return isinstance(rec, dict) and isinstance(rec.get("chunk_sha256"), dict)
+
+
+def cell_chunks(d: Path) -> str | None:
+    """Why the chunks of ``d``, a cell of a sweep (``<sweep>/cells/<label>/``), are not read,
+    or None when ``d`` is no such cell (it was "run.json is missing or not a run record", of
+    a directory that never had one)."""
+    sweep = d.parent.parent
+    if d.parent.name != "cells" or not (sweep / "sweep.parquet").is_file():
+        return None
+    return (
+        f"{d} is a cell of the sweep {sweep}, whose run.json records no sha256 of the cells' "
+        "chunk files: they cannot be checked, and are not read (the cell's tables are)"
+    )

@@ -24,6 +24,12 @@ each; each failed on the code before its fix.
   study, ``table()``): the refusal's line quotes it by its ``repr``, whose exception passed
   through as a traceback naming nothing; it is now one line naming the argument
   (:func:`sim.api_args._unshown`).
+* ``sim.Results`` of a sweep's cell (``<sweep>/cells/<label>/``, run by the API or ``sim
+  run``): ``names()`` listed ``chunks`` and ``trials``, each of which ``table()`` refused as
+  "run.json is missing or not a run record, so the chunks cannot be checked" (a cell has no
+  record of its own, and its sweep's records none of the cells' chunks); they are no longer
+  listed, and the refusal says the directory is a sweep's cell
+  (:func:`sim.api_paths.cell_chunks`).
 * What the API returns and ``sim show`` prints for one directory differed without a word in
   docs/python.md: ``res.claims()``'s ``verdict`` is ``input`` or ``not applicable`` where
   ``sim show`` prints ``input (inconclusive)``, ``not applicable (holds)`` (the ``outcome``
@@ -164,3 +170,19 @@ def test_the_claims_table_and_sim_show_differ_as_the_docs_say():
     doc = " ".join((ROOT / "docs" / "python.md").read_text().split())
     assert "its `outcome` column the rule's own outcome, which `sim show` and README.md" in doc
     assert "which `sim show` notes on standard error) are read as they are" in doc
+
+
+def test_a_sweep_cell_lists_only_the_tables_it_reads(tmp_path):
+    """A sweep run by the API: a cell's ``names()`` lists no chunk dataset (its sweep records
+    no sha256 of the cells' chunks), and ``table("chunks")`` says why it is not read."""
+    f = tmp_path / "sweep.toml"
+    f.write_text(Path(TABLE1).read_text() + '\n[sweep]\n"errors.settings" = [2, 3]\n')
+    res = sim.load(f, trials=20, chunk=1).run(out=tmp_path / "o", figures=False)
+    assert res.names() == ["sweep"]
+    cell = sim.Results(tmp_path / "o" / "cells" / "cell0000_r0", "brown_table1")
+    names = cell.names()
+    assert "claims" in names and "chunks" not in names and "trials" not in names
+    for name in names:
+        cell.table(name)  # every one it lists is read
+    msg = _refused(lambda: cell.table("chunks"))
+    assert msg.startswith("table: chunks: ") and "is a cell of the sweep" in msg
