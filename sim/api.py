@@ -35,6 +35,7 @@ from sim.api_paths import cell_chunks, chunks_recorded, why_not_a_dir, why_unrea
 from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
+from sim.api_state import check_files as _check_files
 from sim.api_tmp import temp_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
@@ -227,7 +228,9 @@ class StudyHandle:
     def replace(self, **overrides) -> "StudyHandle":
         """A new handle with more overrides."""
         _unchanged(self)
-        return load(self.path, **{**self.overrides, **_keyed(overrides)})
+        new = load(self.path, **{**self.overrides, **_keyed(overrides)})
+        _check_files(self, new)  # a network.gama_xml edited since: refused, as run() does
+        return new
 
     @_arguments
     def run(
@@ -266,6 +269,7 @@ class StudyHandle:
                 },
             )
         )
+        _check_files(self, h)  # a network.gama_xml edited since: refused, as run() does
         base = None  # the temporary directory made for this run (out=None)
         if out is None:
             try:  # the caller's tempfile.tempdir (or TMPDIR) may be gone, a file, or full

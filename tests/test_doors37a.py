@@ -30,6 +30,11 @@ each; each failed on the code before its fix.
   record of its own, and its sweep's records none of the cells' chunks); they are no longer
   listed, and the refusal says the directory is a sweep's cell
   (:func:`sim.api_paths.cell_chunks`).
+* A file the study reads, edited after ``sim.load`` (``network.gama_xml``, Wolf's
+  ``table1.file``): ``run()`` refused it ("has changed since the study was loaded"), but
+  ``replace(...)`` and ``run(trials=..., seed=...)``, which load the study file again, read the
+  edited file without a word, one handle running two networks (the class doors13 closed for
+  the study file itself); both refuse it now (:func:`sim.api_state.check_files`).
 * What the API returns and ``sim show`` prints for one directory differed without a word in
   docs/python.md: ``res.claims()``'s ``verdict`` is ``input`` or ``not applicable`` where
   ``sim show`` prints ``input (inconclusive)``, ``not applicable (holds)`` (the ``outcome``
@@ -186,3 +191,23 @@ def test_a_sweep_cell_lists_only_the_tables_it_reads(tmp_path):
         cell.table(name)  # every one it lists is read
     msg = _refused(lambda: cell.table("chunks"))
     assert msg.startswith("table: chunks: ") and "is a cell of the sweep" in msg
+
+
+def test_a_file_the_study_read_edited_since_load_is_refused_by_every_call(tmp_path):
+    """``network.gama_xml`` and Wolf's ``table1.file``, edited after ``sim.load``: ``replace``
+    and ``run(seed=...)`` (which load the study file again) refuse them as ``run()`` does."""
+    xml = tmp_path / "net.xml"
+    xml.write_text((ROOT / "tests" / "data" / "gama" / "one_fixed.xml").read_text())
+    f = tmp_path / "n.toml"
+    f.write_text(f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{xml}"\n')
+    csv = tmp_path / "t1.csv"
+    csv.write_text((ROOT / "studies" / "data" / "wolf_table1.csv").read_text())
+    wolf = sim.load(ROOT / "studies" / "wolf_polynomial.toml", table1__file=str(csv))
+    net = sim.load(f)
+    xml.write_text(xml.read_text() + "\n<!-- edited -->\n")
+    csv.write_text(csv.read_text().replace("0", "1", 3))
+    for h, key in ((net, "network.gama_sha256"), (wolf, "table1.sha256")):
+        for call in (lambda: h.replace(seed=3), lambda: h.run(out=tmp_path / "o", seed=3)):
+            msg = _refused(call)
+            assert msg.startswith(f"{key}: ") and "has changed since sim.load()" in msg, msg
+    assert not (tmp_path / "o").exists()
