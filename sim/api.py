@@ -31,7 +31,7 @@ from sim.api_args import arguments as _arguments
 from sim.api_args import count as _count
 from sim.api_args import flag
 from sim.api_paths import absolute_path as _absolute
-from sim.api_paths import cell_chunks, chunks_recorded, why_not_a_dir, why_unread
+from sim.api_paths import another_run, cell_chunks, chunks_recorded, why_not_a_dir, why_unread
 from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
@@ -104,11 +104,8 @@ class Results:
             why = link_problem(self.path) or why_not_a_dir(self.path, bool(self.run_sha256))
             raise ConfigError("path", f"{self.path} {why}")
         if self.run_sha256 and _run_identity(self.path) not in ("", self.run_sha256):
-            raise ConfigError(  # its tables read silently as this run's (another seed's)
-                "path",
-                f"{self.path} holds another run than the one that returned these Results "
-                f"(run again into it since): read it with sim.Results(path, {self.study!r})",
-            )
+            # its tables read silently as this run's (another seed's)
+            raise ConfigError("path", another_run(self.path, self.study))
 
     def _within(self) -> str:
         """``; <path>/<study> is its results directory: ...`` where ``path`` is a results root

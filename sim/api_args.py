@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from sim.long_words import clipped
 from sim.mc.config import ConfigError
 from sim.mc.pyvalue import as_config_value
 
@@ -96,7 +97,7 @@ def arguments(fn):
             with np.errstate(**NUMPY_DEFAULTS):  # np.seterr(all="raise") made an underflow
                 return fn(*args, **kwargs)  # the suite ignores a FloatingPointError)
         except ConfigError as e:
-            if len(str(e).splitlines()) < 2:
+            if len(str(e).splitlines()) < 2 and clipped(str(e)) == str(e):
                 raise
             raise one_line(e) from None
         except Exception as e:
@@ -155,5 +156,5 @@ def one_line(e: ConfigError) -> ConfigError:
     object of a library whose repr spans lines, ``got Bad(\n...)``) spanned as many."""
     flat = ConfigError(e.key, "")
     flat.__dict__.update(e.__dict__)
-    flat.args = (" ".join(t.strip() for t in str(e).splitlines() if t.strip()),)
+    flat.args = (clipped(" ".join(t.strip() for t in str(e).splitlines() if t.strip())),)
     return flat

@@ -22,6 +22,7 @@ from sim.mc.paths import absolute
 from sim.mc.storage import RECORD, config_hash, read_record, regular_text
 
 __all__ = [
+    "another_run",
     "check_path",
     "absolute_path",
     "cell_chunks",
@@ -157,4 +158,23 @@ def cell_chunks(d: Path) -> str | None:
     return (
         f"{d} is a cell of the sweep {sweep}, whose run.json records no sha256 of the cells' "
         "chunk files: they cannot be checked, and are not read (the cell's tables are)"
+    )
+
+
+def another_run(out: Path, study: str) -> str:
+    """Why the Results of a run of ``study`` into ``out`` no longer read it: another run went
+    there since. Its advice, ``sim.Results(path, study)``, was given of another study's run
+    too, where it is refused in turn ("holds tables of 'brown_dilution'"): that run's study is
+    named instead."""
+    rec = read_record(out)
+    cfg = rec.get("config") if isinstance(rec, dict) else None
+    other = cfg.get("study") if isinstance(cfg, dict) else None
+    if isinstance(other, str) and other != study:
+        return (
+            f"{out} holds a run of {other!r} now (run into it since), not the run of "
+            f"{study!r} that returned these Results"
+        )
+    return (
+        f"{out} holds another run than the one that returned these Results "
+        f"(run again into it since): read it with sim.Results(path, {study!r})"
     )

@@ -35,6 +35,14 @@ each; each failed on the code before its fix.
   ``replace(...)`` and ``run(trials=..., seed=...)``, which load the study file again, read the
   edited file without a word, one handle running two networks (the class doors13 closed for
   the study file itself); both refuse it now (:func:`sim.api_state.check_files`).
+* A very long string as a value or a key (``sim.load(f, plate__pattern="y" * 100_000)``, a
+  key of that length, ``--set plate.pattern=yyy...``) was quoted whole: a refusal of one line
+  of 100 KB, its key and reason lost in the scroll-back. A run of more than 200 characters
+  without white space is now shown cut, with its length (:func:`sim.long_words.clipped`).
+* ``Results`` whose directory another study's run replaced since (``overwrite=True``) were
+  refused with the advice "read it with sim.Results(path, 'brown_table1')", which, followed,
+  is refused in turn ("holds tables of 'brown_dilution'"); the line now names the study whose
+  run the directory holds (:func:`sim.api_paths.another_run`).
 * What the API returns and ``sim show`` prints for one directory differed without a word in
   docs/python.md: ``res.claims()``'s ``verdict`` is ``input`` or ``not applicable`` where
   ``sim show`` prints ``input (inconclusive)``, ``not applicable (holds)`` (the ``outcome``
@@ -211,3 +219,31 @@ def test_a_file_the_study_read_edited_since_load_is_refused_by_every_call(tmp_pa
             msg = _refused(call)
             assert msg.startswith(f"{key}: ") and "has changed since sim.load()" in msg, msg
     assert not (tmp_path / "o").exists()
+
+
+def test_a_very_long_key_or_value_is_shown_cut(capsys):
+    """A string of 100,000 characters as a value or a key, by the API and by ``--set``: the
+    refusal is one line of a few hundred characters, not of 100 KB."""
+    from sim.cli import main
+
+    long = "y" * 100_000
+    for kw in ({"plate__pattern": long}, {"k" * 100_000: 1}):
+        msg = _refused(lambda: sim.load(TABLE1, **kw))
+        assert len(msg) < 400 and "characters)" in msg, msg[:300]
+    assert main(["check", TABLE1, "--set", f"plate.pattern={long}"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("sim: error: plate.pattern: must be one of ") and len(err) < 400
+
+
+def test_results_replaced_by_another_study_name_it(tmp_path):
+    """Results whose directory another study's run replaced: the line names that study,
+    not the advice ``sim.Results(path, study)``, which refuses that directory in turn."""
+    out = tmp_path / "o"
+    res = sim.load(TABLE1, trials=20, chunk=1).run(out=out, figures=False)
+    dilution = str(ROOT / "studies" / "brown_dilution.toml")
+    sim.load(dilution, trials=20, chunk=1).run(out=out, figures=False, overwrite=True)
+    msg = _refused(res.claims)
+    assert msg == (
+        f"path: {out} holds a run of 'brown_dilution' now (run into it since), not the run "
+        "of 'brown_table1' that returned these Results"
+    )
