@@ -28,11 +28,14 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.api_args import arguments as _arguments
+from sim.api_args import count as _count
+from sim.api_args import flag
 from sim.api_paths import absolute_path as _absolute
+from sim.api_paths import another_run, cell_chunks, chunks_recorded, why_not_a_dir, why_unread
 from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
-from sim.api_paths import why_not_a_dir, why_unread
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
+from sim.api_state import check_files as _check_files
 from sim.api_tables import check_owner as _check_owner
 from sim.api_tables import owner as _owner
 from sim.api_tables import run_tables, stale_warning
@@ -114,17 +117,14 @@ class Results:
             why = link_problem(self.path) or why_not_a_dir(self.path, bool(self.run_sha256))
             raise ConfigError("path", f"{self.path} {why}")
         if self.run_sha256 and _run_identity(self.path) not in ("", self.run_sha256):
-            raise ConfigError(  # its tables read silently as this run's (another seed's)
-                "path",
-                f"{self.path} holds another run than the one that returned these Results "
-                f"(run again into it since): read it with sim.Results(path, {self.study!r})",
-            )
+            # its tables read silently as this run's (another seed's)
+            raise ConfigError("path", another_run(self.path, self.study))
 
     def _within(self) -> str:
         """``; <path>/<study> is its results directory: ...`` where ``path`` is a results root
         (``sim.Results("results", "network")``, for ``results/network``), else ""."""
         inner = self.path / self.study
-        if not any(inner.glob("*.parquet")):
+        if not os.path.isdir(inner) or not any(inner.glob("*.parquet")):  # glob: ENAMETOOLONG
             return ""
         return f"; {inner} holds the study's results: give that path"
 
@@ -150,7 +150,7 @@ class Results:
                 f"{self.path} holds tables of {' and '.join(whose) or 'no study sim ran'}, "
                 f"not of {self.study!r}{self._within()}",
             )
-        if (self.path / "trials").is_dir():
+        if (self.path / "trials").is_dir() and chunks_recorded(self.path):  # else unread
             names |= {"chunks", "trials"}
         return sorted(names)
 
@@ -163,16 +163,17 @@ class Results:
         self._check_dir()
         dataset = self._dataset(name)
         p = self.path / ("trials" if dataset else f"{name}.parquet")
-        if not p.exists() and not self.names():  # not "no table 'claims'; it has " (none)
+        there = os.path.exists(p)  # a name too long for a file is none (pathlib's raised)
+        if not there and not self.names():  # not "no table 'claims'; it has " (none)
             raise ConfigError(
                 "path", f"{self.path} is not a results directory (no tables){self._within()}"
             )
-        if not p.exists():
+        if not there:
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
             )
         if dataset and (bad := damaged_chunks(self.path)):
-            raise ConfigError("table", f"{name}: {bad}")
+            raise ConfigError("table", f"{name}: {cell_chunks(self.path) or bad}")
         if not dataset and not p.is_file():  # pyarrow reads a directory as a dataset
             raise ConfigError("table", f"{p} is not a file; run the study again")
         try:
@@ -238,7 +239,9 @@ class StudyHandle:
     def replace(self, **overrides) -> "StudyHandle":
         """A new handle with more overrides."""
         _unchanged(self)
-        return load(self.path, **{**self.overrides, **_keyed(overrides)})
+        new = load(self.path, **{**self.overrides, **_keyed(overrides)})
+        _check_files(self, new)  # a network.gama_xml edited since: refused, as run() does
+        return new
 
     @_arguments
     def run(
@@ -260,8 +263,9 @@ class StudyHandle:
         every executor and worker count. ``figures=False``: no PNG is drawn (``sim run
         --no-figures``), the tables are the same."""
         _check_path("out", out, none_ok=True)  # trials, seed: validated as the config keys
+        workers = _count("workers", workers)  # np.array(2), Decimal("2"): 2, as trials reads
         overwrite, quiet, figures = (
-            _flag(*a) for a in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures))
+            flag(*a) for a in (("overwrite", overwrite), ("quiet", quiet), ("figures", figures))
         )
         _unchanged(self)
         given = {k: v for k, v in (("trials", trials), ("seed", seed)) if v is not HANDLES}
@@ -270,6 +274,7 @@ class StudyHandle:
                 none[0], "is None, which no study file holds: leave it out for the handle's value"
             )
         h = load(self.path, **{**self.overrides, **given}) if given else self
+        _check_files(self, h)  # a network.gama_xml edited since: refused, as run() does
         base = None  # the temporary directory made for this run (out=None)
         if out is None:
             try:  # the caller's tempfile.tempdir (or TMPDIR) may be gone, a file, or full
@@ -376,14 +381,6 @@ def _sha256(path: Path) -> str:
         return ""
     except OSError as e:
         raise ConfigError("study_file", f"{path} cannot be read ({why_unread(e)})") from None
-
-
-def _flag(name: str, v: Any) -> bool:
-    """A flag of ``run()``: a bool, or a NumPy bool (``np.True_``, from a mask), as a config
-    key takes it (it was refused as "must be True or False (got np.True_)")."""
-    if not isinstance(b := as_config_value(name, v), bool):
-        raise ConfigError(name, f"must be True or False (got {v!r})")
-    return b
 
 
 def _unpickled(study: Any, state: dict) -> StudyHandle:

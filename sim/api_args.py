@@ -7,12 +7,15 @@ from __future__ import annotations
 
 import functools
 import inspect
+from typing import Any
 
 import numpy as np
 
+from sim.long_words import clipped
 from sim.mc.config import ConfigError
+from sim.mc.pyvalue import as_config_value
 
-__all__ = ["arguments", "one_line"]
+__all__ = ["arguments", "count", "flag", "one_line"]
 
 
 def _key(k: str) -> str:
@@ -87,18 +90,65 @@ def arguments(fn):
     @functools.wraps(fn)
     def checked(*args, **kwargs):
         try:
-            sig.bind(*args, **kwargs)
+            bound = sig.bind(*args, **kwargs)
         except TypeError:
             raise refusal(args, kwargs) from None
         try:  # under NumPy's default error handling, whatever the caller set (a notebook's
             with np.errstate(**NUMPY_DEFAULTS):  # np.seterr(all="raise") made an underflow
                 return fn(*args, **kwargs)  # the suite ignores a FloatingPointError)
         except ConfigError as e:
-            if len(str(e).splitlines()) < 2:
+            if len(str(e).splitlines()) < 2 and clipped(str(e)) == str(e):
                 raise
             raise one_line(e) from None
+        except Exception as e:
+            if (unshown := _unshown(bound, e)) is not None:
+                raise unshown from None
+            raise
 
     return checked
+
+
+def _unshown(bound: inspect.BoundArguments, e: Exception) -> ConfigError | None:
+    """The refusal of an argument whose ``repr`` raises ``e`` (an object of the caller's
+    whose ``__repr__`` is broken), or None: the line that refuses a value quotes it, and the
+    object's own exception passed through the API as a traceback, naming nothing."""
+    P = inspect.Parameter
+    named: list[tuple[str, object]] = []
+    for name, v in bound.arguments.items():
+        kind = bound.signature.parameters[name].kind
+        if name == "self":
+            continue
+        named += list(v.items()) if kind == P.VAR_KEYWORD else [(name, v)]
+    for name, v in named:
+        try:
+            repr(v)
+        except Exception as r:  # the same failure as the one that ended the call
+            if type(r) is type(e) and str(r) == str(e):
+                return ConfigError(
+                    _key(name),
+                    f"cannot be quoted in a message: repr() of its {type(v).__name__} raised "
+                    f"{type(r).__name__} (give a plain value: a number, a str or a list)",
+                )
+    return None
+
+
+def count(name: str, v: Any) -> Any:
+    """``v`` (a count such as ``run(workers=...)``) read as a config key's number is
+    (:func:`sim.mc.pyvalue.as_config_value`: ``np.array(2)``, ``Decimal("2")``, ``Fraction(2)``
+    are 2; it was "must be an integer (got array(2))" where ``trials=np.array(2)`` is 2); a
+    value that reading refuses is left as it is, to the caller's own check of ``name``."""
+    try:
+        return as_config_value(name, v)
+    except ConfigError:
+        return v
+
+
+def flag(name: str, v: Any) -> bool:
+    """A flag of ``run()``: a bool, or a NumPy bool (``np.True_``, from a mask), as a config
+    key takes it (it was refused as "must be True or False (got np.True_)")."""
+    if not isinstance(b := as_config_value(name, v), bool):
+        raise ConfigError(name, f"must be True or False (got {v!r})")
+    return b
 
 
 def one_line(e: ConfigError) -> ConfigError:
@@ -106,5 +156,5 @@ def one_line(e: ConfigError) -> ConfigError:
     object of a library whose repr spans lines, ``got Bad(\n...)``) spanned as many."""
     flat = ConfigError(e.key, "")
     flat.__dict__.update(e.__dict__)
-    flat.args = (" ".join(t.strip() for t in str(e).splitlines() if t.strip()),)
+    flat.args = (clipped(" ".join(t.strip() for t in str(e).splitlines() if t.strip())),)
     return flat

@@ -21,7 +21,16 @@ from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
 from sim.mc.storage import RECORD, config_hash, read_record, regular_text
 
-__all__ = ["check_path", "absolute_path", "why_not_a_dir", "why_unread"]
+__all__ = [
+    "another_run",
+    "check_path",
+    "absolute_path",
+    "cell_chunks",
+    "chunks_recorded",
+    "too_long",
+    "why_not_a_dir",
+    "why_unread",
+]
 
 
 def check_path(name: str, v: Any, none_ok: bool = False) -> None:
@@ -32,8 +41,14 @@ def check_path(name: str, v: Any, none_ok: bool = False) -> None:
         text = os.fspath(v) if isinstance(v, os.PathLike) else v
     except TypeError:
         text = None
+    except Exception as e:  # a broken os.PathLike of the caller's: its ValueError passed
+        raise ConfigError(  # through the API as a traceback of the caller's own object
+            name, f"is not a path: os.fspath() of its {type(v).__name__} raised {_said(e)}"
+        ) from None
     if not isinstance(text, str) or not text.isprintable() or not text.strip():
         raise ConfigError(name, f"must be a path (a str or os.PathLike of a str), got {v!r}")
+    if (why := too_long(text)) is not None:
+        raise ConfigError(name, why)
     if os.path.lexists(text):
         return
     if text.startswith("~"):
@@ -48,6 +63,33 @@ def check_path(name: str, v: Any, none_ok: bool = False) -> None:
             f"{text} names an environment variable, which Python does not expand: give "
             f"os.path.expandvars({text!r})",
         )
+
+
+def _said(e: Exception) -> str:
+    """``ValueError: boom``: an exception of the caller's code in one line."""
+    text = " ".join(str(e).split())
+    return f"{type(e).__name__}: {text[:120]}" if text else type(e).__name__
+
+
+def too_long(text: str) -> str | None:
+    """Why the system cannot take the path ``text`` (a name in it over the file system's
+    limit, or the whole over the system's: ENAMETOOLONG), in one line that shows the path cut
+    short, or None. pathlib's ``exists``, ``is_dir`` and ``glob`` raise it where they read
+    "absent" for a name that is not there: ``sim.load("a" * 5000)``, ``run(out=...)`` and
+    ``sim.Results(path, ...)`` ended in pathlib's OSError with a traceback."""
+    try:
+        os.lstat(text)
+    except OSError as e:
+        if e.errno == errno.ENAMETOOLONG:
+            longest = max(len(part.encode("utf-8", "surrogateescape")) for part in text.split("/"))
+            shown = text if len(text) <= 80 else f"{text[:40]}...{text[-20:]}"
+            return (
+                f"{shown} is too long a path for the system ({e.strerror}: {len(text)} "
+                f"characters, its longest name {longest} bytes): give a shorter one"
+            )
+    except ValueError:  # an embedded NUL: refused as no path by the callers
+        pass
+    return None
 
 
 def absolute_path(name: str, v: str | os.PathLike) -> Path:
@@ -95,3 +137,44 @@ def why_not_a_dir(path: Path, of_a_run: bool) -> str:
     if os.path.lexists(path):
         return "is not a results directory"
     return "no longer exists (removed since the run)" if of_a_run else "does not exist"
+
+
+def chunks_recorded(d: Path) -> bool:
+    """Whether the run record of ``d`` maps its chunk files to their sha256, the only chunks
+    ``Results.table("chunks")`` reads: a sweep's cell has no record of its own (its sweep's
+    records none of its chunks), and ``names()`` listed ``chunks`` and ``trials`` there, each
+    of which ``table()`` refused."""
+    rec = read_record(d)
+    return isinstance(rec, dict) and isinstance(rec.get("chunk_sha256"), dict)
+
+
+def cell_chunks(d: Path) -> str | None:
+    """Why the chunks of ``d``, a cell of a sweep (``<sweep>/cells/<label>/``), are not read,
+    or None when ``d`` is no such cell (it was "run.json is missing or not a run record", of
+    a directory that never had one)."""
+    sweep = d.parent.parent
+    if d.parent.name != "cells" or not (sweep / "sweep.parquet").is_file():
+        return None
+    return (
+        f"{d} is a cell of the sweep {sweep}, whose run.json records no sha256 of the cells' "
+        "chunk files: they cannot be checked, and are not read (the cell's tables are)"
+    )
+
+
+def another_run(out: Path, study: str) -> str:
+    """Why the Results of a run of ``study`` into ``out`` no longer read it: another run went
+    there since. Its advice, ``sim.Results(path, study)``, was given of another study's run
+    too, where it is refused in turn ("holds tables of 'brown_dilution'"): that run's study is
+    named instead."""
+    rec = read_record(out)
+    cfg = rec.get("config") if isinstance(rec, dict) else None
+    other = cfg.get("study") if isinstance(cfg, dict) else None
+    if isinstance(other, str) and other != study:
+        return (
+            f"{out} holds a run of {other!r} now (run into it since), not the run of "
+            f"{study!r} that returned these Results"
+        )
+    return (
+        f"{out} holds another run than the one that returned these Results "
+        f"(run again into it since): read it with sim.Results(path, {study!r})"
+    )

@@ -32,10 +32,23 @@ from typing import Any
 from sim.api_tmp import KEPT, MARK
 from sim.mc.config import ConfigError
 
-__all__ = ["state_sha256", "check_state", "check_cwd", "working_dir", "anonymous_dir"]
+__all__ = [
+    "state_sha256",
+    "check_state",
+    "check_cwd",
+    "check_files",
+    "working_dir",
+    "anonymous_dir",
+]
 
 #: the config keys whose relative path is read from the working directory
 _FROM_CWD = ("network.gama_xml",)
+#: a config key a study fills on load with the sha256 of a file it reads, and the file's key
+_DIGESTS = {
+    "network.gama_sha256": "network.gama_xml",
+    "table1.sha256": "table1.file",
+    "table3.sha256": "table3.file",
+}
 
 
 def state_sha256(config: dict, overrides: dict, sweep: dict) -> str:
@@ -79,6 +92,22 @@ def check_cwd(h: Any) -> None:
                 key,
                 f"{v} is read from the working directory, {h.cwd} at sim.load() and "
                 f"{now or 'gone'} now: os.chdir back, or give {key} as an absolute path",
+            )
+
+
+def check_files(h: Any, new: Any) -> None:
+    """``new``, the handle ``h.replace(...)`` or ``h.run(trials=..., seed=...)`` loaded again,
+    read the files ``h`` read as they were at :func:`sim.load`: a ``network.gama_xml`` (or
+    Wolf's ``table1.file``) edited since was refused by ``h.run()`` but read anew by the
+    others, one handle running two networks. A file key the new overrides change is a new
+    file, read as such."""
+    for digest, key in _DIGESTS.items():
+        was, now = h.config.get(digest), new.config.get(digest)
+        if was and now and was != now and h.config.get(key) == new.config.get(key):
+            raise ConfigError(
+                digest,
+                f"{new.config[key]} has changed since sim.load() (sha256 {now[:12]}..., "
+                f"loaded {was[:12]}...): load the study again",
             )
 
 

@@ -51,6 +51,7 @@ if __name__ == "__main__":
     refuse_bad_environment("sim.batch")  # a variable NumPy cannot load with: one line, exit 2
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 
+from sim.api_paths import too_long  # noqa: E402
 from sim.batch_checks import (  # noqa: E402
     _clashes,
     _configs_problems,
@@ -323,6 +324,10 @@ def _main(argv: list[str], phase: list[str]) -> int:
     for name, v in [("FILE", f) for f in args.files] + [("--timings", args.timings)]:
         if v is not None and name_problem(v):
             print(f"sim.batch: {name}: {name_problem(v)} (got {v!r})", file=sys.stderr)
+            return 2
+    for name, v in [("FILE", f) for f in args.files] + [("--results", args.results)]:
+        if (why := too_long(str(v))) is not None:  # pathlib's OSError traceback otherwise
+            print(f"sim.batch: {name}: {why}", file=sys.stderr)
             return 2
     files = [Path(f) for f in args.files]
     problems = [study_file_problem(f) for f in files]  # sim check's own check of a file

@@ -34,6 +34,7 @@ from sim.cli_errors import cwd_exists, from_stdout, os_reason
 from sim.cli_read import report, show
 from sim.ends import stdout_failed
 from sim.execute import check_sweep, execute, sweep_limits
+from sim.long_words import clipped
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.memory_limit import memory_given
 from sim.mc.outputs import name_problem
@@ -307,7 +308,7 @@ def _main(argv: list[str]) -> int:
         check_interrupt()  # an interrupt Python dropped (a C callback) never ends in exit 0
         return code
     except (ConfigError, StudyError) as e:
-        print(f"sim: error: {e}".splitlines()[0], file=sys.stderr)
+        print(clipped(f"sim: error: {e}".splitlines()[0]), file=sys.stderr)  # 100 KB of a key
         return INTERNAL if getattr(e, "internal", False) else 2
     except KeyboardInterrupt as e:
         if getattr(e, "published", None) and args is not None:  # as the run published

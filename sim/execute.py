@@ -61,7 +61,7 @@ _SCHEDULER = re.compile(
 
 def _check_options(executor: Any, workers: Any, scheduler: Any) -> None:
     """The run options every door passes (``sim run``, the Python API): one line naming it."""
-    if executor not in ("local", "dask"):
+    if not isinstance(executor, str) or executor not in ("local", "dask"):  # never its __eq__
         raise ConfigError("executor", f"must be 'local' or 'dask' (got {executor!r})")
     top = most_workers()
     if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)):

@@ -71,6 +71,7 @@ from sim.mc.storage import StageLock, write_table
 
 ROOT = Path(__file__).resolve().parents[1]
 PLATE = str(ROOT / "studies" / "network_plate.toml")
+BROWN_NET = str(ROOT / "studies" / "network_brown.toml")
 TABLE1 = str(ROOT / "studies" / "brown_table1.toml")
 GAMA = ROOT / "tests" / "data" / "gama"
 SMALL = {"trials": 40, "chunk": 2}
@@ -222,13 +223,13 @@ def test_array_likes_are_lists_and_a_refusal_is_one_line():
         sim.load(TABLE1, plate__pattern="list", plate__points=_Rows(pts, fails=True))
     assert str(info.value) == "plate.points: must be a list (got Rows( ... ))"
     with pytest.raises(ConfigError, match=r"^workers: .* \(got Rows\( \.\.\. \)\)$"):
-        sim.load(TABLE1).run(workers=_Rows(1))
+        sim.load(TABLE1).run(workers=_Rows(1, fails=True))  # an array-like of 1 is 1 (A37)
 
 
 def test_sequences_are_lists_and_iterators_or_sets_are_named():
-    names = {"G1": 1, "G5": 2}
-    for v in (collections.deque(["G1", "G5"]), names.keys(), range(0)):
-        st = sim.load(PLATE, datum__kind="inner", datum__points=v)
+    names = {"P1": 1, "P5": 2}  # Brown's plate (the plate's weighted coordinates leave no
+    for v in (collections.deque(["P1", "P5"]), names.keys(), range(0)):  # inner datum, s37)
+        st = sim.load(BROWN_NET, datum__kind="inner", datum__points=v)
         assert st.config["datum.points"] == list(v)
     for v, words in (
         ((n for n in names), r"an iterator, read once \(generator\)"),

@@ -250,3 +250,13 @@ def test_a_full_disk_in_a_sweeps_cell_stops_the_run_resumably(tmp_path, capsys, 
     monkeypatch.setitem(mod.STUDIES, "network", real)
     assert main(cmd) == 0
     assert "resuming network: 20 finished chunks found" in capsys.readouterr().err
+
+
+def test_an_inner_datum_on_weighted_coordinates_names_them():
+    """The lead at the merge: the plate network's datum is carried by its observed (weighted)
+    coordinates, no fixed point; the refusal said "the fixed points  already fix" (no name)."""
+    plate = str(Path(__file__).resolve().parents[1] / "studies" / "network_plate.toml")
+    with pytest.raises(
+        sim.ConfigError, match=r"observed \(weighted\) coordinates of G1, G2, G3, G4, G5 \.\.\. "
+    ):
+        sim.load(plate, datum__kind="inner")

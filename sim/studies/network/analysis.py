@@ -170,11 +170,13 @@ def inner_left(net: Network, H: np.ndarray, key: str) -> None:
     nothing (P35's left item)."""
     if H.shape[1]:
         return
-    fixed = [net.names[a] for a in np.flatnonzero(net.role == 1)]
-    names = ", ".join(fixed[:5]) + (" ..." if len(fixed) > 5 else "")
+    role = 1 if (net.role == 1).any() else 2  # fixed points, else weighted coordinates
+    held = [net.names[a] for a in np.flatnonzero(net.role == role)]
+    names = ", ".join(held[:5]) + (" ..." if len(held) > 5 else "")
+    what = "fixed points" if role == 1 else "observed (weighted) coordinates of"
     raise ConfigError(
         key,
-        f'datum.kind = "inner" has nothing to constrain: the fixed points {names} already fix '
+        f'datum.kind = "inner" has nothing to constrain: the {what} {names} already fix '
         "the network's datum (no defect is left for inner constraints over datum.points, which "
         'would change nothing): use datum.kind = "fixed" (output.inner_over states the '
         "precision in an inner datum too)",

@@ -1,0 +1,24 @@
+"""A word too long for a one-line message, shown cut.
+
+A refusal quotes what it refuses: a key, a value, a path. Given a string of 100,000
+characters (``sim.load(f, plate__pattern="y" * 100_000)``, ``--set plate.pattern=yyy...``, a
+key of that length), the one line was 100 KB, the key's name and the reason lost in a
+terminal's scroll-back. :func:`clipped` cuts every run of more than :data:`LONG_WORD`
+characters without white space to its start and end, saying how long it was.
+"""
+
+from __future__ import annotations
+
+import re
+
+__all__ = ["LONG_WORD", "clipped"]
+
+#: the longest run without white space a message shows whole (a path of 200 characters is)
+LONG_WORD = 200
+_LONG = re.compile(r"\S{%d,}" % (LONG_WORD + 1))
+
+
+def clipped(text: str) -> str:
+    """``text`` with every word of more than :data:`LONG_WORD` characters cut:
+    ``'yyyy...yyyy' (100002 characters)``."""
+    return _LONG.sub(lambda m: f"{m[0][:60]}...{m[0][-20:]} ({len(m[0])} characters)", text)
