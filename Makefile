@@ -108,6 +108,8 @@ help: ## list the targets
 # the .venv, which only a finished install removes: made again from scratch too. A .venv of
 # the user's own (no mark) is installed into as it is. The mark holds venv's own output (a
 # PYTHON that is missing or cannot make one, python2.7: one line; Ctrl-C: no traceback).
+# A .venv that is a file or a link to nothing (not the suite's) was "PYTHON (python3) could not
+# make .venv: Error: [Errno 20] Not a directory", blaming PYTHON: it is named, and left alone.
 INSTALLING := $(VENV).installing
 VENV_USABLE := $(shell $(PY) -S -c 'import sys; sys.exit(sys.version_info < (3, 11))' >/dev/null 2>&1 && echo yes)
 MADE_IN := $(shell sed -n 1p $(STAMP) 2>/dev/null)
@@ -153,6 +155,8 @@ pip = @$(call locked,"$$@" >> $(PIP_LOG) 2>&1 || exit; $(3),$(2)) $(PY) -m pip i
 
 $(STAMP): $(PYPROJECT_DEP) $(if $(VENV_USABLE),,venv-unusable) $(if $(venv_lacks),venv-incomplete)
 	$(if $(venv_lacks),@printf 'make: %s: installing the project again\n' $(call q,$(venv_lacks)))
+	@test -d $(VENV) || ! { test -e $(VENV) || test -L $(VENV); } || { printf 'make: %s is %s, not a virtual environment: %s\n' \
+	  $(VENV) 'not a directory (a file, or a link to nothing)' 'remove or rename it, then make venv' >&2; exit 2; }
 	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
 	@$(call locked,"$$@" > $(INSTALLING) 2>&1,skip) $(call q,$(PYTHON)) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) || { rc=$$?; \
 	  test $$rc -gt 128 && exit $$rc; printf 'make: PYTHON (%s) could not make $(VENV): %s\n' $(call q,$(PYTHON)) \

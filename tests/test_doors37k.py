@@ -19,12 +19,14 @@ they build no virtual environment, run no study and touch no network.
   (:mod:`sim.venv_check`): one line naming what is missing, the next ``make venv`` starting
   from scratch; and a ``.venv`` whose libraries changed after its stamp is checked before any
   target and installed into again.
+* a ``.venv`` that is a file or a link to nothing (not the suite's): ``make venv`` said
+  "PYTHON (python3) could not make .venv: Error: [Errno 20] Not a directory", blaming
+  ``PYTHON``, and for a link ``python -m venv`` made the missing target's directory outside
+  the project; it is named in one line, and nothing is made or removed.
 
 Held (found right): ``make -n`` of every target runs nothing; ``make -C`` from another
 directory; ``RUN_FLAGS`` with quotes, ``;``, ``$(...)`` and an open quote (one line);
-``--out`` in ``BENCH_FLAGS``; ``PYTHON`` missing, with a space or not a Python (one line);
-``.venv`` a file or a dangling link (made again); results of older commits (``sim show``,
-``sim report``, ``--stale-only``).
+``--out`` in ``BENCH_FLAGS``; ``PYTHON`` missing or not a Python (one line).
 """
 
 from __future__ import annotations
@@ -172,3 +174,22 @@ def cksum(path: Path) -> str:
     """The checksum the Makefile's stamp records for ``path`` (``cksum < FILE | tr ' ' -``)."""
     out = subprocess.run(["cksum"], stdin=path.open("rb"), capture_output=True, check=True)
     return out.stdout.decode().strip().replace(" ", "-")
+
+
+@pytest.mark.parametrize("shape", ["file", "dangling link"])
+def test_a_venv_that_is_a_file_or_a_dangling_link_is_named_and_left_alone(tmp_path, shape):
+    d = venv_project(tmp_path, ["numpy"])
+    shutil.rmtree(d / ".venv")
+    if shape == "file":
+        (d / ".venv").write_text("mine\n", encoding="utf-8")
+    else:  # python -m venv made the missing target's directory (outside the project)
+        (d / ".venv").symlink_to(tmp_path / "gone" / "venv")
+    p = run_make(d, "venv")
+    err = p.stderr.splitlines()
+    assert p.returncode == 2 and len(err) == 2, p.stderr
+    assert err[0] == (
+        "make: .venv is not a directory (a file, or a link to nothing), not a virtual "
+        "environment: remove or rename it, then make venv"
+    ), err
+    assert not (tmp_path / "calls.log").exists() and not (tmp_path / "gone").exists()
+    assert (d / ".venv").is_symlink() or (d / ".venv").read_text(encoding="utf-8") == "mine\n"
