@@ -23,10 +23,17 @@ they build no virtual environment, run no study and touch no network.
   "PYTHON (python3) could not make .venv: Error: [Errno 20] Not a directory", blaming
   ``PYTHON``, and for a link ``python -m venv`` made the missing target's directory outside
   the project; it is named in one line, and nothing is made or removed.
+* ``sim show``, ``sim report`` and a run's README.md over results of an older version of the
+  suite (``git archive 00dbae17 results``: a run record made before ``plate.layout_seed``
+  existed) named the key the record lacks with a blank value, "`plate.layout_seed` =  (the
+  file: 1)", as if the run had set it empty: it is "not in its record"
+  (:func:`sim.report.config_diff.changes_text`).
 
 Held (found right): ``make -n`` of every target runs nothing; ``make -C`` from another
 directory; ``RUN_FLAGS`` with quotes, ``;``, ``$(...)`` and an open quote (one line);
-``--out`` in ``BENCH_FLAGS``; ``PYTHON`` missing or not a Python (one line).
+``--out`` in ``BENCH_FLAGS``; ``PYTHON`` missing or not a Python (one line); results of older
+commits without ``table_shape`` or ``overrides`` (``sim show`` and ``sim report`` with their note
+that another version made them; an older claims table without ``verdict``: one line, re-run).
 """
 
 from __future__ import annotations
@@ -193,3 +200,15 @@ def test_a_venv_that_is_a_file_or_a_dangling_link_is_named_and_left_alone(tmp_pa
     ), err
     assert not (tmp_path / "calls.log").exists() and not (tmp_path / "gone").exists()
     assert (d / ".venv").is_symlink() or (d / ".venv").read_text(encoding="utf-8") == "mine\n"
+
+
+def test_a_key_the_run_record_of_an_older_version_lacks_is_said_to_be_missing():
+    from sim.report.config_diff import changes_text
+
+    older = {"study": "brown", "plate.random_half_extent_mm": 110.0}  # before layout_seed
+    today = {"study": "brown", "plate.random_half_extent_mm": 100.0, "plate.layout_seed": 1}
+    assert changes_text(older, today) == (
+        "`plate.layout_seed` not in its record (the file: 1), "
+        "`plate.random_half_extent_mm` = 110.0 (the file: 100.0)"
+    )
+    assert changes_text(today, older).startswith("`plate.layout_seed` = 1 (not in the file), ")
