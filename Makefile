@@ -36,10 +36,30 @@ $(call not_read_any,PY python,PYTHON=python3.X chooses the Python of the virtual
 # the settings spelt without their underscore or with a hyphen, in either case (`make verify
 # VERIFYFLAGS="--study NAME"` re-ran every study, `make test TESTWORKERS=0` ran 2 processes)
 lower = $(subst Z,z,$(subst Y,y,$(subst X,x,$(subst W,w,$(subst V,v,$(subst U,u,$(subst T,t,$(subst S,s,$(subst R,r,$(subst Q,q,$(subst P,p,$(subst O,o,$(subst N,n,$(subst M,m,$(subst L,l,$(subst K,k,$(subst J,j,$(subst I,i,$(subst H,h,$(subst G,g,$(subst F,f,$(subst E,e,$(subst D,d,$(subst C,c,$(subst B,b,$(subst A,a,$(1)))))))))))))))))))))))))))
+# a comma inside a $(call ...) argument ($(call) splits its arguments at commas)
+comma := ,
 SETTINGS := PYTHON RUN_FLAGS RUN_JOBS TEST_WORKERS MUTATION_WORKERS VERIFY_FLAGS BENCH_FLAGS \
   BENCH_OUT FUZZ_CASES FUZZ_SEED FUZZ_SAVE
 misspelt = $(filter-out $(1),$(sort $(subst _,,$(1)) $(subst _,-,$(1)) $(call lower,$(subst _,,$(1)) $(subst _,-,$(1)))))
 $(foreach s_,$(SETTINGS),$(call not_read_any,$(call misspelt,$(s_)),$(s_)="..." is the spelling))
+# The Makefile's own names given on make's command line replaced its paths and rules without a
+# word: `make clean VENV=results` removed the committed results/ (`rm -rf results ...`),
+# `make test STAMP=x` or `make reproduce STUDIES=...` ran on misread names. One line, exit 2
+# (each is checked by its origin here, before any of them is used).
+OWN_NAMES := VENV STAMP INSTALLING PIP_LOG VENV_LOCK VENV_USABLE MADE_IN MADE_FROM PYPROJECT_SUM \
+  PYPROJECT_DEP INSTALLED_NOW INSTALLED_AT_START STUDY_FILES STUDIES SETTINGS OWN_NAMES newline comma \
+  q whole shellwords locked pip lower misspelt not_read not_read_any venv_lacks VENV_CHECK
+$(foreach v_,$(OWN_NAMES),$(if $(filter command line,$(origin $(v_))),$(error make: $(v_) is \
+  this Makefile's own name and not a setting (the settings: $(SETTINGS)); leave it off)))
+# A line break in a setting (RUN_FLAGS=$$'--seed 3\n--trials 40', from a script or a pasted
+# line) split the recipe's command into two: "/bin/sh: 1: Syntax error: Unterminated quoted
+# string", naming no variable. One line naming it, exit 2.
+define newline
+
+
+endef
+$(foreach s_,$(SETTINGS),$(if $(findstring $(newline),$(value $(s_))),$(error make: $(s_) \
+  holds a line break: give its value on one line)))
 
 PYTHON ?= python3
 VENV   := .venv
@@ -54,6 +74,7 @@ unexport PYTHONDONTWRITEBYTECODE
 
 .DEFAULT_GOAL := help
 .PHONY: help venv test reproduce rerun verify report bench clean fuzz mutation venv-unusable pyproject-changed
+.PHONY: venv-incomplete
 
 # $(call q,TEXT): TEXT as one single-quoted shell word (a value with spaces or quotes stays one)
 q = '$(subst ','\'',$(1))'
@@ -87,6 +108,8 @@ help: ## list the targets
 # the .venv, which only a finished install removes: made again from scratch too. A .venv of
 # the user's own (no mark) is installed into as it is. The mark holds venv's own output (a
 # PYTHON that is missing or cannot make one, python2.7: one line; Ctrl-C: no traceback).
+# A .venv that is a file or a link to nothing (not the suite's) was "PYTHON (python3) could not
+# make .venv: Error: [Errno 20] Not a directory", blaming PYTHON: it is named, and left alone.
 INSTALLING := $(VENV).installing
 VENV_USABLE := $(shell $(PY) -S -c 'import sys; sys.exit(sys.version_info < (3, 11))' >/dev/null 2>&1 && echo yes)
 MADE_IN := $(shell sed -n 1p $(STAMP) 2>/dev/null)
@@ -96,12 +119,18 @@ PYPROJECT_SUM := $(shell cksum < pyproject.toml | tr ' ' -)
 PYPROJECT_DEP := $(if $(MADE_FROM),$(if $(filter $(PYPROJECT_SUM),$(MADE_FROM)),,pyproject-changed),pyproject.toml)
 VENV_USABLE := $(and $(VENV_USABLE),$(if $(MADE_IN),$(if $(subst $(CURDIR),,$(MADE_IN)),,yes),yes))
 VENV_USABLE := $(and $(VENV_USABLE),$(if $(wildcard $(INSTALLING)),,yes))
+# A .venv installed (its stamp current) that no longer holds what pyproject.toml asks for (a
+# library removed or replaced since: `pip uninstall pyarrow`) was taken for whole: every target
+# failed in it (pytest's collection errors, "No such file or directory: .venv/bin/ruff") and
+# `make venv` did nothing. sim/venv_check.py names what it lacks (decided when site-packages
+# changed after the stamp: pip touches it), and the project is installed into it again.
+VENV_CHECK := $(if $(wildcard sim/venv_check.py),$(PY) -I sim/venv_check.py)
+venv_lacks := $(if $(and $(VENV_CHECK),$(VENV_USABLE),$(MADE_FROM),$(shell find $(VENV)/lib \
+  -maxdepth 2 -name site-packages -newer $(STAMP) 2>/dev/null)),$(shell $(VENV_CHECK) 2>&1))
 # pip (its arguments: at its definition below): its output kept in PIP_LOG; a failure (no network,
 # no index, a Python the project does not support) is one line with pip's first error (else its
 # last line: a pip that does not start), exit 2 (not pip's dozen lines); `make venv` tries again
 PIP_LOG := $(VENV)/pip.log
-# a comma inside a $(call pip,...) argument ($(call) splits its arguments at commas)
-comma := ,
 # Each install step holds the lock VENV_LOCK (where flock(1) exists): a pip still rolling back
 # after a Ctrl-C, or a second `make venv` at once, is waited for instead of racing the next
 # step ("venv --clear: Directory not empty", or a pip left without its modules). The lock file
@@ -124,14 +153,17 @@ locked = $(VENV_LOCK) sh -c $(call q,$(if $(and $(2),$(if $(INSTALLED_AT_START),
 pip = @$(call locked,"$$@" >> $(PIP_LOG) 2>&1 || exit; $(3),$(2)) $(PY) -m pip install --quiet $(1) || { printf 'make: pip could not install into $(VENV): %s (all of its output: $(PIP_LOG))\n' \
 	"$$({ grep -m1 -E '^ *ERROR' $(PIP_LOG) || grep -v '^ *$$' $(PIP_LOG) | tail -1; } | sed -E 's/^ *(ERROR: *)?//')" >&2; exit 2; }
 
-$(STAMP): $(PYPROJECT_DEP) $(if $(VENV_USABLE),,venv-unusable)
+$(STAMP): $(PYPROJECT_DEP) $(if $(VENV_USABLE),,venv-unusable) $(if $(venv_lacks),venv-incomplete)
+	$(if $(venv_lacks),@printf 'make: %s: installing the project again\n' $(call q,$(venv_lacks)))
+	@test -d $(VENV) || ! { test -e $(VENV) || test -L $(VENV); } || { printf 'make: %s is %s, not a virtual environment: %s\n' \
+	  $(VENV) 'not a directory (a file, or a link to nothing)' 'remove or rename it, then make venv' >&2; exit 2; }
 	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
 	@$(call locked,"$$@" > $(INSTALLING) 2>&1,skip) $(call q,$(PYTHON)) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) || { rc=$$?; \
 	  test $$rc -gt 128 && exit $$rc; printf 'make: PYTHON (%s) could not make $(VENV): %s\n' $(call q,$(PYTHON)) \
 	  "$$(grep -v '^ *$$' $(INSTALLING) | tail -1)" >&2; exit 2; }
 	@test -e $(INSTALLING) || exit 0; : > $(PIP_LOG)
 	$(call pip,--upgrade pip,skip)
-	$(call pip,-e ".[dev]",skip,printf '%s\n%s\n' $(call q,$(CURDIR)) $(PYPROJECT_SUM) > $(STAMP) && rm -f $(INSTALLING))
+	$(call pip,-e ".[dev]",skip,$(if $(VENV_CHECK),$(VENV_CHECK) --after-pip >> $(PIP_LOG) &&) printf '%s\n%s\n' $(call q,$(CURDIR)) $(PYPROJECT_SUM) > $(STAMP) && rm -f $(INSTALLING))
 
 venv: $(STAMP) ## create the virtual environment and install the project (with PYTHON=python3, 3.11 or later)
 

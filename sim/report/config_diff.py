@@ -29,12 +29,20 @@ def changed_keys(mine: Mapping[str, Any], base: Mapping[str, Any]) -> list[str]:
     return [k for k in keys if shows_differently(mine.get(k), base.get(k))]
 
 
+def _change(k: str, mine: Mapping[str, Any], base: Mapping[str, Any]) -> str:
+    """One changed key: a key one side lacks is said to be missing there (a run of an older
+    version, before the key existed, read "`plate.layout_seed` =  (the file: 1)": a blank)."""
+    if k not in mine:
+        return f"`{k}` not in its record (the file: {as_set(base.get(k))})"
+    if k not in base:
+        return f"`{k}` = {as_set(mine.get(k))} (not in the file)"
+    return f"`{k}` = {as_set(mine.get(k))} (the file: {as_set(base.get(k))})"
+
+
 def changes_text(mine: Mapping[str, Any], base: Mapping[str, Any], limit: int = 6) -> str:
     """``"`k` = v (the file: w), ..., and N more"``: the first ``limit`` changed keys."""
     diff = changed_keys(mine, base)
-    what = ", ".join(
-        f"`{k}` = {as_set(mine.get(k))} (the file: {as_set(base.get(k))})" for k in diff[:limit]
-    )
+    what = ", ".join(_change(k, mine, base) for k in diff[:limit])
     return what + (f", and {len(diff) - limit} more" if len(diff) > limit else "")
 
 
