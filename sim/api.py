@@ -33,13 +33,12 @@ from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
 from sim.api_paths import why_not_a_dir, why_unread
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
-from sim.api_tmp import temp_dir
+from sim.api_tmp import check_env, temp_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
 from sim.mc.overrides import recorded
 from sim.mc.paths import link_problem
-from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.pyvalue import as_config_value
 from sim.mc.storage import read_provenance
@@ -419,7 +418,7 @@ def _check_owner(p: Path, study: str) -> None:
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
-    check_environment()  # TQDM_NCOLS=abc: refused here, not in the middle of a run
+    check_env()  # TQDM_NCOLS=abc, NUMBA_OPT=x: refused here, not in the middle of a run
     if why := study_file_problem(study_file):  # sim check's own check of a file
         raise ConfigError("study_file", why)
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the

@@ -22,7 +22,7 @@ from sim.cli_args import parser as run_parser
 from sim.cli_errors import cwd_exists
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
-from sim.mc.estimate import check_limits, estimate
+from sim.mc.estimate import estimate
 from sim.mc.message_text import key_text
 from sim.mc.outputs import check_out
 from sim.mc.overrides import command_values, listed, recorded
@@ -33,6 +33,7 @@ from sim.mc.sweep import read_sweep
 from sim.mc.table_edits import edited_tables
 from sim.places import base
 from sim.report.read import mixed_table
+from sim.room import check_room
 from sim.studies import get_study
 
 __all__ = ["is_current", "why_stale"]
@@ -145,7 +146,7 @@ def _configs_problems(
             check_chunks(cfg)
             sweep = read_sweep(f, study.schema)
             est = estimate(cfg, sweep)  # the limits its run applies (sim check's too)
-            check_limits(est, args.max_memory_gb, args.max_adjustments, args.workers)
+            check_room(est, args.max_memory_gb, args.max_adjustments, args.workers)
             out = results / f.stem  # each run is --overwrite: the record is not compared
             record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
             check_out(absolute(out), str(out), record, True)  # (as sim run: check_run_args)

@@ -35,7 +35,7 @@ from sim.cli_read import report, show
 from sim.ends import stdout_failed
 from sim.execute import check_sweep, execute
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
-from sim.mc.estimate import check_limits, estimate
+from sim.mc.estimate import estimate
 from sim.mc.memory_limit import memory_given
 from sim.mc.outputs import name_problem
 from sim.mc.overrides import command_values, listed, recorded
@@ -46,6 +46,7 @@ from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
 from sim.places import base, default_out, shown_path
 from sim.report.run_summary import off_setup, terminal_summary, write_run_readme
+from sim.room import check_room
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
 from sim.studies import design_config, get_study, unread_keys
 from sim.studies.picking import load_picking_chunk
@@ -200,7 +201,7 @@ def _check(args) -> int:
     check_chunks(cfg)  # what sim run refuses, sim check refuses too
     sweep = read_sweep(args.study, study.schema)
     est = estimate(cfg, sweep)
-    check_limits(est, args.max_memory_gb, args.max_adjustments)  # sim run's, at one worker
+    check_room(est, args.max_memory_gb, args.max_adjustments)  # sim run's, at one worker
     check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
     print(f"# {cfg['study']}: {study.title}")
     # listed commented out (set, they would be refused); one a sweep's cells read is kept

@@ -26,7 +26,7 @@ import numpy as np
 from sim.held_stops import held_stops
 from sim.mc.argv import most_workers
 from sim.mc.config import ConfigError, StudyError, check_chunks
-from sim.mc.estimate import check_limits, chunk_note, estimate
+from sim.mc.estimate import chunk_note, estimate
 from sim.mc.executors import StartRefused, script_words
 from sim.mc.left_behind import clear_replaced
 from sim.mc.outputs import _chunks, _differs, _same, check_out, drop_stage, prepare_stage, stage_dir
@@ -45,6 +45,7 @@ from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, refused_cel
 from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
+from sim.room import check_room
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
@@ -142,8 +143,7 @@ def drop_half_imported(before: Collection[str]) -> list[str]:
     process was restarted. A module left behind is one whose parent package is no longer in
     ``sys.modules``; the next import loads them afresh. A module of the caller's that was
     there before the command (a stub put in ``sys.modules`` by hand, a test's mock) is left
-    alone, whatever its name. (Here, not in :mod:`sim.stops`: that module is part of every
-    study's code hash.)"""
+    alone, whatever its name (here, not in :mod:`sim.stops`, part of every study's code hash)."""
     mods = sys.modules
     gone = [
         n
@@ -210,7 +210,7 @@ def execute(
     _check_options(executor, workers, scheduler)
     check_chunks(cfg)
     est = estimate(cfg, sweep)
-    check_limits(est, max_memory_gb, max_adjustments, workers)
+    check_room(est, max_memory_gb, max_adjustments, workers)  # and ulimit -v's room
     check_sweep(study, cfg, sweep, quiet)
     if not quiet and (note := chunk_note(est, cfg["chunk"])):
         print(f"sim: {note}", file=sys.stderr)
