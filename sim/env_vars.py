@@ -1,24 +1,47 @@
 """Variables of the environment that the suite and numba read, checked when a command starts
 (:func:`refuse_bad_variables`) and by ``sim.load`` (:func:`sim.api_tmp.check_env`), so that a
 value they cannot read is one line naming it, not a traceback in the middle of a run nor a
-run on a path the user did not ask for. Outside the studies' code (and its hash).
+run on a path the user did not ask for; and the limit of data a command starts under
+(``ulimit -d``, :data:`MIN_DATA_KB`). Outside the studies' code (and its hash).
 """
 
 from __future__ import annotations
 
 import os
 import re
+import resource
 import sys
 
 from sim.threads import single_threaded_blas
 
-__all__ = ["numba_variables_problem", "refuse_bad_variables", "sim_variables_problem"]
+__all__ = [
+    "MIN_DATA_KB",
+    "numba_variables_problem",
+    "refuse_bad_variables",
+    "sim_variables_problem",
+]
+
+#: the data (kB: ``ulimit -d``, ``RLIMIT_DATA``) below which no command starts, as
+#: :data:`sim.threads.MIN_ADDRESS_SPACE_KB` for ``ulimit -v``: under about 150 MB every command
+#: hung while it loaded SciPy (OpenBLAS retrying its buffers' allocation: no line, no end),
+#: about 200 MB failed in llvmlite's library, and a run of brown_table1 at 40 trials failed on a
+#: 10 MiB array under 450 MB ("MemoryError ... reduce trials, chunk or the sizes")
+MIN_DATA_KB = 1024 * 1024
 
 
 def refuse_bad_variables(prog: str) -> None:
     """Exit 2 with one line naming a variable :func:`sim_variables_problem` or
-    :func:`numba_variables_problem` finds wrong. Called by the entry points after
-    :func:`sim.threads.refuse_bad_environment`."""
+    :func:`numba_variables_problem` finds wrong, or a limit of data under :data:`MIN_DATA_KB`.
+    Called by the entry points after :func:`sim.threads.refuse_bad_environment`, before they
+    load SciPy."""
+    cap = resource.getrlimit(resource.RLIMIT_DATA)[0]
+    if cap != resource.RLIM_INFINITY and cap // 1024 < MIN_DATA_KB:
+        sys.stderr.write(
+            f"{prog}: error: not enough memory: ulimit -d is {cap // 1024} kB, and the suite "
+            f"needs at least {MIN_DATA_KB} kB of data (its libraries' buffers and a run's "
+            "arrays)\n"
+        )
+        sys.exit(2)
     if (problem := sim_variables_problem() or numba_variables_problem()) is not None:
         sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)

@@ -13,11 +13,16 @@ case per class found; each failed on the code before its fix.
   kernels off without a word: a run on the slow Python path, its numbers other in the last
   digits, recorded as ``SIM_NO_JIT=0``. The variable is now 1, or empty or unset; anything else
   is one line naming it (:func:`sim.env_vars.sim_variables_problem`).
-* a run whose memory estimate is over what ``ulimit -v`` leaves the process (brown_table1 on a
-  100 x 100 plate, 0.9 GiB, under ``ulimit -v 1400000``) computed every chunk (30 s here, hours
-  for a large run), then failed on "MemoryError: Unable to allocate 183. MiB", naming no limit;
-  ``sim check`` passed it. Both now refuse it before any work, naming ``ulimit -v``, the
-  estimate and the room left (:func:`sim.room.check_room`).
+* a run whose memory estimate is over what ``ulimit -v`` (or ``ulimit -d``) leaves the process
+  (brown_table1 on a 100 x 100 plate, 0.9 GiB, under ``ulimit -v 1400000``) computed every
+  chunk (30 s here, hours for a large run), then failed on "MemoryError: Unable to allocate
+  183. MiB", naming no limit; ``sim check`` passed it. Both now refuse it before any work,
+  naming the limit, the estimate and the room left (:func:`sim.room.check_room`).
+* a small limit of data (``ulimit -d``, which the 1 GiB floor of ``ulimit -v`` did not look
+  at): under about 150 MB every command hung for good while it loaded SciPy (OpenBLAS
+  retrying its allocations); at 450 MB a 40-trial run failed on a 10 MiB array, advising to
+  "reduce trials, chunk or the sizes". Every entry point now refuses to start under 1 GiB of
+  data, one line naming ``ulimit -d`` (:data:`sim.env_vars.MIN_DATA_KB`).
 * an output encoding that cannot show the suite's own en dash (``PYTHONIOENCODING=ascii``, or
   ``LC_ALL=C`` with ``PYTHONUTF8=0``): ``sim run`` computed and published its results, then
   ended with exit 2 on its closing summary's first interval ("the output (encoding ascii) cannot
@@ -58,7 +63,7 @@ ROOT = Path(__file__).resolve().parents[1]
 TABLE1 = str(ROOT / "studies" / "brown_table1.toml")
 
 
-def _sim(*argv: str, env: dict | None = None, preexec=None) -> subprocess.CompletedProcess:
+def _sim(*argv: str, env: dict | None = None, preexec=None, timeout=120):
     """``python -m sim ARGV`` in the project's root with ``env`` added to the environment."""
     return subprocess.run(
         [sys.executable, "-m", "sim", *argv],
@@ -66,7 +71,7 @@ def _sim(*argv: str, env: dict | None = None, preexec=None) -> subprocess.Comple
         env={**os.environ, **(env or {})},
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=timeout,
         preexec_fn=preexec,
     )
 
@@ -83,6 +88,8 @@ def test_a_numba_variable_numba_cannot_read_is_one_line_naming_it(var, value, wo
     proc = _sim("check", TABLE1, env={var: value})
     line = one_line_of(proc, f"sim: error: {var}: ", words)
     assert proc.stdout == "", line
+    if var != "NUMBA_OPT":
+        return  # sim.load's check is the same function: once is enough
     api = subprocess.run(
         [sys.executable, "-c", f"import sim; sim.load({TABLE1!r})"],
         env={**os.environ, var: value},
@@ -106,24 +113,32 @@ def test_sim_no_jit_other_than_1_or_empty_is_refused(value, monkeypatch):
         sim.load(TABLE1, trials=40)
 
 
-def test_a_run_over_the_room_ulimit_v_leaves_is_refused_before_it_starts():
-    limit = 1200 * 1024 * 1024  # bytes: above the suite's 1 GiB floor, under the estimate's need
-    if resource.getrlimit(resource.RLIMIT_AS)[1] not in (resource.RLIM_INFINITY,) and (
-        resource.getrlimit(resource.RLIMIT_AS)[1] < limit
-    ):
-        pytest.skip("the hard address-space limit is lower than the test's")
+def _limited(limit: int, kb: int):
+    """A ``preexec_fn`` setting the soft ``limit`` to ``kb`` kB (skipped under a lower hard one)."""
+    hard = resource.getrlimit(limit)[1]
+    if hard != resource.RLIM_INFINITY and hard < kb * 1024:
+        pytest.skip("the hard limit is lower than the test's")
+    return lambda: resource.setrlimit(limit, (kb * 1024, hard))
+
+
+@pytest.mark.parametrize(
+    "limit, words", [(resource.RLIMIT_AS, "ulimit -v"), (resource.RLIMIT_DATA, "ulimit -d")]
+)
+def test_a_run_over_the_room_a_limit_leaves_is_refused_before_it_starts(limit, words):
     big = ["--set", "plate.grid=120", "--set", "plate.spacing_mm=1"]
     big += ["--set", "trials=2000", "--set", "chunk=10"]  # about 1.46 GiB
-    proc = _sim(
-        "check",
-        TABLE1,
-        *big,
-        preexec=lambda: resource.setrlimit(
-            resource.RLIMIT_AS, (limit, resource.getrlimit(resource.RLIMIT_AS)[1])
-        ),
+    proc = _sim("check", TABLE1, *big, preexec=_limited(limit, 1200 * 1024))  # over the floor
+    one_line_of(
+        proc, "the run needs about 1.46 GiB", f"{words} (1228800 kB) leaves", f"raise {words}"
     )
-    one_line_of(proc, "the run needs about 1.46 GiB", "ulimit -v (1228800 kB) leaves")
-    assert _sim("check", TABLE1, *big).returncode == 0  # without the limit: as before
+    if limit == resource.RLIMIT_AS:  # without a limit: as before
+        assert _sim("check", TABLE1, *big).returncode == 0
+
+
+def test_a_command_under_a_small_data_limit_does_not_start():
+    """``ulimit -d 100000``: every command hung while loading SciPy (no line, no end)."""
+    proc = _sim("check", TABLE1, preexec=_limited(resource.RLIMIT_DATA, 100_000), timeout=60)
+    one_line_of(proc, "not enough memory: ulimit -d is 100000 kB", "at least 1048576 kB")
 
 
 def test_an_ascii_output_shows_the_suites_dash_as_ascii():
