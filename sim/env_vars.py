@@ -61,6 +61,11 @@ def sim_variables_problem() -> str | None:
     )
 
 
+#: numba's variables it reads as text, which it cannot fail to read: set alone (a container's
+#: cache directory), numba is not loaded for them (half a second of every command)
+_TEXT = frozenset({"NUMBA_CACHE_DIR"})
+
+
 def numba_variables_problem() -> str | None:
     """What is wrong with the ``NUMBA_<option>`` variables, or None. numba reads them when it
     is imported (by the kernels' first call, in the middle of a run): a value it cannot parse
@@ -71,7 +76,7 @@ def numba_variables_problem() -> str | None:
     is set and numba is not loaded yet (once loaded, it has read them); without numba installed
     the variables mean nothing. The words name the variable, without the program."""
     given = sorted(k for k in os.environ if k.startswith("NUMBA_"))
-    if not given or "numba" in sys.modules:
+    if not set(given) - _TEXT or "numba" in sys.modules:
         return None
     import warnings
 
