@@ -1,7 +1,8 @@
 """``python -m sim`` and the ``sim`` command: BLAS single-threaded, matplotlib's notes about
 an unwritable config directory kept quiet, then the command line."""
 
-from sim.ends import open_standard_streams
+from sim.ends import ascii_punctuation, open_standard_streams
+from sim.env_vars import refuse_bad_variables
 from sim.threads import (
     interrupt_while_loading,
     refuse_bad_environment,
@@ -10,6 +11,7 @@ from sim.threads import (
 )
 
 open_standard_streams()  # 2>&-: before any file takes its descriptor
+ascii_punctuation()  # PYTHONIOENCODING=ascii: an interval's dash as '-'
 loaded = interrupt_while_loading("sim")  # Ctrl-C during the imports: one line, exit 130
 
 import logging  # noqa: E402 - after the guard: Ctrl-C in this import was a traceback
@@ -17,6 +19,7 @@ import sys  # noqa: E402
 
 refuse_bad_environment("sim")  # a variable NumPy cannot load with: one line, exit 2
 single_threaded_blas()  # before NumPy loads (sim.cli imports it)
+refuse_bad_variables("sim")  # SIM_NO_JIT=0, NUMBA_OPT=fast: one line, exit 2
 
 
 class _CacheDirNotes(logging.Filter):

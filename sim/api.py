@@ -39,13 +39,12 @@ from sim.api_state import check_files as _check_files
 from sim.api_tables import check_owner as _check_owner
 from sim.api_tables import owner as _owner
 from sim.api_tables import run_tables, stale_warning
-from sim.api_tmp import temp_dir
+from sim.api_tmp import check_env, temp_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
 from sim.mc.overrides import as_read, recorded
 from sim.mc.paths import link_problem
-from sim.mc.progress import check_environment
 from sim.mc.publish import damaged_chunks
 from sim.mc.pyvalue import as_config_value
 from sim.mc.study_file import study_file_problem
@@ -405,7 +404,7 @@ def _unchanged(h: StudyHandle) -> None:
 def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
-    check_environment()  # TQDM_NCOLS=abc: refused here, not in the middle of a run
+    check_env()  # TQDM_NCOLS=abc, NUMBA_OPT=x: refused here, not in the middle of a run
     if why := study_file_problem(study_file):  # sim check's own check of a file
         raise ConfigError("study_file", why)
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the

@@ -15,7 +15,8 @@ them). Directories of other names (an older suite's, the user's) are never looke
 
 A ``TMPDIR`` whose path the suite cannot record (a line break or another control character,
 bytes that are not UTF-8) is refused before the run, naming it: the run computed every chunk,
-then ``Results`` refused its own directory ("path: must be a path ...").
+then ``Results`` refused its own directory ("path: must be a path ..."). The other
+variables of the environment a run reads are checked by :func:`check_env`.
 """
 
 from __future__ import annotations
@@ -27,13 +28,15 @@ import stat
 import tempfile
 from pathlib import Path
 
+from sim.env_vars import numba_variables_problem, sim_variables_problem
 from sim.mc.config import ConfigError
 from sim.mc.dead_dirs import lock_held
 from sim.mc.outputs import name_problem
 from sim.mc.pids import pid_alive
+from sim.mc.progress import check_environment as _check_tqdm
 from sim.mc.storage import RECORD
 
-__all__ = ["KEPT", "MARK", "temp_dir"]
+__all__ = ["KEPT", "MARK", "check_env", "temp_dir"]
 
 #: the marker of a temporary directory whose finished chunks a failed run named to the caller
 KEPT = ".sim-kept"
@@ -95,3 +98,13 @@ def temp_dir(study: str) -> Path:
         shutil.rmtree(d, ignore_errors=True)
         raise
     return d
+
+
+def check_env() -> None:
+    """Raise :class:`ConfigError` naming a variable of the environment the suite, tqdm or numba
+    cannot read (``TQDM_NCOLS=abc``, ``SIM_NO_JIT=0``, ``NUMBA_OPT=fast``), as the commands
+    refuse it when they start (:func:`sim.threads.refuse_bad_environment`): ``sim.load``
+    refuses it, not the middle of a run."""
+    _check_tqdm()
+    if (problem := sim_variables_problem() or numba_variables_problem()) is not None:
+        raise ConfigError(None, problem)

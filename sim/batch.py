@@ -40,6 +40,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from sim.env_vars import refuse_bad_variables
 from sim.threads import interrupt_while_loading, refuse_bad_environment, single_threaded_blas
 
 if __name__ == "__main__":  # 2>&-: before any file takes its descriptor (sim.ends)
@@ -50,6 +51,8 @@ _loaded = interrupt_while_loading("sim.batch")  # Ctrl-C during the imports: one
 if __name__ == "__main__":
     refuse_bad_environment("sim.batch")  # a variable NumPy cannot load with: one line, exit 2
 single_threaded_blas()  # before NumPy loads (the study modules import it)
+if __name__ == "__main__":
+    refuse_bad_variables("sim.batch")  # SIM_NO_JIT=0, NUMBA_OPT=fast: one line, exit 2
 
 from sim.api_paths import too_long  # noqa: E402
 from sim.batch_checks import (  # noqa: E402

@@ -14,11 +14,22 @@ only the programs' entry points use it.
 
 from __future__ import annotations
 
+import codecs
 import io
 import os
 import sys
 
-__all__ = ["finish", "flush_stdout", "stdout_failed", "stdout_unwritten", "open_standard_streams"]
+__all__ = [
+    "ascii_punctuation",
+    "finish",
+    "flush_stdout",
+    "stdout_failed",
+    "stdout_unwritten",
+    "open_standard_streams",
+]
+
+#: the suite's own characters in what it prints (an interval's "0.00–1.00"), and their ASCII
+ASCII_FOR = {"\u2013": "-"}
 
 #: a failed write to standard output that its writer could not raise (see stdout_unwritten)
 _unwritten: list[OSError] = []
@@ -144,3 +155,52 @@ class _Stderr(io.TextIOWrapper):
             super().flush()  # what the failed write left in the buffer: into the null device
         except (OSError, ValueError):
             pass
+
+
+def ascii_punctuation() -> None:
+    """Standard output whose encoding cannot show the suite's own characters
+    (:data:`ASCII_FOR`: ``PYTHONIOENCODING=ascii``, or ``LC_ALL=C`` with ``PYTHONUTF8=0``)
+    writes them in ASCII. ``sim run`` computed every trial and published its results, then
+    ended with exit 2 on its closing summary's first interval ("the output (encoding ascii)
+    cannot show '\\u2013'"), and ``sim show`` of any results failed so. A name of the user's
+    that the encoding cannot show (a network's ``café``) is still refused by the command, in
+    one line, as before; other characters go to the stream's own error handler."""
+    out = sys.stdout
+    try:
+        "".join(ASCII_FOR).encode(out.encoding)
+        return
+    except UnicodeEncodeError:
+        pass
+    except (AttributeError, LookupError, TypeError):  # no stdout (>&-), a stream of the caller's
+        return
+    own = getattr(out, "errors", None) or "strict"
+    name = f"sim-ascii-{own}"
+    try:
+        codecs.lookup_error(name)
+    except LookupError:
+        codecs.register_error(name, _ascii_or(own))
+    try:
+        out.reconfigure(errors=name)
+    except (AttributeError, ValueError, OSError):
+        pass
+
+
+def _ascii_or(own: str):
+    """A codec error handler: a character of :data:`ASCII_FOR` as its ASCII, the characters
+    up to the next such one as the stream's own handler ``own`` takes them."""
+
+    def handler(e: UnicodeError):
+        if not isinstance(e, UnicodeEncodeError):
+            raise e
+        if (c := e.object[e.start]) in ASCII_FOR:
+            return ASCII_FOR[c], e.start + 1
+        end = e.start + 1
+        while end < e.end and e.object[end] not in ASCII_FOR:
+            end += 1
+        if own == "strict":
+            raise UnicodeEncodeError(e.encoding, e.object, e.start, end, e.reason)
+        return codecs.lookup_error(own)(
+            UnicodeEncodeError(e.encoding, e.object, e.start, end, e.reason)
+        )
+
+    return handler

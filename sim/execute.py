@@ -143,8 +143,7 @@ def drop_half_imported(before: Collection[str]) -> list[str]:
     process was restarted. A module left behind is one whose parent package is no longer in
     ``sys.modules``; the next import loads them afresh. A module of the caller's that was
     there before the command (a stub put in ``sys.modules`` by hand, a test's mock) is left
-    alone, whatever its name. (Here, not in :mod:`sim.stops`: that module is part of every
-    study's code hash.)"""
+    alone, whatever its name (here, not in :mod:`sim.stops`, part of every study's code hash)."""
     mods = sys.modules
     gone = [
         n

@@ -10,8 +10,9 @@ from concurrent.futures import BrokenExecutor
 from typing import Any, Mapping
 
 from sim.mc.config import ConfigError
-from sim.mc.estimate import check_limits, estimate
+from sim.mc.estimate import estimate
 from sim.mc.sweep import refused_cells, refused_note
+from sim.room import check_room
 from sim.threads import interrupted, shadowed
 
 __all__ = ["sweep_limits", "check_sweep", "not_the_cells"]
@@ -33,13 +34,13 @@ def sweep_limits(
     (:func:`sim.mc.sweep.refused_cells`)."""
     est = estimate(cfg, sweep)
     try:
-        check_limits(est, max_memory_gb, max_adjustments, workers)
+        check_room(est, max_memory_gb, max_adjustments, workers)  # and ulimit -v's room
     except ConfigError:
         bad = refused_cells(study, cfg, sweep)[0] if sweep else None
         if not bad:
             raise
         est = estimate(cfg, sweep, skip=bad)
-        check_limits(est, max_memory_gb, max_adjustments, workers)
+        check_room(est, max_memory_gb, max_adjustments, workers)
     return est
 
 

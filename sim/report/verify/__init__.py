@@ -40,6 +40,7 @@ there (a directory with its ``run.json``); anything else is refused, never delet
 
 import sys
 
+from sim.env_vars import refuse_bad_variables
 from sim.threads import interrupt_while_loading, refuse_bad_environment
 
 # python -m sim.report.verify imports this package first (sys.argv[0] is "-m" meanwhile):
@@ -49,6 +50,7 @@ _as_main = list(getattr(sys, "argv", None) or [])[:1] == ["-m"]
 _loaded = interrupt_while_loading("sim verify") if _as_main else (lambda: None)
 if _as_main:
     refuse_bad_environment("sim verify")  # a variable NumPy cannot load with: one line, exit 2
+    refuse_bad_variables("sim verify")  # SIM_NO_JIT=0, NUMBA_OPT=fast: one line, exit 2
 
 from sim.report.verify.cli import main  # noqa: E402
 from sim.report.verify.record import markdown, write_record  # noqa: E402

@@ -1,0 +1,106 @@
+"""Variables of the environment that the suite and numba read, checked when a command starts
+(:func:`refuse_bad_variables`) and by ``sim.load`` (:func:`sim.api_tmp.check_env`), so that a
+value they cannot read is one line naming it, not a traceback in the middle of a run nor a
+run on a path the user did not ask for; and the limit of data a command starts under
+(``ulimit -d``, :data:`MIN_DATA_KB`). Outside the studies' code (and its hash).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import resource
+import sys
+
+from sim.threads import single_threaded_blas
+
+__all__ = [
+    "MIN_DATA_KB",
+    "numba_variables_problem",
+    "refuse_bad_variables",
+    "sim_variables_problem",
+]
+
+#: the data (kB: ``ulimit -d``, ``RLIMIT_DATA``) below which no command starts, as
+#: :data:`sim.threads.MIN_ADDRESS_SPACE_KB` for ``ulimit -v``: under about 150 MB every command
+#: hung while it loaded SciPy (OpenBLAS retrying its buffers' allocation: no line, no end),
+#: about 200 MB failed in llvmlite's library, and a run of brown_table1 at 40 trials failed on a
+#: 10 MiB array under 450 MB ("MemoryError ... reduce trials, chunk or the sizes")
+MIN_DATA_KB = 1024 * 1024
+
+
+def refuse_bad_variables(prog: str) -> None:
+    """Exit 2 with one line naming a variable :func:`sim_variables_problem` or
+    :func:`numba_variables_problem` finds wrong, or a limit of data under :data:`MIN_DATA_KB`.
+    Called by the entry points after :func:`sim.threads.refuse_bad_environment`, before they
+    load SciPy."""
+    cap = resource.getrlimit(resource.RLIMIT_DATA)[0]
+    if cap != resource.RLIM_INFINITY and cap // 1024 < MIN_DATA_KB:
+        sys.stderr.write(
+            f"{prog}: error: not enough memory: ulimit -d is {cap // 1024} kB, and the suite "
+            f"needs at least {MIN_DATA_KB} kB of data (its libraries' buffers and a run's "
+            "arrays)\n"
+        )
+        sys.exit(2)
+    if (problem := sim_variables_problem() or numba_variables_problem()) is not None:
+        sys.stderr.write(f"{prog}: error: {problem}\n")
+        sys.exit(2)
+
+
+def sim_variables_problem() -> str | None:
+    """What is wrong with ``SIM_NO_JIT``, or None. Any value but an empty one turned the
+    compiled kernels off (:func:`sim.lsq.compile.available`), ``SIM_NO_JIT=0`` too (numba's
+    own ``NUMBA_DISABLE_JIT=0`` leaves them on): such a run took the slow Python path, whose
+    results differ in the last digits, without a word. The variable is 1, or empty or unset."""
+    v = os.environ.get("SIM_NO_JIT")
+    if v is None or v in ("", "1"):
+        return None
+    return (
+        f"SIM_NO_JIT: must be 1 (the kernels run as Python) or empty or unset (the compiled "
+        f"kernels), got {v[:40]!r}"
+    )
+
+
+#: numba's variables it reads as text, which it cannot fail to read: set alone (a container's
+#: cache directory), numba is not loaded for them (half a second of every command)
+_TEXT = frozenset({"NUMBA_CACHE_DIR"})
+
+
+def numba_variables_problem() -> str | None:
+    """What is wrong with the ``NUMBA_<option>`` variables, or None. numba reads them when it
+    is imported (by the kernels' first call, in the middle of a run): a value it cannot parse
+    (``NUMBA_OPT=fast``, ``NUMBA_DISABLE_JIT=abc``) was a warning of some ten lines carrying a
+    traceback, after which the run went on with numba's default, exit 0; ``NUMBA_NUM_THREADS=0``
+    failed the run at its first chunk ("ValueError: Number of threads specified must be > 0.",
+    naming no variable). So numba is imported here, its warnings recorded, when such a variable
+    is set and numba is not loaded yet (once loaded, it has read them); without numba installed
+    the variables mean nothing. The words name the variable, without the program."""
+    given = sorted(k for k in os.environ if k.startswith("NUMBA_"))
+    if not set(given) - _TEXT or "numba" in sys.modules:
+        return None
+    import warnings
+
+    single_threaded_blas()  # numba loads NumPy, and BLAS reads its thread variables then
+    try:
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            import numba  # noqa: F401 - its import reads the variables
+    except ImportError:  # no numba (the NumPy paths run), or shadowed: said where it is used
+        return None
+    except Exception as e:  # NUMBA_NUM_THREADS=0: ValueError while numba loads
+        last = (str(e).strip().splitlines() or [type(e).__name__])[-1][:200]
+        return f"{', '.join(given)}: numba cannot load with {_it(given)} ({last})"
+    for w in seen:
+        text = str(w.message)
+        m = re.match(r"Environment variable '([^']*)' is defined but its associated value", text)
+        if m is None:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+            continue
+        why = [ln.strip() for ln in text.strip().splitlines() if ln.strip()][-1][:200]
+        value = os.environ.get(m.group(1), "")
+        return f"{m.group(1)}: numba cannot read its value {value[:40]!r} ({why})"
+    return None
+
+
+def _it(names: list) -> str:
+    return "it" if len(names) == 1 else "them"
