@@ -12,11 +12,25 @@ import numpy as np
 
 from sim.mc.config import ConfigError
 
-__all__ = ["arguments", "one_line"]
+__all__ = ["arguments", "dotted", "keyed", "one_line"]
 
 
-def _key(k: str) -> str:
+def dotted(k: str) -> str:
+    """A keyword argument's name as the config key it stands for (``__`` is the dot)."""
     return k.replace("__", ".")
+
+
+def keyed(overrides: dict) -> dict:
+    """``overrides`` by their dotted keys; a key given twice (``**{"datum.kind": ...}`` beside
+    ``datum__kind=...``) is refused, as ``--set`` twice is: one value would be dropped."""
+    out: dict = {}
+    seen: dict = {}
+    for k, v in overrides.items():
+        d = dotted(k) if isinstance(k, str) else k
+        if d in out:
+            raise ConfigError(d, f"given twice ({seen[d]!r} and {k!r}): one value would be dropped")
+        out[d], seen[d] = v, k
+    return out
 
 
 #: where a user gets the object a method is called on
@@ -59,8 +73,8 @@ def arguments(fn):
             if (known is not None and k not in known) or (method and k == "self"):
                 cfg = getattr(args[0], "config", None) if method and args else None
                 hint = (
-                    f"; {_key(k)} is a config key: give it to sim.load() or replace()"
-                    if isinstance(cfg, dict) and _key(k) in cfg
+                    f"; {dotted(k)} is a config key: give it to sim.load() or replace()"
+                    if isinstance(cfg, dict) and dotted(k) in cfg
                     else ""
                 )
                 return ConfigError(k, f"{what} takes no argument {k!r} (it takes {takes}){hint}")
