@@ -29,7 +29,9 @@ import pyarrow.parquet as pq
 
 from sim.api_args import arguments as _arguments
 from sim.api_args import count as _count
+from sim.api_args import dotted as _key
 from sim.api_args import flag
+from sim.api_args import keyed as _keyed
 from sim.api_paths import absolute_path as _absolute
 from sim.api_paths import another_run, cell_chunks, chunks_recorded, why_not_a_dir, why_unread
 from sim.api_paths import check_path as _check_path
@@ -47,6 +49,7 @@ from sim.mc.overrides import as_read, recorded
 from sim.mc.paths import link_problem
 from sim.mc.publish import damaged_chunks
 from sim.mc.pyvalue import as_config_value
+from sim.mc.settle import settled
 from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
 from sim.mc.table_shape import recorded_shape, shape_problem
@@ -68,23 +71,6 @@ class _Handles:
 
 
 HANDLES = _Handles()
-
-
-def _key(k: str) -> str:
-    return k.replace("__", ".")
-
-
-def _keyed(overrides: dict) -> dict:
-    """``overrides`` by their dotted keys; a key given twice (``**{"datum.kind": ...}`` beside
-    ``datum__kind=...``) is refused, as ``--set`` twice is: one value would be dropped."""
-    out: dict = {}
-    seen: dict = {}
-    for k, v in overrides.items():
-        d = _key(k) if isinstance(k, str) else k
-        if d in out:
-            raise ConfigError(d, f"given twice ({seen[d]!r} and {k!r}): one value would be dropped")
-        out[d], seen[d] = v, k
-    return out
 
 
 @dataclass(frozen=True)
@@ -156,9 +142,13 @@ class Results:
     @_arguments
     def table(self, name: str) -> pa.Table:
         """The table ``name`` (``claims``, ``points``, ..., ``trials`` or ``chunks``) as a
-        pyarrow Table."""
+        pyarrow Table (read again when a run published the directory while it was read: a
+        table read of a run whose run.json was read before was called another run's)."""
         if not isinstance(name, str) or not name.isidentifier():
             raise ConfigError("table", f"must be a table name such as 'claims' (got {name!r})")
+        return settled(self.path, lambda: self._table(name), "path")
+
+    def _table(self, name: str) -> pa.Table:
         self._check_dir()
         dataset = self._dataset(name)
         p = self.path / ("trials" if dataset else f"{name}.parquet")

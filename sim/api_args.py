@@ -15,11 +15,25 @@ from sim.long_words import clipped
 from sim.mc.config import ConfigError
 from sim.mc.pyvalue import as_config_value
 
-__all__ = ["arguments", "count", "flag", "one_line"]
+__all__ = ["arguments", "count", "dotted", "flag", "keyed", "one_line"]
 
 
-def _key(k: str) -> str:
+def dotted(k: str) -> str:
+    """A keyword argument's name as the config key it stands for (``__`` is the dot)."""
     return k.replace("__", ".")
+
+
+def keyed(overrides: dict) -> dict:
+    """``overrides`` by their dotted keys; a key given twice (``**{"datum.kind": ...}`` beside
+    ``datum__kind=...``) is refused, as ``--set`` twice is: one value would be dropped."""
+    out: dict = {}
+    seen: dict = {}
+    for k, v in overrides.items():
+        d = dotted(k) if isinstance(k, str) else k
+        if d in out:
+            raise ConfigError(d, f"given twice ({seen[d]!r} and {k!r}): one value would be dropped")
+        out[d], seen[d] = v, k
+    return out
 
 
 #: where a user gets the object a method is called on
@@ -62,8 +76,8 @@ def arguments(fn):
             if (known is not None and k not in known) or (method and k == "self"):
                 cfg = getattr(args[0], "config", None) if method and args else None
                 hint = (
-                    f"; {_key(k)} is a config key: give it to sim.load() or replace()"
-                    if isinstance(cfg, dict) and _key(k) in cfg
+                    f"; {dotted(k)} is a config key: give it to sim.load() or replace()"
+                    if isinstance(cfg, dict) and dotted(k) in cfg
                     else ""
                 )
                 return ConfigError(k, f"{what} takes no argument {k!r} (it takes {takes}){hint}")
@@ -125,7 +139,7 @@ def _unshown(bound: inspect.BoundArguments, e: Exception) -> ConfigError | None:
         except Exception as r:  # the same failure as the one that ended the call
             if type(r) is type(e) and str(r) == str(e):
                 return ConfigError(
-                    _key(name),
+                    dotted(name),
                     f"cannot be quoted in a message: repr() of its {type(v).__name__} raised "
                     f"{type(r).__name__} (give a plain value: a number, a str or a list)",
                 )

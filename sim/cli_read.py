@@ -16,6 +16,7 @@ from sim.cli_errors import not_as_written, older_lacks
 from sim.mc.config import ConfigError
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
+from sim.mc.settle import settled
 from sim.mc.storage import umask_problem
 from sim.places import base, shown_path
 from sim.report.markdown import write_report
@@ -53,23 +54,9 @@ def show(args) -> int:
         )
         why = link_problem(d) or f"{what}{also}"
         raise ConfigError("DIR", f"{args.dir} {why}")
-    check_claims_table(d / "claims.parquet", "DIR")
-    if (sweep := _sweep_of(d)) is not None and (mixed := mixed_run(sweep)) is not None:
-        raise ConfigError("DIR", mixed)  # a cell's figure replaced by hand: its sweep's record
-    try:
-        text = (
-            run_markdown(d, get_study, design=design_config)
-            if args.markdown
-            else terminal_table(d, design=design_config, get_study=get_study)
-        )
-    except ConfigError:
-        raise
-    except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
-        raise ConfigError("DIR", not_as_written(d, e)) from None
-    except FileNotFoundError as e:
-        if (why := older_lacks(d, e)) is None:
-            raise
-        raise ConfigError("DIR", why) from None
+    # read again when a run publishes d meanwhile: one run's claims were printed under the
+    # other's configuration note (sim.mc.settle)
+    text = settled(d, lambda: _shown_text(d, args.markdown), "DIR")
     print(text, end="")
     print("" if args.markdown else "\n", end="")
     if older := other_code(d):  # verdicts of code since changed: read as current otherwise
@@ -79,6 +66,26 @@ def show(args) -> int:
             file=sys.stderr,
         )
     return 0
+
+
+def _shown_text(d: Path, markdown: bool) -> str:
+    """What ``sim show`` prints of the results directory ``d``: its claims as a table, or
+    (``markdown``) its README.md as written from its tables."""
+    check_claims_table(d / "claims.parquet", "DIR")
+    if (sweep := _sweep_of(d)) is not None and (mixed := mixed_run(sweep)) is not None:
+        raise ConfigError("DIR", mixed)  # a cell's figure replaced by hand: its sweep's record
+    try:
+        if markdown:
+            return run_markdown(d, get_study, design=design_config)
+        return terminal_table(d, design=design_config, get_study=get_study)
+    except ConfigError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
+        raise ConfigError("DIR", not_as_written(d, e)) from None
+    except FileNotFoundError as e:
+        if (why := older_lacks(d, e)) is None:
+            raise
+        raise ConfigError("DIR", why) from None
 
 
 def _sweep_of(d: Path) -> Path | None:
