@@ -83,7 +83,7 @@ def why_stale(
         have = have if isinstance(have, dict) else {}
         keys = sorted(k for k in {*want, *have} if want.get(k) != have.get(k))
         more = f" and {len(keys) - 3} more" if len(keys) > 3 else ""
-        return f"made with another config: {', '.join(keys[:3])}{more}"
+        return f"made with another config: {', '.join(map(key_text, keys[:3]))}{more}"
     if record.get("code_hash") != study_code_hash(cfg["study"]):
         return "made by other code: the code the study imports changed since"
     # a table copied in from another run (two results directories merged by hand, or one
