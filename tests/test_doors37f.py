@@ -31,6 +31,11 @@ change them. One case each, each failed on the code before its fix.
   Latin-1 or UTF-16, cut short) was refused as holding "no sim run record (run.json)": the
   user looked for a file that is there. What the file is is now named (``a run.json that is
   no sim run record (it starts with a UTF-8 signature ...)``).
+* A table whose provenance (its Parquet metadata ``sim.provenance``) was edited into bytes
+  that are not UTF-8 was refused in the codec's words (``'utf-8' codec can't decode byte 0xe9
+  in position 2232: invalid continuation byte``), into no JSON in json's alone; the metadata
+  is now named (``its metadata sim.provenance is not as sim writes it (byte 0xe9 is not
+  UTF-8)``).
 * A study file whose TOML error falls on a form feed or a vertical tab (``trials =\\f40``) was
   ``Invalid value (at line 2, column 9)``, pointing at nothing visible; the character is now
   named (``the character there is '\\x0c', U+000C FORM FEED``).
@@ -43,6 +48,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pyarrow.parquet as pq
 import pytest
 
 import sim
@@ -131,6 +137,26 @@ def test_a_run_json_key_with_an_invisible_character_is_escaped(done, tmp_path, c
     rc = main([*argv, "--trials", "40", "--chunk", "2", "--out", str(d), "--no-figures"])
     line = one_line(capsys, rc, '"plate.gr\\u200bid" = 5 (no such key in this run', "--overwrite")
     assert "\u200b" not in line
+
+
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        (lambda b: b.replace(b'"seed"', b'"s\xe9ed"'), "(byte 0xe9 is not UTF-8)"),
+        (lambda b: b.replace(b'"seed"', b'"s\x00ed"'), "(Invalid control character at: "),
+        (lambda b: b[: len(b) // 2], "(Unterminated string starting at: "),
+    ],
+)
+def test_a_damaged_provenance_is_named(done, tmp_path, capsys, edit, needle):
+    d = tmp_path / "run"
+    shutil.copytree(done, d)
+    t = pq.read_table(d / "claims.parquet")
+    meta = dict(t.schema.metadata)
+    meta[b"sim.provenance"] = edit(meta[b"sim.provenance"])
+    pq.write_table(t.replace_schema_metadata(meta), d / "claims.parquet")
+    line = one_line(capsys, main(["show", str(d)]), "claims.parquet cannot be read: its metadata")
+    assert "sim.provenance is not as sim writes it " + needle in line, line
+    assert "codec" not in line
 
 
 @pytest.mark.parametrize(
