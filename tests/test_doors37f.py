@@ -36,6 +36,10 @@ change them. One case each, each failed on the code before its fix.
   in position 2232: invalid continuation byte``), into no JSON in json's alone; the metadata
   is now named (``its metadata sim.provenance is not as sim writes it (byte 0xe9 is not
   UTF-8)``).
+* A ``REPORT.md`` or a results directory's ``README.md`` the suite wrote, saved again by an
+  editor that puts a UTF-8 signature before its mark (Windows Notepad), was taken for the
+  user's: ``sim report`` refused (``REPORT.md was not written by sim report``) and left such a
+  README.md stale without a word. The mark behind a signature is the mark.
 * A study file whose TOML error falls on a form feed or a vertical tab (``trials =\\f40``) was
   ``Invalid value (at line 2, column 9)``, pointing at nothing visible; the character is now
   named (``the character there is '\\x0c', U+000C FORM FEED``).
@@ -157,6 +161,18 @@ def test_a_damaged_provenance_is_named(done, tmp_path, capsys, edit, needle):
     line = one_line(capsys, main(["show", str(d)]), "claims.parquet cannot be read: its metadata")
     assert "sim.provenance is not as sim writes it " + needle in line, line
     assert "codec" not in line
+
+
+def test_a_report_saved_with_a_signature_is_still_the_suites(done, tmp_path, capsys):
+    top = tmp_path / "results"
+    shutil.copytree(done, top / "brown_table1")
+    assert main(["report", "--results", str(top)]) == 0
+    for f in (top / "REPORT.md", top / "brown_table1" / "README.md"):  # Notepad's save
+        f.write_bytes(b"\xef\xbb\xbf" + f.read_bytes().replace(b"\n", b"\r\n") + b"edited\r\n")
+    capsys.readouterr()
+    assert main(["report", "--results", str(top)]) == 0, capsys.readouterr().err
+    for f in (top / "REPORT.md", top / "brown_table1" / "README.md"):
+        assert f.read_bytes().startswith(b"<!-- written by ") and b"edited" not in f.read_bytes()
 
 
 @pytest.mark.parametrize(
