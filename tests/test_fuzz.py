@@ -104,18 +104,30 @@ def test_fuzz_network_keys(tmp_path, capsys):
     assert not failures, f"{len(failures)} of {4 * CASES}:\n" + "\n".join(failures)
 
 
-def _read(which: str, path):
-    """What the study reads of the file: Gama's network, or a table without its notes."""
+def _read(which: str, path, rows: int | None = None):
+    """What the study reads of the file: Gama's network, or a table without its notes (its
+    first ``rows`` rows)."""
     if which == "gama":
         return repr({k: v for k, v in read_gama(path).items() if k != "note"})
     t = getattr(tables, f"load_{which}")(path)
-    return repr({k: v.tolist() for k, v in t.items() if k != "note"})
+    return repr({k: v[:rows].tolist() for k, v in t.items() if k != "note"})
+
+
+def _shorter(which: str, f, src) -> bool:
+    """A table cut at the end of a row (or in the last number of a row without its note) is a
+    valid shorter table, which no reader can tell from one written so: its rows but the last
+    are the first rows of the table."""
+    if which == "gama":
+        return False
+    n = getattr(tables, f"load_{which}")(f)["point"].size
+    return _read(which, f, n - 1) == _read(which, src, n - 1)
 
 
 def test_fuzz_bytes_of_data_files(tmp_path, capsys):
     """BYTES of a GNU Gama XML file and of Wolf's two reading tables (tests/fuzz_bytes.py):
     ``sim check`` of the study that reads the file must read it as the same input (exit 0) or
-    refuse it in one line naming the file (exit 2)."""
+    refuse it in one line naming the file (exit 2); a table cut at the end of a row is a
+    shorter table, whose rows must be the table's first rows."""
     srcs = {
         "gama": ROOT / "tests" / "data" / "gama" / "one_fixed.xml",
         "table1": ROOT / "studies" / "data" / "wolf_table1.csv",
@@ -139,6 +151,8 @@ def test_fuzz_bytes_of_data_files(tmp_path, capsys):
         else:
             rc = main(["check", wolf, "--set", f'{which}.file="{f}"'])
         err = capsys.readouterr().err.strip()
+        if desc == "cut" and rc == 0 and _shorter(which, f, srcs[which]):
+            continue
         if rc == 0 and _read(which, f) != _read(which, srcs[which]):
             failures.append(f"case {i} ({which}: {desc}): exit 0 but read as another input")
         elif rc not in (0, 2) or (rc == 2 and ("\n" in err or str(f) not in err)):
