@@ -307,7 +307,7 @@ def _timings_problem(path: str) -> str | None:
         return f"{p} exists and is not a regular file"
     if p.exists():
         try:
-            old = json.loads(p.read_text(encoding="utf-8"))
+            old = json.loads(p.read_bytes())  # as JSON reads: a signature (Notepad's) skipped
             ours = isinstance(old, dict) and all(isinstance(v, list) for v in old.values())
         except (OSError, ValueError):
             ours = False
