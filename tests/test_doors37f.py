@@ -1,7 +1,9 @@
 """Fuzz, seeds 3701.. and the doors fuzzer's 37001126/7 and 37011126/7 (brief F37), and a new
 mutation kind, BYTES (tests/fuzz_bytes.py): the raw bytes of study files, GNU Gama XML files,
 Wolf's reading tables, ``run.json`` and Parquet metadata changed as editors and cut copies
-change them. One case each, each failed on the code before its fix.
+change them. The seeds' cases of the earlier kinds found no new class; every class below was
+found by BYTES (the fuzzer's, or the same mutations by hand on run.json, Parquet metadata and
+the reports). One case each, each failed on the code before its fix.
 
 * A row of a Wolf reading table whose plate or photo is not one of the paper's (``003`` with
   a zero-width space or a right-to-left mark in it, or any other plate) was read and left out
