@@ -83,7 +83,7 @@ def why_stale(
         have = have if isinstance(have, dict) else {}
         keys = sorted(k for k in {*want, *have} if want.get(k) != have.get(k))
         more = f" and {len(keys) - 3} more" if len(keys) > 3 else ""
-        return f"made with another config: {', '.join(keys[:3])}{more}"
+        return f"made with another config: {', '.join(map(key_text, keys[:3]))}{more}"
     if record.get("code_hash") != study_code_hash(cfg["study"]):
         return "made by other code: the code the study imports changed since"
     # a table copied in from another run (two results directories merged by hand, or one
@@ -307,7 +307,7 @@ def _timings_problem(path: str) -> str | None:
         return f"{p} exists and is not a regular file"
     if p.exists():
         try:
-            old = json.loads(p.read_text(encoding="utf-8"))
+            old = json.loads(p.read_bytes())  # as JSON reads: a signature (Notepad's) skipped
             ours = isinstance(old, dict) and all(isinstance(v, list) for v in old.values())
         except (OSError, ValueError):
             ours = False

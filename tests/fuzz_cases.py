@@ -2,7 +2,7 @@
 tiny file (tests/fuzz_values.py) with one mutation of a kind drawn by the seed: VALUE, two
 values, a ``--set``, STRUCTURE, a ``[sweep]``, an option, a key in the wrong place
 (``relocate``), TYPE, KEY spelling (tests/fuzz_keys.py), EDGE values (tests/fuzz_edges.py), SHAPE
-(tests/fuzz_shapes.py)."""
+(tests/fuzz_shapes.py), BYTES of the file (tests/fuzz_bytes.py)."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import json
 import os
 import random
 
+from fuzz_bytes import bytes_case
 from fuzz_edges import edge_case
 from fuzz_keys import respell
 from fuzz_shapes import shape_case
@@ -71,6 +72,7 @@ def make_case(i: int):
         + ["key"] * int(os.environ.get("FUZZ_KEY_WEIGHT", "2"))
         + ["edge"] * int(os.environ.get("FUZZ_EDGE_WEIGHT", "2"))
         + ["shape"] * int(os.environ.get("FUZZ_SHAPE_WEIGHT", "1"))
+        + ["bytes"] * int(os.environ.get("FUZZ_BYTES_WEIGHT", "2"))
     )
     if kind in ("value", "two"):
         keys = rng.sample(schema, 2 if kind == "two" else 1)
@@ -141,6 +143,8 @@ def make_case(i: int):
     elif kind == "shape":  # the description ends "the same document" or the table named
         text, desc = shape_case(rng, flat)
         raw = text.encode()
+    elif kind == "bytes":  # the description ends with the mutation (fuzz_bytes.SAME: runs)
+        raw, desc = bytes_case(rng, "\n".join(toml_tables(flat)) + "\n")
     elif kind == "relocate":
         raw, desc = relocate(rng, flat, schema)
     elif kind == "key":  # the last word of desc: the key the refusal must name

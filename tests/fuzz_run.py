@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from fuzz_bytes import SAME as SAME_BYTES
 from fuzz_cases import make_case
 from fuzz_shapes import SAME
 from fuzz_values import ROOT, toml_doc
@@ -158,6 +159,8 @@ def fuzz(n: int, tmp: Path) -> list[str]:
                 bad = f"the same document in another shape not run: exit {code}"
             elif not shape.endswith(SAME) and (code != 2 or shape.split()[-1] not in err):
                 bad = f"a table given twice not refused naming {shape.split()[-1]}: exit {code}"
+        if not bad and ": bytes: " in desc and desc.endswith(SAME_BYTES) and code != 0:
+            bad = f"the same document in other bytes not run: exit {code}"
         if bad:
             where = study
             if save:

@@ -18,7 +18,10 @@ tests/fuzz_edges.py; ``FUZZ_EDGE_WEIGHT`` sets its share: a value beyond the bou
 refused naming its key), its SHAPE (a table written inline, records as an array of tables:
 the same document, which must run; a table given twice, by dotted keys and a header or inline
 and then more, the study's name as a table: refused naming it; tests/fuzz_shapes.py;
-``FUZZ_SHAPE_WEIGHT``) or the command line (``--trials``, ``--seed``, ``--workers``, ``--out``,
+``FUZZ_SHAPE_WEIGHT``), its BYTES (a UTF-8 signature, CRLF or lone CR ends, a NUL, UTF-16, a
+Latin-1 byte, an invisible or look-alike character in a key or a number, a form feed for a
+space, the file cut short: tests/fuzz_bytes.py; ``FUZZ_BYTES_WEIGHT``: a signature, CRLF or
+no last line end is the same document, which must run) or the command line (``--trials``, ``--seed``, ``--workers``, ``--out``,
 ``--scheduler``). Every case runs ``sim run`` in a forked child
 (its own session, an address-space limit, a time bound) and must give exit 0 with finite
 results, or exit 2 with exactly one line on standard error and no traceback, and leave
@@ -28,7 +31,9 @@ nothing outside the output directory but, after a failed run, its staging direct
 ``FUZZ_SEED`` picks the generator's seed, ``FUZZ_TIMEOUT`` the bound per case in seconds,
 ``FUZZ_SAVE`` a directory that keeps the study file of every failing case (the failure
 message prints the command that reproduces it). The cases are made in tests/fuzz_cases.py
-from the values of tests/fuzz_values.py and run by tests/fuzz_run.py."""
+from the values of tests/fuzz_values.py and run by tests/fuzz_run.py. The BYTES of a GNU Gama
+XML file and of Wolf's reading tables are fuzzed by ``sim check`` of the study that reads
+them (``test_fuzz_bytes_of_data_files``)."""
 
 from __future__ import annotations
 
@@ -37,6 +42,7 @@ import random
 import sys
 
 import pytest
+from fuzz_bytes import csv_sites, gama_sites, mutate_bytes
 from fuzz_cases import SEED
 from fuzz_keys import network_case
 from fuzz_run import fuzz
@@ -44,6 +50,8 @@ from fuzz_values import NAMES, ROOT, base, small, toml_doc, toml_value
 
 from sim.cli import main
 from sim.studies import load_study
+from sim.studies.network.gama_read import read_gama
+from sim.studies.wolf import tables
 
 CASES = int(os.environ.get("FUZZ_CASES", "14"))
 
@@ -94,6 +102,62 @@ def test_fuzz_network_keys(tmp_path, capsys):
         if rc != 2 or "\n" in err or not any(n in err for n in needles):
             failures.append(f"case {i} ({desc}): exit {rc}: {err[-300:]}")
     assert not failures, f"{len(failures)} of {4 * CASES}:\n" + "\n".join(failures)
+
+
+def _read(which: str, path, rows: int | None = None):
+    """What the study reads of the file: Gama's network, or a table without its notes (its
+    first ``rows`` rows)."""
+    if which == "gama":
+        return repr({k: v for k, v in read_gama(path).items() if k != "note"})
+    t = getattr(tables, f"load_{which}")(path)
+    return repr({k: v[:rows].tolist() for k, v in t.items() if k != "note"})
+
+
+def _shorter(which: str, f, src) -> bool:
+    """A table cut at the end of a row (or in the last number of a row without its note) is a
+    valid shorter table, which no reader can tell from one written so: its rows but the last
+    are the first rows of the table."""
+    if which == "gama":
+        return False
+    n = getattr(tables, f"load_{which}")(f)["point"].size
+    return _read(which, f, n - 1) == _read(which, src, n - 1)
+
+
+def test_fuzz_bytes_of_data_files(tmp_path, capsys):
+    """BYTES of a GNU Gama XML file and of Wolf's two reading tables (tests/fuzz_bytes.py):
+    ``sim check`` of the study that reads the file must read it as the same input (exit 0) or
+    refuse it in one line naming the file (exit 2); a table cut at the end of a row is a
+    shorter table, whose rows must be the table's first rows."""
+    srcs = {
+        "gama": ROOT / "tests" / "data" / "gama" / "one_fixed.xml",
+        "table1": ROOT / "studies" / "data" / "wolf_table1.csv",
+        "table3": ROOT / "studies" / "data" / "wolf_table3.csv",
+    }
+    wolf = str(ROOT / "studies" / "wolf_polynomial.toml")
+    failures = []
+    for i in range(3 * CASES):
+        which = sorted(srcs)[i % 3]
+        text = srcs[which].read_text(encoding="utf-8")
+        sites = gama_sites(text) if which == "gama" else csv_sites(text)
+        data, desc = mutate_bytes(random.Random(SEED * 100_003 + 55_555 + i), text, sites)
+        f = tmp_path / f"{which}-{i}.{'xml' if which == 'gama' else 'csv'}"
+        f.write_bytes(data)
+        if which == "gama":
+            study = tmp_path / "gama.toml"
+            study.write_text(
+                f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{f}"\n'
+            )
+            rc = main(["check", str(study)])
+        else:
+            rc = main(["check", wolf, "--set", f'{which}.file="{f}"'])
+        err = capsys.readouterr().err.strip()
+        if desc == "cut" and rc == 0 and _shorter(which, f, srcs[which]):
+            continue
+        if rc == 0 and _read(which, f) != _read(which, srcs[which]):
+            failures.append(f"case {i} ({which}: {desc}): exit 0 but read as another input")
+        elif rc not in (0, 2) or (rc == 2 and ("\n" in err or str(f) not in err)):
+            failures.append(f"case {i} ({which}: {desc}): exit {rc}: {err[-300:]}")
+    assert not failures, f"{len(failures)} of {3 * CASES}:\n" + "\n".join(failures)
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz

@@ -14,7 +14,6 @@ error amplitude); the report lists them so nobody mistakes them for predictions.
 
 from __future__ import annotations
 
-import codecs
 import difflib
 import math
 import re
@@ -28,6 +27,7 @@ from sim.mc.message_text import key_text, shorten, shown
 from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.study_file import study_file_problem
+from sim.mc.text_bytes import NotText, utf8_text
 from sim.mc.toml_dates import as_written
 from sim.mc.toml_twice import twice_text
 
@@ -363,12 +363,9 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     if why := study_file_problem(p):  # the one check (the batch's too, before any run)
         raise ConfigError(None, why)
     try:
-        data = p.read_bytes()
-        if data.startswith(codecs.BOM_UTF8):  # a Windows editor's UTF-8 signature: not TOML,
-            data = data[len(codecs.BOM_UTF8) :]  # and no part of the text; it was refused
-        if b"\x00" in data:  # as malformed TOML at line 1, column 1 (doors12)
-            raise ConfigError(None, f"{p}: not UTF-8 text (it holds NUL bytes: UTF-16 or binary)")
-        doc = tomllib.loads(text := data.decode("utf-8"), parse_float=toml_float)
+        # a UTF-8 signature skipped (it was refused as malformed TOML at line 1, column 1),
+        # UTF-16 and Latin-1 named (sim.mc.text_bytes)
+        doc = tomllib.loads(text := utf8_text(p.read_bytes()), parse_float=toml_float)
         refuse_big_ints("", doc)
         return as_written(doc)  # a date or time quoted in a message as TOML wrote it
     except ConfigError:  # a ValueError: not to be read as "malformed TOML: <path>: ..." again
@@ -376,7 +373,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     except tomllib.TOMLDecodeError as e:
         at = re.search(r"at line (\d+), column (\d+)", str(e))  # before 3.14: in the text only
         n, col = (int(at.group(1)), int(at.group(2))) if at else (0, 0)
-        line = "".join(data.decode("utf-8").split("\n")[n - 1 : n] if n else [])  # as tomllib
+        line = "".join(text.split("\n")[n - 1 : n] if n else [])  # as tomllib
         curly = [c for c in line if c in TYPOGRAPHIC]  # a word processor's quotes
         hint = f' (the typographic quote {curly[0]} is no TOML quote: type ")' if curly else ""
         hint = hint or kind_hint(text) or toml_char_hint(line, col)
@@ -384,13 +381,8 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         raise ConfigError(None, f"{p}: malformed TOML: {twice or e}{hint}") from None
     except RecursionError:
         raise ConfigError(None, f"{p}: malformed TOML: nested too deeply") from None
-    except UnicodeDecodeError as e:  # where, and the likely encoding (it was "not UTF-8 text")
-        line = data[: e.start].count(b"\n") + 1
-        raise ConfigError(
-            None,
-            f"{p}: not UTF-8 text (byte 0x{data[e.start]:02x} at line {line}: saved as Latin-1 "
-            "or Windows-1252? save it as UTF-8)",
-        ) from None
+    except NotText as e:  # where, and the likely encoding (it was "not UTF-8 text" alone)
+        raise ConfigError(None, f"{p}: {e}") from None
     except ValueError as e:  # an integer of over 4300 digits (Python's int-from-text limit)
         raise ConfigError(None, f"{p}: malformed TOML: {str(e).split(';')[0]}") from None
     except OSError as e:  # another user's file (mode 0600): the API raised PermissionError
@@ -404,12 +396,13 @@ def config_changes(old: Mapping[str, Any], new: Mapping[str, Any], shown: int = 
     ``key = 40 (this run None)``, as if this run had set it to None."""
     keys = sorted(k for k in {*old, *new} if k not in old or k not in new or old[k] != new[k])
 
-    def one(k: str) -> str:
+    def one(k: str) -> str:  # a key with a character that does not print named with its
+        n = key_text(k)  # escape (a zero-width space in run.json's key was shown raw: unseen)
         if k not in new:
-            return f"{k} = {old[k]!r:.40} (no such key in this run's config)"
+            return f"{n} = {old[k]!r:.40} (no such key in this run's config)"
         if k not in old:
-            return f"{k}: not in that config (this run {new[k]!r:.40})"
-        return f"{k} = {old[k]!r:.40} (this run {new[k]!r:.40})"
+            return f"{n}: not in that config (this run {new[k]!r:.40})"
+        return f"{n} = {old[k]!r:.40} (this run {new[k]!r:.40})"
 
     return ", ".join(map(one, keys[:shown])) + (" ..." if len(keys) > shown else "")
 

@@ -27,9 +27,19 @@ _SIGNS = str.maketrans({"\u2212": "-", "\u2010": "-", "\u2011": "-", "\ufe63": "
 _WORD = re.compile(r"\w+")
 
 
+#: the control characters Unicode gives no name (a form feed was "U+000C unnamed")
+_CONTROLS = {
+    "\t": "CHARACTER TABULATION",
+    "\x0b": "LINE TABULATION",
+    "\x0c": "FORM FEED",
+    "\x1b": "ESCAPE",
+    "\x85": "NEXT LINE",
+}
+
+
 def char_name(c: str) -> str:
     """``U+0430 CYRILLIC SMALL LETTER A``."""
-    return f"U+{ord(c):04X} {unicodedata.name(c, 'unnamed')}"
+    return f"U+{ord(c):04X} {unicodedata.name(c, _CONTROLS.get(c, 'unnamed'))}"
 
 
 def skeleton(text: str) -> str:
@@ -99,10 +109,10 @@ def toml_char_hint(line: str, col: int) -> str:
     shows it: a line ended by a lone CR (classic Mac OS), or a character that is not ASCII --
     invisible (a second byte-order mark, a zero-width or no-break space) or drawn as ASCII (a
     Cyrillic letter in a key): "at line 6, column 4" of ``triаls = 5`` pointed at nothing
-    the user could see."""
+    the user could see; nor did "Invalid value" at a form feed or a vertical tab."""
     c = line[col - 1 : col]
     if c == "\r" and line[col : col + 1] != "":  # tomllib's line ends at "\n" only
         return " (a lone CR ends the line, as classic Mac OS saved text: save it with LF ends)"
-    if c and not c.isascii():
-        return f" (the character there is {c!r}, {char_name(c)})"
+    if c and (not c.isascii() or not c.isprintable()):  # a form feed or a vertical tab too:
+        return f" (the character there is {c!r}, {char_name(c)})"  # "Invalid value" named none
     return ""

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from sim.mc.config import ConfigError, config_changes
 from sim.mc.paths import is_chunk_store, link_problem, mount_point, mounts_under
+from sim.mc.record_text import record_problem
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 
 __all__ = [
@@ -156,7 +157,7 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
         if filled:
             raise ConfigError(
                 "--out",
-                f"{shown} holds files but no sim run record (run.json); "
+                f"{shown} holds files but {record_problem(out)}; "  # a damaged one named
                 "sim never replaces it, with or without --overwrite",
             )
         _check_replaceable(out, shown)

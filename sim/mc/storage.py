@@ -328,6 +328,9 @@ def read_provenance(path: str | Path) -> dict[str, Any]:
         return json.loads(meta.get(_KEY, b"{}"))
     except RecursionError:  # provenance nested too deeply: not ours, as garbage JSON is not
         raise ValueError(f"{path}: provenance nested too deeply") from None
+    except ValueError as e:  # its bytes edited: it was the codec's or json's words alone
+        why = f"byte 0x{e.object[e.start]:02x} is not UTF-8" if hasattr(e, "start") else e
+        raise ValueError(f"its metadata sim.provenance is not as sim writes it ({why})") from None
 
 
 def read_tolerances(path: str | Path) -> dict[str, dict]:

@@ -361,8 +361,8 @@ def _ours(path: Path) -> bool:
         return False
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
-            first = f.readline().rstrip("\n")
-    except OSError:
+            first = f.readline().removeprefix("\ufeff").rstrip("\n")  # an editor's signature
+    except OSError:  # (Notepad's) before the mark: it was "not written by sim report"
         return False
     return first in (MARK, "# Reproducibility report")
 

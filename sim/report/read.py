@@ -26,6 +26,7 @@ import pyarrow.parquet as pq
 from sim.claims.region import REGION_VERDICTS
 from sim.claims.rules import VERDICTS
 from sim.mc.config import ConfigError
+from sim.mc.message_text import key_text
 from sim.mc.publish import changed_figure
 from sim.mc.storage import read_provenance, read_record, read_table
 from sim.mc.table_shape import declared_problem, recorded_shape, shape_problem
@@ -263,7 +264,7 @@ def _other_run(prov: Any, record: dict) -> str | None:
         mine, theirs = (x if isinstance(x, dict) else {} for x in (mine, theirs))
         keys = sorted(k for k in {*mine, *theirs} if mine.get(k) != theirs.get(k))
         more = f" and {len(keys) - 3} more" if len(keys) > 3 else ""
-        return f"made with another config: {', '.join(map(str, keys[:3]))}{more}"
+        return f"made with another config: {', '.join(map(key_text, keys[:3]))}{more}"
     if prov["code_hash"] != record.get("code_hash"):
         code = f"{prov['code_hash']!s:.20}, run.json's {record.get('code_hash')!s:.20}"
         return f"made by other code: code hash {code}"

@@ -395,7 +395,9 @@ README_MARK = "<!-- written by sim from this directory's Parquet files; edits ar
 def _ours(path: Path) -> bool:
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
-            return f.readline().rstrip("\n") == README_MARK
+            # the mark behind an editor's UTF-8 signature (Notepad's) is the mark: such a
+            # README was the user's, never rebuilt and left stale without a word
+            return f.readline().removeprefix("\ufeff").rstrip("\n") == README_MARK
     except OSError:
         return False
 

@@ -12,16 +12,59 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 
 from sim.mc.config import ConfigError
+from sim.mc.message_text import key_text
 from sim.mc.paths import link_problem
+from sim.mc.text_bytes import NotText, utf8_text
 
 STATS = ("max", "rms", "mean")
 T1_NUM = ("x_set1_mm", "x_set2_mm", "y_set1_mm", "y_set2_mm", "x_foster_mm", "y_foster_mm")
 T3_NUM = ("x_dba_mm", "y_dba_mm", "x_pg2_mm", "y_pg2_mm", "dx_printed_mm", "dy_printed_mm")
+
+
+#: a transcription is a few kB; more is not the table (it was read cut at 2,000,000 characters)
+MAX_BYTES = 2_000_000
+#: the line ends of a CSV file: str.splitlines also split at a form feed, a vertical tab,
+#: NEL (U+0085) and U+2028, so such a character in a comment made the comment's rest the
+#: header ("missing column(s)" of every column) and one in a row split the row
+_LINE_END = re.compile(r"\r\n|\r|\n")
+
+
+def _text(p: Path, key: str) -> str:
+    """The file's UTF-8 text (a leading signature skipped, as Excel's "CSV UTF-8" writes)."""
+    try:
+        with open(p, "rb") as fh:
+            data = fh.read(MAX_BYTES + 1)
+    except OSError as e:
+        raise ConfigError(key, f"cannot read {p}: {e.strerror}") from None
+    if len(data) > MAX_BYTES:
+        raise ConfigError(key, f"{p} has over {MAX_BYTES:,} bytes: not the CSV transcription")
+    try:
+        return utf8_text(data)
+    except NotText as e:  # the byte and its line, UTF-16 named (sim.mc.text_bytes)
+        raise ConfigError(key, f"{p}: {e}: expected the CSV transcription") from None
+
+
+def _rows(p: Path, key: str, text: str) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    """The header and the data rows with their line numbers (comments and blank lines out)."""
+    kept = [
+        (n, ln)
+        for n, ln in enumerate(_LINE_END.split(text), start=1)
+        if ln.strip() and not ln.startswith("#")
+    ]
+    reader = csv.reader((ln for _, ln in kept), strict=True)
+    try:
+        table = list(reader)
+    except csv.Error as e:  # a quoted cell never closed: the file cut short in a note
+        n = kept[min(reader.line_num, len(kept)) - 1][0]
+        cut = " (a quoted cell is not closed: is the file cut short?)" * ("end of data" in str(e))
+        raise ConfigError(key, f"{p}: not a CSV table at line {n} ({e}){cut}") from None
+    return (table[0] if table else []), [(kept[i][0], r) for i, r in enumerate(table) if i]
 
 
 def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> dict:
@@ -38,24 +81,8 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
         if p.exists():  # a directory, a FIFO, a device: never opened (a FIFO would block)
             raise ConfigError(key, f"{p} is not a regular file: expected the CSV transcription")
         raise ConfigError(key, f"no such file: {p}")
-    try:
-        with open(p, newline="", encoding="utf-8-sig") as fh:  # Excel's "CSV UTF-8" signature
-            text = fh.read(2_000_000)
-    except UnicodeDecodeError:
-        raise ConfigError(
-            key, f"{p} is not a text file (not UTF-8): expected the CSV transcription"
-        ) from None
-    except OSError as e:
-        raise ConfigError(key, f"cannot read {p}: {e.strerror}") from None
-    if "\x00" in text:
-        raise ConfigError(key, f"{p} is a binary file, not the CSV transcription")
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")]
-    try:
-        rows = list(csv.DictReader(lines))
-    except csv.Error as e:
-        raise ConfigError(key, f"{p}: not a CSV table ({e})") from None
+    header, rows = _rows(p, key, _text(p, key))
     cols = (groups, "point", *numeric, "note")
-    header = set(rows[0]) if rows else set()
     missing = [c for c in cols if c not in header]
     if missing:
         raise ConfigError(
@@ -64,15 +91,28 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
             f"{', '.join(missing)} (needs {', '.join(cols)})",
         )
     out: dict[str, list] = {c: [] for c in cols}
-    for i, r in enumerate(rows, start=1):
-        if None in r:  # more cells than the header: every value after a decimal comma moved
+    for i, (line, cells) in enumerate(rows, start=1):
+        if len(cells) > len(header):  # every value after a decimal comma moved
             raise ConfigError(
                 key,
-                f"{p}: data row {i} has {len(r) - 1 + len(r[None])} cells for the header's "
-                f"{len(r) - 1} (a decimal comma? numbers take a point: 33.221)",
+                f"{p}: data row {i} has {len(cells)} cells for the header's "
+                f"{len(header)} (a decimal comma? numbers take a point: 33.221)",
+            )
+        r = dict(zip(header, cells))
+        if gone := [c for c in cols[:-1] if c not in r]:  # the note may be left out
+            raise ConfigError(  # it was "float() argument must be ... not 'NoneType'"
+                key,
+                f"{p}: data row {i} (line {line}) has {len(cells)} cells for the header's "
+                f"{len(header)}: no {gone[0]} (is the file cut short?)",
+            )
+        g = r[groups].strip()
+        if g not in need:  # a row of another plate was left out of every claim without a word
+            raise ConfigError(  # (a zero-width space in "003" too)
+                key,
+                f"{p}: data row {i} (line {line}): {groups} {key_text(g)} is not "
+                f"{' or '.join(need)}, the {groups}s of the paper's table",
             )
         try:
-            out[groups].append(str(r[groups]).strip())
             out["point"].append(int(r["point"]))
             for c in numeric:
                 v = float(r[c])
@@ -83,7 +123,8 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
             raise ConfigError(
                 key, f"{p}: data row {i} has a bad value ({e}): numbers in mm expected"
             ) from None
-        out["note"].append(r["note"] or "")
+        out[groups].append(g)
+        out["note"].append(r.get("note") or "")
     res = {k: np.array(v) for k, v in out.items()}
     for g in need:
         if np.sum(res[groups] == g) < 3:
