@@ -171,8 +171,8 @@ def _json(obj) -> bytes:
 
 
 def test_a_key_given_in_both_spellings_of_the_api_is_refused():
-    study = ROOT / "studies" / "network_testfield.toml"
-    both = {"datum.kind": "fixed", "datum__kind": "inner"}
+    study = ROOT / "studies" / "network_brown.toml"  # (an inner datum on the test field's
+    both = {"datum.kind": "constraints", "datum__kind": "inner"}  # fixed pillars: refused)
     for call in (
         lambda: sim.load(study, **both),
         lambda: sim.load(study, trials=40, chunk=2).replace(**both),
@@ -180,5 +180,7 @@ def test_a_key_given_in_both_spellings_of_the_api_is_refused():
         with pytest.raises(sim.ConfigError, match="datum.kind: given twice"):
             call()
     # one spelling replaces an earlier override, as replace() is for
-    h = sim.load(study, trials=40, chunk=2, datum__kind="fixed").replace(**{"datum.kind": "inner"})
+    h = sim.load(study, trials=40, chunk=2, datum__kind="constraints").replace(
+        **{"datum.kind": "inner"}
+    )
     assert h.config["datum.kind"] == "inner"

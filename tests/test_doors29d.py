@@ -40,7 +40,7 @@ import pyarrow.parquet as pq
 from conftest import tiny_command
 from oneline import SIM_ERROR, one_line, one_line_of
 
-import sim.cli_errors as cli_errors
+import sim.stale as stale
 from sim.cli import main
 from sim.mc.outputs import stage_dir
 from sim.mc.storage import read_provenance, read_record
@@ -133,7 +133,7 @@ def test_results_of_an_older_version_without_a_table_this_one_reads(
     rc = main(["report", "--results", str(results)])  # this version's run, removed by hand
     line = one_line(capsys, rc, "No such file or directory", "region_inputs.parquet")
     assert "another version" not in line, line
-    monkeypatch.setattr(cli_errors, "study_code_hash", lambda study: "0123456789abcdef")
+    monkeypatch.setattr(stale, "study_code_hash", lambda study: "0123456789abcdef")
     said = ("brown_dilution was made by another version", "has no region_inputs.parquet")
     rc = main(["report", "--results", str(results)])  # the code pulled since
     one_line(capsys, rc, *said, "make reproduce re-runs", prefix=SIM_ERROR)

@@ -93,7 +93,7 @@ def test_a_handle_shows_its_overrides():
     (``trials=200``, ``datum__kind="inner"``) looked alike, ``StudyHandle(path=...)``."""
     import sim
 
-    study = ROOT / "studies" / "network_plate.toml"
+    study = ROOT / "studies" / "network_brown.toml"  # (the plate's datum: refused as inner)
     plain, other = sim.load(study), sim.load(study, trials=200, datum__kind="inner")
     assert repr(plain) != repr(other)
     assert "'trials': 200" in repr(other) and "'datum.kind': 'inner'" in repr(other)

@@ -188,11 +188,14 @@ def _held(net, full: dict, dt, sparse: bool):
         # the defect the datum leaves (one fixed point: the rotation about it), not every
         # defect of the network with no point held
         H = held_defect(net, dt.free_index(net.q))
-        if not full.get("network.gama_xml"):  # (a gama-local file's datum is its own)
-            inner_left(net, H, "datum.points" if full["datum.points"] else "datum.kind")
         pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
         check_inner(net, H, pts, "datum.points")
     an = pre_analysis(net, dt, full["reliability.alpha0"], full["reliability.power"])
+    if an.ok and full["datum.kind"] == "inner" and not full.get("network.gama_xml"):
+        # after the normals: a part turning about its own fixed point, an unknown no
+        # observation reaches, is a defect the fixed points leave too (named below when
+        # singular); a gama-local file's datum is its own
+        inner_left(net, H, "datum.points" if full["datum.points"] else "datum.kind")
     if not an.ok:
         # dense too: name the point no observation reaches (docs/network.md), unless nothing
         # holds the network at all (then the rank defect and its advice say it better)
