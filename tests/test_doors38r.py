@@ -6,13 +6,28 @@ failed on the code before its fix.
   removed (``pip uninstall distributed``) was taken for whole by ``make venv`` and every target
   (each ``--executor dask`` test failed). The requirements an extra adds are checked too, one
   line naming the missing one.
+* a run over the room ``ulimit -v`` (or ``-d``) leaves (session 37's :mod:`sim.room`, which a
+  sweep's limits call too): its one line ended "make the run smaller (sim check lists its
+  sizes)", and ``sim check`` refused the same run in the same words, listing nothing. It now
+  names the keys to reduce, and a sweep's largest cell, as the memory limit's refusal does.
 """
 
 from __future__ import annotations
 
+import os
+import resource
+import subprocess
+import sys
 from importlib import metadata
+from pathlib import Path
+
+import pytest
+from oneline import one_line_of
 
 from sim import venv_check
+
+ROOT = Path(__file__).resolve().parents[1]
+TABLE1 = str(ROOT / "studies" / "brown_table1.toml")
 
 
 def _pyproject(tmp_path, dep: str):
@@ -36,3 +51,27 @@ def test_a_requirements_extra_is_checked(tmp_path, monkeypatch):
     # another extra's requirement and the name alone are not asked for
     assert venv_check.problem(_pyproject(tmp_path, "dask>=2023.1")) is None
     assert venv_check.problem(_pyproject(tmp_path, "dask[z]>=2023.1")) is None
+
+
+def _address_space(kb: int):
+    """A ``preexec_fn`` setting the soft ``ulimit -v`` to ``kb`` kB (skipped under a lower hard)."""
+    hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+    if hard != resource.RLIM_INFINITY and hard < kb * 1024:
+        pytest.skip("the hard limit is lower than the test's")
+    return lambda: resource.setrlimit(resource.RLIMIT_AS, (kb * 1024, hard))
+
+
+def test_a_run_over_the_room_of_ulimit_names_the_keys_to_reduce():
+    big = ["--set", "plate.grid=120", "--set", "plate.spacing_mm=1"]
+    big += ["--set", "trials=2000", "--set", "chunk=10"]  # about 1.46 GiB
+    proc = subprocess.run(
+        [sys.executable, "-m", "sim", "check", TABLE1, *big],
+        cwd=ROOT,
+        env=dict(os.environ),
+        capture_output=True,
+        text=True,
+        timeout=120,
+        preexec_fn=_address_space(1200 * 1024),
+    )
+    line = one_line_of(proc, "ulimit -v (1228800 kB) leaves", "raise ulimit -v, or reduce chunk")
+    assert "plate.grid" in line and "sim check" not in line, line
