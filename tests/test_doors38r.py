@@ -10,6 +10,10 @@ failed on the code before its fix.
   sweep's limits call too): its one line ended "make the run smaller (sim check lists its
   sizes)", and ``sim check`` refused the same run in the same words, listing nothing. It now
   names the keys to reduce, and a sweep's largest cell, as the memory limit's refusal does.
+* ``datum.kind = "inner"`` on a network whose datum one fixed point and a weighted one hold
+  together (the merge of ``inner_left`` with the lead's naming of weighted coordinates): the
+  refusal said "the fixed points A already fix the network's datum", which one point cannot.
+  It names both, the fixed points and the weighted coordinates.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from pathlib import Path
 import pytest
 from oneline import one_line_of
 
+import sim
 from sim import venv_check
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -75,3 +80,33 @@ def test_a_run_over_the_room_of_ulimit_names_the_keys_to_reduce():
     )
     line = one_line_of(proc, "ulimit -v (1228800 kB) leaves", "raise ulimit -v, or reduce chunk")
     assert "plate.grid" in line and "sim check" not in line, line
+
+
+MIXED = """study = "network"
+trials = 200
+chunk = 10
+seed = 1
+
+[network]
+name = "mixed"
+points = [ { name = "A", x_m = 0.0, y_m = 0.0, role = "fixed" },
+           { name = "B", x_m = 60.0, y_m = 0.0, role = "observed", sigma_mm = 0.01 },
+           { name = "C", x_m = 60.0, y_m = 40.0 }, { name = "D", x_m = 0.0, y_m = 40.0 } ]
+generate = [
+  { kind = "distance", from = "*", to = "*", sigma_mm = 0.5 },
+  { kind = "direction", from = "*", to = "*", sigma_arcsec = 1.0 },
+]
+
+[datum]
+kind = "inner"
+"""
+
+
+def test_an_inner_datum_held_by_a_fixed_and_a_weighted_point_names_both(tmp_path):
+    f = tmp_path / "mixed.toml"
+    f.write_text(MIXED, encoding="utf-8")
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(f)
+    assert e.value.key == "datum.kind"
+    words = "the fixed points A and the observed (weighted) coordinates of B already fix"
+    assert words in str(e.value), e.value
