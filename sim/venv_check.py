@@ -62,8 +62,10 @@ def _extras_lack(name: str, extras, depth: int) -> str | None:
     the name alone, ``distributed`` uninstalled was a ``.venv`` taken for whole (every
     ``--executor dask`` test failed)."""
     for text in metadata.requires(name) or [] if extras else []:
-        req = Requirement(text)
-        marker = req.marker
+        try:
+            marker = Requirement(text).marker
+        except Exception:  # a line of its METADATA that is no requirement: not ours to judge
+            continue
         if marker is None or "extra" not in str(marker):
             continue
         for e in extras:
