@@ -14,12 +14,18 @@ failed on the code before its fix.
   together (the merge of ``inner_left`` with the lead's naming of weighted coordinates): the
   refusal said "the fixed points A already fix the network's datum", which one point cannot.
   It names both, the fixed points and the weighted coordinates.
+* a directory beside the results whose ``run.json`` holds a config that is not a table
+  (``{"config": "brown_table1", ...}``): ``sim report`` wrote REPORT.md, then its note on
+  results of older code (:mod:`sim.stale`) failed, "sim: internal error: AttributeError:
+  'str' object has no attribute 'get'", exit 3. Such a record is not the suite's: skipped as
+  the report skips it.
 """
 
 from __future__ import annotations
 
 import os
 import resource
+import shutil
 import subprocess
 import sys
 from importlib import metadata
@@ -110,3 +116,13 @@ def test_an_inner_datum_held_by_a_fixed_and_a_weighted_point_names_both(tmp_path
     assert e.value.key == "datum.kind"
     words = "the fixed points A and the observed (weighted) coordinates of B already fix"
     assert words in str(e.value), e.value
+
+
+def test_a_record_whose_config_is_no_table_is_not_an_internal_error(tmp_path, capsys):
+    from sim.cli import main
+
+    shutil.copytree(ROOT / "results" / "brown_table1", tmp_path / "brown_table1")
+    (tmp_path / "junk").mkdir()
+    (tmp_path / "junk" / "run.json").write_text('{"config": "brown_table1", "code_hash": "x"}')
+    assert main(["report", "--results", str(tmp_path)]) == 0
+    assert "internal error" not in capsys.readouterr().err
