@@ -8,7 +8,9 @@ large run: hours of work first); so under a limit of data (``ulimit -d``). :func
 line naming the limit, where the estimate exceeds what the limit leaves beside what the
 process maps already (its libraries: about 700 MB). It refuses only what cannot fit: the
 libraries loaded later (numba's) and the allocator's slack are not counted. Each worker is
-a process of its own under the same limit, so one worker's share is compared.
+a process of its own under the same limit, so one worker's share is compared. The refusal
+names the keys to reduce (and a sweep's largest cell) as the memory limit's does: it sent the
+user to "sim check", which refused the same run in the same words.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import os
 import resource
 
 from sim.mc.config import ConfigError
-from sim.mc.estimate import Estimate, check_limits
+from sim.mc.estimate import Estimate, _either, check_limits
 
 __all__ = ["check_room", "mapped_bytes"]
 
@@ -52,10 +54,11 @@ def check_room(
         if cap == resource.RLIM_INFINITY or used is None or not est.bytes > cap - used:
             continue
         each = " a worker" if workers > 1 else ""
+        cell = f" (the sweep's cell of {est.cell})" if est.cell else ""
         raise ConfigError(
             None,
-            f"{est.study}: the run needs about {est.bytes / 2**30:.3g} GiB of memory{each}, "
+            f"{est.study}: the run needs about {est.bytes / 2**30:.3g} GiB of memory{each}{cell}, "
             f"and {words} ({cap // 1024} kB) leaves this process about "
             f"{max(cap - used, 0) / 2**30:.3g} GiB beside the {used / 2**30:.3g} GiB it maps "
-            f"already: raise {words}, or make the run smaller (sim check lists its sizes)",
+            f"already: raise {words}, or reduce {_either(est.memory_keys)}",
         )

@@ -25,7 +25,8 @@ def stale_dirs(d: Path, first: bool = False) -> list[str]:
     found: list[str] = []
     for r in [d, *results_dirs(d)] if d.is_dir() else []:
         rec = read_record(r)
-        study = rec.get("config", {}).get("study") if rec else None
+        config = rec.get("config") if rec else None  # a run.json edited into another
+        study = config.get("study") if isinstance(config, dict) else None  # shape: not ours
         try:
             if isinstance(study, str) and rec["code_hash"] != study_code_hash(study):
                 found.append(str(r))

@@ -41,10 +41,10 @@ def _name(text: str) -> str:
     return m.group(1) if m else text.strip()
 
 
-def _lacks(text: str) -> str | None:
-    """What the environment lacks of one requirement ``text``, or None."""
+def _lacks(text: str, extra: str = EXTRA, depth: int = 0) -> str | None:
+    """What the environment lacks of one requirement ``text`` (of ``extra``), or None."""
     req = Requirement(text) if Requirement is not None else None
-    if req is not None and req.marker is not None and not req.marker.evaluate({"extra": EXTRA}):
+    if req is not None and req.marker is not None and not req.marker.evaluate({"extra": extra}):
         return None
     name = req.name if req is not None else _name(text)
     try:
@@ -53,6 +53,24 @@ def _lacks(text: str) -> str | None:
         return f"lacks {name}"
     if req is not None and req.specifier and not req.specifier.contains(version, prereleases=True):
         return f"holds {name} {version}"
+    return _extras_lack(name, req.extras if req is not None and depth < 3 else (), depth)
+
+
+def _extras_lack(name: str, extras, depth: int) -> str | None:
+    """What the environment lacks of the requirements the ``extras`` of the installed
+    distribution ``name`` add (``dask[distributed]``: ``distributed``), or None: checked by
+    the name alone, ``distributed`` uninstalled was a ``.venv`` taken for whole (every
+    ``--executor dask`` test failed)."""
+    for text in metadata.requires(name) or [] if extras else []:
+        try:
+            marker = Requirement(text).marker
+        except Exception:  # a line of its METADATA that is no requirement: not ours to judge
+            continue
+        if marker is None or "extra" not in str(marker):
+            continue
+        for e in extras:
+            if marker.evaluate({"extra": e}) and (lacks := _lacks(text, e, depth + 1)):
+                return lacks
     return None
 
 

@@ -170,13 +170,16 @@ def inner_left(net: Network, H: np.ndarray, key: str) -> None:
     nothing (P35's left item)."""
     if H.shape[1]:
         return
-    role = 1 if (net.role == 1).any() else 2  # fixed points, else weighted coordinates
-    held = [net.names[a] for a in np.flatnonzero(net.role == role)]
-    names = ", ".join(held[:5]) + (" ..." if len(held) > 5 else "")
-    what = "fixed points" if role == 1 else "observed (weighted) coordinates of"
+    # the fixed points and the weighted coordinates: both where both are (one fixed point and
+    # a weighted one were "the fixed points A already fix", which one point cannot)
+    parts = []
+    for role, what in ((1, "fixed points"), (2, "observed (weighted) coordinates of")):
+        held = [net.names[a] for a in np.flatnonzero(net.role == role)]
+        if held:
+            parts.append(f"{what} {', '.join(held[:5])}{' ...' if len(held) > 5 else ''}")
     raise ConfigError(
         key,
-        f'datum.kind = "inner" has nothing to constrain: the {what} {names} already fix '
+        f'datum.kind = "inner" has nothing to constrain: the {" and the ".join(parts)} already fix '
         "the network's datum (no defect is left for inner constraints over datum.points, which "
         'would change nothing): use datum.kind = "fixed" (output.inner_over states the '
         "precision in an inner datum too)",
