@@ -28,8 +28,10 @@ __all__ = [
     "open_standard_streams",
 ]
 
-#: the suite's own characters in what it prints (an interval's "0.00–1.00"), and their ASCII
-ASCII_FOR = {"\u2013": "-"}
+#: the suite's own characters in what it prints (an interval's "0.00–1.00", the dash of
+#: ``sim show --markdown``'s "**holds** — ...", which was refused as a name of the user's
+#: would be: "cannot show '\u2014'"), and their ASCII
+ASCII_FOR = {"\u2013": "-", "\u2014": "--", "\u00b1": "+/-", "\u2264": "<=", "\u2265": ">="}
 
 #: a failed write to standard output that its writer could not raise (see stdout_unwritten)
 _unwritten: list[OSError] = []

@@ -16,9 +16,18 @@ __all__ = ["LONG_WORD", "clipped"]
 #: the longest run without white space a message shows whole (a path of 200 characters is)
 LONG_WORD = 200
 _LONG = re.compile(r"\S{%d,}" % (LONG_WORD + 1))
+#: a word's quotes and brackets before it, and those and its punctuation after it
+_EDGES = re.compile(r"""(['"(\[{]*)(.*?)(['")\]}:,;.]*)""", re.S)
 
 
 def clipped(text: str) -> str:
     """``text`` with every word of more than :data:`LONG_WORD` characters cut:
-    ``'yyyy...yyyy' (100002 characters)``."""
-    return _LONG.sub(lambda m: f"{m[0][:60]}...{m[0][-20:]} ({len(m[0])} characters)", text)
+    ``'yyyy...yyyy' (100002 characters)``, the length that of the word without the quotes,
+    brackets and punctuation around it (it counted them: a value of 100,003 characters was
+    "100006 characters" in ``(got 'yyy...')``)."""
+    return _LONG.sub(_cut, text)
+
+
+def _cut(m: re.Match) -> str:
+    core = _EDGES.fullmatch(m[0])[2] or m[0]
+    return f"{m[0][:60]}...{m[0][-20:]} ({len(core)} characters)"
