@@ -1,0 +1,55 @@
+"""A new user's first hour (doors38n): the mistakes people make following README.md from a
+fresh clone, each through a real door, fixed; each test fails on the code before its fix:
+
+* ``sim check brown_tabel1`` (or ``brown_table1``, ``studies/brown_tabel1``) typed from a
+  directory inside the project (``docs/`` while reading docs/cli.md, ``studies/``,
+  ``results/brown_table1/``) was "no such study file" with no guess, where the same words
+  from the root name ``studies/brown_table1.toml``: the project's ``studies/`` is looked in
+  from up to three levels below the root, and the guess is the path as typed from there
+  (``../studies/brown_table1.toml``), a command that works when typed;
+* ``sim show scratch/brown_table1-<hash>`` (the path ``sim run`` printed: "results in
+  scratch/...") or ``sim show results/brown_table1`` typed from ``docs/`` was "DIR: ... does
+  not exist", where ``sim show brown_table1`` from there reads the project's: a path under
+  ``results/`` or ``scratch/`` is read under the project's root too, as a bare name is.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from oneline import SIM_ERROR, one_line
+
+import sim
+from sim.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize(
+    ("where", "typed", "meant"),
+    [
+        ("docs", "brown_tabel1", "../studies/brown_table1.toml"),
+        ("docs", "brown_table1", "../studies/brown_table1.toml"),
+        ("docs", "studies/brown_tabel1.toml", "../studies/brown_table1.toml"),
+        ("studies", "studies/brown_tabel1", "brown_table1.toml"),
+        ("results/brown_table1", "brown_table1", "../../studies/brown_table1.toml"),
+    ],
+)
+def test_a_study_name_typed_below_the_root_is_guessed(capsys, monkeypatch, where, typed, meant):
+    monkeypatch.chdir(ROOT / where)
+    want = f"{typed}: no such study file (did you mean {meant}?)"
+    one_line(capsys, main(["check", typed]), prefix=SIM_ERROR + want)
+    assert main(["check", meant]) == 0  # the guess works when typed
+    capsys.readouterr()
+    with pytest.raises(sim.ConfigError, match=re.escape(want)):
+        sim.load(typed)
+
+
+def test_the_path_a_run_printed_is_shown_from_docs(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT / "docs")
+    assert main(["show", "results/brown_table1"]) == 0
+    assert "brown.table1_closure.dof" in capsys.readouterr().out
+    line = one_line(capsys, main(["show", "scratch/brown_tabel1-0"]), prefix=SIM_ERROR)
+    assert line.endswith("(nor is there a directory ../scratch/brown_tabel1-0)"), line
