@@ -10,7 +10,12 @@ fresh clone, each through a real door, fixed; each test fails on the code before
 * ``sim show scratch/brown_table1-<hash>`` (the path ``sim run`` printed: "results in
   scratch/...") or ``sim show results/brown_table1`` typed from ``docs/`` was "DIR: ... does
   not exist", where ``sim show brown_table1`` from there reads the project's: a path under
-  ``results/`` or ``scratch/`` is read under the project's root too, as a bare name is.
+  ``results/`` or ``scratch/`` is read under the project's root too, as a bare name is;
+* an option of another command (``sim show --trials 4 results/brown_table1``) was
+  "unrecognized arguments: --trials results/brown_table1" (the 4 taken for DIR, the directory
+  named as the bad argument), ``sim check x.toml --out d`` "(did you mean --set?)", and
+  ``sim show --trials`` "sim show: unrecognized arguments": each names the option and the
+  command it belongs to (``--trials: an option of sim run, not of sim show``).
 """
 
 from __future__ import annotations
@@ -53,3 +58,18 @@ def test_the_path_a_run_printed_is_shown_from_docs(capsys, monkeypatch):
     assert "brown.table1_closure.dof" in capsys.readouterr().out
     line = one_line(capsys, main(["show", "scratch/brown_tabel1-0"]), prefix=SIM_ERROR)
     assert line.endswith("(nor is there a directory ../scratch/brown_tabel1-0)"), line
+
+
+@pytest.mark.parametrize(
+    ("argv", "want"),
+    [
+        (["show", "--trials", "4", "results/brown_table1"], "--trials: an option of sim run, "),
+        (["show", "--trials"], "--trials: an option of sim run, not of sim show"),
+        (["check", "studies/brown_table1.toml", "--out", "d"], "--out: an option of sim run, "),
+        (["show", "results/brown_table1", "--set", "a=1"], "--set: an option of sim run and sim "),
+        (["report", "--markdown"], "--markdown: an option of sim show, not of sim report"),
+    ],
+)
+def test_an_option_of_another_command_is_named_as_one(capsys, argv, want):
+    line = one_line(capsys, main(argv), prefix=SIM_ERROR + want)
+    assert want in line and "unrecognized" not in line and "did you mean" not in line, line
