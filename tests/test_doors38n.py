@@ -7,6 +7,10 @@ fresh clone, each through a real door, fixed; each test fails on the code before
   from the root name ``studies/brown_table1.toml``: the project's ``studies/`` is looked in
   from up to three levels below the root, and the guess is the path as typed from there
   (``../studies/brown_table1.toml``), a command that works when typed;
+* a study file copied to a directory of one's own (``~/my.toml``) and named with its suffix
+  mistyped (``sim check my.tom``, ``my.tml``) was "no such study file" with no guess (the
+  name too short for the misspelt suffix to leave it near): a suffix near ``toml`` is read as
+  ``.toml`` when the nearest name is looked for;
 * ``sim show scratch/brown_table1-<hash>`` (the path ``sim run`` printed: "results in
   scratch/...") or ``sim show results/brown_table1`` typed from ``docs/`` was "DIR: ... does
   not exist", where ``sim show brown_table1`` from there reads the project's: a path under
@@ -73,3 +77,12 @@ def test_the_path_a_run_printed_is_shown_from_docs(capsys, monkeypatch):
 def test_an_option_of_another_command_is_named_as_one(capsys, argv, want):
     line = one_line(capsys, main(argv), prefix=SIM_ERROR + want)
     assert want in line and "unrecognized" not in line and "did you mean" not in line, line
+
+
+@pytest.mark.parametrize("typed", ["my.tom", "my.tml", "my.TOML"])
+def test_a_mistyped_suffix_of_ones_own_study_file_is_guessed(tmp_path, capsys, monkeypatch, typed):
+    (tmp_path / "my.toml").write_text((ROOT / "studies" / "brown_table1.toml").read_text())
+    monkeypatch.chdir(tmp_path)
+    want = f"{typed}: no such study file (did you mean my.toml?)"
+    one_line(capsys, main(["check", typed]), prefix=SIM_ERROR + want)
+    one_line(capsys, main(["check", "my.txt"]), prefix=SIM_ERROR + "my.txt: no such study file")

@@ -59,7 +59,7 @@ def _near(p: Path) -> str | None:
     lookalike letter), else the closest spelling (difflib, as a mistyped key or option is
     answered): ``studies/brown_tabel1.toml`` was "no such study file" without the
     ``studies/brown_table1.toml`` beside it (L37)."""
-    stem = p.name.removesuffix(".toml")
+    stem = _stem(p.name)
     seen: dict[str, Path] = {}
     for d in [p.parent] + (_studies_dirs() if _bare(p) else []):
         try:
@@ -72,6 +72,15 @@ def _near(p: Path) -> str | None:
     same = [n for n in seen if looks(n) == looks(stem) and n != stem]
     close = same + difflib.get_close_matches(stem, list(seen), n=3, cutoff=0.75)
     return next((str(seen[n]) for n in close if _names_a_study(seen[n])), None)
+
+
+def _stem(name: str) -> str:
+    """``name`` without ``.toml`` or a mistyped one (``my.tom``, ``x.tml``: "no such study
+    file" without a guess where the name was short, the suffix too far off ``my``)."""
+    base, dot, ext = name.rpartition(".")
+    if dot and base and difflib.SequenceMatcher(None, ext.lower(), "toml").ratio() >= 0.75:
+        return base
+    return name
 
 
 def _names_a_study(p: Path) -> bool:
