@@ -15,6 +15,10 @@ fresh clone, each through a real door, fixed; each test fails on the code before
   scratch/...") or ``sim show results/brown_table1`` typed from ``docs/`` was "DIR: ... does
   not exist", where ``sim show brown_table1`` from there reads the project's: a path under
   ``results/`` or ``scratch/`` is read under the project's root too, as a bare name is;
+* a key typed with another unit than its own (``--set plate.spacing_um=45000``, the value in
+  um) was "unknown key (did you mean plate.spacing_mm?)" alone, and the value moved to the mm
+  key as typed was a spacing 1000 times the one meant: the guess says the unit its value is in
+  (``its value is in mm, not um: convert it``);
 * an option of another command (``sim show --trials 4 results/brown_table1``) was
   "unrecognized arguments: --trials results/brown_table1" (the 4 taken for DIR, the directory
   named as the bad argument), ``sim check x.toml --out d`` "(did you mean --set?)", and
@@ -86,3 +90,17 @@ def test_a_mistyped_suffix_of_ones_own_study_file_is_guessed(tmp_path, capsys, m
     want = f"{typed}: no such study file (did you mean my.toml?)"
     one_line(capsys, main(["check", typed]), prefix=SIM_ERROR + want)
     one_line(capsys, main(["check", "my.txt"]), prefix=SIM_ERROR + "my.txt: no such study file")
+
+
+def test_a_key_in_another_unit_says_the_unit_to_convert_to(capsys):
+    brown = str(ROOT / "studies" / "brown_table1.toml")
+    want = (
+        "plate.spacing_um: unknown key (did you mean plate.spacing_mm? its value is in mm, not um"
+    )
+    one_line(
+        capsys, main(["check", brown, "--set", "plate.spacing_um=45000"]), prefix=SIM_ERROR + want
+    )
+    with pytest.raises(sim.ConfigError, match=re.escape(want)):
+        sim.load(brown, **{"plate.spacing_um": 45000})
+    line = one_line(capsys, main(["check", brown, "--set", "plate.spacing=45"]), prefix=SIM_ERROR)
+    assert line.endswith("(did you mean plate.spacing_mm?)"), line  # no unit typed: none said
