@@ -39,12 +39,33 @@ class _Parser(OnceParser):
         # one reports what no command takes: its line already starts "sim: error:" (it said
         # "sim: error: sim: unrecognized arguments"), and the help to see is the command's
         head, helps = f"{self.prog}: ", self.prog
+        if " " in self.prog:  # a command's own parser (`sim show --trials`: DIR not given)
+            cmd = self.prog.split(" ")[-1]
+            if other := _of_another(message, getattr(self, "commands", {}), cmd):
+                head, message = "", other
         if " " not in self.prog:
             head = ""
             cmds = next((a.choices for a in self._actions if a.dest == "cmd"), {}) or {}
             cmd = next((a for a in getattr(self, "given", []) if a in cmds), None)
             helps = f"{self.prog} {cmd}" if cmd else self.prog
+            message = _of_another(message, cmds, cmd) or message
         raise ConfigError(None, f"{head}{message} (see {helps} --help)")
+
+
+def _of_another(message: str, cmds: dict, cmd: str | None) -> str | None:
+    """``--trials: an option of sim run, not of sim show`` for an option the command ``cmd``
+    lacks and another command has: ``sim show --trials 4 results/x`` was "unrecognized
+    arguments: --trials results/x" (the 4 taken for DIR), ``sim check x.toml --out d``
+    "(did you mean --set?)"; None when the message is no such option's."""
+    m = re.match(r"unrecognized arguments: (.*)", message)
+    if m is None or cmd not in cmds:
+        return None
+    bad = next((w for w in m.group(1).split(" ") if w.startswith("-") and w != "-"), "")
+    word = bad.split("=")[0]
+    has = [c for c, p in cmds.items() if c != cmd and word in p._option_string_actions]
+    if not has or word in cmds[cmd]._option_string_actions:
+        return None
+    return f"{word}: an option of {' and '.join(f'sim {c}' for c in has)}, not of sim {cmd}"
 
 
 def module_doc(doc: str | None, path: str) -> str:
@@ -206,4 +227,6 @@ def parser(doc: str) -> argparse.ArgumentParser:
     rep.add_argument(
         "--results", help="the results directory (default results, the project's from inside it)"
     )
+    for q in sub.choices.values():  # an option of another command is named as one
+        q.commands = sub.choices
     return p

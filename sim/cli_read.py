@@ -42,8 +42,11 @@ def show(args) -> int:
     # the name a README.md gives (`sim show NAME` prints it again) is read under the project's
     # results/ and scratch/ too (from docs/ as from the root), where sim run writes without
     # --out (a scratch run's README named a command that said "does not exist" from the root)
-    # a name only (`sim show results/x` was told of results/results/x too)
+    # a name only (`sim show results/x` was told of results/results/x too); the path a run
+    # printed (`results in scratch/x/`), typed from docs/, is read under the project's root
     where = [Path(shown_path(base() / b)) for b in WHERE] if len(d.parts) == 1 else []
+    if len(d.parts) > 1 and Path(d.parts[0]) in WHERE and base() != Path("."):
+        where = [Path(shown_path(base()))]
     d = next((b / d for b in where if not d.exists() and (b / d).is_dir()), d)
     if not d.is_dir():
         what = "is not a directory" if os.path.lexists(d) else "does not exist"

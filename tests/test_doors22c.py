@@ -172,7 +172,7 @@ FOREIGN = {
     "t",
 }
 #: keys a page names as refused (docs/cli.md: the guess for a mistyped key)
-REFUSED_KEYS = {"comparator.beta"}
+REFUSED_KEYS = {"comparator.beta", "plate.spacing_um"}
 DOTTED = re.compile(r"(?<![\w./-])([a-z_][a-z0-9_]*(?:\.[a-z0-9_*{},]+)+)(?![\w(])")
 
 

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.lookalike import looks, note, toml_char_hint
-from sim.mc.message_text import key_text, shorten, shown
+from sim.mc.message_text import key_text, near_keys, shorten, shown
 from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.study_file import study_file_problem
@@ -320,7 +320,7 @@ def validate(
     for key in raw:
         if key not in schema:
             near = did_you_mean(key, schema)
-            hint = f" (did you mean {' or '.join(near)}?)" if near else ""
+            hint = near_keys(key, near)  # its unit said: spacing_um for spacing_mm
             if inner := [s for s in schema if s.startswith(f"{key}.")][:3]:  # --set plate=4
                 hint = f" ({key} is a table: give one of its keys, {', '.join(inner)}, ...)"
             curly = [c for c in key if c in TYPOGRAPHIC]

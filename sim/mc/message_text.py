@@ -8,6 +8,9 @@ easy to miss (a tab, a no-break space or a zero-width space not seen at all); su
 named in double quotes, its white space other than a plain space and every character that
 does not print written as TOML escapes it (``"tri\\u200bals"``), and the empty key
 (``"" = 5``, which named no key) as ``""``, in a table too (``plate.""``: it was ``plate.``).
+``near_keys``: ``--set plate.spacing_um=45000`` was "unknown key (did you mean
+plate.spacing_mm?)", and the value typed in um, moved to the mm key, was a spacing 1000 times
+the one meant: a key meant that differs only in its unit says the unit to convert to.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-__all__ = ["LONG_DIGITS", "shown", "shorten", "key_text"]
+__all__ = ["LONG_DIGITS", "shown", "shorten", "key_text", "near_keys"]
 
 #: digits of an integer above which a message shows it shortened (a 64-bit one has 19 digits)
 LONG_DIGITS = 19
@@ -85,3 +88,25 @@ def key_text(key: str) -> str:
         for c in key
     )
     return '"' + "".join(esc) + '"'
+
+
+#: the unit suffixes of the studies' keys (and a few a user types for them)
+_UNITS = {"m", "mm", "um", "nm", "cm", "km", "deg", "arcsec", "arcmin", "rad", "gon", "mgon"}
+_UNITS |= {"ppm", "s", "in", "ft", "mu", "micron", "microns"}
+
+
+def near_keys(key: str, near: list[str]) -> str:
+    """`` (did you mean plate.spacing_mm?)`` for the keys ``near`` a mistyped ``key`` ("" for
+    none), with the unit to convert to when the first differs from ``key`` only in its unit
+    suffix (``plate.spacing_um``: ``its value is in mm, not um: convert it``)."""
+    if not near:
+        return ""
+    stem, _, typed = key.rpartition("_")
+    meant_stem, _, unit = near[0].rpartition("_")
+    same = stem and stem == meant_stem and typed != unit
+    said = (
+        f" its value is in {unit}, not {typed}: convert it"
+        if same and {typed, unit} <= _UNITS
+        else ""
+    )
+    return f" (did you mean {' or '.join(near)}?{said})"

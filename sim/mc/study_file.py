@@ -26,21 +26,42 @@ MAX_STUDY_BYTES = 16 * 1024**2
 
 def study_file_hint(p: str | Path) -> str:
     """`` (did you mean studies/brown_table1.toml?)`` for a study file named the way a new
-    user names it: without ``.toml``, without ``studies/``, or with Windows backslashes."""
+    user names it: without ``.toml``, without ``studies/``, or with Windows backslashes, from
+    the project's root or a directory below it (``docs/``: ``../studies/brown_table1.toml``)."""
     text = str(p).replace("\\", "/")
-    tries = [text, f"{text}.toml", f"studies/{text}", f"studies/{text}.toml"]
+    tries = [text, f"{text}.toml"]
+    if _bare(Path(text)):
+        name = Path(text).name
+        tries += [str(d / n) for d in _studies_dirs() for n in (name, f"{name}.toml")]
     hit = next((t for t in tries if t != str(p) and Path(t).is_file()), None)
     return f" (did you mean {hit or _near(Path(text))}?)" if hit or _near(Path(text)) else ""
 
 
+def _bare(p: Path) -> bool:
+    """Whether ``p`` names a study the way a user names one of the project's: a bare name
+    (``brown_table1``) or one under ``studies/``, from wherever in the project it is typed."""
+    return p.parent == Path(".") or p.parent == Path("studies")
+
+
+def _studies_dirs() -> list[Path]:
+    """The ``studies/`` directories a bare name may mean, as typed from here: ``studies``,
+    and the project's (:func:`sim.places.base`) from a directory below its root: ``.`` in
+    ``studies/``, ``../studies`` from ``docs/`` (a bare name from ``docs/`` was "no such study
+    file" with no guess: D38)."""
+    from sim.places import base, shown_path  # here: sim.places reads sim.mc.config
+
+    return list(dict.fromkeys([Path("studies"), Path(shown_path(base() / "studies"))]))
+
+
 def _near(p: Path) -> str | None:
-    """The study file of a name near ``p``'s in its directory (and ``studies/`` for a bare
-    name): the one that looks the same (another case, a lookalike letter), else the closest
-    spelling (difflib, as a mistyped key or option is answered): ``studies/brown_tabel1.toml``
-    was "no such study file" without the ``studies/brown_table1.toml`` beside it (L37)."""
-    stem = p.name.removesuffix(".toml")
+    """The study file of a name near ``p``'s in its directory (and the project's ``studies/``
+    for a bare name, :func:`_studies_dirs`): the one that looks the same (another case, a
+    lookalike letter), else the closest spelling (difflib, as a mistyped key or option is
+    answered): ``studies/brown_tabel1.toml`` was "no such study file" without the
+    ``studies/brown_table1.toml`` beside it (L37)."""
+    stem = _stem(p.name)
     seen: dict[str, Path] = {}
-    for d in [p.parent] + ([Path("studies")] if p.parent == Path(".") else []):
+    for d in [p.parent] + (_studies_dirs() if _bare(p) else []):
         try:
             with os.scandir(d) as it:  # a few hundred names at most: not a whole disk
                 for e in itertools.islice(it, 2000):
@@ -51,6 +72,15 @@ def _near(p: Path) -> str | None:
     same = [n for n in seen if looks(n) == looks(stem) and n != stem]
     close = same + difflib.get_close_matches(stem, list(seen), n=3, cutoff=0.75)
     return next((str(seen[n]) for n in close if _names_a_study(seen[n])), None)
+
+
+def _stem(name: str) -> str:
+    """``name`` without ``.toml`` or a mistyped one (``my.tom``, ``x.tml``: "no such study
+    file" without a guess where the name was short, the suffix too far off ``my``)."""
+    base, dot, ext = name.rpartition(".")
+    if dot and base and difflib.SequenceMatcher(None, ext.lower(), "toml").ratio() >= 0.75:
+        return base
+    return name
 
 
 def _names_a_study(p: Path) -> bool:
