@@ -214,12 +214,17 @@ def in_datum(net: Network, an: Analytic, points: list[int]) -> np.ndarray:
 
 def estimated_points(net: Network, an: Analytic) -> list[int]:
     """Estimated points whose 2 x 2 covariance is regular (a point held by a datum
-    constraint, such as Brown's x1 = 0, has a singular block and no ellipse)."""
+    constraint, such as Brown's x1 = 0, has a singular block and no ellipse; a point inner
+    constraints hold whole, two points against a rotation and a scale, has a block of rounding
+    noise, 1e-18 mm^2, whose relative determinant is noise too: it was taken for estimated and
+    the run refused for its "0 mm" sigma)."""
+    var = (an.cov[:, 0, 0] + an.cov[:, 1, 1]) / 2
     det = an.cov[:, 0, 0] * an.cov[:, 1, 1] - an.cov[:, 0, 1] ** 2
+    noise = 1e-13 * float(var.max(initial=0.0))
     return [
         a
         for a in range(net.n)
-        if net.role[a] != 1 and det[a] > 1e-12 * ((an.cov[a, 0, 0] + an.cov[a, 1, 1]) / 2) ** 2
+        if net.role[a] != 1 and var[a] > noise and det[a] > 1e-12 * var[a] ** 2
     ]
 
 
