@@ -23,6 +23,10 @@ on the code before its fix.
   refused, "net.xml has 0 fixed points (a fixed datum needs two or more)". Two points fixed
   or observed keep the file's datum fixed (:func:`sim.studies.network.gama.merge_gama`); an
   inner datum asked of it is refused naming the weighted coordinates.
+* inner ``datum.points`` that cannot fix the rotation about an observed (weighted) point
+  (``datum.points = ["C"]``, C weighted, no point fixed): the refusal called the defect "1
+  motions of the whole network" (the weighted point's rows of the defect are rounding noise,
+  not zero as a fixed point's); it says "a rotation about the fixed or weighted points".
 """
 
 from __future__ import annotations
@@ -121,3 +125,30 @@ def test_a_gama_file_whose_observed_coordinates_hold_the_datum_keeps_it_fixed(tm
     sim.load(f, datum__kind="fixed")  # was: "fixed" cannot hold: net.xml has 0 fixed points
     with pytest.raises(sim.ConfigError, match="^datum.kind: .*coordinates of A, C already fix"):
         sim.load(f, datum__kind="inner")  # was: resolved inner, run as `inner` (0 constraints)
+
+
+WEIGHTED = """\
+study = "network"
+trials = 40
+chunk = 2
+seed = 1
+[network]
+name = "weighted"
+points = [
+  { name = "A", x_m = 0.0, y_m = 0.0 }, { name = "B", x_m = 100.0, y_m = 0.0 },
+  { name = "C", x_m = 100.0, y_m = 80.0, role = "observed", sigma_mm = 5.0 },
+  { name = "D", x_m = 0.0, y_m = 80.0 }, { name = "E", x_m = 50.0, y_m = 40.0 },
+]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 1.0 } ]
+[datum]
+kind = "inner"
+points = ["C"]
+"""
+
+
+def test_inner_points_against_the_rotation_about_a_weighted_point_say_so(tmp_path):
+    f = tmp_path / "weighted.toml"
+    f.write_text(WEIGHTED, encoding="utf-8")
+    words = r"^datum.points: the points C cannot fix the network's 1 datum defect \(a rotation "
+    with pytest.raises(sim.ConfigError, match=words + r"about the fixed or weighted points\)"):
+        sim.load(f)  # was: (1 motions of the whole network)
