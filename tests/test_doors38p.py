@@ -27,6 +27,11 @@ on the code before its fix.
   (``datum.points = ["C"]``, C weighted, no point fixed): the refusal called the defect "1
   motions of the whole network" (the weighted point's rows of the defect are rounding noise,
   not zero as a fixed point's); it says "a rotation about the fixed or weighted points".
+* an inner datum on a network with a fixed point and a part no observation ties to it (the
+  fixed datum's refusal names that part): the inner datum was taken to hold the largest loose
+  part, as in a network no point holds, so nothing was named and the line said "a rank defect
+  of 3 ... that the datum (0 constraints) does not cover". With points held the inner datum
+  removes only the defect they leave; the part is named (:mod:`sim.studies.network.singular`).
 """
 
 from __future__ import annotations
@@ -152,3 +157,33 @@ def test_inner_points_against_the_rotation_about_a_weighted_point_say_so(tmp_pat
     words = r"^datum.points: the points C cannot fix the network's 1 datum defect \(a rotation "
     with pytest.raises(sim.ConfigError, match=words + r"about the fixed or weighted points\)"):
         sim.load(f)  # was: (1 motions of the whole network)
+
+
+DETACHED = """\
+study = "network"
+trials = 40
+chunk = 2
+seed = 1
+[network]
+name = "detached"
+points = [
+  { name = "A", x_m = 0.0, y_m = 0.0, role = "fixed" }, { name = "B", x_m = 100.0, y_m = 0.0 },
+  { name = "C", x_m = 100.0, y_m = 80.0 }, { name = "D", x_m = 0.0, y_m = 80.0 },
+  { name = "E", x_m = 300.0, y_m = 40.0 }, { name = "F", x_m = 330.0, y_m = 60.0 },
+  { name = "G", x_m = 310.0, y_m = 90.0 },
+]
+generate = [
+  { kind = "distance", from = ["A", "B", "C", "D"], to = ["A", "B", "C", "D"], sigma_mm = 1.0 },
+  { kind = "distance", from = ["E", "F", "G"], to = ["E", "F", "G"], sigma_mm = 1.0 },
+]
+[datum]
+kind = "inner"
+"""
+
+
+def test_an_inner_datum_names_a_part_no_fixed_point_holds(tmp_path):
+    f = tmp_path / "detached.toml"
+    f.write_text(DETACHED, encoding="utf-8")
+    words = r"^datum.kind: the normal matrix is singular: points 'E', 'F', 'G' are tied to the"
+    with pytest.raises(sim.ConfigError, match=words):
+        sim.load(f)  # was: a rank defect of 3 ... the datum (0 constraints) does not cover
