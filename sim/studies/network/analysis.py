@@ -226,7 +226,9 @@ def estimated_points(net: Network, an: Analytic) -> list[int]:
     the run refused for its "0 mm" sigma)."""
     var = (an.cov[:, 0, 0] + an.cov[:, 1, 1]) / 2
     det = an.cov[:, 0, 0] * an.cov[:, 1, 1] - an.cov[:, 0, 1] ** 2
-    noise = 1e-13 * float(var.max(initial=0.0))
+    # rounding noise of the inverse: up to 6e-17 of the largest variance (a 625-point sparse
+    # network); a variance below 1e-14 of it is no estimate either way
+    noise = 1e-14 * float(var.max(initial=0.0))
     return [
         a
         for a in range(net.n)
