@@ -159,7 +159,7 @@ def check_inner(net: Network, H: np.ndarray, points: list[int], key: str) -> Non
         raise ConfigError(
             key,
             f"the points {names} cannot fix the network's {d} datum defect{'s' * (d != 1)} "
-            f"({defect_words(H)}): choose more points, not all on one line",
+            f"({defect_words(H, net.role)}): choose more points, not all on one line",
         )
 
 
@@ -186,17 +186,23 @@ def inner_left(net: Network, H: np.ndarray, key: str) -> None:
     )
 
 
-def defect_words(H: np.ndarray) -> str:
+def defect_words(H: np.ndarray, role: np.ndarray | None = None) -> str:
     """What the datum defects ``H`` (rows of :func:`held_defect`) are, in words: with no point
     held two translations, a rotation and, without a length, a scale; with points held (their
     rows zero) a rotation and a scale about them. It said "translation, rotation, scale" for
-    any count, also for the one rotation left by a fixed point."""
+    any count, also for the one rotation left by a fixed point. A point its observed (weighted)
+    coordinates hold has rows of rounding noise, not zero (``role``: the points' roles, to say
+    which): it said "1 motions of the whole network"."""
     d = H.shape[1]
-    held = bool((~H.reshape(-1, 2 * d).any(axis=1)).any()) if H.size else False
+    rows = np.abs(H.reshape(-1, 2 * d)).max(axis=1) if H.size else np.zeros(0)
+    still = rows <= 1e-9 * rows.max(initial=0.0)
+    held = bool(still.any())
     if not held and d in (3, 4):
         return "two translations and a rotation" + (", and a scale: no length" if d == 4 else "")
     if held and d in (1, 2):
-        return "a rotation" + (" and a scale" if d == 2 else "") + " about the fixed points"
+        weighted = role is not None and bool(np.any(role[still] == 2))
+        about = "the fixed or weighted points" if weighted else "the fixed points"
+        return "a rotation" + (" and a scale" if d == 2 else "") + f" about {about}"
     return f"{d} motions of the whole network"
 
 
@@ -214,12 +220,19 @@ def in_datum(net: Network, an: Analytic, points: list[int]) -> np.ndarray:
 
 def estimated_points(net: Network, an: Analytic) -> list[int]:
     """Estimated points whose 2 x 2 covariance is regular (a point held by a datum
-    constraint, such as Brown's x1 = 0, has a singular block and no ellipse)."""
+    constraint, such as Brown's x1 = 0, has a singular block and no ellipse; a point inner
+    constraints hold whole, two points against a rotation and a scale, has a block of rounding
+    noise, 1e-18 mm^2, whose relative determinant is noise too: it was taken for estimated and
+    the run refused for its "0 mm" sigma)."""
+    var = (an.cov[:, 0, 0] + an.cov[:, 1, 1]) / 2
     det = an.cov[:, 0, 0] * an.cov[:, 1, 1] - an.cov[:, 0, 1] ** 2
+    # rounding noise of the inverse: up to 6e-17 of the largest variance (a 625-point sparse
+    # network); a variance below 1e-14 of it is no estimate either way
+    noise = 1e-14 * float(var.max(initial=0.0))
     return [
         a
         for a in range(net.n)
-        if net.role[a] != 1 and det[a] > 1e-12 * ((an.cov[a, 0, 0] + an.cov[a, 1, 1]) / 2) ** 2
+        if net.role[a] != 1 and var[a] > noise and det[a] > 1e-12 * var[a] ** 2
     ]
 
 

@@ -88,8 +88,12 @@ def merge_gama(cfg: dict) -> dict:
     }
     if rec["datum.points"] and not cfg["datum.points"]:
         out["datum.points"] = rec["datum.points"]
+    # points held: fixed, or their coordinates observed (weighted); two of them fix the datum
+    # (a file whose <coordinates> held it was resolved inner, "(0 constraints)", and "fixed"
+    # refused as "0 fixed points")
     fixed = sum(p.get("role") == "fixed" for p in rec["network.points"])
-    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and fixed < 2:
+    seen = sum(p.get("role") == "observed" for p in rec["network.points"])
+    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and fixed + seen < 2:
         # adj="XY" points: gama-local removes the defect its fixed points leave over them (all
         # of it in a free network, the rotation about a single fixed point), as the suite's
         # own export of an inner datum writes it (its round trip), so the study does too; two
@@ -99,7 +103,8 @@ def merge_gama(cfg: dict) -> dict:
             raise ConfigError(
                 "datum.kind",
                 f'"fixed" cannot hold: {Path(path).name} has {fixed} fixed '
-                f"point{'' if fixed == 1 else 's'} (a fixed datum needs two or more) and "
+                f"point{'' if fixed == 1 else 's'}{' and 1 observed' if seen else ''} (a fixed "
+                "datum needs two or more fixed or observed points) and "
                 'adj="XY" points, which gama-local adjusts in the inner datum: set datum.kind '
                 '= "inner" (or leave it out: the default falls back to it)',
             )

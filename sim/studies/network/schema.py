@@ -134,7 +134,9 @@ def check(cfg: dict) -> None:
     lone = _unreached_free(net, full)
     dt = datum(net, full)
     try:
-        an = _held(net, full, dt, sparse)
+        an = _held(
+            net, full, dt, sparse, {k for k in ("datum.kind", "datum.points") if given(cfg, k)}
+        )
     except ConfigError as e:  # a fixed point nothing observes holds nothing: the cause, named
         if not lone.size:
             raise
@@ -178,10 +180,11 @@ def _unreached_free(net, full: dict) -> np.ndarray:
     return lone
 
 
-def _held(net, full: dict, dt, sparse: bool):
+def _held(net, full: dict, dt, sparse: bool, asked: frozenset | set = frozenset()):
     """The pre-analysis of a network its datum holds: the datum's own checks (minimal
     constraints, inner-datum points), then the normals; a defect is refused naming its cause
-    where it can be found."""
+    where it can be found. ``asked``: the datum keys set (the file, ``--set``, a sweep cell),
+    not resolved from a ``gama-local`` file's ``adj="XY"`` points."""
     if full["datum.kind"] == "constraints":
         _minimal(net, dt, full)
     if full["datum.kind"] == "inner":
@@ -191,11 +194,17 @@ def _held(net, full: dict, dt, sparse: bool):
         pts = match_points(net, "datum.points", full["datum.points"] or ["*"])
         check_inner(net, H, pts, "datum.points")
     an = pre_analysis(net, dt, full["reliability.alpha0"], full["reliability.power"])
-    if an.ok and full["datum.kind"] == "inner" and not full.get("network.gama_xml"):
+    # a gama-local file too: its adj="XY" points resolve the datum inner only where fewer than
+    # two points are held (gama.py), which leaves a defect; an inner datum asked of a file its
+    # fixed points or weighted coordinates hold ran the fixed datum, said as `inner` (0
+    # constraints)
+    gama = bool(full.get("network.gama_xml"))
+    if an.ok and full["datum.kind"] == "inner":
         # after the normals: a part turning about its own fixed point, an unknown no
         # observation reaches, is a defect the fixed points leave too (named below when
-        # singular); a gama-local file's datum is its own
-        inner_left(net, H, "datum.points" if full["datum.points"] else "datum.kind")
+        # singular); the file's adj="XY" points are not a datum.points the user set
+        points = "datum.points" in asked if gama else bool(full["datum.points"])
+        inner_left(net, H, "datum.points" if points else "datum.kind")
     if not an.ok:
         # dense too: name the point no observation reaches (docs/network.md), unless nothing
         # holds the network at all (then the rank defect and its advice say it better)

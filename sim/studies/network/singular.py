@@ -64,7 +64,11 @@ def _islands(net: Network, cfg: dict) -> str:
     graph = coo_matrix((np.ones(a.size), (a, b)), shape=(n + 1, n + 1))
     _, label = connected_components(graph, directed=False)
     loose = label[:n] != label[n]
-    if inner and loose.any():  # the inner datum holds one part: the largest loose one
+    # the inner datum of a network no point holds holds one part: the largest loose one; with
+    # points held it removes only the defect they leave (the rotation about one), not a
+    # part's own (a part with no tie to two fixed points was "a rank defect of 3 that the
+    # datum (0 constraints) does not cover", unnamed)
+    if inner and loose.any() and not anchored.any():
         loose &= label[:n] != np.bincount(label[:n][loose]).argmax()
     if held:  # minimal constraints of a network with no point held hold the parts they name
         loose &= ~np.isin(label[:n], label[_constrained(net, cfg)])
