@@ -152,9 +152,11 @@ def count(name: str, v: Any) -> Any:
     are 2; it was "must be an integer (got array(2))" where ``trials=np.array(2)`` is 2); a
     value that reading refuses is left as it is, to the caller's own check of ``name``."""
     try:
-        return as_config_value(name, v)
+        r = as_config_value(name, v)
     except ConfigError:
         return v
+    # a whole float is the integer, as trials=400.0 is 400 (workers=1.0 was "must be an integer")
+    return int(r) if isinstance(r, float) and r.is_integer() and abs(r) < 2**53 else r
 
 
 def flag(name: str, v: Any) -> bool:

@@ -142,12 +142,15 @@ def test_an_executor_whose_eq_raises_is_one_line(handle, tmp_path):
     assert msg == "executor: must be 'local' or 'dask' (got Odd())"
 
 
-@pytest.mark.parametrize("count", [np.array(99), Decimal("99"), Fraction(99, 1)])
+@pytest.mark.parametrize("count", [np.array(99), Decimal("99"), Fraction(99, 1), 99.0])
 def test_workers_is_read_as_the_number_it_is(handle, tmp_path, count):
     """Any integer type is the integer (refused here for its size, not its type: before any
-    work)."""
+    work); a whole float too, as ``trials=400.0`` is 400 (the lead: ``workers=1.0`` was "must be
+    an integer"), but not a fraction."""
     msg = _refused(lambda: handle.run(out=tmp_path / "o", workers=count))
     assert msg.startswith("workers: must be between 1 and ") and msg.endswith("(got 99)")
+    msg = _refused(lambda: handle.run(out=tmp_path / "o", workers=1.5))
+    assert msg.startswith("workers: must be an integer between 1 and ") and "(got 1.5)" in msg
 
 
 def test_a_value_whose_repr_raises_is_one_line(handle, tmp_path):
