@@ -7,9 +7,9 @@ new one's. ``sim show`` printed the new run's claims under the old run's configu
 (exit 0), and ``Results.table`` called the directory one that "mixes results of two runs; run
 its study again" (its ``run.json`` read before the swap, the table after). :func:`settled`
 reads again when the directory is another one after the reading (its inode: every publish
-puts a new directory in place), and names it when it changed at every reading. (``sim
-report`` and ``make verify`` do the same over a results root: their own ``_settled``.) Not
-imported by any study (no code hash).
+puts a new directory in place), and names it when it changed at every reading; ``sim report``
+reads a results root by the same rule (:func:`reread`: its directories). (``make verify``
+keeps its own loop: it compares tables' content too, and its outcome is a comparison.)
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from typing import Callable, TypeVar
 
 from sim.mc.config import ConfigError
 
-__all__ = ["READS", "settled"]
+__all__ = ["READS", "Spun", "reread", "settled"]
 
 T = TypeVar("T")
 
@@ -37,23 +37,38 @@ def _identity(d: Path) -> tuple[int, int] | None:
     return st.st_dev, st.st_ino
 
 
-def settled(d: str | Path, read: Callable[[], T], key: str) -> T:
-    """``read()`` of the results directory ``d``, made again when another directory took its
-    place while it read (a run published there), also when it failed (a :class:`ConfigError`
-    or an OSError of a reading of two runs' files); after :data:`READS` such readings a
-    :class:`ConfigError` naming ``key`` and ``d`` says so."""
-    for _ in range(READS):
-        before = _identity(Path(d))
+def reread(read: Callable[[], T], state: Callable[[], object], last_stands: bool = False) -> T:
+    """``read()``, made again when ``state()`` (what a publish changes: a directory's inode,
+    a results root's directories) differs after it, also when it failed (a
+    :class:`ConfigError` or an OSError of a reading of two runs' files), at most :data:`READS`
+    times. Then the last outcome stands (``last_stands``: ``sim report``) or :class:`Spun` is
+    raised."""
+    for k in range(READS):
+        before = state()
         try:
             value = read()
         except (ConfigError, OSError):
-            if _identity(Path(d)) == before:
+            if state() == before or (last_stands and k + 1 == READS):
                 raise
             continue
-        if _identity(Path(d)) == before:
+        if state() == before or (last_stands and k + 1 == READS):
             return value
-    raise ConfigError(
-        key,
-        f"{d} was replaced while it was read, {READS} times (a run publishing its results "
-        "there?): read it when that run has ended",
-    )
+    raise Spun
+
+
+class Spun(Exception):
+    """What was read changed at every one of :data:`READS` readings."""
+
+
+def settled(d: str | Path, read: Callable[[], T], key: str) -> T:
+    """``read()`` of the results directory ``d``, made again when another directory took its
+    place while it read (a run published there; :func:`reread`); after :data:`READS` such
+    readings a :class:`ConfigError` naming ``key`` and ``d`` says so."""
+    try:
+        return reread(read, lambda: _identity(Path(d)))
+    except Spun:
+        raise ConfigError(
+            key,
+            f"{d} was replaced while it was read, {READS} times (a run publishing its results "
+            "there?): read it when that run has ended",
+        ) from None

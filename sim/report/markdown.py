@@ -17,6 +17,7 @@ from sim.claims.rules import NOT_APPLICABLE, P_FAIL, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
+from sim.mc.settle import reread
 from sim.mc.storage import atomic_path, read_provenance
 from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
@@ -382,26 +383,13 @@ def _dirs(results: Path) -> dict[str, int]:
     return out
 
 
-#: how many times :func:`_settled` reads the results directories at most
-_READS = 3
-
-
 def _settled(results: Path, build: Callable):
     """``build()``, done again when a run published a study while it read the directories
     (``make reproduce`` in another terminal): the report took the tables of two runs as one
     (or named one of them as another run's table beside a run.json). A failure while the
-    directories moved is read again too; after ``_READS`` reads, the last outcome stands."""
-    for k in range(_READS):
-        before = _dirs(results)
-        try:
-            value = build()
-        except (ConfigError, OSError):
-            if k + 1 < _READS and _dirs(results) != before:
-                continue
-            raise
-        if _dirs(results) == before:
-            return value
-    return value
+    directories moved is read again too; after :data:`sim.mc.settle.READS` reads, the last
+    outcome stands (:func:`sim.mc.settle.reread`)."""
+    return reread(build, lambda: _dirs(results), last_stands=True)
 
 
 def write_report(
