@@ -62,7 +62,8 @@ points = ["E", "F"]
 def test_an_inner_datum_over_two_points_of_a_direction_network_runs(tmp_path):
     f = tmp_path / "directions.toml"
     f.write_text(DIRECTIONS, encoding="utf-8")
-    sim.load(f)  # was: network.points: point 'E' ... its smallest sigma (0 mm)
+    st = sim.load(f)  # was: network.points: point 'E' ... its smallest sigma (0 mm)
+    assert st.config["datum.kind"] == "inner" and st.config["datum.points"] == ["E", "F"]
 
 
 def _gama(fixed: int, seen: str = "") -> str:
