@@ -16,18 +16,30 @@ each; each failed on the code before its fix.
   weights, "keep the ratio above about 6.8e+07". The weights are tried at 1000 times the
   paper's first; singular there, the block is refused naming ``block.sidelap``
   (:func:`sim.studies.agnard.datum.check_datum`, :func:`sim.studies.agnard.strips.tie_words`).
+* ``gridplate_two_plates``: ``trials`` (from 2) below what the order-statistic interval of
+  the self-check ``twoplate.self_check.affine_sigma_analytic`` needs: its indices were clipped
+  to the sample, so at ``trials = 2, chunk = 1`` the median affine sigma of two calibrations
+  took [min, max] as its 95 % interval (it covers the median half the time), and the run
+  printed "self-check (fails)" on it ([-0.098, -0.024] against the analytic sigma's [-0.02,
+  0.02]); at 6 trials the interval [x(2), x(6)] covered it 87.5 % of the time. The median's
+  interval is now the one that covers it at 95 % at least
+  (:func:`sim.studies.gridplate.claims.median_ci`), and fewer than the 6 trials it needs are
+  refused on load, naming ``trials`` and the self-check.
 """
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import sim
 from sim.cli import main
+from sim.studies.gridplate.claims import median_ci
 from tests.oneline import SIM_ERROR, one_line
 
 ROOT = Path(__file__).resolve().parent.parent
 AGNARD = ROOT / "studies" / "agnard_block.toml"
+GRID = ROOT / "studies" / "gridplate_two_plates.toml"
 
 
 def test_strips_that_do_not_overlap_name_the_sidelap(capsys):
@@ -48,3 +60,15 @@ def test_strips_no_pass_point_ties_name_the_sidelap_not_the_weights():
     with pytest.raises(sim.ConfigError) as e:
         sim.load(AGNARD, weights__control_z=1e-12)
     assert str(e.value).startswith("weights.control_z"), e.value
+
+
+def test_a_median_of_too_few_calibrations_is_refused_not_failed(capsys):
+    argv = ["check", str(GRID), "--set", "trials=2", "--set", "chunk=1"]
+    one_line(capsys, main(argv), "trials", "affine_sigma_analytic", prefix=SIM_ERROR)
+    # the interval covers the median at 95 % at least: six values give [x(1), x(6)]
+    # (96.9 %; quantile_ci gave [x(2), x(6)], 87.5 %), five none
+    assert median_ci(np.arange(6.0))[1] == (0.0, 5.0)
+    with pytest.raises(sim.StudyError):
+        median_ci(np.arange(5.0))
+    assert main(["check", str(GRID), "--set", "trials=6", "--set", "chunk=1"]) == 0
+    capsys.readouterr()
