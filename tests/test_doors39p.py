@@ -9,7 +9,9 @@ each; each failed on the code before its fix.
   ``block.relief_m`` ("lower the relief", the relief at its default), and reached ``sim check``
   as a bare ``ValueError:`` line, naming no key, from the trade-off's blocks of several strips
   even with ``block.strips = 1``. It is refused naming ``block.sidelap`` and ``block.usable``
-  (:func:`sim.studies.agnard.strips.check_strip_overlap`).
+  (:func:`sim.studies.agnard.strips.check_strip_overlap`); strips that overlap but that a
+  relief of 200 m parts in a compared block (``block.sidelap = 0.1``) name ``block.relief_m``
+  and that block (:func:`sim.studies.agnard.centre.check_centre_points`).
 * ``agnard_block``: a narrow sidelap (0.1 to 0.14 at ``block.usable = 0.92``) where no
   pass-point row lies in two strips: the region's five-point control leaves the block
   singular at any weight, and it was refused naming ``weights.control_z`` at the paper's
@@ -49,6 +51,10 @@ def test_strips_that_do_not_overlap_name_the_sidelap(capsys):
     with pytest.raises(sim.ConfigError) as e:
         sim.load(AGNARD, block__sidelap=0.3, block__usable=0.6, block__base_mm=50.0)
     assert str(e.value).startswith("block.sidelap: 0.3 with block.usable 0.6"), e.value
+    # overlapping strips that the relief parts: a compared block's builder named its key too
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(AGNARD, block__strips=1, block__sidelap=0.1, block__relief_m=200.0)
+    assert str(e.value).startswith("block.relief_m: the 6 x 24 block compared"), e.value
 
 
 def test_strips_no_pass_point_ties_name_the_sidelap_not_the_weights():
