@@ -51,8 +51,17 @@ def check_centre_points(cfg: dict, block: Block) -> None:
     """Refuse a ``tradeoff.centre_points`` above half the check points of a compared block."""
     k, control = cfg["tradeoff.centre_points"], cfg["tradeoff.block_control"]
     values, d = tuple(cfg[x] for x in BLOCK_KEYS), ground_density(block)
-    sizes = zip(cfg["tradeoff.block_strips"], cfg["tradeoff.block_models"])
-    n, s, m = min((_check_points(values, s, m, d, control), s, m) for s, m in sizes)
+    counts = []
+    for s, m in zip(cfg["tradeoff.block_strips"], cfg["tradeoff.block_models"]):
+        try:
+            counts.append((_check_points(values, s, m, d, control), s, m))
+        except ValueError as e:  # the builder's, of a block compared: named as the main block's
+            raise ConfigError(
+                "block.relief_m",
+                f"the {s} x {m} block compared (tradeoff.block_strips, tradeoff.block_models): "
+                f"{e} (or raise block.sidelap)",
+            ) from None
+    n, s, m = min(counts)
     if n < 2:  # no centre of at most half its check points: the block, not the centre
         raise ConfigError(
             "tradeoff.block_models",

@@ -41,6 +41,7 @@ from sim.lsq import groups
 from sim.lsq.group_solve import dense, scaled
 from sim.lsq.normals import RCOND, scaled_rcond
 from sim.mc.config import ConfigError
+from sim.studies.agnard.strips import tie_words
 
 __all__ = ["MARGIN", "DENSE_MAX", "datum_rcond", "region_insets", "check_datum"]
 
@@ -115,6 +116,16 @@ def _weight_sets(cfg: dict, layouts: dict) -> list[tuple[str, dict, dict]]:
     ]
 
 
+def _geometry(cfg, block: Block, paper: dict, parts: dict, kp: str, ctrl, lay: str, rule) -> None:
+    """Blame the strips, not the weights, when the layout ``lay`` leaves a block of several
+    strips singular even at 1000 times the paper's control weights
+    (:mod:`sim.studies.agnard.strips`)."""
+    axes = [np.asarray(v, float) / cfg[k] * paper[k] for k, v in parts.items()]  # the paper's
+    strong = 1e3 * np.sum(axes, axis=0) / paper[kp]
+    if block.strips >= 2 and not datum_rcond(block, ctrl, np.ones(3), strong, rule)[0]:
+        raise ConfigError("block.sidelap", tie_words(cfg, block, lay))
+
+
 def check_datum(cfg: dict, block: Block, paper: dict, layouts: dict) -> None:
     """Refuse control weights so small against the pass weight that the engine would find
     the block's normals singular (see the module doc): one line naming the control weight,
@@ -144,6 +155,7 @@ def check_datum(cfg: dict, block: Block, paper: dict, layouts: dict) -> None:
             continue
         rc, lay = min(bad)  # the weakest layout names the limit
         rc = None if rc < 0 else rc
+        _geometry(cfg, block, paper, parts, kp, lays[lay], lay, rule)
         what = (
             "fail the engine's singularity rule"
             if rc is None

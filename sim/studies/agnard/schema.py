@@ -23,6 +23,7 @@ from sim.mc.read_when import unless
 from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, reals
 from sim.studies.agnard.centre import check_centre_points
 from sim.studies.agnard.datum import check_datum, region_insets
+from sim.studies.agnard.strips import check_strip_overlap
 
 SEED = "003_5ce730a990a7ebc5.txt"
 NAME = "agnard_block"
@@ -262,6 +263,7 @@ def check(cfg: dict) -> None:
         )
     if cfg["block.strips"] * cfg["block.models"] < 2:
         raise ConfigError("block.models", "a block needs at least two models")
+    check_strip_overlap(cfg)
     # the block's visibility table (points x models) grows with the square of the models
     for key, strips, models in [
         ("block.models", [cfg["block.strips"]], [cfg["block.models"]]),

@@ -140,8 +140,20 @@ PRINTED = (
 SCHEMA.update({k: printed(SCHEMA[k]) for k in PRINTED})
 
 
+#: the fewest values whose median has a 95 % distribution-free interval (2 x 0.5^6 <= 0.05):
+#: the self-check twoplate.self_check.affine_sigma_analytic takes the median over the trials
+MIN_MEDIAN = 6
+
+
 def check(cfg: dict) -> None:
     """Bounds that follow from what the model can compute; one line naming the key."""
+    require(
+        cfg["trials"] >= MIN_MEDIAN,
+        "trials",
+        f"{cfg['trials']} simulated calibrations give the median affine sigma of the "
+        "self-check twoplate.self_check.affine_sigma_analytic no 95 % interval (a "
+        f"distribution-free one needs at least {MIN_MEDIAN}: 2 x 0.5^{MIN_MEDIAN} <= 0.05)",
+    )
     sp, L, sc = cfg["readings.sigma_um"], cfg["readings.count"], cfg["comparator.coord_sigma_um"]
     require(
         sc**2 >= sp**2 / L,
