@@ -1,0 +1,70 @@
+"""Every statement of the docs tried as written (sweep doors39d): the pages' numbers and
+verdicts held to the code and the committed results they describe. Each class was found false
+and fixed in the page; each test fails on the page before its fix:
+
+* docs/gama.md: a ``gama-local`` file's "standard deviation outside the study's range (1e-9 to
+  1e9 mm, 1e-9 to 1e6 arcsec ...)" is refused. The range of an angle is 1e5 arcsec
+  (``SIGMA_RANGE``, the bound docs/network.md gives): a direction of 500,000 cc (162,000
+  arcsec), inside the page's range, was refused "outside [1e-09, 100000]".
+* docs/papers/agnard-nolette-gagnon.md: ``agnard_block_104``'s ``first_pass.pass_xy_cm``
+  "outcome reads inconclusive (fails at both vectors)"; the committed run's outcome is
+  undecidable, as is every prediction's of that run (4 paired blocks at 2 vectors decide none).
+* the same page: the paired shift's ``+-2.31`` standard errors are "Student's 97.5 % point at
+  47 degrees of freedom", which is 2.01; 2.31 is the two-sided 97.5 % point
+  (``sim.studies.agnard.paired.z_box``), its 98.75 % quantile.
+"""
+
+from __future__ import annotations
+
+import re
+
+import pyarrow.parquet as pq
+from conftest import ROOT
+
+from sim.studies.agnard.paired import z_box
+from sim.studies.network.validate import SIGMA_RANGE
+
+DOCS = ROOT / "docs"
+AGNARD = DOCS / "papers" / "agnard-nolette-gagnon.md"
+
+
+def _prose(page) -> str:
+    """The page's text with its line breaks as spaces (a sentence may wrap anywhere)."""
+    return re.sub(r"\s+", " ", page.read_text(encoding="utf-8"))
+
+
+def test_gama_page_gives_the_standard_deviation_range_the_reader_applies():
+    text = _prose(DOCS / "gama.md")
+    m = re.search(
+        r"standard deviation outside the study's range \(([^,]+) mm, ([^,]+) arcsec", text
+    )
+    assert m, "gama.md no longer states the range of a standard deviation"
+    for words, unit in ((m.group(1), "mm"), (m.group(2), "arcsec")):
+        lo, hi = (float(x) for x in words.split(" to "))
+        assert (lo, hi) == SIGMA_RANGE[unit], (words, unit, SIGMA_RANGE[unit])
+    # docs/network.md states the same bound of an angle, and of a gama-local file's
+    net = _prose(DOCS / "network.md")
+    m = re.search(r"A sigma is within \[[^]]+\] mm or \[([^,]+), ([^]]+)\] arcsec", net)
+    assert m and (float(m.group(1)), float(m.group(2))) == SIGMA_RANGE["arcsec"]
+
+
+def test_agnard_page_gives_agnard_block_104s_outcomes_as_committed():
+    text = _prose(AGNARD)
+    m = re.search(r"`agnard_block_104` explores .*? every prediction's outcome reads (\w+)", text)
+    assert m, "the page no longer says what agnard_block_104's predictions read"
+    rows = pq.read_table(ROOT / "results/agnard_block_104/claims.parquet").to_pylist()
+    outcomes = {r["outcome"] for r in rows if r["kind"] == "prediction"}
+    assert outcomes == {m.group(1)}, outcomes
+    pass_xy = [r for r in rows if r["claim"] == "agnard.first_pass.pass_xy_cm"]
+    assert [r["outcome"] for r in pass_xy] == [m.group(1)]
+
+
+def test_agnard_page_names_the_students_point_it_quotes():
+    text = _prose(AGNARD)
+    m = re.search(
+        r"`\+-(\d\.\d\d)` standard errors, Student's ([^,]+?) point at (\d+) degrees", text
+    )
+    assert m, "the page no longer states the paired shift's interval"
+    width, which, dof = float(m.group(1)), m.group(2), int(m.group(3))
+    assert which == "two-sided 97.5 %", which
+    assert abs(z_box(dof + 1) - width) < 0.01  # 2.3155, quoted to two decimals
