@@ -12,6 +12,11 @@ and fixed in the page; each test fails on the page before its fix:
 * the same page: the paired shift's ``+-2.31`` standard errors are "Student's 97.5 % point at
   47 degrees of freedom", which is 2.01; 2.31 is the two-sided 97.5 % point
   (``sim.studies.agnard.paired.z_box``), its 98.75 % quantile.
+
+One in code: docs/cli.md, "``sim check STUDY.toml`` prints every key with its value, meaning,
+unit and bounds". ``seed``'s bound was listed ``<= 9.22337e+18``, below the bound 2**63 - 1 it
+applies: ``--set seed=9223372036854775807`` was listed ``seed = 9223372036854775807 # ... (>= 0,
+<= 9.22337e+18)``, a value over its own bound. An integer bound is now listed exactly.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ import re
 import pyarrow.parquet as pq
 from conftest import ROOT
 
+from sim.cli import main
 from sim.studies.agnard.paired import z_box
 from sim.studies.network.validate import SIGMA_RANGE
 
@@ -68,3 +74,13 @@ def test_agnard_page_names_the_students_point_it_quotes():
     width, which, dof = float(m.group(1)), m.group(2), int(m.group(3))
     assert which == "two-sided 97.5 %", which
     assert abs(z_box(dof + 1) - width) < 0.01  # 2.3155, quoted to two decimals
+
+
+def test_sim_check_lists_an_integer_keys_bound_exactly(capsys):
+    top = 2**63 - 1
+    study = str(ROOT / "studies" / "brown_table1.toml")
+    assert main(["check", study, "--set", f"seed={top}"]) == 0, capsys.readouterr().err
+    line = next(s for s in capsys.readouterr().out.splitlines() if s.startswith("seed = "))
+    value = int(line.split("#")[0].split("=")[1])
+    bound = re.search(r"<= ([^)]+)\)$", line).group(1)
+    assert int(bound.replace("_", "")) == top == value, line
