@@ -17,6 +17,12 @@ One in code: docs/cli.md, "``sim check STUDY.toml`` prints every key with its va
 unit and bounds". ``seed``'s bound was listed ``<= 9.22337e+18``, below the bound 2**63 - 1 it
 applies: ``--set seed=9223372036854775807`` was listed ``seed = 9223372036854775807 # ... (>= 0,
 <= 9.22337e+18)``, a value over its own bound. An integer bound is now listed exactly.
+
+And ``sim run --help`` against docs/cli.md: ``--out``'s default was "results/<study> ... else
+scratch/<study>-<config hash>", where both are named by the study file's name
+(``sim run mine/my_network.toml`` of the study ``network`` writes ``scratch/my_network-<hash>/``,
+docs/cli.md's ``<name>``), and ``--quiet`` was "no progress bar" where it also leaves out the
+closing summary.
 """
 
 from __future__ import annotations
@@ -84,3 +90,17 @@ def test_sim_check_lists_an_integer_keys_bound_exactly(capsys):
     value = int(line.split("#")[0].split("=")[1])
     bound = re.search(r"<= ([^)]+)\)$", line).group(1)
     assert int(bound.replace("_", "")) == top == value, line
+
+
+def test_sim_run_help_names_the_default_directory_and_quiet_as_the_page_does(capsys):
+    assert main(["run", "--help"]) == 0
+    text = re.sub(r"\s+", " ", capsys.readouterr().out)
+    out = text[text.index("--out OUT output") : text.index("--trials TRIALS number")]
+    assert "<study>" not in out, out
+    assert "results/<name>, <name> the study file's name without .toml" in out, out
+    assert "scratch/<name>-<config hash>" in out, out
+    quiet = text[text.index("--quiet no") : text.index("--no-figures draw")]
+    assert "no closing summary" in quiet, quiet
+    cli = _prose(DOCS / "cli.md")
+    assert "`--quiet` also leaves out the closing summary" in cli
+    assert "`results/<name>/` (`<name>` the study file's" in cli
