@@ -9,9 +9,13 @@ and fixed in the page; each test fails on the page before its fix:
 * docs/papers/agnard-nolette-gagnon.md: ``agnard_block_104``'s ``first_pass.pass_xy_cm``
   "outcome reads inconclusive (fails at both vectors)"; the committed run's outcome is
   undecidable, as is every prediction's of that run (4 paired blocks at 2 vectors decide none).
-* the same page: the paired shift's ``+-2.31`` standard errors are "Student's 97.5 % point at
-  47 degrees of freedom", which is 2.01; 2.31 is the two-sided 97.5 % point
+* the same page: the paired shift's ``+-2.31`` standard errors are "Student's 97.5 % point
+  at 47 degrees of freedom", which is 2.01; 2.31 is the two-sided 97.5 % point
   (``sim.studies.agnard.paired.z_box``), its 98.75 % quantile.
+* docs/outputs.md lists the columns of Brown's chunk dataset ``trials/`` as per-model
+  convergence, status, iterations, sigma0 and the global estimates; ``brown_table1``'s chunks
+  also hold three per-trial Table 1 statistics (``pivot_share_1p1_1p3``, ...) the page did
+  not name, in "the contract scripts and the report read".
 
 One in code: docs/cli.md, "``sim check STUDY.toml`` prints every key with its value, meaning,
 unit and bounds". ``seed``'s bound was listed ``<= 9.22337e+18``, below the bound 2**63 - 1 it
@@ -30,6 +34,7 @@ from __future__ import annotations
 import re
 
 import pyarrow.parquet as pq
+import pytest
 from conftest import ROOT
 
 from sim.cli import main
@@ -104,3 +109,18 @@ def test_sim_run_help_names_the_default_directory_and_quiet_as_the_page_does(cap
     cli = _prose(DOCS / "cli.md")
     assert "`--quiet` also leaves out the closing summary" in cli
     assert "`results/<name>/` (`<name>` the study file's" in cli
+
+
+@pytest.mark.parametrize("study", ["brown_dilution", "brown_table1"])
+def test_outputs_page_names_every_column_of_browns_chunks(study, tiny_run):
+    names = set(pq.read_schema(next((tiny_run(study) / "trials").rglob("*.parquet"))).names)
+    models = ("known", "stations", "pivot")
+    said = {"chunk", "trial_in_chunk", "pivot_alpha_mm", "pivot_beta2_mm2"}
+    said |= {f"{m}_{c}" for m in models for c in ("converged", "status", "iterations", "sigma0_um")}
+    said |= {f"{m}_{g}_mm" for m in models[1:] for g in ("y1", "x2", "y2", "y3", "x4")}
+    page = _prose(DOCS / "outputs.md")
+    m = re.search(r"`brown_table1` adds [^(]*\(([^)]*)\)", page)
+    assert m, "outputs.md no longer says what brown_table1's chunks add"
+    if study == "brown_table1":
+        said |= set(re.findall(r"`(\w+)`", m.group(1)))
+    assert names == said, (sorted(names - said), sorted(said - names))
