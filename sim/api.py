@@ -128,6 +128,9 @@ class Results:
         self._check_dir()
         files, ran = list(self.path.glob("*.parquet")), run_tables(self.path, self.study)
         names = {p.stem for p in files if p.name in ran or _owner(p) == self.study}
+        within = "" if names else self._within()
+        if within:  # a results root (results/ and its verify record): [], or 'verify''s tables
+            raise ConfigError("path", f"{self.path} is not a results directory{within}")
         if files and not names:  # another study's run: its tables, none of which table() reads
             whose = sorted({repr(o) for p in files if isinstance(o := _owner(p), str)})
             raise ConfigError(

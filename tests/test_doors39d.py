@@ -22,6 +22,13 @@ unit and bounds". ``seed``'s bound was listed ``<= 9.22337e+18``, below the boun
 applies: ``--set seed=9223372036854775807`` was listed ``seed = 9223372036854775807 # ... (>= 0,
 <= 9.22337e+18)``, a value over its own bound. An integer bound is now listed exactly.
 
+And docs/python.md: ``names()`` "of another study's results ... refuses the directory, naming
+whose tables it holds; of a results root, the study's directory in it". Of a results root
+without tables of its own (``--results myres`` of a batch) ``names()`` was ``[]``, silently; of
+the project's ``results/`` it said the directory "holds tables of 'verify'" (its
+``reproducibility.parquet``), as if verify were a study. Both now refuse the root, naming the
+study's directory in it, as ``table()`` of a root does.
+
 And ``sim run --help`` against docs/cli.md: ``--out``'s default was "results/<study> ... else
 scratch/<study>-<config hash>", where both are named by the study file's name
 (``sim run mine/my_network.toml`` of the study ``network`` writes ``scratch/my_network-<hash>/``,
@@ -32,11 +39,13 @@ closing summary.
 from __future__ import annotations
 
 import re
+import shutil
 
 import pyarrow.parquet as pq
 import pytest
 from conftest import ROOT
 
+import sim
 from sim.cli import main
 from sim.studies.agnard.paired import z_box
 from sim.studies.network.validate import SIGMA_RANGE
@@ -124,3 +133,19 @@ def test_outputs_page_names_every_column_of_browns_chunks(study, tiny_run):
     if study == "brown_table1":
         said |= set(re.findall(r"`(\w+)`", m.group(1)))
     assert names == said, (sorted(names - said), sorted(said - names))
+
+
+@pytest.mark.parametrize("where", ["project", "own"])
+def test_names_of_a_results_root_names_the_studys_directory_in_it(where, tmp_path):
+    root = ROOT / "results"
+    if where == "own":  # a batch's --results DIR: results directories and no table of its own
+        root = tmp_path / "myres"
+        shutil.copytree(ROOT / "results" / "brown_table1", root / "brown_table1")
+    res = sim.Results(root, "brown_table1")
+    for read in (res.names, lambda: res.table("claims")):
+        with pytest.raises(sim.ConfigError) as e:
+            read()
+        line = str(e.value)
+        assert f"{root / 'brown_table1'} holds the study's results: give that path" in line, line
+        assert "'verify'" not in line, line
+    assert "claims" in sim.Results(root / "brown_table1", "brown_table1").names()
