@@ -398,6 +398,7 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
     check_env()  # TQDM_NCOLS=abc, NUMBA_OPT=x: refused here, not in the middle of a run
+    _absolute("study_file", study_file)  # the working directory gone: not "no such study file"
     if why := study_file_problem(study_file):  # sim check's own check of a file
         raise ConfigError("study_file", why)
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the

@@ -29,6 +29,11 @@ the project's ``results/`` it said the directory "holds tables of 'verify'" (its
 ``reproducibility.parquet``), as if verify were a study. Both now refuse the root, naming the
 study's directory in it, as ``table()`` of a root does.
 
+And docs/python.md: "In a process whose working directory was removed, absolute paths work and
+a relative one is refused naming its argument": ``sim.load("studies/x.toml")`` there said
+"study_file: studies/x.toml: no such study file", of a file that may well be there, where
+``run(out=...)`` and ``sim.Results`` say the working directory is gone; it says so now.
+
 And ``sim run --help`` against docs/cli.md: ``--out``'s default was "results/<study> ... else
 scratch/<study>-<config hash>", where both are named by the study file's name
 (``sim run mine/my_network.toml`` of the study ``network`` writes ``scratch/my_network-<hash>/``,
@@ -149,3 +154,15 @@ def test_names_of_a_results_root_names_the_studys_directory_in_it(where, tmp_pat
         assert f"{root / 'brown_table1'} holds the study's results: give that path" in line, line
         assert "'verify'" not in line, line
     assert "claims" in sim.Results(root / "brown_table1", "brown_table1").names()
+
+
+def test_load_of_a_relative_file_with_the_working_directory_gone_says_so(tmp_path, monkeypatch):
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load("studies/brown_table1.toml")
+    assert str(e.value).startswith("study_file: studies/brown_table1.toml is relative, but the")
+    assert "working directory is gone" in str(e.value)
+    assert sim.load(ROOT / "studies" / "brown_table1.toml").config["trials"] == 4000
