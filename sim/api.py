@@ -128,6 +128,9 @@ class Results:
         self._check_dir()
         files, ran = list(self.path.glob("*.parquet")), run_tables(self.path, self.study)
         names = {p.stem for p in files if p.name in ran or _owner(p) == self.study}
+        within = "" if names else self._within()
+        if within:  # a results root (results/ and its verify record): [], or 'verify''s tables
+            raise ConfigError("path", f"{self.path} is not a results directory{within}")
         if files and not names:  # another study's run: its tables, none of which table() reads
             whose = sorted({repr(o) for p in files if isinstance(o := _owner(p), str)})
             raise ConfigError(
@@ -395,6 +398,7 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     """Load and validate a study file with ``overrides`` (dotted keys, or ``__`` for the dot)."""
     _check_path("study_file", study_file)
     check_env()  # TQDM_NCOLS=abc, NUMBA_OPT=x: refused here, not in the middle of a run
+    _absolute("study_file", study_file)  # the working directory gone: not "no such study file"
     if why := study_file_problem(study_file):  # sim check's own check of a file
         raise ConfigError("study_file", why)
     # absolute now: a handle re-loads its file (replace, run with trials or seed), and the

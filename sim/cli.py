@@ -175,6 +175,11 @@ def _off(overrides: list[str], args) -> str | None:
 
 
 def _n(x: float) -> str:
+    """A bound as ``sim check`` lists it: an integer exactly (``seed``'s 2**63 - 1 was
+    ``9.22337e+18``, below the value it let the key hold), a float's whole number with its
+    digits grouped, another float as ``%g``."""
+    if isinstance(x, int):
+        return f"{x:_}"
     return f"{int(x):_}" if float(x).is_integer() and abs(x) < 1e16 else f"{x:g}"
 
 

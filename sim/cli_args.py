@@ -110,8 +110,10 @@ def _run_parser(sub) -> None:
     r.add_argument("study", help="study file, e.g. studies/brown_dilution.toml")
     r.add_argument(
         "--out",
-        help="output directory (default: results/<study> when the run equals the committed "
-        "results, else scratch/<study>-<config hash>)",
+        help="output directory (default: results/<name>, <name> the study file's name "
+        "without .toml, for a study file run as written (in the project: one of its studies/) "
+        "whose results there are of its config and code, or none yet; else "
+        "scratch/<name>-<config hash>; see docs/cli.md)",
     )
     r.add_argument(
         "--trials",
@@ -131,7 +133,7 @@ def _run_parser(sub) -> None:
         help="override any config key by its dotted name, value read as TOML (repeatable); "
         "sim check STUDY.toml lists the keys",
     )
-    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument("--quiet", action="store_true", help="no progress bar and no closing summary")
     r.add_argument(
         "--no-figures",
         action="store_true",
