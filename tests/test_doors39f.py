@@ -40,6 +40,7 @@ import re
 import shutil
 from pathlib import Path
 
+import pyarrow.parquet as pq
 import pytest
 
 import sim
@@ -128,3 +129,24 @@ def test_a_sweep_given_inline_by_an_override_is_told_where_it_goes(capsys, value
     one_line(capsys, rc, want, "[sweep] table", prefix=SIM_ERROR)
     with pytest.raises(ConfigError, match="a sweep is not set by an override"):
         sim.load(TABLE1, sweep={"plate.grid": [4, 5]})
+
+
+@pytest.mark.parametrize("splice", ["table", "provenance", "sweep_provenance"])
+def test_a_sweep_cell_with_a_table_or_metadata_of_another_is_named(sweep, tmp_path, capsys, splice):
+    """The same class, one table or its Parquet metadata spliced: cell 1's points.parquet in
+    cell 0, cell 1's (or the sweep table's) provenance on cell 0's claims.parquet."""
+    d = tmp_path / "sw"
+    shutil.copytree(sweep, d)
+    a, b = d / "cells" / "cell0000_r0", d / "cells" / "cell0001_r0"
+    if splice == "table":
+        shutil.copy(b / "points.parquet", a / "points.parquet")
+    else:
+        src = b / "claims.parquet" if splice == "provenance" else d / "sweep.parquet"
+        meta = dict(pq.read_schema(a / "claims.parquet").metadata)
+        meta[b"sim.provenance"] = pq.read_schema(src).metadata[b"sim.provenance"]
+        t = pq.read_table(a / "claims.parquet")
+        pq.write_table(t.replace_schema_metadata(meta), a / "claims.parquet")
+    capsys.readouterr()
+    name = "points" if splice == "table" else "claims"
+    want = f"{name}.parquet is not a table of the cell cell0000_r0 of its sweep (seed = "
+    one_line(capsys, main(["show", str(a)]), want, prefix=SIM_ERROR)
