@@ -33,7 +33,14 @@ from sim.api_args import dotted as _key
 from sim.api_args import flag
 from sim.api_args import keyed as _keyed
 from sim.api_paths import absolute_path as _absolute
-from sim.api_paths import another_run, cell_chunks, chunks_recorded, why_not_a_dir, why_unread
+from sim.api_paths import (
+    another_run,
+    cell_chunks,
+    cell_mixed,
+    chunks_recorded,
+    why_not_a_dir,
+    why_unread,
+)
 from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
@@ -174,7 +181,8 @@ class Results:
             raise ConfigError("table", f"{p} cannot be read ({why_unread(e)})") from None
         if not dataset:
             _check_owner(p, self.study)
-            if (mixed := mixed_run(self.path, [p.name])) is not None:  # copied from another run
+            mixed = mixed_run(self.path, [p.name]) or cell_mixed(self.path, [p.name])
+            if mixed is not None:  # copied from another run, or another cell's
                 raise ConfigError("table", mixed)
             if (edit := shape_problem(table, recorded_shape(p))) is not None:  # edited by hand
                 raise ConfigError("table", f"{p} is not the table its run wrote: {edit}")

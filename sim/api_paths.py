@@ -17,15 +17,19 @@ import os
 from pathlib import Path
 from typing import Any
 
+import pyarrow as pa
+import pyarrow.parquet as pq
+
 from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
-from sim.mc.storage import RECORD, config_hash, read_record, regular_text
+from sim.mc.storage import RECORD, config_hash, read_provenance, read_record, regular_text
 
 __all__ = [
     "another_run",
     "check_path",
     "absolute_path",
     "cell_chunks",
+    "cell_mixed",
     "chunks_recorded",
     "too_long",
     "why_not_a_dir",
@@ -159,6 +163,47 @@ def cell_chunks(d: Path) -> str | None:
         f"{d} is a cell of the sweep {sweep}, whose run.json records no sha256 of the cells' "
         "chunk files: they cannot be checked, and are not read (the cell's tables are)"
     )
+
+
+def cell_mixed(d: Path, names: list[str] | None = None) -> str | None:
+    """Why the tables of ``d``, a cell of a sweep (``<sweep>/cells/<label>/``, which has no run
+    record of its own), are not that cell's (``names``: only these tables), or None. The
+    sweep's ``sweep.parquet`` row of the label gives the cell's seed and swept values and its
+    ``run.json`` the code: a cell replaced by another cell's, another sweep's or a single run's
+    results (cells renamed, two sweeps merged by hand) was shown as the label's cell."""
+    sweep = d.parent.parent
+    if d.parent.name != "cells" or (d / RECORD).exists() or not (sweep / "sweep.parquet").is_file():
+        return None
+    record = read_record(sweep)
+    cfg = record.get("config") if isinstance(record, dict) else None
+    keys = [k for k in (cfg or {}).get("sweep") or {} if k not in ("replicates", "seed_mode")]
+    try:
+        rows = pq.read_table(sweep / "sweep.parquet").to_pylist()
+    except (OSError, ValueError, pa.ArrowException):
+        return None  # not Parquet: its reader names it
+    row = next((r for r in rows if isinstance(r, dict) and r.get("label") == d.name), None)
+    if not isinstance(cfg, dict) or row is None:
+        return None if row else f"{d}: its sweep {sweep} has no cell {d.name} (sweep.parquet)"
+    want = {k: row.get(k) for k in ("seed", *keys) if not isinstance(row.get(k), (list, dict))}
+    for p in sorted(d / n for n in names) if names else sorted(d.glob("*.parquet")):
+        try:
+            prov = read_provenance(p)
+        except (OSError, ValueError, pa.ArrowException):
+            continue  # not Parquet: its reader names it
+        mine = prov.get("config") if isinstance(prov, dict) else None
+        if not isinstance(mine, dict):
+            continue  # no provenance: read as it is (mixed_run's missing_ok)
+        diff = [
+            f"{k} = {mine.get(k)!r}, the cell's {v!r}" for k, v in want.items() if mine.get(k) != v
+        ]
+        if prov.get("code_hash") != record.get("code_hash"):
+            diff.append("made by other code than its sweep")
+        if diff:
+            return (
+                f"{p} is not a table of the cell {d.name} of its sweep ({diff[0]}): the cell "
+                "holds another cell's or run's results; run the sweep again"
+            )
+    return None
 
 
 def another_run(out: Path, study: str) -> str:

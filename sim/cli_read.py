@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
+from sim.api_paths import cell_mixed
 from sim.cli_errors import not_as_written, older_lacks
 from sim.mc.config import ConfigError
 from sim.mc.outputs import name_problem, results_dirs
@@ -77,6 +78,8 @@ def _shown_text(d: Path, markdown: bool) -> str:
     check_claims_table(d / "claims.parquet", "DIR")
     if (sweep := _sweep_of(d)) is not None and (mixed := mixed_run(sweep)) is not None:
         raise ConfigError("DIR", mixed)  # a cell's figure replaced by hand: its sweep's record
+    if (cell := cell_mixed(d)) is not None:  # a cell's tables of another cell or run
+        raise ConfigError("DIR", cell)
     try:
         if markdown:
             return run_markdown(d, get_study, design=design_config)

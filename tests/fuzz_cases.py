@@ -2,7 +2,8 @@
 tiny file (tests/fuzz_values.py) with one mutation of a kind drawn by the seed: VALUE, two
 values, a ``--set``, STRUCTURE, a ``[sweep]``, an option, a key in the wrong place
 (``relocate``), TYPE, KEY spelling (tests/fuzz_keys.py), EDGE values (tests/fuzz_edges.py), SHAPE
-(tests/fuzz_shapes.py), BYTES of the file (tests/fuzz_bytes.py)."""
+(tests/fuzz_shapes.py), BYTES of the file (tests/fuzz_bytes.py), SPLICE of two studies' files
+(tests/fuzz_splice.py)."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from fuzz_bytes import bytes_case
 from fuzz_edges import edge_case
 from fuzz_keys import respell
 from fuzz_shapes import shape_case
+from fuzz_splice import splice_case
 from fuzz_values import (
     NAMES,
     NAN,
@@ -73,6 +75,7 @@ def make_case(i: int):
         + ["edge"] * int(os.environ.get("FUZZ_EDGE_WEIGHT", "2"))
         + ["shape"] * int(os.environ.get("FUZZ_SHAPE_WEIGHT", "1"))
         + ["bytes"] * int(os.environ.get("FUZZ_BYTES_WEIGHT", "2"))
+        + ["splice"] * int(os.environ.get("FUZZ_SPLICE_WEIGHT", "2"))
     )
     if kind in ("value", "two"):
         keys = rng.sample(schema, 2 if kind == "two" else 1)
@@ -145,6 +148,9 @@ def make_case(i: int):
         raw = text.encode()
     elif kind == "bytes":  # the description ends with the mutation (fuzz_bytes.SAME: runs)
         raw, desc = bytes_case(rng, "\n".join(toml_tables(flat)) + "\n")
+    elif kind == "splice":  # the description ends ": must name ..." when it must be refused
+        text, desc = splice_case(rng, name, flat, fields)
+        raw = text.encode()
     elif kind == "relocate":
         raw, desc = relocate(rng, flat, schema)
     elif kind == "key":  # the last word of desc: the key the refusal must name

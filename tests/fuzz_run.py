@@ -159,6 +159,10 @@ def fuzz(n: int, tmp: Path) -> list[str]:
                 bad = f"the same document in another shape not run: exit {code}"
             elif not shape.endswith(SAME) and (code != 2 or shape.split()[-1] not in err):
                 bad = f"a table given twice not refused naming {shape.split()[-1]}: exit {code}"
+        if not bad and ": splice: " in desc and ": must name " in desc:  # a key out of place
+            named = desc.split(": must name ")[-1].removeprefix("one of ").split()
+            if code != 2 or not any(n in err for n in named):
+                bad = f"a spliced key not refused naming {' or '.join(named)}: exit {code}"
         if not bad and ": bytes: " in desc and desc.endswith(SAME_BYTES) and code != 0:
             bad = f"the same document in other bytes not run: exit {code}"
         if bad:

@@ -21,7 +21,10 @@ and then more, the study's name as a table: refused naming it; tests/fuzz_shapes
 ``FUZZ_SHAPE_WEIGHT``), its BYTES (a UTF-8 signature, CRLF or lone CR ends, a NUL, UTF-16, a
 Latin-1 byte, an invisible or look-alike character in a key or a number, a form feed for a
 space, the file cut short: tests/fuzz_bytes.py; ``FUZZ_BYTES_WEIGHT``: a signature, CRLF or
-no last line end is the same document, which must run) or the command line (``--trials``, ``--seed``, ``--workers``, ``--out``,
+no last line end is the same document, which must run), a SPLICE of two valid files (a table,
+a ``[sweep]`` or a record's field of another study or list pasted in, a list of records
+written as one inline table, a table as an array of tables: tests/fuzz_splice.py;
+``FUZZ_SPLICE_WEIGHT``: refused naming the key brought in) or the command line (``--trials``, ``--seed``, ``--workers``, ``--out``,
 ``--scheduler``). Every case runs ``sim run`` in a forked child
 (its own session, an address-space limit, a time bound) and must give exit 0 with finite
 results, or exit 2 with exactly one line on standard error and no traceback, and leave
@@ -33,7 +36,8 @@ nothing outside the output directory but, after a failed run, its staging direct
 message prints the command that reproduces it). The cases are made in tests/fuzz_cases.py
 from the values of tests/fuzz_values.py and run by tests/fuzz_run.py. The BYTES of a GNU Gama
 XML file and of Wolf's reading tables are fuzzed by ``sim check`` of the study that reads
-them (``test_fuzz_bytes_of_data_files``)."""
+them (``test_fuzz_bytes_of_data_files``), the SPLICE of study files and of GNU Gama XML files
+by ``sim check`` too (``test_fuzz_splice``: many cases in little time)."""
 
 from __future__ import annotations
 
@@ -46,6 +50,7 @@ from fuzz_bytes import csv_sites, gama_sites, mutate_bytes
 from fuzz_cases import SEED
 from fuzz_keys import network_case
 from fuzz_run import fuzz
+from fuzz_splice import gama_splice, splice_case
 from fuzz_values import NAMES, ROOT, base, small, toml_doc, toml_value
 
 from sim.cli import main
@@ -158,6 +163,42 @@ def test_fuzz_bytes_of_data_files(tmp_path, capsys):
         elif rc not in (0, 2) or (rc == 2 and ("\n" in err or str(f) not in err)):
             failures.append(f"case {i} ({which}: {desc}): exit {rc}: {err[-300:]}")
     assert not failures, f"{len(failures)} of {3 * CASES}:\n" + "\n".join(failures)
+
+
+def test_fuzz_splice(tmp_path, capsys):
+    """SPLICE (tests/fuzz_splice.py) by ``sim check``: a study file crossed with another
+    study's must be refused naming the key it brought in, or be a valid file (exit 0); a GNU
+    Gama file with an element or attribute moved must be refused in one line naming the file
+    and the element or attribute, or, moved as ``gama-local`` reads the same, read as it is."""
+    gamas = [ROOT / "tests" / "data" / "gama" / f"{n}.xml" for n in ("one_fixed", "two_sets")]
+    gamas += [ROOT / "tests" / "data" / "gama" / f"{n}.xml" for n in ("user_dms", "plate")]
+    schemas = {n: load_study(ROOT / "studies" / f"{n}.toml")[0].schema for n in NAMES}
+    failures = []
+    for i in range(2 * CASES):
+        rng, name = random.Random(SEED * 100_003 + 33_333 + i), NAMES[i % len(NAMES)]
+        text, desc = splice_case(rng, name, base(name), schemas[name])
+        (f := tmp_path / "study.toml").write_text(text)
+        rc, err = main(["check", str(f)]), capsys.readouterr().err.strip()
+        named = desc.split(": must name ")[-1].removeprefix("one of ").split()
+        if rc not in (0, 2) or (rc == 2 and "\n" in err) or "Traceback" in err:
+            failures.append(f"case {i} ({name}: {desc}): exit {rc}: {err[-300:]}")
+        elif ": must name " in desc and (rc != 2 or not any(n in err for n in named)):
+            failures.append(f"case {i} ({name}: {desc}): not refused naming it: {err[-300:]}")
+    for i in range(2 * CASES):
+        src = gamas[i % len(gamas)]
+        rng = random.Random(SEED * 100_003 + 44_444 + i)
+        text, desc, needle = gama_splice(rng, src.read_text(encoding="utf-8"))
+        (x := tmp_path / f"splice-{i}.xml").write_text(text, encoding="utf-8")
+        study = tmp_path / "gama.toml"
+        study.write_text(
+            f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{x}"\n'
+        )
+        rc, err = main(["check", str(study)]), capsys.readouterr().err.strip()
+        if needle is None and (rc != 0 or _read("gama", x) != _read("gama", src)):
+            failures.append(f"case {i} ({src.name}: {desc}): exit {rc} or read as another input")
+        elif needle and (rc != 2 or "\n" in err or str(x) not in err or needle not in err):
+            failures.append(f"case {i} ({src.name}: {desc}): exit {rc}: {err[-300:]}")
+    assert not failures, f"{len(failures)} of {4 * CASES}:\n" + "\n".join(failures)
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz

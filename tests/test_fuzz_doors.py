@@ -29,7 +29,7 @@ CASES = int(os.environ.get("FUZZ_CASES", "12"))
 
 BAD = {
     "out": [5, 1.0, b"x", "", "   ", "a\0b", ["x"]],
-    "workers": ["2", 2.0, 0, -1, 10_000, True, None],
+    "workers": ["2", 2.5, 0, -1, 10_000, True, None],  # 2.0 is 2 (as trials=400.0 is 400)
     "executor": ["", "thread", None, 1, "LOCAL"],
     "trials": ["10", 1.5, True],
     "seed": ["1", 2.5, [1]],

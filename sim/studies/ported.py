@@ -28,6 +28,8 @@ __all__ = ["foreign_key"]
 
 #: how many of the file's foreign keys the line shows before "and N more"
 SHOWN = 3
+#: the sweep's own keys (not config keys)
+REPEAT = ("replicates", "seed_mode")
 
 
 def _schemas(name: str) -> dict[str, Mapping]:
@@ -80,11 +82,11 @@ def foreign_key(e: ConfigError, path: str | os.PathLike) -> ConfigError:
             note += f" (the file holds {len(old)} such keys: {', '.join(old[:SHOWN])}{more})"
         return ConfigError(e.key, note)
     swept = e.key.removeprefix("sweep.")
-    if swept != e.key and (swept in schema or swept in ("replicates", "seed_mode")):
-        return ConfigError(  # --set sweep.plate.grid=[4,5]: "a key of brown_dilution" (sic)
-            e.key,
-            f"unknown key: a sweep is not set by an override; write {swept} in the study "
-            "file's [sweep] table",
+    if e.key == "sweep" or (swept != e.key and (swept in schema or swept in REPEAT)):
+        return ConfigError(  # --set sweep.plate.grid=[4,5]: "a key of brown_dilution" (sic);
+            e.key,  # --set 'sweep={plate.grid=[4,5]}', the same in TOML: "sweep: unknown key"
+            f"unknown key: a sweep is not set by an override; write "
+            f"{'its keys' if swept == 'sweep' else swept} in the study file's [sweep] table",
         )
     key = e.key.removeprefix("sweep.")
     schemas = _schemas(name)

@@ -182,9 +182,7 @@ def _obs(f: _File, e, dflt: dict, sets: dict, out: list) -> None:
         f.num(e, "from_dh")
     kids = list(e)
     cms = [o for o in kids if _tag(o) == "cov-mat"]
-    obs = [o for o in kids if _tag(o) != "cov-mat"]
-    if len(cms) > 1 or (cms and kids[-1] is not cms[0]):
-        raise f.err(cms[0], "one <cov-mat> after the observations of an <obs>")
+    obs = [o for o in kids if _tag(o) != "cov-mat"]  # the <cov-mat> last: gama_vocab checks
     var = list(_cov(f, cms[0], len(obs))) if cms else [None] * len(obs)
     label = ""
     if any(_tag(o) == "direction" for o in obs):

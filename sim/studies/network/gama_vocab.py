@@ -121,9 +121,8 @@ VOCAB = {
     "vectors": set(),
     "vec": {"from", "to", "dx", "dy", "dz", "from_dh", "to_dh", "extern"},
 }
-#: where each element may stand (gama-local.xsd): element -> the elements that may hold it; an
-#: element elsewhere (a <point> inside <parameters>, an <obs> directly in <network>) would be
-#: skipped by the reader, so it is refused
+#: where each element may stand (gama-local.xsd): element -> the elements that may hold it; one
+#: elsewhere (a <point> inside <parameters>) would be skipped by the reader: it is refused
 PARENTS = {
     "network": {"gama-local"},
     "description": {"network"},
@@ -243,6 +242,8 @@ class _File:
                 if isinstance(e.tag, str) and _tag(parent) not in PARENTS.get(_tag(e), {""}):
                     if _tag(e) in VOCAB and _tag(e) not in _REFUSED:
                         raise self.err(e, f"not allowed inside <{_tag(parent)}>")
+                if _tag(e) == "cov-mat" and e is not parent[-1]:  # gama-local reads none after it
+                    raise self.err(e, f"one <cov-mat>, the last element of its <{_tag(parent)}>")
         for e in root.iter():
             t = _tag(e)
             ns = e.tag[1:].split("}", 1)[0] if isinstance(e.tag, str) and e.tag[:1] == "{" else NS
