@@ -23,7 +23,7 @@ from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, write_record
 from sim.mc.table_shape import kind
 from sim.report.claimtext import interval_text, sim_text
-from sim.report.config_diff import config_line
+from sim.report.config_diff import config_line, sweep_config_line
 from sim.report.off_paper import off_note, off_setup, sweep_off_note
 from sim.report.papers import paper_name
 from sim.report.read import TableError, checked_table, columns, forget, records
@@ -243,7 +243,11 @@ def terminal_table(
     out = Path(out)
     study = _kind_of(out) == "study"
     cfg = read_provenance(out / "claims.parquet") if study else _sweep_prov(out)
-    changed = config_line(cfg.get("config") or {}, out.name, design)
+    changed = (
+        config_line(cfg.get("config") or {}, out.name, design)
+        if study
+        else sweep_config_line(cfg, out.name, design)
+    )
     tail = "" if changed is None else f"\n{changed}"
     if _kind_of(out) == "sweep":  # each cell with its swept values (cell0003_r0 alone named
         t = columns(out / "sweep.parquet")  # no setting), and where its claims are
@@ -364,7 +368,12 @@ def run_markdown(
         f"({md_code(f'sim show {shlex.quote(name)}')} prints it again).",
         "",
     ]
-    if (changed := config_line(prov.get("config") or {}, name, design)) is not None:
+    changed = (
+        config_line(prov.get("config") or {}, name, design)
+        if kind == "study"
+        else sweep_config_line(prov, name, design)
+    )
+    if changed is not None:
         head += [f"**Configuration.** {changed}", ""]
     if kind == "sweep":
         if off := sweep_off_note(out, get_study):  # said once, at the top

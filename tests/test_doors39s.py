@@ -1,0 +1,138 @@
+"""The classes of the sweep doors39s (brief S39: a careless user of sweeps and batches: sweeps
+interrupted and resumed, changed between runs, cells' tables moved by hand, sweeps over keys of
+every kind, batches of sweeps), one case each; each failed on the code before its fix.
+
+* A sweep's "Configuration" line (its README.md, ``sim show``) named only what its base
+  config changed from the study file (``chunk``, ``seed``, ``trials``), never the swept keys,
+  whose cells leave the file's design, nor their values; a swept key given another value
+  outside ``[sweep]`` was named as a change of the run (``plate.spacing_mm = 40.0 (the file:
+  45.0)``), a value no cell ran; a network's sweep (no study file to compare) said nothing.
+  It now says the cells, the swept keys and their values (and the file's value of each), the
+  seeds, then what the other keys change (:func:`sim.report.config_diff.sweep_config_line`).
+* A sweep cell's table replaced by another cell's (``cp cells/cell0000_r0/claims.parquet
+  cells/cell0001_r0/``: the same shape, other numbers) was read as its own by ``sim show`` of
+  the cell and ``sim.Results(cell).table``, and ``--stale-only`` called the sweep current: the
+  sweep's record kept the sha256 of its top-level tables only (a cell has no record of its
+  own). It keeps every cell's tables' too, and the readers of a cell check them
+  (:func:`sim.mc.table_edits.edited_cell`; ``--stale-only``: :func:`edited_tables`).
+
+Held (tried through ``sim run``, ``python -m sim.batch`` and the API): a sweep killed by
+SIGTERM or SIGKILL in a cell or between cells and run again gives every table and figure byte
+for byte as an uninterrupted sweep; the same command with one value added, removed or
+reordered is refused naming the unfinished run's sweep (``--overwrite``: started over, said
+so), and a finished sweep replaced by a smaller one keeps none of the old cells; a sweep over
+``network.gama_xml``, a Wolf table, ``seed`` or ``study`` is refused naming the key; a value
+given twice or spelt twice (``1e3`` and ``1000``) is refused; ``[40]`` is one cell; a key of
+another study is named with the study that has it; a batch naming one file twice (``./a.toml``)
+is refused.
+"""
+
+from __future__ import annotations
+
+import shutil
+import textwrap
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim.cli import main
+from sim.mc.storage import write_table
+from sim.mc.table_edits import edited_tables
+from sim.report.run_summary import run_markdown, terminal_table
+from sim.studies import design_config, get_study
+
+ROOT = Path(__file__).resolve().parents[1]
+
+NETWORK = """\
+study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+           { name = "B", x_mm = 1000.0, y_mm = 0.0, role = "fixed" },
+           { name = "C", x_mm = 400.0, y_mm = 700.0 } ]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
+[sweep]
+"test.alpha" = [0.05, 0.01]
+"""
+
+
+def _sweep_dir(d: Path, cfg: dict, table: dict, keys: list[str], values: dict) -> Path:
+    """A sweep's results as its readers see them: ``sweep.parquet`` with its provenance."""
+    n = len(next(iter(values.values())))
+    cols = {
+        "cell": list(range(n)),
+        "replicate": [0] * n,
+        "label": [f"cell{i:04d}_r0" for i in range(n)],
+        "seed": list(range(1, n + 1)),
+        "feasible": [True] * n,
+        "reason": [""] * n,
+        **values,
+    }
+    prov = {"study": cfg["study"], "config": cfg, "sweep": table, "sweep_keys": keys}
+    d.mkdir()
+    write_table(d / "sweep.parquet", cols, prov)
+    return d
+
+
+def test_a_sweeps_configuration_line_names_the_swept_keys(tmp_path):
+    cfg = sim.load(ROOT / "studies" / "brown_table1.toml", trials=400).config
+    cfg = {**cfg, "plate.spacing_mm": 40.0}  # outside [sweep]: no cell runs it
+    table = {"plate.spacing_mm": [35.0, 45.0], "errors.settings": [1, 2]}
+    values = {"plate.spacing_mm": [35.0, 35.0, 45.0, 45.0], "errors.settings": [1, 2, 1, 2]}
+    d = _sweep_dir(tmp_path / "brown_table1", cfg, table, list(table), values)
+    said = (
+        "A sweep of 4 cells over `plate.spacing_mm` = 35.0, 45.0 (the file: 45.0); "
+        "`errors.settings` = 1, 2 (the file: 2): each its own seed, spawned from seed 1967. "
+        "Its other keys are not the configuration of `studies/brown_table1.toml`: `chunk` = 20 "
+        "(the file: 200), `trials` = 400 (the file: 4000)."
+    )
+    md = run_markdown(d, get_study, design=design_config)
+    assert f"**Configuration.** {said}" in md, md
+    assert "(the file: 45.0), `trials`" not in md and "= 40.0" not in md
+    assert said in terminal_table(d, design=design_config, get_study=get_study)
+    # a network's sweep has no study file to compare with: its line still says what is swept
+    net = sim.load(_file(tmp_path, "n.toml", NETWORK)).config
+    values = {"test.alpha": [0.05, 0.01]}
+    d = _sweep_dir(tmp_path / "n", net, {"test.alpha": [0.05, 0.01]}, ["test.alpha"], values)
+    said = "A sweep of 2 cells over `test.alpha` = 0.05, 0.01: each its own seed, spawned from"
+    assert said in run_markdown(d, get_study, design=design_config)
+
+
+def _file(tmp_path: Path, name: str, text: str) -> Path:
+    p = tmp_path / name
+    p.write_text(textwrap.dedent(text))
+    return p
+
+
+@pytest.fixture(scope="module")
+def swept(tmp_path_factory) -> Path:
+    """A finished two-cell network sweep (tables only)."""
+    tmp = tmp_path_factory.mktemp("swept")
+    out = tmp / "out"
+    cmd = ["run", str(_file(tmp, "s.toml", NETWORK)), "--out", str(out), "--quiet"]
+    assert main([*cmd, "--no-figures"]) == 0
+    return out
+
+
+def test_a_cells_table_copied_from_another_cell_is_not_read_as_its_own(
+    swept, tmp_path, capsys
+):
+    out = tmp_path / "out"
+    shutil.copytree(swept, out)
+    cell = out / "cells" / "cell0001_r0"
+    assert main(["show", str(cell)]) == 0  # as the run wrote it
+    assert sim.Results(cell, "network").table("claims").num_rows
+    assert edited_tables(out) == []
+    shutil.copyfile(out / "cells" / "cell0000_r0" / "claims.parquet", cell / "claims.parquet")
+    capsys.readouterr()
+    assert main(["show", str(cell)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err
+    assert "cell0001_r0/claims.parquet is not the table its cell's run wrote" in err, err
+    with pytest.raises(sim.ConfigError, match="copied from another cell"):
+        sim.Results(cell, "network").table("claims")
+    assert sim.Results(cell, "network").table("points").num_rows  # its own tables still read
+    assert main(["show", str(out / "cells" / "cell0000_r0")]) == 0
+    assert edited_tables(out) == ["cells/cell0001_r0/claims.parquet"]  # --stale-only: re-run
