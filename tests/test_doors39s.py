@@ -116,9 +116,7 @@ def swept(tmp_path_factory) -> Path:
     return out
 
 
-def test_a_cells_table_copied_from_another_cell_is_not_read_as_its_own(
-    swept, tmp_path, capsys
-):
+def test_a_cells_table_copied_from_another_cell_is_not_read_as_its_own(swept, tmp_path, capsys):
     out = tmp_path / "out"
     shutil.copytree(swept, out)
     cell = out / "cells" / "cell0001_r0"
