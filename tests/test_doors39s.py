@@ -15,6 +15,11 @@ every kind, batches of sweeps), one case each; each failed on the code before it
   sweep's record kept the sha256 of its top-level tables only (a cell has no record of its
   own). It keeps every cell's tables' too, and the readers of a cell check them
   (:func:`sim.mc.table_edits.edited_cell`; ``--stale-only``: :func:`edited_tables`).
+* ``sweep.png`` of a sweep over a list-valued key whose values differ in their middle
+  (``network.grids`` of 3 x 3 and 4 x 4 points: ``[{'prefix': 'G', 'nx': 3, ...}]``) labelled
+  every tick the same, ``"[{'pre…0012}]"`` (a long label kept both its ends): the ticks told
+  no cell from another. A label leaves out the text all values share when both ends read the
+  same (``…3, 'ny': 3…``, :func:`sim.report.sweep._apart`).
 
 Held (tried through ``sim run``, ``python -m sim.batch`` and the API): a sweep killed by
 SIGTERM or SIGKILL in a cell or between cells and run again gives every table and figure byte
@@ -40,6 +45,7 @@ from sim.cli import main
 from sim.mc.storage import write_table
 from sim.mc.table_edits import edited_tables
 from sim.report.run_summary import run_markdown, terminal_table
+from sim.report.sweep import fig_sweep
 from sim.studies import design_config, get_study
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -134,3 +140,29 @@ def test_a_cells_table_copied_from_another_cell_is_not_read_as_its_own(swept, tm
     assert sim.Results(cell, "network").table("points").num_rows  # its own tables still read
     assert main(["show", str(out / "cells" / "cell0000_r0")]) == 0
     assert edited_tables(out) == ["cells/cell0001_r0/claims.parquet"]  # --stale-only: re-run
+
+
+def test_a_sweeps_figure_tells_list_values_apart_that_differ_in_their_middle(tmp_path, monkeypatch):
+    grid = "[{{'prefix': 'G', 'nx': {n}, 'ny': {n}, 'spacing_mm': 40.0, 'sigma_mm': 0.0012}}]"
+    values = [grid.format(n=n) for n in range(3, 53)]  # as sweep.parquet holds a list value
+    cols = {
+        "cell": list(range(50)),
+        "replicate": [0] * 50,
+        "label": [f"cell{i:04d}_r0" for i in range(50)],
+        "seed": list(range(50)),
+        "feasible": [True] * 50,
+        "reason": [""] * 50,
+        "network.grids": values,
+        "c.x": [float(i) for i in range(50)],
+        "c.x:lo": [i - 1.0 for i in range(50)],
+        "c.x:hi": [i + 1.0 for i in range(50)],
+    }
+    prov = {"study": "network", "sweep_keys": ["network.grids"], "claim_intervals": {}}
+    write_table(tmp_path / "sweep.parquet", cols, prov)
+    figs: list = []
+    monkeypatch.setattr("sim.report.sweep.save", lambda fig, png: figs.append(fig))
+    fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png")
+    ticks = [t.get_text() for t in figs[0].axes[0].get_xticklabels()]
+    assert len(ticks) == 25 and len(set(ticks)) == 25, ticks
+    assert ticks[:2] == ["\u20263, 'ny': 3\u2026", "\u20265, 'ny': 5\u2026"], ticks
+    assert all(len(t) <= 16 for t in ticks), ticks

@@ -264,12 +264,11 @@ def terminal_table(
         ok = sum(bool(f) for f in t["feasible"])
         off = sweep_off_note(out, get_study)
         return (
-            (
-                f"{table}\n\nsweep: {ok} of {len(rows)} cells ran; every claim of every cell: "
-                f"sim show {shlex.quote(str(out))} --markdown"  # a command to paste (doors25a)
+            (  # what was swept first, the command to paste (doors25a) last but a note
+                f"{table}\n\n{tail[1:] + chr(10) if tail else ''}sweep: {ok} of {len(rows)} cells "
+                f"ran; every claim of every cell: sim show {shlex.quote(str(out))} --markdown"
             )
             + (f"\n{off}" if off else "")
-            + tail
         )
     claims = records(out / "claims.parquet")
     rows = [[r["claim"], _value_text(r), _interval(r), verdict_cell(r)] for r in claims]
