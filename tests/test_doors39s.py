@@ -15,6 +15,11 @@ every kind, batches of sweeps), one case each; each failed on the code before it
   sweep's record kept the sha256 of its top-level tables only (a cell has no record of its
   own). It keeps every cell's tables' too, and the readers of a cell check them
   (:func:`sim.mc.table_edits.edited_cell`; ``--stale-only``: :func:`edited_tables`).
+* ``sim run FILE --trials 60`` of a sweep over ``trials`` (``python -m sim.batch ... --
+  --trials 60`` too) ran with exit 0, recording ``trials = 60`` and ``--trials 60`` as the
+  run's, where no cell ran 60 trials (each sets its swept value again); ``--set trials=60``,
+  ``--chunk`` of a swept chunk and the API's ``run(trials=60)`` were refused. It is refused
+  as they are (:func:`sim.studies.load_study`).
 * ``sweep.png`` of a sweep over a list-valued key whose values differ in their middle
   (``network.grids`` of 3 x 3 and 4 x 4 points: ``[{'prefix': 'G', 'nx': 3, ...}]``) labelled
   every tick the same, ``"[{'pre…0012}]"`` (a long label kept both its ends): the ticks told
@@ -166,3 +171,15 @@ def test_a_sweeps_figure_tells_list_values_apart_that_differ_in_their_middle(tmp
     assert len(ticks) == 25 and len(set(ticks)) == 25, ticks
     assert ticks[:2] == ["\u20263, 'ny': 3\u2026", "\u20265, 'ny': 5\u2026"], ticks
     assert all(len(t) <= 16 for t in ticks), ticks
+
+
+def test_trials_of_a_sweep_over_trials_is_refused(tmp_path, capsys):
+    text = NETWORK.replace('"test.alpha" = [0.05, 0.01]', "trials = [40, 80]")
+    f, out = _file(tmp_path, "t.toml", text), tmp_path / "out"
+    assert main(["run", str(f), "--trials", "60", "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "sim: error: trials: is swept by the file's [sweep] table: an override would have no "
+        "effect\n"
+    ), err
+    assert not out.exists()
