@@ -24,7 +24,7 @@ every kind, batches of sweeps), one case each; each failed on the code before it
   (``network.grids`` of 3 x 3 and 4 x 4 points: ``[{'prefix': 'G', 'nx': 3, ...}]``) labelled
   every tick the same, ``"[{'pre…0012}]"`` (a long label kept both its ends): the ticks told
   no cell from another. A label leaves out the text all values share when both ends read the
-  same (``…3, 'ny': 3…``, :func:`sim.report.sweep._apart`).
+  same (``…3, 'ny': 3…``, :func:`sim.report.labels.apart`).
 
 Held (tried through ``sim run``, ``python -m sim.batch`` and the API): a sweep killed by
 SIGTERM or SIGKILL in a cell or between cells and run again gives every table and figure byte
@@ -94,8 +94,8 @@ def test_a_sweeps_configuration_line_names_the_swept_keys(tmp_path):
     values = {"plate.spacing_mm": [35.0, 35.0, 45.0, 45.0], "errors.settings": [1, 2, 1, 2]}
     d = _sweep_dir(tmp_path / "brown_table1", cfg, table, list(table), values)
     said = (
-        "A sweep of 4 cells over `plate.spacing_mm` = 35.0, 45.0 (the file: 45.0); "
-        "`errors.settings` = 1, 2 (the file: 2): each its own seed, spawned from seed 1967. "
+        "A sweep of 4 cells over `plate.spacing_mm` = [35.0, 45.0] (the file: 45.0); "
+        "`errors.settings` = [1, 2] (the file: 2): each its own seed, spawned from seed 1967. "
         "Its other keys are not the configuration of `studies/brown_table1.toml`: `chunk` = 20 "
         "(the file: 200), `trials` = 400 (the file: 4000)."
     )
@@ -107,7 +107,7 @@ def test_a_sweeps_configuration_line_names_the_swept_keys(tmp_path):
     net = sim.load(_file(tmp_path, "n.toml", NETWORK)).config
     values = {"test.alpha": [0.05, 0.01]}
     d = _sweep_dir(tmp_path / "n", net, {"test.alpha": [0.05, 0.01]}, ["test.alpha"], values)
-    said = "A sweep of 2 cells over `test.alpha` = 0.05, 0.01: each its own seed, spawned from"
+    said = "A sweep of 2 cells over `test.alpha` = [0.05, 0.01]: each its own seed, spawned from"
     assert said in run_markdown(d, get_study, design=design_config)
 
 

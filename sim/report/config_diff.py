@@ -15,7 +15,9 @@ from typing import Any, Callable, Mapping
 from sim.mc.config import ConfigError
 from sim.mc.numtext import shows_differently
 from sim.mc.sweep import expand
+from sim.mc.toml_text import toml_value
 from sim.report.inputs import as_set
+from sim.report.labels import apart, middle
 
 __all__ = ["changed_keys", "changes_text", "design_of", "config_line", "sweep_config_line"]
 
@@ -81,15 +83,17 @@ _SHOWN_VALUES = 6
 
 
 def _values_text(vals: list) -> str:
-    """A swept key's distinct values in order (``35.0, 45.0``; of many, the first five, ``...``
-    and the last, with their count)."""
+    """A swept key's distinct values in order, as TOML writes them (``[35.0, 45.0]``; of
+    many, the first five, ``...`` and the last, with their count), each at most 40
+    characters that tell it from the others (:func:`sim.report.labels.apart`)."""
     seen: dict[str, Any] = {}
     for v in vals:
         seen.setdefault(repr(v), v)
-    shown = [as_set(v)[:40] for v in seen.values()]
+    shown = apart([toml_value(v) for v in seen.values()], 40)
     if len(shown) > _SHOWN_VALUES:
-        shown = [*shown[: _SHOWN_VALUES - 1], "...", f"{shown[-1]} ({len(shown)} values)"]
-    return ", ".join(shown)
+        shown = [*shown[: _SHOWN_VALUES - 1], "...", shown[-1]]
+        return f"[{', '.join(shown)}] ({len(seen)} values)"
+    return f"[{', '.join(shown)}]"
 
 
 def sweep_config_line(
@@ -113,13 +117,15 @@ def sweep_config_line(
     base = found[1] if found else {}
     swept = "; ".join(
         f"`{k}` = {_values_text([c[k] for c in cells])}"
-        + (f" (the file: {as_set(base[k])[:40]})" if k in base else "")
+        + (f" (the file: {middle(as_set(base[k]), 40)})" if k in base else "")
         for k in keys
     )
     n = len(cells) * reps
     seed = as_set(cfg.get("seed"))
     seeds = (
-        f"every cell with seed {seed} (seed_mode common)"
+        f"every setting with seed {seed}"
+        + (", each later replicate with one seed spawned from it" if reps > 1 else "")
+        + " (seed_mode common)"
         if mode == "common"
         else f"each its own seed, spawned from seed {seed}"
     )

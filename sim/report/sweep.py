@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import functools
 import itertools
-import os
 from pathlib import Path
 
 import numpy as np
 
 from sim.mc.publish import drawn
 from sim.mc.storage import read_provenance
+from sim.report.labels import apart
 from sim.report.mpl import ticker
 from sim.report.plotting import (
     figures_off,
@@ -98,47 +98,6 @@ def _short(text: str, n: int = 40) -> str:
     """A legend or tick label of at most ``n`` characters (a list-valued key's values would
     crowd the axes out of the figure)."""
     return text if len(text) <= n else text[: n - 1] + "\u2026"
-
-
-def _middle(text: str, n: int) -> str:
-    """A tick label of at most ``n`` characters keeping both ends (values that differ only
-    at their end, ``variant 01`` and ``variant 02``, stay apart)."""
-    if len(text) <= n:
-        return text
-    head = (n - 1) // 2
-    return text[:head] + "\u2026" + text[len(text) - (n - 1 - head) :]
-
-
-#: where a shortened tick label may start (after one of the first) or end (before one of the
-#: second): a value's own text is kept whole
-_STARTS, _ENDS = " ,:;=([{", " ,:;)]}"
-
-
-def _apart(texts: list[str], n: int) -> list[str]:
-    """Tick labels of at most ``n`` characters that tell the values apart: each text with
-    both its ends (:func:`_middle`), or when two of those read the same, without the text all
-    of them share at their start and at their end (cut where a value's text starts or ends),
-    ``…`` in its place, the rest shortened keeping both its ends. Swept grids
-    (``[{'prefix': 'G', 'nx': 3, ...}]`` and ``nx = 4``) differ in their middle: each label
-    kept both ends of its text, and every tick read ``"[{'pre…0012}]"``."""
-    plain = [_middle(t, n) for t in texts]
-    if len(set(plain)) == len(plain):
-        return plain
-    head = len(os.path.commonprefix(texts))
-    tail = len(os.path.commonprefix([t[::-1] for t in texts]))
-    short = min(len(t) for t in texts)
-    tail = min(tail, short - head)  # "ab" and "abab": the two never overlap
-    first = texts[0]
-    while head and first[head - 1] not in _STARTS:
-        head -= 1
-    while tail and first[len(first) - tail] not in _ENDS:
-        tail -= 1
-    out = []
-    for t in texts:
-        core = t[head : len(t) - tail]
-        room = n - bool(head) - bool(tail)
-        out.append("\u2026" * bool(head) + _middle(core, room) + "\u2026" * bool(tail))
-    return out
 
 
 def _legend_names(keys: list[str]) -> list[str]:
@@ -257,7 +216,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             # (named apart from ``shown``, the other keys' texts the next panel's legend
             # reads: a text first key and a second key failed the whole sweep at its
             # second panel, "string indices must be integers")
-            at = _apart([ticks[i] for i in pos], 16)
+            at = apart([ticks[i] for i in pos], 16)
             ax.set_xticks(pos, at, fontsize=7, rotation=90 if len(pos) > 6 else 0)
         note = _bars(kinds.get(c))
         ax.set_title(c + (f"\n({note})" if note else ""), fontsize=8, wrap=True)
