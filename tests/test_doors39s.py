@@ -25,6 +25,10 @@ every kind, batches of sweeps), one case each; each failed on the code before it
   every tick the same, ``"[{'pre…0012}]"`` (a long label kept both its ends): the ticks told
   no cell from another. A label leaves out the text all values share when both ends read the
   same (``…3, 'ny': 3…``, :func:`sim.report.labels.apart`).
+* ``sim show`` of such a sweep gave every cell's ``network.grids`` as ``[{'prefix': 'GRID',
+  '...`` (cut at 24 columns), and the sweep's configuration line would have cut them alike:
+  no row said which setting its cell is (doors20b's class, for list values). A column whose
+  values read the same when cut is cut apart (:func:`sim.report.labels.column`).
 
 Held (tried through ``sim run``, ``python -m sim.batch`` and the API): a sweep killed by
 SIGTERM or SIGKILL in a cell or between cells and run again gives every table and figure byte
@@ -183,3 +187,18 @@ def test_trials_of_a_sweep_over_trials_is_refused(tmp_path, capsys):
         "effect\n"
     ), err
     assert not out.exists()
+
+
+def test_show_of_a_sweep_over_grids_tells_its_cells_apart(tmp_path):
+    grids = [
+        [{"prefix": "GRID", "nx": n, "ny": n, "spacing_mm": 40.0, "role": "observed"}]
+        for n in (3, 4)
+    ]
+    net = sim.load(_file(tmp_path, "n.toml", NETWORK)).config
+    values = {"network.grids": [repr(g) for g in grids]}  # as sweep.parquet holds a list
+    d = _sweep_dir(tmp_path / "g", net, {"network.grids": grids}, ["network.grids"], values)
+    lines = terminal_table(d, get_study=get_study).splitlines()
+    assert lines[2].split()[:2] == ["cell0000_r0", "...'nx':"], lines
+    assert "'nx': 3, 'ny': 3" in lines[2] and "'nx': 4, 'ny': 4" in lines[3], lines
+    text = "\n".join(lines)
+    assert "`network.grids` = [[{ nx = 3, ny = 3," in text and "[{ nx = 4, ny = 4," in text, text

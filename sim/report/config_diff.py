@@ -85,11 +85,12 @@ _SHOWN_VALUES = 6
 def _values_text(vals: list) -> str:
     """A swept key's distinct values in order, as TOML writes them (``[35.0, 45.0]``; of
     many, the first five, ``...`` and the last, with their count), each at most 40
-    characters that tell it from the others (:func:`sim.report.labels.apart`)."""
+    characters that tell it from the others (:func:`sim.report.labels.apart`; ASCII: ``sim
+    show`` writes to a terminal of any encoding)."""
     seen: dict[str, Any] = {}
     for v in vals:
         seen.setdefault(repr(v), v)
-    shown = apart([toml_value(v) for v in seen.values()], 40)
+    shown = apart([toml_value(v) for v in seen.values()], 40, "...")
     if len(shown) > _SHOWN_VALUES:
         shown = [*shown[: _SHOWN_VALUES - 1], "...", shown[-1]]
         return f"[{', '.join(shown)}] ({len(seen)} values)"
@@ -104,7 +105,8 @@ def sweep_config_line(
     file's value of each), the cells, replicates and seeds, then what the other keys changed
     from the study file. It named only the base config's changes (``chunk``, ``seed``,
     ``trials``), never the swept keys, whose cells leave the study file's design, and gave a
-    swept key's base value, which no cell runs, as a change of the run."""
+    swept key's base value, which no cell runs, as a change of the run. Of a study's
+    provenance (no ``sweep``): :func:`config_line`."""
     cfg = prov.get("config") if isinstance(prov.get("config"), dict) else {}
     table, keys = prov.get("sweep"), prov.get("sweep_keys")
     try:
@@ -117,7 +119,7 @@ def sweep_config_line(
     base = found[1] if found else {}
     swept = "; ".join(
         f"`{k}` = {_values_text([c[k] for c in cells])}"
-        + (f" (the file: {middle(as_set(base[k]), 40)})" if k in base else "")
+        + (f" (the file: {middle(as_set(base[k]), 40, '...')})" if k in base else "")
         for k in keys
     )
     n = len(cells) * reps
