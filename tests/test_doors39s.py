@@ -15,6 +15,13 @@ every kind, batches of sweeps), one case each; each failed on the code before it
   sweep's record kept the sha256 of its top-level tables only (a cell has no record of its
   own). It keeps every cell's tables' too, and the readers of a cell check them
   (:func:`sim.mc.table_edits.edited_cell`; ``--stale-only``: :func:`edited_tables`).
+* A sweep with its keys reordered (``"test.alpha"`` and ``"reliability.power"`` swapped, to
+  draw ``sweep.png`` against the other key) is another sweep: its cells come in the other
+  order, each setting with another cell's seed. The run record's config is written with sorted
+  keys and compared as a dict, so it was "the same config": ``--stale-only`` called the first
+  order's results current (their figure against the old key, other numbers), and ``sim run``
+  replaced them without ``--overwrite``. The record keeps the keys' order (``sweep_keys``,
+  :func:`sim.mc.sweep.swept_order`), and both say so (:func:`sim.mc.sweep.reordered`).
 * ``sim run FILE --trials 60`` of a sweep over ``trials`` (``python -m sim.batch ... --
   --trials 60`` too) ran with exit 0, recording ``trials = 60`` and ``--trials 60`` as the
   run's, where no cell ran 60 trials (each sets its swept value again); ``--set trials=60``,
@@ -50,6 +57,7 @@ from pathlib import Path
 import pytest
 
 import sim
+from sim.batch_checks import why_stale
 from sim.cli import main
 from sim.mc.storage import write_table
 from sim.mc.table_edits import edited_tables
@@ -202,3 +210,22 @@ def test_show_of_a_sweep_over_grids_tells_its_cells_apart(tmp_path):
     assert "'nx': 3, 'ny': 3" in lines[2] and "'nx': 4, 'ny': 4" in lines[3], lines
     text = "\n".join(lines)
     assert "`network.grids` = [[{ nx = 3, ny = 3," in text and "[{ nx = 4, ny = 4," in text, text
+
+
+def test_a_sweep_with_its_keys_reordered_is_another_run(tmp_path, capsys):
+    two = NETWORK + '"reliability.power" = [0.8, 0.9]\n'
+    f = _file(tmp_path, "s.toml", two)
+    out = tmp_path / "results" / "s"
+    assert main(["run", str(f), "--out", str(out), "--quiet", "--no-figures"]) == 0
+    assert why_stale(f, out, ["--no-figures"]) is None
+    alpha, power = '"test.alpha" = [0.05, 0.01]\n', '"reliability.power" = [0.8, 0.9]\n'
+    f.write_text(two.replace(alpha + power, power + alpha))
+    order = (
+        "sweep (its keys in another order: test.alpha, reliability.power; this run "
+        "reliability.power, test.alpha)"
+    )
+    assert why_stale(f, out, ["--no-figures"]) == f"made with another config: {order}"
+    capsys.readouterr()
+    assert main(["run", str(f), "--out", str(out), "--quiet", "--no-figures"]) == 2
+    err = capsys.readouterr().err
+    assert f"holds results of a different config: {order}; use --overwrite" in err, err
