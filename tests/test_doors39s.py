@@ -45,7 +45,9 @@ so), and a finished sweep replaced by a smaller one keeps none of the old cells;
 ``network.gama_xml``, a Wolf table, ``seed`` or ``study`` is refused naming the key; a value
 given twice or spelt twice (``1e3`` and ``1000``) is refused; ``[40]`` is one cell; a key of
 another study is named with the study that has it; a batch naming one file twice (``./a.toml``)
-is refused.
+is refused; two batches at once over one ``--results``: the second's run is refused in one line
+naming the running one; ``--stale-only`` of a sweep whose base ``network.gama_xml`` changed runs
+it again; a sweep of 50 numeric values draws its figure readably.
 """
 
 from __future__ import annotations
