@@ -29,7 +29,7 @@ from sim.mc.overrides import command_values, listed, recorded
 from sim.mc.paths import absolute
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
-from sim.mc.sweep import read_sweep
+from sim.mc.sweep import read_sweep, reordered, swept_order
 from sim.mc.table_edits import edited_tables
 from sim.places import base
 from sim.report.read import mixed_table
@@ -84,6 +84,8 @@ def why_stale(
         keys = sorted(k for k in {*want, *have} if want.get(k) != have.get(k))
         more = f" and {len(keys) - 3} more" if len(keys) > 3 else ""
         return f"made with another config: {', '.join(map(key_text, keys[:3]))}{more}"
+    if order := reordered(record, swept_order(sweep)):  # the cells of another order
+        return f"made with another config: {order}"
     if record.get("code_hash") != study_code_hash(cfg["study"]):
         return "made by other code: the code the study imports changed since"
     # a table copied in from another run (two results directories merged by hand, or one

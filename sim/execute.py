@@ -42,7 +42,7 @@ from sim.mc.storage import (
     versions,
     write_table,
 )
-from sim.mc.sweep import cell_config, cell_label, cell_seed, expand
+from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, swept_order
 from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
@@ -216,6 +216,7 @@ def execute(
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
         "code_hash": code_hash(cfg["study"]),
+        **swept_order(sweep),  # the order of its keys makes its cells: sorted in the config
         "versions": versions(),
         **({} if figures else {"figures": False}),
         **({"overrides": overrides} if overrides else {}),

@@ -26,6 +26,7 @@ from pathlib import Path
 
 from sim.mc.config import ConfigError, config_changes
 from sim.mc.storage import code_hash, read_record
+from sim.mc.sweep import reordered, swept_order
 
 __all__ = ["CODE", "PROJECT", "base", "check_place", "default_out", "shown_path"]
 
@@ -82,8 +83,13 @@ def check_place(out: Path, shown_as: str) -> None:
         )
 
 
-def _config_tag(record: dict) -> str:
-    text = json.dumps(record["config"], sort_keys=True, default=repr)
+def _config_tag(record: dict) -> str:  # a sweep's keys in their order: they make its cells
+    order = record.get("sweep_keys", [])
+    text = json.dumps(
+        {**record["config"], **({"sweep keys": order} if len(order) > 1 else {})},
+        sort_keys=True,
+        default=repr,
+    )
     return hashlib.sha256(text.encode()).hexdigest()[:8]
 
 
@@ -92,8 +98,8 @@ def _differs(old: dict, record: dict) -> str:
     a, b = old.get("config"), record["config"]
     if not isinstance(a, dict):  # a record edited by hand
         return "its config differs"
-    if a != b:  # the keys, as --out's refusal names them (sim.mc.outputs)
-        return f"its config differs ({config_changes(a, b)})"
+    if a != b or reordered(old, record):  # the keys, as --out's refusal names them
+        return f"its config differs ({reordered(old, record) or config_changes(a, b)})"
     return "the code changed since they were made"
 
 
@@ -131,6 +137,7 @@ def default_out(
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
         "code_hash": code_hash(cfg["study"]),
+        **swept_order(sweep),
     }
     old = read_record(committed)
     scratch = at / "scratch" / f"{name}-{_config_tag(record)}"
@@ -151,6 +158,7 @@ def default_out(
     same = (
         old is not None
         and old.get("config") == record["config"]
+        and not reordered(old, record)  # a sweep's keys in another order: other cells
         and old.get("code_hash") == record["code_hash"]
     )
     if not committed.exists() or same:

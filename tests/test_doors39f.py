@@ -37,6 +37,7 @@ them). One case each, each failed on the code before its fix.
 
 from __future__ import annotations
 
+import json
 import re
 import shutil
 from pathlib import Path
@@ -115,12 +116,25 @@ def test_a_sweep_cell_holding_another_cells_tables_is_named(sweep, tmp_path, cap
     capsys.readouterr()
     assert main(["show", str(sweep / "cells" / "cell0000_r0")]) == 0, capsys.readouterr().err
     capsys.readouterr()
+    want = "cell0000_r0/claims.parquet is not the table its cell's run wrote"  # its sha256 (S39)
+    line = one_line(capsys, main(["show", str(a)]), want, "run the sweep again", prefix=SIM_ERROR)
+    with pytest.raises(ConfigError, match="cell0001_r0/claims.parquet is not the table its cell"):
+        sim.Results(b, "brown_table1").table("claims")
+    _forget_cell_shas(d)  # a sweep recorded before its cells' sha256: the seed tells them apart
     want = "claims.parquet is not a table of the cell cell0000_r0 of its sweep (seed = "
     line = one_line(capsys, main(["show", str(a)]), want, "run the sweep again", prefix=SIM_ERROR)
-    assert "plate.grid = 4" not in line  # the seed tells the cells apart
+    assert "plate.grid = 4" not in line
     with pytest.raises(ConfigError, match="is not a table of the cell cell0001_r0 of its sweep"):
         sim.Results(b, "brown_table1").table("claims")
     assert sim.Results(sweep / "cells" / "cell0001_r0", "brown_table1").table("claims").num_rows
+
+
+def _forget_cell_shas(d):
+    """Drop the cells' tables from the sweep's ``table_sha256``, as a sweep recorded before
+    that record had them (its cells then checked by their provenance alone)."""
+    rec = json.loads((d / "run.json").read_text())
+    rec["table_sha256"] = {k: v for k, v in rec["table_sha256"].items() if "/" not in k}
+    (d / "run.json").write_text(json.dumps(rec, indent=1, sort_keys=True) + "\n")
 
 
 @pytest.mark.parametrize("value", ["{plate.grid=[4,5]}", "{ plate = { grid = [4, 5] } }", "3"])
@@ -149,5 +163,8 @@ def test_a_sweep_cell_with_a_table_or_metadata_of_another_is_named(sweep, tmp_pa
         pq.write_table(t.replace_schema_metadata(meta), a / "claims.parquet")
     capsys.readouterr()
     name = "points" if splice == "table" else "claims"
+    want = f"cell0000_r0/{name}.parquet is not the table its cell's run wrote"  # sha256 (S39)
+    one_line(capsys, main(["show", str(a)]), want, prefix=SIM_ERROR)
+    _forget_cell_shas(d)  # a sweep recorded before its cells' sha256: provenance tells them apart
     want = f"{name}.parquet is not a table of the cell cell0000_r0 of its sweep (seed = "
     one_line(capsys, main(["show", str(a)]), want, prefix=SIM_ERROR)

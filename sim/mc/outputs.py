@@ -24,6 +24,7 @@ from sim.mc.config import ConfigError, config_changes
 from sim.mc.paths import is_chunk_store, link_problem, mount_point, mounts_under
 from sim.mc.record_text import record_problem
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
+from sim.mc.sweep import reordered
 
 __all__ = [
     "check_out",
@@ -209,7 +210,8 @@ def _differs(old: dict, record: dict) -> str:
     if not isinstance(ca, dict):
         return "a different config"
     if ca == cb:
-        return "a different code version"
+        order = reordered(old, record)
+        return f"a different config: {order}" if order else "a different code version"
     return f"a different config: {config_changes(ca, cb)}"
 
 
@@ -254,8 +256,9 @@ def _damage(stage: Path) -> str | None:
     return None
 
 
-def _same(a: dict | None, b: dict) -> bool:
-    return bool(a) and a.get("config") == b["config"] and a.get("code_hash") == b["code_hash"]
+def _same(a: dict | None, b: dict) -> bool:  # a sweep's keys reordered: other cells
+    ok = bool(a) and a.get("config") == b["config"] and a.get("code_hash") == b["code_hash"]
+    return ok and not reordered(a, b)
 
 
 def _clear(stage: Path) -> None:

@@ -44,8 +44,8 @@ def _files(d: Path) -> list[str]:
 
 def seal(stage: Path, store: ChunkStore | None) -> None:
     """Before publishing: drop chunk files this run neither wrote nor read (left over or copied
-    in), and record in ``run.json`` every file the run wrote and each chunk file's sha256, so
-    that a later run keeps a file it did not write and a reader can check a chunk's content."""
+    in), and record in ``run.json`` every file the run wrote and each chunk file's, figure's
+    and table's sha256 (a later run keeps a file it did not write; a reader checks content)."""
     if store is not None:
         for p in store.strays():
             p.unlink()
@@ -56,8 +56,8 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
     files = [f for f in _files(stage) if f not in carried]
     chunks = {f: file_sha256(stage / f) for f in files if f.startswith("trials/")}
     figures = {f: file_sha256(stage / f) for f in files if f.endswith(".png")}
-    # the tables' too: make verify tells a table edited after its run from a failed re-run
-    tables = {f: file_sha256(stage / f) for f in files if "/" not in f and f.endswith(".parquet")}
+    tops = [f for f in files if re.fullmatch(r"(cells/[^/]+/)?[^/]+\.parquet", f)]  # table_edits
+    tables = {f: file_sha256(stage / f) for f in tops}
     # and every table's shape (a sweep's cells' too): its readers tell a table edited by hand
     shapes = {f: shape(read_table(stage / f)) for f in files if _a_table(f)}
     record = {**rec, "files": files, "chunk_sha256": chunks, "figure_sha256": figures}

@@ -63,6 +63,8 @@ __all__ = [
     "cell_config",
     "refused_cells",
     "refused_note",
+    "reordered",
+    "swept_order",
     "CHECK_SECONDS",
     "run_adaptive",
 ]
@@ -358,6 +360,28 @@ def refused_note(table: Mapping[str, Any], bad: Mapping[int, str], checked: int)
         f"not run: {which}{rest} (first: {cell_label(first, 0)}, "
         f"{_shown(keys, cells[first])}: {bad[first]})"
     )[:600]
+
+
+def swept_order(table: Mapping[str, Any]) -> dict:
+    """A run record's entry of a sweep's keys in their order, ``{"sweep_keys": [...]}``
+    (``{}`` without a sweep): the order makes the cells (their labels, each setting's seed,
+    the figure's first key), and the record's config, written with sorted keys, loses it."""
+    keys = [k for k in table if k not in RESERVED]
+    return {"sweep_keys": keys} if keys else {}
+
+
+def reordered(old: Any, new: Any) -> str | None:
+    """How two run records' sweeps differ in the order of their keys alone (their
+    ``sweep_keys``, :func:`swept_order`), or None (the same order, or a record without it).
+    A sweep with its keys reordered was "the same config": ``--stale-only`` called the other
+    order's results current and ``sim run`` replaced them without ``--overwrite``."""
+    a = old.get("sweep_keys") if isinstance(old, dict) else None
+    b = new.get("sweep_keys") if isinstance(new, dict) else None
+    if not isinstance(a, list) or not isinstance(b, list) or a == b:
+        return None
+    if sorted(map(str, a)) != sorted(map(str, b)):
+        return None  # other keys: the configs differ, and say so
+    return f"sweep (its keys in another order: {', '.join(map(str, a))}; this run {', '.join(b)})"
 
 
 def cell_seed(seed: int, cell: int, replicate: int, mode: str = "spawn") -> int:

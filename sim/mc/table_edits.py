@@ -1,20 +1,24 @@
 """Which tables of a results directory changed after the run that wrote them: their sha256 is
 not the one its ``run.json`` records (``table_sha256``). ``make verify`` says so before the
 deviations such an edit makes, and ``--stale-only`` (``make reproduce``) re-runs such results,
-as it re-draws a figure replaced by hand, rather than calling them current."""
+as it re-draws a figure replaced by hand, rather than calling them current. A sweep's record
+holds its cells' tables' sha256 too: a cell's table copied from another cell (same shape,
+other numbers) was read as its own by ``sim show`` and ``Results.table`` of the cell
+(:func:`edited_cell`)."""
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
 from sim.mc.publish import file_sha256
 from sim.mc.storage import read_record
 
-__all__ = ["edited_tables"]
+__all__ = ["edited_tables", "edited_cell"]
 
 #: the name of a table of a results directory's top level, as ``table_sha256`` records it
-_TABLE = re.compile(r"[^/\\\x00]+\.parquet")
+_TABLE = re.compile(r"(?:cells/cell\d{4,}_r\d+/)?[^/\\\x00]+\.parquet")
 
 
 def edited_tables(d: Path) -> list[str]:
@@ -39,3 +43,38 @@ def edited_tables(d: Path) -> list[str]:
         except OSError:
             changed.append(name)
     return changed
+
+
+def edited_cell(d: Path, names: list[str] | None = None) -> str | None:
+    """Why a table of ``d``, a sweep's cell (``<sweep>/cells/<label>/``, no record of its
+    own), is not the one its cell's run wrote (its sha256 is not the one the sweep's run
+    record holds for it: copied from another cell, or edited by hand), in one line, or None
+    (the same; ``d`` no cell; a sweep of a version that recorded no cell's sha256).
+    ``names``: only these tables (``["claims.parquet"]``). A table that is not there is left
+    to its reader."""
+    d = Path(d)
+    up = d.resolve().parent
+    if up.name != "cells" or os.path.lexists(d / "run.json"):
+        return None
+    rec = read_record(up.parent) or {}
+    sums = rec.get("table_sha256")
+    if not isinstance(sums, dict):
+        return None
+    prefix = f"cells/{d.resolve().name}/"
+    for name, digest in sorted(sums.items()):
+        if not isinstance(name, str) or not name.startswith(prefix) or not _TABLE.fullmatch(name):
+            continue
+        p = d / name[len(prefix) :]
+        if (names is not None and p.name not in names) or not os.path.lexists(p):
+            continue
+        try:
+            same = p.is_file() and not p.is_symlink() and file_sha256(p) == digest
+        except OSError:
+            same = False
+        if not same:
+            return (
+                f"{p} is not the table its cell's run wrote (its sha256 is not the one "
+                f"{up.parent / 'run.json'} records for {prefix[:-1]}: copied from another cell "
+                "or edited by hand?); run the sweep again"
+            )
+    return None

@@ -12,10 +12,14 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping
 
+from sim.mc.config import ConfigError
 from sim.mc.numtext import shows_differently
+from sim.mc.sweep import expand
+from sim.mc.toml_text import toml_value
 from sim.report.inputs import as_set
+from sim.report.labels import apart, middle
 
-__all__ = ["changed_keys", "changes_text", "design_of", "config_line"]
+__all__ = ["changed_keys", "changes_text", "design_of", "config_line", "sweep_config_line"]
 
 #: keys of a run's config that are not a setting of the study ([sweep]: the sweep's own table)
 _NOT_SETTINGS = {"sweep"}
@@ -71,4 +75,72 @@ def config_line(
     return (
         f"Not the configuration of `{found[0]}`: {changes_text(cfg, found[1])}. Its verdicts "
         "and numbers are of this run's configuration, not of the study file's design."
+    )
+
+
+#: the values of a swept key named in the sweep's configuration line: the first ones and the last
+_SHOWN_VALUES = 6
+
+
+def _values_text(vals: list) -> str:
+    """A swept key's distinct values in order, as TOML writes them (``[35.0, 45.0]``; of
+    many, the first five, ``...`` and the last, with their count), each at most 40
+    characters that tell it from the others (:func:`sim.report.labels.apart`; ASCII: ``sim
+    show`` writes to a terminal of any encoding)."""
+    seen: dict[str, Any] = {}
+    for v in vals:
+        seen.setdefault(repr(v), v)
+    shown = apart([toml_value(v) for v in seen.values()], 40, "...")
+    if len(shown) > _SHOWN_VALUES:
+        shown = [*shown[: _SHOWN_VALUES - 1], "...", shown[-1]]
+        return f"[{', '.join(shown)}] ({len(seen)} values)"
+    return f"[{', '.join(shown)}]"
+
+
+def sweep_config_line(
+    prov: Mapping[str, Any], name: str, design: Callable[[str], dict | None] | None
+) -> str | None:
+    """The configuration sentence of a sweep (its README.md, ``sim show``), from the
+    provenance of its ``sweep.parquet``: the swept keys with their values (and the study
+    file's value of each), the cells, replicates and seeds, then what the other keys changed
+    from the study file. It named only the base config's changes (``chunk``, ``seed``,
+    ``trials``), never the swept keys, whose cells leave the study file's design, and gave a
+    swept key's base value, which no cell runs, as a change of the run. Of a study's
+    provenance (no ``sweep``): :func:`config_line`."""
+    cfg = prov.get("config") if isinstance(prov.get("config"), dict) else {}
+    table, keys = prov.get("sweep"), prov.get("sweep_keys")
+    try:
+        _, cells, reps, mode = expand(table) if isinstance(table, dict) else (0, [], 0, "")
+    except ConfigError:
+        cells = []
+    if not cells or not isinstance(keys, list) or not all(k in cells[0] for k in keys):
+        return config_line(cfg, name, design)  # a record this version did not write
+    found = design_of(cfg, name, design)
+    base = found[1] if found else {}
+    swept = "; ".join(
+        f"`{k}` = {_values_text([c[k] for c in cells])}"
+        + (f" (the file: {middle(as_set(base[k]), 40, '...')})" if k in base else "")
+        for k in keys
+    )
+    n = len(cells) * reps
+    seed = as_set(cfg.get("seed"))
+    seeds = (
+        f"every setting with seed {seed}"
+        + (", each later replicate with one seed spawned from it" if reps > 1 else "")
+        + " (seed_mode common)"
+        if mode == "common"
+        else f"each its own seed, spawned from seed {seed}"
+    )
+    reps_text = f" ({len(cells)} settings x {reps} replicates)" if reps > 1 else ""
+    text = f"A sweep of {n} cell{'s' * (n > 1)}{reps_text} over {swept}: {seeds}."
+    if not found:
+        return text
+    mine = {k: v for k, v in cfg.items() if k not in keys}
+    theirs = {k: v for k, v in base.items() if k not in keys}
+    if not changed_keys(mine, theirs):
+        return f"{text} Its other keys are those of `{found[0]}`."
+    return (
+        f"{text} Its other keys are not the configuration of `{found[0]}`: "
+        f"{changes_text(mine, theirs)}. Its verdicts and numbers are of these cells' "
+        "configurations, not of the study file's design."
     )

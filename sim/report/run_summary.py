@@ -23,7 +23,8 @@ from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, write_record
 from sim.mc.table_shape import kind
 from sim.report.claimtext import interval_text, sim_text
-from sim.report.config_diff import config_line
+from sim.report.config_diff import sweep_config_line
+from sim.report.labels import column
 from sim.report.off_paper import off_note, off_setup, sweep_off_note
 from sim.report.papers import paper_name
 from sim.report.read import TableError, checked_table, columns, forget, records
@@ -243,15 +244,16 @@ def terminal_table(
     out = Path(out)
     study = _kind_of(out) == "study"
     cfg = read_provenance(out / "claims.parquet") if study else _sweep_prov(out)
-    changed = config_line(cfg.get("config") or {}, out.name, design)
+    changed = sweep_config_line(cfg, out.name, design)  # a study's: config_line
     tail = "" if changed is None else f"\n{changed}"
     if _kind_of(out) == "sweep":  # each cell with its swept values (cell0003_r0 alone named
         t = columns(out / "sweep.parquet")  # no setting), and where its claims are
         keys = [k for k in cfg["sweep_keys"] if k in t]
+        texts = {k: column([fmt(v) for v in t[k]], lambda s: _cut(s, 24), 24) for k in keys}
         rows = [
             [
                 t["label"][i],
-                *[_cut(fmt(t[k][i]), 24) for k in keys],
+                *[texts[k][i] for k in keys],
                 "yes" if t["feasible"][i] else f"no: {t['reason'][i]}",
             ]
             for i in range(len(t["label"]))
@@ -260,12 +262,11 @@ def terminal_table(
         ok = sum(bool(f) for f in t["feasible"])
         off = sweep_off_note(out, get_study)
         return (
-            (
-                f"{table}\n\nsweep: {ok} of {len(rows)} cells ran; every claim of every cell: "
-                f"sim show {shlex.quote(str(out))} --markdown"  # a command to paste (doors25a)
+            (  # what was swept first, the command to paste (doors25a) last but a note
+                f"{table}\n\n{tail[1:] + chr(10) if tail else ''}sweep: {ok} of {len(rows)} cells "
+                f"ran; every claim of every cell: sim show {shlex.quote(str(out))} --markdown"
             )
             + (f"\n{off}" if off else "")
-            + tail
         )
     claims = records(out / "claims.parquet")
     rows = [[r["claim"], _value_text(r), _interval(r), verdict_cell(r)] for r in claims]
@@ -364,7 +365,7 @@ def run_markdown(
         f"({md_code(f'sim show {shlex.quote(name)}')} prints it again).",
         "",
     ]
-    if (changed := config_line(prov.get("config") or {}, name, design)) is not None:
+    if (changed := sweep_config_line(prov, name, design)) is not None:  # a study's: config_line
         head += [f"**Configuration.** {changed}", ""]
     if kind == "sweep":
         if off := sweep_off_note(out, get_study):  # said once, at the top

@@ -12,6 +12,7 @@ import numpy as np
 
 from sim.mc.publish import drawn
 from sim.mc.storage import read_provenance
+from sim.report.labels import apart
 from sim.report.mpl import ticker
 from sim.report.plotting import (
     figures_off,
@@ -97,15 +98,6 @@ def _short(text: str, n: int = 40) -> str:
     """A legend or tick label of at most ``n`` characters (a list-valued key's values would
     crowd the axes out of the figure)."""
     return text if len(text) <= n else text[: n - 1] + "\u2026"
-
-
-def _middle(text: str, n: int) -> str:
-    """A tick label of at most ``n`` characters keeping both ends (values that differ only
-    at their end, ``variant 01`` and ``variant 02``, stay apart)."""
-    if len(text) <= n:
-        return text
-    head = (n - 1) // 2
-    return text[:head] + "\u2026" + text[len(text) - (n - 1 - head) :]
 
 
 def _legend_names(keys: list[str]) -> list[str]:
@@ -224,7 +216,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             # (named apart from ``shown``, the other keys' texts the next panel's legend
             # reads: a text first key and a second key failed the whole sweep at its
             # second panel, "string indices must be integers")
-            at = [_middle(ticks[i], 16) for i in pos]
+            at = apart([ticks[i] for i in pos], 16)
             ax.set_xticks(pos, at, fontsize=7, rotation=90 if len(pos) > 6 else 0)
         note = _bars(kinds.get(c))
         ax.set_title(c + (f"\n({note})" if note else ""), fontsize=8, wrap=True)

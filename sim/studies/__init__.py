@@ -231,7 +231,8 @@ def load_study(
     for key, value in (values or {}).items():
         _overridable(key, swept)
         flat[key] = list(value) if isinstance(value, tuple) else value
-    if trials is not None:
+    if trials is not None:  # --trials 60 of a sweep over trials: recorded, no cell ran 60
+        _overridable("trials", swept)
         flat["trials"] = trials
     if seed is not None:
         flat["seed"] = seed

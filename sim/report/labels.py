@@ -1,0 +1,74 @@
+"""Short labels of values that stay apart: a tick of ``sweep.png``, a swept key's values in a
+sweep's configuration line (``sim.report.config_diff``) and its column in ``sim show`` keep
+what tells one value from another when they are cut. ``dots``: the ellipsis (``...`` where a
+terminal of any encoding reads the text)."""
+
+from __future__ import annotations
+
+import os
+from typing import Callable
+
+__all__ = ["middle", "apart", "column"]
+
+ELLIPSIS = "\u2026"
+
+
+def middle(text: str, n: int, dots: str = ELLIPSIS) -> str:
+    """``text`` in at most ``n`` characters keeping both ends (values that differ only at
+    their end, ``variant 01`` and ``variant 02``, stay apart)."""
+    if len(text) <= n:
+        return text
+    head = (n - len(dots)) // 2
+    return text[:head] + dots + text[len(text) - (n - len(dots) - head) :]
+
+
+#: where a shortened label may start (after one of the first) or end (before one of the
+#: second): a value's own text is kept whole
+_STARTS, _ENDS = " ,:;=([{", " ,:;)]}"
+
+
+def apart(texts: list[str], n: int, dots: str = ELLIPSIS) -> list[str]:
+    """Labels of at most ``n`` characters that tell the distinct ``texts`` apart: each text
+    with both its ends (:func:`middle`), or when two of those read the same, without the text
+    all of them share at their start and at their end (cut where a value's text starts or
+    ends; as much of the shared start kept as fits), ``dots`` in its place, the rest shortened
+    keeping both its ends. Swept grids (``[{'prefix': 'G', 'nx': 3, ...}]`` and ``nx = 4``)
+    differ in their middle: each label kept both ends of its text, and every tick of
+    ``sweep.png`` read ``"[{'pre…0012}]"``."""
+    plain = [middle(t, n, dots) for t in texts]
+    if len(set(plain)) == len(plain):
+        return plain
+    head = len(os.path.commonprefix(texts))
+    tail = len(os.path.commonprefix([t[::-1] for t in texts]))
+    short = min(len(t) for t in texts)
+    tail = min(tail, short - head)  # "ab" and "abab": the two never overlap
+    first = texts[0]
+    while head and first[head - 1] not in _STARTS:
+        head -= 1
+    while tail and first[len(first) - tail] not in _ENDS:
+        tail -= 1
+    k = len(dots)
+    longest, shared = max(len(t) for t in texts) - head - tail, head
+    for h in range(shared - 1, -1, -1):  # as much of the shared start as fits: "nx = 3"
+        if (shared - h) + longest > n - k * bool(h) - k * bool(tail):
+            break
+        if h == 0 or (first[h - 1] in _STARTS and first[h] not in _STARTS):
+            head = h
+    out = []
+    for t in texts:
+        core = t[head : len(t) - tail]
+        room = n - k * bool(head) - k * bool(tail)
+        out.append(dots * bool(head) + middle(core, room, dots) + dots * bool(tail))
+    return out
+
+
+def column(texts: list[str], cut: Callable[[str], str], n: int) -> list[str]:
+    """A table's column (a value's text on each row) each shortened by ``cut``, or, when two
+    values would read the same so, by :func:`apart` of its distinct values (``...`` for its
+    ellipsis): ``sim show`` of a sweep over ``network.grids`` gave every cell's grids as
+    ``[{'prefix': 'GRID', '...``, which told no cell's setting."""
+    distinct = list(dict.fromkeys(texts))
+    if len({cut(t) for t in distinct}) == len(distinct):
+        return [cut(t) for t in texts]
+    label = dict(zip(distinct, apart(distinct, n, "...")))
+    return [label[t] for t in texts]
