@@ -21,7 +21,7 @@ import resource
 from sim.mc.config import ConfigError
 from sim.mc.estimate import Estimate, _either, check_limits
 
-__all__ = ["check_room", "mapped_bytes", "short_room"]
+__all__ = ["check_room", "limits_set", "mapped_bytes", "short_room"]
 
 
 def mapped_bytes(field: int = 0) -> int | None:
@@ -37,6 +37,13 @@ def mapped_bytes(field: int = 0) -> int | None:
 
 #: the limits a run's memory is compared with: (limit, field of statm, its shell words)
 _LIMITS = ((resource.RLIMIT_AS, 0, "ulimit -v"), (resource.RLIMIT_DATA, 5, "ulimit -d"))
+
+
+def limits_set() -> str:
+    """The limits of memory this process runs under, as words (``ulimit -v is 1250000 kB``),
+    or ``""``: what a MemoryError in the middle of a run names."""
+    caps = ((words, resource.getrlimit(limit)[0]) for limit, _, words in _LIMITS)
+    return ", ".join(f"{w} is {c // 1024} kB" for w, c in caps if c != resource.RLIM_INFINITY)
 
 
 def short_room(need: float) -> str:

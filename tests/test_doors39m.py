@@ -18,6 +18,12 @@ measured ones in the docstrings).
   before the build (:func:`sim.studies.network.validate.fits_estimate`) now compares the
   estimate with the room too (:func:`sim.room.short_room`), naming ``network.grids`` (the
   key that declares the size) and the limit, in under a second.
+* a run the room check passes can still fail mid-run (the libraries it loads later and the
+  allocator's arenas are not in the estimate): brown_dilution at its defaults (0.33 GiB
+  estimated, 0.43 GiB mapped at the start) failed under ``ulimit -v 1250000`` in its region
+  on "MemoryError: Unable to allocate 110. MiB ... (reduce trials, chunk or the sizes in the
+  study file)", none of which sets that memory; it ran at 1400000. The line now names the
+  limit in force and the keys that set the run's memory (:func:`sim.room.limits_set`).
 """
 
 from __future__ import annotations
@@ -105,3 +111,24 @@ def test_a_network_over_the_room_a_limit_leaves_is_refused_before_it_is_built(
         capsys, main(["check", str(st)]), "network.grids: ", "900 points", f"{words} (", "raise"
     )
     assert line.endswith(f"raise {words} or use fewer points or observations"), line
+
+
+def test_a_memory_error_mid_run_names_the_limit_and_the_keys(tmp_path, monkeypatch, capsys):
+    # before: "(reduce trials, chunk or the sizes in the study file)": brown_dilution's
+    # region failed so under ulimit -v 1250000 (estimate 0.33 GiB, 0.82 GiB left at the start)
+    def short(*a, **kw):
+        raise MemoryError("Unable to allocate 110. MiB for an array")
+
+    real = resource.getrlimit
+    cap = 2**50  # set, and far above what the run needs: the room check passes
+
+    def limited(which):
+        return (cap, real(which)[1]) if which == resource.RLIMIT_AS else real(which)
+
+    monkeypatch.setattr("sim.room.resource.getrlimit", limited)
+    monkeypatch.setattr("sim.studies.brown.region.monotone_at", short)
+    args = ["run", str(STUDIES / "brown_dilution.toml"), "--trials", "40", "--no-figures"]
+    line = one_line(capsys, main([*args, "--out", str(tmp_path / "o")]), "MemoryError")
+    assert line.endswith(
+        f"(ulimit -v is {cap // 1024} kB: raise it, or reduce region.points or region.rounds)"
+    ), line
