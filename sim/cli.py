@@ -28,6 +28,7 @@ from pathlib import Path
 
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
+from sim.api_paths import too_long
 from sim.claims.rules import printed_differs
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
@@ -299,6 +300,8 @@ def _main(argv: list[str]) -> int:
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
+        if args.cmd in ("run", "check") and (why := too_long(args.study)) is not None:
+            raise ConfigError("STUDY", why)  # it was the system's words and the whole path
         if args.cmd in ("check", "show") and sys.stdout is None:  # >&-: print() wrote nowhere
             raise ConfigError(None, "standard output is closed (>&-): nothing to print to")
         for s in _STOPS if in_main_thread() else ():

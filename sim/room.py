@@ -19,7 +19,7 @@ import os
 import resource
 
 from sim.mc.config import ConfigError
-from sim.mc.estimate import Estimate, _either, check_limits
+from sim.mc.estimate import Estimate, check_limits
 
 __all__ = ["check_room", "mapped_bytes"]
 
@@ -60,5 +60,5 @@ def check_room(
             f"{est.study}: the run needs about {est.bytes / 2**30:.3g} GiB of memory{each}{cell}, "
             f"and {words} ({cap // 1024} kB) leaves this process about "
             f"{max(cap - used, 0) / 2**30:.3g} GiB beside the {used / 2**30:.3g} GiB it maps "
-            f"already: raise {words}, or reduce {_either(est.memory_keys)}",
+            f"already: raise {words}, or reduce {est.memory_advice()}",
         )

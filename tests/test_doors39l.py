@@ -1,0 +1,110 @@
+"""Last session's left items (doors39l, brief L39), decided: each class through a real door;
+each test fails on the code before its fix:
+
+* a study file or a directory path too long for the system (a name in it over the file
+  system's 255 bytes) was ``sim: error: File name too long: PATH`` from ``sim run``,
+  ``sim check`` and ``sim show``, the path whole and no argument named: it is refused as the
+  API and the batch refuse it, naming ``STUDY`` (``DIR``) and the path cut short;
+* ``--set plate.spacing_mm="45mm"`` (a unit written in the value) was "must be a number (got
+  '45mm')": the refusal says the unit is in the key's name and what to write (``write 45``),
+  or that the key's unit is another, or to write the number alone;
+* ``python -m sim.batch`` whose ``results/<name>`` is a symbolic link was refused as "--results:
+  results/NAME is a symbolic link; sim never replaces it", nothing said of what to do: it says
+  to choose another ``--results`` or remove the link (what it leads to is kept), as ``sim
+  run --out`` says with ``--out``;
+* ``sim.load(f, trials=1e3)``: the handle's ``overrides`` and ``repr`` showed ``1000.0`` where
+  the run's record says ``trials=1000``: a float the config reads as an integer is that integer;
+* ``sim --version >&-`` (and ``--help``, ``sim run --help``, ``python -m sim.batch --help``)
+  with standard output closed wrote its text to standard error and ended in exit 0 (argparse's
+  fallback): it is one line, "standard output is closed (>&-): nothing to print to", exit 2,
+  as ``sim check`` and ``sim show`` say.
+
+Held: ``sim run --out <5000 characters>`` and ``sim report --results <long>`` named their
+option already; ``sim show``/``sim check``/``--version`` to ``/dev/full``: one line, exit 2.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from oneline import SIM_ERROR, one_line, one_line_of
+
+import sim
+import sim.batch
+from sim.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+TABLE1 = ROOT / "studies" / "brown_table1.toml"
+LONG = "a" * 300
+
+
+@pytest.mark.parametrize(
+    ("argv", "key"),
+    [
+        (["run", f"{LONG}.toml"], "STUDY: "),
+        (["check", f"/tmp/{LONG}/x.toml"], "STUDY: "),
+        (["show", f"/tmp/{LONG}"], "DIR: "),
+    ],
+)
+def test_a_path_too_long_names_its_argument(capsys, argv, key):
+    # before: "sim: error: File name too long: aaaa...(the whole path)"
+    line = one_line(capsys, main(argv), "is too long a path for the system", prefix=SIM_ERROR + key)
+    assert len(line) < 250, line
+
+
+@pytest.mark.parametrize(
+    ("value", "words"),
+    [
+        ('"45mm"', "(got '45mm': the unit is in the key's name (_mm): write 45)"),
+        ("45.0mm", "(got '45.0mm': the unit is in the key's name (_mm): write 45.0)"),
+        ('"45 um"', "the key's unit is mm, in its name: write the number alone, in mm"),
+    ],
+)
+def test_a_unit_written_in_the_value_says_the_key_holds_it(capsys, value, words):
+    rc = main(["check", str(TABLE1), "--set", f"plate.spacing_mm={value}"])
+    one_line(capsys, rc, "plate.spacing_mm: must be a number", words)  # before: no hint
+
+
+def test_trials_written_with_a_word_is_told_to_write_the_number_alone(capsys):
+    rc = main(["check", str(TABLE1), "--set", 'trials="400 trials"'])
+    one_line(capsys, rc, "trials: must be an integer", "write the number alone, without a unit")
+
+
+def test_the_batch_into_a_linked_results_directory_says_what_to_do(tmp_path, monkeypatch, capsys):
+    (tmp_path / "studies").mkdir()
+    (tmp_path / "results").mkdir()
+    (tmp_path / "kept").mkdir()
+    (tmp_path / "studies" / "brown_table1.toml").write_text(TABLE1.read_text(encoding="utf-8"))
+    (tmp_path / "results" / "brown_table1").symlink_to(tmp_path / "kept")
+    monkeypatch.chdir(tmp_path)
+    rc = sim.batch.main(["studies/brown_table1.toml"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "Traceback" not in err, err
+    # before: "... is a symbolic link; sim never replaces it" and no word of what to do
+    assert "choose another --results, or remove the link: what it leads to is kept" in err, err
+    assert (tmp_path / "results" / "brown_table1").is_symlink()
+
+
+def test_the_handles_overrides_show_a_whole_float_as_its_integer():
+    st = sim.load(TABLE1, trials=1e3, **{"errors.settings": 3.0})
+    assert st.overrides == {"trials": 1000, "errors.settings": 3}  # before: 1000.0, 3.0
+    assert type(st.overrides["trials"]) is int
+    assert "'trials': 1000," in repr(st) and "1000.0" not in repr(st.replace(seed=5))
+    assert st.config["trials"] == 1000
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["sim", "--version"], ["sim", "--help"], ["sim", "run", "--help"], ["sim.batch", "--help"]],
+)
+def test_help_or_version_to_a_closed_standard_output_is_one_line(argv):
+    cmd = " ".join([sys.executable, "-m", *argv]) + " >&-"
+    proc = subprocess.run(
+        ["sh", "-c", cmd], capture_output=True, text=True, timeout=60, cwd=ROOT, env=os.environ
+    )
+    # before: the text on standard error, exit 0
+    one_line_of(proc, "standard output is closed (>&-): nothing to print to")
