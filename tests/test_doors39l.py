@@ -26,6 +26,8 @@ option already; ``sim show``/``sim check``/``--version`` to ``/dev/full``: one l
 from __future__ import annotations
 
 import os
+import re
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -108,3 +110,16 @@ def test_help_or_version_to_a_closed_standard_output_is_one_line(argv):
     )
     # before: the text on standard error, exit 0
     one_line_of(proc, "standard output is closed (>&-): nothing to print to")
+
+
+def test_the_show_command_of_a_readme_outside_results_names_its_path(tmp_path, capsys):
+    out = tmp_path / "brown_table1"  # the name of the committed results/brown_table1
+    run = ["run", str(TABLE1), "--trials", "40", "--quiet", "--no-figures", "--out", str(out)]
+    assert main([*run, "--set", "region.points=256", "--set", "region.rounds=0"]) == 0
+    readme = (out / "README.md").read_text(encoding="utf-8")
+    command = re.search(r"`(sim show [^`]+)` prints it again", readme).group(1)
+    assert command == f"sim show {shlex.quote(str(out))}", command  # before: sim show brown_table1
+    capsys.readouterr()
+    assert main(shlex.split(command)[1:]) == 0
+    shown = capsys.readouterr().out
+    assert main(["show", str(out)]) == 0 and capsys.readouterr().out == shown  # this run's
