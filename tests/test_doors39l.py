@@ -17,7 +17,14 @@ each test fails on the code before its fix:
 * ``sim --version >&-`` (and ``--help``, ``sim run --help``, ``python -m sim.batch --help``)
   with standard output closed wrote its text to standard error and ended in exit 0 (argparse's
   fallback): it is one line, "standard output is closed (>&-): nothing to print to", exit 2,
-  as ``sim check`` and ``sim show`` say.
+  as ``sim check`` and ``sim show`` say;
+* a run's README.md says "`sim show NAME` prints it again": for a run written outside
+  ``results/`` and ``scratch/`` (``--out /tmp/brown_table1``) that command printed the
+  committed ``results/brown_table1``, or said "does not exist": it names the directory's
+  absolute path there (the name where ``sim show`` finds it by name);
+* a key given twice in a nested inline table (``plate = {x = {a = 1, a = 2}}``) was "a is given
+  twice in the inline table of plate", the inner table unnamed: the whole key is named
+  (``plate.x.a``; an array's item as ``errors.s[1].x.b``).
 
 Held: ``sim run --out <5000 characters>`` and ``sim report --results <long>`` named their
 option already; ``sim show``/``sim check``/``--version`` to ``/dev/full``: one line, exit 2.
@@ -123,3 +130,18 @@ def test_the_show_command_of_a_readme_outside_results_names_its_path(tmp_path, c
     assert main(shlex.split(command)[1:]) == 0
     shown = capsys.readouterr().out
     assert main(["show", str(out)]) == 0 and capsys.readouterr().out == shown  # this run's
+
+
+@pytest.mark.parametrize(
+    ("line", "key"),
+    [
+        ("plate = {x = {a = 1, a = 2}}", "plate.x.a"),
+        ("plate = {x = {a.b = 1, a.b = 2}}", "plate.x.a.b"),
+        ('errors = {s = [1, {x = {b = "}", b = 2}}]}', "errors.s[1].x.b"),
+    ],
+)
+def test_a_key_given_twice_in_a_nested_inline_table_is_named_whole(tmp_path, capsys, line, key):
+    p = tmp_path / "twice.toml"
+    p.write_text(f'study = "brown_table1"\n{line}\n', encoding="utf-8")
+    # before: "a is given twice in the inline table of plate" (the inner table's x unnamed)
+    one_line(capsys, main(["check", str(p)]), f"malformed TOML: {key} is given twice in an inline")
