@@ -285,6 +285,11 @@ def _interrupted_line(args) -> str:
     again = ""
     if args is not None and getattr(args, "cmd", None) == "run":
         again = "; run the same command again to finish the missing chunks"
+        if getattr(args, "chunks_done", False):  # none is missing: the re-run only writes
+            again = (
+                "; every chunk was done and is kept: run the same command again to write the "
+                "results from them (no trial is computed again)"
+            )
     if getattr(args, "published", None):  # nothing is missing: say where the results are
         again = f" after the results were written to {args.published}/"
     return f"sim: interrupted{why}{again}"
@@ -316,6 +321,8 @@ def _main(argv: list[str]) -> int:
     except KeyboardInterrupt as e:
         if getattr(e, "published", None) and args is not None:  # as the run published
             args.published = e.published
+        if getattr(e, "chunks_done", False) and args is not None:
+            args.chunks_done = True
         print(_interrupted_line(args), file=sys.stderr)
         return 130
     except BrokenPipeError:

@@ -234,7 +234,8 @@ def execute(
         # a refusal before any worker started is not a script's missing main guard
         words = "" if isinstance(e, StartRefused) else script_words(executor, workers, scheduler)
         raise ConfigError(key, f"cannot start the {executor} executor: {msg}{words}") from None
-    lock = None
+    lock = ctx = None
+    finished = False  # the study's run returned: every chunk done, its tables written
     try:
         dropped = _replaced(stage, record) if overwrite else None
         try:
@@ -263,6 +264,7 @@ def execute(
         try:
             with ctx.progress_bar(cfg["study"]), nullcontext() if figures else without_figures():
                 run_sweep(study, cfg, sweep, stage, ctx) if sweep else study.run(cfg, stage, ctx)
+            finished = True
             check_interrupt()  # dropped by Python after the last chunk: the stage is kept
         except (ConfigError, StudyError):
             raise
@@ -287,6 +289,8 @@ def execute(
             err.internal = True
             raise err from None
     except BaseException as e:
+        if isinstance(e, KeyboardInterrupt) and (finished or (ctx and ctx.all_counted())):
+            e.chunks_done = True  # the same command only writes the results: none is missing
         if executor == "dask":
             _quiet_dask_logs()  # its closing chatter is not for users (one line is)
         ex.close(kill=True)
@@ -309,6 +313,8 @@ def execute(
     except BaseException as e:
         if not published:
             drop_stage(stage, lock)
+            if isinstance(e, KeyboardInterrupt):  # every chunk done: only the results are
+                e.chunks_done = True  # left to write
         elif isinstance(e, KeyboardInterrupt):  # the results stand: say where, not "resume"
             e.published = shown
         raise

@@ -22,6 +22,10 @@ each test fails on the code before its fix:
   ``results/`` and ``scratch/`` (``--out /tmp/brown_table1``) that command printed the
   committed ``results/brown_table1``, or said "does not exist": it names the directory's
   absolute path there (the name where ``sim show`` finds it by name);
+* an interrupt after every chunk was done (while the tables or the README were written) said
+  "run the same command again to finish the missing chunks", though none was missing: it says
+  every chunk was done and is kept, and that the same command writes the results from them
+  (it does: no chunk is computed again); an interrupt between chunks still says they are missing;
 * a key given twice in a nested inline table (``plate = {x = {a = 1, a = 2}}``) was "a is given
   twice in the inline table of plate", the inner table unnamed: the whole key is named
   (``plate.x.a``; an array's item as ``errors.s[1].x.b``).
@@ -32,6 +36,7 @@ option already; ``sim show``/``sim check``/``--version`` to ``/dev/full``: one l
 
 from __future__ import annotations
 
+import importlib
 import os
 import re
 import shlex
@@ -45,6 +50,7 @@ from oneline import SIM_ERROR, one_line, one_line_of
 import sim
 import sim.batch
 from sim.cli import main
+from sim.mc.runner import ChunkStore
 
 ROOT = Path(__file__).resolve().parents[1]
 TABLE1 = ROOT / "studies" / "brown_table1.toml"
@@ -145,3 +151,55 @@ def test_a_key_given_twice_in_a_nested_inline_table_is_named_whole(tmp_path, cap
     p.write_text(f'study = "brown_table1"\n{line}\n', encoding="utf-8")
     # before: "a is given twice in the inline table of plate" (the inner table's x unnamed)
     one_line(capsys, main(["check", str(p)]), f"malformed TOML: {key} is given twice in an inline")
+
+
+def _stop_once(monkeypatch, target: str):
+    """``target`` (a module's function) raises KeyboardInterrupt (Ctrl-C) the first time."""
+    mod, name = target.rsplit(".", 1)
+    real = getattr(importlib.import_module(mod), name)
+    calls = []
+
+    def stop(*a, **k):
+        if not calls:
+            calls.append(1)
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(target, stop)
+
+
+@pytest.mark.parametrize(
+    "target",
+    ["sim.studies.brown.core.jackknife", "sim.cli.write_run_readme"],
+    ids=["tables", "readme"],
+)
+def test_an_interrupt_with_every_chunk_done_says_the_rerun_only_writes(
+    tmp_path, monkeypatch, capsys, target
+):
+    run = ["run", str(TABLE1), "--trials", "40", "--quiet", "--no-figures"]
+    run += ["--set", "region.points=256", "--set", "region.rounds=0", "--out", str(tmp_path / "X")]
+    _stop_once(monkeypatch, target)
+    # before: "sim: interrupted; run the same command again to finish the missing chunks"
+    one_line(
+        capsys, main(run), "every chunk was done and is kept", "no trial is computed", code=130
+    )
+    saved = []
+    monkeypatch.setattr(ChunkStore, "save", lambda *a, **k: saved.append(a))
+    assert main(run) == 0
+    assert "resuming brown_table1: 20 finished chunks found" in capsys.readouterr().err
+    assert saved == []  # the re-run computed no chunk
+
+
+def test_an_interrupt_between_chunks_still_says_they_are_missing(tmp_path, monkeypatch, capsys):
+    run = ["run", str(TABLE1), "--trials", "40", "--quiet", "--no-figures"]
+    run += ["--set", "region.points=256", "--set", "region.rounds=0", "--out", str(tmp_path / "X")]
+    real, saved = ChunkStore.save, []
+
+    def save(self, *a, **k):
+        real(self, *a, **k)
+        saved.append(1)
+        if len(saved) == 3:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(ChunkStore, "save", save)
+    one_line(capsys, main(run), "finish the missing chunks", code=130)
