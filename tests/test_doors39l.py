@@ -26,11 +26,16 @@ each test fails on the code before its fix:
   "run the same command again to finish the missing chunks", though none was missing: it says
   every chunk was done and is kept, and that the same command writes the results from them
   (it does: no chunk is computed again); an interrupt between chunks still says they are missing;
+* ``output.inner_over`` over fixed points alone ran, its datums table "inner over A, B" the
+  points' sigmas again (their covariance is zero, so the S-transformation changes nothing):
+  refused naming them, as an inner ``datum.kind`` over fixed points is;
 * a key given twice in a nested inline table (``plate = {x = {a = 1, a = 2}}``) was "a is given
   twice in the inline table of plate", the inner table unnamed: the whole key is named
   (``plate.x.a``; an array's item as ``errors.s[1].x.b``).
 
-Held: ``sim run --out <5000 characters>`` and ``sim report --results <long>`` named their
+Held: ``datum.points = ["A"]`` of a fixed datum ("is not read when datum.kind = 'fixed'") and of
+an inner one over fixed points ("has nothing to constrain: the fixed points ... already fix the
+network's datum") say what is wrong and what to do. ``sim run --out <5000 characters>`` and ``sim report --results <long>`` named their
 option already; ``sim show``/``sim check``/``--version`` to ``/dev/full``: one line, exit 2.
 """
 
@@ -203,3 +208,27 @@ def test_an_interrupt_between_chunks_still_says_they_are_missing(tmp_path, monke
 
     monkeypatch.setattr(ChunkStore, "save", save)
     one_line(capsys, main(run), "finish the missing chunks", code=130)
+
+
+NETWORK = """\
+study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+  { name = "B", x_mm = 400.0, y_mm = 0.0, role = "fixed" },
+  { name = "C", x_mm = 400.0, y_mm = 300.0, role = "fixed" },
+  { name = "P", x_mm = 150.0, y_mm = 120.0 } ]
+generate = [ { kind = "distance", from = ["A", "B", "C"], to = "P", sigma_mm = 0.002 },
+             { kind = "direction", from = ["A", "B", "C"], to = "*", sigma_arcsec = 2.0 } ]
+"""
+
+
+def test_an_inner_datum_over_fixed_points_alone_is_refused(tmp_path, capsys):
+    p = tmp_path / "net.toml"
+    p.write_text(NETWORK, encoding="utf-8")
+    # before: run, its datums table "inner over A, B" the points' sigmas again (A, B: 0 mm)
+    rc = main(["check", str(p), "--set", 'output.inner_over=["A", "B"]'])
+    one_line(capsys, rc, "output.inner_over: A, B are all fixed points", "repeat the points'")
+    capsys.readouterr()
+    assert main(["check", str(p), "--set", 'output.inner_over=["A", "P"]']) == 0  # held
