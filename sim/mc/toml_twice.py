@@ -87,7 +87,10 @@ def _named(text: str, reason: str, line: int, where: str) -> str | None:
         if m := re.fullmatch(r"Duplicate inline table key ('.*')", reason):
             stem = ast.literal_eval(m.group(1))
             at = starts[line - 1] + int(where.split("column ")[-1].rstrip(")")) - 1
-            inner = _inline_key(text[starts[i] : at], _key_end(lines[i]))
+            try:
+                inner = _inline_key(text[starts[i] : at], _key_end(lines[i]))
+            except (tomllib.TOMLDecodeError, IndexError):  # not told: the words below
+                inner = None
             if inner is None:  # the inline table named, its key by its last part
                 inline = key_text(".".join(head + rel))
                 return f"{key_text(stem)} is given twice in the inline table of {inline}{where}"
