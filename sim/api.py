@@ -432,5 +432,6 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     sweep = read_sweep(study_file, study.schema)
     if _sha256(study_file) != sha:  # written to while it was read: which version is this?
         raise ConfigError("study_file", f"{study_file} changed while it was loaded: load it again")
+    vals = as_read(vals, cfg)  # trials=1e3 is shown as the 1000 its record says, not 1000.0
     state = state_sha256(cfg, vals, sweep)
     return StudyHandle(study_file, study, cfg, vals, sweep, sha, state, working_dir())

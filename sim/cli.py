@@ -28,6 +28,7 @@ from pathlib import Path
 
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
+from sim.api_paths import too_long
 from sim.claims.rules import printed_differs
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
@@ -289,6 +290,11 @@ def _interrupted_line(args) -> str:
     again = ""
     if args is not None and getattr(args, "cmd", None) == "run":
         again = "; run the same command again to finish the missing chunks"
+        if getattr(args, "chunks_done", False):  # none is missing: the re-run only writes
+            again = (
+                "; every chunk was done and is kept: run the same command again to write the "
+                "results from them (no trial is computed again)"
+            )
     if getattr(args, "published", None):  # nothing is missing: say where the results are
         again = f" after the results were written to {args.published}/"
     return f"sim: interrupted{why}{again}"
@@ -304,6 +310,8 @@ def _main(argv: list[str]) -> int:
         if args.cmd in ("run", "check") and name_problem(args.study):
             why = name_problem(args.study)
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
+        if args.cmd in ("run", "check") and (why := too_long(args.study)) is not None:
+            raise ConfigError("STUDY", why)  # it was the system's words and the whole path
         if args.cmd in ("check", "show") and sys.stdout is None:  # >&-: print() wrote nowhere
             raise ConfigError(None, "standard output is closed (>&-): nothing to print to")
         for s in _STOPS if in_main_thread() else ():
@@ -318,6 +326,8 @@ def _main(argv: list[str]) -> int:
     except KeyboardInterrupt as e:
         if getattr(e, "published", None) and args is not None:  # as the run published
             args.published = e.published
+        if getattr(e, "chunks_done", False) and args is not None:
+            args.chunks_done = True
         print(_interrupted_line(args), file=sys.stderr)
         return 130
     except BrokenPipeError:

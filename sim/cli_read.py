@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
-from sim.api_paths import cell_mixed
+from sim.api_paths import cell_mixed, too_long
 from sim.cli_errors import not_as_written, older_lacks
 from sim.mc.config import ConfigError
 from sim.mc.outputs import name_problem, results_dirs
@@ -39,6 +39,8 @@ def show(args) -> int:
         raise ConfigError(
             "DIR", f"not a directory name: {name_problem(args.dir)} (got {args.dir!r})"
         )
+    if (why := too_long(args.dir)) is not None:  # it was the system's words and the whole path
+        raise ConfigError("DIR", why)
     d = Path(args.dir)
     # the name a README.md gives (`sim show NAME` prints it again) is read under the project's
     # results/ and scratch/ too (from docs/ as from the root), where sim run writes without

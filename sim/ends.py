@@ -48,7 +48,11 @@ def flush_stdout(prog: str, code: int) -> int:
     docstring); ``code`` stands when it already says a failure."""
     out = sys.stdout
     try:
-        if out is None:  # >&-: print() wrote nowhere
+        if out is None:  # >&-: print() wrote nowhere (argparse's --help: said, exit 2)
+            if _unwritten:
+                _unwritten.clear()
+                _said(f"{prog}: error: standard output is closed (>&-): nothing to print to")
+                return code or 2
             return code
         if _unwritten:  # a write that failed where it could not be raised (argparse's --help)
             raise _unwritten.pop()
@@ -70,12 +74,16 @@ def stdout_failed(prog: str, e: OSError, code: int) -> int:
         pass
     if isinstance(e, BrokenPipeError):
         return code or 141
-    try:
-        why = e.strerror or type(e).__name__
-        print(f"{prog}: error: {why}: standard output", file=sys.stderr, flush=True)
-    except (OSError, ValueError, AttributeError):  # standard error gone as well
-        pass
+    _said(f"{prog}: error: {e.strerror or type(e).__name__}: standard output")
     return code or 2
+
+
+def _said(line: str) -> None:
+    """``line`` on standard error, if it can be written (gone as well: nothing)."""
+    try:
+        print(line, file=sys.stderr, flush=True)
+    except (OSError, ValueError, AttributeError):
+        pass
 
 
 def finish(prog: str, main) -> int:

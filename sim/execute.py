@@ -27,7 +27,7 @@ from sim.execute_sweep import check_sweep, not_the_cells, sweep_limits
 from sim.held_stops import held_stops
 from sim.mc.argv import most_workers
 from sim.mc.config import ConfigError, StudyError, check_chunks
-from sim.mc.estimate import _either, chunk_note
+from sim.mc.estimate import chunk_note
 from sim.mc.executors import StartRefused, script_words
 from sim.mc.left_behind import clear_replaced
 from sim.mc.outputs import _chunks, _differs, _same, check_out, drop_stage, prepare_stage, stage_dir
@@ -46,7 +46,7 @@ from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, swept_order
 from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
-from sim.room import limits_set
+from sim.run_failure import numeric_failure
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
@@ -77,59 +77,6 @@ def _check_options(executor: Any, workers: Any, scheduler: Any) -> None:
             )
         if executor != "dask":
             raise ConfigError("scheduler", "needs executor dask")
-
-
-def _numeric_failure(e: BaseException, study, cfg: dict, keys: tuple = ()) -> StudyError:
-    """One line for an exception raised inside a study's run: the study part (the innermost
-    frame in study code) and, where the message says which, the config key to change (for
-    memory, the estimate's ``keys`` and the ``ulimit`` in force: :func:`_memory_hint`)."""
-    import traceback
-
-    frames = [
-        f
-        for f in traceback.extract_tb(e.__traceback__)
-        if "/sim/" in f.filename.replace(os.sep, "/")
-    ]
-    plumbing = ("runner.py", "cli.py", "storage.py", "sweep.py", "claims.py")
-    study_code = [f for f in frames if "/sim/studies/" in f.filename.replace(os.sep, "/")]
-    model = [f for f in frames if not f.filename.replace(os.sep, "/").endswith(plumbing)]
-    part = None
-    for f in (study_code or model)[-1:]:
-        mod = f.filename.replace(os.sep, "/").rsplit("/sim/", 1)[1][:-3].replace("/", ".")
-        part = f"sim.{mod}.{f.name}"
-    msg = (str(e).strip().splitlines() or [""])[0][:300]
-    hint = _hint(msg, type(e).__name__, study.schema, keys)
-    where = f" in {part}" if part else ""
-    return StudyError(f"{cfg['study']}: the run failed{where}: {type(e).__name__}: {msg}{hint}")
-
-
-_HINTS = (  # message words -> config keys (the first that the study has is named)
-    (("iteration", "converge"), ("solver.max_iter", "solver.tol_mm")),
-    (("overflow",), ("errors.setting_sigma_um", "plate.format_mm")),
-    (("svd", "singular", "degenerate", "collinear"), ("plate.grid", "plate.points", "marks.grid")),
-)
-
-
-def _hint(msg: str, kind: str, schema, keys: tuple = ()) -> str:
-    low = (msg + " " + kind).lower()
-    for words, named in _HINTS:
-        if any(w in low for w in words):
-            have = [k for k in named if k in schema]
-            if have:
-                return f" (check {have[0]})"
-    return _memory_hint(keys) if "memory" in low else ""
-
-
-def _memory_hint(keys: tuple) -> str:
-    """What to change after a MemoryError mid-run: the limit in force and the keys that set
-    the run's memory. It said "reduce trials, chunk or the sizes in the study file" for
-    brown_dilution's region (``region.points``) failing under ``ulimit -v 1250000``."""
-    limits = limits_set()
-    return (
-        f" ({limits}: raise it, or reduce {_either(keys)})"
-        if limits
-        else (f" (reduce {_either(keys)})")
-    )
 
 
 def _not_in_a_starting_worker() -> None:
@@ -247,7 +194,8 @@ def execute(
         # a refusal before any worker started is not a script's missing main guard
         words = "" if isinstance(e, StartRefused) else script_words(executor, workers, scheduler)
         raise ConfigError(key, f"cannot start the {executor} executor: {msg}{words}") from None
-    lock = None
+    lock = ctx = None
+    finished = False  # the study's run returned: every chunk done, its tables written
     try:
         dropped = _replaced(stage, record) if overwrite else None
         try:
@@ -276,6 +224,7 @@ def execute(
         try:
             with ctx.progress_bar(cfg["study"]), nullcontext() if figures else without_figures():
                 run_sweep(study, cfg, sweep, stage, ctx) if sweep else study.run(cfg, stage, ctx)
+            finished = True
             check_interrupt()  # dropped by Python after the last chunk: the stage is kept
         except (ConfigError, StudyError):
             raise
@@ -285,7 +234,7 @@ def execute(
             if interrupted(e):  # Ctrl-C inside an import (or a library that wraps it)
                 raise KeyboardInterrupt from None
             if isinstance(e, (ArithmeticError, ValueError, MemoryError)):  # numbers the model
-                raise _numeric_failure(e, study, cfg, est.memory_keys) from None  # cannot take
+                raise numeric_failure(e, study, cfg, est.memory_keys) from None  # cannot take
             if (words := shadowed(e)) is not None:  # a user's matplotlib.py: not our bug
                 raise StudyError(f"{cfg['study']}: {words}") from None
             if isinstance(e, BrokenExecutor):  # a worker killed (kill -9, the OOM killer): the
@@ -296,10 +245,12 @@ def execute(
                 ) from None
             if os.environ.get("SIM_DEBUG"):  # a bug: one line, the traceback on request
                 raise
-            err = _numeric_failure(e, study, cfg)
+            err = numeric_failure(e, study, cfg)
             err.internal = True
             raise err from None
     except BaseException as e:
+        if isinstance(e, KeyboardInterrupt) and (finished or (ctx and ctx.all_counted())):
+            e.chunks_done = True  # the same command only writes the results: none is missing
         if executor == "dask":
             _quiet_dask_logs()  # its closing chatter is not for users (one line is)
         ex.close(kill=True)
@@ -322,6 +273,8 @@ def execute(
     except BaseException as e:
         if not published:
             drop_stage(stage, lock)
+            if isinstance(e, KeyboardInterrupt):  # every chunk done: only the results are
+                e.chunks_done = True  # left to write
         elif isinstance(e, KeyboardInterrupt):  # the results stand: say where, not "resume"
             e.published = shown
         raise

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import re
 
+from sim.mc.message_text import LONG_WORD, cut_text
+
 __all__ = ["LONG_WORD", "clipped"]
 
-#: the longest run without white space a message shows whole (a path of 200 characters is)
-LONG_WORD = 200
 _LONG = re.compile(r"\S{%d,}" % (LONG_WORD + 1))
 #: a word's quotes and brackets before it, and those and its punctuation after it
 _EDGES = re.compile(r"""(['"(\[{]*)(.*?)(['")\]}:,;.]*)""", re.S)
@@ -30,4 +30,4 @@ def clipped(text: str) -> str:
 
 def _cut(m: re.Match) -> str:
     core = _EDGES.fullmatch(m[0])[2] or m[0]
-    return f"{m[0][:60]}...{m[0][-20:]} ({len(core)} characters)"
+    return cut_text(m[0], len(core))

@@ -28,7 +28,7 @@ from sim.mc.config import ConfigError, config_changes
 from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import reordered, swept_order
 
-__all__ = ["CODE", "PROJECT", "base", "check_place", "default_out", "shown_path"]
+__all__ = ["CODE", "PROJECT", "base", "check_place", "default_out", "shown_path", "show_target"]
 
 #: the suite's package directory (``sim/``) and the checkout it lies in
 CODE = Path(__file__).resolve().parent
@@ -57,6 +57,17 @@ def shown_path(path: Path) -> str:
         return os.path.relpath(path)
     except (OSError, ValueError):
         return str(path)
+
+
+def show_target(where: Path) -> str:
+    """What ``sim show`` is given to print the results directory ``where`` again (its
+    README.md says it): its name where ``sim show`` finds it by name (in ``results/`` or
+    ``scratch/`` of :func:`base`), else its absolute path. ``sim show NAME`` of a run written
+    to ``/tmp/NAME`` said "does not exist", or printed the committed ``results/NAME``."""
+    at = Path(os.path.abspath(where))
+    if any(at.parent == Path(os.path.abspath(base() / d)) for d in ("results", "scratch")):
+        return at.name
+    return str(at)
 
 
 def check_place(out: Path, shown_as: str) -> None:

@@ -19,7 +19,7 @@ import os
 import resource
 
 from sim.mc.config import ConfigError
-from sim.mc.estimate import Estimate, _either, check_limits
+from sim.mc.estimate import Estimate, check_limits
 
 __all__ = ["check_room", "limits_set", "mapped_bytes", "short_room"]
 
@@ -79,5 +79,5 @@ def check_room(
         raise ConfigError(
             None,
             f"{est.study}: the run needs about {est.bytes / 2**30:.3g} GiB of memory{each}{cell}, "
-            f"and {short}: raise {words}, or reduce {_either(est.memory_keys)}",
+            f"and {short}: raise {words}, or reduce {est.memory_advice()}",
         )

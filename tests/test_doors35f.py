@@ -111,7 +111,7 @@ def test_a_set_with_a_no_break_space_is_not_read_as_the_key(capsys, text, needle
         ("plate = 5\n[plate]\ngrid = 5\n", "plate is given twice (a value, then a table)"),
         ("[[plate]]\ngrid = 5\n[plate]\n", "plate is given twice (an array of tables, then a"),
         ('"trials " = 1\n"trials " = 2\n', '"trials " is given twice'),
-        ("plate = {grid = 5, grid = 6}\n", "grid is given twice in the inline table of plate"),
+        ("plate = {grid = 5, grid = 6}\n", "plate.grid is given twice in an inline table"),
         ("trials = [\n 1,\n 2]\ntrials = [\n 3\n]\n", "trials is given twice (at line 7,"),
     ],
 )

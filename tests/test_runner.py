@@ -267,9 +267,10 @@ def test_the_estimate_stops_an_oversized_run_at_once(tmp_path, capsys, monkeypat
     from sim.mc.estimate import estimate
     from sim.studies import load_study
 
-    _, cfg = load_study(STUDY)
+    region = ["region.points=256", "region.rounds=0"]  # the region's share, as small as it goes
+    _, cfg = load_study(STUDY, region)
     small = estimate(cfg)
-    _, cfg = load_study(STUDY, ["plate.grid=200", "plate.spacing_mm=1.0"])
+    _, cfg = load_study(STUDY, region + ["plate.grid=200", "plate.spacing_mm=1.0"])
     big = estimate(cfg)
     assert big.unknowns == 2 * 200**2 + 7 and big.bytes > 1000 * small.bytes
     args = ["run", str(STUDY), "--out", str(tmp_path / "o"), "--quiet", "--set", "chunk=100"]

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import errno
 import os
 import re
 import sys
@@ -188,6 +189,9 @@ class BoundedParser(argparse.ArgumentParser):
         output: exit 0 and no word); one to standard output is kept for the program's end
         (:func:`sim.ends.flush_stdout`: one line naming it, exit 2)."""
         if not message:
+            return
+        if file is None and sys.stdout is None:  # --help, --version >&-: it went to standard
+            stdout_unwritten(OSError(errno.EBADF, "closed"))  # error, exit 0: now one line, 2
             return
         file = file or sys.stderr
         try:

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from sim.mc.lookalike import looks, note, toml_char_hint
-from sim.mc.message_text import key_text, near_keys, shorten, shown
+from sim.mc.message_text import cut_text, key_text, near_keys, shorten, shown, unit_hint
 from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.study_file import study_file_problem
@@ -133,7 +133,9 @@ def _num(key: str, v: Any, want_int: bool) -> float | int:
         n = number_text(v) if isinstance(v, str) else ""  # --set x=.5: TOML read a string
         if n and (not want_int or float(n).is_integer()):  # (no "write 0.5" for an integer)
             raise ConfigError(key, f"must be {what} (got the text {v[:60]!r}: write {n})")
-        raise ConfigError(key, f"must be {what} (got {_cut(shown(v), v)})")
+        said = cut_text(shown(v), len(v) if isinstance(v, str) else None)  # (its length)
+        hint = unit_hint(key, v) if isinstance(v, str) else ""  # "45mm": the key's _mm
+        raise ConfigError(key, f"must be {what} (got {said}{hint})")
     refuse_big_ints(key, v)
     if not math.isfinite(v):
         raise ConfigError(key, f"must be finite (got {v!r})")
@@ -143,15 +145,6 @@ def _num(key: str, v: Any, want_int: bool) -> float | int:
         else:
             raise ConfigError(key, f"must be an integer (got {v!r})")
     return v if want_int else float(v)
-
-
-def _cut(text: str, v: Any) -> str:
-    """``text`` (``v`` shown) whole up to 200 characters, else cut saying ``v``'s length: a
-    value was cut at 60 characters without a word (``(got 'yyy...y)``, its quote left open)."""
-    if len(text) <= 200:
-        return text
-    n = len(v) if isinstance(v, str) else len(text)
-    return f"{text[:60]}...{text[-20:]} ({n} characters)"
 
 
 def _exact(key: str, given: Any) -> None:

@@ -130,6 +130,20 @@ class Estimate:
         t = f"{s:.2g} s" if math.isfinite(s) and s < 60 else _minutes(s)
         return f"about {t} of one core of the reference machine"
 
+    def memory_advice(self) -> str:
+        """The keys that set the run's memory (:attr:`memory_keys`), as advice (``chunk,
+        trials or plate.grid``); without them, the words that cover every study."""
+        return keys_advice(self.memory_keys)
+
+
+def keys_advice(keys) -> str:
+    """Keys that set a run's memory as advice (``chunk, trials or plate.grid``); without
+    them, the words that cover every study."""
+    keys = tuple(keys or ())
+    if not keys:
+        return "chunk, trials or the sizes in the study file"
+    return keys[0] if len(keys) == 1 else f"{', '.join(keys[:-1])} or {keys[-1]}"
+
 
 def _gib(b: float) -> str:
     return f"{b / 2**30:.3g} GiB" if b >= 2**27 else f"{b / 2**20:.3g} MiB"
@@ -372,7 +386,7 @@ def check_limits(
             f"{mem:g} GiB limit (--max-memory-gb or SIM_MAX_MEMORY_GB)"
             + (f", most of it for {est.largest}" if est.largest else "")
             + (f", in the sweep's cell of {est.cell}" if est.cell else "")
-            + f"; reduce {_either(est.memory_keys)}",
+            + f"; reduce {est.memory_advice()}",
         )
     if not est.adjustments <= adj:
         raise ConfigError(
@@ -392,14 +406,6 @@ def check_limits(
             "--max-adjustments or SIM_MAX_ADJUSTMENTS); use fewer points per side or fewer "
             "positions, extents, offsets or betas, or raise the limit",
         )
-
-
-def _either(keys: tuple) -> str:
-    """The keys that set a run's memory, as advice (``chunk, trials or plate.grid``); without
-    them, the words that cover every study."""
-    if not keys:
-        return "chunk, trials or the sizes in the study file"
-    return keys[0] if len(keys) == 1 else f"{', '.join(keys[:-1])} or {keys[-1]}"
 
 
 #: seconds of one core a chunk may take before the run says so: the progress bar moves once

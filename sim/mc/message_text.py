@@ -11,6 +11,10 @@ does not print written as TOML escapes it (``"tri\\u200bals"``), and the empty k
 ``near_keys``: ``--set plate.spacing_um=45000`` was "unknown key (did you mean
 plate.spacing_mm?)", and the value typed in um, moved to the mm key, was a spacing 1000 times
 the one meant: a key meant that differs only in its unit says the unit to convert to.
+``unit_hint``: ``--set plate.spacing_mm="45mm"`` was "must be a number (got '45mm')", with
+no word that the unit is the key's name's and the value the number alone.
+``cut_text``: a value or a word too long for one line, its start and end and its length
+(``sim.mc.config`` and :mod:`sim.long_words` had a copy each).
 """
 
 from __future__ import annotations
@@ -18,7 +22,12 @@ from __future__ import annotations
 import re
 from typing import Any
 
-__all__ = ["LONG_DIGITS", "shown", "shorten", "key_text", "near_keys"]
+__all__ = ["LONG_DIGITS", "LONG_WORD", "cut_text", "shown", "shorten", "key_text", "near_keys"]
+__all__ += ["unit_hint"]
+
+#: the longest text (a run without white space) a message shows whole: a path of 200
+#: characters is
+LONG_WORD = 200
 
 #: digits of an integer above which a message shows it shortened (a 64-bit one has 19 digits)
 LONG_DIGITS = 19
@@ -110,3 +119,33 @@ def near_keys(key: str, near: list[str]) -> str:
         else ""
     )
     return f" (did you mean {' or '.join(near)}?{said})"
+
+
+def cut_text(text: str, n: int | None = None) -> str:
+    """``text`` whole up to :data:`LONG_WORD` characters, else its first 60 and last 20 and
+    its length ``n`` (default ``len(text)``): ``'yyy...yyy' (100000 characters)``."""
+    if len(text) <= LONG_WORD:
+        return text
+    return f"{text[:60]}...{text[-20:]} ({len(text) if n is None else n} characters)"
+
+
+#: a number followed by a unit: ``45mm``, ``45 mm``, ``2.5"``, ``1e-3 arcsec``
+_WITH_UNIT = re.compile(
+    r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z\u00b5\u00b0\"']{1,12})\s*"
+)
+
+
+def unit_hint(key: str, text: str) -> str:
+    """For the text ``text`` given to the number key ``key``: when it is a number written with
+    a unit, the words that say the unit is in the key's name and what to write (``: the unit
+    is in the key's name (_mm): write 45``), else ``""``."""
+    m = _WITH_UNIT.fullmatch(text) if len(text) <= 100 else None
+    if m is None:
+        return ""
+    number, unit = m.groups()
+    stem, _, own = key.rpartition(".")[2].rpartition("_")
+    if stem and own in _UNITS:
+        if unit.lower().replace("\u00b5", "u") == own.lower():
+            return f": the unit is in the key's name (_{own}): write {number}"
+        return f": the key's unit is {own}, in its name: write the number alone, in {own}"
+    return ": write the number alone, without a unit"

@@ -114,7 +114,11 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
     _check_name_length(out, shown)
     _check_not_nested(out, shown)
     if out.is_symlink():
-        raise ConfigError("--out", f"{shown} is a symbolic link; sim never replaces it")
+        raise ConfigError(  # what to do said: the batch named --results, and nothing else
+            "--out",
+            f"{shown} is a symbolic link; sim never replaces it (choose another --out, or "
+            "remove the link: what it leads to is kept)",
+        )
     if not out.exists():  # café typed beside a café of the other Unicode form (doors25a):
         if (why := link_problem(out)) is not None:  # two results directories printed alike
             raise ConfigError("--out", f"{shown} {why}")

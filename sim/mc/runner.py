@@ -355,6 +355,14 @@ class RunContext:
     store: object = None  # sim.mc.runner.ChunkStore of the run's staging directory
     estimate: object = None  # sim.mc.estimate.Estimate of the run (the progress bar's total)
     bars: list = field(default_factory=list, compare=False)  # the open shared bar, if any
+    counted: list = field(default_factory=list, compare=False)  # its trials when it closed
+
+    def all_counted(self) -> bool:
+        """Whether the run's bar has counted every trial of its estimate: every chunk is
+        done (an interrupt then leaves only the tables and figures to the same command)."""
+        total = getattr(self.estimate, "trials", 0) or 0
+        done = self.bars[-1].done if self.bars else (self.counted or [0])[-1]
+        return total > 0 and done >= total
 
     @property
     def bar(self):
@@ -371,3 +379,4 @@ class RunContext:
                 yield p
             finally:
                 self.bars.remove(p)
+                self.counted[:] = [p.done]

@@ -86,8 +86,15 @@ def _named(text: str, reason: str, line: int, where: str) -> str | None:
             return None
         if m := re.fullmatch(r"Duplicate inline table key ('.*')", reason):
             stem = ast.literal_eval(m.group(1))
-            inline = key_text(".".join(head + rel))
-            return f"{key_text(stem)} is given twice in the inline table of {inline}{where}"
+            at = starts[line - 1] + int(where.split("column ")[-1].rstrip(")")) - 1
+            try:
+                inner = _inline_key(text[starts[i] : at], _key_end(lines[i]))
+            except (tomllib.TOMLDecodeError, IndexError):  # not told: the words below
+                inner = None
+            if inner is None:  # the inline table named, its key by its last part
+                inline = key_text(".".join(head + rel))
+                return f"{key_text(stem)} is given twice in the inline table of {inline}{where}"
+            return f"{_dotted(head + rel, inner)} is given twice in an inline table{where}"
         path, second = head + rel, "a value"
     named = _NAMED.match(reason)
     target = list(ast.literal_eval(named.group(1))) if named else _first_taken(before, path)
@@ -105,6 +112,70 @@ def _named(text: str, reason: str, line: int, where: str) -> str | None:
     differ = first != second and (first in tables or second in tables)  # not two values
     both = f" ({first}, then {second})" if differ else ""
     return f"{key_text('.'.join(target))} is given twice{both}{where}"
+
+
+def _key_end(line: str) -> int | None:
+    """Where the ``=`` after the key of the statement beginning ``line`` stands."""
+    for m in re.finditer("=", line):
+        try:
+            tomllib.loads(line[: m.start()] + "= 0")
+            return m.start()
+        except tomllib.TOMLDecodeError:
+            continue
+    return None
+
+
+def _inline_key(src: str, eq: int | None) -> list | None:
+    """The key given twice in an inline value, as parts below the statement's key (a part
+    ``[k]``: the array's item ``k``), read from ``src``, the statement up to tomllib's error
+    (just after the second value of that key), its ``=`` at ``eq``; None when it cannot be
+    told. tomllib names the key by its last part only: ``plate = {x = {a = 1, a = 2}}`` was
+    "a is given twice in the inline table of plate"."""
+    if eq is None:
+        return None
+    stack: list[list] = []  # [table parts, key from, last key] or ["[]", item index]
+    path: list = []  # the parts down to the innermost frame
+    i, n = eq + 1, len(src)
+    while i < n:
+        c = src[i]
+        if c in "\"'":  # a string (a quoted key too): skipped whole
+            q = c * 3 if src.startswith(c * 3, i) else c
+            j = i + len(q)
+            while j < n and not src.startswith(q, j):
+                j += 2 if c == '"' and src[j] == "\\" else 1
+            i = j + len(q)
+            continue
+        top = stack[-1] if stack else None
+        if c == "#":
+            j = src.find("\n", i)  # a comment between an array's lines
+            i = n if j < 0 else j
+            continue
+        if c == "=" and top and top[0] != "[]":
+            top[2] = _path(tomllib.loads(src[top[1] : i] + "= 0"))
+        elif c in "{[":
+            name = (top[2] if top[0] != "[]" else [f"[{top[1]}]"]) if top else []
+            path.append(name)
+            stack.append(["[]", 0] if c == "[" else [name, i + 1, None])
+        elif c in "}]" and stack:
+            stack.pop()
+            path.pop()
+        elif c == "," and top:
+            if top[0] == "[]":
+                top[1] += 1
+            else:
+                top[1] = i + 1
+        i += 1
+    if not stack or stack[-1][0] == "[]" or not stack[-1][2]:
+        return None
+    return [p for part in path for p in part] + stack[-1][2]
+
+
+def _dotted(head: list[str], inner: list) -> str:
+    """``network.grids[0].origin_mm``: the key's parts, an array's item after its key."""
+    out = key_text(".".join(head))
+    for p in inner:
+        out += p if p.startswith("[") else f".{key_text(p)}"
+    return out
 
 
 def _path(doc: Any) -> list[str]:

@@ -22,6 +22,7 @@ from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, write_record
 from sim.mc.table_shape import kind
+from sim.places import show_target
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.config_diff import sweep_config_line
 from sim.report.labels import column
@@ -340,14 +341,20 @@ def _cut(s: str, n: int) -> str:
 
 
 def run_markdown(
-    out: Path, get_study: Callable, name: str | None = None, design: Callable | None = None
+    out: Path,
+    get_study: Callable,
+    name: str | None = None,
+    design: Callable | None = None,
+    where: Path | None = None,
 ) -> str:
     """The README.md of one results directory: what ran (study, paper, config), the verdict
     counts, the region line, then the study's own report section (claims, tables, figures:
     links relative to the directory) or the sweep's table. ``name``: the directory's name in
     its title (a run writes the README in its staging directory, ``.<name>.partial``);
     ``design``: a study file's config by its name (``sim.studies.design_config``), to name
-    what the run changed from it (:mod:`sim.report.config_diff`)."""
+    what the run changed from it (:mod:`sim.report.config_diff`); ``where``: the directory
+    the README ends in (``out`` by default), which its ``sim show`` command names
+    (:func:`sim.places.show_target`)."""
     out = Path(out)
     name = name or out.name
     forget()
@@ -362,7 +369,7 @@ def run_markdown(
         f"Study `{prov['study']}`"
         + (f", seed paper: {paper}." if paper else " (a declared network, no seed paper).")
         + " Written by `sim run` from this directory's Parquet files "
-        f"({md_code(f'sim show {shlex.quote(name)}')} prints it again).",
+        f"({md_code(f'sim show {shlex.quote(show_target(where or out))}')} prints it again).",
         "",
     ]
     if (changed := sweep_config_line(prov, name, design)) is not None:  # a study's: config_line
@@ -432,7 +439,7 @@ def write_run_readme(
             if rec is not None and "README.md" in (rec.get("files") or []):
                 write_record(out, {**rec, "files": [f for f in rec["files"] if f != "README.md"]})
         return None
-    text = README_MARK + "\n" + run_markdown(out, get_study, name, design)
+    text = README_MARK + "\n" + run_markdown(out, get_study, name, design, final)
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     rec = read_record(out)

@@ -160,6 +160,14 @@ def check(cfg: dict) -> None:
     if cfg["output.inner_over"]:
         pts = match_points(net, "output.inner_over", cfg["output.inner_over"])
         check_inner(net, inner_defect(net), pts, "output.inner_over")
+        if all(net.role[p] == 1 for p in pts):  # their covariance is zero: S Q S' = Q
+            raise ConfigError(
+                "output.inner_over",
+                f"{', '.join(net.names[p] for p in pts[:5])}{' ...' * (len(pts) > 5)} are all "
+                "fixed points: the inner datum "
+                "over them is the datum they hold (its table would repeat the points' sigmas "
+                "as 'inner'): name estimated points among them, or leave it out",
+            )
 
 
 def _where(full: dict) -> tuple[str, str]:
