@@ -39,7 +39,8 @@ import numpy as np
 from sim.mc.config import ConfigError, given
 from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network
-from sim.studies.network.gama_read import CC, NE, NS, consistent, read_bytes, read_gama
+from sim.studies.network.gama_frames import NE, consistent
+from sim.studies.network.gama_read import CC, NS, read_bytes, read_gama
 from sim.studies.network.gama_vocab import shifted
 from sim.studies.network.linearity import row_key
 from sim.studies.network.model import computed
