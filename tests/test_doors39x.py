@@ -23,6 +23,9 @@ given to both programs one by one) lives outside the project; ``gama-local``'s p
   matrix holds) and the default ``zenith-angle-stdev`` and ``azimuth-stdev`` (kinds refused
   here) held garbage (``stdev="x3"``) and were read; ``gama-local`` refuses the file. Now each
   is a number, as there.
+* A point whose coordinates the file gives only in ``<coordinates>`` (``<point id="C"
+  adj="xy"/>`` beside them), which ``gama-local`` takes as the point's, was refused: "C has no
+  coordinates". They are now its coordinates.
 * A d-m-s value with more degrees than a C ``int`` holds (``99999999999-1-1``) was read as
   degrees (its stdev in arcseconds); ``gama-local`` refuses it ("bad direction"). Now refused.
 """
@@ -178,3 +181,18 @@ def test_d_m_s_degrees_beyond_gama_locals_int_are_refused(tmp_path):
     ok = tmp_path / "ok.xml"
     ok.write_text(xml.replace("99999999999-1-1", "2147483647-1-1"))
     assert np.isfinite(read_gama(ok)["network.observations"][1]["sigma_arcsec"])
+
+
+def test_coordinates_given_only_in_coordinates_are_the_points(tmp_path):
+    """<point id="C" adj="xy"/> and C's x and y in <coordinates>: gama-local takes them as
+    C's coordinates (and adjusts the file); the suite refused it, "C has no coordinates"."""
+    coords = (
+        '<coordinates><point id="C" x="250" y="280"/>'
+        '<cov-mat dim="2" band="0">4 4</cov-mat></coordinates>'
+    )
+    given = tmp_path / "given.xml"
+    given.write_text(_file(FIXED, _obs() + coords))
+    only = tmp_path / "only.xml"
+    only.write_text(_file(FIXED.replace('x="250" y="280" ', ""), _obs() + coords))
+    assert 'id="C" adj' in only.read_text()
+    assert read_gama(only) == read_gama(given)

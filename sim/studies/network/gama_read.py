@@ -152,6 +152,15 @@ def _stdev(f: _File, o, default, var: float | None) -> float:
     return default
 
 
+def _xy(f: _File, e) -> tuple[float, float]:
+    """The coordinates (mm) of a ``<point>`` (also one in ``<coordinates>``), in range."""
+    xy = (f.mm(e, "x"), f.mm(e, "y"))
+    for ax, v in zip("xy", xy):
+        if not abs(v) <= COORDINATE_MAX_MM:  # no coordinate on the earth, by the element
+            raise f.err(e, f"{v / 1000:g} m: over 100,000 km, out of range", ax)
+    return xy
+
+
 def _point(f: _File, e, points: dict, datum: dict) -> None:
     pid = f.name(e, "id")
     fix, adj = ws(e.get("fix", "")), ws(e.get("adj", ""))
@@ -161,10 +170,7 @@ def _point(f: _File, e, points: dict, datum: dict) -> None:
         raise f.err(e, f"point {pid!r} is both fixed and adjusted in xy", "fix")
     rec = points.setdefault(pid, {"name": pid})
     if e.get("x") is not None or e.get("y") is not None:
-        xy = (f.mm(e, "x"), f.mm(e, "y"))
-        for ax, v in zip("xy", xy):
-            if not abs(v) <= COORDINATE_MAX_MM:  # no coordinate on the earth, by the element
-                raise f.err(e, f"{v / 1000:g} m: over 100,000 km, out of range", ax)
+        xy = _xy(f, e)
         if "x_mm" in rec and (rec["x_mm"], rec["y_mm"]) != xy:
             raise f.err(e, f"point {pid!r} declared twice with different coordinates", "x")
         rec["x_mm"], rec["y_mm"] = xy
@@ -252,9 +258,7 @@ def _coordinates(f: _File, e, coords: list) -> None:
             raise f.err(
                 cms[0], f"point {vocab.said(p.get('id') or '')}: observed x and y need one variance"
             )
-        pid = f.name(p, "id")
-        f.num(p, "x"), f.num(p, "y")
-        coords.append((pid, math.sqrt(vx)))
+        coords.append((f.name(p, "id"), math.sqrt(vx), _xy(f, p)))
 
 
 def _vectors(f: _File, e, out: list) -> None:
@@ -308,6 +312,9 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
     """Every point has coordinates and a role; observed coordinates and observations name
     declared points."""
     key, path = f.key, f.path
+    for pid, _, xy in coords:  # a point's coordinates given only there: gama-local reads them
+        if pid in points and "x_mm" not in points[pid]:
+            points[pid]["x_mm"], points[pid]["y_mm"] = xy
     for pid, rec in points.items():
         if "x_mm" not in rec:
             raise ConfigError(
@@ -317,7 +324,7 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
             )
         if "role" not in rec:
             raise ConfigError(key, f"{path}: <point id={pid!r}> is neither fix nor adj in xy")
-    for pid, s in coords:
+    for pid, s, _ in coords:
         if pid not in points:
             raise ConfigError(
                 key, f"{path}: <coordinates>: observed coordinates of unknown point {pid!r}"
