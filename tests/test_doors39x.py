@@ -26,6 +26,13 @@ given to both programs one by one) lives outside the project; ``gama-local``'s p
 * A point whose coordinates the file gives only in ``<coordinates>`` (``<point id="C"
   adj="xy"/>`` beside them), which ``gama-local`` takes as the point's, was refused: "C has no
   coordinates". They are now its coordinates.
+* The export of a network with weak directions (9000 arcsec, points held by distances) was
+  a file ``gama-local`` could not adjust: its default algorithm (envelope) takes a pivot of the
+  normals under 1.5e-8 for a linear dependence, the set's orientation there (weights 1 /
+  stdev^2 in cc^-2 with the export's ``sigma-apr="1"``), and drops its station and then every
+  point ("No unknowns have been defined"). The export now writes ``sigma-apr`` as a power of
+  ten that lifts the weakest orientation's weight over it (a priori it scales every weight
+  alike, no covariance); other files are written as before, byte for byte.
 * A d-m-s value with more degrees than a C ``int`` holds (``99999999999-1-1``) was read as
   degrees (its stdev in arcseconds); ``gama-local`` refuses it ("bad direction"). Now refused.
 """
@@ -38,10 +45,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from benchmarks.scaling import gama_local
 from sim.cli import main
 from sim.mc.config import ConfigError
+from sim.studies import load_study
+from sim.studies.network.analysis import analyse
+from sim.studies.network.definition import build
+from sim.studies.network.gama import export, merge_gama
 from sim.studies.network.gama_read import NS, read_gama
+from sim.studies.network.model import datum
 from tests.oneline import one_line
+from tests.test_doors20d import gama_cov
 
 XY = {"A": (0.0, 0.0), "B": (300.0, 0.0), "C": (250.0, 280.0), "D": (-20.0, 260.0)}
 
@@ -196,3 +210,39 @@ def test_coordinates_given_only_in_coordinates_are_the_points(tmp_path):
     only.write_text(_file(FIXED.replace('x="250" y="280" ', ""), _obs() + coords))
     assert 'id="C" adj' in only.read_text()
     assert read_gama(only) == read_gama(given)
+
+
+WEAK = """study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_m = 0.0, y_m = 0.0, role = "fixed" },
+           { name = "B", x_m = 50.0, y_m = 0.0, role = "fixed" },
+           { name = "C", x_m = 30.0, y_m = 35.0 }, { name = "D", x_m = -5.0, y_m = 45.0 },
+           { name = "F", x_m = 20.0, y_m = -25.0 } ]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 1.0 },
+             { kind = "direction", from = "*", to = "*", sigma_arcsec = 9000.0 } ]
+"""
+
+
+def test_the_export_of_weak_directions_is_adjusted_by_gama_local(tmp_path):
+    """Directions of 9000 arcsec (a set's weight 4 / (2.8e4 cc)^2 under gama-local's envelope
+    pivot 1.5e-8): gama-local dropped every station, "No unknowns have been defined". The
+    export now writes sigma-apr = 1e3 (a priori it scales every weight alike, no covariance),
+    and gama-local's covariances are the study's."""
+    st = tmp_path / "weak.toml"
+    st.write_text(WEAK)
+    full = merge_gama(load_study(st)[1])
+    net = build(full)
+    an = analyse(net, datum(net, full), 0.001, 0.8)
+    path = tmp_path / "network.xml"
+    assert export(net, full, path) == "network.xml"
+    assert 'sigma-apr="1e3"' in path.read_text()
+    if gama_local() is None:
+        pytest.skip("no gama-local on this machine: the file is checked, not adjusted")
+    got = gama_cov(path)
+    scale = max(np.abs(c).max() for c in got.values())
+    assert sorted(got) == ["C", "D", "F"]
+    for a, nm in enumerate(net.names):
+        if nm in got:
+            np.testing.assert_allclose(an.cov[a], got[nm], rtol=0, atol=1e-6 * scale)
