@@ -6,7 +6,8 @@ bearings clockwise from x, as this suite's bearings from +x towards +y; a networ
 a gama-local file is written in that file's ``axes-xy`` and ``angles``, its coordinates as
 read, directions and angles negated where the angles run against the frame) with
 ``<parameters sigma-apr="1" sigma-act="apriori"/>`` (a precision study: the stdevs are the
-observations' sigmas); points in metres, ``fix="xy"`` (fixed), ``adj="xy"`` (free or
+observations' sigmas; sigma-apr a power of ten where gama-local would drop a weak orientation:
+:func:`_sigma_apr`); points in metres, ``fix="xy"`` (fixed), ``adj="xy"`` (free or
 observed), ``adj="XY"`` on the points of an inner datum; directions grouped one ``<obs>`` per
 orientation set, angles and directions in gon with stdevs in cc, distances with stdevs in mm;
 observed coordinates as ``<coordinates>`` with a diagonal ``<cov-mat>`` (mm^2); ``dx``/``dy``
@@ -39,7 +40,8 @@ import numpy as np
 from sim.mc.config import ConfigError, given
 from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network
-from sim.studies.network.gama_read import CC, NE, NS, consistent, read_bytes, read_gama
+from sim.studies.network.gama_frames import NE, consistent
+from sim.studies.network.gama_read import CC, NS, read_bytes, read_gama
 from sim.studies.network.gama_vocab import shifted
 from sim.studies.network.linearity import row_key
 from sim.studies.network.model import computed
@@ -304,15 +306,8 @@ def _coordinates(net: Network, po: ET.Element) -> None:
     c = ET.SubElement(po, "coordinates")
     xy = net.xy_mm
     for a in obs_pts:
-        ET.SubElement(
-            c,
-            "point",
-            {
-                "id": net.names[a],
-                "x": _metres(xy[a, 0]),
-                "y": _metres(xy[a, 1]),
-            },
-        )
+        attr = {"id": net.names[a], "x": _metres(xy[a, 0]), "y": _metres(xy[a, 1])}
+        ET.SubElement(c, "point", attr)
     cm = ET.SubElement(c, "cov-mat", {"dim": str(2 * len(obs_pts)), "band": "0"})
     cm.text = " ".join(_fmt(sig[int(a)] ** 2) for a in obs_pts for _ in (0, 1))
 
@@ -350,6 +345,17 @@ def _vectors(net: Network, po: ET.Element, pairs: list, val: np.ndarray) -> None
     )
 
 
+def _sigma_apr(net: Network) -> str:
+    """``sigma-apr``: 1, or a power of ten lifting the set orientations' weights (sigma-apr^2 /
+    stdev^2, cc) over gama-local's envelope pivot 1.5e-8, under which it takes the orientation
+    for a dependence and drops its station (directions of 1e4 arcsec: "No unknowns have been
+    defined"); a priori it scales every weight alike, no covariance."""
+    d = net.kind == 1
+    w = np.bincount(net.oset[d], (CC / net.sigma[d]) ** 2) if d.any() else np.zeros(0)
+    least = float(w[np.bincount(net.oset[d]) > 1].min(initial=1.0)) if d.any() else 1.0
+    return "1" if least >= 1e-6 else f"1e{math.ceil(math.log10(1e-4 / least) / 2)}"
+
+
 def write_gama(net: Network, path: str | Path, inner: tuple | list = (), frame: tuple = NE) -> Path:
     """Write ``net`` as ``gama-local`` XML (see the module doc for the mapping and what is
     refused); ``inner``: indices of the points of an inner datum (``adj="XY"``); ``frame``:
@@ -364,7 +370,7 @@ def write_gama(net: Network, path: str | Path, inner: tuple | list = (), frame: 
     root = ET.Element("gama-local", xmlns=NS)
     nw = ET.SubElement(root, "network", {"axes-xy": frame[0], "angles": frame[1]})
     ET.SubElement(nw, "description").text = net.name
-    ET.SubElement(nw, "parameters", {"sigma-apr": "1", "sigma-act": "apriori"})
+    ET.SubElement(nw, "parameters", {"sigma-apr": _sigma_apr(net), "sigma-act": "apriori"})
     po = ET.SubElement(nw, "points-observations")
     _points(net, po, {int(a) for a in inner}, bool(pairs))
     _obs_sets(net, po, val)

@@ -55,6 +55,8 @@ from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
 from sim.studies.network import gama_vocab as vocab
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
+from sim.studies.network.gama_encoding import EncodingProblem, gama_text
+from sim.studies.network.gama_frames import NE, frame_note
 from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
 from sim.studies.network.gama_vocab import words as _words
 from sim.studies.network.validate import SIGMA_RANGE, looks_like
@@ -64,11 +66,9 @@ __all__ = ["read_gama", "read_bytes", "MAX_BYTES", "CC", "NS"]
 
 def _cov(f: _File, cm, n: int) -> np.ndarray:
     """Variances of a ``<cov-mat dim band>`` of ``n`` observations; refuses covariances."""
-    dim = f.num(cm, "dim")
-    band = f.num(cm, "band")
-    if not (dim.is_integer() and band.is_integer() and 0 <= band < dim):
-        raise f.err(cm, f"dim {dim:g} and band {band:g}: need integers, 0 <= band < dim", "band")
-    dim, band = int(dim), int(band)
+    dim, band = f.integer(cm, "dim"), f.integer(cm, "band")
+    if not 0 <= band < dim:
+        raise f.err(cm, f"dim {dim} and band {band}: need 0 <= band < dim", "band")
     if dim != n:
         raise f.err(cm, f"dim {dim} for {n} observations", "dim")
     words = _words(cm.text)
@@ -117,6 +117,9 @@ def _defaults(f: _File, po) -> dict:
     d["distance"] = abc if words else None
     for k in ("direction", "angle"):
         d[k] = f.num(po, f"{k}-stdev") if po.get(f"{k}-stdev") is not None else None
+    for k in ("zenith-angle", "azimuth"):  # of kinds refused here, but numbers in gama-local
+        if po.get(f"{k}-stdev") is not None:
+            f.num(po, f"{k}-stdev")
     return d
 
 
@@ -136,7 +139,9 @@ def _sigma(f: _File, o, default, var: float | None, unit: float | None = None) -
 
 
 def _stdev(f: _File, o, default, var: float | None) -> float:
-    if var is not None:
+    if var is not None:  # the <cov-mat> holds; a stdev beside it is still a number there
+        if o.get("stdev") is not None:
+            f.num(o, "stdev")
         return math.sqrt(var)
     if o.get("stdev") is not None:
         return f.num(o, "stdev", lo=0.0)
@@ -145,6 +150,15 @@ def _stdev(f: _File, o, default, var: float | None) -> float:
     if default <= 0:
         raise f.err(o, "the default stdev is not positive", "stdev")
     return default
+
+
+def _xy(f: _File, e) -> tuple[float, float]:
+    """The coordinates (mm) of a ``<point>`` (also one in ``<coordinates>``), in range."""
+    xy = (f.mm(e, "x"), f.mm(e, "y"))
+    for ax, v in zip("xy", xy):
+        if not abs(v) <= COORDINATE_MAX_MM:  # no coordinate on the earth, by the element
+            raise f.err(e, f"{v / 1000:g} m: over 100,000 km, out of range", ax)
+    return xy
 
 
 def _point(f: _File, e, points: dict, datum: dict) -> None:
@@ -156,10 +170,7 @@ def _point(f: _File, e, points: dict, datum: dict) -> None:
         raise f.err(e, f"point {pid!r} is both fixed and adjusted in xy", "fix")
     rec = points.setdefault(pid, {"name": pid})
     if e.get("x") is not None or e.get("y") is not None:
-        xy = (f.mm(e, "x"), f.mm(e, "y"))
-        for ax, v in zip("xy", xy):
-            if not abs(v) <= COORDINATE_MAX_MM:  # no coordinate on the earth, by the element
-                raise f.err(e, f"{v / 1000:g} m: over 100,000 km, out of range", ax)
+        xy = _xy(f, e)
         if "x_mm" in rec and (rec["x_mm"], rec["y_mm"]) != xy:
             raise f.err(e, f"point {pid!r} declared twice with different coordinates", "x")
         rec["x_mm"], rec["y_mm"] = xy
@@ -172,6 +183,8 @@ def _point(f: _File, e, points: dict, datum: dict) -> None:
         rec["role"] = role
     if "XY" in adj:
         datum[pid] = None  # ordered, each once (a list's "in" made thousands of points n^2)
+    elif adj:  # the last adj holds, as in gama-local: adj="xy" after adj="XY" frees the point
+        datum.pop(pid, None)
 
 
 def _obs(f: _File, e, dflt: dict, sets: dict, out: list) -> None:
@@ -243,9 +256,7 @@ def _coordinates(f: _File, e, coords: list) -> None:
             raise f.err(
                 cms[0], f"point {vocab.said(p.get('id') or '')}: observed x and y need one variance"
             )
-        pid = f.name(p, "id")
-        f.num(p, "x"), f.num(p, "y")
-        coords.append((pid, math.sqrt(vx)))
+        coords.append((f.name(p, "id"), math.sqrt(vx), _xy(f, p)))
 
 
 def _vectors(f: _File, e, out: list) -> None:
@@ -262,52 +273,12 @@ def _vectors(f: _File, e, out: list) -> None:
         out.append({"kind": "dy", "from": fr, "to": to, "sigma_mm": math.sqrt(var[3 * a + 1])})
 
 
-#: gama-local's frames (``axes-xy``): the left-handed ones (x to y clockwise) are ne and its
-#: turns by 90, 180 and 270 degrees, the right-handed ones their mirror images
-FRAMES = {
-    "ne": "x north, y east",
-    "es": "x east, y south: ne turned 90 degrees",
-    "sw": "x south, y west: ne turned 180 degrees",
-    "wn": "x west, y north: ne turned 270 degrees",
-    "en": "x east, y north: right-handed",
-    "nw": "x north, y west: right-handed",
-    "se": "x south, y east: right-handed",
-    "ws": "x west, y south: right-handed",
-}
-LEFT_HANDED = ("ne", "es", "sw", "wn")
-#: gama-local's default frame, the suite's own: (axes-xy, angles), x north, y east, clockwise
-NE = ("ne", "left-handed")
-
-
-def consistent(axes: str, angles: str) -> bool:
-    """The frame and the angles have the same handedness: a direction is a bearing from +x
-    towards +y (minus its orientation), as this suite's; otherwise from +x towards -y."""
-    return (axes in LEFT_HANDED) == (angles == "left-handed")
-
-
-def frame_note(axes: str, angles: str) -> str:
-    """What the report says of a file's frame (``""`` for gama-local's default, ne with
-    left-handed angles)."""
-    if (axes, angles) == NE:
-        return ""
-    note = (
-        f"; axes-xy = {axes!r} ({FRAMES[axes]}), {angles} angles: coordinates and covariances "
-        "are in the file's frame, ellipse bearings from +x towards +y"
-    )
-    if consistent(axes, angles):
-        return note + " (the sense of its angles)"
-    return note + (
-        " (against its angles, which run from +x towards -y: each direction and angle only "
-        "changes sign, which leaves every covariance unchanged)"
-    )
-
-
 def _network(f: _File, data: bytes):
     """The ``<network>`` element of the file's bytes, its root and attributes checked."""
     key, path = f.key, f.path
     try:  # the characters gama-local reads: its own encodings (cp-1250, ...) decoded as there
-        text = vocab.gama_text(data)
-    except vocab.EncodingProblem as why:
+        text = gama_text(data)
+    except EncodingProblem as why:
         raise ConfigError(key, f"{path}: {why}") from None
     if ent := vocab.entity_declared(text):
         raise ConfigError(
@@ -339,6 +310,9 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
     """Every point has coordinates and a role; observed coordinates and observations name
     declared points."""
     key, path = f.key, f.path
+    for pid, _, xy in coords:  # a point's coordinates given only there: gama-local reads them
+        if pid in points and "x_mm" not in points[pid]:
+            points[pid]["x_mm"], points[pid]["y_mm"] = xy
     for pid, rec in points.items():
         if "x_mm" not in rec:
             raise ConfigError(
@@ -348,7 +322,7 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
             )
         if "role" not in rec:
             raise ConfigError(key, f"{path}: <point id={pid!r}> is neither fix nor adj in xy")
-    for pid, s in coords:
+    for pid, s, _ in coords:
         if pid not in points:
             raise ConfigError(
                 key, f"{path}: <coordinates>: observed coordinates of unknown point {pid!r}"
@@ -356,6 +330,12 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
         if points[pid]["role"] == "fixed":
             raise ConfigError(
                 key, f"{path}: <coordinates>: point {pid!r} is fixed; observe a free point"
+            )
+        if points[pid]["role"] == "observed":  # gama-local adjusts both observations
+            raise ConfigError(
+                key,
+                f"{path}: <coordinates>: the coordinates of point {pid!r} are observed twice; "
+                "this suite takes one observation of a point (one sigma_mm): give them once",
             )
         points[pid].update(role="observed", sigma_mm=s)
     for rec in obs:
@@ -433,9 +413,9 @@ def _parameters(f: _File, pars: list) -> str:
             if c >= 1:
                 raise f.err(p, f"{c:g} must be below 1", "conf-pr")
         if p.get("cov-band") is not None:
-            c = f.num(p, "cov-band")
-            if not c.is_integer() or c < -1:
-                raise f.err(p, f"{c:g} must be an integer >= -1", "cov-band")
+            c = f.integer(p, "cov-band", signed=True)
+            if c < -1:
+                raise f.err(p, f"{c} must be an integer >= -1", "cov-band")
         if p.get("latitude") is not None:
             f.angle(p, "latitude")
     act = "aposteriori" if p is None else ws(p.get("sigma-act", "aposteriori"))

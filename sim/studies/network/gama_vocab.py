@@ -7,7 +7,6 @@ before it is opened). The parser: :mod:`sim.studies.network.gama_read`."""
 
 from __future__ import annotations
 
-import codecs
 import decimal
 import math
 import os
@@ -32,9 +31,7 @@ __all__ = [
     "said",
     "entity_declared",
     "raw_name_problem",
-    "gama_text",
     "shifted",
-    "EncodingProblem",
 ]
 
 NS = "http://www.gnu.org/software/gama/gama-local"
@@ -46,6 +43,12 @@ MAX_BYTES = 16 * 1024**2
 #: split a run of digits every way: a 10 MB attribute of digits ending in garbage hung, doors31y)
 _NUM = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$", re.ASCII)
 _DMS = re.compile(r"^[+-]?\d+-\d+-\d+(\.\d*)?([eE][+-]?\d+)?$", re.ASCII)
+#: gama-local's integers: a ``<cov-mat>``'s dim and band are digits only (its ``toIndex``), the
+#: ``cov-band`` digits with a sign (``IsInteger``): "2.0", "2e0" are refused there
+_INDEX = re.compile(r"^\d+$", re.ASCII)
+_INTEGER = re.compile(r"^[+-]?\d+$", re.ASCII)
+#: the largest degrees of a d-m-s value: gama-local reads them into a C int (more: "bad angle")
+_INT_MAX = 2**31 - 1
 #: the white space XML (and gama-local) trims around a value and splits a list at: Python's
 #: ``strip()`` and ``split()`` also take a no-break space and the other Unicode spaces, so an id
 #: ``"A\u00a0"`` was the point ``A`` here and another point in gama-local (doors24c)
@@ -133,7 +136,7 @@ PARENTS = {
     "direction": {"obs"},
     "distance": {"obs"},
     "angle": {"obs"},
-    "cov-mat": {"obs", "coordinates", "vectors"},
+    "cov-mat": {"obs", "coordinates", "vectors", "height-differences"},  # the last: refused
     "coordinates": {"points-observations"},
     "vectors": {"points-observations"},
     "vec": {"vectors"},
@@ -196,6 +199,17 @@ class _File:
             raise self.err(e, f"{said(v)} must be > {lo:g}", attr)
         return x
 
+    def integer(self, e, attr: str, signed: bool = False) -> int:
+        """An integer attribute as gama-local reads it: ASCII digits (with a sign where
+        ``signed``) and white space around them; "2.0" or "2e0" is refused, as there."""
+        v = e.get(attr)
+        if v is None:
+            raise self.err(e, "missing", attr)
+        if not (_INTEGER if signed else _INDEX).match(ws(v)):
+            what = "an integer" if signed else "a whole number of digits"
+            raise self.err(e, f"{said(v)} is not {what} (gama-local refuses it)", attr)
+        return int(ws(v)) if len(ws(v)) < 100 else _INT_MAX  # int() of 5000 digits: ValueError
+
     def mm(self, e, attr: str) -> float:
         """A coordinate of the file (metres) in millimetres: its decimal digits moved by three
         places (``-256.034379`` is -256034.379 mm, where ``-256.034379 * 1000`` is
@@ -228,6 +242,10 @@ class _File:
                 raise self.err(e, f"{said(v)}: the seconds {why}", attr) from None
             # seconds of 60.00 are a value rounded up (gama-local reads them, and its own
             # test data holds "187-33-60.00"); more is garbage
+            if len(d.lstrip("0")) > 10 or int(d) > _INT_MAX:  # gama-local's int overflows
+                raise self.err(
+                    e, f"{said(v)}: over {_INT_MAX} degrees, refused by gama-local", attr
+                )
             if float(m) >= 60 or sec > 60:  # int() of 5000 digits: ValueError
                 raise self.err(
                     e, f"{said(v)}: minutes must be below 60 and seconds at most 60", attr
@@ -298,81 +316,6 @@ def entity_declared(data: bytes | str) -> str | None:
     except (_Prolog, expat.ExpatError, ValueError, LookupError):
         pass
     return found[0] if found else None
-
-
-#: the encodings gama-local decodes: expat's own (any case) and its handler's (names compared
-#: exactly), by Python's codec and the bytes its table maps otherwise (cp1250: 0x80 to U+0080,
-#: not the euro sign, its undefined bytes to themselves; cp1251: 0x98 to U+FFFD); any other
-#: name it reads as ISO-8859-1 (``encoding_unknown_handler.cpp``: the identity table)
-_EXPAT_ENC = ("utf-8", "utf-16", "utf-16be", "utf-16le", "iso-8859-1", "us-ascii")
-_GAMA_ENC = {
-    "cp-1250": "cp1250",
-    "windows-1250": "cp1250",
-    "cp-1251": "cp1251",
-    "windows-1251": "cp1251",
-    "iso-8859-2": "iso8859_2",
-}
-_OWN = {
-    "cp1250": {b: chr(b) for b in (0x80, 0x81, 0x83, 0x88, 0x90, 0x98)},
-    "cp1251": {0x98: "\ufffd"},
-}
-_BOM8 = b"\xef\xbb\xbf"
-#: the XML declaration's encoding (a ``<?xml-stylesheet encoding=...?>`` declares nothing)
-_DECL = re.compile(rb"^(?:\xef\xbb\xbf)?<\?xml[ \t\r\n][^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
-
-
-class EncodingProblem(ValueError):
-    """The file's bytes read as other characters in gama-local than here (the message says why)."""
-
-
-def _table(codec: str) -> dict[int, str]:
-    own = _OWN.get(codec, {})  # gama-local's table of the bytes beyond ASCII
-    return {b: own[b] if b in own else bytes([b]).decode(codec) for b in range(128, 256)}
-
-
-def _latin1(enc: str) -> bool:
-    """``enc`` is a Python name of ISO-8859-1 (``latin_1``, ``L1``), as gama-local reads it."""
-    try:
-        return codecs.lookup(enc).name == "iso8859-1"
-    except (LookupError, ValueError):
-        return False
-
-
-def gama_text(data: bytes) -> bytes | str:
-    """The file as ``gama-local`` reads its characters, for the XML parser: the bytes where
-    the parser decodes them as gama-local's (no declaration, expat's own encodings), else
-    the text decoded as gama-local decodes it: its own encodings (``cp-1250``, ...) by its
-    tables, any other name (``x-foo``, ``latin_1``) as ISO-8859-1, alike for a file of ASCII
-    bytes. Raises :class:`EncodingProblem` where that is not what the file means: a name of
-    another encoding (``koi8-r``, ``ISO-8859-2`` in capitals, ``UTF8``, ``CP1250``: Python's
-    codec would read other characters than gama-local, and the writer meant those) over bytes
-    beyond ASCII, or a UTF-8 byte-order mark before another declared encoding (gama-local
-    reads the bytes in the declared one: ``É`` of the UTF-8 the mark says is ``Ã‰`` there)."""
-    m = _DECL.match(data[:1024])
-    if not m:
-        return data
-    enc = m.group(1).decode("ascii", "replace")
-    bom = data.startswith(_BOM8)
-    body = data[len(_BOM8) :] if bom else data
-    if bom and enc.lower() != "utf-8" and not body.isascii():
-        raise EncodingProblem(
-            f"a UTF-8 byte-order mark before <?xml encoding={said(enc)}?>: gama-local reads "
-            "the bytes beyond ASCII by the declaration, not as UTF-8 (an \u00c9 as \u00c3 and "
-            "another character): remove the mark or declare UTF-8"
-        )
-    if enc.lower() in _EXPAT_ENC:
-        return data
-    if body.isascii():  # no byte beyond ASCII: every name reads alike (gama-local's too)
-        return body.decode("ascii")
-    if enc in _GAMA_ENC:
-        return body.decode("latin-1").translate(_table(_GAMA_ENC[enc]))
-    if _latin1(enc):
-        return body.decode("latin-1")
-    raise EncodingProblem(
-        f"<?xml encoding={said(enc)}?>: gama-local does not know this encoding and reads the "
-        "bytes beyond ASCII as ISO-8859-1, other characters than here: declare UTF-8 "
-        f"(or one of {', '.join(('UTF-16', 'ISO-8859-1', 'US-ASCII', *_GAMA_ENC))})"
-    )
 
 
 class _Raw(Exception):

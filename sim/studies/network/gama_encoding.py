@@ -1,0 +1,90 @@
+"""The encodings GNU Gama's ``gama-local`` decodes, and the characters it reads from a file's
+bytes: expat's own encodings (UTF-8, UTF-16, ISO-8859-1, US-ASCII, any case) and those of its
+own handler (``encoding_unknown_handler.cpp``: ``cp-1250``, ``windows-1250``, ``cp-1251``,
+``windows-1251``, ``iso-8859-2``, names compared exactly, by its own tables); any other name it
+reads as ISO-8859-1. :func:`gama_text` gives the file as ``gama-local`` reads it, or raises
+:class:`EncodingProblem` where that is not what the file means. Used by
+:mod:`sim.studies.network.gama_read`."""
+
+from __future__ import annotations
+
+import codecs
+import re
+
+from sim.studies.network.gama_vocab import said
+
+__all__ = ["gama_text", "EncodingProblem"]
+
+#: the encodings gama-local decodes: expat's own (any case) and its handler's (names compared
+#: exactly), by Python's codec and the bytes its table maps otherwise (cp1250: 0x80 to U+0080,
+#: not the euro sign, its undefined bytes to themselves; cp1251: 0x98 to U+FFFD); any other
+#: name it reads as ISO-8859-1 (``encoding_unknown_handler.cpp``: the identity table)
+_EXPAT_ENC = ("utf-8", "utf-16", "utf-16be", "utf-16le", "iso-8859-1", "us-ascii")
+_GAMA_ENC = {
+    "cp-1250": "cp1250",
+    "windows-1250": "cp1250",
+    "cp-1251": "cp1251",
+    "windows-1251": "cp1251",
+    "iso-8859-2": "iso8859_2",
+}
+_OWN = {
+    "cp1250": {b: chr(b) for b in (0x80, 0x81, 0x83, 0x88, 0x90, 0x98)},
+    "cp1251": {0x98: "\ufffd"},
+}
+_BOM8 = b"\xef\xbb\xbf"
+#: the XML declaration's encoding (a ``<?xml-stylesheet encoding=...?>`` declares nothing)
+_DECL = re.compile(rb"^(?:\xef\xbb\xbf)?<\?xml[ \t\r\n][^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
+
+
+class EncodingProblem(ValueError):
+    """The file's bytes read as other characters in gama-local than here (the message says why)."""
+
+
+def _table(codec: str) -> dict[int, str]:
+    own = _OWN.get(codec, {})  # gama-local's table of the bytes beyond ASCII
+    return {b: own[b] if b in own else bytes([b]).decode(codec) for b in range(128, 256)}
+
+
+def _latin1(enc: str) -> bool:
+    """``enc`` is a Python name of ISO-8859-1 (``latin_1``, ``L1``), as gama-local reads it."""
+    try:
+        return codecs.lookup(enc).name == "iso8859-1"
+    except (LookupError, ValueError):
+        return False
+
+
+def gama_text(data: bytes) -> bytes | str:
+    """The file as ``gama-local`` reads its characters, for the XML parser: the bytes where
+    the parser decodes them as gama-local's (no declaration, expat's own encodings), else
+    the text decoded as gama-local decodes it: its own encodings (``cp-1250``, ...) by its
+    tables, any other name (``x-foo``, ``latin_1``) as ISO-8859-1, alike for a file of ASCII
+    bytes. Raises :class:`EncodingProblem` where that is not what the file means: a name of
+    another encoding (``koi8-r``, ``ISO-8859-2`` in capitals, ``UTF8``, ``CP1250``: Python's
+    codec would read other characters than gama-local, and the writer meant those) over bytes
+    beyond ASCII, or a UTF-8 byte-order mark before another declared encoding (gama-local
+    reads the bytes in the declared one: ``É`` of the UTF-8 the mark says is ``Ã‰`` there)."""
+    m = _DECL.match(data[:1024])
+    if not m:
+        return data
+    enc = m.group(1).decode("ascii", "replace")
+    bom = data.startswith(_BOM8)
+    body = data[len(_BOM8) :] if bom else data
+    if bom and enc.lower() != "utf-8" and not body.isascii():
+        raise EncodingProblem(
+            f"a UTF-8 byte-order mark before <?xml encoding={said(enc)}?>: gama-local reads "
+            "the bytes beyond ASCII by the declaration, not as UTF-8 (an \u00c9 as \u00c3 and "
+            "another character): remove the mark or declare UTF-8"
+        )
+    if enc.lower() in _EXPAT_ENC:
+        return data
+    if body.isascii():  # no byte beyond ASCII: every name reads alike (gama-local's too)
+        return body.decode("ascii")
+    if enc in _GAMA_ENC:
+        return body.decode("latin-1").translate(_table(_GAMA_ENC[enc]))
+    if _latin1(enc):
+        return body.decode("latin-1")
+    raise EncodingProblem(
+        f"<?xml encoding={said(enc)}?>: gama-local does not know this encoding and reads the "
+        "bytes beyond ASCII as ISO-8859-1, other characters than here: declare UTF-8 "
+        f"(or one of {', '.join(('UTF-16', 'ISO-8859-1', 'US-ASCII', *_GAMA_ENC))})"
+    )
