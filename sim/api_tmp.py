@@ -28,13 +28,14 @@ import stat
 import tempfile
 from pathlib import Path
 
-from sim.env_vars import numba_variables_problem, sim_variables_problem
+from sim.env_vars import data_limit_problem, numba_variables_problem, sim_variables_problem
 from sim.mc.config import ConfigError
 from sim.mc.dead_dirs import lock_held
 from sim.mc.outputs import name_problem
 from sim.mc.pids import pid_alive
 from sim.mc.progress import check_environment as _check_tqdm
 from sim.mc.storage import RECORD
+from sim.threads import address_space_problem
 
 __all__ = ["KEPT", "MARK", "check_env", "temp_dir"]
 
@@ -102,9 +103,11 @@ def temp_dir(study: str) -> Path:
 
 def check_env() -> None:
     """Raise :class:`ConfigError` naming a variable of the environment the suite, tqdm or numba
-    cannot read (``TQDM_NCOLS=abc``, ``SIM_NO_JIT=0``, ``NUMBA_OPT=fast``), as the commands
+    cannot read (``TQDM_NCOLS=abc``, ``SIM_NO_JIT=0``, ``NUMBA_OPT=fast``), or a ``ulimit -v``
+    or ``-d`` under what the suite needs (a run failed in its middle), as the commands
     refuse it when they start (:func:`sim.threads.refuse_bad_environment`): ``sim.load``
     refuses it, not the middle of a run."""
     _check_tqdm()
-    if (problem := sim_variables_problem() or numba_variables_problem()) is not None:
+    limits = address_space_problem() or data_limit_problem()  # ulimit -v/-d, as they start
+    if (problem := limits or sim_variables_problem() or numba_variables_problem()) is not None:
         raise ConfigError(None, problem)

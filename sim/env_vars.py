@@ -16,6 +16,7 @@ from sim.threads import single_threaded_blas
 
 __all__ = [
     "MIN_DATA_KB",
+    "data_limit_problem",
     "numba_variables_problem",
     "refuse_bad_variables",
     "sim_variables_problem",
@@ -34,17 +35,26 @@ def refuse_bad_variables(prog: str) -> None:
     :func:`numba_variables_problem` finds wrong, or a limit of data under :data:`MIN_DATA_KB`.
     Called by the entry points after :func:`sim.threads.refuse_bad_environment`, before they
     load SciPy."""
-    cap = resource.getrlimit(resource.RLIMIT_DATA)[0]
-    if cap != resource.RLIM_INFINITY and cap // 1024 < MIN_DATA_KB:
-        sys.stderr.write(
-            f"{prog}: error: not enough memory: ulimit -d is {cap // 1024} kB, and the suite "
-            f"needs at least {MIN_DATA_KB} kB of data (its libraries' buffers and a run's "
-            "arrays)\n"
-        )
+    if (problem := data_limit_problem()) is not None:
+        sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)
     if (problem := sim_variables_problem() or numba_variables_problem()) is not None:
         sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)
+
+
+def data_limit_problem() -> str | None:
+    """The words for a limit of data under :data:`MIN_DATA_KB`, or None (the commands exit on
+    it as they start; ``sim.load`` raises it: a run of brown_table1 at 40 trials under
+    ``ulimit -d 460000`` through the API failed in its middle, "MemoryError ... reduce trials,
+    chunk or the sizes in the study file", of a run that small)."""
+    cap = resource.getrlimit(resource.RLIMIT_DATA)[0]
+    if cap == resource.RLIM_INFINITY or cap // 1024 >= MIN_DATA_KB:
+        return None
+    return (
+        f"not enough memory: ulimit -d is {cap // 1024} kB, and the suite needs at least "
+        f"{MIN_DATA_KB} kB of data (its libraries' buffers and a run's arrays)"
+    )
 
 
 def sim_variables_problem() -> str | None:

@@ -8,15 +8,34 @@ each failed on the code before its fix.
   and its README.md saying it was "held in part by the datum constraints" of a fixed datum of
   0 constraints. A variance is noise only where it is also far below what the point's own
   observations give it (``1 / N_ii``).
+* ``NUMBA_DISABLE_JIT=1``, a value numba reads (docs/cli.md: "like ``SIM_NO_JIT=1``"): numba's
+  ``njit`` then hands back the kernel itself, so :func:`sim.lsq.compile.available` said the
+  compiled kernels ran while their plain-Python loops did, slower than the NumPy twins and with
+  a third set of last digits (``brown_table1``'s claims equal neither the compiled run's nor
+  ``SIM_NO_JIT=1``'s), recorded as the compiled path (no word in ``numerics``). The NumPy twins
+  run, as under ``SIM_NO_JIT=1`` (the same tables), and ``numerics`` records the variable.
+* a ``ulimit -d`` (or ``-v``) under the 1 GiB the commands refuse as they start (session 37):
+  ``sim.load`` took it, and a run of ``brown_table1`` at 40 trials failed in its middle,
+  "StudyError: ... MemoryError: Unable to allocate 3.65 MiB ... (reduce trials, chunk or the
+  sizes in the study file)", advice that cannot help. ``sim.load`` refuses it in the
+  commands' words (``sim.ConfigError``).
 """
 
 from __future__ import annotations
 
+import os
+import resource
+import subprocess
+import sys
 from pathlib import Path
 
 import pyarrow.parquet as pq
+import pytest
 
 import sim
+
+ROOT = Path(__file__).resolve().parents[1]
+TABLE1 = str(ROOT / "studies" / "brown_table1.toml")
 
 SPREAD = """\
 study = "network"
@@ -57,3 +76,46 @@ def test_a_precise_point_beside_a_loose_one_is_estimated(tmp_path):
     sx = dict(zip(points.column("point").to_pylist(), points.column("sigma_x_mm").to_pylist()))
     assert abs(sx["C"] - 0.0001 / 2**0.5) < 1e-9, sx  # two readings of 0.1 um each
     assert "held in part" not in (Path(res.path) / "README.md").read_text(encoding="utf-8")
+
+
+def test_numba_disable_jit_runs_the_numpy_paths_and_is_recorded():
+    code = (
+        "from sim.lsq import compile; from sim.mc.storage import numerics; "
+        "print(compile.available(), numerics().get('NUMBA_DISABLE_JIT'))"
+    )
+    env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
+    env.pop("SIM_NO_JIT", None)
+    proc = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["False", "1"], proc.stdout  # the NumPy twins, recorded
+
+
+@pytest.mark.parametrize(
+    "limit, kb, words",
+    [
+        (resource.RLIMIT_DATA, 460_000, "ulimit -d is 460000 kB"),
+        (resource.RLIMIT_AS, 900_000, "ulimit -v is 900000 kB"),
+    ],
+)
+def test_sim_load_refuses_a_memory_limit_the_commands_refuse(limit, kb, words):
+    hard = resource.getrlimit(limit)[1]
+    if hard != resource.RLIM_INFINITY and hard < kb * 1024:
+        pytest.skip("the hard limit is lower than the test's")
+    code = (
+        "import sim\n"
+        "try:\n"
+        f"    sim.load({TABLE1!r}, trials=40)\n"
+        "except sim.ConfigError as e:\n"
+        "    print('refused:', e)\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        preexec_fn=lambda: resource.setrlimit(limit, (kb * 1024, hard)),
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 0, proc.stderr[-500:]
+    assert proc.stdout.startswith("refused: not enough memory: " + words), proc.stdout
