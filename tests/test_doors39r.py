@@ -19,6 +19,11 @@ each failed on the code before its fix.
   "StudyError: ... MemoryError: Unable to allocate 3.65 MiB ... (reduce trials, chunk or the
   sizes in the study file)", advice that cannot help. ``sim.load`` refuses it in the
   commands' words (``sim.ConfigError``).
+* a key typed in another unit through the doors beside ``--set`` (session 38 made
+  ``--set plate.spacing_um=45000`` say "its value is in mm, not um: convert it"): a sweep's
+  ``plate.spacing_um = [...]`` and a network record's ``sigma_um = 1.2`` were still only
+  "did you mean ...spacing_mm / sigma_mm?", and the value renamed as it stood was a spacing
+  or a sigma 1000 times the one meant. Both say the unit to convert to.
 """
 
 from __future__ import annotations
@@ -119,3 +124,17 @@ def test_sim_load_refuses_a_memory_limit_the_commands_refuse(limit, kb, words):
     )
     assert proc.returncode == 0, proc.stderr[-500:]
     assert proc.stdout.startswith("refused: not enough memory: " + words), proc.stdout
+
+
+def test_a_key_in_another_unit_says_to_convert_through_every_door(tmp_path):
+    text = Path(TABLE1).read_text(encoding="utf-8")
+    swept = tmp_path / "swept.toml"
+    swept.write_text(text + "\n[sweep]\nplate.spacing_um = [45000, 50000]\n", encoding="utf-8")
+    plate = (ROOT / "studies" / "network_plate.toml").read_text(encoding="utf-8")
+    net = tmp_path / "net_um.toml"
+    net.write_text(plate.replace("sigma_mm = 0.0012", "sigma_um = 1.2"), encoding="utf-8")
+    for f, key in ((swept, "sweep.plate.spacing_um"), (net, "network.grids[0].sigma_um")):
+        with pytest.raises(sim.ConfigError) as e:
+            sim.load(f)
+        assert str(e.value).startswith(f"{key}: unknown "), str(e.value)
+        assert "its value is in mm, not um: convert it" in str(e.value), str(e.value)
