@@ -28,14 +28,13 @@ import stat
 import tempfile
 from pathlib import Path
 
-from sim.env_vars import data_limit_problem, numba_variables_problem, sim_variables_problem
+from sim.env_vars import environment_problem
 from sim.mc.config import ConfigError
 from sim.mc.dead_dirs import lock_held
 from sim.mc.outputs import name_problem
 from sim.mc.pids import pid_alive
 from sim.mc.progress import check_environment as _check_tqdm
 from sim.mc.storage import RECORD
-from sim.threads import address_space_problem
 
 __all__ = ["KEPT", "MARK", "check_env", "temp_dir"]
 
@@ -108,6 +107,5 @@ def check_env() -> None:
     refuse it when they start (:func:`sim.threads.refuse_bad_environment`): ``sim.load``
     refuses it, not the middle of a run."""
     _check_tqdm()
-    limits = address_space_problem() or data_limit_problem()  # ulimit -v/-d, as they start
-    if (problem := limits or sim_variables_problem() or numba_variables_problem()) is not None:
+    if (problem := environment_problem()) is not None:  # ulimit -v/-d too, as they start
         raise ConfigError(None, problem)

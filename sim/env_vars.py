@@ -12,11 +12,12 @@ import re
 import resource
 import sys
 
-from sim.threads import single_threaded_blas
+from sim.threads import address_space_problem, single_threaded_blas
 
 __all__ = [
     "MIN_DATA_KB",
     "data_limit_problem",
+    "environment_problem",
     "numba_variables_problem",
     "refuse_bad_variables",
     "sim_variables_problem",
@@ -54,6 +55,19 @@ def data_limit_problem() -> str | None:
     return (
         f"not enough memory: ulimit -d is {cap // 1024} kB, and the suite needs at least "
         f"{MIN_DATA_KB} kB of data (its libraries' buffers and a run's arrays)"
+    )
+
+
+def environment_problem() -> str | None:
+    """What the commands refuse as they start, for a caller in a process of its own
+    (``sim.load``, ``sim.cli.main([...])``): a ``ulimit -v`` or ``-d`` under what the suite
+    needs, a ``SIM_NO_JIT`` or ``NUMBA_`` value; None when there is none. ``sim.cli.main``
+    called from Python ran ``SIM_NO_JIT=0`` with the compiled kernels off, exit 0."""
+    return (
+        address_space_problem()
+        or data_limit_problem()
+        or sim_variables_problem()
+        or numba_variables_problem()
     )
 
 

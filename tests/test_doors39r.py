@@ -24,6 +24,11 @@ each failed on the code before its fix.
   ``plate.spacing_um = [...]`` and a network record's ``sigma_um = 1.2`` were still only
   "did you mean ...spacing_mm / sigma_mm?", and the value renamed as it stood was a spacing
   or a sigma 1000 times the one meant. Both say the unit to convert to.
+* ``sim.cli.main([...])`` called from Python (docs/python.md: it "runs in any thread" and
+  returns its exit code): the checks of the environment ran only in the ``sim`` command's entry
+  point, so ``SIM_NO_JIT=0`` ran a study with the compiled kernels off, exit 0 (the command
+  refuses it), and so did a ``NUMBA_`` value numba cannot read or a ``ulimit -d`` under 1 GiB.
+  ``main`` refuses them in the command's words, exit 2.
 """
 
 from __future__ import annotations
@@ -138,3 +143,12 @@ def test_a_key_in_another_unit_says_to_convert_through_every_door(tmp_path):
             sim.load(f)
         assert str(e.value).startswith(f"{key}: unknown "), str(e.value)
         assert "its value is in mm, not um: convert it" in str(e.value), str(e.value)
+
+
+def test_sim_cli_main_from_python_refuses_what_the_command_refuses(monkeypatch, capsys):
+    from sim import cli
+
+    monkeypatch.setenv("SIM_NO_JIT", "0")
+    assert cli.main(["check", TABLE1]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.startswith("sim: error: SIM_NO_JIT: must be 1"), (out, err)
