@@ -46,6 +46,7 @@ from sim.mc.sweep import cell_config, cell_label, cell_seed, expand
 from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
+from sim.room import limits_said
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
@@ -115,8 +116,8 @@ def _hint(msg: str, kind: str, schema) -> str:
             have = [k for k in keys if k in schema]
             if have:
                 return f" (check {have[0]})"
-    if "memory" in low:
-        return " (reduce trials, chunk or the sizes in the study file)"
+    if "memory" in low:  # under ulimit -v or -d, the limit named first (sim.room)
+        return f" ({limits_said()}reduce trials, chunk or the sizes in the study file)"
     return ""
 
 

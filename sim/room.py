@@ -21,7 +21,7 @@ import resource
 from sim.mc.config import ConfigError
 from sim.mc.estimate import Estimate, _either, check_limits
 
-__all__ = ["check_room", "mapped_bytes"]
+__all__ = ["check_room", "limits_said", "mapped_bytes"]
 
 
 def mapped_bytes(field: int = 0) -> int | None:
@@ -62,3 +62,17 @@ def check_room(
             f"{max(cap - used, 0) / 2**30:.3g} GiB beside the {used / 2**30:.3g} GiB it maps "
             f"already: raise {words}, or reduce {_either(est.memory_keys)}",
         )
+
+
+def limits_said() -> str:
+    """``ulimit -v is 1400000 kB: raise it, or `` for the limits of memory set (``""`` for
+    none), to lead the advice of a run that ran out of memory under them: a run the room
+    check let through (the estimate leaves out the libraries loaded later and the allocator's
+    slack) failed after a minute, "MemoryError: Unable to allocate 64.1 MiB ... (reduce trials,
+    chunk or the sizes in the study file)", naming no limit."""
+    set_ = [
+        f"{words} is {cap // 1024} kB"
+        for limit, _, words in _LIMITS
+        if (cap := resource.getrlimit(limit)[0]) != resource.RLIM_INFINITY
+    ]
+    return f"{' and '.join(set_)}: raise {'them' if len(set_) > 1 else 'it'}, or " if set_ else ""

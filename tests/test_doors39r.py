@@ -29,6 +29,12 @@ each failed on the code before its fix.
   point, so ``SIM_NO_JIT=0`` ran a study with the compiled kernels off, exit 0 (the command
   refuses it), and so did a ``NUMBA_`` value numba cannot read or a ``ulimit -d`` under 1 GiB.
   ``main`` refuses them in the command's words, exit 2.
+* a run the room check of ``ulimit -v`` let through (its estimate leaves out the libraries
+  loaded later and the allocator's slack: ``brown_table1`` on a 100 x 100 plate, 1,200 trials
+  in chunks of 60, estimated at 0.814 GiB beside the 0.885 GiB left under ``ulimit -v
+  1400000``) failed after 78 s, "MemoryError: Unable to allocate 64.1 MiB ... (reduce trials,
+  chunk or the sizes in the study file)", naming no limit. A run out of memory under a
+  ``ulimit -v`` or ``-d`` names it first: "(ulimit -v is 1400000 kB: raise it, or reduce ...)".
 """
 
 from __future__ import annotations
@@ -152,3 +158,21 @@ def test_sim_cli_main_from_python_refuses_what_the_command_refuses(monkeypatch, 
     assert cli.main(["check", TABLE1]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.startswith("sim: error: SIM_NO_JIT: must be 1"), (out, err)
+
+
+def test_a_run_out_of_memory_under_a_ulimit_names_it(monkeypatch):
+    from sim import execute, room
+    from sim.studies import get_study
+
+    real = resource.getrlimit
+    monkeypatch.setattr(
+        room.resource,
+        "getrlimit",
+        lambda r: (1_400_000 * 1024, real(r)[1]) if r == resource.RLIMIT_AS else real(r),
+    )
+    e = MemoryError("Unable to allocate 64.1 MiB for an array with shape (60, 10000, 2, 7)")
+    words = str(execute._numeric_failure(e, get_study("brown_table1"), {"study": "brown_table1"}))
+    assert words.endswith(
+        "(ulimit -v is 1400000 kB: raise it, or reduce trials, chunk or the sizes in the study "
+        "file)"
+    ), words
