@@ -28,7 +28,7 @@ import stat
 import tempfile
 from pathlib import Path
 
-from sim.env_vars import numba_variables_problem, sim_variables_problem
+from sim.env_vars import environment_problem
 from sim.mc.config import ConfigError
 from sim.mc.dead_dirs import lock_held
 from sim.mc.outputs import name_problem
@@ -102,9 +102,10 @@ def temp_dir(study: str) -> Path:
 
 def check_env() -> None:
     """Raise :class:`ConfigError` naming a variable of the environment the suite, tqdm or numba
-    cannot read (``TQDM_NCOLS=abc``, ``SIM_NO_JIT=0``, ``NUMBA_OPT=fast``), as the commands
+    cannot read (``TQDM_NCOLS=abc``, ``SIM_NO_JIT=0``, ``NUMBA_OPT=fast``), or a ``ulimit -v``
+    or ``-d`` under what the suite needs (a run failed in its middle), as the commands
     refuse it when they start (:func:`sim.threads.refuse_bad_environment`): ``sim.load``
     refuses it, not the middle of a run."""
     _check_tqdm()
-    if (problem := sim_variables_problem() or numba_variables_problem()) is not None:
+    if (problem := environment_problem()) is not None:  # ulimit -v/-d too, as they start
         raise ConfigError(None, problem)

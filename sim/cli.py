@@ -34,6 +34,7 @@ from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
 from sim.cli_read import report, show
 from sim.ends import stdout_failed
+from sim.env_vars import environment_problem
 from sim.execute import check_sweep, execute, sweep_limits
 from sim.long_words import clipped
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
@@ -272,6 +273,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if not argv:  # usage, not an error message
             parser(DOC).print_help()
+            return 2
+        if (problem := environment_problem()) is not None:  # as the sim command refuses it
+            print(f"sim: error: {problem}", file=sys.stderr)  # (sim.cli.main from Python)
             return 2
         with keep_lost_interrupts():  # Ctrl-C that Python drops in a C callback: kept
             return _main(argv)

@@ -12,10 +12,12 @@ import re
 import resource
 import sys
 
-from sim.threads import single_threaded_blas
+from sim.threads import address_space_problem, single_threaded_blas
 
 __all__ = [
     "MIN_DATA_KB",
+    "data_limit_problem",
+    "environment_problem",
     "numba_variables_problem",
     "refuse_bad_variables",
     "sim_variables_problem",
@@ -34,17 +36,39 @@ def refuse_bad_variables(prog: str) -> None:
     :func:`numba_variables_problem` finds wrong, or a limit of data under :data:`MIN_DATA_KB`.
     Called by the entry points after :func:`sim.threads.refuse_bad_environment`, before they
     load SciPy."""
-    cap = resource.getrlimit(resource.RLIMIT_DATA)[0]
-    if cap != resource.RLIM_INFINITY and cap // 1024 < MIN_DATA_KB:
-        sys.stderr.write(
-            f"{prog}: error: not enough memory: ulimit -d is {cap // 1024} kB, and the suite "
-            f"needs at least {MIN_DATA_KB} kB of data (its libraries' buffers and a run's "
-            "arrays)\n"
-        )
+    if (problem := data_limit_problem()) is not None:
+        sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)
     if (problem := sim_variables_problem() or numba_variables_problem()) is not None:
         sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)
+
+
+def data_limit_problem() -> str | None:
+    """The words for a limit of data under :data:`MIN_DATA_KB`, or None (the commands exit on
+    it as they start; ``sim.load`` raises it: a run of brown_table1 at 40 trials under
+    ``ulimit -d 460000`` through the API failed in its middle, "MemoryError ... reduce trials,
+    chunk or the sizes in the study file", of a run that small)."""
+    cap = resource.getrlimit(resource.RLIMIT_DATA)[0]
+    if cap == resource.RLIM_INFINITY or cap // 1024 >= MIN_DATA_KB:
+        return None
+    return (
+        f"not enough memory: ulimit -d is {cap // 1024} kB, and the suite needs at least "
+        f"{MIN_DATA_KB} kB of data (its libraries' buffers and a run's arrays)"
+    )
+
+
+def environment_problem() -> str | None:
+    """What the commands refuse as they start, for a caller in a process of its own
+    (``sim.load``, ``sim.cli.main([...])``): a ``ulimit -v`` or ``-d`` under what the suite
+    needs, a ``SIM_NO_JIT`` or ``NUMBA_`` value; None when there is none. ``sim.cli.main``
+    called from Python ran ``SIM_NO_JIT=0`` with the compiled kernels off, exit 0."""
+    return (
+        address_space_problem()
+        or data_limit_problem()
+        or sim_variables_problem()
+        or numba_variables_problem()
+    )
 
 
 def sim_variables_problem() -> str | None:

@@ -226,14 +226,21 @@ def memory_words(e: BaseException | None = None) -> str:
 MIN_ADDRESS_SPACE_KB = 1024 * 1024
 
 
-def _refuse_small_address_space(prog: str) -> None:
+def address_space_problem() -> str | None:
+    """The words for an address-space limit under :data:`MIN_ADDRESS_SPACE_KB`, or None (the
+    commands exit on it as they start; ``sim.load`` raises it)."""
     cap = resource.getrlimit(resource.RLIMIT_AS)[0]
-    if cap != resource.RLIM_INFINITY and cap // 1024 < MIN_ADDRESS_SPACE_KB:
-        sys.stderr.write(
-            f"{prog}: error: not enough memory: ulimit -v is {cap // 1024} kB, and the suite "
-            f"needs at least {MIN_ADDRESS_SPACE_KB} kB of address space (its libraries map "
-            "about 700 MB)\n"
-        )
+    if cap == resource.RLIM_INFINITY or cap // 1024 >= MIN_ADDRESS_SPACE_KB:
+        return None
+    return (
+        f"not enough memory: ulimit -v is {cap // 1024} kB, and the suite needs at least "
+        f"{MIN_ADDRESS_SPACE_KB} kB of address space (its libraries map about 700 MB)"
+    )
+
+
+def _refuse_small_address_space(prog: str) -> None:
+    if (words := address_space_problem()) is not None:
+        sys.stderr.write(f"{prog}: error: {words}\n")
         sys.exit(2)
 
 

@@ -5,8 +5,8 @@ Every compiled module of the suite (the group-block reductions and solves of
 :mod:`sim.lsq.group_kernel`, the linear solves of :mod:`sim.lsq.linear_kernel`, the Brown
 multilateration kernel, the polynomial fit, the stress field) is compiled here and only here:
 
-* :func:`available` -- whether compiled kernels run: numba importable and the environment
-  variable ``SIM_NO_JIT`` unset or empty (read at every call, so a test or the bench can
+* :func:`available` -- whether compiled kernels run: numba importable (and not disabled by
+  its ``NUMBA_DISABLE_JIT``) and the environment variable ``SIM_NO_JIT`` unset or empty (read at every call, so a test or the bench can
   switch it); each caller then runs its NumPy twin instead, the reference implementation;
 * :func:`compiled` -- a kernel compiled once per process and cached on disk, with block
   sizes frozen into it as compile-time constants and its helper functions compiled with it;
@@ -54,18 +54,24 @@ _callers: dict = {}  # what :func:`compiled` returns: the dispatcher behind writ
 
 
 def _numba():
-    """numba's ``njit``, or None without numba."""
+    """numba's ``njit``, or None without numba or with numba's own ``NUMBA_DISABLE_JIT`` set:
+    its ``njit`` then returns the kernel as it is, whose plain-Python loops (200 trials of
+    brown_table1 in 29 s, the NumPy twins' 8 s) gave a third set of last digits, recorded as
+    the compiled path's; the NumPy twins run, as under ``SIM_NO_JIT=1``."""
     if not _njit:
         try:  # heavy optional dependency: imported on first use only
-            from numba import njit
+            from numba import config, njit
         except ImportError:  # pragma: no cover - the NumPy paths run
             njit = None
+        else:
+            njit = None if getattr(config, "DISABLE_JIT", False) else njit
         _njit.append(njit)
     return _njit[0]
 
 
 def available() -> bool:
-    """Whether the compiled kernels run (numba installed and ``SIM_NO_JIT`` unset)."""
+    """Whether the compiled kernels run (numba installed, ``SIM_NO_JIT`` unset and numba's
+    ``NUMBA_DISABLE_JIT`` not set)."""
     return not os.environ.get("SIM_NO_JIT") and _numba() is not None
 
 

@@ -134,12 +134,16 @@ def config_hash(config: Mapping[str, Any] | None, code: str | None = None) -> st
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
+#: the variables of the environment that choose a result's numerical path
+PATH_VARIABLES = ("OPENBLAS_CORETYPE", "SIM_NO_JIT", "NUMBA_DISABLE_JIT")
+
+
 def numerics() -> dict[str, str]:
     """The machine and numerical path a result was computed on (``make verify`` names both:
-    docs/reproducibility.md): system, CPU architecture, and ``OPENBLAS_CORETYPE`` and
-    ``SIM_NO_JIT`` where set."""
+    docs/reproducibility.md): system, CPU architecture, and ``OPENBLAS_CORETYPE``,
+    ``SIM_NO_JIT`` and ``NUMBA_DISABLE_JIT`` (the NumPy paths too) where set."""
     out = {"system": platform.system(), "machine": platform.machine()}
-    out.update({k: os.environ[k] for k in ("OPENBLAS_CORETYPE", "SIM_NO_JIT") if os.environ.get(k)})
+    out.update({k: os.environ[k] for k in PATH_VARIABLES if os.environ.get(k)})
     return out
 
 

@@ -49,6 +49,7 @@ from sim.mc.config import (
     validate,
 )
 from sim.mc.limit_error import LimitError
+from sim.mc.message_text import near_keys
 from sim.mc.numtext import UnheldError, unsigned_zeros
 from sim.mc.progress import Progress
 from sim.mc.runner import chunk_rng
@@ -225,7 +226,8 @@ def expand(table: Mapping[str, Any], schema: Mapping | None = None):
             raise ConfigError(f"sweep.{k}", "cannot be swept (use replicates for seeds)")
         if schema is not None and k not in schema:
             near = did_you_mean(k, {**dict.fromkeys(RESERVED), **schema})  # Replicates too
-            hint = f" (did you mean {' or '.join(f'sweep.{n}' for n in near)}?)" if near else ""
+            # its unit said, as --set says it (sweep.plate.spacing_um's values in mm)
+            hint = near_keys(f"sweep.{k}", [f"sweep.{n}" for n in near])
             raise ConfigError(f"sweep.{k}", f"unknown key{hint}")
         if schema is not None and getattr(schema[k], "sweep", None):
             raise ConfigError(f"sweep.{k}", f"cannot be swept: {schema[k].sweep}")

@@ -13,7 +13,7 @@ import pyarrow.parquet as pq
 from sim.mc.config import ConfigError
 from sim.mc.outputs import results_dirs
 from sim.mc.overrides import listed
-from sim.mc.storage import numerics, read_provenance, versions, write_table
+from sim.mc.storage import PATH_VARIABLES, numerics, read_provenance, versions, write_table
 from sim.report.tables import fmt, md_table
 from sim.report.verify.rules import DEFAULT_RTOL, Comparison, tables_digest
 
@@ -221,7 +221,7 @@ def _committed_on(results: Path) -> str:
         where = (
             " ".join(str(n[k]) for k in ("system", "machine") if k in n) or "an unrecorded machine"
         )
-        path = ", ".join(f"{k}={n[k]}" for k in ("OPENBLAS_CORETYPE", "SIM_NO_JIT") if k in n)
+        path = ", ".join(f"{k}={n[k]}" for k in PATH_VARIABLES if k in n)
         ver = ", ".join(f"{k} {x}" for k, x in sorted(v.items()))
         seen.add(f"{where}{f' ({path})' if path else ''} with {ver}" if ver else where)
     if not seen:

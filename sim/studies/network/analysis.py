@@ -223,16 +223,25 @@ def estimated_points(net: Network, an: Analytic) -> list[int]:
     constraint, such as Brown's x1 = 0, has a singular block and no ellipse; a point inner
     constraints hold whole, two points against a rotation and a scale, has a block of rounding
     noise, 1e-18 mm^2, whose relative determinant is noise too: it was taken for estimated and
-    the run refused for its "0 mm" sigma)."""
+    the run refused for its "0 mm" sigma). Such noise is also far below what the point's own
+    observations give it, ``1 / N_ii`` (the normal matrix's diagonal, :attr:`Analytic.n_diag`):
+    a point measured at 0.1 um beside one at 1 m (a variance 1e-14 of the largest) was left
+    out, "held in part by the datum constraints" of a fixed datum with none."""
     var = (an.cov[:, 0, 0] + an.cov[:, 1, 1]) / 2
     det = an.cov[:, 0, 0] * an.cov[:, 1, 1] - an.cov[:, 0, 1] ** 2
     # rounding noise of the inverse: up to 6e-17 of the largest variance (a 625-point sparse
-    # network); a variance below 1e-14 of it is no estimate either way
-    noise = 1e-14 * float(var.max(initial=0.0))
+    # network); a variance below 1e-14 of it, and below 1e-9 of its own 1 / N_ii, is none
+    noise = np.full(net.n, 1e-14 * float(var.max(initial=0.0)))
+    if an.n_diag is not None:
+        own = np.zeros(net.q)
+        with np.errstate(divide="ignore"):
+            own[an.free] = 1.0 / np.asarray(an.n_diag, dtype=float)
+        own = own[: 2 * net.n].reshape(net.n, 2).mean(axis=1)
+        noise = np.minimum(noise, 1e-9 * own)
     return [
         a
         for a in range(net.n)
-        if net.role[a] != 1 and var[a] > noise and det[a] > 1e-12 * var[a] ** 2
+        if net.role[a] != 1 and var[a] > noise[a] and det[a] > 1e-12 * var[a] ** 2
     ]
 
 

@@ -17,6 +17,7 @@ from sim.mc.config import ConfigError, did_you_mean
 from sim.mc.limit_error import LimitError
 from sim.mc.lookalike import differs, skeleton
 from sim.mc.memory_limit import memory_limit_gb
+from sim.mc.message_text import near_keys
 from sim.mc.network_size import network_counts, network_estimate, state_bytes
 from sim.room import short_room
 
@@ -197,7 +198,7 @@ def _keys(key: str, rec: dict, allowed: set, required: set) -> None:
     bad = set(rec) - allowed
     if bad:  # Name, x-mm, "name ": a guess as for an unknown key (it was "unknown field" alone)
         near = did_you_mean(sorted(bad)[0], dict.fromkeys(sorted(allowed)))
-        hint = f" (did you mean {' or '.join(near)}?)" if near else ""
+        hint = near_keys(sorted(bad)[0], near)  # sigma_um: its value is in mm, convert it
         raise ConfigError(f"{key}.{sorted(bad)[0]}", f"unknown field{hint}")
     miss = required - set(rec)
     if miss:
