@@ -34,6 +34,7 @@ from sim.claims.rules import (
     holds_of,
     off_paper,
     printed_differs,
+    short_chain,
     verdict_of,
     zone,
 )
@@ -245,6 +246,7 @@ class ClaimBook:
         value_high: float | None = None,
         elems: tuple[np.ndarray, np.ndarray] | None = None,
         samples: np.ndarray | None = None,
+        chain_tau: float | None = None,
     ) -> dict[str, Any]:
         """The row of claim ``cid`` from what the simulation produced.
 
@@ -255,6 +257,7 @@ class ClaimBook:
             ``value_high`` default to the smallest and largest element midpoints.
         samples : ``one-plate`` claims: the statistic over simulated plates (1-D); value is
             their median, the interval their 2.5-97.5 % spread.
+        chain_tau : a sampler chain's length in tau (:data:`sim.claims.rules.MIN_CHAIN_TAU`).
         """
         s = self.spec(cid)
         if cid in self._scored:
@@ -300,8 +303,9 @@ class ClaimBook:
             rule = "value" if form == "one-plate" and samples is None else form
             n = None if samples is None else int(np.asarray(samples).size)
             at = (float(ci[0]), float(ci[1]))
-            outcome = decide(rule, at, (zlo, zhi), elems=elems, p_plate=p_plate, plates=n)
-            if few := few_plates(n):
+            kw = {"elems": elems, "p_plate": p_plate, "plates": n, "chain_tau": chain_tau}
+            outcome = decide(rule, at, (zlo, zhi), **kw)
+            if few := few_plates(n) or short_chain(chain_tau):
                 note = f"{few}; {note}" if note else few
         verdict = verdict_of(s["kind"], outcome)
         if s["kind"] == "not comparable":

@@ -8,7 +8,7 @@ from typing import Any
 
 from sim.claims.intervals import LEVEL, METHODS, MIN_CHUNKS
 from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
-from sim.claims.rules import MIN_PLATES, P_FAIL
+from sim.claims.rules import MIN_CHAIN_TAU, MIN_PLATES, P_FAIL
 
 __all__ = ["interval_provenance"]
 
@@ -26,6 +26,7 @@ def interval_provenance() -> dict[str, Any]:
         "region_min_points": REGION_MIN_POINTS,
         "region_share": REGION_SHARE,
         "region_level": REGION_LEVEL,
+        "chain_min_tau": MIN_CHAIN_TAU,
         "interval_column": {
             "ci": "a Monte-Carlo confidence interval (mean, sd, share, bootstrap or jackknife)",
             "spread": "the one-plate 2.5-97.5 % range over simulated plates",

@@ -36,6 +36,9 @@ With ``I`` the simulated interval and ``Z`` the decision zone:
   value, ``p = 2 min(q, 1 - q)`` is the probability of a plate at least as extreme.
   **fails** iff ``p < 0.05``; **holds** iff ``p >= 0.05`` and the central 95 % of plates lies
   inside ``Z`` (the simulation is sharp enough to decide); otherwise **inconclusive**.
+* An interval from a sampler chain (MCMC) shorter than :data:`MIN_CHAIN_TAU` integrated
+  autocorrelation times is **inconclusive**, whatever the forms above give: its standard
+  error rests on a tau the chain is too short to estimate (emcee's rule).
 
 Over a consistent region of unprinted inputs (:mod:`sim.claims.region`) a prediction is
 **holds** / **fails** at every input of the region, **depends** (holds for part of it and
@@ -97,6 +100,8 @@ __all__ = [
     "P_FAIL",
     "MIN_PLATES",
     "few_plates",
+    "MIN_CHAIN_TAU",
+    "short_chain",
     "zone",
     "decide",
     "verdict_of",
@@ -148,6 +153,28 @@ def few_plates(n: int | None) -> str:
     return f"inconclusive on {n} simulated plates: a verdict over plates needs {MIN_PLATES}"
 
 
+#: the shortest sampler chain (MCMC) a Monte-Carlo interval is decided on, in integrated
+#: autocorrelation times tau of its slowest parameter: emcee's own reliability rule (its
+#: ``integrated_time`` refuses a chain shorter than ``tol = 50`` tau; the suite computes tau
+#: with ``tol = 0`` so that every run reports it). Shorter, tau itself is underestimated, and
+#: so the standard error from ``N_eff = steps x walkers / tau``: brown_design's posterior gave
+#: tau = 27 steps on 375 kept steps, 55 on 1,500 and 73 on 6,000, and at 375 the spread of
+#: 16 independent chains was up to 1.4 times the standard error from tau. Fewer: inconclusive
+MIN_CHAIN_TAU = 50
+
+
+def short_chain(n_tau: float | None) -> str:
+    """What a claim's note says of a Monte-Carlo interval from a sampler chain of ``n_tau``
+    autocorrelation times, fewer than :data:`MIN_CHAIN_TAU` (``""``: none given, or enough)."""
+    if n_tau is None or n_tau >= MIN_CHAIN_TAU:
+        return ""
+    got = f"{n_tau:.1f}" if math.isfinite(n_tau) else "an unknown number of"
+    return (
+        f"inconclusive on a chain of {got} autocorrelation times: a verdict on a sampler's "
+        f"chain needs {MIN_CHAIN_TAU} (emcee's rule; raise its steps)"
+    )
+
+
 def zone(form: str, ref: tuple[float, float], half: float, tol: float) -> tuple[float, float]:
     lo, hi = ref[0] - half - tol, ref[1] + half + tol
     if form == "upper":
@@ -165,6 +192,7 @@ def decide(
     elems: tuple[np.ndarray, np.ndarray] | None = None,
     p_plate: float | None = None,
     plates: int | None = None,
+    chain_tau: float | None = None,
 ) -> str:
     """The outcome ``holds`` / ``fails`` / ``inconclusive`` of one claim (see the module doc).
 
@@ -175,10 +203,13 @@ def decide(
     p_plate : for ``one-plate``, the probability of a plate at least as extreme.
     plates : the number of simulated plates the interval (a spread) and ``p_plate`` come
         from, if they do: fewer than :data:`MIN_PLATES` decide nothing (inconclusive).
+    chain_tau : the length in autocorrelation times of the sampler chain the interval comes
+        from, if it does (the shortest chain's, at its slowest parameter): fewer than
+        :data:`MIN_CHAIN_TAU` decide nothing (inconclusive).
     """
     if form not in FORMS:
         raise ValueError(f"form must be one of {', '.join(FORMS)}, not {form!r}")
-    if plates is not None and plates < MIN_PLATES:
+    if (plates is not None and plates < MIN_PLATES) or short_chain(chain_tau):
         return "inconclusive"
     zl, zh = zone
     if form == "range":

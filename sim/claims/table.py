@@ -37,7 +37,9 @@ class Sim:
     value, ci : the estimate and its 95 % interval; ``interval`` says which kind (``ci``,
     ``spread`` or ``exact``). ``value_high``: the upper end of a range value. ``elems``:
     per-element interval arrays of a ``range`` claim. ``samples``: a one-plate statistic over
-    the simulated plates. ``note``: the row's explanation."""
+    the simulated plates. ``chain_tau``: an interval from a sampler chain, the chain's length
+    in autocorrelation times (:data:`sim.claims.rules.MIN_CHAIN_TAU`). ``note``: the row's
+    explanation."""
 
     value: float | None = None
     ci: tuple[float, float] | None = None
@@ -46,6 +48,7 @@ class Sim:
     value_high: float | None = None
     elems: tuple[np.ndarray, np.ndarray] | None = None
     samples: np.ndarray | None = None
+    chain_tau: float | None = None
 
 
 def exact(value: float, note: str = "", **kw: Any) -> Sim:
@@ -53,9 +56,9 @@ def exact(value: float, note: str = "", **kw: Any) -> Sim:
     return Sim(float(value), interval="exact", note=note, **kw)
 
 
-def mc(value: float, se: float, note: str = "") -> Sim:
+def mc(value: float, se: float, note: str = "", **kw: Any) -> Sim:
     """A Monte-Carlo estimate with standard error ``se``: interval value +- 1.96 se."""
-    return Sim(value, (value - Z95 * se, value + Z95 * se), note=note)
+    return Sim(value, (value - Z95 * se, value + Z95 * se), note=note, **kw)
 
 
 def plates(samples: np.ndarray, note: str = "") -> Sim:
@@ -82,6 +85,7 @@ def claim_rows(book: ClaimBook, table: Mapping[str, Sim | None]) -> list[dict[st
                 value_high=s.value_high,
                 elems=s.elems,
                 samples=s.samples,
+                chain_tau=s.chain_tau,
             )
         )
     return rows

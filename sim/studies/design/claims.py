@@ -12,6 +12,7 @@ import numpy as np
 
 from sim.claims.book import ClaimBook
 from sim.claims.intervals import binomial_ci
+from sim.claims.rules import MIN_CHAIN_TAU
 from sim.claims.table import Sim, claim_rows, exact, mc, plates
 from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import StudyError
@@ -261,6 +262,10 @@ def _coverage(R: dict) -> dict[str, Sim]:
 def _bayes(R: dict) -> dict[str, Sim]:
     """The emcee cross-check (:mod:`.posterior`): posterior against least-squares sigmas."""
     by = R["bayes"]
+    n_tau = by["chain_tau"]
+    length = f"{by['kept']} kept steps = {n_tau:.1f} tau (shortest chain, slowest parameter)"
+    if n_tau >= MIN_CHAIN_TAU:
+        length += f", at least {MIN_CHAIN_TAU} as emcee's rule asks"
     table = {}
     for nm, (v, se, tau, neff) in by["ratio"].items():
         table[f"bayes.brown_agreement.{nm.rsplit('_', 1)[0]}"] = Sim(
@@ -268,11 +273,15 @@ def _bayes(R: dict) -> dict[str, Sim]:
             (float(v - 1.96 * se), float(v + 1.96 * se)),
             note=f"posterior / least-squares sigma, one plate; {by['chains']} "
             f"chains x {by['steps']} steps x {by['walkers']} walkers; tau = "
-            f"{tau:.0f} steps, N_eff = {neff:.0f}; interval +-1.96 MC s.e.",
+            f"{tau:.0f} steps, N_eff = {neff:.0f}; {length}; interval +-1.96 MC s.e.",
+            chain_tau=n_tau,
         )
     v, se, a, bb = by["max_corr_diff"]
     table["bayes.brown_agreement.max_corr_diff"] = mc(
-        v, se, f"largest at ({a}, {bb}); interval +-1.96 MC s.e. of that correlation"
+        v,
+        se,
+        f"largest at ({a}, {bb}); {length}; interval +-1.96 MC s.e. of that correlation",
+        chain_tau=n_tau,
     )
     return table
 

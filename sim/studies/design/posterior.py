@@ -88,6 +88,9 @@ def bayes_analysis(cfg: dict, pts: np.ndarray, sr_um: float, ctx) -> tuple[dict,
     }
     vals = {
         "ratio": dict(zip(names, zip(ratio, ratio_se, sim["tau"].mean(0), neff))),
+        # the shortest chain's kept steps in autocorrelation times of its slowest parameter
+        "chain_tau": float((sim["samples"].shape[1] / sim["tau"].max(1)).min()),
+        "kept": int(sim["samples"].shape[1]),
         "max_corr_diff": (float(diff.max()), corr_se, names[i], names[j]),
         "chains": cfg["bayes.chains"],
         "steps": cfg["bayes.steps"],

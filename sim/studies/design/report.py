@@ -254,7 +254,9 @@ def _bayes(out: Path, cfg: dict) -> list[str]:
         f"{cfg['bayes.chains']} independent ensembles (run in parallel). Each number carries its "
         "Monte-Carlo standard error from the integrated autocorrelation time, so the verdicts "
         "do not change with the BLAS's last bits; `make verify` compares these columns with "
-        "tolerances of that size.",
+        "tolerances of that size. That error rests on tau, which a short chain underestimates: "
+        "the self-checks are decided only on chains of at least 50 tau (emcee's rule; "
+        "docs/verdict-rules.md), otherwise inconclusive.",
         md_table(
             list(_BAYES_COLS), _columns(by, tuple(_BAYES_COLS.values()), range(len(by["param"])))
         ),

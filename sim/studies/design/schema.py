@@ -355,7 +355,13 @@ SCHEMA = {
     "coverage.alpha": level(0.05, "level of the global chi-square test"),
     # bayes
     "bayes.walkers": count(32, "emcee walkers", lo=16, hi=1000),
-    "bayes.steps": count(500, "emcee steps per walker and chain", lo=100, hi=1_000_000),
+    "bayes.steps": count(
+        8000,
+        "emcee steps per walker and chain (8,000: about 70 autocorrelation times kept, "
+        "emcee's rule asks 50 for a verdict)",
+        lo=100,
+        hi=1_000_000,
+    ),
     "bayes.chains": count(
         4, "independent emcee ensembles (run in parallel, one per chunk)", lo=2, hi=64
     ),
