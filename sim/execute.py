@@ -27,7 +27,7 @@ from sim.execute_sweep import check_sweep, not_the_cells, sweep_limits
 from sim.held_stops import held_stops
 from sim.mc.argv import most_workers
 from sim.mc.config import ConfigError, StudyError, check_chunks
-from sim.mc.estimate import chunk_note
+from sim.mc.estimate import _either, chunk_note
 from sim.mc.executors import StartRefused, script_words
 from sim.mc.left_behind import clear_replaced
 from sim.mc.outputs import _chunks, _differs, _same, check_out, drop_stage, prepare_stage, stage_dir
@@ -46,6 +46,7 @@ from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, swept_order
 from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
+from sim.room import limits_set
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
@@ -78,9 +79,10 @@ def _check_options(executor: Any, workers: Any, scheduler: Any) -> None:
             raise ConfigError("scheduler", "needs executor dask")
 
 
-def _numeric_failure(e: BaseException, study, cfg: dict) -> StudyError:
+def _numeric_failure(e: BaseException, study, cfg: dict, keys: tuple = ()) -> StudyError:
     """One line for an exception raised inside a study's run: the study part (the innermost
-    frame in study code) and, where the message says which, the config key to change."""
+    frame in study code) and, where the message says which, the config key to change (for
+    memory, the estimate's ``keys`` and the ``ulimit`` in force: :func:`_memory_hint`)."""
     import traceback
 
     frames = [
@@ -96,7 +98,7 @@ def _numeric_failure(e: BaseException, study, cfg: dict) -> StudyError:
         mod = f.filename.replace(os.sep, "/").rsplit("/sim/", 1)[1][:-3].replace("/", ".")
         part = f"sim.{mod}.{f.name}"
     msg = (str(e).strip().splitlines() or [""])[0][:300]
-    hint = _hint(msg, type(e).__name__, study.schema)
+    hint = _hint(msg, type(e).__name__, study.schema, keys)
     where = f" in {part}" if part else ""
     return StudyError(f"{cfg['study']}: the run failed{where}: {type(e).__name__}: {msg}{hint}")
 
@@ -108,16 +110,26 @@ _HINTS = (  # message words -> config keys (the first that the study has is name
 )
 
 
-def _hint(msg: str, kind: str, schema) -> str:
+def _hint(msg: str, kind: str, schema, keys: tuple = ()) -> str:
     low = (msg + " " + kind).lower()
-    for words, keys in _HINTS:
+    for words, named in _HINTS:
         if any(w in low for w in words):
-            have = [k for k in keys if k in schema]
+            have = [k for k in named if k in schema]
             if have:
                 return f" (check {have[0]})"
-    if "memory" in low:
-        return " (reduce trials, chunk or the sizes in the study file)"
-    return ""
+    return _memory_hint(keys) if "memory" in low else ""
+
+
+def _memory_hint(keys: tuple) -> str:
+    """What to change after a MemoryError mid-run: the limit in force and the keys that set
+    the run's memory. It said "reduce trials, chunk or the sizes in the study file" for
+    brown_dilution's region (``region.points``) failing under ``ulimit -v 1250000``."""
+    limits = limits_set()
+    return (
+        f" ({limits}: raise it, or reduce {_either(keys)})"
+        if limits
+        else (f" (reduce {_either(keys)})")
+    )
 
 
 def _not_in_a_starting_worker() -> None:
@@ -273,7 +285,7 @@ def execute(
             if interrupted(e):  # Ctrl-C inside an import (or a library that wraps it)
                 raise KeyboardInterrupt from None
             if isinstance(e, (ArithmeticError, ValueError, MemoryError)):  # numbers the model
-                raise _numeric_failure(e, study, cfg) from None  # cannot take
+                raise _numeric_failure(e, study, cfg, est.memory_keys) from None  # cannot take
             if (words := shadowed(e)) is not None:  # a user's matplotlib.py: not our bug
                 raise StudyError(f"{cfg['study']}: {words}") from None
             if isinstance(e, BrokenExecutor):  # a worker killed (kill -9, the OOM killer): the

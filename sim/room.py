@@ -21,7 +21,7 @@ import resource
 from sim.mc.config import ConfigError
 from sim.mc.estimate import Estimate, _either, check_limits
 
-__all__ = ["check_room", "mapped_bytes"]
+__all__ = ["check_room", "limits_set", "mapped_bytes", "short_room"]
 
 
 def mapped_bytes(field: int = 0) -> int | None:
@@ -39,6 +39,30 @@ def mapped_bytes(field: int = 0) -> int | None:
 _LIMITS = ((resource.RLIMIT_AS, 0, "ulimit -v"), (resource.RLIMIT_DATA, 5, "ulimit -d"))
 
 
+def limits_set() -> str:
+    """The limits of memory this process runs under, as words (``ulimit -v is 1250000 kB``),
+    or ``""``: what a MemoryError in the middle of a run names."""
+    caps = ((words, resource.getrlimit(limit)[0]) for limit, _, words in _LIMITS)
+    return ", ".join(f"{w} is {c // 1024} kB" for w, c in caps if c != resource.RLIM_INFINITY)
+
+
+def short_room(need: float) -> str:
+    """Where ``need`` bytes more exceed what ``ulimit -v`` or ``ulimit -d`` leaves this
+    process: ``"ulimit -v (1300000 kB) leaves this process about 0.6 GiB beside the 0.64 GiB
+    it maps already"``, else ``""``."""
+    for limit, field, words in _LIMITS:
+        cap = resource.getrlimit(limit)[0]
+        used = mapped_bytes(field)
+        if cap == resource.RLIM_INFINITY or used is None or not need > cap - used:
+            continue
+        return (
+            f"{words} ({cap // 1024} kB) leaves this process about "
+            f"{max(cap - used, 0) / 2**30:.3g} GiB beside the {used / 2**30:.3g} GiB it maps "
+            "already"
+        )
+    return ""
+
+
 def check_room(
     est: Estimate,
     max_memory_gb: float | None = None,
@@ -48,17 +72,12 @@ def check_room(
     """:func:`sim.mc.estimate.check_limits`, then ConfigError when the estimate of one
     process (``est.bytes``) exceeds what ``ulimit -v`` or ``ulimit -d`` leaves it."""
     check_limits(est, max_memory_gb, max_adjustments, workers)
-    for limit, field, words in _LIMITS:
-        cap = resource.getrlimit(limit)[0]
-        used = mapped_bytes(field)
-        if cap == resource.RLIM_INFINITY or used is None or not est.bytes > cap - used:
-            continue
+    if short := short_room(est.bytes):
         each = " a worker" if workers > 1 else ""
         cell = f" (the sweep's cell of {est.cell})" if est.cell else ""
+        words = short.split(" (", 1)[0]
         raise ConfigError(
             None,
             f"{est.study}: the run needs about {est.bytes / 2**30:.3g} GiB of memory{each}{cell}, "
-            f"and {words} ({cap // 1024} kB) leaves this process about "
-            f"{max(cap - used, 0) / 2**30:.3g} GiB beside the {used / 2**30:.3g} GiB it maps "
-            f"already: raise {words}, or reduce {_either(est.memory_keys)}",
+            f"and {short}: raise {words}, or reduce {_either(est.memory_keys)}",
         )

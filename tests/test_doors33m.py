@@ -85,7 +85,8 @@ def test_brown_memory_is_per_point_and_counts_the_kept_sums():
     # a 40 x 40 plate's chunk of 10 (0.4 s): the estimate's chunk term against its real peak
     cfg = _brown(40, trials=200, chunk=10)
     _, peak = _chunk(cfg, 10)
-    one = brown_estimate({**cfg, "trials": 10})[3]  # one chunk: its sums are one chunk's
+    # one chunk: its sums are one chunk's; the region's vectors left out (test_doors39m.py)
+    one = brown_estimate({**cfg, "trials": 10, "region.points": 0, "region.rounds": 0})[3]
     assert peak <= one <= 4 * peak, (peak, one)
     # a 80 x 80 plate in chunks of 10 ran in 0.37 GiB: not refused at the default limit
     check_limits(estimate(_brown(80, trials=200, chunk=10)))

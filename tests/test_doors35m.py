@@ -94,7 +94,11 @@ def test_the_sparse_pre_analysis_holds_a_few_times_its_factor_not_every_rows_blo
 @pytest.mark.parametrize(
     "name, sets, keys",
     [
-        ("brown_dilution", [], "reduce chunk, trials, plate.grid or errors.settings"),
+        (  # a chunk larger than the region's vectors (test_doors39m.py)
+            "brown_dilution",
+            ["region.points=256", "region.rounds=0", "plate.grid=20", "plate.spacing_mm=10"],
+            "reduce chunk, trials, plate.grid or errors.settings",
+        ),
         (
             "brown_table1",
             ["plate.pattern=random", "plate.n_random=400"],

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from typing import Mapping
 
-from sim.mc.workunits import COPIES, F8, region_points
+from sim.mc.workunits import COPIES, F8, REGION_MAX_NEW, region_points
 from sim.mc.workunits import n_of as _n
 
 __all__ = [
@@ -23,6 +23,8 @@ __all__ = [
     "BROWN_POINTS_PER_UNIT",
     "BROWN_POINT_BYTES",
     "BROWN_REGION_UNITS",
+    "BROWN_REGION_BYTES",
+    "region_bytes",
 ]
 
 #: points of a plate one unit adjustment's work adjusts (measured, one core, the reduced
@@ -54,6 +56,13 @@ BROWN_SUM_BYTES = 3 * 2 * 2 * F8 * 5
 #: and 8 rounds, 49,152 vectors, 6.2 s for Table 1's region, 31.5 s for the Concept's, which
 #: adds the monotone curves over grids)
 BROWN_REGION_UNITS = {"brown_table1": 2.5, "brown_dilution": 13.0}
+#: bytes of one input vector of brown's region (tracemalloc peak of the region part, 1,024 to
+#: 16,384 points and 0 to 8 rounds): the Concept's keeps every vector's cofactors of its
+#: evidence and monotone curves, 24 to 27 kB a vector of the whole region (1.1 GiB at 16,384
+#: points and 8 rounds, 49,152 vectors; the run peaked at 1.5 GiB, estimated at 1.5 MiB);
+#: Table 1's evaluates a batch at a time, 24 kB a vector of its largest batch (the Sobol
+#: design, or a round's :data:`sim.mc.workunits.REGION_MAX_NEW` new ones)
+BROWN_REGION_BYTES = 26e3
 
 
 #: the key that sets the plate's points, by ``plate.pattern``
@@ -70,10 +79,24 @@ def plate_points(c: Mapping) -> float:
     return max(len(c.get("plate.points", [])), 1)
 
 
-def _memory_keys(c: Mapping, n: float, n_an: float, chunk_b: float, curves_b: float) -> tuple:
+def region_bytes(c: Mapping) -> float:
+    """Bytes brown's region holds at its peak (:data:`BROWN_REGION_BYTES` a vector): every
+    vector of the Concept's region (brown_dilution), the largest batch of Table 1's."""
+    n, rounds = c.get("region.points", 0), c.get("region.rounds", 0)
+    if c.get("study") == "brown_table1":
+        return BROWN_REGION_BYTES * max(n, REGION_MAX_NEW if rounds > 0 else 0)
+    return BROWN_REGION_BYTES * region_points(c)
+
+
+def _memory_keys(
+    c: Mapping, n: float, n_an: float, chunk_b: float, curves_b: float, region_b: float = 0.0
+) -> tuple:
     """The keys that set a Brown run's memory: its chunk's (``chunk``, ``trials``: every
-    chunk's sums are kept, the plate's points and ``errors.settings``), or the analytic
-    curves' (``dilution.grids``, when a grid there has more points than the plate)."""
+    chunk's sums are kept, the plate's points and ``errors.settings``), the analytic
+    curves' (``dilution.grids``, when a grid there has more points than the plate), or the
+    region's (``region.points``, ``region.rounds``)."""
+    if region_b > max(chunk_b, curves_b):
+        return ("region.points", "region.rounds")
     plate = PLATE_KEYS.get(c.get("plate.pattern", "grid"), "plate.points")
     if curves_b > chunk_b:
         return ("dilution.grids",) if n_an > n else (plate,)
@@ -85,10 +108,11 @@ def brown_estimate(c: Mapping) -> tuple:
     model adjustments a trial (four with the bias check, :data:`BROWN_TABLE1_SOLVES` in
     Table 1), each :func:`plate_points` over
     :data:`BROWN_POINTS_PER_UNIT` units (at least one), the settings' draws, the analytic
-    dilution curves (three a grid, offset and extent) and the region; the memory the larger
+    dilution curves (three a grid, offset and extent) and the region; the memory the largest
     of a chunk's arrays (:data:`BROWN_POINT_BYTES`, :data:`BROWN_SETTING_BYTES`) with every
-    chunk's sums (:data:`BROWN_SUM_BYTES`), and the analytic curves' point blocks, with the
-    keys that set it (:func:`_memory_keys`)."""
+    chunk's sums (:data:`BROWN_SUM_BYTES`), the analytic curves' point blocks and the
+    region's vectors (:func:`region_bytes`), with the keys that set it
+    (:func:`_memory_keys`)."""
     n = plate_points(c)
     T, ch = c["trials"], min(c["chunk"], c["trials"])
     L = c.get("errors.settings", 1)
@@ -109,6 +133,9 @@ def brown_estimate(c: Mapping) -> tuple:
     chunk_b = ch * n * point + chunks * n * BROWN_SUM_BYTES
     curves_b = 4 * n_an * 7 * F8 * 3 * COPIES
     region = region_points(c) * BROWN_REGION_UNITS.get(c.get("study"), 13.0)
-    keys = _memory_keys(c, n, n_an, chunk_b, curves_b)
+    region_b = region_bytes(c)
+    keys = _memory_keys(c, n, n_an, chunk_b, curves_b, region_b)
+    what = "the region's input vectors" if region_b > max(chunk_b, curves_b) else ""
     adj = T * trial + analytic + region
-    return T, adj, max(U, 2 * n_an + 7), max(chunk_b, curves_b), "", (0.0, "", ""), keys
+    b = max(chunk_b, curves_b, region_b)
+    return T, adj, max(U, 2 * n_an + 7), b, what, (0.0, "", ""), keys

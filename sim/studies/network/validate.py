@@ -18,6 +18,7 @@ from sim.mc.limit_error import LimitError
 from sim.mc.lookalike import differs, skeleton
 from sim.mc.memory_limit import memory_limit_gb
 from sim.mc.network_size import network_counts, network_estimate, state_bytes
+from sim.room import short_room
 
 __all__ = ["KINDS", "ARCSEC", "ROLES", "SIGMA_RANGE", "MAX_NAME", "MAX_TITLE", "title"]
 
@@ -49,11 +50,12 @@ def _memory_limit() -> float:
 def fits_estimate(cfg: dict) -> None:
     """Refuse, before the network is built and its normals factorised (minutes and most of
     the memory of a large one), a run whose estimate (:func:`sim.mc.network_size.
-    network_estimate`, the memory ``sim check`` shows) is over the memory limit, naming the
-    key that declares the network's size (``network.gama_xml`` and its file, else
+    network_estimate`, the memory ``sim check`` shows) is over the memory limit or what
+    ``ulimit -v`` or ``-d`` leaves (:func:`sim.room.short_room`), naming the key that declares the network's size (``network.gama_xml`` and its file, else
     ``network.generate``, ``network.grids``, ``network.random`` or ``network.points``). The
     estimate was applied after the load: a 90,000-point network under
-    ``SIM_MAX_MEMORY_GB=2`` was built and factorised (two minutes, 1.35 GiB), then refused."""
+    ``SIM_MAX_MEMORY_GB=2`` was built and factorised (two minutes, 1.35 GiB), then refused;
+    so a 50,000-point grid under ``ulimit -v 1300000``, or it failed on a MemoryError."""
     if not _counts_typed(cfg):
         return  # a count as text ("3000"), below 1, not whole: the build names its field
     try:
@@ -61,19 +63,25 @@ def fits_estimate(cfg: dict) -> None:
     except (TypeError, ValueError, KeyError, OverflowError, ZeroDivisionError, OSError):
         return  # the build names what is wrong
     lim = _memory_limit()
-    if need <= lim:
+    short = short_room(need) if need <= lim else ""
+    if need <= lim and not short:
         return
     gama = cfg.get("network.gama_xml")
     key = "network.gama_xml" if gama else _size_key(cfg, k.points, k.rows)
     what = f"a network of about {k.points:,.0f} points and {k.rows:,.0f} observations"
     if gama:  # counted from the file's size, not read
         what = f"{gama}: a gama-local file of about {k.rows:,.0f} observations by its size"
+    over = (
+        f"and {short}: raise {short.split(' (', 1)[0]} or use fewer points or observations"
+        if short
+        else f"over the {lim / 2**30:g} GiB memory limit (--max-memory-gb or "
+        "SIM_MAX_MEMORY_GB): use fewer points or observations"
+    )
     raise LimitError(
         key,
         f"{what} ({k.unknowns:,.0f} unknowns) needs about "
         f"{need / 2**30:.3g} GiB with chunks of {min(cfg['chunk'], cfg['trials'])} trials "
-        f"(estimate), over the {lim / 2**30:g} GiB memory limit (--max-memory-gb or "
-        "SIM_MAX_MEMORY_GB): use fewer points or observations",
+        f"(estimate), {over}",
     )
 
 
