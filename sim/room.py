@@ -59,9 +59,13 @@ _LOADS: dict[str, dict[int, tuple[int, int]]] = {}
 _KEPT = 32
 
 
-def _config_key(cfg: Mapping) -> str:
-    """A config's sha256, as its record in :data:`_LOADS` is found (a copy finds it)."""
-    text = json.dumps(cfg, sort_keys=True, default=repr, ensure_ascii=False)
+def _config_key(cfg: Mapping) -> str | None:
+    """A config's sha256, as its record in :data:`_LOADS` is found (a copy finds it); None
+    for one no JSON holds (nothing is recorded under it)."""
+    try:
+        text = json.dumps(cfg, sort_keys=True, default=repr, ensure_ascii=False)
+    except (TypeError, ValueError, RecursionError):
+        return None
     return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
 
 
@@ -74,7 +78,8 @@ def loaded(load: Callable[[], tuple]) -> tuple:
     for field, b in before.items():
         if b is not None and (a := mapped_bytes(field)) is not None:
             rec[field] = (b, max(a - b, 0))
-    key = _config_key(cfg)
+    if (key := _config_key(cfg)) is None:
+        return study, cfg
     _LOADS.pop(key, None)
     _LOADS[key] = rec
     while len(_LOADS) > _KEPT:
@@ -84,12 +89,8 @@ def loaded(load: Callable[[], tuple]) -> tuple:
 
 def held_by_load(cfg: Mapping | None) -> dict[int, tuple[int, int]]:
     """What the load of ``cfg`` mapped (:func:`loaded`), ``{}`` if it was not recorded."""
-    if cfg is None:
-        return {}
-    try:
-        return _LOADS.get(_config_key(cfg), {})
-    except (TypeError, ValueError):  # a config no JSON holds: nothing recorded under it
-        return {}
+    key = None if cfg is None else _config_key(cfg)
+    return {} if key is None else _LOADS.get(key, {})
 
 
 def limits_set() -> str:

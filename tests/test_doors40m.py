@@ -74,6 +74,7 @@ class _Process:
             self.built = True
             return real_build(*a, **kw)
 
+        monkeypatch.setattr("sim.room._LOADS", {})  # the fake loads' records: this test's
         monkeypatch.setattr("sim.room.resource.getrlimit", limited)
         monkeypatch.setattr("sim.room.mapped_bytes", self.mapped)
         monkeypatch.setattr("sim.studies.network.schema.build", build)
