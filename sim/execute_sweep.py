@@ -31,16 +31,17 @@ def sweep_limits(
     again without the cells the study refuses (recorded infeasible, never run): a 150 x 150
     plate outside the format, refused in its cell, made a sweep of it and a 5 x 5 plate "need
     0.744 GiB" and refused it. A cell refused for the limit itself is named
-    (:func:`sim.mc.sweep.refused_cells`)."""
+    (:func:`sim.mc.sweep.refused_cells`). What the load of ``cfg`` mapped is counted once
+    (:func:`sim.room.loaded`)."""
     est = estimate(cfg, sweep)
     try:
-        check_room(est, max_memory_gb, max_adjustments, workers)  # and ulimit -v's room
+        check_room(est, max_memory_gb, max_adjustments, workers, cfg)  # and ulimit -v's
     except ConfigError:
         bad = refused_cells(study, cfg, sweep)[0] if sweep else None
         if not bad:
             raise
         est = estimate(cfg, sweep, skip=bad)
-        check_room(est, max_memory_gb, max_adjustments, workers)
+        check_room(est, max_memory_gb, max_adjustments, workers, cfg)
     return est
 
 

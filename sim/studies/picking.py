@@ -16,6 +16,7 @@ from typing import Any
 
 from sim.mc.config import ConfigError
 from sim.mc.runner import MIN_CHUNKS
+from sim.room import loaded
 from sim.studies import load_study
 from sim.studies.ported import foreign_key
 
@@ -35,7 +36,14 @@ def load_picking_chunk(
     (:func:`sim.studies.ported.foreign_key`). ``picks``: trials were given and the chunk was
     not; the chunk is then the largest that gives at least :data:`MIN_CHUNKS` chunks, the
     file's own chunk kept when it is smaller, and picked also when the file's chunk is too
-    large for the trials asked for (which alone would be refused)."""
+    large for the trials asked for (which alone would be refused). What the load mapped (a
+    network's: built and factorised) is recorded under the config (:func:`sim.room.loaded`):
+    the room check before the run counts it once."""
+    return loaded(lambda: _load(path, picks, overrides, trials, seed, values))
+
+
+def _load(path, picks: bool, overrides, trials, seed, values):
+    """:func:`load_picking_chunk`'s load."""
 
     def load(chunk: int | None = None):
         vals = dict(values or {}) if chunk is None else {**(values or {}), "chunk": chunk}
