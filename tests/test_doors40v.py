@@ -13,16 +13,35 @@ its fix.
   each column's values in their order (:func:`sim.mc.table_shape.values_digest`, the same for
   a faithful rewrite: other row groups, a dictionary encoding, another text type), and each
   reader names the file and the column whose values are not the run's.
+* The same command again (``sim run`` with the same ``--out``: a resume of finished results,
+  ``make reproduce``'s ``--overwrite``) replaced a table edited by hand with the run's, exit 0,
+  without a word. One note now names the tables changed after their run, replaced
+  (:func:`sim.execute._say_edits_replaced`); a file of the user's is carried over as before.
+* A figure removed by hand from results whose run drew it was "not drawn (``table1.png`` is
+  missing: a run with ``--no-figures``?)" in the README that ``sim report`` writes, a guess
+  that the run record (``figure_sha256``, ``"figures"``) contradicts: it now says the run drew
+  it and it was removed since.
+
+Held (found right): a column retyped (float64 to float32), renamed, a row deleted, a pandas
+index column added, the schema metadata dropped (each named by every reader, exit 2, or
+FAILED by verify); text as ``large_string``, a dictionary encoding, row groups of one or two
+rows (read as the run's); ``run.json`` with its keys reordered or pretty-printed again; a
+README.md edited (one with the mark is rewritten, as its mark says; one without is the
+user's, kept); files and the directory read-only (every reader, nothing written into a
+results directory by ``sim show``); a chunk touched (same bytes: read) or its row groups
+split (``Results.table("chunks")`` names it; a resume reads it by its identity).
 """
 
 from __future__ import annotations
 
 import shutil
+import subprocess
 from pathlib import Path
 
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
+from conftest import ROOT, tiny_command
 from oneline import one_line
 
 import sim
@@ -87,3 +106,26 @@ def test_a_faithful_rewrite_still_reads_as_the_run(tiny_run, tmp_path, capsys):
     assert main(["report", "--results", str(d.parent)]) == 0
     capsys.readouterr()
     assert sim.Results(d, "brown_table1").table("claims").num_rows > 0
+
+
+def test_the_same_command_again_says_which_edited_tables_it_replaces(tiny_run, tmp_path):
+    d = _copy(tiny_run, tmp_path)
+    _edit(d / "points.parquet", lambda t: t.take(list(reversed(range(t.num_rows)))))
+    (d / "notes.txt").write_text("mine\n")
+    r = subprocess.run(tiny_command("brown_table1", d), cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    note = [ln for ln in r.stderr.splitlines() if ln.startswith("sim: note:")]
+    assert len(note) == 1 and "points.parquet" in note[0] and "replaced" in note[0], r.stderr
+    assert str(d) in note[0] and "claims.parquet" not in note[0]
+    assert (d / "notes.txt").read_text() == "mine\n"  # the user's own file: carried over
+    r = subprocess.run(tiny_command("brown_table1", d), cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 0 and "note" not in r.stderr, r.stderr  # nothing edited: no note
+
+
+def test_a_figure_removed_by_hand_is_not_called_a_run_without_figures(tiny_run, tmp_path):
+    d = _copy(tiny_run, tmp_path)
+    (d / "table1.png").unlink()
+    assert main(["report", "--results", str(d.parent)]) == 0
+    text = (d / "README.md").read_text("utf-8")
+    assert "`table1.png` is missing: its run drew it; removed since?" in text
+    assert "no-figures" not in text
