@@ -21,6 +21,9 @@ its fix.
   missing: a run with ``--no-figures``?)" in the README that ``sim report`` writes, a guess
   that the run record (``figure_sha256``, ``"figures"``) contradicts: it now says the run drew
   it and it was removed since.
+* ``sim.Results(d, study).table("points")`` of a table its run wrote and that was removed by
+  hand said "brown_table1 has no table 'points'; it has ..." (the study has it: its run wrote
+  it): the file is named as missing, its run having written it.
 
 Held (found right): a column retyped (float64 to float32), renamed, a row deleted, a pandas
 index column added, the schema metadata dropped (each named by every reader, exit 2, or
@@ -129,3 +132,12 @@ def test_a_figure_removed_by_hand_is_not_called_a_run_without_figures(tiny_run, 
     text = (d / "README.md").read_text("utf-8")
     assert "`table1.png` is missing: its run drew it; removed since?" in text
     assert "no-figures" not in text
+
+
+def test_a_table_removed_by_hand_is_named_by_the_api_as_removed(tiny_run, tmp_path):
+    d = _copy(tiny_run, tmp_path)
+    (d / "points.parquet").unlink()
+    with pytest.raises(ConfigError, match="points.parquet is missing: its run wrote it"):
+        sim.Results(d, "brown_table1").table("points")
+    with pytest.raises(ConfigError, match="has no table 'pointz'"):  # a name of no table
+        sim.Results(d, "brown_table1").table("pointz")
