@@ -303,11 +303,12 @@ def execute(
         seal(stage, ctx.store)
         if readme is not None:
             readme(stage, out.name)
-        _say_edits_replaced(out, shown)
+        edited = _edits(out)
         with held_stops():  # an interrupt between its renames: handled once they are done
             publish(stage, out)
             published = True
             lock.release()
+        _say_edits_replaced(edited, shown)
     except BaseException as e:
         if not published:
             drop_stage(stage, lock)
@@ -317,15 +318,19 @@ def execute(
     return est
 
 
-def _say_edits_replaced(out: Path, shown: str) -> None:
-    """One note naming the tables of the earlier results ``out`` that were changed (or removed)
-    after their run wrote them (their sha256 is not the one its ``run.json`` records): the
-    same command again replaced a verdict or a number edited by hand with the run's, without
-    a word (a file of the user's, which the run did not write, is carried over as it is)."""
+def _edits(out: Path) -> list[str]:
+    """The tables of the earlier results ``out`` changed (or removed) after their run wrote
+    them (their sha256 is not the one its ``run.json`` records), which a publish replaces."""
     try:
-        edited = edited_tables(out) if out.is_dir() and not out.is_symlink() else []
+        return edited_tables(out) if out.is_dir() and not out.is_symlink() else []
     except OSError:
-        return
+        return []
+
+
+def _say_edits_replaced(edited: list[str], shown: str) -> None:
+    """One note naming the ``edited`` tables (:func:`_edits`) the run has replaced: the same
+    command again replaced a verdict or a number edited by hand with the run's, without a
+    word (a file of the user's, which the run did not write, is carried over as it is)."""
     if edited:
         names = ", ".join(edited[:3]) + (f" and {len(edited) - 3} more" if len(edited) > 3 else "")
         print(
