@@ -167,6 +167,8 @@ class Results:
             raise ConfigError(
                 "path", f"{self.path} is not a results directory (no tables){self._within()}"
             )
+        if not there and p.name in run_tables(self.path, self.study):  # not "has no table"
+            raise ConfigError("table", f"{p} is missing: its run wrote it (removed by hand?)")
         if not there:
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"

@@ -43,6 +43,7 @@ from sim.mc.storage import (
     write_table,
 )
 from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, swept_order
+from sim.mc.table_edits import edited_tables
 from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
@@ -266,10 +267,12 @@ def execute(
         seal(stage, ctx.store)
         if readme is not None:
             readme(stage, out.name)
+        edited = _edits(out)
         with held_stops():  # an interrupt between its renames: handled once they are done
             publish(stage, out)
             published = True
             lock.release()
+        _say_edits_replaced(edited, shown)
     except BaseException as e:
         if not published:
             drop_stage(stage, lock)
@@ -279,6 +282,28 @@ def execute(
             e.published = shown
         raise
     return est
+
+
+def _edits(out: Path) -> list[str]:
+    """The tables of the earlier results ``out`` changed (or removed) after their run wrote
+    them (their sha256 is not the one its ``run.json`` records), which a publish replaces."""
+    try:
+        return edited_tables(out) if out.is_dir() and not out.is_symlink() else []
+    except OSError:
+        return []
+
+
+def _say_edits_replaced(edited: list[str], shown: str) -> None:
+    """One note naming the ``edited`` tables (:func:`_edits`) the run has replaced: the same
+    command again replaced a verdict or a number edited by hand with the run's, without a
+    word (a file of the user's, which the run did not write, is carried over as it is)."""
+    if edited:
+        names = ", ".join(edited[:3]) + (f" and {len(edited) - 3} more" if len(edited) > 3 else "")
+        print(
+            f"sim: note: {names} in {shown} changed after the run that wrote "
+            f"{'it' if len(edited) == 1 else 'them'} (edited by hand?): replaced by this run's",
+            file=sys.stderr,
+        )
 
 
 def _this_process(e: ConfigError) -> ConfigError:

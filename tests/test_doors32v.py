@@ -56,6 +56,24 @@ def test_a_verdict_edited_by_hand_is_said_to_be_an_edit_not_a_failed_reproductio
         "--no-record",
     )
     assert out.returncode == 1, out.stderr
+    text = out.stdout + out.stderr  # (doors40v: the claims table's values are not its run's)
+    assert "claims.parquet is not the claims table its run wrote" in text
+    assert "the values of column 'verdict' are not those its run wrote" in text
+    shutil.copy(tmp_path / "S" / "brown_table1" / "claims.parquet", f)  # another table edited:
+    f = tmp_path / "R" / "brown_table1" / "table1_trials.parquet"  # compared, and said so
+    t = pq.read_table(f)
+    t = t.take(list(reversed(range(t.num_rows))))
+    pq.write_table(t.replace_schema_metadata(pq.read_schema(f).metadata), f)
+    out = _sim(
+        "sim.report.verify",
+        "--results",
+        str(tmp_path / "R"),
+        "--scratch",
+        str(tmp_path / "S"),
+        "--no-rerun",
+        "--no-record",
+    )
+    assert out.returncode == 1, out.stderr
     text = out.stdout + out.stderr
-    assert "claims.parquet changed after the run that wrote them" in text
+    assert "table1_trials.parquet changed after the run that wrote them" in text
     assert "not of the code" in text

@@ -13,7 +13,11 @@ keeps:
 * each column's name and kind (the Arrow type, with a dictionary read as its values, every
   text type as ``string``, every integer width as ``int``);
 * per column, how many of its values are null, and per floating column how many are NaN and
-  how many infinite (a key column's value blanked or set to NaN by hand).
+  how many infinite (a key column's value blanked or set to NaN by hand);
+* per column, a digest of its values in their order (:func:`values_digest`: a dictionary read
+  as its values, any text type as text, any integer width as a 64-bit integer), so that a
+  value edited by hand in a table of the same shape (a verdict turned from ``holds`` to
+  ``fails``, a number changed, rows reordered) is not read as its run's.
 
 :func:`shape_problem` says, in a few words naming the column, how a table differs from the
 shape its run recorded; results of a version that recorded none (or a record edited into
@@ -22,9 +26,12 @@ another form) are not checked.
 
 from __future__ import annotations
 
+import hashlib
+import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
@@ -38,6 +45,7 @@ __all__ = [
     "shape",
     "recorded_shape",
     "shape_problem",
+    "values_digest",
     "declared_problem",
 ]
 
@@ -69,9 +77,32 @@ def _count(mask: Any) -> int:
     return int(pc.sum(mask).as_py() or 0)
 
 
+def values_digest(col: pa.ChunkedArray) -> str:
+    """16 hex digits of the sha256 of a column's values in their order, the same for every
+    faithful rewrite of them (a dictionary encoding, another text type or integer width,
+    other row groups, another NaN's bits): which rows are null, then the values."""
+    if pa.types.is_dictionary(col.type):
+        col = pa.chunked_array([c.dictionary_decode() for c in col.chunks], col.type.value_type)
+    t, h = col.type, hashlib.sha256()
+    h.update(np.packbits(col.is_null().to_numpy(zero_copy_only=False).astype(bool)).tobytes())
+    try:
+        if pa.types.is_floating(t):
+            a = col.fill_null(0).to_numpy()
+            h.update(np.where(np.isnan(a), np.nan, a).tobytes())
+        elif pa.types.is_integer(t):
+            h.update(col.fill_null(0).cast(pa.int64()).to_numpy().tobytes())
+        elif pa.types.is_boolean(t):
+            h.update(col.fill_null(False).to_numpy(zero_copy_only=False).astype(bool).tobytes())
+        else:
+            raise TypeError(t)
+    except (TypeError, ValueError, pa.ArrowException):  # text, lists, an int over int64's range
+        h.update(json.dumps(col.to_pylist(), default=repr).encode("utf-8", "surrogatepass"))
+    return h.hexdigest()[:16]
+
+
 def shape(table: pa.Table) -> dict:
-    """``{"rows": n, "columns": {name: kind}, "nulls"|"nan"|"inf": {name: count}}`` of a
-    table (the counts only where not zero)."""
+    """``{"rows": n, "columns": {name: kind}, "nulls"|"nan"|"inf": {name: count}, "values":
+    {name: digest}}`` of a table (the counts only where not zero)."""
     cols: dict[str, str] = {}
     counts: dict[str, dict[str, int]] = {"nulls": {}, "nan": {}, "inf": {}}
     for i, name in enumerate(table.column_names):
@@ -83,7 +114,9 @@ def shape(table: pa.Table) -> dict:
         for what, k in found.items():
             if k:
                 counts[what][name] = k
-    return {"rows": table.num_rows, "columns": cols, **{k: v for k, v in counts.items() if v}}
+    values = {name: values_digest(table.column(i)) for i, name in enumerate(table.column_names)}
+    counted = {k: v for k, v in counts.items() if v}
+    return {"rows": table.num_rows, "columns": cols, **counted, "values": values}
 
 
 def recorded_shape(path: str | Path) -> dict | None:
@@ -155,6 +188,14 @@ def shape_problem(table: pa.Table, recorded: dict | None) -> str | None:
                     f"column {c!r} holds {have.get(c, 0):,} {word} value(s) where its run "
                     f"wrote {had.get(c, 0) or 'none'}"
                 )
+    # the values (a record of a version that recorded no digests: not checked)
+    digests = recorded.get("values")
+    for c in want if isinstance(digests, dict) else ():
+        if isinstance(digests.get(c), str) and now["values"][c] != digests[c]:
+            return (
+                f"the values of column {c!r} are not those its run wrote (edited by hand, or "
+                "its rows reordered?)"
+            )
     return None
 
 

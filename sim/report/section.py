@@ -35,7 +35,7 @@ from typing import Any
 
 from sim.claims.region import REGION_MIN_POINTS
 from sim.mc.publish import drawn
-from sim.mc.storage import read_provenance
+from sim.mc.storage import read_provenance, read_record
 from sim.report.inputs import inputs_markdown
 from sim.report.markdown import claims_markdown
 from sim.report.read import columns, records
@@ -77,6 +77,9 @@ def figure(out: Path, file: str, alt: str) -> str:
     """The Markdown line of one figure of the study, relative to the report; a line saying
     so when the run drew no figures (``sim run --no-figures``)."""
     if not (Path(out) / file).is_file():
+        drew = (read_record(Path(out)) or {}).get("figure_sha256")  # the run drew it: not
+        if isinstance(drew, dict) and file in drew:  # "a run with --no-figures?" of its run
+            return f"*{alt}: not shown (`{file}` is missing: its run drew it; removed since?)*"
         return f"*{alt}: not drawn (`{file}` is missing: a run with `--no-figures`?)*"
     if not drawn(Path(out), file):  # put there by hand: not the run's figure
         return f"*{alt}: not drawn by this run (`{file}` is not the figure its run.json records)*"
