@@ -242,7 +242,11 @@ def fig_twoplate(cols, samples, path):
     fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
     bins = np.logspace(-6, 6, 121)
     for name, rho in samples.items():
-        ax.hist(rho, bins=bins, histtype="step", lw=1.5, label=f"posterior, {name} prior")
+        h = ax.hist(rho, bins=bins, histtype="step", lw=1.5, label=f"chains, {name} prior")
+        j = cols["prior"].index(name)
+        for c in ("rho_q025", "rho_q975"):  # the posterior's 95 % interval by quadrature
+            ax.axvline(cols[c][j], color=h[2][0].get_edgecolor(), ls=":", lw=1.2)
+    ax.plot([], [], color="grey", ls=":", label="95 % interval by quadrature")
     ax.axvline(cols["rw_ratio_mean"][0], color="tab:red", ls="--", label="chi-square re-weighting")
     ax.set_xscale("log")
     ax.set_xlabel("σ²(comparator) / σ²(grid) (ratio, = P_cx / P_x)")

@@ -5,6 +5,10 @@
    covariance.
 2. The comparator / grid variance ratio of one simulated two-plate calibration
    (``gridplate_two_plates``'s default configuration) against the chi-square re-weighting.
+   Its quantiles are computed by quadrature (:mod:`sim.instruments.ranges.twoplate_quad`):
+   with log-uniform priors the ratio's posterior is flat between the prior's bounds, about
+   12 decades wide, and a chain's autocorrelation time there is about 1000 steps (50 of them
+   would take 50,000 steps). The chains stay beside it as the cross-check (their width and length).
 
 Each posterior is ``bayes.chains`` independent ensembles, one chunk each (chunk size 1), so
 they run in parallel on the run's executor and are stored for resumption. An MCMC estimate is
@@ -24,6 +28,7 @@ import numpy as np
 from sim.instruments import gridplate as gp
 from sim.instruments import transforms2d as t2
 from sim.instruments.ranges import multilateration as ml
+from sim.instruments.ranges.twoplate_quad import log10_ratio_quantiles
 from sim.mc.runner import chunk_rng, run_chunks
 from sim.studies.design.chunks import brown_chain_chunk, brown_lsq, twoplate_chain_chunk
 
@@ -131,20 +136,27 @@ def _twoplate_data(cfg: dict):
     return TWO_PLATES, comp, g, sg, rw, fa
 
 
-def _twoplate_row(sim: dict, name: str, rw: dict, gcfg: dict) -> tuple[dict, np.ndarray]:
-    """One prior's row of ``bayes_twoplate.parquet`` from its chains, and the ratio samples."""
+def _twoplate_row(sim: dict, name: str, rw: dict, gcfg: dict, exact) -> tuple[dict, np.ndarray]:
+    """One prior's row of ``bayes_twoplate.parquet``: the ratio's quantiles by quadrature
+    (``exact``: :func:`~sim.instruments.ranges.twoplate_quad.log10_ratio_quantiles`), and the
+    chains' own width, length and diagnostics beside them; and the chains' ratio samples."""
     Y = sim["samples"].reshape(-1, 2)
     lc, lg = Y[:, 0], Y[:, 1]
     lrho = 2 * (lc - lg) / np.log(10)  # log10 of the ratio
     neff = float(_n_eff(sim).min())
-    q = np.quantile(lrho, [0.025, 0.5, 0.975])
-    se_w = np.hypot(quantile_se(lrho, 0.025, neff), quantile_se(lrho, 0.975, neff))
+    q, err = exact
+    cq = np.quantile(lrho, [0.025, 0.975])
     row = {"prior": name}
     for c, v in zip(("rho_q025", "rho_median", "rho_q975"), 10**q):
         row[c] = float(v)
     row["log10_width"] = float(q[2] - q[0])
-    row["log10_width_se"] = se_w
-    row["log10_q_se"] = max(quantile_se(lrho, p, neff) for p in (0.025, 0.5, 0.975))
+    row["quad_err"] = float(err.max())
+    row["chain_log10_width"] = float(cq[1] - cq[0])
+    row["chain_log10_width_se"] = float(
+        np.hypot(quantile_se(lrho, 0.025, neff), quantile_se(lrho, 0.975, neff))
+    )
+    # the shortest chain's kept steps in autocorrelation times of its slowest parameter
+    row["chain_tau"] = float((sim["samples"].shape[1] / sim["tau"].max(1)).min())
     row["sigma_c_median_um"] = float(np.median(np.exp(lc)))
     row["sigma_g_median_um"] = float(np.median(np.exp(lg)))
     row["tau_max"] = float(sim["tau"].max())
@@ -171,8 +183,10 @@ def twoplate_analysis(cfg: dict, ctx):
             "rho_median",
             "rho_q975",
             "log10_width",
-            "log10_width_se",
-            "log10_q_se",
+            "quad_err",
+            "chain_log10_width",
+            "chain_log10_width_se",
+            "chain_tau",
             "sigma_c_median_um",
             "sigma_g_median_um",
             "tau_max",
@@ -196,7 +210,8 @@ def twoplate_analysis(cfg: dict, ctx):
             label=f"emcee (two plates, {name})",
             ctx=ctx,
         )
-        row, samples[name] = _twoplate_row(sim, name, rw, gcfg)
+        exact = log10_ratio_quantiles(comp, g, prior)
+        row, samples[name] = _twoplate_row(sim, name, rw, gcfg, exact)
         for c, v in row.items():
             cols[c].append(v)
     vals = {"sg": sg, "rw_rows": [float(v) for v in rw["ratio"]]}

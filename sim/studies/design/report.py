@@ -272,7 +272,9 @@ _TWOPLATE_COLS = {
     "median": "rho_median",
     "97.5 %": "rho_q975",
     "width (decades)": "log10_width",
-    "MC s.e.": "log10_width_se",
+    "quadrature error": "quad_err",
+    "chain width": "chain_log10_width",
+    "chain length (tau)": "chain_tau",
     "sigma_c (um)": "sigma_c_median_um",
     "sigma_g (um)": "sigma_g_median_um",
     "tau max": "tau_max",
@@ -290,7 +292,9 @@ def _twoplate(out: Path) -> list[str]:
     return [
         "**Two-plate calibration (seed 001): variance components.** One simulated "
         "calibration of `gridplate_two_plates` (its defaults), the true grid coordinates "
-        "integrated out exactly. Posterior of sigma_c^2 / sigma_g^2 (= P_cx / P_x):",
+        "integrated out exactly. Posterior of sigma_c^2 / sigma_g^2 (= P_cx / P_x), its "
+        "quantiles by quadrature; the emcee chains' width and length (in autocorrelation "
+        "times) beside them as the cross-check:",
         md_table(
             list(_TWOPLATE_COLS),
             _columns(tp, tuple(_TWOPLATE_COLS.values()), range(len(tp["prior"]))),

@@ -168,18 +168,22 @@ def _tolerances(R: dict) -> dict:
     tp = R.get("twoplate")
     if tp is not None:
         f = tp["prior"].index("flat")
-        w_rel = 4 * tp["log10_width_se"][f] / tp["log10_width"][f]
-        q_rel = float(np.expm1(4 * np.log(10) * max(tp["log10_q_se"])))  # ratio quantiles
+        w_rel = 4 * tp["chain_log10_width_se"][f] / tp["chain_log10_width"][f]
+        s_rel = float(np.expm1(4 * np.log(10) * tp["chain_log10_width_se"][f]))  # chain sigmas
+        # the quadrature's quantiles: deterministic to its error (decades; ratios relative)
+        q_rel = float(np.expm1(4 * np.log(10) * max(tp["quad_err"])))
         tol["bayes_twoplate.parquet"] = {c: q_rel for c in ("rho_q025", "rho_median", "rho_q975")}
         tol["bayes_twoplate.parquet"].update(
             {
-                "log10_width": w_rel,
-                "log10_width_se": 0.5,
-                "log10_q_se": 0.5,
+                "log10_width": 4 * max(tp["quad_err"]) / min(tp["log10_width"]),
+                "quad_err": 1.0,
+                "chain_log10_width": w_rel,
+                "chain_log10_width_se": 0.5,
+                "chain_tau": 0.5,
                 "tau_max": 0.5,
                 "n_eff": 0.5,
-                "sigma_c_median_um": q_rel,
-                "sigma_g_median_um": q_rel,
+                "sigma_c_median_um": s_rel,
+                "sigma_g_median_um": s_rel,
             }
         )
     return {f: {c: tl.chain(rtol=r) for c, r in t.items()} for f, t in tol.items()}
