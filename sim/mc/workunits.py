@@ -122,6 +122,13 @@ BAYES_UNITS = 1.25
 BAYES_BYTES = 600.0
 
 
+#: brown_design's error-budget rows (sim.studies.design.errbudget.BUDGET_ROWS), each an
+#: adaptive run of up to budget.max_trials, and its emcee posteriors (Brown's, the two
+#: plates' flat and certificate), each bayes.chains chunks of one chain
+DESIGN_BUDGET_ROWS = 11
+DESIGN_POSTERIORS = 3
+
+
 def design_chunk_bytes(ch: float, P: float, n: float) -> float:
     """Bytes of one Monte-Carlo chunk of ``ch`` trials of ``n`` points seen from ``P``
     positions: the per-range arrays of every trial, and the (2n, 2n) inner-datum matrix and
@@ -161,7 +168,14 @@ def design_estimate(c: Mapping) -> tuple:
     budget = 6 * c.get("budget.max_trials", 0)
     walker_steps = c.get("bayes.walkers", 0) * c.get("bayes.steps", 0) * c.get("bayes.chains", 0)
     bayes = BAYES_UNITS * walker_steps
-    trials = T + cov_T + sw_T + budget
+    # the trials the run's bar counts, at most: every budget row up to budget.max_trials, the
+    # affine coverage case (coverage.trials and a sweep's), each posterior's chains (one chunk
+    # a chain); 6 rows and no chains were counted and the bar passed its total with chunks to
+    # come (an interrupt said every chunk was done: sim.mc.runner.RunContext.all_counted)
+    posteriors = DESIGN_POSTERIORS * c.get("bayes.chains", 0)
+    affine = cov_T + c.get("coverage.sweep_trials", 0)
+    trials = T + cov_T + sw_T + DESIGN_BUDGET_ROWS * c.get("budget.max_trials", 0)
+    trials += affine + posteriors
     adj = cells * 3 + T * 3 + cov_T * 2 + sw_T * 2 + budget + bayes
     n_paper = c.get("paper.grid", 5) ** 2
     nc = max(max_of(c.get("coverage.grids"), 5) ** 2, c.get("datum.grid", 5) ** 2)
