@@ -46,6 +46,8 @@ _HINTS = (  # message words -> config keys (the first that the study has is name
 
 
 def hint(msg: str, kind: str, schema, keys: tuple = ()) -> str:
+    """The advice that ends a failure's line: the first key of ``schema`` its words name
+    (:data:`_HINTS`), or for memory :func:`memory_hint`; ``""`` where nothing fits."""
     low = (msg + " " + kind).lower()
     for words, named in _HINTS:
         if any(w in low for w in words):
@@ -61,7 +63,7 @@ def memory_hint(keys: tuple) -> str:
     brown_dilution's region (``region.points``) failing under ``ulimit -v 1250000``."""
     limits = limits_set()
     return (
-        f" ({limits}: raise it, or reduce {keys_advice(keys)})"
+        f" ({limits}: raise {'them' if ', ' in limits else 'it'}, or reduce {keys_advice(keys)})"
         if limits
         else (f" (reduce {keys_advice(keys)})")
     )

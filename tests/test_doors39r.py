@@ -177,3 +177,9 @@ def test_a_run_out_of_memory_under_a_ulimit_names_it(monkeypatch):
         "(ulimit -v is 1400000 kB: raise it, or reduce chunk, trials or the sizes in the study "
         "file)"
     ), words
+    caps = {resource.RLIMIT_AS: 1_400_000 * 1024, resource.RLIMIT_DATA: 1_300_000 * 1024}
+    monkeypatch.setattr(  # both limits set: the advice raises them both
+        room.resource, "getrlimit", lambda r: (caps[r], real(r)[1]) if r in caps else real(r)
+    )
+    words = str(run_failure.numeric_failure(e, study, {"study": "brown_table1"}))
+    assert "ulimit -v is 1400000 kB, ulimit -d is 1300000 kB: raise them, or reduce" in words
