@@ -64,9 +64,12 @@ def show_target(where: Path) -> str:
     README.md says it): its name where ``sim show`` finds it by name (in ``results/`` or
     ``scratch/`` of :func:`base`), else its absolute path. ``sim show NAME`` of a run written
     to ``/tmp/NAME`` said "does not exist", or printed the committed ``results/NAME``."""
-    at = Path(os.path.abspath(where))
-    if any(at.parent == Path(os.path.abspath(base() / d)) for d in ("results", "scratch")):
-        return at.name
+    try:
+        at = Path(os.path.abspath(where))
+        if any(at.parent == Path(os.path.abspath(base() / d)) for d in ("results", "scratch")):
+            return at.name
+    except OSError:  # the working directory removed: ``.`` names no place (doors31b)
+        return str(where)
     return str(at)
 
 
