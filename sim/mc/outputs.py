@@ -84,8 +84,7 @@ def results_dirs(results: Path) -> list[Path]:
 
 
 def swap_dir(out: Path) -> Path:
-    """Where :func:`publish` moves the old results of ``out`` while it swaps the new ones in:
-    ``.<name>.old.<pid>``."""
+    """Where :func:`publish` keeps the old results of ``out`` during the swap: ``.<name>.old.<pid>``."""
     return out.parent / f".{out.name}.old.{os.getpid()}"
 
 
