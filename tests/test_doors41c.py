@@ -11,16 +11,30 @@ fix.
   current) and a README.md that guessed "a run with ``--no-figures``?". The flag is now a
   context variable (:func:`sim.report.plotting.without_figures`), which the threads a study
   runs its parts in take a copy of (:func:`sim.studies.design.parts.side_by_side`).
+* A second ``sim run`` of the same command, started while the first was between sealing its
+  staging directory and publishing it, after an earlier run of it had been killed between
+  publishing's two steps (its results still naming the results they replaced,
+  ``run.json`` ``replaced``): the first's sealed record is byte for byte the replaced one
+  (same config, same code), so the second took the running staging directory for the replaced
+  results left behind and removed it, lock file and all, before taking the lock; it then ran
+  the whole study beside the first and published (exit 0), and the first, every chunk
+  computed, ended "cannot be read as the run's record; run again" (exit 2). A staging
+  directory whose lock is held is never taken for replaced results
+  (:func:`sim.mc.left_behind.replaced_results`): the second is refused, naming the run.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 import threading
 from pathlib import Path
 
 import sim
+from sim import execute
+from sim.cli import main
+from sim.mc.storage import write_record
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -76,3 +90,32 @@ def test_a_run_without_figures_in_one_thread_leaves_another_threads_figures(tmp_
     assert drawn == ["network.png", "reliability.png"]  # before: none
     assert sorted(rec["figure_sha256"]) == drawn
     assert not list((tmp_path / "a").glob("*.png"))  # and the other run drew none
+
+
+def test_a_second_run_never_removes_a_running_runs_staging_directory(tmp_path, monkeypatch, capsys):
+    out = tmp_path / "X"
+    run = ["run", str(_study(tmp_path)), "--quiet", "--no-figures", "--out", str(out)]
+    assert main(run) == 0
+    sealed = (out / "run.json").read_bytes()
+    clean = {p.name: p.read_bytes() for p in out.glob("*.parquet")}
+    # what a run of the same command killed after its swap leaves: its record names the one
+    # it replaced (the same bytes: the same config and code)
+    replaced = hashlib.sha256(sealed).hexdigest()
+    write_record(out, {**json.loads(sealed), "replaced": replaced})
+    real, second = execute.publish, []
+
+    def publish(stage, to):  # sealed, about to publish: another `sim run` of it now
+        if not second:
+            second.append(None)
+            second[0] = main(run)
+        return real(stage, to)
+
+    monkeypatch.setattr(execute, "publish", publish)
+    capsys.readouterr()
+    assert main(run) == 0  # before: 2, "... cannot be read as the run's record; run again"
+    err = capsys.readouterr().err
+    assert second == [2]  # before: 0, the whole study run beside the first
+    assert "is being written by a running sim" in err
+    assert {p.name: p.read_bytes() for p in out.glob("*.parquet")} == clean
+    assert (out / "run.json").read_bytes() == sealed
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["X", "net.toml"]
