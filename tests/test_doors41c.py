@@ -21,6 +21,12 @@ fix.
   computed, ended "cannot be read as the run's record; run again" (exit 2). A staging
   directory whose lock is held is never taken for replaced results
   (:func:`sim.mc.left_behind.replaced_results`): the second is refused, naming the run.
+* ``sim report`` while a run published a study (``make reproduce`` in another terminal):
+  REPORT.md's text was built first, then every study's README.md written (seconds), then
+  REPORT.md written from that text, so a run published meanwhile left REPORT.md with the
+  replaced run's headline claims and consistent region beside the new run's directory and
+  README.md, exit 0. REPORT.md is built again when a study was published while the READMEs
+  were written (:func:`sim.report.markdown.write_report`).
 """
 
 from __future__ import annotations
@@ -28,13 +34,19 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import os
+import shutil
 import threading
 from pathlib import Path
+
+import pytest
+from conftest import tiny_overrides
 
 import sim
 from sim import execute
 from sim.cli import main
 from sim.mc.storage import write_record
+from sim.report import markdown
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -119,3 +131,37 @@ def test_a_second_run_never_removes_a_running_runs_staging_directory(tmp_path, m
     assert {p.name: p.read_bytes() for p in out.glob("*.parquet")} == clean
     assert (out / "run.json").read_bytes() == sealed
     assert sorted(p.name for p in tmp_path.iterdir()) == ["X", "net.toml"]
+
+
+@pytest.fixture(scope="module")
+def two_salsig_runs(tmp_path_factory):
+    """Tiny runs of ``salsig_encoders`` with the seeds 7 and 8 (other headline numbers)."""
+    root = tmp_path_factory.mktemp("salsig")
+    sets = tiny_overrides("salsig_encoders")
+    for seed in (7, 8):
+        run = ["run", str(ROOT / "studies" / "salsig_encoders.toml"), "--quiet", "--no-figures"]
+        assert main([*run, *sets, "--seed", str(seed), "--out", str(root / f"s{seed}")]) == 0
+    return root
+
+
+def test_report_of_a_study_published_meanwhile_is_of_the_new_run(
+    two_salsig_runs, tmp_path, monkeypatch
+):
+    results, name = tmp_path / "results", "salsig_encoders"
+    shutil.copytree(two_salsig_runs / "s7", results / name)
+    shutil.copytree(two_salsig_runs / "s8", tmp_path / "new")
+    real, done = markdown.write_run_readme, []
+
+    def write_run_readme(*args, **kwargs):  # a run of seed 8 publishes while READMEs are written
+        if not done:
+            done.append(1)
+            os.rename(results / name, tmp_path / f".{name}.old.1")
+            os.rename(tmp_path / "new", results / name)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(markdown, "write_run_readme", write_run_readme)
+    assert main(["report", "--results", str(results)]) == 0
+    monkeypatch.undo()
+    raced = (results / "REPORT.md").read_text(encoding="utf-8")
+    assert main(["report", "--results", str(results)]) == 0
+    assert raced == (results / "REPORT.md").read_text(encoding="utf-8")  # before: seed 7's
