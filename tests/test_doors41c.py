@@ -27,6 +27,11 @@ fix.
   replaced run's headline claims and consistent region beside the new run's directory and
   README.md, exit 0. REPORT.md is built again when a study was published while the READMEs
   were written (:func:`sim.report.markdown.write_report`).
+* The output of a run stopped before it published (killed, interrupted after its chunks:
+  only ``.DIR.partial`` is there) was "DIR does not exist" to ``sim show DIR`` and
+  ``sim.Results``, and "no study results" to ``sim report``, as if no run had been made:
+  nothing said that the run is unfinished and that the same command finishes it, or that a
+  run is writing it now (:func:`sim.mc.unfinished.unfinished`).
 """
 
 from __future__ import annotations
@@ -45,7 +50,8 @@ from conftest import tiny_overrides
 import sim
 from sim import execute
 from sim.cli import main
-from sim.mc.storage import write_record
+from sim.mc.outputs import stage_dir
+from sim.mc.storage import StageLock, write_record
 from sim.report import markdown
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -165,3 +171,33 @@ def test_report_of_a_study_published_meanwhile_is_of_the_new_run(
     raced = (results / "REPORT.md").read_text(encoding="utf-8")
     assert main(["report", "--results", str(results)]) == 0
     assert raced == (results / "REPORT.md").read_text(encoding="utf-8")  # before: seed 7's
+
+
+def test_the_output_of_a_run_stopped_before_it_published_is_said_unfinished(
+    tmp_path, monkeypatch, capsys
+):
+    out = tmp_path / "X"
+
+    def stopped(stage, store):  # every chunk done, stopped before it sealed and published
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(execute, "seal", stopped)
+    run = ["run", str(_study(tmp_path)), "--quiet", "--no-figures", "--out", str(out)]
+    assert main(run) == 130
+    monkeypatch.undo()
+    assert stage_dir(out).is_dir() and not out.exists()
+    capsys.readouterr()
+    finish = "its run did not finish"
+    assert main(["show", str(out)]) == 2
+    assert finish in capsys.readouterr().err  # before: "X does not exist"
+    assert main(["report", "--results", str(tmp_path)]) == 2
+    assert finish in capsys.readouterr().err  # before: "no study results in ..." alone
+    with pytest.raises(sim.ConfigError, match=finish):
+        sim.Results(out, "network").claims()
+    lock = StageLock(stage_dir(out)).acquire()  # a run writing it now
+    try:
+        assert main(["show", str(out)]) == 2
+        assert "a run is writing it now" in capsys.readouterr().err
+    finally:
+        lock.release()
+    assert main(run) == 0  # and the same command finishes it
