@@ -31,7 +31,7 @@ fix.
   only ``.DIR.partial`` is there) was "DIR does not exist" to ``sim show DIR`` and
   ``sim.Results``, and "no study results" to ``sim report``, as if no run had been made:
   nothing said that the run is unfinished and that the same command finishes it, or that a
-  run is writing it now (:func:`sim.mc.unfinished.unfinished`).
+  run is writing it now, or that it failed, and why (:func:`sim.mc.unfinished.unfinished`).
 """
 
 from __future__ import annotations

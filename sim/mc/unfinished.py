@@ -12,6 +12,7 @@ from pathlib import Path
 
 from sim.mc.dead_dirs import lock_held
 from sim.mc.outputs import STAGE_SUFFIX, stage_dir
+from sim.mc.storage import read_record
 
 __all__ = ["unfinished", "unfinished_in"]
 
@@ -27,6 +28,9 @@ def unfinished(d: Path) -> str | None:
         return None
     if lock_held(stage):
         return f"a run is writing it now (in {stage}); it is there when that run ends"
+    failed = (read_record(stage) or {}).get("failed")
+    if isinstance(failed, str):  # (a failure of the run itself: the same command fails again)
+        return f"its run failed ({' '.join(failed.split())[:200]}); {stage} keeps its chunks"
     return f"its run did not finish ({stage} holds it): the same command again finishes it"
 
 
