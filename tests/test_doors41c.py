@@ -32,6 +32,13 @@ fix.
   ``sim.Results``, and "no study results" to ``sim report``, as if no run had been made:
   nothing said that the run is unfinished and that the same command finishes it, or that a
   run is writing it now, or that it failed, and why (:func:`sim.mc.unfinished.unfinished`).
+* ``make verify`` while ``make rerun`` (another terminal) replaced a study's committed results
+  made with overrides by a run of others: verify re-ran the overrides it had read before, and
+  the comparison with the new results said they were "of another config than the re-run with
+  the run's overrides ... stale against <the study file> (edited since the run?)", a failure
+  recorded in ``reproducibility.parquet`` against the new tables, of which no re-run had been
+  made. It now says the results were replaced while verify re-ran them
+  (:func:`sim.report.verify.rerun._replaced_since`).
 """
 
 from __future__ import annotations
@@ -53,6 +60,7 @@ from sim.cli import main
 from sim.mc.outputs import stage_dir
 from sim.mc.storage import StageLock, write_record
 from sim.report import markdown
+from sim.report.verify import rerun as verify_rerun
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -201,3 +209,22 @@ def test_the_output_of_a_run_stopped_before_it_published_is_said_unfinished(
     finally:
         lock.release()
     assert main(run) == 0  # and the same command finishes it
+
+
+def test_verify_of_results_replaced_while_it_re_ran_them_says_so(
+    two_salsig_runs, tmp_path, monkeypatch
+):
+    results, name = tmp_path / "results", "salsig_encoders"
+    shutil.copytree(two_salsig_runs / "s7", results / name)
+
+    def rerun_study(d, study, target, *args):  # the re-run of seed 7's overrides, while a
+        os.rename(d, tmp_path / f".{name}.old.1")  # run of seed 8 publishes in d
+        shutil.copytree(two_salsig_runs / "s8", d)
+        shutil.copytree(two_salsig_runs / "s7", target)
+        return None
+
+    monkeypatch.setattr(verify_rerun, "rerun_study", rerun_study)
+    (comp,) = verify_rerun.verify(results, tmp_path / "scratch", studies=ROOT / "studies")
+    assert not comp.ok
+    assert "was replaced while verify re-ran it" in comp.failures[0]  # before: "stale against"
+    assert "(keys seed)" in comp.failures[0]
