@@ -39,6 +39,17 @@ fix.
   recorded in ``reproducibility.parquet`` against the new tables, of which no re-run had been
   made. It now says the results were replaced while verify re-ran them
   (:func:`sim.report.verify.rerun._replaced_since`).
+
+Held (found right): a sweep of three cells killed (SIGKILL) at its fifth table write, before
+and after sealing, after its README.md, after the swap, while removing the replaced results,
+before clearing stale swaps and at a record write of ``--overwrite`` over another seed's
+sweep: ``sim show`` (of the sweep and of a cell) and ``sim report`` show one whole run, and
+the same command again gives every table and ``run.json`` byte for byte as a clean run;
+two sweeps into one ``--out`` at once and ``python -m sim.batch`` while a ``sim run`` writes
+one of its results (the second refused naming the first's pid, by the command line, the API
+and the batch); two API runs in two threads on one ``out`` (the second named as a thread of
+this process); a cell's table edited and read through a symbolic link to the cell (the
+sweep's sha256 names it).
 """
 
 from __future__ import annotations
