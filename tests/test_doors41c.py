@@ -43,7 +43,8 @@ fix.
 Held (found right): a sweep of three cells killed (SIGKILL) at its fifth table write, before
 and after sealing, after its README.md, after the swap, while removing the replaced results,
 before clearing stale swaps and at a record write of ``--overwrite`` over another seed's
-sweep: ``sim show`` (of the sweep and of a cell) and ``sim report`` show one whole run, and
+sweep: ``sim show`` (of the sweep and of a cell) and ``sim report`` show one whole run (or,
+before a first publish, now say the run is unfinished), and
 the same command again gives every table and ``run.json`` byte for byte as a clean run;
 two sweeps into one ``--out`` at once and ``python -m sim.batch`` while a ``sim run`` writes
 one of its results (the second refused naming the first's pid, by the command line, the API
