@@ -49,8 +49,9 @@ the same command again gives every table and ``run.json`` byte for byte as a cle
 two sweeps into one ``--out`` at once and ``python -m sim.batch`` while a ``sim run`` writes
 one of its results (the second refused naming the first's pid, by the command line, the API
 and the batch); two API runs in two threads on one ``out`` (the second named as a thread of
-this process); a cell's table edited and read through a symbolic link to the cell (the
-sweep's sha256 names it).
+this process); ``sim show`` and ``Results.table`` of a sweep's cell while the sweep is
+replaced by another seed's (read again: one run); a cell's table edited and read through a
+symbolic link to the cell (the sweep's sha256 names it).
 """
 
 from __future__ import annotations
