@@ -23,6 +23,7 @@ import pyarrow.parquet as pq
 from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
 from sim.mc.storage import RECORD, config_hash, read_provenance, read_record, regular_text
+from sim.mc.unfinished import unfinished
 
 __all__ = [
     "another_run",
@@ -140,6 +141,8 @@ def why_not_a_dir(path: Path, of_a_run: bool) -> str:
     results removed since the run, or a path that never was) or something else."""
     if os.path.lexists(path):
         return "is not a results directory"
+    if (run := unfinished(path)) is not None:  # a run killed before it published
+        return f"does not exist: {run}"
     return "no longer exists (removed since the run)" if of_a_run else "does not exist"
 
 

@@ -19,6 +19,7 @@ from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.settle import settled
 from sim.mc.storage import umask_problem
+from sim.mc.unfinished import unfinished, unfinished_in
 from sim.places import base, shown_path
 from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, mixed_run
@@ -59,6 +60,8 @@ def show(args) -> int:
             else f" (nor is there a directory {' or '.join(str(b / args.dir) for b in where)})"
         )
         why = link_problem(d) or f"{what}{also}"
+        if (run := unfinished(d)) is not None:  # a run killed before it published
+            why = f"{what}: {run}"
         raise ConfigError("DIR", f"{args.dir} {why}")
     # read again when a run publishes d meanwhile: one run's claims were printed under the
     # other's configuration note (sim.mc.settle)
@@ -125,8 +128,11 @@ def report(results: Path) -> int:
                 f"{results} is one results directory, not a directory of them: give the "
                 f"directory that holds it (sim show {shlex.quote(str(results))} prints this one)",
             )
+        run = unfinished_in(results)
         raise ConfigError(
-            "--results", f"no study results in {results} (no */claims.parquet): nothing to report"
+            "--results",
+            f"no study results in {results} (no */claims.parquet): nothing to report"
+            + (f"; {run}" if run else ""),
         )
     if (why := umask_problem()) is not None:
         raise ConfigError(None, why)

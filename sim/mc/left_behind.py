@@ -9,7 +9,11 @@ have brought the old results back over the new ones). The new results name the r
 the results they replaced by its sha256 (``run.json`` ``replaced``): a staging directory
 holding exactly that record is removed before the next run starts, once every file of the
 user's in it is also in ``<out>`` (copied there before the swap); else the run is refused in
-one line naming the file.
+one line naming the file. A staging directory whose lock a run holds is never taken for them:
+that run's sealed record is byte for byte the replaced one when it re-runs their config with
+the same code (a second ``sim run`` of the same command removed the staging directory of a
+run about to publish, ran the study alongside it, and the first ended "cannot be read as the
+run's record").
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.dead_dirs import lock_held
 from sim.mc.publish import _foreign, _present, _remove_record_last, file_sha256
 from sim.mc.storage import RECORD, read_record
 
@@ -25,7 +30,8 @@ __all__ = ["replaced_results", "clear_replaced"]
 
 def replaced_results(stage: Path, out: Path) -> bool:
     """Whether ``stage`` holds the results that the run published in ``out`` replaced: its
-    run record is the one ``out``'s run record names as replaced."""
+    run record is the one ``out``'s run record names as replaced, and no run holds its lock
+    (module docstring)."""
     if stage.is_symlink() or not stage.is_dir() or out.is_symlink():
         return False
     rec = read_record(out)
@@ -33,7 +39,7 @@ def replaced_results(stage: Path, out: Path) -> bool:
     if not isinstance(want, str) or read_record(stage) is None:
         return False
     try:
-        return file_sha256(stage / RECORD) == want
+        return file_sha256(stage / RECORD) == want and not lock_held(stage)
     except OSError:
         return False
 

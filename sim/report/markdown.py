@@ -397,20 +397,25 @@ def write_report(
 ) -> Path:
     """Write each results directory's README.md (see
     :func:`sim.report.run_summary.write_run_readme`) and ``results/REPORT.md``
-    (:func:`build_report`); a REPORT.md there that the suite did not write is refused (one
-    line naming it), never replaced."""
+    (:func:`build_report`, built again when a run published a study while the READMEs were
+    written); a REPORT.md there that the suite did not write is refused (one line naming it),
+    never replaced."""
     results = Path(results)
     out = results / "REPORT.md"
     if out.is_symlink() or (out.exists() and not _ours(out)):
         raise ConfigError(
             "--results", f"{out} was not written by sim report; sim never replaces it"
         )
-    text = (
-        MARK + "\n" + _settled(results, lambda: build_report(results, get_study, design, studies))
-    )
+
+    def build() -> str:
+        return MARK + "\n" + build_report(results, get_study, design, studies)
+
+    text, read = _settled(results, build), _dirs(results)
     for d in sorted(results_dirs(results)):
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             _settled(results, lambda d=d: write_run_readme(d, get_study, design=design))
+    if _dirs(results) != read:  # a run published while the READMEs were written: REPORT.md
+        text = _settled(results, build)  # held the replaced run's claims beside the new run
     with atomic_path(out) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return out

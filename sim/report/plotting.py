@@ -12,6 +12,7 @@ import sys
 import threading
 import warnings
 from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Callable, Iterator, Sequence
 
@@ -246,8 +247,10 @@ def checking_figures(facts: dict | None = None) -> Iterator[dict[str, list[str]]
         _RECORDER = old
 
 
-#: set while a run draws no figures (:func:`without_figures`)
-_SKIP = threading.Event()
+#: True while a run draws no figures (:func:`without_figures`): a context variable, so that
+#: it holds for that run alone (a process-wide flag of the Python API's ``run(figures=False)``
+#: in one thread took the figures of a run in another thread, whose ``run.json`` said drawn)
+_SKIP: ContextVar[bool] = ContextVar("sim_without_figures", default=False)
 
 
 @contextmanager
@@ -255,21 +258,21 @@ def without_figures() -> Iterator[None]:
     """Inside, no figure is drawn or written (``sim run --no-figures``, and the re-runs of
     ``make verify``, which compares tables only): :func:`draw` skips its jobs, :func:`save`
     closes the figure without a file, and :func:`place_legend` skips its layout pass. The
-    tables are the same: no figure function writes a table from its drawing."""
-    was = _SKIP.is_set()
-    _SKIP.set()
+    tables are the same: no figure function writes a table from its drawing. It holds in this
+    thread's context (and in the threads a study runs its parts in, which take a copy of it:
+    :func:`sim.studies.design.parts.side_by_side`), never in another run's thread."""
+    token = _SKIP.set(True)
     try:
         yield
     finally:
-        if not was:
-            _SKIP.clear()
+        _SKIP.reset(token)
 
 
 def figures_off() -> bool:
     """True inside :func:`without_figures`: a figure function called outside :func:`draw`
     returns before it builds anything (building a figure only to close it unsaved would
     import pyplot and lay out every panel for nothing)."""
-    return _SKIP.is_set()
+    return _SKIP.get()
 
 
 #: matplotlib's warning for a character its font cannot draw (a network named "日本")
@@ -304,7 +307,7 @@ def save(fig, path: str | Path) -> Path:
     (the style's ``figure.dpi`` is its ``savefig.dpi``), so the boxes the check measures are
     the PNG's."""
     path = Path(path)
-    if _SKIP.is_set():  # a run without figures (:func:`without_figures`)
+    if _SKIP.get():  # a run without figures (:func:`without_figures`)
         plt.close(fig)
         return path
     with atomic_path(path) as tmp, warnings.catch_warnings(record=True) as caught:
@@ -335,7 +338,7 @@ def draw(jobs: Sequence[tuple[Callable, tuple]]) -> None:
     process, one at a time under :data:`DRAWING`. (Figures once went to the pool's idle
     workers; ``make bench`` found that it saved under 20 % of any study's time, so it went.)
     Nothing is drawn inside :func:`without_figures`."""
-    if _SKIP.is_set():
+    if _SKIP.get():
         return
     for fn, args in jobs:
         with DRAWING:
@@ -371,7 +374,7 @@ def place_legend(ax, *args, **kw):
     """``ax.legend(*args, **kw)`` at the first place inside the axes where it hides no data
     (markers, lines, bars: :func:`sim.report.figcheck.data_points`), else outside on the
     right. Call it once the axes' data and limits are final."""
-    if _SKIP.is_set():  # no figure will be saved: no layout pass to place it
+    if _SKIP.get():  # no figure will be saved: no layout pass to place it
         return ax.legend(*args, **kw)
     ax.figure.draw_without_rendering()  # the layout and text extents, no pixels
     return _place(ax, args, kw)[0]
@@ -381,9 +384,9 @@ def place_legends(axes, **kw) -> None:
     """:func:`place_legend` on each of ``axes`` (of one figure, every panel drawn): one layout
     pass for them all (a pass per legend cost about a second each on a sweep's 12 panels), and
     a new one after a legend placed outside its axes (that legend moves the panels)."""
-    laid_out = _SKIP.is_set()
+    laid_out = _SKIP.get()
     for ax in axes:
-        if _SKIP.is_set():
+        if _SKIP.get():
             ax.legend(**kw)
             continue
         if not laid_out:

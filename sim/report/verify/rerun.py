@@ -247,7 +247,9 @@ def verify(
             out.append(Comparison(d.name, failures=[mixed]))
             continue
         given: list[str] = []  # the run's overrides, re-run with it (sim.mc.overrides)
+        ran = None  # the config of the run the re-run reproduces
         if rerun:
+            ran = (read_record(d) or {}).get("config")
             given, bad = replayable(read_record(d) or {})
             if bad:  # never passed on: a run.json edited by hand adds no option to a re-run
                 why = f"{d / 'run.json'}: {bad} (edited by hand?): not re-run"
@@ -260,7 +262,7 @@ def verify(
                 out.append(Comparison(d.name, failures=[why], overrides=given))
                 continue
         sf = study_file(d, study, Path(studies)) if rerun else None
-        out.append(_settled(d, target, sf, mode, given))
+        out.append(_settled(d, target, sf, mode, given, ran))
     return out
 
 
@@ -268,14 +270,16 @@ def verify(
 SETTLE = 3
 
 
-def _settled(d: Path, target: Path, sf: Path | None, mode: str, given: list[str]) -> Comparison:
+def _settled(
+    d: Path, target: Path, sf: Path | None, mode: str, given: list[str], ran: object = None
+) -> Comparison:
     """:func:`_judge` of the committed results ``d``, made again when they changed while it
     read them: a ``make reproduce`` in another terminal that published new results of the
     study between its first table and its last (or after their run record was read) made a
     comparison of two runs' tables, a FAILED line of deviations that no re-run had."""
     for _ in range(SETTLE):
         before = _state(d)
-        comp = _judge(d, target, sf, mode, given)
+        comp = _judge(d, target, sf, mode, given, ran)
         if _state(d) == before:
             comp.tables, comp.overrides = before[-1], given
             return comp
@@ -298,11 +302,14 @@ def _state(d: Path) -> tuple:
     return (st.st_dev, st.st_ino, tables_digest(d))
 
 
-def _judge(d: Path, target: Path, sf: Path | None, mode: str, given: list[str]) -> Comparison:
+def _judge(
+    d: Path, target: Path, sf: Path | None, mode: str, given: list[str], ran: object = None
+) -> Comparison:
     """The comparison of the committed results ``d`` with the re-run ``target``: tables of two
     runs, results of another config, else every table by its rules (and, when one fails,
     whether the results were made by other code)."""
-    why = _not_as_written(d) or (_other_config(d, target, sf, given) if mode == "full" else None)
+    why = _not_as_written(d) or _replaced_since(d, ran)
+    why = why or (_other_config(d, target, sf, given) if mode == "full" else None)
     if why:  # not a reproduction failure of these numbers: results of another input
         return Comparison(d.name, failures=[why])
     comp = compare_dirs(d, target, d.name, mode)
@@ -311,6 +318,23 @@ def _judge(d: Path, target: Path, sf: Path | None, mode: str, given: list[str]) 
     if not comp.ok and (older := _other_code(d, target)):  # why, before the deviations
         comp.failures.insert(0, older)  # (first: stale results are made again, edits and all)
     return comp
+
+
+def _replaced_since(d: Path, ran: object) -> str | None:
+    """That the committed results ``d`` are no longer those of the config ``ran`` they held when
+    their re-run started (``make rerun`` in another terminal published a run of other
+    overrides there meanwhile), or None: the re-run reproduces the replaced results, and the
+    comparison said that these were "stale against the study file (edited since the run?)"
+    and recorded them as failing, results no re-run had been made of."""
+    now = (read_record(d) or {}).get("config")
+    if not isinstance(ran, dict) or not isinstance(now, dict) or now == ran:
+        return None
+    keys = sorted(k for k in set(ran) | set(now) if ran.get(k) != now.get(k))
+    return (
+        f"{d} was replaced while verify re-ran it, by a run of another config (keys "
+        f"{', '.join(keys[:5])}{', ...' if len(keys) > 5 else ''}): the re-run reproduces the "
+        "results it replaced; verify again"
+    )
 
 
 def _edited(d: Path) -> str | None:

@@ -14,6 +14,7 @@ each part assembles its chunks in chunk order.
 from __future__ import annotations
 
 from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
+from contextvars import copy_context
 from typing import Callable, Mapping
 
 __all__ = ["side_by_side", "parallel"]
@@ -27,13 +28,14 @@ def parallel(ctx) -> bool:
 
 def side_by_side(tasks: Mapping[str, Callable[[], object]], ctx) -> dict:
     """``{name: task()}`` for independent callables: in threads when :func:`parallel`,
-    else in the given order. An exception of a task (or an interrupt) is raised here at
-    once."""
+    else in the given order, each thread in a copy of the caller's context (a run without
+    figures draws none there either: :func:`sim.report.plotting.without_figures`). An
+    exception of a task (or an interrupt) is raised here at once."""
     if len(tasks) < 2 or not parallel(ctx):
         return {k: f() for k, f in tasks.items()}
     tp = ThreadPoolExecutor(len(tasks), thread_name_prefix="brown_design")
     try:
-        futs = {k: tp.submit(f) for k, f in tasks.items()}
+        futs = {k: tp.submit(copy_context().run, f) for k, f in tasks.items()}
         done, _ = wait(futs.values(), return_when=FIRST_EXCEPTION)
         for f in done:
             if f.exception() is not None:
