@@ -12,6 +12,7 @@ very name exists (an earlier ``./~`` is the caller's to read).
 
 from __future__ import annotations
 
+import ast
 import errno
 import os
 from pathlib import Path
@@ -194,7 +195,9 @@ def cell_mixed(d: Path, names: list[str] | None = None) -> str | None:
         if not isinstance(mine, dict):
             continue  # no provenance: read as it is (mixed_run's missing_ok)
         diff = [
-            f"{k} = {mine.get(k)!r}, the cell's {v!r}" for k, v in want.items() if mine.get(k) != v
+            f"{k} = {mine.get(k)!r}, the cell's {v!r}"
+            for k, v in want.items()
+            if not _same_value(mine.get(k), v)
         ]
         if prov.get("code_hash") != record.get("code_hash"):
             diff.append("made by other code than its sweep")
@@ -204,6 +207,22 @@ def cell_mixed(d: Path, names: list[str] | None = None) -> str | None:
                 "holds another cell's or run's results; run the sweep again"
             )
     return None
+
+
+def _same_value(mine: Any, row: Any) -> bool:
+    """Whether a cell's config value ``mine`` is the value ``sweep.parquet`` records for it
+    (``row``): a list swept (``network.grids``) is recorded as its ``repr`` (the text of the
+    study file's order of keys), read back here; one that cannot be read back is not held
+    against the cell. Every cell of a sweep over ``network.grids`` was refused as "not a
+    table of the cell" (its grids against their own text)."""
+    if isinstance(mine, (list, dict)) and isinstance(row, str):
+        if len(row) > 100_000:
+            return True
+        try:
+            row = ast.literal_eval(row)
+        except (ValueError, TypeError, SyntaxError, MemoryError, RecursionError):
+            return True
+    return mine == row
 
 
 def another_run(out: Path, study: str) -> str:

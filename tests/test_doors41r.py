@@ -1,0 +1,84 @@
+"""The classes of the review R41 (last session's change, 407e16e0..551b69ac, read for defects:
+a check a nearby input slips past, an error path that raises, a refusal of something
+legitimate, a rule whose numbers are wrong), one case each; each failed on the code before its
+fix.
+
+* Every cell of a sweep over a key whose values are lists (``network.grids``, the very sweep
+  :mod:`sim.report.labels` was written for) was refused by ``sim show CELL`` and
+  ``sim.Results(CELL).table(...)`` as "not a table of the cell ... the cell holds another
+  cell's or run's results" (F39's :func:`sim.api_paths.cell_mixed`): ``sweep.parquet`` records
+  a swept list as its ``repr``, and the cell's config holds the list. The text is read back
+  (``ast.literal_eval``) before the two are compared; a cell's table copied from another cell
+  is still refused.
+* A table of a finished run with a column retyped by hand to a timestamp of nanoseconds ended
+  ``sim show`` on pyarrow's "Nanosecond resolution temporal type 1 is not safely convertible
+  to microseconds ... Install pandas" and ``sim.Results.table`` on a traceback: V40's values
+  digest (:func:`sim.mc.table_shape.values_digest`) is taken of every column before the
+  columns' kinds are compared, through ``to_pylist``. Such values are now digested as Arrow
+  bytes, and the readers name the column retyped, as before V40.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+from conftest import ROOT
+from oneline import one_line
+
+import sim
+from sim.cli import main
+from sim.mc.config import ConfigError
+
+GRID = '{{ prefix = "G", nx = 5, ny = 5, spacing_mm = 40.0, role = "observed", sigma_mm = {} }}'
+
+
+@pytest.fixture(scope="module")
+def grids_sweep(tmp_path_factory) -> Path:
+    """A network sweep over ``network.grids`` (two cells), run once for the module."""
+    d = tmp_path_factory.mktemp("grids")
+    text = (ROOT / "studies" / "network_plate.toml").read_text()
+    f = d / "grids.toml"
+    f.write_text(
+        text.replace("trials = 2000", "trials = 40").replace("chunk = 100", "chunk = 2")
+        + f"\n[sweep]\nnetwork.grids = [[{GRID.format(0.0012)}], [{GRID.format(0.0024)}]]\n"
+    )
+    out = d / "out"
+    assert main(["run", str(f), "--out", str(out), "--quiet", "--no-figures"]) == 0
+    return out
+
+
+def test_cell_of_a_list_sweep_is_read(grids_sweep, capsys):
+    cell = grids_sweep / "cells" / "cell0000_r0"
+    assert sim.Results(cell, "network").table("claims").num_rows > 0
+    capsys.readouterr()
+    assert main(["show", str(cell)]) == 0
+    assert "is not a table of the cell" not in capsys.readouterr().err
+
+
+def test_cell_swapped_still_refused(grids_sweep, tmp_path, capsys):
+    d = tmp_path / "sweep"
+    shutil.copytree(grids_sweep, d)
+    a, b = d / "cells" / "cell0000_r0", d / "cells" / "cell0001_r0"
+    shutil.copy(b / "claims.parquet", a / "claims.parquet")
+    with pytest.raises(ConfigError) as e:
+        sim.Results(a, "network").table("claims")
+    assert "claims.parquet" in str(e.value)
+    one_line(capsys, main(["show", str(a)]), "claims.parquet")
+
+
+def test_column_retyped_to_nanoseconds(tiny_run, tmp_path, capsys):
+    d = tmp_path / "network_plate"
+    shutil.copytree(tiny_run("network_plate"), d)
+    p = d / "claims.parquet"
+    t = pq.read_table(p)
+    i = t.schema.get_field_index("value")
+    ns = pa.array([1] * t.num_rows, pa.timestamp("ns"))
+    pq.write_table(t.set_column(i, "value", ns).replace_schema_metadata(t.schema.metadata), p)
+    one_line(capsys, main(["show", str(d)]), "claims.parquet", "'value'", "timestamp")
+    with pytest.raises(ConfigError) as e:
+        sim.Results(d, "network").table("claims")
+    assert "'value'" in str(e.value) and "timestamp" in str(e.value)
