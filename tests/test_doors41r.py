@@ -16,6 +16,10 @@ fix.
   digest (:func:`sim.mc.table_shape.values_digest`) is taken of every column before the
   columns' kinds are compared, through ``to_pylist``. Such values are now digested as Arrow
   bytes, and the readers name the column retyped, as before V40.
+* L39's unit hint told ``--set plate.spacing_mm=".5mm"`` to "write .5" (and ``"07mm"`` "write
+  07", ``"5.mm"`` "write 5."), a value ``--set`` refuses in turn ("got the text '.5': write
+  0.5"), and ``"1e999 mm"`` to "write 1e999", an infinite number: the number is now written
+  as TOML writes it (``0.5``, ``7``, ``5.0``), and a finite one asked for where there is none.
 """
 
 from __future__ import annotations
@@ -82,3 +86,13 @@ def test_column_retyped_to_nanoseconds(tiny_run, tmp_path, capsys):
     with pytest.raises(ConfigError) as e:
         sim.Results(d, "network").table("claims")
     assert "'value'" in str(e.value) and "timestamp" in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "typed, advice",
+    [(".5mm", "write 0.5)"), ("07mm", "write 7)"), ("5.mm", "write 5.0)"), ("1e999 mm", "finite")],
+)
+def test_unit_hint_writes_toml(typed, advice, capsys):
+    f = ROOT / "studies" / "gridplate_two_plates.toml"
+    rc = main(["check", str(f), "--set", f'plate.spacing_mm="{typed}"'])
+    one_line(capsys, rc, "plate.spacing_mm", "(_mm)", advice)
