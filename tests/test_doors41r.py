@@ -20,6 +20,15 @@ fix.
   07", ``"5.mm"`` "write 5."), a value ``--set`` refuses in turn ("got the text '.5': write
   0.5"), and ``"1e999 mm"`` to "write 1e999", an infinite number: the number is now written
   as TOML writes it (``0.5``, ``7``, ``5.0``), and a finite one asked for where there is none.
+* An interrupt of ``sim run`` of agnard_block in its Table 1 scanner region said "every chunk
+  was done and is kept: run the same command again to write the results from them (no trial
+  is computed again)" with most of the region's chunks to come: L39's "every chunk done" (the
+  bar has counted the estimate's trials; R40 made brown_design's estimate count every part)
+  met agnard's estimate, which counted neither region (the tiny run: 10 trials estimated, 48
+  on the bar). Nor did its work count the scanner region: ``table1.trials = 10000`` with
+  ``table1.points = 256`` passed ``sim check`` with the defaults' estimate (6.2 minutes of one
+  core). Both regions are now counted (:func:`sim.mc.agnard_size.agnard_estimate`, a scanner
+  vector's block solves measured: the defaults' estimate is 7 minutes).
 """
 
 from __future__ import annotations
@@ -30,7 +39,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
-from conftest import ROOT
+from conftest import ROOT, tiny_overrides
 from oneline import one_line
 
 import sim
@@ -96,3 +105,28 @@ def test_unit_hint_writes_toml(typed, advice, capsys):
     f = ROOT / "studies" / "gridplate_two_plates.toml"
     rc = main(["check", str(f), "--set", f'plate.spacing_mm="{typed}"'])
     one_line(capsys, rc, "plate.spacing_mm", "(_mm)", advice)
+
+
+def test_agnard_interrupt_in_scanner_region_says_chunks_missing(tmp_path, monkeypatch, capsys):
+    import importlib
+
+    chunks = importlib.import_module("sim.studies.agnard.chunks")
+    real, calls = chunks.table1_chunk, []
+
+    def second_stops(*a, **k):  # Ctrl-C in the scanner region's second chunk of 20
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(chunks, "table1_chunk", second_stops)
+    f = ROOT / "studies" / "agnard_block.toml"
+    run = ["run", str(f), "--quiet", "--no-figures", "--out", str(tmp_path / "A")]
+    rc = main(run + tiny_overrides("agnard_block"))
+    one_line(capsys, rc, "run the same command again to finish the missing chunks", code=130)
+
+
+def test_agnard_estimate_counts_the_scanner_region(capsys):
+    f = ROOT / "studies" / "agnard_block.toml"
+    big = ["--set", "table1.trials=10000", "--set", "table1.points=256"]
+    one_line(capsys, main(["check", str(f), *big]), "adjustments", "over the limit")
