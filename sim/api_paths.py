@@ -31,6 +31,7 @@ __all__ = [
     "absolute_path",
     "cell_chunks",
     "cell_mixed",
+    "study_runs_in",
     "chunks_recorded",
     "too_long",
     "why_not_a_dir",
@@ -207,6 +208,30 @@ def cell_mixed(d: Path, names: list[str] | None = None) -> str | None:
                 "holds another cell's or run's results; run the sweep again"
             )
     return None
+
+
+def study_runs_in(root: Path, study: str, most: int = 500) -> list[Path]:
+    """The results directories of ``study`` directly inside ``root`` (a results root: the
+    project's ``results/``, a batch's ``--results``), by their run record's study: a network's
+    is named by its study file (``results/network_plate``), not ``results/network``, and
+    ``Results(root, "network").names()`` of such a root was ``[]``. At most ``most`` entries
+    of ``root`` are looked at."""
+    found = []
+    try:
+        entries = sorted(os.scandir(root), key=lambda e: e.name)[:most]
+    except OSError:
+        return []
+    for e in entries:
+        try:
+            if not e.is_dir() or not (Path(e.path) / RECORD).is_file():
+                continue
+        except OSError:
+            continue
+        rec = read_record(Path(e.path))
+        cfg = rec.get("config") if isinstance(rec, dict) else None
+        if isinstance(cfg, dict) and cfg.get("study") == study:
+            found.append(Path(e.path))
+    return found
 
 
 def _same_value(mine: Any, row: Any) -> bool:

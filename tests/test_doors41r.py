@@ -29,6 +29,12 @@ fix.
   ``table1.points = 256`` passed ``sim check`` with the defaults' estimate (6.2 minutes of one
   core). Both regions are now counted (:func:`sim.mc.agnard_size.agnard_estimate`, a scanner
   vector's block solves measured: the defaults' estimate is 7 minutes).
+* ``sim.Results(root, "network").names()`` of a results root (a batch's ``--results``, the
+  project's ``results/``) was ``[]``, exit 0: D39's refusal of a root looks for
+  ``root/<study>``, and a network's results are named by its study file
+  (``network_plate``); of a directory without a table it was ``[]`` too. The root's
+  directories of the study are found by their run record and named; a directory without a
+  table is "not a results directory (no tables)", as ``table()`` says.
 """
 
 from __future__ import annotations
@@ -130,3 +136,15 @@ def test_agnard_estimate_counts_the_scanner_region(capsys):
     f = ROOT / "studies" / "agnard_block.toml"
     big = ["--set", "table1.trials=10000", "--set", "table1.points=256"]
     one_line(capsys, main(["check", str(f), *big]), "adjustments", "over the limit")
+
+
+def test_names_of_a_results_root_of_networks(grids_sweep, tmp_path):
+    root = tmp_path / "root"
+    root.mkdir()
+    shutil.copytree(grids_sweep, root / "grids")
+    with pytest.raises(ConfigError) as e:
+        sim.Results(root, "network").names()
+    assert "not a results directory" in str(e.value) and str(root / "grids") in str(e.value)
+    with pytest.raises(ConfigError) as e:
+        sim.Results(root, "wolf_polynomial").names()
+    assert "not a results directory (no tables)" in str(e.value)
