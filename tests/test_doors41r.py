@@ -35,6 +35,13 @@ fix.
   (``network_plate``); of a directory without a table it was ``[]`` too. The root's
   directories of the study are found by their run record and named; a directory without a
   table is "not a results directory (no tables)", as ``table()`` says.
+* P39 gave the median of gridplate_two_plates' self-check its distribution-free interval and
+  left :func:`sim.studies.gridplate.claims.quantile_ci` clipping its order statistics to the
+  sample: the 95th percentile of the re-weighting counts (``twoplate.weight_ratio.
+  reweight_trials``) took the sample's largest as its upper end below 72 values (it covers
+  the percentile about 60 % of the time at 24, 23 % at 6), and at ``trials = 6`` (24
+  adjustments) the configured inputs' outcome held on [1, 1]. Without an order statistic
+  above it the interval now reaches the most re-weightings counted (undecided there).
 """
 
 from __future__ import annotations
@@ -148,3 +155,15 @@ def test_names_of_a_results_root_of_networks(grids_sweep, tmp_path):
     with pytest.raises(ConfigError) as e:
         sim.Results(root, "wolf_polynomial").names()
     assert "not a results directory (no tables)" in str(e.value)
+
+
+def test_gridplate_95th_percentile_of_too_few_is_undecided(tmp_path):
+    f = ROOT / "studies" / "gridplate_two_plates.toml"
+    sets = tiny_overrides("gridplate_two_plates")[1::2]  # its --set values, sized down
+    sets = [kv for kv in sets if not kv.startswith(("trials=", "chunk="))] + ["trials=6", "chunk=1"]
+    small = [w for kv in sets for w in ("--set", kv)]
+    out = tmp_path / "G"
+    assert main(["run", str(f), "--out", str(out), "--quiet", "--no-figures", *small]) == 0
+    rows = sim.Results(out, "gridplate_two_plates").claims().to_pylist()
+    note = next(r["note"] for r in rows if r["claim"].endswith("reweight_trials"))
+    assert "at the configured inputs" in note and "outcome inconclusive" in note, note
