@@ -38,6 +38,7 @@ from sim.api_paths import (
     cell_chunks,
     cell_mixed,
     chunks_recorded,
+    study_runs_in,
     why_not_a_dir,
     why_unread,
 )
@@ -117,7 +118,11 @@ class Results:
         (``sim.Results("results", "network")``, for ``results/network``), else ""."""
         inner = self.path / self.study
         if not os.path.isdir(inner) or not any(inner.glob("*.parquet")):  # glob: ENAMETOOLONG
-            return ""
+            runs = study_runs_in(self.path, self.study)  # a network's: by its study file's name
+            if not runs:
+                return ""
+            more = f" (and {len(runs) - 1} more)" if len(runs) > 1 else ""
+            return f"; {runs[0]}{more} holds the study's results: give that path"
         return f"; {inner} holds the study's results: give that path"
 
     def _dataset(self, name: str) -> bool:
@@ -138,6 +143,8 @@ class Results:
         within = "" if names else self._within()
         if within:  # a results root (results/ and its verify record): [], or 'verify''s tables
             raise ConfigError("path", f"{self.path} is not a results directory{within}")
+        if not files:  # as table() says it: [] told nothing (a batch's --results of networks)
+            raise ConfigError("path", f"{self.path} is not a results directory (no tables)")
         if files and not names:  # another study's run: its tables, none of which table() reads
             whose = sorted({repr(o) for p in files if isinstance(o := _owner(p), str)})
             raise ConfigError(

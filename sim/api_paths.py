@@ -12,6 +12,7 @@ very name exists (an earlier ``./~`` is the caller's to read).
 
 from __future__ import annotations
 
+import ast
 import errno
 import os
 from pathlib import Path
@@ -31,6 +32,7 @@ __all__ = [
     "absolute_path",
     "cell_chunks",
     "cell_mixed",
+    "study_runs_in",
     "chunks_recorded",
     "too_long",
     "why_not_a_dir",
@@ -197,7 +199,9 @@ def cell_mixed(d: Path, names: list[str] | None = None) -> str | None:
         if not isinstance(mine, dict):
             continue  # no provenance: read as it is (mixed_run's missing_ok)
         diff = [
-            f"{k} = {mine.get(k)!r}, the cell's {v!r}" for k, v in want.items() if mine.get(k) != v
+            f"{k} = {mine.get(k)!r}, the cell's {v!r}"
+            for k, v in want.items()
+            if not _same_value(mine.get(k), v)
         ]
         if prov.get("code_hash") != record.get("code_hash"):
             diff.append("made by other code than its sweep")
@@ -207,6 +211,46 @@ def cell_mixed(d: Path, names: list[str] | None = None) -> str | None:
                 "holds another cell's or run's results; run the sweep again"
             )
     return None
+
+
+def study_runs_in(root: Path, study: str, most: int = 500) -> list[Path]:
+    """The results directories of ``study`` directly inside ``root`` (a results root: the
+    project's ``results/``, a batch's ``--results``), by their run record's study: a network's
+    is named by its study file (``results/network_plate``), not ``results/network``, and
+    ``Results(root, "network").names()`` of such a root was ``[]``. At most ``most`` entries
+    of ``root`` are looked at."""
+    found = []
+    try:
+        entries = sorted(os.scandir(root), key=lambda e: e.name)[:most]
+    except OSError:
+        return []
+    for e in entries:
+        try:
+            if not e.is_dir() or not (Path(e.path) / RECORD).is_file():
+                continue
+        except OSError:
+            continue
+        rec = read_record(Path(e.path))
+        cfg = rec.get("config") if isinstance(rec, dict) else None
+        if isinstance(cfg, dict) and cfg.get("study") == study:
+            found.append(Path(e.path))
+    return found
+
+
+def _same_value(mine: Any, row: Any) -> bool:
+    """Whether a cell's config value ``mine`` is the value ``sweep.parquet`` records for it
+    (``row``): a list swept (``network.grids``) is recorded as its ``repr`` (the text of the
+    study file's order of keys), read back here; one that cannot be read back is not held
+    against the cell. Every cell of a sweep over ``network.grids`` was refused as "not a
+    table of the cell" (its grids against their own text)."""
+    if isinstance(mine, (list, dict)) and isinstance(row, str):
+        if len(row) > 100_000:
+            return True
+        try:
+            row = ast.literal_eval(row)
+        except (ValueError, TypeError, SyntaxError, MemoryError, RecursionError):
+            return True
+    return mine == row
 
 
 def another_run(out: Path, study: str) -> str:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Mapping
 
-from sim.mc.workunits import COPIES, F8, grid_count
+from sim.mc.workunits import COPIES, F8, grid_count, region_points
 from sim.mc.workunits import n_of as _n
 
 __all__ = ["agnard_estimate", "AGNARD_MODEL_UNITS", "AGNARD_POINT_UNITS", "AGNARD_CUBE_UNITS"]
@@ -28,6 +28,12 @@ AGNARD_MODEL_UNITS = 3.5
 #: ground points were estimated 17 times under their time: the study's 500 trials, 76
 #: minutes of the main part alone, passed as 4 minutes
 AGNARD_POINT_UNITS = 0.25
+#: block solves (:data:`AGNARD_MODEL_UNITS` a model, and the ground points') one scanner
+#: vector of the Table 1 region costs a trial (its 21- and 5-control layouts, snooped on
+#: the configured scanner's blocks; measured, one core, the 2 x 8 block: 31 ms a vector and
+#: trial, 20 trials x 16 vectors). Not counted, ``table1.trials = 10000`` and
+#: ``table1.points = 256`` passed ``sim check`` with the estimate of the defaults
+AGNARD_VECTOR_SOLVES = 11.0
 #: the paper's ground points, with which :data:`AGNARD_MODEL_UNITS` was measured
 AGNARD_PAPER_POINTS = 178
 #: unit adjustments a snooped block adjustment costs per model cubed: the work of a trial of
@@ -58,7 +64,13 @@ def agnard_estimate(c: Mapping) -> tuple:
     tT, bT = c.get("tradeoff.trials", 0), c.get("tradeoff.block_trials", 0)
     dp, rc = _n(c.get("tradeoff.dpis", [])), _n(c.get("tradeoff.recentre_px", []))
     sT, s_cells = c.get("sweep.trials", 0), _n(c.get("sweep.five_inset", []))  # swept layout
-    trials = T + tT * (dp + rc) + bT * len(sizes) + sT * s_cells
+    # the regions' runs on the bar: the five-point one's region.trials blocks once (its half
+    # with the projection centres reuses them), the scanner region's table1.trials blocks its
+    # design and each round: uncounted, the bar of the tiny run was "full" at 10 of its 48
+    # trials and an interrupt said every chunk was done (sim.mc.runner.RunContext.all_counted)
+    t1T, t1_rounds = c.get("table1.trials", 0), c.get("table1.rounds", 0)
+    regions_T = c.get("region.trials", 0) + t1T * (1 + t1_rounds)
+    trials = T + tT * (dp + rc) + bT * len(sizes) + sT * s_cells + regions_T
     snoop = 1 + c.get("snoop.max_reject", 0)
     w, wt = AGNARD_MODEL_UNITS * M, AGNARD_MODEL_UNITS * Mt  # unit adjustments a block solve
     ws = w + AGNARD_CUBE_UNITS * M**3  # a snooped one
@@ -76,6 +88,10 @@ def agnard_estimate(c: Mapping) -> tuple:
         + bT * len(sizes) * 2 * (wt + pt)
         + sT * s_cells * 3 * (snoop * ws + p)
         + rT * r_pts * 2 * (w + p)
+        + t1T
+        * (region_points(c, "table1.points", "table1.rounds") + 1)
+        * AGNARD_VECTOR_SOLVES
+        * (w + p)
     )
     # reduced normal equations of the models (7 x 7 blocks coupled through the points); the
     # block-size trade-off bounds its chunk by the pair blocks (4e6 floats)

@@ -22,6 +22,8 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from sim.mc.numtext import number_text
+
 __all__ = ["LONG_DIGITS", "LONG_WORD", "cut_text", "shown", "shorten", "key_text", "near_keys"]
 __all__ += ["unit_hint"]
 
@@ -143,9 +145,10 @@ def unit_hint(key: str, text: str) -> str:
     if m is None:
         return ""
     number, unit = m.groups()
+    number = number_text(number)  # as TOML writes it: ".5mm" was told "write .5", refused too
     stem, _, own = key.rpartition(".")[2].rpartition("_")
     if stem and own in _UNITS:
-        if unit.lower().replace("\u00b5", "u") == own.lower():
-            return f": the unit is in the key's name (_{own}): write {number}"
+        if unit.lower().replace("\u00b5", "u") == own.lower():  # 1e999: no number to write
+            return f": the unit is in the key's name (_{own}): write {number or 'a finite number'}"
         return f": the key's unit is {own}, in its name: write the number alone, in {own}"
     return ": write the number alone, without a unit"

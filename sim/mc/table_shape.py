@@ -96,8 +96,23 @@ def values_digest(col: pa.ChunkedArray) -> str:
         else:
             raise TypeError(t)
     except (TypeError, ValueError, pa.ArrowException):  # text, lists, an int over int64's range
-        h.update(json.dumps(col.to_pylist(), default=repr).encode("utf-8", "surrogatepass"))
+        h.update(_as_text(col))
     return h.hexdigest()[:16]
+
+
+def _as_text(col: pa.ChunkedArray) -> bytes:
+    """A column's values as JSON bytes, or, for values Python cannot hold (a timestamp of
+    nanoseconds put in by hand: "not safely convertible to microseconds"), its Arrow bytes.
+    The shape of every table is taken before its columns' kinds are compared: such a column
+    ended ``sim show`` on pyarrow's words and ``Results.table`` on a traceback."""
+    try:
+        return json.dumps(col.to_pylist(), default=repr).encode("utf-8", "surrogatepass")
+    except (TypeError, ValueError, OverflowError, RecursionError, pa.ArrowException):
+        sink = pa.BufferOutputStream()
+        one = pa.table({"c": col.combine_chunks()})
+        with pa.ipc.new_stream(sink, one.schema) as w:
+            w.write_table(one)
+        return sink.getvalue().to_pybytes()
 
 
 def shape(table: pa.Table) -> dict:
