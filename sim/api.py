@@ -168,7 +168,9 @@ class Results:
                 "path", f"{self.path} is not a results directory (no tables){self._within()}"
             )
         if not there and p.name in run_tables(self.path, self.study):  # not "has no table"
-            raise ConfigError("table", f"{p} is missing: its run wrote it (removed by hand?)")
+            why = "the committed results/ hold no chunks; removed by hand?): run the study again"
+            why = why if dataset else "removed by hand?)"
+            raise ConfigError("table", f"{p} is missing: its run wrote it ({why}")
         if not there:
             raise ConfigError(
                 "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"

@@ -57,13 +57,17 @@ def check_owner(p: Path, study: str) -> None:
 
 def run_tables(d: Path, study: str) -> set[str]:
     """The table files the run of ``study`` in ``d`` recorded in its ``run.json`` (none: no
-    record, or another study's)."""
+    record, or another study's), and ``trials`` where it recorded chunks (the committed
+    results hold none: ``table("trials")`` said the study "has no table 'trials'")."""
     rec = read_record(d)
     config = rec.get("config") if isinstance(rec, dict) else None
     tables = rec.get("table_sha256") if isinstance(config, dict) else None
     if not isinstance(config, dict) or config.get("study") != study or not isinstance(tables, dict):
         return set()
-    return {n for n in tables if isinstance(n, str) and "/" not in n}
+    chunks = (
+        {"trials"} if isinstance(rec.get("chunk_sha256"), dict) and rec["chunk_sha256"] else set()
+    )
+    return {n for n in tables if isinstance(n, str) and "/" not in n} | chunks
 
 
 def stale_warning(d: Path) -> None:

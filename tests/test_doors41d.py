@@ -1,0 +1,58 @@
+"""A new user's first hour, the docs tried as written (sweep doors41d): README.md and every
+page docs/index.md links, their commands run in a fresh clone, their examples copied and
+edited. Each class was found false and fixed; each test fails on the code or page before its
+fix:
+
+* docs/python.md: ``table("trials")`` is "else the chunk dataset", and "a table the run wrote
+  and that was removed since is named as removed, not as one the study has not". Of the
+  committed results (``sim.Results("results/brown_table1", "brown_table1")``, whose run wrote
+  20 chunks and recorded their sha256; the clone holds none: ``results/*/trials/`` is not
+  committed) ``table("trials")`` and ``table("chunks")`` said "brown_table1 has no table
+  'trials'; it has claims, ...", a table the study writes. They now say the run wrote it and
+  the committed results hold no chunks: run the study again.
+* REPORT.md's line on a second run of a study ("``t2`` is the study ``brown_table1`` again at
+  another configuration (...)") names what its config changes. It compared the run with the
+  directory named as its study (``results/brown_table1``); over a results directory of yours
+  (``sim report --results runs`` of ``runs/t1`` and ``runs/t2``: the cli.md runs) there is
+  none, and the line listed the first four keys of the config (``comparator.alpha_mm`` =
+  0.500, ...), which both runs share. It now compares with the run shown in the row above.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+
+import pytest
+from conftest import ROOT
+
+import sim
+from sim.cli import main
+from sim.mc.config import ConfigError
+from sim.mc.storage import read_provenance
+
+
+@pytest.mark.parametrize("name", ["trials", "chunks"])
+def test_the_chunk_dataset_of_the_committed_results_is_named_as_written_by_its_run(name):
+    res = sim.Results(ROOT / "results" / "brown_table1", "brown_table1")
+    with pytest.raises(ConfigError) as e:
+        res.table(name)
+    msg = str(e.value)
+    assert "has no table" not in msg, msg
+    assert "trials is missing: its run wrote it" in msg and "hold no chunks" in msg, msg
+    assert "run the study again" in msg and "\n" not in msg, msg
+
+
+def test_a_second_runs_line_names_the_keys_it_changes_from_the_run_shown(tmp_path, capsys):
+    # two runs of agnard_block, neither in a directory named agnard_block (a user's runs)
+    shutil.copytree(ROOT / "results" / "agnard_block", tmp_path / "ab_paper")
+    shutil.copytree(ROOT / "results" / "agnard_block_104", tmp_path / "ab_real")
+    assert main(["report", "--results", str(tmp_path)]) == 0
+    line = next(s for s in (tmp_path / "REPORT.md").read_text().splitlines() if "again at" in s)
+    assert line.startswith("- [ab_real](ab_real/README.md) is the study `agnard_block`"), line
+    shown = re.findall(r"`([a-z_0-9.]+)` = ", line)
+    assert shown, line
+    mine, main_run = (
+        read_provenance(tmp_path / d / "claims.parquet")["config"] for d in ("ab_real", "ab_paper")
+    )
+    assert all(mine[k] != main_run[k] for k in shown), line
