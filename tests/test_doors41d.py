@@ -16,6 +16,12 @@ fix:
   (``sim report --results runs`` of ``runs/t1`` and ``runs/t2``: the cli.md runs) there is
   none, and the line listed the first four keys of the config (``comparator.alpha_mm`` =
   0.500, ...), which both runs share. It now compares with the run shown in the row above.
+
+And one in docs/sweeps.md: its example sweep's configuration line was quoted "spawned from seed
+1967 ... trials = 400 (the file: 4000)", where the page's example (no ``seed``, ``trials = 200``)
+says "spawned from seed 20261122" and names ``chunk``, ``seed`` and ``trials``: the page now
+quotes its own example's line, and says that a sweep file without ``seed`` takes the default,
+not the study file's.
 """
 
 from __future__ import annotations
@@ -30,6 +36,8 @@ import sim
 from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.mc.storage import read_provenance
+from sim.report.config_diff import sweep_config_line
+from sim.studies import design_config
 
 
 @pytest.mark.parametrize("name", ["trials", "chunks"])
@@ -56,3 +64,15 @@ def test_a_second_runs_line_names_the_keys_it_changes_from_the_run_shown(tmp_pat
         read_provenance(tmp_path / d / "claims.parquet")["config"] for d in ("ab_real", "ab_paper")
     )
     assert all(mine[k] != main_run[k] for k in shown), line
+
+
+def test_the_sweep_page_quotes_its_examples_configuration_line(tmp_path):
+    page = (ROOT / "docs" / "sweeps.md").read_text()
+    block = re.search(r"```toml\n# (\S+): .*?```", page, re.S)
+    quoted = re.search(r'"(A sweep of .*?) \.\.\."\)', " ".join(page.split()))
+    assert block and quoted, "the page's example or its quoted line is gone"
+    (tmp_path / block.group(1)).write_text(block.group(0).strip("`").removeprefix("toml\n"))
+    st = sim.load(tmp_path / block.group(1))
+    prov = {"config": st.config, "sweep": st.sweep, "sweep_keys": list(st.sweep)}
+    line = sweep_config_line(prov, block.group(1).removesuffix(".toml"), design_config)
+    assert line.startswith(quoted.group(1)), (quoted.group(1), line)
