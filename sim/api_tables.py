@@ -52,7 +52,15 @@ def check_owner(p: Path, study: str) -> None:
         )
     if who != study:
         whose = f"a table of {who!r}" if isinstance(who, str) else "not a table sim wrote"
-        raise ConfigError("table", f"{p} is {whose}, not of {study!r}; run the study again")
+        rec = read_record(p.parent)  # its run's too: the study named wrong, not a run to redo
+        ran = rec.get("config") if isinstance(rec, dict) else None
+        ran = ran.get("study") if isinstance(ran, dict) else None
+        fix = (
+            f"the directory holds its results: give study={who!r}"
+            if who == ran
+            else "run the study again"
+        )
+        raise ConfigError("table", f"{p} is {whose}, not of {study!r}; {fix}")
 
 
 def run_tables(d: Path, study: str) -> set[str]:

@@ -17,6 +17,11 @@ fix:
   none, and the line listed the first four keys of the config (``comparator.alpha_mm`` =
   0.500, ...), which both runs share. It now compares with the run shown in the row above.
 
+* ``sim.Results(path, study)`` with the study named wrong (``sim.Results("results/brown_table1",
+  "brown_dilution").claims()``, a slip between Brown's two studies) was refused "... is a table
+  of 'brown_table1', not of 'brown_dilution'; run the study again": no run helps. When the
+  directory's run is that table's study, the line now says to give ``study='brown_table1'``.
+
 And one in docs/sweeps.md: its example sweep's configuration line was quoted "spawned from seed
 1967 ... trials = 400 (the file: 4000)", where the page's example (no ``seed``, ``trials = 200``)
 says "spawned from seed 20261122" and names ``chunk``, ``seed`` and ``trials``: the page now
@@ -76,3 +81,13 @@ def test_the_sweep_page_quotes_its_examples_configuration_line(tmp_path):
     prov = {"config": st.config, "sweep": st.sweep, "sweep_keys": list(st.sweep)}
     line = sweep_config_line(prov, block.group(1).removesuffix(".toml"), design_config)
     assert line.startswith(quoted.group(1)), (quoted.group(1), line)
+
+
+@pytest.mark.parametrize("study", ["brown_dilution", "nosuch"])
+def test_results_of_a_study_named_wrong_say_which_study_to_give(study):
+    res = sim.Results(ROOT / "results" / "brown_table1", study)
+    with pytest.raises(ConfigError) as e:
+        res.claims()
+    msg = str(e.value)
+    assert f"is a table of 'brown_table1', not of '{study}'" in msg, msg
+    assert "run the study again" not in msg and "give study='brown_table1'" in msg, msg
