@@ -22,6 +22,10 @@ fix:
   of 'brown_table1', not of 'brown_dilution'; run the study again": no run helps. When the
   directory's run is that table's study, the line now says to give ``study='brown_table1'``.
 
+* ``res.claims()`` of a sweep run through the API (docs/python.md's call on docs/sweeps.md's
+  example) said "brown_table1 has no table 'claims'; it has sweep", and not where the claims
+  are: the line now names the sweep's ``cells/<label>`` directories.
+
 And one in docs/sweeps.md: its example sweep's configuration line was quoted "spawned from seed
 1967 ... trials = 400 (the file: 4000)", where the page's example (no ``seed``, ``trials = 200``)
 says "spawned from seed 20261122" and names ``chunk``, ``seed`` and ``trials``: the page now
@@ -91,3 +95,16 @@ def test_results_of_a_study_named_wrong_say_which_study_to_give(study):
     msg = str(e.value)
     assert f"is a table of 'brown_table1', not of '{study}'" in msg, msg
     assert "run the study again" not in msg and "give study='brown_table1'" in msg, msg
+
+
+def test_claims_of_a_sweep_name_where_its_cells_tables_are(tmp_path):
+    f = tmp_path / "sweep.toml"
+    net = (ROOT / "tests" / "data" / "gama" / "one_fixed.toml").read_text()
+    f.write_text(net + '\n[sweep]\n"test.alpha" = [0.05, 0.01]\n')
+    res = sim.load(f, trials=40, chunk=2).run(out=tmp_path / "o", figures=False)
+    with pytest.raises(ConfigError) as e:
+        res.claims()
+    msg = str(e.value)
+    assert "has no table 'claims'; it has sweep" in msg, msg
+    assert f"each cell's in {tmp_path / 'o' / 'cells'}/<label>" in msg, msg
+    sim.Results(tmp_path / "o" / "cells" / "cell0000_r0", "network").claims()  # there it is
