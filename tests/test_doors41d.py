@@ -26,6 +26,12 @@ fix:
   example) said "brown_table1 has no table 'claims'; it has sweep", and not where the claims
   are: the line now names the sweep's ``cells/<label>`` directories.
 
+And docs/cli.md: in the project's root "a study file of yours kept outside ``studies/`` ... goes
+to ``scratch/my_net-<config hash>/``", ``<name>`` "the study file's" (and ``sim run --help``
+alike). A copy of a project's study file under another name (``my_table1.toml``, copied from
+``studies/brown_table1.toml`` with ``trials = 400``) went to ``scratch/brown_table1-<hash>/``:
+it stands for the study whose results it is compared with. The page and the help say so.
+
 And one in docs/sweeps.md: its example sweep's configuration line was quoted "spawned from seed
 1967 ... trials = 400 (the file: 4000)", where the page's example (no ``seed``, ``trials = 200``)
 says "spawned from seed 20261122" and names ``chunk``, ``seed`` and ``trials``: the page now
@@ -45,6 +51,7 @@ import sim
 from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.mc.storage import read_provenance
+from sim.places import default_out
 from sim.report.config_diff import sweep_config_line
 from sim.studies import design_config
 
@@ -108,3 +115,25 @@ def test_claims_of_a_sweep_name_where_its_cells_tables_are(tmp_path):
     assert "has no table 'claims'; it has sweep" in msg, msg
     assert f"each cell's in {tmp_path / 'o' / 'cells'}/<label>" in msg, msg
     sim.Results(tmp_path / "o" / "cells" / "cell0000_r0", "network").claims()  # there it is
+
+
+def test_a_renamed_copy_of_a_study_file_goes_where_the_page_says(tmp_path, monkeypatch, capsys):
+    (tmp_path / "studies").mkdir()  # a project's root: its studies/ and committed results
+    shutil.copytree(ROOT / "results" / "brown_table1", tmp_path / "results" / "brown_table1")
+    text = (ROOT / "studies" / "brown_table1.toml").read_text()
+    mine = re.sub(
+        r"(?m)^trials = .*$", "trials = 400", re.sub(r"(?m)^chunk = .*$", "chunk = 20", text)
+    )
+    (tmp_path / "my_table1.toml").write_text(mine)
+    monkeypatch.chdir(tmp_path)
+    st = sim.load("my_table1.toml")
+    where = default_out(st.config, st.sweep, tmp_path / "my_table1.toml")[1]
+    assert where.startswith("scratch/brown_table1-"), where
+    assert main(["run", "--help"]) == 0
+    helped = " ".join(capsys.readouterr().out.split())
+    assert (
+        "(of a copy of a project's study file, kept under another name outside studies/: the study's)"
+        in helped
+    )
+    page = " ".join((ROOT / "docs" / "cli.md").read_text().split())
+    assert "its `<name>` is the study's (`scratch/brown_table1-<config hash>/`" in page
