@@ -26,6 +26,11 @@ fix:
   example) said "brown_table1 has no table 'claims'; it has sweep", and not where the claims
   are: the line now names the sweep's ``cells/<label>`` directories.
 
+* ``sim show results`` (the directory ``make reproduce`` writes, typed for a run's) was "results
+  is not a results directory (no claims.parquet or sweep.parquet)", a dead end; so was ``sim
+  show`` of a sweep's ``cells/``. The line now names how many results directories it holds
+  and the command that shows the first, which works as typed.
+
 And docs/cli.md: in the project's root "a study file of yours kept outside ``studies/`` ... goes
 to ``scratch/my_net-<config hash>/``", ``<name>`` "the study file's" (and ``sim run --help``
 alike). A copy of a project's study file under another name (``my_table1.toml``, copied from
@@ -137,3 +142,11 @@ def test_a_renamed_copy_of_a_study_file_goes_where_the_page_says(tmp_path, monke
     )
     page = " ".join((ROOT / "docs" / "cli.md").read_text().split())
     assert "its `<name>` is the study's (`scratch/brown_table1-<config hash>/`" in page
+
+
+def test_show_of_a_directory_of_results_names_a_command_that_shows_one(capsys):
+    assert main(["show", str(ROOT / "results")]) == 2
+    err = capsys.readouterr().err.strip()
+    hint = re.search(r"; it holds (\d+): sim show (\S+), \.\.\.$", err)
+    assert hint and int(hint.group(1)) >= 10 and "\n" not in err, err
+    assert main(["show", hint.group(2)]) == 0, capsys.readouterr().err
