@@ -175,11 +175,14 @@ class Results:
                 "path", f"{self.path} is not a results directory (no tables){self._within()}"
             )
         if not there and p.name in run_tables(self.path, self.study):  # not "has no table"
-            raise ConfigError("table", f"{p} is missing: its run wrote it (removed by hand?)")
-        if not there:
-            raise ConfigError(
-                "table", f"{self.study} has no table {name!r}; it has {', '.join(self.names())}"
-            )
+            why = "the committed results/ hold no chunks; removed by hand?): run the study again"
+            why = why if dataset else "removed by hand?)"
+            raise ConfigError("table", f"{p} is missing: its run wrote it ({why}")
+        if not there:  # a sweep's claims() named only 'sweep', not where its cells' tables are
+            cells = (self.path / "sweep.parquet").is_file() and (self.path / "cells").is_dir()
+            cells = f" (a sweep: each cell's in {self.path / 'cells'}/<label>)" if cells else ""
+            has = f"it has {', '.join(self.names())}{cells}"
+            raise ConfigError("table", f"{self.study} has no table {name!r}; {has}")
         if dataset and (bad := damaged_chunks(self.path)):
             raise ConfigError("table", f"{name}: {cell_chunks(self.path) or bad}")
         if not dataset and not p.is_file():  # pyarrow reads a directory as a dataset

@@ -52,18 +52,30 @@ def check_owner(p: Path, study: str) -> None:
         )
     if who != study:
         whose = f"a table of {who!r}" if isinstance(who, str) else "not a table sim wrote"
-        raise ConfigError("table", f"{p} is {whose}, not of {study!r}; run the study again")
+        rec = read_record(p.parent)  # its run's too: the study named wrong, not a run to redo
+        ran = rec.get("config") if isinstance(rec, dict) else None
+        ran = ran.get("study") if isinstance(ran, dict) else None
+        fix = (
+            f"the directory holds its results: give study={who!r}"
+            if who == ran
+            else "run the study again"
+        )
+        raise ConfigError("table", f"{p} is {whose}, not of {study!r}; {fix}")
 
 
 def run_tables(d: Path, study: str) -> set[str]:
     """The table files the run of ``study`` in ``d`` recorded in its ``run.json`` (none: no
-    record, or another study's)."""
+    record, or another study's), and ``trials`` where it recorded chunks (the committed
+    results hold none: ``table("trials")`` said the study "has no table 'trials'")."""
     rec = read_record(d)
     config = rec.get("config") if isinstance(rec, dict) else None
     tables = rec.get("table_sha256") if isinstance(config, dict) else None
     if not isinstance(config, dict) or config.get("study") != study or not isinstance(tables, dict):
         return set()
-    return {n for n in tables if isinstance(n, str) and "/" not in n}
+    chunks = (
+        {"trials"} if isinstance(rec.get("chunk_sha256"), dict) and rec["chunk_sha256"] else set()
+    )
+    return {n for n in tables if isinstance(n, str) and "/" not in n} | chunks
 
 
 def stale_warning(d: Path) -> None:

@@ -111,7 +111,8 @@ def _run_parser(sub) -> None:
     r.add_argument(
         "--out",
         help="output directory (default: results/<name>, <name> the study file's name "
-        "without .toml, for a study file run as written (in the project: one of its studies/) "
+        "without .toml (of a copy of a project's study file, kept under another name outside "
+        "studies/: the study's), for a study file run as written (in the project: one of its studies/) "
         "whose results there are of its config and code, or none yet; else "
         "scratch/<name>-<config hash>; see docs/cli.md)",
     )

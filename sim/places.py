@@ -28,7 +28,16 @@ from sim.mc.config import ConfigError, config_changes
 from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import reordered, swept_order
 
-__all__ = ["CODE", "PROJECT", "base", "check_place", "default_out", "shown_path", "show_target"]
+__all__ = [
+    "CODE",
+    "PROJECT",
+    "base",
+    "check_place",
+    "default_out",
+    "held_results",
+    "shown_path",
+    "show_target",
+]
 
 #: the suite's package directory (``sim/``) and the checkout it lies in
 CODE = Path(__file__).resolve().parent
@@ -57,6 +66,14 @@ def shown_path(path: Path) -> str:
         return os.path.relpath(path)
     except (OSError, ValueError):
         return str(path)
+
+
+def held_results(d: Path) -> str:
+    """``; it holds N: sim show D/<first>, ...`` of a directory of results directories (the
+    project's ``results/``, a sweep's ``cells/``), which ``sim show`` refused naming none."""
+    held = sorted({p.parent.name for k in ("claims", "sweep") for p in d.glob(f"*/{k}.parquet")})
+    more = ", ..." if len(held) > 1 else ""
+    return f"; it holds {len(held)}: sim show {d / held[0]}{more}" if held else ""
 
 
 def show_target(where: Path) -> str:

@@ -132,10 +132,12 @@ def _config_of(out: Path) -> dict:
         return {}
 
 
-def _variant_note(results: Path, name: str, study, claims: list, of: str) -> str:
+def _variant_note(results: Path, name: str, study, claims: list, of: str, main: str) -> str:
     """One line on a variant run of study ``of``: what its config changes (at most four
-    keys), its counts, a link."""
-    mine, base = _config_of(results / name), _config_of(results / of)
+    keys) from the main run's, in ``main`` (named otherwise than ``of``, a directory of
+    yours: the keys were compared with none and the line listed keys both runs share), its
+    counts, a link."""
+    mine, base = _config_of(results / name), _config_of(results / main)
     skip = {"seed", "trials", "chunk"}
     diff = [
         k for k in mine if k not in skip and not k.startswith("region.") and mine[k] != base.get(k)
@@ -186,8 +188,11 @@ def opening(entries: list[tuple], results: Path) -> str:
     for seed in sorted(s for s in by_seed if s):
         main, other = main_and_variants(by_seed[seed])
         rows.append(_paper_row(seed, main))
+        mains = {s.name: n for n, s, _ in main}
         for name, study, claims in other:
-            variants.append(_variant_note(results, name, study, claims, study.name))
+            variants.append(
+                _variant_note(results, name, study, claims, study.name, mains[study.name])
+            )
         for name, _, _ in main:
             if (reg := region_line(results / name)) is not None:
                 notes.append(f"- `{name}`: {reg}")

@@ -22,7 +22,7 @@ from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path, read_provenance, read_record, write_record
 from sim.mc.table_shape import kind
-from sim.places import show_target
+from sim.places import held_results, show_target
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.config_diff import sweep_config_line
 from sim.report.labels import column
@@ -67,9 +67,8 @@ def _kind_of(out: Path) -> str:
         return "study"
     if (out / "sweep.parquet").is_file():
         return "sweep"
-    raise ConfigError(
-        "DIR", f"{out} is not a results directory (no claims.parquet or sweep.parquet)"
-    )
+    why = "is not a results directory (no claims.parquet or sweep.parquet)"
+    raise ConfigError("DIR", f"{out} {why}{held_results(out)}")
 
 
 def _counted_as(r: dict) -> str:
