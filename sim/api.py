@@ -19,6 +19,7 @@ import contextlib
 import hashlib
 import logging
 import os
+import re
 import tempfile
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -362,7 +363,7 @@ def _api_words(e: ConfigError) -> ConfigError:
     replace is ``overwrite=True`` (the command line's ``--out``/``--overwrite`` name nothing
     a caller of ``run()`` can pass); a work limit's, the environment variable (:data:`_LIMITS`)."""
     if e.key != "--out":  # a work limit: run() takes no option for it, the environment does
-        msg = e.detail
+        msg = re.sub(r"use --workers (\d+)", r"use workers=\1", e.detail)  # run()'s argument
         for cli, api in _LIMITS:
             msg = msg.replace(cli, api)
         return ConfigError(e.key, msg)

@@ -380,13 +380,16 @@ def check_limits(
     )
     need = est.bytes * max(workers, 1)
     if not need <= mem * 2**30:
+        fit = int(mem * 2**30 // est.bytes) if est.bytes > 0 else workers
+        each = f" ({_gib(est.bytes)} each of {workers} worker processes)" if workers > 1 else ""
         raise ConfigError(
             None,
-            f"{est.study}: the run needs {est.describe(workers)}, over the "
+            f"{est.study}: the run needs {est.describe(workers)}{each}, over the "
             f"{mem:g} GiB limit (--max-memory-gb or SIM_MAX_MEMORY_GB)"
             + (f", most of it for {est.largest}" if est.largest else "")
             + (f", in the sweep's cell of {est.cell}" if est.cell else "")
-            + f"; reduce {est.memory_advice()}",
+            + (f"; use --workers {fit}, or reduce" if 1 <= fit < workers else "; reduce")
+            + f" {est.memory_advice()}",
         )
     if not est.adjustments <= adj:
         raise ConfigError(

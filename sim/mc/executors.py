@@ -199,9 +199,18 @@ class _Dask:
                 raise
 
     def run(self, fn, seed, part, jobs):
-        futs = {}  # the chunk function is small: send it with each task (no scatter)
+        """The chunks ``jobs`` of ``fn``, sent to the workers once (scattered), not with each
+        task: a network's chunk function holds the network and its factor (37 MiB pickled at
+        10,000 points), and sent with each of 20 tasks it grew the run's process by 0.75 GiB
+        over the estimate (client and scheduler each held every copy) and printed Dask's
+        six-line "Sending large graph" warning."""
+        jobs = list(jobs)
+        if not jobs:
+            return
+        fn_f = self.client.scatter(fn, broadcast=True, hash=False)
+        futs = {}
         for k, n in jobs:
-            futs[self.client.submit(_call_chunk, fn, seed, part, k, n, pure=False)] = (k, n)
+            futs[self.client.submit(_call_chunk, fn_f, seed, part, k, n, pure=False)] = (k, n)
         for f in self._completed(list(futs)):
             k, n = futs[f]
             yield k, n, f.result()
