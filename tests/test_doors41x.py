@@ -40,7 +40,7 @@ from sim.cli import main
 from sim.mc.network_size import network_counts
 from sim.studies import load_study
 from sim.studies.network.definition import build
-from sim.studies.network.gama import merge_gama, write_gama
+from sim.studies.network.gama import export, merge_gama, write_gama
 from sim.studies.network.gama_read import read_gama
 from tests.oneline import one_line
 from tests.test_doors20d import agree_with_gama, gama_xml, needs_gama, study_of
@@ -164,3 +164,15 @@ def _grid_study(tmp_path: Path, side: int) -> Path:
         '  { kind = "distance", from = ["A", "B"], to = "P*", nearest = 3, sigma_mm = 1.0 } ]\n'
     )
     return st
+
+
+def test_an_export_over_the_readers_limit_says_so(tmp_path, monkeypatch):
+    """A 50,000-point triangulation's export is 36 MiB, over the 16 MiB a gama_xml import
+    reads: the summary said "network.xml", and the file was refused when read back. The
+    limit is lowered here to a 400-point export's size."""
+    net = build(load_study(_grid_study(tmp_path, 20))[1])
+    cfg = {"datum.kind": "fixed", "datum.points": [], "network.points": []}
+    assert export(net, cfg, tmp_path / "network.xml") == "network.xml"
+    monkeypatch.setattr("sim.studies.network.gama.MAX_BYTES", 2**17)
+    said = export(net, cfg, tmp_path / "network.xml")
+    assert said.startswith("network.xml (") and "over the 0.125 MiB network.gama_xml reads" in said
