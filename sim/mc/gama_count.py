@@ -48,7 +48,7 @@ def gama_counts(path: str | os.PathLike) -> GamaCounts | None:
         return None
     if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_COUNT_BYTES:
         return None
-    return _counted(os.fspath(path), st.st_size, st.st_mtime_ns)
+    return _counted(os.path.abspath(path), st.st_size, st.st_mtime_ns)
 
 
 @functools.lru_cache(maxsize=4)
