@@ -160,13 +160,20 @@ def test_a_network_over_the_memory_limit_is_refused_before_it_is_built(
     args = ["run", str(st), "--out", str(tmp_path / "o"), "--max-memory-gb", f"{gib:.6g}"]
     one_line(capsys, main(args), "network.grids: ", *words)
     assert not (tmp_path / "o").exists()
-    # a gama-local file: named with its file, counted by its size (it is not read)
+    # a gama-local file: named with its file, its elements counted (it is not read: doors41x)
     xml = tmp_path / "net.xml"
-    xml.write_text("<gama-local/>" + " " * 80_000)
+    pts = '<point id="A" x="0" y="0" fix="xy"/><point id="B" x="1" y="0" adj="xy"/>'
+    obs = '<obs from="A">' + '<distance to="B" val="1" stdev="1"/>' * 1000 + "</obs>"
+    xml.write_text(
+        f"<gama-local><network><points-observations>{pts}{obs}</points-observations>"
+        + "</network></gama-local>"
+    )
     st.write_text(f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{xml}"\n')
-    monkeypatch.setenv("SIM_MAX_MEMORY_GB", "0.001")
+    need = network_estimate({"network.gama_xml": str(xml), "trials": 40, "chunk": 2})[3]
+    monkeypatch.setenv("SIM_MAX_MEMORY_GB", f"{need / 2 / 2**30:.6g}")
     monkeypatch.setattr("sim.studies.network.schema.merge_gama", unbuilt)
-    one_line(capsys, main(["check", str(st)]), f"network.gama_xml: {xml}: ", "about 1,000 obs")
+    words = ("2 points and 1,000 observations",)
+    one_line(capsys, main(["check", str(st)]), f"network.gama_xml: {xml}: ", *words)
 
 
 def test_sim_check_says_the_work_as_time_of_one_core(capsys):

@@ -320,7 +320,7 @@ BAD = [
     ('x="150.0"', 'x="1_000"', "not a number"),
     ('x="150.0"', 'x="nan"', "not a number"),
     ('stdev="2.0"', 'stdev="abc"', "<distance> attribute 'stdev' (to='B')"),
-    ('stdev="2.0"', 'stdev="-1"', "must be > 0"),
+    ('stdev="2.0"', 'stdev="-1"', "'-1' is negative (gama-local squares it"),
     ('stdev="2.0"', 'stdev="2.0" colour="red"', "unknown attribute"),
     ('<point id="B"', '<point id="A" x="1" y="1" adj="xy" /><point id="B"', "declared twice"),
     ('adj="xy" />', 'adj="xyz" z="1" />', "height unknowns"),

@@ -13,6 +13,7 @@ from typing import Mapping, NamedTuple
 
 from sim.lsq.size import SPARSE_MIN_UNKNOWNS
 from sim.lsq.sparse import factor_nonzeros
+from sim.mc.gama_count import GamaCounts, gama_counts
 from sim.mc.workunits import COPIES, F8
 
 __all__ = [
@@ -155,13 +156,17 @@ class Counts(NamedTuple):
 def network_counts(c: Mapping) -> Counts:
     """:class:`Counts` of the network ``c`` declares (points and observations counted from
     the declaration, patterns matched against the names, ``nearest`` bounding each generated
-    set; an imported ``network.gama_xml`` by its size): the path its unknowns take (the
+    set; an imported ``network.gama_xml`` by its elements, :func:`sim.mc.gama_count.
+    gama_counts`, else by its size): the path its unknowns take (the
     engine's rule), a trial's iterations (:data:`SPARSE_ITERATIONS`,
     :data:`DENSE_ITERATIONS`, at most ``solver.max_iter``) and on the sparse path the
     factor's nonzeros from the normals' (:data:`NNZ_PER_ROW`,
     :func:`sim.lsq.sparse.factor_nonzeros`)."""
     gama = c.get("network.gama_xml", "")
-    if gama:  # an imported file: about 80 bytes per observation, 4 observations a point
+    counted = gama_counts(gama) if gama else None
+    if counted:  # an imported file: its elements counted (sim.mc.gama_count)
+        n, m, orient, nnz_rows, nonlinear = _from_file(counted)
+    elif gama:  # one not counted (not XML, ...): about 80 bytes an observation, 4 a point
         m = os.path.getsize(gama) / 80 if os.path.isfile(gama) else 1e3
         n, orient, nnz_rows, nonlinear = m / 4, m / 16, 6.0 * m, True
     else:
@@ -200,6 +205,15 @@ def network_estimate(c: Mapping) -> tuple:
         )
         setup = 0.0
     return T, T * w + setup + OUTPUT_UNITS_PER_ROW * m + 2, int(U), b
+
+
+def _from_file(k: GamaCounts) -> tuple[float, float, float, float, bool]:
+    """:func:`_declared`'s counts of a ``gama-local`` file's :class:`GamaCounts`."""
+    rows = {kind: float(v) for kind, v in k.rows.items() if kind in NNZ_PER_ROW}
+    m = sum(rows.values()) + k.rows.get("coordinates", 0)
+    nnz_rows = sum(NNZ_PER_ROW[kind] * v for kind, v in rows.items())
+    nonlinear = any(rows.get(kind, 0) > 0 for kind in NONLINEAR_KINDS)
+    return float(k.points), float(m), float(min(k.orientations, k.points)), nnz_rows, nonlinear
 
 
 def _declared(c: Mapping) -> tuple[float, float, float, float, bool]:

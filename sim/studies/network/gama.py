@@ -15,18 +15,12 @@ pairs as ``<vectors>`` with every height fixed at 0 (``fix="z"``: the ``dz`` row
 unknown, so gama-local counts one more degree of freedom per vector). Brown's known offset
 beta, a known additive constant and a known scale error become a plain distance with the
 equivalent stdev ``sigma s / ((1 + scale) d)`` (``s = sqrt(d^2 - beta^2)``): the same row of
-the design, the same precision. ``val`` is the error-free value.
-
-Refused with one line (gama-local cannot express them): an estimated additive constant or
-scale, observation biases, a ``dx`` without its ``dy`` (a vector has both), a ``dy`` whose
-variance is at or below 1e-8 of every ``dx``'s (:func:`_least_first`: a cluster whose order
-would fail gama-local's pivot test is written in ascending variance).
-``datum.kind = "constraints"`` is written as the free network in the inner datum over all its
-points (:func:`export`, which says so): its precision is this study's moved by an
-S-transformation (``output.inner_over``).
-
-Import: :mod:`sim.studies.network.gama_read` (``network.gama_xml``).
-"""
+the design, the same precision. ``val`` is the error-free value. Refused with one line
+(gama-local cannot express them): an estimated additive constant or scale, observation
+biases, a ``dx`` without its ``dy``, a ``dy`` whose variance is at or below 1e-8 of every
+``dx``'s (:func:`_least_first`). ``datum.kind = "constraints"`` is written as the free network
+in the inner datum over all its points (:func:`export` says so). Import:
+:mod:`sim.studies.network.gama_read` (``network.gama_xml``)."""
 
 from __future__ import annotations
 
@@ -39,12 +33,12 @@ import numpy as np
 
 from sim.mc.config import ConfigError, given
 from sim.mc.storage import atomic_path
-from sim.studies.network.definition import Network
+from sim.studies.network.definition import Network, build
 from sim.studies.network.gama_frames import NE, consistent
-from sim.studies.network.gama_read import CC, NS, read_bytes, read_gama
+from sim.studies.network.gama_read import CC, MAX_BYTES, NS, read_bytes, read_gama
 from sim.studies.network.gama_vocab import shifted
 from sim.studies.network.linearity import row_key
-from sim.studies.network.model import computed
+from sim.studies.network.model import computed, defect_basis
 from sim.studies.network.validate import hits, name_index
 
 __all__ = ["read_gama", "write_gama", "merge_gama", "export", "gama_digest", "import_note"]
@@ -90,28 +84,37 @@ def merge_gama(cfg: dict) -> dict:
     }
     if rec["datum.points"] and not cfg["datum.points"]:
         out["datum.points"] = rec["datum.points"]
-    # points held: fixed, or their coordinates observed (weighted); two of them fix the datum
-    # (a file whose <coordinates> held it was resolved inner, "(0 constraints)", and "fixed"
-    # refused as "0 fixed points")
+    # points held: fixed, or their coordinates observed (weighted)
     fixed = sum(p.get("role") == "fixed" for p in rec["network.points"])
     seen = sum(p.get("role") == "observed" for p in rec["network.points"])
-    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and fixed + seen < 2:
-        # adj="XY" points: gama-local removes the defect its fixed points leave over them (all
-        # of it in a free network, the rotation about a single fixed point), as the suite's
-        # own export of an inner datum writes it (its round trip), so the study does too; two
-        # fixed points or more leave no defect, and the datum stays fixed. A fixed datum the
+    if rec["datum.points"] and cfg["datum.kind"] == "fixed" and _defect_left(out, fixed + seen):
+        # adj="XY" points: gama-local removes the defect its fixed points leave over them, as
+        # the suite's own export of an inner datum writes it (its round trip), so the study
+        # does too; where they leave none, the datum stays fixed, as there. A fixed datum the
         # study asked for (the file, --set, a sweep cell) is refused: it would not be the one run
         if given(cfg, "datum.kind"):
             raise ConfigError(
                 "datum.kind",
                 f'"fixed" cannot hold: {Path(path).name} has {fixed} fixed '
                 f"point{'' if fixed == 1 else 's'}{' and 1 observed' if seen else ''} (a fixed "
-                "datum needs two or more fixed or observed points) and "
+                "datum needs two or more fixed or observed points, or one and <vectors>) and "
                 'adj="XY" points, which gama-local adjusts in the inner datum: set datum.kind '
                 '= "inner" (or leave it out: the default falls back to it)',
             )
         out["datum.kind"] = "inner"
     return out
+
+
+def _defect_left(full: dict, held: int) -> bool:
+    """Whether the file's fixed points leave a defect (``held``: points fixed or observed):
+    with none, the translation; with one, the rotation unless ``<vectors>`` hold it, which
+    the design decides (as in gama-local: it was inner, refused, "nothing to constrain")."""
+    if held >= 2:
+        return False
+    if held == 0 or not any(o["kind"] in ("dx", "dy") for o in full["network.observations"]):
+        return True
+    net = build(full)
+    return defect_basis(net, net.free_index()).shape[1] > 0
 
 
 def _fmt(x: float) -> str:
@@ -428,17 +431,20 @@ def export(net: Network, cfg: dict, path: str | Path) -> str:
     frame = tuple(cfg.get("network.gama_frame", NE))  # an imported file's frame, else ne
     try:
         _keyed(net, cfg)
-        if kind == "fixed":
-            write_gama(net, path, frame=frame)
-            return Path(path).name
         pts = [a for a in range(net.n) if net.role[a] != 1]
-        write_gama(net, path, inner_points(net, cfg) if kind == "inner" else pts, frame)
+        inner = () if kind == "fixed" else inner_points(net, cfg) if kind == "inner" else pts
+        write_gama(net, path, inner, frame)
     except ConfigError as e:
         return f"not exported: {e}"
+    size = Path(path).stat().st_size  # over the reader's limit: said (a 50,000-point network)
+    big = f" ({size / 2**20:.3g} MiB: over the {MAX_BYTES / 2**20:g} MiB network.gama_xml reads)"
+    name = Path(path).name + big * (size > MAX_BYTES)
     if kind == "inner":
-        return f'{Path(path).name} (inner datum: adj="XY" on the datum points)'
+        return f'{name} (inner datum: adj="XY" on the datum points)'
+    if kind == "fixed":
+        return name
     return (
-        f"{Path(path).name}: datum.kind = constraints has no gama-local form; written as the "
+        f"{name}: datum.kind = constraints has no gama-local form; written as the "
         "free network in the inner datum over all its points (this study's precision moved "
         "by an S-transformation)"
     )

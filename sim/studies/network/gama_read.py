@@ -144,12 +144,26 @@ def _stdev(f: _File, o, default, var: float | None) -> float:
             f.num(o, "stdev")
         return math.sqrt(var)
     if o.get("stdev") is not None:
-        return f.num(o, "stdev", lo=0.0)
+        sig = f.num(o, "stdev")
+        if sig < 0:
+            raise f.err(o, f"{vocab.said(o.get('stdev'))} is negative{_SQUARED}", "stdev")
+        if sig == 0:
+            raise f.err(o, f"{vocab.said(o.get('stdev'))} must be > 0", "stdev")
+        return sig
     if default is None:
         raise f.err(o, "no stdev and no default in <points-observations>", "stdev")
-    if default <= 0:
+    if default < 0:
+        raise f.err(o, f"the default stdev {default:g} is negative{_SQUARED}", "stdev")
+    if default == 0:
         raise f.err(o, "the default stdev is not positive", "stdev")
     return default
+
+
+#: why a negative stdev is refused, which gama-local reads: it squares it (a variance)
+_SQUARED = (
+    " (gama-local squares it and adjusts as if it had no sign; this suite takes a standard "
+    "deviation as a positive number: write it without the sign)"
+)
 
 
 def _xy(f: _File, e) -> tuple[float, float]:
@@ -296,6 +310,7 @@ def _network(f: _File, data: bytes):
         raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
     if why := vocab.raw_name_problem(text):  # names as gama-local reads them
         raise ConfigError(key, f"{path}: {why}")
+    vocab.drop_empty(root)  # x="", stdev="": absent, as gama-local reads them
     f.vocab(root)
     nets = [e for e in root if _tag(e) == "network"]
     if len(nets) != 1:
@@ -306,22 +321,36 @@ def _network(f: _File, data: bytes):
     return net
 
 
-def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
+def _resolve(f: _File, points: dict, coords: list, obs: list) -> list[str]:
     """Every point has coordinates and a role; observed coordinates and observations name
-    declared points."""
+    declared points. A point without coordinates or without a role in xy that nothing
+    observes is left out, as ``gama-local`` leaves it ("Removed points ... missing
+    coordinates"); its name is returned. One that is observed is refused, with what
+    ``gama-local`` does instead."""
     key, path = f.key, f.path
     for pid, _, xy in coords:  # a point's coordinates given only there: gama-local reads them
         if pid in points and "x_mm" not in points[pid]:
             points[pid]["x_mm"], points[pid]["y_mm"] = xy
+    seen = {rec[k] for rec in obs for k in ("from", "to", "at") if k in rec}
+    seen.update(pid for pid, _, _ in coords)
+    left = [p for p, r in points.items() if p not in seen and ("x_mm" not in r or "role" not in r)]
+    for pid in left:
+        del points[pid]
     for pid, rec in points.items():
         if "x_mm" not in rec:
             raise ConfigError(
                 key,
                 f"{path}: <point id={pid!r}> has no coordinates; the simulation needs every "
-                "point's coordinates",
+                "point's coordinates (gama-local computes approximate ones from the observed "
+                "values, which this suite does not use)",
             )
         if "role" not in rec:
-            raise ConfigError(key, f"{path}: <point id={pid!r}> is neither fix nor adj in xy")
+            raise ConfigError(
+                key,
+                f"{path}: <point id={pid!r}> is neither fix nor adj in xy (gama-local leaves "
+                "it out of the adjustment with every observation of it; this suite drops no "
+                'observation: give it fix="xy" or adj="xy", or remove it and its observations)',
+            )
     for pid, s, _ in coords:
         if pid not in points:
             raise ConfigError(
@@ -345,6 +374,7 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> None:
                 raise ConfigError(
                     key, f"{path}: <{rec['kind']}> {fld}={rec[fld]!r}: no such <point>{like}"
                 )
+    return left
 
 
 def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | None = None) -> dict:
@@ -364,7 +394,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
             f"{sha256[:12]}...): load the study again",
         )
     net = _network(f, data)
-    note = _parameters(f, [e for e in net if _tag(e) == "parameters"])
+    note = vocab.parameters_note(f, [e for e in net if _tag(e) == "parameters"])
     axes = ws(net.get("axes-xy", NE[0]))  # gama-local's vocabulary, checked in _network
     angles = ws(net.get("angles", NE[1]))
     note += frame_note(axes, angles)
@@ -390,7 +420,16 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
             _vectors(f, e, obs)
         else:
             raise f.err(e, "not allowed in <points-observations>")
-    _resolve(f, points, coords, obs)
+    left = _resolve(f, points, coords, obs)
+    if left:  # listed, never observed, no coordinates or no role: gama-local removes them
+        few = ", ".join(repr(p) for p in left[:5]) + (
+            f" and {len(left) - 5} more" * (len(left) > 5)
+        )
+        note += (
+            f"; left out, as gama-local leaves them: {few} (no coordinates or neither fix nor "
+            "adj in xy, and no observation)"
+        )
+        datum = {p: None for p in datum if p in points}
     return {
         "network.points": list(points.values()),
         "network.observations": obs,
@@ -398,30 +437,3 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         "note": note,
         "frame": (axes, angles),
     }
-
-
-def _parameters(f: _File, pars: list) -> str:
-    if len(pars) > 1:
-        raise f.err(pars[1], "given twice")
-    p = pars[0] if pars else None
-    if p is not None:
-        for a, lo in (("sigma-apr", 0.0), ("tol-abs", 0.0)):
-            if p.get(a) is not None:
-                f.num(p, a, lo=lo)
-        if p.get("conf-pr") is not None:
-            c = f.num(p, "conf-pr", lo=0.0)
-            if c >= 1:
-                raise f.err(p, f"{c:g} must be below 1", "conf-pr")
-        if p.get("cov-band") is not None:
-            c = f.integer(p, "cov-band", signed=True)
-            if c < -1:
-                raise f.err(p, f"{c} must be an integer >= -1", "cov-band")
-        if p.get("latitude") is not None:
-            f.angle(p, "latitude")
-    act = "aposteriori" if p is None else ws(p.get("sigma-act", "aposteriori"))
-    if act == "apriori":
-        return "sigma-act = apriori, as this study: the stdevs are the observations' sigmas"
-    return (
-        "the file asks for sigma-act = aposteriori (gama-local's default); this study uses "
-        "the a-priori stdevs (a pre-analysis has no residuals)"
-    )

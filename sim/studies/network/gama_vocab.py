@@ -32,6 +32,8 @@ __all__ = [
     "entity_declared",
     "raw_name_problem",
     "shifted",
+    "drop_empty",
+    "parameters_note",
 ]
 
 NS = "http://www.gnu.org/software/gama/gama-local"
@@ -146,10 +148,23 @@ _CHOICES = {
     ("network", "angles"): ("left-handed", "right-handed"),
     ("parameters", "sigma-act"): ("aposteriori", "apriori"),
     ("parameters", "update-constrained-coordinates"): ("yes", "no"),
-    ("parameters", "algorithm"): ("gso", "svd", "cholesky", "envelope"),
     ("parameters", "angles"): ("400", "360"),
     ("point", "fix"): _XYZ,
     ("point", "adj"): _XYZ,
+}
+#: the attributes ``gama-local`` reads as absent when empty (``x=""``, ``stdev=""``: its parser
+#: tests ``if (sv != "")``): the default holds there (a point without coordinates, the default
+#: stdev); :func:`drop_empty` removes them, so that they are read here as there. An empty value
+#: of any other attribute is refused there and here (``id=""``, ``val=""``, ``sigma-apr=""``)
+_OBS_OPTIONAL = ("stdev", "from_dh", "to_dh", "bs_dh", "fs_dh", "extern")
+EMPTY_IS_ABSENT = {
+    "point": ("x", "y", "z", "fix", "adj"),
+    "obs": ("from", "orientation", "from_dh"),
+    "distance": _OBS_OPTIONAL,
+    "direction": _OBS_OPTIONAL,
+    "angle": _OBS_OPTIONAL,
+    "vec": ("from_dh", "to_dh", "extern"),
+    "coordinates": ("extern",),
 }
 _REFUSED = {
     "s-distance": "slope distances are 3-D",
@@ -169,6 +184,15 @@ def shifted(text: str, places: int) -> decimal.Decimal:
     its exponent moved: no rounding to a context's precision)."""
     sign, digits, exp = decimal.Decimal(text).as_tuple()
     return decimal.Decimal((sign, digits, exp + places))
+
+
+def drop_empty(root) -> None:
+    """Remove the empty attributes ``gama-local`` reads as absent (:data:`EMPTY_IS_ABSENT`)
+    from every element under ``root`` (``x="" y=""``: a point without coordinates there)."""
+    for e in root.iter():
+        for a in EMPTY_IS_ABSENT.get(_tag(e), ()):
+            if e.get(a) == "":
+                del e.attrib[a]
 
 
 class _File:
@@ -286,6 +310,33 @@ class _File:
                 ch = _CHOICES.get((t, a))
                 if ch and v not in ch:  # gama-local compares the value as written: " ne" no
                     raise self.err(e, f"{said(v)} is not one of {', '.join(ch)}", a)
+
+
+def parameters_note(f: _File, pars: list) -> str:
+    """Check the ``<parameters>`` element (at most one) and say which ``sigma-act`` the file
+    asks for (the study always uses the a-priori stdevs)."""
+    if len(pars) > 1:
+        raise f.err(pars[1], "given twice")
+    p = pars[0] if pars else None
+    if p is not None:
+        for a, lo in (("sigma-apr", 0.0), ("tol-abs", 0.0)):
+            if p.get(a) is not None:
+                f.num(p, a, lo=lo)
+        if p.get("conf-pr") is not None:
+            c = f.num(p, "conf-pr", lo=0.0)
+            if c >= 1:
+                raise f.err(p, f"{c:g} must be below 1", "conf-pr")
+        if p.get("cov-band") is not None:  # any integer: gama-local reads one below -1 as -1
+            f.integer(p, "cov-band", signed=True)  # (the whole matrix), and it is not used here
+        if p.get("latitude") is not None:
+            f.angle(p, "latitude")
+    act = "aposteriori" if p is None else ws(p.get("sigma-act", "aposteriori"))
+    if act == "apriori":
+        return "sigma-act = apriori, as this study: the stdevs are the observations' sigmas"
+    return (
+        "the file asks for sigma-act = aposteriori (gama-local's default); this study uses "
+        "the a-priori stdevs (a pre-analysis has no residuals)"
+    )
 
 
 class _Prolog(Exception):

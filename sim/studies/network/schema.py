@@ -147,12 +147,12 @@ def check(cfg: dict) -> None:
         raise ConfigError(
             "network.points", "no estimated point has a regular covariance: nothing to estimate"
         )
-    if an.dof < 1:
+    if an.dof < 1:  # gama-local adjusts it (untested): its global test needs one or more
+        gama = "; gama-local adjusts such a file untested" if full.get("network.gama_xml") else ""
         raise ConfigError(
             "network.observations",
-            f"{net.m} observations for "
-            f"{len(an.free)} unknowns leave {an.dof} degrees of freedom: add "
-            "observations",
+            f"{net.m} observations for {len(an.free)} unknowns leave {an.dof} degrees of "
+            f"freedom: add observations (the global test needs one or more{gama})",
         )
     probe_solver(net, an, dt.constraint_matrix(net.theta_true()[None]), pts, cfg)
     if cfg["compare.fix"]:

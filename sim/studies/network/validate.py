@@ -70,8 +70,8 @@ def fits_estimate(cfg: dict) -> None:
     gama = cfg.get("network.gama_xml")
     key = "network.gama_xml" if gama else _size_key(cfg, k.points, k.rows)
     what = f"a network of about {k.points:,.0f} points and {k.rows:,.0f} observations"
-    if gama:  # counted from the file's size, not read
-        what = f"{gama}: a gama-local file of about {k.rows:,.0f} observations by its size"
+    if gama:  # its elements counted, not read (sim.mc.gama_count)
+        what = f"{gama}: a gama-local file of {k.points:,.0f} points and {k.rows:,.0f} observations"
     over = (
         f"and {short}: raise {short.split(' (', 1)[0]} or use fewer points or observations"
         if short
