@@ -107,6 +107,16 @@ def absolute_path(name: str, v: str | os.PathLike) -> Path:
         ) from None
 
 
+def gone_cwd(name: str, v: str | os.PathLike) -> str | None:
+    """The one line of :func:`absolute_path`'s refusal (``v`` relative, the working directory
+    deleted), for a program that prints its own; None when ``v`` is a path here."""
+    try:
+        absolute_path(name, v)
+    except ConfigError as e:
+        return str(e)
+    return None
+
+
 def why_unread(e: Exception) -> str:
     """Why a file could not be read, in words: an OSError's reason (its kind when it has
     none, as pyarrow's may not), else the kind of error."""

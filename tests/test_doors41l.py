@@ -1,0 +1,124 @@
+"""Last session's left items (doors41l, brief L41), decided: each class through a real door;
+each test fails on the code before its fix:
+
+* ``sim run ... >&-``, ``sim report >&-`` and ``python -m sim.batch ... >&-`` (standard output
+  closed) ran and ended in exit 0, their summary printed nowhere (``> /dev/full`` is exit 2
+  after the run): every program refuses a closed standard output before it starts, one line
+  as ``sim check`` and ``sim show`` said, exit 2 (``> /dev/null`` prints nowhere);
+* the command line with the working directory deleted called a relative study file "no such
+  study file" (``sim check``, ``sim run``, ``python -m sim.batch``) and ``sim show x`` "does not
+  exist": each names the argument and says the working directory is gone, as the API does;
+* a Wolf CSV whose data rows end in Excel's trailing commas (empty cells after the header's
+  last column) was refused as "a decimal comma?": read as nothing; and a decimal comma in the
+  number before the note, with the note left out (``...,32,271``), was read silently as 32 mm
+  and the note "271": refused naming the cell and the note.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from oneline import SIM_ERROR, one_line, one_line_of
+
+import sim
+import sim.batch
+from sim.cli import main
+from sim.studies.wolf.tables import load_table1
+
+ROOT = Path(__file__).resolve().parents[1]
+TABLE1 = ROOT / "studies" / "brown_table1.toml"
+WOLF1 = ROOT / "studies" / "data" / "wolf_table1.csv"
+PY = sys.executable
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["sim", "run", str(TABLE1), "--trials", "40", "--no-figures", "--out", "{tmp}/o"],
+        ["sim", "report", "--results", "{tmp}"],
+        ["sim.batch", str(TABLE1), "--results", "{tmp}", "--", "--trials", "40"],
+    ],
+)
+def test_a_command_that_writes_files_refuses_a_closed_standard_output(tmp_path, argv):
+    cmd = " ".join([PY, "-m", *(a.format(tmp=tmp_path) for a in argv)]) + " >&-"
+    proc = subprocess.run(["sh", "-c", cmd], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    # before: exit 0, the summary (results in DIR, REPORT.md's path, N runs done) nowhere
+    one_line_of(proc, "standard output is closed (>&-): nothing to print to")
+    assert sorted(os.listdir(tmp_path)) == []  # refused before it started
+
+
+@pytest.fixture
+def gone_cwd(tmp_path, monkeypatch):
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    return tmp_path
+
+
+@pytest.mark.parametrize(
+    ("argv", "name"),
+    [
+        (["check", "studies/brown_table1.toml"], "STUDY: studies/brown_table1.toml"),
+        (["run", "studies/brown_table1.toml"], "STUDY: studies/brown_table1.toml"),
+        (["show", "brown_table1"], "DIR: brown_table1"),
+    ],
+)
+def test_the_command_line_with_the_working_directory_gone_says_so(capsys, gone_cwd, argv, name):
+    # before: "no such study file", "does not exist (nor is there a directory results/x ...)"
+    one_line(
+        capsys,
+        main(argv),
+        "is relative, but the working directory is gone",
+        prefix=SIM_ERROR + name,
+    )
+
+
+def test_the_batch_with_the_working_directory_gone_says_so(capsys, gone_cwd):
+    rc = sim.batch.main(["studies/brown_table1.toml", "--results", str(gone_cwd)])
+    one_line(
+        capsys, rc, "FILE: studies/brown_table1.toml is relative, but the working directory is gone"
+    )
+
+
+def _wolf(tmp_path, edit) -> Path:
+    lines = WOLF1.read_text(encoding="utf-8").splitlines()
+    p = tmp_path / "t1.csv"
+    p.write_text("\r\n".join(edit(ln) for ln in lines) + "\r\n", encoding="utf-8-sig")
+    return p
+
+
+def test_excels_trailing_commas_in_a_wolf_table_are_read_as_nothing(tmp_path):
+    p = _wolf(tmp_path, lambda ln: ln + ",,," if ln[:1].isdigit() else ln)
+    got, want = load_table1(p), load_table1(WOLF1)  # before: "a decimal comma?"
+    assert all(np.array_equal(got[k], want[k]) for k in want)
+    st = sim.load(ROOT / "studies" / "wolf_polynomial.toml", **{"table1.file": str(p)})
+    assert st.config["table1.file"] == str(p)
+
+
+def test_a_decimal_comma_before_a_note_left_out_is_named(tmp_path, capsys):
+    def split(ln):  # 005,10,...,-53.136,32.271,"" -> ...,-53.136,32,271
+        return (
+            ",".join(ln.split(",")[:8]).replace(",32.271", ",32,271")
+            if ln.startswith("005,10,")
+            else ln
+        )
+
+    p = _wolf(tmp_path, split)
+    assert ",32,271\n" in p.read_text(encoding="utf-8-sig")
+    rc = main(
+        ["check", str(ROOT / "studies" / "wolf_polynomial.toml"), "--set", f'table1.file="{p}"']
+    )
+    # before: read as y_foster_mm 32 and the note '271', exit 0
+    one_line(
+        capsys,
+        rc,
+        "table1.file: ",
+        "(line ",
+        "y_foster_mm '32' and the note '271': a decimal comma?",
+    )
