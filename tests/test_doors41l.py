@@ -11,7 +11,12 @@ each test fails on the code before its fix:
 * a Wolf CSV whose data rows end in Excel's trailing commas (empty cells after the header's
   last column) was refused as "a decimal comma?": read as nothing; and a decimal comma in the
   number before the note, with the note left out (``...,32,271``), was read silently as 32 mm
-  and the note "271": refused naming the cell and the note.
+  and the note "271": refused naming the cell and the note;
+* a key given twice in an inline table, first as an inline table (``plate = {x = {a = 1},
+  x = 2}``, or ``x.b = 2`` after it) got tomllib's own words ("Cannot mutate immutable
+  namespace ('x',)"): named whole (``plate.x``, an array's item as ``p.q[0].x``); and a key
+  given twice under an array of tables was named without its item
+  (``network.grids.spacing_mm``): ``network.grids[1].spacing_mm``.
 """
 
 from __future__ import annotations
@@ -122,3 +127,32 @@ def test_a_decimal_comma_before_a_note_left_out_is_named(tmp_path, capsys):
         "(line ",
         "y_foster_mm '32' and the note '271': a decimal comma?",
     )
+
+
+@pytest.mark.parametrize(
+    ("value", "name"),
+    [
+        ("plate = {x = {a = 1}, x = 2}", "plate.x"),
+        ("plate = {x = {a = 1}, x.b = 2}", "plate.x"),
+        ("p = {q = [{x = {a = 1}, x = 2}]}", "p.q[0].x"),
+    ],
+)
+def test_a_key_given_twice_after_its_inline_table_is_named(tmp_path, capsys, value, name):
+    f = tmp_path / "s.toml"
+    f.write_text(f'study = "brown_table1"\n{value}\n', encoding="utf-8")
+    # before: "malformed TOML: Cannot mutate immutable namespace ('x',) (at line 2, ...)"
+    one_line(
+        capsys,
+        main(["check", str(f)]),
+        f"malformed TOML: {name} is given twice in an inline table (at line 2",
+    )
+
+
+def test_a_key_given_twice_in_an_array_of_tables_names_its_item(tmp_path, capsys):
+    text = (ROOT / "studies" / "network_brown.toml").read_text(encoding="utf-8")
+    grid = '\n[[network.grids]]\nprefix = "{}"\nnx = 2\nny = 2\nspacing_mm = 45.0\n'
+    text = "\n".join(ln for ln in text.splitlines() if not ln.startswith("grids = "))
+    f = tmp_path / "net.toml"
+    f.write_text(text + grid.format("P") + grid.format("Q") + "spacing_mm = 4\n", encoding="utf-8")
+    # before: "network.grids.spacing_mm is given twice"
+    one_line(capsys, main(["check", str(f)]), "network.grids[1].spacing_mm is given twice (at line")
