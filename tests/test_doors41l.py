@@ -16,22 +16,36 @@ each test fails on the code before its fix:
   x = 2}``, or ``x.b = 2`` after it) got tomllib's own words ("Cannot mutate immutable
   namespace ('x',)"): named whole (``plate.x``, an array's item as ``p.q[0].x``); and a key
   given twice under an array of tables was named without its item
-  (``network.grids.spacing_mm``): ``network.grids[1].spacing_mm``.
+  (``network.grids.spacing_mm``): ``network.grids[1].spacing_mm``;
+* under a memory limit just above a run's peak pyarrow could not allocate (``ArrowMemoryError``)
+  or start a thread of its pool, and ``sim show``, ``sim report`` and ``Results.table`` called
+  ``claims.parquet`` "not the claims table its run wrote: cannot be read": they say not enough
+  memory (the limit when one is set);
+* on a terminal of 0 rows (``stty rows 0``) the progress bar was blank (tqdm took the height
+  for -1 rows, the bar's line outside them): drawn at the terminal's width.
 """
 
 from __future__ import annotations
 
+import fcntl
 import os
+import pty
+import shutil
+import struct
 import subprocess
 import sys
+import termios
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 from oneline import SIM_ERROR, one_line, one_line_of
 
 import sim
 import sim.batch
+import sim.report.read
 from sim.cli import main
 from sim.studies.wolf.tables import load_table1
 
@@ -156,3 +170,62 @@ def test_a_key_given_twice_in_an_array_of_tables_names_its_item(tmp_path, capsys
     f.write_text(text + grid.format("P") + grid.format("Q") + "spacing_mm = 4\n", encoding="utf-8")
     # before: "network.grids.spacing_mm is given twice"
     one_line(capsys, main(["check", str(f)]), "network.grids[1].spacing_mm is given twice (at line")
+
+
+RESULTS = ROOT / "results" / "brown_table1"  # read, never written
+
+
+@pytest.mark.parametrize(
+    "error",
+    [
+        pa.ArrowMemoryError("malloc of size 18752 failed"),
+        pa.ArrowException("Couldn't start thread: Resource temporarily unavailable"),
+    ],
+)
+def test_a_table_read_short_of_memory_is_not_called_damaged(tmp_path, monkeypatch, capsys, error):
+    def short(*a, **k):
+        raise error
+
+    monkeypatch.setattr(sim.report.read, "read_table", short)
+    monkeypatch.setattr(pq, "read_table", short)
+    # before: "claims.parquet is not the claims table its run wrote: cannot be read (...)"
+    line = one_line(capsys, main(["show", str(RESULTS)]), "not enough memory for this command")
+    assert "reading claims.parquet" in line and "not the claims table" not in line, line
+    res = tmp_path / "res"
+    shutil.copytree(RESULTS, res / "brown_table1", ignore=shutil.ignore_patterns("*.png", "trials"))
+    rc = main(["report", "--results", str(res)])
+    one_line(capsys, rc, "not enough memory for this command: reading claims.parquet")
+    with pytest.raises(sim.ConfigError, match="cannot be read \\(not enough memory: "):
+        sim.Results(RESULTS, "brown_table1").table("claims")
+
+
+def test_a_terminal_of_no_rows_shows_the_bar(tmp_path):
+    m, s = pty.openpty()
+    fcntl.ioctl(s, termios.TIOCSWINSZ, struct.pack("HHHH", 0, 100, 0, 0))  # stty rows 0
+    run = [
+        "run",
+        str(TABLE1),
+        "--trials",
+        "40",
+        "--chunk",
+        "2",
+        "--no-figures",
+        "--out",
+        str(tmp_path / "o"),
+    ]
+    proc = subprocess.Popen(
+        [PY, "-m", "sim", *run], stdin=s, stdout=subprocess.DEVNULL, stderr=s, cwd=ROOT
+    )
+    os.close(s)
+    seen = b""
+    while True:
+        try:
+            data = os.read(m, 65536)
+        except OSError:  # the terminal's other end closed: the run ended
+            break
+        if not data:
+            break
+        seen += data
+    os.close(m)
+    assert proc.wait(timeout=120) == 0, seen
+    assert b"/40 trials" in seen, seen  # before: nothing drawn

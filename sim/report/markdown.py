@@ -24,6 +24,7 @@ from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
 from sim.report.glance import by_paper, design_notes, main_and_variants, number, opening
 from sim.report.papers import paper_name
 from sim.report.read import (
+    cannot_read,
     check_claims_table,
     checked_table,
     forget,
@@ -208,7 +209,7 @@ def _claims_of(d: Path, get_study: Callable):
     try:
         return get_study(read_provenance(f)["study"]), read_provenance(f), records(f)
     except (OSError, ValueError, pa.ArrowException) as e:
-        raise ConfigError("--results", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+        raise cannot_read("--results", f, e) from None
 
 
 _RULES = (
