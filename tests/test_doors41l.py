@@ -22,7 +22,10 @@ each test fails on the code before its fix:
   ``claims.parquet`` "not the claims table its run wrote: cannot be read": they say not enough
   memory (the limit when one is set);
 * on a terminal of 0 rows (``stty rows 0``) the progress bar was blank (tqdm took the height
-  for -1 rows, the bar's line outside them): drawn at the terminal's width.
+  for -1 rows, the bar's line outside them): drawn at the terminal's width;
+* a sweep over ``trials`` (``trials = [400, 800]`` of brown_table1, whose chunk is 200) was
+  refused, every cell naming ``chunk``, where ``--set trials=400`` picks the chunk: each cell
+  picks it by the same rule (20 and 40 here).
 """
 
 from __future__ import annotations
@@ -47,6 +50,7 @@ import sim
 import sim.batch
 import sim.report.read
 from sim.cli import main
+from sim.mc.sweep import cell_config
 from sim.studies.wolf.tables import load_table1
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -229,3 +233,16 @@ def test_a_terminal_of_no_rows_shows_the_bar(tmp_path):
     os.close(m)
     assert proc.wait(timeout=120) == 0, seen
     assert b"/40 trials" in seen, seen  # before: nothing drawn
+
+
+def test_a_sweep_over_trials_picks_each_cells_chunk_as_trials_does(tmp_path, capsys):
+    f = tmp_path / "sw.toml"
+    f.write_text('study = "brown_table1"\n[sweep]\ntrials = [400, 800]\n', encoding="utf-8")
+    # before: "sweep.trials: every cell failed (2 of 2) on load ... chunk: 400 trials in chunks
+    # of 200 give 2 chunks ..."
+    assert main(["check", str(f)]) == 0, capsys.readouterr().err
+    assert "in 2 sweep cells" in capsys.readouterr().out
+    st = sim.load(TABLE1)
+    cells = [cell_config(st.study, st.config, {"trials": n}, 1) for n in (400, 800, 8000)]
+    assert [c["chunk"] for c in cells] == [20, 40, 200]  # as --set trials=N picks it
+    assert [sim.load(TABLE1, trials=n).config["chunk"] for n in (400, 800, 8000)] == [20, 40, 200]
