@@ -25,7 +25,10 @@ each test fails on the code before its fix:
   for -1 rows, the bar's line outside them): drawn at the terminal's width;
 * a sweep over ``trials`` (``trials = [400, 800]`` of brown_table1, whose chunk is 200) was
   refused, every cell naming ``chunk``, where ``--set trials=400`` picks the chunk: each cell
-  picks it by the same rule (20 and 40 here).
+  picks it by the same rule (20 and 40 here);
+* ``sim show`` of a sweep whose cell directory was deleted printed the cell's row as if it
+  were there, exit 0 (``sim report`` rewrote the README.md linking it, ``Results.table("sweep")``
+  read it): each names the missing cell, as a removed table is named.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from __future__ import annotations
 import fcntl
 import os
 import pty
+import re
 import shutil
 import struct
 import subprocess
@@ -246,3 +250,19 @@ def test_a_sweep_over_trials_picks_each_cells_chunk_as_trials_does(tmp_path, cap
     cells = [cell_config(st.study, st.config, {"trials": n}, 1) for n in (400, 800, 8000)]
     assert [c["chunk"] for c in cells] == [20, 40, 200]  # as --set trials=N picks it
     assert [sim.load(TABLE1, trials=n).config["chunk"] for n in (400, 800, 8000)] == [20, 40, 200]
+
+
+def test_a_sweep_whose_cell_was_deleted_names_the_cell(tmp_path, capsys):
+    f = tmp_path / "sw.toml"
+    f.write_text('study = "brown_table1"\n[sweep]\ntrials = [40, 60]\n', encoding="utf-8")
+    out = tmp_path / "res" / "sw"
+    assert main(["run", str(f), "--quiet", "--no-figures", "--out", str(out)]) == 0
+    assert main(["show", str(out)]) == 0
+    capsys.readouterr()
+    shutil.rmtree(out / "cells" / "cell0001_r0")
+    words = "cell0001_r0 is missing: its sweep's run wrote it (removed by hand?)"
+    one_line(capsys, main(["show", str(out)]), words, prefix=SIM_ERROR + "DIR: ")  # before: 0
+    one_line(capsys, main(["report", "--results", str(out.parent)]), words)
+    assert not (out.parent / "REPORT.md").exists()
+    with pytest.raises(sim.ConfigError, match=re.escape(words)):
+        sim.Results(out, "brown_table1").table("sweep")

@@ -19,6 +19,7 @@ from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.settle import reread
 from sim.mc.storage import atomic_path, read_provenance
+from sim.mc.table_edits import missing_cell
 from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
 from sim.report.glance import by_paper, design_notes, main_and_variants, number, opening
@@ -410,6 +411,8 @@ def write_report(
         MARK + "\n" + _settled(results, lambda: build_report(results, get_study, design, studies))
     )
     for d in sorted(results_dirs(results)):
+        if (why := missing_cell(d)) is not None:  # its README.md would link a cell that is gone
+            raise ConfigError("--results", why)
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             _settled(results, lambda d=d: write_run_readme(d, get_study, design=design))
     with atomic_path(out) as tmp:

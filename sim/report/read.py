@@ -30,7 +30,7 @@ from sim.mc.config import ConfigError
 from sim.mc.message_text import key_text
 from sim.mc.publish import changed_figure
 from sim.mc.storage import read_provenance, read_record, read_table
-from sim.mc.table_edits import edited_cell
+from sim.mc.table_edits import edited_cell, missing_cell
 from sim.mc.table_shape import declared_problem, recorded_shape, shape_problem
 
 __all__ = [
@@ -333,6 +333,8 @@ def mixed_run(d: Path, names: list[str] | None = None, missing_ok: bool = True) 
     found = mixed_table(d, names, missing_ok)
     if found is None and (cell := edited_cell(Path(d), names)) is not None:
         return cell  # a sweep's cell: its tables' sha256 are in the sweep's record
+    if found is None and (names is None or "sweep.parquet" in names) and (cell := missing_cell(d)):
+        return cell  # a sweep whose cell directory was deleted
     if found is None:
         figure = None if names else changed_figure(Path(d), missing_ok=True)
         return None if figure is None else f"{figure}: run its study again"
