@@ -28,12 +28,19 @@ each test fails on the code before its fix:
   picks it by the same rule (20 and 40 here);
 * ``sim show`` of a sweep whose cell directory was deleted printed the cell's row as if it
   were there, exit 0 (``sim report`` rewrote the README.md linking it, ``Results.table("sweep")``
-  read it): each names the missing cell, as a removed table is named.
+  read it): each names the missing cell, as a removed table is named;
+* results whose run record and tables name a study this version lacks (a newer version's):
+  ``sim show`` said "study: unknown study", ``sim report`` "claims.parquet cannot be read: study:
+  unknown study", and ``Results.table`` warned they were made by code "changed since" (stale):
+  each says the directory holds results of a study this version does not have, and no stale
+  note is given of them.
 """
 
 from __future__ import annotations
 
 import fcntl
+import hashlib
+import json
 import os
 import pty
 import re
@@ -42,6 +49,7 @@ import struct
 import subprocess
 import sys
 import termios
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -266,3 +274,37 @@ def test_a_sweep_whose_cell_was_deleted_names_the_cell(tmp_path, capsys):
     assert not (out.parent / "REPORT.md").exists()
     with pytest.raises(sim.ConfigError, match=re.escape(words)):
         sim.Results(out, "brown_table1").table("sweep")
+
+
+def _of_another_study(d: Path, name: str) -> None:
+    """``d``'s run record and tables made to name the study ``name`` (their sha256 kept)."""
+    rec = json.loads((d / "run.json").read_text(encoding="utf-8"))
+    rec["config"]["study"] = name
+    for f in d.glob("*.parquet"):
+        t = pq.read_table(f)
+        meta = {
+            k: v.replace(b'"study": "brown_table1"', f'"study": "{name}"'.encode())
+            for k, v in t.schema.metadata.items()
+        }
+        pq.write_table(t.replace_schema_metadata(meta), f)
+        rec["table_sha256"][f.name] = hashlib.sha256(f.read_bytes()).hexdigest()
+    (d / "run.json").write_text(json.dumps(rec), encoding="utf-8")
+
+
+def test_results_of_a_study_this_version_lacks_say_so(tmp_path, capsys):
+    d = tmp_path / "res" / "brown_future"
+    shutil.copytree(RESULTS, d, ignore=shutil.ignore_patterns("*.png", "README.md"))
+    _of_another_study(d, "brown_future")
+    words = (
+        "holds results of the study 'brown_future', which this version of the suite does not have"
+    )
+    one_line(capsys, main(["show", str(d)]), words, prefix=SIM_ERROR + "DIR: ")  # "unknown study"
+    one_line(
+        capsys,
+        main(["report", "--results", str(d.parent)]),
+        words,
+        prefix=SIM_ERROR + "--results: ",
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # before: StaleResultsWarning ("its study's code changed")
+        assert sim.Results(d, "brown_future").table("claims").num_rows > 0
