@@ -15,6 +15,7 @@ from __future__ import annotations
 import ast
 import errno
 import os
+import resource
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +26,7 @@ from sim.mc.config import ConfigError
 from sim.mc.paths import absolute
 from sim.mc.storage import RECORD, config_hash, read_provenance, read_record, regular_text
 from sim.mc.unfinished import unfinished
+from sim.report.read import memory_failure
 
 __all__ = [
     "another_run",
@@ -110,9 +112,24 @@ def absolute_path(name: str, v: str | os.PathLike) -> Path:
         ) from None
 
 
+def gone_cwd(name: str, v: str | os.PathLike) -> str | None:
+    """The one line of :func:`absolute_path`'s refusal (``v`` relative, the working directory
+    deleted), for a program that prints its own; None when ``v`` is a path here."""
+    try:
+        absolute_path(name, v)
+    except ConfigError as e:
+        return str(e)
+    return None
+
+
 def why_unread(e: Exception) -> str:
     """Why a file could not be read, in words: an OSError's reason (its kind when it has
-    none, as pyarrow's may not), else the kind of error."""
+    none, as pyarrow's may not), else the kind of error; memory named as such (a limit just
+    above a run's peak: pyarrow could not allocate, or start a thread)."""
+    if memory_failure(e):
+        cap = resource.getrlimit(resource.RLIMIT_AS)[0]
+        limit = f"; ulimit -v is {cap // 1024} kB" if cap != resource.RLIM_INFINITY else ""
+        return f"not enough memory: {str(e).splitlines()[0][:160]}{limit}"
     if isinstance(e, OSError) and e.strerror:
         return e.strerror
     return type(e).__name__

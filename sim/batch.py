@@ -54,7 +54,7 @@ single_threaded_blas()  # before NumPy loads (the study modules import it)
 if __name__ == "__main__":
     refuse_bad_variables("sim.batch")  # SIM_NO_JIT=0, NUMBA_OPT=fast: one line, exit 2
 
-from sim.api_paths import too_long  # noqa: E402
+from sim.api_paths import gone_cwd, too_long  # noqa: E402
 from sim.batch_checks import (  # noqa: E402
     _clashes,
     _configs_problems,
@@ -320,6 +320,10 @@ def _main(argv: list[str], phase: list[str]) -> int:
     if why := link_problem(args.results):  # a loop: every run would fail on it, one by one
         print(f"sim.batch: --results: {args.results} {why}", file=sys.stderr)
         return 2
+    for name, v in [("FILE", f) for f in args.files] + [("--results", args.results)]:
+        if (why := gone_cwd(name, v)) is not None:  # not "no such study file" (sim check's)
+            print(f"sim.batch: {why}", file=sys.stderr)
+            return 2
     if os.path.lexists(args.results) and not os.path.isdir(args.results):
         # each run would name --out, an option this command line does not hold, one by one
         print(f"sim.batch: --results: {args.results} is not a directory", file=sys.stderr)

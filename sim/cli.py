@@ -28,7 +28,7 @@ from pathlib import Path
 
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
-from sim.api_paths import too_long
+from sim.api_paths import absolute_path, too_long
 from sim.claims.rules import printed_differs
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
@@ -316,7 +316,11 @@ def _main(argv: list[str]) -> int:
             raise ConfigError("STUDY", f"not a study file name: {why} (got {args.study!r})")
         if args.cmd in ("run", "check") and (why := too_long(args.study)) is not None:
             raise ConfigError("STUDY", why)  # it was the system's words and the whole path
-        if args.cmd in ("check", "show") and sys.stdout is None:  # >&-: print() wrote nowhere
+        if args.cmd in ("run", "check"):  # the working directory gone: not "no such study file"
+            absolute_path("STUDY", args.study)
+        if args.cmd == "show":
+            absolute_path("DIR", args.dir)
+        if sys.stdout is None:  # >&-: print() wrote nowhere (every command, as sim.ends.finish)
             raise ConfigError(None, "standard output is closed (>&-): nothing to print to")
         for s in _STOPS if in_main_thread() else ():
             if signal.getsignal(s) is signal.SIG_DFL:  # clean up like Ctrl-C (nohup: ignored):

@@ -25,7 +25,7 @@ from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
 from sim.stale import other_code, stale_dirs
-from sim.studies import STUDY_FILES, design_config, get_study
+from sim.studies import MODULES, STUDY_FILES, design_config, get_study
 
 __all__ = ["show", "report"]
 
@@ -87,8 +87,8 @@ def _shown_text(d: Path, markdown: bool) -> str:
         raise ConfigError("DIR", cell)
     try:
         if markdown:
-            return run_markdown(d, get_study, design=design_config)
-        return terminal_table(d, design=design_config, get_study=get_study)
+            return run_markdown(d, _study_of("DIR", d), design=design_config)
+        return terminal_table(d, design=design_config, get_study=_study_of("DIR", d))
     except ConfigError:
         raise
     except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
@@ -137,7 +137,9 @@ def report(results: Path) -> int:
     if (why := umask_problem()) is not None:
         raise ConfigError(None, why)
     try:
-        text = write_report(results, get_study, design_config, project_studies(results))
+        text = write_report(
+            results, _study_of("--results", results), design_config, project_studies(results)
+        )
     except ConfigError:
         raise
     except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
@@ -174,3 +176,20 @@ def project_studies(results: Path) -> list[Path]:
         return sorted(STUDY_FILES.glob("*.toml"))
     except (OSError, RuntimeError):  # a loop: the report names it
         return []
+
+
+def _study_of(key: str, d: Path):
+    """``get_study`` for the tables under ``d``: a study this version of the suite lacks
+    (results of a newer version, or of a study since removed) is named as such, not "study:
+    unknown study" (``sim report``: "claims.parquet cannot be read")."""
+
+    def get(name):
+        if isinstance(name, str) and name not in MODULES:
+            raise ConfigError(
+                key,
+                f"{d} holds results of the study {name!r}, which this version of the suite "
+                f"does not have (results of another version?; it has {', '.join(sorted(MODULES))})",
+            )
+        return get_study(name)
+
+    return get

@@ -88,7 +88,12 @@ def _said(line: str) -> None:
 
 def finish(prog: str, main) -> int:
     """``main()``'s exit code (a ``SystemExit`` of argparse's ``--help`` included) after
-    :func:`flush_stdout`, for ``sys.exit``."""
+    :func:`flush_stdout`, for ``sys.exit``. Standard output closed (``>&-``) is refused
+    before ``main`` runs, by every program alike: what it prints would be lost (``sim run``'s
+    summary, ``sim report``'s path, ``sim.batch``'s count), as ``> /dev/full`` says after."""
+    if sys.stdout is None:  # open_standard_streams: >&- at the start (>/dev/null prints nowhere)
+        _said(f"{prog}: error: standard output is closed (>&-): nothing to print to")
+        return 2
     try:
         code = main()
     except SystemExit as e:

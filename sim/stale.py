@@ -8,6 +8,7 @@ from pathlib import Path
 
 from sim.mc.codehash import study_code_hash
 from sim.mc.outputs import results_dirs
+from sim.mc.registry import MODULES
 from sim.mc.storage import read_record
 
 __all__ = ["other_code", "stale_dirs"]
@@ -27,10 +28,12 @@ def stale_dirs(d: Path, first: bool = False) -> list[str]:
         rec = read_record(r)
         config = rec.get("config") if rec else None  # a run.json edited into another
         study = config.get("study") if isinstance(config, dict) else None  # shape: not ours
+        study = study if isinstance(study, str) else None
         try:
-            if isinstance(study, str) and rec["code_hash"] != study_code_hash(study):
+            # a study this version lacks (a newer version's results) is not "changed since"
+            if study in MODULES and rec["code_hash"] != study_code_hash(study):
                 found.append(str(r))
-        except (KeyError, ValueError, OSError, ImportError):  # an unknown study: not ours
+        except (KeyError, ValueError, OSError, ImportError):  # not ours either: no note
             continue
         if found and first:
             break

@@ -58,6 +58,14 @@ def _columns(stream) -> int | None:
         return None
 
 
+def _rows(stream) -> int | None:
+    """The height of the terminal ``stream`` is (0 after ``stty rows 0``), or None."""
+    try:
+        return os.get_terminal_size(stream.fileno()).lines
+    except (AttributeError, ValueError, OSError, io.UnsupportedOperation):
+        return None
+
+
 #: the bar's width where the terminal gives none (0 columns: tqdm drew no bar at all) and
 #: the widest it is drawn (at 2,000 columns each redraw was a line of 5.8 kB)
 DEFAULT_COLUMNS, MAX_COLUMNS = 80, 200
@@ -107,8 +115,12 @@ class Progress:
         self.enabled = terminal or notebook
         check_environment()
         cols = _columns(stream) if terminal else None
-        fixed = notebook or (cols is not None and not 0 < cols <= MAX_COLUMNS)
+        # a terminal of 0 rows (stty rows 0): tqdm took its height for -1 rows, the bar's own
+        # line outside them, and drew nothing: a fixed width, and rows enough for one bar
+        flat = terminal and _rows(stream) == 0
+        fixed = notebook or flat or (cols is not None and not 0 < cols <= MAX_COLUMNS)
         width = (min(cols or 0, MAX_COLUMNS) or DEFAULT_COLUMNS) if fixed else None
+        width = min(cols - 1, MAX_COLUMNS) if flat and cols and cols > 1 else width  # as tqdm's
         self.bar = _bar_class()(
             total=self.total,
             desc=label,
@@ -120,6 +132,7 @@ class Progress:
             leave=False,
             ncols=width,
             dynamic_ncols=not fixed,
+            nrows=2 if flat else None,  # tqdm keeps the last row for "(more hidden)"
         )
 
     def __enter__(self) -> "Progress":

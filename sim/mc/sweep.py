@@ -52,7 +52,7 @@ from sim.mc.limit_error import LimitError
 from sim.mc.message_text import near_keys
 from sim.mc.numtext import UnheldError, unsigned_zeros
 from sim.mc.progress import Progress
-from sim.mc.runner import chunk_rng
+from sim.mc.runner import MIN_CHUNKS, chunk_rng
 from sim.mc.toml_text import toml_value
 
 __all__ = [
@@ -275,6 +275,8 @@ def cell_config(study, cfg: Mapping[str, Any], cell: Mapping[str, Any], seed: in
     values and ``seed``, through the study's schema and ``check`` and the chunk rule (a
     :class:`ConfigError` naming the key when the study refuses it)."""
     base = {k: v for k, v in cfg.items() if k != "study"}
+    if isinstance(n := cell.get("trials"), int) and "chunk" not in cell and "chunk" in base:
+        cell = {**cell, "chunk": min(base["chunk"], max(1, n // MIN_CHUNKS))}  # as --trials
     # the cell's keys are the ones it sets: the base is resolved (its defaults already are)
     ccfg = validate({**base, **cell, "seed": seed}, study.schema, study.check, frozenset(cell))
     ccfg = {"study": cfg["study"], **ccfg}

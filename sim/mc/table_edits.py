@@ -78,3 +78,19 @@ def edited_cell(d: Path, names: list[str] | None = None) -> str | None:
                 "or edited by hand?); run the sweep again"
             )
     return None
+
+
+def missing_cell(d: Path) -> str | None:
+    """Why ``d``, a sweep's directory, lacks a cell its run wrote: a ``cells/<label>/`` whose
+    tables its run record lists is gone (``sim show`` printed the cell's row of
+    ``sweep.parquet`` as if it were there), in one line, or None."""
+    sums = (read_record(Path(d)) or {}).get("table_sha256")
+    if not (Path(d) / "sweep.parquet").is_file() or not isinstance(sums, dict):
+        return None
+    cells = {n.split("/")[1] for n in sums if isinstance(n, str) and n.startswith("cells/")}
+    for label in sorted(c for c in cells if c and not os.path.lexists(Path(d) / "cells" / c)):
+        return (
+            f"{Path(d) / 'cells' / label} is missing: its sweep's run wrote it (removed by "
+            "hand?); run the sweep again"
+        )
+    return None

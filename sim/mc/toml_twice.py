@@ -97,6 +97,11 @@ def _named(text: str, reason: str, line: int, where: str) -> str | None:
             return f"{_dotted(head + rel, inner)} is given twice in an inline table{where}"
         path, second = head + rel, "a value"
     named = _NAMED.match(reason)
+    if named and stmt[:1] != "[":  # {x = {a = 1}, x = 2}: x named from its inline table
+        key = list(ast.literal_eval(named.group(1)))
+        if (inline := _inline_prefix(text, lines[i], starts, (i, line), where, key)) is not None:
+            shown = _dotted(head + rel, [*inline, key[0]])
+            return f"{shown} is given twice in an inline table{where}"
     target = list(ast.literal_eval(named.group(1))) if named else _first_taken(before, path)
     if target is None:
         return None
@@ -111,7 +116,7 @@ def _named(text: str, reason: str, line: int, where: str) -> str | None:
     tables = ("a table", "an array of tables")
     differ = first != second and (first in tables or second in tables)  # not two values
     both = f" ({first}, then {second})" if differ else ""
-    return f"{key_text('.'.join(target))} is given twice{both}{where}"
+    return f"{_shown(before, target)} is given twice{both}{where}"
 
 
 def _key_end(line: str) -> int | None:
@@ -168,6 +173,34 @@ def _inline_key(src: str, eq: int | None) -> list | None:
     if not stack or stack[-1][0] == "[]" or not stack[-1][2]:
         return None
     return [p for part in path for p in part] + stack[-1][2]
+
+
+def _inline_prefix(text, stmt: str, starts, lines: tuple, where: str, key: list) -> list | None:
+    """The inline table (parts below the statement's key, an array's item as ``[k]``) in
+    which ``key``, tomllib's error of the statement at line ``lines[0]`` (the error at line
+    ``lines[1]``), was given; None when it cannot be told (not an inline table's key)."""
+    at = starts[lines[1] - 1] + int(where.split("column ")[-1].rstrip(")")) - 1
+    try:
+        inner = _inline_key(text[starts[lines[0]] : at], _key_end(stmt))
+    except (tomllib.TOMLDecodeError, IndexError):
+        return None
+    if inner is None or len(inner) < len(key) or inner[len(inner) - len(key) :] != key:
+        return None
+    return inner[: len(inner) - len(key)]
+
+
+def _shown(doc: Any, path: list[str]) -> str:
+    """``path`` named with the item of each array of tables it passes (its last, where the
+    keys go: ``network.grids[1].spacing_mm``, not ``network.grids.spacing_mm``)."""
+    out: list = []
+    for j, k in enumerate(path):
+        doc = _last(doc)
+        nxt = doc.get(k) if isinstance(doc, dict) else None
+        out.append(k)
+        if j < len(path) - 1 and isinstance(nxt, list) and nxt and isinstance(nxt[-1], dict):
+            out.append(f"[{len(nxt) - 1}]")
+        doc = nxt
+    return _dotted([out[0]], out[1:])
 
 
 def _dotted(head: list[str], inner: list) -> str:

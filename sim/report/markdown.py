@@ -19,11 +19,13 @@ from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.settle import reread
 from sim.mc.storage import atomic_path, read_provenance
+from sim.mc.table_edits import missing_cell
 from sim.report.claimtext import interval_text, ref_text, sim_text
 from sim.report.glance import VERDICT_TEXT as _VERDICT_TEXT
 from sim.report.glance import by_paper, design_notes, main_and_variants, number, opening
 from sim.report.papers import paper_name
 from sim.report.read import (
+    cannot_read,
     check_claims_table,
     checked_table,
     forget,
@@ -207,8 +209,10 @@ def _claims_of(d: Path, get_study: Callable):
     check_claims_table(f, "--results")
     try:
         return get_study(read_provenance(f)["study"]), read_provenance(f), records(f)
+    except ConfigError:  # a study this version lacks (sim.cli_read): said as such
+        raise
     except (OSError, ValueError, pa.ArrowException) as e:
-        raise ConfigError("--results", f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+        raise cannot_read("--results", f, e) from None
 
 
 _RULES = (
@@ -412,6 +416,8 @@ def write_report(
 
     text, read = _settled(results, build), _dirs(results)
     for d in sorted(results_dirs(results)):
+        if (why := missing_cell(d)) is not None:  # its README.md would link a cell that is gone
+            raise ConfigError("--results", why)
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             _settled(results, lambda d=d: write_run_readme(d, get_study, design=design))
     if _dirs(results) != read:  # a run published while the READMEs were written: REPORT.md

@@ -16,6 +16,7 @@ The report is built from the tables alone, so a table dropped, replaced or edite
 
 from __future__ import annotations
 
+import re
 import threading
 from pathlib import Path
 from typing import Any
@@ -29,7 +30,7 @@ from sim.mc.config import ConfigError
 from sim.mc.message_text import key_text
 from sim.mc.publish import changed_figure
 from sim.mc.storage import read_provenance, read_record, read_table
-from sim.mc.table_edits import edited_cell
+from sim.mc.table_edits import edited_cell, missing_cell
 from sim.mc.table_shape import declared_problem, recorded_shape, shape_problem
 
 __all__ = [
@@ -116,6 +117,29 @@ class Row(Columns):
         return value
 
 
+#: pyarrow's words when it could not start a thread of its pool (a memory limit just above
+#: a run's peak: the thread's stack could not be mapped), which named the table unreadable
+_THREAD = re.compile(r"thread|resource temporarily unavailable|cannot allocate memory", re.I)
+
+
+def memory_failure(e: BaseException) -> bool:
+    """Whether pyarrow's ``e`` says memory, not the file: an allocation that failed, or a
+    thread of its pool it could not start."""
+    return isinstance(e, MemoryError) or (
+        isinstance(e, pa.ArrowException) and bool(_THREAD.search(str(e)))
+    )
+
+
+def cannot_read(key: str, f: Path, e: Exception) -> ConfigError:
+    """The ConfigError for ``key`` of a file ``f`` pyarrow could not read (``e``); a
+    :func:`memory_failure` is raised as the MemoryError it is (the commands name the memory
+    and its limit), not blamed on the file."""
+    first = str(e).splitlines()[0] if str(e) else type(e).__name__
+    if memory_failure(e):
+        raise MemoryError(f"reading {Path(f).name}: {first[:160]}") from None
+    return ConfigError(key, f"{f} cannot be read: {first}")
+
+
 def checked_table(path: str | Path, shaped: bool = True) -> pa.Table:
     """The table at ``path``; a file that is there but not Parquet, or not of the shape its
     run recorded (:func:`~sim.mc.table_shape.shape_problem`: a column retyped, renamed,
@@ -127,6 +151,7 @@ def checked_table(path: str | Path, shaped: bool = True) -> pa.Table:
     try:
         table = read_table(path)
     except pa.ArrowException as e:
+        cannot_read("", path, e)  # ulimit -v just above a run's peak: not the file's fault
         raise TableError(path, f"cannot be read ({str(e).splitlines()[0][:200]})") from None
     if not shaped:
         return table
@@ -227,14 +252,14 @@ def check_claims_table(f: Path, key: str) -> None:
     try:
         prov, names = read_provenance(f), pq.read_schema(f).names
     except (OSError, ValueError, pa.ArrowException) as e:
-        raise ConfigError(key, f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+        raise cannot_read(key, f, e) from None
     if "study" not in prov or not {"claim", "verdict"} <= set(names):
         raise ConfigError(key, f"{f} is not a claims table written by sim{older(prov, names)}")
     try:
         cols = pq.read_table(f, columns=["claim", "verdict"])
         verdicts, claims = cols.column("verdict").to_pylist(), cols.column("claim").to_pylist()
     except (OSError, ValueError, pa.ArrowException) as e:
-        raise ConfigError(key, f"{f} cannot be read: {str(e).splitlines()[0]}") from None
+        raise cannot_read(key, f, e) from None
     damage = claims_damage(prov, verdicts, claims)
     if damage:
         raise ConfigError(key, f"{f} is not a claims table written by sim: {damage}")
@@ -308,6 +333,8 @@ def mixed_run(d: Path, names: list[str] | None = None, missing_ok: bool = True) 
     found = mixed_table(d, names, missing_ok)
     if found is None and (cell := edited_cell(Path(d), names)) is not None:
         return cell  # a sweep's cell: its tables' sha256 are in the sweep's record
+    if found is None and (names is None or "sweep.parquet" in names) and (cell := missing_cell(d)):
+        return cell  # a sweep whose cell directory was deleted
     if found is None:
         figure = None if names else changed_figure(Path(d), missing_ok=True)
         return None if figure is None else f"{figure}: run its study again"

@@ -64,7 +64,33 @@ def _rows(p: Path, key: str, text: str) -> tuple[list[str], list[tuple[int, list
         n = kept[min(reader.line_num, len(kept)) - 1][0]
         cut = " (a quoted cell is not closed: is the file cut short?)" * ("end of data" in str(e))
         raise ConfigError(key, f"{p}: not a CSV table at line {n} ({e}){cut}") from None
-    return (table[0] if table else []), [(kept[i][0], r) for i, r in enumerate(table) if i]
+    header = table[0] if table else []
+    while header and not header[-1].strip():  # Excel pads every line to the widest with commas
+        header = header[:-1]
+    rows = [(kept[i][0], _unpadded(r, len(header))) for i, r in enumerate(table) if i]
+    return header, rows
+
+
+def _unpadded(cells: list[str], width: int) -> list[str]:
+    """``cells`` without the empty cells after the header's ``width`` (Excel's trailing commas:
+    a line padded to the file's widest, a comment's, as Excel writes a CSV it opened)."""
+    while len(cells) > width and not cells[-1].strip():
+        cells = cells[:-1]
+    return cells
+
+
+def _split_number(header: list[str], cells: list[str], numeric) -> str | None:
+    """A decimal comma in the number before the note (``32,270``, the note ``270``: the same
+    count of cells as the header when the note was left empty or out, or Excel's trailing
+    comma was its place): named, not read as 32 mm and a note."""
+    at = header.index("note")
+    if 0 < at < len(cells) and header[at - 1] in numeric and "." not in cells[at - 1]:
+        if re.fullmatch(r"\d+", cells[at].strip()):
+            return (
+                f"{header[at - 1]} {cells[at - 1].strip()!r} and the note {cells[at].strip()!r}: "
+                "a decimal comma? numbers take a point: 33.221"
+            )
+    return None
 
 
 def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> dict:
@@ -95,8 +121,9 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
         if len(cells) > len(header):  # every value after a decimal comma moved
             raise ConfigError(
                 key,
-                f"{p}: data row {i} has {len(cells)} cells for the header's "
-                f"{len(header)} (a decimal comma? numbers take a point: 33.221)",
+                f"{p}: data row {i} has {len(cells)} cells for the header's {len(header)} "
+                f"(line {line}: {cells[len(header)].strip()[:20]!r} after its last column, "
+                f"{header[-1]}: a decimal comma? numbers take a point: 33.221)",
             )
         r = dict(zip(header, cells))
         if gone := [c for c in cols[:-1] if c not in r]:  # the note may be left out
@@ -105,6 +132,8 @@ def _read_csv(path, key: str, numeric, groups: str, need: tuple[str, ...]) -> di
                 f"{p}: data row {i} (line {line}) has {len(cells)} cells for the header's "
                 f"{len(header)}: no {gone[0]} (is the file cut short?)",
             )
+        if why := _split_number(header, cells, numeric):  # the last number's decimals a note
+            raise ConfigError(key, f"{p}: data row {i} (line {line}): {why}")
         g = r[groups].strip()
         if g not in need:  # a row of another plate was left out of every claim without a word
             raise ConfigError(  # (a zero-width space in "003" too)
