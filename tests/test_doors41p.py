@@ -20,6 +20,12 @@ code before its fix.
   precisely the same x_j, y_j" failed, on the solver's limit, not on Brown's model. The
   check's adjustments are held to 1e-10 mm whatever the run's tolerance, and its note says so
   (:func:`sim.studies.brown.core._bias_rows`).
+* ``brown_dilution`` and ``brown_table1``: ``errors.bias_um`` (up to 10 mm, the personal bias
+  the simulation adds to every reading) with the stations 30 mm out, each within its bounds:
+  the scale check took the true ranges alone (62 to 258 mm, on the 262 mm scale) while the
+  comparator read them 10 mm longer, up to 268 mm, and the run scored the plate as Brown's
+  comparator. The readings with the bias are checked against the scale too, naming
+  ``errors.bias_um`` (:func:`sim.studies.brown.range_keys.check_scale`).
 * a network held by minimal constraints or an inner datum, one of whose sights has a sigma of
   1e-9 mm beside others of 1e-3 mm (each within the weights' bounds): its normals bordered by
   the constraints lose more than ten digits, and it was refused as "a rank defect of 3 (58
@@ -78,6 +84,20 @@ def test_brown_bias_invariance_is_not_decided_by_a_loose_solver_tolerance():
     assert out["bias.alpha_err_mm"][0] < 1e-9, out["bias.alpha_err_mm"]
     # the run's own adjustments keep the run's tolerance
     assert np.all(out["rows.pivot_converged"])
+
+
+@pytest.mark.parametrize("study", ["brown_table1", "brown_dilution"])
+def test_brown_bias_that_reads_off_the_scale_is_refused(capsys, study):
+    path = str(STUDIES / f"{study}.toml")
+    argv = ["check", path, "--set", "comparator.station_offset_mm=30"]
+    line = one_line(capsys, main([*argv, "--set", "errors.bias_um=1e4"]), prefix=SIM_ERROR)
+    assert line.startswith(SIM_ERROR + "errors.bias_um: a bias of 10 mm on every range"), line
+    assert "to 268.2 mm" in line and "reads 0 to 262 mm" in line, line
+    # the range alone off the scale is named by the keys that moved it, as before
+    argv = ["check", path, "--set", "comparator.station_offset_mm=40"]
+    one_line(capsys, main(argv), "ranges run from", prefix=SIM_ERROR + "comparator.station")
+    assert main(["check", path, "--set", "errors.bias_um=1e4"]) == 0  # 256 mm: on the scale
+    capsys.readouterr()
 
 
 GEN = [

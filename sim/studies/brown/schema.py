@@ -17,7 +17,7 @@ from sim.mc.read_when import when
 from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
 from sim.mc.schema_helpers import compared, count, counts, positive, printed, real
 from sim.studies.brown.probe import check_solver
-from sim.studies.brown.range_keys import moved_from_paper
+from sim.studies.brown.range_keys import check_scale, moved_from_paper
 from sim.studies.brown.values import thetas
 
 SEED = "004_f5bd9e86c308241f.txt"
@@ -351,21 +351,7 @@ def check(cfg: dict) -> None:
             f"stations {half + off:g} mm from the centre (half the {2 * half:g} mm format "
             f"plus the {off:g} mm offset) are so far out that the ranges overflow",
         )
-    if cfg["comparator.scale_length_mm"] > 0:
-        reach = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
-        if r.max() > reach or r.min() < 0:
-            moved = moved_from_paper(cfg, key, {k: f.default for k, f in BASE.items()})
-            raise ConfigError(
-                moved[0] if moved else "comparator.scale_length_mm",
-                f"ranges run from {r.min():.1f} to {r.max():.1f} mm but the scale "
-                f"(comparator.scale_length_mm + comparator.micrometer_mm) reads 0 to "
-                f"{reach:g} mm (move the stations in, or use alpha)"
-                + (
-                    f"; changed from their paper or nominal values: {', '.join(moved)}"
-                    if moved
-                    else ""
-                ),
-            )
+    check_scale(cfg, key, r, {k: f.default for k, f in BASE.items()})
     check_pivot(cfg, key, pts)
     check_solver(cfg, pts, setup(cfg)[1], MODEL_NAMES, BASE["solver.max_iter"].default)
     require_chunks(cfg)
