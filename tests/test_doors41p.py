@@ -13,6 +13,15 @@ code before its fix.
   computed every chunk, then refused, "only 0 trials converged in all models (... pivot
   40)". It is refused on load, naming ``comparator.beta_mm`` and the scale's width
   (:func:`sim.studies.brown.schema.check`).
+* ``brown_dilution`` and ``brown_table1``: ``comparator.alpha_mm = 50`` (within its -50 to
+  50 mm) on a 3 x 3 plate 60 mm apart with the stations 0.5 mm out: the pivot model starts at
+  alpha = beta = 0, and its first Gauss-Newton step, even on exact ranges, went to stations 50
+  mm in where its normals are singular. ``sim check`` passed (its solver probe runs only at an
+  iteration limit of 8 or less) and the run computed every chunk, then refused, "only 0 trials
+  converged in all models (non-converged: known 0, stations 0, pivot 40)", naming the solver's
+  keys, which no value helps. Each model's adjustment of the exact ranges from its start is
+  tried on load, and a geometry it cannot leave is refused naming the key whose paper or
+  nominal value lets it converge (:func:`sim.studies.brown.probe.check_start`).
 * ``brown_dilution``: ``solver.tol_mm`` (up to 1e-3 mm) above the zone of the
   bias-invariance claims (+-1e-9 mm, "zero to rounding"): each of the check's two pivot
   adjustments stopped as far from its solution as the solver was asked, so at 1e-3 mm they
@@ -64,6 +73,18 @@ def test_brown_beta_wider_than_the_scale_is_refused(capsys, study):
     one_line(capsys, main(argv), "14.5 mm", prefix=SIM_ERROR + "comparator.beta_mm: ")
     assert main(["check", path, "--set", "comparator.beta_mm=14.5"]) == 0
     capsys.readouterr()
+
+
+@pytest.mark.parametrize("study", ["brown_table1", "brown_dilution"])
+def test_brown_pivot_offsets_its_start_cannot_reach_are_refused_on_load(capsys, study):
+    sets = ["comparator.alpha_mm=50", "comparator.beta_mm=5", "comparator.station_offset_mm=0.5"]
+    sets += ["plate.grid=3", "plate.spacing_mm=60"]
+    argv = ["check", str(STUDIES / f"{study}.toml")]
+    for s in sets:
+        argv += ["--set", s]
+    line = one_line(capsys, main(argv), prefix=SIM_ERROR + "comparator.alpha_mm: the pivot")
+    assert "does not converge from its start values" in line, line
+    assert "plate.grid" in line and "only 0 trials" not in line, line
 
 
 def test_brown_bias_invariance_is_not_decided_by_a_loose_solver_tolerance():
