@@ -41,7 +41,11 @@ code before its fix.
   unknowns, rank 55) that the datum (3 constraints) does not cover: add constraints or
   observations", a defect the constraints do cover. It is named as a fixed datum's is, near-
   singular from its weights, with the weakest unknown and the reciprocal condition number of
-  the bordered normals (:mod:`sim.studies.network.weights`).
+  the bordered normals (:mod:`sim.studies.network.weights`). Where the normals with every
+  observation of one weight are as near-singular, the geometry is named instead: Brown's
+  network with ``network.estimate_scale = true``, whose scale only the 1 mm offset tells from
+  the network's size (a reciprocal condition number of 5.9e-11), was the same "rank defect of
+  3 ... that the datum (3 constraints) does not cover"; it names ``network.estimate_scale``.
 """
 
 from pathlib import Path
@@ -139,3 +143,14 @@ def test_a_held_network_singular_from_its_weights_is_not_a_rank_defect(kind):
     bad = [{"S2.x": 1.0}, {"S4.x": 1.0}, {"S1.y": 1.0}]  # no rotation held
     with pytest.raises(sim.ConfigError, match=r"^datum.constraints: the network has a rank"):
         sim.load(STUDIES / "network_brown.toml", datum__constraints=bad)
+
+
+def test_a_held_network_near_singular_from_its_geometry_names_the_estimated_scale():
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(STUDIES / "network_brown.toml", network__estimate_scale=True)
+    msg = str(e.value)
+    assert msg.startswith("network.estimate_scale: the network is near-singular: scale is"), msg
+    assert "its geometry, not its sigmas" in msg and "rank defect" not in msg, msg
+    # without the offset the scale is a defect no datum of three constraints holds
+    with pytest.raises(sim.ConfigError, match=r"^datum.constraints: the network has a rank"):
+        sim.load(STUDIES / "network_brown.toml", network__estimate_scale=True, network__offset_mm=0)

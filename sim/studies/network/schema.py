@@ -46,7 +46,7 @@ from sim.studies.network.sparse_analysis import (
     variances,
 )
 from sim.studies.network.validate import fits_estimate
-from sim.studies.network.weights import covered, refuse_weights, unknown
+from sim.studies.network.weights import covered, equilibrated, refuse_weights, unknown
 
 __all__ = ["SCHEMA", "check", "unread"]
 
@@ -390,23 +390,11 @@ _DEFECT_ADVICE = {
 }
 
 
-def _equilibrated(A: np.ndarray) -> np.ndarray:
-    """``A`` with unit rows, then unit columns (zero ones left zero): the same rank, without
-    the spread of the weights. A sight of 1e-6 mm weighs 1e22 times a 100 m one; its rows
-    pushed seven honest singular values below the relative tolerance, so a network of full
-    rank held by four fixed points read as a rank defect of 12 the datum does not cover."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.linalg.norm(A, axis=1)
-        B = A / np.where(r > 0, r, 1.0)[:, None]
-        c = np.linalg.norm(B, axis=0)
-        return B / np.where(c > 0, c, 1.0)
-
-
 def _defect(net, dt, key: str, kind: str = "fixed") -> None:
     free = dt.free_index(net.q)
     _, J = computed(net, net.theta_true()[None], jac=True)
     A = J[0][:, free] / net.sigma[:, None]
-    B = _equilibrated(A)
+    B = equilibrated(A)
     sv = np.linalg.svd(B, compute_uv=False)
     rank = int((sv > sv[0] * 1e-10).sum()) if sv.size else 0
     if sv.size and rank == len(free):
