@@ -23,6 +23,7 @@ from sim.instruments.ranges import multilateration as ml
 from sim.mc.config import ConfigError
 from sim.mc.runner import chunk_rng
 from sim.studies.brown import values as V
+from sim.studies.brown.core import BIAS_TOL_MM
 from sim.studies.brown.schema import MODEL_NAMES, TABLE1, range_sigma_um
 
 BOOK = Path(__file__).with_name("claims.toml")
@@ -174,7 +175,13 @@ def score_dilution(book, cfg, pts, theta, an, mc, sim, curve, extra, mono) -> li
             sim["bias.max_point_shift_mm"].max(),
             f"largest coordinate change over {nb} Monte-Carlo plates when "
             f"{cfg['checks.bias_shift_um']:g} um is added to every range (pivot "
-            "model); zero to rounding",
+            "model); zero to rounding"
+            + (
+                f" (both adjustments converged to {BIAS_TOL_MM:g} mm, not the run's "
+                f"solver.tol_mm = {cfg['solver.tol_mm']:g} mm)"
+                if cfg["solver.tol_mm"] > BIAS_TOL_MM
+                else ""
+            ),
         ),
         "brown.bias_invariance.alpha_shift_error_mm": exact(
             sim["bias.alpha_err_mm"].max(),

@@ -10,10 +10,11 @@ from __future__ import annotations
 import numpy as np
 
 from sim.instruments.ranges import multilateration as ml
+from sim.mc.config import ConfigError
 from sim.mc.runner import PROBE_MAX_ITER, PROBE_SEED, PROBE_TRIALS, probe_limit
 from sim.studies.brown.values import start_theta
 
-__all__ = ["check_solver"]
+__all__ = ["check_solver", "check_start"]
 
 
 def check_solver(cfg: dict, pts: np.ndarray, theta: np.ndarray, models, default: int) -> None:
@@ -49,3 +50,43 @@ def check_solver(cfg: dict, pts: np.ndarray, theta: np.ndarray, models, default:
 
     for m in models:
         probe_limit(cfg, statuses(m), default, f"{m} model")
+
+
+def _starts(cfg: dict, geometry, models, max_iter: int) -> str:
+    """The first of ``models`` whose adjustment of the exact ranges of ``geometry(cfg)``
+    (points (n, 2) mm, globals (7,)) does not converge from its start values ("": all do)."""
+    pts, theta = geometry(cfg)
+    r = ml.ranges(pts[None], theta[None])
+    for m in models:
+        t0 = start_theta(theta, m)
+        res = ml.adjust(r, m, t0, tol_mm=cfg["solver.tol_mm"], max_iter=max_iter, engine="numpy")
+        if res.status[0] != 0:
+            return m
+    return ""
+
+
+def check_start(cfg: dict, key: str, geometry, models, moved, defaults: dict) -> None:
+    """Every model's adjustment reaches the true globals from its start values (the design
+    stations; the pivot model's alpha and beta^2 at 0) on the exact ranges, within the larger
+    of ``solver.max_iter`` and its default: a 3 x 3 plate 60 mm apart with alpha = 50 mm took
+    its first Gauss-Newton step to stations 50 mm in, where the normals are singular, and every
+    trial failed after the run computed every chunk ("only 0 trials converged ... pivot 40").
+    ``geometry``: the config's points and globals; ``moved``: the keys changed from
+    ``defaults`` (:func:`sim.studies.brown.range_keys.moved_from_paper`), of which the one
+    whose default value lets the model converge is named (alpha and beta first, which the
+    start misses), else ``key`` (the points')."""
+    it = max(cfg["solver.max_iter"], defaults["solver.max_iter"])
+    m = _starts(cfg, geometry, models, it)
+    if not m:
+        return
+    zeros = ("comparator.alpha_mm", "comparator.beta_mm")  # what the start misses first
+    order = [k for k in zeros if k in moved] + [k for k in reversed(moved) if k not in zeros]
+    blame = next((k for k in order if not _starts({**cfg, k: defaults[k]}, geometry, [m], it)), key)
+    raise ConfigError(
+        blame,
+        f"the {m} model does not converge from its start values (the design stations"
+        + (", alpha and beta at 0" if m == "pivot" else "")
+        + f") within {it} iterations even on exact ranges, so no trial would (the run would "
+        "compute every chunk, then refuse)"
+        + (f"; changed from their paper or nominal values: {', '.join(moved)}" if moved else ""),
+    )

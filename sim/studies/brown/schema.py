@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.instruments.plates import pattern_points
+from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
 from sim.instruments.ranges import positions as po
 from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
@@ -15,8 +16,8 @@ from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import when
 from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
 from sim.mc.schema_helpers import compared, count, counts, positive, printed, real
-from sim.studies.brown.probe import check_solver
-from sim.studies.brown.range_keys import moved_from_paper
+from sim.studies.brown.probe import check_solver, check_start
+from sim.studies.brown.range_keys import check_scale, moved_from_paper
 from sim.studies.brown.values import thetas
 
 SEED = "004_f5bd9e86c308241f.txt"
@@ -91,7 +92,11 @@ BASE = {
         0.5, "radial pivot offset alpha (true value)", lo=-50.0, hi=50.0, unit="mm"
     ),
     "comparator.beta_mm": real(
-        1.0, "tangential pivot offset beta (true value)", lo=0.0, hi=50.0, unit="mm"
+        1.0,
+        "tangential pivot offset beta (true value; at most half the 29 mm scale's width: "
+        "checked on load)",
+        lo=0.0,
+        unit="mm",
     ),
     "comparator.scale_length_mm": printed(
         real(
@@ -270,10 +275,10 @@ def check_extents(cfg: dict) -> None:
 
 
 def check(cfg: dict) -> None:
-    """Cross-key rules: a range sigma the model can divide by, points inside the format,
-    enough points, no duplicates/collinearity, every range on the scale, and the chunks the
-    Monte-Carlo agreement rows' jackknife intervals need (:func:`sim.studies.brown.core.MC.jack`:
-    at least :data:`sim.mc.runner.MIN_CHUNKS`)."""
+    """Cross-key rules: a range sigma the model can divide by, beta under the scale, points
+    inside the format, enough points, no duplicates/collinearity, every range on the scale, and
+    the chunks the Monte-Carlo agreement rows' jackknife intervals need (at least
+    :data:`sim.mc.runner.MIN_CHUNKS`: :func:`sim.studies.brown.core.MC.jack`)."""
     if range_sigma_um(cfg) < MIN_RANGE_SIGMA_UM:
         # (tenth sweep) errors.setting_sigma_um = 5e-324 without a comparator error passed
         # check; the run's ratios to the range sigma were NaN, its claims not finite
@@ -284,6 +289,13 @@ def check(cfg: dict) -> None:
             "ratios to it): give a larger setting or comparator sigma",
         )
     check_extents(cfg)
+    if cfg["comparator.beta_mm"] > B.SCALE_WIDTH_MM / 2:  # (P41) 30 mm ran as Brown's comparator;
+        raise ConfigError(  # at 50 mm no pivot adjustment converged, refused after the run
+            "comparator.beta_mm",
+            f"beta = {cfg['comparator.beta_mm']:g} mm is more than half the "
+            f"{B.SCALE_WIDTH_MM:g} mm width of the scale ({B.SCALE_WIDTH_MM / 2:g} mm): the "
+            "pivot ball lies under the scale",
+        )
     key = {"grid": "plate.grid", "random": "plate.n_random", "list": "plate.points"}[
         cfg["plate.pattern"]
     ]
@@ -339,22 +351,10 @@ def check(cfg: dict) -> None:
             f"stations {half + off:g} mm from the centre (half the {2 * half:g} mm format "
             f"plus the {off:g} mm offset) are so far out that the ranges overflow",
         )
-    if cfg["comparator.scale_length_mm"] > 0:
-        reach = cfg["comparator.scale_length_mm"] + cfg["comparator.micrometer_mm"]
-        if r.max() > reach or r.min() < 0:
-            moved = moved_from_paper(cfg, key, {k: f.default for k, f in BASE.items()})
-            raise ConfigError(
-                moved[0] if moved else "comparator.scale_length_mm",
-                f"ranges run from {r.min():.1f} to {r.max():.1f} mm but the scale "
-                f"(comparator.scale_length_mm + comparator.micrometer_mm) reads 0 to "
-                f"{reach:g} mm (move the stations in, or use alpha)"
-                + (
-                    f"; changed from their paper or nominal values: {', '.join(moved)}"
-                    if moved
-                    else ""
-                ),
-            )
+    check_scale(cfg, key, r, {k: f.default for k, f in BASE.items()})
     check_pivot(cfg, key, pts)
+    base = {k: f.default for k, f in BASE.items()}
+    check_start(cfg, key, setup, MODEL_NAMES, moved_from_paper(cfg, key, base), base)
     check_solver(cfg, pts, setup(cfg)[1], MODEL_NAMES, BASE["solver.max_iter"].default)
     require_chunks(cfg)
 

@@ -14,7 +14,6 @@ import math
 
 import numpy as np
 
-from sim.lsq.normals import RCOND, scaled_rcond
 from sim.mc.config import ConfigError, given
 from sim.mc.progress import phase
 from sim.mc.runner import require_chunks
@@ -47,6 +46,7 @@ from sim.studies.network.sparse_analysis import (
     variances,
 )
 from sim.studies.network.validate import fits_estimate
+from sim.studies.network.weights import covered, equilibrated, refuse_weights, unknown
 
 __all__ = ["SCHEMA", "check", "unread"]
 
@@ -340,7 +340,7 @@ def _conditioned(net, an, key: str) -> None:
     vif = q_ii * n_ii
     if not np.all(np.isfinite(vif)) or vif.max() > MAX_INFLATION:
         g = int(np.argmax(np.where(np.isfinite(vif), vif, np.inf)))
-        what = _unknown(net, int(an.free[g]))
+        what = unknown(net, int(an.free[g]))
         raise ConfigError(
             key,
             f"the network is near-singular: {what} is determined {vif[g]:.3g} times worse "
@@ -349,39 +349,14 @@ def _conditioned(net, an, key: str) -> None:
         )
 
 
-def _unknown(net, par: int) -> str:
-    """The unknown of column ``par`` for a message: a point's coordinate (``point 'P1' (x)``)
-    or the name of a network parameter (a scale, a constant, an orientation)."""
-    if par < 2 * net.n:
-        return f"point {net.names[par // 2]!r} ({'xy'[par % 2]})"
-    return net.parameter_names()[par - 2 * net.n]
-
-
 def _pivot(net, factor, free: np.ndarray) -> str:
     """The unknown at the sparse factor's failed pivot (:attr:`sim.lsq.sparse.Factor.weak`),
     named as the dense path names its weakest one; "" when the factor names none."""
     if factor is None or factor.weak < 0:
         return ""
     return (
-        f"{_unknown(net, int(free[factor.weak]))} is nearly undetermined (the smallest pivot "
+        f"{unknown(net, int(free[factor.weak]))} is nearly undetermined (the smallest pivot "
         "of the normals falls on it; points nearly on one line, or too few observations)"
-    )
-
-
-def _weights(net, A: np.ndarray, free: np.ndarray, key: str) -> None:
-    """A network of full rank whose normals the engine still finds singular: the sigmas
-    make it so (e.g. weighted coordinates a million times looser than the differences
-    between them). Name the weakest unknown and the reciprocal condition number of the
-    normals scaled to unit diagonal, under the engine's limit :data:`RCOND`."""
-    vt = np.linalg.svd(A, full_matrices=False)[2]
-    what = _unknown(net, int(free[int(np.argmax(np.abs(vt[-1])))]))
-    rc = float(scaled_rcond(A.T @ A))
-    raise ConfigError(
-        key,
-        f"the network is near-singular from its weights: {what} is nearly undetermined "
-        f"(the normal matrix scaled to unit diagonal has a reciprocal condition number of "
-        f"{rc:.2g}, under the engine's limit of {RCOND:g}, more than ten digits lost): "
-        "bring the observations' sigmas closer together, or fix points",
     )
 
 
@@ -415,30 +390,21 @@ _DEFECT_ADVICE = {
 }
 
 
-def _equilibrated(A: np.ndarray) -> np.ndarray:
-    """``A`` with unit rows, then unit columns (zero ones left zero): the same rank, without
-    the spread of the weights. A sight of 1e-6 mm weighs 1e22 times a 100 m one; its rows
-    pushed seven honest singular values below the relative tolerance, so a network of full
-    rank held by four fixed points read as a rank defect of 12 the datum does not cover."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.linalg.norm(A, axis=1)
-        B = A / np.where(r > 0, r, 1.0)[:, None]
-        c = np.linalg.norm(B, axis=0)
-        return B / np.where(c > 0, c, 1.0)
-
-
 def _defect(net, dt, key: str, kind: str = "fixed") -> None:
     free = dt.free_index(net.q)
     _, J = computed(net, net.theta_true()[None], jac=True)
     A = J[0][:, free] / net.sigma[:, None]
-    sv = np.linalg.svd(_equilibrated(A), compute_uv=False)
+    B = equilibrated(A)
+    sv = np.linalg.svd(B, compute_uv=False)
     rank = int((sv > sv[0] * 1e-10).sum()) if sv.size else 0
     if sv.size and rank == len(free):
-        _weights(net, A, free, key)
-    if sv.size and rank < len(free):
-        _parameters(net, A, free, rank)
+        refuse_weights(net, A, free, key)
     C = dt.constraint_matrix(net.theta_true()[None])
     c = 0 if C is None else C.shape[-1]
+    if sv.size and rank < len(free) and covered(B, None if C is None else C[0]):
+        refuse_weights(net, A, free, key, C[0])  # the datum holds the defect: the sigmas
+    if sv.size and rank < len(free):
+        _parameters(net, A, free, rank)
     advice = _DEFECT_ADVICE.get(kind, _DEFECT_ADVICE["fixed"])
     if len(free) - rank > defect_basis(net, free).shape[1]:  # more than a datum can hold
         advice = _DEFECT_ADVICE["inner"]  # (inner or constraints: the same refusal again)
