@@ -34,12 +34,14 @@ from pathlib import Path
 
 from fuzz_sequence_run import (
     References,
+    api_read,
     api_run,
     batch_main,
     claims_block,
     incomplete,
     lines,
     record,
+    same_claims,
     sha256,
     sim_main,
     spawn,
@@ -122,8 +124,13 @@ class Case:
         return {str(p.relative_to(self.out)): sha256(p) for p in self.out.rglob("*") if p.is_file()}
 
 
-def _run_argv(rng: random.Random, sets: list[str], overwrite: bool) -> list[str]:
-    argv = ["run", "net.toml", "--quiet", "--out", "res/net"]
+def _spelt(rng: random.Random, c: Case) -> str:
+    """The output directory as a step spells it (one directory whatever the spelling)."""
+    return rng.choice(["res/net"] * 4 + ["./res/net", "res/net/", str(c.out), "res/../res/net"])
+
+
+def _run_argv(rng: random.Random, c: Case, sets: list[str], overwrite: bool) -> list[str]:
+    argv = ["run", "net.toml", "--quiet", "--out", _spelt(rng, c)]
     for s in sets:
         k, v = s.split("=")
         form = rng.random()
@@ -149,7 +156,7 @@ def step(rng: random.Random, c: Case, op: str):
         c.interrupted = None
         return f"resume ({desc})", code, so, se, state, {0, 2}
     if op == "edit_during":  # a run, its Gama or study file saved anew at a marker
-        argv = _run_argv(rng, sets, rng.random() < 0.7)
+        argv = _run_argv(rng, c, sets, rng.random() < 0.7)
         state, target = c.state(sets), sim_main(argv)
         model = {**c.model, "trials": 100 - c.model["trials"]}
         xml = rng.choice([i for i in range(len(XMLS)) if i != c.xml])
@@ -172,7 +179,7 @@ def step(rng: random.Random, c: Case, op: str):
             c.model["sweep"] = True
             c.write()
         overwrite = op == "overwrite" or (op in ("interrupt", "sweep") and rng.random() < 0.7)
-        argv = _run_argv(rng, sets, overwrite)
+        argv = _run_argv(rng, c, sets, overwrite)
         state, target = c.state(sets), sim_main(argv)
         marker = (rng.randint(1, 60), rng.choice(SIGNALS)) if op == "interrupt" else None
         code, so, se = spawn(c.d, target, c.log(), marker=marker)
@@ -185,7 +192,7 @@ def step(rng: random.Random, c: Case, op: str):
     if op == "api":  # interrupted at a marker one time in three
         overwrite = rng.random() < 0.5
         state = c.state(sets)
-        target = api_run("net.toml", _api_kw(sets), "res/net", overwrite)
+        target = api_run("net.toml", _api_kw(sets), _spelt(rng, c), overwrite)
         marker = (rng.randint(1, 60), rng.choice(SIGNALS)) if rng.random() < 0.33 else None
         code, so, se = spawn(c.d, target, c.log(), marker=marker)
         desc = f"api: sim.load(net.toml, {sets}).run(overwrite={overwrite})"
@@ -214,9 +221,14 @@ def step(rng: random.Random, c: Case, op: str):
         return f"edit net.xml: version {c.xml}", 0, "", "", None, {0}
     if op == "hand":
         return _hand(rng, c) + ("", "", None, {0})
+    if op == "results":  # the API's reader of a results directory
+        out = _spelt(rng, c)
+        code, so, se = spawn(c.d, api_read(out, "claims.got"), c.log())
+        return f"sim.Results({out!r}).table('claims')", code, so, se, None, {0, 2}
     if op == "show":
-        code, so, se = spawn(c.d, sim_main(["show", "res/net"]), c.log())
-        return "sim show res/net", code, so, se, None, {0, 2}
+        argv = ["show", _spelt(rng, c)]
+        code, so, se = spawn(c.d, sim_main(argv), c.log())
+        return "sim " + " ".join(argv), code, so, se, None, {0, 2}
     # a report or verify interrupted one time in four, at one of the few files it writes
     marker = (rng.randint(1, 3), rng.choice(SIGNALS)) if rng.random() < 0.25 else None
     how = f" ({signal.Signals(marker[1]).name} at rename {marker[0]})" if marker else ""
@@ -299,6 +311,12 @@ def check(c: Case, op, desc, code, so, se, state, codes, before) -> str | None:
             after.pop("README.md", None), before.pop("README.md", None)
         if after != before:
             return f"{op} changed res/net: {sorted(set(after.items()) ^ set(before.items()))[:3]}"
+    if op == "results" and code == 0:
+        ref = c.refs.of_config(rec.get("config")) if rec else None
+        got = c.d / "claims.got"
+        if ref is None or (ref[2] / "claims.parquet").is_file() and not same_claims(got, ref[2]):
+            return "sim.Results read a claims table other than its run's"
+        got.unlink()
     if op == "show" and code == 0:
         ref = c.refs.of_config(rec.get("config")) if rec else None
         if ref is None or claims_block(so) != ref[1]:

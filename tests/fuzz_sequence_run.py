@@ -165,6 +165,34 @@ def api_run(study: str, kw: dict, out: str, overwrite: bool):
     return target
 
 
+def api_read(out: str, to: str):
+    """``sim.Results(out, "network").table("claims")`` written to ``to`` (0), or one line and
+    2 for a ``ConfigError``/``StudyError``."""
+
+    def target():
+        import pyarrow.parquet as pq
+
+        import sim
+
+        try:
+            t = sim.Results(out, "network").table("claims")
+        except (sim.ConfigError, sim.StudyError) as e:
+            print(f"sim.api: error: {e}", file=sys.stderr)
+            return 2
+        pq.write_table(t.replace_schema_metadata(None), to)
+        return 0
+
+    return target
+
+
+def same_claims(got: Path, ref: Path) -> bool:
+    """Whether the claims table read by the API (``got``) is the reference run's."""
+    import pyarrow.parquet as pq
+
+    a = pq.read_table(got).replace_schema_metadata(None)
+    return a.equals(pq.read_table(ref / "claims.parquet").replace_schema_metadata(None))
+
+
 def lines(err: str) -> list[str]:
     """The lines of ``err`` that are not notes (a batch's run's named by its study file)."""
     err = "\n".join(ln.removeprefix("net.toml: ") for ln in err.splitlines())
