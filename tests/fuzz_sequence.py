@@ -283,12 +283,12 @@ def check(c: Case, op, desc, code, so, se, state, codes, before) -> str | None:
     if rec is not None:
         if (why := incomplete(c.out, c.missing)) is not None:
             return f"res/net is not a complete run: {why}"
-        ref = c.refs.of_config(rec.get("config"))
+        ref = c.refs.of_config(rec)
         for s in reversed(c.asked):
             if ref is not None:
                 break
             c.refs.get(s)
-            ref = c.refs.of_config(rec.get("config"))
+            ref = c.refs.of_config(rec)
         if ref is None:
             return "res/net records a config no step asked for"
         for key in ("table_sha256", "chunk_sha256"):
@@ -312,13 +312,13 @@ def check(c: Case, op, desc, code, so, se, state, codes, before) -> str | None:
         if after != before:
             return f"{op} changed res/net: {sorted(set(after.items()) ^ set(before.items()))[:3]}"
     if op == "results" and code == 0:
-        ref = c.refs.of_config(rec.get("config")) if rec else None
+        ref = c.refs.of_config(rec) if rec else None
         got = c.d / "claims.got"
         if ref is None or (ref[2] / "claims.parquet").is_file() and not same_claims(got, ref[2]):
             return "sim.Results read a claims table other than its run's"
         got.unlink()
     if op == "show" and code == 0:
-        ref = c.refs.of_config(rec.get("config")) if rec else None
+        ref = c.refs.of_config(rec) if rec else None
         if ref is None or claims_block(so) != ref[1]:
             return f"sim show printed claims other than its run's:\n{claims_block(so)[:600]}"
     if op == "verify" and code == 0:

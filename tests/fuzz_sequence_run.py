@@ -243,9 +243,13 @@ class References:
 
     def get(self, state: tuple) -> tuple[dict | None, str, Path]:
         """``(run.json, sim show's claims, directory)`` of ``state``'s clean run; the record is
-        None when the state is refused (a run of it must then be refused too)."""
+        None when the state is refused (a run of it must then be refused too). Made again when
+        the study's code changed since (a code hash of its own: other tables)."""
+        from sim.mc.codehash import study_code_hash
+
+        state = (*state, study_code_hash("network"))
         if state not in self.made:
-            text, xml, sets = state
+            text, xml, sets, _ = state
             d = self.root / f"ref{len(self.made):03d}"
             d.mkdir(parents=True)
             (d / "net.toml").write_text(text)
@@ -261,9 +265,11 @@ class References:
             self.made[state] = (rec, shown, d / "res" / "net")
         return self.made[state]
 
-    def of_config(self, config) -> tuple | None:
-        """The reference made so far whose run recorded ``config``, or None."""
+    def of_config(self, run: dict) -> tuple | None:
+        """The reference made so far whose run recorded the config and code hash of the run
+        record ``run``, or None."""
         for rec, shown, d in self.made.values():
-            if rec is not None and rec.get("config") == config:
-                return rec, shown, d
+            if rec is not None and rec.get("config") == run.get("config"):
+                if rec.get("code_hash") == run.get("code_hash"):
+                    return rec, shown, d
         return None
