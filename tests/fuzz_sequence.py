@@ -246,20 +246,21 @@ def _hand(rng: random.Random, c: Case) -> tuple[str, int]:
     if record(c.out) is None:
         return "hand: nothing to edit", 0
     what = rng.choice(["figure", "touch", "user", "user"])
-    figs = sorted(p for p in c.out.glob("*.png"))
+    figs = sorted(p.relative_to(c.out).as_posix() for p in c.out.rglob("*.png"))  # cells' too
     if what == "figure" and figs:
-        p = rng.choice(figs)
-        p.unlink()
-        c.missing.add(p.name)
-        return f"hand: rm {p.name}", 0
-    tables = sorted(c.out.glob("*.parquet"))
+        f = rng.choice(figs)
+        (c.out / f).unlink()
+        c.missing.add(f)
+        return f"hand: rm {f}", 0
+    tables = sorted(p for p in c.out.rglob("*.parquet") if "trials" not in p.parts)
     if what == "touch" and tables:
         p = rng.choice(tables)
         os.utime(p, (time.time() + 3600, time.time() + 3600))
-        return f"hand: touch {p.name}", 0
-    name = rng.choice(["notes.txt", "mine/plot.py", "notes.txt"])
+        return f"hand: touch {p.relative_to(c.out)}", 0
+    cells = sorted(p.relative_to(c.out).as_posix() for p in c.out.glob("cells/*"))
+    name = rng.choice(["notes.txt", "mine/plot.py", "notes.txt"] + [f"{x}/notes.md" for x in cells])
     data = f"{name}: {rng.random()}\n".encode()
-    (c.out / name).parent.mkdir(exist_ok=True)
+    (c.out / name).parent.mkdir(parents=True, exist_ok=True)
     (c.out / name).write_bytes(data)
     c.users[name] = data
     return f"hand: add {name}", 0
