@@ -303,7 +303,7 @@ def check(c: Case, op, desc, code, so, se, state, codes, before) -> str | None:
         if rec is None or rec.get("config") != want.get("config"):
             return "exit 0 but res/net does not hold the config the step asked for"
         left = [p.name for p in c.res.iterdir() if p.name.startswith(".net.")]
-        if left:
+        if left and not (op == "batch" and "up to date" in so):  # (an unfinished run's: kept)
             return f"exit 0 but {left} left beside res/net"
         c.missing.clear()
     if op in ("show", "verify", "report"):

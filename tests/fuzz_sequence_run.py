@@ -60,6 +60,9 @@ def spawn(cwd: Path, target, log: Path, marker=None, timeout: float = 300.0):
             os.dup2(fo, 1), os.dup2(fe, 2)
             sys.stdout = open(1, "w", closefd=False)
             sys.stderr = open(2, "w", closefd=False)
+            # Ctrl-C as at a terminal, however the fuzzer was started (in the background of a
+            # script SIGINT is ignored, and Python then installs no KeyboardInterrupt for it)
+            signal.signal(signal.SIGINT, signal.default_int_handler)
             if marker is not None:
                 _marker(*marker)
             code = target()
