@@ -21,6 +21,7 @@ from pathlib import Path
 
 #: the lines of standard error that are notes, not the one line of a refusal or interrupt
 NOTES = ("sim: note:", "sim: resuming", "sim: starting", "sim: a run ", "sim.batch: note")
+NOTES += ("sim verify: re-running ",)  # make verify's progress, on standard error
 
 
 def _marker(k: int, sig) -> None:
