@@ -17,7 +17,9 @@ the code before its fix.
   there is no value to give (the digest is filled in on load, and one given by hand must be
   the file's own: refused again). It now says the file changed since the unfinished run
   started and to put back its contents of then (with the other keys, "run again with its
-  values and net.xml as it was then"); doing so resumes the run.
+  values and net.xml as it was then"); doing so resumes the run. The two digests were cut at
+  40 characters with their closing quotes (``'d6ede3... (this run '923d4...)``): a value
+  cut is now ended by ``...`` and its quote or bracket.
 """
 
 from __future__ import annotations
@@ -43,7 +45,8 @@ def test_an_unfinished_run_of_an_edited_gama_file_says_to_put_it_back(tmp_path, 
     x.write_bytes(GAMA.read_bytes().replace(b'stdev="2.0"', b'stdev="2.5"'))  # edited since
     capsys.readouterr()
     # before: "...; run again with its values to finish it, or use --overwrite to replace it"
-    line = one_line(capsys, main(run), "network.gama_sha256", prefix=SIM_ERROR)
+    line = one_line(capsys, main(run), "network.gama_sha256 = '", prefix=SIM_ERROR)
+    assert line.count("'") == 4 and "...' (this run '" in line  # each sha256 cut, then quoted
     assert f"{x} changed since it started: put back its contents of then to finish it" in line
     assert "run again with its values" not in line and "--overwrite" in line
     line = one_line(capsys, main([*run, "--trials", "60"]), prefix=SIM_ERROR)
