@@ -251,7 +251,9 @@ class References:
         the study's code changed since (a code hash of its own: other tables)."""
         from sim.mc.codehash import study_code_hash
 
-        state = (*state, study_code_hash("network"))
+        # read anew, not through its cache: filled in here, the cache would pass to every step
+        # forked after (their runs recording the hash of the code as it was then)
+        state = (*state, study_code_hash.__wrapped__("network"))
         if state not in self.made:
             text, xml, sets, _ = state
             d = self.root / f"ref{len(self.made):03d}"
