@@ -20,6 +20,19 @@ the code before its fix.
   values and net.xml as it was then"); doing so resumes the run. The two digests were cut at
   40 characters with their closing quotes (``'d6ede3... (this run '923d4...)``): a value
   cut is now ended by ``...`` and its quote or bracket.
+
+Held (about 250 sequences of 4-8 steps, seeds 13 and 4101-4111): every run, resume, batch and
+API call that ended with exit 0 left the config it was asked for, complete, its tables and
+chunks byte for byte a clean run's, no staging or swap directory beside it; every interrupt
+(SIGINT, SIGTERM, SIGKILL at each rename of a run, a sweep, the API, ``sim report`` and
+verify) left the old results or the new ones, never a mixture, and the same command again
+finished the run; a Gama or study file saved anew while a run ran gave the results of the
+file as loaded, or one line; ``--stale-only`` re-ran results of another config, of no figures
+or with a figure deleted (a sweep cell's too) and called no others current; verify passed only
+results of the study file's config; ``sim show`` and ``Results.table`` read only the run the
+directory records; a file of the user's (in the results or a cell) was never lost; no worker
+outlived its run. The API's run in a process that ignores SIGINT (started by ``nohup ... &``)
+goes on when sent one, as Python does: not a class.
 """
 
 from __future__ import annotations
