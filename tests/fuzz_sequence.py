@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import random
+import re
 import shutil
 import signal
 import time
@@ -305,11 +306,17 @@ def check(c: Case, op, desc, code, so, se, state, codes, before) -> str | None:
         left = [p.name for p in c.res.iterdir() if p.name.startswith(".net.")]
         if left and not (op == "batch" and "up to date" in so):  # (an unfinished run's: kept)
             return f"exit 0 but {left} left beside res/net"
+        tmps = [str(p.relative_to(c.out)) for p in c.out.rglob("*.tmp")]
+        if tmps and "up to date" not in so:  # a killed writer's, carried into new results
+            return f"exit 0 but the temporary {tmps[0]} is in res/net"
         c.missing.clear()
     if op in ("show", "verify", "report"):
         after = c.snapshot()
         if op == "report":
             after.pop("README.md", None), before.pop("README.md", None)
+        tmp = re.compile(r"(.*/)?\.[^/]+\.\d+\.tmp")  # of a README.md a kill cut short:
+        after = {f: h for f, h in after.items() if not tmp.fullmatch(f)}  # the suite's (the
+        before = {f: h for f, h in before.items() if not tmp.fullmatch(f)}  # next removes it)
         if after != before:
             return f"{op} changed res/net: {sorted(set(after.items()) ^ set(before.items()))[:3]}"
     if op == "results" and code == 0:
