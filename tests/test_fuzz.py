@@ -37,7 +37,11 @@ message prints the command that reproduces it). The cases are made in tests/fuzz
 from the values of tests/fuzz_values.py and run by tests/fuzz_run.py. The BYTES of a GNU Gama
 XML file and of Wolf's reading tables are fuzzed by ``sim check`` of the study that reads
 them (``test_fuzz_bytes_of_data_files``), the SPLICE of study files and of GNU Gama XML files
-by ``sim check`` too (``test_fuzz_splice``: many cases in little time)."""
+by ``sim check`` too (``test_fuzz_splice``: many cases in little time). A SEQUENCE of
+operations on one small study and one output directory (runs, interrupts at a marker, resumes,
+edits of the study and its Gama file, overrides, ``sim show``, ``sim report``, verify, a sweep,
+``--stale-only``, hand edits, the API: tests/fuzz_sequence.py) is checked after each step
+(``test_fuzz_sequences``: one sequence a ten cases, at least two; ``FUZZ_SEQ_SECONDS``)."""
 
 from __future__ import annotations
 
@@ -50,6 +54,7 @@ from fuzz_bytes import csv_sites, gama_sites, mutate_bytes
 from fuzz_cases import SEED
 from fuzz_keys import network_case
 from fuzz_run import fuzz
+from fuzz_sequence import sequences
 from fuzz_splice import gama_splice, splice_case
 from fuzz_values import NAMES, ROOT, base, small, toml_doc, toml_value
 
@@ -199,6 +204,16 @@ def test_fuzz_splice(tmp_path, capsys):
         elif needle and (rc != 2 or "\n" in err or str(x) not in err or needle not in err):
             failures.append(f"case {i} ({src.name}: {desc}): exit {rc}: {err[-300:]}")
     assert not failures, f"{len(failures)} of {4 * CASES}:\n" + "\n".join(failures)
+
+
+def test_fuzz_sequences(tmp_path):
+    """SEQUENCE (tests/fuzz_sequence.py): seeded orders of runs, interrupts, resumes, edits,
+    overrides, ``sim show``, ``sim report``, verify, sweeps, ``--stale-only``, hand edits and
+    the API on one output directory; after each step the results there are one whole run of
+    a config a step asked for, equal to its clean run, or the step was refused in one line."""
+    n = max(2, CASES // 10)
+    failures = sequences(n, SEED, tmp_path)
+    assert not failures, f"{len(failures)} of {n} sequences:\n" + "\n".join(failures)
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz

@@ -398,13 +398,18 @@ def config_changes(old: Mapping[str, Any], new: Mapping[str, Any], shown: int = 
     ``key = 40 (this run None)``, as if this run had set it to None."""
     keys = sorted(k for k in {*old, *new} if k not in old or k not in new or old[k] != new[k])
 
+    def cut(v) -> str:  # at most 40 characters, its closing quote kept ('d6ede3...' was
+        r = repr(v)  # 'd6ede3 (this run ..., a sha256 cut at 40)
+        end = r[-1] if len(r) > 40 and r[-1] in "'\"]})" else ""
+        return r if len(r) <= 40 else r[: 37 - len(end)] + "..." + end
+
     def one(k: str) -> str:  # a key with a character that does not print named with its
         n = key_text(k)  # escape (a zero-width space in run.json's key was shown raw: unseen)
         if k not in new:
-            return f"{n} = {old[k]!r:.40} (no such key in this run's config)"
+            return f"{n} = {cut(old[k])} (no such key in this run's config)"
         if k not in old:
-            return f"{n}: not in that config (this run {new[k]!r:.40})"
-        return f"{n} = {old[k]!r:.40} (this run {new[k]!r:.40})"
+            return f"{n}: not in that config (this run {cut(new[k])})"
+        return f"{n} = {cut(old[k])} (this run {cut(new[k])})"
 
     return ", ".join(map(one, keys[:shown])) + (" ..." if len(keys) > shown else "")
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from sim.mc.config import ConfigError, config_changes
 from sim.mc.paths import is_chunk_store, link_problem, mount_point, mounts_under
-from sim.mc.record_text import record_problem
+from sim.mc.record_text import finish_words, record_problem
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
 from sim.mc.sweep import reordered
 
@@ -350,7 +350,7 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
             finish = (  # another code version: only that version can finish it, not this one
                 "this version of the suite cannot finish it; "
                 if how == "a different code version"
-                else "run again with its values to finish it, or "
+                else finish_words(old.get("config"), record["config"])
             )
             raise ConfigError(
                 "--out",
