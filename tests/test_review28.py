@@ -73,7 +73,8 @@ def test_a_batch_from_a_deleted_working_directory_is_one_line(tmp_path, monkeypa
     for results in ([], ["--results", str(tmp_path / "R")]):
         assert batch.main([*results, study, "--", "--trials", "40"]) == 2
         err = capsys.readouterr().err
-        assert err == (
-            "sim.batch: No such file or directory: the working directory (it was deleted)\n"
-        ), err
+        # one line naming the working directory as gone (with the default --results, the
+        # argument it was read for, since doors41l)
+        assert err.startswith("sim.batch: ") and err.count("\n") == 1, err
+        assert "working directory" in err and ("gone" in err or "deleted" in err), err
     assert sorted(p.name for p in tmp_path.iterdir()) == []
