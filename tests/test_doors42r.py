@@ -1,0 +1,49 @@
+"""A fresh reading of session 41's merges (doors42r, brief R42), decided: each class through a
+real door; each test fails on the code before its fix:
+
+* the output of a run stopped before it published (c41's ``sim.mc.unfinished``) is looked for
+  by its staging name ``.<name>.partial``, nine bytes longer: a results directory named with
+  247 to 255 bytes, not there, made ``sim show NAME`` say only "File name too long:
+  .<name>.partial" (a file the user never named) and ``sim.Results(NAME, ...).names()`` raise
+  pathlib's ``OSError``: each says the directory does not exist, as for a shorter name;
+* a table pyarrow could not read for want of memory (l41's ``memory_failure``) was told by the
+  word "thread" anywhere in pyarrow's message, which quotes the file's path: a damaged
+  ``claims.parquet`` under a directory named ``threads`` was "cannot be read (not enough
+  memory: ...)" from ``Results.table``: the quoted path is not searched, and the table is
+  named unreadable.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "results" / "brown_table1"  # read, never written
+
+
+def test_a_name_whose_staging_name_is_too_long_does_not_exist(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    name = "r" * 250  # a name the system takes; ".<name>.partial" (259 bytes) it does not
+    assert main(["show", name]) == 2
+    err = capsys.readouterr().err.strip()
+    # before: "sim: error: File name too long: .rrr...rrr.partial"
+    assert len(err.splitlines()) == 1 and "does not exist" in err and ".partial" not in err, err
+    # before: OSError [Errno 36] File name too long
+    with pytest.raises(sim.ConfigError, match="does not exist"):
+        sim.Results(name, "brown_table1").names()
+
+
+def test_a_damaged_table_under_a_directory_named_threads_is_not_short_of_memory(tmp_path):
+    d = tmp_path / "threads" / "brown_table1"
+    shutil.copytree(RESULTS, d, ignore=shutil.ignore_patterns("*.png", "trials"))
+    f = d / "claims.parquet"
+    f.write_bytes(f.read_bytes()[: f.stat().st_size // 2])  # its footer cut off
+    # before: "cannot be read (not enough memory: Could not open Parquet input source ..."
+    with pytest.raises(sim.ConfigError, match=r"claims.parquet cannot be read \(ArrowInvalid\)"):
+        sim.Results(d, "brown_table1").table("claims")
