@@ -129,9 +129,12 @@ class Results:
     def _dataset(self, name: str) -> bool:
         """Whether ``name`` is the chunk dataset ``trials/``: ``chunks`` always, ``trials``
         unless the study writes a table ``trials.parquet`` of its own (wolf, agnard,
-        gridplate), which that name reads (it was unreachable, and listed twice)."""
+        gridplate), which that name reads (it was unreachable, and listed twice), also when
+        its run recorded it and it was removed since (the chunks were named missing)."""
         return name == "chunks" or (
-            name == "trials" and not (self.path / "trials.parquet").exists()
+            name == "trials"
+            and not (self.path / "trials.parquet").exists()
+            and "trials.parquet" not in run_tables(self.path, self.study)  # removed since: named
         )
 
     @_arguments
@@ -154,7 +157,7 @@ class Results:
                 f"not of {self.study!r}{self._within()}",
             )
         if (self.path / "trials").is_dir() and chunks_recorded(self.path):  # else unread
-            names |= {"chunks", "trials"}
+            names |= {"chunks", "trials"} if self._dataset("trials") else {"chunks"}
         return sorted(names)
 
     @_arguments

@@ -10,7 +10,12 @@ real door; each test fails on the code before its fix:
   word "thread" anywhere in pyarrow's message, which quotes the file's path: a damaged
   ``claims.parquet`` under a directory named ``threads`` was "cannot be read (not enough
   memory: ...)" from ``Results.table``: the quoted path is not searched, and the table is
-  named unreadable.
+  named unreadable;
+* ``Results.table("trials")`` of a study that writes ``trials.parquet`` (wolf, agnard,
+  gridplate), that file removed by hand, took the name for the chunk dataset: "trials is
+  missing: its run wrote it (the committed results/ hold no chunks ...)" (d41's words for the
+  committed chunks, of the committed results of wolf_polynomial, which hold trials.parquet):
+  ``trials.parquet`` is named missing, as any table its run wrote.
 """
 
 from __future__ import annotations
@@ -47,3 +52,14 @@ def test_a_damaged_table_under_a_directory_named_threads_is_not_short_of_memory(
     # before: "cannot be read (not enough memory: Could not open Parquet input source ..."
     with pytest.raises(sim.ConfigError, match=r"claims.parquet cannot be read \(ArrowInvalid\)"):
         sim.Results(d, "brown_table1").table("claims")
+
+
+def test_a_trials_table_removed_by_hand_is_named_not_the_chunks(tmp_path):
+    d = tmp_path / "wolf_polynomial"
+    src = ROOT / "results" / "wolf_polynomial"
+    shutil.copytree(src, d, ignore=shutil.ignore_patterns("*.png", "trials", "trials.parquet"))
+    # before: ".../trials is missing: its run wrote it (the committed results/ hold no chunks"
+    with pytest.raises(
+        sim.ConfigError, match=r"trials\.parquet is missing: its run wrote it \(removed"
+    ):
+        sim.Results(d, "wolf_polynomial").table("trials")
