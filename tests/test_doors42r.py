@@ -15,7 +15,12 @@ real door; each test fails on the code before its fix:
   gridplate), that file removed by hand, took the name for the chunk dataset: "trials is
   missing: its run wrote it (the committed results/ hold no chunks ...)" (d41's words for the
   committed chunks, of the committed results of wolf_polynomial, which hold trials.parquet):
-  ``trials.parquet`` is named missing, as any table its run wrote.
+  ``trials.parquet`` is named missing, as any table its run wrote;
+* a key given twice after its inline table on a study file's last line, with no line break
+  after it (``plate = {x = 1}`` then ``plate.x = 2``): tomllib says "(at end of document)",
+  which l41's search of the inline table read as a column (``int()`` raised) and the line was
+  tomllib's words again ("Cannot mutate immutable namespace ('plate',)"), named before it:
+  ``plate is given twice (at line 3, the end of the file)``.
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ import pytest
 
 import sim
 from sim.cli import main
+from tests.oneline import one_line
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "results" / "brown_table1"  # read, never written
@@ -63,3 +69,11 @@ def test_a_trials_table_removed_by_hand_is_named_not_the_chunks(tmp_path):
         sim.ConfigError, match=r"trials\.parquet is missing: its run wrote it \(removed"
     ):
         sim.Results(d, "wolf_polynomial").table("trials")
+
+
+def test_a_key_given_twice_on_the_last_line_after_its_inline_table_is_named(tmp_path, capsys):
+    f = tmp_path / "twice.toml"
+    f.write_text('study = "brown_table1"\nplate = {x = 1}\nplate.x = 2', encoding="utf-8")
+    # before: "malformed TOML: Cannot mutate immutable namespace ('plate',) (at end of document)"
+    line = one_line(capsys, main(["check", str(f)]), "plate is given twice (at line 3, the end")
+    assert "immutable" not in line, line
