@@ -20,7 +20,11 @@ real door; each test fails on the code before its fix:
   after it (``plate = {x = 1}`` then ``plate.x = 2``): tomllib says "(at end of document)",
   which l41's search of the inline table read as a column (``int()`` raised) and the line was
   tomllib's words again ("Cannot mutate immutable namespace ('plate',)"), named before it:
-  ``plate is given twice (at line 3, the end of the file)``.
+  ``plate is given twice (at line 3, the end of the file)``;
+* ``sim report --results DIR`` of a directory without results that holds an entry named
+  ``.partial`` (or ``..partial``), which c41's search for a run that did not finish took for
+  the staging directory of a results directory named "" (``.``): "sim: error: ValueError:
+  Invalid name ''": no results named, as of any such directory.
 """
 
 from __future__ import annotations
@@ -77,3 +81,11 @@ def test_a_key_given_twice_on_the_last_line_after_its_inline_table_is_named(tmp_
     # before: "malformed TOML: Cannot mutate immutable namespace ('plate',) (at end of document)"
     line = one_line(capsys, main(["check", str(f)]), "plate is given twice (at line 3, the end")
     assert "immutable" not in line, line
+
+
+@pytest.mark.parametrize("entry", [".partial", "..partial"])
+def test_a_bare_partial_entry_is_no_unfinished_run(tmp_path, capsys, entry):
+    (tmp_path / entry).mkdir()
+    # before: "sim: error: ValueError: Invalid name ''"
+    line = one_line(capsys, main(["report", "--results", str(tmp_path)]), "no study results in")
+    assert "ValueError" not in line, line

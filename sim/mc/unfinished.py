@@ -45,7 +45,9 @@ def unfinished_in(results: Path) -> str | None:
     except OSError:
         return None
     for stage in stages:
-        out = stage.with_name(stage.name[1 : -len(STAGE_SUFFIX)])
-        if stage.name.startswith(".") and (words := unfinished(out)) is not None:
-            return f"{out}: {words}"
+        name = stage.name[1 : -len(STAGE_SUFFIX)]  # ".partial", "..partial": no run's (with_name
+        if name in ("", ".", "..") or not stage.name.startswith("."):  # raised ValueError)
+            continue
+        if (words := unfinished(stage.with_name(name))) is not None:
+            return f"{stage.with_name(name)}: {words}"
     return None
