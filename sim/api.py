@@ -48,8 +48,8 @@ from sim.api_paths import run_identity as _run_identity
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.api_state import check_files as _check_files
 from sim.api_tables import check_owner as _check_owner
+from sim.api_tables import own_trials, run_tables, stale_warning
 from sim.api_tables import owner as _owner
-from sim.api_tables import run_tables, stale_warning
 from sim.api_tmp import check_env, temp_dir
 from sim.execute import execute
 from sim.mc.config import ConfigError
@@ -128,11 +128,9 @@ class Results:
 
     def _dataset(self, name: str) -> bool:
         """Whether ``name`` is the chunk dataset ``trials/``: ``chunks`` always, ``trials``
-        unless the study writes a table ``trials.parquet`` of its own (wolf, agnard,
-        gridplate), which that name reads (it was unreachable, and listed twice)."""
-        return name == "chunks" or (
-            name == "trials" and not (self.path / "trials.parquet").exists()
-        )
+        unless the run wrote a ``trials.parquet`` (wolf, agnard, gridplate: :func:`own_trials`),
+        which that name reads (it was unreachable, and listed twice)."""
+        return name == "chunks" or (name == "trials" and not own_trials(self.path, self.study))
 
     @_arguments
     def names(self) -> list[str]:
@@ -154,7 +152,7 @@ class Results:
                 f"not of {self.study!r}{self._within()}",
             )
         if (self.path / "trials").is_dir() and chunks_recorded(self.path):  # else unread
-            names |= {"chunks", "trials"}
+            names |= {"chunks", "trials"} if self._dataset("trials") else {"chunks"}
         return sorted(names)
 
     @_arguments

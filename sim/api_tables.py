@@ -23,7 +23,14 @@ from sim.stale import other_code
 #: the suite's package directory: a warning points at the first line of the caller's outside it
 _CODE = str(Path(__file__).resolve().parent) + "/"
 
-__all__ = ["StaleResultsWarning", "check_owner", "owner", "run_tables", "stale_warning"]
+__all__ = [
+    "StaleResultsWarning",
+    "check_owner",
+    "owner",
+    "own_trials",
+    "run_tables",
+    "stale_warning",
+]
 
 
 class StaleResultsWarning(UserWarning):
@@ -76,6 +83,13 @@ def run_tables(d: Path, study: str) -> set[str]:
         {"trials"} if isinstance(rec.get("chunk_sha256"), dict) and rec["chunk_sha256"] else set()
     )
     return {n for n in tables if isinstance(n, str) and "/" not in n} | chunks
+
+
+def own_trials(d: Path, study: str) -> bool:
+    """Whether the run of ``study`` in ``d`` wrote a table ``trials.parquet``: there, or
+    recorded by its run and removed since (``table("trials")`` took the name for the chunk
+    dataset and said "the committed results/ hold no chunks" of wolf_polynomial's)."""
+    return (d / "trials.parquet").exists() or "trials.parquet" in run_tables(d, study)
 
 
 def stale_warning(d: Path) -> None:

@@ -179,7 +179,9 @@ def _inline_prefix(text, stmt: str, starts, lines: tuple, where: str, key: list)
     """The inline table (parts below the statement's key, an array's item as ``[k]``) in
     which ``key``, tomllib's error of the statement at line ``lines[0]`` (the error at line
     ``lines[1]``), was given; None when it cannot be told (not an inline table's key)."""
-    at = starts[lines[1] - 1] + int(where.split("column ")[-1].rstrip(")")) - 1
+    col = where.split("column ")[-1].rstrip(")") if "column " in where else None
+    # (at end of document): the error is at the text's end (int() raised: tomllib's words)
+    at = len(text) if col is None else starts[lines[1] - 1] + int(col) - 1
     try:
         inner = _inline_key(text[starts[lines[0]] : at], _key_end(stmt))
     except (tomllib.TOMLDecodeError, IndexError):

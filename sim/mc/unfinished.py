@@ -24,7 +24,10 @@ def unfinished(d: Path) -> str | None:
     if os.path.lexists(d) or not d.name:
         return None
     stage = stage_dir(d)
-    if stage.is_symlink() or not stage.is_dir():
+    try:  # a name of 247 to 255 bytes: its staging directory's is over the system's limit
+        if stage.is_symlink() or not stage.is_dir():
+            return None
+    except OSError:  # (ENAMETOOLONG: sim show said the staging name, the API raised OSError)
         return None
     if lock_held(stage):
         return f"a run is writing it now (in {stage}); it is there when that run ends"
@@ -42,7 +45,9 @@ def unfinished_in(results: Path) -> str | None:
     except OSError:
         return None
     for stage in stages:
-        out = stage.with_name(stage.name[1 : -len(STAGE_SUFFIX)])
-        if stage.name.startswith(".") and (words := unfinished(out)) is not None:
-            return f"{out}: {words}"
+        name = stage.name[1 : -len(STAGE_SUFFIX)]  # ".partial", "..partial": no run's (with_name
+        if name in ("", ".", "..") or not stage.name.startswith("."):  # raised ValueError)
+            continue
+        if (words := unfinished(stage.with_name(name))) is not None:
+            return f"{stage.with_name(name)}: {words}"
     return None

@@ -120,13 +120,18 @@ class Row(Columns):
 #: pyarrow's words when it could not start a thread of its pool (a memory limit just above
 #: a run's peak: the thread's stack could not be mapped), which named the table unreadable
 _THREAD = re.compile(r"thread|resource temporarily unavailable|cannot allocate memory", re.I)
+#: a quoted span of pyarrow's words (the file it could not open, not the ' of "Couldn't"),
+#: left out of the search: a damaged table under a directory named for threads was "not
+#: enough memory"
+_QUOTED = re.compile(r"(?<![A-Za-z])'[^']*'")
 
 
 def memory_failure(e: BaseException) -> bool:
     """Whether pyarrow's ``e`` says memory, not the file: an allocation that failed, or a
     thread of its pool it could not start."""
+    text = _QUOTED.sub("''", str(e))
     return isinstance(e, MemoryError) or (
-        isinstance(e, pa.ArrowException) and bool(_THREAD.search(str(e)))
+        isinstance(e, pa.ArrowException) and bool(_THREAD.search(text))
     )
 
 
