@@ -415,7 +415,7 @@ def _run(args, files: list[Path], run_args: list[str], note, loaded, default, ph
         print(_ENDED + "".join(written), file=sys.stderr)
         code = 130
     rc = rebuild_report(Path(args.results)) if report else 0  # (after its summary line)
-    return code or rc
+    return rc if rc == 130 else code or rc
 
 
 #: the driver's line when interrupted after every run ended (writing the timings, the summary)

@@ -26,7 +26,8 @@ def rebuild_report(results: Path) -> int:
     """Run ``sim report --results RESULTS`` (its lines go to this process's standard output
     and error, as make's own command's did); its exit code (2 with one line when it cannot
     start). An interrupt while it runs reaches it too (Ctrl-C) or is passed on (SIGTERM): it
-    is waited for (``REPORT.md`` written whole or not at all), then raised here."""
+    is waited for (``REPORT.md`` written whole or not at all) and said in one line, 130 (the
+    batch's own line did not say that the report was left as it was)."""
     cmd = [sys.executable, "-m", "sim", "report", f"--results={results}"]  # (a name "-r")
     try:
         proc = subprocess.Popen(cmd, env=child_env(), preexec_fn=_stoppable)
@@ -35,9 +36,15 @@ def rebuild_report(results: Path) -> int:
         return 2
     try:
         code = proc.wait()
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # Ctrl-C reached it too; SIGTERM (to the batch) is passed on
         stop_children([proc])
-        raise
+        code = 130
+    if code == 130:  # (an interrupted batch ignores a second Ctrl-C: the report alone ends)
+        print(
+            f"sim.batch: interrupted while sim report rebuilt {results / 'REPORT.md'}, which "
+            f"is as it was: sim report --results {results} rebuilds it",
+            file=sys.stderr,
+        )
     return code if code >= 0 else 1  # killed by a signal (the OOM killer)
 
 

@@ -9,6 +9,10 @@ failure), one case each; each failed on the code before its fix.
   (``python -m sim.batch --report``, :mod:`sim.batch_report`): after runs that all ended
   well, and after a failed or interrupted batch when a run published its results; one that
   published nothing (every run failed) leaves the report and its failure line alone.
+  Checked in the copy: a run killed (``kill -9``) and Ctrl-C as ``brown_table1`` published
+  (both: REPORT.md then named its new ``seed``). A Ctrl-C that ends the report itself is said
+  in one line (REPORT.md as it was; ``sim report`` rebuilds it): the batch said only
+  "interrupted after every run ended".
 
 Held (found right): each study's README.md is written inside its run's sealed staging
 directory, so it never disagrees with the tables beside it; ``results/reproducibility.parquet``
@@ -20,6 +24,7 @@ its run was killed by SIGKILL; ...``) and make exits 2 naming the batch's code.
 from __future__ import annotations
 
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -70,3 +75,15 @@ def test_make_reproduce_and_rerun_leave_the_report_to_the_batch(tmp_path, target
     calls = [ln for ln in log.read_text(encoding="utf-8").splitlines() if ln.startswith("-m ")]
     assert len(calls) == 1 and calls[0].startswith("-m sim.batch "), calls
     assert " --report " in calls[0] and p.returncode == 2, (calls, p.stderr)
+
+
+def test_a_report_interrupted_as_it_is_rebuilt_is_said(tmp_path, monkeypatch, capfd):
+    import sim.batch_report as br
+
+    real = br.subprocess.Popen  # a sim report ended by Ctrl-C (its exit 130)
+    monkeypatch.setattr(
+        br.subprocess, "Popen", lambda cmd, **k: real([sys.executable, "-c", "exit(130)"], **k)
+    )
+    assert rebuild_report(tmp_path / "res") == 130
+    err = capfd.readouterr().err
+    assert err.count("\n") == 1 and "which is as it was: sim report --results" in err, err
