@@ -23,8 +23,10 @@ its run was killed by SIGKILL; ...``) and make exits 2 naming the batch's code.
 
 from __future__ import annotations
 
+import importlib
 import shutil
 import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -32,6 +34,7 @@ from test_doors18c import MAKE, fake_project, run_make
 
 from sim import batch
 from sim.batch_report import rebuild_report
+from sim.report.plotting import DRAWING, draw
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -87,3 +90,32 @@ def test_a_report_interrupted_as_it_is_rebuilt_is_said(tmp_path, monkeypatch, ca
     assert rebuild_report(tmp_path / "res") == 130
     err = capfd.readouterr().err
     assert err.count("\n") == 1 and "which is as it was: sim report --results" in err, err
+
+
+#: the figures drawn outside draw()'s jobs: (module, function, its arguments)
+DIRECT = [
+    ("sim.report.region", "fig_region", (None, Path("r.png"))),
+    ("sim.studies.brown.figures", "fig_region", (Path("."), [], Path("r.png"))),
+    ("sim.report.sweep", "fig_sweep", (Path("sweep.parquet"), Path("sweep.png"))),
+]
+
+
+@pytest.mark.parametrize(("module", "name", "args"), DIRECT)
+def test_a_figure_drawn_directly_holds_the_figure_lock(monkeypatch, module, name, args):
+    mod = importlib.import_module(module)
+    held = []  # figures_off is the figure's first step: "off" here, nothing drawn
+    monkeypatch.setattr(mod, "figures_off", lambda: held.append(DRAWING.locked()) or True)
+    getattr(mod, name)(*args)
+    assert held == [True] and not DRAWING.locked()
+
+
+def test_a_figure_drawn_inside_a_draw_job_does_not_wait_for_itself(monkeypatch):
+    import sim.report.region as region
+
+    held = []
+    monkeypatch.setattr(region, "figures_off", lambda: held.append(DRAWING.locked()) or True)
+    t = threading.Thread(target=draw, args=([(region.fig_region, (None, Path("r.png")))],))
+    t.daemon = True  # (a deadlock would hang here, not the test session)
+    t.start()
+    t.join(timeout=60)
+    assert not t.is_alive() and held == [True] and not DRAWING.locked()
