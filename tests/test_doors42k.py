@@ -13,6 +13,12 @@ failure), one case each; each failed on the code before its fix.
   (both: REPORT.md then named its new ``seed``). A Ctrl-C that ends the report itself is said
   in one line (REPORT.md as it was; ``sim report`` rebuilds it): the batch said only
   "interrupted after every run ended".
+* the consistent regions (``sim.report.region.fig_region``, called directly by four studies,
+  and brown's own) and a sweep's figure (``fig_sweep``) were drawn outside the figure lock
+  ``DRAWING`` that ``draw()`` holds, so two API runs in threads of one program could draw at
+  once (matplotlib is not thread-safe). They hold it now (:mod:`sim.report.drawing`); a
+  figure drawn inside a ``draw()`` job goes on without taking it again (a second acquire of
+  the plain lock waited for itself: that case is checked too, in a thread with a timeout).
 
 Held (found right): each study's README.md is written inside its run's sealed staging
 directory, so it never disagrees with the tables beside it; ``results/reproducibility.parquet``
