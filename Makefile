@@ -205,19 +205,20 @@ mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (s
 # RUN_JOBS at a time, each in its own process with RUN_FLAGS (sim/batch.py; quiet when
 # RUN_JOBS > 1, the slowest first). Two studies of one worker each keep both cores busy, as
 # fast as two of two workers each and without their pools (results/bench/rerun.parquet).
+# The batch rebuilds the report (--report), after a failed or interrupted batch too when a run
+# published: make stopped before `sim report` when one study's run failed or was killed, and
+# REPORT.md kept the old claims of the studies that had published (sim/batch_report.py).
 RUN_JOBS ?= 2
 
 reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, each with RUN_FLAGS="--workers 1": sim run options)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
-	$(PY) -m sim.batch --stale-only --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)
-	$(PY) -m sim report --results results
+	$(PY) -m sim.batch --stale-only --report --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)
 
 rerun: $(STAMP) ## re-run every study even if its results are up to date, then the report (RUN_JOBS, RUN_FLAGS)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
-	$(PY) -m sim.batch --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)
-	$(PY) -m sim report --results results
+	$(PY) -m sim.batch --report --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)
 
 # VERIFY_FLAGS: e.g. "--study brown_table1", "--scratch DIR" (see python -m sim.report.verify -h;
 # results of your own study files: python -m sim.report.verify --results DIR --studies DIR).

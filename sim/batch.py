@@ -68,6 +68,7 @@ from sim.batch_checks import (  # noqa: E402
     is_current,
     why_stale,
 )
+from sim.batch_report import rebuild_report  # noqa: E402
 from sim.batch_summary import _Stdout, summary  # noqa: E402
 from sim.batch_timings import TimingsLock  # noqa: E402
 from sim.cli_args import module_doc  # noqa: E402
@@ -300,6 +301,12 @@ def _main(argv: list[str], phase: list[str]) -> int:
     ap.add_argument(
         "--stale-only", action="store_true", help="only the studies whose results are not current"
     )
+    ap.add_argument(
+        "--report",
+        action="store_true",
+        help="then rebuild RESULTS/REPORT.md (sim report); after a failed or interrupted batch "
+        "when a run published its results",
+    )
     ap.add_argument("--timings", help="write {study: [exit code, wall s, start s]} (JSON) here")
     try:
         args = ap.parse_args(argv)
@@ -396,14 +403,19 @@ def _run(args, files: list[Path], run_args: list[str], note, loaded, default, ph
         w = getattr(e, "written", None)  # it said nothing of a run's results published meanwhile
         named = f" (the results of {', '.join(w)} were written)" if w else ""
         print(INTERRUPTED + named, file=sys.stderr)
+        if w and args.report:  # (Ctrl-C or SIGTERM again: sim report's own line)
+            rebuild_report(Path(args.results))
         return 130
     phase.append("ended")
     written: list[str] = []
+    report = args.report and (not done or any(v[0] == 0 for v in done.values()))
     try:
-        return _finish(args, files, done, log, written)
+        code = _finish(args, files, done, log, written)
     except KeyboardInterrupt:  # it said "resumes the unfinished runs" of a batch with none
         print(_ENDED + "".join(written), file=sys.stderr)
-        return 130
+        code = 130
+    rc = rebuild_report(Path(args.results)) if report else 0  # (after its summary line)
+    return rc if rc == 130 else code or rc
 
 
 #: the driver's line when interrupted after every run ended (writing the timings, the summary)

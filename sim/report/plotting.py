@@ -9,7 +9,6 @@ import json
 import os
 import re
 import sys
-import threading
 import warnings
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -20,6 +19,7 @@ import numpy as np
 
 from sim.mc.config import ConfigError
 from sim.mc.storage import atomic_path
+from sim.report.drawing import DRAWING, drawing
 from sim.report.figcheck import data_points, figure_facts, points_inside, reader_problems
 from sim.report.mpl import pyplot as plt
 from sim.report.mpl import ticker
@@ -328,20 +328,15 @@ def save(fig, path: str | Path) -> Path:
     return path
 
 
-#: held while this process draws a figure: matplotlib is not thread-safe, and brown_design
-#: runs its parts in threads when its chunks go to a pool (``sim.studies.design.parts``)
-DRAWING = threading.Lock()
-
-
 def draw(jobs: Sequence[tuple[Callable, tuple]]) -> None:
     """Draw every figure job ``fn(*args)`` (``fn`` draws one figure and saves it) in this
-    process, one at a time under :data:`DRAWING`. (Figures once went to the pool's idle
+    process, one at a time under :data:`DRAWING` (:mod:`sim.report.drawing`). (Figures once went to the pool's idle
     workers; ``make bench`` found that it saved under 20 % of any study's time, so it went.)
     Nothing is drawn inside :func:`without_figures`."""
     if _SKIP.get():
         return
     for fn, args in jobs:
-        with DRAWING:
+        with drawing():
             fn(*args)
 
 

@@ -13,6 +13,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from sim.claims.inference import Region
+from sim.report.drawing import one_at_a_time
 from sim.report.papers import paper_name
 from sim.report.plotting import figures_off, plt, save
 
@@ -59,6 +60,7 @@ def _title(title: str) -> str:
     return paper_name(m.group(1)) + title[m.end() :] if m else title
 
 
+@one_at_a_time  # (drawn from two API runs' threads at once)
 def fig_region(
     region: Region,
     path: Path,

@@ -12,6 +12,7 @@ import numpy as np
 
 from sim.mc.publish import drawn
 from sim.mc.storage import read_provenance
+from sim.report.drawing import one_at_a_time
 from sim.report.labels import apart
 from sim.report.mpl import ticker
 from sim.report.plotting import (
@@ -130,6 +131,7 @@ def _bars(kinds) -> str:
     return "; ".join(said)
 
 
+@one_at_a_time  # (drawn from two API runs' threads at once)
 def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     """Each claim's value (with its 95 % interval) against the first swept key, one line per
     combination of the other keys; infeasible cells marked by a red band. Proportions (by

@@ -13,6 +13,7 @@ from sim.claims.intervals import std_rel_se
 from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
 from sim.mc.storage import read_provenance, read_table
+from sim.report.drawing import one_at_a_time
 from sim.report.plotting import figures_off, hist_bins, place_legend, plt, save
 from sim.report.region import reader_label
 from sim.studies.brown.schema import MODEL_NAMES
@@ -171,6 +172,7 @@ def _scale_limit(ax, xname, yname, reg):
         ax.axvline(float(B.max_offset_mm(90.0)), color="k", ls="--", lw=1.2, label="scale limit")
 
 
+@one_at_a_time  # (drawn from two API runs' threads at once)
 def fig_region(out: Path, pairs, path):
     """Pairwise projections of the consistent region (grey: inputs the hardware and the
     constraining statements allow; green: where every prediction holds together), the declared

@@ -1,0 +1,55 @@
+"""``python -m sim.batch --report``: the report of the results directory built again after the
+runs, in a ``sim report`` process of its own (as ``make reproduce`` and ``make rerun`` ran it).
+
+After runs that all ended well it is built always (a batch of up-to-date studies included: the
+report's own code may be newer). After a batch that failed or was interrupted it is built when
+a run published its results, and only then: ``make reproduce`` stopped before ``sim report``
+when one study's run failed or was killed, so ``REPORT.md`` kept the claims the published
+studies had before (and the *Reproducibility* section called their replaced tables verified)
+until the next make succeeded; a batch that published nothing (its input refused, every run
+failed) leaves the report as it is, and its failure line alone.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+from sim.mc.children import STOP_SIGNALS, child_env, stop_children
+
+__all__ = ["rebuild_report"]
+
+
+def rebuild_report(results: Path) -> int:
+    """Run ``sim report --results RESULTS`` (its lines go to this process's standard output
+    and error, as make's own command's did); its exit code (2 with one line when it cannot
+    start). An interrupt while it runs reaches it too (Ctrl-C) or is passed on (SIGTERM): it
+    is waited for (``REPORT.md`` written whole or not at all) and said in one line, 130 (the
+    batch's own line did not say that the report was left as it was)."""
+    cmd = [sys.executable, "-m", "sim", "report", f"--results={results}"]  # (a name "-r")
+    try:
+        proc = subprocess.Popen(cmd, env=child_env(), preexec_fn=_stoppable)
+    except OSError as e:  # no process to be had (ulimit -u): one line
+        print(f"sim.batch: --report: cannot start sim report: {e.strerror or e}", file=sys.stderr)
+        return 2
+    try:
+        code = proc.wait()
+    except KeyboardInterrupt:  # Ctrl-C reached it too; SIGTERM (to the batch) is passed on
+        stop_children([proc])
+        code = 130
+    if code == 130:  # (an interrupted batch ignores a second Ctrl-C: the report alone ends)
+        print(
+            f"sim.batch: interrupted while sim report rebuilt {results / 'REPORT.md'}, which "
+            f"is as it was: sim report --results {results} rebuilds it",
+            file=sys.stderr,
+        )
+    return code if code >= 0 else 1  # killed by a signal (the OOM killer)
+
+
+def _stoppable() -> None:
+    """In the child before it starts: Ctrl-C and SIGTERM as by default (a batch interrupted
+    ignores them from then on, and an ignored SIGINT stays ignored in the report's Python)."""
+    for s in (signal.SIGINT, *STOP_SIGNALS):
+        signal.signal(s, signal.SIG_DFL)
