@@ -9,19 +9,21 @@ subpackages do), so the command line (:mod:`sim.__main__`) can set up its proces
 import importlib
 import os
 import resource
+import sys
 
 
 def _system_pool_under_limits() -> None:
     """Under ``ulimit -v`` or ``-d``, Arrow's tables come from the system's allocator
-    (``ARROW_DEFAULT_MEMORY_POOL=system``, unless the variable is set), read by Arrow when it
+    (``ARROW_DEFAULT_MEMORY_POOL=system``, unless the variable is set, not empty), read by Arrow when it
     loads, so set before: Arrow's default, mimalloc, maps up to 1 GiB of the address space it is
     given at its first table. A 10,000-point network (0.93 GiB mapped at its peak with the
     system's) peaked at 1,999,916 kB under ``ulimit -v 2000000``, 84 kB from the limit: the room
     checked before the run (:mod:`sim.room`) was not there, a Parquet read with no room left
     for Arrow's threads hung for good, and the API's next run in the process was refused."""
     caps = (resource.getrlimit(r)[0] for r in (resource.RLIMIT_AS, resource.RLIMIT_DATA))
-    if any(c != resource.RLIM_INFINITY for c in caps):
-        os.environ.setdefault("ARROW_DEFAULT_MEMORY_POOL", "system")
+    if any(c != resource.RLIM_INFINITY for c in caps):  # an empty value is Arrow's default
+        if not os.environ.get("ARROW_DEFAULT_MEMORY_POOL"):
+            os.environ["ARROW_DEFAULT_MEMORY_POOL"] = "system"
 
 
 _system_pool_under_limits()
@@ -45,9 +47,27 @@ __version__ = "0.1.0"
 
 def __getattr__(name: str):
     if name in _EXPORTS:
+        _refuse_unloadable(_EXPORTS[name])
         return getattr(importlib.import_module(_EXPORTS[name]), name)
     raise AttributeError(f"module 'sim' has no attribute {name!r}")
 
 
 def __dir__():
     return sorted(list(globals()) + __all__)
+
+
+def _refuse_unloadable(module: str) -> None:
+    """Raise :class:`ConfigError` naming a variable of the environment that keeps ``module``
+    from loading, as the commands refuse it when they start: ``sim.load`` with a
+    ``SOURCE_DATE_EPOCH`` that is not an integer (``abc``) ended in a traceback from
+    ``numpy.f2py`` (imported by ``scipy.sparse``), "ValueError: invalid literal for int()";
+    with ``ARROW_DEFAULT_MEMORY_POOL=System`` it ran on Arrow's default allocator after a line
+    of Arrow's own (:func:`sim.threads.arrow_variables_problem`)."""
+    if module in sys.modules or module == "sim.mc.config":  # loaded, or loads no NumPy
+        return
+    from sim.threads import arrow_variables_problem, source_date_epoch_problem
+
+    if (problem := source_date_epoch_problem() or arrow_variables_problem()) is not None:
+        from sim.mc.config import ConfigError
+
+        raise ConfigError(None, problem)

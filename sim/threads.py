@@ -248,21 +248,53 @@ def refuse_bad_environment(prog: str) -> None:
     """Exit 2 with one line when the environment cannot load the suite: an address-space
     limit under :data:`MIN_ADDRESS_SPACE_KB` (``ulimit -v``), or a value that breaks loading
     NumPy or SciPy (``SOURCE_DATE_EPOCH`` that is not an integer ended every command in a
-    traceback from ``numpy.f2py``, imported by ``scipy.sparse``). Called by the entry points
+    traceback from ``numpy.f2py``, imported by ``scipy.sparse``), or an allocator Arrow does
+    not have (:func:`arrow_variables_problem`). Called by the entry points
     before anything imports NumPy."""
     _refuse_small_address_space(prog)
     _refuse_bad_tqdm_variables(prog)
+    if (problem := source_date_epoch_problem() or arrow_variables_problem()) is not None:
+        sys.stderr.write(f"{prog}: error: {problem}\n")
+        sys.exit(2)
+
+
+def source_date_epoch_problem() -> str | None:
+    """What is wrong with ``SOURCE_DATE_EPOCH`` for ``numpy.f2py`` (imported by SciPy, which
+    reads it as an integer while it loads), or None; None too once ``numpy.f2py`` is loaded
+    (it has read it). The words name the variable, without the program: ``sim.load`` raises
+    them (``sim._refuse_unloadable``), as the commands refuse them."""
     v = os.environ.get("SOURCE_DATE_EPOCH")
-    if v is None:
-        return
+    if v is None or "numpy.f2py" in sys.modules:
+        return None
     try:
         time.gmtime(int(v))  # as numpy.f2py reads it (99999999999999999999: OverflowError)
     except (ValueError, OverflowError, OSError):
-        sys.stderr.write(
-            f"{prog}: error: SOURCE_DATE_EPOCH: must be an integer, seconds since 1970 "
-            f"within the system's dates (got {v[:40]!r}); NumPy reads it while loading\n"
+        return (
+            f"SOURCE_DATE_EPOCH: must be an integer, seconds since 1970 within the system's "
+            f"dates (got {v[:40]!r}); NumPy reads it while loading"
         )
-        sys.exit(2)
+    return None
+
+
+#: the allocators Arrow's ``ARROW_DEFAULT_MEMORY_POOL`` names (its words when it refuses one)
+ARROW_POOLS = ("mimalloc", "jemalloc", "system")
+
+
+def arrow_variables_problem() -> str | None:
+    """What is wrong with ``ARROW_DEFAULT_MEMORY_POOL``, or None (None too once pyarrow is
+    loaded: it has read it). Arrow reads it when it loads, in the middle of a command: another
+    value (``System``, ``malloc``) was a line of Arrow's own on standard error
+    ("/arrow/cpp/src/arrow/memory_pool.cc:106: Unsupported backend ...") and a run on Arrow's
+    default allocator, mimalloc, exit 0, under ``ulimit -v`` or ``-d`` too, where the suite
+    asks for the system's (:mod:`sim`). The variable is one of :data:`ARROW_POOLS`, or empty
+    or unset. The words name the variable, without the program."""
+    v = os.environ.get("ARROW_DEFAULT_MEMORY_POOL")
+    if not v or v in ARROW_POOLS or "pyarrow" in sys.modules:
+        return None
+    return (
+        f"ARROW_DEFAULT_MEMORY_POOL: must be {', '.join(ARROW_POOLS[:-1])} or {ARROW_POOLS[-1]} "
+        f"(Arrow's allocators), or empty or unset, got {v[:40]!r}"
+    )
 
 
 def tqdm_variables_problem() -> str | None:
