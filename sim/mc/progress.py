@@ -176,13 +176,13 @@ class Progress:
     def _trials(self) -> None:
         """The bar's text: trials done of the total and their mean rate."""
         t = self.bar.format_dict["elapsed"] if self.enabled else 0.0
-        rate = f"{self.done / t:.3g}" if t > 0 and self.done else "?"
+        r = self.done / t if t > 0 else 0.0
+        rate = (f"{r:,.0f}" if r >= 100 else f"{r:.3g}") if r > 0 else "?"
         self.bar.trials = {
             "trials_done": f"{self.done:,}",
             "trials_total": f"{self.total:,}",
             "trials_rate": rate,
         }
-
 
     def set_doing(self, text: str) -> None:
         """Show ``text`` (what the run does where no trial is counted: an analytic part)

@@ -55,7 +55,7 @@ def run_adaptive(
             st = dict(stat(res))
             worst = max((se / target for _, se in st.values()), default=0.0)
             if worst < 1.0 or N >= top:
-                if shared is not None and hasattr(shared, "unneeded"):
+                if tmp is None and hasattr(shared, "unneeded"):  # the run's bar counted them
                     shared.unneeded(max_trials - N, units)
                 return res, st
             need = N * worst**2 * 1.05 if np.isfinite(worst) else 2 * N
