@@ -104,6 +104,7 @@ class Estimate:
     analytic_part: str = ""  # that part, named
     memory_keys: tuple = ()  # the keys that set ``bytes`` (the refusal names them), if known
     cell: str = ""  # a sweep's: the swept values of the cell that needs ``bytes`` (if cells differ)
+    work: float = 0.0  # unit adjustments of the ``trials`` (the progress bar fills by them)
 
     def describe(self, workers: int = 1) -> str:
         """One line: trials, adjustments (analytic parts in adjustment-equivalents, each
@@ -282,8 +283,8 @@ ESTIMATORS: dict[str, Callable[[Mapping], tuple]] = {
 
 def _one(cfg: Mapping) -> tuple:
     """``(trials, adjustments, unknowns, bytes, the part needing the bytes or "", (analytic
-    adjustment-equivalents, key, part), the keys that set the bytes)``; an estimator may leave
-    out the last three."""
+    adjustment-equivalents, key, part), the keys that set the bytes, the unit adjustments of
+    the trials)``; an estimator may leave out the last four (the trials: one unit each)."""
     fn = ESTIMATORS.get(cfg.get("study"), _generic)
     try:
         t, a, u, b, *rest = fn(cfg)
@@ -294,7 +295,8 @@ def _one(cfg: Mapping) -> tuple:
     what = rest[0] if rest else ""
     eq, key, part = rest[1] if len(rest) > 1 else (0.0, "", "")
     keys = tuple(rest[2]) if len(rest) > 2 else ()
-    return fix(t), a, fix(u), fix(b), what, (fix(eq), key, part), keys
+    work = fix(rest[3]) if len(rest) > 3 else fix(t)
+    return fix(t), a, fix(u), fix(b), what, (fix(eq), key, part), keys, work
 
 
 def _chunk_units(cfg: Mapping, trials: float) -> float:
@@ -331,6 +333,7 @@ def estimate(
             f"the values of sweep.{k}" for k in keys
         )
     eq, key, part = max((p[5] for p in parts), key=lambda x: x[0])  # one cell's, not the sum
+    W = sum(p[7] for p in parts) * reps
     big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
     return Estimate(
         str(cfg.get("study")),
@@ -345,6 +348,7 @@ def estimate(
         part,
         mkeys,
         cell,
+        float(W) if math.isfinite(W) else 0.0,
     )
 
 

@@ -1,5 +1,12 @@
 """The progress bar (tqdm): trials done, trials per second, time left.
 
+The bar fills by work, not by trials: each update counts its trials and the unit adjustments
+they cost (:mod:`sim.mc.estimate`'s unit; one a trial where the caller gives none), so a part
+of few long trials (an emcee chain, one trial of about 20 s) and one of many short ones
+(20,000 trials of a millisecond) move it at the rate of their work: counted as trials alone,
+brown_design's bar said 1,343 to 2,476 hours left of a run of 5 minutes. The time left is the
+work left over the rate of work; the text shows the trials and their mean rate.
+
 Drawn on standard error only when it is a terminal or a Jupyter notebook's output (and not
 ``quiet``); silent otherwise, so logs and CI output stay clean. A run shares one bar over all its parts (see
 :class:`sim.studies.RunContext`), whose total comes from the run's estimate
@@ -20,8 +27,8 @@ from sim.threads import tqdm_variables_problem
 __all__ = ["Progress", "check_environment", "phase", "set_quiet"]
 
 _FORMAT = (
-    "{desc} {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} trials "
-    "[{elapsed}<{remaining}, {rate_fmt}{postfix}]"
+    "{desc} {percentage:3.0f}%|{bar}| {trials_done}/{trials_total} trials "
+    "[{elapsed}<{remaining}, {trials_rate} trials/s{postfix}]"
 )
 
 
@@ -87,12 +94,27 @@ def _bar_class():
     if not _bar:
         from tqdm import tqdm
 
-        _bar.append(type("Bar", (tqdm,), {"monitor_interval": 0, "_lock": threading.RLock()}))
+        def format_dict(self):  # tqdm's, with the trials (its n and total count work)
+            return {**tqdm.format_dict.fget(self), **getattr(self, "trials", {})}
+
+        _bar.append(
+            type(
+                "Bar",
+                (tqdm,),
+                {
+                    "monitor_interval": 0,
+                    "_lock": threading.RLock(),
+                    "format_dict": property(format_dict),
+                },
+            )
+        )
     return _bar[0]
 
 
 class Progress:
-    """``with Progress(total, label) as p: p.update(n)``; ``chunks`` > 0 adds ``chunk i/N``."""
+    """``with Progress(total, label) as p: p.update(n)``; ``chunks`` > 0 adds ``chunk i/N``.
+    ``work``: the unit adjustments the ``total`` trials cost (default: one a trial), which
+    :meth:`update` counts (``work=``, else the mean of a trial) and the bar fills by."""
 
     def __init__(
         self,
@@ -102,8 +124,13 @@ class Progress:
         stream=None,
         min_interval: float = 0.2,
         chunks: int = 0,
+        work: float | None = None,
     ):
         self.total = int(total)
+        self.work_total = float(work) if work and work > 0 else float(self.total)
+        self.work = 0.0
+        self.label = label
+        self.doing = ""  # what the run does now, where no trial is counted (set_doing)
         self.chunks = int(chunks)
         self.chunks_done = 0
         self.done = 0
@@ -122,7 +149,7 @@ class Progress:
         width = (min(cols or 0, MAX_COLUMNS) or DEFAULT_COLUMNS) if fixed else None
         width = min(cols - 1, MAX_COLUMNS) if flat and cols and cols > 1 else width  # as tqdm's
         self.bar = _bar_class()(
-            total=self.total,
+            total=self.work_total,
             desc=label,
             file=stream,
             disable=not self.enabled,
@@ -133,7 +160,12 @@ class Progress:
             ncols=width,
             dynamic_ncols=not fixed,
             nrows=2 if flat else None,  # tqdm keeps the last row for "(more hidden)"
+            delay=1e9,  # drawn below, once its trials are set
         )
+        self._trials()
+        if self.enabled:
+            self.bar.delay = 0
+            self.bar.refresh()
 
     def __enter__(self) -> "Progress":
         return self
@@ -141,16 +173,56 @@ class Progress:
     def __exit__(self, *exc) -> None:
         self.bar.close()
 
-    def update(self, n: int, chunks: int = 0) -> None:
+    def _trials(self) -> None:
+        """The bar's text: trials done of the total and their mean rate."""
+        t = self.bar.format_dict["elapsed"] if self.enabled else 0.0
+        r = self.done / t if t > 0 else 0.0
+        rate = (f"{r:,.0f}" if r >= 100 else f"{r:.3g}") if r > 0 else "?"
+        self.bar.trials = {
+            "trials_done": f"{self.done:,}",
+            "trials_total": f"{self.total:,}",
+            "trials_rate": rate,
+        }
+
+    def set_doing(self, text: str) -> None:
+        """Show ``text`` (what the run does where no trial is counted: an analytic part)
+        after the bar's label, redrawn now; ``""`` removes it."""
+        self.doing = text
+        if self.enabled:
+            self.bar.set_description_str(f"{self.label}: {text}" if text else self.label, False)
+            self._trials()
+            self.bar.refresh()
+
+    def lower(self, trials: int, work: float | None = None) -> None:
+        """Take ``trials`` (costing ``work``, else the mean) off the totals: trials the
+        estimate counted and the run does not need (an adaptive stage that stopped early)."""
+        work = trials * self.work_total / max(self.total, 1) if work is None else work
+        self.total = max(self.total - int(trials), self.done)
+        self.work_total = max(self.work_total - float(work), self.work)
+        if self.enabled:
+            self.bar.total = self.work_total
+            self._trials()
+            self.bar.refresh()
+
+    def update(self, n: int, chunks: int = 0, work: float | None = None) -> None:
+        """Count ``n`` trials (and ``chunks`` chunks) costing ``work`` unit adjustments (by
+        default the mean of a trial)."""
+        work = n * self.work_total / max(self.total, 1) if work is None else float(work)
         self.done += int(n)
+        self.work += work
         self.chunks_done += int(chunks)
         if not self.enabled:
             return
-        if self.done > self.bar.total:  # an estimate that was short: grow, never overflow
-            self.bar.total = self.done
+        # an estimate that was short: grow, never overflow
+        self.total = max(self.total, self.done)
+        if self.work > self.work_total:
+            self.work_total = self.bar.total = self.work
         if self.chunks:
             self.bar.set_postfix_str(f"chunk {self.chunks_done}/{self.chunks}", refresh=False)
-        self.bar.update(int(n))
+        self._trials()
+        self.bar.update(work)
+        if self.done >= self.total:  # the last frame says 100 % (tqdm skips one too soon)
+            self.bar.refresh()
 
 
 #: whether the command runs with ``--quiet`` (set by the entry point before a study file is

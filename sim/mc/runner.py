@@ -250,6 +250,10 @@ class _Shared:
         return None
 
 
+def _work(units: float | None, n: int) -> float | None:
+    return None if units is None else units * n
+
+
 def run_chunks(
     fn: Callable[[np.random.Generator, int], Mapping[str, np.ndarray]],
     trials: int,
@@ -260,8 +264,11 @@ def run_chunks(
     quiet: bool = False,
     ctx=None,
     keep_rows: bool = False,
+    units: float | None = None,
 ) -> dict[str, np.ndarray]:
     """Run ``fn(rng, n)`` over chunks of at most ``chunk`` trials and concatenate.
+    ``units``: the unit adjustments one trial costs (the run's estimate's model of this part,
+    :mod:`sim.mc.estimate`), which the run's bar fills by; default: the estimate's mean.
 
     ``ctx`` (a :class:`sim.studies.RunContext`) supplies the executor and the chunk store;
     without it the chunks run in this process and nothing is stored. Returns the kept arrays
@@ -302,7 +309,8 @@ def run_chunks(
         if shared is not None
         else Progress(trials, label, quiet=quiet, chunks=len(sizes))
     ) as bar:
-        bar.update(done_trials, len(results) - len(again))
+        per = None if units is None else float(units)
+        bar.update(done_trials, len(results) - len(again), _work(per, done_trials))
         if seen is not None:
             seen.update((where, part, k) for k in range(len(sizes)))
         check_interrupt()  # an interrupt Python dropped (a C callback) stops the run here,
@@ -312,7 +320,7 @@ def run_chunks(
             if not keep_rows:
                 out = {key: v for key, v in out.items() if not key.startswith(ROWS)}
             results[k] = out
-            bar.update(n, 1)
+            bar.update(n, 1, _work(per, n))
             check_interrupt()  # or once the chunk it came in is saved
     keys = results[0].keys() if results else []
     return {
@@ -363,14 +371,16 @@ class RunContext:
     store: object = None  # sim.mc.runner.ChunkStore of the run's staging directory
     estimate: object = None  # sim.mc.estimate.Estimate of the run (the progress bar's total)
     bars: list = field(default_factory=list, compare=False)  # the open shared bar, if any
-    counted: list = field(default_factory=list, compare=False)  # its trials when it closed
+    counted: list = field(default_factory=list, compare=False)  # its trials, total at close
     seen: set = field(default_factory=set, compare=False)  # (store, part, chunk) on the bar
 
     def all_counted(self) -> bool:
         """Whether the run's bar has counted every trial of its estimate: every chunk is
         done (an interrupt then leaves only the tables and figures to the same command)."""
-        total = getattr(self.estimate, "trials", 0) or 0
-        done = self.bars[-1].done if self.bars else (self.counted or [0])[-1]
+        if self.bars:  # its total: the estimate's, less the trials an adaptive stage left
+            done, total = self.bars[-1].done, self.bars[-1].total
+        else:
+            done, total = self.counted or (0, getattr(self.estimate, "trials", 0) or 0)
         return total > 0 and done >= total
 
     @property
@@ -380,12 +390,33 @@ class RunContext:
 
     @contextmanager
     def progress_bar(self, label: str):
-        """One bar for the whole run; its total is the estimate's trial count."""
+        """One bar for the whole run; its total is the estimate's trial count, filled by the
+        estimate's work units of those trials (``work``: one a trial where it gives none)."""
         total = getattr(self.estimate, "trials", 0) or 0
-        with Progress(total, label, quiet=self.quiet) as p:
+        work = getattr(self.estimate, "work", 0.0) or None
+        with Progress(total, label, quiet=self.quiet, work=work) as p:
             self.bars.append(p)
             try:
                 yield p
             finally:
                 self.bars.remove(p)
-                self.counted[:] = [p.done]
+                self.counted[:] = [p.done, p.total]
+
+    @contextmanager
+    def doing(self, text: str):
+        """Show ``text`` on the run's bar while the block runs (a part that counts no trial:
+        brown_design's analytic design grid and regions, half a minute at a bar of 0 %)."""
+        bar = self.bar
+        if bar is not None:
+            bar.set_doing(text)
+        try:
+            yield
+        finally:
+            if bar is not None:
+                bar.set_doing("")
+
+    def unneeded(self, trials: int, units: float | None = None) -> None:
+        """Take ``trials`` the estimate counted and the run will not do (an adaptive stage
+        that stopped short of its maximum; ``units`` each) off the run's bar."""
+        if self.bar is not None and trials > 0:
+            self.bar.lower(trials, None if units is None else units * trials)

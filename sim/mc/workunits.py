@@ -26,6 +26,10 @@ __all__ = [
     "design_grid_equivalents",
     "design_chunk_bytes",
     "design_estimate",
+    "design_bar_units",
+    "DESIGN_UNITS",
+    "affine_units",
+    "chain_units",
 ]
 
 F8 = 8.0  # bytes of a float64
@@ -128,6 +132,49 @@ BAYES_BYTES = 600.0
 DESIGN_BUDGET_ROWS = 11
 DESIGN_POSTERIORS = 3
 
+#: unit adjustments a trial of brown_design's Monte-Carlo parts costs, for its progress bar
+#: (measured, one core, chunks of 20): the check and an error-budget row solve the paper's
+#: plate (3.0 to 3.4), a coverage case Brown's 4 stations (1.1 to 3.2; 6 at 10 mm of noise);
+#: the shares of :data:`BAYES_UNITS` of a chain of Brown's posterior and of each two-plate
+#: one (0.45 and 0.18 a walker's step measured: 5,713 and 2,300 units a chain of 32 x 400)
+DESIGN_UNITS = {"check": 3.0, "budget": 3.0, "coverage": 2.0, "brown": 0.55, "twoplate": 0.225}
+#: an affine coverage trial (a linear fit of the grid's points): 28 units at 25 points, 7.5
+#: at 4 (measured as above)
+AFFINE_UNITS, AFFINE_POINT_UNITS = 3.0, 1.0
+
+
+def affine_units(points: float) -> float:
+    """Unit adjustments of one affine coverage trial over ``points`` grid points."""
+    return AFFINE_UNITS + AFFINE_POINT_UNITS * points
+
+
+def chain_units(walkers: float, steps: float, posterior: str) -> float:
+    """Unit adjustments of one chain (one trial on the bar) of ``posterior`` (``brown``,
+    ``twoplate``) of ``walkers`` x ``steps`` (Brown's steps; the two plates run twice as
+    many of a cheaper posterior)."""
+    return BAYES_UNITS * walkers * steps * DESIGN_UNITS[posterior]
+
+
+def design_bar_units(c: Mapping) -> float:
+    """The unit adjustments of the trials brown_design's bar counts (each part's trials at
+    its :data:`DESIGN_UNITS`): 1,343 to 2,476 hours were left on a bar that counted a chain
+    of 18 s as one trial among 274,012 of a millisecond."""
+    u = DESIGN_UNITS
+    cov = c.get("coverage.trials", 0)
+    sweep = c.get("coverage.sweep_trials", 0)
+    cases = n_of(c.get("coverage.noise_um", []))
+    cases += n_of(c.get("coverage.grids", [])) + n_of(c.get("coverage.betas_mm", []))
+    chains = c.get("bayes.chains", 0)
+    walker_steps = c.get("bayes.walkers", 0) * c.get("bayes.steps", 0)
+    return (
+        c["trials"] * u["check"]
+        + DESIGN_BUDGET_ROWS * c.get("budget.max_trials", 0) * u["budget"]
+        + (cov + sweep * cases) * u["coverage"]
+        + cov * affine_units(c.get("datum.grid", 5) ** 2)
+        + sweep * affine_units(4)
+        + chains * BAYES_UNITS * walker_steps * (u["brown"] + 2 * u["twoplate"])
+    )
+
 
 def design_chunk_bytes(ch: float, P: float, n: float) -> float:
     """Bytes of one Monte-Carlo chunk of ``ch`` trials of ``n`` points seen from ``P``
@@ -209,4 +256,5 @@ def design_estimate(c: Mapping) -> tuple:
         * walker_steps,
     }
     what = max(parts, key=parts.get)
-    return trials, adj, max(U, 2 * int(max(nc, n_paper)) + 7), parts[what], what, analytic
+    U = max(U, 2 * int(max(nc, n_paper)) + 7)
+    return trials, adj, U, parts[what], what, analytic, (), design_bar_units(c)

@@ -35,10 +35,12 @@ def run_part(
     trials: int | None = None,
     quiet: bool = False,
     chunk: int | None = None,
+    units: float | None = None,
 ) -> dict[str, np.ndarray]:
     """``fn(rng, n)`` over chunks of ``chunk`` (default ``cfg["chunk"]``) trials (``trials``,
     default ``cfg["trials"]``) from stream ``part`` of ``cfg["seed"]``; quiet when ``quiet`` or
-    ``ctx.quiet``. The per-trial arrays concatenated over chunks."""
+    ``ctx.quiet``; ``units``: a trial's unit adjustments on the run's bar. The per-trial
+    arrays concatenated over chunks."""
     return run_chunks(
         fn,
         cfg["trials"] if trials is None else trials,
@@ -48,6 +50,7 @@ def run_part(
         label=label,
         quiet=quiet,
         ctx=ctx,
+        units=units,
     )
 
 

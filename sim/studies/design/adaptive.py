@@ -7,6 +7,8 @@ while a standard error exceeds the target, it predicts the trials needed from ``
 (rounded up to whole chunks, at least one chunk more) and runs the stage to that total. Each
 stage re-requests chunks ``0 .. K-1`` of the same stream: finished chunks come from the store
 (a temporary one when the run has none), so the first ``N`` trials equal a fixed run of ``N``.
+A stage that stops short of ``max_trials`` (the run's estimate counts every stage at its
+maximum) takes the trials it left off the run's bar, which then ends at 100 %.
 """
 
 from __future__ import annotations
@@ -34,11 +36,12 @@ def run_adaptive(
     max_trials: int,
     label: str = "",
     ctx: RunContext | None = None,
+    units: float | None = None,
 ):
-    """Returns ``(results, stats)``; ``len`` of a per-trial result is the trials it took."""
+    """``units``: a trial's unit adjustments on the run's bar. Returns ``(results, stats)``; ``len`` of a per-trial result is the trials it took."""
     top = max(chunk, (max_trials // chunk) * chunk)  # whole chunks only
     N = min(top, max(chunk, math.ceil(min_trials / chunk) * chunk))
-    tmp = None
+    tmp, shared = None, ctx
     if ctx is None or ctx.store is None:
         tmp = tempfile.TemporaryDirectory(prefix="sim-adaptive-")
         ctx = RunContext(
@@ -48,10 +51,12 @@ def run_adaptive(
         )
     try:
         while True:
-            res = run_chunks(fn, N, seed, chunk, part=part, label=label, ctx=ctx)
+            res = run_chunks(fn, N, seed, chunk, part=part, label=label, ctx=ctx, units=units)
             st = dict(stat(res))
             worst = max((se / target for _, se in st.values()), default=0.0)
             if worst < 1.0 or N >= top:
+                if tmp is None and hasattr(shared, "unneeded"):  # the run's bar counted them
+                    shared.unneeded(max_trials - N, units)
                 return res, st
             need = N * worst**2 * 1.05 if np.isfinite(worst) else 2 * N
             N = min(top, max(N + chunk, math.ceil(need / chunk) * chunk))

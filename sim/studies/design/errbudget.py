@@ -11,6 +11,7 @@ from functools import partial
 
 import numpy as np
 
+from sim.mc.workunits import DESIGN_UNITS
 from sim.studies.design.adaptive import run_adaptive
 from sim.studies.design.chunks import budget_chunk
 from sim.studies.design.parts import side_by_side
@@ -72,6 +73,7 @@ def budget_analysis(cfg: dict, pts: np.ndarray, th: np.ndarray, ctx) -> tuple[di
             max_trials=cfg["budget.max_trials"],
             label=f"budget {name}",
             ctx=ctx,
+            units=DESIGN_UNITS["budget"],
         )
 
     done = side_by_side(

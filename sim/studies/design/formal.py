@@ -16,6 +16,7 @@ import numpy as np
 from sim.instruments.plates import grid_points
 from sim.instruments.ranges import coverage as cv
 from sim.instruments.ranges import multilateration as ml
+from sim.mc.workunits import DESIGN_UNITS, affine_units
 from sim.studies.design.chunks import affine_chunk, coverage_chunk
 from sim.studies.design.parts import side_by_side
 from sim.studies.run_steps import run_part
@@ -97,12 +98,14 @@ def coverage_analysis(cfg: dict, ctx) -> dict:
         pts = grid_points(k, 2 * ext / (k - 1))
         th = ml.design_theta(h, cfg["comparator.alpha_mm"], beta)
         fn = partial(coverage_chunk, pts, th, sig, cfg["coverage.alpha"])
-        tasks[part] = partial(run_part, cfg, ctx, fn, part, f"coverage {scen}", T)
+        units = DESIGN_UNITS["coverage"]
+        tasks[part] = partial(run_part, cfg, ctx, fn, part, f"coverage {scen}", T, units=units)
     affine = ((cfg["datum.grid"], cfg["coverage.trials"]), (2, cfg["coverage.sweep_trials"]))
     for part, (k, T) in enumerate(affine, PART0 + len(tasks)):
         grid = grid_points(k, 2 * 110.0 / (k - 1))
         fn = partial(affine_chunk, grid, sig0, _AFFINE, cfg["coverage.alpha"])
-        tasks[part] = partial(run_part, cfg, ctx, fn, part, "coverage affine", T)
+        units = affine_units(k * k)
+        tasks[part] = partial(run_part, cfg, ctx, fn, part, "coverage affine", T, units=units)
     sims = side_by_side(tasks, ctx)
     part = PART0
     for scen, k, sig, beta, T in _cases(cfg):

@@ -30,6 +30,7 @@ from sim.instruments import transforms2d as t2
 from sim.instruments.ranges import multilateration as ml
 from sim.instruments.ranges.twoplate_quad import log10_ratio_quantiles
 from sim.mc.runner import chunk_rng, run_chunks
+from sim.mc.workunits import chain_units
 from sim.studies.design.chunks import brown_chain_chunk, brown_lsq, twoplate_chain_chunk
 
 __all__ = ["bayes_analysis", "twoplate_analysis", "quantile_se", "PART_BROWN", "PART_TWOPLATE"]
@@ -58,8 +59,16 @@ def bayes_analysis(cfg: dict, pts: np.ndarray, sr_um: float, ctx) -> tuple[dict,
     sig = sr_um * 1e-3
     r, theta_ls, Q = brown_lsq(pts, th, sig, chunk_rng(cfg["seed"], 60, 0))
     fn = partial(brown_chain_chunk, r, sig, theta_ls, Q, cfg["bayes.walkers"], cfg["bayes.steps"])
+    units = chain_units(cfg["bayes.walkers"], cfg["bayes.steps"], "brown")
     sim = run_chunks(
-        fn, cfg["bayes.chains"], cfg["seed"], 1, part=PART_BROWN, label="emcee (Brown)", ctx=ctx
+        fn,
+        cfg["bayes.chains"],
+        cfg["seed"],
+        1,
+        part=PART_BROWN,
+        label="emcee (Brown)",
+        ctx=ctx,
+        units=units,
     )
     X = sim["samples"].reshape(-1, sim["samples"].shape[-1])
     neff = _n_eff(sim)
@@ -209,6 +218,7 @@ def twoplate_analysis(cfg: dict, ctx):
             part=part,
             label=f"emcee (two plates, {name})",
             ctx=ctx,
+            units=chain_units(cfg["bayes.walkers"], cfg["bayes.steps"], "twoplate"),
         )
         exact = log10_ratio_quantiles(comp, g, prior)
         row, samples[name] = _twoplate_row(sim, name, rw, gcfg, exact)

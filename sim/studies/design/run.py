@@ -20,6 +20,7 @@ from sim.lsq import datum as dm
 from sim.mc import tolerance as tl
 from sim.mc.runner import chunk_rng
 from sim.mc.storage import provenance, write_table
+from sim.mc.workunits import DESIGN_UNITS
 from sim.report.plotting import draw
 from sim.studies import RunContext
 from sim.studies.design import figures
@@ -119,7 +120,8 @@ def _scale_length(cfg) -> dict:
 
 
 def _mc_check(cfg, pts, th, sr, ctx):
-    sim = run_part(cfg, ctx, partial(design_chunk, pts, th, sr), part=0, label="design MC")
+    fn = partial(design_chunk, pts, th, sr)
+    sim = run_part(cfg, ctx, fn, part=0, label="design MC", units=DESIGN_UNITS["check"])
     good = sim["status"] == 0
     E = sim["err_um"][good]
     Fan = (
@@ -278,13 +280,17 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
         draw(figures.figure_jobs(stage, out, *data))
 
     # 1. design trade-off (analytic) and its Monte-Carlo check
-    cols = design_cells(cfg)
-    write_table(out / "design.parquet", cols, prov)
-    figs("design", cols)
+    with ctx.doing("design grid"):
+        cols = design_cells(cfg)
+        write_table(out / "design.parquet", cols, prov)
+        figs("design", cols)
     # the unprinted inputs explored jointly (.region): the tolerances analytic, the external
     # comparisons on a small design of plates
-    parts = {"tolerances": DR.tolerance_region(cfg, book), "plates": DR.plates_region(cfg, book)}
-    region_rows, region_table, region_inputs = DR.region_rows(book, parts, cfg)
+    with ctx.doing("tolerance region"):
+        tolerances = DR.tolerance_region(cfg, book)
+    with ctx.doing("plate region"):
+        parts = {"tolerances": tolerances, "plates": DR.plates_region(cfg, book)}
+        region_rows, region_table, region_inputs = DR.region_rows(book, parts, cfg)
     R["design"] = _design(cfg, cols)
     R["time"] = (
         measuring_time(cfg, 4, cfg["time.images"], 1),
