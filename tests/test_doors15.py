@@ -112,7 +112,12 @@ def test_a_library_loaded_in_a_run_short_of_memory_is_named_as_such(monkeypatch,
 
     monkeypatch.setattr(cli, "_check", no_room)
     # 2 GiB: under 1 GiB sim.cli.main refuses to start, as the sim command does (doors39r)
-    monkeypatch.setattr(threads.resource, "getrlimit", lambda what: (2**31, 2**31))
+    real = resource.getrlimit  # ulimit -v only: a library imported now keeps what it reads
+    monkeypatch.setattr(
+        threads.resource,
+        "getrlimit",
+        lambda w: (2**31, 2**31) if w == resource.RLIMIT_AS else real(w),
+    )
     err = one_line(capsys, cli.main(["check", str(ROOT / "studies" / "salsig_encoders.toml")]))
     assert err == (
         "sim: error: not enough memory to load the suite and its libraries (ulimit -v is 2097152 kB)"

@@ -14,7 +14,7 @@ it; one case per class found, each failing on the code before its fix.
   moment, :func:`sim.mc.executors._rss_limit_not_taken`). The test run found it because
   ``test_doors15`` imported ``distributed`` first while ``resource.getrlimit`` was patched to
   answer 1024 for every limit: that test now imports it first and patches ``RLIMIT_NOFILE``
-  only.
+  only (and its ``ulimit -v`` test ``RLIMIT_AS`` only, not every limit at 2 GiB).
 """
 
 from __future__ import annotations
