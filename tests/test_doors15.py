@@ -66,8 +66,13 @@ def test_a_batch_that_cannot_start_its_runs_says_so_in_one_line(tmp_path, monkey
 
 def test_dask_is_not_started_under_too_few_open_files(monkeypatch):
     started = []
-    monkeypatch.setattr(resource, "getrlimit", lambda what: (40, 1024))
+    # imported before getrlimit is patched: distributed fixes its MEMORY_LIMIT at import from
+    # the hard ulimit -m, and 1024 bytes there broke every later Dask run of this process
     pytest.importorskip("dask.distributed")
+    real = resource.getrlimit
+    monkeypatch.setattr(
+        resource, "getrlimit", lambda w: (40, 1024) if w == resource.RLIMIT_NOFILE else real(w)
+    )
     monkeypatch.setattr("dask.distributed.LocalCluster", lambda *a, **k: started.append(1))
     with pytest.raises(RuntimeError, match="needs at least 64 open files, and ulimit -n is 40"):
         executors.make_executor("dask", 2, None)
@@ -107,7 +112,12 @@ def test_a_library_loaded_in_a_run_short_of_memory_is_named_as_such(monkeypatch,
 
     monkeypatch.setattr(cli, "_check", no_room)
     # 2 GiB: under 1 GiB sim.cli.main refuses to start, as the sim command does (doors39r)
-    monkeypatch.setattr(threads.resource, "getrlimit", lambda what: (2**31, 2**31))
+    real = resource.getrlimit  # ulimit -v only: a library imported now keeps what it reads
+    monkeypatch.setattr(
+        threads.resource,
+        "getrlimit",
+        lambda w: (2**31, 2**31) if w == resource.RLIMIT_AS else real(w),
+    )
     err = one_line(capsys, cli.main(["check", str(ROOT / "studies" / "salsig_encoders.toml")]))
     assert err == (
         "sim: error: not enough memory to load the suite and its libraries (ulimit -v is 2097152 kB)"

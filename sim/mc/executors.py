@@ -178,6 +178,7 @@ class _Dask:
             ) from None
         self._completed = dask_completed
         self.cluster = None
+        _rss_limit_not_taken()  # the client's messages are sized from it too
         if scheduler:
             self.client = Client(scheduler, timeout="10s")
         else:
@@ -247,6 +248,25 @@ def _enough_files(workers: int) -> None:
         raise StartRefused(
             f"a LocalCluster of {n} worker{'s' if n > 1 else ''} needs at least {need} open "
             f"files, and ulimit -n is {soft} (raise it, or use --executor local)"
+        )
+
+
+def _rss_limit_not_taken() -> None:
+    """Refuse (one line) to start Dask under a hard ``ulimit -m`` that Dask would take for the
+    machine's memory (:func:`distributed.system.memory_limit`): Linux does not enforce it, but
+    Dask sizes its workers (paused at 80 %) and its messages (half of it) from it, so a run
+    under it hung (400 MB), ended in "CommClosedError ... Stream is closed" (100 MB) or in a
+    63-line tornado traceback (under 256 kB: "cannot convert 'float' object to bytearray")."""
+    hard = resource.getrlimit(resource.RLIMIT_RSS)[1]
+    if hard == resource.RLIM_INFINITY or hard <= 0:
+        return
+    from distributed.system import memory_limit  # heavy optional dependency (dask extra)
+
+    if memory_limit() >= hard:  # the limit is what Dask takes for the memory (or less)
+        raise StartRefused(
+            f"Dask takes ulimit -m ({hard // 1024} kB) for this machine's memory, which Linux "
+            "does not enforce, and its workers stall or fail under it (start the run from a "
+            "shell without ulimit -m, or use --executor local)"
         )
 
 
