@@ -6,9 +6,9 @@ internal. Importing ``sim`` does nothing else: the names load on first use (as S
 subpackages do), so the command line (:mod:`sim.__main__`) can set up its processes first.
 """
 
-import importlib
-import os
-import resource
+import importlib as _importlib  # underscored: dir(sim) (a notebook's completion) listed
+import os as _os  # os, resource and importlib as names of the suite's public surface
+import resource as _resource
 
 
 def _system_pool_under_limits() -> None:
@@ -19,9 +19,9 @@ def _system_pool_under_limits() -> None:
     system's) peaked at 1,999,916 kB under ``ulimit -v 2000000``, 84 kB from the limit: the room
     checked before the run (:mod:`sim.room`) was not there, a Parquet read with no room left
     for Arrow's threads hung for good, and the API's next run in the process was refused."""
-    caps = (resource.getrlimit(r)[0] for r in (resource.RLIMIT_AS, resource.RLIMIT_DATA))
-    if any(c != resource.RLIM_INFINITY for c in caps):
-        os.environ.setdefault("ARROW_DEFAULT_MEMORY_POOL", "system")
+    caps = (_resource.getrlimit(r)[0] for r in (_resource.RLIMIT_AS, _resource.RLIMIT_DATA))
+    if any(c != _resource.RLIM_INFINITY for c in caps):
+        _os.environ.setdefault("ARROW_DEFAULT_MEMORY_POOL", "system")
 
 
 _system_pool_under_limits()
@@ -45,7 +45,7 @@ __version__ = "0.1.0"
 
 def __getattr__(name: str):
     if name in _EXPORTS:
-        return getattr(importlib.import_module(_EXPORTS[name]), name)
+        return getattr(_importlib.import_module(_EXPORTS[name]), name)
     raise AttributeError(f"module 'sim' has no attribute {name!r}")
 
 

@@ -47,6 +47,7 @@ from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.api_state import check_files as _check_files
+from sim.api_state import made_by_load as _by_load
 from sim.api_tables import check_owner as _check_owner
 from sim.api_tables import owner as _owner
 from sim.api_tables import run_tables, stale_warning
@@ -72,8 +73,7 @@ __all__ = ["load", "StudyHandle", "Results"]
 
 
 class _Handles:
-    """``run()``'s ``trials`` and ``seed`` left out: the handle's (None is refused, as
-    ``sim.load(f, trials=None)`` is: ``run(trials=None)`` ran the handle's trials, L37)."""
+    """``run()``'s ``trials`` and ``seed`` left out: the handle's (``None`` is refused)."""
 
     def __repr__(self) -> str:
         return "<the handle's>"
@@ -209,9 +209,6 @@ class Results:
         return self.table("claims")
 
 
-Results.__init__ = _arguments(Results.__init__)  # type: ignore[method-assign]
-
-
 @dataclass(frozen=True)
 class StudyHandle:
     """A validated study configuration, ready to run."""
@@ -326,8 +323,7 @@ class StudyHandle:
                 )
             except ConfigError as e:
                 if e.key in _ARGUMENTS:  # the command line's option: the argument of run()
-                    msg = e.detail
-                    raise ConfigError(_ARGUMENTS[e.key], msg) from None
+                    raise ConfigError(_ARGUMENTS[e.key], e.detail) from None
                 if e.key != "--out" and not any(cli in str(e) for cli, _ in _LIMITS):
                     raise
                 raise _api_words(e) from None
@@ -356,6 +352,10 @@ def _loggers_kept():
     finally:
         for n, level in levels.items():
             logging.getLogger(n).setLevel(level)
+
+
+Results.__init__ = _arguments(Results.__init__)  # type: ignore[method-assign]
+StudyHandle.__init__ = _by_load(StudyHandle.__init__)  # type: ignore[method-assign]
 
 
 def _api_words(e: ConfigError) -> ConfigError:
@@ -405,8 +405,7 @@ def _unpickled(study: Any, state: dict) -> StudyHandle:
 def _unchanged(h: StudyHandle) -> None:
     """A handle runs the file it loaded: its config is that file's, and ``replace`` or
     ``run(trials=...)`` read the file again, so an edited (or deleted) file would give one
-    handle two configs. Refused, as an edited ``network.gama_xml`` is; so is a config changed
-    in place (:func:`sim.api_state.check_state`)."""
+    handle two configs: refused, as is a config changed in place (:func:`check_state`)."""
     check_state(h)
     check_cwd(h)
     if h.file_sha256 and _sha256(h.path) != h.file_sha256:

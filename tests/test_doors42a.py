@@ -1,0 +1,59 @@
+"""The classes of the sweep doors42a (brief A42: a careless user of the Python API in a
+notebook -- cells run out of order and twice, a handle built or copied by hand, ``dir(sim)``
+and ``help()`` of the public names), one case each; each failed on the code before its fix.
+
+* ``sim.StudyHandle`` is a public name (``sim.__all__``, ``dir(sim)``), and a notebook calls
+  it as it calls ``sim.Results(path, study)``: ``sim.StudyHandle("studies/x.toml")`` ended
+  in Python's ``TypeError`` naming two dataclass fields, and ``sim.StudyHandle(path, study,
+  config)`` with a config of the caller's (a dict copied from a handle and edited) ran and
+  published that config unvalidated (no state digest to check it against). A handle is made
+  by ``sim.load`` (or from its own state: a pickle, ``copy``); any other is one
+  ``ConfigError`` naming ``StudyHandle`` and ``sim.load()``, as is
+  ``dataclasses.replace(handle, overrides=...)`` (refused only later, by ``run()``).
+* ``dir(sim)`` (a notebook's tab completion) listed ``os``, ``resource`` and ``importlib``,
+  the modules ``sim/__init__.py`` imports for itself, among the suite's public names; they
+  are underscored now.
+
+Held (found right): overrides from NumPy values (0-d arrays, ``np.str_``, ``np.float16``,
+NaN and inf named), a dict subclass unpacked by ``**``, a NumPy string as a key, a nested
+dict (``errors={"settings": 3}``, named as a table with its keys) beside a dotted key; a
+cell run twice (the second run resumes the finished results, the same claims); a handle's
+Results read after another handle overwrote the same ``out`` (refused, naming the path), a
+``sim.Results(path, study)`` made by hand reading the new run; ``pickle``, ``copy``,
+``deepcopy`` and ``repr`` of a handle; ``help()`` of ``sim``, a handle and ``Results``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import pickle
+from pathlib import Path
+
+import pytest
+
+import sim
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDY = ROOT / "studies" / "brown_table1.toml"
+
+
+def test_a_handle_is_made_by_load_only():
+    h = sim.load(STUDY, trials=40, chunk=2)
+    made = [
+        lambda: sim.StudyHandle(str(STUDY)),
+        lambda: sim.StudyHandle(STUDY, h.study, {**h.config, "trials": 41}),
+        lambda: dataclasses.replace(h, overrides={"trials": 5}),
+    ]
+    for make in made:
+        with pytest.raises(sim.ConfigError, match=r"^StudyHandle: is made by sim\.load\(") as e:
+            make()
+        assert "\n" not in str(e.value)
+    assert pickle.loads(pickle.dumps(h)) == h == dataclasses.replace(h)  # its own state
+    assert h.replace(seed=3).overrides["seed"] == 3
+
+
+def test_dir_of_sim_lists_no_module_it_imports_for_itself():
+    import sim as fresh
+
+    assert not {"os", "resource", "importlib"} & set(dir(fresh))
+    assert set(fresh.__all__) <= set(dir(fresh))
