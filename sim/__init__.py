@@ -34,10 +34,10 @@ _EXPORTS = {
     "StaleResultsWarning": "sim.api_tables",
     "ConfigError": "sim.mc.config",
     "StudyError": "sim.mc.config",
-    "load_study": "sim.studies",
-    "run_chunks": "sim.mc.runner",
-    "write_table": "sim.mc.storage",
-    "read_provenance": "sim.mc.storage",
+    "load_study": "sim.api_helpers",  # the helpers every study uses, checked as the API's
+    "run_chunks": "sim.api_helpers",
+    "write_table": "sim.api_helpers",
+    "read_provenance": "sim.api_helpers",
 }
 __all__ = list(_EXPORTS)
 __version__ = "0.1.0"

@@ -211,7 +211,7 @@ class Results:
 
 @dataclass(frozen=True)
 class StudyHandle:
-    """A validated study configuration, ready to run."""
+    """A validated study configuration, ready to run: made by :func:`load` (by hand, refused)."""
 
     path: Path
     study: Any = field(repr=False)

@@ -13,6 +13,12 @@ and ``help()`` of the public names), one case each; each failed on the code befo
 * ``dir(sim)`` (a notebook's tab completion) listed ``os``, ``resource`` and ``importlib``,
   the modules ``sim/__init__.py`` imports for itself, among the suite's public names; they
   are underscored now.
+* The helpers ``sim`` exports beside the API (``sim.load_study``, ``sim.read_provenance``,
+  ``sim.write_table``, ``sim.run_chunks``), called from a notebook, ended in tracebacks:
+  ``TypeError`` for an argument missing or a handle given as the path, pyarrow's ``OSError``
+  or ``ArrowInvalid`` for ``read_provenance`` of a directory, a missing file or a study file
+  (and ``help(sim.read_provenance)`` said nothing). They take their arguments as
+  ``sim.load`` does now (:mod:`sim.api_helpers`), each misuse one ``ConfigError`` naming it.
 
 Held (found right): overrides from NumPy values (0-d arrays, ``np.str_``, ``np.float16``,
 NaN and inf named), a dict subclass unpacked by ``**``, a NumPy string as a key, a nested
@@ -57,3 +63,21 @@ def test_dir_of_sim_lists_no_module_it_imports_for_itself():
 
     assert not {"os", "resource", "importlib"} & set(dir(fresh))
     assert set(fresh.__all__) <= set(dir(fresh))
+
+
+def test_the_helpers_sim_exports_name_their_argument(tmp_path):
+    h = sim.load(STUDY, trials=40, chunk=2)
+    (tmp_path / "d").mkdir()
+    calls = {
+        r"^path: .*d: a directory, not a table": lambda: sim.read_provenance(tmp_path / "d"),
+        r"^path: .*nope\.parquet: no such file": lambda: sim.read_provenance("nope.parquet"),
+        r"^path: .*\.toml: not a Parquet file$": lambda: sim.read_provenance(STUDY),
+        r"^path: must be a path .* got StudyHandle\(": lambda: sim.load_study(h),
+        r"^fn: missing: run_chunks\(\) needs it": lambda: sim.run_chunks(),
+        r"^prov: missing: write_table\(\) needs it": lambda: sim.write_table("x.parquet", {}),
+    }
+    for want, call in calls.items():
+        with pytest.raises(sim.ConfigError, match=want) as e:
+            call()
+        assert "\n" not in str(e.value)
+    assert sim.read_provenance.__doc__ and sim.load_study(STUDY)[0].name == "brown_table1"
