@@ -31,7 +31,7 @@ import pyarrow.parquet as pq
 from sim.api_args import arguments as _arguments
 from sim.api_args import count as _count
 from sim.api_args import dotted as _key
-from sim.api_args import flag
+from sim.api_args import flag, no_none
 from sim.api_args import keyed as _keyed
 from sim.api_paths import absolute_path as _absolute
 from sim.api_paths import (
@@ -249,6 +249,7 @@ class StudyHandle:
     def replace(self, **overrides) -> "StudyHandle":
         """A new handle with more overrides."""
         _unchanged(self)
+        no_none(_keyed(overrides), "replace")
         new = load(self.path, **{**self.overrides, **_keyed(overrides)})
         _check_files(self, new)  # a network.gama_xml edited since: refused, as run() does
         return new
@@ -279,10 +280,7 @@ class StudyHandle:
         )
         _unchanged(self)
         given = {k: v for k, v in (("trials", trials), ("seed", seed)) if v is not HANDLES}
-        if (none := [k for k, v in given.items() if v is None]) != []:  # as sim.load refuses it
-            raise ConfigError(
-                none[0], "is None, which no study file holds: leave it out for the handle's value"
-            )
+        no_none(given, "run")  # as sim.load refuses it
         h = load(self.path, **{**self.overrides, **given}) if given else self
         _check_files(self, h)  # a network.gama_xml edited since: refused, as run() does
         base = None  # the temporary directory made for this run (out=None)

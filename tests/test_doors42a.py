@@ -19,6 +19,10 @@ and ``help()`` of the public names), one case each; each failed on the code befo
   or ``ArrowInvalid`` for ``read_provenance`` of a directory, a missing file or a study file
   (and ``help(sim.read_provenance)`` said nothing). They take their arguments as
   ``sim.load`` does now (:mod:`sim.api_helpers`), each misuse one ``ConfigError`` naming it.
+* ``handle.replace(trials=None)`` (meant: drop the override, back to the file's value) was
+  refused as ``sim.load(f, trials=None)`` is, "leave it out for the file's value": left out
+  of ``replace()``, the key keeps the handle's value. It says that ``replace()`` drops no
+  override, and ``sim.load()`` the study without the key.
 
 Held (found right): overrides from NumPy values (0-d arrays, ``np.str_``, ``np.float16``,
 NaN and inf named), a dict subclass unpacked by ``**``, a NumPy string as a key, a nested
@@ -81,3 +85,13 @@ def test_the_helpers_sim_exports_name_their_argument(tmp_path):
             call()
         assert "\n" not in str(e.value)
     assert sim.read_provenance.__doc__ and sim.load_study(STUDY)[0].name == "brown_table1"
+
+
+def test_replace_with_none_says_how_to_drop_an_override():
+    h = sim.load(STUDY, trials=40, chunk=2)
+    for given in ({"trials": None}, {"errors.settings": None}):
+        with pytest.raises(sim.ConfigError, match=r"replace\(\) drops no override") as e:
+            h.replace(**given)
+        assert str(e.value).startswith(f"{next(iter(given))}: ") and "sim.load()" in str(e.value)
+    with pytest.raises(sim.ConfigError, match=r"^seed: .*leave it out for the handle's value$"):
+        h.run(seed=None)
