@@ -38,6 +38,7 @@ from sim.api_paths import (
     another_run,
     cell_chunks,
     cell_mixed,
+    check_identity,
     chunks_recorded,
     study_runs_in,
     why_not_a_dir,
@@ -94,6 +95,7 @@ class Results:
 
     def __post_init__(self):  # Results("results/x", "x"): a str is taken as the path
         _check_path("path", self.path)
+        check_identity(self.run_sha256)  # not a table's name given third
         if not isinstance(self.study, str) or not self.study.isidentifier():
             raise ConfigError(
                 "study", f"must be a study name such as 'network' (got {self.study!r})"

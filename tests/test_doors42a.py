@@ -23,6 +23,10 @@ and ``help()`` of the public names), one case each; each failed on the code befo
   refused as ``sim.load(f, trials=None)`` is, "leave it out for the file's value": left out
   of ``replace()``, the key keeps the handle's value. It says that ``replace()`` drops no
   override, and ``sim.load()`` the study without the key.
+* ``sim.Results(path, "brown_table1", "claims")`` (a table's name given third, where
+  ``help(sim.Results)`` shows ``run_sha256``) had every read refused as "holds another run
+  than the one that returned these Results (run again into it since)", of a run never made.
+  A ``run_sha256`` that is not the 16 hex digits ``run()`` sets is refused naming it.
 
 Held (found right): overrides from NumPy values (0-d arrays, ``np.str_``, ``np.float16``,
 NaN and inf named), a dict subclass unpacked by ``**``, a NumPy string as a key, a nested
@@ -95,3 +99,11 @@ def test_replace_with_none_says_how_to_drop_an_override():
         assert str(e.value).startswith(f"{next(iter(given))}: ") and "sim.load()" in str(e.value)
     with pytest.raises(sim.ConfigError, match=r"^seed: .*leave it out for the handle's value$"):
         h.run(seed=None)
+
+
+def test_a_results_third_argument_is_the_identity_run_sets():
+    res = ROOT / "results" / "brown_table1"
+    for bad in ("claims", None, 5):
+        with pytest.raises(sim.ConfigError, match=r"^run_sha256: is the identity of the run"):
+            sim.Results(res, "brown_table1", bad)
+    assert sim.Results(res, "brown_table1", "").path == res
