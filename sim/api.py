@@ -49,6 +49,7 @@ from sim.api_paths import run_identity as _run_identity
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.api_state import check_files as _check_files
 from sim.api_state import made_by_load as _by_load
+from sim.api_state import unchecked as _unchecked
 from sim.api_tables import check_owner as _check_owner
 from sim.api_tables import owner as _owner
 from sim.api_tables import run_tables, stale_warning
@@ -397,9 +398,9 @@ def _sha256(path: Path) -> str:
 
 
 def _unpickled(study: Any, state: dict) -> StudyHandle:
-    """A pickled :class:`StudyHandle` (:meth:`StudyHandle.__reduce__`) made again; ``study``
-    is a registered study's name, or the study."""
-    return StudyHandle(study=get_study(study) if isinstance(study, str) else study, **state)
+    """A pickled handle made as it was (changed in place: refused by run(), not in a worker)."""
+    study = get_study(study) if isinstance(study, str) else study
+    return _unchecked(StudyHandle, study=study, **state)
 
 
 def _unchanged(h: StudyHandle) -> None:

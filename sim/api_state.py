@@ -41,6 +41,7 @@ __all__ = [
     "working_dir",
     "anonymous_dir",
     "made_by_load",
+    "unchecked",
 ]
 
 #: the config keys whose relative path is read from the working directory
@@ -100,6 +101,14 @@ def made_by_load(init):
             raise ConfigError("StudyHandle", _BY_LOAD)  # dataclasses.replace(h, config=...)
 
     return made
+
+
+def unchecked(cls: type, **fields: Any) -> Any:
+    """A ``cls`` (:class:`sim.api.StudyHandle`) made from ``fields`` without
+    :func:`made_by_load`'s check: a pickled handle, as it was pickled."""
+    h = object.__new__(cls)
+    cls.__init__.__wrapped__(h, **fields)  # type: ignore[misc]
+    return h
 
 
 def working_dir() -> str:

@@ -27,6 +27,12 @@ and ``help()`` of the public names), one case each; each failed on the code befo
   ``help(sim.Results)`` shows ``run_sha256``) had every read refused as "holds another run
   than the one that returned these Results (run again into it since)", of a run never made.
   A ``run_sha256`` that is not the 16 hex digits ``run()`` sets is refused naming it.
+* A ``ConfigError`` did not survive its pickle (its ``args`` are the whole line, its
+  ``__init__`` takes ``key, message``): a handle sent to a worker of the caller's own
+  ``multiprocessing.Pool`` (as the docs invite) and refused there (changed in place) ended in
+  a ``TypeError`` in the Pool's result thread, and ``pool.map`` waited for good. It pickles
+  as it is (:mod:`sim.mc.pickled_error`): the caller gets the worker's one line, its key and
+  notes. A handle changed in place unpickles as it was, refused by its ``run()``.
 
 Held (found right): overrides from NumPy values (0-d arrays, ``np.str_``, ``np.float16``,
 NaN and inf named), a dict subclass unpacked by ``**``, a NumPy string as a key, a nested
@@ -40,6 +46,7 @@ Results read after another handle overwrote the same ``out`` (refused, naming th
 from __future__ import annotations
 
 import dataclasses
+import multiprocessing
 import pickle
 from pathlib import Path
 
@@ -107,3 +114,19 @@ def test_a_results_third_argument_is_the_identity_run_sets():
         with pytest.raises(sim.ConfigError, match=r"^run_sha256: is the identity of the run"):
             sim.Results(res, "brown_table1", bad)
     assert sim.Results(res, "brown_table1", "").path == res
+
+
+def _trials(h: sim.StudyHandle) -> int:
+    return h.estimate().trials
+
+
+def test_a_refusal_in_a_pool_worker_comes_back_to_the_caller():
+    e = sim.ConfigError("trials", "must be an integer")
+    e.add_note("a note")
+    back = pickle.loads(pickle.dumps(e))
+    assert (str(back), back.key, back.__notes__) == (str(e), "trials", ["a note"])
+    h = sim.load(STUDY, trials=40, chunk=2)
+    h.config["trials"] = 41  # changed in place: the worker's estimate() refuses it
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        with pytest.raises(sim.ConfigError, match=r"^config: the handle's config"):
+            pool.map_async(_trials, [h]).get(timeout=20)
