@@ -40,7 +40,13 @@ dict (``errors={"settings": 3}``, named as a table with its keys) beside a dotte
 cell run twice (the second run resumes the finished results, the same claims); a handle's
 Results read after another handle overwrote the same ``out`` (refused, naming the path), a
 ``sim.Results(path, study)`` made by hand reading the new run; ``pickle``, ``copy``,
-``deepcopy`` and ``repr`` of a handle; ``help()`` of ``sim``, a handle and ``Results``.
+``deepcopy`` and ``repr`` of a handle; ``help()`` of ``sim``, a handle and ``Results``; a
+run interrupted (``KeyboardInterrupt``, one and two workers: no process or thread left) and
+run again, or run with another config into the same ``out`` (its unfinished run named, or
+replaced with ``overwrite=True``); ``sim.load`` of a 2500-point network interrupted and run
+again; a cell run again with ``figures`` turned on or off; ``run()``'s ``executor``,
+``scheduler``, ``workers`` and flags of wrong types; network records as dict subclasses,
+``OrderedDict``, ``MappingProxyType`` or an object array.
 """
 
 from __future__ import annotations
