@@ -6,10 +6,10 @@ internal. Importing ``sim`` does nothing else: the names load on first use (as S
 subpackages do), so the command line (:mod:`sim.__main__`) can set up its processes first.
 """
 
-import importlib
-import os
-import resource
-import sys
+import importlib as _importlib  # underscored: dir(sim) (a notebook's completion) listed
+import os as _os  # os, resource and importlib as names of the suite's public surface
+import resource as _resource
+import sys as _sys
 
 
 def _system_pool_under_limits() -> None:
@@ -20,10 +20,10 @@ def _system_pool_under_limits() -> None:
     system's) peaked at 1,999,916 kB under ``ulimit -v 2000000``, 84 kB from the limit: the room
     checked before the run (:mod:`sim.room`) was not there, a Parquet read with no room left
     for Arrow's threads hung for good, and the API's next run in the process was refused."""
-    caps = (resource.getrlimit(r)[0] for r in (resource.RLIMIT_AS, resource.RLIMIT_DATA))
-    if any(c != resource.RLIM_INFINITY for c in caps):  # an empty value is Arrow's default
-        if not os.environ.get("ARROW_DEFAULT_MEMORY_POOL"):
-            os.environ["ARROW_DEFAULT_MEMORY_POOL"] = "system"
+    caps = (_resource.getrlimit(r)[0] for r in (_resource.RLIMIT_AS, _resource.RLIMIT_DATA))
+    if any(c != _resource.RLIM_INFINITY for c in caps):  # an empty value is Arrow's default
+        if not _os.environ.get("ARROW_DEFAULT_MEMORY_POOL"):
+            _os.environ["ARROW_DEFAULT_MEMORY_POOL"] = "system"
 
 
 _system_pool_under_limits()
@@ -36,10 +36,10 @@ _EXPORTS = {
     "StaleResultsWarning": "sim.api_tables",
     "ConfigError": "sim.mc.config",
     "StudyError": "sim.mc.config",
-    "load_study": "sim.studies",
-    "run_chunks": "sim.mc.runner",
-    "write_table": "sim.mc.storage",
-    "read_provenance": "sim.mc.storage",
+    "load_study": "sim.api_helpers",  # the helpers every study uses, checked as the API's
+    "run_chunks": "sim.api_helpers",
+    "write_table": "sim.api_helpers",
+    "read_provenance": "sim.api_helpers",
 }
 __all__ = list(_EXPORTS)
 __version__ = "0.1.0"
@@ -48,7 +48,7 @@ __version__ = "0.1.0"
 def __getattr__(name: str):
     if name in _EXPORTS:
         _refuse_unloadable(_EXPORTS[name])
-        return getattr(importlib.import_module(_EXPORTS[name]), name)
+        return getattr(_importlib.import_module(_EXPORTS[name]), name)
     raise AttributeError(f"module 'sim' has no attribute {name!r}")
 
 
@@ -63,7 +63,7 @@ def _refuse_unloadable(module: str) -> None:
     ``numpy.f2py`` (imported by ``scipy.sparse``), "ValueError: invalid literal for int()";
     with ``ARROW_DEFAULT_MEMORY_POOL=System`` it ran on Arrow's default allocator after a line
     of Arrow's own (:func:`sim.threads.arrow_variables_problem`)."""
-    if module in sys.modules or module == "sim.mc.config":  # loaded, or loads no NumPy
+    if module in _sys.modules or module == "sim.mc.config":  # loaded, or loads no NumPy
         return
     from sim.threads import arrow_variables_problem, source_date_epoch_problem
 

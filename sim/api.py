@@ -31,13 +31,14 @@ import pyarrow.parquet as pq
 from sim.api_args import arguments as _arguments
 from sim.api_args import count as _count
 from sim.api_args import dotted as _key
-from sim.api_args import flag
+from sim.api_args import flag, no_none
 from sim.api_args import keyed as _keyed
 from sim.api_paths import absolute_path as _absolute
 from sim.api_paths import (
     another_run,
     cell_chunks,
     cell_mixed,
+    check_identity,
     chunks_recorded,
     study_runs_in,
     why_not_a_dir,
@@ -47,6 +48,8 @@ from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
 from sim.api_state import check_files as _check_files
+from sim.api_state import made_by_load as _by_load
+from sim.api_state import unchecked as _unchecked
 from sim.api_tables import check_owner as _check_owner
 from sim.api_tables import own_trials, run_tables, stale_warning
 from sim.api_tables import owner as _owner
@@ -72,8 +75,7 @@ __all__ = ["load", "StudyHandle", "Results"]
 
 
 class _Handles:
-    """``run()``'s ``trials`` and ``seed`` left out: the handle's (None is refused, as
-    ``sim.load(f, trials=None)`` is: ``run(trials=None)`` ran the handle's trials, L37)."""
+    """``run()``'s ``trials`` and ``seed`` left out: the handle's (``None`` is refused)."""
 
     def __repr__(self) -> str:
         return "<the handle's>"
@@ -94,6 +96,7 @@ class Results:
 
     def __post_init__(self):  # Results("results/x", "x"): a str is taken as the path
         _check_path("path", self.path)
+        check_identity(self.run_sha256)  # not a table's name given third
         if not isinstance(self.study, str) or not self.study.isidentifier():
             raise ConfigError(
                 "study", f"must be a study name such as 'network' (got {self.study!r})"
@@ -207,12 +210,9 @@ class Results:
         return self.table("claims")
 
 
-Results.__init__ = _arguments(Results.__init__)  # type: ignore[method-assign]
-
-
 @dataclass(frozen=True)
 class StudyHandle:
-    """A validated study configuration, ready to run."""
+    """A validated study configuration, ready to run: made by :func:`load` (by hand, refused)."""
 
     path: Path
     study: Any = field(repr=False)
@@ -250,6 +250,7 @@ class StudyHandle:
     def replace(self, **overrides) -> "StudyHandle":
         """A new handle with more overrides."""
         _unchanged(self)
+        no_none(_keyed(overrides), "replace")
         new = load(self.path, **{**self.overrides, **_keyed(overrides)})
         _check_files(self, new)  # a network.gama_xml edited since: refused, as run() does
         return new
@@ -280,10 +281,7 @@ class StudyHandle:
         )
         _unchanged(self)
         given = {k: v for k, v in (("trials", trials), ("seed", seed)) if v is not HANDLES}
-        if (none := [k for k, v in given.items() if v is None]) != []:  # as sim.load refuses it
-            raise ConfigError(
-                none[0], "is None, which no study file holds: leave it out for the handle's value"
-            )
+        no_none(given, "run")  # as sim.load refuses it
         h = load(self.path, **{**self.overrides, **given}) if given else self
         _check_files(self, h)  # a network.gama_xml edited since: refused, as run() does
         base = None  # the temporary directory made for this run (out=None)
@@ -324,8 +322,7 @@ class StudyHandle:
                 )
             except ConfigError as e:
                 if e.key in _ARGUMENTS:  # the command line's option: the argument of run()
-                    msg = e.detail
-                    raise ConfigError(_ARGUMENTS[e.key], msg) from None
+                    raise ConfigError(_ARGUMENTS[e.key], e.detail) from None
                 if e.key != "--out" and not any(cli in str(e) for cli, _ in _LIMITS):
                     raise
                 raise _api_words(e) from None
@@ -354,6 +351,10 @@ def _loggers_kept():
     finally:
         for n, level in levels.items():
             logging.getLogger(n).setLevel(level)
+
+
+Results.__init__ = _arguments(Results.__init__)  # type: ignore[method-assign]
+StudyHandle.__init__ = _by_load(StudyHandle.__init__)  # type: ignore[method-assign]
 
 
 def _api_words(e: ConfigError) -> ConfigError:
@@ -395,16 +396,15 @@ def _sha256(path: Path) -> str:
 
 
 def _unpickled(study: Any, state: dict) -> StudyHandle:
-    """A pickled :class:`StudyHandle` (:meth:`StudyHandle.__reduce__`) made again; ``study``
-    is a registered study's name, or the study."""
-    return StudyHandle(study=get_study(study) if isinstance(study, str) else study, **state)
+    """A pickled handle made as it was (changed in place: refused by run(), not in a worker)."""
+    study = get_study(study) if isinstance(study, str) else study
+    return _unchecked(StudyHandle, study=study, **state)
 
 
 def _unchanged(h: StudyHandle) -> None:
     """A handle runs the file it loaded: its config is that file's, and ``replace`` or
     ``run(trials=...)`` read the file again, so an edited (or deleted) file would give one
-    handle two configs. Refused, as an edited ``network.gama_xml`` is; so is a config changed
-    in place (:func:`sim.api_state.check_state`)."""
+    handle two configs: refused, as is a config changed in place (:func:`check_state`)."""
     check_state(h)
     check_cwd(h)
     if h.file_sha256 and _sha256(h.path) != h.file_sha256:

@@ -15,7 +15,7 @@ from sim.long_words import clipped
 from sim.mc.config import ConfigError
 from sim.mc.pyvalue import as_config_value
 
-__all__ = ["arguments", "count", "dotted", "flag", "keyed", "one_line"]
+__all__ = ["arguments", "count", "dotted", "flag", "keyed", "no_none", "one_line"]
 
 
 def dotted(k: str) -> str:
@@ -34,6 +34,26 @@ def keyed(overrides: dict) -> dict:
             raise ConfigError(d, f"given twice ({seen[d]!r} and {k!r}): one value would be dropped")
         out[d], seen[d] = v, k
     return out
+
+
+#: what a caller of each function does instead of giving a key ``None``
+_INSTEAD = {
+    "run": "leave it out for the handle's value",
+    "replace": (
+        "replace() drops no override (left out, the key keeps the handle's value): "
+        "sim.load() the study without it for the file's value"
+    ),
+}
+
+
+def no_none(given: dict, of: str) -> None:
+    """``given`` (the keys given to ``run`` or ``replace``, ``of``) holds no ``None``, which
+    no study file holds: refused naming the key and what to do for the value meant.
+    ``handle.replace(trials=None)`` (meant: drop the override) said "leave it out for the
+    file's value", where left out of ``replace()`` it is the handle's."""
+    for k, v in given.items():
+        if v is None:
+            raise ConfigError(k, f"is None, which no study file holds: {_INSTEAD[of]}")
 
 
 #: where a user gets the object a method is called on

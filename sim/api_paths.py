@@ -15,6 +15,7 @@ from __future__ import annotations
 import ast
 import errno
 import os
+import re
 import resource
 from pathlib import Path
 from typing import Any
@@ -32,6 +33,7 @@ __all__ = [
     "another_run",
     "check_path",
     "absolute_path",
+    "check_identity",
     "cell_chunks",
     "cell_mixed",
     "study_runs_in",
@@ -133,6 +135,19 @@ def why_unread(e: Exception) -> str:
     if isinstance(e, OSError) and e.strerror:
         return e.strerror
     return type(e).__name__
+
+
+def check_identity(v: Any) -> None:
+    """``v``, a ``Results``' ``run_sha256``: "" (any run) or the 16 hex digits of
+    :func:`run_identity`, which ``run()`` sets. A third argument given by a caller who took
+    it for another (``sim.Results(path, "brown_table1", "claims")``) had every read refused
+    as "holds another run than the one that returned these Results", of a run never made."""
+    if not (v == "" or (isinstance(v, str) and re.fullmatch("[0-9a-f]{16}", v))):
+        raise ConfigError(
+            "run_sha256",
+            f"is the identity of the run that returned these Results, which run() sets (16 "
+            f"hex digits): leave it out to read the directory's run (got {v!r})",
+        )
 
 
 def run_identity(out: Path) -> str:

@@ -23,6 +23,7 @@ directory a run without ``out`` makes.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import json
 import os
@@ -39,6 +40,8 @@ __all__ = [
     "check_files",
     "working_dir",
     "anonymous_dir",
+    "made_by_load",
+    "unchecked",
 ]
 
 #: the config keys whose relative path is read from the working directory
@@ -69,6 +72,43 @@ def check_state(h: Any) -> None:
             "the handle's config, overrides or sweep were changed in place since sim.load() "
             "(unvalidated): use handle.replace(key=value), or sim.load() again",
         )
+
+
+#: why a handle is not made by hand
+_BY_LOAD = (
+    "is made by sim.load(study_file, **overrides), which validates its config (one built "
+    "by hand or by dataclasses.replace ran a config nothing checked): use sim.load(), or "
+    "handle.replace(key=value)"
+)
+
+
+def made_by_load(init):
+    """``StudyHandle.__init__`` refusing a handle :func:`sim.load` did not make: the class is
+    public (``sim.StudyHandle``), and ``sim.StudyHandle("studies/x.toml")`` ended in
+    Python's TypeError naming two fields, while ``sim.StudyHandle(path, study, config)``
+    with a config of the caller's (and no :func:`state_sha256`) ran and published it
+    unvalidated. A handle made again from its own state (a pickle, ``copy``) is one."""
+
+    @functools.wraps(init)
+    def made(self, *args, **kwargs) -> None:
+        try:
+            init(self, *args, **kwargs)
+        except TypeError:
+            raise ConfigError("StudyHandle", _BY_LOAD) from None
+        if not self.state_sha256 or not isinstance(self.path, Path):
+            raise ConfigError("StudyHandle", _BY_LOAD)
+        if state_sha256(self.config, self.overrides, self.sweep) != self.state_sha256:
+            raise ConfigError("StudyHandle", _BY_LOAD)  # dataclasses.replace(h, config=...)
+
+    return made
+
+
+def unchecked(cls: type, **fields: Any) -> Any:
+    """A ``cls`` (:class:`sim.api.StudyHandle`) made from ``fields`` without
+    :func:`made_by_load`'s check: a pickled handle, as it was pickled."""
+    h = object.__new__(cls)
+    cls.__init__.__wrapped__(h, **fields)  # type: ignore[misc]
+    return h
 
 
 def working_dir() -> str:

@@ -26,6 +26,7 @@ from sim.mc.lookalike import looks, note, toml_char_hint
 from sim.mc.message_text import cut_text, key_text, near_keys, shorten, shown, unit_hint
 from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
+from sim.mc.pickled_error import remade
 from sim.mc.study_file import study_file_problem
 from sim.mc.text_bytes import NotText, utf8_text
 from sim.mc.toml_dates import as_written
@@ -45,9 +46,8 @@ __all__ = [
 
 
 class ConfigError(ValueError):
-    """A bad study configuration. ``str(err)`` is one line naming the key; a character in it
-    that looks like an ASCII one but is not (a Cyrillic letter in a key, a full-width digit)
-    is named (:func:`sim.mc.lookalike.note`): the message quoted text that looked right."""
+    """A bad study configuration. ``str(err)`` is one line naming the key; a character that looks
+    like an ASCII one but is not (a Cyrillic letter, a full-width digit) is named too."""
 
     def __init__(self, key: str | None, message: str):
         self.key = key  # a number of hundreds of digits is shortened in any message
@@ -58,6 +58,9 @@ class ConfigError(ValueError):
     def detail(self) -> str:
         """The message without the key it names (to be said again of another key or door)."""
         return str(self).removeprefix(f"{key_text(self.key)}: " if self.key is not None else "")
+
+    def __reduce__(self):  # its args are the whole line, not (key, message): sim.mc.pickled_error
+        return (remade, (type(self), self.args, self.__dict__))
 
 
 class StudyError(RuntimeError):
