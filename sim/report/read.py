@@ -122,8 +122,10 @@ class Row(Columns):
 _THREAD = re.compile(r"thread|resource temporarily unavailable|cannot allocate memory", re.I)
 #: a quoted span of pyarrow's words (the file it could not open, not the ' of "Couldn't"),
 #: left out of the search: a damaged table under a directory named for threads was "not
-#: enough memory"
-_QUOTED = re.compile(r"(?<![A-Za-z])'[^']*'")
+#: enough memory". It ends at a quote followed by punctuation or the end (pyarrow's
+#: ``'PATH': ...``, ``'PATH'.``): a path holding a quote of its own (``it's threads``,
+#: ``runs' threads``) was cut there, and its ``threads`` searched
+_QUOTED = re.compile(r"(?<![A-Za-z0-9])'.*?'(?=[:.,;)]|$)")
 
 
 def memory_failure(e: BaseException) -> bool:
