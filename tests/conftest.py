@@ -123,6 +123,20 @@ def tiny_overrides(study: str) -> list[str]:
     return [a for ln in lines if ln and not ln.startswith("#") for a in ("--set", ln)]
 
 
+# A network of three points (two fixed), 40 trials in chunks of 2: the smallest study a sweep or
+# a publish can be tried on in a second (tests/test_doors37s.py, 39s.py, 41c.py).
+TRIANGLE_NETWORK = """\
+study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+           { name = "B", x_mm = 1000.0, y_mm = 0.0, role = "fixed" },
+           { name = "C", x_mm = 400.0, y_mm = 700.0 } ]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
+"""
+
+
 def study_of(path: Path) -> str:
     """The study kind a study file runs (its ``study`` key)."""
     return tomllib.loads(path.read_text()).get("study", "")

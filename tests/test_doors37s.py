@@ -47,6 +47,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
+from conftest import TRIANGLE_NETWORK
 
 import sim
 from sim.cli import main
@@ -217,18 +218,13 @@ def test_snooping_keys_are_refused_without_snooping(tmp_path, key, value):
         sim.load(f)
 
 
-NETWORK = """\
-study = "network"
-trials = 40
-chunk = 2
-[network]
-points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
-           { name = "B", x_mm = 1000.0, y_mm = 0.0, role = "fixed" },
-           { name = "C", x_mm = 400.0, y_mm = 700.0 } ]
-generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
+NETWORK = (
+    TRIANGLE_NETWORK
+    + """\
 [sweep]
 "network.scale_ppm" = [0.0, 10.0]
 """
+)
 
 
 def test_a_full_disk_in_a_sweeps_cell_stops_the_run_resumably(tmp_path, capsys, monkeypatch):

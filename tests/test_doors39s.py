@@ -57,6 +57,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
+from conftest import TRIANGLE_NETWORK
 
 import sim
 from sim.batch_checks import why_stale
@@ -69,18 +70,13 @@ from sim.studies import design_config, get_study
 
 ROOT = Path(__file__).resolve().parents[1]
 
-NETWORK = """\
-study = "network"
-trials = 40
-chunk = 2
-[network]
-points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
-           { name = "B", x_mm = 1000.0, y_mm = 0.0, role = "fixed" },
-           { name = "C", x_mm = 400.0, y_mm = 700.0 } ]
-generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
+NETWORK = (
+    TRIANGLE_NETWORK
+    + """\
 [sweep]
 "test.alpha" = [0.05, 0.01]
 """
+)
 
 
 def _sweep_dir(d: Path, cfg: dict, table: dict, keys: list[str], values: dict) -> Path:

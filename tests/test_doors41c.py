@@ -65,7 +65,7 @@ import threading
 from pathlib import Path
 
 import pytest
-from conftest import tiny_overrides
+from conftest import TRIANGLE_NETWORK, tiny_overrides
 
 import sim
 from sim import execute
@@ -77,16 +77,7 @@ from sim.report.verify import rerun as verify_rerun
 
 ROOT = Path(__file__).resolve().parents[1]
 
-NETWORK = """\
-study = "network"
-trials = 40
-chunk = 2
-[network]
-points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
-           { name = "B", x_mm = 1000.0, y_mm = 0.0, role = "fixed" },
-           { name = "C", x_mm = 400.0, y_mm = 700.0 } ]
-generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
-"""
+NETWORK = TRIANGLE_NETWORK
 
 
 def _study(tmp_path: Path, text: str = NETWORK) -> Path:
