@@ -87,7 +87,7 @@ def test_the_rule_at_its_threshold_and_a_short_chain_cannot_fail_either():
 
 
 def test_a_real_short_chain_is_measured_in_tau_and_leaves_the_rows_undecided(monkeypatch):
-    def serial(fn, n, seed, size, part, label, ctx):  # the runner's chunks, one by one
+    def serial(fn, n, seed, size, part, label, ctx, units=None):  # the runner's chunks, one by one
         outs = [fn(chunk_rng(seed, part, c), 1) for c in range(n)]
         return {k: np.concatenate([o[k] for o in outs]) for k in outs[0]}
 
