@@ -15,6 +15,7 @@ import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pyarrow as pa
 
 from sim.api_args import arguments
@@ -37,9 +38,28 @@ def _of_a_path(fn):
     return arguments(checked)
 
 
+def _of_counts(run):
+    """``run`` (:func:`sim.mc.runner.run_chunks`) refusing, naming it, a chunk function that is
+    not callable and a count that is not a whole number (``sim.run_chunks(None, 2, 1, 1)`` was
+    "'NoneType' object is not callable" from inside the runner; ``trials=2.5``, NumPy's words)."""
+
+    @functools.wraps(run)
+    def checked(fn, trials, seed, chunk, part=0, *args, **kwargs):
+        if not callable(fn):
+            raise ConfigError("fn", f"must be a function fn(rng, n), got {type(fn).__name__}")
+        for name, v, least in (("trials", trials, 1), ("seed", seed, 0), ("chunk", chunk, 1)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
+                raise ConfigError(name, f"must be a whole number >= {least}, got {v!r}")
+        if isinstance(part, bool) or not isinstance(part, (int, np.integer)) or part < 0:
+            raise ConfigError("part", f"must be a whole number >= 0, got {part!r}")
+        return run(fn, int(trials), int(seed), int(chunk), int(part), *args, **kwargs)
+
+    return arguments(checked)
+
+
 load_study = _of_a_path(_load_study)
 write_table = _of_a_path(storage.write_table)
-run_chunks = arguments(runner.run_chunks)
+run_chunks = _of_counts(runner.run_chunks)
 
 
 @arguments
