@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -57,8 +58,48 @@ def _of_counts(run):
     return arguments(checked)
 
 
-load_study = _of_a_path(_load_study)
-write_table = _of_a_path(storage.write_table)
+def _study_args(path, overrides=(), trials=None, seed=None, values=None):
+    """Refuse overrides given as other than ``"key=value"`` strings (a dict was iterated by its
+    keys and refused as "--set needs key=value (got 'trials')") and values not a mapping."""
+    if isinstance(overrides, (str, bytes, Mapping)) or not isinstance(overrides, (list, tuple)):
+        raise ConfigError(
+            "overrides",
+            f'must be a list of "key=value" strings, got {type(overrides).__name__}'
+            + (" (a mapping of values: values=)" if isinstance(overrides, Mapping) else ""),
+        )
+    for bad in (o for o in overrides if not isinstance(o, str)):
+        raise ConfigError("overrides", f'must be "key=value" strings, got {bad!r}')
+    if values is not None and not isinstance(values, Mapping):
+        raise ConfigError("values", f"must be a mapping of keys to values, got {values!r}")
+
+
+def _table_args(path, columns, prov, tolerances=None):
+    """Refuse columns that are not a mapping of names to 1-D arrays (pyarrow's "only handle
+    1-dimensional arrays", or an AttributeError of ``.items``), a provenance not a mapping."""
+    if not isinstance(columns, (Mapping, pa.Table)):
+        raise ConfigError("columns", f"must map names to 1-D arrays, got {type(columns).__name__}")
+    for name, v in columns.items() if isinstance(columns, Mapping) else ():
+        flat = not isinstance(v, np.ndarray) or v.ndim == 1
+        if isinstance(v, (str, bytes)) or not hasattr(v, "__len__") or not flat:
+            raise ConfigError("columns", f"{name!r} must be a 1-D array or list, got {v!r:.60}")
+    for key, v in (("prov", prov), ("tolerances", tolerances)):
+        if v is not None and not isinstance(v, Mapping):
+            raise ConfigError(key, f"must be a mapping, got {type(v).__name__}")
+
+
+def _checked_by(check, fn):
+    """``fn`` with its arguments checked first by ``check`` (which takes the same ones)."""
+
+    @functools.wraps(fn)
+    def checked(*args, **kwargs):
+        check(*args, **kwargs)
+        return fn(*args, **kwargs)
+
+    return checked
+
+
+load_study = _of_a_path(_checked_by(_study_args, _load_study))
+write_table = _of_a_path(_checked_by(_table_args, storage.write_table))
 run_chunks = _of_counts(runner.run_chunks)
 
 
