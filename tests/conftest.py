@@ -137,6 +137,64 @@ generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
 """
 
 
+def grid_network(tmp_path: Path, side: int = 20) -> tuple[Path, float]:
+    """A side x side trilateration grid (nearest 8, inner datum): its study file and the bytes
+    its run's estimate needs (tests/test_doors39m.py, 40m.py)."""
+    from sim.mc.config import validate
+    from sim.mc.network_size import network_estimate
+    from sim.studies import get_study
+
+    st = tmp_path / "grid.toml"
+    st.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngrids = [ { prefix = "G", '
+        f'nx = {side}, ny = {side}, spacing_m = 100.0 }} ]\ngenerate = [ {{ kind = "distance", '
+        'from = "G*", to = "G*", nearest = 8, sigma_mm = 2.0 } ]\n[datum]\nkind = "inner"\n'
+    )
+    flat = {
+        "trials": 40,
+        "chunk": 2,
+        "network.grids": [{"prefix": "G", "nx": side, "ny": side, "spacing_m": 100.0}],
+        "network.generate": [
+            {"kind": "distance", "from": "G*", "to": "G*", "nearest": 8, "sigma_mm": 2.0}
+        ],
+        "datum.kind": "inner",
+    }
+    return st, network_estimate(validate(flat, get_study("network").schema, None))[3]
+
+
+def on_a_terminal(
+    args: list[str], timeout: float, rows_cols: tuple[int, int] | None = None
+) -> tuple[int, bytes, list[tuple[float, bytes]]]:
+    """Run ``python -m sim ARGS`` with standard error on a pseudo-terminal (the progress bar
+    draws there; ``rows_cols``: its size, as ``stty rows R cols C``); its exit code, what it
+    drew, and each read with its time since the start (tests/test_doors41l.py, 42b.py)."""
+    import pty
+    import struct
+    import termios
+    import time
+
+    m, s = pty.openpty()
+    if rows_cols is not None:
+        fcntl.ioctl(s, termios.TIOCSWINSZ, struct.pack("HHHH", *rows_cols, 0, 0))
+    t0 = time.monotonic()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "sim", *args], stdin=s, stdout=subprocess.DEVNULL, stderr=s, cwd=ROOT
+    )
+    os.close(s)
+    seen, got = b"", []
+    while True:
+        try:
+            data = os.read(m, 65536)
+        except OSError:  # the terminal's other end closed: the run ended
+            break
+        if not data:
+            break
+        seen += data
+        got.append((time.monotonic() - t0, data))
+    os.close(m)
+    return proc.wait(timeout=timeout), seen, got
+
+
 def study_of(path: Path) -> str:
     """The study kind a study file runs (its ``study`` key)."""
     return tomllib.loads(path.read_text()).get("study", "")

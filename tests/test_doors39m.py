@@ -32,11 +32,11 @@ import resource
 from pathlib import Path
 
 import pytest
+from conftest import grid_network
 
 from sim.cli import main
 from sim.mc.brown_size import brown_estimate
 from sim.mc.config import validate
-from sim.mc.network_size import network_estimate
 from sim.room import mapped_bytes
 from sim.studies import get_study
 from tests.oneline import one_line
@@ -65,27 +65,6 @@ def test_brown_region_is_in_the_memory_estimate_and_its_refusal(
     assert line.endswith("; reduce region.points or region.rounds"), line
 
 
-def _network(tmp_path: Path, side: int) -> tuple[Path, float]:
-    """A side x side trilateration grid (nearest 8, inner datum): its study file and the
-    bytes its run's estimate needs."""
-    st = tmp_path / "grid.toml"
-    st.write_text(
-        'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngrids = [ { prefix = "G", '
-        f'nx = {side}, ny = {side}, spacing_m = 100.0 }} ]\ngenerate = [ {{ kind = "distance", '
-        'from = "G*", to = "G*", nearest = 8, sigma_mm = 2.0 } ]\n[datum]\nkind = "inner"\n'
-    )
-    flat = {
-        "trials": 40,
-        "chunk": 2,
-        "network.grids": [{"prefix": "G", "nx": side, "ny": side, "spacing_m": 100.0}],
-        "network.generate": [
-            {"kind": "distance", "from": "G*", "to": "G*", "nearest": 8, "sigma_mm": 2.0}
-        ],
-        "datum.kind": "inner",
-    }
-    return st, network_estimate(validate(flat, get_study("network").schema, None))[3]
-
-
 @pytest.mark.parametrize(
     "limit, words", [(resource.RLIMIT_AS, "ulimit -v"), (resource.RLIMIT_DATA, "ulimit -d")]
 )
@@ -94,10 +73,14 @@ def test_a_network_over_the_room_a_limit_leaves_is_refused_before_it_is_built(
 ):
     # before: built and factorised first (a 50,000-point grid: 20 s), then refused naming
     # no key, or a MemoryError in the build
-    st, need = _network(tmp_path, 30)
+    st, need = grid_network(tmp_path, 30)
     field = 0 if limit == resource.RLIMIT_AS else 5
-    cap = mapped_bytes(field) + int(need / 2)  # half the estimate left: it cannot fit
-    real = resource.getrlimit
+    # what the process maps, 1.5 GiB at least: a limit under the suite's 1 GiB floor is refused
+    # before any room check (this file run alone maps less)
+    used = max(mapped_bytes(field), 3 << 29)
+    cap = used + int(need / 2)  # half the estimate left: it cannot fit
+    real, real_mapped = resource.getrlimit, mapped_bytes
+    monkeypatch.setattr("sim.room.mapped_bytes", lambda f=0: used if f == field else real_mapped(f))
 
     def limited(which):
         return (cap, real(which)[1]) if which == limit else real(which)

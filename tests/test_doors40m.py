@@ -22,47 +22,26 @@ load (a caller's arrays between ``sim.load`` and ``run``) is counted.
 from __future__ import annotations
 
 import resource
-from pathlib import Path
 
 import pytest
+from conftest import grid_network
 
 import sim
 from sim.cli import main
-from sim.mc.config import ConfigError, validate
-from sim.mc.network_size import network_estimate
+from sim.mc.config import ConfigError
 from sim.room import mapped_bytes
-from sim.studies import get_study
 from sim.studies.network import schema
 from tests.oneline import one_line
 
 
-def _network(tmp_path: Path, side: int = 20) -> tuple[Path, float]:
-    """A side x side trilateration grid (nearest 8, inner datum): its study file and the
-    bytes its run's estimate needs."""
-    st = tmp_path / "grid.toml"
-    st.write_text(
-        'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngrids = [ { prefix = "G", '
-        f'nx = {side}, ny = {side}, spacing_m = 100.0 }} ]\ngenerate = [ {{ kind = "distance", '
-        'from = "G*", to = "G*", nearest = 8, sigma_mm = 2.0 } ]\n[datum]\nkind = "inner"\n'
-    )
-    flat = {
-        "trials": 40,
-        "chunk": 2,
-        "network.grids": [{"prefix": "G", "nx": side, "ny": side, "spacing_m": 100.0}],
-        "network.generate": [
-            {"kind": "distance", "from": "G*", "to": "G*", "nearest": 8, "sigma_mm": 2.0}
-        ],
-        "datum.kind": "inner",
-    }
-    return st, network_estimate(validate(flat, get_study("network").schema, None))[3]
-
-
 class _Process:
-    """What the process maps, faked: the real figure at the start, ``grown`` more once the
+    """What the process maps, faked: the real figure at the start (1.5 GiB at least), ``grown`` more once the
     network is built (its load's heap, kept), and ``later`` more set by the test."""
 
     def __init__(self, monkeypatch, need: float, room: float, grown: float):
-        self.base = {f: mapped_bytes(f) for f in (0, 5)}
+        # at least 1.5 GiB: a limit under the suite's 1 GiB floor is refused before any room
+        # check, so the figure of a small process (this file run alone) must not decide it
+        self.base = {f: max(mapped_bytes(f), 3 << 29) for f in (0, 5)}
         self.built, self.later, self.grown = False, 0, int(grown)
         cap = self.base[0] + int(room)
         real_limit, real_build = resource.getrlimit, schema.build
@@ -87,7 +66,7 @@ class _Process:
 def test_what_a_networks_load_mapped_is_counted_once(door, tmp_path, monkeypatch, capsys):
     # before: refused after the load, "ulimit -v (...) leaves this process about 0.5 x the
     # estimate beside ... it maps already": the estimate counted on top of the load's own
-    st, need = _network(tmp_path)
+    st, need = grid_network(tmp_path)
     _Process(monkeypatch, need, room=1.5 * need, grown=need)  # fits once, not twice
     out = tmp_path / "o"
     if door == "api":
@@ -103,7 +82,7 @@ def test_what_a_networks_load_mapped_is_counted_once(door, tmp_path, monkeypatch
 
 def test_what_the_process_maps_beyond_the_load_is_still_counted(tmp_path, monkeypatch):
     # held: a caller's arrays between sim.load and run are no part of the load
-    st, need = _network(tmp_path)
+    st, need = grid_network(tmp_path)
     proc = _Process(monkeypatch, need, room=1.5 * need, grown=need)
     handle = sim.load(st)
     proc.later = int(need)
@@ -116,7 +95,7 @@ def test_what_the_process_maps_beyond_the_load_is_still_counted(tmp_path, monkey
 
 def test_a_limit_far_too_small_is_refused_before_the_build(tmp_path, monkeypatch, capsys):
     # held: the check before the build is unchanged
-    st, need = _network(tmp_path)
+    st, need = grid_network(tmp_path)
     proc = _Process(monkeypatch, need, room=need / 10, grown=need)
     line = one_line(capsys, main(["check", str(st)]), "network.grids: ", "ulimit -v (")
     assert line.endswith("raise ulimit -v or use fewer points or observations"), line

@@ -38,17 +38,13 @@ each test fails on the code before its fix:
 
 from __future__ import annotations
 
-import fcntl
 import hashlib
 import json
 import os
-import pty
 import re
 import shutil
-import struct
 import subprocess
 import sys
-import termios
 import warnings
 from pathlib import Path
 
@@ -56,6 +52,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
+from conftest import on_a_terminal
 from oneline import SIM_ERROR, one_line, one_line_of
 
 import sim
@@ -216,8 +213,6 @@ def test_a_table_read_short_of_memory_is_not_called_damaged(tmp_path, monkeypatc
 
 
 def test_a_terminal_of_no_rows_shows_the_bar(tmp_path):
-    m, s = pty.openpty()
-    fcntl.ioctl(s, termios.TIOCSWINSZ, struct.pack("HHHH", 0, 100, 0, 0))  # stty rows 0
     run = [
         "run",
         str(TABLE1),
@@ -229,21 +224,8 @@ def test_a_terminal_of_no_rows_shows_the_bar(tmp_path):
         "--out",
         str(tmp_path / "o"),
     ]
-    proc = subprocess.Popen(
-        [PY, "-m", "sim", *run], stdin=s, stdout=subprocess.DEVNULL, stderr=s, cwd=ROOT
-    )
-    os.close(s)
-    seen = b""
-    while True:
-        try:
-            data = os.read(m, 65536)
-        except OSError:  # the terminal's other end closed: the run ended
-            break
-        if not data:
-            break
-        seen += data
-    os.close(m)
-    assert proc.wait(timeout=120) == 0, seen
+    rc, seen, _ = on_a_terminal(run, 120, rows_cols=(0, 100))  # stty rows 0
+    assert rc == 0, seen
     assert b"/40 trials" in seen, seen  # before: nothing drawn
 
 

@@ -16,15 +16,13 @@
 
 from __future__ import annotations
 
-import os
-import pty
 import re
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import pytest
+from conftest import on_a_terminal
 
 ROOT = Path(__file__).resolve().parents[1]
 DESIGN = ROOT / "studies" / "brown_design.toml"
@@ -45,24 +43,9 @@ def frames(tmp_path_factory):
     out = tmp_path_factory.mktemp("b42") / "o"
     run = ["run", str(DESIGN), "--no-figures", "--workers", "1", "--out", str(out)]
     run += [w for kv in SMALL for w in ("--set", kv)]
-    m, s = pty.openpty()
     t0 = time.monotonic()
-    proc = subprocess.Popen(
-        [PY, "-m", "sim", *run], stdin=s, stdout=subprocess.DEVNULL, stderr=s, cwd=ROOT
-    )
-    os.close(s)
-    seen, got = b"", []
-    while True:
-        try:
-            data = os.read(m, 65536)
-        except OSError:  # the terminal's other end closed: the run ended
-            break
-        if not data:
-            break
-        seen += data
-        got.append((time.monotonic() - t0, data))
-    os.close(m)
-    assert proc.wait(timeout=300) == 0, seen
+    rc, seen, got = on_a_terminal(run, 300)
+    assert rc == 0, seen
     end = time.monotonic() - t0
     shown = []
     for t, data in got:
