@@ -20,7 +20,9 @@ import numpy as np
 import pyarrow as pa
 
 from sim.api_args import arguments
+from sim.api_chunks import Checked, check_fn, check_options, ran
 from sim.api_paths import check_path, why_unread
+from sim.api_write import checked_write
 from sim.mc import runner, storage
 from sim.mc.config import ConfigError
 from sim.studies import load_study as _load_study
@@ -45,15 +47,34 @@ def _of_counts(run):
     "'NoneType' object is not callable" from inside the runner; ``trials=2.5``, NumPy's words)."""
 
     @functools.wraps(run)
-    def checked(fn, trials, seed, chunk, part=0, *args, **kwargs):
-        if not callable(fn):
-            raise ConfigError("fn", f"must be a function fn(rng, n), got {type(fn).__name__}")
+    def checked(
+        fn,
+        trials,
+        seed,
+        chunk,
+        part=0,
+        label="",
+        quiet=False,
+        ctx=None,
+        keep_rows=False,
+        units=None,
+    ):
+        check_fn(fn)
         for name, v, least in (("trials", trials, 1), ("seed", seed, 0), ("chunk", chunk, 1)):
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
                 raise ConfigError(name, f"must be a whole number >= {least}, got {v!r}")
         if isinstance(part, bool) or not isinstance(part, (int, np.integer)) or part < 0:
             raise ConfigError("part", f"must be a whole number >= 0, got {part!r}")
-        return run(fn, int(trials), int(seed), int(chunk), int(part), *args, **kwargs)
+        check_options(int(trials), int(chunk), label, quiet, ctx, keep_rows, units)
+        try:
+            return run(
+                Checked(fn), int(trials), int(seed), int(chunk), int(part), label, bool(quiet),
+                ctx, bool(keep_rows), units,
+            )  # fmt: skip
+        except Exception as e:
+            if (refusal := ran(e)) is not None:  # chunks that do not fit together
+                raise refusal from None
+            raise
 
     return arguments(checked)
 
@@ -99,7 +120,9 @@ def _checked_by(check, fn):
 
 
 load_study = _of_a_path(_checked_by(_study_args, _load_study))
-write_table = _of_a_path(_checked_by(_table_args, storage.write_table))
+write_table = _of_a_path(
+    _checked_by(_table_args, functools.wraps(storage.write_table)(checked_write))
+)
 run_chunks = _of_counts(runner.run_chunks)
 
 
