@@ -24,7 +24,8 @@ from sim.api_chunks import Checked, check_fn, check_options, ran
 from sim.api_paths import check_path, why_unread
 from sim.api_write import checked_write
 from sim.mc import runner, storage
-from sim.mc.config import ConfigError
+from sim.mc.config import ConfigError, parse_override
+from sim.mc.pyvalue import as_config_value
 from sim.studies import load_study as _load_study
 
 __all__ = ["load_study", "read_provenance", "write_table", "run_chunks"]
@@ -119,7 +120,53 @@ def _checked_by(check, fn):
     return checked
 
 
-load_study = _of_a_path(_checked_by(_study_args, _load_study))
+def _study_values(path, overrides=(), trials=None, seed=None, values=None):
+    """:func:`sim.studies.load_study` of its arguments read as :func:`sim.load` reads them:
+    ``values``, ``trials`` and ``seed`` of any number type (``np.int64(40)``, a tuple) as the
+    plain value (they were "must be an integer (got np.int64(40))"), ``None`` and a key that
+    is not a str refused (it was "is required", and a ``TypeError``), a key given twice (by
+    ``overrides`` and ``values``, or ``values`` and ``trials``) refused, where one value was
+    dropped without a word; a malformed override and an unreadable file named as the argument
+    (it named ``--set``, or nothing)."""
+    _study_args(path, overrides, trials, seed, values)
+    given: dict[str, str] = {}
+    for text in overrides:
+        try:
+            key, _ = parse_override(text)
+        except ConfigError as e:
+            raise ConfigError("overrides", e.detail.replace("--set ", "an override ")) from None
+        given[key] = "overrides"
+    vals = {}
+    for k, v in (values or {}).items():
+        if not isinstance(k, str):
+            raise ConfigError(
+                "values", f"a key must be a dotted str such as 'trials', got {k!r:.60}"
+            )
+        if v is None:
+            raise ConfigError(
+                k, "is None, which no study file holds: leave it out for the file's value"
+            )
+        vals[k] = as_config_value(k, v)
+    counts = {
+        n: as_config_value(n, v) for n, v in (("trials", trials), ("seed", seed)) if v is not None
+    }
+    for k, where in [*((k, "values") for k in vals), *((n, n) for n in counts)]:
+        if k in given:
+            raise ConfigError(
+                k, f"given twice (by {given[k]} and {where}): one value would be dropped"
+            )
+        given[k] = where
+    try:
+        return _load_study(
+            path, overrides, counts.get("trials"), counts.get("seed"), vals or values
+        )
+    except ConfigError as e:
+        if e.key is None and str(e).startswith(os.fspath(path)):  # the study file's own
+            raise ConfigError("path", str(e)) from None
+        raise
+
+
+load_study = _of_a_path(functools.wraps(_load_study)(_study_values))
 write_table = _of_a_path(
     _checked_by(_table_args, functools.wraps(storage.write_table)(checked_write))
 )
@@ -131,6 +178,10 @@ def read_provenance(path: str | Path) -> dict[str, Any]:
     """The provenance a table the suite wrote carries in its Parquet schema (its study's
     ``config``, ``code_hash``, ...), as a dict; ``{}`` for a Parquet file without one."""
     check_path("path", path)
+    p = os.fspath(path)
+    if os.path.exists(p) and not os.path.isdir(p) and not os.path.isfile(p):
+        # a FIFO nobody writes to: pyarrow's open blocked for good
+        raise ConfigError("path", f"{p}: not a regular file (a pipe or a device)")
     try:
         return storage.read_provenance(path)
     except (OSError, ValueError, pa.ArrowException) as e:

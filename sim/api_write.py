@@ -54,6 +54,10 @@ def _target(path: Any) -> Path:
     parent = next((q for q in p.parents if os.path.lexists(q)), None)
     if parent is not None and not parent.is_dir():
         raise ConfigError("path", f"{p}: {parent} is not a directory")
+    if os.path.exists(p) and not p.is_file():
+        raise ConfigError(
+            "path", f"{p} is not a regular file (a pipe or a device); sim never replaces it"
+        )
     if os.path.lexists(p) and not _ours(p):
         raise ConfigError(
             "path",
@@ -65,6 +69,8 @@ def _target(path: Any) -> Path:
 
 def _ours(p: Path) -> bool:
     """Whether ``p`` is a Parquet table with the suite's provenance in its schema."""
+    if not p.is_file():  # a FIFO: reading its schema blocked for good
+        return False
     try:
         return storage._KEY in (pq.read_schema(p).metadata or {})
     except (OSError, ValueError, pa.ArrowException):
@@ -103,6 +109,11 @@ def _table(columns: Mapping | pa.Table) -> pa.Table:
     return pa.table(arrays)
 
 
+def _a(v: Any) -> str:
+    name = type(v).__name__
+    return f"{'an' if name[0] in 'aeiou' else 'a'} {name}"
+
+
 def _where(at: str, key: Any) -> str:
     return f"{at}[{key!r}]" if at else repr(key)
 
@@ -134,7 +145,7 @@ def check_prov(v: Any, at: str = "", seen: tuple = ()) -> None:
                 if not isinstance(k, str):
                     raise ConfigError(
                         "prov",
-                        f"{_where(at, k)} is keyed by a {type(k).__name__}: a key must be a str",
+                        f"{_where(at, k)}: a key must be a str, not {_a(k)}",
                     )
                 check_prov(x, _where(at, k), inner)
         else:
