@@ -25,7 +25,9 @@ from sim.api_paths import check_path, why_unread
 from sim.api_write import checked_write
 from sim.mc import runner, storage
 from sim.mc.config import ConfigError, parse_override
+from sim.mc.paths import link_problem
 from sim.mc.pyvalue import as_config_value
+from sim.report.read import memory_failure
 from sim.studies import load_study as _load_study
 
 __all__ = ["load_study", "read_provenance", "write_table", "run_chunks"]
@@ -183,15 +185,21 @@ def read_provenance(path: str | Path) -> dict[str, Any]:
         # a FIFO nobody writes to: pyarrow's open blocked for good
         raise ConfigError("path", f"{p}: not a regular file (a pipe or a device)")
     try:
-        return storage.read_provenance(path)
+        prov = storage.read_provenance(path)
     except (OSError, ValueError, pa.ArrowException) as e:
-        p = os.fspath(path)
         if os.path.isdir(p):
             why = "a directory, not a table (sim.Results(path, study) reads its tables)"
         elif not os.path.lexists(p):
             why = "no such file"
+        elif (link := link_problem(p)) is not None:  # it was pyarrow's "Failed to open local
+            why = link  # file 'loop'. Detail: [errno 40] Too many levels of symbolic links"
         elif isinstance(e, pa.ArrowInvalid):
             why = "not a Parquet file"
+        elif isinstance(e, OSError) and e.errno and not memory_failure(e):
+            why = os.strerror(e.errno)  # not pyarrow's "Failed to open local file ... Detail"
         else:
             why = why_unread(e) if isinstance(e, OSError) else str(e).splitlines()[0]
         raise ConfigError("path", f"{p}: {why}") from None
+    if not isinstance(prov, dict):  # another tool's key of that name: [1, 2] was returned
+        raise ConfigError("path", f"{p}: its metadata sim.provenance is not a JSON object")
+    return prov

@@ -18,7 +18,9 @@ handle across threads and processes), one case each; each failed on the code bef
 * A masked array (``np.ma``) was written as its data: the masked values as numbers. They are
   nulls.
 * ``sim.read_provenance`` and ``sim.write_table`` of a FIFO blocked for good (pyarrow opened
-  it): refused as not a regular file.
+  it): refused as not a regular file. ``sim.read_provenance`` of a symbolic-link loop or a
+  link to nothing said pyarrow's "Failed to open local file ... Detail: [errno 40]", and
+  returned a list for a ``sim.provenance`` key of another tool's holding one.
 * ``sim.run_chunks`` ran a chunk function returning too many rows (``n + 1``), concatenating
   more values than trials without a word; one returning a list, None, a scalar, Python
   objects, or other keys or shapes from chunk to chunk ended in Python's or NumPy's words
@@ -274,3 +276,14 @@ def test_load_of_a_directory_without_study_files_says_so(tmp_path):
     _refused(lambda: sim.load(tmp_path / "empty"), "study_file", "it holds no study file")
     line = _refused(lambda: sim.load(ROOT / "studies"), "study_file")
     assert line.endswith(f"(its study files are {ROOT / 'studies'}/*.toml)")
+
+
+def test_read_provenance_of_a_link_or_a_foreign_key_is_in_its_own_words(tmp_path):
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    (tmp_path / "gone").symlink_to(tmp_path / "nowhere")
+    line = _refused(lambda: sim.read_provenance(tmp_path / "loop"), "path", "symbolic-link loop")
+    assert "Failed to open" not in line and "Detail" not in line  # pyarrow's words
+    _refused(lambda: sim.read_provenance(tmp_path / "gone"), "path", "which does not exist")
+    table = pa.table({"a": [1]}).replace_schema_metadata({b"sim.provenance": b"[1, 2]"})
+    pq.write_table(table, tmp_path / "t.parquet")  # another tool's key of that name
+    _refused(lambda: sim.read_provenance(tmp_path / "t.parquet"), "path", "not a JSON object")
