@@ -5,7 +5,10 @@ unknown argument was Python's ``TypeError``, a handle or a ``Results`` given for
 ``TypeError: expected str, bytes or os.PathLike``, and ``sim.read_provenance`` of a
 directory, a missing file or a study file pyarrow's ``OSError`` or ``ArrowInvalid`` with a
 traceback (and ``help()`` of it said nothing): each is one :class:`sim.ConfigError` naming
-the argument. The suite's own code calls the functions themselves, unchanged.
+the argument. The suite's own code calls the functions themselves, unchanged. What
+``sim.write_table`` and ``sim.run_chunks`` check beyond their arguments' kinds (the file
+written over, the provenance, the columns; what a chunk function returns) is in
+:mod:`sim.api_write` and :mod:`sim.api_chunks`.
 """
 
 from __future__ import annotations
@@ -159,9 +162,7 @@ def _study_values(path, overrides=(), trials=None, seed=None, values=None):
             )
         given[k] = where
     try:
-        return _load_study(
-            path, overrides, counts.get("trials"), counts.get("seed"), vals or values
-        )
+        return _load_study(path, overrides, counts.get("trials"), counts.get("seed"), vals)
     except ConfigError as e:
         if e.key is None and str(e).startswith(os.fspath(path)):  # the study file's own
             raise ConfigError("path", str(e)) from None
