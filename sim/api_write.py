@@ -19,12 +19,15 @@ tracebacks of pyarrow, ``json`` and the OS, and did worse silently:
   data, the masked values as numbers: they are nulls now, as pyarrow reads a mask.
 * an infinite value was the storage's ``NonFiniteError`` and a tolerance naming no column or
   not a mapping ``ValueError``/``TypeError``.
+* two threads writing one path: "cannot be written (No such file or directory)" (one
+  temporary file for both); they write it one after the other now.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import threading
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -159,8 +162,29 @@ def check_prov(v: Any, at: str = "", seen: tuple = ()) -> None:
     )
 
 
+#: a lock for each file written by threads of this process (:func:`_one_writer`)
+_LOCKS: dict[str, threading.Lock] = {}
+_LOCKS_LOCK = threading.Lock()
+
+
+def _one_writer(path: Any) -> threading.Lock:
+    """The lock of ``path``'s file: its temporary file is named by the process
+    (``.<name>.<pid>.tmp``), so two threads writing one path wrote one temporary, and one of
+    them, its temporary renamed by the other, said "cannot be written (No such file or
+    directory)" (34 of 60 writes of two threads)."""
+    key = os.path.abspath(os.fspath(path))
+    with _LOCKS_LOCK:
+        return _LOCKS.setdefault(key, threading.Lock())
+
+
 def checked_write(path: Any, columns: Any, prov: Any, tolerances: Any = None) -> Path:
-    """:func:`sim.mc.storage.write_table` of checked arguments (see the module's words)."""
+    """:func:`sim.mc.storage.write_table` of checked arguments (see the module's words), one
+    thread of the process at a time for one file."""
+    with _one_writer(path):
+        return _write(path, columns, prov, tolerances)
+
+
+def _write(path: Any, columns: Any, prov: Any, tolerances: Any) -> Path:
     p = _target(path)
     table = _table(columns)
     check_prov(prov)

@@ -21,6 +21,9 @@ handle across threads and processes), one case each; each failed on the code bef
   it): refused as not a regular file. ``sim.read_provenance`` of a symbolic-link loop or a
   link to nothing said pyarrow's "Failed to open local file ... Detail: [errno 40]", and
   returned a list for a ``sim.provenance`` key of another tool's holding one.
+* Two threads of one process writing one table through ``sim.write_table`` shared one
+  temporary file (``.<name>.<pid>.tmp``): one of them said "cannot be written (No such file
+  or directory)". They write it one after the other.
 * ``sim.run_chunks`` ran a chunk function returning too many rows (``n + 1``), concatenating
   more values than trials without a word; one returning a list, None, a scalar, Python
   objects, or other keys or shapes from chunk to chunk ended in Python's or NumPy's words
@@ -287,3 +290,34 @@ def test_read_provenance_of_a_link_or_a_foreign_key_is_in_its_own_words(tmp_path
     table = pa.table({"a": [1]}).replace_schema_metadata({b"sim.provenance": b"[1, 2]"})
     pq.write_table(table, tmp_path / "t.parquet")  # another tool's key of that name
     _refused(lambda: sim.read_provenance(tmp_path / "t.parquet"), "path", "not a JSON object")
+
+
+def test_two_threads_writing_one_table_write_it_one_after_the_other(tmp_path, monkeypatch):
+    """Both threads past the write of the temporary, before its rename (a barrier; with one
+    writer at a time the first goes on alone after 2 s): one temporary file for both, the
+    second's rename found it gone."""
+    both = threading.Barrier(2, timeout=2)
+    real = pq.write_table
+
+    def meeting(*args, **kwargs):  # each has written the temporary; neither renamed it yet
+        real(*args, **kwargs)
+        try:
+            both.wait()
+        except threading.BrokenBarrierError:
+            pass
+
+    monkeypatch.setattr(pq, "write_table", meeting)
+    errors: list = []
+
+    def write(v):
+        try:
+            sim.write_table(tmp_path / "t.parquet", {"a": np.full(1000, v)}, {"v": v})
+        except Exception as e:  # noqa: BLE001 - the OSError of the code before the fix
+            errors.append(f"{type(e).__name__}: {e}")
+
+    threads = [threading.Thread(target=write, args=(v,)) for v in (1.0, 2.0)]
+    [t.start() for t in threads]
+    [t.join() for t in threads]
+    assert not errors
+    v = sim.read_provenance(tmp_path / "t.parquet")["v"]
+    assert set(pq.read_table(tmp_path / "t.parquet").column("a").to_pylist()) == {v}
