@@ -276,6 +276,7 @@ def test_load_of_a_directory_without_study_files_says_so(tmp_path):
     (tmp_path / "run.json").write_text("{}")
     _refused(lambda: sim.load(tmp_path), "study_file", "it holds a run's results and no study")
     (tmp_path / "empty").mkdir()
+    os.mkfifo(tmp_path / "empty" / "x.toml")  # not a study file, and never opened (it blocks)
     _refused(lambda: sim.load(tmp_path / "empty"), "study_file", "it holds no study file")
     line = _refused(lambda: sim.load(ROOT / "studies"), "study_file")
     assert line.endswith(f"(its study files are {ROOT / 'studies'}/*.toml)")

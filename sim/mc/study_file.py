@@ -90,7 +90,8 @@ def _in_dir(p: Path) -> str:
     """
     try:
         with os.scandir(p) as it:
-            tomls = [e.path for e in itertools.islice(it, 10_000) if e.name.endswith(".toml")]
+            entries = itertools.islice(it, 10_000)  # a FIFO named x.toml: never opened
+            tomls = [e.path for e in entries if e.name.endswith(".toml") and e.is_file()]
     except OSError:
         tomls = []
     if any(_names_a_study(Path(t)) for t in tomls[:100]):
