@@ -91,8 +91,9 @@ class Results:
 
     path: Path
     study: str
-    #: the identity of the run that returned these Results (:func:`_run_identity`; "": any)
-    run_sha256: str = field(default="", repr=False, compare=False)
+    #: the identity of the run that returned these Results (:func:`_run_identity`; "": any);
+    #: compared: Results of two runs into one ``out`` (another seed) are not equal
+    run_sha256: str = field(default="")
 
     def __post_init__(self):  # Results("results/x", "x"): a str is taken as the path
         _check_path("path", self.path)

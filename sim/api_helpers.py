@@ -5,7 +5,10 @@ unknown argument was Python's ``TypeError``, a handle or a ``Results`` given for
 ``TypeError: expected str, bytes or os.PathLike``, and ``sim.read_provenance`` of a
 directory, a missing file or a study file pyarrow's ``OSError`` or ``ArrowInvalid`` with a
 traceback (and ``help()`` of it said nothing): each is one :class:`sim.ConfigError` naming
-the argument. The suite's own code calls the functions themselves, unchanged.
+the argument. The suite's own code calls the functions themselves, unchanged. What
+``sim.write_table`` and ``sim.run_chunks`` check beyond their arguments' kinds (the file
+written over, the provenance, the columns; what a chunk function returns) is in
+:mod:`sim.api_write` and :mod:`sim.api_chunks`.
 """
 
 from __future__ import annotations
@@ -20,9 +23,14 @@ import numpy as np
 import pyarrow as pa
 
 from sim.api_args import arguments
+from sim.api_chunks import Checked, check_fn, check_options, ran
 from sim.api_paths import check_path, why_unread
+from sim.api_write import checked_write
 from sim.mc import runner, storage
-from sim.mc.config import ConfigError
+from sim.mc.config import ConfigError, parse_override
+from sim.mc.paths import link_problem
+from sim.mc.pyvalue import as_config_value
+from sim.report.read import memory_failure
 from sim.studies import load_study as _load_study
 
 __all__ = ["load_study", "read_provenance", "write_table", "run_chunks"]
@@ -45,15 +53,34 @@ def _of_counts(run):
     "'NoneType' object is not callable" from inside the runner; ``trials=2.5``, NumPy's words)."""
 
     @functools.wraps(run)
-    def checked(fn, trials, seed, chunk, part=0, *args, **kwargs):
-        if not callable(fn):
-            raise ConfigError("fn", f"must be a function fn(rng, n), got {type(fn).__name__}")
+    def checked(
+        fn,
+        trials,
+        seed,
+        chunk,
+        part=0,
+        label="",
+        quiet=False,
+        ctx=None,
+        keep_rows=False,
+        units=None,
+    ):
+        check_fn(fn)
         for name, v, least in (("trials", trials, 1), ("seed", seed, 0), ("chunk", chunk, 1)):
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
                 raise ConfigError(name, f"must be a whole number >= {least}, got {v!r}")
         if isinstance(part, bool) or not isinstance(part, (int, np.integer)) or part < 0:
             raise ConfigError("part", f"must be a whole number >= 0, got {part!r}")
-        return run(fn, int(trials), int(seed), int(chunk), int(part), *args, **kwargs)
+        check_options(int(trials), int(chunk), label, quiet, ctx, keep_rows, units)
+        try:
+            return run(
+                Checked(fn), int(trials), int(seed), int(chunk), int(part), label, bool(quiet),
+                ctx, bool(keep_rows), units,
+            )  # fmt: skip
+        except Exception as e:
+            if (refusal := ran(e)) is not None:  # chunks that do not fit together
+                raise refusal from None
+            raise
 
     return arguments(checked)
 
@@ -98,8 +125,54 @@ def _checked_by(check, fn):
     return checked
 
 
-load_study = _of_a_path(_checked_by(_study_args, _load_study))
-write_table = _of_a_path(_checked_by(_table_args, storage.write_table))
+def _study_values(path, overrides=(), trials=None, seed=None, values=None):
+    """:func:`sim.studies.load_study` of its arguments read as :func:`sim.load` reads them:
+    ``values``, ``trials`` and ``seed`` of any number type (``np.int64(40)``, a tuple) as the
+    plain value (they were "must be an integer (got np.int64(40))"), ``None`` and a key that
+    is not a str refused (it was "is required", and a ``TypeError``), a key given twice (by
+    ``overrides`` and ``values``, or ``values`` and ``trials``) refused, where one value was
+    dropped without a word; a malformed override and an unreadable file named as the argument
+    (it named ``--set``, or nothing)."""
+    _study_args(path, overrides, trials, seed, values)
+    given: dict[str, str] = {}
+    for text in overrides:
+        try:
+            key, _ = parse_override(text)
+        except ConfigError as e:
+            raise ConfigError("overrides", e.detail.replace("--set ", "an override ")) from None
+        given[key] = "overrides"
+    vals = {}
+    for k, v in (values or {}).items():
+        if not isinstance(k, str):
+            raise ConfigError(
+                "values", f"a key must be a dotted str such as 'trials', got {k!r:.60}"
+            )
+        if v is None:
+            raise ConfigError(
+                k, "is None, which no study file holds: leave it out for the file's value"
+            )
+        vals[k] = as_config_value(k, v)
+    counts = {
+        n: as_config_value(n, v) for n, v in (("trials", trials), ("seed", seed)) if v is not None
+    }
+    for k, where in [*((k, "values") for k in vals), *((n, n) for n in counts)]:
+        if k in given:
+            raise ConfigError(
+                k, f"given twice (by {given[k]} and {where}): one value would be dropped"
+            )
+        given[k] = where
+    try:
+        return _load_study(path, overrides, counts.get("trials"), counts.get("seed"), vals)
+    except ConfigError as e:
+        if e.key is None and str(e).startswith(os.fspath(path)):  # the study file's own
+            raise ConfigError("path", str(e)) from None
+        raise
+
+
+load_study = _of_a_path(functools.wraps(_load_study)(_study_values))
+write_table = _of_a_path(
+    _checked_by(_table_args, functools.wraps(storage.write_table)(checked_write))
+)
 run_chunks = _of_counts(runner.run_chunks)
 
 
@@ -108,16 +181,26 @@ def read_provenance(path: str | Path) -> dict[str, Any]:
     """The provenance a table the suite wrote carries in its Parquet schema (its study's
     ``config``, ``code_hash``, ...), as a dict; ``{}`` for a Parquet file without one."""
     check_path("path", path)
+    p = os.fspath(path)
+    if os.path.exists(p) and not os.path.isdir(p) and not os.path.isfile(p):
+        # a FIFO nobody writes to: pyarrow's open blocked for good
+        raise ConfigError("path", f"{p}: not a regular file (a pipe or a device)")
     try:
-        return storage.read_provenance(path)
+        prov = storage.read_provenance(path)
     except (OSError, ValueError, pa.ArrowException) as e:
-        p = os.fspath(path)
         if os.path.isdir(p):
             why = "a directory, not a table (sim.Results(path, study) reads its tables)"
         elif not os.path.lexists(p):
             why = "no such file"
+        elif (link := link_problem(p)) is not None:  # it was pyarrow's "Failed to open local
+            why = link  # file 'loop'. Detail: [errno 40] Too many levels of symbolic links"
         elif isinstance(e, pa.ArrowInvalid):
             why = "not a Parquet file"
+        elif isinstance(e, OSError) and e.errno and not memory_failure(e):
+            why = os.strerror(e.errno)  # not pyarrow's "Failed to open local file ... Detail"
         else:
             why = why_unread(e) if isinstance(e, OSError) else str(e).splitlines()[0]
         raise ConfigError("path", f"{p}: {why}") from None
+    if not isinstance(prov, dict):  # another tool's key of that name: [1, 2] was returned
+        raise ConfigError("path", f"{p}: its metadata sim.provenance is not a JSON object")
+    return prov

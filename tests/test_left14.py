@@ -99,7 +99,7 @@ def test_the_batch_sim_check_and_the_api_refuse_a_path_in_one_wording(
         sim.load(path)
     assert str(e.value) == f"study_file: {why}"
     want = {
-        "directory": "is a directory, not a study file (its study files are d/*.toml)",
+        "directory": "is a directory, not a study file (it holds no study file: name one)",
         "fifo": "not a regular file (a pipe or a device)",
         "device": "not a regular file (a pipe or a device)",
         "loop": "is a symbolic-link loop",

@@ -83,6 +83,24 @@ def _stem(name: str) -> str:
     return name
 
 
+def _in_dir(p: Path) -> str:
+    """What the directory ``p`` holds, for the line that refuses it as a study file: its
+    study files, or none: "its study files are DIR/*.toml" was said of an empty directory and
+    of a run's results (``sim.load("results/brown_table1")``), where the pattern matches none.
+    """
+    try:
+        with os.scandir(p) as it:
+            entries = itertools.islice(it, 10_000)  # a FIFO named x.toml: never opened
+            tomls = [e.path for e in entries if e.name.endswith(".toml") and e.is_file()]
+    except OSError:
+        tomls = []
+    if any(_names_a_study(Path(t)) for t in tomls[:100]):
+        return f"its study files are {p}/*.toml"
+    if os.path.isfile(p / "run.json"):
+        return "it holds a run's results and no study file: name the study file the run read"
+    return "it holds no study file: name one"
+
+
 def _names_a_study(p: Path) -> bool:
     """Whether ``p`` holds a top-level ``study = ...`` line (not ``pyproject.toml``)."""
     try:
@@ -101,7 +119,7 @@ def study_file_problem(p: str | Path) -> str | None:
     :data:`MAX_STUDY_BYTES`. A file that cannot be read is said when it is read."""
     p = Path(p)
     if p.is_dir():  # both were "no such study file", of a file that is there
-        return f"{p}: is a directory, not a study file (its study files are {p}/*.toml)"
+        return f"{p}: is a directory, not a study file ({_in_dir(p)})"
     if p.exists() and not p.is_file():  # a pipe (cat x.toml | sim check /dev/stdin), a device
         return f"{p}: not a regular file (a pipe or a device): name the study file"
     if not p.is_file():
