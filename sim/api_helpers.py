@@ -11,6 +11,7 @@ the argument. The suite's own code calls the functions themselves, unchanged.
 from __future__ import annotations
 
 import functools
+import json
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -21,8 +22,8 @@ import pyarrow as pa
 
 from sim.api_args import arguments
 from sim.api_paths import check_path, why_unread
-from sim.mc import runner, storage
-from sim.mc.config import ConfigError
+from sim.mc import runner, storage, tolerance
+from sim.mc.config import MAX_CHUNKS, ConfigError
 from sim.studies import load_study as _load_study
 
 __all__ = ["load_study", "read_provenance", "write_table", "run_chunks"]
@@ -53,6 +54,19 @@ def _of_counts(run):
                 raise ConfigError(name, f"must be a whole number >= {least}, got {v!r}")
         if isinstance(part, bool) or not isinstance(part, (int, np.integer)) or part < 0:
             raise ConfigError("part", f"must be a whole number >= 0, got {part!r}")
+        if (n := -(-int(trials) // int(chunk))) > MAX_CHUNKS:  # 10**12 of 1: a list of them
+            raise ConfigError(  # built for good, as the runs' own limit (sim.mc.config) refuses
+                "chunk",
+                f"{trials:,} trials in chunks of {chunk:,} make {n:,} chunks (at most "
+                f"{MAX_CHUNKS:,}): make chunk at least {-(-int(trials) // MAX_CHUNKS):,}",
+            )
+        units = kwargs.get("units")
+        if units is not None and (
+            isinstance(units, bool)
+            or not isinstance(units, (int, float, np.integer, np.floating))
+            or not 0 <= units < float("inf")
+        ):
+            raise ConfigError("units", f"must be a number >= 0 or None, got {units!r}")
         return run(fn, int(trials), int(seed), int(chunk), int(part), *args, **kwargs)
 
     return arguments(checked)
@@ -87,6 +101,58 @@ def _table_args(path, columns, prov, tolerances=None):
             raise ConfigError(key, f"must be a mapping, got {type(v).__name__}")
 
 
+def _as_table(columns: Mapping) -> pa.Table:
+    """``columns`` as the table :func:`sim.mc.storage.write_table` writes (each column made as
+    it makes it), refusing a name that is not a string, a column pyarrow cannot hold (values of
+    mixed kinds, a set) and columns of unequal lengths, naming the column: pyarrow's
+    ``ArrowInvalid`` or ``TypeError`` ended in a traceback ("expected bytes, int found")."""
+    arrays = {}
+    for name, v in columns.items():
+        if not isinstance(name, str):
+            raise ConfigError("columns", f"a column's name must be a string, got {name!r:.60}")
+        try:
+            arrays[name] = pa.array(v if isinstance(v, list) else np.asarray(v))
+        except (pa.ArrowException, TypeError, ValueError, OverflowError) as e:
+            why = str(e).splitlines()[0][:120] if str(e) else type(e).__name__
+            raise ConfigError("columns", f"{name!r} cannot be a Parquet column: {why}") from None
+    first = next(iter(arrays), None)
+    for name, a in arrays.items():
+        if len(a) != len(arrays[first]):
+            raise ConfigError(
+                "columns",
+                f"{name!r} has {len(a):,} values and {first!r} {len(arrays[first]):,}: every "
+                "column of a table has as many",
+            )
+    return pa.table(arrays)
+
+
+@functools.wraps(storage.write_table)
+def _write_table(path, columns, prov, tolerances=None):
+    """:func:`sim.mc.storage.write_table` with its arguments checked first: each refusal one
+    :class:`ConfigError` naming the argument (a directory for ``path``, ``prov`` that is not
+    JSON, a tolerance that is no rule, an infinite value were Python's or pyarrow's words)."""
+    _table_args(path, columns, prov, tolerances)
+    if os.path.isdir(path):
+        raise ConfigError("path", f"{os.fspath(path)} is a directory: name the table's file")
+    table = columns if isinstance(columns, pa.Table) else _as_table(columns)
+    try:
+        json.dumps(prov, sort_keys=True, default=storage._jsonable)
+    except (TypeError, ValueError, RecursionError) as e:
+        raise ConfigError("prov", f"cannot be written as JSON: {str(e)[:120]}") from None
+    for col, rule in (tolerances or {}).items():  # {"a": "x"}: "dictionary update sequence"
+        if not isinstance(rule, Mapping):
+            raise ConfigError("tolerances", f"{col!r} must map to a rule (a mapping with its kind)")
+    if tolerances:
+        try:
+            tolerance.validate(tolerances, table)
+        except (TypeError, ValueError, AttributeError, KeyError) as e:
+            raise ConfigError("tolerances", str(e).splitlines()[0][:160]) from None
+    try:
+        return storage.write_table(path, table, prov, tolerances)
+    except storage.NonFiniteError as e:
+        raise ConfigError("columns", str(e)) from None
+
+
 def _checked_by(check, fn):
     """``fn`` with its arguments checked first by ``check`` (which takes the same ones)."""
 
@@ -99,7 +165,7 @@ def _checked_by(check, fn):
 
 
 load_study = _of_a_path(_checked_by(_study_args, _load_study))
-write_table = _of_a_path(_checked_by(_table_args, storage.write_table))
+write_table = _of_a_path(_write_table)
 run_chunks = _of_counts(runner.run_chunks)
 
 

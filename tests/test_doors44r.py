@@ -1,0 +1,81 @@
+"""The classes of the review R44 of session 43's change (lead41's argument checks of the
+helpers ``sim`` exports: ``sim.write_table``, ``sim.run_chunks``), one case each; each failed
+on the code before its fix.
+
+* ``sim.write_table`` checked that ``columns`` is a mapping of 1-D arrays, and its neighbours
+  slipped past into pyarrow or Python: columns of unequal lengths (``ArrowInvalid: Column 1
+  named b expected length 3 but got length 4``), a name that is not a string (``TypeError:
+  expected bytes, int found``), values pyarrow cannot hold in one column (a set: "only handle
+  1-dimensional arrays"; mixed dicts and numbers), a ``prov`` that is not JSON (``TypeError:
+  not JSON serialisable``), a tolerance that is not a rule (``ValueError: dictionary update
+  sequence element #0``), an infinite value (the suite's ``NonFiniteError``, a ValueError) and
+  a ``path`` that is a directory (``IsADirectoryError``). Each is one ``sim.ConfigError`` naming
+  the argument now, and a good table is written as before.
+* ``sim.run_chunks`` with a count of chunks no run may have (``10**12`` trials in chunks of 1)
+  built its list of chunk sizes for good (a hang, then memory); it is refused naming
+  ``chunk``, at the runs' own limit (``sim.mc.config.MAX_CHUNKS``). ``units`` not a number
+  ended in "could not convert string to float" from the progress bar: refused naming it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+import sim
+
+
+@pytest.mark.parametrize(
+    "columns, prov, tolerances, key, words",
+    [
+        ({"a": np.arange(3), "b": np.arange(4)}, {}, None, "columns", "'b' has 4 values"),
+        ({1: np.arange(3)}, {}, None, "columns", "name must be a string"),
+        ({"a": {1, 2}}, {}, None, "columns", "'a' cannot be a Parquet column"),
+        ({"a": [{"x": 1}, 2]}, {}, None, "columns", "'a' cannot be a Parquet column"),
+        ({"a": [1.0, np.inf]}, {}, None, "columns", "column a is inf"),
+        ({"a": [1, 2]}, {"x": object()}, None, "prov", "JSON"),
+        ({"a": [1, 2]}, {1: 2, "x": 1}, None, "prov", "JSON"),
+        ({"a": [1, 2]}, {}, {"a": "x"}, "tolerances", "'a' must map to a rule"),
+        ({"a": [1, 2]}, {}, {"zz": {"kind": "exact"}}, "tolerances", "zz: no such column"),
+    ],
+)
+def test_write_table_names_the_argument_pyarrow_or_python_refused(
+    tmp_path, columns, prov, tolerances, key, words
+):
+    with pytest.raises(sim.ConfigError) as e:
+        sim.write_table(tmp_path / "t.parquet", columns, prov, tolerances)
+    assert e.value.key == key and words in str(e.value) and "\n" not in str(e.value), str(e.value)
+    assert not (tmp_path / "t.parquet").exists()
+
+
+def test_write_table_into_a_directory_names_the_path(tmp_path):
+    with pytest.raises(sim.ConfigError) as e:
+        sim.write_table(tmp_path, {"a": [1, 2]}, {})
+    assert e.value.key == "path" and "is a directory" in str(e.value)
+
+
+def test_write_table_writes_a_good_table_as_before(tmp_path):
+    cols = {"a": np.arange(3.0), "s": ["x", "y", "z"], "l": [[1], [2, 3], []]}
+    path = sim.write_table(tmp_path / "ok.parquet", cols, {"study": "x"})
+    assert sim.read_provenance(path) == {"study": "x"}
+    assert pq.read_table(path).to_pydict()["l"] == [[1], [2, 3], []]
+    assert sim.write_table(tmp_path / "t.parquet", pa.table({"a": [1]}), {}).is_file()
+
+
+def _fn(rng, n):
+    return {"x": rng.standard_normal(n)}
+
+
+def test_run_chunks_refuses_more_chunks_than_a_run_may_have():
+    with pytest.raises(sim.ConfigError) as e:
+        sim.run_chunks(_fn, 10**12, 1, 1)
+    assert e.value.key == "chunk" and "make chunk at least 10,000,000" in str(e.value)
+
+
+def test_run_chunks_names_units_not_a_number():
+    with pytest.raises(sim.ConfigError) as e:
+        sim.run_chunks(_fn, 4, 1, 2, units="x")
+    assert e.value.key == "units"
+    assert sim.run_chunks(_fn, 4, 1, 2, units=2.5)["x"].shape == (4,)
