@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 import json
 import os
+import stat
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -85,6 +86,9 @@ def _study_args(path, overrides=(), trials=None, seed=None, values=None):
         raise ConfigError("overrides", f'must be "key=value" strings, got {bad!r}')
     if values is not None and not isinstance(values, Mapping):
         raise ConfigError("values", f"must be a mapping of keys to values, got {values!r}")
+    for k in values or {}:  # {1: 2}: "normalize() argument 2 must be str, not int"
+        if not isinstance(k, str):
+            raise ConfigError("values", f"a key must be a string (got {k!r:.60})")
 
 
 def _table_args(path, columns, prov, tolerances=None):
@@ -174,6 +178,13 @@ def read_provenance(path: str | Path) -> dict[str, Any]:
     """The provenance a table the suite wrote carries in its Parquet schema (its study's
     ``config``, ``code_hash``, ...), as a dict; ``{}`` for a Parquet file without one."""
     check_path("path", path)
+    p = os.fspath(path)
+    try:  # a FIFO nobody writes to: pyarrow's open waited for good
+        special = not stat.S_ISREG(os.stat(p).st_mode) and not os.path.isdir(p)
+    except (OSError, ValueError):
+        special = False  # not there: said below, as pyarrow fails
+    if special:
+        raise ConfigError("path", f"{p}: not a regular file (a pipe or a device), not a table")
     try:
         return storage.read_provenance(path)
     except (OSError, ValueError, pa.ArrowException) as e:

@@ -15,9 +15,16 @@ on the code before its fix.
   built its list of chunk sizes for good (a hang, then memory); it is refused naming
   ``chunk``, at the runs' own limit (``sim.mc.config.MAX_CHUNKS``). ``units`` not a number
   ended in "could not convert string to float" from the progress bar: refused naming it.
+* ``sim.read_provenance`` of a FIFO nobody writes to waited for good (pyarrow opened it to
+  read; a directory, a missing file and a study file were refused, a pipe slipped past): it
+  is refused naming ``path``, as ``sim.load`` refuses a study file that is one.
+* ``sim.load_study`` given ``values`` whose key is not a string (``{1: 2}``) ended in
+  "TypeError: normalize() argument 2 must be str, not int"; ``sim.load`` named ``values``.
 """
 
 from __future__ import annotations
+
+import os
 
 import numpy as np
 import pyarrow as pa
@@ -79,3 +86,17 @@ def test_run_chunks_names_units_not_a_number():
         sim.run_chunks(_fn, 4, 1, 2, units="x")
     assert e.value.key == "units"
     assert sim.run_chunks(_fn, 4, 1, 2, units=2.5)["x"].shape == (4,)
+
+
+def test_read_provenance_of_a_fifo_is_refused_not_waited_on(tmp_path):
+    os.mkfifo(tmp_path / "t.parquet")
+    with pytest.raises(sim.ConfigError) as e:
+        sim.read_provenance(tmp_path / "t.parquet")
+    assert e.value.key == "path" and "not a regular file" in str(e.value)
+
+
+def test_load_study_names_values_whose_key_is_not_a_string():
+    study = os.path.join(os.path.dirname(__file__), "..", "studies", "brown_table1.toml")
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load_study(study, values={1: 2})
+    assert e.value.key == "values" and "must be a string" in str(e.value)
