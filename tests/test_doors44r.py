@@ -20,6 +20,10 @@ on the code before its fix.
   is refused naming ``path``, as ``sim.load`` refuses a study file that is one.
 * ``sim.load_study`` given ``values`` whose key is not a string (``{1: 2}``) ended in
   "TypeError: normalize() argument 2 must be str, not int"; ``sim.load`` named ``values``.
+* ``python -m sim.report.verify`` (``make verify``'s command) from a working directory that
+  was deleted ended "sim verify: error: No such file or directory", naming nothing: its own
+  refusal ("no studies/ directory in <cwd>") raised asking for the directory. It names the
+  relative argument, as ``sim`` and ``sim.batch`` do (doors41l).
 """
 
 from __future__ import annotations
@@ -32,6 +36,8 @@ import pyarrow.parquet as pq
 import pytest
 
 import sim
+from sim.report.verify.cli import main as verify_main
+from tests.oneline import VERIFY_ERROR, one_line
 
 
 @pytest.mark.parametrize(
@@ -100,3 +106,16 @@ def test_load_study_names_values_whose_key_is_not_a_string():
     with pytest.raises(sim.ConfigError) as e:
         sim.load_study(study, values={1: 2})
     assert e.value.key == "values" and "must be a string" in str(e.value)
+
+
+def test_verify_from_a_deleted_working_directory_names_the_argument(tmp_path, monkeypatch, capsys):
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    one_line(
+        capsys,
+        verify_main([]),
+        "results is relative, but the working directory is gone",
+        prefix=VERIFY_ERROR + "--results",
+    )
