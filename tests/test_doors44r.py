@@ -24,10 +24,15 @@ on the code before its fix.
   was deleted ended "sim verify: error: No such file or directory", naming nothing: its own
   refusal ("no studies/ directory in <cwd>") raised asking for the directory. It names the
   relative argument, as ``sim`` and ``sim.batch`` do (doors41l).
+* ``sim.Results(root, study)`` of a results root (R41 named the directories holding the
+  study's runs) with a study none of them holds, a name mistyped (``brown_tabel1``), said
+  "holds tables of 'verify', not of 'brown_tabel1'" (the root's make verify record), naming
+  none of the studies there. It names them, and the one the name most likely meant.
 """
 
 from __future__ import annotations
 
+import json
 import os
 
 import numpy as np
@@ -119,3 +124,15 @@ def test_verify_from_a_deleted_working_directory_names_the_argument(tmp_path, mo
         "results is relative, but the working directory is gone",
         prefix=VERIFY_ERROR + "--results",
     )
+
+
+def test_results_of_a_root_with_a_mistyped_study_names_the_studies_there(tmp_path):
+    for name, study in (("brown_table1", "brown_table1"), ("network_plate", "network")):
+        (tmp_path / name).mkdir()
+        record = {"config": {"study": study}, "code_hash": "0" * 16}
+        (tmp_path / name / "run.json").write_text(json.dumps(record), encoding="utf-8")
+    sim.write_table(tmp_path / "reproducibility.parquet", {"study": ["x"]}, {"study": "verify"})
+    with pytest.raises(sim.ConfigError) as e:
+        sim.Results(tmp_path, "brown_tabel1").names()
+    line = str(e.value)
+    assert "did you mean 'brown_table1'?" in line and "brown_table1, network" in line, line
