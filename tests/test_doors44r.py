@@ -28,6 +28,11 @@ on the code before its fix.
   study's runs) with a study none of them holds, a name mistyped (``brown_tabel1``), said
   "holds tables of 'verify', not of 'brown_tabel1'" (the root's make verify record), naming
   none of the studies there. It names them, and the one the name most likely meant.
+* ``--executor dask`` under any hard ``ulimit -m`` below the machine's memory was refused
+  (t43 refused the limits Dask fails under: 400 MB for two workers hung): ``ulimit -m
+  20000000`` (19 GiB of 24) said "its workers stall or fail under it" of a run that fits. A
+  limit that leaves each worker 400 MiB runs (two workers under 1,000,000 kB ran as fast as
+  without it); a smaller one is refused as before, saying each worker's share.
 """
 
 from __future__ import annotations
@@ -42,7 +47,7 @@ import pytest
 
 import sim
 from sim.report.verify.cli import main as verify_main
-from tests.oneline import VERIFY_ERROR, one_line
+from tests.oneline import VERIFY_ERROR, one_line, python_lines
 
 
 @pytest.mark.parametrize(
@@ -136,3 +141,19 @@ def test_results_of_a_root_with_a_mistyped_study_names_the_studies_there(tmp_pat
         sim.Results(tmp_path, "brown_tabel1").names()
     line = str(e.value)
     assert "did you mean 'brown_table1'?" in line and "brown_table1, network" in line, line
+
+
+@pytest.mark.parametrize("kb, refused", [(20_000_000, False), (400_000, True)])
+def test_dask_is_refused_only_under_a_ulimit_m_its_workers_cannot_run_under(kb, refused):
+    pytest.importorskip("distributed")
+    proc = python_lines(  # (a real run under 19 GiB: the same results, see the docstring)
+        "import resource",
+        f"resource.setrlimit(resource.RLIMIT_RSS, ({kb} << 10, {kb} << 10))",
+        "from sim.mc.executors import StartRefused, _rss_limit_not_taken",
+        "try:",
+        "    _rss_limit_not_taken(2)",
+        "except StartRefused as e:",
+        "    print(e)",
+    )
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    assert ("195 MiB each of 2 workers" in proc.stdout) == refused, proc.stdout
