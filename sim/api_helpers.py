@@ -155,6 +155,10 @@ def _write_table(path, columns, prov, tolerances=None):
         return storage.write_table(path, table, prov, tolerances)
     except storage.NonFiniteError as e:
         raise ConfigError("columns", str(e)) from None
+    except OSError as e:  # a file where its directory goes: FileExistsError from mkdir
+        where = f" ({e.filename})" if e.filename and str(e.filename) != os.fspath(path) else ""
+        why = e.strerror or type(e).__name__
+        raise ConfigError("path", f"{os.fspath(path)} cannot be written: {why}{where}") from None
 
 
 def _checked_by(check, fn):

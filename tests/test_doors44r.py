@@ -1,6 +1,6 @@
-"""The classes of the review R44 of session 43's change (lead41's argument checks of the
-helpers ``sim`` exports: ``sim.write_table``, ``sim.run_chunks``), one case each; each failed
-on the code before its fix.
+"""The classes of the review R44 of last session's change (lead41's argument checks of the
+helpers ``sim`` exports, L41's working directory gone, R41's names() of a results root, T43's
+Dask under ``ulimit -m``), one case each; each failed on the code before its fix.
 
 * ``sim.write_table`` checked that ``columns`` is a mapping of 1-D arrays, and its neighbours
   slipped past into pyarrow or Python: columns of unequal lengths (``ArrowInvalid: Column 1
@@ -8,9 +8,9 @@ on the code before its fix.
   expected bytes, int found``), values pyarrow cannot hold in one column (a set: "only handle
   1-dimensional arrays"; mixed dicts and numbers), a ``prov`` that is not JSON (``TypeError:
   not JSON serialisable``), a tolerance that is not a rule (``ValueError: dictionary update
-  sequence element #0``), an infinite value (the suite's ``NonFiniteError``, a ValueError) and
-  a ``path`` that is a directory (``IsADirectoryError``). Each is one ``sim.ConfigError`` naming
-  the argument now, and a good table is written as before.
+  sequence element #0``), an infinite value (the suite's ``NonFiniteError``, a ValueError), a
+  ``path`` that is a directory (``IsADirectoryError``) or below a file (``FileExistsError``).
+  Each is one ``sim.ConfigError`` naming the argument now; a good table is written as before.
 * ``sim.run_chunks`` with a count of chunks no run may have (``10**12`` trials in chunks of 1)
   built its list of chunk sizes for good (a hang, then memory); it is refused naming
   ``chunk``, at the runs' own limit (``sim.mc.config.MAX_CHUNKS``). ``units`` not a number
@@ -77,6 +77,11 @@ def test_write_table_into_a_directory_names_the_path(tmp_path):
     with pytest.raises(sim.ConfigError) as e:
         sim.write_table(tmp_path, {"a": [1, 2]}, {})
     assert e.value.key == "path" and "is a directory" in str(e.value)
+    (tmp_path / "f").write_text("mine")  # a file where its directory goes: FileExistsError
+    with pytest.raises(sim.ConfigError) as e:
+        sim.write_table(tmp_path / "f" / "t.parquet", {"a": [1, 2]}, {})
+    assert e.value.key == "path" and "cannot be written: File exists" in str(e.value)
+    assert (tmp_path / "f").read_text() == "mine"
 
 
 def test_write_table_writes_a_good_table_as_before(tmp_path):
