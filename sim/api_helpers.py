@@ -68,9 +68,26 @@ def _of_counts(run):
             or not 0 <= units < float("inf")
         ):
             raise ConfigError("units", f"must be a number >= 0 or None, got {units!r}")
-        return run(fn, int(trials), int(seed), int(chunk), int(part), *args, **kwargs)
+        return run(_Returns(fn), int(trials), int(seed), int(chunk), int(part), *args, **kwargs)
 
     return arguments(checked)
+
+
+class _Returns:
+    """A chunk function ``fn(rng, n)`` of the caller's whose result is checked to be a mapping
+    of names to arrays, as the runner takes it: an ``int`` or a list was "'int' object has no
+    attribute 'items'" from inside the runner. Picklable when ``fn`` is (a pool's tasks)."""
+
+    def __init__(self, fn):
+        self.fn = fn
+
+    def __call__(self, rng, n):
+        out = self.fn(rng, n)
+        if not isinstance(out, Mapping):
+            raise ConfigError(
+                "fn", f"must return a mapping of names to arrays, returned {type(out).__name__}"
+            )
+        return out
 
 
 def _study_args(path, overrides=(), trials=None, seed=None, values=None):

@@ -14,7 +14,9 @@ Dask under ``ulimit -m``), one case each; each failed on the code before its fix
 * ``sim.run_chunks`` with a count of chunks no run may have (``10**12`` trials in chunks of 1)
   built its list of chunk sizes for good (a hang, then memory); it is refused naming
   ``chunk``, at the runs' own limit (``sim.mc.config.MAX_CHUNKS``). ``units`` not a number
-  ended in "could not convert string to float" from the progress bar: refused naming it.
+  ended in "could not convert string to float" from the progress bar: refused naming it. A
+  chunk function that returns no mapping (an ``int``) ended in "'int' object has no
+  attribute 'items'" from inside the runner: refused naming ``fn``.
 * ``sim.read_provenance`` of a FIFO nobody writes to waited for good (pyarrow opened it to
   read; a directory, a missing file and a study file were refused, a pipe slipped past): it
   is refused naming ``path``, as ``sim.load`` refuses a study file that is one.
@@ -162,3 +164,11 @@ def test_dask_is_refused_only_under_a_ulimit_m_its_workers_cannot_run_under(kb, 
     )
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     assert ("195 MiB each of 2 workers" in proc.stdout) == refused, proc.stdout
+
+
+def test_run_chunks_names_a_chunk_function_that_returns_no_mapping():
+    with pytest.raises(sim.ConfigError) as e:
+        sim.run_chunks(lambda rng, n: 5, 4, 1, 2)
+    assert e.value.key == "fn" and "returned int" in str(e.value)
+    agg = sim.run_chunks(lambda rng, n: {"s": np.array([n])}, 4, 1, 2)  # a chunk's own rows
+    assert agg["s"].tolist() == [2, 2]
