@@ -40,6 +40,7 @@ from sim.api_paths import (
     cell_mixed,
     check_identity,
     chunks_recorded,
+    root_hint,
     study_runs_in,
     why_not_a_dir,
     why_unread,
@@ -124,8 +125,8 @@ class Results:
         inner = self.path / self.study
         if not os.path.isdir(inner) or not any(inner.glob("*.parquet")):  # glob: ENAMETOOLONG
             runs = study_runs_in(self.path, self.study)  # a network's: by its study file's name
-            if not runs:
-                return ""
+            if not runs:  # none of the study: the studies it holds, if a results root
+                return root_hint(self.path, self.study)
             more = f" (and {len(runs) - 1} more)" if len(runs) > 1 else ""
             return f"; {runs[0]}{more} holds the study's results: give that path"
         return f"; {inner} holds the study's results: give that path"

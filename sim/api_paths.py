@@ -13,6 +13,7 @@ very name exists (an earlier ``./~`` is the caller's to read).
 from __future__ import annotations
 
 import ast
+import difflib
 import errno
 import os
 import re
@@ -37,6 +38,7 @@ __all__ = [
     "cell_chunks",
     "cell_mixed",
     "study_runs_in",
+    "root_hint",
     "chunks_recorded",
     "too_long",
     "why_not_a_dir",
@@ -251,6 +253,11 @@ def study_runs_in(root: Path, study: str, most: int = 500) -> list[Path]:
     is named by its study file (``results/network_plate``), not ``results/network``, and
     ``Results(root, "network").names()`` of such a root was ``[]``. At most ``most`` entries
     of ``root`` are looked at."""
+    return [d for d, s in _runs_in(root, most) if s == study]
+
+
+def _runs_in(root: Path, most: int = 500) -> list[tuple[Path, str]]:
+    """``(directory, its run record's study)`` of the results directories inside ``root``."""
     found = []
     try:
         entries = sorted(os.scandir(root), key=lambda e: e.name)[:most]
@@ -264,9 +271,26 @@ def study_runs_in(root: Path, study: str, most: int = 500) -> list[Path]:
             continue
         rec = read_record(Path(e.path))
         cfg = rec.get("config") if isinstance(rec, dict) else None
-        if isinstance(cfg, dict) and cfg.get("study") == study:
-            found.append(Path(e.path))
+        if isinstance(cfg, dict) and isinstance(cfg.get("study"), str):
+            found.append((Path(e.path), cfg["study"]))
     return found
+
+
+def root_hint(root: Path, study: str) -> str:
+    """``; it is a results root: ...`` naming the studies whose results directories ``root``
+    holds (none of ``study``, a name mistyped: the one it most likely meant), or "". Of
+    ``sim.Results("results", "brown_tabel1")`` it said only "holds tables of 'verify', not of
+    'brown_tabel1'" (the root's make verify record), naming none of its twelve studies."""
+    studies = sorted({s for _, s in _runs_in(root)})
+    if not studies:
+        return ""
+    near = difflib.get_close_matches(study, studies, n=1, cutoff=0.75)
+    meant = f" (did you mean {near[0]!r}?)" if near else ""
+    shown = ", ".join(studies[:8]) + (", ..." if len(studies) > 8 else "")
+    return (
+        f"; it is a results root, whose results directories hold no run of {study!r}{meant}: "
+        f"they hold {shown}; give the path of one"
+    )
 
 
 def _same_value(mine: Any, row: Any) -> bool:

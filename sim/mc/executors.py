@@ -178,7 +178,7 @@ class _Dask:
             ) from None
         self._completed = dask_completed
         self.cluster = None
-        _rss_limit_not_taken()  # the client's messages are sized from it too
+        _rss_limit_not_taken(1 if scheduler else workers)  # the client's messages too
         if scheduler:
             self.client = Client(scheduler, timeout="10s")
         else:
@@ -251,22 +251,32 @@ def _enough_files(workers: int) -> None:
         )
 
 
-def _rss_limit_not_taken() -> None:
+#: the least share of a hard ``ulimit -m`` a Dask worker runs under (bytes): a worker process
+#: holds about 150 MB before its first task, and is paused at 80 % of its share (two workers
+#: under 400 MB hung; under 1,000,000 kB each of two ran as without the limit)
+DASK_WORKER_RSS = 400 * 2**20
+
+
+def _rss_limit_not_taken(workers: int = 1) -> None:
     """Refuse (one line) to start Dask under a hard ``ulimit -m`` that Dask would take for the
-    machine's memory (:func:`distributed.system.memory_limit`): Linux does not enforce it, but
-    Dask sizes its workers (paused at 80 %) and its messages (half of it) from it, so a run
-    under it hung (400 MB), ended in "CommClosedError ... Stream is closed" (100 MB) or in a
-    63-line tornado traceback (under 256 kB: "cannot convert 'float' object to bytearray")."""
+    machine's memory (:func:`distributed.system.memory_limit`) and that leaves each of its
+    ``workers`` less than :data:`DASK_WORKER_RSS`: Linux does not enforce it, but Dask sizes
+    its workers (paused at 80 %) and its messages (half of it) from it, so a run under it hung
+    (400 MB), ended in "CommClosedError ... Stream is closed" (100 MB) or in a 63-line tornado
+    traceback (under 256 kB: "cannot convert 'float' object to bytearray"). A larger limit
+    runs (R44: ``ulimit -m 20000000``, 19 GiB on a machine of 24, was refused)."""
     hard = resource.getrlimit(resource.RLIMIT_RSS)[1]
-    if hard == resource.RLIM_INFINITY or hard <= 0:
+    if hard == resource.RLIM_INFINITY or hard <= 0 or hard >= DASK_WORKER_RSS * max(workers, 1):
         return
     from distributed.system import memory_limit  # heavy optional dependency (dask extra)
 
     if memory_limit() >= hard:  # the limit is what Dask takes for the memory (or less)
+        each = f" ({hard / max(workers, 1) / 2**20:.0f} MiB each of {workers} workers)"
         raise StartRefused(
             f"Dask takes ulimit -m ({hard // 1024} kB) for this machine's memory, which Linux "
-            "does not enforce, and its workers stall or fail under it (start the run from a "
-            "shell without ulimit -m, or use --executor local)"
+            f"does not enforce, and its workers stall or fail under it{each * (workers > 1)}, "
+            f"under the {DASK_WORKER_RSS // 2**20} MiB a worker needs (start the run from a "
+            "shell without ulimit -m or with a larger one, or use --executor local)"
         )
 
 

@@ -100,11 +100,23 @@ def _defaults(a) -> None:
     a.studies = shown_path(base() / "studies") if a.studies is None else a.studies
 
 
+def _cwd_exists() -> bool:
+    try:
+        os.getcwd()
+    except OSError:
+        return False
+    return True
+
+
 def _check_args(a) -> None:
     for name, v in (("--results", a.results), ("--scratch", a.scratch), ("--studies", a.studies)):
         why = None if v is None else name_problem(v)
         if why:
             raise VerifyError(f"{name}: {why} (got {v!r})")
+        if v is not None and not os.path.isabs(v) and not _cwd_exists():  # (R44) it was
+            raise VerifyError(  # "No such file or directory", from the refusal's Path.cwd()
+                f"{name}: {v} is relative, but the working directory is gone (it was deleted)"
+            )
     if a.trials is not None and a.trials < MIN_TRIALS:
         raise VerifyError(
             f"--trials: must be at least {MIN_TRIALS}, not {a.trials} (the Monte-Carlo rule takes "
