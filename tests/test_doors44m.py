@@ -9,6 +9,14 @@ file read three times); one case per class found, each failing on the code befor
   once per process and content (:mod:`sim.studies.network.gama_cache`, keyed by the file's
   path and the sha256 of its bytes, which are read again each time): one parse, and an edit
   of the file between two loads is still seen (parsed again, its digest recorded anew).
+* brown_design's bar counted each of its 11 error-budget rows at ``budget.max_trials``
+  (20,000 trials, 60,000 work units a row) until the row's adaptive stages stopped (1,000 to
+  8,500 trials): 660,000 of the bar's 2.32 million units stood for 73,500 of real work, and the
+  time left was 1.3 times the real one at the start and about 2 times when the posteriors
+  (run first on one worker) were done. After each stage the bar now counts the trials the stage
+  predicts (:func:`sim.studies.design.adaptive.run_adaptive`; more put back if a later stage
+  predicts more), and the budget runs first, so every row is counted at its prediction within
+  the first few percent of the run. No number changes (each chunk draws its own stream).
 """
 
 from __future__ import annotations
@@ -17,7 +25,10 @@ from pathlib import Path
 
 import sim
 import sim.studies.network.gama_read as gama_read
+from sim.mc.estimate import Estimate
+from sim.mc.runner import ChunkStore, RunContext
 from sim.studies import load_study
+from sim.studies.design.adaptive import run_adaptive
 from sim.studies.network.definition import build
 from sim.studies.network.gama import merge_gama, write_gama
 from tests.conftest import TRIANGLE_NETWORK
@@ -64,3 +75,26 @@ def test_a_gama_file_is_parsed_once_a_run_and_an_edit_is_seen(tmp_path, monkeypa
     sigmas = [o["sigma_mm"] for o in merge_gama(again.config)["network.observations"]]
     assert sigmas[0] == 0.02 and sigmas[1:] == [0.01] * (len(sigmas) - 1)
     assert len(parses) == 2
+
+
+def _draws(rng, n):
+    return {"x": rng.normal(size=n)}
+
+
+def test_an_adaptive_stage_counts_its_predicted_trials_on_the_bar_not_its_maximum(tmp_path):
+    """A stage of 20 trials whose standard error is twice the target predicts 90 in all (20 x
+    2^2 x 1.05, in whole chunks): while the second stage runs, the bar counts 90 trials (270
+    units), not the estimate's 1,000 (3,000 units); it ends at 90 as before."""
+    est = Estimate("x", 1000, 3000.0, 1, 1.0, work=3000.0)
+    ctx = RunContext(quiet=True, store=ChunkStore(tmp_path / "trials"), estimate=est)
+    seen = []
+
+    def stat(res):
+        seen.append((ctx.bar.total, ctx.bar.work_total))
+        return {"se": (0.0, 2.0 if len(seen) == 1 else 0.5)}
+
+    with ctx.progress_bar("x"):
+        res, _ = run_adaptive(_draws, stat, 1.0, 7, 10, 0, 20, 1000, ctx=ctx, units=3.0)
+    assert len(res["x"]) == 90
+    assert seen == [(1000, 3000.0), (90, 270.0)]
+    assert ctx.counted == [90, 90]

@@ -417,6 +417,7 @@ class RunContext:
 
     def unneeded(self, trials: int, units: float | None = None) -> None:
         """Take ``trials`` the estimate counted and the run will not do (an adaptive stage
-        that stopped short of its maximum; ``units`` each) off the run's bar."""
-        if self.bar is not None and trials > 0:
+        that stopped, or predicts it stops, short of its maximum; ``units`` each) off the
+        run's bar; ``trials`` < 0 puts them back (a later stage predicts more)."""
+        if self.bar is not None and trials != 0:
             self.bar.lower(trials, None if units is None else units * trials)
