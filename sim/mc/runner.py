@@ -403,14 +403,17 @@ class RunContext:
                 self.counted[:] = [p.done, p.total]
 
     @contextmanager
-    def doing(self, text: str):
+    def doing(self, text: str, work: float = 0.0):
         """Show ``text`` on the run's bar while the block runs (a part that counts no trial:
-        brown_design's analytic design grid and regions, half a minute at a bar of 0 %)."""
+        brown_design's analytic design grid and regions, half a minute at a bar of 0 %); the
+        block done, the bar counts its ``work`` (the unit adjustments the estimate gave it)."""
         bar = self.bar
         if bar is not None:
             bar.set_doing(text)
         try:
             yield
+            if bar is not None and work > 0:
+                bar.update(0, 0, work)
         finally:
             if bar is not None:
                 bar.set_doing("")
