@@ -27,6 +27,13 @@ file read three times); one case per class found, each failing on the code befor
   (:func:`sim.mc.workunits.affine_units`); the two-plate posterior's share of a chain, 0.225
   of :data:`sim.mc.workunits.BAYES_UNITS`, measured 0.37 at 32 x 2,000 steps (Brown's 0.65,
   counted 0.55) and is 0.32.
+* agnard_block's bar counted a trial one unit in every part: a trial of the main blocks
+  (10,468 units at the defaults) as one of the five-point region's (1,792) or of a block of 8
+  models (112), so the time left during the main part was the trials left over its slow rate
+  of trials; and it counted the trials of the scan resolution and the re-centring error that
+  the main blocks already have (200 of 1,618 at the defaults, never run): the bar ended at
+  88 %. Each part now counts its trials at its units (:func:`sim.mc.agnard_size.agnard_units`)
+  and the estimate leaves out the parts the run does not run.
 * gridplate_two_plates' bar counted a trial one unit and its region not at all: the region
   (about 2.7 s of the 7 s the estimate gives the study's defaults) ran after the bar had
   said 100 % and no time left. The bar now counts a trial at its units and, once the region is
@@ -50,7 +57,7 @@ from sim.studies import get_study, load_study
 from sim.studies.design.adaptive import run_adaptive
 from sim.studies.network.definition import build
 from sim.studies.network.gama import merge_gama, write_gama
-from tests.conftest import TRIANGLE_NETWORK
+from tests.conftest import TRIANGLE_NETWORK, tiny_overrides
 
 
 def _gama_study(tmp_path: Path) -> tuple[Path, Path]:
@@ -152,3 +159,18 @@ def test_an_affine_coverage_trial_is_counted_with_its_chunks_cost():
     )[1]
     more = 10000 - 10  # trials of a coverage case (2 units) and of the affine case each
     assert design_bar_units(cfg) - design_bar_units(fewer) < more * 2.6
+
+
+def test_the_agnard_bar_counts_each_parts_units_and_only_the_trials_run(tmp_path):
+    """The tiny run (its resolution and re-centring error the main blocks' own): the bar ends
+    with every trial it counted done and its work at its total, each part's trials at its
+    units; before, 4 trials never run were counted and every trial one unit."""
+    sets = [a for a in tiny_overrides("agnard_block") if a != "--set"]
+    cfg = load_study(Path(__file__).parents[1] / "studies" / "agnard_block.toml", sets)[1]
+    est = estimate(cfg)
+    ctx = RunContext(quiet=True, store=ChunkStore(tmp_path / "trials"), estimate=est)
+    with ctx.progress_bar("agnard_block") as bar:
+        get_study("agnard_block").run(cfg, tmp_path / "out", ctx)
+        assert bar.done == bar.total == est.trials
+        assert bar.work == pytest.approx(est.work) and bar.work_total == pytest.approx(est.work)
+    assert est.work > 100 * est.trials
