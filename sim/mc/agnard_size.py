@@ -12,10 +12,16 @@ from __future__ import annotations
 
 from typing import Mapping
 
-from sim.mc.workunits import COPIES, F8, grid_count, region_points
+from sim.mc.workunits import COPIES, F8, REGION_MAX_NEW, grid_count, region_points
 from sim.mc.workunits import n_of as _n
 
-__all__ = ["agnard_estimate", "AGNARD_MODEL_UNITS", "AGNARD_POINT_UNITS", "AGNARD_CUBE_UNITS"]
+__all__ = [
+    "agnard_estimate",
+    "agnard_units",
+    "AGNARD_MODEL_UNITS",
+    "AGNARD_POINT_UNITS",
+    "AGNARD_CUBE_UNITS",
+]
 
 #: unit adjustments one block adjustment costs per model of the block (its reduced normals are
 #: 7 x 7 blocks coupled to a few neighbours: the work grows with the models). Measured from
@@ -41,6 +47,29 @@ AGNARD_PAPER_POINTS = 178
 #: 8 models 3,800 units a trial, 4 x 25 75,000, 6 x 30 405,000; counted by the models alone,
 #: the 6 x 30 block was 3.3 times its estimate and a 12 x 60 one about 60 times)
 AGNARD_CUBE_UNITS = 3.7e-4
+
+
+def agnard_units(c: Mapping) -> dict:
+    """A trial's unit adjustments in each part, as the run's bar counts them (the estimate's
+    block solves, :func:`agnard_estimate`): ``main``, ``scanner`` (a resolution's), ``recentre``,
+    ``size`` (``(strips, models)`` to its trial's), ``region`` (the five-point layouts') and
+    ``table1`` (``n`` scanner vectors to a trial's, the configured scanner's blocks with them).
+    Counted one a trial, a trial of the main blocks (10,468 units at the defaults) weighed as
+    one of the region's (1,792) or of a block of 8 models (112): the bar's time left was the
+    trials left over the main part's slow rate of trials."""
+    M = c.get("block.strips", 2) * c.get("block.models", 8)
+    snoop = 1 + c.get("snoop.max_reject", 0)
+    w = AGNARD_MODEL_UNITS * M
+    p = AGNARD_POINT_UNITS * max(c.get("block.ground_points", 178) - AGNARD_PAPER_POINTS, 0)
+    solve = snoop * (w + AGNARD_CUBE_UNITS * M**3) + p  # a snooped block solve
+    return {
+        "main": (3 + _n(c.get("tradeoff.layouts", []))) * solve,
+        "scanner": 2 * solve,
+        "recentre": solve,
+        "size": lambda S, Mo: 2 * S * Mo * (AGNARD_MODEL_UNITS + p / max(M, 1)),
+        "region": c.get("region.points", 0) * 2 * (w + p),
+        "table1": lambda n: (n + 1) * AGNARD_VECTOR_SOLVES * (w + p),
+    }
 
 
 def agnard_estimate(c: Mapping) -> tuple:
@@ -101,4 +130,20 @@ def agnard_estimate(c: Mapping) -> tuple:
         COPIES * max(ch * (7 * M) ** 2 * F8, ch * scan_nodes * 2 * F8, ch * pts * M * 6 * F8),
         2 * (ch_t * (7 * Mt) ** 2 * F8 + 4e6 * F8),
     )
-    return trials, adj, int(max(U, Ut)), b
+    # the bar: each part's trials at its units; the resolution and the re-centring error the
+    # main blocks already have are not run (their trials were counted, and the bar ended short)
+    u = agnard_units(c)
+    own_dp = c.get("scan.dpi") in c.get("tradeoff.dpis", []) and c.get("control.table1") == c.get(
+        "control.many"
+    )
+    own_rc = c.get("pugging.recentre_px") in c.get("tradeoff.recentre_px", [])
+    trials -= tT * (own_dp + own_rc)
+    work = (
+        T * u["main"]
+        + tT * ((dp - own_dp) * u["scanner"] + (rc - own_rc) * u["recentre"])
+        + bT * sum(u["size"](S, Mo) for S, Mo in sizes)
+        + sT * s_cells * 3 * (snoop * ws + p)
+        + rT * u["region"]
+        + t1T * (u["table1"](c.get("table1.points", 0)) + t1_rounds * u["table1"](REGION_MAX_NEW))
+    )
+    return trials, adj, int(max(U, Ut)), b, "", (0.0, "", ""), (), work

@@ -38,6 +38,7 @@ from typing import Any, Callable, Container, Mapping
 from sim.mc.agnard_size import agnard_estimate as _agnard
 from sim.mc.brown_size import brown_estimate as _brown
 from sim.mc.config import ConfigError
+from sim.mc.gridplate_size import gridplate_estimate as _gridplate
 from sim.mc.network_size import network_estimate as _network
 from sim.mc.numtext import UnheldError, float_text
 from sim.mc.salsig_size import salsig_estimate as _salsig
@@ -155,34 +156,6 @@ def _min(v, default=1.0) -> float:
 
 
 # ---- one estimator per study kind: (trials, adjustments, unknowns, bytes) -------------------
-
-
-#: gridplate_two_plates' trial, measured (one core, chunks of 100, tracemalloc): each reading
-#: (plates x points x readings) 0.002 units and 32 bytes, each plate's point 0.04 units and 300
-#: bytes besides the adjustments counted one a unit. From 10 units and 20 kB a trial at the
-#: study's 2 plates of 5 x 5 points read 4 times to 134 units and 1.5 MB at 4 plates of 15 x 15
-#: read 50 times: counted as the adjustments alone (20 units) and as 384 bytes a reading and
-#: 4,608 a point, the largest plates were 6.7 times over their estimate in time and 14 times
-#: under it in memory (a chunk of 400 refused at 8 GiB that holds 0.6 GiB)
-GP_READING_UNITS, GP_POINT_UNITS = 2e-3, 0.04
-GP_READING_BYTES, GP_POINT_BYTES = 32.0, 300.0
-
-
-def _gridplate(c: Mapping) -> tuple:
-    N = c.get("plate.grid", 5) ** 2
-    P, L = c.get("plate.count", 2), c.get("readings.count", 4)
-    T, ch = c["trials"], min(c["chunk"], c["trials"])
-    per = 3 + _n(c.get("analysis.ratios", [])) + _n(c.get("analysis.stated_sigmas_um", []))
-    U = 2 * N + 3
-    per += GP_READING_UNITS * P * N * L + GP_POINT_UNITS * P * N
-    b = ch * (P * N * L * GP_READING_BYTES + P * N * GP_POINT_BYTES)
-    # the region: region.points input vectors, each round up to 4x as many at its boundary;
-    # each vector draws region.draws calibrations (measured 0.85 ms + 1.25 us a draw) and
-    # counts the iterations of region.iter_calibrations calibrations (a row of each plate each)
-    pts = c.get("region.points", 0) * (1 + 4 * c.get("region.rounds", 0))
-    draw_s = 0.85e-3 + 1.25e-6 * c.get("region.draws", 0)
-    region = pts * (draw_s / ADJUSTMENT_S + c.get("region.iter_calibrations", 0) * 2 * P)
-    return T, T * per + region, U, b
 
 
 #: the main experiment's trial, measured (one core, chunks of 100): each of its sets + 2 fits

@@ -186,12 +186,17 @@ class Progress:
 
     def set_doing(self, text: str) -> None:
         """Show ``text`` (what the run does where no trial is counted: an analytic part)
-        after the bar's label, redrawn now; ``""`` removes it."""
+        after the bar's label, redrawn now; ``""`` removes it, and the rate of work (the time
+        left) is measured from then on: the part's time, with no work counted, made the rate
+        of the trials after it (brown_design's error budget, after a minute of its analytic
+        parts) a fraction of theirs and the time left 20 times the real one."""
         self.doing = text
         if self.enabled:
             self.bar.set_description_str(f"{self.label}: {text}" if text else self.label, False)
             self._trials()
             self.bar.refresh()
+            if not text:
+                self.bar.last_print_n, self.bar.last_print_t = self.bar.n, self.bar._time()
 
     def lower(self, trials: int, work: float | None = None) -> None:
         """Take ``trials`` (costing ``work``, else the mean) off the totals: trials the

@@ -403,20 +403,24 @@ class RunContext:
                 self.counted[:] = [p.done, p.total]
 
     @contextmanager
-    def doing(self, text: str):
+    def doing(self, text: str, work: float = 0.0):
         """Show ``text`` on the run's bar while the block runs (a part that counts no trial:
-        brown_design's analytic design grid and regions, half a minute at a bar of 0 %)."""
+        brown_design's analytic design grid and regions, half a minute at a bar of 0 %); the
+        block done, the bar counts its ``work`` (the unit adjustments the estimate gave it)."""
         bar = self.bar
         if bar is not None:
             bar.set_doing(text)
         try:
             yield
+            if bar is not None and work > 0:
+                bar.update(0, 0, work)
         finally:
             if bar is not None:
                 bar.set_doing("")
 
     def unneeded(self, trials: int, units: float | None = None) -> None:
         """Take ``trials`` the estimate counted and the run will not do (an adaptive stage
-        that stopped short of its maximum; ``units`` each) off the run's bar."""
-        if self.bar is not None and trials > 0:
+        that stopped, or predicts it stops, short of its maximum; ``units`` each) off the
+        run's bar; ``trials`` < 0 puts them back (a later stage predicts more)."""
+        if self.bar is not None and trials != 0:
             self.bar.lower(trials, None if units is None else units * trials)

@@ -136,16 +136,20 @@ DESIGN_POSTERIORS = 3
 #: (measured, one core, chunks of 20): the check and an error-budget row solve the paper's
 #: plate (3.0 to 3.4), a coverage case Brown's 4 stations (1.1 to 3.2; 6 at 10 mm of noise);
 #: the shares of :data:`BAYES_UNITS` of a chain of Brown's posterior and of each two-plate
-#: one (0.45 and 0.18 a walker's step measured: 5,713 and 2,300 units a chain of 32 x 400)
-DESIGN_UNITS = {"check": 3.0, "budget": 3.0, "coverage": 2.0, "brown": 0.55, "twoplate": 0.225}
-#: an affine coverage trial (a linear fit of the grid's points): 28 units at 25 points, 7.5
-#: at 4 (measured as above)
-AFFINE_UNITS, AFFINE_POINT_UNITS = 3.0, 1.0
+#: one (0.45 and 0.18 a walker's step measured: 5,713 and 2,300 units a chain of 32 x 400; at
+#: 32 x 2,000, 0.65 and 0.37: the two-plate share raised to 0.32, 0.575 of Brown's, as there)
+DESIGN_UNITS = {"check": 3.0, "budget": 3.0, "coverage": 2.0, "brown": 0.55, "twoplate": 0.32}
+#: an affine coverage trial (a linear fit of the grid's points) costs little beside its
+#: chunk's: measured, one core, the study's 4,000 + 1,000 trials (25 and 4 points) at 6.0
+#: units a trial in chunks of 20 and 0.39 in chunks of 500 (the study's). Counted 28 and 7 a
+#: trial whatever the chunk, the coverage's 294,000 units stood for about 2,000: the bar's time
+#: left was 2.8 times the real one at 90 % of a run
+AFFINE_TRIAL_UNITS, AFFINE_CHUNK_UNITS = 0.16, 117.0
 
 
-def affine_units(points: float) -> float:
-    """Unit adjustments of one affine coverage trial over ``points`` grid points."""
-    return AFFINE_UNITS + AFFINE_POINT_UNITS * points
+def affine_units(chunk: float) -> float:
+    """Unit adjustments of one affine coverage trial in chunks of ``chunk`` trials."""
+    return AFFINE_TRIAL_UNITS + AFFINE_CHUNK_UNITS / max(chunk, 1)
 
 
 def chain_units(walkers: float, steps: float, posterior: str) -> float:
@@ -170,8 +174,8 @@ def design_bar_units(c: Mapping) -> float:
         c["trials"] * u["check"]
         + DESIGN_BUDGET_ROWS * c.get("budget.max_trials", 0) * u["budget"]
         + (cov + sweep * cases) * u["coverage"]
-        + cov * affine_units(c.get("datum.grid", 5) ** 2)
-        + sweep * affine_units(4)
+        + cov * affine_units(min(c["chunk"], cov or 1))
+        + sweep * affine_units(min(c["chunk"], sweep or 1))
         + chains * BAYES_UNITS * walker_steps * (u["brown"] + 2 * u["twoplate"])
     )
 

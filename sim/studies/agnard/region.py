@@ -48,6 +48,7 @@ from sim.claims.book import ClaimBook
 from sim.claims.book_region import load_declaration, plate_ref, sample_evidence
 from sim.claims.inference import Input, Region, explore
 from sim.instruments.block.layout import Block
+from sim.mc.agnard_size import agnard_units
 from sim.mc.config import Field
 from sim.mc.runner import chunk_rng
 from sim.studies.agnard import chunks as ch
@@ -124,6 +125,7 @@ def explore_region(
             part + len(stats),
             "five-point layouts"
             + (", with and without projection centres" if len(options) > 1 else ""),
+            units=agnard_units(cfg)["region"] * len(options) / 2,
         )
 
     def model(x: dict[str, np.ndarray]) -> dict:
@@ -251,6 +253,7 @@ def explore_scanner(
             cfg["table1.trials"],
             SCANNER_PART + len(stats),
             "scanner vectors (Table 1), each paired with the configured scanner",
+            units=agnard_units(cfg)["table1"](n),
         )
         c, per = _vector_stats(sw, len(five), pj)
         stats.extend(per)

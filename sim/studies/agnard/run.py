@@ -25,6 +25,7 @@ import numpy as np
 from sim.claims.book import write_claims
 from sim.instruments.block import independent_models as im
 from sim.instruments.block.layout import select_control
+from sim.mc.agnard_size import agnard_units
 from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance, write_table
 from sim.report.plotting import draw
@@ -50,12 +51,21 @@ def _add_mean_se(t: dict, q: str, x: np.ndarray) -> None:
     t[q + "_se"].append(se)
 
 
-def _run(fn, trials, cfg, part, label, ctx, chunk=None):
+def _run(fn, trials, cfg, part, label, ctx, chunk=None, units=None):
     """One part through the runner, in at least four chunks (when it has the trials) so that
-    the parts, run one after the other, keep every worker busy."""
+    the parts, run one after the other, keep every worker busy; ``units``: a trial's unit
+    adjustments on the run's bar (:func:`sim.mc.agnard_size.agnard_units`)."""
     chunk = chunk or min(cfg["chunk"], max(1, -(-trials // 4)))
     return run_chunks(
-        fn, trials, cfg["seed"], chunk, part=part, label=f"{NAME} {label}", quiet=ctx.quiet, ctx=ctx
+        fn,
+        trials,
+        cfg["seed"],
+        chunk,
+        part=part,
+        label=f"{NAME} {label}",
+        quiet=ctx.quiet,
+        ctx=ctx,
+        units=units,
     )
 
 
@@ -117,6 +127,7 @@ def _scanner_table(cfg, block, sim, ctx, prov, out):
                 1 + i,
                 f"{dpi:g} DPI",
                 ctx,
+                units=agnard_units(cfg)["scanner"],
             )
         for cal in ("raw", "corrected"):
             t["dpi"].append(dpi)
@@ -193,6 +204,7 @@ def _size_table(cfg, block, ctx, base, prov, out):
             f"{S}x{M}",
             ctx,
             chunk,
+            agnard_units(cfg)["size"](S, M),
         )
         t["strips"].append(S)
         t["models"].append(M)
@@ -220,6 +232,7 @@ def _pugging(cfg, block, sim, ctx, base, prov, out):
                 base + i,
                 f"re-centring {rc:g} px",
                 ctx,
+                units=agnard_units(cfg)["recentre"],
             )
         per[float(rc)] = r["share_pct"]
         t["recentre_px"].append(rc)
@@ -278,7 +291,8 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     c5 = select_control(block, cfg["control.few"])
     c21 = select_control(block, cfg["control.many"])
     draw([(fg.fig_scanner, (cfg, out / "scanner_field.png"))])
-    sim = _run(partial(ch.main_chunk, cfg, block), T, cfg, 0, "2x8 block", ctx)
+    units = agnard_units(cfg)
+    sim = _run(partial(ch.main_chunk, cfg, block), T, cfg, 0, "2x8 block", ctx, units=units["main"])
     per_trial = {k: v for k, v in sim.items() if not k.startswith(ch.CHUNK)}
     write_table(out / "trials.parquet", {"trial": np.arange(T), **per_trial}, prov)
     _layout(block, c5, c21, prov, out)
@@ -295,7 +309,9 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     # --- the unprinted five-point layout (at the configured scanner), the scanner's inputs
     # --- under Table 1 (with the 5-control pass at the joint design's layout points), then
     # --- every claim: over the scanner, and the 5-control rows over both together
-    runner = lambda fn, trials, p, label: _run(fn, trials, cfg, p, label, ctx)  # noqa: E731
+    def runner(fn, trials, p, label, units=None):  # the regions' parts
+        return _run(fn, trials, cfg, p, label, ctx, units=units)
+
     layout, preds5, stats5, insets = dc.five_region(cfg, block, book, runner, base, prov, out)
     scanner, spreds, sstats, five = dc.scanner_region(
         cfg, block, book, per_trial, runner, layout, prov, out

@@ -7,8 +7,10 @@ while a standard error exceeds the target, it predicts the trials needed from ``
 (rounded up to whole chunks, at least one chunk more) and runs the stage to that total. Each
 stage re-requests chunks ``0 .. K-1`` of the same stream: finished chunks come from the store
 (a temporary one when the run has none), so the first ``N`` trials equal a fixed run of ``N``.
-A stage that stops short of ``max_trials`` (the run's estimate counts every stage at its
-maximum) takes the trials it left off the run's bar, which then ends at 100 %.
+The run's estimate counts every stage at ``max_trials``; after each stage the run's bar counts
+the trials predicted instead (more when a stage predicts more), so its time left is the work
+the stages will do, not their maximum (counted at it until it stopped, brown_design's time
+left was about twice the real one for its first half), and it ends at 100 %.
 """
 
 from __future__ import annotations
@@ -49,17 +51,25 @@ def run_adaptive(
             executor=getattr(ctx, "executor", None),
             store=ChunkStore(tmp.name),
         )
+    counted = max_trials  # the trials the run's bar counts for this stage (its estimate's)
+
+    def recount(n: int) -> None:  # the bar counts ``n`` from now on (the stage's prediction)
+        nonlocal counted
+        if tmp is None and hasattr(shared, "unneeded") and n != counted:
+            shared.unneeded(counted - n, units)
+            counted = n
+
     try:
         while True:
             res = run_chunks(fn, N, seed, chunk, part=part, label=label, ctx=ctx, units=units)
             st = dict(stat(res))
             worst = max((se / target for _, se in st.values()), default=0.0)
             if worst < 1.0 or N >= top:
-                if tmp is None and hasattr(shared, "unneeded"):  # the run's bar counted them
-                    shared.unneeded(max_trials - N, units)
+                recount(N)
                 return res, st
             need = N * worst**2 * 1.05 if np.isfinite(worst) else 2 * N
             N = min(top, max(N + chunk, math.ceil(need / chunk) * chunk))
+            recount(N)
     finally:
         if tmp is not None:
             tmp.cleanup()

@@ -104,7 +104,7 @@ def coverage_analysis(cfg: dict, ctx) -> dict:
     for part, (k, T) in enumerate(affine, PART0 + len(tasks)):
         grid = grid_points(k, 2 * 110.0 / (k - 1))
         fn = partial(affine_chunk, grid, sig0, _AFFINE, cfg["coverage.alpha"])
-        units = affine_units(k * k)
+        units = affine_units(min(cfg["chunk"], T))
         tasks[part] = partial(run_part, cfg, ctx, fn, part, "coverage affine", T, units=units)
     sims = side_by_side(tasks, ctx)
     part = PART0

@@ -259,10 +259,10 @@ def _mc_parts(cfg: dict, out: Path, prov: dict, ctx: RunContext, figs, plate) ->
         return tcols, why
 
     return side_by_side(
-        {
+        {  # the error budget first: its adaptive stages tell the bar the trials they need
+            "budget": budget,
             "bayes": bayes,
             "twoplate": twoplate,
-            "budget": budget,
             "coverage": coverage,
             "mc": lambda: _mc_check(cfg, pts, th, sr, ctx),
         },

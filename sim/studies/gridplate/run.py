@@ -12,6 +12,7 @@ from sim.claims.book import write_claims
 from sim.claims.book_region import write_region
 from sim.claims.intervals import spread
 from sim.lsq import distributions as D
+from sim.mc.gridplate_size import gridplate_units
 from sim.mc.runner import chunk_rng
 from sim.mc.storage import provenance, write_table
 from sim.report.plotting import draw
@@ -154,7 +155,8 @@ def true_ratio(cfg: dict) -> tuple[float, int]:
 def run(cfg: dict, out: Path, ctx: RunContext) -> None:
     """The calibrations through the runner, their tables and figures, the claims at the
     configured inputs, then the predictions over the region (``claims.parquet``)."""
-    res = run_part(cfg, ctx, partial(chunk, cfg), part=0, label="gridplate")
+    per, region = gridplate_units(cfg)  # the bar: the trials' work, then the region's
+    res = run_part(cfg, ctx, partial(chunk, cfg), part=0, label="gridplate", units=per)
     prov = provenance(cfg)
     ratios = list(cfg["analysis.ratios"])
     ratio_true, j_true = true_ratio(cfg)
@@ -184,7 +186,8 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
             (F.fig_implied, (imp, stated, paper, out / "implied_grid.png")),
         ]
     )
-    rows = decide_over_region(cfg, book, rows, out, prov, res["gn_iterations"])
+    with ctx.doing("region", region):
+        rows = decide_over_region(cfg, book, rows, out, prov, res["gn_iterations"])
     ex = simulate(cfg, chunk_rng(cfg["seed"], 1, 0), 1)  # one calibration, its own stream
     write_table(
         out / "example_plate.parquet", F.fig_residuals(cfg, ex, out / "residuals.png"), prov

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.mc.config import COMMON
-from sim.mc.estimate import GP_POINT_BYTES, GP_READING_BYTES
+from sim.mc.gridplate_size import GP_POINT_BYTES, GP_READING_BYTES
 from sim.mc.schema_helpers import compared, count, level, positive, printed, real, reals, require
 
 UM = 1e-3  # mm per um

@@ -20,11 +20,10 @@ the design, the same precision. ``val`` is the error-free value. Refused with on
 biases, a ``dx`` without its ``dy``, a ``dy`` whose variance is at or below 1e-8 of every
 ``dx``'s (:func:`_least_first`). ``datum.kind = "constraints"`` is written as the free network
 in the inner datum over all its points (:func:`export` says so). Import:
-:mod:`sim.studies.network.gama_read` (``network.gama_xml``)."""
+:mod:`sim.studies.network.gama_read` (``network.gama_xml``; once a content: ``gama_cache``)."""
 
 from __future__ import annotations
 
-import hashlib
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -34,8 +33,9 @@ import numpy as np
 from sim.mc.config import ConfigError, given
 from sim.mc.storage import atomic_path
 from sim.studies.network.definition import Network, build
+from sim.studies.network.gama_cache import gama_digest, read_gama
 from sim.studies.network.gama_frames import NE, consistent
-from sim.studies.network.gama_read import CC, MAX_BYTES, NS, read_bytes, read_gama
+from sim.studies.network.gama_read import CC, MAX_BYTES, NS
 from sim.studies.network.gama_vocab import shifted
 from sim.studies.network.linearity import row_key
 from sim.studies.network.model import computed, defect_basis
@@ -44,11 +44,6 @@ from sim.studies.network.validate import hits, name_index
 __all__ = ["read_gama", "write_gama", "merge_gama", "export", "gama_digest", "import_note"]
 
 _GON = math.pi / 200
-
-
-def gama_digest(path: str | Path, key: str = "network.gama_xml") -> str:
-    """sha256 of the file's bytes (the file is read as :func:`read_gama` reads it)."""
-    return hashlib.sha256(read_bytes(path, key)).hexdigest()
 
 
 def import_note(cfg: dict) -> str:
