@@ -10,6 +10,9 @@ the argument. The suite's own code calls the functions themselves, unchanged.
 
 from __future__ import annotations
 
+import sim.api_env  # noqa: F401 - the environment, before NumPy and Arrow load
+
+# isort: split
 import functools
 import os
 from collections.abc import Mapping

@@ -9,15 +9,31 @@ the code before its fix.
   the start is now made with the stop signals held (:func:`sim.held_stops.held_stops`), the
   report stopped then and said, and an interrupt after the runs ended and before the report
   began says that REPORT.md was not rebuilt.
+* E42: ``ARROW_USER_SIMD_LEVEL=bogus`` (or empty) was a line of Arrow's own ("cpu_info.cc:393:
+  Invalid value for ARROW_USER_SIMD_LEVEL: BOGUS") and a run at the level Arrow detected, exit
+  0. Arrow's ``ArchParseUserSimdLevel`` (apache/arrow ``cpp/src/arrow/util/cpu_info.cc``) takes
+  NONE, SSE4_2, AVX, AVX2 or AVX512 on x86 and NONE on ARM, upper-casing the value; another is
+  now one line naming the variable (``sim.env_vars.arrow_simd_problem``: the commands, the
+  benchmarks, ``sim.load``). ``import sim.api`` (``sim.api_helpers``, ``sim.api_tables``)
+  directly, not through ``sim.load``, skipped the checks made before NumPy and Arrow load: a
+  ``SOURCE_DATE_EPOCH=abc`` was a traceback from ``numpy.f2py``; importing them now raises the
+  ``ConfigError`` naming it (:mod:`sim.api_env`). ``python -m benchmarks`` did not check
+  ``SIM_NO_JIT``, ``NUMBA_`` or ``ulimit -d`` (``SIM_NO_JIT=0`` timed the Python path): it now
+  refuses them as ``sim`` does.
 """
 
 from __future__ import annotations
 
 import os
+import platform
 import shutil
 import signal
+import subprocess
 import sys
 from pathlib import Path
+
+import pytest
+from oneline import SIM_ERROR, one_line_of
 
 from sim import batch
 from sim.batch_report import rebuild_report
@@ -71,3 +87,31 @@ def test_an_interrupt_before_the_report_says_it_was_not_rebuilt(tmp_path, monkey
     assert batch.main(_batch_up_to_date(tmp_path, monkeypatch)) == 130
     err = capfd.readouterr().err
     assert err.count("\n") == 1 and "REPORT.md was not rebuilt: sim report --results" in err, err
+
+
+def _python(env: dict, *args: str) -> subprocess.CompletedProcess:
+    env = {**os.environ, **env}
+    return subprocess.run(
+        [sys.executable, *args], capture_output=True, text=True, timeout=120, cwd=ROOT, env=env
+    )
+
+
+@pytest.mark.skipif(platform.machine() != "x86_64", reason="Arrow's x86 levels")
+@pytest.mark.parametrize("value", ["bogus", ""])
+def test_an_arrow_simd_level_arrow_does_not_know_is_one_line(value):
+    p = _python(
+        {"ARROW_USER_SIMD_LEVEL": value}, "-m", "sim", "check", "studies/wolf_polynomial.toml"
+    )
+    one_line_of(p, "ARROW_USER_SIMD_LEVEL", "avx2", prefix=SIM_ERROR)
+
+
+@pytest.mark.parametrize("module", ["sim.api", "sim.api_helpers"])
+def test_importing_an_api_module_directly_checks_the_environment(module):
+    code = f"from sim.mc.config import ConfigError\ntry:\n    import {module}\nexcept ConfigError as e:\n    print(e)"
+    p = _python({"SOURCE_DATE_EPOCH": "abc"}, "-c", code)
+    assert p.returncode == 0 and p.stderr == "" and "SOURCE_DATE_EPOCH" in p.stdout, p
+
+
+def test_the_benchmarks_refuse_what_sim_refuses():
+    p = _python({"SIM_NO_JIT": "0"}, "-m", "benchmarks", "--help")
+    one_line_of(p, "SIM_NO_JIT", prefix="benchmarks: error: ")
