@@ -20,6 +20,12 @@ the code before its fix.
   ``ConfigError`` naming it (:mod:`sim.api_env`). ``python -m benchmarks`` did not check
   ``SIM_NO_JIT``, ``NUMBA_`` or ``ulimit -d`` (``SIM_NO_JIT=0`` timed the Python path): it now
   refuses them as ``sim`` does.
+* R41: brown_design's work estimate counted 6 error-budget rows of one unit a trial where its
+  trials (the bar) count the 11 rows (``errbudget.BUDGET_ROWS``) at 3 units each: with
+  ``budget.max_trials = 1e6`` the estimate said about 7.5e6 adjustments of a run that may take
+  3.3e7 (a limit is an upper bound). Now every row is counted at its unit
+  (:func:`sim.mc.workunits.design_estimate`): the study's own estimate went from 1.64e6 to
+  2.18e6 adjustments (its rows ran 24,500 trials, not 220,000: adaptive, they stop early).
 """
 
 from __future__ import annotations
@@ -115,3 +121,22 @@ def test_importing_an_api_module_directly_checks_the_environment(module):
 def test_the_benchmarks_refuse_what_sim_refuses():
     p = _python({"SIM_NO_JIT": "0"}, "-m", "benchmarks", "--help")
     one_line_of(p, "SIM_NO_JIT", prefix="benchmarks: error: ")
+
+
+def _work(capsys, *sets: str) -> tuple[int, float]:
+    from sim.cli import main
+
+    argv = ["check", str(ROOT / "studies" / "brown_design.toml")]
+    assert main([*argv, *(w for kv in sets for w in ("--set", kv))]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("# work: "))
+    trials, _, rest = line.removeprefix("# work: ").partition(" trials")
+    return int(trials.replace(",", "")), float(rest.split("about ")[1].split(" ")[0])
+
+
+def test_the_design_estimate_counts_a_budget_trial_as_its_trials_do(capsys):
+    t0, a0 = _work(capsys, "budget.max_trials=1000")
+    t1, a1 = _work(capsys, "budget.max_trials=1000000")
+    assert t1 - t0 == 11 * 999_000, (t0, t1)  # every budget row up to max_trials
+    # a budget trial costs 3 units, as its bar counts it, and its chunk's 100 units over the
+    # study's 500 trials a chunk (before: 6/11 of a unit and 0.2)
+    assert abs((a1 - a0) / (t1 - t0) - 3.2) < 0.05, (a0, a1, t0, t1)
