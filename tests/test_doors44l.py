@@ -40,9 +40,13 @@ from pathlib import Path
 
 import pytest
 from oneline import SIM_ERROR, one_line_of
+from test_doors39s import NETWORK, _file, _sweep_dir
 
+import sim
 from sim import batch
 from sim.batch_report import rebuild_report
+from sim.report.run_summary import terminal_table
+from sim.studies import get_study
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -140,3 +144,16 @@ def test_the_design_estimate_counts_a_budget_trial_as_its_trials_do(capsys):
     # a budget trial costs 3 units, as its bar counts it, and its chunk's 100 units over the
     # study's 500 trials a chunk (before: 6/11 of a unit and 0.2)
     assert abs((a1 - a0) / (t1 - t0) - 3.2) < 0.05, (a0, a1, t0, t1)
+
+
+def test_a_sweep_over_a_list_that_differs_in_three_places_shows_each_cell_apart(tmp_path):
+    def grids(*n):
+        return [{"prefix": p, "nx": k, "ny": k} for p, k in zip("ABC", n)]
+
+    table = [grids(3, 3, 3), grids(4, 4, 4), grids(4, 3, 4)]  # the last two: their middle
+    net = sim.load(_file(tmp_path, "n.toml", NETWORK)).config
+    values = {"network.grids": [repr(g) for g in table]}  # as sweep.parquet holds a list
+    d = _sweep_dir(tmp_path / "g", net, {"network.grids": table}, ["network.grids"], values)
+    rows = terminal_table(d, get_study=get_study).splitlines()[2:5]
+    shown = [r.split(None, 1)[1] for r in rows]  # each cell's grids, as sim show cuts them
+    assert len(set(shown)) == 3, rows
