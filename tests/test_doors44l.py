@@ -39,7 +39,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from oneline import SIM_ERROR, one_line_of
+from oneline import SIM_ERROR, one_line, one_line_of
 from test_doors39s import NETWORK, _file, _sweep_dir
 
 import sim
@@ -157,3 +157,14 @@ def test_a_sweep_over_a_list_that_differs_in_three_places_shows_each_cell_apart(
     rows = terminal_table(d, get_study=get_study).splitlines()[2:5]
     shown = [r.split(None, 1)[1] for r in rows]  # each cell's grids, as sim show cuts them
     assert len(set(shown)) == 3, rows
+
+
+@pytest.mark.parametrize("link", [os.symlink, os.link])
+def test_one_study_file_under_two_names_in_a_batch_is_refused(tmp_path, capsys, link):
+    a, b = tmp_path / "a.toml", tmp_path / "b.toml"
+    a.write_text(NETWORK, encoding="utf-8")
+    link("a.toml" if link is os.symlink else a, b)
+    res = tmp_path / "res"
+    rc = batch.main(["--results", str(res), str(a), str(b), "--", "--trials", "40"])
+    one_line(capsys, rc, "a.toml and ", "b.toml are one file", "list it once")
+    assert not res.exists()  # before any run
