@@ -47,6 +47,7 @@ from sim import batch
 from sim.batch_report import rebuild_report
 from sim.report.run_summary import terminal_table
 from sim.studies import get_study
+from sim.studies.network.gama_read import read_gama
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -168,3 +169,63 @@ def test_one_study_file_under_two_names_in_a_batch_is_refused(tmp_path, capsys, 
     rc = batch.main(["--results", str(res), str(a), str(b), "--", "--trials", "40"])
     one_line(capsys, rc, "a.toml and ", "b.toml are one file", "list it once")
     assert not res.exists()  # before any run
+
+
+GAMA = """<?xml version="1.0" ?>
+<gama-local xmlns="http://www.gnu.org/software/gama/gama-local">
+  <network axes-xy="ne" angles="left-handed">
+    <parameters sigma-apr="1" sigma-act="apriori" />
+    <points-observations>
+      <point id="A" x="0.0" y="0.0" fix="xy" />
+      <point id="B" x="250.0" y="10.0" fix="xy" />
+      <point id="C" x="240.0" y="260.0" adj="xy" />
+      <point id="D" x="-15.0" y="230.0" adj="xy" />
+      EXTRA
+      <obs from="A">
+        <distance to="C" val="353.836" stdev="2.0" /><distance to="D" val="230.489" stdev="2.0" />
+      </obs>
+      <obs from="B">
+        <distance to="C" val="250.200" stdev="2.0" /><distance to="D" val="322.100" stdev="2.0" />
+      </obs>
+      <obs from="C"><distance to="D" val="256.759" stdev="2.0" /></obs>
+      COORDS
+    </points-observations>
+  </network>
+</gama-local>
+"""
+
+
+def _gama(tmp_path: Path, extra: str = "", coords: str = "") -> Path:
+    (tmp_path / "n.xml").write_text(GAMA.replace("EXTRA", extra).replace("COORDS", coords))
+    f = tmp_path / "n.toml"
+    xml = tmp_path / "n.xml"
+    f.write_text(f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{xml}"\n')
+    return f
+
+
+@pytest.mark.parametrize("adj", ["xy", "XY"])
+def test_an_adj_point_nothing_observes_is_left_out_as_gama_local_does(tmp_path, adj):
+    f = _gama(tmp_path, f'<point id="E" x="100.0" y="100.0" adj="{adj}" />')
+    sim.load(f)  # before: ConfigError, "no observation reaches it"
+    net = read_gama(tmp_path / "n.xml")  # as the run reads it
+    assert [p["name"] for p in net["network.points"]] == ["A", "B", "C", "D"], net
+    assert net["datum.points"] == [] and "left out, as gama-local leaves them: 'E'" in net["note"]
+
+
+COORDINATES = '<coordinates><point id="{}" x="{}" y="{}" /><cov-mat dim="2" band="0">1 1</cov-mat></coordinates>'
+
+
+@pytest.mark.parametrize(
+    ("extra", "coords", "said"),
+    [
+        ("", COORDINATES.format("A", "0.0", "0.0"), "gama-local keeps its observed coordinates"),
+        ('<point id="E" x="9.0" y="9.0" fix="xy" adj="xy" />', "", "gama-local holds it fixed"),
+    ],
+)
+def test_a_fixed_point_gama_local_reads_otherwise_is_one_line_naming_it(
+    tmp_path, capsys, extra, coords, said
+):
+    from sim.cli import main
+
+    f = _gama(tmp_path, extra, coords)
+    one_line(capsys, main(["check", str(f)]), "network.gama_xml", "n.xml", said)
