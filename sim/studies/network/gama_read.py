@@ -341,6 +341,7 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> list[str]:
     # (an adj point with coordinates too: gama-local removes it, "singular coordinates")
     left = [p for p, r in points.items() if p not in seen and r.get("role") in (None, "free")]
     left += [p for p, r in points.items() if p not in seen and "x_mm" not in r and p not in left]
+    declared = dict(points)  # (a name that looks like one left out is still named)
     for pid in left:
         del points[pid]
     for pid, rec in points.items():
@@ -380,7 +381,7 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> list[str]:
     for rec in obs:
         for fld in ("from", "to", "at"):
             if fld in rec and rec[fld] not in points:
-                like = looks_like(rec[fld], points)  # Cyrillic А for A, decomposed É
+                like = looks_like(rec[fld], declared)  # Cyrillic А for A, decomposed É
                 raise ConfigError(
                     key, f"{path}: <{rec['kind']}> {fld}={rec[fld]!r}: no such <point>{like}"
                 )
