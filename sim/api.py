@@ -15,6 +15,9 @@ executors, and the rule that nothing the suite did not write is ever replaced.
 
 from __future__ import annotations
 
+import sim.api_env  # noqa: F401 - the environment, before NumPy and Arrow load
+
+# isort: split
 import contextlib
 import hashlib
 import logging
@@ -300,8 +303,7 @@ class StudyHandle:
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
         out = _absolute("out", out)
-        # the caller's matplotlib and log levels as they were; a failed run's temporary
-        # directory removed, or named when it keeps finished chunks
+        # the caller's matplotlib and log levels kept; a failed run's temp directory removed or named
         with kept(), _loggers_kept(), anonymous_dir(base, out):
             try:
                 execute(

@@ -13,6 +13,9 @@ written over, the provenance, the columns; what a chunk function returns) is in
 
 from __future__ import annotations
 
+import sim.api_env  # noqa: F401 - the environment, before NumPy and Arrow load
+
+# isort: split
 import functools
 import os
 from collections.abc import Mapping

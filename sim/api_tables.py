@@ -8,6 +8,9 @@ it carries no provenance, in ``sim show``'s words."""
 
 from __future__ import annotations
 
+import sim.api_env  # noqa: F401 - the environment, before NumPy and Arrow load
+
+# isort: split
 import sys
 import warnings
 from pathlib import Path

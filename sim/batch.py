@@ -68,7 +68,7 @@ from sim.batch_checks import (  # noqa: E402
     is_current,
     why_stale,
 )
-from sim.batch_report import rebuild_report  # noqa: E402
+from sim.batch_report import not_rebuilt, rebuild_report  # noqa: E402
 from sim.batch_summary import _Stdout, summary  # noqa: E402
 from sim.batch_timings import TimingsLock  # noqa: E402
 from sim.cli_args import module_doc  # noqa: E402
@@ -271,6 +271,7 @@ def main(argv: list[str] | None = None) -> int:
             return code
     except KeyboardInterrupt:  # while it checked its files it said it "resumes the unfinished
         said = {"run": INTERRUPTED, "ended": _ENDED}  # runs" of a batch that had started none
+        said.update({p: f"{_ENDED}; {not_rebuilt(p[7:])}" for p in phase if p[:7] == "report "})
         print(said.get(phase[-1], INTERRUPTED) if phase else NOTHING_RUN, file=sys.stderr)
         return 130
     finally:  # in-process callers (the tests) get their handlers back
@@ -403,18 +404,19 @@ def _run(args, files: list[Path], run_args: list[str], note, loaded, default, ph
         w = getattr(e, "written", None)  # it said nothing of a run's results published meanwhile
         named = f" (the results of {', '.join(w)} were written)" if w else ""
         print(INTERRUPTED + named, file=sys.stderr)
-        if w and args.report:  # (Ctrl-C or SIGTERM again: sim report's own line)
+        if w and args.report:  # (Ctrl-C or SIGTERM again: one line of the report's)
             rebuild_report(Path(args.results))
         return 130
-    phase.append("ended")
     written: list[str] = []
     report = args.report and (not done or any(v[0] == 0 for v in done.values()))
+    phase.append(f"report {args.results}" if report else "ended")  # (the report is due)
     try:
         code = _finish(args, files, done, log, written)
     except KeyboardInterrupt:  # it said "resumes the unfinished runs" of a batch with none
         print(_ENDED + "".join(written), file=sys.stderr)
         code = 130
     rc = rebuild_report(Path(args.results)) if report else 0  # (after its summary line)
+    phase.append("ended")
     return rc if rc == 130 else code or rc
 
 

@@ -101,12 +101,24 @@ def why_stale(
 def _clashes(files: list[Path], run_args: list[str], results: str = "results") -> list[str]:
     """Why these runs cannot share one batch, one line each (every clash, not only the
     first: a batch of many files was refused one clash at a time): two of them would write
-    one results directory (the same file twice, two files of one name), or a file's name is
-    ``.toml`` or ``...toml`` (its results would be <results> itself or its parent)."""
+    one results directory (the same file twice, two files of one name), one file would run
+    twice under two names (a symbolic or hard link beside it: each wrote <results>/<its name>,
+    the same study run twice), or a file's name is ``.toml`` or ``...toml`` (its results would
+    be <results> itself or its parent)."""
     seen: dict[str, Path] = {}
-    out = []
+    out, named = [], {}  # named: the files by their inode, so a link's second name is seen
     for f in files:
-        if f.stem in ("", ".", ".."):
+        try:
+            st = f.stat()
+            other = named.setdefault((st.st_dev, st.st_ino), f)
+        except OSError:  # (said by the file's own check)
+            other = f
+        if other.stem != f.stem:  # two names of one file (a link): the same study run twice
+            out.append(
+                f"{other} and {f} are one file (a link): its study would run twice, into "
+                f"{Path(results) / other.stem} and {Path(results) / f.stem}; list it once"
+            )
+        elif f.stem in ("", ".", ".."):
             out.append(f"{f}: a study file named like this would write <results>/{f.stem}")
         elif f.stem in seen:
             same = f.resolve() == seen[f.stem].resolve()

@@ -8,6 +8,7 @@ run on a path the user did not ask for; and the limit of data a command starts u
 from __future__ import annotations
 
 import os
+import platform
 import re
 import resource
 import sys
@@ -16,6 +17,7 @@ from sim.threads import address_space_problem, single_threaded_blas
 
 __all__ = [
     "MIN_DATA_KB",
+    "arrow_simd_problem",
     "data_limit_problem",
     "environment_problem",
     "numba_variables_problem",
@@ -39,7 +41,8 @@ def refuse_bad_variables(prog: str) -> None:
     if (problem := data_limit_problem()) is not None:
         sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)
-    if (problem := sim_variables_problem() or numba_variables_problem()) is not None:
+    problem = sim_variables_problem() or arrow_simd_problem() or numba_variables_problem()
+    if problem is not None:
         sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)
 
@@ -67,6 +70,7 @@ def environment_problem() -> str | None:
         address_space_problem()
         or data_limit_problem()
         or sim_variables_problem()
+        or arrow_simd_problem()
         or numba_variables_problem()
     )
 
@@ -82,6 +86,33 @@ def sim_variables_problem() -> str | None:
     return (
         f"SIM_NO_JIT: must be 1 (the kernels run as Python) or empty or unset (the compiled "
         f"kernels), got {v[:40]!r}"
+    )
+
+
+#: the levels Arrow's ``ARROW_USER_SIMD_LEVEL`` takes, by machine (its ``cpu_info.cc``,
+#: ``ArchParseUserSimdLevel``, compares the value upper-cased): on another machine any value
+_SIMD_LEVELS = {
+    "x86": ("NONE", "SSE4_2", "AVX", "AVX2", "AVX512"),
+    "arm": ("NONE",),
+}
+
+
+def arrow_simd_problem() -> str | None:
+    """What is wrong with ``ARROW_USER_SIMD_LEVEL``, or None. Arrow reads it at its first
+    compute (a run's first table, not its import): another value (``bogus``, ``avx-2``, an
+    empty one) was a line of Arrow's own ("cpu_info.cc:393: Invalid value for
+    ARROW_USER_SIMD_LEVEL: BOGUS") in the middle of a run, which went on at the level Arrow
+    detected, exit 0. The variable is one of Arrow's levels (any case), or unset."""
+    v = os.environ.get("ARROW_USER_SIMD_LEVEL")
+    m = platform.machine().lower()
+    arch = "x86" if m in ("x86_64", "amd64", "i386", "i686", "x86") else None
+    arch = "arm" if m in ("aarch64", "arm64") else arch
+    if v is None or arch is None or (v.isascii() and v.upper() in _SIMD_LEVELS[arch]):
+        return None
+    levels = [x.lower() for x in _SIMD_LEVELS[arch]]
+    return (
+        f"ARROW_USER_SIMD_LEVEL: must be {', '.join(levels[:-1]) + ' or ' if len(levels) > 1 else ''}"
+        f"{levels[-1]} (Arrow's levels on this machine), or unset, got {v[:40]!r}"
     )
 
 

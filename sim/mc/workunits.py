@@ -216,7 +216,9 @@ def design_estimate(c: Mapping) -> tuple:
         + n_of(c.get("coverage.grids", []))
         + n_of(c.get("coverage.betas_mm", []))
     )
-    budget = 6 * c.get("budget.max_trials", 0)
+    # every budget row up to budget.max_trials at its unit, as the trials count them (6 rows of
+    # one unit were counted: a run of up to 33 units a trial of max_trials was 5.5 times over)
+    budget = DESIGN_BUDGET_ROWS * c.get("budget.max_trials", 0) * DESIGN_UNITS["budget"]
     walker_steps = c.get("bayes.walkers", 0) * c.get("bayes.steps", 0) * c.get("bayes.chains", 0)
     bayes = BAYES_UNITS * walker_steps
     # the trials the run's bar counts, at most: every budget row up to budget.max_trials, the

@@ -34,7 +34,9 @@ def apart(texts: list[str], n: int, dots: str = ELLIPSIS) -> list[str]:
     ends; as much of the shared start kept as fits), ``dots`` in its place, the rest shortened
     keeping both its ends. Swept grids (``[{'prefix': 'G', 'nx': 3, ...}]`` and ``nx = 4``)
     differ in their middle: each label kept both ends of its text, and every tick of
-    ``sweep.png`` read ``"[{'pre…0012}]"``."""
+    ``sweep.png`` read ``"[{'pre…0012}]"``. Texts that still read alike (differing in three
+    places or more, in their middle too) are labelled by the window where they differ
+    (:func:`_unique`)."""
     plain = [middle(t, n, dots) for t in texts]
     if len(set(plain)) == len(plain):
         return plain
@@ -59,6 +61,43 @@ def apart(texts: list[str], n: int, dots: str = ELLIPSIS) -> list[str]:
         core = t[head : len(t) - tail]
         room = n - k * bool(head) - k * bool(tail)
         out.append(dots * bool(head) + middle(core, room, dots) + dots * bool(tail))
+    return _unique(texts, out, n, dots)
+
+
+def _unique(texts: list[str], out: list[str], n: int, dots: str) -> list[str]:
+    """``out`` with the labels two texts share replaced by :func:`_windows` of those texts:
+    cores that differ in three places or more (a swept list's first, middle and last values)
+    kept both their ends, which two of them shared."""
+    groups: dict[str, list[int]] = {}
+    for i, label in enumerate(out):
+        groups.setdefault(label, []).append(i)
+    for same in groups.values():
+        if len(same) > 1 and len({texts[i] for i in same}) == len(same):
+            for i, label in zip(same, _windows([texts[i] for i in same], n, dots)):
+                out[i] = label
+    if len(set(out)) < len(out):  # (windows of different texts that read alike)
+        out = [middle(f"{j + 1}: {t}", n, dots) for j, t in enumerate(texts)]
+    return out
+
+
+def _windows(texts: list[str], n: int, dots: str) -> list[str]:
+    """Labels of at most ``n`` characters of the distinct ``texts``, each the window of its
+    text from where they first differ (from the start of that value), with those that agree
+    there told apart from where they differ next."""
+    at = len(os.path.commonprefix(texts))
+    start = at
+    while start and at - start < n // 2 and texts[0][start - 1] not in _STARTS:
+        start -= 1
+    room = n - len(dots) * (bool(start) + 1)
+    out = [dots * bool(start) + t[start : start + room] for t in texts]
+    out = [o + dots if len(t) - start > room else o for o, t in zip(out, texts)]
+    groups: dict[str, list[int]] = {}
+    for i, label in enumerate(out):
+        groups.setdefault(label, []).append(i)
+    for same in groups.values():
+        if len(same) > 1:  # they agree beyond "at": their next difference is further on
+            for i, label in zip(same, _windows([texts[i] for i in same], n, dots)):
+                out[i] = label
     return out
 
 

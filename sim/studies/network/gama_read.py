@@ -181,7 +181,12 @@ def _point(f: _File, e, points: dict, datum: dict) -> None:
     if "z" in adj.lower():
         raise f.err(e, f"adj={adj!r}: height unknowns are not supported (2-D networks)", "adj")
     if fix and adj and "xy" in fix.lower() and "xy" in adj.lower():
-        raise f.err(e, f"point {pid!r} is both fixed and adjusted in xy", "fix")
+        raise f.err(  # (gama-local: fix wins; a point both is likely a slip of the file)
+            e,
+            f"point {pid!r} is both fixed and adjusted in xy (gama-local holds it fixed): "
+            "give it one of fix and adj",
+            "fix",
+        )
     rec = points.setdefault(pid, {"name": pid})
     if e.get("x") is not None or e.get("y") is not None:
         xy = _xy(f, e)
@@ -323,9 +328,9 @@ def _network(f: _File, data: bytes):
 
 def _resolve(f: _File, points: dict, coords: list, obs: list) -> list[str]:
     """Every point has coordinates and a role; observed coordinates and observations name
-    declared points. A point without coordinates or without a role in xy that nothing
-    observes is left out, as ``gama-local`` leaves it ("Removed points ... missing
-    coordinates"); its name is returned. One that is observed is refused, with what
+    declared points. A point without coordinates, without a role in xy or adjusted that
+    nothing observes is left out, as ``gama-local`` leaves it ("Removed points ... missing
+    coordinates", "singular coordinates": an adj one was refused); its name is returned. One that is observed is refused, with what
     ``gama-local`` does instead."""
     key, path = f.key, f.path
     for pid, _, xy in coords:  # a point's coordinates given only there: gama-local reads them
@@ -333,7 +338,10 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> list[str]:
             points[pid]["x_mm"], points[pid]["y_mm"] = xy
     seen = {rec[k] for rec in obs for k in ("from", "to", "at") if k in rec}
     seen.update(pid for pid, _, _ in coords)
-    left = [p for p, r in points.items() if p not in seen and ("x_mm" not in r or "role" not in r)]
+    # (an adj point with coordinates too: gama-local removes it, "singular coordinates")
+    left = [p for p, r in points.items() if p not in seen and r.get("role") in (None, "free")]
+    left += [p for p, r in points.items() if p not in seen and "x_mm" not in r and p not in left]
+    declared = dict(points)  # (a name that looks like one left out is still named)
     for pid in left:
         del points[pid]
     for pid, rec in points.items():
@@ -358,7 +366,10 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> list[str]:
             )
         if points[pid]["role"] == "fixed":
             raise ConfigError(
-                key, f"{path}: <coordinates>: point {pid!r} is fixed; observe a free point"
+                key,
+                f"{path}: <coordinates>: point {pid!r} is fixed (gama-local keeps its observed "
+                "coordinates as two equations with no unknown, which only add to the degrees of "
+                "freedom; this suite's point is fixed or observed): observe a free point",
             )
         if points[pid]["role"] == "observed":  # gama-local adjusts both observations
             raise ConfigError(
@@ -370,7 +381,7 @@ def _resolve(f: _File, points: dict, coords: list, obs: list) -> list[str]:
     for rec in obs:
         for fld in ("from", "to", "at"):
             if fld in rec and rec[fld] not in points:
-                like = looks_like(rec[fld], points)  # Cyrillic А for A, decomposed É
+                like = looks_like(rec[fld], declared)  # Cyrillic А for A, decomposed É
                 raise ConfigError(
                     key, f"{path}: <{rec['kind']}> {fld}={rec[fld]!r}: no such <point>{like}"
                 )
@@ -426,8 +437,8 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
             f" and {len(left) - 5} more" * (len(left) > 5)
         )
         note += (
-            f"; left out, as gama-local leaves them: {few} (no coordinates or neither fix nor "
-            "adj in xy, and no observation)"
+            f"; left out, as gama-local leaves them: {few} (nothing observes them, and each "
+            "is adj, without coordinates or neither fix nor adj in xy)"
         )
         datum = {p: None for p in datum if p in points}
     return {
