@@ -23,6 +23,11 @@ before its fix.
   to the staging directory's name with them), and a run that finds it held is refused as one
   that finds the staging directory locked: ``--out: res/net is being written by a running sim
   (pid N)`` (sim/mc/swap.py).
+* A run (a sweep) into ``res/net`` while a run into ``res/net/cells/cell0000_r0`` ran was
+  refused as "res/net holds files but no sim run record (run.json); sim never replaces it",
+  naming no run, where the files were that run's locked staging directory. It now names it:
+  ``res/net holds cells/.cell0000_r0.partial, which is being written by a running sim (pid
+  N); wait for it to finish or choose another --out`` (the first words again once it ended).
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ from fuzz_sequence_run import Pause, incomplete, record
 
 import sim.mc.publish as publish_mod
 from sim.cli import main
+from sim.mc.storage import StageLock
 from tests.oneline import SIM_ERROR, one_line
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -89,3 +95,22 @@ def test_a_run_started_while_another_publishes_is_refused(tmp_path, capsys, monk
     assert record(out)["config"]["seed"] == 7 and incomplete(out, set()) is None
     assert not (out / ".lock").exists() and sorted(os.listdir("res")) == ["net"]
     assert main(run) == 0 and record(out)["config"]["seed"] != 7  # the next run runs
+
+
+def test_a_run_into_a_directory_holding_a_running_run_names_it(tmp_path, capsys, monkeypatch):
+    """A sweep into ``res/net`` while a run into ``res/net/cells/cell0000_r0`` runs."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "net.xml").write_bytes(GAMA.read_bytes())
+    (tmp_path / "net.toml").write_text(STUDY)
+    stage = tmp_path / "res" / "net" / "cells" / ".cell0000_r0.partial"
+    lock = StageLock(stage).acquire()  # as the inner run holds it while it runs
+    try:  # before: "res/net holds files but no sim run record (run.json); ..."
+        run = ["run", "net.toml", "--quiet", "--no-figures", "--out", "res/net"]
+        line = one_line(capsys, main(run), prefix=SIM_ERROR)
+    finally:
+        lock.release()
+    assert (
+        f"res/net holds cells/.cell0000_r0.partial, which is being written by a running sim (pid {os.getpid()})"
+        in line
+    )
+    assert "no sim run record" in one_line(capsys, main(run), prefix=SIM_ERROR)  # once it ended

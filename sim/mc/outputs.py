@@ -23,7 +23,7 @@ from sim.mc.config import ConfigError, config_changes
 from sim.mc.paths import is_chunk_store, link_problem, mount_point, mounts_under
 from sim.mc.record_text import finish_words, record_problem
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
-from sim.mc.swap import busy_words, holder, refuse_if_publishing
+from sim.mc.swap import busy_words, holder, refuse_if_publishing, refuse_if_running_under
 from sim.mc.sweep import reordered
 
 __all__ = [
@@ -160,6 +160,7 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
         )
     if old is None:
         if filled:
+            refuse_if_running_under(out, shown)
             raise ConfigError(
                 "--out",
                 f"{shown} holds files but {record_problem(out)}; "  # a damaged one named

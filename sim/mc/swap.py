@@ -12,6 +12,8 @@ the publishing run locks ``<out>/.lock`` of the old results before the swap (it 
 staging directory's name with them) and keeps the lock of its staging directory, which is
 ``<out>/.lock`` after the swap, until its record is final; a run that finds ``<out>/.lock``
 held is refused as one that finds the staging directory locked (:func:`refuse_if_publishing`).
+A directory with no run record of its own that holds a running run's staging directory (a
+run into a directory inside it) is refused naming that run (:func:`refuse_if_running_under`).
 The kernel drops the locks of a killed run: a ``.lock`` file left behind blocks nothing.
 """
 
@@ -27,7 +29,15 @@ from pathlib import Path
 from sim.mc.config import ConfigError
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock
 
-__all__ = ["holder", "hold_old", "refuse_if_publishing", "busy_words", "exchange", "libc"]
+__all__ = [
+    "holder",
+    "hold_old",
+    "refuse_if_publishing",
+    "refuse_if_running_under",
+    "busy_words",
+    "exchange",
+    "libc",
+]
 
 
 def holder(lock: Path) -> tuple[bool, int | None]:
@@ -66,6 +76,17 @@ def refuse_if_publishing(out: Path, shown: str) -> None:
     held, pid = holder(out / LOCK)
     if held and pid != os.getpid():
         raise ConfigError("--out", busy_words(shown, pid))
+
+
+def refuse_if_running_under(out: Path, shown: str) -> None:
+    """Refuse ``out`` (no run record of its own, not empty) while a run writes under it, a run
+    into a directory inside it (its staging directory's ``.lock`` held): it was "holds files
+    but no sim run record", naming no run, as that run went on."""
+    for top, dirs, files in os.walk(out):
+        dirs[:] = [n for n in dirs if not os.path.islink(os.path.join(top, n))]
+        if LOCK in files and (held := holder(Path(top) / LOCK))[0]:
+            where = Path(top).relative_to(out)
+            raise ConfigError("--out", busy_words(f"{shown} holds {where}, which", held[1]))
 
 
 def hold_old(out: Path, shown: str) -> StageLock | None:
