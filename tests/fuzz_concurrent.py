@@ -163,7 +163,7 @@ def run_pair(i: int, seed: int, tmp: Path, refs: References) -> str | None:
     story = f"pair {i} (seed {seed}; res/net: {before}): {a.desc} | {b.desc} ({when})"
     _both(c, a, b, at)
     if getattr(b, "new", None) is not None:  # the edit: a later read sees the new file
-        c.asked.append(b.new)
+        c.asked += [b.new, *(_read_as(a.state, b) if a.state else [])]
         c.model = {**c.model, "trials": 100 - c.model["trials"]} if "toml" in b.desc else c.model
         c.xml = XMLS.index(b.new[1])
     bad = check_pair(c, a, b, old)
