@@ -28,6 +28,12 @@ before its fix.
   naming no run, where the files were that run's locked staging directory. It now names it:
   ``res/net holds cells/.cell0000_r0.partial, which is being written by a running sim (pid
   N); wait for it to finish or choose another --out`` (the first words again once it ended).
+* A sweep whose GNU Gama file (or Wolf table) was saved anew while it ran recorded the cells
+  after it as failed (``feasible`` false, "failed: network.gama_sha256: net.xml has changed
+  ...") and published with exit 0: results of its config that a clean run does not give
+  (``--stale-only`` then called them current). An input file changed since the study was
+  loaded now stops the sweep as a full disk does: one line naming ``network.gama_sha256`` and
+  the file, exit 2, the finished cells kept for the same command (sim/execute_sweep.py).
 """
 
 from __future__ import annotations
@@ -38,6 +44,7 @@ from pathlib import Path
 import pytest
 from fuzz_sequence_run import Pause, incomplete, record
 
+import sim.execute as execute_mod
 import sim.mc.publish as publish_mod
 from sim.cli import main
 from sim.mc.storage import StageLock
@@ -114,3 +121,23 @@ def test_a_run_into_a_directory_holding_a_running_run_names_it(tmp_path, capsys,
         in line
     )
     assert "no sim run record" in one_line(capsys, main(run), prefix=SIM_ERROR)  # once it ended
+
+
+def test_a_sweep_whose_gama_file_changes_between_cells_stops(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "net.xml").write_bytes(GAMA.read_bytes())
+    (tmp_path / "net.toml").write_text(STUDY + "[sweep]\nreliability.power = [0.8, 0.9]\n")
+    real, cells = execute_mod.cell_config, []
+
+    def cell_config(*a, **kw):  # the file saved anew as the first cell ends
+        cells.append(a)
+        if len(cells) == 2:
+            (tmp_path / "net.xml").write_bytes(GAMA.read_bytes().replace(b'"2.0"', b'"2.5"'))
+        return real(*a, **kw)
+
+    monkeypatch.setattr(execute_mod, "cell_config", cell_config)
+    argv = ["run", "net.toml", "--quiet", "--no-figures", "--out", "res/net"]
+    # before: exit 0, the second cell "failed: network.gama_sha256: net.xml has changed ..."
+    line = one_line(capsys, main(argv), "net.xml has changed", prefix=SIM_ERROR)
+    assert len(cells) == 2 and "network.gama_sha256" in line
+    assert not (tmp_path / "res" / "net").exists()
