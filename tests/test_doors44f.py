@@ -34,6 +34,17 @@ before its fix.
   (``--stale-only`` then called them current). An input file changed since the study was
   loaded now stops the sweep as a full disk does: one line naming ``network.gama_sha256`` and
   the file, exit 2, the finished cells kept for the same command (sim/execute_sweep.py).
+
+Held (about 170 pairs, seeds 1-9 of tests/fuzz_concurrent.py and the CONCURRENT cases of
+``make fuzz`` 4411 and 4412): two runs, a run and ``--overwrite``, the API's and the command
+line's, ``--stale-only`` and a run: one ran, the other was refused naming the pid of the lock,
+the other's results or its unfinished run; ``sim show`` during a run printed the claims of a
+run the directory held, or said that a run is writing it; ``sim report`` rewrote the README of
+results published while it wrote them (its READMEs are settled); verify passed only results of
+the study file with their recorded overrides; a sweep and a run into one of its cells: the cell
+run refused as inside a running or finished run; a file of the user's was never lost, and the
+next ``sim run --overwrite`` always ran. ``sim report`` and verify while only a staging
+directory exists say there are no results yet ("a run is writing it now"): true, not a class.
 """
 
 from __future__ import annotations
