@@ -170,6 +170,17 @@ def check(cfg: dict) -> None:
         f"{cfg['marks.placement_sd_mm']:g} mm is more than a quarter of the mark spacing "
         f"{spacing:g} mm: marks would coincide and the affine would be singular",
     )
+    # the detection-power sweep lays its arrays over the same extent with the same scatter: a
+    # 20 x 20 array at 10.5 mm with marks.placement_sd_mm = 12 ran as an "array" (P44)
+    k, sd, ext = max(cfg["power.marks"]), cfg["marks.placement_sd_mm"], cfg["marks.extent_mm"]
+    require(
+        sd <= ext / (k - 1) / 4,
+        "power.marks",
+        f"its {k} x {k} array over marks.extent_mm {ext:g} mm has its marks "
+        f"{ext / (k - 1):g} mm apart, less than four times marks.placement_sd_mm {sd:g} mm: "
+        f"its marks would coincide (compare at most {int(ext / (4 * sd)) + 1 if sd else k} "
+        "marks per side)",
+    )
     require(
         cfg["b8.sigma_um"] * UM <= 0.01 * cfg["marks.extent_mm"],
         "b8.sigma_um",

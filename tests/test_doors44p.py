@@ -1,0 +1,79 @@
+"""Key combinations on salsig_encoders, wolf_polynomial, agnard_block and gridplate_two_plates
+(brief P44: Salsig's encoders against its z scale and marks, Wolf's polynomial against its grid
+and area, Agnard's scanner against its block, the grid plates' weights with few points, region
+keys with trials), about 300 pairs and triples of legal keys at extreme or interacting values
+through ``sim check`` and tiny runs. One case each; each failed on the code before its fix.
+
+* ``wolf_polynomial``: ``plate.spacing_mm`` that does not put grid lines on the edges of
+  ``plate.area_mm`` (25 mm on the paper's -40 to 60 mm: nodes over y -25 to 50 mm; 50 mm:
+  y 0 to 50 mm). The rule that the photograph of Tables 1 and 2 lies inside the calibrated
+  area "(the polynomial is not meant to extrapolate)" compared it with ``plate.area_mm``, not
+  with the grid the polynomial is fitted to, so the photograph's lower 15 mm (at 50 mm: 40
+  mm) and the independent plate's points were corrected by the polynomial extrapolated, and
+  ``sim check`` passed. The photograph and the independent plate's points (the area less 5
+  mm) must now lie inside the grid's nodes, naming ``plate.spacing_mm``
+  (:func:`sim.studies.wolf.checks._photograph`).
+* ``salsig_encoders``: ``marks.placement_sd_mm`` against ``power.marks``. The scatter of the
+  inked marks is held under a quarter of their spacing for ``marks.grid`` ("marks would
+  coincide"), but the detection-power sweep lays each of its arrays over the same extent with
+  the same scatter: at ``marks.placement_sd_mm = 12`` (a quarter of the paper's 50 mm) and
+  ``power.marks = [3, 20]`` the 20 x 20 array, 10.5 mm apart, ran and its power and sigmas
+  were printed as an array's. The largest array compared is held to the same rule, naming
+  ``power.marks`` and the most marks per side the scatter allows
+  (:func:`sim.studies.salsig.schema.check`).
+"""
+
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim.cli import main
+from tests.oneline import SIM_ERROR, one_line
+
+ROOT = Path(__file__).resolve().parent.parent
+WOLF = ROOT / "studies" / "wolf_polynomial.toml"
+SALSIG = ROOT / "studies" / "salsig_encoders.toml"
+
+
+def test_wolf_photograph_beyond_the_grid_nodes_is_refused(capsys):
+    argv = [
+        "check",
+        str(WOLF),
+        "--set",
+        "plate.spacing_mm=25",
+        "--set",
+        "trade.spacings_mm=[20.0,25.0]",
+    ]
+    line = one_line(capsys, main(argv), "plate.spacing_mm", "y -25 to 50 mm", prefix=SIM_ERROR)
+    assert "the photograph" in line and "extrapolated" in line, line
+    # the independent plate's points too, with the photograph moved inside the grid
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(
+            WOLF,
+            plate__spacing_mm=25.0,
+            trade__spacings_mm=[20.0, 25.0],
+            repeat__format_mm=[150.0, 70.0],
+            repeat__centre_mm=[0.0, 12.5],
+        )
+    assert e.value.key == "plate.spacing_mm" and "independent plate" in str(e.value), e.value
+    # an area whose edges lie on the grid still runs: the paper's, and one at 10 mm
+    assert main(["check", str(WOLF), "--set", "plate.spacing_mm=10"]) == 0
+    capsys.readouterr()
+
+
+def test_salsig_power_arrays_closer_than_the_marks_scatter_are_refused(capsys):
+    argv = [
+        "check",
+        str(SALSIG),
+        "--set",
+        "marks.placement_sd_mm=12",
+        "--set",
+        "power.marks=[3,20]",
+    ]
+    line = one_line(capsys, main(argv), "power.marks", "marks.placement_sd_mm", prefix=SIM_ERROR)
+    assert "20 x 20" in line and "at most 5 marks per side" in line, line
+    # the arrays the scatter allows still run
+    argv = ["check", str(SALSIG), "--set", "marks.placement_sd_mm=12", "--set", "power.marks=[3,5]"]
+    assert main(argv) == 0
+    capsys.readouterr()
