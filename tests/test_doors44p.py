@@ -21,6 +21,17 @@ through ``sim check`` and tiny runs. One case each; each failed on the code befo
   were printed as an array's. The largest array compared is held to the same rule, naming
   ``power.marks`` and the most marks per side the scatter allows
   (:func:`sim.studies.salsig.schema.check`).
+* ``gridplate_two_plates``: ``comparator.nonorth_arcsec`` against ``comparator.scale_diff_ppm``
+  (each within its bounds and their sum within the 1 % the decomposition is linearised for).
+  The region of the unprinted inputs explores the scale difference up to 40 ppm with the
+  non-orthogonality in the configured proportion: at 1000 arcsec beside 15 ppm its points
+  reached 2667 arcsec, 1.3 %, and ran past the linearisation ``sim check`` holds the
+  configured comparator to, with no word; past 3600 arcsec (2000 beside 15 ppm, or the
+  default 3.8 arcsec beside ``comparator.scale_diff_ppm = 0.01``) the refusal named
+  ``inputs.scale_diff_at_100mm_um.high`` of the study's own ``region.toml``, not a key the
+  user set. The comparator at the region's largest scale difference is now held to the 1 %,
+  naming the key set and the largest proportion (51.4 arcsec per ppm)
+  (:func:`sim.studies.gridplate.region.check_comparator`).
 """
 
 from pathlib import Path
@@ -34,6 +45,7 @@ from tests.oneline import SIM_ERROR, one_line
 ROOT = Path(__file__).resolve().parent.parent
 WOLF = ROOT / "studies" / "wolf_polynomial.toml"
 SALSIG = ROOT / "studies" / "salsig_encoders.toml"
+GRID = ROOT / "studies" / "gridplate_two_plates.toml"
 
 
 def test_wolf_photograph_beyond_the_grid_nodes_is_refused(capsys):
@@ -76,4 +88,16 @@ def test_salsig_power_arrays_closer_than_the_marks_scatter_are_refused(capsys):
     # the arrays the scatter allows still run
     argv = ["check", str(SALSIG), "--set", "marks.placement_sd_mm=12", "--set", "power.marks=[3,5]"]
     assert main(argv) == 0
+    capsys.readouterr()
+
+
+def test_gridplate_region_comparator_past_the_linearisation_is_refused(capsys):
+    argv = ["check", str(GRID), "--set", "comparator.nonorth_arcsec=1000"]
+    line = one_line(capsys, main(argv), "comparator.nonorth_arcsec: ", prefix=SIM_ERROR)
+    assert "2667 arcsec" in line and "1.3 %" in line and "51.4 arcsec per ppm" in line, line
+    argv = ["check", str(GRID), "--set", "comparator.scale_diff_ppm=0.01"]
+    line = one_line(capsys, main(argv), "comparator.scale_diff_ppm: ", prefix=SIM_ERROR)
+    assert "inputs." not in line, line
+    # a proportion within it runs, of either sign
+    assert main(["check", str(GRID), "--set", "comparator.nonorth_arcsec=-700"]) == 0
     capsys.readouterr()
