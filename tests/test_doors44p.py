@@ -32,6 +32,13 @@ through ``sim check`` and tiny runs. One case each; each failed on the code befo
   user set. The comparator at the region's largest scale difference is now held to the 1 %,
   naming the key set and the largest proportion (51.4 arcsec per ppm)
   (:func:`sim.studies.gridplate.region.check_comparator`).
+* ``salsig_encoders``: ``vertical.extent_mm`` (from 10 mm) against the control errors the
+  region of the vertical test explores (``region.toml``: up to 200 um in z, 50 um in x, y).
+  The configured errors are held within 1 % of the model area ("the conformal fit is
+  meaningless" beyond), but at ``vertical.extent_mm = 10`` the region ran its points at up
+  to 2 % and decided the halving and the "dramatic" improvement over them. The model area
+  must now hold the region's largest errors too (20 mm at least), naming
+  ``vertical.extent_mm`` (:func:`sim.studies.salsig.region.check_vertical`).
 """
 
 from pathlib import Path
@@ -100,4 +107,12 @@ def test_gridplate_region_comparator_past_the_linearisation_is_refused(capsys):
     assert "inputs." not in line, line
     # a proportion within it runs, of either sign
     assert main(["check", str(GRID), "--set", "comparator.nonorth_arcsec=-700"]) == 0
+    capsys.readouterr()
+
+
+def test_salsig_model_area_too_small_for_the_regions_control_errors_is_refused(capsys):
+    argv = ["check", str(SALSIG), "--set", "vertical.extent_mm=10"]
+    line = one_line(capsys, main(argv), "vertical.extent_mm: 10 mm", prefix=SIM_ERROR)
+    assert "up to 200 um" in line and "at least 20 mm" in line, line
+    assert main(["check", str(SALSIG), "--set", "vertical.extent_mm=20"]) == 0
     capsys.readouterr()
