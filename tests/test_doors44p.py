@@ -39,6 +39,13 @@ through ``sim check`` and tiny runs. One case each; each failed on the code befo
   to 2 % and decided the halving and the "dramatic" improvement over them. The model area
   must now hold the region's largest errors too (20 mm at least), naming
   ``vertical.extent_mm`` (:func:`sim.studies.salsig.region.check_vertical`).
+* ``salsig_encoders``: ``vertical.sigma_xy_um`` over 1 % of ``vertical.extent_mm`` (1000 um on
+  a 20 mm model) was refused naming ``vertical.sigma_z_um``, a key at its default; the larger
+  of the two errors is named.
+* ``wolf_polynomial``: ``calib.n_sets`` (or ``plate.spacing_mm``) not among the settings the
+  degree trade-off compares (``calib.n_sets = 50`` beside the default ``trade.n_sets``) was
+  refused naming ``trade.degrees``, a key at its default; the list that lacks the setting is
+  named, with the setting and the list (:func:`sim.studies.wolf.checks._grids`).
 """
 
 from pathlib import Path
@@ -116,3 +123,22 @@ def test_salsig_model_area_too_small_for_the_regions_control_errors_is_refused(c
     assert "up to 200 um" in line and "at least 20 mm" in line, line
     assert main(["check", str(SALSIG), "--set", "vertical.extent_mm=20"]) == 0
     capsys.readouterr()
+
+
+def test_salsig_control_error_names_the_larger_of_its_two_keys(capsys):
+    sets = ["--set", "vertical.extent_mm=20", "--set", "vertical.sigma_xy_um=1000"]
+    one_line(
+        capsys, main(["check", str(SALSIG), *sets]), "vertical.sigma_xy_um: ", prefix=SIM_ERROR
+    )
+    sets[-1] = "vertical.sigma_z_um=1000"
+    one_line(capsys, main(["check", str(SALSIG), *sets]), "vertical.sigma_z_um: ", prefix=SIM_ERROR)
+
+
+def test_wolf_setting_missing_from_the_degree_trade_off_names_its_list(capsys):
+    argv = ["check", str(WOLF), "--set", "calib.n_sets=50"]
+    line = one_line(capsys, main(argv), "trade.n_sets: calib.n_sets = 50", prefix=SIM_ERROR)
+    assert "[1, 2, 3, 6]" in line, line
+    argv = ["check", str(WOLF), "--set", "trade.spacings_mm=[10.0,50.0]"]
+    one_line(capsys, main(argv), "trade.spacings_mm: plate.spacing_mm = 20", prefix=SIM_ERROR)
+    argv = ["check", str(WOLF), "--set", "trade.degrees=[1,2]"]
+    one_line(capsys, main(argv), "trade.degrees: ", "the cubic (3)", prefix=SIM_ERROR)

@@ -201,10 +201,10 @@ def check(cfg: dict) -> None:
         "zscale.sigma_um",
         "exceeds 10 % of zscale.range_mm: the line fit cannot find a scale",
     )
-    require(
-        max(cfg["vertical.sigma_xy_um"], cfg["vertical.sigma_z_um"]) * UM
-        <= 0.01 * cfg["vertical.extent_mm"],
-        "vertical.sigma_z_um",
+    sxy, sz = cfg["vertical.sigma_xy_um"], cfg["vertical.sigma_z_um"]
+    require(  # named by the larger error (vertical.sigma_xy_um = 1000 named sigma_z: P44)
+        max(sxy, sz) * UM <= 0.01 * cfg["vertical.extent_mm"],
+        "vertical.sigma_xy_um" if sxy > sz else "vertical.sigma_z_um",
         "the control error exceeds 1 % of the model area: the conformal fit is meaningless",
     )
     for key in ("b8.sx_mm_per_digit", "b8.sy_mm_per_digit"):

@@ -109,16 +109,20 @@ def _grids(cfg: dict) -> np.ndarray:
     )
     for s in cfg["trade.spacings_mm"]:
         _grid_ok(cfg, s, "trade.spacings_mm")
-    require(
-        3 in cfg["trade.degrees"]
-        and len(set(cfg["trade.degrees"])) >= 2
-        and cfg["plate.spacing_mm"] in cfg["trade.spacings_mm"]
-        and cfg["calib.n_sets"] in cfg["trade.n_sets"],
-        "trade.degrees",
-        "the degree trade-off must compare the cubic (3) with "
-        "another degree at plate.spacing_mm and calib.n_sets (they must be in "
-        "trade.spacings_mm and trade.n_sets): the claim on the cubic reads it",
+    # named by the list that lacks the study's setting (calib.n_sets = 50 beside the default
+    # trade.n_sets named trade.degrees, a key at its default: P44)
+    why = (
+        "the degree trade-off must compare the cubic (3) with another degree at "
+        "plate.spacing_mm and calib.n_sets: the claim on the cubic reads it"
     )
+    degs = cfg["trade.degrees"]
+    require(3 in degs and len(set(degs)) >= 2, "trade.degrees", why)
+    for key, lst in (("plate.spacing_mm", "trade.spacings_mm"), ("calib.n_sets", "trade.n_sets")):
+        require(
+            cfg[key] in cfg[lst],
+            lst,
+            f"{key} = {cfg[key]:g} is not one of {cfg[lst]}: {why}",
+        )
     return g
 
 
