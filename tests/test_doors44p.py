@@ -46,6 +46,11 @@ through ``sim check`` and tiny runs. One case each; each failed on the code befo
   degree trade-off compares (``calib.n_sets = 50`` beside the default ``trade.n_sets``) was
   refused naming ``trade.degrees``, a key at its default; the list that lacks the setting is
   named, with the setting and the list (:func:`sim.studies.wolf.checks._grids`).
+* ``agnard_block``: ``block.scale`` (from 1:100) whose flying height (``block.focal_mm`` x
+  ``block.scale``: 15.2 m at 1:100) the default 20 m of relief exceeds. The block builder's
+  refusal was named ``block.relief_m``, a key at its default, "lower the relief", naming no key
+  the user set; it now names ``block.scale`` when the relief is the default's, and the line
+  gives the relief against the flying height (:func:`sim.studies.agnard.schema._relief_error`).
 """
 
 from pathlib import Path
@@ -60,6 +65,7 @@ ROOT = Path(__file__).resolve().parent.parent
 WOLF = ROOT / "studies" / "wolf_polynomial.toml"
 SALSIG = ROOT / "studies" / "salsig_encoders.toml"
 GRID = ROOT / "studies" / "gridplate_two_plates.toml"
+AGNARD = ROOT / "studies" / "agnard_block.toml"
 
 
 def test_wolf_photograph_beyond_the_grid_nodes_is_refused(capsys):
@@ -142,3 +148,12 @@ def test_wolf_setting_missing_from_the_degree_trade_off_names_its_list(capsys):
     one_line(capsys, main(argv), "trade.spacings_mm: plate.spacing_mm = 20", prefix=SIM_ERROR)
     argv = ["check", str(WOLF), "--set", "trade.degrees=[1,2]"]
     one_line(capsys, main(argv), "trade.degrees: ", "the cubic (3)", prefix=SIM_ERROR)
+
+
+def test_agnard_scale_under_the_relief_names_the_scale(capsys):
+    argv = ["check", str(AGNARD), "--set", "block.scale=100"]
+    line = one_line(capsys, main(argv), "block.scale: ", prefix=SIM_ERROR)
+    assert "20 m of relief" in line and "flying height of 15.2 m" in line, line
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(AGNARD, block__relief_m=500.0, block__scale=1000.0)
+    assert e.value.key == "block.relief_m" and "152 m" in str(e.value), e.value
