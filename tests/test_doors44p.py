@@ -11,8 +11,8 @@ on the code before its fix.
   area "(the polynomial is not meant to extrapolate)" compared it with ``plate.area_mm``, not
   with the grid the polynomial is fitted to, so the photograph's lower 15 and upper 10 mm (at
   50 mm: its lower 40 mm) and the independent plate's points were corrected by the polynomial
-  extrapolated, and ``sim check`` passed. The photograph and the independent plate's points (the area less 5
-  mm) must now lie inside the grid's nodes, naming ``plate.spacing_mm``
+  extrapolated, and ``sim check`` passed. The photograph and the independent plate's points
+  (the area less 5 mm) must now lie inside the grid's nodes, naming ``plate.spacing_mm``
   (:func:`sim.studies.wolf.checks._photograph`).
 * ``salsig_encoders``: ``marks.placement_sd_mm`` against ``power.marks``. The scatter of the
   inked marks is held under a quarter of their spacing for ``marks.grid`` ("marks would
