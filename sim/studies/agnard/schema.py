@@ -281,7 +281,7 @@ def check(cfg: dict) -> None:
     try:
         block = block_of(cfg)
     except ValueError as e:
-        raise ConfigError("block.relief_m", str(e)) from None
+        raise _relief_error(cfg, e) from None
     for key in ("control.table1", "control.few", "control.many"):
         n = control_targets(block, cfg[key]).shape[0]
         if n > block.n_ground:
@@ -310,6 +310,21 @@ def check(cfg: dict) -> None:
             f"{cfg['chunk'] * pairs * 49 * 8 / 1e9:.1f} GB for its normal "
             "equations; lower chunk",
         )
+
+
+def _relief_error(cfg: dict, e: ValueError) -> ConfigError:
+    """The main block's builder's refusal, with the flying height the relief stands against:
+    ``block.scale = 100`` (15.2 m above the ground) was refused as ``block.relief_m`` at its
+    default 20 m, "lower the relief", naming no key the user set (P44)."""
+    relief, h = cfg["block.relief_m"], cfg["block.focal_mm"] * cfg["block.scale"] / 1000.0
+    key = "block.relief_m"
+    if relief == SCHEMA[key].default:  # the relief as it was: the flying height changed
+        key = "block.scale" if cfg["block.scale"] != SCHEMA["block.scale"].default else key
+    return ConfigError(
+        key,
+        f"{e} ({relief:g} m of relief, block.relief_m, under a flying height of {h:g} m, "
+        "block.focal_mm x block.scale); or raise block.scale",
+    )
 
 
 #: the most models (strips x models per strip) of a simulated block: 1000 models see about

@@ -11,12 +11,19 @@ from __future__ import annotations
 from sim.studies import Study, data_check
 from sim.studies.gridplate.beyond import scored_ids
 from sim.studies.gridplate.claims import load_book
-from sim.studies.gridplate.region import DECLARATION, SCALE_DIFF_KEYS, nominal
+from sim.studies.gridplate.region import DECLARATION, SCALE_DIFF_KEYS, check_comparator, nominal
 from sim.studies.gridplate.report import report
 from sim.studies.gridplate.run import run
 from sim.studies.gridplate.schema import SCHEMA, check
 
 SEED = "001_7e3a2951e7fed426.txt"
+
+
+def _check(cfg: dict) -> None:
+    """The schema's cross-key rules, then the comparator the region explores."""
+    check(cfg)
+    check_comparator(cfg)
+
 
 STUDIES = {
     "gridplate_two_plates": Study(
@@ -26,7 +33,7 @@ STUDIES = {
         SCHEMA,
         run,
         report,
-        check,
+        _check,
         order=20,
         data=data_check(
             load_book,

@@ -38,6 +38,7 @@ the rule of every other prediction (:func:`sim.claims.region.region_verdict`).
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +48,7 @@ from sim.claims.book_region import Declaration, load_declaration, plate_ref, sam
 from sim.claims.inference import FAILS, Region, evaluate, explore
 from sim.instruments import transforms2d as t2
 from sim.instruments.plates import grid_points
+from sim.mc.schema_helpers import require
 from sim.studies.gridplate.model import (
     iterations,
     reweight_trials,
@@ -84,6 +86,37 @@ SCALE_DIFF_KEYS = [
     ("comparator.scale_diff_ppm", PPM_PER_UM),
     ("comparator.nonorth_arcsec", _nonorth_per_um),
 ]
+
+
+def check_comparator(cfg: dict) -> None:
+    """The comparator at the region's largest scale difference (``region.toml``'s
+    ``scale_diff_at_100mm_um.high``, 40 ppm) with its non-orthogonality in the configured
+    proportion (:func:`point_cfg`) stays within the 1 % the decomposition is linearised for
+    (:func:`sim.studies.gridplate.schema.check`). A configured proportion of more than about
+    51 arcsec per ppm (``comparator.nonorth_arcsec = 1000`` beside the default 15 ppm, or
+    ``comparator.scale_diff_ppm = 0.01`` beside the default 3.8 arcsec) explored region points
+    past it, and past 3600 arcsec was refused naming ``inputs.scale_diff_at_100mm_um.high`` in
+    ``region.toml``, a file of the study, not the keys set (P44)."""
+    base, eps = cfg["comparator.scale_diff_ppm"], cfg["comparator.nonorth_arcsec"]
+    if not base:  # the region then explores no non-orthogonality (point_cfg)
+        return
+    top = float(tomllib.loads(DECLARATION.read_text())["inputs"]["scale_diff_at_100mm_um"]["high"])
+    ppm = top * PPM_PER_UM
+    arcsec = abs(eps) * ppm / abs(base)
+    share = ppm * 1e-6 + arcsec / 206265
+    # named by the key set: the default non-orthogonality beside a scale difference set small
+    key = "comparator.nonorth_arcsec"
+    key = "comparator.scale_diff_ppm" if eps == SCHEMA[key].default else key
+    require(
+        share <= 0.01,
+        key,
+        f"the region of the unprinted inputs (region.toml) keeps comparator.nonorth_arcsec "
+        f"{eps:g} per comparator.scale_diff_ppm {base:g} ({abs(eps / base):.3g} arcsec per "
+        f"ppm): at its largest scale difference, {ppm:g} ppm, the non-orthogonality is "
+        f"{arcsec:.4g} arcsec, and the two are {share * 100:.3g} %, over the 1 % the "
+        "decomposition is linearised for; keep the proportion at most "
+        f"{(0.01 - ppm * 1e-6) * 206265 / ppm:.3g} arcsec per ppm",
+    )
 
 
 def point_cfg(cfg: dict, x: dict, i: int) -> dict:

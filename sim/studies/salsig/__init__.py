@@ -16,12 +16,19 @@ from sim.studies.salsig.model import (  # noqa: F401
     simulate_vertical,
     simulate_zscale,
 )
-from sim.studies.salsig.region import _KEYS, DECLARATION, nominal
+from sim.studies.salsig.region import _KEYS, DECLARATION, check_vertical, nominal
 from sim.studies.salsig.report import report
 from sim.studies.salsig.run import run
 from sim.studies.salsig.schema import SCHEMA, check
 
 SEED = "002_fb81c7b0481438c4.txt"
+
+
+def _check(cfg: dict) -> None:
+    """The schema's cross-key rules, then the control errors the region explores."""
+    check(cfg)
+    check_vertical(cfg)
+
 
 STUDIES = {
     "salsig_encoders": Study(
@@ -31,7 +38,7 @@ STUDIES = {
         SCHEMA,
         run,
         report,
-        check,
+        _check,
         order=30,
         data=data_check(
             load_book,

@@ -170,6 +170,17 @@ def check(cfg: dict) -> None:
         f"{cfg['marks.placement_sd_mm']:g} mm is more than a quarter of the mark spacing "
         f"{spacing:g} mm: marks would coincide and the affine would be singular",
     )
+    # the detection-power sweep lays its arrays over the same extent with the same scatter: a
+    # 20 x 20 array at 10.5 mm with marks.placement_sd_mm = 12 ran as an "array" (P44)
+    k, sd, ext = max(cfg["power.marks"]), cfg["marks.placement_sd_mm"], cfg["marks.extent_mm"]
+    require(
+        sd <= ext / (k - 1) / 4,
+        "power.marks",
+        f"its {k} x {k} array over marks.extent_mm {ext:g} mm has its marks "
+        f"{ext / (k - 1):g} mm apart, less than four times marks.placement_sd_mm {sd:g} mm: "
+        f"its marks would coincide (compare at most {int(ext / (4 * sd)) + 1 if sd else k} "
+        "marks per side)",
+    )
     require(
         cfg["b8.sigma_um"] * UM <= 0.01 * cfg["marks.extent_mm"],
         "b8.sigma_um",
@@ -190,10 +201,10 @@ def check(cfg: dict) -> None:
         "zscale.sigma_um",
         "exceeds 10 % of zscale.range_mm: the line fit cannot find a scale",
     )
-    require(
-        max(cfg["vertical.sigma_xy_um"], cfg["vertical.sigma_z_um"]) * UM
-        <= 0.01 * cfg["vertical.extent_mm"],
-        "vertical.sigma_z_um",
+    sxy, sz = cfg["vertical.sigma_xy_um"], cfg["vertical.sigma_z_um"]
+    require(  # named by the larger error (vertical.sigma_xy_um = 1000 named sigma_z: P44)
+        max(sxy, sz) * UM <= 0.01 * cfg["vertical.extent_mm"],
+        "vertical.sigma_xy_um" if sxy > sz else "vertical.sigma_z_um",
         "the control error exceeds 1 % of the model area: the conformal fit is meaningless",
     )
     for key in ("b8.sx_mm_per_digit", "b8.sy_mm_per_digit"):
