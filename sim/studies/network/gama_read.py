@@ -57,6 +57,7 @@ from sim.studies.network import gama_vocab as vocab
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
 from sim.studies.network.gama_encoding import EncodingProblem, gama_text
 from sim.studies.network.gama_frames import NE, frame_note
+from sim.studies.network.gama_terms import check_terms
 from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
 from sim.studies.network.gama_vocab import words as _words
 from sim.studies.network.validate import SIGMA_RANGE, looks_like
@@ -421,6 +422,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         else:
             raise f.err(e, "not allowed in <points-observations>")
     left = _resolve(f, points, coords, obs)
+    check_terms(f, net, po, points, obs, (axes, angles))  # gama-local removes: refused
     if left:  # listed, never observed, no coordinates or no role: gama-local removes them
         few = ", ".join(repr(p) for p in left[:5]) + (
             f" and {len(left) - 5} more" * (len(left) > 5)
