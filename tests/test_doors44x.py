@@ -13,6 +13,13 @@ failed on the code before its fix. The tests that run ``gama-local`` skip withou
   (:mod:`sim.studies.network.gama_terms`); 400 random files in all 16 frames, d-m-s and gon,
   with and without orientations, vectors and heights, agreed with ``gama-local`` on what it
   removes.
+* A UTF-16 file declared ``encoding="UTF-16LE"`` or ``"UTF-16BE"`` was read; ``gama-local``
+  2.03 refuses it ("not well-formed": its bundled expat lacks a comma in its table of names,
+  ``"UTF-16BE" "UTF-16LE"``, and reads them as ISO-8859-1), and reads an ASCII file so
+  declared, which the suite refused ("encoding specified in XML declaration is incorrect").
+  Now refused and read as there.
+* A file beginning with a UTF-8 byte-order mark is read, as UTF-8; ``gama-local`` 2.03 stops
+  on every such file (a segmentation fault in its expat). The report's note now says so.
 """
 
 from __future__ import annotations
@@ -99,3 +106,42 @@ def test_the_distance_gama_local_removes_is_the_one_named(tmp_path):
     with pytest.raises(ConfigError, match=r"<distance> attribute 'val' \(to='D'\).* 1500 mm"):
         read_gama(path)
     assert _removed_by_gama(path)
+
+
+def _encoded(xml: str, name: str, codec: str, bom: bytes = b"") -> bytes:
+    return bom + xml.replace(
+        '<?xml version="1.0"?>', f'<?xml version="1.0" encoding="{name}"?>'
+    ).encode(codec)
+
+
+@pytest.mark.parametrize("name", ["UTF-16LE", "utf-16be"])
+def test_utf_16_le_or_be_declared_is_read_as_gama_local_reads_it(tmp_path, name):
+    xml = _file(FIXED)
+    codec = "utf-16-le" if name.lower().endswith("le") else "utf-16-be"
+    path = tmp_path / "n.xml"
+    for bom in (b"", b"\xff\xfe" if codec.endswith("le") else b"\xfe\xff"):
+        path.write_bytes(_encoded(xml, name, codec, bom))
+        with pytest.raises(ConfigError, match=f"'{name}'.*gama-local 2.03 does not know") as e:
+            read_gama(path)
+        assert "\n" not in str(e.value)
+        if gama_local() is not None:
+            run = subprocess.run([gama_local(), str(path)], capture_output=True, text=True)
+            assert "not well-formed" in run.stderr + run.stdout  # its error, as XML
+    path.write_bytes(_encoded(xml, name, "ascii"))  # ASCII bytes: read, as gama-local does
+    plain = tmp_path / "p.xml"
+    plain.write_text(xml)
+    assert read_gama(path)["network.observations"] == read_gama(plain)["network.observations"]
+    path.write_bytes(_encoded(xml, "UTF-16", codec))  # the name gama-local knows
+    assert read_gama(path)["network.observations"] == read_gama(plain)["network.observations"]
+
+
+def test_a_utf_8_byte_order_mark_is_read_and_the_note_says_gama_local_stops_on_it(tmp_path):
+    path = tmp_path / "n.xml"
+    path.write_bytes(b"\xef\xbb\xbf" + _file(FIXED).encode())
+    assert "byte-order mark" in read_gama(path)["note"]
+    path.write_bytes(_file(FIXED).encode())
+    assert "byte-order mark" not in read_gama(path)["note"]
+    if gama_local() is not None:
+        path.write_bytes(b"\xef\xbb\xbf" + _file(FIXED).encode())
+        run = subprocess.run([gama_local(), str(path)], capture_output=True)
+        assert run.returncode != 0  # -11: SIGSEGV

@@ -55,7 +55,7 @@ from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
 from sim.studies.network import gama_vocab as vocab
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
-from sim.studies.network.gama_encoding import EncodingProblem, gama_text
+from sim.studies.network.gama_encoding import EncodingProblem, bom_note, gama_text
 from sim.studies.network.gama_frames import NE, frame_note
 from sim.studies.network.gama_terms import check_terms
 from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
@@ -398,7 +398,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
     note = vocab.parameters_note(f, [e for e in net if _tag(e) == "parameters"])
     axes = ws(net.get("axes-xy", NE[0]))  # gama-local's vocabulary, checked in _network
     angles = ws(net.get("angles", NE[1]))
-    note += frame_note(axes, angles)
+    note += frame_note(axes, angles) + bom_note(data)
     pos = [e for e in net if _tag(e) == "points-observations"]
     if len(pos) != 1:
         raise f.err(net, f"{len(pos)} <points-observations> elements (need one)")
