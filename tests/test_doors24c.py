@@ -125,8 +125,11 @@ def test_a_name_not_found_that_looks_like_a_point_names_the_code_points(tmp_path
 def test_two_gama_ids_that_look_the_same_are_refused_naming_the_file(tmp_path, capsys):
     extra = '<point id="\u0410" x="10.0" y="-50.0" adj="xy"/><point id="B"'
     obs = '<distance to="\u0410" val="1" stdev="2"/><direction to="\u0410" val="1" stdev="2"/>'
-    gama = _gama(
-        tmp_path, ('<point id="B"', extra), ('<distance to="F2"', obs + '<distance to="F2"')
+    gama = _gama(  # val="1": no value of these points, kept under a tol-abs of 1e9 mm
+        tmp_path,
+        ('<point id="B"', extra),
+        ('<distance to="F2"', obs + '<distance to="F2"'),
+        ('sigma-act="apriori"', 'sigma-act="apriori" tol-abs="1e9"'),
     )
     study = tmp_path / "g.toml"
     study.write_text(

@@ -185,7 +185,7 @@ GAMA = """<?xml version="1.0" ?>
         <distance to="C" val="353.836" stdev="2.0" /><distance to="D" val="230.489" stdev="2.0" />
       </obs>
       <obs from="B">
-        <distance to="C" val="250.200" stdev="2.0" /><distance to="D" val="322.100" stdev="2.0" />
+        <distance to="C" val="250.200" stdev="2.0" /><distance to="D" val="344.420" stdev="2.0" />
       </obs>
       <obs from="C"><distance to="D" val="256.759" stdev="2.0" /></obs>
       COORDS

@@ -9,6 +9,7 @@ coordinate no plane grid on the earth reaches."""
 
 from __future__ import annotations
 
+import math
 import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -93,7 +94,8 @@ def test_a_gama_file_in_national_grid_coordinates_is_read(tmp_path):
             for k, (x, y) in pts.items()
         )
         o = "".join(
-            f'<obs from="{s}"><distance to="{t}" val="1" stdev="2"/></obs>'
+            f'<obs from="{s}"><distance to="{t}" val="{math.dist(pts[s], pts[t])!r}" stdev="2"/>'
+            "</obs>"
             for s in pts
             for t in pts
             if s < t

@@ -13,13 +13,15 @@ import re
 
 from sim.studies.network.gama_vocab import said
 
-__all__ = ["gama_text", "EncodingProblem"]
+__all__ = ["gama_text", "EncodingProblem", "bom_note"]
 
 #: the encodings gama-local decodes: expat's own (any case) and its handler's (names compared
 #: exactly), by Python's codec and the bytes its table maps otherwise (cp1250: 0x80 to U+0080,
 #: not the euro sign, its undefined bytes to themselves; cp1251: 0x98 to U+FFFD); any other
 #: name it reads as ISO-8859-1 (``encoding_unknown_handler.cpp``: the identity table)
-_EXPAT_ENC = ("utf-8", "utf-16", "utf-16be", "utf-16le", "iso-8859-1", "us-ascii")
+#: (not "UTF-16LE" nor "UTF-16BE": the expat gama-local 2.03 bundles lacks a comma in its table
+#: of names, ``"UTF-16BE" "UTF-16LE"``, one name "UTF-16BEUTF-16LE"; it reads them as any other)
+_EXPAT_ENC = ("utf-8", "utf-16", "iso-8859-1", "us-ascii")
 _GAMA_ENC = {
     "cp-1250": "cp1250",
     "windows-1250": "cp1250",
@@ -34,6 +36,32 @@ _OWN = {
 _BOM8 = b"\xef\xbb\xbf"
 #: the XML declaration's encoding (a ``<?xml-stylesheet encoding=...?>`` declares nothing)
 _DECL = re.compile(rb"^(?:\xef\xbb\xbf)?<\?xml[ \t\r\n][^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
+
+
+_DECL16 = re.compile(r"^\ufeff?<\?xml[ \t\r\n][^>]*?\bencoding\s*=\s*[\"']([^\"']*)[\"']")
+
+
+def _utf16_name(data: bytes) -> str | None:
+    """The encoding a UTF-16 file's XML declaration names (None: no UTF-16 file, or none)."""
+    head = data[:2048]
+    if head[:2] == b"\xff\xfe" or head[:4] == b"<\0?\0":
+        m = _DECL16.match(head.decode("utf-16-le", "replace"))
+    elif head[:2] == b"\xfe\xff" or head[:4] == b"\0<\0?":
+        m = _DECL16.match(head.decode("utf-16-be", "replace"))
+    else:
+        return None
+    return m.group(1) if m else None
+
+
+def bom_note(data: bytes) -> str:
+    """What the report says of a file that begins with a UTF-8 byte-order mark: read as
+    UTF-8 here, where ``gama-local`` 2.03 stops on it (a segmentation fault in its expat)."""
+    if not data.startswith(_BOM8):
+        return ""
+    return (
+        "; the file begins with a UTF-8 byte-order mark, read as UTF-8 here: gama-local 2.03 "
+        "stops on it (a segmentation fault), remove the mark to run the file there"
+    )
 
 
 class EncodingProblem(ValueError):
@@ -61,8 +89,15 @@ def gama_text(data: bytes) -> bytes | str:
     bytes. Raises :class:`EncodingProblem` where that is not what the file means: a name of
     another encoding (``koi8-r``, ``ISO-8859-2`` in capitals, ``UTF8``, ``CP1250``: Python's
     codec would read other characters than gama-local, and the writer meant those) over bytes
-    beyond ASCII, or a UTF-8 byte-order mark before another declared encoding (gama-local
-    reads the bytes in the declared one: ``É`` of the UTF-8 the mark says is ``Ã‰`` there)."""
+    beyond ASCII, a UTF-8 byte-order mark before another declared encoding (the mark and the
+    declaration disagree: ``É`` of the UTF-8 the mark says is ``Ã‰`` in ISO-8859-1), or a
+    UTF-16 file declared ``UTF-16LE`` or ``UTF-16BE``, names gama-local 2.03 does not know
+    (it refuses the file; over ASCII bytes it reads them, as any other name)."""
+    if (name := _utf16_name(data)) and name.lower() in ("utf-16le", "utf-16be"):
+        raise EncodingProblem(
+            f"<?xml encoding={said(name)}?>: gama-local 2.03 does not know this name (its "
+            'expat knows "UTF-16") and refuses the file as not well-formed: declare UTF-16'
+        )
     m = _DECL.match(data[:1024])
     if not m:
         return data

@@ -55,10 +55,10 @@ from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
 from sim.studies.network import gama_vocab as vocab
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
-from sim.studies.network.gama_encoding import EncodingProblem, gama_text
+from sim.studies.network.gama_encoding import EncodingProblem, bom_note, gama_text
 from sim.studies.network.gama_frames import NE, frame_note
+from sim.studies.network.gama_terms import check_terms
 from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
-from sim.studies.network.gama_vocab import words as _words
 from sim.studies.network.validate import SIGMA_RANGE, looks_like
 
 __all__ = ["read_gama", "read_bytes", "MAX_BYTES", "CC", "NS"]
@@ -71,7 +71,7 @@ def _cov(f: _File, cm, n: int) -> np.ndarray:
         raise f.err(cm, f"dim {dim} and band {band}: need 0 <= band < dim", "band")
     if dim != n:
         raise f.err(cm, f"dim {dim} for {n} observations", "dim")
-    words = _words(cm.text)
+    words = vocab.words(cm.text)
     need = dim * (band + 1) - band * (band + 1) // 2
     if len(words) != need:
         raise f.err(cm, f"{len(words)} numbers for dim {dim}, band {band} (need {need})")
@@ -103,7 +103,7 @@ def _cov(f: _File, cm, n: int) -> np.ndarray:
 
 def _defaults(f: _File, po) -> dict:
     d = {}
-    words = _words(po.get("distance-stdev"))
+    words = vocab.words(po.get("distance-stdev"))
     if len(words) > 3:
         raise f.err(po, "takes 'a [b [c]]' (a + b D^c mm, D in km)", "distance-stdev")
     for w in words:
@@ -408,7 +408,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
     note = vocab.parameters_note(f, [e for e in net if _tag(e) == "parameters"])
     axes = ws(net.get("axes-xy", NE[0]))  # gama-local's vocabulary, checked in _network
     angles = ws(net.get("angles", NE[1]))
-    note += frame_note(axes, angles)
+    note += frame_note(axes, angles) + bom_note(data)
     pos = [e for e in net if _tag(e) == "points-observations"]
     if len(pos) != 1:
         raise f.err(net, f"{len(pos)} <points-observations> elements (need one)")
@@ -432,10 +432,10 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         else:
             raise f.err(e, "not allowed in <points-observations>")
     left = _resolve(f, points, coords, obs)
+    check_terms(f, net, po, points, obs, (axes, angles))  # gama-local removes: refused
     if left:  # listed, never observed, no coordinates or no role: gama-local removes them
-        few = ", ".join(repr(p) for p in left[:5]) + (
-            f" and {len(left) - 5} more" * (len(left) > 5)
-        )
+        more = f" and {len(left) - 5} more" * (len(left) > 5)
+        few = ", ".join(repr(p) for p in left[:5]) + more
         note += (
             f"; left out, as gama-local leaves them: {few} (nothing observes them, and each "
             "is adj, without coordinates or neither fix nor adj in xy)"
