@@ -216,6 +216,7 @@ _COVERAGE_COLS = {
     "c4": "s0_expected",
     "b cov.": "b_coverage",
     "beta cov.": "beta_coverage",
+    "note": "=note",
 }
 
 
