@@ -17,6 +17,20 @@ before its change.
   point-count sweep (every one of 2,000 trials singular, in the committed results) and a
   noise sweep at 1e5 um (no trial converges). Each row now has a ``note`` naming how many
   trials converged and why the others did not (the engine's status), also in README.md.
+* S37: a sweep's cells (each its own seed, spawned) drew the region of the unprinted inputs
+  from that seed, so cells over a key the region does not read explored other regions and a
+  region row could read "holds" in one cell and "depends" in the next. A user comparing cells
+  compares what the swept key changes: the region is a design, not noise, drawn from
+  ``region.seed`` (:func:`sim.mc.schema_helpers.region_seed`; default: the study file's seed,
+  so the committed regions are unchanged), as Brown's ``plate.layout_seed`` draws its plate.
+* The 50-tau rule (:data:`sim.claims.rules.MIN_CHAIN_TAU`) measured chains with emcee's
+  ``integrated_time``, whose per-walker means make it err low near the rule: on AR(1) chains
+  of known tau it passed 44 % of chains 45 tau long and 77 % at 48. tau is now taken about the
+  ensemble's mean (:func:`sim.instruments.ranges.autocorr.ensemble_time`, conservative: 0 %
+  at 45, 0.5 % at 48); emcee's ``c = 10`` passed more short chains and the largest of the
+  walkers' own estimates passed none even at 100 tau (docs/verdict-rules.md has the table).
+  emcee's window rule also gave tau = 1 (the first lag) on a chain shorter than its window:
+  such a chain now gets at least n / 5.
 """
 
 from __future__ import annotations
@@ -98,3 +112,57 @@ def test_a_coverage_row_without_converged_trials_says_why():
         assert row["note"].startswith(want), row["note"]
     out = coverage_chunk(grid_points(5, 45.0), th, 1.0, 0.05, chunk_rng(1, 0, 0), 100)
     assert summarize_cov(out, 1.0, 43)["note"] == ""
+
+
+def _ar1(rng, tau: float, n: int, walkers: int = 32, d: int = 7) -> np.ndarray:
+    """Stationary AR(1) chains of integrated autocorrelation time ``tau``, (n, walkers, d)."""
+    from scipy.signal import lfilter
+
+    phi = (tau - 1) / (tau + 1)
+    e = rng.normal(size=(walkers * d, n)) * np.sqrt(1 - phi**2)
+    x0 = rng.normal(size=walkers * d)
+    x = lfilter([1.0], [1.0, -phi], e, axis=1, zi=(phi * x0)[:, None])[0]
+    return x.reshape(walkers, d, n).transpose(2, 0, 1)
+
+
+def test_the_50_tau_rule_on_chains_of_known_tau():
+    from emcee.autocorr import integrated_time
+
+    from sim.claims.rules import MIN_CHAIN_TAU
+    from sim.instruments.ranges import bayes
+    from sim.instruments.ranges.autocorr import ensemble_time
+
+    rng, tau = np.random.default_rng(44), 10.0
+    short = [_ar1(rng, tau, 45 * int(tau)) for _ in range(20)]  # 45 true tau: too short
+    old = [len(x) / integrated_time(x, tol=0).max() >= MIN_CHAIN_TAU for x in short]
+    new = [len(x) / ensemble_time(x).max() >= MIN_CHAIN_TAU for x in short]
+    assert sum(old) >= 5 and sum(new) == 0, (sum(old), sum(new))
+    long = [_ar1(rng, tau, 80 * int(tau)) for _ in range(5)]  # 80 true tau: decided
+    assert all(len(x) / ensemble_time(x).max() >= MIN_CHAIN_TAU for x in long)
+    # the sampler's chains are measured so (the rule's chain_tau and N_eff)
+    lp = bayes.linear_log_posterior(np.eye(2), np.zeros(2), 1.0)
+    ch = bayes.run_emcee(lp, rng.normal(size=(16, 2)), 400, np.random.SeedSequence(44))
+    kept = ch.samples.reshape(300, 16, 2)
+    np.testing.assert_array_equal(ch.tau, ensemble_time(kept))
+    # a chain shorter than emcee's window (c tau) is not tau = 1 (the first lag)
+    assert ensemble_time(_ar1(rng, 50.0, 100))[0] >= 100 / 5
+
+
+def test_a_sweep_cells_region_is_one_region_whatever_its_seed():
+    """S37: a cell's seed (spawned per cell) drew the region's exploration, so the cells of a
+    sweep over a key the region does not read explored other regions. ``region.seed`` draws it
+    now (default: the study file's seed, the region the committed results explored)."""
+    from sim.studies.brown import region as RG
+
+    def region(**kw):
+        over = {"region.points": 256, "region.rounds": 0, **kw}
+        cfg = sim.load("studies/brown_dilution.toml", **over).config
+        reg, _, verdicts = RG.concept_region(cfg, bc.load_book("brown_dilution"))
+        return np.column_stack([reg.x[k] for k in sorted(reg.x)]), verdicts
+
+    a, va = region(seed=11)
+    b, vb = region(seed=12)
+    assert np.array_equal(a, b) and str(va) == str(vb)
+    c, _ = region(seed=11, **{"region.seed": 7})  # the key chooses another exploration
+    assert not np.array_equal(a, c)
+    assert sim.load("studies/brown_dilution.toml").config["region.seed"] == 1968
