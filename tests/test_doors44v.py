@@ -166,3 +166,11 @@ def test_a_sweep_cells_region_is_one_region_whatever_its_seed():
     c, _ = region(seed=11, **{"region.seed": 7})  # the key chooses another exploration
     assert not np.array_equal(a, c)
     assert sim.load("studies/brown_dilution.toml").config["region.seed"] == 1968
+    # a run record made before the key drew its region from its seed: read so, not as changed
+    from sim.report.config_diff import changed_keys, changes_text
+
+    file = {"seed": 1968, "region.seed": 1968}
+    assert changed_keys({"seed": 1968}, file) == []
+    assert changes_text({"seed": 5}, file) == (
+        "`region.seed` = 5 (the file: 1968), `seed` = 5 (the file: 1968)"
+    )
