@@ -106,7 +106,7 @@ def test_region_keys_are_validated():
 
 
 def _t1_region(n=256, rounds=1):
-    cfg = {"seed": 1967, "region.points": n, "region.rounds": rounds}
+    cfg = {"region.seed": 1967, "region.points": n, "region.rounds": rounds}
     return RG.table1_region(cfg, load_book("brown_table1"))
 
 
@@ -165,7 +165,7 @@ def test_known_edge_note_reads_the_built_comparator_first():
     1 gives: on the outer ring of Table 1's own plate (5 x 5 to +-90 mm) about 0.85 (0.87 at
     stations 5 mm out, 0.84 at 17 mm), and on the format's edge more than 0.9, failing at
     every one of its stations; the Concept's idealised verdict follows."""
-    cfg = {"seed": 1968, "region.points": 256, "region.rounds": 0}
+    cfg = {"region.seed": 1968, "region.points": 256, "region.rounds": 0}
     book = load_book("brown_dilution")
     reg, preds, verdicts = RG.concept_region(cfg, book)
     edge = next(p for p in preds if p.id == "brown.known_edge.ratio")
@@ -301,7 +301,7 @@ def test_pivot_extra_dilution_is_read_with_browns_own_virtually_no_dilution():
     for e, verdict in zip(extra, ("holds", "fails")):
         one = load_book("brown_dilution")  # a book scores each claim once
         assert one.score(cid, value=float(e), interval="exact")["verdict"] == verdict
-    cfg = {"seed": 1968, "region.points": 256, "region.rounds": 1}
+    cfg = {"region.seed": 1968, "region.points": 256, "region.rounds": 1}
     reg, preds, verdicts = RG.concept_region(cfg, book)
     v = verdicts[cid]
     assert v.verdict == "depends" and v.n_holds > 0 and v.n_fails > 0

@@ -108,7 +108,7 @@ def test_emcee_against_the_analytic_linear_posterior_at_the_rules_length():
     ensembles of 16 walkers x 4,000 steps (3,000 kept, about 65 tau): each meets the rule; the
     pooled mean and sd agree with the analytic ones within 4 standard errors from tau; the
     chains' own spread of the sd ratio is within 1.5 of that error per chain (honest, as the
-    rule presumes); on 200 steps the same sampler's tau is underestimated by half."""
+    rule presumes); 200 steps decide nothing."""
     rng = np.random.default_rng(40)
     A = np.column_stack([np.ones(12), np.linspace(-1, 1, 12), np.linspace(-1, 1, 12) ** 2])
     sigma, W, steps = 0.2, 16, 4000
@@ -133,5 +133,7 @@ def test_emcee_against_the_analytic_linear_posterior_at_the_rules_length():
     se_chain = per_chain / np.sqrt(2 * kept * W / np.array([c.tau for c in chs]))
     assert np.all(per_chain.std(0, ddof=1) <= 1.5 * se_chain.mean(0))
     short = bayes.run_emcee(lp, chs[0].samples[:W], 200, np.random.SeedSequence([40, 99]))
-    assert short.tau.max() < 0.5 * np.mean([c.tau.max() for c in chs])
+    # emcee's per-walker estimate gave half the long chains' tau here; about the ensemble's
+    # mean (sim.instruments.ranges.autocorr, doors44v) it is not underestimated so
+    assert short.tau.max() > 0.5 * np.mean([c.tau.max() for c in chs])
     assert (200 - 50) / short.tau.max() < MIN_CHAIN_TAU

@@ -156,7 +156,8 @@ def few_plates(n: int | None) -> str:
 #: the shortest sampler chain (MCMC) a Monte-Carlo interval is decided on, in integrated
 #: autocorrelation times tau of its slowest parameter: emcee's own reliability rule (its
 #: ``integrated_time`` refuses a chain shorter than ``tol = 50`` tau; the suite computes tau
-#: with ``tol = 0`` so that every run reports it). Shorter, tau itself is underestimated, and
+#: itself, about the ensemble's mean, :mod:`sim.instruments.ranges.autocorr`, which errs on the
+#: long side where emcee's errs short). Shorter, tau itself is underestimated, and
 #: so the standard error from ``N_eff = steps x walkers / tau``: brown_design's posterior gave
 #: tau = 27 steps on 375 kept steps, 55 on 1,500 and 73 on 6,000, and at 375 the spread of
 #: 16 independent chains was up to 1.4 times the standard error from tau. Fewer: inconclusive

@@ -29,6 +29,7 @@ from sim.mc.config import ConfigError, Field
 
 __all__ = [
     "count",
+    "region_seed",
     "real",
     "positive",
     "level",
@@ -44,6 +45,23 @@ __all__ = [
 def count(default: int, doc: str, lo: int, hi: int | None = None, *, input: bool = False) -> Field:
     """An integer key in ``[lo, hi]``."""
     return Field(default, "int", doc, lo=lo, hi=hi, input=input)
+
+
+def region_seed(default: int) -> Field:
+    """``region.seed``: the stream of the exploration of a study's unprinted inputs (its
+    space-filling design, refinements and draws), apart from ``seed``. The region is inferred
+    from the paper's printed statements, which neither a sweep's swept key nor ``--seed``
+    changes: drawn from each cell's seed, the cells of a sweep explored other regions, and a
+    region row flipped (holds at 101 points in one cell, depends in the next) with nothing of
+    its inputs swept. ``default``: the study file's ``seed``, which drew it before."""
+    return count(
+        default,
+        "seed of the exploration of the unprinted inputs (the region), apart from seed: --seed, "
+        "replicates and a sweep's cells share one region (sweep this key to see the "
+        f"exploration's spread; {default} is the study file's seed, which drew it before)",
+        lo=0,
+        hi=2**63 - 1,
+    )
 
 
 def real(

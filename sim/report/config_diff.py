@@ -25,10 +25,26 @@ __all__ = ["changed_keys", "changes_text", "design_of", "config_line", "sweep_co
 _NOT_SETTINGS = {"sweep"}
 
 
+#: keys a run record made before they existed lacks, and the key whose value the run used
+#: instead: a run before ``region.seed`` drew its region from its ``seed``
+_BEFORE = {"region.seed": "seed"}
+
+
+def _as_run(mine: Mapping[str, Any], base: Mapping[str, Any]) -> Mapping[str, Any]:
+    """``mine`` with the keys of :data:`_BEFORE` it lacks (and ``base`` has) at what its run
+    used for them."""
+    old = {
+        k: mine[was] for k, was in _BEFORE.items() if k not in mine and k in base and was in mine
+    }
+    return {**mine, **old} if old else mine
+
+
 def changed_keys(mine: Mapping[str, Any], base: Mapping[str, Any]) -> list[str]:
     """The keys whose value in ``mine`` is another than the one in ``base`` (either may lack
     it) as 12 significant digits show them (:func:`sim.mc.numtext.shown`, the rule of the
-    README's inputs table and of ``printed_differs``): a swept 1.1 + 0.6 is a file's 1.7."""
+    README's inputs table and of ``printed_differs``): a swept 1.1 + 0.6 is a file's 1.7. A
+    record made before a key of :data:`_BEFORE` existed is read with what its run used."""
+    mine = _as_run(mine, base)
     keys = sorted((set(mine) | set(base)) - _NOT_SETTINGS)
     return [k for k in keys if shows_differently(mine.get(k), base.get(k))]
 
@@ -45,7 +61,7 @@ def _change(k: str, mine: Mapping[str, Any], base: Mapping[str, Any]) -> str:
 
 def changes_text(mine: Mapping[str, Any], base: Mapping[str, Any], limit: int = 6) -> str:
     """``"`k` = v (the file: w), ..., and N more"``: the first ``limit`` changed keys."""
-    diff = changed_keys(mine, base)
+    diff, mine = changed_keys(mine, base), _as_run(mine, base)
     what = ", ".join(_change(k, mine, base) for k in diff[:limit])
     return what + (f", and {len(diff) - limit} more" if len(diff) > limit else "")
 

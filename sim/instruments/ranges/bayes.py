@@ -28,6 +28,7 @@ import numpy as np
 
 from sim.instruments.ranges import multilateration as ml
 from sim.instruments.ranges import positions as po
+from sim.instruments.ranges.autocorr import ensemble_time
 from sim.instruments.ranges.ensemble import stretch_chain
 
 __all__ = ["Chain", "run_emcee", "brown_log_posterior", "linear_log_posterior"]
@@ -38,7 +39,7 @@ class Chain:
     """Flattened posterior samples ``(N, d)`` after burn-in and thinning, with diagnostics."""
 
     samples: np.ndarray
-    tau: np.ndarray  # integrated autocorrelation time per parameter (steps)
+    tau: np.ndarray  # integrated autocorrelation time per parameter (steps; autocorr.py)
     n_eff: float  # independent samples: kept steps x walkers / max(tau)
     acceptance: float
     steps: int
@@ -61,8 +62,6 @@ def run_emcee(
     step without its per-walker Python loop: the same chain) or ``emcee``
     (``emcee.EnsembleSampler`` itself, the reference).
     """
-    from emcee.autocorr import integrated_time
-
     W, d = p0.shape
     rs = np.random.RandomState(np.random.MT19937(seed))
     if engine == "vectorised":
@@ -78,7 +77,7 @@ def run_emcee(
     else:
         raise ValueError(f"engine must be vectorised or emcee, not {engine!r}")
     burn = steps // 4 if burn is None else burn
-    tau = integrated_time(chain[burn:], tol=0)
+    tau = ensemble_time(chain[burn:])
     kept = chain[burn:].reshape(-1, d)
     n_eff = (steps - burn) * W / float(np.max(tau))
     return Chain(kept, tau, n_eff, float(np.mean(acceptance)), steps, W, burn)

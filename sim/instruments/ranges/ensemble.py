@@ -10,7 +10,7 @@ for the same seed (a test compares them bit for bit). What it leaves out is emce
 Python bookkeeping (a Python loop over the walkers for the acceptance, a ``float`` per
 walker, the generator state copied every step), which costs about a millisecond per step --
 more than the log-probabilities of the suite's posteriors. The autocorrelation time is
-emcee's own (:func:`emcee.autocorr.integrated_time`).
+taken about the ensemble's mean with emcee's window (:mod:`.autocorr`).
 
 Used by :func:`sim.instruments.ranges.bayes.run_emcee` for the cross-checks of seed ``004_f5bd9e86c308241f.txt``
 (Brown 1968) and seed ``001`` (the two-plate variance components). Units: those of the

@@ -147,7 +147,7 @@ def explore_region(
             [Input(i.name, v, v, i.why) if i.name == CENTRES else i for i in dec.inputs],
             dec.statements,
             model,
-            chunk_rng(cfg["seed"], 900, 0),
+            chunk_rng(cfg["region.seed"], 900, 0),
             n=cfg["region.points"],
             rounds=0,
         )
@@ -271,7 +271,7 @@ def explore_scanner(
         dec.inputs,
         dec.statements,
         model,
-        chunk_rng(cfg["seed"], SCANNER_PART - 1, 0),
+        chunk_rng(cfg["region.seed"], SCANNER_PART - 1, 0),
         n=cfg["table1.points"],
         rounds=cfg["table1.rounds"],
     )

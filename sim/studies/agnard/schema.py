@@ -20,7 +20,16 @@ from sim.instruments.block.layout import (
 )
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import unless
-from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, reals
+from sim.mc.schema_helpers import (
+    compared,
+    count,
+    counts,
+    positive,
+    printed,
+    real,
+    reals,
+    region_seed,
+)
 from sim.studies.agnard.centre import check_centre_points
 from sim.studies.agnard.datum import check_datum, region_insets
 from sim.studies.agnard.strips import check_strip_overlap
@@ -215,6 +224,7 @@ SCHEMA = {
         150, "simulated blocks per input vector of the region (region.toml)", 2, 1_000_000
     ),
     "region.points": count(8, "five-point layouts of the region's space-filling design", 2, 64),
+    "region.seed": region_seed(1992),
     "table1.points": count(
         16, "scanner vectors of the Table 1 region's space-filling design (scanner.toml)", 2, 256
     ),

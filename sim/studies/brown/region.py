@@ -78,7 +78,7 @@ CONCEPT_PREDICTIONS = (
 )
 #: the predictions decided over a region on the paper's own setup (Table 1's plate, the
 #: built comparator's format and scale: :mod:`sim.instruments.ranges.brown`), which read no key
-#: of the run's design (only its seed and region sizes): on a run off the paper's setup they
+#: of the run's design (only the region's seed and sizes): on a run off the paper's setup they
 #: stay the paper's verdicts (:func:`sim.claims.rules.off_paper`)
 TABLE1_ON_PAPER = frozenset((*T1_PREDICTIONS, T1_JOINT))
 CONCEPT_ON_PAPER = frozenset(CONCEPT_PREDICTIONS)
@@ -182,7 +182,7 @@ def table1_region(cfg: dict, book):
     cons = [SCALE, printed[CLOSURE]]
     preds = [printed[c] for c in T1_PREDICTIONS]
     names = ("station_offset_mm", "beta_mm", "sigma0_um")
-    rng = chunk_rng(cfg["seed"], 97, 0)
+    rng = chunk_rng(cfg["region.seed"], 97, 0)
     n, rounds = cfg["region.points"], cfg["region.rounds"]
     reg = explore(inputs(names), cons, table1_model, rng, n=n, rounds=rounds, refine_on=preds)
     reg.outputs[T1_JOINT] = _joint(reg, preds)
@@ -242,7 +242,7 @@ def concept_region(cfg: dict, book):
     extent of the 25 points) allowed by the hardware."""
     preds = [statement_of(book, c) for c in CONCEPT_PREDICTIONS]
     names = ("station_offset_mm", "beta_mm", "half_extent_mm")
-    rng = chunk_rng(cfg["seed"], 97, 0)
+    rng = chunk_rng(cfg["region.seed"], 97, 0)
     n, rounds = cfg["region.points"], cfg["region.rounds"]
     reg = explore(
         inputs(names), [SCALE], concept_model, rng, n=n, rounds=rounds, refine_on=preds[:4]

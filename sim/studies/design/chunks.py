@@ -100,6 +100,7 @@ def coverage_chunk(pts, th, sigma_um, alpha_test, rng, T):
         rej = cv.chi2_reject(s0, sigma_um, dof, alpha_test) if dof > 0 else np.zeros(T, bool)
     return {
         "ok": res.status == 0,
+        "status": res.status,
         "cov_known": ink,
         "cov_f": inf_,
         "reject": rej,
@@ -120,6 +121,7 @@ def affine_chunk(grid, sigma_um, aff, alpha_test, rng, n):
         "reject": cv.chi2_reject(r["s0_um"], sigma_um, r["dof"], alpha_test),
         "s0_um": r["s0_um"],
         "ok": np.ones(n, bool),
+        "status": np.zeros(n, np.int8),
         "b_in": np.full(n, np.nan),
         "beta_in": np.full(n, np.nan),
     }

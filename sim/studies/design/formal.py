@@ -16,6 +16,7 @@ import numpy as np
 from sim.instruments.plates import grid_points
 from sim.instruments.ranges import coverage as cv
 from sim.instruments.ranges import multilateration as ml
+from sim.lsq.result import STATUS
 from sim.mc.workunits import DESIGN_UNITS, affine_units
 from sim.studies.design.chunks import affine_chunk, coverage_chunk
 from sim.studies.design.parts import side_by_side
@@ -42,8 +43,25 @@ COLUMNS = (
     "s0_expected",
     "b_coverage",
     "beta_coverage",
+    "note",
 )
 _AFFINE = np.array([[1.00002, 3e-5, 0.01], [-2e-5, 0.99997, -0.02]])
+
+
+def why_not(sim: dict) -> str:
+    """What a case's ``note`` says of its trials that did not converge (``""``: none), by
+    the engine's status (:data:`sim.lsq.result.STATUS`); with fewer than 2 converged its
+    statistics are NaN, and the note says so: a row of NaN says why it has no numbers."""
+    ok, status = sim["ok"], np.asarray(sim["status"])
+    bad = int((~ok).sum())
+    if not bad:
+        return ""
+    N, T = int(ok.sum()), ok.size
+    codes, counts = np.unique(status[~ok], return_counts=True)
+    why = ", ".join(f"{c} {STATUS.get(int(s), f'status {int(s)}')}" for s, c in zip(codes, counts))
+    if N < 2:
+        return f"no statistics: {N} of {T} trials converged ({why})"
+    return f"{bad} of {T} trials did not converge ({why}): the statistics are over the other {N}"
 
 
 def summarize_cov(sim: dict, sigma_um: float, dof: int) -> dict:
@@ -54,8 +72,9 @@ def summarize_cov(sim: dict, sigma_um: float, dof: int) -> dict:
         "nonconverged": int((~ok).sum()),
         "dof": dof,
         "s0_expected": cv.c4(dof + 1) if dof > 0 else np.nan,
+        "note": why_not(sim),
     }
-    if N < 2:  # every trial singular or diverged: recorded, not skipped
+    if N < 2:  # every trial singular or diverged: recorded, not skipped, the note says why
         return base
     s0 = sim["s0_um"][ok] / sigma_um
     return {
@@ -88,7 +107,7 @@ def coverage_analysis(cfg: dict, ctx) -> dict:
         for c, v in zip(COLUMNS[:5], (model, scen, k, sig, beta)):
             cols[c].append(v)
         for c in COLUMNS[5:]:
-            cols[c].append(summ.get(c, np.nan))
+            cols[c].append(summ.get(c, "" if c == "note" else np.nan))
 
     h = cfg["plate.format_mm"] / 2 + cfg["datum.offset_mm"]
     ext = (cfg["datum.grid"] - 1) * cfg["datum.spacing_mm"] / 2

@@ -250,7 +250,7 @@ def tolerance_region(cfg: dict, book):
         _comparator_inputs() + [SIGMA0, PITCH],
         [SCALE, *TABLE1],
         tolerance_model(cfg),
-        chunk_rng(cfg["seed"], 95, 0),
+        chunk_rng(cfg["region.seed"], 95, 0),
         n=cfg["region.points"],
         rounds=cfg["region.rounds"],
         refine_on=preds,
@@ -264,7 +264,7 @@ def plates_region(cfg: dict, book):
         _comparator_inputs() + [SIGMA0, ZEISS, TWO_SCREW],
         PLATE_STATEMENTS,
         plates_model(cfg, book),
-        chunk_rng(cfg["seed"], 96, 0),
+        chunk_rng(cfg["region.seed"], 96, 0),
         n=cfg["region.plate_points"],
         rounds=0,
     )

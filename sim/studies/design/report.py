@@ -216,18 +216,18 @@ _COVERAGE_COLS = {
     "c4": "s0_expected",
     "b cov.": "b_coverage",
     "beta cov.": "beta_coverage",
+    "note": "=note",
 }
 
 
 def _coverage(out: Path) -> list[str]:
     """Formal against empirical coverage (``coverage.parquet``)."""
     c = table(out, "coverage.parquet")
+    # results written before the note column (an older version's run) have none to show
+    cols = {h: k for h, k in _COVERAGE_COLS.items() if k != "=note" or "note" in c}
     return [
         "### Formal against empirical",
-        md_table(
-            list(_COVERAGE_COLS),
-            _columns(c, tuple(_COVERAGE_COLS.values()), range(len(c["model"]))),
-        ),
+        md_table(list(cols), _columns(c, tuple(cols.values()), range(len(c["model"])))),
         figure(out, "coverage.png", "coverage"),
     ]
 

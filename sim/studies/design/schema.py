@@ -12,7 +12,17 @@ from __future__ import annotations
 
 from sim.instruments.ranges import brown as B
 from sim.mc.config import COMMON
-from sim.mc.schema_helpers import compared, count, counts, level, positive, printed, real, reals
+from sim.mc.schema_helpers import (
+    compared,
+    count,
+    counts,
+    level,
+    positive,
+    printed,
+    real,
+    reals,
+    region_seed,
+)
 
 __all__ = ["SEED", "SCHEMA", "MAX_CELLS", "MAX_POINTS", "BETA_MAX_MM"]
 
@@ -309,6 +319,7 @@ SCHEMA = {
         hi=16384,
     ),
     "region.rounds": count(3, "refinement rounds of the tolerance region", lo=0, hi=8),
+    "region.seed": region_seed(1967),
     "region.plate_points": count(
         1024,
         "Sobol design size of the plate region (offset x beta x sigma0 x Zeiss layout x "

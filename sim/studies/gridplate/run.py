@@ -45,7 +45,7 @@ def decide_over_region(
     configured inputs' result kept in the note as an example; for the iterations, the run's
     counts ``gn_iterations``)."""
     region, preds = explore_region(
-        cfg, book, chunk_rng(cfg["seed"], 900, 0), chunk_rng(cfg["seed"], 901, 0)
+        cfg, book, chunk_rng(cfg["region.seed"], 900, 0), chunk_rng(cfg["region.seed"], 901, 0)
     )
     write_region(out / "consistent_region.parquet", region, book, preds, prov)
     fig_region(

@@ -12,7 +12,17 @@ import numpy as np
 
 from sim.mc.config import COMMON
 from sim.mc.gridplate_size import GP_POINT_BYTES, GP_READING_BYTES
-from sim.mc.schema_helpers import compared, count, level, positive, printed, real, reals, require
+from sim.mc.schema_helpers import (
+    compared,
+    count,
+    level,
+    positive,
+    printed,
+    real,
+    reals,
+    region_seed,
+    require,
+)
 
 UM = 1e-3  # mm per um
 #: bytes a chunk may hold (its readings and points: the estimate's measured model, one model)
@@ -112,6 +122,7 @@ SCHEMA = {
         128, "input vectors of the space-filling design (region.toml)", lo=4, hi=65536
     ),
     "region.rounds": count(2, "refinement rounds at the region's boundary", lo=0, hi=6),
+    "region.seed": region_seed(20261122),
     "region.draws": count(
         1000, "simulated calibrations per input vector (chi-square draws)", lo=50, hi=1_000_000
     ),

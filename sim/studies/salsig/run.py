@@ -110,7 +110,7 @@ def run(cfg: dict, out: Path, ctx: RunContext) -> None:
             (F.fig_power, (sw, cfg, out / "power.png")),
         ]
     )
-    region, preds = explore_region(cfg, book, chunk_rng(cfg["seed"], 900, 0))
+    region, preds = explore_region(cfg, book, chunk_rng(cfg["region.seed"], 900, 0))
     write_region(out / "consistent_region.parquet", region, book, preds, prov)
     rows = over_region(book, region, preds, rows, spread_note("models"))
     ex = simulate_chain(cfg, chunk_rng(cfg["seed"], 1, 0), 1, return_all=True)

@@ -19,6 +19,7 @@ from sim.mc.schema_helpers import (
     printed,
     real,
     reals,
+    region_seed,
     require,
 )
 
@@ -130,6 +131,7 @@ SCHEMA = {
     "region.trials": count(
         200, "simulated models per input vector of the region", lo=20, hi=1_000_000
     ),
+    "region.seed": region_seed(20261122),
 }
 
 #: the keys whose default is a number the paper prints for its own setup (seed 002: the B8's

@@ -101,7 +101,7 @@ def explore_region(cfg: dict, book: ClaimBook, ctx) -> tuple[Region, list[str]]:
         calls[0] += 1
         cells = _cells(x, calls[0])
         res = run_part(
-            cfg,
+            {**cfg, "seed": cfg["region.seed"]},  # the region's own stream (region_seed)
             ctx,
             main_chunk(cfg, cells, full=False),
             1 + calls[0],
@@ -115,7 +115,7 @@ def explore_region(cfg: dict, book: ClaimBook, ctx) -> tuple[Region, list[str]]:
         dec.inputs,
         dec.statements,
         model,
-        chunk_rng(cfg["seed"], 900, 0),
+        chunk_rng(cfg["region.seed"], 900, 0),
         n=cfg["region.points"],
         rounds=cfg["region.rounds"],
         per_point=1,

@@ -11,7 +11,16 @@ example.
 from __future__ import annotations
 
 from sim.mc.config import COMMON, Field
-from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, reals
+from sim.mc.schema_helpers import (
+    compared,
+    count,
+    counts,
+    positive,
+    printed,
+    real,
+    reals,
+    region_seed,
+)
 
 __all__ = ["SCHEMA", "SEED"]
 
@@ -274,6 +283,7 @@ SCHEMA = {
         hi=4096,
     ),
     "region.rounds": count(1, "refinement rounds at the region's boundary", lo=0, hi=4),
+    "region.seed": region_seed(20261122),
     "trade.trials": count(400, "trials per cell of the design trade-offs", lo=2, hi=10_000_000),
     "trade.degrees": compared(counts([1, 2, 3, 4, 5], "polynomial degrees compared", lo=1, hi=8)),
     "trade.spacings_mm": compared(
