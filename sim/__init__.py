@@ -14,12 +14,12 @@ import sys as _sys
 
 def _system_pool_under_limits() -> None:
     """Under ``ulimit -v`` or ``-d``, Arrow's tables come from the system's allocator
-    (``ARROW_DEFAULT_MEMORY_POOL=system``, unless the variable is set, not empty), read by Arrow when it
-    loads, so set before: Arrow's default, mimalloc, maps up to 1 GiB of the address space it is
-    given at its first table. A 10,000-point network (0.93 GiB mapped at its peak with the
-    system's) peaked at 1,999,916 kB under ``ulimit -v 2000000``, 84 kB from the limit: the room
-    checked before the run (:mod:`sim.room`) was not there, a Parquet read with no room left
-    for Arrow's threads hung for good, and the API's next run in the process was refused."""
+    (``ARROW_DEFAULT_MEMORY_POOL=system``, unless the variable is set, not empty), read by Arrow
+    when it loads, so set before: Arrow's default, mimalloc, maps up to 1 GiB of the address
+    space it is given at its first table. A 10,000-point network (0.93 GiB mapped at its peak
+    with the system's) peaked at 1,999,916 kB under ``ulimit -v 2000000``, 84 kB from the limit:
+    the room checked before the run (:mod:`sim.room`) was not there, a Parquet read with no room
+    left for Arrow's threads hung for good, and the API's next run in the process was refused."""
     caps = (_resource.getrlimit(r)[0] for r in (_resource.RLIMIT_AS, _resource.RLIMIT_DATA))
     if any(c != _resource.RLIM_INFINITY for c in caps):  # an empty value is Arrow's default
         if not _os.environ.get("ARROW_DEFAULT_MEMORY_POOL"):

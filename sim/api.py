@@ -18,9 +18,7 @@ from __future__ import annotations
 import sim.api_env  # noqa: F401 - the environment, before NumPy and Arrow load
 
 # isort: split
-import contextlib
 import hashlib
-import logging
 import os
 import re
 import tempfile
@@ -36,6 +34,7 @@ from sim.api_args import count as _count
 from sim.api_args import dotted as _key
 from sim.api_args import flag, no_none
 from sim.api_args import keyed as _keyed
+from sim.api_loggers import loggers_kept
 from sim.api_paths import absolute_path as _absolute
 from sim.api_paths import (
     another_run,
@@ -95,8 +94,7 @@ class Results:
 
     path: Path
     study: str
-    #: the identity of the run that returned these Results (:func:`_run_identity`; "": any);
-    #: compared: Results of two runs into one ``out`` (another seed) are not equal
+    #: the run that returned them (:func:`_run_identity`; "" any): two runs into one out differ
     run_sha256: str = field(default="")
 
     def __post_init__(self):  # Results("results/x", "x"): a str is taken as the path
@@ -303,8 +301,8 @@ class StudyHandle:
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
         out = _absolute("out", out)
-        # the caller's matplotlib and log levels kept; a failed run's temp directory removed or named
-        with kept(), _loggers_kept(), anonymous_dir(base, out):
+        # the caller's matplotlib and log levels kept; a failed run's temp dir removed or named
+        with kept(), loggers_kept(), anonymous_dir(base, out):
             try:
                 execute(
                     h.study,
@@ -334,29 +332,6 @@ class StudyHandle:
 
 
 #: the loggers a failed or interrupted Dask run silences (:func:`sim.execute._quiet_dask_logs`)
-_CHATTY = ("asyncio", "distributed", "tornado")
-
-
-@contextlib.contextmanager
-def _loggers_kept():
-    """The levels of the caller's loggers of :data:`_CHATTY` (and below) put back after the
-    run: an interrupted Dask run silences them for the cluster's closing chatter, which in a
-    user's process silenced the user's own ``asyncio`` errors for good. Loggers below them
-    that the run made (its cluster's) stay silenced."""
-    known = logging.root.manager.loggerDict
-    levels = {n: logging.getLogger(n).level for n in _CHATTY}  # NOTSET unless set
-    levels.update(
-        (n, lg.level)
-        for n, lg in list(known.items())
-        if n.split(".")[0] in _CHATTY and isinstance(lg, logging.Logger)
-    )
-    try:
-        yield
-    finally:
-        for n, level in levels.items():
-            logging.getLogger(n).setLevel(level)
-
-
 Results.__init__ = _arguments(Results.__init__)  # type: ignore[method-assign]
 StudyHandle.__init__ = _by_load(StudyHandle.__init__)  # type: ignore[method-assign]
 

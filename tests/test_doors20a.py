@@ -29,7 +29,7 @@ before its fix.
   caller's unguarded script again said only "Nanny failed to start": it asks for the main guard
   (:func:`sim.mc.executors.script_words`);
 * an interrupted Dask run of the API left the caller's ``asyncio``, ``distributed`` and ``tornado``
-  loggers silenced for good (:func:`sim.api._loggers_kept`);
+  loggers silenced for good (:func:`sim.api_loggers.loggers_kept`);
 * a run with ``quiet=False`` while the caller's ``sys.stderr`` was a closed stream failed as
   "the run failed in sim.mc.progress: ValueError: I/O operation on closed file".
 """
