@@ -88,11 +88,13 @@ def _show_guess(typed: str, d: Path) -> str:
     without the config hash of the scratch directory its run went to (``scratch/brown_table1``
     for ``scratch/brown_table1-353c12b0``). Each was "does not exist" with no guess, where
     ``sim run`` and ``sim check`` guess a study file's name (D45). Looked for in the project's
-    ``results/`` and ``scratch/`` (:data:`WHERE`): the directory typed first, then the name
+    ``results/`` and ``scratch/`` (:data:`WHERE`; only the one typed, if any): the name
     itself, then a scratch run of it (the newest), then the closest spelling."""
     stem = Path(typed).name.removesuffix(".toml")
     seen: list[Path] = []
-    for b in WHERE:
+    # a path typed under results/ or scratch/ is guessed there only (a scratch run's typo
+    # is not the committed results)
+    for b in [b for b in WHERE if b.name == Path(typed).parent.name] or WHERE:
         try:
             with os.scandir(base() / b) as it:  # a few hundred runs at most
                 seen += [Path(e.path) for e in itertools.islice(it, 2000) if e.is_dir()]
@@ -103,7 +105,10 @@ def _show_guess(typed: str, d: Path) -> str:
 
     def rank(e: Path) -> tuple:
         kind = 0 if e.name == stem else 1 if e.name.startswith(f"{stem}-") else 2
-        return (e.parent.name != Path(typed).parent.name, kind, -e.stat().st_mtime)
+        try:
+            return (kind, -e.stat().st_mtime)
+        except OSError:  # removed meanwhile
+            return (kind, 0.0)
 
     hits = [e for e in seen if e.name == stem or e.name.startswith(f"{stem}-") or e.name in close]
     hits = [e for e in sorted(hits, key=rank) if os.path.abspath(e) != os.path.abspath(d)]
