@@ -17,6 +17,9 @@ verify STUDY=x``, ``sim`` alone and each ``--help``) were typed in a scratch clo
 * ``make verify VERIFY_FLAGS="--study brown_table1.toml"`` (the study's file, as ``sim run``
   takes it) was "no results of 'brown_table1.toml'" with the list of names: it now says
   ``did you mean --study brown_table1? a study's name, not its file``.
+* ``sim studies/brown_table1.toml`` (the command left out) was argparse's "invalid choice"
+  with the commands and no guess: it now ends ``(a study file: did you mean sim run
+  studies/brown_table1.toml?)`` (:meth:`sim.mc.argv.BoundedParser.explain`).
 """
 
 from __future__ import annotations
@@ -65,3 +68,10 @@ def test_a_project_study_named_from_outside_the_project_is_guessed(tmp_path, mon
 def test_verify_study_given_as_its_file_names_the_study():
     with pytest.raises(VerifyError, match=r"did you mean --study brown_table1\? a study's name"):
         study_dirs(ROOT / "results", ["studies/brown_table1.toml"])
+
+
+@pytest.mark.parametrize("typed", ["studies/brown_table1.toml", "mine.TOML"])
+def test_a_study_file_given_without_a_command_is_guessed_as_sim_run(capsys, typed):
+    one_line(capsys, main([typed]), f"(a study file: did you mean sim run {typed}?)")
+    line = one_line(capsys, main(["rn"]), "(did you mean run?)")  # a command's typo as before
+    assert "a study file" not in line
