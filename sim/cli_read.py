@@ -86,10 +86,15 @@ def _show_guess(typed: str, d: Path) -> str:
     way a new user names it: as its study file (``brown_table1.toml``,
     ``studies/brown_table1.toml``: "is not a directory"), mistyped (``brown_tabel1``), or
     without the config hash of the scratch directory its run went to (``scratch/brown_table1``
-    for ``scratch/brown_table1-353c12b0``). Each was "does not exist" with no guess, where
+    for ``scratch/brown_table1-353c12b0``), or as a file in it (``results/brown_table1/README.md``:
+    ``sim show results/brown_table1 --markdown``). Each was "does not exist" with no guess, where
     ``sim run`` and ``sim check`` guess a study file's name (D45). Looked for in the project's
     ``results/`` and ``scratch/`` (:data:`WHERE`; only the one typed, if any): the name
     itself, then a scratch run of it (the newest), then the closest spelling."""
+    up = Path(os.path.dirname(d))  # a file of a results directory: its README.md, a table
+    if os.path.isfile(d) and ((up / "run.json").is_file() or (up / "claims.parquet").is_file()):
+        markdown = " --markdown" if d.name == "README.md" else ""
+        return f"did you mean sim show {up}{markdown}?"
     stem = Path(typed).name.removesuffix(".toml")
     seen: list[Path] = []
     # a path typed under results/ or scratch/ is guessed there only (a scratch run's typo

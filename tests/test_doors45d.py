@@ -8,7 +8,8 @@ verify STUDY=x``, ``sim`` alone and each ``--help``) were typed in a scratch clo
   file's name: its study file (``sim show brown_table1.toml``, ``sim show
   studies/brown_table1.toml``), a typo (``brown_tabel1``), or the scratch directory its run
   went to without the config hash (``sim show scratch/brown_table1`` for
-  ``scratch/brown_table1-353c12b0``). The line now ends ``did you mean sim show
+  ``scratch/brown_table1-353c12b0``), or a file of it (``results/brown_table1/README.md``:
+  ``sim show results/brown_table1 --markdown``). The line now ends ``did you mean sim show
   results/brown_table1?`` (:func:`sim.cli_read._show_guess`).
 * ``sim run brown_table1`` (or ``sim check``) from a directory of the user's outside the
   project was "no such study file" with no guess (the guess looked only in ``studies/`` here
@@ -43,6 +44,7 @@ ROOT = Path(__file__).resolve().parents[1]
         ("studies/brown_table1.toml", "results/brown_table1"),
         ("brown_tabel1", "results/brown_table1"),
         ("scratch/brown_table1", "scratch/brown_table1-353c12b0"),
+        ("results/brown_table1/README.md", "results/brown_table1 --markdown"),
     ],
 )
 def test_show_of_a_study_file_or_a_near_name_guesses_the_results(
@@ -53,6 +55,7 @@ def test_show_of_a_study_file_or_a_near_name_guesses_the_results(
     (tmp_path / "studies" / "brown_table1.toml").write_text('study = "brown_table1"\n')
     for d in ("results/brown_table1", "scratch/brown_table1-353c12b0"):
         (tmp_path / d / "run.json").write_text("{}")
+    (tmp_path / "results" / "brown_table1" / "README.md").write_text("# a run\n")
     monkeypatch.chdir(tmp_path)
     one_line(capsys, main(["show", typed]), f"did you mean sim show {meant}?")
     one_line(capsys, main(["show", "nothing_like_it"]), "does not exist")  # no guess: none
