@@ -21,6 +21,9 @@ verify STUDY=x``, ``sim`` alone and each ``--help``) were typed in a scratch clo
 * ``sim studies/brown_table1.toml`` (the command left out) was argparse's "invalid choice"
   with the commands and no guess: it now ends ``(a study file: did you mean sim run
   studies/brown_table1.toml?)`` (:meth:`sim.mc.argv.BoundedParser.explain`).
+* README.md and docs/verdicts.md said REPORT.md's first screen gives each paper "three
+  headline claims": it gives up to three, those its claim books mark (Wolf's row one, Salsig's
+  two: :func:`sim.report.glance._headline_pick`). Both now say "up to three".
 """
 
 from __future__ import annotations
@@ -78,3 +81,11 @@ def test_a_study_file_given_without_a_command_is_guessed_as_sim_run(capsys, type
     one_line(capsys, main([typed]), f"(a study file: did you mean sim run {typed}?)")
     line = one_line(capsys, main(["rn"]), "(did you mean run?)")  # a command's typo as before
     assert "a study file" not in line
+
+
+def test_the_pages_say_the_first_screen_gives_up_to_three_headline_claims():
+    for page in (ROOT / "README.md", ROOT / "docs" / "verdicts.md"):
+        text = " ".join(page.read_text(encoding="utf-8").split())
+        assert "three headline" in text and text.count("three headline") == text.count(
+            "up to three headline"
+        ), page
