@@ -5,6 +5,8 @@ it is one line naming it (:func:`sim.cli_errors.not_as_written`)."""
 
 from __future__ import annotations
 
+import difflib
+import itertools
 import os
 import shlex
 import sys
@@ -59,6 +61,8 @@ def show(args) -> int:
             if d.is_absolute() or d.exists() or not where
             else f" (nor is there a directory {' or '.join(str(b / args.dir) for b in where)})"
         )
+        if guess := _show_guess(args.dir, d):  # one bracket: "(nor is ...: did you mean ...?)"
+            also = f"{also[:-1]}: {guess})" if also else f" ({guess})"
         why = link_problem(d) or f"{what}{also}"
         if (run := unfinished(d)) is not None:  # a run killed before it published
             why = f"{what}: {run}"
@@ -75,6 +79,45 @@ def show(args) -> int:
             file=sys.stderr,
         )
     return 0
+
+
+def _show_guess(typed: str, d: Path) -> str:
+    """``did you mean sim show results/brown_table1?`` for a results directory named the
+    way a new user names it: as its study file (``brown_table1.toml``,
+    ``studies/brown_table1.toml``: "is not a directory"), mistyped (``brown_tabel1``), or
+    without the config hash of the scratch directory its run went to (``scratch/brown_table1``
+    for ``scratch/brown_table1-353c12b0``), or as a file in it (``results/brown_table1/README.md``:
+    ``sim show results/brown_table1 --markdown``). Each was "does not exist" with no guess, where
+    ``sim run`` and ``sim check`` guess a study file's name (D45). Looked for in the project's
+    ``results/`` and ``scratch/`` (:data:`WHERE`; only the one typed, if any): the name
+    itself, then a scratch run of it (the newest), then the closest spelling."""
+    up = Path(os.path.dirname(d))  # a file of a results directory: its README.md, a table
+    if os.path.isfile(d) and ((up / "run.json").is_file() or (up / "claims.parquet").is_file()):
+        markdown = " --markdown" if d.name == "README.md" else ""
+        return f"did you mean sim show {up}{markdown}?"
+    stem = Path(typed).name.removesuffix(".toml")
+    seen: list[Path] = []
+    # a path typed under results/ or scratch/ is guessed there only (a scratch run's typo
+    # is not the committed results)
+    for b in [b for b in WHERE if b.name == Path(typed).parent.name] or WHERE:
+        try:
+            with os.scandir(base() / b) as it:  # a few hundred runs at most
+                seen += [Path(e.path) for e in itertools.islice(it, 2000) if e.is_dir()]
+        except OSError:
+            continue
+    seen = [e for e in seen if (e / "run.json").is_file() or (e / "claims.parquet").is_file()]
+    close = difflib.get_close_matches(stem, [e.name for e in seen], n=3, cutoff=0.75)
+
+    def rank(e: Path) -> tuple:
+        kind = 0 if e.name == stem else 1 if e.name.startswith(f"{stem}-") else 2
+        try:
+            return (kind, -e.stat().st_mtime)
+        except OSError:  # removed meanwhile
+            return (kind, 0.0)
+
+    hits = [e for e in seen if e.name == stem or e.name.startswith(f"{stem}-") or e.name in close]
+    hits = [e for e in sorted(hits, key=rank) if os.path.abspath(e) != os.path.abspath(d)]
+    return f"did you mean sim show {shown_path(hits[0])}?" if hits else ""
 
 
 def _shown_text(d: Path, markdown: bool) -> str:

@@ -173,6 +173,10 @@ class BoundedParser(argparse.ArgumentParser):
             # quoted ('run', 'check') up to Python 3.12.7, bare (run, check) since
             choices = [c.strip().strip("'") for c in m.group(2).split(",")]
             close = difflib.get_close_matches(m.group(1), choices, 1)
+            word = m.group(1)
+            if "run" in choices and (word.lower().endswith(".toml") or os.path.isfile(word)):
+                # `sim studies/x.toml`, the command left out: a file is no command (D45)
+                return f"{message} (a study file: did you mean {self.prog} run {word}?)"
             if close:
                 return f"{message} (did you mean {close[0]}?)"
         return message

@@ -47,10 +47,15 @@ def _studies_dirs() -> list[Path]:
     """The ``studies/`` directories a bare name may mean, as typed from here: ``studies``,
     and the project's (:func:`sim.places.base`) from a directory below its root: ``.`` in
     ``studies/``, ``../studies`` from ``docs/`` (a bare name from ``docs/`` was "no such study
-    file" with no guess: D38)."""
-    from sim.places import base, shown_path  # here: sim.places reads sim.mc.config
+    file" with no guess: D38), and from a directory of yours outside the project (no
+    ``studies/`` here) the project's own, by its absolute path (``sim run brown_table1`` from
+    ``~`` was "no such study file" with no guess: D45)."""
+    from sim.places import PROJECT, base, shown_path  # here: sim.places reads sim.mc.config
 
-    return list(dict.fromkeys([Path("studies"), Path(shown_path(base() / "studies"))]))
+    dirs = [Path("studies"), Path(shown_path(base() / "studies"))]
+    if not Path("studies").is_dir() and (PROJECT / "studies").is_dir():
+        dirs.append(PROJECT / "studies")
+    return list(dict.fromkeys(dirs))
 
 
 def _near(p: Path) -> str | None:

@@ -60,10 +60,17 @@ def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path,
                 f"--study: {results / sweeps[0]} holds a sweep's results (sweep.parquet): "
                 "verify re-runs single studies; re-run the sweep with sim run to compare"
             )
-        if unknown:
+        if unknown:  # named as its study file (brown_table1.toml): the name, D45
+            bare = {s: Path(s).name.removesuffix(".toml") for s in unknown}
+            guess = [bare[s] for s in unknown if bare[s] in names]
             raise VerifyError(
                 f"--study: no results of {', '.join(map(repr, unknown))} in {results} "
-                f"(there are: {', '.join(sorted(d.name for d, _ in found))})"
+                + (
+                    f"(did you mean --study {guess[0]}? a study's name, not its file) "
+                    if guess
+                    else ""
+                )
+                + f"(there are: {', '.join(sorted(d.name for d, _ in found))})"
             )
         found = [(d, s) for d, s in found if s in only or d.name in only]
     return found
