@@ -14,7 +14,9 @@ from pathlib import Path
 import numpy as np
 
 from sim.claims.book import ClaimBook, write_claims
+from sim.claims.rules import NOT_APPLICABLE
 from sim.claims.table import Sim, claim_rows, exact
+from sim.studies.network.bias_checks import BIASED_CHECKS
 from sim.studies.network.estimates import McEstimates
 
 __all__ = ["alarm_tol", "design_figures", "network_claims"]
@@ -169,8 +171,31 @@ def _over_all(est: tuple, ok: int, trials: int) -> tuple:
     return v, lo * ok / trials, (hi * ok + trials - ok) / trials
 
 
-def network_claims(out: Path, prov: dict, an, est: McEstimates, cfg: dict, design: dict) -> None:
-    """Score the self-checks and findings of a network study into ``claims.parquet``."""
+def _not_applicable(rows: list[dict], biased: str | None) -> list[dict]:
+    """The rows with the :data:`~sim.studies.network.bias_checks.BIASED_CHECKS` **not
+    applicable** when ``biased`` says why (a bias the adjustment does not absorb), their
+    value and outcome kept and the outcome named in the note."""
+    if biased is None:
+        return rows
+    return [
+        {
+            **r,
+            "verdict": NOT_APPLICABLE,
+            "holds": None,
+            "note": f"{biased}{r['outcome']}; {r['note']}",
+        }
+        if r["claim"] in BIASED_CHECKS
+        else r
+        for r in rows
+    ]
+
+
+def network_claims(
+    out: Path, prov: dict, an, est: McEstimates, cfg: dict, design: dict, biased=None
+) -> None:
+    """Score the self-checks and findings of a network study into ``claims.parquet``;
+    ``biased``: why the checks of unbiased readings are not applicable
+    (:func:`sim.studies.network.bias_checks.bias_effect`), None when they are."""
     checks = _self_checks(cfg["test.alpha"], an.dof)
     finds = _findings(design)
     book = _book(checks, finds)
@@ -194,4 +219,5 @@ def network_claims(out: Path, prov: dict, an, est: McEstimates, cfg: dict, desig
         ),
         **{i: exact(v, note=nt) for i, _, v, nt in finds},
     }
-    write_claims(out / "claims.parquet", claim_rows(book, table), prov, book)
+    rows = _not_applicable(claim_rows(book, table), biased)
+    write_claims(out / "claims.parquet", rows, prov, book)

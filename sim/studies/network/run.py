@@ -21,6 +21,7 @@ from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance
 from sim.report.plotting import draw
 from sim.studies.network.analysis import ellipse, estimated_points, in_datum
+from sim.studies.network.bias_checks import bias_effect
 from sim.studies.network.claims import design_figures, network_claims
 from sim.studies.network.definition import Network, build
 from sim.studies.network.estimates import TOO_FEW, mc_estimates
@@ -140,7 +141,8 @@ def _outputs(out, cfg, full, net, an, dt, C, pts, held, sim, est, prov) -> None:
     }
     write_summary(out, net, an, full, facts, est, prov)  # full: the datum as read
     a95 = K95 * ellipse(an.cov[pts])[0]
-    network_claims(out, prov, an, est, cfg, design_figures(net, an, a95, dil, est))
+    biased = bias_effect(net, an, C, pts, cfg)
+    network_claims(out, prov, an, est, cfg, design_figures(net, an, a95, dil, est), biased)
     draw(
         [
             (network_figure, (net, an, pts, out / "network.png")),
