@@ -369,6 +369,8 @@ def run_sweep(study, cfg: dict, table: Mapping[str, Any], out: Path, ctx) -> dic
             try:
                 ccfg = cell_config(study, cfg, cell, seed)
             except ConfigError as e:
+                if not_the_cells(e):  # an input file changed since the study was loaded
+                    raise
                 row.update(feasible=False, reason=str(e))
                 rows.append(row)
                 continue

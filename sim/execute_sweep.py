@@ -50,11 +50,15 @@ def not_the_cells(e: BaseException) -> bool:
     short (a full disk, ``ulimit -f``), memory, a worker killed, an interrupt inside a library,
     a user's module shadowing one. Such a cell was recorded infeasible ("failed: [Errno 28]
     No space left on device") and the sweep published with exit 0; it now stops the run as
-    it stops a single study's (one line; the finished chunks are kept for the same command)."""
+    it stops a single study's (one line; the finished chunks are kept for the same command).
+    So does an input file of the study (a GNU Gama file, a Wolf table) changed since the study
+    was loaded (its ``...sha256`` key): recorded as the cell's failure, the sweep published
+    with exit 0 results that a clean run of its config does not give."""
     return (
         isinstance(e, (OSError, MemoryError, BrokenExecutor))
         or interrupted(e)
         or shadowed(e) is not None
+        or (isinstance(e, ConfigError) and str(e.key or "").endswith("sha256"))
     )
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import select
 import signal
 import sys
 import time
@@ -26,14 +27,17 @@ NOTES += ("sim verify: re-running ",)  # make verify's progress, on standard err
 
 def _marker(k: int, sig) -> None:
     """At the ``k``-th rename, before it is done: send ``sig`` to this process, or, when
-    ``sig`` is a pair ``(file, bytes)``, write that file (the user saving it as a run runs)."""
+    ``sig`` is a pair ``(file, bytes)``, write that file (the user saving it as a run runs),
+    or, when it is a :class:`Pause`, tell the parent and wait for its word to go on."""
     count = [0]
     real = {"replace": os.replace, "rename": os.rename}
 
     def hook(name):
         def renamed(*a, **kw):
             count[0] += 1
-            if count[0] == k and isinstance(sig, tuple):
+            if count[0] == k and isinstance(sig, Pause):
+                sig.hold()
+            elif count[0] == k and isinstance(sig, tuple):
                 Path(sig[0]).write_bytes(sig[1])
             elif count[0] == k:
                 os.kill(os.getpid(), sig)  # SIGINT/SIGTERM: raised before the next line
@@ -44,9 +48,49 @@ def _marker(k: int, sig) -> None:
     os.replace, os.rename = hook("replace"), hook("rename")
 
 
+class Pause:
+    """A marker that holds the child at its rename until the parent says go (tests/
+    fuzz_concurrent.py: the second process of a pair runs while the first waits there); two
+    pipes, no sleep to order them. ``reached()`` (parent): whether the child ``pid`` got there
+    within ``timeout`` seconds (False: it ended first)."""
+
+    def __init__(self):
+        self.up, self.down = os.pipe(), os.pipe()
+
+    def hold(self) -> None:  # child
+        os.write(self.up[1], b"k")
+        os.read(self.down[0], 1)  # the parent's go, or its end (the pipe closed)
+
+    def reached(self, pid: int, timeout: float) -> bool:  # parent
+        os.close(self.up[1])  # (the child's copy stays open: an end of file is its end)
+        t0 = time.time()
+        while time.time() - t0 < timeout:
+            if select.select([self.up[0]], [], [], 0.05)[0]:
+                return bool(os.read(self.up[0], 1))
+            try:  # ended (its workers may hold the pipe open): a zombie
+                if Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] in "ZX":
+                    return False
+            except OSError:
+                return False
+        return False
+
+    def go(self) -> None:  # parent
+        os.write(self.down[1], b"g")
+        for fd in (*self.up, *self.down):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+
+
 def spawn(cwd: Path, target, log: Path, marker=None, timeout: float = 300.0):
     """``target()`` (an exit code) in a forked child in ``cwd``: ``(code, stdout, stderr)``;
     code ``"timeout"`` past ``timeout`` seconds, ``-N`` killed by signal ``N``."""
+    return wait(start(cwd, target, log, marker), log, timeout)
+
+
+def start(cwd: Path, target, log: Path, marker=None) -> int:
+    """Fork the child that runs ``target()`` (its pid; :func:`wait` for its end)."""
     so, se = log.with_suffix(".out"), log.with_suffix(".err")
     pid = os.fork()
     if pid == 0:  # child
@@ -80,6 +124,12 @@ def spawn(cwd: Path, target, log: Path, marker=None, timeout: float = 300.0):
                 sys.stderr.flush()
             finally:
                 os._exit(code if isinstance(code, int) else 96)
+    return pid
+
+
+def wait(pid: int, log: Path, timeout: float = 300.0):
+    """The end of the child ``pid`` that :func:`start` forked: ``(code, stdout, stderr)``."""
+    so, se = log.with_suffix(".out"), log.with_suffix(".err")
     t0, code = time.time(), "timeout"
     while time.time() - t0 < timeout:
         done, status = os.waitpid(pid, os.WNOHANG)

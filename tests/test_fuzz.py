@@ -41,7 +41,12 @@ by ``sim check`` too (``test_fuzz_splice``: many cases in little time). A SEQUEN
 operations on one small study and one output directory (runs, interrupts at a marker, resumes,
 edits of the study and its Gama file, overrides, ``sim show``, ``sim report``, verify, a sweep,
 ``--stale-only``, hand edits, the API: tests/fuzz_sequence.py) is checked after each step
-(``test_fuzz_sequences``: one sequence a ten cases, at least two; ``FUZZ_SEQ_SECONDS``)."""
+(``test_fuzz_sequences``: one sequence a ten cases, at least two; ``FUZZ_SEQ_SECONDS``). A
+CONCURRENT pair of operations on that study and directory (two runs, a run and ``--overwrite``,
+``sim show``, ``sim report``, verify, ``--stale-only``, the API, a sweep and a run of its cell,
+an edit of the study or Gama file), started at once or the second while the first waits at a
+rename, is checked when both end (tests/fuzz_concurrent.py; ``test_fuzz_concurrent``: one pair
+a seven cases, at least two; ``FUZZ_PAIR_SECONDS``)."""
 
 from __future__ import annotations
 
@@ -52,6 +57,7 @@ import sys
 import pytest
 from fuzz_bytes import csv_sites, gama_sites, mutate_bytes
 from fuzz_cases import SEED
+from fuzz_concurrent import pairs
 from fuzz_keys import network_case
 from fuzz_run import fuzz
 from fuzz_sequence import sequences
@@ -214,6 +220,16 @@ def test_fuzz_sequences(tmp_path):
     n = max(2, CASES // 10)
     failures = sequences(n, SEED, tmp_path)
     assert not failures, f"{len(failures)} of {n} sequences:\n" + "\n".join(failures)
+
+
+def test_fuzz_concurrent(tmp_path):
+    """CONCURRENT (tests/fuzz_concurrent.py): seeded pairs of operations on one output
+    directory at once; after both, each exited 0 or was refused in one line (a run naming the
+    other), and the results are one whole run of a config one of them (or the results before)
+    stood for, equal to its clean run, and the next run of the study file runs."""
+    n = max(2, CASES // 7)
+    failures = pairs(n, SEED, tmp_path)
+    assert not failures, f"{len(failures)} of {n} pairs:\n" + "\n".join(failures)
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz

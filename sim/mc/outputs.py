@@ -12,7 +12,6 @@ wrote and each chunk file's sha256 (sealing and publishing: :mod:`sim.mc.publish
 from __future__ import annotations
 
 import errno
-import fcntl
 import os
 import pwd
 import shutil
@@ -24,6 +23,7 @@ from sim.mc.config import ConfigError, config_changes
 from sim.mc.paths import is_chunk_store, link_problem, mount_point, mounts_under
 from sim.mc.record_text import finish_words, record_problem
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
+from sim.mc.swap import busy_words, holder, refuse_if_publishing, refuse_if_running_under
 from sim.mc.sweep import reordered
 
 __all__ = [
@@ -128,6 +128,7 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
             f"{shown} is a file, not a results directory; sim never "
             "replaces it (choose another --out)",
         )
+    refuse_if_publishing(out, shown)
     if mount_point(out):  # renamed at the run's end: EBUSY after every chunk was computed
         raise ConfigError(
             "--out",
@@ -159,6 +160,7 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
         )
     if old is None:
         if filled:
+            refuse_if_running_under(out, shown)
             raise ConfigError(
                 "--out",
                 f"{shown} holds files but {record_problem(out)}; "  # a damaged one named
@@ -312,12 +314,7 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
     try:
         lock.acquire()
     except Locked as e:
-        who = f"pid {e.pid}" if e.pid else "another process"
-        raise ConfigError(
-            "--out",
-            f"{shown} is being written by a running sim ({who}); wait "
-            "for it to finish or choose another --out",
-        ) from None
+        raise ConfigError("--out", busy_words(shown, e.pid)) from None
     except NotALock as e:
         raise ConfigError(
             "--out",
@@ -328,6 +325,7 @@ def prepare_stage(stage: Path, out: Path, shown: str, record: dict, overwrite: b
             shutil.rmtree(stage, ignore_errors=True)
         raise ConfigError("--out", _not_lockable(stage, out, shown, e)) from None
     try:
+        refuse_if_publishing(out, shown)  # the staging name freed by its swap (sim.mc.swap)
         damage = _damage(stage) if stage.is_dir() else None
         if damage is not None:
             if not overwrite:
@@ -385,36 +383,13 @@ def _uid(p: Path) -> int | None:
         return None
 
 
-def _holder(lock: Path) -> tuple[bool, int | None]:
-    """Whether a process holds the lock ``lock`` that this user may not write (another user's
-    run), and its pid: the lock is tested through a read-only descriptor (a shared lock,
-    dropped at once; never through a link)."""
-    try:
-        fd = os.open(lock, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-    except OSError:
-        return False, None
-    try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            return False, None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-        except BlockingIOError:
-            try:
-                return True, int(os.read(fd, 32).decode().strip() or 0) or None
-            except (OSError, ValueError):
-                return True, None
-        return False, None
-    finally:
-        os.close(fd)
-
-
 def _not_lockable(stage: Path, out: Path, shown: str, e: OSError) -> str:
     """Why the staging directory could not be locked, in words: another user's run writing
     it now, or another user's unfinished run (its staging directory or lock file not ours to
     write: it was "cannot write to <parent>: Permission denied", naming the wrong directory
     and no process), else the directory that could not be written."""
     if e.errno in (errno.EACCES, errno.EPERM) and stage.is_dir() and not stage.is_symlink():
-        held, pid = _holder(stage / LOCK)
+        held, pid = holder(stage / LOCK)
         if held:
             who = f"pid {pid}" if pid else "another process"
             return (

@@ -12,7 +12,6 @@ and refuses when the new run writes a file of a carried entry's name.
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import errno
 import hashlib
 import os
@@ -28,6 +27,9 @@ from sim.mc.paths import mounts_under
 from sim.mc.pids import writer_gone
 from sim.mc.runner import ChunkStore
 from sim.mc.storage import LOCK, read_record, read_table, write_record
+from sim.mc.swap import exchange as _exchange
+from sim.mc.swap import hold_old
+from sim.mc.swap import libc as _libc  # noqa: F401 - tests ask it whether renameat2 exists
 from sim.mc.table_shape import SHAPE_KEY, shape
 
 __all__ = ["seal", "publish", "damaged_chunks", "changed_figure", "drawn", "file_sha256"]
@@ -339,40 +341,21 @@ def _present(p: Path) -> bool:
     return p.is_symlink() or p.exists()
 
 
-#: renameat2(2)'s flag that swaps two paths in one step (Linux 3.15, glibc 2.28)
-_RENAME_EXCHANGE, _AT_FDCWD = 2, -100
-
-
-def _exchange(a: Path, b: Path) -> bool:
-    """Swap the directories ``a`` and ``b`` in one step where the system can (False: it
-    cannot, and nothing was done). Moving the old results aside and the new ones in by two
-    renames left ``out`` absent for an instant, in which ``sim report`` or ``make verify`` in
-    another terminal found no results of that study (and a README.md written into it then
-    made an empty directory in its place, which the second rename could not replace)."""
-    fn = getattr(_libc(), "renameat2", None)
-    if fn is None:
-        return False
-    fn.argtypes = (ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint)
-    enc = [os.fsencode(str(p)) for p in (a, b)]
-    if fn(_AT_FDCWD, enc[0], _AT_FDCWD, enc[1], _RENAME_EXCHANGE) == 0:
-        return True
-    err = ctypes.get_errno()
-    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP, errno.EPERM, errno.EXDEV):
-        return False  # an older kernel, a file system without it (a FUSE mount, NFS; EXDEV:
-        # an overlay, whose directories of a lower layer cannot be renamed)
-    raise OSError(err, os.strerror(err), str(b))
-
-
-def _libc():
-    try:
-        return ctypes.CDLL(None, use_errno=True)
-    except OSError:
-        return None
-
-
 def publish(stage: Path, out: Path) -> None:
     """Replace ``out`` (checked: ours or absent) by the finished staging directory, keeping the
-    files in ``out`` that the suite did not write."""
+    files in ``out`` that the suite did not write; ``<out>/.lock`` is held throughout (the old
+    results' and then the staging directory's, :mod:`sim.mc.swap`) and removed at the end."""
+    held = hold_old(out, str(out)) if out.is_dir() and not out.is_symlink() else None
+    try:
+        _publish(stage, out)
+    finally:
+        with contextlib.suppress(OSError):  # (EIO, EACCES: a published run does not fail for
+            (out / LOCK).unlink(missing_ok=True)  # it; the next run ignores it) still held
+        if held is not None:
+            held.release()
+
+
+def _publish(stage: Path, out: Path) -> None:
     for tmp in stage.rglob("*.tmp"):
         tmp.unlink(missing_ok=True)
     keep = _foreign(out) if out.is_dir() else []
@@ -428,8 +411,6 @@ def publish(stage: Path, out: Path) -> None:
             _remove_in_place(out)
             old = None
         os.replace(stage, out)
-    with contextlib.suppress(OSError):  # (EIO, EACCES: a published run does not fail for it;
-        (out / LOCK).unlink(missing_ok=True)  # the next run ignores it) we still hold it
     _drop_stale_swaps(out, old)
     if old is not None:
         _remove_record_last(old)
