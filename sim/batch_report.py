@@ -15,6 +15,7 @@ from __future__ import annotations
 import signal
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 from sim.mc.children import STOP_SIGNALS, child_env, stop_children
@@ -29,16 +30,18 @@ def rebuild_report(results: Path) -> int:
     is waited for (``REPORT.md`` written whole or not at all) and said in one line, 130 (the
     batch's own line did not say that the report was left as it was)."""
     cmd = [sys.executable, "-m", "sim", "report", f"--results={results}"]  # (a name "-r")
-    try:
-        proc = subprocess.Popen(cmd, env=child_env(), preexec_fn=_stoppable)
-    except OSError as e:  # no process to be had (ulimit -u): one line
+    try:  # its standard error kept until it ends (a file: it never waits on a pipe)
+        with tempfile.TemporaryFile() as err:
+            code = _report(cmd, err)
+            err.seek(0)
+            said = err.read().decode(getattr(sys.stderr, "encoding", None) or "utf-8", "replace")
+    except OSError as e:  # no process to be had (ulimit -u), no file: one line
         print(f"sim.batch: --report: cannot start sim report: {e.strerror or e}", file=sys.stderr)
         return 2
-    try:
-        code = proc.wait()
-    except KeyboardInterrupt:  # Ctrl-C reached it too; SIGTERM (to the batch) is passed on
-        stop_children([proc])
-        code = 130
+    if code == 130:  # its own "sim: interrupted" left out: the batch's line says what it was
+        said = "".join(ln for ln in said.splitlines(True) if not ln.startswith("sim: interrupted"))
+    sys.stderr.write(said)
+    sys.stderr.flush()
     if code == 130:  # (an interrupted batch ignores a second Ctrl-C: the report alone ends)
         print(
             f"sim.batch: interrupted while sim report rebuilt {results / 'REPORT.md'}, which "
@@ -46,6 +49,18 @@ def rebuild_report(results: Path) -> int:
             file=sys.stderr,
         )
     return code if code >= 0 else 1  # killed by a signal (the OOM killer)
+
+
+def _report(cmd: list[str], err) -> int:
+    """Run ``cmd`` (``sim report``) with its standard error into the file ``err``; its exit
+    code, 130 when an interrupt reached it (Ctrl-C) or was passed on to it (SIGTERM): it is
+    waited for, so ``REPORT.md`` is written whole or not at all."""
+    proc = subprocess.Popen(cmd, env=child_env(), stderr=err, preexec_fn=_stoppable)
+    try:
+        return proc.wait()
+    except KeyboardInterrupt:  # Ctrl-C reached it too; SIGTERM (to the batch) is passed on
+        stop_children([proc])
+        return 130
 
 
 def _stoppable() -> None:
