@@ -8,15 +8,28 @@ failed on the code before its fix.
   The report's standard error is now kept until it ends and passed on, its interrupt line
   left out when it was interrupted (the batch's line says it): one line, exit 130
   (:mod:`sim.batch_report`).
+* A signal to ``python -m sim.batch --stale-only`` while it asked which studies are current
+  (each study's tables and figures hashed against its run record: seconds for the project's
+  results) said "interrupted; the same command again resumes the unfinished runs" of a batch
+  that had started none. It says ``sim.batch: interrupted before any run started: nothing was
+  run``, as while it checked its files; so does one after those checks, before the first run
+  started.
 """
 
 from __future__ import annotations
 
+import os
+import shutil
+import signal
 import sys
+from pathlib import Path
 
+import sim.batch
 import sim.batch_report as br
 from sim.batch_report import rebuild_report
 from tests.oneline import one_line
+
+ROOT = Path(__file__).resolve().parent.parent
 
 #: a ``sim report`` that an interrupt ended: its own line, its exit code
 INTERRUPTED_REPORT = "import sys; sys.stderr.write('sim: interrupted\\n'); sys.exit(130)"
@@ -31,3 +44,20 @@ def test_a_report_interrupted_by_the_batch_is_said_in_one_line(tmp_path, monkeyp
     )
     # before: "sim: interrupted" and then the batch's line
     one_line(capfd, rebuild_report(tmp_path / "res"), "which is as it was", code=130)
+
+
+def test_a_batch_interrupted_while_it_asks_which_studies_are_current_says_nothing_ran(
+    tmp_path, monkeypatch, capsys
+):
+    plate = tmp_path / "network_plate.toml"
+    shutil.copyfile(ROOT / "studies" / plate.name, plate)
+
+    def asking(*a, **k):
+        os.kill(os.getpid(), signal.SIGTERM)  # handled before the next line of Python runs
+        raise AssertionError("not interrupted")
+
+    monkeypatch.setattr(sim.batch, "why_stale", asking)
+    argv = [str(plate), "--stale-only", "--results", str(tmp_path / "r"), "--", "--trials", "40"]
+    # before: "sim.batch: interrupted; the same command again resumes the unfinished runs"
+    line = one_line(capsys, sim.batch.main(argv), code=130)
+    assert line == sim.batch.NOTHING_RUN and not (tmp_path / "r").exists()
