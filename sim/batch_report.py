@@ -25,19 +25,25 @@ __all__ = ["rebuild_report"]
 
 def rebuild_report(results: Path) -> int:
     """Run ``sim report --results RESULTS`` (its lines go to this process's standard output
-    and error, as make's own command's did); its exit code (2 with one line when it cannot
+    and error, as make's own command's did: its standard error once it ended, so that an
+    interrupt is said in the batch's one line, not also in the report's); its exit code (2 with one line when it cannot
     start). An interrupt while it runs reaches it too (Ctrl-C) or is passed on (SIGTERM): it
     is waited for (``REPORT.md`` written whole or not at all) and said in one line, 130 (the
     batch's own line did not say that the report was left as it was)."""
     cmd = [sys.executable, "-m", "sim", "report", f"--results={results}"]  # (a name "-r")
     try:  # its standard error kept until it ends (a file: it never waits on a pipe)
-        with tempfile.TemporaryFile() as err:
-            code = _report(cmd, err)
-            err.seek(0)
-            said = err.read().decode(getattr(sys.stderr, "encoding", None) or "utf-8", "replace")
-    except OSError as e:  # no process to be had (ulimit -u), no file: one line
+        err = tempfile.TemporaryFile()
+    except OSError:  # no temporary directory to be had: its lines go out as it says them
+        err = None
+    try:
+        code = _report(cmd, err)
+        said = _read(err)
+    except OSError as e:  # no process to be had (ulimit -u): one line
         print(f"sim.batch: --report: cannot start sim report: {e.strerror or e}", file=sys.stderr)
         return 2
+    finally:
+        if err is not None:
+            err.close()
     if code == 130:  # its own "sim: interrupted" left out: the batch's line says what it was
         said = "".join(ln for ln in said.splitlines(True) if not ln.startswith("sim: interrupted"))
     sys.stderr.write(said)
@@ -61,6 +67,18 @@ def _report(cmd: list[str], err) -> int:
     except KeyboardInterrupt:  # Ctrl-C reached it too; SIGTERM (to the batch) is passed on
         stop_children([proc])
         return 130
+
+
+def _read(err) -> str:
+    """The text of the temporary file ``err`` (``""`` without one)."""
+    if err is None:
+        return ""
+    try:
+        err.seek(0)
+        said = err.read()
+    except OSError:  # (EIO) what it said is lost, not its exit code
+        return ""
+    return said.decode(getattr(sys.stderr, "encoding", None) or "utf-8", "replace")
 
 
 def _stoppable() -> None:
