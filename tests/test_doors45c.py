@@ -14,6 +14,18 @@ failed on the code before its fix.
   that had started none. It says ``sim.batch: interrupted before any run started: nothing was
   run``, as while it checked its files; so does one after those checks, before the first run
   started.
+
+Held (found right, on top of F44's ``<out>/.lock``, merged here): a run held at the end of its
+publish (before removing the replaced results, before its record without ``replaced``): a
+second run is refused naming its pid, ``sim show`` and ``sim report`` read the new results
+whole, and the first ends 0 with one run's results. SIGTERM, SIGHUP or Ctrl-C to ``python -m
+sim.batch --report`` (``--jobs 2``, run options ``--workers 2`` and ``--executor dask
+--workers 2``) as a run starts, as its pool or cluster starts, with chunks written, between two
+runs (``--jobs 1``) and during the report: exit 130, one line, no process left, and the same
+command again resumes and ends 0. Two batches at once over overlapping study lists into one
+results root (other seeds, ``--report``): each run either ran or was refused in one line
+naming the pid of the run writing it; the results are whole runs and ``REPORT.md`` names the
+seeds of the results it sits beside.
 """
 
 from __future__ import annotations
