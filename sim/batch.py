@@ -69,7 +69,7 @@ from sim.batch_checks import (  # noqa: E402
     why_stale,
 )
 from sim.batch_report import not_rebuilt, rebuild_report  # noqa: E402
-from sim.batch_summary import _Stdout, summary  # noqa: E402
+from sim.batch_summary import _Named, _Stdout, summary  # noqa: E402
 from sim.batch_timings import TimingsLock  # noqa: E402
 from sim.cli_args import module_doc  # noqa: E402
 from sim.ends import finish  # noqa: E402
@@ -130,14 +130,18 @@ def run_all(
     of the files the batch resolved before (:func:`sim.batch_checks._configs_problems`),
     which ``--stale-only`` does not resolve again."""
     todo = []
-    for f in order(files):
-        if stale_only:  # is_current's question, asked once
-            why = why_stale(f, results / f.stem, run_args, (loaded or {}).get(f))
-            if why is None:
-                log(f"{f.stem}: up to date")
-                continue
-            log(f"{f.stem}: out of date ({why}): running it")
-        todo.append(f)
+    try:
+        for f in order(files):
+            if stale_only:  # is_current's question, asked once (seconds: the tables' sha256)
+                why = why_stale(f, results / f.stem, run_args, (loaded or {}).get(f))
+                if why is None:
+                    log(f"{f.stem}: up to date")
+                    continue
+                log(f"{f.stem}: out of date ({why}): running it")
+            todo.append(f)
+    except KeyboardInterrupt as e:  # before any run started (the driver says so)
+        e.started = False
+        raise
     quiet = ["--quiet"] if jobs > 1 and "--quiet" not in run_args else []
 
     def argv(f: Path) -> list[str]:
@@ -208,6 +212,7 @@ def run_all(
         stop_children(procs, first=lambda: _set(stop, starting))
         pool.shutdown(wait=True, cancel_futures=True)
         e.written = written  # for the driver's line: results replaced are not "unfinished"
+        e.started = bool(procs)  # (complete: no run starts once stop_children set the flag)
         raise
     pool.shutdown()
     return out
@@ -217,23 +222,6 @@ def _set(stop: threading.Event, starting: threading.Lock) -> None:
     """Start no more runs (under the lock that starts one, so none starts after this)."""
     with starting:
         stop.set()
-
-
-class _Named:
-    """Standard error of one study's run in a batch: every line starts with the study
-    file's name, so that a failure among many runs says which study failed."""
-
-    def __init__(self, stream, name: str):
-        self.stream, self.name, self.start = stream, name, True
-
-    def write(self, text: str) -> int:
-        for part in text.splitlines(keepends=True):
-            self.stream.write(f"{self.name}: {part}" if self.start else part)
-            self.start = part.endswith("\n")
-        return len(text)
-
-    def flush(self) -> None:
-        self.stream.flush()
 
 
 def _on_sigterm(signum, frame):
@@ -401,6 +389,9 @@ def _run(args, files: list[Path], run_args: list[str], note, loaded, default, ph
         )
         check_interrupt()  # before the timings are written
     except KeyboardInterrupt as e:  # the runs were stopped and cleaned up
+        if getattr(e, "started", True) is False:  # (--stale-only's checks: seconds) it said
+            print(NOTHING_RUN, file=sys.stderr)  # it "resumes the unfinished runs" of none
+            return 130
         w = getattr(e, "written", None)  # it said nothing of a run's results published meanwhile
         named = f" (the results of {', '.join(w)} were written)" if w else ""
         print(INTERRUPTED + named, file=sys.stderr)

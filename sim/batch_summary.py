@@ -1,6 +1,7 @@
 """The lines of ``python -m sim.batch`` on standard output: each study's as its run ends, and
 the closing line (:func:`summary`), written through :class:`_Stdout`, which keeps the first
-failed write instead of raising it in a run's thread."""
+failed write instead of raising it in a run's thread; and each run's standard error, its lines
+named by its study file (:class:`_Named`)."""
 
 from __future__ import annotations
 
@@ -49,3 +50,20 @@ class _Stdout:
                     os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
                 except (OSError, ValueError):
                     pass
+
+
+class _Named:
+    """Standard error of one study's run in a batch: every line starts with the study
+    file's name, so that a failure among many runs says which study failed."""
+
+    def __init__(self, stream, name: str):
+        self.stream, self.name, self.start = stream, name, True
+
+    def write(self, text: str) -> int:
+        for part in text.splitlines(keepends=True):
+            self.stream.write(f"{self.name}: {part}" if self.start else part)
+            self.start = part.endswith("\n")
+        return len(text)
+
+    def flush(self) -> None:
+        self.stream.flush()
