@@ -9,12 +9,13 @@ docstrings and in :mod:`sim.mc.agnard_size`).
   s), so a run the work limit passed could run for hours. Each solve is now weighed by the
   block's model observations (each signalised point times the models along its strip and the
   strips across that see it, and the pass points that two models or more see, laid out as
-  :func:`sim.instruments.block.layout.make_block` lays them) over those of the paper's
-  geometry at the block's size, to the power 1.1 (:func:`sim.mc.agnard_size.geometry_factor`;
-  measured, the 2 x 8 block's main trial at bases of 90, 45 and 10 mm and 4 to 20 pass rows:
-  within 0.77 and 1.45 of the measured time; the tiny run at base 45 mm 12.6 s of CPU,
-  estimated 17 s). The committed studies keep the paper's geometry: their estimate is
-  unchanged.
+  :func:`sim.instruments.block.layout.make_block` lays them, a pass point's counted half) over
+  those of the paper's geometry at the block's size, to the power 1.2
+  (:func:`sim.mc.agnard_size.geometry_factor`; measured, the 2 x 8 block's main trial at bases
+  of 90, 45 and 10 mm and 4 to 20 pass rows: within 0.85 and 1.18 of the time; the tiny run,
+  CPU against the estimate: the defaults 6.2 s / 6.5 s, base 45 mm 12.6 / 18, base 10 mm 48.7
+  / 47, 20 pass rows 7.9 / 14, both 134 / 132). The committed studies keep the paper's
+  geometry: their estimate is unchanged.
 * The refusal of a run over the work limit said "reduce trials or the lists in the study
   file" of a run whose cost was its geometry: a design whose solves cost more than 1.5 times
   the paper's now also names the geometry keys off the paper's ("or change block.base_mm or
