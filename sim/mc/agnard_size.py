@@ -112,10 +112,11 @@ def geometry_factor(c: Mapping) -> float:
     strips, models and ground points): its model observations (a pass point's weighed
     :data:`AGNARD_TIE_WEIGHT`) over those of the paper's geometry (:data:`PAPER_GEOMETRY`), to
     the power :data:`AGNARD_OBS_POWER`; 1 at the paper's geometry (the committed studies'
-    estimate is unchanged)."""
+    estimate is unchanged) and never below (a geometry of fewer observations, measured at
+    none, keeps the paper's work: the models' share of it remains)."""
     ref = model_observations(c, AGNARD_TIE_WEIGHT, **PAPER_GEOMETRY)
     k = model_observations(c, AGNARD_TIE_WEIGHT)
-    return (k / ref) ** AGNARD_OBS_POWER if ref > 0 else 1.0
+    return max((k / ref) ** AGNARD_OBS_POWER, 1.0) if ref > 0 else 1.0
 
 
 #: the keys of :data:`PAPER_GEOMETRY`, as a refusal over the work limit names them
