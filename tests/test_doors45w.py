@@ -19,7 +19,8 @@ docstrings and in :mod:`sim.mc.agnard_size`).
 * The refusal of a run over the work limit said "reduce trials or the lists in the study
   file" of a run whose cost was its geometry: a design whose solves cost more than 1.5 times
   the paper's now also names the geometry keys off the paper's ("or change block.base_mm or
-  block.pass_rows").
+  block.pass_rows"; of a sweep's costliest cell, a swept one as "the values of
+  sweep.block.base_mm").
 """
 
 from __future__ import annotations
@@ -76,3 +77,13 @@ def test_a_design_over_the_work_limit_is_refused_naming_its_keys(capsys):
     capsys.readouterr()
     rc = main([*args, "--set", "block.base_mm=10", "--set", "block.pass_rows=20"])
     one_line(capsys, rc, "over the limit of 5e+05", "block.base_mm or block.pass_rows")
+
+
+def test_a_swept_geometry_over_the_work_limit_is_named_as_swept(tmp_path, capsys):
+    f = tmp_path / "agnard_swept.toml"
+    f.write_text(
+        (ROOT / "studies" / "agnard_block.toml").read_text()
+        + '\n[sweep]\n"block.base_mm" = [90.0, 10.0]\n'
+    )
+    args = ["check", str(f), *tiny_overrides("agnard_block"), "--max-adjustments", "5e5"]
+    one_line(capsys, main(args), "or change the values of sweep.block.base_mm")

@@ -310,7 +310,8 @@ def estimate(
         )
     eq, key, part = max((p[5] for p in parts), key=lambda x: x[0])  # one cell's, not the sum
     W = sum(p[7] for p in parts) * reps
-    wkeys = max(parts, key=lambda p: p[1])[8]  # the costliest cell's
+    wkeys = max(parts, key=lambda p: p[1])[8]  # the costliest cell's, a swept key as swept
+    wkeys = tuple(f"the values of sweep.{k}" if k in keys else k for k in wkeys)
     big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
     return Estimate(
         str(cfg.get("study")),
