@@ -106,6 +106,7 @@ class Estimate:
     memory_keys: tuple = ()  # the keys that set ``bytes`` (the refusal names them), if known
     cell: str = ""  # a sweep's: the swept values of the cell that needs ``bytes`` (if cells differ)
     work: float = 0.0  # unit adjustments of the ``trials`` (the progress bar fills by them)
+    work_keys: tuple = ()  # keys besides the trials that make each trial costly (named if over)
 
     def describe(self, workers: int = 1) -> str:
         """One line: trials, adjustments (analytic parts in adjustment-equivalents, each
@@ -257,7 +258,8 @@ ESTIMATORS: dict[str, Callable[[Mapping], tuple]] = {
 def _one(cfg: Mapping) -> tuple:
     """``(trials, adjustments, unknowns, bytes, the part needing the bytes or "", (analytic
     adjustment-equivalents, key, part), the keys that set the bytes, the unit adjustments of
-    the trials)``; an estimator may leave out the last four (the trials: one unit each)."""
+    the trials, the keys besides the trials that make them costly)``; an estimator may leave
+    out the last five (the trials: one unit each)."""
     fn = ESTIMATORS.get(cfg.get("study"), _generic)
     try:
         t, a, u, b, *rest = fn(cfg)
@@ -269,7 +271,8 @@ def _one(cfg: Mapping) -> tuple:
     eq, key, part = rest[1] if len(rest) > 1 else (0.0, "", "")
     keys = tuple(rest[2]) if len(rest) > 2 else ()
     work = fix(rest[3]) if len(rest) > 3 else fix(t)
-    return fix(t), a, fix(u), fix(b), what, (fix(eq), key, part), keys, work
+    wkeys = tuple(rest[4]) if len(rest) > 4 else ()
+    return fix(t), a, fix(u), fix(b), what, (fix(eq), key, part), keys, work, wkeys
 
 
 def _chunk_units(cfg: Mapping, trials: float) -> float:
@@ -307,6 +310,8 @@ def estimate(
         )
     eq, key, part = max((p[5] for p in parts), key=lambda x: x[0])  # one cell's, not the sum
     W = sum(p[7] for p in parts) * reps
+    wkeys = max(parts, key=lambda p: p[1])[8]  # the costliest cell's, a swept key as swept
+    wkeys = tuple(f"the values of sweep.{k}" if k in keys else k for k in wkeys)
     big = lambda x: int(x) if math.isfinite(x) and x < 2**62 else 2**62  # noqa: E731
     return Estimate(
         str(cfg.get("study")),
@@ -322,6 +327,7 @@ def estimate(
         mkeys,
         cell,
         float(W) if math.isfinite(W) else 0.0,
+        wkeys,
     )
 
 
@@ -373,7 +379,8 @@ def check_limits(
             None,
             f"{est.study}: the run needs {est.describe(workers)}, over the "
             f"limit of {adj:.3g} adjustments (--max-adjustments or "
-            "SIM_MAX_ADJUSTMENTS); reduce trials or the lists in the study file",
+            "SIM_MAX_ADJUSTMENTS); reduce trials or the lists in the study file"
+            + (f", or change {keys_advice(est.work_keys)}" if est.work_keys else ""),
         )
     if not est.analytic <= adj * ANALYTIC_SHARE:
         raise ConfigError(
