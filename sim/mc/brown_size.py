@@ -37,6 +37,12 @@ BROWN_POINTS_PER_UNIT = 60.0
 #: covariance of the pivot model's points (measured as two more: 0.083 units a point and trial
 #: against brown_dilution's 0.067 for its three models and the bias check's pivot)
 BROWN_TABLE1_SOLVES = 5
+#: adjustments of brown_dilution's self-check reference under ``errors.bias_um`` (its three
+#: models' derivatives of the points by each of the 4 n ranges, two adjustments each:
+#: :func:`sim.studies.brown.core.spread_sigma`), each of the plate's n points at
+#: :data:`BROWN_POINTS_PER_UNIT`. Left out, 3,600 points with a bias took 150 s (and 11.6 GB)
+#: past an estimate of 59 s for the whole run: 7.8 s at 900 points, counted 16 s here
+BROWN_SPREAD_ADJUSTMENTS = 3 * 2 * 4
 #: unit adjustments of one simulated setting (a normal draw and its average; measured 7 to
 #: 30 ns, Table 1 taking the settings' variance too)
 BROWN_DRAW_UNITS = 4e-4
@@ -136,6 +142,12 @@ def brown_estimate(c: Mapping) -> tuple:
     region_b = region_bytes(c)
     keys = _memory_keys(c, n, n_an, chunk_b, curves_b, region_b)
     what = "the region's input vectors" if region_b > max(chunk_b, curves_b) else ""
-    adj = T * trial + analytic + region
+    spread = 0.0
+    if c.get("study") == "brown_dilution" and c.get("errors.bias_um", 0):
+        spread = BROWN_SPREAD_ADJUSTMENTS * n * n / BROWN_POINTS_PER_UNIT
+    adj = T * trial + analytic + region + spread
     b = max(chunk_b, curves_b, region_b)
-    return T, adj, max(U, 2 * n_an + 7), b, what, (0.0, "", ""), keys
+    # the keys besides the trials that make the run costly, when the bias's reference is most
+    work_keys = ("errors.bias_um", PLATE_KEYS.get(c.get("plate.pattern", "grid"), "plate.points"))
+    wkeys = work_keys if spread > adj / 2 else ()
+    return T, adj, max(U, 2 * n_an + 7), b, what, (0.0, "", ""), keys, T, wkeys

@@ -32,15 +32,22 @@ def ensemble_time(chain: np.ndarray, c: float = WINDOW_C) -> np.ndarray:
     """Integrated autocorrelation time (steps) of each parameter of ``chain`` (steps,
     walkers, d), about the ensemble's mean (see the module doc), shape ``(d,)``."""
     x = np.asarray(chain, float)
+    return np.array([_one(x[:, :, k], c) for k in range(x.shape[2])])
+
+
+def _one(x: np.ndarray, c: float) -> float:
+    """tau of one parameter's chain ``x`` (steps, walkers): a parameter at a time, the
+    transforms of the whole chain at once held 600 to 730 bytes a walker's step of Brown's
+    posterior (7 parameters; emcee's, a walker at a time, 5), which the estimate's
+    :data:`sim.mc.workunits.BAYES_BYTES`, measured before, did not hold."""
     n = x.shape[0]
-    y = x - x.mean(axis=(0, 1))
+    y = x - x.mean()
     m = 1 << (2 * n - 1).bit_length()
     f = np.fft.rfft(y, n=m, axis=0)
-    acf = np.fft.irfft(f * np.conj(f), n=m, axis=0)[:n].mean(axis=1)  # (n, d)
+    acf = np.fft.irfft(f * np.conj(f), n=m, axis=0)[:n].mean(axis=1)  # (n,)
     with np.errstate(invalid="ignore", divide="ignore"):  # a constant parameter: NaN
         acf = acf / acf[0]
-    taus = 2.0 * np.cumsum(acf, axis=0) - 1.0
-    return np.array([_windowed(taus[:, k], c) for k in range(x.shape[2])])
+    return _windowed(2.0 * np.cumsum(acf) - 1.0, c)
 
 
 def _windowed(taus: np.ndarray, c: float) -> float:
