@@ -15,7 +15,10 @@ each failed on the code before its fix.
   refuse ``SIM_NO_JIT=0`` (or ``NUMBA_OPT=fast``, a ``ulimit -d`` too small) as ``python -m
   sim.batch`` and ``make verify`` do: the batch started a ``sim run`` for each study, each of
   which refused it, one line a study and a summary line, and verify re-ran every study into a
-  scratch directory to fail each. Both now refuse it before anything starts, one line, exit 2.
+  scratch directory, each re-run refusing it. Both now refuse it before anything starts, one line, exit 2.
+* ``python -m sim.cli`` (the module run as the command, not ``python -m sim``) with one of the
+  variables above was a traceback (from ``numpy.f2py`` or ``tqdm.utils``; with the first fix
+  alone, of the ``ConfigError``): it is now the ``sim`` command's one line and exit 2.
 
 Held (a harness outside the project): ``python -m sim``, ``runpy.run_module("sim")``, the
 ``sim`` script, ``python -m sim.batch``, ``python -m sim.report.verify`` and ``python -m
@@ -32,7 +35,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from oneline import one_line
+from oneline import one_line, one_line_of
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -85,3 +88,16 @@ def test_verify_from_python_refuses_what_its_command_refuses(tmp_path, monkeypat
                "--scratch", str(scratch), "--trials", "400"])  # fmt: skip
     one_line(capfd, rc, "SIM_NO_JIT", "'0'", prefix="sim verify: error: ")
     assert not scratch.exists()
+
+
+def test_python_m_sim_cli_refuses_in_one_line_as_python_m_sim():
+    env = {**os.environ, "TQDM_NCOLS": "abc"}
+    p = subprocess.run(
+        [sys.executable, "-m", "sim.cli", "check", "studies/wolf_polynomial.toml"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=ROOT,
+        env=env,
+    )
+    one_line_of(p, "TQDM_NCOLS", prefix="sim: error: ")
