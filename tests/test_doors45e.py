@@ -1,7 +1,7 @@
 """Doors sweep 45e: every entry point checks the environment, the commands' modules imported or
 called from Python (``import sim.cli``, ``sim.batch``, ``sim.report.verify``, ``benchmarks``;
-``sim.batch.main([...])``, ``sim.report.verify.cli.main([...])``), one case per class found;
-each failed on the code before its fix.
+``sim.batch.main([...])``, ``sim.report.verify.cli.main([...])``, ``python -m sim.cli``), one
+case per class found; each failed on the code before its fix.
 
 * ``import sim.cli`` (``sim.batch``, ``sim.report.verify``, ``sim.report.verify.cli``,
   ``benchmarks``) from Python, not run as its command, skipped the checks the commands make as
@@ -11,11 +11,12 @@ each failed on the code before its fix.
   Importing them now raises the ``sim.ConfigError`` naming the variable, as ``import sim.api``
   does (:mod:`sim.entry_env`); so ``sim.cli.main([...])`` cannot be reached with them, and
   returns 2 with the ``sim`` command's line on what is read later (``SIM_NO_JIT``, ``NUMBA_``).
-* ``sim.batch.main([...])`` and ``sim.report.verify.cli.main([...])`` from Python did not
-  refuse ``SIM_NO_JIT=0`` (or ``NUMBA_OPT=fast``, a ``ulimit -d`` too small) as ``python -m
-  sim.batch`` and ``make verify`` do: the batch started a ``sim run`` for each study, each of
+* ``sim.batch.main([...])``, ``sim.report.verify.cli.main([...])`` and ``benchmarks.main``
+  from Python did not refuse ``SIM_NO_JIT=0`` (or ``NUMBA_OPT=fast``, a ``ulimit -d`` too
+  small) as ``python -m sim.batch``, ``make verify`` and ``python -m benchmarks`` do: the batch started a ``sim run`` for each study, each of
   which refused it, one line a study and a summary line, and verify re-ran every study into a
-  scratch directory, each re-run refusing it. Both now refuse it before anything starts, one line, exit 2.
+  scratch directory, each re-run refusing it, and the benchmark timed the Python path. They
+  now refuse it before anything starts, one line, exit 2.
 * ``python -m sim.cli`` (the module run as the command, not ``python -m sim``) with one of the
   variables above was a traceback (from ``numpy.f2py`` or ``tqdm.utils``; with the first fix
   alone, of the ``ConfigError``): it is now the ``sim`` command's one line and exit 2.
@@ -101,3 +102,10 @@ def test_python_m_sim_cli_refuses_in_one_line_as_python_m_sim():
         env=env,
     )
     one_line_of(p, "TQDM_NCOLS", prefix="sim: error: ")
+
+
+def test_the_benchmarks_from_python_refuse_what_their_command_refuses(monkeypatch, capsys):
+    from benchmarks import main
+
+    monkeypatch.setenv("SIM_NO_JIT", "0")
+    one_line(capsys, main(["--help"]), "SIM_NO_JIT", prefix="benchmarks: error: ")
