@@ -26,6 +26,8 @@ from sim.threads import refuse_bad_environment
 if sys.argv[:1] == ["-m"]:  # python -m benchmarks, while this package loads (as sim.report.verify)
     refuse_bad_environment("benchmarks")  # a variable NumPy cannot load with: one line, exit 2
     refuse_bad_variables("benchmarks")  # SIM_NO_JIT=0 (timed the Python path), exit 2 too
+else:  # imported from Python (benchmarks.main([...])): a sim.ConfigError naming the variable
+    import sim.entry_env  # noqa: F401
 
 from benchmarks.cli import main  # noqa: E402
 from benchmarks.timing import cpu_time, numpy_path  # noqa: E402

@@ -36,6 +36,7 @@ from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
 from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
 from benchmarks.store import store_rows
+from sim.env_vars import environment_problem
 from sim.mc.argv import ONCE, OnceParser
 from sim.mc.storage import provenance, write_table
 from sim.places import base, shown_path
@@ -230,7 +231,12 @@ def _ours(path: str) -> str:
 def main(argv=None) -> int:
     """The benchmark; SIGTERM and SIGHUP end it as Ctrl-C does (its child processes stopped:
     SIGTERM ended it at once, exit 143 without a word, and left its million-trial run
-    writing into ``--out``): one line, exit 130."""
+    writing into ``--out``): one line, exit 130. Called from Python, it refuses what ``python
+    -m benchmarks`` refuses as it starts (``SIM_NO_JIT=0`` timed the Python path): one line,
+    exit 2."""
+    if (problem := environment_problem()) is not None:
+        print(f"benchmarks: error: {problem}", file=sys.stderr)
+        return 2
     try:
         with ended_as_ctrl_c():
             return _main(argv)

@@ -40,7 +40,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from sim.env_vars import refuse_bad_variables
+from sim.env_vars import environment_problem, refuse_bad_variables
 from sim.threads import interrupt_while_loading, refuse_bad_environment, single_threaded_blas
 
 if __name__ == "__main__":  # 2>&-: before any file takes its descriptor (sim.ends)
@@ -50,6 +50,8 @@ if __name__ == "__main__":  # 2>&-: before any file takes its descriptor (sim.en
 _loaded = interrupt_while_loading("sim.batch")  # Ctrl-C during the imports: one line, exit 130
 if __name__ == "__main__":
     refuse_bad_environment("sim.batch")  # a variable NumPy cannot load with: one line, exit 2
+else:  # imported from Python (sim.batch.main([...])): a ConfigError naming the variable
+    import sim.entry_env  # noqa: F401
 single_threaded_blas()  # before NumPy loads (the study modules import it)
 if __name__ == "__main__":
     refuse_bad_variables("sim.batch")  # SIM_NO_JIT=0, NUMBA_OPT=fast: one line, exit 2
@@ -251,6 +253,9 @@ def main(argv: list[str] | None = None) -> int:
     signals = (signal.SIGINT, *STOP_SIGNALS) if in_main_thread() else ()
     old = {s: signal.getsignal(s) for s in signals}
     phase: list[str] = []  # "run": the runs started; "ended": every run ended
+    if (problem := environment_problem()) is not None:  # as python -m sim.batch refuses it
+        print(f"sim.batch: error: {problem}", file=sys.stderr)  # (from Python: not a line
+        return 2  # of sim run's for each study)
     try:
         with keep_lost_interrupts():  # Ctrl-C that Python drops in a C callback: kept
             code = _main(list(sys.argv[1:] if argv is None else argv), phase)

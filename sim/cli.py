@@ -20,6 +20,9 @@ make rerun pass --out results/<study>).
 
 from __future__ import annotations
 
+import sim.entry_env  # noqa: F401 - imported from Python: the environment, before tqdm loads
+
+# isort: split
 import os
 import re
 import signal

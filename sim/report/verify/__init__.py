@@ -51,6 +51,8 @@ _loaded = interrupt_while_loading("sim verify") if _as_main else (lambda: None)
 if _as_main:
     refuse_bad_environment("sim verify")  # a variable NumPy cannot load with: one line, exit 2
     refuse_bad_variables("sim verify")  # SIM_NO_JIT=0, NUMBA_OPT=fast: one line, exit 2
+else:  # imported from Python (sim.report.verify.cli.main([...])): a ConfigError naming it
+    import sim.entry_env  # noqa: F401
 
 from sim.report.verify.cli import main  # noqa: E402
 from sim.report.verify.record import markdown, write_record  # noqa: E402

@@ -10,6 +10,7 @@ import tempfile
 from pathlib import Path
 
 from sim.ends import stdout_failed
+from sim.env_vars import environment_problem
 from sim.held_stops import held_stops
 from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError, parse_override
@@ -176,6 +177,9 @@ INTERRUPTED = "sim verify: interrupted; the re-run was stopped"
 
 
 def main(argv: list[str] | None = None) -> int:
+    if (problem := environment_problem()) is not None:  # as python -m sim.report.verify
+        print(f"sim verify: error: {problem}", file=sys.stderr)  # refuses it (from Python:
+        return 2  # not a line of sim run's for each re-run)
     try:
         with ended_as_ctrl_c(), keep_lost_interrupts():  # Ctrl-C dropped in a C callback: kept
             code = _main(argv)
