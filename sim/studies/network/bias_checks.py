@@ -23,9 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from sim.studies.network.definition import Network
-from sim.studies.network.linearity import row_key
+from sim.studies.network.linearity import largest_bias, row_key
 from sim.studies.network.probe import chunk_fn
-from sim.studies.network.validate import KINDS
 
 __all__ = ["NEGLIGIBLE", "BIASED_CHECKS", "bias_effect"]
 
@@ -49,13 +48,7 @@ class _NoNoise:
 
 def _named(net: Network, cfg: dict) -> str:
     """The largest bias (in its sigmas) as ``key: the distance at 'A' to 'P' (10 mm)``."""
-    r = int(np.argmax(np.abs(net.bias) / net.sigma))
-    ang = int(net.kind[r]) in (1, 2)
-    unit, f = ("arcsec", 648000 / np.pi) if ang else ("mm", 1.0)
-    obs = f"the {KINDS[int(net.kind[r])]} at {net.names[net.i[r]]!r}"
-    obs += f" from {net.names[net.j[r]]!r}" if net.kind[r] == 2 else ""
-    to = net.k[r] if net.kind[r] == 2 else net.j[r]
-    obs += f" to {net.names[to]!r}" if to >= 0 else ""
+    r, unit, f, obs = largest_bias(net)
     n = int(np.count_nonzero(net.bias))
     more = f" and {n - 1} other biased observation{'s' if n > 2 else ''}" if n > 1 else ""
     return f"{row_key(cfg, r)} (bias_{unit} = {net.bias[r] * f:g} on {obs}{more})"

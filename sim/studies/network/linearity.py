@@ -69,13 +69,10 @@ def why_not_converged(net: Network, cov: np.ndarray, cfg: dict, what: str) -> tu
     )
 
 
-def biased(net: Network, cfg: dict, what: str) -> tuple[str, str] | None:
-    """``(key, message)`` for a network whose trials do not converge (``what``: which) when an
-    observation carries a bias, a gross error unknown to the adjustment: the largest, in its
-    sigmas, named by the key that declares it (a ``network.generate`` bias was named
-    ``network.observations``, a key the study did not set); None when none has a bias."""
-    if not np.any(net.bias):
-        return None
+def largest_bias(net: Network) -> tuple[int, str, float, str]:
+    """The observation of ``net`` with the largest bias in its sigmas: its row, the bias's
+    unit and factor from radians or mm (``arcsec`` or ``mm``) and its words (``the distance
+    at 'A' to 'P'``)."""
     r = int(np.argmax(np.abs(net.bias) / net.sigma))
     ang = int(net.kind[r]) in (1, 2)
     unit, f = ("arcsec", 648000 / np.pi) if ang else ("mm", 1.0)
@@ -83,6 +80,17 @@ def biased(net: Network, cfg: dict, what: str) -> tuple[str, str] | None:
     obs += f" from {net.names[net.j[r]]!r}" if net.kind[r] == 2 else ""
     to = net.k[r] if net.kind[r] == 2 else net.j[r]
     obs += f" to {net.names[to]!r}" if to >= 0 else ""
+    return r, unit, f, obs
+
+
+def biased(net: Network, cfg: dict, what: str) -> tuple[str, str] | None:
+    """``(key, message)`` for a network whose trials do not converge (``what``: which) when an
+    observation carries a bias, a gross error unknown to the adjustment: the largest, in its
+    sigmas, named by the key that declares it (a ``network.generate`` bias was named
+    ``network.observations``, a key the study did not set); None when none has a bias."""
+    if not np.any(net.bias):
+        return None
+    r, unit, f, obs = largest_bias(net)
     return row_key(cfg, r), (
         f"{what}: the bias of {net.bias[r] * f:g} {unit} on {obs} is a gross error the "
         "adjustment cannot absorb (a bias is unknown to it): make it smaller"
