@@ -24,18 +24,18 @@ next ``sim run --overwrite`` of the study file runs, leaving no staging or swap 
 
 from __future__ import annotations
 
-import os
 import random
 import shutil
-import time
 from pathlib import Path
 
 from fuzz_sequence import XMLS, Case, _api_kw, _run_argv, study_text
 from fuzz_sequence_run import (
     Pause,
     References,
+    against_reference,
     api_run,
     batch_main,
+    budgeted,
     claims_block,
     incomplete,
     lines,
@@ -223,20 +223,10 @@ def check_pair(c: Case, a: Op, b: Op, old: dict | None) -> str | None:
     rec = record(c.out)
     if old is not None and rec is None:
         return "the results in res/net were lost (no run.json)"
-    if rec is not None:
-        if (why := incomplete(c.out, set())) is not None:
-            return f"res/net is not a complete run: {why}"
-        ref = c.refs.of_config(rec)
-        for s in reversed(c.asked):
-            if ref is not None:
-                break
-            c.refs.get(s)
-            ref = c.refs.of_config(rec)
-        if ref is None:
-            return "res/net records a config neither process nor the results before stood for"
-        for key in ("table_sha256", "chunk_sha256"):
-            if rec.get(key) != ref[0].get(key):
-                return f"res/net's {key} are not those of a clean run of its config"
+    if rec is not None and (
+        bad := against_reference(c, rec, set(), "neither process nor the results before stood for")
+    ):
+        return bad
     ok = [op for op in (a, b) if op.writer and op.code == 0]
     for op in (a, b):
         if op.writer and op.code == 2 and c.refs.get(op.state)[0] is not None:
@@ -282,11 +272,4 @@ def _next_run(c: Case) -> str | None:
 
 def pairs(n: int, seed: int, tmp: Path) -> list[str]:
     """Run ``n`` pairs (fewer when ``FUZZ_PAIR_SECONDS`` run out): their failures."""
-    budget = float(os.environ.get("FUZZ_PAIR_SECONDS", "600"))
-    refs, t0, failures = References(tmp / "refs"), time.time(), []
-    for i in range(n):
-        if time.time() - t0 > budget:
-            break
-        if (bad := run_pair(i, seed, tmp, refs)) is not None:
-            failures.append(bad)
-    return failures
+    return budgeted(run_pair, n, seed, tmp, "FUZZ_PAIR_SECONDS")

@@ -35,11 +35,12 @@ from pathlib import Path
 
 from fuzz_sequence_run import (
     References,
+    against_reference,
     api_read,
     api_run,
     batch_main,
+    budgeted,
     claims_block,
-    incomplete,
     lines,
     record,
     same_claims,
@@ -282,20 +283,8 @@ def check(c: Case, op, desc, code, so, se, state, codes, before) -> str | None:
     if c.had and rec is None:
         return "the results were lost (no run.json in res/net)"
     c.had = c.had or rec is not None
-    if rec is not None:
-        if (why := incomplete(c.out, c.missing)) is not None:
-            return f"res/net is not a complete run: {why}"
-        ref = c.refs.of_config(rec)
-        for s in reversed(c.asked):
-            if ref is not None:
-                break
-            c.refs.get(s)
-            ref = c.refs.of_config(rec)
-        if ref is None:
-            return "res/net records a config no step asked for"
-        for key in ("table_sha256", "chunk_sha256"):
-            if rec.get(key) != ref[0].get(key):
-                return f"res/net's {key} are not those of a clean run of its config"
+    if rec is not None and (bad := against_reference(c, rec, c.missing, "no step asked for")):
+        return bad
     writer = op in WRITERS or op == "batch"
     if writer and code == 0 and state is not None:
         want = c.refs.get(state)[0]
@@ -355,11 +344,4 @@ def run_sequence(i: int, seed: int, tmp: Path, refs: References) -> str | None:
 
 def sequences(n: int, seed: int, tmp: Path) -> list[str]:
     """Run ``n`` sequences (fewer when ``FUZZ_SEQ_SECONDS`` run out): their failures."""
-    budget = float(os.environ.get("FUZZ_SEQ_SECONDS", "600"))
-    refs, t0, failures = References(tmp / "refs"), time.time(), []
-    for i in range(n):
-        if time.time() - t0 > budget:
-            break
-        if (bad := run_sequence(i, seed, tmp, refs)) is not None:
-            failures.append(bad)
-    return failures
+    return budgeted(run_sequence, n, seed, tmp, "FUZZ_SEQ_SECONDS")

@@ -329,3 +329,38 @@ class References:
                 if rec.get("code_hash") == run.get("code_hash"):
                     return rec, shown, d
         return None
+
+
+def budgeted(run_one, n: int, seed: int, tmp: Path, seconds_env: str) -> list[str]:
+    """Run ``run_one(i, seed, tmp, refs)`` for ``i`` below ``n`` (fewer when the seconds in
+    the variable ``seconds_env``, 600 unless set, run out): their failures (the lines each
+    returned), one reference store for all (the SEQUENCE and CONCURRENT kinds)."""
+    budget = float(os.environ.get(seconds_env, "600"))
+    refs, t0, failures = References(tmp / "refs"), time.time(), []
+    for i in range(n):
+        if time.time() - t0 > budget:
+            break
+        if (bad := run_one(i, seed, tmp, refs)) is not None:
+            failures.append(bad)
+    return failures
+
+
+def against_reference(c, rec: dict, missing: set, unknown: str) -> str | None:
+    """Why ``c.out``, whose run record is ``rec``, is not a complete run whose tables equal a
+    clean run of the config it records (``c.refs``, asked for by ``c.asked`` as needed), or
+    None; ``missing``: files a step removed on purpose; ``unknown``: how the line names a
+    config no reference stands for."""
+    if (why := incomplete(c.out, missing)) is not None:
+        return f"res/net is not a complete run: {why}"
+    ref = c.refs.of_config(rec)
+    for s in reversed(c.asked):
+        if ref is not None:
+            break
+        c.refs.get(s)
+        ref = c.refs.of_config(rec)
+    if ref is None:
+        return f"res/net records a config {unknown}"
+    for key in ("table_sha256", "chunk_sha256"):
+        if rec.get(key) != ref[0].get(key):
+            return f"res/net's {key} are not those of a clean run of its config"
+    return None
