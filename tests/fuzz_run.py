@@ -25,6 +25,40 @@ from sim.mc.message_text import key_text
 TIMEOUT = float(os.environ.get("FUZZ_TIMEOUT", "300"))
 
 
+def in_child(cwd: Path, so: Path, se: Path, body) -> None:
+    """In a forked child of a fuzzer: a session of its own in ``cwd``, the work limits, its
+    standard output and error into ``so`` and ``se``, then ``body()``; ends the process with
+    its code (98 a ``SystemExit`` of no number, 97 a traceback, printed into ``se``). The
+    limits: within a case's timeout, a case asking for hours of work within the default limit
+    (agnard's region.trials = 150000, 2.7e8 adjustments) is a long run, not a hang; under
+    this limit it is refused in one line, as the fuzzers expect."""
+    code = 99
+    try:
+        os.setsid()
+        os.chdir(cwd)
+        os.environ["SIM_MAX_MEMORY_GB"] = "2"
+        os.environ["SIM_MAX_ADJUSTMENTS"] = "1e7"
+        fo = os.open(so, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+        fe = os.open(se, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+        os.dup2(fo, 1), os.dup2(fe, 2)
+        sys.stdout = open(1, "w", closefd=False)
+        sys.stderr = open(2, "w", closefd=False)
+        code = body()
+    except SystemExit as e:
+        code = e.code if isinstance(e.code, int) else 98
+    except BaseException:  # noqa: BLE001 - a traceback: reported as a failure
+        import traceback
+
+        traceback.print_exc()
+        code = 97
+    finally:
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+        finally:
+            os._exit(code if isinstance(code, int) else 96)
+
+
 def run_case(case_dir: Path, study: Path, extra: list[str], timeout: float):
     """``sim run`` in a forked child: (exit code or 'timeout', stdout, stderr, seconds)."""
     out = case_dir / "out"
@@ -39,38 +73,15 @@ def run_case(case_dir: Path, study: Path, extra: list[str], timeout: float):
     t0 = time.time()
     pid = os.fork()
     if pid == 0:  # child
-        code = 99
-        try:
-            os.setsid()
-            os.chdir(case_dir)
+
+        def body():
             import resource
 
             lim = 6 * 2**30
             resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
-            os.environ["SIM_MAX_MEMORY_GB"] = "2"
-            # within TIMEOUT: a case asking for hours of work within the default limit
-            # (agnard's region.trials = 150000, 2.7e8 adjustments) is a long run, not a hang;
-            # under this limit it is refused in one line, as the fuzzer expects
-            os.environ["SIM_MAX_ADJUSTMENTS"] = "1e7"
-            fo, fe = os.open(so, os.O_WRONLY | os.O_CREAT), os.open(se, os.O_WRONLY | os.O_CREAT)
-            os.dup2(fo, 1)
-            os.dup2(fe, 2)
-            sys.stdout = open(1, "w", closefd=False)
-            sys.stderr = open(2, "w", closefd=False)
-            code = main(argv)
-        except SystemExit as e:
-            code = e.code if isinstance(e.code, int) else 98
-        except BaseException:  # noqa: BLE001 - a traceback: report it as a failure
-            import traceback
+            return main(argv)
 
-            traceback.print_exc()
-            code = 97
-        finally:
-            try:
-                sys.stdout.flush()
-                sys.stderr.flush()
-            finally:
-                os._exit(code if isinstance(code, int) else 96)
+        in_child(case_dir, so, se, body)
     code = "timeout"
     while time.time() - t0 < timeout:
         done, status = os.waitpid(pid, os.WNOHANG)

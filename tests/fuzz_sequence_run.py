@@ -20,6 +20,8 @@ import sys
 import time
 from pathlib import Path
 
+from fuzz_run import in_child
+
 #: the lines of standard error that are notes, not the one line of a refusal or interrupt
 NOTES = ("sim: note:", "sim: resuming", "sim: starting", "sim: a run ", "sim.batch: note")
 NOTES += ("sim verify: re-running ",)  # make verify's progress, on standard error
@@ -94,36 +96,16 @@ def start(cwd: Path, target, log: Path, marker=None) -> int:
     so, se = log.with_suffix(".out"), log.with_suffix(".err")
     pid = os.fork()
     if pid == 0:  # child
-        code = 99
-        try:
-            os.setsid()
-            os.chdir(cwd)
-            os.environ["SIM_MAX_MEMORY_GB"] = "2"
-            os.environ["SIM_MAX_ADJUSTMENTS"] = "1e7"
-            fo = os.open(so, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
-            fe = os.open(se, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
-            os.dup2(fo, 1), os.dup2(fe, 2)
-            sys.stdout = open(1, "w", closefd=False)
-            sys.stderr = open(2, "w", closefd=False)
+
+        def body():
             # Ctrl-C as at a terminal, however the fuzzer was started (in the background of a
             # script SIGINT is ignored, and Python then installs no KeyboardInterrupt for it)
             signal.signal(signal.SIGINT, signal.default_int_handler)
             if marker is not None:
                 _marker(*marker)
-            code = target()
-        except SystemExit as e:
-            code = e.code if isinstance(e.code, int) else 98
-        except BaseException:  # noqa: BLE001 - a traceback: reported as a failure
-            import traceback
+            return target()
 
-            traceback.print_exc()
-            code = 97
-        finally:
-            try:
-                sys.stdout.flush()
-                sys.stderr.flush()
-            finally:
-                os._exit(code if isinstance(code, int) else 96)
+        in_child(cwd, so, se, body)
     return pid
 
 
