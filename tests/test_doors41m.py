@@ -37,59 +37,43 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import grid_network
 
 import sim
 from sim.cli import main
-from sim.mc.config import ConfigError, validate
-from sim.mc.network_size import network_estimate
+from sim.mc.config import ConfigError
 from sim.mc.runner import RunContext, make_executor, run_chunks
-from sim.studies import get_study
 from tests.oneline import one_line, python_lines
 
 SIDE = 12
 
 
-def _network(tmp_path: Path) -> Path:
-    """A 12 x 12 trilateration grid (nearest 8, inner datum): about 3.6 MiB a process."""
-    st = tmp_path / "grid.toml"
-    st.write_text(
-        'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngrids = [ { prefix = "G", '
-        f'nx = {SIDE}, ny = {SIDE}, spacing_m = 100.0 }} ]\ngenerate = [ {{ kind = "distance", '
-        'from = "G*", to = "G*", nearest = 8, sigma_mm = 2.0 } ]\n[datum]\nkind = "inner"\n'
-    )
-    return st
+def _network(tmp_path: Path) -> tuple[Path, float]:
+    """A 12 x 12 trilateration grid (nearest 8, inner datum; about 3.6 MiB a process): its
+    study file and the bytes a process of its run needs (tests/conftest.py)."""
+    return grid_network(tmp_path, SIDE)
 
 
-def _limit_for(workers: float) -> str:
-    """A memory limit in GiB that ``workers`` processes of :func:`_network`'s run fit (the
-    next whole number does not), from its estimate (no network is built)."""
-    flat = {
-        "trials": 40,
-        "chunk": 2,
-        "network.grids": [{"prefix": "G", "nx": SIDE, "ny": SIDE, "spacing_m": 100.0}],
-        "network.generate": [
-            {"kind": "distance", "from": "G*", "to": "G*", "nearest": 8, "sigma_mm": 2.0}
-        ],
-        "datum.kind": "inner",
-    }
-    b = network_estimate(validate(flat, get_study("network").schema, None))[3]
-    return f"{b * (workers + 0.5) / 2**30:.6g}"
+def _limit_for(need: float, workers: float) -> str:
+    """A memory limit in GiB that ``workers`` processes needing ``need`` bytes each fit (the
+    next whole number does not)."""
+    return f"{need * (workers + 0.5) / 2**30:.6g}"
 
 
 @pytest.mark.parametrize("workers,fit", [(2, 1), (3, 2)])
 def test_a_memory_refusal_with_workers_names_the_workers_that_fit(workers, fit, tmp_path, capsys):
     # before: "...; reduce chunk, trials or the sizes in the study file", no word of workers
-    st = _network(tmp_path)
+    st, need = _network(tmp_path)
     args = ["run", str(st), "--no-figures", "--out", str(tmp_path / "o"), "--quiet"]
-    args += ["--workers", str(workers), "--max-memory-gb", _limit_for(fit)]
+    args += ["--workers", str(workers), "--max-memory-gb", _limit_for(need, fit)]
     line = one_line(capsys, main(args), f"each of {workers} worker processes", "GiB limit")
     assert f"; use --workers {fit}, or reduce " in line, line
     assert not (tmp_path / "o").exists()
 
 
 def test_the_api_names_its_workers_argument(tmp_path, monkeypatch):
-    st = _network(tmp_path)
-    monkeypatch.setenv("SIM_MAX_MEMORY_GB", _limit_for(1))
+    st, need = _network(tmp_path)
+    monkeypatch.setenv("SIM_MAX_MEMORY_GB", _limit_for(need, 1))
     with pytest.raises(ConfigError) as e:
         sim.load(st).run(out=tmp_path / "o", workers=2, figures=False)
     words = str(e.value)
@@ -98,9 +82,9 @@ def test_the_api_names_its_workers_argument(tmp_path, monkeypatch):
 
 def test_a_memory_refusal_with_one_worker_is_as_before(tmp_path, capsys):
     # held: one worker over the limit is refused before the build, naming the network's size
-    st = _network(tmp_path)
+    st, need = _network(tmp_path)
     args = ["run", str(st), "--no-figures", "--out", str(tmp_path / "o")]
-    args += ["--max-memory-gb", _limit_for(0)]
+    args += ["--max-memory-gb", _limit_for(need, 0)]
     line = one_line(capsys, main(args), "network.grids: ", "GiB memory limit")
     assert "worker" not in line and line.endswith("use fewer points or observations"), line
 
@@ -152,7 +136,7 @@ def test_dask_sends_the_chunk_function_once(tmp_path):
 def test_under_ulimit_v_arrow_does_not_map_the_room(tmp_path):
     # before: the address space grew by 1.3 GiB in the run (mimalloc's reservation), the
     # pool "mimalloc"
-    st = _network(tmp_path)
+    st, need = _network(tmp_path)
     proc = python_lines(
         "import resource",
         "resource.setrlimit(resource.RLIMIT_AS, (6 << 30, resource.RLIM_INFINITY))",
