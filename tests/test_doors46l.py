@@ -7,16 +7,38 @@ that failed on the code before its fix.
   It now looks at no more than :data:`sim.mc.swap.LOOK_AT` entries, breadth first, and the
   refusal names one of the entries it holds (a directory holding only ``.DS_Store`` looked
   empty to ``ls`` and was refused for holding "files").
+* F44/C45: ``make verify`` while a study's only directory is its run's staging directory (a
+  first run in progress, or one killed before it published) said "no study results in
+  RESULTS" (or "no results of 'NAME'" for ``--study NAME``) and nothing of the run; it now says
+  so in its one line, as ``sim show`` and ``sim report`` do (:mod:`sim.mc.unfinished`).
+* N45: ``sim check`` of a network whose bias the adjustment will not absorb (``bias_mm = 10``
+  on the README network's distances) printed the work and nothing else, exit 0; the run then
+  counted its three self-checks "not applicable". It now says so before the run, in a note
+  line naming the bias (:func:`sim.studies.network.bias_checks.bias_notes`); an absorbed bias
+  (each station's orientation) gets no note.
+* E45: ``OPENBLAS_NUM_THREADS`` that OpenBLAS reads as no count (``abc``, ``-1``, ``0``, empty:
+  C's ``atoi`` gives 0 or less) was kept as given: OpenBLAS then read ``OMP_NUM_THREADS``, and
+  with that unreadable too ran on every core where the suite runs one thread a process
+  (measured: two threads, and a 300 x 300 solve's last bits another's), without a word;
+  ``1.5`` was read as 1. It is now one line naming the variable, exit 2, at every door
+  (``sim check`` the same line as ``sim run``). Held, measured: ``OMP_NUM_THREADS=abc`` alone
+  (OpenBLAS reads the suite's ``OPENBLAS_NUM_THREADS=1`` first; Arrow's pool takes it for
+  unset), ``MKL_NUM_THREADS=1.5`` (no MKL: OpenBLAS), ``NUMBA_NUM_THREADS=0``/``abc``/``1.5``
+  (refused already, by numba's own reading).
 """
 
 from __future__ import annotations
 
 import os
+import shutil
+
+import pytest
 
 import sim.mc.swap as swap_mod
 from sim.cli import main
 from sim.mc.storage import StageLock
-from tests.oneline import SIM_ERROR, one_line
+from sim.report.verify.cli import main as verify_main
+from tests.oneline import SIM_ERROR, VERIFY_ERROR, one_line
 
 STUDY = "studies/brown_table1.toml"
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -89,3 +111,86 @@ def test_a_running_run_near_the_top_is_still_named(tmp_path, capsys):
     finally:
         lock.release()
     assert "holds res/.net.partial, which" in line
+
+
+def test_verify_of_results_whose_only_study_is_being_written_says_so(tmp_path, capsys):
+    """A first run into ``res/brown_table1`` holds ``res/.brown_table1.partial`` locked: before,
+    "no study results in res (no */claims.parquet)" and no word of it."""
+    res = tmp_path / "res"
+    lock = StageLock(res / ".brown_table1.partial").acquire()
+    try:
+        argv = ["--results", str(res), "--scratch", str(tmp_path / "v")]
+        line = one_line(capsys, verify_main(argv), "no study results", prefix=VERIFY_ERROR)
+    finally:
+        lock.release()
+    assert f"{res / 'brown_table1'}: a run is writing it now" in line
+
+
+def test_verify_of_a_study_whose_run_was_killed_before_it_published_says_so(tmp_path, capsys):
+    """``--study brown_table1`` of results holding brown_dilution and the staging directory a
+    killed run of brown_table1 left: before, "no results of 'brown_table1' ... (there are:
+    brown_dilution)" alone."""
+    res = tmp_path / "res"
+    shutil.copytree(os.path.join(ROOT, "results", "brown_dilution"), res / "brown_dilution")
+    (res / ".brown_table1.partial").mkdir()
+    argv = ["--results", str(res), "--scratch", str(tmp_path / "v"), "--study", "brown_table1"]
+    line = one_line(capsys, verify_main(argv), "no results of 'brown_table1'", prefix=VERIFY_ERROR)
+    assert "its run did not finish" in line and "the same command again finishes it" in line
+
+
+NETWORK = """study = "network"
+trials = 400
+chunk = 20
+[network]
+points = [ {{ name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" }},
+           {{ name = "B", x_mm = 400.0, y_mm = 0.0, role = "fixed" }},
+           {{ name = "C", x_mm = 400.0, y_mm = 300.0, role = "fixed" }},
+           {{ name = "D", x_mm = 0.0, y_mm = 300.0, role = "fixed" }},
+           {{ name = "P", x_mm = 150.0, y_mm = 120.0 }} ]
+generate = [ {{ kind = "distance", from = ["A", "B", "C", "D"], to = "P", sigma_mm = 0.002{d} }},
+             {{ kind = "direction", from = ["A", "B", "C", "D"], to = "*", sigma_arcsec = 2.0{a} }} ]
+"""
+
+
+def test_sim_check_of_a_network_whose_bias_is_not_absorbed_says_the_checks_are_not_applicable(
+    tmp_path, capsys
+):
+    """Before: the listing and the work line, no word of the three checks the run would count
+    "not applicable"."""
+    p = tmp_path / "net.toml"
+    p.write_text(NETWORK.format(d=", bias_mm = 10.0", a=""))
+    assert main(["check", str(p)]) == 0
+    notes = [x for x in capsys.readouterr().out.splitlines() if x.startswith("# note: ")]
+    assert len(notes) == 1, notes
+    assert "network.coverage95.mean" in notes[0] and "will be not applicable" in notes[0]
+    assert "bias_mm = 10 on the distance at 'A' to 'P'" in notes[0]
+    p.write_text(NETWORK.format(d="", a=", bias_arcsec = 30.0"))  # absorbed: no note
+    assert main(["check", str(p)]) == 0
+    assert "# note: " not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("value", ["abc", "-1", "0", "", "1.5"])
+def test_an_openblas_thread_count_openblas_cannot_read_is_refused(
+    value, tmp_path, capsys, monkeypatch
+):
+    """Before: ``sim check`` exit 0 and ``sim run`` ran (on every core with ``OMP_NUM_THREADS``
+    unreadable as well)."""
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", value)
+    monkeypatch.setenv("OMP_NUM_THREADS", "abc")
+    study = os.path.join(ROOT, STUDY)
+    need = ("OPENBLAS_NUM_THREADS: must be a whole number of threads", repr(value))
+    check = one_line(capsys, main(["check", study]), *need, prefix=SIM_ERROR)
+    run = one_line(capsys, main(["run", study, "--out", str(tmp_path / "x")]), prefix=SIM_ERROR)
+    assert check == run
+
+
+@pytest.mark.parametrize(
+    "variable, value", [("OMP_NUM_THREADS", "abc"), ("MKL_NUM_THREADS", "1.5")]
+)
+def test_thread_variables_no_library_acts_on_stay(variable, value, monkeypatch):
+    """Held: OpenBLAS reads the suite's own ``OPENBLAS_NUM_THREADS`` first; no MKL."""
+    from sim.env_vars import environment_problem
+
+    monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
+    monkeypatch.setenv(variable, value)
+    assert environment_problem() is None
