@@ -25,12 +25,25 @@ that failed on the code before its fix.
   (OpenBLAS reads the suite's ``OPENBLAS_NUM_THREADS=1`` first; Arrow's pool takes it for
   unset), ``MKL_NUM_THREADS=1.5`` (no MKL: OpenBLAS), ``NUMBA_NUM_THREADS=0``/``abc``/``1.5``
   (refused already, by numba's own reading).
+* brown_design's memory refusal advised "reduce chunk, trials or the sizes in the study file"
+  whichever part held the memory: with ``bayes.steps = 200000`` its chains are 14 GiB of it, and
+  neither chunk nor trials changes them. Each part names its keys now (the chains
+  ``bayes.steps, bayes.walkers or bayes.chains``, the design grid ``design.grids, ...``), the
+  same line from ``sim check`` and ``sim run``.
+* F44/C45: ``kill -9`` of ``python -m sim.batch --report`` while its ``sim report`` ran (which
+  then stops too) left the old ``REPORT.md`` beside the newly published results, and no
+  command ever said so. The batch marks the report due before it starts ``sim report``
+  (``<results>/.report-due``, :mod:`sim.report_due`), ``sim report`` clears the mark once
+  ``REPORT.md`` is written, and ``make verify`` (and a batch without ``--report``) names it.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -194,3 +207,69 @@ def test_thread_variables_no_library_acts_on_stay(variable, value, monkeypatch):
     monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
     monkeypatch.setenv(variable, value)
     assert environment_problem() is None
+
+
+@pytest.mark.parametrize(
+    "sets, keys",
+    [
+        (["bayes.steps=200000"], "reduce bayes.steps, bayes.walkers or bayes.chains"),
+        (["design.grids=[5, 7, 29]"], "reduce design.grids, design.offsets_mm or design.beta_mm"),
+    ],
+)
+def test_brown_designs_memory_refusal_names_the_keys_of_the_part_that_holds_it(
+    sets, keys, tmp_path, capsys
+):
+    """Before: "...; reduce chunk, trials or the sizes in the study file"."""
+    study = os.path.join(ROOT, "studies", "brown_design.toml")
+    argv = [x for k in sets for x in ("--set", k)] + ["--max-memory-gb", "0.4"]
+    check = one_line(capsys, main(["check", study, *argv]), "GiB limit", prefix=SIM_ERROR)
+    assert check.endswith(keys), check
+    out = ["--out", str(tmp_path / "x"), "--quiet", "--no-figures"]
+    assert one_line(capsys, main(["run", study, *argv, *out]), prefix=SIM_ERROR) == check
+
+
+def _children(pid: int) -> list[int]:
+    try:
+        tasks = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return []
+    out = []
+    for t in tasks:
+        try:
+            with open(f"/proc/{pid}/task/{t}/children") as f:
+                out += [int(x) for x in f.read().split()]
+        except OSError:
+            pass
+    return out
+
+
+def _await(cond, what: str, limit: float = 120.0) -> None:
+    end = time.monotonic() + limit  # (a bound on a wait for an event, not a timing assert)
+    while not cond():
+        assert time.monotonic() < end, what
+        time.sleep(0.05)
+
+
+def test_a_batch_killed_while_its_report_ran_is_named_by_the_next_verify(tmp_path, capsys):
+    """The batch's report step in a process of its own, killed (SIGKILL) as soon as its ``sim
+    report`` has started: before, ``make verify`` said nothing of the report left as it was."""
+    res = tmp_path / "res"
+    shutil.copytree(os.path.join(ROOT, "results", "brown_dilution"), res / "brown_dilution")
+    code = "import sys; from pathlib import Path; from sim.batch_report import rebuild_report; "
+    code += "rebuild_report(Path(sys.argv[1]))"
+    batch = subprocess.Popen([sys.executable, "-c", code, str(res)], cwd=ROOT)
+    _await(lambda: _children(batch.pid) or batch.poll() is not None, "no sim report started")
+    report = _children(batch.pid)
+    batch.kill()
+    batch.wait()
+    assert report, "the batch ended before its sim report started"
+    _await(lambda: not os.path.exists(f"/proc/{report[0]}"), "sim report did not stop with it")
+    assert not (res / "REPORT.md").exists()
+    argv = ["--results", str(res), "--scratch", str(tmp_path / "v"), "--no-rerun"]
+    assert verify_main(argv) == 2  # (no re-run in the scratch: nothing to compare)
+    err = capsys.readouterr().err
+    assert f"sim verify: note: {res / 'REPORT.md'} was not rebuilt" in err, err
+    assert f"sim report --results {res} rebuilds it" in err
+    assert main(["report", "--results", str(res)]) == 0  # rebuilt: the mark goes with it
+    capsys.readouterr()
+    assert verify_main(argv) == 2 and "not rebuilt" not in capsys.readouterr().err

@@ -23,6 +23,7 @@ from sim.mc.unfinished import unfinished, unfinished_in
 from sim.report.read import check_claims_table
 from sim.report.verify.child import busy_words, launcher, names_one_of, system_error
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
+from sim.report_due import due_words
 
 __all__ = ["study_dirs", "study_file", "rerun_study", "verify"]
 
@@ -244,6 +245,8 @@ def verify(
             " (sweeps: verify re-runs single studies; re-run a sweep with sim run to compare)",
             file=sys.stderr,
         )
+    if (due := due_words(results)) is not None:  # a batch's report killed (kill -9)
+        print(f"sim verify: note: {due}", file=sys.stderr)
     try:
         inside = scratch.resolve() == Path(results).resolve() or Path(results).resolve() in (
             scratch.resolve().parents
