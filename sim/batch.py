@@ -83,6 +83,7 @@ from sim.mc.paths import link_problem  # noqa: E402
 from sim.mc.storage import atomic_path  # noqa: E402
 from sim.mc.study_file import study_file_problem  # noqa: E402
 from sim.places import base, shown_path  # noqa: E402
+from sim.report_due import due_words  # noqa: E402
 from sim.stops import (  # noqa: E402
     check_interrupt,
     exit_status,
@@ -386,6 +387,8 @@ def _run(args, files: list[Path], run_args: list[str], note, loaded, default, ph
             signal.signal(s, _on_sigterm)  # end the runs as Ctrl-C does
     if note:  # once, not one line per run that refuses it
         print(f"sim.batch: note: {note}", file=sys.stderr)
+    if not args.report and (due := due_words(Path(args.results))):  # (--report rebuilds it)
+        print(f"sim.batch: note: {due}", file=sys.stderr)
     log = _Stdout()
     phase.append("run")
     try:

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from sim.held_stops import held_stops
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, stop_children
+from sim.report_due import mark_due
 
 __all__ = ["rebuild_report", "not_rebuilt"]
 
@@ -35,6 +36,7 @@ def rebuild_report(results: Path) -> int:
     ``Popen``, the report skipped and never said)."""
     cmd = [sys.executable, "-m", "sim", "report", f"--results={results}"]  # (a name "-r")
     proc = held = None
+    mark_due(results)  # cleared by sim report once REPORT.md is written (kill -9: said later)
     try:
         try:
             with held_stops():

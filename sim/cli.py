@@ -251,6 +251,8 @@ def _check(args) -> int:
     if off:  # said before the run: its predictions will be findings (sim.claims.rules)
         print(f"# {off_setup(study, cfg, before=True)}")
     print(f"# work: {est.describe()}; {est.core_time()}")
+    for note in study.notes(dict(cfg)) if study.notes else []:  # N45: said before the run
+        print(f"# note: {note}")
     return 0
 
 

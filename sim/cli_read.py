@@ -26,6 +26,7 @@ from sim.places import base, shown_path
 from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
+from sim.report_due import clear_due
 from sim.stale import other_code, stale_dirs
 from sim.studies import MODULES, STUDY_FILES, design_config, get_study
 
@@ -193,6 +194,7 @@ def report(results: Path) -> int:
         if (why := older_lacks(results, e)) is None:
             raise
         raise ConfigError("--results", why) from None
+    clear_due(results)  # a batch's report killed before it ended is rebuilt now
     print(text)
     if stale := stale_dirs(results):  # a report of verdicts since changed: read as current
         names = ", ".join(sorted(Path(s).name for s in stale)[:4]) + (

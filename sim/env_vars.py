@@ -18,6 +18,7 @@ from sim.threads import address_space_problem, single_threaded_blas
 __all__ = [
     "MIN_DATA_KB",
     "arrow_simd_problem",
+    "blas_threads_problem",
     "data_limit_problem",
     "environment_problem",
     "numba_variables_problem",
@@ -41,7 +42,12 @@ def refuse_bad_variables(prog: str) -> None:
     if (problem := data_limit_problem()) is not None:
         sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)
-    problem = sim_variables_problem() or arrow_simd_problem() or numba_variables_problem()
+    problem = (
+        sim_variables_problem()
+        or blas_threads_problem()
+        or arrow_simd_problem()
+        or numba_variables_problem()
+    )
     if problem is not None:
         sys.stderr.write(f"{prog}: error: {problem}\n")
         sys.exit(2)
@@ -70,6 +76,7 @@ def environment_problem() -> str | None:
         address_space_problem()
         or data_limit_problem()
         or sim_variables_problem()
+        or blas_threads_problem()
         or arrow_simd_problem()
         or numba_variables_problem()
     )
@@ -86,6 +93,37 @@ def sim_variables_problem() -> str | None:
     return (
         f"SIM_NO_JIT: must be 1 (the kernels run as Python) or empty or unset (the compiled "
         f"kernels), got {v[:40]!r}"
+    )
+
+
+def blas_threads_problem() -> str | None:
+    """What is wrong with ``OPENBLAS_NUM_THREADS``, or None. NumPy's and SciPy's OpenBLAS read
+    it as C's ``atoi`` when they load, and a value read as 0 or less (``abc``, ``-1``, ``0``, an
+    empty one) is taken for none given: OpenBLAS then reads ``GOTO_NUM_THREADS`` and
+    ``OMP_NUM_THREADS`` the same way, else runs on every core (the suite sets 1 only where a
+    variable is unset: :mod:`sim.threads`). With ``OMP_NUM_THREADS=abc`` too it ran on every
+    core without a word, where the suite runs one thread a process: oversubscribed under
+    ``--workers``, and a large dense solve's last digits another's (a 300 x 300 solve differs
+    at one and two threads); ``1.5`` or ``2x`` were read as their leading digits. The variable
+    is a whole number of threads, 1 or more, or unset. The others stay as given, measured:
+    OpenBLAS reads ``GOTO_NUM_THREADS`` and ``OMP_NUM_THREADS`` only after this one (which the
+    suite sets, or this refuses), Arrow's pool takes an ``OMP_NUM_THREADS`` it cannot read for
+    unset (its I/O threads: the same tables), no library of the suite reads
+    ``MKL_NUM_THREADS`` (OpenBLAS, not MKL), and numba's are checked below."""
+    v = os.environ.get("OPENBLAS_NUM_THREADS")
+    if v is None or (v.isascii() and v.isdigit() and int(v) >= 1):
+        return None
+    m = re.match(r"[ \t\n\v\f\r]*([+-]?[0-9]+)", v)  # atoi's reading
+    read = int(m[1]) if m else 0
+    how = (
+        f"OpenBLAS would read it as {read}"
+        if read >= 1
+        else "OpenBLAS would ignore it (then reading GOTO_NUM_THREADS and OMP_NUM_THREADS, "
+        "else running on every core)"
+    )
+    return (
+        "OPENBLAS_NUM_THREADS: must be a whole number of threads, 1 or more, or unset (the "
+        f"suite then runs one a process), got {v[:40]!r}: {how}"
     )
 
 

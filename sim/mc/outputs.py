@@ -160,11 +160,12 @@ def check_out(out: Path, shown: str, record: dict, overwrite: bool) -> None:
         )
     if old is None:
         if filled:
-            refuse_if_running_under(out, shown)
+            names = refuse_if_running_under(out, shown)  # a bounded look (R45), no walk
+            held = f" (it holds {names[0]!r}{' and more' if names[1:] else ''})" if names else ""
             raise ConfigError(
                 "--out",
                 f"{shown} holds files but {record_problem(out)}; "  # a damaged one named
-                "sim never replaces it, with or without --overwrite",
+                f"sim never replaces it, with or without --overwrite{held}",
             )
         _check_replaceable(out, shown)
         return

@@ -24,10 +24,11 @@ import errno
 import fcntl
 import os
 import stat
+from collections import deque
 from pathlib import Path
 
 from sim.mc.config import ConfigError
-from sim.mc.storage import LOCK, Locked, NotALock, StageLock
+from sim.mc.storage import LOCK, RECORD, Locked, NotALock, StageLock
 
 __all__ = [
     "holder",
@@ -78,15 +79,39 @@ def refuse_if_publishing(out: Path, shown: str) -> None:
         raise ConfigError("--out", busy_words(shown, pid))
 
 
-def refuse_if_running_under(out: Path, shown: str) -> None:
+#: the entries :func:`refuse_if_running_under` looks at, at most (a home directory of
+#: millions of files was walked in full before its refusal: minutes; 10,000 take ~50 ms)
+LOOK_AT = 10_000
+
+
+def refuse_if_running_under(out: Path, shown: str) -> list[str]:
     """Refuse ``out`` (no run record of its own, not empty) while a run writes under it, a run
     into a directory inside it (its staging directory's ``.lock`` held): it was "holds files
-    but no sim run record", naming no run, as that run went on."""
-    for top, dirs, files in os.walk(out):
-        dirs[:] = [n for n in dirs if not os.path.islink(os.path.join(top, n))]
-        if LOCK in files and (held := holder(Path(top) / LOCK))[0]:
-            where = Path(top).relative_to(out)
-            raise ConfigError("--out", busy_words(f"{shown} holds {where}, which", held[1]))
+    but no sim run record", naming no run, as that run went on. Looks at no more than
+    :data:`LOOK_AT` entries, breadth first (the refusal that follows holds without the rest: a run
+    deeper than that is not named). Returns the names directly under ``out`` (the run record
+    aside) of those looked at, sorted, for the refusal to name."""
+    todo, seen, first = deque([out]), 0, []
+    while todo and seen < LOOK_AT:
+        top = todo.popleft()
+        try:
+            with os.scandir(top) as it:
+                for e in it:
+                    seen += 1
+                    if top is out and e.name != RECORD:
+                        first.append(e.name)
+                    if e.name == LOCK and (held := holder(Path(e.path)))[0]:
+                        where = Path(top).relative_to(out)
+                        raise ConfigError(
+                            "--out", busy_words(f"{shown} holds {where}, which", held[1])
+                        )
+                    if e.is_dir(follow_symlinks=False):
+                        todo.append(Path(e.path))
+                    if seen >= LOOK_AT:
+                        break
+        except OSError:
+            continue
+    return sorted(first)
 
 
 def hold_old(out: Path, shown: str) -> StageLock | None:

@@ -59,6 +59,9 @@ class Study:
     #: the config spelled in the paper's printed keys where another spelling resolves to the
     #: paper's setup (brown_table1's list of Table 1's 25 points); None: as it is
     as_printed: Callable[[dict], dict] | None = None
+    #: what ``sim check`` says of the run of the validated config before it (a note a line:
+    #: the network's self-checks a bias will leave not applicable); None: nothing
+    notes: Callable[[dict], list[str]] | None = None
 
 
 def unread_keys(study: Study, cfg: Mapping[str, Any]) -> dict[str, str]:

@@ -19,9 +19,11 @@ from sim.mc.overrides import listed, replayable, without
 from sim.mc.paths import link_problem
 from sim.mc.storage import LOCK, read_provenance, read_record
 from sim.mc.table_edits import edited_tables
+from sim.mc.unfinished import unfinished, unfinished_in
 from sim.report.read import check_claims_table
 from sim.report.verify.child import busy_words, launcher, names_one_of, system_error
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
+from sim.report_due import due_words
 
 __all__ = ["study_dirs", "study_file", "rerun_study", "verify"]
 
@@ -50,7 +52,11 @@ def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path,
                 f"{', ...' if len(sweeps) > 3 else ''}: sweep.parquet): verify re-runs single "
                 "studies; re-run a sweep with sim run to compare"
             )
-        raise VerifyError(f"--results: no study results in {results} (no */claims.parquet)")
+        left = unfinished_in(results)  # a run in progress, or killed before it published
+        raise VerifyError(
+            f"--results: no study results in {results} (no */claims.parquet)"
+            + (f"; {left}" if left else "")
+        )
     if only:
         names = {n for d, s in found for n in (s, d.name)}
         unknown = [s for s in only if s not in names]
@@ -71,9 +77,18 @@ def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path,
                     else ""
                 )
                 + f"(there are: {', '.join(sorted(d.name for d, _ in found))})"
+                + "".join(f"; {results / s}: {w}" for s in unknown[:1] if (w := _left(results, s)))
             )
         found = [(d, s) for d, s in found if s in only or d.name in only]
     return found
+
+
+def _left(results: Path, name: str) -> str | None:
+    """Words on an unfinished run of the study ``name`` in ``results`` (a run writing it now,
+    or killed before it published), or None: verify said only "no results of" it."""
+    if not name or "/" in name or name in (".", ".."):
+        return None
+    return unfinished(results / name)
 
 
 def _target(scratch: Path, name: str) -> tuple[Path, bool]:
@@ -230,6 +245,8 @@ def verify(
             " (sweeps: verify re-runs single studies; re-run a sweep with sim run to compare)",
             file=sys.stderr,
         )
+    if (due := due_words(results)) is not None:  # a batch's report killed (kill -9)
+        print(f"sim verify: note: {due}", file=sys.stderr)
     try:
         inside = scratch.resolve() == Path(results).resolve() or Path(results).resolve() in (
             scratch.resolve().parents

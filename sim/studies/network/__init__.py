@@ -20,6 +20,7 @@ and :mod:`.kernel` (observation model), :mod:`.analysis` and :mod:`.sparse_analy
 from __future__ import annotations
 
 from sim.studies import Study
+from sim.studies.network.bias_checks import bias_notes
 from sim.studies.network.report import report
 from sim.studies.network.run import run
 from sim.studies.network.schema import SCHEMA, check, unread
@@ -35,5 +36,6 @@ STUDIES = {
         check,
         order=90,
         unread=unread,
+        notes=bias_notes,
     ),
 }
