@@ -78,15 +78,35 @@ def refuse_if_publishing(out: Path, shown: str) -> None:
         raise ConfigError("--out", busy_words(shown, pid))
 
 
+#: the entries :func:`refuse_if_running_under` looks at before it gives up naming a run
+WALK_ENTRIES = 20_000
+
+
 def refuse_if_running_under(out: Path, shown: str) -> None:
     """Refuse ``out`` (no run record of its own, not empty) while a run writes under it, a run
     into a directory inside it (its staging directory's ``.lock`` held): it was "holds files
-    but no sim run record", naming no run, as that run went on."""
+    but no sim run record", naming no run, as that run went on. Only the first
+    :data:`WALK_ENTRIES` entries are looked at, and no mounted file system inside ``out``:
+    the caller refuses ``out`` in any case, this only names the run, and ``--out ~`` or
+    ``--out /usr`` walked every file under it before the refusal (122,000 of ``/usr`` took
+    seconds; a home or data disk of millions, minutes)."""
+    seen = 0
     for top, dirs, files in os.walk(out):
-        dirs[:] = [n for n in dirs if not os.path.islink(os.path.join(top, n))]
         if LOCK in files and (held := holder(Path(top) / LOCK))[0]:
             where = Path(top).relative_to(out)
             raise ConfigError("--out", busy_words(f"{shown} holds {where}, which", held[1]))
+        seen += len(dirs) + len(files)
+        if seen > WALK_ENTRIES:
+            return
+        dirs[:] = [n for n in dirs if not _link_or_mount(os.path.join(top, n))]
+
+
+def _link_or_mount(p: str) -> bool:
+    """Whether the directory entry ``p`` is a symbolic link or a mount point (not walked)."""
+    try:
+        return os.path.islink(p) or os.path.ismount(p)
+    except OSError:
+        return True
 
 
 def hold_old(out: Path, shown: str) -> StageLock | None:

@@ -1,0 +1,84 @@
+"""A hostile reading of session 45's merges (brief R46); each test failed on the code before
+its fix.
+
+* ``sim.run_chunks`` (A44's checks of what a chunk function returns,
+  :class:`sim.api_chunks.Checked`) took a key's first axis as the chunk's trials ``n`` or 1
+  (a per-chunk statistic) in each chunk alone: a function giving ``n`` rows in one chunk and
+  one in another passed every chunk, and the concatenation returned 4 values for 6 trials in
+  two chunks of 3, without a word (the silent "more values than trials" A44 closed, in its
+  other direction). The totals tell it now (:func:`sim.api_chunks.check_counts`).
+* F44's refusal of a directory that holds a running run (:func:`sim.mc.swap.
+  refuse_if_running_under`) walked every file under an ``--out`` that has files and no run
+  record before refusing it, which that run is in any case: ``--out /usr`` looked at 122,000
+  entries, ``--out ~`` of a home of millions for minutes, and walked into file systems
+  mounted inside. It looks at :data:`sim.mc.swap.WALK_ENTRIES` entries and no mount now.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+import sim
+from sim.mc import swap
+from sim.mc.config import ConfigError
+
+
+def _mixed(rng, n, calls=[0]):  # noqa: B006 - the chunks' count, across calls
+    calls[0] += 1
+    return {"x": rng.standard_normal(n if calls[0] % 2 else 1)}
+
+
+def test_run_chunks_refuses_a_key_per_trial_in_one_chunk_and_per_chunk_in_another():
+    """Class: a chunk function whose array is of ``n`` rows in one chunk and of 1 in another
+    (each chunk alone as allowed). Before: 4 values for 6 trials returned, exit 0."""
+    with pytest.raises(ConfigError) as e:
+        sim.run_chunks(_mixed, 6, 1, 3, quiet=True)
+    assert e.value.key == "fn"
+    assert "'x'" in str(e.value) and "4 values for 6 trials in 2 chunks" in str(e.value)
+
+
+def test_run_chunks_keeps_per_trial_and_per_chunk_keys_with_a_last_chunk_of_one():
+    """The counts of a consistent function pass, a last chunk of one trial included (its
+    ``n`` and 1 agree), per-trial and per-chunk keys side by side."""
+
+    def fn(rng, n):
+        return {"x": rng.standard_normal((n, 2)), "s": np.array([float(n)])}
+
+    out = sim.run_chunks(fn, 7, 1, 3, quiet=True)
+    assert out["x"].shape == (7, 2)
+    assert out["s"].tolist() == [3.0, 3.0, 1.0]
+
+
+def test_a_directory_without_a_record_is_not_walked_whole_for_a_running_run(tmp_path, monkeypatch):
+    """Class: ``--out`` a large tree of the user's (``~``, ``/usr``), refused as holding files
+    but no run record. Before: every directory under it walked first (here all 61)."""
+    for k in range(60):
+        (tmp_path / f"d{k:02d}").mkdir()
+        (tmp_path / f"d{k:02d}" / "f").write_text("x")
+    tops: list[str] = []
+    walk = os.walk
+
+    def counted(*a, **kw):
+        for item in walk(*a, **kw):
+            tops.append(item[0])
+            yield item
+
+    monkeypatch.setattr(swap, "WALK_ENTRIES", 10, raising=False)
+    monkeypatch.setattr(os, "walk", counted)
+    swap.refuse_if_running_under(tmp_path, str(tmp_path))
+    assert 1 <= len(tops) <= 11
+
+
+def test_a_held_lock_within_the_walk_is_still_named(tmp_path):
+    """The refusal naming the run inside still holds within the walk's entries."""
+    stage = tmp_path / "sub" / ".run.partial"
+    lock = swap.StageLock(stage).acquire()
+    try:
+        with pytest.raises(ConfigError) as e:
+            swap.refuse_if_running_under(tmp_path, "OUT")
+        assert "OUT holds sub/.run.partial" in str(e.value) and f"pid {os.getpid()}" in str(e.value)
+    finally:
+        lock.release()
