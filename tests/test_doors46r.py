@@ -12,11 +12,18 @@ its fix.
   record before refusing it, which that run is in any case: ``--out /usr`` looked at 122,000
   entries, ``--out ~`` of a home of millions for minutes, and walked into file systems
   mounted inside. It looks at :data:`sim.mc.swap.WALK_ENTRIES` entries and no mount now.
+* X44's test of gama-local's absolute terms (:mod:`sim.studies.network.gama_terms`) wrapped
+  an angle to half a turn by subtracting a turn at a time, as gama-local does: a direction's
+  ``val="1e15"`` (gon) or an ``<obs orientation="1e15">`` (radians), finite floats the reader
+  takes, ran ``sim check`` and every run of the file for ever. The IEEE remainder now.
 """
 
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -82,3 +89,35 @@ def test_a_held_lock_within_the_walk_is_still_named(tmp_path):
         assert "OUT holds sub/.run.partial" in str(e.value) and f"pid {os.getpid()}" in str(e.value)
     finally:
         lock.release()
+
+
+TWO_SETS = Path(__file__).parent / "data" / "gama" / "two_sets.xml"
+
+
+def test_a_direction_of_a_huge_value_in_a_gama_file_is_judged_not_wrapped_for_ever(tmp_path):
+    """Class: a GNU Gama file with a direction ``val`` of 1e15 gon and an ``<obs>``
+    orientation of 1e15 radians (finite, read). Before: ``sim check`` never ended (killed by
+    this test's timeout); now the absolute-term test refuses it in one line, naming it."""
+    text = TWO_SETS.read_text()
+    a = '<direction to="B" val="6.345103486110713" stdev="9.25925925925926" />'
+    assert text.count(a) == 1 and text.count('<obs from="B">') == 1
+    text = text.replace(a, a.replace("6.345103486110713", "1e15"))
+    text = text.replace('<obs from="B">', '<obs from="B" orientation="1e15">')
+    (tmp_path / "g.xml").write_text(text)
+    study = tmp_path / "g.toml"
+    study.write_text(
+        f'study = "network"\ntrials = 40\nchunk = 2\nseed = 1\n[network]\ngama_xml = "{tmp_path / "g.xml"}"\n'
+    )
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "sim", "check", str(study)],
+            capture_output=True,
+            text=True,
+            timeout=240,
+            cwd=Path(__file__).parents[1],
+        )
+    except subprocess.TimeoutExpired:
+        pytest.fail("sim check of a direction of 1e15 gon did not end")
+    err = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(err) == 1, done.stderr
+    assert "<direction> attribute 'val'" in err[0] and "Outlying absolute terms" in err[0]
