@@ -22,6 +22,9 @@ its fix.
   of 50 models) was refused "a chunk of 50 blocks needs 232.3 GB" after 47 s of CPU (3 min
   44 s on the loaded machine) of those adjustments. The refusal, which needs only the block's
   table of observations, comes first now.
+* ``sim.write_table`` (A44's checks of its columns) refused a column's value that UTF-8
+  cannot hold (a lone surrogate, as ``os.fsdecode`` makes of bytes that are not UTF-8) but not
+  such a column name: ``UnicodeEncodeError`` from Arrow, a traceback.
 """
 
 from __future__ import annotations
@@ -142,3 +145,14 @@ def test_agnard_refuses_a_chunk_over_memory_before_it_checks_the_datum(monkeypat
     with pytest.raises(ConfigError) as e:
         sim.load("studies/agnard_block.toml", trials=1_000_000, chunk=50_000)
     assert e.value.key == "chunk" and "17.5 GB" in str(e.value)
+
+
+def test_write_table_refuses_a_column_name_utf8_cannot_hold(tmp_path):
+    """Class: a column named with a lone surrogate (``os.fsdecode(b"\\xff")``). Before:
+    ``UnicodeEncodeError`` from pyarrow; now one line naming ``columns``, nothing written."""
+    name = os.fsdecode(b"x\xff")
+    with pytest.raises(ConfigError) as e:
+        sim.write_table(tmp_path / "t.parquet", {name: [1.0]}, {"a": 1})
+    assert e.value.key == "columns" and "UTF-8" in str(e.value)
+    assert not any(tmp_path.iterdir())
+    sim.write_table(tmp_path / "t.parquet", {"x\u00e9": [1.0]}, {"a": 1})  # text beyond ASCII
