@@ -25,6 +25,11 @@ its fix.
 * ``sim.write_table`` (A44's checks of its columns) refused a column's value that UTF-8
   cannot hold (a lone surrogate, as ``os.fsdecode`` makes of bytes that are not UTF-8) but not
   such a column name: ``UnicodeEncodeError`` from Arrow, a traceback.
+* M44's cache of parsed GNU Gama files (:mod:`sim.studies.network.gama_cache`) dropped its
+  oldest entry by iterating the dict another thread was putting one into: network studies
+  loaded in threads at once (``sim.load`` in a thread pool) ended in "RuntimeError:
+  dictionary changed size during iteration". Its neighbours of the same form (the loads'
+  record in :mod:`sim.room`, the last sparse pre-analysis) take it under a lock, or hold it.
 """
 
 from __future__ import annotations
@@ -32,6 +37,8 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -156,3 +163,43 @@ def test_write_table_refuses_a_column_name_utf8_cannot_hold(tmp_path):
     assert e.value.key == "columns" and "UTF-8" in str(e.value)
     assert not any(tmp_path.iterdir())
     sim.write_table(tmp_path / "t.parquet", {"x\u00e9": [1.0]}, {"a": 1})  # text beyond ASCII
+
+
+def test_gama_files_parsed_by_threads_at_once_share_the_cache(monkeypatch):
+    """Class: threads loading network studies from GNU Gama files at once. Before: about
+    every thread ended in "RuntimeError: dictionary changed size during iteration"."""
+    from sim.studies.network import gama_cache
+
+    names = ("two_sets", "one_fixed", "directions_free")
+    files = [Path(__file__).parent / "data" / "gama" / f"{n}.xml" for n in names]
+
+    class Slow(dict):  # the race's window widened: the oldest found, then a pause
+        def __iter__(self):
+            it = super().__iter__()
+            time.sleep(0.002)
+            return it
+
+    monkeypatch.setattr(gama_cache, "_PARSED", Slow())
+    errors: list[str] = []
+
+    def work(i: int) -> None:
+        for k in range(20):
+            try:
+                rec = gama_cache.read_gama(files[(i + k) % 3])
+            except Exception as e:  # noqa: BLE001 - what a thread met is the finding
+                errors.append(repr(e))
+                return
+            assert rec["network.points"]
+
+    old = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)  # threads switch between the dict's steps
+    try:
+        threads = [threading.Thread(target=work, args=(i,)) for i in range(8)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    finally:
+        sys.setswitchinterval(old)
+    assert errors == []
+    assert len(gama_cache._PARSED) == gama_cache.KEPT
