@@ -30,7 +30,7 @@ import numpy as np
 from sim.mc.config import MAX_CHUNKS, ConfigError
 from sim.mc.runner import ROWS, RunContext
 
-__all__ = ["Checked", "check_options", "check_fn", "ran"]
+__all__ = ["Checked", "check_options", "check_fn", "check_counts", "ran"]
 
 #: set on an exception of the chunk function itself (kept through a worker's pickle)
 _OWN = "_sim_chunk_function"
@@ -133,6 +133,24 @@ def check_options(trials: int, chunk: int, label, quiet, ctx, keep_rows, units) 
         )
         if not ok or not math.isfinite(units) or units <= 0:
             raise ConfigError("units", f"must be a positive number or None, got {units!r:.60}")
+
+
+def check_counts(out: Mapping, trials: int, chunks: int) -> None:
+    """Refuse a key whose chunks gave their trials as its first axis in some and 1 (a
+    per-chunk statistic) in others, each chunk alone passing :class:`Checked`: concatenated
+    they are neither ``trials`` values nor ``chunks`` (6 trials in chunks of 3, ``(3,)`` then
+    ``(1,)``: 4 values returned, without a word). Where every chunk gave the same kind the
+    count is exactly one of the two, so the totals tell (run across workers, no chunk knows
+    another's)."""
+    for key, v in out.items():
+        m = np.shape(v)[0]
+        if m not in (trials, chunks):
+            raise ConfigError(
+                "fn",
+                f"returned {key!r} with the chunk's trials as its first axis in some chunks and 1 "
+                f"(a per-chunk statistic) in others: {m} values for {trials} trials in {chunks} "
+                "chunks; return one kind in every chunk",
+            )
 
 
 def ran(e: Exception) -> ConfigError | None:

@@ -26,7 +26,7 @@ import numpy as np
 import pyarrow as pa
 
 from sim.api_args import arguments
-from sim.api_chunks import Checked, check_fn, check_options, ran
+from sim.api_chunks import Checked, check_counts, check_fn, check_options, ran
 from sim.api_paths import check_path, why_unread
 from sim.api_write import checked_write
 from sim.mc import runner, storage
@@ -76,7 +76,7 @@ def _of_counts(run):
             raise ConfigError("part", f"must be a whole number >= 0, got {part!r}")
         check_options(int(trials), int(chunk), label, quiet, ctx, keep_rows, units)
         try:
-            return run(
+            out = run(
                 Checked(fn), int(trials), int(seed), int(chunk), int(part), label, bool(quiet),
                 ctx, bool(keep_rows), units,
             )  # fmt: skip
@@ -84,6 +84,8 @@ def _of_counts(run):
             if (refusal := ran(e)) is not None:  # chunks that do not fit together
                 raise refusal from None
             raise
+        check_counts(out, int(trials), -(-int(trials) // int(chunk)))
+        return out
 
     return arguments(checked)
 

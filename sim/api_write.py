@@ -14,7 +14,8 @@ tracebacks of pyarrow, ``json`` and the OS, and did worse silently:
   written as its str (``{1: 2}`` read back as ``{"1": 2}``); NaN and infinities were written
   as ``NaN`` and ``Infinity``, which are not JSON (another reader of the file refuses them).
 * a column of mixed types (``[1, "x"]``), of complex numbers or a record dtype, columns of
-  different lengths, a column name that is not a str: pyarrow's ``ArrowInvalid``,
+  different lengths, a column name that is not a str (or one with a lone surrogate, as
+  ``os.fsdecode`` makes of bytes that are not UTF-8): pyarrow's ``ArrowInvalid``,
   ``ArrowNotImplementedError`` or ``TypeError``; a masked array (``np.ma``) was written as its
   data, the masked values as numbers: they are nulls now, as pyarrow reads a mask.
 * an infinite value was the storage's ``NonFiniteError`` and a tolerance naming no column or
@@ -84,6 +85,13 @@ def _column(name: Any, v: Any) -> pa.Array:
     """One column as Arrow holds it (a masked array's masked values null), or refused."""
     if not isinstance(name, str):
         raise ConfigError("columns", f"a column's name must be a str, got {name!r:.60}")
+    if not name.isascii():  # a lone surrogate (a name decoded from bytes that are not
+        try:  # UTF-8, os.fsdecode): Arrow's UnicodeEncodeError, a traceback
+            name.encode("utf-8")
+        except UnicodeEncodeError:
+            raise ConfigError(
+                "columns", f"column {name!r:.60}: its name is not text UTF-8 can hold"
+            ) from None
     if isinstance(v, (set, frozenset, Mapping)):  # np.asarray: one object, "only 1-D arrays"
         kind = "mapping" if isinstance(v, Mapping) else "set"
         raise ConfigError("columns", f"column {name!r} is a {kind}, of no order: give a list")

@@ -30,6 +30,7 @@ import hashlib
 import json
 import os
 import resource
+import threading
 from collections.abc import Callable, Mapping
 
 from sim.mc.config import ConfigError
@@ -57,6 +58,7 @@ _LIMITS = ((resource.RLIMIT_AS, 0, "ulimit -v"), (resource.RLIMIT_DATA, 5, "ulim
 #: before the load, what the load added)}; the last :data:`_KEPT` configs loaded
 _LOADS: dict[str, dict[int, tuple[int, int]]] = {}
 _KEPT = 32
+_LOCK = threading.Lock()  # loads in threads at once: one dropped the oldest as another put in
 
 
 def _config_key(cfg: Mapping) -> str | None:
@@ -80,10 +82,11 @@ def loaded(load: Callable[[], tuple]) -> tuple:
             rec[field] = (b, max(a - b, 0))
     if (key := _config_key(cfg)) is None:
         return study, cfg
-    _LOADS.pop(key, None)
-    _LOADS[key] = rec
-    while len(_LOADS) > _KEPT:
-        del _LOADS[next(iter(_LOADS))]
+    with _LOCK:
+        _LOADS.pop(key, None)
+        _LOADS[key] = rec
+        while len(_LOADS) > _KEPT:
+            del _LOADS[next(iter(_LOADS))]
     return study, cfg
 
 

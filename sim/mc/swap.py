@@ -88,8 +88,8 @@ def refuse_if_running_under(out: Path, shown: str) -> list[str]:
     """Refuse ``out`` (no run record of its own, not empty) while a run writes under it, a run
     into a directory inside it (its staging directory's ``.lock`` held): it was "holds files
     but no sim run record", naming no run, as that run went on. Looks at no more than
-    :data:`LOOK_AT` entries, breadth first (the refusal that follows holds without the rest: a run
-    deeper than that is not named). Returns the names directly under ``out`` (the run record
+    :data:`LOOK_AT` entries, breadth first, and no link or mounted file system inside ``out`` (the
+    refusal that follows holds without the rest: a run deeper than that is not named). Returns the names directly under ``out`` (the run record
     aside) of those looked at, sorted, for the refusal to name."""
     todo, seen, first = deque([out]), 0, []
     while todo and seen < LOOK_AT:
@@ -105,7 +105,7 @@ def refuse_if_running_under(out: Path, shown: str) -> list[str]:
                         raise ConfigError(
                             "--out", busy_words(f"{shown} holds {where}, which", held[1])
                         )
-                    if e.is_dir(follow_symlinks=False):
+                    if e.is_dir(follow_symlinks=False) and not os.path.ismount(e.path):
                         todo.append(Path(e.path))
                     if seen >= LOOK_AT:
                         break

@@ -9,11 +9,15 @@ and hashed on every call (20 ms there): a file edited between two loads has anot
 is parsed again, so an edit is always seen (the config records the digest too). Each caller
 gets its own copy of the records (a caller may change them); a file that is refused is not
 kept (the next call refuses it again, in the same words). At most :data:`KEPT` files are kept.
+The kept records are taken and put back under a lock: threads loading network studies at once
+(``sim.load`` in a thread pool) ended in "RuntimeError: dictionary changed size during
+iteration" as one dropped the oldest while another put one in (a parse runs unlocked).
 """
 
 from __future__ import annotations
 
 import hashlib
+import threading
 from pathlib import Path
 
 from sim.studies.network.gama_read import read_bytes
@@ -24,6 +28,7 @@ __all__ = ["read_gama", "gama_digest", "KEPT"]
 #: the parsed files kept (the last ones read): about 25 MB each at 10,000 points
 KEPT = 2
 _PARSED: dict[tuple, dict] = {}
+_LOCK = threading.Lock()
 
 
 def _fresh(x):
@@ -47,10 +52,12 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
     if sha256 and sha256 != digest:
         return _parse(path, key, sha256)  # the file changed since the load: refused there
     at = (str(path), key, digest)
-    rec = _PARSED.pop(at, None)
+    with _LOCK:
+        rec = _PARSED.pop(at, None)
     if rec is None:
         rec = _parse(path, key, digest)  # edited since this read: refused, read again next
-    _PARSED[at] = rec  # the last read kept last
-    while len(_PARSED) > KEPT:
-        del _PARSED[next(iter(_PARSED))]
+    with _LOCK:
+        _PARSED[at] = rec  # the last read kept last
+        while len(_PARSED) > KEPT:
+            del _PARSED[next(iter(_PARSED))]
     return _fresh(rec)

@@ -46,12 +46,12 @@ def angle_rad(text: str) -> float:
 
 
 def _wrap(a: float) -> float:
-    """``a`` (rad) into [-pi, pi], as gama-local wraps an absolute term (in cc)."""
-    while a > math.pi:
-        a -= 2 * math.pi
-    while a < -math.pi:
-        a += 2 * math.pi
-    return a
+    """``a`` (rad) into [-pi, pi], as gama-local wraps an absolute term (in cc): the IEEE
+    remainder by a turn, in one step. gama-local subtracts turn after turn, as this did: a
+    ``val="1e15"`` (gon) of a direction, or an ``<obs orientation>`` of 1e15 radians, ran
+    ``sim check`` and every run for ever (gama-local 2.03 does not end on that file either;
+    a val is a finite float, :mod:`sim.studies.network.gama_vocab`)."""
+    return math.remainder(a, 2 * math.pi)
 
 
 def _median_orientation(sz: list[float]) -> float:

@@ -223,10 +223,12 @@ def pre_analysis(net: Network, datum: lsq.Datum, a0: float, power: float) -> Ana
     if not use_sparse(net):
         return analyse(net, datum, a0, power)
     key = _key(net, datum, a0, power)
-    if key not in _LAST:  # `sim run` checks the config, then runs it: one analysis for both
+    an = _LAST.get(key)  # `sim run` checks the config, then runs it: one analysis for both
+    if an is None:  # (held here: a thread's load of another network clears it meanwhile)
+        an = analyse_sparse(net, datum, a0, power)
         _LAST.clear()
-        _LAST[key] = analyse_sparse(net, datum, a0, power)
-    return _LAST[key]
+        _LAST[key] = an
+    return an
 
 
 #: the last sparse pre-analysis of this process, by the digest of its inputs
