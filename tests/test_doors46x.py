@@ -31,6 +31,13 @@ a check that does not need it.
   alone, it is named in the note now (this study drops every dz, so the networks are the same);
   when its term starts the test that removes a direction by its weighted term only, the line
   names the dz as what starts it, and counts it among those removed.
+* Observed coordinates other than the point's: ``gama-local`` takes the last x, y given as the
+  point's (a ``<coordinates>`` point sets them) and tests every term there; the suite kept the
+  ``<point>``'s and tested none: C observed 2 m off, four observations of C removed there, all
+  kept here (another geometry, four degrees of freedom more), silently. The point moves as
+  there (the note says so), and observed coordinates are tested against a ``<point>`` after
+  them.
+* An ``<obs>`` with no observation was read; ``gama-local`` refuses the file. Refused now.
 """
 
 from __future__ import annotations
@@ -85,7 +92,8 @@ def _gama_run(path: Path) -> tuple[str, int]:
 def _outlying(text: str) -> list[str]:
     """The kinds gama-local lists as outlying absolute terms (``z dif``, ``dir.``, ``angle``:
     the row that ends in the observed value and the term; an angle's fore sight on a line of
-    its own, without the row's number and station)."""
+    its own, without the row's number and station; an observed coordinate's, ``x``, without a
+    target)."""
     if "Outlying absolute terms in project equations" not in text:
         return []
     table = text.split("Outlying absolute terms in project equations")[1].split("Observations")[0]
@@ -93,7 +101,10 @@ def _outlying(text: str) -> list[str]:
     for row in table.splitlines():
         w = row.split()
         if len(w) >= 4 and all(re.fullmatch(r"-?[\d.]+(e[+-]\d+)?", x) for x in w[-2:]):
-            kinds.append(" ".join(w[3:-2] if re.match(r"\s+\d+\s", row) else w[1:-2]))
+            if not re.match(r"\s+\d+\s", row):
+                kinds.append(" ".join(w[1:-2]))
+            else:  # an observed coordinate has no target: its kind follows the station
+                kinds.append(" ".join(w[3:-2]) or w[2])
     return kinds
 
 
@@ -433,3 +444,54 @@ def test_random_files_of_these_kinds_agree_with_gama_local(tmp_path, seed):
     net, an = ours(st)
     assert dof == an.dof + n_vec - len(gone)
     agree_with_gama(st, tmp_path / "s.xml")
+
+
+# --- observed coordinates other than the point's ---------------------------------------------
+
+
+def _observed_c(x: float) -> str:
+    return (
+        f'<coordinates><point id="C" x="{x!r}" y="280"/>'
+        '<cov-mat dim="2" band="0">4 4</cov-mat></coordinates>'
+    )
+
+
+def test_observed_coordinates_after_the_point_move_it_as_in_gama_local(tmp_path):
+    """gama-local's <coordinates> point sets the point's x and y (the last given holds): C
+    observed 2 m from its <point> moves there, and four observations of C are then over
+    tol-abs, removed. The suite kept C at its <point> and every observation, silently; it
+    moves C too now (the note says so), and refuses what gama-local removes."""
+    path = tmp_path / "n.xml"
+    _refused(path, _file(FIXED, _obs() + _observed_c(252.0)), "(to='C')", "(and 3 more)")
+    if gama_local() is not None:
+        assert len(_outlying(_gama_run(path)[0])) == 4
+    path.write_text(_file(FIXED, _obs() + _observed_c(250.001)))
+    got = read_gama(path)
+    c = next(p for p in got["network.points"] if p["name"] == "C")
+    assert (c["x_mm"], c["role"]) == (250001.0, "observed"), c
+    assert "'C' at its observed coordinates (<coordinates>, 1 mm from its <point>)" in got["note"]
+    if gama_local() is not None:
+        agree_with_gama(study_of(tmp_path, path.read_text(), "s"), tmp_path / "s.xml")
+
+
+def test_observed_coordinates_before_the_point_are_tested_against_it(tmp_path):
+    """The <point> after them holds (gama-local): its x 2 m from the observed one is an
+    outlying term there (the observed x removed); the suite did not test it."""
+    path = tmp_path / "n.xml"
+    line = _refused(path, _file(_observed_c(252.0) + "\n" + FIXED), "<point> attribute 'x'")
+    assert "(id='C')" in line and "2000 mm" in line, line
+    if gama_local() is not None:
+        assert _outlying(_gama_run(path)[0]) == ["x"]
+    path.write_text(_file(_observed_c(250.5) + "\n" + FIXED))
+    c = next(p for p in read_gama(path)["network.points"] if p["name"] == "C")
+    assert c["x_mm"] == 250000.0  # the <point>'s, the last given
+
+
+def test_an_empty_obs_is_refused_as_in_gama_local(tmp_path):
+    """``<obs from="C"/>`` was read (as no set); gama-local refuses the file ("variance-
+    covariance matrix is not positive definite")."""
+    path = tmp_path / "n.xml"
+    _refused(path, _file(FIXED, _obs() + '<obs from="C"/>'), "<obs>", "holds no observation")
+    if gama_local() is not None:
+        run = subprocess.run([gama_local(), str(path)], capture_output=True, text=True)
+        assert "not positive definite" in run.stdout + run.stderr

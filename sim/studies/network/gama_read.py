@@ -112,6 +112,12 @@ def _obs(f: _File, e, dflt: dict, sets: dict, out: list) -> None:
     kids = list(e)
     cms = [o for o in kids if _tag(o) == "cov-mat"]
     obs = [o for o in kids if _tag(o) != "cov-mat"]  # the <cov-mat> last: gama_vocab checks
+    if not obs:  # (read here as no set: another file than gama-local's, which it refuses)
+        raise f.err(
+            e,
+            "holds no observation (gama-local refuses the file: the set's empty covariance "
+            'matrix "is not positive definite"): remove it',
+        )
     var = list(variances(f, cms[0], len(obs))) if cms else [None] * len(obs)
     label = ""
     if dirs := [o for o in obs if _tag(o) == "direction"]:
@@ -164,7 +170,13 @@ def _sight(f: _File, o, attr: str, alias: str) -> str:
     return f.name(o, given[0])
 
 
-def _coordinates(f: _File, e, coords: list) -> None:
+def _coordinates(f: _File, e, coords: list, points: dict, moved: list) -> None:
+    """Observed coordinates (``coords``: name, sigma in mm, (x, y) in mm). As in
+    ``gama-local`` (whose ``<coordinates>`` point sets the point's x and y, the last given
+    holding), a point declared before with other coordinates moves to the observed ones
+    (``moved``: name, distance in mm, for the note): it is linearised and its observations'
+    absolute terms tested there (its ``<point>`` kept had kept observations that
+    ``gama-local`` removes, and another geometry, silently)."""
     pts = [o for o in e if _tag(o) == "point"]
     cms = [o for o in e if _tag(o) == "cov-mat"]
     if len(cms) != 1:
@@ -179,7 +191,12 @@ def _coordinates(f: _File, e, coords: list) -> None:
             raise f.err(
                 cms[0], f"point {vocab.said(p.get('id') or '')}: observed x and y need one variance"
             )
-        coords.append((f.name(p, "id"), math.sqrt(vx), _xy(f, p)))
+        pid, xy = f.name(p, "id"), _xy(f, p)
+        coords.append((pid, math.sqrt(vx), xy))
+        rec = points.get(pid, {})
+        if "x_mm" in rec and (rec["x_mm"], rec["y_mm"]) != xy:
+            moved.append((pid, math.dist((rec["x_mm"], rec["y_mm"]), xy)))
+            rec["x_mm"], rec["y_mm"] = xy
 
 
 def _vectors(f: _File, e, out: list) -> None:
@@ -325,6 +342,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
     obs: list = []
     datum: dict = {}
     coords: list = []
+    moved: list = []
     sets: dict = {}
     for e in po:
         t = _tag(e)
@@ -333,13 +351,19 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         elif t == "obs":
             _obs(f, e, dflt, sets, obs)
         elif t == "coordinates":
-            _coordinates(f, e, coords)
+            _coordinates(f, e, coords, points, moved)
         elif t == "vectors":
             _vectors(f, e, obs)
         else:
             raise f.err(e, "not allowed in <points-observations>")
     left = _resolve(f, points, coords, obs)
     note += check_terms(f, net, po, points, obs, (axes, angles))  # it removes: refused
+    if moved:
+        (pid, d), more = moved[0], f" and {len(moved) - 1} more" * (len(moved) > 1)
+        note += (
+            f"; {pid!r}{more} at its observed coordinates (<coordinates>, {d:.6g} mm from its "
+            "<point>), as gama-local takes the last given"
+        )
     if f.sexagesimal:  # read as gama-local reads them, and named: a slip of the file, likely
         (tag, attr, v), n = f.sexagesimal[0], len(f.sexagesimal)
         more = f" and {n - 1} more" * (n > 1)

@@ -15,10 +15,10 @@ removed") and adjusts the rest: another network, another precision. This suite d
 readings from the coordinates and uses no ``val``: it would keep them, so :func:`check_terms`
 refuses such a file, naming the first. (A ``dz`` between fixed heights takes part in the
 test; it has no unknown here, so its own removal only changes ``gama-local``'s degrees of
-freedom: the note names it. A set of one direction is passive in ``gama-local``
-(``revision_observations``: fewer than two targets), neither adjusted nor tested: no term here.
-Observed coordinates, which ``gama-local`` also takes as the point's approximate ones, are
-not tested.)"""
+freedom: the note names it. Observed coordinates are tested against the point's last
+given coordinates, its ``<point>``'s when that comes after them. A set of one direction is
+passive in ``gama-local`` (``revision_observations``: fewer than two targets), neither adjusted
+nor tested: no term here.)"""
 
 from __future__ import annotations
 
@@ -125,6 +125,11 @@ def terms(f, po, points: dict, y_sign: float) -> list:
                     (s1, d1), (s2, _) = bearing(at, bs), bearing(at, fs)
                     ds = s2 - s1 + (2 * math.pi if s2 < s1 else 0.0)
                     out.append((o, abs(_wrap(angle_rad(o.get("val")) - ds)) * d1 * 1000, "val"))
+        elif _tag(e) == "coordinates":  # the point's last given x, y (mm) against these
+            for c in (o for o in e if _tag(o) == "point"):
+                pt = points[f.name(c, "id")]
+                for ax in ("x", "y"):
+                    out.append((c, abs(pt[f"{ax}_mm"] - f.mm(c, ax)), ax))
         elif _tag(e) == "vectors":
             for v in (o for o in e if _tag(o) == "vec"):
                 a, b = f.name(v, "from"), f.name(v, "to")
@@ -147,6 +152,10 @@ def removed(found: list, recs: list, tol_mm: float, m0: float) -> list:
     for e, term, kind in found:
         if kind == "dz":
             continue  # no unknown, no record here
+        if kind in ("x", "y"):  # observed coordinates: no record here, the raw term
+            if term > tol_mm:
+                out.append((e, term, term, kind))
+            continue
         rec = next(rows)  # an angle's or a direction's term is homogenised there by then
         if kind == "passive":
             continue
@@ -192,7 +201,7 @@ def check_terms(f, net, po, points: dict, recs: list, frame: tuple[str, str]) ->
     why = ""
     if term <= tol_mm:  # removed for its weighted term: what starts the test is another's
         te, tt, tk = next(x for x in found if x[1] > tol_mm)
-        what = f"the {tk} of {_named(te)}" if tk in ("dx", "dy", "dz") else _named(te)
+        what = f"the {tk} of {_named(te)}" if tk in ("dx", "dy", "dz", "x", "y") else _named(te)
         why = f" (the test runs as {what} is {tt:.6g} mm off)"
     raise f.err(
         e,
@@ -206,7 +215,7 @@ def check_terms(f, net, po, points: dict, recs: list, frame: tuple[str, str]) ->
 
 def _named(e) -> str:
     """An observation element by its points: ``<vec from='C' to='D'>``."""
-    attrs = " ".join(f"{a}={ws(e.get(a))!r}" for a in ("from", "to", "bs", "fs") if e.get(a))
+    attrs = " ".join(f"{a}={ws(e.get(a))!r}" for a in ("id", "from", "to", "bs", "fs") if e.get(a))
     return f"<{_tag(e)} {attrs}>" if attrs else f"<{_tag(e)}>"
 
 
