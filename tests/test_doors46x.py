@@ -22,7 +22,8 @@ a check that does not need it.
   read is the same (one direction, one orientation: no degree of freedom, no precision).
 * A set whose directions all aim at one point (two sightings of A) is left out whole by
   ``gama-local``; the suite kept them: one degree of freedom more, silently. Refused now, the
-  line saying what ``gama-local`` does.
+  line saying what ``gama-local`` does; and a study's such set is not exported (the export
+  wrote it, and gama-local adjusted the file with a degree of freedom fewer, unsaid).
 * d-m-s minutes or seconds of 60 or more (``11-94-56.7``), read by ``gama-local`` as d + m/60 +
   s/3600, were refused (X44's leftover). Decided: read as there (the value is used only for the
   absolute-term test, which then agrees with ``gama-local``'s), the report's note naming the
@@ -54,6 +55,9 @@ import pytest
 
 from benchmarks.scaling import gama_local
 from sim.mc.config import ConfigError
+from sim.studies import load_study
+from sim.studies.network.definition import build
+from sim.studies.network.gama import export, merge_gama
 from sim.studies.network.gama_read import read_gama
 from tests.test_doors20d import agree_with_gama, ours, study_of
 from tests.test_doors39x import FIXED, XY, _file, _obs
@@ -231,7 +235,7 @@ def test_directions_of_a_set_all_to_one_point_are_refused_saying_what_gama_local
         _obs() + f'<obs from="C"><direction to="A" val="{g!r}" stdev="10"/>'
         f'<direction to="A" val="{g!r}" stdev="12"/></obs>',
     )
-    _refused(path, xml, "<direction>", "(from='C') points to 'A'", "1 fewer", "gama-local leaves")
+    _refused(path, xml, "<direction>", "a set at 'C' points to 'A'", "1 fewer", "gama-local leaves")
     if gama_local() is not None:  # both left out there: 18 observations, as without the set
         text, dof = _gama_run(path)
         assert "Total of observations      :    18" in text and dof == 10
@@ -495,3 +499,36 @@ def test_an_empty_obs_is_refused_as_in_gama_local(tmp_path):
     if gama_local() is not None:
         run = subprocess.run([gama_local(), str(path)], capture_output=True, text=True)
         assert "not positive definite" in run.stdout + run.stderr
+
+
+def _study_with(tmp_path: Path, dirs: int) -> dict:
+    """A study of doors39x's points, five distances and ``dirs`` directions from C to A in
+    one set; its resolved configuration."""
+    pts = ", ".join(
+        f'{{ name = "{p}", x_m = {x}, y_m = {y}, role = "{"fixed" if p in "AB" else "free"}" }}'
+        for p, (x, y) in XY.items()
+    )
+    obs = [f'{{ kind = "distance", from = "{a}", to = "{b}", sigma_mm = 3.0 }}' for a, b in PAIRS]
+    obs += [
+        f'{{ kind = "distance", from = "{a}", to = "{b}", sigma_mm = 3.0 }}'
+        for a, b in ("AD", "BC")
+    ]
+    obs += ['{ kind = "direction", from = "C", to = "A", sigma_arcsec = 3.0 }'] * dirs
+    st = tmp_path / f"s{dirs}.toml"
+    st.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\n'
+        f"points = [{pts}]\nobservations = [{', '.join(obs)}]\n"
+    )
+    return merge_gama(load_study(st)[1])
+
+
+def test_a_study_set_of_directions_all_to_one_point_is_not_exported(tmp_path):
+    """The export wrote it, and gama-local adjusted the file with a degree of freedom fewer
+    than the study's (1 of 2), the summary saying nothing; now "not exported", saying why."""
+    full = _study_with(tmp_path, 2)
+    said = export(build(full), full, tmp_path / "network.xml")
+    assert said.startswith("not exported:") and "a set at 'C' points to 'A'" in said, said
+    assert not (tmp_path / "network.xml").exists()
+    full = _study_with(tmp_path, 1)  # one direction: written, read back as written
+    assert export(build(full), full, tmp_path / "network.xml") == "network.xml"
+    assert len(read_gama(tmp_path / "network.xml")["network.observations"]) == 6

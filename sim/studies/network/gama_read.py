@@ -55,6 +55,7 @@ from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
 from sim.studies.network.gama_encoding import EncodingProblem, bom_note, gama_text
 from sim.studies.network.gama_frames import NE, frame_note
 from sim.studies.network.gama_prolog import entity_declared, raw_name_problem
+from sim.studies.network.gama_sets import one_target
 from sim.studies.network.gama_stdev import default_stdevs, distance_default, sigma, variances
 from sim.studies.network.gama_terms import check_terms
 from sim.studies.network.gama_vocab import CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
@@ -124,13 +125,7 @@ def _obs(f: _File, e, dflt: dict, sets: dict, out: list) -> None:
         if st is None:
             raise f.err(e, "directions need the station", "from")
         if len(dirs) > 1 and len(targets := {f.name(o, "to") for o in dirs}) == 1:
-            raise f.err(  # (gama-local's revision_observations: fewer than two targets)
-                dirs[1],
-                f"every direction of this <obs> (from={st!r}) points to {targets.pop()!r}: "
-                "gama-local leaves a set of fewer than two targets out of its adjustment; "
-                f"this suite would keep its {len(dirs)} directions (gama-local's degrees of freedom: "
-                f"{len(dirs) - 1} fewer): give one, or add a direction to another point",
-            )
+            raise f.err(dirs[1], one_target(st, targets.pop(), len(dirs)))
         sets[st] = sets.get(st, 0) + 1
         label = "" if sets[st] == 1 else str(sets[st])
     for o, v in zip(obs, var):
