@@ -14,7 +14,8 @@ and at real size), one case each; each failed on the code before its fix.
   message by its first 19 characters and its length (a 1 MB ``to`` made a 1 MB "one line").
 * A d-m-s angle with minutes of over 4300 digits (``1-000...01-0``) ended in Python's
   ValueError for ``int()`` of a long string, a traceback; it is now read as gama-local reads
-  it, and minutes of 60 or more are the one line they were.
+  it, and minutes beyond a C ``int`` are one line (doors46x: minutes of 60 or more are read
+  as gama-local reads them, the note naming them).
 """
 
 from __future__ import annotations
@@ -97,5 +98,5 @@ def test_dms_minutes_of_thousands_of_digits_are_read_or_refused_in_one_line(tmp_
     path.write_text(text.replace(val, 'val="1-' + "0" * 5000 + '1-0"'))
     assert len(read_gama(path)["network.observations"]) == 17  # 1-01-0, as gama-local reads it
     path.write_text(SOURCE.read_text().replace(val, 'val="1-' + "9" * 5000 + '-0"'))
-    with pytest.raises(ConfigError, match="minutes must be below 60"):
+    with pytest.raises(ConfigError, match="over 2147483647 minutes, refused by gama-local"):
         read_gama(path)

@@ -333,7 +333,7 @@ BAD = [
         "heights",
     ),
     ("</obs>", '<cov-mat dim="2" band="1">1 0.5 1</cov-mat></obs>', "cov-mat"),
-    ('fs="F2" val="', 'fs="F2" val="12-75-00', "below 60"),
+    ('fs="F2" val="', 'fs="F2" val="12-2147483648-00', "over 2147483647 minutes"),
     ('to="F1"', 'to="Nowhere"', "no such <point>"),
     ("<points-observations>", '<points-observations distance-stdev="2 x">', "distance-stdev"),
     ("<points-observations>", '<points-observations distance-stdev="1 2 3 4">', "distance-stdev"),

@@ -36,6 +36,7 @@ from sim.studies.network.definition import Network, build
 from sim.studies.network.gama_cache import gama_digest, read_gama
 from sim.studies.network.gama_frames import NE, consistent
 from sim.studies.network.gama_read import CC, MAX_BYTES, NS
+from sim.studies.network.gama_sets import one_target_set
 from sim.studies.network.gama_vocab import shifted
 from sim.studies.network.linearity import row_key
 from sim.studies.network.model import computed, defect_basis
@@ -141,6 +142,8 @@ def _refuse(net: Network) -> None:
         )
     if net.estimate_scale:
         raise ConfigError("network.estimate_scale", "gama-local has no scale unknown")
+    if why := one_target_set(net):  # a set gama-local leaves out: other degrees of freedom
+        raise ConfigError("network.observations", why)
 
 
 def _vector_pairs(net: Network) -> list[tuple[int, int]]:

@@ -49,121 +49,19 @@ import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-import numpy as np
-
 from sim.mc.config import ConfigError
-from sim.mc.numtext import UnheldError, float_text
 from sim.studies.network import gama_vocab as vocab
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
 from sim.studies.network.gama_encoding import EncodingProblem, bom_note, gama_text
 from sim.studies.network.gama_frames import NE, frame_note
+from sim.studies.network.gama_prolog import entity_declared, raw_name_problem
+from sim.studies.network.gama_sets import one_target
+from sim.studies.network.gama_stdev import default_stdevs, distance_default, sigma, variances
 from sim.studies.network.gama_terms import check_terms
-from sim.studies.network.gama_vocab import _NUM, CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
-from sim.studies.network.validate import SIGMA_RANGE, looks_like
+from sim.studies.network.gama_vocab import CC, MAX_BYTES, NS, _File, _tag, read_bytes, ws
+from sim.studies.network.validate import looks_like
 
 __all__ = ["read_gama", "read_bytes", "MAX_BYTES", "CC", "NS"]
-
-
-def _cov(f: _File, cm, n: int) -> np.ndarray:
-    """Variances of a ``<cov-mat dim band>`` of ``n`` observations; refuses covariances."""
-    dim, band = f.integer(cm, "dim"), f.integer(cm, "band")
-    if not 0 <= band < dim:
-        raise f.err(cm, f"dim {dim} and band {band}: need 0 <= band < dim", "band")
-    if dim != n:
-        raise f.err(cm, f"dim {dim} for {n} observations", "dim")
-    words = vocab.words(cm.text)
-    need = dim * (band + 1) - band * (band + 1) // 2
-    if len(words) != need:
-        raise f.err(cm, f"{len(words)} numbers for dim {dim}, band {band} (need {need})")
-    if not all(_NUM.match(w) for w in words):
-        bad = next(w for w in words if not _NUM.match(w))
-        raise f.err(cm, f"{vocab.said(bad)} is not a number")
-    for w in words:  # 1e-400: not a variance of 0 ("must be positive"), 1e400 not inf
-        try:
-            float_text(w)
-        except UnheldError as why:
-            raise f.err(cm, str(why)) from None
-    vals = iter(float(w) for w in words)
-    var = np.zeros(dim)
-    for r in range(dim):
-        for c in range(r, min(dim, r + band + 1)):
-            v = next(vals)
-            if c == r:
-                var[r] = v
-            elif v != 0:
-                raise f.err(
-                    cm,
-                    "correlated observations (non-zero covariance) are not supported: "
-                    "give a diagonal matrix",
-                )
-    if not np.all(np.isfinite(var) & (var > 0)):
-        raise f.err(cm, "every variance must be a positive finite number")
-    return var
-
-
-def _defaults(f: _File, po) -> dict:
-    d = {}
-    words = vocab.words(po.get("distance-stdev"))
-    if len(words) > 3:
-        raise f.err(po, "takes 'a [b [c]]' (a + b D^c mm, D in km)", "distance-stdev")
-    for w in words:
-        if not _NUM.match(w):
-            raise f.err(po, f"{vocab.said(w)} is not a number", "distance-stdev")
-        try:  # 1e-400: not a of 0 mm, silently; 1e400: not "not a number"
-            float_text(w)
-        except UnheldError as why:
-            raise f.err(po, str(why), "distance-stdev") from None
-    abc = [float(w) for w in words] + [0.0, 0.0, 1.0][len(words) :]
-    d["distance"] = abc if words else None
-    for k in ("direction", "angle"):
-        d[k] = f.num(po, f"{k}-stdev") if po.get(f"{k}-stdev") is not None else None
-    for k in ("zenith-angle", "azimuth"):  # of kinds refused here, but numbers in gama-local
-        if po.get(f"{k}-stdev") is not None:
-            f.num(po, f"{k}-stdev")
-    return d
-
-
-def _sigma(f: _File, o, default, var: float | None, unit: float | None = None) -> float:
-    """The standard deviation of one observation (mm, cc or arcsec; ``unit`` the angle unit
-    in rad, None for mm), within the study's own range (:data:`SIGMA_RANGE`, in mm or
-    arcsec: what the suite exports, it reads back), named by the element."""
-    sig = _stdev(f, o, default, var)
-    lo, hi = SIGMA_RANGE["mm" if unit is None else "arcsec"]
-    study = sig if unit is None else sig * unit / ARCSEC
-    if not lo <= study <= hi:
-        what = "mm" if unit is None else f"{study:g} arcsec"
-        raise f.err(
-            o, f"a standard deviation of {sig:g} ({what}) is outside [{lo:g}, {hi:g}]", "stdev"
-        )
-    return sig
-
-
-def _stdev(f: _File, o, default, var: float | None) -> float:
-    if var is not None:  # the <cov-mat> holds; a stdev beside it is still a number there
-        if o.get("stdev") is not None:
-            f.num(o, "stdev")
-        return math.sqrt(var)
-    if o.get("stdev") is not None:
-        sig = f.num(o, "stdev")
-        if sig < 0:
-            raise f.err(o, f"{vocab.said(o.get('stdev'))} is negative{_SQUARED}", "stdev")
-        if sig == 0:
-            raise f.err(o, f"{vocab.said(o.get('stdev'))} must be > 0", "stdev")
-        return sig
-    if default is None:
-        raise f.err(o, "no stdev and no default in <points-observations>", "stdev")
-    if default < 0:
-        raise f.err(o, f"the default stdev {default:g} is negative{_SQUARED}", "stdev")
-    if default == 0:
-        raise f.err(o, "the default stdev is not positive", "stdev")
-    return default
-
-
-#: why a negative stdev is refused, which gama-local reads: it squares it (a variance)
-_SQUARED = (
-    " (gama-local squares it and adjusts as if it had no sign; this suite takes a standard "
-    "deviation as a positive number: write it without the sign)"
-)
 
 
 def _xy(f: _File, e) -> tuple[float, float]:
@@ -208,18 +106,26 @@ def _point(f: _File, e, points: dict, datum: dict) -> None:
 
 def _obs(f: _File, e, dflt: dict, sets: dict, out: list) -> None:
     st = f.name(e, "from") if e.get("from") is not None else None
-    if e.get("orientation") is not None:
-        f.num(e, "orientation")
+    if e.get("orientation") is not None:  # radians, as gama-local reads it
+        f.turns(e, "orientation", f.num(e, "orientation") / (2 * math.pi))
     if e.get("from_dh") is not None:
         f.num(e, "from_dh")
     kids = list(e)
     cms = [o for o in kids if _tag(o) == "cov-mat"]
     obs = [o for o in kids if _tag(o) != "cov-mat"]  # the <cov-mat> last: gama_vocab checks
-    var = list(_cov(f, cms[0], len(obs))) if cms else [None] * len(obs)
+    if not obs:  # (read here as no set: another file than gama-local's, which it refuses)
+        raise f.err(
+            e,
+            "holds no observation (gama-local refuses the file: the set's empty covariance "
+            'matrix "is not positive definite"): remove it',
+        )
+    var = list(variances(f, cms[0], len(obs))) if cms else [None] * len(obs)
     label = ""
-    if any(_tag(o) == "direction" for o in obs):
+    if dirs := [o for o in obs if _tag(o) == "direction"]:
         if st is None:
             raise f.err(e, "directions need the station", "from")
+        if len(dirs) > 1 and len(targets := {f.name(o, "to") for o in dirs}) == 1:
+            raise f.err(dirs[1], one_target(st, targets.pop(), len(dirs)))
         sets[st] = sets.get(st, 0) + 1
         label = "" if sets[st] == 1 else str(sets[st])
     for o, v in zip(obs, var):
@@ -229,20 +135,19 @@ def _obs(f: _File, e, dflt: dict, sets: dict, out: list) -> None:
                 f.num(o, a)
         if t == "distance":
             d_m = f.num(o, "val", lo=0.0)
-            abc = dflt["distance"]
-            dd = None if abc is None else abc[0] + abc[1] * (d_m / 1000) ** abc[2]
+            dd = distance_default(dflt["distance"], d_m)
             rec = {"kind": "distance", "from": f.name(o, "from", st), "to": f.name(o, "to")}
-            rec["sigma_mm"] = _sigma(f, o, dd, v)
+            rec["sigma_mm"] = sigma(f, o, dd, v)
         elif t == "direction":
             unit = ARCSEC if f.angle(o) else CC
-            s = _sigma(f, o, dflt["direction"], v, unit)
+            s = sigma(f, o, dflt["direction"], v, unit)
             rec = {"kind": "direction", "from": st, "to": f.name(o, "to")}
             rec["sigma_arcsec"] = s * unit / ARCSEC
             if label:
                 rec["set"] = label
         else:  # angle
             unit = ARCSEC if f.angle(o) else CC
-            s = _sigma(f, o, dflt["angle"], v, unit)
+            s = sigma(f, o, dflt["angle"], v, unit)
             bs, fs = (_sight(f, o, a, b) for a, b in (("bs", "to"), ("fs", "rs")))
             rec = {"kind": "angle", "at": f.name(o, "from", st), "from": bs, "to": fs}
             rec["sigma_arcsec"] = s * unit / ARCSEC
@@ -260,7 +165,13 @@ def _sight(f: _File, o, attr: str, alias: str) -> str:
     return f.name(o, given[0])
 
 
-def _coordinates(f: _File, e, coords: list) -> None:
+def _coordinates(f: _File, e, coords: list, points: dict, moved: list) -> None:
+    """Observed coordinates (``coords``: name, sigma in mm, (x, y) in mm). As in
+    ``gama-local`` (whose ``<coordinates>`` point sets the point's x and y, the last given
+    holding), a point declared before with other coordinates moves to the observed ones
+    (``moved``: name, distance in mm, for the note): it is linearised and its observations'
+    absolute terms tested there (its ``<point>`` kept had kept observations that
+    ``gama-local`` removes, and another geometry, silently)."""
     pts = [o for o in e if _tag(o) == "point"]
     cms = [o for o in e if _tag(o) == "cov-mat"]
     if len(cms) != 1:
@@ -268,14 +179,19 @@ def _coordinates(f: _File, e, coords: list) -> None:
     for p in pts:
         if p.get("z") is not None or p.get("fix") or p.get("adj"):
             raise f.err(p, "observed coordinates take id, x and y only (2-D)", "z")
-    var = _cov(f, cms[0], 2 * len(pts))
+    var = variances(f, cms[0], 2 * len(pts))
     for a, p in enumerate(pts):
         vx, vy = var[2 * a], var[2 * a + 1]
         if not math.isclose(vx, vy, rel_tol=1e-9):
             raise f.err(
                 cms[0], f"point {vocab.said(p.get('id') or '')}: observed x and y need one variance"
             )
-        coords.append((f.name(p, "id"), math.sqrt(vx), _xy(f, p)))
+        pid, xy = f.name(p, "id"), _xy(f, p)
+        coords.append((pid, math.sqrt(vx), xy))
+        rec = points.get(pid, {})
+        if "x_mm" in rec and (rec["x_mm"], rec["y_mm"]) != xy:
+            moved.append((pid, math.dist((rec["x_mm"], rec["y_mm"]), xy)))
+            rec["x_mm"], rec["y_mm"] = xy
 
 
 def _vectors(f: _File, e, out: list) -> None:
@@ -283,11 +199,14 @@ def _vectors(f: _File, e, out: list) -> None:
     cms = [o for o in e if _tag(o) == "cov-mat"]
     if len(cms) != 1:
         raise f.err(e, "needs one <cov-mat> (the variances of dx, dy, dz, mm^2)")
-    var = _cov(f, cms[0], 3 * len(vecs))
+    var = variances(f, cms[0], 3 * len(vecs))
     for a, v in enumerate(vecs):
         fr, to = f.name(v, "from"), f.name(v, "to")
         for c in ("dx", "dy", "dz"):
             f.num(v, c)
+        for c in ("from_dh", "to_dh"):  # numbers there too ("bad instrument/reflector height")
+            if v.get(c) is not None:
+                f.num(v, c)
         out.append({"kind": "dx", "from": fr, "to": to, "sigma_mm": math.sqrt(var[3 * a])})
         out.append({"kind": "dy", "from": fr, "to": to, "sigma_mm": math.sqrt(var[3 * a + 1])})
 
@@ -299,7 +218,7 @@ def _network(f: _File, data: bytes):
         text = gama_text(data)
     except EncodingProblem as why:
         raise ConfigError(key, f"{path}: {why}") from None
-    if ent := vocab.entity_declared(text):
+    if ent := entity_declared(text):
         raise ConfigError(
             key,
             f"{path}: its <!DOCTYPE> declares the entity {ent}: entity declarations are not read "
@@ -313,7 +232,7 @@ def _network(f: _File, data: bytes):
         raise ConfigError(key, f"{path} cannot be decoded: {e}") from None
     if _tag(root) != "gama-local":  # first: an <html lang="en"> was refused for its attribute
         raise ConfigError(key, f"{path}: the root element is <{_tag(root)}>, not <gama-local>")
-    if why := vocab.raw_name_problem(text):  # names as gama-local reads them
+    if why := raw_name_problem(text):  # names as gama-local reads them
         raise ConfigError(key, f"{path}: {why}")
     vocab.drop_empty(root)  # x="", stdev="": absent, as gama-local reads them
     f.vocab(root)
@@ -413,11 +332,12 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
     if len(pos) != 1:
         raise f.err(net, f"{len(pos)} <points-observations> elements (need one)")
     po = pos[0]
-    dflt = _defaults(f, po)
+    dflt = default_stdevs(f, po)
     points: dict = {}
     obs: list = []
     datum: dict = {}
     coords: list = []
+    moved: list = []
     sets: dict = {}
     for e in po:
         t = _tag(e)
@@ -426,13 +346,26 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
         elif t == "obs":
             _obs(f, e, dflt, sets, obs)
         elif t == "coordinates":
-            _coordinates(f, e, coords)
+            _coordinates(f, e, coords, points, moved)
         elif t == "vectors":
             _vectors(f, e, obs)
         else:
             raise f.err(e, "not allowed in <points-observations>")
     left = _resolve(f, points, coords, obs)
-    check_terms(f, net, po, points, obs, (axes, angles))  # gama-local removes: refused
+    note += check_terms(f, net, po, points, obs, (axes, angles))  # it removes: refused
+    if moved:
+        (pid, d), more = moved[0], f" and {len(moved) - 1} more" * (len(moved) > 1)
+        note += (
+            f"; {pid!r}{more} at its observed coordinates (<coordinates>, {d:.6g} mm from its "
+            "<point>), as gama-local takes the last given"
+        )
+    if f.sexagesimal:  # read as gama-local reads them, and named: a slip of the file, likely
+        (tag, attr, v), n = f.sexagesimal[0], len(f.sexagesimal)
+        more = f" and {n - 1} more" * (n > 1)
+        note += (
+            f"; d-m-s values with minutes or seconds of 60 or more read as gama-local reads "
+            f"them, d + m/60 + s/3600: <{tag}> {attr}={vocab.said(v)}{more}"
+        )
     if left:  # listed, never observed, no coordinates or no role: gama-local removes them
         more = f" and {len(left) - 5} more" * (len(left) > 5)
         few = ", ".join(repr(p) for p in left[:5]) + more

@@ -15,8 +15,10 @@ removed") and adjusts the rest: another network, another precision. This suite d
 readings from the coordinates and uses no ``val``: it would keep them, so :func:`check_terms`
 refuses such a file, naming the first. (A ``dz`` between fixed heights takes part in the
 test; it has no unknown here, so its own removal only changes ``gama-local``'s degrees of
-freedom. Observed coordinates, which ``gama-local`` also takes as the point's approximate
-ones, are not tested.)"""
+freedom: the note names it. Observed coordinates are tested against the point's last
+given coordinates, its ``<point>``'s when that comes after them. A set of one direction is
+passive in ``gama-local`` (``revision_observations``: fewer than two targets), neither adjusted
+nor tested: no term here.)"""
 
 from __future__ import annotations
 
@@ -76,8 +78,9 @@ def _heights(po) -> dict:
 def terms(f, po, points: dict, y_sign: float) -> list:
     """``(element, absolute term in mm, kind)`` of every observation of
     ``<points-observations>`` ``po``, in the reader's order (kind ``dz``: a vector's third
-    row, which the reader drops, or the attribute the term is in: ``val``, ``orientation``,
-    ``dx``, ``dy``). ``points``: name -> record with ``x_mm``, ``y_mm``; ``y_sign``: -1
+    row, which the reader drops; ``passive``: the direction of a set of one, no term in
+    ``gama-local``; or the attribute the term is in: ``val``, ``orientation``, ``dx``,
+    ``dy``). ``points``: name -> record with ``x_mm``, ``y_mm``; ``y_sign``: -1
     where the file's angles run against its frame (``gama-local`` negates every y); ``f``:
     the reader's error helper (its ``name`` reads a point name as the reader did)."""
 
@@ -100,6 +103,7 @@ def terms(f, po, points: dict, y_sign: float) -> list:
                 for o in kids
                 if _tag(o) == "direction"
             }
+            lone = len(dirs) == 1  # gama-local sets it passive: not adjusted, not tested
             ori = e.get("orientation")
             if dirs:
                 sz = [_wrap(s - v) for v, s, _ in dirs.values()]
@@ -108,6 +112,8 @@ def terms(f, po, points: dict, y_sign: float) -> list:
                 if _tag(o) == "distance":
                     _, d0 = bearing(f.name(o, "from", st), f.name(o, "to"))
                     out.append((o, abs(float(ws(o.get("val"))) - d0) * 1000, "val"))
+                elif _tag(o) == "direction" and lone:
+                    out.append((o, 0.0, "passive"))
                 elif _tag(o) == "direction":
                     v, s, d0 = dirs[id(o)]
                     why = "val" if ori is None else "orientation"
@@ -119,6 +125,11 @@ def terms(f, po, points: dict, y_sign: float) -> list:
                     (s1, d1), (s2, _) = bearing(at, bs), bearing(at, fs)
                     ds = s2 - s1 + (2 * math.pi if s2 < s1 else 0.0)
                     out.append((o, abs(_wrap(angle_rad(o.get("val")) - ds)) * d1 * 1000, "val"))
+        elif _tag(e) == "coordinates":  # the point's last given x, y (mm) against these
+            for c in (o for o in e if _tag(o) == "point"):
+                pt = points[f.name(c, "id")]
+                for ax in ("x", "y"):
+                    out.append((c, abs(pt[f"{ax}_mm"] - f.mm(c, ax)), ax))
         elif _tag(e) == "vectors":
             for v in (o for o in e if _tag(o) == "vec"):
                 a, b = f.name(v, "from"), f.name(v, "to")
@@ -141,7 +152,13 @@ def removed(found: list, recs: list, tol_mm: float, m0: float) -> list:
     for e, term, kind in found:
         if kind == "dz":
             continue  # no unknown, no record here
+        if kind in ("x", "y"):  # observed coordinates: no record here, the raw term
+            if term > tol_mm:
+                out.append((e, term, term, kind))
+            continue
         rec = next(rows)  # an angle's or a direction's term is homogenised there by then
+        if kind == "passive":
+            continue
         angular = _tag(e) in ("direction", "angle")
         weighted = term * m0 / (rec["sigma_arcsec"] * ARCSEC / CC) if angular else term
         if weighted > tol_mm:
@@ -149,9 +166,12 @@ def removed(found: list, recs: list, tol_mm: float, m0: float) -> list:
     return out
 
 
-def check_terms(f, net, po, points: dict, recs: list, frame: tuple[str, str]) -> None:
+def check_terms(f, net, po, points: dict, recs: list, frame: tuple[str, str]) -> str:
     """Refuse, in one line naming the observation, a file in which ``gama-local`` would remove
-    an observation for its absolute term (:func:`removed`): this suite would keep it."""
+    an observation for its absolute term (:func:`removed`): this suite would keep it. When
+    the one named is removed for its weighted term only, the line names the term that starts
+    the test (a ``dz`` perhaps). Returns a note ("" or the ``dz`` terms ``gama-local`` removes
+    alone: this suite drops every ``dz``, so the networks are the same)."""
     pars = [e for e in net if _tag(e) == "parameters"]
     tol = pars[0].get("tol-abs") if pars else None
     m0 = pars[0].get("sigma-apr") if pars else None
@@ -159,24 +179,44 @@ def check_terms(f, net, po, points: dict, recs: list, frame: tuple[str, str]) ->
     m0 = SIGMA_APR if m0 is None else float(ws(m0))
     found = terms(f, po, points, 1.0 if consistent(*frame) else -1.0)
     gone = removed(found, recs, tol_mm, m0)
+    dz = [(e, term) for e, term, kind in found if kind == "dz" and term > tol_mm]
     if not gone:
-        return
+        if not dz:
+            return ""
+        more = f" and {len(dz) - 1} more" * (len(dz) > 1)
+        return (
+            f"; gama-local removes the dz of {_named(dz[0][0])}{more} before it adjusts "
+            f'("Outlying absolute terms": {dz[0][1]:.6g} mm from the fixed heights, over '
+            f"tol-abs = {tol_mm:g} mm), as this study drops every dz"
+        )
     e, term, weighted, kind = gone[0]
-    more = f" (and {len(gone) - 1} more)" if len(gone) > 1 else ""
+    n_more = len(gone) - 1 + len(dz)
+    more = f" (and {n_more} more)" if n_more else ""
     ori = (
         f" with the orientation of its <obs>, {ws(e_ori)} radians as gama-local reads it,"
         if kind == "orientation" and (e_ori := _orientation_of(po, e)) is not None
         else ""
     )
     how = f", {weighted:.6g} mm weighted by sigma-apr / stdev," if weighted != term else ""
+    why = ""
+    if term <= tol_mm:  # removed for its weighted term: what starts the test is another's
+        te, tt, tk = next(x for x in found if x[1] > tol_mm)
+        what = f"the {tk} of {_named(te)}" if tk in ("dx", "dy", "dz", "x", "y") else _named(te)
+        why = f" (the test runs as {what} is {tt:.6g} mm off)"
     raise f.err(
         e,
         f'gama-local removes this observation{more} before it adjusts ("Outlying absolute '
-        f'terms"): its value{ori} is {term:.6g} mm from what the coordinates give{how} over '
-        f"tol-abs = {tol_mm:g} mm; this suite draws its readings from the coordinates and "
+        f'terms"{why}): its value{ori} is {term:.6g} mm from what the coordinates give{how} '
+        f"over tol-abs = {tol_mm:g} mm; this suite draws its readings from the coordinates and "
         "would keep it: correct the value or the coordinates, or remove the observation",
         "val" if kind in ("val", "orientation") else kind,
     )
+
+
+def _named(e) -> str:
+    """An observation element by its points: ``<vec from='C' to='D'>``."""
+    attrs = " ".join(f"{a}={ws(e.get(a))!r}" for a in ("id", "from", "to", "bs", "fs") if e.get(a))
+    return f"<{_tag(e)} {attrs}>" if attrs else f"<{_tag(e)}>"
 
 
 def _orientation_of(po, e) -> str | None:

@@ -3,7 +3,8 @@ the elements, their attributes and the values an attribute may take, the element
 (3-D and 1-D data), and the checked reading of a file and of its numbers -- every message
 one :class:`~sim.mc.config.ConfigError` line naming the file, the element and the attribute.
 Only a regular file of at most :data:`MAX_BYTES` is read (a FIFO or a device is refused
-before it is opened). The parser: :mod:`sim.studies.network.gama_read`."""
+before it is opened). The parser: :mod:`sim.studies.network.gama_read`; what gama-local's own
+parser sees first (entities, prefixed names): :mod:`sim.studies.network.gama_prolog`."""
 
 from __future__ import annotations
 
@@ -13,7 +14,6 @@ import os
 import re
 import stat
 from pathlib import Path
-from xml.parsers import expat
 
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
@@ -24,13 +24,12 @@ __all__ = [
     "NS",
     "CC",
     "MAX_BYTES",
+    "MAX_TURNS",
     "VOCAB",
     "read_bytes",
     "ws",
     "words",
     "said",
-    "entity_declared",
-    "raw_name_problem",
     "shifted",
     "drop_empty",
     "parameters_note",
@@ -49,8 +48,12 @@ _DMS = re.compile(r"^[+-]?\d+-\d+-\d+(\.\d*)?([eE][+-]?\d+)?$", re.ASCII)
 #: ``cov-band`` digits with a sign (``IsInteger``): "2.0", "2e0" are refused there
 _INDEX = re.compile(r"^\d+$", re.ASCII)
 _INTEGER = re.compile(r"^[+-]?\d+$", re.ASCII)
-#: the largest degrees of a d-m-s value: gama-local reads them into a C int (more: "bad angle")
+#: the largest degrees or minutes of a d-m-s value: gama-local reads them into a C int (more:
+#: "bad angle")
 _INT_MAX = 2**31 - 1
+#: the most turns an angular value (``val``, ``<obs orientation>``) may hold: ``gama-local``
+#: reduces it one turn a step (see :meth:`_File.turns`)
+MAX_TURNS = 1000
 #: the white space XML (and gama-local) trims around a value and splits a list at: Python's
 #: ``strip()`` and ``split()`` also take a no-break space and the other Unicode spaces, so an id
 #: ``"A\u00a0"`` was the point ``A`` here and another point in gama-local (doors24c)
@@ -200,6 +203,9 @@ class _File:
 
     def __init__(self, key: str, path: Path):
         self.key, self.path = key, path
+        #: d-m-s values with minutes or seconds of 60 or more, read as gama-local reads them:
+        #: ``(element, attribute, value)``, for the note
+        self.sexagesimal: list[tuple[str, str, str]] = []
 
     def err(self, e, what: str, attr: str | None = None) -> ConfigError:
         where = f"<{_tag(e)}>" if attr is None else f"<{_tag(e)}> attribute {attr!r}"
@@ -254,7 +260,10 @@ class _File:
             raise self.err(e, str(err).split(": ", 1)[1], attr) from None
 
     def angle(self, e, attr: str = "val") -> bool:
-        """Check an angular value; True when it is d-m-s (degrees), False for gon."""
+        """Check an angular value; True when it is d-m-s (degrees), False for gon. A d-m-s
+        value is read as ``gama-local`` reads it (``deg2gon``): degrees and minutes any C
+        ``int``, seconds any number, d + m/60 + s/3600 (``10-75-0`` is 11 degrees 15 minutes;
+        such values are listed in :attr:`sexagesimal` for the note)."""
         v = ws(e.get(attr) or "")
         if not v:
             raise self.err(e, "missing", attr)
@@ -264,19 +273,38 @@ class _File:
                 sec = float_text(s)
             except UnheldError as why:
                 raise self.err(e, f"{said(v)}: the seconds {why}", attr) from None
-            # seconds of 60.00 are a value rounded up (gama-local reads them, and its own
-            # test data holds "187-33-60.00"); more is garbage
-            if len(d.lstrip("0")) > 10 or int(d) > _INT_MAX:  # gama-local's int overflows
-                raise self.err(
-                    e, f"{said(v)}: over {_INT_MAX} degrees, refused by gama-local", attr
-                )
-            if float(m) >= 60 or sec > 60:  # int() of 5000 digits: ValueError
-                raise self.err(
-                    e, f"{said(v)}: minutes must be below 60 and seconds at most 60", attr
-                )
+            for part, unit in ((d, "degrees"), (m, "minutes")):  # gama-local's int overflows
+                # (int() of 5000 digits: ValueError; leading zeros are no digits of it)
+                if len(part.lstrip("0")) > 10 or int(part.lstrip("0") or "0") > _INT_MAX:
+                    raise self.err(
+                        e, f"{said(v)}: over {_INT_MAX} {unit}, refused by gama-local", attr
+                    )
+            minutes = int(m.lstrip("0") or "0")
+            if minutes >= 60 or sec > 60:  # 60.00 seconds: a value rounded up, not listed
+                self.sexagesimal.append((_tag(e), attr, v))
+            degrees = int(d.lstrip("0") or "0") + minutes / 60 + sec / 3600
+            if attr == "val":  # an observed angle, which gama-local reduces
+                self.turns(e, attr, degrees / 360)
             return True
-        self.num(e, attr)
+        gon = self.num(e, attr)
+        if attr == "val":
+            self.turns(e, attr, gon / 400)
         return False
+
+    def turns(self, e, attr: str, turns: float) -> None:
+        """Refuse an angle of more than :data:`MAX_TURNS` turns: ``gama-local`` reduces an
+        angle by one turn a step (``norm_rad_val``, its absolute terms), which loses the
+        angle's last digits past thousands of turns (1e-8 rad at 1e4, 1e-3 rad at 6e6: the
+        degrees of a C ``int``) and never ends past about 1e16 radians (``val="1e17"`` held
+        it, and this reader, for good; 6e6 turns took this reader 4 s a value)."""
+        if not abs(turns) <= MAX_TURNS:
+            raise self.err(
+                e,
+                f"{said(ws(e.get(attr)))}: {abs(turns):.3g} turns, over {MAX_TURNS} (gama-local "
+                "reduces an angle one turn a step: past thousands of turns it loses the angle's "
+                "last digits, and it never ends on 1e16 radians or more): give it within a turn",
+                attr,
+            )
 
     def vocab(self, root) -> None:
         for parent in root.iter():  # every element's place (iterative: any depth)
@@ -337,79 +365,6 @@ def parameters_note(f: _File, pars: list) -> str:
         "the file asks for sigma-act = aposteriori (gama-local's default); this study uses "
         "the a-priori stdevs (a pre-analysis has no residuals)"
     )
-
-
-class _Prolog(Exception):
-    """The first element: the prolog, where every declaration stands, is over."""
-
-
-def entity_declared(data: bytes | str) -> str | None:
-    """The name of the first entity the file's DOCTYPE declares (None: none). A gama-local file
-    needs none, and entities are how a file of a few kilobytes expands to gigabytes in the
-    parser ("billion laughs"; expat stops an amplification over 100, one just below it held
-    the reader at 50 times the file's size, doors31x) or names a local file or a URL (an
-    external entity: never read nor fetched here). Only the prolog is parsed: the scan stops
-    at the first element; a parse error is left to the reader, which names it."""
-    p = expat.ParserCreate()
-    found: list[str] = []
-
-    def entity(name, is_param, *_):
-        found.append(("%" if is_param else "&") + name + ";")
-        raise _Prolog
-
-    def element(*_):
-        raise _Prolog
-
-    p.EntityDeclHandler = entity
-    p.StartElementHandler = element
-    try:
-        p.Parse(data, True)
-    except (_Prolog, expat.ExpatError, ValueError, LookupError):
-        pass
-    return found[0] if found else None
-
-
-class _Raw(Exception):
-    """The first name gama-local reads otherwise than a namespace-aware parser."""
-
-
-def raw_name_problem(data: bytes | str) -> str | None:
-    """What ``gama-local`` refuses in the file's names as written, or None. Its parser (expat
-    without namespace processing, ``gkfparser.cpp``) reads each name as it stands, where
-    ElementTree drops a prefix: ``<g:gama-local xmlns:g="...">`` is an unknown element there
-    (the same network here), an attribute of ``<gama-local>`` other than ``xmlns`` and
-    ``version`` (``xmlns:g``, ``xsi:schemaLocation``) is refused, and so is ``xmlns`` or any
-    prefixed attribute (``o:note``) of every other element, which reads its own attributes
-    only. A parse error is left to the reader, which names it."""
-    p = expat.ParserCreate()  # no namespace processing: names as gama-local sees them
-    p.ordered_attributes = True
-    depth = [0]
-
-    def start(name, attrs):
-        if ":" in name:
-            raise _Raw(
-                f"<{name}>: an element name with a namespace prefix (gama-local reads no "
-                f"prefix: write <{name.split(':', 1)[1]}>)"
-            )
-        names = attrs[0::2]
-        for a in names:
-            if depth[0] == 0 and a not in ("xmlns", "version"):
-                raise _Raw(f"<{name}> attribute {said(a)}: gama-local takes only xmlns and version")
-            if depth[0] and (a == "xmlns" or ":" in a):
-                raise _Raw(
-                    f"<{name}> attribute {said(a)}: gama-local refuses a namespace declaration "
-                    "or a prefixed attribute here (only <gama-local> takes xmlns)"
-                )
-        depth[0] += 1
-
-    p.StartElementHandler = start
-    try:
-        p.Parse(data, True)
-    except _Raw as why:
-        return str(why)
-    except (expat.ExpatError, ValueError, LookupError):
-        pass
-    return None
 
 
 def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:

@@ -1,0 +1,86 @@
+"""What ``gama-local``'s own parser (expat, without namespace processing:
+``lib/gnu_gama/xml/gkfparser.cpp``) sees in a file before the reader parses it: an entity its
+DOCTYPE declares (refused: a ``gama-local`` file needs none) and the names of elements and
+attributes as written, prefixes included. Each returns what to refuse, or None; the reader
+(:mod:`sim.studies.network.gama_read`) names the file."""
+
+from __future__ import annotations
+
+from xml.parsers import expat
+
+from sim.studies.network.gama_vocab import said
+
+__all__ = ["entity_declared", "raw_name_problem"]
+
+
+class _Prolog(Exception):
+    """The first element: the prolog, where every declaration stands, is over."""
+
+
+def entity_declared(data: bytes | str) -> str | None:
+    """The name of the first entity the file's DOCTYPE declares (None: none). A gama-local file
+    needs none, and entities are how a file of a few kilobytes expands to gigabytes in the
+    parser ("billion laughs"; expat stops an amplification over 100, one just below it held
+    the reader at 50 times the file's size, doors31x) or names a local file or a URL (an
+    external entity: never read nor fetched here). Only the prolog is parsed: the scan stops
+    at the first element; a parse error is left to the reader, which names it."""
+    p = expat.ParserCreate()
+    found: list[str] = []
+
+    def entity(name, is_param, *_):
+        found.append(("%" if is_param else "&") + name + ";")
+        raise _Prolog
+
+    def element(*_):
+        raise _Prolog
+
+    p.EntityDeclHandler = entity
+    p.StartElementHandler = element
+    try:
+        p.Parse(data, True)
+    except (_Prolog, expat.ExpatError, ValueError, LookupError):
+        pass
+    return found[0] if found else None
+
+
+class _Raw(Exception):
+    """The first name gama-local reads otherwise than a namespace-aware parser."""
+
+
+def raw_name_problem(data: bytes | str) -> str | None:
+    """What ``gama-local`` refuses in the file's names as written, or None. Its parser (expat
+    without namespace processing, ``gkfparser.cpp``) reads each name as it stands, where
+    ElementTree drops a prefix: ``<g:gama-local xmlns:g="...">`` is an unknown element there
+    (the same network here), an attribute of ``<gama-local>`` other than ``xmlns`` and
+    ``version`` (``xmlns:g``, ``xsi:schemaLocation``) is refused, and so is ``xmlns`` or any
+    prefixed attribute (``o:note``) of every other element, which reads its own attributes
+    only. A parse error is left to the reader, which names it."""
+    p = expat.ParserCreate()  # no namespace processing: names as gama-local sees them
+    p.ordered_attributes = True
+    depth = [0]
+
+    def start(name, attrs):
+        if ":" in name:
+            raise _Raw(
+                f"<{name}>: an element name with a namespace prefix (gama-local reads no "
+                f"prefix: write <{name.split(':', 1)[1]}>)"
+            )
+        names = attrs[0::2]
+        for a in names:
+            if depth[0] == 0 and a not in ("xmlns", "version"):
+                raise _Raw(f"<{name}> attribute {said(a)}: gama-local takes only xmlns and version")
+            if depth[0] and (a == "xmlns" or ":" in a):
+                raise _Raw(
+                    f"<{name}> attribute {said(a)}: gama-local refuses a namespace declaration "
+                    "or a prefixed attribute here (only <gama-local> takes xmlns)"
+                )
+        depth[0] += 1
+
+    p.StartElementHandler = start
+    try:
+        p.Parse(data, True)
+    except _Raw as why:
+        return str(why)
+    except (expat.ExpatError, ValueError, LookupError):
+        pass
+    return None
