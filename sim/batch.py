@@ -82,6 +82,7 @@ from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
 from sim.mc.storage import atomic_path  # noqa: E402
 from sim.mc.study_file import study_file_problem  # noqa: E402
+from sim.option_words import Meant  # noqa: E402
 from sim.places import base, shown_path  # noqa: E402
 from sim.stops import (  # noqa: E402
     check_interrupt,
@@ -234,7 +235,9 @@ class _BadArgs(ValueError):
     pass
 
 
-class _Parser(OnceParser):
+class _Parser(Meant, OnceParser):  # -j, --out, --workers: what they mean here
+    words = "batch"
+
     def refuse(self, message: str):  # one line, exit 2 (main prints it)
         raise _BadArgs(message)
 

@@ -13,12 +13,14 @@ from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
 from sim.mc.runner import MIN_CHUNKS
+from sim.option_words import Meant
 
 __all__ = ["module_doc", "parser"]
 
 
-class _Parser(OnceParser):
-    """argparse with one-line errors (exit 2 through :func:`main`, no usage dump)."""
+class _Parser(Meant, OnceParser):
+    """argparse with one-line errors (exit 2 through :func:`main`, no usage dump); a word of
+    another tool is answered by its meaning here (:class:`sim.option_words.Meant`)."""
 
     def refuse(self, message: str):
         if message.startswith("the following arguments are required"):

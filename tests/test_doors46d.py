@@ -1,0 +1,138 @@
+"""Helper d46: the docs typed as written and a new user's first hour; one case per class found,
+each failing on the code before its fix. README.md's and docs/cli.md's commands and quoted
+messages (``--trials 1000.5``, ``--set comparator.beta=0``, ``sim show --trials 4 DIR``,
+``sim rn``, the em-dash ``—trials``, ...) held as written; the slips that did not:
+
+* An option of another tool typed by habit got a guess by its letters alone, of another
+  meaning, or none: ``sim run x.toml --threads 2`` "did you mean --trials?" (which would run two
+  trials), ``--force`` ``--workers``, ``--verbose`` and ``--iterations`` ``--version``,
+  ``--config`` ``--no-figures``, ``--resume`` and ``--silent`` ``--set``; ``-o``, ``-j``,
+  ``-q``, ``-f``, ``-t``, ``--output-dir``, ``--no-plots`` none. ``python -m sim.batch --out
+  x`` answered ``--report`` and ``--workers 2`` (a run option, given before ``--``) nothing;
+  ``make verify --out x`` answered ``--set``. Each is now answered by what it means here
+  (:mod:`sim.option_words`), or, where nothing of ``sim`` means it, by what does its work
+  (``--dry-run``: ``sim check STUDY.toml``; ``--resume``: the same command again).
+* ``sim help``, ``sim help run`` and ``sim version`` (as git and cargo take them) were
+  "invalid choice" with the commands and no guess: now ``did you mean sim run --help?``.
+* ``--set trials 40`` (or ``--set trials = 40``) was "unrecognized arguments: 40" alone: now
+  ``(--set takes KEY=VALUE as one word: --set trials=40)``.
+* A switch given a value (``--overwrite=true``, ``--report=yes``) was argparse's "ignored
+  explicit argument 'true'" alone: now ``(--overwrite takes no value: give --overwrite
+  alone)``.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from oneline import SIM_ERROR, VERIFY_ERROR, one_line
+
+from sim import batch
+from sim.cli import main
+from sim.report.verify import cli as verify_cli
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDY = "studies/brown_table1.toml"
+
+
+@pytest.mark.parametrize(
+    ("typed", "meant"),
+    [
+        (["--threads", "2"], "did you mean --workers?"),
+        (["-j", "2"], "did you mean --workers?"),
+        (["--jobs", "2"], "did you mean --workers?"),
+        (["--force"], "did you mean --overwrite?"),
+        (["-f"], "did you mean --overwrite?"),
+        (["-o", "/tmp/x"], "did you mean --out?"),
+        (["--output-dir", "/tmp/x"], "did you mean --out?"),
+        (["-q"], "did you mean --quiet?"),
+        (["--silent"], "did you mean --quiet?"),
+        (["--iterations", "40"], "did you mean --trials?"),
+        (["-t", "40"], "did you mean --trials?"),
+        (["-s", "trials=40"], "did you mean --set?"),
+        (["--no-plots"], "did you mean --no-figures?"),
+        (["--verbose"], "no such option: sim prints its progress"),
+        (["--dry-run"], "sim check STUDY.toml validates the file"),
+        (["--resume"], "the same command again resumes"),
+        (["--config", "y.toml"], "the study file is the command's argument"),
+    ],
+)
+def test_an_option_of_another_tool_is_answered_by_its_meaning(capsys, typed, meant):
+    """Class: a newcomer's option from another tool (make, pytest, git). Before: a guess by
+    letters (``--threads``: ``--trials``; ``--force``: ``--workers``; ``--verbose``:
+    ``--version``) or none (``-o``, ``-j``, ``-q``)."""
+    line = one_line(capsys, main(["run", STUDY, *typed]), meant, prefix=SIM_ERROR)
+    assert "--version" not in line and line.count("did you mean") <= 1
+
+
+def test_a_near_spelling_keeps_its_guess(capsys):
+    """The words of other tools come first; a typo of an option keeps its spelling guess."""
+    one_line(capsys, main(["run", STUDY, "--tri", "4"]), "--trials? options are not abbreviated")
+    one_line(capsys, main(["run", STUDY, "--nworkers", "2"]), "(did you mean --workers?)")
+    one_line(capsys, main(["show", "results/x", "--trials", "4"]), "an option of sim run")
+
+
+@pytest.mark.parametrize(
+    ("typed", "meant"),
+    [
+        (["help"], "(did you mean sim --help? sim COMMAND --help"),
+        (["help", "run"], "(did you mean sim run --help?)"),
+        (["version"], "(did you mean sim --version?)"),
+    ],
+)
+def test_help_or_version_typed_as_a_command_names_the_option(capsys, typed, meant):
+    """Class: a command word of git or cargo (``sim help run``). Before: "invalid choice:
+    'help'" with the commands and no guess."""
+    one_line(capsys, main(typed), meant, prefix=SIM_ERROR)
+
+
+@pytest.mark.parametrize(
+    "value", [["trials", "40"], ["trials", "=", "40"], ["trials=", "40"], ["trials", "=40"]]
+)
+def test_a_set_value_apart_from_its_key_is_shown_joined(capsys, value):
+    """Class: ``--set KEY VALUE`` with a space, as other tools take it. Before:
+    "unrecognized arguments: 40" alone, the key and --set unnamed."""
+    rc = main(["run", STUDY, "--set", *value])
+    one_line(capsys, rc, "(--set takes KEY=VALUE as one word: --set trials=40)")
+
+
+def test_a_switch_given_a_value_says_it_takes_none(capsys):
+    """Class: ``--overwrite=true``. Before: argparse's "ignored explicit argument 'true'"."""
+    rc = main(["run", STUDY, "--overwrite=true"])
+    one_line(capsys, rc, "(--overwrite takes no value: give --overwrite alone)")
+
+
+@pytest.mark.parametrize(
+    ("typed", "meant"),
+    [
+        (["--out", "x"], "(did you mean --results?)"),
+        (["-j", "2"], "(did you mean --jobs?)"),
+        (["--threads", "2"], "(did you mean --jobs?)"),
+        (["--workers", "2"], "give it after --, python -m sim.batch FILES -- --workers"),
+        (["--force"], "give it after --, python -m sim.batch FILES -- --overwrite"),
+        (["--report=yes"], "(--report takes no value"),
+    ],
+)
+def test_batch_answers_an_option_by_its_meaning(capsys, typed, meant):
+    """Class: a run option given to ``python -m sim.batch`` before ``--``, or ``--out`` for
+    ``--results``. Before: ``--out``: "did you mean --report?"; ``--workers``, ``-j``: nothing."""
+    one_line(capsys, batch.main([*typed, STUDY]), meant, prefix="sim.batch: ")
+
+
+@pytest.mark.parametrize(
+    ("typed", "meant"),
+    [(["--out", "x"], "(did you mean --scratch?)"), (["-j", "2"], "(did you mean --workers?)")],
+)
+def test_verify_answers_an_option_by_its_meaning(capsys, typed, meant):
+    """Class: ``make verify VERIFY_FLAGS="--out x"``. Before: "did you mean --set?"."""
+    line = one_line(capsys, verify_cli.main(typed), meant, prefix=VERIFY_ERROR)
+    assert "--set" not in line
+
+
+def test_the_cli_page_says_what_another_tools_option_gets():
+    """The page states the answer to another tool's option (docs/cli.md, *Bad input*)."""
+    text = " ".join((ROOT / "docs" / "cli.md").read_text(encoding="utf-8").split())
+    assert re.search(r"`--threads 2`: `did you mean --workers\?`", text)
+    assert "`sim help run`: `did you mean sim run --help?`" in text
