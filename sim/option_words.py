@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["Meant", "meant", "set_split", "command_word"]
+__all__ = ["Meant", "meant", "set_split", "command_word", "two_sets"]
 
 #: an option, and the words of other tools that mean it
 SYNONYMS: dict[str, tuple[str, ...]] = {
@@ -78,6 +78,7 @@ SYNONYMS: dict[str, tuple[str, ...]] = {
     "--chunk": ("--chunksize", "--chunk-size", "--chunk_size", "--batch-size", "--batch"),
     "--seed": ("--random-seed", "--rng-seed", "--random_seed", "--rseed"),
     "--version": ("-V",),
+    "--markdown": ("--md", "--markdown-output"),
 }
 
 #: ``python -m sim.batch``: its own words for its options (its runs' are after ``--``)
@@ -110,6 +111,17 @@ NO_SUCH: dict[tuple[str, ...], str] = {
     ),
 }
 
+#: words that mean no option of any ``sim`` command: what does their work instead
+NO_SUCH_ANY: dict[tuple[str, ...], str] = {
+    ("--json", "--csv", "--table", "--format"): (
+        "no such option: a run's tables are the Parquet files of its results directory "
+        "(pyarrow reads them; in Python sim.Results(DIR, STUDY).table(NAME))"
+    ),
+    ("--list", "--keys", "--list-keys", "--show-keys"): (
+        "no such option: sim check STUDY.toml lists every key with its meaning, unit and bounds"
+    ),
+}
+
 #: sim.batch: sim run's options, which a batch takes after ``--``
 RUN_OPTIONS = (
     "--trials",
@@ -131,10 +143,13 @@ def _of(word: str, table: dict[str, tuple[str, ...]], options) -> str | None:
     return next((o for o, words in table.items() if word in words and o in options), None)
 
 
-def meant(word: str, options, batch: bool = False, run: bool = False, verify=False) -> str:
+def meant(
+    word: str, options, batch: bool = False, run: bool = False, verify=False, sim=False
+) -> str:
     """`` (did you mean OPTION? ...)`` for an option ``word`` (``=value`` cut off) of another
     tool whose meaning is an option among ``options`` (a command line's), or, with ``run``
-    (``sim run``'s command line), for a word no option of ``sim`` means, what does its work;
+    (``sim run``'s command line) or ``sim`` (any of ``sim``'s), for a word no option of
+    ``sim`` means, what does its work;
     "" for any other word. ``batch``: the words of ``python -m sim.batch``, where ``sim
     run``'s options go after ``--``; ``verify``: those of ``make verify`` first."""
     if verify and (o := _of(word, VERIFY_SYNONYMS, options)) is not None:
@@ -150,6 +165,9 @@ def meant(word: str, options, batch: bool = False, run: bool = False, verify=Fal
         return ""
     if (o := _of(word, SYNONYMS, options)) is not None:
         return f" (did you mean {o}?)"
+    why = next((w for words, w in NO_SUCH_ANY.items() if word in words), None)
+    if (sim or run) and why is not None:
+        return f" ({why})"
     if run:  # sim run's words (sim check, sim show, make verify: the spelling guess)
         if word == "-n":  # pytest's -n is workers, most Monte-Carlo tools' the trials
             return " (did you mean --trials, the number of trials, or --workers?)"
@@ -212,14 +230,52 @@ class Meant:
             bad = next((w for w in m.group(1).split(" ") if w.startswith("-") and w != "-"), "")
             opts = self.options()
             run = self.words == "sim" and "--trials" in opts  # sim run's line
-            kind = {"batch": self.words == "batch", "verify": self.words == "verify"}
+            kind = {w: self.words == w for w in ("batch", "verify", "sim")}
+            if bad and _after_dashes(given, bad):
+                return (
+                    message + " (-- ends the options: the words after it are no options; drop it)"
+                )
             if bad and (hint := meant(bad.split("=")[0], opts, run=run, **kind)):
                 return message + hint
+            cmds = getattr(self, "commands", None) or _commands(self)
+            cmd = next((a for a in given if a in cmds), None)
+            if not bad and self.words == "sim" and cmd == "report":
+                return message + (
+                    " (sim report takes --results DIR, the directory that holds the results "
+                    "directories; sim show DIR prints one)"
+                )
         m = re.match(r"argument COMMAND: invalid choice: '?(.*?)'? \(choose from", message)
-        cmds = next((a.choices for a in self._actions if a.dest == "cmd"), None) or {}
-        if m and (hint := command_word(m.group(1), given, self.prog, cmds)):
+        if m and (hint := command_word(m.group(1), given, self.prog, _commands(self))):
             return message + hint
         m = re.match(r"(?:.*: )?argument (--[\w-]+): ignored explicit argument", message)
         if m:
             return f"{message} ({m.group(1)} takes no value: give {m.group(1)} alone)"
         return super().explain(message)
+
+
+def _commands(parser) -> dict:
+    """The commands of a parser with subcommands (``sim``'s ``run``, ``show``, ...); {} else."""
+    return next((a.choices for a in parser._actions if a.dest == "cmd"), None) or {}
+
+
+def _after_dashes(given: list[str], word: str) -> bool:
+    """True when ``word`` is given only after a ``--`` (``sim run x.toml -- --trials 40``:
+    the option read as a file)."""
+    return "--" in given and word in given and given.index(word) > given.index("--")
+
+
+#: a second ``KEY=`` in a ``--set`` value, after a comma, a semicolon or white space
+_SECOND = re.compile(r"\s*[,;]\s*(?=[A-Za-z_][\w.]*\s*=)|\s+(?=[A-Za-z_][\w.]*\s*=)")
+
+
+def two_sets(overrides: list[str], key: str | None) -> str:
+    """`` (one KEY=VALUE a --set: --set trials=40 --set seed=3)`` when the refused value of
+    ``key`` holds a second override (``--set trials=40,seed=3``, ``--set "trials=40
+    seed=3"``: "trials: must be an integer (got '40,seed=3')" alone); "" otherwise."""
+    for text in overrides:
+        k, eq, value = text.partition("=")
+        if not eq or k.strip() != key or not _SECOND.search(value):
+            continue
+        parts = [f"{k.strip()}={p}" if i == 0 else p for i, p in enumerate(_SECOND.split(value))]
+        return f" (one KEY=VALUE a --set: {' '.join(f'--set {p}' for p in parts)})"
+    return ""

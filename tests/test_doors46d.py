@@ -19,6 +19,14 @@ messages (``--trials 1000.5``, ``--set comparator.beta=0``, ``sim show --trials 
 * A switch given a value (``--overwrite=true``, ``--report=yes``) was argparse's "ignored
   explicit argument 'true'" alone: now ``(--overwrite takes no value: give --overwrite
   alone)``.
+* Two overrides in one ``--set`` (``--set trials=40,seed=3``, ``--set "trials=40 seed=3"``)
+  were "trials: must be an integer (got '40,seed=3')" alone: the line now ends ``(one
+  KEY=VALUE a --set: --set trials=40 --set seed=3)``.
+* ``sim report results/brown_table1`` (the directory given as an argument) was
+  "unrecognized arguments" alone: it now says ``sim report takes --results DIR``; ``sim run
+  x.toml -- --trials 40`` guessed ``--trials`` for ``--trials``: it now says that ``--`` ends
+  the options; ``sim show DIR --json`` guessed ``--version``, ``sim check x.toml --list``
+  ``--set``, ``--md`` nothing: now what gives the tables, the keys, ``--markdown``.
 """
 
 from __future__ import annotations
@@ -131,8 +139,47 @@ def test_verify_answers_an_option_by_its_meaning(capsys, typed, meant):
     assert "--set" not in line
 
 
+@pytest.mark.parametrize(
+    ("value", "split"),
+    [
+        ("trials=40,seed=3", "--set trials=40 --set seed=3"),
+        ("trials=40 seed=3", "--set trials=40 --set seed=3"),
+        ("plate.grid=5; plate.spacing_mm=40", "--set plate.grid=5 --set plate.spacing_mm=40"),
+    ],
+)
+def test_two_overrides_in_one_set_are_shown_apart(capsys, value, split):
+    """Class: ``--set`` given two keys at once, as a list. Before: "must be an integer (got
+    '40,seed=3')", the second key unnamed."""
+    one_line(capsys, main(["check", STUDY, "--set", value]), f"(one KEY=VALUE a --set: {split})")
+
+
+def test_a_list_value_with_commas_is_no_second_override(capsys):
+    """A list's commas are not a second override: its own refusal stands, with no split."""
+    line = one_line(capsys, main(["check", STUDY, "--set", "plate.grid=[3,5]"]), "plate.grid")
+    assert "one KEY=VALUE" not in line
+
+
+@pytest.mark.parametrize(
+    ("typed", "meant"),
+    [
+        (["report", "results/brown_table1"], "sim report takes --results DIR"),
+        (["run", STUDY, "--", "--trials", "40"], "(-- ends the options"),
+        (["show", "results/brown_table1", "--json"], "the Parquet files of its results"),
+        (["check", STUDY, "--list"], "sim check STUDY.toml lists every key"),
+        (["show", "results/brown_table1", "--md"], "(did you mean --markdown?)"),
+    ],
+)
+def test_a_command_given_what_another_takes_says_what_to_type(capsys, typed, meant):
+    """Class: an argument in the wrong place or of another tool's habit. Before: "unrecognized
+    arguments" alone, or a guess of another meaning (``--json``: ``--version``; ``--list``:
+    ``--set``; ``-- --trials``: ``--trials``)."""
+    line = one_line(capsys, main(typed), meant, prefix=SIM_ERROR)
+    assert "--version" not in line and "did you mean --set" not in line
+
+
 def test_the_cli_page_says_what_another_tools_option_gets():
     """The page states the answer to another tool's option (docs/cli.md, *Bad input*)."""
     text = " ".join((ROOT / "docs" / "cli.md").read_text(encoding="utf-8").split())
     assert re.search(r"`--threads 2`: `did you mean --workers\?`", text)
     assert "`sim help run`: `did you mean sim run --help?`" in text
+    assert "`--set trials=40,seed=3`: `one KEY=VALUE a --set" in text
