@@ -67,7 +67,13 @@ def _of_another(message: str, cmds: dict, cmd: str | None) -> str | None:
     has = [c for c, p in cmds.items() if c != cmd and word in p._option_string_actions]
     if not has or word in cmds[cmd]._option_string_actions:
         return None
-    return f"{word}: an option of {' and '.join(f'sim {c}' for c in has)}, not of sim {cmd}"
+    line = f"{word}: an option of {' and '.join(f'sim {c}' for c in has)}, not of sim {cmd}"
+    if cmd == "check" and word in ("--trials", "--seed", "--chunk"):  # as sim run's (d46)
+        words = m.group(1).split(" ")
+        after = words[words.index(bad) + 1 :][:1] or ["N"]
+        value = bad.partition("=")[2] or after[0]
+        line += f": sim check --set {word[2:]}={value} checks what sim run {word} {value} runs"
+    return line
 
 
 def module_doc(doc: str | None, path: str) -> str:

@@ -27,6 +27,9 @@ messages (``--trials 1000.5``, ``--set comparator.beta=0``, ``sim show --trials 
   x.toml -- --trials 40`` guessed ``--trials`` for ``--trials``: it now says that ``--`` ends
   the options; ``sim show DIR --json`` guessed ``--version``, ``sim check x.toml --list``
   ``--set``, ``--md`` nothing: now what gives the tables, the keys, ``--markdown``.
+* ``sim check x.toml --trials 400`` (checking with the flags of the run to come) was "an
+  option of sim run, not of sim check" alone: it now adds ``sim check --set trials=400 checks
+  what sim run --trials 400 runs``.
 """
 
 from __future__ import annotations
@@ -175,6 +178,16 @@ def test_a_command_given_what_another_takes_says_what_to_type(capsys, typed, mea
     ``--set``; ``-- --trials``: ``--trials``)."""
     line = one_line(capsys, main(typed), meant, prefix=SIM_ERROR)
     assert "--version" not in line and "did you mean --set" not in line
+
+
+@pytest.mark.parametrize(
+    ("typed", "meant"), [(["--trials", "400"], "trials=400"), (["--seed=7"], "seed=7")]
+)
+def test_check_given_a_run_option_names_its_set_form(capsys, typed, meant):
+    """Class: ``sim check`` typed with ``sim run``'s flags. Before: "an option of sim run, not
+    of sim check" alone, not how sim check takes it."""
+    line = one_line(capsys, main(["check", STUDY, *typed]), f"sim check --set {meant} checks")
+    assert line.startswith(f"{SIM_ERROR}{typed[0].split('=')[0]}: an option of sim run")
 
 
 def test_the_cli_page_says_what_another_tools_option_gets():
