@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["Meant", "meant", "set_split", "command_word", "two_sets"]
+__all__ = ["Meant", "meant", "set_split", "command_word", "two_sets", "item_key"]
 
 #: an option, and the words of other tools that mean it
 SYNONYMS: dict[str, tuple[str, ...]] = {
@@ -279,3 +279,20 @@ def two_sets(overrides: list[str], key: str | None) -> str:
         parts = [f"{k.strip()}={p}" if i == 0 else p for i, p in enumerate(_SECOND.split(value))]
         return f" (one KEY=VALUE a --set: {' '.join(f'--set {p}' for p in parts)})"
     return ""
+
+
+#: a key that names an item of a list (``network.generate[1].sigma_arcsec``, ``...generate.1...``)
+_ITEM = re.compile(r"^([A-Za-z_][\w.]*?)(?:\[(\d+)\]|\.(\d+))(?:\.|$)")
+
+
+def item_key(key: str | None, detail: str) -> str:
+    """`` (network.generate is a list: ...)`` for an unknown ``key`` that names an item of a
+    list or a field of one (``--set network.generate[1].sigma_arcsec=3``: "unknown key"
+    alone), saying to give the whole list; "" otherwise."""
+    m = _ITEM.match(key or "")
+    if m is None or not detail.startswith("unknown key"):
+        return ""
+    return (
+        f" ({m.group(1)} is a list: its items have no keys of their own; give the whole list, "
+        f"--set '{m.group(1)}=[...]', or edit the study file)"
+    )

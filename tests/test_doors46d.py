@@ -30,6 +30,9 @@ messages (``--trials 1000.5``, ``--set comparator.beta=0``, ``sim show --trials 
 * ``sim check x.toml --trials 400`` (checking with the flags of the run to come) was "an
   option of sim run, not of sim check" alone: it now adds ``sim check --set trials=400 checks
   what sim run --trials 400 runs``.
+* ``--set network.generate[1].sigma_arcsec=3`` (an item of a network's list, as a newcomer
+  would name it) was "unknown key" alone: it now says the list's items have no keys of their
+  own and to give the whole list (``--set 'network.generate=[...]'``) or edit the file.
 """
 
 from __future__ import annotations
@@ -190,9 +193,32 @@ def test_check_given_a_run_option_names_its_set_form(capsys, typed, meant):
     assert line.startswith(f"{SIM_ERROR}{typed[0].split('=')[0]}: an option of sim run")
 
 
+NETWORK = """study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+           { name = "B", x_mm = 400.0, y_mm = 0.0, role = "fixed" },
+           { name = "P", x_mm = 150.0, y_mm = 120.0 } ]
+generate = [ { kind = "distance", from = ["A", "B"], to = "P", sigma_mm = 0.002 } ]
+"""
+
+
+@pytest.mark.parametrize("key", ["network.generate[0].sigma_mm", "network.generate.0.sigma_mm"])
+def test_a_list_items_field_set_by_index_says_to_give_the_list(tmp_path, capsys, key):
+    """Class: ``--set`` of one item of a network's list by its index. Before: "unknown key"
+    alone, with no word of how to change it."""
+    (f := tmp_path / "net.toml").write_text(NETWORK, encoding="utf-8")
+    rc = main(["check", str(f), "--set", f"{key}=0.003"])
+    one_line(capsys, rc, "network.generate is a list", "--set 'network.generate=[...]'")
+    rc = main(["check", str(f), "--set", "network.generat=[]"])  # no item: as before
+    assert "is a list" not in one_line(capsys, rc, "unknown key")
+
+
 def test_the_cli_page_says_what_another_tools_option_gets():
     """The page states the answer to another tool's option (docs/cli.md, *Bad input*)."""
     text = " ".join((ROOT / "docs" / "cli.md").read_text(encoding="utf-8").split())
     assert re.search(r"`--threads 2`: `did you mean --workers\?`", text)
     assert "`sim help run`: `did you mean sim run --help?`" in text
     assert "`--set trials=40,seed=3`: `one KEY=VALUE a --set" in text
+    assert "`--set network.generate[1].sigma_arcsec=3`" in text
