@@ -135,6 +135,16 @@ def test_batch_answers_an_option_by_its_meaning(capsys, typed, meant):
     one_line(capsys, batch.main([*typed, STUDY]), meant, prefix="sim.batch: ")
 
 
+@pytest.mark.parametrize("typed", [["-o", "x"], ["--out", "x"]])
+def test_batch_run_options_name_results_for_an_output(capsys, typed):
+    """Class: an output directory among a batch's run options (after ``--``). Before: ``-o``
+    got "did you mean --out?" (since the words of other tools), which the batch then refuses;
+    ``--out`` was refused without the option that does it."""
+    rc = batch.main(["--results", "unused", STUDY, "--", *typed])
+    line = one_line(capsys, rc, "give --results DIR before --", prefix="sim.batch: ")
+    assert "did you mean --out" not in line
+
+
 @pytest.mark.parametrize(
     ("typed", "meant"),
     [(["--out", "x"], "(did you mean --scratch?)"), (["-j", "2"], "(did you mean --workers?)")],
