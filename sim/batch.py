@@ -82,6 +82,7 @@ from sim.mc.outputs import name_problem  # noqa: E402
 from sim.mc.paths import link_problem  # noqa: E402
 from sim.mc.storage import atomic_path  # noqa: E402
 from sim.mc.study_file import study_file_problem  # noqa: E402
+from sim.option_words import Meant  # noqa: E402
 from sim.places import base, shown_path  # noqa: E402
 from sim.report_due import due_words  # noqa: E402
 from sim.stops import (  # noqa: E402
@@ -232,10 +233,12 @@ def _on_sigterm(signum, frame):
 
 
 class _BadArgs(ValueError):
-    pass
+    """A refusal of the command line (main prints its one line)."""
 
 
-class _Parser(OnceParser):
+class _Parser(Meant, OnceParser):  # -j, --out, --workers: what they mean here
+    words = "batch"
+
     def refuse(self, message: str):  # one line, exit 2 (main prints it)
         raise _BadArgs(message)
 
@@ -244,8 +247,6 @@ class _Parser(OnceParser):
 INTERRUPTED = "sim.batch: interrupted; the same command again resumes the unfinished runs"
 #: what a run of ``sim run`` interrupted while it published its results says
 PUBLISHED = "interrupted after the results were written to"
-
-
 #: the driver's line when it was interrupted before its first run started (checking its files)
 NOTHING_RUN = "sim.batch: interrupted before any run started: nothing was run"
 

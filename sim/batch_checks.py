@@ -259,12 +259,18 @@ def _run_options_problem(run_args: list[str]) -> str | None:
         with contextlib.redirect_stdout(text), contextlib.redirect_stderr(text):
             args = run_parser(cli_doc).parse_args(["run", "STUDY.toml", *run_args])
         if args.out is not None:
-            return "--out cannot be a run option: each study writes <results>/<file name>"
+            return (
+                "--out cannot be a run option: each study writes <results>/<file name> "
+                "(give --results DIR before --)"
+            )
         check_run_args(args)
     except SystemExit:
         return f"{' '.join(run_args)!r} would print the help of sim run and run nothing"
-    except ConfigError as e:
-        return str(e).removeprefix("sim: ")
+    except ConfigError as e:  # -o after --: sim run's --out, which a batch refuses (d46)
+        why = str(e).removeprefix("sim: ")
+        return why.replace(
+            "(did you mean --out?)", "(a batch's output: give --results DIR before --)"
+        )
     return None
 
 

@@ -49,6 +49,7 @@ from sim.mc.progress import set_quiet
 from sim.mc.read_when import read_in_a_cell
 from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
+from sim.option_words import item_key, two_sets
 from sim.places import base, default_out, shown_path
 from sim.report.run_summary import off_setup, terminal_summary, write_run_readme
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
@@ -126,8 +127,13 @@ def load_run(args):
             raise ConfigError(opt, f"given twice, as {opt} and as --set {key}=: give one")
     trials = args.trials is not None or "trials" in given
     picks = trials and args.chunk is None and "chunk" not in given  # --trials's chunk
-    with memory_given(getattr(args, "max_memory_gb", None)):  # a network's size (sim.batch)
-        return load_picking_chunk(args.study, picks, overrides, args.trials, args.seed)
+    try:
+        with memory_given(getattr(args, "max_memory_gb", None)):  # a network's size (sim.batch)
+            return load_picking_chunk(args.study, picks, overrides, args.trials, args.seed)
+    except ConfigError as e:  # --set trials=40,seed=3: two overrides in one, named
+        if hint := two_sets(args.set, e.key) or item_key(e.key, e.detail):
+            raise ConfigError(e.key, e.detail + hint) from None
+        raise
 
 
 def _run(args) -> int:

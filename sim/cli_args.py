@@ -13,12 +13,14 @@ from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
 from sim.mc.runner import MIN_CHUNKS
+from sim.option_words import Meant
 
 __all__ = ["module_doc", "parser"]
 
 
-class _Parser(OnceParser):
-    """argparse with one-line errors (exit 2 through :func:`main`, no usage dump)."""
+class _Parser(Meant, OnceParser):
+    """argparse with one-line errors (exit 2 through :func:`main`, no usage dump); a word of
+    another tool is answered by its meaning here (:class:`sim.option_words.Meant`)."""
 
     def refuse(self, message: str):
         if message.startswith("the following arguments are required"):
@@ -65,7 +67,13 @@ def _of_another(message: str, cmds: dict, cmd: str | None) -> str | None:
     has = [c for c, p in cmds.items() if c != cmd and word in p._option_string_actions]
     if not has or word in cmds[cmd]._option_string_actions:
         return None
-    return f"{word}: an option of {' and '.join(f'sim {c}' for c in has)}, not of sim {cmd}"
+    line = f"{word}: an option of {' and '.join(f'sim {c}' for c in has)}, not of sim {cmd}"
+    if cmd == "check" and word in ("--trials", "--seed", "--chunk"):  # as sim run's (d46)
+        words = m.group(1).split(" ")
+        after = words[words.index(bad) + 1 :][:1] or ["N"]
+        value = bad.partition("=")[2] or after[0]
+        line += f": sim check --set {word[2:]}={value} checks what sim run {word} {value} runs"
+    return line
 
 
 def module_doc(doc: str | None, path: str) -> str:

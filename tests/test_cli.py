@@ -311,7 +311,8 @@ def test_a_failed_run_says_where_and_does_not_block_the_corrected_command(
     [
         (
             ["check", "studies/wolf_polynomial.toml", "--trials", "20"],
-            "sim: error: --trials: an option of sim run, not of sim check (see sim check --help)",
+            "sim: error: --trials: an option of sim run, not of sim check: sim check --set "
+            "trials=20 checks what sim run --trials 20 runs (see sim check --help)",
         ),
         (
             ["show", "results/wolf_polynomial", "-x"],

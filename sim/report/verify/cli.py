@@ -16,6 +16,7 @@ from sim.mc.argv import OnceParser, integer, most_workers
 from sim.mc.config import ConfigError, parse_override
 from sim.mc.outputs import name_problem
 from sim.mc.overrides import listed
+from sim.option_words import Meant
 from sim.places import base, shown_path
 from sim.report.verify.record import write_record
 from sim.report.verify.rerun import verify
@@ -33,7 +34,9 @@ DESCRIPTION = (
 # --- command line -----------------------------------------------------------------------------
 
 
-class _Parser(OnceParser):
+class _Parser(Meant, OnceParser):  # -j: --workers (sim.option_words)
+    words = "verify"
+
     def refuse(self, message: str):  # one line, exit 2 (main prints it)
         raise VerifyError(message)
 
