@@ -28,7 +28,7 @@ from sim.held_stops import held_stops
 from sim.mc.argv import most_workers
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import chunk_note
-from sim.mc.executors import StartRefused, script_words
+from sim.mc.executors import StartRefused, end_dask_clusters, script_words
 from sim.mc.left_behind import clear_replaced
 from sim.mc.outputs import _chunks, _differs, _same, check_out, drop_stage, prepare_stage, stage_dir
 from sim.mc.publish import publish, seal
@@ -48,6 +48,7 @@ from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
 from sim.run_failure import numeric_failure
+from sim.spared_workers import start_sparing_workers
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
@@ -188,7 +189,9 @@ def execute(
     stage = stage_dir(out)
     clear_replaced(stage, out, shown)  # a kill between publishing's two steps left them there
     try:
-        ex = make_executor(executor, workers, scheduler)
+        ex = start_sparing_workers(
+            executor, lambda: make_executor(executor, workers, scheduler), _end
+        )
     except (RuntimeError, OSError, TimeoutError, ValueError, TypeError) as e:
         key = "--scheduler" if scheduler else "--executor"
         msg = (str(e).strip().splitlines() or [type(e).__name__])[0]
@@ -331,6 +334,16 @@ def _replaced(stage: Path, record: dict) -> str | None:
     if not n or old.get("failed") or _same(old, record):
         return None
     return f"its unfinished run of {_differs(old, record)} ({n} chunks)"
+
+
+def _end(ex) -> None:
+    """An executor started, or (None) the Dask clusters starting, ended by an interrupt:
+    quietly, as after a run's."""
+    _quiet_dask_logs()
+    if ex is None:
+        end_dask_clusters()
+    else:
+        ex.close(kill=True)
 
 
 def _quiet_dask_logs() -> None:
