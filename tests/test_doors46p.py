@@ -15,6 +15,12 @@ failed on the code before its fix.
   configuration where one does not converge is refused, naming the larger error share when
   the paper's errors converge on that plate, else the plate's key
   (:func:`sim.studies.brown.probe.check_noise`).
+* ``gridplate_two_plates`` and ``agnard_block``: a region over the work limit
+  (``region.points = 65536``, ``region.rounds = 6`` with ``region.draws = 1e6``; agnard's
+  64 five-point layouts of 1e6 blocks, its Table 1 region of 256 scanner vectors of 10,000
+  blocks in 5 rounds) was told to "reduce trials or the lists in the study file": neither
+  holds any part of it. The region's keys are named when the region outweighs the rest
+  (:mod:`sim.mc.gridplate_size`, :mod:`sim.mc.agnard_size`).
 """
 
 from pathlib import Path
@@ -86,3 +92,39 @@ def test_the_refused_errors_fail_trials_of_the_run_and_the_accepted_do_not():
     assert _converged({**small, "plate.spacing_mm": 1.0})["stations"] < 0.9
     ok = _converged({"errors.comparator_sigma_um": 1800.0})
     assert ok == {"known": 1.0, "stations": 1.0, "pivot": 1.0}, ok
+
+
+@pytest.mark.parametrize(
+    "study, sets, keys",
+    [
+        (
+            "gridplate_two_plates",
+            ("region.points=65536", "region.rounds=6", "region.draws=1e6"),
+            "region.points, region.rounds or region.draws",
+        ),
+        (
+            "gridplate_two_plates",
+            ("region.points=65536", "region.rounds=6", "region.iter_calibrations=64"),
+            "region.points, region.rounds or region.iter_calibrations",
+        ),
+        (
+            "agnard_block_104",
+            ("region.points=64", "region.trials=1e6"),
+            "region.points or region.trials",
+        ),
+        (
+            "agnard_block_104",
+            ("table1.points=256", "table1.trials=1e4", "table1.rounds=5"),
+            "table1.points, table1.rounds or table1.trials",
+        ),
+    ],
+)
+def test_a_region_over_the_work_limit_names_its_keys(capsys, study, sets, keys):
+    """A region's work over the limit: the refusal named no key of it."""
+    argv = _check(study, *sets) + ["--max-adjustments", "4e8"]
+    line = one_line(capsys, main(argv), "over the limit of 4e+08 adjustments", prefix=SIM_ERROR)
+    assert line.endswith(f"or change {keys}"), line
+    # the trials' work over the limit names no key of the region
+    argv = _check(study, "trials=1e6", "chunk=10") + ["--max-adjustments", "1e5"]
+    line = one_line(capsys, main(argv), "over the limit of 1e+05 adjustments", prefix=SIM_ERROR)
+    assert "region." not in line and "table1." not in line, line
