@@ -41,10 +41,12 @@ def test_brown_solver_limit_no_trial_meets_is_refused_at_check(capsys, study, li
 
 
 def test_brown_solver_limit_the_trials_meet_is_accepted(capsys):
-    # 3 iterations: the pivot model converges in 3 or 4, so part of the trials do; a loose
-    # tolerance lets 2 iterations do (the probe decides, not a fixed bound on the key)
+    # 4 iterations: the pivot model converges in 3 or 4, so every probe plate does (at 3,
+    # part of them: refused since P46, tests/test_doors46p.py, as the run's statistics would
+    # be those of that part); a loose tolerance lets 2 iterations do (the probe decides, not
+    # a fixed bound on the key)
     study = str(ROOT / "studies" / "brown_table1.toml")
-    assert main(["check", study, "--set", "solver.max_iter=3"]) == 0
+    assert main(["check", study, "--set", "solver.max_iter=4"]) == 0
     assert main(["check", study, "--set", "solver.max_iter=2", "--set", "solver.tol_mm=1e-3"]) == 0
     capsys.readouterr()
 

@@ -241,4 +241,16 @@ def agnard_estimate(c: Mapping) -> tuple:
         + rT * u["region"]
         + t1T * (u["table1"](c.get("table1.points", 0)) + t1_rounds * u["table1"](REGION_MAX_NEW))
     )
-    return trials, adj, int(max(U, Ut)), b, "", (0.0, "", ""), (), work, geometry_keys(c)
+    # the part that outweighs the rest named by its keys when the geometry is the paper's
+    # (the region's 64 layouts of 1e6 blocks were told to "reduce trials or the lists in the
+    # study file"); a costlier geometry makes every part costly, and is named alone
+    region = rT * r_pts * 2 * (w + p)
+    t1 = adj - region - T * (3 + layouts) * (snoop * ws + p)
+    t1 -= tT * (2 * dp + rc) * (snoop * ws + p) + bT * len(sizes) * 2 * (wt + pt)
+    t1 -= sT * s_cells * 3 * (snoop * ws + p)
+    part = ()
+    if region > adj / 2:
+        part = ("region.points", "region.trials")
+    elif t1 > adj / 2:
+        part = ("table1.points", "table1.rounds", "table1.trials")
+    return trials, adj, int(max(U, Ut)), b, "", (0.0, "", ""), (), work, geometry_keys(c) or part

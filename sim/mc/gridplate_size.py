@@ -61,4 +61,17 @@ def gridplate_estimate(c: Mapping) -> tuple:
     T, ch = c["trials"], min(c["chunk"], c["trials"])
     per, region = gridplate_units(c)
     b = ch * (P * N * L * GP_READING_BYTES + P * N * GP_POINT_BYTES)
-    return T, T * per + region, 2 * N + 3, b, "", (0.0, "", ""), (), T * per + region
+    return T, T * per + region, 2 * N + 3, b, "", (0.0, "", ""), (), T * per + region, _keys(c)
+
+
+def _keys(c: Mapping) -> tuple:
+    """The region's keys a refusal over the work limit names when the region outweighs the
+    trials (``region.points = 65536`` with ``region.draws = 1e6`` was told to "reduce trials
+    or the lists in the study file", which hold no part of it): its points and rounds, and
+    the larger of its draws' and its counted calibrations' work."""
+    per, region = gridplate_units(c)
+    if not region > c["trials"] * per:
+        return ()
+    draws = gridplate_units({**c, "region.iter_calibrations": 0})[1]
+    more = "region.draws" if draws >= region - draws else "region.iter_calibrations"
+    return ("region.points", "region.rounds", more)

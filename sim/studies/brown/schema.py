@@ -16,7 +16,7 @@ from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import when
 from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
 from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, region_seed
-from sim.studies.brown.probe import check_solver, check_start
+from sim.studies.brown.probe import check_noise, check_solver, check_start
 from sim.studies.brown.range_keys import check_scale, moved_from_paper
 from sim.studies.brown.values import thetas
 
@@ -358,6 +358,7 @@ def check(cfg: dict) -> None:
     base = {k: f.default for k, f in BASE.items()}
     check_start(cfg, key, setup, MODEL_NAMES, moved_from_paper(cfg, key, base), base)
     check_solver(cfg, pts, setup(cfg)[1], MODEL_NAMES, BASE["solver.max_iter"].default)
+    check_noise(cfg, key, pts, setup(cfg)[1], MODEL_NAMES, moved_from_paper(cfg, key, base), base)
     require_chunks(cfg)
 
 
