@@ -144,7 +144,8 @@ class Results:
         ``trials`` when the study writes no ``trials.parquet``)."""
         self._check_dir()
         files, ran = list(self.path.glob("*.parquet")), run_tables(self.path, self.study)
-        names = {p.stem for p in files if p.name in ran or _owner(p) == self.study}
+        listed = any(n.endswith(".parquet") for n in ran)  # else an older run's: by provenance
+        names = {p.stem for p in files if p.name in ran or not listed and _owner(p) == self.study}
         within = "" if names else self._within()
         if within:  # a results root (results/ and its verify record): [], or 'verify''s tables
             raise ConfigError("path", f"{self.path} is not a results directory{within}")
@@ -183,6 +184,12 @@ class Results:
             why = "the committed results/ hold no chunks; removed by hand?): run the study again"
             why = why if dataset else "removed by hand?)"
             raise ConfigError("table", f"{p} is missing: its run wrote it ({why}")
+        ran = run_tables(
+            self.path, self.study
+        )  # a copy beside them (claims_old.parquet): unchecked
+        if there and not dataset and p.name not in ran and any(n.endswith(".parquet") for n in ran):
+            why = "a copy or a file added by hand? its run.json does not list it"
+            raise ConfigError("table", f"{p} is not a table its run wrote ({why})")
         if not there:  # a sweep's claims() named only 'sweep', not where its cells' tables are
             cells = (self.path / "sweep.parquet").is_file() and (self.path / "cells").is_dir()
             cells = f" (a sweep: each cell's in {self.path / 'cells'}/<label>)" if cells else ""

@@ -42,8 +42,12 @@ import pyarrow.parquet as pq
 import pytest
 
 import sim
+from sim.batch_checks import why_stale
 from sim.cli import main
+from tests.conftest import tiny_overrides
 from tests.oneline import one_line
+
+PLATE = Path(__file__).resolve().parents[1] / "studies" / "network_plate.toml"
 
 
 def _copy(tiny_run, tmp_path: Path, name: str = "network_plate") -> Path:
@@ -128,10 +132,30 @@ def test_a_run_record_saved_with_a_utf8_signature_is_read(tiny_run, tmp_path, ca
     as the record it is, and the edit is named."""
     d = _copy(tiny_run, tmp_path)
     rec = d / "run.json"
+    args = ["--quiet", *tiny_overrides("network")]
+    assert why_stale(PLATE, d, args) is None
     rec.write_bytes(b"\xef\xbb\xbf" + rec.read_bytes())
     assert json.loads(rec.read_text("utf-8-sig"))["code_hash"]
     assert sim.Results(d, "network").claims().num_rows > 0  # the run's tables: read
+    assert why_stale(PLATE, d, args) is None  # was "its run record or study file does not load"
     _edit_first_value(d)
     one_line(capsys, main(["show", str(d)]), "claims.parquet", "value")
     with pytest.raises(sim.ConfigError, match="is not the table its run wrote"):
         sim.Results(d, "network").claims()
+
+
+def test_a_copy_of_a_table_beside_the_run_is_not_one_of_its_tables(tiny_run, tmp_path):
+    """A copy kept beside the tables (``claims_old.parquet``, a file manager's ``points
+    (copy).parquet``): ``Results.names()`` listed both as the run's tables (the second no
+    name ``table()`` takes) and ``table("claims_old")`` returned the copy, edited or not,
+    unchecked (the run recorded no shape for it). The run's record lists its tables: only
+    those are its names, and a table of another name is refused naming the file."""
+    d = _copy(tiny_run, tmp_path)
+    shutil.copyfile(d / "claims.parquet", d / "claims_old.parquet")
+    shutil.copyfile(d / "points.parquet", d / "points (copy).parquet")
+    res = sim.Results(d, "network")
+    assert "claims_old" not in res.names() and "points (copy)" not in res.names()
+    assert {"claims", "points"} <= set(res.names())
+    with pytest.raises(sim.ConfigError, match=r"claims_old.parquet is not a table its run wrote"):
+        res.table("claims_old")
+    assert (d / "claims_old.parquet").is_file()  # the user's copy, kept
