@@ -67,7 +67,13 @@ from sim.mc.pyvalue import as_config_value
 from sim.mc.settle import settled
 from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
-from sim.mc.table_shape import record_line, record_problem, recorded_shape, shape_problem
+from sim.mc.table_shape import (
+    record_line,
+    record_problem,
+    recorded_shape,
+    shape_problem,
+    sum_problem,
+)
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
 from sim.report.run_summary import write_run_readme
@@ -210,7 +216,9 @@ class Results:
                 raise ConfigError("table", mixed)
             if (bad := record_problem(p)) is not None:  # its tables were read unchecked
                 raise ConfigError("table", record_line(bad))
-            if (edit := shape_problem(table, recorded_shape(p))) is not None:  # edited by hand
+            shaped = recorded_shape(p)  # none recorded: its sha256, where recorded
+            edit = shape_problem(table, shaped) if shaped is not None else sum_problem(p)
+            if edit is not None:  # edited by hand
                 raise ConfigError("table", f"{p} is not the table its run wrote: {edit}")
         self._check_dir()  # replaced while it was read
         stale_warning(self.path)  # sim show's note on results of another version's code

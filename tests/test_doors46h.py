@@ -159,3 +159,19 @@ def test_a_copy_of_a_table_beside_the_run_is_not_one_of_its_tables(tiny_run, tmp
     with pytest.raises(sim.ConfigError, match=r"claims_old.parquet is not a table its run wrote"):
         res.table("claims_old")
     assert (d / "claims_old.parquet").is_file()  # the user's copy, kept
+
+
+def test_a_record_without_shapes_checks_the_tables_by_their_sha256(tiny_run, tmp_path, capsys):
+    """``table_shape`` removed from ``run.json`` (as a record of the versions that held the
+    tables' sha256 but no shapes): the tables were read unchecked, a value edited by hand
+    printed and returned as the run's. A table whose sha256 is not the recorded one is
+    refused there, naming the file."""
+    d = _copy(tiny_run, tmp_path)
+    rec = json.loads((d / "run.json").read_text("utf-8"))
+    del rec["table_shape"]
+    (d / "run.json").write_text(json.dumps(rec), "utf-8")
+    assert sim.Results(d, "network").claims().num_rows > 0  # the run's own: read
+    _edit_first_value(d)
+    one_line(capsys, main(["show", str(d)]), "claims.parquet", "sha256")
+    with pytest.raises(sim.ConfigError, match="claims.parquet is not the table its run wrote"):
+        sim.Results(d, "network").claims()

@@ -48,6 +48,7 @@ __all__ = [
     "record_problem",
     "recorded_shape",
     "shape_problem",
+    "sum_problem",
     "values_digest",
     "declared_problem",
 ]
@@ -183,6 +184,29 @@ def _unrecorded(rec: Path) -> str:
         return "JSON nested too deeply"
     del doc
     return "not an object holding its config and code_hash"
+
+
+def sum_problem(path: str | Path) -> str | None:
+    """For a table whose run record holds no shape of it but its sha256 (``table_sha256``:
+    a record of the versions between the two, or one whose ``table_shape`` was removed by
+    hand): how the file differs (its sha256), else None. Such a table was read unchecked: a
+    value edited by hand was printed as the run's."""
+    path = Path(path)
+    for root, key in _spots(path):
+        if (rec := read_record(root)) is None:
+            continue
+        sums = rec.get("table_sha256")
+        want = sums.get(key) if isinstance(sums, dict) else None
+        if not isinstance(want, str):
+            return None
+        h = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+        if h.hexdigest() != want:
+            return "its sha256 is not the one its run recorded, which holds no shape of it"
+        return None
+    return None
 
 
 def recorded_shape(path: str | Path) -> dict | None:

@@ -37,6 +37,7 @@ from sim.mc.table_shape import (
     record_problem,
     recorded_shape,
     shape_problem,
+    sum_problem,
 )
 
 __all__ = [
@@ -172,6 +173,8 @@ def checked_table(path: str | Path, shaped: bool = True) -> pa.Table:
         raise TableError(bad[0], f"{bad[1]}: edited by hand? its tables cannot be checked")
     if (recorded := recorded_shape(path)) is None:  # an older version's run: what it declares
         if (why := declared_problem(table)) is not None:
+            raise TableError(path, why)
+        if (why := sum_problem(path)) is not None:  # its table_shape removed: unchecked
             raise TableError(path, why)
     elif (why := shape_problem(table, recorded)) is not None:
         raise EditedTable(path, why)
