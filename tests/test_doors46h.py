@@ -44,6 +44,7 @@ import pytest
 import sim
 from sim.batch_checks import why_stale
 from sim.cli import main
+from sim.report.verify.rerun import verify
 from tests.conftest import tiny_overrides
 from tests.oneline import one_line
 
@@ -175,3 +176,18 @@ def test_a_record_without_shapes_checks_the_tables_by_their_sha256(tiny_run, tmp
     one_line(capsys, main(["show", str(d)]), "claims.parquet", "sha256")
     with pytest.raises(sim.ConfigError, match="claims.parquet is not the table its run wrote"):
         sim.Results(d, "network").claims()
+
+
+def test_verify_leaves_out_a_copy_kept_beside_the_tables(tiny_run, tmp_path):
+    """``make verify`` of results with a copy kept beside their tables (``claims_old.parquet``)
+    failed the study, "claims_old.parquet: only in the committed results", a reproduction
+    failure for a file the run never wrote; it compares the tables the run's record lists."""
+    d = _copy(tiny_run, tmp_path)
+    shutil.copyfile(d / "claims.parquet", d / "claims_old.parquet")
+    scratch = tmp_path / "scratch"
+    shutil.copytree(tiny_run("network_plate"), scratch / "network_plate")
+    [comp] = verify(d.parent, scratch, rerun=False)
+    assert comp.ok and not comp.failures, comp.failures
+    (d / "points.parquet").unlink()  # one of the run's: still a failure
+    [comp] = verify(d.parent, scratch, rerun=False)
+    assert not comp.ok and "points.parquet: only in the re-run results" in comp.failures
