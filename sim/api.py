@@ -67,7 +67,13 @@ from sim.mc.pyvalue import as_config_value
 from sim.mc.settle import settled
 from sim.mc.study_file import study_file_problem
 from sim.mc.sweep import read_sweep
-from sim.mc.table_shape import recorded_shape, shape_problem
+from sim.mc.table_shape import (
+    record_line,
+    record_problem,
+    recorded_shape,
+    shape_problem,
+    sum_problem,
+)
 from sim.report.mpl import kept
 from sim.report.read import mixed_run
 from sim.report.run_summary import write_run_readme
@@ -144,7 +150,8 @@ class Results:
         ``trials`` when the study writes no ``trials.parquet``)."""
         self._check_dir()
         files, ran = list(self.path.glob("*.parquet")), run_tables(self.path, self.study)
-        names = {p.stem for p in files if p.name in ran or _owner(p) == self.study}
+        listed = any(n.endswith(".parquet") for n in ran)  # else an older run's: by provenance
+        names = {p.stem for p in files if p.name in ran or not listed and _owner(p) == self.study}
         within = "" if names else self._within()
         if within:  # a results root (results/ and its verify record): [], or 'verify''s tables
             raise ConfigError("path", f"{self.path} is not a results directory{within}")
@@ -183,6 +190,12 @@ class Results:
             why = "the committed results/ hold no chunks; removed by hand?): run the study again"
             why = why if dataset else "removed by hand?)"
             raise ConfigError("table", f"{p} is missing: its run wrote it ({why}")
+        ran = run_tables(
+            self.path, self.study
+        )  # a copy beside them (claims_old.parquet): unchecked
+        if there and not dataset and p.name not in ran and any(n.endswith(".parquet") for n in ran):
+            why = "a copy or a file added by hand? its run.json does not list it"
+            raise ConfigError("table", f"{p} is not a table its run wrote ({why})")
         if not there:  # a sweep's claims() named only 'sweep', not where its cells' tables are
             cells = (self.path / "sweep.parquet").is_file() and (self.path / "cells").is_dir()
             cells = f" (a sweep: each cell's in {self.path / 'cells'}/<label>)" if cells else ""
@@ -201,7 +214,11 @@ class Results:
             mixed = mixed_run(self.path, [p.name]) or cell_mixed(self.path, [p.name])
             if mixed is not None:  # copied from another run, or another cell's
                 raise ConfigError("table", mixed)
-            if (edit := shape_problem(table, recorded_shape(p))) is not None:  # edited by hand
+            if (bad := record_problem(p)) is not None:  # its tables were read unchecked
+                raise ConfigError("table", record_line(bad))
+            shaped = recorded_shape(p)  # none recorded: its sha256, where recorded
+            edit = shape_problem(table, shaped) if shaped is not None else sum_problem(p)
+            if edit is not None:  # edited by hand
                 raise ConfigError("table", f"{p} is not the table its run wrote: {edit}")
         self._check_dir()  # replaced while it was read
         stale_warning(self.path)  # sim show's note on results of another version's code

@@ -62,7 +62,7 @@ def why_stale(
     except UnicodeDecodeError:  # bytes of another tool: a traceback of make reproduce
         return "its run record is not one (run.json is not UTF-8 text)"
     try:
-        record = json.loads(text)
+        record = json.loads(text.removeprefix("\ufeff"))  # an editor's signature: the record
         if loaded is not None:  # the batch resolved it already (_configs_problems)
             args, study, cfg, sweep = loaded
         else:

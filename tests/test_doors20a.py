@@ -34,7 +34,9 @@ before its fix.
   "the run failed in sim.mc.progress: ValueError: I/O operation on closed file".
 """
 
+import hashlib
 import io
+import json
 import logging
 import os
 import subprocess
@@ -110,6 +112,10 @@ def test_a_studys_own_trials_table_is_read_and_the_chunks_are_named_chunks(tmp_p
     assert res.table("trials").num_rows == 40 == res.table("chunks").num_rows
     prov = read_provenance(tmp_path / "o" / "claims.parquet")  # written by the run (wolf's is)
     sim.write_table(tmp_path / "o" / "trials.parquet", {"trial": list(range(5))}, prov)
+    record = json.loads((tmp_path / "o" / "run.json").read_text("utf-8"))  # listed as a study
+    sha = hashlib.sha256((tmp_path / "o" / "trials.parquet").read_bytes()).hexdigest()  # that
+    record["table_sha256"]["trials.parquet"] = sha  # writes one records it (else not its table)
+    (tmp_path / "o" / "run.json").write_text(json.dumps(record), "utf-8")
     names = sim.Results(tmp_path / "o", "network").names()
     assert len(names) == len(set(names)) and {"trials", "chunks"} <= set(names), names
     own = sim.Results(tmp_path / "o", "network")

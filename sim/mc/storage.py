@@ -361,7 +361,7 @@ def read_record(d: str | Path) -> dict | None:
     """The run record (``run.json``) of a directory the suite wrote, or None (none, or not one
     of ours)."""
     try:
-        rec = json.loads(regular_text(Path(d) / RECORD))
+        rec = json.loads(regular_text(Path(d) / RECORD).removeprefix("\ufeff"))  # Notepad's
     except (OSError, ValueError, RecursionError):  # RecursionError: JSON nested too deeply
         return None
     return rec if isinstance(rec, dict) and "config" in rec and "code_hash" in rec else None

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -36,15 +37,18 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from sim.mc import tolerance
-from sim.mc.storage import read_record
+from sim.mc.storage import RECORD, read_record, regular_text
 
 __all__ = [
     "SHAPE_KEY",
     "NUMBERS",
     "kind",
     "shape",
+    "record_line",
+    "record_problem",
     "recorded_shape",
     "shape_problem",
+    "sum_problem",
     "values_digest",
     "declared_problem",
 ]
@@ -134,14 +138,81 @@ def shape(table: pa.Table) -> dict:
     return {"rows": table.num_rows, "columns": cols, **counted, "values": values}
 
 
-def recorded_shape(path: str | Path) -> dict | None:
-    """The shape the run record of ``path``'s results directory recorded for it (a table of
-    a sweep's cell, ``cells/<label>/x.parquet``, is in the sweep's record), or None."""
-    path = Path(path)
+def _spots(path: Path) -> list[tuple[Path, str]]:
+    """``(directory, key)`` of each run record that may cover the table ``path``: its own
+    directory's, and for a sweep's cell (``cells/<label>/x.parquet``) the sweep's."""
     spots = [(path.parent, path.name)]
     if path.parent.parent.name == "cells":
         spots.append((path.parent.parent.parent, f"cells/{path.parent.name}/{path.name}"))
-    for root, key in spots:
+    return spots
+
+
+def record_problem(path: str | Path) -> tuple[Path, str] | None:
+    """``(run.json, what is wrong with it)`` when the run record of the table ``path`` is
+    there but is no run record, else None (one is read, or there is none). Such a
+    ``run.json`` -- invalid JSON left by an editor, a FIFO, a directory, unreadable -- let
+    every reader take the tables unchecked, as of a version that recorded no shapes: a value
+    edited by hand beside it was printed as the run's."""
+    for root, _ in _spots(Path(path)):
+        if read_record(root) is not None:
+            return None
+        if os.path.lexists(rec := root / RECORD):
+            return rec, _unrecorded(rec)
+    return None
+
+
+def record_line(bad: tuple[Path, str]) -> str:
+    """The one line for a :func:`record_problem`."""
+    return (
+        f"{bad[0]} is not a run record ({bad[1]}: edited by hand?), so its tables cannot be "
+        "checked against their run; run the study again"
+    )
+
+
+def _unrecorded(rec: Path) -> str:
+    """What is wrong with ``rec``, a ``run.json`` that :func:`read_record` does not read."""
+    try:
+        text = regular_text(rec).removeprefix("\ufeff")
+        doc = json.loads(text)
+    except UnicodeDecodeError:
+        return "not UTF-8 text"
+    except OSError as e:
+        return e.strerror or str(e).removeprefix(f"{rec} ")
+    except ValueError as e:
+        return f"not JSON: {getattr(e, 'msg', e)} (line {getattr(e, 'lineno', '?')})"
+    except RecursionError:
+        return "JSON nested too deeply"
+    del doc
+    return "not an object holding its config and code_hash"
+
+
+def sum_problem(path: str | Path) -> str | None:
+    """For a table whose run record holds no shape of it but its sha256 (``table_sha256``:
+    a record of the versions between the two, or one whose ``table_shape`` was removed by
+    hand): how the file differs (its sha256), else None. Such a table was read unchecked: a
+    value edited by hand was printed as the run's."""
+    path = Path(path)
+    for root, key in _spots(path):
+        if (rec := read_record(root)) is None:
+            continue
+        sums = rec.get("table_sha256")
+        want = sums.get(key) if isinstance(sums, dict) else None
+        if not isinstance(want, str):
+            return None
+        h = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+        if h.hexdigest() != want:
+            return "its sha256 is not the one its run recorded, which holds no shape of it"
+        return None
+    return None
+
+
+def recorded_shape(path: str | Path) -> dict | None:
+    """The shape the run record of ``path``'s results directory recorded for it (a table of
+    a sweep's cell, ``cells/<label>/x.parquet``, is in the sweep's record), or None."""
+    for root, key in _spots(Path(path)):
         rec = read_record(root)
         if rec is not None:
             shapes = rec.get(SHAPE_KEY)

@@ -31,7 +31,14 @@ from sim.mc.message_text import key_text
 from sim.mc.publish import changed_figure
 from sim.mc.storage import read_provenance, read_record, read_table
 from sim.mc.table_edits import edited_cell, missing_cell
-from sim.mc.table_shape import declared_problem, recorded_shape, shape_problem
+from sim.mc.table_shape import (
+    declared_problem,
+    record_line,
+    record_problem,
+    recorded_shape,
+    shape_problem,
+    sum_problem,
+)
 
 __all__ = [
     "check_claims_table",
@@ -162,8 +169,12 @@ def checked_table(path: str | Path, shaped: bool = True) -> pa.Table:
         raise TableError(path, f"cannot be read ({str(e).splitlines()[0][:200]})") from None
     if not shaped:
         return table
+    if (bad := record_problem(path)) is not None:  # not "an older version's": unchecked
+        raise TableError(bad[0], f"{bad[1]}: edited by hand? its tables cannot be checked")
     if (recorded := recorded_shape(path)) is None:  # an older version's run: what it declares
         if (why := declared_problem(table)) is not None:
+            raise TableError(path, why)
+        if (why := sum_problem(path)) is not None:  # its table_shape removed: unchecked
             raise TableError(path, why)
     elif (why := shape_problem(table, recorded)) is not None:
         raise EditedTable(path, why)
@@ -270,6 +281,8 @@ def check_claims_table(f: Path, key: str) -> None:
     damage = claims_damage(prov, verdicts, claims)
     if damage:
         raise ConfigError(key, f"{f} is not a claims table written by sim: {damage}")
+    if (bad := record_problem(f)) is not None:  # its tables were read unchecked
+        raise ConfigError(key, record_line(bad))
     run = (read_record(f.parent) or {}).get("config")
     owner = run.get("study") if isinstance(run, dict) else None
     if isinstance(owner, str) and prov["study"] != owner:  # another study's table, copied in

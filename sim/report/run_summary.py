@@ -400,6 +400,9 @@ README_MARK = "<!-- written by sim from this directory's Parquet files; edits ar
 
 
 def _ours(path: Path) -> bool:
+    """True for a README.md the suite wrote (its mark on the first line)."""
+    if not path.is_file():  # a FIFO put in its place blocked sim report and a re-run: a
+        return False  # user's file, never opened (as markdown._ours keeps REPORT.md's)
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
             # the mark behind an editor's UTF-8 signature (Notepad's) is the mark: such a

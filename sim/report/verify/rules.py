@@ -13,7 +13,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.mc import tolerance as tl
-from sim.mc.storage import read_provenance, read_tolerances
+from sim.mc.storage import read_provenance, read_record, read_tolerances
 from sim.mc.table_shape import NUMBERS, kind
 
 __all__ = [
@@ -285,8 +285,7 @@ def compare_dirs(
     """Compare every Parquet table of ``committed`` (a study's results) with ``rerun``."""
     committed, rerun = Path(committed), Path(rerun)
     cmp = Comparison(study or committed.name)
-    fa = {p.name for p in committed.glob("*.parquet") if p.name not in SKIP}
-    fb = {p.name for p in rerun.glob("*.parquet") if p.name not in SKIP}
+    fa, fb = _tables(committed), _tables(rerun)
     for missing in sorted(fa ^ fb):
         cmp.failures.append(
             f"{missing}: only in the {'committed' if missing in fa else 're-run'} results"
@@ -295,3 +294,14 @@ def compare_dirs(
         cmp.files += 1
         compare_tables(committed / f, rerun / f, cmp, mode)
     return cmp
+
+
+def _tables(d: Path) -> set[str]:
+    """The tables of the results ``d`` that verify compares: those its run record lists
+    (``table_sha256``), else (an older version's record) every ``*.parquet``. A copy the user
+    kept beside them (``claims_old.parquet``) failed the study as "only in the committed
+    results"; it is not the run's, and is left out."""
+    found = {p.name for p in d.glob("*.parquet") if p.name not in SKIP}
+    sums = (read_record(d) or {}).get("table_sha256")
+    listed = {k for k in sums if "/" not in k} if isinstance(sums, dict) else set()
+    return found & listed if listed else found
