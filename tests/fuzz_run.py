@@ -38,6 +38,12 @@ def in_child(cwd: Path, so: Path, se: Path, body) -> None:
         os.chdir(cwd)
         os.environ["SIM_MAX_MEMORY_GB"] = "2"
         os.environ["SIM_MAX_ADJUSTMENTS"] = "1e7"
+        # the processes it starts (sim.batch's runs, verify's re-runs) import this checkout's
+        # sim, not the one installed in the environment: a worktree sharing another's .venv
+        # ran its batch steps on that checkout's code (another code hash: "res/net records a
+        # config no step asked for")
+        paths = [str(ROOT), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
+        os.environ["PYTHONPATH"] = os.pathsep.join(paths)
         fo = os.open(so, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
         fe = os.open(se, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
         os.dup2(fo, 1), os.dup2(fe, 2)

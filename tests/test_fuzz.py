@@ -46,7 +46,12 @@ CONCURRENT pair of operations on that study and directory (two runs, a run and `
 ``sim show``, ``sim report``, verify, ``--stale-only``, the API, a sweep and a run of its cell,
 an edit of the study or Gama file), started at once or the second while the first waits at a
 rename, is checked when both end (tests/fuzz_concurrent.py; ``test_fuzz_concurrent``: one pair
-a seven cases, at least two; ``FUZZ_PAIR_SECONDS``)."""
+a seven cases, at least two; ``FUZZ_PAIR_SECONDS``). The FILE SYSTEM under a run of that study
+(a file-size limit hit mid-run, too few file descriptors, a file where a directory is expected
+and the reverse at every level of the output tree: tests/fuzz_fs.py; ``test_fuzz_file_system``:
+one case a seven, at least two; ``FUZZ_FS_SECONDS``) must give exit 0 or one line naming the
+file or the thing in the way, change nothing beside the results, and then, the limit lifted or
+the thing moved away, the clean run's results."""
 
 from __future__ import annotations
 
@@ -58,6 +63,7 @@ import pytest
 from fuzz_bytes import csv_sites, gama_sites, mutate_bytes
 from fuzz_cases import SEED
 from fuzz_concurrent import pairs
+from fuzz_fs import cases as fs_cases
 from fuzz_keys import network_case
 from fuzz_run import fuzz
 from fuzz_sequence import sequences
@@ -230,6 +236,16 @@ def test_fuzz_concurrent(tmp_path):
     n = max(2, CASES // 7)
     failures = pairs(n, SEED, tmp_path)
     assert not failures, f"{len(failures)} of {n} pairs:\n" + "\n".join(failures)
+
+
+def test_fuzz_file_system(tmp_path):
+    """FILE SYSTEM (tests/fuzz_fs.py): seeded limits (``ulimit -f``, ``ulimit -n``) and things
+    in the way at each level of the output tree under a run; each run exits 0 or refuses in
+    one line naming the file or thing, changes nothing beside the results, and the user's
+    remedy then gives the clean run's results."""
+    n = max(2, CASES // 7)
+    failures = fs_cases(n, SEED, tmp_path)
+    assert not failures, f"{len(failures)} of {n} file-system cases:\n" + "\n".join(failures)
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz

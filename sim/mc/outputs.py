@@ -251,11 +251,24 @@ def _check_not_nested(out: Path, shown: str) -> None:
 
 def _damage(stage: Path) -> str | None:
     """What is wrong with a staging directory's chunk store, if anything: a chunk path that is
-    not a regular file (a directory, a link), in the run's store or in a sweep cell's."""
+    not a regular file (a directory, a link), or a part's path (``part-<p>``) that is not a
+    directory (it was "File exists: .../trials/part-0", naming neither the damage nor its
+    remedy), in the run's store or in a sweep cell's; a sweep's ``cells`` or one of its cells
+    that is not a directory (it was "Not a directory: .../cells/cell0000_r0" or "File exists:
+    .../cells/cell0001_r0")."""
+    cells = stage / "cells"
+    if cells.is_symlink() or (cells.exists() and not cells.is_dir()):
+        return f"{cells} is not a directory"
+    for p in sorted(cells.iterdir()) if cells.is_dir() else []:
+        if p.is_symlink() or not p.is_dir():
+            return f"{p} is not a directory"
     for t in _stores(stage):
         if t.is_symlink() or (t.exists() and not t.is_dir()):
             return f"{t} is not a directory"
         if t.is_dir():
+            for p in sorted(t.glob("part-*")):
+                if p.is_symlink() or not p.is_dir():
+                    return f"{p} is not a directory"
             for p in sorted(t.rglob("*")):
                 if p.is_symlink() or (p.name.startswith("chunk-") and not p.is_file()):
                     return f"{p} is not a chunk file"
