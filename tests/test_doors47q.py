@@ -1,0 +1,58 @@
+"""Doors of issue 26 read as an attacker after the merges of session 46 (R47).
+
+* The mark of a report due (``<results>/.report-due``, :mod:`sim.report_due`), set by
+  ``python -m sim.batch --report`` before its ``sim report``: a ``.report-due`` that is a
+  symbolic or hard link had the batch's pid written over the file it names (a user's file
+  changed), and one that is a FIFO made the batch wait for a reader after its runs (a hang).
+* ``sim check``'s advice for ``--trials``/``--seed``/``--chunk`` (``sim check --set
+  trials=N``) took its value from argparse's leftovers: the study file (``sim check --trials 5
+  x.toml``: "--set trials=x.toml"), the next option, or the hint's own words (``--seed=``:
+  "--set seed=(did checks what sim run --seed (did runs").
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from sim.report_due import DUE, due_words, mark_due
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+@pytest.mark.parametrize("kind", ["symlink", "hardlink"])
+def test_a_report_due_mark_that_is_a_link_leaves_the_file_it_names(tmp_path, kind):
+    """A results directory touched by hand: ``.report-due`` a link to a user's file. Before,
+    the batch's mark wrote its pid over that file."""
+    res, notes = tmp_path / "res", tmp_path / "notes.txt"
+    res.mkdir()
+    notes.write_text("my notes\n")
+    (os.symlink if kind == "symlink" else os.link)(notes, res / DUE)
+    mark_due(res)
+    assert notes.read_text() == "my notes\n"
+
+
+def test_a_report_due_mark_that_is_a_fifo_does_not_hang_the_batch(tmp_path):
+    """A results directory touched by hand: ``.report-due`` a FIFO nobody reads. Before,
+    setting the mark waited for a reader for ever (the batch's report step hung)."""
+    res = tmp_path / "res"
+    res.mkdir()
+    os.mkfifo(res / DUE)
+    code = "import sys; from pathlib import Path; from sim.report_due import mark_due; "
+    code += "mark_due(Path(sys.argv[1]))"
+    done = subprocess.run([sys.executable, "-c", code, str(res)], cwd=ROOT, timeout=60)
+    assert done.returncode == 0
+    assert due_words(res) is None  # (a FIFO is not the suite's mark)
+
+
+def test_the_report_due_mark_is_still_set_and_read(tmp_path):
+    """The mark as a regular file, set afresh over an old one of its own: still said."""
+    res = tmp_path / "res"
+    res.mkdir()
+    (res / DUE).write_text("123456789\n")
+    mark_due(res)
+    assert (res / DUE).read_text() == f"{os.getpid()}\n"
+    assert "was not rebuilt" in due_words(res)
