@@ -18,9 +18,12 @@ import sys
 
 import pytest
 
+from sim.cli import main
 from sim.report_due import DUE, due_words, mark_due
+from tests.oneline import SIM_ERROR, one_line
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+STUDY = os.path.join(ROOT, "studies", "brown_table1.toml")
 
 
 @pytest.mark.parametrize("kind", ["symlink", "hardlink"])
@@ -56,3 +59,19 @@ def test_the_report_due_mark_is_still_set_and_read(tmp_path):
     mark_due(res)
     assert (res / DUE).read_text() == f"{os.getpid()}\n"
     assert "was not rebuilt" in due_words(res)
+
+
+@pytest.mark.parametrize(
+    "argv, value",
+    [
+        (["check", "--trials", "5", STUDY], "trials=5"),
+        (["check", STUDY, "--seed="], "seed=N"),
+        (["check", STUDY, "--trials", "--seed", "3"], "trials=N"),
+        (["check", STUDY, "--chunk", "7"], "chunk=7"),
+    ],
+)
+def test_sim_checks_advice_for_a_run_option_gives_its_value(capsys, argv, value):
+    """A run option given to ``sim check`` (a careless user): the advice's value is the one
+    given after it, else N. Before: the study file, the next option or "(did"."""
+    line = one_line(capsys, main(argv), f"sim check --set {value} checks", prefix=SIM_ERROR)
+    assert ".toml checks" not in line and "(did" not in line.split("checks")[0]
