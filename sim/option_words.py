@@ -222,6 +222,18 @@ class Meant:
     words = "sim"
 
     def explain(self, message: str) -> str:
+        text, cmds = self._explained(message), _commands(self)
+        cmd = next((a for a in getattr(self, "given", []) if a in cmds), None)
+        if cmd is None:
+            return text
+        own = set(self._option_string_actions) - set(cmds[cmd]._option_string_actions)
+        return re.sub(  # sim's own option guessed after a command (--verison, -V): the guess
+            r"\(did you mean (--?[\w-]+)\?",  # refused again when typed there, as sim's
+            lambda g: f"(did you mean {self.prog} {g[1]}?" if g[1] in own else g[0],
+            text,
+        )
+
+    def _explained(self, message: str) -> str:
         given = getattr(self, "given", [])
         m = re.match(r"unrecognized arguments: (.*)", message)
         if m:
@@ -235,10 +247,15 @@ class Meant:
                 return (
                     message + " (-- ends the options: the words after it are no options; drop it)"
                 )
-            if bad and (hint := meant(bad.split("=")[0], opts, run=run, **kind)):
-                return message + hint
             cmds = getattr(self, "commands", None) or _commands(self)
             cmd = next((a for a in given if a in cmds), None)
+            if bad and cmd and (word := bad.split("=")[0]) in self._option_string_actions:
+                return message + (  # sim's own (--version) after the command: "did you mean
+                    f" ({word} is an option of {self.prog} itself, not of {self.prog} {cmd}: "
+                    f"{self.prog} {word})"  # --version?" before, the spelling guess
+                )
+            if bad and (hint := meant(bad.split("=")[0], opts, run=run, **kind)):
+                return message + hint
             if not bad and self.words == "sim" and cmd == "report":
                 return message + (
                     " (sim report takes --results DIR, the directory that holds the results "

@@ -8,6 +8,9 @@
   trials=N``) took its value from argparse's leftovers: the study file (``sim check --trials 5
   x.toml``: "--set trials=x.toml"), the next option, or the hint's own words (``--seed=``:
   "--set seed=(did checks what sim run --seed (did runs").
+* ``sim``'s own option after a command (``sim run x.toml --version``) was guessed as itself,
+  "(did you mean --version?)"; a slip of it (``-V``, ``--verison``) as ``--version``, which is
+  refused again where it was typed: both now name ``sim --version``.
 """
 
 from __future__ import annotations
@@ -75,3 +78,25 @@ def test_sim_checks_advice_for_a_run_option_gives_its_value(capsys, argv, value)
     given after it, else N. Before: the study file, the next option or "(did"."""
     line = one_line(capsys, main(argv), f"sim check --set {value} checks", prefix=SIM_ERROR)
     assert ".toml checks" not in line and "(did" not in line.split("checks")[0]
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["run", STUDY, "--version"], "--version is an option of sim itself, not of sim run"),
+        (["check", STUDY, "--version=1"], "--version is an option of sim itself"),
+        (["run", STUDY, "-V"], "(did you mean sim --version?)"),
+        (["run", STUDY, "--verison"], "(did you mean sim --version?)"),
+    ],
+)
+def test_sims_own_option_after_a_command_is_not_guessed_as_itself(capsys, argv, needle):
+    """``sim``'s own option (``--version``) typed after a command, or a slip of it: before,
+    "unrecognized arguments: --version (did you mean --version?)", a guess that is the word
+    itself, and for ``-V`` or ``--verison`` a guess refused again where it was typed."""
+    line = one_line(capsys, main(argv), needle, prefix=SIM_ERROR)
+    assert "(did you mean --version?)" not in line
+
+
+def test_a_slip_of_a_commands_own_option_keeps_its_guess(capsys):
+    """The guess of the command's own option is unchanged (a control of the above)."""
+    one_line(capsys, main(["run", STUDY, "--trails", "3"]), "(did you mean --trials?)")
