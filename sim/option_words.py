@@ -13,6 +13,7 @@ guess."""
 from __future__ import annotations
 
 import re
+from collections.abc import Callable, Mapping
 
 __all__ = ["Meant", "meant", "set_split", "command_word", "two_sets", "item_key"]
 
@@ -302,14 +303,27 @@ def two_sets(overrides: list[str], key: str | None) -> str:
 _ITEM = re.compile(r"^([A-Za-z_][\w.]*?)(?:\[(\d+)\]|\.(\d+))(?:\.|$)")
 
 
-def item_key(key: str | None, detail: str) -> str:
+def item_key(key: str | None, detail: str, schema: Callable[[], Mapping | None]) -> str:
     """`` (network.generate is a list: ...)`` for an unknown ``key`` that names an item of a
     list or a field of one (``--set network.generate[1].sigma_arcsec=3``: "unknown key"
-    alone), saying to give the whole list; "" otherwise."""
+    alone), saying to give the whole list; "" otherwise. Only for a key that is a list:
+    ``schema()`` gives the study's keys (their :class:`~sim.mc.config.Field`; None when the
+    study is not known), read only for a key of that form. Before, any key of that form was
+    called a list, to be given whole by ``--set``: an integer (``plate.grid[0]``), a table
+    (``errors.1``), a key the study does not have, a sweep's values (``sweep.plate.grid.0``,
+    which ``--set`` refuses)."""
     m = _ITEM.match(key or "")
     if m is None or not detail.startswith("unknown key"):
         return ""
+    name = m.group(1)
+    field = (schema() or {}).get(name)
+    if field is None or not _LIST_KIND.match(field.kind):
+        return ""
     return (
-        f" ({m.group(1)} is a list: its items have no keys of their own; give the whole list, "
-        f"--set '{m.group(1)}=[...]', or edit the study file)"
+        f" ({name} is a list: its items have no keys of their own; give the whole list, "
+        f"--set '{name}=[...]', or edit the study file)"
     )
+
+
+#: the kinds of :class:`~sim.mc.config.Field` whose value is a list
+_LIST_KIND = re.compile(r"^(?:list\[|points$|records$)")

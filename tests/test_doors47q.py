@@ -11,6 +11,9 @@
 * ``sim``'s own option after a command (``sim run x.toml --version``) was guessed as itself,
   "(did you mean --version?)"; a slip of it (``-V``, ``--verison``) as ``--version``, which is
   refused again where it was typed: both now name ``sim --version``.
+* An unknown key naming an item (``--set plate.grid[0]=3``, ``errors.1``) was answered "plate.grid
+  is a list: ... give the whole list" whatever the key is (an integer, a table, no key of the
+  study, a sweep's values, which ``--set`` refuses): now only for a key the study reads as a list.
 """
 
 from __future__ import annotations
@@ -100,3 +103,28 @@ def test_sims_own_option_after_a_command_is_not_guessed_as_itself(capsys, argv, 
 def test_a_slip_of_a_commands_own_option_keeps_its_guess(capsys):
     """The guess of the command's own option is unchanged (a control of the above)."""
     one_line(capsys, main(["run", STUDY, "--trails", "3"]), "(did you mean --trials?)")
+
+
+NETWORK = os.path.join(ROOT, "studies", "network_plate.toml")
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["check", STUDY, "--set", "plate.grid[0]=3"],  # an integer
+        ["check", STUDY, "--set", "errors.1=3"],  # a table of keys
+        ["check", STUDY, "--set", "version2.0=1"],  # no key of the study
+        ["check", STUDY, "--set", "sweep.plate.grid.0=3"],  # a sweep's, which --set refuses
+    ],
+)
+def test_a_key_of_an_item_is_called_a_list_only_when_it_is_one(capsys, argv):
+    """A careless ``--set`` of an item of something that is no list: before, "(plate.grid is
+    a list: ... give the whole list, --set 'plate.grid=[...]')" for any key of that form."""
+    line = one_line(capsys, main(argv), "unknown key", prefix=SIM_ERROR)
+    assert "is a list" not in line
+
+
+def test_a_key_of_an_item_of_a_list_still_says_to_give_the_list(capsys):
+    """The hint where it is true (a control of the above): network.generate is a list."""
+    argv = ["check", NETWORK, "--set", "network.generate[0].sigma_arcsec=3"]
+    one_line(capsys, main(argv), "network.generate is a list", prefix=SIM_ERROR)
