@@ -43,22 +43,27 @@ class _Parser(Meant, OnceParser):
         head, helps = f"{self.prog}: ", self.prog
         if " " in self.prog:  # a command's own parser (`sim show --trials`: DIR not given)
             cmd = self.prog.split(" ")[-1]
-            if other := _of_another(message, getattr(self, "commands", {}), cmd):
+            commands = getattr(self, "commands", {})
+            if other := _of_another(message, commands, cmd, getattr(self, "given", [])):
                 head, message = "", other
         if " " not in self.prog:
             head = ""
             cmds = next((a.choices for a in self._actions if a.dest == "cmd"), {}) or {}
             cmd = next((a for a in getattr(self, "given", []) if a in cmds), None)
             helps = f"{self.prog} {cmd}" if cmd else self.prog
-            message = _of_another(message, cmds, cmd) or message
+            message = _of_another(message, cmds, cmd, getattr(self, "given", [])) or message
         raise ConfigError(None, f"{head}{message} (see {helps} --help)")
 
 
-def _of_another(message: str, cmds: dict, cmd: str | None) -> str | None:
+def _of_another(message: str, cmds: dict, cmd: str | None, given: list[str]) -> str | None:
     """``--trials: an option of sim run, not of sim show`` for an option the command ``cmd``
     lacks and another command has: ``sim show --trials 4 results/x`` was "unrecognized
     arguments: --trials results/x" (the 4 taken for DIR), ``sim check x.toml --out d``
-    "(did you mean --set?)"; None when the message is no such option's."""
+    "(did you mean --set?)"; None when the message is no such option's. The value of
+    ``sim check``'s ``--set`` advice is the one ``given`` after the option (the command
+    line), else ``N``: taken from argparse's leftovers it was the study file (``sim check
+    --trials 5 x.toml``: argparse read 5 as the file, "--set trials=x.toml"), the next option
+    (``--trials --seed``) or the hint's own words (``--seed=``: "--set seed=(did")."""
     m = re.match(r"unrecognized arguments: (.*)", message)
     if m is None or cmd not in cmds:
         return None
@@ -69,9 +74,10 @@ def _of_another(message: str, cmds: dict, cmd: str | None) -> str | None:
         return None
     line = f"{word}: an option of {' and '.join(f'sim {c}' for c in has)}, not of sim {cmd}"
     if cmd == "check" and word in ("--trials", "--seed", "--chunk"):  # as sim run's (d46)
-        words = m.group(1).split(" ")
-        after = words[words.index(bad) + 1 :][:1] or ["N"]
-        value = bad.partition("=")[2] or after[0]
+        at = given.index(bad) if bad in given else len(given)
+        value = bad.partition("=")[2] or "".join(given[at + 1 : at + 2])
+        if not value or value.startswith("-") or value.endswith(".toml"):
+            value = "N"  # (no value given, or the next option or the study file)
         line += f": sim check --set {word[2:]}={value} checks what sim run {word} {value} runs"
     return line
 

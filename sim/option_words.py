@@ -13,6 +13,7 @@ guess."""
 from __future__ import annotations
 
 import re
+from collections.abc import Callable, Mapping
 
 __all__ = ["Meant", "meant", "set_split", "command_word", "two_sets", "item_key"]
 
@@ -222,6 +223,18 @@ class Meant:
     words = "sim"
 
     def explain(self, message: str) -> str:
+        text, cmds = self._explained(message), _commands(self)
+        cmd = next((a for a in getattr(self, "given", []) if a in cmds), None)
+        if cmd is None:
+            return text
+        own = set(self._option_string_actions) - set(cmds[cmd]._option_string_actions)
+        return re.sub(  # sim's own option guessed after a command (--verison, -V): the guess
+            r"\(did you mean (--?[\w-]+)\?",  # refused again when typed there, as sim's
+            lambda g: f"(did you mean {self.prog} {g[1]}?" if g[1] in own else g[0],
+            text,
+        )
+
+    def _explained(self, message: str) -> str:
         given = getattr(self, "given", [])
         m = re.match(r"unrecognized arguments: (.*)", message)
         if m:
@@ -235,10 +248,15 @@ class Meant:
                 return (
                     message + " (-- ends the options: the words after it are no options; drop it)"
                 )
-            if bad and (hint := meant(bad.split("=")[0], opts, run=run, **kind)):
-                return message + hint
             cmds = getattr(self, "commands", None) or _commands(self)
             cmd = next((a for a in given if a in cmds), None)
+            if bad and cmd and (word := bad.split("=")[0]) in self._option_string_actions:
+                return message + (  # sim's own (--version) after the command: "did you mean
+                    f" ({word} is an option of {self.prog} itself, not of {self.prog} {cmd}: "
+                    f"{self.prog} {word})"  # --version?" before, the spelling guess
+                )
+            if bad and (hint := meant(bad.split("=")[0], opts, run=run, **kind)):
+                return message + hint
             if not bad and self.words == "sim" and cmd == "report":
                 return message + (
                     " (sim report takes --results DIR, the directory that holds the results "
@@ -285,14 +303,27 @@ def two_sets(overrides: list[str], key: str | None) -> str:
 _ITEM = re.compile(r"^([A-Za-z_][\w.]*?)(?:\[(\d+)\]|\.(\d+))(?:\.|$)")
 
 
-def item_key(key: str | None, detail: str) -> str:
+def item_key(key: str | None, detail: str, schema: Callable[[], Mapping | None]) -> str:
     """`` (network.generate is a list: ...)`` for an unknown ``key`` that names an item of a
     list or a field of one (``--set network.generate[1].sigma_arcsec=3``: "unknown key"
-    alone), saying to give the whole list; "" otherwise."""
+    alone), saying to give the whole list; "" otherwise. Only for a key that is a list:
+    ``schema()`` gives the study's keys (their :class:`~sim.mc.config.Field`; None when the
+    study is not known), read only for a key of that form. Before, any key of that form was
+    called a list, to be given whole by ``--set``: an integer (``plate.grid[0]``), a table
+    (``errors.1``), a key the study does not have, a sweep's values (``sweep.plate.grid.0``,
+    which ``--set`` refuses)."""
     m = _ITEM.match(key or "")
     if m is None or not detail.startswith("unknown key"):
         return ""
+    name = m.group(1)
+    field = (schema() or {}).get(name)
+    if field is None or not _LIST_KIND.match(field.kind):
+        return ""
     return (
-        f" ({m.group(1)} is a list: its items have no keys of their own; give the whole list, "
-        f"--set '{m.group(1)}=[...]', or edit the study file)"
+        f" ({name} is a list: its items have no keys of their own; give the whole list, "
+        f"--set '{name}=[...]', or edit the study file)"
     )
+
+
+#: the kinds of :class:`~sim.mc.config.Field` whose value is a list
+_LIST_KIND = re.compile(r"^(?:list\[|points$|records$)")

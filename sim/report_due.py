@@ -13,6 +13,7 @@ Not imported by any study (no code hash).
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 __all__ = ["DUE", "mark_due", "clear_due", "due_words"]
@@ -23,11 +24,24 @@ DUE = ".report-due"
 
 def mark_due(results: Path) -> None:
     """Set the mark in ``results`` (its text: this process's pid); a results directory that
-    cannot hold it goes without (the report's own failure is said where it happens)."""
+    cannot hold it goes without (the report's own failure is said where it happens). Written
+    only as a regular file of that name, never through a link (it wrote the pid over the file
+    a ``.report-due`` symbolic or hard link named) nor into a FIFO (opening it for writing
+    waited for a reader: the batch hung after its runs)."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK
     try:
-        (Path(results) / DUE).write_text(f"{os.getpid()}\n", encoding="ascii")
+        fd = os.open(Path(results) / DUE, flags, 0o644)
+    except OSError:  # a link (ELOOP), a FIFO nobody reads (ENXIO), a directory, read-only
+        return
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISREG(st.st_mode) and st.st_nlink == 1:  # (a hard link: a user's file too)
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()}\n".encode("ascii"))
     except OSError:
         pass
+    finally:
+        os.close(fd)
 
 
 def clear_due(results: Path) -> None:
