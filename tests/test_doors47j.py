@@ -9,6 +9,11 @@ processes), one case each; each failed on the code before its fix.
   "context has already been set", against docs/python.md's promise (doors31b held it for a
   forked pool only). The method is put back unset when the last run of the process ends
   (:mod:`sim.start_method`).
+* A script read from standard input (``python - < script.py``: ``__file__`` is ``<stdin>``)
+  whose run starts ``forkserver`` or ``spawn`` workers (a thread of its own, or Dask): each
+  worker ran ``<stdin>`` again as the main module, printed a ``FileNotFoundError`` traceback,
+  and the run was refused as a script without its main guard. Such a ``__file__`` is hidden
+  while runs are under way (:mod:`sim.start_method`), so the workers import only the suite.
 
 Held (found right): a run inside ``asyncio.run`` (and from its default executor), with
 ``sys.stdout``/``sys.stderr`` replaced by ``io.StringIO`` or closed, under ``-W error`` or
@@ -71,3 +76,33 @@ def _env() -> dict:
     import os
 
     return {**os.environ, "PYTHONPATH": str(ROOT)}
+
+
+def test_a_script_read_from_standard_input_runs_its_workers(tmp_path):
+    """A script piped to ``python -`` (its ``__file__`` is ``<stdin>``, no file) with a thread
+    of its own: ``run(workers=2)`` starts forkserver workers, which ran the script's
+    ``__file__`` again: each printed a ``FileNotFoundError`` traceback and the run was refused
+    as a script without its main guard. It runs now, as from a notebook (whose ``__main__``
+    has no ``__file__``), and ``__file__`` is ``<stdin>`` again after."""
+    code = "\n".join(
+        [
+            "import threading, sim",
+            "stop = threading.Event()",
+            "threading.Thread(target=stop.wait, daemon=True).start()",
+            f"st = sim.load({NETWORK!r}, trials=40, chunk=2)",
+            f"res = st.run(out={str(tmp_path / 'o')!r}, workers=2, quiet=True, figures=False)",
+            "print(res.claims().num_rows > 0, __file__)",
+            "stop.set()",
+        ]
+    )
+    p = subprocess.run(
+        [sys.executable, "-"],
+        input=code + "\n",
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=300,
+        env=_env(),
+    )
+    assert (p.returncode, p.stdout.split()) == (0, ["True", "<stdin>"]), p.stdout + p.stderr
+    assert "Traceback" not in p.stderr, p.stderr[-2000:]
