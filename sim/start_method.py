@@ -18,6 +18,13 @@ worker runs again. A script read from standard input (``python - < script.py``, 
 traceback and the run was refused as if the script lacked its main guard. While runs are under
 way such a ``__file__`` (one naming no file, a script deleted since it started too) is hidden,
 as a notebook's ``__main__`` has none, so the workers import only the suite, and put back after.
+
+A Dask cluster's nannies set variables in the caller's ``os.environ`` before they spawn each
+worker (``distributed.nanny.pre-spawn-environ``: ``OMP_NUM_THREADS=1`` and its kind,
+``MALLOC_TRIM_THRESHOLD_``; ``PYTHONHASHSEED``; ``__DASK_PARENT_PID``) and left them there:
+every process the caller started after a Dask run ran BLAS on one thread with a fixed hash
+seed. Those variables are put back as the first run found them when the last ends (a nanny
+sets them again before each start).
 """
 
 from __future__ import annotations
@@ -34,9 +41,11 @@ __all__ = ["for_the_callers_process"]
 #: the method reading the default fixes (the platform's first, as documented)
 _DEFAULT = multiprocessing.get_all_start_methods()[0]
 _lock = threading.Lock()
+#: the variables a Dask nanny sets in its own process besides its ``pre-spawn-environ``
+_DASK_SETS = ("PYTHONHASHSEED", "__DASK_PARENT_PID")
 #: the runs of this process under way, whether the method was unset when the first began, and
 #: the ``__main__`` whose ``__file__`` naming no file is hidden meanwhile, with that name
-_state: dict = {"runs": 0, "unset": False, "hidden": None}
+_state: dict = {"runs": 0, "unset": False, "hidden": None, "environ": {}}
 
 
 def _no_file(main) -> str | None:
@@ -50,16 +59,31 @@ def _no_file(main) -> str | None:
     return None if os.path.isfile(path) else main.__file__
 
 
+def _dask_variables_back(before: dict) -> None:
+    """The variables a Dask nanny set in this process (see the module) as in ``before``."""
+    if "distributed" not in sys.modules:
+        return  # no Dask cluster ran in this process
+    import dask
+
+    spawn_env = dask.config.get("distributed.nanny.pre-spawn-environ", default={}) or {}
+    for name in (*spawn_env, *_DASK_SETS):
+        if name not in before:
+            os.environ.pop(name, None)
+        elif os.environ.get(name) != before[name]:
+            os.environ[name] = before[name]
+
+
 def for_the_callers_process(fn):
     """``fn`` (a run) leaving the start method unset if it was unset when it began (or when
     the first of the runs then under way in other threads began), its workers not importing a
-    ``__main__`` that names no file."""
+    ``__main__`` that names no file, and the variables a Dask nanny sets as they were."""
 
     @functools.wraps(fn)
     def wrapped(*args, **kwargs):
         with _lock:
             if _state["runs"] == 0:
                 _state["unset"] = multiprocessing.get_start_method(allow_none=True) is None
+                _state["environ"] = dict(os.environ)
                 main = sys.modules.get("__main__")
                 if (name := _no_file(main)) is not None:
                     del main.__file__
@@ -75,6 +99,7 @@ def for_the_callers_process(fn):
                     # the platform's default, as reading it fixes it (not one set since)
                     if _state["unset"] and fixed == _DEFAULT:
                         multiprocessing.set_start_method(None, force=True)
+                    _dask_variables_back(_state["environ"])
                     if _state["hidden"] is not None:
                         main, name = _state["hidden"]
                         _state["hidden"] = None
