@@ -86,8 +86,11 @@ def for_the_callers_process(fn):
                 _state["environ"] = dict(os.environ)
                 main = sys.modules.get("__main__")
                 if (name := _no_file(main)) is not None:
-                    del main.__file__
-                    _state["hidden"] = (main, name)
+                    try:
+                        del main.__file__
+                        _state["hidden"] = (main, name)
+                    except (AttributeError, TypeError):  # not a module's: left as it is
+                        pass
             _state["runs"] += 1
         try:
             return fn(*args, **kwargs)
