@@ -49,6 +49,7 @@ from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
 from sim.run_failure import numeric_failure
 from sim.spared_workers import start_sparing_workers
+from sim.start_method import for_the_callers_process
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
 
@@ -137,6 +138,7 @@ def _no_half_imports(fn):
 
 @_no_half_imports  # every door: Ctrl-C in matplotlib's or numba's first import poisons nothing
 @keep_lost_interrupts()  # every door: Ctrl-C that Python drops in a C callback is kept
+@for_the_callers_process  # every door: start method unset after, a <stdin> script not re-run
 def execute(
     study,
     cfg: dict,
