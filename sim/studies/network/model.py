@@ -241,8 +241,8 @@ def defect_basis(net: Network, free: np.ndarray) -> np.ndarray:
     G = _similarity(net)
     held = np.setdiff1d(np.arange(2 * net.n), free)
     K = np.eye(4)
-    if held.size:
-        _, sv, vt = np.linalg.svd(G[held], full_matrices=True)
+    if held.size:  # U of G[held] (2 x held points, squared) is never wanted: thin from 4 rows
+        _, sv, vt = np.linalg.svd(G[held], full_matrices=held.size < G.shape[1])
         rank = int((sv > 1e-12 * max(sv.max(initial=0.0), 1.0)).sum())
         K = vt[rank:].T
     if K.shape[1] == 0:
