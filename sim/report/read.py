@@ -170,7 +170,7 @@ def checked_table(path: str | Path, shaped: bool = True) -> pa.Table:
     if not shaped:
         return table
     if (bad := record_problem(path)) is not None:  # not "an older version's": unchecked
-        raise TableError(bad[0], f"{bad[1]}: edited by hand? its tables cannot be checked")
+        raise TableError(bad[0], record_line(bad).removeprefix(f"{bad[0]} "))
     if (recorded := recorded_shape(path)) is None:  # an older version's run: what it declares
         if (why := declared_problem(table)) is not None:
             raise TableError(path, why)
