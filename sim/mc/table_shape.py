@@ -151,9 +151,11 @@ def _spots(path: Path) -> list[tuple[Path, str]]:
 MISSING = "missing"
 
 
-def record_problem(path: str | Path) -> tuple[Path, str] | None:
+def record_problem(path: str | Path, missing: bool = False) -> tuple[Path, str] | None:
     """``(run.json, what is wrong with it)`` when the run record of the table ``path`` is
-    there but is no run record, or is not there at all (:data:`MISSING`), else None. Such a
+    there but is no run record, or (``missing``: asked by the readers of a results directory,
+    ``sim show``, ``sim report``, verify, ``Results.table``) is not there at all
+    (:data:`MISSING`), else None. Such a
     ``run.json`` -- invalid JSON left by an editor, a FIFO, a directory, unreadable -- let
     every reader take the tables unchecked, as of a version that recorded no shapes: a value
     edited by hand beside it was printed as the run's. So did a ``run.json`` deleted: every
@@ -166,7 +168,7 @@ def record_problem(path: str | Path) -> tuple[Path, str] | None:
             return None
         if os.path.lexists(rec := root / RECORD):
             return rec, _unrecorded(rec)
-    return spots[-1][0] / RECORD, MISSING
+    return (spots[-1][0] / RECORD, MISSING) if missing else None
 
 
 def record_line(bad: tuple[Path, str]) -> str:

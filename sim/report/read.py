@@ -170,7 +170,7 @@ def checked_table(path: str | Path, shaped: bool = True) -> pa.Table:
     if not shaped:
         return table
     if (bad := record_problem(path)) is not None:  # not "an older version's": unchecked
-        raise TableError(bad[0], record_line(bad).removeprefix(f"{bad[0]} "))
+        raise TableError(bad[0], f"{bad[1]}: edited by hand? its tables cannot be checked")
     if (recorded := recorded_shape(path)) is None:  # an older version's run: what it declares
         if (why := declared_problem(table)) is not None:
             raise TableError(path, why)
@@ -281,7 +281,7 @@ def check_claims_table(f: Path, key: str) -> None:
     damage = claims_damage(prov, verdicts, claims)
     if damage:
         raise ConfigError(key, f"{f} is not a claims table written by sim: {damage}")
-    if (bad := record_problem(f)) is not None:  # its tables were read unchecked
+    if (bad := record_problem(f, missing=True)) is not None:  # its tables were read unchecked
         raise ConfigError(key, record_line(bad))
     run = (read_record(f.parent) or {}).get("config")
     owner = run.get("study") if isinstance(run, dict) else None
