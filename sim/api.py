@@ -214,7 +214,7 @@ class Results:
             mixed = mixed_run(self.path, [p.name]) or cell_mixed(self.path, [p.name])
             if mixed is not None:  # copied from another run, or another cell's
                 raise ConfigError("table", mixed)
-            if (bad := record_problem(p)) is not None:  # its tables were read unchecked
+            if (bad := record_problem(p, missing=True)) is not None:  # read unchecked
                 raise ConfigError("table", record_line(bad))
             shaped = recorded_shape(p)  # none recorded: its sha256, where recorded
             edit = shape_problem(table, shaped) if shaped is not None else sum_problem(p)

@@ -17,6 +17,7 @@ import pyarrow as pa
 from sim.api_paths import cell_mixed, too_long
 from sim.cli_errors import not_as_written, older_lacks
 from sim.mc.config import ConfigError
+from sim.mc.file_kind import odd_table
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.settle import settled
@@ -162,6 +163,9 @@ def report(results: Path) -> int:
     # from / or $HOME: not "is not a results directory" (a link loop on the way: its words)
     if not os.path.lexists(results) and not link_problem(results):
         raise ConfigError("--results", f"{results} does not exist (in {os.getcwd()})")
+    for d in sorted(results_dirs(results)) if results.is_dir() else ():
+        if (odd := odd_table(d)) is not None:  # a FIFO as claims.parquet: the study was
+            raise ConfigError("--results", odd)  # left out of REPORT.md without a word
     if results.is_dir() and not any(
         (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file()
         for d in results_dirs(results)

@@ -15,7 +15,7 @@ import pytest
 
 from sim.cli import main
 from sim.mc.runner import MIN_CHUNKS, make_executor
-from sim.mc.storage import write_table
+from sim.mc.storage import write_record, write_table
 from sim.report.claimtext import interval_text, sim_text
 from sim.report.run_summary import region_line, verdict_line
 
@@ -208,6 +208,7 @@ def test_exact_numbers_keep_the_digits_that_decide():
 
 
 def test_region_line_and_new_verdicts_are_counted(tmp_path):
+    write_record(tmp_path, {"config": {"study": "brown_table1"}, "code_hash": "0" * 16})
     write_table(
         tmp_path / "consistent_region.parquet",
         {

@@ -29,10 +29,10 @@ the reports). One case each, each failed on the code before its fix.
   config: plate.grid: not in that config (this run 5), plate.gr<ZWSP>id = 5" and ``sim
   show``'s "made with another config": two keys that look the same. Such a key is now named
   with its escapes (``"plate.gr\\u200bid"``).
-* An ``--out`` whose ``run.json`` was there but damaged (saved with a UTF-8 signature, in
-  Latin-1 or UTF-16, cut short) was refused as holding "no sim run record (run.json)": the
-  user looked for a file that is there. What the file is is now named (``a run.json that is
-  no sim run record (it starts with a UTF-8 signature ...)``).
+* An ``--out`` whose ``run.json`` was there but damaged (saved in Latin-1 or UTF-16, cut
+  short) was refused as holding "no sim run record (run.json)": the user looked for a file
+  that is there. What the file is is now named (``a run.json that is no sim run record (it is
+  not UTF-8 text ...)``). One saved with a UTF-8 signature is read as the record since H46.
 * A table whose provenance (its Parquet metadata ``sim.provenance``) was edited into bytes
   that are not UTF-8 was refused in the codec's words (``'utf-8' codec can't decode byte 0xe9
   in position 2232: invalid continuation byte``), into no JSON in json's alone; the metadata
@@ -185,7 +185,6 @@ def test_a_report_saved_with_a_signature_is_still_the_suites(done, tmp_path, cap
 @pytest.mark.parametrize(
     "damage, needle",
     [
-        (lambda b: b"\xef\xbb\xbf" + b, "(it starts with a UTF-8 signature, which sim never"),
         (lambda b: b.replace(b'"seed"', b'"s\xe9ed"'), "(it is not UTF-8 text (byte 0xe9 at line"),
         (lambda b: b.decode().encode("utf-16"), "(it is not UTF-8 text (it is UTF-16"),
         (lambda b: b[: len(b) // 2], "(it is not JSON: "),
@@ -200,6 +199,20 @@ def test_a_damaged_run_json_is_named(tmp_path, capsys, damage, needle):
     rc = main(["run", str(TABLE1), "--trials", "40", "--chunk", "2", "--out", str(d)])
     line = one_line(capsys, rc, "holds files but a run.json that is no sim run record", needle)
     assert "no sim run record (run.json)" not in line
+    assert (d / "claims.parquet").read_bytes() == b"x"
+
+
+def test_a_run_json_saved_with_a_utf8_signature_is_read_as_the_record(tmp_path, capsys):
+    # 37f named the signature as damage; since H46 the record behind it is read (an editor's
+    # save), so this one is refused for what it holds: another config, the table kept
+    d = tmp_path / "out"
+    d.mkdir()
+    rec = {"config": {"study": "brown_table1"}, "code_hash": "0" * 16, "seed": 1}
+    (d / "run.json").write_bytes(b"\xef\xbb\xbf" + json.dumps(rec, indent=1).encode())
+    (d / "claims.parquet").write_bytes(b"x")
+    rc = main(["run", str(TABLE1), "--trials", "40", "--chunk", "2", "--out", str(d)])
+    line = one_line(capsys, rc, "holds results of a different config", "--overwrite")
+    assert "no sim run record" not in line, line
     assert (d / "claims.parquet").read_bytes() == b"x"
 
 

@@ -86,4 +86,4 @@ def test_a_swept_geometry_over_the_work_limit_is_named_as_swept(tmp_path, capsys
         + '\n[sweep]\n"block.base_mm" = [90.0, 10.0]\n'
     )
     args = ["check", str(f), *tiny_overrides("agnard_block"), "--max-adjustments", "5e5"]
-    one_line(capsys, main(args), "or change the values of sweep.block.base_mm")
+    one_line(capsys, main(args), "change the values of sweep.block.base_mm, which holds most of it")

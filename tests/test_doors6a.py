@@ -25,7 +25,7 @@ from oneline import SIM_ERROR, one_line
 import sim
 from sim.cli import main
 from sim.mc.config import ConfigError
-from sim.mc.storage import read_provenance, read_record, write_table
+from sim.mc.storage import read_provenance, read_record, write_record, write_table
 from sim.studies.network.gama_read import read_gama
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -170,8 +170,12 @@ def test_api_arguments_of_a_wrong_type_are_named(tmp_path):
 def test_results_read_only_their_studys_tables(tmp_path):
     d = tmp_path / "r"
     d.mkdir()
-    write_table(d / "claims.parquet", {"claim": ["x"]}, {"study": "brown_table1"})
-    write_table(d / "points.parquet", {"a": [1.0]}, {"study": "network"})
+    net, brown = (
+        {"config": {"study": s}, "code_hash": "0" * 16} for s in ("network", "brown_table1")
+    )
+    write_table(d / "claims.parquet", {"claim": ["x"]}, {"study": "brown_table1", **brown})
+    write_table(d / "points.parquet", {"a": [1.0]}, {"study": "network", **net})
+    write_record(d, net)  # (a directory without its run record is refused: doors47k)
     (d / "datums.parquet").mkdir()  # a table replaced by a directory
     res = sim.Results(d, "network")
     assert res.table("points").num_rows == 1
@@ -179,6 +183,7 @@ def test_results_read_only_their_studys_tables(tmp_path):
         res.claims()
     with pytest.raises(ConfigError, match="datums.parquet is not a file"):
         res.table("datums")
+    write_record(d, brown)
     assert sim.Results(d, "brown_table1").claims().num_rows == 1
     write_table(d / "claims.parquet", {"claim": ["x"]}, {})  # no study: not sim's
     with pytest.raises(ConfigError, match="not a table sim wrote"):

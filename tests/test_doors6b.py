@@ -50,7 +50,7 @@ from oneline import one_line
 import sim.__main__  # noqa: F401 - the sim command's set-up (its log filter)
 from sim import batch, cli_read, execute
 from sim.cli import main
-from sim.mc.storage import write_table
+from sim.mc.storage import write_record, write_table
 from sim.report.verify import main as verify_main
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -121,8 +121,12 @@ def test_a_signal_to_batch_ends_its_runs(tmp_path, capsys, monkeypatch, sig):
 def test_a_signal_to_verify_ends_its_rerun(tmp_path, capsys, monkeypatch, sig):
     d = tmp_path / "res" / "brown_table1"
     d.mkdir(parents=True)
+    run = {"config": {"study": "brown_table1"}, "code_hash": "0" * 16}  # its run's record
+    write_record(d, run)  # (a directory without one is refused: doors47k)
     write_table(
-        d / "claims.parquet", {"claim": ["x"], "verdict": ["holds"]}, {"study": "brown_table1"}
+        d / "claims.parquet",
+        {"claim": ["x"], "verdict": ["holds"]},
+        {"study": "brown_table1", **run},
     )
     monkeypatch.chdir(ROOT)  # the re-run reads studies/<study>.toml
     monkeypatch.setattr(sys, "executable", str(_fake_python(tmp_path)))

@@ -35,7 +35,7 @@ from sim import ConfigError
 from sim.batch import is_current
 from sim.batch import main as batch_main
 from sim.cli import main
-from sim.mc.storage import write_table
+from sim.mc.storage import write_record, write_table
 from sim.report.verify import main as verify_main
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -117,8 +117,18 @@ def _results(tmp_path: Path, name: str = "brown_table1") -> Path:
     """A results directory whose one study holds a claims table (nothing else is read)."""
     d = tmp_path / "res" / name
     d.mkdir(parents=True)
-    write_table(d / "claims.parquet", {"claim": ["x"], "verdict": ["holds"]}, {"study": name})
+    _claims_with_record(d, name)
     return d.parent
+
+
+def _claims_with_record(d: Path, study: str) -> None:
+    """A one-claim table of ``study`` in ``d`` and the run record every run writes beside it
+    (a directory without one is refused by every reader: its run.json deleted)."""
+    run = {"config": {"study": study}, "code_hash": "0" * 16}
+    write_table(
+        d / "claims.parquet", {"claim": ["x"], "verdict": ["holds"]}, {"study": study, **run}
+    )
+    write_record(d, run)
 
 
 def test_verify_no_rerun_without_the_reruns_records_nothing(tmp_path, capsys):
@@ -421,7 +431,8 @@ def test_api_paths_keys_and_results_are_checked(tmp_path):
     with pytest.raises(ConfigError, match="'': is not a config key"):
         sim.load(BROWN, **{"": 1})
     d = tmp_path / "r"
-    write_table(d / "claims.parquet", {"claim": ["x"], "verdict": ["holds"]}, {"study": "x"})
+    d.mkdir()
+    _claims_with_record(d, "x")
     assert sim.Results(str(d), "x").claims().num_rows == 1
     with pytest.raises(ConfigError, match="path: must be a path"):
         sim.Results(5, "x")

@@ -379,8 +379,14 @@ def check_limits(
             None,
             f"{est.study}: the run needs {est.describe(workers)}, over the "
             f"limit of {adj:.3g} adjustments (--max-adjustments or "
-            "SIM_MAX_ADJUSTMENTS); reduce trials or the lists in the study file"
-            + (f", or change {keys_advice(est.work_keys)}" if est.work_keys else ""),
+            "SIM_MAX_ADJUSTMENTS); "  # the keys that hold the work first, not after
+            + (
+                f"change {keys_advice(est.work_keys)}, which "
+                f"{'hold' if len(est.work_keys) > 1 else 'holds'} most of it, or "
+                if est.work_keys
+                else ""
+            )
+            + "reduce trials or the lists in the study file",
         )
     if not est.analytic <= adj * ANALYTIC_SHARE:
         raise ConfigError(

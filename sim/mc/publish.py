@@ -22,6 +22,7 @@ from itertools import count
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.file_kind import odd_file
 from sim.mc.outputs import swap_dir
 from sim.mc.paths import mounts_under
 from sim.mc.pids import writer_gone
@@ -111,7 +112,12 @@ def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
         if not p.is_file():
             if missing_ok:
                 continue
-            return f"{p} is missing (the run drew it)"
+            odd = odd_file(p)  # a FIFO in its place: not "missing"
+            return (
+                f"{p} is {odd}, not the figure its run drew"
+                if odd
+                else f"{p} is missing (the run drew it)"
+            )
         try:
             same = _run_drew(p, h)
         except OSError as e:  # a read that fails (EIO) has no file name of its own to say

@@ -36,6 +36,7 @@ from sim.mc.codehash import (  # code no study result depends on
     study_code_hash,
     study_files,
 )
+from sim.mc.finite import NonFiniteError, check_finite_table
 from sim.mc.pids import writer_gone
 
 __all__ = [
@@ -258,35 +259,6 @@ def _drop_stale_temporaries(path: Path) -> None:
         if p.is_file() and not p.is_symlink():
             with contextlib.suppress(OSError):  # (read-only: it stays; the write names the file)
                 p.unlink(missing_ok=True)
-
-
-class NonFiniteError(ValueError):
-    """A statistic that must be a number is NaN or infinite (one line naming the table and
-    column)."""
-
-
-#: columns of a claims table that must hold finite numbers (a NaN reference is "no number")
-CLAIM_NUMBERS = ("value", "ci_low", "ci_high")
-
-
-def check_finite_table(name: str, table: pa.Table) -> None:
-    """No float column may hold +-inf (NaN may mean "missing"), and a claims table's value and
-    interval must be finite: a non-finite verdict is an error, never a result (a null, e.g. in
-    a ``not comparable`` row, is "no number" and allowed)."""
-    is_claims = {"claim", *CLAIM_NUMBERS} <= set(table.column_names)
-    for col, arr in zip(table.column_names, table.columns):
-        if not pa.types.is_floating(arr.type):
-            continue
-        v = arr.to_numpy(zero_copy_only=False).astype(float)
-        valid = np.asarray(arr.is_valid())  # a null is "no number" (a not-comparable claim)
-        bad = np.isinf(v) | (np.isnan(v) & valid if is_claims and col in CLAIM_NUMBERS else False)
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            what = f" (claim {table.column('claim')[i].as_py()})" if is_claims else f" (row {i})"
-            raise NonFiniteError(
-                f"{name}: column {col} is {v[i]}{what}: a statistic that must "
-                "be a number is not finite"
-            )
 
 
 def write_table(

@@ -147,22 +147,37 @@ def _spots(path: Path) -> list[tuple[Path, str]]:
     return spots
 
 
-def record_problem(path: str | Path) -> tuple[Path, str] | None:
+#: :func:`record_problem`'s word for a run record that is not there at all
+MISSING = "missing"
+
+
+def record_problem(path: str | Path, missing: bool = False) -> tuple[Path, str] | None:
     """``(run.json, what is wrong with it)`` when the run record of the table ``path`` is
-    there but is no run record, else None (one is read, or there is none). Such a
+    there but is no run record, or (``missing``: asked by the readers of a results directory,
+    ``sim show``, ``sim report``, verify, ``Results.table``) is not there at all
+    (:data:`MISSING`), else None. Such a
     ``run.json`` -- invalid JSON left by an editor, a FIFO, a directory, unreadable -- let
     every reader take the tables unchecked, as of a version that recorded no shapes: a value
-    edited by hand beside it was printed as the run's."""
-    for root, _ in _spots(Path(path)):
+    edited by hand beside it was printed as the run's. So did a ``run.json`` deleted: every
+    version of the suite that wrote a claims table the readers take (one with a ``verdict``
+    column) wrote its ``run.json`` beside it, so a results directory without one is not an
+    older version's, it is one whose record was removed."""
+    spots = _spots(Path(path))
+    for root, _ in spots:
         if read_record(root) is not None:
             return None
         if os.path.lexists(rec := root / RECORD):
             return rec, _unrecorded(rec)
-    return None
+    return (spots[-1][0] / RECORD, MISSING) if missing else None
 
 
 def record_line(bad: tuple[Path, str]) -> str:
     """The one line for a :func:`record_problem`."""
+    if bad[1] == MISSING:
+        return (
+            f"{bad[0]} is missing (deleted by hand?), so the tables beside it cannot be "
+            "checked against their run; run the study again"
+        )
     return (
         f"{bad[0]} is not a run record ({bad[1]}: edited by hand?), so its tables cannot be "
         "checked against their run; run the study again"

@@ -281,7 +281,7 @@ def check_claims_table(f: Path, key: str) -> None:
     damage = claims_damage(prov, verdicts, claims)
     if damage:
         raise ConfigError(key, f"{f} is not a claims table written by sim: {damage}")
-    if (bad := record_problem(f)) is not None:  # its tables were read unchecked
+    if (bad := record_problem(f, missing=True)) is not None:  # its tables were read unchecked
         raise ConfigError(key, record_line(bad))
     run = (read_record(f.parent) or {}).get("config")
     owner = run.get("study") if isinstance(run, dict) else None

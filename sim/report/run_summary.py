@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import shlex
-import unicodedata
 from collections import Counter
 from pathlib import Path
 from typing import Callable
@@ -20,6 +19,7 @@ import pyarrow.parquet as pq
 
 from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
+from sim.mc.file_kind import odd_table
 from sim.mc.storage import atomic_path, read_provenance, read_record, write_record
 from sim.mc.table_shape import kind
 from sim.places import held_results, show_target
@@ -31,6 +31,7 @@ from sim.report.papers import paper_name
 from sim.report.read import TableError, checked_table, columns, forget, records
 from sim.report.sweep import sweep_markdown
 from sim.report.tables import fmt, md_code, md_text
+from sim.report.text_table import cut, text_table
 
 __all__ = [
     "VERDICT_ORDER",
@@ -67,6 +68,8 @@ def _kind_of(out: Path) -> str:
         return "study"
     if (out / "sweep.parquet").is_file():
         return "sweep"
+    if (odd := odd_table(out)) is not None:  # a FIFO there: not "there is none"
+        raise ConfigError("DIR", odd)
     why = "is not a results directory (no claims.parquet or sweep.parquet)"
     raise ConfigError("DIR", f"{out} {why}{held_results(out)}")
 
@@ -249,7 +252,7 @@ def terminal_table(
     if _kind_of(out) == "sweep":  # each cell with its swept values (cell0003_r0 alone named
         t = columns(out / "sweep.parquet")  # no setting), and where its claims are
         keys = [k for k in cfg["sweep_keys"] if k in t]
-        texts = {k: column([fmt(v) for v in t[k]], lambda s: _cut(s, 24), 24) for k in keys}
+        texts = {k: column([fmt(v) for v in t[k]], lambda s: cut(s, 24), 24) for k in keys}
         rows = [
             [
                 t["label"][i],
@@ -258,7 +261,7 @@ def terminal_table(
             ]
             for i in range(len(t["label"]))
         ]
-        table = _text_table(["cell", *keys, "feasible"], rows, width)
+        table = text_table(["cell", *keys, "feasible"], rows, width)
         ok = sum(bool(f) for f in t["feasible"])
         off = sweep_off_note(out, get_study)
         return (
@@ -270,7 +273,7 @@ def terminal_table(
         )
     claims = records(out / "claims.parquet")
     rows = [[r["claim"], _value_text(r), _interval(r), verdict_cell(r)] for r in claims]
-    table = _text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
+    table = text_table(["claim", "simulated", "95% interval", "verdict"], rows, width)
     conv = converged_line(out)
     off = off_note(out, get_study)
     notes = "".join(f"\n{x}" for x in (conv, off) if x)
@@ -294,49 +297,6 @@ def _sweep_prov(out: Path) -> dict:
     if not all(isinstance(k, str) for k in keys):
         raise TableError(p, f"its provenance's swept keys are not names ({keys!r:.60})")
     return prov
-
-
-def _text_table(header: list[str], rows: list[list], width: int) -> str:
-    """Columns aligned by the width a terminal gives each character (:func:`_cols`): a
-    network's or a swept value's CJK name takes two columns, an accent none."""
-    cols = list(zip(header, *rows)) if rows else [(h,) for h in header]
-    w = [max(_cols(str(c)) for c in col) for col in cols]
-    if sum(w) + 2 * (len(w) - 1) > width and len(w) > 1:  # shorten the first column
-        w[0] = max(12, width - sum(w[1:]) - 2 * (len(w) - 1))
-
-    def line(cells):
-        return "  ".join(_pad(_cut(str(c), w[i]), w[i]) for i, c in enumerate(cells)).rstrip()
-
-    return "\n".join([line(header), line(["-" * x for x in w])] + [line(r) for r in rows])
-
-
-def _cols(s: str) -> int:
-    """Terminal columns of ``s``: East Asian wide and full-width characters two, combining
-    marks and zero-width characters none, every other character one."""
-    return sum(
-        0
-        if unicodedata.combining(ch) or unicodedata.category(ch) in ("Mn", "Me", "Cf")
-        else 2
-        if unicodedata.east_asian_width(ch) in ("W", "F")
-        else 1
-        for ch in s
-    )
-
-
-def _pad(s: str, n: int) -> str:
-    return s + " " * max(n - _cols(s), 0)
-
-
-def _cut(s: str, n: int) -> str:
-    """``s`` in at most ``n`` terminal columns, ``...`` ending a shortened one."""
-    if _cols(s) <= n:
-        return s
-    out, room = "", max(n - 3, 0)
-    for ch in s:
-        if _cols(out + ch) > room:
-            break
-        out += ch
-    return out + "..."
 
 
 def run_markdown(

@@ -34,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from sim.claims.region import REGION_MIN_POINTS
+from sim.mc.file_kind import odd_file
 from sim.mc.publish import drawn
 from sim.mc.storage import read_provenance, read_record
 from sim.report.inputs import inputs_markdown
@@ -76,6 +77,8 @@ def config(out: Path) -> dict[str, Any]:
 def figure(out: Path, file: str, alt: str) -> str:
     """The Markdown line of one figure of the study, relative to the report; a line saying
     so when the run drew no figures (``sim run --no-figures``)."""
+    if (odd := odd_file(Path(out) / file)) is not None:  # a FIFO: not "removed since?"
+        return f"*{alt}: not shown (`{file}` is {odd}, not the figure its run drew)*"
     if not (Path(out) / file).is_file():
         drew = (read_record(Path(out)) or {}).get("figure_sha256")  # the run drew it: not
         if isinstance(drew, dict) and file in drew:  # "a run with --no-figures?" of its run

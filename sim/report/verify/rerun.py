@@ -14,6 +14,7 @@ import pyarrow as pa
 
 from sim.mc.children import child_env, child_text, ended, stop_children
 from sim.mc.config import ConfigError
+from sim.mc.file_kind import odd_table
 from sim.mc.outputs import results_dirs
 from sim.mc.overrides import listed, replayable, without
 from sim.mc.paths import link_problem
@@ -37,6 +38,10 @@ def study_dirs(results: Path, only: list[str] | None = None) -> list[tuple[Path,
     results = Path(results)
     if not results.is_dir():
         raise VerifyError(f"--results: {results} {link_problem(results) or 'is not a directory'}")
+    for d in sorted(results_dirs(results)):  # a FIFO as claims.parquet: not "no results"
+        named = not only or d.name in {Path(s).name.removesuffix(".toml") for s in only}
+        if named and (odd := odd_table(d)) is not None:
+            raise VerifyError(f"--results: {odd}")
     found = []
     for d in sorted(p for p in results_dirs(results) if (p / "claims.parquet").is_file()):
         try:
