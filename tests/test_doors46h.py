@@ -34,7 +34,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
 from pathlib import Path
 
 import pyarrow as pa
@@ -47,6 +46,7 @@ from sim.cli import main
 from sim.report.verify.rerun import verify
 from tests.conftest import tiny_overrides
 from tests.oneline import one_line
+from tests.within import within
 
 PLATE = Path(__file__).resolve().parents[1] / "studies" / "network_plate.toml"
 
@@ -71,25 +71,6 @@ def _edit_first_value(d: Path) -> float:
     return v[0]
 
 
-class _Hung(Exception):
-    pass
-
-
-def _within(seconds: int, fn, *args):
-    """``fn(*args)``, or :class:`_Hung` after ``seconds`` (the conftest gives the handler
-    back)."""
-
-    def hung(*_):
-        raise _Hung(f"{fn.__name__}{args} still blocked after {seconds} s")
-
-    signal.signal(signal.SIGALRM, hung)
-    signal.alarm(seconds)
-    try:
-        return fn(*args)
-    finally:
-        signal.alarm(0)
-
-
 def test_a_readme_made_a_fifo_is_kept_and_never_opened(tiny_run, tmp_path, capsys):
     """A FIFO in a run's README.md: ``sim report`` blocked for good opening it to read the
     suite's mark; it is the user's file now, kept as it is."""
@@ -97,7 +78,7 @@ def test_a_readme_made_a_fifo_is_kept_and_never_opened(tiny_run, tmp_path, capsy
     readme = d / "README.md"
     readme.unlink()
     os.mkfifo(readme)
-    assert _within(60, main, ["report", "--results", str(d.parent)]) == 0
+    assert within(60, main, ["report", "--results", str(d.parent)]) == 0
     capsys.readouterr()
     assert readme.is_fifo() and (d.parent / "REPORT.md").is_file()
 
@@ -120,8 +101,8 @@ def test_a_broken_run_record_is_named_not_taken_as_none(tiny_run, tmp_path, caps
     edited = _edit_first_value(d)
     touch(d / "run.json")
     rec = str(d / "run.json")
-    one_line(capsys, _within(60, main, ["show", str(d)]), rec, words, "run the study again")
-    one_line(capsys, _within(60, main, ["report", "--results", str(d.parent)]), rec, words)
+    one_line(capsys, within(60, main, ["show", str(d)]), rec, words, "run the study again")
+    one_line(capsys, within(60, main, ["report", "--results", str(d.parent)]), rec, words)
     with pytest.raises(sim.ConfigError, match=f"{rec} is not a run record") as e:
         sim.Results(d, "network").claims()
     assert str(edited) not in str(e.value)

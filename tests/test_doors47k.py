@@ -27,7 +27,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
 from pathlib import Path
 
 import pyarrow as pa
@@ -39,6 +38,7 @@ from sim.cli import main
 from sim.report.verify.rerun import verify
 from sim.report.verify.rules import VerifyError
 from tests.oneline import SIM_ERROR, one_line
+from tests.within import within
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
 
@@ -61,20 +61,6 @@ def _edit_first_value(d: Path) -> float:
     v[0] += 1.0
     pq.write_table(t.set_column(i, t.schema.field(i), pa.array(v, t.schema.field(i).type)), p)
     return v[0]
-
-
-def _within(seconds: int, fn, *args):
-    """``fn(*args)``, failing the test after ``seconds`` (a FIFO opened blocks for good)."""
-
-    def hung(*_):
-        raise AssertionError(f"{fn.__name__}{args} still blocked after {seconds} s")
-
-    signal.signal(signal.SIGALRM, hung)
-    signal.alarm(seconds)
-    try:
-        return fn(*args)
-    finally:
-        signal.alarm(0)
 
 
 def test_a_results_directory_whose_run_record_was_deleted_is_refused(tiny_run, tmp_path, capsys):
@@ -109,13 +95,13 @@ def test_a_claims_table_made_a_fifo_is_named_as_one(tiny_run, tmp_path, capsys):
     (d / "claims.parquet").unlink()
     os.mkfifo(d / "claims.parquet")
     words = (str(d / "claims.parquet"), "is a FIFO (named pipe), not a table the suite wrote")
-    one_line(capsys, _within(60, main, ["show", str(d)]), *words, prefix=SIM_ERROR + "DIR: ")
-    rc = _within(60, main, ["report", "--results", str(d.parent)])
+    one_line(capsys, within(60, main, ["show", str(d)]), *words, prefix=SIM_ERROR + "DIR: ")
+    rc = within(60, main, ["report", "--results", str(d.parent)])
     one_line(capsys, rc, *words, prefix=SIM_ERROR + "--results: ")
     assert not (d.parent / "REPORT.md").exists() and (other / "claims.parquet").is_file()
     for only in (None, ["network_plate"]):
         with pytest.raises(VerifyError, match=r"network_plate/claims.parquet is a FIFO"):
-            _within(60, verify, d.parent, tmp_path / "scratch", 1, only, False)
+            within(60, verify, d.parent, tmp_path / "scratch", 1, only, False)
     assert (d / "claims.parquet").is_fifo()
     shutil.rmtree(d)  # the other study alone: read as before
     assert main(["report", "--results", str(d.parent)]) == 0
@@ -130,7 +116,7 @@ def test_a_figure_made_a_fifo_is_named_as_one_in_the_readme(tiny_run, tmp_path, 
     name = sorted(drew)[0]
     (d / name).unlink()
     os.mkfifo(d / name)
-    assert _within(60, main, ["report", "--results", str(d.parent)]) == 0
+    assert within(60, main, ["report", "--results", str(d.parent)]) == 0
     capsys.readouterr()
     readme = (d / "README.md").read_text("utf-8")
     assert f"`{name}` is a FIFO (named pipe), not the figure its run drew" in readme, readme
