@@ -1,10 +1,9 @@
 """Configuration schema of ``agnard_block`` (seed ``003_5ce730a990a7ebc5.txt``, Agnard,
 Nolette & Gagnon): block geometry, scanner, measurement, pugging, weights, control layouts,
 data snooping, trade-offs and the region of the unprinted five-point control layout; the
-cross-key rules (:func:`check`) and the small derived quantities every part uses
-(:func:`block_of`, :func:`model_sigmas`, the weights, the layouts of the region).
-Units: lengths in m on the ground, mm and um on the photo, px of the scan.
-"""
+cross-key rules (:func:`check`) and the small derived quantities every part uses (:func:`block_of`,
+:func:`model_sigmas`, the weights, the layouts of the region). Units: lengths in m on the
+ground, mm and um on the photo, px of the scan."""
 
 from __future__ import annotations
 
