@@ -298,8 +298,13 @@ def factorize(
             "the normal equations are singular (an exactly zero pivot)",
             int(keep[weak]) if weak >= 0 else -1,
         )
-    if not np.array_equal(lu.perm_r, lu.perm_c):  # pragma: no cover - SPD keeps the diagonal
-        return _fail(p, "the normal equations are not positive definite (pivoting needed)")
+    if not np.array_equal(lu.perm_r, lu.perm_c):  # SPD keeps the diagonal: nearly singular
+        weak = _zero_pivot(Ns, rcond)  # (rounding made it indefinite: seen on an AMD EPYC)
+        return _fail(
+            p,
+            "the normal equations are singular (not positive definite in rounding)",
+            int(keep[weak]) if weak >= 0 else -1,
+        )
     D = lu.U.diagonal().copy()
     if not (np.all(np.isfinite(D)) and D.min(initial=1.0) > rcond):
         return _fail(

@@ -142,8 +142,9 @@ def _spots(path: Path) -> list[tuple[Path, str]]:
     """``(directory, key)`` of each run record that may cover the table ``path``: its own
     directory's, and for a sweep's cell (``cells/<label>/x.parquet``) the sweep's."""
     spots = [(path.parent, path.name)]
-    if path.parent.parent.name == "cells":
-        spots.append((path.parent.parent.parent, f"cells/{path.parent.name}/{path.name}"))
+    cell = Path(os.path.abspath(path)).parent  # a relative path ("./x.parquet") has no parents
+    if cell.parent.name == "cells":
+        spots.append((path.parent / ".." / "..", f"cells/{cell.name}/{path.name}"))
     return spots
 
 
