@@ -180,13 +180,17 @@ test: $(STAMP) ## lint (ruff), the layer contracts (import-linter), then the tes
 	$(VENV)/bin/lint-imports
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder
 
+# The tests marked long (tests/conftest.py: many seconds each, a faster test of the same class
+# runs in make test) are skipped by make test and run here, after the fuzz.
 # FUZZ_CASES and FUZZ_SEED are whole numbers (FUZZ_CASES=0 or -1 fuzzed nothing and passed;
 # FUZZ_CASES=abc was a pytest collection error)
-fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=300, FUZZ_SEED, FUZZ_SAVE)
+fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=300, FUZZ_SEED, FUZZ_SAVE), then the tests marked long
 	@case "$${FUZZ_CASES:-300}" in *[!0-9]*) false;; *) test "$${FUZZ_CASES:-300}" -ge 1;; esac || \
 	  { echo "make fuzz: FUZZ_CASES must be a whole number of at least 1 (got '$${FUZZ_CASES}')" >&2; exit 2; }
 	@case "$${FUZZ_SEED:-13}" in *[!0-9]*) echo "make fuzz: FUZZ_SEED must be a whole number (got '$${FUZZ_SEED}')" >&2; exit 2;; esac
 	FUZZ_CASES=$${FUZZ_CASES:-300} $(PY) -m pytest tests/test_fuzz.py -p no:cacheprovider
+	$(if $(filter auto logical,$(TEST_WORKERS)),,$(call whole,TEST_WORKERS,0))
+	SIM_LONG_TESTS=1 $(PY) -m pytest -m long -n $(TEST_WORKERS) --dist loadfile -p no:cacheprovider
 
 # Mutation testing of the verdict rules and interval methods ([tool.mutmut] in pyproject.toml);
 # not part of `make test`: about 10-20 minutes on 2 cores. Writes docs/mutation.md.

@@ -103,11 +103,30 @@ SLOW_FIRST = {
 }
 
 
+#: ``SIM_LONG_TESTS=1`` (``make fuzz`` sets it) runs the tests marked ``long``: hostile-input
+#: cases of many seconds each (a file-size limit hit mid-run, a Dask cluster signalled while it
+#: starts, grids of thousands of points) whose class a faster test of ``make test`` also guards.
+#: Without it they are skipped, naming ``make fuzz``, so that ``make test`` stays in its budget.
+LONG_TESTS = os.environ.get("SIM_LONG_TESTS", "") not in ("", "0")
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "long: a slow hostile-input test, run by make fuzz (SIM_LONG_TESTS=1)"
+    )
+
+
 def pytest_collection_modifyitems(config, items):
     """The slowest files first (SLOW_FIRST), the others after them in their usual order; the
-    tests of a file keep their order. Deterministic, so every xdist worker collects the same."""
+    tests of a file keep their order. Deterministic, so every xdist worker collects the same.
+    Tests marked ``long`` are skipped unless ``SIM_LONG_TESTS=1`` (:data:`LONG_TESTS`)."""
     rank = {f: i for i, f in enumerate(sorted(SLOW_FIRST, key=lambda f: -SLOW_FIRST[f]))}
     items.sort(key=lambda it: rank.get(it.path.name, len(rank)))
+    if not LONG_TESTS:
+        skip = pytest.mark.skip(reason="long: make fuzz runs it (SIM_LONG_TESTS=1)")
+        for it in items:
+            if it.get_closest_marker("long"):
+                it.add_marker(skip)
 
 
 ROOT = Path(__file__).resolve().parent.parent
