@@ -1,0 +1,35 @@
+"""Issue 26, helper U48: a new user's first hour, the design trade-off workflow (an
+instrument designer copies a study, changes the instrument, sweeps a key, compares two
+designs and reads the figures and README.md). Each test names the class of input and what
+was wrong before."""
+
+from __future__ import annotations
+
+from sim.mc.storage import write_table
+from sim.report.sweep import fig_sweep
+
+
+def _generate(sigma: float) -> list[dict]:
+    return [{"kind": k, "from": "G13", "to": "G*", "sigma_mm": sigma} for k in ("dx", "dy")]
+
+
+def test_sweep_png_legend_tells_apart_lists_that_differ_past_their_start(tmp_path, monkeypatch):
+    """Silent nonsense in a figure: a sweep whose second key is a list of tables differing
+    only in a sigma (`"network.generate" = [[{kind = "dx", ..., sigma_mm = 0.002}, ...],
+    [... 0.001 ...]]`, the designer's "compare two instruments") drew two series both named
+    ``generate=[{'kind': 'dx',...`` in every panel's legend: which line was which design
+    could not be read. Each series is named by what tells it apart now."""
+    n = 4
+    cols = {"cell": list(range(n)), "replicate": [0] * n, "label": list("abcd")}
+    cols.update(seed=list(range(n)), feasible=[True] * n, reason=[""] * n)
+    cols["network.constant_mm"] = [0.0, 0.0, 1.0, 1.0]
+    cols["network.generate"] = [str(_generate(0.002)), str(_generate(0.001))] * 2  # as stored
+    cols.update({"v_mm": [1.0] * n, "v_mm:lo": [0.9] * n, "v_mm:hi": [1.1] * n})
+    keys = ["network.constant_mm", "network.generate"]
+    write_table(tmp_path / "sweep.parquet", cols, {"study": "network", "sweep_keys": keys})
+    figs = []
+    monkeypatch.setattr("sim.report.sweep.save", lambda fig, png: figs.append(fig))
+    fig_sweep(tmp_path / "sweep.parquet", tmp_path / "sweep.png")
+    labels = [t.get_text() for t in figs[0].axes[0].get_legend().get_texts()]
+    assert len(labels) == 2 and len(set(labels)) == 2, labels
+    assert "0.002" in labels[0] and "0.001" in labels[1], labels
