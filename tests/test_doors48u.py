@@ -5,6 +5,12 @@ was wrong before."""
 
 from __future__ import annotations
 
+import pytest
+from oneline import one_line
+
+import sim
+from sim.cli import main
+from sim.mc.config import ConfigError
 from sim.mc.storage import write_table
 from sim.report.sweep import fig_sweep
 
@@ -33,3 +39,37 @@ def test_sweep_png_legend_tells_apart_lists_that_differ_past_their_start(tmp_pat
     labels = [t.get_text() for t in figs[0].axes[0].get_legend().get_texts()]
     assert len(labels) == 2 and len(set(labels)) == 2, labels
     assert "0.002" in labels[0] and "0.001" in labels[1], labels
+
+
+_SWEPT_ITEM = """\
+study = "network"
+trials = 40
+chunk = 2
+[network]
+grids = [ { prefix = "G", nx = 3, ny = 3, spacing_mm = 40.0, role = "observed", sigma_mm = 0.0012 } ]
+generate = [ { kind = "dx", from = "G5", to = "G*", sigma_mm = 0.002 } ]
+[sweep]
+KEY = [40.0, 60.0]
+"""
+
+
+@pytest.mark.parametrize("key", ['"network.grids[0].spacing_mm"', '"network.grids.spacing_mm"'])
+def test_a_swept_field_of_a_list_item_says_to_sweep_the_whole_list(tmp_path, key):
+    """Unclear message: a designer sweeping the plate's spacing wrote the field of the grid
+    in the `[sweep]` table (`"network.grids[0].spacing_mm" = [40.0, 60.0]`, or without the
+    index) and got "sweep.network.grids[0].spacing_mm: unknown key" alone, from `sim check`,
+    `sim run` and `sim.load` (the `--set` door said what to do, the sweep did not). The line
+    now says the list is swept whole, one list a cell."""
+    f = tmp_path / "swept.toml"
+    f.write_text(_SWEPT_ITEM.replace("KEY", key))
+    with pytest.raises(ConfigError) as e:
+        sim.load(f)
+    assert e.value.key == f"sweep.{key.strip(chr(34))}"
+    assert 'sweep the whole list, one list a cell: "network.grids" = [[...], [...]]' in str(e.value)
+
+
+def test_set_of_a_list_items_field_without_index_names_the_list(tmp_path, capsys):
+    """Unclear message: `--set network.grids.spacing_mm=60` (a grid's field, no index) was
+    "unknown key" alone, where `network.grids[0].spacing_mm` said to give the whole list."""
+    rc = main(["check", "studies/network_plate.toml", "--set", "network.grids.spacing_mm=60"])
+    one_line(capsys, rc, "network.grids.spacing_mm: unknown key", "--set 'network.grids=[...]'")
