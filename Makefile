@@ -157,6 +157,8 @@ $(STAMP): $(PYPROJECT_DEP) $(if $(VENV_USABLE),,venv-unusable) $(if $(venv_lacks
 	$(if $(venv_lacks),@printf 'make: %s: installing the project again\n' $(call q,$(venv_lacks)))
 	@test -d $(VENV) || ! { test -e $(VENV) || test -L $(VENV); } || { printf 'make: %s is %s, not a virtual environment: %s\n' \
 	  $(VENV) 'not a directory (a file, or a link to nothing)' 'remove or rename it, then make venv' >&2; exit 2; }
+	@$(if $(VENV_USABLE),:,test ! -L $(VENV)) || { printf 'make: %s is a link to %s, %s: it is not made again through the link (venv --clear would empty it there); remove the link, then make venv\n' \
+	  $(VENV) "$$(readlink -f $(VENV))" $(call q,$(if $(and $(MADE_IN),$(subst $(CURDIR),,$(MADE_IN))),a virtual environment made for $(MADE_IN),not a usable virtual environment here)) >&2; exit 2; }
 	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
 	@$(call locked,"$$@" > $(INSTALLING) 2>&1,skip) $(call q,$(PYTHON)) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) || { rc=$$?; \
 	  test $$rc -gt 128 && exit $$rc; printf 'make: PYTHON (%s) could not make $(VENV): %s\n' $(call q,$(PYTHON)) \

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import pytest
 from oneline import one_line
+from test_doors37k import run_make, venv_project
 
 import sim
 from sim.cli import main
@@ -73,3 +74,25 @@ def test_set_of_a_list_items_field_without_index_names_the_list(tmp_path, capsys
     "unknown key" alone, where `network.grids[0].spacing_mm` said to give the whole list."""
     rc = main(["check", "studies/network_plate.toml", "--set", "network.grids.spacing_mm=60"])
     one_line(capsys, rc, "network.grids.spacing_mm: unknown key", "--set 'network.grids=[...]'")
+
+
+def test_make_leaves_a_linked_venv_of_another_directory_alone(tmp_path):
+    """Deleting what the suite did not write: a project whose `.venv` is a link to another
+    checkout's virtual environment (`ln -s ../main/.venv .venv`, a worktree sharing one
+    install) made it again through the link at any `make` target: its stamp names the other
+    directory, so `python -m venv --clear .venv` ran and emptied the other checkout's
+    environment (it happened here: the shared /work/main/.venv was emptied by a `make test` in
+    a worktree). The link is named, left alone, exit 2; nothing is cleared or installed."""
+    d = venv_project(tmp_path, ["numpy"])
+    theirs = tmp_path / "main" / ".venv"
+    theirs.parent.mkdir()
+    (d / ".venv").rename(theirs)
+    (theirs / ".installed").write_text(f"{tmp_path / 'main'}\n1-2\n", encoding="utf-8")
+    (d / ".venv").symlink_to(theirs)
+    p = run_make(d, "test")
+    err = p.stderr.splitlines()
+    assert p.returncode == 2 and len(err) == 2 and "Traceback" not in p.stderr, p.stderr
+    assert err[0].startswith(f"make: .venv is a link to {theirs}, a virtual environment made for")
+    assert "remove the link, then make venv" in err[0], err
+    assert not (tmp_path / "calls.log").exists()  # no venv --clear, no pip
+    assert (theirs / ".installed").exists() and (d / ".venv").is_symlink()
