@@ -251,3 +251,13 @@ bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 a
 
 clean: ## remove the virtual environment and caches (results/ is kept)
 	rm -rf $(VENV) $(VENV).installing $(VENV).lock .pytest_cache sim.egg-info mutants
+
+# A target the Makefile does not have (`make tset`, `make verfiy`, `make reproduce-n`) was make's
+# "No rule to make target 'tset'.  Stop.", naming none it has: one line listing them, exit 2.
+# A missing file another target needs (pyproject.toml) is named as missing. The phony steps of
+# the install have empty rules, or this recipe would run for them.
+venv-unusable pyproject-changed venv-incomplete: ;
+.DEFAULT:
+	@$(if $(filter $@,$(MAKECMDGOALS)),printf 'make: %s is not a target of this Makefile (its targets: %s; make help says what each does)\n' \
+	  $(call q,$@) $(call q,$(shell sed -nE 's/^([a-z]+):.*## .*/\1/p' $(firstword $(MAKEFILE_LIST)) | tr '\n' ' ' | sed 's/ $$//')), \
+	  printf 'make: %s is missing (make %s needs it)\n' $(call q,$@) $(call q,$(or $(MAKECMDGOALS),help))) >&2; exit 2

@@ -96,3 +96,16 @@ def test_make_leaves_a_linked_venv_of_another_directory_alone(tmp_path):
     assert "remove the link, then make venv" in err[0], err
     assert not (tmp_path / "calls.log").exists()  # no venv --clear, no pip
     assert (theirs / ".installed").exists() and (d / ".venv").is_symlink()
+
+
+def test_a_mistyped_make_target_lists_the_targets(tmp_path):
+    """Unclear message: `make tset` (or `make verfiy`, `make reproduce-n` for `-n`) was make's
+    "No rule to make target 'tset'.  Stop.", naming no target the Makefile has. One line
+    now lists them (exit 2), and nothing is installed or run."""
+    d = venv_project(tmp_path, ["numpy"])
+    p = run_make(d, "tset")
+    err = p.stderr.splitlines()
+    assert p.returncode == 2 and "No rule" not in p.stderr, p.stderr
+    assert err[0].startswith("make: tset is not a target of this Makefile (its targets: help venv")
+    assert " verify " in err[0] and "make help says what each does" in err[0], err
+    assert not (tmp_path / "calls.log").exists()
