@@ -5,6 +5,7 @@ was wrong before."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from oneline import one_line
 from test_doors37k import run_make, venv_project
@@ -13,7 +14,11 @@ import sim
 from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.mc.storage import write_table
+from sim.report.plotting import layout_problems
 from sim.report.sweep import fig_sweep
+from sim.studies.design import claims as design_claims
+from sim.studies.design import figures as design_figures
+from sim.studies.design.errbudget import BUDGET_ROWS
 
 
 def _generate(sigma: float) -> list[dict]:
@@ -109,3 +114,40 @@ def test_a_mistyped_make_target_lists_the_targets(tmp_path):
     assert err[0].startswith("make: tset is not a target of this Makefile (its targets: help venv")
     assert " verify " in err[0] and "make help says what each does" in err[0], err
     assert not (tmp_path / "calls.log").exists()
+
+
+def _budget_rows() -> dict:
+    """brown_design's budget table, every source at 0.5 um but the wobble's first harmonic at
+    its committed 3.13e-5 um (standard error 2.76e-7 um)."""
+    src = [n for n, _, _, _ in BUDGET_ROWS]
+    tiny = [s == "wobble_3kg_h1" for s in src]
+    return {
+        "source": src,
+        "description": [d for _, _, _, d in BUDGET_ROWS],
+        "rms_um": [3.13e-5 if t else 0.5 for t in tiny],
+        "se_um": [2.76e-7 if t else 0.0045 for t in tiny],
+        "trials": [1000] * len(src),
+        "settings": [False] * len(src),
+    }
+
+
+def test_the_error_budget_says_a_tiny_source_and_its_standard_error(monkeypatch):
+    """Silent nonsense in the designer's "which error sources matter": brown_design's budget
+    of a source of 3e-5 um (the pivot wobble as a first harmonic) was an empty row in
+    `budget.png` (no bar at that scale, read as a source left out) and its claim's note said
+    "to a standard error of 0.0000 um". Each row's label says its value now, and the note
+    the standard error in significant digits."""
+    b = _budget_rows()
+    figs = []
+    monkeypatch.setattr(design_figures, "save", lambda fig, path: figs.append(fig))
+    design_figures.fig_budget(b, None, 1.3)
+    ticks = [t.get_text() for t in figs[0].axes[0].get_yticklabels()]
+    assert any(t.startswith("wobble_3kg_h1 (") and t.endswith(": 3.13×10⁻⁵ µm") for t in ticks)
+    assert layout_problems(figs[0]) == []
+    R = {
+        "budget": b,
+        "external": {"table1_rms": np.array([1.2, 1.3])},
+        "budget_sims": {"production": {"s0_um": np.linspace(1, 2, 50), "ok": np.ones(50, bool)}},
+    }
+    note = design_claims._budget(R)["brown.budget.wobble_3kg_h1_um"].note
+    assert "to a standard error of 2.8e-07 um" in note, note
