@@ -17,7 +17,7 @@ from sim.cli import main
 from sim.mc.config import ConfigError
 from sim.mc.storage import write_table
 from sim.report.plotting import layout_problems
-from sim.report.sweep import fig_sweep
+from sim.report.sweep import fig_sweep, sweep_markdown
 from sim.studies.design import claims as design_claims
 from sim.studies.design import figures as design_figures
 from sim.studies.design.errbudget import BUDGET_ROWS
@@ -171,3 +171,22 @@ def test_the_largest_point_sigma_gives_the_monte_carlo_of_that_coordinate():
     assert design["sigma_max"] == (2.0, 2.1, 1.05, 4.2)
     (find,) = [f for f in network_claims._findings(design) if f[0].endswith("sigma_max_mm")]
     assert find[2] == 2.0 and find[3].endswith("Monte Carlo of that coordinate 2.1 mm [1.05, 4.2]")
+
+
+def test_a_sweeps_table_gives_each_claims_interval(tmp_path):
+    """A number without its interval: the table of a sweep's README.md gave each cell's
+    self-check as its value alone (`network.global_test.false_alarm` 0.0650 in one cell,
+    0.0850 in the next: a designer compared two noisy numbers whose 95 % intervals, [0.038,
+    0.11] and [0.054, 0.13], overlap). A claim with a 95 % interval gives it; an exact one
+    stays a value."""
+    cols = {"cell": [0, 1], "replicate": [0, 0], "label": ["c0", "c1"], "seed": [1, 2]}
+    cols.update(feasible=[True, True], reason=["", ""], x_mm=[40.0, 60.0])
+    cols.update({"a.rate": [0.065, 0.085], "a.rate:lo": [0.0384, 0.0537]})
+    cols.update({"a.rate:hi": [0.108, 0.132], "b_mm": [0.00104] * 2, "b_mm:lo": [0.00104] * 2})
+    cols["b_mm:hi"] = [0.00104] * 2
+    prov = {"study": "network", "sweep_keys": ["x_mm"]}
+    prov["claim_intervals"] = {"a.rate": ["ci"], "b_mm": ["exact"]}
+    write_table(tmp_path / "sweep.parquet", cols, prov)
+    text = sweep_markdown(tmp_path)
+    assert "| 0.0650 [0.0384, 0.108] | 0.00104 |" in text, text
+    assert "| 0.0850 [0.0537, 0.132] | 0.00104 |" in text, text

@@ -285,8 +285,12 @@ def _value_cell(t: dict, claim: str, i: int, kinds) -> str:
     """A claim's value in cell ``i``: a region row's (every cell's interval kind ``region``)
     is its range over the region, ``0.12–0.92`` as the cell's own README gives it (the
     table gave the range's low end alone, 0.120 in every cell of a sweep of an input the
-    region explores, as if it were the value)."""
+    region explores, as if it were the value); a claim with a 95 % interval in every cell
+    (``ci``) is its value with it, ``1.01 [0.994, 1.02]``, as the cell's own README gives it
+    (the value alone: a self-check's 0.065 read without its [0.038, 0.11])."""
     lo, hi = t[claim][i], t[claim + ":hi"][i]
+    if list(kinds or ()) == ["ci"] and "" not in (fmt(lo), fmt(hi), fmt(t[claim + ":lo"][i])):
+        return f"{fmt(lo)} [{fmt(t[claim + ':lo'][i])}, {fmt(hi)}]"  # (the value alone before)
     if list(kinds or ()) != ["region"] or fmt(hi) in ("", fmt(lo)) or fmt(lo) == "":
         return fmt(lo)
     return f"{fmt(lo)}–{fmt(hi)}"
