@@ -210,9 +210,11 @@ mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (s
 # The batch rebuilds the report (--report), after a failed or interrupted batch too when a run
 # published: make stopped before `sim report` when one study's run failed or was killed, and
 # REPORT.md kept the old claims of the studies that had published (sim/batch_report.py).
-RUN_JOBS ?= 2
+# make's own -jN (`make -j4 reproduce`) ran 2 studies at a time without a word: it is how many
+# run at a time when RUN_JOBS is not given (RUN_JOBS=N wins; -j without a number keeps 2)
+RUN_JOBS ?= $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),2)
 
-reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, each with RUN_FLAGS="--workers 1": sim run options)
+reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, or make -jN's N, each with RUN_FLAGS="--workers 1": sim run options)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
 	$(PY) -m sim.batch --stale-only --report --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)

@@ -190,3 +190,20 @@ def test_a_sweeps_table_gives_each_claims_interval(tmp_path):
     text = sweep_markdown(tmp_path)
     assert "| 0.0650 [0.0384, 0.108] | 0.00104 |" in text, text
     assert "| 0.0850 [0.0537, 0.132] | 0.00104 |" in text, text
+
+
+def test_make_jn_reproduce_runs_n_studies_at_a_time(tmp_path):
+    """Silent nonsense: `make -j4 reproduce` (make's usual way to ask for four at once) ran
+    two studies at a time without a word (RUN_JOBS's default). make's -jN is RUN_JOBS's
+    default now; RUN_JOBS given wins, and -j without a number keeps 2 (printed by -n: nothing
+    runs)."""
+    d = venv_project(tmp_path, ["numpy"])
+    for args, jobs in (
+        (["-j4"], "4"),
+        (["-j4", "RUN_JOBS=3"], "3"),
+        (["-j"], "2"),
+        ([], "2"),
+    ):
+        p = run_make(d, "-n", *args, "reproduce")
+        assert f"-m sim.batch --stale-only --report --jobs {jobs} " in p.stdout, (args, p.stdout)
+    assert not (tmp_path / "calls.log").exists()
