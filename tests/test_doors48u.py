@@ -5,6 +5,7 @@ was wrong before."""
 
 from __future__ import annotations
 
+import shutil
 from types import SimpleNamespace
 
 import numpy as np
@@ -207,3 +208,17 @@ def test_make_jn_reproduce_runs_n_studies_at_a_time(tmp_path):
         p = run_make(d, "-n", *args, "reproduce")
         assert f"-m sim.batch --stale-only --report --jobs {jobs} " in p.stdout, (args, p.stdout)
     assert not (tmp_path / "calls.log").exists()
+
+
+def test_report_of_two_designs_alone_has_no_empty_table(tmp_path, tiny_run, capsys):
+    """Silent nonsense: `sim report --results DIR` over two network designs of one's own (no
+    paper study) opened with "The verdicts at a glance" as a table header without a row.
+    The table is left out when no paper's study is there; the designs' line stays."""
+    results = tmp_path / "results"
+    for name in ("design_a", "design_b"):
+        shutil.copytree(tiny_run("network_plate"), results / name)
+    assert main(["report", "--results", str(results)]) == 0
+    text = (results / "REPORT.md").read_text(encoding="utf-8")
+    glance = text.split("## The verdicts at a glance", 1)[1].split("\n## ", 1)[0]
+    assert "| paper (studies) |" not in glance and "|---|" not in glance, glance
+    assert "[design_a](design_a/README.md)" in glance and "design_b" in glance, glance
