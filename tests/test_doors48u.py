@@ -222,3 +222,17 @@ def test_report_of_two_designs_alone_has_no_empty_table(tmp_path, tiny_run, caps
     glance = text.split("## The verdicts at a glance", 1)[1].split("\n## ", 1)[0]
     assert "| paper (studies) |" not in glance and "|---|" not in glance, glance
     assert "[design_a](design_a/README.md)" in glance and "design_b" in glance, glance
+
+
+def test_a_run_off_the_papers_setup_says_it_in_a_sentence(capsys):
+    """Unclear message: a designer's Brown plate of 4 x 4 (`--set plate.grid=4`) was told
+    "its predictions are findings, but the 5 it decides on the paper's own setup, which stay
+    the paper's verdicts": a clause without its verb, which left unclear what the 5 are. It
+    says which stay the paper's verdicts, and why, in a sentence now."""
+    assert main(["check", "studies/brown_table1.toml", "--set", "plate.grid=4"]) == 0
+    line = capsys.readouterr().out.splitlines()[-2]
+    assert line == (
+        "# off the paper's setup (plate.grid = 4 (paper: 5)): its predictions will be findings,"
+        " except the 5 it decides on the paper's own setup whatever the run's: those stay the"
+        " paper's verdicts"
+    ), line
