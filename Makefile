@@ -157,6 +157,8 @@ $(STAMP): $(PYPROJECT_DEP) $(if $(VENV_USABLE),,venv-unusable) $(if $(venv_lacks
 	$(if $(venv_lacks),@printf 'make: %s: installing the project again\n' $(call q,$(venv_lacks)))
 	@test -d $(VENV) || ! { test -e $(VENV) || test -L $(VENV); } || { printf 'make: %s is %s, not a virtual environment: %s\n' \
 	  $(VENV) 'not a directory (a file, or a link to nothing)' 'remove or rename it, then make venv' >&2; exit 2; }
+	@$(if $(VENV_USABLE),:,test ! -L $(VENV)) || { printf 'make: %s is a link to %s, %s: it is not made again through the link (venv --clear would empty it there); remove the link, then make venv\n' \
+	  $(VENV) "$$(readlink -f $(VENV))" $(call q,$(if $(and $(MADE_IN),$(subst $(CURDIR),,$(MADE_IN))),a virtual environment made for $(MADE_IN),not a usable virtual environment here)) >&2; exit 2; }
 	@echo "making $(VENV) and installing the project and its libraries (pip; its output goes to $(PIP_LOG))"
 	@$(call locked,"$$@" > $(INSTALLING) 2>&1,skip) $(call q,$(PYTHON)) -m venv $(if $(VENV_USABLE),,--clear) $(VENV) || { rc=$$?; \
 	  test $$rc -gt 128 && exit $$rc; printf 'make: PYTHON (%s) could not make $(VENV): %s\n' $(call q,$(PYTHON)) \
@@ -212,9 +214,11 @@ mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (s
 # The batch rebuilds the report (--report), after a failed or interrupted batch too when a run
 # published: make stopped before `sim report` when one study's run failed or was killed, and
 # REPORT.md kept the old claims of the studies that had published (sim/batch_report.py).
-RUN_JOBS ?= 2
+# make's own -jN (`make -j4 reproduce`) ran 2 studies at a time without a word: it is how many
+# run at a time when RUN_JOBS is not given (RUN_JOBS=N wins; -j without a number keeps 2)
+RUN_JOBS ?= $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),2)
 
-reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, each with RUN_FLAGS="--workers 1": sim run options)
+reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, or make -jN's N, each with RUN_FLAGS="--workers 1": sim run options)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
 	$(PY) -m sim.batch --stale-only --report --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)
@@ -253,3 +257,13 @@ bench: $(STAMP) ## time the solvers against SciPy loops, and make rerun with 1 a
 
 clean: ## remove the virtual environment and caches (results/ is kept)
 	rm -rf $(VENV) $(VENV).installing $(VENV).lock .pytest_cache sim.egg-info mutants
+
+# A target the Makefile does not have (`make tset`, `make verfiy`, `make reproduce-n`) was make's
+# "No rule to make target 'tset'.  Stop.", naming none it has: one line listing them, exit 2.
+# A missing file another target needs (pyproject.toml) is named as missing. The phony steps of
+# the install have empty rules, or this recipe would run for them.
+venv-unusable pyproject-changed venv-incomplete: ;
+.DEFAULT:
+	@$(if $(filter $@,$(MAKECMDGOALS)),printf 'make: %s is not a target of this Makefile (its targets: %s; make help says what each does)\n' \
+	  $(call q,$@) $(call q,$(shell sed -nE 's/^([a-z]+):.*## .*/\1/p' $(firstword $(MAKEFILE_LIST)) | tr '\n' ' ' | sed 's/ $$//')), \
+	  printf 'make: %s is missing (make %s needs it)\n' $(call q,$@) $(call q,$(or $(MAKECMDGOALS),help))) >&2; exit 2

@@ -147,7 +147,8 @@ def test_a_sweeps_table_gives_a_region_rows_range(tmp_path):
     }
     write_table(tmp_path / "sweep.parquet", cols, prov)
     text = sweep_markdown(tmp_path)
-    assert "| 0.120–0.920 | 1.64 |" in text and "| 0.0400–0.920 | 1.65 |" in text, text
+    assert "| 0.120–0.920 | 1.64 [1.60, 1.70] |" in text, text  # (U48: with its interval)
+    assert "| 0.0400–0.920 | 1.65 [1.61, 1.71] |" in text, text
 
 
 def test_a_sweeps_doors_say_which_cells_are_off_the_papers_setup(tmp_path):

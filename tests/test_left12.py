@@ -242,7 +242,8 @@ def test_sim_check_says_which_predictions_stay_the_papers(capsys):
     assert main(["check", study, "--set", "plate.spacing_mm=30"]) == 0
     assert capsys.readouterr().out.splitlines()[-2] == (
         "# off the paper's setup (plate.spacing_mm = 30 (paper: 45)): its predictions will be "
-        "findings, but the 5 it decides on the paper's own setup, which stay the paper's verdicts"
+        "findings, except the 5 it decides on the paper's own setup whatever the run's: those "
+        "stay the paper's verdicts"
     )
     study = str(ROOT / "studies" / "gridplate_two_plates.toml")
     assert main(["check", study, "--set", "plate.count=1"]) == 0

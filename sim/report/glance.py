@@ -207,7 +207,9 @@ def opening(entries: list[tuple], results: Path) -> str:
     table = md_table(
         ["paper (studies)", "verdicts", "headline claims", "simulated [95%]", "verdict"], rows
     )
-    return "\n".join(["## The verdicts at a glance", "", table, "", *variants, *notes, ""])
+    # network studies alone (two designs of one's own): the table was its header, no row
+    table = [table, ""] if rows else []
+    return "\n".join(["## The verdicts at a glance", "", *table, *variants, *notes, ""])
 
 
 def design_notes(entries: list[tuple], results: Path, design: Callable | None) -> list[str]:

@@ -19,13 +19,16 @@ def off_setup(study, cfg: dict, before: bool = False) -> str:
     """``off the paper's setup (key = value (paper: default), ...): its predictions are
     findings ...`` for a config whose printed inputs are not the paper's (``sim check`` says
     it before the run, ``before``: "will be"; a run's README.md at its top: it said so only
-    in its claims' notes), else ``""``."""
+    in its claims' notes), else ``""``. The predictions decided on the paper's setup were
+    named in a clause without its verb ("findings, but the 5 it decides on the paper's own
+    setup, which stay the paper's verdicts")."""
     off = printed_differs(study.schema, cfg, study.as_printed)
     if not off:
         return ""
     kept = len(study.paper_design)
     but = (
-        f", but the {kept} it decides on the paper's own setup, which stay the paper's verdicts"
+        f", except the {kept} it decides on the paper's own setup whatever the run's: those "
+        "stay the paper's verdicts"
         if kept
         else ""
     )

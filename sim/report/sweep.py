@@ -95,6 +95,15 @@ def _column(t: dict, name: str) -> np.ndarray:
     return np.array([np.nan if a is None else a for a in t[name]], float)
 
 
+def _legend_values(values, n: int = 16) -> dict:
+    """:func:`_value_texts` in at most ``n`` characters that tell the values apart
+    (:func:`sim.report.labels.apart`): a swept ``network.generate`` whose lists differ only
+    in a sigma was cut at its start, and both series of ``sweep.png`` read
+    ``generate=[{'kind': 'dx',...``."""
+    texts = _value_texts(values)
+    return dict(zip(texts, apart(list(texts.values()), n)))
+
+
 def _short(text: str, n: int = 40) -> str:
     """A legend or tick label of at most ``n`` characters (a list-valued key's values would
     crowd the axes out of the figure)."""
@@ -172,7 +181,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         xlabel += f" - {rep.max() + 1} replicates, a line each"
     empty: list = []  # panels of a claim without a finite value
     names = _legend_names(keys[1:])
-    shown = [_value_texts(t[k]) for k in keys[1:]]
+    shown = [_legend_values(t[k]) for k in keys[1:]]
     for ax, c in zip(axs.ravel(), claims):
         v, lo, hi = _column(t, c), _column(t, c + ":lo"), _column(t, c + ":hi")
         prop = _is_proportion(c, v)
@@ -181,7 +190,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
         for (n, grp), r in itertools.product(enumerate(dict.fromkeys(other)), np.unique(rep)):
             sel = np.array([o == grp for o in other]) & feas & (rep == r)
             o = np.argsort(x[sel], kind="stable")
-            lab = ", ".join(f"{k}={_short(s[repr(g)], 16)}" for k, g, s in zip(names, grp, shown))
+            lab = ", ".join(f"{k}={s[repr(g)]}" for k, g, s in zip(names, grp, shown))
             ax.errorbar(
                 x[sel][o],
                 v[sel][o],
@@ -276,8 +285,12 @@ def _value_cell(t: dict, claim: str, i: int, kinds) -> str:
     """A claim's value in cell ``i``: a region row's (every cell's interval kind ``region``)
     is its range over the region, ``0.12–0.92`` as the cell's own README gives it (the
     table gave the range's low end alone, 0.120 in every cell of a sweep of an input the
-    region explores, as if it were the value)."""
+    region explores, as if it were the value); a claim with a 95 % interval in every cell
+    (``ci``) is its value with it, ``1.01 [0.994, 1.02]``, as the cell's own README gives it
+    (the value alone: a self-check's 0.065 read without its [0.038, 0.11])."""
     lo, hi = t[claim][i], t[claim + ":hi"][i]
+    if list(kinds or ()) == ["ci"] and "" not in (fmt(lo), fmt(hi), fmt(t[claim + ":lo"][i])):
+        return f"{fmt(lo)} [{fmt(t[claim + ':lo'][i])}, {fmt(hi)}]"  # (the value alone before)
     if list(kinds or ()) != ["region"] or fmt(hi) in ("", fmt(lo)) or fmt(lo) == "":
         return fmt(lo)
     return f"{fmt(lo)}–{fmt(hi)}"

@@ -175,7 +175,7 @@ def _budget(R: dict) -> dict[str, Sim]:
             se,
             f"rms coordinate error after a rigid fit, this source alone "
             f"({desc[name]}); {n} trials (adaptive) to a standard error of "
-            f"{se:.4f} um; setting error alone: {B['setting'][0]:.3f} um",
+            f"{se:.2g} um; setting error alone: {B['setting'][0]:.3f} um",
         )
     r, se, n = B["table1_model"]
     lin = float(np.sqrt(np.mean(R["external"]["table1_rms"] ** 2)))

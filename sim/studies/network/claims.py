@@ -28,12 +28,13 @@ def design_figures(net, an, a95_mm: np.ndarray, dil: np.ndarray, est: McEstimate
     """The design figures the findings report: largest point sigma (analytic, Monte Carlo),
     largest 95 % semi-axis ``a95_mm``, smallest redundancy number, the MDBs of the length
     observations, the dilutions ``dil`` (%), the rms point sigma."""
-    an_sig, s_mc = est.an_sig, est.s_mc
+    an_sig = est.an_sig
+    # the Monte Carlo of the coordinate with the largest analytic sigma, with its interval:
+    # the largest of the Monte-Carlo sigmas (0.00119 mm of a 5 x 5 plate at 0.00104 mm
+    # analytic, 200 trials) is raised by their noise, read as the Monte Carlo 15 % worse
+    worst = int(np.argmax(an_sig))
     return {
-        "sigma_max": (
-            float(np.max(np.maximum(an_sig[0::2], an_sig[1::2]))),
-            float(np.max(np.maximum(s_mc[0::2], s_mc[1::2]))),
-        ),
+        "sigma_max": tuple(float(a[worst]) for a in (an_sig, est.s_mc, est.s_lo, est.s_hi)),
         "a95_max": float(np.max(a95_mm)),
         "dilution_max": dil,
         "r_min": float(an.redundancy.min()),
@@ -90,7 +91,9 @@ def _findings(design: dict) -> list[tuple[str, str, float, str]]:
             "network.design.sigma_max_mm",
             "largest point sigma (x or y), mm",
             design["sigma_max"][0],
-            f"analytic; Monte Carlo {design['sigma_max'][1]:.4g} mm",
+            "analytic; Monte Carlo of that coordinate {1:.4g} mm [{2:.4g}, {3:.4g}]".format(
+                *design["sigma_max"]
+            ),
         ),
         (
             "network.design.sigma_rms_mm",
