@@ -310,6 +310,11 @@ def _unknown_sets(files: list[Path], run_args: list[str]) -> tuple[str | None, s
     return None, "; ".join(notes) or None
 
 
+#: the most bytes an earlier ``--timings`` file is read (one short list a study: a batch of
+#: every study writes under 2 kB); a larger file is not one, and is not read
+TIMINGS_BYTES = 1 << 20
+
+
 def _timings_problem(path: str) -> str | None:
     """Why the timings cannot be written to ``path`` (checked before anything runs): its
     directory must be writable, and an existing file must be an earlier timings file (a
@@ -327,6 +332,8 @@ def _timings_problem(path: str) -> str | None:
         return f"{p} exists and is not a regular file"
     if p.exists():
         try:
+            if p.stat().st_size > TIMINGS_BYTES:  # never read whole: a disk image named by
+                raise ValueError  # mistake was read into memory (MemoryError, a traceback)
             old = json.loads(p.read_bytes())  # as JSON reads: a signature (Notepad's) skipped
             ours = isinstance(old, dict) and all(isinstance(v, list) for v in old.values())
         except (OSError, ValueError):

@@ -25,7 +25,7 @@ from sim.mc.storage import umask_problem
 from sim.mc.unfinished import unfinished, unfinished_in
 from sim.places import base, shown_path
 from sim.report.markdown import write_report
-from sim.report.read import check_claims_table, mixed_run
+from sim.report.read import check_claims_table, check_sweep_record, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
 from sim.report_due import clear_due
 from sim.stale import other_code, stale_dirs
@@ -126,6 +126,7 @@ def _shown_text(d: Path, markdown: bool) -> str:
     """What ``sim show`` prints of the results directory ``d``: its claims as a table, or
     (``markdown``) its README.md as written from its tables."""
     check_claims_table(d / "claims.parquet", "DIR")
+    check_sweep_record(d, "DIR")
     if (sweep := _sweep_of(d)) is not None and (mixed := mixed_run(sweep)) is not None:
         raise ConfigError("DIR", mixed)  # a cell's figure replaced by hand: its sweep's record
     if (cell := cell_mixed(d)) is not None:  # a cell's tables of another cell or run

@@ -43,7 +43,7 @@ from sim.mc.storage import (
     write_table,
 )
 from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, swept_order
-from sim.mc.table_edits import edited_tables
+from sim.mc.table_edits import edited_chunks, edited_tables
 from sim.places import check_place
 from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
@@ -291,9 +291,12 @@ def execute(
 
 def _edits(out: Path) -> list[str]:
     """The tables of the earlier results ``out`` changed (or removed) after their run wrote
-    them (their sha256 is not the one its ``run.json`` records), which a publish replaces."""
+    them, and its chunks changed (their sha256 is not the one its ``run.json`` records), which
+    a publish replaces."""
     try:
-        return edited_tables(out) if out.is_dir() and not out.is_symlink() else []
+        return (
+            edited_tables(out) + edited_chunks(out) if out.is_dir() and not out.is_symlink() else []
+        )
     except OSError:
         return []
 

@@ -157,7 +157,9 @@ def damaged_chunks(out: Path) -> str | None:
     if not isinstance(want, dict) or not all(isinstance(v, str) for v in want.values()):
         return f"{out / 'run.json'} does not map the chunk files to their sha256 (edited by hand?)"
     have = sorted(
-        p.relative_to(out).as_posix() for p in (out / "trials").rglob("*") if not p.is_dir()
+        f
+        for p in (out / "trials").rglob("*")
+        if not p.is_dir() and not _litter(f := p.relative_to(out).as_posix())
     )
     for f in sorted(set(want) | set(have)):
         if f not in have:
@@ -170,6 +172,14 @@ def damaged_chunks(out: Path) -> str | None:
                 f"{out / f} is not the file the run wrote (its sha256 differs); run the study again"
             )
     return None
+
+
+def _litter(f: str) -> bool:
+    """Whether ``f`` (under ``trials/``) is a file that the chunk dataset's reader skips, as
+    pyarrow's does: a name or a folder of its path starting with ``.`` or ``_`` (a file
+    manager's ``.DS_Store``, a notebook's ``.ipynb_checkpoints/``). Opening the folder in
+    Finder made ``Results.table("trials")`` refuse the run's chunks as "added by hand"."""
+    return any(part.startswith((".", "_")) for part in f.split("/")[1:])
 
 
 def file_sha256(p: Path) -> str:

@@ -37,6 +37,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.lsq import distributions as D
+from sim.mc.chunk_content import content_digest
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.executors import InProcess, make_executor
 from sim.mc.packed import pack, unpack
@@ -167,7 +168,11 @@ class ChunkStore:
             }
         )
         meta = {_ARRAYS: pack(kept), b"n": str(n).encode()}
-        meta[_IDENTITY] = json.dumps(self._identity(part, k, n, seed), sort_keys=True).encode()
+        ident = {
+            **self._identity(part, k, n, seed),
+            "content": content_digest(table, meta[_ARRAYS]),
+        }
+        meta[_IDENTITY] = json.dumps(ident, sort_keys=True).encode()
         if self.prov is not None:
             meta[b"sim.provenance"] = json.dumps(
                 {**self.prov, "chunk": k, "part": part, "spawn_key": [part, k]}, sort_keys=True
@@ -196,8 +201,9 @@ class ChunkStore:
         self, part: int, k: int, keep_rows: bool = False, n: int | None = None, seed=None
     ) -> dict | None:
         """The stored chunk ``k`` of part ``part``, or None when it is missing, unreadable or
-        not what its name says (another study, config, part, index, size or seed): the caller
-        computes it again and the file is replaced."""
+        not what its name says (another study, config, part, index, size or seed) or not what
+        the run wrote (its content digest differs: edited by hand): the caller computes it
+        again and the file is replaced."""
         p = self.path(part, k)
         if not p.is_file():
             return None
@@ -208,10 +214,13 @@ class ChunkStore:
             want = self._identity(part, k, n if n is not None else ident.get("trials"), seed)
             if seed is None:
                 want["seed"] = ident.get("seed")
+            content = ident.pop("content", None)
             if ident != want or table.num_rows != want["trials"]:
                 return None
+            if content != content_digest(table, meta[_ARRAYS]):
+                return None
             out = unpack(meta[_ARRAYS])
-        except (OSError, KeyError, ValueError, TypeError, pa.ArrowInvalid):
+        except (OSError, KeyError, ValueError, TypeError, AttributeError, pa.ArrowException):
             return None  # unreadable or foreign: recompute it
         if keep_rows:
             for name in table.column_names:

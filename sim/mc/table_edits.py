@@ -15,10 +15,12 @@ from pathlib import Path
 from sim.mc.publish import file_sha256
 from sim.mc.storage import read_record
 
-__all__ = ["edited_tables", "edited_cell"]
+__all__ = ["edited_tables", "edited_chunks", "edited_cell"]
 
 #: the name of a table of a results directory's top level, as ``table_sha256`` records it
 _TABLE = re.compile(r"(?:cells/cell\d{4,}_r\d+/)?[^/\\\x00]+\.parquet")
+#: the name of a chunk file of a results directory, as ``chunk_sha256`` records it
+_CHUNK = re.compile(r"trials/part-\d+/chunk-\d+\.parquet")
 
 
 def edited_tables(d: Path) -> list[str]:
@@ -39,6 +41,27 @@ def edited_tables(d: Path) -> list[str]:
         p = Path(d) / name
         try:
             if not p.is_file() or p.is_symlink() or file_sha256(p) != digest:
+                changed.append(name)
+        except OSError:
+            changed.append(name)
+    return changed
+
+
+def edited_chunks(d: Path) -> list[str]:
+    """The chunk files of the results ``d`` that are there but are not the ones its run wrote
+    (their sha256 is not the one its record's ``chunk_sha256`` holds, or they are no regular
+    file: a user's file saved over one, a link or a FIFO put in its place), which a re-run into
+    ``d`` replaces: it said so of a table (:func:`edited_tables`), not of a chunk."""
+    sums = (read_record(d) or {}).get("chunk_sha256")
+    changed = []
+    for name, digest in sorted(sums.items()) if isinstance(sums, dict) else []:
+        if not isinstance(name, str) or not _CHUNK.fullmatch(name):
+            continue  # not a name seal() writes
+        p = Path(d) / name
+        try:
+            if os.path.lexists(p) and (
+                not p.is_file() or p.is_symlink() or file_sha256(p) != digest
+            ):
                 changed.append(name)
         except OSError:
             changed.append(name)

@@ -27,6 +27,7 @@ from sim.report.papers import paper_name
 from sim.report.read import (
     cannot_read,
     check_claims_table,
+    check_sweep_record,
     checked_table,
     forget,
     records,
@@ -418,6 +419,7 @@ def write_report(
     for d in sorted(results_dirs(results)):
         if (why := missing_cell(d)) is not None:  # its README.md would link a cell that is gone
             raise ConfigError("--results", why)
+        check_sweep_record(d, "--results")  # its README.md from a table it cannot check
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             _settled(results, lambda d=d: write_run_readme(d, get_study, design=design))
     if _dirs(results) != read:  # a run published while the READMEs were written: REPORT.md

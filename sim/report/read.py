@@ -42,6 +42,7 @@ from sim.mc.table_shape import (
 
 __all__ = [
     "check_claims_table",
+    "check_sweep_record",
     "checked_table",
     "TableError",
     "EditedTable",
@@ -295,6 +296,20 @@ def check_claims_table(f: Path, key: str) -> None:
         checked_table(f)
     except TableError as e:
         raise ConfigError(key, f"{f} is not the claims table its run wrote: {e.what}") from None
+
+
+def check_sweep_record(d: Path, key: str) -> None:
+    """A sweep's directory ``d`` (``sweep.parquet``, no claims table of its own) must hold its
+    run record, as a study's run must (:func:`check_claims_table`): with its ``run.json``
+    deleted (or broken) beside a value edited by hand in ``sweep.parquet``, ``sim show`` and
+    ``sim report`` printed the edited value as the sweep's, and ``sim report`` wrote it into
+    the sweep's README.md, exit 0 (``Results.table("sweep")`` refused it). A :class:`ConfigError`
+    for ``key`` naming the ``run.json``; nothing for a directory that is no sweep."""
+    f = Path(d) / "sweep.parquet"
+    if not f.is_file() or (Path(d) / "claims.parquet").is_file():
+        return
+    if (bad := record_problem(f, missing=True)) is not None:
+        raise ConfigError(key, record_line(bad))
 
 
 def _other_run(prov: Any, record: dict) -> str | None:
