@@ -1,0 +1,70 @@
+"""Doors 48r: a hostile reading of session 47's merges (the readers' run-record check, ...),
+each test failing on the code before its fix.
+
+- A symbolic link to a sweep's cell (``latest -> sweep/cells/cell0000_r0``): the readers'
+  new check of a missing ``run.json`` (:func:`sim.mc.table_shape.record_problem`) looked for
+  the cell's sweep through the link's own parents, found none, and refused every table of
+  the cell, "latest/run.json is missing (deleted by hand?)", in ``sim show`` and
+  ``Results.table`` alike: a false refusal of results the suite wrote.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+from conftest import TRIANGLE_NETWORK  # noqa: E402
+
+import sim  # noqa: E402
+from sim.cli import main  # noqa: E402
+
+#: one cell of the triangle network: 20 trials in chunks of 1 (the jackknife's 20 chunks)
+_SWEEP = (
+    TRIANGLE_NETWORK.replace("trials = 40", "trials = 20").replace("chunk = 2", "chunk = 1")
+    + '[sweep]\n"reliability.power" = [0.8]\n'
+)
+
+
+@pytest.fixture(scope="module")
+def sweep(tmp_path_factory) -> Path:
+    """A finished one-cell sweep of the triangle network (no figures). READ ONLY."""
+    base = tmp_path_factory.mktemp("sweep48r")
+    (base / "sw.toml").write_text(_SWEEP)
+    out = base / "sw"
+    assert main(["run", str(base / "sw.toml"), "--out", str(out), "--no-figures", "--quiet"]) == 0
+    return out
+
+
+def _cell(sweep: Path) -> Path:
+    (cell,) = sorted((sweep / "cells").iterdir())
+    return cell
+
+
+def test_a_link_to_a_sweep_cell_is_read_as_the_cell(sweep, tmp_path, capsys):
+    """A symbolic link to a sweep's cell: refused before as a run record deleted by hand
+    (the sweep's run.json looked for above the link, not above the cell); read now, its
+    tables checked against the sweep's record as through the cell's own path."""
+    link = tmp_path / "latest"
+    link.symlink_to(_cell(sweep), target_is_directory=True)
+    want = sim.Results(_cell(sweep), "network").claims()
+    assert sim.Results(link, "network").claims().equals(want)
+    capsys.readouterr()
+    assert main(["show", str(link)]) == 0, capsys.readouterr().err
+    assert "run.json is missing" not in capsys.readouterr().err
+
+
+def test_a_linked_cells_missing_sweep_record_is_named_where_it_is(sweep, tmp_path):
+    """The sweep's run.json removed, its cell read through a link: named as the sweep's
+    record, where it is (before: the link's own 'latest/run.json', which no run writes)."""
+    copy = tmp_path / "sw"
+    shutil.copytree(sweep, copy, symlinks=True)
+    (copy / "run.json").unlink()
+    link = tmp_path / "latest"
+    link.symlink_to(_cell(copy), target_is_directory=True)
+    with pytest.raises(sim.ConfigError) as e:
+        sim.Results(link, "network").claims()
+    assert f"{copy.resolve() / 'run.json'} is missing" in str(e.value)
