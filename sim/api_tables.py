@@ -11,6 +11,7 @@ from __future__ import annotations
 import sim.api_env  # noqa: F401 - the environment, before NumPy and Arrow load
 
 # isort: split
+import os
 import sys
 import warnings
 from pathlib import Path
@@ -20,6 +21,7 @@ import pyarrow as pa
 
 from sim.api_paths import why_unread
 from sim.mc.config import ConfigError
+from sim.mc.file_kind import TABLES
 from sim.mc.storage import read_provenance, read_record
 from sim.stale import other_code
 
@@ -28,6 +30,7 @@ _CODE = str(Path(__file__).resolve().parent) + "/"
 
 __all__ = [
     "StaleResultsWarning",
+    "a_run",
     "check_owner",
     "owner",
     "own_trials",
@@ -86,6 +89,14 @@ def run_tables(d: Path, study: str) -> set[str]:
         {"trials"} if isinstance(rec.get("chunk_sha256"), dict) and rec["chunk_sha256"] else set()
     )
     return {n for n in tables if isinstance(n, str) and "/" not in n} | chunks
+
+
+def a_run(d: Path) -> bool:
+    """Whether ``d`` is a study run's results directory (it holds a claims or sweep table),
+    whose ``run.json`` every version of the suite wrote: without one, deleted by hand. Tables
+    written by ``sim.write_table`` alone, or ``make bench``'s ``results/bench``, have none:
+    read as before (they were refused as "run.json is missing (deleted by hand?)")."""
+    return any(os.path.lexists(Path(d) / name) for name in TABLES)
 
 
 def own_trials(d: Path, study: str) -> bool:

@@ -6,6 +6,8 @@ each test failing on the code before its fix.
   the cell's sweep through the link's own parents, found none, and refused every table of
   the cell, "latest/run.json is missing (deleted by hand?)", in ``sim show`` and
   ``Results.table`` alike: a false refusal of results the suite wrote.
+- Tables of ``sim.write_table`` alone (``results/bench`` too), which no run wrote: the same
+  check refused each in ``Results.table`` as a run whose record was deleted.
 """
 
 from __future__ import annotations
@@ -68,3 +70,18 @@ def test_a_linked_cells_missing_sweep_record_is_named_where_it_is(sweep, tmp_pat
     with pytest.raises(sim.ConfigError) as e:
         sim.Results(link, "network").claims()
     assert f"{copy.resolve() / 'run.json'} is missing" in str(e.value)
+
+
+def test_tables_of_write_table_alone_are_read(tmp_path):
+    """Tables written by ``sim.write_table`` alone (a user's, or ``make bench``'s
+    ``results/bench``): no run, so no ``run.json``. ``names()`` listed them and ``table()``
+    refused each as a directory whose record was "deleted by hand? ... run the study again";
+    read as before now. A run's directory (it holds claims.parquet) without its record is
+    still refused."""
+    sim.write_table(tmp_path / "x.parquet", {"a": [1.0, 2.0]}, {"study": "mine"})
+    res = sim.Results(tmp_path, "mine")
+    assert res.names() == ["x"]
+    assert res.table("x").column("a").to_pylist() == [1.0, 2.0]
+    sim.write_table(tmp_path / "claims.parquet", {"a": [1.0]}, {"study": "mine"})
+    with pytest.raises(sim.ConfigError, match="run.json is missing"):
+        res.table("x")
