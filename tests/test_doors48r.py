@@ -85,3 +85,21 @@ def test_tables_of_write_table_alone_are_read(tmp_path):
     sim.write_table(tmp_path / "claims.parquet", {"a": [1.0]}, {"study": "mine"})
     with pytest.raises(sim.ConfigError, match="run.json is missing"):
         res.table("x")
+
+
+def test_a_thread_count_atoi_wraps_is_refused(tmp_path, capsys, monkeypatch):
+    """``OPENBLAS_NUM_THREADS=4294967296``: all digits, so it passed session 47's check, but
+    OpenBLAS reads it with C's ``atoi``, which wraps it to 0, taken for unset: with
+    ``OMP_NUM_THREADS=abc`` the run went on every core without a word (the very case the
+    check was written for). One line naming the variable now, exit 2."""
+    f = tmp_path / "tri.toml"
+    f.write_text(TRIANGLE_NETWORK)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "4294967296")
+    capsys.readouterr()
+    try:
+        rc = main(["check", str(f)])
+    except SystemExit as e:
+        rc = e.code
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1, err
+    assert "OPENBLAS_NUM_THREADS" in err and "ignore it" in err
