@@ -79,16 +79,21 @@ def check_owner(p: Path, study: str) -> None:
 def run_tables(d: Path, study: str) -> set[str]:
     """The table files the run of ``study`` in ``d`` recorded in its ``run.json`` (none: no
     record, or another study's), and ``trials`` where it recorded chunks (the committed
-    results hold none: ``table("trials")`` said the study "has no table 'trials'")."""
-    rec = read_record(d)
+    results hold none: ``table("trials")`` said the study "has no table 'trials'"). A sweep's
+    cell (``cells/<label>``, no record of its own) has those its sweep's record lists under
+    ``cells/<label>/`` (a copy beside them, ``claims_old.parquet``, was listed and read
+    unchecked there, where a run's own is refused)."""
+    rec, under = read_record(d), ""
+    if rec is None and (cell := Path(os.path.realpath(d))).parent.name == "cells":
+        rec, under = read_record(cell.parent.parent), f"cells/{cell.name}/"
     config = rec.get("config") if isinstance(rec, dict) else None
     tables = rec.get("table_sha256") if isinstance(config, dict) else None
     if not isinstance(config, dict) or config.get("study") != study or not isinstance(tables, dict):
         return set()
-    chunks = (
-        {"trials"} if isinstance(rec.get("chunk_sha256"), dict) and rec["chunk_sha256"] else set()
-    )
-    return {n for n in tables if isinstance(n, str) and "/" not in n} | chunks
+    sums = rec.get("chunk_sha256")  # a sweep's records none of its cells' chunks
+    chunks = {"trials"} if not under and isinstance(sums, dict) and sums else set()
+    names = (n.removeprefix(under) for n in tables if isinstance(n, str) and n.startswith(under))
+    return {n for n in names if "/" not in n} | chunks
 
 
 def a_run(d: Path) -> bool:

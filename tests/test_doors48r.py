@@ -8,6 +8,9 @@ each test failing on the code before its fix.
   ``Results.table`` alike: a false refusal of results the suite wrote.
 - Tables of ``sim.write_table`` alone (``results/bench`` too), which no run wrote: the same
   check refused each in ``Results.table`` as a run whose record was deleted.
+- A copy beside a sweep cell's tables: listed and read unchecked (a run's own is refused).
+- ``OPENBLAS_NUM_THREADS`` of 2**31 or more: passed the new check, which OpenBLAS's ``atoi``
+  wraps to a count it ignores.
 """
 
 from __future__ import annotations
@@ -103,3 +106,19 @@ def test_a_thread_count_atoi_wraps_is_refused(tmp_path, capsys, monkeypatch):
     err = capsys.readouterr().err
     assert rc == 2 and err.count("\n") == 1, err
     assert "OPENBLAS_NUM_THREADS" in err and "ignore it" in err
+
+
+def test_a_copy_beside_a_cells_tables_is_not_the_runs(sweep, tmp_path):
+    """A copy kept beside a sweep cell's tables (``claims_old.parquet``): session 47 made
+    ``Results`` list and read only the tables a run's ``run.json`` lists, but a cell has no
+    record of its own, so its copy was listed and read unchecked (a run's own copy is
+    refused). The cell's tables are those its sweep's record lists under ``cells/<label>/``."""
+    copy = tmp_path / "sw"
+    shutil.copytree(sweep, copy)
+    cell = _cell(copy)
+    shutil.copy(cell / "claims.parquet", cell / "claims_old.parquet")
+    res = sim.Results(cell, "network")
+    assert "claims_old" not in res.names() and "claims" in res.names()
+    with pytest.raises(sim.ConfigError, match="claims_old.parquet is not a table its run wrote"):
+        res.table("claims_old")
+    assert res.claims().num_rows > 0
