@@ -53,8 +53,8 @@ from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, w
 from sim.api_state import check_files as _check_files
 from sim.api_state import made_by_load as _by_load
 from sim.api_state import unchecked as _unchecked
+from sim.api_tables import a_run, own_trials, run_tables, stale_warning
 from sim.api_tables import check_owner as _check_owner
-from sim.api_tables import own_trials, run_tables, stale_warning
 from sim.api_tables import owner as _owner
 from sim.api_tmp import check_env, temp_dir
 from sim.execute import execute
@@ -214,7 +214,7 @@ class Results:
             mixed = mixed_run(self.path, [p.name]) or cell_mixed(self.path, [p.name])
             if mixed is not None:  # copied from another run, or another cell's
                 raise ConfigError("table", mixed)
-            if (bad := record_problem(p, missing=True)) is not None:  # read unchecked
+            if (bad := record_problem(p, missing=a_run(self.path))) is not None:  # unchecked
                 raise ConfigError("table", record_line(bad))
             shaped = recorded_shape(p)  # none recorded: its sha256, where recorded
             edit = shape_problem(table, shaped) if shaped is not None else sum_problem(p)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import sim.api_env  # noqa: F401 - the environment, before NumPy and Arrow load
 
 # isort: split
+import os
 import sys
 import warnings
 from pathlib import Path
@@ -20,6 +21,7 @@ import pyarrow as pa
 
 from sim.api_paths import why_unread
 from sim.mc.config import ConfigError
+from sim.mc.file_kind import TABLES
 from sim.mc.storage import read_provenance, read_record
 from sim.stale import other_code
 
@@ -28,6 +30,7 @@ _CODE = str(Path(__file__).resolve().parent) + "/"
 
 __all__ = [
     "StaleResultsWarning",
+    "a_run",
     "check_owner",
     "owner",
     "own_trials",
@@ -76,16 +79,29 @@ def check_owner(p: Path, study: str) -> None:
 def run_tables(d: Path, study: str) -> set[str]:
     """The table files the run of ``study`` in ``d`` recorded in its ``run.json`` (none: no
     record, or another study's), and ``trials`` where it recorded chunks (the committed
-    results hold none: ``table("trials")`` said the study "has no table 'trials'")."""
-    rec = read_record(d)
+    results hold none: ``table("trials")`` said the study "has no table 'trials'"). A sweep's
+    cell (``cells/<label>``, no record of its own) has those its sweep's record lists under
+    ``cells/<label>/`` (a copy beside them, ``claims_old.parquet``, was listed and read
+    unchecked there, where a run's own is refused)."""
+    rec, under = read_record(d), ""
+    if rec is None and (cell := Path(os.path.realpath(d))).parent.name == "cells":
+        rec, under = read_record(cell.parent.parent), f"cells/{cell.name}/"
     config = rec.get("config") if isinstance(rec, dict) else None
     tables = rec.get("table_sha256") if isinstance(config, dict) else None
     if not isinstance(config, dict) or config.get("study") != study or not isinstance(tables, dict):
         return set()
-    chunks = (
-        {"trials"} if isinstance(rec.get("chunk_sha256"), dict) and rec["chunk_sha256"] else set()
-    )
-    return {n for n in tables if isinstance(n, str) and "/" not in n} | chunks
+    sums = rec.get("chunk_sha256")  # a sweep's records none of its cells' chunks
+    chunks = {"trials"} if not under and isinstance(sums, dict) and sums else set()
+    names = (n.removeprefix(under) for n in tables if isinstance(n, str) and n.startswith(under))
+    return {n for n in names if "/" not in n} | chunks
+
+
+def a_run(d: Path) -> bool:
+    """Whether ``d`` is a study run's results directory (it holds a claims or sweep table),
+    whose ``run.json`` every version of the suite wrote: without one, deleted by hand. Tables
+    written by ``sim.write_table`` alone, or ``make bench``'s ``results/bench``, have none:
+    read as before (they were refused as "run.json is missing (deleted by hand?)")."""
+    return any(os.path.lexists(Path(d) / name) for name in TABLES)
 
 
 def own_trials(d: Path, study: str) -> bool:

@@ -105,16 +105,19 @@ def blas_threads_problem() -> str | None:
     core without a word, where the suite runs one thread a process: oversubscribed under
     ``--workers``, and a large dense solve's last digits another's (a 300 x 300 solve differs
     at one and two threads); ``1.5`` or ``2x`` were read as their leading digits. The variable
-    is a whole number of threads, 1 or more, or unset. The others stay as given, measured:
+    is a whole number of threads, 1 or more (below 2**31: ``atoi`` wraps a larger one,
+    ``4294967296`` read as 0 and ignored, which passed this check), or unset. The others stay
+    as given, measured:
     OpenBLAS reads ``GOTO_NUM_THREADS`` and ``OMP_NUM_THREADS`` only after this one (which the
     suite sets, or this refuses), Arrow's pool takes an ``OMP_NUM_THREADS`` it cannot read for
     unset (its I/O threads: the same tables), no library of the suite reads
     ``MKL_NUM_THREADS`` (OpenBLAS, not MKL), and numba's are checked below."""
     v = os.environ.get("OPENBLAS_NUM_THREADS")
-    if v is None or (v.isascii() and v.isdigit() and int(v) >= 1):
+    if v is None or (v.isascii() and v.isdigit() and 1 <= int(v) < 2**31):
         return None
-    m = re.match(r"[ \t\n\v\f\r]*([+-]?[0-9]+)", v)  # atoi's reading
-    read = int(m[1]) if m else 0
+    m = re.match(r"[ \t\n\v\f\r]*([+-]?[0-9]+)", v)  # atoi's reading: (int) strtol(v)
+    long = max(min(int(m[1]), 2**63 - 1), -(2**63)) if m else 0  # strtol saturates
+    read = (long + 2**31) % 2**32 - 2**31  # and the cast to int wraps
     how = (
         f"OpenBLAS would read it as {read}"
         if read >= 1
@@ -122,8 +125,8 @@ def blas_threads_problem() -> str | None:
         "else running on every core)"
     )
     return (
-        "OPENBLAS_NUM_THREADS: must be a whole number of threads, 1 or more, or unset (the "
-        f"suite then runs one a process), got {v[:40]!r}: {how}"
+        "OPENBLAS_NUM_THREADS: must be a whole number of threads, 1 or more (below 2**31), or "
+        f"unset (the suite then runs one a process), got {v[:40]!r}: {how}"
     )
 
 

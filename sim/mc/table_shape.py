@@ -140,11 +140,14 @@ def shape(table: pa.Table) -> dict:
 
 def _spots(path: Path) -> list[tuple[Path, str]]:
     """``(directory, key)`` of each run record that may cover the table ``path``: its own
-    directory's, and for a sweep's cell (``cells/<label>/x.parquet``) the sweep's."""
+    directory's, and for a sweep's cell (``cells/<label>/x.parquet``) the sweep's. The cell
+    is found where its directory really is: a relative path ("./x.parquet") has no parents,
+    and a symbolic link to a cell (``latest -> sweep/cells/cell0000_r0``) has other ones (its
+    tables were refused, "latest/run.json is missing (deleted by hand?)")."""
     spots = [(path.parent, path.name)]
-    cell = Path(os.path.abspath(path)).parent  # a relative path ("./x.parquet") has no parents
+    cell = Path(os.path.realpath(path.parent))
     if cell.parent.name == "cells":
-        spots.append((path.parent / ".." / "..", f"cells/{cell.name}/{path.name}"))
+        spots.append((cell.parent.parent, f"cells/{cell.name}/{path.name}"))
     return spots
 
 
@@ -169,7 +172,10 @@ def record_problem(path: str | Path, missing: bool = False) -> tuple[Path, str] 
             return None
         if os.path.lexists(rec := root / RECORD):
             return rec, _unrecorded(rec)
-    return (spots[-1][0] / RECORD, MISSING) if missing else None
+    if not missing:
+        return None
+    sweep = len(spots) > 1 and os.path.lexists(spots[-1][0] / "sweep.parquet")  # else its own
+    return (spots[-1 if sweep else 0][0] / RECORD, MISSING)
 
 
 def record_line(bad: tuple[Path, str]) -> str:

@@ -73,7 +73,11 @@ def _xy(f: _File, e) -> tuple[float, float]:
     return xy
 
 
-def _point(f: _File, e, points: dict, datum: dict) -> None:
+def _point(f: _File, e, points: dict, datum: dict, moved: list) -> None:
+    """A ``<point>``: its coordinates (mm), role and datum. Given again after observed
+    coordinates moved it (``moved``), it is the last given, as in ``gama-local``: the point
+    goes back to it, compared with its first ``<point>`` (it was refused as "declared twice
+    with different coordinates" when both ``<point>`` elements gave the same)."""
     pid = f.name(e, "id")
     fix, adj = ws(e.get("fix", "")), ws(e.get("adj", ""))
     if "z" in adj.lower():
@@ -88,8 +92,10 @@ def _point(f: _File, e, points: dict, datum: dict) -> None:
     rec = points.setdefault(pid, {"name": pid})
     if e.get("x") is not None or e.get("y") is not None:
         xy = _xy(f, e)
-        if "x_mm" in rec and (rec["x_mm"], rec["y_mm"]) != xy:
+        first = next((m[2] for m in moved if m[0] == pid), None)  # before <coordinates>
+        if "x_mm" in rec and (first or (rec["x_mm"], rec["y_mm"])) != xy:
             raise f.err(e, f"point {pid!r} declared twice with different coordinates", "x")
+        moved[:] = [m for m in moved if m[0] != pid] if first else moved
         rec["x_mm"], rec["y_mm"] = xy
     if e.get("z") is not None:
         f.num(e, "z")
@@ -169,9 +175,9 @@ def _coordinates(f: _File, e, coords: list, points: dict, moved: list) -> None:
     """Observed coordinates (``coords``: name, sigma in mm, (x, y) in mm). As in
     ``gama-local`` (whose ``<coordinates>`` point sets the point's x and y, the last given
     holding), a point declared before with other coordinates moves to the observed ones
-    (``moved``: name, distance in mm, for the note): it is linearised and its observations'
-    absolute terms tested there (its ``<point>`` kept had kept observations that
-    ``gama-local`` removes, and another geometry, silently)."""
+    (``moved``: name, distance in mm and the ``<point>``'s x, y in mm, for the note): it is
+    linearised and its observations' absolute terms tested there (its ``<point>`` kept had
+    kept observations that ``gama-local`` removes, and another geometry, silently)."""
     pts = [o for o in e if _tag(o) == "point"]
     cms = [o for o in e if _tag(o) == "cov-mat"]
     if len(cms) != 1:
@@ -190,7 +196,8 @@ def _coordinates(f: _File, e, coords: list, points: dict, moved: list) -> None:
         coords.append((pid, math.sqrt(vx), xy))
         rec = points.get(pid, {})
         if "x_mm" in rec and (rec["x_mm"], rec["y_mm"]) != xy:
-            moved.append((pid, math.dist((rec["x_mm"], rec["y_mm"]), xy)))
+            old = (rec["x_mm"], rec["y_mm"])
+            moved.append((pid, math.dist(old, xy), old))
             rec["x_mm"], rec["y_mm"] = xy
 
 
@@ -342,7 +349,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
     for e in po:
         t = _tag(e)
         if t == "point":
-            _point(f, e, points, datum)
+            _point(f, e, points, datum, moved)
         elif t == "obs":
             _obs(f, e, dflt, sets, obs)
         elif t == "coordinates":
@@ -354,7 +361,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
     left = _resolve(f, points, coords, obs)
     note += check_terms(f, net, po, points, obs, (axes, angles))  # it removes: refused
     if moved:
-        (pid, d), more = moved[0], f" and {len(moved) - 1} more" * (len(moved) > 1)
+        (pid, d, _), more = moved[0], f" and {len(moved) - 1} more" * (len(moved) > 1)
         note += (
             f"; {pid!r}{more} at its observed coordinates (<coordinates>, {d:.6g} mm from its "
             "<point>), as gama-local takes the last given"
