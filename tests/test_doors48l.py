@@ -6,6 +6,10 @@ its change.
   ``chunk`` trials, so at ``chunk = 2`` the probe took 8 times the counted Jacobian (39,006
   distances: 1.84 GiB asked for one array). It adjusts them in chunks of the run's ``chunk``
   now, from the same stream (the same draws, so the same statuses).
+* Points of a grid or random set that no observation reaches were refused naming
+  ``network.points``, where the study file lists none of them (the two doors agree on the
+  refusal itself: a listed point, a grid's or a random set's, refused or accepted alike in
+  every datum kind and role); now the key is the set's (``network.grids[0]``).
 """
 
 from __future__ import annotations
@@ -14,8 +18,10 @@ import tracemalloc
 from pathlib import Path
 
 import numpy as np
+from oneline import one_line
 
 import sim
+from sim.cli import main
 
 ALL_PAIRS = """study = "network"
 trials = 40
@@ -75,3 +81,28 @@ def test_dense_probe_holds_the_chunk_the_estimate_counts(tmp_path, monkeypatch):
     whole = probe._probe(net, an, C, pts, {**cfg, "chunk": 16})
     assert np.array_equal(split, whole)
     assert peak <= counted, f"probe {peak / 2**20:.1f} MiB, estimate {counted / 2**20:.1f} MiB"
+
+
+UNREACHED_GRID = """study = "network"
+trials = 200
+chunk = 10
+[network]
+points = [ { name = "B", x_mm = 400.0, y_mm = 0.0 }, { name = "C", x_mm = 400.0, y_mm = 300.0 },
+  { name = "D", x_mm = 0.0, y_mm = 300.0 }, { name = "P", x_mm = 150.0, y_mm = 120.0 } ]
+grids = [ { prefix = "T", nx = 1, ny = 1, spacing_m = 1.0 },
+          { prefix = "G", nx = 2, ny = 1, spacing_m = 20.0, role = "fixed" } ]
+generate = [
+  { kind = "distance", from = ["B", "C", "D", "T1"], to = ["B", "C", "D", "P"], sigma_mm = 0.002 }
+]
+[datum]
+kind = "inner"
+"""
+
+
+def test_unreached_grid_points_are_named_by_their_grid(tmp_path, capsys):
+    """Unclear message (the wrong key): a fixed grid nothing observes, in an inner datum, was
+    refused as ``network.points: fixed points 'G1', 'G2' ...``; the list holds no G1."""
+    f = tmp_path / "net.toml"
+    f.write_text(UNREACHED_GRID)
+    err = one_line(capsys, main(["check", str(f)]), "fixed points 'G1', 'G2'")
+    assert err.startswith("sim: error: network.grids[1]: "), err

@@ -140,7 +140,8 @@ def check(cfg: dict) -> None:
     except ConfigError as e:  # a fixed point nothing observes holds nothing: the cause, named
         if not lone.size:
             raise
-        raise ConfigError(_where(full)[0], unreached_message(net, lone, _where(full)[1])) from e
+        key, where = _where(full, net.names[lone[0]])
+        raise ConfigError(key, unreached_message(net, lone, where)) from e
     _conditioned(net, an, "datum.kind")
     pts = estimated_points(net, an)
     if not pts:
@@ -170,10 +171,22 @@ def check(cfg: dict) -> None:
             )
 
 
-def _where(full: dict) -> tuple[str, str]:
-    """The key and the words that say where the network's points are declared."""
+def _where(full: dict, name: str = "") -> tuple[str, str]:
+    """The key and the words that say where the network's points (the point ``name``) are
+    declared: a grid's or random set's points were named ``network.points``, where the
+    study file lists none of them."""
     gama = full.get("network.gama_xml")
-    return ("network.gama_xml", gama) if gama else ("network.points", "the study file")
+    if gama:
+        return "network.gama_xml", gama
+    listed = {str(p.get("name")) for p in full.get("network.points") or [] if isinstance(p, dict)}
+    for key, count in (("network.grids", ("nx", "ny")), ("network.random", ("n",))):
+        for a, rec in enumerate(full.get(key) or []):
+            tail = name[len(str(rec.get("prefix"))) :]
+            digits = tail.isascii() and tail.isdigit() and tail[0] != "0"
+            if name not in listed and name.startswith(str(rec.get("prefix"))) and digits:
+                if int(tail) <= int(np.prod([int(rec.get(f, 1)) for f in count])):
+                    return f"{key}[{a}]", "the study file"
+    return "network.points", "the study file"
 
 
 def _unreached_free(net, full: dict) -> np.ndarray:
@@ -183,7 +196,7 @@ def _unreached_free(net, full: dict) -> np.ndarray:
     lone = unreached(net)
     free = lone[net.role[lone] != 1]
     if free.size:
-        key, where = _where(full)
+        key, where = _where(full, net.names[free[0]])
         raise ConfigError(key, unreached_message(net, free, where))
     return lone
 
