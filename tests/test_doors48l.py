@@ -6,6 +6,13 @@ its change.
   ``chunk`` trials, so at ``chunk = 2`` the probe took 8 times the counted Jacobian (39,006
   distances: 1.84 GiB asked for one array). It adjusts them in chunks of the run's ``chunk``
   now, from the same stream (the same draws, so the same statuses).
+* Fixed points were counted as unknowns of the sparse factor in the estimate (and in the
+  chunk's size ``sim check`` refuses by): a 100 x 100 fixed grid around 20 new points was
+  estimated at a factor of 280,000 nonzeros over 20,062 unknowns (13 of the 36 MiB stated;
+  the run's arrays peaked at 9 MiB), where the factor holds the 62 estimated unknowns. The
+  memory was over, not under, the run's: last session's "4-5x under" compared the process's
+  resident size, whose ~200-350 MiB of interpreter, libraries and compiled kernels no
+  estimate counts (measured here: warm peaks of 7-9 MiB at 100, 2,500 and 10,000 fixed points).
 * Points of a grid or random set that no observation reaches were refused naming
   ``network.points``, where the study file lists none of them (the two doors agree on the
   refusal itself: a listed point, a grid's or a random set's, refused or accepted alike in
@@ -106,3 +113,30 @@ def test_unreached_grid_points_are_named_by_their_grid(tmp_path, capsys):
     f.write_text(UNREACHED_GRID)
     err = one_line(capsys, main(["check", str(f)]), "fixed points 'G1', 'G2'")
     assert err.startswith("sim: error: network.grids[1]: "), err
+
+
+def test_fixed_points_are_not_unknowns_of_the_estimated_factor():
+    """Silent nonsense in the estimate: 10,000 fixed points (a 100 x 100 control grid) counted
+    as 20,000 unknowns of the sparse factor (280,000 nonzeros); its 62 estimated unknowns hold
+    at most 62 x 63 / 2."""
+    from sim.mc.network_size import network_counts
+
+    flat = {
+        "trials": 40,
+        "chunk": 2,
+        "network.grids": [
+            {"prefix": "G", "nx": 100, "ny": 100, "spacing_m": 20.0, "role": "fixed"}
+        ],
+        "network.random": [{"prefix": "R", "n": 20, "half_extent_m": 800.0}],
+        "network.generate": [
+            {"kind": "distance", "from": "R*", "to": "G*", "nearest": 6, "sigma_mm": 1.0},
+            {"kind": "direction", "from": "R*", "to": "G*", "nearest": 6, "sigma_arcsec": 1.0},
+        ],
+        "datum.kind": "fixed",
+    }
+    k = network_counts(flat)
+    free = 2 * 20 + 20 + 2  # the new points, their orientations, the constant and scale
+    assert k.sparse and k.unknowns == 20_000 + free  # the engine's q: its path, as before
+    assert k.factor_nnz <= free * (free + 1) / 2, k.factor_nnz
+    _, _, _, counted = _estimate(flat)
+    assert 8 * 2**20 < counted < 32 * 2**20  # the points' state, not a 20,062-unknown factor
