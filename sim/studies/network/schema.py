@@ -16,7 +16,7 @@ import numpy as np
 
 from sim.mc.config import ConfigError, given
 from sim.mc.progress import phase
-from sim.mc.runner import require_chunks
+from sim.mc.runner import PROBE_TRIALS, require_chunks
 from sim.mc.schema_helpers import recorded_sha256
 from sim.studies.network.analysis import (
     check_inner,
@@ -42,6 +42,7 @@ from sim.studies.network.singular import (
 from sim.studies.network.sparse_analysis import (
     chunk_bytes,
     pre_analysis,
+    shows_phases,
     shows_phases_of,
     variances,
 )
@@ -111,8 +112,62 @@ def check(cfg: dict) -> None:
     cfg["datum.kind"] = full["datum.kind"]  # a free gama-local file's inner datum, resolved
     with phase("network: building", shows_phases_of(full)):
         net = _build(full)
-    canonical(cfg)  # its records validated: one spelling, one config hash
-    sparse = use_sparse(net)
+    # the steps between the building and the run's bar, each shown on a terminal as its
+    # neighbours are: a 10,370-unknown grid drew nothing for 3 s after its building, 1 s
+    # before its factorising and 2 s after its pre-analysis (the records' and the datum's
+    # checks, the solver probe's 16 trials: a loaded machine); a dense network nothing at all
+    show = shows_phases(net.q) or net.m * (net.q + 1) >= DENSE_PHASE_FROM
+    with phase("network: checking its records and observations", show):
+        canonical(cfg)  # its records validated: one spelling, one config hash
+        sparse = use_sparse(net)
+        _chunk_fits(net, cfg, sparse)
+        if not np.any(net.role != 1):
+            raise ConfigError("network.points", "every point is fixed: nothing to estimate")
+        _no_effect(net, full, cfg)
+        lone = _unreached_free(net, full)
+    with phase("network: the datum (its defects and constraints)", show):
+        dt = datum(net, full)
+        try:
+            an = _held(
+                net, full, dt, sparse, {k for k in ("datum.kind", "datum.points") if given(cfg, k)}
+            )
+        except ConfigError as e:  # a fixed point nothing observes holds nothing: the cause
+            if not lone.size:
+                raise
+            key, where = _where(full, net.names[lone[0]])
+            raise ConfigError(key, unreached_message(net, lone, where)) from e
+    _conditioned(net, an, "datum.kind")
+    pts = estimated_points(net, an)
+    if not pts:
+        raise ConfigError(
+            "network.points", "no estimated point has a regular covariance: nothing to estimate"
+        )
+    if an.dof < 1:  # gama-local adjusts it (untested): its global test needs one or more
+        gama = "; gama-local adjusts such a file untested" if full.get("network.gama_xml") else ""
+        raise ConfigError(
+            "network.observations",
+            f"{net.m} observations for {len(an.free)} unknowns leave {an.dof} degrees of "
+            f"freedom: add observations (the global test needs one or more{gama})",
+        )
+    with phase(f"network: the solver probe ({PROBE_TRIALS} trials of its own)", show):
+        probe_solver(net, an, dt.constraint_matrix(net.theta_true()[None]), pts, cfg)
+    if cfg["compare.fix"]:
+        _check_compare(net, full, cfg["compare.fix"], sparse)
+    if cfg["output.inner_over"]:
+        pts = match_points(net, "output.inner_over", cfg["output.inner_over"])
+        check_inner(net, inner_defect(net), pts, "output.inner_over")
+        if all(net.role[p] == 1 for p in pts):  # their covariance is zero: S Q S' = Q
+            raise ConfigError(
+                "output.inner_over",
+                f"{', '.join(net.names[p] for p in pts[:5])}{' ...' * (len(pts) > 5)} are all "
+                "fixed points: the inner datum "
+                "over them is the datum they hold (its table would repeat the points' sigmas "
+                "as 'inner'): name estimated points among them, or leave it out",
+            )
+
+
+def _chunk_fits(net, cfg: dict, sparse: bool) -> None:
+    """Refuse a chunk over :data:`MAX_CHUNK_BYTES` (``chunk``; ``network`` when one trial is)."""
     nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
     if nbytes > MAX_CHUNK_BYTES:
         one = chunk_bytes(net, 1) if sparse else net.m * (net.q + 1) * 8
@@ -128,47 +183,13 @@ def check(cfg: dict) -> None:
                 f"{MAX_CHUNK_BYTES / 1024**3:g} GiB): use fewer points or observations"
             ),
         )
-    if not np.any(net.role != 1):
-        raise ConfigError("network.points", "every point is fixed: nothing to estimate")
-    _no_effect(net, full, cfg)
-    lone = _unreached_free(net, full)
-    dt = datum(net, full)
-    try:
-        an = _held(
-            net, full, dt, sparse, {k for k in ("datum.kind", "datum.points") if given(cfg, k)}
-        )
-    except ConfigError as e:  # a fixed point nothing observes holds nothing: the cause, named
-        if not lone.size:
-            raise
-        key, where = _where(full, net.names[lone[0]])
-        raise ConfigError(key, unreached_message(net, lone, where)) from e
-    _conditioned(net, an, "datum.kind")
-    pts = estimated_points(net, an)
-    if not pts:
-        raise ConfigError(
-            "network.points", "no estimated point has a regular covariance: nothing to estimate"
-        )
-    if an.dof < 1:  # gama-local adjusts it (untested): its global test needs one or more
-        gama = "; gama-local adjusts such a file untested" if full.get("network.gama_xml") else ""
-        raise ConfigError(
-            "network.observations",
-            f"{net.m} observations for {len(an.free)} unknowns leave {an.dof} degrees of "
-            f"freedom: add observations (the global test needs one or more{gama})",
-        )
-    probe_solver(net, an, dt.constraint_matrix(net.theta_true()[None]), pts, cfg)
-    if cfg["compare.fix"]:
-        _check_compare(net, full, cfg["compare.fix"], sparse)
-    if cfg["output.inner_over"]:
-        pts = match_points(net, "output.inner_over", cfg["output.inner_over"])
-        check_inner(net, inner_defect(net), pts, "output.inner_over")
-        if all(net.role[p] == 1 for p in pts):  # their covariance is zero: S Q S' = Q
-            raise ConfigError(
-                "output.inner_over",
-                f"{', '.join(net.names[p] for p in pts[:5])}{' ...' * (len(pts) > 5)} are all "
-                "fixed points: the inner datum "
-                "over them is the datum they hold (its table would repeat the points' sigmas "
-                "as 'inner'): name estimated points among them, or leave it out",
-            )
+
+
+#: Jacobian entries (observations x unknowns) from which a dense network shows the steps
+#: before its run (:func:`sim.mc.progress.phase`): 5,000 distances of 100 points (1e6
+#: entries) took 22 s in the solver probe on a loaded two-core machine (2.5 s the rest of
+#: ``sim check``), 870 of 30 points 2 s
+DENSE_PHASE_FROM = 1_000_000
 
 
 def _where(full: dict, name: str = "") -> tuple[str, str]:
