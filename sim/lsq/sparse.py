@@ -124,8 +124,9 @@ def normals_nonzeros(cols: np.ndarray, q: int) -> int:
 def factor_nonzeros(p: int, nnz_n: int) -> float:
     """Order-of-magnitude nonzeros of the factor of a plane network's normals (``p`` unknowns,
     ``nnz_n`` nonzeros of ``N``): minimum degree on a planar graph fills ``O(p log p)``
-    (measured: 20,000 unknowns, nearest-8 trilateration, 1.4e6; this model gives about 2e6)."""
-    return float(nnz_n) * max(np.log2(max(p, 2)), 1.0) / 3.0 + 4.0 * p
+    (measured: 20,000 unknowns, nearest-8 trilateration, 1.4e6; this model gives about 2e6),
+    at most the lower triangle's ``p (p + 1) / 2``."""
+    return min(float(nnz_n) * max(np.log2(max(p, 2)), 1.0) / 3.0 + 4.0 * p, p * (p + 1) / 2)
 
 
 @dataclass

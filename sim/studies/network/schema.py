@@ -16,7 +16,7 @@ import numpy as np
 
 from sim.mc.config import ConfigError, given
 from sim.mc.progress import phase
-from sim.mc.runner import require_chunks
+from sim.mc.runner import PROBE_TRIALS, require_chunks
 from sim.mc.schema_helpers import recorded_sha256
 from sim.studies.network.analysis import (
     check_inner,
@@ -42,6 +42,7 @@ from sim.studies.network.singular import (
 from sim.studies.network.sparse_analysis import (
     chunk_bytes,
     pre_analysis,
+    shows_phases,
     shows_phases_of,
     variances,
 )
@@ -111,36 +112,30 @@ def check(cfg: dict) -> None:
     cfg["datum.kind"] = full["datum.kind"]  # a free gama-local file's inner datum, resolved
     with phase("network: building", shows_phases_of(full)):
         net = _build(full)
-    canonical(cfg)  # its records validated: one spelling, one config hash
-    sparse = use_sparse(net)
-    nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
-    if nbytes > MAX_CHUNK_BYTES:
-        one = chunk_bytes(net, 1) if sparse else net.m * (net.q + 1) * 8
-        raise ConfigError(
-            "chunk" if one <= MAX_CHUNK_BYTES else "network",
-            f"a chunk of {cfg['chunk']} trials needs about "
-            f"{nbytes / 1024**3:.1f} GiB ({net.m} observations x "
-            f"{net.q} unknowns{', sparse' if sparse else ''}); "
-            + (
-                "use a smaller chunk"
-                if one <= MAX_CHUNK_BYTES
-                else f"a chunk of one trial too ({one / 1024**3:.1f} GiB, over "
-                f"{MAX_CHUNK_BYTES / 1024**3:g} GiB): use fewer points or observations"
-            ),
-        )
-    if not np.any(net.role != 1):
-        raise ConfigError("network.points", "every point is fixed: nothing to estimate")
-    _no_effect(net, full, cfg)
-    lone = _unreached_free(net, full)
-    dt = datum(net, full)
-    try:
-        an = _held(
-            net, full, dt, sparse, {k for k in ("datum.kind", "datum.points") if given(cfg, k)}
-        )
-    except ConfigError as e:  # a fixed point nothing observes holds nothing: the cause, named
-        if not lone.size:
-            raise
-        raise ConfigError(_where(full)[0], unreached_message(net, lone, _where(full)[1])) from e
+    # the steps between the building and the run's bar, each shown on a terminal as its
+    # neighbours are: a 10,370-unknown grid drew nothing for 3 s after its building, 1 s
+    # before its factorising and 2 s after its pre-analysis (the records' and the datum's
+    # checks, the solver probe's 16 trials: a loaded machine); a dense network nothing at all
+    show = shows_phases(net.q) or net.m * (net.q + 1) >= DENSE_PHASE_FROM
+    with phase("network: checking its records and observations", show):
+        canonical(cfg)  # its records validated: one spelling, one config hash
+        sparse = use_sparse(net)
+        _chunk_fits(net, cfg, sparse)
+        if not np.any(net.role != 1):
+            raise ConfigError("network.points", "every point is fixed: nothing to estimate")
+        _no_effect(net, full, cfg)
+        lone = _unreached_free(net, full)
+    with phase("network: the datum (its defects and constraints)", show):
+        dt = datum(net, full)
+        try:
+            an = _held(
+                net, full, dt, sparse, {k for k in ("datum.kind", "datum.points") if given(cfg, k)}
+            )
+        except ConfigError as e:  # a fixed point nothing observes holds nothing: the cause
+            if not lone.size:
+                raise
+            key, where = _where(full, net.names[lone[0]])
+            raise ConfigError(key, unreached_message(net, lone, where)) from e
     _conditioned(net, an, "datum.kind")
     pts = estimated_points(net, an)
     if not pts:
@@ -154,7 +149,8 @@ def check(cfg: dict) -> None:
             f"{net.m} observations for {len(an.free)} unknowns leave {an.dof} degrees of "
             f"freedom: add observations (the global test needs one or more{gama})",
         )
-    probe_solver(net, an, dt.constraint_matrix(net.theta_true()[None]), pts, cfg)
+    with phase(f"network: the solver probe ({PROBE_TRIALS} trials of its own)", show):
+        probe_solver(net, an, dt.constraint_matrix(net.theta_true()[None]), pts, cfg)
     if cfg["compare.fix"]:
         _check_compare(net, full, cfg["compare.fix"], sparse)
     if cfg["output.inner_over"]:
@@ -170,10 +166,48 @@ def check(cfg: dict) -> None:
             )
 
 
-def _where(full: dict) -> tuple[str, str]:
-    """The key and the words that say where the network's points are declared."""
+def _chunk_fits(net, cfg: dict, sparse: bool) -> None:
+    """Refuse a chunk over :data:`MAX_CHUNK_BYTES` (``chunk``; ``network`` when one trial is)."""
+    nbytes = chunk_bytes(net, cfg["chunk"]) if sparse else cfg["chunk"] * net.m * (net.q + 1) * 8
+    if nbytes > MAX_CHUNK_BYTES:
+        one = chunk_bytes(net, 1) if sparse else net.m * (net.q + 1) * 8
+        raise ConfigError(
+            "chunk" if one <= MAX_CHUNK_BYTES else "network",
+            f"a chunk of {cfg['chunk']} trials needs about "
+            f"{nbytes / 1024**3:.1f} GiB ({net.m} observations x "
+            f"{net.q} unknowns{', sparse' if sparse else ''}); "
+            + (
+                "use a smaller chunk"
+                if one <= MAX_CHUNK_BYTES
+                else f"a chunk of one trial too ({one / 1024**3:.1f} GiB, over "
+                f"{MAX_CHUNK_BYTES / 1024**3:g} GiB): use fewer points or observations"
+            ),
+        )
+
+
+#: Jacobian entries (observations x unknowns) from which a dense network shows the steps
+#: before its run (:func:`sim.mc.progress.phase`): 5,000 distances of 100 points (1e6
+#: entries) took 22 s in the solver probe on a loaded two-core machine (2.5 s the rest of
+#: ``sim check``), 870 of 30 points 2 s
+DENSE_PHASE_FROM = 1_000_000
+
+
+def _where(full: dict, name: str = "") -> tuple[str, str]:
+    """The key and the words that say where the network's points (the point ``name``) are
+    declared: a grid's or random set's points were named ``network.points``, where the
+    study file lists none of them."""
     gama = full.get("network.gama_xml")
-    return ("network.gama_xml", gama) if gama else ("network.points", "the study file")
+    if gama:
+        return "network.gama_xml", gama
+    listed = {str(p.get("name")) for p in full.get("network.points") or [] if isinstance(p, dict)}
+    for key, count in (("network.grids", ("nx", "ny")), ("network.random", ("n",))):
+        for a, rec in enumerate(full.get(key) or []):
+            tail = name[len(str(rec.get("prefix"))) :]
+            digits = tail.isascii() and tail.isdigit() and tail[0] != "0"
+            if name not in listed and name.startswith(str(rec.get("prefix"))) and digits:
+                if int(tail) <= int(np.prod([int(rec.get(f, 1)) for f in count])):
+                    return f"{key}[{a}]", "the study file"
+    return "network.points", "the study file"
 
 
 def _unreached_free(net, full: dict) -> np.ndarray:
@@ -183,7 +217,7 @@ def _unreached_free(net, full: dict) -> np.ndarray:
     lone = unreached(net)
     free = lone[net.role[lone] != 1]
     if free.size:
-        key, where = _where(full)
+        key, where = _where(full, net.names[free[0]])
         raise ConfigError(key, unreached_message(net, free, where))
     return lone
 

@@ -98,11 +98,15 @@ def chunk_bytes(net: Network, chunk: int) -> float:
     steps, the factor and its selected inverse by nonzeros). The factor's nonzeros follow from
     ``N``'s own (the distinct pairs of estimated unknowns the rows join), not from the rows'
     slot pairs, which counted a 10,000-point trilateration grid's factor 11 times too large
-    and refused a 50,000-point one at every chunk (it ran in 1.3 GiB)."""
+    and refused a 50,000-point one at every chunk (it ran in 1.3 GiB); nor over the fixed
+    points' coordinates, which the factor does not hold."""
     cols = pattern(net)
     held = [net.i_constant] * (not net.estimate_constant) + [net.i_scale] * (not net.estimate_scale)
+    fixed = np.flatnonzero(net.role == 1)
+    held = np.concatenate([held, 2 * fixed, 2 * fixed + 1])
     nnz_n = lsq_sparse.normals_nonzeros(np.where(np.isin(cols, held), -1, cols), net.q)
-    return sparse_chunk_bytes(chunk, net.m, net.q, lsq_sparse.factor_nonzeros(net.q, nnz_n))
+    free = max(net.q - 2 * fixed.size, 1)
+    return sparse_chunk_bytes(chunk, net.m, net.q, lsq_sparse.factor_nonzeros(free, nnz_n))
 
 
 def _pairs(net: Network) -> np.ndarray:
