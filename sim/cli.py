@@ -36,7 +36,7 @@ from sim.claims.rules import printed_differs
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
 from sim.cli_read import report, show
-from sim.ends import stdout_failed
+from sim.ends import stdout_failed, unshown
 from sim.env_vars import environment_problem
 from sim.execute import check_sweep, execute, sweep_limits
 from sim.long_words import clipped
@@ -160,6 +160,8 @@ def _run(args) -> int:
         overwrite = overwrite or scratch
     else:
         shown = args.out
+    if (why := unshown(f"{shown.rstrip('/')}/README.md")) is not None:  # its closing lines
+        raise ConfigError("--out" if args.out is not None else None, why)
     execute(
         study,
         cfg,

@@ -1,0 +1,127 @@
+"""Doors sweep 48e: the environment a user brings (the locale and the output's encoding, HOME,
+XDG and TMPDIR, the umask, awkward paths, the interpreter's flags, the clocks), one case per
+class found; each failed on the code before its fix.
+
+* a path or a name of the user's that standard output's encoding cannot show
+  (``PYTHONIOENCODING=ascii`` or ``latin-1``, a Latin-1 locale, ``LC_ALL=C`` with
+  ``PYTHONUTF8=0``): ``sim run --out 'dΩ'`` computed and published every trial, then ended with
+  exit 2 on its closing line "results in ..." (a batch or a script took the published run for a
+  failed one); ``sim report`` wrote REPORT.md, then exit 2 printing its path; ``python -m
+  sim.batch`` of ``ñet.toml`` ran the study, then ended in a ``UnicodeEncodeError`` traceback
+  (exit 1, no report) printing its summary; ``make verify`` of results holding ``ñet`` re-ran it,
+  then a traceback printing "ñet: ...", its record unwritten. Each is now refused before any work,
+  one line naming the character and the path (:func:`sim.ends.unshown`).
+* a ``.venv`` that is a link to another checkout's ``.venv`` (a git worktree or a copy set up to
+  share one environment, ``ln -s ../main/.venv .venv``): ``make test`` there took it for a
+  ``.venv`` moved with the project (its stamp names the other checkout) and ran ``python -m
+  venv --clear .venv`` through the link, wiping the other checkout's environment under its
+  running commands (it happened to this session's shared ``.venv`` at 23:34), then installed
+  this checkout into it. It is now named in one line, exit 2, and left alone (the Makefile's
+  ``SHARED_VENV``).
+"""
+
+from __future__ import annotations
+
+import io
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import TRIANGLE_NETWORK
+from oneline import one_line
+from test_doors37k import MAKE, cksum, run_make, venv_project
+
+import sim.batch
+import sim.cli
+import sim.report.verify.cli as verify_cli
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def ascii_stdout(monkeypatch) -> None:
+    """Standard output in ASCII (``PYTHONIOENCODING=ascii``); called in the test (capsys takes
+    the streams when the test starts, after its fixtures)."""
+    monkeypatch.setattr(sys, "stdout", io.TextIOWrapper(io.BytesIO(), encoding="ascii"))
+
+
+@pytest.fixture(scope="module")
+def triangle_results(tmp_path_factory) -> Path:
+    """One small network run's results directory (no figures), made once."""
+    d = tmp_path_factory.mktemp("tri")
+    (d / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    rc = sim.cli.main(["run", str(d / "tri.toml"), "--out", str(d / "res" / "tri"), "--quiet"])
+    assert rc == 0
+    return d / "res" / "tri"
+
+
+def test_an_out_the_output_cannot_show_is_refused_before_the_run(tmp_path, monkeypatch, capsys):
+    """``sim run --out 'dΩ'`` under an ASCII output: before, every trial was computed and the
+    results published, then exit 2 on the closing "results in ..." line."""
+    ascii_stdout(monkeypatch)
+    (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    out = tmp_path / "d\u03a9"
+    rc = sim.cli.main(["run", str(tmp_path / "tri.toml"), "--out", str(out), "--no-figures"])
+    line = one_line(capsys, rc, "--out: the output (encoding ascii) cannot show '\\u03a9' of ")
+    assert "PYTHONIOENCODING=utf-8" in line and not out.exists(), line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tri.toml"]  # no staging left
+
+
+def test_a_results_path_the_output_cannot_show_gets_no_report(
+    triangle_results, tmp_path, monkeypatch, capsys
+):
+    """``sim report --results 'dΩ'``: before, REPORT.md was written, then exit 2 printing its
+    path (held: the directory's names inside the report are not printed)."""
+    ascii_stdout(monkeypatch)
+    res = tmp_path / "d\u03a9"
+    shutil.copytree(triangle_results, res / "tri")
+    rc = sim.cli.main(["report", "--results", str(res)])
+    one_line(capsys, rc, "--results: the output (encoding ascii) cannot show '\\u03a9'")
+    assert not (res / "REPORT.md").exists()
+
+
+def test_a_batch_of_a_file_the_output_cannot_name_runs_nothing(tmp_path, monkeypatch, capsys):
+    """``python -m sim.batch ñet.toml``: before, the study ran and published, then the
+    summary's print ended in a ``UnicodeEncodeError`` traceback (exit 1, no ``--report``)."""
+    ascii_stdout(monkeypatch)
+    (tmp_path / "\u00f1et.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    res = tmp_path / "res"
+    rc = sim.batch.main(["--results", str(res), str(tmp_path / "\u00f1et.toml")])
+    one_line(capsys, rc, "sim.batch: ", "cannot show '\\xf1' of '\\xf1et.toml'")
+    assert not res.exists()
+
+
+def test_verify_of_a_study_the_output_cannot_name_reruns_nothing(
+    triangle_results, tmp_path, monkeypatch, capsys
+):
+    """``make verify`` of results holding ``ñet``: before, it was re-run, then "ñet: ..."
+    ended in a ``UnicodeEncodeError`` traceback (exit 1), nothing recorded."""
+    ascii_stdout(monkeypatch)
+    res, studies, scratch = tmp_path / "res", tmp_path / "studies", tmp_path / "scratch"
+    shutil.copytree(triangle_results, res / "\u00f1et")
+    studies.mkdir()
+    (studies / "\u00f1et.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    argv = ["--results", str(res), "--studies", str(studies), "--scratch", str(scratch)]
+    rc = verify_cli.main(argv)
+    one_line(capsys, rc, "sim verify: error: ", "cannot show '\\xf1' of ")
+    assert not scratch.exists() and not (res / "reproducibility.parquet").exists()
+
+
+@pytest.mark.skipif(MAKE is None, reason="no make on this machine")
+def test_a_venv_linked_to_another_checkouts_is_left_alone(tmp_path):
+    """``make venv`` in a checkout whose ``.venv`` links to another's (whose stamp names the
+    other): before, ``venv --clear`` and pip ran into the other checkout's environment."""
+    main = venv_project(tmp_path / "m", ["numpy"])
+    (main / ".venv" / ".installed").write_text(
+        f"{main}\n{cksum(main / 'pyproject.toml')}\n", encoding="utf-8"
+    )
+    wt = venv_project(tmp_path, ["numpy"])  # its stand-in Python logs to tmp_path/calls.log
+    shutil.rmtree(wt / ".venv")
+    (wt / ".venv").symlink_to(main / ".venv")
+    p = run_make(wt, "venv")
+    assert p.returncode == 2 and p.stderr.splitlines()[0] == (
+        f"make: .venv is a link to {main / '.venv'}, the environment of {main}: making it again "
+        "here would clear it; run make there, or remove the link (make venv then makes one here)"
+    ), p.stderr
+    assert not (tmp_path / "calls.log").exists() and not (tmp_path / "m" / "calls.log").exists()
+    assert run_make(main, "venv").returncode == 0  # its own checkout: as before, current
