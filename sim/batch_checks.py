@@ -16,6 +16,7 @@ import json
 import os
 from pathlib import Path
 
+from sim.api_paths import arrow_name
 from sim.cli import DOC as cli_doc
 from sim.cli import check_run_args, load_run
 from sim.cli_args import parser as run_parser
@@ -108,6 +109,10 @@ def _clashes(files: list[Path], run_args: list[str], results: str = "results") -
     be <results> itself or its parent), or standard output's encoding cannot show its name."""
     seen: dict[str, Path] = {}
     out, named = [], {}  # named: the files by their inode, so a link's second name is seen
+    try:  # a locale whose file names are not UTF-8: Arrow's would be other files
+        arrow_name("--results", results)
+    except ConfigError as e:
+        return [str(e)]
     for f in files:
         try:
             st = f.stat()

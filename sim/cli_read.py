@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
-from sim.api_paths import cell_mixed, too_long
+from sim.api_paths import arrow_name, cell_mixed, too_long
 from sim.cli_errors import not_as_written, older_lacks
 from sim.ends import unshown
 from sim.mc.config import ConfigError
@@ -187,6 +187,7 @@ def report(results: Path) -> int:
         raise ConfigError(None, why)
     if (why := unshown(str(results / "REPORT.md"))) is not None:  # printed once it is written
         raise ConfigError("--results", why)
+    arrow_name("--results", results)
     try:
         text = write_report(
             results, _study_of("--results", results), design_config, project_studies(results)

@@ -11,6 +11,15 @@ class found; each failed on the code before its fix.
   (exit 1, no report) printing its summary; ``make verify`` of results holding ``ñet`` re-ran it,
   then a traceback printing "ñet: ...", its record unwritten. Each is now refused before any work,
   one line naming the character and the path (:func:`sim.ends.unshown`).
+* a directory of tables whose path is not ASCII under a locale whose file names are not UTF-8
+  (``LC_ALL=de_DE.ISO-8859-1``, or ``LC_ALL=C`` with ``PYTHONUTF8=0 PYTHONCOERCECLOCALE=0``):
+  Python gives the name to the system in the locale's encoding, Arrow in UTF-8, so they name
+  different files. ``sim run --out dé`` failed at its first chunk on "No such file or directory:
+  .../.dé.partial/trials/part-0/chunk-000000.parquet"; ``sim show`` and ``sim report`` said a
+  ``claims.parquet`` that is there could not be found; the API raised Arrow's
+  ``FileNotFoundError`` (Python's ``UnicodeEncodeError`` under ASCII) with a traceback. Each of
+  ``--out``, ``DIR``, ``--results``, ``--scratch`` and ``out=`` is now refused in one line
+  naming the locale's encoding (:func:`sim.api_paths.arrow_name`).
 * a ``.venv`` that is a link to another checkout's ``.venv`` (a git worktree or a copy set up to
   share one environment, ``ln -s ../main/.venv .venv``): ``make test`` there took it for a
   ``.venv`` moved with the project (its stamp names the other checkout) and ran ``python -m
@@ -23,7 +32,9 @@ class found; each failed on the code before its fix.
 from __future__ import annotations
 
 import io
+import os
 import shutil
+import subprocess
 import sys
 from pathlib import Path
 
@@ -125,3 +136,33 @@ def test_a_venv_linked_to_another_checkouts_is_left_alone(tmp_path):
     ), p.stderr
     assert not (tmp_path / "calls.log").exists() and not (tmp_path / "m" / "calls.log").exists()
     assert run_make(main, "venv").returncode == 0  # its own checkout: as before, current
+
+
+def test_a_table_directory_not_ascii_under_a_non_utf8_locale_is_refused(
+    triangle_results, tmp_path, monkeypatch, capsys
+):
+    """``sim show dé`` under a Latin-1 locale: before, "claims.parquet cannot be read: ... No
+    such file or directory" of a file that is there (Arrow names it in UTF-8)."""
+    d = tmp_path / "d\u00e9"
+    shutil.copytree(triangle_results, d)
+    monkeypatch.setattr(sys, "getfilesystemencoding", lambda: "iso8859-1")
+    rc = sim.cli.main(["show", str(d)])
+    one_line(capsys, rc, "sim: error: DIR: ", "this locale's file names are iso8859-1, not UTF-8")
+
+
+def test_an_api_out_not_ascii_under_an_ascii_locale_is_a_config_error(tmp_path):
+    """``sim.load(...).run(out="dé")`` under ``LC_ALL=C PYTHONUTF8=0``: before, Python's
+    ``UnicodeEncodeError`` traceback from the first directory made."""
+    (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    code = (
+        "import sim\ntry:\n"
+        f"    sim.load({str(tmp_path / 'tri.toml')!r}).run(out={str(tmp_path)!r} + '/d\\xe9')\n"
+        "except sim.ConfigError as e:\n    print(ascii(str(e)))\n"
+    )
+    env = {**os.environ, "LC_ALL": "C", "PYTHONUTF8": "0", "PYTHONCOERCECLOCALE": "0"}
+    p = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert p.returncode == 0 and "Traceback" not in p.stderr, p.stderr
+    assert p.stdout[1:].startswith("out: ") and "file names are ascii, not UTF-8" in p.stdout, p
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["tri.toml"]
