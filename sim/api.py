@@ -118,6 +118,7 @@ class Results:
                 "path", f"{self.path} is relative and the current directory no longer exists"
             ) from None
         object.__setattr__(self, "path", where)
+        _arrow_name("path", where)  # Arrow's file names other than Python's (a Latin-1 locale)
 
     def _check_dir(self) -> None:  # not "no table": the directory itself is wrong
         if not self.path.is_dir():  # a run's, deleted since, was "not a results directory"
