@@ -124,9 +124,8 @@ VENV_USABLE := $(and $(VENV_USABLE),$(if $(wildcard $(INSTALLING)),,yes))
 # with the project: `make test` there ran `venv --clear` through the link, wiping the other
 # checkout's environment under its running commands, and installed this checkout into it (the
 # other's `sim` then ran this one's code). It is named in one line and left alone.
-SHARED_VENV := $(if $(subst $(CURDIR),,$(MADE_IN)),$(shell m="$$(sed -n 1p $(STAMP))"; \
-  v="$$(cd $(VENV) 2>/dev/null && pwd -P)"; test -n "$$v" && \
-  test "$$v" = "$$(cd "$$m/$(VENV)" 2>/dev/null && pwd -P)" && printf '%s' "$$m"))
+SHARED_VENV := $(and $(MADE_IN),$(subst $(CURDIR),,$(MADE_IN)),$(realpath $(VENV)),$(if \
+  $(subst $(realpath $(VENV)),,$(realpath $(MADE_IN)/$(VENV))),,$(MADE_IN)))
 SHARED_WORDS := make: %s is a link to %s, the environment of %s: making it again here would clear \
   it; run make there, or remove the link (make venv then makes one here)
 # A .venv installed (its stamp current) that no longer holds what pyproject.toml asks for (a
