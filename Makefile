@@ -47,7 +47,7 @@ $(foreach s_,$(SETTINGS),$(call not_read_any,$(call misspelt,$(s_)),$(s_)="..." 
 # `make test STAMP=x` or `make reproduce STUDIES=...` ran on misread names. One line, exit 2
 # (each is checked by its origin here, before any of them is used).
 OWN_NAMES := VENV STAMP INSTALLING PIP_LOG VENV_LOCK VENV_USABLE MADE_IN MADE_FROM PYPROJECT_SUM \
-  PYPROJECT_DEP INSTALLED_NOW INSTALLED_AT_START SHARED_VENV SHARED_WORDS STUDY_FILES STUDIES SETTINGS OWN_NAMES newline comma \
+  PYPROJECT_DEP INSTALLED_NOW INSTALLED_AT_START STUDY_FILES STUDIES SETTINGS OWN_NAMES newline comma \
   q whole shellwords locked pip lower misspelt not_read not_read_any venv_lacks VENV_CHECK
 $(foreach v_,$(OWN_NAMES),$(if $(filter command line,$(origin $(v_))),$(error make: $(v_) is \
   this Makefile's own name and not a setting (the settings: $(SETTINGS)); leave it off)))
@@ -119,15 +119,6 @@ PYPROJECT_SUM := $(shell cksum < pyproject.toml | tr ' ' -)
 PYPROJECT_DEP := $(if $(MADE_FROM),$(if $(filter $(PYPROJECT_SUM),$(MADE_FROM)),,pyproject-changed),pyproject.toml)
 VENV_USABLE := $(and $(VENV_USABLE),$(if $(MADE_IN),$(if $(subst $(CURDIR),,$(MADE_IN)),,yes),yes))
 VENV_USABLE := $(and $(VENV_USABLE),$(if $(wildcard $(INSTALLING)),,yes))
-# A .venv that is a link to the .venv of another checkout of the project (a git worktree or a
-# copy set up to share one environment: `ln -s ../main/.venv .venv`) was taken for a .venv moved
-# with the project: `make test` there ran `venv --clear` through the link, wiping the other
-# checkout's environment under its running commands, and installed this checkout into it (the
-# other's `sim` then ran this one's code). It is named in one line and left alone.
-SHARED_VENV := $(and $(MADE_IN),$(subst $(CURDIR),,$(MADE_IN)),$(realpath $(VENV)),$(if \
-  $(subst $(realpath $(VENV)),,$(realpath $(MADE_IN)/$(VENV))),,$(MADE_IN)))
-SHARED_WORDS := make: %s is a link to %s, the environment of %s: making it again here would clear \
-  it; run make there, or remove the link (make venv then makes one here)
 # A .venv installed (its stamp current) that no longer holds what pyproject.toml asks for (a
 # library removed or replaced since: `pip uninstall pyarrow`) was taken for whole: every target
 # failed in it (pytest's collection errors, "No such file or directory: .venv/bin/ruff") and
@@ -163,8 +154,6 @@ pip = @$(call locked,"$$@" >> $(PIP_LOG) 2>&1 || exit; $(3),$(2)) $(PY) -m pip i
 	"$$({ grep -m1 -E '^ *ERROR' $(PIP_LOG) || grep -v '^ *$$' $(PIP_LOG) | tail -1; } | sed -E 's/^ *(ERROR: *)?//')" >&2; exit 2; }
 
 $(STAMP): $(PYPROJECT_DEP) $(if $(VENV_USABLE),,venv-unusable) $(if $(venv_lacks),venv-incomplete)
-	$(if $(SHARED_VENV),@printf '$(SHARED_WORDS)\n' $(VENV) $(call q,$(realpath $(VENV))) \
-	  $(call q,$(SHARED_VENV)) >&2; exit 2)
 	$(if $(venv_lacks),@printf 'make: %s: installing the project again\n' $(call q,$(venv_lacks)))
 	@test -d $(VENV) || ! { test -e $(VENV) || test -L $(VENV); } || { printf 'make: %s is %s, not a virtual environment: %s\n' \
 	  $(VENV) 'not a directory (a file, or a link to nothing)' 'remove or rename it, then make venv' >&2; exit 2; }
