@@ -20,13 +20,6 @@ class found; each failed on the code before its fix.
   ``FileNotFoundError`` (Python's ``UnicodeEncodeError`` under ASCII) with a traceback. Each of
   ``--out``, ``DIR``, ``--results``, ``--scratch`` and ``out=`` is now refused in one line
   naming the locale's encoding (:func:`sim.api_paths.arrow_name`).
-* a ``.venv`` that is a link to another checkout's ``.venv`` (a git worktree or a copy set up to
-  share one environment, ``ln -s ../main/.venv .venv``): ``make test`` there took it for a
-  ``.venv`` moved with the project (its stamp names the other checkout) and ran ``python -m
-  venv --clear .venv`` through the link, wiping the other checkout's environment under its
-  running commands (it happened to this session's shared ``.venv`` at 23:34), then installed
-  this checkout into it. It is now named in one line, exit 2, and left alone (the Makefile's
-  ``SHARED_VENV``).
 """
 
 from __future__ import annotations
@@ -41,7 +34,6 @@ from pathlib import Path
 import pytest
 from conftest import TRIANGLE_NETWORK
 from oneline import one_line
-from test_doors37k import MAKE, cksum, run_make, venv_project
 
 import sim.batch
 import sim.cli
@@ -116,26 +108,6 @@ def test_verify_of_a_study_the_output_cannot_name_reruns_nothing(
     rc = verify_cli.main(argv)
     one_line(capsys, rc, "sim verify: error: ", "cannot show '\\xf1' of ")
     assert not scratch.exists() and not (res / "reproducibility.parquet").exists()
-
-
-@pytest.mark.skipif(MAKE is None, reason="no make on this machine")
-def test_a_venv_linked_to_another_checkouts_is_left_alone(tmp_path):
-    """``make venv`` in a checkout whose ``.venv`` links to another's (whose stamp names the
-    other): before, ``venv --clear`` and pip ran into the other checkout's environment."""
-    main = venv_project(tmp_path / "m", ["numpy"])
-    (main / ".venv" / ".installed").write_text(
-        f"{main}\n{cksum(main / 'pyproject.toml')}\n", encoding="utf-8"
-    )
-    wt = venv_project(tmp_path, ["numpy"])  # its stand-in Python logs to tmp_path/calls.log
-    shutil.rmtree(wt / ".venv")
-    (wt / ".venv").symlink_to(main / ".venv")
-    p = run_make(wt, "venv")
-    assert p.returncode == 2 and p.stderr.splitlines()[0] == (
-        f"make: .venv is a link to {main / '.venv'}, the environment of {main}: making it again "
-        "here would clear it; run make there, or remove the link (make venv then makes one here)"
-    ), p.stderr
-    assert not (tmp_path / "calls.log").exists() and not (tmp_path / "m" / "calls.log").exists()
-    assert run_make(main, "venv").returncode == 0  # its own checkout: as before, current
 
 
 def test_a_table_directory_not_ascii_under_a_non_utf8_locale_is_refused(
