@@ -47,6 +47,7 @@ from sim.api_paths import (
     why_not_a_dir,
     why_unread,
 )
+from sim.api_paths import arrow_name as _arrow_name
 from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
 from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
@@ -117,6 +118,7 @@ class Results:
                 "path", f"{self.path} is relative and the current directory no longer exists"
             ) from None
         object.__setattr__(self, "path", where)
+        _arrow_name("path", where)  # Arrow's file names other than Python's (a Latin-1 locale)
 
     def _check_dir(self) -> None:  # not "no table": the directory itself is wrong
         if not self.path.is_dir():  # a run's, deleted since, was "not a results directory"
@@ -318,6 +320,7 @@ class StudyHandle:
         elif not str(out).strip():
             raise ConfigError("out", "is empty: name an output directory")
         out = _absolute("out", out)
+        _arrow_name("out", out)
         # the caller's matplotlib and log levels kept; a failed run's temp dir removed or named
         with kept(), loggers_kept(), anonymous_dir(base, out):
             try:

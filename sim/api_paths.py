@@ -18,6 +18,7 @@ import errno
 import os
 import re
 import resource
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -34,6 +35,7 @@ __all__ = [
     "another_run",
     "check_path",
     "absolute_path",
+    "arrow_name",
     "check_identity",
     "cell_chunks",
     "cell_mixed",
@@ -114,6 +116,29 @@ def absolute_path(name: str, v: str | os.PathLike) -> Path:
         raise ConfigError(
             name, f"{os.fspath(v)} is relative, but the working directory is gone ({e.strerror})"
         ) from None
+
+
+def arrow_name(name: str, v: str | os.PathLike) -> None:
+    """Refuse ``v``, a directory whose tables Arrow reads or writes, when Arrow would name
+    other files than Python: under a locale whose file names are not UTF-8 (``LC_ALL=
+    de_DE.ISO-8859-1`` without UTF-8 mode) Python gives a name that is not ASCII to the system
+    in the locale's encoding and Arrow in UTF-8. ``sim run --out dé`` failed at its first chunk
+    on "No such file or directory: .../.dé.partial/trials/...", ``sim show`` and ``sim report``
+    said a ``claims.parquet`` that is there could not be found, the API raised Arrow's
+    FileNotFoundError. One line naming the argument and the locale's encoding instead."""
+    enc = sys.getfilesystemencoding()
+    try:
+        text = os.fspath(absolute(v))
+    except (OSError, TypeError, ValueError):  # said by the argument's own checks
+        return
+    if text.isascii() or enc.lower().replace("-", "").replace("_", "") in ("utf8", "utf8mb4"):
+        return
+    raise ConfigError(
+        name,
+        f"{text!r} is not ASCII and this locale's file names are {enc}, not UTF-8: Arrow, which "
+        "reads and writes the tables, would name other files; set LC_ALL=C.UTF-8 (or "
+        "PYTHONUTF8=1), or choose an ASCII path",
+    )
 
 
 def gone_cwd(name: str, v: str | os.PathLike) -> str | None:

@@ -16,10 +16,12 @@ import json
 import os
 from pathlib import Path
 
+from sim.api_paths import arrow_name
 from sim.cli import DOC as cli_doc
 from sim.cli import check_run_args, load_run
 from sim.cli_args import parser as run_parser
 from sim.cli_errors import cwd_exists
+from sim.ends import unshown
 from sim.execute import sweep_limits
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
@@ -104,9 +106,13 @@ def _clashes(files: list[Path], run_args: list[str], results: str = "results") -
     one results directory (the same file twice, two files of one name), one file would run
     twice under two names (a symbolic or hard link beside it: each wrote <results>/<its name>,
     the same study run twice), or a file's name is ``.toml`` or ``...toml`` (its results would
-    be <results> itself or its parent)."""
+    be <results> itself or its parent), or standard output's encoding cannot show its name."""
     seen: dict[str, Path] = {}
     out, named = [], {}  # named: the files by their inode, so a link's second name is seen
+    try:  # a locale whose file names are not UTF-8: Arrow's would be other files
+        arrow_name("--results", results)
+    except ConfigError as e:
+        return [str(e)]
     for f in files:
         try:
             st = f.stat()
@@ -127,6 +133,8 @@ def _clashes(files: list[Path], run_args: list[str], results: str = "results") -
                 if same
                 else f"{seen[f.stem]} and {f} would both write {Path(results) / f.stem}"
             )
+        elif why := unshown(f.name) or unshown(str(Path(results) / f.stem / "README.md")):
+            out.append(f"{f}: {why}")  # its lines name it: a traceback after every run
         else:
             seen[f.stem] = f
     return out

@@ -44,6 +44,9 @@ class _Stdout:
         if self.error is None:
             try:
                 print(text, flush=True)
+            except UnicodeEncodeError:  # a name its encoding cannot show (the files' and
+                enc = getattr(sys.stdout, "encoding", None) or "ascii"  # --results' are refused
+                self(text.encode(enc, "backslashreplace").decode(enc))  # before)
             except OSError as e:
                 self.error = e
                 try:  # what is left in the buffer is dropped, not retried at exit

@@ -31,12 +31,12 @@ from pathlib import Path
 
 from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
 
-from sim.api_paths import absolute_path, too_long
+from sim.api_paths import absolute_path, arrow_name, too_long
 from sim.claims.rules import printed_differs
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
 from sim.cli_read import report, show
-from sim.ends import stdout_failed
+from sim.ends import stdout_failed, unshown
 from sim.env_vars import environment_problem
 from sim.execute import check_sweep, execute, sweep_limits
 from sim.long_words import clipped
@@ -160,6 +160,9 @@ def _run(args) -> int:
         overwrite = overwrite or scratch
     else:
         shown = args.out
+    if (why := unshown(f"{shown.rstrip('/')}/README.md")) is not None:  # its closing lines
+        raise ConfigError("--out" if args.out is not None else None, why)
+    arrow_name("--out" if args.out is not None else None, out)
     execute(
         study,
         cfg,
@@ -343,6 +346,7 @@ def _main(argv: list[str]) -> int:
             absolute_path("STUDY", args.study)
         if args.cmd == "show":
             absolute_path("DIR", args.dir)
+            arrow_name("DIR", args.dir)
         if sys.stdout is None:  # >&-: print() wrote nowhere (every command, as sim.ends.finish)
             raise ConfigError(None, "standard output is closed (>&-): nothing to print to")
         for s in _STOPS if in_main_thread() else ():

@@ -14,8 +14,9 @@ from pathlib import Path
 
 import pyarrow as pa
 
-from sim.api_paths import cell_mixed, too_long
+from sim.api_paths import arrow_name, cell_mixed, too_long
 from sim.cli_errors import not_as_written, older_lacks
+from sim.ends import unshown
 from sim.mc.config import ConfigError
 from sim.mc.file_kind import odd_table
 from sim.mc.outputs import name_problem, results_dirs
@@ -185,6 +186,9 @@ def report(results: Path) -> int:
         )
     if (why := umask_problem()) is not None:
         raise ConfigError(None, why)
+    if (why := unshown(str(results / "REPORT.md"))) is not None:  # printed once it is written
+        raise ConfigError("--results", why)
+    arrow_name("--results", results)
     try:
         text = write_report(
             results, _study_of("--results", results), design_config, project_studies(results)

@@ -26,6 +26,7 @@ __all__ = [
     "stdout_failed",
     "stdout_unwritten",
     "open_standard_streams",
+    "unshown",
 ]
 
 #: the suite's own characters in what it prints (an interval's "0.00–1.00", the dash of
@@ -198,6 +199,27 @@ def ascii_punctuation() -> None:
         out.reconfigure(errors=name)
     except (AttributeError, ValueError, OSError):
         pass
+
+
+def unshown(text: str) -> str | None:
+    """What standard output cannot show of ``text`` (a path or a name of the user's that a
+    command prints when it ends), in the words of the commands' refusal, or None. Asked before
+    the work: ``sim run --out 'dΩ'`` under ``PYTHONIOENCODING=ascii`` (or a Latin-1 locale)
+    computed and published every trial, then ended with exit 2 on its closing line "results
+    in ...", and ``python -m sim.batch`` and ``make verify`` with a traceback on a study's
+    name."""
+    out = sys.stdout
+    try:
+        text.encode(out.encoding, getattr(out, "errors", None) or "strict")
+    except UnicodeEncodeError as e:
+        what = ascii(e.object[e.start : e.end])
+        return (
+            f"the output (encoding {e.encoding}) cannot show {what} of {ascii(text)}: "
+            "set PYTHONIOENCODING=utf-8"
+        )
+    except (AttributeError, LookupError, TypeError):  # no stdout, a stream of the caller's
+        return None
+    return None
 
 
 def _ascii_or(own: str):

@@ -9,6 +9,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from sim.api_paths import arrow_name
 from sim.ends import stdout_failed
 from sim.env_vars import environment_problem
 from sim.held_stops import held_stops
@@ -202,6 +203,14 @@ def _main(argv: list[str] | None) -> int:
             return exit_status(e.code)
         _defaults(a)
         _check_args(a)
+        for key, where in (
+            ("--results", a.results),
+            ("--scratch", a.scratch or tempfile.gettempdir()),
+        ):
+            try:  # a locale whose file names are not UTF-8: Arrow's would be other files
+                arrow_name(key, where)
+            except ConfigError as e:
+                raise VerifyError(str(e)) from None
         extra = [] if a.trials is None else ["--trials", str(a.trials)]
         extra += [x for s in a.set for x in ("--set", s)]
         mode = "full" if a.trials is None else "mc"

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
+from sim.ends import unshown
 from sim.mc.children import child_env, child_text, ended, stop_children
 from sim.mc.config import ConfigError
 from sim.mc.file_kind import odd_table
@@ -239,6 +240,9 @@ def verify(
     if scratch.exists() and not scratch.is_dir():
         raise VerifyError(f"--scratch: {scratch} is not a directory")
     todo = study_dirs(results, only)
+    for d, _ in todo:  # its lines (and each re-run's) name them: a traceback after the re-runs
+        if why := unshown(str(d)) or unshown(str(scratch / d.name / "README.md")):
+            raise VerifyError(f"{d.name}: {why}")
     sweeps = sorted(  # (a study's results with an older version's sweep.parquet are not one)
         p.name
         for p in results_dirs(results)
