@@ -13,9 +13,8 @@ guess."""
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Mapping
 
-__all__ = ["Meant", "meant", "set_split", "command_word", "two_sets", "item_key"]
+__all__ = ["Meant", "meant", "set_split", "command_word", "two_sets"]
 
 #: an option, and the words of other tools that mean it
 SYNONYMS: dict[str, tuple[str, ...]] = {
@@ -297,33 +296,3 @@ def two_sets(overrides: list[str], key: str | None) -> str:
         parts = [f"{k.strip()}={p}" if i == 0 else p for i, p in enumerate(_SECOND.split(value))]
         return f" (one KEY=VALUE a --set: {' '.join(f'--set {p}' for p in parts)})"
     return ""
-
-
-#: a key that names an item of a list (``network.generate[1].sigma_arcsec``, ``...generate.1...``)
-_ITEM = re.compile(r"^([A-Za-z_][\w.]*?)(?:\[(\d+)\]|\.(\d+))(?:\.|$)")
-
-
-def item_key(key: str | None, detail: str, schema: Callable[[], Mapping | None]) -> str:
-    """`` (network.generate is a list: ...)`` for an unknown ``key`` that names an item of a
-    list or a field of one (``--set network.generate[1].sigma_arcsec=3``: "unknown key"
-    alone), saying to give the whole list; "" otherwise. Only for a key that is a list:
-    ``schema()`` gives the study's keys (their :class:`~sim.mc.config.Field`; None when the
-    study is not known), read only for a key of that form. Before, any key of that form was
-    called a list, to be given whole by ``--set``: an integer (``plate.grid[0]``), a table
-    (``errors.1``), a key the study does not have, a sweep's values (``sweep.plate.grid.0``,
-    which ``--set`` refuses)."""
-    m = _ITEM.match(key or "")
-    if m is None or not detail.startswith("unknown key"):
-        return ""
-    name = m.group(1)
-    field = (schema() or {}).get(name)
-    if field is None or not _LIST_KIND.match(field.kind):
-        return ""
-    return (
-        f" ({name} is a list: its items have no keys of their own; give the whole list, "
-        f"--set '{name}=[...]', or edit the study file)"
-    )
-
-
-#: the kinds of :class:`~sim.mc.config.Field` whose value is a list
-_LIST_KIND = re.compile(r"^(?:list\[|points$|records$)")
