@@ -264,8 +264,11 @@ def older(prov: dict, names) -> str:
 def check_claims_table(f: Path, key: str) -> None:
     """A results directory's claims table ``f`` must be one the suite wrote, of the study its
     ``run.json`` names (a :class:`ConfigError` for ``key``, naming the file, if not; nothing
-    when there is no table)."""
-    if not f.is_file():
+    when there is no table; a sweep's top directory, its run record checked)."""
+    if not f.is_file():  # a sweep's top without run.json was read unchecked: as a run's now
+        sweep = f.parent / "sweep.parquet"
+        if sweep.is_file() and (bad := record_problem(sweep, missing=True)) is not None:
+            raise ConfigError(key, record_line(bad))
         return
     try:
         prov, names = read_provenance(f), pq.read_schema(f).names
