@@ -169,3 +169,17 @@ def test_a_sweeps_top_directory_without_its_run_record_is_refused(tmp_path, caps
     capsys.readouterr()
     (out / "run.json").unlink()
     one_line(capsys, main(["show", str(out)]), f"{out / 'run.json'} is missing")
+
+
+def test_a_users_table_written_into_a_runs_directory_is_left_out_by_every_reader(
+    tiny_run, tmp_path, capsys
+):
+    """Class: ``sim.write_table`` of the same study into a run's directory. Before: ``sim
+    show`` refused the whole directory ("mixes results of two runs") where ``Results`` and
+    verify left the table out; all leave it out now, and it is kept."""
+    d = _copy(tiny_run, tmp_path)
+    mine = sim.write_table(d / "mine.parquet", {"x": [1.0, 2.0]}, {"study": "network"})
+    assert within(60, main, ["show", str(d)]) == 0
+    assert within(60, main, ["report", "--results", str(d.parent)]) == 0
+    capsys.readouterr()
+    assert "mine" not in sim.Results(d, "network").names() and mine.is_file()

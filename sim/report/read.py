@@ -329,8 +329,11 @@ def mixed_table(
     record = read_record(d)
     if record is None:  # no run record: nothing to check against
         return None
+    # a table the record does not list is none of the run's (sim.write_table of the user's, a
+    # copy): left out, as Results and verify leave it (the whole directory was refused here)
+    ran = record.get("table_sha256") if isinstance(record.get("table_sha256"), dict) else None
     for p in sorted(Path(d) / n for n in names) if names else sorted(Path(d).glob("*.parquet")):
-        if not p.is_file():
+        if not p.is_file() or (not names and ran is not None and p.name not in ran):
             continue
         try:
             prov = read_provenance(p)
