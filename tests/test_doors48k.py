@@ -62,10 +62,12 @@ def test_a_toml_slip_in_a_study_file_says_what_was_meant(tmp_path, capsys, old, 
     one_line(capsys, main(["check", str(f)]), "malformed TOML", "(at line", meant)
 
 
-def test_a_toml_line_with_no_known_slip_gets_no_guess(tmp_path, capsys):
-    """A control of the above: a line none of the slips fits (``trials = 1/2``) is refused
-    in tomllib's words with no guess made up."""
-    text = BROWN.read_text(encoding="utf-8").replace("trials = 4000", "trials = 1/2", 1)
+@pytest.mark.parametrize("value", ["1/2", "0" + "1" * 5000])
+def test_a_toml_line_with_no_known_slip_gets_no_guess(tmp_path, capsys, value):
+    """A control of the above: a line none of the slips fits (``trials = 1/2``), or one too
+    long to be a slip (5,000 digits after a leading zero: no integer of them is made), is
+    refused in tomllib's words with no guess made up."""
+    text = BROWN.read_text(encoding="utf-8").replace("trials = 4000", f"trials = {value}", 1)
     (f := tmp_path / "slip.toml").write_text(text, encoding="utf-8")
     line = one_line(capsys, main(["check", str(f)]), "malformed TOML")
     assert line.endswith("(at line 6, column 11)"), line

@@ -24,6 +24,9 @@ UNITS = ("mm", "um", "m", "nm", "deg", "rad", "arcsec", "mgon", "gon", "pct", "p
 _NUMBER = re.compile(r"[+-]?(?:\d[\d_]*)(?:\.\d[\d_]*)?(?:[eE][+-]?\d+)?")
 _KEY_VALUE = re.compile(r"\s*([A-Za-z0-9_.\-\"' ]+?)\s*=\s*(.*)")
 _BARE_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*")
+#: longest line a hint is looked for in (a study file's lines are short; a line of megabytes
+#: is no slip, and a regular expression's backtracking over it would take minutes)
+LONGEST = 400
 
 
 def quote_hint(line: str) -> str:
@@ -75,7 +78,8 @@ def _opened(lines: list[str], before: int, mark: str) -> int | None:
     """The 1-based number of the last line before line ``before`` whose value opens with
     ``mark`` (``[`` a list, ``{`` an inline table), or None."""
     for k in range(min(before, len(lines)) - 1, -1, -1):
-        if (m := _KEY_VALUE.fullmatch(lines[k])) and m.group(2).startswith(mark):
+        short = len(lines[k]) <= LONGEST
+        if short and (m := _KEY_VALUE.fullmatch(lines[k])) and m.group(2).startswith(mark):
             return k + 1
     return None
 
@@ -92,6 +96,8 @@ def slip_hint(text: str, message: str, n: int, col: int) -> str:
     else:
         where = ""
     line = lines[n - 1] if 0 < n <= len(lines) else ""
+    if len(line) > LONGEST:
+        return ""
     code = line.split("#", 1)[0].rstrip() if '"' not in line and "'" not in line else line
     words = ""
     kv = _KEY_VALUE.fullmatch(code)
