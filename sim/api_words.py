@@ -26,11 +26,16 @@ class _Bound:
         return self._method(*args, **kwargs)
 
     def __getattr__(self, attr: str):
-        if attr.startswith("__") or attr in ("_method", "_name"):
+        if attr in ("_method", "_name"):  # not set yet (copy's or pickle's bare instance)
+            raise AttributeError(attr)
+        if attr.startswith("__"):
             return getattr(self._method, attr)
         raise AttributeError(
             f"Results.{self._name} is a method, not its table: call it, res.{self._name}().{attr}"
         )
+
+    def __reduce__(self):  # pickled (a Pool's task) as the method of its Results
+        return getattr, (self._method.__self__, self._name)
 
     def __eq__(self, other):
         return self._method == (other._method if isinstance(other, _Bound) else other)
