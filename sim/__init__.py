@@ -45,10 +45,30 @@ __all__ = list(_EXPORTS)
 __version__ = "0.1.0"
 
 
+#: names a user likely tries on ``sim`` (``sim.run(...)``: Python's bare AttributeError), and
+#: what does their work
+_MEANT = {
+    "run": "sim.load(STUDY_FILE).run() runs a study",
+    "check": "sim.load(STUDY_FILE) checks a study file, as sim check does",
+    "show": "sim.Results(DIR, STUDY).names() and .table(NAME) read a run's results",
+    "read": "sim.Results(DIR, STUDY).table(NAME) reads a run's table",
+    "results": "sim.Results(DIR, STUDY) reads a run's results",
+    "report": "the report is made by the command sim report",
+    "batch": "the batch is the command python -m sim.batch",
+}
+
+
 def __getattr__(name: str):
     if name in _EXPORTS:
         _refuse_unloadable(_EXPORTS[name])
         return getattr(_importlib.import_module(_EXPORTS[name]), name)
+    lower = {n.lower(): n for n in _EXPORTS}  # sim.LOAD, sim.results
+    if name.lower() in lower or name.lower() in _MEANT:
+        meant = lower.get(name.lower())
+        raise AttributeError(  # an AttributeError still: hasattr(sim, "run") is False
+            f"module 'sim' has no attribute {name!r}: "
+            + (f"did you mean sim.{meant}?" if meant else _MEANT[name.lower()])
+        )
     raise AttributeError(f"module 'sim' has no attribute {name!r}")
 
 

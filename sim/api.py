@@ -58,6 +58,7 @@ from sim.api_tables import a_run, own_trials, run_tables, stale_warning
 from sim.api_tables import check_owner as _check_owner
 from sim.api_tables import owner as _owner
 from sim.api_tmp import check_env, temp_dir
+from sim.api_words import Method, missing
 from sim.execute import execute
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
@@ -120,6 +121,8 @@ class Results:
         object.__setattr__(self, "path", where)
         _arrow_name("path", where)  # Arrow's file names other than Python's (a Latin-1 locale)
 
+    __getattr__ = missing  # res.trials, res.tables: Python's bare words (sim.api_words)
+
     def _check_dir(self) -> None:  # not "no table": the directory itself is wrong
         if not self.path.is_dir():  # a run's, deleted since, was "not a results directory"
             why = link_problem(self.path) or why_not_a_dir(self.path, bool(self.run_sha256))
@@ -146,6 +149,7 @@ class Results:
         which that name reads (it was unreachable, and listed twice)."""
         return name == "chunks" or (name == "trials" and not own_trials(self.path, self.study))
 
+    @Method
     @_arguments
     def names(self) -> list[str]:
         """The tables of the run: each once; ``chunks`` is the per-trial chunk dataset (also
@@ -170,6 +174,7 @@ class Results:
             names |= {"chunks", "trials"} if self._dataset("trials") else {"chunks"}
         return sorted(names)
 
+    @Method
     @_arguments
     def table(self, name: str) -> pa.Table:
         """The table ``name`` (``claims``, ``points``, ..., ``trials`` or ``chunks``) as a
@@ -226,6 +231,7 @@ class Results:
         stale_warning(self.path)  # sim show's note on results of another version's code
         return table
 
+    @Method
     @_arguments
     def claims(self) -> pa.Table:
         """The claims table: each paper claim beside the simulated value and its verdict."""

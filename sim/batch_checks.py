@@ -33,6 +33,7 @@ from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
 from sim.mc.sweep import read_sweep, reordered, swept_order
 from sim.mc.table_edits import edited_tables
+from sim.mc.unknown_key import unknown_key_hint
 from sim.places import base
 from sim.report.read import mixed_table
 from sim.studies import get_study
@@ -300,7 +301,7 @@ def _unknown_sets(files: list[Path], run_args: list[str]) -> tuple[str | None, s
     for f in files:
         try:
             name = read_toml(f).get("study")
-            schemas[f] = (name, set(get_study(name).schema))
+            schemas[f] = (name, get_study(name).schema)
         except (ConfigError, OSError, ValueError, RecursionError):
             continue
     notes = []
@@ -309,8 +310,13 @@ def _unknown_sets(files: list[Path], run_args: list[str]) -> tuple[str | None, s
         if not lack:
             continue
         if len(lack) == len(schemas):
-            many = "no study of the batch has it" if len(files) > 1 else "the study has no such key"
-            return f"--set {key_text(key)}: unknown key ({many})", None
+            if len({name for name, _ in schemas.values()}) == 1:  # sim run's own words
+                hint = unknown_key_hint(key, next(iter(schemas.values()))[1])
+                return (
+                    f"--set {key_text(key)}: unknown key{hint or ' (the study has no such key)'}",
+                    None,
+                )
+            return f"--set {key_text(key)}: unknown key (no study of the batch has it)", None
         studies = ", ".join(f"{f.name} ({schemas[f][0]})" for f in lack)
         notes.append(
             f"--set {key_text(key)}: unknown to {studies}, whose run{'s' * (len(lack) > 1)} will refuse it"

@@ -40,7 +40,7 @@ from sim.ends import stdout_failed, unshown
 from sim.env_vars import environment_problem
 from sim.execute import check_sweep, execute, sweep_limits
 from sim.long_words import clipped
-from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
+from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
 from sim.mc.memory_limit import memory_given
 from sim.mc.outputs import name_problem
 from sim.mc.overrides import as_read, command_values, listed, recorded
@@ -49,7 +49,7 @@ from sim.mc.progress import set_quiet
 from sim.mc.read_when import read_in_a_cell
 from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
-from sim.option_words import item_key, two_sets
+from sim.option_words import two_sets
 from sim.places import base, default_out, shown_path
 from sim.report.run_summary import off_setup, terminal_summary, write_run_readme
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
@@ -131,21 +131,9 @@ def load_run(args):
         with memory_given(getattr(args, "max_memory_gb", None)):  # a network's size (sim.batch)
             return load_picking_chunk(args.study, picks, overrides, args.trials, args.seed)
     except ConfigError as e:  # --set trials=40,seed=3: two overrides in one, named
-        if hint := two_sets(args.set, e.key) or item_key(e.key, e.detail, _schema(args.study)):
+        if hint := two_sets(args.set, e.key):
             raise ConfigError(e.key, e.detail + hint) from None
         raise
-
-
-def _schema(path):
-    """For :func:`sim.option_words.item_key`: the keys of the study ``path`` names, or None."""
-
-    def keys():
-        try:
-            return get_study(read_toml(path).get("study")).schema
-        except ConfigError:
-            return None
-
-    return keys
 
 
 def _run(args) -> int:

@@ -69,6 +69,8 @@ def _of_another(message: str, cmds: dict, cmd: str | None, given: list[str]) -> 
         return None
     bad = next((w for w in m.group(1).split(" ") if w.startswith("-") and w != "-"), "")
     word = bad.split("=")[0]
+    if not any(word in p._option_string_actions for p in cmds.values()):
+        word = word.lower()  # sim check --Trials 40: no guess (sim run's --trials meant)
     has = [c for c, p in cmds.items() if c != cmd and word in p._option_string_actions]
     if not has or word in cmds[cmd]._option_string_actions:
         return None

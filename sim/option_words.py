@@ -13,9 +13,8 @@ guess."""
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Mapping
 
-__all__ = ["Meant", "meant", "set_split", "command_word", "two_sets", "item_key"]
+__all__ = ["Meant", "meant", "set_split", "command_word", "two_sets"]
 
 #: an option, and the words of other tools that mean it
 SYNONYMS: dict[str, tuple[str, ...]] = {
@@ -297,47 +296,3 @@ def two_sets(overrides: list[str], key: str | None) -> str:
         parts = [f"{k.strip()}={p}" if i == 0 else p for i, p in enumerate(_SECOND.split(value))]
         return f" (one KEY=VALUE a --set: {' '.join(f'--set {p}' for p in parts)})"
     return ""
-
-
-#: a key that names an item of a list (``network.generate[1].sigma_arcsec``, ``...generate.1...``)
-_ITEM = re.compile(r"^([A-Za-z_][\w.]*?)(?:\[(\d+)\]|\.(\d+))(?:\.|$)")
-
-
-def item_key(
-    key: str | None, detail: str, schema: Callable[[], Mapping | None], swept: bool = False
-) -> str:
-    """`` (network.generate is a list: ...)`` for an unknown ``key`` that names an item of a
-    list or a field of one (``--set network.generate[1].sigma_arcsec=3``: "unknown key"
-    alone), saying to give the whole list; "" otherwise. Only for a key that is a list:
-    ``schema()`` gives the study's keys (their :class:`~sim.mc.config.Field`; None when the
-    study is not known), read only for a key of that form. Before, any key of that form was
-    called a list, to be given whole by ``--set``: an integer (``plate.grid[0]``), a table
-    (``errors.1``), a key the study does not have, a sweep's values (``sweep.plate.grid.0``,
-    which ``--set`` refuses). A field of the items named without an index
-    (``network.grids.spacing_mm``) is read the same way. ``swept``: ``key`` is a key of a ``[sweep]`` table
-    (``"network.grids[0].spacing_mm" = [40.0, 60.0]``: "unknown key" alone, a designer
-    sweeping a plate's spacing left to read the code): sweep the whole list, one a cell."""
-    m = _ITEM.match(key or "")
-    parts = (key or "").split(".")
-    if (m is None and len(parts) < 3) or not detail.startswith("unknown key"):
-        return ""
-    keys = schema() or {}
-    # a field of the items without an index (network.grids.spacing_mm): the list is named too
-    heads = [".".join(parts[:i]) for i in range(len(parts) - 1, 1, -1)]
-    name = m.group(1) if m else next((h for h in heads if h in keys), "")
-    field = keys.get(name)
-    if field is None or not _LIST_KIND.match(field.kind):
-        return ""
-    if swept:
-        return (
-            f" ({name} is a list: its items have no keys of their own; sweep the whole list,"
-            f' one list a cell: "{name}" = [[...], [...]])'
-        )
-    return (
-        f" ({name} is a list: its items have no keys of their own; give the whole list, "
-        f"--set '{name}=[...]', or edit the study file)"
-    )
-
-
-#: the kinds of :class:`~sim.mc.config.Field` whose value is a list
-_LIST_KIND = re.compile(r"^(?:list\[|points$|records$)")

@@ -36,8 +36,6 @@ import os
 import shutil
 from pathlib import Path
 
-import pyarrow as pa
-import pyarrow.parquet as pq
 import pytest
 
 import sim
@@ -45,6 +43,7 @@ from sim.batch_checks import why_stale
 from sim.cli import main
 from sim.report.verify.rerun import verify
 from tests.conftest import tiny_overrides
+from tests.hand_edits import edit_first_value
 from tests.oneline import one_line
 from tests.within import within
 
@@ -57,18 +56,6 @@ def _copy(tiny_run, tmp_path: Path, name: str = "network_plate") -> Path:
     d = tmp_path / "res" / name
     shutil.copytree(tiny_run(name), d, symlinks=True)
     return d
-
-
-def _edit_first_value(d: Path) -> float:
-    """Add 1 to the first claim's ``value`` in ``d/claims.parquet``, its metadata kept (as a
-    careful edit with pyarrow keeps it); the value now there."""
-    p = d / "claims.parquet"
-    t = pq.read_table(p)
-    i = t.column_names.index("value")
-    v = t["value"].to_pylist()
-    v[0] += 1.0
-    pq.write_table(t.set_column(i, t.schema.field(i), pa.array(v, t.schema.field(i).type)), p)
-    return v[0]
 
 
 def test_a_readme_made_a_fifo_is_kept_and_never_opened(tiny_run, tmp_path, capsys):
@@ -98,7 +85,7 @@ def test_a_broken_run_record_is_named_not_taken_as_none(tiny_run, tmp_path, caps
     directory as an older version's results (no shapes recorded) and printed the edited value
     as the run's, exit 0; each now refuses naming the run.json."""
     d = _copy(tiny_run, tmp_path)
-    edited = _edit_first_value(d)
+    edited = edit_first_value(d)
     touch(d / "run.json")
     rec = str(d / "run.json")
     one_line(capsys, within(60, main, ["show", str(d)]), rec, words, "run the study again")
@@ -120,7 +107,7 @@ def test_a_run_record_saved_with_a_utf8_signature_is_read(tiny_run, tmp_path, ca
     assert json.loads(rec.read_text("utf-8-sig"))["code_hash"]
     assert sim.Results(d, "network").claims().num_rows > 0  # the run's tables: read
     assert why_stale(PLATE, d, args) is None  # was "its run record or study file does not load"
-    _edit_first_value(d)
+    edit_first_value(d)
     one_line(capsys, main(["show", str(d)]), "claims.parquet", "value")
     with pytest.raises(sim.ConfigError, match="is not the table its run wrote"):
         sim.Results(d, "network").claims()
@@ -153,7 +140,7 @@ def test_a_record_without_shapes_checks_the_tables_by_their_sha256(tiny_run, tmp
     del rec["table_shape"]
     (d / "run.json").write_text(json.dumps(rec), "utf-8")
     assert sim.Results(d, "network").claims().num_rows > 0  # the run's own: read
-    _edit_first_value(d)
+    edit_first_value(d)
     one_line(capsys, main(["show", str(d)]), "claims.parquet", "sha256")
     with pytest.raises(sim.ConfigError, match="claims.parquet is not the table its run wrote"):
         sim.Results(d, "network").claims()

@@ -14,7 +14,6 @@ error amplitude); the report lists them so nobody mistakes them for predictions.
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
 import tomllib
@@ -22,15 +21,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from sim.mc.lookalike import looks, note, toml_char_hint
-from sim.mc.message_text import cut_text, key_text, near_keys, shorten, shown, unit_hint
+from sim.mc.lookalike import note, toml_char_hint
+from sim.mc.message_text import cut_text, key_text, shorten, shown, unit_hint
 from sim.mc.not_toml import kind_hint
 from sim.mc.numtext import UnheldError, number_text, toml_float, unsigned_zeros
 from sim.mc.pickled_error import remade
 from sim.mc.study_file import study_file_problem
 from sim.mc.text_bytes import NotText, utf8_text
 from sim.mc.toml_dates import as_written
+from sim.mc.toml_slips import quote_hint, slip_hint
 from sim.mc.toml_twice import twice_text
+from sim.mc.unknown_key import did_you_mean, unknown_key_hint
 
 __all__ = [
     "ConfigError",
@@ -247,25 +248,8 @@ def flatten(d: Mapping, prefix: str = "") -> dict[str, Any]:
     return out
 
 
-def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
-    """The schema keys a mistyped ``key`` most likely meant (at most ``n``): the key that looks
-    the same (:func:`sim.mc.lookalike.looks`: another case, white space, a lookalike letter;
-    paper.positions with a Cyrillic a was "did you mean design.positions or paper.positions"),
-    the key with a unit suffix (``comparator.beta`` -> ``comparator.beta_mm``), the same last
-    part under another table, or the closest spellings (difflib)."""
-    names = list(schema)
-    same_case = [s for s in names if looks(s) == looks(key)]  # TRIALS, "trials ", triаls
-    suffixed = [s for s in names if s.startswith(key + "_") and "." not in s[len(key) :]]
-    last = key.split(".")[-1]
-    same_last = [s for s in names if s.split(".")[-1] == last]
-    close = difflib.get_close_matches(key, names, n=n, cutoff=0.75)
-    return list(dict.fromkeys(same_case + suffixed + same_last + close))[:n]
-
-
-#: quotes an editor or a web page puts where a plain " or ' was typed (“plate.grid=4”)
 #: the white space TOML reads around a key and a value (a no-break space is none: a character)
 TOML_SPACE = " \t"
-TYPOGRAPHIC = "\u201c\u201d\u2018\u2019\u201e\u00ab\u00bb"
 
 
 class Resolved(dict):
@@ -314,16 +298,8 @@ def validate(
         except UnheldError as e:  # 1e-400: not 0, silently
             raise ConfigError(key, str(e)) from None
     for key in raw:
-        if key not in schema:
-            near = did_you_mean(key, schema)
-            hint = near_keys(key, near)  # its unit said: spacing_um for spacing_mm
-            if inner := [s for s in schema if s.startswith(f"{key}.")][:3]:  # --set plate=4
-                hint = f" ({key} is a table: give one of its keys, {', '.join(inner)}, ...)"
-            curly = [c for c in key if c in TYPOGRAPHIC]
-            if curly:  # --set “plate.grid=4” pasted from a web page or a word processor:
-                # "did you mean plate.grid?" alone reads as the same key
-                hint = f' (it holds the typographic quote {curly[0]}: type a plain " or none)'
-            raise ConfigError(key, f"unknown key{hint}")
+        if key not in schema:  # what was meant (sim.mc.unknown_key: the batch's words too)
+            raise ConfigError(key, f"unknown key{unknown_key_hint(key, schema)}")
     cfg = Resolved()
     cfg.given = frozenset(raw if set_keys is None else set_keys)
     for key, f in schema.items():
@@ -379,9 +355,8 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         at = re.search(r"at line (\d+), column (\d+)", str(e))  # before 3.14: in the text only
         n, col = (int(at.group(1)), int(at.group(2))) if at else (0, 0)
         line = "".join(text.split("\n")[n - 1 : n] if n else [])  # as tomllib
-        curly = [c for c in line if c in TYPOGRAPHIC]  # a word processor's quotes
-        hint = f' (the typographic quote {curly[0]} is no TOML quote: type ")' if curly else ""
-        hint = hint or kind_hint(text) or toml_char_hint(line, col)
+        hint = quote_hint(line) or kind_hint(text) or toml_char_hint(line, col)
+        hint = hint or slip_hint(text, str(e), n, col)  # what was meant (sim.mc.toml_slips)
         twice = twice_text(text, str(e))  # the key given twice, named (tomllib names none)
         raise ConfigError(None, f"{p}: malformed TOML: {twice or e}{hint}") from None
     except RecursionError:

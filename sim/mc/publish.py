@@ -110,9 +110,9 @@ def changed_figure(out: Path, missing_ok: bool = False) -> str | None:
             )
         p = out / f
         if not p.is_file():
-            if missing_ok:
+            odd = odd_file(p)  # a FIFO in its place: not "missing", and refused where a
+            if missing_ok and not odd:  # missing one is let be (it was passed as missing)
                 continue
-            odd = odd_file(p)  # a FIFO in its place: not "missing"
             return (
                 f"{p} is {odd}, not the figure its run drew"
                 if odd

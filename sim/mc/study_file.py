@@ -66,7 +66,7 @@ def _near(p: Path) -> str | None:
     ``studies/brown_table1.toml`` beside it (L37)."""
     stem = _stem(p.name)
     seen: dict[str, Path] = {}
-    for d in [p.parent] + (_studies_dirs() if _bare(p) else []):
+    for d in [_folded_dir(p.parent)] + (_studies_dirs() if _bare(p) else []):
         try:
             with os.scandir(d) as it:  # a few hundred names at most: not a whole disk
                 for e in itertools.islice(it, 2000):
@@ -77,6 +77,30 @@ def _near(p: Path) -> str | None:
     same = [n for n in seen if looks(n) == looks(stem) and n != stem]
     close = same + difflib.get_close_matches(stem, list(seen), n=3, cutoff=0.75)
     return next((str(seen[n]) for n in close if _names_a_study(seen[n])), None)
+
+
+def _folded_dir(d: Path) -> Path:
+    """``d``, or when it is not a directory, the one whose names look the same as its, part by
+    part (another case, a lookalike letter): ``Studies/Brown_Table1.toml`` was "no such study
+    file" with no guess, the directory ``Studies`` being none (``studies`` is)."""
+    if d.is_dir() or d == Path("."):
+        return d
+    parts = d.parts
+    at = Path(parts[0]) if d.is_absolute() else Path(".")
+    for part in parts[1:] if d.is_absolute() else parts:
+        if (at / part).is_dir() or part in (".", ".."):
+            at = at / part
+            continue
+        try:
+            with os.scandir(at) as it:  # a few hundred names at most: not a whole disk
+                names = [e.name for e in itertools.islice(it, 2000) if e.is_dir()]
+        except OSError:
+            return d
+        same = [n for n in names if looks(n) == looks(part)]
+        if len(same) != 1:
+            return d
+        at = at / same[0]
+    return at
 
 
 def _stem(name: str) -> str:

@@ -54,7 +54,7 @@ from sim.mc.numtext import UnheldError, unsigned_zeros
 from sim.mc.progress import Progress
 from sim.mc.runner import MIN_CHUNKS, chunk_rng
 from sim.mc.toml_text import toml_value
-from sim.option_words import item_key
+from sim.mc.unknown_key import item_hint
 
 __all__ = [
     "SWEEP_KEY",
@@ -230,7 +230,7 @@ def expand(table: Mapping[str, Any], schema: Mapping | None = None):
             # its unit said, as --set says it (sweep.plate.spacing_um's values in mm)
             hint = near_keys(f"sweep.{k}", [f"sweep.{n}" for n in near])
             # "network.grids[0].spacing_mm": the whole list is swept, one list a cell
-            hint = item_key(k, "unknown key", lambda: schema, swept=True) or hint
+            hint = item_hint(k, schema, swept=True) or hint
             raise ConfigError(f"sweep.{k}", f"unknown key{hint}")
         if schema is not None and getattr(schema[k], "sweep", None):
             raise ConfigError(f"sweep.{k}", f"cannot be swept: {schema[k].sweep}")

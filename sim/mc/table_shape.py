@@ -37,7 +37,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from sim.mc import tolerance
-from sim.mc.storage import RECORD, read_record, regular_text
+from sim.mc.storage import RECORD, code_hash, read_record, regular_text
 
 __all__ = [
     "SHAPE_KEY",
@@ -218,6 +218,12 @@ def sum_problem(path: str | Path) -> str | None:
         if (rec := read_record(root)) is None:
             continue
         sums = rec.get("table_sha256")
+        if sums is None and SHAPE_KEY not in rec and "files" in rec and _this_code(rec):
+            return (  # sealed by this code (files, both written by sim.mc.publish.seal): an
+                # older version's record is so, one of this code's was edited (read unchecked)
+                "its run record holds neither table_sha256 nor table_shape, which this "
+                "version's runs record (removed by hand?)"
+            )
         want = sums.get(key) if isinstance(sums, dict) else None
         if not isinstance(want, str):
             return None
@@ -229,6 +235,16 @@ def sum_problem(path: str | Path) -> str | None:
             return "its sha256 is not the one its run recorded, which holds no shape of it"
         return None
     return None
+
+
+def _this_code(rec: dict) -> bool:
+    """Whether the run record ``rec`` is of a run of this code (its ``code_hash`` this code's
+    hash of its study): such a run recorded every table's sha256 and shape."""
+    study = rec.get("config", {}).get("study") if isinstance(rec.get("config"), dict) else None
+    try:
+        return isinstance(study, str) and rec.get("code_hash") == code_hash(study)
+    except (OSError, ValueError, SyntaxError):  # a source of ours unreadable: not known
+        return False
 
 
 def recorded_shape(path: str | Path) -> dict | None:

@@ -265,8 +265,11 @@ def older(prov: dict, names) -> str:
 def check_claims_table(f: Path, key: str) -> None:
     """A results directory's claims table ``f`` must be one the suite wrote, of the study its
     ``run.json`` names (a :class:`ConfigError` for ``key``, naming the file, if not; nothing
-    when there is no table)."""
-    if not f.is_file():
+    when there is no table; a sweep's top directory, its run record checked)."""
+    if not f.is_file():  # a sweep's top without run.json was read unchecked: as a run's now
+        sweep = f.parent / "sweep.parquet"
+        if sweep.is_file() and (bad := record_problem(sweep, missing=True)) is not None:
+            raise ConfigError(key, record_line(bad))
         return
     try:
         prov, names = read_provenance(f), pq.read_schema(f).names
@@ -341,8 +344,11 @@ def mixed_table(
     record = read_record(d)
     if record is None:  # no run record: nothing to check against
         return None
+    # a table the record does not list is none of the run's (sim.write_table of the user's, a
+    # copy): left out, as Results and verify leave it (the whole directory was refused here)
+    ran = record.get("table_sha256") if isinstance(record.get("table_sha256"), dict) else None
     for p in sorted(Path(d) / n for n in names) if names else sorted(Path(d).glob("*.parquet")):
-        if not p.is_file():
+        if not p.is_file() or (not names and ran is not None and p.name not in ran):
             continue
         try:
             prov = read_provenance(p)

@@ -170,7 +170,11 @@ def get_study(name: str) -> Study:
             "study", f'must name the study as a string, study = "..." (got {what})'
         )
     if not isinstance(name, str) or name not in MODULES:
-        raise ConfigError("study", f"unknown study {name!r}; known: {', '.join(sorted(MODULES))}")
+        near = [m for m in MODULES if isinstance(name, str) and looks(m) == looks(name)]
+        meant = f" (did you mean {near[0]}?)" if near else ""  # "Brown_Table1": no guess
+        raise ConfigError(
+            "study", f"unknown study {name!r}{meant}; known: {', '.join(sorted(MODULES))}"
+        )
     try:
         mod = importlib.import_module(MODULES[name])
     except ModuleNotFoundError as e:
