@@ -11,6 +11,9 @@ case each; each failed on the code before its fix.
   item "the gama estimate counting declared points"): 300,008 unknowns on the sparse path and
   0.547 GiB for a 3-point network, as ``sim check`` printed it. It counts the points the
   reader keeps now (observed, or fixed with coordinates): 8 unknowns, 5 KiB.
+* A study reading a results directory's own ``network.xml`` (the export, edited by hand),
+  run with ``--out`` that directory and ``--overwrite``, replaced the file it read with its
+  export: the user's file lost, exit 0. Refused now before any work, naming the key and file.
 """
 
 from __future__ import annotations
@@ -18,11 +21,13 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from conftest import TRIANGLE_NETWORK
+
+from sim.cli import main
 from sim.mc.gama_count import gama_counts
 from sim.mc.network_size import network_counts
 from sim.studies.network.gama_read import read_gama
 
-ROOT = Path(__file__).resolve().parent.parent
 NET = """<?xml version="1.0" ?>
 <gama-local xmlns="http://www.gnu.org/software/gama/gama-local">
   <network axes-xy="ne" angles="left-handed">
@@ -88,3 +93,24 @@ def test_the_estimate_counts_the_points_the_reader_keeps(tmp_path):
     assert gama_counts(p).points == len(kept)
     c = network_counts({"network.gama_xml": str(p), "solver.max_iter": 20})
     assert not c.sparse and c.points == 5
+
+
+def test_a_run_never_replaces_the_gama_file_its_study_reads(tmp_path, monkeypatch, capsys):
+    """Data loss: a study reading a results directory's own ``network.xml`` (the export, edited
+    by hand with the field's values), run with ``--out`` that directory and ``--overwrite``,
+    read the file, then replaced it with its export: the user's file was gone, exit 0. Refused
+    now before any work, naming the key and the file, which is left as it was."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK)
+    assert main(["run", "tri.toml", "--out", "r1", "--no-figures", "--quiet"]) == 0
+    mine = (tmp_path / "r1/network.xml").read_text().replace("<description>", "<description>field ")
+    (tmp_path / "r1/network.xml").write_text(mine)
+    (tmp_path / "own.toml").write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "r1/network.xml"\n'
+    )
+    capsys.readouterr()
+    rc = main(["run", "own.toml", "--out", "r1", "--overwrite", "--no-figures", "--quiet"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1, err
+    assert err.startswith("sim: error: network.gama_xml: r1/network.xml is network.xml of --out r1")
+    assert (tmp_path / "r1/network.xml").read_text() == mine
