@@ -14,6 +14,8 @@ case each; each failed on the code before its fix.
 * A study reading a results directory's own ``network.xml`` (the export, edited by hand),
   run with ``--out`` that directory and ``--overwrite``, replaced the file it read with its
   export: the user's file lost, exit 0. Refused now before any work, naming the key and file.
+* gama-local's own output (``<gama-local-adjustment>``, kept beside each input in Gama's tree)
+  given as the input: the line says what it is now (and gama-g3's ``<gnu-gama-data>``).
 """
 
 from __future__ import annotations
@@ -21,9 +23,11 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import pytest
 from conftest import TRIANGLE_NETWORK
 
 from sim.cli import main
+from sim.mc.config import ConfigError
 from sim.mc.gama_count import gama_counts
 from sim.mc.network_size import network_counts
 from sim.studies.network.gama_read import read_gama
@@ -114,3 +118,17 @@ def test_a_run_never_replaces_the_gama_file_its_study_reads(tmp_path, monkeypatc
     assert rc == 2 and len(err.splitlines()) == 1, err
     assert err.startswith("sim: error: network.gama_xml: r1/network.xml is network.xml of --out r1")
     assert (tmp_path / "r1/network.xml").read_text() == mine
+
+
+def test_gama_locals_output_given_as_its_input_says_so(tmp_path):
+    """Unclear message: GNU Gama's tree keeps each input beside its adjustment (``x.gkf``,
+    ``x.xml``); the ``.xml`` given as ``network.gama_xml`` was refused as "the root element is
+    <gama-local-adjustment>, not <gama-local>", leaving the user to know what that is. The line
+    says it is gama-local's output now, and to give the input it read."""
+    p = tmp_path / "x.xml"
+    p.write_text(
+        '<?xml version="1.0" ?>\n<gama-local-adjustment xmlns="http://www.gnu.org/software/'
+        'gama/gama-local-adjustment"><description/></gama-local-adjustment>\n'
+    )
+    with pytest.raises(ConfigError, match=r"not <gama-local> \(gama-local's output, its --xml"):
+        read_gama(p)
