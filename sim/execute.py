@@ -25,6 +25,7 @@ import numpy as np
 
 from sim.execute_sweep import check_sweep, not_the_cells, sweep_limits
 from sim.held_stops import held_stops
+from sim.input_places import check_inputs_outside
 from sim.mc.argv import most_workers
 from sim.mc.config import ConfigError, StudyError, check_chunks
 from sim.mc.estimate import chunk_note
@@ -188,6 +189,7 @@ def execute(
         raise ConfigError(None, why)
     check_place(out, shown)  # not in sim/ (a study's code hash), not below a broken link
     check_out(out, shown, record, overwrite)
+    check_inputs_outside(out, shown, cfg)  # a run never replaces the file its study reads
     stage = stage_dir(out)
     clear_replaced(stage, out, shown)  # a kill between publishing's two steps left them there
     try:

@@ -2,7 +2,10 @@
 (:mod:`sim.mc.network_size`): its points, its observations by kind and its orientation sets,
 counted in one pass of expat over the file's elements (no tree is built, no entity expanded).
 The study's reader (``sim.studies.network.gama_read``) checks the file; this only counts what
-it will read: each ``<point>`` of ``<points-observations>`` once by its id, a ``<distance>``,
+it will read: each ``<point>`` of ``<points-observations>`` that it keeps, once by its id (one
+that an observation or ``<coordinates>`` names, or fixed in xy with coordinates: the reader
+leaves out the others, as ``gama-local`` does; a file listing 150,000 such points beside a
+3-point network was counted as 300,008 unknowns on the sparse path), a ``<distance>``,
 ``<direction>`` or ``<angle>`` one row, a ``<vec>`` two (its ``dx`` and ``dy``), a point of
 ``<coordinates>`` two (its x and y), an ``<obs>`` with a direction one orientation unknown.
 The estimate had guessed them from the file's size (80 bytes an observation, 4 observations
@@ -24,10 +27,12 @@ __all__ = ["GamaCounts", "gama_counts", "MAX_COUNT_BYTES"]
 MAX_COUNT_BYTES = 256 * 1024**2
 #: the elements of an ``<obs>`` that are one observation (row) each
 _ROWS = ("distance", "direction", "angle")
+#: the attributes of such an element that name a point (an angle's ``bs``/``fs``, their aliases)
+_SIGHTS = ("to", "bs", "fs", "rs")
 
 
 class GamaCounts(NamedTuple):
-    """``points`` (distinct ids), ``rows`` (observations by kind: distance, direction, angle,
+    """``points`` (distinct ids of the points the reader keeps), ``rows`` (observations by kind: distance, direction, angle,
     dx, dy, and the observed coordinates as ``coordinates``), ``orientations`` (sets)."""
 
     points: int
@@ -54,6 +59,8 @@ def gama_counts(path: str | os.PathLike) -> GamaCounts | None:
 @functools.lru_cache(maxsize=4)
 def _counted(path: str, size: int, mtime_ns: int) -> GamaCounts | None:
     ids: set = set()
+    kept: set = set()  # fixed in xy with coordinates: the reader keeps them, observed or not
+    seen: set = set()  # named by an observation or <coordinates>
     rows = dict.fromkeys(("distance", "direction", "angle", "dx", "dy", "coordinates"), 0)
     stack: list[str] = []
     sets = [0, False]  # orientation sets, and whether the open <obs> has a direction
@@ -63,19 +70,27 @@ def _counted(path: str, size: int, mtime_ns: int) -> GamaCounts | None:
         parent = stack[-1] if stack else ""
         stack.append(tag)
         if tag == "point" and parent == "points-observations":
-            ids.add(" ".join(str(attrs.get("id", "")).split()))
+            pid = _id(attrs.get("id"))
+            ids.add(pid)
+            fixed = "xy" in str(attrs.get("fix", "")).lower()
+            if fixed and str(attrs.get("x", "")).strip() and str(attrs.get("y", "")).strip():
+                kept.add(pid)
         elif tag == "point" and parent == "coordinates":
             rows["coordinates"] += 2
+            seen.add(_id(attrs.get("id")))
         elif tag == "vec":
             rows["dx"] += 1
             rows["dy"] += 1
+            seen.update(_id(attrs.get(k)) for k in ("from", "to"))
         elif tag in _ROWS and parent == "obs":
             rows[tag] += 1
+            seen.update(_id(attrs.get(k)) for k in _SIGHTS)
             if tag == "direction" and not sets[1]:
                 sets[0] += 1
                 sets[1] = True
         elif tag == "obs":
             sets[1] = False
+            seen.add(_id(attrs.get("from")))
 
     def end(name):
         stack.pop()
@@ -91,4 +106,9 @@ def _counted(path: str, size: int, mtime_ns: int) -> GamaCounts | None:
             p.ParseFile(fh)
     except (_Stop, expat.ExpatError, OSError, ValueError, LookupError, RecursionError):
         return None
-    return GamaCounts(len(ids), rows, sets[0])
+    return GamaCounts(len(ids & (seen | kept)), rows, sets[0])
+
+
+def _id(v) -> str:
+    """An id as the reader takes it: trimmed, each run of white space one space."""
+    return " ".join(str(v or "").split())
