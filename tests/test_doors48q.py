@@ -1,0 +1,66 @@
+"""Issue 26, helper R49: a hostile reading of session 48's first merges (P48's salsig and
+gridplate shares, U48's Makefile, H48's chunk digests, R48's environment and table checks,
+L48's network estimate). Each test names the class of bad input and what was wrong before."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sim.env_vars import blas_threads_problem
+from sim.studies.gridplate.schema import no_fixed_point_share
+from sim.studies.picking import load_picking_chunk
+from sim.studies.salsig.schema import transfer_share
+
+ROOT = Path(__file__).resolve().parent.parent
+STUDIES = ROOT / "studies"
+
+
+@pytest.mark.parametrize(
+    "value, says",
+    [
+        ("9" * 5000, "OpenBLAS would ignore it"),  # strtol saturates, the cast wraps to -1
+        ("0" * 5000 + "3", None),  # atoi reads 3: a whole number of threads
+        ("-" + "7" * 4400, "OpenBLAS would ignore it"),
+    ],
+)
+def test_openblas_threads_of_thousands_of_digits_is_one_line(monkeypatch, value, says):
+    """An environment variable of thousands of digits (``OPENBLAS_NUM_THREADS=999...9``, a
+    script's runaway expansion): Python's ``int`` refuses more than 4,300 digits, and every
+    command (``sim check``, ``sim.load``) ended in that ValueError, a traceback, where the
+    variable's one line was due. It is read as OpenBLAS's ``atoi`` reads it now."""
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", value)
+    got = blas_threads_problem()
+    if says is None:
+        assert got is None
+    else:
+        assert got.startswith("OPENBLAS_NUM_THREADS: must be a whole number") and says in got
+
+
+def test_salsig_transfer_share_of_tiny_sigmas_is_their_ratios():
+    """Sigmas within their bounds whose squares underflow (``comparator.sigma_um = 1e-200``,
+    ``b8.sigma_um = 1e-200``): the FIG. 2 share divided by ``sqrt(sb**2 + sc**2) = 0``,
+    ``sim check`` said "ZeroDivisionError: float division by zero" naming no key, and
+    ``sim.load`` raised it. The share depends on the sigmas' ratio alone (the property)."""
+    _, base = load_picking_chunk(STUDIES / "salsig_encoders.toml", False)
+    for sb_over_sc in (1.0, 8.0, 0.125):
+        want = transfer_share({**base, "comparator.sigma_um": 3.0, "b8.sigma_um": 3.0 * sb_over_sc})
+        tiny = {"comparator.sigma_um": 1e-200, "b8.sigma_um": 1e-200 * sb_over_sc}
+        assert transfer_share({**base, **tiny}) == pytest.approx(want, rel=1e-12)
+
+
+def test_gridplate_no_fixed_point_share_of_tiny_sigmas_is_their_ratios():
+    """The same underflow in gridplate's share (``comparator.coord_sigma_um = 1e-170``,
+    ``grid.sigma_true_um = 0``, a stated sigma below it: each within its bounds and past
+    the earlier checks): ``sc**2 + sgt**2 = 0``, a ZeroDivisionError at ``sim check``. The
+    share depends on the sigmas' ratios alone."""
+    _, base = load_picking_chunk(STUDIES / "gridplate_two_plates.toml", False)
+    for stated, true in ((1.0, 0.0), (0.9, 0.5)):
+        sig = {"comparator.coord_sigma_um": 1.2, "grid.sigma_true_um": true * 1.2}
+        want = no_fixed_point_share({**base, **sig, "grid.sigma_stated_um": stated * 1.2})
+        tiny = {"comparator.coord_sigma_um": 1e-170, "grid.sigma_true_um": true * 1e-170}
+        got = no_fixed_point_share({**base, **tiny, "grid.sigma_stated_um": stated * 1e-170})
+        assert np.isfinite(got) and got == pytest.approx(want, rel=1e-9), (stated, got, want)
+        assert 0.0 < want < 1.0
