@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_doors37k import run_make, venv_project
 
 from sim.env_vars import blas_threads_problem
 from sim.studies.gridplate.schema import no_fixed_point_share
@@ -64,3 +65,36 @@ def test_gridplate_no_fixed_point_share_of_tiny_sigmas_is_their_ratios():
         got = no_fixed_point_share({**base, **tiny, "grid.sigma_stated_um": stated * 1e-170})
         assert np.isfinite(got) and got == pytest.approx(want, rel=1e-9), (stated, got, want)
         assert 0.0 < want < 1.0
+
+
+def _fake_pytest(d: Path, long_rc: int) -> None:
+    """The stand-in Python of :func:`venv_project` answering ``-m pytest``: the fuzz passes,
+    and the tests marked long exit ``long_rc`` (5: pytest's "no tests ran", none marked)."""
+    fake = d.parent / "python"
+    text = fake.read_text(encoding="utf-8")
+    cases = f'  *"-m pytest -m long"*) exit {long_rc};;\n  *"-m pytest"*) exit 0;;\n'
+    fake.write_text(text.replace('case "$*" in\n', 'case "$*" in\n' + cases), encoding="utf-8")
+
+
+def test_make_fuzz_passes_when_no_test_is_marked_long(tmp_path):
+    """A documented command failing after its work passed: ``make fuzz`` ran the fuzz, then
+    ``pytest -m long``, which exits 5 ("no tests ran") when no test is marked long (none was
+    when it came): make said "Error 5" and failed. No test marked long passes now; a long
+    test that fails still fails make fuzz."""
+    d = venv_project(tmp_path, ["numpy>=1"])
+    _fake_pytest(d, 5)
+    p = run_make(d, "fuzz", "FUZZ_CASES=1")
+    assert p.returncode == 0, (p.stdout, p.stderr)
+    _fake_pytest(d, 1)
+    assert run_make(d, "fuzz", "FUZZ_CASES=1").returncode != 0
+
+
+def test_make_run_jobs_is_not_a_j_word_of_a_variable_given(tmp_path):
+    """Silent nonsense: RUN_JOBS's default (make's -jN) was read from MAKEFLAGS, which holds
+    the command line's variables too: ``make reproduce RUN_FLAGS="--workers 1 -j9"`` ran 9
+    studies at a time, and with ``make -j4`` too, RUN_JOBS was "4 9", refused as a setting
+    the user never gave. make's own -j alone counts now."""
+    d = venv_project(tmp_path, ["numpy"])
+    for args, jobs in (([], "2"), (["-j4"], "4")):
+        p = run_make(d, "-n", *args, "reproduce", "RUN_FLAGS=--workers 1 -j9")
+        assert f"-m sim.batch --stale-only --report --jobs {jobs} " in p.stdout, (args, p)
