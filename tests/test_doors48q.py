@@ -10,10 +10,14 @@ import numpy as np
 import pytest
 from test_doors37k import run_make, venv_project
 
+import sim
+from sim.cli import main
 from sim.env_vars import blas_threads_problem
+from sim.mc.config import ConfigError
 from sim.studies.gridplate.schema import no_fixed_point_share
 from sim.studies.picking import load_picking_chunk
 from sim.studies.salsig.schema import transfer_share
+from tests.oneline import SIM_ERROR, one_line
 
 ROOT = Path(__file__).resolve().parent.parent
 STUDIES = ROOT / "studies"
@@ -98,3 +102,17 @@ def test_make_run_jobs_is_not_a_j_word_of_a_variable_given(tmp_path):
     for args, jobs in (([], "2"), (["-j4"], "4")):
         p = run_make(d, "-n", *args, "reproduce", "RUN_FLAGS=--workers 1 -j9")
         assert f"-m sim.batch --stale-only --report --jobs {jobs} " in p.stdout, (args, p)
+
+
+def test_set_value_of_thousands_of_digits_names_the_key(capsys):
+    """An override of over 4,300 digits (``--set trials=999...9``, ``--set 'x=[1, 999...9]'``):
+    Python's int-from-text limit inside the TOML reader was "sim: error: ValueError: Exceeds
+    the limit (4300 digits) for integer string conversion ..." naming no key (a study file's
+    was named; ``sim.load_study``'s overrides raised it raw). The key is named now."""
+    big = "9" * 5000
+    for value in (big, f"[1, {big}]"):
+        argv = ["check", str(STUDIES / "brown_table1.toml"), "--set", f"trials={value}"]
+        line = one_line(capsys, main(argv), prefix=SIM_ERROR + "trials: ")
+        assert "integer of over 4300 digits" in line, line
+    with pytest.raises(ConfigError, match="integer of over 4300 digits"):
+        sim.load_study(STUDIES / "brown_table1.toml", overrides=[f"trials={big}"])
