@@ -48,7 +48,7 @@ $(foreach s_,$(SETTINGS),$(call not_read_any,$(call misspelt,$(s_)),$(s_)="..." 
 # (each is checked by its origin here, before any of them is used).
 OWN_NAMES := VENV STAMP INSTALLING PIP_LOG VENV_LOCK VENV_USABLE MADE_IN MADE_FROM PYPROJECT_SUM \
   PYPROJECT_DEP INSTALLED_NOW INSTALLED_AT_START STUDY_FILES STUDIES SETTINGS OWN_NAMES newline comma \
-  q whole shellwords locked pip lower misspelt not_read not_read_any venv_lacks VENV_CHECK
+  q whole shellwords locked pip lower misspelt not_read not_read_any venv_lacks VENV_CHECK MAKE_JOBS
 $(foreach v_,$(OWN_NAMES),$(if $(filter command line,$(origin $(v_))),$(error make: $(v_) is \
   this Makefile's own name and not a setting (the settings: $(SETTINGS)); leave it off)))
 # A line break in a setting (RUN_FLAGS=$$'--seed 3\n--trials 40', from a script or a pasted
@@ -218,10 +218,13 @@ mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (s
 # make's own -jN (`make -j4 reproduce`) ran 2 studies at a time without a word: it is how many
 # run at a time when RUN_JOBS is not given (RUN_JOBS=N wins; -j without a number keeps 2).
 # MFLAGS holds make's options alone: MAKEFLAGS holds the command line's variables too, and a
-# word "-j9" in one of their values (RUN_FLAGS="... -j9") was taken for make's -j
-RUN_JOBS ?= $(or $(patsubst -j%,%,$(filter -j%,$(MFLAGS))),2)
+# word "-j9" in one of their values (RUN_FLAGS="... -j9") was taken for make's -j. At most
+# sim.batch's 64: `make -j$(nproc) reproduce` on a machine of more cores was refused ("--jobs:
+# must be <= 64"), naming an option the user never gave
+MAKE_JOBS = $(patsubst -j%,%,$(filter -j%,$(MFLAGS)))
+RUN_JOBS ?= $(if $(MAKE_JOBS),$(shell test $(MAKE_JOBS) -le 64 && echo $(MAKE_JOBS) || echo 64),2)
 
-reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, or make -jN's N, each with RUN_FLAGS="--workers 1": sim run options)
+reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, or make -jN's N up to 64, each with RUN_FLAGS="--workers 1": sim run options)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
 	$(PY) -m sim.batch --stale-only --report --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)

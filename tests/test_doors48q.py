@@ -97,9 +97,11 @@ def test_make_run_jobs_is_not_a_j_word_of_a_variable_given(tmp_path):
     """Silent nonsense: RUN_JOBS's default (make's -jN) was read from MAKEFLAGS, which holds
     the command line's variables too: ``make reproduce RUN_FLAGS="--workers 1 -j9"`` ran 9
     studies at a time, and with ``make -j4`` too, RUN_JOBS was "4 9", refused as a setting
-    the user never gave. make's own -j alone counts now."""
+    the user never gave. make's own -j alone counts now. A legitimate command refused:
+    ``make -j$(nproc) reproduce`` on a machine of over 64 cores passed ``--jobs 128``, which
+    sim.batch refuses ("must be <= 64", an option the user never gave); it runs 64 now."""
     d = venv_project(tmp_path, ["numpy"])
-    for args, jobs in (([], "2"), (["-j4"], "4")):
+    for args, jobs in (([], "2"), (["-j4"], "4"), (["-j128"], "64")):
         p = run_make(d, "-n", *args, "reproduce", "RUN_FLAGS=--workers 1 -j9")
         assert f"-m sim.batch --stale-only --report --jobs {jobs} " in p.stdout, (args, p)
 
