@@ -48,7 +48,7 @@ $(foreach s_,$(SETTINGS),$(call not_read_any,$(call misspelt,$(s_)),$(s_)="..." 
 # (each is checked by its origin here, before any of them is used).
 OWN_NAMES := VENV STAMP INSTALLING PIP_LOG VENV_LOCK VENV_USABLE MADE_IN MADE_FROM PYPROJECT_SUM \
   PYPROJECT_DEP INSTALLED_NOW INSTALLED_AT_START STUDY_FILES STUDIES SETTINGS OWN_NAMES newline comma \
-  q whole shellwords locked pip lower misspelt not_read not_read_any venv_lacks VENV_CHECK
+  q whole shellwords locked pip lower misspelt not_read not_read_any venv_lacks VENV_CHECK MAKE_JOBS
 $(foreach v_,$(OWN_NAMES),$(if $(filter command line,$(origin $(v_))),$(error make: $(v_) is \
   this Makefile's own name and not a setting (the settings: $(SETTINGS)); leave it off)))
 # A line break in a setting (RUN_FLAGS=$$'--seed 3\n--trials 40', from a script or a pasted
@@ -183,7 +183,8 @@ test: $(STAMP) ## lint (ruff), the layer contracts (import-linter), then the tes
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder
 
 # The tests marked long (tests/conftest.py: many seconds each, a faster test of the same class
-# runs in make test) are skipped by make test and run here, after the fuzz.
+# runs in make test) are skipped by make test and run here, after the fuzz; none marked is
+# pytest's exit 5 ("no tests ran"), which failed make fuzz after its fuzz had passed.
 # FUZZ_CASES and FUZZ_SEED are whole numbers (FUZZ_CASES=0 or -1 fuzzed nothing and passed;
 # FUZZ_CASES=abc was a pytest collection error)
 fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=300, FUZZ_SEED, FUZZ_SAVE), then the tests marked long
@@ -192,7 +193,7 @@ fuzz: $(STAMP) ## long fuzz of study files, overrides and options (FUZZ_CASES=30
 	@case "$${FUZZ_SEED:-13}" in *[!0-9]*) echo "make fuzz: FUZZ_SEED must be a whole number (got '$${FUZZ_SEED}')" >&2; exit 2;; esac
 	FUZZ_CASES=$${FUZZ_CASES:-300} $(PY) -m pytest tests/test_fuzz.py -p no:cacheprovider
 	$(if $(filter auto logical,$(TEST_WORKERS)),,$(call whole,TEST_WORKERS,0))
-	SIM_LONG_TESTS=1 $(PY) -m pytest -m long -n $(TEST_WORKERS) --dist loadfile -p no:cacheprovider
+	SIM_LONG_TESTS=1 $(PY) -m pytest -m long -n $(TEST_WORKERS) --dist loadfile -p no:cacheprovider || test $$? -eq 5
 
 # Mutation testing of the verdict rules and interval methods ([tool.mutmut] in pyproject.toml);
 # not part of `make test`: about 10-20 minutes on 2 cores. Writes docs/mutation.md.
@@ -215,10 +216,15 @@ mutation: $(STAMP) ## mutate the verdict rules, intervals and region verdicts (s
 # published: make stopped before `sim report` when one study's run failed or was killed, and
 # REPORT.md kept the old claims of the studies that had published (sim/batch_report.py).
 # make's own -jN (`make -j4 reproduce`) ran 2 studies at a time without a word: it is how many
-# run at a time when RUN_JOBS is not given (RUN_JOBS=N wins; -j without a number keeps 2)
-RUN_JOBS ?= $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),2)
+# run at a time when RUN_JOBS is not given (RUN_JOBS=N wins; -j without a number keeps 2).
+# MFLAGS holds make's options alone: MAKEFLAGS holds the command line's variables too, and a
+# word "-j9" in one of their values (RUN_FLAGS="... -j9") was taken for make's -j. At most
+# sim.batch's 64: `make -j$(nproc) reproduce` on a machine of more cores was refused ("--jobs:
+# must be <= 64"), naming an option the user never gave
+MAKE_JOBS = $(patsubst -j%,%,$(filter -j%,$(MFLAGS)))
+RUN_JOBS ?= $(if $(MAKE_JOBS),$(shell test $(MAKE_JOBS) -le 64 && echo $(MAKE_JOBS) || echo 64),2)
 
-reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, or make -jN's N, each with RUN_FLAGS="--workers 1": sim run options)
+reproduce: $(STAMP) ## run every study whose results are out of date, then rebuild results/REPORT.md (RUN_JOBS=2 at a time, or make -jN's N up to 64, each with RUN_FLAGS="--workers 1": sim run options)
 	$(call whole,RUN_JOBS,1)
 	$(call shellwords,RUN_FLAGS)
 	$(PY) -m sim.batch --stale-only --report --jobs $(RUN_JOBS) --results results $(STUDY_FILES) -- $(RUN_FLAGS)

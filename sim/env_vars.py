@@ -113,11 +113,9 @@ def blas_threads_problem() -> str | None:
     unset (its I/O threads: the same tables), no library of the suite reads
     ``MKL_NUM_THREADS`` (OpenBLAS, not MKL), and numba's are checked below."""
     v = os.environ.get("OPENBLAS_NUM_THREADS")
-    if v is None or (v.isascii() and v.isdigit() and 1 <= int(v) < 2**31):
+    if v is None or (v.isascii() and v.isdigit() and 1 <= _strtol(v) < 2**31):
         return None
-    m = re.match(r"[ \t\n\v\f\r]*([+-]?[0-9]+)", v)  # atoi's reading: (int) strtol(v)
-    long = max(min(int(m[1]), 2**63 - 1), -(2**63)) if m else 0  # strtol saturates
-    read = (long + 2**31) % 2**32 - 2**31  # and the cast to int wraps
+    read = (_strtol(v) + 2**31) % 2**32 - 2**31  # atoi's reading: (int) strtol(v), wrapped
     how = (
         f"OpenBLAS would read it as {read}"
         if read >= 1
@@ -128,6 +126,18 @@ def blas_threads_problem() -> str | None:
         "OPENBLAS_NUM_THREADS: must be a whole number of threads, 1 or more (below 2**31), or "
         f"unset (the suite then runs one a process), got {v[:40]!r}: {how}"
     )
+
+
+def _strtol(v: str) -> int:
+    """C's ``strtol(v, NULL, 10)``: the leading whitespace skipped, a sign and the digits that
+    follow, saturated at a C long's range (0 without digits). Read by Python's ``int`` whole,
+    a value of more than 4,300 digits was a ValueError (its limit on such conversions), a
+    traceback where the variable's one line was due."""
+    m = re.match(r"[ \t\n\v\f\r]*([+-]?)0*([0-9]{0,20})", v)
+    if m is None or not m[2]:
+        return 0
+    long = -int(m[2]) if m[1] == "-" else int(m[2])  # 20 digits or more: over a long's
+    return max(min(long, 2**63 - 1), -(2**63))
 
 
 #: the levels Arrow's ``ARROW_USER_SIMD_LEVEL`` takes, by machine (its ``cpu_info.cc``,

@@ -333,6 +333,8 @@ def parse_override(text: str) -> tuple[str, Any]:
         return key, val
     except RecursionError:
         raise ConfigError(key, "--set value is nested too deeply") from None
+    except ValueError:  # Python's int-from-text limit ("Exceeds the limit", naming no key)
+        raise ConfigError(key, "--set value holds an integer of over 4300 digits") from None
     if list(doc) != ["v"]:
         raise ConfigError(key, f"--set value must be one TOML value (got {val!r})")
     return key, as_written(doc["v"])  # a date quoted as TOML wrote it
@@ -344,8 +346,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     if why := study_file_problem(p):  # the one check (the batch's too, before any run)
         raise ConfigError(None, why)
     try:
-        # a UTF-8 signature skipped (it was refused as malformed TOML at line 1, column 1),
-        # UTF-16 and Latin-1 named (sim.mc.text_bytes)
+        # a UTF-8 signature skipped (refused as malformed at 1:1), UTF-16 and Latin-1 named
         doc = tomllib.loads(text := utf8_text(p.read_bytes()), parse_float=toml_float)
         refuse_big_ints("", doc)
         return as_written(doc)  # a date or time quoted in a message as TOML wrote it
@@ -403,9 +404,8 @@ def check_chunks(cfg: Mapping[str, Any]) -> None:
     if "trials" in cfg and "chunk" in cfg and cfg["chunk"] >= cfg["trials"]:
         raise ConfigError(
             "chunk",
-            f"{cfg['chunk']} >= trials ({cfg['trials']}) gives one chunk; "
-            "the jackknife intervals need at least 2 chunks (make chunk smaller "
-            "than trials)",
+            f"{cfg['chunk']} >= trials ({cfg['trials']}) gives one chunk; the jackknife "
+            "intervals need at least 2 chunks (make chunk smaller than trials)",
         )
     if "trials" in cfg and "chunk" in cfg and -(-cfg["trials"] // cfg["chunk"]) > MAX_CHUNKS:
         raise ConfigError(

@@ -173,10 +173,14 @@ def no_fixed_point_share(cfg: dict) -> float:
     """The share of calibrations expected to have a row (x' or y' of a plate) whose paper's
     re-weighting has no positive fixed point ``P_cx = s_w^2/sg^2 - k``: its misclosure
     variance ``s_w^2 = (sx'^2 + k sg_true^2) chi2(N - 3)/(N - 3)`` not above ``k`` times the
-    stated ``sg^2`` (``k = A^2 + B^2``, 1 for a near-identity comparator)."""
+    stated ``sg^2`` (``k = A^2 + B^2``, 1 for a near-identity comparator). The ratio of the
+    sigmas is taken before its square: ``sc**2 + sgt**2`` was 0 for a ``coord_sigma`` of
+    1e-170 um and a true grid sigma of 0 (within their bounds), a ZeroDivisionError at
+    ``sim check`` naming no key."""
     sc, sgt = cfg["comparator.coord_sigma_um"], cfg["grid.sigma_true_um"]
     dof = cfg["plate.grid"] ** 2 - 3
-    p = float(D.chi2_cdf(dof * cfg["grid.sigma_stated_um"] ** 2 / (sc**2 + sgt**2), dof))
+    r = cfg["grid.sigma_stated_um"] / float(np.hypot(sc, sgt))  # sc > 0: its bounds
+    p = float(D.chi2_cdf(dof * r * r, dof))
     return 1.0 - (1.0 - p) ** (2 * cfg["plate.count"])
 
 

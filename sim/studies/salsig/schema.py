@@ -9,6 +9,8 @@ vertical test's are explored in the consistent region (:mod:`sim.studies.salsig.
 
 from __future__ import annotations
 
+import math
+
 from sim.mc.config import COMMON
 from sim.mc.schema_helpers import (
     compared,
@@ -182,12 +184,14 @@ def transfer_share(cfg: dict) -> float:
     shear terms (``comparator.sigma_um`` over the grid's moment), as a share of the standard
     deviation FIG. 3's fit states for them (the marks' error, B8 and comparator, over the mark
     array's moment). The FIG. 2 transformation is systematic for all marks of a film, so
-    this share does not average out; FIG. 3's covariance leaves it out."""
+    this share does not average out; FIG. 3's covariance leaves it out. The marks' error is
+    ``hypot(sb, sc)``: ``sqrt(sb**2 + sc**2)`` was 0 for sigmas of 1e-200 um (within their
+    bounds, their squares underflow), a ZeroDivisionError at ``sim check`` naming no key."""
     sc, sb = cfg["comparator.sigma_um"], cfg["b8.sigma_um"]
     km, ext = cfg["marks.grid"], cfg["marks.extent_mm"]
     grid = _moment(cfg["grid.points"], cfg["grid.spacing_mm"])
     marks = _moment(km, ext / (km - 1))
-    return (sc / grid**0.5) / ((sb**2 + sc**2) ** 0.5 / marks**0.5)
+    return math.sqrt(marks / grid) * (sc / math.hypot(sb, sc))
 
 
 def _check_transfer(cfg: dict) -> None:
