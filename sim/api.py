@@ -338,6 +338,7 @@ class StudyHandle:
                         stage, get_study, name, out, design_config
                     ),
                     overrides=recorded(as_read(h.overrides, h.config)),  # as sim run's
+                    source=h.path,
                 )
             except ConfigError as e:
                 if e.key in _ARGUMENTS:  # the command line's option: the argument of run()
