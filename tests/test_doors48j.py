@@ -11,10 +11,14 @@ from pathlib import Path
 import pyarrow.parquet as pq
 import pytest
 from conftest import TRIANGLE_NETWORK
+from oneline import SIM_ERROR, one_line
 
 import sim
 from sim.batch_checks import why_stale
 from sim.cli import main
+from sim.mc.config import ConfigError
+from sim.report.config_diff import _values_text
+from sim.report.labels import middle
 from sim.report.verify.rerun import verify
 
 RUN = ["--quiet", "--no-figures"]
@@ -89,3 +93,50 @@ def test_a_resume_says_how_many_chunks_it_keeps_and_computes_again(batch, tmp_pa
     assert "resuming network: 19 finished chunks kept, 2 computed again" in err, err
     first = pq.read_table(batch / "B" / "alpha" / "claims.parquet").column("value")
     assert pq.read_table(out / "claims.parquet").column("value") == first  # the same trials
+
+
+def _whole_words(text: str, label: str, dots: str) -> bool:
+    """Whether ``label`` is ``text`` cut at word boundaries: its start ends, and its end
+    starts, where a word or number of ``text`` does."""
+    head, tail = label.split(dots)
+    w = lambda c: c.isalnum() or c in "_.-"  # noqa: E731
+    at = len(text) - len(tail)
+    return (
+        text.startswith(head)
+        and text.endswith(tail)
+        and not (w(text[len(head) - 1]) and w(text[len(head)]))
+        and not (w(text[at - 1]) and w(text[at]))
+    )
+
+
+def test_a_sweeps_configuration_line_cuts_its_values_between_words():
+    """Silent nonsense in a sweep's README: its configuration line gave a swept grid's value
+    cut mid-word (``[{ prefix = "G", n...sigma_mm = 0.001 }]``, ``...pacing_mm = 40.0``): the
+    shortening kept both ends by count. Now it cuts where a word ends and another starts."""
+
+    def grid(n: int, sigma: float) -> list[dict]:
+        keys = {"prefix": "G", "nx": n, "ny": n, "spacing_mm": 40.0, "role": "observed"}
+        return [{**keys, "sigma_mm": sigma}]
+
+    line = _values_text([grid(3, 0.001), grid(5, 0.002)])
+    assert (
+        line
+        == '[[{ prefix = "G", ... sigma_mm = 0.001 }], [{ prefix = "G", ... sigma_mm = 0.002 }]]'
+    )
+    text = '[{ prefix = "G", nx = 3, ny = 3, spacing_mm = 40.0, role = "observed", sigma_mm = 0.0012 }]'
+    for n in (20, 30, 40, 50, 60):
+        label = middle(text, n, "...")
+        assert len(label) <= n and _whole_words(text, label, "..."), label
+    assert middle("a" * 60, 10) == "aaaa\u2026aaaaa"  # one word: cut in its middle, as before
+
+
+def test_an_emptied_key_of_points_is_named_as_the_user_set_it(capsys):
+    """Unclear message: `--set network.grids=[]` on a grid plate (its only points) was refused
+    as "network.points: a network needs at least two points", a key the user never named.
+    The key the user set is named now (by sim check and sim.load alike)."""
+    plate = str(Path(__file__).resolve().parent.parent / "studies" / "network_plate.toml")
+    rc = main(["check", plate, "--set", "network.grids=[]"])
+    one_line(capsys, rc, "network.grids: a network needs at least two points", prefix=SIM_ERROR)
+    with pytest.raises(ConfigError) as e:
+        sim.load(plate, network__random=[], network__grids=[])
+    assert e.value.key == "network.grids" and "give 0" in str(e.value)
