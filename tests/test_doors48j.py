@@ -140,3 +140,18 @@ def test_an_emptied_key_of_points_is_named_as_the_user_set_it(capsys):
     with pytest.raises(ConfigError) as e:
         sim.load(plate, network__random=[], network__grids=[])
     assert e.value.key == "network.grids" and "give 0" in str(e.value)
+
+
+def test_a_readme_gives_the_consistent_region_once(tmp_path):
+    """A README.md said the consistent region twice at its top, "Consistent region: N
+    accepted input vectors (...)" and then the study's own "**Consistent region.** ..."
+    section (whose table gives each input's range of the region again): the line is left out
+    where the study's section gives the region."""
+    from sim.report.run_summary import write_run_readme
+    from sim.studies import design_config, get_study
+
+    d = tmp_path / "brown_table1"
+    shutil.copytree(Path(__file__).resolve().parent.parent / "results" / "brown_table1", d)
+    assert write_run_readme(d, get_study, d.name, d, design_config) is not None
+    text = (d / "README.md").read_text()
+    assert text.count("**Consistent region.**") == 1 and "accepted input vectors" not in text
