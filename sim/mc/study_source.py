@@ -25,16 +25,20 @@ __all__ = ["other_source", "recorded_source", "source_fields"]
 def source_fields(study_file: str | os.PathLike | None, out: Path) -> dict:
     """The run record's ``study_file`` (none for a study given as a config, not a file) and
     ``written_as`` (the name of the results directory ``out``)."""
-    fields: dict = {"written_as": Path(os.path.abspath(out)).name}
+    try:
+        fields: dict = {"written_as": Path(os.path.abspath(out)).name}
+    except OSError:  # the working directory removed meanwhile (execute's out is absolute)
+        fields = {"written_as": Path(out).name}
     if study_file is None:
         return fields
-    p = Path(os.path.abspath(study_file))
+    p = Path(study_file)
     try:
         with open(p, "rb") as f:  # (at most sim.mc.study_file.MAX_STUDY_BYTES: read before)
             sha = hashlib.sha256(f.read()).hexdigest()
     except OSError:  # gone since it was read: the record names it without its content
         sha = None
-    try:
+    try:  # the working directory removed meanwhile: the path as given
+        p = Path(os.path.abspath(p))
         shown = str(p.relative_to(Path.cwd()))
     except (ValueError, OSError):
         shown = str(p)
