@@ -347,6 +347,7 @@ class StudyHandle:
                         stage, get_study, name, out, design_config
                     ),
                     overrides=recorded(as_read(h.overrides, h.config)),  # as sim run's
+                    source=h.path,
                 )
             except ConfigError as e:
                 if e.key in _ARGUMENTS:  # the command line's option: the argument of run()
@@ -407,9 +408,8 @@ def _unpickled(study: Any, state: dict) -> StudyHandle:
 
 
 def _unchanged(h: StudyHandle) -> None:
-    """A handle runs the file it loaded: its config is that file's, and ``replace`` or
-    ``run(trials=...)`` read the file again, so an edited (or deleted) file would give one
-    handle two configs: refused, as is a config changed in place (:func:`check_state`)."""
+    """A handle runs the file it loaded (``replace`` and ``run(trials=...)`` read it again): an
+    edited or deleted file, or a config changed in place (:func:`check_state`), is refused."""
     check_state(h)
     check_cwd(h)
     if h.file_sha256 and _sha256(h.path) != h.file_sha256:
@@ -425,8 +425,7 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     _absolute("study_file", study_file)  # the working directory gone: not "no such study file"
     if why := study_file_problem(study_file):  # sim check's own check of a file
         raise ConfigError("study_file", why)
-    # absolute now: a handle re-loads its file (replace, run with trials or seed), and the
-    # working directory may have changed since (it would read another file of that name)
+    # absolute: a handle re-loads its file later, perhaps from another working directory
     study_file = _absolute("study_file", study_file)
     for k in overrides:
         if not _key(k).strip(".").strip() or not k.isprintable():
@@ -434,11 +433,8 @@ def load(study_file: str | os.PathLike, **overrides) -> StudyHandle:
     # each value as a study file would hold it (sim.mc.pyvalue): np.int64(40) is 40, a tuple
     # a list, Decimal("0.1") 0.1, an IntEnum member its int: validated and hashed like one
     vals = {k: as_config_value(str(k), v) for k, v in _keyed(overrides).items()}
-    for k, v in vals.items():
-        if v is None:  # it was "is required" of a key the study file gives
-            raise ConfigError(
-                k, "is None, which no study file holds: leave it out for the file's value"
-            )
+    if none := [k for k, v in vals.items() if v is None]:  # not "is required" of a file's key
+        raise ConfigError(none[0], "is None, which no study file holds: leave it out for its value")
     sha = _sha256(study_file)
     picks = "trials" in vals and "chunk" not in vals  # sim run --trials's chunk
     try:

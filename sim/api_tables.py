@@ -23,6 +23,7 @@ from sim.api_paths import why_unread
 from sim.mc.config import ConfigError
 from sim.mc.file_kind import TABLES
 from sim.mc.storage import read_provenance, read_record
+from sim.mc.study_source import other_source
 from sim.stale import other_code
 
 #: the suite's package directory: a warning points at the first line of the caller's outside it
@@ -40,7 +41,8 @@ __all__ = [
 
 
 class StaleResultsWarning(UserWarning):
-    """Results made by another version of their study's code (``make reproduce`` re-runs)."""
+    """Results made by another version of their study's code (``make reproduce`` re-runs),
+    or another study's results copied or renamed by hand into a directory of this name."""
 
 
 def owner(p: Path) -> Any:
@@ -113,14 +115,18 @@ def own_trials(d: Path, study: str) -> bool:
 
 def stale_warning(d: Path) -> None:
     """Warn (:class:`StaleResultsWarning`, once per place in the caller's code) when ``d``
-    was made by another version of its study's code, in ``sim show``'s words."""
+    was made by another version of its study's code, or holds another study's results than
+    its name says (copied or renamed by hand: :func:`sim.mc.study_source.other_source`), in
+    ``sim show``'s words."""
+    words = [other_source(d)]  # (None: it is the study its name says)
     if older := other_code(d):
-        level, f = 2, sys._getframe(1)  # the caller's line, not one of the suite's
-        while f is not None and f.f_code.co_filename.startswith(_CODE):
-            level, f = level + 1, f.f_back
-        warnings.warn(
+        words.insert(
+            0,
             f"{older} was made by another version of the suite's code (its study's code "
             "changed since): make reproduce re-runs what is stale",
-            StaleResultsWarning,
-            stacklevel=level,
         )
+    level, f = 2, sys._getframe(1)  # the caller's line, not one of the suite's
+    while f is not None and f.f_code.co_filename.startswith(_CODE):
+        level, f = level + 1, f.f_back
+    for w in filter(None, words):
+        warnings.warn(w, StaleResultsWarning, stacklevel=level)

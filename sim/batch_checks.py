@@ -31,6 +31,7 @@ from sim.mc.overrides import command_values, listed, recorded
 from sim.mc.paths import absolute
 from sim.mc.publish import changed_figure
 from sim.mc.storage import regular_text
+from sim.mc.study_source import other_source, recorded_source
 from sim.mc.sweep import read_sweep, reordered, swept_order
 from sim.mc.table_edits import edited_tables
 from sim.mc.unknown_key import unknown_key_hint
@@ -78,6 +79,11 @@ def why_stale(
         return "its run record is not one"
     if record.get("figures") is False and not args.no_figures:  # sim run --no-figures
         return "made without figures"
+    if other_source(results, Path(study_file).stem, record):  # B/alpha copied over B/beta
+        written, path = recorded_source(record)
+        return f"its run.json records a run written as {written}/" + (
+            f" from {path}" if path else ""
+        )
     # the record holds the [sweep] table beside the config, as the run wrote it: without it
     # a swept study was "made with another config: sweep" at once, and re-run every time
     want = json.loads(json.dumps({**cfg, "sweep": sweep} if sweep else cfg))

@@ -167,6 +167,7 @@ def _run(args) -> int:
         figures=not args.no_figures,
         readme=lambda stage, name: write_run_readme(stage, get_study, name, out, design_config),
         overrides=overrides,
+        source=args.study,
     )
     args.published = shown  # an interrupt from now on finds the results written
     check_interrupt()  # dropped by Python since the results were published: not exit 0

@@ -29,7 +29,7 @@ from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, check_sweep_record, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
 from sim.report_due import clear_due
-from sim.stale import other_code, stale_dirs
+from sim.stale import other_code, other_dirs, stale_dirs
 from sim.studies import MODULES, STUDY_FILES, design_config, get_study
 
 __all__ = ["show", "report"]
@@ -81,6 +81,8 @@ def show(args) -> int:
             "code changed since): make reproduce re-runs what is stale",
             file=sys.stderr,
         )
+    for why in other_dirs(d)[:1]:  # another study's results under this name (copied)
+        print(f"sim: note: {why}", file=sys.stderr)
     return 0
 
 
@@ -216,6 +218,8 @@ def report(results: Path) -> int:
             "gives the verdicts as they were; make reproduce re-runs what is stale",
             file=sys.stderr,
         )
+    for why in other_dirs(results):  # another study's numbers under a study's name
+        print(f"sim: note: {why}", file=sys.stderr)
     return 0
 
 

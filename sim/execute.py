@@ -33,6 +33,7 @@ from sim.mc.executors import StartRefused, end_dask_clusters, script_words
 from sim.mc.left_behind import clear_replaced
 from sim.mc.outputs import _chunks, _differs, _same, check_out, drop_stage, prepare_stage, stage_dir
 from sim.mc.publish import publish, seal
+from sim.mc.resumed import resumed_words
 from sim.mc.runner import ChunkStore, RunContext, make_executor
 from sim.mc.storage import (
     code_hash,
@@ -43,6 +44,7 @@ from sim.mc.storage import (
     versions,
     write_table,
 )
+from sim.mc.study_source import source_fields
 from sim.mc.sweep import cell_config, cell_label, cell_seed, expand, swept_order
 from sim.mc.table_edits import edited_chunks, edited_tables
 from sim.places import check_place
@@ -157,6 +159,7 @@ def execute(
     figures: bool = True,
     readme: Callable[[Path, str], Any] | None = None,
     overrides: list[str] | None = None,
+    source: str | os.PathLike | None = None,
 ):
     """Run a validated study config (and its sweep) into ``out`` (absolute): estimate and
     limits, output checks, executor, locked staging directory, the run, and the final
@@ -165,9 +168,9 @@ def execute(
     as up to date). ``readme(stage, name)``: writes the run's README.md into the sealed
     staging directory before it replaces ``out`` (``sim run``; written after, a failure or a
     kill there left the new results without it, or with a ``run.json`` that did not list it,
-    and exit 0). ``overrides``: the run's, as ``run.json`` records them (:mod:`sim.mc.overrides`).
-    Raises ConfigError/StudyError (one line) on any failure. Returns the run's
-    :class:`sim.mc.estimate.Estimate`."""
+    and exit 0). ``overrides``: the run's, as ``run.json`` records them (:mod:`sim.mc.overrides`);
+    ``source``: its study file (:mod:`sim.mc.study_source`). Raises ConfigError/StudyError (one
+    line) on any failure. Returns the run's :class:`sim.mc.estimate.Estimate`."""
 
     _not_in_a_starting_worker()
     shown = shown or str(out)
@@ -184,6 +187,7 @@ def execute(
         "versions": versions(),
         **({} if figures else {"figures": False}),
         **({"overrides": overrides} if overrides else {}),
+        **source_fields(source, out),
     }
     if (why := umask_problem()) is not None:
         raise ConfigError(None, why)
@@ -216,27 +220,21 @@ def execute(
         if not figures:  # figures of an earlier, killed attempt would pass for this run's
             for png in stage.rglob("*.png"):
                 png.unlink()
+        store = ChunkStore(stage / "trials", provenance(cfg))
         if resumed:
-            print(f"sim: resuming {cfg['study']}: {resumed} finished chunks found", file=sys.stderr)
+            print(f"sim: resuming {cfg['study']}: {resumed_words(store)}", file=sys.stderr)
         if dropped:  # not resumed: another version's chunks are not mixed with this one's
             print(
                 f"sim: starting {cfg['study']} over: {dropped} is replaced, not resumed",
                 file=sys.stderr,
             )
-        ctx = RunContext(
-            quiet=quiet,
-            executor=ex,
-            store=ChunkStore(stage / "trials", provenance(cfg)),
-            estimate=est,
-        )
+        ctx = RunContext(quiet=quiet, executor=ex, store=store, estimate=est)
         try:
             with ctx.progress_bar(cfg["study"]), nullcontext() if figures else without_figures():
                 run_sweep(study, cfg, sweep, stage, ctx) if sweep else study.run(cfg, stage, ctx)
             finished = True
             check_interrupt()  # dropped by Python after the last chunk: the stage is kept
-        except (ConfigError, StudyError):
-            raise
-        except (OSError, KeyboardInterrupt, SystemExit):
+        except (ConfigError, StudyError, OSError, KeyboardInterrupt, SystemExit):
             raise
         except Exception as e:
             if interrupted(e):  # Ctrl-C inside an import (or a library that wraps it)

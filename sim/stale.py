@@ -1,6 +1,8 @@
 """Results made by another version of the suite's code: a run record (``run.json``) whose
 ``code_hash`` is not its study's code hash now. ``sim show`` and ``sim report`` say so in a
-note, and so does the Python API's :class:`sim.Results` (a warning) when it reads a table."""
+note, and so does the Python API's :class:`sim.Results` (a warning) when it reads a table.
+So they do of results copied or renamed by hand from another study's directory
+(:func:`other_dirs`, :func:`sim.mc.study_source.other_source`)."""
 
 from __future__ import annotations
 
@@ -10,8 +12,9 @@ from sim.mc.codehash import study_code_hash
 from sim.mc.outputs import results_dirs
 from sim.mc.registry import MODULES
 from sim.mc.storage import read_record
+from sim.mc.study_source import other_source
 
-__all__ = ["other_code", "stale_dirs"]
+__all__ = ["other_code", "other_dirs", "stale_dirs"]
 
 
 def other_code(d: Path) -> str | None:
@@ -37,4 +40,14 @@ def stale_dirs(d: Path, first: bool = False) -> list[str]:
             continue
         if found and first:
             break
+    return found
+
+
+def other_dirs(d: Path) -> list[str]:
+    """Why each results directory at or under ``d`` holds another study's results than its
+    name says (:func:`sim.mc.study_source.other_source`), one line each."""
+    found = []
+    for r in [d, *results_dirs(d)] if d.is_dir() else []:
+        if (why := other_source(r)) is not None:
+            found.append(why)
     return found

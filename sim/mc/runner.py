@@ -205,6 +205,23 @@ class ChunkStore:
         the run wrote (its content digest differs: edited by hand): the caller computes it
         again and the file is replaced."""
         p = self.path(part, k)
+        if (table := self._checked(p, part, k, n, seed)) is None:
+            return None
+        try:
+            out = unpack(table.schema.metadata[_ARRAYS])
+        except (KeyError, ValueError, TypeError, AttributeError):
+            return None  # unreadable or foreign: recompute it
+        if keep_rows:
+            for name in table.column_names:
+                if name not in ("chunk", "trial_in_chunk"):
+                    out[ROWS + name] = table.column(name).to_numpy()
+        self.used.add(p)
+        return out
+
+    def _checked(self, p: Path, part: int, k: int, n, seed, config: bool = True):
+        """The table of chunk file ``p`` when it is chunk ``k`` of part ``part`` as the run
+        wrote it (``n``, ``seed`` None: as it records them; ``config=False``: of any study
+        and config, a sweep cell's), else None."""
         if not p.is_file():
             return None
         try:
@@ -214,20 +231,14 @@ class ChunkStore:
             want = self._identity(part, k, n if n is not None else ident.get("trials"), seed)
             if seed is None:
                 want["seed"] = ident.get("seed")
+            if not config:
+                want.update(study=ident.get("study"), config_hash=ident.get("config_hash"))
             content = ident.pop("content", None)
             if ident != want or table.num_rows != want["trials"]:
                 return None
-            if content != content_digest(table, meta[_ARRAYS]):
-                return None
-            out = unpack(meta[_ARRAYS])
+            return table if content == content_digest(table, meta[_ARRAYS]) else None
         except (OSError, KeyError, ValueError, TypeError, AttributeError, pa.ArrowException):
             return None  # unreadable or foreign: recompute it
-        if keep_rows:
-            for name in table.column_names:
-                if name not in ("chunk", "trial_in_chunk"):
-                    out[ROWS + name] = table.column(name).to_numpy()
-        self.used.add(p)
-        return out
 
     def strays(self) -> list[Path]:
         """Chunk files under the store that this run neither wrote nor read (left over from

@@ -15,11 +15,30 @@ ELLIPSIS = "\u2026"
 
 def middle(text: str, n: int, dots: str = ELLIPSIS) -> str:
     """``text`` in at most ``n`` characters keeping both ends (values that differ only at
-    their end, ``variant 01`` and ``variant 02``, stay apart)."""
+    their end, ``variant 01`` and ``variant 02``, stay apart), each cut where a word or number
+    ends or starts: the start is kept up to its half of the room, back to the last such
+    place, and the end from the first such place in what is left (a sweep's configuration
+    line read ``[{ prefix = "G", n...sigma_mm = 0.001 }]`` and ``...pacing_mm = 40.0``). A text
+    without such places on either side is cut by count."""
     if len(text) <= n:
         return text
-    head = (n - len(dots)) // 2
-    return text[:head] + dots + text[len(text) - (n - len(dots) - head) :]
+    room = n - len(dots)
+    head = room // 2
+    i = next((p for p in range(head, 0, -1) if _between(text, p)), 0)
+    j = next((p for p in range(len(text) - (room - i), len(text)) if _between(text, p)), None)
+    if i and j is not None:
+        return text[:i] + dots + text[j:]
+    return text[:head] + dots + text[len(text) - (room - head) :]
+
+
+def _between(text: str, p: int) -> bool:
+    """Whether ``text`` may be cut before position ``p``: not inside a word or number."""
+    return not (_word(text[p - 1]) and _word(text[p]))
+
+
+def _word(c: str) -> bool:
+    """A character of a word or a number (``spacing_mm``, ``0.0012``, ``-3``): no cut inside."""
+    return c.isalnum() or c in "_.-"
 
 
 #: where a shortened label may start (after one of the first) or end (before one of the

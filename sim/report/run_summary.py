@@ -342,9 +342,11 @@ def run_markdown(
         head += [f"**Verdicts:** {verdict_line(claims)}.", ""]
         if off := off_setup(study, prov.get("config") or {}):  # said once, at the top
             head += [f"**{off[0].upper()}{off[1:]}.**", ""]
-        if (reg := region_line(out)) is not None:
-            head += [reg[0].upper() + reg[1:] + ".", ""]
         body = study.report(out)
+        # the region once: a study's own region section gives it (it read twice, as
+        # "Consistent region: N accepted input vectors" and "**Consistent region.** ...")
+        if (reg := region_line(out)) is not None and "**Consistent region.**" not in body:
+            head += [reg[0].upper() + reg[1:] + ".", ""]
     return "\n".join(head) + "\n" + _relink(body, out.name) + "\n"
 
 

@@ -250,7 +250,7 @@ def load_study(
         field = study.schema.get(e.key) if isinstance(e.key, str) else None
         cwd = field is not None and "repository root" not in field.doc
         e = _beside_the_study(e, Path(path), flat) if cwd else e
-        raise _unswept(e, swept, flat, study, table) from None
+        raise _unswept(_set_key(e, overrides, values), swept, flat, study, table) from None
     refuse_unread(
         study.schema,
         cfg,
@@ -278,6 +278,15 @@ def _asked(
         or (w := getattr(schema.get(k), "read_when", None)) is None
         or w.switch not in over
     }
+
+
+def _set_key(e: ConfigError, overrides: Any, values: Any) -> ConfigError:
+    """``e`` named by the key an override set when the refusal stands for several keys
+    (``e.also``): ``--set network.grids=[]`` on a grid plate was refused as
+    "network.points: a network needs at least two points", a key the user never named."""
+    over = {parse_override(t)[0] for t in overrides} | set(values or {})
+    keys = [k for k in (e.key, *getattr(e, "also", ())) if k in over]
+    return e if not keys or keys[0] == e.key else ConfigError(keys[0], e.detail)
 
 
 #: the cells :func:`_unswept` validates to tell whether the sweep bears on a refusal

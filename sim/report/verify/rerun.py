@@ -20,6 +20,7 @@ from sim.mc.outputs import results_dirs
 from sim.mc.overrides import listed, replayable, without
 from sim.mc.paths import link_problem
 from sim.mc.storage import LOCK, read_provenance, read_record
+from sim.mc.study_source import other_source
 from sim.mc.table_edits import edited_tables
 from sim.mc.unfinished import unfinished, unfinished_in
 from sim.report.read import check_claims_table
@@ -275,7 +276,8 @@ def verify(
     out = []
     for d, study in todo:
         target = scratch / d.name
-        mixed = _not_as_written(d)  # tables of two runs (...): no run's reproduction to check
+        # tables of two runs (...), another study's results (copied): no reproduction to check
+        mixed = _not_as_written(d) or other_source(d)
         if mixed:
             out.append(Comparison(d.name, failures=[mixed]))
             continue

@@ -36,8 +36,14 @@ def _named_by(key: str) -> str:
 
 def check_points(names: list[str], xy: np.ndarray, keys: list[str]) -> None:
     """Refuse the points ``names`` at ``xy`` (mm), each placed by ``keys`` (one line)."""
-    if len(names) < 2:
-        raise ConfigError("network.points", "a network needs at least two points")
+    if len(names) < 2:  # named by the one of the three keys an override set (load_study)
+        e = ConfigError(
+            "network.points",
+            "a network needs at least two points (network.points, network.grids and "
+            f"network.random give {len(names)})",
+        )
+        e.also = ("network.grids", "network.random")
+        raise e
     dup = sorted(x for x, c in Counter(names).items() if c > 1)
     if dup:
         last = max(i for i, nm in enumerate(names) if nm == dup[0])

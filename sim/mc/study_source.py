@@ -1,0 +1,77 @@
+"""Which study file a results directory was written from, and under which name.
+
+A run records in ``run.json`` the study file it ran (``study_file``: its path, relative to
+the working directory when inside it, and the sha256 of its bytes) and the name of the
+directory it wrote (``written_as``). A network study has no name of its own: its results are
+named by their directory (a batch's ``<results>/<study file name>``), so a directory copied
+by hand over another (``cp -r B/alpha B/beta``) was shown, reported, verified and taken as
+current as ``beta`` with alpha's numbers. :func:`other_source` says so: the readers that name
+a study (``sim show``, ``sim report``, :class:`sim.Results`, ``make verify``,
+``python -m sim.batch --stale-only``) name the directory and the study file its record names.
+A record of an older version (without the fields) is read as before.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+from sim.mc.storage import read_record
+
+__all__ = ["other_source", "recorded_source", "source_fields"]
+
+
+def source_fields(study_file: str | os.PathLike | None, out: Path) -> dict:
+    """The run record's ``study_file`` (none for a study given as a config, not a file) and
+    ``written_as`` (the name of the results directory ``out``)."""
+    try:
+        fields: dict = {"written_as": Path(os.path.abspath(out)).name}
+    except OSError:  # the working directory removed meanwhile (execute's out is absolute)
+        fields = {"written_as": Path(out).name}
+    if study_file is None:
+        return fields
+    p = Path(study_file)
+    try:
+        with open(p, "rb") as f:  # (at most sim.mc.study_file.MAX_STUDY_BYTES: read before)
+            sha = hashlib.sha256(f.read()).hexdigest()
+    except OSError:  # gone since it was read: the record names it without its content
+        sha = None
+    try:  # the working directory removed meanwhile: the path as given
+        p = Path(os.path.abspath(p))
+        shown = str(p.relative_to(Path.cwd()))
+    except (ValueError, OSError):
+        shown = str(p)
+    return {**fields, "study_file": {"path": shown, "sha256": sha}}
+
+
+def recorded_source(record: dict | None) -> tuple[str | None, str | None]:
+    """``(written_as, study file path)`` of a run record (None for a field it lacks: an
+    older version's record, or one edited into another shape)."""
+    rec = record if isinstance(record, dict) else {}
+    written = rec.get("written_as")
+    sf = rec.get("study_file")
+    path = sf.get("path") if isinstance(sf, dict) else None
+    return (
+        written if isinstance(written, str) and written else None,
+        path if isinstance(path, str) and path else None,
+    )
+
+
+def other_source(d: str | Path, name: str | None = None, record: dict | None = None) -> str | None:
+    """Why the results directory ``d`` holds another study's results than its name says, or
+    None: its record was written into a directory of another name from a study file of
+    another name (copied or renamed by hand). ``name``: the study the reader expects (a
+    batch's study file name), default the directory's name; ``record``: its run record if
+    read already."""
+    here = Path(os.path.abspath(d))
+    rec = record if record is not None else read_record(here)
+    written, path = recorded_source(rec)
+    want = name if name is not None else here.name
+    if written is None or want in (written, Path(path).stem if path else None):
+        return None
+    where = f" of {path}" if path else ""
+    return (
+        f"{d} holds the results of a run{where} written as {written}/ (its run.json), not "
+        f"{want}'s (copied or renamed by hand?): run {want}'s own study file to replace them"
+    )
