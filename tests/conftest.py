@@ -110,6 +110,12 @@ SLOW_FIRST = {
 LONG_TESTS = os.environ.get("SIM_LONG_TESTS", "") not in ("", "0")
 
 
+def long_params(values, long) -> list:
+    """``values`` for ``pytest.mark.parametrize``, those in ``long`` marked ``long`` (make fuzz
+    runs them): the cheaper values guard the same property in ``make test``."""
+    return [pytest.param(v, marks=pytest.mark.long) if v in long else v for v in values]
+
+
 def pytest_configure(config):
     config.addinivalue_line(
         "markers", "long: a slow hostile-input test, run by make fuzz (SIM_LONG_TESTS=1)"

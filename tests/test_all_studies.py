@@ -26,7 +26,7 @@ from pathlib import Path
 
 import pyarrow.parquet as pq
 import pytest
-from conftest import ROOT, tiny_command
+from conftest import ROOT, long_params, tiny_command
 
 from sim.mc.storage import read_provenance
 from sim.studies import MODULES
@@ -135,7 +135,13 @@ def scheduler():
             p.wait()
 
 
-@pytest.mark.parametrize("study", sorted(MODULES))
+# the slowest kinds in make fuzz (10-35 s of CPU each): the runner's machinery is the same
+@pytest.mark.parametrize(
+    "study",
+    long_params(
+        sorted(MODULES), {"wolf_polynomial", "agnard_block", "brown_dilution", "brown_design"}
+    ),
+)
 def test_two_workers_and_a_killed_run_give_the_same_files(study, tmp_path, scheduler, tiny_run):
     name = FILES.get(study, study)
     one = tiny_run(name)  # 1 worker, in process

@@ -43,6 +43,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import long_params
 
 from sim.mc.config import ConfigError
 from sim.mc.estimate import ADJUSTMENT_S, check_limits, estimate
@@ -119,7 +120,8 @@ AGNARD_MEASURED = {
 }
 
 
-@pytest.mark.parametrize("size", list(AGNARD_MEASURED))
+# the 100,000-point size (30 s of CPU) in make fuzz
+@pytest.mark.parametrize("size", long_params(list(AGNARD_MEASURED), {(2, 8, 100000, 0.0)}))
 def test_agnard_work_counts_points_and_models(size):
     S, M, G, relief = size
     sets = {
