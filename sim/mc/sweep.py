@@ -82,6 +82,8 @@ def _flatten_sweep(d: Mapping, prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in d.items():
         key = f"{prefix}{k}"
+        if isinstance(v, dict) and not v:  # "datum.kind" = {} beside a swept key was dropped
+            raise ConfigError(f"sweep.{key}", "is an empty table: give a list or a range")
         inner = (
             _flatten_sweep(v, key + ".") if isinstance(v, dict) and not _is_range(v) else {key: v}
         )
