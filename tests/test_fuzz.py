@@ -225,8 +225,9 @@ def test_fuzz_splice(tmp_path, capsys):
 def test_fuzz_sweep_levels(tmp_path, capsys, monkeypatch):
     """SWEEP LEVELS (tests/fuzz_sweep.py) by ``sim check``: a small ``[sweep]`` table of each
     study with a level mutated must be refused in one line naming the key as written (a
-    level of the wrong type may be read as one instead: ``0x10``); in ``make fuzz`` a work limit against
-    thousands of cells, and a third of the files that pass run by ``sim run`` (fuzz_run)."""
+    level of the wrong type may be read as one instead: ``0x10``); in ``make fuzz`` a work
+    limit against thousands of cells too, and a third of the files that pass run by
+    ``sim run`` (tests/fuzz_run.py)."""
     n, long = max(2, CASES // 5), CASES > 14
     schemas = {s: load_study(ROOT / "studies" / f"{s}.toml")[0].schema for s in NAMES}
     failures = []
