@@ -229,13 +229,13 @@ def test_fuzz_sweep_levels(tmp_path, capsys, monkeypatch):
     limit against thousands of cells too, and a third of the files that pass run by
     ``sim run`` (tests/fuzz_run.py)."""
     n, long = max(2, CASES // 5), CASES > 14
-    schemas = {s: load_study(ROOT / "studies" / f"{s}.toml")[0].schema for s in NAMES}
     failures = []
     for i in range(n):
         rng, name = random.Random(SEED * 100_003 + 66_666 + i), NAMES[i % len(NAMES)]
-        lines, desc, needle, env, key = sweep_case(rng, base(name), schemas[name], long)
+        schema = load_study(ROOT / "studies" / f"{name}.toml")[0].schema
+        lines, desc, needle, env, key = sweep_case(rng, flat := base(name), schema, long)
         (d := tmp_path / f"case{i}").mkdir()
-        (f := d / "study.toml").write_text(toml_doc(base(name)) + "\n".join(lines) + "\n")
+        (f := d / "study.toml").write_text(toml_doc(flat) + "\n".join(lines) + "\n")
         with monkeypatch.context() as m:
             for k, v in env.items():
                 m.setenv(k, v)
