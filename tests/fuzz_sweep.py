@@ -80,10 +80,11 @@ def _lines(sweep: dict, tables: bool) -> list[str]:
     return out
 
 
-def sweep_case(rng: random.Random, flat: dict, schema: dict, huge_work: bool = False):
+def sweep_case(rng: random.Random, flat: dict, schema: dict, huge_work=False, kind=None):
     """``(lines, description, needle, environment, key)``: the ``[sweep]`` table's lines for
     ``flat``'s study file, mutated; the one-line refusal must hold ``needle`` (None: exit 0,
-    or a refusal naming ``key``), under the variables ``environment`` sets."""
+    or a refusal naming ``key``), under the variables ``environment`` sets; ``kind`` one of
+    :data:`KINDS` (default: drawn)."""
     keys = [
         k
         for k, f in schema.items()
@@ -97,7 +98,7 @@ def sweep_case(rng: random.Random, flat: dict, schema: dict, huge_work: bool = F
         sweep[k2] = _levels(schema[k2], flat[k2])
     if rng.random() < 0.2:
         sweep["replicates"] = 2
-    kind = rng.choice(KINDS + ["huge"] * huge_work)
+    kind = kind or rng.choice(KINDS + ["huge"] * huge_work)
     name, env = f"sweep.{k}", {}
     levels = sweep[k]
     if kind == "type":

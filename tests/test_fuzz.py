@@ -233,7 +233,8 @@ def test_fuzz_sweep_levels(tmp_path, capsys, monkeypatch):
     for i in range(n):
         rng, name = random.Random(SEED * 100_003 + 66_666 + i), NAMES[i % len(NAMES)]
         schema = load_study(ROOT / "studies" / f"{name}.toml")[0].schema
-        lines, desc, needle, env, key = sweep_case(rng, flat := base(name), schema, long)
+        kind = None if long else ("empty", "duplicate")[i % 2]  # make test: the classes fixed
+        lines, desc, needle, env, key = sweep_case(rng, flat := base(name), schema, long, kind)
         (d := tmp_path / f"case{i}").mkdir()
         (f := d / "study.toml").write_text(toml_doc(flat) + "\n".join(lines) + "\n")
         with monkeypatch.context() as m:
