@@ -51,7 +51,10 @@ a seven cases, at least two; ``FUZZ_PAIR_SECONDS``). The FILE SYSTEM under a run
 and the reverse at every level of the output tree: tests/fuzz_fs.py; ``test_fuzz_file_system``:
 one case a seven, at least two; ``FUZZ_FS_SECONDS``) must give exit 0 or one line naming the
 file or the thing in the way, change nothing beside the results, and then, the limit lifted or
-the thing moved away, the clean run's results."""
+the thing moved away, the clean run's results. The LEVELS of a small ``[sweep]`` table (a level
+of the wrong type, none, one twice, a key that is no key, a list's item by its index, more
+cells than the bound or the work limit allows: tests/fuzz_sweep.py; ``test_fuzz_sweep_levels``:
+one case a five, at least two, by ``sim check``; in ``make fuzz`` a valid one also run)."""
 
 from __future__ import annotations
 
@@ -65,9 +68,10 @@ from fuzz_cases import SEED
 from fuzz_concurrent import pairs
 from fuzz_fs import cases as fs_cases
 from fuzz_keys import network_case
-from fuzz_run import fuzz
+from fuzz_run import check_case, fuzz, run_case
 from fuzz_sequence import sequences
 from fuzz_splice import gama_splice, splice_case
+from fuzz_sweep import sweep_case
 from fuzz_values import NAMES, ROOT, base, small, toml_doc, toml_value
 
 from sim.cli import main
@@ -216,6 +220,44 @@ def test_fuzz_splice(tmp_path, capsys):
         elif needle and (rc != 2 or "\n" in err or str(x) not in err or needle not in err):
             failures.append(f"case {i} ({src.name}: {desc}): exit {rc}: {err[-300:]}")
     assert not failures, f"{len(failures)} of {4 * CASES}:\n" + "\n".join(failures)
+
+
+def test_fuzz_sweep_levels(tmp_path, capsys, monkeypatch):
+    """SWEEP LEVELS (tests/fuzz_sweep.py) by ``sim check``: a small ``[sweep]`` table of each
+    study with a level mutated must be refused in one line naming the key as written (a
+    level of the wrong type may be read as one instead: ``0x10``); in ``make fuzz`` a work
+    limit against thousands of cells too, and a third of the files that pass run by
+    ``sim run`` (tests/fuzz_run.py)."""
+    n, long = max(2, CASES // 5), CASES > 14
+    failures = []
+    for i in range(n):
+        rng, name = random.Random(SEED * 100_003 + 66_666 + i), NAMES[i % len(NAMES)]
+        schema = load_study(ROOT / "studies" / f"{name}.toml")[0].schema
+        kind = None if long else ("empty", "duplicate")[i % 2]  # make test: the classes fixed
+        lines, desc, needle, env, key = sweep_case(rng, flat := base(name), schema, long, kind)
+        (d := tmp_path / f"case{i}").mkdir()
+        (f := d / "study.toml").write_text(toml_doc(flat) + "\n".join(lines) + "\n")
+        with monkeypatch.context() as m:
+            for k, v in env.items():
+                m.setenv(k, v)
+            rc = main(["check", str(f)])
+        err = capsys.readouterr().err.strip()
+        said = [ln for ln in err.splitlines() if ln.strip()]
+        # two keys swept, every cell refused: named by the key its reasons name, or "sweep"
+        every = needle is None and err.startswith("sim: error: sweep") and "nothing to run" in err
+        if rc not in (0, 2) or (rc == 2 and len(said) != 1) or "Traceback" in err:
+            failures.append(f"case {i} ({name}: {desc}): exit {rc}: {err[-300:]}")
+        elif (needle and rc != 2) or (rc == 2 and (needle or key) not in err and not every):
+            failures.append(
+                f"case {i} ({name}: {desc}): not refused naming {needle or key}: {err[-300:]}"
+            )
+        elif rc == 0 and long and rng.random() < 1 / 3:
+            code, _, err, secs, argv = run_case(
+                d, f, [], float(os.environ.get("FUZZ_TIMEOUT", "300"))
+            )
+            if bad := check_case(d, code, err, []):
+                failures.append(f"case {i} ({name}: {desc}; {secs:.0f} s): sim {argv}: {bad}")
+    assert not failures, f"{len(failures)} of {n}:\n" + "\n".join(failures)
 
 
 def test_fuzz_sequences(tmp_path):

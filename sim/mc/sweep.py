@@ -82,6 +82,8 @@ def _flatten_sweep(d: Mapping, prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in d.items():
         key = f"{prefix}{k}"
+        if isinstance(v, dict) and not v:  # "datum.kind" = {} beside a swept key was dropped
+            raise ConfigError(f"sweep.{key}", "is an empty table: give a list or a range")
         inner = (
             _flatten_sweep(v, key + ".") if isinstance(v, dict) and not _is_range(v) else {key: v}
         )
@@ -182,15 +184,14 @@ def _values(key: str, v: Any) -> list:
                     f"sweep.{key}",
                     f"step {s!r} gives more than {MAX_CELLS} values from {a!r} to {b!r}",
                 )
-            k = int(math.floor(count + 1e-9))
+            if all(isinstance(x, int) for x in (a, b, s)):  # exact (NumPy's int64 wrapped)
+                return [a + s * i for i in range((b - a) // s + 1)]
             with np.errstate(all="ignore"):
-                out = a + s * np.arange(k + 1)
+                out = a + s * np.arange(int(math.floor(count + 1e-9)) + 1)
         else:
             raise ConfigError(f"sweep.{key}", "a range needs num or step")
         if not np.isfinite(out).all():
             raise ConfigError(f"sweep.{key}", "the range's values are not finite")
-        if all(isinstance(x, int) for x in (a, b, v.get("step", 0))) and "num" not in v:
-            return [int(x) for x in out]
         return [float(x) for x in out]
     raise ConfigError(f"sweep.{key}", f"a sweep takes a list, e.g. {_example(key, v)} (got {v!r})")
 
@@ -250,9 +251,10 @@ def expand(table: Mapping[str, Any], schema: Mapping | None = None):
 
 
 def _same(v: Any) -> Any:
-    """What makes two values of a key one value (``1e-3`` and ``0.001``; ``4`` and ``4.0``)."""
+    """What makes two values of a key one value (``1e-3`` and ``0.001``; ``4`` and ``4.0``;
+    not ``2**53`` and ``2**53 + 1``: Python compares an int and a float exactly)."""
     if isinstance(v, (int, float, np.number)) and not isinstance(v, (bool, np.bool_)):
-        return ("number", float(v))
+        return ("number", v.item() if isinstance(v, np.number) else v)
     return ("other", repr(v))
 
 
