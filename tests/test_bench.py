@@ -81,6 +81,7 @@ def test_scan_finds_compiled_modules_under_any_alias():
     assert not compiles_through_sim_lsq_compile("f = other.compiled(g)\n")
 
 
+@pytest.mark.long
 def test_engines_and_rerun_rows_at_smoke_size(tmp_path, monkeypatch):
     monkeypatch.chdir(ROOT)
     monkeypatch.setattr(studies, "STUDIES", ("network_testfield",))

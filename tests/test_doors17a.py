@@ -63,6 +63,7 @@ STUDY = ROOT / "studies" / "network_plate.toml"
 SMALL = ["--trials", "40", "--chunk", "2"]
 
 
+@pytest.mark.long
 def test_an_api_run_leaves_the_callers_matplotlib_alone(tmp_path):
     p = python_lines(
         "import matplotlib",

@@ -37,6 +37,7 @@ from pathlib import Path
 
 import pyarrow as pa
 import pyarrow.parquet as pq
+import pytest
 from conftest import tiny_command
 from oneline import SIM_ERROR, one_line, one_line_of
 
@@ -101,6 +102,7 @@ def test_a_record_that_is_not_one_is_named_not_a_study_table(tiny_run, tmp_path,
         assert "claims.parquet" not in line and "run its study again" not in line, line
 
 
+@pytest.mark.long
 def test_an_older_versions_unfinished_run_is_not_resumed_and_says_so(tiny_run, tmp_path):
     src, out = tiny_run("brown_table1"), tmp_path / "brown_table1"
     stage = stage_dir(out)  # its run killed under older code: the same config, its chunks

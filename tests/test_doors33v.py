@@ -142,6 +142,7 @@ POINTS = (
 )
 
 
+@pytest.mark.long
 def test_arrays_quoted_strings_and_a_gama_file_round_trip(tmp_path):
     (tmp_path / "studies").mkdir()
     shutil.copy(ROOT / "tests" / "data" / "gama" / "one_fixed.toml", tmp_path / "studies")
@@ -181,6 +182,7 @@ def test_arrays_quoted_strings_and_a_gama_file_round_trip(tmp_path):
     assert "run verify where the run was made" in elsewhere.stdout
 
 
+@pytest.mark.long
 def test_an_override_too_long_for_a_command_line_is_re_run(tmp_path):
     """2,500 observations given to ``sim.load`` (150 kB of TOML, over Linux's 128 KiB an
     argument): the re-run was "Argument list too long", exit 2; it now reads its arguments

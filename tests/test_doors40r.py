@@ -17,6 +17,7 @@ import importlib
 from pathlib import Path
 
 import numpy as np
+import pytest
 from oneline import one_line
 
 from sim.cli import main
@@ -32,6 +33,7 @@ SMALL = (
 ).split()
 
 
+@pytest.mark.long
 def test_an_interrupt_while_design_chains_run_says_chunks_are_missing(
     tmp_path, monkeypatch, capsys
 ):

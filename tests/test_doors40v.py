@@ -111,6 +111,7 @@ def test_a_faithful_rewrite_still_reads_as_the_run(tiny_run, tmp_path, capsys):
     assert sim.Results(d, "brown_table1").table("claims").num_rows > 0
 
 
+@pytest.mark.long
 def test_the_same_command_again_says_which_edited_tables_it_replaces(tiny_run, tmp_path):
     d = _copy(tiny_run, tmp_path)
     _edit(d / "points.parquet", lambda t: t.take(list(reversed(range(t.num_rows)))))

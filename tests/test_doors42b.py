@@ -65,6 +65,7 @@ def _parsed(frames):
             yield t, text, g[0], done, total, left
 
 
+@pytest.mark.long
 def test_the_time_left_is_not_off_by_orders_of_magnitude(frames):
     shown, end = frames
     # frames under 5 % of the work are left out: their rate comes from the error budget's

@@ -167,6 +167,7 @@ def test_an_affine_coverage_trial_is_counted_with_its_chunks_cost():
     assert design_bar_units(cfg) - design_bar_units(fewer) < more * 2.6
 
 
+@pytest.mark.long
 def test_the_agnard_bar_counts_each_parts_units_and_only_the_trials_run(tmp_path):
     """The tiny run (its resolution and re-centring error the main blocks' own): the bar ends
     with every trial it counted done and its work at its total, each part's trials at its

@@ -42,6 +42,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 NETWORK = str(ROOT / "studies" / "network_plate.toml")
 
@@ -86,6 +88,7 @@ def _env() -> dict:
     return {**os.environ, "PYTHONPATH": str(ROOT)}
 
 
+@pytest.mark.long
 def test_a_dask_run_of_a_script_read_from_standard_input(tmp_path):
     """A script piped to ``python -`` (its ``__file__`` is ``<stdin>``, no file) running
     ``executor="dask"``: the spawned workers ran ``<stdin>`` again, each printed a

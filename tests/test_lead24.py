@@ -88,6 +88,7 @@ def sweep(tmp_path_factory) -> Path:
     return d / "out"
 
 
+@pytest.mark.long
 def test_a_sweep_s_cell_figure_replaced_by_hand_is_named(sweep, tmp_path, capsys):
     d = tmp_path / "out"
     shutil.copytree(sweep, d)
