@@ -14,15 +14,18 @@ So the executor is started by a thread of its own in which SIGINT and SIGHUP are
 threads the cluster starts (its event loop's, and through it each worker's launcher) inherit
 that mask, and a process inherits it across ``exec``, so every worker (a restarted one too) and
 the resource tracker, started there first, never receive them. The run's own thread keeps its
-mask and waits: an interrupt while the cluster starts ends it as soon as its start returns
-(blocked in the run's thread instead, it waited for Dask's next ten-second check; ended while
-it starts, from another thread, Dask's start hung).
+mask and waits: an interrupt while the cluster starts kills the worker processes the start
+has begun, which ends the start at once (a nanny whose worker died fails), and then ends what
+started (blocked in the run's thread instead, it waited for Dask's next ten-second check; ended
+while it starts, from another thread, Dask's start hung; waited for, it took 2 to 17 s).
 """
 
 from __future__ import annotations
 
 import signal
 import threading
+import time
+from contextlib import suppress
 from typing import Any, Callable
 
 __all__ = ["SPARED", "start_sparing_workers"]
@@ -47,6 +50,30 @@ def _tracker_started() -> None:
     signal.pthread_sigmask(signal.SIG_BLOCK, SPARED)
 
 
+def _children() -> set[int]:
+    """The pids of this process's child processes (psutil: a dependency of Dask's)."""
+    import psutil
+
+    with suppress(psutil.Error):
+        return {p.pid for p in psutil.Process().children()}
+    return set()
+
+
+def _kill_new_children(before: set[int]) -> None:
+    """Kill this process's children that were not there ``before`` (the worker processes of
+    the cluster that starts), but for multiprocessing's resource tracker (it ends with us, and
+    killed, the semaphores the run releases get its replacement's tracebacks). Children of
+    the caller's own (the Python API) are left as they are."""
+    import psutil
+
+    with suppress(psutil.Error):
+        for p in psutil.Process().children():
+            if p.pid not in before:
+                with suppress(psutil.Error):
+                    if "resource_tracker" not in " ".join(p.cmdline()):
+                        p.kill()
+
+
 def start_sparing_workers(kind: str, make: Callable[[], Any], end: Callable[[Any], None]):
     """``make()`` (an executor of ``kind``); for ``dask`` called by a thread in which
     :data:`SPARED` are blocked (see the module). An interrupt of this thread while it waits is
@@ -67,14 +94,17 @@ def start_sparing_workers(kind: str, make: Callable[[], Any], end: Callable[[Any
         finally:
             done.set()
 
+    before = _children()
     threading.Thread(target=starting, name="sim: starting the dask executor", daemon=True).start()
     try:
         while not done.wait(0.05):
             pass
-    except BaseException:  # an interrupt while it starts: ended once started (ended while
-        started = False  # starting, Dask's start hung), or at once by a second interrupt
-        try:
-            started = done.wait(_WAIT_INTERRUPTED)
+    except BaseException:  # an interrupt while it starts: its workers are killed, which ends
+        started = False  # the start (ended by a close, from here, Dask's start hung), then it
+        try:  # is ended; at once by a second interrupt
+            deadline = time.monotonic() + _WAIT_INTERRUPTED
+            while not (started := done.wait(0.1)) and time.monotonic() < deadline:
+                _kill_new_children(before)
         finally:
             end(got.get("executor") if started else None)
         raise

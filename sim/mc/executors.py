@@ -43,9 +43,12 @@ def _worker_init(ppid: int | None) -> None:
     """In each pool worker: ignore SIGINT (the parent handles Ctrl-C and stops the pool) and
     die with the parent, even after ``kill -9`` (PR_SET_PDEATHSIG on Linux; a thread that
     watches the parent everywhere). ``ppid`` None: the worker's parent is a fork server,
-    which ends when the run's process does."""
+    which ends when the run's process does once the worker lets go of the server's "alive"
+    pipe, which every process it starts is given: held, the server and the workers each
+    waited for the other for ever after the run was killed (SIGKILL, SIGUSR1)."""
     if ppid is None:
         ppid = os.getppid()
+        _release_fork_server()
     signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)  # held by the forking parent (_Pool)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
@@ -59,6 +62,20 @@ def _worker_init(ppid: int | None) -> None:
     if os.getppid() != ppid:  # the parent died before we got here
         os._exit(1)
     threading.Thread(target=_watch_parent, args=(ppid,), daemon=True).start()
+
+
+def _release_fork_server() -> None:
+    """In a worker started by multiprocessing's fork server: close its copy of the server's
+    "alive" pipe (private to multiprocessing; left as it is where it differs), so the server
+    ends when the run's process does (a worker starts no process of its own)."""
+    from multiprocessing import forkserver
+
+    server = getattr(forkserver, "_forkserver", None)
+    fd = getattr(server, "_forkserver_alive_fd", None)
+    if isinstance(fd, int):
+        with suppress(OSError):
+            os.close(fd)
+        server._forkserver_alive_fd = None
 
 
 def process_start_method() -> str:
