@@ -79,27 +79,27 @@ def pytest_runtest_protocol(item, nextitem):
 
 
 #: the test files that take longest, slowest first, with their share (%) of the suite's
-#: summed test CPU time (measured 2026-11-27 on 2 cores: SIM_TEST_CPU_LOG, per file; a shared
-#: tiny run counts for the file that asks for it first). Under ``--dist loadfile`` a file runs
+#: summed test CPU time (measured 2026-11-30 on 2 cores: SIM_TEST_CPU_LOG, per file, the tests
+#: marked long left out; a shared tiny run counts for the file that asks for it first). Under ``--dist loadfile`` a file runs
 #: on one process; handing out the slowest files first keeps one of them from starting last
 #: and running alone at the end (the critical path). The Makefile passes
 #: --no-loadscope-reorder, or pytest-xdist would hand out the files with the most tests first
 #: instead.
 SLOW_FIRST = {
-    "test_docs.py": 23.4,
-    "test_all_studies.py": 22.5,
-    "test_verify.py": 6.1,
-    "test_network.py": 4.2,
-    "test_bench.py": 4.1,
-    "test_batch.py": 3.8,
-    "test_cli_manners.py": 3.4,
-    "test_cli.py": 3.2,
-    "test_design.py": 3.1,
-    "test_runner.py": 2.9,
-    "test_bayes.py": 2.9,
-    "test_wolf.py": 2.8,
-    "test_doors_sweep.py": 2.7,
-    "test_figures.py": 2.3,
+    "test_docs.py": 11.5,
+    "test_fuzz.py": 5.0,
+    "test_verify.py": 3.7,
+    "test_doors22b.py": 3.6,
+    "test_left12.py": 2.7,
+    "test_cli_manners.py": 2.6,
+    "test_cli.py": 2.5,
+    "test_all_studies.py": 2.1,
+    "test_batch.py": 1.9,
+    "test_network.py": 1.9,
+    "test_doors28a.py": 1.6,
+    "test_doors_sweep.py": 1.6,
+    "test_runner.py": 1.6,
+    "test_left8.py": 1.5,
 }
 
 

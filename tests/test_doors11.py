@@ -108,6 +108,7 @@ def test_ctrl_c_while_an_entry_point_loads_is_one_line_and_exit_130():
     assert done.returncode == 130 and done.stderr == "sim: interrupted\n", done
 
 
+@pytest.mark.long
 def test_the_entry_points_hand_ctrl_c_back_once_loaded():
     for mod in ("sim.__main__", "sim.batch", "sim.report.verify"):  # none runs its main
         code = (

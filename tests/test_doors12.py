@@ -66,6 +66,7 @@ def _python(*args, env=None):
     )
 
 
+@pytest.mark.long
 def test_python_OO_keeps_the_usage_text():
     assert module_doc(None, cli.__file__) == cli.__doc__ == cli.DOC
     assert module_doc(None, batch.__file__) == batch.__doc__

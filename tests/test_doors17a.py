@@ -151,6 +151,7 @@ def test_the_command_line_runs_in_a_thread_that_is_not_the_main_one(capsys):
     assert done["rc"] == 0, (done, capsys.readouterr().err)
 
 
+@pytest.mark.long
 def test_a_library_shadowed_or_missing_is_one_line(tmp_path):
     # a file of a library's name on PYTHONPATH (or in the working directory): a traceback at
     # load (tqdm.py: "cannot import name 'tqdm'"; numpy.py: pyarrow's AttributeError), an

@@ -134,6 +134,7 @@ def test_verify_prints_only_its_own_lines(tmp_path):
     assert p.stdout.startswith("network_plate: ok; ") and p.stdout.count("\n") == 1, p.stdout
 
 
+@pytest.mark.long
 def test_output_redirected_into_the_results_directory_is_kept(tmp_path):
     """``sim run ... --out DIR > DIR/log.txt`` over an earlier run into DIR: the user's log was
     carried into the new results as a copy made before the run printed a word, and what it
@@ -156,6 +157,7 @@ def test_output_redirected_into_the_results_directory_is_kept(tmp_path):
         assert f"results in {out}/" in text, (trials, text)
 
 
+@pytest.mark.long
 @pytest.mark.skipif(not FULL.exists(), reason="needs /dev/full")
 def test_batch_of_one_job_says_a_full_output_once(tmp_path):
     """``python -m sim.batch --jobs 1`` passed its standard output to the runs: a full one was
@@ -218,6 +220,7 @@ def test_verify_long_output_that_cannot_be_written(tmp_path, capsys, monkeypatch
         assert line == "sim verify: error: No space left on device: standard output"
 
 
+@pytest.mark.long
 def test_a_directory_name_that_begins_with_a_dash_reaches_the_runs(tmp_path):
     """``python -m sim.batch --results=-r`` (and ``make verify`` ``--scratch=-s``) handed each
     run ``--out -r/<study>``, which sim run read as an option: "argument --out: expected one
@@ -265,6 +268,7 @@ def _closed_stderr(*argv: str, cwd=ROOT) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.mark.long
 def test_a_closed_standard_error_keeps_errors_out_of_standard_output(tmp_path):
     """With standard error closed Python leaves ``sys.stderr`` None, and ``print(...,
     file=sys.stderr)`` wrote to standard output: ``sim check STUDY --set trials=-1 2>&- >

@@ -97,6 +97,7 @@ kind = "fixed"
 """
 
 
+@pytest.mark.long
 def test_a_sweep_png_replaced_by_hand_is_not_shown_as_the_run_s(tmp_path, run_dir, capsys):
     from sim.report.sweep import sweep_markdown
 

@@ -85,6 +85,7 @@ def _read_only(monkeypatch, top: Path) -> None:
     monkeypatch.setattr(pathlib.Path, "write_text", write_text)
 
 
+@pytest.mark.long
 def test_sim_report_on_a_read_only_mount_names_the_readme_not_its_temporary(
     tiny_run, tmp_path, monkeypatch, capsys
 ):

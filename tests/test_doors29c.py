@@ -50,6 +50,7 @@ TABLE1 = str(ROOT / "studies" / "brown_table1.toml")
 SMALL = {"trials": 40, "chunk": 2}
 
 
+@pytest.mark.long
 def test_an_interrupt_in_a_first_import_does_not_poison_the_process(tmp_path):
     """In a fresh Python: Ctrl-C (raised by the import system, as the signal handler would)
     in numba's first import, then in matplotlib's; each next run imports the library anew."""

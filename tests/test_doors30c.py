@@ -146,6 +146,7 @@ def _run(h: sim.StudyHandle, out: str) -> int:  # a task of a pool of the user's
     return h.run(out=out, quiet=np.True_, figures=np.False_).claims().num_rows
 
 
+@pytest.mark.long
 def test_a_handle_pickles_and_runs_in_a_spawned_process(tmp_path):
     st = sim.load(TABLE1, **SMALL)  # its study holds closures (the claim book's check)
     again = pickle.loads(pickle.dumps(st))

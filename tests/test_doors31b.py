@@ -31,10 +31,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 TABLE1 = str(ROOT / "studies" / "brown_table1.toml")
 
 
+@pytest.mark.long
 def test_a_run_leaves_the_start_method_unset(tmp_path):
     """In a fresh Python: after a run with one worker and one with two, the start method is
     still the caller's to choose."""
@@ -55,6 +58,7 @@ def test_a_run_leaves_the_start_method_unset(tmp_path):
     assert p.stdout.split() == ["None", "None", "set"], p.stdout + p.stderr[-2000:]
 
 
+@pytest.mark.long
 def test_an_absolute_path_runs_where_the_working_directory_is_gone(tmp_path):
     """In a fresh Python whose working directory is removed: the absolute study file and
     ``out`` run; a relative ``out`` is refused naming it."""

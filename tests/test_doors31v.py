@@ -77,6 +77,7 @@ def test_a_failing_million_trial_child_is_one_line(tmp_path):
     assert "million_trials.tmp" in msg
 
 
+@pytest.mark.long
 def test_a_store_left_by_a_killed_child_does_not_block_the_next_benchmark(tmp_path, capsys):
     part = tmp_path / "million_trials.tmp" / "part-0"
     part.mkdir(parents=True)
@@ -174,6 +175,7 @@ def _committed(tmp_path, capsys):
     return studies, results
 
 
+@pytest.mark.long
 def test_a_scratch_directory_that_cannot_be_removed_leaves_the_check_standing(
     tmp_path, monkeypatch, capsys
 ):
@@ -199,6 +201,7 @@ def test_a_scratch_directory_that_cannot_be_removed_leaves_the_check_standing(
     shutil.rmtree(left)
 
 
+@pytest.mark.long
 def test_a_re_run_killed_by_a_signal_is_not_recorded_as_a_failed_reproduction(
     tmp_path, monkeypatch, capsys
 ):
@@ -222,6 +225,7 @@ def test_a_re_run_killed_by_a_signal_is_not_recorded_as_a_failed_reproduction(
     assert (results / "reproducibility.parquet").read_bytes() == record
 
 
+@pytest.mark.long
 def test_a_lock_file_left_in_an_earlier_re_run_does_not_block_the_next_verify(tmp_path, capsys):
     studies, results = _committed(tmp_path, capsys)
     argv = ["--results", str(results), "--studies", str(studies), "--no-record"]

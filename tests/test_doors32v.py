@@ -17,6 +17,7 @@ import sys
 
 import pyarrow as pa
 import pyarrow.parquet as pq
+import pytest
 
 
 def _sim(*args, cwd=None):
@@ -25,6 +26,7 @@ def _sim(*args, cwd=None):
     )
 
 
+@pytest.mark.long
 def test_a_verdict_edited_by_hand_is_said_to_be_an_edit_not_a_failed_reproduction(tmp_path):
     run = _sim(
         "sim",

@@ -201,6 +201,7 @@ runpy.run_module("sim", run_name="__main__", alter_sys=True)
 """
 
 
+@pytest.mark.long
 def test_a_batch_interrupted_while_a_run_publishes_names_its_results(tmp_path, monkeypatch, capsys):
     child, res = tmp_path / "child.py", tmp_path / "res"
     child.write_text(_CHILD)

@@ -76,6 +76,7 @@ def test_verify_refuses_a_tmpdir_with_a_line_break_before_it_reruns(
     assert calls == [] and list(broken_tmpdir.iterdir()) == []
 
 
+@pytest.mark.long
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full on this system")
 def test_a_full_standard_error_neither_stops_a_run_nor_changes_an_exit_code(tmp_path):
     (tmp_path / "studies").mkdir()  # a project of one's own: mine/ goes to scratch/, noted

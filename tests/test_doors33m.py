@@ -120,8 +120,10 @@ AGNARD_MEASURED = {
 }
 
 
-# the 100,000-point size (30 s of CPU) in make fuzz
-@pytest.mark.parametrize("size", long_params(list(AGNARD_MEASURED), {(2, 8, 100000, 0.0)}))
+# the 20,000- and 100,000-point sizes (6 and 30 s of CPU) in make fuzz
+@pytest.mark.parametrize(
+    "size", long_params(list(AGNARD_MEASURED), {(2, 8, 20000, 20.0), (2, 8, 100000, 0.0)})
+)
 def test_agnard_work_counts_points_and_models(size):
     S, M, G, relief = size
     sets = {
@@ -218,6 +220,7 @@ def test_gridplate_trial_counts_its_readings_and_points():
     assert peak <= est.bytes <= 3 * peak, (peak, est.bytes)  # 14 times the peak before
 
 
+@pytest.mark.long
 def test_a_chunk_of_minutes_is_said_before_the_run(tmp_path):
     import subprocess
     import sys

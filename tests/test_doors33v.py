@@ -94,6 +94,7 @@ def _rec(d: Path) -> dict:
     return json.loads((d / "run.json").read_text(encoding="utf-8"))
 
 
+@pytest.mark.long
 def test_results_made_with_overrides_are_verified_with_them(made, tmp_path):
     assert _rec(made / "R" / "brown_table1")["overrides"] == RECORDED
     out = _verify(made / "R", "--scratch", tmp_path / "S")  # before: "of another config", 1
@@ -112,6 +113,7 @@ def test_results_made_with_overrides_are_verified_with_them(made, tmp_path):
     assert "(keys comparator.beta_mm): they are stale against" in out.stdout
 
 
+@pytest.mark.long
 def test_fewer_trials_keep_the_runs_other_overrides(made, tmp_path):
     """``--trials 400`` (the Monte-Carlo level): the run's trials and chunk are verify's, its
     other overrides the run's (they were dropped: a grid of 4 compared with the file's 5)."""
@@ -123,6 +125,7 @@ def test_fewer_trials_keep_the_runs_other_overrides(made, tmp_path):
     assert (cfg["plate.grid"], cfg["trials"], cfg["seed"]) == (4, 400, 7)
 
 
+@pytest.mark.long
 def test_the_api_and_the_batch_record_what_sim_run_records(made, tmp_path):
     h = sim.load(BROWN, chunk=2, plate__grid=4, **{"region.points": 256, "region.rounds": 0})
     res = h.run(out=tmp_path / "api" / "brown_table1", trials=40, seed=7, figures=False)

@@ -165,6 +165,7 @@ def test_check_takes_the_limits_its_refusal_names(capsys, monkeypatch):
     one_line(capsys, main(["check", STUDY, "--max-adjustments", "10"]), "--max-adjustments")
 
 
+@pytest.mark.long
 def test_a_networks_size_at_load_takes_the_commands_memory_limit(capsys, tmp_path, monkeypatch):
     net = tmp_path / "net.toml"
     net.write_text(NET, encoding="utf-8")

@@ -146,6 +146,7 @@ def test_a_record_key_that_is_no_string_is_refused(tmp_path, key, value):
     assert str(e.value) == f"{key}: a table's key must be a string (got 1)"
 
 
+@pytest.mark.long
 def test_an_override_refused_in_one_of_its_entries_is_named(tmp_path, capsys):
     studies, results = tmp_path / "studies", tmp_path / "R"
     studies.mkdir()

@@ -189,6 +189,7 @@ def test_the_claims_table_and_sim_show_differ_as_the_docs_say():
     assert "which `sim show` notes on standard error) are read as they are, with a" in doc
 
 
+@pytest.mark.long
 def test_a_sweep_cell_lists_only_the_tables_it_reads(tmp_path):
     """A sweep run by the API: a cell's ``names()`` lists no chunk dataset (its sweep records
     no sha256 of the cells' chunks), and ``table("chunks")`` says why it is not read."""
@@ -239,6 +240,7 @@ def test_a_very_long_key_or_value_is_shown_cut(capsys):
     assert err.startswith("sim: error: plate.pattern: must be one of ") and len(err) < 400
 
 
+@pytest.mark.long
 def test_results_replaced_by_another_study_name_it(tmp_path):
     """Results whose directory another study's run replaced: the line names that study,
     not the advice ``sim.Results(path, study)``, which refuses that directory in turn."""

@@ -141,6 +141,7 @@ def test_a_command_under_a_small_data_limit_does_not_start():
     one_line_of(proc, "not enough memory: ulimit -d is 100000 kB", "at least 1048576 kB")
 
 
+@pytest.mark.long
 def test_an_ascii_output_shows_the_suites_dash_as_ascii():
     proc = _sim("show", "results/brown_table1", env={"PYTHONIOENCODING": "ascii"})
     assert proc.returncode == 0 and "cannot show" not in proc.stderr, proc.stderr

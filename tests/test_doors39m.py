@@ -96,6 +96,7 @@ def test_a_network_over_the_room_a_limit_leaves_is_refused_before_it_is_built(
     assert line.endswith(f"raise {words} or use fewer points or observations"), line
 
 
+@pytest.mark.long
 def test_a_memory_error_mid_run_names_the_limit_and_the_keys(tmp_path, monkeypatch, capsys):
     # before: "(reduce trials, chunk or the sizes in the study file)": brown_dilution's
     # region failed so under ulimit -v 1250000 (estimate 0.33 GiB, 0.82 GiB left at the start)

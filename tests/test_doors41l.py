@@ -212,6 +212,7 @@ def test_a_table_read_short_of_memory_is_not_called_damaged(tmp_path, monkeypatc
         sim.Results(RESULTS, "brown_table1").table("claims")
 
 
+@pytest.mark.long
 def test_a_terminal_of_no_rows_shows_the_bar(tmp_path):
     run = [
         "run",
@@ -242,6 +243,7 @@ def test_a_sweep_over_trials_picks_each_cells_chunk_as_trials_does(tmp_path, cap
     assert [sim.load(TABLE1, trials=n).config["chunk"] for n in (400, 800, 8000)] == [20, 40, 200]
 
 
+@pytest.mark.long
 def test_a_sweep_whose_cell_was_deleted_names_the_cell(tmp_path, capsys):
     f = tmp_path / "sw.toml"
     f.write_text('study = "brown_table1"\n[sweep]\ntrials = [40, 60]\n', encoding="utf-8")

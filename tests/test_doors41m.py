@@ -114,6 +114,7 @@ def _chunk(rng, n, held):
     return {"x": rng.normal(size=n) + held.a[:n]}
 
 
+@pytest.mark.long
 def test_dask_sends_the_chunk_function_once(tmp_path):
     # before: the function with every task: pickled once a chunk, and Dask's "Sending large
     # graph of size 48.8 MiB" warning (6 lines) for four chunks of a 12 MiB function
@@ -133,6 +134,7 @@ def test_dask_sends_the_chunk_function_once(tmp_path):
     assert len(PICKLED) <= 2, len(PICKLED)  # the check that it pickles, and the scatter
 
 
+@pytest.mark.long
 def test_under_ulimit_v_arrow_does_not_map_the_room(tmp_path):
     # before: the address space grew by 1.3 GiB in the run (mimalloc's reservation), the
     # pool "mimalloc"

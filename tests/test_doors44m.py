@@ -132,6 +132,7 @@ def test_an_adaptive_stage_counts_its_predicted_trials_on_the_bar_not_its_maximu
     assert ctx.counted == [90, 90]
 
 
+@pytest.mark.long
 def test_the_gridplate_bar_counts_its_trials_work_and_its_regions(tmp_path):
     """A small run's bar: a total of the trials' units and the region's, every unit counted at
     its end (the region's once it is done, named while it runs); one unit a trial and no

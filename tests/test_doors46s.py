@@ -45,6 +45,7 @@ def _session(sid: int) -> list[str]:
     return left
 
 
+@pytest.mark.long
 def test_ctrl_c_and_a_hangup_to_a_dask_runs_group_end_it_in_one_line(tmp_path):
     pytest.importorskip("distributed")
     out = tmp_path / "out"

@@ -475,6 +475,7 @@ def test_batch_stale_only_reads_a_run_record_of_another_shape_as_stale(tmp_path,
     assert is_current(f, tmp_path / "r" / "n") is False
 
 
+@pytest.mark.long
 def test_a_run_record_listing_its_files_wrongly_is_named_not_a_traceback(tmp_path, capsys):
     """run.json edited into valid JSON of another shape (``"files": 3``) gave a TypeError
     after the whole re-run, when the new results replaced the old."""

@@ -135,6 +135,7 @@ except sim.ConfigError as e:
 """
 
 
+@pytest.mark.long
 def test_a_script_without_a_main_guard_gets_one_line_and_no_worker_tracebacks(tmp_path):
     script = tmp_path / "unguarded.py"
     study = str(ROOT / "studies" / "network_plate.toml")

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from sim.cli import main
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
@@ -203,6 +205,7 @@ def test_a_drivers_variable_left_set_in_a_shell_is_named_not_a_silent_exit():
     assert len(p.stderr.splitlines()) == 1
 
 
+@pytest.mark.long
 def test_a_sweep_whose_first_key_is_text_and_has_a_second_key_draws_its_figure(tmp_path, capsys):
     # before: the figure's second panel read the first panel's tick labels as the legend's
     # texts: "the run failed in sim.execute.run_sweep: TypeError: string indices must be

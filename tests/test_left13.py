@@ -171,6 +171,7 @@ def test_the_summary_says_how_many_trials_did_not_converge(tmp_path, capsys):
     assert shown.splitlines()[-1].startswith(said), shown
 
 
+@pytest.mark.long
 def test_a_run_whose_trials_stop_at_the_limit_says_so(tmp_path, capsys):
     """At a control weight of 3e-6 times the pass weight (the datum check passes it) one of
     the four tiny trials stops at the iteration limit in the 5-control and corner layouts."""
