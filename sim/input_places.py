@@ -42,7 +42,9 @@ def check_inputs_outside(out: Path, shown: str, cfg: dict) -> None:
     files = rec.get("files")
     for key in _file_keys(cfg):  # (named first: the key that reads it)
         _refuse_read(o, shown, cfg, key, files)
-    refuse_changed_export(out, shown, rec)  # an export edited in place: the user's, kept
+    refuse_changed_export(
+        out, shown, rec, cfg.get("study")
+    )  # an export edited in place: the user's, kept
 
 
 def _refuse_read(o: Path, shown: str, cfg: dict, key: str, files) -> None:

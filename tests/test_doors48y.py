@@ -8,7 +8,10 @@ case each; each failed on the code before its fix.
   (``export_sha256``), and such a run is refused before any work, naming the file; the edited
   file is the user's (a publish carries it, and refuses a new export of its name).
 * A FIFO (or a symbolic link, a device) put in the export's place: removed by ``--overwrite``
-  as the run's own file, without a word. Named now, never opened or followed, and kept.
+  as the run's own file, without a word. Named now, never opened or followed, and kept. A
+  directory of its name, refused only when every chunk was done, is refused before any work.
+* (Held, not tested here: an edited export with ``--overwrite`` and another study is carried
+  into the new results as the user's, ``carried`` in its record.)
 * A record of an older version, without ``export_sha256``: its regular export is the run's,
   as before (replaced, no refusal).
 """
@@ -82,19 +85,23 @@ def test_edited_export_is_kept_and_named(done: Path, capsys) -> None:
 def test_fifo_in_place_of_export_is_named_not_removed(done: Path, capsys) -> None:
     """A FIFO named ``network.xml`` in the results, re-run with ``--overwrite``: before, it was
     removed as the run's file (exit 0); now it is named as a FIFO (never opened: no hang) and
-    kept."""
+    kept. A directory of that name was refused only at the run's end: now before any work."""
     xml = done / "r1" / "network.xml"
     original = xml.read_bytes()
     xml.unlink()
-    os.mkfifo(xml)
-    try:
-        rc, err = _rerun(done, capsys, "--overwrite")
-        assert rc == 2, err
-        assert "network.xml is a FIFO (named pipe), not the export its run wrote" in err
-        assert stat.S_ISFIFO(os.lstat(xml).st_mode)
-    finally:
-        xml.unlink()
-        xml.write_bytes(original)
+    for make, what, kept in (
+        (os.mkfifo, "a FIFO (named pipe)", stat.S_ISFIFO),
+        (os.mkdir, "a directory", stat.S_ISDIR),
+    ):
+        make(xml)
+        try:
+            rc, err = _rerun(done, capsys, "--overwrite")
+            assert rc == 2, err
+            assert f"network.xml is {what}, not the export its run wrote" in err
+            assert kept(os.lstat(xml).st_mode)
+        finally:
+            xml.rmdir() if xml.is_dir() else xml.unlink()
+    xml.write_bytes(original)
 
 
 def test_older_record_without_export_sums_reads_as_before(done: Path) -> None:

@@ -55,11 +55,12 @@ def export_sums(stage: Path, files: list[str]) -> dict[str, str]:
     return {f: _sha256(stage / f) for f in files if _EXPORT.fullmatch(f)}
 
 
-def changed_exports(out: Path, rec: dict | None = None) -> dict[str, str]:
+def changed_exports(out: Path, rec: dict | None = None, dirs: bool = False) -> dict[str, str]:
     """The exports the run record of ``out`` (or ``rec``) lists among its files that are there
     but are not the ones its run wrote, each with what it is now (``"changed after the run
     that wrote it (edited by hand?)"``, ``"a FIFO (named pipe)"``, ...). A directory of that
-    name is left to the publish, which refuses it as any entry of the user's in the way."""
+    name is named only with ``dirs`` (a publish refuses it as any entry of the user's in the
+    way, whose files it lists one by one)."""
     rec = read_record(out) if rec is None else rec
     files = rec.get("files") if isinstance(rec, dict) else None
     sums = rec.get(EXPORT_KEY) if isinstance(rec, dict) else None
@@ -74,6 +75,8 @@ def changed_exports(out: Path, rec: dict | None = None) -> dict[str, str]:
         except OSError:  # gone (the run writes it again) or not to be looked at
             continue
         if stat.S_ISDIR(mode):
+            if dirs:
+                found[name] = "a directory"
             continue
         if not stat.S_ISREG(mode):
             found[name] = next((w for t, w in _KINDS if t(mode)), "not a regular file")
@@ -100,10 +103,14 @@ def changed_words(out: Path, name: str, what: str) -> str:
     )
 
 
-def refuse_changed_export(out: Path, shown: str, rec: dict | None) -> None:
-    """Refuse, before any work, a run into the results ``out`` (``shown`` as given) whose
-    export was changed by hand or has a FIFO, device or link in its place (a publish keeps it
-    and the new run's export would take its name)."""
-    found = changed_exports(out, rec)
+def refuse_changed_export(out: Path, shown: str, rec: dict | None, study: object) -> None:
+    """Refuse, before any work, a run of ``study`` into the results ``out`` (``shown`` as
+    given, ``rec`` its record) whose export was changed by hand or has a FIFO, device, link or
+    directory in its place, when the earlier run was of that study (which writes a file of its
+    name; of another study, with ``--overwrite``, the publish carries it)."""
+    config = rec.get("config") if isinstance(rec, dict) else None
+    if not isinstance(config, dict) or config.get("study") != study:
+        return
+    found = changed_exports(out, rec, dirs=True)
     for name, what in sorted(found.items())[:1]:
         raise ConfigError("--out", changed_words(Path(shown), name, what))
