@@ -22,6 +22,7 @@ from itertools import count
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.export_edits import EXPORT_KEY, changed_exports, changed_words, export_sums
 from sim.mc.file_kind import odd_file
 from sim.mc.outputs import swap_dir
 from sim.mc.paths import mounts_under
@@ -64,6 +65,7 @@ def seal(stage: Path, store: ChunkStore | None) -> None:
     # and every table's shape (a sweep's cells' too): its readers tell a table edited by hand
     shapes = {f: shape(read_table(stage / f)) for f in files if _a_table(f)}
     record = {**rec, "files": files, "chunk_sha256": chunks, "figure_sha256": figures}
+    record[EXPORT_KEY] = export_sums(stage, files)  # the GNU Gama export: edited, it is kept
     write_record(stage, {**record, "table_sha256": tables, SHAPE_KEY: shapes})
 
 
@@ -205,7 +207,7 @@ def _foreign(out: Path) -> list[str]:
             f"{out / 'run.json'} does not list the files its run wrote (edited by hand?): "
             "move the directory away, or delete it, and run again",
         )
-    mine = set(rec["files"])
+    mine = set(rec["files"]) - set(changed_exports(out, rec))  # an export edited by hand
     keep = []
     for root, dirs, files in os.walk(out):  # a link to a directory is an entry, not followed
         r = Path(root)
@@ -385,6 +387,8 @@ def _publish(stage: Path, out: Path) -> None:
         if (q.is_symlink() or q.exists()) and not q.is_dir():
             q.unlink()  # (the user's own is still in out): copied again below
     clash = [c for f in keep if (c := _clash(stage, f))]
+    if clash and (what := changed_exports(out).get(clash[0])):
+        raise ConfigError("--out", changed_words(out, clash[0], what))
     if clash:
         raise ConfigError(
             "--out",
