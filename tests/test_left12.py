@@ -124,12 +124,14 @@ def test_an_adjustment_where_only_one_method_found_a_fixed_point_fails_the_check
 
 def test_the_models_disagreement_is_a_difference_of_one():
     """The model marks an adjustment where exactly one method found a positive fixed point
-    (the stated grid sigma near the total misclosure sigma: about half the rows have none)."""
+    (the stated grid sigma near the total misclosure sigma: about half the rows have none).
+    The study's check refuses such a config for a run (most calibrations without a fixed
+    point: test_doors48p); the model's marking is tested at it, validated without the check."""
     from sim.mc.config import validate
     from sim.studies.gridplate import model
-    from sim.studies.gridplate.schema import SCHEMA, check
+    from sim.studies.gridplate.schema import SCHEMA
 
-    cfg = validate({"grid.sigma_stated_um": 1.38, "analysis.iter_sample": 400}, SCHEMA, check)
+    cfg = validate({"grid.sigma_stated_um": 1.38, "analysis.iter_sample": 400}, SCHEMA)
     res = model.chunk(cfg, np.random.default_rng(12), 100)
     ok, one, rel = res["closed_form_ok"], res["closed_form_one"], res["closed_form_rel"]
     assert ok.size == one.size == rel.size == 400 and not np.any(ok & one)
