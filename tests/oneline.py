@@ -6,6 +6,7 @@ program run in a fresh Python, for what a test must not do to its own process.""
 import re
 import subprocess
 import sys
+from pathlib import Path
 from types import SimpleNamespace
 
 #: how the one line of the sim command and of make verify begin
@@ -42,3 +43,11 @@ def python_lines(*lines: str) -> subprocess.CompletedProcess:
     apart from the test process); its exit code and text output."""
     code = "\n".join(lines) + "\n"
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+
+
+def check_argv(study: str, *sets: str) -> list[str]:
+    """``sim check studies/<study>.toml --set S ...`` as ``sim.cli.main``'s arguments."""
+    argv = ["check", str(Path(__file__).resolve().parent.parent / "studies" / f"{study}.toml")]
+    for s in sets:
+        argv += ["--set", s]
+    return argv

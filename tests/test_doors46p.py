@@ -27,8 +27,6 @@ failed on the code before its fix.
   (:mod:`sim.mc.gridplate_size`, :mod:`sim.mc.agnard_size`).
 """
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -37,16 +35,7 @@ from sim.instruments.ranges import multilateration as ml
 from sim.studies.brown.schema import TABLE1, setup
 from sim.studies.brown.values import start_theta
 from tests.oneline import SIM_ERROR, one_line
-
-ROOT = Path(__file__).resolve().parent.parent
-STUDIES = ROOT / "studies"
-
-
-def _check(study: str, *sets: str) -> list[str]:
-    argv = ["check", str(STUDIES / f"{study}.toml")]
-    for s in sets:
-        argv += ["--set", s]
-    return argv
+from tests.oneline import check_argv as _check
 
 
 def _converged(sets: dict, trials: int = 48, seed: int = 4601) -> dict:

@@ -32,16 +32,10 @@ from sim.studies.picking import load_picking_chunk
 from sim.studies.salsig import model as salsig_model
 from sim.studies.salsig.schema import transfer_share
 from tests.oneline import SIM_ERROR, one_line
+from tests.oneline import check_argv as _check
 
 ROOT = Path(__file__).resolve().parent.parent
 STUDIES = ROOT / "studies"
-
-
-def _check(study: str, *sets: str) -> list[str]:
-    argv = ["check", str(STUDIES / f"{study}.toml")]
-    for s in sets:
-        argv += ["--set", s]
-    return argv
 
 
 @pytest.mark.parametrize(
