@@ -1,8 +1,10 @@
 """Edits a user makes by hand to a finished run's results, shared by the door tests of a
-results directory touched by hand (tests/test_doors46h.py, 47k.py)."""
+results directory touched by hand (tests/test_doors46h.py, 47k.py): a claim edited, a private
+copy of a tiny run."""
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pyarrow as pa
@@ -19,3 +21,11 @@ def edit_first_value(d: Path) -> float:
     v[0] += 1.0
     pq.write_table(t.set_column(i, t.schema.field(i), pa.array(v, t.schema.field(i).type)), p)
     return v[0]
+
+
+def copy_of_tiny(tiny_run, tmp_path: Path, name: str = "network_plate") -> Path:
+    """A private copy of the session's tiny run of ``studies/<name>.toml`` under
+    ``tmp_path/res/<name>`` (the shared run is read only)."""
+    d = tmp_path / "res" / name
+    shutil.copytree(tiny_run(name), d, symlinks=True)
+    return d

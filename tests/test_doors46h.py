@@ -43,19 +43,12 @@ from sim.batch_checks import why_stale
 from sim.cli import main
 from sim.report.verify.rerun import verify
 from tests.conftest import tiny_overrides
+from tests.hand_edits import copy_of_tiny as _copy
 from tests.hand_edits import edit_first_value
 from tests.oneline import one_line
 from tests.within import within
 
 PLATE = Path(__file__).resolve().parents[1] / "studies" / "network_plate.toml"
-
-
-def _copy(tiny_run, tmp_path: Path, name: str = "network_plate") -> Path:
-    """A private copy of the session's tiny run of ``studies/<name>.toml`` under
-    ``tmp_path/res/<name>`` (the shared run is read only)."""
-    d = tmp_path / "res" / name
-    shutil.copytree(tiny_run(name), d, symlinks=True)
-    return d
 
 
 def test_a_readme_made_a_fifo_is_kept_and_never_opened(tiny_run, tmp_path, capsys):

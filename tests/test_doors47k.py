@@ -37,19 +37,12 @@ import sim
 from sim.cli import main
 from sim.report.verify.rerun import verify
 from sim.report.verify.rules import VerifyError
+from tests.hand_edits import copy_of_tiny as _copy
 from tests.hand_edits import edit_first_value
 from tests.oneline import SIM_ERROR, one_line
 from tests.within import within
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
-
-
-def _copy(tiny_run, tmp_path: Path, name: str = "network_plate") -> Path:
-    """A private copy of the session's tiny run of ``studies/<name>.toml`` under
-    ``tmp_path/res/<name>`` (the shared run is read only)."""
-    d = tmp_path / "res" / name
-    shutil.copytree(tiny_run(name), d, symlinks=True)
-    return d
 
 
 def test_a_results_directory_whose_run_record_was_deleted_is_refused(tiny_run, tmp_path, capsys):
