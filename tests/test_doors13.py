@@ -24,6 +24,7 @@ failed on the code before its fix.
 * a gama-local file of 3,000 points took three minutes to load (names matched by fnmatch).
 """
 
+import json
 import re
 import shutil
 from pathlib import Path
@@ -202,6 +203,10 @@ def test_verify_states_no_deviation_when_it_compared_nothing(tmp_path, capsys):
     """Results of a study file outside studies/ cannot be re-run: "FAILED; 0 files; largest
     relative deviation 0" read as a comparison made; now it says nothing was compared."""
     res = _results_with(tmp_path, "mine")
+    rec = json.loads((res / "mine" / "run.json").read_text(encoding="utf-8"))
+    rec["written_as"] = "mine"  # a run of a study file kept elsewhere, not a copy of another's
+    rec["study_file"] = {"path": str(tmp_path / "mine.toml"), "sha256": "0" * 64}
+    (res / "mine" / "run.json").write_text(json.dumps(rec), encoding="utf-8")
     rc = verify_main(["--results", str(res), "--study", "mine", "--no-record"])
     out = capsys.readouterr().out
     assert rc == 1 and "mine: FAILED; nothing compared" in out and "deviation" not in out

@@ -264,6 +264,8 @@ def _of_another_study(d: Path, name: str) -> None:
     """``d``'s run record and tables made to name the study ``name`` (their sha256 kept)."""
     rec = json.loads((d / "run.json").read_text(encoding="utf-8"))
     rec["config"]["study"] = name
+    rec["written_as"] = name  # as that version's run of studies/<name>.toml recorded it
+    rec["study_file"] = {"path": f"studies/{name}.toml", "sha256": "0" * 64}
     for f in d.glob("*.parquet"):
         t = pq.read_table(f)
         meta = {
