@@ -246,6 +246,7 @@ def test_sweep_png_draws_each_replicate_as_its_own_line(tmp_path, monkeypatch):
     assert "2 replicates, a line each" in ax.get_xlabel()
 
 
+@pytest.mark.long
 def test_a_sweep_counts_each_cells_own_cost_against_the_work_limit(tmp_path, capsys):
     """10,000 cells of Brown's 4,000 trials were estimated at 4.7e8 adjustments (under the
     5e8 limit) and ran for about 16 hours: each cell's claims, tables and README cost about a

@@ -79,7 +79,7 @@ from sim.studies import load_study
 from sim.studies.network.gama_read import read_gama
 from sim.studies.wolf import tables
 
-CASES = int(os.environ.get("FUZZ_CASES", "14"))
+CASES = int(os.environ.get("FUZZ_CASES", "8"))
 
 
 def test_fuzz_bases_run():
