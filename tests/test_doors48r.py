@@ -90,6 +90,16 @@ def test_tables_of_write_table_alone_are_read(tmp_path):
         res.table("x")
 
 
+def _check(capsys, f) -> tuple[int, str]:
+    """``sim check f`` in process: its exit code and its standard error."""
+    capsys.readouterr()
+    try:
+        rc = main(["check", str(f)])
+    except SystemExit as e:
+        rc = e.code
+    return rc, capsys.readouterr().err
+
+
 def test_a_thread_count_atoi_wraps_is_refused(tmp_path, capsys, monkeypatch):
     """``OPENBLAS_NUM_THREADS=4294967296``: all digits, so it passed session 47's check, but
     OpenBLAS reads it with C's ``atoi``, which wraps it to 0, taken for unset: with
@@ -98,12 +108,7 @@ def test_a_thread_count_atoi_wraps_is_refused(tmp_path, capsys, monkeypatch):
     f = tmp_path / "tri.toml"
     f.write_text(TRIANGLE_NETWORK)
     monkeypatch.setenv("OPENBLAS_NUM_THREADS", "4294967296")
-    capsys.readouterr()
-    try:
-        rc = main(["check", str(f)])
-    except SystemExit as e:
-        rc = e.code
-    err = capsys.readouterr().err
+    rc, err = _check(capsys, f)
     assert rc == 2 and err.count("\n") == 1, err
     assert "OPENBLAS_NUM_THREADS" in err and "ignore it" in err
 
@@ -157,11 +162,6 @@ def test_a_point_given_again_after_its_observed_coordinates(tmp_path, capsys, ag
     f.write_text(
         f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{tmp_path}/g.xml"\n'
     )
-    capsys.readouterr()
-    try:
-        rc = main(["check", str(f)])
-    except SystemExit as e:
-        rc = e.code
-    err = capsys.readouterr().err
+    rc, err = _check(capsys, f)
     assert (rc == 0) == ok, err
     assert ok or "declared twice with different coordinates" in err
