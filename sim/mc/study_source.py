@@ -62,13 +62,21 @@ def other_source(d: str | Path, name: str | None = None, record: dict | None = N
     """Why the results directory ``d`` holds another study's results than its name says, or
     None: its record was written into a directory of another name from a study file of
     another name (copied or renamed by hand). ``name``: the study the reader expects (a
-    batch's study file name), default the directory's name; ``record``: its run record if
-    read already."""
+    batch's study file name, a committed study's for ``make verify``), default the
+    directory's name, which says a study only when its run was written under its study
+    file's name (a batch's ``<results>/<study>``): results written under a name of the
+    user's (``sim run x.toml --out r1``) were named by no study, and moved or renamed as a
+    whole (``mv r1 r2``) they were noted by ``sim show`` and warned of by ``sim.Results`` as
+    "not r2's (copied or renamed by hand?): run r2's own study file", a file that never
+    was. ``record``: its run record if read already."""
     here = Path(os.path.abspath(d))
     rec = record if record is not None else read_record(here)
     written, path = recorded_source(rec)
+    stem = Path(path).stem if path else None
+    if name is None and stem is not None and written != stem:
+        return None  # a directory the user named, not for its study: its name says none
     want = name if name is not None else here.name
-    if written is None or want in (written, Path(path).stem if path else None):
+    if written is None or want in (written, stem):
         return None
     where = f" of {path}" if path else ""
     return (
