@@ -12,6 +12,7 @@ from conftest import TRIANGLE_NETWORK
 
 import sim
 from sim.cli import main
+from sim.mc.config import ConfigError
 from sim.mc.study_source import other_source
 
 RUN = ["--quiet", "--no-figures"]
@@ -47,3 +48,22 @@ def test_results_renamed_as_a_whole_are_not_called_another_studys(done, tmp_path
         assert other_source(moved, "tri") is None
     finally:
         moved.rename(done / "r1")
+
+
+def test_the_api_takes_every_path_the_command_line_wrote(done, tmp_path):
+    """Refused legitimate input (the API's path check against the command line's): results
+    that ``sim run --out`` wrote under a name with a no-break space (or a zero-width one: a
+    name pasted from a web page) were shown by ``sim show`` but ``sim.Results`` refused them,
+    "must be a path (a str or os.PathLike of a str)", of a str; so was a name ``os.listdir``
+    gave of a non-UTF-8 directory, whose words are ``sim run``'s now."""
+    there = tmp_path / "no\u00a0break\u200b"
+    (done / "r1").rename(there)
+    try:
+        assert sim.Results(there, "network").claims().num_rows == 9
+        assert sim.Results(str(there), "network").claims().num_rows == 9
+    finally:
+        there.rename(done / "r1")
+    with pytest.raises(ConfigError, match=r"^path: contains bytes that are not UTF-8 text"):
+        sim.Results(str(tmp_path) + "/r\udcff", "network")
+    with pytest.raises(ConfigError, match=r"^out: contains a control character or a line br"):
+        sim.load(done / "tri.toml").run(out=str(tmp_path / "a\nb"))
