@@ -12,7 +12,7 @@ from conftest import TRIANGLE_NETWORK
 
 import sim
 from sim.cli import main
-from sim.mc.config import ConfigError
+from sim.mc.config import ConfigError, read_toml
 from sim.mc.study_source import other_source
 
 RUN = ["--quiet", "--no-figures"]
@@ -67,3 +67,25 @@ def test_the_api_takes_every_path_the_command_line_wrote(done, tmp_path):
         sim.Results(str(tmp_path) + "/r\udcff", "network")
     with pytest.raises(ConfigError, match=r"^out: contains a control character or a line br"):
         sim.load(done / "tri.toml").run(out=str(tmp_path / "a\nb"))
+
+
+@pytest.mark.parametrize(
+    "lines, meant",
+    [  # the line the slip is on, not the one with an apostrophe in double quotes before it
+        (
+            ["[network]", 'name = "Brown\'s plate"', "gama_xml = 'net.xml"],
+            "(the text opened at line 4 is not closed by ')",
+        ),  # a sign: the same thousands separator as without one, not a decimal comma
+        (["trials = -4,000"], "no thousands separator: trials = -4000, or trials = -4_000)"),
+    ],
+)
+def test_a_toml_slips_hint_names_the_slip_the_user_made(tmp_path, lines, meant):
+    """Unclear message (K48's TOML slips): an unclosed 'text' after a line holding an
+    apostrophe inside double quotes (``name = "Brown's plate"``) was said to be opened on
+    that earlier line, and ``trials = -4,000`` got "a TOML number has a decimal point, not a
+    comma: trials = -4.000" where ``4,000`` gets the thousands separator."""
+    f = tmp_path / "slip.toml"
+    f.write_text("\n".join(['study = "network"', *lines]) + "\n", encoding="utf-8")
+    with pytest.raises(ConfigError) as e:
+        read_toml(f)
+    assert str(e.value).endswith(meant), str(e.value)
