@@ -30,6 +30,7 @@ import os
 from pathlib import Path
 from typing import Any
 
+from sim.api_paths import why_unread
 from sim.api_tmp import KEPT, MARK
 from sim.mc.config import ConfigError
 
@@ -42,6 +43,8 @@ __all__ = [
     "anonymous_dir",
     "made_by_load",
     "unchecked",
+    "study_sha256",
+    "unchanged",
 ]
 
 #: the config keys whose relative path is read from the working directory
@@ -149,6 +152,28 @@ def check_files(h: Any, new: Any) -> None:
                 f"{new.config[key]} has changed since sim.load() (sha256 {now[:12]}..., "
                 f"loaded {was[:12]}...): load the study again",
             )
+
+
+def study_sha256(path: Path) -> str:
+    """The study file's sha256 ("": it is gone). A file that cannot be read (EACCES, EIO) is
+    one line saying so: it was taken for a file that "has changed since sim.load()" (or
+    "changed while it was loaded"), and a handle loaded then checked nothing."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except FileNotFoundError:
+        return ""
+    except OSError as e:
+        raise ConfigError("study_file", f"{path} cannot be read ({why_unread(e)})") from None
+
+
+def unchanged(h: Any) -> None:
+    """A handle runs the file it loaded (``replace`` and ``run(trials=...)`` read it again): an
+    edited or deleted file, or a config changed in place (:func:`check_state`), is refused."""
+    check_state(h)
+    check_cwd(h)
+    if h.file_sha256 and study_sha256(h.path) != h.file_sha256:
+        state = "has changed" if h.path.is_file() else "is gone"
+        raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
 
 
 @contextlib.contextmanager
