@@ -4,6 +4,8 @@ Each test names the class of bad input and what was wrong before its fix."""
 
 from __future__ import annotations
 
+import os
+import signal
 import warnings
 from pathlib import Path
 
@@ -89,3 +91,28 @@ def test_a_toml_slips_hint_names_the_slip_the_user_made(tmp_path, lines, meant):
     with pytest.raises(ConfigError) as e:
         read_toml(f)
     assert str(e.value).endswith(meant), str(e.value)
+
+
+def test_a_handles_study_file_replaced_by_a_fifo_is_named_not_read(done, tmp_path):
+    """Hang: ``sim.load(f)``, then ``f`` replaced by a FIFO (or a link to ``/dev/zero``, a
+    disk image) before ``run()``: the check that the file is the one loaded read it whole,
+    and ``run()`` blocked for ever (``/dev/zero``: until memory ran out). It is named now,
+    unread. (Before the fix this test ended on its alarm, not by hanging.)"""
+    f = tmp_path / "tri.toml"
+    f.write_text(TRIANGLE_NETWORK)
+    h = sim.load(f)
+    f.unlink()
+    os.mkfifo(f)
+    old = signal.signal(signal.SIGALRM, lambda *a: pytest.fail("run() read the FIFO"))
+    signal.alarm(20)
+    try:
+        with pytest.raises(ConfigError, match="is no longer a regular file .* since sim.load"):
+            h.run(out=tmp_path / "r", figures=False)
+        f.unlink()
+        f.symlink_to("/dev/zero")
+        with pytest.raises(ConfigError, match="is no longer a regular file"):
+            h.replace(trials=40)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+    assert not (tmp_path / "r").exists()

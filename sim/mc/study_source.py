@@ -15,9 +15,11 @@ from __future__ import annotations
 
 import hashlib
 import os
+import stat
 from pathlib import Path
 
 from sim.mc.storage import read_record
+from sim.mc.study_file import MAX_STUDY_BYTES
 
 __all__ = ["other_source", "recorded_source", "source_fields"]
 
@@ -32,9 +34,12 @@ def source_fields(study_file: str | os.PathLike | None, out: Path) -> dict:
     if study_file is None:
         return fields
     p = Path(study_file)
-    try:
-        with open(p, "rb") as f:  # (at most sim.mc.study_file.MAX_STUDY_BYTES: read before)
-            sha = hashlib.sha256(f.read()).hexdigest()
+    try:  # gone, or no study file since it was read (a FIFO would block): named, not read
+        st = os.stat(p)
+        sha = None
+        if stat.S_ISREG(st.st_mode) and st.st_size <= MAX_STUDY_BYTES:
+            with open(p, "rb") as f:
+                sha = hashlib.sha256(f.read()).hexdigest()
     except OSError:  # gone since it was read: the record names it without its content
         sha = None
     try:  # the working directory removed meanwhile: the path as given
