@@ -116,3 +116,22 @@ def test_a_handles_study_file_replaced_by_a_fifo_is_named_not_read(done, tmp_pat
         signal.alarm(0)
         signal.signal(signal.SIGALRM, old)
     assert not (tmp_path / "r").exists()
+
+
+def test_a_link_to_a_studys_results_is_not_called_a_copy(tmp_path, capsys):
+    """Unclear message on a legitimate use (J48's copy check): a symbolic link to a batch's
+    results (``latest -> B/alpha``, written under its study file's name) was noted by ``sim
+    show latest`` as "not latest's (copied or renamed by hand?)", and ``sim.Results`` warned.
+    A link is named by the directory it leads to now; a copy under another name still is
+    noted (tests/test_doors48j.py)."""
+    (tmp_path / "alpha.toml").write_text(TRIANGLE_NETWORK)
+    out = tmp_path / "B" / "alpha"
+    assert main(["run", str(tmp_path / "alpha.toml"), "--out", str(out), *RUN]) == 0
+    (latest := tmp_path / "latest").symlink_to(out)
+    capsys.readouterr()
+    assert main(["show", str(latest)]) == 0
+    assert "holds the results of a run" not in capsys.readouterr().err
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sim.Results(latest, "network").claims()
+    assert "written as alpha/" in other_source(latest, "beta")  # a batch's beta: still named

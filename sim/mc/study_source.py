@@ -73,14 +73,16 @@ def other_source(d: str | Path, name: str | None = None, record: dict | None = N
     user's (``sim run x.toml --out r1``) were named by no study, and moved or renamed as a
     whole (``mv r1 r2``) they were noted by ``sim show`` and warned of by ``sim.Results`` as
     "not r2's (copied or renamed by hand?): run r2's own study file", a file that never
-    was. ``record``: its run record if read already."""
+    was. A symbolic link to results (``latest -> B/alpha``) is named by what it leads to.
+    ``record``: its run record if read already."""
     here = Path(os.path.abspath(d))
     rec = record if record is not None else read_record(here)
     written, path = recorded_source(rec)
     stem = Path(path).stem if path else None
     if name is None and stem is not None and written != stem:
         return None  # a directory the user named, not for its study: its name says none
-    want = name if name is not None else here.name
+    # a link's name is not the directory's (latest -> B/alpha: "not latest's", R50)
+    want = name if name is not None else Path(os.path.realpath(here)).name
     if written is None or want in (written, stem):
         return None
     where = f" of {path}" if path else ""
