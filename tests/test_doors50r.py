@@ -4,6 +4,7 @@ Each test names the class of bad input and what was wrong before its fix."""
 
 from __future__ import annotations
 
+import glob
 import os
 import signal
 import warnings
@@ -11,6 +12,7 @@ from pathlib import Path
 
 import pytest
 from conftest import TRIANGLE_NETWORK
+from oneline import one_line
 
 import sim
 from sim.cli import main
@@ -135,3 +137,24 @@ def test_a_link_to_a_studys_results_is_not_called_a_copy(tmp_path, capsys):
         warnings.simplefilter("error")
         sim.Results(latest, "network").claims()
     assert "written as alpha/" in other_source(latest, "beta")  # a batch's beta: still named
+
+
+def test_a_quoted_pattern_of_folders_is_not_walked(tmp_path, monkeypatch, capsys):
+    """Hang: a study file given as a quoted pattern was counted with ``glob``: ``sim check
+    '/*/*/*/*/*/*/*/*/*.toml'`` walked the whole disk (/proc too) for minutes before its one
+    line. A pattern is matched in its own directory only now (at most 2,000 names); one in
+    its folders is named as a pattern unwalked (here ``glob`` would raise)."""
+    (tmp_path / "a").mkdir()
+    (tmp_path / "a" / "x.toml").write_text(TRIANGLE_NETWORK)
+    (tmp_path / "a" / "y.toml").write_text(TRIANGLE_NETWORK)
+
+    def walked(*a, **k):
+        raise AssertionError("the pattern was walked with glob")
+
+    monkeypatch.setattr(glob, "glob", walked)
+    monkeypatch.setattr(glob, "iglob", walked)
+    capsys.readouterr()
+    rc = main(["check", f"{tmp_path}/*/*.toml"])
+    one_line(capsys, rc, "a pattern, not a study file (which the shell did not expand")
+    rc = main(["check", f"{tmp_path}/a/*.toml"])
+    one_line(capsys, rc, "a pattern, not a study file (it matches 2 files,")
