@@ -18,7 +18,6 @@ from __future__ import annotations
 import sim.api_env  # noqa: F401 - the environment, before NumPy and Arrow load
 
 # isort: split
-import hashlib
 import os
 import re
 import tempfile
@@ -50,9 +49,11 @@ from sim.api_paths import (
 from sim.api_paths import arrow_name as _arrow_name
 from sim.api_paths import check_path as _check_path
 from sim.api_paths import run_identity as _run_identity
-from sim.api_state import anonymous_dir, check_cwd, check_state, state_sha256, working_dir
+from sim.api_state import anonymous_dir, check_state, state_sha256, working_dir
 from sim.api_state import check_files as _check_files
 from sim.api_state import made_by_load as _by_load
+from sim.api_state import study_sha256 as _sha256
+from sim.api_state import unchanged as _unchanged
 from sim.api_state import unchecked as _unchecked
 from sim.api_tables import a_run, own_trials, run_tables, stale_warning
 from sim.api_tables import check_owner as _check_owner
@@ -389,32 +390,10 @@ _LIMITS = (
 )
 
 
-def _sha256(path: Path) -> str:
-    """The study file's sha256 ("": it is gone). A file that cannot be read (EACCES, EIO) is
-    one line saying so: it was taken for a file that "has changed since sim.load()" (or
-    "changed while it was loaded"), and a handle loaded then checked nothing."""
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except FileNotFoundError:
-        return ""
-    except OSError as e:
-        raise ConfigError("study_file", f"{path} cannot be read ({why_unread(e)})") from None
-
-
 def _unpickled(study: Any, state: dict) -> StudyHandle:
     """A pickled handle made as it was (changed in place: refused by run(), not in a worker)."""
     study = get_study(study) if isinstance(study, str) else study
     return _unchecked(StudyHandle, study=study, **state)
-
-
-def _unchanged(h: StudyHandle) -> None:
-    """A handle runs the file it loaded (``replace`` and ``run(trials=...)`` read it again): an
-    edited or deleted file, or a config changed in place (:func:`check_state`), is refused."""
-    check_state(h)
-    check_cwd(h)
-    if h.file_sha256 and _sha256(h.path) != h.file_sha256:
-        state = "has changed" if h.path.is_file() else "is gone"
-        raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
 
 
 @_arguments

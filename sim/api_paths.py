@@ -1,9 +1,10 @@
 """The paths a Python caller gives the API (``sim.load(study_file)``, ``run(out=...)``,
 ``sim.Results(path, ...)``), checked as the command line checks its own.
 
-A path is a ``str`` or an ``os.PathLike`` of one (``pathlib.Path``, a str subclass), printable
-and not blank. Python expands neither ``~`` nor ``$HOME`` in a path (a shell does, on the
-command line): ``run(out="~/runs/x")`` made a directory named ``~`` in the working directory,
+A path is a ``str`` or an ``os.PathLike`` of one (``pathlib.Path``, a str subclass), not blank,
+without a control character, a line break or bytes that are not UTF-8 (as ``sim run``'s).
+Python expands neither ``~`` nor ``$HOME`` in a path (a shell does, on the command line):
+``run(out="~/runs/x")`` made a directory named ``~`` in the working directory,
 which ``rm -rf ~`` would then mistake for home, and ``"$HOME/runs/x"`` one named ``$HOME``.
 A path that starts with ``~`` or names a variable of the environment (``$HOME``, ``${HOME}``)
 is refused, naming the argument and the function that expands it, unless a file of that
@@ -19,6 +20,7 @@ import os
 import re
 import resource
 import sys
+import unicodedata
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +50,20 @@ __all__ = [
 ]
 
 
+def _unwritable(text: str) -> str | None:
+    """``sim run``'s words for a str no path of the suite may hold (:func:`sim.mc.outputs.
+    name_problem`), or None. Every other str is a path, as on the command line: a name
+    ``os.listdir`` gave of a non-UTF-8 directory (surrogate escapes) or one holding a line
+    break was refused as "must be a path (a str or os.PathLike of a str)", of a str, and so
+    was any name ``str.isprintable`` refuses that the command line takes (a no-break space,
+    a zero-width space: ``sim.Results`` of the results ``sim run --out`` wrote there)."""
+    if any(unicodedata.category(c) == "Cs" for c in text):
+        return "contains bytes that are not UTF-8 text (a non-UTF-8 name or locale)"
+    if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text):
+        return "contains a control character or a line break"
+    return None
+
+
 def check_path(name: str, v: Any, none_ok: bool = False) -> None:
     """``v`` is a path the API can take as argument ``name`` (module docstring)."""
     if v is None and none_ok:
@@ -60,7 +76,9 @@ def check_path(name: str, v: Any, none_ok: bool = False) -> None:
         raise ConfigError(  # through the API as a traceback of the caller's own object
             name, f"is not a path: os.fspath() of its {type(v).__name__} raised {_said(e)}"
         ) from None
-    if not isinstance(text, str) or not text.isprintable() or not text.strip():
+    if isinstance(text, str) and (why := _unwritable(text)) is not None:
+        raise ConfigError(name, f"{why} (got {v!r})")
+    if not isinstance(text, str) or not text.strip():
         raise ConfigError(name, f"must be a path (a str or os.PathLike of a str), got {v!r}")
     if (why := too_long(text)) is not None:
         raise ConfigError(name, why)

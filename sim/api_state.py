@@ -27,11 +27,14 @@ import functools
 import hashlib
 import json
 import os
+import stat
 from pathlib import Path
 from typing import Any
 
+from sim.api_paths import why_unread
 from sim.api_tmp import KEPT, MARK
 from sim.mc.config import ConfigError
+from sim.mc.study_file import MAX_STUDY_BYTES
 
 __all__ = [
     "state_sha256",
@@ -42,6 +45,8 @@ __all__ = [
     "anonymous_dir",
     "made_by_load",
     "unchecked",
+    "study_sha256",
+    "unchanged",
 ]
 
 #: the config keys whose relative path is read from the working directory
@@ -149,6 +154,41 @@ def check_files(h: Any, new: Any) -> None:
                 f"{new.config[key]} has changed since sim.load() (sha256 {now[:12]}..., "
                 f"loaded {was[:12]}...): load the study again",
             )
+
+
+#: :func:`study_sha256` of a path that is no study file now (a FIFO, a device, a file over
+#: :data:`sim.mc.study_file.MAX_STUDY_BYTES`): never the sha256 of the file loaded
+NOT_A_STUDY_FILE = "not a study file"
+
+
+def study_sha256(path: Path) -> str:
+    """The study file's sha256 ("": it is gone). A file that cannot be read (EACCES, EIO) is
+    one line saying so: it was taken for a file that "has changed since sim.load()" (or
+    "changed while it was loaded"), and a handle loaded then checked nothing. What is no
+    study file now (:data:`NOT_A_STUDY_FILE`) is not read: a handle's file replaced after
+    :func:`sim.load` by a FIFO blocked ``run()`` for ever, by a link to ``/dev/zero`` read
+    until memory ran out, by a disk image read whole."""
+    try:
+        st = os.stat(path)
+        if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_STUDY_BYTES:
+            return NOT_A_STUDY_FILE
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except FileNotFoundError:
+        return ""
+    except OSError as e:
+        raise ConfigError("study_file", f"{path} cannot be read ({why_unread(e)})") from None
+
+
+def unchanged(h: Any) -> None:
+    """A handle runs the file it loaded (``replace`` and ``run(trials=...)`` read it again): an
+    edited or deleted file, or a config changed in place (:func:`check_state`), is refused."""
+    check_state(h)
+    check_cwd(h)
+    if h.file_sha256 and study_sha256(h.path) != h.file_sha256:
+        state = "has changed" if h.path.is_file() else "is gone"
+        if os.path.exists(h.path) and not h.path.is_file():  # never opened: it would block
+            state = "is no longer a regular file (a pipe, a device or a directory now)"
+        raise ConfigError("study_file", f"{h.path} {state} since sim.load(): load the study again")
 
 
 @contextlib.contextmanager

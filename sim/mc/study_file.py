@@ -9,7 +9,7 @@ no size limit until the file's config was read): one check, one wording, the pat
 from __future__ import annotations
 
 import difflib
-import glob
+import fnmatch
 import itertools
 import os
 import re
@@ -140,6 +140,27 @@ def _names_a_study(p: Path) -> bool:
     return re.search(rb"(?m)^[ \t]*study[ \t]*=", head) is not None
 
 
+#: the most names a pattern given as a study file is matched against (a directory's entries)
+_LOOKED = 2000
+
+
+def _matches(p: Path) -> int | None:
+    """How many files the pattern ``p`` matches (over :data:`_LOOKED`: ``_LOOKED + 1``),
+    looking in one directory only, the pattern's own; None for a pattern in its folders
+    (``'*/x.toml'``), which is not walked: ``glob`` of ``'/*/*/*/*/*/*/*/*/*.toml'`` walked
+    the whole disk, /proc too, and ``sim check`` ran for minutes before its one line."""
+    if any(c in str(p.parent) for c in "*?["):
+        return None
+    n = 0
+    try:
+        with os.scandir(p.parent) as it:
+            for e in itertools.islice(it, _LOOKED + 1):
+                n += fnmatch.fnmatchcase(e.name, p.name) and not e.name.startswith(".")
+    except OSError:
+        return 0
+    return n
+
+
 def study_file_problem(p: str | Path) -> str | None:
     """Why ``p`` cannot be read as a study file, one line that starts with the path, or None:
     a directory, a pipe or a device (opening a FIFO nobody writes to blocks), a link that
@@ -155,11 +176,17 @@ def study_file_problem(p: str | Path) -> str | None:
         if why := link_problem(p):  # a link loop was "no such study file", of a name there
             return f"{p}: {why}"
         if any(c in str(p) for c in "*?["):
-            hits = len(glob.glob(str(p)))  # quoted, the shell passed on a pattern of files
-            if hits:
+            hits = _matches(p)  # quoted, the shell passed on a pattern of files
+            if hits is None:  # a pattern of folders: not walked
                 return (
-                    f"{p}: a pattern, not a study file (it matches {hits} files, which the "
-                    "shell did not expand: leave it unquoted, or name the files)"
+                    f"{p}: a pattern, not a study file (which the shell did not expand: leave "
+                    "it unquoted, or name the files)"
+                )
+            if hits:
+                many = f"more than {_LOOKED} names" if hits > _LOOKED else f"{hits} file"
+                return (
+                    f"{p}: a pattern, not a study file (it matches {many}{'s' * (hits > 1)}, "
+                    "which the shell did not expand: leave it unquoted, or name the files)"
                 )
             return (
                 f"{p}: no such study file (a pattern that matched no file: the shell passed "

@@ -15,9 +15,11 @@ from __future__ import annotations
 
 import hashlib
 import os
+import stat
 from pathlib import Path
 
 from sim.mc.storage import read_record
+from sim.mc.study_file import MAX_STUDY_BYTES
 
 __all__ = ["other_source", "recorded_source", "source_fields"]
 
@@ -32,9 +34,12 @@ def source_fields(study_file: str | os.PathLike | None, out: Path) -> dict:
     if study_file is None:
         return fields
     p = Path(study_file)
-    try:
-        with open(p, "rb") as f:  # (at most sim.mc.study_file.MAX_STUDY_BYTES: read before)
-            sha = hashlib.sha256(f.read()).hexdigest()
+    try:  # gone, or no study file since it was read (a FIFO would block): named, not read
+        st = os.stat(p)
+        sha = None
+        if stat.S_ISREG(st.st_mode) and st.st_size <= MAX_STUDY_BYTES:
+            with open(p, "rb") as f:
+                sha = hashlib.sha256(f.read()).hexdigest()
     except OSError:  # gone since it was read: the record names it without its content
         sha = None
     try:  # the working directory removed meanwhile: the path as given
@@ -62,13 +67,23 @@ def other_source(d: str | Path, name: str | None = None, record: dict | None = N
     """Why the results directory ``d`` holds another study's results than its name says, or
     None: its record was written into a directory of another name from a study file of
     another name (copied or renamed by hand). ``name``: the study the reader expects (a
-    batch's study file name), default the directory's name; ``record``: its run record if
-    read already."""
+    batch's study file name, a committed study's for ``make verify``), default the
+    directory's name, which says a study only when its run was written under its study
+    file's name (a batch's ``<results>/<study>``): results written under a name of the
+    user's (``sim run x.toml --out r1``) were named by no study, and moved or renamed as a
+    whole (``mv r1 r2``) they were noted by ``sim show`` and warned of by ``sim.Results`` as
+    "not r2's (copied or renamed by hand?): run r2's own study file", a file that never
+    was. A symbolic link to results (``latest -> B/alpha``) is named by what it leads to.
+    ``record``: its run record if read already."""
     here = Path(os.path.abspath(d))
     rec = record if record is not None else read_record(here)
     written, path = recorded_source(rec)
-    want = name if name is not None else here.name
-    if written is None or want in (written, Path(path).stem if path else None):
+    stem = Path(path).stem if path else None
+    if name is None and stem is not None and written != stem:
+        return None  # a directory the user named, not for its study: its name says none
+    # a link's name is not the directory's (latest -> B/alpha: "not latest's", R50)
+    want = name if name is not None else Path(os.path.realpath(here)).name
+    if written is None or want in (written, stem):
         return None
     where = f" of {path}" if path else ""
     return (

@@ -45,7 +45,7 @@ def _value_slip(key: str, value: str) -> str:
     """What is wrong with ``value``, the text after ``key =`` up to its end or comment."""
     if not value:
         return f"{key} has no value: write one after the ="
-    if m := re.fullmatch(r"(\d{1,3})((?:[, ]\d{3})+)", value):  # 4,000 or 4 000
+    if m := re.fullmatch(r"([+-]?\d{1,3})((?:[, ]\d{3})+)", value):  # 4,000, 4 000, -4,000
         digits = m.group(1) + re.sub(r"[, ]", "", m.group(2))
         return f"a TOML number has no thousands separator: {key} = {digits}, or {key} = " + (
             m.group(1) + re.sub(r"[, ]", "_", m.group(2))
@@ -84,6 +84,36 @@ def _opened(lines: list[str], before: int, mark: str) -> int | None:
     return None
 
 
+def _left_open(text: str, quote: str) -> int | None:
+    """The 1-based number of the first line of ``text`` that opens a one-line string of
+    ``quote`` (``"`` or ``'``) and does not close it, outside comments and multi-line
+    strings, or None. The count of ``'`` per line blamed a line before the slip for the
+    apostrophe of a text in double quotes (``name = "Brown's plate"``)."""
+    state, i, n = "", 0, 1
+    while i < len(text):
+        if state in ("", '"', "'") and text[i] == "\n":
+            if state == quote:
+                return n
+            state, n = "", n + 1
+        elif not state and text[i] == "#":
+            while i + 1 < len(text) and text[i + 1] != "\n":
+                i += 1
+        elif not state and text[i] in "\"'":
+            state = text[i] * 3 if text.startswith(text[i] * 3, i) else text[i]
+            i += len(state) - 1
+        elif state in ('"', '"""') and text[i] == "\\":
+            n += text[i + 1 : i + 2] == "\n"
+            i += 1  # an escaped character: \" closes nothing
+        elif len(state) == 3 and text.startswith(state, i):
+            state, i = "", i + 2
+        elif state and len(state) == 1 and text[i] == state:
+            state = ""
+        elif text[i] == "\n":
+            n += 1
+        i += 1
+    return n if state == quote else None
+
+
 def slip_hint(text: str, message: str, n: int, col: int) -> str:
     """`` (<the slip>: <the line as probably meant>)`` for tomllib's ``message`` on the study
     file ``text`` at line ``n``, column ``col`` (1-based; 0 when tomllib said "at end of
@@ -119,6 +149,6 @@ def slip_hint(text: str, message: str, n: int, col: int) -> str:
     elif message.startswith("Illegal character '\\n'") and line[: col - 1].count('"') % 2:
         words = 'the text opened on this line is not closed by "'
     elif message.startswith('Expected "\'"'):  # a literal string not closed: at the document's end
-        k = next((k for k, x in enumerate(lines) if x.split("#", 1)[0].count("'") % 2), None)
-        return "" if k is None else f" (the text opened at line {k + 1} is not closed by ')"
+        k = _left_open(text, "'")
+        return "" if k is None else f" (the text opened at line {k} is not closed by ')"
     return f" ({where}{words})" if words else ""
