@@ -12,7 +12,7 @@ failing on the code before its fix.
   at 100 um, 1.5e-8 mm at 3 mm): the engine stops an adjustment when the remaining error it
   estimates from the contraction of the last two corrections is below ``solver.tol_mm``, and at
   range errors of 0.1-3 mm that estimate is 100 times short, so the two pivot adjustments the
-  check compares stopped 1e-8 mm from their (equal) solutions. Each is now restarted once
+  check compares stopped 1e-8 mm from their (equal) solutions. Each is now restarted twice
   from its own solution (a fresh first step, no contraction estimate): 1e-11 mm at 3 mm.
 * Brown's comparator in brown_table1 and brown_dilution took a micrometer travel, a scale and
   a plate of any length (``comparator.micrometer_mm = 1000``, a travel in um read as mm: a
