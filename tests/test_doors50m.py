@@ -23,6 +23,9 @@ failing on the code before its fix.
 * brown_dilution's bias-invariance check took a constant of 0 (or 1e-7 um): it compared an
   adjustment with itself and scored the paper's prediction "holds", a claim that could not
   fail. The constant is now at least 1 um (a million times the claims' zone).
+* gridplate_two_plates with its sigmas in metres (1.2e-06 for 1.2 um): its iterations stopped
+  at ``analysis.iter_tol_um`` (0.001 um), a thousand times the errors, and its closed-form
+  self-check failed. A sigma under ten times the tolerance is refused now, naming it.
 """
 
 from __future__ import annotations
@@ -90,3 +93,21 @@ def test_brown_bias_check_with_no_constant_is_refused(value):
     with pytest.raises(sim.ConfigError) as e:
         sim.load(STUDIES / "brown_dilution.toml", checks__bias_shift_um=value)
     assert str(e.value).startswith("checks.bias_shift_um: must be >= 1"), str(e.value)
+
+
+def test_gridplate_sigmas_in_metres_are_refused():
+    """gridplate's printed sigmas written in metres (``1.2e-06`` for 1.2 um; every sigma a
+    millionth): accepted, its re-weighting iterations stopped at analysis.iter_tol_um =
+    0.001 um, a thousand times the errors, and the self-check twoplate.self_check.closed_form
+    failed (3.5e-5 against 1e-6) on a run whose README called the affine sigma "0.0000 um"."""
+    sigmas = {
+        "readings.sigma_um": 1.5e-6,
+        "comparator.coord_sigma_um": 1.2e-6,
+        "grid.sigma_true_um": 7e-7,
+        "grid.sigma_stated_um": 7e-7,
+    }
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(STUDIES / "gridplate_two_plates.toml", **sigmas)
+    msg = str(e.value)
+    assert msg.startswith("grid.sigma_stated_um: grid.sigma_stated_um = 7e-07 um is under ten"), msg
+    assert "analysis.iter_tol_um = 0.001 um" in msg and "\n" not in msg
