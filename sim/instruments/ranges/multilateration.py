@@ -182,15 +182,20 @@ def adjust(
     theta = np.broadcast_to(np.asarray(theta0, float), (T, 7)).copy()
     eng = {"auto": "auto", "numpy": "numpy", "numba": "fast"}[engine]
     p0 = None if points0 is None else np.array(points0, float)
+    if p0 is not None and eng != "numpy":  # the engine's fast path starts from its own points
+        res = _kernel_path(_model(r_obs), theta, lsq.Datum(np.arange(p)), tol_mm, max_iter, p0)
+        if res is not None:
+            return res
     return lsq.gauss_newton(
         _model(r_obs), theta, p0, lsq.Datum(np.arange(p)), tol_mm, max_iter, engine=eng
     )
 
 
-def _kernel_path(model: po.RangeModel, theta, datum: lsq.Datum, tol, max_iter):
+def _kernel_path(model: po.RangeModel, theta, datum: lsq.Datum, tol, max_iter, points0=None):
     """Fast path of the engine for Brown's layout (the compiled kernel), or None. Trials the
     kernel leaves undecided (it could not prove their reduced normals regular) are adjusted
-    again by the NumPy engine, whose exact rule decides them."""
+    again by the NumPy engine, whose exact rule decides them. ``points0``: the start of the
+    points (None: linear trilateration)."""
     free = datum.free_index(model.n_global)
     if (
         not jit.available()
@@ -204,13 +209,15 @@ def _kernel_path(model: po.RangeModel, theta, datum: lsq.Datum, tol, max_iter):
     T, n, _ = r_obs.shape
     p = len(free)
     theta0 = theta.copy()
-    pts, status, iters, res, ssq = jit.gauss_newton(r_obs, theta, None, p, tol, max_iter)
+    start = None if points0 is None else np.array(points0, float)  # the kernel works in place
+    pts, status, iters, res, ssq = jit.gauss_newton(r_obs, theta, start, p, tol, max_iter)
     dof = 4 * n - (2 * n + p)
     s0 = np.sqrt(ssq / dof) if dof > 0 else np.full(T, np.nan)
     rest = np.flatnonzero(status == UNDECIDED)
     if rest.size:  # the engine's exact rule on the NumPy path
+        p0 = None if points0 is None else np.array(points0, float)[rest]
         g = lsq.gauss_newton(
-            _model(r_obs[rest]), theta0[rest], None, datum, tol, max_iter, engine="numpy"
+            _model(r_obs[rest]), theta0[rest], p0, datum, tol, max_iter, engine="numpy"
         )
         pts[rest], theta[rest], res[rest] = g.points, g.theta, g.residuals
         s0[rest], iters[rest], status[rest] = g.sigma0, g.iterations, g.status

@@ -49,8 +49,9 @@ BASE = {
     # printed(...): the paper's own number (seed 004: "245 X 245 mm", "graduated ... over a
     # length of 261 mm", the micrometer's "at most one millimeter"); another value is another
     # instrument, and the run is off the paper's setup (sim.claims.rules.printed_differs)
+    # the bounds: brown_design's of the same instrument (m50: a 1 m micrometer passed)
     "plate.format_mm": printed(
-        real(245.0, "side of the square plate format (paper: 245 mm)", lo=1.0, unit="mm")
+        real(245.0, "side of the square plate format (paper: 245 mm)", lo=1.0, hi=2000.0, unit="mm")
     ),
     "plate.pattern": Field("grid", "str", "point pattern", choices=("grid", "random", "list")),
     "plate.grid": _grid(count(5, "points per side of the grid pattern", lo=2, hi=200)),
@@ -104,11 +105,18 @@ BASE = {
             "graduated length of the scale (paper: 261 mm); every range must fit on "
             "it plus the micrometer travel. 0 = not enforced (an idealised comparator)",
             lo=0.0,
+            hi=5000.0,
             unit="mm",
         )
     ),
     "comparator.micrometer_mm": printed(
-        real(1.0, "micrometer travel added to the scale (paper: at most 1 mm)", lo=0.0, unit="mm")
+        real(
+            1.0,
+            "micrometer travel added to the scale (paper: at most 1 mm)",
+            lo=0.0,
+            hi=100.0,
+            unit="mm",
+        )
     ),
     "errors.setting_sigma_um": positive(
         1.0, "standard deviation of one setting", hi=1e4, unit="um"
@@ -162,8 +170,9 @@ DILUTION = {
     ),
     "checks.bias_shift_um": real(
         100.0,
-        "constant added to all ranges in the bias invariance check",
-        lo=-1e5,
+        "constant added to all ranges in the bias invariance check (at least 1 um, a million "
+        "times its claims' zone of 1e-9 mm: at 0 it compared an adjustment with itself)",
+        lo=1.0,
         hi=1e5,
         unit="um",
     ),

@@ -247,6 +247,20 @@ def check(cfg: dict) -> None:
         "re-weighting ratio exceeds 1e8 (the combined normals lose all precision); state at "
         "least 1e-4 of it",
     )
+    # (m50) the sigmas in m or mm (1.2e-06 for 1.2 um) passed: iterations stopped at 0.001 um
+    # before resolving errors of 1e-6 um, and twoplate.self_check.closed_form failed (3.5e-5)
+    key, s = min(
+        (("comparator.coord_sigma_um", sc), ("grid.sigma_stated_um", st)), key=lambda x: x[1]
+    )
+    tol = cfg["analysis.iter_tol_um"]
+    require(
+        s >= 10 * tol,
+        key if tol == SCHEMA["analysis.iter_tol_um"].default else "analysis.iter_tol_um",
+        f"{key} = {s:g} um is under ten times analysis.iter_tol_um = {tol:g} um, the "
+        "correction below which an iteration counts as converged: the iterations would stop "
+        "before they resolve the errors (a sigma in mm or m, not um?); give the sigmas in um, "
+        "or a smaller analysis.iter_tol_um",
+    )
     _check_fixed_points(cfg)
     extent = cfg["plate.spacing_mm"] * (cfg["plate.grid"] - 1)
     # the systematic displacement at the edge must stay small against the grid (linearised
