@@ -171,3 +171,16 @@ def test_the_sparse_page_states_the_estimates_of_its_grid_plates():
         got.append(f"{estimate(cfg).bytes / 2**30:.2f}")
     page = " ".join((ROOT / "docs" / "sparse.md").read_text().split())
     assert f"(estimated {got[0]} and {got[1]}" in page, got
+
+
+def test_the_python_page_names_every_keyword_of_run():
+    """docs/python.md named neither ``figures`` (``--no-figures`` of the API) nor
+    ``scheduler`` among ``run()``'s keywords: each one is named on the page."""
+    import inspect
+
+    import sim
+
+    page = (ROOT / "docs" / "python.md").read_text()
+    params = inspect.signature(sim.StudyHandle.run).parameters
+    missing = [p for p in params if p != "self" and f"`{p}`" not in page and f"{p}=" not in page]
+    assert not missing, missing
