@@ -282,8 +282,8 @@ def _main(argv: list[str], phase: list[str]) -> int:
         argv, run_args = argv[:i], argv[i + 1 :]
     ap = _Parser(
         prog="python -m sim.batch",
-        usage="python -m sim.batch [-h] [--jobs JOBS] [--results RESULTS] [--stale-only] "
-        "[--timings TIMINGS] files [files ...] [-- RUN_OPTIONS]",
+        usage="python -m sim.batch [-h] [--jobs JOBS] [--results RESULTS] "
+        "[--stale-only] [--report] [--timings TIMINGS] files [files ...] [-- RUN_OPTIONS]",
         description=module_doc(__doc__, __file__).partition("\n")[0].replace("``", ""),
         epilog="RUN_OPTIONS after -- are sim run's (--trials, --set KEY=VALUE, --workers, ...), "
         "read once before any run starts; each study writes RESULTS/<file name>, so --out is "

@@ -297,10 +297,13 @@ def main(out: Path = ROOT / "docs" / "mutation.md") -> int:
         by_module.setdefault(name.split(".x")[0], Counter())[st] += 1
     killed = sum(c["killed"] + c["timeout"] for c in by_module.values())
     total = len(status)
+    commit = subprocess.run(
+        ["git", "rev-parse", "--short=8", "HEAD"], cwd=ROOT, capture_output=True, text=True
+    ).stdout.strip()
     lines = [
         "# Mutation testing of the verdict rules and intervals",
         "",
-        "Written by `make mutation` (mutmut on "
+        f"Written by `make mutation` at commit `{commit or 'unknown'}` (mutmut on "
         + ", ".join(f"`{m}`" for m in modules["only_mutate"])
         + "; tests: "
         + ", ".join(f"`{t}`" for t in modules["pytest_add_cli_args_test_selection"])

@@ -70,7 +70,7 @@ def _parser() -> argparse.ArgumentParser:
         "--workers",
         type=integer("workers", 1, most_workers()),
         default=1,
-        help="workers of each re-run",
+        help="workers of each re-run (default 1; make verify passes 2)",
     )
     p.add_argument("--study", action="append", help="only this study (repeatable)")
     p.add_argument(
@@ -81,7 +81,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--trials",
         type=integer("trials"),
-        help="re-run with this many trials and compare at the Monte-Carlo level",
+        help=f"re-run with this many trials (at least {MIN_TRIALS}) and compare at the "
+        "Monte-Carlo level",
     )
     p.add_argument(
         "--set",
