@@ -52,7 +52,7 @@ from pathlib import Path
 from sim.mc.config import ConfigError
 from sim.studies.network import gama_vocab as vocab
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
-from sim.studies.network.gama_encoding import EncodingProblem, bom_note, gama_text
+from sim.studies.network.gama_encoding import EncodingProblem, bom_note, gama_text, undecodable
 from sim.studies.network.gama_frames import NE, frame_note
 from sim.studies.network.gama_prolog import entity_declared, raw_name_problem
 from sim.studies.network.gama_sets import one_target
@@ -240,7 +240,10 @@ def _network(f: _File, data: bytes):
         )
     try:
         root = ET.fromstring(text)
-    except ET.ParseError as e:
+    except ET.ParseError as e:  # at bytes not of the file's encoding: said so ("invalid token")
+        bad = undecodable(data) if isinstance(text, bytes) else None
+        if bad and bad[0] <= e.position[0]:
+            raise ConfigError(key, f"{path}: {bad[1]}") from None
         raise ConfigError(key, f"{path} is not XML: {e}") from None
     except (LookupError, ValueError) as e:  # an unknown encoding declared, undecodable bytes
         raise ConfigError(key, f"{path} cannot be decoded: {e}") from None
