@@ -7,6 +7,10 @@ one case each; each failed on the code before its fix.
   XML: not well-formed (invalid token): line 8, column 17", which names neither the encoding
   nor the cure (``gama-local`` 2.03 reads such bytes as they are, other names). The line names
   the bytes, the encoding they were read in, and what to declare.
+* ``gama_xml = "~/net.xml"`` (or ``$HOME/net.xml``, ``file:///.../net.xml``, a URL, the name
+  with a space after it or in another case) was "cannot read ...: No such file or directory" of
+  a file the user can list (a study file expands no ``~``; a path made ``file:///x``
+  ``file:/x``): the line says why and names the file that exists.
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ import pytest
 
 from sim.mc.config import ConfigError
 from sim.studies.network.gama_read import read_gama
+from sim.studies.network.gama_vocab import read_bytes
 
 NET = """<?xml version="1.0" {decl}?>
 <gama-local xmlns="http://www.gnu.org/software/gama/gama-local">
@@ -68,3 +73,24 @@ def test_bytes_of_another_encoding_are_named_with_the_declaration_to_give(tmp_pa
     broken = latin2.replace(b"<parameters", b"<parameters <")
     with pytest.raises(ConfigError, match=r"is not XML: not well-formed \(invalid token\): line 4"):
         read_gama(_file(tmp_path, broken))
+
+
+def test_a_path_a_shell_would_have_expanded_says_what_exists(tmp_path, monkeypatch):
+    """Unclear message: ``~/net.xml``, ``$HOME/net.xml``, ``file:///...``, ``https://...``,
+    ``net.xml `` and ``NET.xml`` were "No such file or directory" alone (the ``file:`` URL
+    shown as ``file:/...``); each now says why, naming the file that exists."""
+    monkeypatch.setenv("HOME", str(tmp_path))
+    net = _file(tmp_path, b"<gama-local/>")
+    cases = {
+        "~/net.xml": f"'~' is not expanded in a study file: give the full path: {net} exists",
+        "$HOME/net.xml": f"environment variables are not expanded in a study file: give the "
+        f"full path: {net} exists",
+        f"file://{net}": f"a file: URL: give the path itself: {net} exists",
+        "https://example.org/net.xml": "a URL: only a local file is read",
+        f"{net} ": f"white space around the name: {net} exists",
+        str(tmp_path / "NET.xml"): f"{net} exists: the name differs in case",
+    }
+    for given, why in cases.items():
+        with pytest.raises(ConfigError) as e:
+            read_bytes(given)
+        assert "No such file or directory (" + why in str(e.value), str(e.value)
