@@ -15,6 +15,10 @@ one case each; each failed on the code before its fix.
   30,002 unknowns) drew nothing on the terminal for the first 31 s of ``sim run`` on the loaded
   machine: its parse (5.4 s of one core) was shown by no step, where the building after it is.
   A parse of a file of 2 MiB or more is shown now ("network: reading NAME ...").
+* The work and memory estimate of a file declared in ``gama-local``'s own ``cp-1251`` or
+  ``cp-1250`` (spelt so; names Python's expat does not know) fell back to the file's size: a
+  10,000-point mesh counted 56,102 rows and 2.1e6 factor nonzeros for its 88,803 and 3.6e6, the
+  memory 40 % short. Such a file is counted byte by byte now, as the file in UTF-8.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ import pytest
 
 from sim.mc import progress
 from sim.mc.config import ConfigError
+from sim.mc.gama_count import gama_counts
 from sim.studies.network import gama_cache
 from sim.studies.network.gama_read import read_gama
 from sim.studies.network.gama_vocab import read_bytes
@@ -116,3 +121,17 @@ def test_the_parse_of_a_large_file_is_shown_on_a_terminal(tmp_path, monkeypatch,
     assert "network: reading" not in capsys.readouterr().err
     assert gama_cache.read_gama(large)["network.points"][2]["name"] == "C"
     assert "network: reading large.xml ..." in capsys.readouterr().err
+
+
+def test_a_file_in_gama_locals_own_encoding_is_counted_for_the_estimate(tmp_path):
+    """Estimate short of the run: a file declared ``cp-1251`` (or ``cp-1250``, ``x-any``: the
+    reader reads it) could not be counted (None: the size's guess, 40 % short of the memory at
+    10,000 points); it is counted as the same network in UTF-8 now."""
+    utf8 = gama_counts(_file(tmp_path, NET.format(decl="", c="\u0416\u0443\u043a").encode()))
+    assert utf8 is not None and utf8.points == 3 and utf8.rows["distance"] == 3
+    for enc, codec in (("cp-1251", "cp1251"), ("cp-1250", "cp1250"), ("x-any", "ascii")):
+        name = "\u0416\u0443\u043a" if codec == "cp1251" else "\u010c\u00e1p" * (codec != "ascii")
+        text = NET.format(decl=f'encoding="{enc}" ', c=name or "C")
+        p = _file(tmp_path, text.encode(codec), f"{enc}.xml")
+        assert gama_counts(p) == utf8, enc
+        assert len(read_gama(p)["network.points"]) == 3  # (the reader reads each)
