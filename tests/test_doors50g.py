@@ -18,7 +18,8 @@ one case each; each failed on the code before its fix.
 * The work and memory estimate of a file declared in ``gama-local``'s own ``cp-1251`` or
   ``cp-1250`` (spelt so; names Python's expat does not know) fell back to the file's size: a
   10,000-point mesh counted 56,102 rows and 2.1e6 factor nonzeros for its 88,803 and 3.6e6, the
-  memory 40 % short. Such a file is counted byte by byte now, as the file in UTF-8.
+  memory 40 % short. Such a file is counted byte by byte now, as the file in UTF-8. A point
+  named only by an observation's own ``from`` (in an ``<obs>`` without one) was not counted.
 """
 
 from __future__ import annotations
@@ -135,3 +136,19 @@ def test_a_file_in_gama_locals_own_encoding_is_counted_for_the_estimate(tmp_path
         p = _file(tmp_path, text.encode(codec), f"{enc}.xml")
         assert gama_counts(p) == utf8, enc
         assert len(read_gama(p)["network.points"]) == 3  # (the reader reads each)
+
+
+def test_a_point_named_only_by_an_observations_own_from_is_counted(tmp_path):
+    """Estimate short of the run: ``<obs><distance from="C" to="A"/>...`` (a program that writes
+    each distance with its ends) named C nowhere else; the counts left it out (2 points of 3)."""
+    text = NET.format(decl="", c="C")
+    text = text.replace(
+        '<obs from="B">\n        <distance to="C"', '<obs>\n        <distance from="C" to="B"'
+    )
+    text = text.replace(
+        '<distance to="C" val="0.806225774829855"',
+        '<distance from="C" to="A" val="0.806225774829855"',
+    )
+    p = _file(tmp_path, text.encode())
+    assert [r["to"] for r in read_gama(p)["network.observations"]] == ["B", "A", "B"]
+    assert gama_counts(p).points == 3

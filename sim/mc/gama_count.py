@@ -31,8 +31,10 @@ __all__ = ["GamaCounts", "gama_counts", "MAX_COUNT_BYTES"]
 MAX_COUNT_BYTES = 256 * 1024**2
 #: the elements of an ``<obs>`` that are one observation (row) each
 _ROWS = ("distance", "direction", "angle")
-#: the attributes of such an element that name a point (an angle's ``bs``/``fs``, their aliases)
-_SIGHTS = ("to", "bs", "fs", "rs")
+#: the attributes of such an element that name a point (an angle's ``bs``/``fs``, their aliases;
+#: its own ``from``, which an ``<obs>`` without one needs: a point only ever named there was not
+#: counted, 3 points of a file of 3 as 2)
+_SIGHTS = ("from", "to", "bs", "fs", "rs")
 
 
 class GamaCounts(NamedTuple):
