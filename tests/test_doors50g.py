@@ -20,6 +20,10 @@ one case each; each failed on the code before its fix.
   10,000-point mesh counted 56,102 rows and 2.1e6 factor nonzeros for its 88,803 and 3.6e6, the
   memory 40 % short. Such a file is counted byte by byte now, as the file in UTF-8. A point
   named only by an observation's own ``from`` (in an ``<obs>`` without one) was not counted.
+* A file declared ``ISO-8859-1`` or ``windows-1250`` whose bytes are UTF-8 (a program writing
+  UTF-8 under another declaration) was read with its point names as other characters
+  (``P\u00e1\u00e9`` as ``P\u00c3\u00a1\u00c3\u00a9``), as gama-local reads them, without a word; the report's note
+  says so now, with the declaration to give.
 """
 
 from __future__ import annotations
@@ -152,3 +156,20 @@ def test_a_point_named_only_by_an_observations_own_from_is_counted(tmp_path):
     p = _file(tmp_path, text.encode())
     assert [r["to"] for r in read_gama(p)["network.observations"]] == ["B", "A", "B"]
     assert gama_counts(p).points == 3
+
+
+def test_utf8_bytes_under_a_single_byte_declaration_are_noted(tmp_path):
+    """Silent nonsense (names): UTF-8 bytes declared ISO-8859-1 or windows-1250 were read as
+    other names without a word. Read as before (as gama-local reads them), with a note; a
+    file truly in ISO-8859-1 (not UTF-8) gets none."""
+    for enc in ("ISO-8859-1", "windows-1250"):
+        text = NET.format(decl=f'encoding="{enc}" ', c="P\u00e1\u00e9")
+        rec = read_gama(_file(tmp_path, text.encode("utf-8")))
+        assert rec["network.points"][2]["name"] == "P\u00e1\u00e9".encode().decode(
+            "latin-1" if enc == "ISO-8859-1" else "cp1250"
+        )
+        assert f"declares '{enc}' and its bytes beyond ASCII" in rec["note"], rec["note"]
+        assert 'if the file is UTF-8, declare encoding="UTF-8"' in rec["note"]
+    latin = NET.format(decl='encoding="ISO-8859-1" ', c="P\u00e1\u00e9").encode("latin-1")
+    rec = read_gama(_file(tmp_path, latin))
+    assert rec["network.points"][2]["name"] == "P\u00e1\u00e9" and "UTF-8" not in rec["note"]

@@ -13,7 +13,7 @@ import re
 
 from sim.studies.network.gama_vocab import said
 
-__all__ = ["gama_text", "EncodingProblem", "bom_note", "undecodable"]
+__all__ = ["gama_text", "EncodingProblem", "bom_note", "utf8_note", "undecodable"]
 
 #: the encodings gama-local decodes: expat's own (any case) and its handler's (names compared
 #: exactly), by Python's codec and the bytes its table maps otherwise (cp1250: 0x80 to U+0080,
@@ -61,6 +61,27 @@ def bom_note(data: bytes) -> str:
     return (
         "; the file begins with a UTF-8 byte-order mark, read as UTF-8 here: gama-local 2.03 "
         "stops on it (a segmentation fault), remove the mark to run the file there"
+    )
+
+
+def utf8_note(data: bytes) -> str:
+    """What the report says of a file that declares a single-byte encoding (``ISO-8859-1``,
+    ``cp-1250``, ...) over bytes beyond ASCII that are UTF-8 as well: a program that writes
+    UTF-8 under another declaration. They are read as declared, as ``gama-local`` reads them
+    (the same network, its point names other characters: ``\u010c\u00e1p`` read as ``\u00c4\u0152\u00c3\u00a1p``);
+    a Latin-1 text is almost never valid UTF-8, so the note says what the writer likely meant."""
+    m = _DECL.match(data[:1024])
+    if not m or data.startswith(_BOM8):
+        return ""
+    enc = m.group(1).decode("ascii", "replace")
+    if enc.lower() in _EXPAT_ENC and enc.lower() != "iso-8859-1":
+        return ""
+    if data.isascii() or not _utf8(data):
+        return ""
+    return (
+        f"; the file declares {said(enc)} and its bytes beyond ASCII are read so, as gama-local "
+        "reads them, but they are UTF-8 too (point names in UTF-8 read as other characters): "
+        'if the file is UTF-8, declare encoding="UTF-8"'
     )
 
 

@@ -52,7 +52,13 @@ from pathlib import Path
 from sim.mc.config import ConfigError
 from sim.studies.network import gama_vocab as vocab
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
-from sim.studies.network.gama_encoding import EncodingProblem, bom_note, gama_text, undecodable
+from sim.studies.network.gama_encoding import (
+    EncodingProblem,
+    bom_note,
+    gama_text,
+    undecodable,
+    utf8_note,
+)
 from sim.studies.network.gama_frames import NE, frame_note
 from sim.studies.network.gama_prolog import entity_declared, raw_name_problem
 from sim.studies.network.gama_sets import one_target
@@ -348,7 +354,7 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
     note = vocab.parameters_note(f, [e for e in net if _tag(e) == "parameters"])
     axes = ws(net.get("axes-xy", NE[0]))  # gama-local's vocabulary, checked in _network
     angles = ws(net.get("angles", NE[1]))
-    note += frame_note(axes, angles) + bom_note(data)
+    note += frame_note(axes, angles) + bom_note(data) + utf8_note(data)
     pos = [e for e in net if _tag(e) == "points-observations"]
     if len(pos) != 1:
         raise f.err(net, f"{len(pos)} <points-observations> elements (need one)")
