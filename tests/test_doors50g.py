@@ -23,7 +23,8 @@ one case each; each failed on the code before its fix.
 * A file declared ``ISO-8859-1`` or ``windows-1250`` whose bytes are UTF-8 (a program writing
   UTF-8 under another declaration) was read with its point names as other characters
   (``P\u00e1\u00e9`` as ``P\u00c3\u00a1\u00c3\u00a9``), as gama-local reads them, without a word; the report's note
-  says so now, with the declaration to give.
+  says so now, with the declaration to give; where such a name is refused (``\u010c`` read as
+  ``\u00c4`` and the control character U+008C) the refusal says it too.
 """
 
 from __future__ import annotations
@@ -173,3 +174,9 @@ def test_utf8_bytes_under_a_single_byte_declaration_are_noted(tmp_path):
     latin = NET.format(decl='encoding="ISO-8859-1" ', c="P\u00e1\u00e9").encode("latin-1")
     rec = read_gama(_file(tmp_path, latin))
     assert rec["network.points"][2]["name"] == "P\u00e1\u00e9" and "UTF-8" not in rec["note"]
+    text = NET.format(decl='encoding="ISO-8859-1" ', c="\u010c\u00e1p")
+    with pytest.raises(ConfigError) as e:
+        read_gama(_file(tmp_path, text.encode("utf-8")))
+    assert "is printable" in str(e.value) and str(e.value).endswith(
+        '(the file\'s bytes are UTF-8: declare encoding="UTF-8")'
+    ), str(e.value)

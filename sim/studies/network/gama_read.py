@@ -350,6 +350,8 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
             f"{path} has changed since the study was loaded (sha256 {now[:12]}..., recorded "
             f"{sha256[:12]}...): load the study again",
         )
+    if utf8_note(data):  # a name refused for characters the declaration made of UTF-8 bytes
+        f.names_hint = ' (the file\'s bytes are UTF-8: declare encoding="UTF-8")'
     net = _network(f, data)
     note = vocab.parameters_note(f, [e for e in net if _tag(e) == "parameters"])
     axes = ws(net.get("axes-xy", NE[0]))  # gama-local's vocabulary, checked in _network

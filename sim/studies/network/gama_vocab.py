@@ -206,6 +206,9 @@ class _File:
         #: d-m-s values with minutes or seconds of 60 or more, read as gama-local reads them:
         #: ``(element, attribute, value)``, for the note
         self.sexagesimal: list[tuple[str, str, str]] = []
+        #: said after a refused point name where the file's bytes are UTF-8 under another
+        #: declaration (its names read as other characters: ``gama_encoding.utf8_note``)
+        self.names_hint = ""
 
     def err(self, e, what: str, attr: str | None = None) -> ConfigError:
         where = f"<{_tag(e)}>" if attr is None else f"<{_tag(e)}> attribute {attr!r}"
@@ -257,7 +260,7 @@ class _File:
         try:
             return _point_name(attr, v)
         except ConfigError as err:
-            raise self.err(e, str(err).split(": ", 1)[1], attr) from None
+            raise self.err(e, str(err).split(": ", 1)[1] + self.names_hint, attr) from None
 
     def angle(self, e, attr: str = "val") -> bool:
         """Check an angular value; True when it is d-m-s (degrees), False for gon. A d-m-s
