@@ -25,6 +25,11 @@ one case each; each failed on the code before its fix.
   (``P\u00e1\u00e9`` as ``P\u00c3\u00a1\u00c3\u00a9``), as gama-local reads them, without a word; the report's note
   says so now, with the declaration to give; where such a name is refused (``\u010c`` read as
   ``\u00c4`` and the control character U+008C) the refusal says it too.
+* A DOCTYPE declaring an attribute default (``<!ATTLIST distance stdev CDATA "5">``) gave every
+  distance without its own stdev 5 mm from a line no element shows (``gama-local`` too), and
+  ``<!ATTLIST point adj CDATA "xy">`` was refused as "point 'A' is both fixed and adjusted"
+  naming the ``fix`` of a ``<point fix="xy">``; refused now as the entities are, naming the
+  element and the attribute.
 """
 
 from __future__ import annotations
@@ -180,3 +185,26 @@ def test_utf8_bytes_under_a_single_byte_declaration_are_noted(tmp_path):
     assert "is printable" in str(e.value) and str(e.value).endswith(
         '(the file\'s bytes are UTF-8: declare encoding="UTF-8")'
     ), str(e.value)
+
+
+def test_an_attribute_default_of_the_doctype_is_refused_naming_it(tmp_path):
+    """Silent (a stdev from the DOCTYPE) and unclear (an ``adj`` blamed on ``fix``): an
+    attribute default the DOCTYPE declares is refused, naming the element and the attribute;
+    a declaration without a default (``#IMPLIED``) is read."""
+    text = NET.format(decl="", c="C").replace(' stdev="0.01"', "")
+    for decl, named in (
+        (
+            '<!ATTLIST distance stdev CDATA "5">',
+            "gives <distance> attribute 'stdev' the default '5'",
+        ),
+        (
+            '<!ATTLIST point adj CDATA #FIXED "xy">',
+            "gives <point> attribute 'adj' the default 'xy'",
+        ),
+    ):
+        data = text.replace("?>\n", f"?>\n<!DOCTYPE gama-local [{decl}]>\n", 1).encode()
+        with pytest.raises(ConfigError, match="its <!DOCTYPE> " + named + ": attribute defaults"):
+            read_gama(_file(tmp_path, data))
+    implied = "<!DOCTYPE gama-local [<!ATTLIST point adj CDATA #IMPLIED>]>"
+    data = NET.format(decl="", c="C").replace("?>\n", f"?>\n{implied}\n", 1).encode()
+    assert len(read_gama(_file(tmp_path, data))["network.points"]) == 3

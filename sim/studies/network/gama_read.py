@@ -60,7 +60,7 @@ from sim.studies.network.gama_encoding import (
     utf8_note,
 )
 from sim.studies.network.gama_frames import NE, frame_note
-from sim.studies.network.gama_prolog import entity_declared, raw_name_problem
+from sim.studies.network.gama_prolog import default_declared, entity_declared, raw_name_problem
 from sim.studies.network.gama_sets import one_target
 from sim.studies.network.gama_stdev import default_stdevs, distance_default, sigma, variances
 from sim.studies.network.gama_terms import check_terms
@@ -243,6 +243,15 @@ def _network(f: _File, data: bytes):
             key,
             f"{path}: its <!DOCTYPE> declares the entity {ent}: entity declarations are not read "
             "(a gama-local file needs none; write the values in place)",
+        )
+    if found := default_declared(text):
+        el, att, v = found
+        raise ConfigError(
+            key,
+            f"{path}: its <!DOCTYPE> gives <{el[:40]}> attribute {att[:40]!r} the default "
+            f"{vocab.said(v)}: "
+            "attribute defaults are not read (a gama-local file needs none; write the value on "
+            "the elements, a default stdev on <points-observations>)",
         )
     try:
         root = ET.fromstring(text)
