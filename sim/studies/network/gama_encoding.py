@@ -3,8 +3,8 @@ bytes: expat's own encodings (UTF-8, UTF-16, ISO-8859-1, US-ASCII, any case) and
 own handler (``encoding_unknown_handler.cpp``: ``cp-1250``, ``windows-1250``, ``cp-1251``,
 ``windows-1251``, ``iso-8859-2``, names compared exactly, by its own tables); any other name it
 reads as ISO-8859-1. :func:`gama_text` gives the file as ``gama-local`` reads it, or raises
-:class:`EncodingProblem` where that is not what the file means. Used by
-:mod:`sim.studies.network.gama_read`."""
+:class:`EncodingProblem` where that is not what the file means. :func:`undecodable` names the first bytes that are not of the encoding the parser reads the
+file in (UTF-8 when it declares none). Used by :mod:`sim.studies.network.gama_read`."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import re
 
 from sim.studies.network.gama_vocab import said
 
-__all__ = ["gama_text", "EncodingProblem", "bom_note"]
+__all__ = ["gama_text", "EncodingProblem", "bom_note", "utf8_note", "undecodable"]
 
 #: the encodings gama-local decodes: expat's own (any case) and its handler's (names compared
 #: exactly), by Python's codec and the bytes its table maps otherwise (cp1250: 0x80 to U+0080,
@@ -61,6 +61,27 @@ def bom_note(data: bytes) -> str:
     return (
         "; the file begins with a UTF-8 byte-order mark, read as UTF-8 here: gama-local 2.03 "
         "stops on it (a segmentation fault), remove the mark to run the file there"
+    )
+
+
+def utf8_note(data: bytes) -> str:
+    """What the report says of a file that declares a single-byte encoding (``ISO-8859-1``,
+    ``cp-1250``, ...) over bytes beyond ASCII that are UTF-8 as well: a program that writes
+    UTF-8 under another declaration. They are read as declared, as ``gama-local`` reads them
+    (the same network, its point names other characters: ``\u010c\u00e1p`` read as ``\u00c4\u0152\u00c3\u00a1p``);
+    a Latin-1 text is almost never valid UTF-8, so the note says what the writer likely meant."""
+    m = _DECL.match(data[:1024])
+    if not m or data.startswith(_BOM8):
+        return ""
+    enc = m.group(1).decode("ascii", "replace")
+    if enc.lower() in _EXPAT_ENC and enc.lower() != "iso-8859-1":
+        return ""
+    if data.isascii() or not _utf8(data):
+        return ""
+    return (
+        f"; the file declares {said(enc)} and its bytes beyond ASCII are read so, as gama-local "
+        "reads them, but they are UTF-8 too (point names in UTF-8 read as other characters): "
+        'if the file is UTF-8, declare encoding="UTF-8"'
     )
 
 
@@ -123,3 +144,51 @@ def gama_text(data: bytes) -> bytes | str:
         "bytes beyond ASCII as ISO-8859-1, other characters than here: declare UTF-8 "
         f"(or one of {', '.join(('UTF-16', 'ISO-8859-1', 'US-ASCII', *_GAMA_ENC))})"
     )
+
+
+_LINE_END = re.compile(rb"\r\n|\r|\n")
+
+
+def undecodable(data: bytes) -> tuple[int, str] | None:
+    """``(line, why)`` of the first bytes of ``data`` that are not of the encoding the XML
+    parser reads it in: UTF-8 where it declares none or ``UTF-8``, ASCII where it declares
+    ``US-ASCII`` (None: no such bytes, or another encoding). The parser stops there with "not
+    well-formed (invalid token)", which does not say why: a file from another program, in
+    ISO-8859-2 or windows-1250 (Czech point names) and without a declaration, is the likely
+    case (``gama-local`` 2.03 reads such bytes as they are, other characters than written)."""
+    head = data[:4]
+    if head[:2] in (b"\xff\xfe", b"\xfe\xff") or head in (b"<\0?\0", b"\0<\0?"):
+        return None  # UTF-16: its own checks
+    m = _DECL.match(data[:1024])
+    enc = m.group(1).decode("ascii", "replace") if m else None
+    if enc is not None and enc.lower() not in ("utf-8", "us-ascii"):
+        return None
+    codec = "ascii" if enc is not None and enc.lower() == "us-ascii" else "utf-8"
+    try:
+        data.decode(codec)
+        return None
+    except UnicodeDecodeError as e:
+        start = e.start
+    line = len(_LINE_END.findall(data, 0, start)) + 1
+    bad = repr(data[start : start + 4])
+    if enc is None:
+        decl = "declares no encoding, so it is read as UTF-8 (XML's default)"
+    else:
+        decl = f"declares {said(enc)}"
+    what = "beyond ASCII" if codec == "ascii" else "that are not UTF-8"
+    why = f"line {line}: bytes {what} ({bad}...) in a file that {decl}"
+    if codec == "ascii" and _utf8(data):
+        return line, f'{why}: they read as UTF-8, declare encoding="UTF-8"'
+    return line, (
+        f"{why}: it was written in another encoding: declare that one in its first line, such "
+        'as <?xml version="1.0" encoding="iso-8859-2"?> or "windows-1250" (names gama-local '
+        "knows, spelt so), or save the file as UTF-8"
+    )
+
+
+def _utf8(data: bytes) -> bool:
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return True

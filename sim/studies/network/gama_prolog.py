@@ -10,7 +10,7 @@ from xml.parsers import expat
 
 from sim.studies.network.gama_vocab import said
 
-__all__ = ["entity_declared", "raw_name_problem"]
+__all__ = ["entity_declared", "default_declared", "raw_name_problem"]
 
 
 class _Prolog(Exception):
@@ -35,6 +35,33 @@ def entity_declared(data: bytes | str) -> str | None:
         raise _Prolog
 
     p.EntityDeclHandler = entity
+    p.StartElementHandler = element
+    try:
+        p.Parse(data, True)
+    except (_Prolog, expat.ExpatError, ValueError, LookupError):
+        pass
+    return found[0] if found else None
+
+
+def default_declared(data: bytes | str) -> tuple[str, str, str] | None:
+    """``(element, attribute, value)`` of the first attribute default the file's DOCTYPE
+    declares (``<!ATTLIST distance stdev CDATA "5">``, ``#FIXED`` too), None: none. The parser
+    (here and in ``gama-local``) gives every element without the attribute that value: a stdev
+    or an ``adj`` no element shows, which a refusal then named on an element that does not
+    hold it ("point 'A' is both fixed and adjusted" of a ``<point fix="xy">``). Only the prolog
+    is parsed; a parse error is left to the reader."""
+    p = expat.ParserCreate()
+    found: list[tuple[str, str, str]] = []
+
+    def attlist(elname, attname, _type, default, _required):
+        if default is not None:
+            found.append((elname, attname, default))
+            raise _Prolog
+
+    def element(*_):
+        raise _Prolog
+
+    p.AttlistDeclHandler = attlist
     p.StartElementHandler = element
     try:
         p.Parse(data, True)

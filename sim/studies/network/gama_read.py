@@ -52,9 +52,15 @@ from pathlib import Path
 from sim.mc.config import ConfigError
 from sim.studies.network import gama_vocab as vocab
 from sim.studies.network.definition import ARCSEC, COORDINATE_MAX_MM
-from sim.studies.network.gama_encoding import EncodingProblem, bom_note, gama_text
+from sim.studies.network.gama_encoding import (
+    EncodingProblem,
+    bom_note,
+    gama_text,
+    undecodable,
+    utf8_note,
+)
 from sim.studies.network.gama_frames import NE, frame_note
-from sim.studies.network.gama_prolog import entity_declared, raw_name_problem
+from sim.studies.network.gama_prolog import default_declared, entity_declared, raw_name_problem
 from sim.studies.network.gama_sets import one_target
 from sim.studies.network.gama_stdev import default_stdevs, distance_default, sigma, variances
 from sim.studies.network.gama_terms import check_terms
@@ -238,9 +244,21 @@ def _network(f: _File, data: bytes):
             f"{path}: its <!DOCTYPE> declares the entity {ent}: entity declarations are not read "
             "(a gama-local file needs none; write the values in place)",
         )
+    if found := default_declared(text):
+        el, att, v = found
+        raise ConfigError(
+            key,
+            f"{path}: its <!DOCTYPE> gives <{el[:40]}> attribute {att[:40]!r} the default "
+            f"{vocab.said(v)}: "
+            "attribute defaults are not read (a gama-local file needs none; write the value on "
+            "the elements, a default stdev on <points-observations>)",
+        )
     try:
         root = ET.fromstring(text)
-    except ET.ParseError as e:
+    except ET.ParseError as e:  # at bytes not of the file's encoding: said so ("invalid token")
+        bad = undecodable(data) if isinstance(text, bytes) else None
+        if bad and bad[0] <= e.position[0]:
+            raise ConfigError(key, f"{path}: {bad[1]}") from None
         raise ConfigError(key, f"{path} is not XML: {e}") from None
     except (LookupError, ValueError) as e:  # an unknown encoding declared, undecodable bytes
         raise ConfigError(key, f"{path} cannot be decoded: {e}") from None
@@ -341,11 +359,13 @@ def read_gama(path: str | Path, key: str = "network.gama_xml", sha256: str | Non
             f"{path} has changed since the study was loaded (sha256 {now[:12]}..., recorded "
             f"{sha256[:12]}...): load the study again",
         )
+    if utf8_note(data):  # a name refused for characters the declaration made of UTF-8 bytes
+        f.names_hint = ' (the file\'s bytes are UTF-8: declare encoding="UTF-8")'
     net = _network(f, data)
     note = vocab.parameters_note(f, [e for e in net if _tag(e) == "parameters"])
     axes = ws(net.get("axes-xy", NE[0]))  # gama-local's vocabulary, checked in _network
     angles = ws(net.get("angles", NE[1]))
-    note += frame_note(axes, angles) + bom_note(data)
+    note += frame_note(axes, angles) + bom_note(data) + utf8_note(data)
     pos = [e for e in net if _tag(e) == "points-observations"]
     if len(pos) != 1:
         raise f.err(net, f"{len(pos)} <points-observations> elements (need one)")

@@ -206,6 +206,9 @@ class _File:
         #: d-m-s values with minutes or seconds of 60 or more, read as gama-local reads them:
         #: ``(element, attribute, value)``, for the note
         self.sexagesimal: list[tuple[str, str, str]] = []
+        #: said after a refused point name where the file's bytes are UTF-8 under another
+        #: declaration (its names read as other characters: ``gama_encoding.utf8_note``)
+        self.names_hint = ""
 
     def err(self, e, what: str, attr: str | None = None) -> ConfigError:
         where = f"<{_tag(e)}>" if attr is None else f"<{_tag(e)}> attribute {attr!r}"
@@ -257,7 +260,7 @@ class _File:
         try:
             return _point_name(attr, v)
         except ConfigError as err:
-            raise self.err(e, str(err).split(": ", 1)[1], attr) from None
+            raise self.err(e, str(err).split(": ", 1)[1] + self.names_hint, attr) from None
 
     def angle(self, e, attr: str = "val") -> bool:
         """Check an angular value; True when it is d-m-s (degrees), False for gon. A d-m-s
@@ -367,6 +370,44 @@ def parameters_note(f: _File, pars: list) -> str:
     )
 
 
+#: a URL's scheme, as a path keeps it: ``file:///x`` is the path ``file:/x`` (a drive letter is one
+#: letter: ``C:/x`` is no URL)
+_URL = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]+):/")
+
+
+def _meant(text: str) -> str:
+    """What a path that names nothing likely meant, `` (...)``, or "": a Windows path pasted into
+    the study file (``C:\\x.xml``), a ``~`` or ``$HOME`` a shell would have expanded (a study
+    file expands neither: "No such file" of a file the user can list), a URL (``file:///x``, whose
+    path is given then, or ``https://...``: only a local file is read), white space around the
+    name, a name that differs in case from one in its directory."""
+    slash = text.replace("\\", "/")
+    if slash != text and Path(slash).is_file():
+        return f" (did you mean {slash}?)"
+    full, what = os.path.expandvars(os.path.expanduser(text)), ""
+    if text.startswith("~"):
+        what = "'~' is not expanded in a study file"
+    elif full != text:
+        what = "environment variables are not expanded in a study file"
+    if what:
+        there = f": {full} exists" if os.path.isfile(full) else ""
+        return f" ({what}: give the full path{there})"
+    if m := _URL.match(text):
+        if m.group(1).lower() != "file":
+            return " (a URL: only a local file is read; download it and give its path)"
+        local = "/" + text[len("file:") :].lstrip("/")
+        there = f": {local} exists" if os.path.isfile(local) else ""
+        return f" (a file: URL: give the path itself{there})"
+    if ws(text) != text and os.path.isfile(ws(text)):
+        return f" (white space around the name: {ws(text)} exists)"
+    q = Path(text)
+    try:  # (a file system that tells case apart: MyNet.xml for mynet.xml)
+        near = next((n for n in os.listdir(q.parent) if n.casefold() == q.name.casefold()), None)
+    except (OSError, ValueError):
+        near = None
+    return f" ({q.parent / near} exists: the name differs in case)" if near else ""
+
+
 def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
     """The bytes of ``path``: a regular file of at most :data:`MAX_BYTES` (else one line)."""
     path = Path(path)
@@ -376,11 +417,9 @@ def read_bytes(path: str | Path, key: str = "network.gama_xml") -> bytes:
     try:
         st = os.stat(path)
     except OSError as e:
-        slash = str(path).replace("\\", "/")  # a Windows path pasted into the study file
-        hint = f" (did you mean {slash}?)" if slash != str(path) and Path(slash).is_file() else ""
         if why := link_problem(path):  # a loop of links, a name of another Unicode form
             raise ConfigError(key, f"cannot read {path}: it {why}") from None
-        raise ConfigError(key, f"cannot read {path}: {e.strerror}{hint}") from None
+        raise ConfigError(key, f"cannot read {path}: {e.strerror}{_meant(str(path))}") from None
     if not stat.S_ISREG(st.st_mode):
         raise ConfigError(key, f"{path} is not a regular file")
     if st.st_size > MAX_BYTES:
