@@ -241,7 +241,7 @@ def execute(
                 raise KeyboardInterrupt from None
             if isinstance(e, (ArithmeticError, ValueError, MemoryError)):  # numbers the model
                 raise numeric_failure(e, study, cfg, est.memory_keys) from None  # cannot take
-            if (words := shadowed(e)) is not None:  # a user's matplotlib.py: not our bug
+            if (words := shadowed(e, forget=True)) is not None:  # a user's matplotlib.py
                 raise StudyError(f"{cfg['study']}: {words}") from None
             if isinstance(e, BrokenExecutor):  # a worker killed (kill -9, the OOM killer): the
                 raise StudyError(  # study part was blamed, exit 3 "internal error"
