@@ -14,9 +14,19 @@ state), one case each; each failed on the code before its fix.
   naming it) stayed loaded: renamed as told, the next run in the process was refused again,
   naming a file that no longer exists. Its module is dropped with the refusal
   (:func:`sim.threads.shadowed`), and the next run loads the library.
+* A run resumed (or noting anything on standard error: a chunk's length, a sweep's refused
+  cells, a table edited by hand) by a caller whose ``sys.stderr`` is closed (a ``StringIO`` it
+  closed), broken (a pipe whose reader left: ``OSError``) or ``None``: the note's ``print``
+  ended the run in ``ValueError: I/O operation on closed file`` (or the ``OSError``), a
+  traceback from the suite, before any chunk; with ``None`` the note went to standard output.
+  Each note is dropped when it cannot be written (:func:`sim.standard_error.say`).
 * ``importlib.reload(sim.api)`` (a notebook reloading what it imported): a handle loaded
   before it said "trials: must be an integer (got <the handle's>)" on ``run()``, its default
   the sentinel object before the reload. The sentinel survives the reload.
+* ``importlib.reload(sim.mc.config)``: the suite's modules raised the first ``ConfigError``,
+  which the caller's ``except sim.ConfigError`` (the class made again) let through
+  (``sim.load(123)``: a traceback), and ``sim.cli.main`` said "sim: error: ConfigError: ...".
+  The classes made by the first import are kept.
 
 Held (found right), each against a clean process's tables (byte-equal): ``np.seterr(all=
 "ignore")``, a ``decimal`` context of 3 digits trapping ``Inexact`` and ``Rounded``,
@@ -28,12 +38,12 @@ kept), ``set_start_method("spawn")`` and ``("forkserver")`` before a two-worker 
 ``socket.setdefaulttimeout(1e-5)`` for forkserver and ``1e-3`` for Dask workers, ``python -c``
 with ``sys.argv == [""]`` and a thread of its own (forkserver) or Dask (spawn), ``python -i``
 fed on standard input with Dask, ``os.umask(0o277)`` (refused in one line),
-``importlib.reload(sim)`` and of ``sim.mc.config``'s callers' errors (see the report), a
-user's ``numba.py`` or ``dask.py`` in the working directory (not loaded by a local run).
+``importlib.reload(sim)``, a user's ``numba.py`` or ``dask.py`` in the working directory (not loaded by a local run).
 """
 
 from __future__ import annotations
 
+import io
 import os
 import subprocess
 import sys
@@ -44,6 +54,7 @@ import numpy as np
 import pytest
 
 import sim
+import sim.execute
 from tests.conftest import TRIANGLE_NETWORK
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -142,3 +153,45 @@ def test_a_handle_loaded_before_a_reload_of_the_api_runs(tmp_path):
     )
     p = _python(code, tmp_path)
     assert p.returncode == 0 and p.stdout.split() == ["40"], p.stdout + p.stderr[-2000:]
+
+
+def test_a_run_resumed_under_a_closed_standard_error_goes_on(tmp_path, monkeypatch):
+    """The caller closed its ``sys.stderr`` (a ``StringIO``): the resumed run's note "sim:
+    resuming ..." ended it in "ValueError: I/O operation on closed file" from the suite's
+    ``print``. The note is dropped; the run resumes and finishes."""
+    study = tmp_path / "tri.toml"
+    study.write_text(TRIANGLE_NETWORK)
+    handle, out = sim.load(study), tmp_path / "o"
+
+    def interrupted() -> None:  # Ctrl-C once every chunk was computed: the stage is kept
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sim.execute, "check_interrupt", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        handle.run(out=out, figures=False)
+    monkeypatch.undo()
+    closed = io.StringIO()
+    closed.close()
+    monkeypatch.setattr(sys, "stderr", closed)
+    res = handle.run(out=out, figures=False)
+    assert res.table("trials").num_rows == 40
+
+
+def test_the_errors_are_one_class_after_a_reload_of_the_config_module(tmp_path):
+    """``importlib.reload(sim.mc.config)``: ``sim.load(123)`` raised the ConfigError of the
+    first import, which ``except sim.ConfigError`` (the reloaded class) did not catch."""
+    code = "\n".join(
+        [
+            "import importlib, sim, sim.api, sim.mc.config",
+            "importlib.reload(sim.mc.config)",
+            "try:",
+            "    sim.load(123)",
+            "except sim.ConfigError as e:",
+            "    print('REFUSED', e.key)",
+            "print(sim.StudyError is sim.mc.config.StudyError)",
+        ]
+    )
+    p = _python(code, tmp_path)
+    assert p.returncode == 0 and p.stdout.split() == ["REFUSED", "study_file", "True"], (
+        p.stdout + p.stderr[-2000:]
+    )
