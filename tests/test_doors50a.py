@@ -55,6 +55,7 @@ import pytest
 
 import sim
 import sim.execute
+import sim.mc.progress
 from tests.conftest import TRIANGLE_NETWORK
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -114,7 +115,7 @@ def test_a_file_shadowing_a_library_is_one_config_error_then_forgotten(tmp_path)
     assert loaded == "LOADED network", p.stdout
 
 
-def test_a_file_shadowing_a_library_in_a_run_is_forgotten_with_its_refusal(tmp_path):
+def test_a_file_shadowing_a_library_in_a_run_is_forgotten_with_its_refusal(tmp_path, monkeypatch):
     """A user's ``tqdm.py`` loaded when the run's progress bar starts: refused naming it, but
     it stayed loaded, and the next run (the file renamed as told) was refused again naming a
     file gone. Its module is dropped with the refusal: the next run draws with tqdm."""
@@ -124,6 +125,7 @@ def test_a_file_shadowing_a_library_in_a_run_is_forgotten_with_its_refusal(tmp_p
     mine = types.ModuleType("tqdm")
     mine.__file__ = str(tmp_path / "tqdm.py")  # as an empty tqdm.py imported from the cwd
     real = {n: m for n, m in sys.modules.items() if n.split(".")[0] == "tqdm"}
+    monkeypatch.setattr(sim.mc.progress, "_bar", [])  # tqdm imported again: not the cached bar
     sys.modules["tqdm"] = mine
     try:
         with pytest.raises(sim.StudyError, match="tqdm.py shadows the library tqdm"):
