@@ -61,7 +61,12 @@ _MEANT = {
 def __getattr__(name: str):
     if name in _EXPORTS:
         _refuse_unloadable(_EXPORTS[name])
-        return getattr(_importlib.import_module(_EXPORTS[name]), name)
+        try:
+            module = _importlib.import_module(_EXPORTS[name])
+        except (ImportError, AttributeError) as e:  # a user's scipy.py, numpy.py in the cwd
+            _refuse_shadowed(e)
+            raise
+        return getattr(module, name)
     lower = {n.lower(): n for n in _EXPORTS}  # sim.LOAD, sim.results
     if name.lower() in lower or name.lower() in _MEANT:
         meant = lower.get(name.lower())
@@ -91,3 +96,18 @@ def _refuse_unloadable(module: str) -> None:
         from sim.mc.config import ConfigError
 
         raise ConfigError(None, problem)
+
+
+def _refuse_shadowed(e: BaseException) -> None:
+    """Raise :class:`ConfigError` naming a file of the user's that shadows a library the API
+    loads on first use (an empty ``scipy.py``, ``numpy.py`` or ``pyarrow.py`` in the working
+    directory of a notebook): ``sim.load`` ended in an ImportError traceback from the suite's
+    imports, where the commands say one line (:func:`sim.threads.shadowed`). The file's module
+    is dropped, so the process loads the library once the file is renamed."""
+    from sim.threads import shadowed
+
+    if (words := shadowed(e, forget=True)) is not None:
+        from sim.mc.config import ConfigError
+
+        first = (str(e).splitlines() or [type(e).__name__])[0][:300]
+        raise ConfigError(None, f"cannot load the suite: {first}; {words}") from None

@@ -93,7 +93,7 @@ class _Handles:
         return "<the handle's>"
 
 
-HANDLES = _Handles()
+HANDLES = globals().get("HANDLES", _Handles())  # one, as a reload(sim.api)'s old handles have
 
 
 @dataclass(frozen=True)

@@ -52,6 +52,7 @@ from sim.report.plotting import without_figures
 from sim.report.sweep import fig_sweep
 from sim.run_failure import numeric_failure
 from sim.spared_workers import start_sparing_workers
+from sim.standard_error import say
 from sim.start_method import for_the_callers_process
 from sim.stops import check_interrupt, keep_lost_interrupts
 from sim.threads import interrupted, shadowed
@@ -179,7 +180,7 @@ def execute(
     est = sweep_limits(study, cfg, sweep, max_memory_gb, max_adjustments, workers)
     check_sweep(study, cfg, sweep, quiet)
     if not quiet and (note := chunk_note(est, cfg["chunk"])):
-        print(f"sim: {note}", file=sys.stderr)
+        say(f"sim: {note}")
     record = {
         "config": {**cfg, "sweep": sweep} if sweep else cfg,
         "code_hash": code_hash(cfg["study"]),
@@ -222,11 +223,10 @@ def execute(
                 png.unlink()
         store = ChunkStore(stage / "trials", provenance(cfg))
         if resumed:
-            print(f"sim: resuming {cfg['study']}: {resumed_words(store)}", file=sys.stderr)
+            say(f"sim: resuming {cfg['study']}: {resumed_words(store)}")
         if dropped:  # not resumed: another version's chunks are not mixed with this one's
-            print(
+            say(
                 f"sim: starting {cfg['study']} over: {dropped} is replaced, not resumed",
-                file=sys.stderr,
             )
         ctx = RunContext(quiet=quiet, executor=ex, store=store, estimate=est)
         try:
@@ -241,7 +241,7 @@ def execute(
                 raise KeyboardInterrupt from None
             if isinstance(e, (ArithmeticError, ValueError, MemoryError)):  # numbers the model
                 raise numeric_failure(e, study, cfg, est.memory_keys) from None  # cannot take
-            if (words := shadowed(e)) is not None:  # a user's matplotlib.py: not our bug
+            if (words := shadowed(e, forget=True)) is not None:  # a user's matplotlib.py
                 raise StudyError(f"{cfg['study']}: {words}") from None
             if isinstance(e, BrokenExecutor):  # a worker killed (kill -9, the OOM killer): the
                 raise StudyError(  # study part was blamed, exit 3 "internal error"
@@ -307,10 +307,9 @@ def _say_edits_replaced(edited: list[str], shown: str) -> None:
     word (a file of the user's, which the run did not write, is carried over as it is)."""
     if edited:
         names = ", ".join(edited[:3]) + (f" and {len(edited) - 3} more" if len(edited) > 3 else "")
-        print(
+        say(
             f"sim: note: {names} in {shown} changed after the run that wrote "
             f"{'it' if len(edited) == 1 else 'them'} (edited by hand?): replaced by this run's",
-            file=sys.stderr,
         )
 
 

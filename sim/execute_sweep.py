@@ -5,7 +5,6 @@ not the cell's (:func:`not_the_cells`)."""
 
 from __future__ import annotations
 
-import sys
 from concurrent.futures import BrokenExecutor
 from typing import Any, Mapping
 
@@ -13,6 +12,7 @@ from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
 from sim.mc.sweep import refused_cells, refused_note
 from sim.room import check_room
+from sim.standard_error import say
 from sim.threads import interrupted, shadowed
 
 __all__ = ["sweep_limits", "check_sweep", "not_the_cells"]
@@ -72,4 +72,4 @@ def check_sweep(study, cfg: dict, sweep: Mapping[str, Any], quiet: bool = False)
         return
     note = refused_note(sweep, *refused_cells(study, cfg, sweep))
     if note and not quiet:
-        print(f"sim: {note}", file=sys.stderr)
+        say(f"sim: {note}")

@@ -161,12 +161,14 @@ def _installed(path: str) -> bool:
     return path.startswith((sys.prefix, sys.base_prefix, suite + os.sep))
 
 
-def shadowed(e: BaseException | None) -> str | None:
+def shadowed(e: BaseException | None, forget: bool = False) -> str | None:
     """Words naming a file of the user's that shadows a library (``tomllib.py``,
     ``matplotlib.py``, an empty ``numba/`` directory on ``PYTHONPATH`` or in the working
     directory), if ``e`` (or an exception it came from) is an ImportError of that library or
     an AttributeError read from that module; else None. Such a file ended a command in an
-    "internal error" (exit 3) or a traceback, wherever the library was first used."""
+    "internal error" (exit 3) or a traceback, wherever the library was first used.
+    ``forget``: the file's module (and its submodules) is dropped from ``sys.modules``, so a
+    process that goes on (the API's caller) imports the library once the file is renamed."""
     seen = set()
     while e is not None and id(e) not in seen:
         seen.add(id(e))
@@ -180,6 +182,10 @@ def shadowed(e: BaseException | None) -> str | None:
             where = getattr(module, "__file__", None)
             where = where or next(iter(getattr(module, "__path__", None) or ()), None)
             if where and not _installed(str(where)):
+                if forget:
+                    top = module.__name__.split(".")[0]
+                    for name in [n for n in sys.modules if n.split(".")[0] == top]:
+                        del sys.modules[name]
                 return (
                     f"{where} shadows the library {module.__name__} (PYTHONPATH or the working "
                     "directory): rename it or leave that directory"

@@ -69,6 +69,12 @@ class StudyError(RuntimeError):
     singular reduced normal matrix in every trial). One line, like :class:`ConfigError`."""
 
 
+#: the first classes, kept by ``importlib.reload(sim.mc.config)``: the suite's modules hold
+#: them, and a caller's ``except sim.ConfigError`` (the new class) let their errors through
+ConfigError, StudyError = globals().get("_ERRORS", (ConfigError, StudyError))
+_ERRORS = (ConfigError, StudyError)
+
+
 @dataclass(frozen=True)
 class Field:
     """One configuration key.

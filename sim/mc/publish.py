@@ -17,7 +17,6 @@ import hashlib
 import os
 import re
 import shutil
-import sys
 from itertools import count
 from pathlib import Path
 
@@ -33,6 +32,7 @@ from sim.mc.swap import exchange as _exchange
 from sim.mc.swap import hold_old
 from sim.mc.swap import libc as _libc  # noqa: F401 - tests ask it whether renameat2 exists
 from sim.mc.table_shape import SHAPE_KEY, shape
+from sim.standard_error import say
 
 __all__ = ["seal", "publish", "damaged_chunks", "changed_figure", "drawn", "file_sha256"]
 
@@ -344,10 +344,9 @@ def _drop_stale_swaps(out: Path, mine: Path | None) -> None:
             except OSError:  # kept, and named below
                 lost = [f for f in lost if not _present(out / f)] or ["run.json"]
             if lost:
-                print(
+                say(
                     f"sim: note: {d} holds results replaced by a run that was killed, with "
                     f"{d / lost[0]}, which is not in {out}: move what you need out of it",
-                    file=sys.stderr,
                 )
                 continue
             _remove_record_last(d)
@@ -444,7 +443,6 @@ def _publish(stage: Path, out: Path) -> None:
     if old.exists() or old.is_symlink():  # a file or directory of the old results that this
         # user may not remove: they are not lost, but say where (a hidden directory)
         left = next(iter(sorted(old.rglob("*"), key=lambda q: -len(q.parts))), old)
-        print(
+        say(
             f"sim: note: the replaced results are kept in {old} ({left} could not be removed)",
-            file=sys.stderr,
         )

@@ -10,7 +10,8 @@ integer, a double and a string, in lists and tables. Each value is read as the n
   the same digits (``Decimal("0.1")`` is ``0.1``); one beyond a double's range, or so small it
   would be read as 0, is refused naming the key;
 * a NumPy float is the decimal number it prints: ``np.float32(0.1)`` is ``0.1`` (not its
-  binary value ``0.10000000149011612``), as the same digits typed into a study file would be;
+  binary value ``0.10000000149011612``), as the same digits typed into a study file would be
+  (the shortest digits, whatever the caller's ``np.set_printoptions(legacy="1.13")`` prints);
   ``np.longdouble`` is the double nearest it (refused as a ``Decimal`` is when
   no double holds it: ``1e-4000``); a ``float`` subclass is the ``float``;
 * a NumPy array, a tuple and a list are lists (at any depth: ``plate.points`` as a tuple of
@@ -87,7 +88,8 @@ def _scalar(key: str, v: Any) -> Any:
     if isinstance(v, numbers.Integral):  # int subclasses, IntEnum, NumPy integers
         return int(v)
     if isinstance(v, np.floating):  # the decimal number it prints (float32(0.1) is 0.1);
-        x = float(str(v))  # a longdouble no double holds (1e-4000 was 0.0, silently) refused
+        with np.printoptions(legacy=False):  # the caller's legacy="1.13": 12 digits printed
+            x = float(str(v))  # a longdouble no double holds (1e-4000 was 0.0) refused
         return _nearest(key, v, x) if np.isfinite(v) else x
     if isinstance(v, float):
         return float(v)

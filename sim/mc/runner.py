@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import json
 import pickle
-import sys
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -44,6 +43,7 @@ from sim.mc.packed import pack, unpack
 from sim.mc.progress import Progress
 from sim.mc.storage import atomic_path, config_hash
 from sim.mc.streams import chunk_rng
+from sim.standard_error import say
 from sim.stops import check_interrupt
 
 __all__ = [
@@ -310,10 +310,9 @@ def run_chunks(
             todo.append((k, n))
     if executor is None or (not isinstance(executor, InProcess) and not _picklable(fn)):
         if executor is not None and not isinstance(executor, InProcess):
-            print(
+            say(
                 f"sim: note: {label or 'this study'} runs in-process (its chunk function "
                 "cannot be sent to workers)",
-                file=sys.stderr,
             )
         executor = InProcess()
     shared = getattr(ctx, "bar", None)

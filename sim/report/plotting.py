@@ -8,7 +8,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import sys
 import warnings
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -23,6 +22,7 @@ from sim.report.drawing import DRAWING, drawing
 from sim.report.figcheck import data_points, figure_facts, points_inside, reader_problems
 from sim.report.mpl import pyplot as plt
 from sim.report.mpl import ticker
+from sim.standard_error import say
 
 __all__ = [
     "plt",
@@ -291,10 +291,9 @@ def _glyph_note(path: Path, caught: list) -> None:
         elif chr(int(m.group(1))) not in missing:
             missing.append(chr(int(m.group(1))))
     if missing:
-        print(
+        say(
             f"sim: note: {path.name}: its font has no glyph for {''.join(missing)!r} "
             "(drawn as boxes)",
-            file=sys.stderr,
         )
 
 
