@@ -8,10 +8,11 @@ import linecache
 import os
 from pathlib import Path
 
+from sim.mc.file_kind import odd_file
 from sim.report.read import EditedTable, TableError, damaged_message, last_read
 from sim.stale import other_code
 
-__all__ = ["cwd_exists", "from_stdout", "os_reason", "not_as_written", "older_lacks"]
+__all__ = ["cwd_exists", "from_stdout", "lost_table", "os_reason", "not_as_written", "older_lacks"]
 
 
 def cwd_exists() -> bool:
@@ -79,9 +80,9 @@ def older_lacks(d: Path, e: FileNotFoundError) -> str | None:
     name = e.filename or (e.args[0] if len(e.args) == 1 else None)  # pyarrow's: the path only
     if not isinstance(name, str) or not name:
         return None
-    try:
+    try:  # (a link that loops: RuntimeError before Python 3.13, which raises OSError)
         parts = Path(name).resolve().relative_to(Path(d).resolve()).parts
-    except (ValueError, OSError):
+    except (ValueError, OSError, RuntimeError):
         return None
     own = Path(d) / parts[0] if len(parts) > 1 else Path(d)
     if other_code(own) != str(own):
@@ -90,6 +91,18 @@ def older_lacks(d: Path, e: FileNotFoundError) -> str | None:
         f"{own} was made by another version of the suite's code (it has no {parts[-1]}, which "
         "this version reads): make reproduce re-runs what is stale"
     )
+
+
+def lost_table(e: FileNotFoundError) -> str | None:
+    """The line for a table show or report could not open (``e``, pyarrow's, names the path
+    only) when something other than a regular file stands there: a FIFO, a device, a link
+    that leads nowhere or loops ("No such file or directory" named a file that is there, and
+    a link that loops ended in a traceback); None otherwise (a table removed by hand: the
+    plain line names it)."""
+    name = e.filename or (e.args[0] if len(e.args) == 1 else None)
+    if not isinstance(name, str) or not name or (what := odd_file(name)) is None:
+        return None
+    return f"{name} is {what}, not a table the suite wrote; run its study again"
 
 
 def _table_dir(d: Path, e: Exception) -> Path | None:
@@ -101,6 +114,6 @@ def _table_dir(d: Path, e: Exception) -> Path | None:
         return None
     try:
         parts = Path(f).resolve().relative_to(Path(d).resolve()).parts
-    except (ValueError, OSError):
+    except (ValueError, OSError, RuntimeError):  # (a link that loops, before Python 3.13)
         return None
     return Path(d) / parts[0] if len(parts) > 1 and (Path(d) / parts[0]).is_dir() else Path(d)

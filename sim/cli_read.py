@@ -15,7 +15,7 @@ from pathlib import Path
 import pyarrow as pa
 
 from sim.api_paths import arrow_name, cell_mixed, too_long
-from sim.cli_errors import not_as_written, older_lacks
+from sim.cli_errors import lost_table, not_as_written, older_lacks
 from sim.ends import unshown
 from sim.mc.config import ConfigError
 from sim.mc.file_kind import odd_table
@@ -143,7 +143,7 @@ def _shown_text(d: Path, markdown: bool) -> str:
     except (KeyError, IndexError, TypeError, ValueError, pa.ArrowException) as e:
         raise ConfigError("DIR", not_as_written(d, e)) from None
     except FileNotFoundError as e:
-        if (why := older_lacks(d, e)) is None:
+        if (why := older_lacks(d, e) or lost_table(e)) is None:
             raise
         raise ConfigError("DIR", why) from None
 
@@ -202,7 +202,7 @@ def report(results: Path) -> int:
         # by sim (a table replaced or edited by hand)
         raise ConfigError("--results", not_as_written(results, e)) from None
     except FileNotFoundError as e:
-        if (why := older_lacks(results, e)) is None:
+        if (why := older_lacks(results, e) or lost_table(e)) is None:
             raise
         raise ConfigError("--results", why) from None
     clear_due(results)  # a batch's report killed before it ended is rebuilt now

@@ -54,7 +54,11 @@ file or the thing in the way, change nothing beside the results, and then, the l
 the thing moved away, the clean run's results. The LEVELS of a small ``[sweep]`` table (a level
 of the wrong type, none, one twice, a key that is no key, a list's item by its index, more
 cells than the bound or the work limit allows: tests/fuzz_sweep.py; ``test_fuzz_sweep_levels``:
-one case a five, at least two, by ``sim check``; in ``make fuzz`` a valid one also run)."""
+one case a five, at least two, by ``sim check``; in ``make fuzz`` a valid one also run). A
+finished RESULTS directory changed by hand (its bytes, a file's kind, a table rewritten, the
+run record, the trials: tests/fuzz_results.py; ``test_fuzz_results_directory``: one case a
+three, at least three) read by ``sim show``, ``sim report``, the API and verify: exit 0 with what the
+clean run gives, or one line; the directory unchanged."""
 
 from __future__ import annotations
 
@@ -67,7 +71,9 @@ from fuzz_bytes import csv_sites, gama_sites, mutate_bytes
 from fuzz_cases import SEED
 from fuzz_concurrent import pairs
 from fuzz_fs import cases as fs_cases
+from fuzz_gama_values import gama_value
 from fuzz_keys import network_case
+from fuzz_results import cases as results_cases
 from fuzz_run import check_case, fuzz, run_case
 from fuzz_sequence import sequences
 from fuzz_splice import gama_splice, splice_case
@@ -222,6 +228,30 @@ def test_fuzz_splice(tmp_path, capsys):
     assert not failures, f"{len(failures)} of {4 * CASES}:\n" + "\n".join(failures)
 
 
+def test_fuzz_gama_values(tmp_path, capsys):
+    """VALUES of a GNU Gama file (tests/fuzz_gama_values.py) by ``sim check``: one attribute
+    given another value (no number, an edge, a padded number, another point's name) is read
+    (exit 0) or refused in one line naming the file; no finite number where a number stood
+    is refused."""
+    srcs = ("one_fixed", "two_sets", "user_dms", "plate", "directions_free", "brown")
+    failures = []
+    for i in range(CASES):
+        src = ROOT / "tests" / "data" / "gama" / f"{srcs[i % len(srcs)]}.xml"
+        rng = random.Random(SEED * 100_003 + 49_049 + i)
+        text, desc, refuse = gama_value(rng, src.read_text(encoding="utf-8"))
+        (x := tmp_path / f"value-{i}.xml").write_text(text, encoding="utf-8")
+        study = tmp_path / "gama.toml"
+        study.write_text(
+            f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{x}"\n'
+        )
+        rc, err = main(["check", str(study)]), capsys.readouterr().err.strip()
+        if rc not in (0, 2) or (rc == 2 and ("\n" in err or str(x) not in err)):
+            failures.append(f"case {i} ({src.name}: {desc}): exit {rc}: {err[-300:]}")
+        elif refuse and rc != 2:
+            failures.append(f"case {i} ({src.name}: {desc}): no number, read as one")
+    assert not failures, f"{len(failures)} of {CASES}:\n" + "\n".join(failures)
+
+
 def test_fuzz_sweep_levels(tmp_path, capsys, monkeypatch):
     """SWEEP LEVELS (tests/fuzz_sweep.py) by ``sim check``: a small ``[sweep]`` table of each
     study with a level mutated must be refused in one line naming the key as written (a
@@ -288,6 +318,15 @@ def test_fuzz_file_system(tmp_path):
     n = max(2, CASES // 7)
     failures = fs_cases(n, SEED, tmp_path)
     assert not failures, f"{len(failures)} of {n} file-system cases:\n" + "\n".join(failures)
+
+
+def test_fuzz_results_directory(tiny_run, tmp_path):
+    """RESULTS (tests/fuzz_results.py): seeded changes of a finished run's files (bytes, kind,
+    a table rewritten with its metadata, the run record, the trials) read by show, report,
+    the API and verify: exit 0 giving what the clean run gives, or one line; nothing changed."""
+    n = max(3, CASES // 3)
+    failures = results_cases(n, SEED, tmp_path, tiny_run("network_plate"))
+    assert not failures, f"{len(failures)} of {n} results cases:\n" + "\n".join(failures)
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz

@@ -6,7 +6,8 @@ store damaged between a kill and the resume (chunks truncated, swapped, duplicat
 from another seed, left over beyond the run) resumes to results equal to a clean run's.
 ``TYPED`` adds TYPE confusion to every argument (a date, a timedelta, a ``Decimal`` NaN, a
 complex, a bytearray, a set, a NumPy array, an integer beyond 64 bits).
-``FUZZ_CASES`` sets the number of cases (``make fuzz`` raises it)."""
+``FUZZ_CASES`` sets the number of cases (``make fuzz`` raises it), ``FUZZ_DOORS_SEED`` the
+arguments' seed (the chunk store's is the next number; default 20261126)."""
 
 import datetime
 import decimal
@@ -26,6 +27,7 @@ from sim.studies import RunContext
 ROOT = Path(__file__).resolve().parent.parent
 STUDY = ROOT / "studies" / "brown_table1.toml"
 CASES = int(os.environ.get("FUZZ_CASES", "12"))
+SEED = int(os.environ.get("FUZZ_DOORS_SEED", "20261126"))
 
 BAD = {
     "out": [5, 1.0, b"x", "", "   ", "a\0b", ["x"]],
@@ -54,7 +56,7 @@ for _k in BAD:
 
 @pytest.mark.parametrize("case", range(CASES))
 def test_api_arguments(tmp_path, case):
-    rng = np.random.default_rng([20261126, case])
+    rng = np.random.default_rng([SEED, case])
     st = sim.load(STUDY, trials=20, chunk=1)
     key = sorted(BAD)[rng.integers(len(BAD))]
     value = BAD[key][rng.integers(len(BAD[key]))]
@@ -95,7 +97,7 @@ def _damage(rng, d: Path, other: Path) -> str:
 
 @pytest.mark.parametrize("case", range(CASES))
 def test_damaged_chunk_store_resumes_to_the_clean_result(tmp_path, case):
-    rng = np.random.default_rng([20261127, case])
+    rng = np.random.default_rng([SEED + 1, case])
     clean = run_chunks(_toy, 60, 3, 10, quiet=True, keep_rows=True)
     prov = {"study": "toy", "config": {"k": 1}}
     other = ChunkStore(tmp_path / "other", prov)
