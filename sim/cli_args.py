@@ -10,9 +10,9 @@ from importlib import metadata
 from pathlib import Path
 
 from sim.mc.argv import OnceParser, integer, most_workers
+from sim.mc.chunk_count import MIN_CHUNKS
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
-from sim.mc.runner import MIN_CHUNKS
 from sim.option_words import Meant
 
 __all__ = ["module_doc", "parser"]
