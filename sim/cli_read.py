@@ -1,7 +1,7 @@
 """The commands of ``sim`` that read finished results: ``sim show DIR`` (one results
 directory as a table, or its README.md) and ``sim report`` (REPORT.md and every study's
 README.md). They read the Parquet tables only; a table that does not read as its study wrote
-it is one line naming it (:func:`sim.cli_errors.not_as_written`)."""
+it is one line naming it (:func:`sim.cli_tables.not_as_written`)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from pathlib import Path
 import pyarrow as pa
 
 from sim.api_paths import arrow_name, cell_mixed, too_long
-from sim.cli_errors import not_as_written, older_lacks
+from sim.cli_tables import not_as_written, older_lacks
 from sim.ends import unshown
 from sim.mc.config import ConfigError
 from sim.mc.file_kind import odd_table
