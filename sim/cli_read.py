@@ -32,7 +32,7 @@ from sim.report_due import clear_due
 from sim.stale import other_code, other_dirs, stale_dirs
 from sim.studies import MODULES, STUDY_FILES, design_config, get_study
 
-__all__ = ["show", "report"]
+__all__ = ["show", "report", "report_command"]
 
 #: where ``sim show NAME`` looks for NAME when it is no directory here: the project's results
 #: and the scratch directories of its runs without ``--out``
@@ -159,6 +159,17 @@ def _sweep_of(d: Path) -> Path | None:
         if not (d / "run.json").exists():
             return up.parent
     return None
+
+
+def report_command(args) -> int:
+    """``sim report [--results DIR]``: the project's results when none is given (from a
+    directory inside the project, docs/, too)."""
+    if args.results is None:
+        args.results = shown_path(base() / "results")
+    if name_problem(args.results):
+        why = name_problem(args.results)
+        raise ConfigError("--results", f"not a directory name: {why} (got {args.results!r})")
+    return report(Path(args.results))
 
 
 def report(results: Path) -> int:
