@@ -8,7 +8,9 @@ drawn in ``engines.png``; ``README.md`` (:mod:`benchmarks.page`) names each comp
 the row that keeps it; ``scaling`` (``scaling.parquet``, ``scaling.png``: the sparse path
 from 100 to 10,000 points and blocks of 10 to 200 models, :mod:`benchmarks.scaling`); ``store``
 (``store.parquet``: a chunk's kept arrays saved and loaded packed against ``.npz``,
-:mod:`benchmarks.store`). ``--quick`` is a smoke run: small sizes, and the rerun rows with
+:mod:`benchmarks.store`); ``startup`` (``startup.parquet``: the CPU time of a command before
+it does its work, ``sim --version`` and a refused ``sim check`` against 0.45 s,
+:mod:`benchmarks.startup`). ``--quick`` is a smoke run: small sizes, and the rerun rows with
 the test suite's tiny configuration of each study (``tests/data/tiny/<study>.txt``), so its
 rerun times say nothing about the 90 s target; without ``--out`` it writes
 ``scratch/bench-quick`` (:data:`QUICK_OUT`), and a directory holding a full benchmark's tables
@@ -35,6 +37,7 @@ from benchmarks.outdir import OutLock, full_measurement, not_written_here
 from benchmarks.page import write_page
 from benchmarks.rerun import rerun_rows, study_files
 from benchmarks.scaling import gama_local, scaling_figure, scaling_rows
+from benchmarks.startup import startup_rows
 from benchmarks.store import store_rows
 from sim.env_vars import environment_problem
 from sim.mc.argv import ONCE, OnceParser
@@ -44,7 +47,7 @@ from sim.stops import ended_as_ctrl_c
 
 __all__ = ["main", "run"]
 
-SECTIONS = ("brown", "engines", "studies", "rerun", "scaling", "store")
+SECTIONS = ("brown", "engines", "studies", "rerun", "scaling", "store", "startup")
 TINY = Path(__file__).resolve().parent.parent / "tests" / "data" / "tiny"
 
 
@@ -111,6 +114,9 @@ def run(
     if "store" in sections:
         tables["store.parquet"] = store_rows(quick)
         write_table(out / "store.parquet", tables["store.parquet"], provenance(prov))
+    if "startup" in sections:
+        tables["startup.parquet"] = startup_rows(quick)
+        write_table(out / "startup.parquet", tables["startup.parquet"], provenance(prov))
     if "engines" in sections or "rerun" in sections:
         engines_figure(
             tables.get("engines.parquet"), tables.get("rerun.parquet"), out / "engines.png"

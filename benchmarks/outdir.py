@@ -29,7 +29,7 @@ from benchmarks.page import HEADING
 
 __all__ = ["WRITES", "OutLock", "full_measurement", "not_written_here"]
 
-TABLES = ("bench", "engines", "studies", "rerun", "scaling", "store")
+TABLES = ("bench", "engines", "studies", "rerun", "scaling", "store", "startup")
 FIGURES = {"bench.png": "bench", "engines.png": "engines", "scaling.png": "scaling"}
 STORE = "million_trials.tmp"
 WRITES = (*(f"{t}.parquet" for t in TABLES), *FIGURES, "README.md", STORE)

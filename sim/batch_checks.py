@@ -18,9 +18,9 @@ from pathlib import Path
 
 from sim.api_paths import arrow_name
 from sim.cli import DOC as cli_doc
-from sim.cli import check_run_args, load_run
 from sim.cli_args import parser as run_parser
 from sim.cli_errors import cwd_exists
+from sim.cli_run import check_run_args, load_run
 from sim.ends import unshown
 from sim.execute import sweep_limits
 from sim.mc.codehash import study_code_hash

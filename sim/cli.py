@@ -23,247 +23,40 @@ from __future__ import annotations
 import sim.entry_env  # noqa: F401 - imported from Python: the environment, before tqdm loads
 
 # isort: split
+import importlib
 import os
-import re
 import signal
 import sys
-from pathlib import Path
 
-from tqdm import tqdm  # noqa: F401 - loaded with the command line: a shadowing tqdm.py is named
-
-from sim.api_paths import absolute_path, arrow_name, too_long
-from sim.claims.rules import printed_differs
 from sim.cli_args import module_doc, parser
 from sim.cli_errors import cwd_exists, from_stdout, os_reason
-from sim.cli_read import report, show
-from sim.ends import stdout_failed, unshown
+from sim.ends import stdout_failed
 from sim.env_vars import environment_problem
-from sim.execute import check_sweep, execute, sweep_limits
 from sim.long_words import clipped
-from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override
+from sim.mc.config import ConfigError, StudyError
 from sim.mc.memory_limit import memory_given
-from sim.mc.outputs import name_problem
-from sim.mc.overrides import as_read, command_values, listed, recorded
-from sim.mc.paths import absolute
-from sim.mc.progress import set_quiet
-from sim.mc.read_when import read_in_a_cell
-from sim.mc.sweep import expand, read_sweep
-from sim.mc.toml_text import toml_key, toml_value
-from sim.option_words import two_sets
-from sim.places import base, default_out, shown_path
-from sim.report.run_summary import off_setup, terminal_summary, write_run_readme
+from sim.mc.path_names import name_problem
+from sim.path_args import absolute_path, arrow_name, too_long
 from sim.stops import check_interrupt, exit_status, in_main_thread, keep_lost_interrupts
-from sim.studies import design_config, get_study, unread_keys
-from sim.studies.picking import load_picking_chunk
-from sim.threads import interrupted, memory_words, shadowed, short_of_memory
+from sim.threads import import_words, interrupted, memory_words, shadowed, short_of_memory
 
-__all__ = ["main", "check_run_args"]
+__all__ = ["main", "COMMANDS"]
 
 #: the usage text of ``sim`` (the module docstring, also under ``python -OO``)
 DOC = module_doc(__doc__, __file__)
 
 #: exit code of an internal error (a bug, not bad input): one line, traceback with SIM_DEBUG=1
 INTERNAL = 3
-_SCHEDULER = re.compile(
-    r"^(?:(?:tcp|tls|ucx|ws|wss)://)?(?:\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+)"
-    r":(\d{1,5})/?$"
-)
 
-
-def check_run_args(args) -> Path:
-    """Options that need no study: one line each. Returns the output path (absolute)."""
-    if args.workers < 1 or args.workers > max(4 * (os.cpu_count() or 1), 8):
-        raise ConfigError(
-            "--workers",
-            f"must be between 1 and {max(4 * (os.cpu_count() or 1), 8)} (got {args.workers})",
-        )
-    if args.scheduler is not None:
-        m = _SCHEDULER.match(args.scheduler)
-        if not m or not 0 < int(m.group(1)) < 65536:
-            raise ConfigError(
-                "--scheduler",
-                f"not a scheduler address like tcp://HOST:8786 (got {args.scheduler!r})",
-            )
-        if args.executor != "dask":
-            raise ConfigError("--scheduler", "needs --executor dask")
-    if args.out is not None:
-        if not args.out.strip():
-            raise ConfigError("--out", "is empty: name an output directory")
-        if args.out == "-":  # read as standard output by many programs: it made a directory "-"
-            raise ConfigError(
-                "--out", "'-' is not standard output here: name a directory (./- for one named '-')"
-            )
-        why = name_problem(args.out)
-        if why:
-            raise ConfigError("--out", f"{why} (got {args.out!r})")
-    return absolute(args.out) if args.out else None
-
-
-def _keys_set(overrides: list[str]) -> set[str]:
-    """The keys of the ``--set`` overrides; a key set twice is refused (one of its values
-    would be dropped silently)."""
-    keys = set()
-    for text in overrides:
-        try:
-            key = parse_override(text)[0]
-        except ConfigError:
-            continue  # load_study names the bad override
-        if key in keys:
-            raise ConfigError(key, "given twice by --set: give one value")
-        keys.add(key)
-    return keys
-
-
-def load_run(args):
-    """The study and its resolved config, as ``sim run`` (or ``check``) with the parsed
-    ``args`` resolves them. ``--trials`` (or ``--set trials=``) without a chunk
-    size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it
-    (:func:`sim.studies.picking.load_picking_chunk`, :func:`sim.load`'s rule too)."""
-    set_quiet(getattr(args, "quiet", False))  # the check of a large network shows its steps
-    overrides = list(args.set) + ([f"chunk={args.chunk}"] if args.chunk is not None else [])
-    given = _keys_set(args.set)
-    for opt, key in (("--trials", "trials"), ("--seed", "seed"), ("--chunk", "chunk")):
-        if getattr(args, key) is not None and key in given:  # one would be dropped silently
-            raise ConfigError(opt, f"given twice, as {opt} and as --set {key}=: give one")
-    trials = args.trials is not None or "trials" in given
-    picks = trials and args.chunk is None and "chunk" not in given  # --trials's chunk
-    try:
-        with memory_given(getattr(args, "max_memory_gb", None)):  # a network's size (sim.batch)
-            return load_picking_chunk(args.study, picks, overrides, args.trials, args.seed)
-    except ConfigError as e:  # --set trials=40,seed=3: two overrides in one, named
-        if hint := two_sets(args.set, e.key):
-            raise ConfigError(e.key, e.detail + hint) from None
-        raise
-
-
-def _run(args) -> int:
-    out = check_run_args(args)
-    study, cfg = load_run(args)
-    sweep = read_sweep(args.study, study.schema)  # a [sweep] table: run every cell
-    overwrite = args.overwrite
-    given = command_values(args.set, trials=args.trials, seed=args.seed, chunk=args.chunk)
-    overrides = recorded(as_read(given, cfg))  # --set trials=1e3 as --trials 1e3: trials=1000
-    if out is None:
-        out, shown, scratch = default_out(cfg, sweep, Path(args.study), _off(overrides, args))
-        overwrite = overwrite or scratch
-    else:
-        shown = args.out
-    if (why := unshown(f"{shown.rstrip('/')}/README.md")) is not None:  # its closing lines
-        raise ConfigError("--out" if args.out is not None else None, why)
-    arrow_name("--out" if args.out is not None else None, out)
-    execute(
-        study,
-        cfg,
-        sweep,
-        out,
-        shown,
-        executor=args.executor,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        overwrite=overwrite,
-        quiet=args.quiet,
-        max_memory_gb=args.max_memory_gb,
-        max_adjustments=args.max_adjustments,
-        figures=not args.no_figures,
-        readme=lambda stage, name: write_run_readme(stage, get_study, name, out, design_config),
-        overrides=overrides,
-        source=args.study,
-    )
-    args.published = shown  # an interrupt from now on finds the results written
-    check_interrupt()  # dropped by Python since the results were published: not exit 0
-    try:  # (its README.md was written before the results were published)
-        summary = terminal_summary(out, shown=shown, get_study=get_study)
-    except (OSError, ValueError, KeyError) as e:  # the results stand; only their summary failed
-        summary = f"(no summary: {type(e).__name__}: {e})".splitlines()[0]
-    print(f"{cfg['study']}: results in {shown.rstrip('/')}/")  # (--out DIR/: not DIR//)
-    if not args.quiet:
-        print(summary)
-    return 0
-
-
-def _off(overrides: list[str], args) -> str | None:
-    """What makes a run other than its study file as written (the words of
-    :func:`sim.places.default_out`), or None."""
-    what = [f"the overrides {listed(overrides)}"] if overrides else []
-    what += ["--no-figures"] if args.no_figures else []
-    return " and ".join(what) or None
-
-
-def _n(x: float) -> str:
-    """A bound as ``sim check`` lists it: an integer exactly (``seed``'s 2**63 - 1 was
-    ``9.22337e+18``, below the value it let the key hold), a float's whole number with its
-    digits grouped, another float as ``%g``."""
-    if isinstance(x, int):
-        return f"{x:_}"
-    return f"{int(x):_}" if float(x).is_integer() and abs(x) < 1e16 else f"{x:g}"
-
-
-def _bounds(f) -> str:
-    if f.choices:
-        return "one of " + ", ".join(map(str, f.choices))
-    if f.lo is None and f.hi is None:
-        return ""
-    lo = "" if f.lo is None else (f"> {_n(f.lo)}" if f.lo_open else f">= {_n(f.lo)}")
-    hi = "" if f.hi is None else f"<= {_n(f.hi)}"
-    return ", ".join(x for x in (lo, hi) if x)
-
-
-#: ``sim check``'s note on a printed key: another value, or the paper's setup in other keys
-_PRINTED = ("another value is off its setup", "the paper's setup spelled another way")
-
-
-def _check(args) -> int:
-    # the config sim run would resolve: --set trials= without a chunk picks the chunk
-    args.trials = args.chunk = args.seed = None
-    study, cfg = load_run(args)
-    check_chunks(cfg)  # what sim run refuses, sim check refuses too
-    sweep = read_sweep(args.study, study.schema)
-    est = sweep_limits(study, cfg, sweep, args.max_memory_gb, args.max_adjustments)  # at one worker
-    check_sweep(study, cfg, sweep)  # a sweep of only refused cells is refused (sim run too)
-    print(f"# {cfg['study']}: {study.title}")
-    # listed commented out (set, they would be refused); one a sweep's cells read is kept
-    cells = expand(sweep)[1] if sweep else []
-    skip = {
-        k: w
-        for k, w in unread_keys(study, cfg).items()
-        if not read_in_a_cell(study.schema[k], cfg, cells)
-    }
-    off = printed_differs(study.schema, cfg, study.as_printed)
-    # a printed key spelling the paper's setup another way (Table 1's 25 points as a list)
-    spelled = {s.split(" = ")[0] for s in printed_differs(study.schema, cfg)}
-    spelled -= {s.split(" = ")[0] for s in off}
-    for k, v in cfg.items():
-        f = study.schema.get(k)
-        if f is None:
-            print(f"{k} = {toml_value(v)}")
-            continue
-        unit = f.unit or ""
-        notes = "; ".join(
-            x
-            for x in (
-                unit and f"unit {unit}",
-                _bounds(f),
-                f.compared
-                and "settings compared: each once"
-                + ("" if f.kind == "list[str]" else ", read in increasing order"),
-                "paper input" if f.input else "",
-                f.printed and f"printed by the paper: {_PRINTED[k in spelled]}",
-                k in skip and f"not read: {skip[k]}",
-            )
-            if x
-        )
-        line = f"{k} = {toml_value(v)}  # {f.doc}" + (f" ({notes})" if notes else "")
-        print(f"# {line}" if k in skip else line)
-    if sweep:  # as the file gives it: the listing saved is the same study, sweep and all
-        print("[sweep]")
-        for k, v in sweep.items():
-            print(f"{toml_key(k)} = {toml_value(v)}")
-    if off:  # said before the run: its predictions will be findings (sim.claims.rules)
-        print(f"# {off_setup(study, cfg, before=True)}")
-    print(f"# work: {est.describe()}; {est.core_time()}")
-    for note in study.notes(dict(cfg)) if study.notes else []:  # N45: said before the run
-        print(f"# note: {note}")
-    return 0
+#: each command's module and function, imported when the command runs: ``sim --version``,
+#: ``--help``, a refused option or path load no study, no runner and no SciPy (every
+#: command loaded them all: about 1.2 s of CPU before the arguments were read)
+COMMANDS = {
+    "run": ("sim.cli_run", "run"),
+    "check": ("sim.cli_check", "check"),
+    "show": ("sim.cli_read", "show"),
+    "report": ("sim.cli_read", "report_command"),
+}
 
 
 #: signals that end a command as Ctrl-C does; SIGXCPU: the soft CPU limit (``ulimit -S -t``),
@@ -407,20 +200,22 @@ def _command(args) -> int:
 
 
 def _dispatch(args) -> int:
-    if args.cmd == "run":
-        return _run(args)
-    if args.cmd == "check":
-        return _check(args)
-    if args.cmd == "show":
-        return show(args)
-    if args.cmd == "report":
-        if args.results is None:  # from a directory inside the project (docs/): the project's
-            args.results = shown_path(base() / "results")
-        if name_problem(args.results):
-            why = name_problem(args.results)
-            raise ConfigError("--results", f"not a directory name: {why} (got {args.results!r})")
-        return report(Path(args.results))
-    return 1
+    if args.cmd not in COMMANDS:
+        return 1
+    module, name = COMMANDS[args.cmd]
+    return getattr(_loaded(module), name)(args)
+
+
+def _loaded(module: str):
+    """The command's module, imported now: a library it cannot import (missing, or shadowed
+    by a file of its name on the path) is one line naming it (:func:`sim.threads.import_words`),
+    as when the suite loads (:func:`sim.threads.interrupt_while_loading`)."""
+    try:
+        return importlib.import_module(module)
+    except (ImportError, AttributeError) as e:
+        if (words := import_words(e)) is None:
+            raise
+        raise ConfigError(None, words) from None
 
 
 if __name__ == "__main__":  # pragma: no cover

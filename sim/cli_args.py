@@ -6,13 +6,13 @@ from __future__ import annotations
 import argparse
 import ast
 import re
-from importlib import metadata
 from pathlib import Path
 
+import sim
 from sim.mc.argv import OnceParser, integer, most_workers
+from sim.mc.chunk_count import MIN_CHUNKS
 from sim.mc.config import ConfigError
 from sim.mc.numtext import UnheldError, float_text
-from sim.mc.runner import MIN_CHUNKS
 from sim.option_words import Meant
 
 __all__ = ["module_doc", "parser"]
@@ -95,13 +95,6 @@ def module_doc(doc: str | None, path: str) -> str:
     except (OSError, SyntaxError, ValueError):
         return ""
     return ast.get_docstring(tree, clean=False) or ""
-
-
-def _version() -> str:
-    try:
-        return metadata.version("sim")
-    except metadata.PackageNotFoundError:  # a source tree that was never installed
-        return "unknown"
 
 
 def _limit_value(text: str) -> float:
@@ -209,7 +202,7 @@ def parser(doc: str) -> argparse.ArgumentParser:
         epilog="\n\n".join(doc.split("\n\n")[1:2]) + "\n\nsim COMMAND --help: its options.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--version", action="version", version=f"sim {_version()}")
+    p.add_argument("--version", action="version", version=f"sim {sim.__version__}")
     sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
     _run_parser(sub)
     sh = sub.add_parser(

@@ -1,7 +1,7 @@
 """The commands of ``sim`` that read finished results: ``sim show DIR`` (one results
 directory as a table, or its README.md) and ``sim report`` (REPORT.md and every study's
 README.md). They read the Parquet tables only; a table that does not read as its study wrote
-it is one line naming it (:func:`sim.cli_errors.not_as_written`)."""
+it is one line naming it (:func:`sim.cli_tables.not_as_written`)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from pathlib import Path
 import pyarrow as pa
 
 from sim.api_paths import arrow_name, cell_mixed, too_long
-from sim.cli_errors import lost_table, not_as_written, older_lacks
+from sim.cli_tables import lost_table, not_as_written, older_lacks
 from sim.ends import unshown
 from sim.mc.config import ConfigError
 from sim.mc.file_kind import odd_table
@@ -32,7 +32,7 @@ from sim.report_due import clear_due
 from sim.stale import other_code, other_dirs, stale_dirs
 from sim.studies import MODULES, STUDY_FILES, design_config, get_study
 
-__all__ = ["show", "report"]
+__all__ = ["show", "report", "report_command"]
 
 #: where ``sim show NAME`` looks for NAME when it is no directory here: the project's results
 #: and the scratch directories of its runs without ``--out``
@@ -159,6 +159,17 @@ def _sweep_of(d: Path) -> Path | None:
         if not (d / "run.json").exists():
             return up.parent
     return None
+
+
+def report_command(args) -> int:
+    """``sim report [--results DIR]``: the project's results when none is given (from a
+    directory inside the project, docs/, too)."""
+    if args.results is None:
+        args.results = shown_path(base() / "results")
+    if name_problem(args.results):
+        why = name_problem(args.results)
+        raise ConfigError("--results", f"not a directory name: {why} (got {args.results!r})")
+    return report(Path(args.results))
 
 
 def report(results: Path) -> int:

@@ -25,7 +25,7 @@ import pytest
 from oneline import one_line
 
 from benchmarks import cli as bench
-from sim import cli
+from sim import cli, cli_check
 from sim.cli import main
 from sim.mc.storage import write_table
 from sim.report.plotting import checking_figures
@@ -189,7 +189,7 @@ def test_a_bug_outside_a_run_is_one_line_and_exit_3(monkeypatch, capsys):
     def broken(args):
         raise TypeError("unhashable type: 'list'")
 
-    monkeypatch.setattr(cli, "_check", broken)
+    monkeypatch.setattr(cli_check, "check", broken)
     monkeypatch.delenv("SIM_DEBUG", raising=False)
     rc = cli.main(["check", str(ROOT / "studies" / "brown_table1.toml")])
     one_line(capsys, rc, "internal error: TypeError: unhashable", code=3)

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from oneline import one_line
 
-from sim import cli
+from sim import cli_check
 from sim.cli import main
 from sim.mc import publish as publishing
 from sim.mc import runner
@@ -105,5 +105,5 @@ def test_ctrl_c_inside_an_import_is_an_interruption(tmp_path, monkeypatch, capsy
     monkeypatch.setattr(runner.RunContext, "progress_bar", _import_cut_short)
     cmd = ["run", f, "--out", str(out), "--quiet", "--no-figures", "--set", "trials=40"]
     one_line(capsys, main([*cmd, "--set", "chunk=2"]), prefix="sim: interrupted", code=130)
-    monkeypatch.setattr(cli, "_check", _import_cut_short)  # outside a run: the same
+    monkeypatch.setattr(cli_check, "check", _import_cut_short)  # outside a run: the same
     assert one_line(capsys, main(["check", f]), code=130) == "sim: interrupted"

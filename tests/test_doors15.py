@@ -23,7 +23,7 @@ from pathlib import Path
 import pytest
 from oneline import one_line, one_line_of
 
-from sim import batch, cli, threads
+from sim import batch, cli, cli_check, threads
 from sim.mc import executors, outputs, storage
 from sim.mc import publish as publishing
 from sim.mc.storage import atomic_path, read_record, write_record
@@ -110,7 +110,7 @@ def test_a_library_loaded_in_a_run_short_of_memory_is_named_as_such(monkeypatch,
     def no_room(args):
         raise OSError("Could not find/load shared object file 'libllvmlite.so' from resource")
 
-    monkeypatch.setattr(cli, "_check", no_room)
+    monkeypatch.setattr(cli_check, "check", no_room)
     # 2 GiB: under 1 GiB sim.cli.main refuses to start, as the sim command does (doors39r)
     real = resource.getrlimit  # ulimit -v only: a library imported now keeps what it reads
     monkeypatch.setattr(
@@ -168,7 +168,7 @@ def test_the_soft_cpu_limit_ends_a_command_in_one_line(monkeypatch, capsys):
         raise AssertionError("SIGXCPU was not handled")
 
     before = signal.getsignal(signal.SIGXCPU)
-    monkeypatch.setattr(cli, "_check", busy)
+    monkeypatch.setattr(cli_check, "check", busy)
     rc = cli.main(["check", str(ROOT / "studies" / "salsig_encoders.toml")])
     assert one_line(capsys, rc, code=130) == "sim: interrupted by the CPU time limit (ulimit -t)"
     assert signal.getsignal(signal.SIGXCPU) == before  # in-process callers get theirs back

@@ -34,8 +34,9 @@ from oneline import one_line
 
 import sim
 from sim.batch_checks import why_stale
-from sim.cli import DOC, load_run, main
+from sim.cli import DOC, main
 from sim.cli_args import parser
+from sim.cli_run import load_run
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError
 from sim.mc.sweep import read_sweep

@@ -21,7 +21,7 @@ must be >= 256``, a ``pugging.gross_px`` no longer read at ``gross_rate = 0``).
   named another directory (network_testfield, the first listed) as made by another version:
   a hand edit blamed for what an older version wrote, and the wrong study named. The line now
   says the table's own directory was made by another version of the suite's code
-  (:func:`sim.cli_errors.not_as_written`). Results of older commits were otherwise read
+  (:func:`sim.cli_tables.not_as_written`). Results of older commits were otherwise read
   right: ``sim show`` with its note, ``sim report`` of the day before's tree.
 """
 

@@ -22,7 +22,7 @@ failed on the code before its fix.
   (``brown_dilution`` of e48edaac~1: no ``region_inputs.parquet``): ``sim report`` and ``sim show
   --markdown`` said only "No such file or directory: .../region_inputs.parquet"; now the
   directory is named as made by another version of the code, and make reproduce as the remedy
-  (:func:`sim.cli_errors.older_lacks`); a table removed by hand from this version's run is
+  (:func:`sim.cli_tables.older_lacks`); a table removed by hand from this version's run is
   still the plain line.
 * ``make verify`` over such results (brown_table1 of e48edaac~1, whose run wrote a table named
   ``sweep.parquet`` beside its claims) said "not verified: brown_table1 (sweeps: verify re-runs

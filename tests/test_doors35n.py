@@ -46,6 +46,7 @@ import pytest
 
 import sim
 import sim.cli
+import sim.cli_run
 import sim.places
 from sim.mc.config import ConfigError
 from sim.mc.storage import code_hash
@@ -74,7 +75,7 @@ def _run_goes_to(monkeypatch, cwd: Path, *argv: str) -> tuple[Path, str, str]:
         seen.update(out=out, shown=shown)
         raise ConfigError(None, "stopped by the test")
 
-    monkeypatch.setattr(sim.cli, "execute", stop)
+    monkeypatch.setattr(sim.cli_run, "execute", stop)
     monkeypatch.chdir(cwd)
     err = io.StringIO()
     with contextlib.redirect_stderr(err):

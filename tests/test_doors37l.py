@@ -52,6 +52,7 @@ import benchmarks.cli
 import sim
 import sim.api
 import sim.cli
+import sim.cli_run
 import sim.report.verify.cli
 import sim.stale
 from sim.cli import main
@@ -110,7 +111,7 @@ def test_a_link_at_the_default_results_sends_the_run_to_scratch(capsys, tmp_path
     (tmp_path / "results" / "brown_table1").symlink_to(to)
     monkeypatch.chdir(tmp_path)
     seen = []
-    monkeypatch.setattr(sim.cli, "execute", lambda *a, **k: seen.append(a[4]))
+    monkeypatch.setattr(sim.cli_run, "execute", lambda *a, **k: seen.append(a[4]))
     assert main(["run", "studies/brown_table1.toml", "--quiet"]) == 0
     err = capsys.readouterr().err
     assert seen and seen[0].startswith("scratch/brown_table1-"), (seen, err)
@@ -150,7 +151,7 @@ def test_a_mistyped_study_file_is_answered_with_the_near_name(capsys, monkeypatc
 def test_a_float_count_is_recorded_as_the_integer_by_every_door(tmp_path, monkeypatch):
     seen = []
     keep = lambda *a, **k: seen.append(k["overrides"])  # noqa: E731
-    monkeypatch.setattr(sim.cli, "execute", keep)
+    monkeypatch.setattr(sim.cli_run, "execute", keep)
     monkeypatch.setattr(sim.api, "execute", keep)
     brown = str(ROOT / "studies" / "brown_table1.toml")
     for opts in (["--trials", "1e3"], ["--set", "trials=1e3"], ["--set", "trials=1000.0"]):

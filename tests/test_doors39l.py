@@ -175,7 +175,7 @@ def _stop_once(monkeypatch, target: str):
 
 @pytest.mark.parametrize(
     "target",
-    ["sim.studies.brown.core.jackknife", "sim.cli.write_run_readme"],
+    ["sim.studies.brown.core.jackknife", "sim.cli_run.write_run_readme"],
     ids=["tables", "readme"],
 )
 def test_an_interrupt_with_every_chunk_done_says_the_rerun_only_writes(

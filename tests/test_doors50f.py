@@ -8,7 +8,7 @@ the code before its fix.
   ``Path.resolve`` raises RuntimeError for a loop, which the reader's path check did not
   catch). The same table made a FIFO or a link that leads nowhere was "No such file or
   directory: .../points.parquet", a file that is there. Each now names the file and what
-  stands there (:func:`sim.cli_errors.lost_table`), as the claims table's own check does.
+  stands there (:func:`sim.cli_tables.lost_table`), as the claims table's own check does.
 """
 
 import os

@@ -156,8 +156,9 @@ def test_the_networks_solver_refusal_says_why_one_iteration_never_converges(
 
 # ------------------------------------------------------------- 5. a key one config lacks
 def test_a_key_of_an_older_config_is_not_said_as_none_in_this_run(tmp_path, capsys):
-    from sim.cli import DOC, load_run
+    from sim.cli import DOC
     from sim.cli_args import parser
+    from sim.cli_run import load_run
     from sim.places import _differs
 
     argv = ["run", str(PLATE), "--trials", "40", "--out", str(tmp_path / "old")]

@@ -24,7 +24,7 @@ from oneline import one_line, python_lines
 import sim
 import sim.batch
 import sim.report.verify.cli as verify_cli
-from sim import cli, execute
+from sim import cli_check, cli_run, execute
 from sim.cli import main
 from sim.mc import executors
 from sim.stops import check_interrupt, keep_lost_interrupts
@@ -110,14 +110,14 @@ def test_an_interrupt_dropped_after_the_last_chunk_is_not_published(tmp_path, mo
 
 
 def test_an_interrupt_dropped_after_publishing_is_not_exit_0(tmp_path, monkeypatch, capsys):
-    summary = cli.terminal_summary  # the first step after publishing (the README is before)
+    summary = cli_run.terminal_summary  # the first step after publishing (the README is before)
     monkeypatch.setattr(
-        cli, "terminal_summary", lambda *a, **k: (_drop_an_interrupt(), summary(*a, **k))[1]
+        cli_run, "terminal_summary", lambda *a, **k: (_drop_an_interrupt(), summary(*a, **k))[1]
     )
     err = _interrupted(capsys, main(["run", PLATE, "--out", str(tmp_path / "np"), *RUN]))
     assert err == f"sim: interrupted after the results were written to {tmp_path / 'np'}/", err
     assert (tmp_path / "np" / "claims.parquet").is_file()  # published, complete
-    monkeypatch.setattr(cli, "_check", lambda args: (_drop_an_interrupt(), 0)[1])
+    monkeypatch.setattr(cli_check, "check", lambda args: (_drop_an_interrupt(), 0)[1])
     _interrupted(capsys, main(["check", PLATE]))  # any command
 
 

@@ -51,8 +51,9 @@ def test_the_batch_checks_the_results_directory_its_run_writes(tmp_path, monkeyp
 )
 def test_the_api_resolves_the_config_sim_run_resolves(vals, argv):
     import sim
-    from sim.cli import DOC, load_run
+    from sim.cli import DOC
     from sim.cli_args import parser
+    from sim.cli_run import load_run
 
     study = ROOT / "studies" / "brown_table1.toml"
     _, cfg = load_run(parser(DOC).parse_args(["run", str(study), *argv]))

@@ -30,7 +30,6 @@ bounded too: at most :data:`MAX_CELLS` cells times replicates.
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from numbers import Integral
 from typing import Any, Callable, Container, Mapping
@@ -39,8 +38,9 @@ from sim.mc.agnard_size import agnard_estimate as _agnard
 from sim.mc.brown_size import brown_estimate as _brown
 from sim.mc.config import ConfigError
 from sim.mc.gridplate_size import gridplate_estimate as _gridplate
+from sim.mc.memory_limit import DEFAULT_MAX_MEMORY_GB
+from sim.mc.memory_limit import limit_value as _limit
 from sim.mc.network_size import network_estimate as _network
-from sim.mc.numtext import UnheldError, float_text
 from sim.mc.salsig_size import salsig_estimate as _salsig
 from sim.mc.sweep import MAX_CELLS, expand
 from sim.mc.toml_text import toml_value
@@ -82,7 +82,6 @@ CHUNK_UNITS = 100.0
 #: cell against eight (0.96 s a cell on the loaded 2-core machine). Without it 10,000 cells
 #: of 4,000 trials were estimated at 4.7e8 (under the limit) and measured at about 16 hours
 CELL_UNITS = 1.5e4
-DEFAULT_MAX_MEMORY_GB = 8.0
 DEFAULT_MAX_ADJUSTMENTS = 5e8
 #: an analytic part (no progress bar, nothing to resume) may take at most this share of the
 #: work limit: 5e5 adjustment-equivalents, about 25 s on one core, at the default 5e8
@@ -329,23 +328,6 @@ def estimate(
         float(W) if math.isfinite(W) else 0.0,
         wkeys,
     )
-
-
-def _limit(given: float | None, env: str, default: float, key: str) -> float:
-    if given is None:
-        txt = os.environ.get(env)
-        if txt is None or not txt.strip():
-            return default
-        try:  # ASCII digits, as --max-memory-gb reads them ('٨' was read as 8); 1e-400 is
-            given = float_text(txt) if txt.isascii() else float("x")  # no 0 (the digits said)
-        except UnheldError as e:
-            raise ConfigError(env, str(e)) from None
-        except ValueError:
-            raise ConfigError(env, f"must be a number (got {txt!r})") from None
-        key = env
-    if not math.isfinite(given) or given <= 0:
-        raise ConfigError(key, f"must be a finite positive number (got {given!r})")
-    return given
 
 
 def check_limits(

@@ -16,10 +16,10 @@ import os
 import pwd
 import shutil
 import stat
-import unicodedata
 from pathlib import Path
 
 from sim.mc.config import ConfigError, config_changes
+from sim.mc.path_names import STAGE_SUFFIX, name_problem, stage_dir
 from sim.mc.paths import is_chunk_store, link_problem, mount_point, mounts_under
 from sim.mc.record_text import finish_words, record_problem
 from sim.mc.storage import LOCK, Locked, NotALock, StageLock, read_record, write_record
@@ -36,26 +36,6 @@ __all__ = [
 ]
 
 
-def name_problem(text: str) -> str | None:
-    """Why a path given on the command line cannot name a file of the suite, in a few words
-    (None: it can): empty or blank, a control character or a line break, a leading ``~``
-    the shell left unexpanded, or bytes that are not UTF-8 text (a Latin-1 name, or any
-    non-ASCII name in a C locale without UTF-8 mode, which Python keeps as surrogate escapes;
-    the suite writes every path it records as UTF-8, so such a run would fail at its end)."""
-    if not text.strip():
-        return "is empty"
-    if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text):
-        return "contains a control character or a line break"
-    if any(unicodedata.category(c) == "Cs" for c in text):
-        return "contains bytes that are not UTF-8 text (a non-UTF-8 name or locale)"
-    if text.startswith("~"):  # --out=~/x: the shell expands no ~ after "=", and a directory
-        return (  # named "~" was made here, which "rm -rf ~" would then mistake for home
-            "starts with '~', which the shell did not expand (it does not after '='): use "
-            "$HOME, or a space for the '=' (./~ names a file that starts with ~)"
-        )
-    return None
-
-
 def _name_max(d: Path) -> int:
     """The file system's longest file name (bytes) in ``d`` or its nearest existing parent."""
     for p in (d, *d.parents):
@@ -65,14 +45,6 @@ def _name_max(d: Path) -> int:
             except (OSError, ValueError):
                 break
     return 255
-
-
-STAGE_SUFFIX = ".partial"
-
-
-def stage_dir(out: Path) -> Path:
-    """The run's staging directory next to ``out``: ``.<name>.partial`` (resumed after a kill)."""
-    return out.parent / f".{out.name}{STAGE_SUFFIX}"
 
 
 def results_dirs(results: Path) -> list[Path]:

@@ -37,6 +37,7 @@ import pyarrow.parquet as pq
 
 from sim.lsq import distributions as D
 from sim.mc.chunk_content import content_digest
+from sim.mc.chunk_count import MIN_CHUNKS, require_chunks
 from sim.mc.config import ConfigError, StudyError
 from sim.mc.executors import InProcess, make_executor
 from sim.mc.packed import pack, unpack
@@ -61,10 +62,6 @@ __all__ = [
     "probe_limit",
 ]
 
-#: the fewest chunks a jackknife interval is computed from: with C chunks the interval's
-#: standard error has C - 1 degrees of freedom, and below about 20 it is itself too uncertain
-#: to decide a claim on (the issue-25 run of 2 chunks gave a proportion's interval [0.07, 0.07])
-MIN_CHUNKS = 20
 #: a study's solver probe at load time (brown's check_solver, the network's probe_solver):
 #: PROBE_TRIALS trials from a fixed stream of their own (PROBE_SEED, not the run's), run when
 #: ``solver.max_iter`` is at most PROBE_MAX_ITER (their adjustments converge in 1 to 4)
@@ -88,30 +85,6 @@ def require_finite(name: str, array, part: str, key: str | None = None) -> np.nd
             f"NaN or infinite){hint}"
         )
     return a
-
-
-def require_chunks(cfg: Mapping, need: int = MIN_CHUNKS, use: str = "jackknife intervals") -> None:
-    """Refuse, at load time, a config whose ``trials`` in chunks of ``chunk`` give fewer than
-    ``need`` chunks (:class:`sim.mc.config.ConfigError`, one line naming ``chunk``, or
-    ``trials`` when no chunk size can give enough). A study whose results call
-    :func:`jackknife` on the chunks of its ``trials``/``chunk`` run calls it from its schema's
-    ``check`` (brown_table1, brown_dilution, network): without it a run of too few chunks
-    computed every trial and then failed in :func:`jackknife`. ``need >= 2``."""
-    trials, chunk = cfg["trials"], cfg["chunk"]
-    have = -(-trials // chunk)
-    if have >= need:
-        return
-    if trials < need:  # chunk = 1 gives `trials` chunks: only more trials help
-        # both numbers: "at least 20 trials (one per chunk)" followed with the chunk kept
-        # (a chunk of 2 given) was refused again, "make chunk at most 1"
-        fix = f"give at least {need} trials in chunks of 1, or {need * chunk:,} in chunks of {chunk:,}"
-    else:  # the largest chunk c with ceil(trials / c) >= need
-        fix = f"make chunk at most {-(-trials // (need - 1)) - 1}"
-    raise ConfigError(
-        "trials" if trials < need else "chunk",
-        f"{trials:,} trials in chunks of {chunk:,} give {have} chunk{'s' * (have != 1)}; "
-        f"this study's {use} are taken over chunks and need at least {need}: {fix}",
-    )
 
 
 def probe_limit(
