@@ -24,6 +24,7 @@ import stat
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.file_kind import mode_kind
 from sim.mc.storage import read_record
 
 __all__ = ["EXPORT_KEY", "export_sums", "changed_exports", "refuse_changed_export"]
@@ -32,14 +33,6 @@ __all__ = ["EXPORT_KEY", "export_sums", "changed_exports", "refuse_changed_expor
 EXPORT_KEY = "export_sha256"
 #: the name of an export as a run record lists it: a run's, or a sweep's cell's
 _EXPORT = re.compile(r"(?:cells/[^/\\\x00]+/)?[^/\\\x00]+\.xml")
-
-_KINDS = (
-    (stat.S_ISLNK, "a symbolic link"),
-    (stat.S_ISFIFO, "a FIFO (named pipe)"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISSOCK, "a socket"),
-)
 
 
 def _sha256(p: Path) -> str:
@@ -79,7 +72,7 @@ def changed_exports(out: Path, rec: dict | None = None, dirs: bool = False) -> d
                 found[name] = "a directory"
             continue
         if not stat.S_ISREG(mode):
-            found[name] = next((w for t, w in _KINDS if t(mode)), "not a regular file")
+            found[name] = mode_kind(mode)
             continue
         want = sums.get(name)
         try:
