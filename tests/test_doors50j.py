@@ -7,6 +7,9 @@ each failed on the code before its fix.
 * A file of the user's named ``network.xml`` in the ``--out`` of a network run (one the
   earlier run there did not write): refused only when the run published, after every chunk
   was computed; now before any work, naming it.
+* ``python -m sim.batch --stale-only`` over results whose network export was edited by hand:
+  "up to date", exit 0 (a run of them, by ``--overwrite``, is refused while the edit is
+  there); now the batch names the file before any run (exit 2), and ``why_stale`` says it.
 """
 
 from __future__ import annotations
@@ -67,3 +70,33 @@ def test_own_network_xml_in_out_refused_before_any_work(tmp_path: Path, capsys) 
     assert "r1/network.xml was not written by sim" in err and "export" in err
     assert not stage_dir(out).exists()  # refused before the staging directory: no work
     assert (out / "network.xml").read_text(encoding="utf-8") == "<mine/>\n"
+
+
+def test_stale_only_names_an_edited_export(tmp_path: Path, capsys) -> None:
+    """A batch's results of the triangle network, their ``network.xml`` edited by hand, then
+    ``--stale-only`` again: before, "tri: up to date", exit 0; now exit 2 before any run, one
+    line naming the edited file, and ``why_stale`` calls the results not current, naming it."""
+    from sim.batch import main as batch
+    from sim.batch_checks import why_stale
+
+    (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    argv = ["run", "tri.toml", "--out", "res/tri", "--no-figures", "--quiet"]
+    assert _in(tmp_path, argv, capsys)[0] == 0
+    xml = tmp_path / "res" / "tri" / "network.xml"
+    xml.write_bytes(xml.read_bytes() + b"<!-- mine -->\n")
+    args = ["--stale-only", "--jobs", "1", "--results", "res", "tri.toml", "--", "--no-figures"]
+    here = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        capsys.readouterr()
+        rc = batch(args)
+        out, err = capsys.readouterr()
+        why = why_stale("tri.toml", "res/tri", ["--no-figures"])
+    finally:
+        os.chdir(here)
+    assert rc == 2, out + err
+    assert "up to date" not in out
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    assert "network.xml was changed after the run that wrote it" in err
+    assert why is not None and why.startswith("network.xml was changed after the run")
+    assert xml.read_bytes().endswith(b"<!-- mine -->\n")
