@@ -10,6 +10,9 @@ each failed on the code before its fix.
 * ``python -m sim.batch --stale-only`` over results whose network export was edited by hand:
   "up to date", exit 0 (a run of them, by ``--overwrite``, is refused while the edit is
   there); now the batch names the file before any run (exit 2), and ``why_stale`` says it.
+* A GNU Gama file edited through the Python API keeping its size and modification time: its
+  counts for the work estimate were cached by those two, and the old counts kept; now by
+  its content.
 """
 
 from __future__ import annotations
@@ -100,3 +103,25 @@ def test_stale_only_names_an_edited_export(tmp_path: Path, capsys) -> None:
     assert "network.xml was changed after the run that wrote it" in err
     assert why is not None and why.startswith("network.xml was changed after the run")
     assert xml.read_bytes().endswith(b"<!-- mine -->\n")
+
+
+def test_gama_counts_follow_an_edit_that_keeps_size_and_mtime(tmp_path: Path) -> None:
+    """An observation of a gama-local file turned into a comment of its length, the file's
+    modification time put back: before, ``gama_counts`` gave the cached counts of the file
+    as it was (the observation still counted); now the counts of what the file holds."""
+    from sim.mc.gama_count import gama_counts
+
+    src = Path(__file__).parent / "data" / "gama" / "directions_free.xml"
+    f = tmp_path / "net.xml"
+    text = src.read_text(encoding="utf-8")
+    f.write_text(text, encoding="utf-8")
+    before = gama_counts(f)
+    st = os.stat(f)
+    obs = '<direction to="P2" val="4.76572592091002" stdev="6.172839506172839" />'
+    assert obs in text
+    f.write_text(text.replace(obs, "<!--" + " " * (len(obs) - 7) + "-->", 1), encoding="utf-8")
+    os.utime(f, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert os.stat(f).st_size == st.st_size and os.stat(f).st_mtime_ns == st.st_mtime_ns
+    after = gama_counts(f)
+    assert before is not None and after is not None
+    assert after.rows["direction"] == before.rows["direction"] - 1
