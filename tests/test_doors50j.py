@@ -13,6 +13,8 @@ each failed on the code before its fix.
 * A GNU Gama file edited through the Python API keeping its size and modification time: its
   counts for the work estimate were cached by those two, and the old counts kept; now by
   its content.
+* A sweep range without ``stop`` (``{start = 20, step = 20}``): read as a table of keys,
+  "sweep.trials.start: unknown key"; now the range is named with what it lacks.
 """
 
 from __future__ import annotations
@@ -125,3 +127,18 @@ def test_gama_counts_follow_an_edit_that_keeps_size_and_mtime(tmp_path: Path) ->
     after = gama_counts(f)
     assert before is not None and after is not None
     assert after.rows["direction"] == before.rows["direction"] - 1
+
+
+def test_sweep_range_without_stop_names_it(tmp_path: Path) -> None:
+    """``[sweep] trials = {start = 20, step = 20}``: before, flattened into the keys
+    ``trials.start`` and ``trials.step`` ("sweep.trials.start: unknown key"); now
+    "sweep.trials: a range needs start and stop (it has no stop)"."""
+    from sim.mc.config import ConfigError
+    from sim.mc.sweep import read_sweep
+    from sim.studies import get_study
+
+    f = tmp_path / "sw.toml"
+    f.write_text(TRIANGLE_NETWORK + "[sweep]\ntrials = {start = 20, step = 20}\n")
+    with pytest.raises(ConfigError) as e:
+        read_sweep(f, get_study("network").schema)
+    assert str(e.value) == "sweep.trials: a range needs start and stop (it has no stop)"

@@ -18,7 +18,10 @@ MAX_CELLS = 10_000  # cells x replicates of one sweep (sim.mc.estimate uses the 
 
 
 def _is_range(v: Any) -> bool:
-    return isinstance(v, dict) and "start" in v and "stop" in v
+    """A range table, or one meant as a range that lacks ``start`` or ``stop`` (no study key
+    ends in ``start`` or ``stop``): ``{start = 1, step = 1}`` was flattened into the keys
+    ``sweep.k.start`` and ``sweep.k.step``, "unknown key" rather than the missing ``stop``."""
+    return isinstance(v, dict) and ("start" in v or "stop" in v)
 
 
 def _finite(key: str, name: str, x: Any) -> float:
@@ -34,8 +37,9 @@ def _values(key: str, v: Any) -> list:
         if len(v) > MAX_CELLS:
             raise ConfigError(f"sweep.{key}", f"has {len(v)} values (at most {MAX_CELLS})")
         return v
-    if isinstance(v, dict) and not _is_range(v):
-        raise ConfigError(f"sweep.{key}", "a range needs start and stop")
+    if isinstance(v, dict) and not {"start", "stop"} <= set(v):
+        lack = " and ".join(sorted({"start", "stop"} - set(v), reverse=True))
+        raise ConfigError(f"sweep.{key}", f"a range needs start and stop (it has no {lack})")
     if _is_range(v):
         extra = set(v) - {"start", "stop", "num", "step"}
         if extra:
