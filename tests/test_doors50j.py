@@ -15,6 +15,9 @@ each failed on the code before its fix.
   its content.
 * A sweep range without ``stop`` (``{start = 20, step = 20}``): read as a table of keys,
   "sweep.trials.start: unknown key"; now the range is named with what it lacks.
+* ``make verify`` over a results directory copied under another name that no study file
+  has: "run mine's own study file to replace them", a file that does not exist; now it says
+  there is none, and to move the directory away.
 """
 
 from __future__ import annotations
@@ -142,3 +145,24 @@ def test_sweep_range_without_stop_names_it(tmp_path: Path) -> None:
     with pytest.raises(ConfigError) as e:
         read_sweep(f, get_study("network").schema)
     assert str(e.value) == "sweep.trials: a range needs start and stop (it has no stop)"
+
+
+def test_verify_copy_without_its_study_file(tmp_path: Path, capsys) -> None:
+    """A run's results copied to ``R/mine`` beside ``R/tri``, ``studies/`` holding only
+    ``tri.toml``: verify said "run mine's own study file to replace them"; now "there is no
+    studies/mine.toml to replace them: move R/mine away" (nothing re-run)."""
+    import shutil
+
+    from sim.report.verify.rerun import verify
+
+    (tmp_path / "studies").mkdir()
+    (tmp_path / "studies" / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    argv = ["run", "studies/tri.toml", "--out", "R/tri", "--no-figures", "--quiet"]
+    assert _in(tmp_path, argv, capsys)[0] == 0
+    shutil.copytree(tmp_path / "R" / "tri", tmp_path / "R" / "mine")
+    studies = tmp_path / "studies"
+    (comp,) = verify(tmp_path / "R", tmp_path / "S", only=["mine"], studies=studies)
+    (why,) = comp.failures
+    assert "run mine's own study file" not in why
+    assert f"there is no {studies / 'mine'}.toml to replace them" in why
+    assert not (tmp_path / "S" / "mine").exists()
