@@ -18,6 +18,9 @@ each failed on the code before its fix.
 * ``make verify`` over a results directory copied under another name that no study file
   has: "run mine's own study file to replace them", a file that does not exist; now it says
   there is none, and to move the directory away.
+* A ``run.json`` of this code's run forged by hand, its ``table_sha256`` and ``table_shape``
+  made null, or both removed with ``files``: the claims read unchecked, an edited value
+  printed as the run's; now refused in one line (an older version's record stays readable).
 """
 
 from __future__ import annotations
@@ -166,3 +169,35 @@ def test_verify_copy_without_its_study_file(tmp_path: Path, capsys) -> None:
     assert "run mine's own study file" not in why
     assert f"there is no {studies / 'mine'}.toml to replace them" in why
     assert not (tmp_path / "S" / "mine").exists()
+
+
+def test_forged_record_of_this_code_is_refused(tmp_path: Path, capsys, monkeypatch) -> None:
+    """A claim's value edited and the record's integrity fields nulled (``table_sha256``,
+    ``table_shape``) or removed with ``files``: before, ``sim show`` printed the edited value,
+    exit 0 (only both removed with ``files`` kept was refused); now exit 2, one line naming
+    what the record lacks. The same record read by another version of the code (an older
+    record of a version that wrote no such fields) is read as before."""
+    import json
+
+    from hand_edits import edit_first_value
+
+    (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    assert (
+        _in(tmp_path, ["run", "tri.toml", "--out", "r", "--no-figures", "--quiet"], capsys)[0] == 0
+    )
+    d = tmp_path / "r"
+    rec = json.loads((d / "run.json").read_text(encoding="utf-8"))
+    claims = (d / "claims.parquet").read_bytes()
+    edit_first_value(d)
+    nulled = {**rec, "table_sha256": None, "table_shape": None}
+    removed = {k: v for k, v in rec.items() if k not in ("table_sha256", "table_shape", "files")}
+    for forged, words in ((nulled, "neither table_sha256 nor table_shape"), (removed, "nor files")):
+        (d / "run.json").write_text(json.dumps(forged), encoding="utf-8")
+        rc, err = _in(tmp_path, ["show", "r"], capsys)
+        assert rc == 2, err
+        assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+        assert words in err and "removed by hand?" in err
+    (d / "claims.parquet").write_bytes(claims)  # the record, read by a later version:
+    monkeypatch.setattr("sim.mc.table_shape.code_hash", lambda study: "0" * 64)
+    rc, err = _in(tmp_path, ["show", "r"], capsys)
+    assert rc == 0, err
