@@ -21,6 +21,10 @@ each failed on the code before its fix.
 * A ``run.json`` of this code's run forged by hand, its ``table_sha256`` and ``table_shape``
   made null, or both removed with ``files``: the claims read unchecked, an edited value
   printed as the run's; now refused in one line (an older version's record stays readable).
+* A results README.md edited by hand (notes added under the suite's text): replaced by the
+  same run again, or by ``sim report``, without a word. Its sha256 is recorded now: such a
+  README is the user's, the run is refused before any work naming it (as an edited
+  export), and ``sim report`` keeps it and says so.
 """
 
 from __future__ import annotations
@@ -201,3 +205,25 @@ def test_forged_record_of_this_code_is_refused(tmp_path: Path, capsys, monkeypat
     monkeypatch.setattr("sim.mc.table_shape.code_hash", lambda study: "0" * 64)
     rc, err = _in(tmp_path, ["show", "r"], capsys)
     assert rc == 0, err
+
+
+def test_edited_readme_is_kept_and_named(tmp_path: Path, capsys) -> None:
+    """A line of the user's added to a run's README.md, then the same command again with
+    ``--overwrite``, then ``sim report``: before, exit 0 both, the line gone; now the run is
+    refused before any work (one line naming README.md), and the report keeps the README
+    and says so in a note."""
+    (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    argv = ["run", "tri.toml", "--out", "res/tri", "--no-figures", "--quiet", "--overwrite"]
+    assert _in(tmp_path, argv, capsys)[0] == 0
+    readme = tmp_path / "res" / "tri" / "README.md"
+    edited = readme.read_text(encoding="utf-8") + "\nMy notes on this run.\n"
+    readme.write_text(edited, encoding="utf-8")
+    rc, err = _in(tmp_path, argv, capsys)
+    assert rc == 2, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    assert "README.md was changed after the run that wrote it" in err
+    assert not stage_dir(readme.parent).exists()
+    rc, err = _in(tmp_path, ["report", "--results", "res"], capsys)
+    assert rc == 0, err
+    assert f"{Path('res') / 'tri' / 'README.md'} was changed after the run" in err
+    assert readme.read_text(encoding="utf-8") == edited
