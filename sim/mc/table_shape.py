@@ -243,13 +243,13 @@ def sum_problem(path: str | Path) -> str | None:
 
 
 def _lost(rec: dict) -> str | None:
-    """Which of the fields a run of this code records for its tables ``rec`` lacks or holds
-    as something else (null, say), in words (``"neither table_sha256 nor table_shape"``,
-    ``"no files"``), or None."""
+    """``"neither table_sha256 nor table_shape"`` (``", nor files"``) when ``rec`` holds
+    neither a table's sha256 nor its shape (removed, or made null), else None: with one of
+    them its tables are checked (a record of the versions between the two has no shape)."""
     lost = [k for k, t in _SEALED if not isinstance(rec.get(k), t)]
-    if lost[:2] == ["table_sha256", SHAPE_KEY]:
-        return "neither table_sha256 nor table_shape" + (", nor files" if len(lost) > 2 else "")
-    return f"no {' and no '.join(lost)}" if lost else None
+    if lost[:2] != ["table_sha256", SHAPE_KEY]:
+        return None
+    return "neither table_sha256 nor table_shape" + (", nor files" if len(lost) > 2 else "")
 
 
 def _this_code(rec: dict) -> bool:
