@@ -23,8 +23,10 @@ from sim.cli_errors import cwd_exists
 from sim.cli_run import check_run_args, load_run
 from sim.ends import unshown
 from sim.execute import sweep_limits
+from sim.input_places import check_inputs_outside
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
+from sim.mc.export_edits import changed_exports
 from sim.mc.message_text import key_text
 from sim.mc.outputs import check_out
 from sim.mc.overrides import command_values, listed, recorded
@@ -55,7 +57,8 @@ def why_stale(
 ) -> str | None:
     """Why ``results`` are not current for ``sim run STUDY_FILE RUN_ARGS`` (no results, a
     config key that differs, the code changed since, no figures or one replaced by hand), in
-    a few words; None when they are (:func:`is_current`). ``--stale-only`` printed nothing
+    a few words, a network export edited by hand among them (the user's now: a run is
+    refused while it is there); None when they are (:func:`is_current`). ``--stale-only`` printed nothing
     for a study it re-ran, so results made by older code or copied from elsewhere were re-run
     without a word. ``loaded``: the file's ``(args, study, cfg, sweep)`` as the batch resolved
     them before any run (:func:`_configs_problems`), not resolved again."""
@@ -104,6 +107,10 @@ def why_stale(
         return f"{mixed[0].name} is not of the run of run.json: {mixed[1]}"
     if edited := edited_tables(Path(results)):  # a table edited by hand: made again, as a
         return f"{edited[0]} changed after its run (sha256 not run.json's: edited by hand?)"
+    for name, what in sorted(changed_exports(Path(results)).items())[:1]:  # the user's now:
+        # the results were called up to date, and a run of them is refused while it is there
+        kind = f"was {what}" if what.startswith("changed") else f"is {what}, not its run's export"
+        return f"{name} {kind}: a run into {results} is refused until it is moved away"
     return changed_figure(Path(results))  # figure replaced by hand is drawn again
 
 
@@ -154,7 +161,8 @@ def _configs_problems(
     (``sim run FILE RUN_ARGS`` resolves it here, before any run starts: a study file ported
     from another study, a bad key or value, a bad ``[sweep]``, a run over the memory or work
     limits, a ``<results>/<file name>`` its run refuses to replace: a file, a foreign
-    directory, a link), every such file named, and
+    directory, a link; one whose network export was edited by hand, or where a file of the
+    user's stands in its export's place), every such file named, and
     ``{file: (args, study, cfg, sweep)}`` of the others (``--stale-only`` reads them). One
     broken file among many ran the others first, for hours in ``make reproduce``, and was
     named only when its turn came. A ``--set`` key a study has not is left out of its check
@@ -178,6 +186,7 @@ def _configs_problems(
             out = results / f.stem  # each run is --overwrite: the record is not compared
             record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
             check_out(absolute(out), str(out), record, True)  # (as sim run: check_run_args)
+            check_inputs_outside(absolute(out), str(out), cfg, sweep)  # an edited export
         except (ConfigError, StudyError) as e:  # a line that names the file already: as it is
             text = str(_out_in_batch_words(e) if isinstance(e, ConfigError) else e)
             lines.append(text if text.startswith(f"{f}: ") else f"{f}: {text}")

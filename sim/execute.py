@@ -194,7 +194,7 @@ def execute(
         raise ConfigError(None, why)
     check_place(out, shown)  # not in sim/ (a study's code hash), not below a broken link
     check_out(out, shown, record, overwrite)
-    check_inputs_outside(out, shown, cfg)  # a run never replaces the file its study reads
+    check_inputs_outside(out, shown, cfg, sweep)  # a run never replaces a file its study reads
     stage = stage_dir(out)
     clear_replaced(stage, out, shown)  # a kill between publishing's two steps left them there
     try:

@@ -13,6 +13,11 @@ the user's (:func:`sim.mc.publish._foreign`) and a run that would write a file o
 refused, before any work (:func:`refuse_changed_export`) and at its end, naming it: as for
 any file of the user's in the way of one the run writes. A record of an older version, with
 no ``export_sha256``, has its regular files taken as the run's, as before.
+
+So is a results directory's ``README.md`` edited by hand (its sha256 is not the
+``readme_sha256`` that ``sim run`` and ``sim report`` record when they write it): the user's
+notes were replaced by a re-run, or by ``sim report``, without a word (the mark on its first
+line said "edits are overwritten", hidden where Markdown is shown).
 """
 
 from __future__ import annotations
@@ -24,22 +29,17 @@ import stat
 from pathlib import Path
 
 from sim.mc.config import ConfigError
+from sim.mc.file_kind import mode_kind
 from sim.mc.storage import read_record
 
-__all__ = ["EXPORT_KEY", "export_sums", "changed_exports", "refuse_changed_export"]
+__all__ = ["EXPORT_KEY", "README_KEY", "export_sums", "changed_exports", "refuse_changed_export"]
 
 #: the run record's key of the exports' sha256
 EXPORT_KEY = "export_sha256"
+#: the run record's key of the sha256 of the README.md the suite wrote last
+README_KEY = "readme_sha256"
 #: the name of an export as a run record lists it: a run's, or a sweep's cell's
 _EXPORT = re.compile(r"(?:cells/[^/\\\x00]+/)?[^/\\\x00]+\.xml")
-
-_KINDS = (
-    (stat.S_ISLNK, "a symbolic link"),
-    (stat.S_ISFIFO, "a FIFO (named pipe)"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISSOCK, "a socket"),
-)
 
 
 def _sha256(p: Path) -> str:
@@ -65,9 +65,12 @@ def changed_exports(out: Path, rec: dict | None = None, dirs: bool = False) -> d
     files = rec.get("files") if isinstance(rec, dict) else None
     sums = rec.get(EXPORT_KEY) if isinstance(rec, dict) else None
     sums = sums if isinstance(sums, dict) else {}
+    readme = rec.get(README_KEY) if isinstance(rec, dict) else None
+    if isinstance(readme, str):  # (a record without it: the README is the suite's, as before)
+        sums = {**sums, "README.md": readme}
     found = {}
     for name in files if isinstance(files, list) else []:
-        if not isinstance(name, str) or not _EXPORT.fullmatch(name):
+        if not isinstance(name, str) or not (_EXPORT.fullmatch(name) or name in sums):
             continue
         p = Path(out) / name
         try:
@@ -79,7 +82,7 @@ def changed_exports(out: Path, rec: dict | None = None, dirs: bool = False) -> d
                 found[name] = "a directory"
             continue
         if not stat.S_ISREG(mode):
-            found[name] = next((w for t, w in _KINDS if t(mode)), "not a regular file")
+            found[name] = mode_kind(mode)
             continue
         want = sums.get(name)
         try:
@@ -94,9 +97,8 @@ def changed_exports(out: Path, rec: dict | None = None, dirs: bool = False) -> d
 def changed_words(out: Path, name: str, what: str) -> str:
     """The refusal of a run that would replace the export ``name`` of ``out``, ``what`` it is."""
     p = Path(out) / name
-    kind = (
-        f"was {what}" if what.startswith("changed") else f"is {what}, not the export its run wrote"
-    )
+    mine = "the export" if name.endswith(".xml") else "the file"
+    kind = f"was {what}" if what.startswith("changed") else f"is {what}, not {mine} its run wrote"
     return (
         f"{p} {kind}; a run into {out} writes a file of that name: copy it out of the results "
         "directory (or move it away) and run again"

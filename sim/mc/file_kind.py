@@ -8,18 +8,26 @@ import os
 import stat
 from pathlib import Path
 
-__all__ = ["odd_file", "odd_table"]
+__all__ = ["odd_file", "odd_table", "mode_kind"]
 
 #: the tables that make a directory a results directory (a study run's, a sweep's)
 TABLES = ("claims.parquet", "sweep.parquet")
 
 _KINDS = (
+    (stat.S_ISLNK, "a symbolic link"),  # (an lstat's mode: os.stat follows it)
     (stat.S_ISFIFO, "a FIFO (named pipe)"),
     (stat.S_ISCHR, "a character device"),
     (stat.S_ISBLK, "a block device"),
     (stat.S_ISSOCK, "a socket"),
     (stat.S_ISDIR, "a directory"),
 )
+
+
+def mode_kind(mode: int) -> str:
+    """What a file of the ``st_mode`` ``mode`` is in a message (``"a FIFO (named pipe)"``,
+    ``"a symbolic link"`` of an ``lstat``, ``"a directory"``, ...), for one that is not a
+    regular file (:mod:`sim.mc.export_edits` names an export's place in the same words)."""
+    return next((what for test, what in _KINDS if test(mode)), "not a regular file")
 
 
 def odd_file(p: str | Path) -> str | None:
@@ -33,7 +41,7 @@ def odd_file(p: str | Path) -> str | None:
         return "a symbolic link that leads nowhere" if os.path.islink(p) else None
     if stat.S_ISREG(mode):
         return None
-    return next((what for test, what in _KINDS if test(mode)), "not a regular file")
+    return mode_kind(mode)
 
 
 def odd_table(d: str | Path) -> str | None:

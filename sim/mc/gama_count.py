@@ -20,6 +20,7 @@ and 2.1e6 factor nonzeros for its 88,803 and 3.6e6: the memory estimate 40 % sho
 from __future__ import annotations
 
 import functools
+import hashlib
 import os
 import stat
 from typing import NamedTuple
@@ -52,18 +53,27 @@ class _Stop(Exception):
 
 def gama_counts(path: str | os.PathLike) -> GamaCounts | None:
     """The counts of the ``gama-local`` file at ``path``, or None where it cannot be counted
-    (read once per version of the file: its size and modification time)."""
+    (parsed once per content of the file, its sha256: keyed on its size and modification
+    time, an edit that kept both, through the Python API within one process, kept the old
+    counts in the work estimate; hashing is a small part of parsing)."""
     try:
         st = os.stat(path)
     except (OSError, ValueError):
         return None
     if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_COUNT_BYTES:
         return None
-    return _counted(os.path.abspath(path), st.st_size, st.st_mtime_ns)
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            while block := fh.read(1 << 20):
+                h.update(block)
+    except (OSError, ValueError):
+        return None
+    return _counted(os.path.abspath(path), h.hexdigest())
 
 
 @functools.lru_cache(maxsize=4)
-def _counted(path: str, size: int, mtime_ns: int) -> GamaCounts | None:
+def _counted(path: str, sha256: str) -> GamaCounts | None:
     ids: set = set()
     kept: set = set()  # fixed in xy with coordinates: the reader keeps them, observed or not
     seen: set = set()  # named by an observation or <coordinates>

@@ -63,7 +63,9 @@ def recorded_source(record: dict | None) -> tuple[str | None, str | None]:
     )
 
 
-def other_source(d: str | Path, name: str | None = None, record: dict | None = None) -> str | None:
+def other_source(
+    d: str | Path, name: str | None = None, record: dict | None = None, studies: Path | None = None
+) -> str | None:
     """Why the results directory ``d`` holds another study's results than its name says, or
     None: its record was written into a directory of another name from a study file of
     another name (copied or renamed by hand). ``name``: the study the reader expects (a
@@ -74,7 +76,9 @@ def other_source(d: str | Path, name: str | None = None, record: dict | None = N
     whole (``mv r1 r2``) they were noted by ``sim show`` and warned of by ``sim.Results`` as
     "not r2's (copied or renamed by hand?): run r2's own study file", a file that never
     was. A symbolic link to results (``latest -> B/alpha``) is named by what it leads to.
-    ``record``: its run record if read already."""
+    ``record``: its run record if read already; ``studies``: the directory of the study files
+    (``make verify``'s), where one of the expected name may be missing (it said "run mine's
+    own study file" then)."""
     here = Path(os.path.abspath(d))
     rec = record if record is not None else read_record(here)
     written, path = recorded_source(rec)
@@ -86,7 +90,10 @@ def other_source(d: str | Path, name: str | None = None, record: dict | None = N
     if written is None or want in (written, stem):
         return None
     where = f" of {path}" if path else ""
+    fix = f"run {want}'s own study file to replace them"
+    if studies is not None and not (Path(studies) / f"{want}.toml").is_file():
+        fix = f"there is no {Path(studies) / want}.toml to replace them: move {d} away"
     return (
         f"{d} holds the results of a run{where} written as {written}/ (its run.json), not "
-        f"{want}'s (copied or renamed by hand?): run {want}'s own study file to replace them"
+        f"{want}'s (copied or renamed by hand?): {fix}"
     )

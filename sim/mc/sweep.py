@@ -53,6 +53,7 @@ from sim.mc.message_text import near_keys
 from sim.mc.numtext import UnheldError, unsigned_zeros
 from sim.mc.progress import Progress
 from sim.mc.runner import MIN_CHUNKS, chunk_rng
+from sim.mc.sweep_values import MAX_CELLS, _is_range, _values
 from sim.mc.toml_text import toml_value
 from sim.mc.unknown_key import item_hint
 
@@ -73,7 +74,6 @@ __all__ = [
 
 SWEEP_KEY = 0x5EE9  # spawn-key tag of the sweep's seed streams
 RESERVED = ("replicates", "seed_mode")
-MAX_CELLS = 10_000  # cells x replicates of one sweep (sim.mc.estimate uses the same bound)
 
 
 def _flatten_sweep(d: Mapping, prefix: str = "") -> dict[str, Any]:
@@ -134,80 +134,6 @@ def _canonical(flat: dict[str, Any], schema: Mapping) -> dict[str, Any]:
             v = [check_value(f"sweep.{k}", schema[k], e) for e in v]
         out[k] = v
     return out
-
-
-def _is_range(v: Any) -> bool:
-    return isinstance(v, dict) and "start" in v and "stop" in v
-
-
-def _finite(key: str, name: str, x: Any) -> float:
-    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
-        raise ConfigError(f"sweep.{key}", f"{name} must be a finite number (got {x!r})")
-    return x
-
-
-def _values(key: str, v: Any) -> list:
-    if isinstance(v, list):
-        if not v:
-            raise ConfigError(f"sweep.{key}", "needs at least one value")
-        if len(v) > MAX_CELLS:
-            raise ConfigError(f"sweep.{key}", f"has {len(v)} values (at most {MAX_CELLS})")
-        return v
-    if isinstance(v, dict) and not _is_range(v):
-        raise ConfigError(f"sweep.{key}", "a range needs start and stop")
-    if _is_range(v):
-        extra = set(v) - {"start", "stop", "num", "step"}
-        if extra:
-            raise ConfigError(f"sweep.{key}", f"unknown range entries {sorted(extra)}")
-        a, b = _finite(key, "start", v["start"]), _finite(key, "stop", v["stop"])
-        if "num" in v and "step" in v:
-            raise ConfigError(f"sweep.{key}", "give num or step, not both")
-        if "num" in v:
-            n = v["num"]
-            if isinstance(n, float) and n.is_integer() and abs(n) <= MAX_CELLS:
-                n = int(n)  # num = 1e3 or 3.0: the count, as trials = 1e3 is
-            if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_CELLS:
-                raise ConfigError(
-                    f"sweep.{key}", f"num must be an integer from 1 to {MAX_CELLS} (got {n!r})"
-                )
-            with np.errstate(all="ignore"):  # b - a overflowing: refused below, not warned
-                out = np.linspace(a, b, n)
-        elif "step" in v:
-            s = _finite(key, "step", v["step"])
-            if s == 0 or (b - a) / s < 0:
-                raise ConfigError(
-                    f"sweep.{key}", "step must be non-zero and point from start to stop"
-                )
-            count = (b - a) / s
-            if not count < MAX_CELLS:
-                raise ConfigError(
-                    f"sweep.{key}",
-                    f"step {s!r} gives more than {MAX_CELLS} values from {a!r} to {b!r}",
-                )
-            if all(isinstance(x, int) for x in (a, b, s)):  # exact (NumPy's int64 wrapped)
-                return [a + s * i for i in range((b - a) // s + 1)]
-            with np.errstate(all="ignore"):
-                out = a + s * np.arange(int(math.floor(count + 1e-9)) + 1)
-        else:
-            raise ConfigError(f"sweep.{key}", "a range needs num or step")
-        if not np.isfinite(out).all():
-            raise ConfigError(f"sweep.{key}", "the range's values are not finite")
-        return [float(x) for x in out]
-    raise ConfigError(f"sweep.{key}", f"a sweep takes a list, e.g. {_example(key, v)} (got {v!r})")
-
-
-def _example(key: str, v: Any) -> str:
-    """``key = [v, ...]`` in TOML, the way to sweep a key given one value (``trials = 40`` was
-    read as a sweep of one cell)."""
-    name = key if key.replace("_", "").isalnum() else f'"{key}"'
-    if isinstance(v, int) and not isinstance(v, bool) and abs(v) < 2**52:
-        more = repr(2 * v or 1)
-    elif isinstance(v, float) and math.isfinite(v):
-        more = repr(2 * v or 1.0)
-    else:
-        more = "..."
-    first = f'"{v}"' if isinstance(v, str) and len(v) < 40 and '"' not in v else repr(v)[:40]
-    return f"{name} = [{str(v).lower() if isinstance(v, bool) else first}, {more}]"
 
 
 def expand(table: Mapping[str, Any], schema: Mapping | None = None):

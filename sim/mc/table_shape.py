@@ -208,6 +208,10 @@ def _unrecorded(rec: Path) -> str:
     return "not an object holding its config and code_hash"
 
 
+#: the fields of a run record that the run's tables are checked by, and their types
+_SEALED = (("table_sha256", dict), (SHAPE_KEY, dict), ("files", list))
+
+
 def sum_problem(path: str | Path) -> str | None:
     """For a table whose run record holds no shape of it but its sha256 (``table_sha256``:
     a record of the versions between the two, or one whose ``table_shape`` was removed by
@@ -218,11 +222,12 @@ def sum_problem(path: str | Path) -> str | None:
         if (rec := read_record(root)) is None:
             continue
         sums = rec.get("table_sha256")
-        if sums is None and SHAPE_KEY not in rec and "files" in rec and _this_code(rec):
-            return (  # sealed by this code (files, both written by sim.mc.publish.seal): an
-                # older version's record is so, one of this code's was edited (read unchecked)
-                "its run record holds neither table_sha256 nor table_shape, which this "
-                "version's runs record (removed by hand?)"
+        if (lost := _lost(rec)) and _this_code(rec):  # every one written by this code's
+            # sim.mc.publish.seal: an older version's record may lack them, one of this code's
+            # was edited (read unchecked: table_shape and table_sha256 made null, or removed
+            # with files, which told an older version's record apart)
+            return (
+                f"its run record holds {lost}, which this version's runs record (removed by hand?)"
             )
         want = sums.get(key) if isinstance(sums, dict) else None
         if not isinstance(want, str):
@@ -235,6 +240,16 @@ def sum_problem(path: str | Path) -> str | None:
             return "its sha256 is not the one its run recorded, which holds no shape of it"
         return None
     return None
+
+
+def _lost(rec: dict) -> str | None:
+    """``"neither table_sha256 nor table_shape"`` (``", nor files"``) when ``rec`` holds
+    neither a table's sha256 nor its shape (removed, or made null), else None: with one of
+    them its tables are checked (a record of the versions between the two has no shape)."""
+    lost = [k for k, t in _SEALED if not isinstance(rec.get(k), t)]
+    if lost[:2] != ["table_sha256", SHAPE_KEY]:
+        return None
+    return "neither table_sha256 nor table_shape" + (", nor files" if len(lost) > 2 else "")
 
 
 def _this_code(rec: dict) -> bool:

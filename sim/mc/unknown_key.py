@@ -16,7 +16,7 @@ from sim.mc.lookalike import looks
 from sim.mc.message_text import near_keys
 from sim.mc.toml_slips import TYPOGRAPHIC
 
-__all__ = ["did_you_mean", "unknown_key_hint"]
+__all__ = ["did_you_mean", "item_hint", "unknown_key_hint"]
 
 
 def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:

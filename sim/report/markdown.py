@@ -7,6 +7,7 @@ Markdown. Nothing here runs a simulation.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Callable
 
@@ -15,6 +16,7 @@ import pyarrow as pa
 from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
 from sim.claims.rules import NOT_APPLICABLE, P_FAIL, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
+from sim.mc.export_edits import changed_exports
 from sim.mc.outputs import results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.settle import reread
@@ -397,6 +399,12 @@ def _settled(results: Path, build: Callable):
     return reread(build, lambda: _dirs(results), last_stands=True)
 
 
+def _kept(what: str) -> str:
+    """The words of a results directory's README.md kept by ``sim report`` as the user's."""
+    kind = f"was {what}" if what.startswith("changed") else f"is {what}"
+    return f"{kind}: kept as yours, not rebuilt (move it away for the run's)"
+
+
 def write_report(
     results: Path, get_study: Callable, design: Callable | None = None, studies=()
 ) -> Path:
@@ -422,6 +430,8 @@ def write_report(
         check_sweep_record(d, "--results")  # its README.md from a table it cannot check
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             _settled(results, lambda d=d: write_run_readme(d, get_study, design=design))
+            if (what := changed_exports(d).get("README.md")) is not None:  # kept: said
+                print(f"sim: note: {d / 'README.md'} {_kept(what)}", file=sys.stderr)
     if _dirs(results) != read:  # a run published while the READMEs were written: REPORT.md
         text = _settled(results, build)  # held the replaced run's claims beside the new run
     with atomic_path(out) as tmp:

@@ -7,6 +7,7 @@ A directory is a study run (``claims.parquet``) or a ``[sweep]`` run (``sweep.pa
 
 from __future__ import annotations
 
+import hashlib
 import math
 import shlex
 from collections import Counter
@@ -19,6 +20,7 @@ import pyarrow.parquet as pq
 
 from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
 from sim.mc.config import ConfigError
+from sim.mc.export_edits import README_KEY
 from sim.mc.file_kind import odd_table
 from sim.mc.storage import atomic_path, read_provenance, read_record, write_record
 from sim.mc.table_shape import kind
@@ -358,19 +360,29 @@ def _relink(body: str, name: str) -> str:
 
 #: the first line of every README.md the suite writes in a results directory: a README.md
 #: without it is the user's, and is never replaced
-README_MARK = "<!-- written by sim from this directory's Parquet files; edits are overwritten -->"
+README_MARK = (
+    "<!-- written by sim from this directory's Parquet files; edited, it is yours: kept, "
+    "and a run into the directory refused -->"
+)
+#: the mark of the versions that replaced an edited README.md ("edits are overwritten")
+_OLD_MARKS = ("<!-- written by sim from this directory's Parquet files; edits are overwritten -->",)
 
 
 def _ours(path: Path) -> bool:
-    """True for a README.md the suite wrote (its mark on the first line)."""
+    """True for a README.md the suite wrote (its mark on the first line) and has not been
+    edited since (its sha256 the one its directory's run record holds, where it holds one:
+    :mod:`sim.mc.export_edits`)."""
     if not path.is_file():  # a FIFO put in its place blocked sim report and a re-run: a
         return False  # user's file, never opened (as markdown._ours keeps REPORT.md's)
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
             # the mark behind an editor's UTF-8 signature (Notepad's) is the mark: such a
             # README was the user's, never rebuilt and left stale without a word
-            return f.readline().removeprefix("\ufeff").rstrip("\n") == README_MARK
-    except OSError:
+            if f.readline().removeprefix("\ufeff").rstrip("\n") not in (README_MARK, *_OLD_MARKS):
+                return False
+        want = (read_record(path.parent) or {}).get(README_KEY)
+        return not isinstance(want, str) or hashlib.sha256(path.read_bytes()).hexdigest() == want
+    except (OSError, ValueError):
         return False
 
 
@@ -406,7 +418,10 @@ def write_run_readme(
     text = README_MARK + "\n" + run_markdown(out, get_study, name, design, final)
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
-    rec = read_record(out)
-    if rec is not None and isinstance(rec.get("files"), list) and "README.md" not in rec["files"]:
-        write_record(out, {**rec, "files": sorted([*rec["files"], "README.md"])})
+    rec = read_record(out)  # its sha256: one edited by hand is the user's (kept, named)
+    if rec is not None and isinstance(rec.get("files"), list):
+        digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
+        new = {**rec, "files": sorted({*rec["files"], "README.md"}), README_KEY: digest}
+        if new != rec:
+            write_record(out, new)
     return path

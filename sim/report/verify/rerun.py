@@ -277,7 +277,7 @@ def verify(
     for d, study in todo:
         target = scratch / d.name
         # tables of two runs (...), another study's results (copied): no reproduction to check
-        mixed = _not_as_written(d) or other_source(d, d.name)  # a committed study's name
+        mixed = _not_as_written(d) or other_source(d, d.name, studies=Path(studies))
         if mixed:
             out.append(Comparison(d.name, failures=[mixed]))
             continue
