@@ -6,6 +6,11 @@ merges), one case each; each failed on the code before its fix.
   file listed after them was "a pattern that matched no file" (and more than 2,000 matches
   were "more than 2000 namess"). The directory is read up to 200,000 entries
   (:func:`sim.mc.study_file._matches`).
+* A study file's name mistyped in a directory whose own name holds ``[`` (``run[1]/stdy.toml``,
+  a directory of that very name): R50 took every path with ``[`` in its folders for a pattern
+  of folders, "a pattern, not a study file", where it is a file that is not there (and
+  ``'run[1]/*.toml'`` was not counted). An existing directory is read as itself: "no such
+  study file (did you mean run[1]/study.toml?)".
 """
 
 from __future__ import annotations
@@ -42,3 +47,14 @@ def test_a_pattern_matching_a_file_listed_after_2000_others_is_named_as_matching
     assert "it matches 1 file," in said and "matched no file" not in said
     said = study_file.study_file_problem(tmp_path / "*.txt")
     assert "it matches more than 2000 files," in said
+
+
+def test_a_mistyped_name_in_a_directory_named_with_brackets_is_no_pattern(tmp_path):
+    """Bad input: ``run[1]/stdy.toml`` for ``run[1]/study.toml``. Before: "a pattern, not a
+    study file (which the shell did not expand ...)", without the near name."""
+    d = tmp_path / "run[1]"
+    d.mkdir()
+    (d / "study.toml").write_text('study = "brown_table1"\n')
+    said = study_file.study_file_problem(d / "stdy.toml")
+    assert "no such study file" in said and "study.toml?" in said and "pattern" not in said
+    assert "it matches 1 file," in study_file.study_file_problem(d / "*.toml")

@@ -147,6 +147,13 @@ _LOOKED = 2000
 _SCANNED = 200_000
 
 
+def _wild(d: Path) -> bool:
+    """Whether the directory part ``d`` of a study file's path is a pattern: it holds ``*``,
+    ``?`` or ``[`` and names no directory (``run[1]/``, a directory of that very name, is
+    read as itself: a name mistyped in it was "a pattern, not a study file")."""
+    return any(c in str(d) for c in "*?[") and not d.is_dir()
+
+
 def _matches(p: Path) -> int | None:
     """How many files the pattern ``p`` matches (over :data:`_LOOKED`: ``_LOOKED + 1``),
     looking in one directory only, the pattern's own, as the shell would (a name that starts
@@ -156,7 +163,7 @@ def _matches(p: Path) -> int | None:
     directory's entries are read up to :data:`_SCANNED`, not its first :data:`_LOOKED` only: a
     study file listed after them (``'runs/*.toml'`` in a directory of 3,000 outputs) was "a
     pattern that matched no file"."""
-    if any(c in str(p.parent) for c in "*?["):
+    if _wild(p.parent):
         return None
     n, hidden = 0, p.name.startswith(".")
     try:
@@ -185,7 +192,7 @@ def study_file_problem(p: str | Path) -> str | None:
     if not p.is_file():
         if why := link_problem(p):  # a link loop was "no such study file", of a name there
             return f"{p}: {why}"
-        if any(c in str(p) for c in "*?["):
+        if any(c in p.name for c in "*?[") or _wild(p.parent):
             hits = _matches(p)  # quoted, the shell passed on a pattern of files
             if hits is None:  # a pattern of folders: not walked
                 return (
