@@ -140,22 +140,39 @@ def _names_a_study(p: Path) -> bool:
     return re.search(rb"(?m)^[ \t]*study[ \t]*=", head) is not None
 
 
-#: the most names a pattern given as a study file is matched against (a directory's entries)
+#: the most files a pattern given as a study file is counted matching (more: "more than")
 _LOOKED = 2000
+#: the most entries of the pattern's directory read (a directory of a million files is not
+#: read whole before a one-line refusal)
+_SCANNED = 200_000
+
+
+def _wild(d: Path) -> bool:
+    """Whether the directory part ``d`` of a study file's path is a pattern: it holds ``*``,
+    ``?`` or ``[`` and names no directory (``run[1]/``, a directory of that very name, is
+    read as itself: a name mistyped in it was "a pattern, not a study file")."""
+    return any(c in str(d) for c in "*?[") and not d.is_dir()
 
 
 def _matches(p: Path) -> int | None:
     """How many files the pattern ``p`` matches (over :data:`_LOOKED`: ``_LOOKED + 1``),
-    looking in one directory only, the pattern's own; None for a pattern in its folders
+    looking in one directory only, the pattern's own, as the shell would (a name that starts
+    with ``.`` only for a pattern that does); None for a pattern in its folders
     (``'*/x.toml'``), which is not walked: ``glob`` of ``'/*/*/*/*/*/*/*/*/*.toml'`` walked
-    the whole disk, /proc too, and ``sim check`` ran for minutes before its one line."""
-    if any(c in str(p.parent) for c in "*?["):
+    the whole disk, /proc too, and ``sim check`` ran for minutes before its one line. The
+    directory's entries are read up to :data:`_SCANNED`, not its first :data:`_LOOKED` only: a
+    study file listed after them (``'runs/*.toml'`` in a directory of 3,000 outputs) was "a
+    pattern that matched no file"."""
+    if _wild(p.parent):
         return None
-    n = 0
+    n, hidden = 0, p.name.startswith(".")
     try:
         with os.scandir(p.parent) as it:
-            for e in itertools.islice(it, _LOOKED + 1):
-                n += fnmatch.fnmatchcase(e.name, p.name) and not e.name.startswith(".")
+            for e in itertools.islice(it, _SCANNED):
+                if fnmatch.fnmatchcase(e.name, p.name) and (hidden or e.name[0] != "."):
+                    n += 1
+                    if n > _LOOKED:
+                        break
     except OSError:
         return 0
     return n
@@ -175,7 +192,7 @@ def study_file_problem(p: str | Path) -> str | None:
     if not p.is_file():
         if why := link_problem(p):  # a link loop was "no such study file", of a name there
             return f"{p}: {why}"
-        if any(c in str(p) for c in "*?["):
+        if any(c in p.name for c in "*?[") or _wild(p.parent):
             hits = _matches(p)  # quoted, the shell passed on a pattern of files
             if hits is None:  # a pattern of folders: not walked
                 return (
@@ -183,9 +200,10 @@ def study_file_problem(p: str | Path) -> str | None:
                     "it unquoted, or name the files)"
                 )
             if hits:
-                many = f"more than {_LOOKED} names" if hits > _LOOKED else f"{hits} file"
+                many = f"more than {_LOOKED}" if hits > _LOOKED else str(hits)
                 return (
-                    f"{p}: a pattern, not a study file (it matches {many}{'s' * (hits > 1)}, "
+                    f"{p}: a pattern, not a study file (it matches {many} file"
+                    f"{'s' * (hits > 1)}, "
                     "which the shell did not expand: leave it unquoted, or name the files)"
                 )
             return (
