@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.mc.config import ConfigError, StudyError
-from sim.studies.network.analysis import in_datum, match_points
+from sim.studies.network.analysis import check_inner, in_datum, inner_defect, match_points
 from sim.studies.network.definition import Network
 from sim.studies.network.model import datum
 from sim.studies.network.rank_defect import refuse_defect
@@ -20,7 +20,9 @@ __all__ = ["check_compare", "compare_points", "dilution", "held_by"]
 
 
 def check_compare(net, full: dict, fix: list, sparse: bool) -> None:
-    """``compare.fix``: the compared datum leaves something to estimate and covers the defects."""
+    """``compare.fix``: the compared datum leaves something to estimate and covers the defects,
+    and, where the dilution is stated in the inner datum over its points (:func:`held_by`),
+    those points can hold that datum (not one point against a rotation)."""
     extra = match_points(net, "compare.fix", fix)
     if all(net.role[e] == 1 for e in extra):
         raise ConfigError("compare.fix", "names only fixed points: the compared datum is this one")
@@ -31,6 +33,17 @@ def check_compare(net, full: dict, fix: list, sparse: bool) -> None:
         raise ConfigError("compare.fix", f"{an2.factor.message} in the compared datum")
     if not an2.ok:
         refuse_defect(net, datum(net, full, tuple(extra)), "compare.fix")
+    if not held_by(net, datum(net, full), extra):
+        # the dilution moves the study's sigmas to the inner datum over these points: one
+        # point against a rotation printed +25 % to +251 % from a singular S-transformation
+        try:
+            check_inner(net, inner_defect(net), extra, "compare.fix")
+        except ConfigError as e:
+            raise ConfigError(
+                "compare.fix",
+                f"{str(e)[len(e.key) + 2 :]} (the study's datum is not one that holding them "
+                "holds, so the dilution compares both in the inner datum over them)",
+            ) from None
 
 
 def compare_points(net: Network, cfg: dict) -> list[int]:

@@ -1,0 +1,55 @@
+"""Helper n51: the network kind's keys in combination.
+
+Combinations a designer would try (a free datum with fixed points too, constraints on fixed
+points, grid patterns matching no point, ``--set`` on a grid list's element, directions
+without a distance, distances alone under a free datum, a network in two unconnected parts,
+a point observed once, observations only between fixed points, estimated constant or scale
+without the observations that determine them, a sweep over ``compare.fix``); one case per
+class found, each failing on the code before its fix.
+
+* ``compare.fix`` naming one point of a network whose datum it does not hold (an inner
+  datum, or constraints on other points): the dilution moves the study's sigmas into the
+  inner datum over the ``compare.fix`` points by S-transformation, and one point cannot hold
+  a rotation: the transformation's ``H' W H`` was singular to rounding and ``np.linalg.solve``
+  gave numbers anyway: the run printed dilutions of +25 % to +251 % and a finding "largest
+  dilution 251 %", exit 0 (``output.inner_over`` over the same point was refused). Refused
+  now by ``sim check``, naming ``compare.fix`` and the defects the points cannot hold.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from oneline import SIM_ERROR, one_line
+
+from sim.cli import main
+
+FIVE = """study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0 }, { name = "B", x_mm = 1000.0, y_mm = 0.0 },
+           { name = "C", x_mm = 400.0, y_mm = 700.0 }, { name = "D", x_mm = 900.0, y_mm = 800.0 },
+           { name = "E", x_mm = 500.0, y_mm = -600.0 } ]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
+[datum]
+kind = "inner"
+"""
+
+
+def _study(tmp_path: Path, text: str, name: str = "net") -> str:
+    p = tmp_path / f"{name}.toml"
+    p.write_text(text)
+    return str(p)
+
+
+def test_compare_fix_of_one_point_against_an_inner_datum_is_refused(tmp_path, capsys):
+    """A compared parameterisation whose points cannot hold the study's datum (one point
+    against a rotation, the study's datum inner): its dilution was an S-transformation
+    through a singular matrix, +251 % printed as a finding, exit 0; two points hold it."""
+    two = _study(tmp_path, FIVE + '[compare]\nfix = ["A", "B"]\n', "two")
+    assert main(["check", two]) == 0
+    capsys.readouterr()
+    one = _study(tmp_path, FIVE + '[compare]\nfix = ["A"]\n', "one")
+    line = one_line(capsys, main(["check", one]), "compare.fix", prefix=SIM_ERROR)
+    assert "the points A cannot fix" in line and "a rotation" in line, line
