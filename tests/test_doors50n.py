@@ -14,6 +14,11 @@ class found, each failing on the code before its fix.
   gave numbers anyway: the run printed dilutions of +25 % to +251 % and a finding "largest
   dilution 251 %", exit 0 (``output.inner_over`` over the same point was refused). Refused
   now by ``sim check``, naming ``compare.fix`` and the defects the points cannot hold.
+* Distances alone about one fixed point (the rotation undetermined), directions alone about
+  one (rotation and scale): refused as "a rank defect of 1 (6 unknowns, rank 5) that the
+  datum (0 constraints) does not cover", which motion left to the user to guess; the line now
+  says it ("a rotation about the fixed points", "a rotation and a scale ...") where the
+  defect is the datum's motions and no constraint is given.
 """
 
 from __future__ import annotations
@@ -53,3 +58,15 @@ def test_compare_fix_of_one_point_against_an_inner_datum_is_refused(tmp_path, ca
     one = _study(tmp_path, FIVE + '[compare]\nfix = ["A"]\n', "one")
     line = one_line(capsys, main(["check", one]), "compare.fix", prefix=SIM_ERROR)
     assert "the points A cannot fix" in line and "a rotation" in line, line
+
+
+def test_a_rank_defect_of_the_fixed_datum_says_which_motion_is_left(tmp_path, capsys):
+    """Distances alone and one fixed point: the rotation about it is undetermined; the
+    refusal gave the defect's size alone (1), not which motion of the network it is."""
+    text = FIVE.replace(
+        '"A", x_mm = 0.0, y_mm = 0.0 }', '"A", x_mm = 0.0, y_mm = 0.0, role = "fixed" }'
+    )
+    text = text.replace('kind = "inner"', 'kind = "fixed"')
+    line = one_line(capsys, main(["check", _study(tmp_path, text)]), prefix=SIM_ERROR)
+    assert line.startswith(SIM_ERROR + "datum.kind: the network has a rank defect of 1"), line
+    assert "a rotation about the fixed points" in line, line

@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from sim.mc.config import ConfigError
-from sim.studies.network.model import computed, defect_basis
+from sim.studies.network.analysis import defect_words, held_defect
+from sim.studies.network.model import computed
 from sim.studies.network.weights import covered, equilibrated, refuse_weights
 
 __all__ = ["refuse_defect"]
@@ -62,10 +63,14 @@ def refuse_defect(net, dt, key: str, kind: str = "fixed") -> None:
     if sv.size and rank < len(free):
         _parameters(net, A, free, rank)
     advice = _DEFECT_ADVICE.get(kind, _DEFECT_ADVICE["fixed"])
-    if len(free) - rank > defect_basis(net, free).shape[1]:  # more than a datum can hold
+    H = held_defect(net, free)
+    if len(free) - rank > H.shape[1]:  # more than a datum can hold
         advice = _DEFECT_ADVICE["inner"]  # (inner or constraints: the same refusal again)
+    # a datum's motions alone and no constraint: say which (distances alone about one fixed
+    # point leave its rotation; it said "a rank defect of 1" and left the user to guess)
+    what = f": {defect_words(H, net.role)}" if C is None and len(free) - rank == H.shape[1] else ""
     raise ConfigError(
         key,
         f"the network has a rank defect of {len(free) - rank} ({len(free)} "
-        f"unknowns, rank {rank}) that the datum ({c} constraints) does not cover: " + advice,
+        f"unknowns, rank {rank}{what}) that the datum ({c} constraints) does not cover: " + advice,
     )
