@@ -14,6 +14,11 @@ class found, each failing on the code before its fix.
   gave numbers anyway: the run printed dilutions of +25 % to +251 % and a finding "largest
   dilution 251 %", exit 0 (``output.inner_over`` over the same point was refused). Refused
   now by ``sim check``, naming ``compare.fix`` and the defects the points cannot hold.
+  With a fixed point in the network (one fixed, an inner datum over the others, one point
+  compared) the transformation removed a free network's translations too, which the fixed
+  point already holds: singular again, a dilution of -8 % printed (holding a point made
+  another less precise). It removes the defects the fixed points leave now (the rotation
+  about the fixed point), and every dilution is at least 0.
 * Distances alone about one fixed point (the rotation undetermined), directions alone about
   one (rotation and scale): refused as "a rank defect of 1 (6 unknowns, rank 5) that the
   datum (0 constraints) does not cover", which motion left to the user to guess; the line now
@@ -25,9 +30,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 from oneline import SIM_ERROR, one_line
 
+import sim
 from sim.cli import main
+from sim.studies.network.analysis import estimated_points
+from sim.studies.network.compare import dilution
+from sim.studies.network.definition import build
+from sim.studies.network.gama import merge_gama
+from sim.studies.network.model import datum
+from sim.studies.network.sparse_analysis import pre_analysis
 
 FIVE = """study = "network"
 trials = 40
@@ -70,3 +83,34 @@ def test_a_rank_defect_of_the_fixed_datum_says_which_motion_is_left(tmp_path, ca
     line = one_line(capsys, main(["check", _study(tmp_path, text)]), prefix=SIM_ERROR)
     assert line.startswith(SIM_ERROR + "datum.kind: the network has a rank defect of 1"), line
     assert "a rotation about the fixed points" in line, line
+
+
+def _dilution(path: str):
+    cfg = sim.load(path).config
+    full = merge_gama(cfg)
+    net = build(full)
+    an = pre_analysis(net, datum(net, full), 0.001, 0.8)
+    pts = estimated_points(net, an)
+    return [net.names[p] for p in pts], dilution(net, an, full, cfg, pts)
+
+
+def test_compare_fix_of_one_point_about_a_fixed_point_is_the_held_datum_s(tmp_path):
+    """One fixed point A, an inner datum over the others, B compared: the dilution's
+    S-transformation removed translations A holds (singular: C +25 %, and -8 % in a
+    gama-local file's network). It is now the dilution of the datum that holding B holds
+    about A, B's rotation about A (B.y = 0: B lies on A's x axis), written out as that
+    minimal constraint."""
+    text = FIVE.replace(
+        '"A", x_mm = 0.0, y_mm = 0.0 }', '"A", x_mm = 0.0, y_mm = 0.0, role = "fixed" }'
+    )
+    text = text.replace(
+        "generate = [",
+        'generate = [ { kind = "direction", from = "*", to = "*", sigma_arcsec = 1.0 },',
+    )
+    cmp = '[compare]\nfix = ["B"]\n'
+    names, inner = _dilution(_study(tmp_path, text + cmp, "inner"))
+    held = text.replace('kind = "inner"', 'kind = "constraints"\nconstraints = [ { "B.y" = 1.0 } ]')
+    names2, ref = _dilution(_study(tmp_path, held + cmp, "held"))
+    assert names == ["B", "C", "D", "E"] and names2 == ["C", "D", "E"], (names, names2)
+    np.testing.assert_allclose(inner[1:], ref, rtol=1e-6)
+    assert min(ref) >= 0 and max(ref) > 0.01, ref

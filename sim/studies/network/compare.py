@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.mc.config import ConfigError, StudyError
-from sim.studies.network.analysis import check_inner, in_datum, inner_defect, match_points
+from sim.studies.network.analysis import check_inner, held_defect, in_datum, match_points
 from sim.studies.network.definition import Network
 from sim.studies.network.model import datum
 from sim.studies.network.rank_defect import refuse_defect
@@ -33,11 +33,12 @@ def check_compare(net, full: dict, fix: list, sparse: bool) -> None:
         raise ConfigError("compare.fix", f"{an2.factor.message} in the compared datum")
     if not an2.ok:
         refuse_defect(net, datum(net, full, tuple(extra)), "compare.fix")
-    if not held_by(net, datum(net, full), extra):
+    dt = datum(net, full)
+    if not held_by(net, dt, extra):
         # the dilution moves the study's sigmas to the inner datum over these points: one
         # point against a rotation printed +25 % to +251 % from a singular S-transformation
         try:
-            check_inner(net, inner_defect(net), extra, "compare.fix")
+            check_inner(net, held_defect(net, dt.free_index(net.q)), extra, "compare.fix")
         except ConfigError as e:
             raise ConfigError(
                 "compare.fix",
@@ -68,8 +69,14 @@ def dilution(net: Network, an, full: dict, cfg: dict, pts: list[int]) -> np.ndar
         if not an2.ok:
             raise StudyError("compare.fix: the compared parameterisation is singular")
         cov = an.cov
-        if not held_by(net, datum(net, full), extra):
-            cov = in_datum_sparse(net, an, extra) if an.Q is None else in_datum(net, an, extra)
+        dt = datum(net, full)
+        if not held_by(net, dt, extra):
+            # the defects the study's fixed points leave (one fixed point: the rotation about
+            # it), not a free network's: its translations over one compared point were singular
+            H = held_defect(net, dt.free_index(net.q))
+            cov = (
+                in_datum_sparse(net, an, extra, H) if an.Q is None else in_datum(net, an, extra, H)
+            )
         s1, s2 = _rms_sigma(cov[pts]), _rms_sigma(an2.cov[pts])
         with np.errstate(divide="ignore", invalid="ignore"):
             dil = np.where(s2 > 0, 100 * (s1 / s2 - 1), np.nan)
