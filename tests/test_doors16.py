@@ -6,7 +6,7 @@ before its fix.
   (``network.generate = []`` in ``studies/network_testfield.toml``) ended in NumPy's
   "zero-size array to reduction operation minimum" (the API's ``ValueError``, the command
   line's "sim: error: ValueError: ..." naming no key): the reduced SVD of a wide matrix
-  holds no null space (:func:`sim.studies.network.schema._parameters`);
+  holds no null space (:func:`sim.studies.network.rank_defect._parameters`);
 * Wolf's ``table1.file``/``table3.file`` naming a file too long for the file system raised
   pathlib's ``OSError`` from ``sim.load`` (the command line's line named no key), and one
   holding a line break gave a two-line ``ConfigError`` (:mod:`sim.studies.wolf.tables`); so did

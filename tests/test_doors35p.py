@@ -157,9 +157,9 @@ fix = ["A", "B"]
 
 
 def test_a_dilution_compares_sigmas_of_one_datum(tmp_path):
+    from sim.studies.network.compare import held_by as _held_by
     from sim.studies.network.definition import build
     from sim.studies.network.model import datum
-    from sim.studies.network.run import _held_by
 
     f = tmp_path / "free.toml"
     f.write_text(FREE)

@@ -222,11 +222,14 @@ def defect_words(H: np.ndarray, role: np.ndarray | None = None) -> str:
     return f"{d} motions of the whole network"
 
 
-def in_datum(net: Network, an: Analytic, points: list[int]) -> np.ndarray:
+def in_datum(
+    net: Network, an: Analytic, points: list[int], H: np.ndarray | None = None
+) -> np.ndarray:
     """Point covariances ``(n, 2, 2)`` stated in the inner-constraint datum over ``points``
     (S-transformation removing every defect the network has: translation, rotation and, for
-    a network without a length, scale; as ``gama-local``'s ``adj="XY"``)."""
-    H = inner_defect(net)
+    a network without a length, scale; as ``gama-local``'s ``adj="XY"``; or the defects
+    ``H`` only, ``(2n, d)``: those its fixed points leave, :func:`held_defect`)."""
+    H = inner_defect(net) if H is None else H
     full = point_cov_in(net, an.free, an.Q)
     if H.shape[1]:
         full = s_transform(full, s_matrix(H, datum_weights(net, points)))

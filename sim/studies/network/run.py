@@ -13,17 +13,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from sim.mc.config import StudyError
 from sim.mc.progress import phase
 from sim.mc.runner import run_chunks
 from sim.mc.storage import provenance
 from sim.report.plotting import draw
-from sim.studies.network.analysis import ellipse, estimated_points, in_datum
+from sim.studies.network.analysis import ellipse, estimated_points
 from sim.studies.network.bias_checks import bias_effect
 from sim.studies.network.claims import design_figures, network_claims
-from sim.studies.network.definition import Network, build
+from sim.studies.network.compare import dilution
+from sim.studies.network.definition import build
 from sim.studies.network.estimates import TOO_FEW, mc_estimates
 from sim.studies.network.figures import network_figure, reliability_figure
 from sim.studies.network.gama import export, import_note, merge_gama
@@ -31,7 +30,6 @@ from sim.studies.network.model import datum
 from sim.studies.network.probe import chunk_fn, not_converged
 from sim.studies.network.rounding import check_rounding
 from sim.studies.network.sparse_analysis import (
-    in_datum_sparse,
     pre_analysis,
     shows_phases,
     shows_phases_of,
@@ -44,51 +42,8 @@ from sim.studies.network.tables import (
     write_points,
     write_summary,
 )
-from sim.studies.network.validate import name_index, select
 
-__all__ = ["run", "compare_points"]
-
-
-def compare_points(net: Network, cfg: dict) -> list[int]:
-    """The points ``compare.fix`` names (patterns), each once, in the order named."""
-    return select("compare.fix", cfg["compare.fix"], net.names, name_index(net.names))
-
-
-def _rms_sigma(cov: np.ndarray) -> np.ndarray:
-    return np.sqrt((cov[:, 0, 0] + cov[:, 1, 1]) / 2)
-
-
-def _dilution(net: Network, an, full: dict, cfg: dict, pts: list[int]) -> np.ndarray:
-    """Per point, how much larger (%) its rms sigma is than with the ``compare.fix`` points
-    known as well (NaN without ``compare.fix`` or where the compared sigma is 0). Both sigmas
-    are in a datum that holding those points holds: the study's own when its constraints touch
-    only their coordinates (``fixed``; Brown's x1 = x3 = 0, y4 = -y2 against the stations
-    known), else the inner datum over them (S-transformation: :func:`_held_by`)."""
-    dil = np.full(len(pts), np.nan)
-    extra = compare_points(net, cfg)
-    if extra:
-        an2 = pre_analysis(net, datum(net, full, tuple(extra)), 0.001, 0.8)
-        if not an2.ok:
-            raise StudyError("compare.fix: the compared parameterisation is singular")
-        cov = an.cov
-        if not _held_by(net, datum(net, full), extra):
-            cov = in_datum_sparse(net, an, extra) if an.Q is None else in_datum(net, an, extra)
-        s1, s2 = _rms_sigma(cov[pts]), _rms_sigma(an2.cov[pts])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            dil = np.where(s2 > 0, 100 * (s1 / s2 - 1), np.nan)
-    return dil
-
-
-def _held_by(net: Network, dt, extra: list[int]) -> bool:
-    """Whether the ``extra`` points known hold the datum ``dt`` too (every constraint touches
-    only their coordinates): else its sigmas are of another datum than the compared ones, and
-    their ratio no dilution (an inner datum over every point against two of them known: the
-    other points' sigmas -45 % "diluted", the smaller in the inner datum)."""
-    C = dt.constraint_matrix(net.theta_true()[None])
-    if C is None:
-        return True
-    g = dt.free_index(net.q)[np.abs(C[0]).sum(1) > 0]
-    return bool(np.all((g < 2 * net.n) & np.isin(g // 2, extra)))
+__all__ = ["run"]
 
 
 def _mc(net, an, C, pts, cfg, ctx):
@@ -128,7 +83,7 @@ def run(cfg: dict, out: Path, ctx) -> None:
 
 def _outputs(out, cfg, full, net, an, dt, C, pts, held, sim, est, prov) -> None:
     """The compared parameterisation, the tables, the claims, the export and the figures."""
-    dil = _dilution(net, an, full, cfg, pts)
+    dil = dilution(net, an, full, cfg, pts)
     write_points(out, net, an, pts, est, dil, prov)
     write_parameters(out, net, an, sim, est.n_ok, prov)
     write_datums(out, net, an, cfg, prov)

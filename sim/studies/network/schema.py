@@ -27,11 +27,13 @@ from sim.studies.network.analysis import (
     match_points,
 )
 from sim.studies.network.canonical import canonical
+from sim.studies.network.compare import check_compare
 from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.keys import SCHEMA
-from sim.studies.network.model import computed, datum, defect_basis, use_sparse
+from sim.studies.network.model import datum, defect_basis, use_sparse
 from sim.studies.network.probe import probe_solver
+from sim.studies.network.rank_defect import refuse_defect
 from sim.studies.network.rounding import check_rounding
 from sim.studies.network.singular import (
     loose_part,
@@ -47,26 +49,12 @@ from sim.studies.network.sparse_analysis import (
     variances,
 )
 from sim.studies.network.validate import fits_estimate
-from sim.studies.network.weights import covered, equilibrated, refuse_weights, unknown
+from sim.studies.network.weights import unknown
 
 __all__ = ["SCHEMA", "check", "unread"]
 
 #: bytes of one chunk's dense Jacobians above which a configuration is refused
 MAX_CHUNK_BYTES = 2 * 1024**3
-
-
-def _check_compare(net, full: dict, fix: list, sparse: bool) -> None:
-    """``compare.fix``: the compared datum leaves something to estimate and covers the defects."""
-    extra = match_points(net, "compare.fix", fix)
-    if all(net.role[e] == 1 for e in extra):
-        raise ConfigError("compare.fix", "names only fixed points: the compared datum is this one")
-    if set(np.flatnonzero(net.role != 1)) <= set(extra):
-        raise ConfigError("compare.fix", "fixes every estimated point: nothing to compare")
-    an2 = pre_analysis(net, datum(net, full, tuple(extra)), 0.001, 0.8)
-    if not an2.ok and sparse:
-        raise ConfigError("compare.fix", f"{an2.factor.message} in the compared datum")
-    if not an2.ok:
-        _defect(net, datum(net, full, tuple(extra)), "compare.fix")
 
 
 def _build(full: dict):
@@ -152,7 +140,7 @@ def check(cfg: dict) -> None:
     with phase(f"network: the solver probe ({PROBE_TRIALS} trials of its own)", show):
         probe_solver(net, an, dt.constraint_matrix(net.theta_true()[None]), pts, cfg)
     if cfg["compare.fix"]:
-        _check_compare(net, full, cfg["compare.fix"], sparse)
+        check_compare(net, full, cfg["compare.fix"], sparse)
     if cfg["output.inner_over"]:
         pts = match_points(net, "output.inner_over", cfg["output.inner_over"])
         check_inner(net, inner_defect(net), pts, "output.inner_over")
@@ -264,7 +252,7 @@ def _held(net, full: dict, dt, sparse: bool, asked: frozenset | set = frozenset(
             raise ConfigError("datum.kind", f"{what}{': ' + cause if cause else ''}: {fix}")
         # explicit constraints that leave a defect (one of coefficient 1e-300, say) are theirs
         kind = full["datum.kind"]
-        _defect(net, dt, "datum.constraints" if kind == "constraints" else "datum.kind", kind)
+        refuse_defect(net, dt, "datum.constraints" if kind == "constraints" else "datum.kind", kind)
     check_rounding(net, an.cov, estimated_points(net, an))
     return an
 
@@ -391,59 +379,4 @@ def _pivot(net, factor, free: np.ndarray) -> str:
     return (
         f"{unknown(net, int(free[factor.weak]))} is nearly undetermined (the smallest pivot "
         "of the normals falls on it; points nearly on one line, or too few observations)"
-    )
-
-
-def _parameters(net, A: np.ndarray, free: np.ndarray, rank: int) -> None:
-    """A rank defect among the distances' constant and scale (and orientations) alone, no
-    coordinate in it: no datum covers it, so name the keys that estimate them."""
-    _, _, vt = np.linalg.svd(A, full_matrices=False)
-    w = (vt[rank:] ** 2).sum(axis=0)
-    involved = free[w > 1e-6 * w.max()] if w.size else free[:0]
-    if not involved.size or involved.min() < 2 * net.n:
-        # coordinates move (a datum defect), or fewer observations than unknowns (the
-        # reduced SVD holds no null space to look at): the caller's message
-        return
-    names = [net.parameter_names()[g - 2 * net.n] for g in involved]
-    pairs = (("network.estimate_constant", net.i_constant), ("network.estimate_scale", net.i_scale))
-    keys = [k for k, g in pairs if g in involved]
-    raise ConfigError(
-        keys[0] if keys else "network.observations",
-        f"the {' and the '.join(names)} cannot be told apart by these observations (a rank "
-        f"defect of {len(free) - rank} among them, no coordinate in it: no datum covers it): "
-        + ("estimate fewer of them, or " if keys else "")
-        + "add observations of other lengths or directions",
-    )
-
-
-#: what to do about a rank defect the datum leaves, by datum kind (never the datum it has)
-_DEFECT_ADVICE = {
-    "fixed": "fix points, add observations, or use datum.kind = inner",
-    "constraints": "add constraints or observations, or use datum.kind = inner",
-    "inner": "add observations that tie every point to the rest, or fix points",
-}
-
-
-def _defect(net, dt, key: str, kind: str = "fixed") -> None:
-    free = dt.free_index(net.q)
-    _, J = computed(net, net.theta_true()[None], jac=True)
-    A = J[0][:, free] / net.sigma[:, None]
-    B = equilibrated(A)
-    sv = np.linalg.svd(B, compute_uv=False)
-    rank = int((sv > sv[0] * 1e-10).sum()) if sv.size else 0
-    if sv.size and rank == len(free):
-        refuse_weights(net, A, free, key)
-    C = dt.constraint_matrix(net.theta_true()[None])
-    c = 0 if C is None else C.shape[-1]
-    if sv.size and rank < len(free) and covered(B, None if C is None else C[0]):
-        refuse_weights(net, A, free, key, C[0])  # the datum holds the defect: the sigmas
-    if sv.size and rank < len(free):
-        _parameters(net, A, free, rank)
-    advice = _DEFECT_ADVICE.get(kind, _DEFECT_ADVICE["fixed"])
-    if len(free) - rank > defect_basis(net, free).shape[1]:  # more than a datum can hold
-        advice = _DEFECT_ADVICE["inner"]  # (inner or constraints: the same refusal again)
-    raise ConfigError(
-        key,
-        f"the network has a rank defect of {len(free) - rank} ({len(free)} "
-        f"unknowns, rank {rank}) that the datum ({c} constraints) does not cover: " + advice,
     )

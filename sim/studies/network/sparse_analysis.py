@@ -270,16 +270,19 @@ def variances(an: Analytic, idx: np.ndarray) -> np.ndarray:
     return an.Q[idx, idx]
 
 
-def in_datum_sparse(net: Network, an: SparseAnalytic, points: list[int]) -> np.ndarray:
+def in_datum_sparse(
+    net: Network, an: SparseAnalytic, points: list[int], H: np.ndarray | None = None
+) -> np.ndarray:
     """Point covariances ``(n, 2, 2)`` in the inner datum over ``points``, removing every
     defect the network has (:func:`sim.studies.network.analysis.inner_defect`: translation,
     rotation and, for a network without a length, scale; as the dense
     :func:`~sim.studies.network.analysis.in_datum`): ``S Q S'`` with
     ``S = I - H (H' W H)^-1 H' W`` as a low-rank correction of the selected entries (``d``
-    solves with the factor, no dense matrix)."""
+    solves with the factor, no dense matrix); or the defects ``H`` only (those the fixed
+    points leave, :func:`~sim.studies.network.analysis.held_defect`)."""
     f = an.factor
     Q0 = _point_blocks(net, _free_pos(net, an.free), f)
-    H = inner_defect(net)  # (2n, d)
+    H = inner_defect(net) if H is None else H  # (2n, d)
     if not H.shape[1]:
         return Q0
     V = H * datum_weights(net, points)[:, None]
