@@ -269,6 +269,19 @@ def _run_options_problem(run_args: list[str]) -> str | None:
     ``sim run`` reads them, abbreviations included): a bad option or value, an ``--out``
     (each study writes <results>/<file name>), or ``--help`` (each run would print its help
     and exit 0 without running)."""
+    why = _sim_run_problem(run_args)
+    own = [a for a in run_args if a.partition("=")[0] in BATCH_OPTIONS]
+    if why is not None and own:  # "unrecognized arguments: --jobs 2 (did you mean --workers?)"
+        return f"{own[0]} is an option of sim.batch, not of sim run: give it before --"
+    return why
+
+
+#: the batch's own options, which a hurried user puts among sim run's after ``--``
+BATCH_OPTIONS = ("-j", "--jobs", "--results", "--stale-only", "--report", "--timings")
+
+
+def _sim_run_problem(run_args: list[str]) -> str | None:
+    """Why ``sim run STUDY.toml RUN_ARGS`` refuses its options (:func:`_run_options_problem`)."""
     text = io.StringIO()
     try:
         with contextlib.redirect_stdout(text), contextlib.redirect_stderr(text):

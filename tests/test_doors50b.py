@@ -1,0 +1,48 @@
+"""The batch, verify and report doors used carelessly (doors50b, brief B51): each class through
+a real door; each test fails on the code before its fix:
+
+* the batch's own options put after ``--`` among sim run's (``-- -j 2``, ``-- --report``,
+  ``-- --stale-only``, ``-- --timings t.json``) were called "unrecognized arguments" with a
+  wrong guess ("did you mean --workers?", "--set?", "--trials?") or ``--results`` "an option of
+  sim report": each is named as the batch's own, to give before ``--``;
+* ``python -m sim.batch --report`` into a results directory whose ``REPORT.md`` is the user's
+  (a file of theirs, a directory, a link) ran every study, for hours overnight, and then
+  failed on the report (exit 2): refused before any run, one line naming it.
+"""
+
+from __future__ import annotations
+
+import pytest
+from conftest import TRIANGLE_NETWORK
+from oneline import one_line
+
+import sim.batch
+
+
+@pytest.mark.parametrize(
+    "own", [["-j", "2"], ["--jobs=2"], ["--report"], ["--stale-only"], ["--results=x"]]
+)
+def test_the_batchs_own_option_after_the_double_dash_is_named_as_its(capsys, tmp_path, own):
+    """Class: an option of the batch given among sim run's. Before: "unrecognized arguments:
+    -j 2 (did you mean --workers?)" (or --set?, or "an option of sim report")."""
+    st = tmp_path / "tri.toml"
+    st.write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    rc = sim.batch.main([str(st), "--results", str(tmp_path / "r"), "--", "--no-figures", *own])
+    line = one_line(capsys, rc, f"{own[0]} is an option of sim.batch, not of sim run")
+    assert "give it before --" in line and "did you mean" not in line
+    assert not (tmp_path / "r").exists()
+
+
+def test_a_batch_report_over_a_users_report_md_is_refused_before_the_runs(capsys, tmp_path):
+    """Class: ``--report`` into a results directory whose REPORT.md the suite did not write.
+    Before: every study ran (and published) and then sim report refused it, exit 2."""
+    st = tmp_path / "tri.toml"
+    st.write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    results = tmp_path / "r"
+    results.mkdir()
+    mine = results / "REPORT.md"
+    mine.write_text("# my notes\n", encoding="utf-8")
+    rc = sim.batch.main([str(st), "--results", str(results), "--report", "--", "--no-figures"])
+    one_line(capsys, rc, f"--report: {mine} was not written by sim report")
+    assert not (results / "tri").exists()  # nothing ran
+    assert mine.read_text(encoding="utf-8") == "# my notes\n"
