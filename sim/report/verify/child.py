@@ -17,6 +17,9 @@ from sim.report.verify.rules import VerifyError
 
 __all__ = ["launcher", "busy_words", "names_one_of", "system_error", "refusal"]
 
+#: how the re-run's error line begins
+_ERR = "sim: error: "
+
 
 def refusal(
     name: str, sf: Path, line: str, target: Path, overrides: list[str] | tuple, extra: list[str]
@@ -44,6 +47,14 @@ def refusal(
             f"the run's overrides no longer apply: the re-run of {sf} with them was refused "
             f"({line}): the study file or the code changed since the run (its results are "
             "stale: run it again), or its run.json was edited"
+        )
+    if os.strerror(errno.ENOENT) in line and re.match(r"sim: error: [^-\s][^:\s]*: ", line):
+        # a file the study file names (network.gama_xml) moved away: it was recorded as a
+        # failed reproduction ("FAILED; nothing compared: the re-run exited with 2", exit 1)
+        raise VerifyError(
+            f"{name}: a file its study file {sf} names is not here ({line.removeprefix(_ERR)}): "
+            "a relative path is read from the working directory; put it back, or run verify "
+            "where the run was made (nothing recorded)"
         )
     if extra or line.startswith("sim: error: --"):
         # the re-run refused the options verify passed (--trials, --set, --workers, the
