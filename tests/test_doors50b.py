@@ -2,9 +2,10 @@
 a real door; each test fails on the code before its fix:
 
 * the batch's own options put after ``--`` among sim run's (``-- -j 2``, ``-- --report``,
-  ``-- --stale-only``, ``-- --timings t.json``) were called "unrecognized arguments" with a
-  wrong guess ("did you mean --workers?", "--set?", "--trials?") or ``--results`` "an option of
-  sim report": each is named as the batch's own, to give before ``--``;
+  ``-- --stale-only``, ``-- --timings t.json``, a beginning ``--stale``) were called
+  "unrecognized arguments" with a wrong guess ("did you mean --workers?", "--set?", "--trials?",
+  for ``--job`` "a batch's output: give --results") or ``--results`` "an option of sim
+  report": each is named as the batch's own, to give before ``--``;
 * ``python -m sim.batch --report`` into a results directory whose ``REPORT.md`` is the user's
   (a file of theirs, a directory, a link) ran every study, for hours overnight, and then
   failed on the report (exit 2): refused before any run, one line naming it;
@@ -30,15 +31,25 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.mark.parametrize(
-    "own", [["-j", "2"], ["--jobs=2"], ["--report"], ["--stale-only"], ["--results=x"]]
+    ("own", "named"),
+    [
+        (["-j", "2"], "-j"),
+        (["-j2"], "-j"),
+        (["--jobs=2"], "--jobs"),
+        (["--job", "2"], "--job (--jobs?)"),
+        (["--report"], "--report"),
+        (["--stale"], "--stale (--stale-only?)"),
+        (["--results=x"], "--results"),
+    ],
 )
-def test_the_batchs_own_option_after_the_double_dash_is_named_as_its(capsys, tmp_path, own):
+def test_the_batchs_own_option_after_the_double_dash_is_named_as_its(capsys, tmp_path, own, named):
     """Class: an option of the batch given among sim run's. Before: "unrecognized arguments:
-    -j 2 (did you mean --workers?)" (or --set?, or "an option of sim report")."""
+    -j 2 (did you mean --workers?)" (or --set?, --trials?, "an option of sim report", and for
+    ``--job 2`` "a batch's output: give --results DIR before --")."""
     st = tmp_path / "tri.toml"
     st.write_text(TRIANGLE_NETWORK, encoding="utf-8")
     rc = sim.batch.main([str(st), "--results", str(tmp_path / "r"), "--", "--no-figures", *own])
-    line = one_line(capsys, rc, f"{own[0]} is an option of sim.batch, not of sim run")
+    line = one_line(capsys, rc, f"{named} is an option of sim.batch, not of sim run")
     assert "give it before --" in line and "did you mean" not in line
     assert not (tmp_path / "r").exists()
 
