@@ -70,7 +70,7 @@ from sim.batch_checks import (  # noqa: E402
     is_current,
     why_stale,
 )
-from sim.batch_report import not_rebuilt, rebuild_report  # noqa: E402
+from sim.batch_report import not_rebuilt, rebuild_report, report_problem  # noqa: E402
 from sim.batch_summary import _Named, _Stdout, summary  # noqa: E402
 from sim.batch_timings import TimingsLock  # noqa: E402
 from sim.cli_args import module_doc  # noqa: E402
@@ -149,8 +149,7 @@ def run_all(
     quiet = ["--quiet"] if jobs > 1 and "--quiet" not in run_args else []
 
     def argv(f: Path) -> list[str]:
-        # a name that begins with "-" (--results=-r, ./-x.toml) is a value, never an option:
-        # sim run read "--out -r/x" as an --out without its value
+        # a name "-r" (--results=-r, ./-x.toml) is a value: sim run read "--out -r/x" as no --out
         return [
             "run",
             str(f) if not str(f).startswith("-") else f"./{f}",
@@ -376,8 +375,9 @@ def _main(argv: list[str], phase: list[str]) -> int:
 def _run(args, files: list[Path], run_args: list[str], note, loaded, default, phase) -> int:
     """Run the checked ``files`` and write their timings; the batch's exit code. ``default``:
     no ``--results`` was given; ``phase``: told when the runs start and end (:func:`main`)."""
-    for f in files:
-        if why := _replaces_project_results(f, Path(args.results)):
+    whys = [_replaces_project_results(f, Path(args.results)) for f in files]
+    for why in [*whys, args.report and report_problem(Path(args.results))]:
+        if why:  # (a REPORT.md of the user's: refused after the runs, which ran for nothing)
             print(f"sim.batch: {why}", file=sys.stderr)
             return 2
     if default and (why := _default_results_problem(files, run_args)):

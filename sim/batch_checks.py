@@ -278,6 +278,29 @@ def _run_options_problem(run_args: list[str]) -> str | None:
     ``sim run`` reads them, abbreviations included): a bad option or value, an ``--out``
     (each study writes <results>/<file name>), or ``--help`` (each run would print its help
     and exit 0 without running)."""
+    why = _sim_run_problem(run_args)
+    own = [o for a in run_args if (o := _batch_option(a.partition("=")[0]))]
+    if why is not None and own:  # "unrecognized arguments: --jobs 2 (did you mean --workers?)"
+        return f"{own[0]} is an option of sim.batch, not of sim run: give it before --"
+    return why
+
+
+#: the batch's own options, which a hurried user puts among sim run's after ``--``
+BATCH_OPTIONS = ("-j", "--jobs", "--results", "--stale-only", "--report", "--timings")
+
+
+def _batch_option(name: str) -> str | None:
+    """The batch's option that ``name`` (an argument after ``--``) gives: itself, ``-j2``'s
+    ``-j``, or the one it begins (``--stale``, ``--job``: no option of sim run begins so), or
+    None. (``--job 2`` there got sim run's guess "a batch's output: give --results".)"""
+    if name in BATCH_OPTIONS or (name[:2] == "-j" and name[2:].isdigit()):
+        return name[:2] if name[:2] == "-j" else name
+    begun = [o for o in BATCH_OPTIONS if len(name) >= 4 and o.startswith(name)]
+    return f"{name} ({begun[0]}?)" if len(begun) == 1 else None
+
+
+def _sim_run_problem(run_args: list[str]) -> str | None:
+    """Why ``sim run STUDY.toml RUN_ARGS`` refuses its options (:func:`_run_options_problem`)."""
     text = io.StringIO()
     try:
         with contextlib.redirect_stdout(text), contextlib.redirect_stderr(text):

@@ -20,9 +20,20 @@ from pathlib import Path
 
 from sim.held_stops import held_stops
 from sim.mc.children import STOP_SIGNALS, child_env, child_text, stop_children
+from sim.report.markdown import _ours
 from sim.report_due import mark_due
 
-__all__ = ["rebuild_report", "not_rebuilt"]
+__all__ = ["rebuild_report", "not_rebuilt", "report_problem"]
+
+
+def report_problem(results: Path) -> str | None:
+    """Why ``sim report`` would refuse to rebuild ``RESULTS/REPORT.md`` (a file, link or
+    directory of that name the suite did not write: it never replaces one), asked before the
+    runs: the batch ran every study, for hours, and then failed on its report."""
+    out = Path(results) / "REPORT.md"
+    if out.is_symlink() or (out.exists() and not _ours(out)):
+        return f"--report: {out} was not written by sim report; sim never replaces it"
+    return None
 
 
 def rebuild_report(results: Path) -> int:

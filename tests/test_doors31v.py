@@ -60,6 +60,7 @@ import pytest
 from benchmarks import brown, cli
 from benchmarks.page import write_page
 from sim.cli import main as sim_main
+from sim.report.verify import child as verify_child
 from sim.report.verify import main as verify_main
 from sim.report.verify import rerun as verify_rerun
 from tests.oneline import one_line
@@ -239,8 +240,8 @@ def test_a_lock_file_left_in_an_earlier_re_run_does_not_block_the_next_verify(tm
 
 def test_a_scratch_that_cannot_be_written_is_the_machines_not_the_options():
     line = "sim: error: --out: cannot write to /s/brown_table1: No space left on device"
-    assert verify_rerun.system_error(line)  # before: "the re-run refused its options"
-    assert not verify_rerun.system_error("sim: error: --out: must not be empty")
+    assert verify_child.system_error(line)  # before: "the re-run refused its options"
+    assert not verify_child.system_error("sim: error: --out: must not be empty")
 
 
 TORN = """

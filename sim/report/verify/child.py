@@ -13,8 +13,54 @@ import sys
 from pathlib import Path
 
 from sim.mc.overrides import keys_of
+from sim.report.verify.rules import VerifyError
 
-__all__ = ["launcher", "busy_words", "names_one_of", "system_error"]
+__all__ = ["launcher", "busy_words", "names_one_of", "system_error", "refusal"]
+
+#: how the re-run's error line begins
+_ERR = "sim: error: "
+
+
+def refusal(
+    name: str, sf: Path, line: str, target: Path, overrides: list[str] | tuple, extra: list[str]
+) -> str | None:
+    """What the last error line ``line`` of the re-run of results ``name`` (from the study file
+    ``sf``, into ``target``) that exited with 2 means: a failure to record (returned), a bad
+    request or this machine's problem (:class:`VerifyError`: nothing recorded), or None (the
+    re-run's own failure, its lines shown)."""
+    if system_error(line):
+        # a scratch directory full or read-only, memory short: this machine's, not a failed
+        # reproduction (it was recorded as one, "FAILED; nothing compared", exit 1; with
+        # --trials it was "the re-run refused its options")
+        raise VerifyError(f"{name}: the re-run could not run here: {line}")
+    if busy := busy_words(line, target):
+        raise VerifyError(f"{name}: {busy}")
+    if names_one_of(line, overrides):
+        # a key removed since, a value the file or the code refuses now (or edited by hand):
+        # it was "the re-run exited with 2", or with --trials "the re-run refused its options"
+        if os.strerror(errno.ENOENT) in line:  # a file it names (network.gama_xml)
+            return (
+                f"a file the run's overrides name is not here ({line}): a relative path "
+                "is read from the working directory; run verify where the run was made"
+            )
+        return (
+            f"the run's overrides no longer apply: the re-run of {sf} with them was refused "
+            f"({line}): the study file or the code changed since the run (its results are "
+            "stale: run it again), or its run.json was edited"
+        )
+    if os.strerror(errno.ENOENT) in line and re.match(r"sim: error: [^-\s][^:\s]*: ", line):
+        # a file the study file names (network.gama_xml) moved away: it was recorded as a
+        # failed reproduction ("FAILED; nothing compared: the re-run exited with 2", exit 1)
+        raise VerifyError(
+            f"{name}: a file its study file {sf} names is not here ({line.removeprefix(_ERR)}): "
+            "a relative path is read from the working directory; put it back, or run verify "
+            "where the run was made (nothing recorded)"
+        )
+    if extra or line.startswith("sim: error: --"):
+        # the re-run refused the options verify passed (--trials, --set, --workers, the
+        # --out under --scratch): a request error, not a failed comparison to record
+        raise VerifyError(f"{name}: the re-run refused its options: {line}")
+    return None
 
 
 #: the longest argument, and all of them, that a re-run is given on its command line (Linux

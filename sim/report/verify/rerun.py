@@ -4,7 +4,6 @@ wrote there is ever replaced) and comparing them with it (the record and the rep
 
 from __future__ import annotations
 
-import errno
 import os
 import subprocess
 import sys
@@ -24,7 +23,7 @@ from sim.mc.study_source import other_source
 from sim.mc.table_edits import edited_tables
 from sim.mc.unfinished import unfinished, unfinished_in
 from sim.report.read import check_claims_table
-from sim.report.verify.child import busy_words, launcher, names_one_of, system_error
+from sim.report.verify.child import launcher, refusal
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
 from sim.report_due import due_words
 
@@ -186,31 +185,12 @@ def rerun_study(
             stop_children([proc], drain=True)  # as Ctrl-C does, without a word of its own
             raise
     lines = [ln for ln in err.splitlines() if ln.strip()]
-    if proc.returncode == 2 and lines and system_error(lines[-1]):
-        # a scratch directory full or read-only, memory short: this machine's, not a failed
-        # reproduction (it was recorded as one, "FAILED; nothing compared", exit 1; with
-        # --trials it was "the re-run refused its options")
-        raise VerifyError(f"{d.name}: the re-run could not run here: {lines[-1]}")
-    busy = busy_words(lines[-1], target) if proc.returncode == 2 and lines else None
-    if busy:
-        raise VerifyError(f"{d.name}: {busy}")
-    if proc.returncode == 2 and lines and names_one_of(lines[-1], overrides):
-        # a key removed since, a value the file or the code refuses now (or edited by hand):
-        # it was "the re-run exited with 2", or with --trials "the re-run refused its options"
-        if os.strerror(errno.ENOENT) in lines[-1]:  # a file it names (network.gama_xml)
-            return (
-                f"a file the run's overrides name is not here ({lines[-1]}): a relative path "
-                "is read from the working directory; run verify where the run was made"
-            )
-        return (
-            f"the run's overrides no longer apply: the re-run of {sf} with them was refused "
-            f"({lines[-1]}): the study file or the code changed since the run (its results are "
-            "stale: run it again), or its run.json was edited"
-        )
-    if proc.returncode == 2 and lines and (extra or lines[-1].startswith("sim: error: --")):
-        # the re-run refused the options verify passed (--trials, --set, --workers, the
-        # --out under --scratch): a request error, not a failed comparison to record
-        raise VerifyError(f"{d.name}: the re-run refused its options: {lines[-1]}")
+    if (
+        proc.returncode == 2
+        and lines
+        and (why := refusal(d.name, sf, lines[-1], target, overrides, extra))
+    ):
+        return why
     if proc.returncode < 0 or proc.returncode == 130:
         # ended by a signal of its own (the OOM killer, a kill -9 or SIGTERM of the re-run
         # alone): nothing was reproduced or not; it was recorded as a failed comparison ("no:
