@@ -18,6 +18,7 @@ import os
 import stat
 from pathlib import Path
 
+from sim.mc.message_text import printable
 from sim.mc.storage import read_record
 from sim.mc.study_file import MAX_STUDY_BYTES
 
@@ -86,7 +87,7 @@ def other_source(d: str | Path, name: str | None = None, record: dict | None = N
     if written is None or want in (written, stem):
         return None
     where = f" of {path}" if path else ""
-    return (
+    return printable(  # a record forged with escape sequences: shown, not obeyed
         f"{d} holds the results of a run{where} written as {written}/ (its run.json), not "
         f"{want}'s (copied or renamed by hand?): run {want}'s own study file to replace them"
     )
