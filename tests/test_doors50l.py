@@ -7,7 +7,10 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from sim.long_words import clipped
+from sim.mc.config import ConfigError
 from sim.mc.study_source import other_source
 
 #: what a hostile run.json holds: a window title, a screen clear, a carriage return, a bidi
@@ -32,3 +35,17 @@ def test_forged_record_strings_are_shown_escaped(tmp_path):
     # the command line's error line, and the API's one-line refusal, the same way
     line = clipped(f"sim: error: --set: {FORGED}")
     assert line.isprintable() and line.endswith("\\u202eevil")
+
+
+def test_sweep_range_wider_than_a_float_is_counted():
+    """Class: a ``[sweep]`` range whose span overflows a float (start 1e308, stop -1e308).
+    Its count ``(stop - start) / step`` was inf: three values (step -1e308) were refused as
+    "more than 10000 values", and ``num = 3`` as "the range's values are not finite". Now
+    reckoned in halves (exact): the values the user wrote, the count a true one."""
+    from sim.mc.sweep import _values
+
+    assert _values("k", {"start": 1e308, "stop": -1e308, "step": -1e308}) == [1e308, 0.0, -1e308]
+    assert _values("k", {"start": 1e308, "stop": -1e308, "num": 3}) == [1e308, 0.0, -1e308]
+    # a range of that span with a small step still has too many values, and says so
+    with pytest.raises(ConfigError, match="more than 10000 values"):
+        _values("k", {"start": -1.7e308, "stop": 1.7e308, "step": 1e300})
