@@ -12,6 +12,7 @@ import pytest
 from sim.long_words import clipped
 from sim.mc.config import ConfigError
 from sim.mc.study_source import other_source
+from tests.conftest import TRIANGLE_NETWORK
 
 #: what a hostile run.json holds: a window title, a screen clear, a carriage return, a bidi
 #: override
@@ -49,3 +50,20 @@ def test_sweep_range_wider_than_a_float_is_counted():
     # a range of that span with a small step still has too many values, and says so
     with pytest.raises(ConfigError, match="more than 10000 values"):
         _values("k", {"start": -1.7e308, "stop": 1.7e308, "step": 1e300})
+
+
+@pytest.mark.parametrize("index", ["[99999999999999999999999]", "[-1]"])
+def test_list_item_key_echoed_as_written_and_hinted(tmp_path, capsys, index):
+    """Class: ``--set`` of a list's item by an index no list has. A 23-digit index was echoed
+    as ``points[1e+23]`` (a key the user never wrote: the message's long-number shortening
+    reached the key), and ``points[-1]`` (Python's last item) had no word that a list's items
+    are given whole. Now the key as written, and the list's hint for any index."""
+    from sim.cli import main
+
+    st = tmp_path / "t.toml"
+    st.write_text(TRIANGLE_NETWORK)
+    assert main(["check", str(st), "--set", f"network.points{index}.x_mm=1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"sim: error: network.points{index}.x_mm: unknown key"), err
+    assert "network.points is a list" in err and "--set 'network.points=[...]'" in err
+    assert len(err.splitlines()) == 1
