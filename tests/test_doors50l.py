@@ -67,3 +67,25 @@ def test_list_item_key_echoed_as_written_and_hinted(tmp_path, capsys, index):
     assert err.startswith(f"sim: error: network.points{index}.x_mm: unknown key"), err
     assert "network.points is a list" in err and "--set 'network.points=[...]'" in err
     assert len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("line", "said"),
+    [
+        ("trials = NaN", "in lower case, nan and inf: trials = nan"),
+        ("trials = -Inf", "in lower case, nan and inf: trials = -inf"),
+        ("trials = None", "TOML has no null: leave trials out"),
+    ],
+)
+def test_python_words_for_toml_values_hinted(tmp_path, capsys, line, said):
+    """Class: a study file written as Python or NumPy would (``NaN``, ``Inf``, ``None``).
+    ``NaN`` and ``Inf`` got tomllib's bare "Invalid value", no word that TOML writes ``nan``
+    and ``inf``; ``None`` was hinted as a text to quote (``trials = "None"``), where a
+    Python user means no value: TOML has no null, the key is left out."""
+    from sim.cli import main
+
+    st = tmp_path / "t.toml"
+    st.write_text(TRIANGLE_NETWORK.replace("trials = 40", line))
+    assert main(["check", str(st)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "malformed TOML" in err and said in err and len(err.splitlines()) == 1, err
