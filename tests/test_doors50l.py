@@ -89,3 +89,44 @@ def test_python_words_for_toml_values_hinted(tmp_path, capsys, line, said):
     assert main(["check", str(st)]) == 2
     err = capsys.readouterr().err.strip()
     assert "malformed TOML" in err and said in err and len(err.splitlines()) == 1, err
+
+
+def _one_fixed(tmp_path, enc: str | None = None, stdev: str | None = None):
+    """tests/data/gama/one_fixed.xml, its stdevs replaced, saved as UTF-16 declaring ``enc``."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).parent / "data" / "gama" / "one_fixed.xml").read_text()
+    if stdev is not None:
+        text = re.sub(r'stdev="[^"]*"', f'stdev="{stdev}"', text)
+    p = tmp_path / "net.xml"
+    if enc is None:
+        p.write_text(text)
+    else:
+        text = re.sub(r"^<\?xml[^>]*\?>", f'<?xml version="1.0" encoding="{enc}"?>', text)
+        p.write_bytes(text.encode("utf-16"))
+    return p
+
+
+def test_gama_utf16_file_declaring_another_encoding_named(tmp_path):
+    """Class: a GNU Gama file saved as UTF-16 by an editor that kept its declaration of
+    iso-8859-2. Refused with the parser's bare "not well-formed (invalid token): line 2"
+    (gama-local refuses it too): now the disagreement and what to do are said; a UTF-16 file
+    declaring UTF-16 is still read."""
+    from sim.studies.network.gama_read import read_gama
+
+    with pytest.raises(ConfigError) as e:
+        read_gama(_one_fixed(tmp_path, "iso-8859-2"))
+    assert "a UTF-16 file" in str(e.value) and "declare UTF-16" in str(e.value)
+    assert read_gama(_one_fixed(tmp_path, "UTF-16"))["network.points"]
+
+
+def test_gama_stdev_out_of_range_quoted_as_written(tmp_path):
+    """Class: a GNU Gama stdev far out of range, written subnormal (``stdev="1e-320"``). The
+    refusal printed the float's nearest representation, ``9.99989e-321``, a number the file
+    does not hold, and "(0 arcsec)": now the attribute's text and "under 1e-300 arcsec"."""
+    from sim.studies.network.gama_read import read_gama
+
+    with pytest.raises(ConfigError) as e:
+        read_gama(_one_fixed(tmp_path, stdev="1e-320"))
+    assert "a standard deviation of 1e-320 (under 1e-300 arcsec)" in str(e.value)
