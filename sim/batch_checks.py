@@ -27,7 +27,7 @@ from sim.input_places import check_inputs_outside
 from sim.mc.codehash import study_code_hash
 from sim.mc.config import ConfigError, StudyError, check_chunks, parse_override, read_toml
 from sim.mc.export_edits import changed_exports
-from sim.mc.message_text import key_text
+from sim.mc.message_text import key_text, printable
 from sim.mc.outputs import check_out
 from sim.mc.overrides import command_values, listed, recorded
 from sim.mc.paths import absolute
@@ -84,8 +84,8 @@ def why_stale(
         return "made without figures"
     if other_source(results, Path(study_file).stem, record):  # B/alpha copied over B/beta
         written, path = recorded_source(record)
-        return f"its run.json records a run written as {written}/" + (
-            f" from {path}" if path else ""
+        return printable(  # a forged record's escape sequences shown, not obeyed
+            f"its run.json records a run written as {written}/" + (f" from {path}" if path else "")
         )
     # the record holds the [sweep] table beside the config, as the run wrote it: without it
     # a swept study was "made with another config: sweep" at once, and re-run every time

@@ -19,6 +19,7 @@ from sim.cli_tables import lost_table, not_as_written, older_lacks
 from sim.ends import unshown
 from sim.mc.config import ConfigError
 from sim.mc.file_kind import odd_table
+from sim.mc.message_text import printable
 from sim.mc.outputs import name_problem, results_dirs
 from sim.mc.paths import link_problem
 from sim.mc.settle import settled
@@ -73,7 +74,7 @@ def show(args) -> int:
     # read again when a run publishes d meanwhile: one run's claims were printed under the
     # other's configuration note (sim.mc.settle)
     text = settled(d, lambda: _shown_text(d, args.markdown), "DIR")
-    print(text, end="")
+    print(printable(text, lines=True), end="")  # a forged note's escape sequences: shown
     print("" if args.markdown else "\n", end="")
     if older := other_code(d):  # verdicts of code since changed: read as current otherwise
         print(

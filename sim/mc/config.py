@@ -52,8 +52,8 @@ class ConfigError(ValueError):
 
     def __init__(self, key: str | None, message: str):
         self.key = key  # a number of hundreds of digits is shortened in any message
-        text = f"{key_text(key)}: {message}" if key is not None else message
-        super().__init__(shorten(text + note(text)))
+        head = f"{key_text(key)}: " if key is not None else ""  # the key as the user wrote it
+        super().__init__(head + shorten(message + note(head + message)))  # (points[1e+23])
 
     @property
     def detail(self) -> str:

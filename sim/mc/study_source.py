@@ -18,6 +18,7 @@ import os
 import stat
 from pathlib import Path
 
+from sim.mc.message_text import printable
 from sim.mc.storage import read_record
 from sim.mc.study_file import MAX_STUDY_BYTES
 
@@ -93,7 +94,7 @@ def other_source(
     fix = f"run {want}'s own study file to replace them"
     if studies is not None and not (Path(studies) / f"{want}.toml").is_file():
         fix = f"there is no {Path(studies) / want}.toml to replace them: move {d} away"
-    return (
+    return printable(  # a record forged with escape sequences: shown, not obeyed
         f"{d} holds the results of a run{where} written as {written}/ (its run.json), not "
         f"{want}'s (copied or renamed by hand?): {fix}"
     )

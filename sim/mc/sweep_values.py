@@ -45,6 +45,7 @@ def _values(key: str, v: Any) -> list:
         if extra:
             raise ConfigError(f"sweep.{key}", f"unknown range entries {sorted(extra)}")
         a, b = _finite(key, "start", v["start"]), _finite(key, "stop", v["stop"])
+        h = 0.5 if isinstance(b - a, float) and math.isinf(b - a) else 1  # 1e308 to -1e308:
         if "num" in v and "step" in v:
             raise ConfigError(f"sweep.{key}", "give num or step, not both")
         if "num" in v:
@@ -55,15 +56,15 @@ def _values(key: str, v: Any) -> list:
                 raise ConfigError(
                     f"sweep.{key}", f"num must be an integer from 1 to {MAX_CELLS} (got {n!r})"
                 )
-            with np.errstate(all="ignore"):  # b - a overflowing: refused below, not warned
-                out = np.linspace(a, b, n)
+            with np.errstate(all="ignore"):  # reckoned in halves (its count was inf, "more
+                out = np.linspace(a * h, b * h, n) / h  # than 10000 values", not finite)
         elif "step" in v:
             s = _finite(key, "step", v["step"])
-            if s == 0 or (b - a) / s < 0:
+            if s == 0 or (b * h - a * h) / s < 0:
                 raise ConfigError(
                     f"sweep.{key}", "step must be non-zero and point from start to stop"
                 )
-            count = (b - a) / s
+            count = (b * h - a * h) / (s * h)
             if not count < MAX_CELLS:
                 raise ConfigError(
                     f"sweep.{key}",
@@ -72,7 +73,7 @@ def _values(key: str, v: Any) -> list:
             if all(isinstance(x, int) for x in (a, b, s)):  # exact (NumPy's int64 wrapped)
                 return [a + s * i for i in range((b - a) // s + 1)]
             with np.errstate(all="ignore"):
-                out = a + s * np.arange(int(math.floor(count + 1e-9)) + 1)
+                out = (a * h + s * h * np.arange(int(math.floor(count + 1e-9)) + 1)) / h
         else:
             raise ConfigError(f"sweep.{key}", "a range needs num or step")
         if not np.isfinite(out).all():

@@ -5,7 +5,8 @@ what the user probably meant. The slips a new user makes in a study file are few
 see in the line: a text value without quotes (``study = brown_table1``), a number with a
 thousands separator or a decimal comma (``trials = 4,000``, ``format_mm = 245,0``), a number
 with its unit (``setting_sigma_um = 1.7um``: the unit is in the key's name), ``True`` for
-``true``, ``key: value``, a table name or a list without its closing bracket, a string without
+``true``, ``NaN`` and ``Inf`` for ``nan`` and ``inf``, ``None`` or ``null`` (TOML has none),
+``key: value``, a table name or a list without its closing bracket, a string without
 its closing quote. :func:`slip_hint` names the slip and the line as it was probably meant;
 :func:`quote_hint` names a word processor's typographic quote. No hint is a guess at random:
 a line none of these fits gets none.
@@ -74,6 +75,30 @@ def _value_slip(key: str, value: str) -> str:
     return ""
 
 
+#: what a user of Python, JSON or NumPy writes for no value, for NaN and for infinity
+_NULLS = ("None", "null", "NULL", "Null", "nil")
+_SPECIAL = re.compile(r"([+-]?)(nan|inf|infinity)", re.I)
+
+
+def _word_slip(line: str, col: int) -> str:
+    """What is wrong with the bare word at column ``col`` (1-based) of ``line`` when it is
+    ``NaN``, ``Inf`` (TOML writes ``nan``, ``inf``) or ``None``, ``null`` (TOML has no null),
+    or ""; it was no hint (``x = NaN``) or "a text value is quoted" (``x = None``)."""
+    m = re.match(r"[+-]?[A-Za-z_]\w*", line[col - 1 :] if col > 0 else "")
+    word = m.group() if m else ""
+    k = re.search(r"([\w\-]+|\"[^\"]*\")\s*=\s*$", line[: col - 1])
+    key = k.group(1) if k else "x"
+    if (special := _SPECIAL.fullmatch(word)) and word not in ("nan", "inf", "+nan", "-nan"):
+        fixed = special[1] + ("nan" if special[2].lower() == "nan" else "inf")
+        return f"TOML writes not-a-number and infinity in lower case, nan and inf: {key} = {fixed}"
+    if word in _NULLS:
+        return (
+            f"TOML has no null: leave {key} out for no value (its default), or quote a "
+            f'text: {key} = "{word}"'
+        )
+    return ""
+
+
 def _opened(lines: list[str], before: int, mark: str) -> int | None:
     """The 1-based number of the last line before line ``before`` whose value opens with
     ``mark`` (``[`` a list, ``{`` an inline table), or None."""
@@ -127,7 +152,9 @@ def slip_hint(text: str, message: str, n: int, col: int) -> str:
     code = line.split("#", 1)[0].rstrip() if '"' not in line and "'" not in line else line
     words = ""
     kv = _KEY_VALUE.fullmatch(code)
-    if message.startswith(("Invalid value", "Expected newline or end of document")) and kv:
+    if message.startswith("Invalid value") and (words := _word_slip(line, col)):
+        pass  # NaN, Inf, None: in a list or an inline table too
+    elif message.startswith(("Invalid value", "Expected newline or end of document")) and kv:
         words = _value_slip(kv.group(1).strip(), kv.group(2).strip())
     elif message.startswith("Expected ']' at the end of a table") and "[" in line:
         words = f"a table's name is closed by ]: {code.strip()}]"

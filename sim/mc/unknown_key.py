@@ -35,7 +35,8 @@ def did_you_mean(key: str, schema: Mapping[str, Any], n: int = 2) -> list[str]:
 
 
 #: a key that names an item of a list (``network.generate[1].sigma_arcsec``, ``...generate.1...``)
-_ITEM = re.compile(r"^([A-Za-z_][\w.]*?)(?:\[(\d+)\]|\.(\d+))(?:\.|$)")
+#: (any index in brackets, a negative one too: points[-1] had no hint, as Python's last item)
+_ITEM = re.compile(r"^([A-Za-z_][\w.]*?)(?:\[([^\]]*)\]|\.(-?\d+))(?:\.|$)")
 #: the kinds of :class:`~sim.mc.config.Field` whose value is a list
 _LIST_KIND = re.compile(r"^(?:list\[|points$|records$)")
 

@@ -23,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from sim.studies.network.analysis import estimated_points
-from sim.studies.network.definition import Network, build
+from sim.studies.network.built import built as build
+from sim.studies.network.definition import Network
 from sim.studies.network.gama import merge_gama
 from sim.studies.network.linearity import largest_bias, row_key
 from sim.studies.network.model import datum

@@ -113,11 +113,19 @@ def gama_text(data: bytes) -> bytes | str:
     beyond ASCII, a UTF-8 byte-order mark before another declared encoding (the mark and the
     declaration disagree: ``É`` of the UTF-8 the mark says is ``Ã‰`` in ISO-8859-1), or a
     UTF-16 file declared ``UTF-16LE`` or ``UTF-16BE``, names gama-local 2.03 does not know
-    (it refuses the file; over ASCII bytes it reads them, as any other name)."""
+    (it refuses the file; over ASCII bytes it reads them, as any other name), or a UTF-16 file
+    declaring another encoding (``iso-8859-2``: gama-local refuses it as "not well-formed" or
+    "encoding specified in XML declaration is incorrect", and so did this reader, unexplained)."""
     if (name := _utf16_name(data)) and name.lower() in ("utf-16le", "utf-16be"):
         raise EncodingProblem(
             f"<?xml encoding={said(name)}?>: gama-local 2.03 does not know this name (its "
             'expat knows "UTF-16") and refuses the file as not well-formed: declare UTF-16'
+        )
+    if name and name.lower() != "utf-16":  # a UTF-16 file declaring iso-8859-2: "not well-formed"
+        raise EncodingProblem(
+            f"a UTF-16 file (its bytes) declaring <?xml encoding={said(name)}?>: gama-local "
+            "refuses it (the declaration and the bytes disagree): declare UTF-16, or save the "
+            f"file in {said(name)}"
         )
     m = _DECL.match(data[:1024])
     if not m:

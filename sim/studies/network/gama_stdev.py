@@ -101,9 +101,12 @@ def sigma(f: _File, o, default, var: float | None, unit: float | None = None) ->
     lo, hi = SIGMA_RANGE["mm" if unit is None else "arcsec"]
     study = sig if unit is None else sig * unit / ARCSEC
     if not lo <= study <= hi:
-        what = "mm" if unit is None else f"{study:g} arcsec"
+        what = "mm" if unit is None else f"{study:g} arcsec" if study else "under 1e-300 arcsec"
+        # as written, when written: a subnormal 1e-320 was "9.99989e-321"
+        text = o.get("stdev").strip() if var is None and o.get("stdev") is not None else ""
+        shown = text if text and len(text) <= 40 else f"{sig:g}"
         raise f.err(
-            o, f"a standard deviation of {sig:g} ({what}) is outside [{lo:g}, {hi:g}]", "stdev"
+            o, f"a standard deviation of {shown} ({what}) is outside [{lo:g}, {hi:g}]", "stdev"
         )
     return sig
 

@@ -26,9 +26,9 @@ from sim.studies.network.analysis import (
     inner_left,
     match_points,
 )
+from sim.studies.network.built import built as build
 from sim.studies.network.canonical import canonical
 from sim.studies.network.compare import check_compare
-from sim.studies.network.definition import build
 from sim.studies.network.gama import gama_digest, merge_gama
 from sim.studies.network.keys import SCHEMA
 from sim.studies.network.model import datum, defect_basis, use_sparse
