@@ -135,6 +135,7 @@ def test_show_prints_a_results_directory(tmp_path, capsys):
     (out / "README.md").write_text("my notes\n")
     assert main(["report", "--results", str(tmp_path)]) == 0
     assert (out / "README.md").read_text() == "my notes\n"
+    assert "kept as yours" in capsys.readouterr().err  # said, in a note line
     assert main(["show", str(tmp_path)]) == 2  # not a results directory: one line
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "not a results directory" in err

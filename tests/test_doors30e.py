@@ -48,6 +48,8 @@ configuration does not read, written at its default (``plate.n_random = 25`` on 
 refused as set (docs/cli.md).
 """
 
+import hashlib
+import json
 from pathlib import Path
 
 import sim
@@ -79,6 +81,13 @@ def test_the_api_writes_the_directory_sim_run_writes(tmp_path):
     a["README.md"] = a["README.md"].replace(str(cli).encode(), b"DIR")
     b["README.md"] = b["README.md"].replace(str(api).encode(), b"DIR")
     assert b"sim show DIR" in a["README.md"]
+    # run.json records README.md's sha256 (an edited README is the user's), which names the path
+    for files, d in ((a, cli), (b, api)):
+        rec = json.loads(files.pop("run.json"))
+        assert (
+            rec.pop("readme_sha256") == hashlib.sha256((d / "README.md").read_bytes()).hexdigest()
+        )
+        files["run.json"] = json.dumps(rec, sort_keys=True).encode()
     assert [f for f in a if a[f] != b[f]] == []
 
 

@@ -81,9 +81,10 @@ def test_api_trials_picks_the_chunk_as_sim_run_trials_does(capsys):
 
 def test_a_format_so_large_that_ranges_overflow_names_the_format(capsys):
     """Brown's stations stand half the format plus the offset from the centre; a format of
-    1e300 mm was blamed on the 17 mm ``comparator.station_offset_mm``."""
+    1e300 mm was blamed on the 17 mm ``comparator.station_offset_mm`` (refused now at the
+    format's bound for the comparator, brown_design's, before any range is reckoned)."""
     argv = ["check", str(ROOT / "studies" / "brown_table1.toml"), "--set", "plate.format_mm=1e300"]
-    one_line(capsys, main(argv), "overflow", prefix="sim: error: plate.format_mm: ")
+    one_line(capsys, main(argv), "must be <= 2000", prefix="sim: error: plate.format_mm: ")
 
 
 @pytest.mark.parametrize(

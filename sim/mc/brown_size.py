@@ -37,6 +37,13 @@ BROWN_POINTS_PER_UNIT = 60.0
 #: covariance of the pivot model's points (measured as two more: 0.083 units a point and trial
 #: against brown_dilution's 0.067 for its three models and the bias check's pivot)
 BROWN_TABLE1_SOLVES = 5
+#: adjustments' worth of a trial of brown_dilution's bias-invariance check
+#: (``checks.bias_shift_um``): the shifted pivot adjustment and two restarts of each of the
+#: check's two adjustments from their own solutions (:func:`sim.studies.brown.core._polished`),
+#: measured as 3.7 of a model's adjustments at 60 points (0.021 s of a trial's 0.038 s, its
+#: three models 0.017 s). Counted as the one shifted adjustment, a trial's work was estimated
+#: at a quarter of its CPU time once the restarts came
+BROWN_BIAS_SOLVES = 4
 #: adjustments of brown_dilution's self-check reference under ``errors.bias_um`` (its three
 #: models' derivatives of the points by each of the 4 n ranges, two adjustments each:
 #: :func:`sim.studies.brown.core.spread_sigma`), each of the plate's n points at
@@ -111,7 +118,8 @@ def _memory_keys(
 
 def brown_estimate(c: Mapping) -> tuple:
     """brown_dilution's or brown_table1's ``(trials, adjustments, unknowns, bytes)``: three
-    model adjustments a trial (four with the bias check, :data:`BROWN_TABLE1_SOLVES` in
+    model adjustments a trial (:data:`BROWN_BIAS_SOLVES` more with the bias check,
+    :data:`BROWN_TABLE1_SOLVES` in
     Table 1), each :func:`plate_points` over
     :data:`BROWN_POINTS_PER_UNIT` units (at least one), the settings' draws, the analytic
     dilution curves (three a grid, offset and extent) and the region; the memory the largest
@@ -126,7 +134,7 @@ def brown_estimate(c: Mapping) -> tuple:
     per = (
         BROWN_TABLE1_SOLVES
         if c.get("study") == "brown_table1"
-        else 3 + ("checks.bias_shift_um" in c)
+        else 3 + BROWN_BIAS_SOLVES * ("checks.bias_shift_um" in c)
     )
     trial = per * max(1.0, n / BROWN_POINTS_PER_UNIT) + 4 * n * L * BROWN_DRAW_UNITS
     grids = c.get("dilution.grids", [])

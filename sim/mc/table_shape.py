@@ -37,6 +37,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from sim.mc import tolerance
+from sim.mc.path_names import STAGE_SUFFIX
 from sim.mc.storage import RECORD, code_hash, read_record, regular_text
 
 __all__ = [
@@ -222,8 +223,8 @@ def sum_problem(path: str | Path) -> str | None:
         if (rec := read_record(root)) is None:
             continue
         sums = rec.get("table_sha256")
-        if (lost := _lost(rec)) and _this_code(rec):  # every one written by this code's
-            # sim.mc.publish.seal: an older version's record may lack them, one of this code's
+        if (lost := _lost(rec)) and _this_code(rec) and not _staging(root):  # every one
+            # written by this code's sim.mc.publish.seal: an older version's record may lack them, one of this code's
             # was edited (read unchecked: table_shape and table_sha256 made null, or removed
             # with files, which told an older version's record apart)
             return (
@@ -250,6 +251,13 @@ def _lost(rec: dict) -> str | None:
     if lost[:2] != ["table_sha256", SHAPE_KEY]:
         return None
     return "neither table_sha256 nor table_shape" + (", nor files" if len(lost) > 2 else "")
+
+
+def _staging(root: Path) -> bool:
+    """Whether ``root`` is a run's staging directory (``.<name>.partial``), whose record is
+    sealed only at publish: a sweep reads its own ``sweep.parquet`` there before (refused as
+    a forged record of this code's, "removed by hand?", and the sweep failed)."""
+    return root.name.startswith(".") and root.name.endswith(STAGE_SUFFIX)
 
 
 def _this_code(rec: dict) -> bool:
