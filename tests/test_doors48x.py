@@ -25,6 +25,7 @@ from pathlib import Path
 
 import pytest
 from conftest import TRIANGLE_NETWORK
+from gama_triangle import triangle
 
 from sim.cli import main
 from sim.mc.config import ConfigError
@@ -32,30 +33,10 @@ from sim.mc.gama_count import gama_counts
 from sim.mc.network_size import network_counts
 from sim.studies.network.gama_read import read_gama
 
-NET = """<?xml version="1.0" ?>
-<gama-local xmlns="http://www.gnu.org/software/gama/gama-local">
-  <network axes-xy="ne" angles="left-handed">
-    <parameters sigma-apr="1" sigma-act="apriori" />
-    <points-observations>
-{extra}      <point id="A" x="0.0" y="0.0" fix="xy" />
-      <point id="B" x="1.0" y="0.0" fix="xy" />
-      <point id="C" x="0.4" y="0.7" adj="xy" />
-      <obs from="A">
-        <distance to="B" val="1.0" stdev="0.01" />
-        <distance to="C" val="0.806225774829855" stdev="0.01" />
-      </obs>
-      <obs from="B">
-        <distance to="C" val="0.921954445729289" stdev="0.01" />
-      </obs>
-    </points-observations>
-  </network>
-</gama-local>
-"""
-
 
 def _file(tmp_path: Path, name: str, extra: str) -> Path:
     p = tmp_path / name
-    p.write_text(NET.format(extra=extra), encoding="utf-8")
+    p.write_text(triangle(extra=extra), encoding="utf-8")
     return p
 
 

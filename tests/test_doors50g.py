@@ -37,6 +37,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from gama_triangle import triangle
 
 from sim.mc import progress
 from sim.mc.config import ConfigError
@@ -44,26 +45,6 @@ from sim.mc.gama_count import gama_counts
 from sim.studies.network import gama_cache
 from sim.studies.network.gama_read import read_gama
 from sim.studies.network.gama_vocab import read_bytes
-
-NET = """<?xml version="1.0" {decl}?>
-<gama-local xmlns="http://www.gnu.org/software/gama/gama-local">
-  <network axes-xy="ne" angles="left-handed">
-    <parameters sigma-apr="1" sigma-act="apriori" />
-    <points-observations>
-      <point id="A" x="0.0" y="0.0" fix="xy" />
-      <point id="B" x="1.0" y="0.0" fix="xy" />
-      <point id="{c}" x="0.4" y="0.7" adj="xy" />
-      <obs from="A">
-        <distance to="B" val="1.0" stdev="0.01" />
-        <distance to="{c}" val="0.806225774829855" stdev="0.01" />
-      </obs>
-      <obs from="B">
-        <distance to="{c}" val="0.921954445729289" stdev="0.01" />
-      </obs>
-    </points-observations>
-  </network>
-</gama-local>
-"""
 
 
 def _file(tmp_path: Path, data: bytes, name: str = "net.xml") -> Path:
@@ -76,16 +57,16 @@ def test_bytes_of_another_encoding_are_named_with_the_declaration_to_give(tmp_pa
     """Unclear message: a Czech file in ISO-8859-2 with no encoding declared (or declared
     UTF-8) was "not XML: not well-formed (invalid token)"; UTF-8 bytes declared US-ASCII too.
     The line names the line, the bytes and the encoding to declare; the declared file reads."""
-    latin2 = NET.format(decl="", c="\u010c\u00e1p").encode("iso8859_2")
+    latin2 = triangle(decl="", c="\u010c\u00e1p").encode("iso8859_2")
     for decl in ("", 'encoding="UTF-8" '):
-        data = NET.format(decl=decl, c="\u010c\u00e1p").encode("iso8859_2")
+        data = triangle(decl=decl, c="\u010c\u00e1p").encode("iso8859_2")
         with pytest.raises(ConfigError) as e:
             read_gama(_file(tmp_path, data))
         msg = str(e.value)
         assert "not XML" not in msg and "\n" not in msg, msg
         assert "line 8: bytes that are not UTF-8 (b'\\xc8\\xe1p\"'...)" in msg, msg
         assert 'encoding="iso-8859-2"' in msg, msg
-    ascii_ = NET.format(decl='encoding="US-ASCII" ', c="\u010c\u00e1p").encode("utf-8")
+    ascii_ = triangle(decl='encoding="US-ASCII" ', c="\u010c\u00e1p").encode("utf-8")
     with pytest.raises(ConfigError, match='line 8: bytes beyond ASCII .*declare encoding="UTF-8"'):
         read_gama(_file(tmp_path, ascii_))
     # the cure the line gives holds, and a syntax error before the bytes is still named as one
@@ -125,7 +106,7 @@ def test_the_parse_of_a_large_file_is_shown_on_a_terminal(tmp_path, monkeypatch,
     monkeypatch.setattr(progress, "_terminal", lambda stream: True)
     monkeypatch.setenv("TERM", "xterm")
     progress.set_quiet(False)
-    data = NET.format(decl="", c="C").encode()
+    data = triangle(decl="", c="C").encode()
     small, large = _file(tmp_path, data, "small.xml"), _file(tmp_path, data + b" ", "large.xml")
     monkeypatch.setattr(gama_cache, "SHOWN_FROM_BYTES", len(data) + 1, raising=False)
     assert gama_cache.read_gama(small)["network.points"][2]["name"] == "C"
@@ -138,11 +119,11 @@ def test_a_file_in_gama_locals_own_encoding_is_counted_for_the_estimate(tmp_path
     """Estimate short of the run: a file declared ``cp-1251`` (or ``cp-1250``, ``x-any``: the
     reader reads it) could not be counted (None: the size's guess, 40 % short of the memory at
     10,000 points); it is counted as the same network in UTF-8 now."""
-    utf8 = gama_counts(_file(tmp_path, NET.format(decl="", c="\u0416\u0443\u043a").encode()))
+    utf8 = gama_counts(_file(tmp_path, triangle(decl="", c="\u0416\u0443\u043a").encode()))
     assert utf8 is not None and utf8.points == 3 and utf8.rows["distance"] == 3
     for enc, codec in (("cp-1251", "cp1251"), ("cp-1250", "cp1250"), ("x-any", "ascii")):
         name = "\u0416\u0443\u043a" if codec == "cp1251" else "\u010c\u00e1p" * (codec != "ascii")
-        text = NET.format(decl=f'encoding="{enc}" ', c=name or "C")
+        text = triangle(decl=f'encoding="{enc}" ', c=name or "C")
         p = _file(tmp_path, text.encode(codec), f"{enc}.xml")
         assert gama_counts(p) == utf8, enc
         assert len(read_gama(p)["network.points"]) == 3  # (the reader reads each)
@@ -151,7 +132,7 @@ def test_a_file_in_gama_locals_own_encoding_is_counted_for_the_estimate(tmp_path
 def test_a_point_named_only_by_an_observations_own_from_is_counted(tmp_path):
     """Estimate short of the run: ``<obs><distance from="C" to="A"/>...`` (a program that writes
     each distance with its ends) named C nowhere else; the counts left it out (2 points of 3)."""
-    text = NET.format(decl="", c="C")
+    text = triangle(decl="", c="C")
     text = text.replace(
         '<obs from="B">\n        <distance to="C"', '<obs>\n        <distance from="C" to="B"'
     )
@@ -169,17 +150,17 @@ def test_utf8_bytes_under_a_single_byte_declaration_are_noted(tmp_path):
     other names without a word. Read as before (as gama-local reads them), with a note; a
     file truly in ISO-8859-1 (not UTF-8) gets none."""
     for enc in ("ISO-8859-1", "windows-1250"):
-        text = NET.format(decl=f'encoding="{enc}" ', c="P\u00e1\u00e9")
+        text = triangle(decl=f'encoding="{enc}" ', c="P\u00e1\u00e9")
         rec = read_gama(_file(tmp_path, text.encode("utf-8")))
         assert rec["network.points"][2]["name"] == "P\u00e1\u00e9".encode().decode(
             "latin-1" if enc == "ISO-8859-1" else "cp1250"
         )
         assert f"declares '{enc}' and its bytes beyond ASCII" in rec["note"], rec["note"]
         assert 'if the file is UTF-8, declare encoding="UTF-8"' in rec["note"]
-    latin = NET.format(decl='encoding="ISO-8859-1" ', c="P\u00e1\u00e9").encode("latin-1")
+    latin = triangle(decl='encoding="ISO-8859-1" ', c="P\u00e1\u00e9").encode("latin-1")
     rec = read_gama(_file(tmp_path, latin))
     assert rec["network.points"][2]["name"] == "P\u00e1\u00e9" and "UTF-8" not in rec["note"]
-    text = NET.format(decl='encoding="ISO-8859-1" ', c="\u010c\u00e1p")
+    text = triangle(decl='encoding="ISO-8859-1" ', c="\u010c\u00e1p")
     with pytest.raises(ConfigError) as e:
         read_gama(_file(tmp_path, text.encode("utf-8")))
     assert "is printable" in str(e.value) and str(e.value).endswith(
@@ -191,7 +172,7 @@ def test_an_attribute_default_of_the_doctype_is_refused_naming_it(tmp_path):
     """Silent (a stdev from the DOCTYPE) and unclear (an ``adj`` blamed on ``fix``): an
     attribute default the DOCTYPE declares is refused, naming the element and the attribute;
     a declaration without a default (``#IMPLIED``) is read."""
-    text = NET.format(decl="", c="C").replace(' stdev="0.01"', "")
+    text = triangle(decl="", c="C").replace(' stdev="0.01"', "")
     for decl, named in (
         (
             '<!ATTLIST distance stdev CDATA "5">',
@@ -206,5 +187,5 @@ def test_an_attribute_default_of_the_doctype_is_refused_naming_it(tmp_path):
         with pytest.raises(ConfigError, match="its <!DOCTYPE> " + named + ": attribute defaults"):
             read_gama(_file(tmp_path, data))
     implied = "<!DOCTYPE gama-local [<!ATTLIST point adj CDATA #IMPLIED>]>"
-    data = NET.format(decl="", c="C").replace("?>\n", f"?>\n{implied}\n", 1).encode()
+    data = triangle(decl="", c="C").replace("?>\n", f"?>\n{implied}\n", 1).encode()
     assert len(read_gama(_file(tmp_path, data))["network.points"]) == 3

@@ -65,6 +65,7 @@ from __future__ import annotations
 import os
 import random
 import sys
+from pathlib import Path
 
 import pytest
 from fuzz_bytes import csv_sites, gama_sites, mutate_bytes
@@ -216,16 +217,20 @@ def test_fuzz_splice(tmp_path, capsys):
         rng = random.Random(SEED * 100_003 + 44_444 + i)
         text, desc, needle = gama_splice(rng, src.read_text(encoding="utf-8"))
         (x := tmp_path / f"splice-{i}.xml").write_text(text, encoding="utf-8")
-        study = tmp_path / "gama.toml"
-        study.write_text(
-            f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{x}"\n'
-        )
+        study = _gama_study(tmp_path, x)
         rc, err = main(["check", str(study)]), capsys.readouterr().err.strip()
         if needle is None and (rc != 0 or _read("gama", x) != _read("gama", src)):
             failures.append(f"case {i} ({src.name}: {desc}): exit {rc} or read as another input")
         elif needle and (rc != 2 or "\n" in err or str(x) not in err or needle not in err):
             failures.append(f"case {i} ({src.name}: {desc}): exit {rc}: {err[-300:]}")
     assert not failures, f"{len(failures)} of {4 * CASES}:\n" + "\n".join(failures)
+
+
+def _gama_study(tmp_path: Path, x: Path) -> Path:
+    """A small network study (40 trials in chunks of 2) reading the Gama file ``x``."""
+    study = tmp_path / "gama.toml"
+    study.write_text(f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{x}"\n')
+    return study
 
 
 def test_fuzz_gama_values(tmp_path, capsys):
@@ -240,10 +245,7 @@ def test_fuzz_gama_values(tmp_path, capsys):
         rng = random.Random(SEED * 100_003 + 49_049 + i)
         text, desc, refuse = gama_value(rng, src.read_text(encoding="utf-8"))
         (x := tmp_path / f"value-{i}.xml").write_text(text, encoding="utf-8")
-        study = tmp_path / "gama.toml"
-        study.write_text(
-            f'study = "network"\ntrials = 40\nchunk = 2\n[network]\ngama_xml = "{x}"\n'
-        )
+        study = _gama_study(tmp_path, x)
         rc, err = main(["check", str(study)]), capsys.readouterr().err.strip()
         if rc not in (0, 2) or (rc == 2 and ("\n" in err or str(x) not in err)):
             failures.append(f"case {i} ({src.name}: {desc}): exit {rc}: {err[-300:]}")
