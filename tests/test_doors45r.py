@@ -31,6 +31,7 @@ import pytest
 
 import sim
 from sim.instruments.ranges.autocorr import ensemble_time
+from sim.mc.brown_size import BROWN_POINTS_PER_UNIT, BROWN_SPREAD_ADJUSTMENTS
 from sim.mc.config import ConfigError
 from sim.mc.estimate import check_limits, estimate
 from sim.studies.brown.core import spread_sigma
@@ -46,7 +47,10 @@ def _cfg(bias: float, grid: int, spacing: float) -> dict:
 
 def test_the_biased_reference_is_counted_in_the_estimate_and_named_over_the_limit():
     plain, biased = (estimate(_cfg(b, 60, 3.0)) for b in (0.0, 10.0))
-    assert biased.adjustments > 4 * plain.adjustments  # it was equal
+    n = 60 * 60  # it was equal: the reference's derivatives, each of n points, are counted
+    spread = BROWN_SPREAD_ADJUSTMENTS * n * n / BROWN_POINTS_PER_UNIT
+    assert biased.adjustments - plain.adjustments == pytest.approx(spread, rel=1e-12)
+    assert biased.adjustments > 3 * plain.adjustments  # the larger part of the run's work
     with pytest.raises(ConfigError) as e:
         check_limits(biased, max_adjustments=2e6)
     assert "errors.bias_um or plate.grid" in str(e.value)
