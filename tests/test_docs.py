@@ -31,7 +31,7 @@ import warnings
 from pathlib import Path
 
 import pytest
-from conftest import ROOT, study_of, tiny_overrides
+from conftest import ROOT, long_params, study_of, tiny_overrides
 
 from sim.cli import main
 
@@ -165,7 +165,13 @@ class Page:
         assert code in (0, None), f"{what}: exit {code}\n{err.getvalue()[-2000:]}"
 
 
-@pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(ROOT)) for p in PAGES])
+# docs/sparse.md's commands (networks of thousands of points, 15 s of CPU) in make fuzz: the
+# other pages' commands guard the class in make test, test_sparse the sparse path
+@pytest.mark.parametrize(
+    "page",
+    long_params(PAGES, {ROOT / "docs" / "sparse.md"}),
+    ids=[str(p.relative_to(ROOT)) for p in PAGES],
+)
 def test_every_command_of_the_page_runs(page, tmp_path, tiny_run):
     (tmp_path / "studies").symlink_to(ROOT / "studies")
     mirror_results(tmp_path / "results")

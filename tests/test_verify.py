@@ -252,9 +252,13 @@ def _run(study: str, out: Path, workers: int, env: dict, *extra: str) -> None:
     assert r.returncode == 0, r.stderr
 
 
-# test_all_studies: forward; the two slowest kinds (7-17 s of CPU) in make fuzz
+# test_all_studies: forward; the four slowest kinds (7-17 s of CPU) in make fuzz
 @pytest.mark.parametrize(
-    "kind", long_params(sorted(MODULES, reverse=True), {"agnard_block", "brown_design"})
+    "kind",
+    long_params(
+        sorted(MODULES, reverse=True),
+        {"agnard_block", "brown_design", "gridplate_two_plates", "salsig_encoders"},
+    ),
 )
 def test_another_numerical_path_agrees_by_the_same_rules(kind, tiny_run):
     """Every study kind at its tiny size: the shared 1-worker run on the usual path against
