@@ -32,6 +32,7 @@ overrides), one case each; each failed on the code before its fix.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import shutil
 import subprocess
@@ -130,8 +131,14 @@ def test_the_api_and_the_batch_record_what_sim_run_records(made, tmp_path):
     h = sim.load(BROWN, chunk=2, plate__grid=4, **{"region.points": 256, "region.rounds": 0})
     res = h.run(out=tmp_path / "api" / "brown_table1", trials=40, seed=7, figures=False)
     assert _rec(res.path)["overrides"] == RECORDED  # before: no overrides recorded
-    ours = made / "R" / "brown_table1" / "run.json"
-    assert (res.path / "run.json").read_bytes() == ours.read_bytes()  # the same record
+    ours = made / "R" / "brown_table1"
+    # the same record, but README.md's sha256: the README names its own directory's path
+    a, b = _rec(res.path), _rec(ours)
+    for rec, d in ((a, res.path), (b, ours)):
+        assert (
+            rec.pop("readme_sha256") == hashlib.sha256((d / "README.md").read_bytes()).hexdigest()
+        )
+    assert a == b
     sets = [x for s in [*TINY, "plate.grid=4"] for x in ("--set", s)]
     batch = _py("sim.batch", BROWN, "--results", tmp_path / "B", "--", "--seed", "7", *sets)
     assert batch.returncode == 0, batch.stderr
