@@ -31,6 +31,16 @@ def done(tmp_path_factory) -> Path:
     return top
 
 
+def _not_named_another_studys(capsys, d) -> None:
+    """``sim show`` and ``sim.Results`` of ``d`` say nothing of another study's results."""
+    capsys.readouterr()
+    assert main(["show", str(d)]) == 0
+    assert "holds the results of a run" not in capsys.readouterr().err
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sim.Results(d, "network").claims()
+
+
 def test_results_renamed_as_a_whole_are_not_called_another_studys(done, tmp_path, capsys):
     """Unclear message on a legitimate use (J48's copy check): results written with ``--out
     r1`` and then moved or renamed as a whole (``mv r1 2026-11-30``) were noted by ``sim show``
@@ -41,12 +51,7 @@ def test_results_renamed_as_a_whole_are_not_called_another_studys(done, tmp_path
     moved = tmp_path / "2026-11-30"
     (done / "r1").rename(moved)
     try:
-        capsys.readouterr()
-        assert main(["show", str(moved)]) == 0
-        assert "holds the results of a run" not in capsys.readouterr().err
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            sim.Results(moved, "network").claims()
+        _not_named_another_studys(capsys, moved)
         # where the name is taken as a study file's (a batch's B/<stem>), it is still named
         assert "written as r1/" in other_source(moved, "beta")
         assert other_source(moved, "tri") is None
@@ -130,12 +135,7 @@ def test_a_link_to_a_studys_results_is_not_called_a_copy(tmp_path, capsys):
     out = tmp_path / "B" / "alpha"
     assert main(["run", str(tmp_path / "alpha.toml"), "--out", str(out), *RUN]) == 0
     (latest := tmp_path / "latest").symlink_to(out)
-    capsys.readouterr()
-    assert main(["show", str(latest)]) == 0
-    assert "holds the results of a run" not in capsys.readouterr().err
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        sim.Results(latest, "network").claims()
+    _not_named_another_studys(capsys, latest)
     assert "written as alpha/" in other_source(latest, "beta")  # a batch's beta: still named
 
 
