@@ -5,6 +5,8 @@ Coordinates in mm, standard deviations in um.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from sim.instruments.plates import pattern_points
@@ -168,9 +170,10 @@ DILUTION = {
     ),
     "checks.bias_shift_um": real(
         100.0,
-        "constant added to all ranges in the bias invariance check (at least 1 um, a million "
-        "times its claims' zone of 1e-9 mm: at 0 it compared an adjustment with itself)",
-        lo=1.0,
+        "constant added to all ranges in the bias invariance check, of either sign (at least "
+        "1 um in size, a million times its claims' zone of 1e-9 mm: at 0 it compared an "
+        "adjustment with itself)",
+        lo=-1e5,
         hi=1e5,
         unit="um",
     ),
@@ -267,6 +270,39 @@ def check_extents(cfg: dict) -> None:
         )
 
 
+#: smallest size of the bias invariance check's constant (um, either sign): a million times
+#: its claims' zone of 1e-9 mm
+MIN_BIAS_SHIFT_UM = 1.0
+
+
+def check_shift(cfg: dict, r: np.ndarray) -> None:
+    """The bias check's constant is at least :data:`MIN_BIAS_SHIFT_UM` in size: a negative
+    additive constant (ranges read short) is as valid as a positive one (it was refused as
+    "must be >= 1"), but one of 0 compared an adjustment with itself; a negative one keeps
+    the shortest of the true ranges ``r`` (mm), with ``errors.bias_um``, at or above 0 (no
+    comparator reads a negative range: at -100 mm no shifted adjustment converged, and the
+    claims held "over 0 Monte-Carlo plates")."""
+    v = cfg.get("checks.bias_shift_um")
+    if v is None:
+        return
+    if abs(v) < MIN_BIAS_SHIFT_UM:
+        raise ConfigError(
+            "checks.bias_shift_um",
+            f"must be >= {MIN_BIAS_SHIFT_UM:g} or <= -{MIN_BIAS_SHIFT_UM:g} um (got {v:g}): a "
+            "smaller constant moves the pivot adjustment by less than its claims' zone of "
+            "1e-9 mm, and 0 compares it with itself",
+        )
+    low = r.min() + (cfg["errors.bias_um"] + v) * 1e-3
+    if low < 0:
+        raise ConfigError(
+            "checks.bias_shift_um",
+            f"{v:g} um reads the shortest range, {r.min():.1f} mm (plus errors.bias_um = "
+            f"{cfg['errors.bias_um']:g} um), as {low:.1f} mm: a comparator reads no negative "
+            f"range (give a constant no lower than "
+            f"{math.ceil(-(r.min() * 1e3 + cfg['errors.bias_um'])):d} um)",
+        )
+
+
 def check(cfg: dict) -> None:
     """Cross-key rules: a range sigma the model can divide by, beta under the scale, points
     inside the format, enough points, no duplicates/collinearity, every range on the scale, and
@@ -345,6 +381,7 @@ def check(cfg: dict) -> None:
             f"plus the {off:g} mm offset) are so far out that the ranges overflow",
         )
     check_scale(cfg, key, r, {k: f.default for k, f in BASE.items()})
+    check_shift(cfg, r)
     check_pivot(cfg, key, pts, {k: f.default for k, f in BASE.items()})
     base = {k: f.default for k, f in BASE.items()}
     check_start(cfg, key, setup, MODEL_NAMES, moved_from_paper(cfg, key, base), base)

@@ -1,0 +1,36 @@
+"""Helper j51 (session 52's J52): the last session's left items, each a bad (or wrongly
+refused) input through one door, each test failing on the code before its fix.
+
+* brown_dilution's bias-invariance constant of either sign: ``checks.bias_shift_um = -100``
+  (ranges read short, as valid an additive constant as +100) was refused ("must be >= 1");
+  a negative constant that reads the shortest range below 0 (-100 mm) was then run and the
+  paper's "precisely the same x_j, y_j" scored "holds" over 0 Monte-Carlo plates (no shifted
+  adjustment converged). Now |shift| >= 1 um, and a negative one keeps every reading >= 0.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import sim
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDIES = ROOT / "studies"
+
+
+def test_a_negative_bias_constant_is_accepted_and_one_below_the_shortest_range_refused():
+    """A wrongly refused value (a negative additive constant) and a meaningless one (readings
+    below 0): -100 um was refused "must be >= 1"; -100 mm then ran, and scored "holds" over
+    no plate. Now -100 um loads, -100 mm and -0.5 um are refused naming the key."""
+    cfg = sim.load(STUDIES / "brown_dilution.toml", checks__bias_shift_um=-100.0).config
+    assert cfg["checks.bias_shift_um"] == -100.0
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(STUDIES / "brown_dilution.toml", checks__bias_shift_um=-1e5)
+    msg = str(e.value)
+    assert msg.startswith("checks.bias_shift_um: -100000 um reads the shortest range"), msg
+    assert "no negative range" in msg and "\n" not in msg
+    with pytest.raises(sim.ConfigError) as e:
+        sim.load(STUDIES / "brown_dilution.toml", checks__bias_shift_um=-0.5)
+    assert str(e.value).startswith("checks.bias_shift_um: must be >= 1 or <= -1 um"), str(e.value)
