@@ -6,10 +6,16 @@ refused) input through one door, each test failing on the code before its fix.
   a negative constant that reads the shortest range below 0 (-100 mm) was then run and the
   paper's "precisely the same x_j, y_j" scored "holds" over 0 Monte-Carlo plates (no shifted
   adjustment converged). Now |shift| >= 1 um, and a negative one keeps every reading >= 0.
+* A note (``sim.standard_error.say``: "resuming", "note: ...") naming a path with a non-ASCII
+  character to a strict-ASCII standard error (``PYTHONIOENCODING=ascii:strict``) raised
+  ``UnicodeEncodeError``, a traceback in place of the note; a path's terminal control codes
+  reached the terminal raw (one-line errors escaped them). Both are escaped now
+  (:func:`sim.escapes.printable`, moved below every layer that prints).
 """
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import pytest
@@ -34,3 +40,17 @@ def test_a_negative_bias_constant_is_accepted_and_one_below_the_shortest_range_r
     with pytest.raises(sim.ConfigError) as e:
         sim.load(STUDIES / "brown_dilution.toml", checks__bias_shift_um=-0.5)
     assert str(e.value).startswith("checks.bias_shift_um: must be >= 1 or <= -1 um"), str(e.value)
+
+
+def test_a_note_to_a_strict_ascii_stderr_is_escaped_not_raised(monkeypatch):
+    """An environment (stderr's encoding strict ASCII) and a hostile path (an escape
+    sequence): ``say`` raised UnicodeEncodeError on ``é`` and wrote ``\\x1b[2J`` raw. Now
+    both are backslash escapes, the line written whole."""
+    from sim.standard_error import say
+
+    raw = io.BytesIO()
+    err = io.TextIOWrapper(raw, encoding="ascii", errors="strict")
+    monkeypatch.setattr("sys.stderr", err)
+    say("sim: note: /tmp/r\u00e9sultats\x1b[2J/run.json")
+    err.flush()
+    assert raw.getvalue() == b"sim: note: /tmp/r\\xe9sultats\\x1b[2J/run.json\n"
