@@ -11,6 +11,9 @@ refused) input through one door, each test failing on the code before its fix.
   ``UnicodeEncodeError``, a traceback in place of the note; a path's terminal control codes
   reached the terminal raw (one-line errors escaped them). Both are escaped now
   (:func:`sim.escapes.printable`, moved below every layer that prints).
+* A quoted pattern whose directory cannot be read (``chmod 000 d; sim check 'd/*.toml'``)
+  read "a pattern that matched no file", of a directory that may hold the files; a pattern in
+  a directory that does not exist read the same. Each names its directory now.
 """
 
 from __future__ import annotations
@@ -54,3 +57,27 @@ def test_a_note_to_a_strict_ascii_stderr_is_escaped_not_raised(monkeypatch):
     say("sim: note: /tmp/r\u00e9sultats\x1b[2J/run.json")
     err.flush()
     assert raw.getvalue() == b"sim: note: /tmp/r\\xe9sultats\\x1b[2J/run.json\n"
+
+
+def test_a_pattern_in_an_unreadable_directory_names_the_directory(tmp_path, monkeypatch, capsys):
+    """A path (a pattern) whose directory cannot be listed (root reads a chmod 000 directory,
+    so its listing is made to fail): "a pattern that matched no file". Now the directory and
+    the reason, exit 2."""
+    import os
+
+    from sim.cli import main
+
+    d = tmp_path / "studies"
+    d.mkdir()
+    real = os.scandir
+
+    def scandir(path="."):
+        if Path(path) == d:
+            raise PermissionError(13, "Permission denied", str(path))
+        return real(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    assert main(["check", str(d / "*.toml")]) == 2
+    err = capsys.readouterr().err
+    assert f"a pattern whose directory {d} could not be read (Permission denied)" in err, err
+    assert "matched no file" not in err and len(err.splitlines()) == 1
