@@ -14,6 +14,10 @@ refused) input through one door, each test failing on the code before its fix.
 * A quoted pattern whose directory cannot be read (``chmod 000 d; sim check 'd/*.toml'``)
   read "a pattern that matched no file", of a directory that may hold the files; a pattern in
   a directory that does not exist read the same. Each names its directory now.
+* A GNU Gama file whose DOCTYPE declares a harmless attribute default (``<!ATTLIST gama-local
+  xmlns CDATA #FIXED "...gama-local">``, which gama-local 2.03 reads; or a default no element
+  lacks) was refused as every default was. It is read now; a default that gives an element a
+  value it does not write (another namespace, a stdev) is still refused.
 """
 
 from __future__ import annotations
@@ -81,3 +85,29 @@ def test_a_pattern_in_an_unreadable_directory_names_the_directory(tmp_path, monk
     err = capsys.readouterr().err
     assert f"a pattern whose directory {d} could not be read (Permission denied)" in err, err
     assert "matched no file" not in err and len(err.splitlines()) == 1
+
+
+def test_a_doctype_default_that_changes_nothing_is_read(tmp_path):
+    """A GNU Gama file (a harmless DOCTYPE): ``#FIXED`` xmlns of gama-local's own namespace on a
+    root without one (gama-local 2.03 adjusts it) and a distance stdev default every distance
+    overrides were refused "attribute defaults are not read". Now read; a default namespace
+    of another URI (gama-local: "bad namespace") is still refused, naming it."""
+    from gama_triangle import triangle
+
+    from sim.studies.network.gama_read import read_gama
+
+    ns = '<gama-local xmlns="http://www.gnu.org/software/gama/gama-local">'
+    fixed = '<!ATTLIST gama-local xmlns CDATA #FIXED "http://www.gnu.org/software/gama/gama-local">'
+    for decl in (fixed, '<!ATTLIST distance stdev CDATA "5">'):
+        text = triangle().replace(ns, "<gama-local>" if "xmlns" in decl else ns)
+        p = tmp_path / "net.xml"
+        p.write_text(text.replace("?>\n", f"?>\n<!DOCTYPE gama-local [{decl}]>\n", 1))
+        assert [q["name"] for q in read_gama(p)["network.points"]] == ["A", "B", "C"]
+    other = fixed.replace("software/gama/gama-local", "x")
+    p.write_text(
+        triangle()
+        .replace(ns, "<gama-local>")
+        .replace("?>\n", f"?>\n<!DOCTYPE gama-local [{other}]>\n", 1)
+    )
+    with pytest.raises(sim.ConfigError, match="gives <gama-local> attribute 'xmlns' the default"):
+        read_gama(p)
