@@ -18,6 +18,11 @@ refused) input through one door, each test failing on the code before its fix.
   xmlns CDATA #FIXED "...gama-local">``, which gama-local 2.03 reads; or a default no element
   lacks) was refused as every default was. It is read now; a default that gives an element a
   value it does not write (another namespace, a stdev) is still refused.
+* A run.json of this code whose ``files`` list was emptied (or made null) by hand was read as
+  the run's, and ``sim report`` re-filled it with README.md alone: the run's own tables and
+  export then read as the user's (a re-run refused its own ``network.xml``). The readers
+  (show, report, ``sim.Results``) refuse it now, as a record with its sha256s removed is
+  (J50's forged-record rule), naming run.json and the table the list does not name.
 """
 
 from __future__ import annotations
@@ -111,3 +116,25 @@ def test_a_doctype_default_that_changes_nothing_is_read(tmp_path):
     )
     with pytest.raises(sim.ConfigError, match="gives <gama-local> attribute 'xmlns' the default"):
         read_gama(p)
+
+
+def test_a_run_record_whose_files_list_was_emptied_is_refused(tmp_path, tiny_run, capsys):
+    """A results directory touched by hand (run.json's ``files`` emptied): ``sim show`` read
+    it as the run's and ``sim report`` wrote ``files = ["README.md"]`` into it. Now each
+    refuses naming run.json and claims.parquet, exit 2, and run.json is left as it was."""
+    import json
+    import shutil
+
+    from sim.cli import main
+
+    out = tmp_path / "results" / "network_plate"
+    shutil.copytree(tiny_run("network_plate"), out)
+    rec = out / "run.json"
+    rec.write_text(json.dumps({**json.loads(rec.read_text()), "files": []}))
+    before = rec.read_bytes()
+    for argv in (["show", str(out)], ["report", "--results", str(out.parent)]):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert f"{rec} is not a run record (its files list does not name claims.parquet" in err
+        assert len(err.splitlines()) == 1, err
+    assert rec.read_bytes() == before
