@@ -23,6 +23,12 @@ refused) input through one door, each test failing on the code before its fix.
   export then read as the user's (a re-run refused its own ``network.xml``). The readers
   (show, report, ``sim.Results``) refuse it now, as a record with its sha256s removed is
   (J50's forged-record rule), naming run.json and the table the list does not name.
+* ``output.inner_over`` over one point beside a fixed point (one fixed point, an inner datum
+  over the others) was refused, "cannot fix the network's 3 datum defects", though the point
+  holds the one defect the fixed point leaves (the rotation about it), and ``compare.fix``
+  over the same point was accepted (N51). The two agree now: the inner datum removes the
+  defects the fixed points leave when its points cannot hold every free-network defect
+  (named "... (about the fixed points)"); points that hold neither are still refused.
 """
 
 from __future__ import annotations
@@ -138,3 +144,40 @@ def test_a_run_record_whose_files_list_was_emptied_is_refused(tmp_path, tiny_run
         assert f"{rec} is not a run record (its files list does not name claims.parquet" in err
         assert len(err.splitlines()) == 1, err
     assert rec.read_bytes() == before
+
+
+ONE_FIXED = """study = "network"
+trials = 40
+chunk = 2
+[network]
+points = [ { name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" },
+           { name = "B", x_mm = 1000.0, y_mm = 0.0 },
+           { name = "C", x_mm = 400.0, y_mm = 700.0 },
+           { name = "D", x_mm = 900.0, y_mm = 800.0 } ]
+generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 0.01 } ]
+[datum]
+kind = "inner"
+[output]
+inner_over = ["C"]
+"""
+
+
+def test_inner_over_one_point_beside_a_fixed_point_holds_the_rotation_about_it(tmp_path):
+    """Network keys in combination (``output.inner_over`` over one point with one fixed point):
+    refused, though ``compare.fix = ["C"]`` was accepted. Now it runs, and its datum is the
+    one the mathematics gives: A held, C's motion about A (tangential) removed, so C's
+    covariance is along the line A-C alone (its ellipse's small axis 0)."""
+    import numpy as np
+    import pyarrow.parquet as pq
+
+    study = tmp_path / "one.toml"
+    study.write_text(ONE_FIXED)
+    sim.load(study).run(tmp_path / "r", figures=False)
+    d = pq.read_table(tmp_path / "r" / "datums.parquet").to_pydict()
+    assert set(d["datum"]) == {"inner over C (about the fixed points)"}
+    sx, sy = (dict(zip(d["point"], d[k])) for k in ("sigma_x_mm", "sigma_y_mm"))
+    assert sx["A"] == sy["A"] == 0.0 and sx["B"] > 1e-3
+    u = np.array([400.0, 700.0]) / np.hypot(400.0, 700.0)  # A-C, radial
+    assert sx["C"] ** 2 / sy["C"] ** 2 == pytest.approx((u[0] / u[1]) ** 2, rel=1e-6)
+    with pytest.raises(sim.ConfigError, match="output.inner_over: the points A cannot fix"):
+        sim.load(study, output__inner_over=["A"])  # the fixed point holds no rotation about it
