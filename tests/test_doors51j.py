@@ -29,6 +29,9 @@ refused) input through one door, each test failing on the code before its fix.
   over the same point was accepted (N51). The two agree now: the inner datum removes the
   defects the fixed points leave when its points cannot hold every free-network defect
   (named "... (about the fixed points)"); points that hold neither are still refused.
+* A claim note edited into ``claims.parquet`` with terminal control codes (its record forged to
+  match) was escaped by ``sim show`` only: ``sim report`` wrote it raw into the results'
+  README.md (``cat`` cleared the screen). REPORT.md and every README.md are escaped now.
 """
 
 from __future__ import annotations
@@ -181,3 +184,38 @@ def test_inner_over_one_point_beside_a_fixed_point_holds_the_rotation_about_it(t
     assert sx["C"] ** 2 / sy["C"] ** 2 == pytest.approx((u[0] / u[1]) ** 2, rel=1e-6)
     with pytest.raises(sim.ConfigError, match="output.inner_over: the points A cannot fix"):
         sim.load(study, output__inner_over=["A"])  # the fixed point holds no rotation about it
+
+
+def test_a_note_with_control_codes_is_escaped_in_the_readme(tmp_path, tiny_run):
+    """A table touched by hand, its record forged to match (a note holding ``\\x1b[2J``):
+    written raw into README.md by ``sim report``. Now escaped there and in REPORT.md."""
+    import hashlib
+    import json
+    import shutil
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from sim.cli import main
+    from sim.mc.table_shape import shape
+
+    out = tmp_path / "results" / "network_plate"
+    shutil.copytree(tiny_run("network_plate"), out)
+    t = pq.read_table(out / "claims.parquet")
+    notes = t.column("note").to_pylist()
+    notes[0] = "cleared\x1b[2J here"
+    t = t.set_column(
+        t.column_names.index("note"), "note", pa.array(notes, t.schema.field("note").type)
+    )
+    pq.write_table(t, out / "claims.parquet")
+    rec = json.loads((out / "run.json").read_text())
+    rec["table_shape"]["claims.parquet"] = shape(t)
+    rec["table_sha256"]["claims.parquet"] = hashlib.sha256(
+        (out / "claims.parquet").read_bytes()
+    ).hexdigest()
+    (out / "run.json").write_text(json.dumps(rec))
+    assert main(["report", "--results", str(out.parent)]) == 0
+    readme = (out / "README.md").read_text(encoding="utf-8")
+    assert "cleared\\x1b[2J here" in readme
+    for f in (out / "README.md", out.parent / "REPORT.md"):
+        assert "\x1b" not in f.read_text(encoding="utf-8"), f
