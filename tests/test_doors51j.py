@@ -32,6 +32,9 @@ refused) input through one door, each test failing on the code before its fix.
 * A claim note edited into ``claims.parquet`` with terminal control codes (its record forged to
   match) was escaped by ``sim show`` only: ``sim report`` wrote it raw into the results'
   README.md (``cat`` cleared the screen). REPORT.md and every README.md are escaped now.
+* sim/places.py printed its notes itself ("... is not the project's studies/x.toml: writing
+  to scratch/..."): a study file named ``réseau.toml`` under a strict-ASCII standard error
+  ended the run in ``UnicodeEncodeError``, a closed one in ``ValueError``. Through ``say`` now.
 """
 
 from __future__ import annotations
@@ -219,3 +222,23 @@ def test_a_note_with_control_codes_is_escaped_in_the_readme(tmp_path, tiny_run):
     assert "cleared\\x1b[2J here" in readme
     for f in (out / "README.md", out.parent / "REPORT.md"):
         assert "\x1b" not in f.read_text(encoding="utf-8"), f
+
+
+def test_the_scratch_note_of_a_non_ascii_study_file_is_said_not_raised(tmp_path, monkeypatch):
+    """An environment (strict-ASCII or closed stderr) and a path (``réseau.toml``, not the
+    project's): ``default_out``'s note raised UnicodeEncodeError (closed: ValueError), a
+    traceback before the run. Now the note is escaped (or dropped) and the scratch place
+    returned."""
+    from sim.places import default_out
+
+    cfg = {"study": "network"}
+    raw = io.BytesIO()
+    err = io.TextIOWrapper(raw, encoding="ascii", errors="strict")
+    monkeypatch.setattr("sys.stderr", err)
+    path = tmp_path / "r\u00e9seau.toml"
+    at, shown, overwrite = default_out(cfg, {}, path)
+    err.flush()
+    assert overwrite and "scratch" in shown
+    assert b"r\\xe9seau.toml is not the project's studies/r\\xe9seau.toml" in raw.getvalue()
+    err.close()
+    assert default_out(cfg, {}, path)[2]
