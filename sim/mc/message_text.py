@@ -13,11 +13,11 @@ plate.spacing_mm?)", and the value typed in um, moved to the mm key, was a spaci
 the one meant: a key meant that differs only in its unit says the unit to convert to.
 ``unit_hint``: ``--set plate.spacing_mm="45mm"`` was "must be a number (got '45mm')", with
 no word that the unit is the key's name's and the value the number alone.
-``printable`` (:mod:`sim.escapes`, below every layer that prints): a string a run record holds (``written_as``, a study file's path, forged or
-edited by hand) reached the terminal as it was in notes and warnings: an escape sequence
-(``\\x1b]0;...\\x07`` retitled the window, ``\\x1b[2J`` cleared it), a carriage return or a
-bidi override (U+202E) hid or reversed the words around it; such characters are written
-escaped.
+``printable`` (from :mod:`sim.escapes`, below every layer that prints): a string a run
+record holds (``written_as``, a study file's path, forged or edited by hand) reached the
+terminal as it was in notes and warnings: an escape sequence (``\\x1b]0;...\\x07`` retitled
+the window, ``\\x1b[2J`` cleared it), a carriage return or a bidi override (U+202E) hid or
+reversed the words around it; such characters are written escaped.
 ``cut_text``: a value or a word too long for one line, its start and end and its length
 (``sim.mc.config`` and :mod:`sim.long_words` had a copy each).
 """
