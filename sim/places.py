@@ -14,6 +14,11 @@
 * :func:`check_place`: an output directory inside the suite's package ``sim/`` is
   refused, as is one below a symbolic link to nothing (the data files of a study's package, ``.json`` and ``.toml`` among them, are part of
   its code hash: a run's ``run.json`` there made the study's committed results stale).
+
+Their notes ("writing to scratch/...") go through :func:`sim.standard_error.say`: printed
+here, a study file's path with ``é`` ended a run under a strict-ASCII standard error in
+``UnicodeEncodeError``, one with terminal control codes reached the terminal raw, and a closed
+standard error (the Python API's caller's) ended it in ``ValueError``.
 """
 
 from __future__ import annotations
@@ -21,12 +26,12 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import sys
 from pathlib import Path
 
 from sim.mc.config import ConfigError, config_changes
 from sim.mc.storage import code_hash, read_record
 from sim.mc.sweep import reordered, swept_order
+from sim.standard_error import say
 
 __all__ = [
     "CODE",
@@ -173,17 +178,15 @@ def default_out(
     old = read_record(committed)
     scratch = at / "scratch" / f"{name}-{_config_tag(record)}"
     if os.path.islink(committed):  # never replaced (sim.mc.outputs.check_out): it was
-        print(  # "--out: results/<name> is a symbolic link" of a command without --out
+        say(  # "--out: results/<name> is a symbolic link" of a command without --out
             f"sim: {shown_path(committed)} is a symbolic link, which sim never replaces: "
             f"writing to {shown_path(scratch)}/ (--out DIR to choose)",
-            file=sys.stderr,
         )
         return Path(os.path.abspath(scratch)), shown_path(scratch), True
     if not committed.exists() and not _project_file(path, name, at):
-        print(
+        say(
             f"sim: {path} is not the project's studies/{name}.toml: writing to "
             f"{shown_path(scratch)}/ (--out DIR to choose; results/ holds the project's studies)",
-            file=sys.stderr,
         )
         return Path(os.path.abspath(scratch)), shown_path(scratch), True
     same = (
@@ -195,17 +198,15 @@ def default_out(
     if not committed.exists() or same:
         if off is None:
             return Path(os.path.abspath(committed)), shown_path(committed), False
-        print(
+        say(
             f"sim: a run with {off} is not {path} as written, whose results go to "
             f"{shown_path(committed)}/: writing to {shown_path(scratch)}/ (--out DIR to choose)",
-            file=sys.stderr,
         )
         return Path(os.path.abspath(scratch)), shown_path(scratch), True
     why = _differs(old, record) if old is not None else "it is not a results directory of sim"
-    print(
+    say(
         f"sim: {shown_path(committed)}/ holds the committed results and {why}: writing to "
-        f"{shown_path(scratch)}/ (--out DIR to choose; make reproduce rewrites results/)",
-        file=sys.stderr,
+        f"{shown_path(scratch)}/ (--out DIR to choose; make reproduce rewrites results/)"
     )
     return Path(os.path.abspath(scratch)), shown_path(scratch), True
 

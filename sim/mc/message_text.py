@@ -13,11 +13,11 @@ plate.spacing_mm?)", and the value typed in um, moved to the mm key, was a spaci
 the one meant: a key meant that differs only in its unit says the unit to convert to.
 ``unit_hint``: ``--set plate.spacing_mm="45mm"`` was "must be a number (got '45mm')", with
 no word that the unit is the key's name's and the value the number alone.
-``printable``: a string a run record holds (``written_as``, a study file's path, forged or
-edited by hand) reached the terminal as it was in notes and warnings: an escape sequence
-(``\\x1b]0;...\\x07`` retitled the window, ``\\x1b[2J`` cleared it), a carriage return or a
-bidi override (U+202E) hid or reversed the words around it; such characters are written
-escaped.
+``printable`` (from :mod:`sim.escapes`, below every layer that prints): a string a run
+record holds (``written_as``, a study file's path, forged or edited by hand) reached the
+terminal as it was in notes and warnings: an escape sequence (``\\x1b]0;...\\x07`` retitled
+the window, ``\\x1b[2J`` cleared it), a carriage return or a bidi override (U+202E) hid or
+reversed the words around it; such characters are written escaped.
 ``cut_text``: a value or a word too long for one line, its start and end and its length
 (``sim.mc.config`` and :mod:`sim.long_words` had a copy each).
 """
@@ -25,9 +25,9 @@ escaped.
 from __future__ import annotations
 
 import re
-import unicodedata
 from typing import Any
 
+from sim.escapes import printable
 from sim.mc.numtext import number_text
 
 __all__ = ["LONG_DIGITS", "LONG_WORD", "cut_text", "shown", "shorten", "key_text", "near_keys"]
@@ -158,30 +158,3 @@ def unit_hint(key: str, text: str) -> str:
             return f": the unit is in the key's name (_{own}): write {number or 'a finite number'}"
         return f": the key's unit is {own}, in its name: write the number alone, in {own}"
     return ": write the number alone, without a unit"
-
-
-#: the categories of the characters :func:`printable` writes escaped: controls (C0, C1, DEL),
-#: format characters (bidi overrides and isolates, zero-width ones), line and paragraph
-#: separators, surrogates and private use
-_UNPRINTED = {"Cc", "Cf", "Zl", "Zp", "Cs", "Co"}
-
-
-def printable(text: str, lines: bool = False) -> str:
-    """``text`` with every control, format (bidi override), separator, surrogate or
-    private-use character written as Python escapes it (``\\x1b``, ``\\u202e``), so that a
-    string from a file shows as what it holds and does nothing to the terminal; ``lines``:
-    its line feeds and tabs kept (a text of several lines)."""
-    if not isinstance(text, str):
-        text = str(text)
-    if text.isascii() and text.isprintable():
-        return text
-    return "".join(
-        c
-        if (lines and c in "\n\t") or unicodedata.category(c) not in _UNPRINTED
-        else f"\\x{ord(c):02x}"
-        if ord(c) < 0x100
-        else f"\\u{ord(c):04x}"
-        if ord(c) < 0x10000
-        else f"\\U{ord(c):08x}"
-        for c in text
-    )

@@ -162,19 +162,17 @@ def _matches(p: Path) -> int | None:
     the whole disk, /proc too, and ``sim check`` ran for minutes before its one line. The
     directory's entries are read up to :data:`_SCANNED`, not its first :data:`_LOOKED` only: a
     study file listed after them (``'runs/*.toml'`` in a directory of 3,000 outputs) was "a
-    pattern that matched no file"."""
+    pattern that matched no file". A directory that cannot be read raises its ``OSError``
+    (it was "matched no file" too, of a directory of study files that could not be listed)."""
     if _wild(p.parent):
         return None
     n, hidden = 0, p.name.startswith(".")
-    try:
-        with os.scandir(p.parent) as it:
-            for e in itertools.islice(it, _SCANNED):
-                if fnmatch.fnmatchcase(e.name, p.name) and (hidden or e.name[0] != "."):
-                    n += 1
-                    if n > _LOOKED:
-                        break
-    except OSError:
-        return 0
+    with os.scandir(p.parent) as it:
+        for e in itertools.islice(it, _SCANNED):
+            if fnmatch.fnmatchcase(e.name, p.name) and (hidden or e.name[0] != "."):
+                n += 1
+                if n > _LOOKED:
+                    break
     return n
 
 
@@ -193,7 +191,15 @@ def study_file_problem(p: str | Path) -> str | None:
         if why := link_problem(p):  # a link loop was "no such study file", of a name there
             return f"{p}: {why}"
         if any(c in p.name for c in "*?[") or _wild(p.parent):
-            hits = _matches(p)  # quoted, the shell passed on a pattern of files
+            try:
+                hits = _matches(p)  # quoted, the shell passed on a pattern of files
+            except FileNotFoundError:
+                return f"{p}: no such study file (a pattern in {p.parent}, no such directory)"
+            except OSError as e:  # unreadable (chmod 000), not a directory, gone
+                return (
+                    f"{p}: a pattern whose directory {p.parent} could not be read "
+                    f"({e.strerror or type(e).__name__}): name the study files"
+                )
             if hits is None:  # a pattern of folders: not walked
                 return (
                     f"{p}: a pattern, not a study file (which the shell did not expand: leave "

@@ -168,15 +168,32 @@ def record_problem(path: str | Path, missing: bool = False) -> tuple[Path, str] 
     column) wrote its ``run.json`` beside it, so a results directory without one is not an
     older version's, it is one whose record was removed."""
     spots = _spots(Path(path))
-    for root, _ in spots:
-        if read_record(root) is not None:
-            return None
+    for root, key in spots:
+        if (doc := read_record(root)) is not None:
+            return (root / RECORD, why) if (why := _unlisted(doc, root, key)) else None
         if os.path.lexists(rec := root / RECORD):
             return rec, _unrecorded(rec)
     if not missing:
         return None
     sweep = len(spots) > 1 and os.path.lexists(spots[-1][0] / "sweep.parquet")  # else its own
     return (spots[-1 if sweep else 0][0] / RECORD, MISSING)
+
+
+def _unlisted(rec: dict, root: Path, key: str) -> str | None:
+    """What is wrong when ``rec``, a record of this code's run (sealed: not a staging
+    directory's), recorded the shape of the table ``key`` but its ``files`` does not name it
+    (emptied or made null by hand), else None. Such a record was read as the run's, and
+    ``sim report`` re-filled its ``files`` with README.md alone: the run's own files then read
+    as the user's, and a re-run refused its own export."""
+    files = rec.get("files")
+    shapes = rec.get(SHAPE_KEY)
+    if not isinstance(shapes, dict) or key not in shapes or _staging(root):
+        return None
+    if isinstance(files, list) and key in files:
+        return None
+    if not _this_code(rec):
+        return None
+    return f"its files list does not name {key}, which its run wrote"
 
 
 def record_line(bad: tuple[Path, str]) -> str:

@@ -7,7 +7,6 @@ Markdown. Nothing here runs a simulation.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from typing import Callable
 
@@ -15,6 +14,7 @@ import pyarrow as pa
 
 from sim.claims.region import REGION_LEVEL, REGION_MIN_POINTS, REGION_SHARE
 from sim.claims.rules import NOT_APPLICABLE, P_FAIL, PREDICTION_VERDICTS
+from sim.escapes import printable
 from sim.mc.config import ConfigError
 from sim.mc.export_edits import changed_exports
 from sim.mc.outputs import results_dirs
@@ -37,6 +37,7 @@ from sim.report.read import (
 from sim.report.run_summary import converged_line, headline_rows, verdict_cell, write_run_readme
 from sim.report.tables import Md, fmt, md_href, md_link, md_table
 from sim.report.verify import markdown as reproducibility_markdown
+from sim.standard_error import say
 
 __all__ = [
     "build_report",
@@ -421,7 +422,7 @@ def write_report(
         )
 
     def build() -> str:
-        return MARK + "\n" + build_report(results, get_study, design, studies)
+        return MARK + "\n" + printable(build_report(results, get_study, design, studies), True)
 
     text, read = _settled(results, build), _dirs(results)
     for d in sorted(results_dirs(results)):
@@ -431,7 +432,7 @@ def write_report(
         if (d / "claims.parquet").is_file() or (d / "sweep.parquet").is_file():
             _settled(results, lambda d=d: write_run_readme(d, get_study, design=design))
             if (what := changed_exports(d).get("README.md")) is not None:  # kept: said
-                print(f"sim: note: {d / 'README.md'} {_kept(what)}", file=sys.stderr)
+                say(f"sim: note: {d / 'README.md'} {_kept(what)}")
     if _dirs(results) != read:  # a run published while the READMEs were written: REPORT.md
         text = _settled(results, build)  # held the replaced run's claims beside the new run
     with atomic_path(out) as tmp:

@@ -19,6 +19,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from sim.claims.rules import NOT_APPLICABLE, PREDICTION_VERDICTS
+from sim.escapes import printable
 from sim.mc.config import ConfigError
 from sim.mc.export_edits import README_KEY
 from sim.mc.file_kind import odd_table
@@ -415,7 +416,7 @@ def write_run_readme(
             if rec is not None and "README.md" in (rec.get("files") or []):
                 write_record(out, {**rec, "files": [f for f in rec["files"] if f != "README.md"]})
         return None
-    text = README_MARK + "\n" + run_markdown(out, get_study, name, design, final)
+    text = README_MARK + "\n" + printable(run_markdown(out, get_study, name, design, final), True)
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     rec = read_record(out)  # its sha256: one edited by hand is the user's (kept, named)

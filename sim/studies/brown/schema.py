@@ -5,20 +5,20 @@ Coordinates in mm, standard deviations in um.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from sim.instruments.plates import pattern_points
 from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
-from sim.instruments.ranges import positions as po
-from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import when
-from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
+from sim.mc.runner import MIN_CHUNKS, require_chunks
 from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, region_seed
+from sim.studies.brown.pivot_geometry import check_pivot, points_of, setup, within_beta
 from sim.studies.brown.probe import check_noise, check_solver, check_start
 from sim.studies.brown.range_keys import check_scale, moved_from_paper
-from sim.studies.brown.values import thetas
 
 SEED = "004_f5bd9e86c308241f.txt"
 MODEL_NAMES = ("known", "stations", "pivot")
@@ -170,9 +170,10 @@ DILUTION = {
     ),
     "checks.bias_shift_um": real(
         100.0,
-        "constant added to all ranges in the bias invariance check (at least 1 um, a million "
-        "times its claims' zone of 1e-9 mm: at 0 it compared an adjustment with itself)",
-        lo=1.0,
+        "constant added to all ranges in the bias invariance check, of either sign (at least "
+        "1 um in size, a million times its claims' zone of 1e-9 mm: at 0 it compared an "
+        "adjustment with itself)",
+        lo=-1e5,
         hi=1e5,
         unit="um",
     ),
@@ -243,22 +244,6 @@ def range_sigma_um(cfg: dict) -> float:
     )
 
 
-def points_of(cfg: dict) -> np.ndarray:
-    """The plate's points (n, 2) mm; a random pattern is drawn once from stream part 99 of
-    ``plate.layout_seed``, never of the run's ``seed``: a sweep's cells (validated at the
-    study's seed, run at their own) and ``--seed`` each drew another plate, so a sweep over an
-    error compared plates of other layouts."""
-    return pattern_points(
-        cfg["plate.pattern"],
-        grid=cfg["plate.grid"],
-        spacing_mm=cfg["plate.spacing_mm"],
-        n_random=cfg["plate.n_random"],
-        half_extent_mm=cfg["plate.random_half_extent_mm"],
-        points=cfg["plate.points"],
-        rng=chunk_rng(cfg["plate.layout_seed"], 99, 0),
-    )
-
-
 def max_offset_mm(cfg: dict, half_extent_mm: float) -> float:
     """Largest station offset at which every range of a grid reaching +-half_extent_mm fits
     the scale plus the micrometer (inf when the scale is not enforced). The farthest point
@@ -282,6 +267,39 @@ def check_extents(cfg: dict) -> None:
     if v is not None and v > half:
         raise ConfigError(
             "idealised.half_extent_mm", f"half extents must lie inside the format (<= {half:g} mm)"
+        )
+
+
+#: smallest size of the bias invariance check's constant (um, either sign): a million times
+#: its claims' zone of 1e-9 mm
+MIN_BIAS_SHIFT_UM = 1.0
+
+
+def check_shift(cfg: dict, r: np.ndarray) -> None:
+    """The bias check's constant is at least :data:`MIN_BIAS_SHIFT_UM` in size: a negative
+    additive constant (ranges read short) is as valid as a positive one (it was refused as
+    "must be >= 1"), but one of 0 compared an adjustment with itself; a negative one keeps
+    the shortest of the true ranges ``r`` (mm), with ``errors.bias_um``, at or above 0 (no
+    comparator reads a negative range: at -100 mm no shifted adjustment converged, and the
+    claims held "over 0 Monte-Carlo plates")."""
+    v = cfg.get("checks.bias_shift_um")
+    if v is None:
+        return
+    if abs(v) < MIN_BIAS_SHIFT_UM:
+        raise ConfigError(
+            "checks.bias_shift_um",
+            f"must be >= {MIN_BIAS_SHIFT_UM:g} or <= -{MIN_BIAS_SHIFT_UM:g} um (got {v:g}): a "
+            "smaller constant moves the pivot adjustment by less than its claims' zone of "
+            "1e-9 mm, and 0 compares it with itself",
+        )
+    low = r.min() + (cfg["errors.bias_um"] + v) * 1e-3
+    if low < 0:
+        raise ConfigError(
+            "checks.bias_shift_um",
+            f"{v:g} um reads the shortest range, {r.min():.1f} mm (plus errors.bias_um = "
+            f"{cfg['errors.bias_um']:g} um), as {low:.1f} mm: a comparator reads no negative "
+            f"range (give a constant no lower than "
+            f"{math.ceil(-(r.min() * 1e3 + cfg['errors.bias_um'])):d} um)",
         )
 
 
@@ -350,7 +368,7 @@ def check(cfg: dict) -> None:
         raise ConfigError(
             key, "all points are collinear: the station coordinates cannot be recovered"
         )
-    _within_beta(cfg, key, pts)
+    within_beta(cfg, key, pts)
     _, theta = setup(cfg)
     with np.errstate(over="ignore", invalid="ignore"):  # named below, not warned
         r = ml.ranges(pts[None], theta[None])
@@ -363,87 +381,10 @@ def check(cfg: dict) -> None:
             f"plus the {off:g} mm offset) are so far out that the ranges overflow",
         )
     check_scale(cfg, key, r, {k: f.default for k, f in BASE.items()})
-    check_pivot(cfg, key, pts)
+    check_shift(cfg, r)
+    check_pivot(cfg, key, pts, {k: f.default for k, f in BASE.items()})
     base = {k: f.default for k, f in BASE.items()}
     check_start(cfg, key, setup, MODEL_NAMES, moved_from_paper(cfg, key, base), base)
     check_solver(cfg, pts, setup(cfg)[1], MODEL_NAMES, BASE["solver.max_iter"].default)
     check_noise(cfg, key, pts, setup(cfg)[1], MODEL_NAMES, moved_from_paper(cfg, key, base), base)
     require_chunks(cfg)
-
-
-def _within_beta(cfg: dict, key: str, pts: np.ndarray) -> None:
-    """A point no farther from a station than the tangential offset beta has no range
-    (r = sqrt(d^2 - beta^2) - alpha): it was accepted (or blamed on a singular normal matrix,
-    or on the scale) and every trial failed at run time after a NumPy warning."""
-    _, theta = setup(cfg)
-    st = ml.stations(theta)  # (4, 2) mm
-    with np.errstate(over="ignore"):  # inf: the range check names stations that far out
-        d2 = ((pts[:, None, :] - st[None, :, :]) ** 2).sum(-1)  # (n, 4) mm^2
-    beta = cfg["comparator.beta_mm"]
-    bad = np.argwhere(d2 <= beta**2)
-    if len(bad):
-        i, j = bad[0]
-        raise ConfigError(
-            key,
-            f"point {i + 1} ({pts[i, 0]:g}, {pts[i, 1]:g}) mm lies {np.sqrt(d2[i, j]):.3g} mm "
-            f"from station {j + 1} ({st[j, 0]:g}, {st[j, 1]:g}), within the tangential pivot "
-            f"offset beta = {beta:g} mm: its range is undefined (move the point, or the "
-            "stations out: comparator.station_offset_mm)",
-        )
-
-
-def pivot_rcond(pts: np.ndarray, theta: np.ndarray) -> float:
-    """The engine's singularity measure (:func:`sim.lsq.normals.scaled_rcond`, 0 for a
-    singular point block) of the pivot model's reduced normals -- the widest model the
-    studies adjust: stations, alpha and beta^2 free -- at the true points (n, 2) mm and
-    globals (7,), where the noise-free ranges are exact."""
-    r = ml.ranges(pts[None], theta[None])
-    model = po.RangeModel(r, ml.BROWN_LAYOUT, P=4, dense=True)
-    red = reduced_normals(model, pts[None], theta[None], np.arange(7))
-    return float(scaled_rcond(red.Nbar)[0]) if red.ok[0] else 0.0
-
-
-def check_pivot(cfg: dict, key: str, pts: np.ndarray) -> None:
-    """Every geometry the run adjusts with the pivot model can be solved by the engine's one
-    rule (a 2 x 2 grid cannot: its symmetry leaves the reduced normals singular, and every
-    trial failed at run time): the plate's points, and the grids of ``dilution.grids`` over
-    the plate's extent."""
-    _, theta = setup(cfg)
-    if not np.all(np.isfinite(ml.ranges(pts[None], theta[None]))):
-        return  # an overflow is named by the range check before this one
-    rc = pivot_rcond(pts, theta)
-    if not rc > RCOND:
-        moved = moved_from_paper(cfg, key, {k: f.default for k, f in BASE.items()})
-        blame = key  # the comparator's keys when the points are solved from the paper's
-        # stations (stations 1e9 mm out blamed the plate's grid)
-        if comp := [k for k in moved if k.startswith("comparator.")]:
-            paper = {**cfg, **{k: BASE[k].default for k in comp}}
-            blame = comp[-1] if pivot_rcond(pts, setup(paper)[1]) > RCOND else key
-        raise ConfigError(
-            blame,
-            f"the pivot model (stations, alpha and beta free) cannot be solved at these "
-            f"{len(pts)} points: its reduced normal matrix is singular (scaled reciprocal "
-            f"condition {rc:.2g}, the adjustment needs > {RCOND:g})"
-            + (
-                f"; changed from their paper or nominal values: {', '.join(moved)}" if moved else ""
-            ),
-        )
-    ext = float(np.abs(pts).max())
-    th = thetas(cfg["plate.format_mm"], cfg["comparator.station_offset_mm"], 0.0, 0.0)[0]
-    for k in cfg.get("dilution.grids", ()):
-        g = pattern_points("grid", grid=k, spacing_mm=2.0 * ext / (k - 1))
-        rc = pivot_rcond(g, th)
-        if not rc > RCOND:
-            raise ConfigError(
-                "dilution.grids",
-                f"the pivot model cannot be solved on a {k} x {k} grid: its reduced normal "
-                f"matrix is singular (scaled reciprocal condition {rc:.2g}, the adjustment "
-                f"needs > {RCOND:g})",
-            )
-
-
-def setup(cfg: dict):
-    pts = points_of(cfg)
-    h = cfg["plate.format_mm"] / 2 + cfg["comparator.station_offset_mm"]
-    theta = ml.design_theta(h, cfg["comparator.alpha_mm"], cfg["comparator.beta_mm"])
-    return pts, theta

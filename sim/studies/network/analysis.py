@@ -179,6 +179,29 @@ def check_inner(net: Network, H: np.ndarray, points: list[int], key: str) -> Non
         )
 
 
+def inner_over_defect(
+    net: Network, free: np.ndarray, points: list[int], key: str
+) -> tuple[np.ndarray, bool]:
+    """The defects ``H`` (2n, d) the inner datum over ``points`` (``output.inner_over``)
+    removes, and whether they are those the fixed points leave: every defect of the network
+    adjusted free (translation, rotation, scale: :func:`inner_defect`; the held network's
+    precision moved to the inner datum) where the points can hold them all, else the defects
+    the fixed points leave (one fixed point: the rotation, and scale, about it,
+    :func:`held_defect`, as ``compare.fix`` takes them), where the points hold those: one
+    point beside a fixed point was refused, though it holds the rotation about it. Points
+    that hold neither are refused naming ``key``."""
+    H = inner_defect(net)
+    try:
+        check_inner(net, H, points, key)
+        return H, False
+    except ConfigError:
+        held = held_defect(net, free)
+        if not 0 < held.shape[1] < H.shape[1]:  # no fixed point, or none left: meaningless
+            raise
+        check_inner(net, held, points, key)
+        return held, True
+
+
 def inner_left(net: Network, H: np.ndarray, key: str) -> None:
     """Refuse an inner datum (``key``: ``datum.kind``, or ``datum.points`` when given) on a
     network whose fixed points leave no defect ``H`` (:func:`held_defect`): its run was the

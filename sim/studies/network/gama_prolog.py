@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from xml.parsers import expat
 
-from sim.studies.network.gama_vocab import said
+from sim.studies.network.gama_frames import NE
+from sim.studies.network.gama_vocab import NS, said
 
 __all__ = ["entity_declared", "default_declared", "raw_name_problem"]
 
@@ -43,23 +44,55 @@ def entity_declared(data: bytes | str) -> str | None:
     return found[0] if found else None
 
 
+#: attribute defaults a DOCTYPE may declare because they change nothing gama-local or this
+#: suite reads: (element, attribute) -> the value gama-local assumes when the attribute is
+#: absent (``gkfparser.cpp``: ``xmlns`` must be its namespace, refused otherwise; ``axes-xy``
+#: and ``angles`` of ``<network>`` default to ``ne`` and ``left-handed``), None: any value
+#: (``version`` of ``<gama-local>``, ignored there and here)
+ASSUMED = {
+    ("gama-local", "xmlns"): NS,
+    ("gama-local", "version"): None,
+    ("network", "axes-xy"): NE[0],
+    ("network", "angles"): NE[1],
+}
+
+
+def _assumed(element: str, attribute: str, value: str) -> bool:
+    """Whether a default ``value`` of ``attribute`` on ``element`` is what gama-local assumes
+    without it (:data:`ASSUMED`)."""
+    if (element, attribute) not in ASSUMED:
+        return False
+    want = ASSUMED[element, attribute]
+    return want is None or value == want
+
+
 def default_declared(data: bytes | str) -> tuple[str, str, str] | None:
     """``(element, attribute, value)`` of the first attribute default the file's DOCTYPE
-    declares (``<!ATTLIST distance stdev CDATA "5">``, ``#FIXED`` too), None: none. The parser
-    (here and in ``gama-local``) gives every element without the attribute that value: a stdev
-    or an ``adj`` no element shows, which a refusal then named on an element that does not
-    hold it ("point 'A' is both fixed and adjusted" of a ``<point fix="xy">``). Only the prolog
-    is parsed; a parse error is left to the reader."""
+    declares (``<!ATTLIST distance stdev CDATA "5">``, ``#FIXED`` too) that gives an element
+    a value it does not write, None: none. The parser (here and in ``gama-local``) gives every
+    element without the attribute that value: a stdev or an ``adj`` no element shows, which a
+    refusal then named on an element that does not hold it ("point 'A' is both fixed and
+    adjusted" of a ``<point fix="xy">``). A default that changes nothing is read: one every
+    such element writes itself, or the value gama-local assumes without it (:data:`ASSUMED`:
+    ``<!ATTLIST gama-local xmlns CDATA #FIXED "...gama-local">`` was refused too). The scan
+    stops at the first element when the DOCTYPE declares no default; a parse error is left to
+    the reader."""
     p = expat.ParserCreate()
+    p.specified_attributes = True  # the attributes as written: a default is not reported
+    declared: dict[str, dict[str, str]] = {}
     found: list[tuple[str, str, str]] = []
 
     def attlist(elname, attname, _type, default, _required):
-        if default is not None:
-            found.append((elname, attname, default))
-            raise _Prolog
+        if default is not None and not _assumed(elname, attname, default):
+            declared.setdefault(elname, {}).setdefault(attname, default)
 
-    def element(*_):
-        raise _Prolog
+    def element(name, attrs):
+        if not declared:
+            raise _Prolog
+        for att, v in declared.get(name, {}).items():
+            if att not in attrs:
+                found.append((name, att, v))
+                raise _Prolog
 
     p.AttlistDeclHandler = attlist
     p.StartElementHandler = element

@@ -22,8 +22,8 @@ from sim.studies.network.analysis import (
     check_inner,
     estimated_points,
     held_defect,
-    inner_defect,
     inner_left,
+    inner_over_defect,
     match_points,
 )
 from sim.studies.network.built import built as build
@@ -143,7 +143,7 @@ def check(cfg: dict) -> None:
         check_compare(net, full, cfg["compare.fix"], sparse)
     if cfg["output.inner_over"]:
         pts = match_points(net, "output.inner_over", cfg["output.inner_over"])
-        check_inner(net, inner_defect(net), pts, "output.inner_over")
+        inner_over_defect(net, an.free, pts, "output.inner_over")
         if all(net.role[p] == 1 for p in pts):  # their covariance is zero: S Q S' = Q
             raise ConfigError(
                 "output.inner_over",

@@ -13,7 +13,14 @@ import numpy as np
 from sim.mc import tolerance as tol
 from sim.mc.runner import jackknife
 from sim.mc.storage import write_table
-from sim.studies.network.analysis import CHI2_2_95, bearing_deg, ellipse, in_datum, match_points
+from sim.studies.network.analysis import (
+    CHI2_2_95,
+    bearing_deg,
+    ellipse,
+    in_datum,
+    inner_over_defect,
+    match_points,
+)
 from sim.studies.network.definition import KINDS, Network
 from sim.studies.network.estimates import McEstimates, sample_sd
 from sim.studies.network.sparse_analysis import in_datum_sparse, variances
@@ -148,13 +155,18 @@ def write_parameters(out: Path, net: Network, an, sim: dict, n_ok: np.ndarray, p
 
 def write_datums(out: Path, net: Network, an, cfg: dict, prov: dict) -> None:
     """``datums.parquet``: the point sigmas in the inner datum over ``output.inner_over`` (the
-    patterns form one set of datum points; empty without it)."""
+    patterns form one set of datum points; empty without it), removing every defect of the
+    network adjusted free, or, where the points cannot hold those but hold the ones the fixed
+    points leave, these (the datum named "... (about the fixed points)":
+    :func:`~sim.studies.network.analysis.inner_over_defect`)."""
     drows = {"datum": [], "point": [], "sigma_x_mm": [], "sigma_y_mm": []}
     if cfg["output.inner_over"]:
         sel = match_points(net, "output.inner_over", cfg["output.inner_over"])
-        cov = in_datum_sparse(net, an, sel) if an.Q is None else in_datum(net, an, sel)
+        H, held = inner_over_defect(net, an.free, sel, "output.inner_over")
+        cov = in_datum_sparse(net, an, sel, H) if an.Q is None else in_datum(net, an, sel, H)
+        name = f"inner over {', '.join(cfg['output.inner_over'])}"
         for a in range(net.n):
-            drows["datum"].append(f"inner over {', '.join(cfg['output.inner_over'])}")
+            drows["datum"].append(name + " (about the fixed points)" * held)
             drows["point"].append(net.names[a])
             drows["sigma_x_mm"].append(float(np.sqrt(max(cov[a, 0, 0], 0))))
             drows["sigma_y_mm"].append(float(np.sqrt(max(cov[a, 1, 1], 0))))
