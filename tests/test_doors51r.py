@@ -1,0 +1,73 @@
+"""The classes of the sweep doors51r (brief R52: a hostile reading of session 51's second wave),
+one case each; each failed on the code before its fix.
+
+* A sweep range reckoned in halves (its span overflows a double) with the smallest step
+  (``{start = -1e308, stop = 1e308, step = 5e-324}``): half the step is 0.0, and the count of
+  values divided by it: ``ZeroDivisionError`` from ``sim.load`` (a traceback of the API),
+  "sim: error: ZeroDivisionError: float division by zero" from ``sim check``, no key named;
+  now "more than 10000 values", naming the key.
+* A ``run.json`` of this code's run forged by keeping its integrity fields and emptying them
+  (``table_sha256 = {}``, ``table_shape = {}``): J50's check refused them made null or
+  removed, but empty ones passed and a claim's value edited beside them was printed as the
+  run's (``sim show`` exit 0, ``sim.Results``); now refused in one line naming the table.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from conftest import TRIANGLE_NETWORK
+
+import sim
+from sim.cli import main
+
+
+def _in(cwd: Path, args: list[str], capsys, monkeypatch) -> tuple[int, str]:
+    monkeypatch.chdir(cwd)
+    rc = main(args)
+    return rc, capsys.readouterr().err
+
+
+def test_sweep_range_in_halves_with_a_denormal_step(tmp_path: Path, capsys, monkeypatch) -> None:
+    """Bad input: a sweep's step of 5e-324 over a range whose span overflows (reckoned in
+    halves). Before: ZeroDivisionError (the API's traceback, the command's bare "float
+    division by zero"); now one ConfigError naming the sweep's key."""
+    f = tmp_path / "s.toml"
+    f.write_text(
+        TRIANGLE_NETWORK + "[sweep]\ntrials = { start = -1e308, stop = 1e308, step = 5e-324 }\n",
+        encoding="utf-8",
+    )
+    with pytest.raises(sim.ConfigError, match=r"^sweep\.trials: step 5e-324 gives more than"):
+        sim.load(f)
+    rc, err = _in(tmp_path, ["check", "s.toml"], capsys, monkeypatch)
+    assert rc == 2 and "sweep.trials" in err and "ZeroDivision" not in err, err
+
+
+def test_forged_record_with_emptied_integrity_fields(tmp_path: Path, capsys, monkeypatch) -> None:
+    """Bad input: a run record of this code whose ``table_sha256`` and ``table_shape`` are kept
+    but emptied (``{}``), or whose claims' entries are removed, beside a claim's value edited
+    by hand. Before: ``sim show`` printed the edited value, exit 0, and ``sim.Results`` read
+    it; now both refuse in one line naming the table, and the unforged record still reads."""
+    from hand_edits import edit_first_value
+
+    (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    args = ["run", "tri.toml", "--out", "r", "--no-figures", "--quiet"]
+    assert _in(tmp_path, args, capsys, monkeypatch)[0] == 0
+    d = tmp_path / "r"
+    rec = json.loads((d / "run.json").read_text(encoding="utf-8"))
+    edit_first_value(d)
+    keys = ("table_sha256", "table_shape")
+    one = {k: {n: v for n, v in rec[k].items() if n != "claims.parquet"} for k in keys}
+    for forged in ({**rec, "table_sha256": {}, "table_shape": {}}, {**rec, **one}):
+        (d / "run.json").write_text(json.dumps(forged), encoding="utf-8")
+        rc, err = _in(tmp_path, ["show", "r"], capsys, monkeypatch)
+        assert rc == 2, err
+        assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+        assert "neither a sha256 nor a shape of claims.parquet" in err, err
+        with pytest.raises(sim.ConfigError, match=r"claims\.parquet is not .*table its run"):
+            sim.Results(d, "network").claims()
+    (d / "run.json").write_text(json.dumps(rec), encoding="utf-8")
+    rc, err = _in(tmp_path, ["show", "r"], capsys, monkeypatch)
+    assert rc == 2 and "is not the claims table its run wrote" in err, err  # the edit is seen
