@@ -71,3 +71,18 @@ def test_forged_record_with_emptied_integrity_fields(tmp_path: Path, capsys, mon
     (d / "run.json").write_text(json.dumps(rec), encoding="utf-8")
     rc, err = _in(tmp_path, ["show", "r"], capsys, monkeypatch)
     assert rc == 2 and "is not the claims table its run wrote" in err, err  # the edit is seen
+
+
+def test_joiners_of_a_legit_name_are_not_escaped(tmp_path: Path, capsys, monkeypatch) -> None:
+    """Legit non-ASCII names: a Persian directory name with its zero-width non-joiner
+    ("نقشه‌برداری", surveying) and an emoji sequence joined by ZWJ. Before: L51's escaping of
+    every format character wrote them as ``\\u200c``/``\\u200d`` in every refusal naming them
+    (noise, a path no longer copyable); now kept between two non-ASCII characters, while a
+    joiner hidden between Latin letters and a bidi override are still escaped."""
+    from sim.mc.message_text import printable
+
+    persian, emoji = "نقشه\u200cبرداری", "fam\U0001f468\u200d\U0001f469\u200d\U0001f467"
+    for name in (persian, emoji):
+        rc, err = _in(tmp_path, ["check", f"{name}/nosuch.toml"], capsys, monkeypatch)
+        assert rc == 2 and f"{name}/nosuch.toml: no such study file" in err, err
+    assert printable("r\u200dm \u200cx \u202e\u200c") == "r\\u200dm \\u200cx \\u202e\\u200c"
