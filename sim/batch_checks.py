@@ -16,7 +16,7 @@ import json
 import os
 from pathlib import Path
 
-from sim.api_paths import arrow_name
+from sim.api_paths import arrow_name, too_long
 from sim.cli import DOC as cli_doc
 from sim.cli_args import parser as run_parser
 from sim.cli_errors import cwd_exists
@@ -373,6 +373,8 @@ def _timings_problem(path: str) -> str | None:
     JSON object of lists), never a file of the user's."""
     if path == "-":  # read as standard output by many programs: here it named a file "-"
         return "'-' is not standard output here: name a file (./- for a file named '-')"
+    if why := too_long(path):  # pathlib's is_dir raised it: "OSError: File name too long"
+        return why
     p = Path(path)
     try:
         parent = p.resolve().parent

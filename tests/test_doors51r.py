@@ -86,3 +86,28 @@ def test_joiners_of_a_legit_name_are_not_escaped(tmp_path: Path, capsys, monkeyp
         rc, err = _in(tmp_path, ["check", f"{name}/nosuch.toml"], capsys, monkeypatch)
         assert rc == 2 and f"{name}/nosuch.toml: no such study file" in err, err
     assert printable("r\u200dm \u200cx \u202e\u200c") == "r\\u200dm \\u200cx \\u202e\\u200c"
+
+
+def test_paths_too_long_for_the_system_at_the_other_doors(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    """Paths too long for the system (a name of 300 bytes; 30 names of 200): T50 checked
+    ``sim run STUDY`` and the API's ``out``, not the neighbouring doors. Before:
+    ``python -m sim.batch --timings`` of one ended in pathlib's "OSError: File name too long"
+    (a traceback, exit 1), ``sim run --out`` of one printed the system's words and the whole
+    path (6 kB, no option named), ``sim report --results`` said it "does not exist"; now
+    one line each naming the option, exit 2, nothing made."""
+    import sim.batch
+
+    (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    deep, wide = "/".join(["b" * 200] * 30), "c" * 300
+    for path in (deep, wide):
+        monkeypatch.chdir(tmp_path)
+        assert sim.batch.main(["--timings", path, "tri.toml"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("sim.batch: --timings: ") and "too long a path" in err, err
+        for args in (["run", "tri.toml", "--out", path], ["report", "--results", path]):
+            rc, err = _in(tmp_path, args, capsys, monkeypatch)
+            assert rc == 2 and f"{args[-2]}: " in err and "too long a path" in err, err
+            assert len(err) < 400, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tri.toml"]
