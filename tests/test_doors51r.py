@@ -95,9 +95,12 @@ def test_paths_too_long_for_the_system_at_the_other_doors(
     ``sim run STUDY`` and the API's ``out``, not the neighbouring doors. Before:
     ``python -m sim.batch --timings`` of one ended in pathlib's "OSError: File name too long"
     (a traceback, exit 1), ``sim run --out`` of one printed the system's words and the whole
-    path (6 kB, no option named), ``sim report --results`` said it "does not exist"; now
-    one line each naming the option, exit 2, nothing made."""
+    path (6 kB, no option named), ``sim report --results`` said it "does not exist", and
+    ``python -m sim.report.verify --scratch`` (``--results``, ``--studies``, ``--study``)
+    "File name too long: " and the whole path; now one line each naming the option, exit 2,
+    nothing made."""
     import sim.batch
+    from sim.report.verify.cli import main as verify
 
     (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
     deep, wide = "/".join(["b" * 200] * 30), "c" * 300
@@ -110,4 +113,8 @@ def test_paths_too_long_for_the_system_at_the_other_doors(
             rc, err = _in(tmp_path, args, capsys, monkeypatch)
             assert rc == 2 and f"{args[-2]}: " in err and "too long a path" in err, err
             assert len(err) < 400, err
+        for opt in ("--scratch", "--study"):
+            assert verify([opt, path]) == 2
+            err = capsys.readouterr().err
+            assert f"error: {opt}: " in err and "too long a path" in err and len(err) < 400, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["tri.toml"]
