@@ -15,6 +15,7 @@ one case each; each failed on the code before its fix.
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -22,6 +23,16 @@ from conftest import TRIANGLE_NETWORK
 
 import sim
 from sim.cli import main
+
+
+@pytest.fixture(scope="module")
+def tri_run(tmp_path_factory) -> Path:
+    """A finished run of conftest's triangle network (no figures), made once: READ ONLY."""
+    base = tmp_path_factory.mktemp("tri")
+    (base / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
+    args = ["run", str(base / "tri.toml"), "--out", str(base / "r"), "--no-figures", "--quiet"]
+    assert main(args) == 0
+    return base / "r"
 
 
 def _in(cwd: Path, args: list[str], capsys, monkeypatch) -> tuple[int, str]:
@@ -45,17 +56,17 @@ def test_sweep_range_in_halves_with_a_denormal_step(tmp_path: Path, capsys, monk
     assert rc == 2 and "sweep.trials" in err and "ZeroDivision" not in err, err
 
 
-def test_forged_record_with_emptied_integrity_fields(tmp_path: Path, capsys, monkeypatch) -> None:
+def test_forged_record_with_emptied_integrity_fields(
+    tri_run: Path, tmp_path: Path, capsys, monkeypatch
+) -> None:
     """Bad input: a run record of this code whose ``table_sha256`` and ``table_shape`` are kept
     but emptied (``{}``), or whose claims' entries are removed, beside a claim's value edited
     by hand. Before: ``sim show`` printed the edited value, exit 0, and ``sim.Results`` read
     it; now both refuse in one line naming the table, and the unforged record still reads."""
     from hand_edits import edit_first_value
 
-    (tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
-    args = ["run", "tri.toml", "--out", "r", "--no-figures", "--quiet"]
-    assert _in(tmp_path, args, capsys, monkeypatch)[0] == 0
     d = tmp_path / "r"
+    shutil.copytree(tri_run, d)
     rec = json.loads((d / "run.json").read_text(encoding="utf-8"))
     edit_first_value(d)
     keys = ("table_sha256", "table_shape")
@@ -118,3 +129,21 @@ def test_paths_too_long_for_the_system_at_the_other_doors(
             err = capsys.readouterr().err
             assert f"error: {opt}: " in err and "too long a path" in err and len(err) < 400, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["tri.toml"]
+
+
+def test_a_kept_readme_of_the_users_is_not_called_the_report(tri_run: Path, tmp_path: Path) -> None:
+    """A README.md of the user's kept in a results directory (carried by a run of another
+    study with ``--overwrite``: the earlier run's README, edited, or notes of the user's).
+    Before: the run's closing lines said "report: DIR/README.md", sending the user to a file
+    that is not the run's report (another study's, or their own notes); now they say none
+    was written, that one is theirs, and how to print the run's."""
+    from sim.report.run_summary import terminal_summary
+    from sim.studies import get_study
+
+    d = tmp_path / "r"
+    shutil.copytree(tri_run, d)
+    assert terminal_summary(d, shown="r", get_study=get_study).endswith("report: r/README.md")
+    (d / "README.md").write_text("# my notes\n", encoding="utf-8")
+    last = terminal_summary(d, shown="r", get_study=get_study).splitlines()[-1]
+    assert last.startswith("report: not written (r/README.md is yours, kept"), last
+    assert "sim show --markdown r" in last
