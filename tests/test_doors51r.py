@@ -147,3 +147,25 @@ def test_a_kept_readme_of_the_users_is_not_called_the_report(tri_run: Path, tmp_
     last = terminal_summary(d, shown="r", get_study=get_study).splitlines()[-1]
     assert last.startswith("report: not written (r/README.md is yours, kept"), last
     assert "sim show --markdown r" in last
+
+
+def test_verify_of_a_study_whose_gama_file_is_no_file(tmp_path: Path, capsys, monkeypatch) -> None:
+    """A study's ``network.gama_xml`` replaced by a directory, or by a link to nothing, since
+    its run; then ``make verify``. Before: B51 told a file moved away (ENOENT) from a failed
+    reproduction, but these re-runs' refusals were recorded as "FAILED; nothing compared: the
+    re-run exited with 2" (exit 1); now one line naming the file, nothing recorded. (The
+    re-run's own line is taken from ``sim check`` of the same study here.)"""
+    from sim.report.verify.child import refusal
+    from sim.report.verify.rules import VerifyError
+
+    sf = tmp_path / "net.toml"
+    sf.write_text('study = "network"\n[network]\ngama_xml = "net.xml"\n', encoding="utf-8")
+    (tmp_path / "net.xml").mkdir()
+    (tmp_path / "gone.xml").symlink_to(tmp_path / "nowhere")
+    for xml in ("net.xml", "gone.xml"):
+        sf.write_text(f'study = "network"\n[network]\ngama_xml = "{xml}"\n', encoding="utf-8")
+        rc, err = _in(tmp_path, ["check", "net.toml"], capsys, monkeypatch)
+        assert rc == 2, err
+        line = err.strip()
+        with pytest.raises(VerifyError, match=rf"^net: a file its study file .* {xml}"):
+            refusal("net", sf, line, tmp_path / "S" / "net", [], [])
