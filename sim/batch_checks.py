@@ -36,6 +36,7 @@ from sim.mc.storage import regular_text
 from sim.mc.study_source import other_source, recorded_source
 from sim.mc.sweep import read_sweep, reordered, swept_order
 from sim.mc.table_edits import edited_tables
+from sim.mc.table_shape import recorded_shape, sum_problem
 from sim.mc.unknown_key import unknown_key_hint
 from sim.places import base
 from sim.report.read import mixed_table
@@ -107,6 +108,8 @@ def why_stale(
         return f"{mixed[0].name} is not of the run of run.json: {mixed[1]}"
     if edited := edited_tables(Path(results)):  # a table edited by hand: made again, as a
         return f"{edited[0]} changed after its run (sha256 not run.json's: edited by hand?)"
+    if unsealed := _unsealed(Path(results)):  # a record emptied by hand: the readers refuse
+        return unsealed  # its tables ("up to date", where sim show and the API refuse them)
     for name, what in sorted(changed_exports(Path(results)).items())[:1]:  # the user's now:
         # the results were called up to date, and a run of them is refused while it is there
         kind = f"was {what}" if what.startswith("changed") else f"is {what}, not its run's export"
@@ -152,6 +155,16 @@ def _clashes(files: list[Path], run_args: list[str], results: str = "results") -
         else:
             seen[f.stem] = f
     return out
+
+
+def _unsealed(results: Path) -> str | None:
+    """``NAME its run record holds neither ...`` for the first table of ``results`` (a
+    sweep's cells' too) that its record neither sums nor shapes, as the readers refuse it
+    (:func:`sim.mc.table_shape.sum_problem`), else None."""
+    for p in sorted([*results.glob("*.parquet"), *results.glob("cells/*/*.parquet")]):
+        if p.is_file() and recorded_shape(p) is None and (why := sum_problem(p)) is not None:
+            return f"{p.relative_to(results)}: {why}"
+    return None
 
 
 def _configs_problems(

@@ -30,9 +30,9 @@ def tri_run(tmp_path_factory) -> Path:
     """A finished run of conftest's triangle network (no figures), made once: READ ONLY."""
     base = tmp_path_factory.mktemp("tri")
     (base / "tri.toml").write_text(TRIANGLE_NETWORK, encoding="utf-8")
-    args = ["run", str(base / "tri.toml"), "--out", str(base / "r"), "--no-figures", "--quiet"]
+    args = ["run", str(base / "tri.toml"), "--out", str(base / "tri"), "--no-figures", "--quiet"]
     assert main(args) == 0
-    return base / "r"
+    return base / "tri"
 
 
 def _in(cwd: Path, args: list[str], capsys, monkeypatch) -> tuple[int, str]:
@@ -60,27 +60,40 @@ def test_forged_record_with_emptied_integrity_fields(
     tri_run: Path, tmp_path: Path, capsys, monkeypatch
 ) -> None:
     """Bad input: a run record of this code whose ``table_sha256`` and ``table_shape`` are kept
-    but emptied (``{}``), or whose claims' entries are removed, beside a claim's value edited
-    by hand. Before: ``sim show`` printed the edited value, exit 0, and ``sim.Results`` read
-    it; now both refuse in one line naming the table, and the unforged record still reads."""
+    but emptied (``{}``), or whose claims' entries are removed, or emptied with every table
+    taken off ``files`` too, beside a claim's value edited by hand. Before: ``sim show``
+    printed the edited value, exit 0, ``sim.Results`` read it, and ``sim.batch --stale-only``
+    called the results up to date; now the readers refuse in one line naming a table, the
+    batch calls them out of date, and the unforged record still finds the edit."""
     from hand_edits import edit_first_value
 
-    d = tmp_path / "r"
+    from sim.batch_checks import why_stale
+
+    d = tmp_path / "tri"
     shutil.copytree(tri_run, d)
     rec = json.loads((d / "run.json").read_text(encoding="utf-8"))
     edit_first_value(d)
     keys = ("table_sha256", "table_shape")
     one = {k: {n: v for n, v in rec[k].items() if n != "claims.parquet"} for k in keys}
-    for forged in ({**rec, "table_sha256": {}, "table_shape": {}}, {**rec, **one}):
+    emptied = {**rec, "table_sha256": {}, "table_shape": {}}
+    listed = [f for f in rec["files"] if f.startswith("trials/") or not f.endswith(".parquet")]
+    words = "neither a sha256 nor a shape of claims.parquet"
+    for forged, said in (
+        (emptied, words),
+        ({**rec, **one}, words),
+        ({**emptied, "files": listed}, "lists no claims.parquet among the files"),
+    ):
         (d / "run.json").write_text(json.dumps(forged), encoding="utf-8")
-        rc, err = _in(tmp_path, ["show", "r"], capsys, monkeypatch)
+        rc, err = _in(tmp_path, ["show", "tri", "--markdown"], capsys, monkeypatch)
         assert rc == 2, err
         assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
-        assert "neither a sha256 nor a shape of claims.parquet" in err, err
+        assert said in err or "(removed by hand?)" in err, err
         with pytest.raises(sim.ConfigError, match=r"claims\.parquet is not .*table its run"):
             sim.Results(d, "network").claims()
+        why = why_stale(tri_run.parent / "tri.toml", d, ["--no-figures"])
+        assert why is not None and "by hand?" in why, why
     (d / "run.json").write_text(json.dumps(rec), encoding="utf-8")
-    rc, err = _in(tmp_path, ["show", "r"], capsys, monkeypatch)
+    rc, err = _in(tmp_path, ["show", "tri"], capsys, monkeypatch)
     assert rc == 2 and "is not the claims table its run wrote" in err, err  # the edit is seen
 
 
@@ -140,7 +153,7 @@ def test_a_kept_readme_of_the_users_is_not_called_the_report(tri_run: Path, tmp_
     from sim.report.run_summary import terminal_summary
     from sim.studies import get_study
 
-    d = tmp_path / "r"
+    d = tmp_path / "tri"
     shutil.copytree(tri_run, d)
     assert terminal_summary(d, shown="r", get_study=get_study).endswith("report: r/README.md")
     (d / "README.md").write_text("# my notes\n", encoding="utf-8")

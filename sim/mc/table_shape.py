@@ -262,9 +262,14 @@ def _unsealed(rec: dict, root: Path, key: str) -> str | None:
     edited beside it printed as the run's."""
     if not _this_code(rec) or _staging(root):
         return None
-    carried = rec.get("carried")
+    carried, files = rec.get("carried"), rec.get("files")
     if isinstance(carried, list) and key in carried:
         return None
+    if isinstance(files, list) and key not in files:  # added beside the run's files, or the
+        return (  # record's lists emptied of it too: read unchecked as the run's
+            f"its run record lists no {key} among the files its run wrote (added or "
+            "removed by hand?)"
+        )
     return (
         f"its run record holds neither a sha256 nor a shape of {key}, which this version's "
         "runs record for every table (removed by hand?)"
