@@ -32,7 +32,7 @@ from sim.mc.outputs import check_out
 from sim.mc.overrides import command_values, listed, recorded
 from sim.mc.paths import absolute
 from sim.mc.publish import changed_figure
-from sim.mc.storage import regular_text
+from sim.mc.storage import read_record, regular_text
 from sim.mc.study_source import other_source, recorded_source
 from sim.mc.sweep import read_sweep, reordered, swept_order
 from sim.mc.table_edits import edited_tables
@@ -161,10 +161,18 @@ def _unsealed(results: Path) -> str | None:
     """``NAME its run record holds neither ...`` for the first table of ``results`` (a
     sweep's cells' too) that its record neither sums nor shapes, as the readers refuse it
     (:func:`sim.mc.table_shape.sum_problem`), else None."""
+    files = (read_record(results) or {}).get("files")
     for p in sorted([*results.glob("*.parquet"), *results.glob("cells/*/*.parquet")]):
+        name = p.relative_to(results).as_posix()
+        if isinstance(files, list) and name not in files and p.name not in _RUNS_OWN:
+            continue  # a table of the user's put beside (the readers name it): no re-run
         if p.is_file() and recorded_shape(p) is None and (why := sum_problem(p)) is not None:
-            return f"{p.relative_to(results)}: {why}"
+            return f"{name}: {why}"
     return None
+
+
+#: the tables every run (or sweep) writes: one its record does not list was taken off by hand
+_RUNS_OWN = ("claims.parquet", "sweep.parquet")
 
 
 def _configs_problems(
