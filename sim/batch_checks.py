@@ -16,7 +16,7 @@ import json
 import os
 from pathlib import Path
 
-from sim.api_paths import arrow_name
+from sim.api_paths import arrow_name, too_long
 from sim.cli import DOC as cli_doc
 from sim.cli_args import parser as run_parser
 from sim.cli_errors import cwd_exists
@@ -32,10 +32,11 @@ from sim.mc.outputs import check_out
 from sim.mc.overrides import command_values, listed, recorded
 from sim.mc.paths import absolute
 from sim.mc.publish import changed_figure
-from sim.mc.storage import regular_text
+from sim.mc.storage import read_record, regular_text
 from sim.mc.study_source import other_source, recorded_source
 from sim.mc.sweep import read_sweep, reordered, swept_order
 from sim.mc.table_edits import edited_tables
+from sim.mc.table_shape import recorded_shape, sum_problem
 from sim.mc.unknown_key import unknown_key_hint
 from sim.places import base
 from sim.report.read import mixed_table
@@ -107,6 +108,8 @@ def why_stale(
         return f"{mixed[0].name} is not of the run of run.json: {mixed[1]}"
     if edited := edited_tables(Path(results)):  # a table edited by hand: made again, as a
         return f"{edited[0]} changed after its run (sha256 not run.json's: edited by hand?)"
+    if unsealed := _unsealed(Path(results)):  # a record emptied by hand: the readers refuse
+        return unsealed  # its tables ("up to date", where sim show and the API refuse them)
     for name, what in sorted(changed_exports(Path(results)).items())[:1]:  # the user's now:
         # the results were called up to date, and a run of them is refused while it is there
         kind = f"was {what}" if what.startswith("changed") else f"is {what}, not its run's export"
@@ -152,6 +155,24 @@ def _clashes(files: list[Path], run_args: list[str], results: str = "results") -
         else:
             seen[f.stem] = f
     return out
+
+
+def _unsealed(results: Path) -> str | None:
+    """``NAME its run record holds neither ...`` for the first table of ``results`` (a
+    sweep's cells' too) that its record neither sums nor shapes, as the readers refuse it
+    (:func:`sim.mc.table_shape.sum_problem`), else None."""
+    files = (read_record(results) or {}).get("files")
+    for p in sorted([*results.glob("*.parquet"), *results.glob("cells/*/*.parquet")]):
+        name = p.relative_to(results).as_posix()
+        if isinstance(files, list) and name not in files and p.name not in _RUNS_OWN:
+            continue  # a table of the user's put beside (the readers name it): no re-run
+        if p.is_file() and recorded_shape(p) is None and (why := sum_problem(p)) is not None:
+            return f"{name}: {why}"
+    return None
+
+
+#: the tables every run (or sweep) writes: one its record does not list was taken off by hand
+_RUNS_OWN = ("claims.parquet", "sweep.parquet")
 
 
 def _configs_problems(
@@ -373,6 +394,8 @@ def _timings_problem(path: str) -> str | None:
     JSON object of lists), never a file of the user's."""
     if path == "-":  # read as standard output by many programs: here it named a file "-"
         return "'-' is not standard output here: name a file (./- for a file named '-')"
+    if why := too_long(path):  # pathlib's is_dir raised it: "OSError: File name too long"
+        return why
     p = Path(path)
     try:
         parent = p.resolve().parent

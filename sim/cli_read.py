@@ -170,6 +170,8 @@ def report_command(args) -> int:
     if name_problem(args.results):
         why = name_problem(args.results)
         raise ConfigError("--results", f"not a directory name: {why} (got {args.results!r})")
+    if why := too_long(args.results):  # was "does not exist"
+        raise ConfigError("--results", why)
     return report(Path(args.results))
 
 

@@ -23,7 +23,7 @@ from sim.mc.paths import absolute
 from sim.mc.progress import set_quiet
 from sim.mc.sweep import read_sweep
 from sim.option_words import two_sets
-from sim.path_args import arrow_name
+from sim.path_args import arrow_name, too_long
 from sim.places import default_out
 from sim.report.run_summary import terminal_summary, write_run_readme
 from sim.stops import check_interrupt
@@ -64,6 +64,8 @@ def check_run_args(args) -> Path:
         why = name_problem(args.out)
         if why:
             raise ConfigError("--out", f"{why} (got {args.out!r})")
+        if why := too_long(args.out):  # it was the system's words and the whole path, of 6 kB
+            raise ConfigError("--out", why)  # (a name over 255 bytes: named with the suffix)
     return absolute(args.out) if args.out else None
 
 

@@ -22,19 +22,40 @@ _UNPRINTED = {"Cc", "Cf", "Zl", "Zp", "Cs", "Co"}
 def printable(text: str, lines: bool = False) -> str:
     """``text`` with every control, format (bidi override), separator, surrogate or
     private-use character written as Python escapes it (``\\x1b``, ``\\u202e``), so that a
-    string from a file shows as what it holds and does nothing to the terminal; ``lines``:
-    its line feeds and tabs kept (a text of several lines)."""
+    string from a file shows as what it holds and does nothing to the terminal; a zero-width
+    (non-)joiner between two non-ASCII characters that print is kept (:data:`_JOINERS`);
+    ``lines``: its line feeds and tabs kept (a text of several lines)."""
     if not isinstance(text, str):
         text = str(text)
     if text.isascii() and text.isprintable():
         return text
     return "".join(
         c
-        if (lines and c in "\n\t") or unicodedata.category(c) not in _UNPRINTED
+        if (lines and c in "\n\t") or _shown(text, i)
         else f"\\x{ord(c):02x}"
         if ord(c) < 0x100
         else f"\\u{ord(c):04x}"
         if ord(c) < 0x10000
         else f"\\U{ord(c):08x}"
-        for c in text
+        for i, c in enumerate(text)
+    )
+
+
+#: the zero-width non-joiner and joiner, format characters that a script's words and an emoji
+#: sequence hold (Persian's "نقشه\u200cبرداری", a family emoji): kept between two characters
+#: that print and are not ASCII (a legit name was shown as "نقشه\\u200cبرداری"), escaped
+#: elsewhere (hidden between Latin letters)
+_JOINERS = "\u200c\u200d"
+
+
+def _shown(text: str, i: int) -> bool:
+    """Whether ``text[i]`` is written as it is by :func:`printable`."""
+    c = text[i]
+    if unicodedata.category(c) not in _UNPRINTED:
+        return True
+    if c not in _JOINERS or not 0 < i < len(text) - 1:
+        return False
+    return all(
+        not n.isascii() and unicodedata.category(n) not in _UNPRINTED
+        for n in (text[i - 1], text[i + 1])
     )

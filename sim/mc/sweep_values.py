@@ -64,7 +64,7 @@ def _values(key: str, v: Any) -> list:
                 raise ConfigError(
                     f"sweep.{key}", "step must be non-zero and point from start to stop"
                 )
-            count = (b * h - a * h) / (s * h)
+            count = (b * h - a * h) / s / h  # (s * h: 0.0 for a step of 5e-324, in halves)
             if not count < MAX_CELLS:
                 raise ConfigError(
                     f"sweep.{key}",

@@ -249,7 +249,7 @@ def sum_problem(path: str | Path) -> str | None:
             )
         want = sums.get(key) if isinstance(sums, dict) else None
         if not isinstance(want, str):
-            return None
+            return _unsealed(rec, root, key)
         h = hashlib.sha256()
         with open(path, "rb") as f:
             for block in iter(lambda: f.read(1 << 20), b""):
@@ -268,6 +268,29 @@ def _lost(rec: dict) -> str | None:
     if lost[:2] != ["table_sha256", SHAPE_KEY]:
         return None
     return "neither table_sha256 nor table_shape" + (", nor files" if len(lost) > 2 else "")
+
+
+def _unsealed(rec: dict, root: Path, key: str) -> str | None:
+    """Why the table ``key`` of a run record of this code (``rec``, not a staging one) that
+    holds neither its sha256 nor its shape is not read (None: an older version's record, or a
+    file of the user's that a publish carried in). :func:`sim.mc.publish.seal` records both
+    for every table; a record whose ``table_sha256`` and ``table_shape`` were emptied by hand
+    (``{}``: the fields kept, their entries gone) had its tables read unchecked, a value
+    edited beside it printed as the run's."""
+    if not _this_code(rec) or _staging(root):
+        return None
+    carried, files = rec.get("carried"), rec.get("files")
+    if isinstance(carried, list) and key in carried:
+        return None
+    if isinstance(files, list) and key not in files:  # added beside the run's files, or the
+        return (  # record's lists emptied of it too: read unchecked as the run's
+            f"its run record lists no {key} among the files its run wrote (added or "
+            "removed by hand?)"
+        )
+    return (
+        f"its run record holds neither a sha256 nor a shape of {key}, which this version's "
+        "runs record for every table (removed by hand?)"
+    )
 
 
 def _staging(root: Path) -> bool:

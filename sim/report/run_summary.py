@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
 import shlex
 from collections import Counter
 from pathlib import Path
@@ -211,7 +212,8 @@ def _interval(r: dict) -> str:
 def terminal_summary(out: Path, n: int = 5, shown: str | None = None, get_study=None) -> str:
     """The closing lines of a run: the verdict counts, up to ``n`` headline rows (value,
     95 % interval, verdict), the region line, and the path of the directory's README.md
-    (under ``shown``, the directory as the user named it, if given); ``get_study`` given, a run
+    (under ``shown``, the directory as the user named it, if given; one of the user's kept
+    there is said to be no report of the run); ``get_study`` given, a run
     off the paper's setup says so as its README.md does (:func:`off_note`)."""
     out = Path(out)
     if _kind_of(out) == "sweep":
@@ -234,8 +236,14 @@ def terminal_summary(out: Path, n: int = 5, shown: str | None = None, get_study=
             )
         if (reg := region_line(out)) is not None:
             lines.append(reg)
-    if (out / "README.md").is_file():
-        lines.append(f"report: {Path(shown or out) / 'README.md'}")
+    readme = Path(shown or out) / "README.md"
+    if _ours(out / "README.md"):
+        lines.append(f"report: {readme}")
+    elif os.path.lexists(out / "README.md"):  # a user's, kept: "report:" sent them to it
+        lines.append(
+            f"report: not written ({readme} is yours, kept; sim show --markdown "
+            f"{shown or out} prints the run's)"
+        )
     return "\n".join(lines)
 
 

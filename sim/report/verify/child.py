@@ -21,6 +21,21 @@ __all__ = ["launcher", "busy_words", "names_one_of", "system_error", "refusal"]
 _ERR = "sim: error: "
 
 
+#: a re-run's refusal of a file the study reads (``network.gama_xml``, a ``*.file`` key) that
+#: is there but is no file it can read, in the readers' words (sim.studies.network.gama_vocab,
+#: sim.studies.wolf.tables)
+_UNREADABLE = re.compile(
+    r"sim: error: (?:network\.gama_xml|[\w.]+\.file): (?:cannot read |.* is not a regular file)"
+)
+
+
+def _unreadable(line: str) -> bool:
+    """Whether ``line`` refuses a file the study file names as unreadable (not its content):
+    it was recorded as a failed reproduction, "FAILED; nothing compared: the re-run exited
+    with 2", exit 1, where B51's check of a file moved away (ENOENT) said what it is."""
+    return _UNREADABLE.match(line) is not None
+
+
 def refusal(
     name: str, sf: Path, line: str, target: Path, overrides: list[str] | tuple, extra: list[str]
 ) -> str | None:
@@ -55,6 +70,11 @@ def refusal(
             f"{name}: a file its study file {sf} names is not here ({line.removeprefix(_ERR)}): "
             "a relative path is read from the working directory; put it back, or run verify "
             "where the run was made (nothing recorded)"
+        )
+    if _unreadable(line):  # a directory, a dangling link or a FIFO put in its place: as above
+        raise VerifyError(
+            f"{name}: a file its study file {sf} names cannot be read "
+            f"({line.removeprefix(_ERR)}): put back the file the run read (nothing recorded)"
         )
     if extra or line.startswith("sim: error: --"):
         # the re-run refused the options verify passed (--trials, --set, --workers, the

@@ -9,7 +9,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from sim.api_paths import arrow_name
+from sim.api_paths import arrow_name, too_long
 from sim.ends import stdout_failed
 from sim.env_vars import environment_problem
 from sim.held_stops import held_stops
@@ -119,10 +119,15 @@ def _check_args(a) -> None:
         why = None if v is None else name_problem(v)
         if why:
             raise VerifyError(f"{name}: {why} (got {v!r})")
+        if v is not None and (why := too_long(v)):  # it was the system's words and the whole
+            raise VerifyError(f"{name}: {why}")  # path (6 kB), no option named
         if v is not None and not os.path.isabs(v) and not _cwd_exists():  # (R44) it was
             raise VerifyError(  # "No such file or directory", from the refusal's Path.cwd()
                 f"{name}: {v} is relative, but the working directory is gone (it was deleted)"
             )
+    for v in a.study or ():  # a name of 300 bytes: "File name too long: results/ccc..."
+        if why := too_long(v):
+            raise VerifyError(f"--study: {why}")
     if a.trials is not None and a.trials < MIN_TRIALS:
         raise VerifyError(
             f"--trials: must be at least {MIN_TRIALS}, not {a.trials} (the Monte-Carlo rule takes "
