@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import functools
 import inspect
+import os
+from pathlib import PurePath
 from typing import Any
 
 import numpy as np
@@ -144,9 +146,17 @@ def arguments(fn):
 
 
 def _plain(v: Any) -> Any:
-    """``v``, or the ``str`` a ``str`` subclass holds (a ``StrEnum`` member, ``np.str_``): the
-    API reads its text, not its ``__str__`` (a caller's subclass whose ``__str__`` raised
-    passed through ``sim.load``, ``run(out=...)`` and ``Results.table`` as a traceback)."""
+    """``v``, or the ``str`` a ``str`` subclass holds (a ``StrEnum`` member, ``np.str_``), also
+    as an ``os.PathLike``'s path: the API reads its text, not its ``__str__`` (a caller's
+    subclass whose ``__str__`` raised passed through ``sim.load``, ``run(out=...)`` and
+    ``Results.table`` as a traceback; a PathLike whose ``__fspath__`` raises is left to the
+    check of its argument, which names it)."""
+    if isinstance(v, os.PathLike) and not isinstance(v, PurePath):
+        try:
+            text = os.fspath(v)
+        except Exception:  # noqa: BLE001 - refused by the argument's check, naming it
+            return v
+        v = text if isinstance(text, str) and type(text) is not str else v
     return str.__str__(v) if isinstance(v, str) and type(v) is not str else v
 
 

@@ -162,6 +162,7 @@ def flags(b: bool) -> list[tuple[Any, str]]:
 def paths(p: Path) -> list[tuple[Any, str]]:
     """The existing path ``p`` in odd types."""
     same = [p, str(p), np.str_(str(p)), BrokenStr(str(p)), PathTo(str(p))]
+    same += [PathTo(BrokenStr(str(p)))]
     bad = [str(p).encode(), bytearray(str(p).encode()), memoryview(str(p).encode())]
     bad += [PathTo(str(p).encode()), PathTo(None), PathTo(5), 5, 2.5, [str(p)], ""]
     bad += [RaisingPath(RuntimeError), RaisingPath(ValueError), RaisingPath(KeyError)]

@@ -9,7 +9,15 @@ from __future__ import annotations
 
 import pytest
 from conftest import TRIANGLE_NETWORK
-from fuzz_api_types import BrokenArray, BrokenInt, BrokenMap, BrokenSeq, BrokenStr, RaisingPath
+from fuzz_api_types import (
+    BrokenArray,
+    BrokenInt,
+    BrokenMap,
+    BrokenSeq,
+    BrokenStr,
+    PathTo,
+    RaisingPath,
+)
 
 import sim
 
@@ -51,10 +59,11 @@ def test_a_value_whose_reading_raises_is_refused_naming_its_key(study, tmp_path)
 
 def test_a_str_subclass_is_read_as_its_text(study, tmp_path):
     """A ``str`` SUBCLASS whose ``__str__`` raises (its text is the str it holds: pathlib
-    and f-strings call ``__str__``) as ``sim.load``'s study file, ``sim.Results``' path or
-    study, or ``table``'s name: the subclass's RuntimeError passed through as a traceback;
+    and f-strings call ``__str__``), or an ``os.PathLike`` giving one, as ``sim.load``'s study
+    file, ``sim.Results``' path or study, or ``table``'s name: the subclass's RuntimeError passed through as a traceback;
     now read as the text it holds (the same handle; the same refusal as the plain str)."""
     assert sim.load(BrokenStr(str(study))).config == sim.load(study).config
+    assert sim.load(PathTo(BrokenStr(str(study)))).config == sim.load(study).config
     (empty := tmp_path / "empty").mkdir()
     res = sim.Results(BrokenStr(str(empty)), BrokenStr("network"))
     assert res.path == empty and type(res.study) is str
