@@ -69,3 +69,31 @@ def test_a_str_subclass_is_read_as_its_text(study, tmp_path):
     assert res.path == empty and type(res.study) is str
     plain = _refused(lambda: sim.Results(empty, "network").table("points"), "path")
     assert _refused(lambda: res.table(BrokenStr("points")), "path") == plain
+
+
+def test_results_fuzzer_reads_a_report_as_it_now_writes(tmp_path):
+    """The RESULTS fuzzer (tests/fuzz_results.py) at seeds 5020 and 5021: every ``sim report``
+    case failed, as the fuzzer's wrong expectation, not the suite's defect: the report
+    rebuilds README.md (it names its directory) and records its sha256 in run.json (J50),
+    which the fuzzer called "the reader changed what it read"; and its diff of a nested dict
+    was itself a TypeError ("unhashable type: 'dict'") that hid the case. Now run.json is
+    compared without ``readme_sha256`` (any other change still counts), never opened when it
+    is no regular file (a FIFO), and the snapshot is flat."""
+    import json
+    import os
+
+    from fuzz_results import _both, _sans_readme
+
+    (rec := tmp_path / "res" / "run.json").parent.mkdir()
+    rec.write_text(json.dumps({"study": "network", "readme_sha256": "a"}))
+    was = _sans_readme(rec)
+    rec.write_text(json.dumps({"study": "network", "readme_sha256": "b"}))
+    assert _sans_readme(rec) == was
+    rec.write_text(json.dumps({"study": "other", "readme_sha256": "b"}))
+    assert _sans_readme(rec) != was
+    os.mkfifo(fifo := tmp_path / "res" / "fifo.json")
+    assert _sans_readme(fifo) is None
+    (out := tmp_path / "outside").mkdir()
+    (out / "copy").write_text("x")
+    both = _both(tmp_path / "res", out)
+    assert "outside/copy" in both and set(both.items())
