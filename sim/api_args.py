@@ -1,12 +1,14 @@
 """The Python API's arguments checked as its config keys are: an argument a function of
 :mod:`sim.api` does not take, one given twice, too many or one missing is one
 :class:`sim.mc.config.ConfigError` line naming it and the ones the function takes, not
-Python's ``TypeError``."""
+Python's ``TypeError``; a ``str`` subclass is read as the text it holds."""
 
 from __future__ import annotations
 
 import functools
 import inspect
+import os
+from pathlib import PurePath
 from typing import Any
 
 import numpy as np
@@ -127,6 +129,7 @@ def arguments(fn):
             bound = sig.bind(*args, **kwargs)
         except TypeError:
             raise refusal(args, kwargs) from None
+        args, kwargs = tuple(map(_plain, args)), {k: _plain(v) for k, v in kwargs.items()}
         try:  # under NumPy's default error handling, whatever the caller set (a notebook's
             with np.errstate(**NUMPY_DEFAULTS):  # np.seterr(all="raise") made an underflow
                 return fn(*args, **kwargs)  # the suite ignores a FloatingPointError)
@@ -140,6 +143,21 @@ def arguments(fn):
             raise
 
     return checked
+
+
+def _plain(v: Any) -> Any:
+    """``v``, or the ``str`` a ``str`` subclass holds (a ``StrEnum`` member, ``np.str_``), also
+    as an ``os.PathLike``'s path: the API reads its text, not its ``__str__`` (a caller's
+    subclass whose ``__str__`` raised passed through ``sim.load``, ``run(out=...)`` and
+    ``Results.table`` as a traceback; a PathLike whose ``__fspath__`` raises is left to the
+    check of its argument, which names it)."""
+    if isinstance(v, os.PathLike) and not isinstance(v, PurePath):
+        try:
+            text = os.fspath(v)
+        except Exception:  # noqa: BLE001 - refused by the argument's check, naming it
+            return v
+        v = text if isinstance(text, str) and type(text) is not str else v
+    return str.__str__(v) if isinstance(v, str) and type(v) is not str else v
 
 
 def _unshown(bound: inspect.BoundArguments, e: Exception) -> ConfigError | None:

@@ -58,7 +58,11 @@ one case a five, at least two, by ``sim check``; in ``make fuzz`` a valid one al
 finished RESULTS directory changed by hand (its bytes, a file's kind, a table rewritten, the
 run record, the trials: tests/fuzz_results.py; ``test_fuzz_results_directory``: one case a
 three, at least three) read by ``sim show``, ``sim report``, the API and verify: exit 0 with what the
-clean run gives, or one line; the directory unchanged."""
+clean run gives, or one line; the directory unchanged. The API's arguments in odd TYPES
+(``np.int64``, a 0-d array, ``Fraction``, ``np.str_``, a ``str`` subclass, bytes paths, an
+``os.PathLike`` or a container that raises: tests/fuzz_api_types.py; ``test_fuzz_api_types``:
+three calls a case) give what the plain value gives, or one ``ConfigError`` line naming the
+argument."""
 
 from __future__ import annotations
 
@@ -68,6 +72,9 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import TRIANGLE_NETWORK
+from fuzz_api_types import case as api_case
+from fuzz_api_types import check as api_check
 from fuzz_bytes import csv_sites, gama_sites, mutate_bytes
 from fuzz_cases import SEED
 from fuzz_concurrent import pairs
@@ -81,6 +88,7 @@ from fuzz_splice import gama_splice, splice_case
 from fuzz_sweep import sweep_case
 from fuzz_values import NAMES, ROOT, base, small, toml_doc, toml_value
 
+import sim
 from sim.cli import main
 from sim.studies import load_study
 from sim.studies.network.gama_read import read_gama
@@ -329,6 +337,21 @@ def test_fuzz_results_directory(tiny_run, tmp_path):
     n = max(3, CASES // 3)
     failures = results_cases(n, SEED, tmp_path, tiny_run("network_plate"))
     assert not failures, f"{len(failures)} of {n} results cases:\n" + "\n".join(failures)
+
+
+def test_fuzz_api_types(tmp_path):
+    """API TYPES (tests/fuzz_api_types.py): seeded calls of ``sim.load``, ``replace``,
+    ``run`` (into a finished run's directory: no new run), ``sim.Results`` and ``table`` with
+    one argument of an odd type: what the plain value gives, or one ConfigError line that
+    starts with the argument's name; never the caller's object's own exception."""
+    (study := tmp_path / "tri.toml").write_text(TRIANGLE_NETWORK)
+    res = sim.load(study).run(out=(out := tmp_path / "out"), figures=False)
+    failures = []
+    for i in range(3 * CASES):
+        c = api_case(random.Random(SEED * 100_003 + 58_585 + i), study, out, res)
+        if (why := api_check(c)) is not None:
+            failures.append(f"case {i} ({c.desc}): {why}")
+    assert not failures, f"{len(failures)} of {3 * CASES}:\n" + "\n".join(failures)
 
 
 if __name__ == "__main__":  # pragma: no cover - the long run: make fuzz

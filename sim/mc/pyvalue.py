@@ -25,6 +25,10 @@ integer, a double and a string, in lists and tables. Each value is read as the n
 * an ``os.PathLike`` of a ``str`` (``pathlib.Path``) is that ``str``: a file key
   (``network.gama_xml``) takes the path it is (it was refused as "must be a string").
 
+A caller's object that raises while it is read (a ``PathLike`` whose ``__fspath__``, a
+``Sequence`` whose ``__len__``, an ``Integral`` whose ``__int__`` raises) is refused naming
+the key and the exception (it passed through the API as a traceback of the caller's code).
+
 Anything else (a complex number, a date, ``None``) is passed on as given and refused by the
 key's validation with one line naming the type expected (a date or time quoted as TOML writes
 it: ``2020-01-01``, not ``datetime.date(2020, 1, 1)``). A bool stays a bool (refused where
@@ -127,6 +131,22 @@ def as_config_value(key: str, v: Any) -> Any:
         return _convert(key, v)
     except RecursionError:
         raise ConfigError(key, "is nested too deeply") from None
+    except ConfigError:
+        raise
+    except Exception as e:  # the caller's object raised while read: a PathLike whose
+        # __fspath__, a Sequence whose __len__, a Mapping whose __iter__, an Integral whose
+        # __int__, an array-like whose __array__ raised passed through the API as a traceback
+        raise ConfigError(key, _unreadable(v, e)) from None
+
+
+def _unreadable(v: Any, e: Exception) -> str:
+    """The words for ``v``, a caller's object that raised ``e`` while read as a value."""
+    said = " ".join(str(e).split())[:120]
+    said = f"{type(e).__name__}: {said}" if said else type(e).__name__
+    return (
+        f"is not a config value: reading its {type(v).__name__} raised {said} "
+        "(give a plain value: a number, a str or a list)"
+    )
 
 
 def _convert(key: str, v: Any) -> Any:
