@@ -8,21 +8,29 @@ code before its fix:
   would run none of them: the current ones are "up to date" now, a stale one is still refused;
 * ``make verify`` of results on a read-only share re-ran every study (hours) and only then
   failed writing ``reproducibility.parquet`` (exit 2): refused before any re-run, naming
-  ``--no-record``.
+  ``--no-record``;
+* results of an older commit unpacked outside the project were noted by ``sim show``,
+  ``sim report`` and ``sim.Results`` as "make reproduce re-runs what is stale", a command that
+  re-runs only the project's ``results/``: outside them the note names ``sim run ... --out DIR
+  --overwrite``.
 """
 
 from __future__ import annotations
 
 import os
+import shutil
 from pathlib import Path
 
 import pytest
 from conftest import TRIANGLE_NETWORK
 from oneline import one_line
 
+import sim
 import sim.batch
 import sim.report.verify.cli as verify_cli
 from sim.cli import main as cli_main
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def _read_only(monkeypatch, root: Path) -> None:
@@ -75,3 +83,22 @@ def test_verify_into_read_only_results_is_refused_before_any_rerun(capsys, monke
     one_line(capsys, rc, f"you may not write in {results}", "--no-record")
     with pytest.raises(AssertionError, match="a re-run started"):  # --no-record: it goes on
         verify_cli.main(["--results", str(results), "--studies", str(tmp_path), "--no-record"])
+
+
+def test_older_results_elsewhere_are_not_sent_to_make_reproduce(capsys, monkeypatch, tmp_path):
+    """Class: results of an older commit unpacked outside the project. Before: "was made by
+    another version of the suite's code ...: make reproduce re-runs what is stale" from show,
+    report and the API, though make reproduce never re-runs them; the project's own results/
+    keep that note."""
+    shared = tmp_path / "from_a_colleague"
+    shutil.copytree(ROOT / "results" / "network_plate", shared / "network_plate")
+    monkeypatch.setattr("sim.stale.study_code_hash", lambda study: "f" * 16)  # an older run
+    assert cli_main(["show", str(shared / "network_plate")]) == 0
+    err = capsys.readouterr().err
+    assert "another version" in err and "--overwrite makes them current" in err, err
+    assert "make reproduce re-runs" not in err
+    assert cli_main(["show", str(ROOT / "results" / "network_plate")]) == 0
+    err = capsys.readouterr().err
+    assert "another version" in err and "make reproduce re-runs what is stale" in err, err
+    with pytest.warns(UserWarning, match=r"--overwrite makes them current \(not make reproduce"):
+        sim.Results(shared / "network_plate", "network").table("claims")
