@@ -24,7 +24,7 @@ from sim.mc.config import ConfigError
 from sim.mc.file_kind import TABLES
 from sim.mc.storage import read_provenance, read_record
 from sim.mc.study_source import other_source
-from sim.stale import other_code
+from sim.stale import other_code, remade
 
 #: the suite's package directory: a warning points at the first line of the caller's outside it
 _CODE = str(Path(__file__).resolve().parent) + "/"
@@ -123,7 +123,7 @@ def stale_warning(d: Path) -> None:
         words.insert(
             0,
             f"{older} was made by another version of the suite's code (its study's code "
-            "changed since): make reproduce re-runs what is stale",
+            f"changed since): {remade(d)}",
         )
     level, f = 2, sys._getframe(1)  # the caller's line, not one of the suite's
     while f is not None and f.f_code.co_filename.startswith(_CODE):

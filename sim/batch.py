@@ -354,7 +354,7 @@ def _main(argv: list[str], phase: list[str]) -> int:
     if why:
         print(f"sim.batch: run options: {why}", file=sys.stderr)
         return 2
-    bad, loaded = _configs_problems(files, run_args, Path(args.results))  # every file named
+    bad, loaded = _configs_problems(files, run_args, Path(args.results), args.stale_only)
     for why in bad:
         print(f"sim.batch: {why}", file=sys.stderr)
     if bad:

@@ -176,14 +176,15 @@ _RUNS_OWN = ("claims.parquet", "sweep.parquet")
 
 
 def _configs_problems(
-    files: list[Path], run_args: list[str], results: Path
+    files: list[Path], run_args: list[str], results: Path, stale_only: bool = False
 ) -> tuple[list[str], dict]:
     """``(lines, loaded)``: one line for each study file whose run would refuse its config
     (``sim run FILE RUN_ARGS`` resolves it here, before any run starts: a study file ported
     from another study, a bad key or value, a bad ``[sweep]``, a run over the memory or work
     limits, a ``<results>/<file name>`` its run refuses to replace: a file, a foreign
     directory, a link; one whose network export was edited by hand, or where a file of the
-    user's stands in its export's place), every such file named, and
+    user's stands in its export's place; with ``stale_only``, not for results that are current:
+    no run replaces them), every such file named, and
     ``{file: (args, study, cfg, sweep)}`` of the others (``--stale-only`` reads them). One
     broken file among many ran the others first, for hours in ``make reproduce``, and was
     named only when its turn came. A ``--set`` key a study has not is left out of its check
@@ -206,7 +207,11 @@ def _configs_problems(
             sweep_limits(study, cfg, sweep, *lim)  # the limits its run applies (sim check's too)
             out = results / f.stem  # each run is --overwrite: the record is not compared
             record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
-            check_out(absolute(out), str(out), record, True)  # (as sim run: check_run_args)
+            try:  # (as sim run: check_run_args)
+                check_out(absolute(out), str(out), record, True)
+            except ConfigError:  # results on a read-only share: --stale-only runs none that
+                if not stale_only or why_stale(f, out, run_args, (args, study, cfg, sweep)):
+                    raise  # is current, and was refused ("cannot be replaced") for each
             check_inputs_outside(absolute(out), str(out), cfg, sweep)  # an edited export
         except (ConfigError, StudyError) as e:  # a line that names the file already: as it is
             text = str(_out_in_batch_words(e) if isinstance(e, ConfigError) else e)

@@ -30,7 +30,7 @@ from sim.report.markdown import write_report
 from sim.report.read import check_claims_table, check_sweep_record, mixed_run
 from sim.report.run_summary import run_markdown, terminal_table
 from sim.report_due import clear_due
-from sim.stale import other_code, other_dirs, stale_dirs
+from sim.stale import other_code, other_dirs, remade, stale_dirs
 from sim.studies import MODULES, STUDY_FILES, design_config, get_study
 
 __all__ = ["show", "report", "report_command"]
@@ -79,7 +79,7 @@ def show(args) -> int:
     if older := other_code(d):  # verdicts of code since changed: read as current otherwise
         print(
             f"sim: note: {older} was made by another version of the suite's code (its study's "
-            "code changed since): make reproduce re-runs what is stale",
+            f"code changed since): {remade(d)}",
             file=sys.stderr,
         )
     for why in other_dirs(d)[:1]:  # another study's results under this name (copied)
@@ -229,7 +229,7 @@ def report(results: Path) -> int:
             f"sim: note: {len(stale)} of the reported results directories ({names}) "
             f"{'was' if len(stale) == 1 else 'were'} made by another version of the suite's code "
             "(changed since the run): the report "
-            "gives the verdicts as they were; make reproduce re-runs what is stale",
+            f"gives the verdicts as they were; {remade(results)}",
             file=sys.stderr,
         )
     for why in other_dirs(results):  # another study's numbers under a study's name

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from sim.mc.file_kind import odd_file
 from sim.report.read import EditedTable, TableError, damaged_message, last_read
-from sim.stale import other_code
+from sim.stale import other_code, remade
 
 __all__ = ["lost_table", "not_as_written", "older_lacks"]
 
@@ -24,13 +24,10 @@ def not_as_written(d: Path, e: Exception) -> str:
         # it is as that version wrote it ("not as sim wrote it" blamed a hand edit)
         return msg.replace(
             "is not as sim wrote it (", "was made by another version of the suite's code ("
-        ).replace("; run its study again", ": make reproduce re-runs what is stale")
+        ).replace("; run its study again", f": {remade(own)}")
     older = other_code(d)
     if older:  # the likely cause: a table this version reads as it writes it now
-        msg += (
-            f" ({older} was made by another version of the suite's code: make reproduce "
-            "re-runs what is stale)"
-        )
+        msg += f" ({older} was made by another version of the suite's code: {remade(d)})"
     return msg
 
 
@@ -51,7 +48,7 @@ def older_lacks(d: Path, e: FileNotFoundError) -> str | None:
         return None
     return (
         f"{own} was made by another version of the suite's code (it has no {parts[-1]}, which "
-        "this version reads): make reproduce re-runs what is stale"
+        f"this version reads): {remade(own)}"
     )
 
 

@@ -13,8 +13,25 @@ from sim.mc.outputs import results_dirs
 from sim.mc.registry import MODULES
 from sim.mc.storage import read_record
 from sim.mc.study_source import other_source
+from sim.places import base
 
-__all__ = ["other_code", "other_dirs", "stale_dirs"]
+__all__ = ["other_code", "other_dirs", "remade", "stale_dirs"]
+
+#: how the project's stale results are made again
+REPRODUCE = "make reproduce re-runs what is stale"
+
+
+def remade(d: Path) -> str:
+    """How stale results ``d`` are made current: ``make reproduce`` re-runs the project's
+    ``results/`` only; of results elsewhere (a colleague's unpacked, a scratch run) the note
+    sent their reader to a command that never touches them."""
+    try:
+        ours = Path(d).resolve().is_relative_to((base() / "results").resolve())
+    except (OSError, RuntimeError, ValueError):  # a loop, a name too long: not ours
+        ours = False
+    if ours:
+        return REPRODUCE
+    return "sim run STUDY.toml --out DIR --overwrite makes them current (not make reproduce)"
 
 
 def other_code(d: Path) -> str | None:

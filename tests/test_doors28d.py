@@ -150,7 +150,7 @@ def test_report_over_an_older_versions_results_says_so_of_the_tables_own_study(
         main(["report", "--results", str(root)]),
         "agnard_block/claims.parquet under",
         "was made by another version of the suite's code",
-        "make reproduce re-runs what is stale",
+        "--overwrite makes them current (not make reproduce)",  # not the project's results/
         prefix=SIM_ERROR,
     )
     assert "not as sim wrote it" not in line and "brown_table1" not in line, line

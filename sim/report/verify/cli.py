@@ -220,6 +220,8 @@ def _main(argv: list[str] | None) -> int:
         extra = [] if a.trials is None else ["--trials", str(a.trials)]
         extra += [x for s in a.set for x in ("--set", s)]
         mode = "full" if a.trials is None else "mc"
+        if (why := _unrecordable(_record_path(a, mode))) is not None:
+            raise VerifyError(why)
         if not a.scratch and (why := name_problem(tempfile.gettempdir())) is not None:
             raise VerifyError(  # each re-run's --out would be refused (a line break in TMPDIR)
                 f"the temporary directory {tempfile.gettempdir()!r} (TMPDIR) {why}: "
@@ -263,6 +265,21 @@ def _record_path(a, mode: str) -> Path | None:
     """Where the comparisons are recorded (None: not recorded, a part of them or by trials)."""
     full = not a.no_record and mode == "full" and not a.study
     return Path(a.results) / "reproducibility.parquet" if full else None
+
+
+def _unrecordable(where: Path | None) -> str | None:
+    """Why the record ``where`` cannot be written, said before any re-run: results on a
+    read-only share or another user's were re-run for hours, then "cannot write
+    <results>/reproducibility.parquet: Read-only file system", exit 2 (None: it can be)."""
+    if where is None or not where.parent.is_dir():  # (a missing --results: named by verify)
+        return None
+    ids = os.access in os.supports_effective_ids
+    if os.access(where.parent, os.W_OK | os.X_OK, effective_ids=ids):
+        return None
+    return (
+        f"--results: you may not write in {where.parent} (read-only?), where the re-runs' "
+        f"record {where.name} is written after them: give --no-record to compare only"
+    )
 
 
 def _after(a, mode: str, said: list[str]) -> str:
