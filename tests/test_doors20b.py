@@ -139,8 +139,8 @@ def test_show_of_a_sweep_names_each_cells_setting(tmp_path, capsys):
     assert lines[0].split() == ["cell", "network.scale_ppm", "feasible"]
     rows = [ln.split() for ln in lines[2:6]]
     assert rows == [
-        ["cell0000_r0", "0", "yes"],
-        ["cell0000_r1", "0", "yes"],
+        ["cell0000_r0", "0.0", "yes"],
+        ["cell0000_r1", "0.0", "yes"],
         ["cell0001_r0", "25.0", "yes"],
         ["cell0001_r1", "25.0", "yes"],
     ]

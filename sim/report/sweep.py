@@ -26,7 +26,7 @@ from sim.report.plotting import (
 from sim.report.read import columns
 from sim.report.tables import fmt, md_table
 
-__all__ = ["fig_sweep", "sweep_markdown"]
+__all__ = ["fig_sweep", "level_texts", "sweep_markdown"]
 
 
 def _claim_columns(t: dict, keys: list) -> list[str]:
@@ -67,6 +67,20 @@ def _value_texts(values) -> dict:
         if len(set(shown.values())) == len(shown):
             break
     return {k: shown[k] if k in floats else str(v) for k, v in vals.items()}
+
+
+def level_texts(values: list) -> list[str]:
+    """A swept key's column of a sweep's table (README.md's, ``sim show``'s): each float level as asked, its shortest
+    text (``45.001``, ``0.001``), or, past 12 characters, with the fewest digits that keep the
+    levels apart (:func:`_value_texts`); anything else as :func:`fmt` shows it. With three
+    digits, ``plate.spacing_mm = [45.0, 45.001]`` read 45.0 in both rows, and a range's
+    0.30000000000000004 read 0.300."""
+    finite = [isinstance(v, float) and bool(np.isfinite(v)) for v in values]
+    short = _value_texts([v for v, f in zip(values, finite) if f])
+    return [
+        (r if len(r := repr(v)) <= 12 else short[r]) if f else fmt(v)
+        for v, f in zip(values, finite)
+    ]
 
 
 def unit_of(name: str) -> str:
@@ -305,10 +319,11 @@ def sweep_markdown(out: Path, name: str | None = None) -> str:
     keys = prov.get("sweep_keys", [])
     claims = _claim_columns(t, keys)
     kinds = prov.get("claim_intervals") or {}
+    levels = {k: level_texts(list(t[k])) for k in keys}
     rows = [
         [
             t["label"][i],
-            *[fmt(t[k][i]) for k in keys],
+            *[levels[k][i] for k in keys],
             t["seed"][i],
             "yes" if t["feasible"][i] else f"no: {t['reason'][i]}",
             *[

@@ -1,0 +1,118 @@
+"""Doors, session 51, helper P52: sweeps and overrides used as a design study would use them.
+
+Each test names the class of bad (or merely careless) input and what the suite did with it
+before: a level silently changed, a table or note that mislabels a level, an unclear refusal.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import sim
+from sim.mc.chunk_count import require_chunks
+from sim.mc.config import ConfigError
+from sim.mc.storage import provenance, write_table
+from sim.mc.sweep import expand, read_sweep
+from sim.report.off_paper import sweep_off_note
+from sim.report.run_summary import terminal_table
+from sim.report.sweep import sweep_markdown
+from sim.studies import get_study
+
+ROOT = Path(__file__).resolve().parent.parent
+BROWN = ROOT / "studies" / "brown_table1.toml"
+
+
+def _sweep_dir(tmp_path: Path, keys: list[str], cells: list[dict], table: dict) -> Path:
+    """A sweep's results directory as ``sim run`` writes its ``sweep.parquet`` (its record's
+    ``sweep`` with its keys sorted, as the JSON of the run record writes them; the keys'
+    order in ``sweep_keys``), its cells all feasible, no claims."""
+    cfg = sim.load(BROWN).config
+    d = tmp_path / "sw"
+    d.mkdir()
+    n = len(cells)
+    cols = {
+        "cell": list(range(n)),
+        "replicate": [0] * n,
+        "label": [f"cell{i:04d}_r0" for i in range(n)],
+        "seed": list(range(1, n + 1)),
+        "feasible": [True] * n,
+        "reason": [""] * n,
+        **{k: [c[k] for c in cells] for k in keys},
+    }
+    prov = provenance(
+        cfg,
+        sweep=dict(sorted(table.items())),
+        sweep_keys=keys,
+        seed_mode="spawn",
+        claim_intervals={},
+    )
+    write_table(d / "sweep.parquet", cols, prov)
+    return d
+
+
+def test_range_levels_are_the_decimal_values_asked(tmp_path):
+    """Class: a sweep range of decimal steps (``{start = 0.1, stop = 0.3, step = 0.1}``,
+    ``{start = 0.0, stop = 1.0, num = 11}``, a descending step). The levels were reckoned in
+    binary: 0.30000000000000004, 0.6000000000000001, 0.19999999999999998, each cell run at a
+    value nobody asked for (and shown as such by every table). Now the values as written."""
+    study = tmp_path / "range.toml"
+    study.write_text(
+        'study = "brown_table1"\n[sweep]\n'
+        '"errors.setting_sigma_um" = { start = 0.1, stop = 0.3, step = 0.1 }\n'
+        '"errors.comparator_sigma_um" = { start = 0.3, stop = 0.1, step = -0.1 }\n'
+    )
+    table = read_sweep(study, get_study("brown_table1").schema)
+    cells = expand(table)[1]
+    assert sorted({c["errors.setting_sigma_um"] for c in cells}) == [0.1, 0.2, 0.3]
+    assert [c["errors.comparator_sigma_um"] for c in cells[:3]] == [0.3, 0.2, 0.1]
+    tenths = expand({"k": {"start": 0.0, "stop": 1.0, "num": 11}})[1]
+    assert [c["k"] for c in tenths] == [i / 10 for i in range(11)]
+    # integers stay exact, a step that does not fall on stop stops before it
+    assert [c["k"] for c in expand({"k": {"start": 1, "stop": 10, "step": 3}})[1]] == [1, 4, 7, 10]
+    assert [c["k"] for c in expand({"k": {"start": 0.0, "stop": 1.0, "step": 0.3}})[1]] == [
+        0.0,
+        0.3,
+        0.6,
+        0.9,
+    ]
+
+
+def test_off_paper_note_names_the_cell_with_its_own_values(tmp_path):
+    """Class: a sweep of two keys, the first not in alphabetical order (``plate.grid`` then
+    ``errors.settings``). The line on the cells off the paper's setup (README.md, ``sim
+    show``, the end of ``sim run``) read the run record's sweep, whose keys are sorted, and
+    named ``cell0001`` (plate.grid = 5, errors.settings = 1) with the values of cell0002
+    (``plate.grid = 3 (paper: 5)``). Now each cell with its own values."""
+    keys = ["plate.grid", "errors.settings"]
+    cells = [{"plate.grid": g, "errors.settings": s} for g in (5, 3) for s in (2, 1)]
+    d = _sweep_dir(tmp_path, keys, cells, {"plate.grid": [5, 3], "errors.settings": [2, 1]})
+    note = sweep_off_note(d, get_study)
+    assert "3 of 4 cells (cell0001: errors.settings = 1 (paper: 2) ...)" in note, note
+    assert "plate.grid" not in note, note
+
+
+def test_table_levels_are_told_apart(tmp_path):
+    """Class: levels of a swept float closer than three significant digits
+    (``plate.spacing_mm = [45.0, 45.001]``). README.md's table of cells and ``sim show``'s
+    wrote both as ``45.0``: two rows of one setting, as if the level were given twice. Now
+    each level as asked (``45.001``), or with the digits that keep them apart."""
+    keys = ["plate.spacing_mm"]
+    cells = [{"plate.spacing_mm": v} for v in (45.0, 45.001, 0.1 + 0.2, 0.3)]
+    d = _sweep_dir(tmp_path, keys, cells, {"plate.spacing_mm": [c[keys[0]] for c in cells]})
+    md = sweep_markdown(d)
+    rows = [line.split(" | ")[1] for line in md.splitlines() if line.startswith("| cell0")]
+    assert rows == ["45.0", "45.001", "0.30000000000000004", "0.3"], md
+    shown = terminal_table(d)
+    lines = [line.split()[1] for line in shown.splitlines() if line.startswith("cell0")]
+    assert lines == rows, shown
+
+
+def test_chunk_advice_of_chunks_of_one_says_one_thing():
+    """Class: too few trials in chunks of 1 (a sweep's ``trials = [40, 4]`` picks chunks of
+    1 for its small cell). The refusal advised "give at least 20 trials in chunks of 1, or
+    20 in chunks of 1". Now "give at least 20 trials"."""
+    with pytest.raises(ConfigError) as e:
+        require_chunks({"trials": 4, "chunk": 1})
+    assert str(e.value).endswith("need at least 20: give at least 20 trials"), str(e.value)
