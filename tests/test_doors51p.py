@@ -24,7 +24,9 @@ ROOT = Path(__file__).resolve().parent.parent
 BROWN = ROOT / "studies" / "brown_table1.toml"
 
 
-def _sweep_dir(tmp_path: Path, keys: list[str], cells: list[dict], table: dict) -> Path:
+def _sweep_dir(
+    tmp_path: Path, keys: list[str], cells: list[dict], table: dict, claim: bool = False
+) -> Path:
     """A sweep's results directory as ``sim run`` writes its ``sweep.parquet`` (its record's
     ``sweep`` with its keys sorted, as the JSON of the run record writes them; the keys'
     order in ``sweep_keys``), its cells all feasible, no claims."""
@@ -41,6 +43,8 @@ def _sweep_dir(tmp_path: Path, keys: list[str], cells: list[dict], table: dict) 
         "reason": [""] * n,
         **{k: [c[k] for c in cells] for k in keys},
     }
+    if claim:  # one claim with its interval, for the figure
+        cols |= {"c.v_mm": [1.0] * n, "c.v_mm:lo": [0.5] * n, "c.v_mm:hi": [1.5] * n}
     prov = provenance(
         cfg,
         sweep=dict(sorted(table.items())),
@@ -116,3 +120,22 @@ def test_chunk_advice_of_chunks_of_one_says_one_thing():
     with pytest.raises(ConfigError) as e:
         require_chunks({"trials": 4, "chunk": 1})
     assert str(e.value).endswith("need at least 20: give at least 20 trials"), str(e.value)
+
+
+def test_a_swept_switch_is_drawn_and_shown_as_its_values(tmp_path, monkeypatch):
+    """Class: a bool key swept (``network.estimate_scale = [false, true]``). ``sweep.png``
+    drew it on a number axis from 0.0 to 1.0, ticks at 0.2, 0.4, ... (levels nobody asked
+    for), and the tables wrote ``no`` and ``yes``. Now two places labelled ``false`` and
+    ``true``, as the study file writes them, and the same words in the tables."""
+    import sim.report.sweep as sweep_report
+
+    keys = ["network.estimate_scale"]
+    cells = [{keys[0]: v} for v in (False, True)]
+    d = _sweep_dir(tmp_path, keys, cells, {keys[0]: [False, True]}, claim=True)
+    drawn = []
+    monkeypatch.setattr(sweep_report, "save", lambda fig, png: drawn.append(fig) or png)
+    assert sweep_report.fig_sweep(d / "sweep.parquet", d / "sweep.png") is not None
+    ax = drawn[0].axes[0]
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["false", "true"]
+    rows = [line.split(" | ")[1] for line in sweep_markdown(d).splitlines() if "| cell0" in line]
+    assert rows == ["false", "true"]
