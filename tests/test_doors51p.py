@@ -13,12 +13,14 @@ import pytest
 import sim
 from sim.mc.chunk_count import require_chunks
 from sim.mc.config import ConfigError
+from sim.mc.estimate import estimate
 from sim.mc.storage import provenance, write_table
 from sim.mc.sweep import expand, read_sweep
 from sim.report.off_paper import sweep_off_note
 from sim.report.run_summary import terminal_table
 from sim.report.sweep import sweep_markdown
 from sim.studies import get_study
+from tests.conftest import TRIANGLE_NETWORK
 
 ROOT = Path(__file__).resolve().parent.parent
 BROWN = ROOT / "studies" / "brown_table1.toml"
@@ -139,3 +141,18 @@ def test_a_swept_switch_is_drawn_and_shown_as_its_values(tmp_path, monkeypatch):
     assert [t.get_text() for t in ax.get_xticklabels()] == ["false", "true"]
     rows = [line.split(" | ")[1] for line in sweep_markdown(d).splitlines() if "| cell0" in line]
     assert rows == ["false", "true"]
+
+
+def test_a_sweep_of_trials_is_estimated_at_the_chunk_its_cells_run(tmp_path):
+    """Class: a sweep of ``trials`` below the study file's (``trials = [200]`` of a file of
+    2,000 trials in chunks of 100). Each cell runs in the chunk ``--trials`` picks (10 here),
+    but the memory estimate counted the file's chunk: ten times the memory, a sweep refused
+    over a limit its cells stay far below. Now the cell's chunk."""
+    f = tmp_path / "n.toml"
+    f.write_text(
+        TRIANGLE_NETWORK.replace("trials = 40", "trials = 2000").replace("chunk = 2", "chunk = 100")
+    )
+    cfg = sim.load(f).config
+    swept = estimate(cfg, {"trials": [200]})
+    assert swept.bytes == estimate({**cfg, "trials": 200, "chunk": 10}).bytes
+    assert swept.bytes < estimate({**cfg, "trials": 200}).bytes
