@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 import sim
+from sim.cli import main as sim_main
 from sim.mc.chunk_count import require_chunks
 from sim.mc.config import ConfigError
 from sim.mc.estimate import estimate
@@ -156,3 +157,18 @@ def test_a_sweep_of_trials_is_estimated_at_the_chunk_its_cells_run(tmp_path):
     swept = estimate(cfg, {"trials": [200]})
     assert swept.bytes == estimate({**cfg, "trials": 200, "chunk": 10}).bytes
     assert swept.bytes < estimate({**cfg, "trials": 200}).bytes
+
+
+def test_sim_check_estimates_only_the_cells_that_run(tmp_path, capsys):
+    """Class: a sweep with a level the study refuses in its cell (``trials = [40, 4]``: 4
+    trials give too few chunks; recorded infeasible, never run). ``sim check``'s estimate
+    counted it, "44 trials in 2 sweep cells", of a sweep that runs one cell of 40; only a
+    sweep over a limit was estimated again without it. Now always without it, and the
+    refused cell named once."""
+    f = tmp_path / "n.toml"
+    f.write_text(TRIANGLE_NETWORK + "[sweep]\ntrials = [40, 4]\n")
+    assert sim_main(["check", str(f)]) == 0
+    out, err = capsys.readouterr()
+    work = [line for line in out.splitlines() if line.startswith("# work:")]
+    assert work and work[0].startswith("# work: 40 trials,"), work
+    assert err.count("1 of 2 cells are infeasible") == 1, err
