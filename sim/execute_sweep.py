@@ -27,22 +27,23 @@ def sweep_limits(
     workers: int = 1,
 ):
     """The run's estimate (:func:`sim.mc.estimate.estimate`), checked against the limits
-    (``sim run``, ``sim check``, ``python -m sim.batch``). A sweep over a limit is estimated
-    again without the cells the study refuses (recorded infeasible, never run): a 150 x 150
-    plate outside the format, refused in its cell, made a sweep of it and a 5 x 5 plate "need
-    0.744 GiB" and refused it. A cell refused for the limit itself is named
+    (``sim run``, ``sim check``, ``python -m sim.batch``). A sweep is estimated without the
+    cells the study refuses (recorded infeasible, never run): a 150 x 150 plate outside the
+    format, refused in its cell, made a sweep of it and a 5 x 5 plate "need 0.744 GiB" and
+    refused it, and ``sim check`` said "120 trials in 3 sweep cells" of a sweep that runs one. A cell refused for the limit itself is named
     (:func:`sim.mc.sweep.refused_cells`). What the load of ``cfg`` mapped is counted once
     (:func:`sim.room.loaded`)."""
-    est = estimate(cfg, sweep)
-    try:
-        check_room(est, max_memory_gb, max_adjustments, workers, cfg)  # and ulimit -v's
-    except ConfigError:
-        bad = refused_cells(study, cfg, sweep)[0] if sweep else None
-        if not bad:
-            raise
-        est = estimate(cfg, sweep, skip=bad)
-        check_room(est, max_memory_gb, max_adjustments, workers, cfg)
+    refused = refused_cells(study, cfg, sweep) if sweep else ({}, 0)
+    _CHECKED[:] = [(study, cfg, sweep, refused)] if sweep else []  # for check_sweep, once
+    est = estimate(cfg, sweep, skip=refused[0])
+    check_room(est, max_memory_gb, max_adjustments, workers, cfg)  # and ulimit -v's
     return est
+
+
+#: the cells :func:`sweep_limits` validated, ``[(study, cfg, sweep, (refused, checked))]``,
+#: taken by the :func:`check_sweep` of the same objects that follows it (the cells of a
+#: 2,500-point network take 0.7 s each to validate: not twice)
+_CHECKED: list = []
 
 
 def not_the_cells(e: BaseException) -> bool:
@@ -70,6 +71,8 @@ def check_sweep(study, cfg: dict, sweep: Mapping[str, Any], quiet: bool = False)
     ``quiet`` (``sweep.parquet`` records them with the reason)."""
     if not sweep:
         return
-    note = refused_note(sweep, *refused_cells(study, cfg, sweep))
+    done = [r for s, c, w, r in _CHECKED if s is study and c is cfg and w is sweep]
+    _CHECKED.clear()
+    note = refused_note(sweep, *(done[0] if done else refused_cells(study, cfg, sweep)))
     if note and not quiet:
         say(f"sim: {note}")

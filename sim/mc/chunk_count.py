@@ -32,6 +32,7 @@ def require_chunks(cfg: Mapping, need: int = MIN_CHUNKS, use: str = "jackknife i
         # both numbers: "at least 20 trials (one per chunk)" followed with the chunk kept
         # (a chunk of 2 given) was refused again, "make chunk at most 1"
         fix = f"give at least {need} trials in chunks of 1, or {need * chunk:,} in chunks of {chunk:,}"
+        fix = fix if chunk > 1 else f"give at least {need} trials"  # not "20 ..., or 20 ..."
     else:  # the largest chunk c with ceil(trials / c) >= need
         fix = f"make chunk at most {-(-trials // (need - 1)) - 1}"
     raise ConfigError(

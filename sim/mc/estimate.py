@@ -42,7 +42,7 @@ from sim.mc.memory_limit import DEFAULT_MAX_MEMORY_GB
 from sim.mc.memory_limit import limit_value as _limit
 from sim.mc.network_size import network_estimate as _network
 from sim.mc.salsig_size import salsig_estimate as _salsig
-from sim.mc.sweep import MAX_CELLS, expand
+from sim.mc.sweep import MAX_CELLS, cell_values, expand
 from sim.mc.toml_text import toml_value
 from sim.mc.workunits import (
     ADJUSTMENT_S,
@@ -295,7 +295,7 @@ def estimate(
     if sweep:
         keys, cells, reps, _ = expand(sweep)
         cells = [c for i, c in enumerate(cells) if i not in skip] or cells
-        cfgs = [{**cfg, **cell} for cell in cells]
+        cfgs = [{**cfg, **cell_values(cfg, cell)} for cell in cells]  # a cell's chunk too
     parts = [_one(c) for c in cfgs]
     T = sum(p[0] for p in parts) * reps
     A = sum(p[1] for p in parts) * reps + (len(cfgs) * reps * CELL_UNITS if sweep else 0.0)

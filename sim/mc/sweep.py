@@ -64,6 +64,7 @@ __all__ = [
     "cell_seed",
     "cell_label",
     "cell_config",
+    "cell_values",
     "refused_cells",
     "refused_note",
     "reordered",
@@ -201,13 +202,25 @@ def _no_repeats(key: str, raw: list, vs: list) -> None:
             )
 
 
+def cell_values(cfg: Mapping[str, Any], cell: Mapping[str, Any]) -> dict:
+    """The values a cell sets over the base ``cfg``: its swept keys, and the chunk a swept
+    ``trials`` picks when ``chunk`` is not swept (the base's, or the largest that gives
+    :data:`MIN_CHUNKS` chunks, as ``--trials`` picks it). :func:`cell_config` runs them and
+    :func:`sim.mc.estimate.estimate` counts them: it counted the base's chunk, ten times the
+    memory of a cell of ``trials = [200]`` of network_plate (chunk 100; its cell runs 10)."""
+    n = cell.get("trials")
+    if isinstance(n, (int, float)) and not isinstance(n, bool) and "chunk" not in cell:
+        if isinstance(cfg.get("chunk"), int) and math.isfinite(n):
+            return {**cell, "chunk": min(cfg["chunk"], max(1, int(n) // MIN_CHUNKS))}
+    return dict(cell)
+
+
 def cell_config(study, cfg: Mapping[str, Any], cell: Mapping[str, Any], seed: int) -> dict:
     """The validated configuration of one cell: the resolved base ``cfg`` with the cell's
     values and ``seed``, through the study's schema and ``check`` and the chunk rule (a
     :class:`ConfigError` naming the key when the study refuses it)."""
     base = {k: v for k, v in cfg.items() if k != "study"}
-    if isinstance(n := cell.get("trials"), int) and "chunk" not in cell and "chunk" in base:
-        cell = {**cell, "chunk": min(base["chunk"], max(1, n // MIN_CHUNKS))}  # as --trials
+    cell = cell_values(base, cell)
     # the cell's keys are the ones it sets: the base is resolved (its defaults already are)
     ccfg = validate({**base, **cell, "seed": seed}, study.schema, study.check, frozenset(cell))
     ccfg = {"study": cfg["study"], **ccfg}

@@ -1,11 +1,14 @@
 """The values one key of a ``[sweep]`` table takes (:mod:`sim.mc.sweep` makes its cells of
 them): a list as written, or a range ``{start, stop, num}`` (``numpy.linspace``) or ``{start,
 stop, step}`` (``start + step * i`` up to ``stop``; integers exactly), checked to be finite and
-at most :data:`MAX_CELLS` values."""
+at most :data:`MAX_CELLS` values. A range's values are reckoned in decimal from the numbers as
+written (:func:`_decimal_range`): ``{start = 0.1, stop = 0.3, step = 0.1}`` is 0.1, 0.2, 0.3,
+the values asked (binary arithmetic made its last level 0.30000000000000004)."""
 
 from __future__ import annotations
 
 import math
+from decimal import Context, Decimal
 from typing import Any
 
 import numpy as np
@@ -56,8 +59,7 @@ def _values(key: str, v: Any) -> list:
                 raise ConfigError(
                     f"sweep.{key}", f"num must be an integer from 1 to {MAX_CELLS} (got {n!r})"
                 )
-            with np.errstate(all="ignore"):  # reckoned in halves (its count was inf, "more
-                out = np.linspace(a * h, b * h, n) / h  # than 10000 values", not finite)
+            out = _decimal_range(a, b, n - 1, None)
         elif "step" in v:
             s = _finite(key, "step", v["step"])
             if s == 0 or (b * h - a * h) / s < 0:
@@ -72,14 +74,37 @@ def _values(key: str, v: Any) -> list:
                 )
             if all(isinstance(x, int) for x in (a, b, s)):  # exact (NumPy's int64 wrapped)
                 return [a + s * i for i in range((b - a) // s + 1)]
-            with np.errstate(all="ignore"):
-                out = (a * h + s * h * np.arange(int(math.floor(count + 1e-9)) + 1)) / h
+            out = _decimal_range(a, b, int(math.floor(count + 1e-9)), s)
         else:
             raise ConfigError(f"sweep.{key}", "a range needs num or step")
         if not np.isfinite(out).all():
             raise ConfigError(f"sweep.{key}", "the range's values are not finite")
         return [float(x) for x in out]
     raise ConfigError(f"sweep.{key}", f"a sweep takes a list, e.g. {_example(key, v)} (got {v!r})")
+
+
+#: decimal digits of a range's arithmetic: a value is rounded once, to the nearest float
+_DECIMAL = Context(prec=40, Emax=999_999, Emin=-999_999)
+
+
+def _decimal_range(a: float, b: float, steps: int, s: float | None) -> np.ndarray:
+    """``steps + 1`` values from ``a``: by ``s`` each (``{start, stop, step}``), or ``steps``
+    equal parts of ``a`` to ``b`` (``{start, stop, num}``, ``b`` exactly at the end), reckoned
+    in decimal from the shortest text of each number (``0.1`` is 0.1 there, not its binary
+    neighbour), then rounded to the nearest float: the levels asked, not ``0.1 + 2 * 0.1`` =
+    0.30000000000000004 or linspace's 0.6000000000000001 of 0 to 1 in 11. A value beyond the
+    floats' range is inf (refused by the caller)."""
+    da, db, c = Decimal(repr(a)), Decimal(repr(b)), _DECIMAL
+    if s is None:
+        width = c.subtract(db, da)
+        vals = [c.add(da, c.divide(c.multiply(width, i), steps)) for i in range(steps)] + [db]
+        vals = vals if steps else [da]
+    else:
+        vals = [c.add(da, c.multiply(Decimal(repr(s)), i)) for i in range(steps + 1)]
+    out = np.array([float(v) for v in vals], dtype=float)
+    if s is not None and abs(out[-1] - b) <= 1e-9 * abs(s):  # the step falls on stop
+        out[-1] = b
+    return out
 
 
 def _example(key: str, v: Any) -> str:

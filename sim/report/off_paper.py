@@ -52,14 +52,18 @@ def sweep_off_note(out: Path, get_study: Callable | None) -> str:
     decided as :func:`off_setup` says), for its README.md, ``sim show`` and the end of ``sim
     run``, or ``""``: a sweep of a printed key (``errors.settings = [1, 2]``) said nothing of
     it, where ``sim show`` of its cell ``errors.settings = 1`` says its predictions are
-    findings."""
+    findings. Its cells are the run's, in the order of its keys (``sweep_keys``): the record's
+    table, its keys sorted, named ``cell0001`` with another cell's values."""
     if get_study is None:
         return ""
     prov = read_provenance(Path(out) / "sweep.parquet")
     cfg = prov.get("config") if isinstance(prov.get("config"), dict) else {}
+    table, order = prov.get("sweep") or {}, prov.get("sweep_keys")
     try:
+        if isinstance(table, dict) and isinstance(order, list):  # the record's keys sorted:
+            table = {**{k: table[k] for k in order if k in table}, **table}  # the run's order
         study = get_study(prov.get("study"))
-        cells = expand(prov.get("sweep") or {})[1]
+        cells = expand(table)[1]
     except (ConfigError, TypeError, AttributeError):  # a provenance edited by hand: no line
         return ""
     off = [

@@ -33,7 +33,7 @@ from sim.report.labels import column
 from sim.report.off_paper import off_note, off_setup, sweep_off_note
 from sim.report.papers import paper_name
 from sim.report.read import TableError, checked_table, columns, forget, records
-from sim.report.sweep import sweep_markdown
+from sim.report.sweep import level_texts, sweep_markdown
 from sim.report.tables import fmt, md_code, md_text
 from sim.report.text_table import cut, text_table
 
@@ -263,7 +263,7 @@ def terminal_table(
     if _kind_of(out) == "sweep":  # each cell with its swept values (cell0003_r0 alone named
         t = columns(out / "sweep.parquet")  # no setting), and where its claims are
         keys = [k for k in cfg["sweep_keys"] if k in t]
-        texts = {k: column([fmt(v) for v in t[k]], lambda s: cut(s, 24), 24) for k in keys}
+        texts = {k: column(level_texts(list(t[k])), lambda s: cut(s, 24), 24) for k in keys}
         rows = [
             [
                 t["label"][i],

@@ -26,7 +26,7 @@ from sim.report.plotting import (
 from sim.report.read import columns
 from sim.report.tables import fmt, md_table
 
-__all__ = ["fig_sweep", "sweep_markdown"]
+__all__ = ["fig_sweep", "level_texts", "sweep_markdown"]
 
 
 def _claim_columns(t: dict, keys: list) -> list[str]:
@@ -66,7 +66,33 @@ def _value_texts(values) -> dict:
         shown = {k: f"{v:.{digits}g}" for k, v in floats.items()}
         if len(set(shown.values())) == len(shown):
             break
-    return {k: shown[k] if k in floats else str(v) for k, v in vals.items()}
+    return {
+        k: shown[k] if k in floats else _BOOL_TEXT[k] if isinstance(v, bool) else str(v)
+        for k, v in vals.items()
+    }
+
+
+#: a bool level as the study file writes it (TOML), by its ``repr``
+_BOOL_TEXT = {"False": "false", "True": "true"}
+
+
+def level_texts(values: list) -> list[str]:
+    """A swept key's column of a sweep's table (README.md's, ``sim show``'s): each float
+    level as asked, its shortest text (``45.001``, ``0.001``), or, past 12 characters, with
+    the fewest digits that keep the levels apart (:func:`_value_texts`); a bool as TOML
+    writes it (``false``, not ``no``); anything else as :func:`fmt` shows it. With three
+    digits, ``plate.spacing_mm = [45.0, 45.001]`` read 45.0 in both rows, and a range's
+    0.30000000000000004 read 0.300."""
+    finite = [isinstance(v, float) and bool(np.isfinite(v)) for v in values]
+    short = _value_texts([v for v, f in zip(values, finite) if f])
+    return [
+        (r if len(r := repr(v)) <= 12 else short[r])
+        if f
+        else _BOOL_TEXT[repr(v)]
+        if isinstance(v, bool)
+        else fmt(v)
+        for v, f in zip(values, finite)
+    ]
 
 
 def unit_of(name: str) -> str:
@@ -159,7 +185,9 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
     if not keys or not claims:
         return None
     first = t[keys[0]]
-    numeric = all(isinstance(v, (int, float)) for v in first)
+    # a bool key's false and true at two labelled places: drawn at 0.0 and 1.0 of a number
+    # axis, its ticks read 0.2, 0.4, ... of a switch
+    numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in first)
     whole = numeric and all(isinstance(v, int) and not isinstance(v, bool) for v in first)
     ticks = list(dict.fromkeys(repr(v) for v in first))  # text, list values: one place each
     x = np.array([float(v) for v in first] if numeric else [ticks.index(repr(v)) for v in first])
@@ -227,7 +255,7 @@ def fig_sweep(path: Path, png: Path, max_panels: int = 12) -> Path | None:
             # (named apart from ``shown``, the other keys' texts the next panel's legend
             # reads: a text first key and a second key failed the whole sweep at its
             # second panel, "string indices must be integers")
-            at = apart([ticks[i] for i in pos], 16)
+            at = apart([_BOOL_TEXT.get(ticks[i], ticks[i]) for i in pos], 16)
             ax.set_xticks(pos, at, fontsize=7, rotation=90 if len(pos) > 6 else 0)
         note = _bars(kinds.get(c))
         ax.set_title(c + (f"\n({note})" if note else ""), fontsize=8, wrap=True)
@@ -305,10 +333,11 @@ def sweep_markdown(out: Path, name: str | None = None) -> str:
     keys = prov.get("sweep_keys", [])
     claims = _claim_columns(t, keys)
     kinds = prov.get("claim_intervals") or {}
+    levels = {k: level_texts(list(t[k])) for k in keys}
     rows = [
         [
             t["label"][i],
-            *[fmt(t[k][i]) for k in keys],
+            *[levels[k][i] for k in keys],
             t["seed"][i],
             "yes" if t["feasible"][i] else f"no: {t['reason'][i]}",
             *[
