@@ -12,10 +12,11 @@ from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
 from sim.instruments.ranges import positions as po
 from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
+from sim.mc.chunk_count import MIN_CHUNKS, require_chunks
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import when
-from sim.mc.runner import MIN_CHUNKS, chunk_rng, require_chunks
 from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, region_seed
+from sim.mc.streams import chunk_rng
 from sim.studies.brown.probe import check_noise, check_solver, check_start
 from sim.studies.brown.range_keys import check_scale, moved_from_paper
 from sim.studies.brown.values import thetas
