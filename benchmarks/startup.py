@@ -8,8 +8,10 @@ than wall time on a shared machine), ``wall_s`` that round's wall time. The comm
 loads a command's module only when that command runs (:data:`sim.cli.COMMANDS`), so
 ``sim --version``, ``--help`` and a refused option load no study, runner or SciPy; their
 rows carry the :data:`TARGET_S` target (``target_s``; NaN on the rows of commands that load
-a study, whose cost is the study's code). ``exit`` is the command's exit code (2 on the
-refusals, as they should be). Nothing is written: the refused ``sim check`` names a study
+a study, whose cost is the study's code; the rows ``keys of ...`` read one study's keys, as
+``sim check`` and :func:`sim.load` validate against them: the target applies to the kinds
+whose keys need neither the engine nor the claim machinery). ``exit`` is the command's exit
+code (2 on the refusals, as they should be). Nothing is written: the refused ``sim check`` names a study
 file that does not exist.
 """
 
@@ -34,6 +36,8 @@ TARGET_S = 0.45
 REPEAT = 3
 #: the study file of the rows that check one (the project's, from wherever the benchmark runs)
 WOLF = str(Path(__file__).resolve().parent.parent / "studies" / "wolf_polynomial.toml")
+#: the code of the rows that read a study's keys alone (``sim.studies.get_study``)
+_KEYS = "from sim.studies import get_study; get_study({!r}).schema"
 #: row name -> (arguments of ``python``, its expected exit code, whether TARGET_S applies)
 COMMANDS = {
     "sim --version": (["-m", "sim", "--version"], 0, True),
@@ -43,6 +47,11 @@ COMMANDS = {
     "sim check (no such file)": (["-m", "sim", "check", "no-such-study.toml"], 2, False),
     "sim check wolf_polynomial": (["-m", "sim", "check", WOLF], 0, False),
     "sim.batch --help": (["-m", "sim.batch", "--help"], 0, False),
+    # a study's keys (what sim check and sim.load validate against) without its run code
+    # (issue 26's T52: 1.3 to 1.6 s, the package loading its run, report and claim book)
+    "keys of wolf_polynomial": (["-c", _KEYS.format("wolf_polynomial")], 0, True),
+    "keys of salsig_encoders": (["-c", _KEYS.format("salsig_encoders")], 0, True),
+    "keys of brown_table1": (["-c", _KEYS.format("brown_table1")], 0, False),
 }
 
 

@@ -33,7 +33,7 @@ def test_grid_is_the_papers():
     g = _grid()
     assert len(g) == 66
     assert g[:, 0].max() - g[:, 0].min() == 200 and g[:, 1].max() - g[:, 1].min() == 100
-    assert wolf._index(g, (0, 0)) >= 0 and wolf._index(g, (100, 0)) >= 0
+    assert wolf.node_index(g, (0, 0)) >= 0 and wolf.node_index(g, (100, 0)) >= 0
 
 
 def test_cubic_field_removed_exactly_without_noise():
@@ -116,7 +116,7 @@ def test_two_point_undoes_a_similarity():
         [np.stack([np.cos(th), -np.sin(th)], -1), np.stack([np.sin(th), np.cos(th)], -1)], -2
     )
     C = s[:, None, None] * np.einsum("tij,nj->tni", R, G) + rng.uniform(-1e4, 1e4, (T, 1, 2))
-    ia, ib = wolf._index(G, (0, 0)), wolf._index(G, (100, 0))
+    ia, ib = wolf.node_index(G, (0, 0)), wolf.node_index(G, (100, 0))
     out = pl.apply_two_point(pl.two_point_transform(C[:, ia], C[:, ib], G[ia], G[ib]), C)
     assert np.abs(out - G).max() < 1e-9
 

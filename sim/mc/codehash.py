@@ -1,8 +1,8 @@
 """Which code a study's results depend on, and whether committed results are current.
 
-A study's *code* is the closure of the ``sim`` modules its package imports (read statically
-from the parsed sources, so nothing is imported or run), plus the data files inside its package
-(the claim book). Its hash decides staleness per study: editing one study's caption re-runs
+A study's *code* is the closure of the ``sim`` modules the modules of its package import
+(read statically from the parsed sources, so nothing is imported or run), plus the data files
+inside its package (the claim book). Its hash decides staleness per study: editing one study's caption re-runs
 that study only, and a fresh clone (whose file times are the checkout's) does not re-run
 anything that is current.
 
@@ -140,17 +140,19 @@ def _study_module(study: str) -> str:
 
 
 def study_files(study: str) -> list[Path]:
-    """The files whose content decides the results of the study named ``study``: its code
-    closure and the data files (claim book, tables) inside its package directory."""
+    """The files whose content decides the results of the study named ``study``: the code
+    closure of every module of its package directory (a package names its run and report
+    modules as data, :class:`sim.studies.Part`, imported when a run needs them: the closure of
+    its ``__init__`` alone missed them) and the data files (claim book, tables) inside it."""
     module = _study_module(study)
     files = list(study_modules(module))
     f0 = _module_file(module)
     if f0 is not None and f0.name == "__init__.py":
-        files += [
-            p
-            for p in sorted(f0.parent.rglob("*"))
-            if p.is_file() and p.suffix in (".toml", ".csv", ".json")
-        ]
+        inside = sorted(p for p in f0.parent.rglob("*") if p.is_file())
+        if study in MODULES:  # (not sim.studies itself: every kind's code)
+            for p in (p for p in inside if p.suffix == ".py"):
+                files += study_modules(_module_name(p))
+        files += [p for p in inside if p.suffix in (".toml", ".csv", ".json")]
     return sorted(set(files))
 
 

@@ -39,6 +39,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from sim.mc.chunk_count import MIN_CHUNKS
 from sim.mc.config import (
     ConfigError,
     Field,
@@ -52,7 +53,7 @@ from sim.mc.limit_error import LimitError
 from sim.mc.message_text import near_keys
 from sim.mc.numtext import UnheldError, unsigned_zeros
 from sim.mc.progress import Progress
-from sim.mc.runner import MIN_CHUNKS, chunk_rng
+from sim.mc.streams import chunk_rng
 from sim.mc.sweep_values import MAX_CELLS, _is_range, _values
 from sim.mc.toml_text import toml_value
 from sim.mc.unknown_key import item_hint

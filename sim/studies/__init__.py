@@ -12,17 +12,21 @@ import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 from sim.mc.config import ConfigError, Field, flatten, parse_override, read_toml, validate
 from sim.mc.lookalike import looks
 from sim.mc.read_when import refuse_unread, unread
 from sim.mc.registry import MODULES
-from sim.mc.runner import RunContext
 from sim.mc.sweep import RESERVED, expand, read_sweep
 from sim.studies.scored_ids import check_literal_ids, check_scored, named_ids
 
+if TYPE_CHECKING:
+    from sim.mc.runner import RunContext
+
 __all__ = [
+    "Part",
+    "names_from",
     "Study",
     "data_check",
     "RunContext",
@@ -33,6 +37,58 @@ __all__ = [
     "unread_keys",
     "MODULES",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """``RunContext`` (the studies' run modules import it from here), loaded with the
+    Monte-Carlo runner only when a run module asks for it: validating a study file does not
+    load the runner (SciPy, Arrow)."""
+    if name == "RunContext":
+        from sim.mc.runner import RunContext
+
+        return RunContext
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+@dataclass(frozen=True)
+class Part:
+    """A study's function named by its module and name, imported when it is first called: a
+    study package names its run and report code and its :attr:`Study.data` check so
+    (``Part("sim.studies.wolf.run", "run")``) and validating a study file (``sim check``, the
+    batch's checks, :func:`sim.load`) loads its keys and checks only, not the code that runs
+    the trials, draws and reports (SciPy, Arrow, Matplotlib). The code hash counts every module of a study's
+    package (:func:`sim.mc.codehash.study_files`), these included."""
+
+    module: str
+    name: str
+
+    @property
+    def function(self) -> Callable:
+        """The function itself (imported now)."""
+        return getattr(importlib.import_module(self.module), self.name)
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return self.function(*args, **kwargs)
+
+    def __getattr__(self, name: str) -> Any:
+        """The function's own attributes (a :func:`data_check`'s ``scored``)."""
+        if name.startswith("__"):  # pickle's and copy's look-ups: not the function's
+            raise AttributeError(name)
+        return getattr(self.function, name)
+
+
+def names_from(table: Mapping[str, str]) -> Callable[[str], Any]:
+    """A study package's module ``__getattr__``: each name of ``table`` (name -> the module of
+    the package that defines it) imported from there when first asked for, so that the
+    package keeps offering its functions (``sim.studies.wolf.main_chunk``) without loading
+    them with its keys."""
+
+    def __getattr__(name: str) -> Any:
+        if name not in table:
+            raise AttributeError(f"no attribute {name!r}")
+        return getattr(importlib.import_module(table[name]), name)
+
+    return __getattr__
 
 
 @dataclass(frozen=True)

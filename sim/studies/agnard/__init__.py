@@ -18,11 +18,7 @@ of blocks and its adjustments), :mod:`.run` (through the runner), ``claims.toml`
 
 from __future__ import annotations
 
-from sim.studies import Study, data_check
-from sim.studies.agnard.claims import load_book, scored_ids
-from sim.studies.agnard.region import CENTRES, DECLARATION, INSET, SCANNER, SCANNER_KEYS
-from sim.studies.agnard.report import report
-from sim.studies.agnard.run import run
+from sim.studies import Part, Study
 from sim.studies.agnard.schema import NAME, SCHEMA, SEED, check
 
 STUDIES = {
@@ -32,15 +28,10 @@ STUDIES = {
         "calibration and a block of independent models",
         seed_file=SEED,
         schema=SCHEMA,
-        run=run,
-        report=report,
+        run=Part("sim.studies.agnard.run", "run"),
+        report=Part("sim.studies.agnard.report", "report"),
         check=check,
         order=50,
-        data=data_check(
-            load_book,
-            (DECLARATION, lambda cfg: (CENTRES, "five_inset_1"), {"five_inset_1": INSET}),
-            (SCANNER, lambda cfg: SCANNER_KEYS, SCANNER_KEYS),
-            scored=scored_ids,
-        ),
+        data=Part("sim.studies.agnard.data_checks", "DATA"),
     )
 }

@@ -15,28 +15,9 @@ reports. Coordinates in mm, standard deviations in um.
 
 from __future__ import annotations
 
-from sim.studies import Study, data_check
-from sim.studies.brown.claims import load_book, scored_by
-from sim.studies.brown.region import (
-    CONCEPT_ON_PAPER,
-    T1_JOINT,
-    T1_PREDICTIONS,
-    TABLE1_ON_PAPER,
-)
-from sim.studies.brown.report import report_dilution, report_table1
-from sim.studies.brown.run import run_dilution, run_table1
-from sim.studies.brown.schema import DILUTION, MODEL_NAMES, SEED, TABLE1, as_printed, check
-
-
-def _dilution_ids(cfg: dict, book) -> list[str]:
-    """The ids brown_dilution builds (:func:`.claims.score_dilution`)."""
-    return [f"brown.mc_agreement.{m}.mean_ratio" for m in MODEL_NAMES]
-
-
-def _table1_ids(cfg: dict, book) -> list[str]:
-    """The ids brown_table1 builds: Table 1's statements over the region (:mod:`.region`)."""
-    return [*T1_PREDICTIONS, T1_JOINT]
-
+from sim.studies import Part, Study
+from sim.studies.brown.claim_ids import CONCEPT_ON_PAPER, TABLE1_ON_PAPER
+from sim.studies.brown.schema import DILUTION, SEED, TABLE1, as_printed, check
 
 STUDIES = {
     "brown_dilution": Study(
@@ -44,15 +25,11 @@ STUDIES = {
         "Brown: known stations, dilution, pivot offsets",
         SEED,
         DILUTION,
-        run_dilution,
-        report_dilution,
+        Part("sim.studies.brown.run", "run_dilution"),
+        Part("sim.studies.brown.report", "report_dilution"),
         check,
         order=10,
-        data=data_check(
-            lambda: load_book("brown_dilution"),
-            scores=scored_by("brown_dilution"),
-            scored=_dilution_ids,
-        ),
+        data=Part("sim.studies.brown.data_checks", "DILUTION_DATA"),
         paper_design=CONCEPT_ON_PAPER,
     ),
     "brown_table1": Study(
@@ -60,13 +37,11 @@ STUDIES = {
         "Brown: the production test (Table 1)",
         SEED,
         TABLE1,
-        run_table1,
-        report_table1,
+        Part("sim.studies.brown.run", "run_table1"),
+        Part("sim.studies.brown.report", "report_table1"),
         check,
         order=11,
-        data=data_check(
-            lambda: load_book("brown_table1"), scores=scored_by("brown_table1"), scored=_table1_ids
-        ),
+        data=Part("sim.studies.brown.data_checks", "TABLE1_DATA"),
         paper_design=TABLE1_ON_PAPER,
         as_printed=as_printed,
     ),

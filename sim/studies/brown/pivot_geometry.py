@@ -16,7 +16,7 @@ from sim.instruments.ranges import multilateration as ml
 from sim.instruments.ranges import positions as po
 from sim.lsq.normals import RCOND, reduced_normals, scaled_rcond
 from sim.mc.config import ConfigError
-from sim.mc.runner import chunk_rng
+from sim.mc.streams import chunk_rng
 from sim.studies.brown.range_keys import moved_from_paper
 from sim.studies.brown.values import thetas
 

@@ -46,6 +46,14 @@ from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
 from sim.mc.runner import chunk_rng
 from sim.studies.brown import values as V
+from sim.studies.brown.claim_ids import (  # noqa: F401 - the region's ids, named from here too
+    CONCEPT_ON_PAPER,
+    CONCEPT_PREDICTIONS,
+    T1,
+    T1_JOINT,
+    T1_PREDICTIONS,
+    TABLE1_ON_PAPER,
+)
 
 SCALE = Statement(
     "hardware.scale_reads",
@@ -56,32 +64,11 @@ SCALE = Statement(
     "mm: both on the scale)",
     source="004, Implementation of the Concept",
 )
-T1 = "brown.table1_point_sigma."
-T1_PREDICTIONS = (
-    T1 + "share_1p1_1p3",
-    T1 + "points_ge_1p45",
-    T1 + "max_um",
-    T1 + "below_closure",
-)
-T1_JOINT = T1 + "together"
 CLOSURE = "brown.table1_closure.rms_um"
 #: the Concept region's outputs for the notes: the points at Table 1's stations, and the
 #: known-station ratio on the outer ring of Table 1's plate there
 T1_STATIONS = "table1_stations"
 RING = "brown.known_edge.ratio@table1_ring"
-CONCEPT_PREDICTIONS = (
-    "brown.known_center.ratio",
-    "brown.known_edge.ratio",
-    "brown.dilution.range_pct",
-    "brown.pivot_extra_dilution.typical_pct",
-    "brown.dilution_falls_with_points.monotone",
-)
-#: the predictions decided over a region on the paper's own setup (Table 1's plate, the
-#: built comparator's format and scale: :mod:`sim.instruments.ranges.brown`), which read no key
-#: of the run's design (only the region's seed and sizes): on a run off the paper's setup they
-#: stay the paper's verdicts (:func:`sim.claims.rules.off_paper`)
-TABLE1_ON_PAPER = frozenset((*T1_PREDICTIONS, T1_JOINT))
-CONCEPT_ON_PAPER = frozenset(CONCEPT_PREDICTIONS)
 #: points per side of the format's edge at which "points near the edges" are evaluated
 EDGE_POINTS = 25
 #: grids of the "more points, less dilution" prediction over the region (same extent)

@@ -12,9 +12,9 @@ import numpy as np
 from sim.instruments.plates import pattern_points
 from sim.instruments.ranges import brown as B
 from sim.instruments.ranges import multilateration as ml
+from sim.mc.chunk_count import MIN_CHUNKS, require_chunks
 from sim.mc.config import COMMON, ConfigError, Field
 from sim.mc.read_when import when
-from sim.mc.runner import MIN_CHUNKS, require_chunks
 from sim.mc.schema_helpers import compared, count, counts, positive, printed, real, region_seed
 from sim.studies.brown.pivot_geometry import check_pivot, points_of, setup, within_beta
 from sim.studies.brown.probe import check_noise, check_solver, check_start

@@ -11,13 +11,18 @@ book), :mod:`.run`, :mod:`.figures`, :mod:`.report`.
 
 from __future__ import annotations
 
-from sim.studies import Study, data_check
-from sim.studies.design.cells import geometry_eval, measuring_time, pareto_front, time_model
+from sim.studies import Part, Study, names_from
 from sim.studies.design.checks import check
-from sim.studies.design.claims import load_book, scored_ids
-from sim.studies.design.report import report
-from sim.studies.design.run import run
 from sim.studies.design.schema import SCHEMA, SEED
+
+#: the package's functions, imported when first asked for (:func:`sim.studies.names_from`)
+__getattr__ = names_from(
+    {
+        n: "sim.studies.design.cells"
+        for n in ("geometry_eval", "measuring_time", "pareto_front", "time_model")
+    }
+    | {"run": "sim.studies.design.run", "report": "sim.studies.design.report"}
+)
 
 __all__ = [
     "STUDIES",
@@ -36,10 +41,10 @@ STUDIES = {
         "budget, datum, coverage, Bayesian check",
         SEED,
         SCHEMA,
-        run,
-        report,
+        Part("sim.studies.design.run", "run"),
+        Part("sim.studies.design.report", "report"),
         check,
         order=12,
-        data=data_check(load_book, scored=scored_ids),
+        data=Part("sim.studies.design.data_checks", "DATA"),
     ),
 }

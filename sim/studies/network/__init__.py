@@ -19,10 +19,8 @@ and :mod:`.kernel` (observation model), :mod:`.analysis` and :mod:`.sparse_analy
 
 from __future__ import annotations
 
-from sim.studies import Study
+from sim.studies import Part, Study
 from sim.studies.network.bias_checks import bias_notes
-from sim.studies.network.report import report
-from sim.studies.network.run import run
 from sim.studies.network.schema import SCHEMA, check, unread
 
 STUDIES = {
@@ -31,8 +29,8 @@ STUDIES = {
         "Network design study (your own instrument as data)",
         "",
         SCHEMA,
-        run,
-        report,
+        Part("sim.studies.network.run", "run"),
+        Part("sim.studies.network.report", "report"),
         check,
         order=90,
         unread=unread,

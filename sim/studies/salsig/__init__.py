@@ -8,26 +8,19 @@ consistent set), ``claims.toml`` + :mod:`.claims` (scoring), :mod:`.figures`, :m
 
 from __future__ import annotations
 
-from sim.studies import Study, data_check
-from sim.studies.salsig.claims import load_book, scored_ids
-from sim.studies.salsig.model import (  # noqa: F401
-    decompositions,
-    simulate_chain,
-    simulate_vertical,
-    simulate_zscale,
-)
-from sim.studies.salsig.region import _KEYS, DECLARATION, check_vertical, nominal
-from sim.studies.salsig.report import report
-from sim.studies.salsig.run import run
-from sim.studies.salsig.schema import SCHEMA, check
+from sim.studies import Part, Study, names_from
+from sim.studies.salsig.schema import SCHEMA
 
 SEED = "002_fb81c7b0481438c4.txt"
 
-
-def _check(cfg: dict) -> None:
-    """The schema's cross-key rules, then the control errors the region explores."""
-    check(cfg)
-    check_vertical(cfg)
+#: the package's functions, imported when first asked for (:func:`sim.studies.names_from`)
+__getattr__ = names_from(
+    {
+        n: "sim.studies.salsig.model"
+        for n in ("decompositions", "simulate_chain", "simulate_vertical", "simulate_zscale")
+    }
+    | {"check": "sim.studies.salsig.schema"}
+)
 
 
 STUDIES = {
@@ -36,14 +29,10 @@ STUDIES = {
         "Salsig: calibrating stereo plotter encoders",
         SEED,
         SCHEMA,
-        run,
-        report,
-        _check,
+        Part("sim.studies.salsig.run", "run"),
+        Part("sim.studies.salsig.report", "report"),
+        Part("sim.studies.salsig.data_checks", "check"),
         order=30,
-        data=data_check(
-            load_book,
-            (DECLARATION, nominal, {**_KEYS, "control_1": "vertical.control"}),
-            scored=scored_ids,
-        ),
+        data=Part("sim.studies.salsig.data_checks", "DATA"),
     ),
 }

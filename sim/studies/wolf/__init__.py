@@ -18,17 +18,9 @@ Modules: :mod:`.schema` (the config's keys), :mod:`.checks` (cross-key rules),
 
 from __future__ import annotations
 
-from sim.studies import Study, data_check
+from sim.studies import Part, Study, names_from
 from sim.studies.wolf.checks import check
-from sim.studies.wolf.chunks import degree_chunk, main_chunk, stability_chunk
-from sim.studies.wolf.claims import load_book, scored_ids
-from sim.studies.wolf.grid import grid_nodes, mid_cells, node_index
-from sim.studies.wolf.model import reading_error_rms
-from sim.studies.wolf.region import CELL, DECLARATION, nominal
-from sim.studies.wolf.report import report
-from sim.studies.wolf.run import run
 from sim.studies.wolf.schema import SCHEMA, SEED
-from sim.studies.wolf.tables import load_table1, load_table3, summary, table1_discrepancies
 
 __all__ = [
     "STUDIES",
@@ -47,11 +39,24 @@ __all__ = [
     "table1_discrepancies",
     "summary",
     "node_index",
-    "_index",
 ]
 
-#: the name the tests knew :func:`node_index` by
-_index = node_index
+#: the package's functions, imported when first asked for (:func:`sim.studies.names_from`)
+__getattr__ = names_from(
+    {
+        **dict.fromkeys(
+            ("degree_chunk", "main_chunk", "stability_chunk"), "sim.studies.wolf.chunks"
+        ),
+        **dict.fromkeys(("grid_nodes", "mid_cells", "node_index"), "sim.studies.wolf.grid"),
+        "reading_error_rms": "sim.studies.wolf.model",
+        "run": "sim.studies.wolf.run",
+        "report": "sim.studies.wolf.report",
+        **dict.fromkeys(
+            ("load_table1", "load_table3", "summary", "table1_discrepancies"),
+            "sim.studies.wolf.tables",
+        ),
+    }
+)
 
 STUDIES = {
     "wolf_polynomial": Study(
@@ -59,14 +64,10 @@ STUDIES = {
         "Wolf & Pearsall: the Kern PG-2 as a monocomparator",
         SEED,
         SCHEMA,
-        run,
-        report,
+        Part("sim.studies.wolf.run", "run"),
+        Part("sim.studies.wolf.report", "report"),
         check,
         order=40,
-        data=data_check(
-            load_book,
-            (DECLARATION, nominal, {k: v for k, v in CELL.items() if "." in v}),
-            scored=scored_ids,
-        ),
+        data=Part("sim.studies.wolf.data_checks", "DATA"),
     ),
 }
