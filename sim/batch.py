@@ -70,6 +70,7 @@ from sim.batch_checks import (  # noqa: E402
     is_current,
     why_stale,
 )
+from sim.batch_order import SLOW_FIRST, order  # noqa: E402
 from sim.batch_report import not_rebuilt, rebuild_report, report_problem  # noqa: E402
 from sim.batch_summary import _Named, _Stdout, summary  # noqa: E402
 from sim.batch_timings import TimingsLock  # noqa: E402
@@ -97,23 +98,6 @@ if __name__ != "__main__":  # imported: the default handlers (the program: run_p
     _loaded()
 
 __all__ = ["SLOW_FIRST", "order", "run_all", "main", "summary", "is_current", "why_stale"]
-
-#: the studies that take longest (``make bench``'s rerun rows), started first in this order
-SLOW_FIRST = (
-    "wolf_polynomial",
-    "brown_design",
-    "agnard_block",
-    "salsig_encoders",
-    "gridplate_two_plates",
-    "brown_dilution",
-)
-
-
-def order(files: list[Path]) -> list[Path]:
-    """``files`` with those named in :data:`SLOW_FIRST` first (in its order), then the rest in
-    the given order."""
-    rank = {s: i for i, s in enumerate(SLOW_FIRST)}
-    return sorted(files, key=lambda f: rank.get(f.stem, len(rank)))
 
 
 def run_all(
