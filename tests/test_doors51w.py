@@ -1,0 +1,63 @@
+"""Issue 26 item 1 (W52): the work and memory estimate against what runs really take.
+
+``python -m sim.batch --jobs J`` checked each run's estimate alone against the memory limit,
+so J large runs side by side could hold J times the limit (B51's left item): the batch now
+starts a run only while its estimate fits beside those of the runs going
+(:mod:`sim.batch_memory`)."""
+
+import json
+import threading
+
+from sim import batch
+from sim.batch_memory import MemoryGate
+from tests.conftest import grid_network
+
+
+def _two_grids(tmp_path):
+    """Two copies of a 6 x 6 trilateration grid (``a.toml``, ``b.toml``) and the bytes one
+    run's estimate needs."""
+    src, need = grid_network(tmp_path, side=6)
+    a, b = tmp_path / "a.toml", tmp_path / "b.toml"
+    a.write_text(src.read_text())
+    b.write_text(src.read_text())
+    return a, b, need
+
+
+def test_jobs_do_not_hold_more_than_the_memory_limit_together(tmp_path, capsys):
+    """Runs side by side over the memory limit together (``--jobs 2``, each run's estimate
+    under the limit, two of them over it): both started at once before, each checked alone
+    (J runs of a large network could need J x the limit); the second now starts when the
+    first has ended, with one line saying why, and both run (nothing refused)."""
+    a, b, need = _two_grids(tmp_path)
+    gb = 1.5 * need / 2**30  # one run fits, two do not
+    timings = tmp_path / "t.json"
+    args = ["--jobs", "2", "--results", str(tmp_path / "r"), "--timings", str(timings)]
+    rc = batch.main([*args, str(a), str(b), "--", "--no-figures", "--max-memory-gb", repr(gb)])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    done = json.loads(timings.read_text())  # {stem: [exit code, wall s, start s]}
+    assert {k: v[0] for k, v in done.items()} == {"a": 0, "b": 0}
+    first, second = sorted(done.values(), key=lambda v: v[2])
+    assert second[2] >= first[2] + first[1]  # started after the first ended
+    assert "waits for a run to end" in err and "--max-memory-gb" in err
+
+
+def test_the_gate_admits_a_lone_run_and_lets_go_on_a_stop():
+    """A run larger than the limit alone is admitted (its own check bounded it: refusing it
+    here would hang the batch), and a run waiting for room returns when the batch is
+    interrupted (held bytes given back each time)."""
+    said: list[str] = []
+    gate = MemoryGate({"big": 2.0 * 2**30, "small": 1.0}, 1.0, said.append)
+    stop = threading.Event()
+    assert gate.enter("big", 2.0 * 2**30, stop)  # alone: admitted
+    stop.set()
+    assert not gate.enter("small", 2**30, stop)  # would wait: stopped
+    gate.leave(2.0 * 2**30)
+    assert gate.held == 0.0 and said == []  # stopped before it said it waits
+    assert gate.around("small", threading.Event(), lambda f: f, lambda: None) == "small"
+
+
+def test_without_estimates_nothing_waits():
+    """run_all called without estimates (tests, benchmarks) holds no gate."""
+    gate = MemoryGate({}, None)
+    assert gate.enter("x", 1e30, threading.Event()) and gate.enter("y", 1e30, threading.Event())
