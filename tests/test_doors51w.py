@@ -7,10 +7,13 @@ starts a run only while its estimate fits beside those of the runs going
 
 import json
 import threading
+from pathlib import Path
 
 from sim import batch
 from sim.batch_memory import MemoryGate
 from tests.conftest import grid_network
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def _two_grids(tmp_path):
@@ -61,3 +64,23 @@ def test_without_estimates_nothing_waits():
     """run_all called without estimates (tests, benchmarks) holds no gate."""
     gate = MemoryGate({}, None)
     assert gate.enter("x", 1e30, threading.Event()) and gate.enter("y", 1e30, threading.Event())
+
+
+def test_wolf_estimate_counts_the_trade_off_chunks_the_run_takes():
+    """An estimate too high (a run that fits refused): Wolf's trade-offs run in chunks of
+    :func:`sim.studies.wolf.chunks.sub_chunk` (at least four chunks: 100 of its 400 trials),
+    but were counted in chunks of ``min(trade.trials, chunk)`` (400): the paper's setup was
+    estimated at 1.09 GiB for a run measured at 0.39 GiB at its peak (the whole process).
+    The estimate now follows the study's rule, so it no longer grows with ``chunk`` past
+    a quarter of ``trade.trials``."""
+    import sim
+    from sim.mc.estimate import estimate, wolf_sub_chunk
+    from sim.studies.wolf.chunks import sub_chunk
+
+    for t, ch in [(400, 500), (3, 500), (1000, 10), (1, 1), (7, 2)]:
+        assert wolf_sub_chunk(t, ch) == sub_chunk(t, ch)
+    cfg = dict(sim.load(ROOT / "studies" / "wolf_polynomial.toml").config)
+    assert (cfg["trade.trials"], cfg["chunk"]) == (400, 500)  # the case measured
+    at_500 = estimate(cfg).bytes
+    assert at_500 == estimate({**cfg, "chunk": 100}).bytes  # the trade chunk is 100 in both
+    assert at_500 < 0.4 * 2**30
