@@ -84,3 +84,22 @@ def test_wolf_estimate_counts_the_trade_off_chunks_the_run_takes():
     at_500 = estimate(cfg).bytes
     assert at_500 == estimate({**cfg, "chunk": 100}).bytes  # the trade chunk is 100 in both
     assert at_500 < 0.4 * 2**30
+
+
+def test_a_span_just_over_1000_km_is_named_with_the_digits_that_put_it_over(tmp_path, capsys):
+    """An unclear message: a 5,000-leg traverse of 200 m legs with its end points (1000.2 km)
+    was refused as "the network spans 1000 km: over 1000 km" (four digits); the span is now
+    printed with the digits that put it over the bound."""
+    from sim.cli import main
+
+    st = tmp_path / "long.toml"
+    st.write_text(
+        'study = "network"\ntrials = 40\nchunk = 2\n[network]\npoints = [ '
+        '{ name = "A", x_mm = 0.0, y_mm = 0.0, role = "fixed" }, '
+        '{ name = "B", x_mm = 1000200000.0, y_mm = 0.0, role = "fixed" }, '
+        '{ name = "C", x_mm = 500000000.0, y_mm = 1000.0 } ]\n'
+        'generate = [ { kind = "distance", from = "*", to = "*", sigma_mm = 1.0 } ]\n'
+    )
+    assert main(["check", str(st)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "spans 1000.2 km: over 1000 km" in err, err
