@@ -63,6 +63,7 @@ from sim.batch_checks import (  # noqa: E402
     _default_results_problem,
     _files_after,
     _in_batch_words,
+    _parsed,
     _replaces_project_results,
     _run_options_problem,
     _timings_problem,
@@ -70,6 +71,8 @@ from sim.batch_checks import (  # noqa: E402
     is_current,
     why_stale,
 )
+from sim.batch_memory import MemoryGate  # noqa: E402
+from sim.batch_order import SLOW_FIRST, order  # noqa: E402
 from sim.batch_report import not_rebuilt, rebuild_report, report_problem  # noqa: E402
 from sim.batch_summary import _Named, _Stdout, summary  # noqa: E402
 from sim.batch_timings import TimingsLock  # noqa: E402
@@ -98,23 +101,6 @@ if __name__ != "__main__":  # imported: the default handlers (the program: run_p
 
 __all__ = ["SLOW_FIRST", "order", "run_all", "main", "summary", "is_current", "why_stale"]
 
-#: the studies that take longest (``make bench``'s rerun rows), started first in this order
-SLOW_FIRST = (
-    "wolf_polynomial",
-    "brown_design",
-    "agnard_block",
-    "salsig_encoders",
-    "gridplate_two_plates",
-    "brown_dilution",
-)
-
-
-def order(files: list[Path]) -> list[Path]:
-    """``files`` with those named in :data:`SLOW_FIRST` first (in its order), then the rest in
-    the given order."""
-    rank = {s: i for i, s in enumerate(SLOW_FIRST)}
-    return sorted(files, key=lambda f: rank.get(f.stem, len(rank)))
-
 
 def run_all(
     files: list[Path],
@@ -125,6 +111,7 @@ def run_all(
     log=print,
     extra=None,
     loaded=None,
+    memory=None,
 ) -> dict[str, tuple[int, float, float]]:
     """Run every study file of ``files`` into ``results/<stem>``, ``jobs`` at a time, with
     ``run_args`` (and ``extra[stem]``, more arguments of one study's run). ``log`` gets the
@@ -132,7 +119,8 @@ def run_all(
     ``{stem: (exit code, wall seconds, start in seconds after the first start)}`` of the runs
     made (up-to-date studies are left out). ``loaded``: ``{file: (args, study, cfg, sweep)}``
     of the files the batch resolved before (:func:`sim.batch_checks._configs_problems`),
-    which ``--stale-only`` does not resolve again."""
+    which ``--stale-only`` does not resolve again. ``memory``: ``({file: estimated bytes},
+    the runs' --max-memory-gb)``, what the runs side by side may hold (:mod:`sim.batch_memory`)."""
     todo = []
     try:
         for f in order(files):
@@ -166,7 +154,12 @@ def run_all(
     stop = threading.Event()  # set on an interrupt: start no more runs, print nothing of theirs
     starting = threading.Lock()
 
-    def one(f: Path):
+    gate = MemoryGate(*(memory or ({}, None)))
+
+    def one(f: Path):  # started when its estimate fits beside the runs going
+        return gate.around(f, stop, started, lambda: (f.stem, None, 0.0, time.perf_counter() - t0))
+
+    def started(f: Path):
         cmd = [sys.executable, "-m", "sim", *argv(f)]
         t = time.perf_counter()
         with starting:
@@ -354,7 +347,10 @@ def _main(argv: list[str], phase: list[str]) -> int:
     if why:
         print(f"sim.batch: run options: {why}", file=sys.stderr)
         return 2
-    bad, loaded = _configs_problems(files, run_args, Path(args.results), args.stale_only)
+    args.memory = ({}, _parsed(run_args).max_memory_gb)  # each run's estimate (batch_memory)
+    bad, loaded = _configs_problems(
+        files, run_args, Path(args.results), args.stale_only, args.memory[0]
+    )
     for why in bad:
         print(f"sim.batch: {why}", file=sys.stderr)
     if bad:
@@ -393,9 +389,8 @@ def _run(args, files: list[Path], run_args: list[str], note, loaded, default, ph
     log = _Stdout()
     phase.append("run")
     try:
-        done = run_all(
-            files, Path(args.results), args.jobs, run_args, args.stale_only, log, loaded=loaded
-        )
+        todo, out, jobs, stale = files, Path(args.results), args.jobs, args.stale_only
+        done = run_all(todo, out, jobs, run_args, stale, log, loaded=loaded, memory=args.memory)
         check_interrupt()  # before the timings are written
     except KeyboardInterrupt as e:  # the runs were stopped and cleaned up
         if getattr(e, "started", True) is False:  # (--stale-only's checks: seconds) it said

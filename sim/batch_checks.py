@@ -176,7 +176,11 @@ _RUNS_OWN = ("claims.parquet", "sweep.parquet")
 
 
 def _configs_problems(
-    files: list[Path], run_args: list[str], results: Path, stale_only: bool = False
+    files: list[Path],
+    run_args: list[str],
+    results: Path,
+    stale_only: bool = False,
+    needs: dict | None = None,
 ) -> tuple[list[str], dict]:
     """``(lines, loaded)``: one line for each study file whose run would refuse its config
     (``sim run FILE RUN_ARGS`` resolves it here, before any run starts: a study file ported
@@ -189,7 +193,8 @@ def _configs_problems(
     broken file among many ran the others first, for hours in ``make reproduce``, and was
     named only when its turn came. A ``--set`` key a study has not is left out of its check
     (:func:`_unknown_sets` says it once; that run refuses it). A working directory that was
-    deleted is one line for all (as ``sim run`` says it)."""
+    deleted is one line for all (as ``sim run`` says it). ``needs`` gets ``{file: bytes}``, each
+    run's estimated memory with its workers (:mod:`sim.batch_memory`)."""
     if not cwd_exists():  # each run resolves its --out against it, and would refuse
         return ["No such file or directory: the working directory (it was deleted)"], {}
     base = _parsed(run_args)
@@ -204,7 +209,9 @@ def _configs_problems(
             check_chunks(cfg)
             sweep = read_sweep(f, study.schema)
             lim = args.max_memory_gb, args.max_adjustments, args.workers
-            sweep_limits(study, cfg, sweep, *lim)  # the limits its run applies (sim check's too)
+            est = sweep_limits(study, cfg, sweep, *lim)  # its run's limits (sim check's too)
+            if needs is not None:
+                needs[f] = est.bytes * max(args.workers or 1, 1)
             out = results / f.stem  # each run is --overwrite: the record is not compared
             record = {"config": cfg, "code_hash": study_code_hash(cfg["study"])}
             try:  # (as sim run: check_run_args)

@@ -174,6 +174,14 @@ def wolf_draws(n: float, sets: float, rd: float, c: Mapping) -> float:
     return WOLF_READING_UNITS * n * sets * rd * 2 + WOLF_CHECK_UNITS * c.get("check.n_points", 0)
 
 
+def wolf_sub_chunk(trials: int, chunk: int) -> int:
+    """The chunk of Wolf's smaller parts (trade-offs, cells), as the study takes it
+    (:func:`sim.studies.wolf.chunks.sub_chunk`): at most ``chunk`` and at least four chunks.
+    Counted as ``min(trade.trials, chunk)``, the paper's setup (400 trade trials, chunks of
+    500) was estimated at 1.09 GiB for a run that peaks at 0.39 GiB (its chunks are of 100)."""
+    return max(1, min(chunk, -(-trials // 4)))
+
+
 def _wolf(c: Mapping) -> tuple:
     T, ch = c["trials"], min(c["chunk"], c["trials"])
     area = c.get("plate.area_mm", [-100.0, 100.0, -40.0, 60.0])
@@ -190,7 +198,8 @@ def _wolf(c: Mapping) -> tuple:
     chk = max(
         c.get("check.n_points", 0), c.get("repeat.n_points", 0), c.get("trade.check_points", 0)
     )
-    Tt, cht = c.get("trade.trials", 0), min(c.get("trade.trials", 1) or 1, ch)
+    Tt = c.get("trade.trials", 0)
+    cht = wolf_sub_chunk(Tt or 1, c["chunk"])  # the trade-offs' chunks (4x too large before)
     dmax = _max(c.get("trade.degrees"), d)
     Ut = int((dmax + 1) * (dmax + 2))
     nt = points(_min(c.get("trade.spacings_mm"), c.get("plate.spacing_mm", 20.0)))

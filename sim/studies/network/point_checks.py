@@ -62,9 +62,11 @@ def check_points(names: list[str], xy: np.ndarray, keys: list[str]) -> None:
         axis = int(np.argmax(span))
         ends = (int(np.argmin(xy[:, axis])), int(np.argmax(xy[:, axis])))
         at = max(ends, key=lambda i: abs(xy[i, axis] - np.median(xy[:, axis])))
+        km = f"{float(span.max()) / 1e6:.4g}"  # 1000.2 km read "spans 1000 km: over 1000 km"
+        km = km if float(km) > 1000 else f"{float(span.max()) / 1e6:.9f}".rstrip("0")
         raise ConfigError(
             keys[at],
-            f"the network spans {float(span.max()) / 1e6:.4g} km: over 1000 km, out of range for "
+            f"the network spans {km} km: over 1000 km, out of range for "
             "a plane network (the earth's curvature) and for double-precision adjustment at "
             "the um level",
         )
