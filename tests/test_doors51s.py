@@ -1,0 +1,53 @@
+"""A hostile reading of session 53's first merges and two left items (doors51s, brief R53);
+each test fails on the code before its fix:
+
+* ``sim --version extra`` printed the version and exited 0, the extra words ignored: refused
+  in one line, exit 2 (``sim --version`` alone still prints it);
+* ``make verify --trials N --set KEY=V`` with a key a study to re-run lacks was refused only
+  by that study's re-run, after every study before it had re-run (hours): refused before any
+  re-run, naming the key, the study and its file, as ``python -m sim.batch`` does.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from oneline import one_line
+
+import sim
+import sim.report.verify.cli as verify_cli
+import sim.report.verify.rerun as rerun_mod
+from sim.cli import main as cli_main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_version_with_extra_words_is_refused(capsys):
+    """Class: extra words after ``--version``. Before: ``sim --version extra`` (and
+    ``sim --version check x.toml``) printed the version and exited 0, the rest ignored; now one
+    line naming the first extra word, exit 2; ``--version`` alone prints it, exit 0."""
+    one_line(capsys, cli_main(["--version", "extra"]), "--version takes no other words", "'extra'")
+    assert cli_main(["--version"]) == 0
+    assert capsys.readouterr().out == f"sim {sim.__version__}\n"
+
+
+def test_verify_set_key_a_study_lacks_is_refused_before_any_rerun(capsys, monkeypatch, tmp_path):
+    """Class: ``make verify``'s ``--set`` with a key one of the studies to re-run does not have
+    (``plate.format_mm``, Brown's, over wolf_polynomial's results). Before: the re-runs
+    started, and the study lacking the key refused it in its own re-run, after those before it
+    had re-run; now one line before any re-run naming the key and the study."""
+    results = tmp_path / "res"
+    shutil.copytree(ROOT / "results" / "wolf_polynomial", results / "wolf_polynomial")
+    started = []
+
+    def rerun(d, *args, **kwargs):
+        started.append(d.name)
+        return "not re-run in this test"
+
+    monkeypatch.chdir(ROOT)  # studies/ of the project
+    monkeypatch.setattr(rerun_mod, "rerun_study", rerun)
+    argv = ["--results", str(results), "--scratch", str(tmp_path / "s"), "--no-record"]
+    rc = verify_cli.main([*argv, "--trials", "400", "--set", "plate.format_mm=245"])
+    one_line(capsys, rc, "--set", "wolf_polynomial", "plate.format_mm: unknown key")
+    assert started == []
