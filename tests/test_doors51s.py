@@ -5,7 +5,10 @@ each test fails on the code before its fix:
   in one line, exit 2 (``sim --version`` alone still prints it);
 * ``make verify --trials N --set KEY=V`` with a key a study to re-run lacks was refused only
   by that study's re-run, after every study before it had re-run (hours): refused before any
-  re-run, naming the key, the study and its file, as ``python -m sim.batch`` does.
+  re-run, naming the key, the study and its file, as ``python -m sim.batch`` does;
+* ``make verify`` with a directory where its record ``reproducibility.parquet`` goes re-ran
+  every study and then failed writing it ("Is a directory"): refused before any re-run, as
+  K52 refuses read-only results.
 """
 
 from __future__ import annotations
@@ -51,3 +54,21 @@ def test_verify_set_key_a_study_lacks_is_refused_before_any_rerun(capsys, monkey
     rc = verify_cli.main([*argv, "--trials", "400", "--set", "plate.format_mm=245"])
     one_line(capsys, rc, "--set", "wolf_polynomial", "plate.format_mm: unknown key")
     assert started == []
+
+
+def test_verify_with_a_directory_as_its_record_is_refused_before_any_rerun(
+    capsys, monkeypatch, tmp_path
+):
+    """Class: the neighbour of K52's read-only results: a directory where ``make verify``
+    writes its record (``results/reproducibility.parquet/``). Before: every study was re-run,
+    then "cannot write .../reproducibility.parquet: Is a directory", exit 2; now one line
+    before any re-run naming it and --no-record."""
+    results = tmp_path / "res"
+    (results / "reproducibility.parquet").mkdir(parents=True)
+
+    def rerun(*args, **kwargs):
+        raise AssertionError("a re-run started")
+
+    monkeypatch.setattr(verify_cli, "verify", rerun)
+    rc = verify_cli.main(["--results", str(results), "--studies", str(tmp_path)])
+    one_line(capsys, rc, "reproducibility.parquet is a directory", "--no-record")
