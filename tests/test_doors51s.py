@@ -8,20 +8,25 @@ each test fails on the code before its fix:
   re-run, naming the key, the study and its file, as ``python -m sim.batch`` does;
 * ``make verify`` with a directory where its record ``reproducibility.parquet`` goes re-ran
   every study and then failed writing it ("Is a directory"): refused before any re-run, as
-  K52 refuses read-only results.
+  K52 refuses read-only results;
+* a caller's object that raises while the API reads it (F52's class), its exception's own
+  ``__str__`` raising too: the refusal's words raised it, a traceback; named by its type.
 """
 
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 
+import pytest
 from oneline import one_line
 
 import sim
 import sim.report.verify.cli as verify_cli
 import sim.report.verify.rerun as rerun_mod
 from sim.cli import main as cli_main
+from sim.mc.config import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -72,3 +77,34 @@ def test_verify_with_a_directory_as_its_record_is_refused_before_any_rerun(
     monkeypatch.setattr(verify_cli, "verify", rerun)
     rc = verify_cli.main(["--results", str(results), "--studies", str(tmp_path)])
     one_line(capsys, rc, "reproducibility.parquet is a directory", "--no-record")
+
+
+class _Unsayable(Exception):
+    """An exception of the caller's whose own ``__str__`` raises."""
+
+    def __str__(self):
+        raise RuntimeError("its __str__ raised")
+
+
+class _BrokenPath(os.PathLike):
+    def __fspath__(self):
+        raise _Unsayable()
+
+
+def test_api_object_raising_an_unsayable_exception_is_named_by_its_type():
+    """Class: F52's neighbour: a caller's object that raises while read, with an exception
+    whose own ``__str__`` raises. Before: the refusal's words (``str(e)``) raised that second
+    exception, a ``RuntimeError`` traceback from ``sim.load`` (as a config value and as the
+    study file); now one ``ConfigError`` naming the key and the exception's type."""
+    for call, key in (
+        (
+            lambda: sim.load(
+                str(ROOT / "studies" / "network_plate.toml"), **{"network.gama_xml": _BrokenPath()}
+            ),
+            "network.gama_xml",
+        ),
+        (lambda: sim.load(_BrokenPath()), "study_file"),
+    ):
+        with pytest.raises(ConfigError) as e:
+            call()
+        assert str(e.value).startswith(f"{key}: ") and "raised _Unsayable" in str(e.value)
