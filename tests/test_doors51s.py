@@ -10,7 +10,9 @@ each test fails on the code before its fix:
   every study and then failed writing it ("Is a directory"): refused before any re-run, as
   K52 refuses read-only results;
 * a caller's object that raises while the API reads it (F52's class), its exception's own
-  ``__str__`` raising too: the refusal's words raised it, a traceback; named by its type.
+  ``__str__`` raising too: the refusal's words raised it, a traceback; named by its type;
+* a GNU Gama DOCTYPE declaring an assumed default and then another for the same attribute
+  (XML binds the first, as gama-local reads it) was refused naming the second.
 """
 
 from __future__ import annotations
@@ -108,3 +110,26 @@ def test_api_object_raising_an_unsayable_exception_is_named_by_its_type():
         with pytest.raises(ConfigError) as e:
             call()
         assert str(e.value).startswith(f"{key}: ") and "raised _Unsayable" in str(e.value)
+
+
+def test_a_doctype_default_declared_twice_binds_its_first(tmp_path):
+    """Class: J52's harmless DOCTYPE defaults, declared twice. XML binds an attribute's first
+    declaration (gama-local 2.03 reads ``angles`` CDATA "left-handed" then "right-handed" on a
+    ``<network>`` without ``angles`` as left-handed: its output equals the file's with
+    ``angles="left-handed"``). Before: refused "gives <network> attribute 'angles' the default
+    'right-handed'", a default no parser applies; now read. The reverse order, which does
+    make it right-handed, is still refused."""
+    import re
+
+    from gama_triangle import triangle
+
+    from sim.studies.network.gama_read import read_gama
+
+    text = re.sub(r"<network[^>]*>", "<network>", triangle())
+    left, right = (f'<!ATTLIST network angles CDATA "{h}-handed">' for h in ("left", "right"))
+    p = tmp_path / "net.xml"
+    p.write_text(text.replace("?>\n", f"?>\n<!DOCTYPE gama-local [{left}{right}]>\n", 1))
+    assert [q["name"] for q in read_gama(p)["network.points"]] == ["A", "B", "C"]
+    p.write_text(text.replace("?>\n", f"?>\n<!DOCTYPE gama-local [{right}{left}]>\n", 1))
+    with pytest.raises(ConfigError, match="attribute 'angles' the default 'right-handed'"):
+        read_gama(p)
