@@ -185,8 +185,7 @@ def set_refusal(files: list[tuple[str, Path]], extra: list[str]) -> str | None:
         lines = [ln for ln in done.stderr.splitlines() if ln.strip()]
         if done.returncode == 2 and lines and names_one_of(lines[-1], sets):
             return (
-                f"--set: the re-run of {name} ({sf}) would refuse it: "
-                f"{lines[-1].removeprefix(_ERR)} (nothing re-run; --study names the studies "
-                "to verify)"
+                f"--set: refused by the study file of {name}, {sf}, before any re-run: "
+                f"{lines[-1].removeprefix(_ERR)} (--study names the studies to verify)"
             )
     return None
