@@ -12,7 +12,9 @@ each test fails on the code before its fix:
 * a caller's object that raises while the API reads it (F52's class), its exception's own
   ``__str__`` raising too: the refusal's words raised it, a traceback; named by its type;
 * a GNU Gama DOCTYPE declaring an assumed default and then another for the same attribute
-  (XML binds the first, as gama-local reads it) was refused naming the second.
+  (XML binds the first, as gama-local reads it) was refused naming the second;
+* the API's ``StudyHandle.estimate()`` of a sweep counted the cells the study refuses, which
+  ``sim check`` leaves out since P52 (404 trials in 2 cells of a sweep that runs one of 400).
 """
 
 from __future__ import annotations
@@ -133,3 +135,19 @@ def test_a_doctype_default_declared_twice_binds_its_first(tmp_path):
     p.write_text(text.replace("?>\n", f"?>\n<!DOCTYPE gama-local [{right}{left}]>\n", 1))
     with pytest.raises(ConfigError, match="attribute 'angles' the default 'right-handed'"):
         read_gama(p)
+
+
+def test_api_estimate_leaves_out_the_cells_the_study_refuses(tmp_path, capsys):
+    """Class: P52's count at a neighbouring door. ``sim check`` of a sweep ``trials = [400,
+    4]`` counts the one cell that runs (400 trials); the API's ``StudyHandle.estimate()`` of
+    the same file counted the refused cell too (404 trials in 2 cells). Now both count 400."""
+    from sim.cli import main
+
+    study = tmp_path / "np.toml"
+    study.write_text(
+        (ROOT / "studies" / "network_plate.toml").read_text() + "\n[sweep]\ntrials = [400, 4]\n"
+    )
+    assert main(["check", str(study)]) == 0
+    assert "# work: 400 trials," in capsys.readouterr().out
+    est = sim.load(study).estimate()
+    assert (est.trials, est.cells) == (400, 1)
