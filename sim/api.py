@@ -69,7 +69,7 @@ from sim.mc.publish import damaged_chunks
 from sim.mc.pyvalue import as_config_value
 from sim.mc.settle import settled
 from sim.mc.study_file import study_file_problem
-from sim.mc.sweep import read_sweep
+from sim.mc.sweep import read_sweep, refused_cells
 from sim.mc.table_shape import (
     record_line,
     record_problem,
@@ -271,9 +271,12 @@ class StudyHandle:
 
     @_arguments
     def estimate(self):
-        """Work and memory of a run (:class:`sim.mc.estimate.Estimate`)."""
+        """Work and memory of a run (:class:`sim.mc.estimate.Estimate`), without the sweep
+        cells the study refuses, as ``sim check`` counts them (:func:`refused_cells`): it
+        counted them, 404 trials in 2 cells of ``trials = [400, 4]``, a sweep that runs one)."""
         check_state(self)
-        return estimate(self.config, self.sweep)
+        skip = refused_cells(self.study, self.config, self.sweep)[0] if self.sweep else ()
+        return estimate(self.config, self.sweep, skip=skip)
 
     @_arguments
     def replace(self, **overrides) -> "StudyHandle":

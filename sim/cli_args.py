@@ -55,6 +55,20 @@ class _Parser(Meant, OnceParser):
         raise ConfigError(None, f"{head}{message} (see {helps} --help)")
 
 
+class _Version(argparse._VersionAction):
+    """``--version``: the version, printed when the option is the command line's only word;
+    ``sim --version extra`` (or ``--version check x.toml``) printed it and exited 0, the rest
+    of the line ignored without a word."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        rest = list(getattr(parser, "given", []))
+        if option_string in rest:
+            rest.remove(option_string)
+        if rest:
+            parser.error(f"{option_string} takes no other words: give it alone (got {rest[0]!r})")
+        super().__call__(parser, namespace, values, option_string)
+
+
 def _of_another(message: str, cmds: dict, cmd: str | None, given: list[str]) -> str | None:
     """``--trials: an option of sim run, not of sim show`` for an option the command ``cmd``
     lacks and another command has: ``sim show --trials 4 results/x`` was "unrecognized
@@ -202,7 +216,7 @@ def parser(doc: str) -> argparse.ArgumentParser:
         epilog="\n\n".join(doc.split("\n\n")[1:2]) + "\n\nsim COMMAND --help: its options.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--version", action="version", version=f"sim {sim.__version__}")
+    p.add_argument("--version", action=_Version, version=f"sim {sim.__version__}")
     sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
     _run_parser(sub)
     sh = sub.add_parser(

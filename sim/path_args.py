@@ -77,8 +77,12 @@ def check_path(name: str, v: Any, none_ok: bool = False) -> None:
 
 
 def _said(e: Exception) -> str:
-    """``ValueError: boom``: an exception of the caller's code in one line."""
-    text = " ".join(str(e).split())
+    """``ValueError: boom``: an exception of the caller's code in one line (its type alone
+    when its own ``__str__`` raises: that second exception was a traceback)."""
+    try:
+        text = " ".join(str(e).split())
+    except Exception:  # noqa: BLE001 - the caller's broken exception, named by its type
+        text = ""
     return f"{type(e).__name__}: {text[:120]}" if text else type(e).__name__
 
 

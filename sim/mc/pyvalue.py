@@ -141,7 +141,10 @@ def as_config_value(key: str, v: Any) -> Any:
 
 def _unreadable(v: Any, e: Exception) -> str:
     """The words for ``v``, a caller's object that raised ``e`` while read as a value."""
-    said = " ".join(str(e).split())[:120]
+    try:  # an exception of the caller's whose own __str__ raises: named by its type
+        said = " ".join(str(e).split())[:120]
+    except Exception:  # noqa: BLE001 - (it was that second exception's traceback)
+        said = ""
     said = f"{type(e).__name__}: {said}" if said else type(e).__name__
     return (
         f"is not a config value: reading its {type(v).__name__} raised {said} "

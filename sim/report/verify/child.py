@@ -9,13 +9,15 @@ import errno
 import json
 import os
 import re
+import subprocess
 import sys
 from pathlib import Path
 
+from sim.mc.children import child_env, child_text
 from sim.mc.overrides import keys_of
 from sim.report.verify.rules import VerifyError
 
-__all__ = ["launcher", "busy_words", "names_one_of", "system_error", "refusal"]
+__all__ = ["launcher", "busy_words", "names_one_of", "system_error", "refusal", "set_refusal"]
 
 #: how the re-run's error line begins
 _ERR = "sim: error: "
@@ -155,3 +157,35 @@ def system_error(line: str) -> bool:
         # "--out: cannot write to DIR: No space left on device" (its --out under --scratch)
         or (text.startswith("--out: cannot write") and text.rsplit(": ", 1)[-1] in _STRERRORS)
     )
+
+
+def set_refusal(files: list[tuple[str, Path]], extra: list[str]) -> str | None:
+    """Why a ``--set`` of verify's options ``extra`` would be refused by the re-run of one of
+    ``files`` (results directory name, study file), asked of ``sim check`` before any re-run
+    (each study's keys are its schema's, a layer above this one); None when none refuses it.
+    A key one study lacks was refused by its re-run, after those before it had re-run (hours
+    of ``make verify``), as ``python -m sim.batch`` refuses it before any run."""
+    sets = [extra[i + 1] for i, w in enumerate(extra[:-1]) if w == "--set"]
+    checked: set[Path] = set()
+    for name, sf in files if sets else ():
+        if sf in checked or not sf.is_file():  # (a missing file: the re-run's own line)
+            continue
+        checked.add(sf)
+        cmd, given = launcher(
+            [sys.executable, "-m", "sim", "check", str(sf), *(f"--set={s}" for s in sets)]
+        )
+        done = subprocess.run(
+            cmd,
+            input=given,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            env=child_env(),
+            **child_text(),
+        )
+        lines = [ln for ln in done.stderr.splitlines() if ln.strip()]
+        if done.returncode == 2 and lines and names_one_of(lines[-1], sets):
+            return (
+                f"--set: refused by the study file of {name}, {sf}, before any re-run: "
+                f"{lines[-1].removeprefix(_ERR)} (--study names the studies to verify)"
+            )
+    return None

@@ -269,10 +269,16 @@ def _record_path(a, mode: str) -> Path | None:
 
 def _unrecordable(where: Path | None) -> str | None:
     """Why the record ``where`` cannot be written, said before any re-run: results on a
-    read-only share or another user's were re-run for hours, then "cannot write
-    <results>/reproducibility.parquet: Read-only file system", exit 2 (None: it can be)."""
+    read-only share or another user's (or a directory in the record's place) were re-run for
+    hours, then "cannot write <results>/reproducibility.parquet: Read-only file system" (or
+    "Is a directory"), exit 2 (None: it can be)."""
     if where is None or not where.parent.is_dir():  # (a missing --results: named by verify)
         return None
+    if where.is_dir():  # as read-only results: "cannot write ...: Is a directory" after them
+        return (
+            f"--results: {where} is a directory, where the re-runs' record is written after "
+            "them: move it away, or give --no-record to compare only"
+        )
     ids = os.access in os.supports_effective_ids
     if os.access(where.parent, os.W_OK | os.X_OK, effective_ids=ids):
         return None

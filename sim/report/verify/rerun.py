@@ -23,7 +23,7 @@ from sim.mc.study_source import other_source
 from sim.mc.table_edits import edited_tables
 from sim.mc.unfinished import unfinished, unfinished_in
 from sim.report.read import check_claims_table
-from sim.report.verify.child import launcher, refusal
+from sim.report.verify.child import launcher, refusal, set_refusal
 from sim.report.verify.rules import Comparison, VerifyError, compare_dirs, tables_digest
 from sim.report_due import due_words
 
@@ -253,6 +253,9 @@ def verify(
             f"--no-rerun: no re-run of {', '.join(missing)} in {scratch} "
             "(run without --no-rerun, or choose the --scratch that holds them)"
         )
+    files = [(d.name, study_file(d, study, Path(studies))) for d, study in todo]
+    if rerun and (why := set_refusal(files, extra or [])) is not None:
+        raise VerifyError(why)  # before any re-run, as python -m sim.batch does
     out = []
     for d, study in todo:
         target = scratch / d.name

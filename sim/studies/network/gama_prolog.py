@@ -83,14 +83,18 @@ def default_declared(data: bytes | str) -> tuple[str, str, str] | None:
     found: list[tuple[str, str, str]] = []
 
     def attlist(elname, attname, _type, default, _required):
-        if default is not None and not _assumed(elname, attname, default):
-            declared.setdefault(elname, {}).setdefault(attname, default)
+        # the first declaration of an attribute binds (XML 1.0, 3.3), a later one is ignored:
+        # an assumed default then another was refused naming the other, which no parser gives
+        if default is not None and attname not in declared.get(elname, {}):
+            declared.setdefault(elname, {})[attname] = (
+                None if _assumed(elname, attname, default) else default
+            )
 
     def element(name, attrs):
-        if not declared:
+        if not any(v is not None for d in declared.values() for v in d.values()):
             raise _Prolog
         for att, v in declared.get(name, {}).items():
-            if att not in attrs:
+            if v is not None and att not in attrs:
                 found.append((name, att, v))
                 raise _Prolog
 
