@@ -66,8 +66,8 @@ def changed_exports(out: Path, rec: dict | None = None, dirs: bool = False) -> d
     sums = rec.get(EXPORT_KEY) if isinstance(rec, dict) else None
     sums = sums if isinstance(sums, dict) else {}
     readme = rec.get(README_KEY) if isinstance(rec, dict) else None
-    if isinstance(readme, str):  # (a record without it: the README is the suite's, as before)
-        sums = {**sums, "README.md": readme}
+    if isinstance(readme, (str, list)):  # (a record without it: the README is the suite's, as
+        sums = {**sums, "README.md": readme}  # before; a list: either, one being written)
     found = {}
     for name in files if isinstance(files, list) else []:
         if not isinstance(name, str) or not (_EXPORT.fullmatch(name) or name in sums):
@@ -86,7 +86,8 @@ def changed_exports(out: Path, rec: dict | None = None, dirs: bool = False) -> d
             continue
         want = sums.get(name)
         try:
-            same = not isinstance(want, str) or _sha256(p) == want
+            wants = [want] if isinstance(want, str) else want if isinstance(want, list) else None
+            same = wants is None or _sha256(p) in wants
         except OSError:
             same = False
         if not same:

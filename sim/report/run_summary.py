@@ -390,6 +390,8 @@ def _ours(path: Path) -> bool:
             if f.readline().removeprefix("\ufeff").rstrip("\n") not in (README_MARK, *_OLD_MARKS):
                 return False
         want = (read_record(path.parent) or {}).get(README_KEY)
+        if isinstance(want, list):  # one being written (write_run_readme): either is ours
+            return hashlib.sha256(path.read_bytes()).hexdigest() in want
         return not isinstance(want, str) or hashlib.sha256(path.read_bytes()).hexdigest() == want
     except (OSError, ValueError):
         return False
@@ -425,12 +427,17 @@ def write_run_readme(
                 write_record(out, {**rec, "files": [f for f in rec["files"] if f != "README.md"]})
         return None
     text = README_MARK + "\n" + printable(run_markdown(out, get_study, name, design, final), True)
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
     rec = read_record(out)  # its sha256: one edited by hand is the user's (kept, named)
-    if rec is not None and isinstance(rec.get("files"), list):
-        digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    listed = rec is not None and isinstance(rec.get("files"), list)
+    if listed and path.is_file():  # the record names both READMEs before the new one is put
+        was = hashlib.sha256(path.read_bytes()).hexdigest()  # in place: a process killed
+        if was != digest and rec.get(README_KEY) != [was, digest]:  # between the two renames
+            write_record(out, {**rec, README_KEY: [was, digest]})  # left the suite's README
+    with atomic_path(path) as tmp:  # taken as edited by hand (kept, a re-run refused)
+        tmp.write_text(text, encoding="utf-8")
+    if listed:
         new = {**rec, "files": sorted({*rec["files"], "README.md"}), README_KEY: digest}
-        if new != rec:
+        if new != read_record(out):
             write_record(out, new)
     return path
