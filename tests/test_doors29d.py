@@ -98,7 +98,7 @@ def test_a_record_that_is_not_one_is_named_not_a_study_table(tiny_run, tmp_path,
         else:
             rec.write_bytes(bad)
         rc = main(["report", "--results", str(results)])
-        line = one_line(capsys, rc, str(rec), why, "make verify writes it again", prefix=SIM_ERROR)
+        line = one_line(capsys, rc, str(rec), why, "move it away", prefix=SIM_ERROR)
         assert "claims.parquet" not in line and "run its study again" not in line, line
 
 

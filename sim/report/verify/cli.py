@@ -19,7 +19,7 @@ from sim.mc.outputs import name_problem
 from sim.mc.overrides import listed
 from sim.option_words import Meant
 from sim.places import base, shown_path
-from sim.report.verify.record import write_record
+from sim.report.verify.record import not_a_record, write_record
 from sim.report.verify.rerun import verify
 from sim.report.verify.rules import Comparison, VerifyError
 from sim.report.verify.scratch import scratch_dir
@@ -278,6 +278,11 @@ def _unrecordable(where: Path | None) -> str | None:
         return (
             f"--results: {where} is a directory, where the re-runs' record is written after "
             "them: move it away, or give --no-record to compare only"
+        )
+    if where.exists() and (why := not_a_record(where)) is not None:  # a file of the user's
+        return (  # was replaced by the record after the re-runs, without a word
+            f"--results: {where} is not a record of make verify ({why}); the re-runs' record "
+            "is written there after them: move it away, or give --no-record to compare only"
         )
     ids = os.access in os.supports_effective_ids
     if os.access(where.parent, os.W_OK | os.X_OK, effective_ids=ids):

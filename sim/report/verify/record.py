@@ -17,7 +17,7 @@ from sim.mc.storage import PATH_VARIABLES, numerics, read_provenance, versions, 
 from sim.report.tables import fmt, md_table
 from sim.report.verify.rules import DEFAULT_RTOL, Comparison, tables_digest
 
-__all__ = ["write_record", "markdown"]
+__all__ = ["write_record", "markdown", "not_a_record"]
 
 
 def _machine() -> dict:
@@ -115,26 +115,39 @@ _COLUMNS = ("study", "files", "max_rel_dev", "max_dev_over_tol", "worst", "first
 _COLUMNS += ("text_columns_changed", "ok")
 
 
+def not_a_record(p: Path) -> str | None:
+    """Why the file ``p`` is not a record of make verify (truncated, another table, a file of
+    the user's in its place), else None."""
+    try:
+        t = pq.read_schema(p)
+        prov = read_provenance(p)
+        m = prov.get("machine", {}) if isinstance(prov, dict) else None
+        lacks = [c for c in _COLUMNS if c not in t.names]
+        why = f"it has no column {lacks[0]!r}" if lacks else None
+        why = why or (None if isinstance(m, dict) else "its provenance names no machine")
+        why = why or (None if prov.get("study") == "verify" else "make verify did not write it")
+    except (pa.ArrowException, ValueError, AttributeError, OSError) as e:
+        why = f"{type(e).__name__}: {str(e).splitlines()[0][:160]}"
+    return why
+
+
 def _read(p: Path) -> tuple[list[dict], dict]:
     """The rows and the machine of the record ``p``; one that is not a record of make verify
     (truncated, or another table in its place) is a :class:`ConfigError` naming it (the
     report blamed the last study table it had read: "wolf_polynomial/claims.parquet ... is
     not as sim wrote it (column 'kind': KeyError: 'study'); run its study again")."""
-    try:
-        t = pq.read_table(p)
-        m = read_provenance(p).get("machine", {})
-        lacks = [c for c in _COLUMNS if c not in t.column_names]
-        why = f"it has no column {lacks[0]!r}" if lacks else None
-        why = why or (None if isinstance(m, dict) else "its provenance names no machine")
-    except (pa.ArrowException, ValueError, AttributeError) as e:
-        why = f"{type(e).__name__}: {str(e).splitlines()[0][:160]}"
+    why = not_a_record(p)
     if why is not None:
         raise ConfigError(
             "--results",
-            f"{p} is not a record of make verify ({why}): make verify writes it again "
-            "(or remove it)",
+            f"{p} is not a record of make verify ({why}): move it away (make verify then "
+            "writes its record there)",
         )
-    return t.to_pylist(), m
+    try:
+        return pq.read_table(p).to_pylist(), read_provenance(p).get("machine", {})
+    except (pa.ArrowException, ValueError, OSError) as e:
+        why = f"{type(e).__name__}: {str(e).splitlines()[0][:160]}"
+        raise ConfigError("--results", f"{p} cannot be read ({why}): move it away") from None
 
 
 def _verdict(r: dict, older: bool) -> str:
