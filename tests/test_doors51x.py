@@ -38,3 +38,23 @@ def test_verify_fifo_as_record_refused_not_hung(tmp_path, capsys):
     assert len(err) == 1 and "reproducibility.parquet" in err[0], err
     assert "not a regular file" in err[0] and "Traceback" not in err[0]
     assert fifo.exists() and not fifo.is_file()  # kept, a FIFO still
+
+
+def test_verify_set_checked_at_the_reruns_trials():
+    """``make verify --trials N --set K=V`` (``--set`` is only allowed with ``--trials``): the
+    pre-check of R53 asked ``sim check`` with the study file's trials, not the re-runs' N.
+    Before, ``--trials 40000 --set chunk=1000`` of brown_dilution (40 chunks, as its re-run
+    takes it) was refused before any re-run ("4,000 trials in chunks of 1,000 give 4 chunks"),
+    and ``--trials 400 --set chunk=100`` (4 chunks: its re-run refuses it) passed the check.
+    Now the check takes ``--trials`` as the re-run does: the first passes, the second is
+    refused naming ``chunk``, the re-runs' 400 trials and the study file."""
+    from pathlib import Path
+
+    from sim.report.verify.child import set_refusal
+
+    files = [("brown_dilution", Path("studies/brown_dilution.toml"))]
+    assert set_refusal(files, ["--trials", "40000", "--set", "chunk=1000"]) is None
+    why = set_refusal(files, ["--trials", "400", "--set", "chunk=100"])
+    assert why is not None and "\n" not in why
+    assert "chunk: 400 trials" in why and "brown_dilution.toml" in why
+    assert "--trials 400" in why
