@@ -138,7 +138,7 @@ def test_results_of_an_older_version_without_a_table_this_one_reads(
     monkeypatch.setattr(stale, "study_code_hash", lambda study: "0123456789abcdef")
     said = ("brown_dilution was made by another version", "has no region_inputs.parquet")
     rc = main(["report", "--results", str(results)])  # the code pulled since
-    one_line(capsys, rc, *said, "make reproduce re-runs", prefix=SIM_ERROR)
+    one_line(capsys, rc, *said, "--overwrite makes them current", prefix=SIM_ERROR)
     rc = main(["show", "--markdown", str(d)])
     one_line(capsys, rc, *said, prefix=SIM_ERROR)
 

@@ -166,13 +166,19 @@ def set_refusal(files: list[tuple[str, Path]], extra: list[str]) -> str | None:
     A key one study lacks was refused by its re-run, after those before it had re-run (hours
     of ``make verify``), as ``python -m sim.batch`` refuses it before any run."""
     sets = [extra[i + 1] for i, w in enumerate(extra[:-1]) if w == "--set"]
+    # the re-runs' --trials N, as sim check takes it (--set trials=N): checked at the study
+    # file's trials, --trials 40000 --set chunk=1000 was refused (4,000 trials give 4 chunks)
+    # and --trials 400 --set chunk=100 passed, refused by its re-run after the others
+    trials = [f"--set=trials={extra[i + 1]}" for i, w in enumerate(extra[:-1]) if w == "--trials"]
+    with_trials = f" (with --trials {trials[-1].rpartition('=')[2]})" if trials else ""
     checked: set[Path] = set()
     for name, sf in files if sets else ():
         if sf in checked or not sf.is_file():  # (a missing file: the re-run's own line)
             continue
         checked.add(sf)
         cmd, given = launcher(
-            [sys.executable, "-m", "sim", "check", str(sf), *(f"--set={s}" for s in sets)]
+            [sys.executable, "-m", "sim", "check", str(sf), *trials[-1:]]
+            + [f"--set={s}" for s in sets]
         )
         done = subprocess.run(
             cmd,
@@ -186,6 +192,7 @@ def set_refusal(files: list[tuple[str, Path]], extra: list[str]) -> str | None:
         if done.returncode == 2 and lines and names_one_of(lines[-1], sets):
             return (
                 f"--set: refused by the study file of {name}, {sf}, before any re-run: "
-                f"{lines[-1].removeprefix(_ERR)} (--study names the studies to verify)"
+                f"{lines[-1].removeprefix(_ERR)}{with_trials} (--study names the studies to "
+                "verify)"
             )
     return None

@@ -117,7 +117,10 @@ _COLUMNS += ("text_columns_changed", "ok")
 
 def not_a_record(p: Path) -> str | None:
     """Why the file ``p`` is not a record of make verify (truncated, another table, a file of
-    the user's in its place), else None."""
+    the user's in its place, a pipe or a device), else None. A FIFO there is named unread: make
+    verify hung before any re-run, opening it for its first bytes, deaf to Ctrl-C and SIGTERM."""
+    if not p.is_file():
+        return "it is not a regular file (a pipe, a device or a directory)"
     try:
         t = pq.read_schema(p)
         prov = read_provenance(p)
