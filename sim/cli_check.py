@@ -1,11 +1,11 @@
 """``sim check STUDY.toml`` (:mod:`sim.cli` imports it when the command runs): the config
-``sim run`` would resolve (:func:`sim.cli_run.load_run`), listed key by key with its meaning,
+``sim run`` would resolve (:func:`sim.cli_load.load_run`), listed key by key with its meaning,
 bounds and unit, and the work the run would do."""
 
 from __future__ import annotations
 
 from sim.claims.rules import printed_differs
-from sim.cli_run import load_run
+from sim.cli_load import load_run
 from sim.execute import check_sweep, sweep_limits
 from sim.mc.config import check_chunks
 from sim.mc.read_when import read_in_a_cell
