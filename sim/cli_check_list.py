@@ -1,16 +1,16 @@
 """The listing of ``sim check STUDY.toml`` (:mod:`sim.cli_check` calls it once the study file
 is read and its config resolved): each key with its meaning, bounds and unit, the sweep, and
-the work the run would do (:func:`sim.execute.sweep_limits`: the estimate's engine), and what
+the work the run would do (:func:`sim.execute_sweep.sweep_limits`: the estimate's engine), and what
 the run would refuse of the sweep and its size."""
 
 from __future__ import annotations
 
 from sim.claims.rules import printed_differs
-from sim.execute import check_sweep, sweep_limits
+from sim.execute_sweep import check_sweep, sweep_limits
 from sim.mc.read_when import read_in_a_cell
 from sim.mc.sweep import expand, read_sweep
 from sim.mc.toml_text import toml_key, toml_value
-from sim.report.run_summary import off_setup
+from sim.report.off_paper import off_setup
 from sim.studies import unread_keys
 
 __all__ = ["listing"]
