@@ -1,7 +1,7 @@
 """U51 (issue 26's T54): what ``sim check`` of a study file loads before it refuses the file.
 
 * A refused ``sim check`` of wolf's or salsig's study file (a bad value, ``--set trials=-1``)
-  cost about 1.2 s of CPU (1.75 s with an unknown key) after T52 made reading their keys
+  cost about 1.2 s of CPU (1.9 s with an unknown key) after T52 made reading their keys
   light: the command's own modules loaded the run first. ``sim.cli_check`` imported
   ``sim.execute`` (the estimate, the sweep, the run's engine, the report's summary) and
   ``sim.cli_run`` (which held ``load_run``, and imports ``sim.execute`` and tqdm), and
