@@ -20,7 +20,8 @@ from sim.api_paths import arrow_name, too_long
 from sim.cli import DOC as cli_doc
 from sim.cli_args import parser as run_parser
 from sim.cli_errors import cwd_exists
-from sim.cli_run import check_run_args, load_run
+from sim.cli_load import load_run
+from sim.cli_run import check_run_args
 from sim.ends import unshown
 from sim.execute import sweep_limits
 from sim.input_places import check_inputs_outside

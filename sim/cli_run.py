@@ -1,6 +1,6 @@
 """``sim run STUDY.toml`` (:mod:`sim.cli` imports it when the command runs): the options a
-run needs (:func:`check_run_args`), the study and config they resolve (:func:`load_run`, which
-``sim check`` and ``python -m sim.batch`` use too) and the run itself."""
+run needs (:func:`check_run_args`) and the run itself, of the study and config they resolve
+(:func:`sim.cli_load.load_run`, which ``sim check`` and ``python -m sim.batch`` use too)."""
 
 from __future__ import annotations
 
@@ -13,24 +13,21 @@ from pathlib import Path
 
 from tqdm import tqdm  # noqa: F401 - loaded with the command: a shadowing tqdm.py is named
 
+from sim.cli_load import load_run
 from sim.ends import unshown
 from sim.execute import execute
-from sim.mc.config import ConfigError, parse_override
-from sim.mc.memory_limit import memory_given
+from sim.mc.config import ConfigError
 from sim.mc.overrides import as_read, command_values, listed, recorded
 from sim.mc.path_names import name_problem
 from sim.mc.paths import absolute
-from sim.mc.progress import set_quiet
 from sim.mc.sweep import read_sweep
-from sim.option_words import two_sets
 from sim.path_args import arrow_name, too_long
 from sim.places import default_out
 from sim.report.run_summary import terminal_summary, write_run_readme
 from sim.stops import check_interrupt
 from sim.studies import design_config, get_study
-from sim.studies.picking import load_picking_chunk
 
-__all__ = ["check_run_args", "load_run", "run"]
+__all__ = ["check_run_args", "load_run", "run"]  # load_run: sim.cli_load's, for its callers
 
 _SCHEDULER = re.compile(
     r"^(?:(?:tcp|tls|ucx|ws|wss)://)?(?:\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+)"
@@ -67,43 +64,6 @@ def check_run_args(args) -> Path:
         if why := too_long(args.out):  # it was the system's words and the whole path, of 6 kB
             raise ConfigError("--out", why)  # (a name over 255 bytes: named with the suffix)
     return absolute(args.out) if args.out else None
-
-
-def _keys_set(overrides: list[str]) -> set[str]:
-    """The keys of the ``--set`` overrides; a key set twice is refused (one of its values
-    would be dropped silently)."""
-    keys = set()
-    for text in overrides:
-        try:
-            key = parse_override(text)[0]
-        except ConfigError:
-            continue  # load_study names the bad override
-        if key in keys:
-            raise ConfigError(key, "given twice by --set: give one value")
-        keys.add(key)
-    return keys
-
-
-def load_run(args):
-    """The study and its resolved config, as ``sim run`` (or ``check``) with the parsed
-    ``args`` resolves them. ``--trials`` (or ``--set trials=``) without a chunk
-    size picks the largest chunk giving at least MIN_CHUNKS chunks; ``--chunk`` sets it
-    (:func:`sim.studies.picking.load_picking_chunk`, :func:`sim.load`'s rule too)."""
-    set_quiet(getattr(args, "quiet", False))  # the check of a large network shows its steps
-    overrides = list(args.set) + ([f"chunk={args.chunk}"] if args.chunk is not None else [])
-    given = _keys_set(args.set)
-    for opt, key in (("--trials", "trials"), ("--seed", "seed"), ("--chunk", "chunk")):
-        if getattr(args, key) is not None and key in given:  # one would be dropped silently
-            raise ConfigError(opt, f"given twice, as {opt} and as --set {key}=: give one")
-    trials = args.trials is not None or "trials" in given
-    picks = trials and args.chunk is None and "chunk" not in given  # --trials's chunk
-    try:
-        with memory_given(getattr(args, "max_memory_gb", None)):  # a network's size (sim.batch)
-            return load_picking_chunk(args.study, picks, overrides, args.trials, args.seed)
-    except ConfigError as e:  # --set trials=40,seed=3: two overrides in one, named
-        if hint := two_sets(args.set, e.key):
-            raise ConfigError(e.key, e.detail + hint) from None
-        raise
 
 
 def run(args) -> int:

@@ -1,7 +1,7 @@
 """A study file loaded for a command, with the chunk ``trials`` picks: ``sim run --trials N``
 (and ``sim check``, the batch's checks, :func:`sim.load` with ``trials=N``), one rule for all.
 
-``sim.cli_run.load_run`` and ``sim.api``'s loader wrote the rule twice (one of them negated): a
+``sim.cli_load.load_run`` and ``sim.api``'s loader wrote the rule twice (one of them negated): a
 change to one would have given ``sim.load`` another config, another config hash and other
 results than ``sim run`` with the same numbers. No study imports this module (the rule is
 the command's, as :func:`sim.studies.ported.foreign_key`'s wording): it is no part of any
@@ -14,8 +14,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from sim.mc.chunk_count import MIN_CHUNKS
 from sim.mc.config import ConfigError
-from sim.mc.runner import MIN_CHUNKS
 from sim.room import loaded
 from sim.studies import load_study
 from sim.studies.ported import foreign_key
