@@ -58,6 +58,7 @@ from pathlib import Path
 
 import pytest
 from conftest import TRIANGLE_NETWORK
+from sweep_cells import cell_columns
 
 import sim
 from sim.batch_checks import why_stale
@@ -81,16 +82,7 @@ NETWORK = (
 
 def _sweep_dir(d: Path, cfg: dict, table: dict, keys: list[str], values: dict) -> Path:
     """A sweep's results as its readers see them: ``sweep.parquet`` with its provenance."""
-    n = len(next(iter(values.values())))
-    cols = {
-        "cell": list(range(n)),
-        "replicate": [0] * n,
-        "label": [f"cell{i:04d}_r0" for i in range(n)],
-        "seed": list(range(1, n + 1)),
-        "feasible": [True] * n,
-        "reason": [""] * n,
-        **values,
-    }
+    cols = cell_columns(values)
     prov = {"study": cfg["study"], "config": cfg, "sweep": table, "sweep_keys": keys}
     d.mkdir()
     write_table(d / "sweep.parquet", cols, prov)

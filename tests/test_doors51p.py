@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from sweep_cells import cell_columns
 
 import sim
 from sim.cli import main as sim_main
@@ -37,15 +38,7 @@ def _sweep_dir(
     d = tmp_path / "sw"
     d.mkdir()
     n = len(cells)
-    cols = {
-        "cell": list(range(n)),
-        "replicate": [0] * n,
-        "label": [f"cell{i:04d}_r0" for i in range(n)],
-        "seed": list(range(1, n + 1)),
-        "feasible": [True] * n,
-        "reason": [""] * n,
-        **{k: [c[k] for c in cells] for k in keys},
-    }
+    cols = cell_columns({k: [c[k] for c in cells] for k in keys})
     if claim:  # one claim with its interval, for the figure
         cols |= {"c.v_mm": [1.0] * n, "c.v_mm:lo": [0.5] * n, "c.v_mm:hi": [1.5] * n}
     prov = provenance(
