@@ -478,7 +478,7 @@ def test_tiny_run_end_to_end(tiny_run):
     assert not [c for c in cl["claim"] if c.endswith("_recomputed")]
     for f in ("pareto.png", "corner.png"):
         assert (out / f).is_file()
-    assert "Consistent region" in design.report(out)
+    assert "Consistent region" in design.STUDIES["brown_design"].report(out)
 
 
 def test_coverage_of_a_linear_models_ellipses_is_95_percent():

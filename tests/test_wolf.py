@@ -420,7 +420,7 @@ def test_study_runs_and_reports(tiny_run):
     d = read_table(tmp_path / "degree.parquet").to_pydict()
     k = [j for j, (s, g) in enumerate(zip(d["spacing_mm"], d["degree"])) if s == 50.0 and g == 3]
     assert all(d["estimable_share"][j] == 0 for j in k)  # 2 rows cannot carry a cubic
-    md = wolf.report(tmp_path)
+    md = wolf.STUDIES["wolf_polynomial"].report(tmp_path)
     assert "wolf.after.rms_x_um" in md and f"{tmp_path.name}/vectors.png" in md
     assert "Consistent region" in md and "`pointing_sigma_um`" in md
     for f in (
